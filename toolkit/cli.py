@@ -1,0 +1,101 @@
+"""The ``sgtool`` command: a click group whose subcommands load lazily.
+
+Each subcommand lives in its own module ``sgtool.commands.<name>`` exposing ``command``
+(a click command or group), so ``sgtool --help`` stays fast and a missing optional piece
+never breaks the other commands. User errors (:class:`sgtool.errors.SgtoolError`) print as
+one line on stderr with exit code 2; anything else is a bug and keeps its traceback.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import logging
+import sys
+
+import click
+
+from sgtool import __version__
+from sgtool.errors import SgtoolError
+
+# command name -> module under sgtool.commands; order is the order of --help
+COMMANDS: dict[str, tuple[str, str]] = {
+    "demo": ("demo", "Record the demo house, replay it, benchmark planners, print the tables."),
+    "info": ("info", "Summarise a log: channels, schemas, counts, time range, frames, episode."),
+    "doctor": ("doctor", "Check a log for truncation or corruption and recover what is readable."),
+    "scenes": ("scenes", "Generate, draw and summarise houses; list search episodes."),
+    "record": ("record", "Simulate a robot in a house with PyBullet and log RGB-D + ids to MCAP."),
+    "replay": ("replay", "Rebuild voxel map, occupancy, Voronoi graph, rooms, scene graph."),
+    "view": ("view", "Write a Rerun recording (.rrd) of a log, or open the viewer."),
+    "import": ("import_", "Import ROS 1/2 bags and RGB-D folders into sgtool logs."),
+    "distill": ("distill", "Train the relational priors (containment, co-occurrence) MLPs."),
+    "bench": ("bench", "Run the symbolic object-search benchmark over planners."),
+    "run": ("run", "Closed-loop search in PyBullet with a planner, logged to MCAP."),
+    "eval": ("eval", "Recompute metrics from episode logs; evaluate planners offline."),
+}
+
+CONTEXT_SETTINGS = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
+
+
+class LazyGroup(click.Group):
+    def _available(self) -> dict[str, tuple[str, str]]:
+        out = {}
+        for name, (module, summary) in COMMANDS.items():
+            if importlib.util.find_spec(f"sgtool.commands.{module}") is not None:
+                out[name] = (module, summary)
+        return out
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return list(self._available())
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        avail = self._available()
+        if cmd_name not in avail:
+            return None
+        mod = importlib.import_module(f"sgtool.commands.{avail[cmd_name][0]}")
+        return mod.command
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        rows = [(name, summary) for name, (_, summary) in self._available().items()]
+        if rows:
+            with formatter.section("Commands"):
+                formatter.write_dl(rows)
+
+
+@click.group(cls=LazyGroup, context_settings=CONTEXT_SETTINGS)
+@click.version_option(__version__, "--version", prog_name="sgtool")
+@click.option("-v", "--verbose", count=True, help="More log output (-v info, -vv debug).")
+def cli(verbose: int) -> None:
+    """sgtool: language-grounded interactive object search on 3D scene graphs.
+
+    Logs are MCAP files: record them in simulation or import them, replay them into scene
+    graphs, look at them in Rerun, benchmark planners on them. Run `sgtool COMMAND -h` for
+    the options of a command.
+    """
+    level = logging.WARNING - 10 * min(verbose, 2)
+    logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+
+
+def main(argv: list[str] | None = None) -> None:
+    try:
+        cli.main(args=argv, prog_name="sgtool", standalone_mode=False)
+    except SgtoolError as e:
+        click.echo(f"sgtool: error: {e}", err=True)
+        sys.exit(e.exit_code)
+    except click.exceptions.Abort:
+        click.echo("sgtool: aborted", err=True)
+        sys.exit(130)
+    except click.ClickException as e:
+        e.show()
+        sys.exit(e.exit_code)
+    except click.exceptions.Exit as e:
+        sys.exit(e.exit_code)
+    except KeyboardInterrupt:
+        click.echo("sgtool: interrupted", err=True)
+        sys.exit(130)
+    except BrokenPipeError:
+        sys.exit(0)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,25 @@
+"""Errors a user can cause and fix. The CLI prints them as one clear message, no traceback."""
+
+from __future__ import annotations
+
+
+class SgtoolError(Exception):
+    """Base for every error caused by input a user gave (a file, an option, a log)."""
+
+    exit_code = 2
+
+
+class LogFormatError(SgtoolError):
+    """A file is not an sgtool/MCAP log, is truncated or corrupt where it must not be."""
+
+
+class SchemaVersionError(LogFormatError):
+    """A log was written with a log schema major version this sgtool cannot read."""
+
+
+class MissingChannelError(LogFormatError):
+    """A log lacks a channel that the requested operation needs."""
+
+
+class SpecError(SgtoolError):
+    """A house spec (or another JSON input) fails validation; the message names the field."""

@@ -1,0 +1,58 @@
+"""The planner interface: scene graph + query -> action.
+
+Every planner (random, greedy, sbert, scout, moma-llm) implements :class:`Planner`. A planner
+never touches a simulator; it sees only :class:`~sgtool.scenegraph.graph.SceneGraph`s and
+returns :class:`Action`s whose ``target`` is the id of a node of the graph it was given
+(or None for ``done``). Whoever executes the action (the symbolic benchmark, the PyBullet
+closed loop) reports the outcome back through :meth:`Planner.feedback`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal, Protocol
+
+from sgtool.scenegraph.graph import SceneGraph
+
+Skill = Literal["navigate", "open", "close", "explore", "done"]
+Outcome = Literal["success", "failure", "invalid"]
+
+
+@dataclass(frozen=True)
+class Action:
+    """A high-level action on a scene-graph node.
+
+    - ``navigate(target)``: go to a room, region, frontier or object node;
+    - ``open(target)``: go to and open an object or a door (MoMa-LLM's go_to_and_open);
+    - ``close(target)``: close an object or door;
+    - ``explore(target)``: explore an unexplored room or a frontier;
+    - ``done()``: the target is observed; ``target`` is the node id of the found object.
+    """
+
+    skill: Skill
+    target: str | None = None
+    reason: str = ""
+    # seconds the planner took to decide; filled by the caller, not by the planner
+    decision_time_s: float = 0.0
+    scores: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Feedback:
+    action: Action
+    outcome: Outcome
+    message: str = ""
+    travelled_m: float = 0.0
+
+
+class Planner(Protocol):
+    name: str
+
+    def reset(self, query: str, seed: int = 0) -> None:
+        """Start a new episode searching for ``query`` (an object category, free text)."""
+
+    def decide(self, graph: SceneGraph) -> Action:
+        """Choose the next action on ``graph``."""
+
+    def feedback(self, fb: Feedback) -> None:
+        """Learn the outcome of the last action (planners may ignore it)."""

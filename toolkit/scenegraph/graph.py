@@ -1,0 +1,263 @@
+"""The hierarchical scene graph: the one structure every planner sees.
+
+Five layers, as in SCOUT (section III): root -> rooms -> regions/frontiers -> objects ->
+nested objects. Every node has exactly one parent in the layer above (objects nested in or
+on another object have that object as parent). Rooms are joined by intra-layer edges (doors
+or open passages). States and affordances are attributes.
+
+The same type comes out of the replayer (from a log), the live closed loop, and the
+symbolic benchmark (``sgtool.datasets.symbolic``). Its canonical JSON form
+(:meth:`SceneGraph.to_json`) is byte-stable: sorted keys, fixed float rounding, nodes in
+id order, so two replays of one log give identical bytes.
+
+Node ids are strings with a layer prefix: ``room:3``, ``region:3.1``, ``frontier:7``,
+``obj:42`` (42 is the instance id of the log), ``door:5``.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, field
+from typing import Any, Literal
+
+SCENE_GRAPH_VERSION = "1.0"
+
+RegionKind = Literal["region", "frontier"]
+FrontierType = Literal["unexplored area", "leading out"]
+Relation = Literal["inside", "ontop"]
+OpenState = Literal["open", "closed"]
+
+_ROUND = 4  # decimals kept for floats in the canonical form
+
+
+def _r(x: float) -> float:
+    v = round(float(x), _ROUND)
+    return 0.0 if v == 0 else v  # no "-0.0"
+
+
+def _rt(xs: tuple[float, ...] | list[float]) -> list[float]:
+    return [_r(x) for x in xs]
+
+
+@dataclass(frozen=True)
+class RoomNode:
+    """A room. ``explored`` is False for rooms known only through a door (SCOUT: unexplored
+    room nodes, all attributes hidden: category "unknown", no children)."""
+
+    id: str
+    category: str = "unknown"
+    position: tuple[float, float] = (0.0, 0.0)
+    explored: bool = True
+    # category -> probability, best first; empty when unknown
+    category_scores: tuple[tuple[str, float], ...] = ()
+    neighbours: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class RegionNode:
+    """A region of a room: a visited place ("region") or a place whose contents are not yet
+    revealed ("frontier"). Frontiers carry MoMa-LLM's type: "unexplored area" (inside the
+    room) or "leading out" (towards unknown space outside it)."""
+
+    id: str
+    room: str
+    position: tuple[float, float]
+    kind: RegionKind = "region"
+    frontier_type: FrontierType | None = None
+    size: float = 0.0  # frontier length in metres (0 for regions)
+
+
+@dataclass(frozen=True)
+class ObjectNode:
+    """An object, container, or nested object. ``parent`` is a region id for first-level
+    objects, an object id for nested ones (with ``relation``). ``state`` is "open" or
+    "closed" for openable things, None otherwise. ``explored`` is True once its contents
+    have been revealed (opened or looked into)."""
+
+    id: str
+    category: str
+    parent: str
+    room: str
+    position: tuple[float, float, float]
+    instance: int = -1
+    relation: Relation | None = None
+    state: OpenState | None = None
+    affordances: tuple[str, ...] = ()
+    explored: bool = False
+
+
+@dataclass(frozen=True)
+class DoorNode:
+    """A door between rooms. A closed door leading to an unexplored room is an entrance to
+    unexplored space; ``rooms`` names the rooms it joins (one of them may be unexplored)."""
+
+    id: str
+    position: tuple[float, float]
+    state: OpenState
+    rooms: tuple[str, ...] = ()
+    instance: int = -1
+
+
+@dataclass(frozen=True)
+class RobotState:
+    position: tuple[float, float]
+    yaw: float = 0.0
+    room: str | None = None
+    region: str | None = None
+
+
+@dataclass(frozen=True)
+class SceneGraph:
+    """One observation of the world at ``time_ns`` (log time; 0 in the symbolic benchmark).
+
+    ``distances`` holds the travel distance in metres from the robot to every node it could
+    act on (rooms, regions, frontiers, objects, doors), as computed by whoever built the
+    graph (Voronoi graph paths in the replayer, geodesics on the occupancy grid in the
+    symbolic benchmark). A node missing from it is unreachable.
+    """
+
+    robot: RobotState
+    rooms: tuple[RoomNode, ...] = ()
+    regions: tuple[RegionNode, ...] = ()
+    objects: tuple[ObjectNode, ...] = ()
+    doors: tuple[DoorNode, ...] = ()
+    distances: dict[str, float] = field(default_factory=dict)
+    time_ns: int = 0
+    version: str = SCENE_GRAPH_VERSION
+
+    # ----- look-ups -------------------------------------------------------------------
+    def node(self, node_id: str) -> RoomNode | RegionNode | ObjectNode | DoorNode | None:
+        for group in (self.rooms, self.regions, self.objects, self.doors):
+            for n in group:
+                if n.id == node_id:
+                    return n
+        return None
+
+    def node_ids(self) -> set[str]:
+        return {n.id for g in (self.rooms, self.regions, self.objects, self.doors) for n in g}
+
+    def room(self, room_id: str) -> RoomNode | None:
+        return next((r for r in self.rooms if r.id == room_id), None)
+
+    def objects_in(self, room_id: str) -> tuple[ObjectNode, ...]:
+        return tuple(o for o in self.objects if o.room == room_id)
+
+    def children(self, node_id: str) -> tuple[ObjectNode, ...]:
+        return tuple(o for o in self.objects if o.parent == node_id)
+
+    def frontiers(self) -> tuple[RegionNode, ...]:
+        return tuple(r for r in self.regions if r.kind == "frontier")
+
+    def categories(self) -> set[str]:
+        return {o.category for o in self.objects}
+
+    # ----- canonical form -------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        def room(n: RoomNode) -> dict[str, Any]:
+            d = asdict(n)
+            d["position"] = _rt(n.position)
+            d["category_scores"] = [[c, _r(p)] for c, p in n.category_scores]
+            d["neighbours"] = sorted(n.neighbours)
+            return d
+
+        def region(n: RegionNode) -> dict[str, Any]:
+            d = asdict(n)
+            d["position"] = _rt(n.position)
+            d["size"] = _r(n.size)
+            return d
+
+        def obj(n: ObjectNode) -> dict[str, Any]:
+            d = asdict(n)
+            d["position"] = _rt(n.position)
+            d["affordances"] = sorted(n.affordances)
+            return d
+
+        def door(n: DoorNode) -> dict[str, Any]:
+            d = asdict(n)
+            d["position"] = _rt(n.position)
+            d["rooms"] = sorted(n.rooms)
+            return d
+
+        return {
+            "version": self.version,
+            "time_ns": int(self.time_ns),
+            "robot": {
+                "position": _rt(self.robot.position),
+                "yaw": _r(self.robot.yaw),
+                "room": self.robot.room,
+                "region": self.robot.region,
+            },
+            "rooms": [room(n) for n in sorted(self.rooms, key=lambda n: _idkey(n.id))],
+            "regions": [region(n) for n in sorted(self.regions, key=lambda n: _idkey(n.id))],
+            "objects": [obj(n) for n in sorted(self.objects, key=lambda n: _idkey(n.id))],
+            "doors": [door(n) for n in sorted(self.doors, key=lambda n: _idkey(n.id))],
+            "distances": {k: _r(v) for k, v in sorted(self.distances.items())},
+        }
+
+    def to_json(self) -> str:
+        """Canonical JSON: byte-identical for equal graphs."""
+        return json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"))
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> SceneGraph:
+        major = str(d.get("version", "0")).split(".")[0]
+        if major != SCENE_GRAPH_VERSION.split(".")[0]:
+            raise ValueError(
+                f"scene graph version {d.get('version')} is not readable by this sgtool "
+                f"(reads {SCENE_GRAPH_VERSION.split('.')[0]}.x)"
+            )
+        rb = d["robot"]
+        return cls(
+            robot=RobotState(
+                position=tuple(rb["position"]), yaw=rb.get("yaw", 0.0),
+                room=rb.get("room"), region=rb.get("region"),
+            ),
+            rooms=tuple(
+                RoomNode(
+                    id=r["id"], category=r["category"], position=tuple(r["position"]),
+                    explored=r["explored"],
+                    category_scores=tuple((c, p) for c, p in r.get("category_scores", [])),
+                    neighbours=tuple(r.get("neighbours", [])),
+                )
+                for r in d.get("rooms", [])
+            ),
+            regions=tuple(
+                RegionNode(
+                    id=r["id"], room=r["room"], position=tuple(r["position"]), kind=r["kind"],
+                    frontier_type=r.get("frontier_type"), size=r.get("size", 0.0),
+                )
+                for r in d.get("regions", [])
+            ),
+            objects=tuple(
+                ObjectNode(
+                    id=o["id"], category=o["category"], parent=o["parent"], room=o["room"],
+                    position=tuple(o["position"]), instance=o.get("instance", -1),
+                    relation=o.get("relation"), state=o.get("state"),
+                    affordances=tuple(o.get("affordances", [])), explored=o.get("explored", False),
+                )
+                for o in d.get("objects", [])
+            ),
+            doors=tuple(
+                DoorNode(
+                    id=x["id"], position=tuple(x["position"]), state=x["state"],
+                    rooms=tuple(x.get("rooms", [])), instance=x.get("instance", -1),
+                )
+                for x in d.get("doors", [])
+            ),
+            distances=dict(d.get("distances", {})),
+            time_ns=int(d.get("time_ns", 0)),
+            version=str(d.get("version", SCENE_GRAPH_VERSION)),
+        )
+
+    @classmethod
+    def from_json(cls, text: str | bytes) -> SceneGraph:
+        return cls.from_dict(json.loads(text))
+
+
+def _idkey(node_id: str) -> tuple[str, tuple[int | str, ...]]:
+    """Sort ids naturally: room:2 before room:10, region:3.1 before region:3.12."""
+    prefix, _, rest = node_id.partition(":")
+    parts: list[int | str] = []
+    for p in rest.split("."):
+        parts.append(int(p) if p.isdigit() else p)
+    return prefix, tuple((0, p) if isinstance(p, int) else (1, p) for p in parts)  # type: ignore[misc]
