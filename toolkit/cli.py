@@ -78,7 +78,9 @@ def cli(verbose: int) -> None:
 
 def main(argv: list[str] | None = None) -> None:
     try:
-        cli.main(args=argv, prog_name="sgtool", standalone_mode=False)
+        rc = cli.main(args=argv, prog_name="sgtool", standalone_mode=False)
+        if isinstance(rc, int) and rc != 0:
+            sys.exit(rc)
     except SgtoolError as e:
         click.echo(f"sgtool: error: {e}", err=True)
         sys.exit(e.exit_code)

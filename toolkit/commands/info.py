@@ -1,0 +1,24 @@
+"""``sgtool info LOG``: what a log holds."""
+
+from __future__ import annotations
+
+import json
+
+import click
+
+from sgtool.log.inspect import format_summary, summarize
+
+
+@click.command("info")
+@click.argument("log", type=click.Path(dir_okay=False))
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object (for scripts).")
+def command(log: str, as_json: bool) -> None:
+    """Summarise LOG: channels, schemas, message counts, time range, frame count, log
+    schema version and the episode summary. Works on foreign MCAP files too (lists their
+    topics, schemas and counts). A truncated file gives an error that points to
+    `sgtool doctor`."""
+    s = summarize(log)
+    if as_json:
+        click.echo(json.dumps(s, indent=2, sort_keys=True))
+    else:
+        click.echo(format_summary(s))

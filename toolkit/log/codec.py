@@ -1,0 +1,184 @@
+"""Conversions between numpy arrays and Foxglove protobuf messages (pure functions)."""
+
+from __future__ import annotations
+
+import numpy as np
+from foxglove_schemas_protobuf.CameraCalibration_pb2 import CameraCalibration
+from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
+from foxglove_schemas_protobuf.Grid_pb2 import Grid
+from foxglove_schemas_protobuf.PackedElementField_pb2 import PackedElementField
+from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
+from google.protobuf.timestamp_pb2 import Timestamp
+
+from sgtool.log import schemas as S
+from sgtool.log.frame import CameraIntrinsics
+
+_DTYPES = {
+    "rgb8": (np.dtype(np.uint8), 3),
+    "bgr8": (np.dtype(np.uint8), 3),
+    "rgba8": (np.dtype(np.uint8), 4),
+    "bgra8": (np.dtype(np.uint8), 4),
+    "mono8": (np.dtype(np.uint8), 1),
+    "8UC1": (np.dtype(np.uint8), 1),
+    "8UC3": (np.dtype(np.uint8), 3),
+    "mono16": (np.dtype("<u2"), 1),
+    "16UC1": (np.dtype("<u2"), 1),
+    "32SC1": (np.dtype("<i4"), 1),
+    "32FC1": (np.dtype("<f4"), 1),
+}
+
+
+def timestamp(t_ns: int) -> Timestamp:
+    return Timestamp(seconds=int(t_ns // 1_000_000_000), nanos=int(t_ns % 1_000_000_000))
+
+
+def encode_image(t_ns: int, arr: np.ndarray, encoding: str, frame_id: str) -> RawImage:
+    dtype, channels = _DTYPES[encoding]
+    a = np.ascontiguousarray(arr, dtype=dtype)
+    h, w = a.shape[:2]
+    if (channels == 1 and a.ndim != 2) or (channels > 1 and a.shape[2:] != (channels,)):
+        raise ValueError(f"image of shape {a.shape} does not fit encoding {encoding}")
+    return RawImage(
+        timestamp=timestamp(t_ns), frame_id=frame_id, width=w, height=h, encoding=encoding,
+        step=w * channels * dtype.itemsize, data=a.tobytes(),
+    )
+
+
+def decode_image(msg: RawImage) -> np.ndarray:
+    if msg.encoding not in _DTYPES:
+        raise ValueError(f"unsupported image encoding {msg.encoding!r}")
+    dtype, channels = _DTYPES[msg.encoding]
+    row = msg.width * channels * dtype.itemsize
+    buf = np.frombuffer(msg.data, dtype=np.uint8)
+    if msg.step != row:  # rows padded
+        buf = buf.reshape(msg.height, msg.step)[:, :row].copy()
+    a = buf.view(dtype)
+    shape = (msg.height, msg.width) if channels == 1 else (msg.height, msg.width, channels)
+    a = a.reshape(shape)
+    if msg.encoding in ("bgr8", "bgra8"):
+        a = a[..., [2, 1, 0]]
+    elif msg.encoding == "rgba8":
+        a = a[..., :3]
+    return a
+
+
+def depth_to_mm(depth_m: np.ndarray) -> np.ndarray:
+    """Metric depth (float, NaN/inf/<=0 = no return) -> uint16 millimetres (0 = none)."""
+    d = np.nan_to_num(np.asarray(depth_m, dtype=np.float32), nan=0.0, posinf=0.0, neginf=0.0)
+    mm = np.rint(d * S.DEPTH_SCALE)
+    mm[(mm < 0) | (mm > 65535)] = 0
+    return mm.astype("<u2")
+
+
+def depth_from_image(msg: RawImage, scale: float = S.DEPTH_SCALE) -> np.ndarray:
+    """Depth image -> float32 metres (0 = no return)."""
+    a = decode_image(msg)
+    if msg.encoding == "32FC1":
+        return np.nan_to_num(a.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
+    return a.astype(np.float32) / np.float32(scale)
+
+
+def encode_calibration(t_ns: int, k: CameraIntrinsics, frame_id: str) -> CameraCalibration:
+    return CameraCalibration(
+        timestamp=timestamp(t_ns), frame_id=frame_id, width=k.width, height=k.height,
+        distortion_model="plumb_bob", D=[0.0] * 5,
+        K=[k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0],
+        R=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+        P=[k.fx, 0.0, k.cx, 0.0, 0.0, k.fy, k.cy, 0.0, 0.0, 0.0, 1.0, 0.0],
+    )
+
+
+def decode_calibration(msg: CameraCalibration) -> CameraIntrinsics:
+    K = list(msg.K)  # noqa: N806
+    return CameraIntrinsics(int(msg.width), int(msg.height), K[0], K[4], K[2], K[5])
+
+
+def quat_from_matrix(R: np.ndarray) -> tuple[float, float, float, float]:  # noqa: N803
+    """Rotation matrix -> unit quaternion (x, y, z, w), w >= 0 (Shepperd's method)."""
+    m = np.asarray(R, dtype=np.float64)
+    tr = m[0, 0] + m[1, 1] + m[2, 2]
+    if tr > 0:
+        s = np.sqrt(tr + 1.0) * 2
+        w, x = 0.25 * s, (m[2, 1] - m[1, 2]) / s
+        y, z = (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2
+        w, x = (m[2, 1] - m[1, 2]) / s, 0.25 * s
+        y, z = (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s
+    elif m[1, 1] > m[2, 2]:
+        s = np.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2
+        w, x = (m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s
+        y, z = 0.25 * s, (m[1, 2] + m[2, 1]) / s
+    else:
+        s = np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2
+        w, x = (m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s
+        y, z = (m[1, 2] + m[2, 1]) / s, 0.25 * s
+    q = np.array([x, y, z, w])
+    q /= np.linalg.norm(q)
+    if q[3] < 0:
+        q = -q
+    return float(q[0]), float(q[1]), float(q[2]), float(q[3])
+
+
+def matrix_from_quat(x: float, y: float, z: float, w: float) -> np.ndarray:
+    n = x * x + y * y + z * z + w * w
+    if n == 0:
+        return np.eye(3)
+    s = 2.0 / n
+    return np.array(
+        [
+            [1 - s * (y * y + z * z), s * (x * y - z * w), s * (x * z + y * w)],
+            [s * (x * y + z * w), 1 - s * (x * x + z * z), s * (y * z - x * w)],
+            [s * (x * z - y * w), s * (y * z + x * w), 1 - s * (x * x + y * y)],
+        ]
+    )
+
+
+def encode_transform(t_ns: int, parent: str, child: str, T: np.ndarray) -> FrameTransform:  # noqa: N803
+    """``T`` is parent_T_child (4x4): the pose of ``child`` in ``parent``."""
+    T = np.asarray(T, dtype=np.float64)  # noqa: N806
+    qx, qy, qz, qw = quat_from_matrix(T[:3, :3])
+    msg = FrameTransform(timestamp=timestamp(t_ns), parent_frame_id=parent, child_frame_id=child)
+    msg.translation.x, msg.translation.y, msg.translation.z = (float(v) for v in T[:3, 3])
+    msg.rotation.x, msg.rotation.y, msg.rotation.z, msg.rotation.w = qx, qy, qz, qw
+    return msg
+
+
+def decode_transform(msg: FrameTransform) -> np.ndarray:
+    T = np.eye(4)  # noqa: N806
+    r = msg.rotation
+    T[:3, :3] = matrix_from_quat(r.x, r.y, r.z, r.w)
+    T[:3, 3] = (msg.translation.x, msg.translation.y, msg.translation.z)
+    return T
+
+
+def encode_grid(
+    t_ns: int, cells: np.ndarray, origin_xy: tuple[float, float], resolution: float,
+    frame_id: str = S.WORLD_FRAME, z: float = 0.0,
+) -> Grid:
+    """An int8 occupancy grid (rows = +y, cols = +x) as a Foxglove Grid with one int8 field
+    ``occupancy`` (-1 unknown, 0 free, 100 occupied; the ROS convention)."""
+    a = np.ascontiguousarray(cells, dtype=np.int8)
+    h, w = a.shape
+    msg = Grid(
+        timestamp=timestamp(t_ns), frame_id=frame_id, column_count=w,
+        cell_size=_vec2(resolution, resolution), row_stride=w, cell_stride=1,
+        fields=[PackedElementField(name="occupancy", offset=0, type=PackedElementField.INT8)],
+        data=a.tobytes(),
+    )
+    msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = origin_xy[0], origin_xy[1], z
+    msg.pose.orientation.w = 1.0
+    return msg
+
+
+def decode_grid(msg: Grid) -> tuple[np.ndarray, tuple[float, float], float]:
+    w = int(msg.column_count)
+    h = len(msg.data) // max(int(msg.row_stride), 1)
+    a = np.frombuffer(msg.data, dtype=np.int8).reshape(h, msg.row_stride)[:, :w].copy()
+    return a, (msg.pose.position.x, msg.pose.position.y), float(msg.cell_size.x)
+
+
+def _vec2(x: float, y: float):  # type: ignore[no-untyped-def]
+    from foxglove_schemas_protobuf.Vector2_pb2 import Vector2
+
+    return Vector2(x=x, y=y)

@@ -1,0 +1,435 @@
+"""Reading sgtool logs: frames, records, attachments, random access by time.
+
+:class:`LogReader` opens an indexed MCAP file (a complete one: a truncated file gives a
+:class:`~sgtool.errors.LogFormatError` that points to ``sgtool doctor --recover``). It
+checks the log schema version of sgtool logs (a newer major version is refused with a
+message naming both versions) and still opens foreign MCAP files (ROS 2 recordings) for
+listing; operations that need an sgtool channel name it when it is missing.
+
+A *frame* is the depth message at one log time together with the RGB and instance-id
+messages of the same log time, the camera calibration in force and the camera pose composed
+from the ``/tf`` transforms (world -> ... -> camera) in force at that time.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+from mcap.exceptions import InvalidMagic, McapError
+from mcap.reader import SeekingReader
+from mcap.records import Channel, Message, Schema
+from mcap.summary import Summary
+
+from sgtool.errors import LogFormatError, MissingChannelError, SchemaVersionError
+from sgtool.log import codec
+from sgtool.log import schemas as S
+from sgtool.log.frame import CameraIntrinsics, Frame
+
+_PROTO_CLASSES: dict[str, Any] = {}
+
+
+def _proto_class(schema_name: str) -> Any:
+    """The Foxglove protobuf class for a schema name, or None for other schemas."""
+    if schema_name in _PROTO_CLASSES:
+        return _PROTO_CLASSES[schema_name]
+    cls = None
+    if schema_name.startswith("foxglove."):
+        import importlib
+
+        short = schema_name.split(".", 1)[1]
+        try:
+            mod = importlib.import_module(f"foxglove_schemas_protobuf.{short}_pb2")
+            cls = getattr(mod, short)
+        except (ImportError, AttributeError):
+            cls = None
+    _PROTO_CLASSES[schema_name] = cls
+    return cls
+
+
+@dataclass(frozen=True)
+class ChannelInfo:
+    id: int
+    topic: str
+    schema_name: str
+    schema_encoding: str
+    message_encoding: str
+    message_count: int
+
+
+@dataclass(frozen=True)
+class Decoded:
+    topic: str
+    log_time_ns: int
+    schema_name: str
+    message: Any  # protobuf message, dict (JSON) or bytes (unknown encodings)
+
+
+class TransformBuffer:
+    """Transforms by (parent, child) over time; lookup of the latest at or before t."""
+
+    def __init__(self) -> None:
+        self._parent: dict[str, str] = {}
+        self._times: dict[str, list[int]] = {}
+        self._values: dict[str, list[np.ndarray]] = {}
+
+    def add(self, t_ns: int, parent: str, child: str, T: np.ndarray) -> None:  # noqa: N803
+        self._parent[child] = parent
+        times = self._times.setdefault(child, [])
+        vals = self._values.setdefault(child, [])
+        if times and t_ns < times[-1]:
+            i = int(np.searchsorted(times, t_ns, side="right"))
+            times.insert(i, t_ns)
+            vals.insert(i, T)
+        else:
+            times.append(t_ns)
+            vals.append(T)
+
+    def lookup(self, t_ns: int, target: str, root: str = S.WORLD_FRAME) -> np.ndarray | None:
+        """root_T_target at ``t_ns``, or None when the chain is not known yet."""
+        T = np.eye(4)  # noqa: N806
+        frame = target
+        for _ in range(32):
+            if frame == root:
+                return T
+            if frame not in self._parent:
+                return None
+            times = self._times[frame]
+            i = int(np.searchsorted(times, t_ns, side="right")) - 1
+            if i < 0:
+                return None
+            T = self._values[frame][i] @ T  # noqa: N806
+            frame = self._parent[frame]
+        return None
+
+
+class LogReader:
+    """An open log. Use as a context manager or call :meth:`close`."""
+
+    def __init__(self, path: str | os.PathLike[str], *, check_version: bool = True) -> None:
+        self.path = Path(path)
+        if not self.path.exists():
+            raise LogFormatError(f"{self.path}: no such file")
+        if self.path.is_dir():
+            raise LogFormatError(f"{self.path} is a folder; expected an MCAP file")
+        self._f: IO[bytes] = open(self.path, "rb")  # noqa: SIM115
+        try:
+            self._reader = SeekingReader(self._f, validate_crcs=False)
+            self._reader.get_header()
+            summary = self._reader.get_summary()
+        except InvalidMagic as e:
+            self._f.close()
+            raise LogFormatError(
+                f"{self.path}: not an MCAP file (it does not start with the MCAP magic bytes)"
+            ) from e
+        except (McapError, ValueError, EOFError, OSError) as e:
+            self._f.close()
+            raise LogFormatError(
+                f"{self.path}: not a readable MCAP file ({type(e).__name__}: {e}); "
+                f"`sgtool doctor {self.path}` says what is wrong"
+            ) from e
+        except Exception as e:  # the mcap library raises struct.error etc. on garbage
+            self._f.close()
+            raise LogFormatError(
+                f"{self.path}: not a readable MCAP file ({type(e).__name__}); "
+                f"`sgtool doctor {self.path}` says what is wrong"
+            ) from e
+        if summary is None:
+            self._f.close()
+            raise LogFormatError(
+                f"{self.path}: the file has no summary section (truncated or still being "
+                f"written); recover it with `sgtool doctor {self.path} --recover OUT.mcap`"
+            )
+        self.summary: Summary = summary
+        self.metadata: dict[str, dict[str, str]] = {
+            m.name: dict(m.metadata) for m in self._reader.iter_metadata()
+        }
+        self._decoders: dict[int, Any] = {}
+        self._frame_times: list[int] | None = None
+        if check_version:
+            self.check_version()
+
+    # ----- identity -------------------------------------------------------------------
+    @property
+    def is_sgtool(self) -> bool:
+        return S.METADATA_NAME in self.metadata
+
+    @property
+    def schema_version(self) -> tuple[int, int] | None:
+        meta = self.metadata.get(S.METADATA_NAME)
+        if not meta or "log_schema_version" not in meta:
+            return None
+        try:
+            return S.parse_version(meta["log_schema_version"])
+        except ValueError as e:
+            raise LogFormatError(
+                f"{self.path}: bad log_schema_version {meta['log_schema_version']!r}"
+            ) from e
+
+    @property
+    def seed(self) -> int | None:
+        s = self.metadata.get(S.METADATA_NAME, {}).get("seed", "")
+        return int(s) if s else None
+
+    def check_version(self) -> None:
+        v = self.schema_version
+        if v is not None and v[0] > S.LOG_SCHEMA_VERSION[0]:
+            raise SchemaVersionError(
+                f"{self.path} was written with log schema version {S.format_version(v)}; "
+                f"this sgtool reads version {S.LOG_SCHEMA_VERSION[0]}.x "
+                f"(log schema {S.format_version(S.LOG_SCHEMA_VERSION)}): upgrade sgtool"
+            )
+
+    # ----- summary ----------------------------------------------------------------------
+    def channels(self) -> list[ChannelInfo]:
+        counts = self.summary.statistics.channel_message_counts if self.summary.statistics else {}
+        out = []
+        for cid, ch in sorted(self.summary.channels.items()):
+            sch = self.summary.schemas.get(ch.schema_id)
+            out.append(
+                ChannelInfo(
+                    cid, ch.topic, sch.name if sch else "", sch.encoding if sch else "",
+                    ch.message_encoding, int(counts.get(cid, 0)),
+                )
+            )
+        return out
+
+    def topics(self) -> set[str]:
+        return {ch.topic for ch in self.summary.channels.values()}
+
+    def has(self, topic: str) -> bool:
+        return topic in self.topics()
+
+    def require(self, *topics: str, why: str = "") -> None:
+        for t in topics:
+            if not self.has(t):
+                extra = f" ({why})" if why else ""
+                raise MissingChannelError(f"{self.path} has no channel {t}{extra}")
+
+    def time_range(self) -> tuple[int, int] | None:
+        st = self.summary.statistics
+        if st is None or st.message_count == 0:
+            return None
+        return int(st.message_start_time), int(st.message_end_time)
+
+    def message_count(self, topic: str | None = None) -> int:
+        return sum(c.message_count for c in self.channels() if topic is None or c.topic == topic)
+
+    def frame_count(self) -> int:
+        return self.message_count(S.DEPTH)
+
+    # ----- attachments ----------------------------------------------------------------
+    def attachments(self) -> dict[str, bytes]:
+        return {a.name: a.data for a in self._reader.iter_attachments()}
+
+    def attachment(self, name: str) -> bytes | None:
+        for a in self._reader.iter_attachments():
+            if a.name == name:
+                return a.data
+        return None
+
+    def house_json(self) -> str | None:
+        data = self.attachment(S.HOUSE_ATTACHMENT)
+        return data.decode() if data is not None else None
+
+    # ----- messages ---------------------------------------------------------------------
+    def _decode(self, schema: Schema | None, channel: Channel, message: Message) -> Any:
+        if channel.message_encoding == "json":
+            return json.loads(message.data)
+        if channel.message_encoding == "protobuf" and schema is not None:
+            cls = _proto_class(schema.name)
+            if cls is not None:
+                msg = cls()
+                msg.ParseFromString(message.data)
+                return msg
+            dec = self._decoders.get(channel.id)
+            if dec is None:
+                from mcap_protobuf.decoder import DecoderFactory
+
+                dec = DecoderFactory().decoder_for("protobuf", schema)
+                self._decoders[channel.id] = dec
+            return dec(message.data) if dec else message.data
+        return message.data
+
+    def messages(
+        self,
+        topics: Iterable[str] | None = None,
+        *,
+        start_ns: int | None = None,
+        end_ns: int | None = None,
+        reverse: bool = False,
+    ) -> Iterator[Decoded]:
+        """Decoded messages in log-time order, ``start_ns <= t < end_ns``."""
+        topics = list(topics) if topics is not None else None
+        for schema, channel, message in self._reader.iter_messages(
+            topics=topics, starting_at=start_ns, ending_before=end_ns,
+            log_time_order=True, reverse=reverse,
+        ):
+            yield Decoded(
+                channel.topic, int(message.log_time), schema.name if schema else "",
+                self._decode(schema, channel, message),
+            )
+
+    def records(self, kind: str, **kw: Any) -> Iterator[tuple[int, dict[str, Any]]]:
+        """(log time, record) of an sgtool JSON record kind, in time order."""
+        topic = S.RECORDS[kind].topic
+        if not self.has(topic):
+            return
+        for d in self.messages([topic], **kw):
+            yield d.log_time_ns, d.message
+
+    def last_record(self, kind: str, at_ns: int | None = None) -> dict[str, Any] | None:
+        topic = S.RECORDS[kind].topic
+        if not self.has(topic):
+            return None
+        end = None if at_ns is None else at_ns + 1
+        for d in self.messages([topic], end_ns=end, reverse=True):
+            return d.message
+        return None
+
+    # ----- frames -----------------------------------------------------------------------
+    def frames(
+        self, *, start_ns: int | None = None, end_ns: int | None = None
+    ) -> Iterator[Frame]:
+        """Frames in log-time order (see the module docstring)."""
+        self.require(S.DEPTH, why="frames need depth images")
+        tf = TransformBuffer()
+        calib: CameraIntrinsics | None = None
+        cam_frame = S.CAMERA_FRAME
+        # transforms and calibration before the window still apply inside it
+        if start_ns is not None:
+            tf, calib = self._state_before(start_ns)
+        topics = [S.RGB, S.DEPTH, S.IDS, S.CALIBRATION, S.TF]
+        pending: dict[str, Any] = {}
+        pending_t: int | None = None
+        index = self._frame_index_before(start_ns) if start_ns is not None else 0
+
+        def emit() -> Frame | None:
+            nonlocal index
+            if "depth" not in pending or pending_t is None:
+                return None
+            depth_msg = pending["depth"]
+            k = calib or _fallback_intrinsics(depth_msg)
+            pose = tf.lookup(pending_t, depth_msg.frame_id or cam_frame)
+            if pose is None:
+                pose = np.full((4, 4), np.nan)
+            base = tf.lookup(pending_t, S.BASE_FRAME)
+            fr = Frame(
+                index=index,
+                time_ns=pending_t,
+                rgb=codec.decode_image(pending["rgb"]) if "rgb" in pending else None,
+                depth=codec.depth_from_image(depth_msg),
+                ids=codec.decode_image(pending["ids"]).astype(np.int32)
+                if "ids" in pending else None,
+                pose=pose,
+                intrinsics=k,
+                base_pose=base,
+            )
+            index += 1
+            return fr
+
+        for d in self.messages(topics, start_ns=start_ns, end_ns=end_ns):
+            if pending_t is not None and d.log_time_ns != pending_t:
+                fr = emit()
+                if fr is not None:
+                    yield fr
+                pending = {}
+            pending_t = d.log_time_ns
+            if d.topic == S.TF:
+                tf.add(d.log_time_ns, d.message.parent_frame_id, d.message.child_frame_id,
+                       codec.decode_transform(d.message))
+            elif d.topic == S.CALIBRATION:
+                calib = codec.decode_calibration(d.message)
+            elif d.topic == S.DEPTH:
+                pending["depth"] = d.message
+            elif d.topic == S.RGB:
+                pending["rgb"] = d.message
+            elif d.topic == S.IDS:
+                pending["ids"] = d.message
+        fr = emit()
+        if fr is not None:
+            yield fr
+
+    def frame_times(self) -> list[int]:
+        """Log times of all frames, sorted. Read from the MCAP message indexes: no chunk is
+        decompressed and no image decoded."""
+        self.require(S.DEPTH, why="frames need depth images")
+        if self._frame_times is None:
+            self._frame_times = self._index_times(S.DEPTH)
+        return self._frame_times
+
+    def _index_times(self, topic: str) -> list[int]:
+        import io
+
+        from mcap.data_stream import ReadDataStream
+        from mcap.records import MessageIndex
+
+        cids = {cid for cid, ch in self.summary.channels.items() if ch.topic == topic}
+        times: list[int] = []
+        for ci in self.summary.chunk_indexes:
+            for cid, offset in ci.message_index_offsets.items():
+                if cid not in cids:
+                    continue
+                self._f.seek(offset + 1 + 8, io.SEEK_SET)  # opcode, record length
+                idx = MessageIndex.read(ReadDataStream(self._f))
+                times.extend(int(t) for t, _ in idx.records)
+        times.sort()
+        return times
+
+    def frame_at(self, t_ns: int) -> Frame | None:
+        """The frame at or before ``t_ns`` (None before the first frame), found through the
+        MCAP chunk index without reading the log from the start."""
+        self.require(S.DEPTH, why="frames need depth images")
+        import bisect
+
+        times = self.frame_times()
+        i = bisect.bisect_right(times, int(t_ns)) - 1
+        t_frame = times[i] if i >= 0 else None
+        if t_frame is None:
+            return None
+        for fr in self.frames(start_ns=t_frame, end_ns=t_frame + 1):
+            return fr
+        return None
+
+    def _state_before(self, t_ns: int) -> tuple[TransformBuffer, CameraIntrinsics | None]:
+        tf = TransformBuffer()
+        calib = None
+        for d in self.messages([S.CALIBRATION], end_ns=t_ns, reverse=True):
+            calib = codec.decode_calibration(d.message)
+            break
+        # the latest transform of each link before t, newest first, until the camera
+        # chain is complete
+        seen: set[str] = set()
+        for d in self.messages([S.TF], end_ns=t_ns, reverse=True):
+            child = d.message.child_frame_id
+            if child not in seen:
+                seen.add(child)
+                tf.add(d.log_time_ns, d.message.parent_frame_id, child,
+                       codec.decode_transform(d.message))
+            if tf.lookup(t_ns, S.CAMERA_FRAME) is not None:
+                break
+        return tf, calib
+
+    def _frame_index_before(self, t_ns: int) -> int:
+        import bisect
+
+        return bisect.bisect_left(self.frame_times(), t_ns)
+
+    # ----- end --------------------------------------------------------------------------
+    def close(self) -> None:
+        self._f.close()
+
+    def __enter__(self) -> LogReader:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+
+def _fallback_intrinsics(depth_msg: Any) -> CameraIntrinsics:
+    return CameraIntrinsics.from_fov(int(depth_msg.width), int(depth_msg.height), 60.0)

@@ -1,0 +1,186 @@
+"""The log contract: topics, schema names, JSON schemas and the log schema version.
+
+Sensor and map data use Foxglove's well-known protobuf schemas (so a log opens in
+Foxglove/Lichtblick and Rerun without plug-ins); sgtool's own records use JSON channels
+with named JSON schemas. Every sgtool log carries a metadata record named ``sgtool`` with
+the sgtool version, the log schema version (``major.minor``) and the seed.
+
+Versioning rule: a reader reads every log whose major version equals its own and whose
+minor version is any (new minor versions only add optional fields or channels); a newer
+major version is refused with a message naming both versions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+LOG_SCHEMA_VERSION: tuple[int, int] = (1, 0)
+PROFILE = "sgtool"
+METADATA_NAME = "sgtool"
+HOUSE_ATTACHMENT = "house.json"
+
+WORLD_FRAME = "world"
+BASE_FRAME = "base"
+CAMERA_FRAME = "camera"
+
+# protobuf (Foxglove well-known) topics
+RGB = "/camera/rgb"
+DEPTH = "/camera/depth"
+IDS = "/camera/instances"
+CALIBRATION = "/camera/calibration"
+TF = "/tf"
+OCCUPANCY = "/map/occupancy"
+VORONOI = "/map/voronoi"
+ROOMS = "/map/rooms"
+
+# encodings of the RawImage channels
+RGB_ENCODING = "rgb8"
+DEPTH_ENCODING = "16UC1"  # millimetres, little endian, 0 = no return
+IDS_ENCODING = "32SC1"  # instance ids, little endian int32, 0 = none
+DEPTH_SCALE = 1000.0  # depth units per metre
+
+
+@dataclass(frozen=True)
+class RecordKind:
+    """A JSON record type: its schema name, version, topic and JSON schema."""
+
+    key: str
+    schema_name: str
+    version: str
+    topic: str
+    schema: dict[str, Any]
+
+    def schema_bytes(self) -> bytes:
+        import json
+
+        doc = {
+            "$schema": "https://json-schema.org/draft/2020-12/schema",
+            "$id": f"sgtool/{self.schema_name}/{self.version}",
+            "title": self.schema_name,
+            "version": self.version,
+            **self.schema,
+        }
+        return json.dumps(doc, sort_keys=True, separators=(",", ":")).encode()
+
+
+def _obj(props: dict[str, Any], required: list[str]) -> dict[str, Any]:
+    return {"type": "object", "properties": props, "required": required}
+
+
+_STR = {"type": "string"}
+_NUM = {"type": "number"}
+_INT = {"type": "integer"}
+_BOOL = {"type": "boolean"}
+_NSTR = {"type": ["string", "null"]}
+
+RECORDS: dict[str, RecordKind] = {
+    "episode": RecordKind(
+        "episode",
+        "sgtool.Episode",
+        "1.0",
+        "/sgtool/episode",
+        _obj(
+            {
+                "kind": {"enum": ["recording", "search", "import"]},
+                "source": _STR,
+                "house_id": _NSTR,
+                "query": _NSTR,
+                "planner": _NSTR,
+                "status": {"enum": ["started", "success", "failure", "ended"]},
+                "steps": _INT,
+                "travelled_m": _NUM,
+                "shortest_m": {"type": ["number", "null"]},
+                "frames": _INT,
+                "extra": {"type": "object"},
+            },
+            ["kind", "status"],
+        ),
+    ),
+    "instances": RecordKind(
+        "instances",
+        "sgtool.Instances",
+        "1.0",
+        "/sgtool/instances",
+        _obj(
+            {
+                "instances": {
+                    "type": "array",
+                    "items": _obj(
+                        {
+                            "id": _INT,
+                            "category": _STR,
+                            "synset": _NSTR,
+                            "kind": {"enum": ["object", "furniture", "door", "structure"]},
+                            "state": {"enum": ["open", "closed", None]},
+                            "affordances": {"type": "array", "items": _STR},
+                            "parent": {"type": ["integer", "null"]},
+                            "relation": {"enum": ["inside", "ontop", None]},
+                            "spec_id": _NSTR,
+                        },
+                        ["id", "category", "kind"],
+                    ),
+                }
+            },
+            ["instances"],
+        ),
+    ),
+    "action": RecordKind(
+        "action",
+        "sgtool.Action",
+        "1.0",
+        "/sgtool/action",
+        _obj(
+            {
+                "skill": _STR,
+                "target": _NSTR,
+                "outcome": {"enum": ["success", "failure", "invalid"]},
+                "reason": _STR,
+                "travelled_m": _NUM,
+                "decision_time_s": _NUM,
+                "planner": _NSTR,
+                "step": _INT,
+            },
+            ["skill", "outcome"],
+        ),
+    ),
+    "scene_graph": RecordKind(
+        "scene_graph",
+        "sgtool.SceneGraph",
+        "1.0",
+        "/sgtool/scene_graph",
+        _obj({"version": _STR, "rooms": {"type": "array"}, "objects": {"type": "array"}},
+             ["version"]),
+    ),
+    "llm_exchange": RecordKind(
+        "llm_exchange",
+        "sgtool.LlmExchange",
+        "1.0",
+        "/sgtool/llm",
+        _obj(
+            {
+                "model": _STR,
+                "messages": {"type": "array"},
+                "response": _NSTR,
+                "latency_s": _NUM,
+                "prompt_tokens": {"type": ["integer", "null"]},
+                "completion_tokens": {"type": ["integer", "null"]},
+                "error": _NSTR,
+                "attempt": _INT,
+            },
+            ["model", "messages"],
+        ),
+    ),
+}
+
+RECORD_BY_SCHEMA = {k.schema_name: k for k in RECORDS.values()}
+RECORD_BY_TOPIC = {k.topic: k for k in RECORDS.values()}
+
+
+def format_version(v: tuple[int, int]) -> str:
+    return f"{v[0]}.{v[1]}"
+
+
+def parse_version(text: str) -> tuple[int, int]:
+    major, _, minor = text.partition(".")
+    return int(major), int(minor or 0)

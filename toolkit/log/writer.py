@@ -1,0 +1,264 @@
+"""Writing sgtool logs (MCAP).
+
+The writer is crash tolerant and atomic:
+- it writes to ``OUT.partial`` and renames to ``OUT`` only when :meth:`LogWriter.close`
+  succeeds; an exception inside ``with LogWriter(...)`` removes the partial file, so a
+  failed command never leaves a half-written output behind;
+- it closes and flushes a chunk to the operating system at least every
+  ``flush_interval_ns`` of log time (1 s by default) and whenever a chunk exceeds
+  ``chunk_size``; a process killed with SIGKILL leaves ``OUT.partial`` whose complete chunks
+  ``sgtool doctor --recover`` turns into a valid log, losing at most that last interval.
+
+Output is deterministic: the same calls give the same bytes (no wall clock is written).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+from mcap.writer import CompressionType, Writer
+from mcap_protobuf.schema import build_file_descriptor_set
+
+from sgtool import __version__
+from sgtool.errors import SgtoolError
+from sgtool.log import codec
+from sgtool.log import schemas as S
+from sgtool.log.frame import CameraIntrinsics
+
+_COMPRESSION = {
+    "zstd": CompressionType.ZSTD,
+    "lz4": CompressionType.LZ4,
+    "none": CompressionType.NONE,
+}
+
+
+class LogWriter:
+    """Writes one sgtool log. Use as a context manager::
+
+        with LogWriter("run.mcap", seed=3) as log:
+            log.attach_house(house_json)
+            log.write_record("instances", 0, {"instances": [...]})
+            log.write_frame(t_ns, rgb=rgb, depth=depth_m, ids=ids, pose=world_T_cam,
+                            intrinsics=k, base_pose=world_T_base)
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike[str],
+        *,
+        seed: int | None = None,
+        compression: str = "zstd",
+        chunk_size: int = 8 * 1024 * 1024,
+        flush_interval_ns: int = 1_000_000_000,
+        metadata: dict[str, str] | None = None,
+        overwrite: bool = True,
+    ) -> None:
+        if compression not in _COMPRESSION:
+            raise SgtoolError(f"unknown compression {compression!r} (zstd, lz4, none)")
+        self.path = Path(path)
+        if self.path.exists() and not overwrite:
+            raise SgtoolError(f"{self.path} exists; not overwriting it")
+        if self.path.is_dir():
+            raise SgtoolError(f"{self.path} is a folder, not a file name")
+        if not self.path.parent.exists():
+            raise SgtoolError(f"folder {self.path.parent} does not exist")
+        self.partial_path = self.path.with_name(self.path.name + ".partial")
+        self._stream: IO[bytes] = open(self.partial_path, "wb")  # noqa: SIM115
+        self._mcap = Writer(
+            self._stream, chunk_size=chunk_size, compression=_COMPRESSION[compression]
+        )
+        self._mcap.start(profile=S.PROFILE, library=f"sgtool {__version__}")
+        self._flush_interval_ns = int(flush_interval_ns)
+        self._last_flush_ns: int | None = None
+        self._schemas: dict[str, int] = {}
+        self._channels: dict[str, int] = {}
+        self._sequence: dict[int, int] = {}
+        self._last_calibration: CameraIntrinsics | None = None
+        self._static_sent: set[tuple[str, str]] = set()
+        self._closed = False
+        self.message_count = 0
+        meta = {
+            "sgtool_version": __version__,
+            "log_schema_version": S.format_version(S.LOG_SCHEMA_VERSION),
+            "seed": "" if seed is None else str(int(seed)),
+        }
+        meta.update(metadata or {})
+        self._mcap.add_metadata(S.METADATA_NAME, meta)
+        self._mcap.flush()  # metadata first, so even a log killed in its first second has it
+
+    # ----- channels ---------------------------------------------------------------------
+    def _proto_channel(self, topic: str, message_class: Any) -> int:
+        if topic in self._channels:
+            return self._channels[topic]
+        name = message_class.DESCRIPTOR.full_name
+        if name not in self._schemas:
+            fds = build_file_descriptor_set(message_class)
+            self._schemas[name] = self._mcap.register_schema(
+                name=name, encoding="protobuf", data=fds.SerializeToString(deterministic=True)
+            )
+        cid = self._mcap.register_channel(
+            topic=topic, message_encoding="protobuf", schema_id=self._schemas[name]
+        )
+        self._channels[topic] = cid
+        return cid
+
+    def _json_channel(self, kind: S.RecordKind) -> int:
+        if kind.topic in self._channels:
+            return self._channels[kind.topic]
+        if kind.schema_name not in self._schemas:
+            self._schemas[kind.schema_name] = self._mcap.register_schema(
+                name=kind.schema_name, encoding="jsonschema", data=kind.schema_bytes()
+            )
+        cid = self._mcap.register_channel(
+            topic=kind.topic, message_encoding="json", schema_id=self._schemas[kind.schema_name],
+            metadata={"version": kind.version},
+        )
+        self._channels[kind.topic] = cid
+        return cid
+
+    def _add(self, cid: int, t_ns: int, data: bytes) -> None:
+        if self._closed:
+            raise RuntimeError("log writer is closed")
+        t_ns = int(t_ns)
+        if t_ns < 0:
+            raise ValueError("log time must be >= 0")
+        if self._last_flush_ns is None:
+            self._last_flush_ns = t_ns
+        elif t_ns - self._last_flush_ns >= self._flush_interval_ns:
+            # close the chunk before the first message of the next interval, so chunks
+            # hold whole frames and a crash loses at most one interval of log time
+            self._mcap.flush()
+            self._last_flush_ns = t_ns
+        seq = self._sequence.get(cid, 0)
+        self._sequence[cid] = seq + 1
+        self._mcap.add_message(
+            channel_id=cid, log_time=t_ns, publish_time=t_ns, data=data, sequence=seq
+        )
+        self.message_count += 1
+
+    # ----- generic ----------------------------------------------------------------------
+    def write_proto(self, topic: str, t_ns: int, msg: Any) -> None:
+        """Write any protobuf message (e.g. a Foxglove SceneUpdate) on ``topic``."""
+        cid = self._proto_channel(topic, type(msg))
+        self._add(cid, t_ns, msg.SerializeToString(deterministic=True))
+
+    def write_record(self, kind: str, t_ns: int, record: dict[str, Any]) -> None:
+        """Write an sgtool JSON record (``episode``, ``instances``, ``action``,
+        ``scene_graph``, ``llm_exchange``); ``record`` must be JSON-serialisable."""
+        if kind not in S.RECORDS:
+            raise ValueError(f"unknown record kind {kind!r}; one of {sorted(S.RECORDS)}")
+        cid = self._json_channel(S.RECORDS[kind])
+        data = json.dumps(record, sort_keys=True, separators=(",", ":")).encode()
+        self._add(cid, t_ns, data)
+
+    def write_json_bytes(self, kind: str, t_ns: int, data: bytes) -> None:
+        """Like :meth:`write_record` for an already canonical JSON text (a scene graph)."""
+        cid = self._json_channel(S.RECORDS[kind])
+        self._add(cid, t_ns, data)
+
+    def attach(self, name: str, data: bytes, media_type: str, t_ns: int = 0) -> None:
+        self._mcap.add_attachment(
+            create_time=t_ns, log_time=t_ns, name=name, media_type=media_type, data=data
+        )
+
+    def attach_house(self, house_json: str | bytes) -> None:
+        data = house_json.encode() if isinstance(house_json, str) else house_json
+        self.attach(S.HOUSE_ATTACHMENT, data, "application/json")
+
+    def add_metadata(self, name: str, data: dict[str, str]) -> None:
+        self._mcap.add_metadata(name, data)
+
+    # ----- sensors ----------------------------------------------------------------------
+    def write_rgb(self, t_ns: int, rgb: np.ndarray, frame_id: str = S.CAMERA_FRAME) -> None:
+        self.write_proto(S.RGB, t_ns, codec.encode_image(t_ns, rgb, S.RGB_ENCODING, frame_id))
+
+    def write_depth(self, t_ns: int, depth_m: np.ndarray, frame_id: str = S.CAMERA_FRAME) -> None:
+        """Metric depth (float metres) or already uint16 millimetres."""
+        mm = depth_m if depth_m.dtype == np.uint16 else codec.depth_to_mm(depth_m)
+        self.write_proto(S.DEPTH, t_ns, codec.encode_image(t_ns, mm, S.DEPTH_ENCODING, frame_id))
+
+    def write_ids(self, t_ns: int, ids: np.ndarray, frame_id: str = S.CAMERA_FRAME) -> None:
+        self.write_proto(S.IDS, t_ns, codec.encode_image(t_ns, ids, S.IDS_ENCODING, frame_id))
+
+    def write_calibration(
+        self, t_ns: int, k: CameraIntrinsics, frame_id: str = S.CAMERA_FRAME
+    ) -> None:
+        self.write_proto(S.CALIBRATION, t_ns, codec.encode_calibration(t_ns, k, frame_id))
+        self._last_calibration = k
+
+    def write_transform(self, t_ns: int, parent: str, child: str, T: np.ndarray) -> None:  # noqa: N803
+        """``T`` is parent_T_child: the pose of ``child`` in ``parent``."""
+        self.write_proto(S.TF, t_ns, codec.encode_transform(t_ns, parent, child, T))
+
+    def write_frame(
+        self,
+        t_ns: int,
+        *,
+        depth: np.ndarray,
+        pose: np.ndarray,
+        intrinsics: CameraIntrinsics,
+        rgb: np.ndarray | None = None,
+        ids: np.ndarray | None = None,
+        base_pose: np.ndarray | None = None,
+    ) -> None:
+        """One time step. ``pose`` is world_T_camera; with ``base_pose`` (world_T_base) the
+        transforms are written as the chain world -> base -> camera, else world -> camera.
+        Calibration is written on the first frame and whenever it changes."""
+        if intrinsics != self._last_calibration:
+            self.write_calibration(t_ns, intrinsics)
+        if base_pose is not None:
+            self.write_transform(t_ns, S.WORLD_FRAME, S.BASE_FRAME, base_pose)
+            base_T_cam = np.linalg.inv(base_pose) @ pose  # noqa: N806
+            self.write_transform(t_ns, S.BASE_FRAME, S.CAMERA_FRAME, base_T_cam)
+        else:
+            self.write_transform(t_ns, S.WORLD_FRAME, S.CAMERA_FRAME, pose)
+        if rgb is not None:
+            self.write_rgb(t_ns, rgb)
+        self.write_depth(t_ns, depth)
+        if ids is not None:
+            self.write_ids(t_ns, ids)
+
+    # ----- end --------------------------------------------------------------------------
+    def flush(self) -> None:
+        self._mcap.flush()
+
+    def close(self) -> Path:
+        """Finish the file (summary, index) and move it into place. Returns the path."""
+        if self._closed:
+            return self.path
+        self._mcap.finish()
+        self._stream.flush()
+        os.fsync(self._stream.fileno())
+        self._stream.close()
+        self._closed = True
+        os.replace(self.partial_path, self.path)
+        return self.path
+
+    def abort(self) -> None:
+        """Stop writing and remove the partial file."""
+        if not self._closed:
+            self._closed = True
+            try:
+                self._stream.close()
+            finally:
+                self.partial_path.unlink(missing_ok=True)
+
+    def __enter__(self) -> LogWriter:
+        return self
+
+    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
+        if exc_type is None:
+            self.close()
+        elif exc_type is KeyboardInterrupt:
+            # keep what was recorded: flush, leave OUT.partial for `sgtool doctor --recover`
+            try:
+                self._mcap.flush()
+                self._stream.close()
+            finally:
+                self._closed = True
+        else:
+            self.abort()
