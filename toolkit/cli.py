@@ -37,7 +37,22 @@ COMMANDS: dict[str, tuple[str, str]] = {
 CONTEXT_SETTINGS = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
 
+class UserError(click.ClickException):
+    """A :class:`SgtoolError` on its way out: one line on stderr, exit code 2."""
+
+    exit_code = 2
+
+    def show(self, file: object = None) -> None:
+        click.echo(f"sgtool: error: {self.message}", err=True)
+
+
 class LazyGroup(click.Group):
+    def invoke(self, ctx: click.Context) -> object:
+        try:
+            return super().invoke(ctx)
+        except SgtoolError as e:
+            raise UserError(str(e)) from e
+
     def _available(self) -> dict[str, tuple[str, str]]:
         out = {}
         for name, (module, summary) in COMMANDS.items():

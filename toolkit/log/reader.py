@@ -32,6 +32,7 @@ from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics, Frame
 
 _PROTO_CLASSES: dict[str, Any] = {}
+_MAGIC = bytes([137, 77, 67, 65, 80, 48, 13, 10])
 
 
 def _proto_class(schema_name: str) -> Any:
@@ -117,6 +118,11 @@ class LogReader:
             raise LogFormatError(f"{self.path}: no such file")
         if self.path.is_dir():
             raise LogFormatError(f"{self.path} is a folder; expected an MCAP file")
+        with open(self.path, "rb") as f:
+            if f.read(8) != _MAGIC:
+                raise LogFormatError(
+                    f"{self.path}: not an MCAP file (it does not start with the MCAP magic bytes)"
+                )
         self._f: IO[bytes] = open(self.path, "rb")  # noqa: SIM115
         try:
             self._reader = SeekingReader(self._f, validate_crcs=False)

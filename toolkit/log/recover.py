@@ -150,6 +150,8 @@ def _consume(items: Iterator[_Item], diag: Diagnosis, writer: _Copier | None) ->
         if isinstance(r, Schema):
             schemas[r.id] = r
         elif isinstance(r, Channel):
+            if r.id not in channels and writer is not None:
+                writer.channel(schemas.get(r.schema_id), r)
             channels[r.id] = r
             diag.channels = len(channels)
         elif isinstance(r, Message):
@@ -181,7 +183,7 @@ class _Copier:
         self.schema_ids: dict[int, int] = {}
         self.channel_ids: dict[int, int] = {}
 
-    def message(self, schema: Schema | None, ch: Channel, m: Message) -> None:
+    def channel(self, schema: Schema | None, ch: Channel) -> None:
         if ch.id not in self.channel_ids:
             sid = 0
             if schema is not None:
@@ -193,6 +195,9 @@ class _Copier:
             self.channel_ids[ch.id] = self.w.register_channel(
                 ch.topic, ch.message_encoding, sid, dict(ch.metadata)
             )
+
+    def message(self, schema: Schema | None, ch: Channel, m: Message) -> None:
+        self.channel(schema, ch)
         self.w.add_message(
             self.channel_ids[ch.id], m.log_time, m.data, m.publish_time, m.sequence
         )
