@@ -1,0 +1,246 @@
+"""Export a log to a Rerun recording (``.rrd``).
+
+Rerun converts some Foxglove MCAP messages itself, but not Grid or SceneUpdate, and knows
+nothing of sgtool's JSON records; so sgtool logs everything natively with the Rerun SDK:
+
+- ``world/camera``: the camera pose (Transform3D), pinhole, RGB, depth and instance
+  segmentation (class ids = instance ids, labelled with their categories);
+- ``world/robot``: the base position and the path travelled so far;
+- ``world/map/occupancy``: the BEV occupancy grid (``GridMap``);
+- ``world/map/voronoi``: the Voronoi graph coloured by room (``LineStrips3D``);
+- ``world/map/voxels``: the semantic voxel map when the caller passes one per refresh;
+- ``world/graph/rooms|objects|frontiers``: scene-graph nodes with labels;
+- ``actions``: the actions with their outcomes (``TextLog``).
+
+Two timelines: ``frame`` (frame index) and ``sim_time`` (log time since the start). Export is
+deterministic for a given log (the recording id is derived from the log's path name).
+"""
+
+from __future__ import annotations
+
+import colorsys
+import hashlib
+import os
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sgtool.log import LogReader, codec
+from sgtool.log import schemas as S
+
+APP_ID = "sgtool"
+
+
+def color_for(
+    key: int | str, saturation: float = 0.65, value: float = 0.95
+) -> tuple[int, int, int]:
+    """A stable, well-spread colour for an id or name (golden-ratio hue steps)."""
+    if isinstance(key, str):
+        key = int.from_bytes(hashlib.blake2s(key.encode(), digest_size=4).digest(), "little")
+    h = (int(key) * 0.618033988749895) % 1.0
+    r, g, b = colorsys.hsv_to_rgb(h, saturation, value)
+    return int(r * 255), int(g * 255), int(b * 255)
+
+
+def _time(rec: Any, frame: int | None, t_ns: int) -> None:
+    import rerun as rr
+
+    if frame is not None:
+        rr.set_time("frame", sequence=int(frame), recording=rec)
+    rr.set_time("sim_time", duration=np.timedelta64(int(t_ns), "ns"), recording=rec)
+
+
+def _scene_update_strips(msg: Any) -> tuple[list[np.ndarray], list[tuple[int, int, int]]]:
+    """Foxglove SceneUpdate line primitives -> 2-point strips with colours."""
+    strips: list[np.ndarray] = []
+    colors: list[tuple[int, int, int]] = []
+    for ent in msg.entities:
+        for line in ent.lines:
+            pts = np.array([[p.x, p.y, p.z] for p in line.points], np.float32)
+            cols = list(line.colors)
+            base = line.color
+            if line.type == line.LINE_LIST:
+                pairs = range(0, len(pts) - 1, 2)
+                for i in pairs:
+                    strips.append(pts[i : i + 2])
+                    c = cols[i] if cols else base
+                    colors.append((int(c.r * 255), int(c.g * 255), int(c.b * 255)))
+            else:
+                strips.append(pts)
+                colors.append((int(base.r * 255), int(base.g * 255), int(base.b * 255)))
+    return strips, colors
+
+
+def export(
+    log_path: str | os.PathLike[str],
+    rrd_path: str | os.PathLike[str] | None,
+    *,
+    every: int = 1,
+    max_frames: int | None = None,
+    progress: Callable[[int], None] | None = None,
+    voxels: Callable[[Any], Iterator[tuple[int, int, np.ndarray, np.ndarray, float]]]
+    | None = None,
+    spawn: bool = False,
+) -> Path | None:
+    """Write ``log_path`` as a Rerun recording to ``rrd_path`` (atomically), or stream it
+    to a spawned viewer when ``spawn`` is set. ``every`` logs one camera frame in K (maps,
+    graphs and actions are always logged). ``voxels``, when given, is called with the open
+    reader and yields (frame index, t_ns, voxel centres (N,3), colours (N,3) uint8,
+    voxel size) to draw the semantic voxel map over time."""
+    import rerun as rr
+
+    log_path = Path(log_path)
+    rid = hashlib.sha256(log_path.name.encode()).hexdigest()[:32]
+    rec = rr.RecordingStream(APP_ID, recording_id=rid, send_properties=False)
+    out = Path(rrd_path) if rrd_path is not None else None
+    tmp = out.with_name(out.name + ".partial") if out is not None else None
+    if spawn:
+        rec.spawn()
+    elif tmp is not None:
+        rec.save(tmp)
+    try:
+        with LogReader(log_path) as r:
+            _export(rec, r, every=every, max_frames=max_frames, progress=progress,
+                    voxels=voxels)
+        rec.flush()
+        rec.disconnect()
+        if tmp is not None and out is not None and not spawn:
+            os.replace(tmp, out)
+    except BaseException:
+        if tmp is not None:
+            tmp.unlink(missing_ok=True)
+        raise
+    return out
+
+
+def _export(
+    rec: Any, r: LogReader, *, every: int, max_frames: int | None,
+    progress: Callable[[int], None] | None, voxels: Any,
+) -> None:
+    import rerun as rr
+
+    tr = r.time_range()
+    t0 = tr[0] if tr else 0
+
+    def stamp(frame: int | None, t_ns: int) -> None:
+        _time(rec, frame, t_ns - t0)
+
+    rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+    instances = r.last_record("instances")
+    labels: dict[int, str] = {}
+    if instances:
+        labels = {int(i["id"]): i["category"] for i in instances["instances"]}
+        ctx = [(0, "none", (0, 0, 0))] + [
+            (iid, f"{cat} #{iid}", color_for(iid)) for iid, cat in sorted(labels.items())
+        ]
+        rec.log("world/camera/image", rr.AnnotationContext(ctx), static=True)
+    # camera frames
+    path_xy: list[tuple[float, float, float]] = []
+    if r.has(S.DEPTH):
+        for n, fr in enumerate(r.frames()):
+            if max_frames is not None and n >= max_frames:
+                break
+            if progress:
+                progress(1)
+            base = fr.base_pose if fr.base_pose is not None else fr.pose
+            if np.all(np.isfinite(base)):
+                path_xy.append((float(base[0, 3]), float(base[1, 3]), 0.02))
+            if fr.index % every:
+                continue
+            stamp(fr.index, fr.time_ns)
+            if np.all(np.isfinite(fr.pose)):
+                rec.log("world/camera", rr.Transform3D(
+                    translation=fr.pose[:3, 3].astype(np.float32),
+                    mat3x3=fr.pose[:3, :3].astype(np.float32)))
+            k = fr.intrinsics
+            rec.log("world/camera/image", rr.Pinhole(
+                image_from_camera=k.K.astype(np.float32), resolution=[k.width, k.height],
+                camera_xyz=rr.ViewCoordinates.RDF, image_plane_distance=0.3))
+            if fr.rgb is not None:
+                rec.log("world/camera/image/rgb", rr.Image(fr.rgb))
+            rec.log("world/camera/image/depth", rr.DepthImage(fr.depth, meter=1.0))
+            if fr.ids is not None:
+                rec.log("world/camera/image/segmentation",
+                        rr.SegmentationImage(fr.ids.astype(np.uint16)))
+            rec.log("world/robot", rr.Points3D([path_xy[-1]], radii=0.15,
+                                               colors=[(230, 80, 40)]))
+            if len(path_xy) > 1:
+                rec.log("world/robot/path", rr.LineStrips3D([np.array(path_xy, np.float32)],
+                                                           radii=0.02, colors=[(230, 80, 40)]))
+    # voxel map over time (computed by the caller)
+    if voxels is not None:
+        for idx, t_ns, centres, cols, size in voxels(r):
+            stamp(idx, t_ns)
+            rec.log("world/map/voxels", rr.Boxes3D(
+                centers=centres.astype(np.float32),
+                half_sizes=np.full((len(centres), 3), size / 2, np.float32),
+                colors=cols, fill_mode="solid"))
+    frame_times = r.frame_times() if r.has(S.DEPTH) else []
+
+    def frame_of(t: int) -> int | None:
+        import bisect
+
+        if not frame_times:
+            return None
+        return max(bisect.bisect_right(frame_times, t) - 1, 0)
+
+    # derived layers
+    if r.has(S.OCCUPANCY):
+        for d in r.messages([S.OCCUPANCY]):
+            cells, origin, res = codec.decode_grid(d.message)
+            stamp(frame_of(d.log_time_ns), d.log_time_ns)
+            h, w = cells.shape
+            rec.log("world/map/occupancy", rr.GridMap(
+                data=cells.tobytes(),
+                format=rr.components.ImageFormat(width=w, height=h, color_model="L",
+                                                 channel_datatype="U8"),
+                cell_size=res, translation=[origin[0], origin[1], -0.01],
+                colormap=rr.components.Colormap.RvizMap))
+    for topic, entity in ((S.VORONOI, "world/map/voronoi"), (S.ROOMS, "world/map/rooms")):
+        if r.has(topic):
+            for d in r.messages([topic]):
+                strips, colors = _scene_update_strips(d.message)
+                stamp(frame_of(d.log_time_ns), d.log_time_ns)
+                rec.log(entity, rr.LineStrips3D(strips, colors=colors, radii=0.02)
+                        if strips else rr.Clear(recursive=False))
+    for t, g in r.records("scene_graph"):
+        stamp(frame_of(t), t)
+        _log_scene_graph(rec, g)
+    for t, a in r.records("action"):
+        stamp(frame_of(t), t)
+        level = "INFO" if a.get("outcome") == "success" else "WARN"
+        text = f"{a.get('skill')}({a.get('target') or ''}) -> {a.get('outcome')}"
+        if a.get("reason"):
+            text += f": {a['reason']}"
+        if a.get("travelled_m"):
+            text += f" [{a['travelled_m']:.2f} m]"
+        rec.log("actions", rr.TextLog(text, level=level))
+
+
+def _log_scene_graph(rec: Any, g: dict[str, Any]) -> None:
+    import rerun as rr
+
+    rooms = g.get("rooms", [])
+    if rooms:
+        rec.log("world/graph/rooms", rr.Points3D(
+            [(*rm["position"][:2], 1.5) for rm in rooms],
+            labels=[f"{rm['id']}: {rm['category']}" for rm in rooms],
+            colors=[color_for(rm["id"]) for rm in rooms], radii=0.12))
+    objs = g.get("objects", [])
+    if objs:
+        rec.log("world/graph/objects", rr.Points3D(
+            [o["position"] for o in objs],
+            labels=[o["category"] + (f" ({o['state']})" if o.get("state") else "")
+                    for o in objs],
+            colors=[color_for(o["room"]) for o in objs], radii=0.05))
+    fr = [x for x in g.get("regions", []) if x.get("kind") == "frontier"]
+    if fr:
+        rec.log("world/graph/frontiers", rr.Points3D(
+            [(*x["position"][:2], 0.05) for x in fr],
+            labels=[x.get("frontier_type") or "frontier" for x in fr],
+            colors=[(40, 200, 255) if x.get("frontier_type") == "leading out"
+                    else (255, 200, 40) for x in fr], radii=0.08))
+    else:
+        rec.log("world/graph/frontiers", rr.Clear(recursive=False))
