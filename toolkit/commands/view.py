@@ -1,0 +1,63 @@
+"""``sgtool view LOG [-o view.rrd]``: look at a log in Rerun."""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import click
+
+from sgtool.errors import SgtoolError
+
+
+@click.command("view")
+@click.argument("log", type=click.Path(dir_okay=False))
+@click.option("-o", "--out", type=click.Path(dir_okay=False),
+              help="Write a Rerun recording (.rrd) instead of opening the viewer.")
+@click.option("--every", type=click.IntRange(min=1), default=1, show_default=True,
+              help="Log one camera frame in K (maps, graphs and actions are always logged).")
+@click.option("--max-frames", type=click.IntRange(min=1), default=None,
+              help="Stop after this many camera frames.")
+@click.option("--voxels/--no-voxels", default=True, show_default=True,
+              help="Rebuild and show the semantic voxel map (needs the mapping pipeline).")
+def command(log: str, out: str | None, every: int, max_frames: int | None,
+            voxels: bool) -> None:
+    """Show LOG in Rerun: camera with RGB, depth and segmentation, the voxel map, BEV
+    occupancy, the Voronoi graph coloured by room, room labels, objects, frontiers, the
+    robot's path and its actions, on a frame timeline. Derived layers appear when LOG is
+    the output of `sgtool replay`.
+
+    Without -o the Rerun viewer is spawned (it needs a display); with -o the recording is
+    written to a file that `rerun view.rrd` opens later (`rerun rrd verify` checks it)."""
+    from tqdm import tqdm
+
+    from sgtool.analysis.rerun_view import export
+    from sgtool.log import LogReader
+
+    if out is None:
+        if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+            raise SgtoolError("no display to open the Rerun viewer on; write a file with "
+                              "-o view.rrd and open it with `rerun view.rrd` elsewhere")
+        if shutil.which("rerun") is None:
+            raise SgtoolError("the `rerun` viewer is not on PATH; use -o view.rrd")
+    elif Path(out).resolve() == Path(log).resolve():
+        raise SgtoolError("the output must not be the input log")
+    with LogReader(log) as r:
+        total = r.frame_count() if r.has("/camera/depth") else 0
+    if max_frames is not None:
+        total = min(total, max_frames)
+    voxel_source = None
+    if voxels:
+        try:
+            from sgtool.replayers.voxels import voxel_snapshots
+        except ImportError:
+            voxel_source = None
+        else:
+            def voxel_source(reader):  # type: ignore[no-untyped-def]
+                return voxel_snapshots(reader, every=max(every, 10), max_frames=max_frames)
+    with tqdm(total=total, unit="frame", desc="view", disable=None) as bar:
+        export(log, out, every=every, max_frames=max_frames, progress=bar.update,
+               voxels=voxel_source, spawn=out is None)
+    if out:
+        click.echo(f"wrote {out}; open it with: rerun {out}")
