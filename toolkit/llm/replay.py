@@ -1,0 +1,132 @@
+"""Transcripts of LLM exchanges (JSONL) and a client that serves them back.
+
+A run against a live endpoint writes every exchange record (:mod:`sgtool.llm.exchange`) as
+one JSON line. ``--llm-replay FILE`` then answers each prompt with the response recorded for
+the identical prompt (matched by ``prompt_sha256``; several answers to one prompt are served
+in recorded order), including recorded faults, which are raised again. A deterministic
+planner fed the same scene graphs therefore makes the same decisions without any endpoint.
+A prompt the transcript does not hold raises :class:`ReplayMiss`, which the planner turns
+into a clear failure instead of a guess.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import time
+from collections import deque
+from pathlib import Path
+from typing import Any
+
+from sgtool.errors import SgtoolError
+from sgtool.llm.client import ChatResult, LlmTransportError
+from sgtool.llm.exchange import Message, prompt_key
+
+log = logging.getLogger(__name__)
+
+
+class TranscriptError(SgtoolError):
+    """A transcript file is missing or malformed."""
+
+
+class ReplayMiss(LlmTransportError):
+    """The transcript has no (more) responses for this prompt."""
+
+
+class TranscriptWriter:
+    """Writes records as JSON lines, one ``write`` + flush per record.
+
+    ``append=True`` (what planners use) adds to an existing transcript, so the episodes of
+    a benchmark run collect in one file and a crash loses at most the line being written.
+    ``append=False`` writes a fresh file through ``path.partial``, renamed on :meth:`close`,
+    so an interrupted run never leaves a file that looks complete.
+    """
+
+    def __init__(self, path: str | Path, append: bool = True) -> None:
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self.append = append
+        self._tmp = self.path if append else self.path.with_name(self.path.name + ".partial")
+        self._fh = open(self._tmp, "a" if append else "w", encoding="utf-8")  # noqa: SIM115
+        self.count = 0
+
+    def write(self, record: dict[str, Any]) -> None:
+        self._fh.write(json.dumps(record, sort_keys=True, ensure_ascii=False) + "\n")
+        self._fh.flush()
+        self.count += 1
+
+    def close(self) -> None:
+        if not self._fh.closed:
+            self._fh.close()
+            if not self.append:
+                os.replace(self._tmp, self.path)
+
+    def __enter__(self) -> TranscriptWriter:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def read_transcript(path: str | Path) -> list[dict[str, Any]]:
+    path = Path(path)
+    if not path.is_file():
+        raise TranscriptError(f"LLM transcript not found: {path}")
+    out = []
+    with open(path, encoding="utf-8") as fh:
+        lines = fh.readlines()
+    for n, line in enumerate(lines, 1):
+        if not line.strip():
+            continue
+        try:
+            rec = json.loads(line)
+        except json.JSONDecodeError as e:
+            if n == len(lines) and not line.endswith("\n"):
+                log.warning("%s:%d: incomplete last line (interrupted run) ignored", path, n)
+                continue
+            raise TranscriptError(f"{path}:{n}: not a JSON line ({e.msg})") from e
+        if not isinstance(rec, dict) or "messages" not in rec:
+            raise TranscriptError(f"{path}:{n}: not an sgtool.LlmExchange record")
+        rec.setdefault("prompt_sha256", prompt_key(rec["messages"]))
+        out.append(rec)
+    return out
+
+
+class ReplayChatClient:
+    """Serves recorded responses by prompt; see the module doc."""
+
+    source = "replay"
+
+    def __init__(self, path: str | Path, model: str | None = None) -> None:
+        self.path = Path(path)
+        records = read_transcript(self.path)
+        self.model = model or (records[0]["model"] if records else "replay")
+        self._queues: dict[str, deque[dict[str, Any]]] = {}
+        for rec in records:
+            self._queues.setdefault(rec["prompt_sha256"], deque()).append(rec)
+        self.served = 0
+
+    def remaining(self) -> int:
+        return sum(len(q) for q in self._queues.values())
+
+    def complete(self, messages: list[Message]) -> ChatResult:
+        t0 = time.perf_counter()
+        q = self._queues.get(prompt_key(messages))
+        if not q:
+            raise ReplayMiss(
+                f"transcript {self.path} holds no (more) responses for this prompt; "
+                "the run diverged from the recorded one"
+            )
+        rec = q.popleft()
+        self.served += 1
+        if rec.get("error") or rec.get("response") is None:
+            raise LlmTransportError(f"(replayed) {rec.get('error') or 'no response'}")
+        return ChatResult(
+            text=str(rec["response"]),
+            model=str(rec.get("model", self.model)),
+            latency_s=time.perf_counter() - t0,
+            prompt_tokens=rec.get("prompt_tokens"),
+            completion_tokens=rec.get("completion_tokens"),
+            source="replay",
+        )

@@ -1,0 +1,137 @@
+"""Which scene-graph nodes a planner may act on, how far they are, and whether the search is over.
+
+SCOUT (sec. IV-D) selects among the actionable nodes N_a: "nodes with exploration
+affordances such as openable containers, closed doors, or unexplored frontiers", plus the
+unexplored room nodes that closed doors reveal (sec. IV-A). The mapping from a node to the
+skill of :class:`~sgtool.planning.base.Action` is:
+
+===========================================  =============  ==========================
+node                                         skill          condition
+===========================================  =============  ==========================
+room, ``explored=False``                     ``explore``    always
+region, ``kind="frontier"``                  ``explore``    always
+object, not ``explored``                     ``open``       ``state == "closed"`` or
+                                                            affordance ``open``
+object, not ``explored``                     ``navigate``   affordance ``explore``,
+                                                            ``examine`` or ``search``
+                                                            (look on/into it)
+door, ``state == "closed"``                  ``open``       joins an unexplored or
+                                                            unknown room
+===========================================  =============  ==========================
+
+A node is reachable when it has an entry in ``graph.distances``; if the graph carries no
+distances at all (a hand-made graph), the straight-line distance from the robot is used.
+
+The query counts as found when an object whose category equals the query after
+:func:`~sgtool.semantics.text.category_text` is in the graph (no embeddings involved:
+"frying_pan.n.01" matches "Frying pan", "pan" does not).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from sgtool.planning.base import Skill
+from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode, SceneGraph
+from sgtool.semantics.text import same_category
+
+OPEN_AFFORDANCES = frozenset({"open", "openable"})
+EXAMINE_AFFORDANCES = frozenset({"explore", "examine", "search"})
+
+NodeKind = str  # "room" | "frontier" | "object" | "door"
+
+
+@dataclass(frozen=True)
+class Candidate:
+    node_id: str
+    skill: Skill
+    kind: NodeKind
+    distance: float
+    position: tuple[float, float]
+
+
+def natural_key(node_id: str) -> tuple[str, tuple[tuple[int, int | str], ...]]:
+    """Sort ids naturally: ``room:2`` before ``room:10``, ``region:3.1`` before ``region:3.12``."""
+    prefix, _, rest = node_id.partition(":")
+    return prefix, tuple((0, int(p)) if p.isdigit() else (1, p) for p in rest.split("."))
+
+
+def node_xy(node: RoomNode | RegionNode | ObjectNode | DoorNode) -> tuple[float, float]:
+    p = node.position
+    return float(p[0]), float(p[1])
+
+
+def distance_to(graph: SceneGraph, node: RoomNode | RegionNode | ObjectNode | DoorNode
+                ) -> float | None:
+    """Travel distance from the robot, None when unreachable (see module doc)."""
+    if graph.distances:
+        d = graph.distances.get(node.id)
+        return None if d is None or not math.isfinite(d) else float(d)
+    x, y = node_xy(node)
+    rx, ry = graph.robot.position
+    return math.hypot(x - rx, y - ry)
+
+
+def object_skill(obj: ObjectNode) -> Skill | None:
+    """The exploring skill of an object, None when it offers nothing to explore."""
+    if obj.explored:
+        return None
+    affs = {a.lower() for a in obj.affordances}
+    if obj.state == "closed" or (obj.state is None and affs & OPEN_AFFORDANCES):
+        return "open"
+    if affs & EXAMINE_AFFORDANCES:
+        return "navigate"
+    return None
+
+
+def door_is_entrance(graph: SceneGraph, door: DoorNode) -> bool:
+    """A closed door is worth opening when it joins a room that is unexplored or unknown."""
+    if door.state != "closed":
+        return False
+    if not door.rooms:
+        return True
+    for rid in door.rooms:
+        room = graph.room(rid)
+        if room is None or not room.explored:
+            return True
+    return False
+
+
+def actionable(graph: SceneGraph) -> list[Candidate]:
+    """N_a in natural id order; unreachable nodes are left out."""
+    out: list[Candidate] = []
+
+    def add(node: RoomNode | RegionNode | ObjectNode | DoorNode, skill: Skill, kind: str) -> None:
+        d = distance_to(graph, node)
+        if d is not None:
+            out.append(Candidate(node.id, skill, kind, d, node_xy(node)))
+
+    for r in graph.rooms:
+        if not r.explored:
+            add(r, "explore", "room")
+    for f in graph.regions:
+        if f.kind == "frontier":
+            add(f, "explore", "frontier")
+    for o in graph.objects:
+        skill = object_skill(o)
+        if skill is not None:
+            add(o, skill, "object")
+    for door in graph.doors:
+        if door_is_entrance(graph, door):
+            add(door, "open", "door")
+    out.sort(key=lambda c: natural_key(c.node_id))
+    return out
+
+
+def find_target(graph: SceneGraph, query: str) -> ObjectNode | None:
+    """The nearest observed object of the query category (exact name match), or None."""
+    best: tuple[float, str, ObjectNode] | None = None
+    for o in graph.objects:
+        if not same_category(o.category, query):
+            continue
+        d = distance_to(graph, o)
+        key = (d if d is not None else math.inf, o.id, o)
+        if best is None or key[:2] < best[:2]:
+            best = key
+    return None if best is None else best[2]

@@ -1,0 +1,242 @@
+"""MoMa-LLM as a planner: structured scene text -> chat model -> grounded command.
+
+Per decision (MoMa-LLM sec. III-C/D; reference notes):
+
+1. encode the scene graph (:mod:`~sgtool.planning.moma.scene_text`) and the history of
+   executed actions, *realigned* to the current graph: a past action keeps its node and
+   position; it is shown with the room that node (or, if the node is gone, the graph node
+   nearest to the position) belongs to *now* (``explore(living room)`` becomes
+   ``explore(kitchen)`` once the room is reclassified);
+2. ask the model (system: role, task, skill API, answer format; user: scene, history);
+3. parse "Analysis / Reasoning / Command" and ground the command
+   (:mod:`~sgtool.planning.moma.commands`);
+4. on a transport fault retry the same prompt; on an unusable or invalid command append
+   the answer and a feedback message naming the problem and the valid choices, and ask
+   again. This feedback reaches the model (MoMa-LLM's own feedback strings were dropped by
+   a role filter: the defect noted in the reference notes). At most ``max_attempts``
+   requests per decision; then the decision fails clearly (``done`` without target,
+   reason "llm failure: ...");
+5. stuck detector: the same grounded action chosen ``stuck_repeats`` times in a row ends
+   the episode (``done`` without target, reason "stuck: ...").
+
+The outcome of executed actions (:meth:`MomaLlmPlanner.feedback`) goes into the history as
+``success``, ``failure`` or ``invalid argument`` with the executor's message. Every request
+is logged as an ``sgtool.LlmExchange`` record: kept in :attr:`MomaLlmPlanner.exchanges`,
+passed to ``on_exchange`` and appended to ``transcript`` (JSONL, replayable).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from sgtool.llm.client import ChatClient, LlmTransportError
+from sgtool.llm.exchange import Message, exchange_record
+from sgtool.llm.replay import ReplayMiss, TranscriptWriter
+from sgtool.planning.base import Action, Feedback
+from sgtool.planning.moma.commands import InvalidCommand, ground, parse_response
+from sgtool.planning.moma.scene_text import encode_scene, nearest_room, room_of
+from sgtool.scenegraph.graph import SceneGraph
+from sgtool.semantics.text import category_text
+
+OUTCOME_TEXT = {"success": "success", "failure": "failure", "invalid": "invalid argument"}
+
+
+def system_prompt(query: str) -> str:
+    q = query.strip()
+    return (
+        f"You are a robot in an unexplored house. Your task is to find a {q}.\n"
+        "You can call these functions:\n"
+        "1. navigate(room, object): go to an object in a room and look at it and on it.\n"
+        "2. go_to_and_open(room, object): go to an object or a door in a room and open it "
+        "to see what is inside or behind it.\n"
+        "3. close(room, object): close an open object or door in a room.\n"
+        "4. explore(room): explore the unexplored area of a room, the space leading out of "
+        "it, or an unexplored room.\n"
+        f"5. done(): finish; call it only when a {q} is among the observed objects.\n"
+        "Use room and object names exactly as the scene description writes them.\n"
+        "Answer in exactly this format:\n"
+        f"Analysis: <where a {q} is likely to be and which actions could reveal it>\n"
+        "Reasoning: <why your next command is the best one now>\n"
+        "Command: <one function call>"
+    )
+
+
+@dataclass
+class HistoryEntry:
+    command: str  # navigate | go_to_and_open | close | explore
+    target: str | None
+    position: tuple[float, float] | None
+    label: str  # object words at decision time ("" for explore)
+    room_name: str  # as shown then (used only if nothing better is known now)
+    outcome: str | None = None
+    message: str = ""
+
+
+class MomaLlmPlanner:
+    name = "moma-llm"
+
+    def __init__(
+        self,
+        client: ChatClient,
+        max_attempts: int = 5,
+        stuck_repeats: int = 3,
+        history_limit: int = 30,
+        on_exchange: Callable[[dict[str, Any]], None] | None = None,
+        transcript: str | Path | None = None,
+    ) -> None:
+        if max_attempts < 1:
+            raise ValueError("max_attempts must be >= 1")
+        self.client = client
+        self.max_attempts = int(max_attempts)
+        self.stuck_repeats = int(stuck_repeats)
+        self.history_limit = int(history_limit)
+        self.on_exchange = on_exchange
+        self._transcript = TranscriptWriter(transcript) if transcript else None
+        self.exchanges: list[dict[str, Any]] = []
+        self.query = ""
+        self.step = 0
+        self.history: list[HistoryEntry] = []
+        self._repeat: tuple[tuple[str, str | None], int] | None = None
+
+    # ----- Planner protocol -------------------------------------------------------------
+    def reset(self, query: str, seed: int = 0) -> None:
+        self.query = query
+        self.step = 0
+        self.history = []
+        self._repeat = None
+
+    def feedback(self, fb: Feedback) -> None:
+        if not self.history or fb.action.skill == "done":
+            return
+        last = self.history[-1]
+        if last.target == fb.action.target and last.outcome is None:
+            last.outcome = fb.outcome
+            last.message = fb.message
+
+    def decide(self, graph: SceneGraph) -> Action:
+        if not self.query:
+            raise RuntimeError("moma-llm: reset(query) must be called before decide()")
+        self.step += 1
+        scene = encode_scene(graph)
+        messages: list[Message] = [
+            {"role": "system", "content": system_prompt(self.query)},
+            {"role": "user", "content": self.user_prompt(graph, scene.text)},
+        ]
+        problems: list[str] = []
+        for attempt in range(self.max_attempts):
+            try:
+                result = self.client.complete(messages)
+            except ReplayMiss as e:
+                self._log(messages, None, 0.0, None, None, str(e), attempt)
+                return Action("done", None, reason=f"llm failure: {e}")
+            except LlmTransportError as e:
+                self._log(messages, None, 0.0, None, None, str(e), attempt)
+                problems.append(str(e))
+                continue
+            self._log(messages, result.text, result.latency_s, result.prompt_tokens,
+                      result.completion_tokens, None, attempt, result.model, result.source)
+            try:
+                cmd = parse_response(result.text)
+                action = ground(cmd, graph, scene, self.query)
+            except InvalidCommand as e:
+                problems.append(str(e))
+                messages = [
+                    *messages,
+                    {"role": "assistant", "content": result.text},
+                    {"role": "user", "content": (
+                        f"Your command could not be executed: invalid argument: {e}. "
+                        "Answer again in the same format with a valid command."
+                    )},
+                ]
+                continue
+            return self._accept(cmd.name, action, graph, scene.name_by_room)
+        last = problems[-1] if problems else "no answer"
+        return Action(
+            "done", None,
+            reason=f"llm failure: no valid command after {self.max_attempts} attempts: {last}",
+        )
+
+    # ----- pieces -----------------------------------------------------------------------
+    def _accept(self, command: str, action: Action, graph: SceneGraph,
+                names: dict[str, str]) -> Action:
+        key = (action.skill, action.target)
+        if self._repeat is not None and self._repeat[0] == key:
+            self._repeat = (key, self._repeat[1] + 1)
+        else:
+            self._repeat = (key, 1)
+        if self.stuck_repeats > 0 and self._repeat[1] >= self.stuck_repeats:
+            return Action(
+                "done", None,
+                reason=f"stuck: {action.skill}({action.target}) chosen "
+                       f"{self._repeat[1]} times in a row",
+            )
+        if action.skill != "done":
+            node = graph.node(action.target) if action.target else None
+            pos = (float(node.position[0]), float(node.position[1])) if node else None
+            label = category_text(getattr(node, "category", "")) if command != "explore" else ""
+            if not label and command != "explore":
+                label = "door"
+            room = room_of(graph, action.target) if action.target else None
+            self.history.append(
+                HistoryEntry(command, action.target, pos, label, names.get(room or "", "?"))
+            )
+        return action
+
+    def user_prompt(self, graph: SceneGraph, scene_text: str) -> str:
+        parts = [scene_text]
+        hist = self.render_history(graph)
+        parts.append("Previous actions:\n" + ("\n".join(hist) if hist else "- none"))
+        parts.append("What is your next command?")
+        return "\n\n".join(parts)
+
+    def render_history(self, graph: SceneGraph) -> list[str]:
+        """History lines realigned to the rooms of ``graph`` (module doc)."""
+        from sgtool.planning.moma.scene_text import room_names
+
+        names = room_names(graph)
+        out = []
+        entries = self.history[-self.history_limit:] if self.history_limit > 0 else []
+        for e in entries:
+            room = None
+            if e.target is not None and graph.node(e.target) is not None:
+                room = room_of(graph, e.target)
+            elif e.position is not None:
+                room = nearest_room(graph, e.position)
+            room_name = names.get(room or "", e.room_name)
+            if e.command == "explore":
+                call = f"explore({room_name})"
+            else:
+                call = f"{e.command}({room_name}, {e.label})"
+            if e.outcome is None:
+                out.append(f"- {call}")
+            else:
+                tail = f": {e.message}" if e.message else ""
+                out.append(f"- {call} - {OUTCOME_TEXT.get(e.outcome, e.outcome)}{tail}")
+        return out
+
+    def _log(self, messages: list[Message], response: str | None, latency: float,
+             ptok: int | None, ctok: int | None, error: str | None, attempt: int,
+             model: str | None = None, source: str | None = None) -> None:
+        rec = exchange_record(
+            model=model or self.client.model, messages=messages, response=response,
+            latency_s=latency, prompt_tokens=ptok, completion_tokens=ctok, error=error,
+            attempt=attempt, step=self.step, query=self.query,
+            source=source or str(getattr(self.client, "source", "endpoint")),
+        )
+        self.exchanges.append(rec)
+        if self._transcript is not None:
+            self._transcript.write(rec)
+        if self.on_exchange is not None:
+            self.on_exchange(rec)
+
+    def drain_exchanges(self) -> list[dict[str, Any]]:
+        """Exchanges since the last call (for a log writer), oldest first."""
+        out, self.exchanges = self.exchanges, []
+        return out
+
+    def close(self) -> None:
+        if self._transcript is not None:
+            self._transcript.close()

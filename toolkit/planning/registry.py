@@ -1,0 +1,136 @@
+"""Planners by name: ``make_planner(name, **options) -> Planner``.
+
+==================  ====================================================================
+name                what it is
+==================  ====================================================================
+``random``          uniform over actionable nodes (SCOUT's random agent)
+``greedy``          nearest actionable node
+``sbert``           SBERT cosine utilities with room influence (SCOUT Table VI defaults)
+``sbert-noroom``    the same without room influence ("w/o RI")
+``scout``           distilled containment/co-occurrence priors, Eqs. 1-4, 12-13
+                    (Table II defaults: room 0.7, frontier 0.6, delta 0.1, w 0.3)
+``scout-noroom``    SCOUT without room influence
+``scout-delta0``    SCOUT with delta = 0 (greedy on utility, Eq. 13)
+``moma-llm``        MoMa-LLM over an OpenAI-compatible chat endpoint or a transcript
+==================  ====================================================================
+
+Every planner comes wrapped in :class:`~sgtool.planning.timing.TimedPlanner`, so each
+action carries its measured decision time. Options:
+
+- all: ``timed`` (bool, default True), ``max_failures`` (node-selection planners: failed
+  attempts before a node is dropped, default 2);
+- ``sbert*``/``scout*``: ``default_room``, ``default_frontier``, ``delta``, ``room_weight``,
+  ``frontier_radius`` override the table defaults; ``encoder`` (a SentenceEncoder),
+  ``weights_dir`` (scout only: another set of distilled weights);
+- ``moma-llm``: ``base_url``, ``model``, ``api_key`` (else from the environment, see
+  :mod:`sgtool.llm.client`), ``timeout_s``, ``temperature``, ``replay`` (a JSONL transcript
+  to serve instead of an endpoint), ``transcript`` (append exchanges to this JSONL),
+  ``on_exchange`` (callback per exchange record), ``max_attempts``, ``stuck_repeats``,
+  ``history_limit``, ``client`` (any object with ``model`` and ``complete(messages)``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from sgtool.errors import SgtoolError
+from sgtool.planning.base import Planner
+
+PLANNER_NAMES: tuple[str, ...] = (
+    "random", "greedy", "sbert", "sbert-noroom", "scout", "scout-noroom", "scout-delta0",
+    "moma-llm",
+)
+
+_UTILITY_KEYS = ("default_room", "default_frontier", "delta", "room_weight", "frontier_radius")
+
+
+class UnknownPlannerError(SgtoolError):
+    """A planner name that is not registered, or an option it does not take."""
+
+
+def _pop_params(options: dict[str, Any]) -> dict[str, Any]:
+    return {k: float(options.pop(k)) for k in _UTILITY_KEYS if k in options}
+
+
+def _utility(name: str, options: dict[str, Any]) -> Planner:
+    from sgtool.planning.search import UtilityPlanner
+    from sgtool.planning.utility import UtilityParams
+    from sgtool.semantics.priors import CosinePriors, LearnedPriors, default_priors
+
+    encoder = options.pop("encoder", None)
+    weights_dir = options.pop("weights_dir", None)
+    max_failures = int(options.pop("max_failures", 2))
+    params = _pop_params(options)
+    family, _, variant = name.partition("-")
+    if variant == "noroom":
+        params["room_influence"] = False
+    if variant == "delta0":
+        params["delta"] = 0.0
+    if family == "sbert":
+        scorer: Any = CosinePriors(encoder)
+        up = UtilityParams.sbert(**params)
+    else:
+        if encoder is None and weights_dir is None:
+            scorer = default_priors()
+        else:
+            scorer = LearnedPriors(encoder, weights_dir)
+        up = UtilityParams.scout(**params)
+    return UtilityPlanner(name, scorer, up, max_failures=max_failures)
+
+
+def _moma(options: dict[str, Any]) -> Planner:
+    from sgtool.llm.client import LlmSettings, OpenAIChatClient
+    from sgtool.llm.replay import ReplayChatClient
+    from sgtool.planning.moma.planner import MomaLlmPlanner
+
+    client = options.pop("client", None)
+    replay = options.pop("replay", None)
+    settings_kw = {k: options.pop(k) for k in
+                   ("base_url", "model", "api_key", "timeout_s", "temperature", "max_tokens")
+                   if k in options}
+    if client is None:
+        if replay:
+            client = ReplayChatClient(replay, model=settings_kw.get("model"))
+        else:
+            client = OpenAIChatClient(LlmSettings.resolve(**settings_kw))
+    kw = {k: options.pop(k) for k in
+          ("max_attempts", "stuck_repeats", "history_limit", "on_exchange", "transcript")
+          if k in options}
+    return MomaLlmPlanner(client, **kw)
+
+
+def _simple(cls_name: str) -> Callable[[dict[str, Any]], Planner]:
+    def make(options: dict[str, Any]) -> Planner:
+        from sgtool.planning import search
+
+        return getattr(search, cls_name)(max_failures=int(options.pop("max_failures", 2)))
+
+    return make
+
+
+def make_planner(name: str, **options: Any) -> Planner:
+    """A fresh planner by name (see the module doc for names and options)."""
+    timed = bool(options.pop("timed", True))
+    key = name.strip().lower()
+    if key == "random":
+        planner = _simple("RandomPlanner")(options)
+    elif key == "greedy":
+        planner = _simple("GreedyPlanner")(options)
+    elif key in ("sbert", "sbert-noroom", "scout", "scout-noroom", "scout-delta0"):
+        planner = _utility(key, options)
+    elif key == "moma-llm":
+        planner = _moma(options)
+    else:
+        raise UnknownPlannerError(
+            f"unknown planner {name!r}; choose one of: {', '.join(PLANNER_NAMES)}"
+        )
+    if options:
+        raise UnknownPlannerError(
+            f"planner {name!r} does not take option(s): {', '.join(sorted(options))}"
+        )
+    if timed:
+        from sgtool.planning.timing import TimedPlanner
+
+        return TimedPlanner(planner)  # type: ignore[return-value]
+    return planner

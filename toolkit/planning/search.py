@@ -1,0 +1,102 @@
+"""The planners that choose among actionable nodes: random, greedy, SBERT similarity, SCOUT.
+
+They share one loop (:class:`NodeSelectionPlanner`): if an object of the query category is
+in the graph, ``done`` on the nearest one; otherwise choose among the actionable nodes
+(:func:`~sgtool.planning.candidates.actionable`) that the episode memory has not ruled out;
+with nothing left, give up with ``done`` and no target (the executor counts that as a
+failure, never as a success). Subclasses implement :meth:`NodeSelectionPlanner.choose`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sgtool.planning.base import Action, Feedback
+from sgtool.planning.candidates import Candidate, actionable, find_target
+from sgtool.planning.memory import EpisodeMemory
+from sgtool.planning.utility import UtilityParams, candidate_utilities, select_with_margin
+from sgtool.scenegraph.graph import SceneGraph
+from sgtool.semantics.priors import RelationScorer
+
+GIVE_UP = "nothing left to explore"
+
+
+class NodeSelectionPlanner:
+    name = "node-selection"
+
+    def __init__(self, max_failures: int = 2) -> None:
+        self.query = ""
+        self.seed = 0
+        self.memory = EpisodeMemory(max_failures=max_failures)
+
+    def reset(self, query: str, seed: int = 0) -> None:
+        self.query = query
+        self.seed = int(seed)
+        self.memory.reset()
+
+    def feedback(self, fb: Feedback) -> None:
+        self.memory.record(fb)
+
+    def decide(self, graph: SceneGraph) -> Action:
+        if not self.query:
+            raise RuntimeError(f"{self.name}: reset(query) must be called before decide()")
+        found = find_target(graph, self.query)
+        if found is not None:
+            return Action("done", target=found.id, reason=f"{found.category} observed")
+        cands = self.memory.filter(actionable(graph))
+        self.memory.offered(cands)
+        if not cands:
+            return Action("done", target=None, reason=GIVE_UP)
+        i, reason, scores = self.choose(graph, cands)
+        c = cands[i]
+        return Action(c.skill, target=c.node_id, reason=reason, scores=scores)
+
+    def choose(self, graph: SceneGraph, cands: list[Candidate]
+               ) -> tuple[int, str, dict[str, float]]:
+        raise NotImplementedError
+
+
+class RandomPlanner(NodeSelectionPlanner):
+    """SCOUT's random agent: uniform over actionable nodes (seeded per episode)."""
+
+    name = "random"
+
+    def reset(self, query: str, seed: int = 0) -> None:
+        super().reset(query, seed)
+        self._rng = np.random.default_rng(self.seed)
+
+    def choose(self, graph: SceneGraph, cands: list[Candidate]
+               ) -> tuple[int, str, dict[str, float]]:
+        i = int(self._rng.integers(len(cands)))
+        return i, f"random among {len(cands)}", {}
+
+
+class GreedyPlanner(NodeSelectionPlanner):
+    """Nearest actionable node (MoMa-LLM's greedy baseline); id breaks ties."""
+
+    name = "greedy"
+
+    def choose(self, graph: SceneGraph, cands: list[Candidate]
+               ) -> tuple[int, str, dict[str, float]]:
+        i = min(range(len(cands)), key=lambda k: (cands[k].distance, cands[k].node_id))
+        return i, f"nearest ({cands[i].distance:.2f} m)", {}
+
+
+class UtilityPlanner(NodeSelectionPlanner):
+    """Utility-driven selection (SCOUT Eqs. 1-4, 12-13) over any relation scorer: the
+    distilled priors give SCOUT, SBERT cosine gives the similarity baselines."""
+
+    def __init__(self, name: str, scorer: RelationScorer, params: UtilityParams,
+                 max_failures: int = 2) -> None:
+        super().__init__(max_failures=max_failures)
+        self.name = name
+        self.scorer = scorer
+        self.params = params
+
+    def choose(self, graph: SceneGraph, cands: list[Candidate]
+               ) -> tuple[int, str, dict[str, float]]:
+        u = candidate_utilities(graph, cands, self.query, self.scorer, self.params)
+        i = select_with_margin(u, [c.distance for c in cands], [c.node_id for c in cands],
+                               self.params.delta)
+        scores = {c.node_id: round(v, 4) for c, v in zip(cands, u, strict=True)}
+        return i, f"u={u[i]:.3f} (max {max(u):.3f}), d={cands[i].distance:.2f} m", scores

