@@ -111,3 +111,95 @@ def house(extra_objects: Sequence[ObjectNode] = (), robot_room: str = "room:1",
         robot=RobotState((0.0, 0.0), 0.0, robot_room, "region:1.1"),
         rooms=rooms, regions=regions, objects=objects, doors=doors, distances=distances,
     )
+
+
+class ChatServer:
+    """A chat-completions endpoint on 127.0.0.1 that plays back a script.
+
+    Each request consumes the next script item:
+    ``{"text": str}`` a normal answer; ``{"status": int}`` an HTTP error;
+    ``{"sleep": s, "text": str}`` an answer after ``s`` seconds (for timeouts);
+    ``{"raw": bytes}`` a 200 response with this body (malformed JSON).
+    When the script is exhausted the server answers HTTP 500. Requests are kept in
+    :attr:`requests` (the decoded JSON bodies).
+    """
+
+    def __init__(self, script: list[dict] | None = None, model: str = "scripted-model") -> None:
+        import json
+        import threading
+        import time
+        from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+
+        self.script = list(script or [])
+        self.requests: list[dict] = []
+        self.model = model
+        server = self
+
+        class Handler(BaseHTTPRequestHandler):
+            def log_message(self, *args: object) -> None:  # keep test output clean
+                pass
+
+            def _send(self, status: int, body: bytes) -> None:
+                try:
+                    self.send_response(status)
+                    self.send_header("Content-Type", "application/json")
+                    self.send_header("Content-Length", str(len(body)))
+                    self.end_headers()
+                    self.wfile.write(body)
+                except (BrokenPipeError, ConnectionResetError):
+                    pass  # the client gave up (timeout test)
+
+            def do_POST(self) -> None:  # noqa: N802
+                n = int(self.headers.get("Content-Length", "0"))
+                req = json.loads(self.rfile.read(n) or b"{}")
+                server.requests.append(req)
+                item = server.script.pop(0) if server.script else {"status": 500}
+                if "sleep" in item:
+                    time.sleep(item["sleep"])
+                if "status" in item:
+                    err = {"error": {"message": "scripted failure", "type": "server_error"}}
+                    self._send(int(item["status"]), json.dumps(err).encode())
+                    return
+                if "raw" in item:
+                    self._send(200, item["raw"])
+                    return
+                text = item["text"]
+                body = {
+                    "id": f"chatcmpl-{len(server.requests)}",
+                    "object": "chat.completion",
+                    "created": 0,
+                    "model": server.model,
+                    "choices": [{"index": 0, "finish_reason": "stop",
+                                 "message": {"role": "assistant", "content": text}}],
+                    "usage": {"prompt_tokens": 100 + len(server.requests),
+                              "completion_tokens": len(text.split()),
+                              "total_tokens": 100 + len(server.requests) + len(text.split())},
+                }
+                self._send(200, json.dumps(body).encode())
+
+        self.httpd = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+        self.httpd.daemon_threads = True
+        self.thread = threading.Thread(target=self.httpd.serve_forever, args=(0.02,),
+                                       daemon=True)
+        self.thread.start()
+
+    @property
+    def base_url(self) -> str:
+        host, port = self.httpd.server_address[:2]
+        return f"http://{host}:{port}/v1"
+
+    def close(self) -> None:
+        self.httpd.shutdown()
+        self.httpd.server_close()
+
+    def __enter__(self) -> ChatServer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def answer(command: str, analysis: str = "Looking around.",
+           reasoning: str = "Closest lead.") -> dict:
+    """A well-formed MoMa-LLM answer as a script item."""
+    return {"text": f"Analysis: {analysis}\nReasoning: {reasoning}\nCommand: {command}"}

@@ -131,8 +131,11 @@ class OpenAIChatClient:
             raise LlmTransportError(f"{self.where}: HTTP {e.status_code}: {_short(e)}") from e
         except openai.APIConnectionError as e:
             raise LlmTransportError(f"{self.where}: connection failed: {_short(e)}") from e
-        except openai.OpenAIError as e:  # malformed body, validation errors
-            raise LlmTransportError(f"{self.where}: unusable reply: {_short(e)}") from e
+        except (openai.OpenAIError, ValueError, KeyError, TypeError) as e:
+            # malformed JSON body (ValueError from the decoder), unexpected structure
+            raise LlmTransportError(
+                f"{self.where}: unusable reply: {type(e).__name__}: {_short(e)}"
+            ) from e
         latency = time.perf_counter() - t0
         try:
             text = resp.choices[0].message.content
