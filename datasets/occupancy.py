@@ -1,0 +1,365 @@
+"""Occupancy grid of a house spec and shortest paths on it.
+
+The grid is what the symbolic benchmark, the episode lister and the scripted recorder plan
+on. ``occupied`` marks cells covered by an obstacle: walls, furniture whose box starts below
+``max_obstacle_height``, closed doors (unless ``closed_doors_free``), and everything outside
+the house (cells whose centre lies in no room polygon), so paths never leave the house.
+``blocked`` is ``occupied`` grown by the robot's radius: a cell is blocked when a disc of
+``robot_radius`` centred on the cell centre would overlap an occupied cell. Paths run on the
+free (not blocked) cells, 8-connected, unit steps of one cell and sqrt(2) cells on
+diagonals; a diagonal step needs both cells it cuts past to be free (no corner cutting).
+This is the "dilated occupancy map + A*" geodesic of SCOUT's SymSearch (Fig. 5 f).
+
+Arrays are indexed ``[row, col]`` with row = y and col = x; cell ``[0, 0]`` has its lower
+left corner at ``origin``; the centre of cell (r, c) is
+``origin + ((c + 0.5) * resolution, (r + 0.5) * resolution)``.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from matplotlib.path import Path as MplPath
+from scipy import ndimage
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from sgtool.datasets.house import HouseSpec
+
+_SQRT2 = math.sqrt(2.0)
+_TOL = 1e-6
+# (d_row, d_col) of the 8 neighbours; the first four are the axis steps
+_STEPS = ((0, 1), (0, -1), (1, 0), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
+
+
+@dataclass(frozen=True, eq=False)
+class OccupancyMap:
+    """A house rasterised at ``resolution`` metres per cell (see the module docstring)."""
+
+    occupied: np.ndarray  # bool [rows=y, cols=x]
+    blocked: np.ndarray  # bool, occupied grown by robot_radius
+    origin: tuple[float, float]
+    resolution: float
+    robot_radius: float = 0.2
+    closed_doors_free: bool = False
+    _cache: dict = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return (int(self.occupied.shape[0]), int(self.occupied.shape[1]))
+
+    @property
+    def free(self) -> np.ndarray:
+        """Cells the robot centre may be in (not blocked)."""
+        return ~self.blocked
+
+    def in_bounds(self, row: int, col: int) -> bool:
+        return 0 <= row < self.shape[0] and 0 <= col < self.shape[1]
+
+
+# ----------------------------------------------------------------------------------------
+# coordinates
+# ----------------------------------------------------------------------------------------
+def world_to_cell(occ: OccupancyMap, x: float, y: float) -> tuple[int, int]:
+    """(row, col) of the cell holding world point (x, y) (may be out of bounds)."""
+    col = math.floor((x - occ.origin[0]) / occ.resolution + 1e-9)
+    row = math.floor((y - occ.origin[1]) / occ.resolution + 1e-9)
+    return (int(row), int(col))
+
+
+def cell_to_world(occ: OccupancyMap, row: int, col: int) -> tuple[float, float]:
+    """World (x, y) of the centre of cell (row, col)."""
+    return (occ.origin[0] + (col + 0.5) * occ.resolution,
+            occ.origin[1] + (row + 0.5) * occ.resolution)
+
+
+def cell_centers(occ: OccupancyMap) -> tuple[np.ndarray, np.ndarray]:
+    """(X, Y) arrays of cell-centre coordinates, each of the grid's shape."""
+    rows, cols = occ.shape
+    xs = occ.origin[0] + (np.arange(cols) + 0.5) * occ.resolution
+    ys = occ.origin[1] + (np.arange(rows) + 0.5) * occ.resolution
+    return np.meshgrid(xs, ys)
+
+
+# ----------------------------------------------------------------------------------------
+# rasterisation
+# ----------------------------------------------------------------------------------------
+def house_occupancy(spec: HouseSpec, resolution: float = 0.05, robot_radius: float = 0.2,
+                    closed_doors_free: bool = False, max_obstacle_height: float = 1.8,
+                    margin: float = 0.5) -> OccupancyMap:
+    """Rasterise ``spec`` (see the module docstring for what counts as an obstacle).
+
+    ``closed_doors_free=True`` treats closed doors as passable (the robot can open them),
+    which is what a planner that may open doors plans on. ``margin`` metres of (occupied)
+    outside are kept around the house.
+    """
+    if resolution <= 0:
+        raise ValueError("resolution must be > 0")
+    xmin, ymin, xmax, ymax = spec.bounds()
+    ox = math.floor((xmin - margin) / resolution) * resolution
+    oy = math.floor((ymin - margin) / resolution) * resolution
+    cols = int(math.ceil((xmax + margin - ox) / resolution))
+    rows = int(math.ceil((ymax + margin - oy) / resolution))
+    grid = OccupancyMap(np.zeros((rows, cols), bool), np.zeros((rows, cols), bool),
+                        (round(ox, 9), round(oy, 9)), resolution, robot_radius,
+                        closed_doors_free)
+    inside = np.zeros((rows, cols), bool)
+    for room in spec.rooms:
+        _fill_polygon(grid, inside, room.polygon)
+    occupied = ~inside
+    for w in spec.walls:
+        cx, cy = (w.a[0] + w.b[0]) / 2.0, (w.a[1] + w.b[1]) / 2.0
+        _fill_box(grid, occupied, (cx, cy), (w.length, w.thickness), w.yaw)
+    if not closed_doors_free:
+        for d in spec.doors:
+            if d.state == "closed":
+                _fill_box(grid, occupied, d.center, (d.width, d.thickness), d.yaw)
+    for f in spec.furniture:
+        if f.bottom < max_obstacle_height:
+            _fill_box(grid, occupied, f.center[:2], f.size[:2], f.yaw)
+    blocked = inflate(occupied, robot_radius, resolution)
+    return OccupancyMap(occupied, blocked, grid.origin, resolution, robot_radius,
+                        closed_doors_free)
+
+
+def inflate(occupied: np.ndarray, radius: float, resolution: float) -> np.ndarray:
+    """Cells whose centre is closer than ``radius`` to an occupied cell's square (distance
+    between centres < radius + resolution / 2)."""
+    if radius <= 0:
+        return occupied.copy()
+    if occupied.all():
+        return occupied.copy()
+    dist = ndimage.distance_transform_edt(~occupied, sampling=resolution)
+    return dist < radius + resolution / 2.0 - _TOL
+
+
+def _cell_window(occ: OccupancyMap, xs: Sequence[float],
+                 ys: Sequence[float]) -> tuple[slice, slice] | None:
+    r0, c0 = world_to_cell(occ, min(xs), min(ys))
+    r1, c1 = world_to_cell(occ, max(xs), max(ys))
+    rows, cols = occ.shape
+    r0, c0 = max(r0 - 1, 0), max(c0 - 1, 0)
+    r1, c1 = min(r1 + 2, rows), min(c1 + 2, cols)
+    if r0 >= r1 or c0 >= c1:
+        return None
+    return slice(r0, r1), slice(c0, c1)
+
+
+def _window_centers(occ: OccupancyMap, win: tuple[slice, slice]) -> tuple[np.ndarray, np.ndarray]:
+    rs, cs = win
+    xs = occ.origin[0] + (np.arange(cs.start, cs.stop) + 0.5) * occ.resolution
+    ys = occ.origin[1] + (np.arange(rs.start, rs.stop) + 0.5) * occ.resolution
+    return np.meshgrid(xs, ys)
+
+
+def _fill_box(occ: OccupancyMap, out: np.ndarray, center: Sequence[float],
+              size: Sequence[float], yaw: float) -> None:
+    """Mark the cells whose square overlaps the oriented box (exact for axis-aligned boxes,
+    slightly generous for rotated ones)."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    hx, hy = size[0] / 2.0, size[1] / 2.0
+    ex = abs(c) * hx + abs(s) * hy
+    ey = abs(s) * hx + abs(c) * hy
+    win = _cell_window(occ, (center[0] - ex, center[0] + ex), (center[1] - ey, center[1] + ey))
+    if win is None:
+        return
+    X, Y = _window_centers(occ, win)
+    dx, dy = X - center[0], Y - center[1]
+    lx = c * dx + s * dy
+    ly = -s * dx + c * dy
+    # half a cell along the box axes, grown to the cell's extent in that direction
+    px = 0.5 * occ.resolution * (abs(c) + abs(s))
+    mask = (np.abs(lx) < hx + px - _TOL) & (np.abs(ly) < hy + px - _TOL)
+    out[win] |= mask
+
+
+def _fill_polygon(occ: OccupancyMap, out: np.ndarray, poly: Sequence[tuple[float, float]]) -> None:
+    """Mark cells whose centre lies inside (or on the border of) ``poly``."""
+    xs = [p[0] for p in poly]
+    ys = [p[1] for p in poly]
+    win = _cell_window(occ, xs, ys)
+    if win is None:
+        return
+    X, Y = _window_centers(occ, win)
+    path = MplPath(np.asarray(poly, float))
+    pts = np.column_stack([X.ravel(), Y.ravel()])
+    # a small positive radius counts points on the border as inside whatever the winding
+    sign = 1.0 if _is_ccw(poly) else -1.0
+    mask = path.contains_points(pts, radius=sign * 1e-6).reshape(X.shape)
+    out[win] |= mask
+
+
+def _is_ccw(poly: Sequence[tuple[float, float]]) -> bool:
+    s = 0.0
+    for i in range(len(poly)):
+        x0, y0 = poly[i]
+        x1, y1 = poly[(i + 1) % len(poly)]
+        s += x0 * y1 - x1 * y0
+    return s > 0
+
+
+# ----------------------------------------------------------------------------------------
+# graph search
+# ----------------------------------------------------------------------------------------
+def _graph(occ: OccupancyMap) -> tuple[csr_matrix, np.ndarray, np.ndarray]:
+    """CSR adjacency over free cells (cached on the map): (graph, index grid, flat cells)."""
+    cached = occ._cache.get("graph")
+    if cached is not None:
+        return cached
+    free = ~occ.blocked
+    rows, cols = free.shape
+    index = np.full(free.shape, -1, np.int64)
+    flat = np.flatnonzero(free)
+    index.ravel()[flat] = np.arange(flat.size)
+    src_all, dst_all, w_all = [], [], []
+    for dr, dc in _STEPS:
+        # cells (r, c) with neighbour (r + dr, c + dc) inside the grid
+        rs = slice(max(0, -dr), rows - max(0, dr))
+        cs = slice(max(0, -dc), cols - max(0, dc))
+        rd = slice(max(0, dr), rows - max(0, -dr))
+        cd = slice(max(0, dc), cols - max(0, -dc))
+        ok = free[rs, cs] & free[rd, cd]
+        if dr and dc:  # no corner cutting: both axis neighbours must be free
+            ok &= free[rd, cs] & free[rs, cd]
+        src_all.append(index[rs, cs][ok])
+        dst_all.append(index[rd, cd][ok])
+        w = occ.resolution * (_SQRT2 if dr and dc else 1.0)
+        w_all.append(np.full(int(ok.sum()), w))
+    n = flat.size
+    g = csr_matrix((np.concatenate(w_all), (np.concatenate(src_all), np.concatenate(dst_all))),
+                   shape=(n, n))
+    occ._cache["graph"] = (g, index, flat)
+    return g, index, flat
+
+
+def nearest_free_cell(occ: OccupancyMap, x: float, y: float,
+                      max_snap: float = 0.5) -> tuple[int, int] | None:
+    """The free cell nearest to (x, y) (the point's own cell when free), None when none is
+    within ``max_snap`` metres."""
+    r, c = world_to_cell(occ, x, y)
+    if occ.in_bounds(r, c) and not occ.blocked[r, c]:
+        return (r, c)
+    free = ~occ.blocked
+    if not free.any():
+        return None
+    k = int(math.ceil(max_snap / occ.resolution)) + 1
+    r0, r1 = max(r - k, 0), min(r + k + 1, occ.shape[0])
+    c0, c1 = max(c - k, 0), min(c + k + 1, occ.shape[1])
+    if r0 >= r1 or c0 >= c1:
+        return None
+    sub = free[r0:r1, c0:c1]
+    rr, cc = np.nonzero(sub)
+    if rr.size == 0:
+        return None
+    X = occ.origin[0] + (cc + c0 + 0.5) * occ.resolution
+    Y = occ.origin[1] + (rr + r0 + 0.5) * occ.resolution
+    d2 = (X - x) ** 2 + (Y - y) ** 2
+    i = int(np.lexsort((cc, rr, d2))[0])  # ties: lowest row, then column
+    if d2[i] > (max_snap + occ.resolution) ** 2:
+        return None
+    return (int(rr[i] + r0), int(cc[i] + c0))
+
+
+def geodesic_distances(occ: OccupancyMap, start_xy: Sequence[float] | Iterable[Sequence[float]],
+                       max_snap: float = 0.5) -> np.ndarray:
+    """Shortest 8-connected path length (m) from ``start_xy`` to every cell; ``inf`` for
+    blocked or unreachable cells. ``start_xy`` is one (x, y) or several (distance to the
+    nearest of them). A start in a blocked cell is moved to the nearest free cell within
+    ``max_snap`` m; with none there, everything is ``inf``."""
+    starts = _as_points(start_xy)
+    g, index, flat = _graph(occ)
+    src = []
+    for x, y in starts:
+        cell = nearest_free_cell(occ, x, y, max_snap)
+        if cell is not None:
+            src.append(int(index[cell]))
+    out = np.full(occ.shape, np.inf)
+    if not src or flat.size == 0:
+        return out
+    d = dijkstra(g, directed=True, indices=sorted(set(src)), min_only=True)
+    out.ravel()[flat] = d
+    return out
+
+
+def shortest_path_length(occ: OccupancyMap, a: Sequence[float], b: Sequence[float],
+                         max_snap: float = 0.5) -> float:
+    """Geodesic distance (m) between world points a and b (``inf`` when not connected)."""
+    cb = nearest_free_cell(occ, b[0], b[1], max_snap)
+    if cb is None:
+        return math.inf
+    return float(geodesic_distances(occ, a, max_snap)[cb])
+
+
+def astar(occ: OccupancyMap, start_xy: Sequence[float], goal_xy: Sequence[float],
+          max_snap: float = 0.5) -> list[tuple[float, float]] | None:
+    """A shortest 8-connected path from start to goal as world points (cell centres, first
+    the start's cell, last the goal's), or None when the goal cannot be reached.
+
+    A* with the octile-distance heuristic (admissible and consistent for these step costs),
+    over the cached free-cell graph; ties broken by insertion order, so it is deterministic.
+    """
+    cs = nearest_free_cell(occ, start_xy[0], start_xy[1], max_snap)
+    cg = nearest_free_cell(occ, goal_xy[0], goal_xy[1], max_snap)
+    if cs is None or cg is None:
+        return None
+    g, index, flat = _graph(occ)
+    s, t = int(index[cs]), int(index[cg])
+    cols = occ.shape[1]
+    indptr, indices, weights = g.indptr, g.indices, g.data
+    gr, gc = cg
+    res = occ.resolution
+
+    def h(node: int) -> float:
+        r, c = divmod(int(flat[node]), cols)
+        dr, dc = abs(r - gr), abs(c - gc)
+        return res * (max(dr, dc) + (_SQRT2 - 1.0) * min(dr, dc))
+
+    best = {s: 0.0}
+    came: dict[int, int] = {}
+    heap = [(h(s), 0, s)]
+    counter = 1
+    closed: set[int] = set()
+    while heap:
+        _, _, u = heapq.heappop(heap)
+        if u == t:
+            break
+        if u in closed:
+            continue
+        closed.add(u)
+        gu = best[u]
+        for k in range(indptr[u], indptr[u + 1]):
+            v = int(indices[k])
+            nd = gu + float(weights[k])
+            if nd < best.get(v, math.inf) - 1e-12:
+                best[v] = nd
+                came[v] = u
+                heapq.heappush(heap, (nd + h(v), counter, v))
+                counter += 1
+    if t not in best:
+        return None
+    path = [t]
+    while path[-1] != s:
+        path.append(came[path[-1]])
+    path.reverse()
+    return [cell_to_world(occ, *divmod(int(flat[n]), cols)) for n in path]
+
+
+def path_length(path: Sequence[Sequence[float]]) -> float:
+    """Summed Euclidean length of a polyline."""
+    return float(sum(math.dist(path[i], path[i + 1]) for i in range(len(path) - 1)))
+
+
+def reachable(occ: OccupancyMap, start_xy: Sequence[float]) -> np.ndarray:
+    """Bool grid of the free cells connected to ``start_xy``."""
+    return np.isfinite(geodesic_distances(occ, start_xy))
+
+
+def _as_points(p: Sequence[float] | Iterable[Sequence[float]]) -> list[tuple[float, float]]:
+    seq = list(p)  # type: ignore[arg-type]
+    if len(seq) == 2 and all(isinstance(v, (int, float, np.floating, np.integer)) for v in seq):
+        return [(float(seq[0]), float(seq[1]))]
+    return [(float(q[0]), float(q[1])) for q in seq]
