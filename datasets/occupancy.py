@@ -100,10 +100,11 @@ def house_occupancy(spec: HouseSpec, resolution: float = 0.05, robot_radius: flo
     if resolution <= 0:
         raise ValueError("resolution must be > 0")
     xmin, ymin, xmax, ymax = spec.bounds()
-    ox = math.floor((xmin - margin) / resolution) * resolution
-    oy = math.floor((ymin - margin) / resolution) * resolution
-    cols = int(math.ceil((xmax + margin - ox) / resolution))
-    rows = int(math.ceil((ymax + margin - oy) / resolution))
+    # whole cells from a multiple of the resolution (1e-9 absorbs float error in x / res)
+    ox = math.floor((xmin - margin) / resolution + 1e-9) * resolution
+    oy = math.floor((ymin - margin) / resolution + 1e-9) * resolution
+    cols = int(math.ceil((xmax + margin - ox) / resolution - 1e-9))
+    rows = int(math.ceil((ymax + margin - oy) / resolution - 1e-9))
     grid = OccupancyMap(np.zeros((rows, cols), bool), np.zeros((rows, cols), bool),
                         (round(ox, 9), round(oy, 9)), resolution, robot_radius,
                         closed_doors_free)
