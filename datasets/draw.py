@@ -14,7 +14,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from sgtool.datasets.house import HouseSpec
+from sgtool.datasets.house import HouseSpec, _default_mode
 
 _PALETTE = [
     "#8dd3c7", "#ffffb3", "#bebada", "#fb8072", "#80b1d3", "#fdb462", "#b3de69",
@@ -123,6 +123,7 @@ def draw_house(spec: HouseSpec, path: str | os.PathLike[str], dpi: int = 120,
     os.close(fd)
     try:
         fig.savefig(tmp, dpi=dpi, metadata={"Software": None} if path.suffix == ".png" else None)
+        os.chmod(tmp, _default_mode())
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):

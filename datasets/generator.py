@@ -151,9 +151,14 @@ def _PLACEABLE_FURNITURE_OK(synset: str) -> set[str]:  # noqa: N802 - tiny predi
 @functools.cache
 def _candidates(split: str, parent: str, relation: str,
                 room_type: str) -> tuple[tuple[str, ...], np.ndarray]:
-    """Small objects that may be ``relation`` ``parent`` (or a hypernym of it) in
-    ``room_type``, with weights = number of activities stating it. Relations stated in the
-    same room type are used when there are at least three distinct objects; else all."""
+    """Small objects that may be ``relation`` ``parent`` (or a hypernym of it) in a room of
+    ``room_type``, with sampling weights.
+
+    The pool is every object the split relates to the parent that is also known in this
+    room type (stated there by an activity, or held by a real room of that type); its
+    weight is the number of activities relating it to the parent, tripled for activities
+    that put the parent in this room type. When fewer than three objects qualify, every
+    object related to the parent is used (weights as above)."""
     k = knowledge_for(split)
     anc = ancestors(parent)
     local: Counter[str] = Counter()
@@ -169,7 +174,10 @@ def _candidates(split: str, parent: str, relation: str,
         if r.room_type == room_type and (r.activity, r.child) not in seen_local:
             seen_local.add((r.activity, r.child))
             local[r.child] += 1
-    pool = local if len(local) >= 3 else anywhere
+    known_here = {s for s, _ in k.room_objects.get(room_type, ())}
+    pool = {c: anywhere[c] + 2 * local[c] for c in anywhere if c in known_here or local[c]}
+    if len(pool) < 3:
+        pool = {c: anywhere[c] + 2 * local[c] for c in anywhere}
     names = tuple(sorted(pool))
     w = np.array([pool[n] for n in names], float)
     return names, (w / w.sum() if w.size else w)

@@ -307,12 +307,20 @@ def save_house(spec: HouseSpec, path: str | os.PathLike[str]) -> Path:
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
+        os.chmod(tmp, _default_mode())
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
     return path
+
+
+def _default_mode() -> int:
+    """0o666 minus the process umask (what open() would give a new file)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
 
 
 def load_house(source: str | os.PathLike[str] | Mapping[str, Any]) -> HouseSpec:

@@ -1,0 +1,184 @@
+"""Object-search episodes in a house: what to find, where the robot starts, how far it is.
+
+An episode (as in SCOUT's SymSearch and its OmniGibson benchmark) names a query category
+(a small object's readable category), the ids of all instances of it in the house (finding
+any one succeeds), a start pose, and whether the target is hidden: every instance lies
+inside a closed container, so the robot must open something to see it.
+
+``shortest_path`` is the optimal travel distance used by SPL: the geodesic on the house's
+occupancy grid (robot radius 0.2 m, 8-connected, closed doors passable because the robot
+may open them) from the start to the nearest place where the robot can reach a target:
+a free cell in the target's room whose centre is within ``reach`` (1 m) of the footprint
+of the target's parent furniture (SCOUT, Fig. 5 f: the closest unoccupied pixel to the
+goal object within the same room, then A* on the dilated map).
+
+Starts are the house's start poses; an episode prefers a start outside every target room
+(starting next to the target is not a search).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from dataclasses import dataclass
+
+import numpy as np
+from matplotlib.path import Path as MplPath
+
+from sgtool.datasets.house import HouseSpec, StartPose
+from sgtool.datasets.occupancy import (
+    OccupancyMap,
+    cell_centers,
+    geodesic_distances,
+    house_occupancy,
+)
+
+REACH = 1.0
+
+
+@dataclass(frozen=True)
+class Episode:
+    id: str
+    query: str  # readable category
+    synset: str
+    targets: tuple[str, ...]  # object ids, sorted
+    target_rooms: tuple[str, ...]  # room ids, sorted
+    start: StartPose
+    hidden: bool  # every instance is inside a closed container
+    shortest_path: float  # metres, inf when no target can be reached
+    description: str  # "inside a closed cabinet in the kitchen"
+
+    def to_dict(self) -> dict:
+        return {
+            "id": self.id, "query": self.query, "synset": self.synset,
+            "targets": list(self.targets), "target_rooms": list(self.target_rooms),
+            "start": {"x": self.start.x, "y": self.start.y, "yaw": self.start.yaw,
+                      "room": self.start.room},
+            "hidden": self.hidden,
+            "shortest_path": (round(self.shortest_path, 4)
+                              if math.isfinite(self.shortest_path) else None),
+            "description": self.description,
+        }
+
+
+def room_raster(spec: HouseSpec, occ: OccupancyMap) -> np.ndarray:
+    """Int grid: index into ``spec.rooms`` of the room holding each cell centre, -1 outside
+    (on a shared border the first room in id order wins, as in :func:`room_at`)."""
+    X, Y = cell_centers(occ)
+    out = np.full(occ.shape, -1, np.int32)
+    pts = np.column_stack([X.ravel(), Y.ravel()])
+    for i in reversed(range(len(spec.rooms))):
+        poly = np.asarray(spec.rooms[i].polygon, float)
+        area2 = float(np.sum(poly[:, 0] * np.roll(poly[:, 1], -1)
+                             - np.roll(poly[:, 0], -1) * poly[:, 1]))
+        radius = 1e-6 if area2 > 0 else -1e-6
+        inside = MplPath(poly).contains_points(pts, radius=radius).reshape(occ.shape)
+        out[inside] = i
+    return out
+
+
+def _describe(spec: HouseSpec, obj_ids: list[str]) -> str:
+    objs = spec.object_by_id()
+    furn = spec.furniture_by_id()
+    o = objs[obj_ids[0]]
+    p = furn[o.parent]
+    room = spec.room(o.room).category.replace("_", " ")
+    where = "inside" if o.relation == "inside" else "on top of"
+    state = f"{p.state} " if p.state and o.relation == "inside" else ""
+    more = f" (+{len(obj_ids) - 1} more)" if len(obj_ids) > 1 else ""
+    thing = f"{state}{p.category}"
+    article = "an" if thing[:1].lower() in "aeiou" else "a"
+    return f"{where} {article} {thing} in the {room}{more}"
+
+
+class EpisodeGeometry:
+    """Occupancy, room raster and goal masks of one house, shared by its episodes."""
+
+    def __init__(self, spec: HouseSpec, reach: float = REACH, resolution: float = 0.05,
+                 robot_radius: float = 0.2):
+        self.spec = spec
+        self.reach = reach
+        self.occ = house_occupancy(spec, resolution=resolution, robot_radius=robot_radius,
+                                   closed_doors_free=True)
+        self.rooms = room_raster(spec, self.occ)
+        self.X, self.Y = cell_centers(self.occ)
+        self._room_index = {r.id: i for i, r in enumerate(spec.rooms)}
+        self._dist: dict[tuple[float, float], np.ndarray] = {}
+
+    def goal_mask(self, obj_id: str) -> np.ndarray:
+        """Free cells of the object's room within ``reach`` of its parent's footprint."""
+        o = self.spec.object_by_id()[obj_id]
+        p = self.spec.furniture_by_id()[o.parent]
+        lx_ly = _to_local(p, self.X, self.Y)
+        dx = np.maximum(np.abs(lx_ly[0]) - p.size[0] / 2, 0.0)
+        dy = np.maximum(np.abs(lx_ly[1]) - p.size[1] / 2, 0.0)
+        near = dx ** 2 + dy ** 2 <= self.reach ** 2
+        return near & (self.rooms == self._room_index[o.room]) & ~self.occ.blocked
+
+    def distances(self, start: StartPose) -> np.ndarray:
+        key = (start.x, start.y)
+        if key not in self._dist:
+            self._dist[key] = geodesic_distances(self.occ, key, max_snap=1.0)
+        return self._dist[key]
+
+    def shortest_path(self, start: StartPose, obj_ids: list[str]) -> float:
+        d = self.distances(start)
+        best = math.inf
+        for oid in obj_ids:
+            m = self.goal_mask(oid)
+            if m.any():
+                best = min(best, float(d[m].min()))
+        return best
+
+
+def _to_local(p, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    c, s = math.cos(p.yaw), math.sin(p.yaw)
+    dx, dy = X - p.center[0], Y - p.center[1]
+    return (c * dx + s * dy, -s * dx + c * dy)
+
+
+def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
+                  reach: float = REACH) -> list[Episode]:
+    """Search episodes in ``spec``: one per small-object category (sorted by category)
+    when ``n`` is None, else ``n`` episodes drawn with ``seed`` (categories without
+    replacement while they last, then again with other starts)."""
+    if not spec.objects or not spec.starts:
+        return []
+    by_cat: dict[str, list[str]] = defaultdict(list)
+    synset_of: dict[str, str] = {}
+    for o in spec.objects:
+        by_cat[o.category].append(o.id)
+        synset_of.setdefault(o.category, o.synset)
+    cats = sorted(by_cat)
+    rng = np.random.default_rng(seed)
+    if n is None:
+        chosen = cats
+    else:
+        chosen = []
+        while len(chosen) < n:
+            take = min(n - len(chosen), len(cats))
+            chosen += [cats[i] for i in sorted(rng.choice(len(cats), size=take,
+                                                          replace=False).tolist())]
+    geo = EpisodeGeometry(spec, reach=reach)
+    objs = spec.object_by_id()
+    furn = spec.furniture_by_id()
+    out = []
+    for i, cat in enumerate(chosen):
+        ids = sorted(by_cat[cat], key=_id_key)
+        rooms = tuple(sorted({objs[o].room for o in ids}, key=_id_key))
+        starts = [s for s in spec.starts if s.room not in rooms] or list(spec.starts)
+        start = starts[int(rng.integers(len(starts)))]
+        hidden = all(objs[o].relation == "inside" and furn[objs[o].parent].state == "closed"
+                     for o in ids)
+        out.append(Episode(
+            id=f"ep_{i}", query=cat, synset=synset_of[cat], targets=tuple(ids),
+            target_rooms=rooms, start=start, hidden=hidden,
+            shortest_path=geo.shortest_path(start, ids),
+            description=_describe(spec, ids),
+        ))
+    return out
+
+
+def _id_key(s: str) -> tuple[str, int]:
+    head, _, num = s.rpartition("_")
+    return (head, int(num)) if num.isdigit() else (s, -1)
