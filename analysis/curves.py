@@ -1,0 +1,45 @@
+"""Efficiency curves as PNG: success rate against budget, one line per planner.
+
+MoMa-LLM's efficiency curve (and SCOUT's Fig. 8 for the step budget): the share of all
+episodes solved within each budget, drawn as the same polyline whose area is AUC-E
+(:func:`sgtool.analysis.metrics.efficiency_curve`); the legend gives each planner's AUC-E.
+Drawn with matplotlib's Agg backend (no display needed); the PNG carries no timestamp.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+from sgtool.analysis.metrics import CostModel, curve_area, curve_of
+from sgtool.analysis.records import EpisodeResult, write_text_atomic
+
+
+def plot_efficiency(results_by_planner: Sequence[tuple[str, Sequence[EpisodeResult]]],
+                    model: CostModel, path: str | os.PathLike[str], title: str = "") -> Path:
+    """Write the efficiency curves of ``model`` for each planner to ``path`` (PNG)."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6.4, 4.2), dpi=110)
+    ax = fig.add_subplot(1, 1, 1)
+    for name, results in results_by_planner:
+        xs, ys = curve_of(results, model)
+        ax.plot(xs, ys, label=f"{name} (AUC-E {curve_area(xs, ys, model.max_cost):.3f})",
+                linewidth=1.6)
+    ax.set_xlim(0, model.max_cost)
+    ax.set_ylim(0, 1.0)
+    ax.set_xlabel(f"budget: {model.label}")
+    ax.set_ylabel("success rate")
+    ax.grid(True, alpha=0.3)
+    ax.set_title(title or f"Efficiency curve ({model.name} budget, max {model.max_cost:g})",
+                 fontsize=10)
+    ax.legend(fontsize=8, loc="lower right")
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", metadata={"Software": None})
+    return write_text_atomic(path, buf.getvalue())

@@ -1,0 +1,272 @@
+"""The per-episode record every metric is computed from, and its JSONL file.
+
+One :class:`EpisodeResult` per episode, whatever ran it: the symbolic benchmark
+(:mod:`sgtool.datasets.symbolic`) writes them directly; a closed-loop log is turned into
+one by :func:`result_from_log_records` from its ``sgtool.Episode`` and ``sgtool.Action``
+JSON records (the mapping is documented there).
+
+Determinism: everything in a record is derived data except the ``wall`` mapping (decision
+and episode wall-clock seconds). Two runs of one command give the same JSONL bytes except
+inside ``wall``; :func:`results_digest` hashes the records with ``wall`` left out, so it is
+the figure to compare between runs.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+from sgtool.errors import SgtoolError
+
+RESULT_VERSION = "1.0"
+_ROUND = 4
+
+
+class ResultsFormatError(SgtoolError):
+    """A results file is not a JSONL file of episode records, or a record lacks a field."""
+
+
+@dataclass(frozen=True)
+class Step:
+    """One executed action: skill, target node id, outcome, metres travelled for it."""
+
+    skill: str
+    target: str | None
+    outcome: str
+    travelled_m: float = 0.0
+
+
+@dataclass(frozen=True)
+class EpisodeResult:
+    """What happened in one episode.
+
+    - ``success``: the query object was revealed within the step budget (SCOUT V.C);
+    - ``steps``: high-level actions executed (invalid ones count: a step is spent);
+    - ``travelled_m`` / ``shortest_m``: path length walked and the geodesic from the start
+      to the nearest place the target can be seen from (SPL's p and l; ``shortest_m`` is
+      None when unknown, e.g. a log without it: SPL is then undefined for the episode);
+    - ``n_open``: successful open interactions (containers and doors), for the distance
+      variant of AUC-E (MoMa-LLM: 30 low-level steps per open);
+    - ``seen``: whether the query category occurs in the planners' training knowledge
+      (SCOUT Table IX); None when not known;
+    - ``end``: why it ended ("found", "max_steps", "gave_up", "wrong_done", "stuck", ...);
+    - ``wall``: wall-clock figures (``decision_s`` summed over decisions, ``decisions``,
+      ``episode_s``), the only non-deterministic part.
+    """
+
+    planner: str
+    seed: int
+    house: str
+    episode: int
+    query: str
+    success: bool
+    steps: int
+    travelled_m: float
+    shortest_m: float | None
+    n_open: int = 0
+    n_invalid: int = 0
+    n_failure: int = 0
+    seen: bool | None = None
+    end: str = ""
+    source: str = "symbolic"
+    trace: tuple[Step, ...] = ()
+    wall: Mapping[str, float] = field(default_factory=dict)
+
+    @property
+    def decision_s(self) -> float:
+        return float(self.wall.get("decision_s", 0.0))
+
+    @property
+    def decisions(self) -> int:
+        return int(self.wall.get("decisions", self.steps))
+
+    def key(self) -> tuple[str, int, str, int]:
+        return (self.planner, self.seed, self.house, self.episode)
+
+    # ----- JSON -----------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "version": RESULT_VERSION,
+            "planner": self.planner,
+            "seed": int(self.seed),
+            "house": self.house,
+            "episode": int(self.episode),
+            "query": self.query,
+            "seen": self.seen,
+            "success": bool(self.success),
+            "steps": int(self.steps),
+            "travelled_m": _r(self.travelled_m),
+            "shortest_m": None if self.shortest_m is None else _r(self.shortest_m),
+            "n_open": int(self.n_open),
+            "n_invalid": int(self.n_invalid),
+            "n_failure": int(self.n_failure),
+            "end": self.end,
+            "source": self.source,
+            "trace": [[s.skill, s.target, s.outcome, _r(s.travelled_m)] for s in self.trace],
+            "wall": {k: round(float(v), 6) for k, v in sorted(self.wall.items())},
+        }
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"))
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> EpisodeResult:
+        missing = [k for k in ("planner", "success", "steps", "travelled_m") if k not in d]
+        if missing:
+            raise ResultsFormatError(f"episode record lacks field(s): {', '.join(missing)}")
+        major = str(d.get("version", RESULT_VERSION)).split(".")[0]
+        if major != RESULT_VERSION.split(".")[0]:
+            raise ResultsFormatError(
+                f"episode record version {d.get('version')} is not readable by this sgtool "
+                f"(reads {RESULT_VERSION.split('.')[0]}.x)"
+            )
+        shortest = d.get("shortest_m")
+        return cls(
+            planner=str(d["planner"]),
+            seed=int(d.get("seed", 0)),
+            house=str(d.get("house", "")),
+            episode=int(d.get("episode", 0)),
+            query=str(d.get("query", "")),
+            seen=d.get("seen"),
+            success=bool(d["success"]),
+            steps=int(d["steps"]),
+            travelled_m=float(d["travelled_m"]),
+            shortest_m=None if shortest is None else float(shortest),
+            n_open=int(d.get("n_open", 0)),
+            n_invalid=int(d.get("n_invalid", 0)),
+            n_failure=int(d.get("n_failure", 0)),
+            end=str(d.get("end", "")),
+            source=str(d.get("source", "symbolic")),
+            trace=tuple(Step(str(s[0]), s[1], str(s[2]), float(s[3]))
+                        for s in d.get("trace", [])),
+            wall=dict(d.get("wall", {})),
+        )
+
+
+def _r(x: float) -> float:
+    v = round(float(x), _ROUND)
+    return 0.0 if v == 0 else v
+
+
+# ----------------------------------------------------------------------------------------
+# files
+# ----------------------------------------------------------------------------------------
+def write_jsonl(results: Iterable[EpisodeResult], path: str | os.PathLike[str]) -> Path:
+    """One record per line, written to a temp file beside ``path`` and renamed at the end."""
+    return write_text_atomic(path, "".join(r.to_json() + "\n" for r in results))
+
+
+def write_text_atomic(path: str | os.PathLike[str], text: str | bytes) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(text.encode("utf-8") if isinstance(text, str) else text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def read_jsonl(path: str | os.PathLike[str]) -> list[EpisodeResult]:
+    p = Path(path)
+    try:
+        lines = p.read_text(encoding="utf-8").splitlines()
+    except FileNotFoundError:
+        raise ResultsFormatError(f"{p}: no such file") from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise ResultsFormatError(f"{p}: cannot read: {e}") from None
+    out = []
+    for i, line in enumerate(lines, 1):
+        if not line.strip():
+            continue
+        try:
+            d = json.loads(line)
+        except json.JSONDecodeError as e:
+            raise ResultsFormatError(f"{p}:{i}: not a JSON line ({e.msg})") from None
+        if not isinstance(d, dict):
+            raise ResultsFormatError(f"{p}:{i}: expected a JSON object")
+        try:
+            out.append(EpisodeResult.from_dict(d))
+        except ResultsFormatError as e:
+            raise ResultsFormatError(f"{p}:{i}: {e}") from None
+        except (TypeError, ValueError, IndexError) as e:
+            raise ResultsFormatError(f"{p}:{i}: malformed episode record ({e})") from None
+    return out
+
+
+def results_digest(results: Sequence[EpisodeResult]) -> str:
+    """SHA-256 over the canonical records without their ``wall`` figures."""
+    h = hashlib.sha256()
+    for r in results:
+        d = r.to_dict()
+        d.pop("wall")
+        h.update(json.dumps(d, sort_keys=True, separators=(",", ":")).encode())
+        h.update(b"\n")
+    return h.hexdigest()
+
+
+# ----------------------------------------------------------------------------------------
+# from log records
+# ----------------------------------------------------------------------------------------
+def result_from_log_records(episode: Mapping[str, Any], actions: Sequence[Mapping[str, Any]],
+                            source: str = "log") -> EpisodeResult:
+    """An :class:`EpisodeResult` from the records of one episode of a log.
+
+    Reads the final ``sgtool.Episode`` record (``status`` "success"/"failure"/"ended",
+    ``steps``, ``travelled_m``, ``shortest_m``, ``query``, ``planner``, ``house_id``) and
+    the episode's ``sgtool.Action`` records (``skill``, ``target``, ``outcome``,
+    ``travelled_m``, ``decision_time_s``). From ``extra`` it reads, when present: ``seed``
+    (int), ``episode`` (int), ``seen`` (bool), ``end`` (str), ``n_open`` (int).
+
+    Derived when absent: ``n_open`` = actions with skill "open" and outcome "success";
+    ``n_invalid`` / ``n_failure`` = actions with that outcome; ``steps`` = number of
+    actions; ``travelled_m`` = sum over actions.
+    """
+    extra = episode.get("extra") or {}
+    trace = tuple(
+        Step(str(a.get("skill", "")), a.get("target"), str(a.get("outcome", "")),
+             float(a.get("travelled_m", 0.0)))
+        for a in actions
+    )
+    status = episode.get("status")
+    steps = episode.get("steps")
+    travelled = episode.get("travelled_m")
+    n_open = extra.get("n_open")
+    if n_open is None:
+        n_open = sum(1 for s in trace if s.skill == "open" and s.outcome == "success")
+    decision_s = sum(float(a.get("decision_time_s", 0.0)) for a in actions)
+    seen = extra.get("seen")
+    return EpisodeResult(
+        planner=str(episode.get("planner") or next(
+            (a.get("planner") for a in actions if a.get("planner")), "unknown")),
+        seed=int(extra.get("seed", 0)),
+        house=str(episode.get("house_id") or ""),
+        episode=int(extra.get("episode", 0)),
+        query=str(episode.get("query") or ""),
+        seen=None if seen is None else bool(seen),
+        success=status == "success",
+        steps=int(steps if steps is not None else len(trace)),
+        travelled_m=float(travelled if travelled is not None
+                          else sum(s.travelled_m for s in trace)),
+        shortest_m=None if episode.get("shortest_m") is None else float(episode["shortest_m"]),
+        n_open=int(n_open),
+        n_invalid=sum(1 for s in trace if s.outcome == "invalid"),
+        n_failure=sum(1 for s in trace if s.outcome == "failure"),
+        end=str(extra.get("end", status or "")),
+        source=source,
+        trace=trace,
+        wall={"decision_s": decision_s, "decisions": float(len(actions))},
+    )
+
+
+RESULT_FIELDS = tuple(f.name for f in fields(EpisodeResult))

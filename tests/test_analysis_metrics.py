@@ -1,0 +1,121 @@
+"""Metrics against values worked out by hand (SR, SPL, steps, AUC-E, seeds, Table IX)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sgtool.analysis.metrics import (
+    DISTANCE_COST,
+    STEP_COST,
+    Stat,
+    auc_e,
+    auc_e_of,
+    cost_models,
+    distance_cost,
+    efficiency_curve,
+    episode_spl,
+    mean_decision_time,
+    mean_steps,
+    seen_unseen,
+    spl,
+    sr_at,
+    success_rate,
+    summarize,
+)
+from sgtool.analysis.records import EpisodeResult
+
+
+def ep(success: bool, steps: int = 10, travelled: float = 10.0, shortest: float | None = 5.0,
+       planner: str = "p", seed: int = 0, n_open: int = 0, seen: bool | None = None,
+       decision_s: float = 0.0, episode: int = 0) -> EpisodeResult:
+    return EpisodeResult(planner=planner, seed=seed, house="h", episode=episode, query="cup",
+                         success=success, steps=steps, travelled_m=travelled,
+                         shortest_m=shortest, n_open=n_open, seen=seen,
+                         wall={"decision_s": decision_s, "decisions": steps})
+
+
+def test_episode_spl_cases():
+    assert episode_spl(True, 5.0, 10.0) == 0.5
+    assert episode_spl(True, 5.0, 4.0) == 1.0  # travelled below shortest: capped at 1
+    assert episode_spl(False, 5.0, 5.0) == 0.0
+    assert episode_spl(True, 0.0, 0.0) == 1.0  # target visible from the start
+    assert math.isnan(episode_spl(True, None, 3.0))
+
+
+def test_sr_spl_steps_over_a_set():
+    rs = [ep(True, steps=4, travelled=10, shortest=5), ep(True, steps=6, travelled=8, shortest=8),
+          ep(False, steps=50), ep(True, steps=2, travelled=3, shortest=None)]
+    assert success_rate(rs) == 0.75
+    # SPL over the three episodes with a known shortest path: (0.5 + 1 + 0) / 3
+    assert spl(rs) == pytest.approx(0.5)
+    assert mean_steps(rs) == pytest.approx(62 / 4)
+
+
+def test_decision_time_is_per_decision():
+    rs = [ep(True, steps=2, decision_s=0.2), ep(False, steps=8, decision_s=0.3)]
+    assert mean_decision_time(rs) == pytest.approx(0.05)
+
+
+def test_efficiency_curve_vertices_and_area():
+    # N = 4; solved at 10 and 20; solved at 60 is over the budget 50 and left out
+    xs, ys = efficiency_curve([10, 20, 30, 60], [True, True, False, True], 50)
+    assert xs.tolist() == [0, 10, 20, 50]
+    assert ys.tolist() == [0, 0.25, 0.5, 0.5]
+    # trapezoids: 10 * 0.125 + 10 * 0.375 + 30 * 0.5 = 20; 20 / 50 = 0.4
+    assert auc_e([10, 20, 30, 60], [True, True, False, True], 50) == pytest.approx(0.4)
+
+
+def test_auc_e_bounds_and_ties():
+    assert auc_e([0, 0, 0], [True, True, True], 50) == pytest.approx(1.0)
+    assert auc_e([1, 2, 3], [False, False, False], 50) == 0.0
+    assert auc_e([], [], 50) == 0.0
+    # ties: two solved at 25 of 2 episodes -> y jumps 0 -> 1 at x = 25 (after a ramp from
+    # (0,0)); area = 25 * 0.25 (ramp to the first vertex at y=0.5) + 0 + 25 * 1 = 31.25
+    assert auc_e([25, 25], [True, True], 50) == pytest.approx(31.25 / 50)
+
+
+def test_sr_at_reads_the_curve():
+    xs, ys = efficiency_curve([10, 20, 30, 60], [True, True, False, True], 50)
+    np.testing.assert_allclose(sr_at(xs, ys, [0, 10, 15, 20, 50]), [0, 0.25, 0.375, 0.5, 0.5])
+    xs, ys = efficiency_curve([0, 0], [True, True], 50)
+    assert sr_at(xs, ys, [0])[0] == 1.0  # vertical run at x = 0 takes its top
+
+
+def test_distance_cost_is_momallm_low_level():
+    r = ep(True, travelled=12.3, n_open=2)
+    assert distance_cost(r) == pytest.approx(123 + 60)
+    assert DISTANCE_COST.max_cost == 5000 and STEP_COST.max_cost == 50
+    # one episode solved with cost 183 of budget 5000: area = 183 * 0.5 + (5000-183) * 1
+    assert auc_e_of([r], DISTANCE_COST) == pytest.approx((91.5 + 4817) / 5000)
+    d, s = cost_models(distance_budget=1000, open_cost=10)
+    assert d.cost(r) == pytest.approx(143) and d.max_cost == 1000 and "1000" in d.statement()
+    assert s.cost(r) == 10
+
+
+def test_summary_mean_std_over_seeds():
+    rs = [ep(True, seed=0), ep(False, seed=0, episode=1),
+          ep(True, seed=1), ep(True, seed=1, episode=1),
+          ep(False, planner="q", seed=0)]
+    sums = summarize(rs)
+    assert [s.planner for s in sums] == ["p", "q"]
+    sr = sums[0].stats["sr"]
+    assert sr.per_seed == (0.5, 1.0)
+    assert sr.mean == pytest.approx(0.75)
+    assert sr.std == pytest.approx(math.sqrt(0.125))  # sample std of (0.5, 1.0)
+    assert sums[0].episodes == 4 and sums[0].seeds == (0, 1)
+    assert sums[1].stats["sr"].std == 0.0  # one seed
+    assert set(sums[0].stats) >= {"sr", "spl", "steps", "decision_s", "auc_e_distance",
+                                  "auc_e_steps"}
+    assert Stat.of([math.nan, 1.0]).mean == 1.0
+
+
+def test_seen_unseen_breakdown():
+    rs = [ep(True, seen=True), ep(False, seen=True), ep(True, seen=False, travelled=5),
+          ep(True, seen=None)]
+    (row,) = seen_unseen(rs)
+    assert (row.seen_n, row.unseen_n) == (2, 1)
+    assert row.seen_sr == 0.5 and row.unseen_sr == 1.0
+    assert row.seen_spl == pytest.approx(0.25) and row.unseen_spl == pytest.approx(1.0)

@@ -1,0 +1,108 @@
+"""Episode records: JSONL round trip, digest without wall-clock, log mapping, tables, PNG."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from sgtool.analysis.curves import plot_efficiency
+from sgtool.analysis.metrics import COST_MODELS, STEP_COST, seen_unseen, summarize
+from sgtool.analysis.records import (
+    EpisodeResult,
+    ResultsFormatError,
+    Step,
+    read_jsonl,
+    result_from_log_records,
+    results_digest,
+    write_jsonl,
+)
+from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
+
+
+def _result(wall: float = 0.01, success: bool = True, planner: str = "scout") -> EpisodeResult:
+    return EpisodeResult(
+        planner=planner, seed=3, house="house-7", episode=2, query="cup", success=success,
+        steps=3, travelled_m=7.25, shortest_m=4.0, n_open=1, n_invalid=1, seen=False,
+        end="found", trace=(Step("explore", "room:2", "success", 4.0),
+                            Step("open", "obj:9", "success", 3.25),
+                            Step("open", "obj:99", "invalid", 0.0)),
+        wall={"decision_s": wall, "decisions": 3, "episode_s": 2 * wall},
+    )
+
+
+def test_jsonl_round_trip(tmp_path):
+    rs = [_result(), _result(success=False, planner="random")]
+    p = write_jsonl(rs, tmp_path / "out" / "episodes.jsonl")
+    back = read_jsonl(p)
+    assert back == rs
+    assert [json.loads(line)["planner"] for line in p.read_text().splitlines()] == [
+        "scout", "random"]
+    assert not list((tmp_path / "out").glob(".*.tmp"))  # no temp file left behind
+
+
+def test_digest_ignores_wall_clock_only():
+    a, b = _result(wall=0.01), _result(wall=0.5)
+    assert a.to_json() != b.to_json()
+    assert results_digest([a]) == results_digest([b])
+    assert results_digest([a]) != results_digest([_result(success=False)])
+
+
+def test_read_errors_name_the_line(tmp_path):
+    p = tmp_path / "bad.jsonl"
+    p.write_text(_result().to_json() + "\n{not json\n")
+    with pytest.raises(ResultsFormatError, match=r"bad.jsonl:2"):
+        read_jsonl(p)
+    p.write_text('{"planner": "x"}\n')
+    with pytest.raises(ResultsFormatError, match="success"):
+        read_jsonl(p)
+    with pytest.raises(ResultsFormatError, match="no such file"):
+        read_jsonl(tmp_path / "missing.jsonl")
+
+
+def test_result_from_log_records_derives_counts():
+    episode = {"kind": "search", "status": "success", "query": "cup", "planner": "scout",
+               "house_id": "house-1", "steps": 3, "travelled_m": 6.5, "shortest_m": 5.0,
+               "extra": {"seed": 4, "episode": 1, "seen": True}}
+    actions = [
+        {"skill": "explore", "target": "room:1", "outcome": "success", "travelled_m": 4.0,
+         "decision_time_s": 0.02},
+        {"skill": "open", "target": "door:0", "outcome": "success", "travelled_m": 2.5,
+         "decision_time_s": 0.03},
+        {"skill": "open", "target": "obj:5", "outcome": "invalid", "travelled_m": 0.0,
+         "decision_time_s": 0.01},
+    ]
+    r = result_from_log_records(episode, actions)
+    assert (r.success, r.steps, r.n_open, r.n_invalid, r.seed, r.episode, r.seen) == (
+        True, 3, 1, 1, 4, 1, True)
+    assert r.decision_s == pytest.approx(0.06) and r.decisions == 3
+    r2 = result_from_log_records({"kind": "search", "status": "failure"}, actions)
+    assert not r2.success and r2.steps == 3 and r2.travelled_m == pytest.approx(6.5)
+    assert r2.shortest_m is None and r2.planner == "unknown"
+
+
+def test_tables_and_summary_dict():
+    rs = [_result(), _result(success=False, planner="random")]
+    sums = summarize(rs)
+    text = format_table(sums, throughput={"scout": 12.0}, models=COST_MODELS, title="T")
+    lines = text.splitlines()
+    assert lines[0] == "T"
+    assert lines[1].startswith("| Planner") and "AUC-E dist" in lines[1]
+    row = next(ln for ln in lines if ln.startswith("| scout"))
+    assert "1.000 ± 0.000" in row and "12.0" in row
+    assert "budget max 5000" in text and "budget max 50" in text
+    split = format_seen_unseen(seen_unseen(rs))
+    assert "| scout" in split and "Unseen SR" in split
+    d = summary_dict(sums)
+    assert d["scout"]["sr"]["mean"] == 1.0 and d["random"]["sr"]["mean"] == 0.0
+
+
+def test_plot_writes_png(tmp_path):
+    import matplotlib.image as mpimg
+
+    rs = [_result(), _result(success=False, planner="random")]
+    p = plot_efficiency([("scout", rs[:1]), ("random", rs[1:])], STEP_COST,
+                        tmp_path / "curve.png")
+    assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    img = mpimg.imread(p)
+    assert img.shape[0] > 100 and img.shape[1] > 100
