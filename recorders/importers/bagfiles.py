@@ -1,0 +1,131 @@
+"""Opening ROS bags with ``rosbags`` and describing what is in them.
+
+:func:`open_bag` accepts what people pass around:
+- a ROS 1 ``.bag`` file;
+- a ROS 2 bag folder (``metadata.yaml`` plus ``.db3`` or ``.mcap`` storage files), or a
+  storage file inside such a folder;
+- a bare ROS 2 ``.mcap`` or ``.db3`` file without ``metadata.yaml`` (a copy of the storage
+  file alone, or a recording made by ``mcap``/Foxglove tools): ``rosbags`` reads these
+  from the file's own schemas and tables.
+
+Failures become :class:`SgtoolError` messages that name the file and what it is instead
+(an sgtool log or another non-ROS MCAP file is named as such).
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from sgtool.errors import SgtoolError
+
+IMAGE_TYPES = ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage")
+INFO_TYPES = ("sensor_msgs/msg/CameraInfo",)
+TF_TYPES = ("tf2_msgs/msg/TFMessage", "tf/msg/tfMessage")
+POSE_TYPES = (
+    "geometry_msgs/msg/PoseStamped",
+    "geometry_msgs/msg/PoseWithCovarianceStamped",
+    "geometry_msgs/msg/TransformStamped",
+    "nav_msgs/msg/Odometry",
+)
+
+
+@dataclass(frozen=True)
+class TopicInfo:
+    topic: str
+    msgtype: str
+    count: int
+
+
+def _normalise_type(t: str) -> str:
+    """ROS 1 names types ``pkg/Type``; rosbags reports ``pkg/msg/Type``: accept both."""
+    parts = t.split("/")
+    return f"{parts[0]}/msg/{parts[1]}" if len(parts) == 2 else t
+
+
+def bag_kind(path: Path) -> str:
+    """``ros1`` or ``ros2`` (folder, or bare storage file)."""
+    if path.is_dir():
+        return "ros2"
+    if path.suffix == ".bag":
+        return "ros1"
+    return "ros2"
+
+
+def _check_mcap_profile(path: Path) -> None:
+    """A non-ROS MCAP file (an sgtool log, a protobuf recording) gets a message that says
+    what it is, rather than the bag reader's "Profile is not ros2"."""
+    from mcap.reader import make_reader
+
+    try:
+        with open(path, "rb") as f:
+            reader = make_reader(f)
+            header = reader.get_header()
+            summary = reader.get_summary()
+    except Exception as e:  # the mcap library raises assorted errors on garbage
+        raise SgtoolError(f"{path}: not a readable MCAP file ({type(e).__name__}: {e})") from e
+    encodings = sorted({ch.message_encoding for ch in summary.channels.values()}) if summary \
+        else []
+    if header.profile != "ros2" or (encodings and encodings != ["cdr"]):
+        raise SgtoolError(
+            f"{path} is an MCAP file with profile {header.profile!r} and "
+            f"{', '.join(encodings) or 'no'} messages, not a ROS 2 bag (profile 'ros2', cdr)"
+            + ("; it already is an sgtool log" if header.profile == "sgtool" else "")
+        )
+
+
+@contextlib.contextmanager
+def open_bag(path: str | Path) -> Iterator[Any]:
+    """An open ``rosbags`` AnyReader over the bag at ``path`` (see the module docstring)."""
+    from rosbags.highlevel import AnyReader, AnyReaderError
+    from rosbags.typesys import Stores, get_typestore
+
+    path = Path(path)
+    if not path.exists():
+        raise SgtoolError(f"{path}: no such file or folder")
+    with contextlib.ExitStack() as stack:
+        target = path
+        if path.is_file() and path.suffix in (".mcap", ".db3"):
+            if (path.parent / "metadata.yaml").is_file():
+                target = path.parent
+            elif path.suffix == ".mcap":
+                _check_mcap_profile(path)
+        elif path.is_dir() and not (path / "metadata.yaml").is_file():
+            raise SgtoolError(f"{path}: a folder without metadata.yaml is not a ROS 2 bag")
+        elif path.is_file() and path.suffix != ".bag":
+            raise SgtoolError(
+                f"{path}: not a ROS bag (expected a ROS 1 .bag file, a ROS 2 bag folder, or a "
+                "ROS 2 .mcap/.db3 file)"
+            )
+        try:
+            reader = AnyReader([target], default_typestore=get_typestore(Stores.LATEST))
+            stack.enter_context(reader)
+        except (AnyReaderError, FileNotFoundError, ValueError, KeyError) as e:
+            raise SgtoolError(f"{path}: not a readable ROS bag ({type(e).__name__}: {e})") from e
+        except Exception as e:  # the bag readers raise assorted errors on garbage
+            raise SgtoolError(f"{path}: not a readable ROS bag ({type(e).__name__}: {e})") from e
+        yield reader
+
+
+def list_topics(reader: Any) -> list[TopicInfo]:
+    out: dict[str, TopicInfo] = {}
+    for c in reader.connections:
+        prev = out.get(c.topic)
+        n = int(c.msgcount) + (prev.count if prev else 0)
+        out[c.topic] = TopicInfo(c.topic, _normalise_type(c.msgtype), n)
+    return [out[t] for t in sorted(out)]
+
+
+def format_topics(topics: list[TopicInfo]) -> str:
+    if not topics:
+        return "  (no topics)"
+    w = max(len(t.topic) for t in topics)
+    wt = max(len(t.msgtype) for t in topics)
+    return "\n".join(f"  {t.topic:<{w}}  {t.msgtype:<{wt}}  {t.count:>7}" for t in topics)
+
+
+def connections_for(reader: Any, topic: str) -> list[Any]:
+    return [c for c in reader.connections if c.topic == topic]

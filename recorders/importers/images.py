@@ -1,0 +1,210 @@
+"""Image decoding for the importers, with OpenCV: image files, and ROS ``sensor_msgs/Image``
+and ``sensor_msgs/CompressedImage`` messages (including ``compressedDepth``).
+
+Colour comes out as (H, W, 3) uint8 RGB. Depth comes out as metres (float32, 0 = no
+return) through :func:`depth_to_metres`, or kept as uint16 millimetres when the source
+already is millimetres (no rounding at all, so a round trip is exact). Depth sensors mark
+"no return" with 0 (ROS, TUM, Open3D) or 65535 (7-Scenes); both become 0.
+"""
+
+from __future__ import annotations
+
+import struct
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+
+from sgtool.errors import SgtoolError
+
+INVALID_U16 = 65535
+
+
+def read_color_file(path: Path) -> np.ndarray:
+    """An 8-bit colour (or grey) image file -> (H, W, 3) uint8 RGB."""
+    a = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    if a is None:
+        raise SgtoolError(f"{path}: OpenCV cannot read this image")
+    return _to_rgb(a, str(path))
+
+
+def read_depth_file(path: Path) -> np.ndarray:
+    """A 16-bit depth image file (PNG/TIFF) -> its raw uint16 values (units per the
+    dataset's depth scale)."""
+    a = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    if a is None:
+        raise SgtoolError(f"{path}: OpenCV cannot read this image")
+    if a.ndim != 2 or a.dtype != np.uint16:
+        raise SgtoolError(
+            f"{path}: a depth image must be single-channel 16-bit, this one is "
+            f"{a.dtype} with shape {a.shape}"
+        )
+    return a
+
+
+def _to_rgb(a: np.ndarray, what: str) -> np.ndarray:
+    if a.dtype == np.uint16:
+        a = (a >> 8).astype(np.uint8)
+    if a.dtype != np.uint8:
+        raise SgtoolError(f"{what}: expected an 8-bit colour image, got {a.dtype}")
+    if a.ndim == 2:
+        return np.repeat(a[:, :, None], 3, axis=2)
+    if a.shape[2] == 4:
+        return cv2.cvtColor(a, cv2.COLOR_BGRA2RGB)
+    if a.shape[2] == 3:
+        return cv2.cvtColor(a, cv2.COLOR_BGR2RGB)
+    raise SgtoolError(f"{what}: unsupported channel count {a.shape[2]}")
+
+
+def depth_to_metres(raw: np.ndarray, scale: float) -> np.ndarray:
+    """Raw depth in units of 1/``scale`` metres -> float32 metres (0 = no return)."""
+    if raw.dtype == np.uint16:
+        out = raw.astype(np.float32) / np.float32(scale)
+        out[raw == INVALID_U16] = 0.0
+        return out
+    out = np.nan_to_num(raw.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0) / np.float32(
+        scale
+    )
+    out[out < 0] = 0.0
+    return out
+
+
+def depth_for_log(raw: np.ndarray, scale: float) -> np.ndarray:
+    """What :meth:`LogWriter.write_frame` takes: uint16 millimetres untouched when the
+    source is millimetres, else float32 metres."""
+    if raw.dtype == np.uint16 and scale == 1000.0:
+        if np.any(raw == INVALID_U16):
+            raw = raw.copy()
+            raw[raw == INVALID_U16] = 0
+        return raw
+    return depth_to_metres(raw, scale)
+
+
+# ----- ROS messages ------------------------------------------------------------------------
+_RAW = {
+    "rgb8": (np.uint8, 3), "bgr8": (np.uint8, 3), "rgba8": (np.uint8, 4),
+    "bgra8": (np.uint8, 4), "mono8": (np.uint8, 1), "8UC1": (np.uint8, 1),
+    "8UC3": (np.uint8, 3), "mono16": (np.uint16, 1), "16UC1": (np.uint16, 1),
+    "16SC1": (np.int16, 1), "32SC1": (np.int32, 1), "32FC1": (np.float32, 1),
+}
+
+
+def decode_raw_image(msg: Any, topic: str) -> tuple[np.ndarray, str]:
+    """A ``sensor_msgs/Image`` -> (array, encoding). Rows padded by ``step`` are cut and
+    big-endian data swapped."""
+    enc = str(msg.encoding)
+    if enc not in _RAW:
+        raise SgtoolError(
+            f"topic {topic}: image encoding {enc!r} is not supported "
+            f"(supported: {', '.join(sorted(_RAW))})"
+        )
+    dtype, ch = _RAW[enc]
+    dt = np.dtype(dtype).newbyteorder(">" if msg.is_bigendian else "<")
+    h, w, step = int(msg.height), int(msg.width), int(msg.step)
+    buf = np.asarray(msg.data, dtype=np.uint8)
+    row = w * ch * dt.itemsize
+    if step < row or buf.size < step * h:
+        raise SgtoolError(
+            f"topic {topic}: image data is shorter than {h} rows of {row} bytes "
+            f"(step {step}, {buf.size} bytes)"
+        )
+    a = buf[: step * h].reshape(h, step)[:, :row].copy().view(dt)
+    a = a.reshape((h, w) if ch == 1 else (h, w, ch)).astype(dt.newbyteorder("="))
+    return a, enc
+
+
+def color_from_raw(a: np.ndarray, enc: str, topic: str) -> np.ndarray:
+    if enc in ("rgb8", "8UC3"):
+        return a
+    if enc == "bgr8":
+        return a[..., ::-1].copy()
+    if enc == "rgba8":
+        return a[..., :3].copy()
+    if enc == "bgra8":
+        return a[..., 2::-1].copy()
+    if enc in ("mono8", "8UC1"):
+        return np.repeat(a[:, :, None], 3, axis=2)
+    if enc == "mono16":
+        return np.repeat((a >> 8).astype(np.uint8)[:, :, None], 3, axis=2)
+    raise SgtoolError(f"topic {topic}: image encoding {enc!r} is not a colour image")
+
+
+def decode_color_message(msg: Any, msgtype: str, topic: str) -> np.ndarray:
+    """``Image`` or ``CompressedImage`` -> (H, W, 3) uint8 RGB."""
+    if msgtype.endswith("CompressedImage"):
+        a = cv2.imdecode(np.asarray(msg.data, dtype=np.uint8), cv2.IMREAD_UNCHANGED)
+        if a is None:
+            raise SgtoolError(f"topic {topic}: OpenCV cannot decode a {msg.format!r} image")
+        return _to_rgb(a, f"topic {topic}")
+    a, enc = decode_raw_image(msg, topic)
+    return color_from_raw(a, enc, topic)
+
+
+def decode_depth_message(msg: Any, msgtype: str, topic: str) -> tuple[np.ndarray, float]:
+    """``Image`` (16UC1/mono16 millimetres, 32FC1 metres) or ``CompressedImage`` (PNG, or
+    image_transport's ``compressedDepth``) -> (raw array, units per metre)."""
+    if msgtype.endswith("CompressedImage"):
+        fmt = str(msg.format)
+        data = bytes(np.asarray(msg.data, dtype=np.uint8).tobytes())
+        if "compresseddepth" in fmt.lower().replace(" ", ""):
+            return _decode_compressed_depth(data, fmt, topic)
+        a = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED)
+        if a is None or a.ndim != 2 or a.dtype != np.uint16:
+            raise SgtoolError(
+                f"topic {topic}: compressed depth format {fmt!r} did not decode to a "
+                "single-channel 16-bit image"
+            )
+        return a, 1000.0
+    a, enc = decode_raw_image(msg, topic)
+    if enc in ("16UC1", "mono16"):
+        return a, 1000.0
+    if enc == "32FC1":
+        return a, 1.0
+    raise SgtoolError(
+        f"topic {topic}: image encoding {enc!r} is not a depth encoding (16UC1 mm, 32FC1 m)"
+    )
+
+
+def _decode_compressed_depth(data: bytes, fmt: str, topic: str) -> tuple[np.ndarray, float]:
+    """image_transport ``compressedDepth``: a 12-byte header (int32 format, float
+    depthQuantA, float depthQuantB) then a PNG. 16UC1 stores millimetres; 32FC1 stores
+    quantised inverse depth, depth = A / (v - B) for v != 0."""
+    if len(data) < 12:
+        raise SgtoolError(f"topic {topic}: compressedDepth message shorter than its header")
+    _, qa, qb = struct.unpack("<iff", data[:12])
+    if "rvl" in fmt.lower():
+        raise SgtoolError(f"topic {topic}: compressedDepth RVL ({fmt!r}) is not supported")
+    a = cv2.imdecode(np.frombuffer(data[12:], np.uint8), cv2.IMREAD_UNCHANGED)
+    if a is None or a.dtype != np.uint16:
+        raise SgtoolError(f"topic {topic}: compressedDepth PNG did not decode ({fmt!r})")
+    if fmt.split(";")[0].strip() == "32FC1":
+        v = a.astype(np.float32)
+        out = np.zeros(v.shape, np.float32)
+        ok = v != 0
+        out[ok] = qa / (v[ok] - qb)
+        return out, 1.0
+    return a, 1000.0
+
+
+def decode_ids_message(msg: Any, msgtype: str, topic: str) -> np.ndarray:
+    """Instance-id image (8/16/32-bit integer) -> int32."""
+    if msgtype.endswith("CompressedImage"):
+        a = cv2.imdecode(np.asarray(msg.data, dtype=np.uint8), cv2.IMREAD_UNCHANGED)
+        if a is None or a.ndim != 2:
+            raise SgtoolError(f"topic {topic}: instance ids must decode to one channel")
+        return a.astype(np.int32)
+    a, enc = decode_raw_image(msg, topic)
+    if a.ndim != 2 or not np.issubdtype(a.dtype, np.integer):
+        raise SgtoolError(
+            f"topic {topic}: instance ids need a one-channel integer encoding, got {enc!r}"
+        )
+    return a.astype(np.int32)
+
+
+def resize_to(a: np.ndarray, width: int, height: int) -> np.ndarray:
+    """Resize an image to the depth image's size (area averaging for colour)."""
+    if a.shape[1] == width and a.shape[0] == height:
+        return a
+    interp = cv2.INTER_AREA if a.dtype == np.uint8 else cv2.INTER_NEAREST
+    return cv2.resize(a, (width, height), interpolation=interp)

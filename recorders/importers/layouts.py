@@ -1,0 +1,281 @@
+"""RGB-D folder layouts: detection and listing of frames, poses and camera parameters.
+
+- ``tum`` (TUM RGB-D benchmark): ``rgb.txt`` and ``depth.txt`` list time-stamped images,
+  ``groundtruth.txt`` holds the motion-capture trajectory (camera-to-world) at ~100 Hz.
+  Colour is associated with each depth image by nearest time stamp within ``max_dt``
+  (20 ms, as the benchmark's ``associate.py``); the pose at the depth time is interpolated
+  from the ground truth. Depth is in 1/5000 m. Intrinsics: the benchmark's published
+  calibration for freiburg1/2/3 when the folder name says which, else they must be given.
+- ``7scenes`` (Microsoft 7-Scenes, Shotton et al. CVPR 2013): ``frame-XXXXXX.color.png``
+  (or ``.jpg``), ``frame-XXXXXX.depth.png`` (mm, 65535 = no return), ``frame-XXXXXX.pose.txt``
+  (camera-to-world 4x4). Kinect v1 at 30 Hz: frame n is at n/30 s. Intrinsics: a
+  ``camera-intrinsics.txt`` 3x3 matrix when present, else the dataset's 585, 585, 320, 240.
+  (7-Scenes depth is not registered to colour; the mapping uses depth only.)
+- ``open3d`` (Open3D reconstruction system / Redwood): ``color/`` (or ``image/``, ``rgb/``)
+  and ``depth/`` folders of images paired by name, a ``.log`` trajectory (camera-to-world)
+  and an intrinsics JSON (``intrinsic_matrix``); depth in mm. Without a JSON, the PrimeSense
+  default 525, 525, 319.5, 239.5 that Open3D itself assumes. Frames are ``1/fps`` apart.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from sgtool.errors import SgtoolError
+from sgtool.recorders.importers.poses import PoseTrack
+from sgtool.recorders.importers.textformats import (
+    PinholeParams,
+    read_intrinsics_file,
+    read_open3d_log,
+    read_tum_list,
+    read_tum_trajectory,
+)
+
+LAYOUTS = ("tum", "7scenes", "open3d")
+
+# TUM RGB-D calibrated colour intrinsics (vision.in.tum.de/data/datasets/rgbd-dataset/
+# file_formats, "Intrinsic Camera Calibration of the Kinect")
+TUM_INTRINSICS = {
+    "freiburg1": PinholeParams(517.3, 516.5, 318.6, 255.3, source="TUM freiburg1 calibration"),
+    "freiburg2": PinholeParams(520.9, 521.0, 325.1, 249.7, source="TUM freiburg2 calibration"),
+    "freiburg3": PinholeParams(535.4, 539.2, 320.1, 247.6, source="TUM freiburg3 calibration"),
+}
+SEVEN_SCENES_INTRINSICS = PinholeParams(585.0, 585.0, 320.0, 240.0, source="7-Scenes default")
+PRIMESENSE_INTRINSICS = PinholeParams(525.0, 525.0, 319.5, 239.5, source="PrimeSense default")
+
+_IMAGE_EXT = (".png", ".jpg", ".jpeg", ".ppm", ".bmp", ".tif", ".tiff")
+_SEVEN = re.compile(r"^frame-(\d+)\.(color|depth|pose)\.(png|jpg|jpeg|txt)$")
+
+
+@dataclass(frozen=True)
+class FolderFrame:
+    time_ns: int
+    depth_path: Path
+    color_path: Path | None
+    pose: np.ndarray | None  # camera-to-world in the source world, when the source has one
+
+
+@dataclass(frozen=True)
+class FolderSequence:
+    layout: str
+    root: Path
+    frames: tuple[FolderFrame, ...]
+    intrinsics: PinholeParams | None
+    depth_scale: float  # raw depth units per metre
+    pose_source: str  # "ground truth" | "trajectory" | "none"
+    notes: tuple[str, ...] = ()
+
+
+def detect_layout(root: Path) -> str:
+    """The layout of a folder, or a user error that says what was looked for."""
+    if not root.is_dir():
+        raise SgtoolError(f"{root} is not a folder")
+    names = {p.name for p in root.iterdir()}
+    if "rgb.txt" in names and "depth.txt" in names:
+        return "tum"
+    if any(_SEVEN.match(n) and ".depth." in n for n in names):
+        return "7scenes"
+    if "depth" in names and (root / "depth").is_dir() and _color_dir(root) is not None:
+        return "open3d"
+    seqs = sorted(n for n in names if n.startswith("seq-") and (root / n).is_dir())
+    hint = f"; it has sequence folders {', '.join(seqs[:5])}: import one of them" if seqs else ""
+    raise SgtoolError(
+        f"{root}: no known RGB-D layout (TUM: rgb.txt + depth.txt; 7-Scenes: "
+        f"frame-XXXXXX.depth.png; Open3D/Redwood: color/ or image/ and depth/ folders){hint}"
+    )
+
+
+def _color_dir(root: Path) -> Path | None:
+    for n in ("color", "image", "rgb"):
+        if (root / n).is_dir():
+            return root / n
+    return None
+
+
+def _images(folder: Path) -> list[Path]:
+    return sorted(p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_EXT)
+
+
+def read_sequence(
+    root: Path,
+    layout: str | None = None,
+    *,
+    max_dt_ns: int = 20_000_000,
+    fps: float = 30.0,
+    trajectory: Path | None = None,
+    keep_unposed: bool = False,
+) -> FolderSequence:
+    """List a folder's frames (see the module docstring). ``trajectory`` overrides the
+    dataset's pose file (TUM text or Open3D .log); ``keep_unposed`` keeps frames the
+    ground truth does not cover (for pose estimation)."""
+    root = Path(root)
+    layout = layout or detect_layout(root)
+    if layout == "tum":
+        seq = _read_tum(root, max_dt_ns, trajectory, keep_unposed)
+    elif layout == "7scenes":
+        seq = _read_7scenes(root, fps, trajectory)
+    elif layout == "open3d":
+        seq = _read_open3d(root, fps, trajectory)
+    else:
+        raise SgtoolError(f"unknown layout {layout!r} ({', '.join(LAYOUTS)})")
+    if not seq.frames:
+        raise SgtoolError(f"{root}: no frames found in the {layout} layout")
+    return seq
+
+
+def _nearest(times: list[int], t: int) -> int | None:
+    import bisect
+
+    if not times:
+        return None
+    i = bisect.bisect_left(times, t)
+    cands = [j for j in (i - 1, i) if 0 <= j < len(times)]
+    return min(cands, key=lambda j: abs(times[j] - t))
+
+
+def _read_tum(
+    root: Path, max_dt_ns: int, trajectory: Path | None, keep_unposed: bool
+) -> FolderSequence:
+    rgb = read_tum_list(root / "rgb.txt")
+    depth = read_tum_list(root / "depth.txt")
+    rgb_times = [t for t, _ in rgb]
+    gt_path = trajectory or (root / "groundtruth.txt")
+    track = None
+    if gt_path.is_file():
+        # ground truth at ~100 Hz: interpolate over gaps up to 0.1 s, no extrapolation
+        # beyond 10 ms (the motion-capture system loses markers now and then)
+        track = PoseTrack.from_samples(
+            read_tum_trajectory(gt_path), max_gap_ns=100_000_000, tolerance_ns=10_000_000
+        )
+    frames = []
+    no_rgb = no_pose = 0
+    for t, name in depth:
+        j = _nearest(rgb_times, t)
+        color = None
+        if j is not None and abs(rgb_times[j] - t) <= max_dt_ns:
+            color = root / rgb[j][1]
+        else:
+            no_rgb += 1
+        pose = track.at(t) if track is not None else None
+        if track is not None and pose is None:
+            no_pose += 1
+            if not keep_unposed:
+                continue
+        frames.append(FolderFrame(t, root / name, color, pose))
+    notes = []
+    if no_rgb:
+        notes.append(f"{no_rgb} depth images had no colour image within {max_dt_ns / 1e6:g} ms")
+    if no_pose:
+        what = "kept without pose" if keep_unposed else "dropped"
+        notes.append(f"{no_pose} depth images outside the ground truth ({what})")
+    intr = None
+    for key, params in TUM_INTRINSICS.items():
+        if key in root.resolve().name:
+            intr = params
+    return FolderSequence(
+        "tum", root, tuple(frames), intr, 5000.0,
+        "none" if track is None else ("trajectory" if trajectory else "ground truth"),
+        tuple(notes),
+    )
+
+
+def _read_7scenes(root: Path, fps: float, trajectory: Path | None) -> FolderSequence:
+    by_id: dict[int, dict[str, Path]] = {}
+    for p in root.iterdir():
+        m = _SEVEN.match(p.name)
+        if m:
+            by_id.setdefault(int(m.group(1)), {})[m.group(2)] = p
+    ext_poses = _external_poses(trajectory, len([i for i in by_id if "depth" in by_id[i]]))
+    frames = []
+    for n, i in enumerate(sorted(k for k, v in by_id.items() if "depth" in v)):
+        files = by_id[i]
+        pose = None
+        if ext_poses is not None:
+            pose = ext_poses[n]
+        elif "pose" in files:
+            pose = _read_pose_matrix(files["pose"])
+        frames.append(FolderFrame(round(i * 1e9 / fps), files["depth"], files.get("color"), pose))
+    intr = SEVEN_SCENES_INTRINSICS
+    if (root / "camera-intrinsics.txt").is_file():
+        intr = read_intrinsics_file(root / "camera-intrinsics.txt")
+    posed = sum(f.pose is not None for f in frames)
+    if 0 < posed < len(frames):
+        raise SgtoolError(f"{root}: {len(frames) - posed} of {len(frames)} frames have no pose.txt")
+    kind = "trajectory" if trajectory else ("ground truth" if posed else "none")
+    return FolderSequence("7scenes", root, tuple(frames), intr, 1000.0, kind)
+
+
+def _read_pose_matrix(path: Path) -> np.ndarray:
+    try:
+        m = np.loadtxt(path, dtype=np.float64)
+    except ValueError as e:
+        raise SgtoolError(f"{path}: expected a 4x4 pose matrix ({e})") from e
+    if m.shape != (4, 4) or not np.all(np.isfinite(m)):
+        raise SgtoolError(f"{path}: expected a 4x4 pose matrix, got shape {m.shape}")
+    return m
+
+
+def _external_poses(trajectory: Path | None, count: int) -> list[np.ndarray] | None:
+    """Poses from a --trajectory file for frames in order (Open3D .log, or a TUM file whose
+    lines are taken in order)."""
+    if trajectory is None:
+        return None
+    if not trajectory.is_file():
+        raise SgtoolError(f"--trajectory {trajectory}: no such file")
+    if trajectory.suffix == ".log":
+        poses = read_open3d_log(trajectory)
+    else:
+        poses = [T for _, T in read_tum_trajectory(trajectory)]
+    if len(poses) != count:
+        raise SgtoolError(f"{trajectory} has {len(poses)} poses for {count} frames")
+    return poses
+
+
+def _read_open3d(root: Path, fps: float, trajectory: Path | None) -> FolderSequence:
+    cdir = _color_dir(root)
+    depths = _images(root / "depth")
+    colors = _images(cdir) if cdir is not None else []
+    by_stem = {p.stem: p for p in colors}
+    if all(d.stem in by_stem for d in depths):
+        pairs = [(d, by_stem[d.stem]) for d in depths]
+    elif len(colors) == len(depths):
+        pairs = list(zip(depths, colors, strict=True))
+    else:
+        raise SgtoolError(
+            f"{root}: {len(depths)} depth and {len(colors)} colour images with different "
+            "names; cannot pair them"
+        )
+    traj = trajectory
+    if traj is None:
+        logs = sorted(root.glob("*.log"))
+        named = [p for p in logs if p.name == "trajectory.log"]
+        if named:
+            traj = named[0]
+        elif len(logs) == 1:
+            traj = logs[0]
+        elif len(logs) > 1:
+            raise SgtoolError(
+                f"{root}: several trajectories ({', '.join(p.name for p in logs)}); "
+                "choose one with --trajectory"
+            )
+    poses = _external_poses(traj, len(pairs)) if traj is not None else None
+    intr = None
+    for p in sorted(root.glob("*.json")):
+        try:
+            intr = read_intrinsics_file(p)
+            break
+        except SgtoolError:
+            continue
+    frames = tuple(
+        FolderFrame(round(i * 1e9 / fps), d, c, poses[i] if poses is not None else None)
+        for i, (d, c) in enumerate(pairs)
+    )
+    return FolderSequence(
+        "open3d", root, frames, intr or PRIMESENSE_INTRINSICS, 1000.0,
+        "trajectory" if poses is not None else "none",
+        (f"poses from {traj.name}",) if traj is not None else (),
+    )

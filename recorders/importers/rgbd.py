@@ -1,0 +1,184 @@
+"""``sgtool import rgbd``: an RGB-D folder (TUM, 7-Scenes, Open3D/Redwood) into a log.
+
+Steps: list the frames (:mod:`.layouts`); take the dataset's poses, or estimate them by
+odometry (:mod:`.odometry`) when it has none or when asked, measuring the drift against
+the dataset's poses where they exist; estimate the z-up world alignment from the poses and
+a few depth frames (:mod:`.upright`); write the frames (:mod:`.sink`). Log times are the
+dataset's time stamps (TUM) or frame number / fps. The images are read twice (odometry,
+then writing) rather than held in memory.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from sgtool.errors import SgtoolError
+from sgtool.log.frame import CameraIntrinsics
+from sgtool.recorders.importers.images import (
+    depth_for_log,
+    depth_to_metres,
+    read_color_file,
+    read_depth_file,
+    resize_to,
+)
+from sgtool.recorders.importers.layouts import FolderFrame, FolderSequence, read_sequence
+from sgtool.recorders.importers.odometry import (
+    DriftReport,
+    OdometryResult,
+    drift_against,
+    estimate_trajectory,
+)
+from sgtool.recorders.importers.sink import ImportFrame, ImportReport, drift_metadata, write_log
+from sgtool.recorders.importers.textformats import PinholeParams
+from sgtool.recorders.importers.upright import DepthSample, estimate_alignment
+
+ALIGNMENT_SAMPLES = 8
+
+
+@dataclass(frozen=True)
+class RgbdOptions:
+    layout: str | None = None
+    depth_scale: float | None = None  # raw units per metre; None = the layout's
+    intrinsics: PinholeParams | None = None  # None = the layout's
+    fps: float = 30.0
+    trajectory: Path | None = None
+    estimate_poses: bool = False
+    odometry: str = "rgbd+icp"
+    depth_max: float = 4.0  # odometry only
+    up: np.ndarray | None = None  # None = estimate
+    floor: float | None = None  # None = estimate (unless floor_auto is False)
+    floor_auto: bool = True
+    every: int = 1
+    limit: int | None = None
+    max_dt_ns: int = 20_000_000
+    progress: bool = True
+
+
+def camera_for(seq: FolderSequence, opts: RgbdOptions, width: int, height: int) -> CameraIntrinsics:
+    p = opts.intrinsics or seq.intrinsics
+    if p is None:
+        raise SgtoolError(
+            f"{seq.root}: the {seq.layout} layout does not say the camera intrinsics; give "
+            "them with --intrinsics fx,fy,cx,cy (or an intrinsics file)"
+        )
+    if (p.width and p.width != width) or (p.height and p.height != height):
+        raise SgtoolError(
+            f"intrinsics {p.source or ''} are for {p.width}x{p.height} images, the depth "
+            f"images are {width}x{height}"
+        )
+    return CameraIntrinsics(width, height, float(p.fx), float(p.fy), float(p.cx), float(p.cy))
+
+
+def _load(fr: FolderFrame, scale: float, size: tuple[int, int] | None = None):  # type: ignore[no-untyped-def]
+    raw = read_depth_file(fr.depth_path)
+    if size is not None and (raw.shape[1], raw.shape[0]) != size:
+        raise SgtoolError(
+            f"{fr.depth_path}: {raw.shape[1]}x{raw.shape[0]} pixels, the first depth image has "
+            f"{size[0]}x{size[1]}"
+        )
+    rgb = None
+    if fr.color_path is not None:
+        rgb = resize_to(read_color_file(fr.color_path), raw.shape[1], raw.shape[0])
+    return raw, rgb
+
+
+def run_odometry(
+    frames: list[FolderFrame], k: CameraIntrinsics, scale: float, opts: RgbdOptions,
+    start: np.ndarray | None,
+) -> OdometryResult:
+    from tqdm import tqdm
+
+    size = (k.width, k.height)
+    bar = tqdm(total=len(frames), unit="frame", desc="odometry", disable=None if opts.progress
+               else True, leave=False)
+
+    def gen():  # type: ignore[no-untyped-def]
+        for fr in frames:
+            raw, rgb = _load(fr, scale, size)
+            yield rgb, depth_to_metres(raw, scale)
+
+    if opts.odometry == "rgbd" and any(f.color_path is None for f in frames):
+        raise SgtoolError("--odometry rgbd needs a colour image for every frame; use icp")
+    try:
+        return estimate_trajectory(gen(), k, method=opts.odometry, start=start,
+                                   depth_max=opts.depth_max, progress=lambda i: bar.update(1))
+    finally:
+        bar.close()
+
+
+def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = None) -> ImportReport:
+    """Import an RGB-D folder into the log ``out`` (see the module docstring)."""
+    opts = opts or RgbdOptions()
+    root, out = Path(root), Path(out)
+    if opts.every < 1:
+        raise SgtoolError("--every must be >= 1")
+    seq = read_sequence(root, opts.layout, max_dt_ns=opts.max_dt_ns, fps=opts.fps,
+                        trajectory=opts.trajectory, keep_unposed=opts.estimate_poses)
+    frames = list(seq.frames[:: opts.every])
+    if opts.limit is not None:
+        frames = frames[: opts.limit]
+    if not frames:
+        raise SgtoolError(f"{root}: no frames left after --every/--limit")
+    scale = float(opts.depth_scale or seq.depth_scale)
+    first = read_depth_file(frames[0].depth_path)
+    k = camera_for(seq, opts, first.shape[1], first.shape[0])
+
+    notes = list(seq.notes)
+    drift: DriftReport | None = None
+    failures: int | None = None
+    source_poses = [f.pose for f in frames]
+    if opts.estimate_poses or seq.pose_source == "none":
+        # start at the first reference pose, so the estimate lives in the dataset's world
+        odo = run_odometry(frames, k, scale, opts, source_poses[0])
+        failures = odo.failures
+        poses = list(odo.poses)
+        idx = [i for i, p in enumerate(source_poses) if p is not None]
+        if len(idx) >= 2:
+            drift = drift_against([poses[i] for i in idx], [source_poses[i] for i in idx])
+        pose_source = f"estimated by {odo.method} odometry"
+        if seq.pose_source != "none":
+            pose_source += f" (the dataset's {seq.pose_source} kept for the drift)"
+    else:
+        poses = [np.asarray(p) for p in source_poses]
+        pose_source = f"{seq.pose_source} of the dataset"
+
+    picks = np.unique(np.linspace(0, len(frames) - 1, min(ALIGNMENT_SAMPLES, len(frames)))
+                      .round().astype(int))
+    samples = [
+        DepthSample(depth_to_metres(read_depth_file(frames[i].depth_path), scale), k, poses[i])
+        for i in picks
+    ]
+    alignment = estimate_alignment(poses, samples, up=opts.up, floor=opts.floor,
+                                   floor_auto=opts.floor_auto)
+
+    meta = {
+        "source": str(root.resolve().name),
+        "source_kind": f"rgbd/{seq.layout}",
+        "layout": seq.layout,
+        "pose_source": pose_source,
+        "depth_scale": f"{scale:g}",
+        "intrinsics": f"{k.fx:g},{k.fy:g},{k.cx:g},{k.cy:g}",
+        "intrinsics_source": (opts.intrinsics or seq.intrinsics).source  # type: ignore[union-attr]
+        or "given",
+        "instance_ids": "absent",
+        "frames_in_source": str(len(seq.frames)),
+        "every": str(opts.every),
+        **drift_metadata(drift),
+    }
+
+    def gen():  # type: ignore[no-untyped-def]
+        size = (k.width, k.height)
+        for fr, pose in zip(frames, poses, strict=True):
+            raw, rgb = _load(fr, scale, size)
+            yield ImportFrame(fr.time_ns, depth_for_log(raw, scale), pose, k, rgb=rgb)
+
+    n, has_rgb, has_ids = write_log(out, gen(), alignment=alignment, metadata=meta,
+                                    total=len(frames), progress=opts.progress, notes=notes)
+    return ImportReport(
+        output=out, source=str(root), kind=f"rgbd/{seq.layout}", frames=n, poses=len(poses),
+        alignment=alignment, has_rgb=has_rgb, has_ids=has_ids, pose_source=pose_source,
+        drift=drift, odometry_failures=failures, notes=tuple(notes),
+    )

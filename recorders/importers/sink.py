@@ -1,0 +1,132 @@
+"""Writing imported frames into an sgtool log, and the report of an import.
+
+Every importer ends here: frames (depth, optional colour and instance ids, the source's
+world_T_camera and the intrinsics) go through the world alignment and into
+:class:`~sgtool.log.LogWriter` as sgtool frames (depth, rgb and ids at the same log time,
+``/tf`` world -> camera). The writer is atomic, so an error half way (a corrupt image) leaves
+no output file.
+
+The log carries:
+- metadata ``sgtool.import``: source path and kind, layout or topics, pose source, world
+  alignment (matrix, source up direction, floor height, how each was found), depth scale,
+  intrinsics source, whether instance ids exist, odometry drift when measured;
+- an ``episode`` record (kind ``import``) at the first frame (``started``) and at the last
+  (``ended``, with the frame count and the notes of the import).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from sgtool.errors import SgtoolError
+from sgtool.log.frame import CameraIntrinsics
+from sgtool.log.writer import LogWriter
+from sgtool.recorders.importers.odometry import DriftReport
+from sgtool.recorders.importers.upright import WorldAlignment
+
+IMPORT_METADATA = "sgtool.import"
+
+
+@dataclass(frozen=True, eq=False)
+class ImportFrame:
+    time_ns: int
+    depth: np.ndarray  # uint16 millimetres or float32 metres
+    pose: np.ndarray  # world_T_camera in the SOURCE world
+    intrinsics: CameraIntrinsics
+    rgb: np.ndarray | None = None
+    ids: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class ImportReport:
+    output: Path
+    source: str
+    kind: str  # "rgbd/tum", "rgbd/7scenes", "rgbd/open3d", "bag/ros1", "bag/ros2"...
+    frames: int
+    poses: int
+    alignment: WorldAlignment
+    has_rgb: bool
+    has_ids: bool
+    pose_source: str
+    drift: DriftReport | None = None
+    odometry_failures: int | None = None
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+    def lines(self) -> list[str]:
+        a = self.alignment
+        out = [
+            f"wrote {self.output}: {self.frames} frames from {self.kind} {self.source}",
+            f"poses: {self.pose_source}",
+            "world: source up ({:.3f}, {:.3f}, {:.3f}) [{}] -> +z, floor {:.3f} m [{}] -> z=0"
+            .format(*a.up, a.up_method, a.floor, a.floor_method),
+            "colour: " + ("yes" if self.has_rgb else "no")
+            + "; instance ids: " + ("yes" if self.has_ids else "none (geometry only)"),
+        ]
+        if self.odometry_failures is not None:
+            out.append(f"odometry: {self.odometry_failures} failed steps (previous motion kept)")
+        if self.drift is not None:
+            out.append("drift against ground truth: " + self.drift.summary())
+        out.extend(f"note: {n}" for n in self.notes)
+        return out
+
+
+def write_log(
+    out: Path,
+    frames: Iterable[ImportFrame],
+    *,
+    alignment: WorldAlignment,
+    metadata: dict[str, str],
+    total: int | None = None,
+    progress: bool = True,
+    notes: Iterable[str] = (),
+) -> tuple[int, bool, bool]:
+    """Write the frames; returns (frame count, any colour, any ids). Raises
+    :class:`SgtoolError` (leaving no output) when there is no frame at all."""
+    from tqdm import tqdm
+
+    out = Path(out)
+    meta = dict(metadata)
+    meta.update(alignment.metadata())
+    n = 0
+    has_rgb = has_ids = False
+    first_t = last_t = 0
+    A = alignment.matrix  # noqa: N806
+    with LogWriter(out, compression="lz4") as w:
+        w.add_metadata(IMPORT_METADATA, meta)
+        bar = tqdm(total=total, unit="frame", desc="import", file=sys.stderr,
+                   disable=None if progress else True, leave=False)
+        try:
+            for fr in frames:
+                if n == 0:
+                    first_t = fr.time_ns
+                    w.write_record("episode", fr.time_ns, {
+                        "kind": "import", "status": "started",
+                        "source": meta.get("source", ""), "frames": 0,
+                    })
+                w.write_frame(fr.time_ns, depth=fr.depth, pose=A @ fr.pose,
+                              intrinsics=fr.intrinsics, rgb=fr.rgb, ids=fr.ids)
+                has_rgb |= fr.rgb is not None
+                has_ids |= fr.ids is not None
+                last_t = fr.time_ns
+                n += 1
+                bar.update(1)
+        finally:
+            bar.close()
+        if n == 0:
+            raise SgtoolError("nothing to import: no frame has both a depth image and a pose")
+        w.write_record("episode", max(last_t, first_t), {
+            "kind": "import", "status": "ended", "source": meta.get("source", ""),
+            "frames": n, "extra": {"notes": list(notes), "instance_ids": has_ids,
+                                   "colour": has_rgb},
+        })
+    return n, has_rgb, has_ids
+
+
+def drift_metadata(drift: DriftReport | None) -> dict[str, str]:
+    return {} if drift is None else {"odometry_drift": json.dumps(drift.as_dict(), sort_keys=True)}

@@ -1,0 +1,184 @@
+"""Readers (and writers) of the small text formats RGB-D datasets come with.
+
+- TUM RGB-D (Sturm et al., IROS 2012): ``rgb.txt`` / ``depth.txt`` ("timestamp filename"
+  lines) and trajectories ``groundtruth.txt`` ("timestamp tx ty tz qx qy qz qw", the pose
+  of the colour camera's optical centre in the motion-capture world, i.e. camera-to-world);
+  ``#`` starts a comment.
+- Open3D / Redwood ``.log`` trajectories: blocks of one metadata line ("i j n") and four
+  rows of a camera-to-world 4x4 matrix.
+- Intrinsics: Open3D's ``PinholeCameraIntrinsic`` JSON (``intrinsic_matrix`` stored column
+  major), a 3x3 matrix as text (7-Scenes / tsdf-fusion ``camera-intrinsics.txt``), or
+  ``fx,fy,cx,cy`` given on the command line.
+
+Parsing errors are user errors naming the file and the line.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import dataclass
+from decimal import Decimal, InvalidOperation
+from pathlib import Path
+
+import numpy as np
+
+from sgtool.errors import SgtoolError
+from sgtool.recorders.importers.poses import pose_from_tq, tq_from_pose
+
+
+def seconds_to_ns(text: str) -> int:
+    """A decimal seconds stamp ("1305031102.160407") -> integer nanoseconds, exactly (no
+    float rounding, so two files naming the same instant agree to the nanosecond)."""
+    try:
+        return int((Decimal(text) * 1_000_000_000).to_integral_value())
+    except InvalidOperation as e:
+        raise ValueError(f"not a time stamp: {text!r}") from e
+
+
+def ns_to_seconds_text(t_ns: int) -> str:
+    """Integer nanoseconds -> "seconds.microseconds" as TUM files write them."""
+    return f"{t_ns // 1_000_000_000}.{(t_ns % 1_000_000_000) // 1000:06d}"
+
+
+def _data_lines(path: Path) -> list[tuple[int, list[str]]]:
+    try:
+        text = path.read_text()
+    except UnicodeDecodeError as e:
+        raise SgtoolError(f"{path} is not a text file") from e
+    out = []
+    for n, line in enumerate(text.splitlines(), 1):
+        s = line.split("#", 1)[0].strip()
+        if s:
+            out.append((n, s.replace(",", " ").split()))
+    return out
+
+
+def read_tum_list(path: Path) -> list[tuple[int, str]]:
+    """(time ns, relative file name) from a TUM ``rgb.txt`` / ``depth.txt``."""
+    out = []
+    for n, parts in _data_lines(path):
+        if len(parts) < 2:
+            raise SgtoolError(f"{path}:{n}: expected 'timestamp filename', got {' '.join(parts)!r}")
+        try:
+            out.append((seconds_to_ns(parts[0]), parts[1]))
+        except ValueError as e:
+            raise SgtoolError(f"{path}:{n}: {e}") from e
+    return sorted(out)
+
+
+def read_tum_trajectory(path: Path) -> list[tuple[int, np.ndarray]]:
+    """(time ns, camera-to-world 4x4) from a TUM trajectory file."""
+    out = []
+    for n, parts in _data_lines(path):
+        if len(parts) != 8:
+            raise SgtoolError(
+                f"{path}:{n}: a TUM trajectory line has 8 numbers "
+                f"(timestamp tx ty tz qx qy qz qw), this one has {len(parts)}"
+            )
+        try:
+            t = seconds_to_ns(parts[0])
+            v = [float(x) for x in parts[1:]]
+        except ValueError as e:
+            raise SgtoolError(f"{path}:{n}: {e}") from e
+        if not np.all(np.isfinite(v)) or np.linalg.norm(v[3:]) < 1e-6:
+            raise SgtoolError(f"{path}:{n}: not a valid pose (NaN or zero quaternion)")
+        out.append((t, pose_from_tq(v[:3], v[3:])))
+    return sorted(out, key=lambda tp: tp[0])
+
+
+def write_tum_trajectory(path: Path, poses: list[tuple[int, np.ndarray]]) -> None:
+    lines = ["# timestamp tx ty tz qx qy qz qw"]
+    for t, T in poses:  # noqa: N806
+        tr, q = tq_from_pose(T)
+        vals = " ".join(f"{v:.9f}" for v in (*tr, *q))
+        lines.append(f"{ns_to_seconds_text(t)} {vals}")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def read_open3d_log(path: Path) -> list[np.ndarray]:
+    """Camera-to-world 4x4 poses of an Open3D / Redwood ``.log`` trajectory, in order."""
+    rows = _data_lines(path)
+    if len(rows) % 5:
+        raise SgtoolError(
+            f"{path}: an Open3D .log trajectory has 5 lines per pose (\"i j n\" and 4 matrix "
+            f"rows); {len(rows)} lines is not a multiple of 5"
+        )
+    poses = []
+    for b in range(0, len(rows), 5):
+        n0, head = rows[b]
+        if len(head) != 3:
+            raise SgtoolError(f"{path}:{n0}: expected the block header 'i j n'")
+        try:
+            m = np.array([[float(x) for x in rows[b + k][1]] for k in range(1, 5)])
+        except ValueError as e:
+            raise SgtoolError(f"{path}:{rows[b + 1][0]}: {e}") from e
+        if m.shape != (4, 4) or not np.all(np.isfinite(m)):
+            raise SgtoolError(f"{path}:{rows[b + 1][0]}: expected four rows of four numbers")
+        poses.append(m)
+    return poses
+
+
+def write_open3d_log(path: Path, poses: list[np.ndarray]) -> None:
+    lines = []
+    for i, T in enumerate(poses):  # noqa: N806
+        lines.append(f"{i} {i} {i + 1}")
+        lines.extend(" ".join(f"{v:.8f}" for v in row) for row in np.asarray(T))
+    path.write_text("\n".join(lines) + "\n")
+
+
+@dataclass(frozen=True)
+class PinholeParams:
+    """fx, fy, cx, cy in pixels and, when the source says, the image size."""
+
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+    width: int | None = None
+    height: int | None = None
+    source: str = ""
+
+
+def read_intrinsics_file(path: Path) -> PinholeParams:
+    """Open3D intrinsic JSON or a 3x3 matrix text file."""
+    if path.suffix.lower() == ".json":
+        try:
+            d = json.loads(path.read_text())
+            m = np.asarray(d["intrinsic_matrix"], dtype=np.float64).reshape(3, 3).T
+        except (json.JSONDecodeError, KeyError, ValueError, TypeError) as e:
+            raise SgtoolError(
+                f"{path}: expected Open3D intrinsics JSON with 'width', 'height' and a "
+                f"9-number 'intrinsic_matrix' ({type(e).__name__}: {e})"
+            ) from e
+        w, h = d.get("width"), d.get("height")
+        return PinholeParams(m[0, 0], m[1, 1], m[0, 2], m[1, 2],
+                             int(w) if w else None, int(h) if h else None, str(path.name))
+    try:
+        m = np.loadtxt(path, dtype=np.float64)
+    except ValueError as e:
+        raise SgtoolError(f"{path}: expected a 3x3 camera matrix ({e})") from e
+    if m.shape != (3, 3) or abs(m[2, 2] - 1.0) > 1e-6 or m[0, 0] <= 0 or m[1, 1] <= 0:
+        raise SgtoolError(f"{path}: expected a 3x3 camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]]")
+    return PinholeParams(m[0, 0], m[1, 1], m[0, 2], m[1, 2], source=str(path.name))
+
+
+def parse_intrinsics(text: str) -> PinholeParams:
+    """``fx,fy,cx,cy`` or a path to an intrinsics file."""
+    parts = [p for p in re.split(r"[,\s]+", text.strip()) if p]
+    if len(parts) == 4:
+        try:
+            fx, fy, cx, cy = (float(p) for p in parts)
+        except ValueError:
+            pass
+        else:
+            if fx <= 0 or fy <= 0:
+                raise SgtoolError(f"--intrinsics {text!r}: focal lengths must be positive")
+            return PinholeParams(fx, fy, cx, cy, source="given")
+    path = Path(text)
+    if not path.is_file():
+        raise SgtoolError(
+            f"--intrinsics {text!r}: give 'fx,fy,cx,cy' in pixels or an intrinsics file "
+            "(Open3D JSON, or a 3x3 matrix as text)"
+        )
+    return read_intrinsics_file(path)

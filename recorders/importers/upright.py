@@ -1,0 +1,214 @@
+"""Making an imported world z-up with the floor at z = 0.
+
+sgtool's mapping takes heights along world z (the floor plane is x/y), but real datasets
+put their world frame anywhere: 7-Scenes and ICL-NUIM/Open3D trajectories start from the
+first camera (y down), motion capture worlds (TUM) are tilted arbitrarily. An importer
+therefore applies one fixed rigid transform ``A`` to every pose,
+``world_T_camera' = A @ world_T_camera``, with ``A`` = rotate the source's up direction
+onto +z, then shift along z so the floor is at 0.
+
+Up direction:
+- given (``--up -y``, or a vector ``0,-1,0``): used as is;
+- automatic: start from the average "up" of the camera, ``-y`` of the optical frame in
+  the world (hand-held and robot cameras are held roughly level, so their image "up" is
+  close to the world's up on average), then refine it as the mean normal of the horizontal
+  surfaces seen in a few depth frames (floor, table tops, ceiling share one normal). The
+  refinement keeps normals within 30 degrees of the current estimate, then within 15
+  degrees, so walls never enter.
+
+Floor height: the 1st percentile of the heights of upward-facing horizontal surface points
+(floor, tables), when there are enough of them, else the 1st percentile of all points: a
+robust "lowest surface" that ignores a few outliers. When the floor is not in view the
+lowest visible surface (a counter) is taken; ``--floor`` overrides.
+
+The transform and how it was found are recorded in the log metadata (``sgtool.import``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from sgtool.errors import SgtoolError
+from sgtool.log.frame import CameraIntrinsics
+
+AXES = {
+    "x": (1.0, 0.0, 0.0), "-x": (-1.0, 0.0, 0.0),
+    "y": (0.0, 1.0, 0.0), "-y": (0.0, -1.0, 0.0),
+    "z": (0.0, 0.0, 1.0), "-z": (0.0, 0.0, -1.0),
+}
+
+
+def parse_up(text: str) -> np.ndarray | None:
+    """``auto`` -> None; an axis (``-y``) or three numbers -> unit vector."""
+    s = text.strip().lower().replace("+", "")
+    if s == "auto":
+        return None
+    if s in AXES:
+        return np.array(AXES[s])
+    try:
+        v = np.array([float(x) for x in s.replace(",", " ").split()])
+    except ValueError:
+        v = np.zeros(0)
+    if v.shape != (3,) or not np.all(np.isfinite(v)) or np.linalg.norm(v) < 1e-9:
+        raise SgtoolError(
+            f"--up {text!r}: give auto, an axis (x, -x, y, -y, z, -z) or a vector 'ux,uy,uz'"
+        )
+    return v / np.linalg.norm(v)
+
+
+def rotation_to_z(u: np.ndarray) -> np.ndarray:
+    """The smallest rotation taking unit vector ``u`` onto +z (Rodrigues); a half turn about
+    x when ``u`` is -z."""
+    u = np.asarray(u, dtype=np.float64)
+    u = u / np.linalg.norm(u)
+    z = np.array([0.0, 0.0, 1.0])
+    c = float(u @ z)
+    if c > 1.0 - 1e-12:
+        return np.eye(3)
+    if c < -1.0 + 1e-12:
+        return np.diag([1.0, -1.0, -1.0])
+    axis = np.cross(u, z)
+    s = float(np.linalg.norm(axis))
+    k = axis / s
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + s * kx + (1.0 - c) * (kx @ kx)
+
+
+@dataclass(frozen=True)
+class WorldAlignment:
+    """``matrix`` maps source-world points to sgtool's z-up world."""
+
+    rotation: np.ndarray  # 3x3
+    floor: float  # source height of the floor along ``up`` (subtracted)
+    up: tuple[float, float, float]  # the source world's up direction
+    up_method: str  # "given", "camera-up", "horizontal-normals", "none"
+    floor_method: str  # "given", "none", "horizontal-surfaces", "all-points"
+
+    @classmethod
+    def identity(cls) -> WorldAlignment:
+        return cls(np.eye(3), 0.0, (0.0, 0.0, 1.0), "none", "none")
+
+    @property
+    def matrix(self) -> np.ndarray:
+        A = np.eye(4)  # noqa: N806
+        A[:3, :3] = self.rotation
+        A[2, 3] = -self.floor
+        return A
+
+    def apply(self, pose: np.ndarray) -> np.ndarray:
+        return self.matrix @ pose
+
+    def metadata(self) -> dict[str, str]:
+        return {
+            "world_alignment": " ".join(f"{v:.9g}" for v in self.matrix.ravel()),
+            "source_up": " ".join(f"{v:.6f}" for v in self.up),
+            "up_method": self.up_method,
+            "floor_height_in_source": f"{self.floor:.4f}",
+            "floor_method": self.floor_method,
+        }
+
+
+@dataclass(frozen=True)
+class DepthSample:
+    """A depth image (metres) with its camera and source-world pose, for the estimates."""
+
+    depth: np.ndarray
+    intrinsics: CameraIntrinsics
+    pose: np.ndarray
+
+
+def backproject(depth: np.ndarray, k: CameraIntrinsics, stride: int) -> np.ndarray:
+    """(h, w, 3) camera-frame points of every ``stride``-th pixel (z = 0 where no return)."""
+    v, u = np.mgrid[0 : depth.shape[0] : stride, 0 : depth.shape[1] : stride]
+    z = depth[::stride, ::stride].astype(np.float64)
+    x = (u - k.cx) / k.fx * z
+    y = (v - k.cy) / k.fy * z
+    return np.stack([x, y, z], axis=-1)
+
+
+def surface_points(sample: DepthSample, stride: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """World points and unit normals (oriented towards the camera) of one depth image, from
+    central differences on the pixel grid; pixels at depth edges (neighbours more than
+    5 % + 2 cm apart in depth) have no normal and are dropped."""
+    P = backproject(sample.depth, sample.intrinsics, stride)  # noqa: N806
+    z = P[..., 2]
+    dx = P[1:-1, 2:] - P[1:-1, :-2]
+    dy = P[2:, 1:-1] - P[:-2, 1:-1]
+    zc = z[1:-1, 1:-1]
+    ok = (zc > 0) & (z[1:-1, 2:] > 0) & (z[1:-1, :-2] > 0) & (z[2:, 1:-1] > 0) & (z[:-2, 1:-1] > 0)
+    lim = 0.05 * zc + 0.02
+    ok &= (np.abs(dx[..., 2]) < lim) & (np.abs(dy[..., 2]) < lim)
+    n = np.cross(dx, dy)
+    norm = np.linalg.norm(n, axis=-1)
+    ok &= norm > 1e-12
+    p = P[1:-1, 1:-1][ok]
+    n = n[ok] / norm[ok][:, None]
+    flip = np.einsum("ij,ij->i", n, p) > 0  # towards the camera at the origin
+    n[flip] *= -1
+    R, t = sample.pose[:3, :3], sample.pose[:3, 3]  # noqa: N806
+    return p @ R.T + t, n @ R.T
+
+
+def camera_up(poses: Sequence[np.ndarray]) -> np.ndarray:
+    """Mean image-up direction (-y of the optical frame) of the cameras, in the world."""
+    ups = np.array([-np.asarray(T)[:3, 1] for T in poses])
+    m = ups.mean(axis=0)
+    n = float(np.linalg.norm(m))
+    if n < 1e-6:
+        raise SgtoolError(
+            "cannot estimate the up direction: the cameras point every which way; "
+            "give it with --up (e.g. --up -y)"
+        )
+    return m / n
+
+
+def estimate_alignment(
+    poses: Sequence[np.ndarray],
+    samples: Sequence[DepthSample],
+    *,
+    up: np.ndarray | None = None,
+    floor: float | None = None,
+    floor_auto: bool = True,
+) -> WorldAlignment:
+    """The world alignment (see the module docstring). ``up`` None = estimate it;
+    ``floor`` given = use it; else ``floor_auto`` estimates it, or leaves the height."""
+    pts_list, nrm_list = [], []
+    for s in samples:
+        p, n = surface_points(s)
+        pts_list.append(p)
+        nrm_list.append(n)
+    pts = np.concatenate(pts_list) if pts_list else np.zeros((0, 3))
+    nrm = np.concatenate(nrm_list) if nrm_list else np.zeros((0, 3))
+
+    if up is not None:
+        u = np.asarray(up, dtype=np.float64) / np.linalg.norm(up)
+        up_method = "given"
+    else:
+        u = camera_up(poses)
+        up_method = "camera-up"
+        for cos_min in (np.cos(np.radians(30)), np.cos(np.radians(15))):
+            d = nrm @ u
+            sel = np.abs(d) > cos_min
+            if sel.sum() < max(200, 0.02 * len(nrm)):
+                break
+            oriented = nrm[sel] * np.sign(d[sel])[:, None]
+            m = oriented.mean(axis=0)
+            u = m / np.linalg.norm(m)
+            up_method = "horizontal-normals"
+
+    R = rotation_to_z(u)  # noqa: N806
+    if floor is not None:
+        fl, floor_method = float(floor), "given"
+    elif not floor_auto or len(pts) == 0:
+        fl, floor_method = 0.0, "none"
+    else:
+        h = pts @ u
+        upward = (nrm @ u) > np.cos(np.radians(20))
+        if upward.sum() >= max(100, 0.01 * len(pts)):
+            fl, floor_method = float(np.percentile(h[upward], 1.0)), "horizontal-surfaces"
+        else:
+            fl, floor_method = float(np.percentile(h, 1.0)), "all-points"
+    return WorldAlignment(R, fl, (float(u[0]), float(u[1]), float(u[2])), up_method, floor_method)
