@@ -111,10 +111,16 @@ def save_mlp(
     biases: list[np.ndarray],
     metadata: dict[str, str],
 ) -> None:
-    """Write weights atomically (temp file beside the target, then rename)."""
+    """Write weights atomically (temp file beside the target, then rename), byte-stable.
+
+    The safetensors writer keeps metadata in a hash map, so its header order changes from
+    run to run; the header JSON is re-serialised with sorted keys (same length rules:
+    padded with spaces to a multiple of 8), which the format allows.
+    """
+    import json
     import os
 
-    from safetensors.numpy import save_file
+    from safetensors.numpy import save
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -122,6 +128,11 @@ def save_mlp(
     for name, w, b in zip(TENSOR_NAMES, weights, biases, strict=True):
         tensors[f"{name}.weight"] = np.ascontiguousarray(w, np.float32)
         tensors[f"{name}.bias"] = np.ascontiguousarray(b, np.float32)
+    raw = save(tensors, metadata={k: str(v) for k, v in sorted(metadata.items())})
+    n = int.from_bytes(raw[:8], "little")
+    header = json.dumps(json.loads(raw[8 : 8 + n]), sort_keys=True, separators=(",", ":"))
+    hb = header.encode()
+    hb += b" " * (-len(hb) % 8)
     tmp = path.with_name(path.name + ".partial")
-    save_file(tensors, str(tmp), metadata={k: str(v) for k, v in sorted(metadata.items())})
+    tmp.write_bytes(len(hb).to_bytes(8, "little") + hb + raw[8 + n :])
     os.replace(tmp, path)

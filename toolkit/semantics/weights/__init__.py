@@ -1,0 +1,1 @@
+"""Shipped weights of the distilled relational models (safetensors + metadata.json)."""
