@@ -134,7 +134,8 @@ def sample_negatives(pool: list[str], degree: Counter[str], k: int,
     return [pool[i] for i in sorted(idx.tolist())]
 
 
-def _from_table(relation: str, table: dict[tuple[str, str], float]) -> RelationalSet:
+def table_to_set(relation: str, table: dict[tuple[str, str], float]) -> RelationalSet:
+    """A set from {(node text, query text): target} (any source: knowledge or an LLM)."""
     nodes = tuple(sorted({n for n, _ in table}))
     queries = tuple(sorted({q for _, q in table}))
     ni = {n: i for i, n in enumerate(nodes)}
@@ -196,7 +197,7 @@ def containment_set(knowledge, seed: int = 0) -> RelationalSet:
         k = min(len(pool), max(MIN_ROOM_NEGATIVES, ROOM_NEGATIVES_PER_POSITIVE * len(seen)))
         for i in sorted(rng.choice(len(pool), size=k, replace=False).tolist()):
             table[(category_text(pool[i]), t)] = 0.0
-    return _from_table("containment", table)
+    return table_to_set("containment", table)
 
 
 def place_units(knowledge) -> list[frozenset[str]]:
@@ -279,7 +280,7 @@ def cooccurrence_set(knowledge, seed: int = 0) -> RelationalSet:
         pool = [o for o in vocab if o != q and o not in mine and o not in near[q]]
         for o in sample_negatives(pool, degree, min(len(mine), len(pool)), rng):
             table[(o, q)] = 0.0
-    return _from_table("cooccurrence", table)
+    return table_to_set("cooccurrence", table)
 
 
 @dataclass(frozen=True)

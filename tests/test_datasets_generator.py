@@ -1,0 +1,199 @@
+"""Generated houses: connectivity of all rooms, no overlapping furniture, walls with gaps at
+doors, every contained object really in or on an existing container/supporter,
+approachable containers, determinism, and no knowledge from the other split."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections import deque
+
+import numpy as np
+import pytest
+
+import sgtool.datasets as ds
+from sgtool.datasets.demo import DEMO_PATH, build_demo
+from sgtool.datasets.episodes import EpisodeGeometry
+from sgtool.datasets.generator import generate_house
+from sgtool.datasets.house import load_house, placement_problem, point_in_polygon
+from sgtool.datasets.knowledge import ancestors
+from sgtool.datasets.occupancy import geodesic_distances
+from sgtool.datasets.split import evaluation_knowledge, training_knowledge
+from sgtool.errors import SgtoolError
+
+CASES = [(0, (4, 12)), (1, (4, 12)), (2, (4, 4)), (3, (12, 12)), (4, (6, 9)), (5, (4, 12)),
+         (11, (8, 8))]
+
+
+@pytest.fixture(scope="module")
+def houses():
+    return {(seed, rooms): generate_house(seed, rooms=rooms) for seed, rooms in CASES}
+
+
+def _aabb(center, size, yaw):
+    c, s = abs(math.cos(yaw)), abs(math.sin(yaw))
+    ex = c * size[0] / 2 + s * size[1] / 2
+    ey = s * size[0] / 2 + c * size[1] / 2
+    return (center[0] - ex, center[1] - ey, center[2] - size[2] / 2,
+            center[0] + ex, center[1] + ey, center[2] + size[2] / 2)
+
+
+def _overlap(a, b, tol=1e-4):
+    return all(min(a[i + 3], b[i + 3]) - max(a[i], b[i]) > tol for i in range(3))
+
+
+@pytest.mark.parametrize("case", CASES, ids=[f"seed{s}-rooms{r[0]}-{r[1]}" for s, r in CASES])
+def test_house_invariants(houses, case):
+    spec = houses[case]
+    lo, hi = case[1]
+    assert lo <= len(spec.rooms) <= hi
+    ids = [r.id for r in spec.rooms]
+    assert ids == [f"room_{i}" for i in range(len(ids))]
+    # --- rooms: plausible sizes, no two rooms overlap
+    for r in spec.rooms:
+        x0, y0, x1, y1 = r.bounds
+        if r.category != "corridor":
+            assert 2.5 - 1e-6 <= x1 - x0 <= 6.0 + 1e-6 and 2.5 - 1e-6 <= y1 - y0 <= 6.0 + 1e-6
+    for a, b in itertools.combinations(spec.rooms, 2):
+        ax0, ay0, ax1, ay1 = a.bounds
+        bx0, by0, bx1, by1 = b.bounds
+        assert min(ax1, bx1) - max(ax0, bx0) <= 1e-6 or min(ay1, by1) - max(ay0, by0) <= 1e-6
+    # --- topology: the door/passage graph joins every room
+    graph = spec.room_graph()
+    seen, todo = {ids[0]}, deque([ids[0]])
+    while todo:
+        for nb in graph[todo.popleft()]:
+            if nb not in seen:
+                seen.add(nb)
+                todo.append(nb)
+    assert seen == set(ids)
+    # --- doors: 0.9 m, on the border of both rooms, and no wall across the opening
+    for d in spec.doors:
+        assert d.width == pytest.approx(0.9)
+        for rid in d.rooms:
+            poly = spec.room(rid).polygon
+            assert point_in_polygon(d.center[0], d.center[1], poly)
+        (px0, py0), (px1, py1) = d.segment
+        for w in spec.walls:
+            assert w.thickness == pytest.approx(0.1) and w.height == pytest.approx(2.5)
+            collinear = (abs(w.a[1] - w.b[1]) < 1e-9 and abs(py0 - py1) < 1e-6
+                         and abs(w.a[1] - py0) < 1e-6)
+            if collinear:
+                lo_w, hi_w = sorted((w.a[0], w.b[0]))
+                assert min(hi_w, max(px0, px1)) - max(lo_w, min(px0, px1)) <= 1e-6, (d.id, w.id)
+    assert any(r.open_plan_group for r in spec.rooms) == bool(
+        [p for p in spec.passages if spec.room(p.rooms[0]).category != "corridor"])
+    # --- furniture: inside its room clear of walls, no two pieces overlap
+    boxes = {f.id: _aabb(f.center, f.size, f.yaw) for f in spec.furniture}
+    for f in spec.furniture:
+        x0, y0, z0, x1, y1, z1 = boxes[f.id]
+        rx0, ry0, rx1, ry1 = spec.room(f.room).bounds
+        assert rx0 + 0.05 - 1e-3 <= x0 and x1 <= rx1 - 0.05 + 1e-3
+        assert ry0 + 0.05 - 1e-3 <= y0 and y1 <= ry1 - 0.05 + 1e-3
+        assert z0 >= -1e-6 and z1 <= 2.5
+        assert abs(math.sin(2 * f.yaw)) < 1e-3  # against walls: multiples of 90 degrees
+    for a, b in itertools.combinations(spec.furniture, 2):
+        assert not _overlap(boxes[a.id], boxes[b.id]), (a.id, a.category, b.id, b.category)
+    # --- containers are openable where the flags say so, with a state
+    for f in spec.furniture:
+        if f.is_openable:
+            assert f.state in ("open", "closed")
+        else:
+            assert f.state is None
+    # --- small objects: parent exists, inside -> container, really inside / on top,
+    #     and no two objects overlap
+    furn = spec.furniture_by_id()
+    for o in spec.objects:
+        p = furn[o.parent]
+        assert o.room == p.room
+        if o.relation == "inside":
+            assert p.is_container
+        else:
+            assert "supporter" in p.affordances
+            assert o.position[2] - o.size[2] / 2 == pytest.approx(p.top, abs=1e-3)
+        assert placement_problem(o, p) is None
+    obj_boxes = [(o, _aabb(o.position, o.size, furn[o.parent].yaw)) for o in spec.objects]
+    for (oa, a), (ob, b) in itertools.combinations(obj_boxes, 2):
+        assert not _overlap(a, b), (oa.id, ob.id)
+
+
+@pytest.mark.parametrize("case", CASES[:4], ids=[f"seed{s}" for s, _ in CASES[:4]])
+def test_every_room_and_container_is_reachable(houses, case):
+    spec = houses[case]
+    geo = EpisodeGeometry(spec)  # occupancy with closed doors passable, robot radius 0.2
+    start = spec.starts[0]
+    dist = geodesic_distances(geo.occ, (start.x, start.y))
+    reach = np.isfinite(dist)
+    for i, r in enumerate(spec.rooms):
+        assert (reach & (geo.rooms == i)).any(), r.id
+    for s in spec.starts:
+        assert np.isfinite(dist[_cell(geo, s.x, s.y)])
+    for f in spec.furniture:
+        if not f.is_container:
+            continue
+        obj = next((o for o in spec.objects if o.parent == f.id), None)
+        if obj is None:
+            continue
+        assert (geo.goal_mask(obj.id) & reach).any(), f.id
+    # a closed door is an obstacle unless closed doors count as passable
+    from sgtool.datasets.occupancy import house_occupancy
+    occ = house_occupancy(spec)
+    for d in spec.doors:
+        cell = _cell(geo, *d.center)
+        assert occ.occupied[cell] == (d.state == "closed"), d.id
+        assert not geo.occ.occupied[cell]
+
+
+def _cell(geo, x, y):
+    from sgtool.datasets.occupancy import world_to_cell
+    return world_to_cell(geo.occ, x, y)
+
+
+def test_same_seed_same_bytes_and_seeds_differ():
+    a = generate_house(7).to_json()
+    b = generate_house(7).to_json()
+    assert a == b
+    assert generate_house(8).to_json() != a
+    assert load_house(a).to_json() == a
+    # options are part of the result
+    assert generate_house(7, split="train").to_json() != a
+
+
+def test_houses_use_only_their_split():
+    """Train houses contain only training vocabulary; every small object of an eval house
+    rests on a relation of the evaluation activities."""
+    tr, ev = training_knowledge(), evaluation_knowledge()
+    tr_vocab = tr.vocabulary()
+    ev_rel = {(r.child, r.relation, r.parent) for r in ev.relations}
+    for seed in (0, 1, 2):
+        h = generate_house(seed, rooms=(6, 10), split="train")
+        assert h.split == "train"
+        for f in h.furniture:
+            assert f.synset in tr_vocab, f.synset
+        for o in h.objects:
+            assert o.synset in tr_vocab, o.synset
+        e = generate_house(seed, rooms=(6, 10), split="eval")
+        furn = e.furniture_by_id()
+        for o in e.objects:
+            parents = ancestors(furn[o.parent].synset)
+            assert any((o.synset, o.relation, p) in ev_rel for p in parents), o
+
+
+def test_bad_arguments():
+    with pytest.raises(SgtoolError, match="rooms"):
+        generate_house(0, rooms=(3, 5))
+    with pytest.raises(SgtoolError, match="split"):
+        generate_house(0, split="test")
+    with pytest.raises(SgtoolError, match="seed"):
+        generate_house(-1)
+
+
+def test_demo_house_is_shipped_and_current():
+    spec = ds.demo_house()
+    assert len(spec.rooms) == 5
+    assert any(d.state == "closed" for d in spec.doors)
+    furn = spec.furniture_by_id()
+    assert any(o.relation == "inside" and furn[o.parent].state == "closed"
+               for o in spec.objects)
+    # the file is what the documented command writes today
+    assert DEMO_PATH.read_text() == build_demo().to_json()

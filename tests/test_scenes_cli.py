@@ -1,0 +1,98 @@
+"""`sgtool scenes`: generate (same seed, same bytes, also across processes), show (a real
+PNG), stats (Table I columns equal to the library's), episodes, knowledge, user errors."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+from click.testing import CliRunner
+
+from sgtool.cli import cli
+from sgtool.datasets.generator import generate_house
+from sgtool.datasets.house import load_house
+from sgtool.datasets.stats import house_stats
+
+
+def test_generate_is_byte_stable(tmp_path):
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    r = CliRunner().invoke(cli, ["scenes", "generate", "--seed", "5", "--rooms", "6-8",
+                                 "-o", str(a)])
+    assert r.exit_code == 0, r.output
+    assert "rooms" in r.output
+    # a separate process (fresh caches, fresh hash seed) writes the same bytes
+    code = ("from sgtool.cli import main; main(['scenes', 'generate', '--seed', '5', "
+            f"'--rooms', '6-8', '-o', {str(b)!r}])")
+    subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
+                   env={"PYTHONHASHSEED": "123", "PATH": "/usr/bin:/bin"})
+    assert a.read_bytes() == b.read_bytes()
+    spec = load_house(a)
+    assert 6 <= len(spec.rooms) <= 8
+    assert spec.to_json() == generate_house(5, rooms=(6, 8)).to_json()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json", "b.json"]
+
+
+def test_show_writes_a_png(tmp_path):
+    house = tmp_path / "h.json"
+    CliRunner().invoke(cli, ["scenes", "generate", "--seed", "2", "--rooms", "5", "-o",
+                             str(house)])
+    r = CliRunner().invoke(cli, ["scenes", "show", str(house), "-o", str(tmp_path / "p.png")])
+    assert r.exit_code == 0, r.output
+    data = (tmp_path / "p.png").read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 20_000
+    # default output name beside the house
+    r = CliRunner().invoke(cli, ["scenes", "show", str(house), "--no-objects"])
+    assert r.exit_code == 0 and (tmp_path / "h.png").is_file()
+    r = CliRunner().invoke(cli, ["scenes", "show", str(house), "-o", str(tmp_path / "p.gif")])
+    assert r.exit_code == 2
+
+
+def test_stats_json_matches_the_library():
+    r = CliRunner().invoke(cli, ["scenes", "stats", "-n", "3", "--seed", "10", "--rooms", "5-7",
+                                 "--json"])
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    ours = out["rows"]["sgtool eval houses"]
+    ref = house_stats(generate_house(s, rooms=(5, 7)) for s in (10, 11, 12)).to_dict()
+    assert ours == ref
+    assert ours["scenes"] == 3 and 5 <= ours["rooms_per_scene"] <= 7
+    assert out["rows"]["bddl scenes, all (measured)"]["scenes"] == 51
+    assert out["rows"]["bddl scenes, all (measured)"]["rooms_per_scene"] == 374 / 51
+    assert out["rows"]["OmniGibson (SCOUT Table I)"]["rooms_per_scene"] == 7.1
+    text = CliRunner().invoke(cli, ["scenes", "stats", "-n", "2"]).output
+    assert "Contained Obj./Sc." in text and "InteriorGS (SCOUT Table I)" in text
+
+
+def test_episodes_and_knowledge(tmp_path):
+    house = tmp_path / "h.json"
+    CliRunner().invoke(cli, ["scenes", "generate", "--seed", "1", "--rooms", "5", "-o",
+                             str(house)])
+    r = CliRunner().invoke(cli, ["scenes", "episodes", str(house), "--json"])
+    assert r.exit_code == 0, r.output
+    eps = json.loads(r.output)
+    spec = load_house(house)
+    assert len(eps) == len({o.category for o in spec.objects})
+    assert all(e["shortest_path"] > 0 for e in eps)
+    r = CliRunner().invoke(cli, ["scenes", "episodes", str(house), "-n", "3"])
+    assert r.exit_code == 0 and r.output.count("ep_") == 3
+    r = CliRunner().invoke(cli, ["scenes", "knowledge", "--json"])
+    k = json.loads(r.output)
+    assert k["all"]["relations"] == {"inside": 2608, "ontop": 5313, "inroom": 3207}
+    assert k["train"]["activities"] + k["eval"]["activities"] == 1016
+
+
+def test_user_errors_name_the_problem(tmp_path):
+    bad = tmp_path / "bad.json"
+    spec = json.loads(generate_house(0, rooms=(4, 4)).to_json())
+    spec["furniture"][0]["size"] = [1, -1, 1]
+    bad.write_text(json.dumps(spec))
+    r = CliRunner().invoke(cli, ["scenes", "episodes", str(bad)])
+    assert r.exit_code == 2
+    assert "furniture[0].size: every side must be > 0" in r.output
+    r = CliRunner().invoke(cli, ["scenes", "generate", "--rooms", "3-5", "-o",
+                                 str(tmp_path / "x.json")])
+    assert r.exit_code == 2 and "--rooms" in r.output
+    assert not (tmp_path / "x.json").exists()
+    r = CliRunner().invoke(cli, ["scenes", "show", str(tmp_path / "missing.json")])
+    assert r.exit_code == 2 and "no such house spec file" in r.output

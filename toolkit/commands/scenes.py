@@ -1,0 +1,202 @@
+"""``sgtool scenes``: generate houses, draw them, summarise them, list search episodes."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+
+import click
+
+
+def _parse_rooms(value: str) -> tuple[int, int]:
+    try:
+        if "-" in value:
+            a, b = value.split("-", 1)
+            lo, hi = int(a), int(b)
+        else:
+            lo = hi = int(value)
+    except ValueError:
+        raise click.BadParameter(f"expected N or MIN-MAX, got {value!r}") from None
+    if not 4 <= lo <= hi <= 16:
+        raise click.BadParameter(f"need 4 <= MIN <= MAX <= 16, got {value!r}")
+    return lo, hi
+
+
+def _rooms_option(f):  # type: ignore[no-untyped-def]
+    return click.option(
+        "--rooms", default="4-12", show_default=True, metavar="MIN-MAX",
+        callback=lambda ctx, p, v: _parse_rooms(v),
+        help="Range of the number of rooms, corridors included (or one number).")(f)
+
+
+def _split_option(f):  # type: ignore[no-untyped-def]
+    return click.option(
+        "--split", type=click.Choice(["eval", "train"]), default="eval", show_default=True,
+        help="Knowledge that furnishes the house: 'eval' for benchmark houses, 'train' for "
+             "houses built only from what planners may learn from.")(f)
+
+
+@click.group("scenes")
+def command() -> None:
+    """Houses furnished from BEHAVIOR-1K knowledge (the `bddl` package, read offline):
+    generate them from a seed, draw their floor plans, summarise them in the columns of
+    SCOUT's Table I, list object-search episodes."""
+
+
+@command.command("generate")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Random seed; the same seed gives the same bytes.")
+@_rooms_option
+@_split_option
+@click.option("-o", "--output", type=click.Path(dir_okay=False), required=True,
+              help="House spec JSON to write (atomically).")
+def generate_cmd(seed: int, rooms: tuple[int, int], split: str, output: str) -> None:
+    """Generate a connected multi-room house and write its JSON spec."""
+    from sgtool.datasets.generator import generate_house
+    from sgtool.datasets.house import save_house
+
+    spec = generate_house(seed, rooms=rooms, split=split)
+    save_house(spec, output)
+    closed = sum(d.state == "closed" for d in spec.doors)
+    inside = sum(o.relation == "inside" for o in spec.objects)
+    click.echo(f"{output}: {len(spec.rooms)} rooms ({', '.join(r.category for r in spec.rooms)}), "
+               f"{len(spec.doors)} doors ({closed} closed), {len(spec.passages)} passages, "
+               f"{len(spec.furniture)} furniture, {len(spec.objects)} objects "
+               f"({inside} inside)", err=True)
+
+
+@command.command("show")
+@click.argument("house", type=click.Path(dir_okay=False))
+@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
+              help="Image to write (.png, .svg or .pdf) [default: HOUSE with .png].")
+@click.option("--dpi", type=click.IntRange(min=30, max=600), default=120, show_default=True,
+              help="Resolution of raster images.")
+@click.option("--no-objects", is_flag=True, help="Leave small objects out of the picture.")
+def show_cmd(house: str, output: str | None, dpi: int, no_objects: bool) -> None:
+    """Draw the floor plan of HOUSE: rooms coloured and labelled, walls, doors (open green,
+    closed red), open-plan passages, furniture (containers hatched), small objects (dots;
+    crosses when hidden in a closed container), start poses."""
+    from pathlib import Path
+
+    from sgtool.datasets.draw import draw_house
+    from sgtool.datasets.house import load_house
+
+    spec = load_house(house)
+    out = Path(output) if output else Path(house).with_suffix(".png")
+    if out.suffix.lower() not in (".png", ".svg", ".pdf"):
+        raise click.BadParameter("use a .png, .svg or .pdf file name", param_hint="--output")
+    draw_house(spec, out, dpi=dpi, show_objects=not no_objects)
+    click.echo(f"wrote {out}", err=True)
+
+
+@command.command("stats")
+@click.option("-n", "--houses", type=click.IntRange(min=1), default=20, show_default=True,
+              help="Number of houses to generate (seeds SEED .. SEED+N-1).")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="First seed.")
+@_rooms_option
+@_split_option
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+def stats_cmd(houses: int, seed: int, rooms: tuple[int, int], split: str,
+              as_json: bool) -> None:
+    """Table I of SCOUT for N generated houses, beside the real OmniGibson scenes of
+    `bddl` (all, and homes only) and the rows printed in the paper."""
+    from tqdm import tqdm
+
+    from sgtool.datasets.generator import generate_house
+    from sgtool.datasets.knowledge import load_knowledge
+    from sgtool.datasets.stats import PAPER_TABLE_I, format_table, house_stats, inventory_stats
+
+    specs = [generate_house(s, rooms=rooms, split=split)
+             for s in tqdm(range(seed, seed + houses), desc="houses", unit="house",
+                           disable=not sys.stderr.isatty(), file=sys.stderr)]
+    ours = house_stats(specs)
+    k = load_knowledge()
+    rows = {
+        f"sgtool {split} houses": ours.to_dict(),
+        "bddl scenes, all (measured)": inventory_stats(k).to_dict(),
+        "bddl scenes, homes (measured)": inventory_stats(k, household_only=True).to_dict(),
+        **PAPER_TABLE_I,
+    }
+    if as_json:
+        click.echo(json.dumps({"rooms": list(rooms), "split": split, "first_seed": seed,
+                               "rows": rows}, indent=2, sort_keys=True))
+        return
+    click.echo(format_table(rows))
+    click.echo(f"\nsgtool houses: {ours.furniture_per_scene:.1f} furniture, "
+               f"{ours.contained_per_scene:.1f} small objects per house "
+               f"({ours.inside_per_scene:.1f} inside, {ours.hidden_per_scene:.1f} hidden in "
+               f"closed containers), {ours.closed_doors_per_scene:.1f} closed doors.")
+    click.echo("Obj./Sc. = object instances, Obj. Cat./Sc. = distinct object categories per "
+               "scene (the paper's 'Obj. Inst./Sc.' column); rows marked SCOUT are quoted "
+               "from the paper, not measured here.")
+
+
+@command.command("episodes")
+@click.argument("house", type=click.Path(dir_okay=False))
+@click.option("-n", "--count", type=click.IntRange(min=1), default=None,
+              help="Number of episodes [default: one per object category].")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Seed of the choice of categories and start poses.")
+@click.option("--reach", type=click.FloatRange(min=0.1), default=1.0, show_default=True,
+              help="A target counts as reached within this distance (m) of its parent.")
+@click.option("--json", "as_json", is_flag=True, help="Print JSON (one list).")
+def episodes_cmd(house: str, count: int | None, seed: int, reach: float,
+                 as_json: bool) -> None:
+    """List object-search episodes of HOUSE: query category, target instances, start pose,
+    whether every target is hidden in a closed container, and the shortest path (m) from
+    the start to the nearest target on the house's occupancy grid (closed doors
+    passable)."""
+    from sgtool.datasets.episodes import list_episodes
+    from sgtool.datasets.house import load_house
+
+    spec = load_house(house)
+    eps = list_episodes(spec, n=count, seed=seed, reach=reach)
+    if as_json:
+        click.echo(json.dumps([e.to_dict() for e in eps], indent=1, sort_keys=True))
+        return
+    if not eps:
+        click.echo("no episodes: the house has no small objects or no start poses")
+        return
+    w = max(len(e.query) for e in eps)
+    click.echo(f"{'id':<6} {'query':<{w}}  {'start':>18}  {'hidden':<6} {'path m':>7}  "
+               "targets / where")
+    for e in eps:
+        sp = f"{e.shortest_path:7.2f}" if math.isfinite(e.shortest_path) else "    inf"
+        start = f"{e.start.room}({e.start.x:.1f},{e.start.y:.1f})"
+        click.echo(f"{e.id:<6} {e.query:<{w}}  {start:>18}  {'yes' if e.hidden else 'no':<6} "
+                   f"{sp}  {','.join(e.targets)}: {e.description}")
+    hidden = sum(e.hidden for e in eps)
+    click.echo(f"{len(eps)} episodes, {hidden} hidden in closed containers", err=True)
+
+
+@command.command("knowledge")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
+def knowledge_cmd(as_json: bool) -> None:
+    """Figures of the BEHAVIOR-1K knowledge read from `bddl` and of its train/eval split."""
+    from sgtool.datasets.knowledge import load_knowledge, negated_relation_counts
+    from sgtool.datasets.split import evaluation_knowledge, training_knowledge, unseen_queries
+
+    def fig(k) -> dict:  # type: ignore[no-untyped-def]
+        return {"scenes": len(k.scenes), "rooms": len(k.rooms),
+                "room_types": len(k.room_type_counts), "activities": len(k.activities),
+                "relations": k.relation_counts(), "triples": len(k.triples)}
+
+    out = {"all": fig(load_knowledge()), "train": fig(training_knowledge()),
+           "eval": fig(evaluation_knowledge()), "negated_atoms_left_out": negated_relation_counts(),
+           "unseen_queries": unseen_queries()}
+    if as_json:
+        click.echo(json.dumps(out, indent=2, sort_keys=True))
+        return
+    for part in ("all", "train", "eval"):
+        f = out[part]
+        r = f["relations"]
+        click.echo(f"{part:>5}: {f['scenes']} scenes, {f['rooms']} rooms "
+                   f"({f['room_types']} types), {f['activities']} activities, "
+                   f"{r['inside']} inside / {r['ontop']} ontop / {r['inroom']} inroom atoms, "
+                   f"{f['triples']} distinct triples")
+    click.echo(f"left out (under 'not'): {out['negated_atoms_left_out']}")
+    uq = out["unseen_queries"]
+    click.echo(f"{len(uq)} unseen query categories (in eval houses, never in training): "
+               + ", ".join(uq[:20]) + (", ..." if len(uq) > 20 else ""))
