@@ -113,6 +113,13 @@ LAMBDA_INSIDE = 2.2
 LAMBDA_ONTOP = 1.3
 
 
+# shop and school fittings that some room inventories hold but a home generator skips
+NOT_IN_HOMES = frozenset({
+    "shopping_cart.n.01", "checkout.n.03", "cash_register.n.01", "grocery_shelf.n.01",
+    "grocery_fridge.n.01", "display_panel.n.01", "blackboard.n.01",
+})
+
+
 class _Retry(Exception):
     """This attempt painted itself into a corner; draw again from the same stream."""
 
@@ -135,17 +142,10 @@ def _inventory(split: str) -> _Inventory:
     furniture: dict[str, tuple[FurnitureFreq, ...]] = {}
     for rt in HOUSE_ROOM_TYPES + ("corridor",):
         rows = kh.room_furniture.get(rt) or k.room_furniture.get(rt) or ()
-        furniture[rt] = tuple(f for f in rows if f.synset in _PLACEABLE_FURNITURE_OK(f.synset))
+        furniture[rt] = tuple(f for f in rows if f.synset not in NOT_IN_HOMES)
     counts = Counter(r.room_type for r in household)
     weights = {rt: float(counts.get(rt, 0)) for rt in HOUSE_ROOM_TYPES}
     return _Inventory(k, furniture, weights)
-
-
-def _PLACEABLE_FURNITURE_OK(synset: str) -> set[str]:  # noqa: N802 - tiny predicate
-    # furniture the generator can build: anything with a size, skipping vehicles/shop units
-    bad = {"shopping_cart.n.01", "checkout.n.03", "cash_register.n.01", "grocery_shelf.n.01",
-           "grocery_fridge.n.01", "display_panel.n.01", "blackboard.n.01"}
-    return set() if synset in bad else {synset}
 
 
 @functools.cache

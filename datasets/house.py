@@ -26,7 +26,8 @@ Conventions (all of them are checked by :func:`load_house`):
   pieces and None otherwise;
 - a small object has a ``parent`` furniture id and a ``relation`` "inside" (its box lies
   within the parent's box; the parent must be a container) or "ontop" (its box rests on
-  the parent's top face: position z = parent top + sz / 2); ``position`` is its box centre;
+  the parent's top face: position z = parent top + sz / 2); ``position`` is its box centre
+  and ``size`` its extent along the parent's axes (small objects share the parent's yaw);
 - ``starts`` are robot start poses (x, y, yaw) on free floor, each in a named room.
 
 The canonical text (:meth:`HouseSpec.to_json`) sorts keys, rounds floats to 4 decimals and

@@ -25,6 +25,9 @@ the derived tables:
   the scenes + activities placing it in that room type);
 - ``affordances``: synset -> ("container", "openable", "supporter") subset.
 
+Planners must learn only from :func:`sgtool.datasets.split.training_knowledge`;
+:func:`load_knowledge` holds both parts and is for figures and for the split itself.
+
 Categories have readable names (:func:`readable_name`): ``electric_refrigerator.n.01`` ->
 "refrigerator", ``pack__of__ground_beef.n.01`` -> "pack of ground beef"; the synset is kept
 alongside everywhere.
@@ -82,6 +85,12 @@ NAME_OVERRIDES: Mapping[str, str] = MappingProxyType({
     "stove.n.01": "stove",
     "microwave.n.02": "microwave",
     "sink.n.01": "sink",
+    # homonyms whose senses both occur in the activities
+    "belt.n.01": "drive belt",
+    "belt.n.02": "belt",
+    "bow.n.02": "violin bow",
+    "bow.n.08": "ribbon bow",
+    "package.n.02": "parcel",
 })
 
 
