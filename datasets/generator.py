@@ -432,8 +432,7 @@ def _openings(rng: np.random.Generator, plan: _Plan) -> None:
     for members in groups.values():
         a, b = sorted(members, key=lambda r: r.rect.x0)
         x = a.rect.x1
-        lo = max(a.rect.y0, b.rect.y0) if a.side == "n" else max(a.rect.y0, b.rect.y0)
-        hi = min(a.rect.y1, b.rect.y1)
+        lo, hi = max(a.rect.y0, b.rect.y0), min(a.rect.y1, b.rect.y1)  # shared wall
         stub = 0.3
         width = round(hi - lo - 2 * stub, 4)
         plan.openings.append(_Opening("passage", (x, round((lo + hi) / 2, 4)), width, False,
@@ -728,8 +727,9 @@ def _furnish_room(rng: np.random.Generator, room: _PRoom, plan: _Plan, inv: _Inv
         cx, cy = (base.box.x0 + base.box.x1) / 2, (base.box.y0 + base.box.y1) / 2
         aff = inv.knowledge.affordances.get(s, ())
         mine.append(_Piece(s, room.idx, _footprint(cx, cy, size[0], size[1], base.yaw),
-                           base.z0 + base.size[2], size, base.yaw, pieces.__len__() +
-                           mine.index(base), True, aff, _initial_state(rng, aff)))
+                           base.z0 + base.size[2], size, base.yaw,
+                           len(pieces) + mine.index(base), True, aff,
+                           _initial_state(rng, aff)))
     pieces.extend(mine)
 
 
