@@ -136,14 +136,68 @@ def suggest_flags(topics: list[B.TopicInfo]) -> list[str]:
         ns = depth.rsplit("/", 1)[0] if depth else ""
         out.append(f"--info {next((t for t in infos if ns and t.startswith(ns)), infos[0])}")
     if not depth and not tfs and poses:
-        out.append(f"--pose {poses[0]}")
+        out.append(" | ".join(f"--pose {p}" for p in poses[:4]))
     if not depth and tfs:
         out.append("--tf-frames WORLD:FRAME")
     return out
 
 
-def _missing_message(path: Path, topics: list[B.TopicInfo], what: str) -> str:
+def peek_tf(reader: Any, topics: list[B.TopicInfo], max_messages: int = 500) -> TfTree:
+    """The tf tree from ``/tf_static`` and the first ``max_messages`` ``/tf`` messages: the
+    frames a bag has, cheaply, for listing and suggestions."""
+    tree = TfTree()
+    for t in topics:
+        if t.msgtype not in B.TF_TYPES:
+            continue
+        static = t.topic.rstrip("/").endswith("tf_static")
+        for n, (c, _, raw) in enumerate(reader.messages(B.connections_for(reader, t.topic))):
+            if n >= max_messages:
+                break
+            msg = reader.deserialize(raw, c.msgtype)
+            for tr in msg.transforms:
+                tree.add(tr.header.frame_id, tr.child_frame_id, stamp_ns(tr.header),
+                         _tq(tr.transform.translation, tr.transform.rotation), static=static)
+    return tree.freeze()
+
+
+def tf_suggestions(tree: TfTree) -> list[str]:
+    """``--tf-frames ROOT:LEAF`` for every leaf frame of the tree."""
+    parents = {link.parent for link in tree.links.values()}
+    leaves = sorted(f for f in tree.links if f not in parents)
+    cams = [f for f in leaves if "optical" in f] or [f for f in leaves if "camera" in f]
+    picks = cams or leaves
+    out = [f"--tf-frames {tree.root_of(f)}:{f}" for f in picks[:6]]
+    if len(picks) > 6:
+        out.append(f"... ({len(picks) - 6} more)")
+    return out
+
+
+def describe_bag(reader: Any, path: Path) -> str:
+    """Topics, tf links and suggested flags (``sgtool import bag PATH --list``)."""
+    topics = B.list_topics(reader)
+    tree = peek_tf(reader, topics)
+    lines = [f"{path} ({B.bag_kind(path)}): topics", B.format_topics(topics)]
+    if tree.links:
+        lines.append("tf links (from /tf_static and the first /tf messages):")
+        lines.extend("  " + d for d in tree.describe())
+    sugg = [s for s in suggest_flags(topics) if s != "--tf-frames WORLD:FRAME"]
+    if sugg:
+        lines.append("suggested flags: " + " ".join(sugg))
+    tfs = tf_suggestions(tree)
+    if tfs:
+        lines.append("camera / trajectory frames: " + " | ".join(tfs))
+    return "\n".join(lines)
+
+
+def _missing_message(
+    path: Path, topics: list[B.TopicInfo], what: str, reader: Any = None
+) -> str:
     sugg = suggest_flags(topics)
+    if reader is not None and any(t.msgtype in B.TF_TYPES for t in topics):
+        tfs = tf_suggestions(peek_tf(reader, topics))
+        if tfs and "--tf-frames WORLD:FRAME" in sugg:
+            sugg.remove("--tf-frames WORLD:FRAME")
+            sugg.append(" | ".join(tfs))
     return (
         f"{path}: {what}. The bag's topics:\n{B.format_topics(topics)}"
         + (f"\nsuggested flags: {' '.join(sugg)}" if sugg else "")
@@ -168,12 +222,14 @@ def _check_topic(
         raise SgtoolError(f"{path}: {flag} {topic} has no messages")
 
 
-def check_flags(path: Path, topics: list[B.TopicInfo], opts: BagOptions) -> None:
+def check_flags(
+    path: Path, topics: list[B.TopicInfo], opts: BagOptions, reader: Any = None
+) -> None:
     if opts.depth is None and opts.tf_frames is None and opts.pose is None:
         raise SgtoolError(_missing_message(
             path, topics,
             "say which topics to import: --depth (and --rgb, --info) for camera frames, or "
-            "--tf-frames WORLD:FRAME / --pose TOPIC for a trajectory",
+            "--tf-frames WORLD:FRAME / --pose TOPIC for a trajectory", reader,
         ))
     if opts.depth is None and (opts.rgb or opts.ids or opts.info):
         raise SgtoolError(
@@ -500,7 +556,7 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         raise SgtoolError("--every must be >= 1")
     with B.open_bag(path) as reader:
         topics = B.list_topics(reader)
-        check_flags(path, topics, opts)
+        check_flags(path, topics, opts, reader)
         idx = _index(reader, opts, topics)
         src = _pose_source(path, idx, opts)
         kind = f"bag/{B.bag_kind(path)}"

@@ -13,8 +13,9 @@ Up direction:
   the world (hand-held and robot cameras are held roughly level, so their image "up" is
   close to the world's up on average), then refine it as the mean normal of the horizontal
   surfaces seen in a few depth frames (floor, table tops, ceiling share one normal). The
-  refinement keeps normals within 30 degrees of the current estimate, then within 15
-  degrees, so walls never enter.
+  refinement keeps normals within 30 degrees of the current estimate, then 15, then 8
+  degrees, so walls never enter and pixels at wall/floor corners (normals in between)
+  drop out of the last pass.
 
 Floor height: the 1st percentile of the heights of upward-facing horizontal surface points
 (floor, tables), when there are enough of them, else the 1st percentile of all points: a
@@ -131,16 +132,19 @@ def backproject(depth: np.ndarray, k: CameraIntrinsics, stride: int) -> np.ndarr
 
 def surface_points(sample: DepthSample, stride: int = 4) -> tuple[np.ndarray, np.ndarray]:
     """World points and unit normals (oriented towards the camera) of one depth image, from
-    central differences on the pixel grid; pixels at depth edges (neighbours more than
-    5 % + 2 cm apart in depth) have no normal and are dropped."""
+    central differences on the pixel grid; pixels at depth edges (second difference of the
+    depth above 2 % + 2 cm) have no normal and are dropped."""
     P = backproject(sample.depth, sample.intrinsics, stride)  # noqa: N806
     z = P[..., 2]
     dx = P[1:-1, 2:] - P[1:-1, :-2]
     dy = P[2:, 1:-1] - P[:-2, 1:-1]
     zc = z[1:-1, 1:-1]
     ok = (zc > 0) & (z[1:-1, 2:] > 0) & (z[1:-1, :-2] > 0) & (z[2:, 1:-1] > 0) & (z[:-2, 1:-1] > 0)
-    lim = 0.05 * zc + 0.02
-    ok &= (np.abs(dx[..., 2]) < lim) & (np.abs(dy[..., 2]) < lim)
+    # a depth edge bends the depth profile sharply; a plane, even at a grazing angle, barely
+    # (its depth is 1 / linear in the pixel coordinates): test the second differences
+    lim = 0.02 * zc + 0.02
+    ok &= np.abs(z[1:-1, 2:] - 2 * zc + z[1:-1, :-2]) < lim
+    ok &= np.abs(z[2:, 1:-1] - 2 * zc + z[:-2, 1:-1]) < lim
     n = np.cross(dx, dy)
     norm = np.linalg.norm(n, axis=-1)
     ok &= norm > 1e-12
@@ -177,7 +181,7 @@ def estimate_alignment(
     ``floor`` given = use it; else ``floor_auto`` estimates it, or leaves the height."""
     pts_list, nrm_list = [], []
     for s in samples:
-        p, n = surface_points(s)
+        p, n = surface_points(s, stride=max(1, s.depth.shape[1] // 160))
         pts_list.append(p)
         nrm_list.append(n)
     pts = np.concatenate(pts_list) if pts_list else np.zeros((0, 3))
@@ -189,7 +193,7 @@ def estimate_alignment(
     else:
         u = camera_up(poses)
         up_method = "camera-up"
-        for cos_min in (np.cos(np.radians(30)), np.cos(np.radians(15))):
+        for cos_min in np.cos(np.radians([30.0, 15.0, 8.0])):
             d = nrm @ u
             sel = np.abs(d) > cos_min
             if sel.sum() < max(200, 0.02 * len(nrm)):

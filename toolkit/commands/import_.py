@@ -1,0 +1,233 @@
+"""``sgtool import bag|rgbd``: foreign recordings into sgtool logs.
+
+The work is done in :mod:`sgtool.recorders.importers`; this module parses options and
+prints the import report (or JSON with ``--json``).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict
+from pathlib import Path
+
+import click
+
+from sgtool.errors import SgtoolError
+
+
+def _floor(text: str) -> tuple[float | None, bool]:
+    s = text.strip().lower()
+    if s == "auto":
+        return None, True
+    if s == "none":
+        return None, False
+    try:
+        return float(s), False
+    except ValueError as e:
+        raise SgtoolError(f"--floor {text!r}: give auto, none or a height in metres") from e
+
+
+def _output(output: str | None, force: bool) -> Path:
+    if not output:
+        raise SgtoolError("give the output log with -o OUT.mcap")
+    out = Path(output)
+    if out.exists() and not force:
+        raise SgtoolError(f"{out} exists; not overwriting it (use --force)")
+    if out.suffix != ".mcap":
+        raise SgtoolError(f"-o {out}: the output is an MCAP log; name it *.mcap")
+    return out
+
+
+def _print_report(report, as_json: bool) -> None:  # type: ignore[no-untyped-def]
+    if as_json:
+        a = report.alignment
+        d = {
+            "output": str(report.output), "source": report.source, "kind": report.kind,
+            "frames": report.frames, "poses": report.poses, "pose_source": report.pose_source,
+            "colour": report.has_rgb, "instance_ids": report.has_ids,
+            "alignment": {"matrix": a.matrix.round(9).tolist(), "source_up": list(a.up),
+                          "up_method": a.up_method, "floor": a.floor,
+                          "floor_method": a.floor_method},
+            "drift": asdict(report.drift) if report.drift else None,
+            "odometry_failures": report.odometry_failures, "notes": list(report.notes),
+        }
+        click.echo(json.dumps(d, indent=2, sort_keys=True))
+    else:
+        for line in report.lines():
+            click.echo(line)
+
+
+def _world_options(f):  # type: ignore[no-untyped-def]
+    f = click.option(
+        "--floor", default="auto", show_default=True,
+        help="Floor height in the source world along the up direction: 'auto' (1st "
+        "percentile of upward-facing surface heights in a few depth frames), 'none' (keep "
+        "the height), or metres.",
+    )(f)
+    f = click.option(
+        "--up", default="auto", show_default=True,
+        help="Direction of the source world that points up: an axis (x, -x, y, -y, z, -z), "
+        "a vector 'ux,uy,uz', or 'auto' (mean camera up, refined by the normals of "
+        "horizontal surfaces). Bag trajectories without images keep their world unless "
+        "given.",
+    )(f)
+    return f
+
+
+def _common_options(f):  # type: ignore[no-untyped-def]
+    for opt in reversed([
+        click.option("-o", "--output", type=click.Path(dir_okay=False),
+                     help="The sgtool log to write (OUT.mcap)."),
+        click.option("--intrinsics", default=None,
+                     help="Camera intrinsics 'fx,fy,cx,cy' in pixels, or a file (Open3D JSON "
+                     "or a 3x3 matrix as text); overrides what the source says."),
+        click.option("--depth-scale", type=float, default=None,
+                     help="Raw 16-bit depth units per metre (default: 1000 for bags and "
+                     "7-Scenes/Open3D, 5000 for TUM)."),
+        click.option("--max-dt", type=float, default=0.02, show_default=True,
+                     help="Largest time difference (s) when pairing colour (and ids) "
+                     "with a depth image."),
+        click.option("--every", type=int, default=1, show_default=True,
+                     help="Keep every N-th frame."),
+        click.option("--limit", type=int, default=None, help="Keep at most N frames."),
+        click.option("--force", is_flag=True, help="Overwrite the output log."),
+        click.option("--json", "as_json", is_flag=True, help="Print the report as JSON."),
+        click.option("--quiet", is_flag=True, help="No progress bars."),
+    ]):
+        f = opt(f)
+    return f
+
+
+@click.group("import")
+def command() -> None:
+    """Import ROS 1/2 bags and RGB-D folders into sgtool logs.
+
+    Imported logs hold depth, colour (when the source has it), camera calibration and
+    world -> camera poses; instance ids only when the source has them (replay then builds
+    geometry only). The imported world is made z-up with the floor at z=0 (sgtool maps
+    heights along z): see --up and --floor.
+    """
+
+
+@command.command("bag")
+@click.argument("path", type=click.Path(exists=True))
+@click.option("--depth", help="Depth image topic (sensor_msgs/Image 16UC1 or 32FC1, or "
+              "CompressedImage PNG/compressedDepth): one frame per depth image.")
+@click.option("--rgb", help="Colour image topic (Image or CompressedImage).")
+@click.option("--ids", help="Instance-id image topic (integer Image), if the bag has one.")
+@click.option("--info", help="CameraInfo topic of the depth camera (the intrinsics).")
+@click.option("--tf-frames", help="WORLD:CAMERA frames of the tf tree for the camera pose "
+              "(default: the depth image's frame in the root of its tree). Without --depth: "
+              "import the trajectory of CAMERA in WORLD.")
+@click.option("--pose", help="Pose topic (PoseStamped, PoseWithCovarianceStamped, "
+              "TransformStamped, Odometry) giving the camera's optical frame in the world, "
+              "instead of tf.")
+@click.option("--tf-tolerance", type=float, default=0.05, show_default=True,
+              help="How far (s) before/after a transform's samples a pose may be taken.")
+@click.option("--list", "list_only", is_flag=True,
+              help="List the bag's topics, tf links and suggested flags, and stop.")
+@_world_options
+@_common_options
+def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: str | None,
+        tf_frames: str | None, pose: str | None, tf_tolerance: float, list_only: bool,
+        up: str, floor: str, output: str | None, intrinsics: str | None,
+        depth_scale: float | None, max_dt: float, every: int, limit: int | None, force: bool,
+        as_json: bool, quiet: bool) -> None:
+    """Import a ROS 1 .bag, a ROS 2 bag folder (sqlite3 or MCAP) or a bare ROS 2 .mcap/.db3
+    file at PATH.
+
+    Each depth image becomes a frame at its header time, with the colour (and id) image of
+    nearest time within --max-dt and the camera pose from tf interpolated at that time.
+    Without flags, lists the topics and suggests them.
+
+    \b
+    Example:
+      sgtool import bag run.bag -o run.mcap --depth /camera/depth/image_raw \\
+        --rgb /camera/rgb/image_color --info /camera/depth/camera_info
+      sgtool import bag tf_example.bag -o traj.mcap --tf-frames odom:base_link
+    """
+    from sgtool.recorders.importers.bag import BagOptions, describe_bag, import_bag
+    from sgtool.recorders.importers.bagfiles import open_bag
+    from sgtool.recorders.importers.textformats import parse_intrinsics
+    from sgtool.recorders.importers.upright import parse_up
+
+    if list_only:
+        with open_bag(path) as reader:
+            click.echo(describe_bag(reader, Path(path)))
+        return
+    frames = None
+    if tf_frames is not None:
+        parts = tf_frames.split(":")
+        if len(parts) != 2 or not all(parts):
+            raise SgtoolError(f"--tf-frames {tf_frames!r}: give WORLD:CAMERA, e.g. map:camera")
+        frames = (parts[0], parts[1])
+    fl, floor_auto = _floor(floor)
+    opts = BagOptions(
+        rgb=rgb, depth=depth, ids=ids, info=info, tf_frames=frames, pose=pose,
+        intrinsics=parse_intrinsics(intrinsics) if intrinsics else None,
+        depth_scale=depth_scale, max_dt_ns=int(max_dt * 1e9),
+        tf_tolerance_ns=int(tf_tolerance * 1e9), up=parse_up(up), floor=fl,
+        floor_auto=floor_auto, every=every, limit=limit, progress=not quiet,
+    )
+    if not (depth or tf_frames or pose):
+        # nothing to import yet: the error lists the topics and suggests flags
+        from sgtool.recorders.importers.bag import check_flags
+        from sgtool.recorders.importers.bagfiles import list_topics
+
+        with open_bag(path) as reader:
+            check_flags(Path(path), list_topics(reader), opts, reader)
+    _print_report(import_bag(path, _output(output, force), opts), as_json)
+
+
+@command.command("rgbd")
+@click.argument("folder", type=click.Path(exists=True, file_okay=False))
+@click.option("--layout", type=click.Choice(["auto", "tum", "7scenes", "open3d"]),
+              default="auto", show_default=True,
+              help="Folder layout: TUM RGB-D (rgb.txt, depth.txt, groundtruth.txt), 7-Scenes "
+              "(frame-XXXXXX.color/depth/pose), Open3D/Redwood (color|image/, depth/, "
+              "*.log, intrinsics JSON).")
+@click.option("--fps", type=float, default=30.0, show_default=True,
+              help="Frame rate for layouts without time stamps (7-Scenes frame n is at n/fps).")
+@click.option("--trajectory", type=click.Path(dir_okay=False, exists=True),
+              help="Poses to use instead of the dataset's: an Open3D .log or a TUM file.")
+@click.option("--estimate-poses", is_flag=True,
+              help="Estimate the poses by RGB-D odometry even when the dataset has them "
+              "(their drift against the dataset's poses is reported). Sources without "
+              "poses are always estimated.")
+@click.option("--odometry", type=click.Choice(["rgbd+icp", "rgbd", "icp"]),
+              default="rgbd+icp", show_default=True,
+              help="Odometry: Open3D RGB-D odometry refined by point-to-plane ICP, RGB-D "
+              "odometry alone, or ICP alone.")
+@click.option("--depth-max", type=float, default=4.0, show_default=True,
+              help="Depth beyond this (m) is ignored by the odometry (not by the import).")
+@_world_options
+@_common_options
+def rgbd(folder: str, layout: str, fps: float, trajectory: str | None, estimate_poses: bool,
+         odometry: str, depth_max: float, up: str, floor: str, output: str | None,
+         intrinsics: str | None, depth_scale: float | None, max_dt: float, every: int,
+         limit: int | None, force: bool, as_json: bool, quiet: bool) -> None:
+    """Import an RGB-D image folder (TUM RGB-D, 7-Scenes, Open3D/Redwood) at FOLDER.
+
+    Log times are the dataset's time stamps (TUM) or frame number / --fps. Poses are the
+    dataset's (ground truth or trajectory) or estimated by odometry.
+
+    \b
+    Example:
+      sgtool import rgbd rgbd_dataset_freiburg1_xyz -o fr1_xyz.mcap
+      sgtool import rgbd 7scenes/redkitchen/seq-01 -o kitchen.mcap --estimate-poses
+    """
+    from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
+    from sgtool.recorders.importers.textformats import parse_intrinsics
+    from sgtool.recorders.importers.upright import parse_up
+
+    out = _output(output, force)
+    fl, floor_auto = _floor(floor)
+    opts = RgbdOptions(
+        layout=None if layout == "auto" else layout, depth_scale=depth_scale,
+        intrinsics=parse_intrinsics(intrinsics) if intrinsics else None, fps=fps,
+        trajectory=Path(trajectory) if trajectory else None, estimate_poses=estimate_poses,
+        odometry=odometry, depth_max=depth_max, up=parse_up(up), floor=fl,
+        floor_auto=floor_auto, every=every, limit=limit, max_dt_ns=int(max_dt * 1e9),
+        progress=not quiet,
+    )
+    _print_report(import_rgbd(folder, out, opts), as_json)
