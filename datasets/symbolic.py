@@ -64,6 +64,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -72,6 +73,7 @@ from scipy import ndimage
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
+from sgtool.analysis.records import EpisodeResult, Step
 from sgtool.datasets.house import HouseSpec
 from sgtool.datasets.occupancy import (
     OccupancyMap,
@@ -80,7 +82,7 @@ from sgtool.datasets.occupancy import (
     house_occupancy,
     world_to_cell,
 )
-from sgtool.planning.base import Action, Feedback
+from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.scenegraph.graph import (
     DoorNode,
     ObjectNode,
@@ -288,10 +290,12 @@ class SymbolicHouse:
 
     def _room_centre(self, ri: int) -> tuple[float, float]:
         cx, cy = self.spec.rooms[ri].centroid
-        return cell_to_world(self.occ, *self.snap(cx, cy, ri))
+        px, py = cell_to_world(self.occ, *self.snap(cx, cy, ri))
+        return float(px), float(py)
 
     def _add_place(self, x: float, y: float, room: int) -> int:
-        self.places.append(cell_to_world(self.occ, *self.snap(x, y, room)))
+        px, py = cell_to_world(self.occ, *self.snap(x, y, room))
+        self.places.append((round(float(px), 6), round(float(py), 6)))
         self.place_room.append(room)
         return len(self.places) - 1
 
@@ -681,12 +685,13 @@ class SymbolicEnv:
             d = self._move(place, dist)
             self.furn_state[i] = "closed"
             return self._fb(a, "success", f"{fu.category} closed", d)
-        # navigate / explore of a furniture that is not closed
+        # navigate / explore of a piece that is not closed: look into / onto it
+        fresh = explorable and i not in self.furn_explored and state != "closed"
+        if skill == "explore" and not fresh:
+            return self._fb(a, "failure", f"nothing left to explore at the {fu.category}")
         d = self._move(place, dist)
-        if explorable and i not in self.furn_explored and state != "closed":
+        if fresh:
             return self._fb(a, "success", self._reveal(i), d)
-        if skill == "explore":
-            return self._fb(a, "failure", f"nothing to explore at the {fu.category}", d)
         return self._fb(a, "success", f"at the {fu.category}", d)
 
     def _reveal(self, f: int) -> str:
@@ -710,3 +715,51 @@ class SymbolicEnv:
                 best = min(best, float(dist[h.regions[h.region_of_furn[f]].place]),
                            float(dist[h.furn_place[f]]))
         return best if math.isfinite(best) else None
+
+
+# ----------------------------------------------------------------------------------------
+# one episode with a planner
+# ----------------------------------------------------------------------------------------
+def planner_seed(seed: int, house_seed: int, episode_index: int) -> int:
+    """The planner's seed for an episode (a 32-bit draw from the three numbers)."""
+    ss = np.random.SeedSequence([int(seed), int(house_seed), int(episode_index), 1])
+    return int(ss.generate_state(1)[0])
+
+
+def run_episode(house: SymbolicHouse, planner: Planner, query: str, targets: Sequence[str],
+                seed: int = 0, episode_index: int = 0, avoid_rooms: Sequence[str] = (),
+                max_steps: int = N_MAX, seen: bool | None = None, house_id: str = "",
+                planner_name: str | None = None) -> EpisodeResult:
+    """Roll out one episode: observe, decide, act, feed back, until it ends.
+
+    ``targets`` (spec ids of the query's instances) only serve the shortest path of SPL;
+    success is decided by category (module doc). Decision time is the wall time of each
+    ``decide`` call (kept in the record's ``wall`` figures only).
+    """
+    env = SymbolicEnv(house, query, seed=seed, episode_index=episode_index,
+                      avoid_rooms=avoid_rooms, max_steps=max_steps)
+    t_start = time.perf_counter()
+    planner.reset(query, seed=planner_seed(seed, house.spec.seed, episode_index))
+    trace: list[Step] = []
+    decision_s = 0.0
+    decisions = 0
+    while not env.ended:
+        graph = env.observe()
+        t0 = time.perf_counter()
+        action = planner.decide(graph)
+        decision_s += time.perf_counter() - t0
+        decisions += 1
+        out = env.step(action)
+        planner.feedback(out.feedback)
+        fb = out.feedback
+        trace.append(Step(action.skill, action.target, fb.outcome, fb.travelled_m))
+    return EpisodeResult(
+        planner=planner_name or getattr(planner, "name", "planner"),
+        seed=int(seed), house=house_id or f"house-{house.spec.seed}",
+        episode=int(episode_index), query=query, success=env.success, steps=env.steps,
+        travelled_m=env.travelled, shortest_m=env.shortest_path(targets),
+        n_open=env.n_open, n_invalid=env.n_invalid, n_failure=env.n_failure, seen=seen,
+        end=env.end_reason, source="symbolic", trace=tuple(trace),
+        wall={"decision_s": decision_s, "decisions": float(decisions),
+              "episode_s": time.perf_counter() - t_start},
+    )
