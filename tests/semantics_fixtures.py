@@ -120,11 +120,12 @@ class ChatServer:
     ``{"text": str}`` a normal answer; ``{"status": int}`` an HTTP error;
     ``{"sleep": s, "text": str}`` an answer after ``s`` seconds (for timeouts);
     ``{"raw": bytes}`` a 200 response with this body (malformed JSON).
-    When the script is exhausted the server answers HTTP 500. Requests are kept in
-    :attr:`requests` (the decoded JSON bodies).
+    When the script is exhausted, ``responder(request) -> item`` answers if given, else
+    the server answers HTTP 500. Requests are kept in :attr:`requests` (decoded JSON).
     """
 
-    def __init__(self, script: list[dict] | None = None, model: str = "scripted-model") -> None:
+    def __init__(self, script: list[dict] | None = None, model: str = "scripted-model",
+                 responder=None) -> None:
         import json
         import threading
         import time
@@ -133,6 +134,8 @@ class ChatServer:
         self.script = list(script or [])
         self.requests: list[dict] = []
         self.model = model
+        self.responder = responder
+        self.errors: list[str] = []
         server = self
 
         class Handler(BaseHTTPRequestHandler):
@@ -153,7 +156,16 @@ class ChatServer:
                 n = int(self.headers.get("Content-Length", "0"))
                 req = json.loads(self.rfile.read(n) or b"{}")
                 server.requests.append(req)
-                item = server.script.pop(0) if server.script else {"status": 500}
+                if server.script:
+                    item = server.script.pop(0)
+                elif server.responder is not None:
+                    try:
+                        item = server.responder(req)
+                    except Exception as e:  # a bug in a test responder: say so, loudly
+                        server.errors.append(repr(e))
+                        item = {"status": 599}
+                else:
+                    item = {"status": 500}
                 if "sleep" in item:
                     time.sleep(item["sleep"])
                 if "status" in item:

@@ -1,0 +1,84 @@
+"""Distillation: determinism, what is written, held-out report, the ``sgtool distill`` command."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+
+import numpy as np
+from click.testing import CliRunner
+from semantics_fixtures import encoder
+from test_semantics_relational import tiny
+
+from sgtool.datasets.relational import containment_set, cooccurrence_set
+from sgtool.semantics.distill import DistillConfig, distill, quality_report
+from sgtool.semantics.priors import LearnedPriors
+
+FILES = ("containment.safetensors", "cooccurrence.safetensors", "metadata.json")
+CFG = DistillConfig(seed=3, holdout=0.3, epochs_containment=3, epochs_cooccurrence=3)
+
+
+def tiny_sets():
+    k = tiny()
+    return containment_set(k, seed=3), cooccurrence_set(k, seed=3)
+
+
+def digest(folder) -> dict[str, str]:
+    return {f: hashlib.sha256((folder / f).read_bytes()).hexdigest() for f in FILES}
+
+
+def test_distill_is_byte_identical_and_loadable(tmp_path) -> None:
+    a, b = tmp_path / "a", tmp_path / "b"
+    ma = distill(a, CFG, sets=tiny_sets(), split_fingerprint="tiny", encoder=encoder())
+    distill(b, CFG, sets=tiny_sets(), split_fingerprint="tiny", encoder=encoder())
+    assert digest(a) == digest(b)
+    assert not list(a.glob("*.partial"))
+    meta = json.loads((a / "metadata.json").read_text())
+    assert meta == json.loads(json.dumps(ma))
+    assert meta["config"]["seed"] == 3 and meta["split_fingerprint"] == "tiny"
+    for rel, loss in (("containment", "mse"), ("cooccurrence", "bce")):
+        m = meta["models"][rel]
+        assert m["loss"] == loss and len(m["history"]) == 3
+        assert m["train_pairs"] + m["val_pairs"] + m["heldout"].get("pairs", 0) == \
+            m["data"]["pairs"]
+    p = LearnedPriors(encoder(), weights_dir=a)
+    s = p.rooms(["kitchen"], "plate")
+    assert 0.0 <= s[0] <= 1.0
+    # the stored held-out numbers are what a fresh evaluation of the files gives
+    rep = quality_report(a, sets=tiny_sets(), encoder=encoder())
+    for rel in ("containment", "cooccurrence"):
+        assert rep[rel] == meta["models"][rel]["heldout"]
+
+
+def test_another_seed_gives_other_weights(tmp_path) -> None:
+    distill(tmp_path / "a", CFG, sets=tiny_sets(), encoder=encoder())
+    cfg = DistillConfig(seed=4, holdout=0.3, epochs_containment=3, epochs_cooccurrence=3)
+    distill(tmp_path / "b", cfg, sets=tiny_sets(), encoder=encoder())
+    assert digest(tmp_path / "a")["containment.safetensors"] != \
+        digest(tmp_path / "b")["containment.safetensors"]
+
+
+def test_cli_report_on_shipped_weights() -> None:
+    from sgtool.commands.distill import command
+
+    res = CliRunner().invoke(command, ["--report"])
+    assert res.exit_code == 0, res.output
+    assert "AUC learned" in res.output and "containment" in res.output
+    res = CliRunner().invoke(command, ["--report", "--json"])
+    rep = json.loads(res.output)
+    assert rep["cooccurrence"]["learned"]["auc"] > rep["cooccurrence"]["cosine"]["auc"]
+
+
+def test_cli_trains_into_a_folder(tmp_path) -> None:
+    from sgtool.commands.distill import command
+
+    out = tmp_path / "w"
+    res = CliRunner().invoke(command, ["--out", str(out), "--epochs-containment", "1",
+                                       "--epochs-cooccurrence", "1"])
+    assert res.exit_code == 0, res.output
+    assert sorted(p.name for p in out.iterdir()) == sorted(FILES)  # no temp folder left
+    assert "wrote" in res.output
+    meta = json.loads((out / "metadata.json").read_text())
+    assert meta["models"]["containment"]["data"]["pairs"] > 3000
+    p = LearnedPriors(encoder(), weights_dir=out)
+    assert np.isfinite(p.objects(["sink"], "toothbrush")[0])

@@ -1,0 +1,94 @@
+"""The shipped distilled priors: scores a person can check, agreement with torch, the report."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from semantics_fixtures import encoder
+
+from sgtool.semantics.priors import WEIGHTS_DIR, CosinePriors, LearnedPriors
+
+
+@pytest.fixture(scope="module")
+def priors() -> LearnedPriors:
+    return LearnedPriors(encoder())
+
+
+@pytest.mark.parametrize(
+    "query,better,worse",
+    [
+        ("frying pan", "kitchen", "bathroom"),
+        ("toilet", "bathroom", "kitchen"),
+        ("pillow", "bedroom", "kitchen"),
+        ("milk", "kitchen", "bedroom"),
+        ("something to cook with", "kitchen", "bedroom"),  # a descriptive query
+    ],
+)
+def test_room_containment_ranks(priors: LearnedPriors, query: str, better: str,
+                                worse: str) -> None:
+    hi, lo = priors.rooms([better, worse], query)
+    assert hi > lo, f"{query}: {better} {hi:.2f} <= {worse} {lo:.2f}"
+
+
+@pytest.mark.parametrize(
+    "query,better,worse",
+    [
+        ("toothbrush", "sink", "sofa"),  # toothbrush is held out of training
+        ("frying pan", "stove", "sofa"),
+        ("milk", "refrigerator", "sofa"),
+        ("book", "bookcase", "stove"),
+        ("plate", "dishwasher", "sofa"),
+    ],
+)
+def test_object_cooccurrence_ranks(priors: LearnedPriors, query: str, better: str,
+                                   worse: str) -> None:
+    hi, lo = priors.objects([better, worse], query)
+    assert hi > lo, f"{query}: {better} {hi:.2f} <= {worse} {lo:.2f}"
+
+
+def test_scores_are_probabilities_and_memoised(priors: LearnedPriors) -> None:
+    names = ["kitchen", "bathroom", "Living_Room", "garage"]
+    a = priors.rooms(names, "Frying_Pan")
+    assert a.shape == (4,) and np.all((a >= 0) & (a <= 1))
+    b = priors.rooms(list(reversed(names)), "Frying_Pan")
+    assert np.array_equal(a, b[::-1])
+    # spelling does not matter: the canonical text is what gets embedded
+    assert priors.rooms(["living room"], "frying pan")[0] == pytest.approx(a[2], abs=1e-7)
+
+
+def test_numpy_inference_matches_torch(priors: LearnedPriors) -> None:
+    import torch
+    from safetensors.torch import load_file
+
+    from sgtool.semantics.training import build_torch_mlp
+
+    net = build_torch_mlp()
+    net.load_state_dict(load_file(str(WEIGHTS_DIR / "cooccurrence.safetensors")))
+    rng = np.random.default_rng(0)
+    x = rng.normal(size=(32, 768)).astype(np.float32)
+    with torch.no_grad():
+        ref = torch.sigmoid(net(torch.from_numpy(x))).numpy()
+    np.testing.assert_allclose(priors.cooccurrence.pairs(x), ref, atol=1e-5)
+    assert priors.cooccurrence.n_parameters == 558_081  # SCOUT: 558K per relational model
+
+
+def test_shipped_metadata_and_report() -> None:
+    from sgtool.datasets.relational import knowledge_fingerprint
+    from sgtool.datasets.split import training_knowledge
+
+    meta = json.loads((WEIGHTS_DIR / "metadata.json").read_text())
+    assert meta["split_fingerprint"] == knowledge_fingerprint(training_knowledge())
+    assert meta["encoder"] == encoder().model_id
+    for rel in ("containment", "cooccurrence"):
+        held = meta["models"][rel]["heldout"]
+        # SCOUT Fig. 7: learned priors separate related from unrelated pairs, cosine less so
+        assert held["learned"]["auc"] > held["cosine"]["auc"] + 0.1
+        assert held["learned"]["auc"] > 0.75
+
+
+def test_cosine_priors_are_plain_similarity() -> None:
+    cp = CosinePriors(encoder())
+    v = encoder().encode(["kitchen", "frying pan"])
+    assert cp.rooms(["kitchen"], "frying pan")[0] == pytest.approx(float(v[0] @ v[1]), abs=1e-6)

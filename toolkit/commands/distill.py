@@ -1,0 +1,149 @@
+"""``sgtool distill``: train the relational priors, or report how well they separate.
+
+Training writes into a temporary folder beside the output and moves the three files
+(containment.safetensors, cooccurrence.safetensors, metadata.json) in only when both models
+are done, so an interrupted run never leaves a mixed set.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+import click
+
+from sgtool.errors import SgtoolError
+
+
+def _weights_dir() -> Path:
+    from sgtool.semantics.priors import WEIGHTS_DIR
+
+    return WEIGHTS_DIR
+
+
+@click.command(
+    "distill",
+    context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100},
+)
+@click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
+              default=None,
+              help="Folder for the trained weights [default: the weights shipped in the "
+                   "package, sgtool/semantics/weights].")
+@click.option("--report", "report_only", is_flag=True,
+              help="Do not train: print the held-out quality report (ROC-AUC of the learned "
+                   "scores vs raw SBERT cosine) of the weights in --weights.")
+@click.option("--weights", "weights_dir", type=click.Path(file_okay=False, exists=True,
+                                                          path_type=Path),
+              default=None, help="Weights to report on [default: the shipped ones].")
+@click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
+@click.option("--seed", type=int, default=0, show_default=True,
+              help="Seed of negative sampling, held-out choice, initialisation, shuffling.")
+@click.option("--holdout", type=click.FloatRange(0.0, 0.9), default=0.15, show_default=True,
+              help="Share of query categories held out of training for the report.")
+@click.option("--epochs-containment", type=click.IntRange(1, 1000), default=20,
+              show_default=True, help="Epochs of the containment model (MSE).")
+@click.option("--epochs-cooccurrence", type=click.IntRange(1, 1000), default=15,
+              show_default=True, help="Epochs of the co-occurrence model (BCE).")
+@click.option("--threads", type=click.IntRange(1, 64), default=1, show_default=True,
+              help="Torch CPU threads (1 keeps the weights bit-identical across machines "
+                   "with the same libraries).")
+@click.option("--source", type=click.Choice(["knowledge", "llm"]), default="knowledge",
+              show_default=True,
+              help="knowledge: the training split of the BEHAVIOR-1K knowledge (offline). "
+                   "llm: SCOUT's procedural generation and labelling by an LLM.")
+@click.option("--llm-base-url", default=None,
+              help="OpenAI-compatible endpoint for --source llm [env SGTOOL_LLM_BASE_URL].")
+@click.option("--llm-model", default=None, help="Model name [env SGTOOL_LLM_MODEL].")
+@click.option("--llm-api-key", default=None, help="API key [env SGTOOL_LLM_API_KEY].")
+@click.option("--llm-cache", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="Folder caching every LLM answer (resumable; a complete cache replays the "
+                   "generation offline) [default: $SGTOOL_CACHE/llm-knowledge].")
+@click.option("--llm-runs", type=click.IntRange(1, 20), default=1, show_default=True,
+              help="Repetitions of each generation prompt, for diversity.")
+@click.option("--llm-max-queries", type=int, default=None,
+              help="Label at most this many generated objects (cost cap).")
+def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, as_json: bool,
+            seed: int, holdout: float, epochs_containment: int, epochs_cooccurrence: int,
+            threads: int, source: str, llm_base_url: str | None, llm_model: str | None,
+            llm_api_key: str | None, llm_cache: Path | None, llm_runs: int,
+            llm_max_queries: int | None) -> None:
+    """Train the containment and co-occurrence MLPs (SCOUT sec. IV-C) or report on them.
+
+    By default the training data come from the training split of the household knowledge
+    only, the encoder is the bundled all-MiniLM-L6-v2, and the run is deterministic: the
+    same seed writes byte-identical files. Takes about a minute on 2 CPU cores.
+    """
+    from sgtool.semantics.distill import DistillConfig, distill, format_report, quality_report
+
+    if report_only:
+        wd = weights_dir or _weights_dir()
+        if not (wd / "metadata.json").is_file():
+            raise SgtoolError(f"{wd}: no metadata.json; not a folder of distilled weights")
+        rep = quality_report(wd)
+        click.echo(json.dumps(rep, indent=1, sort_keys=True) if as_json else format_report(rep))
+        return
+
+    cfg = DistillConfig(seed=seed, holdout=holdout, epochs_containment=epochs_containment,
+                        epochs_cooccurrence=epochs_cooccurrence, threads=threads)
+    sets = None
+    room_types = None
+    fingerprint = None
+    if source == "llm":
+        sets, room_types, fingerprint = _llm_sets(llm_base_url, llm_model, llm_api_key,
+                                                  llm_cache, llm_runs, llm_max_queries, seed)
+    target = out_dir or _weights_dir()
+    target.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=".distill-", dir=target))
+    try:
+        meta = distill(tmp, cfg, sets=sets, split_fingerprint=fingerprint,
+                       room_types=room_types, progress=sys.stderr.isatty())
+        for name in ("containment.safetensors", "cooccurrence.safetensors", "metadata.json"):
+            os.replace(tmp / name, target / name)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    rep = {"heldout_queries": len(meta["heldout_queries"]),
+           **{r: meta["models"][r]["heldout"] for r in ("containment", "cooccurrence")}}
+    if as_json:
+        click.echo(json.dumps(meta, indent=1, sort_keys=True))
+    else:
+        for rel in ("containment", "cooccurrence"):
+            m = meta["models"][rel]
+            click.echo(f"{rel}: {m['data']['pairs']} pairs ({m['data']['positives']} positive), "
+                       f"{m['data']['queries']} queries, best epoch {m['best_epoch']}, "
+                       f"val loss {m['history'][m['best_epoch'] - 1]['val_loss']:.4f}")
+        click.echo(format_report(rep))
+        click.echo(f"wrote {target}")
+
+
+def _llm_sets(base_url, model, api_key, cache, runs, max_queries, seed):
+    from sgtool.llm.client import LlmSettings, OpenAIChatClient
+    from sgtool.semantics.cache import cache_root
+    from sgtool.semantics.llm_knowledge import (
+        CachedAsker,
+        GenerationConfig,
+        generate_sets,
+    )
+
+    cache = cache or (cache_root() / "llm-knowledge")
+    try:
+        client = OpenAIChatClient(LlmSettings.resolve(base_url, model, api_key))
+    except SgtoolError:
+        if not (cache / "exchanges.jsonl").is_file():
+            raise
+        client = None  # a complete cache replays the generation offline
+    asker = CachedAsker(client, cache)
+    cont, cooc, rooms = generate_sets(
+        asker, GenerationConfig(runs=runs, max_queries=max_queries, seed=seed),
+        progress=sys.stderr.isatty())
+    st = asker.stats
+    click.echo(f"LLM knowledge: {len(rooms)} rooms, {len(cont.queries)} objects labelled; "
+               f"{st.prompts} prompts ({st.cached} cached, {st.requested} asked, "
+               f"{st.skipped} skipped)", err=True)
+    import hashlib
+
+    fp = hashlib.sha256((cont.fingerprint() + cooc.fingerprint()).encode()).hexdigest()
+    return (cont, cooc), rooms, f"llm:{fp}"
