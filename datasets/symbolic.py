@@ -193,6 +193,10 @@ class SymbolicHouse:
         self.room_index = {r.id: i for i, r in enumerate(spec.rooms)}
         self.room_ids = tuple(f"room:{i}" for i in range(len(spec.rooms)))
         self.room_names = tuple(category_text(r.category) for r in spec.rooms)
+        self.furn_cat = tuple(category_text(f.category) for f in spec.furniture)
+        self.obj_cat = tuple(category_text(o.category) for o in spec.objects)
+        self._furn_nodes: dict[tuple[int, str | None, bool], ObjectNode] = {}
+        self._obj_nodes: dict[int, ObjectNode] = {}
         self._walkable_rooms()
         self.places: list[tuple[float, float]] = []
         self.place_room: list[int] = []
@@ -339,6 +343,41 @@ class SymbolicHouse:
             self._rows[key] = row
         return row
 
+    def furniture_node(self, f: int, state: str | None, explored: bool) -> ObjectNode:
+        """The node of furniture ``f`` in a given state (memoised: nodes are frozen)."""
+        key = (f, state, explored)
+        node = self._furn_nodes.get(key)
+        if node is None:
+            fu = self.spec.furniture[f]
+            affs = set(fu.affordances)
+            if affs & {"container", "supporter"}:
+                affs.add(_EXAMINE)
+            node = ObjectNode(
+                id=self.furn_node_id(f), category=self.furn_cat[f],
+                parent=self.regions[self.region_of_furn[f]].id,
+                room=self.room_ids[self.room_index[fu.room]],
+                position=tuple(float(v) for v in fu.center),  # type: ignore[arg-type]
+                instance=f + 1, state=state,  # type: ignore[arg-type]
+                affordances=tuple(sorted(affs)), explored=explored,
+            )
+            self._furn_nodes[key] = node
+        return node
+
+    def object_node(self, j: int) -> ObjectNode:
+        """The node of small object ``j`` (nested in its parent furniture)."""
+        node = self._obj_nodes.get(j)
+        if node is None:
+            o = self.spec.objects[j]
+            node = ObjectNode(
+                id=self.obj_node_id(j), category=self.obj_cat[j],
+                parent=self.furn_node_id(self.furn_index[o.parent]),
+                room=self.room_ids[self.room_index[o.room]],
+                position=tuple(float(v) for v in o.position),  # type: ignore[arg-type]
+                instance=len(self.spec.furniture) + 1 + j, relation=o.relation,  # type: ignore[arg-type]
+            )
+            self._obj_nodes[j] = node
+        return node
+
     def all_doors(self) -> frozenset[int]:
         return frozenset(range(len(self.spec.doors)))
 
@@ -349,10 +388,6 @@ class SymbolicHouse:
 # ----------------------------------------------------------------------------------------
 # the episode
 # ----------------------------------------------------------------------------------------
-def _readable(category: str) -> str:
-    return category_text(category)
-
-
 @dataclass(frozen=True)
 class StepOutcome:
     """What one action did (besides the feedback the planner gets)."""
@@ -371,6 +406,8 @@ class SymbolicEnv:
         self.spec = house.spec
         self.query = query
         self._query_text = category_text(query)
+        self._target_furn = {i for i, c in enumerate(house.furn_cat) if c == self._query_text}
+        self._target_obj = {j for j, c in enumerate(house.obj_cat) if c == self._query_text}
         self.max_steps = int(max_steps)
         self.steps = 0
         self.travelled = 0.0
@@ -433,10 +470,8 @@ class SymbolicEnv:
         return sorted(out)
 
     def _check_found(self) -> None:
-        if any(category_text(self.spec.furniture[f].category) == self._query_text
-               for f in self.visible_furniture()) or \
-           any(category_text(self.spec.objects[j].category) == self._query_text
-               for j in self.visible_objects()):
+        if any(f in self._target_furn for f in self.visible_furniture()) or \
+           any(j in self._target_obj for j in self.visible_objects()):
             self.success = True
             self.ended = True
 
@@ -490,18 +525,11 @@ class SymbolicEnv:
                 put(r.id, r.place)
         objects = []
         for f in self.visible_furniture():
-            objects.append(self._furn_node(f))
+            objects.append(h.furniture_node(f, self.furn_state[f], f in self.furn_explored))
             put(h.furn_node_id(f), h.furn_place[f])
         for j in self.visible_objects():
-            o = spec.objects[j]
-            parent = h.furn_index[o.parent]
-            objects.append(ObjectNode(
-                id=h.obj_node_id(j), category=_readable(o.category),
-                parent=h.furn_node_id(parent), room=h.room_ids[h.room_index[o.room]],
-                position=tuple(float(v) for v in o.position),  # type: ignore[arg-type]
-                instance=len(spec.furniture) + 1 + j, relation=o.relation,  # type: ignore[arg-type]
-            ))
-            put(h.obj_node_id(j), h.furn_place[parent])
+            objects.append(h.object_node(j))
+            put(h.obj_node_id(j), h.furn_place[h.furn_index[spec.objects[j].parent]])
         doors = []
         for di in sorted(self.visible_doors):
             d = spec.doors[di]
@@ -517,20 +545,6 @@ class SymbolicEnv:
                            region=region)
         return SceneGraph(robot=robot, rooms=tuple(rooms), regions=tuple(regions),
                           objects=tuple(objects), doors=tuple(doors), distances=distances)
-
-    def _furn_node(self, f: int) -> ObjectNode:
-        h = self.house
-        fu = self.spec.furniture[f]
-        affs = set(fu.affordances)
-        if affs & {"container", "supporter"}:
-            affs.add(_EXAMINE)
-        return ObjectNode(
-            id=h.furn_node_id(f), category=_readable(fu.category),
-            parent=h.regions[h.region_of_furn[f]].id, room=h.room_ids[h.room_index[fu.room]],
-            position=tuple(float(v) for v in fu.center),  # type: ignore[arg-type]
-            instance=f + 1, state=self.furn_state[f],  # type: ignore[arg-type]
-            affordances=tuple(sorted(affs)), explored=f in self.furn_explored,
-        )
 
     # ----- acting ---------------------------------------------------------------------
     def _lookup(self, node_id: str | None) -> tuple[str, int] | None:
@@ -696,7 +710,7 @@ class SymbolicEnv:
 
     def _reveal(self, f: int) -> str:
         self.furn_explored.add(f)
-        names = sorted(category_text(self.spec.objects[j].category) for j in self.house.nested[f])
+        names = sorted(self.house.obj_cat[j] for j in self.house.nested[f])
         return f"found {', '.join(names)}" if names else "nothing inside or on top"
 
     # ----- figures --------------------------------------------------------------------

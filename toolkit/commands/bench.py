@@ -1,0 +1,119 @@
+"""``sgtool bench``: the symbolic object-search benchmark over planners."""
+
+from __future__ import annotations
+
+import shlex
+import sys
+from typing import Any
+
+import click
+
+from sgtool.errors import SgtoolError
+
+
+class OptionError(SgtoolError):
+    """A malformed command-line value."""
+
+
+def _rooms(text: str) -> tuple[int, int]:
+    parts = text.replace(",", "-").split("-")
+    try:
+        if len(parts) == 1:
+            n = int(parts[0])
+            return n, n
+        if len(parts) == 2:
+            return int(parts[0]), int(parts[1])
+    except ValueError:
+        pass
+    raise OptionError(f"--rooms: expected MIN-MAX (e.g. 4-12), got {text!r}")
+
+
+def _value(text: str) -> Any:
+    for cast in (int, float):
+        try:
+            return cast(text)
+        except ValueError:
+            pass
+    if text.lower() in ("true", "false"):
+        return text.lower() == "true"
+    return text
+
+
+def _planner_options(items: tuple[str, ...]) -> dict[str, dict[str, Any]]:
+    out: dict[str, dict[str, Any]] = {}
+    for item in items:
+        key, eq, value = item.partition("=")
+        name, dot, opt = key.partition(".")
+        if not eq or not dot or not name or not opt:
+            raise OptionError(f"--planner-option: expected PLANNER.KEY=VALUE, got {item!r}")
+        out.setdefault(name.strip(), {})[opt.strip()] = _value(value.strip())
+    return out
+
+
+@click.command("bench")
+@click.option("--planners", default=None, metavar="LIST",
+              help="Comma-separated planners to compare (random, greedy, sbert, sbert-noroom, "
+                   "scout, scout-noroom, scout-delta0, moma-llm). Default: all but moma-llm.")
+@click.option("--houses", default=10, show_default=True,
+              help="Number of evaluation-split houses (house seeds HOUSE_SEED, +1, ...).")
+@click.option("--episodes", default=20, show_default=True,
+              help="Search episodes per house (the same for every seed).")
+@click.option("--seeds", default=5, show_default=True,
+              help="Seeds 0..N-1; each draws the start regions and the planners' randomness; "
+                   "metrics are reported as mean ± std over seeds.")
+@click.option("--workers", "-w", default=1, show_default=True,
+              help="Worker processes (results do not depend on it).")
+@click.option("-o", "--out", "out_dir", default="results", show_default=True,
+              type=click.Path(file_okay=False),
+              help="Output folder: episodes.jsonl, summary.md, summary.json, "
+                   "efficiency_distance.png, efficiency_steps.png.")
+@click.option("--rooms", default="4-12", show_default=True, metavar="MIN-MAX",
+              help="Room count range of the generated houses (corridors included, 4..16).")
+@click.option("--house-seed", default=0, show_default=True, help="Seed of the first house.")
+@click.option("--max-steps", default=50, show_default=True,
+              help="High-level actions per episode (SymSearch's N_max).")
+@click.option("--distance-budget", default=5000.0, show_default=True,
+              help="AUC-E distance variant budget max, in low-level steps "
+                   "(0.1 m of travel = 1, an open = 30; MoMa-LLM).")
+@click.option("--step-budget", default=50.0, show_default=True,
+              help="AUC-E step variant budget max, in high-level steps.")
+@click.option("--llm-replay", type=click.Path(dir_okay=False), default=None,
+              help="moma-llm: serve answers from this JSONL transcript instead of an endpoint.")
+@click.option("--llm-transcript", type=click.Path(dir_okay=False), default=None,
+              help="moma-llm: append every LLM exchange to this JSONL transcript "
+                   "(needs --workers 1).")
+@click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
+              help="Extra planner option, e.g. scout.delta=0.2 or moma-llm.model=gpt-4o-mini "
+                   "(repeatable; see sgtool.planning.registry).")
+@click.option("--progress/--no-progress", default=None,
+              help="Progress bar on stderr (default: when stderr is a terminal).")
+def command(planners: str | None, houses: int, episodes: int, seeds: int, workers: int,
+            out_dir: str, rooms: str, house_seed: int, max_steps: int, distance_budget: float,
+            step_budget: float, llm_replay: str | None, llm_transcript: str | None,
+            planner_option: tuple[str, ...], progress: bool | None) -> None:
+    """Run the symbolic object-search benchmark (SCOUT's SymSearch roll-out) on generated
+    evaluation houses and print a table in the shape of SCOUT's Table VII: success rate,
+    SPL, high-level steps, decision time, and MoMa-LLM's AUC-E with a distance-plus-open
+    budget and a step budget (mean ± std over seeds), then the seen/unseen query breakdown
+    (SCOUT Table IX). Writes per-episode JSONL, the summary and the efficiency curves to
+    OUT. The same command gives the same episodes.jsonl except its wall-clock fields."""
+    from sgtool.analysis.bench import DEFAULT_PLANNERS, BenchConfig, run_benchmark, write_outputs
+
+    names = tuple(p.strip() for p in planners.split(",") if p.strip()) if planners \
+        else DEFAULT_PLANNERS
+    options = _planner_options(planner_option)
+    if llm_replay or llm_transcript:
+        moma = options.setdefault("moma-llm", {})
+        if llm_replay:
+            moma["replay"] = llm_replay
+        if llm_transcript:
+            moma["transcript"] = llm_transcript
+    cfg = BenchConfig(planners=names, houses=houses, episodes=episodes, seeds=seeds,
+                      rooms=_rooms(rooms), house_seed=house_seed, max_steps=max_steps,
+                      workers=workers, distance_budget=distance_budget,
+                      step_budget=step_budget, planner_options=options)
+    res = run_benchmark(cfg, progress=progress)
+    paths = write_outputs(res, out_dir, command=shlex.join(["sgtool", *sys.argv[1:]]))
+    click.echo(res.table)
+    click.echo(res.seen_table)
+    click.echo(f"wrote {', '.join(str(p) for p in paths)}")
