@@ -296,3 +296,63 @@ def test_cli_json_report_and_refusal_to_overwrite(tmp_path):
     r = run(args)
     assert r.exit_code == 2 and "exists; not overwriting it (use --force)" in r.output
     assert run(args + ["--force"]).exit_code == 0
+
+
+def test_pose_topic_instead_of_tf_with_every_and_limit(tmp_path):
+    """Camera poses from a PoseStamped topic (no tf at all); --every 2 --limit 3."""
+    src = write_sgtool_log(tmp_path / "src.mcap", n=8)
+    bag = bag_path(tmp_path, "ros2-sqlite3")
+    with LogReader(src) as r, BagWriter(bag, "ros2-sqlite3") as w:
+        frames = list(r.frames())
+        for f in frames:
+            t = f.time_ns
+            w.write("/camera/pose", "geometry_msgs/msg/PoseStamped", t,
+                    w.pose_stamped(t, "map", f.pose))
+            w.write(TOPICS["depth"], "sensor_msgs/msg/Image", t,
+                    w.image(t, "cam", (f.depth * 1000).round().astype(np.uint16), "16UC1"))
+    out = tmp_path / "o.mcap"
+    k = frames[0].intrinsics
+    from sgtool.recorders.importers.textformats import PinholeParams
+
+    rep = import_bag(bag, out, BagOptions(depth=TOPICS["depth"], pose="/camera/pose",
+                                          intrinsics=PinholeParams(k.fx, k.fy, k.cx, k.cy),
+                                          every=2, limit=3, **KEEP_WORLD))
+    assert rep.frames == 3 and rep.pose_source == "topic /camera/pose (8 poses)"
+    with LogReader(out) as r:
+        got = list(r.frames())
+    for g, f in zip(got, frames[::2], strict=False):
+        assert g.time_ns == f.time_ns and pose_difference(g.pose, f.pose)[0] < 1e-9
+        assert np.array_equal(g.depth, f.depth)
+
+
+def test_bag_poses_estimated_by_odometry(shared_data_dir, tmp_path):
+    """Six real ICL-NUIM frames as a ROS 2 bag: with tf and --estimate-poses the drift
+    against the bag's tf is reported; without tf (a camera recorded alone) the poses are
+    estimated from the images and start at the identity."""
+    from sgtool.recorders.importers.export import write_frames_bag
+    from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
+
+    icl = tmp_path / "icl.mcap"
+    import_rgbd(shared_data_dir / "rgbd" / "icl-livingroom1-micro", icl,
+                RgbdOptions(limit=6, progress=False))
+    with_tf, no_tf = tmp_path / "with_tf", tmp_path / "no_tf"
+    with LogReader(icl) as r:
+        frames = list(r.frames())
+    write_frames_bag(frames, with_tf, "ros2-mcap")
+    write_frames_bag(frames, no_tf, "ros2-mcap", tf=False)
+    flags = dict(depth=TOPICS["depth"], rgb=TOPICS["rgb"], info=TOPICS["info"], odometry="icp")
+    rep = import_bag(with_tf, tmp_path / "a.mcap",
+                     BagOptions(estimate_poses=True, **flags, **KEEP_WORLD))
+    assert rep.frames == 6 and rep.drift is not None and rep.odometry_failures == 0
+    assert rep.pose_source == ("estimated by icp odometry (tf world -> camera_optical_frame "
+                               "kept for the drift)")
+    assert 0 < rep.drift.ate_rmse_m < 0.01
+    rep = import_bag(no_tf, tmp_path / "b.mcap", BagOptions(**flags, **KEEP_WORLD))
+    assert rep.frames == 6 and rep.drift is None
+    assert rep.pose_source == "estimated by icp odometry"
+    with LogReader(tmp_path / "b.mcap") as r:
+        est = [f.pose for f in r.frames()]
+    assert np.allclose(est[0], np.eye(4))
+    # relative motion agrees with the reference trajectory to a centimetre
+    rel = [np.linalg.inv(frames[0].pose) @ f.pose for f in frames]
+    assert max(np.linalg.norm(a[:3, 3] - b[:3, 3]) for a, b in zip(est, rel, strict=True)) < 0.01

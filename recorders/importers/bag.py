@@ -16,6 +16,11 @@ What is read (flags of the command):
 Without ``--depth``, ``--tf-frames`` or ``--pose`` alone import a *trajectory*: a log of
 ``/tf`` world -> camera transforms at the times the pose was measured, without frames.
 
+A bag with images but no ``/tf`` and no ``--pose`` (a camera recorded alone), or any bag
+with ``--estimate-poses``, gets its camera poses from RGB-D odometry (:mod:`.odometry`,
+one more pass over the images); the drift against the bag's own poses is reported when it
+has them.
+
 When a flag is missing or names the wrong thing, the error lists the bag's topics with
 their types and suggests flags. The bag is read in two passes (time stamps, transforms and
 calibration; then the images), so memory stays at a few frames.
@@ -44,11 +49,13 @@ from sgtool.recorders.importers.images import (
     depth_to_metres,
     resize_to,
 )
+from sgtool.recorders.importers.odometry import DriftReport, drift_against, estimate_trajectory
 from sgtool.recorders.importers.poses import PoseTrack, pose_from_tq
 from sgtool.recorders.importers.sink import (
     IMPORT_METADATA,
     ImportFrame,
     ImportReport,
+    drift_metadata,
     write_log,
 )
 from sgtool.recorders.importers.textformats import PinholeParams
@@ -77,6 +84,10 @@ class BagOptions:
     every: int = 1
     limit: int | None = None
     progress: bool = True
+    compression: str = "zstd"
+    estimate_poses: bool = False
+    odometry: str = "rgbd+icp"
+    depth_max: float = 4.0
 
 
 # ----- message fields ------------------------------------------------------------------------
@@ -249,10 +260,6 @@ def check_flags(
                "(the bag has no CameraInfo topic)")
             + " or --intrinsics fx,fy,cx,cy"
         )
-    if opts.tf_frames is None and opts.pose is None and opts.depth is not None:
-        if not any(t.msgtype in B.TF_TYPES for t in topics):
-            raise SgtoolError(_missing_message(
-                path, topics, "no /tf topic for the camera pose; give --pose TOPIC"))
 
 
 # ----- pass 1: index --------------------------------------------------------------------------
@@ -391,7 +398,7 @@ def _pose_source(path: Path, idx: _BagIndex, opts: BagOptions) -> _PoseSource:
 class _Planned:
     k_depth: int
     t_ns: int
-    pose: np.ndarray
+    pose: np.ndarray | None
     k_rgb: int | None
     k_ids: int | None
 
@@ -414,7 +421,12 @@ def _nearest_within(stamps: list[int], order: list[int], t: int, max_dt: int) ->
     return None if best is None else best[1]
 
 
-def _plan(idx: _BagIndex, src: _PoseSource, opts: BagOptions) -> tuple[list[_Planned], list[str]]:
+def _plan(
+    idx: _BagIndex, src: _PoseSource | None, opts: BagOptions, keep_unposed: bool = False
+) -> tuple[list[_Planned], list[str]]:
+    """The frames to write: depth images in time order with their pose (None when
+    ``src`` is None or, with ``keep_unposed``, when it does not cover the time) and the
+    colour/id images paired with them."""
     notes = []
     seen: set[int] = set()
     rgb_order = sorted(range(len(idx.rgb.stamps)), key=lambda i: idx.rgb.stamps[i])
@@ -428,17 +440,19 @@ def _plan(idx: _BagIndex, src: _PoseSource, opts: BagOptions) -> tuple[list[_Pla
             dup += 1
             continue
         seen.add(t)
-        pose = src.at(t, None if explicit_cam else idx.depth.frames[k])
-        if pose is None:
+        pose = None if src is None else src.at(t, None if explicit_cam else idx.depth.frames[k])
+        if pose is None and src is not None:
             no_pose += 1
-            continue
+            if not keep_unposed:
+                continue
         k_rgb = _nearest_within(idx.rgb.stamps, rgb_order, t, opts.max_dt_ns) if opts.rgb else None
         k_ids = _nearest_within(idx.ids.stamps, ids_order, t, opts.max_dt_ns) if opts.ids else None
         no_rgb += opts.rgb is not None and k_rgb is None
         no_ids += opts.ids is not None and k_ids is None
         plan.append(_Planned(k, t, pose, k_rgb, k_ids))
-    if no_pose:
-        notes.append(f"{no_pose} depth images without a pose from {src.describe} (dropped)")
+    if no_pose and src is not None:
+        what = "kept, estimated" if keep_unposed else "dropped"
+        notes.append(f"{no_pose} depth images without a pose from {src.describe} ({what})")
     if dup:
         notes.append(f"{dup} depth images repeated a time stamp (dropped)")
     if no_rgb:
@@ -446,6 +460,14 @@ def _plan(idx: _BagIndex, src: _PoseSource, opts: BagOptions) -> tuple[list[_Pla
     if no_ids:
         notes.append(f"{no_ids} depth images had no instance ids within "
                      f"{opts.max_dt_ns / 1e6:g} ms")
+    if opts.tf_frames is not None and idx.depth.frames:
+        img_frames = sorted(set(idx.depth.frames))
+        if img_frames != [frame_name(opts.tf_frames[1])]:
+            notes.append(
+                f"the depth images are in frame {', '.join(img_frames)}; the pose is that of "
+                f"--tf-frames {frame_name(opts.tf_frames[1])} (it must be the optical frame: "
+                "x right, y down, z forward)"
+            )
     if idx.zero_stamps:
         notes.append(f"{idx.zero_stamps} images had a zero header stamp (bag time used)")
     if idx.info_changes:
@@ -488,8 +510,8 @@ def _frames(
         raw, scale = d["depth"]
         rgb = resize_to(d["rgb"], k.width, k.height) if "rgb" in d else None
         ids = resize_to(d["ids"], k.width, k.height) if "ids" in d else None
-        return ImportFrame(plan[i].t_ns, depth_for_log(raw, scale), plan[i].pose, k,
-                           rgb=rgb, ids=ids)
+        pose = plan[i].pose if plan[i].pose is not None else np.eye(4)
+        return ImportFrame(plan[i].t_ns, depth_for_log(raw, scale), pose, k, rgb=rgb, ids=ids)
 
     for c, _, raw in reader.messages(connections=conns):
         kind = topic_kind[c.topic]
@@ -558,27 +580,46 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         topics = B.list_topics(reader)
         check_flags(path, topics, opts, reader)
         idx = _index(reader, opts, topics)
-        src = _pose_source(path, idx, opts)
+        has_tf = bool(idx.tf.links)
+        estimate = opts.depth is not None and (
+            opts.estimate_poses or (opts.pose is None and opts.tf_frames is None and not has_tf)
+        )
+        src = None
+        if not (estimate and not has_tf and opts.pose is None):
+            try:
+                src = _pose_source(path, idx, opts)
+            except SgtoolError:
+                if not estimate:
+                    raise
+                # estimating anyway: the bag's poses were only wanted as the reference
         kind = f"bag/{B.bag_kind(path)}"
         meta = {
             "source": path.resolve().name,
             "source_kind": kind,
-            "pose_source": src.describe,
+            "pose_source": src.describe if src else "none",
             "topics": " ".join(f"{f}={t}" for f, t in (
                 ("depth", opts.depth), ("rgb", opts.rgb), ("ids", opts.ids),
                 ("info", opts.info), ("pose", opts.pose)) if t),
             "instance_ids": "present" if opts.ids else "absent",
         }
         if opts.depth is None:
+            assert src is not None
             return _import_trajectory(path, out, src, opts, meta, kind)
         k = _camera(path, idx, opts)
-        plan, notes = _plan(idx, src, opts)
+        plan, notes = _plan(idx, src, opts, keep_unposed=estimate)
         if not plan:
             raise SgtoolError(
                 f"{path}: none of the {len(idx.depth.stamps)} depth images has a pose from "
-                f"{src.describe}"
-                + (f" (tf links: {'; '.join(idx.tf.describe())})" if src.tree else "")
+                f"{src.describe if src else 'anywhere'}"
+                + (f" (tf links: {'; '.join(idx.tf.describe())})" if src and src.tree else "")
             )
+        drift = None
+        failures = None
+        pose_source = src.describe if src else "none"
+        if estimate:
+            plan, drift, failures, pose_source = _estimate(reader, plan, idx, opts, k, src)
+            meta.update(drift_metadata(drift))
+        meta["pose_source"] = pose_source
         by_k = {p.k_depth: p for p in plan}
         samples = [
             DepthSample(depth_to_metres(raw, opts.depth_scale if opts.depth_scale and
@@ -591,12 +632,49 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         meta["intrinsics_source"] = f"topic {opts.info}" if opts.intrinsics is None else "given"
         n, has_rgb, has_ids = write_log(
             out, _frames(reader, plan, idx, opts, k), alignment=alignment, metadata=meta,
-            total=len(plan), progress=opts.progress, notes=notes,
+            total=len(plan), progress=opts.progress, notes=notes, compression=opts.compression,
         )
     return ImportReport(
         output=out, source=str(path), kind=kind, frames=n, poses=n, alignment=alignment,
-        has_rgb=has_rgb, has_ids=has_ids, pose_source=src.describe, notes=tuple(notes),
+        has_rgb=has_rgb, has_ids=has_ids, pose_source=pose_source, drift=drift,
+        odometry_failures=failures, notes=tuple(notes),
     )
+
+
+def _estimate(
+    reader: Any, plan: list[_Planned], idx: _BagIndex, opts: BagOptions, k: CameraIntrinsics,
+    src: _PoseSource | None,
+) -> tuple[list[_Planned], DriftReport | None, int, str]:
+    """Poses of the planned frames by odometry (an extra pass over the images); the drift
+    against the bag's own poses where it has them."""
+    from dataclasses import replace
+
+    from tqdm import tqdm
+
+    if opts.odometry == "rgbd" and not opts.rgb:
+        raise SgtoolError("--odometry rgbd needs --rgb; use icp")
+    bar = tqdm(total=len(plan), unit="frame", desc="odometry", file=sys.stderr,
+               disable=None if opts.progress else True, leave=False)
+
+    def gen():  # type: ignore[no-untyped-def]
+        for fr in _frames(reader, plan, idx, opts, k):
+            d = fr.depth.astype(np.float32) / 1000.0 if fr.depth.dtype == np.uint16 else fr.depth
+            yield fr.rgb, d
+
+    try:
+        res = estimate_trajectory(gen(), k, method=opts.odometry, start=plan[0].pose,
+                                  depth_max=opts.depth_max, progress=lambda i: bar.update(1))
+    finally:
+        bar.close()
+    ref = [(i, p.pose) for i, p in enumerate(plan) if p.pose is not None]
+    drift = None
+    if len(ref) >= 2:
+        drift = drift_against([res.poses[i] for i, _ in ref], [T for _, T in ref])
+    new_plan = [replace(p, pose=T) for p, T in zip(plan, res.poses, strict=True)]
+    desc = f"estimated by {res.method} odometry"
+    if src is not None:
+        desc += f" ({src.describe} kept for the drift)"
+    return new_plan, drift, res.failures, desc
 
 
 def _import_trajectory(
@@ -613,6 +691,7 @@ def _import_trajectory(
         if not times:  # all static: one pose
             times = [0]
     samples = [(t, T) for t in times if (T := src.at(t)) is not None]  # noqa: N806
+    unresolved = len(times) - len(samples)
     samples = samples[:: opts.every]
     if opts.limit is not None:
         samples = samples[: opts.limit]
@@ -627,7 +706,7 @@ def _import_trajectory(
         alignment = WorldAlignment.identity()
     meta = {**meta, **alignment.metadata(), "content": "trajectory"}
     A = alignment.matrix  # noqa: N806
-    with LogWriter(out, compression="lz4") as w:
+    with LogWriter(out, compression=opts.compression) as w:
         w.add_metadata(IMPORT_METADATA, meta)
         w.write_record("episode", samples[0][0], {"kind": "import", "status": "started",
                                                   "source": meta["source"], "frames": 0})
@@ -640,7 +719,10 @@ def _import_trajectory(
     return ImportReport(
         output=out, source=str(path), kind=kind, frames=0, poses=len(samples),
         alignment=alignment, has_rgb=False, has_ids=False,
-        pose_source=src.describe, notes=(f"trajectory of {len(samples)} poses, no frames",),
+        pose_source=src.describe,
+        notes=(f"trajectory of {len(samples)} poses, no frames",)
+        + ((f"{unresolved} sample times where the chain was incomplete (skipped)",)
+           if unresolved else ()),
     )
 
 

@@ -178,15 +178,18 @@ def write_frames_bag(
     *,
     topics: BagTopics | None = None,
     rgb_format: str = "raw",  # raw | jpg | png
+    tf: bool = True,
 ) -> int:
-    """Write sgtool frames as a bag (see the module docstring); returns the frame count."""
+    """Write sgtool frames as a bag (see the module docstring); returns the frame count.
+    ``tf=False`` leaves the poses out (a camera recorded alone)."""
     tp = topics or BagTopics()
     n = 0
     with BagWriter(out, fmt) as w:
         for fr in frames:
             t = fr.time_ns
-            w.write(tp.tf, "tf2_msgs/msg/TFMessage", t,
-                    w.tf(t, [w.transform_stamped(t, tp.world, tp.camera, fr.pose)]))
+            if tf:
+                w.write(tp.tf, "tf2_msgs/msg/TFMessage", t,
+                        w.tf(t, [w.transform_stamped(t, tp.world, tp.camera, fr.pose)]))
             w.write(tp.info, "sensor_msgs/msg/CameraInfo", t, w.camera_info(t, tp.camera, fr))
             w.write(tp.depth, "sensor_msgs/msg/Image", t,
                     w.image(t, tp.camera, depth_to_mm(fr.depth), "16UC1"))

@@ -55,6 +55,7 @@ class RgbdOptions:
     limit: int | None = None
     max_dt_ns: int = 20_000_000
     progress: bool = True
+    compression: str = "zstd"
 
 
 def camera_for(seq: FolderSequence, opts: RgbdOptions, width: int, height: int) -> CameraIntrinsics:
@@ -176,7 +177,8 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
             yield ImportFrame(fr.time_ns, depth_for_log(raw, scale), pose, k, rgb=rgb)
 
     n, has_rgb, has_ids = write_log(out, gen(), alignment=alignment, metadata=meta,
-                                    total=len(frames), progress=opts.progress, notes=notes)
+                                    total=len(frames), progress=opts.progress, notes=notes,
+                                    compression=opts.compression)
     return ImportReport(
         output=out, source=str(root), kind=f"rgbd/{seq.layout}", frames=n, poses=len(poses),
         alignment=alignment, has_rgb=has_rgb, has_ids=has_ids, pose_source=pose_source,

@@ -90,6 +90,9 @@ def _common_options(f):  # type: ignore[no-untyped-def]
         click.option("--every", type=int, default=1, show_default=True,
                      help="Keep every N-th frame."),
         click.option("--limit", type=int, default=None, help="Keep at most N frames."),
+        click.option("--compression", type=click.Choice(["zstd", "lz4", "none"]),
+                     default="zstd", show_default=True,
+                     help="MCAP chunk compression (lz4: ~1.4x faster import, ~30 % larger)."),
         click.option("--force", is_flag=True, help="Overwrite the output log."),
         click.option("--json", "as_json", is_flag=True, help="Print the report as JSON."),
         click.option("--quiet", is_flag=True, help="No progress bars."),
@@ -124,15 +127,25 @@ def command() -> None:
               "instead of tf.")
 @click.option("--tf-tolerance", type=float, default=0.05, show_default=True,
               help="How far (s) before/after a transform's samples a pose may be taken.")
+@click.option("--estimate-poses", is_flag=True,
+              help="Estimate the camera poses by RGB-D odometry even when the bag has tf "
+              "(the drift against the bag's poses is reported). A bag without tf and "
+              "without --pose is always estimated.")
+@click.option("--odometry", type=click.Choice(["rgbd+icp", "rgbd", "icp"]),
+              default="rgbd+icp", show_default=True,
+              help="Odometry for estimated poses (see `sgtool import rgbd --help`).")
+@click.option("--depth-max", type=float, default=4.0, show_default=True,
+              help="Depth beyond this (m) is ignored by the odometry.")
 @click.option("--list", "list_only", is_flag=True,
               help="List the bag's topics, tf links and suggested flags, and stop.")
 @_world_options
 @_common_options
 def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: str | None,
-        tf_frames: str | None, pose: str | None, tf_tolerance: float, list_only: bool,
+        tf_frames: str | None, pose: str | None, tf_tolerance: float, estimate_poses: bool,
+        odometry: str, depth_max: float, list_only: bool,
         up: str, floor: str, output: str | None, intrinsics: str | None,
-        depth_scale: float | None, max_dt: float, every: int, limit: int | None, force: bool,
-        as_json: bool, quiet: bool) -> None:
+        depth_scale: float | None, max_dt: float, every: int, limit: int | None,
+        compression: str, force: bool, as_json: bool, quiet: bool) -> None:
     """Import a ROS 1 .bag, a ROS 2 bag folder (sqlite3 or MCAP) or a bare ROS 2 .mcap/.db3
     file at PATH.
 
@@ -168,6 +181,8 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
         depth_scale=depth_scale, max_dt_ns=int(max_dt * 1e9),
         tf_tolerance_ns=int(tf_tolerance * 1e9), up=parse_up(up), floor=fl,
         floor_auto=floor_auto, every=every, limit=limit, progress=not quiet,
+        compression=compression, estimate_poses=estimate_poses, odometry=odometry,
+        depth_max=depth_max,
     )
     if not (depth or tf_frames or pose):
         # nothing to import yet: the error lists the topics and suggests flags
@@ -205,7 +220,8 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
 def rgbd(folder: str, layout: str, fps: float, trajectory: str | None, estimate_poses: bool,
          odometry: str, depth_max: float, up: str, floor: str, output: str | None,
          intrinsics: str | None, depth_scale: float | None, max_dt: float, every: int,
-         limit: int | None, force: bool, as_json: bool, quiet: bool) -> None:
+         limit: int | None, compression: str, force: bool, as_json: bool,
+         quiet: bool) -> None:
     """Import an RGB-D image folder (TUM RGB-D, 7-Scenes, Open3D/Redwood) at FOLDER.
 
     Log times are the dataset's time stamps (TUM) or frame number / --fps. Poses are the
@@ -228,6 +244,6 @@ def rgbd(folder: str, layout: str, fps: float, trajectory: str | None, estimate_
         trajectory=Path(trajectory) if trajectory else None, estimate_poses=estimate_poses,
         odometry=odometry, depth_max=depth_max, up=parse_up(up), floor=fl,
         floor_auto=floor_auto, every=every, limit=limit, max_dt_ns=int(max_dt * 1e9),
-        progress=not quiet,
+        progress=not quiet, compression=compression,
     )
     _print_report(import_rgbd(folder, out, opts), as_json)
