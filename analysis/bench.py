@@ -219,7 +219,9 @@ def run_benchmark(cfg: BenchConfig, progress: bool | None = None) -> BenchResult
         bar.close()
     wall = time.perf_counter() - t0
     order = {p: i for i, p in enumerate(cfg.planners)}
-    results = sorted((r for c in chunks for r in c),
+    # through the JSONL form, so the summary is exactly what `sgtool eval` recomputes from
+    # episodes.jsonl (figures rounded as written)
+    results = sorted((EpisodeResult.from_dict(r.to_dict()) for c in chunks for r in c),
                      key=lambda r: (order[r.planner], r.seed, int(r.house.split("-")[-1]),
                                     r.episode))
     spent: dict[str, float] = {}

@@ -34,7 +34,7 @@ def fmt_stat(s: Stat | None, spec: str) -> str:
     return f"{format(s.mean, spec)} ± {format(s.std, spec)}"
 
 
-def _pipe_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+def pipe_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h)
               for i, h in enumerate(header)]
 
@@ -63,7 +63,7 @@ def format_table(summaries: Sequence[PlannerSummary],
     parts = []
     if title:
         parts.append(title)
-    parts.append(_pipe_table(header, rows))
+    parts.append(pipe_table(header, rows))
     notes = ["mean ± std (ddof=1) over seeds; decision time = wall seconds per decision."]
     if models:
         notes.append("AUC-E budgets: " + "; ".join(m.statement() for m in models) + ".")
@@ -78,7 +78,7 @@ def format_seen_unseen(rows: Sequence[SplitSummary], title: str = "") -> str:
              _fmt(r.unseen_sr, ".3f"), _fmt(r.unseen_spl, ".3f"), str(r.unseen_n)]
             for r in rows]
     parts = [title] if title else []
-    parts.append(_pipe_table(header, body))
+    parts.append(pipe_table(header, body))
     return "\n".join(parts) + "\n"
 
 

@@ -67,6 +67,7 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -743,37 +744,71 @@ def planner_seed(seed: int, house_seed: int, episode_index: int) -> int:
 def run_episode(house: SymbolicHouse, planner: Planner, query: str, targets: Sequence[str],
                 seed: int = 0, episode_index: int = 0, avoid_rooms: Sequence[str] = (),
                 max_steps: int = N_MAX, seen: bool | None = None, house_id: str = "",
-                planner_name: str | None = None) -> EpisodeResult:
+                planner_name: str | None = None, log: Any = None) -> EpisodeResult:
     """Roll out one episode: observe, decide, act, feed back, until it ends.
 
     ``targets`` (spec ids of the query's instances) only serve the shortest path of SPL;
     success is decided by category (module doc). Decision time is the wall time of each
     ``decide`` call (kept in the record's ``wall`` figures only).
+
+    With ``log`` (an open :class:`sgtool.log.writer.LogWriter`) the episode is also
+    recorded the way the closed loop records one, so ``sgtool eval`` reads both alike: an
+    ``sgtool.Episode`` record "started" at t = 0, then per step k (t = k s) the
+    ``sgtool.SceneGraph`` the planner saw and the ``sgtool.Action`` it took, and the
+    closing Episode record with the final figures (``extra``: seed, planner_seed, episode,
+    seen, end, n_open, start_region).
     """
+    name = planner_name or getattr(planner, "name", "planner")
+    hid = house_id or f"house-{house.spec.seed}"
     env = SymbolicEnv(house, query, seed=seed, episode_index=episode_index,
                       avoid_rooms=avoid_rooms, max_steps=max_steps)
     t_start = time.perf_counter()
-    planner.reset(query, seed=planner_seed(seed, house.spec.seed, episode_index))
+    pseed = planner_seed(seed, house.spec.seed, episode_index)
+    planner.reset(query, seed=pseed)
     trace: list[Step] = []
     decision_s = 0.0
     decisions = 0
+    base = {"kind": "search", "source": "symbolic", "house_id": hid, "query": query,
+            "planner": name, "frames": 0}
+    if log is not None:
+        log.write_record("episode", 0, {**base, "status": "started", "steps": 0,
+                                         "travelled_m": 0.0, "shortest_m": None, "extra": {}})
     while not env.ended:
         graph = env.observe()
         t0 = time.perf_counter()
         action = planner.decide(graph)
-        decision_s += time.perf_counter() - t0
+        dt = time.perf_counter() - t0
+        decision_s += dt
         decisions += 1
         out = env.step(action)
         planner.feedback(out.feedback)
         fb = out.feedback
         trace.append(Step(action.skill, action.target, fb.outcome, fb.travelled_m))
-    return EpisodeResult(
-        planner=planner_name or getattr(planner, "name", "planner"),
-        seed=int(seed), house=house_id or f"house-{house.spec.seed}",
+        if log is not None:
+            t_ns = len(trace) * 1_000_000_000
+            log.write_json_bytes("scene_graph", t_ns, graph.to_json().encode())
+            log.write_record("action", t_ns, {
+                "skill": action.skill, "target": action.target, "outcome": fb.outcome,
+                "reason": action.reason, "travelled_m": round(fb.travelled_m, 4),
+                "decision_time_s": dt, "planner": name, "step": len(trace),
+            })
+    shortest = env.shortest_path(targets)
+    result = EpisodeResult(
+        planner=name, seed=int(seed), house=hid,
         episode=int(episode_index), query=query, success=env.success, steps=env.steps,
-        travelled_m=env.travelled, shortest_m=env.shortest_path(targets),
+        travelled_m=env.travelled, shortest_m=shortest,
         n_open=env.n_open, n_invalid=env.n_invalid, n_failure=env.n_failure, seen=seen,
         end=env.end_reason, source="symbolic", trace=tuple(trace),
         wall={"decision_s": decision_s, "decisions": float(decisions),
               "episode_s": time.perf_counter() - t_start},
     )
+    if log is not None:
+        log.write_record("episode", (len(trace) + 1) * 1_000_000_000, {
+            **base, "status": "success" if env.success else "failure", "steps": env.steps,
+            "travelled_m": round(env.travelled, 4),
+            "shortest_m": None if shortest is None else round(shortest, 4),
+            "extra": {"seed": int(seed), "planner_seed": pseed, "episode": int(episode_index),
+                      "seen": seen, "end": env.end_reason, "n_open": env.n_open,
+                      "start_region": env.start_region},
+        })
+    return result

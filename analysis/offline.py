@@ -1,0 +1,251 @@
+"""Offline evaluation from recorded episodes: metrics from logs, planners against logs.
+
+**Episodes in a log.** A closed-loop log holds, on sgtool's JSON channels, ``sgtool.Episode``
+records (``/sgtool/episode``), one ``sgtool.Action`` record per executed action
+(``/sgtool/action``) and ``sgtool.SceneGraph`` records (``/sgtool/scene_graph``, the
+canonical JSON of :class:`~sgtool.scenegraph.graph.SceneGraph`). Episodes are cut by their
+Episode records in log-time order: a record with status "started" opens an episode, a
+record with status "success", "failure" or "ended" closes it (it carries the final figures;
+see :func:`sgtool.analysis.records.result_from_log_records` for the fields read); the
+actions in between belong to it. A log without a "started" record has one episode from its
+start; an episode still open at the end of the log (a killed run) is closed as "ended"
+(not a success) with the figures derived from its actions.
+
+**Decision points.** Every Action record is a decision point; the scene graph the planner
+decided on is the last SceneGraph record at or before the action's log time.
+
+**A planner against a log** (:func:`replay_decisions`): the planner is reset with the
+episode's query and seed, then at every decision point it decides on the logged graph and
+its choice is compared with the logged action; then it is told the logged outcome
+(teacher forcing: its memory follows what was really done, not what it would have done).
+Reported: exact agreement (same skill and target), same target, same room (the chosen and
+the logged node lie in the same room), and choices that name no node of the graph.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from sgtool.analysis.records import EpisodeResult, read_jsonl, result_from_log_records
+from sgtool.errors import SgtoolError
+from sgtool.planning.base import Action, Feedback
+from sgtool.scenegraph.graph import DoorNode, SceneGraph
+
+_TERMINAL = ("success", "failure", "ended")
+
+
+class EvalInputError(SgtoolError):
+    """An input of ``sgtool eval`` that is neither an MCAP log nor an episode JSONL file."""
+
+
+@dataclass(frozen=True)
+class Decision:
+    t_ns: int
+    graph: SceneGraph | None
+    action: Mapping[str, Any]
+
+
+@dataclass(frozen=True)
+class LoggedEpisode:
+    source: str
+    index: int  # episode number within its log
+    episode: Mapping[str, Any]  # the closing Episode record (synthesised when missing)
+    decisions: tuple[Decision, ...]
+
+    def result(self) -> EpisodeResult:
+        r = result_from_log_records(self.episode, [d.action for d in self.decisions],
+                                    source=self.source)
+        if "episode" not in (self.episode.get("extra") or {}):
+            r = _replace(r, episode=self.index)
+        return r
+
+
+def _replace(r: EpisodeResult, **kw: Any) -> EpisodeResult:
+    import dataclasses
+
+    return dataclasses.replace(r, **kw)
+
+
+def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
+    """The episodes of one MCAP log (module doc for how they are cut)."""
+    from sgtool.log.reader import LogReader
+
+    p = Path(path)
+    with LogReader(p) as log:
+        stream: list[tuple[int, int, str, Any]] = []
+        for order, kind in enumerate(("scene_graph", "episode", "action")):
+            for t, rec in log.records(kind):
+                stream.append((t, order, kind, rec))
+    # at equal times: the graph first, then episode records, then actions
+    stream.sort(key=lambda x: (x[0], x[1]))
+    episodes: list[LoggedEpisode] = []
+    graph: SceneGraph | None = None
+    opened: Mapping[str, Any] | None = None
+    decisions: list[Decision] = []
+
+    def close(record: Mapping[str, Any]) -> None:
+        nonlocal decisions, opened
+        episodes.append(LoggedEpisode(str(p), len(episodes), record, tuple(decisions)))
+        decisions = []
+        opened = None
+
+    for t, _, kind, rec in stream:
+        if kind == "scene_graph":
+            try:
+                graph = SceneGraph.from_dict(rec)
+            except (KeyError, TypeError, ValueError) as e:
+                raise EvalInputError(f"{p}: unreadable scene graph record at {t} ns: {e}") \
+                    from None
+        elif kind == "episode":
+            status = rec.get("status")
+            if status == "started":
+                if opened is not None or decisions:
+                    close({**(opened or {}), "status": "ended"})
+                opened = rec
+            elif status in _TERMINAL:
+                close({**(opened or {}), **rec})
+        else:
+            decisions.append(Decision(t, graph, rec))
+    if opened is not None or decisions:
+        close({**(opened or {"kind": "search"}), "status": "ended"})
+    return episodes
+
+
+def load_results(paths: Iterable[str | os.PathLike[str]]) -> tuple[list[EpisodeResult],
+                                                                   list[LoggedEpisode]]:
+    """Episode results from MCAP logs and/or episode JSONL files (``sgtool bench``
+    output); the logged episodes (with their decision points) of the MCAP inputs."""
+    results: list[EpisodeResult] = []
+    logged: list[LoggedEpisode] = []
+    for path in paths:
+        p = Path(path)
+        if not p.exists():
+            raise EvalInputError(f"{p}: no such file")
+        if p.is_dir():
+            raise EvalInputError(f"{p} is a folder; give MCAP logs or episodes.jsonl files")
+        with open(p, "rb") as f:
+            head = f.read(8)
+        if head == b"\x89MCAP0\r\n":
+            eps = read_log_episodes(p)
+            logged.extend(eps)
+            results.extend(e.result() for e in eps)
+        elif p.suffix in (".jsonl", ".json") or head[:1] == b"{":
+            results.extend(read_jsonl(p))
+        else:
+            raise EvalInputError(f"{p}: neither an MCAP log nor an episode JSONL file")
+    return results, logged
+
+
+# ----------------------------------------------------------------------------------------
+# a planner against the logged decisions
+# ----------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class DecisionComparison:
+    source: str
+    episode: int
+    step: int
+    logged: tuple[str, str | None]
+    chosen: tuple[str, str | None]
+    valid: bool  # the chosen target is a node of the graph (or done)
+    same_room: bool
+    decision_s: float
+
+
+@dataclass(frozen=True)
+class OfflineReport:
+    planner: str
+    comparisons: tuple[DecisionComparison, ...]
+    skipped: int  # decision points without a logged scene graph
+
+    @property
+    def decisions(self) -> int:
+        return len(self.comparisons)
+
+    def rate(self, what: str) -> float:
+        if not self.comparisons:
+            return math.nan
+        if what == "agree":
+            hits = sum(c.chosen == c.logged for c in self.comparisons)
+        elif what == "target":
+            hits = sum(c.chosen[1] == c.logged[1] for c in self.comparisons)
+        elif what == "room":
+            hits = sum(c.same_room for c in self.comparisons)
+        elif what == "invalid":
+            hits = sum(not c.valid for c in self.comparisons)
+        else:
+            raise ValueError(what)
+        return hits / len(self.comparisons)
+
+    def mean_decision_s(self) -> float:
+        if not self.comparisons:
+            return math.nan
+        return sum(c.decision_s for c in self.comparisons) / len(self.comparisons)
+
+
+def node_rooms(graph: SceneGraph, node_id: str | None) -> frozenset[str]:
+    """The room(s) a node lies in: a room is its own, a door joins two."""
+    if node_id is None:
+        return frozenset()
+    n = graph.node(node_id)
+    if n is None:
+        return frozenset()
+    if isinstance(n, DoorNode):
+        return frozenset(n.rooms)
+    room = getattr(n, "room", None)
+    return frozenset([room]) if room else frozenset([n.id])
+
+
+def replay_decisions(planner: Any, episodes: Sequence[LoggedEpisode],
+                     name: str | None = None) -> OfflineReport:
+    """Ask ``planner`` at every logged decision point (module doc)."""
+    out: list[DecisionComparison] = []
+    skipped = 0
+    for ep in episodes:
+        extra = ep.episode.get("extra") or {}
+        query = ep.episode.get("query")
+        if not query:
+            skipped += len(ep.decisions)
+            continue
+        planner.reset(str(query), seed=int(extra.get("planner_seed", extra.get("seed", 0))))
+        for step, d in enumerate(ep.decisions):
+            logged = Action(str(d.action.get("skill", "")), d.action.get("target"))
+            if d.graph is not None:
+                t0 = time.perf_counter()
+                chosen = planner.decide(d.graph)
+                dt = time.perf_counter() - t0
+                valid = chosen.skill == "done" or chosen.target in d.graph.node_ids()
+                lr = node_rooms(d.graph, logged.target)
+                same_room = bool(lr & node_rooms(d.graph, chosen.target)) or (
+                    chosen.skill == logged.skill == "done")
+                out.append(DecisionComparison(
+                    ep.source, ep.index, step, (logged.skill, logged.target),
+                    (chosen.skill, chosen.target), valid, same_room, dt))
+            else:
+                skipped += 1
+            planner.feedback(Feedback(
+                logged, d.action.get("outcome", "success"), str(d.action.get("reason", "")),
+                float(d.action.get("travelled_m", 0.0))))
+    return OfflineReport(name or getattr(planner, "name", "planner"), tuple(out), skipped)
+
+
+def format_offline(reports: Sequence[OfflineReport]) -> str:
+    from sgtool.analysis.report import pipe_table
+
+    def pct(x: float) -> str:
+        return "-" if math.isnan(x) else f"{100 * x:.1f}%"
+
+    rows = [[r.planner, str(r.decisions), pct(r.rate("agree")), pct(r.rate("target")),
+             pct(r.rate("room")), pct(r.rate("invalid")),
+             "-" if math.isnan(r.mean_decision_s()) else f"{r.mean_decision_s():.4f}",
+             str(r.skipped)]
+            for r in reports]
+    head = ["Planner", "Decisions", "Same action", "Same target", "Same room",
+            "Not in graph", "Decision time (s)", "Skipped"]
+    return ("Planners against the logged decisions (teacher-forced: each is told what was "
+            "really done)\n" + pipe_table(head, rows) + "\n")

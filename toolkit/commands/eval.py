@@ -1,0 +1,95 @@
+"""``sgtool eval``: metrics from recorded episodes; planners evaluated against logged decisions."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict
+from typing import Any
+
+import click
+
+
+@click.command("eval")
+@click.argument("inputs", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.option("-p", "--planner", "planners", multiple=True, metavar="NAME[,NAME]",
+              help="Also ask these planners at every logged decision point (MCAP logs with "
+                   "scene graphs) and compare their choices with what was done (repeatable "
+                   "or comma-separated).")
+@click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
+              help="Planner option, e.g. scout.delta=0.2 (repeatable).")
+@click.option("--llm-replay", type=click.Path(dir_okay=False), default=None,
+              help="moma-llm: answer from this JSONL transcript instead of an endpoint.")
+@click.option("--distance-budget", default=5000.0, show_default=True,
+              help="AUC-E distance variant budget max (low-level steps: 0.1 m = 1, open = 30).")
+@click.option("--step-budget", default=50.0, show_default=True,
+              help="AUC-E step variant budget max (high-level steps).")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of tables.")
+@click.option("-o", "--out", type=click.Path(dir_okay=False), default=None,
+              help="Also write the output to this file (JSON if it ends in .json).")
+def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: tuple[str, ...],
+            llm_replay: str | None, distance_budget: float, step_budget: float, as_json: bool,
+            out: str | None) -> None:
+    """Recompute the benchmark metrics (SR, SPL, steps, decision time, AUC-E with both
+    budgets, seen/unseen) from recorded episodes: MCAP logs of closed-loop runs (their
+    sgtool.Episode and sgtool.Action records) and/or episodes.jsonl files written by
+    `sgtool bench`. With --planner, replay every logged decision point of the MCAP logs:
+    the planner decides on the logged scene graph, its choice is compared with the logged
+    action, and it is then told what was really done."""
+    from sgtool.analysis.metrics import cost_models, seen_unseen, summarize
+    from sgtool.analysis.offline import format_offline, load_results, replay_decisions
+    from sgtool.analysis.records import write_text_atomic
+    from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
+    from sgtool.commands.bench import OptionError, _planner_options
+    from sgtool.planning.registry import make_planner
+
+    results, logged = load_results(inputs)
+    if not results:
+        raise OptionError("no episodes found in " + ", ".join(inputs))
+    models = cost_models(distance_budget, step_budget)
+    sums = summarize(results, models)
+    names = [n.strip() for item in planners for n in item.split(",") if n.strip()]
+    options = _planner_options(planner_option)
+    if llm_replay:
+        options.setdefault("moma-llm", {})["replay"] = llm_replay
+    if names and not any(d.graph is not None for e in logged for d in e.decisions):
+        raise OptionError("--planner needs MCAP logs with sgtool.SceneGraph records; "
+                          "the inputs have none")
+    reports = [replay_decisions(make_planner(n, **options.get(n, {})), logged, name=n)
+               for n in names]
+    if as_json or (out and out.endswith(".json")):
+        doc: dict[str, Any] = {
+            "episodes": len(results),
+            "budgets": {m.name: {"max": m.max_cost, "cost": m.label} for m in models},
+            "planners": summary_dict(sums),
+            "seen_unseen": [asdict(s) for s in seen_unseen(results)],
+            "offline": {r.planner: {"decisions": r.decisions, "same_action": r.rate("agree"),
+                                    "same_target": r.rate("target"),
+                                    "same_room": r.rate("room"),
+                                    "not_in_graph": r.rate("invalid"), "skipped": r.skipped,
+                                    "decision_s": r.mean_decision_s()}
+                        for r in reports},
+        }
+        text = json.dumps(_clean(doc), indent=1, sort_keys=True, allow_nan=False) + "\n"
+    else:
+        parts = [format_table(sums, models=models,
+                              title=f"Metrics recomputed from {len(results)} episode(s) in "
+                                    f"{len(inputs)} file(s)")]
+        if any(r.seen is not None for r in results):
+            parts.append(format_seen_unseen(seen_unseen(results), title="Seen vs unseen queries"))
+        if reports:
+            parts.append(format_offline(reports))
+        text = "\n".join(parts)
+    if out:
+        write_text_atomic(out, text)
+    click.echo(text, nl=False)
+
+
+def _clean(x: Any) -> Any:
+    if isinstance(x, float):
+        return None if math.isnan(x) else x
+    if isinstance(x, dict):
+        return {k: _clean(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_clean(v) for v in x]
+    return x
