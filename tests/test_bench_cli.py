@@ -92,3 +92,50 @@ def test_cli_option_errors(tmp_path, args, message):
 def test_config_check_rejects_duplicates():
     with pytest.raises(BenchError, match="named twice"):
         BenchConfig(planners=("random", "random")).check()
+
+
+class ScriptedLlm:
+    """A stand-in chat model: reads MoMa-LLM's scene text and explores the first unexplored
+    room, then the first room with an unexplored area, then opens the first closed thing."""
+
+    model = "scripted"
+
+    def complete(self, messages):
+        import re
+
+        from sgtool.llm.client import ChatResult
+
+        user = messages[-1]["content"]
+        m = re.search(r"Unexplored rooms seen through doors: ([^(,]+?) \(", user)
+        cmd = "done()"
+        if m:
+            cmd = f"explore({m.group(1)})"
+        else:
+            for room, objs in re.findall(r"^- ([^:]+): \[(.*)\]$", user, re.M):
+                if "unexplored area" in objs:
+                    cmd = f"explore({room})"
+                    break
+                closed = re.search(r"closed ([^,\]]+)", objs)
+                if closed:
+                    cmd = f"go_to_and_open({room}, {closed.group(1)})"
+                    break
+        return ChatResult(text=f"Analysis: a\nReasoning: b\nCommand: {cmd}", model=self.model,
+                          latency_s=0.0)
+
+
+def test_moma_llm_transcript_then_replay(tmp_path):
+    """moma-llm runs in the bench; its transcript replays to the same episodes offline."""
+    transcript = tmp_path / "moma.jsonl"
+    cfg = BenchConfig(planners=("moma-llm",), houses=1, episodes=2, seeds=1,
+                      planner_options={"moma-llm": {"client": ScriptedLlm(),
+                                                    "transcript": str(transcript)}})
+    live = run_benchmark(cfg)
+    assert transcript.stat().st_size > 0
+    assert all(r.n_invalid == 0 for r in live.results)
+    assert sum(r.steps for r in live.results) >= 4
+    r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
+                                 "--episodes", "2", "--seeds", "1", "--no-progress",
+                                 "--llm-replay", str(transcript), "-o", str(tmp_path / "o")])
+    assert r.exit_code == 0, r.output
+    replayed = read_jsonl(tmp_path / "o" / "episodes.jsonl")
+    assert results_digest(replayed) == live.digest

@@ -67,8 +67,10 @@ def _planner_options(items: tuple[str, ...]) -> dict[str, dict[str, Any]]:
               type=click.Path(file_okay=False),
               help="Output folder: episodes.jsonl, summary.md, summary.json, "
                    "efficiency_distance.png, efficiency_steps.png.")
-@click.option("--rooms", default="4-12", show_default=True, metavar="MIN-MAX",
-              help="Room count range of the generated houses (corridors included, 4..16).")
+@click.option("--rooms", default="12-16", show_default=True, metavar="MIN-MAX",
+              help="Room count range of the generated houses (corridors included, 4..16); "
+                   "the default gives about as many first-level objects per house as "
+                   "SymSearch's scenes.")
 @click.option("--house-seed", default=0, show_default=True, help="Seed of the first house.")
 @click.option("--max-steps", default=50, show_default=True,
               help="High-level actions per episode (SymSearch's N_max).")
