@@ -73,6 +73,7 @@ class BenchConfig:
     distance_budget: float = 5000.0  # MoMa-LLM low-level budget (0.1 m steps + 30 per open)
     step_budget: float = 50.0  # MoMa-LLM high-level budget
     planner_options: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    log_dir: str | None = None  # also record every episode as an MCAP log here
 
     def check(self) -> None:
         from sgtool.planning.registry import PLANNER_NAMES
@@ -113,6 +114,7 @@ class BenchConfig:
         d["planner_options"] = {k: {kk: str(vv) for kk, vv in v.items()}
                                 for k, v in sorted(self.planner_options.items())}
         d.pop("workers")  # does not change the results
+        d.pop("log_dir")
         return d
 
 
@@ -182,12 +184,18 @@ def _task(args: tuple[BenchConfig, int, str]) -> list[EpisodeResult]:
     out = []
     for seed in range(cfg.seeds):
         for i, ep in enumerate(episodes):
-            out.append(run_episode(
-                house, planner, ep.query, ep.targets, seed=seed, episode_index=i,
-                avoid_rooms=ep.target_rooms, max_steps=cfg.max_steps,
-                seen=category_text(ep.query) not in unseen, house_id=f"house-{house_seed}",
-                planner_name=name,
-            ))
+            kw = dict(seed=seed, episode_index=i, avoid_rooms=ep.target_rooms,
+                      max_steps=cfg.max_steps, seen=category_text(ep.query) not in unseen,
+                      house_id=f"house-{house_seed}", planner_name=name)
+            if cfg.log_dir is None:
+                out.append(run_episode(house, planner, ep.query, ep.targets, **kw))
+                continue
+            from sgtool.log.writer import LogWriter
+
+            path = Path(cfg.log_dir) / name / f"house-{house_seed}" / f"seed{seed}-ep{i}.mcap"
+            path.parent.mkdir(parents=True, exist_ok=True)
+            with LogWriter(path, seed=seed) as log:
+                out.append(run_episode(house, planner, ep.query, ep.targets, log=log, **kw))
     return out
 
 

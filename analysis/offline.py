@@ -134,12 +134,24 @@ def load_results(paths: Iterable[str | os.PathLike[str]]) -> tuple[list[EpisodeR
         if head == b"\x89MCAP0\r\n":
             eps = read_log_episodes(p)
             logged.extend(eps)
-            results.extend(e.result() for e in eps)
+            results.extend(_with_seen(e.result()) for e in eps)
         elif p.suffix in (".jsonl", ".json") or head[:1] == b"{":
             results.extend(read_jsonl(p))
         else:
             raise EvalInputError(f"{p}: neither an MCAP log nor an episode JSONL file")
     return results, logged
+
+
+def _with_seen(r: EpisodeResult) -> EpisodeResult:
+    """A log that does not say whether its query is seen: decide it from the split (the
+    query is unseen when it is one of :func:`sgtool.datasets.split.unseen_queries`)."""
+    if r.seen is not None or not r.query:
+        return r
+    from sgtool.datasets.split import unseen_queries
+    from sgtool.semantics.text import category_text
+
+    unseen = {category_text(q) for q in unseen_queries()}
+    return _replace(r, seen=category_text(r.query) not in unseen)
 
 
 # ----------------------------------------------------------------------------------------

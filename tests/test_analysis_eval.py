@@ -124,3 +124,33 @@ def test_eval_cli_on_logs_and_bench_output(tmp_path, greedy_log):
     assert json.loads((tmp_path / "e.json").read_text()) == got
     r = runner.invoke(cli, ["eval", str(tmp_path / "b" / "episodes.jsonl"), "-p", "greedy"])
     assert r.exit_code == 2 and "needs MCAP logs" in r.output
+
+
+def test_bench_logs_round_trip_through_eval(tmp_path):
+    """Episodes recorded by `sgtool bench --log-dir` give back the bench's own records."""
+    cfg = BenchConfig(planners=("greedy",), houses=1, episodes=2, seeds=1, rooms=(5, 6),
+                      log_dir=str(tmp_path / "logs"))
+    bench = run_benchmark(cfg)
+    logs = sorted((tmp_path / "logs").rglob("*.mcap"))
+    assert len(logs) == 2
+    results, logged = load_results(logs)
+    assert [(r.query, r.success, r.steps, r.n_open, r.end, r.seen) for r in results] == \
+        [(r.query, r.success, r.steps, r.n_open, r.end, r.seen) for r in bench.results]
+    assert [r.travelled_m for r in results] == pytest.approx(
+        [r.travelled_m for r in bench.results], abs=1e-3)
+    rep = replay_decisions(make_planner("greedy"), logged)
+    assert rep.decisions == sum(r.steps for r in bench.results) and rep.rate("agree") == 1.0
+
+
+def test_seen_is_filled_from_the_split_when_a_log_lacks_it(tmp_path):
+    from sgtool.datasets.split import unseen_queries
+
+    unseen = unseen_queries()[0]
+    path = tmp_path / "q.mcap"
+    with LogWriter(path) as log:
+        for t, q in enumerate(("cup", unseen)):
+            log.write_record("episode", 2 * t, {"kind": "search", "status": "started",
+                                                "query": q})
+            log.write_record("episode", 2 * t + 1, {"kind": "search", "status": "failure"})
+    results, _ = load_results([path])
+    assert [r.seen for r in results] == [True, False]

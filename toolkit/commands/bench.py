@@ -87,12 +87,16 @@ def _planner_options(items: tuple[str, ...]) -> dict[str, dict[str, Any]]:
 @click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
               help="Extra planner option, e.g. scout.delta=0.2 or moma-llm.model=gpt-4o-mini "
                    "(repeatable; see sgtool.planning.registry).")
+@click.option("--log-dir", type=click.Path(file_okay=False), default=None,
+              help="Also record every episode as an MCAP log (scene graph and action per "
+                   "step) under LOG_DIR/PLANNER/HOUSE/, readable by `sgtool eval`.")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
 def command(planners: str | None, houses: int, episodes: int, seeds: int, workers: int,
             out_dir: str, rooms: str, house_seed: int, max_steps: int, distance_budget: float,
             step_budget: float, llm_replay: str | None, llm_transcript: str | None,
-            planner_option: tuple[str, ...], progress: bool | None) -> None:
+            planner_option: tuple[str, ...], log_dir: str | None,
+            progress: bool | None) -> None:
     """Run the symbolic object-search benchmark (SCOUT's SymSearch roll-out) on generated
     evaluation houses and print a table in the shape of SCOUT's Table VII: success rate,
     SPL, high-level steps, decision time, and MoMa-LLM's AUC-E with a distance-plus-open
@@ -113,7 +117,7 @@ def command(planners: str | None, houses: int, episodes: int, seeds: int, worker
     cfg = BenchConfig(planners=names, houses=houses, episodes=episodes, seeds=seeds,
                       rooms=_rooms(rooms), house_seed=house_seed, max_steps=max_steps,
                       workers=workers, distance_budget=distance_budget,
-                      step_budget=step_budget, planner_options=options)
+                      step_budget=step_budget, planner_options=options, log_dir=log_dir)
     res = run_benchmark(cfg, progress=progress)
     paths = write_outputs(res, out_dir, command=shlex.join(["sgtool", *sys.argv[1:]]))
     click.echo(res.table)
