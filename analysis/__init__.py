@@ -1,0 +1,15 @@
+"""Metrics, reports and exports of object-search runs.
+
+Modules (import them directly; this package imports nothing on its own):
+
+- :mod:`sgtool.analysis.records`: the per-episode record (:class:`EpisodeResult`), its JSONL
+  file, the digest without wall-clock figures, the mapping from log records;
+- :mod:`sgtool.analysis.metrics`: SR, SPL, steps, decision time, MoMa-LLM's AUC-E (distance
+  plus open cost, and step budget), mean ± std over seeds, seen/unseen breakdown;
+- :mod:`sgtool.analysis.report`: tables in the shape of SCOUT's Tables VII and IX;
+- :mod:`sgtool.analysis.curves`: efficiency curves as PNG;
+- :mod:`sgtool.analysis.bench`: the symbolic benchmark run (``sgtool bench``, ``run_bench``);
+- :mod:`sgtool.analysis.offline`: metrics from logs and planners against logged decisions
+  (``sgtool eval``);
+- :mod:`sgtool.analysis.rerun_view`: Rerun export of logs.
+"""
