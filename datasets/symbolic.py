@@ -266,10 +266,11 @@ class SymbolicHouse:
         raster = room_raster(self.spec, self.occ)
         free = ~self.occ.blocked
         self._snap: list[tuple[tuple[slice, slice], np.ndarray, np.ndarray] | None] = []
-        eight = np.ones((3, 3), bool)
         for ri in range(len(self.spec.rooms)):
             mask = free & (raster == ri)
-            lab, n = ndimage.label(mask, structure=eight)
+            # 4-connected: paths may not cut corners, so cells touching only diagonally
+            # are not connected for the robot
+            lab, n = ndimage.label(mask)
             if n == 0:
                 self._snap.append(None)
                 continue

@@ -260,3 +260,14 @@ def test_registry_planners_run_without_invalid_actions(house, name):
         assert r.n_invalid == 0
         # the house is small: every planner that explores exhaustively finds it
         assert r.success, (name, query, r.trace)
+
+
+@pytest.mark.parametrize("seed, rooms", [(12, (4, 12)), (25, (12, 16))])
+def test_every_place_of_generated_houses_is_reachable(seed, rooms):
+    """Regression: places snapped into a pocket joined to the room only diagonally (the
+    robot may not cut corners) were unreachable in these two houses."""
+    from sgtool.datasets.generator import generate_house
+
+    h = SymbolicHouse(generate_house(seed, rooms=rooms))
+    d = h.distances_from(h.regions[0].place, h.all_doors())
+    assert np.isfinite(d).all()
