@@ -39,6 +39,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from sgtool import __version__
 from sgtool.analysis.metrics import CostModel, cost_models, seen_unseen, summarize
 from sgtool.analysis.records import EpisodeResult, results_digest, write_jsonl, write_text_atomic
 from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
@@ -258,6 +259,21 @@ def run_benchmark(cfg: BenchConfig, progress: bool | None = None) -> BenchResult
                        results_digest(results), wall)
 
 
+def priors_fingerprint() -> str:
+    """SHA-256 (first 16 hex digits) of the shipped relational-prior weights the sbert/scout
+    planners load, so a table can be traced to the priors that produced it."""
+    import hashlib
+
+    from sgtool.semantics.priors import WEIGHTS_DIR
+
+    h = hashlib.sha256()
+    for p in sorted(Path(WEIGHTS_DIR).glob("*")):
+        if p.is_file():
+            h.update(p.name.encode())
+            h.update(p.read_bytes())
+    return h.hexdigest()[:16]
+
+
 def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
                   command: str = "") -> list[Path]:
     """episodes.jsonl, summary.md, summary.json and the two efficiency PNGs."""
@@ -273,7 +289,8 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
     md = [res.table, res.seen_table,
           f"Episodes per second: one core, episode roll-outs only (house preparation "
           f"excluded); whole run {res.wall_s:.1f} s with {cfg.workers} worker(s).",
-          f"Digest of episodes.jsonl without wall-clock fields: {res.digest}"]
+          f"Digest of episodes.jsonl without wall-clock fields: {res.digest}",
+          f"sgtool {__version__}; relational priors {priors_fingerprint()}"]
     if command:
         md.append(f"Command: `{command}`")
     paths.append(write_text_atomic(out / "summary.md", "\n".join(md) + "\n"))
@@ -284,6 +301,8 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
         "planners": summary_dict(summarize(res.results, cfg.models(), cfg.planners)),
         "seen_unseen": [asdict(s) for s in seen_unseen(res.results, cfg.planners)],
         "digest": res.digest,
+        "sgtool_version": __version__,
+        "priors_sha256_16": priors_fingerprint(),
         "wall": {"seconds": round(res.wall_s, 3), "workers": cfg.workers,
                  "episodes_per_s": {k: round(v, 3) for k, v in res.throughput.items()}},
     }
