@@ -268,7 +268,7 @@ def priors_fingerprint() -> str:
 
     h = hashlib.sha256()
     for p in sorted(Path(WEIGHTS_DIR).glob("*")):
-        if p.is_file():
+        if p.is_file() and (p.suffix == ".safetensors" or p.name == "metadata.json"):
             h.update(p.name.encode())
             h.update(p.read_bytes())
     return h.hexdigest()[:16]
