@@ -17,7 +17,8 @@ def room_of(graph, node_id: str) -> str | None:
     return getattr(n, "room", None)
 
 
-@pytest.mark.parametrize("query,room", [("frying pan", "room:1"), ("toothbrush", "room:2")])
+@pytest.mark.parametrize("query,room", [("frying pan", "room:1"), ("razor", "room:2"),
+                                        ("remote control", "room:3")])
 def test_scout_goes_where_a_person_would(query: str, room: str) -> None:
     g = house()
     p = make_planner("scout", encoder=encoder())

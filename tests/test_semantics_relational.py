@@ -97,7 +97,7 @@ def test_training_sets_are_deterministic_and_from_training_only() -> None:
         assert not unseen & set(rs.nodes)
     # sizes of the order of SCOUT's (92K / 7.5K from an LLM): thousands of pairs each
     assert len(a.containment) > 3000 and len(a.cooccurrence) > 3000
-    assert 0.2 < a.containment.positives / len(a.containment) < 0.6
+    assert 0.05 < a.containment.positives / len(a.containment) < 0.3  # 8 zeros per positive
     assert a.cooccurrence.positives * 2 == len(a.cooccurrence)  # balanced
     assert {"kitchen", "bathroom", "bedroom", "living_room"} <= set(a.room_types)
 

@@ -34,20 +34,27 @@ def _weights_dir() -> Path:
               help="Folder for the trained weights [default: the weights shipped in the "
                    "package, sgtool/semantics/weights].")
 @click.option("--report", "report_only", is_flag=True,
-              help="Do not train: print the held-out quality report (ROC-AUC of the learned "
-                   "scores vs raw SBERT cosine) of the weights in --weights.")
+              help="Do not train: print the quality report of the weights in --weights: on "
+                   "query categories held out of training, ROC-AUC of the learned scores vs "
+                   "raw SBERT cosine similarity, for containment and co-occurrence.")
 @click.option("--weights", "weights_dir", type=click.Path(file_okay=False, exists=True,
                                                           path_type=Path),
               default=None, help="Weights to report on [default: the shipped ones].")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
 @click.option("--seed", type=int, default=0, show_default=True,
               help="Seed of negative sampling, held-out choice, initialisation, shuffling.")
-@click.option("--holdout", type=click.FloatRange(0.0, 0.9), default=0.15, show_default=True,
-              help="Share of query categories held out of training for the report.")
-@click.option("--epochs-containment", type=click.IntRange(1, 1000), default=20,
+@click.option("--holdout", type=click.FloatRange(0.0, 0.9), default=0.0, show_default=True,
+              help="Share of training query categories held out of training, reported as "
+                   "a second group (the main report group is always the categories unseen "
+                   "in training, from the evaluation part).")
+@click.option("--epochs-containment", type=click.IntRange(1, 1000), default=30,
               show_default=True, help="Epochs of the containment model (MSE).")
-@click.option("--epochs-cooccurrence", type=click.IntRange(1, 1000), default=15,
+@click.option("--epochs-cooccurrence", type=click.IntRange(1, 1000), default=5,
               show_default=True, help="Epochs of the co-occurrence model (BCE).")
+@click.option("--keep", type=click.Choice(["last", "best"]), default="last",
+              show_default=True,
+              help="Keep the final weights, or those of the epoch with the lowest "
+                   "validation loss.")
 @click.option("--threads", type=click.IntRange(1, 64), default=1, show_default=True,
               help="Torch CPU threads (1 keeps the weights bit-identical across machines "
                    "with the same libraries).")
@@ -68,7 +75,7 @@ def _weights_dir() -> Path:
               help="Label at most this many generated objects (cost cap).")
 def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, as_json: bool,
             seed: int, holdout: float, epochs_containment: int, epochs_cooccurrence: int,
-            threads: int, source: str, llm_base_url: str | None, llm_model: str | None,
+            keep: str, threads: int, source: str, llm_base_url: str | None, llm_model: str | None,
             llm_api_key: str | None, llm_cache: Path | None, llm_runs: int,
             llm_max_queries: int | None) -> None:
     """Train the containment and co-occurrence MLPs (SCOUT sec. IV-C) or report on them.
@@ -88,7 +95,7 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
         return
 
     cfg = DistillConfig(seed=seed, holdout=holdout, epochs_containment=epochs_containment,
-                        epochs_cooccurrence=epochs_cooccurrence, threads=threads)
+                        epochs_cooccurrence=epochs_cooccurrence, keep=keep, threads=threads)
     sets = None
     room_types = None
     fingerprint = None
@@ -105,15 +112,14 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
             os.replace(tmp / name, target / name)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    rep = {"heldout_queries": len(meta["heldout_queries"]),
-           **{r: meta["models"][r]["heldout"] for r in ("containment", "cooccurrence")}}
+    rep = meta["report"]
     if as_json:
         click.echo(json.dumps(meta, indent=1, sort_keys=True))
     else:
         for rel in ("containment", "cooccurrence"):
             m = meta["models"][rel]
             click.echo(f"{rel}: {m['data']['pairs']} pairs ({m['data']['positives']} positive), "
-                       f"{m['data']['queries']} queries, best epoch {m['best_epoch']}, "
+                       f"{m['data']['queries']} queries, kept epoch {m['best_epoch']}, "
                        f"val loss {m['history'][m['best_epoch'] - 1]['val_loss']:.4f}")
         click.echo(format_report(rep))
         click.echo(f"wrote {target}")

@@ -4,15 +4,20 @@ Pipeline (SCOUT sec. IV-C and VI-A, with the offline knowledge source in place o
 
 1. the relational sets D_contain and D_co-occur (Eqs. 6-7) from the *training* split of the
    household knowledge only (:mod:`sgtool.datasets.relational`);
-2. a deterministic share of query categories is held out of training (for the report);
+2. optionally (``holdout > 0``) a deterministic share of the training query categories is
+   held out of training, for a second report group;
 3. every distinct text is encoded once with the frozen encoder E (Eq. 8);
 4. the two MLPs are trained (:mod:`sgtool.semantics.training`), containment with MSE and
    co-occurrence with BCE;
 5. the weights are written as safetensors (never pickle) next to ``metadata.json``: data
    sizes, seed, hyper-parameters, losses, the split's fingerprint, the held-out queries,
    room types, and the quality report;
-6. the report (SCOUT Fig. 7 as numbers): on the held-out queries, ROC-AUC of the learned
-   score and of raw SBERT cosine similarity for containment and co-occurrence.
+6. the report (SCOUT Fig. 7 as numbers): on query categories held out of training, ROC-AUC
+   of the learned score and of raw SBERT cosine similarity for containment and
+   co-occurrence. The main group is the unseen categories: objects of the *evaluation*
+   part that no training record mentions (their pairs come from the evaluation part,
+   which is only read for this report, never trained on), so the shipped models use every
+   training query and are still judged on categories they never saw.
 
 Everything is a function of the knowledge and the seed; no wall-clock enters the outputs,
 so two runs write byte-identical files.
@@ -33,18 +38,20 @@ from sgtool.semantics.metrics import separation_summary
 from sgtool.semantics.mlp import load_mlp, save_mlp
 from sgtool.semantics.priors import CONTAINMENT_FILE, COOCCURRENCE_FILE, METADATA_FILE
 
-METADATA_VERSION = 1
+METADATA_VERSION = 2
+FILES = {"containment": CONTAINMENT_FILE, "cooccurrence": COOCCURRENCE_FILE}
 
 
 @dataclass(frozen=True)
 class DistillConfig:
     seed: int = 0
-    holdout: float = 0.15  # share of query categories held out of training for the report
-    epochs_containment: int = 20
-    epochs_cooccurrence: int = 15
+    holdout: float = 0.0  # share of training queries held out of training (report only)
+    epochs_containment: int = 30
+    epochs_cooccurrence: int = 5
     batch_size: int = 256
     lr: float = 1e-3
     weight_decay: float = 0.0
+    keep: str = "last"  # which epoch's weights: "last" or "best" validation loss
     val_fraction: float = 0.1
     threads: int = 1
 
@@ -81,29 +88,35 @@ def distill(
     room_types: tuple[str, ...] | None = None,
     encoder: SentenceEncoder | None = None,
     progress: bool = False,
+    eval_sets: tuple[Any, Any] | None = None,
 ) -> dict[str, Any]:
     """Train both models into ``out_dir`` and return the metadata written there.
 
     ``sets`` = (containment set, co-occurrence set); by default built from
-    ``sgtool.datasets.split.training_knowledge()``.
+    ``sgtool.datasets.split.training_knowledge()``, and then the report covers the unseen
+    query categories of the evaluation part (``eval_sets`` by default
+    :func:`sgtool.datasets.relational.evaluation_sets`). With ``cfg.holdout > 0`` a share of
+    the training queries is also held out of training and reported.
     """
     from sgtool.datasets.relational import holdout_queries
     from sgtool.semantics.training import TrainConfig, train_relation
 
     if sets is None:
-        from sgtool.datasets.relational import training_sets
+        from sgtool.datasets.relational import evaluation_sets, training_sets
 
         built = training_sets(seed=cfg.seed)
         sets = (built.containment, built.cooccurrence)
         split_fingerprint = split_fingerprint or built.split_fingerprint
         room_types = room_types or built.room_types
+        if eval_sets is None:
+            eval_sets = evaluation_sets(seed=cfg.seed)
     cont, cooc = sets
     encoder = encoder or default_encoder()
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
 
     all_queries = sorted(set(cont.queries) | set(cooc.queries))
-    held = holdout_queries(all_queries, cfg.holdout, cfg.seed)
+    held = holdout_queries(all_queries, cfg.holdout, cfg.seed) if cfg.holdout > 0 else set()
     train_q = set(all_queries) - held
 
     meta: dict[str, Any] = {
@@ -114,27 +127,29 @@ def distill(
         "room_types": sorted(room_types or cont.nodes),
         "heldout_queries": sorted(held),
         "models": {},
+        "report": {},
     }
-    files = {"containment": CONTAINMENT_FILE, "cooccurrence": COOCCURRENCE_FILE}
+    mlps = {}
     for rs, loss, epochs in ((cont, "mse", cfg.epochs_containment),
                              (cooc, "bce", cfg.epochs_cooccurrence)):
         node_emb, query_emb = _encode_set(encoder, rs)
         train = rs.subset_queries(train_q)
         tcfg = TrainConfig(epochs=epochs, batch_size=cfg.batch_size, lr=cfg.lr,
                            weight_decay=cfg.weight_decay, val_fraction=cfg.val_fraction,
-                           seed=cfg.seed, threads=cfg.threads)
+                           seed=cfg.seed, threads=cfg.threads, keep=cfg.keep)
         res = train_relation(rs.relation, node_emb, query_emb, train.pairs, train.targets,
-                             loss, tcfg, progress=progress)
-        path = out_dir / files[rs.relation]
+                             loss, tcfg, progress=progress,
+                             sample_weights=train.balanced_weights())
+        path = out_dir / FILES[rs.relation]
         save_mlp(path, res.weights, res.biases, {
             "relation": rs.relation, "encoder": encoder.model_id, "loss": loss,
             "seed": str(cfg.seed), "data_fingerprint": rs.fingerprint(),
         })
-        mlp = load_mlp(path, rs.relation)
+        mlps[rs.relation] = load_mlp(path, rs.relation)
         meta["models"][rs.relation] = {
-            "file": files[rs.relation],
+            "file": FILES[rs.relation],
             "loss": loss,
-            "parameters": mlp.n_parameters,
+            "parameters": mlps[rs.relation].n_parameters,
             "data": {
                 "pairs": len(rs), "positives": rs.positives, "nodes": len(rs.nodes),
                 "queries": len(rs.queries), "fingerprint": rs.fingerprint(),
@@ -144,10 +159,28 @@ def distill(
             "best_epoch": res.best_epoch,
             "history": [{k: (round(v, 6) if isinstance(v, float) else v) for k, v in h.items()}
                         for h in res.history],
-            "heldout": evaluate_set(rs.subset_queries(held), node_emb, query_emb, mlp),
         }
+    meta["report"] = _report(mlps, encoder, eval_sets, (cont, cooc), held)
     write_json_atomic(out_dir / METADATA_FILE, meta)
     return meta
+
+
+def _report(mlps: dict, encoder: SentenceEncoder, eval_sets, train_sets, held: set[str]
+            ) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    if eval_sets is not None:
+        names = {rs.queries[i] for rs in eval_sets for i in np.unique(rs.pairs[:, 1])}
+        group: dict[str, Any] = {"queries": len(names)}
+        for rs in eval_sets:
+            group[rs.relation] = evaluate_set(rs, *_encode_set(encoder, rs), mlps[rs.relation])
+        out["unseen"] = group
+    if held:
+        group = {"queries": len(held)}
+        for rs in train_sets:
+            group[rs.relation] = evaluate_set(rs.subset_queries(held), *_encode_set(encoder, rs),
+                                              mlps[rs.relation])
+        out["heldout"] = group
+    return out
 
 
 def write_json_atomic(path: Path, obj: Any) -> None:
@@ -160,47 +193,56 @@ def quality_report(
     weights_dir: str | Path,
     sets: tuple[Any, Any] | None = None,
     encoder: SentenceEncoder | None = None,
+    eval_sets: tuple[Any, Any] | None = None,
 ) -> dict[str, Any]:
-    """Recompute the held-out separation of the weights in ``weights_dir``.
+    """Recompute the report of the weights in ``weights_dir`` from the files themselves.
 
-    The held-out queries are read from the weights' metadata; the pairs are rebuilt from
-    the training knowledge (or ``sets``), so the report checks the shipped files, not a
-    number stored next to them.
+    Groups: ``unseen`` (evaluation-part categories absent from training; rebuilt unless
+    ``sets`` are given without ``eval_sets``) and ``heldout`` (training queries held out by
+    the metadata's list, rebuilt from the training knowledge or ``sets``).
     """
-    from sgtool.datasets.relational import training_sets
-
     weights_dir = Path(weights_dir)
     meta = json.loads((weights_dir / METADATA_FILE).read_text())
+    seed = int(meta["config"]["seed"])
     if sets is None:
-        built = training_sets(seed=int(meta["config"]["seed"]))
+        from sgtool.datasets.relational import evaluation_sets, training_sets
+
+        built = training_sets(seed=seed)
         sets = (built.containment, built.cooccurrence)
+        if eval_sets is None:
+            eval_sets = evaluation_sets(seed=seed)
     encoder = encoder or default_encoder()
-    held = set(meta["heldout_queries"])
-    out: dict[str, Any] = {"heldout_queries": len(held), "encoder": encoder.model_id}
-    files = {"containment": CONTAINMENT_FILE, "cooccurrence": COOCCURRENCE_FILE}
-    for rs in sets:
-        node_emb, query_emb = _encode_set(encoder, rs)
-        mlp = load_mlp(weights_dir / files[rs.relation], rs.relation)
-        out[rs.relation] = evaluate_set(rs.subset_queries(held), node_emb, query_emb, mlp)
-    return out
+    mlps = {rel: load_mlp(weights_dir / f, rel) for rel, f in FILES.items()}
+    rep = _report(mlps, encoder, eval_sets, sets, set(meta["heldout_queries"]))
+    rep["encoder"] = encoder.model_id
+    return rep
+
+
+GROUP_TITLES = {
+    "unseen": "query categories unseen in training (evaluation part)",
+    "heldout": "training query categories held out of training",
+}
 
 
 def format_report(report: dict[str, Any]) -> str:
-    """A small text table: relation, pairs, AUC learned vs cosine, mean scores."""
-    lines = [
-        f"held-out query categories: {report.get('heldout_queries')}",
-        f"{'relation':<13} {'pairs':>7} {'pos':>6} {'AUC learned':>12} {'AUC cosine':>11} "
-        f"{'mean+ / mean- learned':>22} {'mean+ / mean- cosine':>21}",
-    ]
-    for rel in ("containment", "cooccurrence"):
-        r = report.get(rel)
-        if not r or not r.get("pairs"):
-            lines.append(f"{rel:<13} {'0':>7}")
+    """Text table per group: relation, pairs, AUC learned vs cosine, mean scores."""
+    lines = []
+    for key, title in GROUP_TITLES.items():
+        group = report.get(key)
+        if not group:
             continue
-        lr, cs = r["learned"], r["cosine"]
+        lines.append(f"{title}: {group.get('queries')}")
         lines.append(
-            f"{rel:<13} {r['pairs']:>7} {lr['n_pos']:>6} {lr['auc']:>12.3f} {cs['auc']:>11.3f} "
-            f"{lr['mean_pos']:>10.3f} / {lr['mean_neg']:<9.3f} "
-            f"{cs['mean_pos']:>9.3f} / {cs['mean_neg']:<9.3f}"
-        )
-    return "\n".join(lines)
+            f"  {'relation':<13} {'pairs':>6} {'pos':>5} {'AUC learned':>12} {'AUC cosine':>11}"
+            f" {'mean+/- learned':>16} {'mean+/- cosine':>15}")
+        for rel in ("containment", "cooccurrence"):
+            r = group.get(rel)
+            if not r or not r.get("pairs"):
+                lines.append(f"  {rel:<13} {0:>6}")
+                continue
+            lr, cs = r["learned"], r["cosine"]
+            lines.append(
+                f"  {rel:<13} {r['pairs']:>6} {lr['n_pos']:>5} {lr['auc']:>12.3f} "
+                f"{cs['auc']:>11.3f} {lr['mean_pos']:>8.3f}/{lr['mean_neg']:<7.3f} "
+                f"{cs['mean_pos']:>7.3f}/{cs['mean_neg']:<7.3f}")
+    return "\n".join(lines) if lines else "no report groups"
