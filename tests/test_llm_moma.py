@@ -47,7 +47,7 @@ def test_valid_command_is_grounded_and_logged() -> None:
            "unexplored area]" in user
     assert "Rooms with space leading out: living room (far)." in user
     assert "Rooms with closed doors: living room." in user
-    assert "Unexplored rooms seen through doors: unexplored room 1 (far)." in user
+    assert "Unexplored rooms seen through doors: unexplored room 4 (far)." in user
     assert json.dumps(ex)  # a plain JSON-serialisable record
 
 
@@ -86,7 +86,7 @@ def test_nonexistent_room_is_fed_back_with_the_valid_rooms() -> None:
     assert (a.skill, a.target) == ("navigate", "obj:20")
     fb = srv.requests[1]["messages"][-1]["content"]
     assert "room 'garage' does not exist" in fb
-    assert "bathroom, kitchen, living room, unexplored room 1" in fb
+    assert "bathroom, kitchen, living room, unexplored room 4" in fb
 
 
 def test_wrong_object_and_early_done_are_invalid() -> None:
@@ -199,3 +199,59 @@ def test_no_endpoint_configured_is_a_user_error(monkeypatch) -> None:
         monkeypatch.delenv(var, raising=False)
     with pytest.raises(LlmConfigError, match="no LLM endpoint configured"):
         make_planner("moma-llm")
+
+
+def test_symbolic_episode_end_to_end_over_http() -> None:
+    """A whole SymSearch episode: the endpoint is a rule-following stand-in for an LLM
+    that reads the scene text it is sent (explore unexplored rooms, open closed doors, then
+    open or look at the first unvisited thing, done() once the target is in reach)."""
+    import re
+
+    from sgtool.datasets.episodes import list_episodes
+    from sgtool.datasets.generator import generate_house
+    from sgtool.datasets.symbolic import SymbolicHouse, run_episode
+
+    spec = generate_house(101, rooms=(6, 8), split="eval")
+    house_ = SymbolicHouse(spec)
+    ep = list_episodes(spec, n=1, seed=3)[0]
+    tried: set[str] = set()
+
+    def llm(req: dict) -> dict:
+        user = req["messages"][1]["content"]
+        scene, _, history = user.partition("Previous actions:")
+        if re.search(rf"\b{re.escape(ep.query)}", scene.split("Observed rooms")[-1]):
+            return answer("done()")
+        revealed = {x.strip() for m in re.finditer(r"found ([^\n]*)", history)
+                    for x in m.group(1).split(",")}
+
+        def first_new(cmds, repeat: bool = False):
+            for cmd in cmds:
+                if repeat or cmd not in tried:
+                    tried.add(cmd)
+                    return answer(cmd)
+            return None
+
+        doors = re.search(r"Rooms with closed doors: (.*)\.", scene)
+        listing = re.findall(r"^- ([^:\n]+): \[([^\]]*)\]", scene, re.M)
+        items = [(room, re.sub(r"^\d+ ", "", it.strip())) for room, its in listing
+                 for it in its.split(",") if it.strip()]
+        return (first_new(f"explore({m})" for m in re.findall(r"(unexplored room \d+)", scene))
+                or first_new(f"go_to_and_open({re.sub(r' [(].*', '', r)}, door)"
+                             for r in (doors.group(1).split(", ") if doors else []))
+                or first_new(f"explore({room})" for room, it in items
+                             if it == "unexplored area")
+                # closed things stay listed as closed until opened: ask again freely
+                or first_new((f"go_to_and_open({room}, {it})" for room, it in items
+                              if it.startswith("closed ")), repeat=True)
+                or first_new(f"navigate({room}, {it})" for room, it in items
+                             if it != "unexplored area" and it.split()[-1].rstrip("s")
+                             not in {x.split()[-1] for x in revealed})
+                or answer("done()"))
+
+    with ChatServer(responder=llm) as srv:
+        p = planner(srv, stuck_repeats=0)
+        r = run_episode(house_, p, ep.query, list(ep.targets), seed=0, episode_index=0)
+        assert not srv.errors
+    assert r.success and r.n_invalid == 0, r.trace
+    assert len(p.exchanges) >= r.steps
+    assert all(e["step"] >= 1 for e in p.exchanges)

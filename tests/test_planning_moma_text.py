@@ -39,7 +39,7 @@ def test_room_names_number_duplicates_and_unknowns() -> None:
     rooms = (*g.rooms, RoomNode("room:5", "bathroom", (6.0, 6.0)), RoomNode("room:6", "unknown"))
     names = room_names(dataclasses.replace(g, rooms=rooms))
     assert names == {"room:1": "kitchen", "room:2": "bathroom 1", "room:3": "living room",
-                     "room:4": "unexplored room 1", "room:5": "bathroom 2", "room:6": "room 1"}
+                     "room:4": "unexplored room 4", "room:5": "bathroom 2", "room:6": "room 6"}
 
 
 def test_scene_text_of_the_test_house() -> None:
@@ -52,7 +52,7 @@ def test_scene_text_of_the_test_house() -> None:
         "unexplored area]",
         "- bathroom: [closed bottom cabinet, sink]",
         "- living room: [coffee table, sofa]",
-        "Unexplored rooms seen through doors: unexplored room 1 (far).",
+        "Unexplored rooms seen through doors: unexplored room 4 (far).",
         "Rooms with space leading out: living room (far).",
         "Rooms with closed doors: living room.",
     ]
@@ -97,7 +97,7 @@ def test_grounding_picks_matching_instances() -> None:
     assert act("navigate(kitchen, chairs)").target == "obj:13"  # nearest of the two
     assert act("go_to_and_open(the kitchen, closed fridge)").target == "obj:10"
     assert act("go_to_and_open(living room, door)").target == "door:1"
-    assert act("explore(unexplored room 1)").target == "room:4"
+    assert act("explore(unexplored room 4)").target == "room:4"
     assert act("explore(living room)").target == "frontier:2"
     assert act("explore(Kitchen)").target == "frontier:1"
     with pytest.raises(InvalidCommand, match="cannot be opened"):
@@ -107,7 +107,7 @@ def test_grounding_picks_matching_instances() -> None:
     with pytest.raises(InvalidCommand, match="no unexplored area"):
         act("explore(bathroom)")
     with pytest.raises(InvalidCommand, match="unexplored; explore"):
-        act("navigate(unexplored room 1, bed)")
+        act("navigate(unexplored room 4, bed)")
     opened = dataclasses.replace(g, objects=tuple(
         dataclasses.replace(o, state="open", explored=True) if o.id == "obj:10" else o
         for o in g.objects))

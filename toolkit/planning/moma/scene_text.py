@@ -13,8 +13,9 @@ What the model sees, per the paper and the reference notes:
 
 Room names are the room categories in plain words ("living room"); two rooms of one
 category are numbered in id order ("bedroom 1", "bedroom 2"); a room without a category is
-"room N". :class:`EncodedScene` keeps the maps from names back to node ids, so a command the
-model writes can be grounded in the graph it was shown.
+"room N" or "unexplored room N" with N its id number (stable while other rooms get
+explored). :class:`EncodedScene` keeps the maps from names back to node ids, so a command
+the model writes can be grounded in the graph it was shown.
 """
 
 from __future__ import annotations
@@ -102,7 +103,12 @@ def room_names(graph: SceneGraph) -> dict[str, str]:
     out: dict[str, str] = {}
     for r in rooms:
         b = base[r.id]
-        if counts[b] > 1 or b in ("room", "unexplored room"):
+        suffix = r.id.rpartition(":")[2]
+        if b in ("room", "unexplored room") and suffix.isdigit():
+            # rooms without a category keep their id number: "unexplored room 1" must not
+            # turn into another room when room 1 gets explored and the others move up
+            out[r.id] = f"{b} {int(suffix)}"
+        elif counts[b] > 1 or b in ("room", "unexplored room"):
             seen[b] += 1
             out[r.id] = f"{b} {seen[b]}"
         else:
