@@ -118,3 +118,30 @@ def test_parsing_helpers() -> None:
     assert extract_json('x {"k": 1} y') == {"k": 1}
     with pytest.raises(ValueError):
         extract_json("no json here")
+
+
+def test_cli_distills_from_an_llm_and_replays_from_the_cache(tmp_path, monkeypatch) -> None:
+    from click.testing import CliRunner
+
+    from sgtool.commands.distill import command
+    from sgtool.semantics.priors import LearnedPriors
+
+    for var in ("SGTOOL_LLM_BASE_URL", "OPENAI_BASE_URL", "SGTOOL_LLM_API_KEY",
+                "OPENAI_API_KEY"):
+        monkeypatch.delenv(var, raising=False)
+    cache, out = tmp_path / "cache", tmp_path / "w"
+    args = ["--source", "llm", "--llm-cache", str(cache), "--out", str(out),
+            "--epochs-containment", "2", "--epochs-cooccurrence", "2"]
+    with ChatServer(responder=household) as srv:
+        res = CliRunner().invoke(command, [*args, "--llm-base-url", srv.base_url,
+                                           "--llm-model", "m"])
+        assert res.exit_code == 0, res.output
+    meta = json.loads((out / "metadata.json").read_text())
+    assert meta["room_types"] == ["bathroom", "kitchen"]
+    assert meta["split_fingerprint"].startswith("llm:")
+    assert LearnedPriors(weights_dir=out).rooms(["kitchen"], "pot").shape == (1,)
+    first = (out / "containment.safetensors").read_bytes()
+    # no endpoint any more: the complete cache answers every prompt, same weights
+    res = CliRunner().invoke(command, args)
+    assert res.exit_code == 0, res.output
+    assert (out / "containment.safetensors").read_bytes() == first

@@ -1,0 +1,1 @@
+"""Chat models over OpenAI-compatible endpoints: client, exchange records, transcripts, replay."""

@@ -63,7 +63,9 @@ class LlmSettings:
     model: str
     api_key: str | None
     timeout_s: float = 60.0
-    temperature: float | None = 0.0
+    # None: not sent (the server's default). Reasoning models such as gpt-5-mini refuse any
+    # temperature but 1, so a fixed 0 would break them; pass 0 for local models.
+    temperature: float | None = None
     max_tokens: int | None = None
 
     @classmethod
@@ -73,7 +75,7 @@ class LlmSettings:
         model: str | None = None,
         api_key: str | None = None,
         timeout_s: float = 60.0,
-        temperature: float | None = 0.0,
+        temperature: float | None = None,
         max_tokens: int | None = None,
     ) -> LlmSettings:
         env = os.environ

@@ -1,0 +1,1 @@
+"""MoMa-LLM: structured scene text, command grounding, the planner loop."""
