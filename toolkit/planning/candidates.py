@@ -29,12 +29,13 @@ The query counts as found when an object whose category equals the query after
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 from sgtool.planning.base import Skill
 from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode, SceneGraph
-from sgtool.semantics.text import same_category
+from sgtool.semantics.text import category_text
 
 OPEN_AFFORDANCES = frozenset({"open", "openable"})
 EXAMINE_AFFORDANCES = frozenset({"explore", "examine", "search"})
@@ -51,6 +52,7 @@ class Candidate:
     position: tuple[float, float]
 
 
+@functools.lru_cache(maxsize=65536)
 def natural_key(node_id: str) -> tuple[str, tuple[tuple[int, int | str], ...]]:
     """Sort ids naturally: ``room:2`` before ``room:10``, ``region:3.1`` before ``region:3.12``."""
     prefix, _, rest = node_id.partition(":")
@@ -127,8 +129,9 @@ def actionable(graph: SceneGraph) -> list[Candidate]:
 def find_target(graph: SceneGraph, query: str) -> ObjectNode | None:
     """The nearest observed object of the query category (exact name match), or None."""
     best: tuple[float, str, ObjectNode] | None = None
+    want = category_text(query)
     for o in graph.objects:
-        if not same_category(o.category, query):
+        if category_text(o.category) != want:
             continue
         d = distance_to(graph, o)
         key = (d if d is not None else math.inf, o.id, o)

@@ -4,17 +4,20 @@ Category names arrive in several spellings: BEHAVIOR-1K synsets (``frying_pan.n.
 OmniGibson categories (``bottom_cabinet``), free text from a user (``Frying Pan``). The
 relational models are trained on one spelling and queried with another, so every path into
 the encoder goes through :func:`category_text`: lowercase, underscores and hyphens to spaces,
-the WordNet sense suffix dropped, whitespace collapsed. The function is pure and idempotent.
+the WordNet sense suffix dropped, whitespace collapsed. The function is pure and idempotent
+(and memoised: planners call it for every node at every decision).
 """
 
 from __future__ import annotations
 
+import functools
 import re
 
 _SENSE = re.compile(r"\.[a-z]\.\d+$")  # WordNet sense suffix: ".n.01"
 _SPACES = re.compile(r"\s+")
 
 
+@functools.lru_cache(maxsize=65536)
 def category_text(name: str) -> str:
     """``"Frying_Pan.n.01"`` -> ``"frying pan"``; ``"bottom-cabinet"`` -> ``"bottom cabinet"``."""
     s = name.strip().lower()
