@@ -308,7 +308,7 @@ def _index(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> _BagInde
         for c, bag_t, raw in reader.messages(connections=conns):
             bar.update(1)
             msg = reader.deserialize(raw, c.msgtype)
-            mt = B._normalise_type(c.msgtype)
+            mt = B.normalise_type(c.msgtype)
             if c.topic in tf_topics:
                 static = c.topic.rstrip("/").endswith("tf_static")
                 for tr in msg.transforms:
@@ -520,7 +520,7 @@ def _frames(
         targets = need[kind].get(kk)
         if targets is None:
             continue
-        mt = B._normalise_type(c.msgtype)
+        mt = B.normalise_type(c.msgtype)
         msg = reader.deserialize(raw, c.msgtype)
         if kind == "depth":
             raw_d, scale = decode_depth_message(msg, mt, c.topic)

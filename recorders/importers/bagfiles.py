@@ -40,7 +40,7 @@ class TopicInfo:
     count: int
 
 
-def _normalise_type(t: str) -> str:
+def normalise_type(t: str) -> str:
     """ROS 1 names types ``pkg/Type``; rosbags reports ``pkg/msg/Type``: accept both."""
     parts = t.split("/")
     return f"{parts[0]}/msg/{parts[1]}" if len(parts) == 2 else t
@@ -115,7 +115,7 @@ def list_topics(reader: Any) -> list[TopicInfo]:
     for c in reader.connections:
         prev = out.get(c.topic)
         n = int(c.msgcount) + (prev.count if prev else 0)
-        out[c.topic] = TopicInfo(c.topic, _normalise_type(c.msgtype), n)
+        out[c.topic] = TopicInfo(c.topic, normalise_type(c.msgtype), n)
     return [out[t] for t in sorted(out)]
 
 
