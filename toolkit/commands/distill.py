@@ -101,10 +101,14 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
     fingerprint = None
     if source == "llm":
         sets, room_types, fingerprint = _llm_sets(llm_base_url, llm_model, llm_api_key,
-                                                  llm_cache, llm_runs, llm_max_queries, seed)
+                                                  llm_cache, llm_runs, llm_max_queries)
     target = out_dir or _weights_dir()
-    target.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=".distill-", dir=target))
+    try:
+        target.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=".distill-", dir=target))
+    except OSError as e:
+        raise SgtoolError(f"cannot write weights to {target} ({e.strerror}); "
+                          "choose a folder with --out") from e
     try:
         meta = distill(tmp, cfg, sets=sets, split_fingerprint=fingerprint,
                        room_types=room_types, progress=sys.stderr.isatty())
@@ -125,7 +129,7 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
         click.echo(f"wrote {target}")
 
 
-def _llm_sets(base_url, model, api_key, cache, runs, max_queries, seed):
+def _llm_sets(base_url, model, api_key, cache, runs, max_queries):
     from sgtool.llm.client import LlmSettings, OpenAIChatClient
     from sgtool.semantics.cache import cache_root
     from sgtool.semantics.llm_knowledge import (
@@ -143,7 +147,7 @@ def _llm_sets(base_url, model, api_key, cache, runs, max_queries, seed):
         client = None  # a complete cache replays the generation offline
     asker = CachedAsker(client, cache)
     cont, cooc, rooms = generate_sets(
-        asker, GenerationConfig(runs=runs, max_queries=max_queries, seed=seed),
+        asker, GenerationConfig(runs=runs, max_queries=max_queries),
         progress=sys.stderr.isatty())
     st = asker.stats
     click.echo(f"LLM knowledge: {len(rooms)} rooms, {len(cont.queries)} objects labelled; "

@@ -190,7 +190,6 @@ class GenerationConfig:
     max_objects: int = 10  # per (room, category)
     max_queries: int | None = None  # label at most this many objects (sorted), None = all
     cooccurrence_per_label: int = 5  # asked-for positives and negatives per query
-    seed: int = 0
 
 
 def generate_sets(asker: CachedAsker, cfg: GenerationConfig = GenerationConfig(),
