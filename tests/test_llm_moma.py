@@ -78,15 +78,25 @@ def test_fault_then_retry(fault: dict, error_part: str | None) -> None:
 
 
 def test_nonexistent_room_is_fed_back_with_the_valid_rooms() -> None:
-    script = [answer("navigate(garage, toolbox)"), answer("navigate(bathroom, sink)")]
+    script = [answer("navigate(garage, toolbox)"), answer("navigate(bathroom, sink)"),
+              answer("explore(kitchen)")]
     with ChatServer(script) as srv:
         p = planner(srv)
         p.reset("toothbrush")
         a = p.decide(house())
-    assert (a.skill, a.target) == ("navigate", "obj:20")
-    fb = srv.requests[1]["messages"][-1]["content"]
-    assert "room 'garage' does not exist" in fb
-    assert "bathroom, kitchen, living room, unexplored room 4" in fb
+        assert (a.skill, a.target) == ("navigate", "obj:20")
+        fb = srv.requests[1]["messages"][-1]["content"]
+        assert "room 'garage' does not exist" in fb
+        assert "bathroom, kitchen, living room, unexplored room 4" in fb
+        p.feedback(Feedback(a, "success", "found towel"))
+        p.decide(house())
+    # the next decision's history keeps the rejected command (MoMa-LLM: invalid argument)
+    hist = srv.requests[2]["messages"][1]["content"].split("Previous actions:")[1]
+    assert hist.splitlines()[1:3] == [
+        "- navigate(garage, toolbox) - invalid argument: room 'garage' does not exist; "
+        "rooms are: bathroom, kitchen, living room, unexplored room 4",
+        "- navigate(bathroom, sink) - success: found towel",
+    ]
 
 
 def test_wrong_object_and_early_done_are_invalid() -> None:

@@ -20,9 +20,11 @@ Per decision (MoMa-LLM sec. III-C/D; reference notes):
    the episode (``done`` without target, reason "stuck: ...").
 
 The outcome of executed actions (:meth:`MomaLlmPlanner.feedback`) goes into the history as
-``success``, ``failure`` or ``invalid argument`` with the executor's message. Every request
-is logged as an ``sgtool.LlmExchange`` record: kept in :attr:`MomaLlmPlanner.exchanges`,
-passed to ``on_exchange`` and appended to ``transcript`` (JSONL, replayable).
+``success``, ``failure`` or ``invalid argument`` with the executor's message; commands the
+planner rejected stay in the history as written, with ``invalid argument`` and the reason.
+Every request is logged as an ``sgtool.LlmExchange`` record: kept in
+:attr:`MomaLlmPlanner.exchanges`, passed to ``on_exchange`` and appended to ``transcript``
+(JSONL, replayable).
 """
 
 from __future__ import annotations
@@ -73,6 +75,7 @@ class HistoryEntry:
     room_name: str  # as shown then (used only if nothing better is known now)
     outcome: str | None = None
     message: str = ""
+    text: str = ""  # a rejected command as the model wrote it (no node to realign)
 
 
 class MomaLlmPlanner:
@@ -111,8 +114,8 @@ class MomaLlmPlanner:
     def feedback(self, fb: Feedback) -> None:
         if not self.history or fb.action.skill == "done":
             return
-        last = self.history[-1]
-        if last.target == fb.action.target and last.outcome is None:
+        last = next((h for h in reversed(self.history) if not h.text), None)
+        if last is not None and last.target == fb.action.target and last.outcome is None:
             last.outcome = fb.outcome
             last.message = fb.message
 
@@ -138,11 +141,15 @@ class MomaLlmPlanner:
                 continue
             self._log(messages, result.text, result.latency_s, result.prompt_tokens,
                       result.completion_tokens, None, attempt, result.model, result.source)
+            cmd = None
             try:
                 cmd = parse_response(result.text)
                 action = ground(cmd, graph, scene, self.query)
             except InvalidCommand as e:
                 problems.append(str(e))
+                if cmd is not None:  # MoMa-LLM keeps "invalid argument" in the history
+                    self.history.append(HistoryEntry(cmd.name, None, None, "", "",
+                                                     "invalid", str(e), cmd.text()))
                 messages = [
                     *messages,
                     {"role": "assistant", "content": result.text},
@@ -200,6 +207,9 @@ class MomaLlmPlanner:
         out = []
         entries = self.history[-self.history_limit:] if self.history_limit > 0 else []
         for e in entries:
+            if e.text:
+                out.append(f"- {e.text} - invalid argument: {e.message}")
+                continue
             room = None
             if e.target is not None and graph.node(e.target) is not None:
                 room = room_of(graph, e.target)
