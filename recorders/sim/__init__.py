@@ -1,0 +1,60 @@
+"""The PyBullet house simulation and its recording (``sgtool record``).
+
+Modules, one job each:
+
+- :mod:`~sgtool.recorders.sim.camera`: camera config, mounting, OpenGL matrices, depth
+  from the depth buffer, instance ids from the segmentation mask (pure functions);
+- :mod:`~sgtool.recorders.sim.instances`: the instance table (ids in spec order);
+- :mod:`~sgtool.recorders.sim.articulation`: hinged door panels of doors and containers;
+- :mod:`~sgtool.recorders.sim.build`: the house as PyBullet bodies;
+- :mod:`~sgtool.recorders.sim.navigation`: occupancy in the current door states, goals,
+  smoothed A* paths, per-frame poses;
+- :mod:`~sgtool.recorders.sim.simulation`: :class:`Simulation` (render, skills, observers);
+- :mod:`~sgtool.recorders.sim.explore`: the scripted whole-house exploration;
+- :mod:`~sgtool.recorders.sim.noise`: seeded sensor faults;
+- :mod:`~sgtool.recorders.sim.recording`: :class:`LogRecorder` and :func:`record_house`.
+
+Importing this package does not import PyBullet; building a :class:`Simulation` does.
+"""
+
+from __future__ import annotations
+
+from sgtool.recorders.sim.camera import CameraConfig
+from sgtool.recorders.sim.explore import ExplorationReport, ScriptOptions, explore_house
+from sgtool.recorders.sim.instances import Instance, instance_table
+from sgtool.recorders.sim.navigation import RobotConfig
+from sgtool.recorders.sim.noise import PROFILES, NoiseProfile, SensorFaults, parse_noise
+from sgtool.recorders.sim.recording import (
+    LogRecorder,
+    RecordOptions,
+    RecordReport,
+    record_house,
+)
+from sgtool.recorders.sim.simulation import (
+    SimObserver,
+    Simulation,
+    SkillOutcome,
+    StopSimulation,
+)
+
+__all__ = [
+    "PROFILES",
+    "CameraConfig",
+    "ExplorationReport",
+    "Instance",
+    "LogRecorder",
+    "NoiseProfile",
+    "RecordOptions",
+    "RecordReport",
+    "RobotConfig",
+    "ScriptOptions",
+    "SensorFaults",
+    "SimObserver",
+    "Simulation",
+    "SkillOutcome",
+    "StopSimulation",
+    "explore_house",
+    "instance_table",
+    "parse_noise",
+    "record_house",
+]

@@ -1,0 +1,273 @@
+"""Where the robot may drive and how: occupancy in the current door states, goals near
+targets, smoothed A* paths and the per-frame poses that follow them (pure functions).
+
+Paths are planned on :func:`sgtool.datasets.occupancy.house_occupancy` (walls, furniture,
+closed doors, the outside, grown by the robot radius) with the house's *current* door
+states, plus the footprints of open door panels (house doors and container doors stick out
+into the room when open). A* runs on that grid (8-connected, no corner cutting); the
+cell path is shortened by string pulling (keep a waypoint only where the straight line to
+the next one would cross a blocked cell), and the base follows it like a differential
+drive: turn on the spot to face the next waypoint, then drive straight, in steps of at
+most ``speed / fps`` metres and ``turn_speed / fps`` radians per frame.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+from matplotlib.path import Path as MplPath
+from scipy import ndimage
+
+from sgtool.datasets.house import HouseSpec, Room
+from sgtool.datasets.occupancy import (
+    OccupancyMap,
+    cell_centers,
+    house_occupancy,
+    inflate,
+    world_to_cell,
+)
+from sgtool.errors import SgtoolError
+from sgtool.recorders.sim.articulation import Box2
+
+Pose2 = tuple[float, float, float]  # x, y, yaw
+
+
+@dataclass(frozen=True)
+class RobotConfig:
+    """The kinematic mobile base.
+
+    ``reach``: how far (m, from the base centre to the nearest point of an object's
+    footprint) the arm opens and closes things; the house generator guarantees a free
+    cell within ``reach - radius`` of every container. ``approach``: the distance range
+    (m, base centre to footprint) the robot stops at in front of a target, far enough for
+    the tilted camera to see low shelves, near enough to reach.
+    """
+
+    radius: float = 0.2
+    reach: float = 1.0
+    approach: tuple[float, float] = (0.55, 0.9)
+    speed: float = 0.5  # m/s
+    turn_speed: float = math.radians(90.0)  # rad/s
+    open_time: float = 1.0  # s to open or close a door
+    resolution: float = 0.05  # occupancy cell (m)
+
+    def __post_init__(self) -> None:
+        if self.speed <= 0 or self.turn_speed <= 0 or self.open_time <= 0:
+            raise SgtoolError("robot speed, turn speed and open time must be > 0")
+        if not 0 < self.approach[0] < self.approach[1] <= self.reach:
+            raise SgtoolError(f"robot approach range {self.approach}: need 0 < min < max "
+                              f"<= reach ({self.reach} m)")
+
+
+# ----------------------------------------------------------------------------------------
+# occupancy
+# ----------------------------------------------------------------------------------------
+def occupancy_with(spec: HouseSpec, door_states: Mapping[str, str], extra: Sequence[Box2],
+                   robot: RobotConfig, doors_passable: bool = False) -> OccupancyMap:
+    """The house's occupancy with doors in ``door_states`` (spec id -> open/closed) and the
+    ``extra`` footprints (open panels) marked occupied; ``doors_passable`` treats closed
+    doors as free (for "would it be reachable if the doors were open")."""
+    doors = tuple(replace(d, state=door_states.get(d.id, d.state)) for d in spec.doors)
+    base = house_occupancy(replace(spec, doors=doors), robot.resolution, robot.radius,
+                           closed_doors_free=doors_passable)
+    if not extra:
+        return base
+    occ = base.occupied.copy()
+    for b in extra:
+        rasterise_box(base, occ, b)
+    return OccupancyMap(occ, inflate(occ, robot.radius, robot.resolution), base.origin,
+                        base.resolution, robot.radius, doors_passable)
+
+
+def rasterise_box(grid: OccupancyMap, out: np.ndarray, box: Box2) -> None:
+    """Mark the cells of ``out`` (shaped like ``grid``) whose centre lies within the
+    oriented box grown by half a cell."""
+    x, y, sx, sy, yaw = box
+    c, s = math.cos(yaw), math.sin(yaw)
+    ex = abs(c) * sx / 2 + abs(s) * sy / 2 + grid.resolution
+    ey = abs(s) * sx / 2 + abs(c) * sy / 2 + grid.resolution
+    r0, c0 = world_to_cell(grid, x - ex, y - ey)
+    r1, c1 = world_to_cell(grid, x + ex, y + ey)
+    rows, cols = grid.shape
+    r0, c0, r1, c1 = max(r0, 0), max(c0, 0), min(r1 + 1, rows), min(c1 + 1, cols)
+    if r0 >= r1 or c0 >= c1:
+        return
+    xs = grid.origin[0] + (np.arange(c0, c1) + 0.5) * grid.resolution
+    ys = grid.origin[1] + (np.arange(r0, r1) + 0.5) * grid.resolution
+    X, Y = np.meshgrid(xs, ys)
+    dx, dy = X - x, Y - y
+    lx, ly = c * dx + s * dy, -s * dx + c * dy
+    h = grid.resolution / 2
+    out[r0:r1, c0:c1] |= (np.abs(lx) <= sx / 2 + h) & (np.abs(ly) <= sy / 2 + h)
+
+
+def box_distance_grid(grid: OccupancyMap, box: Box2) -> np.ndarray:
+    """Distance (m) from every cell centre to the oriented box (0 inside)."""
+    X, Y = cell_centers(grid)
+    x, y, sx, sy, yaw = box
+    c, s = math.cos(yaw), math.sin(yaw)
+    dx, dy = X - x, Y - y
+    lx, ly = c * dx + s * dy, -s * dx + c * dy
+    ex = np.maximum(np.abs(lx) - sx / 2, 0.0)
+    ey = np.maximum(np.abs(ly) - sy / 2, 0.0)
+    return np.hypot(ex, ey)
+
+
+# ----------------------------------------------------------------------------------------
+# goals
+# ----------------------------------------------------------------------------------------
+def approach_goal(grid: OccupancyMap, dist: np.ndarray, box: Box2, robot: RobotConfig,
+                  front: Box2 | None = None) -> tuple[float, float] | None:
+    """Where to stop to work on the object with footprint ``box``: a reachable free cell
+    (finite ``dist``, the geodesic distance from the robot) whose distance to the box is in
+    ``robot.approach``; when ``front`` (the box of the piece whose front matters) is given,
+    cells in front of it (local +y beyond its face) come first, scored by path length plus
+    the sideways offset from the front's centre line so the camera looks in square on.
+    Falls back to any reachable cell within reach. None when nothing qualifies."""
+    d = box_distance_grid(grid, box)
+    ok = np.isfinite(dist)
+    lo, hi = robot.approach
+    cand = ok & (d >= lo) & (d <= hi)
+    if not cand.any():
+        cand = ok & (d <= robot.reach - 1e-6)
+        if not cand.any():
+            return None
+    score = np.where(cand, dist, np.inf)
+    if front is not None:
+        X, Y = cell_centers(grid)
+        x, y, sx, sy, yaw = front
+        c, s = math.cos(yaw), math.sin(yaw)
+        lx = c * (X - x) + s * (Y - y)
+        ly = -s * (X - x) + c * (Y - y)
+        ahead = cand & (ly > sy / 2)
+        # square on first (within the middle of the front), then anywhere along it
+        for half in (max(sx / 2 - 0.15, 0.1), sx / 2 + 0.1):
+            in_front = ahead & (np.abs(lx) <= half)
+            if in_front.any():
+                score = np.where(in_front, dist + 2.0 * np.abs(lx), np.inf)
+                break
+    return _argmin_cell(grid, score)
+
+
+def room_mask(grid: OccupancyMap, room: Room) -> np.ndarray:
+    """Cells whose centre lies in the room's polygon."""
+    X, Y = cell_centers(grid)
+    path = MplPath(np.asarray(room.polygon, float))
+    pts = np.column_stack([X.ravel(), Y.ravel()])
+    return path.contains_points(pts).reshape(X.shape)
+
+
+def room_viewpoint(grid: OccupancyMap, dist: np.ndarray, room: Room,
+                   clearance: float = 0.5) -> tuple[float, float] | None:
+    """A reachable free cell in ``room`` to look around from: the one nearest the room's
+    centroid among those at least ``clearance`` m from any obstacle (any reachable cell of
+    the room when none is that clear). None when the room cannot be reached."""
+    inside = room_mask(grid, room) & np.isfinite(dist)
+    if not inside.any():
+        return None
+    clear = ndimage.distance_transform_edt(~grid.occupied) * grid.resolution
+    good = inside & (clear >= clearance)
+    if good.any():
+        inside = good
+    X, Y = cell_centers(grid)
+    cx, cy = room.centroid
+    return _argmin_cell(grid, np.where(inside, np.hypot(X - cx, Y - cy), np.inf))
+
+
+def _argmin_cell(grid: OccupancyMap, score: np.ndarray) -> tuple[float, float] | None:
+    flat = score.ravel()
+    if not np.isfinite(flat).any():
+        return None
+    i = int(np.argmin(flat))  # first minimum: lowest row, then column
+    r, c = divmod(i, grid.shape[1])
+    return (grid.origin[0] + (c + 0.5) * grid.resolution,
+            grid.origin[1] + (r + 0.5) * grid.resolution)
+
+
+# ----------------------------------------------------------------------------------------
+# paths
+# ----------------------------------------------------------------------------------------
+def line_is_free(grid: OccupancyMap, a: Sequence[float], b: Sequence[float]) -> bool:
+    """True when every sample (every quarter cell) of segment a-b lies in a free cell."""
+    n = max(2, int(math.ceil(math.dist(a, b) / (grid.resolution / 4))) + 1)
+    t = np.linspace(0.0, 1.0, n)
+    x = a[0] + (b[0] - a[0]) * t
+    y = a[1] + (b[1] - a[1]) * t
+    col = np.floor((x - grid.origin[0]) / grid.resolution + 1e-9).astype(int)
+    row = np.floor((y - grid.origin[1]) / grid.resolution + 1e-9).astype(int)
+    rows, cols = grid.shape
+    if (row < 0).any() or (col < 0).any() or (row >= rows).any() or (col >= cols).any():
+        return False
+    return not grid.blocked[row, col].any()
+
+
+def smooth_path(grid: OccupancyMap, pts: Sequence[tuple[float, float]]
+                ) -> list[tuple[float, float]]:
+    """String pulling: from each kept point jump to the farthest later point still in
+    straight free sight (checked on the blocked grid)."""
+    if len(pts) <= 2:
+        return list(pts)
+    out = [pts[0]]
+    i = 0
+    while i < len(pts) - 1:
+        j = i + 1
+        for k in range(len(pts) - 1, i + 1, -1):
+            if line_is_free(grid, pts[i], pts[k]):
+                j = k
+                break
+        out.append(pts[j])
+        i = j
+    return out
+
+
+def wrap_angle(a: float) -> float:
+    return math.atan2(math.sin(a), math.cos(a))
+
+
+def turn_poses(pose: Pose2, yaw: float, turn_step: float) -> list[Pose2]:
+    """Poses turning on the spot from ``pose`` to heading ``yaw`` (the shorter way), in
+    equal steps of at most ``turn_step``; empty when already there."""
+    x, y, a = pose
+    d = wrap_angle(yaw - a)
+    n = int(math.ceil(abs(d) / turn_step - 1e-9))
+    return [(x, y, wrap_angle(a + d * k / n)) for k in range(1, n + 1)]
+
+
+def drive_poses(pose: Pose2, goal: Sequence[float], step: float) -> list[Pose2]:
+    """Poses driving straight from ``pose`` to ``goal`` (keeping the heading), in equal
+    steps of at most ``step``; empty when already there."""
+    x, y, a = pose
+    d = math.dist((x, y), goal)
+    n = int(math.ceil(d / step - 1e-9))
+    return [(x + (goal[0] - x) * k / n, y + (goal[1] - y) * k / n, a) for k in range(1, n + 1)]
+
+
+def follow_poses(pose: Pose2, waypoints: Sequence[Sequence[float]], step: float,
+                 turn_step: float, final_yaw: float | None = None) -> list[Pose2]:
+    """Per-frame poses along ``waypoints``: turn to face each one, drive to it; at the end
+    turn to ``final_yaw`` when given. Waypoints closer than 1 mm are skipped."""
+    out: list[Pose2] = []
+    cur = pose
+    for w in waypoints:
+        if math.dist(cur[:2], w) < 1e-3:
+            continue
+        heading = math.atan2(w[1] - cur[1], w[0] - cur[0])
+        seg = turn_poses(cur, heading, turn_step)
+        seg += drive_poses(seg[-1] if seg else cur, w, step)
+        out += seg
+        cur = out[-1]
+    if final_yaw is not None:
+        out += turn_poses(cur, final_yaw, turn_step)
+    return out
+
+
+def travelled(pose: Pose2, poses: Sequence[Pose2]) -> float:
+    """Summed straight-line distance of a pose sequence starting at ``pose``."""
+    total, prev = 0.0, pose
+    for p in poses:
+        total += math.dist(prev[:2], p[:2])
+        prev = p
+    return total

@@ -1,0 +1,242 @@
+"""Seeded sensor faults for robustness studies: depth noise and holes, instance label swaps
+and dropouts, odometry pose drift.
+
+Faults apply to what is *logged* (the frames a mapper sees), never to the simulated world:
+the robot still drives where it drives and the instances table stays the truth.
+
+- depth noise: ``z + N(0, (sigma * z^2)^2)``, the quadratic growth of structured-light
+  and stereo depth error with distance (Khoshelham & Elberink 2012 for the Kinect);
+- depth holes: each pixel independently reads 0 (no return) with probability ``holes``;
+- label swaps: per frame, each visible non-structure instance is, with probability
+  ``label_swap``, paired with another visible one and their ids exchanged in that frame
+  (the confusions of a per-frame instance segmenter);
+- label dropouts: per frame, each visible non-structure instance reads 0 with
+  probability ``label_dropout`` (a missed detection);
+- pose drift: the logged base pose integrates the true per-frame motion (dx, dy, dyaw in
+  the base frame) with zero-mean errors of std ``drift_xy * |d|`` on each translation
+  component and ``drift_yaw * (|d| + |dyaw|)`` on the heading, like wheel odometry; the
+  logged camera pose rides on it.
+
+Floor and walls (``structure``) are exempt from label faults, so rooms stay mappable; use
+them to study object-level robustness. Each fault draws from its own generator spawned
+from the seed, so turning one fault on or off does not change the others' draws.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterable
+from dataclasses import asdict, dataclass, fields, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sgtool.errors import SgtoolError
+from sgtool.log.frame import Frame
+from sgtool.recorders.sim.camera import se2_matrix
+
+
+@dataclass(frozen=True)
+class NoiseProfile:
+    """Fault strengths (all 0 = a perfect sensor)."""
+
+    name: str = "none"
+    depth_sigma: float = 0.0  # m of std at 1 m; grows with z^2
+    holes: float = 0.0  # probability a depth pixel reads 0
+    label_swap: float = 0.0  # per visible instance and frame
+    label_dropout: float = 0.0  # per visible instance and frame
+    drift_xy: float = 0.0  # std (m) per metre driven, per axis
+    drift_yaw: float = 0.0  # std (rad) per metre driven + per radian turned
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            if f.name == "name":
+                continue
+            v = getattr(self, f.name)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise SgtoolError(f"noise {f.name}: expected a number, got {v!r}")
+            if v < 0:
+                raise SgtoolError(f"noise {f.name}: must be >= 0, got {v}")
+        for p in ("holes", "label_swap", "label_dropout"):
+            if getattr(self, p) > 1:
+                raise SgtoolError(f"noise {p}: a probability, at most 1")
+
+    @property
+    def is_clean(self) -> bool:
+        return all(getattr(self, f.name) == 0 for f in fields(self) if f.name != "name")
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+PROFILES: dict[str, NoiseProfile] = {
+    "none": NoiseProfile("none"),
+    # a good RGB-D camera and a fair segmenter
+    "mild": NoiseProfile("mild", depth_sigma=0.0015, holes=0.01, label_swap=0.01,
+                         label_dropout=0.02, drift_xy=0.005, drift_yaw=0.005),
+    # a poor one: strong far-range noise, many holes, frequent label errors, fast drift
+    "strong": NoiseProfile("strong", depth_sigma=0.006, holes=0.08, label_swap=0.05,
+                           label_dropout=0.1, drift_xy=0.02, drift_yaw=0.02),
+}
+
+
+def parse_noise(text: str | None) -> NoiseProfile:
+    """A profile from ``none``/``mild``/``strong``, optionally followed by overrides
+    (``mild,holes=0.05,drift_xy=0``), only overrides (``holes=0.05``, starting from none),
+    or a JSON file holding an object of fields."""
+    if text is None or not text.strip():
+        return PROFILES["none"]
+    t = text.strip()
+    if t.endswith(".json") or Path(t).is_file():
+        p = Path(t)
+        try:
+            d = json.loads(p.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError) as e:
+            raise SgtoolError(f"--noise {t}: cannot read: {e}") from None
+        except json.JSONDecodeError as e:
+            raise SgtoolError(f"--noise {t}: not valid JSON ({e.msg})") from None
+        if not isinstance(d, dict):
+            raise SgtoolError(f"--noise {t}: expected a JSON object of noise fields")
+        prof = d.pop("profile", "none")
+        if prof not in PROFILES:
+            raise SgtoolError(f"--noise {t}: unknown profile {prof!r} (one of "
+                              f"{', '.join(PROFILES)})")
+        return _override(PROFILES[prof], d.items(), t, default_name=p.stem)
+    parts = [s.strip() for s in t.split(",") if s.strip()]
+    base = PROFILES["none"]
+    if parts and "=" not in parts[0]:
+        if parts[0] not in PROFILES:
+            raise SgtoolError(f"--noise {t}: unknown profile {parts[0]!r} (one of "
+                              f"{', '.join(PROFILES)}, or key=value overrides, or a .json file)")
+        base = PROFILES[parts.pop(0)]
+    items = []
+    for s in parts:
+        k, eq, v = s.partition("=")
+        if not eq:
+            raise SgtoolError(f"--noise {t}: {s!r} is not key=value")
+        try:
+            items.append((k.strip(), float(v)))
+        except ValueError:
+            raise SgtoolError(f"--noise {t}: {k.strip()}={v!r} is not a number") from None
+    return _override(base, items, t, default_name=t)
+
+
+def _override(base: NoiseProfile, items: Iterable[tuple[str, Any]], where: str,
+              default_name: str) -> NoiseProfile:
+    names = {f.name for f in fields(NoiseProfile)} - {"name"}
+    kw: dict[str, Any] = {}
+    for k, v in items:
+        if k == "name":
+            kw["name"] = str(v)
+            continue
+        if k not in names:
+            raise SgtoolError(f"--noise {where}: unknown field {k!r} (fields: "
+                              f"{', '.join(sorted(names))})")
+        kw[k] = v
+    if not kw:
+        return base
+    kw.setdefault("name", default_name)
+    return replace(base, **kw)
+
+
+class SensorFaults:
+    """Applies a :class:`NoiseProfile` to a sequence of frames, seeded and in order
+    (frame k's faults depend on the seed and frames 0..k only)."""
+
+    def __init__(self, profile: NoiseProfile, seed: int, structure_ids: Iterable[int] = (),
+                 base_T_camera: np.ndarray | None = None) -> None:
+        self.profile = profile
+        ss = np.random.SeedSequence([int(seed), 0x5EED])
+        self._depth_rng, self._label_rng, self._pose_rng = (
+            np.random.default_rng(s) for s in ss.spawn(3))
+        self._structure = frozenset(int(i) for i in structure_ids)
+        self._base_T_cam = base_T_camera
+        self._true_prev: tuple[float, float, float] | None = None
+        self._est: tuple[float, float, float] | None = None
+
+    def apply(self, frame: Frame) -> Frame:
+        p = self.profile
+        if p.is_clean:
+            return frame
+        depth, ids = frame.depth, frame.ids
+        if p.depth_sigma > 0 or p.holes > 0:
+            depth = self._depth(depth)
+        if ids is not None and (p.label_swap > 0 or p.label_dropout > 0):
+            ids = self._labels(ids)
+        pose, base = frame.pose, frame.base_pose
+        if base is not None and (p.drift_xy > 0 or p.drift_yaw > 0):
+            pose, base = self._drift(pose, base)
+        return replace(frame, depth=depth, ids=ids, pose=pose, base_pose=base)
+
+    # ----- depth ------------------------------------------------------------------------
+    def _depth(self, depth: np.ndarray) -> np.ndarray:
+        p, rng = self.profile, self._depth_rng
+        d = depth.astype(np.float32, copy=True)
+        valid = d > 0
+        if p.depth_sigma > 0:
+            n = rng.standard_normal(d.shape, dtype=np.float32)
+            d += np.float32(p.depth_sigma) * d * d * n
+            d[~valid] = 0.0
+            np.maximum(d, 0.0, out=d)
+        if p.holes > 0:
+            d[rng.random(d.shape, dtype=np.float32) < np.float32(p.holes)] = 0.0
+        return d
+
+    # ----- labels -----------------------------------------------------------------------
+    def _labels(self, ids: np.ndarray) -> np.ndarray:
+        p, rng = self.profile, self._label_rng
+        uniq, inverse = np.unique(ids, return_inverse=True)
+        objs = [int(u) for u in uniq if u != 0 and u not in self._structure]
+        mapping = {int(u): int(u) for u in uniq}
+        if p.label_swap > 0 and len(objs) >= 2:
+            free = list(objs)
+            for u in objs:
+                if u not in free:
+                    continue
+                hit = rng.random() < p.label_swap
+                if not hit:
+                    continue
+                others = [v for v in free if v != u]
+                if not others:
+                    break
+                v = others[int(rng.integers(len(others)))]
+                mapping[u], mapping[v] = v, u
+                free.remove(u)
+                free.remove(v)
+        if p.label_dropout > 0:
+            for u in objs:
+                if rng.random() < p.label_dropout:
+                    mapping[u] = 0
+        if all(mapping[int(u)] == int(u) for u in uniq):
+            return ids
+        lut = np.array([mapping[int(u)] for u in uniq], dtype=np.int32)
+        return lut[inverse.reshape(ids.shape)]
+
+    # ----- pose -------------------------------------------------------------------------
+    def _drift(self, pose: np.ndarray, base: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        p, rng = self.profile, self._pose_rng
+        true = (float(base[0, 3]), float(base[1, 3]), math.atan2(base[1, 0], base[0, 0]))
+        if self._true_prev is None or self._est is None:
+            self._true_prev, self._est = true, true
+        else:
+            x0, y0, a0 = self._true_prev
+            c, s = math.cos(a0), math.sin(a0)
+            dxw, dyw = true[0] - x0, true[1] - y0
+            dx, dy = c * dxw + s * dyw, -s * dxw + c * dyw  # in the previous base frame
+            da = math.atan2(math.sin(true[2] - a0), math.cos(true[2] - a0))
+            dist = math.hypot(dx, dy)
+            e = rng.standard_normal(3)
+            dx += e[0] * p.drift_xy * dist
+            dy += e[1] * p.drift_xy * dist
+            da += e[2] * p.drift_yaw * (dist + abs(da))
+            ex, ey, ea = self._est
+            ce, se = math.cos(ea), math.sin(ea)
+            self._est = (ex + ce * dx - se * dy, ey + se * dx + ce * dy,
+                         math.atan2(math.sin(ea + da), math.cos(ea + da)))
+            self._true_prev = true
+        est_base = se2_matrix(*self._est)
+        est_base[2, 3] = base[2, 3]
+        base_T_cam = np.linalg.inv(base) @ pose if self._base_T_cam is None else self._base_T_cam
+        return est_base @ base_T_cam, est_base

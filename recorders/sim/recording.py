@@ -1,0 +1,212 @@
+"""Recording a simulation into an sgtool log (MCAP).
+
+:class:`LogRecorder` is a :class:`~sgtool.recorders.sim.simulation.SimObserver` that
+writes, through :class:`sgtool.log.LogWriter`:
+
+- every tick as one frame: rgb, depth, instance ids, calibration (first frame), and the
+  transforms world -> base -> camera (with the noise profile's faults applied);
+- the instances table (``sgtool.Instances``) at the start and again, whole, with the
+  new states whenever a door or container opens or closes;
+- one ``sgtool.Action`` per top-level skill, with its outcome, reason and distance;
+- ``sgtool.Episode`` records when the run starts and ends.
+
+:func:`record_house` runs the scripted exploration (:mod:`sgtool.recorders.sim.explore`)
+of a house into a log; the closed loop builds its own run from :class:`LogRecorder`.
+
+Log time is ``frame index * 1e9 / fps`` (integers, never the wall clock), the house spec
+is attached as ``house.json``, and the same house, options and seed give a byte-identical
+file. The writer writes ``OUT.partial`` and renames it at the end; on an error nothing is
+left behind.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from sgtool.datasets.house import HouseSpec
+from sgtool.log.writer import LogWriter
+from sgtool.recorders.sim.camera import CameraConfig, base_T_camera
+from sgtool.recorders.sim.explore import ExplorationReport, ScriptOptions, explore_house
+from sgtool.recorders.sim.instances import STRUCTURE
+from sgtool.recorders.sim.navigation import RobotConfig
+from sgtool.recorders.sim.noise import PROFILES, NoiseProfile, SensorFaults
+from sgtool.recorders.sim.simulation import (
+    SimObserver,
+    Simulation,
+    SkillOutcome,
+    StopSimulation,
+)
+
+SOURCE = "pybullet"
+
+
+class LogRecorder(SimObserver):
+    """Writes a simulation's frames, state changes and actions to ``writer``.
+
+    ``max_frames`` ends the run (by raising :class:`StopSimulation` from the tick that
+    would exceed it). ``planner`` fills the action records' planner field. ``progress``
+    is anything with ``update(n)`` (a tqdm bar).
+    """
+
+    def __init__(self, writer: LogWriter, sim: Simulation, *,
+                 noise: NoiseProfile | None = None, seed: int = 0,
+                 max_frames: int | None = None, planner: str | None = None,
+                 progress: Any = None, log_actions: bool = True) -> None:
+        self.writer = writer
+        self.max_frames = max_frames
+        self.planner = planner
+        self.progress = progress
+        self.log_actions = log_actions
+        self.frames = 0
+        self.actions = 0
+        self.last_time_ns = 0
+        profile = noise or PROFILES["none"]
+        structure = [i.id for i in sim.instances if i.kind == STRUCTURE]
+        self.faults = None if profile.is_clean else SensorFaults(
+            profile, seed, structure,
+            base_T_camera(sim.camera.mount_height, sim.camera.tilt_deg))
+
+    def write_instances(self, sim: Simulation) -> None:
+        self.writer.write_record("instances", sim.time_ns(),
+                                 {"instances": sim.instance_records()})
+
+    def on_tick(self, sim: Simulation) -> None:
+        if self.max_frames is not None and self.frames >= self.max_frames:
+            raise StopSimulation(f"frame budget of {self.max_frames} reached")
+        f = sim.render()
+        if self.faults is not None:
+            f = self.faults.apply(f)
+        self.writer.write_frame(f.time_ns, depth=f.depth, pose=f.pose, intrinsics=f.intrinsics,
+                                rgb=f.rgb, ids=f.ids, base_pose=f.base_pose)
+        self.last_time_ns = f.time_ns
+        self.frames += 1
+        if self.progress is not None:
+            self.progress.update(1)
+
+    def on_state(self, sim: Simulation, spec_id: str, state: str) -> None:
+        self.write_instances(sim)
+
+    def on_skill(self, sim: Simulation, outcome: SkillOutcome) -> None:
+        if self.log_actions:
+            self.log_action(sim, outcome)
+
+    def log_action(self, sim: Simulation, outcome: SkillOutcome, *,
+                   decision_time_s: float = 0.0) -> None:
+        """Write the ``sgtool.Action`` record of ``outcome`` at the time of the last frame
+        the skill took (the current time when it took none)."""
+        t = sim.time_ns(max(sim.tick_index - 1, 0)) if outcome.ticks else sim.time_ns()
+        t = max(t, self.last_time_ns)
+        self.writer.write_record("action", t, {
+            "skill": outcome.skill, "target": outcome.target, "outcome": outcome.outcome,
+            "reason": outcome.reason, "travelled_m": round(outcome.travelled_m, 6),
+            "decision_time_s": float(decision_time_s), "planner": self.planner,
+            "step": self.actions,
+        })
+        self.actions += 1
+
+
+@dataclass(frozen=True)
+class RecordOptions:
+    fps: float = 10.0
+    frames: int | None = None  # stop after this many frames (None: when the script ends)
+    camera: CameraConfig = field(default_factory=CameraConfig)
+    robot: RobotConfig = field(default_factory=RobotConfig)
+    noise: NoiseProfile = field(default_factory=lambda: PROFILES["none"])
+    seed: int = 0  # seeds the sensor faults
+    start: int = 0  # index of the house's start pose
+    script: ScriptOptions = field(default_factory=ScriptOptions)
+    compression: str = "zstd"
+
+
+@dataclass(frozen=True)
+class RecordReport:
+    output: Path
+    house_id: str
+    frames: int
+    actions: int
+    travelled_m: float
+    rooms_visited: tuple[str, ...]
+    rooms_missed: dict[str, str]
+    opened: tuple[str, ...]
+    truncated: bool
+    seconds: float  # wall-clock time of the run (reported, never logged)
+
+    def lines(self) -> list[str]:
+        fps = self.frames / self.seconds if self.seconds > 0 else 0.0
+        out = [
+            f"wrote {self.output} ({self.output.stat().st_size / 1e6:.1f} MB)",
+            f"house {self.house_id}: {self.frames} frames, {self.actions} actions, "
+            f"{self.travelled_m:.1f} m driven, {self.seconds:.1f} s ({fps:.1f} frames/s)",
+            f"rooms visited: {len(self.rooms_visited)} ({', '.join(self.rooms_visited)})",
+        ]
+        if self.opened:
+            out.append(f"opened: {', '.join(self.opened)}")
+        for r, why in self.rooms_missed.items():
+            out.append(f"missed {r}: {why}")
+        if self.truncated:
+            out.append("stopped at the frame budget before the exploration finished")
+        return out
+
+
+def record_house(house: HouseSpec, output: str | os.PathLike[str],
+                 options: RecordOptions | None = None, *, house_id: str = "",
+                 progress: Any = None) -> RecordReport:
+    """Record the scripted exploration of ``house`` into the log ``output``."""
+    opts = options or RecordOptions()
+    if opts.frames is not None and opts.frames < 1:
+        from sgtool.errors import SgtoolError
+
+        raise SgtoolError(f"frames {opts.frames}: must be >= 1")
+    hid = house_id or f"house-{house.seed}"
+    t_wall = time.perf_counter()
+    rep = ExplorationReport()
+    truncated = False
+    with Simulation(house, camera=opts.camera, robot=opts.robot, fps=opts.fps,
+                    start=opts.start) as sim, \
+            LogWriter(output, seed=opts.seed, compression=opts.compression,
+                      metadata={"source": SOURCE, "house_id": hid}) as writer:
+        rec = LogRecorder(writer, sim, noise=opts.noise, seed=opts.seed,
+                          max_frames=opts.frames, planner="scripted", progress=progress)
+        sim.observers.append(rec)
+        writer.attach_house(house.to_json())
+        writer.write_record("episode", 0, {
+            "kind": "recording", "source": SOURCE, "house_id": hid, "status": "started",
+            "extra": _episode_extra(opts, sim),
+        })
+        rec.write_instances(sim)
+        try:
+            sim.tick()  # the view at the start pose
+            explore_house(sim, opts.script, rep)
+        except StopSimulation:
+            truncated = True
+        writer.write_record("episode", rec.last_time_ns, {
+            "kind": "recording", "source": SOURCE, "house_id": hid, "status": "ended",
+            "steps": rec.actions, "frames": rec.frames,
+            "travelled_m": round(sim.travelled_m, 6),
+            "extra": {"rooms_visited": rep.visited, "rooms_missed": rep.missed,
+                      "opened": rep.opened, "truncated": truncated},
+        })
+        travelled = sim.travelled_m
+        frames, actions = rec.frames, rec.actions
+    return RecordReport(Path(output), hid, frames, actions, travelled, tuple(rep.visited),
+                        dict(rep.missed), tuple(rep.opened), truncated,
+                        time.perf_counter() - t_wall)
+
+
+def _episode_extra(opts: RecordOptions, sim: Simulation) -> dict[str, Any]:
+    k = sim.intrinsics
+    return {
+        "fps": opts.fps, "seed": opts.seed, "start": opts.start,
+        "start_pose": [round(v, 6) for v in sim.base],
+        "camera": asdict(opts.camera),
+        "intrinsics": {"width": k.width, "height": k.height, "fx": k.fx, "fy": k.fy,
+                       "cx": k.cx, "cy": k.cy},
+        "robot": asdict(opts.robot),
+        "noise": opts.noise.to_dict(),
+        "script": asdict(opts.script),
+        "frame_budget": opts.frames,
+    }
