@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -154,8 +155,10 @@ class RecordReport:
 
 def record_house(house: HouseSpec, output: str | os.PathLike[str],
                  options: RecordOptions | None = None, *, house_id: str = "",
-                 progress: Any = None) -> RecordReport:
-    """Record the scripted exploration of ``house`` into the log ``output``."""
+                 progress: Any = None, observers: Sequence[SimObserver] = ()) -> RecordReport:
+    """Record the scripted exploration of ``house`` into the log ``output``. ``observers``
+    also watch the simulation (after the recorder, so they see each frame once it is
+    written)."""
     opts = options or RecordOptions()
     if opts.frames is not None and opts.frames < 1:
         from sgtool.errors import SgtoolError
@@ -172,6 +175,7 @@ def record_house(house: HouseSpec, output: str | os.PathLike[str],
         rec = LogRecorder(writer, sim, noise=opts.noise, seed=opts.seed,
                           max_frames=opts.frames, planner="scripted", progress=progress)
         sim.observers.append(rec)
+        sim.observers.extend(observers)
         writer.attach_house(house.to_json())
         writer.write_record("episode", 0, {
             "kind": "recording", "source": SOURCE, "house_id": hid, "status": "started",

@@ -1,0 +1,130 @@
+"""Seeded sensor faults on synthetic frames: depth noise growing with z^2, holes, label
+swaps and dropouts (structure exempt), odometry drift, profile parsing."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sgtool.errors import SgtoolError
+from sgtool.log.frame import CameraIntrinsics, Frame
+from sgtool.recorders.sim.camera import base_T_camera, se2_matrix
+from sgtool.recorders.sim.noise import PROFILES, NoiseProfile, SensorFaults, parse_noise
+
+K = CameraIntrinsics.from_fov(200, 100, 60.0)
+CAM = base_T_camera(1.2, 15.0)
+
+
+def _frame(i: int = 0, z: float = 2.0, ids: np.ndarray | None = None,
+           base: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> Frame:
+    depth = np.full((100, 200), z, np.float32)
+    depth[:, :10] = 0.0  # no return
+    if ids is None:
+        ids = np.zeros((100, 200), np.int32)
+        ids[:, :50] = 1  # floor (structure)
+        ids[:, 50:100] = 20
+        ids[:, 100:150] = 21
+        ids[:, 150:] = 22
+    b = se2_matrix(*base)
+    return Frame(i, i * 100_000_000, None, depth, ids, b @ CAM, K, b)
+
+
+def test_clean_profile_is_the_identity() -> None:
+    f = _frame()
+    assert SensorFaults(PROFILES["none"], 0).apply(f) is f
+
+
+def test_depth_noise_grows_with_z_squared_and_holes_have_their_rate() -> None:
+    p = NoiseProfile("t", depth_sigma=0.004, holes=0.1)
+    for z in (1.0, 3.0):
+        f = _frame(z=z)
+        g = SensorFaults(p, 7).apply(f)
+        assert np.all(g.depth[:, :10] == 0.0)  # no return stays no return
+        valid = g.depth[:, 10:]
+        holes = valid == 0
+        assert abs(holes.mean() - 0.1) < 0.01
+        err = valid[~holes] - z
+        assert abs(err.mean()) < 0.004 * z * z * 0.05
+        assert math.isclose(err.std(), 0.004 * z * z, rel_tol=0.05)
+        assert f.depth[0, 20] == z  # the input is not modified
+
+
+def test_label_dropout_and_swaps_touch_objects_not_structure() -> None:
+    f = _frame()
+    drop = SensorFaults(NoiseProfile("d", label_dropout=1.0), 1, structure_ids=[1]).apply(f)
+    assert set(np.unique(drop.ids).tolist()) == {0, 1}
+    assert np.array_equal(drop.ids[:, :50], f.ids[:, :50])
+
+    swap = SensorFaults(NoiseProfile("s", label_swap=1.0), 1, structure_ids=[1]).apply(f)
+    assert np.array_equal(swap.ids[:, :50], f.ids[:, :50])
+    ids = {int(swap.ids[0, c]) for c in (60, 110, 160)}
+    assert ids == {20, 21, 22}  # still the same ids, regions permuted...
+    moved = [int(swap.ids[0, c]) != int(f.ids[0, c]) for c in (60, 110, 160)]
+    assert sum(moved) == 2  # ...one pair of three exchanged
+
+    rates = NoiseProfile("r", label_dropout=0.3)
+    faults = SensorFaults(rates, 3, structure_ids=[1])
+    dropped = [len({20, 21, 22} & set(np.unique(faults.apply(_frame(i)).ids).tolist())) < 3
+               for i in range(400)]
+    # P(at least one of three objects dropped) = 1 - 0.7^3 = 0.657
+    assert abs(np.mean(dropped) - 0.657) < 0.06
+
+
+def test_drift_follows_odometry_and_is_seeded() -> None:
+    """Driving 10 m straight in 0.05 m steps: no drift -> the true pose; with drift_xy the
+    lateral error is a random walk of std drift_xy * sqrt(sum of d^2) per step..."""
+    def run(p: NoiseProfile, seed: int) -> np.ndarray:
+        faults = SensorFaults(p, seed, base_T_camera=CAM)
+        out = []
+        for i in range(201):
+            f = faults.apply(_frame(i, base=(0.05 * i, 0.0, 0.0)))
+            out.append(f.base_pose.copy())
+            assert np.allclose(np.linalg.inv(f.base_pose) @ f.pose, CAM)
+        return np.array(out)
+
+    clean = run(NoiseProfile("z", holes=1e-9), 0)  # a non-clean profile without drift
+    assert np.allclose(clean[-1][:2, 3], [10.0, 0.0])
+    p = NoiseProfile("d", drift_xy=0.02)
+    a, b, c = run(p, 1), run(p, 1), run(p, 2)
+    assert np.array_equal(a, b) and not np.array_equal(a, c)
+    ends = np.array([run(p, s)[-1][1, 3] for s in range(40)])
+    # lateral: sum of 200 steps of std 0.02 * 0.05 -> std 0.02 * 0.05 * sqrt(200) = 0.0141
+    assert 0.008 < ends.std() < 0.02
+    assert np.allclose(a[0], clean[0])  # the first frame is the true pose
+
+
+def test_fault_streams_are_independent() -> None:
+    """Adding depth holes does not change which labels get dropped."""
+    p1 = NoiseProfile("a", label_dropout=0.5)
+    p2 = replace(p1, holes=0.2)
+    f1, f2 = SensorFaults(p1, 9, [1]), SensorFaults(p2, 9, [1])
+    for i in range(20):
+        assert np.array_equal(f1.apply(_frame(i)).ids, f2.apply(_frame(i)).ids)
+
+
+def test_parse_noise(tmp_path: Path) -> None:
+    assert parse_noise(None) == PROFILES["none"] == parse_noise("none")
+    assert parse_noise("mild") == PROFILES["mild"]
+    p = parse_noise("strong,holes=0.2,drift_xy=0")
+    assert (p.holes, p.drift_xy, p.label_swap) == (0.2, 0.0, PROFILES["strong"].label_swap)
+    assert parse_noise("holes=0.05").depth_sigma == 0.0
+    f = tmp_path / "faults.json"
+    f.write_text(json.dumps({"profile": "mild", "label_swap": 0.5}))
+    q = parse_noise(str(f))
+    assert (q.name, q.label_swap, q.holes) == ("faults", 0.5, PROFILES["mild"].holes)
+    with pytest.raises(SgtoolError, match="unknown profile 'loud'"):
+        parse_noise("loud")
+    with pytest.raises(SgtoolError, match="unknown field 'hole'"):
+        parse_noise("hole=0.1")
+    with pytest.raises(SgtoolError, match="at most 1"):
+        parse_noise("holes=2")
+    with pytest.raises(SgtoolError, match="not a number"):
+        parse_noise("holes=lots")
+    (tmp_path / "bad.json").write_text("[1, 2]")
+    with pytest.raises(SgtoolError, match="JSON object"):
+        parse_noise(str(tmp_path / "bad.json"))
