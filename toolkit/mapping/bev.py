@@ -1,0 +1,350 @@
+"""Bird's-eye occupancy (free / occupied / unknown) from the voxel map.
+
+MoMa-LLM (paper sec. III-B) analyses "stixels", the voxel columns of the map: the highest
+occupied voxel of a column inside a height band above the floor decides the cell; a column
+whose highest voxel is floor is free space, any other occupied column is an obstacle. Since
+the floor is the lowest thing in a column, that is: a column with a voxel in the band
+``(floor + floor_tolerance, floor + band_top]`` is **occupied**; else a column with a floor
+voxel (within ``floor_tolerance`` of the floor, or below it) is **free**; else **unknown**.
+Things above ``band_top`` (door lintels, lamps, the ceiling) never block: the robot passes
+under them.
+
+Two fixes for what a camera cannot see:
+
+- the cells under the robot's footprint along its trajectory are free (the camera never
+  sees the floor it stands on);
+- small unknown holes in free space (floor cells that far, grazing rays skipped, a few
+  cells wide) become free when they are enclosed by free cells and smaller than
+  ``max_hole``; a hole touching an obstacle or the map border stays unknown.
+
+The floor height is taken from the config or estimated as the lowest voxel level holding
+at least half as many voxels as the fullest level (floors are the largest horizontal
+surfaces a camera sees; the ceiling, when seen, is higher).
+
+Cells use the convention of :mod:`sgtool.datasets.occupancy`: arrays ``[row, col]`` with
+row = y and col = x, cell (0, 0) has its lower-left corner at ``origin``; values follow ROS
+and Foxglove occupancy grids: 0 free, 100 occupied, -1 unknown (int8). The grid is aligned
+with the voxel lattice (one cell per voxel column) and its origin snapped to whole
+``snap`` cells, so it only grows as the map grows and cells keep their indices between
+refreshes while the map extent does not change.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from sgtool.mapping.voxels import AXIS_BITS, AXIS_MASK, COLUMN_SHIFT, OFFSET, SHIFT_Z
+
+FREE = np.int8(0)
+OCCUPIED = np.int8(100)
+UNKNOWN = np.int8(-1)
+
+
+@dataclass(frozen=True)
+class BevConfig:
+    floor_z: float | None = None  # m; None = estimate from the voxels
+    floor_tolerance: float = 0.1  # m above the floor still counted as floor
+    band_top: float = 1.6  # m above the floor; higher voxels never block
+    robot_radius: float = 0.25  # m; footprint cleared along the trajectory
+    max_hole: float = 0.1  # m^2; enclosed unknown holes up to this size become free
+    margin: int = 10  # cells of unknown kept around the observed extent
+    snap: int = 20  # grid origin at multiples of this many cells
+
+
+@dataclass(frozen=True, eq=False)
+class OccupancyGrid:
+    """int8 ``grid[row=y, col=x]`` of FREE / OCCUPIED / UNKNOWN (module doc)."""
+
+    grid: np.ndarray
+    origin: tuple[float, float]
+    resolution: float
+    floor_z: float = 0.0
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return int(self.grid.shape[0]), int(self.grid.shape[1])
+
+    @property
+    def free(self) -> np.ndarray:
+        return self.grid == FREE
+
+    @property
+    def occupied(self) -> np.ndarray:
+        return self.grid == OCCUPIED
+
+    @property
+    def unknown(self) -> np.ndarray:
+        return self.grid == UNKNOWN
+
+    def cell_of(self, x: np.ndarray | float, y: np.ndarray | float
+                ) -> tuple[np.ndarray, np.ndarray]:
+        """(row, col) of world points (may be out of bounds)."""
+        c = np.floor((np.asarray(x, dtype=np.float64) - self.origin[0]) / self.resolution)
+        r = np.floor((np.asarray(y, dtype=np.float64) - self.origin[1]) / self.resolution)
+        return r.astype(np.int64), c.astype(np.int64)
+
+    def center_of(self, rows: np.ndarray | int, cols: np.ndarray | int
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """World (x, y) of cell centres."""
+        x = self.origin[0] + (np.asarray(cols, dtype=np.float64) + 0.5) * self.resolution
+        y = self.origin[1] + (np.asarray(rows, dtype=np.float64) + 0.5) * self.resolution
+        return x, y
+
+    def inside(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        h, w = self.shape
+        return (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
+
+    def value_at(self, x: float, y: float) -> int:
+        r, c = self.cell_of(x, y)
+        if not self.inside(r, c):
+            return int(UNKNOWN)
+        return int(self.grid[r, c])
+
+
+def estimate_floor_level(lowest: int, hist: np.ndarray) -> int | None:
+    """Voxel level of the floor from a height histogram (``hist[i]`` voxels at level
+    ``lowest + i``): the lowest level with at least half the voxels of the fullest level
+    (None without voxels)."""
+    if hist.size == 0 or hist.max() <= 0:
+        return None
+    return lowest + int(np.flatnonzero(hist >= 0.5 * hist.max())[0])
+
+
+def floor_level(config: BevConfig, resolution: float, lowest: int, hist: np.ndarray) -> int:
+    """The configured floor level, or the estimated one (0 without voxels)."""
+    if config.floor_z is not None:
+        return int(math.floor(config.floor_z / resolution + 1e-9))
+    level = estimate_floor_level(lowest, hist)
+    return 0 if level is None else level
+
+
+@dataclass(frozen=True)
+class ColumnClasses:
+    """Column indices (ix, iy) of occupied and of floor columns."""
+
+    occupied: np.ndarray  # (n, 2) int64
+    floor: np.ndarray  # (m, 2) int64
+
+
+def _unique_columns(col: np.ndarray, presorted: bool) -> np.ndarray:
+    if col.size == 0:
+        return np.zeros((0, 2), dtype=np.int64)
+    if presorted:
+        col = col[np.concatenate([[True], col[1:] != col[:-1]])]
+    else:
+        col = np.unique(col)
+    ix = ((col >> AXIS_BITS) & AXIS_MASK) - OFFSET
+    iy = (col & AXIS_MASK) - OFFSET
+    return np.stack([ix, iy], axis=1)
+
+
+def classify_keys(keys: np.ndarray, level: int, resolution: float, config: BevConfig,
+                  presorted: bool = False) -> ColumnClasses:
+    """Occupied and floor columns of packed voxel keys (:mod:`sgtool.mapping.voxels`;
+    sorted keys, as the map stores them, skip a sort)."""
+    iz = ((keys >> SHIFT_Z) & AXIS_MASK) - OFFSET
+    col = keys >> COLUMN_SHIFT
+    tol = int(round(config.floor_tolerance / resolution))
+    top = int(round(config.band_top / resolution))
+    is_floor = iz <= level + tol
+    in_band = (iz > level + tol) & (iz <= level + top)
+    return ColumnClasses(_unique_columns(col[in_band], presorted),
+                         _unique_columns(col[is_floor], presorted))
+
+
+class ColumnGrid:
+    """Occupied/floor flags per voxel column over a grid that grows with the map, updated
+    with the columns of new voxels only (the incremental half of the BEV)."""
+
+    OCC = np.uint8(1)
+    FLOOR = np.uint8(2)
+
+    def __init__(self, resolution: float, config: BevConfig) -> None:
+        self.resolution = resolution
+        self.config = config
+        self.flags = np.zeros((0, 0), dtype=np.uint8)
+        self.extent: tuple[int, int, int, int] | None = None  # ix0, iy0, ix1, iy1
+
+    def _fit(self, sets: Sequence[np.ndarray], trajectory: Sequence[tuple[float, float]]
+             ) -> None:
+        want = grid_extent(sets, self.resolution, self.config, trajectory)
+        if self.extent is not None:
+            o = self.extent
+            want = (min(want[0], o[0]), min(want[1], o[1]), max(want[2], o[2]),
+                    max(want[3], o[3]))
+            if want == o:
+                return
+        flags = np.zeros((want[3] - want[1] + 1, want[2] - want[0] + 1), dtype=np.uint8)
+        if self.extent is not None and self.flags.size:
+            o = self.extent
+            flags[o[1] - want[1]:o[3] - want[1] + 1, o[0] - want[0]:o[2] - want[0] + 1] = \
+                self.flags
+        self.flags, self.extent = flags, want
+
+    def add(self, classes: ColumnClasses,
+            trajectory: Sequence[tuple[float, float]] = ()) -> None:
+        self._fit([classes.occupied, classes.floor], trajectory)
+        assert self.extent is not None
+        ix0, iy0 = self.extent[0], self.extent[1]
+        for cols, flag in ((classes.occupied, self.OCC), (classes.floor, self.FLOOR)):
+            if len(cols):
+                self.flags[cols[:, 1] - iy0, cols[:, 0] - ix0] |= flag
+
+    def occupancy(self, trajectory: Sequence[tuple[float, float]] = (),
+                  level: int = 0) -> OccupancyGrid:
+        """The occupancy grid (module doc) of the flags plus the trajectory footprint."""
+        self._fit([], trajectory)
+        assert self.extent is not None
+        return occupancy_grid(self.flags, self.extent, self.resolution, self.config,
+                              trajectory, level)
+
+
+def occupancy_grid(flags: np.ndarray, extent: tuple[int, int, int, int], resolution: float,
+                   config: BevConfig, trajectory: Sequence[tuple[float, float]] = (),
+                   level: int = 0) -> OccupancyGrid:
+    """FREE / OCCUPIED / UNKNOWN from column flags (``ColumnGrid.OCC``/``FLOOR``) over the
+    voxel-index ``extent``, with the robot footprint along ``trajectory`` and small holes
+    filled."""
+    ix0, iy0 = extent[0], extent[1]
+    h, w = flags.shape
+    grid = np.full((h, w), UNKNOWN, dtype=np.int8)
+    grid[(flags & ColumnGrid.FLOOR) != 0] = FREE
+    if len(trajectory):
+        grid[footprint(trajectory, extent, (h, w), resolution, config.robot_radius)] = FREE
+    grid[(flags & ColumnGrid.OCC) != 0] = OCCUPIED
+    fill_holes(grid, int(config.max_hole / resolution**2))
+    origin = (ix0 * resolution, iy0 * resolution)
+    return OccupancyGrid(grid, origin, resolution, (level + 1) * resolution)
+
+
+def occupancy_from_keys(keys: np.ndarray, resolution: float, config: BevConfig,
+                        trajectory: Sequence[tuple[float, float]] = (),
+                        level: int | None = None) -> OccupancyGrid:
+    """From-scratch BEV of packed voxel keys (sorted or not)."""
+    if level is None:
+        if keys.size:
+            iz = ((keys >> SHIFT_Z) & AXIS_MASK) - OFFSET
+            lo = int(iz.min())
+            level = floor_level(config, resolution, lo, np.bincount(iz - lo))
+        else:
+            level = floor_level(config, resolution, 0, np.zeros(0, np.int64))
+    presorted = bool(keys.size < 2 or np.all(keys[1:] >= keys[:-1]))
+    cg = ColumnGrid(resolution, config)
+    cg.add(classify_keys(keys, level, resolution, config, presorted), trajectory)
+    return cg.occupancy(trajectory, level)
+
+
+def grid_extent(column_sets: Sequence[np.ndarray], resolution: float, config: BevConfig,
+                trajectory: Sequence[tuple[float, float]] = ()) -> tuple[int, int, int, int]:
+    """Snapped voxel-index extent (ix0, iy0, ix1, iy1) covering columns and trajectory."""
+    xs: list[int] = []
+    ys: list[int] = []
+    for cs in column_sets:
+        if len(cs):
+            xs += [int(cs[:, 0].min()), int(cs[:, 0].max())]
+            ys += [int(cs[:, 1].min()), int(cs[:, 1].max())]
+    if len(trajectory):
+        t = np.floor(np.asarray(trajectory, dtype=np.float64).reshape(-1, 2) / resolution)
+        xs += [int(t[:, 0].min()), int(t[:, 0].max())]
+        ys += [int(t[:, 1].min()), int(t[:, 1].max())]
+    if not xs:
+        xs, ys = [0, 0], [0, 0]
+    m, s = config.margin, max(1, config.snap)
+    ix0 = (min(xs) - m) // s * s
+    iy0 = (min(ys) - m) // s * s
+    ix1 = -((-(max(xs) + m + 1)) // s) * s - 1
+    iy1 = -((-(max(ys) + m + 1)) // s) * s - 1
+    return ix0, iy0, ix1, iy1
+
+
+def footprint(trajectory: Sequence[tuple[float, float]], extent: tuple[int, int, int, int],
+              shape: tuple[int, int], resolution: float, radius: float) -> np.ndarray:
+    """Cells within ``radius`` of a trajectory point (disks stamped at its distinct cells)."""
+    h, w = shape
+    t = np.asarray(trajectory, dtype=np.float64).reshape(-1, 2)
+    r = np.floor(t[:, 1] / resolution).astype(np.int64) - extent[1]
+    c = np.floor(t[:, 0] / resolution).astype(np.int64) - extent[0]
+    cells = np.unique(r * (w + 1) + c)  # distinct (row, col); w + 1 keeps them apart
+    r, c = np.divmod(cells, w + 1)
+    rad = int(round(radius / resolution))
+    dr, dc = np.nonzero(disk(rad))
+    rr = (r[:, None] + dr[None, :] - rad).ravel()
+    cc = (c[:, None] + dc[None, :] - rad).ravel()
+    ok = (rr >= 0) & (rr < h) & (cc >= 0) & (cc < w)
+    out = np.zeros((h, w), dtype=bool)
+    out[rr[ok], cc[ok]] = True
+    return out
+
+
+def near(mask: np.ndarray) -> np.ndarray:
+    """Cells 8-adjacent to (or in) ``mask`` (a 3x3 dilation by shifted ORs)."""
+    p = np.pad(mask, 1)
+    out = p[1:-1, 1:-1].copy()
+    h, w = mask.shape
+    for dr in (0, 1, 2):
+        for dc in (0, 1, 2):
+            if dr != 1 or dc != 1:
+                out |= p[dr:dr + h, dc:dc + w]
+    return out
+
+
+def disk(radius: int) -> np.ndarray:
+    """Boolean disk structuring element of a radius in cells."""
+    r = np.arange(-radius, radius + 1)
+    return (r[:, None] ** 2 + r[None, :] ** 2) <= radius * radius
+
+
+def fill_holes(grid: np.ndarray, max_cells: int) -> int:
+    """Turn enclosed unknown holes of at most ``max_cells`` cells (4-connected, bordered
+    only by free cells, not touching the grid border) into free space, in place; returns
+    the number of cells filled."""
+    if max_cells <= 0:
+        return 0
+    unknown = grid == UNKNOWN
+    lab, n = ndimage.label(unknown)
+    if n == 0:
+        return 0
+    sizes = np.bincount(lab.ravel())
+    bad = np.zeros(n + 1, dtype=bool)
+    bad[0] = True
+    bad[sizes > max_cells] = True
+    # holes next to an obstacle are not holes in free space
+    near_occ = near(grid == OCCUPIED)
+    bad[np.unique(lab[near_occ & unknown])] = True
+    edge = np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]])
+    bad[np.unique(edge)] = True
+    fill = ~bad[lab]
+    grid[fill] = FREE
+    return int(fill.sum())
+
+
+def line_of_sight(blocked: np.ndarray, occ: OccupancyGrid, a: np.ndarray, b: np.ndarray,
+                  skip_end: float = 0.0) -> np.ndarray:
+    """For segments a[i] -> b[i] (world (k, 2)), True when no ``blocked`` cell lies on
+    them (sampled every half cell; the last ``skip_end`` metres before b are not checked,
+    so b may sit on an obstacle such as a door panel). Out-of-grid samples block."""
+    a = np.asarray(a, dtype=np.float64).reshape(-1, 2)
+    b = np.asarray(b, dtype=np.float64).reshape(-1, 2)
+    k = len(a)
+    if k == 0:
+        return np.zeros(0, dtype=bool)
+    vec = b - a
+    length = np.hypot(vec[:, 0], vec[:, 1])
+    usable = np.maximum(length - skip_end, 0.0)
+    step = occ.resolution / 2.0
+    n = int(np.ceil(usable.max() / step)) + 1
+    f = np.linspace(0.0, 1.0, n)[None, :] * usable[:, None]  # (k, n) metres from a
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit = np.where(length[:, None] > 0, vec / np.maximum(length, 1e-12)[:, None], 0.0)
+    x = a[:, 0:1] + unit[:, 0:1] * f
+    y = a[:, 1:2] + unit[:, 1:2] * f
+    r, c = occ.cell_of(x, y)
+    inside = occ.inside(r, c)
+    hit = np.ones_like(inside)
+    hit[inside] = blocked[r[inside], c[inside]]
+    return ~hit.any(axis=1)

@@ -1,0 +1,360 @@
+"""Generalized Voronoi graph of explored free space, clearance-filtered and sparsified.
+
+MoMa-LLM (paper sec. III-B) computes the generalized Voronoi diagram (GVD) of the inflated
+BEV map: the points with equal clearance to the two closest obstacles, filtered to free,
+explored space away from obstacles; the largest connected component is the navigation
+graph, sparsified to fewer nodes. Their implementation runs ``scipy.spatial.Voronoi`` over
+every obstacle pixel (measured here: 70 ms for 5,000 points, 300 ms for 20,000), then an
+all-pairs Dijkstra to sparsify (O(N^2)). We compute the same diagram on the grid instead:
+
+1. **Ridge cells.** The feature transform of the distance field
+   (:func:`sgtool.mapping.esdf.distance_field`) gives every free cell its nearest obstacle
+   cell. Two neighbouring cells whose nearest obstacles are far apart (more than
+   ``ridge_ratio`` times their clearance and ``min_ridge``) straddle the GVD: the one of
+   the two closer to being equidistant from both obstacles is a ridge cell. Between two
+   walls that is the centre line; from a room corner, its bisector; along one straight wall
+   nothing (neighbouring cells share nearly the same nearest wall cell), so the "hairs" a
+   point-site Voronoi grows between adjacent wall pixels never appear. Obstacles are
+   occupied *and unknown* cells (the explored/unexplored border bounds the diagram, as in
+   MoMa-LLM), and ridge cells must have at least ``min_clearance`` to the nearest obstacle
+   (the inflation; MoMa-LLM clips the distance field at 3 px of 7.5 cm).
+2. **Thinning.** Zhang-Suen thinning (1984) makes the ridge one cell wide; the pixel graph
+   joins 8-neighbours, skipping a diagonal step when a 4-neighbour path exists.
+3. **Component.** The component holding the ridge cell nearest to ``anchor`` (the robot),
+   else the largest (ties: the one with the lowest cell).
+4. **Sparsification** (MoMa-LLM: keep nodes of degree != 2, join them along degree-2
+   chains, re-insert a node every 0.6 m): chains are traced once (linear time), spurs
+   shorter than ``min_spur`` ending in a junction are dropped, and each chain gets
+   ``round(length / node_spacing) - 1`` evenly spaced intermediate nodes. Edges weigh their
+   length along the ridge and keep the cells they follow (for the door cut of
+   :mod:`sgtool.scenegraph.rooms`).
+
+Nodes are numbered in raster order of their cells, edges are sorted: the same grid always
+gives the same graph.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import networkx as nx
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
+
+from sgtool.mapping.bev import OccupancyGrid
+from sgtool.mapping.esdf import distance_field, obstacles
+
+_SQRT2 = math.sqrt(2.0)
+
+
+@dataclass(frozen=True)
+class VoronoiConfig:
+    min_clearance: float = 0.2  # m from the nearest obstacle (or unknown) cell
+    ridge_ratio: float = 1.0  # nearest obstacles of neighbours >= this x clearance apart
+    min_ridge: float = 0.2  # m: ... and at least this far apart
+    node_spacing: float = 0.6  # m between sparsified nodes along a chain (MoMa-LLM)
+    min_spur: float = 0.3  # m: dead ends shorter than this are dropped
+
+
+@dataclass(frozen=True, eq=False)
+class VoronoiGraph:
+    """The sparsified graph. ``graph`` is a networkx Graph on nodes ``0..n-1`` with node
+    attributes ``pos`` (x, y), ``clearance`` (m), ``cell`` (row, col) and edge attributes
+    ``weight`` (m along the ridge); the same data is in the arrays."""
+
+    graph: nx.Graph
+    positions: np.ndarray  # (n, 2) world x, y
+    clearance: np.ndarray  # (n,) m
+    cells: np.ndarray  # (n, 2) row, col
+    edges: np.ndarray  # (m, 2) node ids, u < v, sorted
+    lengths: np.ndarray  # (m,) m
+    edge_cells: tuple[np.ndarray, ...]  # per edge: flat cell indices along the ridge
+    ridge: np.ndarray = field(repr=False)  # bool grid: thinned ridge (all components)
+    shape: tuple[int, int] = (0, 0)
+
+    def __len__(self) -> int:
+        return len(self.positions)
+
+    def csgraph(self, keep: np.ndarray | None = None) -> csr_matrix:
+        """Symmetric sparse adjacency (weights in m); ``keep`` masks edges."""
+        n = len(self.positions)
+        e, w = self.edges, self.lengths
+        if keep is not None:
+            e, w = e[keep], w[keep]
+        if len(e) == 0:
+            return csr_matrix((n, n))
+        rows = np.concatenate([e[:, 0], e[:, 1]])
+        cols = np.concatenate([e[:, 1], e[:, 0]])
+        return csr_matrix((np.concatenate([w, w]), (rows, cols)), shape=(n, n))
+
+
+def ridge_cells(free: np.ndarray, resolution: float, config: VoronoiConfig
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """(ridge mask before thinning, clearance (m) of every cell); see the module doc."""
+    dist_m, feat = distance_field(~free, resolution, with_features=True)
+    assert feat is not None
+    h, w = free.shape
+    ridge = np.zeros((h, w), dtype=bool)
+    ok = free & (dist_m >= config.min_clearance)
+    fr = feat[0].astype(np.int32).ravel()
+    fc = feat[1].astype(np.int32).ravel()
+    dflat = dist_m.ravel() / resolution
+    okf = ok.ravel()
+    min_sep = config.min_ridge / resolution
+    for step in (1, w):  # right and down neighbours in flat indices
+        a = np.flatnonzero(okf[:-step] & okf[step:])
+        if step == 1:
+            a = a[(a % w) != w - 1]  # no wrap-around between rows
+        b = a + step
+        sep2 = (fr[a] - fr[b]) ** 2 + (fc[a] - fc[b]) ** 2
+        thr = np.maximum(min_sep, config.ridge_ratio * np.minimum(dflat[a], dflat[b]))
+        keep = sep2 > thr * thr
+        a, b = a[keep], b[keep]
+        if a.size == 0:
+            continue
+        # imbalance: how much farther the other cell's obstacle is than one's own
+        ra, ca = np.divmod(a, w)
+        rb, cb = np.divmod(b, w)
+        imb_a = np.hypot(ra - fr[b], ca - fc[b]) - dflat[a]
+        imb_b = np.hypot(rb - fr[a], cb - fc[a]) - dflat[b]
+        pick_a = imb_a <= imb_b
+        ridge.ravel()[a[pick_a]] = True
+        ridge.ravel()[b[~pick_a]] = True
+    return ridge, dist_m
+
+
+def thin(mask: np.ndarray) -> np.ndarray:
+    """Zhang-Suen thinning of a boolean image (vectorised; works on the mask's bounding
+    box)."""
+    if not mask.any():
+        return mask.copy()
+    rr, cc = np.nonzero(mask)
+    r0, r1, c0, c1 = rr.min(), rr.max() + 1, cc.min(), cc.max() + 1
+    img = np.pad(mask[r0:r1, c0:c1], 1).astype(np.uint8)
+    while True:
+        changed = False
+        for step in (0, 1):
+            p2 = img[:-2, 1:-1]
+            p3 = img[:-2, 2:]
+            p4 = img[1:-1, 2:]
+            p5 = img[2:, 2:]
+            p6 = img[2:, 1:-1]
+            p7 = img[2:, :-2]
+            p8 = img[1:-1, :-2]
+            p9 = img[:-2, :-2]
+            seq = (p2, p3, p4, p5, p6, p7, p8, p9, p2)
+            b = p2 + p3 + p4 + p5 + p6 + p7 + p8 + p9
+            a = sum(((seq[i] == 0) & (seq[i + 1] == 1)).astype(np.uint8) for i in range(8))
+            cond = (img[1:-1, 1:-1] == 1) & (b >= 2) & (b <= 6) & (a == 1)
+            if step == 0:
+                cond &= (p2 * p4 * p6 == 0) & (p4 * p6 * p8 == 0)
+            else:
+                cond &= (p2 * p4 * p8 == 0) & (p2 * p6 * p8 == 0)
+            if cond.any():
+                img[1:-1, 1:-1][cond] = 0
+                changed = True
+        if not changed:
+            break
+    out = np.zeros_like(mask)
+    out[r0:r1, c0:c1] = img[1:-1, 1:-1].astype(bool)
+    return out
+
+
+def _pixel_graph(mask: np.ndarray) -> tuple[np.ndarray, csr_matrix]:
+    """(flat indices of the mask's pixels in raster order, adjacency with step lengths in
+    cells): 4-neighbours always, diagonal neighbours only without a 4-neighbour detour."""
+    h, w = mask.shape
+    flat = np.flatnonzero(mask.ravel())
+    index = np.full(h * w, -1, dtype=np.int64)
+    index[flat] = np.arange(len(flat))
+    m = np.pad(mask, 1)
+    core = m[1:-1, 1:-1]
+    src: list[np.ndarray] = []
+    dst: list[np.ndarray] = []
+    wts: list[np.ndarray] = []
+    for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
+        nb = m[1 + dr:1 + dr + h, 1 + dc:1 + dc + w]
+        e = core & nb
+        if dr and dc:
+            e &= ~m[1:1 + h, 1 + dc:1 + dc + w] & ~m[1 + dr:1 + dr + h, 1:1 + w]
+        r, c = np.nonzero(e)
+        src.append(index[r * w + c])
+        dst.append(index[(r + dr) * w + (c + dc)])
+        wts.append(np.full(len(r), _SQRT2 if dr and dc else 1.0))
+    s, d, wt = np.concatenate(src), np.concatenate(dst), np.concatenate(wts)
+    n = len(flat)
+    adj = csr_matrix((np.concatenate([wt, wt]), (np.concatenate([s, d]), np.concatenate([d, s]))),
+                     shape=(n, n))
+    adj.sort_indices()
+    return flat, adj
+
+
+def _trace_chains(adj: csr_matrix) -> list[tuple[list[int], list[float]]]:
+    """Chains between key pixels (degree != 2) as (pixel list, cumulative length in cells
+    along it), each once; loops without a key pixel start at their lowest pixel."""
+    indptr = adj.indptr.tolist()
+    indices = adj.indices.tolist()
+    data = adj.data.tolist()
+    n = len(indptr) - 1
+    deg = [indptr[i + 1] - indptr[i] for i in range(n)]
+    used: set[tuple[int, int]] = set()
+    chains: list[tuple[list[int], list[float]]] = []
+
+    def walk(start: int, k: int) -> None:
+        nxt = indices[k]
+        if (start, nxt) in used:
+            return
+        path = [start]
+        cum = [0.0]
+        prev, cur, wgt = start, nxt, data[k]
+        while True:
+            used.add((prev, cur))
+            used.add((cur, prev))
+            path.append(cur)
+            cum.append(cum[-1] + wgt)
+            if deg[cur] != 2 or cur == start:
+                break
+            a = indptr[cur]
+            j = a + 1 if indices[a] == prev else a
+            prev, cur, wgt = cur, indices[j], data[j]
+            if (prev, cur) in used:
+                break
+        chains.append((path, cum))
+
+    for p in range(n):
+        if deg[p] != 2:
+            for k in range(indptr[p], indptr[p + 1]):
+                walk(p, k)
+    for p in range(n):  # pure loops
+        if deg[p] == 2 and (p, indices[indptr[p]]) not in used:
+            walk(p, indptr[p])
+    return chains
+
+
+@dataclass(frozen=True, eq=False)
+class RidgeGraph:
+    """The thinned ridge as a pixel graph, before choosing a component (what depends on
+    the occupancy grid only; the builder caches it while the grid does not change)."""
+
+    ridge: np.ndarray  # bool grid
+    clearance: np.ndarray  # m per cell
+    flat: np.ndarray  # flat cell index of each ridge pixel, raster order
+    adj: csr_matrix  # pixel adjacency, step lengths in cells
+    component: np.ndarray  # component label per pixel
+
+
+def ridge_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None) -> RidgeGraph:
+    """Steps 1-2 of the module doc: ridge cells, thinning, pixel graph, components."""
+    cfg = config or VoronoiConfig()
+    free = ~obstacles(occ)
+    ridge0, dist_m = ridge_cells(free, occ.resolution, cfg)
+    ridge = thin(ridge0)
+    flat, adj = _pixel_graph(ridge)
+    if len(flat):
+        _, comp = connected_components(adj, directed=False)
+    else:
+        comp = np.zeros(0, dtype=np.int32)
+    return RidgeGraph(ridge, dist_m, flat, adj, comp)
+
+
+def voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
+                  anchor: tuple[float, float] | None = None,
+                  ridge: RidgeGraph | None = None) -> VoronoiGraph:
+    """The sparsified generalized Voronoi graph of the explored free space of ``occ``
+    (``ridge``: a :func:`ridge_graph` of the same grid, to skip steps 1-2)."""
+    cfg = config or VoronoiConfig()
+    rg = ridge if ridge is not None else ridge_graph(occ, cfg)
+    res = occ.resolution
+    dist_m = rg.clearance
+    h, w = rg.ridge.shape
+    empty = VoronoiGraph(nx.Graph(), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2), np.int64),
+                         np.zeros((0, 2), np.int64), np.zeros(0), (), rg.ridge, (h, w))
+    if len(rg.flat) == 0:
+        return empty
+    flat, adj, comp = rg.flat, rg.adj, rg.component
+    if anchor is not None:
+        pr, pc = np.divmod(flat, w)
+        px, py = occ.center_of(pr, pc)
+        d2 = (px - anchor[0]) ** 2 + (py - anchor[1]) ** 2
+        target = comp[int(np.argmin(d2))]
+    else:
+        sizes = np.bincount(comp)
+        target = int(np.flatnonzero(sizes == sizes.max())[0])
+    keep = np.flatnonzero(comp == target)
+    flat = flat[keep]
+    adj = adj[keep][:, keep].tocsr()
+    adj.sort_indices()
+    chains = _trace_chains(adj)
+    n = adj.shape[0]
+    deg = np.diff(adj.indptr)
+    # drop short spurs (leaf chains ending at a junction)
+    spur = cfg.min_spur / res
+    kept: list[tuple[list[int], list[float]]] = []
+    for path, cum in chains:
+        length = cum[-1]
+        a, b = path[0], path[-1]
+        leaf = deg[a] == 1 or deg[b] == 1
+        junction = deg[a] >= 3 or deg[b] >= 3
+        if leaf and junction and length < spur:
+            continue
+        kept.append((path, cum))
+    step = cfg.node_spacing / res
+    node_px: set[int] = set()
+    segs: list[tuple[list[int], float]] = []
+    pairs: set[tuple[int, int]] = set()
+    for path, cum in kept:
+        length = cum[-1]
+        k = max(1, int(round(length / step)))
+        a, b = path[0], path[-1]
+        if a == b:
+            k = max(k, 3)
+        elif (min(a, b), max(a, b)) in pairs and k < 2:
+            k = 2
+        pairs.add((min(a, b), max(a, b)))
+        cum_arr = np.asarray(cum)
+        cuts = [0]
+        for i in range(1, k):
+            target_len = length * i / k
+            j = int(np.searchsorted(cum_arr, target_len))
+            j = min(max(j, cuts[-1] + 1), len(path) - 1)
+            if j < len(path) - 1:
+                cuts.append(j)
+        cuts.append(len(path) - 1)
+        for s0, s1 in zip(cuts[:-1], cuts[1:], strict=True):
+            seg = path[s0:s1 + 1]
+            segs.append((seg, float(cum_arr[s1] - cum_arr[s0])))
+            node_px.add(seg[0])
+            node_px.add(seg[-1])
+    if not segs:
+        node_px = {0} if n else set()  # a lone ridge cell
+    order = sorted(node_px, key=lambda p: int(flat[p]))
+    node_id = {p: i for i, p in enumerate(order)}
+    cells_flat = flat[np.asarray(order, dtype=np.int64)]
+    rows, cols = np.divmod(cells_flat, w)
+    xs, ys = occ.center_of(rows, cols)
+    positions = np.stack([xs, ys], axis=1)
+    clearance = dist_m[rows, cols]
+    edge_map: dict[tuple[int, int], tuple[float, np.ndarray]] = {}
+    for seg, length in segs:
+        u, v = node_id[seg[0]], node_id[seg[-1]]
+        if u == v:
+            continue
+        key = (min(u, v), max(u, v))
+        cells = flat[np.asarray(seg if u < v else seg[::-1], dtype=np.int64)]
+        lm = length * res
+        if key not in edge_map or lm < edge_map[key][0]:
+            edge_map[key] = (lm, cells)
+    keys = sorted(edge_map)
+    edges = np.asarray(keys, dtype=np.int64).reshape(-1, 2)
+    lengths = np.asarray([edge_map[k][0] for k in keys], dtype=np.float64)
+    edge_cells = tuple(edge_map[k][1] for k in keys)
+    g = nx.Graph()
+    for i in range(len(order)):
+        g.add_node(i, pos=(float(positions[i, 0]), float(positions[i, 1])),
+                   clearance=float(clearance[i]), cell=(int(rows[i]), int(cols[i])))
+    for (u, v), lm in zip(keys, lengths.tolist(), strict=True):
+        g.add_edge(u, v, weight=lm)
+    return VoronoiGraph(g, positions, clearance, np.stack([rows, cols], axis=1), edges,
+                        lengths, edge_cells, rg.ridge, (h, w))
