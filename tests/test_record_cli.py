@@ -104,3 +104,20 @@ def test_option_errors(tmp_path: Path) -> None:
     out.write_bytes(b"keep")
     r = _run("-o", str(out), "--frames", "1")
     assert r.exit_code == 2 and "--force" in r.output and out.read_bytes() == b"keep"
+
+
+def test_same_bytes_in_a_fresh_process(tmp_path: Path) -> None:
+    """A separate interpreter (other hash seed, fresh PyBullet) writes the same log."""
+    import hashlib
+    import subprocess
+    import sys
+
+    args = ["record", "--seed", "2", "--rooms", "4,5", "--frames", "30", "--resolution",
+            "48x36", "--noise", "strong", "--quiet"]
+    a, b = tmp_path / "a.mcap", tmp_path / "b.mcap"
+    r = CliRunner().invoke(cli, [*args, "-o", str(a)])
+    assert r.exit_code == 0, r.output
+    code = f"from sgtool.cli import main; main({[*args, '-o', str(b)]!r})"
+    subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
+                   env={"PYTHONHASHSEED": "77", "PATH": "/usr/bin:/bin"})
+    assert hashlib.sha256(a.read_bytes()).digest() == hashlib.sha256(b.read_bytes()).digest()

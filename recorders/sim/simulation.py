@@ -49,6 +49,7 @@ from sgtool.recorders.sim.camera import (
     base_T_camera,
     depth_from_buffer,
     ids_from_segmentation,
+    pixel_ray,
     projection_matrix,
     se2_matrix,
     view_matrix,
@@ -119,6 +120,7 @@ class Simulation:
         self.robot = robot or RobotConfig()
         self.fps = float(fps)
         self._dt = Fraction(fps).limit_denominator(1_000_000)
+        self.base: Pose2 = self._start_pose(start)
         self._pb = pybullet()
         self.client = self._pb.connect(self._pb.DIRECT)
         try:
@@ -130,7 +132,6 @@ class Simulation:
         self.intrinsics = self.camera.intrinsics()
         self._proj = projection_matrix(self.camera)
         self._base_T_cam = base_T_camera(self.camera.mount_height, self.camera.tilt_deg)
-        self.base: Pose2 = self._start_pose(start)
         self.tick_index = 0
         self.travelled_m = 0.0
         self.observers: list[SimObserver] = []
@@ -222,17 +223,14 @@ class Simulation:
     def ray_depth(self, u: float, v: float) -> float:
         """Depth along the optical axis of the first surface through pixel (u, v), by a
         PyBullet ray test against the collision shapes (0 when nothing is within range)."""
-        from sgtool.recorders.sim.camera import pixel_ray
-
         pose = self.camera_matrix()
-        d = pixel_ray(self.intrinsics, u, v)
-        length = self.camera.depth_max * float(np.linalg.norm(d))
+        d = pixel_ray(self.intrinsics, u, v)  # z = 1: the ray's end lies at z = depth_max
         origin = pose[:3, 3]
         end = origin + pose[:3, :3] @ (d * self.camera.depth_max)
         hit = self._pb.rayTest(origin.tolist(), end.tolist(), physicsClientId=self.client)[0]
         if hit[0] < 0:
             return 0.0
-        return float(hit[2]) * length / float(np.linalg.norm(d))
+        return float(hit[2]) * self.camera.depth_max  # hit fraction of the way to z = max
 
     # ----- clock ------------------------------------------------------------------------
     def tick(self) -> None:
