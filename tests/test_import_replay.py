@@ -5,7 +5,7 @@ and the Voronoi graph of one room must come out plausible, and the missing seman
 Stated ranges and why:
 - ICL-NUIM livingroom1 (211 frames, 3.7 m of camera path, every 2nd frame replayed) and
   7-Scenes redkitchen (100 frames, 6.8 m): a hand-held Kinect in one room sees a few
-  square metres of floor; free area 2-15 m^2 (measured 4.0 and 3.7 m^2), obstacles
+  square metres of floor; free area 2-15 m^2 (measured 4.4 and 4.7 m^2), obstacles
   (walls, sofa, counters) 0.5-20 m^2 (1.8 and 7.8 m^2), and everything occupied within a
   room-sized box of 1.5-8 m a side;
 - the camera's path is mostly free: a hand-held camera is carried by someone standing on
@@ -14,7 +14,9 @@ Stated ranges and why:
   ICL 100 %, 7-Scenes 84 %);
 - the Voronoi graph is connected and no node is in or near an obstacle: every node on a
   free cell at least ``min_clearance`` (0.2 m) minus one cell from any occupied or
-  unknown cell, checked with an independent distance transform.
+  unknown cell, checked with an independent distance transform. In the living room it
+  has edges (measured: 10 nodes); in the kitchen the free floor is an aisle between
+  counters too narrow for more than one node at 0.2 m clearance (measured: 1 node).
 """
 
 from __future__ import annotations
@@ -47,7 +49,8 @@ def replay(log: Path):  # type: ignore[no-untyped-def]
     return b, sg, np.array(cams)
 
 
-def check_room(b, sg, cams: np.ndarray, free_m2: tuple[float, float]) -> dict[str, float]:  # type: ignore[no-untyped-def]
+def check_room(b, sg, cams: np.ndarray, free_m2: tuple[float, float], min_nodes: int  # type: ignore[no-untyped-def]
+               ) -> dict[str, float]:
     occ = b.layers.occupancy
     vg = b.layers.voronoi
     res = occ.resolution
@@ -62,7 +65,7 @@ def check_room(b, sg, cams: np.ndarray, free_m2: tuple[float, float]) -> dict[st
     r, c = occ.cell_of(cams[:, 0], cams[:, 1])
     assert np.mean(grid[r, c] == bev.FREE) >= 0.75
     # the Voronoi graph: connected, every node well inside free space
-    assert len(vg) >= 1
+    assert len(vg) >= min_nodes
     assert nx.is_connected(vg.graph)
     clearance = ndimage.distance_transform_edt(grid == bev.FREE) * res
     min_clear = b.config.voronoi.min_clearance
@@ -71,7 +74,7 @@ def check_room(b, sg, cams: np.ndarray, free_m2: tuple[float, float]) -> dict[st
         assert clearance[row, col] >= min_clear - res
     # geometry only: no objects, no room categories, and the graph says where to explore
     assert sg.objects == () and sg.doors == ()
-    assert all(not room.scores for room in sg.rooms)
+    assert all(room.category == "unknown" and not room.category_scores for room in sg.rooms)
     assert len(b.layers.frontiers) >= 1
     return {"free": free, "occupied": occupied, "nodes": len(vg)}
 
@@ -81,7 +84,7 @@ def test_replay_icl_livingroom(shared_data_dir, tmp_path):
     import_rgbd(shared_data_dir / "rgbd" / "icl-livingroom1-micro", out,
                 RgbdOptions(every=2, progress=False))
     b, sg, cams = replay(out)
-    check_room(b, sg, cams, (2.0, 15.0))
+    check_room(b, sg, cams, (2.0, 15.0), min_nodes=4)
 
 
 def test_replay_7scenes_kitchen(shared_data_dir, tmp_path):
@@ -89,4 +92,4 @@ def test_replay_7scenes_kitchen(shared_data_dir, tmp_path):
     import_rgbd(shared_data_dir / "rgbd" / "7scenes-redkitchen-every10", out,
                 RgbdOptions(progress=False))
     b, sg, cams = replay(out)
-    check_room(b, sg, cams, (2.0, 15.0))
+    check_room(b, sg, cams, (2.0, 15.0), min_nodes=1)
