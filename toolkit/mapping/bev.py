@@ -9,10 +9,13 @@ voxel (within ``floor_tolerance`` of the floor, or below it) is **free**; else *
 Things above ``band_top`` (door lintels, lamps, the ceiling) never block: the robot passes
 under them.
 
-Two fixes for what a camera cannot see:
+Three fixes for what a camera cannot see:
 
 - the cells under the robot's footprint along its trajectory are free (the camera never
   sees the floor it stands on);
+- the ground cells under camera rays that end on the floor are free (:func:`floor_fans`,
+  :meth:`ColumnGrid.carve`): a camera pitched down never sees the floor right in front
+  of the robot, and spinning in place would leave a blind ring around it;
 - small unknown holes in free space (floor cells that far, grazing rays skipped, a few
   cells wide) become free when they are enclosed by free cells and smaller than
   ``max_hole``; a hole touching an obstacle or the map border stays unknown.
@@ -163,6 +166,7 @@ class ColumnGrid:
 
     OCC = np.uint8(1)
     FLOOR = np.uint8(2)
+    CARVED = np.uint8(4)
 
     def __init__(self, resolution: float, config: BevConfig) -> None:
         self.resolution = resolution
@@ -195,6 +199,32 @@ class ColumnGrid:
             if len(cols):
                 self.flags[cols[:, 1] - iy0, cols[:, 0] - ix0] |= flag
 
+    def carve(self, fans: np.ndarray, level: int) -> None:
+        """Mark the ground cells under camera rays that end on the floor (see
+        :func:`floor_fans`): ``fans`` rows (cam_x, cam_y, end_x, end_y, end_z)."""
+        if len(fans) == 0:
+            return
+        res = self.resolution
+        tol = int(round(self.config.floor_tolerance / res))
+        ez = np.floor(fans[:, 4] / res).astype(np.int64)
+        f = fans[ez <= level + tol]
+        if len(f) == 0:
+            return
+        xy = np.concatenate([f[:, 0:2], f[:, 2:4]])
+        self._fit([np.floor(xy / res).astype(np.int64)], ())
+        assert self.extent is not None
+        vec = f[:, 2:4] - f[:, 0:2]
+        length = np.hypot(vec[:, 0], vec[:, 1])
+        n = np.ceil(length / res).astype(np.int64) + 1  # samples per ray, one per cell
+        ray = np.repeat(np.arange(len(f)), n)
+        first = np.concatenate([[0], np.cumsum(n)[:-1]])
+        t = (np.arange(int(n.sum())) - first[ray]) / np.maximum(n[ray] - 1, 1)
+        x = f[ray, 0] + vec[ray, 0] * t
+        y = f[ray, 1] + vec[ray, 1] * t
+        c = np.floor(x / res).astype(np.int64) - self.extent[0]
+        r = np.floor(y / res).astype(np.int64) - self.extent[1]
+        self.flags[r, c] |= self.CARVED
+
     def occupancy(self, trajectory: Sequence[tuple[float, float]] = (),
                   level: int = 0) -> OccupancyGrid:
         """The occupancy grid (module doc) of the flags plus the trajectory footprint."""
@@ -213,7 +243,7 @@ def occupancy_grid(flags: np.ndarray, extent: tuple[int, int, int, int], resolut
     ix0, iy0 = extent[0], extent[1]
     h, w = flags.shape
     grid = np.full((h, w), UNKNOWN, dtype=np.int8)
-    grid[(flags & ColumnGrid.FLOOR) != 0] = FREE
+    grid[(flags & (ColumnGrid.FLOOR | ColumnGrid.CARVED)) != 0] = FREE
     if len(trajectory):
         grid[footprint(trajectory, extent, (h, w), resolution, config.robot_radius)] = FREE
     grid[(flags & ColumnGrid.OCC) != 0] = OCCUPIED
@@ -260,6 +290,36 @@ def grid_extent(column_sets: Sequence[np.ndarray], resolution: float, config: Be
     ix1 = -((-(max(xs) + m + 1)) // s) * s - 1
     iy1 = -((-(max(ys) + m + 1)) // s) * s - 1
     return ix0, iy0, ix1, iy1
+
+
+def floor_fans(depth: np.ndarray, pose: np.ndarray, fx: float, fy: float, cx: float,
+               cy: float, every: int = 8, min_range: float = 0.1,
+               max_range: float = 5.0) -> np.ndarray:
+    """The blind zone in front of the camera, as rays: for every ``every``-th image
+    column, the bottom-most valid pixel (the nearest ground point the camera sees in that
+    direction). Rows (cam_x, cam_y, end_x, end_y, end_z) in the world; at refresh, rays
+    ending on the floor clear the ground cells they pass over (:meth:`ColumnGrid.carve`):
+    a camera pitched down never sees the floor right in front of the robot, and an
+    obstacle there, up to the ray's height, would have been hit instead of the floor."""
+    h, w = depth.shape
+    cols = np.arange(0, w, every)
+    d = depth[:, cols]
+    with np.errstate(invalid="ignore"):
+        valid = (d >= min_range) & (d < max_range)
+    has = valid.any(axis=0)
+    if not has.any():
+        return np.zeros((0, 5))
+    row = h - 1 - np.argmax(valid[::-1], axis=0)
+    cols, row = cols[has], row[has]
+    z = d[row, np.flatnonzero(has)].astype(np.float64)
+    xc = (cols - cx) / fx * z
+    yc = (row - cy) / fy * z
+    R, t = pose[:3, :3], pose[:3, 3]  # noqa: N806
+    ex = R[0, 0] * xc + R[0, 1] * yc + R[0, 2] * z + t[0]
+    ey = R[1, 0] * xc + R[1, 1] * yc + R[1, 2] * z + t[1]
+    ez = R[2, 0] * xc + R[2, 1] * yc + R[2, 2] * z + t[2]
+    k = len(z)
+    return np.stack([np.full(k, t[0]), np.full(k, t[1]), ex, ey, ez], axis=1)
 
 
 def footprint(trajectory: Sequence[tuple[float, float]], extent: tuple[int, int, int, int],

@@ -254,3 +254,68 @@ def walk(points: Sequence[tuple[float, float]], step: float = 0.1
             f = i / n
             out.append((x0 + f * (x1 - x0), y0 + f * (y1 - y0), yaw))
     return out
+
+
+def two_room_house(opening: str = "open") -> Any:
+    """A small :class:`~sgtool.datasets.house.HouseSpec` for tests: a kitchen [0, 4] x
+    [0, 3] and a bedroom [4, 8] x [0, 3] joined at x = 4 (y 1.05-1.95) by an open door
+    (``opening="open"``), a closed door (``"closed"``) or a doorless open-plan passage
+    (``"passage"``). Kitchen: a closed refrigerator in the corner (0, 0) holding an apple, a
+    countertop by the dividing wall at (3.6, 2.6) with a cup on top. Bedroom: a bed along
+    the far wall, a closed wardrobe with a sweater inside."""
+    from sgtool.datasets.house import load_house
+
+    def wall(i: int, a: list[float], b: list[float]) -> dict[str, Any]:
+        return {"id": f"wall_{i}", "a": a, "b": b, "thickness": 0.1, "height": 2.5}
+
+    def furn(i: int, cat: str, synset: str, room: str, center: list[float],
+             size: list[float], aff: list[str], state: str | None) -> dict[str, Any]:
+        return {"id": f"furn_{i}", "category": cat, "synset": synset, "room": room,
+                "center": center, "size": size, "yaw": 0, "affordances": aff, "state": state}
+
+    def obj(i: int, cat: str, parent: str, rel: str, room: str, pos: list[float]
+            ) -> dict[str, Any]:
+        return {"id": f"obj_{i}", "category": cat, "synset": f"{cat}.n.01", "parent": parent,
+                "relation": rel, "room": room, "position": pos, "size": [0.1, 0.1, 0.1]}
+
+    group = "open_0" if opening == "passage" else None
+    spec: dict[str, Any] = {
+        "version": "1.0", "seed": 0,
+        "rooms": [
+            {"id": "room_0", "category": "kitchen", "polygon": [[0, 0], [4, 0], [4, 3], [0, 3]],
+             "open_plan_group": group},
+            {"id": "room_1", "category": "bedroom", "polygon": [[4, 0], [8, 0], [8, 3], [4, 3]],
+             "open_plan_group": group},
+        ],
+        "walls": [
+            wall(0, [0, 0], [8, 0]), wall(1, [0, 3], [8, 3]), wall(2, [0, 0], [0, 3]),
+            wall(3, [8, 0], [8, 3]), wall(4, [4, 0], [4, 1.05]), wall(5, [4, 1.95], [4, 3]),
+        ],
+        "doors": [],
+        "passages": [],
+        "furniture": [
+            furn(0, "refrigerator", "electric_refrigerator.n.01", "room_0", [0.45, 0.4, 0.9],
+                 [0.7, 0.6, 1.8], ["container", "openable"], "closed"),
+            furn(1, "countertop", "countertop.n.01", "room_0", [3.6, 2.6, 0.45],
+                 [0.6, 0.6, 0.9], ["supporter"], None),
+            furn(2, "bed", "bed.n.01", "room_1", [7.0, 1.5, 0.3], [1.6, 2.0, 0.6],
+                 ["supporter"], None),
+            furn(3, "wardrobe", "wardrobe.n.01", "room_1", [4.6, 2.65, 1.0], [1.0, 0.5, 2.0],
+                 ["container", "openable"], "closed"),
+        ],
+        "objects": [
+            obj(0, "apple", "furn_0", "inside", "room_0", [0.45, 0.4, 1.0]),
+            obj(1, "cup", "furn_1", "ontop", "room_0", [3.6, 2.6, 0.95]),
+            obj(2, "sweater", "furn_3", "inside", "room_1", [4.6, 2.65, 1.2]),
+        ],
+        "starts": [{"x": 2.0, "y": 1.5, "yaw": 0, "room": "room_0"}],
+    }
+    if opening == "passage":
+        spec["passages"] = [{"id": "pass_0", "center": [4, 1.5], "width": 0.9,
+                             "yaw": math.pi / 2, "rooms": ["room_0", "room_1"]}]
+    elif opening in ("open", "closed"):
+        spec["doors"] = [{"id": "door_0", "center": [4, 1.5], "width": 0.9, "yaw": math.pi / 2,
+                          "state": opening, "rooms": ["room_0", "room_1"]}]
+    else:
+        raise ValueError(f"opening must be open, closed or passage, got {opening!r}")
+    return load_house(spec)

@@ -10,8 +10,11 @@ all-pairs Dijkstra to sparsify (O(N^2)). We compute the same diagram on the grid
 1. **Ridge cells.** The feature transform of the distance field
    (:func:`sgtool.mapping.esdf.distance_field`) gives every free cell its nearest obstacle
    cell. Two neighbouring cells whose nearest obstacles are far apart (more than
-   ``ridge_ratio`` times their clearance and ``min_ridge``) straddle the GVD: the one of
-   the two closer to being equidistant from both obstacles is a ridge cell. Between two
+   ``min_ridge``) straddle the GVD: the one of the two closer to being equidistant from
+   both obstacles is a ridge cell. (A threshold relative to the clearance, as in
+   ``ridge_ratio``, would suppress hairs from bumpy walls but also the bisector of a
+   doorway's two jambs seen from more than a door width away, disconnecting rooms; it is
+   off by default.) Between two
    walls that is the centre line; from a room corner, its bisector; along one straight wall
    nothing (neighbouring cells share nearly the same nearest wall cell), so the "hairs" a
    point-site Voronoi grows between adjacent wall pixels never appear. Obstacles are
@@ -52,8 +55,8 @@ _SQRT2 = math.sqrt(2.0)
 @dataclass(frozen=True)
 class VoronoiConfig:
     min_clearance: float = 0.2  # m from the nearest obstacle (or unknown) cell
-    ridge_ratio: float = 1.0  # nearest obstacles of neighbours >= this x clearance apart
-    min_ridge: float = 0.2  # m: ... and at least this far apart
+    min_ridge: float = 0.3  # m: nearest obstacles of neighbouring cells this far apart
+    ridge_ratio: float = 0.0  # ... and at least this x their clearance (0: off)
     node_spacing: float = 0.6  # m between sparsified nodes along a chain (MoMa-LLM)
     min_spur: float = 0.3  # m: dead ends shorter than this are dropped
 

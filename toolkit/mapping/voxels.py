@@ -443,7 +443,8 @@ class VoxelMap:
         keys, _ = self.entries()
         if not labs or len(keys) == 0:
             return np.zeros((0, 3), np.int64)
-        sel = keys[np.isin(keys & LABEL_MASK, np.asarray(labs, dtype=np.int64))]
+        lab = keys & LABEL_MASK
+        sel = keys[lab == labs[0]] if len(labs) == 1 else keys[np.isin(lab, labs)]
         ix, iy, iz, _ = unpack(sel)
         return np.stack([ix, iy, iz], axis=1)
 

@@ -59,6 +59,7 @@ from sgtool.mapping.bev import (
     ColumnGrid,
     OccupancyGrid,
     classify_keys,
+    floor_fans,
     floor_level,
     line_of_sight,
 )
@@ -88,6 +89,7 @@ from sgtool.scenegraph.rooms import (
     RoomSegmentation,
     RoomTracker,
     door_density,
+    opening_from_panel,
     room_neighbours,
     segment_rooms,
 )
@@ -183,6 +185,8 @@ class SceneGraphBuilder:
         self.robot: tuple[float, float, float] | None = None
         self.frames_since_refresh = 0
         self.timings: dict[str, list[float]] = defaultdict(list)
+        self._fans: list[np.ndarray] = []  # per frame: rays to the nearest ground hit
+        self._carved = 0  # frames whose fans are carved into self._columns
         self._columns: ColumnGrid | None = None
         self._level: int | None = None
         self._removals = -1
@@ -216,6 +220,11 @@ class SceneGraphBuilder:
         else:  # camera optical axis (z) projected on the floor
             yaw = math.atan2(float(src[1, 2]), float(src[0, 2]))
         self.voxels.integrate(frame, (x, y))
+        k = frame.intrinsics
+        vc = self.config.voxels
+        self._fans.append(floor_fans(np.asarray(frame.depth), np.asarray(frame.pose), k.fx,
+                                     k.fy, k.cx, k.cy, min_range=vc.min_range,
+                                     max_range=vc.max_range))
         self.trajectory.append((x, y))
         self.robot = (x, y, yaw)
         self.frames_since_refresh += 1
@@ -390,23 +399,43 @@ class SceneGraphBuilder:
             cg = ColumnGrid(res, cfg)
             cg.add(classify_keys(keys, level, res, cfg, presorted=True), self.trajectory)
             self._columns, self._level, self._removals = cg, level, self.voxels.removals
+            self._carved = 0
         else:
             new = self.voxels.drain_new_keys()
             self._columns.add(classify_keys(new, level, res, cfg), self.trajectory)
+        if self._carved < len(self._fans):
+            self._columns.carve(np.concatenate(self._fans[self._carved:]), level)
+            self._carved = len(self._fans)
         return self._columns.occupancy(self.trajectory, level)
 
     def _door_cells(self, occ: OccupancyGrid) -> np.ndarray:
+        """Door evidence (:mod:`sgtool.scenegraph.rooms`): the *passable* columns of each
+        open (or state-unknown) door -- its opening under the lintel, not the swung panel,
+        whose cells would cut the room it stands in -- else the panel's closed position,
+        else all its columns."""
         cells = np.zeros(occ.shape, dtype=bool)
-        open_doors = [i for i, v in self.instances.items()
-                      if v.kind == "door" and v.state != "closed"]
-        if not open_doors:
-            return cells
-        ijk = self.voxels.instance_voxels(open_doors)
-        if len(ijk):
-            r = ijk[:, 1] - int(round(occ.origin[1] / occ.resolution))
-            c = ijk[:, 0] - int(round(occ.origin[0] / occ.resolution))
+        ix0 = int(round(occ.origin[0] / occ.resolution))
+        iy0 = int(round(occ.origin[1] / occ.resolution))
+        for iid, v in self.instances.items():
+            if v.kind != "door" or v.state == "closed":
+                continue
+            ijk = self.voxels.instance_voxels([iid])
+            if not len(ijk):
+                continue
+            r, c = ijk[:, 1] - iy0, ijk[:, 0] - ix0
             ok = occ.inside(r, c)
-            cells[r[ok], c[ok]] = True
+            r, c = r[ok], c[ok]
+            passable = occ.grid[r, c] != OCCUPIED
+            if passable.any():
+                r, c = r[passable], c[passable]
+            else:
+                cell = np.unique(r * (occ.shape[1] + 1) + c)
+                r, c = np.divmod(cell, occ.shape[1] + 1)
+                got = opening_from_panel(r, c, occ.grid == OCCUPIED,
+                                         int(0.4 / occ.resolution))
+                if got is not None:
+                    r, c = got
+            cells[r, c] = True
         return cells
 
     def _seen(self, kinds: tuple[str, ...]) -> list[tuple[InstanceInfo, tuple[float, ...],

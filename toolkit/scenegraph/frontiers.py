@@ -7,6 +7,7 @@ centre = medoid. A cluster is **leading out** when it touches unknown cells outs
 hole-filled footprint of what has been seen (occupied or free) -- unknown space open to
 the outside of the explored area, e.g. beyond a doorway -- and an **unexplored area**
 inside its room otherwise (an unseen pocket enclosed by seen space, e.g. behind furniture).
+Pockets smaller than ``min_pocket`` (0.5 m^2) raise no frontier at all.
 
 Clusters are 8-connected components of frontier cells of at least ``min_size`` metres;
 longer ones are cut into pieces of at most ``max_size`` along their principal axis so one
@@ -33,6 +34,7 @@ class FrontierConfig:
     min_size: float = 0.3  # m (cells x resolution)
     max_size: float = 2.5  # m; longer clusters are split
     snap: float = 0.5  # m: the robot's start cell may be this far from free space
+    min_pocket: float = 0.5  # m^2: unknown pockets smaller than this are not worth a visit
 
 
 @dataclass(frozen=True, eq=False)
@@ -72,11 +74,22 @@ def reachable_free(occ: OccupancyGrid, start: tuple[float, float] | None,
 
 
 def frontier_cells(occ: OccupancyGrid, start: tuple[float, float] | None = None,
-                   snap: float = 0.5) -> np.ndarray:
+                   snap: float = 0.5, min_pocket: float = 0.0) -> np.ndarray:
     """Free cells (reachable from ``start``) 4-adjacent to unknown and not 8-adjacent to
-    occupied."""
+    occupied; unknown pockets (4-connected) under ``min_pocket`` m^2 that do not touch the
+    grid border do not count as unknown (the camera's blind ring around the robot, the
+    shadow of a chair: not places to explore)."""
     reach = reachable_free(occ, start, snap)
-    unknown = np.pad(occ.grid == UNKNOWN, 1, constant_values=True)
+    unknown = occ.grid == UNKNOWN
+    max_cells = int(min_pocket / occ.resolution**2)
+    if max_cells > 0 and unknown.any():
+        lab, n = ndimage.label(unknown, structure=_FOUR)
+        small = np.bincount(lab.ravel()) < max_cells
+        small[0] = False
+        edge = np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]])
+        small[np.unique(edge)] = False
+        unknown = unknown & ~small[lab]
+    unknown = np.pad(unknown, 1, constant_values=True)
     next_unknown = (unknown[:-2, 1:-1] | unknown[2:, 1:-1] | unknown[1:-1, :-2]
                     | unknown[1:-1, 2:])
     near_occ = ndimage.binary_dilation(occ.grid == OCCUPIED, structure=_EIGHT)
@@ -93,7 +106,7 @@ def find_frontiers(occ: OccupancyGrid, start: tuple[float, float] | None = None,
                    config: FrontierConfig | None = None) -> list[Frontier]:
     """Frontier clusters in raster order of their medoid cells."""
     cfg = config or FrontierConfig()
-    mask = frontier_cells(occ, start, cfg.snap)
+    mask = frontier_cells(occ, start, cfg.snap, cfg.min_pocket)
     if not mask.any():
         return []
     res = occ.resolution

@@ -10,11 +10,12 @@ are dropped, the room's position is the graph centre.
 
 What we do, and why it differs:
 
-- **Door evidence** is every grid cell whose column holds a voxel of an open (or
-  state-unknown) door instance, at any height: a door's lintel and frame sit exactly in
-  the opening even when its panel is swung away, whereas one point per door (the centroid
-  of a swung panel) can miss the opening by half a door width. Closed doors are walls
-  already (the graph never crosses them) and would only cut corridors running past them.
+- **Door evidence** is the doorway itself, not one point per door (the centroid of a
+  swung panel misses the opening by half a door width): the grid cells of an open (or
+  state-unknown) door instance that are passable (its lintel above the free opening),
+  or, for a door seen only as its swung panel, the panel's closed position
+  (:func:`opening_from_panel`), or else all its cells. Closed doors are walls already
+  (the graph never crosses them) and would only cut corridors running past them.
 - **Density without the 1/N_D factor**: ``gaussian_filter(door_cells, sigma=0.15 m)`` is
   ``sum_i K_H(x - x_i) * cell_area``, the kernel mass of door cells near x. With the 1/N_D
   normalisation a fixed threshold cuts less and less as more doors are observed (the same
@@ -61,6 +62,52 @@ def door_density(door_cells: np.ndarray, resolution: float, bandwidth: float) ->
         return np.zeros(door_cells.shape, dtype=np.float64)
     return ndimage.gaussian_filter(door_cells.astype(np.float64), sigma=bandwidth / resolution,
                                    mode="constant", truncate=4.0)
+
+
+def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
+                       min_width: int = 8) -> tuple[np.ndarray, np.ndarray] | None:
+    """The doorway of a door seen only as its swung-open panel: the panel's closed
+    position, found by turning it by 90 degrees about its hinge. The hinge is the end of
+    the panel (along its principal axis) with wall on exactly one side of it half a panel
+    width away; the opening lies on the other side. None when the cells are not one
+    panel at least ``min_width`` cells long or no end qualifies (then the caller uses
+    the panel's own cells)."""
+    if len(rows) < 2:
+        return None
+    pts = np.stack([cols, rows], axis=1).astype(np.float64)
+    mean = pts.mean(axis=0)
+    cen = pts - mean
+    evals, evecs = np.linalg.eigh(cen.T @ cen)
+    a = evecs[:, int(np.argmax(evals))]
+    proj = cen @ a
+    s0, s1 = float(proj.min()), float(proj.max())
+    width = s1 - s0 + 1.0
+    if width < min_width:
+        return None
+    t = np.array([-a[1], a[0]])
+    h, w = occupied.shape
+
+    def occ_near(p: np.ndarray) -> bool:
+        c, r = int(round(p[0])), int(round(p[1]))
+        win = occupied[max(r - 1, 0):min(r + 2, h), max(c - 1, 0):min(c + 2, w)]
+        return bool(win.any())
+
+    found = []
+    for s in (s0, s1):
+        end = mean + a * s
+        plus, minus = occ_near(end + t * width / 2), occ_near(end - t * width / 2)
+        if plus != minus:
+            found.append((end, -1.0 if plus else 1.0))
+    if len(found) != 1:
+        return None
+    end, sign = found[0]
+    k = int(np.ceil(2 * width)) + 1
+    f = np.linspace(0.0, width, k)[:, None]
+    p = end[None, :] + sign * t[None, :] * f
+    c = np.round(p[:, 0]).astype(np.int64)
+    r = np.round(p[:, 1]).astype(np.int64)
+    ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+    return r[ok], c[ok]
 
 
 @dataclass(frozen=True, eq=False)
