@@ -254,3 +254,13 @@ def test_cli_rgbd(rgbd_data, tmp_path):
                                  str(tmp_path / "p.mcap"), "--layout", "7scenes"])
     assert r.exit_code == 2 and "no frames found in the 7scenes layout" in r.output
     assert "Traceback" not in r.output
+
+
+def test_import_is_byte_identical(rgbd_data, tmp_path):
+    """Same folder, same options -> the same bytes (no wall clock, stable order)."""
+    outs = []
+    for name in ("a.mcap", "b.mcap"):
+        import_rgbd(rgbd_data / "7scenes-redkitchen-every10", tmp_path / name,
+                    RgbdOptions(every=20, **QUIET))
+        outs.append((tmp_path / name).read_bytes())
+    assert outs[0] == outs[1]
