@@ -1,0 +1,211 @@
+"""Scene-graph stages on hand-made inputs: rooms, assignment, frontiers, regions, categories."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.sparse import csr_matrix
+
+from sgtool.mapping.bev import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from sgtool.mapping.voronoi import voronoi_graph
+from sgtool.scenegraph.assign import AssignConfig, assign_objects
+from sgtool.scenegraph.categories import FrequencyRoomClassifier, RoomClassifier
+from sgtool.scenegraph.frontiers import FrontierConfig, find_frontiers
+from sgtool.scenegraph.regions import cluster_room
+from sgtool.scenegraph.rooms import (
+    RoomTracker,
+    door_density,
+    opening_from_panel,
+    room_neighbours,
+    segment_rooms,
+)
+
+RES = 0.05
+
+
+def cell(v: float) -> int:
+    return 4 + int(round(v / RES))
+
+
+def two_rooms() -> tuple[OccupancyGrid, np.ndarray]:
+    """Rooms [0, 4] x [0, 3] and [4, 8] x [0, 3], a doorway at x = 4, y 1.05-1.95; and the
+    doorway's cells (door evidence)."""
+    h, w = cell(3.0) + 4, cell(8.0) + 4
+    g = np.full((h, w), UNKNOWN, dtype=np.int8)
+    g[2:-2, 2:-2] = OCCUPIED
+    g[4:-4, 4:-4] = FREE
+    c = cell(4.0)
+    g[4:-4, c - 1:c + 1] = OCCUPIED
+    g[cell(1.05):cell(1.95), c - 1:c + 1] = FREE
+    door = np.zeros_like(g, dtype=bool)
+    door[cell(1.05):cell(1.95), c - 1:c + 1] = True
+    return OccupancyGrid(g, (-4 * RES, -4 * RES), RES), door
+
+
+# ----- rooms --------------------------------------------------------------------------
+def test_door_density_cuts_the_graph_into_two_rooms() -> None:
+    occ, door = two_rooms()
+    vg = voronoi_graph(occ)
+    one = segment_rooms(vg, None)
+    assert one.count == 1
+    dens = door_density(door, RES, 0.15)
+    # next to a two-cell-thick line of door cells: about 2 x 0.133
+    assert dens[cell(1.5), cell(4.0)] == pytest.approx(0.26, abs=0.03)
+    seg = segment_rooms(vg, dens)
+    assert seg.count == 2
+    xs = [vg.positions[nodes, 0] for nodes in seg.rooms]
+    assert xs[0].max() < 4.0 < xs[1].min()
+    assert seg.cut_edges.any()
+    assert room_neighbours(vg, seg) == [(0, 1)]
+    for nodes, c in zip(seg.rooms, seg.centres, strict=True):
+        assert c in nodes
+
+
+def test_room_ids_are_stable_and_unexplored_rooms_pass_theirs_on() -> None:
+    tr = RoomTracker()
+    a = np.array([[1.0, 1.0], [1.5, 1.0], [2.0, 1.0]])
+    b = np.array([[6.0, 1.0], [6.5, 1.0]])
+    assert tr.assign([a, b], 0.6) == [0, 1]
+    # next refresh: listed in the other order, shifted a little, a third room appears
+    c = np.array([[10.0, 1.0], [10.5, 1.0]])
+    assert tr.assign([b + 0.1, c, a - 0.1], 0.6) == [1, 2, 0]
+    # a closed door at x = 12 hides a room: it gets a number now...
+    assert tr.unexplored_room(door=77, position=(13.0, 1.0)) == 3
+    assert tr.unexplored_room(door=77, position=(13.0, 1.1)) == 3
+    # ...that the room found there later inherits
+    d = np.array([[13.2, 1.0], [14.0, 1.0]])
+    assert tr.assign([a, b, c, d], 0.6) == [0, 1, 2, 3]
+    assert 77 not in tr.unexplored
+
+
+def test_swung_panel_gives_its_doorway() -> None:
+    occupied = np.zeros((60, 100), dtype=bool)
+    occupied[20, :] = True  # a wall along x at row 20 ...
+    occupied[20, 40:58] = False  # ... with an 18-cell gap
+    rows = np.arange(21, 39)  # the panel, hinged at (20, 40), swung into +row
+    cols = np.full(len(rows), 40)
+    occupied[rows, cols] = True
+    got = opening_from_panel(rows, cols, occupied, min_width=8)
+    assert got is not None
+    r, c = got
+    assert np.all(np.abs(r - 20) <= 1)
+    assert c.min() <= 41 and 56 <= c.max() <= 59
+    assert opening_from_panel(rows[:4], cols[:4], occupied, min_width=8) is None
+
+
+# ----- assignment -----------------------------------------------------------------------
+def test_assignment_goes_around_the_wall_not_through_it() -> None:
+    """A wall at x = 4 with a doorway at y 2.6-3.0. The object stands against the wall in
+    the left room, seen from (2, 0.5); the nearest node (0.4 m) is in the right room."""
+    h, w = 80, 180
+    g = np.full((h, w), FREE, dtype=np.int8)
+    g[:, 80] = OCCUPIED
+    g[52:60, 80] = FREE
+    occ = OccupancyGrid(g, (0.0, 0.0), RES)
+    left = [(x, 1.5) for x in (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5)] + [(3.5, 2.8)]
+    right = [(4.5, 2.8), (4.3, 1.5), (4.3, 0.5), (5.0, 1.5), (6.0, 1.5)]
+    pos = np.array(left + right)
+    room = np.array([0] * len(left) + [1] * len(right))
+    edges = [(i, i + 1) for i in range(6)] + [(6, 7), (7, 8), (8, 9), (9, 10), (9, 11),
+                                              (11, 12)]
+    e = np.array(edges)
+    wts = np.hypot(*(pos[e[:, 0]] - pos[e[:, 1]]).T)
+    graph = csr_matrix((np.r_[wts, wts], (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])),
+                       shape=(len(pos),) * 2)
+    obj = np.array([[3.9, 0.5]])
+    vp = np.array([[2.0, 0.5]])
+    asg = assign_objects(pos, room, graph, obj, vp, occ, g == OCCUPIED)
+    assert room[asg.node[0]] == 0
+    # without a viewpoint only the Euclidean term is left: the wrong room
+    blind = assign_objects(pos, room, graph, obj, np.full((1, 2), np.nan), occ, g == OCCUPIED)
+    assert room[blind.node[0]] == 1
+    # the cost is MoMa-LLM's: path / u + (|o - n| / u) ** 1.3 + |vp - v| / u
+    cfg = AssignConfig()
+    n = asg.node[0]
+    euc = (np.hypot(*(obj[0] - pos[n])) / cfg.unit) ** cfg.exponent
+    assert asg.cost[0] > euc
+
+
+# ----- frontiers ------------------------------------------------------------------------
+def test_frontier_types() -> None:
+    """A 4 m x 3 m room whose left wall has a 1 m gap to the unknown outside, an enclosed
+    1 m x 1 m unseen pocket inside, and a tiny 0.1 m x 0.1 m one."""
+    h, w = cell(3.0) + 4, cell(4.0) + 4
+    g = np.full((h, w), UNKNOWN, dtype=np.int8)
+    g[2:-2, 2:-2] = OCCUPIED
+    g[4:-4, 4:-4] = FREE
+    g[cell(1.0):cell(2.0), 2:4] = FREE  # the gap in the left wall
+    g[cell(1.0):cell(2.0), cell(2.5):cell(3.5)] = UNKNOWN  # pocket
+    g[cell(0.4):cell(0.5), cell(1.5):cell(1.6)] = UNKNOWN  # tiny pocket
+    occ = OccupancyGrid(g, (-4 * RES, -4 * RES), RES)
+    fr = find_frontiers(occ, (1.0, 2.5), FrontierConfig(max_size=10.0))
+    kinds = sorted((f.type, round(f.medoid[0])) for f in fr)
+    assert kinds == [("leading out", 0), ("unexplored area", 3)]
+    out = next(f for f in fr if f.leading_out)
+    assert out.size == pytest.approx(1.0, abs=0.15)
+    # nothing reachable from a start outside the room's free space component
+    assert all(f.cells.shape[1] == 2 for f in fr)
+
+
+def test_long_frontiers_are_split() -> None:
+    h, w = 60, 200
+    g = np.full((h, w), FREE, dtype=np.int8)
+    g[30:, :] = UNKNOWN
+    g[:30, 0] = g[:30, -1] = g[0, :] = OCCUPIED  # walls on three sides
+    occ = OccupancyGrid(g, (0.0, 0.0), RES)
+    fr = find_frontiers(occ, (1.0, 0.5), FrontierConfig(max_size=2.5))
+    # 196 cells (the two next to the side walls excluded) in pieces of at most 2.5 m
+    assert len(fr) == 4
+    assert sum(f.size for f in fr) == pytest.approx(196 * RES)
+    assert all(f.leading_out for f in fr)
+
+
+# ----- regions --------------------------------------------------------------------------
+def test_regions_split_long_rooms_deterministically() -> None:
+    pos = np.array([[x, 0.0] for x in np.arange(0.0, 12.0, 0.5)])
+    reg = cluster_room(pos, length=11.5, centre=12)
+    assert len(reg.centres) == 3  # round(11.5 / 4)
+    # contiguous clusters along the line (labels change twice), numbered by centre node
+    assert np.count_nonzero(np.diff(reg.labels)) == 2
+    assert list(reg.labels) == sorted(reg.labels)
+    assert list(reg.centres) == sorted(reg.centres)
+    again = cluster_room(pos, length=11.5, centre=12)
+    assert np.array_equal(reg.labels, again.labels)
+    one = cluster_room(pos[:3], length=1.0, centre=1)
+    assert len(one.centres) == 1 and set(one.labels) == {0}
+
+
+# ----- categories -----------------------------------------------------------------------
+def test_frequency_classifier_is_naive_bayes() -> None:
+    table = {"kitchen": {"Refrigerator": 8, "cup": 2}, "bedroom": {"bed": 9, "cup": 1}}
+    clf = FrequencyRoomClassifier(table, alpha=1.0)
+    assert isinstance(clf, RoomClassifier)
+    ranked = clf.classify(["refrigerator", "cup", "spaceship"])
+    assert [r for r, _ in ranked] == ["kitchen", "bedroom"]
+    # P(kitchen) / P(bedroom) = (9/13 * 3/13) / (1/13 * 2/13)  (V = 3, N = 10 each)
+    p = dict(ranked)
+    assert p["kitchen"] / p["bedroom"] == pytest.approx((9 * 3) / (1 * 2))
+    assert sum(p.values()) == pytest.approx(1.0)
+    assert clf.classify(["spaceship"]) == [] and clf.classify([]) == []
+    with pytest.raises(ValueError):
+        FrequencyRoomClassifier({})
+
+
+@pytest.mark.parametrize("objects,room", [
+    (["bed", "nightstand"], "bedroom"),
+    (["toilet", "bathtub"], "bathroom"),
+    (["refrigerator", "stove", "dishwasher"], "kitchen"),
+    (["sofa", "coffee table", "television"], "living_room"),
+])
+def test_classifier_from_training_knowledge(objects: list[str], room: str) -> None:
+    clf = _trained()
+    assert clf.classify(objects)[0][0] == room
+
+
+_CLF: list[FrequencyRoomClassifier] = []
+
+
+def _trained() -> FrequencyRoomClassifier:
+    if not _CLF:
+        _CLF.append(FrequencyRoomClassifier.from_training_knowledge())
+    return _CLF[0]
