@@ -396,15 +396,16 @@ def line_of_sight(blocked: np.ndarray, occ: OccupancyGrid, a: np.ndarray, b: np.
     vec = b - a
     length = np.hypot(vec[:, 0], vec[:, 1])
     usable = np.maximum(length - skip_end, 0.0)
-    step = occ.resolution / 2.0
-    n = int(np.ceil(usable.max() / step)) + 1
-    f = np.linspace(0.0, 1.0, n)[None, :] * usable[:, None]  # (k, n) metres from a
-    with np.errstate(invalid="ignore", divide="ignore"):
-        unit = np.where(length[:, None] > 0, vec / np.maximum(length, 1e-12)[:, None], 0.0)
-    x = a[:, 0:1] + unit[:, 0:1] * f
-    y = a[:, 1:2] + unit[:, 1:2] * f
-    r, c = occ.cell_of(x, y)
+    n = np.ceil(usable / (occ.resolution / 2.0)).astype(np.int64) + 1  # samples per segment
+    seg = np.repeat(np.arange(k), n)
+    first = np.concatenate([[0], np.cumsum(n)[:-1]])
+    f = (np.arange(int(n.sum())) - first[seg]) * (occ.resolution / 2.0)
+    f = np.minimum(f, usable[seg])
+    unit = vec / np.maximum(length, 1e-12)[:, None]
+    r, c = occ.cell_of(a[seg, 0] + unit[seg, 0] * f, a[seg, 1] + unit[seg, 1] * f)
     inside = occ.inside(r, c)
-    hit = np.ones_like(inside)
+    hit = np.ones(len(seg), dtype=bool)
     hit[inside] = blocked[r[inside], c[inside]]
-    return ~hit.any(axis=1)
+    out = np.ones(k, dtype=bool)
+    out[np.unique(seg[hit])] = False
+    return out

@@ -66,29 +66,32 @@ def assign_objects(positions: np.ndarray, node_room: np.ndarray, graph: csr_matr
     u = cfg.unit
     tree_all = cKDTree(positions)
     tree_lab = cKDTree(positions[labelled])
-    # viewpoint nodes per object
-    vp_nodes: list[np.ndarray] = []
-    vis_cache: dict[tuple[float, float], np.ndarray] = {}
-    for i in range(k):
-        vp = viewpoints[i]
-        if not np.all(np.isfinite(vp)):
-            vp_nodes.append(np.zeros(0, dtype=np.int64))
-            continue
-        key = (float(vp[0]), float(vp[1]))
-        got = vis_cache.get(key)
-        if got is None:
-            near = np.asarray(sorted(tree_all.query_ball_point(vp, cfg.viewpoint_radius)),
-                              dtype=np.int64)
-            if len(near) and cfg.line_of_sight and occ is not None and blocked is not None:
-                vis = line_of_sight(blocked, occ, np.repeat(vp[None, :], len(near), axis=0),
-                                    positions[near])
-                if vis.any():
-                    near = near[vis]
-            if len(near) == 0:
-                near = np.asarray([int(tree_all.query(vp)[1])], dtype=np.int64)
-            got = near
-            vis_cache[key] = got
-        vp_nodes.append(got)
+    # viewpoint nodes per object: the nodes within reach of each distinct viewpoint,
+    # those visible from it when any is (one batched line-of-sight test)
+    vp_key = [None if not np.all(np.isfinite(viewpoints[i])) else
+              (float(viewpoints[i][0]), float(viewpoints[i][1])) for i in range(k)]
+    distinct = sorted({v for v in vp_key if v is not None})
+    near_of: dict[tuple[float, float], np.ndarray] = {}
+    for v in distinct:
+        near_of[v] = np.asarray(sorted(tree_all.query_ball_point(v, cfg.viewpoint_radius)),
+                                dtype=np.int64)
+    if cfg.line_of_sight and occ is not None and blocked is not None and distinct:
+        seg_vp = np.concatenate([np.repeat(np.asarray([v]), len(near_of[v]), axis=0)
+                                 for v in distinct] or [np.zeros((0, 2))])
+        seg_n = np.concatenate([near_of[v] for v in distinct])
+        vis = line_of_sight(blocked, occ, seg_vp, positions[seg_n]) if len(seg_n) else \
+            np.zeros(0, bool)
+        at = 0
+        for v in distinct:
+            m = len(near_of[v])
+            sel = vis[at:at + m]
+            if sel.any():
+                near_of[v] = near_of[v][sel]
+            at += m
+    for v in distinct:
+        if len(near_of[v]) == 0:
+            near_of[v] = np.asarray([int(tree_all.query(v)[1])], dtype=np.int64)
+    vp_nodes = [near_of[v] if v is not None else np.zeros(0, dtype=np.int64) for v in vp_key]
     sources = np.unique(np.concatenate([v for v in vp_nodes if len(v)] or
                                        [np.zeros(0, np.int64)]))
     row_of = {int(s): j for j, s in enumerate(sources.tolist())}

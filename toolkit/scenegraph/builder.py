@@ -22,7 +22,9 @@ caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
    explored side leads to an unexplored room node (SCOUT sec. IV-A), placed
    ``unexplored_offset`` beyond the door;
 7. room categories from the contained furniture (all objects when a room has none) with
-   the configured :class:`~sgtool.scenegraph.categories.RoomClassifier`;
+   the configured :class:`~sgtool.scenegraph.categories.RoomClassifier`; a room with no
+   object at all whose graph is long (>= 3 m) and narrow (median node clearance <= 0.9 m)
+   is a corridor (``BuilderConfig.corridor``), otherwise "unknown";
 8. travel distances from the robot to every node over the Voronoi graph (entry: the
    visible nodes within ``entry_radius``; object and frontier: their node plus the
    straight last leg).
@@ -113,6 +115,9 @@ class BuilderConfig:
     frontier_match: float = 1.0  # m: a frontier keeps its id if its medoid moved less
     classify_kinds: tuple[str, ...] = ("furniture",)  # instance kinds voting for the type
     max_scores: int = 5  # room category scores kept per room
+    corridor: str | None = "corridor"  # the type of an empty narrow room (None: unknown)
+    corridor_clearance: float = 0.9  # m: median node clearance of a narrow room
+    corridor_length: float = 3.0  # m of Voronoi graph at least
 
 
 @dataclass(frozen=True, eq=False)
@@ -279,8 +284,8 @@ class SceneGraphBuilder:
         frontiers = find_frontiers(occ, robot_xy, cfg.frontiers)
         fids = self._frontiers.assign([f.medoid for f in frontiers], cfg.frontier_match)
         frontier_ids = [f"frontier:{i}" for i in fids]
-        f_nodes = [self._entry(vg, node_room, f.medoid, occ, blocked, labelled=True)
-                   for f in frontiers]
+        f_nodes = self._nearest_visible(vg, np.flatnonzero(node_room >= 0),
+                                        [f.medoid for f in frontiers], occ, blocked)
         tick("frontiers")
         rooms = self._room_nodes(vg, seg, room_ids, objects, doors)
         tick("categories")
@@ -593,6 +598,8 @@ class SceneGraphBuilder:
                         got = list(self.classifier.classify(list(evidence)))
                         self._class_memo[evidence] = got
                     scores = got[: self.config.max_scores]
+                elif self._corridor_like(vg, seg.rooms[i]):
+                    scores = [(str(self.config.corridor), 1.0)]
             out.append(RoomNode(
                 id=rid, category=scores[0][0] if scores else "unknown",
                 position=(float(vg.positions[c, 0]), float(vg.positions[c, 1])),
@@ -608,31 +615,63 @@ class SceneGraphBuilder:
         return out
 
     # ----- helpers ----------------------------------------------------------------------
-    def _entries(self, vg: VoronoiGraph, xy: tuple[float, float], occ: OccupancyGrid,
-                 blocked: np.ndarray, labelled_only: np.ndarray | None = None) -> np.ndarray:
-        """Visible nodes within ``entry_radius`` of ``xy`` (else the nearest node)."""
-        pos = vg.positions
-        cand = np.arange(len(pos)) if labelled_only is None else labelled_only
-        if len(cand) == 0:
-            return np.zeros(0, dtype=np.int64)
-        d = np.hypot(pos[cand, 0] - xy[0], pos[cand, 1] - xy[1])
-        near = cand[d <= self.config.entry_radius]
-        if len(near):
-            vis = line_of_sight(blocked, occ, np.repeat(np.asarray([xy]), len(near), axis=0),
-                                pos[near])
-            if vis.any():
-                return near[vis]
-        return np.asarray([int(cand[int(np.argmin(d))])], dtype=np.int64)
+    def _corridor_like(self, vg: VoronoiGraph, nodes: np.ndarray) -> bool:
+        """An empty room whose graph is long and whose nodes are close to walls: with no
+        object to vote, the geometry says corridor (transparent rule, off with
+        ``corridor=None``)."""
+        cfg = self.config
+        if cfg.corridor is None or len(nodes) < 2 or not self.instances:
+            return False  # without semantics an empty room says nothing
+        inside = np.isin(vg.edges, nodes).all(axis=1)
+        length = float(vg.lengths[inside].sum())
+        return (length >= cfg.corridor_length
+                and float(np.median(vg.clearance[nodes])) <= cfg.corridor_clearance)
 
-    def _entry(self, vg: VoronoiGraph, node_room: np.ndarray, xy: tuple[float, float],
-               occ: OccupancyGrid, blocked: np.ndarray, labelled: bool = False) -> int:
-        """The nearest visible (labelled) node of a point, -1 when there is none."""
-        cand = np.flatnonzero(node_room >= 0) if labelled else None
-        e = self._entries(vg, xy, occ, blocked, cand)
-        if len(e) == 0:
-            return -1
-        d = np.hypot(vg.positions[e, 0] - xy[0], vg.positions[e, 1] - xy[1])
-        return int(e[int(np.lexsort((e, d))[0])])
+    def _entries(self, vg: VoronoiGraph, xy: tuple[float, float], occ: OccupancyGrid,
+                 blocked: np.ndarray) -> np.ndarray:
+        """Visible nodes within ``entry_radius`` of ``xy`` (else the nearest node)."""
+        return self._visible_near(vg, np.arange(len(vg.positions)), [xy], occ, blocked)[0]
+
+    def _visible_near(self, vg: VoronoiGraph, cand: np.ndarray,
+                      points: list[tuple[float, float]], occ: OccupancyGrid,
+                      blocked: np.ndarray) -> list[np.ndarray]:
+        """Per point: the candidate nodes within ``entry_radius`` visible from it, else the
+        nearest candidate (one batched line-of-sight test for all points)."""
+        pos = vg.positions
+        if len(cand) == 0 or not points:
+            return [np.zeros(0, dtype=np.int64) for _ in points]
+        tree = cKDTree(pos[cand])
+        near = [cand[np.asarray(sorted(tree.query_ball_point(p, self.config.entry_radius)),
+                                dtype=np.int64)] for p in points]
+        a = np.concatenate([np.repeat(np.asarray([p]), len(n), axis=0)
+                            for p, n in zip(points, near, strict=True)] or [np.zeros((0, 2))])
+        idx = np.concatenate(near) if near else np.zeros(0, dtype=np.int64)
+        vis = line_of_sight(blocked, occ, a, pos[idx]) if len(idx) else np.zeros(0, bool)
+        out = []
+        at = 0
+        for p, n in zip(points, near, strict=True):
+            sel = vis[at:at + len(n)]
+            at += len(n)
+            if sel.any():
+                out.append(n[sel])
+            else:
+                out.append(np.asarray([int(cand[int(tree.query(p)[1])])], dtype=np.int64))
+        return out
+
+    def _nearest_visible(self, vg: VoronoiGraph, cand: np.ndarray,
+                         points: list[tuple[float, float]], occ: OccupancyGrid,
+                         blocked: np.ndarray) -> list[int]:
+        """Per point: the nearest visible candidate node (see :meth:`_visible_near`),
+        -1 without candidates."""
+        out = []
+        for p, e in zip(points, self._visible_near(vg, cand, points, occ, blocked),
+                        strict=True):
+            if len(e) == 0:
+                out.append(-1)
+                continue
+            d = np.hypot(vg.positions[e, 0] - p[0], vg.positions[e, 1] - p[1])
+            out.append(int(e[int(np.lexsort((e, d))[0])]))
+        return out
 
     def stage_summary(self) -> dict[str, tuple[float, float, int]]:
         """Per stage: (median ms, max ms, count)."""

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from sgtool.mapping.bev import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from sgtool.mapping.bev import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, near
 
 _EIGHT = np.ones((3, 3), dtype=bool)
 _FOUR = ndimage.generate_binary_structure(2, 1)
@@ -92,14 +92,21 @@ def frontier_cells(occ: OccupancyGrid, start: tuple[float, float] | None = None,
     unknown = np.pad(unknown, 1, constant_values=True)
     next_unknown = (unknown[:-2, 1:-1] | unknown[2:, 1:-1] | unknown[1:-1, :-2]
                     | unknown[1:-1, 2:])
-    near_occ = ndimage.binary_dilation(occ.grid == OCCUPIED, structure=_EIGHT)
-    return reach & next_unknown & ~near_occ
+    return reach & next_unknown & ~near(occ.grid == OCCUPIED)
 
 
 def outside_footprint(occ: OccupancyGrid) -> np.ndarray:
-    """Cells outside the hole-filled footprint of everything seen (free or occupied)."""
-    seen = occ.grid != UNKNOWN
-    return ~ndimage.binary_fill_holes(seen)
+    """Cells outside the hole-filled footprint of everything seen (free or occupied): the
+    unknown cells 4-connected to the grid border (everything beyond the grid is unseen)."""
+    unknown = occ.grid == UNKNOWN
+    lab, n = ndimage.label(unknown, structure=_FOUR)
+    if n == 0:
+        return unknown
+    edge = np.unique(np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]]))
+    out = np.zeros(n + 1, dtype=bool)
+    out[edge] = True
+    out[0] = False
+    return out[lab]
 
 
 def find_frontiers(occ: OccupancyGrid, start: tuple[float, float] | None = None,
@@ -111,7 +118,7 @@ def find_frontiers(occ: OccupancyGrid, start: tuple[float, float] | None = None,
         return []
     res = occ.resolution
     lab, n = ndimage.label(mask, structure=_EIGHT)
-    outside = ndimage.binary_dilation(outside_footprint(occ), structure=_EIGHT)
+    outside = near(outside_footprint(occ))
     min_cells = max(1, int(round(cfg.min_size / res)))
     max_cells = max(min_cells, int(round(cfg.max_size / res)))
     objs = ndimage.find_objects(lab)
