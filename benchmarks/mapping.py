@@ -199,9 +199,13 @@ def main(argv: list[str] | None = None) -> int:
         digest = hashlib.sha256(sg.to_json().encode()).hexdigest()[:16]
         print(f"\nhouse seed {seed}: {len(spec.rooms)} rooms, {n} frames {a.width}x{a.height}, "
               f"{len(b.voxels)} (voxel, label) entries at {b.voxels.resolution} m")
-        print(f"{'stage':<12}{'median ms':>10}{'max ms':>10}{'calls':>7}")
+        scratch = b.stage_summary(from_scratch=True)
+        print(f"{'stage':<12}{'median ms':>10}{'max ms':>10}{'calls':>7}"
+              f"{'scratch median':>16}{'scratch max':>13}")
         for stage, (med, mx, cnt) in b.stage_summary().items():
-            print(f"{stage:<12}{med:>10.2f}{mx:>10.2f}{cnt:>7}")
+            sm = scratch.get(stage)
+            extra = f"{sm[0]:>16.2f}{sm[1]:>13.2f}" if sm else ""
+            print(f"{stage:<12}{med:>10.2f}{mx:>10.2f}{cnt:>7}{extra}")
         integ = sum(b.timings["integrate"]) / 1e3
         print(f"integration: {n / integ:.1f} frames/s; integration + refreshes: "
               f"{n / (integ + sum(b.timings['refresh']) / 1e3):.1f} frames/s "

@@ -448,6 +448,23 @@ class VoxelMap:
         ix, iy, iz, _ = unpack(sel)
         return np.stack([ix, iy, iz], axis=1)
 
+    def voxels_of(self, instance_ids: list[int]) -> dict[int, np.ndarray]:
+        """Instance id -> ijk (M, 3) of its voxels, for several instances in one pass."""
+        keys, _ = self.entries()
+        labs = {i: self._label_of[i] for i in sorted(instance_ids)
+                if 0 < self._label_of.get(i, 0) < OVERFLOW_LABEL}
+        out = {i: np.zeros((0, 3), np.int64) for i in sorted(instance_ids)}
+        if not labs or len(keys) == 0:
+            return out
+        lab = keys & LABEL_MASK
+        sel = np.isin(lab, np.asarray(sorted(labs.values()), dtype=np.int64))
+        sk, sl = keys[sel], lab[sel]
+        ix, iy, iz, _ = unpack(sk)
+        ijk = np.stack([ix, iy, iz], axis=1)
+        for i, lb in labs.items():
+            out[i] = ijk[sl == lb]
+        return out
+
     def instance_voxels_by_label(self) -> tuple[np.ndarray, np.ndarray]:
         """(ijk (M, 3), instance id (M,)) of every labelled (voxel, label) entry."""
         keys, _ = self.entries()

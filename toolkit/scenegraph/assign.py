@@ -65,7 +65,6 @@ def assign_objects(positions: np.ndarray, node_room: np.ndarray, graph: csr_matr
         return Assignment(node, cost)
     u = cfg.unit
     tree_all = cKDTree(positions)
-    tree_lab = cKDTree(positions[labelled])
     # viewpoint nodes per object: the nodes within reach of each distinct viewpoint,
     # those visible from it when any is (one batched line-of-sight test)
     vp_key = [None if not np.all(np.isfinite(viewpoints[i])) else
@@ -91,33 +90,35 @@ def assign_objects(positions: np.ndarray, node_room: np.ndarray, graph: csr_matr
     for v in distinct:
         if len(near_of[v]) == 0:
             near_of[v] = np.asarray([int(tree_all.query(v)[1])], dtype=np.int64)
-    vp_nodes = [near_of[v] if v is not None else np.zeros(0, dtype=np.int64) for v in vp_key]
-    sources = np.unique(np.concatenate([v for v in vp_nodes if len(v)] or
-                                       [np.zeros(0, np.int64)]))
-    row_of = {int(s): j for j, s in enumerate(sources.tolist())}
-    dist = dijkstra(graph, directed=False, indices=sources) if len(sources) else None
+    n = len(positions)
+    # path term per distinct viewpoint: min over its nodes v of d_graph(v, n) + |vp - v|
+    path_of: dict[tuple[float, float], np.ndarray] = {}
+    if distinct:
+        sources = np.unique(np.concatenate([near_of[v] for v in distinct]))
+        row_of = np.full(n, -1, dtype=np.int64)
+        row_of[sources] = np.arange(len(sources))
+        dist = dijkstra(graph, directed=False, indices=sources).reshape(len(sources), n)
+        for v in distinct:
+            vs = near_of[v]
+            start = np.hypot(positions[vs, 0] - v[0], positions[vs, 1] - v[1])
+            path_of[v] = np.min(dist[row_of[vs]] + start[:, None], axis=0) / u
+    # Euclidean term and candidates for all objects at once (objects x nodes)
+    d_on = np.hypot(objects[:, None, 0] - positions[None, :, 0],
+                    objects[:, None, 1] - positions[None, :, 1])
+    is_lab = node_room >= 0
+    euc_all = (d_on / u) ** cfg.exponent
     for i in range(k):
-        o = objects[i]
-        cand = labelled[np.asarray(sorted(tree_lab.query_ball_point(o, cfg.candidate_radius)),
-                                   dtype=np.int64)]
-        if len(cand) == 0:
-            cand = labelled[[int(tree_lab.query(o)[1])]]
-        euc = (np.hypot(positions[cand, 0] - o[0], positions[cand, 1] - o[1]) / u) ** cfg.exponent
-        vs = vp_nodes[i]
-        if len(vs) and dist is not None:
-            vp = viewpoints[i]
-            start = np.hypot(positions[vs, 0] - vp[0], positions[vs, 1] - vp[1]) / u
-            rows = dist[[row_of[int(v)] for v in vs]][:, cand] / u  # (|vs|, |cand|)
-            path = np.min(rows + start[:, None], axis=0)
-            c = path + euc
-        else:
-            c = euc
+        cand_mask = is_lab & (d_on[i] <= cfg.candidate_radius)
+        if not cand_mask.any():  # nearest labelled node (ties: the lowest id)
+            cand_mask = np.zeros(n, dtype=bool)
+            cand_mask[labelled[int(np.argmin(d_on[i, labelled]))]] = True
+        cand = np.flatnonzero(cand_mask)
+        euc = euc_all[i, cand]
+        c = euc + path_of[vp_key[i]][cand] if vp_key[i] is not None else euc
         j = int(np.argmin(c))  # ties: the lowest node id (cand is sorted)
         if np.isfinite(c[j]):
-            node[i] = int(cand[j])
-            cost[i] = float(c[j])
+            node[i], cost[i] = int(cand[j]), float(c[j])
         else:  # no path from the viewpoint: fall back on the nearest candidate
             j = int(np.argmin(euc))
-            node[i] = int(cand[j])
-            cost[i] = float(euc[j])
+            node[i], cost[i] = int(cand[j]), float(euc[j])
     return Assignment(node, cost)

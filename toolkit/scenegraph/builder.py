@@ -37,7 +37,7 @@ and :meth:`SceneGraphBuilder.refresh` with ``from_scratch=True`` (every cache dr
 used to measure the incremental gain) gives the same graph as the incremental path. The
 room and frontier id trackers are history: replaying a log calls ``refresh`` at the same
 frames, hence the same ids. Stage timings (wall clock, never in the graph) are kept in
-:attr:`SceneGraphBuilder.timings`.
+:attr:`SceneGraphBuilder.timings` (from-scratch refreshes in ``timings_scratch``).
 """
 
 from __future__ import annotations
@@ -190,6 +190,7 @@ class SceneGraphBuilder:
         self.robot: tuple[float, float, float] | None = None
         self.frames_since_refresh = 0
         self.timings: dict[str, list[float]] = defaultdict(list)
+        self.timings_scratch: dict[str, list[float]] = defaultdict(list)  # from_scratch=True
         self._fans: list[np.ndarray] = []  # per frame: rays to the nearest ground hit
         self._carved = 0  # frames whose fans are carved into self._columns
         self._columns: ColumnGrid | None = None
@@ -253,7 +254,8 @@ class SceneGraphBuilder:
             self._columns = None
             self._ridge = None
             self._class_memo = {}
-        tick = _Ticker(self.timings)
+        timings = self.timings_scratch if from_scratch else self.timings
+        tick = _Ticker(timings)
         cfg = self.config
         occ = self._occupancy()
         tick("bev")
@@ -388,7 +390,7 @@ class SceneGraphBuilder:
         self._last = (key, sg)
         self.frames_since_refresh = 0
         tick("assemble")
-        self.timings["refresh"].append((time.perf_counter() - t_all) * 1e3)
+        timings["refresh"].append((time.perf_counter() - t_all) * 1e3)
         return sg
 
     # ----- stages -----------------------------------------------------------------------
@@ -421,10 +423,9 @@ class SceneGraphBuilder:
         cells = np.zeros(occ.shape, dtype=bool)
         ix0 = int(round(occ.origin[0] / occ.resolution))
         iy0 = int(round(occ.origin[1] / occ.resolution))
-        for iid, v in self.instances.items():
-            if v.kind != "door" or v.state == "closed":
-                continue
-            ijk = self.voxels.instance_voxels([iid])
+        doors = [iid for iid, v in self.instances.items()
+                 if v.kind == "door" and v.state != "closed"]
+        for ijk in self.voxels.voxels_of(doors).values():
             if not len(ijk):
                 continue
             r, c = ijk[:, 1] - iy0, ijk[:, 0] - ix0
@@ -673,10 +674,12 @@ class SceneGraphBuilder:
             out.append(int(e[int(np.lexsort((e, d))[0])]))
         return out
 
-    def stage_summary(self) -> dict[str, tuple[float, float, int]]:
-        """Per stage: (median ms, max ms, count)."""
+    def stage_summary(self, from_scratch: bool = False) -> dict[str, tuple[float, float, int]]:
+        """Per stage: (median ms, max ms, count) of the incremental refreshes (or of the
+        from-scratch ones)."""
+        t = self.timings_scratch if from_scratch else self.timings
         return {k: (float(np.median(v)), float(np.max(v)), len(v))
-                for k, v in sorted(self.timings.items()) if v}
+                for k, v in sorted(t.items()) if v}
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,51 @@
+"""Quality figures of a scene graph against ground-truth room polygons."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sgtool.scenegraph.quality import adjusted_rand_index, evaluate, gt_rooms_of
+
+SQUARES = {
+    "room_0": [(0.0, 0.0), (4.0, 0.0), (4.0, 4.0), (0.0, 4.0)],
+    "room_1": [(4.0, 0.0), (8.0, 0.0), (8.0, 4.0), (4.0, 4.0)],
+    "room_2": [(8.0, 0.0), (12.0, 0.0), (12.0, 4.0), (8.0, 4.0)],
+}
+CATS = {"room_0": "kitchen", "room_1": "living_room", "room_2": "bedroom"}
+
+
+def test_points_in_polygons() -> None:
+    pts = np.array([[1.0, 1.0], [5.0, 3.0], [13.0, 1.0], [11.9, 3.9]])
+    assert gt_rooms_of(pts, SQUARES) == ["room_0", "room_1", None, "room_2"]
+    l_shape = {"l": [(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)]}
+    assert gt_rooms_of(np.array([[0.5, 1.5], [1.5, 1.5]]), l_shape) == ["l", None]
+
+
+def test_adjusted_rand_index() -> None:
+    assert adjusted_rand_index([0, 0, 1, 1], [5, 5, 7, 7]) == pytest.approx(1.0)
+    assert adjusted_rand_index([0, 0, 1, 1], [0, 0, 1, 2]) == pytest.approx(0.5714, abs=1e-4)
+    assert adjusted_rand_index([0, 0, 0, 0], [0, 0, 0, 0]) == 1.0
+
+
+def test_open_plan_under_segmentation_strict_and_merged() -> None:
+    """Kitchen and living room predicted as one room (open plan), the bedroom right."""
+    xy = np.array([[1.0, 2.0], [2.0, 2.0], [3.0, 2.0], [5.0, 2.0], [9.0, 2.0], [10.0, 2.0]])
+    rooms = ["room:0", "room:0", "room:0", "room:0", "room:1", "room:1"]
+    q = evaluate(xy, rooms, {"room:0": "kitchen", "room:1": "bedroom"},
+                 object_rooms={"obj:1": "room:0", "obj:2": "room:0", "obj:3": "room:1"},
+                 object_gt={"obj:1": "room_0", "obj:2": "room_1", "obj:3": "room_2"},
+                 polygons=SQUARES, gt_categories=CATS)
+    assert (q.rooms, q.gt_rooms_seen, q.room_count_error) == (2, 3, -1)
+    assert q.purity == pytest.approx(5 / 6)
+    assert q.object_accuracy == pytest.approx(2 / 3)  # the living-room object is "wrong"
+    assert q.category_accuracy == 1.0
+    merged = evaluate(xy, rooms, {"room:0": "living_room", "room:1": "bedroom"},
+                      object_rooms={"obj:1": "room:0", "obj:2": "room:0", "obj:3": "room:1"},
+                      object_gt={"obj:1": "room_0", "obj:2": "room_1", "obj:3": "room_2"},
+                      polygons=SQUARES, gt_categories=CATS,
+                      merge={"room_0": "room_0", "room_1": "room_0"})
+    assert (merged.gt_rooms, merged.room_count_error) == (2, 0)
+    assert merged.purity == 1.0 and merged.ari == pytest.approx(1.0)
+    assert merged.object_accuracy == 1.0
+    assert merged.category_accuracy == 1.0  # "living_room" names a part of the open plan
