@@ -181,3 +181,40 @@ def test_every_node_has_one_parent_in_the_layer_above(opening: str) -> None:
             assert sg.node(o.parent).room == o.room  # type: ignore[union-attr]
     if sg.robot.region is not None:
         assert sg.robot.region in regions
+
+
+def test_empty_and_blank_input_never_fails() -> None:
+    import numpy as np
+
+    b = SceneGraphBuilder()
+    assert b.refresh(0).rooms == ()
+    blank = Frame(0, 5, None, np.full((30, 40), np.nan, dtype="float32"), None,
+                  np.eye(4), CameraIntrinsics.from_fov(40, 30, 60))
+    b.integrate(blank)
+    sg = b.refresh(5)
+    assert sg.rooms == () and sg.objects == () and sg.time_ns == 5
+
+
+def test_empty_narrow_rooms_are_corridors() -> None:
+    """The corridor rule on hand-made Voronoi graphs: long and narrow -> corridor; wide,
+    short or without semantics (no instance table) -> no guess."""
+    import numpy as np
+
+    from sgtool.mapping.bev import OccupancyGrid
+    from sgtool.mapping.voronoi import voronoi_graph
+    from sgtool.scenegraph.instances import InstanceInfo
+
+    def walled(w: float, h: float) -> OccupancyGrid:
+        g = np.full((int(h / 0.05) + 4, int(w / 0.05) + 4), 100, dtype=np.int8)
+        g[2:-2, 2:-2] = 0
+        return OccupancyGrid(g, (-0.1, -0.1), 0.05)
+
+    b = SceneGraphBuilder({1: InstanceInfo(1, "wall", "structure")}, None, CONFIG)
+    corridor = voronoi_graph(walled(6.0, 1.4))
+    room = voronoi_graph(walled(4.0, 3.0))
+    short = voronoi_graph(walled(2.0, 1.4))
+    assert b._corridor_like(corridor, np.arange(len(corridor)))
+    assert not b._corridor_like(room, np.arange(len(room)))
+    assert not b._corridor_like(short, np.arange(len(short)))
+    assert not SceneGraphBuilder(None, None, CONFIG)._corridor_like(
+        corridor, np.arange(len(corridor)))

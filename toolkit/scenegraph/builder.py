@@ -23,8 +23,8 @@ caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
    ``unexplored_offset`` beyond the door;
 7. room categories from the contained furniture (all objects when a room has none) with
    the configured :class:`~sgtool.scenegraph.categories.RoomClassifier`; a room with no
-   object at all whose graph is long (>= 3 m) and narrow (median node clearance <= 0.9 m)
-   is a corridor (``BuilderConfig.corridor``), otherwise "unknown";
+   object at all whose nodes span >= 3 m and stay within 0.9 m of a wall is a corridor
+   (``BuilderConfig.corridor``), otherwise "unknown";
 8. travel distances from the robot to every node over the Voronoi graph (entry: the
    visible nodes within ``entry_radius``; object and frontier: their node plus the
    straight last leg).
@@ -116,8 +116,8 @@ class BuilderConfig:
     classify_kinds: tuple[str, ...] = ("furniture",)  # instance kinds voting for the type
     max_scores: int = 5  # room category scores kept per room
     corridor: str | None = "corridor"  # the type of an empty narrow room (None: unknown)
-    corridor_clearance: float = 0.9  # m: median node clearance of a narrow room
-    corridor_length: float = 3.0  # m of Voronoi graph at least
+    corridor_clearance: float = 0.9  # m: no node of a narrow room is farther from a wall
+    corridor_length: float = 3.0  # m: the span of its nodes at least
 
 
 @dataclass(frozen=True, eq=False)
@@ -617,16 +617,16 @@ class SceneGraphBuilder:
 
     # ----- helpers ----------------------------------------------------------------------
     def _corridor_like(self, vg: VoronoiGraph, nodes: np.ndarray) -> bool:
-        """An empty room whose graph is long and whose nodes are close to walls: with no
-        object to vote, the geometry says corridor (transparent rule, off with
-        ``corridor=None``)."""
+        """An empty room that is long (its nodes span ``corridor_length``) and narrow (no
+        node farther than ``corridor_clearance`` from a wall): with no object to vote,
+        the geometry says corridor (transparent rule, off with ``corridor=None``)."""
         cfg = self.config
         if cfg.corridor is None or len(nodes) < 2 or not self.instances:
             return False  # without semantics an empty room says nothing
-        inside = np.isin(vg.edges, nodes).all(axis=1)
-        length = float(vg.lengths[inside].sum())
-        return (length >= cfg.corridor_length
-                and float(np.median(vg.clearance[nodes])) <= cfg.corridor_clearance)
+        p = vg.positions[nodes]
+        span = float(np.hypot(*(p.max(axis=0) - p.min(axis=0))))
+        return (span >= cfg.corridor_length
+                and float(vg.clearance[nodes].max()) <= cfg.corridor_clearance)
 
     def _entries(self, vg: VoronoiGraph, xy: tuple[float, float], occ: OccupancyGrid,
                  blocked: np.ndarray) -> np.ndarray:
