@@ -67,11 +67,15 @@ def door_density(door_cells: np.ndarray, resolution: float, bandwidth: float) ->
 def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
                        min_width: int = 8) -> tuple[np.ndarray, np.ndarray] | None:
     """The doorway of a door seen only as its swung-open panel: the panel's closed
-    position, found by turning it by 90 degrees about its hinge. The hinge is the end of
-    the panel (along its principal axis) with wall on exactly one side of it half a panel
-    width away; the opening lies on the other side. None when the cells are not one
-    panel at least ``min_width`` cells long or no end qualifies (then the caller uses
-    the panel's own cells)."""
+    position, found by turning it by 90 degrees about its hinge.
+
+    For each end of the panel (along its principal axis) and each side across it, score
+    how much the surroundings look like a doorway seen from the hinge: wall running away
+    on one side (share of occupied cells 0.1-0.45 panel widths along it), a clear opening
+    on the other (share of occupied cells along the panel's closed position, which must be
+    low) and the far jamb just beyond it. The best hinge and side must score well and
+    clearly beat every alternative; otherwise None (the caller then uses the panel's own
+    cells), as for cells that are not one panel at least ``min_width`` cells long."""
     if len(rows) < 2:
         return None
     pts = np.stack([cols, rows], axis=1).astype(np.float64)
@@ -86,24 +90,38 @@ def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
         return None
     t = np.array([-a[1], a[0]])
     h, w = occupied.shape
+    grown = ndimage.binary_dilation(occupied, structure=np.ones((3, 3), dtype=bool))
 
-    def occ_near(p: np.ndarray) -> bool:
-        c, r = int(round(p[0])), int(round(p[1]))
-        win = occupied[max(r - 1, 0):min(r + 2, h), max(c - 1, 0):min(c + 2, w)]
-        return bool(win.any())
+    def share(p0: np.ndarray, direction: np.ndarray, lo: float, hi: float,
+              grid: np.ndarray = occupied) -> float:
+        f = np.linspace(lo, hi, max(2, int(np.ceil(2 * (hi - lo)))))
+        p = p0[None, :] + direction[None, :] * f[:, None]
+        c, r = np.round(p[:, 0]).astype(np.int64), np.round(p[:, 1]).astype(np.int64)
+        ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+        return float(grid[r[ok], c[ok]].mean()) if ok.any() else 0.0
 
-    found = []
-    for s in (s0, s1):
-        end = mean + a * s
-        plus, minus = occ_near(end + t * width / 2), occ_near(end - t * width / 2)
-        if plus != minus:
-            found.append((end, -1.0 if plus else 1.0))
-    if len(found) != 1:
+    scored = []
+    for s, out in ((s0, -a), (s1, a)):
+        for sign in (1.0, -1.0):
+            d = sign * t
+            best = None
+            for off in range(4):  # the wall line may lie a few cells beyond the panel's end
+                end = mean + a * s + out * off
+                wall = share(end, -d, 0.1 * width, 0.45 * width, grown)
+                opening = share(end, d, 0.15 * width, 0.85 * width)
+                jamb = share(end, d, 1.05 * width, 1.3 * width, grown)
+                cand = (wall + jamb - 2.0 * opening, off)
+                if best is None or cand[0] > best[0]:
+                    best = cand
+            assert best is not None
+            scored.append((best[0], s, sign, best[1], out))
+    scored.sort(key=lambda x: -x[0])
+    best, second = scored[0], scored[1]
+    if best[0] < 1.0 or best[0] - second[0] < 0.5:
         return None
-    end, sign = found[0]
-    k = int(np.ceil(2 * width)) + 1
-    f = np.linspace(0.0, width, k)[:, None]
-    p = end[None, :] + sign * t[None, :] * f
+    end, d = mean + a * best[1] + best[4] * best[3], best[2] * t
+    f = np.linspace(0.0, width, int(np.ceil(2 * width)) + 1)[:, None]
+    p = end[None, :] + d[None, :] * f
     c = np.round(p[:, 0]).astype(np.int64)
     r = np.round(p[:, 1]).astype(np.int64)
     ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
