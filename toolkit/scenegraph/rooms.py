@@ -78,6 +78,18 @@ def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
     cells), as for cells that are not one panel at least ``min_width`` cells long."""
     if len(rows) < 2:
         return None
+    # work in a window around the panel (everything looked at is within 1.3 widths)
+    span = int(max(rows.max() - rows.min(), cols.max() - cols.min())) + 1
+    pad = int(1.5 * span) + 6
+    r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
+    r1 = min(int(rows.max()) + pad + 1, occupied.shape[0])
+    c1 = min(int(cols.max()) + pad + 1, occupied.shape[1])
+    got = _opening(rows - r0, cols - c0, occupied[r0:r1, c0:c1], min_width)
+    return None if got is None else (got[0] + r0, got[1] + c0)
+
+
+def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray, min_width: int
+             ) -> tuple[np.ndarray, np.ndarray] | None:
     pts = np.stack([cols, rows], axis=1).astype(np.float64)
     mean = pts.mean(axis=0)
     cen = pts - mean
