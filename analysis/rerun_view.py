@@ -68,6 +68,8 @@ def _scene_update_strips(msg: Any) -> tuple[list[np.ndarray], list[tuple[int, in
                     c = cols[i] if cols else base
                     colors.append((int(c.r * 255), int(c.g * 255), int(c.b * 255)))
             else:
+                if line.type == line.LINE_LOOP and len(pts) > 2:
+                    pts = np.concatenate([pts, pts[:1]])
                 strips.append(pts)
                 colors.append((int(base.r * 255), int(base.g * 255), int(base.b * 255)))
     return strips, colors

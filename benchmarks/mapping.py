@@ -49,9 +49,9 @@ from sgtool.mapping.synthetic import (
 )
 from sgtool.mapping.synthetic import base_pose as base_of
 from sgtool.mapping.voxels import VoxelConfig
+from sgtool.replayers.score import score, score_lines
 from sgtool.scenegraph.builder import BuilderConfig, SceneGraphBuilder
 from sgtool.scenegraph.categories import FrequencyRoomClassifier
-from sgtool.scenegraph.quality import evaluate
 
 VFOV = 60.0
 HEIGHT = 1.2
@@ -145,32 +145,7 @@ def run(builder: SceneGraphBuilder, frame_iter, compare_every: int = 100
 
 
 def quality(spec: HouseSpec, hw: HouseWorld, builder: SceneGraphBuilder, sg) -> dict:  # noqa: ANN001
-    layers = builder.layers
-    polygons = {r.id: r.polygon for r in spec.rooms}
-    gt_cat = {r.id: r.category for r in spec.rooms}
-    rooms_by_spec = {f.id: f.room for f in spec.furniture} | {o.id: o.room for o in spec.objects}
-    object_gt = {}
-    for o in sg.objects:
-        sid = hw.instances[o.instance].spec_id
-        if sid in rooms_by_spec:
-            object_gt[o.id] = rooms_by_spec[sid]
-    merge: dict[str, str] = {}
-    for p in spec.passages:  # union of rooms joined without a door
-        a, b = sorted(p.rooms)
-        ra, rb = merge.get(a, a), merge.get(b, b)
-        keep, drop = min(ra, rb), max(ra, rb)
-        for k, v in list(merge.items()):
-            if v == drop:
-                merge[k] = keep
-        merge[drop] = keep
-        merge.setdefault(keep, keep)
-    args = dict(
-        node_xy=layers.voronoi.positions, node_rooms=layers.node_rooms,
-        room_categories={r.id: r.category for r in sg.rooms if r.explored},
-        object_rooms={o.id: o.room for o in sg.objects}, object_gt=object_gt,
-        polygons=polygons, gt_categories=gt_cat,
-    )
-    return {"strict": evaluate(**args), "merged": evaluate(**args, merge=merge)}
+    return score(spec, hw.instances, builder.layers, sg)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -230,12 +205,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"graph: {len(b.layers.voronoi)} Voronoi nodes, {len(sg.rooms)} rooms "
               f"({unexplored} unexplored behind closed doors), {len(sg.objects)} objects, "
               f"{len(sg.frontiers())} frontiers, {len(sg.doors)} doors")
-        for name, v in q.items():
-            print(f"quality ({name}): rooms {v.rooms} vs {v.gt_rooms_seen} seen of {v.gt_rooms} "
-                  f"(error {v.room_count_error:+d}); node purity {v.purity:.3f}, ARI {v.ari:.3f}; "
-                  f"objects in the right room {v.object_accuracy:.1%} of {v.objects}; "
-                  f"room categories right {v.category_accuracy:.1%} of {v.rooms} "
-                  f"({v.categorised} categorised)")
+        for line in score_lines(q):
+            print(line)
     return 0
 
 

@@ -109,6 +109,72 @@ class TransformBuffer:
         return None
 
 
+FRAME_TOPICS = (S.RGB, S.DEPTH, S.IDS, S.CALIBRATION, S.TF)
+
+
+class FrameAssembler:
+    """Groups decoded frame-topic messages, pushed in log order, into frames: the depth
+    image of one log time with the RGB and id images of the same time, the calibration in
+    force and the camera pose from the transforms in force (module doc).
+
+    :meth:`push` returns the previous frame when a message of a new log time arrives;
+    :meth:`flush` returns the frame being assembled (when it has its depth image), so a
+    caller that meets another record of the same time can take the frame first."""
+
+    def __init__(self, index: int = 0, transforms: TransformBuffer | None = None,
+                 calibration: CameraIntrinsics | None = None) -> None:
+        self.index = index
+        self.transforms = transforms or TransformBuffer()
+        self.calibration = calibration
+        self._pending: dict[str, Any] = {}
+        self._t: int | None = None
+
+    def push(self, topic: str, t_ns: int, message: Any) -> Frame | None:
+        out = None
+        if self._t is not None and t_ns != self._t:
+            out = self.flush()
+            self._pending = {}
+        self._t = t_ns
+        if topic == S.TF:
+            self.transforms.add(t_ns, message.parent_frame_id, message.child_frame_id,
+                                codec.decode_transform(message))
+        elif topic == S.CALIBRATION:
+            self.calibration = codec.decode_calibration(message)
+        elif topic == S.DEPTH:
+            self._pending["depth"] = message
+        elif topic == S.RGB:
+            self._pending["rgb"] = message
+        elif topic == S.IDS:
+            self._pending["ids"] = message
+        return out
+
+    def flush(self) -> Frame | None:
+        """The frame of the current log time, if its depth image has arrived (it is then
+        handed out once); None otherwise."""
+        pending, t = self._pending, self._t
+        if "depth" not in pending or t is None:
+            return None
+        self._pending = {}
+        depth_msg = pending["depth"]
+        k = self.calibration or _fallback_intrinsics(depth_msg)
+        pose = self.transforms.lookup(t, depth_msg.frame_id or S.CAMERA_FRAME)
+        if pose is None:
+            pose = np.full((4, 4), np.nan)
+        fr = Frame(
+            index=self.index,
+            time_ns=t,
+            rgb=codec.decode_image(pending["rgb"]) if "rgb" in pending else None,
+            depth=codec.depth_from_image(depth_msg),
+            ids=codec.decode_image(pending["ids"]).astype(np.int32)
+            if "ids" in pending else None,
+            pose=pose,
+            intrinsics=k,
+            base_pose=self.transforms.lookup(t, S.BASE_FRAME),
+        )
+        self.index += 1
+        return fr
+
+
 class LogReader:
     """An open log. Use as a context manager or call :meth:`close`."""
 
@@ -304,62 +370,28 @@ class LogReader:
     ) -> Iterator[Frame]:
         """Frames in log-time order (see the module docstring)."""
         self.require(S.DEPTH, why="frames need depth images")
-        tf = TransformBuffer()
-        calib: CameraIntrinsics | None = None
-        cam_frame = S.CAMERA_FRAME
-        # transforms and calibration before the window still apply inside it
-        if start_ns is not None:
-            tf, calib = self._state_before(start_ns)
-        topics = [S.RGB, S.DEPTH, S.IDS, S.CALIBRATION, S.TF]
-        pending: dict[str, Any] = {}
-        pending_t: int | None = None
+        tf, calib = (self._state_before(start_ns) if start_ns is not None
+                     else (TransformBuffer(), None))
         index = self._frame_index_before(start_ns) if start_ns is not None else 0
-
-        def emit() -> Frame | None:
-            nonlocal index
-            if "depth" not in pending or pending_t is None:
-                return None
-            depth_msg = pending["depth"]
-            k = calib or _fallback_intrinsics(depth_msg)
-            pose = tf.lookup(pending_t, depth_msg.frame_id or cam_frame)
-            if pose is None:
-                pose = np.full((4, 4), np.nan)
-            base = tf.lookup(pending_t, S.BASE_FRAME)
-            fr = Frame(
-                index=index,
-                time_ns=pending_t,
-                rgb=codec.decode_image(pending["rgb"]) if "rgb" in pending else None,
-                depth=codec.depth_from_image(depth_msg),
-                ids=codec.decode_image(pending["ids"]).astype(np.int32)
-                if "ids" in pending else None,
-                pose=pose,
-                intrinsics=k,
-                base_pose=base,
-            )
-            index += 1
-            return fr
-
-        for d in self.messages(topics, start_ns=start_ns, end_ns=end_ns):
-            if pending_t is not None and d.log_time_ns != pending_t:
-                fr = emit()
-                if fr is not None:
-                    yield fr
-                pending = {}
-            pending_t = d.log_time_ns
-            if d.topic == S.TF:
-                tf.add(d.log_time_ns, d.message.parent_frame_id, d.message.child_frame_id,
-                       codec.decode_transform(d.message))
-            elif d.topic == S.CALIBRATION:
-                calib = codec.decode_calibration(d.message)
-            elif d.topic == S.DEPTH:
-                pending["depth"] = d.message
-            elif d.topic == S.RGB:
-                pending["rgb"] = d.message
-            elif d.topic == S.IDS:
-                pending["ids"] = d.message
-        fr = emit()
+        asm = FrameAssembler(index=index, transforms=tf, calibration=calib)
+        for d in self.messages(FRAME_TOPICS, start_ns=start_ns, end_ns=end_ns):
+            fr = asm.push(d.topic, d.log_time_ns, d.message)
+            if fr is not None:
+                yield fr
+        fr = asm.flush()
         if fr is not None:
             yield fr
+
+    def raw_messages(self, topics: Iterable[str] | None = None
+                     ) -> Iterator[tuple[Schema | None, Channel, Message]]:
+        """Undecoded (schema, channel, message) records in log-time order (ties in file
+        order); :meth:`decode` decodes one."""
+        yield from self._reader.iter_messages(
+            topics=list(topics) if topics is not None else None, log_time_order=True)
+
+    def decode(self, schema: Schema | None, channel: Channel, message: Message) -> Any:
+        """A raw message decoded as :meth:`messages` decodes it."""
+        return self._decode(schema, channel, message)
 
     def frame_times(self) -> list[int]:
         """Log times of all frames, sorted. Read from the MCAP message indexes: no chunk is

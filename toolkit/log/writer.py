@@ -140,6 +140,32 @@ class LogWriter:
         )
         self.message_count += 1
 
+    def copy_channel(self, topic: str, schema_name: str, schema_encoding: str,
+                     schema_data: bytes, message_encoding: str,
+                     metadata: dict[str, str] | None = None) -> int:
+        """Register a channel copied from another log, with its schema as it is (a foreign
+        schema keeps its bytes); returns the channel id for :meth:`write_raw`. A topic
+        copied twice gets the same id."""
+        if topic in self._channels:
+            return self._channels[topic]
+        key = f"copy\0{schema_name}\0{schema_encoding}\0" + schema_data.hex()
+        sid = self._schemas.get(key)
+        if sid is None:
+            if schema_name or schema_encoding or schema_data:
+                sid = self._mcap.register_schema(name=schema_name, encoding=schema_encoding,
+                                                 data=schema_data)
+            else:
+                sid = 0  # a schemaless channel
+            self._schemas[key] = sid
+        cid = self._mcap.register_channel(topic=topic, message_encoding=message_encoding,
+                                          schema_id=sid, metadata=dict(metadata or {}))
+        self._channels[topic] = cid
+        return cid
+
+    def write_raw(self, channel_id: int, t_ns: int, data: bytes) -> None:
+        """Write already encoded message bytes on a channel of :meth:`copy_channel`."""
+        self._add(channel_id, t_ns, data)
+
     # ----- generic ----------------------------------------------------------------------
     def write_proto(self, topic: str, t_ns: int, msg: Any) -> None:
         """Write any protobuf message (e.g. a Foxglove SceneUpdate) on ``topic``."""

@@ -1,0 +1,285 @@
+"""Golden logs: small recorded logs whose replayed scene graphs are pinned by digest.
+
+``tests/golden/`` holds, per case of :data:`CASES`, the recorded log ``NAME.mcap`` (under
+2 MB), the canonical JSON of every scene graph its replay produces
+(``NAME.graphs.jsonl.gz``, written deterministically), and ``expected.json`` with the
+digests: the sha256 of the log, of the final graph and of the whole refresh sequence. The
+regression test replays each log and, on a mismatch, prints a readable diff
+(:func:`diff_graphs`: rooms, objects, doors, frontiers, edges) of the first refresh that
+differs, not just two hashes.
+
+Regenerate on purpose only, and say why in the commit::
+
+    python -m sgtool.replayers.golden            # recompute expectations from the logs
+    python -m sgtool.replayers.golden --record   # re-record the logs first (PyBullet)
+
+The first after a deliberate change of the replay pipeline or of the shipped weights;
+the second after a change of the recorder or of the house generator.
+"""
+
+from __future__ import annotations
+
+import argparse
+import gzip
+import hashlib
+import io
+import json
+import math
+import os
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from sgtool.replayers.replay import ReplayOptions, replay
+from sgtool.replayers.stream import Refresh, SceneGraphStream
+from sgtool.scenegraph.graph import SceneGraph
+
+EXPECTED = "expected.json"
+FORMAT = 1
+REPLAY = ReplayOptions(every=10, classifier="containment")
+
+
+@dataclass(frozen=True)
+class GoldenCase:
+    name: str
+    seed: int  # generated house (evaluation split)
+    rooms: int
+    width: int
+    height: int
+    fps: float
+    frames: int | None  # frame budget (None: the whole scripted tour)
+    why: str
+
+
+CASES: tuple[GoldenCase, ...] = (
+    GoldenCase("house6-tour", 6, 4, 128, 96, 2.0, None,
+               "4 rooms: corridor, a bathroom behind a closed door the robot opens, an "
+               "open-plan kitchen + living room; the whole scripted tour"),
+    GoldenCase("house10-start", 10, 4, 128, 96, 3.0, 110,
+               "4 rooms with a closed door and an open-plan passage; stops early, so the "
+               "graph still has frontiers and rooms seen only in part"),
+)
+
+
+def default_folder() -> Path:
+    """``tests/golden`` of the source checkout this module lives in."""
+    return Path(__file__).resolve().parent.parent / "tests" / "golden"
+
+
+# ----- digests and files ---------------------------------------------------------------
+def sha256_file(path: str | os.PathLike[str]) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def sequence_digest(graphs: Sequence[str]) -> str:
+    """sha256 over the graphs' own sha256 digests, in order."""
+    h = hashlib.sha256()
+    for g in graphs:
+        h.update(hashlib.sha256(g.encode()).digest())
+    return h.hexdigest()
+
+
+def replay_graphs(log: str | os.PathLike[str], options: ReplayOptions = REPLAY
+                  ) -> list[tuple[Refresh, str]]:
+    """Every refresh of a replay of ``log`` with the canonical JSON of its graph."""
+    out: list[tuple[Refresh, str]] = []
+
+    def keep(r: Refresh, _s: SceneGraphStream) -> None:
+        out.append((r, r.graph.to_json()))
+
+    replay(log, None, options, on_refresh=keep)
+    return out
+
+
+def write_graphs(path: Path, graphs: Sequence[str]) -> None:
+    """Graphs as gzip-compressed JSON lines, byte-stable (no file name or time inside)."""
+    buf = io.BytesIO()
+    with gzip.GzipFile(fileobj=buf, mode="wb", mtime=0, filename="") as z:
+        for g in graphs:
+            z.write(g.encode() + b"\n")
+    tmp = path.with_name(path.name + ".partial")
+    tmp.write_bytes(buf.getvalue())
+    os.replace(tmp, path)
+
+
+def read_graphs(path: Path) -> list[str]:
+    with gzip.open(path, "rb") as z:
+        return [line.decode() for line in z.read().splitlines() if line]
+
+
+# ----- readable differences --------------------------------------------------------------
+def _fmt_list(xs: Sequence[str]) -> str:
+    return "[" + ", ".join(xs) + "]"
+
+
+def _scores(room: object) -> str:
+    pairs = getattr(room, "category_scores", ())
+    return "[" + ", ".join(f"{c} {p:.3f}" for c, p in pairs[:3]) + "]"
+
+
+def diff_graphs(expected: SceneGraph, actual: SceneGraph, tol: float = 1e-4) -> list[str]:
+    """What differs between two scene graphs, one line per difference, grouped by layer
+    (empty when they are equal up to ``tol`` in positions and distances)."""
+    out: list[str] = []
+    er = {r.id: r for r in expected.rooms}
+    ar = {r.id: r for r in actual.rooms}
+    for rid in sorted(er.keys() - ar.keys()):
+        out.append(f"rooms: - {rid} ({er[rid].category})")
+    for rid in sorted(ar.keys() - er.keys()):
+        out.append(f"rooms: + {rid} ({ar[rid].category})")
+    for rid in sorted(er.keys() & ar.keys()):
+        a, b = er[rid], ar[rid]
+        if a.category != b.category:
+            out.append(f"rooms: {rid} category {a.category} -> {b.category}")
+        sa, sb = dict(a.category_scores), dict(b.category_scores)
+        if sa.keys() != sb.keys() or any(abs(sa[k] - sb[k]) > tol for k in sa):
+            out.append(f"rooms: {rid} category scores {_scores(a)} -> {_scores(b)}")
+        if a.explored != b.explored:
+            out.append(f"rooms: {rid} explored {a.explored} -> {b.explored}")
+        if sorted(a.neighbours) != sorted(b.neighbours):
+            out.append(f"edges: {rid} neighbours {_fmt_list(sorted(a.neighbours))} -> "
+                       f"{_fmt_list(sorted(b.neighbours))}")
+        if math.dist(a.position, b.position) > tol:
+            out.append(f"rooms: {rid} moved {math.dist(a.position, b.position):.2f} m")
+    eo = {o.id: o for o in expected.objects}
+    ao = {o.id: o for o in actual.objects}
+    for oid in sorted(eo.keys() - ao.keys()):
+        out.append(f"objects: - {oid} {eo[oid].category} in {eo[oid].room}")
+    for oid in sorted(ao.keys() - eo.keys()):
+        out.append(f"objects: + {oid} {ao[oid].category} in {ao[oid].room}")
+    for oid in sorted(eo.keys() & ao.keys()):
+        a, b = eo[oid], ao[oid]
+        for attr in ("room", "parent", "relation", "state", "explored", "category"):
+            if getattr(a, attr) != getattr(b, attr):
+                out.append(f"objects: {oid} {a.category} {attr} {getattr(a, attr)} -> "
+                           f"{getattr(b, attr)}")
+        if math.dist(a.position, b.position) > tol:
+            out.append(f"objects: {oid} {a.category} moved "
+                       f"{math.dist(a.position, b.position):.3f} m")
+    ed = {d.id: d for d in expected.doors}
+    ad = {d.id: d for d in actual.doors}
+    for did in sorted(ed.keys() ^ ad.keys()):
+        d = ed.get(did) or ad[did]
+        out.append(f"doors: {'-' if did in ed else '+'} {did} ({d.state}, "
+                   f"{_fmt_list(sorted(d.rooms))})")
+    for did in sorted(ed.keys() & ad.keys()):
+        a, b = ed[did], ad[did]
+        if a.state != b.state:
+            out.append(f"doors: {did} state {a.state} -> {b.state}")
+        if sorted(a.rooms) != sorted(b.rooms):
+            out.append(f"edges: {did} joins {_fmt_list(sorted(a.rooms))} -> "
+                       f"{_fmt_list(sorted(b.rooms))}")
+    eg = {r.id: r for r in expected.regions}
+    ag = {r.id: r for r in actual.regions}
+    for gid in sorted(eg.keys() ^ ag.keys()):
+        g = eg.get(gid) or ag[gid]
+        what = g.frontier_type or "region" if g.kind == "frontier" else "region"
+        out.append(f"regions: {'-' if gid in eg else '+'} {gid} ({what} in {g.room})")
+    for gid in sorted(eg.keys() & ag.keys()):
+        a, b = eg[gid], ag[gid]
+        if (a.room, a.kind, a.frontier_type) != (b.room, b.kind, b.frontier_type):
+            out.append(f"regions: {gid} {a.kind}/{a.frontier_type} in {a.room} -> "
+                       f"{b.kind}/{b.frontier_type} in {b.room}")
+        elif math.dist(a.position, b.position) > tol:
+            out.append(f"regions: {gid} moved {math.dist(a.position, b.position):.2f} m")
+    if (expected.robot.room, expected.robot.region) != (actual.robot.room, actual.robot.region):
+        out.append(f"robot: in {expected.robot.room}/{expected.robot.region} -> "
+                   f"{actual.robot.room}/{actual.robot.region}")
+    keys = expected.distances.keys() | actual.distances.keys()
+    worst, n = (0.0, ""), 0
+    for k in sorted(keys):
+        a, b = expected.distances.get(k), actual.distances.get(k)
+        if a is None or b is None:
+            n += 1
+            worst = max(worst, (math.inf, k))
+        elif abs(a - b) > tol:
+            n += 1
+            worst = max(worst, (abs(a - b), k))
+    if n:
+        out.append(f"distances: {n} differ, largest {worst[0]:.3f} m ({worst[1]})")
+    if not out and expected.to_json() != actual.to_json():
+        out.append("the canonical JSON differs below the tolerance (rounding)")
+    return out
+
+
+def describe_mismatch(expected: Sequence[str], actual: Sequence[tuple[Refresh, str]],
+                      limit: int = 40) -> list[str]:
+    """The first refresh whose graph differs, with :func:`diff_graphs` of it."""
+    for i, (exp, (ref, got)) in enumerate(zip(expected, actual, strict=False)):
+        if exp != got:
+            lines = diff_graphs(SceneGraph.from_json(exp), SceneGraph.from_json(got))
+            head = (f"refresh {i} at {ref.time_ns / 1e9:.3f} s (after {ref.frames} frames, "
+                    f"{ref.reason}) differs:")
+            more = [f"  ... and {len(lines) - limit} more"] if len(lines) > limit else []
+            return [head] + ["  " + x for x in lines[:limit]] + more
+    if len(expected) != len(actual):
+        return [f"{len(actual)} refreshes where {len(expected)} were expected; the first "
+                f"{min(len(expected), len(actual))} agree"]
+    return []
+
+
+# ----- regeneration ----------------------------------------------------------------------
+def record_case(case: GoldenCase, folder: Path) -> Path:
+    """Record the case's log (PyBullet) into ``folder``."""
+    from sgtool.datasets.generator import generate_house
+    from sgtool.recorders.sim.camera import CameraConfig
+    from sgtool.recorders.sim.recording import RecordOptions, record_house
+
+    house = generate_house(case.seed, rooms=(case.rooms, case.rooms))
+    out = folder / f"{case.name}.mcap"
+    opts = RecordOptions(fps=case.fps, frames=case.frames,
+                         camera=CameraConfig(width=case.width, height=case.height))
+    record_house(house, out, opts, house_id=f"house-{case.seed}")
+    return out
+
+
+def expectations(folder: Path, cases: Sequence[GoldenCase] = CASES) -> dict[str, object]:
+    """Replay every case's log, write its graphs file, return the ``expected.json`` text."""
+    entries: dict[str, object] = {}
+    for case in cases:
+        log = folder / f"{case.name}.mcap"
+        got = replay_graphs(log)
+        graphs = [g for _, g in got]
+        write_graphs(folder / f"{case.name}.graphs.jsonl.gz", graphs)
+        entries[case.name] = {
+            "why": case.why, "log_sha256": sha256_file(log), "refreshes": len(graphs),
+            "final_sha256": hashlib.sha256(graphs[-1].encode()).hexdigest() if graphs else "",
+            "sequence_sha256": sequence_digest(graphs),
+        }
+    return {"format": FORMAT, "replay": {"every": REPLAY.every,
+                                         "classifier": REPLAY.classifier},
+            "cases": entries}
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(
+        prog="python -m sgtool.replayers.golden",
+        description="Regenerate the golden logs' expected scene graphs (tests/golden).")
+    ap.add_argument("--folder", type=Path, default=None,
+                    help="golden folder (default: tests/golden of this checkout)")
+    ap.add_argument("--record", action="store_true",
+                    help="re-record the logs with PyBullet first")
+    a = ap.parse_args(argv)
+    folder = a.folder or default_folder()
+    folder.mkdir(parents=True, exist_ok=True)
+    if a.record:
+        for case in CASES:
+            path = record_case(case, folder)
+            print(f"recorded {path} ({path.stat().st_size / 1e6:.2f} MB)", file=sys.stderr)
+    doc = expectations(folder)
+    tmp = folder / (EXPECTED + ".partial")
+    tmp.write_text(json.dumps(doc, indent=2, sort_keys=True) + "\n")
+    os.replace(tmp, folder / EXPECTED)
+    for name, e in doc["cases"].items():  # type: ignore[union-attr]
+        print(f"{name}: {e['refreshes']} refreshes, final {e['final_sha256'][:16]}",
+              file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

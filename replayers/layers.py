@@ -1,0 +1,160 @@
+"""The derived layers of a refresh as log messages (pure functions, no I/O).
+
+- ``/map/occupancy``: the BEV occupancy grid as a Foxglove ``Grid`` (int8: -1 unknown,
+  0 free, 100 occupied; :func:`sgtool.log.codec.encode_grid`);
+- ``/map/voronoi``: the Voronoi graph as a ``SceneUpdate`` with one ``LINE_LIST`` whose
+  edges are coloured by room (grey: cut at a door or in no room), and the nodes as small
+  spheres in the same colours;
+- ``/map/rooms``: per explored room its outline (the convex hull of its nodes, grown by
+  their clearance-free margin of ``ROOM_MARGIN``) as a ``LINE_LOOP`` and a text label
+  "room:3 kitchen"; every update first deletes all earlier entities, so rooms that merged
+  or vanished disappear;
+- ``/sgtool/scene_graph``: the canonical JSON of the graph.
+
+Colours come from :func:`sgtool.analysis.rerun_view.color_for`, so a room has the same
+colour in Foxglove and in ``sgtool view``. Everything is a deterministic function of the
+refresh.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from foxglove_schemas_protobuf.Color_pb2 import Color
+from foxglove_schemas_protobuf.LinePrimitive_pb2 import LinePrimitive
+from foxglove_schemas_protobuf.Point3_pb2 import Point3
+from foxglove_schemas_protobuf.SceneEntity_pb2 import SceneEntity
+from foxglove_schemas_protobuf.SceneEntityDeletion_pb2 import SceneEntityDeletion
+from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
+from foxglove_schemas_protobuf.TextPrimitive_pb2 import TextPrimitive
+
+from sgtool.analysis.rerun_view import color_for
+from sgtool.log import codec
+from sgtool.log import schemas as S
+from sgtool.log.writer import LogWriter
+from sgtool.replayers.stream import Refresh
+
+GRAPH_Z = 0.05  # m: height of the drawn graph above the floor
+LABEL_Z = 1.5  # m: height of room labels
+ROOM_MARGIN = 0.3  # m: room outlines grow this far beyond their nodes
+NO_ROOM = (0.55, 0.55, 0.55)
+DERIVED_TOPICS = (S.OCCUPANCY, S.VORONOI, S.ROOMS, S.RECORDS["scene_graph"].topic)
+
+
+def _color(key: str | None, alpha: float = 1.0) -> Color:
+    if key is None:
+        r, g, b = NO_ROOM
+    else:
+        r, g, b = (c / 255.0 for c in color_for(key))
+    return Color(r=r, g=g, b=b, a=alpha)
+
+
+def occupancy_message(refresh: Refresh) -> Any | None:
+    if refresh.layers is None:
+        return None
+    occ = refresh.layers.occupancy
+    return codec.encode_grid(refresh.time_ns, occ.grid, occ.origin, occ.resolution)
+
+
+def voronoi_message(refresh: Refresh) -> Any | None:
+    """The Voronoi graph, edges and nodes coloured by room (module doc)."""
+    if refresh.layers is None:
+        return None
+    lay = refresh.layers
+    vg = lay.voronoi
+    rooms = lay.node_rooms
+    ent = SceneEntity(timestamp=codec.timestamp(refresh.time_ns), frame_id=S.WORLD_FRAME,
+                      id="voronoi")
+    if len(vg.edges):
+        pts, cols = [], []
+        for u, v in vg.edges.tolist():
+            ru, rv = rooms[u], rooms[v]
+            c = _color(ru if ru == rv else None)
+            for n in (u, v):
+                x, y = vg.positions[n]
+                pts.append(Point3(x=float(x), y=float(y), z=GRAPH_Z))
+                cols.append(c)
+        ent.lines.append(LinePrimitive(type=LinePrimitive.LINE_LIST, thickness=0.03,
+                                       points=pts, colors=cols, color=_color(None)))
+    for n in range(len(vg)):
+        x, y = vg.positions[n]
+        s = ent.spheres.add()
+        s.pose.position.x, s.pose.position.y, s.pose.position.z = float(x), float(y), GRAPH_Z
+        s.pose.orientation.w = 1.0
+        s.size.x = s.size.y = s.size.z = 0.08
+        s.color.CopyFrom(_color(rooms[n]))
+    return SceneUpdate(deletions=[SceneEntityDeletion(
+        timestamp=codec.timestamp(refresh.time_ns), type=SceneEntityDeletion.ALL)],
+        entities=[ent])
+
+
+def _hull(points: np.ndarray, margin: float) -> np.ndarray:
+    """Convex hull (counter-clockwise) of the discs of radius ``margin`` around ``points``,
+    approximated by 8 points per disc."""
+    ang = np.arange(8) * (np.pi / 4)
+    ring = np.stack([np.cos(ang), np.sin(ang)], axis=1) * margin
+    cloud = (points[:, None, :] + ring[None, :, :]).reshape(-1, 2)
+    cloud = np.unique(np.round(cloud, 6), axis=0)  # sorted: Andrew's monotone chain
+    if len(cloud) < 3:
+        return cloud
+
+    def half(pts: np.ndarray) -> list[np.ndarray]:
+        out: list[np.ndarray] = []
+        for p in pts:
+            while len(out) >= 2:
+                a, b = out[-2], out[-1]
+                if (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) > 1e-12:
+                    break
+                out.pop()
+            out.append(p)
+        return out
+
+    lower, upper = half(cloud), half(cloud[::-1])
+    return np.asarray(lower[:-1] + upper[:-1])
+
+
+def rooms_message(refresh: Refresh) -> Any | None:
+    """Room outlines and labels (module doc)."""
+    if refresh.layers is None:
+        return None
+    lay = refresh.layers
+    vg = lay.voronoi
+    stamp = codec.timestamp(refresh.time_ns)
+    upd = SceneUpdate(deletions=[SceneEntityDeletion(timestamp=stamp,
+                                                     type=SceneEntityDeletion.ALL)])
+    by_room: dict[str, list[int]] = {}
+    for n, r in enumerate(lay.node_rooms):
+        if r is not None:
+            by_room.setdefault(r, []).append(n)
+    categories = {r.id: r.category for r in refresh.graph.rooms}
+    for rid in sorted(by_room, key=lambda s: (len(s), s)):
+        nodes = np.asarray(by_room[rid])
+        hull = _hull(vg.positions[nodes], ROOM_MARGIN)
+        ent = SceneEntity(timestamp=stamp, frame_id=S.WORLD_FRAME, id=rid)
+        ent.lines.append(LinePrimitive(
+            type=LinePrimitive.LINE_LOOP, thickness=0.05, color=_color(rid),
+            points=[Point3(x=float(x), y=float(y), z=GRAPH_Z) for x, y in hull.tolist()]))
+        cx, cy = (float(v) for v in vg.positions[nodes].mean(axis=0))
+        room = refresh.graph.room(rid)
+        if room is not None:
+            cx, cy = room.position
+        t = TextPrimitive(billboard=True, font_size=14.0, scale_invariant=True,
+                          color=_color(rid), text=f"{rid} {categories.get(rid, 'unknown')}")
+        t.pose.position.x, t.pose.position.y, t.pose.position.z = cx, cy, LABEL_Z
+        t.pose.orientation.w = 1.0
+        ent.texts.append(t)
+        upd.entities.append(ent)
+    return upd
+
+
+def write_refresh(writer: LogWriter, refresh: Refresh) -> None:
+    """Write the derived channels of ``refresh`` at its time: occupancy, Voronoi graph,
+    rooms (when map layers exist) and the scene graph."""
+    t = refresh.time_ns
+    for topic, make in ((S.OCCUPANCY, occupancy_message), (S.VORONOI, voronoi_message),
+                        (S.ROOMS, rooms_message)):
+        msg = make(refresh)
+        if msg is not None:
+            writer.write_proto(topic, t, msg)
+    writer.write_json_bytes("scene_graph", t, refresh.graph.to_json().encode())

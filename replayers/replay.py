@@ -1,0 +1,293 @@
+"""Replaying a log into scene graphs, frame by frame, and writing the derived log.
+
+:func:`replay` reads a log once, in log-time order (ties in file order, i.e. the order the
+recorder wrote them), and feeds a :class:`~sgtool.replayers.stream.SceneGraphStream`:
+instance tables, frames (assembled by :class:`~sgtool.log.reader.FrameAssembler`) and
+action records. With an output it also writes the derived log: a copy of every input
+message (same bytes, same channels and schemas, same order), the input's attachments and
+its ``sgtool`` metadata, and after the message that caused each refresh the derived
+channels of :mod:`sgtool.replayers.layers` at the refresh time. Derived channels of the
+input (a log that was already replayed, or a closed-loop log) are not copied: they are
+rebuilt. A metadata record ``sgtool.replay`` holds the options.
+
+Options default to what the log says it was built with: a closed-loop log records its
+mapping options in its ``sgtool.Episode`` record (``extra.mapping``), so replaying it with
+the defaults rebuilds the same graphs it decided on. Otherwise: a refresh every 10 frames
+and at every action, the containment room classifier, and MoMa-LLM's "seen" threshold of 50
+points per frame scaled by the image size (``50 * W * H / 320 / 240``, at least 5).
+
+Logs without instance ids (imported real data) replay to geometry only: voxels,
+occupancy, Voronoi graph, rooms without door cuts, frontiers; the report says that the
+semantics are absent.
+
+Determinism: the output depends on the input bytes and the options only (no wall clock,
+no path names), so replaying a log twice gives byte-identical files.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from sgtool.errors import SgtoolError
+from sgtool.log import schemas as S
+from sgtool.log.reader import FRAME_TOPICS, FrameAssembler, LogReader
+from sgtool.log.writer import LogWriter
+from sgtool.mapping.voxels import VoxelConfig
+from sgtool.replayers.layers import DERIVED_TOPICS, write_refresh
+from sgtool.replayers.stream import Refresh, SceneGraphStream
+from sgtool.scenegraph.builder import BuilderConfig
+from sgtool.scenegraph.categories import RoomClassifier
+
+CLASSIFIERS = ("containment", "frequency", "none")
+REPLAY_METADATA = "sgtool.replay"
+_INSTANCES = S.RECORDS["instances"].topic
+_ACTION = S.RECORDS["action"].topic
+_EPISODE = S.RECORDS["episode"].topic
+MIN_POINTS_320x240 = 50  # MoMa-LLM: an object is seen with > 50 points (256x256 camera)
+
+
+@dataclass(frozen=True)
+class ReplayOptions:
+    """How to rebuild; ``None`` fields take the log's recorded value, else the default."""
+
+    every: int | None = None  # frames between refreshes (K)
+    classifier: str | None = None  # containment | frequency | none
+    min_points: int | None = None  # points in one frame for an instance to count as seen
+    voxel_size: float | None = None  # m
+    max_frames: int | None = None  # stop after this many frames
+
+
+@dataclass(frozen=True)
+class ResolvedOptions:
+    every: int
+    classifier: str
+    min_points: int
+    voxel_size: float
+    max_frames: int | None
+
+    def to_metadata(self) -> dict[str, str]:
+        return {k: "" if v is None else str(v) for k, v in asdict(self).items()}
+
+
+def default_min_points(width: int, height: int) -> int:
+    """MoMa-LLM's 50 points at 320x240, scaled by the pixel count (at least 5)."""
+    return max(5, round(MIN_POINTS_320x240 * width * height / (320 * 240)))
+
+
+def mapping_record(options: ResolvedOptions) -> dict[str, Any]:
+    """What a live builder writes into its Episode record (``extra.mapping``) so that a
+    replay with default options rebuilds its graphs."""
+    return {"every": options.every, "classifier": options.classifier,
+            "min_points": options.min_points, "voxel_size": options.voxel_size}
+
+
+def make_classifier(name: str) -> RoomClassifier | None:
+    if name == "containment":
+        from sgtool.semantics.rooms import ContainmentRoomClassifier
+
+        return ContainmentRoomClassifier()
+    if name == "frequency":
+        from sgtool.scenegraph.categories import FrequencyRoomClassifier
+
+        return FrequencyRoomClassifier.from_training_knowledge()
+    if name == "none":
+        return None
+    raise SgtoolError(f"unknown room classifier {name!r}; one of {', '.join(CLASSIFIERS)}")
+
+
+def builder_config(options: ResolvedOptions) -> BuilderConfig:
+    return BuilderConfig(voxels=VoxelConfig(resolution=options.voxel_size,
+                                            min_points=options.min_points),
+                         refresh_every=options.every)
+
+
+def resolve_options(reader: LogReader, options: ReplayOptions) -> ResolvedOptions:
+    """Fill the unset options from the log's Episode record, else the defaults."""
+    recorded: dict[str, Any] = {}
+    for _, rec in reader.records("episode"):
+        m = (rec.get("extra") or {}).get("mapping")
+        if isinstance(m, dict):
+            recorded = m
+            break
+    size = _image_size(reader)
+    every = options.every if options.every is not None else int(recorded.get("every", 10))
+    clf = options.classifier or str(recorded.get("classifier", "containment"))
+    if clf not in CLASSIFIERS:
+        raise SgtoolError(f"unknown room classifier {clf!r}; one of {', '.join(CLASSIFIERS)}")
+    mp = options.min_points if options.min_points is not None else recorded.get("min_points")
+    if mp is None:
+        mp = default_min_points(*size) if size is not None else MIN_POINTS_320x240
+    vs = options.voxel_size if options.voxel_size is not None else float(
+        recorded.get("voxel_size", VoxelConfig().resolution))
+    if every < 1:
+        raise SgtoolError(f"--every {every}: must be >= 1")
+    if not 0.01 <= vs <= 0.5:
+        raise SgtoolError(f"voxel size {vs} m: must be 0.01..0.5")
+    if int(mp) < 1:
+        raise SgtoolError(f"min points {mp}: must be >= 1")
+    return ResolvedOptions(every=int(every), classifier=clf, min_points=int(mp),
+                           voxel_size=float(vs), max_frames=options.max_frames)
+
+
+def _image_size(reader: LogReader) -> tuple[int, int] | None:
+    """(width, height) of the camera: its first calibration, else its first depth image."""
+    for topic in (S.CALIBRATION, S.DEPTH):
+        if reader.has(topic):
+            for d in reader.messages([topic]):
+                return int(d.message.width), int(d.message.height)
+    return None
+
+
+@dataclass
+class ReplayReport:
+    input: Path
+    output: Path | None
+    options: ResolvedOptions
+    frames: int = 0
+    refreshes: int = 0
+    semantic: bool = True  # the log has instance ids
+    last: Refresh | None = None
+    stages: dict[str, tuple[float, float, int]] = field(default_factory=dict)
+    seconds: float = 0.0  # wall clock of the run (reported, never written)
+    truncated: bool = False  # stopped at max_frames
+
+    def lines(self) -> list[str]:
+        out = []
+        if self.output is not None and self.output.exists():
+            out.append(f"wrote {self.output} ({self.output.stat().st_size / 1e6:.1f} MB)")
+        fps = self.frames / self.seconds if self.seconds > 0 else 0.0
+        o = self.options
+        out.append(f"{self.frames} frames, {self.refreshes} refreshes (every {o.every} frames "
+                   f"and at every action), {self.seconds:.1f} s ({fps:.1f} frames/s); room "
+                   f"classifier {o.classifier}, voxels {o.voxel_size} m, seen at "
+                   f">= {o.min_points} points")
+        if not self.semantic:
+            out.append("the log has no instance ids: semantics are absent, so the graph has "
+                       "geometry only (occupancy, Voronoi graph, rooms without door cuts, "
+                       "frontiers; no objects, doors or room categories)")
+        if self.truncated:
+            out.append(f"stopped after {self.frames} frames (--max-frames)")
+        if self.last is not None:
+            g = self.last.graph
+            explored = [r for r in g.rooms if r.explored]
+            cats = ", ".join(f"{r.id} {r.category}" for r in explored)
+            out.append(f"final graph: {len(explored)} rooms ({cats}), "
+                       f"{len(g.rooms) - len(explored)} unexplored behind closed doors, "
+                       f"{len(g.objects)} objects, {len(g.frontiers())} frontiers, "
+                       f"{len(g.doors)} doors")
+        if self.stages:
+            out.append(f"{'stage':<12}{'median ms':>10}{'max ms':>10}{'calls':>7}")
+            for stage, (med, mx, n) in self.stages.items():
+                out.append(f"{stage:<12}{med:>10.2f}{mx:>10.2f}{n:>7}")
+        return out
+
+
+def replay(
+    log: str | os.PathLike[str],
+    output: str | os.PathLike[str] | None = None,
+    options: ReplayOptions | None = None,
+    *,
+    on_refresh: Callable[[Refresh, SceneGraphStream], None] | None = None,
+    progress: Any = None,
+    compression: str = "zstd",
+) -> ReplayReport:
+    """Replay ``log`` (module doc). ``on_refresh`` sees every refresh as it happens;
+    ``progress`` is anything with ``update(n)`` (a tqdm bar), advanced per frame."""
+    src = Path(log)
+    dst = Path(output) if output is not None else None
+    if dst is not None and dst.exists() and src.exists() and dst.resolve() == src.resolve():
+        raise SgtoolError("the output must not be the input log")
+    with LogReader(src) as reader:
+        reader.require(S.DEPTH, why="replay builds the map from depth images")
+        opts = resolve_options(reader, options or ReplayOptions())
+        report = ReplayReport(src, dst, opts, semantic=reader.has(S.IDS))
+        stream = SceneGraphStream(None, make_classifier(opts.classifier),
+                                  builder_config(opts))
+        t0 = time.perf_counter()
+        if dst is None:
+            _run(reader, stream, None, opts, report, on_refresh, progress)
+        else:
+            meta = dict(reader.metadata.get(S.METADATA_NAME, {}))
+            extra = {k: v for k, v in meta.items()
+                     if k not in ("sgtool_version", "log_schema_version", "seed")}
+            with LogWriter(dst, seed=reader.seed, compression=compression,
+                           metadata=extra) as writer:
+                for name, data in sorted(reader.metadata.items()):
+                    if name not in (S.METADATA_NAME, REPLAY_METADATA):
+                        writer.add_metadata(name, data)
+                writer.add_metadata(REPLAY_METADATA, opts.to_metadata())
+                for a in reader._reader.iter_attachments():
+                    writer.attach(a.name, a.data, a.media_type, a.log_time)
+                _run(reader, stream, writer, opts, report, on_refresh, progress)
+        report.seconds = time.perf_counter() - t0
+        report.stages = stream.builder.stage_summary()
+    return report
+
+
+def _run(reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
+         opts: ResolvedOptions, report: ReplayReport,
+         on_refresh: Callable[[Refresh, SceneGraphStream], None] | None, progress: Any
+         ) -> None:
+    frame_topics = set(FRAME_TOPICS)
+    needed = frame_topics | {_INSTANCES, _ACTION}
+    copied: dict[int, int] = {}  # input channel id -> output channel id
+    asm = FrameAssembler()
+    last_t = 0
+
+    def refreshed(r: Refresh | None) -> None:
+        if r is None:
+            return
+        report.refreshes += 1
+        report.last = r
+        if writer is not None:
+            write_refresh(writer, r)
+        if on_refresh is not None:
+            on_refresh(r, stream)
+
+    def take_frame(fr: Any) -> bool:
+        """Integrate a finished frame; False when the frame budget is spent."""
+        if fr is None:
+            return True
+        if opts.max_frames is not None and report.frames >= opts.max_frames:
+            report.truncated = True
+            return False
+        report.frames += 1
+        if progress is not None:
+            progress.update(1)
+        refreshed(stream.frame(fr))
+        return True
+
+    for schema, channel, message in reader.raw_messages():
+        topic = channel.topic
+        t = int(message.log_time)
+        if topic in needed:
+            decoded = reader.decode(schema, channel, message)
+            if topic in frame_topics:
+                if not take_frame(asm.push(topic, t, decoded)):
+                    break
+            else:
+                if not take_frame(asm.flush()):
+                    break
+                if topic == _INSTANCES:
+                    stream.instances(t, decoded)
+                else:
+                    refreshed(stream.action(t))
+        if writer is not None and topic not in DERIVED_TOPICS:
+            cid = copied.get(channel.id)
+            if cid is None:
+                cid = writer.copy_channel(
+                    topic, schema.name if schema else "", schema.encoding if schema else "",
+                    bytes(schema.data) if schema else b"", channel.message_encoding,
+                    dict(channel.metadata))
+                copied[channel.id] = cid
+            writer.write_raw(cid, t, bytes(message.data))
+        last_t = max(last_t, t)
+    else:
+        take_frame(asm.flush())
+    refreshed(stream.finish(last_t if not report.truncated else None))
+

@@ -1,0 +1,176 @@
+"""``sgtool replay LOG -o derived.mcap``: rebuild the scene graph of a log, frame by frame.
+
+The work is done in :mod:`sgtool.replayers`; this module parses options, shows a progress
+bar, prints the report, the per-stage timings and, with ``--score``, the quality of the
+final graph against the house the log was recorded in.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import click
+
+from sgtool.errors import SgtoolError
+
+
+@click.command("replay")
+@click.argument("log", type=click.Path(dir_okay=False))
+@click.option("-o", "--output", type=click.Path(dir_okay=False),
+              help="Derived log to write: a copy of LOG's messages plus /map/occupancy, "
+              "/map/voronoi, /map/rooms and /sgtool/scene_graph at every refresh. Without "
+              "it nothing is written (use with --score or --json).")
+@click.option("--every", type=click.IntRange(min=1), default=None,
+              help="Refresh the graph every K frames (and always at every action). "
+              "Default: what the log was built with, else 10.")
+@click.option("--classifier", type=click.Choice(["containment", "frequency", "none"]),
+              default=None, help="Room categories from contents: the distilled containment "
+              "model, the naive-Bayes frequency model of the training knowledge, or none. "
+              "Default: the log's, else containment.")
+@click.option("--min-points", type=click.IntRange(min=1), default=None,
+              help="Points an instance needs in one frame to count as seen. Default: the "
+              "log's, else MoMa-LLM's 50 at 320x240 scaled by the image size.")
+@click.option("--voxel-size", type=float, default=None,
+              help="Voxel edge in metres. Default: the log's, else 0.05.")
+@click.option("--max-frames", type=click.IntRange(min=1), default=None,
+              help="Stop after this many frames.")
+@click.option("--rrd", type=click.Path(dir_okay=False),
+              help="Also write a Rerun recording of the derived log (needs -o).")
+@click.option("--score", is_flag=True,
+              help="Score the final graph against the house spec in the log: room count "
+              "error, Voronoi node purity and adjusted Rand index, object-to-room and room "
+              "category accuracy, strict and with open-plan rooms merged.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of text.")
+@click.option("--force", is_flag=True, help="Overwrite the output files.")
+@click.option("--progress/--no-progress", default=None,
+              help="Progress bar on stderr (default: when stderr is a terminal).")
+def command(log: str, output: str | None, every: int | None, classifier: str | None,
+            min_points: int | None, voxel_size: float | None, max_frames: int | None,
+            rrd: str | None, score: bool, as_json: bool, force: bool,
+            progress: bool | None) -> None:
+    """Replay LOG into a semantic voxel map, BEV occupancy, a Voronoi graph, rooms, objects,
+    frontiers and the hierarchical scene graph, deterministically: the same log and options
+    give a byte-identical output.
+
+    The graph refreshes every K frames and at every logged action; a closed door or
+    container that opens drops its old voxels. Logs without instance ids (imported real
+    data) give geometry only. Example: `sgtool replay run.mcap -o derived.mcap --score`.
+    """
+    from tqdm import tqdm
+
+    from sgtool.log import LogReader
+    from sgtool.replayers.replay import ReplayOptions, replay
+
+    src = Path(log)
+    dst = Path(output) if output else None
+    if not src.exists():
+        raise SgtoolError(f"{src}: no such file")
+    if dst is None and rrd:
+        raise SgtoolError("--rrd views the derived log: give -o derived.mcap as well")
+    for p, opt in ((dst, "-o"), (Path(rrd) if rrd else None, "--rrd")):
+        if p is None:
+            continue
+        if p.resolve() == src.resolve():
+            raise SgtoolError(f"{opt} {p}: the output must not be the input log")
+        if p.exists() and not force:
+            raise SgtoolError(f"{p} exists; not overwriting it (use --force)")
+        if not p.parent.exists():
+            raise SgtoolError(f"{opt} {p}: folder {p.parent} does not exist")
+    if dst is not None and dst.suffix != ".mcap":
+        raise SgtoolError(f"-o {dst}: the output is an MCAP log; name it *.mcap")
+    if voxel_size is not None and not 0.01 <= voxel_size <= 0.5:
+        raise SgtoolError(f"--voxel-size {voxel_size}: must be 0.01..0.5 m")
+    with LogReader(src) as r:
+        total = r.frame_count() if r.has("/camera/depth") else 0
+        house = r.house_json() if score else None
+    if score and house is None:
+        raise SgtoolError(f"{src} has no house spec attachment (house.json): --score needs "
+                          "the ground truth of a simulated log")
+    if max_frames is not None:
+        total = min(total, max_frames)
+    final: dict[str, Any] = {}
+
+    def keep(ref, stream) -> None:  # type: ignore[no-untyped-def]  # noqa: ANN001
+        final["refresh"], final["stream"] = ref, stream
+
+    show = progress if progress is not None else sys.stderr.isatty()
+    opts = ReplayOptions(every=every, classifier=classifier, min_points=min_points,
+                         voxel_size=voxel_size, max_frames=max_frames)
+    with tqdm(total=total, unit="frame", desc="replay", file=sys.stderr, leave=False,
+              disable=not show, dynamic_ncols=True) as bar:
+        report = replay(src, dst, opts, on_refresh=keep if score else None, progress=bar)
+    scores = None
+    if score:
+        scores = _score(house, final)  # type: ignore[arg-type]
+    if rrd and dst is not None:
+        _view(dst, Path(rrd), show)
+    if as_json:
+        click.echo(json.dumps(_as_dict(report, scores, rrd), sort_keys=True))
+        return
+    for line in report.lines():
+        click.echo(line)
+    if scores is not None:
+        from sgtool.replayers.score import score_lines
+
+        for line in score_lines(scores):
+            click.echo(line)
+    if rrd:
+        click.echo(f"wrote {rrd}; open it with: rerun {rrd}")
+
+
+def _score(house: str, final: dict[str, Any]) -> Any:
+    from sgtool.datasets.house import load_house
+    from sgtool.replayers.score import score
+
+    if "refresh" not in final:
+        raise SgtoolError("the log produced no scene graph to score (no frames?)")
+    spec = load_house(json.loads(house))
+    ref, stream = final["refresh"], final["stream"]
+    if ref.layers is None:
+        raise SgtoolError("the last refresh has no map layers to score")
+    return score(spec, stream.builder.instances, ref.layers, ref.graph)
+
+
+def _view(derived: Path, rrd: Path, show: bool) -> None:
+    from tqdm import tqdm
+
+    from sgtool.analysis.rerun_view import export
+    from sgtool.log import LogReader
+    from sgtool.replayers.voxels import voxel_snapshots
+
+    with LogReader(derived) as r:
+        total = r.frame_count()
+    with tqdm(total=total, unit="frame", desc="view", file=sys.stderr, leave=False,
+              disable=not show, dynamic_ncols=True) as bar:
+        export(derived, rrd, progress=bar.update,
+               voxels=lambda reader: voxel_snapshots(reader, every=10))
+
+
+def _as_dict(report: Any, scores: Any, rrd: str | None) -> dict[str, Any]:
+    from dataclasses import asdict
+
+    from sgtool.replayers.score import score_dict
+
+    g = report.last.graph if report.last is not None else None
+    out: dict[str, Any] = {
+        "input": str(report.input), "output": str(report.output) if report.output else None,
+        "options": asdict(report.options), "frames": report.frames,
+        "refreshes": report.refreshes, "semantic": report.semantic,
+        "truncated": report.truncated, "seconds": report.seconds,
+        "stages_ms": {k: {"median": v[0], "max": v[1], "calls": v[2]}
+                      for k, v in report.stages.items()},
+        "graph": None if g is None else {
+            "rooms": sum(r.explored for r in g.rooms),
+            "unexplored_rooms": sum(not r.explored for r in g.rooms),
+            "objects": len(g.objects), "frontiers": len(g.frontiers()),
+            "doors": len(g.doors),
+            "categories": {r.id: r.category for r in g.rooms if r.explored},
+        },
+        "rrd": rrd,
+    }
+    if scores is not None:
+        out["score"] = score_dict(scores)
+    return out
