@@ -407,5 +407,5 @@ def line_of_sight(blocked: np.ndarray, occ: OccupancyGrid, a: np.ndarray, b: np.
     hit = np.ones(len(seg), dtype=bool)
     hit[inside] = blocked[r[inside], c[inside]]
     out = np.ones(k, dtype=bool)
-    out[np.unique(seg[hit])] = False
+    out[seg[hit]] = False
     return out

@@ -200,6 +200,7 @@ class SceneGraphBuilder:
         self._rooms = RoomTracker()
         self._frontiers = _Frontiers()
         self._class_memo: dict[tuple[str, ...], list[tuple[str, float]]] = {}
+        self._panel_memo: dict[bytes, object] = {}  # door openings from swung panels
         self._last: tuple[tuple, SceneGraph] | None = None
         self._unexplored_pos: dict[str, tuple[float, float]] = {}
         self.layers: MapLayers | None = None
@@ -254,6 +255,7 @@ class SceneGraphBuilder:
             self._columns = None
             self._ridge = None
             self._class_memo = {}
+            self._panel_memo = {}
         timings = self.timings_scratch if from_scratch else self.timings
         tick = _Ticker(timings)
         cfg = self.config
@@ -425,6 +427,7 @@ class SceneGraphBuilder:
         iy0 = int(round(occ.origin[1] / occ.resolution))
         doors = [iid for iid, v in self.instances.items()
                  if v.kind == "door" and v.state != "closed"]
+        occupied: np.ndarray | None = None
         for ijk in self.voxels.voxels_of(doors).values():
             if not len(ijk):
                 continue
@@ -437,8 +440,10 @@ class SceneGraphBuilder:
             else:
                 cell = np.unique(r * (occ.shape[1] + 1) + c)
                 r, c = np.divmod(cell, occ.shape[1] + 1)
-                got = opening_from_panel(r, c, occ.grid == OCCUPIED,
-                                         int(0.4 / occ.resolution))
+                if occupied is None:
+                    occupied = occ.grid == OCCUPIED
+                got = opening_from_panel(r, c, occupied, int(0.4 / occ.resolution),
+                                         memo=self._panel_memo)
                 if got is not None:
                     r, c = got
             cells[r, c] = True

@@ -37,8 +37,10 @@ passes its id to the explored room found beyond that door later.
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -65,7 +67,8 @@ def door_density(door_cells: np.ndarray, resolution: float, bandwidth: float) ->
 
 
 def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
-                       min_width: int = 8) -> tuple[np.ndarray, np.ndarray] | None:
+                       min_width: int = 8, memo: dict[bytes, Any] | None = None
+                       ) -> tuple[np.ndarray, np.ndarray] | None:
     """The doorway of a door seen only as its swung-open panel: the panel's closed
     position, found by turning it by 90 degrees about its hinge.
 
@@ -84,8 +87,23 @@ def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
     r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
     r1 = min(int(rows.max()) + pad + 1, occupied.shape[0])
     c1 = min(int(cols.max()) + pad + 1, occupied.shape[1])
-    got = _opening(rows - r0, cols - c0, occupied[r0:r1, c0:c1], min_width)
-    return None if got is None else (got[0] + r0, got[1] + c0)
+    window = occupied[r0:r1, c0:c1]
+    key = None
+    if memo is not None:  # the same panel cells in the same surroundings: the same answer
+        h = hashlib.blake2b(digest_size=16)
+        for a in (rows - r0, cols - c0, np.ascontiguousarray(window)):
+            h.update(np.ascontiguousarray(a).tobytes())
+        h.update(repr((window.shape, min_width, r0, c0, rows.dtype.str)).encode())
+        key = h.digest()
+        if key in memo:
+            return memo[key]
+    got = _opening(rows - r0, cols - c0, window, min_width)
+    out = None if got is None else (got[0] + r0, got[1] + c0)
+    if memo is not None and key is not None:
+        if len(memo) > 256:
+            memo.clear()
+        memo[key] = out
+    return out
 
 
 def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray, min_width: int
