@@ -55,7 +55,7 @@ def test_truncation_every_two_percent_recovers_a_growing_prefix(long_log, tmp_pa
         with pytest.raises(LogFormatError):  # the only error a reader may raise
             LogReader(cut)
         out = tmp_path / "rec.mcap"
-        d = recover(cut, out)
+        d = recover(cut, out, overwrite=True)
         assert d.status == "truncated"
         assert d.readable_messages >= previous
         previous = d.readable_messages
@@ -141,3 +141,48 @@ def test_doctor_never_overwrites_input(long_log):
     r = CliRunner().invoke(cli, ["doctor", str(long_log), "--recover", str(long_log)])
     assert r.exit_code == 2 and "refusing to write the recovered log over its input" in r.output
     assert long_log.read_bytes() == before
+
+
+def test_damaged_chunks_give_the_documented_error_only(long_log, tmp_path):
+    """100 garbage bytes written over the log at 30 places: reading frames either works
+    (the bytes hit something not read) or raises LogFormatError pointing to doctor, never
+    a decompression or CRC error of the libraries."""
+    import random
+
+    data = long_log.read_bytes()
+    errors = 0
+    for k, off in enumerate(range(200, len(data) - 200, len(data) // 30)):
+        bad = tmp_path / "bad.mcap"
+        rng = random.Random(k)
+        bad.write_bytes(data[:off] + bytes(rng.randrange(256) for _ in range(100))
+                        + data[off + 100:])
+        try:
+            with LogReader(bad) as r:
+                sum(1 for _ in r.frames())
+        except LogFormatError as e:
+            errors += 1
+            assert "sgtool doctor" in str(e)
+    assert errors >= 20  # most places are chunk data, which CRCs and zstd check
+
+
+def test_doctor_user_errors(long_log, tmp_path):
+    junk = tmp_path / "junk.mcap"
+    junk.write_bytes(b"no log here")
+    r = CliRunner().invoke(cli, ["doctor", str(junk)])
+    assert r.exit_code == 2 and "not an MCAP file" in r.output
+    r = CliRunner().invoke(cli, ["doctor", str(junk), "--recover", str(tmp_path / "o.mcap")])
+    assert r.exit_code == 2 and not (tmp_path / "o.mcap").exists()
+    taken = tmp_path / "taken.mcap"
+    taken.write_bytes(b"keep me")
+    r = CliRunner().invoke(cli, ["doctor", str(long_log), "--recover", str(taken)])
+    assert r.exit_code == 2 and "use --force" in r.output and taken.read_bytes() == b"keep me"
+    r = CliRunner().invoke(cli, ["doctor", str(long_log), "--recover", str(taken), "--force"])
+    assert r.exit_code == 0 and taken.stat().st_size > 1000
+
+
+def test_info_on_a_truncated_log_points_to_doctor(long_log, tmp_path):
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(long_log.read_bytes()[: long_log.stat().st_size // 2])
+    r = CliRunner().invoke(cli, ["info", str(cut)])
+    assert r.exit_code == 2
+    assert "without the MCAP footer" in r.output and "--recover" in r.output

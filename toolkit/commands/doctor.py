@@ -34,8 +34,9 @@ def _report(d: Diagnosis) -> str:
     help="Write every readable message to OUT as a valid, indexed MCAP file "
     "(never the input file).",
 )
+@click.option("--force", is_flag=True, help="Overwrite OUT if it exists.")
 @click.option("--json", "as_json", is_flag=True, help="Print the diagnosis as JSON.")
-def command(log: str, out: str | None, as_json: bool) -> None:
+def command(log: str, out: str | None, force: bool, as_json: bool) -> None:
     """Check LOG record by record and say whether it is complete, truncated (a recorder
     killed mid-write, a copy cut short) or corrupt (damaged bytes), and how many messages
     are readable. With --recover OUT, copy what is readable into a new log.
@@ -43,7 +44,7 @@ def command(log: str, out: str | None, as_json: bool) -> None:
     Exit code 0 for a complete file, 1 for a truncated or corrupt one (also after a
     successful recovery), 2 for a usage error.
     """
-    d = recover(log, out) if out else scan(log)
+    d = recover(log, out, overwrite=force) if out else scan(log)
     if as_json:
         click.echo(json.dumps(d.as_dict() | ({"recovered_to": out} if out else {}), indent=2))
     else:

@@ -15,12 +15,14 @@ from __future__ import annotations
 
 import json
 import os
+import struct
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
+import zstandard
 from mcap.exceptions import InvalidMagic, McapError
 from mcap.reader import SeekingReader
 from mcap.records import Channel, Message, Schema
@@ -189,9 +191,19 @@ class LogReader:
                 raise LogFormatError(
                     f"{self.path}: not an MCAP file (it does not start with the MCAP magic bytes)"
                 )
+            f.seek(0, os.SEEK_END)
+            size = f.tell()
+            f.seek(max(size - 8, 0))
+            if size < 16 or f.read(8) != _MAGIC:
+                raise LogFormatError(
+                    f"{self.path}: the file ends without the MCAP footer (truncated, or still "
+                    f"being written); `sgtool doctor {self.path} --recover OUT.mcap` copies "
+                    "what is readable into a valid log"
+                )
         self._f: IO[bytes] = open(self.path, "rb")  # noqa: SIM115
         try:
-            self._reader = SeekingReader(self._f, validate_crcs=False)
+            # chunk CRCs are checked as chunks are read: damaged bytes give a clear error
+            self._reader = SeekingReader(self._f, validate_crcs=True)
             self._reader.get_header()
             summary = self._reader.get_summary()
         except InvalidMagic as e:
@@ -338,10 +350,10 @@ class LogReader:
     ) -> Iterator[Decoded]:
         """Decoded messages in log-time order, ``start_ns <= t < end_ns``."""
         topics = list(topics) if topics is not None else None
-        for schema, channel, message in self._reader.iter_messages(
+        for schema, channel, message in self._checked(self._reader.iter_messages(
             topics=topics, starting_at=start_ns, ending_before=end_ns,
             log_time_order=True, reverse=reverse,
-        ):
+        )):
             yield Decoded(
                 channel.topic, int(message.log_time), schema.name if schema else "",
                 self._decode(schema, channel, message),
@@ -386,8 +398,20 @@ class LogReader:
                      ) -> Iterator[tuple[Schema | None, Channel, Message]]:
         """Undecoded (schema, channel, message) records in log-time order (ties in file
         order); :meth:`decode` decodes one."""
-        yield from self._reader.iter_messages(
-            topics=list(topics) if topics is not None else None, log_time_order=True)
+        yield from self._checked(self._reader.iter_messages(
+            topics=list(topics) if topics is not None else None, log_time_order=True))
+
+    def _checked(self, it: Iterator[Any]) -> Iterator[Any]:
+        """``it``, with damaged chunks (bad CRC, bad compression, bad records) turned into a
+        :class:`LogFormatError` that points to ``sgtool doctor``."""
+        try:
+            yield from it
+        except (McapError, ValueError, EOFError, struct.error, RuntimeError,
+                zstandard.ZstdError) as e:  # lz4 reports bad frames as RuntimeError
+            raise LogFormatError(
+                f"{self.path}: damaged data ({type(e).__name__}: {str(e)[:120]}); "
+                f"`sgtool doctor {self.path}` says what is readable and --recover copies it"
+            ) from e
 
     def decode(self, schema: Schema | None, channel: Channel, message: Message) -> Any:
         """A raw message decoded as :meth:`messages` decodes it."""

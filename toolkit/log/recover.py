@@ -136,10 +136,20 @@ def scan(path: str | os.PathLike[str]) -> Diagnosis:
     p = Path(path)
     if not p.is_file():
         raise LogFormatError(f"{p}: no such file")
+    _require_magic(p)
     diag = Diagnosis(str(p), p.stat().st_size)
     with open(p, "rb") as f:
         _consume(_walk(f, diag.size, diag), diag, None)
     return diag
+
+
+def _require_magic(p: Path) -> None:
+    """A file that does not even start like an MCAP file is not a damaged log: say so."""
+    with open(p, "rb") as f:
+        head = f.read(8)
+    if head != bytes([137, 77, 67, 65, 80, 48, 13, 10]):
+        raise LogFormatError(f"{p}: not an MCAP file (it does not start with the MCAP magic "
+                             "bytes): there is no log to check or recover")
 
 
 def _consume(items: Iterator[_Item], diag: Diagnosis, writer: _Copier | None) -> None:
@@ -209,7 +219,8 @@ class _Copier:
         self.w.add_metadata(m.name, dict(m.metadata))
 
 
-def recover(path: str | os.PathLike[str], out: str | os.PathLike[str]) -> Diagnosis:
+def recover(path: str | os.PathLike[str], out: str | os.PathLike[str],
+            overwrite: bool = False) -> Diagnosis:
     """Copy every readable message of ``path`` into ``out`` (a valid, indexed MCAP file).
 
     Messages are written in the order they were found; the MCAP index of the new file lets
@@ -223,6 +234,9 @@ def recover(path: str | os.PathLike[str], out: str | os.PathLike[str]) -> Diagno
         raise SgtoolError(f"refusing to write the recovered log over its input {src}")
     if dst.is_dir():
         raise SgtoolError(f"{dst} is a folder, not a file name")
+    if dst.exists() and not overwrite:
+        raise SgtoolError(f"{dst} exists; not overwriting it (use --force)")
+    _require_magic(src)
     if not dst.parent.exists():
         raise SgtoolError(f"folder {dst.parent} does not exist")
     diag = Diagnosis(str(src), src.stat().st_size)
