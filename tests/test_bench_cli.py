@@ -75,8 +75,8 @@ def test_run_bench_returns_the_tables():
 
 @pytest.mark.parametrize("args, message", [
     (["--planners", "random,oracle"], "unknown planner 'oracle'"),
-    (["--rooms", "3-20"], "--rooms: need 4 <= MIN <= MAX <= 16"),
-    (["--rooms", "big"], "--rooms: expected MIN-MAX"),
+    (["--rooms", "3-20"], "need 4 <= MIN <= MAX <= 16"),
+    (["--rooms", "big"], "give N or MIN-MAX"),
     (["--seeds", "0"], "--seeds: must be >= 1"),
     (["--planners", "moma-llm", "--llm-replay", "/nonexistent/t.jsonl"],
      "no such transcript"),

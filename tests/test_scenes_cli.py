@@ -96,3 +96,20 @@ def test_user_errors_name_the_problem(tmp_path):
     assert not (tmp_path / "x.json").exists()
     r = CliRunner().invoke(cli, ["scenes", "show", str(tmp_path / "missing.json")])
     assert r.exit_code == 2 and "no such house spec file" in r.output
+
+
+def test_outputs_are_checked_before_writing(tmp_path):
+    out = tmp_path / "h.json"
+    args = ["scenes", "generate", "--seed", "1", "--rooms", "4,5", "-o", str(out)]
+    assert CliRunner().invoke(cli, args).exit_code == 0  # MIN,MAX works as MIN-MAX does
+    r = CliRunner().invoke(cli, args)
+    assert r.exit_code == 2 and "use --force" in r.output
+    assert CliRunner().invoke(cli, args + ["--force"]).exit_code == 0
+    r = CliRunner().invoke(cli, ["scenes", "generate", "-o", str(tmp_path / "no" / "h.json")])
+    assert r.exit_code == 2 and "does not exist" in r.output
+    r = CliRunner().invoke(cli, ["scenes", "show", str(out), "-o",
+                                 str(tmp_path / "no" / "p.png")])
+    assert r.exit_code == 2 and "does not exist" in r.output
+    assert not (tmp_path / "no").exists()
+    r = CliRunner().invoke(cli, ["scenes", "show", str(out), "-o", str(tmp_path / "p.gif")])
+    assert r.exit_code == 2 and ".png" in r.output

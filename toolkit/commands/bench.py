@@ -16,16 +16,9 @@ class OptionError(SgtoolError):
 
 
 def _rooms(text: str) -> tuple[int, int]:
-    parts = text.replace(",", "-").split("-")
-    try:
-        if len(parts) == 1:
-            n = int(parts[0])
-            return n, n
-        if len(parts) == 2:
-            return int(parts[0]), int(parts[1])
-    except ValueError:
-        pass
-    raise OptionError(f"--rooms: expected MIN-MAX (e.g. 4-12), got {text!r}")
+    from sgtool.commands.options import parse_rooms
+
+    return parse_rooms(text)
 
 
 def _value(text: str) -> Any:

@@ -42,8 +42,8 @@ def _pair(option: str, text: str) -> tuple[float, float]:
 @click.option("--seed", type=int, default=None,
               help="Generate the house for this seed (`sgtool scenes generate`) instead of "
               "reading --house.")
-@click.option("--rooms", default="4,12", show_default=True,
-              help="Room count range MIN,MAX for a house generated with --seed.")
+@click.option("--rooms", default="4-12", show_default=True, metavar="MIN-MAX",
+              help="Room count range for a house generated with --seed (N, MIN-MAX).")
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
               help="The log to write (OUT.mcap).")
 @click.option("--frames", type=int, default=None,
@@ -148,12 +148,10 @@ def _house(path: str | None, seed: int | None, rooms: str):  # type: ignore[no-u
 
         return load_house(path), Path(path).stem
     if seed is not None:
+        from sgtool.commands.options import parse_rooms
         from sgtool.datasets.generator import generate_house
 
-        lo, hi = _pair("--rooms", rooms)
-        if lo != int(lo) or hi != int(hi):
-            raise SgtoolError(f"--rooms {rooms!r}: give two whole numbers MIN,MAX")
-        return generate_house(seed, rooms=(int(lo), int(hi))), f"house-{seed}"
+        return generate_house(seed, rooms=parse_rooms(rooms)), f"house-{seed}"
     from sgtool.datasets import demo_house
 
     return demo_house(), "demo"

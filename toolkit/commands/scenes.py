@@ -10,17 +10,9 @@ import click
 
 
 def _parse_rooms(value: str) -> tuple[int, int]:
-    try:
-        if "-" in value:
-            a, b = value.split("-", 1)
-            lo, hi = int(a), int(b)
-        else:
-            lo = hi = int(value)
-    except ValueError:
-        raise click.BadParameter(f"expected N or MIN-MAX, got {value!r}") from None
-    if not 4 <= lo <= hi <= 16:
-        raise click.BadParameter(f"need 4 <= MIN <= MAX <= 16, got {value!r}")
-    return lo, hi
+    from sgtool.commands.options import parse_rooms
+
+    return parse_rooms(value)
 
 
 def _rooms_option(f):  # type: ignore[no-untyped-def]
@@ -51,11 +43,15 @@ def command() -> None:
 @_split_option
 @click.option("-o", "--output", type=click.Path(dir_okay=False), required=True,
               help="House spec JSON to write (atomically).")
-def generate_cmd(seed: int, rooms: tuple[int, int], split: str, output: str) -> None:
+@click.option("--force", is_flag=True, help="Overwrite the output file.")
+def generate_cmd(seed: int, rooms: tuple[int, int], split: str, output: str,
+                 force: bool) -> None:
     """Generate a connected multi-room house and write its JSON spec."""
+    from sgtool.commands.options import check_output
     from sgtool.datasets.generator import generate_house
     from sgtool.datasets.house import save_house
 
+    check_output(output, force=force, suffixes=(".json",), what="house spec")
     spec = generate_house(seed, rooms=rooms, split=split)
     save_house(spec, output)
     closed = sum(d.state == "closed" for d in spec.doors)
@@ -73,19 +69,20 @@ def generate_cmd(seed: int, rooms: tuple[int, int], split: str, output: str) -> 
 @click.option("--dpi", type=click.IntRange(min=30, max=600), default=120, show_default=True,
               help="Resolution of raster images.")
 @click.option("--no-objects", is_flag=True, help="Leave small objects out of the picture.")
-def show_cmd(house: str, output: str | None, dpi: int, no_objects: bool) -> None:
+@click.option("--force", is_flag=True, help="Overwrite the image.")
+def show_cmd(house: str, output: str | None, dpi: int, no_objects: bool, force: bool) -> None:
     """Draw the floor plan of HOUSE: rooms coloured and labelled, walls, doors (open green,
     closed red), open-plan passages, furniture (containers hatched), small objects (dots;
     crosses when hidden in a closed container), start poses."""
     from pathlib import Path
 
+    from sgtool.commands.options import check_output
     from sgtool.datasets.draw import draw_house
     from sgtool.datasets.house import load_house
 
     spec = load_house(house)
-    out = Path(output) if output else Path(house).with_suffix(".png")
-    if out.suffix.lower() not in (".png", ".svg", ".pdf"):
-        raise click.BadParameter("use a .png, .svg or .pdf file name", param_hint="--output")
+    out = check_output(output or Path(house).with_suffix(".png"), force=force,
+                       suffixes=(".png", ".svg", ".pdf"), what="image")
     draw_house(spec, out, dpi=dpi, show_objects=not no_objects)
     click.echo(f"wrote {out}", err=True)
 

@@ -1,0 +1,42 @@
+"""Option parsing and output checks shared by the commands (one wording everywhere)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from sgtool.errors import SgtoolError
+
+
+def parse_rooms(text: str, option: str = "--rooms", lo_limit: int = 4,
+                hi_limit: int = 16) -> tuple[int, int]:
+    """A room-count range: ``N``, ``MIN-MAX`` or ``MIN,MAX``."""
+    parts = text.replace(",", "-").split("-")
+    try:
+        if len(parts) == 1:
+            lo = hi = int(parts[0])
+        elif len(parts) == 2:
+            lo, hi = int(parts[0]), int(parts[1])
+        else:
+            raise ValueError
+    except ValueError:
+        raise SgtoolError(f"{option} {text!r}: give N or MIN-MAX, e.g. 4-12") from None
+    if not lo_limit <= lo <= hi <= hi_limit:
+        raise SgtoolError(f"{option} {text!r}: need {lo_limit} <= MIN <= MAX <= {hi_limit}")
+    return lo, hi
+
+
+def check_output(path: str | Path, *, force: bool = False, option: str = "-o",
+                 suffixes: Sequence[str] = (), what: str = "output") -> Path:
+    """An output file name a command may write: its folder exists, it is not a folder, it
+    has one of ``suffixes`` (when given), and it does not exist unless ``force``."""
+    p = Path(path)
+    if p.is_dir():
+        raise SgtoolError(f"{option} {p} is a folder; give a file name")
+    if suffixes and p.suffix.lower() not in suffixes:
+        raise SgtoolError(f"{option} {p}: the {what} must end in {' or '.join(suffixes)}")
+    if not p.parent.exists():
+        raise SgtoolError(f"{option} {p}: folder {p.parent} does not exist")
+    if p.exists() and not force:
+        raise SgtoolError(f"{p} exists; not overwriting it (use --force)")
+    return p
