@@ -132,13 +132,30 @@ def test_clear_failure_after_max_attempts() -> None:
     assert len(p.exchanges) == 3 and all(e["error"] for e in p.exchanges)
 
 
-def test_connection_refused_is_a_clear_failure() -> None:
+def test_an_endpoint_that_never_answers_is_a_configuration_error() -> None:
+    """Connection refused before any reply: a wrong address, reported at once (the CLI
+    prints it as one line) instead of every episode quietly giving up."""
+    from sgtool.llm.client import LlmUnreachableError
+
     srv = ChatServer([])
     url = srv.base_url
     srv.close()
     p = make_planner("moma-llm", base_url=url, api_key="x", max_attempts=2, timeout_s=2.0)
     p.reset("milk")
-    a = p.decide(house())
+    with pytest.raises(LlmUnreachableError, match="cannot reach the LLM endpoint"):
+        p.decide(house())
+
+
+def test_connection_lost_mid_run_is_a_clear_failure() -> None:
+    """Once the endpoint has answered, a refused connection is a fault: retried, then the
+    episode ends with the reason."""
+    with ChatServer([answer("navigate(kitchen, countertop)")]) as srv:
+        url = srv.base_url
+        p = make_planner("moma-llm", base_url=url, api_key="x", max_attempts=2, timeout_s=2.0)
+        p.reset("milk")
+        first = p.decide(house())
+    assert first.skill == "navigate"
+    a = p.decide(house())  # the server is gone now
     assert a.skill == "done" and a.target is None and "connection failed" in a.reason
 
 

@@ -117,3 +117,13 @@ def test_grounding_picks_matching_instances() -> None:
     with_milk = dataclasses.replace(g, objects=(*g.objects, milk))
     assert ground(parse_response("Command: done()"), with_milk, encode_scene(with_milk),
                   "Milk").target == "obj:50"
+
+
+def test_the_prompt_names_the_query_with_the_right_article():
+    from sgtool.planning.moma.planner import system_prompt, with_article
+
+    assert with_article("mug") == "a mug"
+    assert with_article("apple") == "an apple"
+    assert with_article("short pants") == "some short pants"
+    assert with_article("wineglass") == "a wineglass"
+    assert "find some short pants." in system_prompt("short pants")

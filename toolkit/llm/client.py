@@ -37,6 +37,11 @@ class LlmConfigError(SgtoolError):
     """The LLM endpoint is not configured or configured wrongly."""
 
 
+class LlmUnreachableError(LlmConfigError):
+    """The endpoint never answered (connection refused, unknown host): a configuration
+    problem, reported at once instead of retried episode after episode."""
+
+
 class LlmTransportError(Exception):
     """One request failed (timeout, HTTP error, unusable reply); retrying may help."""
 
@@ -84,9 +89,10 @@ class LlmSettings:
         api_key = api_key or env.get("SGTOOL_LLM_API_KEY") or env.get("OPENAI_API_KEY")
         if not base_url and not api_key:
             raise LlmConfigError(
-                "no LLM endpoint configured: pass a base URL (--llm-base-url / base_url=) or "
-                "set SGTOOL_LLM_BASE_URL (and SGTOOL_LLM_API_KEY if it needs one), or replay "
-                "a recorded transcript with --llm-replay FILE"
+                "no LLM endpoint configured: set SGTOOL_LLM_BASE_URL (and SGTOOL_LLM_API_KEY "
+                "if it needs one) or give the base URL (-O moma-llm.base_url=URL for bench, "
+                "eval and run; --llm-base-url for distill), or replay a recorded transcript "
+                "with --llm-replay FILE"
             )
         if timeout_s <= 0:
             raise LlmConfigError(f"LLM timeout must be > 0 s, got {timeout_s}")
@@ -109,6 +115,7 @@ class OpenAIChatClient:
             timeout=settings.timeout_s,
             max_retries=0,
         )
+        self.replies = 0  # HTTP replies received (any status): the endpoint exists
 
     @property
     def where(self) -> str:
@@ -130,8 +137,15 @@ class OpenAIChatClient:
                 f"{self.where}: no reply within {self.settings.timeout_s:g} s"
             ) from e
         except openai.APIStatusError as e:
+            self.replies += 1
             raise LlmTransportError(f"{self.where}: HTTP {e.status_code}: {_short(e)}") from e
         except openai.APIConnectionError as e:
+            if not self.replies:
+                # never reached at all: a wrong address, not a fault to retry around
+                raise LlmUnreachableError(
+                    f"cannot reach the LLM endpoint {self.where}: {_short(e)}; check "
+                    "SGTOOL_LLM_BASE_URL / base_url, or replay a transcript with --llm-replay"
+                ) from e
             raise LlmTransportError(f"{self.where}: connection failed: {_short(e)}") from e
         except (openai.OpenAIError, ValueError, KeyError, TypeError) as e:
             # malformed JSON body (ValueError from the decoder), unexpected structure
@@ -139,6 +153,7 @@ class OpenAIChatClient:
                 f"{self.where}: unusable reply: {type(e).__name__}: {_short(e)}"
             ) from e
         latency = time.perf_counter() - t0
+        self.replies += 1
         try:
             text = resp.choices[0].message.content
         except (AttributeError, IndexError, TypeError) as e:

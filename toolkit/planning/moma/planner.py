@@ -46,10 +46,21 @@ from sgtool.semantics.text import category_text
 OUTCOME_TEXT = {"success": "success", "failure": "failure", "invalid": "invalid argument"}
 
 
+def with_article(noun: str) -> str:
+    """"a mug", "an apple", "some short pants" (a plural-looking last word: -s but not
+    -ss, -us or -is)."""
+    q = noun.strip()
+    last = q.split()[-1].lower() if q else ""
+    if last.endswith("s") and not last.endswith(("ss", "us", "is")):
+        return f"some {q}"
+    return f"{'an' if q[:1].lower() in 'aeiou' and q else 'a'} {q}"
+
+
 def system_prompt(query: str) -> str:
     q = query.strip()
+    aq = with_article(q)
     return (
-        f"You are a robot in an unexplored house. Your task is to find a {q}.\n"
+        f"You are a robot in an unexplored house. Your task is to find {aq}.\n"
         "You can call these functions:\n"
         "1. navigate(room, object): go to an object in a room and look at it and on it.\n"
         "2. go_to_and_open(room, object): go to an object or a door in a room and open it "
@@ -57,10 +68,10 @@ def system_prompt(query: str) -> str:
         "3. close(room, object): close an open object or door in a room.\n"
         "4. explore(room): explore the unexplored area of a room, the space leading out of "
         "it, or an unexplored room.\n"
-        f"5. done(): finish; call it only when a {q} is among the observed objects.\n"
+        f"5. done(): finish; call it only when {aq} is among the observed objects.\n"
         "Use room and object names exactly as the scene description writes them.\n"
         "Answer in exactly this format:\n"
-        f"Analysis: <where a {q} is likely to be and which actions could reveal it>\n"
+        f"Analysis: <where {aq} is likely to be and which actions could reveal it>\n"
         "Reasoning: <why your next command is the best one now>\n"
         "Command: <one function call>"
     )
