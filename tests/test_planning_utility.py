@@ -15,6 +15,7 @@ from sgtool.planning.utility import (
     candidate_utilities,
     frontier_utility,
     room_influence,
+    room_utilities,
     select_with_margin,
 )
 from sgtool.scenegraph.graph import ObjectNode
@@ -87,6 +88,31 @@ def test_candidate_utilities_by_node_type() -> None:
     noroom = UtilityParams(room_influence=False)
     u2 = dict(zip(ids, candidate_utilities(g, cands, QUERY, SCORER, noroom), strict=True))
     assert u2["obj:11"] == u2["obj:21"] == 0.9  # without room context they tie
+
+
+class NoBathrooms(TableScorer):
+    """A table scorer with no score for bathrooms (like the distilled prior for a room
+    type its training data hardly covers)."""
+
+    def can_score_room(self, name: str) -> bool:
+        return name != "bathroom"
+
+
+def test_a_room_the_scorer_cannot_score_is_treated_as_uncategorised() -> None:
+    g = house()
+    scorer = NoBathrooms(SCORER.room_table, SCORER.object_table)
+    params = UtilityParams()
+    # Eq. 2 for the kitchen and the living room; the bathroom and the unexplored room:4
+    # take the default room score
+    assert room_utilities(g, QUERY, scorer, params) == {
+        "room:1": 0.8, "room:2": 0.7, "room:3": 0.3, "room:4": 0.7}
+    cands = actionable(g)
+    u = dict(zip([c.node_id for c in cands], candidate_utilities(g, cands, QUERY, scorer,
+                                                                 params), strict=True))
+    assert u["obj:21"] == pytest.approx(0.7 * (0.3 + 0.7 * 0.9))  # bathroom cabinet
+    assert u["obj:11"] == pytest.approx(0.8 * (0.3 + 0.7 * 0.9))  # kitchen cabinet: as before
+    # a scorer without can_score_room scores every room (TableScorer): the bathroom's 0.1
+    assert room_utilities(g, QUERY, SCORER, params)["room:2"] == pytest.approx(0.1)
 
 
 def test_scout_prefers_the_kitchen_cabinet_and_breaks_ties_by_distance() -> None:

@@ -38,6 +38,11 @@ def test_distill_is_byte_identical_and_loadable(tmp_path) -> None:
     assert meta == json.loads(json.dumps(ma))
     assert meta["config"]["seed"] == 16 and meta["split_fingerprint"] == "tiny"
     assert meta["heldout_queries"] == ["refrigerator"]
+    # containment evidence of the 5 trained queries (refrigerator held out): kitchen for
+    # apple, cabinet, plate, sink; dining room for cabinet, plate; bathroom for cabinet,
+    # sink, toilet (test_semantics_relational.tiny)
+    assert meta["room_evidence"] == {
+        "queries": 5, "positives": {"bathroom": 3, "dining room": 2, "kitchen": 4}}
     held = meta["report"]["heldout"]
     assert held["queries"] == len(meta["heldout_queries"]) > 0
     assert "unseen" not in meta["report"]  # explicit sets, no evaluation sets given

@@ -8,7 +8,13 @@ import numpy as np
 import pytest
 from semantics_fixtures import encoder
 
-from sgtool.semantics.priors import WEIGHTS_DIR, CosinePriors, LearnedPriors
+from sgtool.semantics.priors import (
+    MIN_ROOM_EVIDENCE,
+    WEIGHTS_DIR,
+    CosinePriors,
+    LearnedPriors,
+    unscored_room_types,
+)
 
 
 @pytest.fixture(scope="module")
@@ -74,10 +80,36 @@ def test_numpy_inference_matches_torch(priors: LearnedPriors) -> None:
     assert priors.cooccurrence.n_parameters == 558_081  # SCOUT: 558K per relational model
 
 
+def test_room_types_the_training_data_hardly_covers_are_unscored(priors: LearnedPriors
+                                                                 ) -> None:
+    ev = priors.metadata["room_evidence"]
+    assert ev["queries"] > 500
+    need = MIN_ROOM_EVIDENCE * ev["queries"]
+    # a handful of training objects are stated to be found in a pantry, hundreds in a kitchen
+    assert ev["positives"]["pantry room"] < need < 300 < ev["positives"]["kitchen"]
+    for room in ("pantry_room", "storage room", "Closet", "television_room"):
+        assert not priors.can_score_room(room), room
+    # household rooms the data describes, and names it never saw (open vocabulary)
+    for room in ("kitchen", "bedroom", "bathroom", "living_room", "childs_room", "corridor",
+                 "laundry room"):
+        assert priors.can_score_room(room), room
+    # what "unscored" stands for: ~0 whatever the query, even for pantry things
+    assert max(priors.rooms(["pantry room"], q)[0] for q in ("spatula", "flour sack")) < 0.05
+
+
+def test_unscored_room_types_rule() -> None:
+    ev = {"queries": 200, "positives": {"kitchen": 150, "Pantry_Room": 1, "hall": 2}}
+    assert unscored_room_types(ev, 0.01) == {"pantry room"}  # 1 < 2 <= 2
+    assert unscored_room_types(ev, 0.0) == frozenset()
+    assert unscored_room_types(None, 0.01) == frozenset()  # weights without the field
+    assert CosinePriors(encoder()).can_score_room("pantry room")  # cosine scores any name
+
+
 def test_shipped_weights_match_the_current_training_data() -> None:
     """Fails when the knowledge or the set builders change without ``sgtool distill``."""
     from sgtool.datasets.relational import knowledge_fingerprint, training_sets
     from sgtool.datasets.split import training_knowledge
+    from sgtool.semantics.distill import room_evidence
 
     meta = json.loads((WEIGHTS_DIR / "metadata.json").read_text())
     assert meta["split_fingerprint"] == knowledge_fingerprint(training_knowledge())
@@ -87,6 +119,7 @@ def test_shipped_weights_match_the_current_training_data() -> None:
     assert meta["models"]["cooccurrence"]["data"]["fingerprint"] == \
         sets.cooccurrence.fingerprint()
     assert meta["room_types"] == list(sets.room_types)
+    assert meta["room_evidence"] == room_evidence(sets.containment)
 
 
 def test_shipped_report_learned_beats_cosine_on_unseen_queries() -> None:

@@ -1,7 +1,9 @@
 """SCOUT's utility of scene-graph nodes and its selection rule, as pure functions.
 
 - rooms (Eq. 2): u_q(r) = p_contains(r, q) for an explored, categorised room; unexplored or
-  uncategorised rooms get the default room exploration score;
+  uncategorised rooms get the default room exploration score, and so do rooms of a category
+  the scorer cannot score (:func:`~sgtool.semantics.priors.can_score_room`: a room type the
+  distilled prior's training data hardly covers, where its ~0 is an absence of data);
 - objects (Eq. 3-4): u_q(o) = p_co-occur(o, q), with room influence
   u'_q(o) = u_q(r_o) * (w + (1 - w) * u_q(o)) where r_o is the object's room;
 - frontiers (sec. IV-B c): the aggregate of the utilities of objects within a radius; with
@@ -25,7 +27,7 @@ import numpy as np
 
 from sgtool.planning.candidates import Candidate
 from sgtool.scenegraph.graph import SceneGraph
-from sgtool.semantics.priors import RelationScorer
+from sgtool.semantics.priors import RelationScorer, can_score_room
 
 UNKNOWN_ROOM = frozenset({"", "unknown", "none"})
 
@@ -88,9 +90,10 @@ def select_with_margin(
 
 def room_utilities(graph: SceneGraph, query: str, scorer: RelationScorer,
                    params: UtilityParams) -> dict[str, float]:
-    """Eq. 2 for every room node of the graph."""
+    """Eq. 2 for every room node of the graph (module doc)."""
     out: dict[str, float] = {}
-    known = [r for r in graph.rooms if r.explored and r.category.lower() not in UNKNOWN_ROOM]
+    known = [r for r in graph.rooms if r.explored and r.category.lower() not in UNKNOWN_ROOM
+             and can_score_room(scorer, r.category)]
     scores = scorer.rooms([r.category for r in known], query) if known else np.zeros(0)
     for r, s in zip(known, scores, strict=True):
         out[r.id] = float(s)

@@ -11,7 +11,9 @@ Pipeline (SCOUT sec. IV-C and VI-A, with the offline knowledge source in place o
    co-occurrence with BCE;
 5. the weights are written as safetensors (never pickle) next to ``metadata.json``: data
    sizes, seed, hyper-parameters, losses, the split's fingerprint, the held-out queries,
-   room types, and the quality report;
+   room types, the containment evidence per room type (:func:`room_evidence`, so a
+   planner knows which room types the prior has learned anything about) and the quality
+   report;
 6. the report (SCOUT Fig. 7 as numbers): on query categories held out of training, ROC-AUC
    of the learned score and of raw SBERT cosine similarity for containment and
    co-occurrence. The main group is the unseen categories: objects of the *evaluation*
@@ -38,7 +40,7 @@ from sgtool.semantics.metrics import separation_summary
 from sgtool.semantics.mlp import load_mlp, save_mlp
 from sgtool.semantics.priors import CONTAINMENT_FILE, COOCCURRENCE_FILE, METADATA_FILE
 
-METADATA_VERSION = 2
+METADATA_VERSION = 3  # 3: room_evidence
 FILES = {"containment": CONTAINMENT_FILE, "cooccurrence": COOCCURRENCE_FILE}
 
 
@@ -125,6 +127,7 @@ def distill(
         "config": asdict(cfg),
         "split_fingerprint": split_fingerprint,
         "room_types": sorted(room_types or cont.nodes),
+        "room_evidence": room_evidence(cont.subset_queries(train_q)),
         "heldout_queries": sorted(held),
         "models": {},
         "report": {},
@@ -163,6 +166,16 @@ def distill(
     meta["report"] = _report(mlps, encoder, eval_sets, (cont, cooc), held)
     write_json_atomic(out_dir / METADATA_FILE, meta)
     return meta
+
+
+def room_evidence(containment) -> dict[str, Any]:
+    """How much the containment pairs say about each room type: ``queries`` (the number of
+    query categories with pairs) and ``positives`` (room type -> how many of them have a
+    target above 0 there, i.e. are stated to be found in it)."""
+    pos = containment.pairs[containment.targets > 0, 0]
+    counts = np.bincount(pos, minlength=len(containment.nodes))
+    return {"queries": int(len(np.unique(containment.pairs[:, 1]))),
+            "positives": {n: int(c) for n, c in zip(containment.nodes, counts, strict=True)}}
 
 
 def _report(mlps: dict, encoder: SentenceEncoder, eval_sets, train_sets, held: set[str]
