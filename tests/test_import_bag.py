@@ -346,6 +346,9 @@ def test_bag_poses_estimated_by_odometry(shared_data_dir, tmp_path):
     assert rep.frames == 6 and rep.drift is not None and rep.odometry_failures == 0
     assert rep.pose_source == ("estimated by icp odometry (tf world -> camera_optical_frame "
                                "kept for the drift)")
+    # the reference is the bag's tf, not ground truth
+    assert ("drift against the bag's poses (tf world -> camera_optical_frame): 6 frames"
+            in "\n".join(rep.lines()))
     assert 0 < rep.drift.ate_rmse_m < 0.01
     rep = import_bag(no_tf, tmp_path / "b.mcap", BagOptions(**flags, **KEEP_WORLD))
     assert rep.frames == 6 and rep.drift is None
@@ -356,3 +359,61 @@ def test_bag_poses_estimated_by_odometry(shared_data_dir, tmp_path):
     # relative motion agrees with the reference trajectory to a centimetre
     rel = [np.linalg.inv(frames[0].pose) @ f.pose for f in frames]
     assert max(np.linalg.norm(a[:3, 3] - b[:3, 3]) for a, b in zip(est, rel, strict=True)) < 0.01
+
+
+# ----- audit regressions: trajectory-only bags, --estimate-poses, --depth-scale ----------------
+NAV2 = ("logs", "rosbag2-mcap", "evo_nav2_turtlebot.mcap")
+
+
+def test_trajectory_bag_suggests_pose_topics_and_tf(shared_data_dir, tmp_path):
+    """The Nav2 recording has /odom and /amcl_pose besides /tf: the suggestions list them
+    as alternatives to --tf-frames (only --tf-frames was suggested)."""
+    bag = shared_data_dir.joinpath(*NAV2)
+    r = run(["import", "bag", str(bag), "-o", str(tmp_path / "o.mcap")])
+    assert r.exit_code == 2 and "Traceback" not in r.output
+    sugg = next(line for line in r.output.splitlines() if line.startswith("suggested flags:"))
+    assert "--tf-frames map:oakd_rgb_camera_optical_frame" in sugg
+    assert "| --pose /amcl_pose | --pose /odom" in sugg
+    assert "WORLD:FRAME" not in sugg
+    r = run(["import", "bag", str(bag), "--list"])
+    assert r.exit_code == 0 and "suggested flags: --pose /amcl_pose | --pose /odom" in r.output
+    assert not (tmp_path / "o.mcap").exists()
+
+
+@pytest.mark.parametrize("extra", [[], ["--tf-frames", "map:base_footprint"],
+                                   ["--pose", "/odom"]])
+def test_estimate_poses_without_images_is_an_error(shared_data_dir, tmp_path, extra):
+    """--estimate-poses on a bag of trajectories alone was ignored (a trajectory was
+    written); it is an error that says why and suggests the trajectory flags."""
+    out = tmp_path / "o.mcap"
+    r = run(["import", "bag", str(shared_data_dir.joinpath(*NAV2)), "-o", str(out),
+             "--estimate-poses", *extra])
+    assert r.exit_code == 2 and "Traceback" not in r.output, r.output
+    assert ("--estimate-poses estimates camera poses from depth images, and the bag has no "
+            "image topic") in r.output
+    assert "--pose /amcl_pose" in r.output and "--tf-frames map:" in r.output
+    assert not out.exists() and not Path(str(out) + ".partial").exists()
+
+
+def test_estimate_poses_needs_depth_when_the_bag_has_images(tmp_path):
+    src = write_sgtool_log(tmp_path / "src.mcap", n=2)
+    bag = bag_path(tmp_path, "ros2-mcap")
+    write_log_as_bag(src, bag, "ros2-mcap")
+    with pytest.raises(SgtoolError, match=r"--estimate-poses .* it needs --depth"):
+        import_bag(bag, tmp_path / "o.mcap", BagOptions(tf_frames=("world", "camera"),
+                                                        estimate_poses=True, progress=False))
+
+
+@pytest.mark.parametrize("scale", [-1000.0, 0.0, float("nan"), float("inf")])
+def test_bag_depth_scale_must_be_positive(tmp_path, scale):
+    src = write_sgtool_log(tmp_path / "src.mcap", n=2)
+    bag = bag_path(tmp_path, "ros1")
+    write_log_as_bag(src, bag, "ros1")
+    out = tmp_path / "o.mcap"
+    with pytest.raises(SgtoolError, match=r"--depth-scale .*: give the raw depth units per "
+                                          r"metre, a positive number"):
+        import_bag(bag, out, BagOptions(**TOPICS, depth_scale=scale, **KEEP_WORLD))
+    r = run(["import", "bag", str(bag), "-o", str(out), f"--depth-scale={scale}"])
+    assert r.exit_code == 2 and "Traceback" not in r.output
+    assert "give the raw depth units per metre" in r.output, r.output
+    assert not out.exists()

@@ -191,9 +191,15 @@ def test_odometry_drift_on_7scenes(rgbd_data, tmp_path):
     assert 1e-4 < d.ate_rmse_m < 0.03 and d.rpe_translation_m < 0.02
     assert d.rpe_rotation_deg < 1.0
     assert rep.pose_source.startswith("estimated by rgbd+icp odometry")
+    assert rep.drift_reference == "ground truth"
+    assert any(line.startswith("drift against ground truth: ") for line in rep.lines())
+    assert "odometry: 0 of 5 steps failed" in "\n".join(rep.lines())
     with LogReader(tmp_path / "o.mcap") as r:
-        drift = json.loads(r.metadata[IMPORT_METADATA]["odometry_drift"])
+        meta = r.metadata[IMPORT_METADATA]
+        drift = json.loads(meta["odometry_drift"])
         assert drift["ate_rmse_m"] == pytest.approx(d.ate_rmse_m, abs=1e-6)
+        assert meta["odometry_drift_reference"] == "ground truth"
+        assert json.loads(meta["odometry_failures"])["failed"] == 0
 
 
 def test_folder_without_poses_is_estimated(rgbd_data, tmp_path):
@@ -252,7 +258,7 @@ def test_cli_rgbd(rgbd_data, tmp_path):
     assert rep["kind"] == "rgbd/open3d" and rep["drift"] is None
     r = CliRunner().invoke(cli, ["import", "rgbd", str(rgbd_data / "open3d-testdata"), "-o",
                                  str(tmp_path / "p.mcap"), "--layout", "7scenes"])
-    assert r.exit_code == 2 and "no frames found in the 7scenes layout" in r.output
+    assert r.exit_code == 2 and "not a 7-Scenes folder" in r.output
     assert "Traceback" not in r.output
 
 
@@ -264,3 +270,147 @@ def test_import_is_byte_identical(rgbd_data, tmp_path):
                     RgbdOptions(every=20, **QUIET))
         outs.append((tmp_path / name).read_bytes())
     assert outs[0] == outs[1]
+
+
+# ----- audit regressions: layouts, options, the drift's reference -------------------------------
+def one_line_error(args: list[str]) -> str:
+    """Run the CLI; it must fail with exit code 2 and a one-line message, no traceback."""
+    r = CliRunner().invoke(cli, args)
+    assert r.exit_code == 2, r.output
+    assert isinstance(r.exception, SystemExit) and "Traceback" not in r.output
+    lines = r.output.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("sgtool: error: "), r.output
+    return lines[0]
+
+
+LAYOUT_OF = {"a 7-Scenes folder": "7scenes", "an Open3D/Redwood folder": "open3d"}
+LAYOUT_MISMATCH = [
+    # folder, --layout, what is missing, what the folder looks like
+    ("7scenes-redkitchen-every10", "tum", "no rgb.txt and no depth.txt", "a 7-Scenes folder"),
+    ("7scenes-redkitchen-every10", "open3d", "no depth/ folder", "a 7-Scenes folder"),
+    ("icl-livingroom1-micro", "tum", "no rgb.txt and no depth.txt", "an Open3D/Redwood folder"),
+    ("icl-livingroom1-micro", "7scenes", "no frame-XXXXXX.depth.png files",
+     "an Open3D/Redwood folder"),
+    ("open3d-testdata", "tum", "no rgb.txt and no depth.txt", "an Open3D/Redwood folder"),
+    ("open3d-testdata", "7scenes", "no frame-XXXXXX.depth.png files",
+     "an Open3D/Redwood folder"),
+]
+
+
+@pytest.mark.parametrize(("name", "layout", "missing", "seen"), LAYOUT_MISMATCH)
+def test_folder_of_another_layout_is_a_one_line_error(rgbd_data, tmp_path, name, layout,
+                                                      missing, seen):
+    """Every layout against every other layout's real folder: a one-line SgtoolError that
+    names what is missing and the layout the folder looks like; no output file (was a
+    FileNotFoundError traceback for tum and open3d)."""
+    out = tmp_path / "x.mcap"
+    msg = one_line_error(["import", "rgbd", str(rgbd_data / name), "--layout", layout,
+                          "-o", str(out), "--quiet"])
+    assert missing in msg and f"it looks like {seen}" in msg, msg
+    assert f"use --layout {LAYOUT_OF[seen]}, or --layout auto" in msg
+    assert not out.exists() and not Path(str(out) + ".partial").exists()
+
+
+@pytest.mark.parametrize("layout", ["auto", "tum", "7scenes", "open3d"])
+def test_empty_and_half_made_folders(tmp_path, layout):
+    """An empty folder in every layout; an Open3D folder whose depth/ is empty; a TUM
+    folder without depth.txt; a folder that does not exist (Python API)."""
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    out = tmp_path / "x.mcap"
+    msg = one_line_error(["import", "rgbd", str(empty), "--layout", layout, "-o", str(out)])
+    assert "no known" in msg or "matches no known layout" in msg, msg
+    half = tmp_path / "half"
+    (half / "depth").mkdir(parents=True)
+    (half / "color").mkdir()
+    msg = one_line_error(["import", "rgbd", str(half), "--layout", layout, "-o", str(out)]
+                         if layout != "auto" else ["import", "rgbd", str(half), "-o", str(out)])
+    expect = {"tum": "no rgb.txt and no depth.txt; it looks like an Open3D/Redwood folder",
+              "7scenes": "no frame-XXXXXX.depth.png files; it looks like an Open3D",
+              "open3d": "not an Open3D/Redwood folder", "auto": "no images in depth/"}
+    assert expect[layout] in msg, msg
+    assert not out.exists()
+    (half / "rgb.txt").write_text("0.0 rgb/a.png\n")
+    with pytest.raises(SgtoolError, match=r"not a TUM RGB-D folder .*: no depth.txt"):
+        read_sequence(half, "tum")
+    with pytest.raises(SgtoolError, match="no such folder"):
+        import_rgbd(tmp_path / "nowhere", out, RgbdOptions(layout=layout if layout != "auto"
+                                                             else None, **QUIET))
+
+
+def test_tum_folder_read_in_another_layout(shared_data_dir, tmp_path):
+    """A TUM folder (rgb/ and depth/ image folders too): as 7-Scenes an error that points
+    at TUM; forced to Open3D it reads, with a note that it looks like TUM."""
+    root = tmp_path / "tum"
+    make_tum_folder(shared_data_dir, root, n=3)
+    msg = one_line_error(["import", "rgbd", str(root), "--layout", "7scenes", "-o",
+                          str(tmp_path / "x.mcap")])
+    assert "it looks like a TUM RGB-D folder (rgb.txt + depth.txt): use --layout tum" in msg
+    seq = read_sequence(root, "open3d")
+    assert any("also looks like TUM RGB-D" in n for n in seq.notes)
+    assert read_sequence(root).layout == "tum" and not any("looks like" in n for n in
+                                                            read_sequence(root).notes)
+
+
+@pytest.mark.parametrize(("flag", "value"), [
+    ("--depth-scale", "-1000"), ("--depth-scale", "0"), ("--depth-scale", "nan"),
+    ("--depth-scale", "inf"), ("--fps", "0"), ("--limit", "-1"), ("--max-dt", "-0.01"),
+    ("--depth-max", "0"),
+])
+def test_bad_numeric_options_are_refused(rgbd_data, tmp_path, flag, value):
+    """--depth-scale -1000 wrote an all-zero depth log and 0 fell back to the default;
+    now both, and other non-positive / non-finite numbers, are one-line errors."""
+    out = tmp_path / "x.mcap"
+    msg = one_line_error(["import", "rgbd", str(rgbd_data / "open3d-testdata"), "-o",
+                          str(out), f"{flag}={value}", "--quiet"])
+    assert msg.startswith(f"sgtool: error: {flag} "), msg
+    if flag == "--depth-scale":
+        assert "a positive number (1000 for millimetres, 5000 for TUM RGB-D)" in msg
+    assert not out.exists()
+
+
+def test_given_depth_scale_is_used(rgbd_data, tmp_path):
+    """A valid --depth-scale replaces the layout's: 2000 units per metre halve the depth."""
+    depths = []
+    for scale in (None, 2000.0):
+        out = tmp_path / f"{scale}.mcap"
+        import_rgbd(rgbd_data / "open3d-testdata", out,
+                    RgbdOptions(depth_scale=scale, limit=1, up=np.array([0.0, -1.0, 0.0]),
+                                floor_auto=False, **QUIET))
+        with LogReader(out) as r:
+            depths.append(next(iter(r.frames())).depth)
+    ok = depths[0] > 0
+    assert np.allclose(depths[1][ok], depths[0][ok] / 2, atol=1e-3)
+
+
+def test_drift_against_a_reconstructed_reference_is_not_called_ground_truth(rgbd_data,
+                                                                           tmp_path):
+    """The Open3D layout's .log (ICL-NUIM's trajectory in the Open3D data) is Open3D's
+    reconstruction: the report, JSON and metadata say so; 7-Scenes and TUM keep
+    "ground truth" (test_odometry_drift_on_7scenes, test_tum_estimate_reports_ground_truth)."""
+    out = tmp_path / "o.mcap"
+    r = CliRunner().invoke(cli, ["import", "rgbd", str(rgbd_data / "open3d-testdata"), "-o",
+                                 str(out), "--estimate-poses", "--odometry", "icp", "--quiet",
+                                 "--up", "-y", "--floor", "none"])
+    assert r.exit_code == 0, r.output
+    ref = "the reference trajectory (reconstructed, not ground truth)"
+    assert f"drift against {ref}: 5 frames" in r.output
+    assert "ground truth" not in r.output.replace(ref, "")
+    with LogReader(out) as log:
+        assert log.metadata[IMPORT_METADATA]["odometry_drift_reference"] == ref
+    r = CliRunner().invoke(cli, ["import", "rgbd", str(rgbd_data / "open3d-testdata"), "-o",
+                                 str(out), "--estimate-poses", "--odometry", "icp", "--quiet",
+                                 "--up", "-y", "--floor", "none", "--force", "--json"])
+    rep = json.loads(r.output)
+    assert rep["drift_reference"] == ref and rep["odometry_failures"] == 0
+    assert rep["odometry_failure_reasons"] == {"reported": 0, "matches": 0, "motion": 0}
+
+
+def test_tum_estimate_reports_ground_truth(shared_data_dir, tmp_path):
+    root = tmp_path / "rgbd_dataset_freiburg1_xyz"
+    make_tum_folder(shared_data_dir, root, n=3)
+    rep = import_rgbd(root, tmp_path / "o.mcap",
+                      RgbdOptions(estimate_poses=True, odometry="icp", floor_auto=False,
+                                  up=np.array([0.0, 0.0, 1.0]), **QUIET))
+    assert rep.drift is not None and rep.drift_reference == "ground truth"
+    assert any(line.startswith("drift against ground truth: ") for line in rep.lines())

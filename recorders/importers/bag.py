@@ -19,7 +19,8 @@ Without ``--depth``, ``--tf-frames`` or ``--pose`` alone import a *trajectory*: 
 A bag with images but no ``/tf`` and no ``--pose`` (a camera recorded alone), or any bag
 with ``--estimate-poses``, gets its camera poses from RGB-D odometry (:mod:`.odometry`,
 one more pass over the images); the drift against the bag's own poses is reported when it
-has them.
+has them. ``--estimate-poses`` needs ``--depth``: a bag of trajectories alone (no image
+topic) is an error that suggests ``--tf-frames`` and ``--pose``.
 
 When a flag is missing or names the wrong thing, the error lists the bag's topics with
 their types and suggests flags. The bag is read in two passes (time stamps, transforms and
@@ -41,6 +42,12 @@ from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.writer import LogWriter
 from sgtool.recorders.importers import bagfiles as B
+from sgtool.recorders.importers.checks import (
+    check_counts,
+    check_depth_scale,
+    check_non_negative,
+    check_positive,
+)
 from sgtool.recorders.importers.images import (
     decode_color_message,
     decode_depth_message,
@@ -49,13 +56,20 @@ from sgtool.recorders.importers.images import (
     depth_to_metres,
     resize_to,
 )
-from sgtool.recorders.importers.odometry import DriftReport, drift_against, estimate_trajectory
+from sgtool.recorders.importers.odometry import (
+    DriftReport,
+    OdometryResult,
+    drift_against,
+    estimate_trajectory,
+)
 from sgtool.recorders.importers.poses import PoseTrack, pose_from_tq
 from sgtool.recorders.importers.sink import (
     IMPORT_METADATA,
     ImportFrame,
     ImportReport,
     drift_metadata,
+    odometry_metadata,
+    odometry_report_fields,
     write_log,
 )
 from sgtool.recorders.importers.textformats import PinholeParams
@@ -122,8 +136,10 @@ def intrinsics_of_info(msg: Any) -> tuple[int, int, float, float, float, float]:
 
 
 # ----- flags, topics and suggestions ---------------------------------------------------------
-def suggest_flags(topics: list[B.TopicInfo]) -> list[str]:
-    """Flags guessed from topic names and types (depth/colour/camera_info/ids)."""
+def suggest_flags(topics: list[B.TopicInfo], tf_frames: list[str] | None = None) -> list[str]:
+    """Flags guessed from topic names and types (depth/colour/camera_info/ids). Without a
+    depth topic, one item of alternatives for a trajectory: ``tf_frames`` (``--tf-frames
+    WORLD:FRAME`` when not given and the bag has tf) and the pose topics."""
     images = [t.topic for t in topics if t.msgtype in B.IMAGE_TYPES]
     infos = [t.topic for t in topics if t.msgtype in B.INFO_TYPES]
     poses = [t.topic for t in topics if t.msgtype in B.POSE_TYPES]
@@ -146,10 +162,14 @@ def suggest_flags(topics: list[B.TopicInfo]) -> list[str]:
     if infos:
         ns = depth.rsplit("/", 1)[0] if depth else ""
         out.append(f"--info {next((t for t in infos if ns and t.startswith(ns)), infos[0])}")
-    if not depth and not tfs and poses:
-        out.append(" | ".join(f"--pose {p}" for p in poses[:4]))
-    if not depth and tfs:
-        out.append("--tf-frames WORLD:FRAME")
+    if not depth:
+        alternatives = (list(tf_frames) if tf_frames is not None else
+                        ["--tf-frames WORLD:FRAME"] if tfs else [])
+        alternatives += [f"--pose {p}" for p in poses[:4]]
+        if len(poses) > 4:
+            alternatives.append(f"... ({len(poses) - 4} more pose topics)")
+        if alternatives:
+            out.append(" | ".join(alternatives))
     return out
 
 
@@ -191,7 +211,7 @@ def describe_bag(reader: Any, path: Path) -> str:
     if tree.links:
         lines.append("tf links (from /tf_static and the first /tf messages):")
         lines.extend("  " + d for d in tree.describe())
-    sugg = [s for s in suggest_flags(topics) if s != "--tf-frames WORLD:FRAME"]
+    sugg = suggest_flags(topics, tf_frames=[])
     if sugg:
         lines.append("suggested flags: " + " ".join(sugg))
     tfs = tf_suggestions(tree)
@@ -203,12 +223,10 @@ def describe_bag(reader: Any, path: Path) -> str:
 def _missing_message(
     path: Path, topics: list[B.TopicInfo], what: str, reader: Any = None
 ) -> str:
-    sugg = suggest_flags(topics)
+    tfs = None
     if reader is not None and any(t.msgtype in B.TF_TYPES for t in topics):
-        tfs = tf_suggestions(peek_tf(reader, topics))
-        if tfs and "--tf-frames WORLD:FRAME" in sugg:
-            sugg.remove("--tf-frames WORLD:FRAME")
-            sugg.append(" | ".join(tfs))
+        tfs = tf_suggestions(peek_tf(reader, topics)) or None
+    sugg = suggest_flags(topics, tf_frames=tfs)
     return (
         f"{path}: {what}. The bag's topics:\n{B.format_topics(topics)}"
         + (f"\nsuggested flags: {' '.join(sugg)}" if sugg else "")
@@ -236,6 +254,16 @@ def _check_topic(
 def check_flags(
     path: Path, topics: list[B.TopicInfo], opts: BagOptions, reader: Any = None
 ) -> None:
+    if opts.estimate_poses and opts.depth is None:
+        has_images = any(t.msgtype in B.IMAGE_TYPES for t in topics)
+        raise SgtoolError(_missing_message(
+            path, topics,
+            "--estimate-poses estimates camera poses from depth images, and "
+            + ("it needs --depth (and --info, --rgb)" if has_images else
+               "the bag has no image topic (sensor_msgs Image or CompressedImage): import "
+               "its trajectory with --tf-frames or --pose, without --estimate-poses"),
+            reader,
+        ))
     if opts.depth is None and opts.tf_frames is None and opts.pose is None:
         raise SgtoolError(_missing_message(
             path, topics,
@@ -571,11 +599,19 @@ def _camera(path: Path, idx: _BagIndex, opts: BagOptions) -> CameraIntrinsics:
 
 
 # ----- entry points ---------------------------------------------------------------------------
+def check_options(opts: BagOptions) -> None:
+    """The numeric options, before the bag is opened (user errors naming the flag)."""
+    check_counts(opts.every, opts.limit)
+    check_depth_scale(opts.depth_scale)
+    check_positive(opts.depth_max, "--depth-max", "metres")
+    check_non_negative(opts.max_dt_ns / 1e9, "--max-dt", "seconds")
+    check_non_negative(opts.tf_tolerance_ns / 1e9, "--tf-tolerance", "seconds")
+
+
 def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportReport:
     """Import a bag into the log ``out`` (see the module docstring)."""
     path, out = Path(path), Path(out)
-    if opts.every < 1:
-        raise SgtoolError("--every must be >= 1")
+    check_options(opts)
     with B.open_bag(path) as reader:
         topics = B.list_topics(reader)
         check_flags(path, topics, opts, reader)
@@ -614,11 +650,15 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
                 + (f" (tf links: {'; '.join(idx.tf.describe())})" if src and src.tree else "")
             )
         drift = None
-        failures = None
+        odo: OdometryResult | None = None
         pose_source = src.describe if src else "none"
+        reference = f"the bag's poses ({src.describe})" if src else "none"
         if estimate:
-            plan, drift, failures, pose_source = _estimate(reader, plan, idx, opts, k, src)
-            meta.update(drift_metadata(drift))
+            plan, drift, odo, pose_source = _estimate(reader, plan, idx, opts, k, src)
+            meta.update(drift_metadata(drift, reference))
+            meta.update(odometry_metadata(odo))
+            if odo.warning():
+                notes.append(str(odo.warning()))
         meta["pose_source"] = pose_source
         by_k = {p.k_depth: p for p in plan}
         samples = [
@@ -637,14 +677,15 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
     return ImportReport(
         output=out, source=str(path), kind=kind, frames=n, poses=n, alignment=alignment,
         has_rgb=has_rgb, has_ids=has_ids, pose_source=pose_source, drift=drift,
-        odometry_failures=failures, notes=tuple(notes),
+        notes=tuple(notes), drift_reference=reference,
+        **(odometry_report_fields(odo) if odo is not None else {}),  # type: ignore[arg-type]
     )
 
 
 def _estimate(
     reader: Any, plan: list[_Planned], idx: _BagIndex, opts: BagOptions, k: CameraIntrinsics,
     src: _PoseSource | None,
-) -> tuple[list[_Planned], DriftReport | None, int, str]:
+) -> tuple[list[_Planned], DriftReport | None, OdometryResult, str]:
     """Poses of the planned frames by odometry (an extra pass over the images); the drift
     against the bag's own poses where it has them."""
     from dataclasses import replace
@@ -663,7 +704,8 @@ def _estimate(
 
     try:
         res = estimate_trajectory(gen(), k, method=opts.odometry, start=plan[0].pose,
-                                  depth_max=opts.depth_max, progress=lambda i: bar.update(1))
+                                  depth_max=opts.depth_max, times_ns=[p.t_ns for p in plan],
+                                  progress=lambda i: bar.update(1))
     finally:
         bar.close()
     ref = [(i, p.pose) for i, p in enumerate(plan) if p.pose is not None]
@@ -674,7 +716,7 @@ def _estimate(
     desc = f"estimated by {res.method} odometry"
     if src is not None:
         desc += f" ({src.describe} kept for the drift)"
-    return new_plan, drift, res.failures, desc
+    return new_plan, drift, res, desc
 
 
 def _import_trajectory(

@@ -21,20 +21,25 @@ from sgtool.errors import SgtoolError
 INVALID_U16 = 65535
 
 
-def read_color_file(path: Path) -> np.ndarray:
-    """An 8-bit colour (or grey) image file -> (H, W, 3) uint8 RGB."""
+def _read_image(path: Path) -> np.ndarray:
+    if not Path(path).is_file():
+        raise SgtoolError(f"{path}: no such image file")
     a = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     if a is None:
         raise SgtoolError(f"{path}: OpenCV cannot read this image")
+    return a
+
+
+def read_color_file(path: Path) -> np.ndarray:
+    """An 8-bit colour (or grey) image file -> (H, W, 3) uint8 RGB."""
+    a = _read_image(path)
     return _to_rgb(a, str(path))
 
 
 def read_depth_file(path: Path) -> np.ndarray:
     """A 16-bit depth image file (PNG/TIFF) -> its raw uint16 values (units per the
     dataset's depth scale)."""
-    a = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-    if a is None:
-        raise SgtoolError(f"{path}: OpenCV cannot read this image")
+    a = _read_image(path)
     if a.ndim != 2 or a.dtype != np.uint16:
         raise SgtoolError(
             f"{path}: a depth image must be single-channel 16-bit, this one is "

@@ -20,7 +20,7 @@
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -70,10 +70,16 @@ class FolderSequence:
     notes: tuple[str, ...] = ()
 
 
-def detect_layout(root: Path) -> str:
-    """The layout of a folder, or a user error that says what was looked for."""
-    if not root.is_dir():
-        raise SgtoolError(f"{root} is not a folder")
+LAYOUT_NAMES = {"tum": "TUM RGB-D", "7scenes": "7-Scenes", "open3d": "Open3D/Redwood"}
+LAYOUT_FILES = {
+    "tum": "rgb.txt + depth.txt",
+    "7scenes": "frame-XXXXXX.depth.png",
+    "open3d": "color/ or image/ and depth/ folders",
+}
+
+
+def looks_like(root: Path) -> str | None:
+    """The layout a folder's names suggest (see :func:`detect_layout`), or None."""
     names = {p.name for p in root.iterdir()}
     if "rgb.txt" in names and "depth.txt" in names:
         return "tum"
@@ -81,11 +87,62 @@ def detect_layout(root: Path) -> str:
         return "7scenes"
     if "depth" in names and (root / "depth").is_dir() and _color_dir(root) is not None:
         return "open3d"
-    seqs = sorted(n for n in names if n.startswith("seq-") and (root / n).is_dir())
-    hint = f"; it has sequence folders {', '.join(seqs[:5])}: import one of them" if seqs else ""
-    raise SgtoolError(
-        f"{root}: no known RGB-D layout (TUM: rgb.txt + depth.txt; 7-Scenes: "
-        f"frame-XXXXXX.depth.png; Open3D/Redwood: color/ or image/ and depth/ folders){hint}"
+    return None
+
+
+def _sequence_hint(root: Path) -> str:
+    seqs = sorted(p.name for p in root.iterdir() if p.name.startswith("seq-") and p.is_dir())
+    return f"; it has sequence folders {', '.join(seqs[:5])}: import one of them" if seqs else ""
+
+
+def detect_layout(root: Path) -> str:
+    """The layout of a folder, or a user error that says what was looked for."""
+    if not root.is_dir():
+        raise SgtoolError(f"{root} is not a folder")
+    layout = looks_like(root)
+    if layout is not None:
+        return layout
+    known = "; ".join(f"{LAYOUT_NAMES[k]}: {v}" for k, v in LAYOUT_FILES.items())
+    raise SgtoolError(f"{root}: no known RGB-D layout ({known}){_sequence_hint(root)}")
+
+
+def missing_for_layout(root: Path, layout: str) -> str | None:
+    """What a folder lacks to be read in ``layout``, or None when it has it all."""
+    if layout == "tum":
+        absent = [n for n in ("rgb.txt", "depth.txt") if not (root / n).is_file()]
+        return f"no {' and no '.join(absent)}" if absent else None
+    if layout == "7scenes":
+        if not any(_SEVEN.match(p.name) and ".depth." in p.name for p in root.iterdir()):
+            return "no frame-XXXXXX.depth.png files"
+        return None
+    if layout == "open3d":
+        if not (root / "depth").is_dir():
+            return "no depth/ folder"
+        if _color_dir(root) is None:
+            return "no color/, image/ or rgb/ folder"
+        if not _images(root / "depth"):
+            return "no images in depth/"
+        return None
+    raise SgtoolError(f"unknown layout {layout!r} ({', '.join(LAYOUTS)})")
+
+
+def _a(name: str) -> str:
+    return f"{'an' if name[0] in 'AEIOU' else 'a'} {name}"
+
+
+def layout_error(root: Path, layout: str, missing: str) -> SgtoolError:
+    """A one-line error: the folder is not ``layout`` (what is missing), and which layout
+    it looks like instead."""
+    seen = looks_like(root) if root.is_dir() else None
+    if seen is not None and seen != layout:
+        hint = (f"; it looks like {_a(LAYOUT_NAMES[seen])} folder ({LAYOUT_FILES[seen]}): use "
+                f"--layout {seen}, or --layout auto")
+    elif seen is None:
+        hint = f"; it matches no known layout{_sequence_hint(root)}"
+    else:
+        hint = ""
+    return SgtoolError(
+        f"{root}: not {_a(LAYOUT_NAMES[layout])} folder ({LAYOUT_FILES[layout]}): {missing}{hint}"
     )
 
 
@@ -113,17 +170,29 @@ def read_sequence(
     dataset's pose file (TUM text or Open3D .log); ``keep_unposed`` keeps frames the
     ground truth does not cover (for pose estimation)."""
     root = Path(root)
+    if not root.is_dir():
+        raise SgtoolError(f"{root}: no such folder" if not root.exists()
+                          else f"{root} is not a folder")
+    given = layout
     layout = layout or detect_layout(root)
+    missing = missing_for_layout(root, layout)
+    if missing is not None:
+        raise layout_error(root, layout, missing)
     if layout == "tum":
         seq = _read_tum(root, max_dt_ns, trajectory, keep_unposed)
     elif layout == "7scenes":
         seq = _read_7scenes(root, fps, trajectory)
     elif layout == "open3d":
         seq = _read_open3d(root, fps, trajectory)
-    else:
+    else:  # pragma: no cover - missing_for_layout refuses unknown layouts
         raise SgtoolError(f"unknown layout {layout!r} ({', '.join(LAYOUTS)})")
     if not seq.frames:
-        raise SgtoolError(f"{root}: no frames found in the {layout} layout")
+        raise SgtoolError(f"{root}: no frames found in the {LAYOUT_NAMES[layout]} layout")
+    seen = looks_like(root)
+    if given is not None and seen is not None and seen != given:
+        seq = replace(seq, notes=(*seq.notes, f"read as {LAYOUT_NAMES[given]} as asked; the "
+                                  f"folder also looks like {LAYOUT_NAMES[seen]} "
+                                  f"({LAYOUT_FILES[seen]})"))
     return seq
 
 
@@ -142,6 +211,8 @@ def _read_tum(
 ) -> FolderSequence:
     rgb = read_tum_list(root / "rgb.txt")
     depth = read_tum_list(root / "depth.txt")
+    if not depth:
+        raise SgtoolError(f"{root / 'depth.txt'} lists no depth images")
     rgb_times = [t for t, _ in rgb]
     gt_path = trajectory or (root / "groundtruth.txt")
     track = None
@@ -166,6 +237,11 @@ def _read_tum(
             if not keep_unposed:
                 continue
         frames.append(FolderFrame(t, root / name, color, pose))
+    if not frames:
+        raise SgtoolError(
+            f"{root}: none of the {len(depth)} depth images is within the time span of "
+            f"{gt_path.name}; give --estimate-poses to estimate their poses"
+        )
     notes = []
     if no_rgb:
         notes.append(f"{no_rgb} depth images had no colour image within {max_dt_ns / 1e6:g} ms")

@@ -2,10 +2,11 @@
 
 Steps: list the frames (:mod:`.layouts`); take the dataset's poses, or estimate them by
 odometry (:mod:`.odometry`) when it has none or when asked, measuring the drift against
-the dataset's poses where they exist; estimate the z-up world alignment from the poses and
-a few depth frames (:mod:`.upright`); write the frames (:mod:`.sink`). Log times are the
-dataset's time stamps (TUM) or frame number / fps. The images are read twice (odometry,
-then writing) rather than held in memory.
+the dataset's poses where they exist (ground truth for TUM and 7-Scenes, the reconstructed
+trajectory an Open3D/Redwood folder comes with); estimate the z-up world alignment from
+the poses and a few depth frames (:mod:`.upright`); write the frames (:mod:`.sink`). Log
+times are the dataset's time stamps (TUM) or frame number / fps. The images are read
+twice (odometry, then writing) rather than held in memory.
 """
 
 from __future__ import annotations
@@ -17,6 +18,12 @@ import numpy as np
 
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
+from sgtool.recorders.importers.checks import (
+    check_counts,
+    check_depth_scale,
+    check_non_negative,
+    check_positive,
+)
 from sgtool.recorders.importers.images import (
     depth_for_log,
     depth_to_metres,
@@ -31,7 +38,14 @@ from sgtool.recorders.importers.odometry import (
     drift_against,
     estimate_trajectory,
 )
-from sgtool.recorders.importers.sink import ImportFrame, ImportReport, drift_metadata, write_log
+from sgtool.recorders.importers.sink import (
+    ImportFrame,
+    ImportReport,
+    drift_metadata,
+    odometry_metadata,
+    odometry_report_fields,
+    write_log,
+)
 from sgtool.recorders.importers.textformats import PinholeParams
 from sgtool.recorders.importers.upright import DepthSample, estimate_alignment
 
@@ -56,6 +70,26 @@ class RgbdOptions:
     max_dt_ns: int = 20_000_000
     progress: bool = True
     compression: str = "zstd"
+
+
+def check_options(opts: RgbdOptions) -> None:
+    """The numeric options, before anything is read (user errors naming the flag)."""
+    check_counts(opts.every, opts.limit)
+    check_depth_scale(opts.depth_scale)
+    check_positive(opts.fps, "--fps", "frames per second")
+    check_positive(opts.depth_max, "--depth-max", "metres")
+    check_non_negative(opts.max_dt_ns / 1e9, "--max-dt", "seconds")
+
+
+def drift_reference(seq: FolderSequence, trajectory: Path | None) -> str:
+    """What the drift of estimated poses is measured against: the dataset's ground truth
+    (TUM, 7-Scenes), a trajectory given with --trajectory, or the trajectory an Open3D /
+    Redwood folder comes with (a reconstruction, e.g. ICL-NUIM's in the Open3D data)."""
+    if seq.pose_source == "ground truth":
+        return "ground truth"
+    if trajectory is not None:
+        return f"the given trajectory {trajectory.name} (not ground truth)"
+    return "the reference trajectory (reconstructed, not ground truth)"
 
 
 def camera_for(seq: FolderSequence, opts: RgbdOptions, width: int, height: int) -> CameraIntrinsics:
@@ -105,7 +139,9 @@ def run_odometry(
         raise SgtoolError("--odometry rgbd needs a colour image for every frame; use icp")
     try:
         return estimate_trajectory(gen(), k, method=opts.odometry, start=start,
-                                   depth_max=opts.depth_max, progress=lambda i: bar.update(1))
+                                   depth_max=opts.depth_max,
+                                   times_ns=[f.time_ns for f in frames],
+                                   progress=lambda i: bar.update(1))
     finally:
         bar.close()
 
@@ -114,8 +150,7 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     """Import an RGB-D folder into the log ``out`` (see the module docstring)."""
     opts = opts or RgbdOptions()
     root, out = Path(root), Path(out)
-    if opts.every < 1:
-        raise SgtoolError("--every must be >= 1")
+    check_options(opts)
     seq = read_sequence(root, opts.layout, max_dt_ns=opts.max_dt_ns, fps=opts.fps,
                         trajectory=opts.trajectory, keep_unposed=opts.estimate_poses)
     frames = list(seq.frames[:: opts.every])
@@ -123,19 +158,21 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         frames = frames[: opts.limit]
     if not frames:
         raise SgtoolError(f"{root}: no frames left after --every/--limit")
-    scale = float(opts.depth_scale or seq.depth_scale)
+    scale = float(opts.depth_scale if opts.depth_scale is not None else seq.depth_scale)
     first = read_depth_file(frames[0].depth_path)
     k = camera_for(seq, opts, first.shape[1], first.shape[0])
 
     notes = list(seq.notes)
     drift: DriftReport | None = None
-    failures: int | None = None
+    odo: OdometryResult | None = None
+    reference = drift_reference(seq, opts.trajectory)
     source_poses = [f.pose for f in frames]
     if opts.estimate_poses or seq.pose_source == "none":
         # start at the first reference pose, so the estimate lives in the dataset's world
         odo = run_odometry(frames, k, scale, opts, source_poses[0])
-        failures = odo.failures
         poses = list(odo.poses)
+        if odo.warning():
+            notes.append(str(odo.warning()))
         idx = [i for i, p in enumerate(source_poses) if p is not None]
         if len(idx) >= 2:
             drift = drift_against([poses[i] for i in idx], [source_poses[i] for i in idx])
@@ -167,7 +204,8 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         "instance_ids": "absent",
         "frames_in_source": str(len(seq.frames)),
         "every": str(opts.every),
-        **drift_metadata(drift),
+        **drift_metadata(drift, reference),
+        **(odometry_metadata(odo) if odo is not None else {}),
     }
 
     def gen():  # type: ignore[no-untyped-def]
@@ -182,5 +220,6 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     return ImportReport(
         output=out, source=str(root), kind=f"rgbd/{seq.layout}", frames=n, poses=len(poses),
         alignment=alignment, has_rgb=has_rgb, has_ids=has_ids, pose_source=pose_source,
-        drift=drift, odometry_failures=failures, notes=tuple(notes),
+        drift=drift, notes=tuple(notes), drift_reference=reference,
+        **(odometry_report_fields(odo) if odo is not None else {}),  # type: ignore[arg-type]
     )

@@ -9,7 +9,8 @@ no output file.
 The log carries:
 - metadata ``sgtool.import``: source path and kind, layout or topics, pose source, world
   alignment (matrix, source up direction, floor height, how each was found), depth scale,
-  intrinsics source, whether instance ids exist, odometry drift when measured;
+  intrinsics source, whether instance ids exist, odometry drift (and what it was measured
+  against) and failed odometry steps when poses were estimated;
 - an ``episode`` record (kind ``import``) at the first frame (``started``) and at the last
   (``ended``, with the frame count and the notes of the import).
 """
@@ -27,7 +28,7 @@ import numpy as np
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.writer import LogWriter
-from sgtool.recorders.importers.odometry import DriftReport
+from sgtool.recorders.importers.odometry import DriftReport, OdometryResult
 from sgtool.recorders.importers.upright import WorldAlignment
 
 IMPORT_METADATA = "sgtool.import"
@@ -57,6 +58,11 @@ class ImportReport:
     drift: DriftReport | None = None
     odometry_failures: int | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
+    # what the drift was measured against: "ground truth" (TUM, 7-Scenes) or another
+    # reference, e.g. "the reference trajectory (reconstructed, not ground truth)"
+    drift_reference: str = "ground truth"
+    odometry_summary: str = ""  # OdometryResult.summary()
+    odometry_reasons: tuple[tuple[str, int], ...] = ()  # failed steps per reason
 
     def lines(self) -> list[str]:
         a = self.alignment
@@ -69,9 +75,11 @@ class ImportReport:
             + "; instance ids: " + ("yes" if self.has_ids else "none (geometry only)"),
         ]
         if self.odometry_failures is not None:
-            out.append(f"odometry: {self.odometry_failures} failed steps (previous motion kept)")
+            out.append("odometry: " + (self.odometry_summary or
+                                       f"{self.odometry_failures} failed steps (previous "
+                                       "motion kept)"))
         if self.drift is not None:
-            out.append("drift against ground truth: " + self.drift.summary())
+            out.append(f"drift against {self.drift_reference}: " + self.drift.summary())
         out.extend(f"note: {n}" for n in self.notes)
         return out
 
@@ -131,5 +139,21 @@ def write_log(
     return n, has_rgb, has_ids
 
 
-def drift_metadata(drift: DriftReport | None) -> dict[str, str]:
-    return {} if drift is None else {"odometry_drift": json.dumps(drift.as_dict(), sort_keys=True)}
+def drift_metadata(drift: DriftReport | None, reference: str = "ground truth") -> dict[str, str]:
+    if drift is None:
+        return {}
+    return {"odometry_drift": json.dumps(drift.as_dict(), sort_keys=True),
+            "odometry_drift_reference": reference}
+
+
+def odometry_metadata(res: OdometryResult) -> dict[str, str]:
+    """The failed steps of an odometry run, for the log's import metadata."""
+    return {"odometry_failures": json.dumps(
+        {"steps": res.steps, "failed": res.failures, "by_reason": res.reasons(),
+         "frames": [f.frame for f in res.failed]}, sort_keys=True)}
+
+
+def odometry_report_fields(res: OdometryResult) -> dict[str, object]:
+    """The :class:`ImportReport` fields of an odometry run."""
+    return {"odometry_failures": res.failures, "odometry_summary": res.summary(),
+            "odometry_reasons": tuple(res.reasons().items())}

@@ -49,7 +49,11 @@ def _print_report(report, as_json: bool) -> None:  # type: ignore[no-untyped-def
                           "up_method": a.up_method, "floor": a.floor,
                           "floor_method": a.floor_method},
             "drift": asdict(report.drift) if report.drift else None,
-            "odometry_failures": report.odometry_failures, "notes": list(report.notes),
+            "drift_reference": report.drift_reference if report.drift else None,
+            "odometry_failures": report.odometry_failures,
+            "odometry_failure_reasons": dict(report.odometry_reasons)
+            if report.odometry_failures is not None else None,
+            "notes": list(report.notes),
         }
         click.echo(json.dumps(d, indent=2, sort_keys=True))
     else:
@@ -129,8 +133,8 @@ def command() -> None:
               help="How far (s) before/after a transform's samples a pose may be taken.")
 @click.option("--estimate-poses", is_flag=True,
               help="Estimate the camera poses by RGB-D odometry even when the bag has tf "
-              "(the drift against the bag's poses is reported). A bag without tf and "
-              "without --pose is always estimated.")
+              "(the drift against the bag's poses is reported). Needs --depth. A bag "
+              "without tf and without --pose is always estimated.")
 @click.option("--odometry", type=click.Choice(["rgbd+icp", "rgbd", "icp"]),
               default="rgbd+icp", show_default=True,
               help="Odometry for estimated poses (see `sgtool import rgbd --help`).")
@@ -159,7 +163,7 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
         --rgb /camera/rgb/image_color --info /camera/depth/camera_info
       sgtool import bag tf_example.bag -o traj.mcap --tf-frames odom:base_link
     """
-    from sgtool.recorders.importers.bag import BagOptions, describe_bag, import_bag
+    from sgtool.recorders.importers.bag import BagOptions, check_options, describe_bag, import_bag
     from sgtool.recorders.importers.bagfiles import open_bag
     from sgtool.recorders.importers.textformats import parse_intrinsics
     from sgtool.recorders.importers.upright import parse_up
@@ -184,6 +188,7 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
         compression=compression, estimate_poses=estimate_poses, odometry=odometry,
         depth_max=depth_max,
     )
+    check_options(opts)
     if not (depth or tf_frames or pose):
         # nothing to import yet: the error lists the topics and suggests flags
         from sgtool.recorders.importers.bag import check_flags
