@@ -23,8 +23,26 @@
    0.2 m) can still cross the room between all its doors and stand within 1 m of every
    container and supporter.
 4. **Small objects.** Containers are filled and supporters dressed with objects drawn
-   from the split's ``inside``/``ontop`` relations whose parent is the piece's synset or
-   one of its hypernyms, preferring relations stated in the same room type; each object
+   by the room type of the piece. A category is a candidate for a piece when (a) some
+   activity of the split relates it ``inside``/``ontop`` the piece's synset or one of its
+   hypernyms, in any room type (it can sit there), and (b) the piece's room type knows it:
+   at least :data:`MIN_SUPPORT` (2) sources of the split put it in a room of that type -
+   real rooms of that type holding it, activities placing it there (the counts of
+   ``Knowledge.room_objects``) - so one odd activity (pennies cleaned with salt in a bowl
+   on a bathroom sink) or one odd scan does not bring a category into a room type that
+   has better evidence for that piece. Only when no related category reaches two sources
+   for the piece does a single source of that room type admit (the room type's own
+   inventory: toilet tissue on a toilet, a blouse in a closet's wardrobe). The weight comes
+   from that room type only: the share of the type's real rooms holding the category,
+   plus the share of the activities placing objects in the type that place it there, plus
+   :data:`LOCAL_BONUS` times the share that relate it to this parent there. Relations
+   stated in other room types only admit a candidate and never weigh in, so the many
+   kitchen activities with a bowl in a cabinet do not fill bathroom cabinets. A piece
+   whose (parent, relation, room type) has no candidate at all stays empty: objects of
+   other room types are never imported (in the evaluation split corridors, entryways and
+   most storage-room pieces have no evidence and stay empty). With fewer than
+   :data:`FULL_POOL` candidates the mean count is scaled down by the pool size, so thin
+   evidence gives fewer objects rather than many copies of one category. Each object
    gets a slot (a shelf level inside a container, a spot on a top face) so objects never
    overlap and lie really inside (within the box) or on top (bottom on the top face).
 5. **Checks.** The spec is validated (:func:`load_house`) and the whole house is checked
@@ -111,6 +129,13 @@ OPEN_PLAN_PARTNERS = ("living_room", "dining_room")
 # mean number of small objects per piece (Poisson), for containers and for top faces
 LAMBDA_INSIDE = 2.2
 LAMBDA_ONTOP = 1.3
+# small objects (module docstring, step 4): a category must be held by / put in rooms of
+# the piece's room type by at least this many sources (real rooms + activities, the counts
+# of Knowledge.room_objects) to be placed there
+MIN_SUPPORT = 2
+LOCAL_BONUS = 2  # weight of relating the object to this parent in this room type
+# fewer objects on thin evidence: the mean count is scaled by min(1, pool size / this)
+FULL_POOL = 3
 
 
 # shop and school fittings that some room inventories hold but a home generator skips
@@ -148,36 +173,76 @@ def _inventory(split: str) -> _Inventory:
     return _Inventory(k, furniture, weights)
 
 
+@dataclass(frozen=True)
+class _RoomEvidence:
+    """Per room type of one split: how many real rooms of that type hold each small-object
+    category, and how many activities put it in a room of that type."""
+
+    rooms: dict[str, Counter[str]]  # room type -> synset -> rooms holding it
+    n_rooms: Counter[str]  # room type -> rooms of that type
+    acts: dict[str, Counter[str]]  # room type -> synset -> activities placing it there
+    n_acts: Counter[str]  # room type -> activities placing any small object there
+
+
+@functools.cache
+def _room_evidence(split: str) -> _RoomEvidence:
+    k = knowledge_for(split)
+    rooms: dict[str, Counter[str]] = {}
+    n_rooms: Counter[str] = Counter()
+    for r in k.rooms:
+        n_rooms[r.room_type] += 1
+        c = rooms.setdefault(r.room_type, Counter())
+        c.update(s for s, _ in r.items if k.kind(s) == "object")
+    placed: set[tuple[str, str, str]] = set()  # (room type, synset, activity)
+    for rel in k.relations:
+        if rel.room_type is not None and k.kind(rel.child) == "object":
+            placed.add((rel.room_type, rel.child, rel.activity))
+    for ir in k.inroom:
+        if k.kind(ir.synset) == "object":
+            placed.add((ir.room_type, ir.synset, ir.activity))
+    acts: dict[str, Counter[str]] = {}
+    for rt, s, _ in placed:
+        acts.setdefault(rt, Counter())[s] += 1
+    n_acts = Counter({rt: len({a for t, _, a in placed if t == rt}) for rt in acts})
+    return _RoomEvidence(rooms, n_rooms, acts, n_acts)
+
+
 @functools.cache
 def _candidates(split: str, parent: str, relation: str,
                 room_type: str) -> tuple[tuple[str, ...], np.ndarray]:
     """Small objects that may be ``relation`` ``parent`` (or a hypernym of it) in a room of
-    ``room_type``, with sampling weights.
+    ``room_type``, with sampling weights (see "Small objects" in the module docstring).
 
-    The pool is every object the split relates to the parent that is also known in this
-    room type (stated there by an activity, or held by a real room of that type); its
-    weight is the number of activities relating it to the parent, tripled for activities
-    that put the parent in this room type. When fewer than three objects qualify, every
-    object related to the parent is used (weights as above)."""
+    Admitted: an object some activity of the split relates to the parent (in any room
+    type) that at least :data:`MIN_SUPPORT` sources of the split put in this room type
+    (real rooms of the type holding it + activities placing it there, the counts of
+    ``Knowledge.room_objects``); when no related object reaches that, the related objects
+    with one source there. Weight, from this room type only: the share of its real rooms
+    holding the object + the share of the activities placing objects in it that place
+    this one + :data:`LOCAL_BONUS` times the share relating it to the parent here.
+    Relations stated in other room types only admit, they add no weight; nothing admitted
+    gives an empty pool (the piece stays empty)."""
     k = knowledge_for(split)
+    ev = _room_evidence(split)
     anc = ancestors(parent)
+    related: set[str] = set()
     local: Counter[str] = Counter()
-    anywhere: Counter[str] = Counter()
     seen_local: set[tuple[str, str]] = set()
-    seen_any: set[tuple[str, str]] = set()
     for r in k.relations:
         if r.relation != relation or r.parent not in anc or k.kind(r.child) != "object":
             continue
-        if (r.activity, r.child) not in seen_any:
-            seen_any.add((r.activity, r.child))
-            anywhere[r.child] += 1
+        related.add(r.child)
         if r.room_type == room_type and (r.activity, r.child) not in seen_local:
             seen_local.add((r.activity, r.child))
             local[r.child] += 1
-    known_here = {s for s, _ in k.room_objects.get(room_type, ())}
-    pool = {c: anywhere[c] + 2 * local[c] for c in anywhere if c in known_here or local[c]}
-    if len(pool) < 3:
-        pool = {c: anywhere[c] + 2 * local[c] for c in anywhere}
+    rooms = ev.rooms.get(room_type, Counter())
+    acts = ev.acts.get(room_type, Counter())
+    nr = max(ev.n_rooms[room_type], 1)
+    na = max(ev.n_acts[room_type], 1)
+    support = {c: rooms[c] + acts[c] for c in related}
+    need = MIN_SUPPORT if any(n >= MIN_SUPPORT for n in support.values()) else 1
+    pool = {c: rooms[c] / nr + (acts[c] + LOCAL_BONUS * local[c]) / na
+            for c, n in support.items() if n >= need}
     names = tuple(sorted(pool))
     w = np.array([pool[n] for n in names], float)
     return names, (w / w.sum() if w.size else w)
@@ -808,6 +873,7 @@ def _place_objects(rng: np.random.Generator, split: str, pieces: list[_Piece],
             if not names:
                 continue
             lam = LAMBDA_INSIDE if relation == "inside" else LAMBDA_ONTOP
+            lam *= min(1.0, len(names) / FULL_POOL)
             slots = _slots(p, relation)
             n = min(int(rng.poisson(lam)), len(slots))
             if n == 0:
