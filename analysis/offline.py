@@ -11,8 +11,15 @@ actions in between belong to it. A log without a "started" record has one episod
 start; an episode still open at the end of the log (a killed run) is closed as "ended"
 (not a success) with the figures derived from its actions.
 
-**Decision points.** Every Action record is a decision point; the scene graph the planner
-decided on is the last SceneGraph record at or before the action's log time.
+**Decision points.** Every Action record is a decision point, except one decided on no
+graph. An action with ``graph_time_ns`` (``sgtool.Action`` 1.1) was decided on the last
+SceneGraph record at or before that log time; one with ``graph_time_ns: null`` on no graph
+(the closed loop's opening look-around): it is no decision point, so a planner is neither
+asked nor told about it and it counts in no decision time; an action without the field
+(1.0 logs), on the last SceneGraph record at or before the action's own log time. The
+closed loop needs the field: it writes an action when its skill ends, and the graph
+refreshes during the skill. At equal log times a closing Episode record comes after the
+actions (the closed loop closes an episode at the time of its last action).
 
 **A planner against a log** (:func:`replay_decisions`): the planner is reset with the
 episode's query and seed, then at every decision point it decides on the logged graph and
@@ -24,6 +31,7 @@ the logged node lie in the same room), and choices that name no node of the grap
 
 from __future__ import annotations
 
+import bisect
 import math
 import os
 import time
@@ -50,6 +58,11 @@ class Decision:
     graph: SceneGraph | None
     action: Mapping[str, Any]
 
+    @property
+    def decided(self) -> bool:
+        """False for an action decided on no graph (``graph_time_ns: null``)."""
+        return not ("graph_time_ns" in self.action and self.action["graph_time_ns"] is None)
+
 
 @dataclass(frozen=True)
 class LoggedEpisode:
@@ -61,6 +74,11 @@ class LoggedEpisode:
     def result(self) -> EpisodeResult:
         r = result_from_log_records(self.episode, [d.action for d in self.decisions],
                                     source=self.source)
+        if not all(d.decided for d in self.decisions):  # decision time over decisions only
+            decided = [d.action for d in self.decisions if d.decided]
+            r = _replace(r, wall={
+                "decision_s": sum(float(a.get("decision_time_s", 0.0)) for a in decided),
+                "decisions": float(len(decided))})
         if "episode" not in (self.episode.get("extra") or {}):
             r = _replace(r, episode=self.index)
         return r
@@ -82,10 +100,17 @@ def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
         for order, kind in enumerate(("scene_graph", "episode", "action")):
             for t, rec in log.records(kind):
                 stream.append((t, order, kind, rec))
-    # at equal times: the graph first, then episode records, then actions
-    stream.sort(key=lambda x: (x[0], x[1]))
+    # at equal times: the graph first, then opening episode records, then actions, then
+    # closing episode records
+    def tie_order(x: tuple[int, int, str, Any]) -> tuple[int, int]:
+        closing = x[2] == "episode" and x[3].get("status") in _TERMINAL
+        return (x[0], 3 if closing else x[1])
+
+    stream.sort(key=tie_order)
     episodes: list[LoggedEpisode] = []
     graph: SceneGraph | None = None
+    graph_times: list[int] = []  # every graph so far, in stream order (non-decreasing times)
+    graphs: list[SceneGraph] = []
     opened: Mapping[str, Any] | None = None
     decisions: list[Decision] = []
 
@@ -102,6 +127,8 @@ def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
             except (KeyError, TypeError, ValueError) as e:
                 raise EvalInputError(f"{p}: unreadable scene graph record at {t} ns: {e}") \
                     from None
+            graph_times.append(t)
+            graphs.append(graph)
         elif kind == "episode":
             status = rec.get("status")
             if status == "started":
@@ -111,10 +138,23 @@ def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
             elif status in _TERMINAL:
                 close({**(opened or {}), **rec})
         else:
-            decisions.append(Decision(t, graph, rec))
+            decisions.append(Decision(t, _decided_on(rec, graph, graph_times, graphs), rec))
     if opened is not None or decisions:
         close({**(opened or {"kind": "search"}), "status": "ended"})
     return episodes
+
+
+def _decided_on(action: Mapping[str, Any], latest: SceneGraph | None, times: list[int],
+                graphs: list[SceneGraph]) -> SceneGraph | None:
+    """The graph an action was decided on (module doc): by its ``graph_time_ns`` when it
+    has the field, else ``latest`` (the last graph at or before the action)."""
+    if "graph_time_ns" not in action:
+        return latest
+    t = action["graph_time_ns"]
+    if t is None:
+        return None
+    i = bisect.bisect_right(times, int(t))
+    return graphs[i - 1] if i else None
 
 
 def load_results(paths: Iterable[str | os.PathLike[str]]) -> tuple[list[EpisodeResult],
@@ -226,6 +266,8 @@ def replay_decisions(planner: Any, episodes: Sequence[LoggedEpisode],
             continue
         planner.reset(str(query), seed=int(extra.get("planner_seed", extra.get("seed", 0))))
         for step, d in enumerate(ep.decisions):
+            if not d.decided:
+                continue
             logged = Action(str(d.action.get("skill", "")), d.action.get("target"))
             if d.graph is not None:
                 t0 = time.perf_counter()

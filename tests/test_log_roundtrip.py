@@ -103,7 +103,8 @@ def test_json_schemas_are_named_and_versioned(tmp_path):
         for sch in r.summary.schemas.values():
             if sch.encoding == "jsonschema":
                 doc = json.loads(sch.data)
-                assert doc["title"] == sch.name and doc["version"] == "1.0"
+                assert doc["title"] == sch.name
+                assert doc["version"] == S.RECORD_BY_SCHEMA[sch.name].version
                 assert sch.name.startswith("sgtool.")
 
 

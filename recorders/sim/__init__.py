@@ -12,7 +12,10 @@ Modules, one job each:
 - :mod:`~sgtool.recorders.sim.simulation`: :class:`Simulation` (render, skills, observers);
 - :mod:`~sgtool.recorders.sim.explore`: the scripted whole-house exploration;
 - :mod:`~sgtool.recorders.sim.noise`: seeded sensor faults;
-- :mod:`~sgtool.recorders.sim.recording`: :class:`LogRecorder` and :func:`record_house`.
+- :mod:`~sgtool.recorders.sim.recording`: :class:`LogRecorder` and :func:`record_house`;
+- :mod:`~sgtool.recorders.sim.closed_loop`: a planner searching the house on the scene
+  graph built live (``sgtool run``): :func:`run_closed_loop` (``closed_loop.run_episode``),
+  :func:`plan_skills` (planner actions to skills).
 
 Importing this package does not import PyBullet; building a :class:`Simulation` does.
 """
@@ -20,6 +23,15 @@ Importing this package does not import PyBullet; building a :class:`Simulation` 
 from __future__ import annotations
 
 from sgtool.recorders.sim.camera import CameraConfig
+from sgtool.recorders.sim.closed_loop import (
+    ClosedLoopOptions,
+    ClosedLoopReport,
+    SkillCall,
+    SkillPlan,
+    pick_episode,
+    plan_skills,
+)
+from sgtool.recorders.sim.closed_loop import run_episode as run_closed_loop
 from sgtool.recorders.sim.explore import ExplorationReport, ScriptOptions, explore_house
 from sgtool.recorders.sim.instances import Instance, instance_table
 from sgtool.recorders.sim.navigation import RobotConfig
@@ -40,6 +52,8 @@ from sgtool.recorders.sim.simulation import (
 __all__ = [
     "PROFILES",
     "CameraConfig",
+    "ClosedLoopOptions",
+    "ClosedLoopReport",
     "ExplorationReport",
     "Instance",
     "LogRecorder",
@@ -51,10 +65,15 @@ __all__ = [
     "SensorFaults",
     "SimObserver",
     "Simulation",
+    "SkillCall",
     "SkillOutcome",
+    "SkillPlan",
     "StopSimulation",
     "explore_house",
     "instance_table",
     "parse_noise",
+    "pick_episode",
+    "plan_skills",
     "record_house",
+    "run_closed_loop",
 ]

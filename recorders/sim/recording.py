@@ -7,7 +7,9 @@ writes, through :class:`sgtool.log.LogWriter`:
   transforms world -> base -> camera (with the noise profile's faults applied);
 - the instances table (``sgtool.Instances``) at the start and again, whole, with the
   new states whenever a door or container opens or closes;
-- one ``sgtool.Action`` per top-level skill, with its outcome, reason and distance;
+- one ``sgtool.Action`` per top-level skill, with its outcome, reason and distance (the
+  closed loop, :mod:`sgtool.recorders.sim.closed_loop`, logs one per planner action
+  instead);
 - ``sgtool.Episode`` records when the run starts and ends.
 
 :func:`record_house` runs the scripted exploration (:mod:`sgtool.recorders.sim.explore`)
@@ -23,12 +25,13 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
 from sgtool.datasets.house import HouseSpec
+from sgtool.log.frame import Frame
 from sgtool.log.writer import LogWriter
 from sgtool.recorders.sim.camera import CameraConfig, base_T_camera
 from sgtool.recorders.sim.explore import ExplorationReport, ScriptOptions, explore_house
@@ -50,7 +53,9 @@ class LogRecorder(SimObserver):
 
     ``max_frames`` ends the run (by raising :class:`StopSimulation` from the tick that
     would exceed it). ``planner`` fills the action records' planner field. ``progress``
-    is anything with ``update(n)`` (a tqdm bar).
+    is anything with ``update(n)`` (a tqdm bar). :attr:`last_frame` is the last frame as
+    written (after the sensor faults) and :attr:`last_instances` the last instances
+    record, for whoever builds from what the log holds (the closed loop).
     """
 
     def __init__(self, writer: LogWriter, sim: Simulation, *,
@@ -65,6 +70,8 @@ class LogRecorder(SimObserver):
         self.frames = 0
         self.actions = 0
         self.last_time_ns = 0
+        self.last_frame: Frame | None = None
+        self.last_instances: dict[str, Any] | None = None
         profile = noise or PROFILES["none"]
         structure = [i.id for i in sim.instances if i.kind == STRUCTURE]
         self.faults = None if profile.is_clean else SensorFaults(
@@ -72,8 +79,8 @@ class LogRecorder(SimObserver):
             base_T_camera(sim.camera.mount_height, sim.camera.tilt_deg))
 
     def write_instances(self, sim: Simulation) -> None:
-        self.writer.write_record("instances", sim.time_ns(),
-                                 {"instances": sim.instance_records()})
+        self.last_instances = {"instances": sim.instance_records()}
+        self.writer.write_record("instances", sim.time_ns(), self.last_instances)
 
     def on_tick(self, sim: Simulation) -> None:
         if self.max_frames is not None and self.frames >= self.max_frames:
@@ -84,6 +91,7 @@ class LogRecorder(SimObserver):
         self.writer.write_frame(f.time_ns, depth=f.depth, pose=f.pose, intrinsics=f.intrinsics,
                                 rgb=f.rgb, ids=f.ids, base_pose=f.base_pose)
         self.last_time_ns = f.time_ns
+        self.last_frame = f
         self.frames += 1
         if self.progress is not None:
             self.progress.update(1)
@@ -96,18 +104,21 @@ class LogRecorder(SimObserver):
             self.log_action(sim, outcome)
 
     def log_action(self, sim: Simulation, outcome: SkillOutcome, *,
-                   decision_time_s: float = 0.0) -> None:
+                   decision_time_s: float = 0.0,
+                   fields: Mapping[str, Any] | None = None) -> int:
         """Write the ``sgtool.Action`` record of ``outcome`` at the time of the last frame
-        the skill took (the current time when it took none)."""
+        the skill took (the current time when it took none); ``fields`` are added to the
+        record (e.g. ``graph_time_ns``). Returns the record's log time."""
         t = sim.time_ns(max(sim.tick_index - 1, 0)) if outcome.ticks else sim.time_ns()
         t = max(t, self.last_time_ns)
         self.writer.write_record("action", t, {
             "skill": outcome.skill, "target": outcome.target, "outcome": outcome.outcome,
             "reason": outcome.reason, "travelled_m": round(outcome.travelled_m, 6),
             "decision_time_s": float(decision_time_s), "planner": self.planner,
-            "step": self.actions,
+            "step": self.actions, **(fields or {}),
         })
         self.actions += 1
+        return t
 
 
 @dataclass(frozen=True)

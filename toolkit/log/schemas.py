@@ -15,7 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-LOG_SCHEMA_VERSION: tuple[int, int] = (1, 0)
+# 1.1: sgtool.Action 1.1 adds the optional ``graph_time_ns``
+LOG_SCHEMA_VERSION: tuple[int, int] = (1, 1)
 PROFILE = "sgtool"
 METADATA_NAME = "sgtool"
 HOUSE_ATTACHMENT = "house.json"
@@ -125,10 +126,13 @@ RECORDS: dict[str, RecordKind] = {
             ["instances"],
         ),
     ),
+    # 1.1: optional graph_time_ns, the log time of the sgtool.SceneGraph the action was
+    # decided on (null: decided on no graph, e.g. the closed loop's opening look-around;
+    # absent: the last graph at or before the action's log time)
     "action": RecordKind(
         "action",
         "sgtool.Action",
-        "1.0",
+        "1.1",
         "/sgtool/action",
         _obj(
             {
@@ -140,6 +144,7 @@ RECORDS: dict[str, RecordKind] = {
                 "decision_time_s": _NUM,
                 "planner": _NSTR,
                 "step": _INT,
+                "graph_time_ns": {"type": ["integer", "null"]},
             },
             ["skill", "outcome"],
         ),

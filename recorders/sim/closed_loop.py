@@ -1,0 +1,498 @@
+"""The closed loop: a planner searches a PyBullet house on the scene graph built live.
+
+One episode (:func:`run_episode`), all of it into one MCAP log:
+
+1. the simulation starts at the episode's start pose; the log gets the house attachment,
+   an ``sgtool.Episode`` record "started" (query, planner, the camera, robot and mapping
+   settings: ``extra.mapping`` is what ``sgtool replay`` rebuilds with by default) and the
+   instances table;
+2. every simulator tick is a logged frame (:class:`~sgtool.recorders.sim.recording.LogRecorder`)
+   and is fed, *as the log holds it* (:func:`sgtool.log.echo.as_logged`, after the sensor
+   faults), to a :class:`~sgtool.replayers.stream.SceneGraphStream`, the refresh schedule
+   replay uses: a refresh every K frames, and one at every action record, each written as
+   the derived channels ``/map/occupancy``, ``/map/voronoi``, ``/map/rooms`` and
+   ``/sgtool/scene_graph`` right after the message that caused it. Instance tables (a door
+   or container changed state) go to the stream as they are written. Since replay feeds
+   the same stream the same messages in the same order, ``sgtool replay`` of the episode
+   log rebuilds the live scene graphs byte for byte;
+3. start: one frame, then ``look_around()``, logged as an action decided on no graph
+   (``graph_time_ns: null``, planner null, step 0), so the first decision has a graph;
+4. per high-level step: the planner decides on the graph in force
+   (:attr:`SceneGraphStream.current`), its LLM exchanges (moma-llm) are logged as
+   ``sgtool.LlmExchange`` records, the action is mapped to simulator skills
+   (:func:`plan_skills`) and executed, and one ``sgtool.Action`` record is written when it
+   ends (at the time of its last frame) with the outcome and reason of the simulator, the
+   distance driven, the measured decision time, the planner, the step number and
+   ``graph_time_ns``, the log time of the graph the decision was made on. The outcome
+   goes back to the planner (:meth:`Planner.feedback`, the simulator's reason as message);
+5. end: **success as soon as the graph refreshed at an action record (the graph the
+   planner would decide on next) holds an object of the query category** (exact match
+   after :func:`~sgtool.semantics.text.category_text`, as
+   :func:`~sgtool.planning.candidates.find_target`), which is the rule of the symbolic
+   benchmark (SymSearch: the episode ends when the target becomes visible; no ``done``
+   needed); failure on ``done`` (end "gave_up", or "wrong_done" when ``done`` names a
+   target), after ``max_steps`` high-level steps ("max_steps", default 50) or at the frame
+   budget ("frames": the skill under way is cut and logged as a failure). The closing
+   Episode record has status success/failure, steps, travelled_m, shortest_m (the
+   episode's geodesic, :mod:`sgtool.datasets.episodes`), frames and ``extra`` (query,
+   planner, seed, end, n_open, mapping, episode).
+
+Steps count every planner decision, invalid ones and ``done`` included (a step is spent),
+but not the opening look-around. Log time is the simulator's (``tick * 1e9 / fps``), never
+the wall clock: the same house, episode, options and planner seed give the same log except
+the measured fields, ``decision_time_s`` of the actions and ``latency_s`` of the LLM
+exchanges (so the file bytes differ too, through the compressed chunks; every message on
+every other channel is identical, the scene graphs included). The writer writes
+``OUT.partial`` and renames it at the end: an error leaves no half-written log.
+
+Mapping planner actions to skills (:func:`plan_skills`, pure):
+
+=========================================  ===============================================
+action                                     simulator calls
+=========================================  ===============================================
+``navigate(obj:N | door:N)``               ``navigate(N)``
+``navigate(room | region | frontier)``     ``navigate((x, y))`` of the node
+``explore(frontier | room | region)``      ``explore((x, y))`` (go there, look around)
+``explore(obj:N | door:N)``                ``explore(N)``
+``open(obj:N | door:N)``                   ``navigate(N)`` then ``open(N)`` (MoMa-LLM's
+                                           go_to_and_open): one action, summed distance,
+                                           the outcome of the open (or of the navigate
+                                           when that fails)
+``close(obj:N | door:N)``                  ``navigate(N)`` then ``close(N)``
+``open``/``close`` of a room or region     invalid, no motion
+a target not in the graph the planner saw  invalid, no motion
+``done``                                   ends the episode
+=========================================  ===============================================
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import statistics
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from sgtool.datasets.episodes import Episode, list_episodes
+from sgtool.datasets.house import HouseSpec
+from sgtool.errors import SgtoolError
+from sgtool.log.echo import as_logged
+from sgtool.log.writer import LogWriter
+from sgtool.planning.base import Action, Feedback, Planner
+from sgtool.planning.candidates import find_target
+from sgtool.recorders.sim.camera import CameraConfig
+from sgtool.recorders.sim.navigation import RobotConfig
+from sgtool.recorders.sim.noise import PROFILES, NoiseProfile
+from sgtool.recorders.sim.recording import SOURCE, LogRecorder
+from sgtool.recorders.sim.simulation import Simulation, SkillOutcome, StopSimulation
+from sgtool.replayers.layers import write_refresh
+from sgtool.replayers.replay import (
+    CLASSIFIERS,
+    ResolvedOptions,
+    builder_config,
+    default_min_points,
+    make_classifier,
+    mapping_record,
+)
+from sgtool.replayers.stream import Refresh, SceneGraphStream
+from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode, SceneGraph
+from sgtool.semantics.text import category_text
+
+N_MAX = 50  # high-level steps per episode (SymSearch's N_max)
+SKILLS = ("navigate", "open", "close", "explore", "done")
+DONE_MESSAGE = "episode ended by the planner"
+
+
+# ----------------------------------------------------------------------------------------
+# actions -> skills (pure)
+# ----------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class SkillCall:
+    """One simulator skill: ``navigate``/``explore``/``open``/``close`` of an instance id or
+    a point (x, y)."""
+
+    skill: str
+    target: int | tuple[float, float]
+
+
+@dataclass(frozen=True)
+class SkillPlan:
+    """What an action means for the simulator: calls run in order until one does not
+    succeed; or ``invalid`` (why, nothing moves); or ``done``."""
+
+    calls: tuple[SkillCall, ...] = ()
+    invalid: str | None = None
+    done: bool = False
+
+
+def _instance(node: ObjectNode | DoorNode) -> int | None:
+    if node.instance >= 0:
+        return int(node.instance)
+    _, _, num = node.id.partition(":")
+    return int(num) if num.isdigit() else None
+
+
+def plan_skills(graph: SceneGraph, action: Action) -> SkillPlan:
+    """The simulator calls of ``action`` on the graph the planner decided on (module doc)."""
+    skill = action.skill
+    if skill == "done":
+        return SkillPlan(done=True)
+    if skill not in SKILLS:
+        return SkillPlan(invalid=f"unknown skill {skill!r}; one of {', '.join(SKILLS)}")
+    if action.target is None:
+        return SkillPlan(invalid=f"{skill} needs a target node")
+    node = graph.node(action.target)
+    if node is None:
+        return SkillPlan(invalid=f"{action.target!r} is not a node of the scene graph the "
+                                 "planner saw")
+    if isinstance(node, (ObjectNode, DoorNode)):
+        iid = _instance(node)
+        if iid is None:
+            return SkillPlan(invalid=f"{node.id} names no instance")
+        if skill in ("open", "close"):
+            return SkillPlan((SkillCall("navigate", iid), SkillCall(skill, iid)))
+        return SkillPlan((SkillCall(skill, iid),))
+    assert isinstance(node, (RoomNode, RegionNode))
+    what = "room" if isinstance(node, RoomNode) else (
+        "frontier" if node.kind == "frontier" else "region")
+    if skill in ("open", "close"):
+        return SkillPlan(invalid=f"cannot {skill} a {what} ({node.id})")
+    xy = (float(node.position[0]), float(node.position[1]))
+    return SkillPlan((SkillCall(skill, xy),))
+
+
+# ----------------------------------------------------------------------------------------
+# options, episodes, report
+# ----------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ClosedLoopOptions:
+    fps: float = 10.0
+    camera: CameraConfig = field(default_factory=CameraConfig)
+    robot: RobotConfig = field(default_factory=RobotConfig)
+    noise: NoiseProfile = field(default_factory=lambda: PROFILES["none"])
+    noise_seed: int = 0
+    every: int = 10  # frames between graph refreshes (and one at every action)
+    classifier: str = "containment"
+    min_points: int | None = None  # None: MoMa-LLM's 50 at 320x240, scaled
+    voxel_size: float = 0.05
+    max_steps: int = N_MAX
+    frames: int | None = None  # frame budget (None: none)
+    planner_seed: int = 0
+    compression: str = "zstd"
+
+    def mapping(self) -> ResolvedOptions:
+        """The replay options this run builds with (``extra.mapping`` of the log)."""
+        if self.every < 1:
+            raise SgtoolError(f"--every {self.every}: must be >= 1")
+        if self.classifier not in CLASSIFIERS:
+            raise SgtoolError(f"unknown room classifier {self.classifier!r}; one of "
+                              f"{', '.join(CLASSIFIERS)}")
+        if not 0.01 <= self.voxel_size <= 0.5:
+            raise SgtoolError(f"voxel size {self.voxel_size} m: must be 0.01..0.5")
+        mp = self.min_points if self.min_points is not None else default_min_points(
+            self.camera.width, self.camera.height)
+        if mp < 1:
+            raise SgtoolError(f"min points {mp}: must be >= 1")
+        return ResolvedOptions(every=int(self.every), classifier=self.classifier,
+                               min_points=int(mp), voxel_size=float(self.voxel_size),
+                               max_frames=None)
+
+
+def pick_episode(house: HouseSpec, query: str | None = None, index: int | None = None
+                 ) -> tuple[int, Episode]:
+    """(index, episode) of ``house``'s search episodes (``sgtool scenes episodes``, one per
+    small-object category): the one of category ``query``, else number ``index`` (0)."""
+    eps = list_episodes(house)
+    if not eps:
+        raise SgtoolError("the house has no search episodes (it needs small objects and "
+                          "start poses)")
+    if query is not None:
+        if index is not None:
+            raise SgtoolError("give either --query or --episode, not both")
+        want = category_text(query)
+        for i, e in enumerate(eps):
+            if category_text(e.query) == want:
+                return i, e
+        cats = ", ".join(e.query for e in eps)
+        raise SgtoolError(f"no object of category {query!r} in the house; its small-object "
+                          f"categories are: {cats}")
+    k = 0 if index is None else int(index)
+    if not 0 <= k < len(eps):
+        raise SgtoolError(f"episode {k}: the house has {len(eps)} episodes "
+                          f"(0..{len(eps) - 1}; see `sgtool scenes episodes`)")
+    return k, eps[k]
+
+
+@dataclass(frozen=True)
+class ClosedLoopReport:
+    output: Path
+    house_id: str
+    planner: str
+    query: str
+    episode: str
+    success: bool
+    end: str
+    steps: int
+    travelled_m: float
+    shortest_m: float | None
+    frames: int
+    refreshes: int
+    n_open: int
+    decision_times: tuple[float, ...]  # wall clock per decision (reported and logged)
+    seconds: float  # wall clock of the run (reported, never logged)
+
+    @property
+    def spl(self) -> float | None:
+        if self.shortest_m is None:
+            return None
+        if not self.success:
+            return 0.0
+        return self.shortest_m / max(self.shortest_m, self.travelled_m, 1e-9)
+
+    @property
+    def frames_per_s(self) -> float:
+        return self.frames / self.seconds if self.seconds > 0 else 0.0
+
+    def lines(self) -> list[str]:
+        out = []
+        if self.output.exists():
+            out.append(f"wrote {self.output} ({self.output.stat().st_size / 1e6:.1f} MB)")
+        verdict = (f"found after {self.steps} steps" if self.success
+                   else f"not found ({self.end}) after {self.steps} steps")
+        out.append(f"{self.planner} searching for {self.query!r} in {self.house_id} "
+                   f"({self.episode}): {verdict}")
+        short = "unknown" if self.shortest_m is None else f"{self.shortest_m:.2f} m"
+        spl = "-" if self.spl is None else f"{self.spl:.3f}"
+        out.append(f"{self.travelled_m:.1f} m driven (shortest {short}, SPL {spl}), "
+                   f"{self.n_open} opened, {self.frames} frames, {self.refreshes} graph "
+                   "refreshes")
+        dt = self.decision_times
+        med = f"{statistics.median(dt):.4f} s" if dt else "-"
+        mx = f"{max(dt):.4f} s" if dt else "-"
+        out.append(f"{self.seconds:.1f} s ({self.frames_per_s:.1f} frames/s); decision "
+                   f"time median {med}, max {mx}")
+        return out
+
+
+# ----------------------------------------------------------------------------------------
+# the live recorder
+# ----------------------------------------------------------------------------------------
+class _LiveRecorder(LogRecorder):
+    """The log recorder that also feeds the scene-graph stream what it writes, in the
+    order it writes it, and writes the stream's refreshes."""
+
+    def __init__(self, writer: LogWriter, sim: Simulation, stream: SceneGraphStream,
+                 **kw: Any) -> None:
+        super().__init__(writer, sim, log_actions=False, **kw)
+        self.stream = stream
+        self.refreshes = 0
+        self.last_refresh: Refresh | None = None
+
+    def write_instances(self, sim: Simulation) -> None:
+        super().write_instances(sim)
+        assert self.last_instances is not None
+        self.stream.instances(sim.time_ns(), self.last_instances)
+
+    def on_tick(self, sim: Simulation) -> None:
+        super().on_tick(sim)
+        assert self.last_frame is not None
+        self.refreshed(self.stream.frame(as_logged(self.last_frame)))
+
+    def act(self, sim: Simulation, outcome: SkillOutcome, decision_time_s: float,
+            fields: Mapping[str, Any]) -> int:
+        """Log an action and refresh on it (as replay does at every action record)."""
+        t = self.log_action(sim, outcome, decision_time_s=decision_time_s, fields=fields)
+        self.refreshed(self.stream.action(t))
+        return t
+
+    def refreshed(self, r: Refresh | None) -> None:
+        if r is not None:
+            write_refresh(self.writer, r)
+            self.refreshes += 1
+            self.last_refresh = r
+
+
+def _execute(sim: Simulation, calls: Sequence[SkillCall]
+             ) -> tuple[str, str, float, int, bool]:
+    """Run ``calls`` until one does not succeed: (outcome, reason, metres, ticks, cut)
+    where ``cut`` says the frame budget stopped it."""
+    t0, d0 = sim.tick_index, sim.travelled_m
+    out: SkillOutcome | None = None
+    try:
+        for c in calls:
+            out = sim.look_around() if c.skill == "look_around" else \
+                getattr(sim, c.skill)(c.target)
+            if not out.success:
+                break
+    except StopSimulation as e:
+        return ("failure", f"stopped: {e}", sim.travelled_m - d0, sim.tick_index - t0, True)
+    assert out is not None
+    return (out.outcome, out.reason, sim.travelled_m - d0, sim.tick_index - t0, False)
+
+
+# ----------------------------------------------------------------------------------------
+# one episode
+# ----------------------------------------------------------------------------------------
+def run_episode(house: HouseSpec, episode: Episode, planner: str | Planner,
+                output: str | os.PathLike[str], options: ClosedLoopOptions | None = None, *,
+                house_id: str = "", episode_index: int = 0,
+                planner_options: Mapping[str, Any] | None = None,
+                overwrite: bool = False, progress: Any = None,
+                on_decision: Callable[[SceneGraph, Action], None] | None = None
+                ) -> ClosedLoopReport:
+    """Run one closed-loop search episode into the log ``output`` (module doc).
+
+    ``planner`` is a name of :func:`sgtool.planning.registry.make_planner` (with
+    ``planner_options``) or a planner object; its LLM exchanges, when it keeps them
+    (``drain_exchanges()``, moma-llm), are logged after each decision. ``progress`` is
+    anything with ``update(n)`` (a tqdm bar), advanced per frame; ``on_decision`` sees
+    every graph and the action chosen on it.
+    """
+    opts = options or ClosedLoopOptions()
+    if opts.max_steps < 1:
+        raise SgtoolError(f"--max-steps {opts.max_steps}: must be >= 1")
+    if opts.frames is not None and opts.frames < 1:
+        raise SgtoolError(f"--frames {opts.frames}: must be >= 1")
+    mapping = opts.mapping()
+    if isinstance(planner, str):
+        from sgtool.planning.registry import make_planner
+
+        agent: Planner = make_planner(planner, **dict(planner_options or {}))
+    else:
+        if planner_options:
+            raise SgtoolError("planner options go with a planner name, not a planner object")
+        agent = planner
+    name = str(getattr(agent, "name", planner if isinstance(planner, str) else "planner"))
+    classifier = make_classifier(mapping.classifier)
+    hid = house_id or f"house-{house.seed}"
+    query = episode.query
+    shortest = episode.shortest_path if math.isfinite(episode.shortest_path) else None
+    t_wall = time.perf_counter()
+    decision_times: list[float] = []
+    try:
+        with Simulation(house, camera=opts.camera, robot=opts.robot, fps=opts.fps,
+                        start=episode.start) as sim, \
+                LogWriter(output, seed=opts.planner_seed, compression=opts.compression,
+                          overwrite=overwrite,
+                          metadata={"source": SOURCE, "house_id": hid, "planner": name,
+                                    "query": query}) as writer:
+            stream = SceneGraphStream(None, classifier, builder_config(mapping))
+            rec = _LiveRecorder(writer, sim, stream, noise=opts.noise, seed=opts.noise_seed,
+                                max_frames=opts.frames, planner=name, progress=progress)
+            sim.observers.append(rec)
+            base = {"kind": "search", "source": SOURCE, "house_id": hid, "query": query,
+                    "planner": name}
+            extra = _started_extra(opts, sim, mapping, episode, episode_index)
+            writer.attach_house(house.to_json())
+            writer.write_record("episode", 0, {
+                **base, "status": "started", "steps": 0, "travelled_m": 0.0,
+                "shortest_m": None if shortest is None else round(shortest, 4), "frames": 0,
+                "extra": extra})
+            rec.write_instances(sim)
+            agent.reset(query, seed=opts.planner_seed)
+            steps, n_open, end = 0, 0, ""
+            last_t = 0
+            # start: one frame, then a look around, so the first decision has a graph
+            cut = False
+            try:
+                sim.tick()
+            except StopSimulation:
+                cut = True
+            if not cut:
+                o, why, dist, ticks, cut = _execute(sim, (SkillCall("look_around", 0),))
+                last_t = rec.act(sim, SkillOutcome("look_around", None, o, why, dist, ticks),
+                                 0.0, {"graph_time_ns": None, "planner": None})
+            if _found(rec.last_refresh, query):
+                end = "found"
+            elif cut:
+                end = "frames"
+            while not end:
+                if steps >= opts.max_steps:
+                    end = "max_steps"
+                    break
+                cur = stream.current
+                if cur is None:  # no frame at all (cannot happen with a frame budget >= 1)
+                    end = "frames"
+                    break
+                graph = cur.graph
+                t0 = time.perf_counter()
+                action = agent.decide(graph)
+                dt = time.perf_counter() - t0
+                decision_times.append(dt)
+                steps += 1
+                _log_exchanges(agent, writer, rec.last_time_ns)
+                if on_decision is not None:
+                    on_decision(graph, action)
+                plan = plan_skills(graph, action)
+                if plan.done:
+                    o, why, dist, ticks = "success", DONE_MESSAGE, 0.0, 0
+                    end = "gave_up" if action.target is None else "wrong_done"
+                elif plan.invalid is not None:
+                    o, why, dist, ticks = "invalid", plan.invalid, 0.0, 0
+                else:
+                    o, why, dist, ticks, cut = _execute(sim, plan.calls)
+                    if action.skill == "open" and o == "success":
+                        n_open += 1
+                outcome = SkillOutcome(action.skill, action.target, o, why, dist, ticks)
+                last_t = rec.act(sim, outcome, dt, {"graph_time_ns": int(cur.time_ns)})
+                agent.feedback(Feedback(action, o, why, dist))  # type: ignore[arg-type]
+                if _found(stream.current, query):
+                    end = "found"
+                elif cut:
+                    end = "frames"
+            success = end == "found"
+            t_end = max(rec.last_time_ns, last_t)
+            writer.write_record("episode", t_end, {
+                **base, "status": "success" if success else "failure", "steps": steps,
+                "travelled_m": round(sim.travelled_m, 6),
+                "shortest_m": None if shortest is None else round(shortest, 4),
+                "frames": rec.frames,
+                "extra": {"query": query, "planner": name, "seed": opts.planner_seed,
+                          "episode": int(episode_index), "episode_id": episode.id,
+                          "end": end, "n_open": n_open, "mapping": mapping_record(mapping)},
+            })
+            rec.refreshed(stream.finish(t_end))  # as replay ends: only if anything is new
+            travelled, frames, refreshes = sim.travelled_m, rec.frames, rec.refreshes
+    finally:
+        closer = getattr(agent, "close", None)
+        if callable(closer):
+            closer()
+    return ClosedLoopReport(
+        output=Path(output), house_id=hid, planner=name, query=query, episode=episode.id,
+        success=success, end=end, steps=steps, travelled_m=travelled, shortest_m=shortest,
+        frames=frames, refreshes=refreshes, n_open=n_open,
+        decision_times=tuple(decision_times), seconds=time.perf_counter() - t_wall)
+
+
+def _found(refresh: Refresh | None, query: str) -> bool:
+    return refresh is not None and find_target(refresh.graph, query) is not None
+
+
+def _log_exchanges(agent: Any, writer: LogWriter, t_ns: int) -> None:
+    drain = getattr(agent, "drain_exchanges", None)
+    if not callable(drain):
+        return
+    for ex in drain():
+        writer.write_record("llm_exchange", t_ns, ex)
+
+
+def _started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOptions,
+                   episode: Episode, index: int) -> dict[str, Any]:
+    k = sim.intrinsics
+    return {
+        "mapping": mapping_record(mapping),
+        "episode": int(index), "episode_id": episode.id,
+        "targets": list(episode.targets), "target_rooms": list(episode.target_rooms),
+        "hidden": episode.hidden, "description": episode.description,
+        "seed": opts.planner_seed, "max_steps": opts.max_steps, "frame_budget": opts.frames,
+        "fps": opts.fps, "start_pose": [round(v, 6) for v in sim.base],
+        "start_room": episode.start.room,
+        "camera": asdict(opts.camera),
+        "intrinsics": {"width": k.width, "height": k.height, "fx": k.fx, "fy": k.fy,
+                       "cx": k.cx, "cy": k.cy},
+        "robot": asdict(opts.robot),
+        "noise": opts.noise.to_dict(), "noise_seed": opts.noise_seed,
+    }

@@ -1,0 +1,175 @@
+"""``sgtool run``: one closed-loop object search in PyBullet, logged to MCAP.
+
+The work is done in :mod:`sgtool.recorders.sim.closed_loop`; this module parses options,
+picks the house and the episode, checks the output, shows a progress bar of frames and
+prints the report.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any
+
+import click
+
+from sgtool.errors import SgtoolError
+
+
+def _planner_options(items: tuple[str, ...]) -> dict[str, Any]:
+    from sgtool.commands.bench import _value
+
+    out: dict[str, Any] = {}
+    for item in items:
+        key, eq, value = item.partition("=")
+        if not eq or not key.strip():
+            raise SgtoolError(f"-O {item!r}: expected KEY=VALUE, e.g. -O delta=0.2")
+        out[key.strip()] = _value(value.strip())
+    return out
+
+
+@click.command("run")
+@click.option("--planner", "-p", required=True,
+              help="The planner: random, greedy, sbert, sbert-noroom, scout, scout-noroom, "
+              "scout-delta0 or moma-llm.")
+@click.option("--house", "house_path", type=click.Path(dir_okay=False),
+              help="House spec (JSON, see `sgtool scenes`). Default: the demo house shipped "
+              "with sgtool, unless --seed is given.")
+@click.option("--seed", type=int, default=None,
+              help="Search a generated evaluation house (`sgtool scenes generate`) of this "
+              "seed instead of --house.")
+@click.option("--rooms", default="4-12", show_default=True, metavar="MIN-MAX",
+              help="Room count range of a house generated with --seed.")
+@click.option("--query", default=None, metavar="CATEGORY",
+              help="The object category to find (a small object of the house, e.g. 'bowl'); "
+              "the start pose is that of its episode in `sgtool scenes episodes`.")
+@click.option("--episode", type=click.IntRange(min=0), default=None, metavar="K",
+              help="Run the K-th episode of `sgtool scenes episodes HOUSE` (query and start "
+              "pose). Default: 0, unless --query is given.")
+@click.option("--max-steps", type=click.IntRange(min=1), default=50, show_default=True,
+              help="High-level planner steps before the episode fails (SymSearch's N_max).")
+@click.option("--frames", type=click.IntRange(min=1), default=None,
+              help="Frame budget: the episode fails when it is spent. Default: none.")
+@click.option("--resolution", default="320x240", show_default=True,
+              help="Camera image size WIDTHxHEIGHT.")
+@click.option("--fps", type=float, default=10.0, show_default=True,
+              help="Frames per second of log time (the robot drives 0.5 m/s, turns 90 deg/s).")
+@click.option("--every", type=click.IntRange(min=1), default=10, show_default=True,
+              help="Refresh the scene graph every K frames (and always at every action).")
+@click.option("--classifier", type=click.Choice(["containment", "frequency", "none"]),
+              default="containment", show_default=True,
+              help="Room categories from contents: the distilled containment model, the "
+              "naive-Bayes frequency model of the training knowledge, or none.")
+@click.option("--min-points", type=click.IntRange(min=1), default=None,
+              help="Points an instance needs in one frame to count as seen. Default: "
+              "MoMa-LLM's 50 at 320x240 scaled by the image size.")
+@click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="KEY=VALUE",
+              help="Planner option, e.g. -O delta=0.2 (scout), -O model=gpt-4o-mini "
+              "-O base_url=http://localhost:8000/v1 (moma-llm); repeatable. See "
+              "sgtool.planning.registry.")
+@click.option("--planner-seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Seed of the planner's randomness (random planner, tie-breaks).")
+@click.option("--llm-replay", type=click.Path(dir_okay=False), default=None,
+              help="moma-llm: serve answers from this JSONL transcript instead of an endpoint.")
+@click.option("--llm-transcript", type=click.Path(dir_okay=False), default=None,
+              help="moma-llm: append every LLM exchange to this JSONL transcript (replay it "
+              "later with --llm-replay).")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
+              help="The episode log to write (OUT.mcap).")
+@click.option("--force", is_flag=True, help="Overwrite the output log.")
+@click.option("--quiet", is_flag=True, help="No progress bar, no report.")
+def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
+            query: str | None, episode: int | None, max_steps: int, frames: int | None,
+            resolution: str, fps: float, every: int, classifier: str, min_points: int | None,
+            planner_option: tuple[str, ...], planner_seed: int, llm_replay: str | None,
+            llm_transcript: str | None, output: str, force: bool, quiet: bool) -> None:
+    """Search a house for an object in closed loop: PyBullet renders the camera, the scene
+    graph is built live from the frames (the same refresh schedule as `sgtool replay`:
+    every K frames and at every action), the planner chooses an action on it, the
+    simulator's skills execute it (navigate, explore = go there and look around, open /
+    close = go there and open / close), and the outcome goes back to the planner.
+
+    The episode starts with a look around; it succeeds as soon as the scene graph holds an
+    object of the query category (as in the symbolic benchmark, no done() needed), and
+    fails on done(), after --max-steps steps or when the --frames budget is spent.
+
+    Everything goes into one log: sensors, instance tables, the derived map layers and
+    scene graphs, every action (outcome, reason, distance, decision time, the graph it was
+    decided on), the LLM exchanges of moma-llm and the episode's figures. `sgtool view`
+    shows it, `sgtool replay OUT.mcap` rebuilds the very same scene graphs, `sgtool eval
+    OUT.mcap` recomputes SR, SPL and steps. The same inputs give the same log except the
+    measured decision times (and LLM latencies).
+
+    Example: `sgtool run --planner scout --query bowl -o bowl.mcap`.
+    """
+    from sgtool.commands.bench import _rooms
+    from sgtool.commands.record import _resolution
+    from sgtool.recorders.sim import CameraConfig
+    from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
+
+    out = Path(output)
+    if out.suffix != ".mcap":
+        raise SgtoolError(f"-o {out}: the output is an MCAP log; name it *.mcap")
+    if out.exists() and not force:
+        raise SgtoolError(f"{out} exists; not overwriting it (use --force)")
+    if out.is_dir():
+        raise SgtoolError(f"-o {out} is a folder; name the log file")
+    if not out.parent.exists():
+        raise SgtoolError(f"-o {out}: folder {out.parent} does not exist")
+    if house_path is not None and seed is not None:
+        raise SgtoolError("give either --house or --seed, not both")
+    if query is not None and episode is not None:
+        raise SgtoolError("give either --query or --episode, not both")
+    if not 0.1 <= fps <= 1000:
+        raise SgtoolError(f"--fps {fps}: must be 0.1..1000")
+    from sgtool.planning.registry import PLANNER_NAMES
+
+    name = planner.strip().lower()
+    if name not in PLANNER_NAMES:
+        raise SgtoolError(f"unknown planner {planner!r}; choose one of: "
+                          f"{', '.join(PLANNER_NAMES)}")
+    options = _planner_options(planner_option)
+    if (llm_replay or llm_transcript) and name != "moma-llm":
+        raise SgtoolError("--llm-replay and --llm-transcript are for --planner moma-llm")
+    if llm_replay:
+        if not Path(llm_replay).is_file():
+            raise SgtoolError(f"--llm-replay {llm_replay}: no such file")
+        options["replay"] = llm_replay
+    if llm_transcript:
+        options["transcript"] = llm_transcript
+    width, height = _resolution(resolution)
+    camera = CameraConfig(width=width, height=height)
+    house, house_id = _house(house_path, seed, rooms, _rooms)
+    index, ep = pick_episode(house, query=query, index=episode)
+    opts = ClosedLoopOptions(fps=fps, camera=camera, every=every, classifier=classifier,
+                             min_points=min_points, max_steps=max_steps, frames=frames,
+                             planner_seed=planner_seed)
+    from tqdm import tqdm
+
+    bar = tqdm(total=frames, unit="frame", desc=f"run {name}", file=sys.stderr, leave=False,
+               disable=quiet or not sys.stderr.isatty(), dynamic_ncols=True)
+    try:
+        report = run_episode(house, ep, name, out, opts, house_id=house_id,
+                             episode_index=index, planner_options=options, overwrite=force,
+                             progress=bar)
+    finally:
+        bar.close()
+    if not quiet:
+        for line in report.lines():
+            click.echo(line)
+
+
+def _house(path: str | None, seed: int | None, rooms: str, parse_rooms: Any) -> tuple[Any, str]:
+    """(HouseSpec, house id) from --house, --seed or the demo house."""
+    if path is not None:
+        from sgtool.datasets.house import load_house
+
+        return load_house(path), Path(path).stem
+    if seed is not None:
+        from sgtool.datasets.generator import generate_house
+
+        lo, hi = parse_rooms(rooms)
+        return generate_house(seed, rooms=(lo, hi)), f"house-{seed}"
+    from sgtool.datasets import demo_house
+
+    return demo_house(), "demo"
