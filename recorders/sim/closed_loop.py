@@ -378,7 +378,7 @@ def run_episode(house: HouseSpec, episode: Episode, planner: str | Planner,
                 LogWriter(output, seed=opts.planner_seed, compression=opts.compression,
                           overwrite=overwrite,
                           metadata={"source": SOURCE, "house_id": hid, "planner": name,
-                                    "query": query}) as writer:
+                                    "query": query, "house_seed": str(house.seed)}) as writer:
             stream = SceneGraphStream(None, classifier, builder_config(mapping))
             rec = _LiveRecorder(writer, sim, stream, noise=opts.noise, seed=opts.noise_seed,
                                 max_frames=opts.frames, planner=name, progress=progress)

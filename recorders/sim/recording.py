@@ -182,7 +182,8 @@ def record_house(house: HouseSpec, output: str | os.PathLike[str],
     with Simulation(house, camera=opts.camera, robot=opts.robot, fps=opts.fps,
                     start=opts.start) as sim, \
             LogWriter(output, seed=opts.seed, compression=opts.compression,
-                      metadata={"source": SOURCE, "house_id": hid}) as writer:
+                      metadata={"source": SOURCE, "house_id": hid,
+                                "house_seed": str(house.seed)}) as writer:
         rec = LogRecorder(writer, sim, noise=opts.noise, seed=opts.seed,
                           max_frames=opts.frames, planner="scripted", progress=progress)
         sim.observers.append(rec)

@@ -57,6 +57,8 @@ def summarize(path: str | os.PathLike[str]) -> dict[str, Any]:
         out["log_schema_version"] = S.format_version(v) if v else None
         out["readable"] = v is None or v[0] <= S.LOG_SCHEMA_VERSION[0]
         out["seed"] = r.seed
+        hs = r.metadata.get(S.METADATA_NAME, {}).get("house_seed", "")
+        out["house_seed"] = int(hs) if hs.lstrip("-").isdigit() else None
         if not out["readable"]:
             return out
         out["frames"] = r.frame_count()
@@ -82,6 +84,7 @@ def format_summary(s: dict[str, Any]) -> str:
             f"sgtool log, schema version {s.get('log_schema_version')}, "
             f"written by sgtool {s['metadata'].get('sgtool', {}).get('sgtool_version', '?')}, "
             f"seed {s.get('seed')}"
+            + (f", house seed {s['house_seed']}" if s.get("house_seed") is not None else "")
         )
         if not s.get("readable", True):
             lines.append(
