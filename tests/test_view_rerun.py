@@ -23,18 +23,24 @@ def strict_rerun():
     rr.set_strict_mode(False)
 
 
+def rrd_verify(path: Path) -> subprocess.CompletedProcess[str]:
+    """`rerun rrd verify PATH` (the venv's rerun, else the one on PATH); must succeed."""
+    exe = str(Path(sys.executable).parent / "rerun")
+    if not Path(exe).exists():
+        exe = shutil.which("rerun") or "rerun"
+    res = subprocess.run([exe, "rrd", "verify", str(path)], capture_output=True, text=True,
+                         timeout=120)
+    assert res.returncode == 0, res.stderr
+    return res
+
+
 def test_view_writes_a_verified_rrd(tmp_path):
     log = write_log(tmp_path / "run.mcap")
     out = tmp_path / "view.rrd"
     r = CliRunner().invoke(cli, ["view", str(log), "-o", str(out), "--no-voxels"])
     assert r.exit_code == 0, r.output
     assert out.stat().st_size > 10_000 and not (tmp_path / "view.rrd.partial").exists()
-    exe = str(Path(sys.executable).parent / "rerun")
-    if not Path(exe).exists():
-        exe = shutil.which("rerun") or "rerun"
-    res = subprocess.run([exe, "rrd", "verify", str(out)], capture_output=True, text=True,
-                         timeout=120)
-    assert res.returncode == 0, res.stderr
+    res = rrd_verify(out)
     assert "verified without error" in res.stderr + res.stdout
 
 
@@ -61,9 +67,4 @@ def test_view_of_a_replayed_log_with_voxels_and_derived_layers(tmp_path):
     out = tmp_path / "view.rrd"
     r = CliRunner().invoke(cli, ["view", str(derived), "-o", str(out)])
     assert r.exit_code == 0, r.output
-    exe = str(Path(sys.executable).parent / "rerun")
-    if not Path(exe).exists():
-        exe = shutil.which("rerun") or "rerun"
-    res = subprocess.run([exe, "rrd", "verify", str(out)], capture_output=True, text=True,
-                         timeout=120)
-    assert res.returncode == 0, res.stderr
+    rrd_verify(out)
