@@ -35,7 +35,7 @@ from sgtool.datasets.generator import generate_house
 from sgtool.datasets.house import load_house
 from sgtool.log import LogReader
 from sgtool.recorders.sim.recording import RecordOptions, record_house
-from sgtool.replayers.replay import ReplayOptions, replay
+from sgtool.replayers.replay import ReplayOptions, replay, stage_lines
 from sgtool.replayers.score import score, score_lines
 
 
@@ -97,9 +97,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"\nhouse seed {seed}: {len(spec.rooms)} rooms, {rep.frames} frames 320x240, "
               f"{rep.refreshes} refreshes (every {a.every} frames and at every action), log "
               f"{log.stat().st_size / 1e6:.1f} MB")
-        print(f"{'stage':<12}{'median ms':>10}{'max ms':>10}{'calls':>7}")
-        for stage, (med, mx, n) in rep2.stages.items():
-            print(f"{stage:<12}{med:>10.2f}{mx:>10.2f}{n:>7}")
+        print("\n".join(stage_lines(rep2.stages)))
         b = last["stream"].builder  # type: ignore[attr-defined]
         integ = sum(b.timings["integrate"]) / 1e3
         refresh = sum(b.timings["refresh"]) / 1e3

@@ -143,6 +143,16 @@ def _image_size(reader: LogReader) -> tuple[int, int] | None:
     return None
 
 
+def stage_lines(stages: dict[str, tuple[float, float, int]]) -> list[str]:
+    """A table of per-stage (median ms, max ms, calls), empty without stages."""
+    if not stages:
+        return []
+    out = [f"{'stage':<12}{'median ms':>10}{'max ms':>10}{'calls':>7}"]
+    for stage, (med, mx, n) in stages.items():
+        out.append(f"{stage:<12}{med:>10.2f}{mx:>10.2f}{n:>7}")
+    return out
+
+
 @dataclass
 class ReplayReport:
     input: Path
@@ -180,11 +190,7 @@ class ReplayReport:
                        f"{len(g.rooms) - len(explored)} unexplored behind closed doors, "
                        f"{len(g.objects)} objects, {len(g.frontiers())} frontiers, "
                        f"{len(g.doors)} doors")
-        if self.stages:
-            out.append(f"{'stage':<12}{'median ms':>10}{'max ms':>10}{'calls':>7}")
-            for stage, (med, mx, n) in self.stages.items():
-                out.append(f"{stage:<12}{med:>10.2f}{mx:>10.2f}{n:>7}")
-        return out
+        return out + stage_lines(self.stages)
 
 
 def replay(

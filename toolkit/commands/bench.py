@@ -8,28 +8,12 @@ from typing import Any
 
 import click
 
+from sgtool.commands.options import parse_rooms, parse_value
 from sgtool.errors import SgtoolError
 
 
 class OptionError(SgtoolError):
     """A malformed command-line value."""
-
-
-def _rooms(text: str) -> tuple[int, int]:
-    from sgtool.commands.options import parse_rooms
-
-    return parse_rooms(text)
-
-
-def _value(text: str) -> Any:
-    for cast in (int, float):
-        try:
-            return cast(text)
-        except ValueError:
-            pass
-    if text.lower() in ("true", "false"):
-        return text.lower() == "true"
-    return text
 
 
 def _planner_options(items: tuple[str, ...]) -> dict[str, dict[str, Any]]:
@@ -39,7 +23,7 @@ def _planner_options(items: tuple[str, ...]) -> dict[str, dict[str, Any]]:
         name, dot, opt = key.partition(".")
         if not eq or not dot or not name or not opt:
             raise OptionError(f"--planner-option: expected PLANNER.KEY=VALUE, got {item!r}")
-        out.setdefault(name.strip(), {})[opt.strip()] = _value(value.strip())
+        out.setdefault(name.strip(), {})[opt.strip()] = parse_value(value.strip())
     return out
 
 
@@ -108,7 +92,7 @@ def command(planners: str | None, houses: int, episodes: int, seeds: int, worker
         if llm_transcript:
             moma["transcript"] = llm_transcript
     cfg = BenchConfig(planners=names, houses=houses, episodes=episodes, seeds=seeds,
-                      rooms=_rooms(rooms), house_seed=house_seed, max_steps=max_steps,
+                      rooms=parse_rooms(rooms), house_seed=house_seed, max_steps=max_steps,
                       workers=workers, distance_budget=distance_budget,
                       step_budget=step_budget, planner_options=options, log_dir=log_dir)
     res = run_benchmark(cfg, progress=progress)

@@ -46,6 +46,7 @@ def command(out_dir: str, frames: int | None, houses: int, episodes: int, seeds:
     from tqdm import tqdm
 
     from sgtool.analysis.bench import run_bench
+    from sgtool.commands.replay import write_view
     from sgtool.datasets import demo_house
     from sgtool.log.inspect import format_summary, summarize
     from sgtool.recorders.sim import RecordOptions, record_house
@@ -77,18 +78,11 @@ def command(out_dir: str, frames: int | None, houses: int, episodes: int, seeds:
                       on_refresh=lambda r, s: final.update(ref=r, stream=s))
     for line in rrep.lines():
         click.echo(line)
-    import json
-
-    from sgtool.datasets.house import load_house
-
     ref, stream = final["ref"], final["stream"]
-    spec = load_house(json.loads(demo_house().to_json()))
-    for line in score_lines(score(spec, stream.builder.instances, ref.layers,  # type: ignore[attr-defined]
-                                  ref.graph)):  # type: ignore[attr-defined]
+    for line in score_lines(score(demo_house(), stream.builder.instances,  # type: ignore[attr-defined]
+                                  ref.layers, ref.graph)):  # type: ignore[attr-defined]
         click.echo(line)
-    from sgtool.commands.replay import _view
-
-    _view(derived, rrd, show)
+    write_view(derived, rrd, show)
     click.echo(f"wrote {rrd}; open it with: rerun {rrd}")
 
     _step(f"sgtool bench --planners {','.join(DEMO_PLANNERS)} --houses {houses} "

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from sgtool.errors import SgtoolError
 
@@ -40,3 +41,44 @@ def check_output(path: str | Path, *, force: bool = False, option: str = "-o",
     if p.exists() and not force:
         raise SgtoolError(f"{p} exists; not overwriting it (use --force)")
     return p
+
+
+def parse_resolution(text: str, option: str = "--resolution") -> tuple[int, int]:
+    """``WIDTHxHEIGHT``."""
+    w, sep, h = text.lower().partition("x")
+    try:
+        if not sep:
+            raise ValueError
+        return int(w), int(h)
+    except ValueError:
+        raise SgtoolError(f"{option} {text!r}: give WIDTHxHEIGHT, e.g. 320x240") from None
+
+
+def parse_value(text: str) -> Any:
+    """A planner option value: int, float, true/false, else the text."""
+    for cast in (int, float):
+        try:
+            return cast(text)
+        except ValueError:
+            pass
+    if text.lower() in ("true", "false"):
+        return text.lower() == "true"
+    return text
+
+
+def house_from_options(path: str | None, seed: int | None, rooms: str) -> tuple[Any, str]:
+    """(HouseSpec, house id) of ``--house``, ``--seed`` (with ``--rooms``) or the demo
+    house shipped with sgtool; both given is an error."""
+    if path is not None and seed is not None:
+        raise SgtoolError("give either --house or --seed, not both")
+    if path is not None:
+        from sgtool.datasets.house import load_house
+
+        return load_house(path), Path(path).stem
+    if seed is not None:
+        from sgtool.datasets.generator import generate_house
+
+        return generate_house(seed, rooms=parse_rooms(rooms)), f"house-{seed}"
+    from sgtool.datasets import demo_house
+
+    return demo_house(), "demo"

@@ -15,16 +15,6 @@ import click
 from sgtool.errors import SgtoolError
 
 
-def _resolution(text: str) -> tuple[int, int]:
-    w, sep, h = text.lower().partition("x")
-    try:
-        if not sep:
-            raise ValueError
-        return int(w), int(h)
-    except ValueError:
-        raise SgtoolError(f"--resolution {text!r}: give WIDTHxHEIGHT, e.g. 320x240") from None
-
-
 def _pair(option: str, text: str) -> tuple[float, float]:
     a, sep, b = text.partition(",")
     try:
@@ -96,6 +86,7 @@ def command(house_path: str | None, seed: int | None, rooms: str, output: str,
     """
     from dataclasses import replace
 
+    from sgtool.commands.options import house_from_options, parse_resolution
     from sgtool.recorders.sim import (
         CameraConfig,
         RecordOptions,
@@ -114,16 +105,14 @@ def command(house_path: str | None, seed: int | None, rooms: str, output: str,
         raise SgtoolError(f"-o {out}: folder {out.parent} does not exist")
     if frames is not None and frames < 1:
         raise SgtoolError(f"--frames {frames}: must be >= 1")
-    if house_path is not None and seed is not None:
-        raise SgtoolError("give either --house or --seed, not both")
-    width, height = _resolution(resolution)
+    width, height = parse_resolution(resolution)
     dmin, dmax = _pair("--depth-range", depth_range)
     camera = CameraConfig(width=width, height=height, vfov_deg=fov, mount_height=camera_height,
                           tilt_deg=tilt, depth_min=dmin, depth_max=dmax,
                           near=min(0.05, dmin))
     robot = replace(RobotConfig(), speed=speed)
     profile = parse_noise(noise)
-    house, house_id = _house(house_path, seed, rooms)
+    house, house_id = house_from_options(house_path, seed, rooms)
     opts = RecordOptions(fps=fps, frames=frames, camera=camera, robot=robot, noise=profile,
                          seed=noise_seed, start=start,
                          script=ScriptOptions(open_containers=not no_open_containers),
@@ -140,18 +129,3 @@ def command(house_path: str | None, seed: int | None, rooms: str, output: str,
         for line in report.lines():
             click.echo(line)
 
-
-def _house(path: str | None, seed: int | None, rooms: str):  # type: ignore[no-untyped-def]
-    """(HouseSpec, house id) from --house, --seed or the demo house."""
-    if path is not None:
-        from sgtool.datasets.house import load_house
-
-        return load_house(path), Path(path).stem
-    if seed is not None:
-        from sgtool.commands.options import parse_rooms
-        from sgtool.datasets.generator import generate_house
-
-        return generate_house(seed, rooms=parse_rooms(rooms)), f"house-{seed}"
-    from sgtool.datasets import demo_house
-
-    return demo_house(), "demo"

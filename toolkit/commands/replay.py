@@ -106,7 +106,7 @@ def command(log: str, output: str | None, every: int | None, classifier: str | N
     if score:
         scores = _score(house, final)  # type: ignore[arg-type]
     if rrd and dst is not None:
-        _view(dst, Path(rrd), show)
+        write_view(dst, Path(rrd), show)
     if as_json:
         click.echo(json.dumps(_as_dict(report, scores, rrd), sort_keys=True))
         return
@@ -134,7 +134,9 @@ def _score(house: str, final: dict[str, Any]) -> Any:
     return score(spec, stream.builder.instances, ref.layers, ref.graph)
 
 
-def _view(derived: Path, rrd: Path, show: bool) -> None:
+def write_view(derived: Path, rrd: Path, show: bool) -> None:
+    """A Rerun recording of a derived log with the voxel map (``sgtool view`` with its
+    defaults), with a progress bar when ``show``."""
     from tqdm import tqdm
 
     from sgtool.analysis.rerun_view import export

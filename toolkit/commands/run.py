@@ -13,18 +13,17 @@ from typing import Any
 
 import click
 
+from sgtool.commands.options import parse_value
 from sgtool.errors import SgtoolError
 
 
 def _planner_options(items: tuple[str, ...]) -> dict[str, Any]:
-    from sgtool.commands.bench import _value
-
     out: dict[str, Any] = {}
     for item in items:
         key, eq, value = item.partition("=")
         if not eq or not key.strip():
             raise SgtoolError(f"-O {item!r}: expected KEY=VALUE, e.g. -O delta=0.2")
-        out[key.strip()] = _value(value.strip())
+        out[key.strip()] = parse_value(value.strip())
     return out
 
 
@@ -102,8 +101,7 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
 
     Example: `sgtool run --planner scout --query bowl -o bowl.mcap`.
     """
-    from sgtool.commands.bench import _rooms
-    from sgtool.commands.record import _resolution
+    from sgtool.commands.options import house_from_options, parse_resolution
     from sgtool.recorders.sim import CameraConfig
     from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
 
@@ -116,8 +114,6 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
         raise SgtoolError(f"-o {out} is a folder; name the log file")
     if not out.parent.exists():
         raise SgtoolError(f"-o {out}: folder {out.parent} does not exist")
-    if house_path is not None and seed is not None:
-        raise SgtoolError("give either --house or --seed, not both")
     if query is not None and episode is not None:
         raise SgtoolError("give either --query or --episode, not both")
     if not 0.1 <= fps <= 1000:
@@ -137,9 +133,9 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
         options["replay"] = llm_replay
     if llm_transcript:
         options["transcript"] = llm_transcript
-    width, height = _resolution(resolution)
+    width, height = parse_resolution(resolution)
     camera = CameraConfig(width=width, height=height)
-    house, house_id = _house(house_path, seed, rooms, _rooms)
+    house, house_id = house_from_options(house_path, seed, rooms)
     index, ep = pick_episode(house, query=query, index=episode)
     opts = ClosedLoopOptions(fps=fps, camera=camera, every=every, classifier=classifier,
                              min_points=min_points, max_steps=max_steps, frames=frames,
@@ -158,18 +154,3 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
         for line in report.lines():
             click.echo(line)
 
-
-def _house(path: str | None, seed: int | None, rooms: str, parse_rooms: Any) -> tuple[Any, str]:
-    """(HouseSpec, house id) from --house, --seed or the demo house."""
-    if path is not None:
-        from sgtool.datasets.house import load_house
-
-        return load_house(path), Path(path).stem
-    if seed is not None:
-        from sgtool.datasets.generator import generate_house
-
-        lo, hi = parse_rooms(rooms)
-        return generate_house(seed, rooms=(lo, hi)), f"house-{seed}"
-    from sgtool.datasets import demo_house
-
-    return demo_house(), "demo"
