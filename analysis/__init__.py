@@ -2,7 +2,7 @@
 
 Modules (import them directly; this package imports nothing on its own):
 
-- :mod:`sgtool.analysis.records`: the per-episode record (:class:`EpisodeResult`), its JSONL
+- :mod:`sgtool.results`: the per-episode record (:class:`EpisodeResult`), its JSONL
   file, the digest without wall-clock figures, the mapping from log records;
 - :mod:`sgtool.analysis.metrics`: SR, SPL, steps, decision time, MoMa-LLM's AUC-E (distance
   plus open cost, and step budget), mean ± std over seeds, seen/unseen breakdown;

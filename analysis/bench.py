@@ -9,7 +9,8 @@ Protocol (SCOUT sec. VI, Table VII; MoMa-LLM's AUC-E):
   (seeded by the house seed, so the episode set is the same for every bench seed);
 - per bench seed (0 .. ``seeds`` - 1): the start region of every episode and the planner's
   own seed are drawn from (seed, house seed, episode index)
-  (:class:`sgtool.datasets.symbolic.SymbolicEnv`, :func:`~sgtool.datasets.symbolic.planner_seed`);
+  (:class:`sgtool.recorders.symbolic_environment.SymbolicEnv`,
+  :func:`~sgtool.recorders.symbolic_environment.planner_seed`);
 - every planner runs every (seed, house, episode) with at most ``max_steps`` actions;
 - a query is "unseen" when it is one of :func:`sgtool.datasets.split.unseen_queries` (it
   occurs nowhere in the knowledge the planners were trained on), "seen" otherwise.
@@ -41,9 +42,11 @@ from typing import Any
 
 from sgtool import __version__
 from sgtool.analysis.metrics import CostModel, cost_models, seen_unseen, summarize
-from sgtool.analysis.records import EpisodeResult, results_digest, write_jsonl, write_text_atomic
 from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
+from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
+from sgtool.files import atomic_write
+from sgtool.results import EpisodeResult, results_digest, write_jsonl
 
 DEFAULT_PLANNERS: tuple[str, ...] = (
     "random", "greedy", "sbert-noroom", "sbert", "scout-noroom", "scout-delta0", "scout",
@@ -140,7 +143,7 @@ _PLANNERS: dict[tuple[str, str], Any] = {}
 def _house(seed: int, rooms: tuple[int, int], episodes: int) -> tuple[Any, list[Any]]:
     from sgtool.datasets.episodes import list_episodes
     from sgtool.datasets.generator import generate_house
-    from sgtool.datasets.symbolic import SymbolicHouse
+    from sgtool.recorders.symbolic_environment import SymbolicHouse
 
     key = (seed, rooms)
     hit = _HOUSES.get(key)
@@ -174,7 +177,7 @@ def _unseen() -> frozenset[str]:
 
 
 def _task(args: tuple[BenchConfig, int, str]) -> list[EpisodeResult]:
-    from sgtool.datasets.symbolic import run_episode
+    from sgtool.recorders.symbolic_environment import run_episode
     from sgtool.semantics.text import category_text
 
     cfg, house_i, name = args
@@ -293,7 +296,7 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
           f"sgtool {__version__}; relational priors {priors_fingerprint()}"]
     if command:
         md.append(f"Command: `{command}`")
-    paths.append(write_text_atomic(out / "summary.md", "\n".join(md) + "\n"))
+    paths.append(atomic_write(out / "summary.md", "\n".join(md) + "\n"))
     summary = {
         "version": BENCH_VERSION,
         "settings": cfg.settings(),
@@ -306,21 +309,10 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
         "wall": {"seconds": round(res.wall_s, 3), "workers": cfg.workers,
                  "episodes_per_s": {k: round(v, 3) for k, v in res.throughput.items()}},
     }
-    paths.append(write_text_atomic(
+    paths.append(atomic_write(
         out / "summary.json",
-        json.dumps(_clean(summary), indent=1, sort_keys=True, allow_nan=False) + "\n"))
+        json.dumps(strict_json(summary), indent=1, sort_keys=True, allow_nan=False) + "\n"))
     return paths
-
-
-def _clean(x: Any) -> Any:
-    """NaN -> None, recursively (strict JSON)."""
-    if isinstance(x, float):
-        return None if math.isnan(x) else x
-    if isinstance(x, dict):
-        return {k: _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    return x
 
 
 def run_bench(planners: Sequence[str] = DEFAULT_PLANNERS, houses: int = 10, episodes: int = 20,

@@ -14,7 +14,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from sgtool.analysis.metrics import CostModel, curve_area, curve_of
-from sgtool.analysis.records import EpisodeResult, write_text_atomic
+from sgtool.files import atomic_write
+from sgtool.results import EpisodeResult
 
 
 def plot_efficiency(results_by_planner: Sequence[tuple[str, Sequence[EpisodeResult]]],
@@ -42,4 +43,4 @@ def plot_efficiency(results_by_planner: Sequence[tuple[str, Sequence[EpisodeResu
     fig.tight_layout()
     buf = io.BytesIO()
     fig.savefig(buf, format="png", metadata={"Software": None})
-    return write_text_atomic(path, buf.getvalue())
+    return atomic_write(path, buf.getvalue())

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sgtool.analysis.records import EpisodeResult
+from sgtool.results import EpisodeResult
 
 
 # ----------------------------------------------------------------------------------------

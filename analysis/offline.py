@@ -6,7 +6,7 @@ records (``/sgtool/episode``), one ``sgtool.Action`` record per executed action
 canonical JSON of :class:`~sgtool.scenegraph.graph.SceneGraph`). Episodes are cut by their
 Episode records in log-time order: a record with status "started" opens an episode, a
 record with status "success", "failure" or "ended" closes it (it carries the final figures;
-see :func:`sgtool.analysis.records.result_from_log_records` for the fields read); the
+see :func:`sgtool.results.result_from_log_records` for the fields read); the
 actions in between belong to it. A log without a "started" record has one episode from its
 start; an episode still open at the end of the log (a killed run) is closed as "ended"
 (not a success) with the figures derived from its actions.
@@ -40,9 +40,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sgtool.analysis.records import EpisodeResult, read_jsonl, result_from_log_records
 from sgtool.errors import SgtoolError
 from sgtool.planning.base import Action, Feedback
+from sgtool.results import EpisodeResult, read_jsonl, result_from_log_records
 from sgtool.scenegraph.graph import DoorNode, SceneGraph
 
 _TERMINAL = ("success", "failure", "ended")

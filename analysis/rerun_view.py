@@ -18,7 +18,7 @@ deterministic for a given log (the recording id is derived from the log's path n
 
 from __future__ import annotations
 
-import colorsys
+import contextlib
 import hashlib
 import os
 from collections.abc import Callable, Iterator
@@ -27,21 +27,12 @@ from typing import Any
 
 import numpy as np
 
+from sgtool.colors import color_for
+from sgtool.files import atomic_output
 from sgtool.log import LogReader, codec
 from sgtool.log import schemas as S
 
 APP_ID = "sgtool"
-
-
-def color_for(
-    key: int | str, saturation: float = 0.65, value: float = 0.95
-) -> tuple[int, int, int]:
-    """A stable, well-spread colour for an id or name (golden-ratio hue steps)."""
-    if isinstance(key, str):
-        key = int.from_bytes(hashlib.blake2s(key.encode(), digest_size=4).digest(), "little")
-    h = (int(key) * 0.618033988749895) % 1.0
-    r, g, b = colorsys.hsv_to_rgb(h, saturation, value)
-    return int(r * 255), int(g * 255), int(b * 255)
 
 
 def _time(rec: Any, frame: int | None, t_ns: int) -> None:
@@ -96,25 +87,19 @@ def export(
     log_path = Path(log_path)
     rid = hashlib.sha256(log_path.name.encode()).hexdigest()[:32]
     rec = rr.RecordingStream(APP_ID, recording_id=rid, send_properties=False)
-    out = Path(rrd_path) if rrd_path is not None else None
-    tmp = out.with_name(out.name + ".partial") if out is not None else None
-    if spawn:
-        rec.spawn()
-    elif tmp is not None:
-        rec.save(tmp)
-    try:
+    target = contextlib.nullcontext(None) if spawn or rrd_path is None \
+        else atomic_output(rrd_path)
+    with target as tmp:
+        if spawn:
+            rec.spawn()
+        elif tmp is not None:
+            rec.save(tmp)
         with LogReader(log_path) as r:
             _export(rec, r, every=every, max_frames=max_frames, progress=progress,
                     voxels=voxels)
         rec.flush()
         rec.disconnect()
-        if tmp is not None and out is not None and not spawn:
-            os.replace(tmp, out)
-    except BaseException:
-        if tmp is not None:
-            tmp.unlink(missing_ok=True)
-        raise
-    return out
+    return Path(rrd_path) if rrd_path is not None and not spawn else None
 
 
 def _export(

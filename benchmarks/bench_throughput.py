@@ -21,10 +21,10 @@ import time
 from sgtool.analysis.bench import DEFAULT_PLANNERS, DEFAULT_ROOMS
 from sgtool.datasets.episodes import list_episodes
 from sgtool.datasets.generator import generate_house
-from sgtool.datasets.symbolic import SymbolicHouse, run_episode
 from sgtool.planning.base import Action, Feedback
 from sgtool.planning.candidates import actionable, find_target
 from sgtool.planning.registry import make_planner
+from sgtool.recorders.symbolic_environment import SymbolicHouse, run_episode
 from sgtool.scenegraph.graph import SceneGraph
 
 

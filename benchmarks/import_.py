@@ -19,9 +19,10 @@ import tempfile
 import time
 from pathlib import Path
 
+from support.bag_export import write_log_as_bag
+
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.recorders.importers.bag import BagOptions, import_bag
-from sgtool.recorders.importers.export import write_log_as_bag
 from sgtool.recorders.importers.images import depth_to_metres, read_color_file, read_depth_file
 from sgtool.recorders.importers.layouts import read_sequence
 from sgtool.recorders.importers.odometry import METHODS, drift_against, estimate_trajectory

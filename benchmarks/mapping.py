@@ -1,7 +1,7 @@
 """Speed and quality of the mapping / scene-graph pipeline on rendered multi-room houses.
 
 Houses come from the generator (``sgtool.datasets.generator.generate_house``, 10 rooms),
-rendered with the numpy ray-caster of :mod:`sgtool.mapping.synthetic` along a tour that
+rendered with the numpy ray-caster of :mod:`support.synthetic_world` along a tour that
 visits every reachable room (A* on the house's occupancy grid, closed doors blocked) and
 looks around (``--spin`` views) in each: about 1,000 frames of 320x240 depth + instance
 ids. Rendering is not timed; frames are cached as .npy files (``--cache``).
@@ -34,12 +34,7 @@ import tracemalloc
 from pathlib import Path
 
 import numpy as np
-
-from sgtool.datasets.generator import generate_house
-from sgtool.datasets.house import HouseSpec
-from sgtool.datasets.occupancy import astar, house_occupancy
-from sgtool.log.frame import CameraIntrinsics, Frame
-from sgtool.mapping.synthetic import (
+from support.synthetic_world import (
     HouseWorld,
     camera_pose,
     look_around,
@@ -47,11 +42,16 @@ from sgtool.mapping.synthetic import (
     walk,
     world_of_house,
 )
-from sgtool.mapping.synthetic import base_pose as base_of
+from support.synthetic_world import base_pose as base_of
+
+from sgtool.datasets.generator import generate_house
+from sgtool.datasets.room_evidence import frequency_room_classifier
+from sgtool.house.spec import HouseSpec
+from sgtool.log.frame import CameraIntrinsics, Frame
+from sgtool.mapping.occupancy import astar, house_occupancy
 from sgtool.mapping.voxels import VoxelConfig
 from sgtool.replayers.score import score, score_lines
 from sgtool.scenegraph.builder import BuilderConfig, SceneGraphBuilder
-from sgtool.scenegraph.categories import FrequencyRoomClassifier
 
 VFOV = 60.0
 HEIGHT = 1.2
@@ -161,7 +161,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="folder of rendered frames (reused across runs)")
     ap.add_argument("--no-memory", action="store_true", help="skip the traced second pass")
     a = ap.parse_args(argv)
-    clf = FrequencyRoomClassifier.from_training_knowledge()
+    clf = frequency_room_classifier()
     pixels = a.width * a.height
     cfg = BuilderConfig(voxels=VoxelConfig(min_points=max(5, round(50 * pixels / 76800))),
                         refresh_every=a.refresh_every)

@@ -32,10 +32,10 @@ import tracemalloc
 from pathlib import Path
 
 from sgtool.datasets.generator import generate_house
-from sgtool.datasets.house import load_house
+from sgtool.house.spec import load_house
 from sgtool.log import LogReader
 from sgtool.recorders.sim.recording import RecordOptions, record_house
-from sgtool.replayers.replay import ReplayOptions, replay, stage_lines
+from sgtool.replayers.derived_log import ReplayOptions, replay, stage_lines
 from sgtool.replayers.score import score, score_lines
 
 

@@ -2,8 +2,8 @@
 
 Modules (import them directly; this package imports nothing heavy on its own):
 
-- :mod:`sgtool.datasets.house`: the versioned JSON house spec, validation, canonical JSON;
-- :mod:`sgtool.datasets.occupancy`: occupancy grid of a house, geodesics, A*;
+- :mod:`sgtool.house.spec`: the versioned JSON house spec, validation, canonical JSON;
+- :mod:`sgtool.mapping.occupancy`: occupancy grid of a house, geodesics, A*;
 - :mod:`sgtool.datasets.knowledge`: tables read from the ``bddl`` package (BEHAVIOR-1K);
 - :mod:`sgtool.datasets.split`: the training / evaluation split of that knowledge;
 - :mod:`sgtool.datasets.generator`: seeded multi-room houses furnished from the knowledge;
@@ -16,7 +16,7 @@ from importlib import resources
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from sgtool.datasets.house import HouseSpec
+    from sgtool.house.spec import HouseSpec
 
 DEMO_HOUSE = "demo_house.json"
 
@@ -27,7 +27,7 @@ def demo_house() -> HouseSpec:
     It is ``generate_house`` output for a fixed seed; regenerate it with
     ``python -m sgtool.datasets.demo`` (see :mod:`sgtool.datasets.demo`).
     """
-    from sgtool.datasets.house import load_house
+    from sgtool.house.spec import load_house
 
     text = resources.files("sgtool.datasets").joinpath("data", DEMO_HOUSE).read_text("utf-8")
     return load_house(text)

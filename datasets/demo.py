@@ -20,7 +20,7 @@ import sys
 from pathlib import Path
 
 from sgtool.datasets.generator import generate_house
-from sgtool.datasets.house import HouseSpec, save_house
+from sgtool.house.spec import HouseSpec, save_house
 
 DEMO_SEED = 1
 DEMO_ROOMS = (5, 5)

@@ -25,8 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 from matplotlib.path import Path as MplPath
 
-from sgtool.datasets.house import HouseSpec, StartPose
-from sgtool.datasets.occupancy import (
+from sgtool.house.spec import HouseSpec, StartPose
+from sgtool.mapping.occupancy import (
     OccupancyMap,
     cell_centers,
     geodesic_distances,

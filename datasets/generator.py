@@ -65,7 +65,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import ndimage
 
-from sgtool.datasets.house import HouseSpec, load_house
 from sgtool.datasets.knowledge import (
     FurnitureFreq,
     Knowledge,
@@ -73,7 +72,6 @@ from sgtool.datasets.knowledge import (
     build_knowledge,
     readable_name,
 )
-from sgtool.datasets.occupancy import geodesic_distances, house_occupancy
 from sgtool.datasets.sizes import (
     CENTRAL,
     DEFAULT_MAX_PER_ROOM,
@@ -85,6 +83,8 @@ from sgtool.datasets.sizes import (
 )
 from sgtool.datasets.split import is_household_scene, knowledge_for
 from sgtool.errors import SgtoolError
+from sgtool.house.spec import HouseSpec, load_house
+from sgtool.mapping.occupancy import geodesic_distances, house_occupancy
 
 WALL_T = 0.1
 WALL_H = 2.5

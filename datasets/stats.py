@@ -19,8 +19,8 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from dataclasses import asdict, dataclass
 
-from sgtool.datasets.house import HouseSpec
 from sgtool.datasets.knowledge import Knowledge
+from sgtool.house.spec import HouseSpec
 
 COLUMNS = (
     ("scenes", "Scenes"),

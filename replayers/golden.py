@@ -10,8 +10,8 @@ differs, not just two hashes.
 
 Regenerate on purpose only, and say why in the commit::
 
-    python -m sgtool.replayers.golden            # recompute expectations from the logs
-    python -m sgtool.replayers.golden --record   # re-record the logs first (PyBullet)
+    .venv/bin/python tests/golden/regenerate.py            # recompute expectations from the logs
+    .venv/bin/python tests/golden/regenerate.py --record   # re-record the logs first (PyBullet)
 
 The first after a deliberate change of the replay pipeline or of the shipped weights;
 the second after a change of the recorder or of the house generator.
@@ -19,21 +19,19 @@ the second after a change of the recorder or of the house generator.
 
 from __future__ import annotations
 
-import argparse
 import gzip
 import hashlib
 import io
-import json
 import math
 import os
-import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from sgtool.replayers.replay import ReplayOptions, replay
-from sgtool.replayers.stream import Refresh, SceneGraphStream
+from sgtool.files import atomic_write
+from sgtool.replayers.derived_log import ReplayOptions, replay
 from sgtool.scenegraph.graph import SceneGraph
+from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 
 EXPECTED = "expected.json"
 FORMAT = 1
@@ -102,9 +100,7 @@ def write_graphs(path: Path, graphs: Sequence[str]) -> None:
     with gzip.GzipFile(fileobj=buf, mode="wb", mtime=0, filename="") as z:
         for g in graphs:
             z.write(g.encode() + b"\n")
-    tmp = path.with_name(path.name + ".partial")
-    tmp.write_bytes(buf.getvalue())
-    os.replace(tmp, path)
+    atomic_write(path, buf.getvalue())
 
 
 def read_graphs(path: Path) -> list[str]:
@@ -223,21 +219,6 @@ def describe_mismatch(expected: Sequence[str], actual: Sequence[tuple[Refresh, s
     return []
 
 
-# ----- regeneration ----------------------------------------------------------------------
-def record_case(case: GoldenCase, folder: Path) -> Path:
-    """Record the case's log (PyBullet) into ``folder``."""
-    from sgtool.datasets.generator import generate_house
-    from sgtool.recorders.sim.camera import CameraConfig
-    from sgtool.recorders.sim.recording import RecordOptions, record_house
-
-    house = generate_house(case.seed, rooms=(case.rooms, case.rooms))
-    out = folder / f"{case.name}.mcap"
-    opts = RecordOptions(fps=case.fps, frames=case.frames,
-                         camera=CameraConfig(width=case.width, height=case.height))
-    record_house(house, out, opts, house_id=f"house-{case.seed}")
-    return out
-
-
 def expectations(folder: Path, cases: Sequence[GoldenCase] = CASES) -> dict[str, object]:
     """Replay every case's log, write its graphs file, return the ``expected.json`` text."""
     entries: dict[str, object] = {}
@@ -254,32 +235,3 @@ def expectations(folder: Path, cases: Sequence[GoldenCase] = CASES) -> dict[str,
     return {"format": FORMAT, "replay": {"every": REPLAY.every,
                                          "classifier": REPLAY.classifier},
             "cases": entries}
-
-
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(
-        prog="python -m sgtool.replayers.golden",
-        description="Regenerate the golden logs' expected scene graphs (tests/golden).")
-    ap.add_argument("--folder", type=Path, default=None,
-                    help="golden folder (default: tests/golden of this checkout)")
-    ap.add_argument("--record", action="store_true",
-                    help="re-record the logs with PyBullet first")
-    a = ap.parse_args(argv)
-    folder = a.folder or default_folder()
-    folder.mkdir(parents=True, exist_ok=True)
-    if a.record:
-        for case in CASES:
-            path = record_case(case, folder)
-            print(f"recorded {path} ({path.stat().st_size / 1e6:.2f} MB)", file=sys.stderr)
-    doc = expectations(folder)
-    tmp = folder / (EXPECTED + ".partial")
-    tmp.write_text(json.dumps(doc, indent=2, sort_keys=True) + "\n")
-    os.replace(tmp, folder / EXPECTED)
-    for name, e in doc["cases"].items():  # type: ignore[union-attr]
-        print(f"{name}: {e['refreshes']} refreshes, final {e['final_sha256'][:16]}",
-              file=sys.stderr)
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

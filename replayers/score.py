@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import asdict
 
-from sgtool.datasets.house import HouseSpec
+from sgtool.house.spec import HouseSpec
 from sgtool.scenegraph.builder import MapLayers
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.instances import InstanceInfo

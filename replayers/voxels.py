@@ -15,7 +15,7 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from sgtool.analysis.rerun_view import color_for
+from sgtool.colors import color_for
 from sgtool.log.reader import LogReader
 from sgtool.mapping.voxels import VoxelConfig, VoxelMap
 

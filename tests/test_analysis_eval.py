@@ -18,10 +18,10 @@ from sgtool.analysis.offline import (
     replay_decisions,
 )
 from sgtool.cli import cli
-from sgtool.datasets.house import load_house
-from sgtool.datasets.symbolic import SymbolicHouse, run_episode
+from sgtool.house.spec import load_house
 from sgtool.log.writer import LogWriter
 from sgtool.planning.registry import make_planner
+from sgtool.recorders.symbolic_environment import SymbolicHouse, run_episode
 
 
 @pytest.fixture(scope="module")

@@ -25,7 +25,7 @@ from sgtool.analysis.metrics import (
     success_rate,
     summarize,
 )
-from sgtool.analysis.records import EpisodeResult
+from sgtool.results import EpisodeResult
 
 
 def ep(success: bool, steps: int = 10, travelled: float = 10.0, shortest: float | None = 5.0,

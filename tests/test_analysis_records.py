@@ -8,7 +8,8 @@ import pytest
 
 from sgtool.analysis.curves import plot_efficiency
 from sgtool.analysis.metrics import COST_MODELS, STEP_COST, seen_unseen, summarize
-from sgtool.analysis.records import (
+from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
+from sgtool.results import (
     EpisodeResult,
     ResultsFormatError,
     Step,
@@ -17,7 +18,6 @@ from sgtool.analysis.records import (
     results_digest,
     write_jsonl,
 )
-from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
 
 
 def _result(wall: float = 0.01, success: bool = True, planner: str = "scout") -> EpisodeResult:

@@ -9,8 +9,8 @@ import pytest
 from click.testing import CliRunner
 
 from sgtool.analysis.bench import BenchConfig, BenchError, run_bench, run_benchmark
-from sgtool.analysis.records import read_jsonl, results_digest
 from sgtool.cli import cli
+from sgtool.results import read_jsonl, results_digest
 
 TINY = ["--houses", "2", "--episodes", "2", "--seeds", "2", "--planners", "random,greedy",
         "--no-progress"]

@@ -36,7 +36,7 @@ from sgtool.recorders.sim.closed_loop import (
     plan_skills,
     run_episode,
 )
-from sgtool.replayers.layers import DERIVED_TOPICS
+from sgtool.scenegraph.derived_layers import DERIVED_TOPICS
 from sgtool.scenegraph.graph import (
     DoorNode,
     ObjectNode,

@@ -11,8 +11,8 @@ from datasets_fixtures import two_rooms
 
 import sgtool.datasets as ds
 from sgtool.datasets.episodes import EpisodeGeometry, list_episodes
-from sgtool.datasets.house import load_house
-from sgtool.datasets.occupancy import astar, path_length, world_to_cell
+from sgtool.house.spec import load_house
+from sgtool.mapping.occupancy import astar, path_length, world_to_cell
 
 
 def test_demo_episodes_are_consistent():

@@ -15,11 +15,11 @@ import sgtool.datasets as ds
 from sgtool.datasets.demo import build_demo
 from sgtool.datasets.episodes import EpisodeGeometry
 from sgtool.datasets.generator import generate_house
-from sgtool.datasets.house import load_house, placement_problem, point_in_polygon
 from sgtool.datasets.knowledge import ancestors
-from sgtool.datasets.occupancy import geodesic_distances
 from sgtool.datasets.split import evaluation_knowledge, training_knowledge
 from sgtool.errors import SgtoolError
+from sgtool.house.spec import load_house, placement_problem, point_in_polygon
+from sgtool.mapping.occupancy import geodesic_distances
 
 CASES = [(0, (4, 12)), (1, (4, 12)), (2, (4, 4)), (3, (12, 12)), (4, (6, 9)), (5, (4, 12)),
          (11, (8, 8))]
@@ -136,7 +136,7 @@ def test_every_room_and_container_is_reachable(houses, case):
             continue
         assert (geo.goal_mask(obj.id) & reach).any(), f.id
     # a closed door is an obstacle unless closed doors count as passable
-    from sgtool.datasets.occupancy import house_occupancy
+    from sgtool.mapping.occupancy import house_occupancy
     occ = house_occupancy(spec)
     for d in spec.doors:
         cell = _cell(geo, *d.center)
@@ -145,7 +145,7 @@ def test_every_room_and_container_is_reachable(houses, case):
 
 
 def _cell(geo, x, y):
-    from sgtool.datasets.occupancy import world_to_cell
+    from sgtool.mapping.occupancy import world_to_cell
     return world_to_cell(geo.occ, x, y)
 
 

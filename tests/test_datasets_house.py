@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 from datasets_fixtures import two_rooms
 
-from sgtool.datasets.house import HouseSpec, load_house, room_at, save_house
-from sgtool.datasets.occupancy import (
+from sgtool.errors import SpecError
+from sgtool.house.spec import HouseSpec, load_house, room_at, save_house
+from sgtool.mapping.occupancy import (
     astar,
     cell_to_world,
     geodesic_distances,
@@ -21,7 +22,6 @@ from sgtool.datasets.occupancy import (
     shortest_path_length,
     world_to_cell,
 )
-from sgtool.errors import SpecError
 
 
 def test_round_trip_is_canonical(tmp_path):

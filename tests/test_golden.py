@@ -2,7 +2,7 @@
 
 On a mismatch the failure shows what changed in the first refresh that differs (rooms,
 objects, doors, edges, frontiers), not two hashes. To accept a deliberate change, run
-``python -m sgtool.replayers.golden`` and say why in the commit (tests/golden/README.md).
+``python tests/golden/regenerate.py`` and say why in the commit (tests/golden/README.md).
 """
 
 from __future__ import annotations
@@ -36,14 +36,14 @@ def test_golden_log_replays_to_the_committed_graphs(case):
     assert log.stat().st_size < 2_000_000
     assert sha256_file(log) == e["log_sha256"], (
         f"{log.name} is not the log the expectations were made from; regenerate with "
-        "`python -m sgtool.replayers.golden`")
+        "`python tests/golden/regenerate.py`")
     expected = read_graphs(GOLDEN / f"{case}.graphs.jsonl.gz")
     assert sequence_digest(expected) == e["sequence_sha256"]
     got = replay_graphs(log)
     problems = describe_mismatch(expected, got)
     if problems:
         pytest.fail(f"{case}: the replayed scene graphs changed\n" + "\n".join(problems)
-                    + "\n(deliberate? `python -m sgtool.replayers.golden`, and say why in the "
+                    + "\n(deliberate? `python tests/golden/regenerate.py`, and say why in the "
                     "commit)", pytrace=False)
     assert sequence_digest([g for _, g in got]) == e["sequence_sha256"]
 

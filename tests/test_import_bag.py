@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 from logfixtures import synthetic_frame
+from support.bag_export import BagWriter, write_log_as_bag
 
 from sgtool.cli import cli
 from sgtool.errors import SgtoolError
 from sgtool.log import LogReader, LogWriter
 from sgtool.recorders.importers.bag import BagOptions, import_bag, read_trajectory
-from sgtool.recorders.importers.export import BagWriter, write_log_as_bag
 from sgtool.recorders.importers.poses import pose_difference, pose_from_tq
 from sgtool.recorders.importers.sink import IMPORT_METADATA
 from sgtool.recorders.importers.textformats import read_tum_trajectory, seconds_to_ns
@@ -329,7 +329,8 @@ def test_bag_poses_estimated_by_odometry(shared_data_dir, tmp_path):
     """Six real ICL-NUIM frames as a ROS 2 bag: with tf and --estimate-poses the drift
     against the bag's tf is reported; without tf (a camera recorded alone) the poses are
     estimated from the images and start at the identity."""
-    from sgtool.recorders.importers.export import write_frames_bag
+    from support.bag_export import write_frames_bag
+
     from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
 
     icl = tmp_path / "icl.mcap"

@@ -9,11 +9,11 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
+from support.bag_export import typestore_for
 
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.recorders.importers import images, textformats
-from sgtool.recorders.importers.export import typestore_for
 from sgtool.recorders.importers.poses import (
     PoseTrack,
     interpolate,

@@ -133,7 +133,7 @@ def test_lost_tracking_in_a_recorded_turn_counts_as_failed(tmp_path: Path):
     --odometry rgbd. Open3D "succeeds" on every step, with steps of 0.4-0.8 m in 0.1 s:
     before the checks the report said 0 failed steps for an ATE of 2 m (60 frames: 22 m);
     now those steps fail, keep the previous motion, and the ATE stays a few centimetres."""
-    from sgtool.recorders.importers.export import write_log_as_bag
+    from support.bag_export import write_log_as_bag
 
     log, bag, out = tmp_path / "d.mcap", tmp_path / "d_bag", tmp_path / "o.mcap"
     r = CliRunner().invoke(cli, ["record", "-o", str(log), "--frames", "12"])

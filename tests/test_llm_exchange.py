@@ -8,7 +8,7 @@ import pytest
 
 from sgtool.llm.client import LlmTransportError
 from sgtool.llm.exchange import exchange_record, prompt_key
-from sgtool.llm.replay import ReplayChatClient, ReplayMiss, TranscriptError, TranscriptWriter
+from sgtool.llm.recorded import ReplayChatClient, ReplayMiss, TranscriptError, TranscriptWriter
 from sgtool.log.schemas import RECORDS
 
 MSGS = [{"role": "system", "content": "You are a robot."},

@@ -236,7 +236,7 @@ def test_symbolic_episode_end_to_end_over_http() -> None:
 
     from sgtool.datasets.episodes import list_episodes
     from sgtool.datasets.generator import generate_house
-    from sgtool.datasets.symbolic import SymbolicHouse, run_episode
+    from sgtool.recorders.symbolic_environment import SymbolicHouse, run_episode
 
     spec = generate_house(101, rooms=(6, 8), split="eval")
     house_ = SymbolicHouse(spec)

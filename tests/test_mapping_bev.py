@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from support.synthetic_world import camera_pose
 
 from sgtool.mapping.bev import (
     FREE,
@@ -19,7 +20,6 @@ from sgtool.mapping.bev import (
     occupancy_from_keys,
 )
 from sgtool.mapping.esdf import distance_field, inflate, signed_distance
-from sgtool.mapping.synthetic import camera_pose
 from sgtool.mapping.voxels import pack
 
 RES = 0.05
@@ -105,8 +105,9 @@ def test_incremental_column_grid_equals_rebuild() -> None:
 def test_floor_fans_clear_the_blind_zone() -> None:
     """A camera 1 m up, pitched 0.5 rad down, sees the floor from ~1.3 m on; rays ending
     on the floor clear the cells between the robot and there."""
+    from support.synthetic_world import BoxWorld, render
+
     from sgtool.log.frame import CameraIntrinsics
-    from sgtool.mapping.synthetic import BoxWorld, render
 
     k = CameraIntrinsics.from_fov(40, 30, 40)
     pose = camera_pose(0.0, 0.0, 0.0, height=1.0, pitch=0.5)

@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 import pytest
+from support.synthetic_world import Box, BoxWorld, camera_pose, make_frame
 
 from sgtool.log.frame import CameraIntrinsics, Frame
-from sgtool.mapping.synthetic import Box, BoxWorld, camera_pose, make_frame
 from sgtool.mapping.voxels import VoxelConfig, VoxelMap, pack, unpack
 
 K = CameraIntrinsics.from_fov(40, 30, 60)

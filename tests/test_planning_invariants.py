@@ -15,8 +15,8 @@ import pytest
 from semantics_fixtures import TableScorer
 
 from sgtool.planning.base import Action, Feedback
+from sgtool.planning.planners import GreedyPlanner, RandomPlanner, UtilityPlanner
 from sgtool.planning.registry import make_planner
-from sgtool.planning.search import GreedyPlanner, RandomPlanner, UtilityPlanner
 from sgtool.planning.utility import UtilityParams
 from sgtool.scenegraph.graph import (
     DoorNode,

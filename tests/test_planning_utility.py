@@ -9,7 +9,7 @@ from semantics_fixtures import TableScorer, house
 
 from sgtool.planning.base import Feedback
 from sgtool.planning.candidates import actionable
-from sgtool.planning.search import UtilityPlanner
+from sgtool.planning.planners import UtilityPlanner
 from sgtool.planning.utility import (
     UtilityParams,
     candidate_utilities,

@@ -2,7 +2,7 @@
 
 Inputs are the committed golden logs (tests/golden, recorded in PyBullet from generated
 4-room houses at 128x96) and small logs written here from the numpy ray-caster of
-:mod:`sgtool.mapping.synthetic` (the two-room house: kitchen and bedroom joined by a door),
+:mod:`support.synthetic_world` (the two-room house: kitchen and bedroom joined by a door),
 so no simulator is needed.
 """
 
@@ -16,16 +16,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from support.synthetic_world import look_around, make_frame, two_room_house, walk, world_of_house
 
 from sgtool.cli import cli
 from sgtool.log import LogReader, LogWriter
 from sgtool.log import schemas as S
 from sgtool.log.echo import as_logged
-from sgtool.mapping.synthetic import look_around, make_frame, two_room_house, walk, world_of_house
-from sgtool.replayers.layers import DERIVED_TOPICS, _hull
-from sgtool.replayers.replay import ReplayOptions, default_min_points, replay
-from sgtool.replayers.stream import SceneGraphStream
+from sgtool.replayers.derived_log import ReplayOptions, replay
+from sgtool.scenegraph.derived_layers import DERIVED_TOPICS, _hull
 from sgtool.scenegraph.graph import SceneGraph
+from sgtool.scenegraph.options import default_min_points
+from sgtool.scenegraph.stream import SceneGraphStream
 
 GOLDEN = Path(__file__).parent / "golden"
 TOUR = GOLDEN / "house6-tour.mcap"
@@ -180,7 +181,8 @@ def test_a_stream_fed_live_equals_the_replay_of_its_log(tmp_path):
     cfg_opts = ReplayOptions(every=10, classifier="none")
     got = []
     replay(log, None, cfg_opts, on_refresh=lambda ref, s: got.append(ref.graph.to_json()))
-    from sgtool.replayers.replay import builder_config, resolve_options
+    from sgtool.replayers.derived_log import resolve_options
+    from sgtool.scenegraph.options import builder_config
 
     with LogReader(log) as r:
         resolved = resolve_options(r, cfg_opts)

@@ -1,6 +1,6 @@
 """The scene-graph builder on rendered two-room scenes (numpy ray-caster, no simulator).
 
-The house (:func:`sgtool.mapping.synthetic.two_room_house`): a kitchen [0, 4] x [0, 3] and
+The house (:func:`support.synthetic_world.two_room_house`): a kitchen [0, 4] x [0, 3] and
 a bedroom [4, 8] x [0, 3] joined at x = 4 by an open door, a closed door or an open-plan
 passage. The robot looks around in the kitchen, walks through the opening and looks around
 in the bedroom (if it can).
@@ -11,9 +11,7 @@ from __future__ import annotations
 import functools
 
 import pytest
-
-from sgtool.log.frame import CameraIntrinsics, Frame
-from sgtool.mapping.synthetic import (
+from support.synthetic_world import (
     HouseWorld,
     look_around,
     make_frame,
@@ -21,6 +19,8 @@ from sgtool.mapping.synthetic import (
     walk,
     world_of_house,
 )
+
+from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.mapping.voxels import VoxelConfig
 from sgtool.planning.candidates import actionable, door_is_entrance
 from sgtool.scenegraph.builder import BuilderConfig, SceneGraphBuilder

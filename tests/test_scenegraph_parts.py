@@ -6,13 +6,14 @@ import numpy as np
 import pytest
 from scipy.sparse import csr_matrix
 
+from sgtool.datasets.room_evidence import frequency_room_classifier
 from sgtool.mapping.bev import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.voronoi import voronoi_graph
 from sgtool.scenegraph.assign import AssignConfig, assign_objects
 from sgtool.scenegraph.categories import FrequencyRoomClassifier, RoomClassifier
 from sgtool.scenegraph.frontiers import FrontierConfig, find_frontiers
 from sgtool.scenegraph.regions import cluster_room
-from sgtool.scenegraph.rooms import (
+from sgtool.scenegraph.room_segmentation import (
     RoomTracker,
     door_density,
     opening_from_panel,
@@ -207,5 +208,5 @@ _CLF: list[FrequencyRoomClassifier] = []
 
 def _trained() -> FrequencyRoomClassifier:
     if not _CLF:
-        _CLF.append(FrequencyRoomClassifier.from_training_knowledge())
+        _CLF.append(frequency_room_classifier())
     return _CLF[0]

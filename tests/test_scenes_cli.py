@@ -11,8 +11,8 @@ from click.testing import CliRunner
 
 from sgtool.cli import cli
 from sgtool.datasets.generator import generate_house
-from sgtool.datasets.house import load_house
 from sgtool.datasets.stats import house_stats
+from sgtool.house.spec import load_house
 
 
 def test_generate_is_byte_stable(tmp_path):

@@ -97,7 +97,7 @@ def test_cli_trains_into_a_folder(tmp_path) -> None:
     assert np.isfinite(p.objects(["sink"], "toothbrush")[0])
 
 
-@pytest.mark.slow
+@pytest.mark.ci_only
 def test_shipped_weights_are_what_distill_writes(tmp_path) -> None:
     """`sgtool distill` with its defaults (about 20 s here) rebuilds the shipped weights:
     byte-identical on this machine type (measured), compared here within 1e-5 so that a

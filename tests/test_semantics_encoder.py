@@ -40,7 +40,7 @@ def test_vectors_do_not_depend_on_batch_company(tmp_path) -> None:
     texts = ["sink", "bathroom", "toothbrush holder", "a", "living room", "sink"]
     e = SentenceEncoder(cache=False)
     together = e.encode(texts)
-    e2 = SentenceEncoder(cache=False, batch_size=2)
+    e2 = SentenceEncoder(cache=False)
     alone = np.stack([e2.encode([t])[0] for t in texts])
     assert np.array_equal(together, alone)  # bit for bit
     assert np.array_equal(together[0], together[5])

@@ -12,10 +12,10 @@ from sgtool.datasets.relational import (
     containment_set,
     cooccurrence_labels,
     cooccurrence_set,
-    holdout_queries,
     knowledge_fingerprint,
     training_sets,
 )
+from sgtool.semantics.relational_set import holdout_queries
 
 FRIDGE = "electric_refrigerator.n.01"
 CABINET = "cabinet.n.01"

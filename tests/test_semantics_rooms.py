@@ -6,7 +6,7 @@ import pytest
 from semantics_fixtures import encoder
 
 from sgtool.semantics.priors import LearnedPriors
-from sgtool.semantics.rooms import ContainmentRoomClassifier
+from sgtool.semantics.room_classification import ContainmentRoomClassifier
 
 
 @pytest.fixture(scope="module")

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from sgtool.datasets.house import HouseSpec, load_house
+from sgtool.house.spec import HouseSpec, load_house
 from sgtool.recorders.sim.instances import instance_table
 
 

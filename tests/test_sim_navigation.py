@@ -8,7 +8,7 @@ import math
 import numpy as np
 from test_sim_fixtures import small_house
 
-from sgtool.datasets.occupancy import astar, geodesic_distances, world_to_cell
+from sgtool.mapping.occupancy import astar, geodesic_distances, world_to_cell
 from sgtool.recorders.sim import articulation as art
 from sgtool.recorders.sim import navigation as nav
 

@@ -11,9 +11,9 @@ from scipy import ndimage
 from test_sim_fixtures import small_house
 
 from sgtool.datasets.generator import generate_house
-from sgtool.datasets.house import room_at
-from sgtool.datasets.occupancy import world_to_cell
 from sgtool.errors import SgtoolError
+from sgtool.house.spec import room_at
+from sgtool.mapping.occupancy import world_to_cell
 from sgtool.recorders.sim import (
     CameraConfig,
     ScriptOptions,

@@ -10,15 +10,15 @@ import numpy as np
 import pytest
 from symbolic_fixtures import three_rooms
 
-from sgtool.datasets.house import load_house
-from sgtool.datasets.occupancy import house_occupancy, shortest_path_length
-from sgtool.datasets.symbolic import (
+from sgtool.house.spec import load_house
+from sgtool.mapping.occupancy import house_occupancy, shortest_path_length
+from sgtool.planning.base import Action, Feedback
+from sgtool.recorders.symbolic_environment import (
     SymbolicEnv,
     SymbolicHouse,
     cluster_regions,
     run_episode,
 )
-from sgtool.planning.base import Action, Feedback
 from sgtool.scenegraph.graph import SceneGraph
 
 

@@ -12,8 +12,8 @@ import rerun as rr
 from click.testing import CliRunner
 from test_log_roundtrip import write_log
 
-from sgtool.analysis.rerun_view import color_for
 from sgtool.cli import cli
+from sgtool.colors import color_for
 
 
 @pytest.fixture(autouse=True)
@@ -59,7 +59,7 @@ def test_colours_are_stable_and_distinct():
 def test_view_of_a_replayed_log_with_voxels_and_derived_layers(tmp_path):
     """A golden log replayed (occupancy, Voronoi graph, rooms, scene graphs) and viewed with
     the voxel map, in strict mode: every logged archetype is valid, and the file verifies."""
-    from sgtool.replayers.replay import ReplayOptions, replay
+    from sgtool.replayers.derived_log import ReplayOptions, replay
 
     golden = Path(__file__).parent / "golden" / "house10-start.mcap"
     derived = tmp_path / "derived.mcap"

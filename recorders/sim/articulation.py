@@ -26,7 +26,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from sgtool.datasets.house import Door, Furniture
+from sgtool.house.spec import Door, Furniture
 
 DOUBLE_DOOR_WIDTH = 0.9  # fronts wider than this get two doors (m)
 CONTAINER_PANEL_T = 0.02  # container door thickness (m)

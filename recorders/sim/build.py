@@ -26,7 +26,7 @@ from types import ModuleType
 
 import numpy as np
 
-from sgtool.datasets.house import HouseSpec
+from sgtool.house.spec import HouseSpec
 from sgtool.recorders.sim import articulation as art
 from sgtool.recorders.sim.camera import uid_lut
 from sgtool.recorders.sim.instances import Instance, initial_states, instance_table

@@ -8,7 +8,7 @@ One episode (:func:`run_episode`), all of it into one MCAP log:
    instances table;
 2. every simulator tick is a logged frame (:class:`~sgtool.recorders.sim.recording.LogRecorder`)
    and is fed, *as the log holds it* (:func:`sgtool.log.echo.as_logged`, after the sensor
-   faults), to a :class:`~sgtool.replayers.stream.SceneGraphStream`, the refresh schedule
+   faults), to a :class:`~sgtool.scenegraph.stream.SceneGraphStream`, the refresh schedule
    replay uses: a refresh every K frames, and one at every action record, each written as
    the derived channels ``/map/occupancy``, ``/map/voronoi``, ``/map/rooms`` and
    ``/sgtool/scene_graph`` right after the message that caused it. Instance tables (a door
@@ -77,8 +77,9 @@ from pathlib import Path
 from typing import Any
 
 from sgtool.datasets.episodes import Episode, list_episodes
-from sgtool.datasets.house import HouseSpec
+from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
+from sgtool.house.spec import HouseSpec
 from sgtool.log.echo import as_logged
 from sgtool.log.writer import LogWriter
 from sgtool.planning.base import Action, Feedback, Planner
@@ -88,17 +89,16 @@ from sgtool.recorders.sim.navigation import RobotConfig
 from sgtool.recorders.sim.noise import PROFILES, NoiseProfile
 from sgtool.recorders.sim.recording import SOURCE, LogRecorder
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome, StopSimulation
-from sgtool.replayers.layers import write_refresh
-from sgtool.replayers.replay import (
+from sgtool.scenegraph.derived_layers import write_refresh
+from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode, SceneGraph
+from sgtool.scenegraph.options import (
     CLASSIFIERS,
     ResolvedOptions,
     builder_config,
     default_min_points,
-    make_classifier,
     mapping_record,
 )
-from sgtool.replayers.stream import Refresh, SceneGraphStream
-from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode, SceneGraph
+from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 from sgtool.semantics.text import category_text
 
 N_MAX = 50  # high-level steps per episode (SymSearch's N_max)

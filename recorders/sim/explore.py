@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sgtool.datasets.occupancy import geodesic_distances, world_to_cell
+from sgtool.mapping.occupancy import geodesic_distances, world_to_cell
 from sgtool.recorders.sim import navigation as nav
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome
 

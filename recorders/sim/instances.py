@@ -20,7 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from sgtool.datasets.house import HouseSpec
+from sgtool.house.spec import HouseSpec
 
 STRUCTURE, DOOR, FURNITURE, OBJECT = "structure", "door", "furniture", "object"
 

@@ -1,7 +1,7 @@
 """Where the robot may drive and how: occupancy in the current door states, goals near
 targets, smoothed A* paths and the per-frame poses that follow them (pure functions).
 
-Paths are planned on :func:`sgtool.datasets.occupancy.house_occupancy` (walls, furniture,
+Paths are planned on :func:`sgtool.mapping.occupancy.house_occupancy` (walls, furniture,
 closed doors, the outside, grown by the robot radius) with the house's *current* door
 states, plus the footprints of open door panels (house doors and container doors stick out
 into the room when open). A* runs on that grid (8-connected, no corner cutting); the
@@ -21,15 +21,15 @@ import numpy as np
 from matplotlib.path import Path as MplPath
 from scipy import ndimage
 
-from sgtool.datasets.house import HouseSpec, Room
-from sgtool.datasets.occupancy import (
+from sgtool.errors import SgtoolError
+from sgtool.house.spec import HouseSpec, Room
+from sgtool.mapping.occupancy import (
     OccupancyMap,
     cell_centers,
     house_occupancy,
     inflate,
     world_to_cell,
 )
-from sgtool.errors import SgtoolError
 from sgtool.recorders.sim.articulation import Box2
 
 Pose2 = tuple[float, float, float]  # x, y, yaw

@@ -30,7 +30,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from sgtool.datasets.house import HouseSpec
+from sgtool.house.spec import HouseSpec
 from sgtool.log.frame import Frame
 from sgtool.log.writer import LogWriter
 from sgtool.recorders.sim.camera import CameraConfig, base_T_camera

@@ -30,10 +30,10 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
-from sgtool.datasets.house import Door, HouseSpec, StartPose, room_at
-from sgtool.datasets.occupancy import OccupancyMap, astar, geodesic_distances, nearest_free_cell
 from sgtool.errors import SgtoolError
+from sgtool.house.spec import Door, HouseSpec, StartPose, room_at
 from sgtool.log.frame import Frame
+from sgtool.mapping.occupancy import OccupancyMap, astar, geodesic_distances, nearest_free_cell
 from sgtool.recorders.sim import articulation as art
 from sgtool.recorders.sim import navigation as nav
 from sgtool.recorders.sim.build import (

@@ -50,7 +50,7 @@ def command(out_dir: str, frames: int | None, houses: int, episodes: int, seeds:
     from sgtool.datasets import demo_house
     from sgtool.log.inspect import format_summary, summarize
     from sgtool.recorders.sim import RecordOptions, record_house
-    from sgtool.replayers.replay import replay
+    from sgtool.replayers.derived_log import replay
     from sgtool.replayers.score import score, score_lines
 
     out = Path(out_dir)

@@ -84,24 +84,31 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
     only, the encoder is the bundled all-MiniLM-L6-v2, and the run is deterministic: the
     same seed writes byte-identical files. Takes about a minute on 2 CPU cores.
     """
+    from sgtool.datasets.relational import evaluation_sets, training_sets
     from sgtool.semantics.distill import DistillConfig, distill, format_report, quality_report
 
     if report_only:
         wd = weights_dir or _weights_dir()
         if not (wd / "metadata.json").is_file():
             raise SgtoolError(f"{wd}: no metadata.json; not a folder of distilled weights")
-        rep = quality_report(wd)
+        seed = int(json.loads((wd / "metadata.json").read_text())["config"]["seed"])
+        built = training_sets(seed=seed)
+        rep = quality_report(wd, (built.containment, built.cooccurrence),
+                             eval_sets=evaluation_sets(seed=seed))
         click.echo(json.dumps(rep, indent=1, sort_keys=True) if as_json else format_report(rep))
         return
 
     cfg = DistillConfig(seed=seed, holdout=holdout, epochs_containment=epochs_containment,
                         epochs_cooccurrence=epochs_cooccurrence, keep=keep, threads=threads)
-    sets = None
-    room_types = None
-    fingerprint = None
+    eval_sets = None
     if source == "llm":
         sets, room_types, fingerprint = _llm_sets(llm_base_url, llm_model, llm_api_key,
                                                   llm_cache, llm_runs, llm_max_queries)
+    else:
+        built = training_sets(seed=seed)
+        sets = (built.containment, built.cooccurrence)
+        room_types, fingerprint = built.room_types, built.split_fingerprint
+        eval_sets = evaluation_sets(seed=seed)
     target = out_dir or _weights_dir()
     try:
         target.mkdir(parents=True, exist_ok=True)
@@ -111,7 +118,8 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
                           "choose a folder with --out") from e
     try:
         meta = distill(tmp, cfg, sets=sets, split_fingerprint=fingerprint,
-                       room_types=room_types, progress=sys.stderr.isatty())
+                       room_types=room_types, progress=sys.stderr.isatty(),
+                       eval_sets=eval_sets)
         for name in ("containment.safetensors", "cooccurrence.safetensors", "metadata.json"):
             os.replace(tmp / name, target / name)
     finally:

@@ -1,13 +1,15 @@
+
 """``sgtool eval``: metrics from recorded episodes; planners evaluated against logged decisions."""
 
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import asdict
 from typing import Any
 
 import click
+
+from sgtool.canonical import strict_json
 
 
 @click.command("eval")
@@ -38,9 +40,9 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
     action, and it is then told what was really done."""
     from sgtool.analysis.metrics import cost_models, seen_unseen, summarize
     from sgtool.analysis.offline import format_offline, load_results, replay_decisions
-    from sgtool.analysis.records import write_text_atomic
     from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
     from sgtool.commands.bench import OptionError, _planner_options
+    from sgtool.files import atomic_write
     from sgtool.planning.registry import make_planner
 
     results, logged = load_results(inputs)
@@ -70,7 +72,7 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
                                     "decision_s": r.mean_decision_s()}
                         for r in reports},
         }
-        text = json.dumps(_clean(doc), indent=1, sort_keys=True, allow_nan=False) + "\n"
+        text = json.dumps(strict_json(doc), indent=1, sort_keys=True, allow_nan=False) + "\n"
     else:
         parts = [format_table(sums, models=models,
                               title=f"Metrics recomputed from {len(results)} episode(s) in "
@@ -81,15 +83,5 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
             parts.append(format_offline(reports))
         text = "\n".join(parts)
     if out:
-        write_text_atomic(out, text)
+        atomic_write(out, text)
     click.echo(text, nl=False)
-
-
-def _clean(x: Any) -> Any:
-    if isinstance(x, float):
-        return None if math.isnan(x) else x
-    if isinstance(x, dict):
-        return {k: _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    return x

@@ -72,7 +72,7 @@ def house_from_options(path: str | None, seed: int | None, rooms: str) -> tuple[
     if path is not None and seed is not None:
         raise SgtoolError("give either --house or --seed, not both")
     if path is not None:
-        from sgtool.datasets.house import load_house
+        from sgtool.house.spec import load_house
 
         return load_house(path), Path(path).stem
     if seed is not None:

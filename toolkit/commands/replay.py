@@ -62,7 +62,7 @@ def command(log: str, output: str | None, every: int | None, classifier: str | N
     from tqdm import tqdm
 
     from sgtool.log import LogReader
-    from sgtool.replayers.replay import ReplayOptions, replay
+    from sgtool.replayers.derived_log import ReplayOptions, replay
 
     src = Path(log)
     dst = Path(output) if output else None
@@ -122,7 +122,7 @@ def command(log: str, output: str | None, every: int | None, classifier: str | N
 
 
 def _score(house: str, final: dict[str, Any]) -> Any:
-    from sgtool.datasets.house import load_house
+    from sgtool.house.spec import load_house
     from sgtool.replayers.score import score
 
     if "refresh" not in final:

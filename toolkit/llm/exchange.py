@@ -3,7 +3,7 @@
 The same dict goes to the MCAP log (``LogWriter.write_record("llm_exchange", t, record)``)
 and, one JSON object per line, to a transcript file that ``--llm-replay`` serves back. The
 fields required by the log schema are ``model`` and ``messages``; ``prompt_sha256`` keys a
-response to its prompt for replay (:mod:`sgtool.llm.replay`).
+response to its prompt for replay (:mod:`sgtool.llm.recorded`).
 """
 
 from __future__ import annotations

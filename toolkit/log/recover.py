@@ -25,6 +25,7 @@ from mcap.stream_reader import MAGIC_SIZE, breakup_chunk
 from mcap.writer import CompressionType, Writer
 
 from sgtool.errors import LogFormatError, SgtoolError
+from sgtool.files import atomic_open
 
 MAGIC = bytes([137, 77, 67, 65, 80, 48, 13, 10])
 Status = Literal["complete", "truncated", "corrupt"]
@@ -240,19 +241,13 @@ def recover(path: str | os.PathLike[str], out: str | os.PathLike[str],
     if not dst.parent.exists():
         raise SgtoolError(f"folder {dst.parent} does not exist")
     diag = Diagnosis(str(src), src.stat().st_size)
-    tmp = dst.with_name(dst.name + ".partial")
-    try:
-        with open(src, "rb") as f, open(tmp, "wb") as o:
-            f.seek(0)
-            header_lib = _header_library(f)
-            f.seek(0)
-            copier = _Copier(o, profile=header_lib[0], library=header_lib[1])
-            _consume(_walk(f, diag.size, diag), diag, copier)
-            copier.w.finish()
-        os.replace(tmp, dst)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    with open(src, "rb") as f, atomic_open(dst, "wb") as o:
+        f.seek(0)
+        header_lib = _header_library(f)
+        f.seek(0)
+        copier = _Copier(o, profile=header_lib[0], library=header_lib[1])
+        _consume(_walk(f, diag.size, diag), diag, copier)
+        copier.w.finish()
     return diag
 
 

@@ -24,7 +24,7 @@ The floor height is taken from the config or estimated as the lowest voxel level
 at least half as many voxels as the fullest level (floors are the largest horizontal
 surfaces a camera sees; the ceiling, when seen, is higher).
 
-Cells use the convention of :mod:`sgtool.datasets.occupancy`: arrays ``[row, col]`` with
+Cells use the convention of :mod:`sgtool.mapping.occupancy`: arrays ``[row, col]`` with
 row = y and col = x, cell (0, 0) has its lower-left corner at ``origin``; values follow ROS
 and Foxglove occupancy grids: 0 free, 100 occupied, -1 unknown (int8). The grid is aligned
 with the voxel lattice (one cell per voxel column) and its origin snapped to whole

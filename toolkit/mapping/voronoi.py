@@ -30,7 +30,7 @@ all-pairs Dijkstra to sparsify (O(N^2)). We compute the same diagram on the grid
    shorter than ``min_spur`` ending in a junction are dropped, and each chain gets
    ``round(length / node_spacing) - 1`` evenly spaced intermediate nodes. Edges weigh their
    length along the ridge and keep the cells they follow (for the door cut of
-   :mod:`sgtool.scenegraph.rooms`).
+   :mod:`sgtool.scenegraph.room_segmentation`).
 
 Nodes are numbered in raster order of their cells, edges are sorted: the same grid always
 gives the same graph.

@@ -54,7 +54,7 @@ def _pop_params(options: dict[str, Any]) -> dict[str, Any]:
 
 
 def _utility(name: str, options: dict[str, Any]) -> Planner:
-    from sgtool.planning.search import UtilityPlanner
+    from sgtool.planning.planners import UtilityPlanner
     from sgtool.planning.utility import UtilityParams
     from sgtool.semantics.priors import CosinePriors, LearnedPriors, default_priors
 
@@ -81,7 +81,7 @@ def _utility(name: str, options: dict[str, Any]) -> Planner:
 
 def _moma(options: dict[str, Any]) -> Planner:
     from sgtool.llm.client import LlmSettings, OpenAIChatClient
-    from sgtool.llm.replay import ReplayChatClient
+    from sgtool.llm.recorded import ReplayChatClient
     from sgtool.planning.moma.planner import MomaLlmPlanner
 
     client = options.pop("client", None)
@@ -102,9 +102,9 @@ def _moma(options: dict[str, Any]) -> Planner:
 
 def _simple(cls_name: str) -> Callable[[dict[str, Any]], Planner]:
     def make(options: dict[str, Any]) -> Planner:
-        from sgtool.planning import search
+        from sgtool.planning import planners
 
-        return getattr(search, cls_name)(max_failures=int(options.pop("max_failures", 2)))
+        return getattr(planners, cls_name)(max_failures=int(options.pop("max_failures", 2)))
 
     return make
 

@@ -10,8 +10,8 @@ caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
    or voxels were removed (an instance changed state);
 2. Voronoi graph (:mod:`sgtool.mapping.voronoi`): the ridge pixel graph is reused while the
    occupancy grid is unchanged; the component is the robot's;
-3. rooms (:mod:`sgtool.scenegraph.rooms`): door cells of open doors cut the graph, ids are
-   kept stable by overlap with the previous refresh;
+3. rooms (:mod:`sgtool.scenegraph.room_segmentation`): door cells of open doors cut the
+   graph, ids are kept stable by overlap with the previous refresh;
 4. objects (:mod:`sgtool.scenegraph.assign`): instances seen with enough points, placed at
    their voxel centroid, first-level ones assigned by MoMa-LLM's weighted travel distance
    from their closest viewpoint, nested ones (``inside``/``ontop`` a seen parent) in their
@@ -86,7 +86,7 @@ from sgtool.scenegraph.graph import (
 )
 from sgtool.scenegraph.instances import InstanceInfo
 from sgtool.scenegraph.regions import RegionConfig, cluster_room
-from sgtool.scenegraph.rooms import (
+from sgtool.scenegraph.room_segmentation import (
     RoomConfig,
     RoomSegmentation,
     RoomTracker,
@@ -418,8 +418,8 @@ class SceneGraphBuilder:
         return self._columns.occupancy(self.trajectory, level)
 
     def _door_cells(self, occ: OccupancyGrid) -> np.ndarray:
-        """Door evidence (:mod:`sgtool.scenegraph.rooms`): the *passable* columns of each
-        open (or state-unknown) door -- its opening under the lintel, not the swung panel,
+        """Door evidence (:mod:`sgtool.scenegraph.room_segmentation`): the *passable* columns
+        of each open (or state-unknown) door -- its opening under the lintel, not the swung panel,
         whose cells would cut the room it stands in -- else the panel's closed position,
         else all its columns."""
         cells = np.zeros(occ.shape, dtype=bool)

@@ -4,7 +4,7 @@ SCOUT infers room categories "from the objects they contain" (sec. IV-A); MoMa-L
 LLM with the room's object list (paper Fig. 3; 27.6% room category accuracy in
 simulation). Any object with ``classify(object_categories) -> [(room type, probability),
 ...]`` best first (empty for an empty room) is a :class:`RoomClassifier`; the learned
-:class:`sgtool.semantics.rooms.ContainmentRoomClassifier` is one.
+:class:`sgtool.semantics.room_classification.ContainmentRoomClassifier` is one.
 
 :class:`FrequencyRoomClassifier` is the transparent one: multinomial naive Bayes over a
 table ``room type -> {object category: count}``,
@@ -15,7 +15,7 @@ with Laplace smoothing ``alpha``, vocabulary V (categories in the table), N_r th
 count of room type r, and a uniform prior by default (houses need not follow the table's
 room-type frequencies). Categories outside V carry no evidence and are skipped.
 Categories are compared after :func:`sgtool.semantics.text.category_text` ("Bottom_cabinet"
-= "bottom cabinet"). :meth:`FrequencyRoomClassifier.from_training_knowledge` builds the
+= "bottom cabinet"). ``sgtool.datasets.room_evidence.frequency_room_classifier`` builds the
 table from the training part of the BEHAVIOR-1K knowledge only (never the evaluation part
 that furnishes benchmark houses).
 """
@@ -23,7 +23,7 @@ that furnishes benchmark houses).
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from typing import Protocol, runtime_checkable
 
 from sgtool.semantics.text import category_text
@@ -88,45 +88,3 @@ class FrequencyRoomClassifier:
         ranked = sorted(((r, math.exp(s - top) / z) for r, s in score.items()),
                         key=lambda rp: (-rp[1], rp[0]))
         return ranked
-
-    @classmethod
-    def from_training_knowledge(cls, room_types: Iterable[str] | None = None,
-                                alpha: float = 1.0, small_objects: bool = False
-                                ) -> FrequencyRoomClassifier:
-        """From :func:`sgtool.datasets.split.training_knowledge`: per room type, in how
-        many rooms of the household training scenes each category occurs (document
-        frequency: a kitchen's eleven cabinets count once, so one category cannot swamp
-        the evidence), restricted to ``room_types`` (default: the room types the house
-        generator uses). ``small_objects`` adds the activity-derived small-object counts
-        per room type.
-
-        Measured on the rooms of twelve evaluation-split houses (seeds 100-111, 8-12 rooms,
-        classified from their furniture; alpha 1): 67% with document frequencies, 55% with
-        raw counts; adding the small-object counts lowers both (52%, 64% -> 49% when the
-        small objects are classified too), so they are off by default."""
-        from sgtool.datasets.split import is_household_scene, training_knowledge
-
-        k = training_knowledge()
-        if room_types is None:
-            from sgtool.datasets.generator import HOUSE_ROOM_TYPES
-
-            room_types = (*HOUSE_ROOM_TYPES, "corridor")
-        wanted = set(room_types)
-        table: dict[str, dict[str, float]] = {r: {} for r in sorted(wanted)}
-        for inv in k.rooms:
-            if inv.room_type not in wanted or not is_household_scene(inv.scene):
-                continue
-            row = table[inv.room_type]
-            for name in sorted({k.name(s) for s, _ in inv.items
-                                if k.kind(s) in ("furniture", "object")}):
-                row[name] = row.get(name, 0.0) + 1.0
-        if small_objects:
-            for room, items in k.room_objects.items():
-                if room not in wanted:
-                    continue
-                row = table[room]
-                for synset, n in items:
-                    name = k.name(synset)
-                    row[name] = row.get(name, 0.0) + float(n)
-        table = {r: row for r, row in table.items() if row}
-        return cls(table, alpha=alpha)

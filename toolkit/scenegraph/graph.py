@@ -1,3 +1,4 @@
+
 """The hierarchical scene graph: the one structure every planner sees.
 
 Five layers, as in SCOUT (section III): root -> rooms -> regions/frontiers -> objects ->
@@ -6,7 +7,7 @@ on another object have that object as parent). Rooms are joined by intra-layer e
 or open passages). States and affordances are attributes.
 
 The same type comes out of the replayer (from a log), the live closed loop, and the
-symbolic benchmark (``sgtool.datasets.symbolic``). Its canonical JSON form
+symbolic benchmark (``sgtool.recorders.symbolic_environment``). Its canonical JSON form
 (:meth:`SceneGraph.to_json`) is byte-stable: sorted keys, fixed float rounding, nodes in
 id order, so two replays of one log give identical bytes.
 
@@ -20,6 +21,8 @@ import json
 from dataclasses import asdict, dataclass, field
 from typing import Any, Literal
 
+from sgtool.canonical import canonical_float, canonical_floats
+
 SCENE_GRAPH_VERSION = "1.0"
 
 RegionKind = Literal["region", "frontier"]
@@ -27,16 +30,6 @@ FrontierType = Literal["unexplored area", "leading out"]
 Relation = Literal["inside", "ontop"]
 OpenState = Literal["open", "closed"]
 
-_ROUND = 4  # decimals kept for floats in the canonical form
-
-
-def _r(x: float) -> float:
-    v = round(float(x), _ROUND)
-    return 0.0 if v == 0 else v  # no "-0.0"
-
-
-def _rt(xs: tuple[float, ...] | list[float]) -> list[float]:
-    return [_r(x) for x in xs]
 
 
 @dataclass(frozen=True)
@@ -155,26 +148,26 @@ class SceneGraph:
     def to_dict(self) -> dict[str, Any]:
         def room(n: RoomNode) -> dict[str, Any]:
             d = asdict(n)
-            d["position"] = _rt(n.position)
-            d["category_scores"] = [[c, _r(p)] for c, p in n.category_scores]
+            d["position"] = canonical_floats(n.position)
+            d["category_scores"] = [[c, canonical_float(p)] for c, p in n.category_scores]
             d["neighbours"] = sorted(n.neighbours)
             return d
 
         def region(n: RegionNode) -> dict[str, Any]:
             d = asdict(n)
-            d["position"] = _rt(n.position)
-            d["size"] = _r(n.size)
+            d["position"] = canonical_floats(n.position)
+            d["size"] = canonical_float(n.size)
             return d
 
         def obj(n: ObjectNode) -> dict[str, Any]:
             d = asdict(n)
-            d["position"] = _rt(n.position)
+            d["position"] = canonical_floats(n.position)
             d["affordances"] = sorted(n.affordances)
             return d
 
         def door(n: DoorNode) -> dict[str, Any]:
             d = asdict(n)
-            d["position"] = _rt(n.position)
+            d["position"] = canonical_floats(n.position)
             d["rooms"] = sorted(n.rooms)
             return d
 
@@ -182,8 +175,8 @@ class SceneGraph:
             "version": self.version,
             "time_ns": int(self.time_ns),
             "robot": {
-                "position": _rt(self.robot.position),
-                "yaw": _r(self.robot.yaw),
+                "position": canonical_floats(self.robot.position),
+                "yaw": canonical_float(self.robot.yaw),
                 "room": self.robot.room,
                 "region": self.robot.region,
             },
@@ -191,7 +184,7 @@ class SceneGraph:
             "regions": [region(n) for n in sorted(self.regions, key=lambda n: _idkey(n.id))],
             "objects": [obj(n) for n in sorted(self.objects, key=lambda n: _idkey(n.id))],
             "doors": [door(n) for n in sorted(self.doors, key=lambda n: _idkey(n.id))],
-            "distances": {k: _r(v) for k, v in sorted(self.distances.items())},
+            "distances": {k: canonical_float(v) for k, v in sorted(self.distances.items())},
         }
 
     def to_json(self) -> str:

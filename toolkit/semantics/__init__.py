@@ -7,7 +7,8 @@
 - :mod:`~sgtool.semantics.distill`, :mod:`~sgtool.semantics.training`: training them
   (``sgtool distill``), :mod:`~sgtool.semantics.llm_knowledge`: SCOUT's optional LLM
   knowledge generation;
-- :mod:`~sgtool.semantics.rooms`: room categories from contents with the containment model.
+- :mod:`~sgtool.semantics.room_classification`: room categories from contents with the
+  containment model.
 
 Importing this package is cheap; submodules load numpy, torch or the model only when used.
 """

@@ -28,13 +28,13 @@ so two runs write byte-identical files.
 from __future__ import annotations
 
 import json
-import os
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from sgtool.files import atomic_write
 from sgtool.semantics.encoder import SentenceEncoder, default_encoder
 from sgtool.semantics.metrics import separation_summary
 from sgtool.semantics.mlp import load_mlp, save_mlp
@@ -85,7 +85,8 @@ def evaluate_set(rs, node_emb: np.ndarray, query_emb: np.ndarray, mlp) -> dict[s
 def distill(
     out_dir: str | Path,
     cfg: DistillConfig = DistillConfig(),
-    sets: tuple[Any, Any] | None = None,
+    *,
+    sets: tuple[Any, Any],
     split_fingerprint: str | None = None,
     room_types: tuple[str, ...] | None = None,
     encoder: SentenceEncoder | None = None,
@@ -94,24 +95,15 @@ def distill(
 ) -> dict[str, Any]:
     """Train both models into ``out_dir`` and return the metadata written there.
 
-    ``sets`` = (containment set, co-occurrence set); by default built from
-    ``sgtool.datasets.split.training_knowledge()``, and then the report covers the unseen
-    query categories of the evaluation part (``eval_sets`` by default
-    :func:`sgtool.datasets.relational.evaluation_sets`). With ``cfg.holdout > 0`` a share of
-    the training queries is also held out of training and reported.
+    ``sets`` = (containment set, co-occurrence set), e.g. those of
+    :func:`sgtool.datasets.relational.training_sets`; the report covers ``eval_sets`` (e.g.
+    the unseen query categories of :func:`sgtool.datasets.relational.evaluation_sets`) when
+    given. With ``cfg.holdout > 0`` a share of the training queries is also held out of
+    training and reported.
     """
-    from sgtool.datasets.relational import holdout_queries
+    from sgtool.semantics.relational_set import holdout_queries
     from sgtool.semantics.training import TrainConfig, train_relation
 
-    if sets is None:
-        from sgtool.datasets.relational import evaluation_sets, training_sets
-
-        built = training_sets(seed=cfg.seed)
-        sets = (built.containment, built.cooccurrence)
-        split_fingerprint = split_fingerprint or built.split_fingerprint
-        room_types = room_types or built.room_types
-        if eval_sets is None:
-            eval_sets = evaluation_sets(seed=cfg.seed)
     cont, cooc = sets
     encoder = encoder or default_encoder()
     out_dir = Path(out_dir)
@@ -197,33 +189,22 @@ def _report(mlps: dict, encoder: SentenceEncoder, eval_sets, train_sets, held: s
 
 
 def write_json_atomic(path: Path, obj: Any) -> None:
-    tmp = path.with_name(path.name + ".partial")
-    tmp.write_text(json.dumps(obj, indent=1, sort_keys=True, allow_nan=True) + "\n")
-    os.replace(tmp, path)
+    atomic_write(path, json.dumps(obj, indent=1, sort_keys=True, allow_nan=True) + "\n")
 
 
 def quality_report(
     weights_dir: str | Path,
-    sets: tuple[Any, Any] | None = None,
+    sets: tuple[Any, Any],
     encoder: SentenceEncoder | None = None,
     eval_sets: tuple[Any, Any] | None = None,
 ) -> dict[str, Any]:
     """Recompute the report of the weights in ``weights_dir`` from the files themselves.
 
-    Groups: ``unseen`` (evaluation-part categories absent from training; rebuilt unless
-    ``sets`` are given without ``eval_sets``) and ``heldout`` (training queries held out by
-    the metadata's list, rebuilt from the training knowledge or ``sets``).
+    Groups: ``unseen`` (``eval_sets``, when given: evaluation-part categories absent from
+    training) and ``heldout`` (the queries of ``sets`` that the metadata's list held out).
     """
     weights_dir = Path(weights_dir)
     meta = json.loads((weights_dir / METADATA_FILE).read_text())
-    seed = int(meta["config"]["seed"])
-    if sets is None:
-        from sgtool.datasets.relational import evaluation_sets, training_sets
-
-        built = training_sets(seed=seed)
-        sets = (built.containment, built.cooccurrence)
-        if eval_sets is None:
-            eval_sets = evaluation_sets(seed=seed)
     encoder = encoder or default_encoder()
     mlps = {rel: load_mlp(weights_dir / f, rel) for rel, f in FILES.items()}
     rep = _report(mlps, encoder, eval_sets, sets, set(meta["heldout_queries"]))

@@ -39,12 +39,10 @@ class SentenceEncoder:
         self,
         cache: EmbeddingCache | None | bool = True,
         backend: str = "numpy",
-        batch_size: int = 64,
     ) -> None:
         if backend not in ("numpy", "sentence-transformers"):
             raise ValueError(f"unknown encoder backend {backend!r}")
         self.backend = backend
-        self.batch_size = int(batch_size)
         if cache is True:
             self.cache: EmbeddingCache | None = EmbeddingCache()
         elif cache is False or cache is None:
@@ -83,7 +81,7 @@ class SentenceEncoder:
     def _run_model(self, texts: list[str]) -> np.ndarray:
         model = self._load()
         if self.backend == "numpy":
-            return model.encode(texts, batch_size=self.batch_size)  # type: ignore[attr-defined]
+            return model.encode(texts)  # type: ignore[attr-defined]
         # reference backend: one text per call, so vectors do not depend on batch padding
         vecs = [
             model.encode([t], normalize_embeddings=True, convert_to_numpy=True)[0]  # type: ignore[attr-defined]

@@ -34,7 +34,7 @@ import numpy as np
 from sgtool.errors import SgtoolError
 from sgtool.llm.client import ChatClient, LlmTransportError
 from sgtool.llm.exchange import exchange_record, prompt_key
-from sgtool.llm.replay import TranscriptWriter, read_transcript
+from sgtool.llm.recorded import TranscriptWriter, read_transcript
 from sgtool.semantics.text import category_text
 
 log = logging.getLogger(__name__)
@@ -195,7 +195,7 @@ class GenerationConfig:
 def generate_sets(asker: CachedAsker, cfg: GenerationConfig = GenerationConfig(),
                   progress: bool = False):
     """(containment set, co-occurrence set, room types) from the LLM (module doc)."""
-    from sgtool.datasets.relational import table_to_set
+    from sgtool.semantics.relational_set import table_to_set
 
     rooms: list[str] = []
     for k in range(cfg.runs):

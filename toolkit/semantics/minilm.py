@@ -10,9 +10,12 @@ safetensors file, loads in ~0.3 s and matches the reference implementation to ~1
 (``tests/test_semantics_encoder.py`` checks against vectors produced by
 sentence-transformers 6.2; ``benchmarks/encoder_reference.py`` regenerates them).
 
-Determinism: texts are grouped by token count and each group is run without padding, so a
-text's vector does not depend on which other texts share its batch (checked bit for bit in
-the tests); the cache then stores exactly what a lone encoding would give.
+Determinism: every text runs through the network alone, without padding, so its vector does
+not depend on which other texts are encoded with it (checked bit for bit in the tests); the
+cache then stores exactly what a lone encoding gives. Batching texts of equal token count
+is not enough: BLAS picks its kernel blocking by the row count of a product, so a batch of
+three and a lone text differ in the last bits on some CPUs (seen with OpenBLAS' Haswell
+kernels on an AMD EPYC). Category names are a few tokens long; the loop costs ~1 ms a text.
 """
 
 from __future__ import annotations
@@ -132,19 +135,14 @@ class MiniLM:
         norm = np.maximum(np.linalg.norm(pooled, axis=1, keepdims=True), 1e-12)
         return (pooled / norm).astype(np.float32)
 
-    def encode(self, texts: Sequence[str], batch_size: int = 64) -> np.ndarray:
+    def encode(self, texts: Sequence[str]) -> np.ndarray:
         """Unit vectors (len(texts), 384), float32, in the order of ``texts``."""
         out = np.zeros((len(texts), self.dim), dtype=np.float32)
         if not texts:
             return out
         encs = self.tokenizer.encode_batch(list(texts))
-        by_len: dict[int, list[int]] = {}
         for i, e in enumerate(encs):
-            by_len.setdefault(len(e.ids), []).append(i)
-        for _, idx in sorted(by_len.items()):
-            for s in range(0, len(idx), batch_size):
-                chunk = idx[s : s + batch_size]
-                ids = np.array([encs[i].ids for i in chunk], dtype=np.int64)
-                types = np.array([encs[i].type_ids for i in chunk], dtype=np.int64)
-                out[chunk] = self._forward(ids, types)
+            ids = np.array([e.ids], dtype=np.int64)
+            types = np.array([e.type_ids], dtype=np.int64)
+            out[i] = self._forward(ids, types)[0]
         return out

@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from sgtool.files import atomic_write
+
 LAYER_SIZES: tuple[int, ...] = (768, 512, 256, 128, 1)
 TENSOR_NAMES = tuple(f"net.{2 * i}" for i in range(len(LAYER_SIZES) - 1))  # net.0, net.2 ...
 
@@ -118,7 +120,6 @@ def save_mlp(
     padded with spaces to a multiple of 8), which the format allows.
     """
     import json
-    import os
 
     from safetensors.numpy import save
 
@@ -133,6 +134,4 @@ def save_mlp(
     header = json.dumps(json.loads(raw[8 : 8 + n]), sort_keys=True, separators=(",", ":"))
     hb = header.encode()
     hb += b" " * (-len(hb) % 8)
-    tmp = path.with_name(path.name + ".partial")
-    tmp.write_bytes(len(hb).to_bytes(8, "little") + hb + raw[8 + n :])
-    os.replace(tmp, path)
+    atomic_write(path, len(hb).to_bytes(8, "little") + hb + raw[8 + n :])

@@ -36,7 +36,7 @@ from typing import Any
 
 from sgtool.llm.client import ChatClient, LlmTransportError
 from sgtool.llm.exchange import Message, exchange_record
-from sgtool.llm.replay import ReplayMiss, TranscriptWriter
+from sgtool.llm.recorded import ReplayMiss, TranscriptWriter
 from sgtool.planning.base import Action, Feedback
 from sgtool.planning.moma.commands import InvalidCommand, ground, parse_response
 from sgtool.planning.moma.scene_text import encode_scene, nearest_room, room_of

@@ -11,7 +11,7 @@
   or vanished disappear;
 - ``/sgtool/scene_graph``: the canonical JSON of the graph.
 
-Colours come from :func:`sgtool.analysis.rerun_view.color_for`, so a room has the same
+Colours come from :func:`sgtool.colors.color_for`, so a room has the same
 colour in Foxglove and in ``sgtool view``. Everything is a deterministic function of the
 refresh.
 """
@@ -29,11 +29,11 @@ from foxglove_schemas_protobuf.SceneEntityDeletion_pb2 import SceneEntityDeletio
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
 from foxglove_schemas_protobuf.TextPrimitive_pb2 import TextPrimitive
 
-from sgtool.analysis.rerun_view import color_for
+from sgtool.colors import color_for
 from sgtool.log import codec
 from sgtool.log import schemas as S
 from sgtool.log.writer import LogWriter
-from sgtool.replayers.stream import Refresh
+from sgtool.scenegraph.stream import Refresh
 
 GRAPH_Z = 0.05  # m: height of the drawn graph above the floor
 LABEL_Z = 1.5  # m: height of room labels

@@ -39,19 +39,19 @@ from __future__ import annotations
 import json
 import math
 import os
-import tempfile
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from sgtool.canonical import canonical_float, canonical_floats
 from sgtool.errors import SpecError
+from sgtool.files import atomic_write
 
 SPEC_VERSION = "1.0"
 AFFORDANCES = ("container", "openable", "supporter")
 RELATIONS = ("inside", "ontop")
 STATES = ("open", "closed")
-_ROUND = 4
 _EPS = 1e-3  # tolerance (m) of the containment checks, above the 4-decimal rounding
 
 Point = tuple[float, float]
@@ -253,40 +253,46 @@ class HouseSpec:
             "seed": int(self.seed),
             "split": self.split,
             "rooms": [
-                {"id": r.id, "category": r.category, "polygon": [_rt(p) for p in r.polygon],
+                {"id": r.id, "category": r.category,
+                 "polygon": [canonical_floats(p) for p in r.polygon],
                  "open_plan_group": r.open_plan_group}
                 for r in self.rooms
             ],
             "walls": [
-                {"id": w.id, "a": _rt(w.a), "b": _rt(w.b), "thickness": _r(w.thickness),
-                 "height": _r(w.height)}
+                {"id": w.id, "a": canonical_floats(w.a), "b": canonical_floats(w.b),
+                 "thickness": canonical_float(w.thickness),
+                 "height": canonical_float(w.height)}
                 for w in self.walls
             ],
             "doors": [
-                {"id": d.id, "center": _rt(d.center), "width": _r(d.width), "yaw": _r(d.yaw),
-                 "state": d.state, "rooms": list(d.rooms), "height": _r(d.height),
-                 "thickness": _r(d.thickness)}
+                {"id": d.id, "center": canonical_floats(d.center),
+                 "width": canonical_float(d.width), "yaw": canonical_float(d.yaw),
+                 "state": d.state, "rooms": list(d.rooms), "height": canonical_float(d.height),
+                 "thickness": canonical_float(d.thickness)}
                 for d in self.doors
             ],
             "passages": [
-                {"id": p.id, "center": _rt(p.center), "width": _r(p.width), "yaw": _r(p.yaw),
+                {"id": p.id, "center": canonical_floats(p.center),
+                 "width": canonical_float(p.width), "yaw": canonical_float(p.yaw),
                  "rooms": list(p.rooms)}
                 for p in self.passages
             ],
             "furniture": [
                 {"id": f.id, "category": f.category, "synset": f.synset, "room": f.room,
-                 "center": _rt(f.center), "size": _rt(f.size), "yaw": _r(f.yaw),
+                 "center": canonical_floats(f.center), "size": canonical_floats(f.size),
+                 "yaw": canonical_float(f.yaw),
                  "affordances": list(f.affordances), "state": f.state}
                 for f in self.furniture
             ],
             "objects": [
                 {"id": o.id, "category": o.category, "synset": o.synset, "parent": o.parent,
-                 "relation": o.relation, "room": o.room, "position": _rt(o.position),
-                 "size": _rt(o.size)}
+                 "relation": o.relation, "room": o.room, "position": canonical_floats(o.position),
+                 "size": canonical_floats(o.size)}
                 for o in self.objects
             ],
             "starts": [
-                {"x": _r(s.x), "y": _r(s.y), "yaw": _r(s.yaw), "room": s.room}
+                {"x": canonical_float(s.x), "y": canonical_float(s.y),
+                 "yaw": canonical_float(s.yaw), "room": s.room}
                 for s in self.starts
             ],
         }
@@ -301,27 +307,7 @@ class HouseSpec:
 # ----------------------------------------------------------------------------------------
 def save_house(spec: HouseSpec, path: str | os.PathLike[str]) -> Path:
     """Write the canonical JSON atomically (temp file beside ``path``, then rename)."""
-    path = Path(path)
-    text = spec.to_json()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.chmod(tmp, _default_mode())
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
-
-
-def _default_mode() -> int:
-    """0o666 minus the process umask (what open() would give a new file)."""
-    mask = os.umask(0)
-    os.umask(mask)
-    return 0o666 & ~mask
+    return atomic_write(path, spec.to_json())
 
 
 def load_house(source: str | os.PathLike[str] | Mapping[str, Any]) -> HouseSpec:
@@ -451,7 +437,7 @@ def _str(where: str, x: Mapping[str, Any], key: str) -> str:
 def _num(where: str, v: Any) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
         raise SpecError(f"{where}: expected a finite number, got {v!r}")
-    return _r(v)  # canonical precision, so load(to_json(spec)) == spec
+    return canonical_float(v)  # canonical precision, so load(to_json(spec)) == spec
 
 
 def _vec(where: str, v: Any, n: int) -> tuple[float, ...]:
@@ -650,15 +636,6 @@ def placement_problem(obj: SmallObject, parent: Furniture) -> str | None:
 # ----------------------------------------------------------------------------------------
 # geometry helpers
 # ----------------------------------------------------------------------------------------
-def _r(x: float) -> float:
-    v = round(float(x), _ROUND)
-    return 0.0 if v == 0 else v
-
-
-def _rt(xs: Sequence[float]) -> list[float]:
-    return [_r(x) for x in xs]
-
-
 def _signed_area(poly: Sequence[Point]) -> float:
     s = 0.0
     n = len(poly)

@@ -28,7 +28,7 @@ from scipy import ndimage
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from sgtool.datasets.house import HouseSpec
+from sgtool.house.spec import HouseSpec
 
 _SQRT2 = math.sqrt(2.0)
 _TOL = 1e-6

@@ -1,8 +1,8 @@
 """The per-episode record every metric is computed from, and its JSONL file.
 
 One :class:`EpisodeResult` per episode, whatever ran it: the symbolic benchmark
-(:mod:`sgtool.datasets.symbolic`) writes them directly; a closed-loop log is turned into
-one by :func:`result_from_log_records` from its ``sgtool.Episode`` and ``sgtool.Action``
+(:mod:`sgtool.recorders.symbolic_environment`) writes them directly; a closed-loop log is
+turned into one by :func:`result_from_log_records` from its ``sgtool.Episode`` and ``sgtool.Action``
 JSON records (the mapping is documented there).
 
 Determinism: everything in a record is derived data except the ``wall`` mapping (decision
@@ -16,16 +16,16 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import tempfile
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+from sgtool.canonical import canonical_float
 from sgtool.errors import SgtoolError
+from sgtool.files import atomic_write
 
 RESULT_VERSION = "1.0"
-_ROUND = 4
 
 
 class ResultsFormatError(SgtoolError):
@@ -101,14 +101,15 @@ class EpisodeResult:
             "seen": self.seen,
             "success": bool(self.success),
             "steps": int(self.steps),
-            "travelled_m": _r(self.travelled_m),
-            "shortest_m": None if self.shortest_m is None else _r(self.shortest_m),
+            "travelled_m": canonical_float(self.travelled_m),
+            "shortest_m": None if self.shortest_m is None else canonical_float(self.shortest_m),
             "n_open": int(self.n_open),
             "n_invalid": int(self.n_invalid),
             "n_failure": int(self.n_failure),
             "end": self.end,
             "source": self.source,
-            "trace": [[s.skill, s.target, s.outcome, _r(s.travelled_m)] for s in self.trace],
+            "trace": [[s.skill, s.target, s.outcome, canonical_float(s.travelled_m)]
+                      for s in self.trace],
             "wall": {k: round(float(v), 6) for k, v in sorted(self.wall.items())},
         }
 
@@ -149,39 +150,14 @@ class EpisodeResult:
         )
 
 
-def _r(x: float) -> float:
-    v = round(float(x), _ROUND)
-    return 0.0 if v == 0 else v
-
-
 # ----------------------------------------------------------------------------------------
 # files
 # ----------------------------------------------------------------------------------------
 def write_jsonl(results: Iterable[EpisodeResult], path: str | os.PathLike[str]) -> Path:
     """One record per line, written to a temp file beside ``path`` and renamed at the end."""
-    return write_text_atomic(path, "".join(r.to_json() + "\n" for r in results))
+    return atomic_write(path, "".join(r.to_json() + "\n" for r in results))
 
 
-def write_text_atomic(path: str | os.PathLike[str], text: str | bytes) -> Path:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(text.encode("utf-8") if isinstance(text, str) else text)
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual mode
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 def read_jsonl(path: str | os.PathLike[str]) -> list[EpisodeResult]:

@@ -16,7 +16,7 @@ A refresh that would see nothing new (no frame and no instance change since the 
 is not repeated: :meth:`action` then returns ``None`` and :attr:`current` stays the graph
 in force. The room and frontier ids of the builder are history (they follow the previous
 refresh), so two consumers get the same graphs exactly when they call the same methods in
-the same order with the same frames; replay (:mod:`sgtool.replayers.replay`) and the live
+the same order with the same frames; replay (:mod:`sgtool.replayers.derived_log`) and the live
 closed loop both go through this class, and the closed loop feeds it frames as the log
 will hold them (:func:`sgtool.log.echo.as_logged`).
 """

@@ -6,7 +6,7 @@ instance id, and :func:`render` intersects every pixel ray with them (slab test 
 box's frame). Depth is along the optical axis, as :class:`~sgtool.log.frame.Frame` wants,
 because rays are ``(u', v', 1)`` in the camera frame, so the ray parameter is the depth.
 
-:func:`world_of_house` turns a :class:`~sgtool.datasets.house.HouseSpec` into such a world
+:func:`world_of_house` turns a :class:`~sgtool.house.spec.HouseSpec` into such a world
 and an instance table (floor and walls "structure", doors with a lintel above the opening
 and a panel: in the opening when closed, swung by 90 degrees into the door's second
 room when open; furniture; small
@@ -173,7 +173,7 @@ class HouseWorld:
 
 
 def world_of_house(spec: Any, panel_thickness: float = 0.05) -> HouseWorld:
-    """Boxes and instance table of a :class:`~sgtool.datasets.house.HouseSpec` (module doc).
+    """Boxes and instance table of a :class:`~sgtool.house.spec.HouseSpec` (module doc).
     Instance ids: 1 floor, then walls, doors, furniture, small objects in spec order."""
     boxes: list[Box] = []
     infos: list[InstanceInfo] = [InstanceInfo(1, "floor", "structure", spec_id="floor")]
@@ -257,13 +257,13 @@ def walk(points: Sequence[tuple[float, float]], step: float = 0.1
 
 
 def two_room_house(opening: str = "open") -> Any:
-    """A small :class:`~sgtool.datasets.house.HouseSpec` for tests: a kitchen [0, 4] x
+    """A small :class:`~sgtool.house.spec.HouseSpec` for tests: a kitchen [0, 4] x
     [0, 3] and a bedroom [4, 8] x [0, 3] joined at x = 4 (y 1.05-1.95) by an open door
     (``opening="open"``), a closed door (``"closed"``) or a doorless open-plan passage
     (``"passage"``). Kitchen: a closed refrigerator in the corner (0, 0) holding an apple, a
     countertop by the dividing wall at (3.6, 2.6) with a cup on top. Bedroom: a bed along
     the far wall, a closed wardrobe with a sweater inside."""
-    from sgtool.datasets.house import load_house
+    from sgtool.house.spec import load_house
 
     def wall(i: int, a: list[float], b: list[float]) -> dict[str, Any]:
         return {"id": f"wall_{i}", "a": a, "b": b, "thickness": 0.1, "height": 2.5}

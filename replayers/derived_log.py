@@ -1,12 +1,12 @@
 """Replaying a log into scene graphs, frame by frame, and writing the derived log.
 
 :func:`replay` reads a log once, in log-time order (ties in file order, i.e. the order the
-recorder wrote them), and feeds a :class:`~sgtool.replayers.stream.SceneGraphStream`:
+recorder wrote them), and feeds a :class:`~sgtool.scenegraph.stream.SceneGraphStream`:
 instance tables, frames (assembled by :class:`~sgtool.log.reader.FrameAssembler`) and
 action records. With an output it also writes the derived log: a copy of every input
 message (same bytes, same channels and schemas, same order), the input's attachments and
 its ``sgtool`` metadata, and after the message that caused each refresh the derived
-channels of :mod:`sgtool.replayers.layers` at the refresh time. Derived channels of the
+channels of :mod:`sgtool.scenegraph.derived_layers` at the refresh time. Derived channels of the
 input (a log that was already replayed, or a closed-loop log) are not copied: they are
 rebuilt. A metadata record ``sgtool.replay`` holds the options.
 
@@ -29,26 +29,30 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
 from sgtool.log import schemas as S
 from sgtool.log.reader import FRAME_TOPICS, FrameAssembler, LogReader
 from sgtool.log.writer import LogWriter
 from sgtool.mapping.voxels import VoxelConfig
-from sgtool.replayers.layers import DERIVED_TOPICS, write_refresh
-from sgtool.replayers.stream import Refresh, SceneGraphStream
-from sgtool.scenegraph.builder import BuilderConfig
-from sgtool.scenegraph.categories import RoomClassifier
+from sgtool.scenegraph.derived_layers import DERIVED_TOPICS, write_refresh
+from sgtool.scenegraph.options import (
+    CLASSIFIERS,
+    MIN_POINTS_320x240,
+    ResolvedOptions,
+    builder_config,
+    default_min_points,
+)
+from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 
-CLASSIFIERS = ("containment", "frequency", "none")
 REPLAY_METADATA = "sgtool.replay"
 _INSTANCES = S.RECORDS["instances"].topic
 _ACTION = S.RECORDS["action"].topic
 _EPISODE = S.RECORDS["episode"].topic
-MIN_POINTS_320x240 = 50  # MoMa-LLM: an object is seen with > 50 points (256x256 camera)
 
 
 @dataclass(frozen=True)
@@ -60,50 +64,6 @@ class ReplayOptions:
     min_points: int | None = None  # points in one frame for an instance to count as seen
     voxel_size: float | None = None  # m
     max_frames: int | None = None  # stop after this many frames
-
-
-@dataclass(frozen=True)
-class ResolvedOptions:
-    every: int
-    classifier: str
-    min_points: int
-    voxel_size: float
-    max_frames: int | None
-
-    def to_metadata(self) -> dict[str, str]:
-        return {k: "" if v is None else str(v) for k, v in asdict(self).items()}
-
-
-def default_min_points(width: int, height: int) -> int:
-    """MoMa-LLM's 50 points at 320x240, scaled by the pixel count (at least 5)."""
-    return max(5, round(MIN_POINTS_320x240 * width * height / (320 * 240)))
-
-
-def mapping_record(options: ResolvedOptions) -> dict[str, Any]:
-    """What a live builder writes into its Episode record (``extra.mapping``) so that a
-    replay with default options rebuilds its graphs."""
-    return {"every": options.every, "classifier": options.classifier,
-            "min_points": options.min_points, "voxel_size": options.voxel_size}
-
-
-def make_classifier(name: str) -> RoomClassifier | None:
-    if name == "containment":
-        from sgtool.semantics.rooms import ContainmentRoomClassifier
-
-        return ContainmentRoomClassifier()
-    if name == "frequency":
-        from sgtool.scenegraph.categories import FrequencyRoomClassifier
-
-        return FrequencyRoomClassifier.from_training_knowledge()
-    if name == "none":
-        return None
-    raise SgtoolError(f"unknown room classifier {name!r}; one of {', '.join(CLASSIFIERS)}")
-
-
-def builder_config(options: ResolvedOptions) -> BuilderConfig:
-    return BuilderConfig(voxels=VoxelConfig(resolution=options.voxel_size,
-                                            min_points=options.min_points),
-                         refresh_every=options.every)
 
 
 def resolve_options(reader: LogReader, options: ReplayOptions) -> ResolvedOptions:

@@ -1,7 +1,7 @@
 """The symbolic object-search benchmark: SCOUT's SymSearch roll-out over generated houses.
 
 SCOUT (sec. V) evaluates high-level search decisions on scene graphs without a simulator.
-This module turns a :class:`~sgtool.datasets.house.HouseSpec` into that environment:
+This module turns a :class:`~sgtool.house.spec.HouseSpec` into that environment:
 
 **Scene graph of a house** (SCOUT V.B, Fig. 5). Rooms are the spec's rooms. Regions: per
 room, the (x, y) positions of its furniture are clustered by k-means (deterministic
@@ -15,7 +15,7 @@ first-level objects of their region; small objects are nested in their parent fu
 of its own room nearest to it (walkable: free on the occupancy grid dilated by the robot
 radius, in the room's largest free component), i.e. the closest unoccupied point to the
 goal within the same room. Distances are geodesics on the occupancy grid of
-:mod:`sgtool.datasets.occupancy`. To let doors open and close during an episode without
+:mod:`sgtool.mapping.occupancy`. To let doors open and close during an episode without
 re-rasterising, they are computed once on the grid with every door closed (each room, or
 open-plan group, its own component) between all places, plus one place each side of every
 door; an open door joins its two side places with an edge of their straight-line length.
@@ -74,9 +74,8 @@ from scipy import ndimage
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from sgtool.analysis.records import EpisodeResult, Step
-from sgtool.datasets.house import HouseSpec
-from sgtool.datasets.occupancy import (
+from sgtool.house.spec import HouseSpec
+from sgtool.mapping.occupancy import (
     OccupancyMap,
     cell_to_world,
     geodesic_distances,
@@ -84,6 +83,7 @@ from sgtool.datasets.occupancy import (
     world_to_cell,
 )
 from sgtool.planning.base import Action, Feedback, Planner
+from sgtool.results import EpisodeResult, Step
 from sgtool.scenegraph.graph import (
     DoorNode,
     ObjectNode,

@@ -1,0 +1,67 @@
+"""Room-type evidence for the scene-graph builder: room classifiers by name.
+
+``containment`` is the distilled model shipped with sgtool
+(:class:`~sgtool.semantics.room_classification.ContainmentRoomClassifier`); ``frequency`` is
+naive Bayes over the BEHAVIOR-1K training scenes' room inventories, built here because it
+reads the knowledge; ``none`` leaves rooms unclassified.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from sgtool.datasets.generator import HOUSE_ROOM_TYPES
+from sgtool.datasets.split import is_household_scene, training_knowledge
+from sgtool.errors import SgtoolError
+from sgtool.scenegraph.categories import FrequencyRoomClassifier, RoomClassifier
+from sgtool.scenegraph.options import CLASSIFIERS
+from sgtool.semantics.room_classification import ContainmentRoomClassifier
+
+
+def frequency_room_classifier(room_types: Iterable[str] | None = None, alpha: float = 1.0,
+                          small_objects: bool = False) -> FrequencyRoomClassifier:
+    """A :class:`FrequencyRoomClassifier` from
+    :func:`sgtool.datasets.split.training_knowledge`: per room type, in how
+    many rooms of the household training scenes each category occurs (document
+    frequency: a kitchen's eleven cabinets count once, so one category cannot swamp
+    the evidence), restricted to ``room_types`` (default: the room types the house
+    generator uses). ``small_objects`` adds the activity-derived small-object counts
+    per room type.
+
+    Measured on the rooms of twelve evaluation-split houses (seeds 100-111, 8-12 rooms,
+    classified from their furniture; alpha 1): 67% with document frequencies, 55% with
+    raw counts; adding the small-object counts lowers both (52%, 64% -> 49% when the
+    small objects are classified too), so they are off by default."""
+    k = training_knowledge()
+    if room_types is None:
+        room_types = (*HOUSE_ROOM_TYPES, "corridor")
+    wanted = set(room_types)
+    table: dict[str, dict[str, float]] = {r: {} for r in sorted(wanted)}
+    for inv in k.rooms:
+        if inv.room_type not in wanted or not is_household_scene(inv.scene):
+            continue
+        row = table[inv.room_type]
+        for name in sorted({k.name(s) for s, _ in inv.items
+                            if k.kind(s) in ("furniture", "object")}):
+            row[name] = row.get(name, 0.0) + 1.0
+    if small_objects:
+        for room, items in k.room_objects.items():
+            if room not in wanted:
+                continue
+            row = table[room]
+            for synset, n in items:
+                name = k.name(synset)
+                row[name] = row.get(name, 0.0) + float(n)
+    table = {r: row for r, row in table.items() if row}
+    return FrequencyRoomClassifier(table, alpha=alpha)
+
+
+def make_classifier(name: str) -> RoomClassifier | None:
+    """The room classifier a replay or a live builder uses, by name (``CLASSIFIERS``)."""
+    if name == "containment":
+        return ContainmentRoomClassifier()
+    if name == "frequency":
+        return frequency_room_classifier()
+    if name == "none":
+        return None
+    raise SgtoolError(f"unknown room classifier {name!r}; one of {', '.join(CLASSIFIERS)}")
