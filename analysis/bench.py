@@ -143,7 +143,7 @@ _PLANNERS: dict[tuple[str, str], Any] = {}
 def _house(seed: int, rooms: tuple[int, int], episodes: int) -> tuple[Any, list[Any]]:
     from sgtool.datasets.episodes import list_episodes
     from sgtool.datasets.generator import generate_house
-    from sgtool.recorders.symbolic_environment import SymbolicHouse
+    from sgtool.recorders.symbolic_environment.house import SymbolicHouse
 
     key = (seed, rooms)
     hit = _HOUSES.get(key)
@@ -177,7 +177,7 @@ def _unseen() -> frozenset[str]:
 
 
 def _task(args: tuple[BenchConfig, int, str]) -> list[EpisodeResult]:
-    from sgtool.recorders.symbolic_environment import run_episode
+    from sgtool.recorders.symbolic_environment.rollout import run_episode
     from sgtool.semantics.text import category_text
 
     cfg, house_i, name = args

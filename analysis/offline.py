@@ -32,15 +32,18 @@ the logged node lie in the same room), and choices that name no node of the grap
 from __future__ import annotations
 
 import bisect
+import dataclasses
 import math
 import os
 import time
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from sgtool.errors import SgtoolError
+from sgtool.log.records import Absent, Episode, LogRecord, SceneGraphRecord, given
+from sgtool.log.records import Action as LoggedAction
 from sgtool.planning.base import Action, Feedback
 from sgtool.results import EpisodeResult, read_jsonl, result_from_log_records
 from sgtool.scenegraph.graph import DoorNode, SceneGraph
@@ -56,19 +59,19 @@ class EvalInputError(SgtoolError):
 class Decision:
     t_ns: int
     graph: SceneGraph | None
-    action: Mapping[str, Any]
+    action: LoggedAction
 
     @property
     def decided(self) -> bool:
         """False for an action decided on no graph (``graph_time_ns: null``)."""
-        return not ("graph_time_ns" in self.action and self.action["graph_time_ns"] is None)
+        return self.action.decided
 
 
 @dataclass(frozen=True)
 class LoggedEpisode:
     source: str
     index: int  # episode number within its log
-    episode: Mapping[str, Any]  # the closing Episode record (synthesised when missing)
+    episode: Episode  # the closing Episode record (synthesised when missing)
     decisions: tuple[Decision, ...]
 
     def result(self) -> EpisodeResult:
@@ -77,16 +80,14 @@ class LoggedEpisode:
         if not all(d.decided for d in self.decisions):  # decision time over decisions only
             decided = [d.action for d in self.decisions if d.decided]
             r = _replace(r, wall={
-                "decision_s": sum(float(a.get("decision_time_s", 0.0)) for a in decided),
+                "decision_s": sum(float(given(a.decision_time_s, 0.0)) for a in decided),
                 "decisions": float(len(decided))})
-        if "episode" not in (self.episode.get("extra") or {}):
+        if "episode" not in self.episode.extras:
             r = _replace(r, episode=self.index)
         return r
 
 
 def _replace(r: EpisodeResult, **kw: Any) -> EpisodeResult:
-    import dataclasses
-
     return dataclasses.replace(r, **kw)
 
 
@@ -96,14 +97,14 @@ def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
 
     p = Path(path)
     with LogReader(p) as log:
-        stream: list[tuple[int, int, str, Any]] = []
-        for order, kind in enumerate(("scene_graph", "episode", "action")):
+        stream: list[tuple[int, int, LogRecord]] = []
+        for order, kind in enumerate((SceneGraphRecord, Episode, LoggedAction)):
             for t, rec in log.records(kind):
-                stream.append((t, order, kind, rec))
+                stream.append((t, order, rec))
     # at equal times: the graph first, then opening episode records, then actions, then
     # closing episode records
-    def tie_order(x: tuple[int, int, str, Any]) -> tuple[int, int]:
-        closing = x[2] == "episode" and x[3].get("status") in _TERMINAL
+    def tie_order(x: tuple[int, int, LogRecord]) -> tuple[int, int]:
+        closing = isinstance(x[2], Episode) and x[2].status in _TERMINAL
         return (x[0], 3 if closing else x[1])
 
     stream.sort(key=tie_order)
@@ -111,46 +112,52 @@ def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
     graph: SceneGraph | None = None
     graph_times: list[int] = []  # every graph so far, in stream order (non-decreasing times)
     graphs: list[SceneGraph] = []
-    opened: Mapping[str, Any] | None = None
+    opened: Episode | None = None
     decisions: list[Decision] = []
 
-    def close(record: Mapping[str, Any]) -> None:
+    def close(record: Episode) -> None:
         nonlocal decisions, opened
         episodes.append(LoggedEpisode(str(p), len(episodes), record, tuple(decisions)))
         decisions = []
         opened = None
 
-    for t, _, kind, rec in stream:
-        if kind == "scene_graph":
+    for t, _, rec in stream:
+        if isinstance(rec, SceneGraphRecord):
             try:
-                graph = SceneGraph.from_dict(rec)
+                graph = rec.graph()
             except (KeyError, TypeError, ValueError) as e:
                 raise EvalInputError(f"{p}: unreadable scene graph record at {t} ns: {e}") \
                     from None
             graph_times.append(t)
             graphs.append(graph)
-        elif kind == "episode":
-            status = rec.get("status")
-            if status == "started":
+        elif isinstance(rec, Episode):
+            if rec.status == "started":
                 if opened is not None or decisions:
-                    close({**(opened or {}), "status": "ended"})
+                    close(_ended(opened))
                 opened = rec
-            elif status in _TERMINAL:
-                close({**(opened or {}), **rec})
+            elif rec.status in _TERMINAL:
+                close(rec if opened is None else opened.merged(rec))
         else:
+            assert isinstance(rec, LoggedAction)
             decisions.append(Decision(t, _decided_on(rec, graph, graph_times, graphs), rec))
     if opened is not None or decisions:
-        close({**(opened or {"kind": "search"}), "status": "ended"})
+        close(_ended(opened))
     return episodes
 
 
-def _decided_on(action: Mapping[str, Any], latest: SceneGraph | None, times: list[int],
+def _ended(opened: Episode | None) -> Episode:
+    """The closing record of an episode that has none (a killed run)."""
+    return dataclasses.replace(opened or Episode(kind="search", status="ended"),
+                               status="ended")
+
+
+def _decided_on(action: LoggedAction, latest: SceneGraph | None, times: list[int],
                 graphs: list[SceneGraph]) -> SceneGraph | None:
     """The graph an action was decided on (module doc): by its ``graph_time_ns`` when it
     has the field, else ``latest`` (the last graph at or before the action)."""
-    if "graph_time_ns" not in action:
+    t = action.graph_time_ns
+    if isinstance(t, Absent):
         return latest
-    t = action["graph_time_ns"]
     if t is None:
         return None
     i = bisect.bisect_right(times, int(t))
@@ -259,8 +266,8 @@ def replay_decisions(planner: Any, episodes: Sequence[LoggedEpisode],
     out: list[DecisionComparison] = []
     skipped = 0
     for ep in episodes:
-        extra = ep.episode.get("extra") or {}
-        query = ep.episode.get("query")
+        extra = ep.episode.extras
+        query = given(ep.episode.query)
         if not query:
             skipped += len(ep.decisions)
             continue
@@ -268,7 +275,7 @@ def replay_decisions(planner: Any, episodes: Sequence[LoggedEpisode],
         for step, d in enumerate(ep.decisions):
             if not d.decided:
                 continue
-            logged = Action(str(d.action.get("skill", "")), d.action.get("target"))
+            logged = Action(d.action.skill, given(d.action.target))
             if d.graph is not None:
                 t0 = time.perf_counter()
                 chosen = planner.decide(d.graph)
@@ -283,8 +290,8 @@ def replay_decisions(planner: Any, episodes: Sequence[LoggedEpisode],
             else:
                 skipped += 1
             planner.feedback(Feedback(
-                logged, d.action.get("outcome", "success"), str(d.action.get("reason", "")),
-                float(d.action.get("travelled_m", 0.0))))
+                logged, d.action.outcome, str(given(d.action.reason, "")),  # type: ignore[arg-type]
+                float(given(d.action.travelled_m, 0.0))))
     return OfflineReport(name or getattr(planner, "name", "planner"), tuple(out), skipped)
 
 

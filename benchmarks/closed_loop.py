@@ -58,6 +58,7 @@ def main(argv: list[str] | None = None) -> int:
     from sgtool.cli import cli
     from sgtool.datasets import demo_house
     from sgtool.datasets.generator import generate_house
+    from sgtool.planning.registry import make_planner
     from sgtool.recorders.sim import CameraConfig
     from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, run_episode
 
@@ -93,7 +94,8 @@ def main(argv: list[str] | None = None) -> int:
                 path = out / f"{p}_{hid}_ep{k}.mcap"
                 if path.exists() and args.force:
                     path.unlink()
-                rep = run_episode(house, ep, p, path, opts, house_id=hid, episode_index=k)
+                rep = run_episode(house, ep, make_planner(p), path, opts, house_id=hid,
+                                  episode_index=k)
                 rows[p].append(rep)
                 logs.append(str(path))
                 med = 1e3 * statistics.median(rep.decision_times) if rep.decision_times \

@@ -15,11 +15,10 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import tempfile
 import time
 from pathlib import Path
-
-from support.bag_export import write_log_as_bag
 
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.recorders.importers.bag import BagOptions, import_bag
@@ -27,6 +26,9 @@ from sgtool.recorders.importers.images import depth_to_metres, read_color_file, 
 from sgtool.recorders.importers.layouts import read_sequence
 from sgtool.recorders.importers.odometry import METHODS, drift_against, estimate_trajectory
 from sgtool.recorders.importers.rgbd import RgbdOptions, camera_for, import_rgbd
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))  # the test support modules
+from support.bag_export import write_log_as_bag  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 

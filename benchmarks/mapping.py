@@ -34,15 +34,6 @@ import tracemalloc
 from pathlib import Path
 
 import numpy as np
-from support.synthetic_world import (
-    HouseWorld,
-    camera_pose,
-    look_around,
-    render,
-    walk,
-    world_of_house,
-)
-from support.synthetic_world import base_pose as base_of
 
 from sgtool.datasets.generator import generate_house
 from sgtool.datasets.room_evidence import frequency_room_classifier
@@ -52,6 +43,17 @@ from sgtool.mapping.occupancy import astar, house_occupancy
 from sgtool.mapping.voxels import VoxelConfig
 from sgtool.replayers.score import score, score_lines
 from sgtool.scenegraph.builder import BuilderConfig, SceneGraphBuilder
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))  # the test support modules
+from support.synthetic_world import (  # noqa: E402
+    HouseWorld,
+    base_pose,
+    camera_pose,
+    look_around,
+    render,
+    walk,
+    world_of_house,
+)
 
 VFOV = 60.0
 HEIGHT = 1.2
@@ -121,7 +123,7 @@ def frames(arrays: dict[str, np.ndarray], k: CameraIntrinsics, limit: int | None
         x, y, yaw = arrays["poses"][i]
         yield Frame(i, i * 100_000_000, None, np.array(arrays["depth"][i]),
                     np.array(arrays["ids"][i]), camera_pose(x, y, yaw, HEIGHT, PITCH), k,
-                    base_of(x, y, yaw))
+                    base_pose(x, y, yaw))
 
 
 def run(builder: SceneGraphBuilder, frame_iter, compare_every: int = 100

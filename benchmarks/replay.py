@@ -32,7 +32,7 @@ import tracemalloc
 from pathlib import Path
 
 from sgtool.datasets.generator import generate_house
-from sgtool.house.spec import load_house
+from sgtool.house.io import load_house
 from sgtool.log import LogReader
 from sgtool.recorders.sim.recording import RecordOptions, record_house
 from sgtool.replayers.derived_log import ReplayOptions, replay, stage_lines

@@ -2,12 +2,17 @@
 
 Modules (import them directly; this package imports nothing heavy on its own):
 
-- :mod:`sgtool.house.spec`: the versioned JSON house spec, validation, canonical JSON;
-- :mod:`sgtool.mapping.occupancy`: occupancy grid of a house, geodesics, A*;
-- :mod:`sgtool.datasets.knowledge`: tables read from the ``bddl`` package (BEHAVIOR-1K);
+- :mod:`sgtool.house` (core): the versioned JSON house spec (``spec``), its validation
+  (``parse``), ``load_house`` / ``save_house`` (``io``), polygon helpers (``geometry``);
+- :mod:`sgtool.mapping.occupancy` (core): occupancy grid of a house, geodesics, A*;
+- :mod:`sgtool.datasets.knowledge`: tables read from the ``bddl`` package (BEHAVIOR-1K),
+  with :mod:`~sgtool.datasets.synsets` (names, hypernyms) and
+  :mod:`~sgtool.datasets.activities` (the BDDL parser);
 - :mod:`sgtool.datasets.split`: the training / evaluation split of that knowledge;
-- :mod:`sgtool.datasets.generator`: seeded multi-room houses furnished from the knowledge;
-- :mod:`sgtool.datasets.episodes`: object-search episodes with shortest path lengths.
+- :mod:`sgtool.datasets.generator`: seeded multi-room houses furnished from the knowledge
+  (its steps in the modules its docstring lists);
+- :mod:`sgtool.datasets.episodes`: object-search episodes with shortest path lengths;
+- :mod:`sgtool.datasets.demo`: the demo house shipped in ``data/`` and its check.
 """
 
 from __future__ import annotations
@@ -24,10 +29,11 @@ DEMO_HOUSE = "demo_house.json"
 def demo_house() -> HouseSpec:
     """The small house shipped with the package (``data/demo_house.json``).
 
-    It is ``generate_house`` output for a fixed seed; regenerate it with
-    ``python -m sgtool.datasets.demo`` (see :mod:`sgtool.datasets.demo`).
+    Its layout and furniture are ``generate_house`` output for a fixed seed; its small
+    objects and start yaws are an older draw of the generator, kept on purpose. See
+    :mod:`sgtool.datasets.demo` (``python -m sgtool.datasets.demo --check`` checks both).
     """
-    from sgtool.house.spec import load_house
+    from sgtool.house.io import load_house
 
     text = resources.files("sgtool.datasets").joinpath("data", DEMO_HOUSE).read_text("utf-8")
     return load_house(text)

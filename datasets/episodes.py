@@ -23,15 +23,10 @@ from collections import defaultdict
 from dataclasses import dataclass
 
 import numpy as np
-from matplotlib.path import Path as MplPath
 
 from sgtool.house.spec import HouseSpec, StartPose
-from sgtool.mapping.occupancy import (
-    OccupancyMap,
-    cell_centers,
-    geodesic_distances,
-    house_occupancy,
-)
+from sgtool.mapping.occupancy import OccupancyMap, geodesic_distances, house_occupancy
+from sgtool.mapping.raster import cell_centers, polygon_mask
 
 REACH = 1.0
 
@@ -64,16 +59,9 @@ class Episode:
 def room_raster(spec: HouseSpec, occ: OccupancyMap) -> np.ndarray:
     """Int grid: index into ``spec.rooms`` of the room holding each cell centre, -1 outside
     (on a shared border the first room in id order wins, as in :func:`room_at`)."""
-    X, Y = cell_centers(occ)
     out = np.full(occ.shape, -1, np.int32)
-    pts = np.column_stack([X.ravel(), Y.ravel()])
     for i in reversed(range(len(spec.rooms))):
-        poly = np.asarray(spec.rooms[i].polygon, float)
-        area2 = float(np.sum(poly[:, 0] * np.roll(poly[:, 1], -1)
-                             - np.roll(poly[:, 0], -1) * poly[:, 1]))
-        radius = 1e-6 if area2 > 0 else -1e-6
-        inside = MplPath(poly).contains_points(pts, radius=radius).reshape(occ.shape)
-        out[inside] = i
+        out[polygon_mask(occ, spec.rooms[i].polygon)] = i
     return out
 
 

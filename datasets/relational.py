@@ -89,9 +89,9 @@ def sample_negatives(pool: list[str], degree: Counter[str], k: int,
     return [pool[i] for i in sorted(idx.tolist())]
 
 
-def _text(knowledge, synset: str) -> str | None:
+def _synset_text(knowledge, synset: str) -> str | None:
     """Canonical text of a furniture/object synset, None for anything else."""
-    from sgtool.datasets.knowledge import readable_name
+    from sgtool.datasets.synsets import readable_name
 
     if knowledge.kind(synset) not in KINDS:
         return None
@@ -106,18 +106,18 @@ def containment_set(knowledge, seed: int = 0, negatives: str = "uniform") -> Rel
     holding: dict[tuple[str, str], set[str]] = defaultdict(set)
     for r in knowledge.rooms:
         for s, _ in r.items:
-            t = _text(knowledge, s)
+            t = _synset_text(knowledge, s)
             if t is not None:
                 holding[(t, r.room_type)].add(f"{r.scene}/{r.room}")
     scene_share = {k: len(v) / (rooms_of_type[k[1]] + PSEUDO_ROOMS) for k, v in holding.items()}
     # activity placements: (activity, text, room type) once each
     placed: set[tuple[str, str, str]] = set()
     for rel in knowledge.relations:
-        t = _text(knowledge, rel.child)
+        t = _synset_text(knowledge, rel.child)
         if t is not None and rel.room_type is not None:
             placed.add((rel.activity, t, rel.room_type))
     for ir in knowledge.inroom:
-        t = _text(knowledge, ir.synset)
+        t = _synset_text(knowledge, ir.synset)
         if t is not None:
             placed.add((ir.activity, t, ir.room_type))
     per_obj: Counter[str] = Counter(t for _, t, _ in placed)
@@ -154,7 +154,7 @@ def place_units(knowledge) -> list[frozenset[str]]:
     through ``inside``/``ontop`` on something in that room)."""
     units: list[frozenset[str]] = []
     for r in knowledge.rooms:
-        items = frozenset(t for s, _ in r.items if (t := _text(knowledge, s)) is not None)
+        items = frozenset(t for s, _ in r.items if (t := _synset_text(knowledge, s)) is not None)
         if items:
             units.append(items)
     by_room: dict[tuple[str, str], set[str]] = defaultdict(set)
@@ -162,10 +162,10 @@ def place_units(knowledge) -> list[frozenset[str]]:
         if rel.room_type is None:
             continue
         for s in (rel.child, rel.parent):
-            if (t := _text(knowledge, s)) is not None:
+            if (t := _synset_text(knowledge, s)) is not None:
                 by_room[(rel.activity, rel.room_type)].add(t)
     for ir in knowledge.inroom:
-        if (t := _text(knowledge, ir.synset)) is not None:
+        if (t := _synset_text(knowledge, ir.synset)) is not None:
             by_room[(ir.activity, ir.room_type)].add(t)
     units.extend(frozenset(v) for _, v in sorted(by_room.items()) if v)
     return units
@@ -180,7 +180,7 @@ def cooccurrence_labels(knowledge) -> tuple[set[tuple[str, str]], set[tuple[str,
 
     siblings: dict[tuple[str, str], set[str]] = defaultdict(set)
     for rel in knowledge.relations:
-        c, p = _text(knowledge, rel.child), _text(knowledge, rel.parent)
+        c, p = _synset_text(knowledge, rel.child), _synset_text(knowledge, rel.parent)
         if c and p and c != p:
             direct[key(c, p)].add(rel.activity)
         if c is not None:
@@ -217,7 +217,7 @@ def cooccurrence_set(knowledge, seed: int = 0, negatives: str = "popular") -> Re
     near: dict[str, set[str]] = defaultdict(set)
     for o, q in related:
         near[q].add(o)
-    vocab = sorted({t for s in knowledge.vocabulary() if (t := _text(knowledge, s))})
+    vocab = sorted({t for s in knowledge.vocabulary() if (t := _synset_text(knowledge, s))})
     if negatives not in ("popular", "uniform"):
         raise ValueError(f"negatives must be 'popular' or 'uniform', not {negatives!r}")
     degree: Counter[str] = Counter(o for o, _ in pos) if negatives == "popular" else Counter()

@@ -19,7 +19,7 @@ from sgtool.semantics.room_classification import ContainmentRoomClassifier
 
 
 def frequency_room_classifier(room_types: Iterable[str] | None = None, alpha: float = 1.0,
-                          small_objects: bool = False) -> FrequencyRoomClassifier:
+                              small_objects: bool = False) -> FrequencyRoomClassifier:
     """A :class:`FrequencyRoomClassifier` from
     :func:`sgtool.datasets.split.training_knowledge`: per room type, in how
     many rooms of the household training scenes each category occurs (document

@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from types import MappingProxyType
 
-from sgtool.datasets.knowledge import ancestors
+from sgtool.datasets.synsets import synset_catalogue
 
 Size = tuple[float, float, float]
 
@@ -139,8 +139,6 @@ def furniture_size(synset: str) -> Size:
 
 def object_size(synset: str) -> Size:
     """Size of a small object from the nearest ancestor with a known size."""
-    from sgtool.datasets.knowledge import synset_catalogue
-
     cat = synset_catalogue()
     # breadth-first over the hypernyms so the nearest ancestor wins
     frontier = [synset]
@@ -157,7 +155,3 @@ def object_size(synset: str) -> Size:
                     nxt.append(h)
         frontier = nxt
     return DEFAULT_OBJECT_SIZE
-
-
-def is_a(synset: str, ancestor: str) -> bool:
-    return ancestor in ancestors(synset)

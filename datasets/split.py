@@ -32,7 +32,8 @@ from __future__ import annotations
 import functools
 import hashlib
 
-from sgtool.datasets.knowledge import Knowledge, build_knowledge, raw_records, readable_name
+from sgtool.datasets.knowledge import Knowledge, build_knowledge, raw_records
+from sgtool.datasets.synsets import readable_name
 
 SALT = "sgtool-split-v1:"
 EVAL_EVERY = 3  # one in three goes to evaluation
@@ -46,12 +47,12 @@ def scene_family(scene: str) -> str:
     return scene.split("_", 1)[0]
 
 
-def _key(name: str) -> str:
+def _hash_key(name: str) -> str:
     return hashlib.sha256((SALT + name).encode("utf-8")).hexdigest()
 
 
 def _every_third(names: list[str]) -> set[str]:
-    order = sorted(names, key=lambda n: (_key(n), n))
+    order = sorted(names, key=lambda n: (_hash_key(n), n))
     return {n for i, n in enumerate(order) if i % EVAL_EVERY == EVAL_EVERY - 1}
 
 
@@ -70,14 +71,6 @@ def evaluation_activities() -> frozenset[str]:
     return frozenset(_every_third(list(raw_records().activities)))
 
 
-def split_of_scene(scene: str) -> str:
-    return "eval" if scene in evaluation_scenes() else "train"
-
-
-def split_of_activity(activity: str) -> str:
-    return "eval" if activity in evaluation_activities() else "train"
-
-
 def is_household_scene(scene: str) -> bool:
     """Homes and hotel suites (not offices, shops, restaurants, schools, gardens)."""
     fam = scene_family(scene)
@@ -86,7 +79,7 @@ def is_household_scene(scene: str) -> bool:
     return not (fam == "hotel" and "suite" not in scene)
 
 
-def _part(which: str) -> Knowledge:
+def _knowledge_part(which: str) -> Knowledge:
     raw = raw_records()
     ev_s, ev_a = evaluation_scenes(), evaluation_activities()
     want = which == "eval"
@@ -104,13 +97,13 @@ def _part(which: str) -> Knowledge:
 @functools.cache
 def training_knowledge() -> Knowledge:
     """What planners may learn from."""
-    return _part("train")
+    return _knowledge_part("train")
 
 
 @functools.cache
 def evaluation_knowledge() -> Knowledge:
     """What furnishes benchmark houses (``--split eval``)."""
-    return _part("eval")
+    return _knowledge_part("eval")
 
 
 def knowledge_for(split: str) -> Knowledge:

@@ -2,7 +2,7 @@
 
 :func:`replay` reads a log once, in log-time order (ties in file order, i.e. the order the
 recorder wrote them), and feeds a :class:`~sgtool.scenegraph.stream.SceneGraphStream`:
-instance tables, frames (assembled by :class:`~sgtool.log.reader.FrameAssembler`) and
+instance tables, frames (assembled by :class:`~sgtool.log.assembly.FrameAssembler`) and
 action records. With an output it also writes the derived log: a copy of every input
 message (same bytes, same channels and schemas, same order), the input's attachments and
 its ``sgtool`` metadata, and after the message that caused each refresh the derived
@@ -36,7 +36,9 @@ from typing import Any
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
 from sgtool.log import schemas as S
-from sgtool.log.reader import FRAME_TOPICS, FrameAssembler, LogReader
+from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler
+from sgtool.log.reader import LogReader
+from sgtool.log.records import Episode, Instances
 from sgtool.log.writer import LogWriter
 from sgtool.mapping.voxels import VoxelConfig
 from sgtool.scenegraph.derived_layers import DERIVED_TOPICS, write_refresh
@@ -69,8 +71,8 @@ class ReplayOptions:
 def resolve_options(reader: LogReader, options: ReplayOptions) -> ResolvedOptions:
     """Fill the unset options from the log's Episode record, else the defaults."""
     recorded: dict[str, Any] = {}
-    for _, rec in reader.records("episode"):
-        m = (rec.get("extra") or {}).get("mapping")
+    for _, rec in reader.records(Episode):
+        m = rec.extras.get("mapping")
         if isinstance(m, dict):
             recorded = m
             break
@@ -240,7 +242,8 @@ def _run(reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
                 if not take_frame(asm.flush()):
                     break
                 if topic == _INSTANCES:
-                    stream.instances(t, decoded)
+                    stream.instances(t, Instances.from_json(
+                        decoded, where=f"{reader.path}: {Instances.describe(t_ns=t)}"))
                 else:
                     refreshed(stream.action(t))
         if writer is not None and topic not in DERIVED_TOPICS:

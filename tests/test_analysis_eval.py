@@ -18,7 +18,7 @@ from sgtool.analysis.offline import (
     replay_decisions,
 )
 from sgtool.cli import cli
-from sgtool.house.spec import load_house
+from sgtool.house.io import load_house
 from sgtool.log.writer import LogWriter
 from sgtool.planning.registry import make_planner
 from sgtool.recorders.symbolic_environment import SymbolicHouse, run_episode

@@ -9,6 +9,7 @@ import pytest
 from sgtool.analysis.curves import plot_efficiency
 from sgtool.analysis.metrics import COST_MODELS, STEP_COST, seen_unseen, summarize
 from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
+from sgtool.log.records import Action, Episode
 from sgtool.results import (
     EpisodeResult,
     ResultsFormatError,
@@ -72,11 +73,12 @@ def test_result_from_log_records_derives_counts():
         {"skill": "open", "target": "obj:5", "outcome": "invalid", "travelled_m": 0.0,
          "decision_time_s": 0.01},
     ]
+    episode, actions = Episode.from_json(episode), [Action.from_json(a) for a in actions]
     r = result_from_log_records(episode, actions)
     assert (r.success, r.steps, r.n_open, r.n_invalid, r.seed, r.episode, r.seen) == (
         True, 3, 1, 1, 4, 1, True)
     assert r.decision_s == pytest.approx(0.06) and r.decisions == 3
-    r2 = result_from_log_records({"kind": "search", "status": "failure"}, actions)
+    r2 = result_from_log_records(Episode(kind="search", status="failure"), actions)
     assert not r2.success and r2.steps == 3 and r2.travelled_m == pytest.approx(6.5)
     assert r2.shortest_m is None and r2.planner == "unknown"
 

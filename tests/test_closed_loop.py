@@ -206,7 +206,7 @@ def test_same_inputs_same_log_but_decision_times(scout_log, house, tmp_path) -> 
     path, _ = scout_log
     idx, ep = pick_episode(house, index=0)
     again = tmp_path / "again.mcap"
-    rep = run_episode(house, ep, "scout", again, OPTS, house_id=f"house-{SEED}",
+    rep = run_episode(house, ep, make_planner("scout"), again, OPTS, house_id=f"house-{SEED}",
                       episode_index=idx)
     assert rep.success and rep.end == "found"
     assert messages(path, [GRAPH]) == messages(again, [GRAPH])
@@ -217,7 +217,7 @@ def test_same_inputs_same_log_but_decision_times(scout_log, house, tmp_path) -> 
 def test_random_episode(house, tmp_path) -> None:
     idx, ep = pick_episode(house, index=3)
     out = tmp_path / "random.mcap"
-    rep = run_episode(house, ep, "random", out, ClosedLoopOptions(
+    rep = run_episode(house, ep, make_planner("random"), out, ClosedLoopOptions(
         camera=OPTS.camera, max_steps=3, planner_seed=1), episode_index=idx)
     assert 1 <= rep.steps <= 3 and rep.end in ("found", "max_steps")
     (logged,) = read_log_episodes(out)
@@ -273,7 +273,7 @@ def test_invalid_targets_and_done_in_the_loop(house, tmp_path) -> None:
 def test_frame_budget_cuts_the_episode(house, tmp_path) -> None:
     idx, ep = pick_episode(house, index=0)
     out = tmp_path / "budget.mcap"
-    rep = run_episode(house, ep, "greedy", out, ClosedLoopOptions(camera=OPTS.camera,
+    rep = run_episode(house, ep, make_planner("greedy"), out, ClosedLoopOptions(camera=OPTS.camera,
                                                                    frames=25))
     assert (rep.frames, rep.end, rep.success) == (25, "frames", False)
     with LogReader(out) as r:
@@ -317,10 +317,9 @@ def test_moma_llm_episode_and_its_replay(house, tmp_path) -> None:
     live = tmp_path / "moma.mcap"
     opts = ClosedLoopOptions(camera=OPTS.camera, max_steps=2)
     with ChatServer(responder=responder) as srv:
-        rep = run_episode(house, ep, "moma-llm", live, opts, episode_index=idx,
-                          planner_options={"base_url": srv.base_url, "model": "scripted",
-                                           "api_key": "test", "timeout_s": 10.0,
-                                           "transcript": str(transcript)})
+        moma = make_planner("moma-llm", base_url=srv.base_url, model="scripted",
+                            api_key="test", timeout_s=10.0, transcript=str(transcript))
+        rep = run_episode(house, ep, moma, live, opts, episode_index=idx)
         assert not srv.errors
     assert rep.steps >= 1
     with LogReader(live) as r:

@@ -11,7 +11,7 @@ from datasets_fixtures import two_rooms
 
 import sgtool.datasets as ds
 from sgtool.datasets.episodes import EpisodeGeometry, list_episodes
-from sgtool.house.spec import load_house
+from sgtool.house.io import load_house
 from sgtool.mapping.occupancy import astar, path_length, world_to_cell
 
 

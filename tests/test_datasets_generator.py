@@ -12,13 +12,16 @@ import numpy as np
 import pytest
 
 import sgtool.datasets as ds
-from sgtool.datasets.demo import build_demo
+from sgtool.datasets.demo import build_demo, layout_differences
+from sgtool.datasets.demo import main as demo_main
 from sgtool.datasets.episodes import EpisodeGeometry
 from sgtool.datasets.generator import generate_house
-from sgtool.datasets.knowledge import ancestors
 from sgtool.datasets.split import evaluation_knowledge, training_knowledge
+from sgtool.datasets.synsets import ancestors
 from sgtool.errors import SgtoolError
-from sgtool.house.spec import load_house, placement_problem, point_in_polygon
+from sgtool.house.geometry import point_in_polygon
+from sgtool.house.io import load_house
+from sgtool.house.spec import placement_problem
 from sgtool.mapping.occupancy import geodesic_distances
 
 CASES = [(0, (4, 12)), (1, (4, 12)), (2, (4, 4)), (3, (12, 12)), (4, (6, 9)), (5, (4, 12)),
@@ -199,9 +202,14 @@ def test_demo_house_is_shipped_and_matches_the_generator_layout():
     # small objects (and the start yaws drawn after them) are the placement before small
     # objects followed their room type (see sgtool.datasets.demo): kept on purpose, so the
     # demo's recorded figures and the tests built on its first frames stay comparable
-    shipped, today = spec.to_dict(), build_demo().to_dict()
-    for key in ("rooms", "walls", "doors", "passages", "furniture"):
-        assert shipped[key] == today[key], key
+    assert layout_differences(spec, build_demo()) == []
+    assert spec.objects != build_demo().objects  # the older draw: say so if this changes
+
+
+def test_demo_check_passes_and_says_what_holds(capsys):
+    assert demo_main(["--check"]) == 0
+    out = capsys.readouterr().out
+    assert "up to date" in out and "older draw" in out
 
 
 TABLEWARE = frozenset({"bowl", "plate", "mug", "wineglass", "beer glass", "water glass",
@@ -247,12 +255,12 @@ def test_bathrooms_hold_no_tableware():
 
 
 def test_candidates_weigh_room_type_evidence_only():
-    from sgtool.datasets.generator import _candidates
+    from sgtool.datasets.object_candidates import candidates
 
-    names, w = _candidates("eval", "cabinet.n.01", "inside", "bathroom")
+    names, w = candidates("eval", "cabinet.n.01", "inside", "bathroom")
     assert "bowl.n.01" not in names and "bar_soap.n.01" in names
-    names, w = _candidates("eval", "cabinet.n.01", "inside", "kitchen")
+    names, w = candidates("eval", "cabinet.n.01", "inside", "kitchen")
     best = [n for _, n in sorted(zip(-w, names, strict=True))][:3]
     assert "bowl.n.01" in best  # the kitchen's own evidence
-    names, w = _candidates("eval", "wardrobe.n.01", "inside", "entryway")
+    names, w = candidates("eval", "wardrobe.n.01", "inside", "entryway")
     assert names == () and w.size == 0  # no evidence: the piece stays empty

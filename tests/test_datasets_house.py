@@ -12,7 +12,8 @@ import pytest
 from datasets_fixtures import two_rooms
 
 from sgtool.errors import SpecError
-from sgtool.house.spec import HouseSpec, load_house, room_at, save_house
+from sgtool.house.io import load_house, save_house
+from sgtool.house.spec import HouseSpec, room_at
 from sgtool.mapping.occupancy import (
     astar,
     cell_to_world,

@@ -10,13 +10,9 @@ from collections import Counter
 
 import pytest
 
-from sgtool.datasets.knowledge import (
-    bddl_root,
-    load_knowledge,
-    negated_relation_counts,
-    parse_activity,
-    readable_name,
-)
+from sgtool.datasets.activities import parse_activity
+from sgtool.datasets.knowledge import load_knowledge, negated_relation_counts
+from sgtool.datasets.synsets import bddl_root, readable_name
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import hashlib
 
-from sgtool.datasets.knowledge import load_knowledge, readable_name
+from sgtool.datasets.knowledge import load_knowledge
 from sgtool.datasets.split import (
     SALT,
     evaluation_knowledge,
@@ -16,6 +16,7 @@ from sgtool.datasets.split import (
     training_knowledge,
     unseen_queries,
 )
+from sgtool.datasets.synsets import readable_name
 
 
 def test_parts_are_disjoint_and_complete():

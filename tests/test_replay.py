@@ -22,6 +22,7 @@ from sgtool.cli import cli
 from sgtool.log import LogReader, LogWriter
 from sgtool.log import schemas as S
 from sgtool.log.echo import as_logged
+from sgtool.log.records import Instances
 from sgtool.replayers.derived_log import ReplayOptions, replay
 from sgtool.scenegraph.derived_layers import DERIVED_TOPICS, _hull
 from sgtool.scenegraph.graph import SceneGraph
@@ -174,7 +175,7 @@ def test_a_stream_fed_live_equals_the_replay_of_its_log(tmp_path):
     """What the closed loop does: build from frames while logging them."""
     log = synthetic_log(tmp_path / "live.mcap")
     with LogReader(log) as r:
-        table = r.last_record("instances")
+        table = r.last_record(Instances)
         frames = list(r.frames())
         actions = [t for t, _ in r.records("action")]
     hw = world_of_house(two_room_house("open"))

@@ -202,19 +202,17 @@ def test_empty_narrow_rooms_are_corridors() -> None:
 
     from sgtool.mapping.bev import OccupancyGrid
     from sgtool.mapping.voronoi import voronoi_graph
-    from sgtool.scenegraph.instances import InstanceInfo
+    from sgtool.scenegraph.room_nodes import corridor_like
 
     def walled(w: float, h: float) -> OccupancyGrid:
         g = np.full((int(h / 0.05) + 4, int(w / 0.05) + 4), 100, dtype=np.int8)
         g[2:-2, 2:-2] = 0
         return OccupancyGrid(g, (-0.1, -0.1), 0.05)
 
-    b = SceneGraphBuilder({1: InstanceInfo(1, "wall", "structure")}, None, CONFIG)
     corridor = voronoi_graph(walled(6.0, 1.4))
     room = voronoi_graph(walled(4.0, 3.0))
     short = voronoi_graph(walled(2.0, 1.4))
-    assert b._corridor_like(corridor, np.arange(len(corridor)))
-    assert not b._corridor_like(room, np.arange(len(room)))
-    assert not b._corridor_like(short, np.arange(len(short)))
-    assert not SceneGraphBuilder(None, None, CONFIG)._corridor_like(
-        corridor, np.arange(len(corridor)))
+    assert corridor_like(corridor, np.arange(len(corridor)), CONFIG)
+    assert not corridor_like(room, np.arange(len(room)), CONFIG)
+    assert not corridor_like(short, np.arange(len(short)), CONFIG)
+    assert not corridor_like(corridor, np.arange(len(corridor)), CONFIG, semantic=False)

@@ -12,7 +12,7 @@ from click.testing import CliRunner
 from sgtool.cli import cli
 from sgtool.datasets.generator import generate_house
 from sgtool.datasets.stats import house_stats
-from sgtool.house.spec import load_house
+from sgtool.house.io import load_house
 
 
 def test_generate_is_byte_stable(tmp_path):

@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import math
 
-from sgtool.house.spec import HouseSpec, load_house
+from sgtool.house.io import load_house
+from sgtool.house.spec import HouseSpec
 from sgtool.recorders.sim.instances import instance_table
 
 

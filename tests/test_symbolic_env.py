@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from symbolic_fixtures import three_rooms
 
-from sgtool.house.spec import load_house
+from sgtool.house.io import load_house
 from sgtool.mapping.occupancy import house_occupancy, shortest_path_length
 from sgtool.planning.base import Action, Feedback
 from sgtool.recorders.symbolic_environment import (

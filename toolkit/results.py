@@ -2,8 +2,8 @@
 
 One :class:`EpisodeResult` per episode, whatever ran it: the symbolic benchmark
 (:mod:`sgtool.recorders.symbolic_environment`) writes them directly; a closed-loop log is
-turned into one by :func:`result_from_log_records` from its ``sgtool.Episode`` and ``sgtool.Action``
-JSON records (the mapping is documented there).
+turned into one by :func:`result_from_log_records` from its typed ``sgtool.Episode`` and
+``sgtool.Action`` records (:mod:`sgtool.log.records`; the mapping is documented there).
 
 Determinism: everything in a record is derived data except the ``wall`` mapping (decision
 and episode wall-clock seconds). Two runs of one command give the same JSONL bytes except
@@ -17,13 +17,15 @@ import hashlib
 import json
 import os
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from sgtool.canonical import canonical_float
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write
+from sgtool.log.records import Action as LoggedAction
+from sgtool.log.records import Episode, given
 
 RESULT_VERSION = "1.0"
 
@@ -201,7 +203,7 @@ def results_digest(results: Sequence[EpisodeResult]) -> str:
 # ----------------------------------------------------------------------------------------
 # from log records
 # ----------------------------------------------------------------------------------------
-def result_from_log_records(episode: Mapping[str, Any], actions: Sequence[Mapping[str, Any]],
+def result_from_log_records(episode: Episode, actions: Sequence[LoggedAction],
                             source: str = "log") -> EpisodeResult:
     """An :class:`EpisodeResult` from the records of one episode of a log.
 
@@ -215,33 +217,30 @@ def result_from_log_records(episode: Mapping[str, Any], actions: Sequence[Mappin
     ``n_invalid`` / ``n_failure`` = actions with that outcome; ``steps`` = number of
     actions; ``travelled_m`` = sum over actions.
     """
-    extra = episode.get("extra") or {}
+    extra = episode.extras
     trace = tuple(
-        Step(str(a.get("skill", "")), a.get("target"), str(a.get("outcome", "")),
-             float(a.get("travelled_m", 0.0)))
+        Step(a.skill, given(a.target), a.outcome, float(given(a.travelled_m, 0.0)))
         for a in actions
     )
-    status = episode.get("status")
-    steps = episode.get("steps")
-    travelled = episode.get("travelled_m")
+    status = episode.status
     n_open = extra.get("n_open")
     if n_open is None:
         n_open = sum(1 for s in trace if s.skill == "open" and s.outcome == "success")
-    decision_s = sum(float(a.get("decision_time_s", 0.0)) for a in actions)
+    decision_s = sum(float(given(a.decision_time_s, 0.0)) for a in actions)
     seen = extra.get("seen")
+    shortest = given(episode.shortest_m)
     return EpisodeResult(
-        planner=str(episode.get("planner") or next(
-            (a.get("planner") for a in actions if a.get("planner")), "unknown")),
+        planner=str(given(episode.planner) or next(
+            (a.planner for a in actions if given(a.planner)), "unknown")),
         seed=int(extra.get("seed", 0)),
-        house=str(episode.get("house_id") or ""),
+        house=str(given(episode.house_id, "")),
         episode=int(extra.get("episode", 0)),
-        query=str(episode.get("query") or ""),
+        query=str(given(episode.query, "")),
         seen=None if seen is None else bool(seen),
         success=status == "success",
-        steps=int(steps if steps is not None else len(trace)),
-        travelled_m=float(travelled if travelled is not None
-                          else sum(s.travelled_m for s in trace)),
-        shortest_m=None if episode.get("shortest_m") is None else float(episode["shortest_m"]),
+        steps=int(given(episode.steps, len(trace))),
+        travelled_m=float(given(episode.travelled_m, sum(s.travelled_m for s in trace))),
+        shortest_m=None if shortest is None else float(shortest),
         n_open=int(n_open),
         n_invalid=sum(1 for s in trace if s.outcome == "invalid"),
         n_failure=sum(1 for s in trace if s.outcome == "failure"),
@@ -250,6 +249,3 @@ def result_from_log_records(episode: Mapping[str, Any], actions: Sequence[Mappin
         trace=trace,
         wall={"decision_s": decision_s, "decisions": float(len(actions))},
     )
-
-
-RESULT_FIELDS = tuple(f.name for f in fields(EpisodeResult))

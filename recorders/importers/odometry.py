@@ -69,6 +69,7 @@ pixel exactly on Open3D's depth-difference bound.
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
@@ -376,3 +377,39 @@ def estimate_trajectory(
     if times_ns is not None and len(times_ns) != len(poses):
         raise ValueError(f"{len(times_ns)} frame times for {len(poses)} frames")
     return OdometryResult(tuple(poses), method, tuple(failed), limits)
+
+
+def estimate_with_progress(
+    frames: Iterable[tuple[np.ndarray | None, np.ndarray]],
+    intrinsics: CameraIntrinsics,
+    total: int,
+    *,
+    method: str,
+    start: np.ndarray | None,
+    depth_max: float,
+    times_ns: Sequence[int],
+    progress: bool,
+) -> OdometryResult:
+    """:func:`estimate_trajectory` of ``total`` frames behind a progress bar on stderr
+    (none when ``progress`` is False)."""
+    from tqdm import tqdm
+
+    bar = tqdm(total=total, unit="frame", desc="odometry", file=sys.stderr,
+               disable=None if progress else True, leave=False)
+    try:
+        return estimate_trajectory(frames, intrinsics, method=method, start=start,
+                                   depth_max=depth_max, times_ns=times_ns,
+                                   progress=lambda i: bar.update(1))
+    finally:
+        bar.close()
+
+
+def drift_where_known(estimated: Sequence[np.ndarray],
+                      reference: Sequence[np.ndarray | None]) -> DriftReport | None:
+    """The drift of ``estimated`` against the frames that have a ``reference`` pose (None:
+    that frame has none); None when fewer than two have one."""
+    known = [i for i, p in enumerate(reference) if p is not None]
+    if len(known) < 2:
+        return None
+    return drift_against([estimated[i] for i in known],
+                         [reference[i] for i in known])  # type: ignore[misc]

@@ -35,8 +35,8 @@ from sgtool.recorders.importers.layouts import FolderFrame, FolderSequence, read
 from sgtool.recorders.importers.odometry import (
     DriftReport,
     OdometryResult,
-    drift_against,
-    estimate_trajectory,
+    drift_where_known,
+    estimate_with_progress,
 )
 from sgtool.recorders.importers.sink import (
     ImportFrame,
@@ -47,9 +47,7 @@ from sgtool.recorders.importers.sink import (
     write_log,
 )
 from sgtool.recorders.importers.textformats import PinholeParams
-from sgtool.recorders.importers.upright import DepthSample, estimate_alignment
-
-ALIGNMENT_SAMPLES = 8
+from sgtool.recorders.importers.upright import DepthSample, estimate_alignment, sample_indices
 
 
 @dataclass(frozen=True)
@@ -124,11 +122,7 @@ def run_odometry(
     frames: list[FolderFrame], k: CameraIntrinsics, scale: float, opts: RgbdOptions,
     start: np.ndarray | None,
 ) -> OdometryResult:
-    from tqdm import tqdm
-
     size = (k.width, k.height)
-    bar = tqdm(total=len(frames), unit="frame", desc="odometry", disable=None if opts.progress
-               else True, leave=False)
 
     def gen():  # type: ignore[no-untyped-def]
         for fr in frames:
@@ -137,13 +131,9 @@ def run_odometry(
 
     if opts.odometry == "rgbd" and any(f.color_path is None for f in frames):
         raise SgtoolError("--odometry rgbd needs a colour image for every frame; use icp")
-    try:
-        return estimate_trajectory(gen(), k, method=opts.odometry, start=start,
-                                   depth_max=opts.depth_max,
-                                   times_ns=[f.time_ns for f in frames],
-                                   progress=lambda i: bar.update(1))
-    finally:
-        bar.close()
+    return estimate_with_progress(gen(), k, len(frames), method=opts.odometry, start=start,
+                                  depth_max=opts.depth_max,
+                                  times_ns=[f.time_ns for f in frames], progress=opts.progress)
 
 
 def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = None) -> ImportReport:
@@ -173,9 +163,7 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         poses = list(odo.poses)
         if odo.warning():
             notes.append(str(odo.warning()))
-        idx = [i for i, p in enumerate(source_poses) if p is not None]
-        if len(idx) >= 2:
-            drift = drift_against([poses[i] for i in idx], [source_poses[i] for i in idx])
+        drift = drift_where_known(poses, source_poses)
         pose_source = f"estimated by {odo.method} odometry"
         if seq.pose_source != "none":
             pose_source += f" (the dataset's {seq.pose_source} kept for the drift)"
@@ -183,11 +171,9 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         poses = [np.asarray(p) for p in source_poses]
         pose_source = f"{seq.pose_source} of the dataset"
 
-    picks = np.unique(np.linspace(0, len(frames) - 1, min(ALIGNMENT_SAMPLES, len(frames)))
-                      .round().astype(int))
     samples = [
         DepthSample(depth_to_metres(read_depth_file(frames[i].depth_path), scale), k, poses[i])
-        for i in picks
+        for i in sample_indices(len(frames))
     ]
     alignment = estimate_alignment(poses, samples, up=opts.up, floor=opts.floor,
                                    floor_auto=opts.floor_auto)

@@ -27,6 +27,7 @@ import numpy as np
 
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
+from sgtool.log.records import Episode
 from sgtool.log.writer import LogWriter
 from sgtool.recorders.importers.odometry import DriftReport, OdometryResult
 from sgtool.recorders.importers.upright import WorldAlignment
@@ -116,10 +117,9 @@ def write_log(
             for fr in frames:
                 if n == 0:
                     first_t = fr.time_ns
-                    w.write_record("episode", fr.time_ns, {
-                        "kind": "import", "status": "started",
-                        "source": meta.get("source", ""), "frames": 0,
-                    })
+                    w.write_record(Episode(kind="import", status="started",
+                                           source=meta.get("source", ""), frames=0),
+                                   fr.time_ns)
                 w.write_frame(fr.time_ns, depth=fr.depth, pose=A @ fr.pose,
                               intrinsics=fr.intrinsics, rgb=fr.rgb, ids=fr.ids)
                 has_rgb |= fr.rgb is not None
@@ -131,11 +131,10 @@ def write_log(
             bar.close()
         if n == 0:
             raise SgtoolError("nothing to import: no frame has both a depth image and a pose")
-        w.write_record("episode", max(last_t, first_t), {
-            "kind": "import", "status": "ended", "source": meta.get("source", ""),
-            "frames": n, "extra": {"notes": list(notes), "instance_ids": has_ids,
-                                   "colour": has_rgb},
-        })
+        w.write_record(Episode(
+            kind="import", status="ended", source=meta.get("source", ""), frames=n,
+            extra={"notes": list(notes), "instance_ids": has_ids, "colour": has_rgb},
+        ), max(last_t, first_t))
     return n, has_rgb, has_ids
 
 

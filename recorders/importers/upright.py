@@ -169,6 +169,15 @@ def camera_up(poses: Sequence[np.ndarray]) -> np.ndarray:
     return m / n
 
 
+ALIGNMENT_SAMPLES = 8  # depth frames whose surfaces the alignment looks at
+
+
+def sample_indices(n: int, k: int = ALIGNMENT_SAMPLES) -> list[int]:
+    """``k`` indices spread evenly over ``n`` frames (first and last included), sorted and
+    distinct: the frames an importer hands to :func:`estimate_alignment`."""
+    return np.unique(np.linspace(0, n - 1, min(k, n)).round().astype(int)).tolist()
+
+
 def estimate_alignment(
     poses: Sequence[np.ndarray],
     samples: Sequence[DepthSample],

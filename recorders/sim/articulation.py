@@ -110,12 +110,6 @@ def swing_choices(door: Door, preferred_side: int,
         [c for c, ok in zip(choices, clear, strict=True) if not ok]
 
 
-def choose_door_swing(door: Door, preferred_side: int,
-                      obstacles: Sequence[Box2]) -> tuple[int, int]:
-    """The first of :func:`swing_choices`."""
-    return swing_choices(door, preferred_side, obstacles)[0]
-
-
 # ----------------------------------------------------------------------------------------
 # containers
 # ----------------------------------------------------------------------------------------

@@ -45,28 +45,12 @@ exchanges (so the file bytes differ too, through the compressed chunks; every me
 every other channel is identical, the scene graphs included). The writer writes
 ``OUT.partial`` and renames it at the end: an error leaves no half-written log.
 
-Mapping planner actions to skills (:func:`plan_skills`, pure):
-
-=========================================  ===============================================
-action                                     simulator calls
-=========================================  ===============================================
-``navigate(obj:N | door:N)``               ``navigate(N)``
-``navigate(room | region | frontier)``     ``navigate((x, y))`` of the node
-``explore(frontier | room | region)``      ``explore((x, y))`` (go there, look around)
-``explore(obj:N | door:N)``                ``explore(N)``
-``open(obj:N | door:N)``                   ``navigate(N)`` then ``open(N)`` (MoMa-LLM's
-                                           go_to_and_open): one action, summed distance,
-                                           the outcome of the open (or of the navigate
-                                           when that fails)
-``close(obj:N | door:N)``                  ``navigate(N)`` then ``close(N)``
-``open``/``close`` of a room or region     invalid, no motion
-a target not in the graph the planner saw  invalid, no motion
-``done``                                   ends the episode
-=========================================  ===============================================
+Planner actions become simulator skills by :func:`sgtool.recorders.sim.skill_plan.plan_skills`.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import statistics
@@ -76,21 +60,32 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from sgtool.canonical import canonical_float
 from sgtool.datasets.episodes import Episode, list_episodes
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
 from sgtool.house.spec import HouseSpec
 from sgtool.log.echo import as_logged
+from sgtool.log.records import Episode as LoggedEpisode
+from sgtool.log.records import LlmExchange
 from sgtool.log.writer import LogWriter
 from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.planning.candidates import find_target
+from sgtool.planning.episode import SearchStep, run_search
 from sgtool.recorders.sim.camera import CameraConfig
 from sgtool.recorders.sim.navigation import RobotConfig
 from sgtool.recorders.sim.noise import PROFILES, NoiseProfile
 from sgtool.recorders.sim.recording import SOURCE, LogRecorder
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome, StopSimulation
+from sgtool.recorders.sim.skill_plan import (  # noqa: F401 (re-exported)
+    DONE_MESSAGE,
+    SKILLS,
+    SkillCall,
+    SkillPlan,
+    plan_skills,
+)
 from sgtool.scenegraph.derived_layers import write_refresh
-from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode, SceneGraph
+from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.options import (
     CLASSIFIERS,
     ResolvedOptions,
@@ -102,66 +97,6 @@ from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 from sgtool.semantics.text import category_text
 
 N_MAX = 50  # high-level steps per episode (SymSearch's N_max)
-SKILLS = ("navigate", "open", "close", "explore", "done")
-DONE_MESSAGE = "episode ended by the planner"
-
-
-# ----------------------------------------------------------------------------------------
-# actions -> skills (pure)
-# ----------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class SkillCall:
-    """One simulator skill: ``navigate``/``explore``/``open``/``close`` of an instance id or
-    a point (x, y)."""
-
-    skill: str
-    target: int | tuple[float, float]
-
-
-@dataclass(frozen=True)
-class SkillPlan:
-    """What an action means for the simulator: calls run in order until one does not
-    succeed; or ``invalid`` (why, nothing moves); or ``done``."""
-
-    calls: tuple[SkillCall, ...] = ()
-    invalid: str | None = None
-    done: bool = False
-
-
-def _instance(node: ObjectNode | DoorNode) -> int | None:
-    if node.instance >= 0:
-        return int(node.instance)
-    _, _, num = node.id.partition(":")
-    return int(num) if num.isdigit() else None
-
-
-def plan_skills(graph: SceneGraph, action: Action) -> SkillPlan:
-    """The simulator calls of ``action`` on the graph the planner decided on (module doc)."""
-    skill = action.skill
-    if skill == "done":
-        return SkillPlan(done=True)
-    if skill not in SKILLS:
-        return SkillPlan(invalid=f"unknown skill {skill!r}; one of {', '.join(SKILLS)}")
-    if action.target is None:
-        return SkillPlan(invalid=f"{skill} needs a target node")
-    node = graph.node(action.target)
-    if node is None:
-        return SkillPlan(invalid=f"{action.target!r} is not a node of the scene graph the "
-                                 "planner saw")
-    if isinstance(node, (ObjectNode, DoorNode)):
-        iid = _instance(node)
-        if iid is None:
-            return SkillPlan(invalid=f"{node.id} names no instance")
-        if skill in ("open", "close"):
-            return SkillPlan((SkillCall("navigate", iid), SkillCall(skill, iid)))
-        return SkillPlan((SkillCall(skill, iid),))
-    assert isinstance(node, (RoomNode, RegionNode))
-    what = "room" if isinstance(node, RoomNode) else (
-        "frontier" if node.kind == "frontier" else "region")
-    if skill in ("open", "close"):
-        return SkillPlan(invalid=f"cannot {skill} a {what} ({node.id})")
-    xy = (float(node.position[0]), float(node.position[1]))
-    return SkillPlan((SkillCall(skill, xy),))
 
 
 # ----------------------------------------------------------------------------------------
@@ -336,20 +271,106 @@ def _execute(sim: Simulation, calls: Sequence[SkillCall]
 # ----------------------------------------------------------------------------------------
 # one episode
 # ----------------------------------------------------------------------------------------
-def run_episode(house: HouseSpec, episode: Episode, planner: str | Planner,
+class _Search:
+    """The closed loop as a :class:`~sgtool.planning.episode.SearchEnvironment` and its
+    :class:`~sgtool.planning.episode.SearchRecorder`: the graph in force is observed, an
+    action runs as simulator skills and is logged when it ends, then the graph refreshed on
+    it decides whether the query is found."""
+
+    def __init__(self, sim: Simulation, rec: _LiveRecorder, agent: Planner, query: str,
+                 max_steps: int,
+                 on_decision: Callable[[SceneGraph, Action], None] | None) -> None:
+        self.sim, self.rec, self.agent, self.query = sim, rec, agent, query
+        self.max_steps = max_steps
+        self.on_decision = on_decision
+        self.steps = self.n_open = self.last_t = 0
+        self.end = ""
+        self.decision_times: list[float] = []
+        self._graph_time_ns = 0
+        self._decision_s = 0.0
+
+    def start(self) -> None:
+        """One frame, then a look around (logged as decided on no graph), so the first
+        decision has a graph."""
+        cut = False
+        try:
+            self.sim.tick()
+        except StopSimulation:
+            cut = True
+        if not cut:
+            o, why, dist, ticks, cut = _execute(self.sim, (SkillCall("look_around", 0),))
+            self.last_t = self.rec.act(
+                self.sim, SkillOutcome("look_around", None, o, why, dist, ticks), 0.0,
+                {"graph_time_ns": None, "planner": None})
+        self._check(self.rec.last_refresh, cut)
+
+    def _check(self, refresh: Refresh | None, cut: bool) -> None:
+        if _found(refresh, self.query):
+            self.end = "found"
+        elif cut:
+            self.end = "frames"
+
+    @property
+    def ended(self) -> bool:
+        if not self.end and self.steps >= self.max_steps:
+            self.end = "max_steps"
+        return bool(self.end)
+
+    def observe(self) -> SceneGraph | None:
+        cur = self.rec.stream.current
+        if cur is None:  # no frame at all (cannot happen with a frame budget >= 1)
+            self.end = "frames"
+            return None
+        self._graph_time_ns = int(cur.time_ns)
+        return cur.graph
+
+    def decided(self, index: int, graph: SceneGraph, action: Action,
+                decision_s: float) -> None:
+        self.decision_times.append(decision_s)
+        self._decision_s = decision_s
+        self.steps += 1
+        _log_exchanges(self.agent, self.rec.writer, self.rec.last_time_ns)
+        if self.on_decision is not None:
+            self.on_decision(graph, action)
+
+    def execute(self, action: Action) -> Feedback:
+        cur = self.rec.stream.current
+        assert cur is not None
+        plan = plan_skills(cur.graph, action)
+        cut = False
+        if plan.done:
+            o, why, dist, ticks = "success", DONE_MESSAGE, 0.0, 0
+            self.end = "gave_up" if action.target is None else "wrong_done"
+        elif plan.invalid is not None:
+            o, why, dist, ticks = "invalid", plan.invalid, 0.0, 0
+        else:
+            o, why, dist, ticks, cut = _execute(self.sim, plan.calls)
+            if action.skill == "open" and o == "success":
+                self.n_open += 1
+        outcome = SkillOutcome(action.skill, action.target, o, why, dist, ticks)
+        self.last_t = self.rec.act(self.sim, outcome, self._decision_s,
+                                   {"graph_time_ns": self._graph_time_ns})
+        self._check(self.rec.stream.current, cut)  # found overrides a done
+        return Feedback(action, o, why, dist)  # type: ignore[arg-type]
+
+    def executed(self, step: SearchStep) -> None:
+        pass
+
+
+def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                 output: str | os.PathLike[str], options: ClosedLoopOptions | None = None, *,
                 house_id: str = "", episode_index: int = 0,
-                planner_options: Mapping[str, Any] | None = None,
                 overwrite: bool = False, progress: Any = None,
                 on_decision: Callable[[SceneGraph, Action], None] | None = None
                 ) -> ClosedLoopReport:
-    """Run one closed-loop search episode into the log ``output`` (module doc).
+    """Run one closed-loop search episode into the log ``output`` (module doc) through
+    :func:`sgtool.planning.episode.run_search`.
 
-    ``planner`` is a name of :func:`sgtool.planning.registry.make_planner` (with
-    ``planner_options``) or a planner object; its LLM exchanges, when it keeps them
-    (``drain_exchanges()``, moma-llm), are logged after each decision. ``progress`` is
-    anything with ``update(n)`` (a tqdm bar), advanced per frame; ``on_decision`` sees
-    every graph and the action chosen on it.
+    ``planner`` is built by the caller (:func:`sgtool.planning.registry.make_planner`) and
+    closed here (its ``close()``, when it has one) when the episode ends; its LLM
+    exchanges, when it keeps them (``drain_exchanges()``, moma-llm), are logged after each
+    decision. ``progress`` is anything with ``update(n)`` (a tqdm bar), advanced per
+    frame; ``on_decision`` sees every graph and the action chosen on it.
     """
     opts = options or ClosedLoopOptions()
     if opts.max_steps < 1:
@@ -357,21 +378,13 @@ def run_episode(house: HouseSpec, episode: Episode, planner: str | Planner,
     if opts.frames is not None and opts.frames < 1:
         raise SgtoolError(f"--frames {opts.frames}: must be >= 1")
     mapping = opts.mapping()
-    if isinstance(planner, str):
-        from sgtool.planning.registry import make_planner
-
-        agent: Planner = make_planner(planner, **dict(planner_options or {}))
-    else:
-        if planner_options:
-            raise SgtoolError("planner options go with a planner name, not a planner object")
-        agent = planner
-    name = str(getattr(agent, "name", planner if isinstance(planner, str) else "planner"))
+    name = str(getattr(planner, "name", "planner"))
     classifier = make_classifier(mapping.classifier)
     hid = house_id or f"house-{house.seed}"
     query = episode.query
     shortest = episode.shortest_path if math.isfinite(episode.shortest_path) else None
+    shortest_m = None if shortest is None else canonical_float(shortest)
     t_wall = time.perf_counter()
-    decision_times: list[float] = []
     try:
         with Simulation(house, camera=opts.camera, robot=opts.robot, fps=opts.fps,
                         start=episode.start) as sim, \
@@ -383,88 +396,38 @@ def run_episode(house: HouseSpec, episode: Episode, planner: str | Planner,
             rec = _LiveRecorder(writer, sim, stream, noise=opts.noise, seed=opts.noise_seed,
                                 max_frames=opts.frames, planner=name, progress=progress)
             sim.observers.append(rec)
-            base = {"kind": "search", "source": SOURCE, "house_id": hid, "query": query,
-                    "planner": name}
-            extra = _started_extra(opts, sim, mapping, episode, episode_index)
+            base = LoggedEpisode(kind="search", status="started", source=SOURCE,
+                                 house_id=hid, query=query, planner=name)
             writer.attach_house(house.to_json())
-            writer.write_record("episode", 0, {
-                **base, "status": "started", "steps": 0, "travelled_m": 0.0,
-                "shortest_m": None if shortest is None else round(shortest, 4), "frames": 0,
-                "extra": extra})
+            writer.write_record(dataclasses.replace(
+                base, steps=0, travelled_m=0.0, shortest_m=shortest_m, frames=0,
+                extra=_started_extra(opts, sim, mapping, episode, episode_index)), 0)
             rec.write_instances(sim)
-            agent.reset(query, seed=opts.planner_seed)
-            steps, n_open, end = 0, 0, ""
-            last_t = 0
-            # start: one frame, then a look around, so the first decision has a graph
-            cut = False
-            try:
-                sim.tick()
-            except StopSimulation:
-                cut = True
-            if not cut:
-                o, why, dist, ticks, cut = _execute(sim, (SkillCall("look_around", 0),))
-                last_t = rec.act(sim, SkillOutcome("look_around", None, o, why, dist, ticks),
-                                 0.0, {"graph_time_ns": None, "planner": None})
-            if _found(rec.last_refresh, query):
-                end = "found"
-            elif cut:
-                end = "frames"
-            while not end:
-                if steps >= opts.max_steps:
-                    end = "max_steps"
-                    break
-                cur = stream.current
-                if cur is None:  # no frame at all (cannot happen with a frame budget >= 1)
-                    end = "frames"
-                    break
-                graph = cur.graph
-                t0 = time.perf_counter()
-                action = agent.decide(graph)
-                dt = time.perf_counter() - t0
-                decision_times.append(dt)
-                steps += 1
-                _log_exchanges(agent, writer, rec.last_time_ns)
-                if on_decision is not None:
-                    on_decision(graph, action)
-                plan = plan_skills(graph, action)
-                if plan.done:
-                    o, why, dist, ticks = "success", DONE_MESSAGE, 0.0, 0
-                    end = "gave_up" if action.target is None else "wrong_done"
-                elif plan.invalid is not None:
-                    o, why, dist, ticks = "invalid", plan.invalid, 0.0, 0
-                else:
-                    o, why, dist, ticks, cut = _execute(sim, plan.calls)
-                    if action.skill == "open" and o == "success":
-                        n_open += 1
-                outcome = SkillOutcome(action.skill, action.target, o, why, dist, ticks)
-                last_t = rec.act(sim, outcome, dt, {"graph_time_ns": int(cur.time_ns)})
-                agent.feedback(Feedback(action, o, why, dist))  # type: ignore[arg-type]
-                if _found(stream.current, query):
-                    end = "found"
-                elif cut:
-                    end = "frames"
+            search = _Search(sim, rec, planner, query, opts.max_steps, on_decision)
+            search.start()
+            run_search(search, planner, query, seed=opts.planner_seed, recorder=search)
+            end, steps, n_open = search.end, search.steps, search.n_open
             success = end == "found"
-            t_end = max(rec.last_time_ns, last_t)
-            writer.write_record("episode", t_end, {
-                **base, "status": "success" if success else "failure", "steps": steps,
-                "travelled_m": round(sim.travelled_m, 6),
-                "shortest_m": None if shortest is None else round(shortest, 4),
-                "frames": rec.frames,
-                "extra": {"query": query, "planner": name, "seed": opts.planner_seed,
-                          "episode": int(episode_index), "episode_id": episode.id,
-                          "end": end, "n_open": n_open, "mapping": mapping_record(mapping)},
-            })
+            t_end = max(rec.last_time_ns, search.last_t)
+            writer.write_record(dataclasses.replace(
+                base, status="success" if success else "failure", steps=steps,
+                travelled_m=round(sim.travelled_m, 6), shortest_m=shortest_m,
+                frames=rec.frames,
+                extra={"query": query, "planner": name, "seed": opts.planner_seed,
+                       "episode": int(episode_index), "episode_id": episode.id,
+                       "end": end, "n_open": n_open, "mapping": mapping_record(mapping)},
+            ), t_end)
             rec.refreshed(stream.finish(t_end))  # as replay ends: only if anything is new
             travelled, frames, refreshes = sim.travelled_m, rec.frames, rec.refreshes
     finally:
-        closer = getattr(agent, "close", None)
+        closer = getattr(planner, "close", None)
         if callable(closer):
             closer()
     return ClosedLoopReport(
         output=Path(output), house_id=hid, planner=name, query=query, episode=episode.id,
         success=success, end=end, steps=steps, travelled_m=travelled, shortest_m=shortest,
         frames=frames, refreshes=refreshes, n_open=n_open,
-        decision_times=tuple(decision_times), seconds=time.perf_counter() - t_wall)
+        decision_times=tuple(search.decision_times), seconds=time.perf_counter() - t_wall)
 
 
 def _found(refresh: Refresh | None, query: str) -> bool:
@@ -476,7 +439,7 @@ def _log_exchanges(agent: Any, writer: LogWriter, t_ns: int) -> None:
     if not callable(drain):
         return
     for ex in drain():
-        writer.write_record("llm_exchange", t_ns, ex)
+        writer.write_record(LlmExchange.from_json(ex), t_ns)
 
 
 def _started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOptions,

@@ -18,18 +18,12 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
-from matplotlib.path import Path as MplPath
 from scipy import ndimage
 
 from sgtool.errors import SgtoolError
 from sgtool.house.spec import HouseSpec, Room
-from sgtool.mapping.occupancy import (
-    OccupancyMap,
-    cell_centers,
-    house_occupancy,
-    inflate,
-    world_to_cell,
-)
+from sgtool.mapping.occupancy import OccupancyMap, house_occupancy, inflate
+from sgtool.mapping.raster import cell_centers, fill_box_grown, polygon_mask
 from sgtool.recorders.sim.articulation import Box2
 
 Pose2 = tuple[float, float, float]  # x, y, yaw
@@ -76,32 +70,10 @@ def occupancy_with(spec: HouseSpec, door_states: Mapping[str, str], extra: Seque
     if not extra:
         return base
     occ = base.occupied.copy()
-    for b in extra:
-        rasterise_box(base, occ, b)
+    for x, y, sx, sy, yaw in extra:
+        fill_box_grown(base, occ, (x, y), (sx, sy), yaw)
     return OccupancyMap(occ, inflate(occ, robot.radius, robot.resolution), base.origin,
                         base.resolution, robot.radius, doors_passable)
-
-
-def rasterise_box(grid: OccupancyMap, out: np.ndarray, box: Box2) -> None:
-    """Mark the cells of ``out`` (shaped like ``grid``) whose centre lies within the
-    oriented box grown by half a cell."""
-    x, y, sx, sy, yaw = box
-    c, s = math.cos(yaw), math.sin(yaw)
-    ex = abs(c) * sx / 2 + abs(s) * sy / 2 + grid.resolution
-    ey = abs(s) * sx / 2 + abs(c) * sy / 2 + grid.resolution
-    r0, c0 = world_to_cell(grid, x - ex, y - ey)
-    r1, c1 = world_to_cell(grid, x + ex, y + ey)
-    rows, cols = grid.shape
-    r0, c0, r1, c1 = max(r0, 0), max(c0, 0), min(r1 + 1, rows), min(c1 + 1, cols)
-    if r0 >= r1 or c0 >= c1:
-        return
-    xs = grid.origin[0] + (np.arange(c0, c1) + 0.5) * grid.resolution
-    ys = grid.origin[1] + (np.arange(r0, r1) + 0.5) * grid.resolution
-    X, Y = np.meshgrid(xs, ys)
-    dx, dy = X - x, Y - y
-    lx, ly = c * dx + s * dy, -s * dx + c * dy
-    h = grid.resolution / 2
-    out[r0:r1, c0:c1] |= (np.abs(lx) <= sx / 2 + h) & (np.abs(ly) <= sy / 2 + h)
 
 
 def box_distance_grid(grid: OccupancyMap, box: Box2) -> np.ndarray:
@@ -153,11 +125,8 @@ def approach_goal(grid: OccupancyMap, dist: np.ndarray, box: Box2, robot: RobotC
 
 
 def room_mask(grid: OccupancyMap, room: Room) -> np.ndarray:
-    """Cells whose centre lies in the room's polygon."""
-    X, Y = cell_centers(grid)
-    path = MplPath(np.asarray(room.polygon, float))
-    pts = np.column_stack([X.ravel(), Y.ravel()])
-    return path.contains_points(pts).reshape(X.shape)
+    """Cells whose centre lies in the room's polygon (centres on its border: either way)."""
+    return polygon_mask(grid, room.polygon, border=False)
 
 
 def room_viewpoint(grid: OccupancyMap, dist: np.ndarray, room: Room,

@@ -23,6 +23,7 @@ left behind.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 from collections.abc import Mapping, Sequence
@@ -32,6 +33,7 @@ from typing import Any
 
 from sgtool.house.spec import HouseSpec
 from sgtool.log.frame import Frame
+from sgtool.log.records import Action, Episode, Instances
 from sgtool.log.writer import LogWriter
 from sgtool.recorders.sim.camera import CameraConfig, base_T_camera
 from sgtool.recorders.sim.explore import ExplorationReport, ScriptOptions, explore_house
@@ -71,7 +73,7 @@ class LogRecorder(SimObserver):
         self.actions = 0
         self.last_time_ns = 0
         self.last_frame: Frame | None = None
-        self.last_instances: dict[str, Any] | None = None
+        self.last_instances: Instances | None = None
         profile = noise or PROFILES["none"]
         structure = [i.id for i in sim.instances if i.kind == STRUCTURE]
         self.faults = None if profile.is_clean else SensorFaults(
@@ -79,8 +81,8 @@ class LogRecorder(SimObserver):
             base_T_camera(sim.camera.mount_height, sim.camera.tilt_deg))
 
     def write_instances(self, sim: Simulation) -> None:
-        self.last_instances = {"instances": sim.instance_records()}
-        self.writer.write_record("instances", sim.time_ns(), self.last_instances)
+        self.last_instances = Instances.of(sim.instance_records())
+        self.writer.write_record(self.last_instances, sim.time_ns())
 
     def on_tick(self, sim: Simulation) -> None:
         if self.max_frames is not None and self.frames >= self.max_frames:
@@ -107,16 +109,15 @@ class LogRecorder(SimObserver):
                    decision_time_s: float = 0.0,
                    fields: Mapping[str, Any] | None = None) -> int:
         """Write the ``sgtool.Action`` record of ``outcome`` at the time of the last frame
-        the skill took (the current time when it took none); ``fields`` are added to the
+        the skill took (the current time when it took none); ``fields`` are set on the
         record (e.g. ``graph_time_ns``). Returns the record's log time."""
         t = sim.time_ns(max(sim.tick_index - 1, 0)) if outcome.ticks else sim.time_ns()
         t = max(t, self.last_time_ns)
-        self.writer.write_record("action", t, {
-            "skill": outcome.skill, "target": outcome.target, "outcome": outcome.outcome,
-            "reason": outcome.reason, "travelled_m": round(outcome.travelled_m, 6),
-            "decision_time_s": float(decision_time_s), "planner": self.planner,
-            "step": self.actions, **(fields or {}),
-        })
+        record = Action(
+            skill=outcome.skill, target=outcome.target, outcome=outcome.outcome,
+            reason=outcome.reason, travelled_m=round(outcome.travelled_m, 6),
+            decision_time_s=float(decision_time_s), planner=self.planner, step=self.actions)
+        self.writer.write_record(dataclasses.replace(record, **(fields or {})), t)
         self.actions += 1
         return t
 
@@ -189,23 +190,20 @@ def record_house(house: HouseSpec, output: str | os.PathLike[str],
         sim.observers.append(rec)
         sim.observers.extend(observers)
         writer.attach_house(house.to_json())
-        writer.write_record("episode", 0, {
-            "kind": "recording", "source": SOURCE, "house_id": hid, "status": "started",
-            "extra": _episode_extra(opts, sim),
-        })
+        writer.write_record(Episode(kind="recording", source=SOURCE, house_id=hid,
+                                    status="started", extra=_episode_extra(opts, sim)), 0)
         rec.write_instances(sim)
         try:
             sim.tick()  # the view at the start pose
             explore_house(sim, opts.script, rep)
         except StopSimulation:
             truncated = True
-        writer.write_record("episode", rec.last_time_ns, {
-            "kind": "recording", "source": SOURCE, "house_id": hid, "status": "ended",
-            "steps": rec.actions, "frames": rec.frames,
-            "travelled_m": round(sim.travelled_m, 6),
-            "extra": {"rooms_visited": rep.visited, "rooms_missed": rep.missed,
-                      "opened": rep.opened, "truncated": truncated},
-        })
+        writer.write_record(Episode(
+            kind="recording", source=SOURCE, house_id=hid, status="ended",
+            steps=rec.actions, frames=rec.frames, travelled_m=round(sim.travelled_m, 6),
+            extra={"rooms_visited": rep.visited, "rooms_missed": rep.missed,
+                   "opened": rep.opened, "truncated": truncated},
+        ), rec.last_time_ns)
         travelled = sim.travelled_m
         frames, actions = rec.frames, rec.actions
     return RecordReport(Path(output), hid, frames, actions, travelled, tuple(rep.visited),

@@ -263,7 +263,7 @@ def two_room_house(opening: str = "open") -> Any:
     (``"passage"``). Kitchen: a closed refrigerator in the corner (0, 0) holding an apple, a
     countertop by the dividing wall at (3.6, 2.6) with a cup on top. Bedroom: a bed along
     the far wall, a closed wardrobe with a sweater inside."""
-    from sgtool.house.spec import load_house
+    from sgtool.house.io import load_house
 
     def wall(i: int, a: list[float], b: list[float]) -> dict[str, Any]:
         return {"id": f"wall_{i}", "a": a, "b": b, "thickness": 0.1, "height": 2.5}

@@ -7,11 +7,14 @@ prints the import report (or JSON with ``--json``).
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
+from typing import Any
 
 import click
 
+from sgtool.commands.options import option_group
 from sgtool.errors import SgtoolError
 
 
@@ -78,31 +81,40 @@ def _world_options(f):  # type: ignore[no-untyped-def]
     return f
 
 
-def _common_options(f):  # type: ignore[no-untyped-def]
-    for opt in reversed([
-        click.option("-o", "--output", type=click.Path(dir_okay=False),
-                     help="The sgtool log to write (OUT.mcap)."),
-        click.option("--intrinsics", default=None,
-                     help="Camera intrinsics 'fx,fy,cx,cy' in pixels, or a file (Open3D JSON "
-                     "or a 3x3 matrix as text); overrides what the source says."),
-        click.option("--depth-scale", type=float, default=None,
-                     help="Raw 16-bit depth units per metre (default: 1000 for bags and "
-                     "7-Scenes/Open3D, 5000 for TUM)."),
-        click.option("--max-dt", type=float, default=0.02, show_default=True,
-                     help="Largest time difference (s) when pairing colour (and ids) "
-                     "with a depth image."),
-        click.option("--every", type=int, default=1, show_default=True,
-                     help="Keep every N-th frame."),
-        click.option("--limit", type=int, default=None, help="Keep at most N frames."),
-        click.option("--compression", type=click.Choice(["zstd", "lz4", "none"]),
-                     default="zstd", show_default=True,
-                     help="MCAP chunk compression (lz4: ~1.4x faster import, ~30 % larger)."),
-        click.option("--force", is_flag=True, help="Overwrite the output log."),
-        click.option("--json", "as_json", is_flag=True, help="Print the report as JSON."),
-        click.option("--quiet", is_flag=True, help="No progress bars."),
-    ]):
-        f = opt(f)
-    return f
+_common_options = option_group([
+    click.option("-o", "--output", type=click.Path(dir_okay=False),
+                 help="The sgtool log to write (OUT.mcap)."),
+    click.option("--intrinsics", default=None,
+                 help="Camera intrinsics 'fx,fy,cx,cy' in pixels, or a file (Open3D JSON "
+                 "or a 3x3 matrix as text); overrides what the source says."),
+    click.option("--depth-scale", type=float, default=None,
+                 help="Raw 16-bit depth units per metre (default: 1000 for bags and "
+                 "7-Scenes/Open3D, 5000 for TUM)."),
+    click.option("--max-dt", type=float, default=0.02, show_default=True,
+                 help="Largest time difference (s) when pairing colour (and ids) "
+                 "with a depth image."),
+    click.option("--every", type=int, default=1, show_default=True,
+                 help="Keep every N-th frame."),
+    click.option("--limit", type=int, default=None, help="Keep at most N frames."),
+    click.option("--compression", type=click.Choice(["zstd", "lz4", "none"]),
+                 default="zstd", show_default=True,
+                 help="MCAP chunk compression (lz4: ~1.4x faster import, ~30 % larger)."),
+    click.option("--force", is_flag=True, help="Overwrite the output log."),
+    click.option("--json", "as_json", is_flag=True, help="Print the report as JSON."),
+    click.option("--quiet", is_flag=True, help="No progress bars."),
+])
+
+
+def _odometry_options(estimate_help: str, odometry_help: str,
+                      depth_max_help: str) -> Callable[[Any], Any]:
+    """``--estimate-poses``, ``--odometry`` and ``--depth-max``, with the command's help."""
+    return option_group([
+        click.option("--estimate-poses", is_flag=True, help=estimate_help),
+        click.option("--odometry", type=click.Choice(["rgbd+icp", "rgbd", "icp"]),
+                     default="rgbd+icp", show_default=True, help=odometry_help),
+        click.option("--depth-max", type=float, default=4.0, show_default=True,
+                     help=depth_max_help),
+    ])
 
 
 @click.group("import")
@@ -131,15 +143,12 @@ def command() -> None:
               "instead of tf.")
 @click.option("--tf-tolerance", type=float, default=0.05, show_default=True,
               help="How far (s) before/after a transform's samples a pose may be taken.")
-@click.option("--estimate-poses", is_flag=True,
-              help="Estimate the camera poses by RGB-D odometry even when the bag has tf "
-              "(the drift against the bag's poses is reported). Needs --depth. A bag "
-              "without tf and without --pose is always estimated.")
-@click.option("--odometry", type=click.Choice(["rgbd+icp", "rgbd", "icp"]),
-              default="rgbd+icp", show_default=True,
-              help="Odometry for estimated poses (see `sgtool import rgbd --help`).")
-@click.option("--depth-max", type=float, default=4.0, show_default=True,
-              help="Depth beyond this (m) is ignored by the odometry.")
+@_odometry_options(
+    estimate_help="Estimate the camera poses by RGB-D odometry even when the bag has tf (the "
+    "drift against the bag's poses is reported). Needs --depth. A bag without tf and without "
+    "--pose is always estimated.",
+    odometry_help="Odometry for estimated poses (see `sgtool import rgbd --help`).",
+    depth_max_help="Depth beyond this (m) is ignored by the odometry.")
 @click.option("--list", "list_only", is_flag=True,
               help="List the bag's topics, tf links and suggested flags, and stop.")
 @_world_options
@@ -210,16 +219,13 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
               help="Frame rate for layouts without time stamps (7-Scenes frame n is at n/fps).")
 @click.option("--trajectory", type=click.Path(dir_okay=False, exists=True),
               help="Poses to use instead of the dataset's: an Open3D .log or a TUM file.")
-@click.option("--estimate-poses", is_flag=True,
-              help="Estimate the poses by RGB-D odometry even when the dataset has them "
-              "(their drift against the dataset's poses is reported). Sources without "
-              "poses are always estimated.")
-@click.option("--odometry", type=click.Choice(["rgbd+icp", "rgbd", "icp"]),
-              default="rgbd+icp", show_default=True,
-              help="Odometry: Open3D RGB-D odometry refined by point-to-plane ICP, RGB-D "
-              "odometry alone, or ICP alone.")
-@click.option("--depth-max", type=float, default=4.0, show_default=True,
-              help="Depth beyond this (m) is ignored by the odometry (not by the import).")
+@_odometry_options(
+    estimate_help="Estimate the poses by RGB-D odometry even when the dataset has them (their "
+    "drift against the dataset's poses is reported). Sources without poses are always "
+    "estimated.",
+    odometry_help="Odometry: Open3D RGB-D odometry refined by point-to-plane ICP, RGB-D "
+    "odometry alone, or ICP alone.",
+    depth_max_help="Depth beyond this (m) is ignored by the odometry (not by the import).")
 @_world_options
 @_common_options
 def rgbd(folder: str, layout: str, fps: float, trajectory: str | None, estimate_poses: bool,

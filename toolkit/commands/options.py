@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
+
+import click
 
 from sgtool.errors import SgtoolError
+
+F = TypeVar("F", bound=Callable[..., Any])
 
 
 def parse_rooms(text: str, option: str = "--rooms", lo_limit: int = 4,
@@ -72,7 +76,7 @@ def house_from_options(path: str | None, seed: int | None, rooms: str) -> tuple[
     if path is not None and seed is not None:
         raise SgtoolError("give either --house or --seed, not both")
     if path is not None:
-        from sgtool.house.spec import load_house
+        from sgtool.house.io import load_house
 
         return load_house(path), Path(path).stem
     if seed is not None:
@@ -82,3 +86,36 @@ def house_from_options(path: str | None, seed: int | None, rooms: str) -> tuple[
     from sgtool.datasets import demo_house
 
     return demo_house(), "demo"
+
+
+def option_group(options: Sequence[Callable[[F], F]]) -> Callable[[F], F]:
+    """One decorator of several click options, listed in ``--help`` in the order given."""
+    def decorate(f: F) -> F:
+        for opt in reversed(options):
+            f = opt(f)
+        return f
+    return decorate
+
+
+def house_options(seed_help: str, rooms_help: str) -> Callable[[F], F]:
+    """``--house``, ``--seed`` and ``--rooms`` (for :func:`house_from_options`); the help of
+    ``--seed`` and ``--rooms`` says what the command does with the house."""
+    return option_group([
+        click.option("--house", "house_path", type=click.Path(dir_okay=False),
+                     help="House spec (JSON, see `sgtool scenes`). Default: the demo house "
+                     "shipped with sgtool, unless --seed is given."),
+        click.option("--seed", type=int, default=None, help=seed_help),
+        click.option("--rooms", default="4-12", show_default=True, metavar="MIN-MAX",
+                     help=rooms_help),
+    ])
+
+
+def llm_log_options(transcript_help: str) -> Callable[[F], F]:
+    """``--llm-replay`` and ``--llm-transcript`` of the moma-llm planner."""
+    return option_group([
+        click.option("--llm-replay", type=click.Path(dir_okay=False), default=None,
+                     help="moma-llm: serve answers from this JSONL transcript instead of an "
+                     "endpoint."),
+        click.option("--llm-transcript", type=click.Path(dir_okay=False), default=None,
+                     help=transcript_help),
+    ])

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import click
 
+from sgtool.commands.options import house_options
 from sgtool.errors import SgtoolError
 
 
@@ -26,14 +27,10 @@ def _pair(option: str, text: str) -> tuple[float, float]:
 
 
 @click.command("record")
-@click.option("--house", "house_path", type=click.Path(dir_okay=False),
-              help="House spec (JSON, see `sgtool scenes`). Default: the demo house shipped "
-              "with sgtool, unless --seed is given.")
-@click.option("--seed", type=int, default=None,
-              help="Generate the house for this seed (`sgtool scenes generate`) instead of "
-              "reading --house.")
-@click.option("--rooms", default="4-12", show_default=True, metavar="MIN-MAX",
-              help="Room count range for a house generated with --seed (N, MIN-MAX).")
+@house_options(
+    seed_help="Generate the house for this seed (`sgtool scenes generate`) instead of "
+    "reading --house.",
+    rooms_help="Room count range for a house generated with --seed (N, MIN-MAX).")
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
               help="The log to write (OUT.mcap).")
 @click.option("--frames", type=int, default=None,

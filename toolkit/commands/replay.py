@@ -122,7 +122,7 @@ def command(log: str, output: str | None, every: int | None, classifier: str | N
 
 
 def _score(house: str, final: dict[str, Any]) -> Any:
-    from sgtool.house.spec import load_house
+    from sgtool.house.io import load_house
     from sgtool.replayers.score import score
 
     if "refresh" not in final:

@@ -144,9 +144,11 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
 
     bar = tqdm(total=frames, unit="frame", desc=f"run {name}", file=sys.stderr, leave=False,
                disable=quiet or not sys.stderr.isatty(), dynamic_ncols=True)
+    from sgtool.planning.registry import make_planner
+
     try:
-        report = run_episode(house, ep, name, out, opts, house_id=house_id,
-                             episode_index=index, planner_options=options, overwrite=force,
+        report = run_episode(house, ep, make_planner(name, **options), out, opts,
+                             house_id=house_id, episode_index=index, overwrite=force,
                              progress=bar)
     finally:
         bar.close()

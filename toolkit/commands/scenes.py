@@ -49,7 +49,7 @@ def generate_cmd(seed: int, rooms: tuple[int, int], split: str, output: str,
     """Generate a connected multi-room house and write its JSON spec."""
     from sgtool.commands.options import check_output
     from sgtool.datasets.generator import generate_house
-    from sgtool.house.spec import save_house
+    from sgtool.house.io import save_house
 
     check_output(output, force=force, suffixes=(".json",), what="house spec")
     spec = generate_house(seed, rooms=rooms, split=split)
@@ -78,7 +78,7 @@ def show_cmd(house: str, output: str | None, dpi: int, no_objects: bool, force: 
 
     from sgtool.commands.options import check_output
     from sgtool.datasets.draw import draw_house
-    from sgtool.house.spec import load_house
+    from sgtool.house.io import load_house
 
     spec = load_house(house)
     out = check_output(output or Path(house).with_suffix(".png"), force=force,
@@ -146,7 +146,7 @@ def episodes_cmd(house: str, count: int | None, seed: int, reach: float,
     the start to the nearest target on the house's occupancy grid (closed doors
     passable)."""
     from sgtool.datasets.episodes import list_episodes
-    from sgtool.house.spec import load_house
+    from sgtool.house.io import load_house
 
     spec = load_house(house)
     eps = list_episodes(spec, n=count, seed=seed, reach=reach)

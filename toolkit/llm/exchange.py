@@ -1,6 +1,7 @@
 """One LLM exchange as a plain record: the ``sgtool.LlmExchange`` log record and a transcript line.
 
-The same dict goes to the MCAP log (``LogWriter.write_record("llm_exchange", t, record)``)
+:func:`exchange_record` gives the JSON form of an :class:`sgtool.log.records.LlmExchange`:
+the same dict goes to the MCAP log (``LogWriter.write_record(LlmExchange.from_json(d), t)``)
 and, one JSON object per line, to a transcript file that ``--llm-replay`` serves back. The
 fields required by the log schema are ``model`` and ``messages``; ``prompt_sha256`` keys a
 response to its prompt for replay (:mod:`sgtool.llm.recorded`).
@@ -11,6 +12,8 @@ from __future__ import annotations
 import hashlib
 import json
 from typing import Any
+
+from sgtool.log.records import LlmExchange
 
 Message = dict[str, str]
 
@@ -41,17 +44,17 @@ def exchange_record(
     ``attempt`` counts retries within one decision (0 = first try); ``step`` is the decision
     number within the episode; ``source`` is ``endpoint`` or ``replay``.
     """
-    return {
-        "model": str(model),
-        "messages": [{"role": m["role"], "content": m["content"]} for m in messages],
-        "prompt_sha256": prompt_key(messages),
-        "response": response,
-        "latency_s": float(latency_s),
-        "prompt_tokens": None if prompt_tokens is None else int(prompt_tokens),
-        "completion_tokens": None if completion_tokens is None else int(completion_tokens),
-        "error": error,
-        "attempt": int(attempt),
-        "step": step,
-        "query": query,
-        "source": source,
-    }
+    return LlmExchange(
+        model=str(model),
+        messages=tuple({"role": m["role"], "content": m["content"]} for m in messages),
+        prompt_sha256=prompt_key(messages),
+        response=response,
+        latency_s=float(latency_s),
+        prompt_tokens=None if prompt_tokens is None else int(prompt_tokens),
+        completion_tokens=None if completion_tokens is None else int(completion_tokens),
+        error=error,
+        attempt=int(attempt),
+        step=step,
+        query=query,
+        source=source,
+    ).to_json()

@@ -19,9 +19,10 @@ from collections import deque
 from pathlib import Path
 from typing import Any
 
-from sgtool.errors import SgtoolError
+from sgtool.errors import LogFormatError, SgtoolError
 from sgtool.llm.client import ChatResult, LlmTransportError
 from sgtool.llm.exchange import Message, prompt_key
+from sgtool.log.records import LlmExchange
 
 log = logging.getLogger(__name__)
 
@@ -86,8 +87,11 @@ def read_transcript(path: str | Path) -> list[dict[str, Any]]:
                 log.warning("%s:%d: incomplete last line (interrupted run) ignored", path, n)
                 continue
             raise TranscriptError(f"{path}:{n}: not a JSON line ({e.msg})") from e
-        if not isinstance(rec, dict) or "messages" not in rec:
-            raise TranscriptError(f"{path}:{n}: not an sgtool.LlmExchange record")
+        try:
+            LlmExchange.check(rec, "the line")
+        except LogFormatError as e:
+            raise TranscriptError(f"{path}:{n}: not an sgtool.LlmExchange record ({e})") \
+                from None
         rec.setdefault("prompt_sha256", prompt_key(rec["messages"]))
         out.append(rec)
     return out

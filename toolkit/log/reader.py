@@ -19,9 +19,8 @@ import struct
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, TypeVar, overload
 
-import numpy as np
 import zstandard
 from mcap.exceptions import InvalidMagic, McapError
 from mcap.reader import SeekingReader
@@ -31,7 +30,11 @@ from mcap.summary import Summary
 from sgtool.errors import LogFormatError, MissingChannelError, SchemaVersionError
 from sgtool.log import codec
 from sgtool.log import schemas as S
+from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler, TransformBuffer
 from sgtool.log.frame import CameraIntrinsics, Frame
+from sgtool.log.records import RECORD_TYPES, LogRecord
+
+R = TypeVar("R", bound=LogRecord)
 
 _PROTO_CLASSES: dict[str, Any] = {}
 _MAGIC = bytes([137, 77, 67, 65, 80, 48, 13, 10])
@@ -71,110 +74,6 @@ class Decoded:
     log_time_ns: int
     schema_name: str
     message: Any  # protobuf message, dict (JSON) or bytes (unknown encodings)
-
-
-class TransformBuffer:
-    """Transforms by (parent, child) over time; lookup of the latest at or before t."""
-
-    def __init__(self) -> None:
-        self._parent: dict[str, str] = {}
-        self._times: dict[str, list[int]] = {}
-        self._values: dict[str, list[np.ndarray]] = {}
-
-    def add(self, t_ns: int, parent: str, child: str, T: np.ndarray) -> None:  # noqa: N803
-        self._parent[child] = parent
-        times = self._times.setdefault(child, [])
-        vals = self._values.setdefault(child, [])
-        if times and t_ns < times[-1]:
-            i = int(np.searchsorted(times, t_ns, side="right"))
-            times.insert(i, t_ns)
-            vals.insert(i, T)
-        else:
-            times.append(t_ns)
-            vals.append(T)
-
-    def lookup(self, t_ns: int, target: str, root: str = S.WORLD_FRAME) -> np.ndarray | None:
-        """root_T_target at ``t_ns``, or None when the chain is not known yet."""
-        T = np.eye(4)  # noqa: N806
-        frame = target
-        for _ in range(32):
-            if frame == root:
-                return T
-            if frame not in self._parent:
-                return None
-            times = self._times[frame]
-            i = int(np.searchsorted(times, t_ns, side="right")) - 1
-            if i < 0:
-                return None
-            T = self._values[frame][i] @ T  # noqa: N806
-            frame = self._parent[frame]
-        return None
-
-
-FRAME_TOPICS = (S.RGB, S.DEPTH, S.IDS, S.CALIBRATION, S.TF)
-
-
-class FrameAssembler:
-    """Groups decoded frame-topic messages, pushed in log order, into frames: the depth
-    image of one log time with the RGB and id images of the same time, the calibration in
-    force and the camera pose from the transforms in force (module doc).
-
-    :meth:`push` returns the previous frame when a message of a new log time arrives;
-    :meth:`flush` returns the frame being assembled (when it has its depth image), so a
-    caller that meets another record of the same time can take the frame first."""
-
-    def __init__(self, index: int = 0, transforms: TransformBuffer | None = None,
-                 calibration: CameraIntrinsics | None = None) -> None:
-        self.index = index
-        self.transforms = transforms or TransformBuffer()
-        self.calibration = calibration
-        self._pending: dict[str, Any] = {}
-        self._t: int | None = None
-
-    def push(self, topic: str, t_ns: int, message: Any) -> Frame | None:
-        out = None
-        if self._t is not None and t_ns != self._t:
-            out = self.flush()
-            self._pending = {}
-        self._t = t_ns
-        if topic == S.TF:
-            self.transforms.add(t_ns, message.parent_frame_id, message.child_frame_id,
-                                codec.decode_transform(message))
-        elif topic == S.CALIBRATION:
-            self.calibration = codec.decode_calibration(message)
-        elif topic == S.DEPTH:
-            self._pending["depth"] = message
-        elif topic == S.RGB:
-            self._pending["rgb"] = message
-        elif topic == S.IDS:
-            self._pending["ids"] = message
-        return out
-
-    def flush(self) -> Frame | None:
-        """The frame of the current log time, if its depth image has arrived (it is then
-        handed out once); None otherwise."""
-        pending, t = self._pending, self._t
-        if "depth" not in pending or t is None:
-            return None
-        self._pending = {}
-        depth_msg = pending["depth"]
-        k = self.calibration or _fallback_intrinsics(depth_msg)
-        pose = self.transforms.lookup(t, depth_msg.frame_id or S.CAMERA_FRAME)
-        if pose is None:
-            pose = np.full((4, 4), np.nan)
-        fr = Frame(
-            index=self.index,
-            time_ns=t,
-            rgb=codec.decode_image(pending["rgb"]) if "rgb" in pending else None,
-            depth=codec.depth_from_image(depth_msg),
-            ids=codec.decode_image(pending["ids"]).astype(np.int32)
-            if "ids" in pending else None,
-            pose=pose,
-            intrinsics=k,
-            base_pose=self.transforms.lookup(t, S.BASE_FRAME),
-        )
-        self.index += 1
-        return fr
 
 
 class LogReader:
@@ -324,7 +223,12 @@ class LogReader:
     # ----- messages ---------------------------------------------------------------------
     def _decode(self, schema: Schema | None, channel: Channel, message: Message) -> Any:
         if channel.message_encoding == "json":
-            return json.loads(message.data)
+            try:
+                return json.loads(message.data)
+            except ValueError as e:
+                raise LogFormatError(
+                    f"{self.path}: {channel.topic} message at {message.log_time} ns is not "
+                    f"JSON ({e})") from None
         if channel.message_encoding == "protobuf" and schema is not None:
             cls = _proto_class(schema.name)
             if cls is not None:
@@ -359,21 +263,39 @@ class LogReader:
                 self._decode(schema, channel, message),
             )
 
-    def records(self, kind: str, **kw: Any) -> Iterator[tuple[int, dict[str, Any]]]:
-        """(log time, record) of an sgtool JSON record kind, in time order."""
-        topic = S.RECORDS[kind].topic
-        if not self.has(topic):
-            return
-        for d in self.messages([topic], **kw):
-            yield d.log_time_ns, d.message
+    @overload
+    def records(self, kind: type[R], **kw: Any) -> Iterator[tuple[int, R]]: ...
 
-    def last_record(self, kind: str, at_ns: int | None = None) -> dict[str, Any] | None:
-        topic = S.RECORDS[kind].topic
-        if not self.has(topic):
-            return None
+    @overload
+    def records(self, kind: str, **kw: Any) -> Iterator[tuple[int, dict[str, Any]]]: ...
+
+    def records(self, kind: type[LogRecord] | str, **kw: Any) -> Iterator[tuple[int, Any]]:
+        """(log time, record) of one sgtool JSON channel, in time order, each checked
+        against its schema (:mod:`sgtool.log.records`: a missing or mistyped field is a
+        :class:`LogFormatError` naming the channel, the record and the field). ``kind`` a
+        record type (``Episode``) gives typed records; a kind name (``"episode"``) gives
+        the checked JSON dicts. ``kw``: the time range of :meth:`messages`."""
+        rtype = RECORD_TYPES[kind] if isinstance(kind, str) else kind
+        if not self.has(rtype.channel().topic):
+            return
+        for i, d in enumerate(self.messages([rtype.channel().topic], **kw)):
+            index = None if kw.get("reverse") else i
+            rec = rtype.from_json(
+                d.message, where=f"{self.path}: {rtype.describe(index, d.log_time_ns)}")
+            yield d.log_time_ns, (d.message if isinstance(kind, str) else rec)
+
+    @overload
+    def last_record(self, kind: type[R], at_ns: int | None = None) -> R | None: ...
+
+    @overload
+    def last_record(self, kind: str, at_ns: int | None = None) -> dict[str, Any] | None: ...
+
+    def last_record(self, kind: type[LogRecord] | str, at_ns: int | None = None) -> Any:
+        """The last record of a channel (at or before ``at_ns``), checked as
+        :meth:`records`; None when there is none."""
         end = None if at_ns is None else at_ns + 1
-        for d in self.messages([topic], end_ns=end, reverse=True):
-            return d.message
+        for _, rec in self.records(kind, end_ns=end, reverse=True):  # type: ignore[call-overload]
+            return rec
         return None
 
     # ----- frames -----------------------------------------------------------------------
@@ -491,7 +413,3 @@ class LogReader:
 
     def __exit__(self, *exc: Any) -> None:
         self.close()
-
-
-def _fallback_intrinsics(depth_msg: Any) -> CameraIntrinsics:
-    return CameraIntrinsics.from_fov(int(depth_msg.width), int(depth_msg.height), 60.0)

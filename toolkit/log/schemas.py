@@ -8,6 +8,9 @@ the sgtool version, the log schema version (``major.minor``) and the seed.
 Versioning rule: a reader reads every log whose major version equals its own and whose
 minor version is any (new minor versions only add optional fields or channels); a newer
 major version is refused with a message naming both versions.
+
+Each JSON record kind has a typed record in :mod:`sgtool.log.records`, checked against the
+JSON schema registered here whenever it is written or read.
 """
 
 from __future__ import annotations
@@ -179,7 +182,6 @@ RECORDS: dict[str, RecordKind] = {
 }
 
 RECORD_BY_SCHEMA = {k.schema_name: k for k in RECORDS.values()}
-RECORD_BY_TOPIC = {k.topic: k for k in RECORDS.values()}
 
 
 def format_version(v: tuple[int, int]) -> str:

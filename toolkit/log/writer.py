@@ -16,8 +16,9 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Mapping
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, overload
 
 import numpy as np
 from mcap.writer import CompressionType, Writer
@@ -28,6 +29,7 @@ from sgtool.errors import SgtoolError
 from sgtool.log import codec
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
+from sgtool.log.records import RECORD_TYPES, LogRecord
 
 _COMPRESSION = {
     "zstd": CompressionType.ZSTD,
@@ -41,7 +43,7 @@ class LogWriter:
 
         with LogWriter("run.mcap", seed=3) as log:
             log.attach_house(house_json)
-            log.write_record("instances", 0, {"instances": [...]})
+            log.write_record(Instances.of([...]), 0)
             log.write_frame(t_ns, rgb=rgb, depth=depth_m, ids=ids, pose=world_T_cam,
                             intrinsics=k, base_pose=world_T_base)
     """
@@ -172,17 +174,36 @@ class LogWriter:
         cid = self._proto_channel(topic, type(msg))
         self._add(cid, t_ns, msg.SerializeToString(deterministic=True))
 
-    def write_record(self, kind: str, t_ns: int, record: dict[str, Any]) -> None:
-        """Write an sgtool JSON record (``episode``, ``instances``, ``action``,
-        ``scene_graph``, ``llm_exchange``); ``record`` must be JSON-serialisable."""
-        if kind not in S.RECORDS:
-            raise ValueError(f"unknown record kind {kind!r}; one of {sorted(S.RECORDS)}")
-        cid = self._json_channel(S.RECORDS[kind])
-        data = json.dumps(record, sort_keys=True, separators=(",", ":")).encode()
-        self._add(cid, t_ns, data)
+    @overload
+    def write_record(self, record: LogRecord, t_ns: int) -> None: ...
+
+    @overload
+    def write_record(self, record: str, t_ns: int, data: Mapping[str, Any]) -> None: ...
+
+    def write_record(self, record: LogRecord | str, t_ns: int,
+                     data: Mapping[str, Any] | None = None) -> None:
+        """Write a typed sgtool JSON record (:mod:`sgtool.log.records`) on its channel,
+        checked against its schema first (a :class:`~sgtool.errors.LogFormatError` names
+        the field that is wrong).
+
+        ``write_record(kind, t_ns, dict)`` (the form before typed records) reads the dict
+        as that kind's record and writes it the same way."""
+        if isinstance(record, str):
+            rtype = RECORD_TYPES.get(record)
+            if rtype is None:
+                raise ValueError(f"unknown record kind {record!r}; one of {sorted(RECORD_TYPES)}")
+            record = rtype.from_json(dict(data or {}),
+                                     where=rtype.describe(t_ns=int(t_ns)) + " to write")
+        if not isinstance(record, LogRecord):
+            raise TypeError(f"write_record takes an sgtool.log.records record, not "
+                            f"{type(record).__name__}")
+        d = record.checked_json(record.describe(t_ns=int(t_ns)) + " to write")
+        cid = self._json_channel(record.channel())
+        self._add(cid, t_ns, json.dumps(d, sort_keys=True, separators=(",", ":")).encode())
 
     def write_json_bytes(self, kind: str, t_ns: int, data: bytes) -> None:
-        """Like :meth:`write_record` for an already canonical JSON text (a scene graph)."""
+        """Like :meth:`write_record` for an already canonical JSON text that its maker
+        guarantees to be valid (the scene graph of a refresh: no second encoding)."""
         cid = self._json_channel(S.RECORDS[kind])
         self._add(cid, t_ns, data)
 

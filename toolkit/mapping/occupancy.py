@@ -12,7 +12,9 @@ This is the "dilated occupancy map + A*" geodesic of SCOUT's SymSearch (Fig. 5 f
 
 Arrays are indexed ``[row, col]`` with row = y and col = x; cell ``[0, 0]`` has its lower
 left corner at ``origin``; the centre of cell (r, c) is
-``origin + ((c + 0.5) * resolution, (r + 0.5) * resolution)``.
+``origin + ((c + 0.5) * resolution, (r + 0.5) * resolution)``. Rooms, walls, doors and
+furniture are rasterised by :mod:`sgtool.mapping.raster` (cell <-> world coordinates too:
+``world_to_cell`` and ``cell_to_world`` are importable from here as well).
 """
 
 from __future__ import annotations
@@ -23,12 +25,17 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from matplotlib.path import Path as MplPath
 from scipy import ndimage
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from sgtool.house.spec import HouseSpec
+from sgtool.mapping.raster import (
+    cell_to_world,
+    fill_box_overlap,
+    fill_polygon,
+    world_to_cell,
+)
 
 _SQRT2 = math.sqrt(2.0)
 _TOL = 1e-6
@@ -62,30 +69,6 @@ class OccupancyMap:
 
 
 # ----------------------------------------------------------------------------------------
-# coordinates
-# ----------------------------------------------------------------------------------------
-def world_to_cell(occ: OccupancyMap, x: float, y: float) -> tuple[int, int]:
-    """(row, col) of the cell holding world point (x, y) (may be out of bounds)."""
-    col = math.floor((x - occ.origin[0]) / occ.resolution + 1e-9)
-    row = math.floor((y - occ.origin[1]) / occ.resolution + 1e-9)
-    return (int(row), int(col))
-
-
-def cell_to_world(occ: OccupancyMap, row: int, col: int) -> tuple[float, float]:
-    """World (x, y) of the centre of cell (row, col)."""
-    return (occ.origin[0] + (col + 0.5) * occ.resolution,
-            occ.origin[1] + (row + 0.5) * occ.resolution)
-
-
-def cell_centers(occ: OccupancyMap) -> tuple[np.ndarray, np.ndarray]:
-    """(X, Y) arrays of cell-centre coordinates, each of the grid's shape."""
-    rows, cols = occ.shape
-    xs = occ.origin[0] + (np.arange(cols) + 0.5) * occ.resolution
-    ys = occ.origin[1] + (np.arange(rows) + 0.5) * occ.resolution
-    return np.meshgrid(xs, ys)
-
-
-# ----------------------------------------------------------------------------------------
 # rasterisation
 # ----------------------------------------------------------------------------------------
 def house_occupancy(spec: HouseSpec, resolution: float = 0.05, robot_radius: float = 0.2,
@@ -110,18 +93,18 @@ def house_occupancy(spec: HouseSpec, resolution: float = 0.05, robot_radius: flo
                         closed_doors_free)
     inside = np.zeros((rows, cols), bool)
     for room in spec.rooms:
-        _fill_polygon(grid, inside, room.polygon)
+        fill_polygon(grid, inside, room.polygon)
     occupied = ~inside
     for w in spec.walls:
         cx, cy = (w.a[0] + w.b[0]) / 2.0, (w.a[1] + w.b[1]) / 2.0
-        _fill_box(grid, occupied, (cx, cy), (w.length, w.thickness), w.yaw)
+        fill_box_overlap(grid, occupied, (cx, cy), (w.length, w.thickness), w.yaw)
     if not closed_doors_free:
         for d in spec.doors:
             if d.state == "closed":
-                _fill_box(grid, occupied, d.center, (d.width, d.thickness), d.yaw)
+                fill_box_overlap(grid, occupied, d.center, (d.width, d.thickness), d.yaw)
     for f in spec.furniture:
         if f.bottom < max_obstacle_height:
-            _fill_box(grid, occupied, f.center[:2], f.size[:2], f.yaw)
+            fill_box_overlap(grid, occupied, f.center[:2], f.size[:2], f.yaw)
     blocked = inflate(occupied, robot_radius, resolution)
     return OccupancyMap(occupied, blocked, grid.origin, resolution, robot_radius,
                         closed_doors_free)
@@ -136,71 +119,6 @@ def inflate(occupied: np.ndarray, radius: float, resolution: float) -> np.ndarra
         return occupied.copy()
     dist = ndimage.distance_transform_edt(~occupied, sampling=resolution)
     return dist < radius + resolution / 2.0 - _TOL
-
-
-def _cell_window(occ: OccupancyMap, xs: Sequence[float],
-                 ys: Sequence[float]) -> tuple[slice, slice] | None:
-    r0, c0 = world_to_cell(occ, min(xs), min(ys))
-    r1, c1 = world_to_cell(occ, max(xs), max(ys))
-    rows, cols = occ.shape
-    r0, c0 = max(r0 - 1, 0), max(c0 - 1, 0)
-    r1, c1 = min(r1 + 2, rows), min(c1 + 2, cols)
-    if r0 >= r1 or c0 >= c1:
-        return None
-    return slice(r0, r1), slice(c0, c1)
-
-
-def _window_centers(occ: OccupancyMap, win: tuple[slice, slice]) -> tuple[np.ndarray, np.ndarray]:
-    rs, cs = win
-    xs = occ.origin[0] + (np.arange(cs.start, cs.stop) + 0.5) * occ.resolution
-    ys = occ.origin[1] + (np.arange(rs.start, rs.stop) + 0.5) * occ.resolution
-    return np.meshgrid(xs, ys)
-
-
-def _fill_box(occ: OccupancyMap, out: np.ndarray, center: Sequence[float],
-              size: Sequence[float], yaw: float) -> None:
-    """Mark the cells whose square overlaps the oriented box (exact for axis-aligned boxes,
-    slightly generous for rotated ones)."""
-    c, s = math.cos(yaw), math.sin(yaw)
-    hx, hy = size[0] / 2.0, size[1] / 2.0
-    ex = abs(c) * hx + abs(s) * hy
-    ey = abs(s) * hx + abs(c) * hy
-    win = _cell_window(occ, (center[0] - ex, center[0] + ex), (center[1] - ey, center[1] + ey))
-    if win is None:
-        return
-    X, Y = _window_centers(occ, win)
-    dx, dy = X - center[0], Y - center[1]
-    lx = c * dx + s * dy
-    ly = -s * dx + c * dy
-    # half a cell along the box axes, grown to the cell's extent in that direction
-    px = 0.5 * occ.resolution * (abs(c) + abs(s))
-    mask = (np.abs(lx) < hx + px - _TOL) & (np.abs(ly) < hy + px - _TOL)
-    out[win] |= mask
-
-
-def _fill_polygon(occ: OccupancyMap, out: np.ndarray, poly: Sequence[tuple[float, float]]) -> None:
-    """Mark cells whose centre lies inside (or on the border of) ``poly``."""
-    xs = [p[0] for p in poly]
-    ys = [p[1] for p in poly]
-    win = _cell_window(occ, xs, ys)
-    if win is None:
-        return
-    X, Y = _window_centers(occ, win)
-    path = MplPath(np.asarray(poly, float))
-    pts = np.column_stack([X.ravel(), Y.ravel()])
-    # a small positive radius counts points on the border as inside whatever the winding
-    sign = 1.0 if _is_ccw(poly) else -1.0
-    mask = path.contains_points(pts, radius=sign * 1e-6).reshape(X.shape)
-    out[win] |= mask
-
-
-def _is_ccw(poly: Sequence[tuple[float, float]]) -> bool:
-    s = 0.0
-    for i in range(len(poly)):
-        x0, y0 = poly[i]
-        x1, y1 = poly[(i + 1) % len(poly)]
-        s += x0 * y1 - x1 * y0
-    return s > 0
 
 
 # ----------------------------------------------------------------------------------------
@@ -314,14 +232,14 @@ def astar(occ: OccupancyMap, start_xy: Sequence[float], goal_xy: Sequence[float]
     gr, gc = cg
     res = occ.resolution
 
-    def h(node: int) -> float:
+    def heuristic(node: int) -> float:
         r, c = divmod(int(flat[node]), cols)
         dr, dc = abs(r - gr), abs(c - gc)
         return res * (max(dr, dc) + (_SQRT2 - 1.0) * min(dr, dc))
 
     best = {s: 0.0}
     came: dict[int, int] = {}
-    heap = [(h(s), 0, s)]
+    heap = [(heuristic(s), 0, s)]
     counter = 1
     closed: set[int] = set()
     while heap:
@@ -338,7 +256,7 @@ def astar(occ: OccupancyMap, start_xy: Sequence[float], goal_xy: Sequence[float]
             if nd < best.get(v, math.inf) - 1e-12:
                 best[v] = nd
                 came[v] = u
-                heapq.heappush(heap, (nd + h(v), counter, v))
+                heapq.heappush(heap, (nd + heuristic(v), counter, v))
                 counter += 1
     if t not in best:
         return None

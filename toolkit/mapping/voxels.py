@@ -148,7 +148,6 @@ class VoxelMap:
         self._stats = _Stats()
         self._stats.grow(1)
         self._rays: dict[tuple[int, int, float, float, float, float], tuple[np.ndarray, ...]] = {}
-        self.frames = 0
         self.version = 0  # bumped whenever the voxels change
         self.removals = 0  # bumped by forget_instance (maps derived incrementally rebuild)
         self._new_keys: list[np.ndarray] = []  # entries new since the last drain
@@ -216,7 +215,6 @@ class VoxelMap:
         cfg = self.config
         with np.errstate(invalid="ignore"):
             idx = np.flatnonzero((d >= cfg.min_range) & (d < cfg.max_range))
-        self.frames += 1
         if viewpoint is None:
             src = frame.base_pose if frame.base_pose is not None else frame.pose
             viewpoint = (float(src[0, 3]), float(src[1, 3]))
@@ -405,9 +403,6 @@ class VoxelMap:
         """Instance id of every label index (index 0: 0, no instance)."""
         return np.asarray(self._label_ids, dtype=np.int64)
 
-    def label_of(self, instance_id: int) -> int | None:
-        return self._label_of.get(int(instance_id))
-
     def observation(self, instance_id: int) -> InstanceObservation | None:
         lab = self._label_of.get(int(instance_id))
         if lab is None or lab == 0 or lab == OVERFLOW_LABEL:
@@ -436,18 +431,6 @@ class VoxelMap:
         return sorted(i for lab, i in enumerate(self._label_ids)
                       if lab > 0 and st.points_total[lab] > 0)
 
-    def instance_voxels(self, instance_ids: list[int] | set[int]) -> np.ndarray:
-        """ijk (M, 3) of the distinct voxels any of these instances voted for."""
-        labs = [self._label_of[i] for i in sorted(instance_ids) if i in self._label_of]
-        labs = [lab for lab in labs if 0 < lab < OVERFLOW_LABEL]
-        keys, _ = self.entries()
-        if not labs or len(keys) == 0:
-            return np.zeros((0, 3), np.int64)
-        lab = keys & LABEL_MASK
-        sel = keys[lab == labs[0]] if len(labs) == 1 else keys[np.isin(lab, labs)]
-        ix, iy, iz, _ = unpack(sel)
-        return np.stack([ix, iy, iz], axis=1)
-
     def voxels_of(self, instance_ids: list[int]) -> dict[int, np.ndarray]:
         """Instance id -> ijk (M, 3) of its voxels, for several instances in one pass."""
         keys, _ = self.entries()
@@ -464,13 +447,3 @@ class VoxelMap:
         for i, lb in labs.items():
             out[i] = ijk[sl == lb]
         return out
-
-    def instance_voxels_by_label(self) -> tuple[np.ndarray, np.ndarray]:
-        """(ijk (M, 3), instance id (M,)) of every labelled (voxel, label) entry."""
-        keys, _ = self.entries()
-        lab = keys & LABEL_MASK
-        sel = keys[lab > 0]
-        ix, iy, iz, lb = unpack(sel)
-        ids = self.label_ids()
-        inst = np.where(lb < len(ids), ids[np.minimum(lb, len(ids) - 1)], -1)
-        return np.stack([ix, iy, iz], axis=1), inst

@@ -1,9 +1,10 @@
 """Objects to rooms by MoMa-LLM's weighted travel distance, so nothing is assigned through a
 wall.
 
-MoMa-LLM (paper sec. III-B, Eq. 2; exact form from NOTES): for an object o seen from its
-closest viewpoint vp, the candidate nodes are the Voronoi nodes within 2.5 m of o, the
-viewpoint nodes those within 5 m of vp, and
+MoMa-LLM (paper sec. III-B, Eq. 2; the exact form is that of MoMa-LLM's released code, as
+summarised in the project's reference notes): for an object o seen from its closest
+viewpoint vp, the candidate nodes are the Voronoi nodes within 2.5 m of o, the viewpoint
+nodes those within 5 m of vp, and
 
     cost(n) = min_v  d_graph(v, n) / u  +  (|o - n| / u) ** 1.3  +  |vp - v| / u
 

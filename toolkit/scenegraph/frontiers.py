@@ -1,13 +1,14 @@
 """Frontiers of the occupancy grid: clustered, centred on medoids, typed.
 
 Frontiers are "boundaries between explored traversable space and unexplored regions"
-(SCOUT sec. IV-A, after Topiwala et al.). MoMa-LLM's implementation (NOTES): free cells
-next to unknown, not next to occupied, connected to the robot's free component; clustered;
-centre = medoid. A cluster is **leading out** when it touches unknown cells outside the
-hole-filled footprint of what has been seen (occupied or free) -- unknown space open to
-the outside of the explored area, e.g. beyond a doorway -- and an **unexplored area**
-inside its room otherwise (an unseen pocket enclosed by seen space, e.g. behind furniture).
-Pockets smaller than ``min_pocket`` (0.5 m^2) raise no frontier at all.
+(SCOUT sec. IV-A, after Topiwala et al.). MoMa-LLM's released code, as summarised in the
+project's reference notes: free cells next to unknown, not next to occupied, connected to
+the robot's free component; clustered; centre = medoid. A cluster is **leading out** when
+it touches unknown cells outside the hole-filled footprint of what has been seen (occupied
+or free) -- unknown space open to the outside of the explored area, e.g. beyond a doorway
+-- and an **unexplored area** inside its room otherwise (an unseen pocket enclosed by seen
+space, e.g. behind furniture). Pockets smaller than ``min_pocket`` (0.5 m^2) raise no
+frontier at all.
 
 Clusters are 8-connected components of frontier cells of at least ``min_size`` metres;
 longer ones are cut into pieces of at most ``max_size`` along their principal axis so one

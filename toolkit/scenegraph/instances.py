@@ -58,8 +58,6 @@ class InstanceInfo:
         }
 
 
-InstanceTable = Mapping[int, InstanceInfo]
-
 
 def instance_from_record(item: Mapping[str, Any]) -> InstanceInfo:
     parent = item.get("parent")

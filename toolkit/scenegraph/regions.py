@@ -3,9 +3,9 @@
 SCOUT's third layer holds regions and frontiers; SymSearch (sec. V-B) clusters a room's
 object positions with a Gaussian mixture whose component count is chosen by BIC. A room
 being explored may hold no object yet, and every region must be a place the robot can go,
-so we cluster the room's Voronoi nodes instead: k-means on node positions with
-``k = clamp(round(graph length / region_length), 1, max_regions)``, initialised
-deterministically (the node nearest the room centre node, then farthest-point), with the
+so we cluster the room's Voronoi nodes instead: k-means (:mod:`sgtool.scenegraph.kmeans`)
+on node positions with ``k = clamp(round(graph length / region_length), 1, max_regions)``,
+initialised deterministically (the room centre node, then farthest-point), with the
 region's position the node closest to its cluster mean (a real, reachable node). An
 object's region is the region of the node it was assigned to
 (:mod:`sgtool.scenegraph.assign`), so regions and objects agree.
@@ -16,6 +16,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+
+from sgtool.scenegraph.kmeans import kmeans, planar_distances
 
 
 @dataclass(frozen=True)
@@ -40,25 +42,8 @@ def cluster_room(positions: np.ndarray, length: float, centre: int,
     if k == 0:
         return Regions(np.zeros(0, np.int64), np.zeros(0, np.int64))
     r = int(min(max(1, round(length / cfg.region_length)), cfg.max_regions, k))
-    seeds = [int(centre)]
-    d = np.hypot(*(positions - positions[centre]).T)
-    while len(seeds) < r:
-        j = int(np.argmax(d))  # ties: lowest index
-        seeds.append(j)
-        d = np.minimum(d, np.hypot(*(positions - positions[j]).T))
-    means = positions[seeds].astype(np.float64)
-    labels = np.full(k, -1, dtype=np.int64)
-    for _ in range(cfg.iterations):
-        dist = np.hypot(positions[:, None, 0] - means[None, :, 0],
-                        positions[:, None, 1] - means[None, :, 1])
-        new = np.argmin(dist, axis=1)
-        if np.array_equal(new, labels):
-            break
-        labels = new
-        for c in range(r):
-            sel = labels == c
-            if sel.any():
-                means[c] = positions[sel].mean(axis=0)
+    labels, means = kmeans(positions, r, centre, metric=planar_distances,
+                           iterations=cfg.iterations)
     centres = np.zeros(r, dtype=np.int64)
     keep = []
     for c in range(r):

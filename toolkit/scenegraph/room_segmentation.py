@@ -4,9 +4,10 @@ MoMa-LLM (paper sec. III-B, "Room clustering (door-based separation)"): a Gaussi
 density over observed door positions, ``rho(x) = 1/N_D sum_i K_H(x - x_i)``; Voronoi edges
 and nodes in high-density door regions are removed, which cuts the graph into disjoint
 components, the rooms. Neighbouring rooms: "if a path traverses exactly two components,
-they are marked as neighbors". Their code (NOTES): bandwidth 0.15 m evaluated on the grid,
-an edge is cut when its summed density exceeds 0.001, isolated nodes and tiny components
-are dropped, the room's position is the graph centre.
+they are marked as neighbors". MoMa-LLM's released code (as summarised in the project's
+reference notes): bandwidth 0.15 m evaluated on the grid, an edge is cut when its summed
+density exceeds 0.001, isolated nodes and tiny components are dropped, the room's position
+is the graph centre.
 
 What we do, and why it differs:
 

@@ -25,9 +25,10 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Literal
 
 from sgtool.log.frame import Frame
+from sgtool.log.records import Instances
 from sgtool.scenegraph.builder import BuilderConfig, MapLayers, SceneGraphBuilder
 from sgtool.scenegraph.categories import RoomClassifier
 from sgtool.scenegraph.graph import SceneGraph
@@ -70,11 +71,11 @@ class SceneGraphStream:
         """The last refresh (None before the first)."""
         return self._current
 
-    def instances(self, t_ns: int, record: Mapping[str, Any]) -> list[int]:
+    def instances(self, t_ns: int, record: Instances) -> list[int]:
         """A new instance table (an ``sgtool.Instances`` record); returns the instances whose
         state changed."""
         first = not self.builder.instances
-        changed = self.builder.set_instances(instances_from_record(record))
+        changed = self.builder.set_instances(instances_from_record(record.to_json()))
         if changed or (first and self.frames):
             self._dirty = True
         return changed

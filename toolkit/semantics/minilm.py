@@ -105,7 +105,7 @@ class MiniLM:
             )
 
     # ------------------------------------------------------------------------------------
-    def _ln(self, x: np.ndarray, gb: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    def _layer_norm(self, x: np.ndarray, gb: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
         mu = x.mean(axis=-1, keepdims=True)
         var = ((x - mu) ** 2).mean(axis=-1, keepdims=True)
         return ((x - mu) / np.sqrt(var + self.eps)) * gb[0] + gb[1]
@@ -116,7 +116,7 @@ class MiniLM:
         h, nh = self.hidden, self.heads
         d = h // nh
         x = self.word[ids] + self.pos[:n][None] + self.type[types]
-        x = self._ln(x, self.emb_ln).reshape(b * n, h).astype(np.float32)
+        x = self._layer_norm(x, self.emb_ln).reshape(b * n, h).astype(np.float32)
         scale = np.float32(1.0 / np.sqrt(d))
         for blk in self.blocks:
             qkv = x @ blk["qkv_w"] + blk["qkv_b"]  # (B*L, 3H)
@@ -127,10 +127,10 @@ class MiniLM:
             p = np.exp(s)
             p /= p.sum(axis=-1, keepdims=True)
             ctx = (p @ val).transpose(0, 2, 1, 3).reshape(b * n, h)
-            x = self._ln(ctx @ blk["o_w"] + blk["o_b"] + x, blk["ln1"])
+            x = self._layer_norm(ctx @ blk["o_w"] + blk["o_b"] + x, blk["ln1"])
             inter = x @ blk["i_w"] + blk["i_b"]
             inter = 0.5 * inter * (1.0 + erf(inter * np.float32(1.0 / np.sqrt(2.0))))
-            x = self._ln(inter.astype(np.float32) @ blk["f_w"] + blk["f_b"] + x, blk["ln2"])
+            x = self._layer_norm(inter.astype(np.float32) @ blk["f_w"] + blk["f_b"] + x, blk["ln2"])
         pooled = x.reshape(b, n, h).mean(axis=1)
         norm = np.maximum(np.linalg.norm(pooled, axis=1, keepdims=True), 1e-12)
         return (pooled / norm).astype(np.float32)

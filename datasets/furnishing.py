@@ -1,0 +1,177 @@
+"""Furniture of a generated house (step 3 of :mod:`sgtool.datasets.generator`): per room,
+the categories of that room type's real inventories drawn with their frequencies, placed
+against walls, in the open (tables) or around tables (chairs), stacked pieces on a base,
+each kept only if the room stays crossable and its containers reachable."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from sgtool.datasets.house_inventory import Inventory
+from sgtool.datasets.house_plan import Piece, Plan, PlanRoom, Rect, snap
+from sgtool.datasets.room_space import RoomSpace
+from sgtool.datasets.sizes import (
+    CENTRAL,
+    DEFAULT_MAX_PER_ROOM,
+    MAX_PER_ROOM,
+    SEATS,
+    STACKED_ON,
+    furniture_size,
+)
+from sgtool.datasets.synsets import ancestors
+
+
+def _furniture_list(rng: np.random.Generator, room_type: str, inv: Inventory) -> list[str]:
+    rows = inv.furniture.get(room_type, ())
+    out: list[str] = []
+    for f in rows:
+        if rng.random() >= f.frequency:
+            continue
+        cap = MAX_PER_ROOM.get(f.synset, DEFAULT_MAX_PER_ROOM)
+        n = 1 + int(rng.poisson(max(f.mean_count - 1.0, 0.0)))
+        out += [f.synset] * min(n, cap)
+    if room_type != "corridor" and not any(_holds_things(s, inv) for s in out):
+        useful = [f.synset for f in rows if _holds_things(f.synset, inv)]
+        if useful:
+            out.append(useful[0])
+    return out
+
+
+def _holds_things(synset: str, inv: Inventory) -> bool:
+    a = inv.knowledge.affordances.get(synset, ())
+    return "container" in a or "supporter" in a
+
+
+def _jittered_size(rng: np.random.Generator, size: tuple[float, float, float]
+            ) -> tuple[float, float, float]:
+    f = rng.uniform(0.92, 1.08, size=3)
+    return tuple(round(float(s * k), 2) for s, k in zip(size, f, strict=True))  # type: ignore[return-value]
+
+
+def _footprint(cx: float, cy: float, w: float, d: float, yaw: float) -> Rect:
+    if abs(math.sin(yaw)) > 0.5:  # rotated by +-90 degrees
+        w, d = d, w
+    return Rect(round(cx - w / 2, 4), round(cy - d / 2, 4), round(cx + w / 2, 4),
+                 round(cy + d / 2, 4))
+
+
+def _wall_candidate(rng: np.random.Generator, inner: Rect, w: float,
+                    d: float) -> tuple[float, float, float] | None:
+    """(cx, cy, yaw) of a piece of width w (along the wall) and depth d against a wall; the
+    piece's front (local +y) faces into the room."""
+    side = int(rng.integers(4))
+    if side in (0, 1):  # south / north wall: runs along x
+        if inner.width < w:
+            return None
+        cx = snap(float(rng.uniform(inner.x0 + w / 2, inner.x1 - w / 2)), 0.01)
+        cx = min(max(cx, inner.x0 + w / 2), inner.x1 - w / 2)
+        if side == 0:
+            return (cx, inner.y0 + d / 2, 0.0)
+        return (cx, inner.y1 - d / 2, math.pi)
+    if inner.height < w:
+        return None
+    cy = snap(float(rng.uniform(inner.y0 + w / 2, inner.y1 - w / 2)), 0.01)
+    cy = min(max(cy, inner.y0 + w / 2), inner.y1 - w / 2)
+    if side == 2:  # west wall, front faces +x
+        return (inner.x0 + d / 2, cy, -math.pi / 2)
+    return (inner.x1 - d / 2, cy, math.pi / 2)
+
+
+def furnish_room(rng: np.random.Generator, room: PlanRoom, plan: Plan, inv: Inventory,
+                 pieces: list[Piece]) -> None:
+    """Draw and place the furniture of ``room``, appending the kept pieces to ``pieces``
+    (whose length gives the index of the room's first piece)."""
+    space = RoomSpace(room, plan.openings)
+    wanted = _furniture_list(rng, room.type, inv)
+    floor = [s for s in wanted if s not in STACKED_ON]
+    stacked = [s for s in wanted if s in STACKED_ON]
+
+    def order_key(s: str) -> tuple[int, float, str]:
+        w, d, _ = furniture_size(s)
+        group = 2 if s in SEATS else (1 if s in CENTRAL else 0)
+        return (group, -w * d, s)
+
+    floor.sort(key=order_key)
+    mine: list[Piece] = []
+    for s in floor:
+        size = _jittered_size(rng, furniture_size(s))
+        w, d, h = size
+        placed = None
+        for _ in range(24):
+            if s in SEATS and any(p.synset in CENTRAL for p in mine):
+                cand = _seat_candidate(rng, [p for p in mine if p.synset in CENTRAL], w, d)
+            elif s in CENTRAL and _ < 12:
+                m = 0.75
+                x0, x1 = space.inner.x0 + m + w / 2, space.inner.x1 - m - w / 2
+                y0, y1 = space.inner.y0 + m + d / 2, space.inner.y1 - m - d / 2
+                if x1 < x0 or y1 < y0:
+                    cand = _wall_candidate(rng, space.inner, w, d)
+                else:
+                    cand = (snap(float(rng.uniform(x0, x1)), 0.01),
+                            snap(float(rng.uniform(y0, y1)), 0.01), 0.0)
+            else:
+                cand = _wall_candidate(rng, space.inner, w, d)
+            if cand is None:
+                continue
+            cx, cy, yaw = cand
+            box = _footprint(cx, cy, w, d, yaw)
+            if not box.inside(space.inner):
+                continue
+            if any(box.overlaps(p.box, 0.05) for p in mine):
+                continue
+            if any(box.overlaps(k) for k in space.keepouts):
+                continue
+            aff = inv.knowledge.affordances.get(s, ())
+            reach = [p.box for p in mine if p.affordances]
+            if aff:
+                reach.append(box)
+            if not space.free_ok(reach, box):
+                continue
+            placed = Piece(s, room.idx, box, 0.0, size, yaw % (2 * math.pi), None, False,
+                            aff, _initial_state(rng, aff))
+            break
+        if placed is not None:
+            space.add(placed.box)
+            mine.append(placed)
+    for s in stacked:
+        bases = [p for p in mine if p.on is None and not p.top_used
+                 and any(a in ancestors(p.synset) for a in STACKED_ON[s])]
+        size = _jittered_size(rng, furniture_size(s))
+        bases = [p for p in bases if p.size[0] >= size[0] and p.size[1] >= size[1]]
+        if not bases:
+            continue
+        base = bases[int(rng.integers(len(bases)))]
+        base.top_used = True
+        cx, cy = (base.box.x0 + base.box.x1) / 2, (base.box.y0 + base.box.y1) / 2
+        aff = inv.knowledge.affordances.get(s, ())
+        mine.append(Piece(s, room.idx, _footprint(cx, cy, size[0], size[1], base.yaw),
+                           base.z0 + base.size[2], size, base.yaw,
+                           len(pieces) + mine.index(base), True, aff,
+                           _initial_state(rng, aff)))
+    pieces.extend(mine)
+
+
+def _seat_candidate(rng: np.random.Generator, tables: list[Piece], w: float,
+                    d: float) -> tuple[float, float, float]:
+    t = tables[int(rng.integers(len(tables)))]
+    side = int(rng.integers(4))
+    b = t.box
+    gap = 0.05
+    if side == 0:  # south of the table, facing +y (north)
+        x = float(rng.uniform(b.x0 + w / 2, max(b.x1 - w / 2, b.x0 + w / 2)))
+        return (snap(x, 0.01), b.y0 - gap - d / 2, 0.0)
+    if side == 1:
+        x = float(rng.uniform(b.x0 + w / 2, max(b.x1 - w / 2, b.x0 + w / 2)))
+        return (snap(x, 0.01), b.y1 + gap + d / 2, math.pi)
+    y = float(rng.uniform(b.y0 + w / 2, max(b.y1 - w / 2, b.y0 + w / 2)))
+    if side == 2:  # west of the table, facing +x
+        return (b.x0 - gap - d / 2, snap(y, 0.01), -math.pi / 2)
+    return (b.x1 + gap + d / 2, snap(y, 0.01), math.pi / 2)
+
+
+def _initial_state(rng: np.random.Generator, aff: tuple[str, ...]) -> str | None:
+    if "openable" not in aff:
+        return None
+    return "open" if rng.random() < 0.1 else "closed"

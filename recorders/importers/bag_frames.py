@@ -1,0 +1,118 @@
+"""Pass 2 of a bag import: the planned frames decoded from the image messages (depth,
+colour, instance ids) in time order, only the images the plan uses; and the camera
+intrinsics from ``--info`` or ``--intrinsics``, checked against the depth images."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sgtool.errors import SgtoolError
+from sgtool.log.frame import CameraIntrinsics
+from sgtool.recorders.importers import bagfiles as B
+from sgtool.recorders.importers.bag_index import BagIndex
+from sgtool.recorders.importers.bag_options import BagOptions
+from sgtool.recorders.importers.bag_sync import PlannedFrame
+from sgtool.recorders.importers.images import (
+    decode_color_message,
+    decode_depth_message,
+    decode_ids_message,
+    depth_for_log,
+    resize_to,
+)
+from sgtool.recorders.importers.sink import ImportFrame
+
+
+def decode_frames(
+    reader: Any, plan: list[PlannedFrame], idx: BagIndex, opts: BagOptions, k: CameraIntrinsics
+) -> Iterator[ImportFrame]:
+    """The planned frames in time order, decoding only the images they use."""
+    need: dict[str, dict[int, Any]] = {
+        "depth": {p.k_depth: i for i, p in enumerate(plan)},
+        "rgb": {},
+        "ids": {},
+    }
+    for i, p in enumerate(plan):
+        if p.k_rgb is not None:
+            need["rgb"].setdefault(p.k_rgb, []).append(i)
+        if p.k_ids is not None:
+            need["ids"].setdefault(p.k_ids, []).append(i)
+    topic_kind = {opts.depth: "depth", opts.rgb: "rgb", opts.ids: "ids"}
+    topic_kind.pop(None, None)
+    counters = dict.fromkeys(("depth", "rgb", "ids"), 0)
+    decoded: dict[int, dict[str, Any]] = {}
+    conns = [c for c in reader.connections if c.topic in topic_kind]
+    next_i = 0
+
+    def complete(i: int) -> bool:
+        d = decoded.get(i, {})
+        p = plan[i]
+        return ("depth" in d and (p.k_rgb is None or "rgb" in d)
+                and (p.k_ids is None or "ids" in d))
+
+    def build(i: int) -> ImportFrame:
+        d = decoded.pop(i)
+        raw, scale = d["depth"]
+        rgb = resize_to(d["rgb"], k.width, k.height) if "rgb" in d else None
+        ids = resize_to(d["ids"], k.width, k.height) if "ids" in d else None
+        pose = plan[i].pose if plan[i].pose is not None else np.eye(4)
+        return ImportFrame(plan[i].t_ns, depth_for_log(raw, scale), pose, k, rgb=rgb, ids=ids)
+
+    for c, _, raw in reader.messages(connections=conns):
+        kind = topic_kind[c.topic]
+        kk = counters[kind]
+        counters[kind] += 1
+        targets = need[kind].get(kk)
+        if targets is None:
+            continue
+        mt = B.normalise_type(c.msgtype)
+        msg = reader.deserialize(raw, c.msgtype)
+        if kind == "depth":
+            raw_d, scale = decode_depth_message(msg, mt, c.topic)
+            if raw_d.shape != (k.height, k.width):
+                raise SgtoolError(
+                    f"topic {c.topic}: a depth image of {raw_d.shape[1]}x{raw_d.shape[0]} "
+                    f"pixels; the camera info says {k.width}x{k.height}"
+                )
+            if opts.depth_scale is not None and raw_d.dtype == np.uint16:
+                scale = opts.depth_scale
+            decoded.setdefault(targets, {})["depth"] = (raw_d, scale)
+        else:
+            arr = (decode_color_message(msg, mt, c.topic) if kind == "rgb"
+                   else decode_ids_message(msg, mt, c.topic))
+            for i in targets:
+                decoded.setdefault(i, {})[kind] = arr
+        while next_i < len(plan) and complete(next_i):
+            yield build(next_i)
+            next_i += 1
+    while next_i < len(plan):
+        if not complete(next_i):  # the bag changed between the passes
+            raise SgtoolError("the bag's images changed while it was being read")
+        yield build(next_i)
+        next_i += 1
+
+
+def camera_of(path: Path, idx: BagIndex, opts: BagOptions) -> CameraIntrinsics:
+    if not idx.samples:
+        raise SgtoolError(f"{path}: --depth {opts.depth} has no messages")
+    raw, _ = next(iter(idx.samples.values()))
+    h, w = raw.shape[:2]
+    if opts.intrinsics is not None:
+        p = opts.intrinsics
+        if (p.width and p.width != w) or (p.height and p.height != h):
+            raise SgtoolError(f"--intrinsics are for {p.width}x{p.height}, depth is {w}x{h}")
+        return CameraIntrinsics(w, h, p.fx, p.fy, p.cx, p.cy)
+    if idx.info is None:
+        raise SgtoolError(f"{path}: --info {opts.info} has no messages")
+    iw, ih, fx, fy, cx, cy = idx.info
+    if (iw, ih) != (w, h):
+        raise SgtoolError(
+            f"{path}: --info {opts.info} is for {iw}x{ih} images but the depth images on "
+            f"{opts.depth} are {w}x{h}; give the depth camera's CameraInfo topic"
+        )
+    if fx <= 0 or fy <= 0:
+        raise SgtoolError(f"{path}: --info {opts.info} has no focal length (K is zero)")
+    return CameraIntrinsics(w, h, fx, fy, cx, cy)

@@ -1,0 +1,97 @@
+"""Pass 1 of a bag import: the time stamps and frames of the images, the tf tree, the pose
+samples and the calibration, and a few depth images for the world alignment -- everything
+but the images, so memory stays small."""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from sgtool.recorders.importers import bagfiles as B
+from sgtool.recorders.importers.bag_messages import (
+    add_tf_message,
+    intrinsics_of_info,
+    pose_of_message,
+    stamp_ns,
+)
+from sgtool.recorders.importers.bag_options import BagOptions
+from sgtool.recorders.importers.images import decode_depth_message
+from sgtool.recorders.importers.tftree import TfTree, frame_name
+from sgtool.recorders.importers.upright import sample_indices
+
+
+@dataclass
+class ImageIndex:
+    stamps: list[int] = field(default_factory=list)
+    frames: list[str] = field(default_factory=list)
+
+
+@dataclass
+class BagIndex:
+    depth: ImageIndex = field(default_factory=ImageIndex)
+    rgb: ImageIndex = field(default_factory=ImageIndex)
+    ids: ImageIndex = field(default_factory=ImageIndex)
+    tf: TfTree = field(default_factory=TfTree)
+    pose_samples: list[tuple[int, np.ndarray]] = field(default_factory=list)
+    pose_frame: str = ""
+    info: tuple[int, int, float, float, float, float] | None = None
+    info_changes: int = 0
+    samples: dict[int, tuple[np.ndarray, float]] = field(default_factory=dict)  # depth k ->
+    zero_stamps: int = 0
+
+
+def _stamp_or_bagtime(header: Any, bag_t: int, idx: BagIndex) -> int:
+    t = stamp_ns(header)
+    if t == 0:
+        idx.zero_stamps += 1
+        return int(bag_t)
+    return t
+
+
+def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIndex:
+    """Pass 1 over the wanted topics (module doc); the tf tree comes back frozen."""
+    from tqdm import tqdm
+
+    idx = BagIndex(tf=TfTree(max_gap_ns=opts.tf_max_gap_ns, tolerance_ns=opts.tf_tolerance_ns))
+    tf_topics = [t.topic for t in topics if t.msgtype in B.TF_TYPES]
+    wanted = {opts.depth, opts.rgb, opts.ids, opts.info, opts.pose, *tf_topics} - {None}
+    conns = [c for c in reader.connections if c.topic in wanted]
+    n_depth = sum(t.count for t in topics if t.topic == opts.depth)
+    keep = set(sample_indices(n_depth))  # depth images kept for the world alignment
+    total = sum(int(c.msgcount) for c in conns)
+    bar = tqdm(total=total, unit="msg", desc="index", file=sys.stderr,
+               disable=None if opts.progress else True, leave=False)
+    try:
+        for c, bag_t, raw in reader.messages(connections=conns):
+            bar.update(1)
+            msg = reader.deserialize(raw, c.msgtype)
+            mt = B.normalise_type(c.msgtype)
+            if c.topic in tf_topics:
+                add_tf_message(idx.tf, msg, c.topic)
+                continue
+            if c.topic == opts.pose:
+                t, parent, T = pose_of_message(msg, mt)  # noqa: N806
+                idx.pose_samples.append((t, T))
+                idx.pose_frame = idx.pose_frame or parent
+                continue
+            if c.topic == opts.info:
+                k = intrinsics_of_info(msg)
+                if idx.info is None:
+                    idx.info = k
+                elif k != idx.info:
+                    idx.info_changes += 1
+                continue
+            for topic, ii in ((opts.depth, idx.depth), (opts.rgb, idx.rgb), (opts.ids, idx.ids)):
+                if c.topic == topic:
+                    t = _stamp_or_bagtime(msg.header, bag_t, idx)
+                    if topic == opts.depth and len(ii.stamps) in keep:
+                        idx.samples[len(ii.stamps)] = decode_depth_message(msg, mt, topic)
+                    ii.stamps.append(t)
+                    ii.frames.append(frame_name(msg.header.frame_id))
+    finally:
+        bar.close()
+    idx.tf.freeze()
+    return idx

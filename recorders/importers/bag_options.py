@@ -1,0 +1,50 @@
+"""The options of a bag import (the flags of ``sgtool import bag``) and the check of its
+numeric ones, before the bag is opened."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sgtool.recorders.importers.checks import (
+    check_counts,
+    check_depth_scale,
+    check_non_negative,
+    check_positive,
+)
+from sgtool.recorders.importers.textformats import PinholeParams
+
+
+@dataclass(frozen=True)
+class BagOptions:
+    rgb: str | None = None
+    depth: str | None = None
+    ids: str | None = None
+    info: str | None = None
+    tf_frames: tuple[str, str] | None = None  # (world, camera)
+    pose: str | None = None
+    intrinsics: PinholeParams | None = None
+    depth_scale: float | None = None  # units per metre of 16-bit depth; None = mm
+    max_dt_ns: int = 20_000_000
+    tf_tolerance_ns: int = 50_000_000
+    tf_max_gap_ns: int = 500_000_000
+    up: np.ndarray | None = None
+    floor: float | None = None
+    floor_auto: bool = True
+    every: int = 1
+    limit: int | None = None
+    progress: bool = True
+    compression: str = "zstd"
+    estimate_poses: bool = False
+    odometry: str = "rgbd+icp"
+    depth_max: float = 4.0
+
+
+def check_options(opts: BagOptions) -> None:
+    """The numeric options, before the bag is opened (user errors naming the flag)."""
+    check_counts(opts.every, opts.limit)
+    check_depth_scale(opts.depth_scale)
+    check_positive(opts.depth_max, "--depth-max", "metres")
+    check_non_negative(opts.max_dt_ns / 1e9, "--max-dt", "seconds")
+    check_non_negative(opts.tf_tolerance_ns / 1e9, "--tf-tolerance", "seconds")

@@ -1,0 +1,72 @@
+"""Where the camera poses of a bag import come from: a pose topic (``--pose``) or the tf
+tree between a world frame and the camera frame (``--tf-frames``, by default the depth
+image's frame in the root of its tree), checked against the bag with errors that list
+its frames and links."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from sgtool.errors import SgtoolError
+from sgtool.recorders.importers.bag_index import BagIndex
+from sgtool.recorders.importers.bag_options import BagOptions
+from sgtool.recorders.importers.poses import PoseTrack
+from sgtool.recorders.importers.tftree import TfTree, frame_name
+
+
+@dataclass(frozen=True)
+class PoseSource:
+    """world_T_camera at a time, from the tf ``tree`` or a pose ``track`` (one of them)."""
+
+    world: str  # frame name
+    camera: str  # frame name ("camera" for a pose topic)
+    describe: str  # for notes, errors and the log metadata
+    tree: TfTree | None = None
+    track: PoseTrack | None = None
+
+    def at(self, t_ns: int, camera: str | None = None) -> np.ndarray | None:
+        """The pose at ``t_ns`` (of frame ``camera`` instead of the source's, in a tree);
+        None where it cannot be resolved."""
+        if self.track is not None:
+            return self.track.at(t_ns)
+        assert self.tree is not None
+        return self.tree.lookup(self.world, camera or self.camera, t_ns)
+
+
+def pose_source_of(path: Path, idx: BagIndex, opts: BagOptions) -> PoseSource:
+    if opts.pose is not None:
+        if not idx.pose_samples:
+            raise SgtoolError(f"{path}: --pose {opts.pose} has no messages")
+        track = PoseTrack.from_samples(idx.pose_samples, max_gap_ns=opts.tf_max_gap_ns,
+                                       tolerance_ns=opts.tf_tolerance_ns)
+        return PoseSource(idx.pose_frame or "world", "camera",
+                           f"topic {opts.pose} ({len(track)} poses)", track=track)
+    tree = idx.tf
+    if not tree.links:
+        raise SgtoolError(f"{path}: no transforms on /tf or /tf_static; give --pose TOPIC")
+    frames_list = ", ".join(tree.frames())
+    if opts.tf_frames is not None:
+        world, camera = (frame_name(f) for f in opts.tf_frames)
+    else:
+        camera = idx.depth.frames[0] if idx.depth.frames else ""
+        if camera not in tree.frames():
+            raise SgtoolError(
+                f"{path}: the depth images are in frame {camera!r}, which is not in the tf "
+                f"tree (frames: {frames_list}); give --tf-frames WORLD:CAMERA"
+            )
+        world = tree.root_of(camera)
+    for f in (world, camera):
+        if f not in tree.frames():
+            raise SgtoolError(
+                f"{path}: --tf-frames: frame {f!r} is not in the tf tree; its links are:\n  "
+                + "\n  ".join(tree.describe())
+            )
+    if tree.path(world, camera) is None:
+        raise SgtoolError(
+            f"{path}: frames {world!r} and {camera!r} are not connected in the tf tree "
+            f"(roots: {', '.join(tree.roots())}); links:\n  " + "\n  ".join(tree.describe())
+        )
+    return PoseSource(world, camera, f"tf {world} -> {camera}", tree=tree)

@@ -1,0 +1,160 @@
+"""Which topics of a bag to import: the check of the topic flags against the bag's topics,
+and, when a flag is missing or wrong, the listing of its topics and tf frames with
+suggested flags (also ``sgtool import bag PATH --list``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from sgtool.errors import SgtoolError
+from sgtool.recorders.importers import bagfiles as B
+from sgtool.recorders.importers.bag_messages import add_tf_message
+from sgtool.recorders.importers.bag_options import BagOptions
+from sgtool.recorders.importers.tftree import TfTree
+
+
+def suggest_flags(topics: list[B.TopicInfo], tf_frames: list[str] | None = None) -> list[str]:
+    """Flags guessed from topic names and types (depth/colour/camera_info/ids). Without a
+    depth topic, one item of alternatives for a trajectory: ``tf_frames`` (``--tf-frames
+    WORLD:FRAME`` when not given and the bag has tf) and the pose topics."""
+    images = [t.topic for t in topics if t.msgtype in B.IMAGE_TYPES]
+    infos = [t.topic for t in topics if t.msgtype in B.INFO_TYPES]
+    poses = [t.topic for t in topics if t.msgtype in B.POSE_TYPES]
+    tfs = [t.topic for t in topics if t.msgtype in B.TF_TYPES]
+    out = []
+    depth = next((t for t in images if "depth" in t.lower()), None)
+    ids_words = ("instance", "segment", "label", "ids", "mask")
+    ids = next((t for t in images if any(w in t.lower() for w in ids_words)), None)
+    rgb = next(
+        (t for t in images if t not in (depth, ids)
+         and any(w in t.lower() for w in ("rgb", "color", "colour", "image"))),
+        None,
+    )
+    out.extend(f"{flag} {topic}" for flag, topic in (("--depth", depth), ("--rgb", rgb),
+                                                     ("--ids", ids)) if topic)
+    if infos:
+        ns = depth.rsplit("/", 1)[0] if depth else ""
+        out.append(f"--info {next((t for t in infos if ns and t.startswith(ns)), infos[0])}")
+    if not depth:
+        alternatives = (list(tf_frames) if tf_frames is not None else
+                        ["--tf-frames WORLD:FRAME"] if tfs else [])
+        alternatives += [f"--pose {p}" for p in poses[:4]]
+        if len(poses) > 4:
+            alternatives.append(f"... ({len(poses) - 4} more pose topics)")
+        if alternatives:
+            out.append(" | ".join(alternatives))
+    return out
+
+
+def peek_tf(reader: Any, topics: list[B.TopicInfo], max_messages: int = 500) -> TfTree:
+    """The tf tree from ``/tf_static`` and the first ``max_messages`` ``/tf`` messages: the
+    frames a bag has, cheaply, for listing and suggestions."""
+    tree = TfTree()
+    for t in topics:
+        if t.msgtype not in B.TF_TYPES:
+            continue
+        for n, (c, _, raw) in enumerate(reader.messages(B.connections_for(reader, t.topic))):
+            if n >= max_messages:
+                break
+            add_tf_message(tree, reader.deserialize(raw, c.msgtype), t.topic)
+    return tree.freeze()
+
+
+def tf_suggestions(tree: TfTree) -> list[str]:
+    """``--tf-frames ROOT:LEAF`` for every leaf frame of the tree."""
+    parents = {link.parent for link in tree.links.values()}
+    leaves = sorted(f for f in tree.links if f not in parents)
+    cams = [f for f in leaves if "optical" in f] or [f for f in leaves if "camera" in f]
+    picks = cams or leaves
+    out = [f"--tf-frames {tree.root_of(f)}:{f}" for f in picks[:6]]
+    if len(picks) > 6:
+        out.append(f"... ({len(picks) - 6} more)")
+    return out
+
+
+def describe_bag(reader: Any, path: Path) -> str:
+    """Topics, tf links and suggested flags (``sgtool import bag PATH --list``)."""
+    topics = B.list_topics(reader)
+    tree = peek_tf(reader, topics)
+    lines = [f"{path} ({B.bag_kind(path)}): topics", B.format_topics(topics)]
+    if tree.links:
+        lines.append("tf links (from /tf_static and the first /tf messages):")
+        lines.extend("  " + d for d in tree.describe())
+    sugg = suggest_flags(topics, tf_frames=[])
+    if sugg:
+        lines.append("suggested flags: " + " ".join(sugg))
+    tfs = tf_suggestions(tree)
+    if tfs:
+        lines.append("camera / trajectory frames: " + " | ".join(tfs))
+    return "\n".join(lines)
+
+
+def missing_message(
+    path: Path, topics: list[B.TopicInfo], what: str, reader: Any = None
+) -> str:
+    tfs = None
+    if reader is not None and any(t.msgtype in B.TF_TYPES for t in topics):
+        tfs = tf_suggestions(peek_tf(reader, topics)) or None
+    sugg = suggest_flags(topics, tf_frames=tfs)
+    return (
+        f"{path}: {what}. The bag's topics:\n{B.format_topics(topics)}"
+        + (f"\nsuggested flags: {' '.join(sugg)}" if sugg else "")
+    )
+
+
+def _check_topic(
+    path: Path, topics: list[B.TopicInfo], topic: str | None, flag: str, allowed: tuple[str, ...]
+) -> None:
+    if topic is None:
+        return
+    found = {t.topic: t for t in topics}
+    if topic not in found:
+        raise SgtoolError(missing_message(path, topics, f"{flag} {topic}: no such topic"))
+    t = found[topic]
+    if t.msgtype not in allowed:
+        raise SgtoolError(
+            f"{path}: {flag} {topic} is a {t.msgtype} topic; {flag} needs "
+            + " or ".join(allowed)
+        )
+    if t.count == 0:
+        raise SgtoolError(f"{path}: {flag} {topic} has no messages")
+
+
+def check_flags(
+    path: Path, topics: list[B.TopicInfo], opts: BagOptions, reader: Any = None
+) -> None:
+    if opts.estimate_poses and opts.depth is None:
+        has_images = any(t.msgtype in B.IMAGE_TYPES for t in topics)
+        raise SgtoolError(missing_message(
+            path, topics,
+            "--estimate-poses estimates camera poses from depth images, and "
+            + ("it needs --depth (and --info, --rgb)" if has_images else
+               "the bag has no image topic (sensor_msgs Image or CompressedImage): import "
+               "its trajectory with --tf-frames or --pose, without --estimate-poses"),
+            reader,
+        ))
+    if opts.depth is None and opts.tf_frames is None and opts.pose is None:
+        raise SgtoolError(missing_message(
+            path, topics,
+            "say which topics to import: --depth (and --rgb, --info) for camera frames, or "
+            "--tf-frames WORLD:FRAME / --pose TOPIC for a trajectory", reader,
+        ))
+    if opts.depth is None and (opts.rgb or opts.ids or opts.info):
+        raise SgtoolError(
+            missing_message(path, topics, "--rgb/--ids/--info need --depth (a frame is a "
+                             "depth image)")
+        )
+    _check_topic(path, topics, opts.depth, "--depth", B.IMAGE_TYPES)
+    _check_topic(path, topics, opts.rgb, "--rgb", B.IMAGE_TYPES)
+    _check_topic(path, topics, opts.ids, "--ids", B.IMAGE_TYPES)
+    _check_topic(path, topics, opts.info, "--info", B.INFO_TYPES)
+    _check_topic(path, topics, opts.pose, "--pose", B.POSE_TYPES)
+    if opts.depth and opts.info is None and opts.intrinsics is None:
+        infos = [t.topic for t in topics if t.msgtype in B.INFO_TYPES]
+        raise SgtoolError(
+            f"{path}: the camera intrinsics are needed: give --info TOPIC "
+            + (f"(CameraInfo topics: {', '.join(infos)})" if infos else
+               "(the bag has no CameraInfo topic)")
+            + " or --intrinsics fx,fy,cx,cy"
+        )

@@ -1,0 +1,43 @@
+"""What the simulation tells the outside: skill outcomes, observer callbacks, and the
+signal an observer raises to stop a run."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from sgtool.recorders.sim.simulation import Simulation
+
+
+class StopSimulation(Exception):  # noqa: N818 (a control-flow signal, not an error)
+    """Raised by an observer to end the current run (frame budget reached)."""
+
+
+@dataclass(frozen=True)
+class SkillOutcome:
+    """What a skill did: the log's ``sgtool.Action`` fields."""
+
+    skill: str
+    target: str | None
+    outcome: str  # success | failure | invalid
+    reason: str = ""
+    travelled_m: float = 0.0
+    ticks: int = 0
+
+    @property
+    def success(self) -> bool:
+        return self.outcome == "success"
+
+
+class SimObserver:
+    """Receives the simulation's events; override what you need."""
+
+    def on_tick(self, sim: Simulation) -> None:
+        """A new frame: the base and the doors are where they are at ``sim.tick_index``."""
+
+    def on_state(self, sim: Simulation, spec_id: str, state: str) -> None:
+        """A door or container changed to ``state`` (at the current tick)."""
+
+    def on_skill(self, sim: Simulation, outcome: SkillOutcome) -> None:
+        """A top-level skill finished (at the last tick it took)."""

@@ -1,0 +1,37 @@
+"""The symbolic object-search benchmark: SCOUT's SymSearch roll-out over generated houses.
+
+SCOUT (sec. V) evaluates high-level search decisions on scene graphs without a simulator.
+This package turns a :class:`~sgtool.house.spec.HouseSpec` into that environment:
+
+- :mod:`~sgtool.recorders.symbolic_environment.regions`: a room's regions, its furniture
+  clustered by k-means with k chosen by BIC (X-means);
+- :mod:`~sgtool.recorders.symbolic_environment.house`: :class:`SymbolicHouse`, the house
+  prepared once (regions, places, travel distances for any door states);
+- :mod:`~sgtool.recorders.symbolic_environment.environment`: :class:`SymbolicEnv`, one
+  episode's rules (start, what each action reveals, invalid and failed actions, the end);
+- :mod:`~sgtool.recorders.symbolic_environment.rollout`: :func:`run_episode`, one episode
+  with a planner through :func:`sgtool.planning.episode.run_search`, optionally logged.
+"""
+
+from sgtool.recorders.symbolic_environment.environment import N_MAX, StepOutcome, SymbolicEnv
+from sgtool.recorders.symbolic_environment.house import Region, SymbolicHouse
+from sgtool.recorders.symbolic_environment.regions import (
+    MAX_REGIONS,
+    MIN_REGION_STD,
+    cluster_regions,
+)
+from sgtool.recorders.symbolic_environment.rollout import EpisodeLog, planner_seed, run_episode
+
+__all__ = [
+    "MAX_REGIONS",
+    "MIN_REGION_STD",
+    "N_MAX",
+    "EpisodeLog",
+    "Region",
+    "StepOutcome",
+    "SymbolicEnv",
+    "SymbolicHouse",
+    "cluster_regions",
+    "planner_seed",
+    "run_episode",
+]

@@ -1,0 +1,402 @@
+"""One SymSearch episode in a :class:`~sgtool.recorders.symbolic_environment.house.SymbolicHouse`.
+
+**Roll-out** (SCOUT V.C, Fig. 4), :class:`SymbolicEnv`:
+
+- start: a random region of a random room (rooms holding a target are avoided when others
+  exist), drawn from the episode seed; the start room is explored: the agent sees the
+  start region with its furniture, the room's other regions as frontiers ("unexplored
+  area"), its doors, and the rooms behind its open doors and passages as unexplored rooms
+  (``RoomNode(explored=False, category="unknown")``);
+- ``explore`` (or ``navigate``) an unexplored room: the agent walks to the room's region
+  nearest to it, which is revealed with its furniture; the room's other regions become
+  frontiers; its doors and the rooms behind open doors/passages appear;
+- ``explore`` (or ``navigate``) a frontier: the agent walks there; the region's furniture
+  is revealed;
+- ``open`` a closed openable object: walk there, open it, reveal its nested objects;
+  ``navigate`` to (or ``explore``) an unexplored container/supporter that is not closed:
+  look into / onto it, revealing its nested objects (SymSearch: every nested object needs
+  its parent explored, "on top" included);
+- ``open`` a closed door: walk to it and open it; the room beyond appears as an unexplored
+  room. ``close`` closes an open object or door; ``navigate`` to anything else just walks;
+- ``done``: ends the episode.
+
+An action whose target is not a node of the observed graph (or is None, for anything but
+``done``), or whose skill does not apply to that kind of node (open a room), is
+**invalid**: a step is spent, nothing happens, feedback outcome "invalid". An action that
+applies but has no effect (open an open fridge, a target that cannot be reached) is a
+**failure**, also a spent step.
+
+**End and success** (SCOUT V.C): the episode ends as soon as an object of the query
+category is visible (success, even without ``done``: SymSearch terminates "when the target
+object becomes visible"), on ``done`` (failure, since the target was not visible), or
+after ``max_steps`` actions (failure; SymSearch's N_max = 50). Success therefore never
+depends on a planner calling ``done``; MoMa-LLM's stricter rule (success only on an
+explicit ``done()``) belongs to the closed loop.
+
+Everything is deterministic: the start comes from ``numpy.random.default_rng`` seeded with
+(seed, house seed, episode index); iteration is in id order.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from sgtool.planning.base import Action, Feedback
+from sgtool.recorders.symbolic_environment.house import SymbolicHouse
+from sgtool.scenegraph.graph import DoorNode, RegionNode, RobotState, RoomNode, SceneGraph
+from sgtool.semantics.text import category_text
+
+N_MAX = 50  # SymSearch's maximum episode length (SCOUT sec. VI / appendix C)
+
+
+@dataclass(frozen=True)
+class StepOutcome:
+    """What one action did (besides the feedback the planner gets)."""
+
+    feedback: Feedback
+    opened: bool = False  # a successful open interaction (MoMa-LLM's open cost)
+
+
+class SymbolicEnv:
+    """One SymSearch episode in a :class:`SymbolicHouse` (rules in the module doc)."""
+
+    def __init__(self, house: SymbolicHouse, query: str, seed: int = 0, episode_index: int = 0,
+                 avoid_rooms: Sequence[str] = (), max_steps: int = N_MAX,
+                 start_region: str | None = None):
+        self.house = house
+        self.spec = house.spec
+        self.query = query
+        self._query_text = category_text(query)
+        self._target_furn = {i for i, c in enumerate(house.furn_cat) if c == self._query_text}
+        self._target_obj = {j for j, c in enumerate(house.obj_cat) if c == self._query_text}
+        self.max_steps = int(max_steps)
+        self.steps = 0
+        self.travelled = 0.0
+        self.n_open = 0
+        self.n_invalid = 0
+        self.n_failure = 0
+        self.ended = False
+        self.success = False
+        self.end_reason = ""
+        # dynamic state
+        self.open_doors: set[int] = set(house.initially_open())
+        self.furn_state: list[str | None] = [f.state for f in self.spec.furniture]
+        self.furn_explored: set[int] = set()
+        self.revealed_regions: set[int] = set()
+        self.explored_rooms: set[int] = set()
+        self.known_rooms: set[int] = set()
+        self.visible_doors: set[int] = set()
+        # start: a random region of a random room (SCOUT V.C)
+        if start_region is not None:
+            reg = next(i for i, r in enumerate(house.regions) if r.id == start_region)
+        else:
+            rng = np.random.default_rng([int(seed), int(self.spec.seed), int(episode_index)])
+            avoid = {house.room_index[r] for r in avoid_rooms if r in house.room_index}
+            rooms = [ri for ri in range(len(self.spec.rooms)) if ri not in avoid] or \
+                list(range(len(self.spec.rooms)))
+            ri = rooms[int(rng.integers(len(rooms)))]
+            regs = house.room_regions[ri]
+            reg = regs[int(rng.integers(len(regs)))]
+        self.start_region = house.regions[reg].id
+        self.place = house.regions[reg].place
+        self.start_place = self.place
+        self._enter_room(house.regions[reg].room, reg)
+        self._check_found()
+        if self.success:
+            self.end_reason = "found"
+
+    # ----- visibility -----------------------------------------------------------------
+    def _enter_room(self, ri: int, region: int) -> None:
+        self.explored_rooms.add(ri)
+        self.known_rooms.add(ri)
+        self.revealed_regions.add(region)
+        for other, door in self.house.links[ri]:
+            if door is not None:
+                self.visible_doors.add(door)
+                if door in self.open_doors:
+                    self.known_rooms.add(other)
+            else:
+                self.known_rooms.add(other)
+
+    def visible_furniture(self) -> list[int]:
+        out = []
+        for reg in sorted(self.revealed_regions):
+            out.extend(self.house.regions[reg].furniture)
+        return sorted(out)
+
+    def visible_objects(self) -> list[int]:
+        out = []
+        for f in sorted(self.furn_explored):
+            out.extend(self.house.nested[f])
+        return sorted(out)
+
+    def _check_found(self) -> None:
+        if any(f in self._target_furn for f in self.visible_furniture()) or \
+           any(j in self._target_obj for j in self.visible_objects()):
+            self.success = True
+            self.ended = True
+
+    # ----- observation ----------------------------------------------------------------
+    def _distances(self) -> np.ndarray:
+        return self.house.distances_from(self.place, frozenset(self.open_doors))
+
+    def _room_place(self, ri: int, dist: np.ndarray) -> int:
+        regs = self.house.room_regions[ri]
+        return min((self.house.regions[r].place for r in regs), key=lambda p: (dist[p], p))
+
+    def _door_place(self, di: int, dist: np.ndarray) -> int:
+        a, b = self.house.door_sides[di]
+        return a if (dist[a], a) <= (dist[b], b) else b
+
+    def observe(self) -> SceneGraph:
+        """The observed subgraph with travel distances from the agent (finite ones only)."""
+        h, spec = self.house, self.spec
+        dist = self._distances()
+        distances: dict[str, float] = {}
+
+        def put(node_id: str, place: int) -> None:
+            d = float(dist[place])
+            if math.isfinite(d):
+                distances[node_id] = d
+
+        rooms = []
+        for ri in sorted(self.known_rooms):
+            rid = h.room_ids[ri]
+            explored = ri in self.explored_rooms
+            cx, cy = spec.rooms[ri].centroid
+            neighbours = tuple(sorted({h.room_ids[o] for o, door in h.links[ri]
+                                       if o in self.known_rooms})) if explored else ()
+            rooms.append(RoomNode(
+                id=rid, category=h.room_names[ri] if explored else "unknown",
+                position=(float(cx), float(cy)), explored=explored,
+                category_scores=((h.room_names[ri], 1.0),) if explored else (),
+                neighbours=neighbours,
+            ))
+            put(rid, self._room_place(ri, dist))
+        regions = []
+        for ri in sorted(self.explored_rooms):
+            for reg in h.room_regions[ri]:
+                r = h.regions[reg]
+                revealed = reg in self.revealed_regions
+                regions.append(RegionNode(
+                    id=r.id, room=h.room_ids[ri], position=r.center,
+                    kind="region" if revealed else "frontier",
+                    frontier_type=None if revealed else "unexplored area",
+                ))
+                put(r.id, r.place)
+        objects = []
+        for f in self.visible_furniture():
+            objects.append(h.furniture_node(f, self.furn_state[f], f in self.furn_explored))
+            put(h.furn_node_id(f), h.furn_place[f])
+        for j in self.visible_objects():
+            objects.append(h.object_node(j))
+            put(h.obj_node_id(j), h.furn_place[h.furn_index[spec.objects[j].parent]])
+        doors = []
+        for di in sorted(self.visible_doors):
+            d = spec.doors[di]
+            doors.append(DoorNode(
+                id=f"door:{di}", position=(float(d.center[0]), float(d.center[1])),
+                state="open" if di in self.open_doors else "closed",
+                rooms=tuple(h.room_ids[h.room_index[r]] for r in d.rooms), instance=-1,
+            ))
+            put(f"door:{di}", self._door_place(di, dist))
+        here = self.place
+        region = next((r.id for r in h.regions if r.place == here), None)
+        robot = RobotState(position=h.places[here], room=h.room_ids[h.place_room[here]],
+                           region=region)
+        return SceneGraph(robot=robot, rooms=tuple(rooms), regions=tuple(regions),
+                          objects=tuple(objects), doors=tuple(doors), distances=distances)
+
+    # ----- acting ---------------------------------------------------------------------
+    def _lookup(self, node_id: str | None) -> tuple[str, int] | None:
+        """(kind, index) of an observed node, None when it is not in the observed graph."""
+        if not node_id:
+            return None
+        h = self.house
+        prefix, _, rest = node_id.partition(":")
+        try:
+            if prefix == "room":
+                ri = int(rest)
+                return ("room", ri) if ri in self.known_rooms else None
+            if prefix == "region":
+                reg = next((i for i, r in enumerate(h.regions) if r.id == node_id), None)
+                if reg is None or h.regions[reg].room not in self.explored_rooms:
+                    return None
+                return "region", reg
+            if prefix == "door":
+                di = int(rest)
+                return ("door", di) if di in self.visible_doors else None
+            if prefix == "obj":
+                k = int(rest) - 1
+                nf = len(self.spec.furniture)
+                if 0 <= k < nf:
+                    return ("furniture", k) if k in set(self.visible_furniture()) else None
+                j = k - nf
+                if 0 <= j < len(self.spec.objects):
+                    return ("object", j) if j in set(self.visible_objects()) else None
+        except ValueError:
+            return None
+        return None
+
+    def _move(self, place: int, dist: np.ndarray) -> float:
+        d = float(dist[place])
+        self.travelled += d
+        self.place = place
+        return d
+
+    def step(self, action: Action) -> StepOutcome:
+        """Execute ``action``; a step is spent whatever the outcome."""
+        if self.ended:
+            raise RuntimeError("the episode has ended")
+        self.steps += 1
+        out = self._execute(action)
+        if out.feedback.outcome == "invalid":
+            self.n_invalid += 1
+        elif out.feedback.outcome == "failure":
+            self.n_failure += 1
+        if out.opened:
+            self.n_open += 1
+        if not self.ended:
+            self._check_found()
+            if self.success:
+                self.end_reason = "found"
+            elif self.steps >= self.max_steps:
+                self.ended = True
+                self.end_reason = "max_steps"
+        return out
+
+    def execute(self, action: Action) -> Feedback:
+        """:meth:`step` as a :class:`~sgtool.planning.episode.SearchEnvironment`: the
+        feedback only."""
+        return self.step(action).feedback
+
+    def _fb(self, action: Action, outcome: str, message: str, travelled: float = 0.0,
+            opened: bool = False) -> StepOutcome:
+        return StepOutcome(Feedback(action, outcome, message, travelled), opened)  # type: ignore[arg-type]
+
+    def _execute(self, a: Action) -> StepOutcome:
+        h = self.house
+        if a.skill == "done":
+            self.ended = True
+            self.end_reason = "gave_up" if a.target is None else "wrong_done"
+            return self._fb(a, "success", "episode ended by the planner")
+        found = self._lookup(a.target)
+        if found is None:
+            return self._fb(a, "invalid", f"{a.target!r} is not a node of the observed graph")
+        kind, i = found
+        dist = self._distances()
+        skill = a.skill
+        if kind == "room":
+            if skill in ("open", "close"):
+                return self._fb(a, "invalid", f"cannot {skill} a room")
+            place = self._room_place(i, dist)
+            if not math.isfinite(dist[place]):
+                return self._fb(a, "failure", f"{a.target} cannot be reached")
+            if i in self.explored_rooms:
+                if skill == "explore":
+                    return self._fb(a, "failure", f"{a.target} is already explored")
+                return self._fb(a, "success", f"at {a.target}", self._move(place, dist))
+            reg = next(r for r in h.room_regions[i] if h.regions[r].place == place)
+            d = self._move(place, dist)
+            self._enter_room(i, reg)
+            n = len(h.regions[reg].furniture)
+            return self._fb(a, "success", f"entered {h.room_names[i]}: {n} objects in view", d)
+        if kind == "region":
+            reg = h.regions[i]
+            if skill in ("open", "close"):
+                return self._fb(a, "invalid", f"cannot {skill} a region")
+            if not math.isfinite(dist[reg.place]):
+                return self._fb(a, "failure", f"{a.target} cannot be reached")
+            if i in self.revealed_regions:
+                if skill == "explore":
+                    return self._fb(a, "failure", f"{a.target} is already explored")
+                return self._fb(a, "success", f"at {a.target}", self._move(reg.place, dist))
+            d = self._move(reg.place, dist)
+            self.revealed_regions.add(i)
+            return self._fb(a, "success", f"{len(reg.furniture)} objects in view", d)
+        if kind == "door":
+            place = self._door_place(i, dist)
+            if not math.isfinite(dist[place]):
+                return self._fb(a, "failure", f"{a.target} cannot be reached")
+            is_open = i in self.open_doors
+            if skill == "explore":
+                return self._fb(a, "invalid", "cannot explore a door; open it")
+            if skill == "navigate":
+                return self._fb(a, "success", f"at {a.target}", self._move(place, dist))
+            if skill == "open":
+                if is_open:
+                    return self._fb(a, "failure", f"{a.target} is already open")
+                d = self._move(place, dist)
+                self.open_doors.add(i)
+                for r in self.spec.doors[i].rooms:
+                    self.known_rooms.add(h.room_index[r])
+                return self._fb(a, "success", "door opened", d, opened=True)
+            if not is_open:  # close
+                return self._fb(a, "failure", f"{a.target} is already closed")
+            d = self._move(place, dist)
+            self.open_doors.discard(i)
+            return self._fb(a, "success", "door closed", d)
+        if kind == "object":  # nested objects: walk to the parent
+            parent = h.furn_index[self.spec.objects[i].parent]
+            place = h.furn_place[parent]
+            if skill != "navigate":
+                return self._fb(a, "invalid", f"cannot {skill} a {self.spec.objects[i].category}")
+            if not math.isfinite(dist[place]):
+                return self._fb(a, "failure", f"{a.target} cannot be reached")
+            return self._fb(a, "success", f"at {a.target}", self._move(place, dist))
+        # furniture
+        fu = self.spec.furniture[i]
+        place = h.furn_place[i]
+        if not math.isfinite(dist[place]):
+            return self._fb(a, "failure", f"{a.target} cannot be reached")
+        state = self.furn_state[i]
+        explorable = bool(set(fu.affordances) & {"container", "supporter"})
+        if skill == "open" or (skill == "explore" and state == "closed"):
+            if not fu.is_openable:
+                return self._fb(a, "failure", f"a {fu.category} cannot be opened")
+            if state == "open":
+                return self._fb(a, "failure", f"the {fu.category} is already open")
+            d = self._move(place, dist)
+            self.furn_state[i] = "open"
+            return self._fb(a, "success", self._reveal(i), d, opened=True)
+        if skill == "close":
+            if state != "open":
+                return self._fb(a, "failure", f"the {fu.category} is not open")
+            d = self._move(place, dist)
+            self.furn_state[i] = "closed"
+            return self._fb(a, "success", f"{fu.category} closed", d)
+        # navigate / explore of a piece that is not closed: look into / onto it
+        fresh = explorable and i not in self.furn_explored and state != "closed"
+        if skill == "explore" and not fresh:
+            return self._fb(a, "failure", f"nothing left to explore at the {fu.category}")
+        d = self._move(place, dist)
+        if fresh:
+            return self._fb(a, "success", self._reveal(i), d)
+        return self._fb(a, "success", f"at the {fu.category}", d)
+
+    def _reveal(self, f: int) -> str:
+        self.furn_explored.add(f)
+        names = sorted(self.house.obj_cat[j] for j in self.house.nested[f])
+        return f"found {', '.join(names)}" if names else "nothing inside or on top"
+
+    # ----- figures --------------------------------------------------------------------
+    def shortest_path(self, targets: Sequence[str]) -> float | None:
+        """Geodesic from the start to the nearest place a target is seen from, every door
+        passable (an optimal agent opens the doors on its way); None when unreachable."""
+        h = self.house
+        dist = h.distances_from(self.start_place, h.all_doors())
+        best = math.inf
+        for t in targets:
+            if t in h.obj_index:
+                parent = h.furn_index[self.spec.objects[h.obj_index[t]].parent]
+                best = min(best, float(dist[h.furn_place[parent]]))
+            elif t in h.furn_index:
+                f = h.furn_index[t]
+                best = min(best, float(dist[h.regions[h.region_of_furn[f]].place]),
+                           float(dist[h.furn_place[f]]))
+        return best if math.isfinite(best) else None
+

@@ -1,0 +1,266 @@
+"""A house prepared for SymSearch roll-outs: regions, places and travel distances.
+
+**Scene graph of a house** (SCOUT V.B, Fig. 5). Rooms are the spec's rooms. Regions: per
+room, the (x, y) positions of its furniture are clustered by k-means (deterministic
+farthest-point initialisation) with the number of clusters chosen by the Bayesian
+Information Criterion of the matching spherical Gaussian mixture (X-means), k in
+``[1, min(4, n - 1)]``; a room without furniture is one empty region. Furniture are the
+first-level objects of their region; small objects are nested in their parent furniture
+(relation "inside"/"ontop"). Rooms are joined by doors (open/closed) and open-plan passages.
+
+**Travel** (SCOUT Fig. 5 f). Every node the agent can go to has a *place*: the walkable cell
+of its own room nearest to it (walkable: free on the occupancy grid dilated by the robot
+radius, in the room's largest free component), i.e. the closest unoccupied point to the
+goal within the same room. Distances are geodesics on the occupancy grid of
+:mod:`sgtool.mapping.occupancy`. To let doors open and close during an episode without
+re-rasterising, they are computed once on the grid with every door closed (each room, or
+open-plan group, its own component) between all places, plus one place each side of every
+door; an open door joins its two side places with an edge of their straight-line length.
+Travel distance is then the shortest path on that place graph for the current door states.
+A nested object's place is its parent's; a room's is its nearest region's; a door's is its
+nearer side.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from sgtool.house.spec import HouseSpec
+from sgtool.mapping.occupancy import (
+    OccupancyMap,
+    cell_to_world,
+    geodesic_distances,
+    house_occupancy,
+    world_to_cell,
+)
+from sgtool.recorders.symbolic_environment.regions import cluster_regions
+from sgtool.scenegraph.graph import ObjectNode
+from sgtool.semantics.text import category_text
+
+_EXAMINE = "examine"
+
+
+@dataclass(frozen=True)
+class Region:
+    id: str  # "region:<room>.<k>"
+    room: int  # index into spec.rooms
+    center: tuple[float, float]
+    furniture: tuple[int, ...]  # indices into spec.furniture
+    place: int
+
+
+class SymbolicHouse:
+    """A house prepared for SymSearch roll-outs: regions, places and their distances.
+
+    Build once per house (``SymbolicHouse(spec)``, ~0.1-0.5 s) and run any number of
+    episodes on it; it is never modified by an episode.
+    """
+
+    def __init__(self, spec: HouseSpec, resolution: float = 0.05, robot_radius: float = 0.2):
+        self.spec = spec
+        self.resolution = resolution
+        closed = dataclasses.replace(
+            spec, doors=tuple(dataclasses.replace(d, state="closed") for d in spec.doors))
+        self.occ: OccupancyMap = house_occupancy(closed, resolution=resolution,
+                                                 robot_radius=robot_radius)
+        self.room_index = {r.id: i for i, r in enumerate(spec.rooms)}
+        self.room_ids = tuple(f"room:{i}" for i in range(len(spec.rooms)))
+        self.room_names = tuple(category_text(r.category) for r in spec.rooms)
+        self.furn_cat = tuple(category_text(f.category) for f in spec.furniture)
+        self.obj_cat = tuple(category_text(o.category) for o in spec.objects)
+        self._furn_nodes: dict[tuple[int, str | None, bool], ObjectNode] = {}
+        self._obj_nodes: dict[int, ObjectNode] = {}
+        self._walkable_rooms()
+        self.places: list[tuple[float, float]] = []
+        self.place_room: list[int] = []
+        # furniture
+        self.furn_index = {f.id: i for i, f in enumerate(spec.furniture)}
+        self.furn_place = [self._add_place(f.center[0], f.center[1], self.room_index[f.room])
+                           for f in spec.furniture]
+        # regions per room
+        self.regions: list[Region] = []
+        self.room_regions: list[tuple[int, ...]] = []
+        for ri, room in enumerate(spec.rooms):
+            members = [i for i, f in enumerate(spec.furniture) if f.room == room.id]
+            idx: list[int] = []
+            if members:
+                labels = cluster_regions([spec.furniture[i].center[:2] for i in members])
+                for k in range(int(labels.max()) + 1):
+                    fs = tuple(m for m, lab in zip(members, labels, strict=True) if lab == k)
+                    cx = float(np.mean([spec.furniture[i].center[0] for i in fs]))
+                    cy = float(np.mean([spec.furniture[i].center[1] for i in fs]))
+                    idx.append(len(self.regions))
+                    self.regions.append(Region(f"region:{ri}.{k}", ri, (cx, cy), fs,
+                                               self._add_place(cx, cy, ri)))
+            else:
+                cx, cy = self._room_centre(ri)
+                idx.append(len(self.regions))
+                self.regions.append(Region(f"region:{ri}.0", ri, (cx, cy), (),
+                                           self._add_place(cx, cy, ri)))
+            self.room_regions.append(tuple(idx))
+        self.region_of_furn = {f: ri for ri, reg in enumerate(self.regions) for f in reg.furniture}
+        # doors: one place each side
+        self.door_sides: list[tuple[int, int]] = []
+        for d in spec.doors:
+            a, b = (self.room_index[r] for r in d.rooms)
+            self.door_sides.append((self._add_place(d.center[0], d.center[1], a),
+                                    self._add_place(d.center[0], d.center[1], b)))
+        # neighbours: (other room, door index or None for a passage)
+        self.links: list[list[tuple[int, int | None]]] = [[] for _ in spec.rooms]
+        for di, d in enumerate(spec.doors):
+            a, b = (self.room_index[r] for r in d.rooms)
+            self.links[a].append((b, di))
+            self.links[b].append((a, di))
+        for p in spec.passages:
+            a, b = (self.room_index[r] for r in p.rooms)
+            self.links[a].append((b, None))
+            self.links[b].append((a, None))
+        # small objects
+        self.obj_index = {o.id: j for j, o in enumerate(spec.objects)}
+        self.nested: list[list[int]] = [[] for _ in spec.furniture]
+        for j, o in enumerate(spec.objects):
+            self.nested[self.furn_index[o.parent]].append(j)
+        self._base = self._base_distances()
+        self._graphs: dict[frozenset[int], csr_matrix] = {}
+        self._rows: dict[tuple[frozenset[int], int], np.ndarray] = {}
+
+    # ----- ids ------------------------------------------------------------------------
+    def furn_node_id(self, i: int) -> str:
+        return f"obj:{i + 1}"
+
+    def obj_node_id(self, j: int) -> str:
+        return f"obj:{len(self.spec.furniture) + 1 + j}"
+
+    # ----- geometry -------------------------------------------------------------------
+    def _walkable_rooms(self) -> None:
+        from sgtool.datasets.episodes import room_raster
+
+        raster = room_raster(self.spec, self.occ)
+        free = ~self.occ.blocked
+        self._snap: list[tuple[tuple[slice, slice], np.ndarray, np.ndarray] | None] = []
+        for ri in range(len(self.spec.rooms)):
+            mask = free & (raster == ri)
+            # 4-connected: paths may not cut corners, so cells touching only diagonally
+            # are not connected for the robot
+            lab, n = ndimage.label(mask)
+            if n == 0:
+                self._snap.append(None)
+                continue
+            sizes = np.bincount(lab.ravel())[1:]
+            walk = lab == (1 + int(np.argmax(sizes)))
+            rr, cc = np.nonzero(walk)
+            win = (slice(max(rr.min() - 2, 0), rr.max() + 3),
+                   slice(max(cc.min() - 2, 0), cc.max() + 3))
+            sub = walk[win]
+            _, (ir, ic) = ndimage.distance_transform_edt(~sub, return_indices=True)
+            self._snap.append((win, ir, ic))
+
+    def snap(self, x: float, y: float, room: int) -> tuple[int, int]:
+        """The walkable cell of ``room`` nearest to (x, y)."""
+        s = self._snap[room]
+        if s is None:
+            raise ValueError(f"room {self.spec.rooms[room].id} has no free floor")
+        (rs, cs), ir, ic = s
+        r, c = world_to_cell(self.occ, x, y)
+        lr = min(max(r - rs.start, 0), ir.shape[0] - 1)
+        lc = min(max(c - cs.start, 0), ir.shape[1] - 1)
+        return int(ir[lr, lc]) + rs.start, int(ic[lr, lc]) + cs.start
+
+    def _room_centre(self, ri: int) -> tuple[float, float]:
+        cx, cy = self.spec.rooms[ri].centroid
+        px, py = cell_to_world(self.occ, *self.snap(cx, cy, ri))
+        return float(px), float(py)
+
+    def _add_place(self, x: float, y: float, room: int) -> int:
+        px, py = cell_to_world(self.occ, *self.snap(x, y, room))
+        self.places.append((round(float(px), 6), round(float(py), 6)))
+        self.place_room.append(room)
+        return len(self.places) - 1
+
+    def _base_distances(self) -> np.ndarray:
+        """Geodesics between all places with every door closed (inf across doors)."""
+        n = len(self.places)
+        cells = [world_to_cell(self.occ, x, y) for x, y in self.places]
+        rows = np.array([c[0] for c in cells])
+        cols = np.array([c[1] for c in cells])
+        out = np.full((n, n), np.inf)
+        done: dict[tuple[int, int], np.ndarray] = {}
+        for i, cell in enumerate(cells):
+            if cell not in done:
+                grid = geodesic_distances(self.occ, self.places[i], max_snap=0.0)
+                done[cell] = grid[rows, cols]
+            out[i] = done[cell]
+        return np.minimum(out, out.T)  # exact symmetry despite float summation order
+
+    def _graph(self, open_doors: frozenset[int]) -> csr_matrix:
+        g = self._graphs.get(open_doors)
+        if g is None:
+            w = self._base.copy()
+            np.fill_diagonal(w, np.inf)
+            for di in sorted(open_doors):
+                a, b = self.door_sides[di]
+                d = math.dist(self.places[a], self.places[b])
+                w[a, b] = w[b, a] = min(w[a, b], max(d, 1e-6))
+            src, dst = np.nonzero(np.isfinite(w))
+            g = csr_matrix((w[src, dst], (src, dst)), shape=w.shape)
+            self._graphs[open_doors] = g
+        return g
+
+    def distances_from(self, place: int, open_doors: frozenset[int]) -> np.ndarray:
+        """Travel distance (m) from ``place`` to every place with these doors open."""
+        key = (open_doors, place)
+        row = self._rows.get(key)
+        if row is None:
+            row = dijkstra(self._graph(open_doors), directed=False, indices=place)
+            if len(self._rows) > 20000:
+                self._rows.clear()
+            self._rows[key] = row
+        return row
+
+    def furniture_node(self, f: int, state: str | None, explored: bool) -> ObjectNode:
+        """The node of furniture ``f`` in a given state (memoised: nodes are frozen)."""
+        key = (f, state, explored)
+        node = self._furn_nodes.get(key)
+        if node is None:
+            fu = self.spec.furniture[f]
+            affs = set(fu.affordances)
+            if affs & {"container", "supporter"}:
+                affs.add(_EXAMINE)
+            node = ObjectNode(
+                id=self.furn_node_id(f), category=self.furn_cat[f],
+                parent=self.regions[self.region_of_furn[f]].id,
+                room=self.room_ids[self.room_index[fu.room]],
+                position=tuple(float(v) for v in fu.center),  # type: ignore[arg-type]
+                instance=f + 1, state=state,  # type: ignore[arg-type]
+                affordances=tuple(sorted(affs)), explored=explored,
+            )
+            self._furn_nodes[key] = node
+        return node
+
+    def object_node(self, j: int) -> ObjectNode:
+        """The node of small object ``j`` (nested in its parent furniture)."""
+        node = self._obj_nodes.get(j)
+        if node is None:
+            o = self.spec.objects[j]
+            node = ObjectNode(
+                id=self.obj_node_id(j), category=self.obj_cat[j],
+                parent=self.furn_node_id(self.furn_index[o.parent]),
+                room=self.room_ids[self.room_index[o.room]],
+                position=tuple(float(v) for v in o.position),  # type: ignore[arg-type]
+                instance=len(self.spec.furniture) + 1 + j, relation=o.relation,  # type: ignore[arg-type]
+            )
+            self._obj_nodes[j] = node
+        return node
+
+    def all_doors(self) -> frozenset[int]:
+        return frozenset(range(len(self.spec.doors)))
+
+    def initially_open(self) -> frozenset[int]:
+        return frozenset(i for i, d in enumerate(self.spec.doors) if d.state == "open")

@@ -1,0 +1,161 @@
+"""Typed log records (sgtool.log.records): round trips, checks on write and on read."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import pytest
+
+from sgtool.errors import LogFormatError
+from sgtool.log import LogReader, LogWriter
+from sgtool.log import schemas as S
+from sgtool.log.records import (
+    ABSENT,
+    RECORD_TYPES,
+    Action,
+    Episode,
+    InstanceItem,
+    Instances,
+    LlmExchange,
+    SceneGraphRecord,
+)
+from sgtool.scenegraph.graph import RobotState, RoomNode, SceneGraph
+
+GRAPH = SceneGraph(robot=RobotState(position=(1.0, 2.0), room="room:0"),
+                   rooms=(RoomNode(id="room:0", category="kitchen", position=(0.5, 0.5),
+                                   explored=True),),
+                   distances={"room:0": 1.25})
+
+SAMPLES = [
+    Episode(kind="search", status="started", source="pybullet", house_id="house-1",
+            query="cup", planner="scout", steps=0, travelled_m=0.0, shortest_m=None,
+            frames=0, extra={"mapping": {"every": 10}, "hidden": True, "list": [1, 2]}),
+    Episode(kind="import", status="ended", source="", frames=3),
+    Action(skill="look_around", outcome="success", target=None, reason="", travelled_m=0.0,
+           decision_time_s=0.0, planner=None, step=0, graph_time_ns=None),
+    Action(skill="explore", outcome="failure", target="room:1", graph_time_ns=10),
+    Action(skill="done", outcome="success"),
+    Instances((InstanceItem(id=1, category="fridge", kind="furniture", state="closed",
+                            affordances=("container", "openable"), parent=None,
+                            relation=None, synset="fridge.n.01", spec_id="f0"),
+               InstanceItem(id=2, category="cup", kind="object", parent=1,
+                            relation="inside"))),
+    SceneGraphRecord.of_graph(GRAPH),
+    LlmExchange(model="m", messages=({"role": "user", "content": "hi"},),
+                prompt_sha256="abc", response=None, latency_s=0.5, prompt_tokens=None,
+                completion_tokens=3, error="HTTP 500", attempt=1, step=None, query="cup",
+                source="endpoint"),
+]
+
+
+@pytest.mark.parametrize("record", SAMPLES, ids=lambda r: type(r).__name__)
+def test_round_trip(record) -> None:
+    d = record.to_json()
+    assert type(record).from_json(d) == record
+    assert type(record).from_json(json.loads(json.dumps(d))).to_json() == d
+
+
+def test_every_json_channel_has_a_record_type_matching_its_schema() -> None:
+    assert set(RECORD_TYPES) == set(S.RECORDS)
+    for kind, rtype in RECORD_TYPES.items():
+        schema = S.RECORDS[kind].schema
+        names = {f for f in rtype.__dataclass_fields__ if f != "unknown"}
+        assert set(schema["properties"]) <= names, kind
+        assert rtype.channel() is S.RECORDS[kind]
+
+
+def test_absent_and_null_differ_and_unknown_keys_survive() -> None:
+    a = Action.from_json({"skill": "done", "outcome": "success"})
+    b = Action.from_json({"skill": "done", "outcome": "success", "graph_time_ns": None})
+    assert a.graph_time_ns is ABSENT and a.decided
+    assert b.graph_time_ns is None and not b.decided
+    assert "graph_time_ns" not in a.to_json() and b.to_json()["graph_time_ns"] is None
+    future = {"skill": "done", "outcome": "success", "confidence": 0.9}
+    assert Action.from_json(future).to_json() == future
+
+
+def test_the_graph_record_is_the_graph_json() -> None:
+    rec = SceneGraphRecord.of_graph(GRAPH)
+    assert json.dumps(rec.to_json(), sort_keys=True, separators=(",", ":")) == GRAPH.to_json()
+    assert rec.graph() == GRAPH
+
+
+def test_typed_write_is_byte_identical_to_the_dict_write(tmp_path) -> None:
+    def write(path, typed: bool) -> bytes:
+        with LogWriter(path) as w:
+            for i, r in enumerate(SAMPLES):
+                if typed:
+                    w.write_record(r, i)
+                else:
+                    w.write_record(r.KIND, i, r.to_json())
+        return path.read_bytes()
+
+    assert write(tmp_path / "a.mcap", True) == write(tmp_path / "b.mcap", False)
+    with LogReader(tmp_path / "a.mcap") as r:
+        assert [rec for _, rec in r.records(Action)] == [s for s in SAMPLES
+                                                         if isinstance(s, Action)]
+        assert r.last_record(Episode) == SAMPLES[1]
+        assert r.last_record("episode") == SAMPLES[1].to_json()
+
+
+@pytest.mark.parametrize("record, field", [
+    (Action(skill="navigate", outcome="success", travelled_m="far"), "travelled_m"),
+    (Action(skill="navigate", outcome="maybe"), "outcome"),
+    (Episode(kind="search", status="started", steps=1.5), "steps"),
+    (Instances((InstanceItem(id=1, category="cup", kind="thing"),)), "instances[0].kind"),
+    (LlmExchange(model="m", messages=({"role": "user", "content": "x"},), attempt=True),
+     "attempt"),
+])
+def test_a_wrong_type_is_refused_on_write(tmp_path, record, field) -> None:
+    with LogWriter(tmp_path / "x.mcap") as w, \
+            pytest.raises(LogFormatError,
+                          match=re.escape(record.channel().topic) + ".*" + re.escape(f"'{field}'")):
+        w.write_record(record, 5)
+
+
+def test_a_missing_field_is_refused_on_write(tmp_path) -> None:
+    with LogWriter(tmp_path / "x.mcap") as w, pytest.raises(LogFormatError, match="'status'"):
+        w.write_record("episode", 0, {"kind": "search"})
+
+
+def _raw_log(path, kind: str, messages: list[tuple[int, bytes]]) -> None:
+    """A log whose records on ``kind``'s channel are the given raw bytes (unchecked)."""
+    with LogWriter(path) as w:
+        for t, data in messages:
+            w.write_json_bytes(kind, t, data)
+
+
+@pytest.mark.parametrize("kind, bad, field", [
+    ("action", {"skill": "open", "outcome": "success", "travelled_m": "1.0"}, "travelled_m"),
+    ("action", {"skill": "open"}, "outcome"),
+    ("episode", {"kind": "search", "status": "ended", "frames": "3"}, "frames"),
+    ("instances", {"instances": [{"id": 1, "category": "cup"}]}, "instances[0].kind"),
+    ("scene_graph", {"rooms": []}, "version"),
+    ("llm_exchange", {"model": "m", "messages": [], "step": "4"}, "step"),
+])
+def test_a_bad_record_in_a_log_names_channel_record_and_field(tmp_path, kind, bad,
+                                                              field) -> None:
+    good = RECORD_TYPES[kind].from_json(
+        {"episode": {"kind": "search", "status": "started"},
+         "action": {"skill": "done", "outcome": "success"},
+         "instances": {"instances": []},
+         "scene_graph": json.loads(GRAPH.to_json()),
+         "llm_exchange": {"model": "m", "messages": []}}[kind])
+    path = tmp_path / "bad.mcap"
+    _raw_log(path, kind, [(1000, json.dumps(good.to_json()).encode()),
+                          (2000, json.dumps(bad).encode())])
+    topic = S.RECORDS[kind].topic
+    with LogReader(path) as r, pytest.raises(LogFormatError) as e:
+        list(r.records(RECORD_TYPES[kind]))
+    msg = str(e.value)
+    assert topic in msg and "record 1 at 2000 ns" in msg and f"'{field}'" in msg, msg
+    with LogReader(path) as r, pytest.raises(LogFormatError, match=re.escape(f"'{field}'")):
+        r.last_record(kind)
+
+
+def test_a_record_that_is_not_json_is_a_log_format_error(tmp_path) -> None:
+    path = tmp_path / "garbage.mcap"
+    _raw_log(path, "action", [(7, b"{not json")])
+    with LogReader(path) as r, pytest.raises(LogFormatError, match="/sgtool/action.*not JSON"):
+        list(r.records(Action))

@@ -1,0 +1,362 @@
+"""Typed sgtool JSON log records: one frozen dataclass per JSON channel, checked both ways.
+
+Every JSON channel of :data:`sgtool.log.schemas.RECORDS` has its record type here:
+
+=================  =======================  =====================================
+kind               record type              channel
+=================  =======================  =====================================
+``episode``        :class:`Episode`         ``/sgtool/episode`` (sgtool.Episode)
+``instances``      :class:`Instances`       ``/sgtool/instances`` (sgtool.Instances)
+``action``         :class:`Action`          ``/sgtool/action`` (sgtool.Action)
+``scene_graph``    :class:`SceneGraphRecord` ``/sgtool/scene_graph`` (sgtool.SceneGraph)
+``llm_exchange``   :class:`LlmExchange`     ``/sgtool/llm`` (sgtool.LlmExchange)
+=================  =======================  =====================================
+
+``to_json()`` gives the dict exactly as it is written (the writer dumps it with sorted keys
+and no spaces), ``from_json(d)`` reads one back; ``from_json(r.to_json()) == r`` and
+``from_json(d).to_json() == d`` for every valid ``d``. JSON distinguishes a field that is
+absent from one that is null, and so do the records: a field not given is :data:`ABSENT`
+and is left out of ``to_json()``; ``None`` is written as null (the Action field
+``graph_time_ns`` means different things absent and null). Keys a record type does not
+know (a newer minor schema version) are kept in ``unknown`` and written back.
+
+**Checked.** Both directions check the JSON form against the record's JSON schema, the
+one registered with the channel (:mod:`sgtool.log.schemas`; an LlmExchange also has the
+optional transcript fields ``prompt_sha256``, ``step``, ``query`` and ``source``, which the
+registered schema leaves open): a missing required field, a wrong type or a value outside
+an enumeration is a :class:`~sgtool.errors.LogFormatError` naming the channel, the record
+(its index on the channel and log time) and the field, e.g. ``/sgtool/action record 3 at
+2000000000 ns: field 'travelled_m' must be number, got string``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
+from typing import TYPE_CHECKING, Any, ClassVar, Final, TypeVar
+
+from sgtool.errors import LogFormatError
+from sgtool.log import schemas as S
+
+if TYPE_CHECKING:
+    from sgtool.scenegraph.graph import SceneGraph
+
+T = TypeVar("T")
+R = TypeVar("R", bound="LogRecord")
+J = TypeVar("J", bound="JsonRecord")
+
+
+class Absent:
+    """The type of :data:`ABSENT`: a field the JSON record does not hold (not even null)."""
+
+    _it: ClassVar[Absent | None] = None
+
+    def __new__(cls) -> Absent:
+        if cls._it is None:
+            cls._it = super().__new__(cls)
+        return cls._it
+
+    def __repr__(self) -> str:
+        return "ABSENT"
+
+    def __bool__(self) -> bool:
+        return False
+
+    def __reduce__(self) -> tuple[type[Absent], tuple[()]]:
+        return (Absent, ())
+
+
+ABSENT: Final = Absent()
+
+
+def given(value: T | None | Absent, default: Any = None) -> Any:
+    """``value``, or ``default`` when the field is absent or null."""
+    return default if value is None or isinstance(value, Absent) else value
+
+
+# ----------------------------------------------------------------------------------------
+# checking the JSON form against a JSON schema (the subset the record schemas use)
+# ----------------------------------------------------------------------------------------
+_JSON_TYPES: dict[str, tuple[type, ...]] = {
+    "string": (str,), "number": (int, float), "integer": (int,), "boolean": (bool,),
+    "object": (dict,), "array": (list,), "null": (type(None),),
+}
+
+
+def _json_type(v: Any) -> str:
+    if isinstance(v, bool):
+        return "boolean"
+    for name in ("null", "string", "integer", "number", "object", "array"):
+        if isinstance(v, _JSON_TYPES[name]):
+            return name
+    return type(v).__name__
+
+
+def _is(v: Any, t: str) -> bool:
+    if isinstance(v, bool) and t in ("number", "integer"):
+        return False
+    return isinstance(v, _JSON_TYPES[t])
+
+
+def schema_problem(value: Any, schema: Mapping[str, Any], path: str = "") -> tuple[str, str] | None:
+    """The first (field path, problem) of ``value`` against ``schema``; None when it fits."""
+    enum = schema.get("enum")
+    if enum is not None and not any(value == e and type(value) is type(e) for e in enum):
+        return path, f"must be one of {', '.join(map(repr, enum))}, got {value!r}"
+    types = schema.get("type")
+    if types is not None:
+        allowed = [types] if isinstance(types, str) else list(types)
+        if not any(_is(value, t) for t in allowed):
+            return path, f"must be {' or '.join(allowed)}, got {_json_type(value)}"
+    if isinstance(value, dict):
+        for key in schema.get("required", ()):
+            if key not in value:
+                return (f"{path}.{key}" if path else key), "is missing"
+        for key, sub in schema.get("properties", {}).items():
+            if key in value:
+                p = schema_problem(value[key], sub, f"{path}.{key}" if path else key)
+                if p is not None:
+                    return p
+    if isinstance(value, list) and "items" in schema:
+        for i, item in enumerate(value):
+            p = schema_problem(item, schema["items"], f"{path}[{i}]")
+            if p is not None:
+                return p
+    return None
+
+
+# ----------------------------------------------------------------------------------------
+# the records
+# ----------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class JsonRecord:
+    """A JSON object with typed fields (base of the records and their items)."""
+
+    unknown: Mapping[str, Any] = field(default_factory=dict, kw_only=True, compare=True)
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON object as written: absent fields left out, tuples as lists."""
+        out = dict(self.unknown)
+        for f in fields(self):
+            if f.name == "unknown":
+                continue
+            v = getattr(self, f.name)
+            if isinstance(v, Absent):
+                continue
+            if isinstance(v, tuple):
+                v = [x.to_json() if isinstance(x, JsonRecord) else x for x in v]
+            out[f.name] = v
+        return out
+
+    @classmethod
+    def _build(cls: type[J], d: Mapping[str, Any]) -> J:
+        """The record of an already checked JSON object."""
+        names = {f.name for f in fields(cls)} - {"unknown"}
+        kw: dict[str, Any] = {}
+        for k in names:
+            v = d.get(k, ABSENT)
+            kw[k] = tuple(v) if isinstance(v, list) else v
+        return cls(**kw, unknown={k: v for k, v in d.items() if k not in names})
+
+
+@dataclass(frozen=True)
+class LogRecord(JsonRecord):
+    """A record of one of sgtool's JSON channels."""
+
+    KIND: ClassVar[str] = ""
+
+    @classmethod
+    def channel(cls) -> S.RecordKind:
+        return S.RECORDS[cls.KIND]
+
+    @classmethod
+    def json_schema(cls) -> Mapping[str, Any]:
+        """The schema records of this type are checked against (module doc)."""
+        return cls.channel().schema
+
+    @classmethod
+    def check(cls, d: Any, where: str) -> None:
+        """Raise :class:`LogFormatError` naming ``where`` and the field when ``d`` is not a
+        valid JSON form of this record type."""
+        p = schema_problem(d, cls.json_schema())
+        if p is None:
+            return
+        path, problem = p
+        what = f"field {path!r} {problem}" if path else f"the record {problem}"
+        raise LogFormatError(f"{where}: {what}")
+
+    @classmethod
+    def describe(cls, index: int | None = None, t_ns: int | None = None) -> str:
+        """``/sgtool/action record 3 at 2000 ns``: the channel and the record, for messages."""
+        out = f"{cls.channel().topic} ({cls.channel().schema_name}) record"
+        if index is not None:
+            out += f" {index}"
+        if t_ns is not None:
+            out += f" at {t_ns} ns"
+        return out
+
+    @classmethod
+    def from_json(cls: type[R], d: Any, *, where: str = "") -> R:
+        """The record of a JSON object; :class:`LogFormatError` when it is not valid."""
+        cls.check(d, where or cls.describe())
+        return cls._build(d)
+
+    def checked_json(self, where: str = "") -> dict[str, Any]:
+        """:meth:`to_json`, checked (what the writer writes)."""
+        d = self.to_json()
+        self.check(d, where or self.describe())
+        return d
+
+
+@dataclass(frozen=True)
+class Episode(LogRecord):
+    """``sgtool.Episode``: a run starts ("started") or ends (its final figures)."""
+
+    KIND: ClassVar[str] = "episode"
+
+    kind: str  # recording | search | import
+    status: str  # started | success | failure | ended
+    source: str | Absent = ABSENT
+    house_id: str | None | Absent = ABSENT
+    query: str | None | Absent = ABSENT
+    planner: str | None | Absent = ABSENT
+    steps: int | Absent = ABSENT
+    travelled_m: float | Absent = ABSENT
+    shortest_m: float | None | Absent = ABSENT
+    frames: int | Absent = ABSENT
+    extra: Mapping[str, Any] | Absent = ABSENT
+
+    @property
+    def extras(self) -> Mapping[str, Any]:
+        """``extra``, empty when absent."""
+        return given(self.extra, {})
+
+    def merged(self, later: Episode) -> Episode:
+        """This record with the fields ``later`` holds replaced by its values (a closing
+        record over its opening one)."""
+        d = self.to_json()
+        d.update(later.to_json())
+        return Episode._build(d)
+
+
+@dataclass(frozen=True)
+class Action(LogRecord):
+    """``sgtool.Action``: one executed action. ``graph_time_ns`` (1.1): the log time of the
+    scene graph it was decided on; null: decided on no graph; absent: the last graph at or
+    before the action's log time."""
+
+    KIND: ClassVar[str] = "action"
+
+    skill: str
+    outcome: str  # success | failure | invalid
+    target: str | None | Absent = ABSENT
+    reason: str | Absent = ABSENT
+    travelled_m: float | Absent = ABSENT
+    decision_time_s: float | Absent = ABSENT
+    planner: str | None | Absent = ABSENT
+    step: int | Absent = ABSENT
+    graph_time_ns: int | None | Absent = ABSENT
+
+    @property
+    def decided(self) -> bool:
+        """False for an action decided on no graph (``graph_time_ns`` null)."""
+        return self.graph_time_ns is not None
+
+
+@dataclass(frozen=True)
+class InstanceItem(JsonRecord):
+    """One item of an ``sgtool.Instances`` table."""
+
+    id: int
+    category: str
+    kind: str  # object | furniture | door | structure
+    synset: str | None | Absent = ABSENT
+    state: str | None | Absent = ABSENT
+    affordances: tuple[str, ...] | Absent = ABSENT
+    parent: int | None | Absent = ABSENT
+    relation: str | None | Absent = ABSENT
+    spec_id: str | None | Absent = ABSENT
+
+
+@dataclass(frozen=True)
+class Instances(LogRecord):
+    """``sgtool.Instances``: the whole instance table (written again on every change)."""
+
+    KIND: ClassVar[str] = "instances"
+
+    instances: tuple[InstanceItem, ...]
+
+    @classmethod
+    def _build(cls, d: Mapping[str, Any]) -> Instances:
+        return cls(tuple(InstanceItem._build(x) for x in d["instances"]),
+                   unknown={k: v for k, v in d.items() if k != "instances"})
+
+    @classmethod
+    def of(cls, items: list[dict[str, Any]]) -> Instances:
+        """The record of a list of item dicts (checked when written)."""
+        return cls(tuple(InstanceItem._build(x) for x in items))
+
+
+@dataclass(frozen=True)
+class SceneGraphRecord(LogRecord):
+    """``sgtool.SceneGraph``: the canonical JSON of a
+    :class:`sgtool.scenegraph.graph.SceneGraph` (:meth:`graph` builds it back)."""
+
+    KIND: ClassVar[str] = "scene_graph"
+
+    version: str
+    time_ns: int | Absent = ABSENT
+    robot: Mapping[str, Any] | Absent = ABSENT
+    rooms: tuple[Any, ...] | Absent = ABSENT
+    regions: tuple[Any, ...] | Absent = ABSENT
+    objects: tuple[Any, ...] | Absent = ABSENT
+    doors: tuple[Any, ...] | Absent = ABSENT
+    distances: Mapping[str, float] | Absent = ABSENT
+
+    @classmethod
+    def of_graph(cls, graph: SceneGraph) -> SceneGraphRecord:
+        return cls._build(graph.to_dict())
+
+    def graph(self) -> SceneGraph:
+        from sgtool.scenegraph.graph import SceneGraph
+
+        return SceneGraph.from_dict(self.to_json())
+
+
+# fields of an LLM exchange that transcripts carry and the registered schema leaves open
+_LLM_TRANSCRIPT_FIELDS = {
+    "prompt_sha256": {"type": ["string", "null"]},
+    "step": {"type": ["integer", "null"]},
+    "query": {"type": ["string", "null"]},
+    "source": {"type": "string"},
+}
+
+
+@dataclass(frozen=True)
+class LlmExchange(LogRecord):
+    """``sgtool.LlmExchange``: one prompt and its answer (:mod:`sgtool.llm.exchange`)."""
+
+    KIND: ClassVar[str] = "llm_exchange"
+
+    model: str
+    messages: tuple[Mapping[str, str], ...]
+    prompt_sha256: str | None | Absent = ABSENT
+    response: str | None | Absent = ABSENT
+    latency_s: float | Absent = ABSENT
+    prompt_tokens: int | None | Absent = ABSENT
+    completion_tokens: int | None | Absent = ABSENT
+    error: str | None | Absent = ABSENT
+    attempt: int | Absent = ABSENT
+    step: int | None | Absent = ABSENT
+    query: str | None | Absent = ABSENT
+    source: str | Absent = ABSENT
+
+    @classmethod
+    def json_schema(cls) -> Mapping[str, Any]:
+        base = cls.channel().schema
+        return {**base, "properties": {**base["properties"], **_LLM_TRANSCRIPT_FIELDS}}
+
+
+RECORD_TYPES: dict[str, type[LogRecord]] = {
+    c.KIND: c for c in (Episode, Instances, Action, SceneGraphRecord, LlmExchange)
+}

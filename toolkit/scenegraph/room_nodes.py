@@ -1,0 +1,120 @@
+"""The room layer of the scene graph: regions within each room, and the room nodes with
+their neighbours and categories.
+
+Room categories come from the contained furniture (all objects when a room has none) with
+the configured :class:`~sgtool.scenegraph.categories.RoomClassifier`; a room with no object
+at all whose nodes span >= ``corridor_length`` and stay within ``corridor_clearance`` of a
+wall is a corridor (``BuilderConfig.corridor``), otherwise "unknown". Rooms seen only
+through a closed door are unexplored room nodes.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from collections.abc import Mapping
+
+import numpy as np
+
+from sgtool.mapping.voronoi import VoronoiGraph
+from sgtool.scenegraph.builder_config import BuilderConfig
+from sgtool.scenegraph.categories import RoomClassifier
+from sgtool.scenegraph.door_evidence import DoorObservation
+from sgtool.scenegraph.graph import RoomNode
+from sgtool.scenegraph.instances import InstanceInfo
+from sgtool.scenegraph.object_placement import PlacedObject
+from sgtool.scenegraph.regions import RegionConfig, cluster_room
+from sgtool.scenegraph.room_segmentation import RoomSegmentation, room_neighbours
+
+# region id -> (room id, its Voronoi node, its position)
+Regions = dict[str, tuple[str, int, tuple[float, float]]]
+
+
+def room_regions(vg: VoronoiGraph, seg: RoomSegmentation, room_ids: list[str],
+                 config: RegionConfig) -> tuple[Regions, dict[int, str]]:
+    """The regions of every room, and the region id of every node of a room."""
+    regions: Regions = {}
+    node_region: dict[int, str] = {}
+    for i, nodes in enumerate(seg.rooms):
+        rid = room_ids[i]
+        num = rid.split(":", 1)[1]
+        inside = np.isin(vg.edges, nodes).all(axis=1) if len(vg.edges) else np.zeros(0, bool)
+        length = float(vg.lengths[inside].sum()) if len(vg.edges) else 0.0
+        centre = int(np.searchsorted(nodes, seg.centres[i]))
+        reg = cluster_room(vg.positions[nodes], length, centre, config)
+        for k, c in enumerate(reg.centres.tolist(), start=1):
+            node = int(nodes[c])
+            reg_id = f"region:{num}.{k}"
+            regions[reg_id] = (rid, node, (float(vg.positions[node, 0]),
+                                           float(vg.positions[node, 1])))
+        for j, n in enumerate(nodes.tolist()):
+            node_region[int(n)] = f"region:{num}.{int(reg.labels[j]) + 1}"
+    return regions, node_region
+
+
+def room_nodes(
+    vg: VoronoiGraph, seg: RoomSegmentation, room_ids: list[str], objects: list[PlacedObject],
+    doors: list[DoorObservation], unexplored_pos: Mapping[str, tuple[float, float]],
+    instances: Mapping[int, InstanceInfo], classifier: RoomClassifier | None,
+    class_memo: dict[tuple[str, ...], list[tuple[str, float]]], config: BuilderConfig,
+) -> list[RoomNode]:
+    """The explored rooms (neighbours, category scores) then the unexplored ones behind
+    closed doors; ``class_memo`` caches the classifier's answers across calls."""
+    nb: dict[str, set[str]] = {rid: set() for rid in room_ids}
+    for a, b in room_neighbours(vg, seg):
+        nb[room_ids[a]].add(room_ids[b])
+        nb[room_ids[b]].add(room_ids[a])
+    for d in doors:
+        joined = list(d.rooms) + ([d.unexplored_room] if d.unexplored_room else [])
+        for a in joined:
+            for b in joined:
+                if a != b and a in nb:
+                    nb[a].add(b)
+    cats: dict[str, list[str]] = defaultdict(list)
+    voters: dict[str, list[str]] = defaultdict(list)
+    for o in objects:
+        if o.room is None:
+            continue
+        info = instances[o.instance]
+        cats[o.room].append(info.category)
+        if info.kind in config.classify_kinds:
+            voters[o.room].append(info.category)
+    out = []
+    for i, rid in enumerate(room_ids):
+        c = seg.centres[i]
+        scores: list[tuple[str, float]] = []
+        if classifier is not None:
+            evidence = tuple(sorted(voters.get(rid) or cats.get(rid) or ()))
+            if evidence:
+                got = class_memo.get(evidence)
+                if got is None:
+                    got = list(classifier.classify(list(evidence)))
+                    class_memo[evidence] = got
+                scores = got[: config.max_scores]
+            elif corridor_like(vg, seg.rooms[i], config, semantic=bool(instances)):
+                scores = [(str(config.corridor), 1.0)]
+        out.append(RoomNode(
+            id=rid, category=scores[0][0] if scores else "unknown",
+            position=(float(vg.positions[c, 0]), float(vg.positions[c, 1])),
+            explored=True, category_scores=tuple((r, float(p)) for r, p in scores),
+            neighbours=tuple(sorted(nb[rid])),
+        ))
+    for d in doors:
+        if d.unexplored_room is None:
+            continue
+        out.append(RoomNode(id=d.unexplored_room, position=unexplored_pos[d.unexplored_room],
+                            explored=False, neighbours=tuple(sorted(d.rooms))))
+    return out
+
+
+def corridor_like(vg: VoronoiGraph, nodes: np.ndarray, config: BuilderConfig,
+                  semantic: bool = True) -> bool:
+    """An empty room that is long (its nodes span ``corridor_length``) and narrow (no node
+    farther than ``corridor_clearance`` from a wall): with no object to vote, the geometry
+    says corridor (transparent rule, off with ``corridor=None``). Without semantics
+    (``semantic=False``: no instance table) an empty room says nothing."""
+    if config.corridor is None or len(nodes) < 2 or not semantic:
+        return False
+    p = vg.positions[nodes]
+    span = float(np.hypot(*(p.max(axis=0) - p.min(axis=0))))
+    return (span >= config.corridor_length
+            and float(vg.clearance[nodes].max()) <= config.corridor_clearance)
