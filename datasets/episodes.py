@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sgtool.house.spec import HouseSpec, StartPose
+from sgtool.house.spec import HouseSpec, StartPose, spec_id_key
 from sgtool.mapping.occupancy import OccupancyMap, geodesic_distances, house_occupancy
 from sgtool.mapping.raster import cell_centers, polygon_mask
 
@@ -152,8 +152,8 @@ def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
     furn = spec.furniture_by_id()
     out = []
     for i, cat in enumerate(chosen):
-        ids = sorted(by_cat[cat], key=_id_key)
-        rooms = tuple(sorted({objs[o].room for o in ids}, key=_id_key))
+        ids = sorted(by_cat[cat], key=spec_id_key)
+        rooms = tuple(sorted({objs[o].room for o in ids}, key=spec_id_key))
         starts = [s for s in spec.starts if s.room not in rooms] or list(spec.starts)
         start = starts[int(rng.integers(len(starts)))]
         hidden = all(objs[o].relation == "inside" and furn[objs[o].parent].state == "closed"
@@ -166,7 +166,3 @@ def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
         ))
     return out
 
-
-def _id_key(s: str) -> tuple[str, int]:
-    head, _, num = s.rpartition("_")
-    return (head, int(num)) if num.isdigit() else (s, -1)

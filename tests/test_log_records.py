@@ -120,10 +120,11 @@ def test_a_missing_field_is_refused_on_write(tmp_path) -> None:
 
 
 def _raw_log(path, kind: str, messages: list[tuple[int, bytes]]) -> None:
-    """A log whose records on ``kind``'s channel are the given raw bytes (unchecked)."""
+    """A log whose records on ``kind``'s channel are the given raw bytes (unchecked: the
+    writer's private channel API, as a damaged or foreign writer would write them)."""
     with LogWriter(path) as w:
         for t, data in messages:
-            w.write_json_bytes(kind, t, data)
+            w._add(w._json_channel(S.RECORDS[kind]), t, data)
 
 
 @pytest.mark.parametrize("kind, bad, field", [

@@ -7,9 +7,6 @@ import pytest
 from support.synthetic_world import camera_pose
 
 from sgtool.mapping.bev import (
-    FREE,
-    OCCUPIED,
-    UNKNOWN,
     BevConfig,
     ColumnGrid,
     classify_keys,
@@ -19,7 +16,9 @@ from sgtool.mapping.bev import (
     line_of_sight,
     occupancy_from_keys,
 )
-from sgtool.mapping.esdf import distance_field, inflate, signed_distance
+from sgtool.mapping.esdf import distance_field
+from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN
+from sgtool.mapping.occupancy import inflate
 from sgtool.mapping.voxels import pack
 
 RES = 0.05
@@ -144,7 +143,9 @@ def test_distance_fields_and_inflation() -> None:
     assert dist[5, 8] == pytest.approx(0.3)
     assert dist[0, 5] == pytest.approx(0.1)  # the virtual border around the grid
     assert tuple(feat[:, 5, 7]) == (5, 5)
-    sdf = signed_distance(obstacle, 0.1)
-    assert sdf[5, 5] < 0 < sdf[5, 6]
+    # inflation (the robot's footprint): cell centres closer than radius + half a cell to
+    # the obstacle's centre: 0.2 + 0.05 m takes (5, 7) at 0.2 m and (6, 7) at 0.224 m,
+    # not (5, 8) at 0.3 m nor (7, 7) at 0.283 m
     grown = inflate(obstacle, 0.2, 0.1)
-    assert grown[5, 7] and grown[6, 6] and not grown[5, 8] and not grown[7, 7]
+    assert grown[5, 7] and grown[6, 7] and grown[6, 6]
+    assert not grown[5, 8] and not grown[7, 7]

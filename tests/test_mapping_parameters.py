@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sgtool.mapping.bev import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiConfig, voronoi_graph
 
 DEFAULT = VoronoiConfig()

@@ -6,8 +6,8 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from sgtool.mapping.bev import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.esdf import distance_field
+from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiConfig, thin, voronoi_graph
 
 RES = 0.05

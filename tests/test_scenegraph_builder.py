@@ -200,7 +200,7 @@ def test_empty_narrow_rooms_are_corridors() -> None:
     short or without semantics (no instance table) -> no guess."""
     import numpy as np
 
-    from sgtool.mapping.bev import OccupancyGrid
+    from sgtool.mapping.grid import OccupancyGrid
     from sgtool.mapping.voronoi import voronoi_graph
     from sgtool.scenegraph.room_nodes import corridor_like
 

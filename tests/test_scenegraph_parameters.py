@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from scipy.sparse import csr_matrix
 
-from sgtool.mapping.bev import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph, voronoi_graph
 from sgtool.scenegraph.assign import AssignConfig, assign_objects
 from sgtool.scenegraph.frontiers import FrontierConfig, find_frontiers

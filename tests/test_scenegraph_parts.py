@@ -7,7 +7,7 @@ import pytest
 from scipy.sparse import csr_matrix
 
 from sgtool.datasets.room_evidence import frequency_room_classifier
-from sgtool.mapping.bev import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.voronoi import voronoi_graph
 from sgtool.scenegraph.assign import AssignConfig, assign_objects
 from sgtool.scenegraph.categories import FrequencyRoomClassifier, RoomClassifier

@@ -42,6 +42,7 @@ import numpy as np
 from sgtool.errors import SgtoolError
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
+from sgtool.log.records import Episode
 from sgtool.log.writer import LogWriter
 from sgtool.recorders.importers import bagfiles as B
 from sgtool.recorders.importers.bag_frames import camera_of, decode_frames
@@ -203,14 +204,13 @@ def _import_trajectory(
     A = alignment.matrix  # noqa: N806
     with LogWriter(out, compression=opts.compression) as w:
         w.add_metadata(IMPORT_METADATA, meta)
-        w.write_record("episode", samples[0][0], {"kind": "import", "status": "started",
-                                                  "source": meta["source"], "frames": 0})
+        w.write_record(Episode(kind="import", status="started", source=meta["source"],
+                               frames=0), samples[0][0])
         for t, T in samples:  # noqa: N806
             w.write_transform(t, S.WORLD_FRAME, S.CAMERA_FRAME, A @ T)
-        w.write_record("episode", samples[-1][0], {
-            "kind": "import", "status": "ended", "source": meta["source"], "frames": 0,
-            "extra": {"poses": len(samples), "content": "trajectory"},
-        })
+        w.write_record(Episode(kind="import", status="ended", source=meta["source"], frames=0,
+                               extra={"poses": len(samples), "content": "trajectory"}),
+                       samples[-1][0])
     return ImportReport(
         output=out, source=str(path), kind=kind, frames=0, poses=len(samples),
         alignment=alignment, has_rgb=False, has_ids=False,

@@ -126,7 +126,7 @@ def missing_for_layout(root: Path, layout: str) -> str | None:
     raise SgtoolError(f"unknown layout {layout!r} ({', '.join(LAYOUTS)})")
 
 
-def _a(name: str) -> str:
+def _with_article(name: str) -> str:
     return f"{'an' if name[0] in 'AEIOU' else 'a'} {name}"
 
 
@@ -135,14 +135,15 @@ def layout_error(root: Path, layout: str, missing: str) -> SgtoolError:
     it looks like instead."""
     seen = looks_like(root) if root.is_dir() else None
     if seen is not None and seen != layout:
-        hint = (f"; it looks like {_a(LAYOUT_NAMES[seen])} folder ({LAYOUT_FILES[seen]}): use "
-                f"--layout {seen}, or --layout auto")
+        hint = (f"; it looks like {_with_article(LAYOUT_NAMES[seen])} folder "
+                f"({LAYOUT_FILES[seen]}): use --layout {seen}, or --layout auto")
     elif seen is None:
         hint = f"; it matches no known layout{_sequence_hint(root)}"
     else:
         hint = ""
     return SgtoolError(
-        f"{root}: not {_a(LAYOUT_NAMES[layout])} folder ({LAYOUT_FILES[layout]}): {missing}{hint}"
+        f"{root}: not {_with_article(LAYOUT_NAMES[layout])} folder "
+        f"({LAYOUT_FILES[layout]}): {missing}{hint}"
     )
 
 

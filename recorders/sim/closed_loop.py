@@ -60,7 +60,6 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from sgtool.canonical import canonical_float
 from sgtool.datasets.episodes import Episode, list_episodes
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
@@ -383,7 +382,6 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
     hid = house_id or f"house-{house.seed}"
     query = episode.query
     shortest = episode.shortest_path if math.isfinite(episode.shortest_path) else None
-    shortest_m = None if shortest is None else canonical_float(shortest)
     t_wall = time.perf_counter()
     try:
         with Simulation(house, camera=opts.camera, robot=opts.robot, fps=opts.fps,
@@ -400,7 +398,7 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                                  house_id=hid, query=query, planner=name)
             writer.attach_house(house.to_json())
             writer.write_record(dataclasses.replace(
-                base, steps=0, travelled_m=0.0, shortest_m=shortest_m, frames=0,
+                base, steps=0, travelled_m=0.0, shortest_m=shortest, frames=0,
                 extra=_started_extra(opts, sim, mapping, episode, episode_index)), 0)
             rec.write_instances(sim)
             search = _Search(sim, rec, planner, query, opts.max_steps, on_decision)
@@ -411,7 +409,7 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
             t_end = max(rec.last_time_ns, search.last_t)
             writer.write_record(dataclasses.replace(
                 base, status="success" if success else "failure", steps=steps,
-                travelled_m=round(sim.travelled_m, 6), shortest_m=shortest_m,
+                travelled_m=sim.travelled_m, shortest_m=shortest,
                 frames=rec.frames,
                 extra={"query": query, "planner": name, "seed": opts.planner_seed,
                        "episode": int(episode_index), "episode_id": episode.id,

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from sgtool.house.spec import spec_id_key
 from sgtool.mapping.occupancy import geodesic_distances, world_to_cell
 from sgtool.recorders.sim import navigation as nav
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome
@@ -90,7 +91,7 @@ def _nearest_room(sim: Simulation, rooms: list[str]) -> str | None:
     occ = sim.occupancy(doors_passable=True)
     geo = geodesic_distances(occ, sim.base[:2])
     best: tuple[float, str] | None = None
-    for rid in sorted(rooms, key=_id_key):
+    for rid in sorted(rooms, key=spec_id_key):
         vp = nav.room_viewpoint(occ, geo, sim.spec.room(rid))
         if vp is None:
             continue
@@ -137,7 +138,3 @@ def _open_containers(sim: Simulation, room: str, rep: ExplorationReport,
         if do(sim.open(f.id)).success:
             rep.opened.append(f.id)
 
-
-def _id_key(s: str) -> tuple[str, int]:
-    head, _, num = s.rpartition("_")
-    return (head, int(num)) if num.isdigit() else (s, -1)

@@ -22,7 +22,7 @@ from scipy import ndimage
 
 from sgtool.errors import SgtoolError
 from sgtool.house.spec import HouseSpec, Room
-from sgtool.mapping.occupancy import OccupancyMap, house_occupancy, inflate
+from sgtool.mapping.occupancy import OccupancyMap, house_occupancy
 from sgtool.mapping.raster import cell_centers, fill_box_grown, polygon_mask
 from sgtool.recorders.sim.articulation import Box2
 
@@ -72,8 +72,8 @@ def occupancy_with(spec: HouseSpec, door_states: Mapping[str, str], extra: Seque
     occ = base.occupied.copy()
     for x, y, sx, sy, yaw in extra:
         fill_box_grown(base, occ, (x, y), (sx, sy), yaw)
-    return OccupancyMap(occ, inflate(occ, robot.radius, robot.resolution), base.origin,
-                        base.resolution, robot.radius, doors_passable)
+    return OccupancyMap.of_occupied(occ, base.origin, base.resolution, robot.radius,
+                                    doors_passable)
 
 
 def box_distance_grid(grid: OccupancyMap, box: Box2) -> np.ndarray:

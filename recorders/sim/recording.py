@@ -115,7 +115,7 @@ class LogRecorder(SimObserver):
         t = max(t, self.last_time_ns)
         record = Action(
             skill=outcome.skill, target=outcome.target, outcome=outcome.outcome,
-            reason=outcome.reason, travelled_m=round(outcome.travelled_m, 6),
+            reason=outcome.reason, travelled_m=outcome.travelled_m,
             decision_time_s=float(decision_time_s), planner=self.planner, step=self.actions)
         self.writer.write_record(dataclasses.replace(record, **(fields or {})), t)
         self.actions += 1
@@ -200,7 +200,7 @@ def record_house(house: HouseSpec, output: str | os.PathLike[str],
             truncated = True
         writer.write_record(Episode(
             kind="recording", source=SOURCE, house_id=hid, status="ended",
-            steps=rec.actions, frames=rec.frames, travelled_m=round(sim.travelled_m, 6),
+            steps=rec.actions, frames=rec.frames, travelled_m=sim.travelled_m,
             extra={"rooms_visited": rep.visited, "rooms_missed": rep.missed,
                    "opened": rep.opened, "truncated": truncated},
         ), rec.last_time_ns)

@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from sgtool.errors import SgtoolError
-from sgtool.house.spec import HouseSpec, StartPose, room_at
+from sgtool.house.spec import HouseSpec, StartPose, room_at, spec_id_key
 from sgtool.log.frame import Frame
 from sgtool.mapping.occupancy import OccupancyMap
 from sgtool.recorders.sim import articulation as art
@@ -90,7 +90,7 @@ class Simulation(Skills):
         self._depth = 0  # nesting of skills; only top-level ones are reported
         self._occ_cache: dict[tuple[Any, ...], OccupancyMap] = {}
         self._opening = OpeningPlanner(house, self.world, self.robot)
-        for sid in sorted(self.world.panels, key=_id_key):  # open what the spec says is open
+        for sid in sorted(self.world.panels, key=spec_id_key):  # open what the spec says is open
             if self.world.states[sid] == "open":
                 self._set_open(sid, 1.0, self._layout_for_opening(sid))
 
@@ -248,7 +248,3 @@ class Simulation(Skills):
         for o in self.observers:
             o.on_state(self, sid, state)
 
-
-def _id_key(s: str) -> tuple[str, int]:
-    head, _, num = s.rpartition("_")
-    return (head, int(num)) if num.isdigit() else (s, -1)

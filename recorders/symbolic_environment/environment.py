@@ -274,7 +274,7 @@ class SymbolicEnv:
         feedback only."""
         return self.step(action).feedback
 
-    def _fb(self, action: Action, outcome: str, message: str, travelled: float = 0.0,
+    def _outcome(self, action: Action, outcome: str, message: str, travelled: float = 0.0,
             opened: bool = False) -> StepOutcome:
         return StepOutcome(Feedback(action, outcome, message, travelled), opened)  # type: ignore[arg-type]
 
@@ -283,100 +283,101 @@ class SymbolicEnv:
         if a.skill == "done":
             self.ended = True
             self.end_reason = "gave_up" if a.target is None else "wrong_done"
-            return self._fb(a, "success", "episode ended by the planner")
+            return self._outcome(a, "success", "episode ended by the planner")
         found = self._lookup(a.target)
         if found is None:
-            return self._fb(a, "invalid", f"{a.target!r} is not a node of the observed graph")
+            return self._outcome(a, "invalid", f"{a.target!r} is not a node of the observed graph")
         kind, i = found
         dist = self._distances()
         skill = a.skill
         if kind == "room":
             if skill in ("open", "close"):
-                return self._fb(a, "invalid", f"cannot {skill} a room")
+                return self._outcome(a, "invalid", f"cannot {skill} a room")
             place = self._room_place(i, dist)
             if not math.isfinite(dist[place]):
-                return self._fb(a, "failure", f"{a.target} cannot be reached")
+                return self._outcome(a, "failure", f"{a.target} cannot be reached")
             if i in self.explored_rooms:
                 if skill == "explore":
-                    return self._fb(a, "failure", f"{a.target} is already explored")
-                return self._fb(a, "success", f"at {a.target}", self._move(place, dist))
+                    return self._outcome(a, "failure", f"{a.target} is already explored")
+                return self._outcome(a, "success", f"at {a.target}", self._move(place, dist))
             reg = next(r for r in h.room_regions[i] if h.regions[r].place == place)
             d = self._move(place, dist)
             self._enter_room(i, reg)
             n = len(h.regions[reg].furniture)
-            return self._fb(a, "success", f"entered {h.room_names[i]}: {n} objects in view", d)
+            return self._outcome(a, "success", f"entered {h.room_names[i]}: {n} objects in view", d)
         if kind == "region":
             reg = h.regions[i]
             if skill in ("open", "close"):
-                return self._fb(a, "invalid", f"cannot {skill} a region")
+                return self._outcome(a, "invalid", f"cannot {skill} a region")
             if not math.isfinite(dist[reg.place]):
-                return self._fb(a, "failure", f"{a.target} cannot be reached")
+                return self._outcome(a, "failure", f"{a.target} cannot be reached")
             if i in self.revealed_regions:
                 if skill == "explore":
-                    return self._fb(a, "failure", f"{a.target} is already explored")
-                return self._fb(a, "success", f"at {a.target}", self._move(reg.place, dist))
+                    return self._outcome(a, "failure", f"{a.target} is already explored")
+                return self._outcome(a, "success", f"at {a.target}", self._move(reg.place, dist))
             d = self._move(reg.place, dist)
             self.revealed_regions.add(i)
-            return self._fb(a, "success", f"{len(reg.furniture)} objects in view", d)
+            return self._outcome(a, "success", f"{len(reg.furniture)} objects in view", d)
         if kind == "door":
             place = self._door_place(i, dist)
             if not math.isfinite(dist[place]):
-                return self._fb(a, "failure", f"{a.target} cannot be reached")
+                return self._outcome(a, "failure", f"{a.target} cannot be reached")
             is_open = i in self.open_doors
             if skill == "explore":
-                return self._fb(a, "invalid", "cannot explore a door; open it")
+                return self._outcome(a, "invalid", "cannot explore a door; open it")
             if skill == "navigate":
-                return self._fb(a, "success", f"at {a.target}", self._move(place, dist))
+                return self._outcome(a, "success", f"at {a.target}", self._move(place, dist))
             if skill == "open":
                 if is_open:
-                    return self._fb(a, "failure", f"{a.target} is already open")
+                    return self._outcome(a, "failure", f"{a.target} is already open")
                 d = self._move(place, dist)
                 self.open_doors.add(i)
                 for r in self.spec.doors[i].rooms:
                     self.known_rooms.add(h.room_index[r])
-                return self._fb(a, "success", "door opened", d, opened=True)
+                return self._outcome(a, "success", "door opened", d, opened=True)
             if not is_open:  # close
-                return self._fb(a, "failure", f"{a.target} is already closed")
+                return self._outcome(a, "failure", f"{a.target} is already closed")
             d = self._move(place, dist)
             self.open_doors.discard(i)
-            return self._fb(a, "success", "door closed", d)
+            return self._outcome(a, "success", "door closed", d)
         if kind == "object":  # nested objects: walk to the parent
             parent = h.furn_index[self.spec.objects[i].parent]
             place = h.furn_place[parent]
             if skill != "navigate":
-                return self._fb(a, "invalid", f"cannot {skill} a {self.spec.objects[i].category}")
+                return self._outcome(a, "invalid",
+                                     f"cannot {skill} a {self.spec.objects[i].category}")
             if not math.isfinite(dist[place]):
-                return self._fb(a, "failure", f"{a.target} cannot be reached")
-            return self._fb(a, "success", f"at {a.target}", self._move(place, dist))
+                return self._outcome(a, "failure", f"{a.target} cannot be reached")
+            return self._outcome(a, "success", f"at {a.target}", self._move(place, dist))
         # furniture
         fu = self.spec.furniture[i]
         place = h.furn_place[i]
         if not math.isfinite(dist[place]):
-            return self._fb(a, "failure", f"{a.target} cannot be reached")
+            return self._outcome(a, "failure", f"{a.target} cannot be reached")
         state = self.furn_state[i]
         explorable = bool(set(fu.affordances) & {"container", "supporter"})
         if skill == "open" or (skill == "explore" and state == "closed"):
             if not fu.is_openable:
-                return self._fb(a, "failure", f"a {fu.category} cannot be opened")
+                return self._outcome(a, "failure", f"a {fu.category} cannot be opened")
             if state == "open":
-                return self._fb(a, "failure", f"the {fu.category} is already open")
+                return self._outcome(a, "failure", f"the {fu.category} is already open")
             d = self._move(place, dist)
             self.furn_state[i] = "open"
-            return self._fb(a, "success", self._reveal(i), d, opened=True)
+            return self._outcome(a, "success", self._reveal(i), d, opened=True)
         if skill == "close":
             if state != "open":
-                return self._fb(a, "failure", f"the {fu.category} is not open")
+                return self._outcome(a, "failure", f"the {fu.category} is not open")
             d = self._move(place, dist)
             self.furn_state[i] = "closed"
-            return self._fb(a, "success", f"{fu.category} closed", d)
+            return self._outcome(a, "success", f"{fu.category} closed", d)
         # navigate / explore of a piece that is not closed: look into / onto it
         fresh = explorable and i not in self.furn_explored and state != "closed"
         if skill == "explore" and not fresh:
-            return self._fb(a, "failure", f"nothing left to explore at the {fu.category}")
+            return self._outcome(a, "failure", f"nothing left to explore at the {fu.category}")
         d = self._move(place, dist)
         if fresh:
-            return self._fb(a, "success", self._reveal(i), d)
-        return self._fb(a, "success", f"at the {fu.category}", d)
+            return self._outcome(a, "success", self._reveal(i), d)
+        return self._outcome(a, "success", f"at the {fu.category}", d)
 
     def _reveal(self, f: int) -> str:
         self.furn_explored.add(f)

@@ -14,7 +14,6 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from sgtool.canonical import canonical_float
 from sgtool.log.records import Action as LoggedAction
 from sgtool.log.records import Episode, SceneGraphRecord
 from sgtool.log.writer import LogWriter
@@ -38,8 +37,8 @@ class EpisodeLog:
     """Records a symbolic episode into an open log: an ``sgtool.Episode`` record "started"
     at t = 0, then per step k (t = k s) the ``sgtool.SceneGraph`` the planner saw and the
     ``sgtool.Action`` it took, and (:meth:`close`) the closing Episode record at
-    t = (steps + 1) s. Distances are :func:`~sgtool.canonical.canonical_float` (4
-    decimals)."""
+    t = (steps + 1) s. Distances are rounded by the records themselves
+    (:class:`sgtool.log.records.Action`)."""
 
     def __init__(self, log: LogWriter, base: Episode, planner: str) -> None:
         self.log = log
@@ -61,15 +60,15 @@ class EpisodeLog:
         self.log.write_record(SceneGraphRecord.of_graph(step.graph), t_ns)
         self.log.write_record(LoggedAction(
             skill=a.skill, target=a.target, outcome=fb.outcome, reason=a.reason,
-            travelled_m=canonical_float(fb.travelled_m), decision_time_s=step.decision_s,
+            travelled_m=fb.travelled_m, decision_time_s=step.decision_s,
             planner=self.planner, step=step.index), t_ns)
 
     def close(self, steps: int, env: SymbolicEnv, shortest: float | None,
               extra: dict[str, object]) -> None:
         self.log.write_record(dataclasses.replace(
             self.base, status="success" if env.success else "failure", steps=env.steps,
-            travelled_m=canonical_float(env.travelled),
-            shortest_m=None if shortest is None else canonical_float(shortest), extra=extra,
+            travelled_m=env.travelled,
+            shortest_m=shortest, extra=extra,
         ), (steps + 1) * SECOND_NS)
 
 

@@ -4,27 +4,10 @@ from __future__ import annotations
 
 import shlex
 import sys
-from typing import Any
 
 import click
 
-from sgtool.commands.options import parse_rooms, parse_value
-from sgtool.errors import SgtoolError
-
-
-class OptionError(SgtoolError):
-    """A malformed command-line value."""
-
-
-def _planner_options(items: tuple[str, ...]) -> dict[str, dict[str, Any]]:
-    out: dict[str, dict[str, Any]] = {}
-    for item in items:
-        key, eq, value = item.partition("=")
-        name, dot, opt = key.partition(".")
-        if not eq or not dot or not name or not opt:
-            raise OptionError(f"--planner-option: expected PLANNER.KEY=VALUE, got {item!r}")
-        out.setdefault(name.strip(), {})[opt.strip()] = parse_value(value.strip())
-    return out
+from sgtool.commands.options import llm_log_options, parse_rooms, planner_options
 
 
 @click.command("bench")
@@ -56,11 +39,9 @@ def _planner_options(items: tuple[str, ...]) -> dict[str, dict[str, Any]]:
                    "(0.1 m of travel = 1, an open = 30; MoMa-LLM).")
 @click.option("--step-budget", default=50.0, show_default=True,
               help="AUC-E step variant budget max, in high-level steps.")
-@click.option("--llm-replay", type=click.Path(dir_okay=False), default=None,
-              help="moma-llm: serve answers from this JSONL transcript instead of an endpoint.")
-@click.option("--llm-transcript", type=click.Path(dir_okay=False), default=None,
-              help="moma-llm: append every LLM exchange to this JSONL transcript "
-                   "(needs --workers 1).")
+@llm_log_options(
+    transcript_help="moma-llm: append every LLM exchange to this JSONL transcript "
+    "(needs --workers 1).")
 @click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
               help="Extra planner option, e.g. scout.delta=0.2 or moma-llm.model=gpt-4o-mini "
                    "(repeatable; see sgtool.planning.registry).")
@@ -84,7 +65,7 @@ def command(planners: str | None, houses: int, episodes: int, seeds: int, worker
 
     names = tuple(p.strip() for p in planners.split(",") if p.strip()) if planners \
         else DEFAULT_PLANNERS
-    options = _planner_options(planner_option)
+    options = planner_options(planner_option)
     if llm_replay or llm_transcript:
         moma = options.setdefault("moma-llm", {})
         if llm_replay:

@@ -10,6 +10,7 @@ from typing import Any
 import click
 
 from sgtool.canonical import strict_json
+from sgtool.errors import SgtoolError
 
 
 @click.command("eval")
@@ -41,21 +42,21 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
     from sgtool.analysis.metrics import cost_models, seen_unseen, summarize
     from sgtool.analysis.offline import format_offline, load_results, replay_decisions
     from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
-    from sgtool.commands.bench import OptionError, _planner_options
+    from sgtool.commands.options import planner_options
     from sgtool.files import atomic_write
     from sgtool.planning.registry import make_planner
 
     results, logged = load_results(inputs)
     if not results:
-        raise OptionError("no episodes found in " + ", ".join(inputs))
+        raise SgtoolError("no episodes found in " + ", ".join(inputs))
     models = cost_models(distance_budget, step_budget)
     sums = summarize(results, models)
     names = [n.strip() for item in planners for n in item.split(",") if n.strip()]
-    options = _planner_options(planner_option)
+    options = planner_options(planner_option)
     if llm_replay:
         options.setdefault("moma-llm", {})["replay"] = llm_replay
     if names and not any(d.graph is not None for e in logged for d in e.decisions):
-        raise OptionError("--planner needs MCAP logs with sgtool.SceneGraph records; "
+        raise SgtoolError("--planner needs MCAP logs with sgtool.SceneGraph records; "
                           "the inputs have none")
     reports = [replay_decisions(make_planner(n, **options.get(n, {})), logged, name=n)
                for n in names]

@@ -119,3 +119,26 @@ def llm_log_options(transcript_help: str) -> Callable[[F], F]:
         click.option("--llm-transcript", type=click.Path(dir_okay=False), default=None,
                      help=transcript_help),
     ])
+
+
+def planner_options(items: tuple[str, ...]) -> dict[str, dict[str, Any]]:
+    """``-O PLANNER.KEY=VALUE`` values (bench, eval) as {planner: {key: value}}."""
+    out: dict[str, dict[str, Any]] = {}
+    for item in items:
+        key, eq, value = item.partition("=")
+        name, dot, opt = key.partition(".")
+        if not eq or not dot or not name or not opt:
+            raise SgtoolError(f"--planner-option: expected PLANNER.KEY=VALUE, got {item!r}")
+        out.setdefault(name.strip(), {})[opt.strip()] = parse_value(value.strip())
+    return out
+
+
+def key_value_options(items: tuple[str, ...]) -> dict[str, Any]:
+    """``-O KEY=VALUE`` values of one planner (run) as {key: value}."""
+    out: dict[str, Any] = {}
+    for item in items:
+        key, eq, value = item.partition("=")
+        if not eq or not key.strip():
+            raise SgtoolError(f"-O {item!r}: expected KEY=VALUE, e.g. -O delta=0.2")
+        out[key.strip()] = parse_value(value.strip())
+    return out

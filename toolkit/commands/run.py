@@ -9,36 +9,21 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Any
 
 import click
 
-from sgtool.commands.options import parse_value
+from sgtool.commands.options import house_options, key_value_options, llm_log_options
 from sgtool.errors import SgtoolError
-
-
-def _planner_options(items: tuple[str, ...]) -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for item in items:
-        key, eq, value = item.partition("=")
-        if not eq or not key.strip():
-            raise SgtoolError(f"-O {item!r}: expected KEY=VALUE, e.g. -O delta=0.2")
-        out[key.strip()] = parse_value(value.strip())
-    return out
 
 
 @click.command("run")
 @click.option("--planner", "-p", required=True,
               help="The planner: random, greedy, sbert, sbert-noroom, scout, scout-noroom, "
               "scout-delta0 or moma-llm.")
-@click.option("--house", "house_path", type=click.Path(dir_okay=False),
-              help="House spec (JSON, see `sgtool scenes`). Default: the demo house shipped "
-              "with sgtool, unless --seed is given.")
-@click.option("--seed", type=int, default=None,
-              help="Search a generated evaluation house (`sgtool scenes generate`) of this "
-              "seed instead of --house.")
-@click.option("--rooms", default="4-12", show_default=True, metavar="MIN-MAX",
-              help="Room count range of a house generated with --seed.")
+@house_options(
+    seed_help="Search a generated evaluation house (`sgtool scenes generate`) of this seed "
+    "instead of --house.",
+    rooms_help="Room count range of a house generated with --seed.")
 @click.option("--query", default=None, metavar="CATEGORY",
               help="The object category to find (a small object of the house, e.g. 'bowl'); "
               "the start pose is that of its episode in `sgtool scenes episodes`.")
@@ -68,11 +53,9 @@ def _planner_options(items: tuple[str, ...]) -> dict[str, Any]:
               "sgtool.planning.registry.")
 @click.option("--planner-seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the planner's randomness (random planner, tie-breaks).")
-@click.option("--llm-replay", type=click.Path(dir_okay=False), default=None,
-              help="moma-llm: serve answers from this JSONL transcript instead of an endpoint.")
-@click.option("--llm-transcript", type=click.Path(dir_okay=False), default=None,
-              help="moma-llm: append every LLM exchange to this JSONL transcript (replay it "
-              "later with --llm-replay).")
+@llm_log_options(
+    transcript_help="moma-llm: append every LLM exchange to this JSONL transcript (replay it "
+    "later with --llm-replay).")
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
               help="The episode log to write (OUT.mcap).")
 @click.option("--force", is_flag=True, help="Overwrite the output log.")
@@ -124,7 +107,7 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
     if name not in PLANNER_NAMES:
         raise SgtoolError(f"unknown planner {planner!r}; choose one of: "
                           f"{', '.join(PLANNER_NAMES)}")
-    options = _planner_options(planner_option)
+    options = key_value_options(planner_option)
     if (llm_replay or llm_transcript) and name != "moma-llm":
         raise SgtoolError("--llm-replay and --llm-transcript are for --planner moma-llm")
     if llm_replay:

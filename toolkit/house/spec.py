@@ -334,3 +334,9 @@ def placement_problem(obj: SmallObject, parent: Furniture) -> str | None:
     if abs(z0 - parent.top) > 0.01:
         return f"{obj.id} bottom z={z0:.3f} is not on {parent.id}'s top z={parent.top:.3f}"
     return None
+
+
+def spec_id_key(spec_id: str) -> tuple[str, int]:
+    """Sort key of a spec id in natural order: ``obj_2`` before ``obj_10``."""
+    head, _, num = spec_id.rpartition("_")
+    return (head, int(num)) if num.isdigit() else (spec_id, -1)

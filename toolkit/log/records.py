@@ -35,6 +35,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Any, ClassVar, Final, TypeVar
 
+from sgtool.canonical import canonical_float
 from sgtool.errors import LogFormatError
 from sgtool.log import schemas as S
 
@@ -133,9 +134,12 @@ class JsonRecord:
     """A JSON object with typed fields (base of the records and their items)."""
 
     unknown: Mapping[str, Any] = field(default_factory=dict, kw_only=True, compare=True)
+    CANONICAL: ClassVar[tuple[str, ...]] = ()  # float fields written canonically rounded
 
     def to_json(self) -> dict[str, Any]:
-        """The JSON object as written: absent fields left out, tuples as lists."""
+        """The JSON object as written: absent fields left out, tuples as lists, the
+        :data:`CANONICAL` fields rounded by :func:`sgtool.canonical.canonical_float` (so
+        every writer writes distances alike)."""
         out = dict(self.unknown)
         for f in fields(self):
             if f.name == "unknown":
@@ -145,6 +149,8 @@ class JsonRecord:
                 continue
             if isinstance(v, tuple):
                 v = [x.to_json() if isinstance(x, JsonRecord) else x for x in v]
+            elif f.name in self.CANONICAL and isinstance(v, float):
+                v = canonical_float(v)
             out[f.name] = v
         return out
 
@@ -213,6 +219,7 @@ class Episode(LogRecord):
     """``sgtool.Episode``: a run starts ("started") or ends (its final figures)."""
 
     KIND: ClassVar[str] = "episode"
+    CANONICAL: ClassVar[tuple[str, ...]] = ("travelled_m", "shortest_m")
 
     kind: str  # recording | search | import
     status: str  # started | success | failure | ended
@@ -246,6 +253,7 @@ class Action(LogRecord):
     before the action's log time."""
 
     KIND: ClassVar[str] = "action"
+    CANONICAL: ClassVar[tuple[str, ...]] = ("travelled_m",)
 
     skill: str
     outcome: str  # success | failure | invalid

@@ -201,12 +201,6 @@ class LogWriter:
         cid = self._json_channel(record.channel())
         self._add(cid, t_ns, json.dumps(d, sort_keys=True, separators=(",", ":")).encode())
 
-    def write_json_bytes(self, kind: str, t_ns: int, data: bytes) -> None:
-        """Like :meth:`write_record` for an already canonical JSON text that its maker
-        guarantees to be valid (the scene graph of a refresh: no second encoding)."""
-        cid = self._json_channel(S.RECORDS[kind])
-        self._add(cid, t_ns, data)
-
     def attach(self, name: str, data: bytes, media_type: str, t_ns: int = 0) -> None:
         self._mcap.add_attachment(
             create_time=t_ns, log_time=t_ns, name=name, media_type=media_type, data=data

@@ -24,9 +24,9 @@ The floor height is taken from the config or estimated as the lowest voxel level
 at least half as many voxels as the fullest level (floors are the largest horizontal
 surfaces a camera sees; the ceiling, when seen, is higher).
 
-Cells use the convention of :mod:`sgtool.mapping.occupancy`: arrays ``[row, col]`` with
-row = y and col = x, cell (0, 0) has its lower-left corner at ``origin``; values follow ROS
-and Foxglove occupancy grids: 0 free, 100 occupied, -1 unknown (int8). The grid is aligned
+The result is an :class:`~sgtool.mapping.grid.OccupancyGrid` (the one grid type: arrays
+``[row, col]`` with row = y and col = x, cell (0, 0) has its lower-left corner at
+``origin``; 0 free, 100 occupied, -1 unknown, int8, as ROS and Foxglove grids). The grid is aligned
 with the voxel lattice (one cell per voxel column) and its origin snapped to whole
 ``snap`` cells, so it only grows as the map grows and cells keep their indices between
 refreshes while the map extent does not change.
@@ -41,11 +41,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.voxels import AXIS_BITS, AXIS_MASK, COLUMN_SHIFT, OFFSET, SHIFT_Z
-
-FREE = np.int8(0)
-OCCUPIED = np.int8(100)
-UNKNOWN = np.int8(-1)
 
 
 @dataclass(frozen=True)
@@ -57,56 +54,6 @@ class BevConfig:
     max_hole: float = 0.1  # m^2; enclosed unknown holes up to this size become free
     margin: int = 10  # cells of unknown kept around the observed extent
     snap: int = 20  # grid origin at multiples of this many cells
-
-
-@dataclass(frozen=True, eq=False)
-class OccupancyGrid:
-    """int8 ``grid[row=y, col=x]`` of FREE / OCCUPIED / UNKNOWN (module doc)."""
-
-    grid: np.ndarray
-    origin: tuple[float, float]
-    resolution: float
-    floor_z: float = 0.0
-
-    @property
-    def shape(self) -> tuple[int, int]:
-        return int(self.grid.shape[0]), int(self.grid.shape[1])
-
-    @property
-    def free(self) -> np.ndarray:
-        return self.grid == FREE
-
-    @property
-    def occupied(self) -> np.ndarray:
-        return self.grid == OCCUPIED
-
-    @property
-    def unknown(self) -> np.ndarray:
-        return self.grid == UNKNOWN
-
-    def cell_of(self, x: np.ndarray | float, y: np.ndarray | float
-                ) -> tuple[np.ndarray, np.ndarray]:
-        """(row, col) of world points (may be out of bounds)."""
-        c = np.floor((np.asarray(x, dtype=np.float64) - self.origin[0]) / self.resolution)
-        r = np.floor((np.asarray(y, dtype=np.float64) - self.origin[1]) / self.resolution)
-        return r.astype(np.int64), c.astype(np.int64)
-
-    def center_of(self, rows: np.ndarray | int, cols: np.ndarray | int
-                  ) -> tuple[np.ndarray, np.ndarray]:
-        """World (x, y) of cell centres."""
-        x = self.origin[0] + (np.asarray(cols, dtype=np.float64) + 0.5) * self.resolution
-        y = self.origin[1] + (np.asarray(rows, dtype=np.float64) + 0.5) * self.resolution
-        return x, y
-
-    def inside(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-        h, w = self.shape
-        return (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
-
-    def value_at(self, x: float, y: float) -> int:
-        r, c = self.cell_of(x, y)
-        if not self.inside(r, c):
-            return int(UNKNOWN)
-        return int(self.grid[r, c])
 
 
 def estimate_floor_level(lowest: int, hist: np.ndarray) -> int | None:

@@ -30,6 +30,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from sgtool.house.spec import HouseSpec
+from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
 from sgtool.mapping.raster import (
     cell_to_world,
     fill_box_overlap,
@@ -45,19 +46,45 @@ _STEPS = ((0, 1), (0, -1), (1, 0), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
 
 @dataclass(frozen=True, eq=False)
 class OccupancyMap:
-    """A house rasterised at ``resolution`` metres per cell (see the module docstring)."""
+    """A house's occupancy grid (:class:`~sgtool.mapping.bev.OccupancyGrid`, FREE or
+    OCCUPIED cells: the one grid type of the mapping code) with the robot's footprint:
+    ``blocked`` is ``occupied`` grown by ``robot_radius`` (see the module docstring)."""
 
-    occupied: np.ndarray  # bool [rows=y, cols=x]
+    grid: OccupancyGrid
     blocked: np.ndarray  # bool, occupied grown by robot_radius
-    origin: tuple[float, float]
-    resolution: float
     robot_radius: float = 0.2
     closed_doors_free: bool = False
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
+    @classmethod
+    def of_occupied(cls, occupied: np.ndarray, origin: tuple[float, float], resolution: float,
+                    robot_radius: float = 0.2, closed_doors_free: bool = False
+                    ) -> OccupancyMap:
+        """The map of a boolean ``occupied`` mask (blocked cells by :func:`inflate`)."""
+        grid = OccupancyGrid(np.where(occupied, OCCUPIED, FREE).astype(np.int8), origin,
+                             resolution)
+        return cls(grid, inflate(occupied, robot_radius, resolution), robot_radius,
+                   closed_doors_free)
+
+    @property
+    def origin(self) -> tuple[float, float]:
+        return self.grid.origin
+
+    @property
+    def resolution(self) -> float:
+        return self.grid.resolution
+
     @property
     def shape(self) -> tuple[int, int]:
-        return (int(self.occupied.shape[0]), int(self.occupied.shape[1]))
+        return self.grid.shape
+
+    @property
+    def occupied(self) -> np.ndarray:
+        """bool [rows=y, cols=x]: cells covered by an obstacle."""
+        mask = self._cache.get("occupied")
+        if mask is None:
+            mask = self._cache["occupied"] = self.grid.occupied
+        return mask
 
     @property
     def free(self) -> np.ndarray:
@@ -88,9 +115,8 @@ def house_occupancy(spec: HouseSpec, resolution: float = 0.05, robot_radius: flo
     oy = math.floor((ymin - margin) / resolution + 1e-9) * resolution
     cols = int(math.ceil((xmax + margin - ox) / resolution - 1e-9))
     rows = int(math.ceil((ymax + margin - oy) / resolution - 1e-9))
-    grid = OccupancyMap(np.zeros((rows, cols), bool), np.zeros((rows, cols), bool),
-                        (round(ox, 9), round(oy, 9)), resolution, robot_radius,
-                        closed_doors_free)
+    grid = OccupancyGrid(np.zeros((rows, cols), np.int8), (round(ox, 9), round(oy, 9)),
+                         resolution)
     inside = np.zeros((rows, cols), bool)
     for room in spec.rooms:
         fill_polygon(grid, inside, room.polygon)
@@ -105,9 +131,8 @@ def house_occupancy(spec: HouseSpec, resolution: float = 0.05, robot_radius: flo
     for f in spec.furniture:
         if f.bottom < max_obstacle_height:
             fill_box_overlap(grid, occupied, f.center[:2], f.size[:2], f.yaw)
-    blocked = inflate(occupied, robot_radius, resolution)
-    return OccupancyMap(occupied, blocked, grid.origin, resolution, robot_radius,
-                        closed_doors_free)
+    return OccupancyMap.of_occupied(occupied, grid.origin, resolution, robot_radius,
+                                    closed_doors_free)
 
 
 def inflate(occupied: np.ndarray, radius: float, resolution: float) -> np.ndarray:

@@ -46,8 +46,8 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
-from sgtool.mapping.bev import OccupancyGrid
 from sgtool.mapping.esdf import distance_field, obstacles
+from sgtool.mapping.grid import OccupancyGrid
 
 _SQRT2 = math.sqrt(2.0)
 

@@ -31,7 +31,8 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
-from sgtool.mapping.bev import OccupancyGrid, line_of_sight
+from sgtool.mapping.bev import line_of_sight
+from sgtool.mapping.grid import OccupancyGrid
 
 
 @dataclass(frozen=True)

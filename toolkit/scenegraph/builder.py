@@ -61,14 +61,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from sgtool.log.frame import Frame
-from sgtool.mapping.bev import (
-    OCCUPIED,
-    ColumnGrid,
-    OccupancyGrid,
-    classify_keys,
-    floor_fans,
-    floor_level,
-)
+from sgtool.mapping.bev import ColumnGrid, classify_keys, floor_fans, floor_level
+from sgtool.mapping.grid import OCCUPIED, OccupancyGrid
 from sgtool.mapping.voronoi import RidgeGraph, VoronoiGraph, ridge_graph, voronoi_graph
 from sgtool.mapping.voxels import VoxelMap
 from sgtool.scenegraph.assembly import GraphParts, assemble_graph, robot_state

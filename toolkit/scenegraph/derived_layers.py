@@ -32,6 +32,7 @@ from foxglove_schemas_protobuf.TextPrimitive_pb2 import TextPrimitive
 from sgtool.colors import color_for
 from sgtool.log import codec
 from sgtool.log import schemas as S
+from sgtool.log.records import SceneGraphRecord
 from sgtool.log.writer import LogWriter
 from sgtool.scenegraph.stream import Refresh
 
@@ -157,4 +158,4 @@ def write_refresh(writer: LogWriter, refresh: Refresh) -> None:
         msg = make(refresh)
         if msg is not None:
             writer.write_proto(topic, t, msg)
-    writer.write_json_bytes("scene_graph", t, refresh.graph.to_json().encode())
+    writer.write_record(SceneGraphRecord.of_graph(refresh.graph), t)

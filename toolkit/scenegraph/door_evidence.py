@@ -18,7 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from sgtool.mapping.bev import OCCUPIED, OccupancyGrid, line_of_sight
+from sgtool.mapping.bev import line_of_sight
+from sgtool.mapping.grid import OCCUPIED, OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph
 from sgtool.mapping.voxels import VoxelMap
 from sgtool.scenegraph.instances import InstanceInfo

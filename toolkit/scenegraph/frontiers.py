@@ -24,7 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from sgtool.mapping.bev import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, near
+from sgtool.mapping.bev import near
+from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 
 _EIGHT = np.ones((3, 3), dtype=bool)
 _FOUR = ndimage.generate_binary_structure(2, 1)

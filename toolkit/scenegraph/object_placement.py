@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sgtool.mapping.bev import OccupancyGrid
+from sgtool.mapping.grid import OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph
 from sgtool.mapping.voxels import VoxelMap
 from sgtool.scenegraph.assign import AssignConfig, assign_objects

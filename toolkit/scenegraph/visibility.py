@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from sgtool.mapping.bev import OccupancyGrid, line_of_sight
+from sgtool.mapping.bev import line_of_sight
+from sgtool.mapping.grid import OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph
 
 
