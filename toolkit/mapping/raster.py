@@ -2,8 +2,9 @@
 covers, and the cell <-> world coordinates that decide it.
 
 A grid is anything with ``origin`` (world x, y of the lower-left corner of cell [0, 0]),
-``resolution`` (metres per cell) and ``shape`` (rows = y, cols = x), such as :class:`~sgtool.mapping.grid.OccupancyGrid` or
-:class:`~sgtool.mapping.occupancy.OccupancyMap`; the centre of cell (r, c) is
+``resolution`` (metres per cell) and ``shape`` (rows = y, cols = x), such as
+:class:`~sgtool.mapping.grid.OccupancyGrid` or :class:`~sgtool.mapping.occupancy.OccupancyMap`;
+the centre of cell (r, c) is
 ``origin + ((c + 0.5) * resolution, (r + 0.5) * resolution)``. The ``fill_*`` functions
 OR a shape into a boolean array of the grid's shape, looking only at a window of cells
 around the shape's bounding box.
