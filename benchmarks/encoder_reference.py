@@ -1,6 +1,6 @@
 """Compare sgtool's numpy MiniLM with the reference sentence-transformers implementation.
 
-Prints the reference values embedded in tests/test_semantics_encoder.py (first components
+Prints the reference values embedded in tests/toolkit/semantics/test_encoder.py (first components
 and pairwise cosines computed by sentence-transformers) and the largest deviation of the
 numpy encoder over a few hundred household names, plus load and encode times side by side.
 

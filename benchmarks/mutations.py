@@ -13,8 +13,8 @@ while others edit and test it. Tests run one mutation at a time (the machine is 
 Usage (from the repository root, by hand)::
 
     python benchmarks/mutations.py                      # the default test files
-    python benchmarks/mutations.py --tests tests/test_scenegraph_parts.py \
-        tests/test_mapping_voronoi.py                   # e.g. the "before" column
+    python benchmarks/mutations.py --tests tests/toolkit/scenegraph/test_parts.py \
+        tests/toolkit/mapping/test_voronoi.py       # e.g. the "before" column
     python benchmarks/mutations.py --only door          # mutations whose parameter matches
 """
 
@@ -35,8 +35,9 @@ REPO = Path(__file__).resolve().parents[1]
 ROOTS = {"toolkit": "sgtool", "recorders": "sgtool/recorders",
          "replayers": "sgtool/replayers", "datasets": "sgtool/datasets",
          "analysis": "sgtool/analysis"}
-DEFAULT_TESTS = ("tests/test_mapping_parameters.py", "tests/test_scenegraph_parameters.py",
-                 "tests/test_scenegraph_parts.py", "tests/test_mapping_voronoi.py")
+DEFAULT_TESTS = ("tests/toolkit/mapping/test_parameters.py",
+                 "tests/toolkit/scenegraph/test_parameters.py",
+                 "tests/toolkit/scenegraph/test_parts.py", "tests/toolkit/mapping/test_voronoi.py")
 RS, VO = "scenegraph/room_segmentation.py", "mapping/voronoi.py"
 AS, FR = "scenegraph/assign.py", "scenegraph/frontiers.py"
 
@@ -123,7 +124,7 @@ def summary(failed: list[str]) -> str:
     """``file (n tests)`` per test file, from ``path::test`` ids."""
     per: dict[str, int] = {}
     for f in failed:
-        name = Path(f.split("::")[0]).name
+        name = f.split("::")[0].removeprefix("tests/")
         per[name] = per.get(name, 0) + 1
     return ", ".join(f"{k} ({v})" for k, v in sorted(per.items()))
 

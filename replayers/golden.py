@@ -24,9 +24,10 @@ import hashlib
 import io
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from sgtool.files import atomic_write
 from sgtool.replayers.derived_log import ReplayOptions, replay
@@ -118,77 +119,87 @@ def _scores(room: object) -> str:
     return "[" + ", ".join(f"{c} {p:.3f}" for c, p in pairs[:3]) + "]"
 
 
-def diff_graphs(expected: SceneGraph, actual: SceneGraph, tol: float = 1e-4) -> list[str]:
-    """What differs between two scene graphs, one line per difference, grouped by layer
-    (empty when they are equal up to ``tol`` in positions and distances)."""
-    out: list[str] = []
-    er = {r.id: r for r in expected.rooms}
-    ar = {r.id: r for r in actual.rooms}
-    for rid in sorted(er.keys() - ar.keys()):
-        out.append(f"rooms: - {rid} ({er[rid].category})")
-    for rid in sorted(ar.keys() - er.keys()):
-        out.append(f"rooms: + {rid} ({ar[rid].category})")
-    for rid in sorted(er.keys() & ar.keys()):
-        a, b = er[rid], ar[rid]
-        if a.category != b.category:
-            out.append(f"rooms: {rid} category {a.category} -> {b.category}")
-        sa, sb = dict(a.category_scores), dict(b.category_scores)
-        if sa.keys() != sb.keys() or any(abs(sa[k] - sb[k]) > tol for k in sa):
-            out.append(f"rooms: {rid} category scores {_scores(a)} -> {_scores(b)}")
-        if a.explored != b.explored:
-            out.append(f"rooms: {rid} explored {a.explored} -> {b.explored}")
-        if sorted(a.neighbours) != sorted(b.neighbours):
-            out.append(f"edges: {rid} neighbours {_fmt_list(sorted(a.neighbours))} -> "
-                       f"{_fmt_list(sorted(b.neighbours))}")
-        if math.dist(a.position, b.position) > tol:
-            out.append(f"rooms: {rid} moved {math.dist(a.position, b.position):.2f} m")
-    eo = {o.id: o for o in expected.objects}
-    ao = {o.id: o for o in actual.objects}
-    for oid in sorted(eo.keys() - ao.keys()):
-        out.append(f"objects: - {oid} {eo[oid].category} in {eo[oid].room}")
-    for oid in sorted(ao.keys() - eo.keys()):
-        out.append(f"objects: + {oid} {ao[oid].category} in {ao[oid].room}")
-    for oid in sorted(eo.keys() & ao.keys()):
-        a, b = eo[oid], ao[oid]
-        for attr in ("room", "parent", "relation", "state", "explored", "category"):
-            if getattr(a, attr) != getattr(b, attr):
-                out.append(f"objects: {oid} {a.category} {attr} {getattr(a, attr)} -> "
-                           f"{getattr(b, attr)}")
-        if math.dist(a.position, b.position) > tol:
-            out.append(f"objects: {oid} {a.category} moved "
-                       f"{math.dist(a.position, b.position):.3f} m")
-    ed = {d.id: d for d in expected.doors}
-    ad = {d.id: d for d in actual.doors}
-    for did in sorted(ed.keys() ^ ad.keys()):
-        d = ed.get(did) or ad[did]
-        out.append(f"doors: {'-' if did in ed else '+'} {did} ({d.state}, "
-                   f"{_fmt_list(sorted(d.rooms))})")
-    for did in sorted(ed.keys() & ad.keys()):
-        a, b = ed[did], ad[did]
-        if a.state != b.state:
-            out.append(f"doors: {did} state {a.state} -> {b.state}")
-        if sorted(a.rooms) != sorted(b.rooms):
-            out.append(f"edges: {did} joins {_fmt_list(sorted(a.rooms))} -> "
-                       f"{_fmt_list(sorted(b.rooms))}")
-    eg = {r.id: r for r in expected.regions}
-    ag = {r.id: r for r in actual.regions}
-    for gid in sorted(eg.keys() ^ ag.keys()):
-        g = eg.get(gid) or ag[gid]
-        what = g.frontier_type or "region" if g.kind == "frontier" else "region"
-        out.append(f"regions: {'-' if gid in eg else '+'} {gid} ({what} in {g.room})")
-    for gid in sorted(eg.keys() & ag.keys()):
-        a, b = eg[gid], ag[gid]
-        if (a.room, a.kind, a.frontier_type) != (b.room, b.kind, b.frontier_type):
-            out.append(f"regions: {gid} {a.kind}/{a.frontier_type} in {a.room} -> "
-                       f"{b.kind}/{b.frontier_type} in {b.room}")
-        elif math.dist(a.position, b.position) > tol:
-            out.append(f"regions: {gid} moved {math.dist(a.position, b.position):.2f} m")
-    if (expected.robot.room, expected.robot.region) != (actual.robot.room, actual.robot.region):
-        out.append(f"robot: in {expected.robot.room}/{expected.robot.region} -> "
-                   f"{actual.robot.room}/{actual.robot.region}")
-    keys = expected.distances.keys() | actual.distances.keys()
+def _by_id(nodes: Sequence[Any]) -> dict[str, Any]:
+    return {n.id: n for n in nodes}
+
+
+def _added_removed(layer: str, expected: dict[str, Any], actual: dict[str, Any],
+                   describe: Callable[[Any], str]) -> list[str]:
+    """``layer: - id ...`` for nodes only expected, ``layer: + id ...`` for new ones."""
+    return [f"{layer}: {'-' if k in expected else '+'} {k} "
+            f"{describe(expected[k] if k in expected else actual[k])}"
+            for k in sorted(expected.keys() ^ actual.keys())]
+
+
+def _moved(a: Any, b: Any, tol: float) -> float | None:
+    d = math.dist(a.position, b.position)
+    return d if d > tol else None
+
+
+def _room_changes(a: Any, b: Any, tol: float) -> list[str]:
+    out = []
+    if a.category != b.category:
+        out.append(f"rooms: {a.id} category {a.category} -> {b.category}")
+    sa, sb = dict(a.category_scores), dict(b.category_scores)
+    if sa.keys() != sb.keys() or any(abs(sa[k] - sb[k]) > tol for k in sa):
+        out.append(f"rooms: {a.id} category scores {_scores(a)} -> {_scores(b)}")
+    if a.explored != b.explored:
+        out.append(f"rooms: {a.id} explored {a.explored} -> {b.explored}")
+    if sorted(a.neighbours) != sorted(b.neighbours):
+        out.append(f"edges: {a.id} neighbours {_fmt_list(sorted(a.neighbours))} -> "
+                   f"{_fmt_list(sorted(b.neighbours))}")
+    if (d := _moved(a, b, tol)) is not None:
+        out.append(f"rooms: {a.id} moved {d:.2f} m")
+    return out
+
+
+def _object_changes(a: Any, b: Any, tol: float) -> list[str]:
+    out = [f"objects: {a.id} {a.category} {attr} {getattr(a, attr)} -> {getattr(b, attr)}"
+           for attr in ("room", "parent", "relation", "state", "explored", "category")
+           if getattr(a, attr) != getattr(b, attr)]
+    if (d := _moved(a, b, tol)) is not None:
+        out.append(f"objects: {a.id} {a.category} moved {d:.3f} m")
+    return out
+
+
+def _door_changes(a: Any, b: Any, tol: float) -> list[str]:
+    out = []
+    if a.state != b.state:
+        out.append(f"doors: {a.id} state {a.state} -> {b.state}")
+    if sorted(a.rooms) != sorted(b.rooms):
+        out.append(f"edges: {a.id} joins {_fmt_list(sorted(a.rooms))} -> "
+                   f"{_fmt_list(sorted(b.rooms))}")
+    return out
+
+
+def _region_changes(a: Any, b: Any, tol: float) -> list[str]:
+    if (a.room, a.kind, a.frontier_type) != (b.room, b.kind, b.frontier_type):
+        return [f"regions: {a.id} {a.kind}/{a.frontier_type} in {a.room} -> "
+                f"{b.kind}/{b.frontier_type} in {b.room}"]
+    if (d := _moved(a, b, tol)) is not None:
+        return [f"regions: {a.id} moved {d:.2f} m"]
+    return []
+
+
+def _region_kind(g: Any) -> str:
+    return (g.frontier_type or "region") if g.kind == "frontier" else "region"
+
+
+# layer name, nodes of a graph, how an added/removed node reads, what changed in a kept one
+_LAYERS: tuple[tuple[str, Callable[[SceneGraph], Sequence[Any]], Callable[[Any], str],
+                     Callable[[Any, Any, float], list[str]]], ...] = (
+    ("rooms", lambda g: g.rooms, lambda n: f"({n.category})", _room_changes),
+    ("objects", lambda g: g.objects, lambda n: f"{n.category} in {n.room}", _object_changes),
+    ("doors", lambda g: g.doors, lambda n: f"({n.state}, {_fmt_list(sorted(n.rooms))})",
+     _door_changes),
+    ("regions", lambda g: g.regions, lambda n: f"({_region_kind(n)} in {n.room})",
+     _region_changes),
+)
+
+
+def _distance_changes(expected: SceneGraph, actual: SceneGraph, tol: float) -> list[str]:
     worst, n = (0.0, ""), 0
-    for k in sorted(keys):
+    for k in sorted(expected.distances.keys() | actual.distances.keys()):
         a, b = expected.distances.get(k), actual.distances.get(k)
         if a is None or b is None:
             n += 1
@@ -196,8 +207,22 @@ def diff_graphs(expected: SceneGraph, actual: SceneGraph, tol: float = 1e-4) -> 
         elif abs(a - b) > tol:
             n += 1
             worst = max(worst, (abs(a - b), k))
-    if n:
-        out.append(f"distances: {n} differ, largest {worst[0]:.3f} m ({worst[1]})")
+    return [f"distances: {n} differ, largest {worst[0]:.3f} m ({worst[1]})"] if n else []
+
+
+def diff_graphs(expected: SceneGraph, actual: SceneGraph, tol: float = 1e-4) -> list[str]:
+    """What differs between two scene graphs, one line per difference, grouped by layer
+    (empty when they are equal up to ``tol`` in positions and distances)."""
+    out: list[str] = []
+    for layer, nodes, describe, changes in _LAYERS:
+        e, a = _by_id(nodes(expected)), _by_id(nodes(actual))
+        out += _added_removed(layer, e, a, describe)
+        for k in sorted(e.keys() & a.keys()):
+            out += changes(e[k], a[k], tol)
+    er, ar = expected.robot, actual.robot
+    if (er.room, er.region) != (ar.room, ar.region):
+        out.append(f"robot: in {er.room}/{er.region} -> {ar.room}/{ar.region}")
+    out += _distance_changes(expected, actual, tol)
     if not out and expected.to_json() != actual.to_json():
         out.append("the canonical JSON differs below the tolerance (rounding)")
     return out

@@ -30,7 +30,7 @@ with or without the RGB-D start on these sequences and is 4-5x faster. The defau
 the photometric start because ICP alone slides along geometry without structure (a bare
 wall, a corridor), where the image texture still constrains the motion (on a textured
 wall ICP reports no motion at all while RGB-D odometry follows the 3 cm steps:
-``tests/test_import_odometry.py``); ``--odometry icp``
+``tests/recorders/importers/test_odometry.py``); ``--odometry icp``
 is the fast choice for cluttered rooms. (Times on 2 shared cores, with other work running.)
 
 A step fails, keeps the previous motion (constant velocity) and is counted when

@@ -119,7 +119,7 @@ def projection_matrix(cfg: CameraConfig) -> list[float]:
     centres), so with the plain matrix the image's principal point sits at ``(W/2, H/2 - 1)``
     instead of ``((W-1)/2, (H-1)/2)``. Shifting NDC by ``+1/W`` and ``+1/H`` puts the pixel
     centres where the intrinsics say; rendered depth then matches ray tests through the
-    pixel centres to < 0.1 mm at any resolution (tests/test_sim_camera.py)."""
+    pixel centres to < 0.1 mm at any resolution (tests/recorders/sim/test_camera.py)."""
     f = 1.0 / math.tan(math.radians(cfg.vfov_deg) / 2.0)
     aspect = cfg.width / cfg.height
     n, fa = cfg.near, cfg.far

@@ -7,7 +7,7 @@ CLI call, test session and benchmark worker would pay it. The model is a 6-layer
 over the attention mask and L2 normalisation (the package's ``modules.json``:
 Transformer -> Pooling(mean) -> Normalize); that is ~60 lines of numpy over the very same
 safetensors file, loads in ~0.3 s and matches the reference implementation to ~1e-6
-(``tests/test_semantics_encoder.py`` checks against vectors produced by
+(``tests/toolkit/semantics/test_encoder.py`` checks against vectors produced by
 sentence-transformers 6.2; ``benchmarks/encoder_reference.py`` regenerates them).
 
 Determinism: every text runs through the network alone, without padding, so its vector does

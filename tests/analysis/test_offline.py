@@ -1,0 +1,156 @@
+"""``sgtool eval``: metrics from MCAP logs written with sgtool.log's writer and from bench
+JSONL; planners replayed against logged decisions; episode cutting in multi-episode and
+unfinished logs."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from click.testing import CliRunner
+from support.symbolic_fixtures import three_rooms
+
+from sgtool.analysis.bench import BenchConfig, run_benchmark, write_outputs
+from sgtool.analysis.offline import (
+    EvalInputError,
+    load_results,
+    read_log_episodes,
+    replay_decisions,
+)
+from sgtool.cli import cli
+from sgtool.house.io import load_house
+from sgtool.log.writer import LogWriter
+from sgtool.planning.registry import make_planner
+from sgtool.recorders.symbolic_environment import SymbolicHouse, run_episode
+
+
+@pytest.fixture(scope="module")
+def house() -> SymbolicHouse:
+    return SymbolicHouse(load_house(three_rooms()))
+
+
+@pytest.fixture(scope="module")
+def greedy_log(house, tmp_path_factory):
+    path = tmp_path_factory.mktemp("logs") / "greedy.mcap"
+    with LogWriter(path, seed=2) as log:
+        res = run_episode(house, make_planner("greedy"), "sweater", ["obj_5"], seed=2,
+                          episode_index=0, seen=False, house_id="three", log=log)
+    return path, res
+
+
+def test_metrics_from_a_log_match_the_run(greedy_log):
+    path, res = greedy_log
+    (ep,) = read_log_episodes(path)
+    assert len(ep.decisions) == res.steps
+    assert all(d.graph is not None for d in ep.decisions)
+    r = ep.result()
+    assert (r.success, r.steps, r.n_open, r.seed, r.seen, r.planner, r.query, r.house) == (
+        res.success, res.steps, res.n_open, 2, False, "greedy", "sweater", "three")
+    assert r.travelled_m == pytest.approx(res.travelled_m, abs=1e-3)
+    assert r.shortest_m == pytest.approx(res.shortest_m, abs=1e-3)
+    assert [(s.skill, s.target, s.outcome) for s in r.trace] == \
+        [(s.skill, s.target, s.outcome) for s in res.trace]
+
+
+def test_planner_against_its_own_log_agrees(greedy_log):
+    path, res = greedy_log
+    eps = read_log_episodes(path)
+    same = replay_decisions(make_planner("greedy"), eps)
+    assert same.decisions == res.steps and same.skipped == 0
+    assert same.rate("agree") == 1.0 and same.rate("invalid") == 0.0
+    assert same.rate("room") == 1.0
+    other = replay_decisions(make_planner("scout"), eps, name="scout")
+    assert other.decisions == res.steps and other.rate("invalid") == 0.0
+    assert 0.0 <= other.rate("agree") <= other.rate("target") <= 1.0
+
+
+def test_multi_episode_and_unfinished_logs(tmp_path, house):
+    path = tmp_path / "two.mcap"
+    with LogWriter(path) as log:
+        log.write_record("episode", 0, {"kind": "search", "status": "started", "query": "cup",
+                                        "planner": "x"})
+        log.write_record("action", 1, {"skill": "open", "target": "door:0",
+                                       "outcome": "success", "travelled_m": 2.0})
+        log.write_record("episode", 2, {"kind": "search", "status": "success", "steps": 1,
+                                        "travelled_m": 2.0, "shortest_m": 1.0})
+        log.write_record("episode", 3, {"kind": "search", "status": "started", "query": "mug",
+                                        "planner": "x"})
+        log.write_record("action", 4, {"skill": "explore", "target": "room:1",
+                                       "outcome": "success", "travelled_m": 3.0})
+        log.write_record("action", 5, {"skill": "open", "target": "obj:1",
+                                       "outcome": "invalid", "travelled_m": 0.0})
+        # the run was killed: no closing record
+    a, b = read_log_episodes(path)
+    ra, rb = a.result(), b.result()
+    assert (ra.query, ra.success, ra.steps, ra.n_open, ra.shortest_m) == ("cup", True, 1, 1, 1.0)
+    assert (rb.query, rb.success, rb.steps, rb.travelled_m, rb.n_invalid, rb.end) == (
+        "mug", False, 2, 3.0, 1, "ended")
+    assert (ra.episode, rb.episode) == (0, 1)
+    # no scene graphs: a planner has nothing to decide on
+    rep = replay_decisions(make_planner("greedy"), [a, b])
+    assert rep.decisions == 0 and rep.skipped == 3
+
+
+def test_load_results_rejects_other_files(tmp_path):
+    bad = tmp_path / "x.bin"
+    bad.write_bytes(b"\x00\x01garbage")
+    with pytest.raises(EvalInputError, match="neither an MCAP log"):
+        load_results([bad])
+    with pytest.raises(EvalInputError, match="no such file"):
+        load_results([tmp_path / "missing.mcap"])
+
+
+def test_eval_cli_on_logs_and_bench_output(tmp_path, greedy_log):
+    path, res = greedy_log
+    runner = CliRunner()
+    r = runner.invoke(cli, ["eval", str(path), "--planner", "greedy,random"])
+    assert r.exit_code == 0, r.output
+    assert "Metrics recomputed from 1 episode(s)" in r.output
+    assert "Planners against the logged decisions" in r.output
+    row = next(ln for ln in r.output.splitlines() if ln.startswith("| greedy") and "%" in ln)
+    assert "100.0%" in row
+    # bench output: eval recomputes the bench summary exactly
+    bench = run_benchmark(BenchConfig(planners=("random", "greedy"), houses=1, episodes=2,
+                                      seeds=2))
+    write_outputs(bench, tmp_path / "b")
+    r = runner.invoke(cli, ["eval", str(tmp_path / "b" / "episodes.jsonl"), "--json",
+                            "-o", str(tmp_path / "e.json")])
+    assert r.exit_code == 0, r.output
+    got = json.loads(r.output)
+    want = json.loads((tmp_path / "b" / "summary.json").read_text())["planners"]
+    for p in ("random", "greedy"):
+        for k in ("sr", "spl", "steps", "auc_e_distance", "auc_e_steps"):
+            assert got["planners"][p][k]["mean"] == want[p][k]["mean"]
+    assert json.loads((tmp_path / "e.json").read_text()) == got
+    r = runner.invoke(cli, ["eval", str(tmp_path / "b" / "episodes.jsonl"), "-p", "greedy"])
+    assert r.exit_code == 2 and "needs MCAP logs" in r.output
+
+
+def test_bench_logs_round_trip_through_eval(tmp_path):
+    """Episodes recorded by `sgtool bench --log-dir` give back the bench's own records."""
+    cfg = BenchConfig(planners=("greedy",), houses=1, episodes=2, seeds=1, rooms=(5, 6),
+                      log_dir=str(tmp_path / "logs"))
+    bench = run_benchmark(cfg)
+    logs = sorted((tmp_path / "logs").rglob("*.mcap"))
+    assert len(logs) == 2
+    results, logged = load_results(logs)
+    assert [(r.query, r.success, r.steps, r.n_open, r.end, r.seen) for r in results] == \
+        [(r.query, r.success, r.steps, r.n_open, r.end, r.seen) for r in bench.results]
+    assert [r.travelled_m for r in results] == pytest.approx(
+        [r.travelled_m for r in bench.results], abs=1e-3)
+    rep = replay_decisions(make_planner("greedy"), logged)
+    assert rep.decisions == sum(r.steps for r in bench.results) and rep.rate("agree") == 1.0
+
+
+def test_seen_is_filled_from_the_split_when_a_log_lacks_it(tmp_path):
+    from sgtool.datasets.split import unseen_queries
+
+    unseen = unseen_queries()[0]
+    path = tmp_path / "q.mcap"
+    with LogWriter(path) as log:
+        for t, q in enumerate(("cup", unseen)):
+            log.write_record("episode", 2 * t, {"kind": "search", "status": "started",
+                                                "query": q})
+            log.write_record("episode", 2 * t + 1, {"kind": "search", "status": "failure"})
+    results, _ = load_results([path])
+    assert [r.seen for r in results] == [True, False]

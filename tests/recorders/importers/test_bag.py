@@ -1,0 +1,420 @@
+"""`sgtool import bag`: round trips through ROS 1 / ROS 2 sqlite3 / ROS 2 MCAP bags, camera
+poses from tf checked against the TUM RGB-D ground truth, the real evo and Nav2 bags, and
+the messages for bags and flags that are not what they claim."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from support.bag_export import BagWriter, write_log_as_bag
+from support.logfixtures import synthetic_frame
+
+from sgtool.cli import cli
+from sgtool.errors import SgtoolError
+from sgtool.log import LogReader, LogWriter
+from sgtool.recorders.importers.bag import BagOptions, import_bag, read_trajectory
+from sgtool.recorders.importers.poses import pose_difference, pose_from_tq
+from sgtool.recorders.importers.sink import IMPORT_METADATA
+from sgtool.recorders.importers.textformats import read_tum_trajectory, seconds_to_ns
+
+FORMATS = ["ros1", "ros2-sqlite3", "ros2-mcap"]
+TOPICS = dict(depth="/camera/depth/image_raw", rgb="/camera/rgb/image_raw",
+              ids="/camera/instances/image_raw", info="/camera/depth/camera_info")
+KEEP_WORLD = dict(up=np.array([0.0, 0.0, 1.0]), floor_auto=False, progress=False)
+
+
+def bag_path(tmp: Path, fmt: str, name: str = "b") -> Path:
+    return tmp / (f"{name}.bag" if fmt == "ros1" else f"{name}_{fmt}")
+
+
+def write_sgtool_log(path: Path, n: int = 8) -> Path:
+    with LogWriter(path, seed=1) as w:
+        for i in range(n):
+            k, rgb, depth, ids, pose, _ = synthetic_frame(i)
+            w.write_frame(1_700_000_000_000_000_000 + i * 33_333_333, depth=depth, pose=pose,
+                          intrinsics=k, rgb=rgb, ids=ids)
+    return path
+
+
+# ----- round trip ------------------------------------------------------------------------------
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_round_trip_sgtool_log_through_a_bag(tmp_path, fmt):
+    src = write_sgtool_log(tmp_path / "src.mcap")
+    bag = bag_path(tmp_path, fmt)
+    assert write_log_as_bag(src, bag, fmt) == 8
+    out = tmp_path / "back.mcap"
+    rep = import_bag(bag, out, BagOptions(**TOPICS, **KEEP_WORLD))
+    assert rep.frames == 8 and rep.has_rgb and rep.has_ids
+    with LogReader(src) as a, LogReader(out) as b:
+        fa, fb = list(a.frames()), list(b.frames())
+        assert len(fa) == len(fb) == 8
+        for x, y in zip(fa, fb, strict=True):
+            assert x.time_ns == y.time_ns  # header stamps kept, to the nanosecond
+            assert np.array_equal(x.depth, y.depth)  # millimetres, bit-exact
+            assert np.array_equal(x.rgb, y.rgb) and np.array_equal(x.ids, y.ids)
+            assert x.intrinsics == y.intrinsics
+            dt, dr = pose_difference(x.pose, y.pose)
+            assert dt < 1e-9 and dr < 1e-6
+        meta = b.metadata[IMPORT_METADATA]
+        assert meta["source_kind"] == ("bag/ros1" if fmt == "ros1" else "bag/ros2")
+        assert meta["instance_ids"] == "present"
+        assert b.last_record("episode")["kind"] == "import"
+
+
+def test_round_trip_with_png_colour_and_automatic_world(tmp_path):
+    """CompressedImage colour decodes losslessly (PNG); the automatic alignment of the
+    synthetic scene (camera 1.2 m above a floor at z = 0, world already z-up) is the
+    identity to within a degree and a centimetre."""
+    src = write_sgtool_log(tmp_path / "src.mcap", n=6)
+    bag = bag_path(tmp_path, "ros2-mcap")
+    write_log_as_bag(src, bag, "ros2-mcap", rgb_format="png")
+    out = tmp_path / "back.mcap"
+    rep = import_bag(bag, out, BagOptions(depth=TOPICS["depth"], rgb=TOPICS["rgb"],
+                                          info=TOPICS["info"], progress=False))
+    assert not rep.has_ids
+    a = rep.alignment
+    assert np.degrees(np.arccos(a.up[2])) < 1.0 and abs(a.floor) < 0.01
+    with LogReader(src) as r1, LogReader(out) as r2:
+        for x, y in zip(r1.frames(), r2.frames(), strict=True):
+            assert np.array_equal(x.rgb, y.rgb) and y.ids is None
+            assert pose_difference(x.pose, y.pose)[0] < 0.01
+
+
+# ----- TUM ground truth through tf --------------------------------------------------------------
+OPTICAL_IN_BODY = pose_from_tq((0.02, -0.045, 0.01), (0.5, -0.5, 0.5, -0.5))  # a camera mount
+
+
+def write_tum_bag(evo: Path, path: Path, fmt: str) -> tuple[list[int], list]:
+    """A bag as a Kinect + motion capture recording of TUM fr1_xyz would be: /tf
+    world -> kinect_body at the ground-truth times (100 Hz), /tf_static kinect_body ->
+    optical frame, and 16UC1 depth images with CameraInfo at the real camera times (those of
+    the RGBDSLAM estimate). The ground truth is the optical frame's pose, so the body's pose
+    is gt @ inv(mount)."""
+    gt = read_tum_trajectory(evo / "freiburg1_xyz-groundtruth.txt")
+    cam_times = [seconds_to_ns(line.split()[0]) for line in
+                 (evo / "freiburg1_xyz-rgbdslam.txt").read_text().splitlines()
+                 if line and not line.startswith("#")]
+    inv_mount = np.linalg.inv(OPTICAL_IN_BODY)
+    events = [(t, 0, T) for t, T in gt] + [(t, 1, None) for t in cam_times]  # noqa: N806
+    events.sort(key=lambda e: (e[0], e[1]))
+    depth = np.full((6, 8), 1500, np.uint16)
+    with BagWriter(path, fmt) as w:
+        w.write("/tf_static", "tf2_msgs/msg/TFMessage", events[0][0], w.tf(0, [
+            w.transform_stamped(events[0][0], "kinect_body", "openni_rgb_optical_frame",
+                                OPTICAL_IN_BODY)]))
+        Info = w.T("sensor_msgs/msg/CameraInfo")  # noqa: N806
+        for t, kind, T in events:  # noqa: N806
+            if kind == 0:
+                w.write("/tf", "tf2_msgs/msg/TFMessage", t,
+                        w.tf(t, [w.transform_stamped(t, "world", "kinect_body", T @ inv_mount)]))
+            else:
+                w.write("/camera/depth/image", "sensor_msgs/msg/Image", t,
+                        w.image(t, "openni_rgb_optical_frame", depth, "16UC1"))
+                k = np.array([5.0, 0, 3.5, 0, 5.0, 2.5, 0, 0, 1])
+                names = [n for n, _ in w.ts.fielddefs["sensor_msgs/msg/CameraInfo"][1]]
+                up = "K" in names
+                kw = {("K" if up else "k"): k, ("D" if up else "d"): np.zeros(0),
+                      ("R" if up else "r"): np.eye(3).ravel(),
+                      ("P" if up else "p"): np.zeros(12)}
+                roi = w.T("sensor_msgs/msg/RegionOfInterest")(
+                    x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
+                w.write("/camera/depth/camera_info", "sensor_msgs/msg/CameraInfo", t, Info(
+                    header=w.header(t, "openni_rgb_optical_frame"), height=6, width=8,
+                    distortion_model="plumb_bob", binning_x=0, binning_y=0, roi=roi, **kw))
+    return cam_times, gt
+
+
+def gt_at(gt: list, t: int) -> tuple[np.ndarray, float]:
+    """Independent check value: the ground truth position linearly interpolated per axis,
+    and the rotation angle between the two bracketing samples (a bound)."""
+    times = np.array([s for s, _ in gt], dtype=np.float64)
+    pos = np.array([T[:3, 3] for _, T in gt])
+    p = np.array([np.interp(float(t), times, pos[:, i]) for i in range(3)])
+    j = int(np.searchsorted(times, t))
+    return p, pose_difference(gt[j - 1][1], gt[j][1])[1]
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_tf_poses_against_tum_ground_truth(shared_data_dir, tmp_path, fmt):
+    evo = shared_data_dir / "logs" / "evo"
+    bag = bag_path(tmp_path, fmt, "fr1_xyz")
+    cam_times, gt = write_tum_bag(evo, bag, fmt)
+    out = tmp_path / "fr1_xyz.mcap"
+    rep = import_bag(bag, out, BagOptions(depth="/camera/depth/image",
+                                          info="/camera/depth/camera_info", **KEEP_WORLD))
+    # every camera frame of fr1_xyz lies inside the ground truth's span
+    assert len(cam_times) == 788 and gt[0][0] < cam_times[0] and cam_times[-1] < gt[-1][0]
+    assert rep.frames == 788 and rep.pose_source == "tf world -> openni_rgb_optical_frame"
+    with LogReader(out) as r:
+        times = r.frame_times()
+        assert times == sorted(cam_times)
+        for i in (0, 100, 401, 787):
+            fr = r.frame_at(times[i])
+            p, bracket_deg = gt_at(gt, fr.time_ns)
+            assert np.linalg.norm(fr.pose[:3, 3] - p) < 1e-6
+            j = int(np.searchsorted([s for s, _ in gt], fr.time_ns))
+            ang0 = pose_difference(gt[j - 1][1], fr.pose)[1]
+            ang1 = pose_difference(gt[j][1], fr.pose)[1]
+            assert ang0 <= bracket_deg + 1e-6 and ang1 <= bracket_deg + 1e-6
+            assert fr.intrinsics.fx == 5.0 and fr.depth[0, 0] == pytest.approx(1.5)
+
+
+# ----- the real bags of evo and Nav2 -----------------------------------------------------------
+FIRST_ODOM = (1714741164177519307, (1.1603796887148006, -2.942426888388735, 0.0),
+              (0.0, 0.0, 0.6808039454578293, 0.7324656905610344))
+
+
+@pytest.mark.parametrize("name", ["tf_example.bag", "tf_example", "tf_example/tf_example.db3"])
+def test_evo_tf_bags_ros1_and_ros2(shared_data_dir, tmp_path, name):
+    """The same TurtleBot run as a ROS 1 bag, a ROS 2 sqlite3 bag folder and its bare .db3:
+    517 odom -> base_footprint samples (+ a static base_link), so 517 poses of base_link,
+    the first equal to the first /tf message."""
+    bag = shared_data_dir / "logs" / "evo" / name
+    out = tmp_path / "traj.mcap"
+    rep = import_bag(bag, out, BagOptions(tf_frames=("odom", "base_link"), progress=False))
+    assert rep.frames == 0 and rep.poses == 517
+    traj = read_trajectory(out)
+    assert len(traj) == 517
+    t0, T0 = traj[0]  # noqa: N806
+    assert t0 == FIRST_ODOM[0]
+    dt, dr = pose_difference(T0, pose_from_tq(FIRST_ODOM[1], FIRST_ODOM[2]))
+    assert dt < 1e-12 and dr < 1e-6
+    assert all(abs(T[2, 3]) < 1e-9 for _, T in traj)  # a ground robot
+
+
+def test_evo_ros1_and_ros2_bags_give_the_same_trajectory(shared_data_dir, tmp_path):
+    evo = shared_data_dir / "logs" / "evo"
+    trajs = []
+    for name in ("tf_example.bag", "tf_example"):
+        out = tmp_path / f"{name.replace('.', '_')}.mcap"
+        import_bag(evo / name, out, BagOptions(tf_frames=("odom", "base_link"), progress=False))
+        trajs.append(read_trajectory(out))
+    assert [t for t, _ in trajs[0]] == [t for t, _ in trajs[1]]
+    assert max(pose_difference(a, b)[0] for (_, a), (_, b) in zip(*trajs, strict=True)) < 1e-12
+
+
+def test_evo_pose_topic_trajectory(shared_data_dir, tmp_path):
+    bag = shared_data_dir / "logs" / "evo" / "ROS_example.bag"
+    out = tmp_path / "gt.mcap"
+    rep = import_bag(bag, out, BagOptions(pose="groundtruth", progress=False))
+    assert rep.poses == 12765
+    traj = read_trajectory(out)
+    assert len(traj) == 12765 and traj[0][0] == 1502792570283404827
+    assert np.allclose(traj[0][1][:3, 3], [-0.004899939787714927, -0.01775981455685227,
+                                           -0.013755318406774505], atol=1e-12)
+
+
+def test_nav2_bare_ros2_mcap_through_a_tf_chain(shared_data_dir, tmp_path):
+    """A bare ROS 2 MCAP file (no metadata.yaml): map -> odom (AMCL) -> base_link (odometry)
+    -> base_footprint (static): a planar robot path of plausible speed."""
+    bag = shared_data_dir / "logs" / "rosbag2-mcap" / "evo_nav2_turtlebot.mcap"
+    out = tmp_path / "nav2.mcap"
+    rep = import_bag(bag, out, BagOptions(tf_frames=("map", "base_footprint"), progress=False))
+    traj = read_trajectory(out)
+    assert rep.poses == len(traj) > 1000
+    xyz = np.array([T[:3, 3] for _, T in traj])
+    t = np.array([s for s, _ in traj]) / 1e9
+    assert np.all(np.abs(xyz[:, 2]) < 0.05)
+    speed = np.linalg.norm(np.diff(xyz[:, :2], axis=0), axis=1) / np.maximum(np.diff(t), 1e-3)
+    assert np.percentile(speed, 99) < 1.0  # a TurtleBot 4 drives < 0.5 m/s (+ AMCL jumps)
+
+
+# ----- messages for foreign files and wrong flags ------------------------------------------------
+def run(args: list[str]):  # type: ignore[no-untyped-def]
+    return CliRunner().invoke(cli, args)
+
+
+def test_missing_flags_list_topics_and_suggest(shared_data_dir, tmp_path):
+    bag = shared_data_dir / "logs" / "evo" / "tf_example.bag"
+    r = run(["import", "bag", str(bag), "-o", str(tmp_path / "o.mcap")])
+    assert r.exit_code == 2 and "Traceback" not in r.output
+    assert "/tf_static  tf2_msgs/msg/TFMessage" in r.output
+    assert "suggested flags: --tf-frames odom:base_link" in r.output
+    assert not (tmp_path / "o.mcap").exists()
+    r = run(["import", "bag", str(shared_data_dir / "logs" / "evo" / "ROS_example.bag"),
+             "--list"])
+    assert r.exit_code == 0 and "--pose groundtruth" in r.output
+
+
+def test_wrong_topic_types_name_topic_and_type(tmp_path):
+    src = write_sgtool_log(tmp_path / "src.mcap", n=3)
+    bag = bag_path(tmp_path, "ros1")
+    write_log_as_bag(src, bag, "ros1")
+    out = tmp_path / "o.mcap"
+    base = ["import", "bag", str(bag), "-o", str(out)]
+    r = run(base + ["--depth", TOPICS["info"], "--info", TOPICS["info"]])
+    assert r.exit_code == 2
+    assert ("--depth /camera/depth/camera_info is a sensor_msgs/msg/CameraInfo topic"
+            in r.output)
+    r = run(base + ["--depth", TOPICS["rgb"], "--info", TOPICS["info"]])
+    assert r.exit_code == 2
+    assert "topic /camera/rgb/image_raw: image encoding 'rgb8' is not a depth encoding" \
+        in r.output
+    r = run(base + ["--depth", TOPICS["depth"], "--info", TOPICS["depth"]])
+    assert "--info /camera/depth/image_raw is a sensor_msgs/msg/Image topic" in r.output
+    r = run(base + ["--depth", "/nope", "--info", TOPICS["info"]])
+    assert "--depth /nope: no such topic" in r.output and "/camera/rgb/image_raw" in r.output
+    r = run(base + ["--depth", TOPICS["depth"]])
+    assert "CameraInfo topics: /camera/depth/camera_info" in r.output
+    r = run(base + ["--depth", TOPICS["depth"], "--info", TOPICS["info"],
+                    "--tf-frames", "map:camera_optical_frame"])
+    assert "frame 'map' is not in the tf tree" in r.output
+    assert "world -> camera_optical_frame" in r.output
+    assert not out.exists() and not Path(str(out) + ".partial").exists()
+    assert all("Traceback" not in x for x in [r.output])
+
+
+def test_foreign_files_are_named(shared_data_dir, tmp_path):
+    src = write_sgtool_log(tmp_path / "src.mcap", n=2)
+    with pytest.raises(SgtoolError, match="profile 'sgtool'.*not a ROS 2 bag.*sgtool log"):
+        import_bag(src, tmp_path / "o.mcap", BagOptions(depth="/camera/depth"))
+    readme = shared_data_dir / "README.md"
+    with pytest.raises(SgtoolError, match="README.md: not a ROS bag"):
+        import_bag(readme, tmp_path / "o.mcap", BagOptions(depth="/d"))
+    talker = shared_data_dir / "logs" / "rosbag2-mcap" / "talker.mcap"
+    with pytest.raises(SgtoolError, match="--depth /topic is a std_msgs/msg/String topic"):
+        import_bag(talker, tmp_path / "o.mcap", BagOptions(depth="/topic", info="/topic"))
+    assert not (tmp_path / "o.mcap").exists()
+
+
+def test_cli_json_report_and_refusal_to_overwrite(tmp_path):
+    src = write_sgtool_log(tmp_path / "src.mcap", n=3)
+    bag = bag_path(tmp_path, "ros2-sqlite3")
+    write_log_as_bag(src, bag, "ros2-sqlite3")
+    out = tmp_path / "o.mcap"
+    args = ["import", "bag", str(bag), "-o", str(out), "--depth", TOPICS["depth"],
+            "--info", TOPICS["info"], "--up", "z", "--floor", "none", "--json", "--quiet"]
+    r = run(args)
+    assert r.exit_code == 0, r.output
+    rep = json.loads(r.output)
+    assert rep["frames"] == 3 and rep["instance_ids"] is False
+    assert rep["alignment"]["up_method"] == "given"
+    r = run(args)
+    assert r.exit_code == 2 and "exists; not overwriting it (use --force)" in r.output
+    assert run(args + ["--force"]).exit_code == 0
+
+
+def test_pose_topic_instead_of_tf_with_every_and_limit(tmp_path):
+    """Camera poses from a PoseStamped topic (no tf at all); --every 2 --limit 3."""
+    src = write_sgtool_log(tmp_path / "src.mcap", n=8)
+    bag = bag_path(tmp_path, "ros2-sqlite3")
+    with LogReader(src) as r, BagWriter(bag, "ros2-sqlite3") as w:
+        frames = list(r.frames())
+        for f in frames:
+            t = f.time_ns
+            w.write("/camera/pose", "geometry_msgs/msg/PoseStamped", t,
+                    w.pose_stamped(t, "map", f.pose))
+            w.write(TOPICS["depth"], "sensor_msgs/msg/Image", t,
+                    w.image(t, "cam", (f.depth * 1000).round().astype(np.uint16), "16UC1"))
+    out = tmp_path / "o.mcap"
+    k = frames[0].intrinsics
+    from sgtool.recorders.importers.textformats import PinholeParams
+
+    rep = import_bag(bag, out, BagOptions(depth=TOPICS["depth"], pose="/camera/pose",
+                                          intrinsics=PinholeParams(k.fx, k.fy, k.cx, k.cy),
+                                          every=2, limit=3, **KEEP_WORLD))
+    assert rep.frames == 3 and rep.pose_source == "topic /camera/pose (8 poses)"
+    with LogReader(out) as r:
+        got = list(r.frames())
+    for g, f in zip(got, frames[::2], strict=False):
+        assert g.time_ns == f.time_ns and pose_difference(g.pose, f.pose)[0] < 1e-9
+        assert np.array_equal(g.depth, f.depth)
+
+
+def test_bag_poses_estimated_by_odometry(shared_data_dir, tmp_path):
+    """Six real ICL-NUIM frames as a ROS 2 bag: with tf and --estimate-poses the drift
+    against the bag's tf is reported; without tf (a camera recorded alone) the poses are
+    estimated from the images and start at the identity."""
+    from support.bag_export import write_frames_bag
+
+    from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
+
+    icl = tmp_path / "icl.mcap"
+    import_rgbd(shared_data_dir / "rgbd" / "icl-livingroom1-micro", icl,
+                RgbdOptions(limit=6, progress=False))
+    with_tf, no_tf = tmp_path / "with_tf", tmp_path / "no_tf"
+    with LogReader(icl) as r:
+        frames = list(r.frames())
+    write_frames_bag(frames, with_tf, "ros2-mcap")
+    write_frames_bag(frames, no_tf, "ros2-mcap", tf=False)
+    flags = dict(depth=TOPICS["depth"], rgb=TOPICS["rgb"], info=TOPICS["info"], odometry="icp")
+    rep = import_bag(with_tf, tmp_path / "a.mcap",
+                     BagOptions(estimate_poses=True, **flags, **KEEP_WORLD))
+    assert rep.frames == 6 and rep.drift is not None and rep.odometry_failures == 0
+    assert rep.pose_source == ("estimated by icp odometry (tf world -> camera_optical_frame "
+                               "kept for the drift)")
+    # the reference is the bag's tf, not ground truth
+    assert ("drift against the bag's poses (tf world -> camera_optical_frame): 6 frames"
+            in "\n".join(rep.lines()))
+    assert 0 < rep.drift.ate_rmse_m < 0.01
+    rep = import_bag(no_tf, tmp_path / "b.mcap", BagOptions(**flags, **KEEP_WORLD))
+    assert rep.frames == 6 and rep.drift is None
+    assert rep.pose_source == "estimated by icp odometry"
+    with LogReader(tmp_path / "b.mcap") as r:
+        est = [f.pose for f in r.frames()]
+    assert np.allclose(est[0], np.eye(4))
+    # relative motion agrees with the reference trajectory to a centimetre
+    rel = [np.linalg.inv(frames[0].pose) @ f.pose for f in frames]
+    assert max(np.linalg.norm(a[:3, 3] - b[:3, 3]) for a, b in zip(est, rel, strict=True)) < 0.01
+
+
+# ----- audit regressions: trajectory-only bags, --estimate-poses, --depth-scale ----------------
+NAV2 = ("logs", "rosbag2-mcap", "evo_nav2_turtlebot.mcap")
+
+
+def test_trajectory_bag_suggests_pose_topics_and_tf(shared_data_dir, tmp_path):
+    """The Nav2 recording has /odom and /amcl_pose besides /tf: the suggestions list them
+    as alternatives to --tf-frames (only --tf-frames was suggested)."""
+    bag = shared_data_dir.joinpath(*NAV2)
+    r = run(["import", "bag", str(bag), "-o", str(tmp_path / "o.mcap")])
+    assert r.exit_code == 2 and "Traceback" not in r.output
+    sugg = next(line for line in r.output.splitlines() if line.startswith("suggested flags:"))
+    assert "--tf-frames map:oakd_rgb_camera_optical_frame" in sugg
+    assert "| --pose /amcl_pose | --pose /odom" in sugg
+    assert "WORLD:FRAME" not in sugg
+    r = run(["import", "bag", str(bag), "--list"])
+    assert r.exit_code == 0 and "suggested flags: --pose /amcl_pose | --pose /odom" in r.output
+    assert not (tmp_path / "o.mcap").exists()
+
+
+@pytest.mark.parametrize("extra", [[], ["--tf-frames", "map:base_footprint"],
+                                   ["--pose", "/odom"]])
+def test_estimate_poses_without_images_is_an_error(shared_data_dir, tmp_path, extra):
+    """--estimate-poses on a bag of trajectories alone was ignored (a trajectory was
+    written); it is an error that says why and suggests the trajectory flags."""
+    out = tmp_path / "o.mcap"
+    r = run(["import", "bag", str(shared_data_dir.joinpath(*NAV2)), "-o", str(out),
+             "--estimate-poses", *extra])
+    assert r.exit_code == 2 and "Traceback" not in r.output, r.output
+    assert ("--estimate-poses estimates camera poses from depth images, and the bag has no "
+            "image topic") in r.output
+    assert "--pose /amcl_pose" in r.output and "--tf-frames map:" in r.output
+    assert not out.exists() and not Path(str(out) + ".partial").exists()
+
+
+def test_estimate_poses_needs_depth_when_the_bag_has_images(tmp_path):
+    src = write_sgtool_log(tmp_path / "src.mcap", n=2)
+    bag = bag_path(tmp_path, "ros2-mcap")
+    write_log_as_bag(src, bag, "ros2-mcap")
+    with pytest.raises(SgtoolError, match=r"--estimate-poses .* it needs --depth"):
+        import_bag(bag, tmp_path / "o.mcap", BagOptions(tf_frames=("world", "camera"),
+                                                        estimate_poses=True, progress=False))
+
+
+@pytest.mark.parametrize("scale", [-1000.0, 0.0, float("nan"), float("inf")])
+def test_bag_depth_scale_must_be_positive(tmp_path, scale):
+    src = write_sgtool_log(tmp_path / "src.mcap", n=2)
+    bag = bag_path(tmp_path, "ros1")
+    write_log_as_bag(src, bag, "ros1")
+    out = tmp_path / "o.mcap"
+    with pytest.raises(SgtoolError, match=r"--depth-scale .*: give the raw depth units per "
+                                          r"metre, a positive number"):
+        import_bag(bag, out, BagOptions(**TOPICS, depth_scale=scale, **KEEP_WORLD))
+    r = run(["import", "bag", str(bag), "-o", str(out), f"--depth-scale={scale}"])
+    assert r.exit_code == 2 and "Traceback" not in r.output
+    assert "give the raw depth units per metre" in r.output, r.output
+    assert not out.exists()

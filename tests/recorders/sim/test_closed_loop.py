@@ -1,0 +1,410 @@
+"""`sgtool run`: the closed loop in PyBullet, on a small generated 4-room house at 160x120.
+
+The simulator is the real one throughout. Checked: the pure mapping of planner actions to
+skills; one scout episode end to end (episode, action and LLM records, scene graphs,
+derived map channels, the house attachment), `sgtool replay` of its log rebuilding the
+live scene graphs byte for byte, `sgtool eval` recomputing its figures, a rerun giving the
+same messages except the measured decision times; a random episode; invalid targets and
+done with a scripted planner; the frame budget; moma-llm against a scripted chat server
+and then from its transcript; user errors; the graph_time_ns pairing of `sgtool eval`.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+from support.semantics_fixtures import ChatServer
+
+from sgtool.analysis.offline import read_log_episodes, replay_decisions
+from sgtool.cli import cli
+from sgtool.datasets.generator import generate_house
+from sgtool.errors import SgtoolError
+from sgtool.log import LogReader, LogWriter
+from sgtool.log import schemas as S
+from sgtool.planning.base import Action, Feedback
+from sgtool.planning.candidates import find_target
+from sgtool.planning.registry import make_planner
+from sgtool.recorders.sim import CameraConfig
+from sgtool.recorders.sim.closed_loop import (
+    ClosedLoopOptions,
+    SkillCall,
+    pick_episode,
+    plan_skills,
+    run_episode,
+)
+from sgtool.scenegraph.derived_layers import DERIVED_TOPICS
+from sgtool.scenegraph.graph import (
+    DoorNode,
+    ObjectNode,
+    RegionNode,
+    RobotState,
+    RoomNode,
+    SceneGraph,
+)
+
+SEED, ROOMS = 6, "4-4"
+OPTS = ClosedLoopOptions(camera=CameraConfig(width=160, height=120))
+GRAPH = S.RECORDS["scene_graph"].topic
+MEASURED = ("decision_time_s", "latency_s")  # wall-clock fields, the only ones that vary
+
+
+@pytest.fixture(scope="module")
+def house():
+    return generate_house(SEED, rooms=(4, 4))
+
+
+def messages(path: Path, topics=None) -> list[tuple[str, int, bytes]]:
+    with LogReader(path) as r:
+        return [(c.topic, int(m.log_time), bytes(m.data))
+                for _, c, m in r.raw_messages(topics)]
+
+
+def masked(path: Path) -> list[tuple[str, int, object]]:
+    """Every message, with the measured fields of JSON records blanked."""
+    out = []
+    for topic, t, data in messages(path):
+        if topic.startswith("/sgtool/"):
+            rec = json.loads(data)
+            for k in MEASURED:
+                if k in rec:
+                    rec[k] = 0
+            out.append((topic, t, rec))
+        else:
+            out.append((topic, t, data))
+    return out
+
+
+# ----- the pure mapping ---------------------------------------------------------------
+def toy_graph() -> SceneGraph:
+    return SceneGraph(
+        robot=RobotState((0.5, 0.5), room="room:0"),
+        rooms=(RoomNode("room:0", "kitchen", (1.0, 1.0)),
+               RoomNode("room:1", position=(5.0, 1.0), explored=False)),
+        regions=(RegionNode("region:0.0", "room:0", (1.0, 1.5)),
+                 RegionNode("frontier:3", "room:0", (2.0, 2.5), kind="frontier",
+                            frontier_type="unexplored area", size=1.0)),
+        objects=(ObjectNode("obj:7", "refrigerator", "region:0.0", "room:0", (1.0, 2.0, 0.9),
+                            instance=7, state="closed", affordances=("openable",)),),
+        doors=(DoorNode("door:4", (3.0, 1.0), "closed", ("room:0", "room:1"), instance=4),),
+    )
+
+
+def test_actions_map_to_skills() -> None:
+    g = toy_graph()
+
+    def calls(skill, target):
+        p = plan_skills(g, Action(skill, target))
+        assert p.invalid is None and not p.done
+        return p.calls
+
+    assert calls("navigate", "obj:7") == (SkillCall("navigate", 7),)
+    assert calls("navigate", "door:4") == (SkillCall("navigate", 4),)
+    assert calls("navigate", "room:0") == (SkillCall("navigate", (1.0, 1.0)),)
+    assert calls("navigate", "region:0.0") == (SkillCall("navigate", (1.0, 1.5)),)
+    assert calls("explore", "frontier:3") == (SkillCall("explore", (2.0, 2.5)),)
+    assert calls("explore", "room:1") == (SkillCall("explore", (5.0, 1.0)),)
+    # open / close: go to it, then open / close it (MoMa-LLM's go_to_and_open)
+    assert calls("open", "obj:7") == (SkillCall("navigate", 7), SkillCall("open", 7))
+    assert calls("open", "door:4") == (SkillCall("navigate", 4), SkillCall("open", 4))
+    assert calls("close", "obj:7") == (SkillCall("navigate", 7), SkillCall("close", 7))
+
+
+def test_invalid_targets_and_done() -> None:
+    g = toy_graph()
+    assert plan_skills(g, Action("done")).done
+    assert plan_skills(g, Action("done", "obj:7")).done
+    for action, why in [(Action("navigate", "obj:99"), "not a node of the scene graph"),
+                        (Action("open", "room:0"), "cannot open a room"),
+                        (Action("close", "frontier:3"), "cannot close a frontier"),
+                        (Action("explore", None), "needs a target"),
+                        (Action("fly", "room:0"), "unknown skill")]:  # type: ignore[arg-type]
+        p = plan_skills(g, action)
+        assert p.calls == () and not p.done and why in p.invalid
+
+
+# ----- one scout episode end to end ---------------------------------------------------
+@pytest.fixture(scope="module")
+def scout_log(tmp_path_factory):
+    out = tmp_path_factory.mktemp("run") / "scout.mcap"
+    r = CliRunner().invoke(cli, ["run", "--planner", "scout", "--seed", str(SEED), "--rooms",
+                                 ROOMS, "--episode", "0", "--resolution", "160x120", "-o",
+                                 str(out)])
+    assert r.exit_code == 0, r.output
+    return out, r.output
+
+
+def test_scout_episode_log(scout_log, house) -> None:
+    path, report = scout_log
+    _, ep = pick_episode(house, index=0)
+    assert f"scout searching for {ep.query!r}" in report and "frames/s" in report
+    assert not path.with_name(path.name + ".partial").exists()
+    with LogReader(path) as r:
+        assert r.house_json() == house.to_json()
+        assert r.schema_version == S.LOG_SCHEMA_VERSION
+        started, ended = [rec for _, rec in r.records("episode")]
+        assert started["status"] == "started" and started["query"] == ep.query
+        assert started["extra"]["mapping"] == {"every": 10, "classifier": "containment",
+                                               "min_points": 12, "voxel_size": 0.05}
+        assert ended["status"] == "success" and ended["planner"] == "scout"
+        assert ended["shortest_m"] == pytest.approx(ep.shortest_path, abs=1e-3)
+        assert ended["extra"]["end"] == "found" and ended["extra"]["query"] == ep.query
+        assert ended["frames"] == r.frame_count() > 40
+        actions = list(r.records("action"))
+        graphs = {t for t, _ in r.records("scene_graph")}
+        look = actions[0][1]
+        assert (look["skill"], look["graph_time_ns"], look["step"]) == ("look_around", None, 0)
+        decided = [a for _, a in actions[1:]]
+        assert len(decided) == ended["steps"] >= 1
+        for k, (t, a) in enumerate(actions[1:], start=1):
+            assert a["planner"] == "scout" and a["step"] == k and a["decision_time_s"] > 0
+            assert a["graph_time_ns"] in graphs and a["graph_time_ns"] <= t
+            # a refresh at every action that took frames
+            assert t in graphs or a["outcome"] == "invalid" or a["skill"] == "done"
+        # every logged distance is rounded to 0.1 mm (the records' canonical rounding)
+        assert ended["travelled_m"] == pytest.approx(sum(a["travelled_m"] for a in decided),
+                                                     abs=5e-5 * (len(decided) + 1))
+        for topic in DERIVED_TOPICS:
+            assert r.has(topic), topic
+        assert r.has(S.RECORDS["instances"].topic)
+        assert find_target(SceneGraph.from_dict(r.last_record("scene_graph")), ep.query)
+
+
+def test_replay_reproduces_the_live_scene_graphs(scout_log, tmp_path) -> None:
+    path, _ = scout_log
+    derived = tmp_path / "replayed.mcap"
+    r = CliRunner().invoke(cli, ["replay", str(path), "-o", str(derived)])  # default options
+    assert r.exit_code == 0, r.output
+    live, again = messages(path, [GRAPH]), messages(derived, [GRAPH])
+    assert len(live) > 5 and live == again
+    assert messages(path, list(DERIVED_TOPICS)) == messages(derived, list(DERIVED_TOPICS))
+
+
+def test_eval_recomputes_the_episode(scout_log) -> None:
+    path, _ = scout_log
+    r = CliRunner().invoke(cli, ["eval", str(path), "--json"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.output)
+    with LogReader(path) as log:
+        ended = log.last_record("episode")
+        times = [a["decision_time_s"] for _, a in log.records("action")][1:]
+    assert doc["episodes"] == 1
+    s = doc["planners"]["scout"]
+    assert s["sr"]["mean"] == 1.0 and s["steps"]["mean"] == ended["steps"]
+    # the look-around is no decision: the mean is over the planner's decisions only
+    assert s["decision_s"]["mean"] == pytest.approx(sum(times) / len(times), abs=2e-6)
+    (ep,) = read_log_episodes(path)
+    assert [d.decided for d in ep.decisions] == [False] + [True] * ended["steps"]
+    # offline: the same planner on the logged graphs makes the same choices
+    rep = replay_decisions(make_planner("scout"), [ep])
+    assert rep.decisions == ended["steps"] and rep.skipped == 0 and rep.rate("agree") == 1.0
+
+
+def test_same_inputs_same_log_but_decision_times(scout_log, house, tmp_path) -> None:
+    path, _ = scout_log
+    idx, ep = pick_episode(house, index=0)
+    again = tmp_path / "again.mcap"
+    rep = run_episode(house, ep, make_planner("scout"), again, OPTS, house_id=f"house-{SEED}",
+                      episode_index=idx)
+    assert rep.success and rep.end == "found"
+    assert messages(path, [GRAPH]) == messages(again, [GRAPH])
+    assert masked(path) == masked(again)
+
+
+# ----- other planners and endings -----------------------------------------------------
+def test_random_episode(house, tmp_path) -> None:
+    idx, ep = pick_episode(house, index=3)
+    out = tmp_path / "random.mcap"
+    rep = run_episode(house, ep, make_planner("random"), out, ClosedLoopOptions(
+        camera=OPTS.camera, max_steps=3, planner_seed=1), episode_index=idx)
+    assert 1 <= rep.steps <= 3 and rep.end in ("found", "max_steps")
+    (logged,) = read_log_episodes(out)
+    res = logged.result()
+    assert (res.planner, res.steps, res.success, res.episode) == (
+        "random", rep.steps, rep.success, idx)
+    assert all(d.graph is not None for d in logged.decisions[1:])
+
+
+class Scripted:
+    """A planner that plays fixed actions and remembers the feedback it gets."""
+
+    name = "scripted"
+
+    def __init__(self, actions) -> None:
+        self.actions = list(actions)
+        self.feedbacks: list[Feedback] = []
+        self.graphs: list[SceneGraph] = []
+
+    def reset(self, query: str, seed: int = 0) -> None:
+        pass
+
+    def decide(self, graph: SceneGraph) -> Action:
+        self.graphs.append(graph)
+        a = self.actions.pop(0)
+        return a(graph) if callable(a) else a
+
+    def feedback(self, fb: Feedback) -> None:
+        self.feedbacks.append(fb)
+
+
+def test_invalid_targets_and_done_in_the_loop(house, tmp_path) -> None:
+    idx, ep = pick_episode(house, index=0)
+    p = Scripted([Action("navigate", "obj:424242"),
+                  lambda g: Action("open", g.rooms[0].id),
+                  lambda g: Action("navigate", g.regions[0].id),
+                  Action("done")])
+    out = tmp_path / "scripted.mcap"
+    rep = run_episode(house, ep, p, out, OPTS, episode_index=idx)
+    assert (rep.success, rep.end, rep.steps) == (False, "gave_up", 4)
+    assert [f.outcome for f in p.feedbacks[:2]] == ["invalid", "invalid"]
+    assert "not a node of the scene graph" in p.feedbacks[0].message
+    assert "cannot open a room" in p.feedbacks[1].message
+    assert p.feedbacks[2].action.skill == "navigate"  # a real motion, success or failure
+    with LogReader(out) as r:
+        acts = [a for _, a in r.records("action")]
+        ended = r.last_record("episode")
+    assert [a["outcome"] for a in acts[1:3]] == ["invalid", "invalid"]
+    assert acts[1]["travelled_m"] == 0.0 and acts[-1]["skill"] == "done"
+    assert (ended["status"], ended["steps"], ended["extra"]["end"]) == ("failure", 4, "gave_up")
+
+
+def test_frame_budget_cuts_the_episode(house, tmp_path) -> None:
+    idx, ep = pick_episode(house, index=0)
+    out = tmp_path / "budget.mcap"
+    rep = run_episode(house, ep, make_planner("greedy"), out, ClosedLoopOptions(camera=OPTS.camera,
+                                                                   frames=25))
+    assert (rep.frames, rep.end, rep.success) == (25, "frames", False)
+    with LogReader(out) as r:
+        assert r.frame_count() == 25
+        (look,) = [a for _, a in r.records("action")]
+        assert look["outcome"] == "failure" and "frame budget" in look["reason"]
+        assert r.last_record("episode")["status"] == "failure"
+
+
+def test_error_mid_run_leaves_no_file(house, tmp_path) -> None:
+    idx, ep = pick_episode(house, index=0)
+
+    def boom(g):
+        raise SgtoolError("planner broke")
+
+    out = tmp_path / "broken.mcap"
+    with pytest.raises(SgtoolError, match="planner broke"):
+        run_episode(house, ep, Scripted([boom]), out, OPTS)
+    assert not out.exists() and not out.with_name(out.name + ".partial").exists()
+
+
+# ----- moma-llm: scripted endpoint, then its transcript -------------------------------
+def responder(request: dict) -> dict:
+    """Open the first closed thing of the first observed room, else explore that room."""
+    user = request["messages"][1]["content"]
+    m = re.search(r"^- ([^:\n]+): \[(.*)\]$", user, re.M)
+    if m is None:
+        return {"text": "Analysis: nothing seen.\nReasoning: look.\nCommand: done()"}
+    room, items = m.group(1), [s.strip() for s in m.group(2).split(",")]
+    closed = [re.sub(r"^\d+ ", "", s)[len("closed "):] for s in items if "closed " in s]
+    retry = len(request["messages"]) > 2
+    cmd = f"go_to_and_open({room}, {closed[0]})" if closed and not retry else \
+        f"explore({room})"
+    return {"text": f"Analysis: the {room} is close.\nReasoning: nearest lead.\n"
+                    f"Command: {cmd}"}
+
+
+def test_moma_llm_episode_and_its_replay(house, tmp_path) -> None:
+    idx, ep = pick_episode(house, index=4)
+    transcript = tmp_path / "llm.jsonl"
+    live = tmp_path / "moma.mcap"
+    opts = ClosedLoopOptions(camera=OPTS.camera, max_steps=2)
+    with ChatServer(responder=responder) as srv:
+        moma = make_planner("moma-llm", base_url=srv.base_url, model="scripted",
+                            api_key="test", timeout_s=10.0, transcript=str(transcript))
+        rep = run_episode(house, ep, moma, live, opts, episode_index=idx)
+        assert not srv.errors
+    assert rep.steps >= 1
+    with LogReader(live) as r:
+        exchanges = [x for _, x in r.records("llm_exchange")]
+        acts = [a for _, a in r.records("action")][1:]
+    assert len(exchanges) >= rep.steps and all(x["model"] == srv.model for x in exchanges)
+    assert "find a" in exchanges[0]["messages"][0]["content"]
+    assert all(a["planner"] == "moma-llm" for a in acts)
+    if len(exchanges) > 1:  # the executor's outcome reached the model's history
+        assert "Previous actions:\n- " in exchanges[-1]["messages"][1]["content"]
+    # the same episode from the transcript: the same prompts, graphs and actions
+    again = tmp_path / "moma-replay.mcap"
+    r = CliRunner().invoke(cli, ["run", "--planner", "moma-llm", "--seed", str(SEED),
+                                 "--rooms", ROOMS, "--episode", str(idx), "--resolution",
+                                 "160x120", "--max-steps", "2", "--llm-replay",
+                                 str(transcript), "--quiet", "-o", str(again)])
+    assert r.exit_code == 0, r.output
+    assert messages(live, [GRAPH]) == messages(again, [GRAPH])
+    with LogReader(again) as r2:
+        replayed = [x for _, x in r2.records("llm_exchange")]
+        acts2 = [a for _, a in r2.records("action")][1:]
+    assert [x["prompt_sha256"] for x in replayed] == [x["prompt_sha256"] for x in exchanges]
+    assert [x["response"] for x in replayed] == [x["response"] for x in exchanges]
+    strip = [{k: v for k, v in a.items() if k != "decision_time_s"} for a in acts]
+    assert [{k: v for k, v in a.items() if k != "decision_time_s"} for a in acts2] == strip
+
+
+# ----- user errors --------------------------------------------------------------------
+@pytest.mark.parametrize("args,message", [
+    (["--planner", "nope"], "unknown planner 'nope'"),
+    (["--planner", "scout", "--house", "{missing}"], "no such house spec file"),
+    (["--planner", "scout", "--house", "{bad}"], "not valid JSON"),
+    (["--planner", "scout", "--query", "unicorn"], "no object of category 'unicorn'"),
+    (["--planner", "scout", "--episode", "999"], "episode 999: the house has"),
+    (["--planner", "scout", "-O", "nonsense=1"], "does not take option(s): nonsense"),
+    (["--planner", "scout", "--llm-replay", "x.jsonl"], "are for --planner moma-llm"),
+    (["--planner", "scout", "-o", "{exists}"], "exists; not overwriting it (use --force)"),
+])
+def test_user_errors(tmp_path, args, message) -> None:
+    (tmp_path / "bad.json").write_text("{not json")
+    (tmp_path / "exists.mcap").write_bytes(b"keep me")
+    subs = {"{missing}": str(tmp_path / "missing.json"), "{bad}": str(tmp_path / "bad.json"),
+            "{exists}": str(tmp_path / "exists.mcap")}
+    args = [subs.get(a, a) for a in args]
+    if "-o" not in args:
+        args += ["-o", str(tmp_path / "out.mcap")]
+    r = CliRunner().invoke(cli, ["run", *args])
+    assert r.exit_code == 2, r.output
+    assert message in r.output and "Traceback" not in r.output
+    assert not (tmp_path / "out.mcap").exists()
+    assert not list(tmp_path.glob("*.partial"))
+    assert (tmp_path / "exists.mcap").read_bytes() == b"keep me"
+
+
+def test_help_explains_the_loop() -> None:
+    r = CliRunner().invoke(cli, ["run", "-h"])
+    assert r.exit_code == 0
+    for word in ("--planner", "--query", "--episode", "--frames", "--llm-replay", "replay"):
+        assert word in r.output
+
+
+# ----- sgtool eval: which graph an action was decided on ------------------------------
+def test_eval_pairs_actions_with_graph_time_ns(tmp_path) -> None:
+    def graph(x: float) -> dict:
+        return SceneGraph(robot=RobotState((x, 0.0))).to_dict()
+
+    path = tmp_path / "pairing.mcap"
+    with LogWriter(path) as w:
+        w.write_record("episode", 0, {"kind": "search", "status": "started", "query": "cup"})
+        w.write_record("action", 5, {"skill": "look_around", "outcome": "success",
+                                     "graph_time_ns": None, "decision_time_s": 0.0})
+        w.write_record("scene_graph", 10, graph(1.0))
+        w.write_record("scene_graph", 20, graph(2.0))  # mid-skill refresh
+        w.write_record("action", 30, {"skill": "explore", "target": "room:0",
+                                      "outcome": "success", "graph_time_ns": 10,
+                                      "decision_time_s": 0.5})
+        w.write_record("scene_graph", 30, graph(3.0))
+        w.write_record("action", 40, {"skill": "done", "outcome": "success",
+                                      "decision_time_s": 0.1})  # 1.0 log: the old rule
+        w.write_record("episode", 40, {"kind": "search", "status": "failure", "steps": 2})
+    (ep,) = read_log_episodes(path)  # the closing record at the last action's time
+    look, explore, done = ep.decisions
+    assert look.graph is None and not look.decided
+    assert explore.graph.robot.position == (1.0, 0.0)  # by graph_time_ns, not the latest
+    assert done.graph.robot.position == (3.0, 0.0) and done.decided
+    res = ep.result()
+    assert res.steps == 2 and res.decisions == 2 and res.decision_s == pytest.approx(0.6)

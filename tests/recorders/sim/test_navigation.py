@@ -1,0 +1,101 @@
+"""Navigation helpers of the simulator (pure): per-frame poses, string pulling, goals in
+front of containers, open panels in the occupancy, hinged panel geometry."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from support.small_house import small_house
+
+from sgtool.mapping.occupancy import astar, geodesic_distances, world_to_cell
+from sgtool.recorders.sim import articulation as art
+from sgtool.recorders.sim import navigation as nav
+
+
+def test_follow_poses_turns_then_drives_in_bounded_steps() -> None:
+    poses = nav.follow_poses((0.0, 0.0, 0.0), [(0.0, 1.0), (1.0, 1.0)], step=0.1,
+                             turn_step=math.radians(30), final_yaw=math.pi)
+    # 90 deg left in 3 turns, 10 drive steps, 90 deg right in 3, 10 steps, 180 deg in 6
+    assert len(poses) == 3 + 10 + 3 + 10 + 6
+    assert np.allclose(poses[2], (0.0, 0.0, math.pi / 2))
+    assert np.allclose(poses[12], (0.0, 1.0, math.pi / 2))
+    assert np.allclose(poses[25][:2], (1.0, 1.0))
+    assert math.isclose(abs(poses[-1][2]), math.pi)
+    assert math.isclose(nav.travelled((0.0, 0.0, 0.0), poses), 2.0)
+    assert nav.turn_poses((0, 0, 3.0), -3.0, 0.1)[0][2] > 3.0  # the short way, through pi
+
+
+def test_smoothed_path_is_free_and_shorter() -> None:
+    h = small_house(door="open")
+    occ = nav.occupancy_with(h, {"door_0": "open"}, [], nav.RobotConfig())
+    path = astar(occ, (1.0, 2.5), (6.0, 0.5))
+    assert path is not None
+    smooth = nav.smooth_path(occ, path)
+    assert smooth[0] == path[0] and smooth[-1] == path[-1]
+    assert len(smooth) < len(path) / 5
+    for a, b in zip(smooth, smooth[1:], strict=False):
+        assert nav.line_is_free(occ, a, b)
+    length = sum(math.dist(a, b) for a, b in zip(smooth, smooth[1:], strict=False))
+    raw = sum(math.dist(a, b) for a, b in zip(path, path[1:], strict=False))
+    assert length <= raw + 1e-9
+
+
+def test_open_panels_block_the_floor_they_swing_into() -> None:
+    h = small_house(door="open")
+    robot = nav.RobotConfig()
+    d = h.doors[0]
+    p = art.door_panel(d, -1, 1)
+    fp = p.footprint(1.0)
+    without = nav.occupancy_with(h, {"door_0": "open"}, [], robot)
+    with_panel = nav.occupancy_with(h, {"door_0": "open"}, [fp], robot)
+    r, c = world_to_cell(without, fp[0], fp[1])
+    assert not without.occupied[r, c] and with_panel.occupied[r, c]
+    closed = nav.occupancy_with(h, {"door_0": "closed"}, [], robot)
+    r, c = world_to_cell(closed, 4.0, 1.5)
+    assert closed.occupied[r, c] and not without.occupied[r, c]
+
+
+def test_door_panel_hinges_and_sides() -> None:
+    h = small_house()
+    d = h.doors[0]  # centre (4, 1.5), along +y (yaw pi/2): left of it is -x
+    assert art.side_of_door(d, 3.0, 1.5) == 1 and art.side_of_door(d, 5.0, 1.5) == -1
+    for end in (-1, 1):
+        for side in (-1, 1):
+            p = art.door_panel(d, end, side)
+            (x, y, _), yaw = p.pose(0.0)
+            assert np.allclose((x, y), d.center)  # closed: fills the opening
+            (x, y, _), yaw = p.pose(1.0)
+            hinge_y = 1.5 + end * 0.45
+            assert math.isclose(y, hinge_y, abs_tol=1e-4)  # yaw is stored to 4 decimals
+            assert math.isclose(x, 4.0 - side * 0.45, abs_tol=1e-4)  # swung to that side
+
+
+def test_container_panels_close_the_front_and_open_outwards() -> None:
+    h = small_house()
+    cab = h.furniture_by_id()["furn_0"]  # front faces +y, at y = 0.35 + 0.25
+    (single,) = art.container_panels(cab)
+    (x, y, z), yaw = single.pose(0.0)
+    assert math.isclose(x, 1.0, abs_tol=1e-9) and 0.58 < y < 0.6
+    (x, y, _), yaw = single.pose(1.0)
+    assert math.isclose(x, 1.0 - 0.4, abs_tol=0.02) and y > 0.6 + 0.3
+    fridge = h.furniture_by_id()["furn_2"]  # front faces -x
+    (p,) = art.container_panels(fridge, hinge=1)
+    (x, y, _), _ = p.pose(1.0)
+    assert x < 6.15 - 0.3
+    wide = art.container_panels(h.furniture_by_id()["furn_1"])  # 1 m wide: double doors
+    assert len(wide) == 2 and all(math.isclose(q.width, 0.5) for q in wide)
+
+
+def test_approach_goal_stands_square_in_front() -> None:
+    h = small_house()
+    robot = nav.RobotConfig()
+    occ = nav.occupancy_with(h, {"door_0": "closed"}, [], robot)
+    geo = geodesic_distances(occ, (3.0, 2.5))
+    cab = h.furniture_by_id()["furn_0"]
+    box = (cab.center[0], cab.center[1], cab.size[0], cab.size[1], cab.yaw)
+    x, y = nav.approach_goal(occ, geo, box, robot, front=box)
+    lx, ly = cab.to_local(x, y)
+    assert ly > cab.size[1] / 2 and abs(lx) <= cab.size[0] / 2 - 0.15 + 1e-9
+    d = art.point_box_distance(x, y, box)
+    assert robot.approach[0] <= d <= robot.approach[1]

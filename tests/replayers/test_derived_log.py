@@ -1,0 +1,280 @@
+"""`sgtool replay`: derived logs from recorded logs, deterministic, complete, scored.
+
+Inputs are the committed golden logs (tests/golden, recorded in PyBullet from generated
+4-room houses at 128x96) and small logs written here from the numpy ray-caster of
+:mod:`support.synthetic_world` (the two-room house: kitchen and bedroom joined by a door),
+so no simulator is needed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from support.paths import GOLDEN
+from support.synthetic_world import look_around, make_frame, two_room_house, walk, world_of_house
+
+from sgtool.cli import cli
+from sgtool.log import LogReader, LogWriter
+from sgtool.log import schemas as S
+from sgtool.log.echo import as_logged
+from sgtool.log.records import Instances
+from sgtool.replayers.derived_log import ReplayOptions, replay
+from sgtool.scenegraph.derived_layers import DERIVED_TOPICS, _hull
+from sgtool.scenegraph.graph import SceneGraph
+from sgtool.scenegraph.options import default_min_points
+from sgtool.scenegraph.stream import SceneGraphStream
+
+TOUR = GOLDEN / "house6-tour.mcap"
+K = __import__("sgtool.log.frame", fromlist=["CameraIntrinsics"]).CameraIntrinsics.from_fov(
+    80, 60, 60)
+
+
+def sha(p: Path) -> str:
+    return hashlib.sha256(p.read_bytes()).hexdigest()
+
+
+def messages(path: Path) -> dict[str, list[tuple[int, bytes]]]:
+    out: dict[str, list[tuple[int, bytes]]] = defaultdict(list)
+    with LogReader(path) as r:
+        for _schema, ch, m in r.raw_messages():
+            out[ch.topic].append((int(m.log_time), bytes(m.data)))
+    return out
+
+
+def synthetic_log(path: Path, with_ids: bool = True, opening: str = "open") -> Path:
+    """The two-room house seen by a robot looking around in the kitchen, walking to the
+    bedroom and looking around there; an action record after each part."""
+    hw = world_of_house(two_room_house(opening))
+    parts = [look_around(2.0, 1.5, 0.0, 12), walk([(2.0, 1.5), (6.0, 1.5)], 0.25),
+             look_around(6.0, 1.0, 0.0, 12)]
+    with LogWriter(path, seed=3) as w:
+        if with_ids:
+            w.write_record("instances", 0, {"instances": [
+                v.to_record() for v in hw.instances.values()]})
+        i = 0
+        for n, poses in enumerate(parts):
+            for x, y, yaw in poses:
+                f = make_frame(hw.world, x, y, yaw, K, index=i, pitch=0.3, with_ids=with_ids)
+                w.write_frame(i * 100_000_000, depth=f.depth, pose=f.pose, intrinsics=K,
+                              ids=f.ids, base_pose=f.base_pose)
+                i += 1
+            w.write_record("action", (i - 1) * 100_000_000, {
+                "skill": "explore", "outcome": "success", "step": n})
+    return path
+
+
+# ----- the derived log ----------------------------------------------------------------
+def test_derived_log_copies_every_input_message_and_adds_the_layers(tmp_path):
+    out = tmp_path / "derived.mcap"
+    rep = replay(TOUR, out, ReplayOptions())
+    src, dst = messages(TOUR), messages(out)
+    for topic, msgs in src.items():
+        assert dst[topic] == msgs, topic  # same bytes, same times, same order
+    # one message per refresh on every derived channel, at non-decreasing times
+    for topic in DERIVED_TOPICS:
+        assert len(dst[topic]) == rep.refreshes, topic
+        times = [t for t, _ in dst[topic]]
+        assert times == sorted(times)
+    # a refresh at every action (the action's time is the time of the skill's last frame)
+    graph_times = {t for t, _ in dst[S.RECORDS["scene_graph"].topic]}
+    assert {t for t, _ in src[S.RECORDS["action"].topic]} <= graph_times
+    with LogReader(TOUR) as a, LogReader(out) as b:
+        assert b.attachments() == a.attachments()
+        assert b.metadata["sgtool"]["house_id"] == a.metadata["sgtool"]["house_id"]
+        assert b.seed == a.seed
+        assert b.metadata["sgtool.replay"]["every"] == "10"
+        assert b.metadata["sgtool.replay"]["classifier"] == "containment"
+        # the last graph is the report's, and it names the rooms of the derived layers
+        last = SceneGraph.from_json(dst[S.RECORDS["scene_graph"].topic][-1][1])
+        assert last.to_json() == rep.last.graph.to_json()
+        rooms_msg = list(b.messages([S.ROOMS]))[-1].message
+        explored = {r.id for r in last.rooms if r.explored}
+        assert {e.id for e in rooms_msg.entities} == explored
+        assert all(e.texts[0].text.startswith(e.id) for e in rooms_msg.entities)
+        grid = list(b.messages([S.OCCUPANCY]))[-1].message
+        assert set(np.frombuffer(grid.data, np.int8).tolist()) <= {-1, 0, 100}
+
+
+def test_replay_is_byte_identical_and_replaying_a_derived_log_rebuilds_the_same(tmp_path):
+    a, b, c = tmp_path / "a.mcap", tmp_path / "b.mcap", tmp_path / "c.mcap"
+    replay(TOUR, a)
+    replay(TOUR, b)
+    assert sha(a) == sha(b)
+    replay(a, c)  # the derived channels of the input are rebuilt, not copied
+    assert messages(c) == messages(a)
+
+
+def test_refresh_schedule_every_k_frames_and_at_actions(tmp_path):
+    log = synthetic_log(tmp_path / "two.mcap")
+    seen = []
+    rep = replay(log, None, ReplayOptions(every=7, classifier="none"),
+                 on_refresh=lambda r, s: seen.append((r.reason, r.frames)))
+    n_walk = len(walk([(2.0, 1.5), (6.0, 1.5)], 0.25))
+    ends = [12, 12 + n_walk, 24 + n_walk]  # frames integrated when each action is logged
+    assert rep.frames == ends[-1]
+    # every 7 frames since the last refresh; at each action unless one just happened
+    expected, since = [], 0
+    for f in range(1, ends[-1] + 1):
+        since += 1
+        if since == 7:
+            expected.append(("every", f))
+            since = 0
+        if f in ends and since:
+            expected.append(("action", f))
+            since = 0
+    assert seen == expected
+    graph = rep.last.graph
+    assert len([r for r in graph.rooms if r.explored]) == 2  # the door cuts the graph
+
+
+def test_min_points_scale_with_the_image():
+    assert default_min_points(320, 240) == 50
+    assert default_min_points(128, 96) == 8
+    assert default_min_points(64, 48) == 5
+    assert default_min_points(640, 480) == 200
+
+
+def test_a_log_without_instance_ids_gives_geometry_only(tmp_path):
+    log = synthetic_log(tmp_path / "bare.mcap", with_ids=False)
+    rep = replay(log, tmp_path / "out.mcap")
+    assert not rep.semantic
+    assert any("semantics are absent" in line for line in rep.lines())
+    g = rep.last.graph
+    assert g.objects == () and g.doors == ()
+    assert len(g.rooms) == 1 and g.rooms[0].category == "unknown"
+    assert len(rep.last.layers.voronoi) > 5
+
+
+def test_as_logged_is_what_the_reader_gives_back(tmp_path):
+    hw = world_of_house(two_room_house("open"))
+    frames = [make_frame(hw.world, 2.0 + 0.3 * i, 1.5, 0.2 * i, K, index=i, pitch=0.3)
+              for i in range(4)]
+    path = tmp_path / "echo.mcap"
+    with LogWriter(path) as w:
+        for f in frames:
+            w.write_frame(f.time_ns, depth=f.depth, pose=f.pose, intrinsics=K, ids=f.ids,
+                          base_pose=f.base_pose)
+    with LogReader(path) as r:
+        back = list(r.frames())
+    for f, g in zip(frames, back, strict=True):
+        e = as_logged(f)
+        assert e.depth.dtype == g.depth.dtype and np.array_equal(e.depth, g.depth)
+        assert np.array_equal(e.ids, g.ids)
+        assert np.array_equal(e.pose, g.pose)  # bit for bit, not just close
+        assert np.array_equal(e.base_pose, g.base_pose)
+        assert e.intrinsics == g.intrinsics
+
+
+def test_a_stream_fed_live_equals_the_replay_of_its_log(tmp_path):
+    """What the closed loop does: build from frames while logging them."""
+    log = synthetic_log(tmp_path / "live.mcap")
+    with LogReader(log) as r:
+        table = r.last_record(Instances)
+        frames = list(r.frames())
+        actions = [t for t, _ in r.records("action")]
+    hw = world_of_house(two_room_house("open"))
+    cfg_opts = ReplayOptions(every=10, classifier="none")
+    got = []
+    replay(log, None, cfg_opts, on_refresh=lambda ref, s: got.append(ref.graph.to_json()))
+    from sgtool.replayers.derived_log import resolve_options
+    from sgtool.scenegraph.options import builder_config
+
+    with LogReader(log) as r:
+        resolved = resolve_options(r, cfg_opts)
+    live = SceneGraphStream(None, None, builder_config(resolved))
+    live.instances(0, table)
+    graphs = []
+    for f in frames:
+        original = make_frame(hw.world, float(f.base_pose[0, 3]), float(f.base_pose[1, 3]),
+                              float(np.arctan2(f.base_pose[1, 0], f.base_pose[0, 0])), K,
+                              index=f.index, pitch=0.3)
+        ref = live.frame(as_logged(original))
+        if ref is not None:
+            graphs.append(ref.graph.to_json())
+        if f.time_ns in actions:
+            ref = live.action(f.time_ns)
+            if ref is not None:
+                graphs.append(ref.graph.to_json())
+    assert graphs == got
+
+
+def test_room_outline_is_the_convex_hull_grown_by_the_margin():
+    pts = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0], [1.0, 0.5]])
+    hull = _hull(pts, 0.3)
+    assert hull[:, 0].min() == pytest.approx(-0.3) and hull[:, 0].max() == pytest.approx(2.3)
+    assert hull[:, 1].min() == pytest.approx(-0.3) and hull[:, 1].max() == pytest.approx(1.3)
+    # counter-clockwise: positive signed area
+    x, y = hull[:, 0], hull[:, 1]
+    assert 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)) > 2.0 * 1.0
+
+
+# ----- quality against the house -------------------------------------------------------
+def test_score_on_the_golden_tour():
+    """House 6 (4 rooms: corridor, bathroom behind a door, kitchen and living room joined
+    by an open-plan passage). Measured on the committed log: strict 4 rooms for 4 (the
+    passage is split, but the corridor is split too, at a floor lamp where the robot never
+    walked and the Voronoi ridge breaks), merged purity 1.000 and ARI 0.963, objects
+    100 % in the right merged room (95.1 % strict: two objects by the passage), categories
+    2 of 4 (the bathroom holds only a cabinet and a sink and is called a kitchen; the
+    corridor piece with a floor lamp a living room). The bounds leave room for noise in
+    the last digits, not for regressions."""
+    r = CliRunner().invoke(cli, ["replay", str(TOUR), "--score", "--json"])
+    assert r.exit_code == 0, r.output
+    s = json.loads(r.output)["score"]
+    strict, merged = s["strict"], s["merged"]
+    assert abs(strict["room_count_error"]) <= 1 and abs(merged["room_count_error"]) <= 1
+    assert merged["purity"] >= 0.95 and merged["ari"] >= 0.9
+    assert strict["purity"] >= 0.65 and strict["ari"] >= 0.5
+    assert merged["object_accuracy"] >= 0.95 and strict["object_accuracy"] >= 0.9
+    assert strict["objects"] >= 35
+    assert merged["category_accuracy"] >= 0.5
+
+
+# ----- the command ----------------------------------------------------------------------
+def test_cli_writes_the_derived_log_the_rrd_and_the_score(tmp_path):
+    out, rrd = tmp_path / "d.mcap", tmp_path / "v.rrd"
+    r = CliRunner().invoke(cli, ["replay", str(TOUR), "-o", str(out), "--rrd", str(rrd),
+                                 "--score", "--every", "20"])
+    assert r.exit_code == 0, r.output
+    assert out.exists() and rrd.stat().st_size > 100_000
+    assert "quality (strict)" in r.output and "quality (merged)" in r.output
+    assert "refreshes (every 20 frames" in r.output
+    for stage in ("integrate", "voronoi", "rooms", "refresh"):
+        assert stage in r.output
+    assert not list(tmp_path.glob("*.partial"))
+
+
+@pytest.mark.parametrize("args, message", [
+    (["missing.mcap"], "no such file"),
+    (["{tour}", "-o", "{tour}"], "must not be the input"),
+    (["{tour}", "--rrd", "x.rrd"], "give -o"),
+    (["{tour}", "-o", "{exists}"], "not overwriting"),
+    (["{tour}", "-o", "out.txt"], "name it *.mcap"),
+    (["{tour}", "-o", "nofolder/out.mcap"], "does not exist"),
+    (["{bare}", "--score"], "no house spec"),
+    (["{tour}", "--voxel-size", "2"], "--voxel-size"),
+])
+def test_cli_user_errors(tmp_path, monkeypatch, args, message):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "exists.mcap").write_bytes(b"x")
+    bare = synthetic_log(tmp_path / "bare.mcap", with_ids=False)
+    subst = {"tour": str(TOUR), "exists": "exists.mcap", "bare": str(bare)}
+    r = CliRunner().invoke(cli, ["replay"] + [a.format(**subst) for a in args])
+    assert r.exit_code == 2, r.output
+    assert message in r.output
+    assert "Traceback" not in r.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bare.mcap", "exists.mcap"]
+
+
+def test_cli_on_a_file_that_is_not_a_log(tmp_path):
+    p = tmp_path / "junk.mcap"
+    p.write_bytes(b"not an mcap file at all")
+    r = CliRunner().invoke(cli, ["replay", str(p), "-o", str(tmp_path / "o.mcap")])
+    assert r.exit_code == 2 and "not an MCAP file" in r.output
+    assert not (tmp_path / "o.mcap").exists()

@@ -1,0 +1,188 @@
+"""Crash tolerance: truncated logs recover a growing prefix; a SIGKILLed recorder loses at
+most its last second of log time; doctor tells complete, truncated and corrupt apart."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import textwrap
+
+import pytest
+from click.testing import CliRunner
+from support.logfixtures import synthetic_frame
+from support.paths import TESTS
+
+from sgtool.cli import cli
+from sgtool.errors import LogFormatError
+from sgtool.log import LogReader, LogWriter
+from sgtool.log.recover import recover, scan
+
+FPS = 20
+DT = 1_000_000_000 // FPS
+
+
+@pytest.fixture(scope="module")
+def long_log(tmp_path_factory):
+    """6 s of log time at 20 fps; chunks close every second."""
+    path = tmp_path_factory.mktemp("logs") / "long.mcap"
+    with LogWriter(path, seed=1) as w:
+        w.attach_house("{}")
+        for i in range(6 * FPS):
+            k, rgb, depth, ids, pose, base = synthetic_frame(i)
+            w.write_frame(i * DT, rgb=rgb, depth=depth, ids=ids, pose=pose, intrinsics=k,
+                          base_pose=base)
+    return path
+
+
+def test_complete_log_scans_complete(long_log):
+    d = scan(long_log)
+    assert d.status == "complete" and not d.problems
+    with LogReader(long_log) as r:
+        assert d.readable_messages == r.message_count()
+
+
+def test_truncation_every_two_percent_recovers_a_growing_prefix(long_log, tmp_path):
+    data = long_log.read_bytes()
+    with LogReader(long_log) as r:
+        total_frames = r.frame_count()
+    previous = -1
+    frames_seen = []
+    for pct in range(2, 100, 2):
+        cut = tmp_path / "cut.mcap"
+        cut.write_bytes(data[: len(data) * pct // 100])
+        with pytest.raises(LogFormatError):  # the only error a reader may raise
+            LogReader(cut)
+        out = tmp_path / "rec.mcap"
+        d = recover(cut, out, overwrite=True)
+        assert d.status == "truncated"
+        assert d.readable_messages >= previous
+        previous = d.readable_messages
+        with LogReader(out) as r:
+            n = r.frame_count() if r.has("/camera/depth") else 0
+            frames = list(r.frames()) if n else []
+            assert len(frames) == n
+            # a recovered prefix is the first n frames, whole
+            assert [f.index for f in frames] == list(range(n))
+            assert all(f.rgb is not None and f.ids is not None for f in frames)
+        frames_seen.append(n)
+    assert frames_seen == sorted(frames_seen)
+    assert frames_seen[-1] >= total_frames - FPS  # all but the last second
+    assert frames_seen[0] < frames_seen[-1]
+
+
+def test_corrupt_chunk_is_reported_and_skipped(long_log, tmp_path):
+    data = bytearray(long_log.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    bad = tmp_path / "bad.mcap"
+    bad.write_bytes(bytes(data))
+    d = recover(bad, tmp_path / "ok.mcap")
+    assert d.status == "corrupt" and d.lost_chunks == 1
+    with LogReader(tmp_path / "ok.mcap") as r:
+        n = r.frame_count()
+    assert 0 < n < 6 * FPS
+
+
+RECORDER = textwrap.dedent(
+    """
+    import sys
+    sys.path.insert(0, {tests!r})
+    from support.logfixtures import synthetic_frame
+    from sgtool.log import LogWriter
+    DT = {dt}
+    w = LogWriter(sys.argv[1], seed=0)
+    for i in range(100000):
+        k, rgb, depth, ids, pose, base = synthetic_frame(i)
+        w.write_frame(i * DT, rgb=rgb, depth=depth, ids=ids, pose=pose, intrinsics=k,
+                      base_pose=base)
+        print(i, flush=True)
+    """
+)
+
+
+def test_sigkilled_recorder_loses_at_most_the_last_second(tmp_path):
+    out = tmp_path / "run.mcap"
+    script = RECORDER.format(tests=str(TESTS), dt=DT)
+    proc = subprocess.Popen([sys.executable, "-c", script, str(out)], stdout=subprocess.PIPE,
+                            text=True)
+    written = -1
+    assert proc.stdout is not None
+    for line in proc.stdout:
+        written = int(line)
+        if written >= 5 * FPS + 7:  # mid-second, mid-chunk
+            break
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    partial = tmp_path / "run.mcap.partial"
+    assert partial.exists() and not out.exists()
+    result = CliRunner().invoke(
+        cli, ["doctor", str(partial), "--recover", str(tmp_path / "r.mcap")]
+    )
+    assert result.exit_code == 1, result.output  # it was truncated
+    assert "truncated" in result.output
+    with LogReader(tmp_path / "r.mcap") as r:
+        frames = list(r.frames())
+    # frames 0..written were handed to the writer; at most one second of log time is lost
+    assert len(frames) >= written + 1 - FPS
+    assert [f.index for f in frames] == list(range(len(frames)))
+    assert frames[-1].time_ns >= written * DT - 1_000_000_000
+
+
+def test_doctor_cli_on_complete_and_json(long_log):
+    r = CliRunner().invoke(cli, ["doctor", str(long_log), "--json"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.output)
+    assert d["status"] == "complete" and d["readable_messages"] > 6 * FPS * 4
+
+
+def test_doctor_never_overwrites_input(long_log):
+    before = long_log.read_bytes()
+    r = CliRunner().invoke(cli, ["doctor", str(long_log), "--recover", str(long_log)])
+    assert r.exit_code == 2 and "refusing to write the recovered log over its input" in r.output
+    assert long_log.read_bytes() == before
+
+
+def test_damaged_chunks_give_the_documented_error_only(long_log, tmp_path):
+    """100 garbage bytes written over the log at 30 places: reading frames either works
+    (the bytes hit something not read) or raises LogFormatError pointing to doctor, never
+    a decompression or CRC error of the libraries."""
+    import random
+
+    data = long_log.read_bytes()
+    errors = 0
+    for k, off in enumerate(range(200, len(data) - 200, len(data) // 30)):
+        bad = tmp_path / "bad.mcap"
+        rng = random.Random(k)
+        bad.write_bytes(data[:off] + bytes(rng.randrange(256) for _ in range(100))
+                        + data[off + 100:])
+        try:
+            with LogReader(bad) as r:
+                sum(1 for _ in r.frames())
+        except LogFormatError as e:
+            errors += 1
+            assert "sgtool doctor" in str(e)
+    assert errors >= 20  # most places are chunk data, which CRCs and zstd check
+
+
+def test_doctor_user_errors(long_log, tmp_path):
+    junk = tmp_path / "junk.mcap"
+    junk.write_bytes(b"no log here")
+    r = CliRunner().invoke(cli, ["doctor", str(junk)])
+    assert r.exit_code == 2 and "not an MCAP file" in r.output
+    r = CliRunner().invoke(cli, ["doctor", str(junk), "--recover", str(tmp_path / "o.mcap")])
+    assert r.exit_code == 2 and not (tmp_path / "o.mcap").exists()
+    taken = tmp_path / "taken.mcap"
+    taken.write_bytes(b"keep me")
+    r = CliRunner().invoke(cli, ["doctor", str(long_log), "--recover", str(taken)])
+    assert r.exit_code == 2 and "use --force" in r.output and taken.read_bytes() == b"keep me"
+    r = CliRunner().invoke(cli, ["doctor", str(long_log), "--recover", str(taken), "--force"])
+    assert r.exit_code == 0 and taken.stat().st_size > 1000
+
+
+def test_info_on_a_truncated_log_points_to_doctor(long_log, tmp_path):
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(long_log.read_bytes()[: long_log.stat().st_size // 2])
+    r = CliRunner().invoke(cli, ["info", str(cut)])
+    assert r.exit_code == 2
+    assert "without the MCAP footer" in r.output and "--recover" in r.output
