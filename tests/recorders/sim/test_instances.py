@@ -1,13 +1,4 @@
-"""A small two-room house for the simulator and recorder tests (and checks of it).
-
-Living room [0, 4] x [0, 3] and kitchen [4, 7] x [0, 3], walls 0.1 m thick, 2.5 m high,
-joined by door_0 in the wall x = 4 (y 1.05-1.95), closed. Living room: a closed cabinet
-against the south wall (front facing +y, into the room) with a mug inside and a book on
-top, a table in the open with an apple on it. Kitchen: a closed refrigerator against the
-east wall (yaw pi/2: its front faces -x, into the room) with milk inside, an open-fronted
-shelf against the north wall (yaw pi: front faces -y) with a bowl inside. Starts: one
-per room.
-"""
+"""The instance table of the small two-room house (:mod:`support.small_house`)."""
 
 from __future__ import annotations
 
