@@ -27,6 +27,11 @@ its choice is compared with the logged action; then it is told the logged outcom
 (teacher forcing: its memory follows what was really done, not what it would have done).
 Reported: exact agreement (same skill and target), same target, same room (the chosen and
 the logged node lie in the same room), and choices that name no node of the graph.
+
+**What is scored** (:func:`load_results`): search episodes whose figures pass
+:func:`sgtool.analysis.validity.episode_problem`. Episodes of other kinds (recordings,
+imports) are skipped and impossible ones refused, each with a one-line note naming the
+file (and the field).
 """
 
 from __future__ import annotations
@@ -41,6 +46,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from sgtool.analysis.validity import SEARCH_KIND, episode_problem
 from sgtool.errors import SgtoolError
 from sgtool.log.records import Absent, Episode, LogRecord, SceneGraphRecord, given
 from sgtool.log.records import Action as LoggedAction
@@ -164,12 +170,15 @@ def _decided_on(action: LoggedAction, latest: SceneGraph | None, times: list[int
     return graphs[i - 1] if i else None
 
 
-def load_results(paths: Iterable[str | os.PathLike[str]]) -> tuple[list[EpisodeResult],
-                                                                   list[LoggedEpisode]]:
+def load_results(paths: Iterable[str | os.PathLike[str]], notes: list[str] | None = None
+                 ) -> tuple[list[EpisodeResult], list[LoggedEpisode]]:
     """Episode results from MCAP logs and/or episode JSONL files (``sgtool bench``
-    output); the logged episodes (with their decision points) of the MCAP inputs."""
+    output); the logged episodes (with their decision points) of the MCAP inputs. Episodes
+    that are no search or whose figures are impossible are left out, with a one-line note
+    each appended to ``notes`` (module doc)."""
     results: list[EpisodeResult] = []
     logged: list[LoggedEpisode] = []
+    notes = [] if notes is None else notes
     for path in paths:
         p = Path(path)
         if not p.exists():
@@ -179,14 +188,35 @@ def load_results(paths: Iterable[str | os.PathLike[str]]) -> tuple[list[EpisodeR
         with open(p, "rb") as f:
             head = f.read(8)
         if head == b"\x89MCAP0\r\n":
-            eps = read_log_episodes(p)
-            logged.extend(eps)
-            results.extend(_with_seen(e.result()) for e in eps)
+            for e in _search_episodes(p, read_log_episodes(p), notes):
+                r = _with_seen(e.result())
+                if _accepted(r, f"{p}: episode {e.index}", notes):
+                    logged.append(e)
+                    results.append(r)
         elif p.suffix in (".jsonl", ".json") or head[:1] == b"{":
-            results.extend(read_jsonl(p))
+            results.extend(r for i, r in enumerate(read_jsonl(p))
+                           if _accepted(r, f"{p}: record {i + 1}", notes))
         else:
             raise EvalInputError(f"{p}: neither an MCAP log nor an episode JSONL file")
     return results, logged
+
+
+def _search_episodes(p: Path, episodes: list[LoggedEpisode], notes: list[str]
+                     ) -> list[LoggedEpisode]:
+    """The search episodes of a log; a note for the others (recordings, imports)."""
+    other = sorted({e.episode.kind for e in episodes if e.episode.kind != SEARCH_KIND})
+    if other:
+        n = sum(1 for e in episodes if e.episode.kind != SEARCH_KIND)
+        notes.append(f"{p}: skipped {n} episode record(s) of kind {', '.join(other)} "
+                     "(not a search episode)")
+    return [e for e in episodes if e.episode.kind == SEARCH_KIND]
+
+
+def _accepted(r: EpisodeResult, where: str, notes: list[str]) -> bool:
+    problem = episode_problem(r)
+    if problem is not None:
+        notes.append(f"{where}: refused: {problem}")
+    return problem is None
 
 
 def _with_seen(r: EpisodeResult) -> EpisodeResult:

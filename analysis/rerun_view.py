@@ -14,11 +14,18 @@ nothing of sgtool's JSON records; so sgtool logs everything natively with the Re
 
 Two timelines: ``frame`` (frame index) and ``sim_time`` (log time since the start). Export is
 deterministic for a given log (the recording id is derived from the log's path name).
+
+The ``.rrd`` is written atomically (:func:`sgtool.files.atomic_output`): an error or Ctrl-C
+leaves nothing at its path. Rerun's file sink does not report write errors (on a full disk
+it warns and its flush waits forever), so the export watches the free space of the
+destination itself and stops with an :class:`~sgtool.files.OutputError` when less than
+:data:`FREE_MARGIN` bytes are left.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import hashlib
 import os
 from collections.abc import Callable, Iterator
@@ -28,11 +35,21 @@ from typing import Any
 import numpy as np
 
 from sgtool.colors import color_for
-from sgtool.files import atomic_output
+from sgtool.files import atomic_output, output_error
 from sgtool.log import LogReader, codec
 from sgtool.log import schemas as S
 
 APP_ID = "sgtool"
+FREE_MARGIN = 16 * 1024 * 1024  # bytes that must stay free beside the .rrd while writing
+FLUSH_TIMEOUT_S = 600.0
+
+
+def require_space(rrd_path: Path) -> None:
+    """Raise an :class:`~sgtool.files.OutputError` when the folder of ``rrd_path`` has
+    less than :data:`FREE_MARGIN` bytes free (Rerun would fail silently and hang)."""
+    st = os.statvfs(rrd_path.parent)
+    if st.f_bavail * st.f_frsize < FREE_MARGIN:
+        raise output_error(OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)), rrd_path)
 
 
 def _time(rec: Any, frame: int | None, t_ns: int) -> None:
@@ -93,13 +110,26 @@ def export(
         if spawn:
             rec.spawn()
         elif tmp is not None:
+            require_space(Path(rrd_path))  # type: ignore[arg-type]
             rec.save(tmp)
+            progress = _watching_space(Path(rrd_path), progress)  # type: ignore[arg-type]
         with LogReader(log_path) as r:
             _export(rec, r, every=every, max_frames=max_frames, progress=progress,
                     voxels=voxels)
-        rec.flush()
+        rec.flush(timeout_sec=FLUSH_TIMEOUT_S)
+        if tmp is not None:
+            require_space(Path(rrd_path))  # type: ignore[arg-type]
         rec.disconnect()
     return Path(rrd_path) if rrd_path is not None and not spawn else None
+
+
+def _watching_space(rrd_path: Path, progress: Callable[[int], None] | None
+                    ) -> Callable[[int], None]:
+    def tick(n: int) -> None:
+        require_space(rrd_path)
+        if progress is not None:
+            progress(n)
+    return tick
 
 
 def _export(

@@ -189,7 +189,7 @@ def replay(
                     if name not in (S.METADATA_NAME, REPLAY_METADATA):
                         writer.add_metadata(name, data)
                 writer.add_metadata(REPLAY_METADATA, opts.to_metadata())
-                for a in reader._reader.iter_attachments():
+                for a in reader.iter_attachments():
                     writer.attach(a.name, a.data, a.media_type, a.log_time)
                 _run(reader, stream, writer, opts, report, on_refresh, progress)
         report.seconds = time.perf_counter() - t0
@@ -204,7 +204,7 @@ def _run(reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
     frame_topics = set(FRAME_TOPICS)
     needed = frame_topics | {_INSTANCES, _ACTION}
     copied: dict[int, int] = {}  # input channel id -> output channel id
-    asm = FrameAssembler()
+    asm = FrameAssembler(where=str(reader.path))
     last_t = 0
 
     def refreshed(r: Refresh | None) -> None:

@@ -3,7 +3,11 @@
 Each subcommand lives in its own module ``sgtool.commands.<name>`` exposing ``command``
 (a click command or group), so ``sgtool --help`` stays fast and a missing optional piece
 never breaks the other commands. User errors (:class:`sgtool.errors.SgtoolError`) print as
-one line on stderr with exit code 2; anything else is a bug and keeps its traceback.
+one line on stderr with exit code 2, and so does an :class:`OSError` that the user's
+environment causes (a read-only, missing or full destination: ``sgtool.files``). Ctrl-C
+prints one line (what was kept, if anything) with exit code 130; once a command has
+finished, Ctrl-C no longer interrupts the exit (its outputs are complete). Anything else is
+a bug and keeps its traceback.
 """
 
 from __future__ import annotations
@@ -11,12 +15,15 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import logging
+import signal
 import sys
 
 import click
 
 from sgtool import __version__
 from sgtool.errors import SgtoolError
+from sgtool.files import is_environment_error
+from sgtool.redact import redact_text
 
 # command name -> module under sgtool.commands; order is the order of --help
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -43,7 +50,23 @@ class UserError(click.ClickException):
     exit_code = 2
 
     def show(self, file: object = None) -> None:
-        click.echo(f"sgtool: error: {self.message}", err=True)
+        click.echo(f"sgtool: error: {redact_text(self.message)}", err=True)
+
+
+class Interrupted(click.ClickException):
+    """Ctrl-C during a command: one line on stderr (what was kept), exit code 130."""
+
+    exit_code = 130
+
+    def show(self, file: object = None) -> None:
+        tail = f"; {self.message}" if self.message else ""
+        click.echo(f"sgtool: interrupted{tail}", err=True)
+
+
+def os_error_text(e: OSError) -> str:
+    """One line for an :class:`OSError`: ``Read-only file system: /data/out.mcap``."""
+    reason = e.strerror or type(e).__name__
+    return f"{reason}: {e.filename}" if e.filename is not None else reason
 
 
 class LazyGroup(click.Group):
@@ -52,6 +75,13 @@ class LazyGroup(click.Group):
             return super().invoke(ctx)
         except SgtoolError as e:
             raise UserError(str(e)) from e
+        except OSError as e:
+            if not is_environment_error(e):
+                raise
+            raise UserError(os_error_text(e)) from e
+        except KeyboardInterrupt as e:
+            # not click's Abort (a blank line and "Aborted!"): one line, what was kept
+            raise Interrupted(getattr(e, "note", "") or "no output was left half-written") from e
 
     def _available(self) -> dict[str, tuple[str, str]]:
         out = {}
@@ -94,13 +124,14 @@ def cli(verbose: int) -> None:
 def main(argv: list[str] | None = None) -> None:
     try:
         rc = cli.main(args=argv, prog_name="sgtool", standalone_mode=False)
+        _finished()
         if isinstance(rc, int) and rc != 0:
             sys.exit(rc)
     except SgtoolError as e:
-        click.echo(f"sgtool: error: {e}", err=True)
+        click.echo(f"sgtool: error: {redact_text(str(e))}", err=True)
         sys.exit(e.exit_code)
     except click.exceptions.Abort:
-        click.echo("sgtool: aborted", err=True)
+        click.echo("sgtool: interrupted", err=True)
         sys.exit(130)
     except click.ClickException as e:
         e.show()
@@ -112,6 +143,15 @@ def main(argv: list[str] | None = None) -> None:
         sys.exit(130)
     except BrokenPipeError:
         sys.exit(0)
+
+
+def _finished() -> None:
+    """The command is done and its outputs are in place: a Ctrl-C during the exit (a
+    library's shutdown hooks) must not turn a complete run into a killed one."""
+    try:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except ValueError:  # not the main thread
+        pass
 
 
 if __name__ == "__main__":

@@ -7,22 +7,87 @@ the mode a plain ``open`` would give (umask applied), and are renamed over the f
 An error, Ctrl-C or a concurrent writer never leaves a half-written file at the final path;
 the temporary file is removed on any exception. Two processes writing the same path each
 use their own temporary file, and the last rename wins with a complete file.
+
+:func:`temp_beside` makes such a unique temporary file for writers that manage it
+themselves (the log writer); :class:`OutputError` is the one-line user error for a
+destination that cannot be written (read-only, missing, full), made by
+:func:`output_error` from the :class:`OSError`.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO
 
+from sgtool.errors import SgtoolError
+
+# OSError numbers that a user's environment causes (a destination that is read-only,
+# missing, full, not writable): reported as one line, never as a traceback
+ENVIRONMENT_ERRNOS = frozenset({
+    errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC, errno.EDQUOT, errno.ENOENT,
+    errno.ENOTDIR, errno.EISDIR, errno.EEXIST, errno.EFBIG, errno.ENAMETOOLONG, errno.EIO,
+    errno.ENXIO, errno.ETXTBSY, errno.EMFILE, errno.ENFILE, errno.ELOOP, errno.EXDEV,
+    errno.ENOTEMPTY, errno.EBUSY,
+})
+
+
+# errors of a write that say the destination is full or failing, whatever file they name
+FULL_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO})
+
+
+class OutputError(SgtoolError):
+    """An output could not be written (read-only folder, missing folder, full disk)."""
+
 
 def _umask() -> int:
     mask = os.umask(0)
     os.umask(mask)
     return mask
+
+
+def is_environment_error(e: BaseException) -> bool:
+    """True for an :class:`OSError` a user's environment causes (see ``ENVIRONMENT_ERRNOS``)."""
+    return isinstance(e, OSError) and e.errno in ENVIRONMENT_ERRNOS
+
+
+def concerns(e: OSError, *paths: str | os.PathLike[str]) -> bool:
+    """Is ``e`` a failure to write one of ``paths``: it names one of them, or names no file
+    and says that the destination is full or failing (a buffered write)?"""
+    if e.filename is not None:
+        return str(e.filename) in {str(p) for p in paths}
+    return e.errno in FULL_ERRNOS
+
+
+def output_error(e: OSError, path: str | os.PathLike[str] | None = None,
+                 note: str = "nothing was written") -> OutputError:
+    """The one-line :class:`OutputError` for ``e`` while writing ``path`` (or the file the
+    error names): ``cannot write PATH: No space left on device (nothing was written)``."""
+    where = path if path is not None else (e.filename or "the output")
+    reason = e.strerror or type(e).__name__
+    return OutputError(f"cannot write {where}: {reason}" + (f" ({note})" if note else ""))
+
+
+def temp_beside(path: str | os.PathLike[str], suffix: str = ".partial",
+                hidden: bool = True) -> tuple[int, Path]:
+    """A new, uniquely named, empty file in the folder of ``path`` (``.NAME.XXXXXXXX`` +
+    ``suffix``, or ``NAME.XXXXXXXX`` + ``suffix`` when not ``hidden``) with the mode a
+    plain ``open`` would give; returns its open descriptor and path. Two callers never get
+    the same name."""
+    path = Path(path)
+    prefix = f".{path.name}." if hidden else f"{path.name}."
+    fd, name = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=path.parent)
+    try:
+        os.fchmod(fd, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual mode
+    except BaseException:
+        os.close(fd)
+        os.unlink(name)
+        raise
+    return fd, Path(name)
 
 
 @contextlib.contextmanager
@@ -33,16 +98,23 @@ def atomic_output(path: str | os.PathLike[str], suffix: str = ".partial") -> Ite
     file exists (empty) when the block starts. The parent folder is created.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = temp_beside(path, suffix)
+    except OSError as e:
+        raise output_error(e, path) from None
     os.close(fd)
-    tmp = Path(name)
     try:
         yield tmp
         with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual mode
+        os.chmod(tmp, 0o666 & ~_umask())  # a library may have made its own file anew
         os.replace(tmp, path)
+    except OSError as e:
+        tmp.unlink(missing_ok=True)
+        if concerns(e, tmp, path):
+            raise output_error(e, path) from None
+        raise
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise

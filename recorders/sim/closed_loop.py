@@ -43,7 +43,7 @@ the wall clock: the same house, episode, options and planner seed give the same 
 the measured fields, ``decision_time_s`` of the actions and ``latency_s`` of the LLM
 exchanges (so the file bytes differ too, through the compressed chunks; every message on
 every other channel is identical, the scene graphs included). The writer writes
-``OUT.partial`` and renames it at the end: an error leaves no half-written log.
+``OUT.XXXXXXXX.partial`` and renames it at the end: an error leaves no half-written log.
 
 Planner actions become simulator skills by :func:`sgtool.recorders.sim.skill_plan.plan_skills`.
 """

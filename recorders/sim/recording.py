@@ -17,8 +17,8 @@ of a house into a log; the closed loop builds its own run from :class:`LogRecord
 
 Log time is ``frame index * 1e9 / fps`` (integers, never the wall clock), the house spec
 is attached as ``house.json``, and the same house, options and seed give a byte-identical
-file. The writer writes ``OUT.partial`` and renames it at the end; on an error nothing is
-left behind.
+file. The writer writes ``OUT.XXXXXXXX.partial`` and renames it at the end; on an error
+nothing is left behind (:mod:`sgtool.log.writer`).
 """
 
 from __future__ import annotations

@@ -3,10 +3,17 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import click
 
+from sgtool.errors import SgtoolError
 from sgtool.log.recover import Diagnosis, recover, scan
+from sgtool.log.writer import partial_files
+
+
+def _s(t_ns: int | None) -> str:
+    return f"{(t_ns or 0) / 1e9:.3f}"
 
 
 def _report(d: Diagnosis) -> str:
@@ -18,8 +25,27 @@ def _report(d: Diagnosis) -> str:
         f"readable: {d.readable_messages} messages on {d.channels} channels, "
         f"{d.attachments} attachments{span}"
     )
+    if d.salvaged_messages:
+        lines.append(f"  of which {d.salvaged_messages} were decoded from cut or damaged "
+                     "chunks, up to the cut or the damage (no CRC covers them)")
+    checks = ", ".join(f"{k} {v}" for k, v in d.checks.items())
+    if checks:
+        lines.append(f"CRCs: {checks}")
     if d.lost_chunks:
-        lines.append(f"lost: {d.lost_chunks} damaged chunks")
+        lines.append(f"damaged or cut chunks: {d.lost_chunks}")
+    if d.lost_messages or d.lost_unknown:
+        if not d.lost_unknown:
+            lines.append(f"lost: {d.lost_messages} messages")
+        elif d.lost_messages:
+            lines.append(f"lost: {d.lost_messages} messages, and more that no index counts")
+        else:
+            lines.append("lost: messages that no index counts (the cut or damaged data has "
+                         "no index)")
+        for topic, e in sorted(d.lost.items()):
+            span = ""
+            if e["first_ns"] is not None and e["last_ns"] is not None:
+                span = f", log time {_s(e['first_ns'])} .. {_s(e['last_ns'])} s"
+            lines.append(f"  {topic}: {e['messages']}{span}")
     for p in d.problems[:10]:
         lines.append(f"  - {p}")
     if len(d.problems) > 10:
@@ -38,12 +64,26 @@ def _report(d: Diagnosis) -> str:
 @click.option("--json", "as_json", is_flag=True, help="Print the diagnosis as JSON.")
 def command(log: str, out: str | None, force: bool, as_json: bool) -> None:
     """Check LOG record by record and say whether it is complete, truncated (a recorder
-    killed mid-write, a copy cut short) or corrupt (damaged bytes), and how many messages
-    are readable. With --recover OUT, copy what is readable into a new log.
+    killed mid-write, a copy cut short) or corrupt (damaged bytes), how many messages are
+    readable and which were lost (per channel, with their log time range, as far as the
+    indexes and statistics tell). "complete" means every CRC the file carries is right
+    (chunks, attachments, summary, data section) and every index, the statistics and the
+    summary copies agree with the records. With --recover OUT, copy what is readable into
+    a new log: damaged records are skipped up to the next valid one, channels whose
+    definition is damaged are read with their summary copy, and the readable prefix of a
+    cut or damaged compressed chunk is decoded.
 
-    Exit code 0 for a complete file, 1 for a truncated or corrupt one (also after a
-    successful recovery), 2 for a usage error.
+    A file whose writer wrote no CRCs over its messages (many ROS 2 recordings) is at best
+    "unverified": nothing is found wrong, but damage inside a message cannot be seen.
+
+    Exit code 0 for a complete or unverified file, 1 for a truncated or corrupt one (also
+    after a successful recovery), 2 for a usage error.
     """
+    found = [] if Path(log).exists() else partial_files(log)
+    if found:  # a killed writer leaves LOG.XXXXXXXX.partial, never LOG
+        raise SgtoolError(f"{log} does not exist; partial files: "
+                          f"{', '.join(map(str, found))} (recover one with: sgtool doctor "
+                          f"{found[0]} --recover {log})")
     d = recover(log, out, overwrite=force) if out else scan(log)
     if as_json:
         click.echo(json.dumps(d.as_dict() | ({"recovered_to": out} if out else {}), indent=2))
@@ -51,7 +91,11 @@ def command(log: str, out: str | None, force: bool, as_json: bool) -> None:
         click.echo(_report(d))
         if out:
             click.echo(f"recovered {d.readable_messages} messages into {out}")
+        elif d.status == "unverified":
+            click.echo("unverified: every record reads and every index agrees, but the "
+                       "writer wrote no CRCs over (some of) the messages, so damage inside "
+                       "them cannot be detected")
         elif d.status != "complete":
             click.echo(f"recover with: sgtool doctor {log} --recover OUT.mcap")
-    if d.status != "complete":
+    if d.status not in ("complete", "unverified"):
         raise click.exceptions.Exit(1)

@@ -38,7 +38,14 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
     sgtool.Episode and sgtool.Action records) and/or episodes.jsonl files written by
     `sgtool bench`. With --planner, replay every logged decision point of the MCAP logs:
     the planner decides on the logged scene graph, its choice is compared with the logged
-    action, and it is then told what was really done."""
+    action, and it is then told what was really done.
+
+    Only search episodes are scored: logs of recordings and imports are skipped with a note.
+    An episode whose figures cannot be true (negative steps or counts, a negative or
+    non-finite travelled_m or shortest_m) is refused: it is left out of every metric and a
+    one-line note on stderr names the file, the episode and the field (the JSON output
+    lists the notes too). A shortest_m of 0 is accepted: the target is seen from the
+    start."""
     from sgtool.analysis.metrics import cost_models, seen_unseen, summarize
     from sgtool.analysis.offline import format_offline, load_results, replay_decisions
     from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
@@ -46,9 +53,13 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
     from sgtool.files import atomic_write
     from sgtool.planning.registry import make_planner
 
-    results, logged = load_results(inputs)
+    notes: list[str] = []
+    results, logged = load_results(inputs, notes)
+    for note in notes:
+        click.echo(f"sgtool: note: {note}", err=True)
     if not results:
-        raise SgtoolError("no episodes found in " + ", ".join(inputs))
+        why = f" ({len(notes)} skipped or refused, see the notes)" if notes else ""
+        raise SgtoolError("no search episodes to score in " + ", ".join(inputs) + why)
     models = cost_models(distance_budget, step_budget)
     sums = summarize(results, models)
     names = [n.strip() for item in planners for n in item.split(",") if n.strip()]
@@ -63,6 +74,7 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
     if as_json or (out and out.endswith(".json")):
         doc: dict[str, Any] = {
             "episodes": len(results),
+            "notes": notes,
             "budgets": {m.name: {"max": m.max_cost, "cost": m.label} for m in models},
             "planners": summary_dict(sums),
             "seen_unseen": [asdict(s) for s in seen_unseen(results)],

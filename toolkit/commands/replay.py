@@ -58,6 +58,16 @@ def command(log: str, output: str | None, every: int | None, classifier: str | N
     The graph refreshes every K frames and at every logged action; a closed door or
     container that opens drops its old voxels. Logs without instance ids (imported real
     data) give geometry only. Example: `sgtool replay run.mcap -o derived.mcap --score`.
+
+    Inconsistent sensor data is refused (exit 2, one error naming the channel, the log
+    time and the field), never guessed at: a transform that is not finite or whose
+    quaternion is zero; a calibration with a short K or a focal length that is not
+    positive; a depth image with no calibration before it (no field of view is assumed);
+    a depth image whose size differs from the calibration, or RGB/instance images whose
+    size differs from the depth image; zero-size images or image data that does not match
+    width x step; instance ids in a non-integer encoding; two images of one channel at one
+    log time (frames are told apart by log time, so they would merge). A damaged log is
+    refused too; `sgtool doctor LOG --recover OUT` copies what is readable.
     """
     from tqdm import tqdm
 

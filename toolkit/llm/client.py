@@ -18,6 +18,15 @@ API key          ``api_key``              ``SGTOOL_LLM_API_KEY``, ``OPENAI_API_K
 ===============  =======================  ======================
 
 A local server (llama.cpp, vLLM, Ollama) needs no key; a placeholder is sent then.
+
+Replies are read tolerantly: any reply that does not hold ``choices[0].message.content``
+as text (``choices`` an object, empty, missing; token counts that are no integers) is a
+retryable :class:`LlmTransportError` with a one-line reason. A reply longer than
+:data:`MAX_REPLY_CHARS` is cut there (:attr:`ChatResult.truncated_from` keeps its length),
+so a runaway endpoint cannot fill the log or the transcript. The API key never appears in
+an error message (:mod:`sgtool.redact`). :meth:`OpenAIChatClient.complete` takes a
+``timeout_s`` for this one request, so a caller can keep a deadline over several attempts
+(:func:`complete_within`).
 """
 
 from __future__ import annotations
@@ -25,12 +34,15 @@ from __future__ import annotations
 import os
 import time
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 from sgtool.errors import SgtoolError
 from sgtool.llm.exchange import Message
+from sgtool.redact import redact_text
 
 DEFAULT_MODEL = "gpt-5-mini"  # SCOUT's choice for its MoMa-LLM baseline (sec. VI-D)
+DEFAULT_TIMEOUT_S = 30.0  # one request; a decision has its own deadline over all attempts
+MAX_REPLY_CHARS = 64 * 1024  # longer replies are cut (a valid answer is a few hundred)
 
 
 class LlmConfigError(SgtoolError):
@@ -54,6 +66,7 @@ class ChatResult:
     prompt_tokens: int | None = None
     completion_tokens: int | None = None
     source: str = "endpoint"
+    truncated_from: int | None = None  # the reply's length in characters when it was cut
 
 
 class ChatClient(Protocol):
@@ -62,12 +75,25 @@ class ChatClient(Protocol):
     def complete(self, messages: list[Message]) -> ChatResult: ...
 
 
+def complete_within(client: ChatClient, messages: list[Message], timeout_s: float) -> ChatResult:
+    """``client.complete(messages)``, bounded by ``timeout_s`` when the client takes a
+    per-request timeout (``takes_timeout``); other clients (a replay) answer at once."""
+    if getattr(client, "takes_timeout", False):
+        return client.complete(messages, timeout_s=timeout_s)  # type: ignore[call-arg]
+    return client.complete(messages)
+
+
+def cut_reply(text: str, limit: int = MAX_REPLY_CHARS) -> tuple[str, int | None]:
+    """``text`` cut to ``limit`` characters, and its full length when it was cut."""
+    return (text, None) if len(text) <= limit else (text[:limit], len(text))
+
+
 @dataclass(frozen=True)
 class LlmSettings:
     base_url: str | None
     model: str
     api_key: str | None
-    timeout_s: float = 60.0
+    timeout_s: float = DEFAULT_TIMEOUT_S
     # None: not sent (the server's default). Reasoning models such as gpt-5-mini refuse any
     # temperature but 1, so a fixed 0 would break them; pass 0 for local models.
     temperature: float | None = None
@@ -79,7 +105,7 @@ class LlmSettings:
         base_url: str | None = None,
         model: str | None = None,
         api_key: str | None = None,
-        timeout_s: float = 60.0,
+        timeout_s: float = DEFAULT_TIMEOUT_S,
         temperature: float | None = None,
         max_tokens: int | None = None,
     ) -> LlmSettings:
@@ -94,15 +120,21 @@ class LlmSettings:
                 "eval and run; --llm-base-url for distill), or replay a recorded transcript "
                 "with --llm-replay FILE"
             )
-        if timeout_s <= 0:
+        try:
+            timeout = float(timeout_s)
+        except (TypeError, ValueError):
+            raise LlmConfigError(f"LLM timeout must be a number of seconds, got {timeout_s!r}") \
+                from None
+        if not timeout > 0:
             raise LlmConfigError(f"LLM timeout must be > 0 s, got {timeout_s}")
-        return cls(base_url, model, api_key, float(timeout_s), temperature, max_tokens)
+        return cls(base_url, model, api_key, timeout, temperature, max_tokens)
 
 
 class OpenAIChatClient:
     """One chat-completion request per :meth:`complete` call."""
 
     source = "endpoint"
+    takes_timeout = True
 
     def __init__(self, settings: LlmSettings) -> None:
         from openai import OpenAI
@@ -119,12 +151,18 @@ class OpenAIChatClient:
 
     @property
     def where(self) -> str:
-        return self.settings.base_url or "api.openai.com"
+        return redact_text(self.settings.base_url or "api.openai.com")
 
-    def complete(self, messages: list[Message]) -> ChatResult:
+    def _short(self, e: BaseException) -> str:
+        return redact_text(_short(e), [self.settings.api_key])
+
+    def complete(self, messages: list[Message], timeout_s: float | None = None) -> ChatResult:
+        """One request; ``timeout_s`` (at most the settings' timeout) bounds this one."""
         import openai
 
-        kwargs: dict = {"model": self.model, "messages": messages}
+        timeout = self.settings.timeout_s if timeout_s is None \
+            else max(0.001, min(float(timeout_s), self.settings.timeout_s))
+        kwargs: dict = {"model": self.model, "messages": messages, "timeout": timeout}
         if self.settings.temperature is not None:
             kwargs["temperature"] = self.settings.temperature
         if self.settings.max_tokens is not None:
@@ -133,41 +171,79 @@ class OpenAIChatClient:
         try:
             resp = self._client.chat.completions.create(**kwargs)
         except openai.APITimeoutError as e:
-            raise LlmTransportError(
-                f"{self.where}: no reply within {self.settings.timeout_s:g} s"
-            ) from e
+            raise LlmTransportError(f"{self.where}: no reply within {timeout:g} s") from e
         except openai.APIStatusError as e:
             self.replies += 1
-            raise LlmTransportError(f"{self.where}: HTTP {e.status_code}: {_short(e)}") from e
+            raise LlmTransportError(
+                f"{self.where}: HTTP {e.status_code}: {self._short(e)}") from e
         except openai.APIConnectionError as e:
             if not self.replies:
                 # never reached at all: a wrong address, not a fault to retry around
                 raise LlmUnreachableError(
-                    f"cannot reach the LLM endpoint {self.where}: {_short(e)}; check "
+                    f"cannot reach the LLM endpoint {self.where}: {self._short(e)}; check "
                     "SGTOOL_LLM_BASE_URL / base_url, or replay a transcript with --llm-replay"
                 ) from e
-            raise LlmTransportError(f"{self.where}: connection failed: {_short(e)}") from e
-        except (openai.OpenAIError, ValueError, KeyError, TypeError) as e:
-            # malformed JSON body (ValueError from the decoder), unexpected structure
+            raise LlmTransportError(f"{self.where}: connection failed: {self._short(e)}") from e
+        except Exception as e:  # noqa: BLE001 - any malformed reply is a retryable fault
             raise LlmTransportError(
-                f"{self.where}: unusable reply: {type(e).__name__}: {_short(e)}"
+                f"{self.where}: unusable reply: {type(e).__name__}: {self._short(e)}"
             ) from e
         latency = time.perf_counter() - t0
         self.replies += 1
-        try:
-            text = resp.choices[0].message.content
-        except (AttributeError, IndexError, TypeError) as e:
-            raise LlmTransportError(f"{self.where}: reply has no choices/message") from e
-        if not isinstance(text, str):
-            raise LlmTransportError(f"{self.where}: reply has no text content")
-        usage = getattr(resp, "usage", None)
+        text = reply_text(resp, self.where)
+        text, full = cut_reply(text)
+        usage = _field(resp, "usage")
         return ChatResult(
             text=text,
-            model=str(getattr(resp, "model", None) or self.model),
+            model=_text_or(_field(resp, "model"), self.model),
             latency_s=latency,
-            prompt_tokens=getattr(usage, "prompt_tokens", None) if usage else None,
-            completion_tokens=getattr(usage, "completion_tokens", None) if usage else None,
+            prompt_tokens=_count(_field(usage, "prompt_tokens")),
+            completion_tokens=_count(_field(usage, "completion_tokens")),
+            truncated_from=full,
         )
+
+
+def reply_text(resp: Any, where: str = "the endpoint") -> str:
+    """``choices[0].message.content`` of a chat reply (an object or plain dicts), or a
+    :class:`LlmTransportError` naming what is missing."""
+    choices = _field(resp, "choices")
+    if not isinstance(choices, list | tuple):
+        raise LlmTransportError(
+            f"{where}: unusable reply: 'choices' is {_kind(choices)}, not a list")
+    if not choices:
+        raise LlmTransportError(f"{where}: unusable reply: 'choices' is empty")
+    message = _field(choices[0], "message")
+    if message is None:
+        raise LlmTransportError(f"{where}: unusable reply: choices[0] has no message")
+    text = _field(message, "content")
+    if not isinstance(text, str):
+        raise LlmTransportError(
+            f"{where}: unusable reply: the message content is {_kind(text)}, not text")
+    return text
+
+
+def _field(obj: Any, name: str) -> Any:
+    """``obj.name`` or ``obj[name]``; None when it has neither (or raises on access)."""
+    if obj is None:
+        return None
+    try:
+        if isinstance(obj, dict):
+            return obj.get(name)
+        return getattr(obj, name, None)
+    except Exception:  # noqa: BLE001 - a property of a malformed reply
+        return None
+
+
+def _kind(v: Any) -> str:
+    return "missing" if v is None else f"a {type(v).__name__}"
+
+
+def _count(v: Any) -> int | None:
+    return v if isinstance(v, int) and not isinstance(v, bool) and v >= 0 else None
+
+
+def _text_or(v: Any, default: str) -> str:
+    return v if isinstance(v, str) and v else default
 
 
 def _short(e: BaseException, limit: int = 200) -> str:

@@ -4,7 +4,9 @@
 the same dict goes to the MCAP log (``LogWriter.write_record(LlmExchange.from_json(d), t)``)
 and, one JSON object per line, to a transcript file that ``--llm-replay`` serves back. The
 fields required by the log schema are ``model`` and ``messages``; ``prompt_sha256`` keys a
-response to its prompt for replay (:mod:`sgtool.llm.recorded`).
+response to its prompt for replay (:mod:`sgtool.llm.recorded`). A reply the client cut
+(:data:`sgtool.llm.client.MAX_REPLY_CHARS`) records its full length in
+``response_truncated_from``; messages are redacted of the secrets the caller names.
 """
 
 from __future__ import annotations
@@ -38,11 +40,13 @@ def exchange_record(
     step: int | None = None,
     query: str | None = None,
     source: str = "endpoint",
+    truncated_from: int | None = None,
 ) -> dict[str, Any]:
     """A JSON-serialisable ``sgtool.LlmExchange`` record.
 
     ``attempt`` counts retries within one decision (0 = first try); ``step`` is the decision
-    number within the episode; ``source`` is ``endpoint`` or ``replay``.
+    number within the episode; ``source`` is ``endpoint`` or ``replay``;
+    ``truncated_from`` the length of a reply that was cut to ``response``.
     """
     return LlmExchange(
         model=str(model),
@@ -57,4 +61,5 @@ def exchange_record(
         step=step,
         query=query,
         source=source,
+        unknown={} if truncated_from is None else {"response_truncated_from": int(truncated_from)},
     ).to_json()

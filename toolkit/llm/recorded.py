@@ -11,6 +11,7 @@ into a clear failure instead of a guess.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import os
@@ -20,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from sgtool.errors import LogFormatError, SgtoolError
+from sgtool.files import output_error, temp_beside
 from sgtool.llm.client import ChatResult, LlmTransportError
 from sgtool.llm.exchange import Message, prompt_key
 from sgtool.log.records import LlmExchange
@@ -40,34 +42,60 @@ class TranscriptWriter:
 
     ``append=True`` (what planners use) adds to an existing transcript, so the episodes of
     a benchmark run collect in one file and a crash loses at most the line being written.
-    ``append=False`` writes a fresh file through ``path.partial``, renamed on :meth:`close`,
-    so an interrupted run never leaves a file that looks complete.
+    ``append=False`` writes a fresh file through a uniquely named ``.NAME.XXXXXXXX.partial``
+    beside it (:func:`sgtool.files.temp_beside`), renamed on :meth:`close`, so an
+    interrupted run never leaves a file that looks complete; an exception inside ``with``
+    removes it. A destination that cannot be written is an :class:`~sgtool.files.OutputError`.
     """
 
     def __init__(self, path: str | Path, append: bool = True) -> None:
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
         self.append = append
-        self._tmp = self.path if append else self.path.with_name(self.path.name + ".partial")
-        self._fh = open(self._tmp, "a" if append else "w", encoding="utf-8")  # noqa: SIM115
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            if append:
+                self._tmp = self.path
+                self._fh = open(self.path, "a", encoding="utf-8")  # noqa: SIM115
+            else:
+                fd, self._tmp = temp_beside(self.path)
+                self._fh = os.fdopen(fd, "w", encoding="utf-8")
+        except OSError as e:
+            raise output_error(e, self.path) from None
         self.count = 0
 
     def write(self, record: dict[str, Any]) -> None:
-        self._fh.write(json.dumps(record, sort_keys=True, ensure_ascii=False) + "\n")
-        self._fh.flush()
+        try:
+            self._fh.write(json.dumps(record, sort_keys=True, ensure_ascii=False) + "\n")
+            self._fh.flush()
+        except OSError as e:
+            raise output_error(e, self.path, "the transcript keeps the lines before") from None
         self.count += 1
 
     def close(self) -> None:
         if not self._fh.closed:
+            try:
+                self._fh.close()
+                if not self.append:
+                    os.replace(self._tmp, self.path)
+            except OSError as e:
+                self.abort()
+                raise output_error(e, self.path) from None
+
+    def abort(self) -> None:
+        """Close; a fresh transcript (``append=False``) is removed."""
+        with contextlib.suppress(OSError):
             self._fh.close()
-            if not self.append:
-                os.replace(self._tmp, self.path)
+        if not self.append:
+            self._tmp.unlink(missing_ok=True)
 
     def __enter__(self) -> TranscriptWriter:
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    def __exit__(self, exc_type: object, *exc: object) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
 
 
 def read_transcript(path: str | Path) -> list[dict[str, Any]]:

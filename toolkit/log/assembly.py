@@ -9,13 +9,17 @@ from the ``/tf`` transforms (world -> ... -> camera) in force at that time. The 
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable
+from typing import Any, TypeVar
 
 import numpy as np
 
+from sgtool.errors import LogFormatError
 from sgtool.log import codec
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics, Frame
+
+T = TypeVar("T")
 
 
 class TransformBuffer:
@@ -57,6 +61,17 @@ class TransformBuffer:
 
 
 FRAME_TOPICS = (S.RGB, S.DEPTH, S.IDS, S.CALIBRATION, S.TF)
+_IMAGES = {S.DEPTH: "depth", S.RGB: "rgb", S.IDS: "ids"}
+
+
+def decoded(where: str, topic: str, t_ns: int, fn: Callable[[Any], T], message: Any) -> T:
+    """``fn(message)``, with a :class:`LogFormatError` of ``fn`` naming the source, the
+    channel and the log time as well as the field."""
+    try:
+        return fn(message)
+    except LogFormatError as e:
+        prefix = f"{where}: " if where else ""
+        raise LogFormatError(f"{prefix}{topic} message at {t_ns} ns: {e}") from None
 
 
 class FrameAssembler:
@@ -66,13 +81,21 @@ class FrameAssembler:
 
     :meth:`push` returns the previous frame when a message of a new log time arrives;
     :meth:`flush` returns the frame being assembled (when it has its depth image), so a
-    caller that meets another record of the same time can take the frame first."""
+    caller that meets another record of the same time can take the frame first.
+
+    Inconsistent sensor data is refused with a :class:`LogFormatError` naming ``where``
+    (the log), the channel, the log time and the field: a transform that is not finite or
+    whose quaternion cannot be normalised, a calibration with a short K or a focal length
+    that is not positive, a depth image with no calibration before it, images whose size
+    differs from the calibration's or from each other, zero-size images, instance ids in
+    a non-integer encoding, two images of one channel at one log time."""
 
     def __init__(self, index: int = 0, transforms: TransformBuffer | None = None,
-                 calibration: CameraIntrinsics | None = None) -> None:
+                 calibration: CameraIntrinsics | None = None, where: str = "") -> None:
         self.index = index
         self.transforms = transforms or TransformBuffer()
         self.calibration = calibration
+        self.where = where
         self._pending: dict[str, Any] = {}
         self._t: int | None = None
 
@@ -83,17 +106,22 @@ class FrameAssembler:
             self._pending = {}
         self._t = t_ns
         if topic == S.TF:
-            self.transforms.add(t_ns, message.parent_frame_id, message.child_frame_id,
-                                codec.decode_transform(message))
+            T = decoded(self.where, topic, t_ns, codec.decode_transform, message)  # noqa: N806
+            self.transforms.add(t_ns, message.parent_frame_id, message.child_frame_id, T)
         elif topic == S.CALIBRATION:
-            self.calibration = codec.decode_calibration(message)
-        elif topic == S.DEPTH:
-            self._pending["depth"] = message
-        elif topic == S.RGB:
-            self._pending["rgb"] = message
-        elif topic == S.IDS:
-            self._pending["ids"] = message
+            self.calibration = decoded(self.where, topic, t_ns, codec.decode_calibration,
+                                       message)
+        elif topic in _IMAGES:
+            key = _IMAGES[topic]
+            if key in self._pending:
+                self._fail(topic, t_ns, "a second image of this channel at the same log "
+                           "time (each frame needs its own log time)")
+            self._pending[key] = message
         return out
+
+    def _fail(self, topic: str, t_ns: int, why: str) -> None:
+        prefix = f"{self.where}: " if self.where else ""
+        raise LogFormatError(f"{prefix}{topic} message at {t_ns} ns: {why}")
 
     def flush(self) -> Frame | None:
         """The frame of the current log time, if its depth image has arrived (it is then
@@ -103,24 +131,31 @@ class FrameAssembler:
             return None
         self._pending = {}
         depth_msg = pending["depth"]
-        k = self.calibration or _fallback_intrinsics(depth_msg)
+        k = self.calibration
+        if k is None:
+            self._fail(S.DEPTH, t, f"no camera calibration ({S.CALIBRATION}) before it")
+        assert k is not None
+        depth = decoded(self.where, S.DEPTH, t, codec.depth_from_image, depth_msg)
+        if depth.shape != (k.height, k.width):
+            self._fail(S.DEPTH, t, f"fields width/height: {depth.shape[1]}x{depth.shape[0]} "
+                       f"pixels, the camera calibration says {k.width}x{k.height}")
+        rgb = ids = None
+        if "rgb" in pending:
+            rgb = decoded(self.where, S.RGB, t, codec.decode_image, pending["rgb"])
+        if "ids" in pending:
+            if pending["ids"].encoding not in codec.INTEGER_ENCODINGS:
+                self._fail(S.IDS, t, f"field encoding: instance ids must be integers, not "
+                           f"{pending['ids'].encoding[:40]!r}")
+            ids = decoded(self.where, S.IDS, t, codec.decode_image,
+                          pending["ids"]).astype(np.int32)
+        for topic, img in ((S.RGB, rgb), (S.IDS, ids)):
+            if img is not None and img.shape[:2] != depth.shape:
+                self._fail(topic, t, f"fields width/height: {img.shape[1]}x{img.shape[0]} "
+                           f"pixels, the depth image is {depth.shape[1]}x{depth.shape[0]}")
         pose = self.transforms.lookup(t, depth_msg.frame_id or S.CAMERA_FRAME)
         if pose is None:
             pose = np.full((4, 4), np.nan)
-        fr = Frame(
-            index=self.index,
-            time_ns=t,
-            rgb=codec.decode_image(pending["rgb"]) if "rgb" in pending else None,
-            depth=codec.depth_from_image(depth_msg),
-            ids=codec.decode_image(pending["ids"]).astype(np.int32)
-            if "ids" in pending else None,
-            pose=pose,
-            intrinsics=k,
-            base_pose=self.transforms.lookup(t, S.BASE_FRAME),
-        )
+        fr = Frame(index=self.index, time_ns=t, rgb=rgb, depth=depth, ids=ids, pose=pose,
+                   intrinsics=k, base_pose=self.transforms.lookup(t, S.BASE_FRAME))
         self.index += 1
         return fr
-
-
-def _fallback_intrinsics(depth_msg: Any) -> CameraIntrinsics:
-    return CameraIntrinsics.from_fov(int(depth_msg.width), int(depth_msg.height), 60.0)

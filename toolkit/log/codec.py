@@ -10,6 +10,7 @@ from foxglove_schemas_protobuf.PackedElementField_pb2 import PackedElementField
 from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
 from google.protobuf.timestamp_pb2 import Timestamp
 
+from sgtool.errors import LogFormatError
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
 
@@ -44,11 +45,25 @@ def encode_image(t_ns: int, arr: np.ndarray, encoding: str, frame_id: str) -> Ra
     )
 
 
+INTEGER_ENCODINGS = frozenset({"mono8", "8UC1", "mono16", "16UC1", "32SC1"})
+
+
 def decode_image(msg: RawImage) -> np.ndarray:
+    """The pixels of ``msg``; :class:`LogFormatError` (naming the field) when its
+    encoding, size, step and data disagree."""
     if msg.encoding not in _DTYPES:
-        raise ValueError(f"unsupported image encoding {msg.encoding!r}")
+        raise LogFormatError(f"field encoding: unsupported image encoding "
+                             f"{msg.encoding[:40]!r}")
     dtype, channels = _DTYPES[msg.encoding]
+    if msg.width <= 0 or msg.height <= 0:
+        raise LogFormatError(f"fields width/height: image of {msg.width}x{msg.height} pixels")
     row = msg.width * channels * dtype.itemsize
+    if msg.step < row:
+        raise LogFormatError(f"field step: {msg.step} bytes, a row of {msg.width} "
+                             f"{msg.encoding} pixels takes {row}")
+    if len(msg.data) != msg.step * msg.height:
+        raise LogFormatError(f"field data: {len(msg.data)} bytes, {msg.height} rows of "
+                             f"{msg.step} bytes (step) take {msg.step * msg.height}")
     buf = np.frombuffer(msg.data, dtype=np.uint8)
     if msg.step != row:  # rows padded
         buf = buf.reshape(msg.height, msg.step)[:, :row].copy()
@@ -89,7 +104,17 @@ def encode_calibration(t_ns: int, k: CameraIntrinsics, frame_id: str) -> CameraC
 
 
 def decode_calibration(msg: CameraCalibration) -> CameraIntrinsics:
+    """Pinhole intrinsics of ``msg``; :class:`LogFormatError` (naming the field) unless K
+    has 9 finite values, positive focal lengths and the image a positive size."""
     K = list(msg.K)  # noqa: N806
+    if len(K) != 9:
+        raise LogFormatError(f"field K: {len(K)} values, a 3x3 matrix has 9")
+    if not all(np.isfinite(K)):
+        raise LogFormatError("field K: values that are not finite")
+    if not (K[0] > 0 and K[4] > 0):
+        raise LogFormatError(f"field K: focal lengths fx {K[0]}, fy {K[4]} (must be > 0)")
+    if msg.width <= 0 or msg.height <= 0:
+        raise LogFormatError(f"fields width/height: {msg.width}x{msg.height} pixels")
     return CameraIntrinsics(int(msg.width), int(msg.height), K[0], K[4], K[2], K[5])
 
 
@@ -145,8 +170,17 @@ def encode_transform(t_ns: int, parent: str, child: str, T: np.ndarray) -> Frame
 
 
 def decode_transform(msg: FrameTransform) -> np.ndarray:
+    """parent_T_child of ``msg``; :class:`LogFormatError` (naming the field) when the
+    translation is not finite or the rotation is not a quaternion that can be normalised
+    (a zero quaternion is no rotation, not the identity)."""
+    t, r = msg.translation, msg.rotation
+    if not np.all(np.isfinite([t.x, t.y, t.z])):
+        raise LogFormatError(f"field translation: ({t.x}, {t.y}, {t.z}) is not finite")
+    q = np.array([r.x, r.y, r.z, r.w])
+    if not np.all(np.isfinite(q)) or not np.linalg.norm(q) > 1e-6:
+        raise LogFormatError(f"field rotation: quaternion ({r.x}, {r.y}, {r.z}, {r.w}) "
+                             "cannot be normalised")
     T = np.eye(4)  # noqa: N806
-    r = msg.rotation
     T[:3, :3] = matrix_from_quat(r.x, r.y, r.z, r.w)
     T[:3, 3] = (msg.translation.x, msg.translation.y, msg.translation.z)
     return T
@@ -173,7 +207,10 @@ def encode_grid(
 
 def decode_grid(msg: Grid) -> tuple[np.ndarray, tuple[float, float], float]:
     w = int(msg.column_count)
-    h = len(msg.data) // max(int(msg.row_stride), 1)
+    if not 0 < w <= msg.row_stride or len(msg.data) % msg.row_stride:
+        raise LogFormatError(f"fields column_count/row_stride/data: {w} columns, rows of "
+                             f"{msg.row_stride} bytes, {len(msg.data)} bytes of data")
+    h = len(msg.data) // int(msg.row_stride)
     a = np.frombuffer(msg.data, dtype=np.int8).reshape(h, msg.row_stride)[:, :w].copy()
     return a, (msg.pose.position.x, msg.pose.position.y), float(msg.cell_size.x)
 

@@ -11,7 +11,9 @@ import os
 from pathlib import Path
 from typing import Any
 
+from sgtool.log import codec
 from sgtool.log import schemas as S
+from sgtool.log.assembly import decoded
 from sgtool.log.reader import LogReader
 
 
@@ -64,8 +66,10 @@ def summarize(path: str | os.PathLike[str]) -> dict[str, Any]:
         out["frames"] = r.frame_count()
         if out["frames"] and r.has(S.CALIBRATION):
             for d in r.messages([S.CALIBRATION]):
-                out["camera"] = {"width": d.message.width, "height": d.message.height,
-                                 "fx": round(d.message.K[0], 3), "fy": round(d.message.K[4], 3)}
+                k = decoded(str(p), d.topic, d.log_time_ns, codec.decode_calibration,
+                            d.message)
+                out["camera"] = {"width": k.width, "height": k.height,
+                                 "fx": round(k.fx, 3), "fy": round(k.fy, 3)}
                 break
         out["has_rgb"] = r.has(S.RGB)
         out["has_instance_ids"] = r.has(S.IDS)

@@ -13,26 +13,27 @@ from the ``/tf`` transforms (world -> ... -> camera) in force at that time.
 
 from __future__ import annotations
 
+import io
 import json
 import os
-import struct
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any, TypeVar, overload
 
-import zstandard
 from mcap.exceptions import InvalidMagic, McapError
 from mcap.reader import SeekingReader
-from mcap.records import Channel, Message, Schema
+from mcap.records import Attachment, Channel, Message, Schema
 from mcap.summary import Summary
 
-from sgtool.errors import LogFormatError, MissingChannelError, SchemaVersionError
+from sgtool.errors import LogFormatError, MissingChannelError, SchemaVersionError, SgtoolError
 from sgtool.log import codec
 from sgtool.log import schemas as S
-from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler, TransformBuffer
+from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler, TransformBuffer, decoded
 from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.log.records import RECORD_TYPES, LogRecord
+from sgtool.log.summary_check import BoundedReader as _BoundedReader
+from sgtool.log.summary_check import check_summary, read_attachment
 
 R = TypeVar("R", bound=LogRecord)
 
@@ -99,7 +100,9 @@ class LogReader:
                     f"being written); `sgtool doctor {self.path} --recover OUT.mcap` copies "
                     "what is readable into a valid log"
                 )
-        self._f: IO[bytes] = open(self.path, "rb")  # noqa: SIM115
+        self.size = size
+        # reads are clamped to the file: a damaged length cannot allocate gigabytes
+        self._f: IO[bytes] = _BoundedReader(io.FileIO(self.path, "rb"), size)
         try:
             # chunk CRCs are checked as chunks are read: damaged bytes give a clear error
             self._reader = SeekingReader(self._f, validate_crcs=True)
@@ -129,9 +132,20 @@ class LogReader:
                 f"written); recover it with `sgtool doctor {self.path} --recover OUT.mcap`"
             )
         self.summary: Summary = summary
-        self.metadata: dict[str, dict[str, str]] = {
-            m.name: dict(m.metadata) for m in self._reader.iter_metadata()
-        }
+        try:
+            check_summary(self._f, size, summary)
+            self.metadata: dict[str, dict[str, str]] = {
+                m.name: dict(m.metadata) for m in self._reader.iter_metadata()
+            }
+        except LogFormatError as e:
+            self._f.close()
+            raise LogFormatError(f"{self.path}: {e}; `sgtool doctor {self.path}` says what "
+                                 "is readable and --recover copies it") from None
+        except Exception as e:  # noqa: BLE001 - the mcap library on damaged records
+            self._f.close()
+            raise LogFormatError(
+                f"{self.path}: damaged metadata ({type(e).__name__}); `sgtool doctor "
+                f"{self.path}` says what is readable") from None
         self._decoders: dict[int, Any] = {}
         self._frame_times: list[int] | None = None
         if check_version:
@@ -157,7 +171,11 @@ class LogReader:
     @property
     def seed(self) -> int | None:
         s = self.metadata.get(S.METADATA_NAME, {}).get("seed", "")
-        return int(s) if s else None
+        try:
+            return int(s) if s else None
+        except ValueError:
+            raise LogFormatError(f"{self.path}: metadata {S.METADATA_NAME} field seed is "
+                                 f"{s[:40]!r}, not an integer") from None
 
     def check_version(self) -> None:
         v = self.schema_version
@@ -207,42 +225,61 @@ class LogReader:
         return self.message_count(S.DEPTH)
 
     # ----- attachments ----------------------------------------------------------------
+    def iter_attachments(self) -> Iterator[Attachment]:
+        """The attachments, each checked against its CRC."""
+        for ai in self.summary.attachment_indexes:
+            yield read_attachment(self._f, ai, where=str(self.path))
+
     def attachments(self) -> dict[str, bytes]:
-        return {a.name: a.data for a in self._reader.iter_attachments()}
+        return {a.name: a.data for a in self.iter_attachments()}
 
     def attachment(self, name: str) -> bytes | None:
-        for a in self._reader.iter_attachments():
+        for a in self.iter_attachments():
             if a.name == name:
                 return a.data
         return None
 
     def house_json(self) -> str | None:
         data = self.attachment(S.HOUSE_ATTACHMENT)
-        return data.decode() if data is not None else None
+        if data is None:
+            return None
+        try:
+            return data.decode()
+        except UnicodeDecodeError:
+            raise LogFormatError(f"{self.path}: attachment {S.HOUSE_ATTACHMENT} is not "
+                                 "UTF-8 text") from None
 
     # ----- messages ---------------------------------------------------------------------
     def _decode(self, schema: Schema | None, channel: Channel, message: Message) -> Any:
         if channel.message_encoding == "json":
             try:
                 return json.loads(message.data)
-            except ValueError as e:
+            except (ValueError, RecursionError) as e:
                 raise LogFormatError(
                     f"{self.path}: {channel.topic} message at {message.log_time} ns is not "
-                    f"JSON ({e})") from None
+                    f"JSON ({str(e)[:100]})") from None
         if channel.message_encoding == "protobuf" and schema is not None:
-            cls = _proto_class(schema.name)
-            if cls is not None:
-                msg = cls()
-                msg.ParseFromString(message.data)
-                return msg
-            dec = self._decoders.get(channel.id)
-            if dec is None:
-                from mcap_protobuf.decoder import DecoderFactory
-
-                dec = DecoderFactory().decoder_for("protobuf", schema)
-                self._decoders[channel.id] = dec
-            return dec(message.data) if dec else message.data
+            try:
+                return self._decode_protobuf(schema, channel, message)
+            except Exception as e:  # noqa: BLE001 - protobuf's DecodeError and kin
+                raise LogFormatError(
+                    f"{self.path}: {channel.topic} message at {message.log_time} ns is not a "
+                    f"valid {schema.name} ({type(e).__name__}: {str(e)[:80]})") from None
         return message.data
+
+    def _decode_protobuf(self, schema: Schema, channel: Channel, message: Message) -> Any:
+        cls = _proto_class(schema.name)
+        if cls is not None:
+            msg = cls()
+            msg.ParseFromString(message.data)
+            return msg
+        dec = self._decoders.get(channel.id)
+        if dec is None:
+            from mcap_protobuf.decoder import DecoderFactory
+
+            dec = DecoderFactory().decoder_for("protobuf", schema)
+            self._decoders[channel.id] = dec
+        return dec(message.data) if dec else message.data
 
     def messages(
         self,
@@ -307,7 +344,8 @@ class LogReader:
         tf, calib = (self._state_before(start_ns) if start_ns is not None
                      else (TransformBuffer(), None))
         index = self._frame_index_before(start_ns) if start_ns is not None else 0
-        asm = FrameAssembler(index=index, transforms=tf, calibration=calib)
+        asm = FrameAssembler(index=index, transforms=tf, calibration=calib,
+                             where=str(self.path))
         for d in self.messages(FRAME_TOPICS, start_ns=start_ns, end_ns=end_ns):
             fr = asm.push(d.topic, d.log_time_ns, d.message)
             if fr is not None:
@@ -328,8 +366,10 @@ class LogReader:
         :class:`LogFormatError` that points to ``sgtool doctor``."""
         try:
             yield from it
-        except (McapError, ValueError, EOFError, struct.error, RuntimeError,
-                zstandard.ZstdError) as e:  # lz4 reports bad frames as RuntimeError
+        except SgtoolError:
+            raise
+        except Exception as e:  # noqa: BLE001 - McapError, CRC, zstd, lz4 (RuntimeError),
+            # struct.error, KeyError (a message on an undefined channel), MemoryError ...
             raise LogFormatError(
                 f"{self.path}: damaged data ({type(e).__name__}: {str(e)[:120]}); "
                 f"`sgtool doctor {self.path}` says what is readable and --recover copies it"
@@ -348,7 +388,6 @@ class LogReader:
         return self._frame_times
 
     def _index_times(self, topic: str) -> list[int]:
-        import io
 
         from mcap.data_stream import ReadDataStream
         from mcap.records import MessageIndex
@@ -360,8 +399,17 @@ class LogReader:
                 if cid not in cids:
                     continue
                 self._f.seek(offset + 1 + 8, io.SEEK_SET)  # opcode, record length
-                idx = MessageIndex.read(ReadDataStream(self._f))
-                times.extend(int(t) for t, _ in idx.records)
+                try:
+                    idx = MessageIndex.read(ReadDataStream(self._f))
+                except Exception:  # noqa: BLE001 - garbage where the index points
+                    idx = None
+                found = [int(t) for t, _ in idx.records] if idx is not None else []
+                if idx is None or idx.channel_id != cid or any(
+                        not ci.message_start_time <= t <= ci.message_end_time for t in found):
+                    raise LogFormatError(
+                        f"{self.path}: the message index of {topic} at byte {offset} is "
+                        f"damaged; `sgtool doctor {self.path}` says what is readable")
+                times.extend(found)
         times.sort()
         return times
 
@@ -384,7 +432,8 @@ class LogReader:
         tf = TransformBuffer()
         calib = None
         for d in self.messages([S.CALIBRATION], end_ns=t_ns, reverse=True):
-            calib = codec.decode_calibration(d.message)
+            calib = decoded(str(self.path), d.topic, d.log_time_ns, codec.decode_calibration,
+                            d.message)
             break
         # the latest transform of each link before t, newest first, until the camera
         # chain is complete
@@ -394,7 +443,8 @@ class LogReader:
             if child not in seen:
                 seen.add(child)
                 tf.add(d.log_time_ns, d.message.parent_frame_id, child,
-                       codec.decode_transform(d.message))
+                       decoded(str(self.path), d.topic, d.log_time_ns,
+                               codec.decode_transform, d.message))
             if tf.lookup(t_ns, S.CAMERA_FRAME) is not None:
                 break
         return tf, calib

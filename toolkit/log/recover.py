@@ -1,43 +1,43 @@
 """Diagnosing and recovering MCAP files that were cut short or damaged.
 
-:func:`scan` walks the file record by record without trusting its summary: it tells a
-*complete* file (header, data, footer, closing magic, every chunk readable) from a
-*truncated* one (the bytes stop inside or after a record with no footer: a killed
-recorder, a full disk, a copy cut short) and a *corrupt* one (bad magic, a chunk whose CRC
-or compression fails, a record length that makes no sense while bytes remain).
-:func:`recover` writes every complete, readable message (with its schemas, channels,
-attachments and metadata) to a new, indexed MCAP file; it never writes over its input.
+:func:`scan` walks the file record by record without trusting it
+(:mod:`sgtool.log.file_walk`) and cross-checks what it read (:mod:`sgtool.log.file_check`):
+it tells a *complete* file (header, data, summary and footer all there, every CRC the file
+carries right: chunks, attachments, summary, data section; every index and the statistics
+agreeing with the records; CRCs over every message) from an *unverified* one (the same, but
+the writer wrote no CRC over some chunks, so damage inside their messages cannot be
+seen: many ROS 2 recordings), a *truncated* one (the bytes stop inside or after a record
+with no footer: a killed recorder, a full disk, a copy cut short) and a *corrupt* one
+(anything else). :func:`recover` writes every readable message (with its schemas,
+channels, attachments and metadata) to a new, indexed MCAP file and never writes over its
+input. It keeps every intact byte: channels whose definition is damaged in the data section
+are read with their summary copies, a damaged header or record is skipped up to the next
+valid record, the readable prefix of a cut or damaged compressed chunk is decoded; and it
+says what was lost (messages per channel and their time range, from the indexes and the
+statistics).
 """
 
 from __future__ import annotations
 
 import io
+import mmap
 import os
-import struct
+from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
-from mcap.opcode import Opcode
-from mcap.records import Attachment, Channel, Chunk, Footer, Message, Metadata, Schema
-from mcap.stream_reader import MAGIC_SIZE, breakup_chunk
+from mcap.records import Attachment, Channel, Message, Metadata, Schema, Statistics
 from mcap.writer import CompressionType, Writer
 
 from sgtool.errors import LogFormatError, SgtoolError
 from sgtool.files import atomic_open
+from sgtool.log.file_check import SummaryState, check, expected_messages, summary_state
+from sgtool.log.file_walk import Item, Layout, walk
+from sgtool.log.mcap_records import MAGIC
 
-MAGIC = bytes([137, 77, 67, 65, 80, 48, 13, 10])
-Status = Literal["complete", "truncated", "corrupt"]
-
-_RECORD_TYPES = {
-    Opcode.SCHEMA: Schema,
-    Opcode.CHANNEL: Channel,
-    Opcode.ATTACHMENT: Attachment,
-    Opcode.METADATA: Metadata,
-    Opcode.CHUNK: Chunk,
-    Opcode.FOOTER: Footer,
-}
+Status = Literal["complete", "unverified", "truncated", "corrupt"]
 
 
 @dataclass
@@ -53,83 +53,93 @@ class Diagnosis:
     last_good_offset: int = 0  # byte offset after the last record read whole
     first_time_ns: int | None = None
     last_time_ns: int | None = None
+    salvaged_messages: int = 0  # read from damaged chunks: not covered by a CRC
+    lost_messages: int = 0  # that the indexes or statistics know of
+    lost_unknown: bool = False  # some damaged or cut data had no index: more may be lost
+    lost: dict[str, dict[str, int | None]] = field(default_factory=dict)  # per topic
+    checks: dict[str, str] = field(default_factory=dict)  # CRC -> ok | mismatch | ...
 
     def as_dict(self) -> dict[str, object]:
         return dict(self.__dict__)
 
 
-@dataclass(frozen=True)
-class _Item:
-    record: Schema | Channel | Message | Attachment | Metadata
+def _mapped(f: io.BufferedReader, size: int) -> mmap.mmap:
+    return mmap.mmap(f.fileno(), size, access=mmap.ACCESS_READ)
 
 
-def _walk(f: io.BufferedReader, size: int, diag: Diagnosis) -> Iterator[_Item]:
-    """Yield every readable record; fill ``diag`` with what went wrong."""
-    from mcap.data_stream import ReadDataStream
+def _diagnose(buf: mmap.mmap, diag: Diagnosis, writer: _Copier | None) -> None:
+    """Walk ``buf``, copy what is readable to ``writer``, fill ``diag``."""
+    lay = Layout(diag.size)
+    if writer is not None:
+        writer.layout = lay
+    unknown = _consume(walk(buf, lay), diag, writer)
+    read = {c.offset: Counter((cid, t) for cid, t, _ in c.messages if cid not in unknown)
+            for c in lay.chunks}
+    state = summary_state(buf, lay)
+    diag.checks = _checks(lay, state)
+    problems = list(lay.problems) + diag.problems
+    if not lay.corrupt and not lay.truncated:
+        problems += check(buf, lay, state)
+    diag.problems = problems
+    diag.last_good_offset = lay.last_good_offset
+    diag.status = ("corrupt" if lay.corrupt or (problems and not lay.truncated)
+                   else "truncated" if lay.truncated else _verified(lay))
+    diag.lost_chunks = sum(not c.intact for c in lay.chunks)
+    _account_losses(buf, lay, state, read, diag)
 
-    head = f.read(MAGIC_SIZE)
-    if head != MAGIC:
-        diag.status = "corrupt"
-        diag.problems.append("does not start with the MCAP magic bytes: not an MCAP file")
-        return
-    pos = MAGIC_SIZE
-    diag.last_good_offset = pos
-    saw_footer = False
-    while True:
-        if pos == size:
-            break
-        if size - pos < 9:
-            diag.status = "truncated"
-            diag.problems.append(f"file ends inside a record header at byte {pos}")
-            return
-        f.seek(pos)
-        opcode, length = struct.unpack("<BQ", f.read(9))
-        body_start = pos + 9
-        if length > size - body_start:
-            # a record that runs past the end: the writer was cut off while writing it
-            diag.status = "truncated"
-            diag.problems.append(
-                f"file ends inside a record (opcode 0x{opcode:02x}, {length} bytes) at byte {pos}"
-            )
-            return
-        body = f.read(length)
-        pos = body_start + length
-        cls = _RECORD_TYPES.get(opcode)
-        if opcode == Opcode.FOOTER:
-            saw_footer = True
-            diag.last_good_offset = pos
-            tail = f.read(MAGIC_SIZE)
-            if tail != MAGIC:
-                diag.status = "truncated" if len(tail) < MAGIC_SIZE else "corrupt"
-                diag.problems.append("footer is not followed by the closing magic bytes")
-            break
-        if cls is None:
-            diag.last_good_offset = pos
-            continue  # data end, indexes, summary records: not needed to recover
-        try:
-            rec = cls.read(ReadDataStream(io.BytesIO(body)))
-        except Exception as e:  # noqa: BLE001 - any parse failure means a damaged record
-            diag.status = "corrupt"
-            diag.problems.append(f"unreadable {cls.__name__} at byte {pos - length - 9}: {e}")
-            if cls is Chunk:
-                diag.lost_chunks += 1
-            continue
-        if isinstance(rec, Chunk):
-            try:
-                inner = breakup_chunk(rec, validate_crc=True)
-            except Exception as e:  # noqa: BLE001
-                diag.status = "corrupt"
-                diag.lost_chunks += 1
-                diag.problems.append(f"chunk at byte {pos - length - 9} is damaged: {e}")
-                continue
-            for r in inner:
-                yield _Item(r)
-        else:
-            yield _Item(rec)
-        diag.last_good_offset = pos
-    if not saw_footer and diag.status == "complete":
-        diag.status = "truncated"
-        diag.problems.append("no footer: the file was not closed (writer killed or still writing)")
+
+def _verified(lay: Layout) -> Status:
+    """"complete" when CRCs cover every message, else "unverified": every record reads and
+    every index agrees, but damage inside the messages of a chunk without a CRC (the
+    writer wrote none) cannot be seen."""
+    if lay.data_end is not None and lay.data_end.record.data_section_crc:
+        return "complete"
+    return "complete" if all(c.header.uncompressed_crc for c in lay.chunks) else "unverified"
+
+
+def _checks(lay: Layout, state: SummaryState) -> dict[str, str]:
+    chunks = [c for c in lay.chunks if c.header.uncompressed_crc]
+    out = {"chunks": f"{sum(c.intact for c in chunks)} of {len(lay.chunks)} verified"
+           if chunks else "no CRCs written"}
+    out["summary"] = ("absent" if not state.present else "not written"
+                      if not state.crc_checked else "ok" if state.crc_ok else "mismatch")
+    if lay.data_end is not None:
+        out["data"] = "written" if lay.data_end.record.data_section_crc else "not written"
+    return out
+
+
+def _account_losses(buf: mmap.mmap, lay: Layout, state: SummaryState,
+                    read: dict[int, Counter[tuple[int, int]]], diag: Diagnosis) -> None:
+    """What the indexes (and the statistics) say is missing from what was read."""
+    expected = expected_messages(buf, lay, state)
+    lost: Counter[tuple[int, int]] = Counter()
+    for off, entries in expected.items():
+        lost += Counter(entries) - read.get(off, Counter())
+    diag.lost_unknown = any(not c.intact and c.offset not in expected for c in lay.chunks)
+    if lay.truncated and not state.trusted:
+        diag.lost_unknown = True
+    names = {**{c.id: c.topic for c in _summary_channels(lay)},
+             **{c.id: c.topic for c in lay.channels.values()}}
+    per: dict[str, dict[str, int | None]] = {}
+    for (cid, t), n in sorted(lost.items()):
+        e = per.setdefault(names.get(cid, f"channel {cid}"),
+                           {"messages": 0, "first_ns": t, "last_ns": t})
+        e["messages"] = int(e["messages"] or 0) + n
+        e["last_ns"] = t
+    stats = [r.record for r in lay.summary_records() if isinstance(r.record, Statistics)]
+    if state.trusted and stats:
+        got: Counter[int] = Counter()
+        for c in read.values():
+            for (cid, _), n in c.items():
+                got[cid] += n
+        for cid, n in stats[0].channel_message_counts.items():
+            missing = int(n) - got[cid]
+            name = names.get(cid, f"channel {cid}")
+            if missing > int(per.get(name, {}).get("messages") or 0):
+                e = per.setdefault(name, {"messages": 0, "first_ns": None, "last_ns": None})
+                e["messages"] = missing
+    diag.lost = per
+    diag.lost_messages = sum(int(e["messages"] or 0) for e in per.values())
 
 
 def scan(path: str | os.PathLike[str]) -> Diagnosis:
@@ -139,8 +149,8 @@ def scan(path: str | os.PathLike[str]) -> Diagnosis:
         raise LogFormatError(f"{p}: no such file")
     _require_magic(p)
     diag = Diagnosis(str(p), p.stat().st_size)
-    with open(p, "rb") as f:
-        _consume(_walk(f, diag.size, diag), diag, None)
+    with open(p, "rb") as f, _mapped(f, diag.size) as buf:
+        _diagnose(buf, diag, None)
     return diag
 
 
@@ -148,51 +158,98 @@ def _require_magic(p: Path) -> None:
     """A file that does not even start like an MCAP file is not a damaged log: say so."""
     with open(p, "rb") as f:
         head = f.read(8)
-    if head != bytes([137, 77, 67, 65, 80, 48, 13, 10]):
+    if head != MAGIC:
         raise LogFormatError(f"{p}: not an MCAP file (it does not start with the MCAP magic "
                              "bytes): there is no log to check or recover")
 
 
-def _consume(items: Iterator[_Item], diag: Diagnosis, writer: _Copier | None) -> None:
+def _summary_channels(lay: Layout) -> list[Channel]:
+    return [r.record for r in lay.summary_records() if isinstance(r.record, Channel)]
+
+
+def _consume(items: Iterator[Item], diag: Diagnosis, writer: _Copier | None) -> set[int]:
+    """Count (and copy) the records of ``items``; messages whose channel is defined
+    nowhere before them wait for the summary copies. Returns the ids of channels defined
+    nowhere (their messages are lost)."""
     schemas: dict[int, Schema] = {}
     channels: dict[int, Channel] = {}
+    spare_schemas: dict[int, Schema] = {}
+    spare_channels: dict[int, Channel] = {}
+    orphans: list[Item] = []
+    seen_channels: set[int] = set()
+
+    def take(it: Item, ch: Channel) -> None:
+        r = it.record
+        schema = schemas.get(ch.schema_id) or spare_schemas.get(ch.schema_id)
+        seen_channels.add(ch.id)
+        diag.readable_messages += 1
+        diag.salvaged_messages += it.source == "salvaged"
+        t = int(r.log_time)
+        diag.first_time_ns = t if diag.first_time_ns is None else min(diag.first_time_ns, t)
+        diag.last_time_ns = t if diag.last_time_ns is None else max(diag.last_time_ns, t)
+        if writer is not None:
+            writer.message(schema, ch, r)
+
     for it in items:
         r = it.record
         if isinstance(r, Schema):
-            schemas[r.id] = r
+            (spare_schemas if it.source == "summary" else schemas).setdefault(r.id, r)
         elif isinstance(r, Channel):
-            if r.id not in channels and writer is not None:
-                writer.channel(schemas.get(r.schema_id), r)
-            channels[r.id] = r
-            diag.channels = len(channels)
+            (spare_channels if it.source == "summary" else channels).setdefault(r.id, r)
         elif isinstance(r, Message):
             ch = channels.get(r.channel_id)
             if ch is None:
-                diag.problems.append(f"message on unknown channel {r.channel_id} skipped")
-                continue
-            diag.readable_messages += 1
-            t = int(r.log_time)
-            diag.first_time_ns = t if diag.first_time_ns is None else min(diag.first_time_ns, t)
-            diag.last_time_ns = t if diag.last_time_ns is None else max(diag.last_time_ns, t)
-            if writer is not None:
-                writer.message(schemas.get(ch.schema_id), ch, r)
-        elif isinstance(r, Attachment):
+                orphans.append(it)
+            else:
+                take(it, ch)
+        elif isinstance(r, Attachment) and it.source == "data":
             diag.attachments += 1
             if writer is not None:
                 writer.attachment(r)
-        elif isinstance(r, Metadata):
+        elif isinstance(r, Metadata) and it.source == "data":
             if writer is not None:
                 writer.metadata(r)
+    unknown: Counter[int] = Counter()
+    taken: Counter[int] = Counter()
+    for it in orphans:
+        cid = it.record.channel_id
+        ch = channels.get(cid) or spare_channels.get(cid)
+        if ch is None:
+            unknown[cid] += 1
+        else:
+            taken[cid] += 1
+            take(it, ch)
+    for cid, n in sorted(taken.items()):
+        diag.problems.append(f"{n} messages of channel {cid} read with the summary's copy "
+                             "of its definition (the data section's is damaged)")
+    for cid, n in sorted(unknown.items()):
+        diag.problems.append(f"{n} messages of channel {cid}, defined nowhere, skipped")
+    if writer is not None:  # channels without messages are kept too
+        for _, ch in sorted({**spare_channels, **channels}.items()):
+            writer.channel(schemas.get(ch.schema_id) or spare_schemas.get(ch.schema_id), ch)
+    diag.channels = len(seen_channels)
+    return set(unknown)
 
 
 class _Copier:
-    """Re-writes records into a fresh, indexed MCAP file, renumbering nothing."""
+    """Re-writes records into a fresh, indexed MCAP file with the input's header (read
+    by the walk before any record is copied), renumbering nothing."""
 
-    def __init__(self, out: io.BufferedWriter, profile: str, library: str) -> None:
-        self.w = Writer(out, compression=CompressionType.ZSTD)
-        self.w.start(profile=profile, library=library)
+    def __init__(self, out: io.BufferedWriter) -> None:
+        self.out = out
+        self.layout: Layout | None = None
+        self._w: Writer | None = None
         self.schema_ids: dict[int, int] = {}
         self.channel_ids: dict[int, int] = {}
+
+    @property
+    def w(self) -> Writer:
+        if self._w is None:
+            h = self.layout.header if self.layout is not None else None
+            self._w = Writer(self.out, compression=CompressionType.ZSTD)
+            self._w.start(profile=h.profile if h else "",
+                          library=h.library if h else "sgtool doctor")
+        return self._w
 
     def channel(self, schema: Schema | None, ch: Channel) -> None:
         if ch.id not in self.channel_ids:
@@ -241,27 +298,8 @@ def recover(path: str | os.PathLike[str], out: str | os.PathLike[str],
     if not dst.parent.exists():
         raise SgtoolError(f"folder {dst.parent} does not exist")
     diag = Diagnosis(str(src), src.stat().st_size)
-    with open(src, "rb") as f, atomic_open(dst, "wb") as o:
-        f.seek(0)
-        header_lib = _header_library(f)
-        f.seek(0)
-        copier = _Copier(o, profile=header_lib[0], library=header_lib[1])
-        _consume(_walk(f, diag.size, diag), diag, copier)
+    with open(src, "rb") as f, _mapped(f, diag.size) as buf, atomic_open(dst, "wb") as o:
+        copier = _Copier(o)
+        _diagnose(buf, diag, copier)
         copier.w.finish()
     return diag
-
-
-def _header_library(f: io.BufferedReader) -> tuple[str, str]:
-    from mcap.data_stream import ReadDataStream
-    from mcap.records import Header
-
-    try:
-        if f.read(MAGIC_SIZE) != MAGIC:
-            return "", "sgtool doctor"
-        opcode, length = struct.unpack("<BQ", f.read(9))
-        if opcode != Opcode.HEADER or length > 1 << 20:
-            return "", "sgtool doctor"
-        h = Header.read(ReadDataStream(io.BytesIO(f.read(length))))
-        return h.profile, h.library
-    except Exception:  # noqa: BLE001
-        return "", "sgtool doctor"

@@ -1,13 +1,23 @@
 """Writing sgtool logs (MCAP).
 
 The writer is crash tolerant and atomic:
-- it writes to ``OUT.partial`` and renames to ``OUT`` only when :meth:`LogWriter.close`
-  succeeds; an exception inside ``with LogWriter(...)`` removes the partial file, so a
-  failed command never leaves a half-written output behind;
+- it writes to a partial file with a unique name beside the output, ``OUT.XXXXXXXX.partial``
+  (``XXXXXXXX``: eight random characters; the pattern is :data:`PARTIAL_GLOB`, listed by
+  :func:`partial_files`), and renames it to ``OUT`` only when :meth:`LogWriter.close`
+  succeeds. Two writers of one output never share a file: each renames its own complete
+  log, and the last rename wins;
+- an exception inside ``with LogWriter(...)`` removes the partial file, so a failed command
+  never leaves a half-written output behind. A destination that cannot be written
+  (read-only or missing folder, full disk) is a one-line
+  :class:`~sgtool.files.OutputError` and leaves nothing behind;
+- Ctrl-C (:class:`KeyboardInterrupt`) keeps the partial file when it holds messages, and
+  re-raises as :class:`InterruptedWrite`, whose text names the file and the
+  ``sgtool doctor`` line that recovers it;
 - it closes and flushes a chunk to the operating system at least every
   ``flush_interval_ns`` of log time (1 s by default) and whenever a chunk exceeds
-  ``chunk_size``; a process killed with SIGKILL leaves ``OUT.partial`` whose complete chunks
-  ``sgtool doctor --recover`` turns into a valid log, losing at most that last interval.
+  ``chunk_size``; a process killed with SIGKILL leaves ``OUT.XXXXXXXX.partial`` whose
+  complete chunks ``sgtool doctor OUT.XXXXXXXX.partial --recover OUT`` turns into a valid
+  log, losing at most that last interval.
 
 Output is deterministic: the same calls give the same bytes (no wall clock is written).
 """
@@ -26,10 +36,41 @@ from mcap_protobuf.schema import build_file_descriptor_set
 
 from sgtool import __version__
 from sgtool.errors import SgtoolError
+from sgtool.files import concerns, output_error, temp_beside
 from sgtool.log import codec
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.records import RECORD_TYPES, LogRecord
+
+PARTIAL_SUFFIX = ".partial"
+PARTIAL_GLOB = "*.????????" + PARTIAL_SUFFIX  # OUT.XXXXXXXX.partial, see the module doc
+
+
+def partial_files(path: str | os.PathLike[str]) -> list[Path]:
+    """The partial files that writers of ``path`` left (killed or interrupted), newest
+    first: ``OUT.XXXXXXXX.partial`` beside ``OUT``."""
+    path = Path(path)
+    if not path.parent.is_dir():
+        return []
+    found = [p for p in path.parent.glob(f"{glob_escape(path.name)}.????????{PARTIAL_SUFFIX}")
+             if p.is_file()]
+    return sorted(found, key=lambda p: (p.stat().st_mtime_ns, p.name), reverse=True)
+
+
+def glob_escape(name: str) -> str:
+    """``name`` with the glob special characters quoted."""
+    return "".join(f"[{c}]" if c in "*?[" else c for c in name)
+
+
+class InterruptedWrite(KeyboardInterrupt):
+    """Ctrl-C while writing a log; ``str()`` says what was kept (the partial file and how
+    to recover it) or that nothing was written."""
+
+    def __init__(self, note: str, partial: Path | None) -> None:
+        super().__init__(note)
+        self.note = note
+        self.partial = partial
+
 
 _COMPRESSION = {
     "zstd": CompressionType.ZSTD,
@@ -68,12 +109,31 @@ class LogWriter:
             raise SgtoolError(f"{self.path} is a folder, not a file name")
         if not self.path.parent.exists():
             raise SgtoolError(f"folder {self.path.parent} does not exist")
-        self.partial_path = self.path.with_name(self.path.name + ".partial")
-        self._stream: IO[bytes] = open(self.partial_path, "wb")  # noqa: SIM115
-        self._mcap = Writer(
-            self._stream, chunk_size=chunk_size, compression=_COMPRESSION[compression]
-        )
-        self._mcap.start(profile=S.PROFILE, library=f"sgtool {__version__}")
+        try:
+            fd, self.partial_path = temp_beside(self.path, PARTIAL_SUFFIX, hidden=False)
+        except OSError as e:
+            raise output_error(e, self.path) from None
+        self._stream: IO[bytes] = os.fdopen(fd, "wb")
+        self._closed = False
+        self.message_count = 0
+        try:
+            self._mcap = Writer(
+                self._stream, chunk_size=chunk_size, compression=_COMPRESSION[compression]
+            )
+            self._mcap.start(profile=S.PROFILE, library=f"sgtool {__version__}")
+            meta = {
+                "sgtool_version": __version__,
+                "log_schema_version": S.format_version(S.LOG_SCHEMA_VERSION),
+                "seed": "" if seed is None else str(int(seed)),
+            }
+            meta.update(metadata or {})
+            self._mcap.add_metadata(S.METADATA_NAME, meta)
+            self._mcap.flush()  # metadata first: even a log killed in its first second has it
+        except BaseException as e:
+            self.abort()
+            if isinstance(e, OSError):
+                raise output_error(e, self.path) from None
+            raise
         self._flush_interval_ns = int(flush_interval_ns)
         self._last_flush_ns: int | None = None
         self._schemas: dict[str, int] = {}
@@ -81,16 +141,6 @@ class LogWriter:
         self._sequence: dict[int, int] = {}
         self._last_calibration: CameraIntrinsics | None = None
         self._static_sent: set[tuple[str, str]] = set()
-        self._closed = False
-        self.message_count = 0
-        meta = {
-            "sgtool_version": __version__,
-            "log_schema_version": S.format_version(S.LOG_SCHEMA_VERSION),
-            "seed": "" if seed is None else str(int(seed)),
-        }
-        meta.update(metadata or {})
-        self._mcap.add_metadata(S.METADATA_NAME, meta)
-        self._mcap.flush()  # metadata first, so even a log killed in its first second has it
 
     # ----- channels ---------------------------------------------------------------------
     def _proto_channel(self, topic: str, message_class: Any) -> int:
@@ -268,25 +318,55 @@ class LogWriter:
         self._mcap.flush()
 
     def close(self) -> Path:
-        """Finish the file (summary, index) and move it into place. Returns the path."""
+        """Finish the file (summary, index) and move it into place. Returns the path. A
+        destination that fails now (full disk) is an :class:`~sgtool.files.OutputError`
+        and the partial file is removed."""
         if self._closed:
             return self.path
-        self._mcap.finish()
-        self._stream.flush()
-        os.fsync(self._stream.fileno())
-        self._stream.close()
-        self._closed = True
-        os.replace(self.partial_path, self.path)
+        try:
+            self._mcap.finish()
+            self._stream.flush()
+            os.fsync(self._stream.fileno())
+            self._stream.close()
+            self._closed = True
+            os.replace(self.partial_path, self.path)
+        except OSError as e:
+            self._closed = False
+            self.abort()
+            raise output_error(e, self.path) from None
         return self.path
 
     def abort(self) -> None:
         """Stop writing and remove the partial file."""
-        if not self._closed:
-            self._closed = True
-            try:
-                self._stream.close()
-            finally:
-                self.partial_path.unlink(missing_ok=True)
+        self._closed = True
+        try:
+            self._stream.close()
+        except OSError:
+            pass  # a full disk refuses the buffered rest: the file goes anyway
+        finally:
+            self.partial_path.unlink(missing_ok=True)
+
+    def _keep_partial(self) -> InterruptedWrite:
+        """After Ctrl-C: close the partial file with what it holds (complete chunks), or
+        remove it when it holds no message; the exception to raise says which."""
+        self._closed = True
+        kept = False
+        try:
+            if self.message_count:
+                self._mcap.flush()
+            self._stream.close()
+            kept = self.message_count > 0
+        except OSError:
+            kept = False
+        finally:
+            if not kept:
+                self.abort()
+        if not kept:
+            return InterruptedWrite(f"nothing written to {self.path}", None)
+        p = self.partial_path
+        return InterruptedWrite(
+            f"{self.path} not written; what was recorded is kept in {p} (recover it with: "
+            f"sgtool doctor {p} --recover {self.path})", p)
 
     def __enter__(self) -> LogWriter:
         return self
@@ -294,12 +374,9 @@ class LogWriter:
     def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
         if exc_type is None:
             self.close()
-        elif exc_type is KeyboardInterrupt:
-            # keep what was recorded: flush, leave OUT.partial for `sgtool doctor --recover`
-            try:
-                self._mcap.flush()
-                self._stream.close()
-            finally:
-                self._closed = True
+        elif issubclass(exc_type, KeyboardInterrupt) and not self._closed:
+            raise self._keep_partial() from None
         else:
             self.abort()
+            if isinstance(exc, OSError) and concerns(exc, self.partial_path, self.path):
+                raise output_error(exc, self.path) from None

@@ -14,8 +14,9 @@ Per decision (MoMa-LLM sec. III-C/D; reference notes):
    the answer and a feedback message naming the problem and the valid choices, and ask
    again. This feedback reaches the model (MoMa-LLM's own feedback strings were dropped by
    a role filter: the defect noted in the reference notes). At most ``max_attempts``
-   requests per decision; then the decision fails clearly (``done`` without target,
-   reason "llm failure: ...");
+   requests per decision, all within ``decision_timeout_s`` (60 s by default: each request
+   waits at most what is left of it); then the decision fails clearly (``done`` without
+   target, reason "llm failure: ...");
 5. stuck detector: the same grounded action chosen ``stuck_repeats`` times in a row ends
    the episode (``done`` without target, reason "stuck: ...").
 
@@ -29,12 +30,13 @@ Every request is logged as an ``sgtool.LlmExchange`` record: kept in
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sgtool.llm.client import ChatClient, LlmTransportError
+from sgtool.llm.client import ChatClient, LlmTransportError, complete_within
 from sgtool.llm.exchange import Message, exchange_record
 from sgtool.llm.recorded import ReplayMiss, TranscriptWriter
 from sgtool.planning.base import Action, Feedback
@@ -89,6 +91,9 @@ class HistoryEntry:
     text: str = ""  # a rejected command as the model wrote it (no node to realign)
 
 
+DECISION_TIMEOUT_S = 60.0  # wall seconds for all the requests of one decision
+
+
 class MomaLlmPlanner:
     name = "moma-llm"
 
@@ -100,9 +105,13 @@ class MomaLlmPlanner:
         history_limit: int = 30,
         on_exchange: Callable[[dict[str, Any]], None] | None = None,
         transcript: str | Path | None = None,
+        decision_timeout_s: float = DECISION_TIMEOUT_S,
     ) -> None:
         if max_attempts < 1:
             raise ValueError("max_attempts must be >= 1")
+        if not decision_timeout_s > 0:
+            raise ValueError("decision_timeout_s must be > 0")
+        self.decision_timeout_s = float(decision_timeout_s)
         self.client = client
         self.max_attempts = int(max_attempts)
         self.stuck_repeats = int(stuck_repeats)
@@ -140,9 +149,17 @@ class MomaLlmPlanner:
             {"role": "user", "content": self.user_prompt(graph, scene.text)},
         ]
         problems: list[str] = []
+        deadline = time.monotonic() + self.decision_timeout_s
+        attempts = 0
         for attempt in range(self.max_attempts):
+            left = deadline - time.monotonic()
+            if left <= 0:
+                problems.append(f"the decision deadline of {self.decision_timeout_s:g} s "
+                                "is spent")
+                break
+            attempts += 1
             try:
-                result = self.client.complete(messages)
+                result = complete_within(self.client, messages, left)
             except ReplayMiss as e:
                 self._log(messages, None, 0.0, None, None, str(e), attempt)
                 return Action("done", None, reason=f"llm failure: {e}")
@@ -151,7 +168,8 @@ class MomaLlmPlanner:
                 problems.append(str(e))
                 continue
             self._log(messages, result.text, result.latency_s, result.prompt_tokens,
-                      result.completion_tokens, None, attempt, result.model, result.source)
+                      result.completion_tokens, None, attempt, result.model, result.source,
+                      getattr(result, "truncated_from", None))
             cmd = None
             try:
                 cmd = parse_response(result.text)
@@ -174,7 +192,8 @@ class MomaLlmPlanner:
         last = problems[-1] if problems else "no answer"
         return Action(
             "done", None,
-            reason=f"llm failure: no valid command after {self.max_attempts} attempts: {last}",
+            reason=f"llm failure: no valid command after {attempts} attempt"
+                   f"{'' if attempts == 1 else 's'}: {last}",
         )
 
     # ----- pieces -----------------------------------------------------------------------
@@ -240,12 +259,14 @@ class MomaLlmPlanner:
 
     def _log(self, messages: list[Message], response: str | None, latency: float,
              ptok: int | None, ctok: int | None, error: str | None, attempt: int,
-             model: str | None = None, source: str | None = None) -> None:
+             model: str | None = None, source: str | None = None,
+             truncated_from: int | None = None) -> None:
         rec = exchange_record(
             model=model or self.client.model, messages=messages, response=response,
             latency_s=latency, prompt_tokens=ptok, completion_tokens=ctok, error=error,
             attempt=attempt, step=self.step, query=self.query,
             source=source or str(getattr(self.client, "source", "endpoint")),
+            truncated_from=truncated_from,
         )
         self.exchanges.append(rec)
         if self._transcript is not None:

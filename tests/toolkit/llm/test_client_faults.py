@@ -1,0 +1,164 @@
+"""The LLM client and MoMa-LLM against hostile endpoints: malformed replies are retryable
+one-line faults, a decision has a total deadline, huge replies are cut in the record, and
+the API key is written nowhere."""
+
+from __future__ import annotations
+
+import json
+import time
+
+import pytest
+from support.semantics_fixtures import ChatServer, answer, house
+
+from sgtool.llm.client import (
+    MAX_REPLY_CHARS,
+    ChatResult,
+    LlmSettings,
+    LlmTransportError,
+    OpenAIChatClient,
+    reply_text,
+)
+from sgtool.llm.recorded import TranscriptWriter, read_transcript
+from sgtool.planning.moma.planner import MomaLlmPlanner
+
+KEY = "sk-test-SECRET-0123456789"
+
+
+def client(server: ChatServer, **kw) -> OpenAIChatClient:
+    return OpenAIChatClient(LlmSettings.resolve(base_url=server.base_url, model="m",
+                                                api_key=KEY, timeout_s=kw.pop("timeout_s", 5)))
+
+
+def body(**fields) -> dict:
+    return {"raw": json.dumps({"id": "x", "object": "chat.completion", "model": "m",
+                               **fields}).encode()}
+
+
+MESSAGE = {"message": {"role": "assistant", "content": "hi"}}
+
+
+@pytest.mark.parametrize(("reply", "reason"), [
+    (body(choices={"0": MESSAGE}), "'choices' is a dict, not a list"),
+    (body(choices=[]), "'choices' is empty"),
+    (body(), "'choices' is missing, not a list"),
+    (body(choices=["text"]), "choices[0] has no message"),
+    (body(choices=[{"message": {"content": 7}}]), "the message content is a int, not text"),
+    (body(choices=[{"message": {"content": None}}]), "the message content is missing"),
+    ({"raw": b'{"choices": [ '}, "unusable reply: "),
+    ({"raw": b"[1, 2]"}, "unusable reply: "),
+])
+def test_malformed_replies_are_retryable_one_line_faults(reply, reason):
+    with ChatServer([reply]) as srv:
+        with pytest.raises(LlmTransportError) as info:
+            client(srv).complete([{"role": "user", "content": "x"}])
+    msg = str(info.value)
+    assert reason in msg and "\n" not in msg and KEY not in msg
+
+
+def test_bad_token_counts_are_dropped_not_fatal():
+    reply = body(choices=[MESSAGE], usage={"prompt_tokens": "many", "completion_tokens": -1})
+    with ChatServer([reply]) as srv:
+        r = client(srv).complete([{"role": "user", "content": "x"}])
+    assert (r.text, r.prompt_tokens, r.completion_tokens) == ("hi", None, None)
+
+
+def test_reply_text_reads_plain_dicts_too():
+    assert reply_text({"choices": [{"message": {"content": "ok"}}]}) == "ok"
+
+
+def test_planner_survives_a_choices_object_and_retries():
+    with ChatServer([body(choices={"0": MESSAGE}),
+                     answer("go_to_and_open(kitchen, fridge)")]) as srv:
+        p = MomaLlmPlanner(client(srv))
+        p.reset("milk")
+        a = p.decide(house())
+    assert (a.skill, a.target) == ("open", "obj:10")
+    first, second = p.exchanges
+    assert "'choices' is a dict" in first["error"] and second["error"] is None
+
+
+def test_a_huge_reply_is_cut_and_the_cut_is_recorded(tmp_path):
+    huge = "x" * (16 * 1024 * 1024)
+    transcript = tmp_path / "t.jsonl"
+    with ChatServer([{"text": huge}] * 3) as srv:
+        p = MomaLlmPlanner(client(srv, timeout_s=30), max_attempts=3, transcript=transcript)
+        p.reset("milk")
+        a = p.decide(house())
+        p.close()
+    assert a.skill == "done" and a.reason.startswith("llm failure")
+    assert len(p.exchanges) == 3
+    for ex in p.exchanges:
+        assert len(ex["response"]) == MAX_REPLY_CHARS
+        assert ex["response_truncated_from"] == len(huge)
+    # three cut replies, each also echoed in the next prompt: well under a megabyte each
+    assert transcript.stat().st_size < 3 * 4 * MAX_REPLY_CHARS
+    assert [r["response_truncated_from"] for r in read_transcript(transcript)] == [len(huge)] * 3
+
+
+class SlowClient:
+    """Fails every request after using the time it is given (at most ``per_call`` s)."""
+
+    model = "slow"
+    takes_timeout = True
+
+    def __init__(self, clock: list[float], per_call: float) -> None:
+        self.clock, self.per_call, self.timeouts = clock, per_call, []
+
+    def complete(self, messages, timeout_s=None) -> ChatResult:
+        self.timeouts.append(timeout_s)
+        self.clock[0] += min(self.per_call, timeout_s)
+        raise LlmTransportError(f"no reply within {timeout_s:g} s")
+
+
+def test_a_decision_has_a_total_deadline(monkeypatch):
+    clock = [1000.0]
+    monkeypatch.setattr("sgtool.planning.moma.planner.time.monotonic", lambda: clock[0])
+    c = SlowClient(clock, per_call=25.0)
+    p = MomaLlmPlanner(c, max_attempts=5)  # the default deadline: 60 s over all attempts
+    p.reset("milk")
+    a = p.decide(house())
+    assert c.timeouts == [60.0, 35.0, 10.0]  # each request waits at most what is left
+    assert clock[0] - 1000.0 == 60.0
+    assert a.skill == "done"
+    assert a.reason == ("llm failure: no valid command after 3 attempts: the decision "
+                        "deadline of 60 s is spent")
+
+
+def test_the_deadline_bounds_a_real_request():
+    with ChatServer([{"sleep": 3.0, "text": "late"}]) as srv:
+        p = MomaLlmPlanner(client(srv, timeout_s=30), decision_timeout_s=0.5)
+        p.reset("milk")
+        t0 = time.perf_counter()
+        a = p.decide(house())
+        elapsed = time.perf_counter() - t0
+    assert a.skill == "done" and "deadline" in a.reason + p.exchanges[-1]["error"]
+    assert elapsed < 2.5  # not a speed target: the server answers only after 3 s
+
+
+def test_the_api_key_is_not_in_error_messages(monkeypatch):
+    c = OpenAIChatClient(LlmSettings.resolve(base_url="http://user:pw-XYZ1@127.0.0.1:9/v1",
+                                             api_key=KEY))
+
+    def create(**kw):
+        raise ValueError(f"Incorrect API key provided: {KEY}")
+
+    monkeypatch.setattr(c._client.chat.completions, "create", create)
+    with pytest.raises(LlmTransportError) as info:
+        c.complete([{"role": "user", "content": "x"}])
+    msg = str(info.value)
+    assert KEY not in msg and "pw-XYZ1" not in msg and "<redacted>" in msg
+
+
+def test_a_fresh_transcript_uses_a_unique_temporary_name(tmp_path):
+    path = tmp_path / "t.jsonl"
+    a, b = TranscriptWriter(path, append=False), TranscriptWriter(path, append=False)
+    a.write({"model": "m", "messages": [], "response": "a"})
+    b.write({"model": "m", "messages": [], "response": "b"})
+    a.close()
+    b.close()
+    assert [json.loads(x)["response"] for x in path.read_text().splitlines()] == ["b"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.jsonl"]
+    with pytest.raises(RuntimeError), TranscriptWriter(tmp_path / "u.jsonl", append=False) as w:
+        w.write({"model": "m", "messages": []})
+        raise RuntimeError("boom")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.jsonl"]

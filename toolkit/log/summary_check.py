@@ -1,0 +1,106 @@
+"""Checks a reader makes before it trusts the summary section of an MCAP file.
+
+The summary (statistics, chunk, attachment and metadata indexes) says where everything is;
+damaged, it makes a reader seek to nonsense, allocate gigabytes or print a time span of
+years. :func:`check_summary` verifies the summary CRC (when the writer wrote one) and that
+every offset and length it holds lies inside the file; :func:`read_attachment` reads one
+attachment and checks its CRC; :class:`BoundedReader` clamps every read to the file.
+"""
+
+from __future__ import annotations
+
+import io
+import zlib
+from typing import IO
+
+from mcap.opcode import Opcode
+from mcap.records import Attachment, AttachmentIndex
+from mcap.summary import Summary
+
+from sgtool.errors import LogFormatError
+from sgtool.log.mcap_records import FOOTER_RECORD_SIZE, RecordError, footer_at_end, parse_body
+
+
+class BoundedReader(io.BufferedReader):
+    """A buffered file whose reads never ask for more bytes than the file holds after the
+    current position (a damaged length field gives a short read, not a MemoryError)."""
+
+    def __init__(self, raw: io.FileIO, size: int) -> None:
+        super().__init__(raw)
+        self._size = size
+
+    def read(self, n: int | None = -1) -> bytes:
+        if n is None or n < 0:
+            return super().read()
+        return super().read(max(0, min(n, self._size - self.tell())))
+
+
+def _tail(f: IO[bytes], size: int) -> bytes:
+    """The footer and closing magic, after 8 bytes standing for the file's magic."""
+    n = min(size, 8 + FOOTER_RECORD_SIZE)
+    f.seek(size - n)
+    return b"\0" * (16 + FOOTER_RECORD_SIZE - n) + f.read(n)
+
+
+def check_summary(f: IO[bytes], size: int, summary: Summary) -> None:
+    """:class:`LogFormatError` when the summary CRC is wrong or an index points outside
+    the file or contradicts the others."""
+    tail = _tail(f, size)
+    found = footer_at_end(tail, len(tail))
+    if found is not None and found[1].summary_crc and found[1].summary_start:
+        footer = found[1]
+        start = int(footer.summary_start)
+        end = size - 8 - FOOTER_RECORD_SIZE + 9 + 16
+        if not 8 <= start <= end:
+            raise LogFormatError(f"the footer's summary start {start} is outside the file")
+        f.seek(start)
+        crc = 0
+        left = end - start
+        while left > 0:
+            block = f.read(min(left, 1 << 20))
+            if not block:
+                break
+            crc = zlib.crc32(block, crc)
+            left -= len(block)
+        if crc != footer.summary_crc:
+            raise LogFormatError("the summary section is damaged (its CRC does not match: "
+                                 "statistics, indexes or summary copies are wrong)")
+    for ci in summary.chunk_indexes:
+        if (ci.chunk_start_offset + ci.chunk_length > size
+                or ci.message_start_time > ci.message_end_time
+                or any(o + 9 > size for o in ci.message_index_offsets.values())):
+            raise LogFormatError(f"a chunk index (chunk at byte {ci.chunk_start_offset}, "
+                                 f"{ci.chunk_length} bytes) does not fit the file")
+    for ai in summary.attachment_indexes:
+        if ai.offset + ai.length > size or ai.data_size > ai.length:
+            raise LogFormatError(f"the attachment index of {ai.name!r} does not fit the file")
+    for mi in summary.metadata_indexes:
+        if mi.offset + mi.length > size:
+            raise LogFormatError(f"the metadata index of {mi.name!r} does not fit the file")
+    st = summary.statistics
+    if st is not None and st.message_count and summary.chunk_indexes:
+        span = (min(c.message_start_time for c in summary.chunk_indexes),
+                max(c.message_end_time for c in summary.chunk_indexes))
+        if (st.message_start_time, st.message_end_time) != span:
+            raise LogFormatError(f"the statistics say messages from {st.message_start_time} "
+                                 f"to {st.message_end_time} ns, the chunk indexes "
+                                 f"{span[0]} to {span[1]} ns")
+
+
+def read_attachment(f: IO[bytes], ai: AttachmentIndex, where: str) -> Attachment:
+    """The attachment ``ai`` points to, its CRC checked; :class:`LogFormatError` when it
+    is not there or damaged."""
+    f.seek(int(ai.offset))
+    data = f.read(int(ai.length))
+    try:
+        if len(data) != ai.length or data[0] != Opcode.ATTACHMENT:
+            raise RecordError("no attachment record there")
+        a = parse_body(Opcode.ATTACHMENT, data[9:])
+    except RecordError as e:
+        raise LogFormatError(f"{where}: attachment {ai.name!r} at byte {ai.offset} is "
+                             f"damaged ({e}); `sgtool doctor {where}` says what is "
+                             "readable") from None
+    if a.name != ai.name:
+        raise LogFormatError(f"{where}: the attachment at byte {ai.offset} is {a.name!r}, "
+                             f"its index says {ai.name!r}")
+    return a
