@@ -14,7 +14,7 @@ import os
 from pathlib import Path
 
 from sgtool.files import atomic_output
-from sgtool.house.spec import HouseSpec
+from sgtool.house.spec import HouseSpec, hidden_objects
 
 _PALETTE = [
     "#8dd3c7", "#ffffb3", "#bebada", "#fb8072", "#80b1d3", "#fdb462", "#b3de69",
@@ -66,7 +66,6 @@ def draw_house(spec: HouseSpec, path: str | os.PathLike[str], dpi: int = 120,
     for p in spec.passages:
         (x0, y0), (x1, y1) = p.segment
         ax.plot([x0, x1], [y0, y1], color="#777777", linewidth=1.0, linestyle=":", zorder=5)
-    furn = spec.furniture_by_id()
     for f in spec.furniture:
         corners = f.footprint()
         closed = f.state == "closed"
@@ -83,9 +82,9 @@ def draw_house(spec: HouseSpec, path: str | os.PathLike[str], dpi: int = 120,
             ax.text(f.center[0], f.center[1], f.category, ha="center", va="center",
                     fontsize=4.5, color="#222222", zorder=7, clip_on=True)
     if show_objects:
+        hidden_ids = hidden_objects(spec)
         for o in spec.objects:
-            parent = furn[o.parent]
-            hidden = o.relation == "inside" and parent.state == "closed"
+            hidden = o.id in hidden_ids
             ax.plot([o.position[0]], [o.position[1]], marker="x" if hidden else "o",
                     markersize=3 if hidden else 2.5,
                     color="#1f4e9e" if o.relation == "inside" else "#e377c2", zorder=8,

@@ -2,15 +2,20 @@
 
 An episode (as in SCOUT's SymSearch and its OmniGibson benchmark) names a query category
 (a small object's readable category), the ids of all instances of it in the house (finding
-any one succeeds), a start pose, and whether the target is hidden: every instance lies
-inside a closed container, so the robot must open something to see it.
+any one succeeds): the small objects of that category and any furniture whose category
+reads the same (the environments count a piece of the query category as found), a start
+pose, and whether the target is hidden: no piece of the category, and every small object
+needs something opened before it can be seen (:func:`sgtool.house.spec.hidden_objects`:
+walking up to a piece shows what is on its top, even when it is closed; what is inside a
+closed piece, or inside a closed object within it, needs opening).
 
 ``shortest_path`` is the optimal travel distance used by SPL: the geodesic on the house's
 occupancy grid (robot radius 0.2 m, 8-connected, closed doors passable because the robot
 may open them) from the start to the nearest place where the robot can reach a target:
 a free cell in the target's room whose centre is within ``reach`` (1 m) of the footprint
-of the target's parent furniture (SCOUT, Fig. 5 f: the closest unoccupied pixel to the
-goal object within the same room, then A* on the dilated map).
+of the target's furniture (a small object's: the piece at the bottom of its chain of
+parents; SCOUT, Fig. 5 f: the closest unoccupied pixel to the goal object within the same
+room, then A* on the dilated map).
 
 Starts are the house's start poses; an episode prefers a start outside every target room
 (starting next to the target is not a search).
@@ -24,9 +29,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sgtool.house.spec import HouseSpec, StartPose, spec_id_key
+from sgtool.house.spec import (
+    Furniture,
+    HouseSpec,
+    StartPose,
+    enclosed,
+    hidden_objects,
+    spec_id_key,
+)
 from sgtool.mapping.occupancy import OccupancyMap, geodesic_distances, house_occupancy
 from sgtool.mapping.raster import cell_centers, polygon_mask
+from sgtool.semantics.text import category_text
 
 REACH = 1.0
 
@@ -36,10 +49,10 @@ class Episode:
     id: str
     query: str  # readable category
     synset: str
-    targets: tuple[str, ...]  # object ids, sorted
+    targets: tuple[str, ...]  # object ids, then furniture ids of the category, each sorted
     target_rooms: tuple[str, ...]  # room ids, sorted
     start: StartPose
-    hidden: bool  # every instance is inside a closed container
+    hidden: bool  # every instance needs something opened to be seen
     shortest_path: float  # metres, inf when no target can be reached
     description: str  # "inside a closed cabinet in the kitchen"
 
@@ -66,17 +79,24 @@ def room_raster(spec: HouseSpec, occ: OccupancyMap) -> np.ndarray:
 
 
 def _describe(spec: HouseSpec, obj_ids: list[str]) -> str:
-    objs = spec.object_by_id()
-    furn = spec.furniture_by_id()
-    o = objs[obj_ids[0]]
-    p = furn[o.parent]
-    room = spec.room(o.room).category.replace("_", " ")
-    where = "inside" if o.relation == "inside" else "on top of"
-    state = f"{p.state} " if p.state and o.relation == "inside" else ""
+    """Where the first instance is, through its chain of parents: "inside a closed box
+    inside a closed cabinet in the kitchen (+2 more)"."""
+    holders = spec.holder_by_id()
+    o = holders[obj_ids[0]]
+    parts = []
+    while True:
+        p = holders[o.parent]  # type: ignore[union-attr]
+        shut = enclosed(o, p)  # type: ignore[arg-type]
+        where = "inside" if o.relation == "inside" else "on a shelf of" if shut else "on top of"  # type: ignore[union-attr]
+        thing = f"{p.state} {p.category}" if p.state and shut else p.category
+        article = "an" if thing[:1].lower() in "aeiou" else "a"
+        parts.append(f"{where} {article} {thing}")
+        if isinstance(p, Furniture):
+            break
+        o = p
+    room = spec.room(p.room).category.replace("_", " ")
     more = f" (+{len(obj_ids) - 1} more)" if len(obj_ids) > 1 else ""
-    thing = f"{state}{p.category}"
-    article = "an" if thing[:1].lower() in "aeiou" else "a"
-    return f"{where} {article} {thing} in the {room}{more}"
+    return f"{' '.join(parts)} in the {room}{more}"
 
 
 class EpisodeGeometry:
@@ -91,17 +111,21 @@ class EpisodeGeometry:
         self.rooms = room_raster(spec, self.occ)
         self.X, self.Y = cell_centers(self.occ)
         self._room_index = {r.id: i for i, r in enumerate(spec.rooms)}
+        self._roots = spec.root_furniture()
         self._dist: dict[tuple[float, float], np.ndarray] = {}
 
-    def goal_mask(self, obj_id: str) -> np.ndarray:
-        """Free cells of the object's room within ``reach`` of its parent's footprint."""
-        o = self.spec.object_by_id()[obj_id]
-        p = self.spec.furniture_by_id()[o.parent]
+    def goal_mask(self, target_id: str) -> np.ndarray:
+        """Free cells of the target's room within ``reach`` of its furniture's footprint (a
+        small object's furniture is the piece at the bottom of its chain of parents)."""
+        furn = self.spec.furniture_by_id()
+        if target_id not in furn:
+            target_id = self._roots[target_id]
+        p = furn[target_id]
         lx_ly = _to_local(p, self.X, self.Y)
         dx = np.maximum(np.abs(lx_ly[0]) - p.size[0] / 2, 0.0)
         dy = np.maximum(np.abs(lx_ly[1]) - p.size[1] / 2, 0.0)
         near = dx ** 2 + dy ** 2 <= self.reach ** 2
-        return near & (self.rooms == self._room_index[o.room]) & ~self.occ.blocked
+        return near & (self.rooms == self._room_index[p.room]) & ~self.occ.blocked
 
     def distances(self, start: StartPose) -> np.ndarray:
         key = (start.x, start.y)
@@ -109,10 +133,11 @@ class EpisodeGeometry:
             self._dist[key] = geodesic_distances(self.occ, key, max_snap=1.0)
         return self._dist[key]
 
-    def shortest_path(self, start: StartPose, obj_ids: list[str]) -> float:
+    def shortest_path(self, start: StartPose, target_ids: list[str]) -> float:
+        """Geodesic to the nearest target (small object or furniture ids)."""
         d = self.distances(start)
         best = math.inf
-        for oid in obj_ids:
+        for oid in target_ids:
             m = self.goal_mask(oid)
             if m.any():
                 best = min(best, float(d[m].min()))
@@ -150,18 +175,23 @@ def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
     geo = EpisodeGeometry(spec, reach=reach)
     objs = spec.object_by_id()
     furn = spec.furniture_by_id()
+    hidden_ids = hidden_objects(spec)
+    furn_by_text: dict[str, list[str]] = defaultdict(list)
+    for f in spec.furniture:
+        furn_by_text[category_text(f.category)].append(f.id)
     out = []
     for i, cat in enumerate(chosen):
         ids = sorted(by_cat[cat], key=spec_id_key)
-        rooms = tuple(sorted({objs[o].room for o in ids}, key=spec_id_key))
+        pieces = sorted(furn_by_text.get(category_text(cat), ()), key=spec_id_key)
+        rooms = tuple(sorted({objs[o].room for o in ids} |
+                             {furn[f].room for f in pieces}, key=spec_id_key))
         starts = [s for s in spec.starts if s.room not in rooms] or list(spec.starts)
         start = starts[int(rng.integers(len(starts)))]
-        hidden = all(objs[o].relation == "inside" and furn[objs[o].parent].state == "closed"
-                     for o in ids)
+        hidden = not pieces and all(o in hidden_ids for o in ids)
         out.append(Episode(
-            id=f"ep_{i}", query=cat, synset=synset_of[cat], targets=tuple(ids),
+            id=f"ep_{i}", query=cat, synset=synset_of[cat], targets=tuple(ids + pieces),
             target_rooms=rooms, start=start, hidden=hidden,
-            shortest_path=geo.shortest_path(start, ids),
+            shortest_path=geo.shortest_path(start, ids + pieces),
             description=_describe(spec, ids),
         ))
     return out

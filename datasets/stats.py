@@ -20,7 +20,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import asdict, dataclass
 
 from sgtool.datasets.knowledge import Knowledge
-from sgtool.house.spec import HouseSpec
+from sgtool.house.spec import HouseSpec, hidden_objects
 
 COLUMNS = (
     ("scenes", "Scenes"),
@@ -85,7 +85,6 @@ def house_stats(specs: Iterable[HouseSpec]) -> SceneStats:
         oc = {f.category for f in s.furniture} | {o.category for o in s.objects}
         room_cats |= rc
         obj_cats |= oc
-        furn = s.furniture_by_id()
         per["rooms"].append(len(s.rooms))
         per["room_cats"].append(len(rc))
         per["objects"].append(len(s.furniture) + len(s.objects))
@@ -94,8 +93,7 @@ def house_stats(specs: Iterable[HouseSpec]) -> SceneStats:
         per["inside"].append(sum(o.relation == "inside" for o in s.objects))
         per["furniture"].append(len(s.furniture))
         per["closed"].append(sum(d.state == "closed" for d in s.doors))
-        per["hidden"].append(sum(o.relation == "inside" and furn[o.parent].state == "closed"
-                                 for o in s.objects))
+        per["hidden"].append(len(hidden_objects(s)))
     return SceneStats(
         scenes=len(specs), room_categories=len(room_cats), object_categories=len(obj_cats),
         rooms_per_scene=_mean(per["rooms"]), room_categories_per_scene=_mean(per["room_cats"]),

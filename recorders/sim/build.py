@@ -3,7 +3,12 @@
 Everything is a box: the floor (one slab under the whole house, top at z = 0), the walls,
 a lintel above every door opening, door panels, furniture and small objects. Containers
 are hollow (five boards, open at the front) so that their contents are hidden behind the
-door panels (:mod:`sgtool.recorders.sim.articulation`) until a door opens. Every panel
+door panels (:mod:`sgtool.recorders.sim.articulation`) until a door opens; a piece with
+shelf ``levels`` (house spec 2) is hollow too, with one board under each level, so what
+stands on a lower shelf rests on a board. A small object nested in another (house spec 2)
+is a box at its position, turned like the furniture at the bottom of its chain; a small
+container is hollow (a tray: bottom and four sides, and a lid when it is openable and
+closed; small objects are not opened in the simulation). Every panel
 is built closed; the simulation then opens what the spec says is open. Bodies have
 collision shapes equal to their visual shapes so ray tests see what the camera sees; the
 simulation is kinematic (no physics steps), so nothing moves unless the simulator moves it.
@@ -26,7 +31,7 @@ from types import ModuleType
 
 import numpy as np
 
-from sgtool.house.spec import HouseSpec
+from sgtool.house.spec import Furniture, HouseSpec
 from sgtool.recorders.sim import articulation as art
 from sgtool.recorders.sim.camera import uid_lut
 from sgtool.recorders.sim.instances import Instance, initial_states, instance_table
@@ -187,8 +192,8 @@ def build_world(pb: ModuleType, client: int, spec: HouseSpec) -> World:
     for f in spec.furniture:
         iid = by_spec[f.id].id
         rgb = category_rgb(f.category)
-        if f.is_container:
-            b.boxes(iid, art.carcass_boards(f), f.center, f.yaw, rgb)
+        if f.is_container or f.levels:
+            b.boxes(iid, art.carcass_boards(f) + shelf_boards(f), f.center, f.yaw, rgb)
         else:
             b.box(iid, f.center, f.size, f.yaw, rgb)
         if f.is_openable:  # built closed, like the doors
@@ -200,12 +205,43 @@ def build_world(pb: ModuleType, client: int, spec: HouseSpec) -> World:
                 bodies.append(PanelBody(uid, p, 0.0))
             world.panels[f.id] = bodies
     furn = spec.furniture_by_id()
+    roots = spec.root_furniture()
     for o in spec.objects:
-        b.box(by_spec[o.id].id, o.position, o.size, furn[o.parent].yaw,
-              category_rgb(o.category))
+        yaw, rgb = furn[roots[o.id]].yaw, category_rgb(o.category)
+        if o.is_container:
+            b.boxes(by_spec[o.id].id, tray_boards(o.size, lid=o.state == "closed"),
+                    o.position, yaw, rgb)
+        else:
+            b.box(by_spec[o.id].id, o.position, o.size, yaw, rgb)
     world.body_instance = b.body_instance
     world.lut = uid_lut(b.body_instance)
     return world
+
+
+def shelf_boards(f: Furniture) -> tuple[
+        tuple[tuple[float, float, float], tuple[float, float, float]], ...]:
+    """One board per shelf level in the piece's local frame, its top at the level (the
+    carcass's board thickness; a level within a board of the bottom has none)."""
+    sx, sy, sz = f.size
+    t = min(art.BOARD_T, sx / 4.0, sy / 4.0, sz / 4.0)
+    return tuple(((0.0, 0.0, -sz / 2.0 + h - t / 2.0), (sx, sy, t))
+                 for h in f.levels if h >= t)
+
+
+def tray_boards(size: Sequence[float], lid: bool) -> tuple[
+        tuple[tuple[float, float, float], tuple[float, float, float]], ...]:
+    """Boards of a small hollow container in its local frame: bottom, four sides, and the
+    lid when ``lid``."""
+    sx, sy, sz = size
+    t = min(art.BOARD_T / 2.0, sx / 4.0, sy / 4.0, sz / 4.0)
+    boards = [((0.0, 0.0, -sz / 2.0 + t / 2.0), (sx, sy, t)),
+              ((0.0, -sy / 2.0 + t / 2.0, 0.0), (sx, t, sz)),
+              ((0.0, sy / 2.0 - t / 2.0, 0.0), (sx, t, sz)),
+              ((-sx / 2.0 + t / 2.0, 0.0, 0.0), (t, sy, sz)),
+              ((sx / 2.0 - t / 2.0, 0.0, 0.0), (t, sy, sz))]
+    if lid:
+        boards.append(((0.0, 0.0, sz / 2.0 - t / 2.0), (sx, sy, t)))
+    return tuple(boards)
 
 
 def door_obstacles(spec: HouseSpec) -> list[art.Box2]:

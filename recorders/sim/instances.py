@@ -10,7 +10,8 @@ PyBullet uids, so the same house always gives the same ids:
 3. the doors in spec order (``door``, "door", openable),
 4. one lintel per door, the wall piece above the door opening (``structure``, "wall"),
 5. the furniture and containers in spec order (``furniture``),
-6. the small objects in spec order (``object``, with parent instance and relation).
+6. the small objects in spec order (``object``, with parent instance and relation; the
+   parent is a piece of furniture or, house spec 2, another small object).
 
 0 is background (no body).
 """
@@ -64,14 +65,16 @@ def instance_table(spec: HouseSpec) -> tuple[Instance, ...]:
         out.append(Instance(nxt(), "door", DOOR, d.id, "door.n.01", ("openable",)))
     for _ in spec.doors:
         out.append(Instance(nxt(), "wall", STRUCTURE, None, "wall.n.01"))
-    furn_ids: dict[str, int] = {}
+    ids: dict[str, int] = {}
     for f in spec.furniture:
-        furn_ids[f.id] = nxt()
+        ids[f.id] = nxt()
         out.append(Instance(nxt(), f.category, FURNITURE, f.id, f.synset,
                             tuple(f.affordances)))
+    first = nxt()
+    ids.update((o.id, first + k) for k, o in enumerate(spec.objects))
     for o in spec.objects:
         out.append(Instance(nxt(), o.category, OBJECT, o.id, o.synset, (),
-                            furn_ids[o.parent], o.relation))
+                            ids[o.parent], o.relation))
     return tuple(out)
 
 

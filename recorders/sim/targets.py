@@ -75,7 +75,7 @@ def resolve_instance(spec: HouseSpec, inst: Instance,
         return Resolved(label, "furniture", (f.center[0], f.center[1]), box, inst, front)
     if inst.kind == OBJECT and sid:
         o = spec.object_by_id()[sid]
-        parent = spec.furniture_by_id()[o.parent]
+        parent = spec.furniture_by_id()[spec.root_furniture()[o.id]]
         box = (o.position[0], o.position[1], o.size[0], o.size[1], parent.yaw)
         pbox = (parent.center[0], parent.center[1], parent.size[0], parent.size[1],
                 parent.yaw)

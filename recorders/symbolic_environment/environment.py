@@ -12,10 +12,18 @@
   frontiers; its doors and the rooms behind open doors/passages appear;
 - ``explore`` (or ``navigate``) a frontier: the agent walks there; the region's furniture
   is revealed;
-- ``open`` a closed openable object: walk there, open it, reveal its nested objects;
-  ``navigate`` to (or ``explore``) an unexplored container/supporter that is not closed:
-  look into / onto it, revealing its nested objects (SymSearch: every nested object needs
-  its parent explored, "on top" included);
+- walking up to a piece of furniture (``navigate`` to it or to an object on it,
+  ``explore``, ``open``) reveals what is on its top face, even when it is closed; what is
+  *enclosed* by it (``inside``, or ``ontop`` of a lower shelf:
+  :func:`sgtool.house.spec.enclosed`) is revealed only when it is not closed: ``open`` a
+  closed openable piece (walk there, open it, reveal its contents), or ``navigate`` to /
+  ``explore`` a container/supporter that is not closed (look into / onto it);
+- nesting (house spec 2): what is revealed is looked at in turn, by the same rule: the
+  things on top of a revealed object are revealed with it, and its contents too unless
+  it is closed; so nested containers open one at a time (a bowl inside a closed cabinet
+  appears when the cabinet is opened, with the apple in it; an apple inside a closed
+  lidded box inside the cabinet needs the box opened too: ``open`` an openable small
+  object walks to its furniture and opens it); revealed objects stay revealed;
 - ``open`` a closed door: walk to it and open it; the room beyond appears as an unexplored
   room. ``close`` closes an open object or door; ``navigate`` to anything else just walks;
 - ``done``: ends the episode.
@@ -85,7 +93,10 @@ class SymbolicEnv:
         # dynamic state
         self.open_doors: set[int] = set(house.initially_open())
         self.furn_state: list[str | None] = [f.state for f in self.spec.furniture]
-        self.furn_explored: set[int] = set()
+        self.obj_state: list[str | None] = [o.state for o in self.spec.objects]
+        self.furn_explored: set[int] = set()  # contents revealed (looked at, not closed)
+        self.obj_explored: set[int] = set()
+        self.seen_objects: set[int] = set()
         self.revealed_regions: set[int] = set()
         self.explored_rooms: set[int] = set()
         self.known_rooms: set[int] = set()
@@ -129,10 +140,32 @@ class SymbolicEnv:
         return sorted(out)
 
     def visible_objects(self) -> list[int]:
-        out = []
-        for f in sorted(self.furn_explored):
-            out.extend(self.house.nested[f])
-        return sorted(out)
+        return sorted(self.seen_objects)
+
+    def _look(self, f: int) -> list[int]:
+        """Walk-up view of furniture ``f``: reveal what is on it, and what is in it when it
+        is not closed, then what is on / in each revealed object by the same rule (module
+        doc). Returns the newly revealed objects."""
+        h = self.house
+        closed = self.furn_state[f] == "closed"
+        if not closed and h.explorable[f]:
+            self.furn_explored.add(f)
+        new: list[int] = []
+        stack = [j for j in reversed(h.nested[f]) if not (closed and h.enclosed[j])]
+        while stack:
+            j = stack.pop()
+            if j not in self.seen_objects:
+                self.seen_objects.add(j)
+                new.append(j)
+            shut = self.obj_state[j] == "closed"
+            if not shut:
+                self.obj_explored.add(j)
+            stack.extend(c for c in reversed(h.obj_children[j]) if not (shut and h.enclosed[c]))
+        return new
+
+    def _found(self, new: list[int]) -> str:
+        names = sorted(self.house.obj_cat[j] for j in new)
+        return f"found {', '.join(names)}" if names else "nothing inside or on top"
 
     def _check_found(self) -> None:
         if any(f in self._target_furn for f in self.visible_furniture()) or \
@@ -193,8 +226,10 @@ class SymbolicEnv:
             objects.append(h.furniture_node(f, self.furn_state[f], f in self.furn_explored))
             put(h.furn_node_id(f), h.furn_place[f])
         for j in self.visible_objects():
-            objects.append(h.object_node(j))
-            put(h.obj_node_id(j), h.furn_place[h.furn_index[spec.objects[j].parent]])
+            o = spec.objects[j]
+            objects.append(h.object_node(j, self.obj_state[j],
+                                         bool(o.affordances) and j in self.obj_explored))
+            put(h.obj_node_id(j), h.furn_place[h.obj_furn[j]])
         doors = []
         for di in sorted(self.visible_doors):
             d = spec.doors[di]
@@ -237,7 +272,7 @@ class SymbolicEnv:
                     return ("furniture", k) if k in set(self.visible_furniture()) else None
                 j = k - nf
                 if 0 <= j < len(self.spec.objects):
-                    return ("object", j) if j in set(self.visible_objects()) else None
+                    return ("object", j) if j in self.seen_objects else None
         except ValueError:
             return None
         return None
@@ -340,22 +375,14 @@ class SymbolicEnv:
             d = self._move(place, dist)
             self.open_doors.discard(i)
             return self._outcome(a, "success", "door closed", d)
-        if kind == "object":  # nested objects: walk to the parent
-            parent = h.furn_index[self.spec.objects[i].parent]
-            place = h.furn_place[parent]
-            if skill != "navigate":
-                return self._outcome(a, "invalid",
-                                     f"cannot {skill} a {self.spec.objects[i].category}")
-            if not math.isfinite(dist[place]):
-                return self._outcome(a, "failure", f"{a.target} cannot be reached")
-            return self._outcome(a, "success", f"at {a.target}", self._move(place, dist))
+        if kind == "object":
+            return self._object_action(a, i, dist)
         # furniture
         fu = self.spec.furniture[i]
         place = h.furn_place[i]
         if not math.isfinite(dist[place]):
             return self._outcome(a, "failure", f"{a.target} cannot be reached")
         state = self.furn_state[i]
-        explorable = bool(set(fu.affordances) & {"container", "supporter"})
         if skill == "open" or (skill == "explore" and state == "closed"):
             if not fu.is_openable:
                 return self._outcome(a, "failure", f"a {fu.category} cannot be opened")
@@ -363,41 +390,75 @@ class SymbolicEnv:
                 return self._outcome(a, "failure", f"the {fu.category} is already open")
             d = self._move(place, dist)
             self.furn_state[i] = "open"
-            return self._outcome(a, "success", self._reveal(i), d, opened=True)
+            return self._outcome(a, "success", self._found(self._look(i)), d, opened=True)
         if skill == "close":
             if state != "open":
                 return self._outcome(a, "failure", f"the {fu.category} is not open")
             d = self._move(place, dist)
             self.furn_state[i] = "closed"
             return self._outcome(a, "success", f"{fu.category} closed", d)
-        # navigate / explore of a piece that is not closed: look into / onto it
-        fresh = explorable and i not in self.furn_explored and state != "closed"
+        # navigate / explore: walk up; look into / onto a piece that is not closed, onto
+        # the top of a closed one
+        fresh = h.explorable[i] and i not in self.furn_explored and state != "closed"
         if skill == "explore" and not fresh:
             return self._outcome(a, "failure", f"nothing left to explore at the {fu.category}")
         d = self._move(place, dist)
+        new = self._look(i)
         if fresh:
-            return self._outcome(a, "success", self._reveal(i), d)
+            return self._outcome(a, "success", self._found(new), d)
+        if new:
+            return self._outcome(a, "success", f"at the {fu.category}; {self._found(new)}", d)
         return self._outcome(a, "success", f"at the {fu.category}", d)
 
-    def _reveal(self, f: int) -> str:
-        self.furn_explored.add(f)
-        names = sorted(self.house.obj_cat[j] for j in self.house.nested[f])
-        return f"found {', '.join(names)}" if names else "nothing inside or on top"
+    def _object_action(self, a: Action, j: int, dist: np.ndarray) -> StepOutcome:
+        """A skill on a revealed small object: the agent walks to its furniture (and looks
+        at it); only an openable object can be opened or closed, only a container
+        explored."""
+        h, o = self.house, self.spec.objects[j]
+        f = h.obj_furn[j]
+        place = h.furn_place[f]
+        skill, state = a.skill, self.obj_state[j]
+        opens = skill == "open" or (skill == "explore" and state == "closed")
+        applies = skill == "navigate" or (o.is_openable and (opens or skill == "close")) or \
+            (skill == "explore" and o.is_container)
+        if not applies:
+            return self._outcome(a, "invalid", f"cannot {skill} a {o.category}")
+        if not math.isfinite(dist[place]):
+            return self._outcome(a, "failure", f"{a.target} cannot be reached")
+        if opens and state == "open":
+            return self._outcome(a, "failure", f"the {o.category} is already open")
+        if skill == "close" and state != "open":
+            return self._outcome(a, "failure", f"the {o.category} is not open")
+        if skill == "explore" and not opens and j in self.obj_explored:
+            return self._outcome(a, "failure", f"nothing left to explore at the {o.category}")
+        d = self._move(place, dist)
+        if skill == "close":
+            self.obj_state[j] = "closed"
+            return self._outcome(a, "success", f"{o.category} closed", d)
+        if opens:
+            self.obj_state[j] = "open"
+        new = self._look(f)
+        if opens or skill == "explore":
+            return self._outcome(a, "success", self._found(new), d, opened=opens)
+        if new:
+            return self._outcome(a, "success", f"at {a.target}; {self._found(new)}", d)
+        return self._outcome(a, "success", f"at {a.target}", d)
 
     # ----- figures --------------------------------------------------------------------
     def shortest_path(self, targets: Sequence[str]) -> float | None:
         """Geodesic from the start to the nearest place a target is seen from, every door
-        passable (an optimal agent opens the doors on its way); None when unreachable."""
+        passable (an optimal agent opens the doors on its way); None when unreachable.
+        The furniture of the query category counts as targets too, since finding one ends
+        the episode as found."""
         h = self.house
         dist = h.distances_from(self.start_place, h.all_doors())
         best = math.inf
+        furniture = {h.furn_index[t] for t in targets if t in h.furn_index} | self._target_furn
         for t in targets:
             if t in h.obj_index:
-                parent = h.furn_index[self.spec.objects[h.obj_index[t]].parent]
-                best = min(best, float(dist[h.furn_place[parent]]))
-            elif t in h.furn_index:
-                f = h.furn_index[t]
-                best = min(best, float(dist[h.regions[h.region_of_furn[f]].place]),
-                           float(dist[h.furn_place[f]]))
+                best = min(best, float(dist[h.furn_place[h.obj_furn[h.obj_index[t]]]]))
+        for f in furniture:
+            best = min(best, float(dist[h.regions[h.region_of_furn[f]].place]),
+                       float(dist[h.furn_place[f]]))
         return best if math.isfinite(best) else None
 

@@ -5,8 +5,9 @@ room, the (x, y) positions of its furniture are clustered by k-means (determinis
 farthest-point initialisation) with the number of clusters chosen by the Bayesian
 Information Criterion of the matching spherical Gaussian mixture (X-means), k in
 ``[1, min(4, n - 1)]``; a room without furniture is one empty region. Furniture are the
-first-level objects of their region; small objects are nested in their parent furniture
-(relation "inside"/"ontop"). Rooms are joined by doors (open/closed) and open-plan passages.
+first-level objects of their region; small objects are nested in their parent (a piece of
+furniture or, house spec 2, another small object: a bowl in a cabinet holds an apple;
+relation "inside"/"ontop"). Rooms are joined by doors (open/closed) and open-plan passages.
 
 **Travel** (SCOUT Fig. 5 f). Every node the agent can go to has a *place*: the walkable cell
 of its own room nearest to it (walkable: free on the occupancy grid dilated by the robot
@@ -17,8 +18,8 @@ re-rasterising, they are computed once on the grid with every door closed (each 
 open-plan group, its own component) between all places, plus one place each side of every
 door; an open door joins its two side places with an edge of their straight-line length.
 Travel distance is then the shortest path on that place graph for the current door states.
-A nested object's place is its parent's; a room's is its nearest region's; a door's is its
-nearer side.
+A nested object's place is its furniture's (the piece at the bottom of its chain of
+parents); a room's is its nearest region's; a door's is its nearer side.
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ from scipy import ndimage
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from sgtool.house.spec import HouseSpec
+from sgtool.house.spec import HouseSpec, enclosed
 from sgtool.mapping.occupancy import (
     OccupancyMap,
     cell_to_world,
@@ -76,7 +77,7 @@ class SymbolicHouse:
         self.furn_cat = tuple(category_text(f.category) for f in spec.furniture)
         self.obj_cat = tuple(category_text(o.category) for o in spec.objects)
         self._furn_nodes: dict[tuple[int, str | None, bool], ObjectNode] = {}
-        self._obj_nodes: dict[int, ObjectNode] = {}
+        self._obj_nodes: dict[tuple[int, str | None, bool], ObjectNode] = {}
         self._walkable_rooms()
         self.places: list[tuple[float, float]] = []
         self.place_room: list[int] = []
@@ -122,11 +123,23 @@ class SymbolicHouse:
             a, b = (self.room_index[r] for r in p.rooms)
             self.links[a].append((b, None))
             self.links[b].append((a, None))
-        # small objects
+        # small objects: children of each piece and of each object, the piece at the root
+        # of each object's chain, whether a closed parent hides it (spec.enclosed)
         self.obj_index = {o.id: j for j, o in enumerate(spec.objects)}
         self.nested: list[list[int]] = [[] for _ in spec.furniture]
+        self.obj_children: list[list[int]] = [[] for _ in spec.objects]
+        holders = spec.holder_by_id()
+        self.enclosed = tuple(enclosed(o, holders[o.parent]) for o in spec.objects)
         for j, o in enumerate(spec.objects):
-            self.nested[self.furn_index[o.parent]].append(j)
+            if o.parent in self.furn_index:
+                self.nested[self.furn_index[o.parent]].append(j)
+            else:
+                self.obj_children[self.obj_index[o.parent]].append(j)
+        # pieces one can look into / onto (whatever they hold)
+        self.explorable = tuple(bool(set(f.affordances) & {"container", "supporter"}) or
+                                bool(self.nested[i]) for i, f in enumerate(spec.furniture))
+        roots = spec.root_furniture()
+        self.obj_furn = tuple(self.furn_index[roots[o.id]] for o in spec.objects)
         self._base = self._base_distances()
         self._graphs: dict[frozenset[int], csr_matrix] = {}
         self._rows: dict[tuple[frozenset[int], int], np.ndarray] = {}
@@ -244,19 +257,33 @@ class SymbolicHouse:
             self._furn_nodes[key] = node
         return node
 
-    def object_node(self, j: int) -> ObjectNode:
-        """The node of small object ``j`` (nested in its parent furniture)."""
-        node = self._obj_nodes.get(j)
+    def parent_node_id(self, j: int) -> str:
+        """Node id of small object ``j``'s parent (a piece of furniture or an object)."""
+        parent = self.spec.objects[j].parent
+        f = self.furn_index.get(parent)
+        return self.furn_node_id(f) if f is not None else self.obj_node_id(self.obj_index[parent])
+
+    def object_node(self, j: int, state: str | None = None, explored: bool = False) -> ObjectNode:
+        """The node of small object ``j`` (nested in its parent) in ``state`` (an openable
+        object's; None for others). An object without affordances has the node of house
+        spec 1; a container or openable one lists them (with "examine" for a container)."""
+        key = (j, state, explored)
+        node = self._obj_nodes.get(key)
         if node is None:
             o = self.spec.objects[j]
+            affs = set(o.affordances)
+            if "container" in affs:
+                affs.add(_EXAMINE)
             node = ObjectNode(
                 id=self.obj_node_id(j), category=self.obj_cat[j],
-                parent=self.furn_node_id(self.furn_index[o.parent]),
+                parent=self.parent_node_id(j),
                 room=self.room_ids[self.room_index[o.room]],
                 position=tuple(float(v) for v in o.position),  # type: ignore[arg-type]
                 instance=len(self.spec.furniture) + 1 + j, relation=o.relation,  # type: ignore[arg-type]
+                state=state, affordances=tuple(sorted(affs)),  # type: ignore[arg-type]
+                explored=explored,
             )
-            self._obj_nodes[j] = node
+            self._obj_nodes[key] = node
         return node
 
     def all_doors(self) -> frozenset[int]:

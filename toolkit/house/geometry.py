@@ -1,5 +1,6 @@
 """Plane geometry of house specs: polygon area, centroid and containment, door segments,
-box corners (pure functions over (x, y) points)."""
+box corners, distances to segments and polygons, triangulation and the area two polygons
+share (pure functions over (x, y) points)."""
 
 from __future__ import annotations
 
@@ -71,3 +72,105 @@ def box_corners(center: Sequence[float], size: Sequence[float],
     for lx, ly in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)):
         out.append((center[0] + c * lx - s * ly, center[1] + s * lx + c * ly))
     return tuple(out)  # type: ignore[return-value]
+
+
+def segment_distance(x: float, y: float, a: Point, b: Point) -> float:
+    """Distance from (x, y) to the segment a-b."""
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    n = dx * dx + dy * dy
+    t = 0.0 if n == 0 else max(0.0, min(1.0, ((x - a[0]) * dx + (y - a[1]) * dy) / n))
+    return math.hypot(x - a[0] - t * dx, y - a[1] - t * dy)
+
+
+def distance_to_polygon(x: float, y: float, poly: Sequence[Point]) -> float:
+    """0 inside (or on the border of) ``poly``, else the distance to its border."""
+    if point_in_polygon(x, y, poly):
+        return 0.0
+    n = len(poly)
+    return min(segment_distance(x, y, poly[i], poly[(i + 1) % n]) for i in range(n))
+
+
+def triangulate(poly: Sequence[Point]) -> list[tuple[Point, Point, Point]]:
+    """Counter-clockwise triangles covering a simple polygon (ear clipping, O(n^2))."""
+    pts = list(poly) if signed_area(poly) > 0 else list(reversed(poly))
+    idx = list(range(len(pts)))
+    out: list[tuple[Point, Point, Point]] = []
+    guard = 0
+    while len(idx) > 3 and guard < 2 * len(pts) ** 2:
+        guard += 1
+        for k in range(len(idx)):
+            a, b, c = pts[idx[k - 1]], pts[idx[k]], pts[idx[(k + 1) % len(idx)]]
+            if _cross(a, b, c) <= 1e-12:
+                continue  # reflex or flat corner: not an ear
+            if any(_in_triangle(pts[j], a, b, c) for j in idx
+                   if j not in (idx[k - 1], idx[k], idx[(k + 1) % len(idx)])):
+                continue
+            out.append((a, b, c))
+            del idx[k]
+            break
+        else:
+            break  # no ear left (self-intersecting input): keep what was found
+    if len(idx) == 3:
+        out.append((pts[idx[0]], pts[idx[1]], pts[idx[2]]))
+    return out
+
+
+def _cross(a: Point, b: Point, c: Point) -> float:
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
+
+def _in_triangle(p: Point, a: Point, b: Point, c: Point) -> bool:
+    return _cross(a, b, p) >= 0 and _cross(b, c, p) >= 0 and _cross(c, a, p) >= 0
+
+
+def clip_convex(subject: Sequence[Point], clip: Sequence[Point]) -> list[Point]:
+    """``subject`` clipped to the convex counter-clockwise polygon ``clip``
+    (Sutherland-Hodgman)."""
+    out = list(subject)
+    n = len(clip)
+    for i in range(n):
+        if not out:
+            break
+        a, b = clip[i], clip[(i + 1) % n]
+        src, out = out, []
+        for j in range(len(src)):
+            p, q = src[j - 1], src[j]
+            pin, qin = _cross(a, b, p) >= 0, _cross(a, b, q) >= 0
+            if qin:
+                if not pin:
+                    out.append(_intersection(a, b, p, q))
+                out.append(q)
+            elif pin:
+                out.append(_intersection(a, b, p, q))
+    return out
+
+
+def _intersection(a: Point, b: Point, p: Point, q: Point) -> Point:
+    """Where the segment p-q crosses the line a-b."""
+    dp, dq = _cross(a, b, p), _cross(a, b, q)
+    t = dp / (dp - dq)
+    return (p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1]))
+
+
+def overlap_area(a: Sequence[Point], b: Sequence[Point]) -> float:
+    """Area shared by two simple polygons (sum over pairs of their triangles)."""
+    ta, tb = triangulate(a), triangulate(b)
+    total = 0.0
+    for t in ta:
+        bt = _bounds(t)
+        for u in tb:
+            if _boxes_meet(bt, _bounds(u)):
+                piece = clip_convex(t, u)
+                if len(piece) >= 3:
+                    total += abs(signed_area(piece))
+    return total
+
+
+def _bounds(poly: Sequence[Point]) -> tuple[float, float, float, float]:
+    xs = [p[0] for p in poly]
+    ys = [p[1] for p in poly]
+    return (min(xs), min(ys), max(xs), max(ys))
+
+
+def _boxes_meet(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]

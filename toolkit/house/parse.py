@@ -1,9 +1,15 @@
 """Validation of a parsed house-spec document into a :class:`~sgtool.house.spec.HouseSpec`.
 
-Every rule of the conventions in :mod:`sgtool.house.spec` is checked here; a failure raises
-:class:`sgtool.errors.SpecError` whose message starts with the offending field
-(``furniture[3].size: every side must be > 0``). Numbers are rounded to the canonical
-precision, so parsing the canonical text of a spec gives back the same spec.
+Every rule of the conventions in :mod:`sgtool.house.spec` is checked here (the fields of
+each entry, within :class:`~sgtool.house.spec.SpecLimits`), in
+:mod:`sgtool.house.nesting` (parents, depth, placement of small objects) and in
+:mod:`sgtool.house.consistency` (rooms, doors and furniture against each other); a
+failure raises :class:`sgtool.errors.SpecError` whose message starts with the offending
+field (``furniture[3].size: every side must be > 0``). Every list is measured against its
+limit before its entries are read and every number against ``limits.coordinate`` before
+it is converted, so a hostile file is refused in time linear in its size. Numbers are
+rounded to the canonical precision, so parsing the canonical text of a spec gives back the
+same spec.
 """
 
 from __future__ import annotations
@@ -14,9 +20,13 @@ from typing import Any
 
 from sgtool.canonical import canonical_float
 from sgtool.errors import SpecError
+from sgtool.house.consistency import check_consistency
 from sgtool.house.geometry import signed_area
+from sgtool.house.migrate import upgrade
+from sgtool.house.nesting import check_nesting
 from sgtool.house.spec import (
     AFFORDANCES,
+    LIMITS,
     RELATIONS,
     SPEC_VERSION,
     STATES,
@@ -26,76 +36,276 @@ from sgtool.house.spec import (
     Passage,
     Room,
     SmallObject,
+    SpecLimits,
     StartPose,
     Wall,
-    placement_problem,
 )
 
 
-def parse_house(d: Any) -> HouseSpec:
+def parse_house(d: Any, limits: SpecLimits = LIMITS) -> HouseSpec:
     """Validate a parsed JSON document (see the conventions of :mod:`sgtool.house.spec`)
-    into a :class:`HouseSpec`; raises :class:`SpecError` naming the offending field."""
-    if not isinstance(d, Mapping):
-        raise SpecError("top level: expected a JSON object")
-    version = d.get("version")
-    if version is None:
-        raise SpecError("version: missing")
-    if not isinstance(version, str) or version.split(".")[0] != SPEC_VERSION.split(".")[0]:
-        raise SpecError(f"version: {version!r} is not supported (this sgtool reads "
-                        f"{SPEC_VERSION.split('.')[0]}.x)")
+    into a :class:`HouseSpec` of the current version (a version-1 document is migrated);
+    raises :class:`SpecError` naming the offending field. Time is linear in the number
+    of entries (rooms are compared pairwise, at most ``limits.rooms`` of them)."""
+    d = upgrade(d)
     seed = d.get("seed", 0)
-    if isinstance(seed, bool) or not isinstance(seed, int):
-        raise SpecError("seed: expected an integer")
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 63:
+        raise SpecError("seed: expected an integer in [0, 2^63)")
     split = d.get("split", "eval")
     if split not in ("eval", "train"):
         raise SpecError(f"split: expected 'eval' or 'train', got {split!r}")
-
-    rooms = tuple(_parse_room(f"rooms[{i}]", r)
-                  for i, r in enumerate(_entries(d, "rooms", min_len=1)))
+    p = _Parser(limits)
+    rooms = tuple(p.room(f"rooms[{i}]", r)
+                  for i, r in enumerate(p.entries(d, "rooms", limits.rooms, min_len=1)))
     room_ids = _unique_ids("rooms", rooms, "room_")
-    walls = tuple(_parse_wall(f"walls[{i}]", w) for i, w in enumerate(_entries(d, "walls")))
+    p.room_ids = room_ids
+    walls = tuple(p.wall(f"walls[{i}]", w)
+                  for i, w in enumerate(p.entries(d, "walls", limits.walls)))
     _unique_ids("walls", walls, "wall_")
-    doors = tuple(_parse_door(f"doors[{i}]", x, room_ids)
-                  for i, x in enumerate(_entries(d, "doors")))
+    doors = tuple(p.door(f"doors[{i}]", x)
+                  for i, x in enumerate(p.entries(d, "doors", limits.doors)))
     _unique_ids("doors", doors, "door_")
-    passages = tuple(_parse_passage(f"passages[{i}]", x, room_ids)
-                     for i, x in enumerate(_entries(d, "passages", required=False)))
+    passages = tuple(p.passage(f"passages[{i}]", x) for i, x in
+                     enumerate(p.entries(d, "passages", limits.doors, required=False)))
     _unique_ids("passages", passages, "pass_")
-    furniture = tuple(_parse_furniture(f"furniture[{i}]", x, room_ids)
-                      for i, x in enumerate(_entries(d, "furniture")))
-    furn = {f.id: f for f in furniture}
+    furniture = tuple(p.furniture(f"furniture[{i}]", x)
+                      for i, x in enumerate(p.entries(d, "furniture", limits.furniture)))
     _unique_ids("furniture", furniture, "furn_")
-    by_room = {r.id: r for r in rooms}
-    for i, f in enumerate(furniture):
-        if not by_room[f.room].contains(f.center[0], f.center[1]):
-            raise SpecError(f"furniture[{i}].center: ({f.center[0]}, {f.center[1]}) is outside "
-                            f"its room {f.room}")
-    objects = tuple(_parse_object(f"objects[{i}]", x, furn, room_ids)
-                    for i, x in enumerate(_entries(d, "objects")))
+    objects = tuple(p.small_object(f"objects[{i}]", x)
+                    for i, x in enumerate(p.entries(d, "objects", limits.objects)))
     _unique_ids("objects", objects, "obj_")
-    starts = tuple(_parse_start(f"starts[{i}]", x, room_ids)
-                   for i, x in enumerate(_entries(d, "starts")))
-    for i, s in enumerate(starts):
-        if not by_room[s.room].contains(s.x, s.y):
-            raise SpecError(f"starts[{i}]: ({s.x}, {s.y}) is outside its room {s.room}")
-    return HouseSpec(seed=seed, rooms=rooms, walls=walls, doors=doors, furniture=furniture,
+    starts = tuple(p.start(f"starts[{i}]", x)
+                   for i, x in enumerate(p.entries(d, "starts", limits.starts)))
+    spec = HouseSpec(seed=seed, rooms=rooms, walls=walls, doors=doors, furniture=furniture,
                      objects=objects, starts=starts, passages=passages, split=split,
-                     version=version)
+                     version=SPEC_VERSION)
+    check_consistency(spec, limits)
+    check_nesting(furniture, objects, limits.depth)
+    return spec
 
 
-def _entries(d: Mapping[str, Any], key: str, min_len: int = 0,
-             required: bool = True) -> list[Any]:
-    """The list under ``key`` (an empty list when absent and not ``required``)."""
-    if key not in d:
-        if required:
-            raise SpecError(f"{key}: missing")
-        return []
-    v = d[key]
-    if not isinstance(v, list):
-        raise SpecError(f"{key}: expected a list")
-    if len(v) < min_len:
-        raise SpecError(f"{key}: needs at least {min_len} entr{'y' if min_len == 1 else 'ies'}")
-    return v
+class _Parser:
+    """Field rules of each kind of entry, within ``limits``."""
+
+    def __init__(self, limits: SpecLimits):
+        self.limits = limits
+        self.room_ids: set[str] = set()
+
+    # ----- shapes and scalars ---------------------------------------------------------
+    def entries(self, d: Mapping[str, Any], key: str, limit: int, min_len: int = 0,
+                required: bool = True) -> list[Any]:
+        """The list under ``key`` (an empty list when absent and not ``required``)."""
+        if key not in d:
+            if required:
+                raise SpecError(f"{key}: missing")
+            return []
+        v = d[key]
+        if not isinstance(v, list):
+            raise SpecError(f"{key}: expected a list")
+        if len(v) < min_len:
+            raise SpecError(f"{key}: needs at least {min_len} "
+                            f"entr{'y' if min_len == 1 else 'ies'}")
+        if len(v) > limit:
+            raise SpecError(f"{key}: {len(v)} entries, more than the limit of {limit}")
+        return v
+
+    def string(self, where: str, x: Mapping[str, Any], key: str) -> str:
+        return self.name(f"{where}.{key}", _required(where, x, key))
+
+    def name(self, where: str, v: Any) -> str:
+        if not isinstance(v, str) or not v:
+            raise SpecError(f"{where}: expected a non-empty string")
+        if len(v) > self.limits.name_length:
+            raise SpecError(f"{where}: {len(v)} characters, more than the limit of "
+                            f"{self.limits.name_length}")
+        return v
+
+    def number(self, where: str, v: Any) -> float:
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise SpecError(f"{where}: expected a finite number, got {_short(v)}")
+        lim = self.limits.coordinate
+        if isinstance(v, int) and abs(v) > lim:  # before float(): 10**400 overflows it
+            raise SpecError(f"{where}: {_short(v)} is out of range (|x| <= {lim:g})")
+        if not math.isfinite(v):
+            raise SpecError(f"{where}: expected a finite number, got {v!r}")
+        if abs(v) > lim:
+            raise SpecError(f"{where}: {_short(v)} is out of range (|x| <= {lim:g})")
+        return canonical_float(v)  # canonical precision, so load(to_json(spec)) == spec
+
+    def numbers(self, where: str, v: Any, n: int) -> tuple[float, ...]:
+        if not isinstance(v, (list, tuple)) or len(v) != n:
+            raise SpecError(f"{where}: expected {n} numbers")
+        lim = self.limits.coordinate
+        if all(type(c) is float and -lim <= c <= lim for c in v):  # the common case, fast
+            return tuple(canonical_float(c) for c in v)
+        return tuple(self.number(f"{where}[{i}]", c) for i, c in enumerate(v))
+
+    def positive(self, where: str, x: Mapping[str, Any], key: str, limit: float,
+                 default: float | None = None) -> float:
+        """The number in (0, limit] under ``key`` (required when there is no ``default``)."""
+        v = _required(where, x, key) if default is None else x.get(key, default)
+        v = self.number(f"{where}.{key}", v)
+        if v <= 0:
+            raise SpecError(f"{where}.{key}: must be > 0, got {v}")
+        if v > limit:
+            raise SpecError(f"{where}.{key}: {v} is more than the limit of {limit:g}")
+        return v
+
+    def size(self, where: str, v: Any, limit: float) -> tuple[float, ...]:
+        size = self.numbers(where, v, 3)
+        if min(size) <= 0:
+            raise SpecError(f"{where}: every side must be > 0, got {list(size)}")
+        if max(size) > limit:
+            raise SpecError(f"{where}: {list(size)} has a side over the limit of {limit:g} m")
+        return size
+
+    def room_ref(self, where: str, v: Any) -> str:
+        if not isinstance(v, str) or v not in self.room_ids:
+            raise SpecError(f"{where}: unknown room {_short(v)}")
+        return v
+
+    def room_pair(self, where: str, v: Any) -> tuple[str, str]:
+        if not isinstance(v, list) or len(v) != 2 or not all(isinstance(r, str) for r in v):
+            raise SpecError(f"{where}: expected two room ids")
+        for r in v:
+            self.room_ref(where, r)
+        if v[0] == v[1]:
+            raise SpecError(f"{where}: joins room {v[0]!r} to itself")
+        return (v[0], v[1])
+
+    def affordances(self, where: str, x: Mapping[str, Any]) -> tuple[tuple[str, ...], str | None]:
+        """Affordances and state of a piece or a small object (a state only when openable)."""
+        v = x.get("affordances", [])
+        if not isinstance(v, list) or not all(isinstance(a, str) for a in v):
+            raise SpecError(f"{where}.affordances: expected a list of strings")
+        for a in v:
+            if a not in AFFORDANCES:
+                raise SpecError(f"{where}.affordances: unknown affordance {_short(a)} "
+                                f"(known: {', '.join(AFFORDANCES)})")
+        aff = tuple(sorted(set(v)))
+        openable = "openable" in aff
+        state = x.get("state")
+        if not (state is None and not openable) and state not in STATES:
+            raise SpecError(f"{where}.state: expected 'open' or 'closed', got {_short(state)}")
+        if state is not None and not openable:
+            raise SpecError(f"{where}.state: {state!r} given but the piece is not openable")
+        return aff, state
+
+    # ----- entries --------------------------------------------------------------------
+    def room(self, where: str, x: Any) -> Room:
+        x = _json_object(where, x)
+        poly_raw = _required(where, x, "polygon")
+        if not isinstance(poly_raw, list):
+            raise SpecError(f"{where}.polygon: expected a list of [x, y] points")
+        if len(poly_raw) < 3:
+            raise SpecError(f"{where}.polygon: needs at least 3 points, got {len(poly_raw)}")
+        if len(poly_raw) > self.limits.polygon_points:
+            raise SpecError(f"{where}.polygon: {len(poly_raw)} points, more than the limit "
+                            f"of {self.limits.polygon_points}")
+        poly = tuple(self.numbers(f"{where}.polygon[{i}]", q, 2) for i, q in enumerate(poly_raw))
+        if abs(signed_area(poly)) < 1e-6:  # type: ignore[arg-type]
+            raise SpecError(f"{where}.polygon: has zero area")
+        group = x.get("open_plan_group")
+        if group is not None:
+            self.name(f"{where}.open_plan_group", group)
+        return Room(id=self.string(where, x, "id"), category=self.string(where, x, "category"),
+                    polygon=poly, open_plan_group=group)  # type: ignore[arg-type]
+
+    def wall(self, where: str, x: Any) -> Wall:
+        x = _json_object(where, x)
+        a = self.numbers(f"{where}.a", _required(where, x, "a"), 2)
+        b = self.numbers(f"{where}.b", _required(where, x, "b"), 2)
+        if math.dist(a, b) < 1e-6:
+            raise SpecError(f"{where}: has zero length (a == b)")
+        lim = self.limits
+        return Wall(id=self.string(where, x, "id"), a=a, b=b,  # type: ignore[arg-type]
+                    thickness=self.positive(where, x, "thickness", lim.wall_thickness, 0.1),
+                    height=self.positive(where, x, "height", lim.wall_height, 2.5))
+
+    def _opening(self, where: str, x: Mapping[str, Any], width: float) -> dict[str, Any]:
+        """``id``, ``center``, ``width`` (up to ``width``), ``yaw`` and ``rooms`` of a door
+        or a passage."""
+        return {"id": self.string(where, x, "id"),
+                "center": self.numbers(f"{where}.center", _required(where, x, "center"), 2),
+                "width": self.positive(where, x, "width", width),
+                "yaw": self.number(f"{where}.yaw", x.get("yaw", 0.0)),
+                "rooms": self.room_pair(f"{where}.rooms", _required(where, x, "rooms"))}
+
+    def door(self, where: str, x: Any) -> Door:
+        x = _json_object(where, x)
+        state = _required(where, x, "state")
+        if state not in STATES:
+            raise SpecError(f"{where}.state: expected 'open' or 'closed', got {_short(state)}")
+        lim = self.limits
+        return Door(**self._opening(where, x, lim.door_width), state=state,
+                    height=self.positive(where, x, "height", lim.door_height, 2.1),
+                    thickness=self.positive(where, x, "thickness", lim.wall_thickness, 0.1))
+
+    def passage(self, where: str, x: Any) -> Passage:
+        x = _json_object(where, x)
+        return Passage(**self._opening(where, x, self.limits.passage_width))
+
+    def furniture(self, where: str, x: Any) -> Furniture:
+        x = _json_object(where, x)
+        size = self.size(f"{where}.size", _required(where, x, "size"), self.limits.furniture_side)
+        aff, state = self.affordances(where, x)
+        return Furniture(
+            id=self.string(where, x, "id"), category=self.string(where, x, "category"),
+            synset=self.string(where, x, "synset"),
+            room=self.room_ref(f"{where}.room", _required(where, x, "room")),
+            center=self.numbers(f"{where}.center", _required(where, x, "center"), 3),  # type: ignore[arg-type]
+            size=size,  # type: ignore[arg-type]
+            yaw=self.number(f"{where}.yaw", x.get("yaw", 0.0)),
+            affordances=aff, state=state, levels=self.levels(f"{where}.levels", x, size[2]),
+        )
+
+    def levels(self, where: str, x: Mapping[str, Any], height: float) -> tuple[float, ...]:
+        v = x.get("levels", [])
+        if not isinstance(v, list):
+            raise SpecError(f"{where}: expected a list of shelf heights")
+        if len(v) > self.limits.levels:
+            raise SpecError(f"{where}: {len(v)} levels, more than the limit of "
+                            f"{self.limits.levels}")
+        out = tuple(self.number(f"{where}[{i}]", h) for i, h in enumerate(v))
+        for i, h in enumerate(out):
+            if not 0 <= h < height:
+                raise SpecError(f"{where}[{i}]: {h} is not within the piece's height "
+                                f"[0, {height})")
+            if i and h <= out[i - 1]:
+                raise SpecError(f"{where}[{i}]: levels must be ascending")
+        return out
+
+    def small_object(self, where: str, x: Any) -> SmallObject:
+        x = _json_object(where, x)
+        rel = _required(where, x, "relation")
+        if rel not in RELATIONS:
+            raise SpecError(f"{where}.relation: expected 'inside' or 'ontop', got {_short(rel)}")
+        aff, state = self.affordances(where, x)
+        side = self.limits.object_side
+        return SmallObject(
+            id=self.string(where, x, "id"), category=self.string(where, x, "category"),
+            synset=self.string(where, x, "synset"), parent=self.string(where, x, "parent"),
+            relation=rel, room=self.room_ref(f"{where}.room", _required(where, x, "room")),
+            position=self.numbers(f"{where}.position", _required(where, x, "position"), 3),  # type: ignore[arg-type]
+            size=self.size(f"{where}.size", _required(where, x, "size"), side),  # type: ignore[arg-type]
+            affordances=aff, state=state)
+
+    def start(self, where: str, x: Any) -> StartPose:
+        x = _json_object(where, x)
+        return StartPose(x=self.number(f"{where}.x", _required(where, x, "x")),
+                         y=self.number(f"{where}.y", _required(where, x, "y")),
+                         yaw=self.number(f"{where}.yaw", x.get("yaw", 0.0)),
+                         room=self.room_ref(f"{where}.room", _required(where, x, "room")))
+
+
+def _short(v: Any, n: int = 40) -> str:
+    """``repr`` of a value cut to ``n`` characters (a 10^400 integer or a 100,000-character
+    string is named, not printed)."""
+    if isinstance(v, int) and not isinstance(v, bool) and abs(v) > 10 ** 30:
+        return f"an integer of {len(str(abs(v))) if abs(v) < 10 ** 4000 else 'over 4000'} digits"
+    r = repr(v) if not isinstance(v, (str, list, dict)) or len(v) < 1000 else \
+        f"{type(v).__name__} of length {len(v)}"
+    return r if len(r) <= n else r[:n - 3] + "..."
 
 
 def _json_object(where: str, x: Any) -> Mapping[str, Any]:
@@ -108,183 +318,6 @@ def _required(where: str, x: Mapping[str, Any], key: str) -> Any:
     if key not in x:
         raise SpecError(f"{where}.{key}: missing")
     return x[key]
-
-
-def _string(where: str, x: Mapping[str, Any], key: str) -> str:
-    v = _required(where, x, key)
-    if not isinstance(v, str) or not v:
-        raise SpecError(f"{where}.{key}: expected a non-empty string")
-    return v
-
-
-def _number(where: str, v: Any) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-        raise SpecError(f"{where}: expected a finite number, got {v!r}")
-    return canonical_float(v)  # canonical precision, so load(to_json(spec)) == spec
-
-
-def _numbers(where: str, v: Any, n: int) -> tuple[float, ...]:
-    if not isinstance(v, (list, tuple)) or len(v) != n:
-        raise SpecError(f"{where}: expected {n} numbers")
-    return tuple(_number(f"{where}[{i}]", c) for i, c in enumerate(v))
-
-
-def _positive(where: str, v: float) -> float:
-    if v <= 0:
-        raise SpecError(f"{where}: must be > 0, got {v}")
-    return v
-
-
-def _positive_field(where: str, x: Mapping[str, Any], key: str,
-                    default: float | None = None) -> float:
-    """The number > 0 under ``key`` (required when there is no ``default``)."""
-    v = _required(where, x, key) if default is None else x.get(key, default)
-    return _positive(f"{where}.{key}", _number(f"{where}.{key}", v))
-
-
-def _open_or_closed(where: str, v: Any, allow_none: bool) -> str | None:
-    if v is None and allow_none:
-        return None
-    if v not in STATES:
-        raise SpecError(f"{where}: expected 'open' or 'closed', got {v!r}")
-    return v
-
-
-def _room_pair(where: str, v: Any, room_ids: set[str]) -> tuple[str, str]:
-    if not isinstance(v, list) or len(v) != 2 or not all(isinstance(r, str) for r in v):
-        raise SpecError(f"{where}: expected two room ids")
-    for r in v:
-        if r not in room_ids:
-            raise SpecError(f"{where}: unknown room {r!r}")
-    if v[0] == v[1]:
-        raise SpecError(f"{where}: joins room {v[0]!r} to itself")
-    return (v[0], v[1])
-
-
-def _room_ref(where: str, v: Any, room_ids: set[str]) -> str:
-    if not isinstance(v, str) or v not in room_ids:
-        raise SpecError(f"{where}: unknown room {v!r}")
-    return v
-
-
-def _parse_room(where: str, x: Any) -> Room:
-    x = _json_object(where, x)
-    poly_raw = _required(where, x, "polygon")
-    if not isinstance(poly_raw, list):
-        raise SpecError(f"{where}.polygon: expected a list of [x, y] points")
-    if len(poly_raw) < 3:
-        raise SpecError(f"{where}.polygon: needs at least 3 points, got {len(poly_raw)}")
-    poly = tuple(_numbers(f"{where}.polygon[{i}]", p, 2) for i, p in enumerate(poly_raw))
-    if abs(signed_area(poly)) < 1e-6:  # type: ignore[arg-type]
-        raise SpecError(f"{where}.polygon: has zero area")
-    group = x.get("open_plan_group")
-    if group is not None and (not isinstance(group, str) or not group):
-        raise SpecError(f"{where}.open_plan_group: expected a string or null")
-    return Room(id=_string(where, x, "id"), category=_string(where, x, "category"),
-                polygon=poly, open_plan_group=group)  # type: ignore[arg-type]
-
-
-def _parse_wall(where: str, x: Any) -> Wall:
-    x = _json_object(where, x)
-    a = _numbers(f"{where}.a", _required(where, x, "a"), 2)
-    b = _numbers(f"{where}.b", _required(where, x, "b"), 2)
-    if math.dist(a, b) < 1e-6:
-        raise SpecError(f"{where}: has zero length (a == b)")
-    return Wall(id=_string(where, x, "id"), a=a, b=b,  # type: ignore[arg-type]
-                thickness=_positive_field(where, x, "thickness", 0.1),
-                height=_positive_field(where, x, "height", 2.5))
-
-
-def _opening_geometry(where: str, x: Mapping[str, Any]) -> dict[str, Any]:
-    """``id``, ``center``, ``width`` and ``yaw`` of a door or a passage."""
-    return {"id": _string(where, x, "id"),
-            "center": _numbers(f"{where}.center", _required(where, x, "center"), 2),
-            "width": _positive_field(where, x, "width"),
-            "yaw": _number(f"{where}.yaw", x.get("yaw", 0.0))}
-
-
-def _parse_door(where: str, x: Any, room_ids: set[str]) -> Door:
-    x = _json_object(where, x)
-    return Door(
-        **_opening_geometry(where, x),
-        state=_open_or_closed(f"{where}.state", _required(where, x, "state"), allow_none=False),  # type: ignore[arg-type]
-        rooms=_room_pair(f"{where}.rooms", _required(where, x, "rooms"), room_ids),
-        height=_positive_field(where, x, "height", 2.1),
-        thickness=_positive_field(where, x, "thickness", 0.1),
-    )
-
-
-def _parse_passage(where: str, x: Any, room_ids: set[str]) -> Passage:
-    x = _json_object(where, x)
-    return Passage(**_opening_geometry(where, x),
-                   rooms=_room_pair(f"{where}.rooms", _required(where, x, "rooms"), room_ids))
-
-
-def _affordance_list(where: str, v: Any) -> tuple[str, ...]:
-    if not isinstance(v, list) or not all(isinstance(a, str) for a in v):
-        raise SpecError(f"{where}: expected a list of strings")
-    for a in v:
-        if a not in AFFORDANCES:
-            raise SpecError(f"{where}: unknown affordance {a!r} (known: {', '.join(AFFORDANCES)})")
-    return tuple(sorted(set(v)))
-
-
-def _parse_furniture(where: str, x: Any, room_ids: set[str]) -> Furniture:
-    x = _json_object(where, x)
-    size = _numbers(f"{where}.size", _required(where, x, "size"), 3)
-    if min(size) <= 0:
-        raise SpecError(f"{where}.size: every side must be > 0, got {list(size)}")
-    aff = _affordance_list(f"{where}.affordances", x.get("affordances", []))
-    openable = "openable" in aff
-    state = _open_or_closed(f"{where}.state", x.get("state"), allow_none=not openable)
-    if state is not None and not openable:
-        raise SpecError(f"{where}.state: {state!r} given but the piece is not openable")
-    return Furniture(
-        id=_string(where, x, "id"), category=_string(where, x, "category"),
-        synset=_string(where, x, "synset"),
-        room=_room_ref(f"{where}.room", _required(where, x, "room"), room_ids),
-        center=_numbers(f"{where}.center", _required(where, x, "center"), 3),  # type: ignore[arg-type]
-        size=size,  # type: ignore[arg-type]
-        yaw=_number(f"{where}.yaw", x.get("yaw", 0.0)),
-        affordances=aff, state=state,
-    )
-
-
-def _parse_object(where: str, x: Any, furn: Mapping[str, Furniture],
-                  room_ids: set[str]) -> SmallObject:
-    x = _json_object(where, x)
-    parent_id = _string(where, x, "parent")
-    parent = furn.get(parent_id)
-    if parent is None:
-        raise SpecError(f"{where}.parent: unknown furniture {parent_id!r}")
-    rel = _required(where, x, "relation")
-    if rel not in RELATIONS:
-        raise SpecError(f"{where}.relation: expected 'inside' or 'ontop', got {rel!r}")
-    if rel == "inside" and not parent.is_container:
-        raise SpecError(f"{where}.parent: {parent_id} ({parent.category}) is not a container, "
-                        "so nothing can be inside it")
-    size = _numbers(f"{where}.size", _required(where, x, "size"), 3)
-    if min(size) <= 0:
-        raise SpecError(f"{where}.size: every side must be > 0, got {list(size)}")
-    pos = _numbers(f"{where}.position", _required(where, x, "position"), 3)
-    room = _room_ref(f"{where}.room", _required(where, x, "room"), room_ids)
-    if room != parent.room:
-        raise SpecError(f"{where}.room: {room!r} differs from its parent's room {parent.room!r}")
-    obj = SmallObject(id=_string(where, x, "id"), category=_string(where, x, "category"),
-                      synset=_string(where, x, "synset"), parent=parent_id, relation=rel,
-                      room=room, position=pos, size=size)  # type: ignore[arg-type]
-    problem = placement_problem(obj, parent)
-    if problem:
-        raise SpecError(f"{where}.position: {problem}")
-    return obj
-
-
-def _parse_start(where: str, x: Any, room_ids: set[str]) -> StartPose:
-    x = _json_object(where, x)
-    return StartPose(x=_number(f"{where}.x", _required(where, x, "x")),
-                     y=_number(f"{where}.y", _required(where, x, "y")),
-                     yaw=_number(f"{where}.yaw", x.get("yaw", 0.0)),
-                     room=_room_ref(f"{where}.room", _required(where, x, "room"), room_ids))
 
 
 def _unique_ids(key: str, items: Iterable[Any], prefix: str) -> set[str]:
