@@ -11,6 +11,7 @@ import numpy as np
 
 from sgtool.datasets.house_inventory import Inventory
 from sgtool.datasets.house_plan import Piece, Plan, PlanRoom, Rect, snap
+from sgtool.datasets.presets import PRESETS, GeneratorPreset
 from sgtool.datasets.room_space import RoomSpace
 from sgtool.datasets.sizes import (
     CENTRAL,
@@ -23,14 +24,16 @@ from sgtool.datasets.sizes import (
 from sgtool.datasets.synsets import ancestors
 
 
-def _furniture_list(rng: np.random.Generator, room_type: str, inv: Inventory) -> list[str]:
+def _furniture_list(rng: np.random.Generator, room_type: str, inv: Inventory,
+                    preset: GeneratorPreset) -> list[str]:
     rows = inv.furniture.get(room_type, ())
     out: list[str] = []
     for f in rows:
-        if rng.random() >= f.frequency:
+        if rng.random() >= min(1.0, f.frequency * preset.furniture_frequency_scale):
             continue
-        cap = MAX_PER_ROOM.get(f.synset, DEFAULT_MAX_PER_ROOM)
-        n = 1 + int(rng.poisson(max(f.mean_count - 1.0, 0.0)))
+        cap = MAX_PER_ROOM.get(f.synset, DEFAULT_MAX_PER_ROOM) * preset.furniture_cap_scale
+        mean = f.mean_count * preset.furniture_count_scale
+        n = 1 + int(rng.poisson(max(mean - 1.0, 0.0)))
         out += [f.synset] * min(n, cap)
     if room_type != "corridor" and not any(_holds_things(s, inv) for s in out):
         useful = [f.synset for f in rows if _holds_things(f.synset, inv)]
@@ -80,11 +83,12 @@ def _wall_candidate(rng: np.random.Generator, inner: Rect, w: float,
 
 
 def furnish_room(rng: np.random.Generator, room: PlanRoom, plan: Plan, inv: Inventory,
-                 pieces: list[Piece]) -> None:
+                 pieces: list[Piece], preset: GeneratorPreset = PRESETS["default"]) -> None:
     """Draw and place the furniture of ``room``, appending the kept pieces to ``pieces``
-    (whose length gives the index of the room's first piece)."""
+    (whose length gives the index of the room's first piece); ``preset`` scales how many
+    pieces are drawn."""
     space = RoomSpace(room, plan.openings)
-    wanted = _furniture_list(rng, room.type, inv)
+    wanted = _furniture_list(rng, room.type, inv, preset)
     floor = [s for s in wanted if s not in STACKED_ON]
     stacked = [s for s in wanted if s in STACKED_ON]
 

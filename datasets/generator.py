@@ -51,6 +51,12 @@
    A failed attempt is redrawn from the same random stream, so the result still depends
    on the seed only.
 
+**Presets** (:mod:`sgtool.datasets.presets`): the steps above are the ``default`` preset;
+``symsearch`` runs the same steps with more furniture per room, more small objects per
+container and top face, and small objects from the long tail of the split (categories
+whose home is the room type, even on one source, drawn evenly, most draws going to
+categories unseen in training), for houses as dense as SymSearch's InteriorGS scenes.
+
 The same seed gives the same bytes (numpy PCG64 stream, sorted iteration, 4-decimal
 canonical JSON).
 
@@ -84,6 +90,7 @@ from sgtool.datasets.house_plan import (
     PlanRetry,
 )
 from sgtool.datasets.object_placement import place_objects
+from sgtool.datasets.presets import get_preset
 from sgtool.datasets.robot_clearance import start_poses
 from sgtool.datasets.synsets import readable_name
 from sgtool.datasets.walls import wall_segments
@@ -135,9 +142,11 @@ def _wrap_angle(a: float) -> float:
 
 
 def generate_house(seed: int, rooms: tuple[int, int] = (4, 12), split: str = "eval",
-                   max_attempts: int = 40) -> HouseSpec:
+                   max_attempts: int = 40, preset: str = "default") -> HouseSpec:
     """A furnished house for ``seed`` (see the module docstring). ``rooms`` is the range
-    of the room count, corridors included (inclusive, 4..16)."""
+    of the room count, corridors included (inclusive, 4..16); ``preset`` names a
+    :mod:`sgtool.datasets.presets` entry ("default": as documented here; "symsearch":
+    InteriorGS-dense houses with long-tail small objects)."""
     lo, hi = int(rooms[0]), int(rooms[1])
     if not 4 <= lo <= hi <= 16:
         raise SgtoolError(f"rooms: need 4 <= min <= max <= 16, got {lo}-{hi}")
@@ -145,6 +154,7 @@ def generate_house(seed: int, rooms: tuple[int, int] = (4, 12), split: str = "ev
         raise SgtoolError(f"split: expected 'eval' or 'train', got {split!r}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise SgtoolError(f"seed: expected an integer >= 0, got {seed!r}")
+    pre = get_preset(preset)
     inv = house_inventory(split)
     rng = np.random.default_rng(int(seed))
     n_rooms = int(rng.integers(lo, hi + 1))
@@ -153,9 +163,9 @@ def generate_house(seed: int, rooms: tuple[int, int] = (4, 12), split: str = "ev
             plan = floor_plan(rng, n_rooms, inv)
             pieces: list[Piece] = []
             for r in plan.rooms:
-                furnish_room(rng, r, plan, inv, pieces)
+                furnish_room(rng, r, plan, inv, pieces, pre)
             room_types = {r.idx: r.type for r in plan.rooms}
-            objs = place_objects(rng, split, pieces, room_types)
+            objs = place_objects(rng, split, pieces, room_types, pre)
             draft = load_house(_spec_dict(seed, split, plan, pieces, objs, []))
             starts = start_poses(rng, draft)
             return load_house(_spec_dict(seed, split, plan, pieces, objs, starts))

@@ -1,7 +1,10 @@
 """Which small objects may go in or on a piece of furniture of a given room type, with
 sampling weights (step 4 of :mod:`sgtool.datasets.generator`, "Small objects"): candidates
 are admitted by relations of the split and weighed by the evidence of the piece's room
-type only."""
+type only. The ``long_tail`` variant (the ``symsearch`` preset of
+:mod:`sgtool.datasets.presets`) also admits categories whose home is the piece's room type
+on a single source, and draws them evenly, a share of the draws going to categories unseen
+in training."""
 
 from __future__ import annotations
 
@@ -11,8 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sgtool.datasets.split import knowledge_for
-from sgtool.datasets.synsets import ancestors
+from sgtool.datasets.split import knowledge_for, unseen_queries
+from sgtool.datasets.synsets import ancestors, readable_name
 
 # a category must be held by / put in rooms of
 # the piece's room type by at least this many sources (real rooms + activities, the counts
@@ -56,8 +59,28 @@ def _room_evidence(split: str) -> _RoomEvidence:
 
 
 @functools.cache
-def candidates(split: str, parent: str, relation: str,
-               room_type: str) -> tuple[tuple[str, ...], np.ndarray]:
+def _home_support(split: str) -> dict[str, int]:
+    """Small-object synset -> its support in the room type with the most evidence for it
+    (real rooms of the type holding it + activities placing it there)."""
+    ev = _room_evidence(split)
+    best: Counter[str] = Counter()
+    for rt in set(ev.rooms) | set(ev.acts):
+        here = ev.rooms.get(rt, Counter()) + ev.acts.get(rt, Counter())
+        for s, n in here.items():
+            best[s] = max(best[s], n)
+    return dict(best)
+
+
+@functools.cache
+def _novel(split: str) -> frozenset[str]:
+    """Readable names that ``split`` can place and the other split never mentions (for the
+    evaluation split: :func:`sgtool.datasets.split.unseen_queries`; none for training)."""
+    return frozenset(unseen_queries()) if split == "eval" else frozenset()
+
+
+@functools.cache
+def candidates(split: str, parent: str, relation: str, room_type: str, long_tail: bool = False,
+               novel_share: float = 0.0) -> tuple[tuple[str, ...], np.ndarray]:
     """Small objects that may be ``relation`` ``parent`` (or a hypernym of it) in a room of
     ``room_type``, with sampling weights (step 4, "Small objects", of
     :mod:`sgtool.datasets.generator`).
@@ -70,7 +93,14 @@ def candidates(split: str, parent: str, relation: str,
     holding the object + the share of the activities placing objects in it that place
     this one + :data:`LOCAL_BONUS` times the share relating it to the parent here.
     Relations stated in other room types only admit, they add no weight; nothing admitted
-    gives an empty pool (the piece stays empty)."""
+    gives an empty pool (the piece stays empty).
+
+    ``long_tail``: also admitted, a related object with a single source here when this room
+    type is its home (no room type has more sources for it: olive oil in a kitchen cabinet,
+    a hair dryer in a bathroom, never a bowl in a bathroom, whose home is the kitchen);
+    every admitted object weighs the same, except that ``novel_share`` of the weight goes
+    evenly to the admitted objects unseen in training (:func:`_novel`), when there are
+    any."""
     k = knowledge_for(split)
     ev = _room_evidence(split)
     anc = ancestors(parent)
@@ -90,8 +120,26 @@ def candidates(split: str, parent: str, relation: str,
     na = max(ev.n_acts[room_type], 1)
     support = {c: rooms[c] + acts[c] for c in related}
     need = MIN_SUPPORT if any(n >= MIN_SUPPORT for n in support.values()) else 1
-    pool = {c: rooms[c] / nr + (acts[c] + LOCAL_BONUS * local[c]) / na
-            for c, n in support.items() if n >= need}
+    admitted = {c for c, n in support.items() if n >= need}
+    if long_tail:
+        home = _home_support(split)
+        admitted |= {c for c, n in support.items() if n >= 1 and n >= home.get(c, 0)}
+    pool = {c: rooms[c] / nr + (acts[c] + LOCAL_BONUS * local[c]) / na for c in admitted}
     names = tuple(sorted(pool))
+    if long_tail:
+        return names, _long_tail_weights(split, names, novel_share)
     w = np.array([pool[n] for n in names], float)
     return names, (w / w.sum() if w.size else w)
+
+
+def _long_tail_weights(split: str, names: tuple[str, ...], novel_share: float) -> np.ndarray:
+    """``novel_share`` of the weight spread evenly over the objects unseen in training,
+    the rest evenly over the others (all of it evenly when one part is empty)."""
+    if not names:
+        return np.zeros(0)
+    novel = np.array([readable_name(c) in _novel(split) for c in names])
+    w = np.full(len(names), 1.0 / len(names))
+    if novel.any() and not novel.all():
+        w[novel] = novel_share / novel.sum()
+        w[~novel] = (1.0 - novel_share) / (~novel).sum()
+    return w

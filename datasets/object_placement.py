@@ -1,7 +1,8 @@
 """Small objects of a generated house: containers filled and supporters dressed with
 candidates of the piece's room type (:mod:`sgtool.datasets.object_candidates`), each object
 in its own slot (a shelf level inside a container, a spot on a top face) so objects never
-overlap and lie really inside or on top."""
+overlap and lie really inside or on top. How many, and from which pool, is set by the
+generator preset (:mod:`sgtool.datasets.presets`)."""
 
 from __future__ import annotations
 
@@ -11,12 +12,10 @@ import numpy as np
 
 from sgtool.datasets.house_plan import Piece
 from sgtool.datasets.object_candidates import candidates
+from sgtool.datasets.presets import PRESETS, GeneratorPreset
 from sgtool.datasets.sizes import object_size
 from sgtool.datasets.synsets import readable_name
 
-# mean number of small objects per piece (Poisson), for containers and for top faces
-LAMBDA_INSIDE = 2.2
-LAMBDA_ONTOP = 1.3
 # fewer objects on thin evidence: the mean count is scaled by min(1, pool size / this)
 FULL_POOL = 3
 
@@ -55,10 +54,20 @@ def _to_world(p: Piece, lx: float, ly: float) -> tuple[float, float]:
     return (cx + c * lx - s * ly, cy + s * lx + c * ly)
 
 
+def _distinct_categories(rng: np.random.Generator, w: np.ndarray, n: int) -> list[int]:
+    """``n`` draws of candidate indices with weights ``w``, none repeated while the pool
+    lasts."""
+    first = min(n, int(np.count_nonzero(w)))
+    out = rng.choice(len(w), size=first, replace=False, p=w).tolist()
+    return out + rng.choice(len(w), size=n - first, p=w).tolist()
+
+
 def place_objects(rng: np.random.Generator, split: str, pieces: list[Piece],
-                  room_types: dict[int, str]) -> list[dict]:
+                  room_types: dict[int, str],
+                  preset: GeneratorPreset = PRESETS["default"]) -> list[dict]:
     """Small-object records (spec ``objects`` entries without ids) for ``pieces``;
-    ``room_types`` maps plan room index -> room type."""
+    ``room_types`` maps plan room index -> room type; ``preset`` sets the mean counts and
+    the candidate pool."""
     objs: list[dict] = []
     for pi, p in enumerate(pieces):
         for relation in ("inside", "ontop"):
@@ -67,19 +76,21 @@ def place_objects(rng: np.random.Generator, split: str, pieces: list[Piece],
             if relation == "ontop" and ("supporter" not in p.affordances or p.top_used
                                         or p.size[2] > 1.7):
                 continue
-            names, w = candidates(split, p.synset, relation, room_types[p.room])
+            names, w = candidates(split, p.synset, relation, room_types[p.room],
+                                  preset.long_tail, preset.novel_share)
             if not names:
                 continue
-            lam = LAMBDA_INSIDE if relation == "inside" else LAMBDA_ONTOP
+            lam = preset.lambda_inside if relation == "inside" else preset.lambda_ontop
             lam *= min(1.0, len(names) / FULL_POOL)
             slots = _slots(p, relation)
             n = min(int(rng.poisson(lam)), len(slots))
             if n == 0:
                 continue
             chosen_slots = sorted(rng.choice(len(slots), size=n, replace=False).tolist())
-            for si in chosen_slots:
+            cats = _distinct_categories(rng, w, n) if preset.long_tail else None
+            for i, si in enumerate(chosen_slots):
                 cx, cy, z, ssx, ssy, szmax = slots[si]
-                syn = names[int(rng.choice(len(names), p=w))]
+                syn = names[int(rng.choice(len(names), p=w)) if cats is None else cats[i]]
                 bx, by, bz = object_size(syn)
                 k = rng.uniform(0.9, 1.1)
                 # objects keep the piece's orientation; clip them to the slot

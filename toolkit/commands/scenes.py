@@ -29,6 +29,16 @@ def _split_option(f):  # type: ignore[no-untyped-def]
              "houses built only from what planners may learn from.")(f)
 
 
+def _preset_option(f):  # type: ignore[no-untyped-def]
+    from sgtool.datasets.presets import PRESET_NAMES
+
+    return click.option(
+        "--preset", type=click.Choice(list(PRESET_NAMES)), default="default",
+        show_default=True,
+        help="Generator preset: 'default', or 'symsearch' for houses as dense as "
+             "SymSearch's InteriorGS scenes with long-tail small objects.")(f)
+
+
 @click.group("scenes")
 def command() -> None:
     """Houses furnished from BEHAVIOR-1K knowledge (the `bddl` package, read offline):
@@ -41,10 +51,11 @@ def command() -> None:
               help="Random seed; the same seed gives the same bytes.")
 @_rooms_option
 @_split_option
+@_preset_option
 @click.option("-o", "--output", type=click.Path(dir_okay=False), required=True,
               help="House spec JSON to write (atomically).")
 @click.option("--force", is_flag=True, help="Overwrite the output file.")
-def generate_cmd(seed: int, rooms: tuple[int, int], split: str, output: str,
+def generate_cmd(seed: int, rooms: tuple[int, int], split: str, preset: str, output: str,
                  force: bool) -> None:
     """Generate a connected multi-room house and write its JSON spec."""
     from sgtool.commands.options import check_output
@@ -52,7 +63,7 @@ def generate_cmd(seed: int, rooms: tuple[int, int], split: str, output: str,
     from sgtool.house.io import save_house
 
     check_output(output, force=force, suffixes=(".json",), what="house spec")
-    spec = generate_house(seed, rooms=rooms, split=split)
+    spec = generate_house(seed, rooms=rooms, split=split, preset=preset)
     save_house(spec, output)
     closed = sum(d.state == "closed" for d in spec.doors)
     inside = sum(o.relation == "inside" for o in spec.objects)
@@ -94,8 +105,9 @@ def show_cmd(house: str, output: str | None, dpi: int, no_objects: bool, force: 
               help="First seed.")
 @_rooms_option
 @_split_option
+@_preset_option
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object.")
-def stats_cmd(houses: int, seed: int, rooms: tuple[int, int], split: str,
+def stats_cmd(houses: int, seed: int, rooms: tuple[int, int], split: str, preset: str,
               as_json: bool) -> None:
     """Table I of SCOUT for N generated houses, beside the real OmniGibson scenes of
     `bddl` (all, and homes only) and the rows printed in the paper."""
@@ -105,20 +117,21 @@ def stats_cmd(houses: int, seed: int, rooms: tuple[int, int], split: str,
     from sgtool.datasets.knowledge import load_knowledge
     from sgtool.datasets.stats import PAPER_TABLE_I, format_table, house_stats, inventory_stats
 
-    specs = [generate_house(s, rooms=rooms, split=split)
+    specs = [generate_house(s, rooms=rooms, split=split, preset=preset)
              for s in tqdm(range(seed, seed + houses), desc="houses", unit="house",
                            disable=not sys.stderr.isatty(), file=sys.stderr)]
     ours = house_stats(specs)
     k = load_knowledge()
     rows = {
-        f"sgtool {split} houses": ours.to_dict(),
+        f"sgtool {split} houses" + (f" ({preset})" if preset != "default" else ""):
+            ours.to_dict(),
         "bddl scenes, all (measured)": inventory_stats(k).to_dict(),
         "bddl scenes, homes (measured)": inventory_stats(k, household_only=True).to_dict(),
         **PAPER_TABLE_I,
     }
     if as_json:
-        click.echo(json.dumps({"rooms": list(rooms), "split": split, "first_seed": seed,
-                               "rows": rows}, indent=2, sort_keys=True))
+        click.echo(json.dumps({"rooms": list(rooms), "split": split, "preset": preset,
+                               "first_seed": seed, "rows": rows}, indent=2, sort_keys=True))
         return
     click.echo(format_table(rows))
     click.echo(f"\nsgtool houses: {ours.furniture_per_scene:.1f} furniture, "
@@ -138,18 +151,25 @@ def stats_cmd(houses: int, seed: int, rooms: tuple[int, int], split: str,
               help="Seed of the choice of categories and start poses.")
 @click.option("--reach", type=click.FloatRange(min=0.1), default=1.0, show_default=True,
               help="A target counts as reached within this distance (m) of its parent.")
+@_preset_option
 @click.option("--json", "as_json", is_flag=True, help="Print JSON (one list).")
-def episodes_cmd(house: str, count: int | None, seed: int, reach: float,
+def episodes_cmd(house: str, count: int | None, seed: int, reach: float, preset: str,
                  as_json: bool) -> None:
     """List object-search episodes of HOUSE: query category, target instances, start pose,
     whether every target is hidden in a closed container, and the shortest path (m) from
     the start to the nearest target on the house's occupancy grid (closed doors
-    passable)."""
+    passable). With --preset symsearch, a third of the episodes ask for furniture (SymSearch's
+    non-interactive targets); COUNT defaults to the number of small-object categories."""
+    from sgtool.datasets.episode_mix import symsearch_episodes
     from sgtool.datasets.episodes import list_episodes
     from sgtool.house.io import load_house
 
     spec = load_house(house)
-    eps = list_episodes(spec, n=count, seed=seed, reach=reach)
+    if preset == "symsearch":
+        n = count or len({o.category for o in spec.objects}) or len(spec.furniture)
+        eps = symsearch_episodes(spec, n, seed=seed, reach=reach)
+    else:
+        eps = list_episodes(spec, n=count, seed=seed, reach=reach)
     if as_json:
         click.echo(json.dumps([e.to_dict() for e in eps], indent=1, sort_keys=True))
         return

@@ -113,3 +113,26 @@ def test_outputs_are_checked_before_writing(tmp_path):
     assert not (tmp_path / "no").exists()
     r = CliRunner().invoke(cli, ["scenes", "show", str(out), "-o", str(tmp_path / "p.gif")])
     assert r.exit_code == 2 and ".png" in r.output
+
+
+def test_symsearch_preset_generate_stats_episodes(tmp_path):
+    house = tmp_path / "dense.json"
+    r = CliRunner().invoke(cli, ["scenes", "generate", "--seed", "2", "--rooms", "9-12",
+                                 "--preset", "symsearch", "-o", str(house)])
+    assert r.exit_code == 0, r.output
+    spec = load_house(house)
+    assert spec == generate_house(2, rooms=(9, 12), preset="symsearch")
+    r = CliRunner().invoke(cli, ["scenes", "stats", "-n", "1", "--seed", "2", "--rooms",
+                                 "9-12", "--preset", "symsearch", "--json"])
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    assert out["preset"] == "symsearch"
+    row = out["rows"]["sgtool eval houses (symsearch)"]
+    assert row["objects_per_scene"] == len(spec.furniture) + len(spec.objects)
+    r = CliRunner().invoke(cli, ["scenes", "episodes", str(house), "-n", "6", "--preset",
+                                 "symsearch", "--json"])
+    assert r.exit_code == 0, r.output
+    eps = json.loads(r.output)
+    furn = [e for e in eps if e["targets"][0].startswith("furn_")]
+    assert len(eps) == 6 and len(furn) == 2  # a third ask for furniture
+    assert all(e["shortest_path"] is not None and not e["hidden"] for e in furn)
