@@ -4,20 +4,29 @@ Protocol (SCOUT sec. VI, Table VII; MoMa-LLM's AUC-E):
 
 - houses ``generate_house(house_seed + i, rooms=rooms, split="eval")`` for i < ``houses``:
   furnished from the evaluation part of the knowledge only (``rooms`` defaults to
-  :data:`DEFAULT_ROOMS`, chosen for scene size, see there);
+  :data:`DEFAULT_ROOMS`, chosen for scene size, see there), ids ``house-<seed>``; then the
+  house spec files of ``house_files`` (files or folders of ``*.json``), ids from the spec
+  or the file name, every file checked before anything runs
+  (:mod:`sgtool.analysis.bench_houses`);
 - per house, ``episodes`` search episodes from :func:`sgtool.datasets.episodes.list_episodes`
-  (seeded by the house seed, so the episode set is the same for every bench seed);
+  (seeded by the house seed, so the episode set is the same for every bench seed; a house
+  file without start poses gets one per reachable room first);
 - per bench seed (0 .. ``seeds`` - 1): the start region of every episode and the planner's
   own seed are drawn from (seed, house seed, episode index)
   (:class:`sgtool.recorders.symbolic_environment.SymbolicEnv`,
   :func:`~sgtool.recorders.symbolic_environment.planner_seed`);
 - every planner runs every (seed, house, episode) with at most ``max_steps`` actions;
-- a query is "unseen" when it is one of :func:`sgtool.datasets.split.unseen_queries` (it
-  occurs nowhere in the knowledge the planners were trained on), "seen" otherwise.
+- a query is "seen" when its :func:`~sgtool.semantics.text.category_text` is one of the
+  training queries of the relational priors (the shipped ones, or those in ``priors_dir``,
+  which the scout planners then also load): :func:`sgtool.semantics.priors.training_queries`,
+  the vocabulary ``sgtool distill`` writes into the weights' metadata; "unseen" otherwise.
 
 Outputs (in ``out_dir``): ``episodes.jsonl`` (one :class:`EpisodeResult` per line, ordered
-by planner, seed, house, episode), ``summary.md`` (Table VII-shaped table, seen/unseen
-table, AUC-E budgets, settings, digest), ``summary.json``, and the efficiency curves
+by planner, then house id (plain string order), episode index, seed), ``summary.md`` (Table
+VII-shaped table, the same next to the rows quoted from SCOUT Table VII, seen/unseen table,
+per-house and per-query tables, AUC-E budgets, settings, digest), ``summary.json``,
+``per_house.md``/``per_house.jsonl`` and ``per_query.md``/``per_query.jsonl`` (SR, SPL,
+steps per planner, pooled over seeds), and the efficiency curves
 ``efficiency_distance.png`` and ``efficiency_steps.png``. Every file is written to a temp
 file and renamed. Records are identical between runs except their ``wall`` figures; the
 digest in the summary leaves those out.
@@ -41,15 +50,31 @@ from pathlib import Path
 from typing import Any
 
 from sgtool import __version__
-from sgtool.analysis.metrics import CostModel, cost_models, seen_unseen, summarize
-from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
+from sgtool.analysis.bench_houses import (
+    BenchHouse,
+    bench_episodes,
+    generated_houses,
+    load_house_files,
+)
+from sgtool.analysis.metrics import CostModel, breakdown, cost_models, seen_unseen, summarize
+from sgtool.analysis.paper_tables import TABLE_IX_SYMSEARCH
+from sgtool.analysis.report import (
+    breakdown_records,
+    format_breakdown,
+    format_seen_unseen,
+    format_side_by_side,
+    format_table,
+    summary_dict,
+)
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write
+from sgtool.redact import redact_options, redact_text, secret_values
 from sgtool.results import EpisodeResult, results_digest, write_jsonl
 
 DEFAULT_PLANNERS: tuple[str, ...] = (
     "random", "greedy", "sbert-noroom", "sbert", "scout-noroom", "scout-delta0", "scout",
+    "godhs", "esc", "bayes-search",
 )
 BENCH_VERSION = "1.0"
 # Room-count range of the benchmark houses. 12-16 rooms give ~48 furniture pieces (the
@@ -71,6 +96,7 @@ class BenchConfig:
     episodes: int = 20  # per house
     seeds: int = 5
     rooms: tuple[int, int] = DEFAULT_ROOMS
+    preset: str = "default"  # generator preset of the generated houses
     house_seed: int = 0  # first house seed
     max_steps: int = 50  # SymSearch's N_max
     workers: int = 1
@@ -78,6 +104,8 @@ class BenchConfig:
     step_budget: float = 50.0  # MoMa-LLM high-level budget
     planner_options: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     log_dir: str | None = None  # also record every episode as an MCAP log here
+    house_files: tuple[str, ...] = ()  # house spec files or folders, after the generated
+    priors_dir: str | None = None  # relational priors (vocabulary, scout weights)
 
     def check(self) -> None:
         from sgtool.planning.registry import PLANNER_NAMES
@@ -90,13 +118,18 @@ class BenchConfig:
                                  f"{', '.join(PLANNER_NAMES)}")
         if len(set(self.planners)) != len(self.planners):
             raise BenchError("--planners: a planner is named twice")
-        for name, value in (("--houses", self.houses), ("--episodes", self.episodes),
-                            ("--seeds", self.seeds), ("--max-steps", self.max_steps),
-                            ("--workers", self.workers)):
+        for name, value in (("--episodes", self.episodes), ("--seeds", self.seeds),
+                            ("--max-steps", self.max_steps), ("--workers", self.workers)):
             if value < 1:
                 raise BenchError(f"{name}: must be >= 1, got {value}")
+        if self.houses < 0 or (self.houses == 0 and not self.house_files):
+            raise BenchError(f"--houses: must be >= 1, or >= 0 with --house, got {self.houses}")
         if self.house_seed < 0:
             raise BenchError(f"--house-seed: must be >= 0, got {self.house_seed}")
+        from sgtool.datasets.presets import PRESET_NAMES
+
+        if self.preset not in PRESET_NAMES:
+            raise BenchError(f"--preset: one of {', '.join(PRESET_NAMES)}, got {self.preset!r}")
         lo, hi = self.rooms
         if not 4 <= lo <= hi <= 16:
             raise BenchError(f"--rooms: need 4 <= MIN <= MAX <= 16, got {lo}-{hi}")
@@ -115,7 +148,7 @@ class BenchConfig:
         d = asdict(self)
         d["planners"] = list(self.planners)
         d["rooms"] = list(self.rooms)
-        d["planner_options"] = {k: {kk: str(vv) for kk, vv in v.items()}
+        d["planner_options"] = {k: {kk: str(vv) for kk, vv in redact_options(v).items()}
                                 for k, v in sorted(self.planner_options.items())}
         d.pop("workers")  # does not change the results
         d.pop("log_dir")
@@ -131,27 +164,41 @@ class BenchResult:
     seen_table: str
     digest: str
     wall_s: float
+    houses: tuple[BenchHouse, ...] = ()
+    vocabulary_size: int = 0  # training queries of the priors
+
+    @property
+    def side_by_side(self) -> str:
+        return format_side_by_side(
+            summarize(self.results, self.config.models(), self.config.planners),
+            title="Ours next to SCOUT Table VII (SymSearch rows quoted from the paper)")
+
+    def breakdown_table(self, by: str) -> str:
+        rows = breakdown(self.results, by, self.config.planners)
+        what = "house" if by == "house" else "query (seen: in the priors' training queries)"
+        return format_breakdown(rows, by, self.config.planners,
+                                title=f"Per {what}: SR / SPL per planner, episodes pooled "
+                                      "over seeds")
 
 
 # ----------------------------------------------------------------------------------------
 # one worker task: one house, one planner, every seed and episode
 # ----------------------------------------------------------------------------------------
-_HOUSES: OrderedDict[tuple[int, tuple[int, int]], Any] = OrderedDict()
+_HOUSES: OrderedDict[tuple[str, str, tuple[int, int], str], Any] = OrderedDict()
 _PLANNERS: dict[tuple[str, str], Any] = {}
 
 
-def _house(seed: int, rooms: tuple[int, int], episodes: int) -> tuple[Any, list[Any]]:
-    from sgtool.datasets.episodes import list_episodes
-    from sgtool.datasets.generator import generate_house
+def _house(ref: BenchHouse, rooms: tuple[int, int], episodes: int,
+           preset: str = "default") -> tuple[Any, list[Any]]:
     from sgtool.recorders.symbolic_environment.house import SymbolicHouse
 
-    key = (seed, rooms)
+    key = (ref.id, ref.source, rooms, preset)
     hit = _HOUSES.get(key)
     if hit is not None and len(hit[1]) >= episodes:
         _HOUSES.move_to_end(key)
         return hit[0], hit[1][:episodes]
-    spec = generate_house(seed, rooms=rooms, split="eval")
-    entry = (SymbolicHouse(spec), list_episodes(spec, episodes, seed=seed))
+    spec = ref.load(rooms, preset)
+    entry = (SymbolicHouse(spec), bench_episodes(spec, episodes, preset))
     _HOUSES[key] = entry
     while len(_HOUSES) > 3:
         _HOUSES.popitem(last=False)
@@ -169,34 +216,41 @@ def _planner(name: str, options: Mapping[str, Any]) -> Any:
     return p
 
 
-def _unseen() -> frozenset[str]:
-    from sgtool.datasets.split import unseen_queries
-    from sgtool.semantics.text import category_text
+def planner_options_for(cfg: BenchConfig, name: str) -> dict[str, Any]:
+    """The options ``name`` is built with: the configured ones, and for the scout planners
+    the weights of ``cfg.priors_dir`` unless an option names other weights."""
+    opts = dict(cfg.planner_options.get(name, {}))
+    if cfg.priors_dir is not None and name.startswith("scout"):
+        opts.setdefault("weights_dir", cfg.priors_dir)
+    return opts
 
-    return frozenset(category_text(q) for q in unseen_queries())
+
+def _vocabulary(priors_dir: str | None) -> frozenset[str]:
+    from sgtool.semantics.priors import training_queries
+
+    return training_queries(priors_dir)
 
 
-def _task(args: tuple[BenchConfig, int, str]) -> list[EpisodeResult]:
+def _task(args: tuple[BenchConfig, BenchHouse, str]) -> list[EpisodeResult]:
     from sgtool.recorders.symbolic_environment.rollout import run_episode
     from sgtool.semantics.text import category_text
 
-    cfg, house_i, name = args
-    house_seed = cfg.house_seed + house_i
-    house, episodes = _house(house_seed, cfg.rooms, cfg.episodes)
-    planner = _planner(name, cfg.planner_options.get(name, {}))
-    unseen = _unseen()
+    cfg, ref, name = args
+    house, episodes = _house(ref, cfg.rooms, cfg.episodes, cfg.preset)
+    planner = _planner(name, planner_options_for(cfg, name))
+    vocabulary = _vocabulary(cfg.priors_dir)
     out = []
     for seed in range(cfg.seeds):
         for i, ep in enumerate(episodes):
             kw = dict(seed=seed, episode_index=i, avoid_rooms=ep.target_rooms,
-                      max_steps=cfg.max_steps, seen=category_text(ep.query) not in unseen,
-                      house_id=f"house-{house_seed}", planner_name=name)
+                      max_steps=cfg.max_steps, seen=category_text(ep.query) in vocabulary,
+                      house_id=ref.id, planner_name=name)
             if cfg.log_dir is None:
                 out.append(run_episode(house, planner, ep.query, ep.targets, **kw))
                 continue
             from sgtool.log.writer import LogWriter
 
-            path = Path(cfg.log_dir) / name / f"house-{house_seed}" / f"seed{seed}-ep{i}.mcap"
+            path = Path(cfg.log_dir) / name / ref.id / f"seed{seed}-ep{i}.mcap"
             path.parent.mkdir(parents=True, exist_ok=True)
             with LogWriter(path, seed=seed) as log:
                 out.append(run_episode(house, planner, ep.query, ep.targets, log=log, **kw))
@@ -209,7 +263,9 @@ def _task(args: tuple[BenchConfig, int, str]) -> list[EpisodeResult]:
 def run_benchmark(cfg: BenchConfig, progress: bool | None = None) -> BenchResult:
     """Run every planner on every episode (module doc); nothing is written."""
     cfg.check()
-    tasks = [(cfg, h, p) for h in range(cfg.houses) for p in cfg.planners]
+    houses = prepare_houses(cfg)
+    vocabulary = _vocabulary(cfg.priors_dir)  # a bad --priors fails before any episode
+    tasks = [(cfg, h, p) for h in houses for p in cfg.planners]
     show = sys.stderr.isatty() if progress is None else progress
     t0 = time.perf_counter()
     chunks: list[list[EpisodeResult]] = []
@@ -241,8 +297,7 @@ def run_benchmark(cfg: BenchConfig, progress: bool | None = None) -> BenchResult
     # through the JSONL form, so the summary is exactly what `sgtool eval` recomputes from
     # episodes.jsonl (figures rounded as written)
     results = sorted((EpisodeResult.from_dict(r.to_dict()) for c in chunks for r in c),
-                     key=lambda r: (order[r.planner], r.seed, int(r.house.split("-")[-1]),
-                                    r.episode))
+                     key=lambda r: (order[r.planner], r.house, r.episode, r.seed))
     spent: dict[str, float] = {}
     count: dict[str, int] = {}
     for r in results:
@@ -251,26 +306,44 @@ def run_benchmark(cfg: BenchConfig, progress: bool | None = None) -> BenchResult
     throughput = {p: (count[p] / spent[p] if spent.get(p) else math.nan) for p in count}
     models = cfg.models()
     sums = summarize(results, models, planners=cfg.planners)
-    title = (f"Symbolic benchmark (SymSearch roll-out): {cfg.houses} houses x {cfg.episodes} "
-             f"episodes x {cfg.seeds} seeds, N_max = {cfg.max_steps}, rooms "
-             f"{cfg.rooms[0]}-{cfg.rooms[1]}")
-    table = format_table(sums, throughput=throughput, models=models, title=title)
-    seen_table = format_seen_unseen(seen_unseen(results, cfg.planners),
-                                    title="Seen vs unseen queries (SCOUT Table IX), "
-                                          "episodes pooled over seeds")
+    table = format_table(sums, throughput=throughput, models=models, title=_title(cfg))
+    priors = cfg.priors_dir or "the shipped priors"
+    seen_table = format_seen_unseen(
+        seen_unseen(results, cfg.planners), quoted=TABLE_IX_SYMSEARCH,
+        title=f"Seen vs unseen queries (SCOUT Table IX), episodes pooled over seeds; seen = "
+              f"one of the {len(vocabulary)} training queries of {priors}")
     return BenchResult(cfg, tuple(results), throughput, table, seen_table,
-                       results_digest(results), wall)
+                       results_digest(results), wall, houses, len(vocabulary))
 
 
-def priors_fingerprint() -> str:
-    """SHA-256 (first 16 hex digits) of the shipped relational-prior weights the sbert/scout
-    planners load, so a table can be traced to the priors that produced it."""
+def prepare_houses(cfg: BenchConfig) -> tuple[BenchHouse, ...]:
+    """The run's houses: the generated ones, then every house file, all checked first
+    (:func:`sgtool.analysis.bench_houses.load_house_files`)."""
+    made = generated_houses(cfg.houses, cfg.house_seed)
+    given = load_house_files(cfg.house_files, taken=[h.id for h in made]) \
+        if cfg.house_files else ()
+    return made + given
+
+
+def _title(cfg: BenchConfig) -> str:
+    parts = []
+    if cfg.houses:
+        parts.append(f"{cfg.houses} generated houses (rooms {cfg.rooms[0]}-{cfg.rooms[1]})")
+    if cfg.house_files:
+        parts.append(f"houses from {', '.join(cfg.house_files)}")
+    return (f"Symbolic benchmark (SymSearch roll-out): {' + '.join(parts)}; {cfg.episodes} "
+            f"episodes per house x {cfg.seeds} seeds, N_max = {cfg.max_steps}")
+
+
+def priors_fingerprint(weights_dir: str | os.PathLike[str] | None = None) -> str:
+    """SHA-256 (first 16 hex digits) of the relational-prior weights the scout planners load
+    (the shipped ones by default), so a table can be traced to the priors behind it."""
     import hashlib
 
     from sgtool.semantics.priors import WEIGHTS_DIR
 
     h = hashlib.sha256()
-    for p in sorted(Path(WEIGHTS_DIR).glob("*")):
+    for p in sorted(Path(weights_dir or WEIGHTS_DIR).glob("*")):
         if p.is_file() and (p.suffix == ".safetensors" or p.name == "metadata.json"):
             h.update(p.name.encode())
             h.update(p.read_bytes())
@@ -279,7 +352,8 @@ def priors_fingerprint() -> str:
 
 def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
                   command: str = "") -> list[Path]:
-    """episodes.jsonl, summary.md, summary.json and the two efficiency PNGs."""
+    """episodes.jsonl, summary.md, summary.json, per_house.md/.jsonl, per_query.md/.jsonl
+    and the two efficiency PNGs."""
     from sgtool.analysis.curves import plot_efficiency
 
     out = Path(out_dir)
@@ -289,13 +363,21 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
     by_planner = [(p, [r for r in res.results if r.planner == p]) for p in cfg.planners]
     for model in cfg.models():
         paths.append(plot_efficiency(by_planner, model, out / f"efficiency_{model.name}.png"))
-    md = [res.table, res.seen_table,
+    for by in ("house", "query"):
+        rows = breakdown(res.results, by, cfg.planners)
+        paths.append(atomic_write(out / f"per_{by}.md", res.breakdown_table(by)))
+        paths.append(atomic_write(out / f"per_{by}.jsonl", "".join(
+            json.dumps(d, sort_keys=True, allow_nan=False) + "\n"
+            for d in breakdown_records(rows, by))))
+    md = [res.table, res.side_by_side, res.seen_table, res.breakdown_table("house"),
+          res.breakdown_table("query"),
           f"Episodes per second: one core, episode roll-outs only (house preparation "
           f"excluded); whole run {res.wall_s:.1f} s with {cfg.workers} worker(s).",
           f"Digest of episodes.jsonl without wall-clock fields: {res.digest}",
-          f"sgtool {__version__}; relational priors {priors_fingerprint()}"]
-    if command:
-        md.append(f"Command: `{command}`")
+          f"sgtool {__version__}; relational priors "
+          f"{priors_fingerprint(cfg.priors_dir)}"]
+    if command:  # secrets given as options (-O moma-llm.api_key=...) never reach a file
+        md.append(f"Command: `{redact_text(command, secret_values(cfg.planner_options))}`")
     paths.append(atomic_write(out / "summary.md", "\n".join(md) + "\n"))
     summary = {
         "version": BENCH_VERSION,
@@ -303,9 +385,11 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
         "budgets": {m.name: {"max": m.max_cost, "cost": m.label} for m in cfg.models()},
         "planners": summary_dict(summarize(res.results, cfg.models(), cfg.planners)),
         "seen_unseen": [asdict(s) for s in seen_unseen(res.results, cfg.planners)],
+        "vocabulary": {"priors": cfg.priors_dir, "training_queries": res.vocabulary_size},
+        "houses": [{"id": h.id, "source": h.source} for h in res.houses],
         "digest": res.digest,
         "sgtool_version": __version__,
-        "priors_sha256_16": priors_fingerprint(),
+        "priors_sha256_16": priors_fingerprint(cfg.priors_dir),
         "wall": {"seconds": round(res.wall_s, 3), "workers": cfg.workers,
                  "episodes_per_s": {k: round(v, 3) for k, v in res.throughput.items()}},
     }
@@ -319,13 +403,15 @@ def run_bench(planners: Sequence[str] = DEFAULT_PLANNERS, houses: int = 10, epis
               seeds: int = 5, workers: int = 1, out_dir: str | os.PathLike[str] | None = None,
               rooms: tuple[int, int] = DEFAULT_ROOMS, max_steps: int = 50, house_seed: int = 0,
               planner_options: Mapping[str, Mapping[str, Any]] | None = None,
-              progress: bool | None = None) -> str:
+              progress: bool | None = None, house_files: Sequence[str] = (),
+              priors_dir: str | None = None) -> str:
     """Run the benchmark and return its table text (Table VII shape, then Table IX);
     with ``out_dir``, also write the outputs there (see :func:`write_outputs`)."""
     cfg = BenchConfig(planners=tuple(planners), houses=houses, episodes=episodes, seeds=seeds,
                       rooms=(int(rooms[0]), int(rooms[1])), house_seed=house_seed,
                       max_steps=max_steps, workers=workers,
-                      planner_options=dict(planner_options or {}))
+                      planner_options=dict(planner_options or {}),
+                      house_files=tuple(map(str, house_files)), priors_dir=priors_dir)
     res = run_benchmark(cfg, progress=progress)
     if out_dir is not None:
         write_outputs(res, out_dir)

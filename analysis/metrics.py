@@ -274,6 +274,8 @@ class SplitSummary:
     unseen_n: int
     unseen_sr: float
     unseen_spl: float
+    seen_queries: int = 0  # distinct query categories among the seen episodes
+    unseen_queries: int = 0
 
 
 def seen_unseen(results: Sequence[EpisodeResult], planners: Sequence[str] | None = None
@@ -287,5 +289,40 @@ def seen_unseen(results: Sequence[EpisodeResult], planners: Sequence[str] | None
         seen = [r for r in rs if r.seen is True]
         unseen = [r for r in rs if r.seen is False]
         out.append(SplitSummary(p, len(seen), success_rate(seen), spl(seen), len(unseen),
-                                success_rate(unseen), spl(unseen)))
+                                success_rate(unseen), spl(unseen),
+                                len({r.query for r in seen}), len({r.query for r in unseen})))
+    return out
+
+
+@dataclass(frozen=True)
+class BreakdownRow:
+    """One planner's episodes of one house or one query, pooled over seeds."""
+
+    key: str  # the house id or the query
+    planner: str
+    episodes: int
+    sr: float
+    spl: float
+    steps: float
+    seen: bool | None = None  # per query: seen by the priors (None per house)
+
+
+def breakdown(results: Sequence[EpisodeResult], by: str,
+              planners: Sequence[str] | None = None) -> list[BreakdownRow]:
+    """SR, SPL and mean steps per (house or query, planner), ``by`` = "house" or "query";
+    rows sorted by key (plain string order), then by planner in ``planners`` order."""
+    if by not in ("house", "query"):
+        raise ValueError(f"by must be 'house' or 'query', got {by!r}")
+    order = list(planners) if planners is not None else planner_order(results)
+    groups = group_by(results, lambda r: (getattr(r, by), r.planner))
+    out = []
+    for key in sorted({k for k, _ in groups}):  # type: ignore[misc]
+        for p in order:
+            rs = groups.get((key, p))
+            if not rs:
+                continue
+            seen = {r.seen for r in rs}
+            out.append(BreakdownRow(str(key), p, len(rs), success_rate(rs), spl(rs),
+                                    mean_steps(rs),
+                                    seen.pop() if by == "query" and len(seen) == 1 else None))
     return out

@@ -1,4 +1,6 @@
-"""Text tables in the shape of SCOUT's Table VII (SymSearch columns) and Table IX.
+"""Text tables in the shape of SCOUT's Table VII (SymSearch columns) and Table IX, the same
+columns next to the rows quoted from the paper (:mod:`sgtool.analysis.paper_tables`), and
+the per-house and per-query breakdowns.
 
 Plain text (a Markdown pipe table), so the same string prints on a terminal, goes into
 ``summary.md`` and into the README demo. Numbers: SR, SPL and AUC-E with three decimals,
@@ -11,7 +13,21 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 
-from sgtool.analysis.metrics import CostModel, PlannerSummary, SplitSummary, Stat
+from sgtool.analysis.metrics import (
+    BreakdownRow,
+    CostModel,
+    PlannerSummary,
+    SplitSummary,
+    Stat,
+)
+from sgtool.analysis.paper_tables import (
+    SOURCE,
+    SOURCE_IX,
+    TABLE_VII_SYMSEARCH,
+    QuotedRow,
+    QuotedSplit,
+    quoted_for,
+)
 
 _COLUMNS: tuple[tuple[str, str, str], ...] = (
     # (stat key, header, format)
@@ -71,15 +87,102 @@ def format_table(summaries: Sequence[PlannerSummary],
     return "\n".join(parts) + "\n"
 
 
-def format_seen_unseen(rows: Sequence[SplitSummary], title: str = "") -> str:
-    """SCOUT Table IX: SR and SPL on seen and on unseen queries (episodes pooled over seeds)."""
-    header = ["Planner", "Seen SR", "Seen SPL", "Seen n", "Unseen SR", "Unseen SPL", "Unseen n"]
+def format_seen_unseen(rows: Sequence[SplitSummary], title: str = "",
+                       quoted: QuotedSplit | None = None) -> str:
+    """SCOUT Table IX: SR and SPL on seen and on unseen queries (episodes pooled over
+    seeds), with the episode and distinct-query counts of each half; then, with ``quoted``
+    (e.g. :data:`~sgtool.analysis.paper_tables.TABLE_IX_SYMSEARCH`), the paper's own row,
+    marked as quoted."""
+    header = ["Planner", "Seen SR", "Seen SPL", "Seen n", "Seen queries", "Unseen SR",
+              "Unseen SPL", "Unseen n", "Unseen queries"]
     body = [[r.planner, _fmt(r.seen_sr, ".3f"), _fmt(r.seen_spl, ".3f"), str(r.seen_n),
-             _fmt(r.unseen_sr, ".3f"), _fmt(r.unseen_spl, ".3f"), str(r.unseen_n)]
+             str(r.seen_queries), _fmt(r.unseen_sr, ".3f"), _fmt(r.unseen_spl, ".3f"),
+             str(r.unseen_n), str(r.unseen_queries)]
             for r in rows]
+    if quoted is not None:
+        body.append([f"{quoted.agent} (quoted from SCOUT Table IX)", f"{quoted.seen_sr:.3f}",
+                     f"{quoted.seen_spl:.3f}", "-", "-", f"{quoted.unseen_sr:.3f}",
+                     f"{quoted.unseen_spl:.3f}", "-", "-"])
+    parts = [title] if title else []
+    parts.append(pipe_table(header, body))
+    if quoted is not None:
+        parts.append(f"Last row quoted from {SOURCE_IX}: SymSearch scenes, not these houses.")
+    return "\n".join(parts) + "\n"
+
+
+def format_side_by_side(summaries: Sequence[PlannerSummary], title: str = "") -> str:
+    """Our Table VII columns next to the SymSearch rows quoted from SCOUT Table VII: one row
+    per planner of ours (with the paper's agent of the same design, when there is one),
+    then the paper's agents we have no planner for."""
+    header = ["Planner", "SCOUT agent (quoted)", "SR ours", "SR quoted", "SPL ours",
+              "SPL quoted", "N steps ours", "N steps quoted", "Decision (s) ours",
+              "Inference (s) quoted"]
+
+    def quote(q: QuotedRow | None, field: str, spec: str) -> str:
+        if q is None:
+            return "-"
+        mean, std = getattr(q, field)
+        return f"{format(mean, spec)} ± {format(std, spec)}"
+
+    def row(planner: str, s: PlannerSummary | None, q: QuotedRow | None) -> list[str]:
+        ours = [fmt_stat(s.stats.get(k), spec) if s is not None else "-"
+                for k, spec in (("sr", ".3f"), ("spl", ".3f"), ("steps", ".1f"),
+                                ("decision_s", ".4f"))]
+        return [planner, q.agent if q is not None else "-",
+                ours[0], quote(q, "sr", ".3f"), ours[1], quote(q, "spl", ".3f"),
+                ours[2], quote(q, "steps", ".0f"), ours[3], quote(q, "inference_s", ".2f")]
+
+    rows = [row(s.planner, s, quoted_for(s.planner)) for s in summaries]
+    ours = {s.planner for s in summaries}
+    rows += [row("-", None, q) for q in TABLE_VII_SYMSEARCH if q.planner not in ours]
+    parts = [title] if title else []
+    parts.append(pipe_table(header, rows))
+    parts.append(f"Columns \"quoted\" are quoted from SCOUT Table VII ({SOURCE}): mean ± "
+                 "std over 5 seeds on SymSearch's scenes with SCOUT's LLM-distilled priors. "
+                 "They show the regime of the published benchmark; ours are these houses.")
+    return "\n".join(parts) + "\n"
+
+
+def format_breakdown(rows: Sequence[BreakdownRow], by: str, planners: Sequence[str],
+                     title: str = "") -> str:
+    """Per-house or per-query table (``by`` = "house" or "query"): one line per house or
+    query, ``SR / SPL`` per planner, episodes per planner (pooled over seeds), and for
+    queries whether the priors saw them in training."""
+    keys = list(dict.fromkeys(r.key for r in rows))
+    cell = {(r.key, r.planner): r for r in rows}
+    header = ["House" if by == "house" else "Query"]
+    if by == "query":
+        header.append("Seen")
+    header += ["Episodes", *(f"{p} SR / SPL" for p in planners)]
+    body = []
+    for k in keys:
+        got = [cell[(k, p)] for p in planners if (k, p) in cell]
+        line = [k]
+        if by == "query":
+            seen = got[0].seen if got else None
+            line.append("-" if seen is None else ("yes" if seen else "no"))
+        line.append(str(got[0].episodes) if got else "0")
+        line += [f"{_fmt(cell[(k, p)].sr, '.3f')} / {_fmt(cell[(k, p)].spl, '.3f')}"
+                 if (k, p) in cell else "-" for p in planners]
+        body.append(line)
     parts = [title] if title else []
     parts.append(pipe_table(header, body))
     return "\n".join(parts) + "\n"
+
+
+def breakdown_records(rows: Sequence[BreakdownRow], by: str) -> list[dict[str, object]]:
+    """JSON-ready rows of a breakdown (NaN as null), one per (house or query, planner)."""
+    def num(x: float) -> float | None:
+        return None if math.isnan(x) else round(x, 6)
+
+    out: list[dict[str, object]] = []
+    for r in rows:
+        d: dict[str, object] = {by: r.key, "planner": r.planner, "episodes": r.episodes,
+                                "sr": num(r.sr), "spl": num(r.spl), "steps": num(r.steps)}
+        if by == "query":
+            d["seen"] = r.seen
+        out.append(d)
+    return out
 
 
 def summary_dict(summaries: Sequence[PlannerSummary]) -> dict[str, dict[str, object]]:

@@ -10,7 +10,8 @@ This package turns a :class:`~sgtool.house.spec.HouseSpec` into that environment
 - :mod:`~sgtool.recorders.symbolic_environment.environment`: :class:`SymbolicEnv`, one
   episode's rules (start, what each action reveals, invalid and failed actions, the end);
 - :mod:`~sgtool.recorders.symbolic_environment.rollout`: :func:`run_episode`, one episode
-  with a planner through :func:`sgtool.planning.episode.run_search`, optionally logged.
+  with a planner through :func:`sgtool.planning.episode.run_search`, optionally logged;
+  :func:`run_one`, the same for a script: any house spec, a planner or its name, a query.
 """
 
 from sgtool.recorders.symbolic_environment.environment import N_MAX, StepOutcome, SymbolicEnv
@@ -20,7 +21,13 @@ from sgtool.recorders.symbolic_environment.regions import (
     MIN_REGION_STD,
     cluster_regions,
 )
-from sgtool.recorders.symbolic_environment.rollout import EpisodeLog, planner_seed, run_episode
+from sgtool.recorders.symbolic_environment.rollout import (
+    EpisodeLog,
+    RunOneError,
+    planner_seed,
+    run_episode,
+    run_one,
+)
 
 __all__ = [
     "MAX_REGIONS",
@@ -28,10 +35,12 @@ __all__ = [
     "N_MAX",
     "EpisodeLog",
     "Region",
+    "RunOneError",
     "StepOutcome",
     "SymbolicEnv",
     "SymbolicHouse",
     "cluster_regions",
     "planner_seed",
     "run_episode",
+    "run_one",
 ]

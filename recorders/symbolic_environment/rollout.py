@@ -4,6 +4,8 @@
 :class:`~sgtool.recorders.symbolic_environment.environment.SymbolicEnv` and returns its
 :class:`~sgtool.results.EpisodeResult`; with a log it is also recorded the way the closed
 loop records one (:class:`EpisodeLog`), so ``sgtool eval`` reads both alike.
+:func:`run_one` is the same for a user's script: any house spec, a planner or its name, a
+query, and optionally a start.
 """
 
 from __future__ import annotations
@@ -14,6 +16,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from sgtool.errors import SgtoolError
+from sgtool.house.spec import HouseSpec, StartPose
 from sgtool.log.records import Action as LoggedAction
 from sgtool.log.records import Episode, SceneGraphRecord
 from sgtool.log.writer import LogWriter
@@ -23,6 +27,7 @@ from sgtool.recorders.symbolic_environment.environment import N_MAX, SymbolicEnv
 from sgtool.recorders.symbolic_environment.house import SymbolicHouse
 from sgtool.results import EpisodeResult, Step
 from sgtool.scenegraph.graph import SceneGraph
+from sgtool.semantics.text import category_text
 
 SECOND_NS = 1_000_000_000
 
@@ -75,8 +80,8 @@ class EpisodeLog:
 def run_episode(house: SymbolicHouse, planner: Planner, query: str, targets: Sequence[str],
                 seed: int = 0, episode_index: int = 0, avoid_rooms: Sequence[str] = (),
                 max_steps: int = N_MAX, seen: bool | None = None, house_id: str = "",
-                planner_name: str | None = None, log: LogWriter | None = None
-                ) -> EpisodeResult:
+                planner_name: str | None = None, log: LogWriter | None = None,
+                start_region: str | None = None) -> EpisodeResult:
     """Roll out one episode: observe, decide, act, feed back, until it ends.
 
     ``targets`` (spec ids of the query's instances) only serve the shortest path of SPL;
@@ -86,12 +91,13 @@ def run_episode(house: SymbolicHouse, planner: Planner, query: str, targets: Seq
 
     With ``log`` (an open :class:`sgtool.log.writer.LogWriter`) the episode is also
     recorded (:class:`EpisodeLog`); the closing record's ``extra`` holds seed,
-    planner_seed, episode, seen, end, n_open, start_region.
+    planner_seed, episode, seen, end, n_open, start_region. ``start_region`` (a region id,
+    ``region:<room>.<k>``) fixes the start instead of drawing it.
     """
     name = planner_name or getattr(planner, "name", "planner")
     hid = house_id or f"house-{house.spec.seed}"
     env = SymbolicEnv(house, query, seed=seed, episode_index=episode_index,
-                      avoid_rooms=avoid_rooms, max_steps=max_steps)
+                      avoid_rooms=avoid_rooms, max_steps=max_steps, start_region=start_region)
     t_start = time.perf_counter()
     pseed = planner_seed(seed, house.spec.seed, episode_index)
     recorder = None
@@ -119,3 +125,60 @@ def run_episode(house: SymbolicHouse, planner: Planner, query: str, targets: Seq
             "seen": seen, "end": env.end_reason, "n_open": env.n_open,
             "start_region": env.start_region})
     return result
+
+
+class RunOneError(SgtoolError):
+    """A query or a start that does not fit the house of :func:`run_one`."""
+
+
+def run_one(house: HouseSpec | SymbolicHouse, planner: Planner | str, query: str, *,
+            start: str | StartPose | None = None, seed: int = 0, episode_index: int = 0,
+            max_steps: int = N_MAX, house_id: str = "", seen: bool | None = None,
+            log: LogWriter | None = None) -> EpisodeResult:
+    """One SymSearch episode on any house with one planner, for scripting your own runs.
+
+    ``house`` is a spec (prepared here; pass a :class:`SymbolicHouse` to reuse one for
+    many episodes) and ``planner`` a planner or a registry name
+    (:func:`sgtool.planning.registry.make_planner`). Every instance of ``query`` in the
+    house (furniture or small object, by :func:`~sgtool.semantics.text.category_text`) is a
+    target. ``start``: None draws a start region from (seed, house seed, episode index)
+    outside the target rooms, as the benchmark does; a region id fixes it; a
+    :class:`~sgtool.house.spec.StartPose` (e.g. from
+    :func:`sgtool.datasets.start_poses.start_poses`) starts in the region of its room
+    nearest to it. Raises :class:`RunOneError` for a query with no instance in the house
+    or a start that is not in it.
+    """
+    from sgtool.planning.registry import make_planner
+
+    h = house if isinstance(house, SymbolicHouse) else SymbolicHouse(house)
+    spec = h.spec
+    text = category_text(query)
+    targets = [o.id for o in spec.objects if category_text(o.category) == text] + \
+        [f.id for f in spec.furniture if category_text(f.category) == text]
+    if not targets:
+        raise RunOneError(f"query {query!r}: no object of that category in the house")
+    p = make_planner(planner) if isinstance(planner, str) else planner
+    name = planner if isinstance(planner, str) else None
+    rooms = sorted({o.room for o in spec.objects if o.id in targets} |
+                   {f.room for f in spec.furniture if f.id in targets})
+    return run_episode(h, p, query, targets, seed=seed, episode_index=episode_index,
+                       avoid_rooms=rooms, max_steps=max_steps, seen=seen,
+                       house_id=house_id, planner_name=name, log=log,
+                       start_region=_start_region(h, start))
+
+
+def _start_region(h: SymbolicHouse, start: str | StartPose | None) -> str | None:
+    if start is None:
+        return None
+    if isinstance(start, str):
+        if not any(r.id == start for r in h.regions):
+            raise RunOneError(f"start: no region {start!r} in the house (regions: "
+                              f"{', '.join(r.id for r in h.regions)})")
+        return start
+    ri = h.room_index.get(start.room)
+    if ri is None:
+        raise RunOneError(f"start.room: no room {start.room!r} in the house")
+    regs = h.room_regions[ri]
+    best = min(regs, key=lambda k: (h.regions[k].center[0] - start.x) ** 2 +
+               (h.regions[k].center[1] - start.y) ** 2)
+    return h.regions[best].id

@@ -8,14 +8,27 @@ import sys
 import click
 
 from sgtool.commands.options import llm_log_options, parse_rooms, planner_options
+from sgtool.datasets.presets import PRESET_NAMES
 
 
 @click.command("bench")
 @click.option("--planners", default=None, metavar="LIST",
               help="Comma-separated planners to compare (random, greedy, sbert, sbert-noroom, "
-                   "scout, scout-noroom, scout-delta0, moma-llm). Default: all but moma-llm.")
+                   "scout, scout-noroom, scout-delta0, godhs, esc, bayes-search, moma-llm). "
+                   "Default: all but moma-llm.")
 @click.option("--houses", default=10, show_default=True,
-              help="Number of evaluation-split houses (house seeds HOUSE_SEED, +1, ...).")
+              help="Number of generated evaluation-split houses (house seeds HOUSE_SEED, +1, "
+                   "...); 0 with --house benches the given houses only.")
+@click.option("--house", "house_files", multiple=True, metavar="PATH",
+              type=click.Path(path_type=str),
+              help="A house spec JSON file, or a folder of them, to bench as well (repeatable); "
+                   "named by the spec's id or the file name. Every file is checked first; "
+                   "a bad one stops the run before any episode, naming file and field.")
+@click.option("--priors", "priors_dir", default=None, metavar="DIR",
+              type=click.Path(file_okay=False, path_type=str),
+              help="Relational priors (a folder written by `sgtool distill`): the scout "
+                   "planners load them, and a query is 'seen' when it is one of their "
+                   "training queries [default: the shipped priors].")
 @click.option("--episodes", default=20, show_default=True,
               help="Search episodes per house (the same for every seed).")
 @click.option("--seeds", default=5, show_default=True,
@@ -25,12 +38,19 @@ from sgtool.commands.options import llm_log_options, parse_rooms, planner_option
               help="Worker processes (results do not depend on it).")
 @click.option("-o", "--out", "out_dir", default="results", show_default=True,
               type=click.Path(file_okay=False),
-              help="Output folder: episodes.jsonl, summary.md, summary.json, "
-                   "efficiency_distance.png, efficiency_steps.png.")
+              help="Output folder: episodes.jsonl, summary.md, summary.json, per_house.md, "
+                   "per_house.jsonl, per_query.md, per_query.jsonl, efficiency_distance.png, "
+                   "efficiency_steps.png.")
 @click.option("--rooms", default="12-16", show_default=True, metavar="MIN-MAX",
               help="Room count range of the generated houses (corridors included, 4..16); "
                    "the default gives about as many first-level objects per house as "
                    "SymSearch's scenes.")
+@click.option("--preset", type=click.Choice(list(PRESET_NAMES)), default="default",
+              show_default=True,
+              help="Generator preset of the generated houses: 'symsearch' furnishes them as "
+                   "densely as SymSearch's InteriorGS scenes (~280 objects, long-tail small "
+                   "objects) and makes about a third of the episodes furniture-level "
+                   "(non-interactive) targets.")
 @click.option("--house-seed", default=0, show_default=True, help="Seed of the first house.")
 @click.option("--max-steps", default=50, show_default=True,
               help="High-level actions per episode (SymSearch's N_max).")
@@ -50,17 +70,20 @@ from sgtool.commands.options import llm_log_options, parse_rooms, planner_option
                    "step) under LOG_DIR/PLANNER/HOUSE/, readable by `sgtool eval`.")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
-def command(planners: str | None, houses: int, episodes: int, seeds: int, workers: int,
-            out_dir: str, rooms: str, house_seed: int, max_steps: int, distance_budget: float,
+def command(planners: str | None, houses: int, house_files: tuple[str, ...],
+            priors_dir: str | None, episodes: int, seeds: int, workers: int, out_dir: str,
+            rooms: str, preset: str, house_seed: int, max_steps: int, distance_budget: float,
             step_budget: float, llm_replay: str | None, llm_transcript: str | None,
             planner_option: tuple[str, ...], log_dir: str | None,
             progress: bool | None) -> None:
     """Run the symbolic object-search benchmark (SCOUT's SymSearch roll-out) on generated
-    evaluation houses and print a table in the shape of SCOUT's Table VII: success rate,
-    SPL, high-level steps, decision time, and MoMa-LLM's AUC-E with a distance-plus-open
-    budget and a step budget (mean ± std over seeds), then the seen/unseen query breakdown
-    (SCOUT Table IX). Writes per-episode JSONL, the summary and the efficiency curves to
-    OUT. The same command gives the same episodes.jsonl except its wall-clock fields."""
+    evaluation houses and/or house spec files and print a table in the shape of SCOUT's
+    Table VII: success rate, SPL, high-level steps, decision time, and MoMa-LLM's AUC-E with
+    a distance-plus-open budget and a step budget (mean ± std over seeds), the same next to
+    the SymSearch rows quoted from SCOUT Table VII, then the seen/unseen query breakdown
+    (SCOUT Table IX; seen = a training query of the priors). Writes per-episode JSONL, the
+    summary, per-house and per-query tables and the efficiency curves to OUT. The same
+    command gives the same episodes.jsonl except its wall-clock fields."""
     from sgtool.analysis.bench import DEFAULT_PLANNERS, BenchConfig, run_benchmark, write_outputs
 
     names = tuple(p.strip() for p in planners.split(",") if p.strip()) if planners \
@@ -73,11 +96,14 @@ def command(planners: str | None, houses: int, episodes: int, seeds: int, worker
         if llm_transcript:
             moma["transcript"] = llm_transcript
     cfg = BenchConfig(planners=names, houses=houses, episodes=episodes, seeds=seeds,
-                      rooms=parse_rooms(rooms), house_seed=house_seed, max_steps=max_steps,
+                      rooms=parse_rooms(rooms), preset=preset, house_seed=house_seed,
+                      max_steps=max_steps,
                       workers=workers, distance_budget=distance_budget,
-                      step_budget=step_budget, planner_options=options, log_dir=log_dir)
+                      step_budget=step_budget, planner_options=options, log_dir=log_dir,
+                      house_files=house_files, priors_dir=priors_dir)
     res = run_benchmark(cfg, progress=progress)
     paths = write_outputs(res, out_dir, command=shlex.join(["sgtool", *sys.argv[1:]]))
     click.echo(res.table)
+    click.echo(res.side_by_side)
     click.echo(res.seen_table)
     click.echo(f"wrote {', '.join(str(p) for p in paths)}")

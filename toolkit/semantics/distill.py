@@ -11,9 +11,10 @@ Pipeline (SCOUT sec. IV-C and VI-A, with the offline knowledge source in place o
    co-occurrence with BCE;
 5. the weights are written as safetensors (never pickle) next to ``metadata.json``: data
    sizes, seed, hyper-parameters, losses, the split's fingerprint, the held-out queries,
-   room types, the containment evidence per room type (:func:`room_evidence`, so a
-   planner knows which room types the prior has learned anything about) and the quality
-   report;
+   the training queries (the query texts the models were trained on, sorted: the
+   vocabulary that makes a benchmark query "seen"), room types, the containment evidence
+   per room type (:func:`room_evidence`, so a planner knows which room types the prior has
+   learned anything about) and the quality report;
 6. the report (SCOUT Fig. 7 as numbers): on query categories held out of training, ROC-AUC
    of the learned score and of raw SBERT cosine similarity for containment and
    co-occurrence. The main group is the unseen categories: objects of the *evaluation*
@@ -40,7 +41,7 @@ from sgtool.semantics.metrics import separation_summary
 from sgtool.semantics.mlp import load_mlp, save_mlp
 from sgtool.semantics.priors import CONTAINMENT_FILE, COOCCURRENCE_FILE, METADATA_FILE
 
-METADATA_VERSION = 3  # 3: room_evidence
+METADATA_VERSION = 4  # 3: room_evidence; 4: training_queries
 FILES = {"containment": CONTAINMENT_FILE, "cooccurrence": COOCCURRENCE_FILE}
 
 
@@ -121,6 +122,7 @@ def distill(
         "room_types": sorted(room_types or cont.nodes),
         "room_evidence": room_evidence(cont.subset_queries(train_q)),
         "heldout_queries": sorted(held),
+        "training_queries": sorted(train_q),
         "models": {},
         "report": {},
     }

@@ -40,6 +40,7 @@ from typing import Protocol
 
 import numpy as np
 
+from sgtool.errors import SgtoolError
 from sgtool.semantics.encoder import SentenceEncoder, default_encoder
 from sgtool.semantics.mlp import RelationMLP, load_mlp
 from sgtool.semantics.text import category_text
@@ -170,6 +171,32 @@ class CosinePriors:
 
     def objects(self, names: Sequence[str], query: str) -> np.ndarray:
         return self._memo.scores("cos", names, query, self._cos)
+
+
+class PriorsVocabularyError(SgtoolError):
+    """A weights folder whose metadata does not list the queries it was trained on."""
+
+
+def training_queries(weights_dir: str | Path | None = None) -> frozenset[str]:
+    """The query categories (canonical text) the distilled priors in ``weights_dir`` (the
+    shipped ones by default) were trained on, from the ``training_queries`` of their
+    ``metadata.json`` (written by ``sgtool distill`` since metadata version 4). A query is
+    *seen* by those priors when its :func:`category_text` is in this set."""
+    folder = Path(weights_dir) if weights_dir is not None else WEIGHTS_DIR
+    path = folder / METADATA_FILE
+    try:
+        meta = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise PriorsVocabularyError(f"{path}: no such file; not a folder of distilled "
+                                    "weights") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise PriorsVocabularyError(f"{path}: cannot read weights metadata ({e})") from None
+    queries = meta.get("training_queries") if isinstance(meta, dict) else None
+    if not isinstance(queries, list) or not all(isinstance(q, str) for q in queries):
+        raise PriorsVocabularyError(
+            f"{path}: training_queries: missing or not a list of strings (weights distilled "
+            "before metadata version 4; run `sgtool distill` again)")
+    return frozenset(category_text(q) for q in queries)
 
 
 @functools.lru_cache(maxsize=1)

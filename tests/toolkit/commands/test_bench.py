@@ -7,6 +7,7 @@ import json
 
 import pytest
 from click.testing import CliRunner
+from support.foreign_house import QUERIES, write_cottage
 
 from sgtool.analysis.bench import BenchConfig, BenchError, run_bench, run_benchmark
 from sgtool.cli import cli
@@ -33,13 +34,17 @@ def test_cli_writes_outputs_and_is_deterministic(tmp_path):
     assert "Unseen SR" in a.output
     files = sorted(p.name for p in (tmp_path / "a").iterdir())
     assert files == ["efficiency_distance.png", "efficiency_steps.png", "episodes.jsonl",
+                     "per_house.jsonl", "per_house.md", "per_query.jsonl", "per_query.md",
                      "summary.json", "summary.md"]
     recs = read_jsonl(tmp_path / "a" / "episodes.jsonl")
-    # 2 planners x 2 seeds x 2 houses x 2 episodes, ordered planner, seed, house, episode
+    # 2 planners x 2 seeds x 2 houses x 2 episodes, ordered planner, house, episode, seed
     assert len(recs) == 16
+    assert [(r.planner, r.house, r.episode, r.seed) for r in recs[:4]] == [
+        ("random", "house-0", 0, 0), ("random", "house-0", 0, 1), ("random", "house-0", 1, 0),
+        ("random", "house-0", 1, 1)]
     assert [r.key() for r in recs] == sorted(
-        (r.key() for r in recs), key=lambda k: (["random", "greedy"].index(k[0]), k[1],
-                                                int(k[2].split("-")[1]), k[3]))
+        (r.key() for r in recs), key=lambda k: (["random", "greedy"].index(k[0]), k[2], k[3],
+                                                k[1]))
     assert all(r.steps <= 50 and r.wall["decisions"] == r.steps for r in recs)
     summary = json.loads((tmp_path / "a" / "summary.json").read_text())
     assert summary["budgets"]["distance"]["max"] == 5000.0
@@ -53,6 +58,99 @@ def test_cli_writes_outputs_and_is_deterministic(tmp_path):
         _strip_wall(tmp_path / "b" / "episodes.jsonl")
     assert json.loads((tmp_path / "b" / "summary.json").read_text())["digest"] == \
         summary["digest"]
+
+
+def _toy_priors(folder, queries) -> str:
+    """A weights folder holding only a metadata.json with ``queries`` as its vocabulary."""
+    folder.mkdir()
+    (folder / "metadata.json").write_text(json.dumps({"training_queries": list(queries)}))
+    return str(folder)
+
+
+def test_cli_benches_a_hand_made_house_only(tmp_path):
+    houses = tmp_path / "houses"
+    write_cottage(houses)
+    priors = _toy_priors(tmp_path / "toy", ["Mug", "pillow", "piano"])
+    out = tmp_path / "o"
+    r = CliRunner().invoke(cli, ["bench", "--house", str(houses), "--houses", "0",
+                                 "--episodes", "5", "--seeds", "2", "--planners",
+                                 "random,greedy", "--priors", priors, "--no-progress",
+                                 "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    recs = read_jsonl(out / "episodes.jsonl")
+    assert len(recs) == 2 * 5 * 2 and {r.house for r in recs} == {"cottage"}
+    assert sorted({r.query for r in recs}) == sorted(QUERIES)
+    # seen = a training query of the toy priors (canonical text): mug and pillow
+    assert {r.query for r in recs if r.seen} == {"mug", "pillow"}
+    per_house = (out / "per_house.md").read_text().splitlines()
+    assert len(per_house) == 3 + 1 and per_house[3].startswith("| cottage | 10 ")
+    assert len((out / "per_house.jsonl").read_text().splitlines()) == 2  # 1 house x 2
+    per_query = (out / "per_query.md").read_text().splitlines()
+    assert [line.split("|")[1].strip() for line in per_query[3:]] == list(QUERIES)
+    assert [line.split("|")[2].strip() for line in per_query[3:]] == \
+        ["no", "yes", "yes", "no", "no"]
+    assert len((out / "per_query.jsonl").read_text().splitlines()) == 10
+    summary_md = (out / "summary.md").read_text()
+    assert "quoted from SCOUT Table VII" in summary_md and "Per house" in summary_md
+    assert "Per query" in summary_md and "3 training queries of " + priors in summary_md
+    summary = json.loads((out / "summary.json").read_text())
+    (random_row, greedy_row) = summary["seen_unseen"]
+    # 2 seen queries x 2 seeds, 3 unseen x 2 seeds, per planner
+    assert (random_row["seen_n"], random_row["seen_queries"]) == (4, 2)
+    assert (greedy_row["unseen_n"], greedy_row["unseen_queries"]) == (6, 3)
+    assert summary["houses"] == [{"id": "cottage", "source": str(houses / "cottage.json")}]
+    assert summary["vocabulary"] == {"priors": priors, "training_queries": 3}
+
+
+def test_house_files_next_to_generated_houses_sort_by_id(tmp_path):
+    from sgtool.analysis.bench import planner_options_for
+
+    path = write_cottage(tmp_path, "zz-cottage.json", id="Cottage")  # the spec's own id
+    cfg = BenchConfig(planners=("greedy",), houses=1, house_seed=3, episodes=2, seeds=2,
+                      house_files=(str(path),))
+    res = run_benchmark(cfg)
+    # plain string order of ids ("C" < "h"), then episode, then seed
+    assert [(r.house, r.episode, r.seed) for r in res.results] == [
+        ("Cottage", 0, 0), ("Cottage", 0, 1), ("Cottage", 1, 0), ("Cottage", 1, 1),
+        ("house-3", 0, 0), ("house-3", 0, 1), ("house-3", 1, 0), ("house-3", 1, 1)]
+    assert [h.id for h in res.houses] == ["house-3", "Cottage"]
+    assert "1 generated houses (rooms 12-16) + houses from" in res.table
+    # --priors reaches the scout planners, unless an option names other weights
+    cfg = BenchConfig(priors_dir="/p", planner_options={"scout-noroom": {"weights_dir": "/q"}})
+    assert planner_options_for(cfg, "scout") == {"weights_dir": "/p"}
+    assert planner_options_for(cfg, "scout-noroom") == {"weights_dir": "/q"}
+    assert planner_options_for(cfg, "sbert") == {}
+
+
+def test_bad_house_files_stop_the_run_before_anything_is_written(tmp_path):
+    good = write_cottage(tmp_path)
+    bad = write_cottage(tmp_path, "bad.json", version="9.0")
+    d = json.loads(good.read_text())
+    d["objects"][0]["parent"] = "furn_piano"
+    worse = write_cottage(tmp_path, "worse.json", objects=d["objects"])
+    r = CliRunner().invoke(cli, ["bench", "--house", str(good), "--house", str(bad),
+                                 "--house", str(worse), "--houses", "1", "--no-progress",
+                                 "-o", str(tmp_path / "out")])
+    assert r.exit_code == 2
+    # one line per bad file, naming file and field (the wording is the house loader's)
+    lines = r.output.removeprefix("sgtool: error: ").splitlines()
+    assert len(lines) == 2
+    assert lines[0].startswith(f"{bad}: version:") and "9.0" in lines[0]
+    assert lines[1].startswith(f"{worse}: objects[0].parent:") and "furn_piano" in lines[1]
+    assert str(good) not in r.output
+    assert not (tmp_path / "out").exists()
+    r = CliRunner().invoke(cli, ["bench", "--houses", "0", "--no-progress",
+                                 "-o", str(tmp_path / "out")])
+    assert r.exit_code == 2 and ">= 0 with --house" in r.output
+
+
+def test_priors_without_a_vocabulary_are_refused(tmp_path):
+    (tmp_path / "old").mkdir()
+    (tmp_path / "old" / "metadata.json").write_text('{"metadata_version": 3}')
+    r = CliRunner().invoke(cli, ["bench", *TINY, "--priors", str(tmp_path / "old"),
+                                 "-o", str(tmp_path / "out")])
+    assert r.exit_code == 2 and "training_queries: missing" in r.output
+    assert not (tmp_path / "out").exists()
 
 
 def test_seeds_change_starts_not_episodes():

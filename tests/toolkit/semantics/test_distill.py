@@ -39,6 +39,8 @@ def test_distill_is_byte_identical_and_loadable(tmp_path) -> None:
     assert meta == json.loads(json.dumps(ma))
     assert meta["config"]["seed"] == 16 and meta["split_fingerprint"] == "tiny"
     assert meta["heldout_queries"] == ["refrigerator"]
+    assert meta["metadata_version"] == 4
+    assert meta["training_queries"] == ["apple", "cabinet", "plate", "sink", "toilet"]
     # containment evidence of the 5 trained queries (refrigerator held out): kitchen for
     # apple, cabinet, plate, sink; dining room for cabinet, plate; bathroom for cabinet,
     # sink, toilet (test_semantics_relational.tiny)
@@ -99,20 +101,42 @@ def test_cli_trains_into_a_folder(tmp_path) -> None:
 
 @pytest.mark.ci_only
 def test_shipped_weights_are_what_distill_writes(tmp_path) -> None:
-    """`sgtool distill` with its defaults (about 20 s here) rebuilds the shipped weights:
-    byte-identical on this machine type (measured), compared here within 1e-5 so that a
-    machine with other CPU kernels does not fail for the last bits."""
-    from safetensors.numpy import load_file
+    """`sgtool distill` with its defaults (1-2 min) rebuilds the shipped priors.
+
+    On one machine type two retrains are byte-identical, but torch's CPU kernels differ
+    between processors (summation order of the SIMD width), and 40 epochs of training
+    carry the last bits into visible weight differences: a retrain on an AMD EPYC of the
+    weights shipped from another machine differed by up to 0.52 in a weight, yet scored
+    the 19,009 training pairs with Spearman 0.946 (containment) and 0.994 (co-occurrence),
+    mean |difference| 0.025, and unseen-query ROC-AUC within 0.004 (measured 2026-12-01).
+    So the check is what the weights do, not their bits: the same data and configuration
+    in the metadata, the same quality, and the same ranking of the training pairs."""
+    from scipy.stats import spearmanr
 
     from sgtool.commands.distill import command
+    from sgtool.datasets.relational import training_sets
+    from sgtool.semantics.distill import _encode_set
+    from sgtool.semantics.mlp import load_mlp
     from sgtool.semantics.priors import WEIGHTS_DIR
 
     r = CliRunner().invoke(command, ["--out", str(tmp_path)])
     assert r.exit_code == 0, r.output
-    for f in FILES:
-        if not f.endswith(".safetensors"):
-            continue
-        new, shipped = load_file(tmp_path / f), load_file(WEIGHTS_DIR / f)
-        assert new.keys() == shipped.keys()
-        for k in new:
-            assert np.allclose(new[k], shipped[k], atol=1e-5, rtol=0), (f, k)
+    new = json.loads((tmp_path / "metadata.json").read_text())
+    shipped = json.loads((WEIGHTS_DIR / "metadata.json").read_text())
+    trained = {"models", "report"}  # the figures training produces
+    assert {k: v for k, v in new.items() if k not in trained} == \
+        {k: v for k, v in shipped.items() if k not in trained}
+    for rel in ("containment", "cooccurrence"):
+        assert new["models"][rel]["data"] == shipped["models"][rel]["data"], rel
+        auc_new = new["report"]["unseen"][rel]["learned"]["auc"]
+        auc_shipped = shipped["report"]["unseen"][rel]["learned"]["auc"]
+        assert abs(auc_new - auc_shipped) < 0.02, (rel, auc_new, auc_shipped)
+    sets = training_sets(seed=int(shipped["config"]["seed"]))
+    enc = encoder()
+    for rel, rs in (("containment", sets.containment), ("cooccurrence", sets.cooccurrence)):
+        nodes, queries = _encode_set(enc, rs)
+        x = np.concatenate([nodes[rs.pairs[:, 0]], queries[rs.pairs[:, 1]]], axis=1)
+        a = load_mlp(tmp_path / f"{rel}.safetensors", rel).pairs(x)
+        b = load_mlp(WEIGHTS_DIR / f"{rel}.safetensors", rel).pairs(x)
+        assert spearmanr(a, b).statistic > 0.9, rel
+        assert float(np.abs(a - b).mean()) < 0.05, rel

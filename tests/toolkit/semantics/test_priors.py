@@ -120,6 +120,29 @@ def test_shipped_weights_match_the_current_training_data() -> None:
         sets.cooccurrence.fingerprint()
     assert meta["room_types"] == list(sets.room_types)
     assert meta["room_evidence"] == room_evidence(sets.containment)
+    # the vocabulary of "seen" queries: every query of both sets (none held out)
+    assert meta["heldout_queries"] == []
+    assert meta["training_queries"] == sorted(set(sets.containment.queries) |
+                                              set(sets.cooccurrence.queries))
+
+
+def test_training_queries_are_the_seen_vocabulary(tmp_path) -> None:
+    from sgtool.datasets.split import unseen_queries
+    from sgtool.semantics.priors import PriorsVocabularyError, training_queries
+    from sgtool.semantics.text import category_text
+
+    shipped = training_queries()
+    assert len(shipped) > 900 and "frying pan" in shipped
+    # the split's unseen categories are exactly those no training record mentions
+    assert not shipped & {category_text(q) for q in unseen_queries()}
+    (tmp_path / "metadata.json").write_text(json.dumps(
+        {"training_queries": ["Frying_Pan.n.01", "mug"]}))
+    assert training_queries(tmp_path) == {"frying pan", "mug"}
+    (tmp_path / "metadata.json").write_text(json.dumps({"metadata_version": 3}))
+    with pytest.raises(PriorsVocabularyError, match="training_queries: missing"):
+        training_queries(tmp_path)
+    with pytest.raises(PriorsVocabularyError, match="no such file"):
+        training_queries(tmp_path / "nowhere")
 
 
 def test_shipped_report_learned_beats_cosine_on_unseen_queries() -> None:
