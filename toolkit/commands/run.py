@@ -19,7 +19,7 @@ from sgtool.errors import SgtoolError
 @click.command("run")
 @click.option("--planner", "-p", required=True,
               help="The planner: random, greedy, sbert, sbert-noroom, scout, scout-noroom, "
-              "scout-delta0 or moma-llm.")
+              "scout-delta0, godhs, esc, bayes-search or moma-llm.")
 @house_options(
     seed_help="Search a generated evaluation house (`sgtool scenes generate`) of this seed "
     "instead of --house.",

@@ -39,6 +39,7 @@ from sgtool.semantics.text import category_text
 
 OPEN_AFFORDANCES = frozenset({"open", "openable"})
 EXAMINE_AFFORDANCES = frozenset({"explore", "examine", "search"})
+CARRIER_AFFORDANCES = OPEN_AFFORDANCES | EXAMINE_AFFORDANCES | {"container", "supporter"}
 
 NodeKind = str  # "room" | "frontier" | "object" | "door"
 
@@ -85,6 +86,14 @@ def object_skill(obj: ObjectNode) -> Skill | None:
     if affs & EXAMINE_AFFORDANCES:
         return "navigate"
     return None
+
+
+def is_carrier(obj: ObjectNode) -> bool:
+    """Whether an object can hold others (a container or supporter), explored or not: it
+    has a state, or an open/examine/container/supporter affordance."""
+    if obj.state is not None:
+        return True
+    return any(a.lower() in CARRIER_AFFORDANCES for a in obj.affordances)
 
 
 def door_is_entrance(graph: SceneGraph, door: DoorNode) -> bool:

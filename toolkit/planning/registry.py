@@ -11,6 +11,12 @@ name                what it is
                     (Table II defaults: room 0.7, frontier 0.6, delta 0.1, w 0.3)
 ``scout-noroom``    SCOUT without room influence
 ``scout-delta0``    SCOUT with delta = 0 (greedy on utility, Eq. 13)
+``godhs``           GODHS (SCOUT sec. VI, [12]): explore everything, then rooms by
+                    relevance, then identified carriers (:mod:`sgtool.planning.godhs`)
+``esc``             ESC-Interactive (MoMa-LLM's baseline): soft commonsense rules over
+                    frontiers and carriers (:mod:`sgtool.planning.esc`)
+``bayes-search``    search theory: Bayes belief over places, p/c ratio rule with a
+                    look-ahead (:mod:`sgtool.planning.search_theory`)
 ``moma-llm``        MoMa-LLM over an OpenAI-compatible chat endpoint or a transcript
 ==================  ====================================================================
 
@@ -22,6 +28,13 @@ action carries its measured decision time. Options:
 - ``sbert*``/``scout*``: ``default_room``, ``default_frontier``, ``delta``, ``room_weight``,
   ``frontier_radius`` override the table defaults; ``encoder`` (a SentenceEncoder),
   ``weights_dir`` (scout only: another set of distilled weights);
+- ``godhs``, ``esc``, ``bayes-search``: ``encoder``, ``weights_dir`` as for scout;
+  ``godhs``: ``carrier_threshold`` (default 0.1), ``ranker`` (any
+  :class:`~sgtool.planning.godhs.Ranker`, e.g. an LLM ranker; default the priors);
+  ``esc``: ``w_obj``, ``w_room``, ``w_dist``, ``radius``; ``bayes-search``: ``step_cost``,
+  ``open_cost``, ``reveal_cost``, ``top_k``, ``horizon``, ``step_budget`` (0: none),
+  ``room_floor``, ``object_floor``, ``sharpness``, ``object_sharpness``, ``beyond``,
+  ``miss``, ``blend`` (false: learned scores only, no novelty blend);
 - ``moma-llm``: ``base_url``, ``model``, ``api_key`` (else from the environment, see
   :mod:`sgtool.llm.client`), ``timeout_s``, ``temperature``, ``replay`` (a JSONL transcript
   to serve instead of an endpoint), ``transcript`` (append exchanges to this JSONL),
@@ -39,7 +52,7 @@ from sgtool.planning.base import Planner
 
 PLANNER_NAMES: tuple[str, ...] = (
     "random", "greedy", "sbert", "sbert-noroom", "scout", "scout-noroom", "scout-delta0",
-    "moma-llm",
+    "godhs", "esc", "bayes-search", "moma-llm",
 )
 
 _UTILITY_KEYS = ("default_room", "default_frontier", "delta", "room_weight", "frontier_radius")
@@ -79,6 +92,56 @@ def _utility(name: str, options: dict[str, Any]) -> Planner:
     return UtilityPlanner(name, scorer, up, max_failures=max_failures)
 
 
+def _priors(options: dict[str, Any], blend: bool) -> Any:
+    """The learned priors (``encoder``/``weights_dir`` options), optionally blended with the
+    cosine by query novelty (:mod:`sgtool.planning.calibration`)."""
+    from sgtool.semantics.encoder import default_encoder
+    from sgtool.semantics.priors import CosinePriors, LearnedPriors, default_priors
+
+    encoder = options.pop("encoder", None)
+    weights_dir = options.pop("weights_dir", None)
+    if encoder is None and weights_dir is None:
+        learned = default_priors()
+    else:
+        learned = LearnedPriors(encoder, weights_dir)
+    if not blend:
+        return learned
+    from sgtool.planning.calibration import BlendedPriors
+
+    enc = encoder or default_encoder()
+    return BlendedPriors(learned, CosinePriors(enc), learned.metadata.get("training_queries"),
+                         enc)
+
+
+def _search(name: str, options: dict[str, Any]) -> Planner:
+    max_failures = int(options.pop("max_failures", 2))
+    if name == "bayes-search":
+        from sgtool.planning.belief import BeliefParams
+        from sgtool.planning.search_theory import SearchParams, SearchTheoryPlanner
+
+        keys = ("step_cost", "open_cost", "reveal_cost", "top_k", "horizon", "step_budget")
+        kw = {k: type(getattr(SearchParams, k))(options.pop(k)) for k in keys if k in options}
+        bkeys = ("room_floor", "object_floor", "sharpness", "object_sharpness", "beyond",
+                 "miss")
+        bkw = {k: float(options.pop(k)) for k in bkeys if k in options}
+        kw["belief"] = BeliefParams(**bkw)
+        blend = str(options.pop("blend", True)).strip().lower() not in ("false", "0", "no")
+        scorer = _priors(options, blend=blend)
+        return SearchTheoryPlanner(scorer, SearchParams(**kw), max_failures=max_failures)
+    if name == "esc":
+        from sgtool.planning.esc import EscParams, EscPlanner
+
+        keys = ("w_obj", "w_room", "w_dist", "radius")
+        kw = {k: float(options.pop(k)) for k in keys if k in options}
+        return EscPlanner(_priors(options, blend=False), EscParams(**kw),
+                          max_failures=max_failures)
+    from sgtool.planning.godhs import GodhsPlanner, PriorRanker
+
+    ranker = options.pop("ranker", None) or PriorRanker(_priors(options, blend=False))
+    return GodhsPlanner(ranker, float(options.pop("carrier_threshold", 0.1)),
+                        max_failures=max_failures)
+
+
 def _moma(options: dict[str, Any]) -> Planner:
     from sgtool.llm.client import LlmSettings, OpenAIChatClient
     from sgtool.llm.recorded import ReplayChatClient
@@ -95,7 +158,8 @@ def _moma(options: dict[str, Any]) -> Planner:
         else:
             client = OpenAIChatClient(LlmSettings.resolve(**settings_kw))
     kw = {k: options.pop(k) for k in
-          ("max_attempts", "stuck_repeats", "history_limit", "on_exchange", "transcript")
+          ("max_attempts", "stuck_repeats", "history_limit", "on_exchange", "transcript",
+           "decision_timeout_s")
           if k in options}
     return MomaLlmPlanner(client, **kw)
 
@@ -119,6 +183,8 @@ def make_planner(name: str, **options: Any) -> Planner:
         planner = _simple("GreedyPlanner")(options)
     elif key in ("sbert", "sbert-noroom", "scout", "scout-noroom", "scout-delta0"):
         planner = _utility(key, options)
+    elif key in ("godhs", "esc", "bayes-search"):
+        planner = _search(key, options)
     elif key == "moma-llm":
         planner = _moma(options)
     else:

@@ -65,6 +65,14 @@ def frontier_utility(nearby: Sequence[float], fallback: float) -> float:
     return float(max([fallback, *nearby]))
 
 
+def objects_within(obj_xy: Sequence[tuple[str, float, float]], position: tuple[float, float],
+                   radius: float) -> list[str]:
+    """Ids of the ``(id, x, y)`` objects within ``radius`` of ``position`` (in order)."""
+    fx, fy = position
+    r2 = radius ** 2
+    return [i for i, x, y in obj_xy if (x - fx) ** 2 + (y - fy) ** 2 <= r2]
+
+
 def select_with_margin(
     utilities: Sequence[float], distances: Sequence[float], ids: Sequence[str], delta: float
 ) -> int:
@@ -140,9 +148,8 @@ def candidate_utilities(
             out.append(objects[c.node_id])
         else:  # frontier
             region = graph.node(c.node_id)
-            fx, fy = c.position
-            r2 = params.frontier_radius ** 2
-            nearby = [objects[i] for i, x, y in obj_xy if (x - fx) ** 2 + (y - fy) ** 2 <= r2]
+            nearby = [objects[i] for i in objects_within(obj_xy, c.position,
+                                                         params.frontier_radius)]
             room_id = getattr(region, "room", None)
             if getattr(region, "frontier_type", None) == "leading out" or room_id is None:
                 fallback = params.default_frontier

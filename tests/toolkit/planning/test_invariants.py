@@ -12,8 +12,11 @@ import pytest
 from support.planning_world import World
 from support.semantics_fixtures import TableScorer
 
+from sgtool.planning.esc import EscPlanner
+from sgtool.planning.godhs import GodhsPlanner, PriorRanker
 from sgtool.planning.planners import GreedyPlanner, RandomPlanner, UtilityPlanner
-from sgtool.planning.registry import make_planner
+from sgtool.planning.registry import PLANNER_NAMES, make_planner
+from sgtool.planning.search_theory import SearchTheoryPlanner
 from sgtool.planning.utility import UtilityParams
 from sgtool.semantics.text import same_category
 
@@ -27,6 +30,9 @@ def planners() -> list:
         UtilityPlanner("scout", scorer, UtilityParams()),
         UtilityPlanner("scout-noroom", scorer, UtilityParams(room_influence=False)),
         UtilityPlanner("scout-delta0", scorer, UtilityParams(delta=0.0)),
+        GodhsPlanner(PriorRanker(scorer)),
+        EscPlanner(scorer),
+        SearchTheoryPlanner(scorer),
     ]
 
 
@@ -57,19 +63,23 @@ def test_invariants_on_random_worlds(seed: int) -> None:
         assert (a.target is not None) == exists, f"{planner.name}: search ended wrongly"
 
 
+def play(planner, world: World, seed: int, limit: int) -> list[str | None]:
+    """The targets of a search in ``world`` (at most ``limit`` actions; a final ``done``
+    included)."""
+    planner.reset(world.query, seed=seed)
+    out = []
+    for _ in range(limit):
+        a = planner.decide(world.graph())
+        out.append(a.target)
+        if a.skill == "done":
+            break
+        planner.feedback(world.execute(a))
+    return out
+
+
 def test_random_planner_is_seeded() -> None:
     def run(seed: int) -> list[str | None]:
-        w = World(3)
-        p = RandomPlanner()
-        p.reset(w.query, seed=seed)
-        out = []
-        for _ in range(8):
-            a = p.decide(w.graph())
-            out.append(a.target)
-            if a.skill == "done":
-                break
-            p.feedback(w.execute(a))
-        return out
+        return play(RandomPlanner(), World(3), seed, 8)
 
     assert run(1) == run(1)
     assert any(run(1) != run(s) for s in range(2, 6))
@@ -89,3 +99,16 @@ def test_registry_names_and_timing() -> None:
         make_planner("astar")
     with pytest.raises(UnknownPlannerError, match="does not take"):
         make_planner("greedy", delta=0.3)
+
+
+@pytest.mark.parametrize("name", ["godhs", "esc", "bayes-search"])
+@pytest.mark.parametrize("seed", range(3))
+def test_search_planners_with_real_priors(name: str, seed: int) -> None:
+    """The registry builds them on the shipped weights; a search ends, the same for a seed."""
+    from support.semantics_fixtures import encoder
+
+    assert name in PLANNER_NAMES
+
+    first = play(make_planner(name, encoder=encoder()), World(seed), seed, 60)
+    assert first[-1] is not None and len(first) < 60, f"{name}: no end or no target"
+    assert first == play(make_planner(name, encoder=encoder()), World(seed), seed, 60)

@@ -1,0 +1,119 @@
+"""bayes-search: the target's location as a distribution, Bayes updates, the p/c ratio rule
+with a look-ahead."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from support.semantics_fixtures import TableScorer
+
+from sgtool.planning.belief import BeliefParams, place_masses
+from sgtool.planning.candidates import Candidate, actionable
+from sgtool.planning.registry import make_planner
+from sgtool.planning.search_theory import (
+    SearchParams,
+    SearchTheoryPlanner,
+    best_first,
+    step_price,
+)
+from sgtool.scenegraph.graph import (
+    DoorNode,
+    ObjectNode,
+    RegionNode,
+    RobotState,
+    RoomNode,
+    SceneGraph,
+)
+
+SCORER = TableScorer(rooms={"kitchen": 0.9}, objects={"fridge": 0.8, "wardrobe": 0.2})
+
+
+def kitchen(fridge_explored: bool = False) -> SceneGraph:
+    """Robot in a kitchen; a fridge 1 m away, a wardrobe 10 m away (both closed), a closed
+    door 12 m away to an unknown room."""
+    fridge = ObjectNode("obj:1", "fridge", "region:1.1", "room:1", (1.0, 0.0, 0.0),
+                        state="open" if fridge_explored else "closed", affordances=("open",),
+                        explored=fridge_explored)
+    wardrobe = ObjectNode("obj:2", "wardrobe", "region:1.1", "room:1", (-10.0, 0.0, 0.0),
+                          state="closed", affordances=("open",))
+    return SceneGraph(
+        RobotState((0.0, 0.0), room="room:1"),
+        rooms=(RoomNode("room:1", "kitchen", (0.0, 0.0)),),
+        regions=(RegionNode("region:1.1", "room:1", (0.0, 0.0)),),
+        objects=(fridge, wardrobe),
+        doors=(DoorNode("door:1", (0.0, 12.0), "closed", ("room:1", "room:2")),),
+        distances={"obj:1": 1.0, "obj:2": 10.0, "door:1": 12.0},
+    )
+
+
+def test_opens_the_cheap_likely_container_first() -> None:
+    p = SearchTheoryPlanner(SCORER)
+    p.reset("frying pan")
+    a = p.decide(kitchen())
+    assert (a.skill, a.target) == ("open", "obj:1")
+    assert a.scores["obj:1"] > a.scores["obj:2"]
+
+
+def test_bayes_update_after_an_empty_container() -> None:
+    params = BeliefParams()
+    before_g, after_g = kitchen(), kitchen(fridge_explored=True)
+    before = dict(zip([c.node_id for c in actionable(before_g)],
+                      place_masses(before_g, actionable(before_g), "q", SCORER, params),
+                      strict=True))
+    cands = actionable(after_g)
+    after = dict(zip([c.node_id for c in cands],
+                     place_masses(after_g, cands, "q", SCORER, params), strict=True))
+    assert "obj:1" not in after
+    # (B5): P(n | fridge empty) = P(n) / (1 - P(fridge))
+    for n in ("obj:2", "door:1"):
+        assert after[n] == pytest.approx(before[n] / (1.0 - before["obj:1"]))
+    # the prior by hand: R(kitchen) = 0.05 + 0.95 * 0.9, C = 0.05 + 0.95 * s,
+    # Z = C(fridge) + C(wardrobe); the door holds R̄ (no room types listed: 0.3)
+    r, cf, cw = 0.05 + 0.95 * 0.9, 0.05 + 0.95 * 0.8, 0.05 + 0.95 * 0.2
+    w = np.array([r * cf / (cf + cw), r * cw / (cf + cw), 0.3])
+    assert [before[n] for n in ("obj:1", "obj:2", "door:1")] == pytest.approx(w / w.sum())
+    # the kitchen's remaining mass (its wardrobe, ~0.21 unnormalised) is now below the
+    # unknown room's (0.3): the planner leaves for the door instead of the wardrobe
+    assert after["door:1"] > after["obj:2"]
+    p = SearchTheoryPlanner(SCORER)
+    p.reset("frying pan")
+    assert p.decide(after_g).target == "door:1"
+
+
+def test_failed_attempts_lower_the_mass() -> None:
+    g = kitchen()
+    cands = actionable(g)
+    plain = place_masses(g, cands, "q", SCORER, BeliefParams())
+    failed = place_masses(g, cands, "q", SCORER, BeliefParams(miss=0.5), failures=[1, 0, 0])
+    assert failed[0] < plain[0] and failed.sum() == pytest.approx(1.0)
+
+
+def cand(node_id: str, x: float) -> Candidate:
+    return Candidate(node_id, "navigate", "object", abs(x), (x, 0.0))
+
+
+def test_look_ahead_takes_the_pair_on_the_same_side() -> None:
+    # Y alone has the best p/c, but X and Z together hold more mass for about the same walk
+    cands = [cand("obj:x", 10.0), cand("obj:y", -10.0), cand("obj:z", 10.5)]
+    p = np.array([0.4, 0.45, 0.15])
+    i, _ = best_first(cands, p, (0.0, 0.0), SearchParams(step_cost=1.0, horizon=1))
+    assert cands[i].node_id == "obj:y"
+    i, value = best_first(cands, p, (0.0, 0.0), SearchParams(step_cost=1.0, horizon=3))
+    assert cands[i].node_id == "obj:x"
+    # (S2) for (x, z, y): 11 + 0.6 * (0.5 + 1) + 0.45 * (20.5 + 1)
+    assert value == pytest.approx(1.0 / 21.575)
+
+
+def test_steps_get_dearer_when_the_budget_is_short() -> None:
+    p = np.full(20, 0.05)  # N_eff = 20 places
+    assert step_price(p, 40, 2.0) == 2.0  # plenty of steps
+    assert step_price(p, 10, 2.0) == pytest.approx(4.0)  # twice as many places as steps
+    assert step_price(p, None, 2.0) == 2.0  # no budget
+
+
+def test_registry_options() -> None:
+    p = make_planner("bayes-search", horizon="2", step_cost=0.5, timed=False)
+    assert (p.params.horizon, p.params.step_cost) == (2, 0.5)
+    assert dataclasses.is_dataclass(p.params)

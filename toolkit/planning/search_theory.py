@@ -1,0 +1,152 @@
+"""``bayes-search``: optimal-search theory over the scene graph.
+
+The target's location is a distribution over the places the robot can check
+(:mod:`sgtool.planning.belief`: calibrated containment and co-occurrence priors, Bayes
+updates as places are found empty). Checking place i costs
+
+    c_i = d_i + a + b·[open] + e·[reveal]                                             (S1)
+
+metres-equivalent: d_i the travel distance, ``a`` the price of spending one action, ``b``
+the extra of an open interaction, ``e`` the expected local travel still needed after
+revealing a region or room (0 by default: what the reveal teaches about the room pays for
+it). The episode has a step budget (``step_budget``, SymSearch's N_max = 50): when the mass
+is spread over more places than there are steps left, an action becomes dearer,
+
+    a_t = a · max(1, N_eff / steps_left),   N_eff = 1 / Σ_i p_i²                       (S3)
+
+(N_eff, the effective number of places, is the inverse Simpson index of the belief). For
+independent places with perfect detection and no switching cost the
+expected cost to find is minimised by checking in decreasing order of p_i / c_i (the
+classic ratio rule of search theory; Kadane & Simon 1977, Stone 1975). Travel costs are
+not independent of the order, so the ratio only preselects: among the ``top_k`` places by
+p_i / c_i, every ordering (i_1, .., i_h) of ``horizon`` of them is scored by its detection
+probability per expected cost
+
+    V = (Σ_j p_{i_j}) / E[cost],
+    E[cost] = c_{i_1} + Σ_{j≥2} (1 - Σ_{l<j} p_{i_l}) · c(i_{j-1} -> i_j)            (S2)
+
+(later legs are paid only if the earlier places were empty), with the leg cost
+c(i -> j) = ρ·|x_i - x_j| + a + b·[open_j] + e·[reveal_j]; ρ, the detour factor, is the
+median ratio of travel distance to straight-line distance over the current candidates
+(≥ 1). The first place of the best ordering is checked; after the outcome the
+distribution is rebuilt from the new graph (B5), so the plan is re-made at every step
+(receding horizon). Everything is deterministic (ties broken by node id): the seed is not
+used.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from sgtool.planning.belief import BeliefParams, place_masses
+from sgtool.planning.candidates import Candidate
+from sgtool.planning.planners import UtilityPlanner
+from sgtool.scenegraph.graph import SceneGraph
+from sgtool.semantics.priors import RelationScorer
+
+REVEAL_KINDS = frozenset({"room", "frontier", "door"})
+
+
+@dataclass(frozen=True)
+class SearchParams:
+    step_cost: float = 2.0  # a of (S1), metres per action
+    open_cost: float = 0.5  # b of (S1)
+    reveal_cost: float = 0.0  # e of (S1)
+    top_k: int = 5
+    horizon: int = 3
+    step_budget: int = 50  # actions per episode (SymSearch's N_max); 0: no budget
+    belief: BeliefParams = field(default_factory=BeliefParams)
+
+
+def step_price(p: np.ndarray, steps_left: int | None, base: float) -> float:
+    """a of (S1): ``base``, raised when the mass is spread over more places than there are
+    steps left: a · max(1, N_eff / steps_left) with N_eff = 1 / Σ p² (module doc)."""
+    if not steps_left or steps_left <= 0 or not len(p):
+        return base
+    n_eff = 1.0 / max(float(np.sum(p * p)), 1e-12)
+    return base * max(1.0, n_eff / steps_left)
+
+
+def extra_cost(c: Candidate, params: SearchParams, step: float | None = None) -> float:
+    """The part of (S1) besides travel (``step``: the price of an action, default a)."""
+    step = params.step_cost if step is None else step
+    return (step + (params.open_cost if c.skill == "open" else 0.0)
+            + (params.reveal_cost if c.kind in REVEAL_KINDS else 0.0))
+
+
+def detour_factor(cands: Sequence[Candidate], robot: tuple[float, float]) -> float:
+    """ρ of (S2): median travel / straight-line distance, clipped to [1, 3]."""
+    ratios = []
+    for c in cands:
+        e = math.hypot(c.position[0] - robot[0], c.position[1] - robot[1])
+        if e > 0.5:
+            ratios.append(c.distance / e)
+    return float(np.clip(np.median(ratios), 1.0, 3.0)) if ratios else 1.0
+
+
+def sequence_value(order: Sequence[int], p: np.ndarray, first_cost: np.ndarray,
+                   legs: np.ndarray) -> float:
+    """V of (S2) for an ordering of candidate indices."""
+    cost = float(first_cost[order[0]])
+    left = 1.0
+    for a, b in itertools.pairwise(order):
+        left -= float(p[a])
+        cost += max(left, 0.0) * float(legs[a, b])
+    return float(sum(p[i] for i in order)) / cost
+
+
+def best_first(cands: Sequence[Candidate], p: np.ndarray, robot: tuple[float, float],
+               params: SearchParams, steps_left: int | None = None) -> tuple[int, float]:
+    """Index of the candidate to check first and the value of its ordering (module doc)."""
+    step = step_price(p, steps_left, params.step_cost)
+    extra = np.array([extra_cost(c, params, step) for c in cands])
+    first = np.array([c.distance for c in cands]) + extra
+    ratio = p / first
+    ranked = sorted(range(len(cands)), key=lambda i: (-ratio[i], cands[i].node_id))
+    top = ranked[: max(1, params.top_k)]
+    h = min(params.horizon, len(top))
+    if h <= 1:
+        return top[0], float(ratio[top[0]])
+    rho = detour_factor(cands, robot)
+    xy = np.array([cands[i].position for i in range(len(cands))])
+    legs = np.zeros((len(cands), len(cands)))
+    for a in top:
+        for b in top:
+            legs[a, b] = rho * float(np.hypot(*(xy[a] - xy[b]))) + extra[b]
+    best: tuple[float, tuple[str, ...], int] | None = None
+    for order in itertools.permutations(top, h):
+        v = sequence_value(order, p, first, legs)
+        key = (-v, tuple(cands[i].node_id for i in order), order[0])
+        if best is None or key[:2] < best[:2]:
+            best = key
+    assert best is not None
+    return best[2], -best[0]
+
+
+class SearchTheoryPlanner(UtilityPlanner):
+    """Bayesian search with the p/c ratio rule and a short look-ahead (module doc)."""
+
+    def __init__(self, scorer: RelationScorer, params: SearchParams = SearchParams(),
+                 name: str = "bayes-search", max_failures: int = 2) -> None:
+        super().__init__(name, scorer, params, max_failures)  # type: ignore[arg-type]
+        self.steps = 0
+
+    def reset(self, query: str, seed: int = 0) -> None:
+        super().reset(query, seed)
+        self.steps = 0
+
+    def choose(self, graph: SceneGraph, cands: list[Candidate]
+               ) -> tuple[int, str, dict[str, float]]:
+        fails = [len(self.memory.failures.get(c.node_id, ())) for c in cands]
+        p = place_masses(graph, cands, self.query, self.scorer, self.params.belief, fails)
+        budget = self.params.step_budget
+        left = budget - self.steps if budget > 0 else None
+        self.steps += 1
+        i, value = best_first(cands, p, graph.robot.position, self.params, left)
+        scores = {c.node_id: round(float(v), 4) for c, v in zip(cands, p, strict=True)}
+        return i, f"p={p[i]:.3f}, d={cands[i].distance:.2f} m, value={value:.4f}", scores
