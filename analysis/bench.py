@@ -216,11 +216,15 @@ def _planner(name: str, options: Mapping[str, Any]) -> Any:
     return p
 
 
+PRIORS_PLANNERS = ("scout", "scout-noroom", "scout-delta0", "godhs", "esc", "bayes-search")
+
+
 def planner_options_for(cfg: BenchConfig, name: str) -> dict[str, Any]:
-    """The options ``name`` is built with: the configured ones, and for the scout planners
-    the weights of ``cfg.priors_dir`` unless an option names other weights."""
+    """The options ``name`` is built with: the configured ones, and for the planners that
+    use the learned priors (:data:`PRIORS_PLANNERS`) the weights of ``cfg.priors_dir``
+    unless an option names other weights."""
     opts = dict(cfg.planner_options.get(name, {}))
-    if cfg.priors_dir is not None and name.startswith("scout"):
+    if cfg.priors_dir is not None and name in PRIORS_PLANNERS:
         opts.setdefault("weights_dir", cfg.priors_dir)
     return opts
 

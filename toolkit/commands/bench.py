@@ -26,9 +26,10 @@ from sgtool.datasets.presets import PRESET_NAMES
                    "a bad one stops the run before any episode, naming file and field.")
 @click.option("--priors", "priors_dir", default=None, metavar="DIR",
               type=click.Path(file_okay=False, path_type=str),
-              help="Relational priors (a folder written by `sgtool distill`): the scout "
-                   "planners load them, and a query is 'seen' when it is one of their "
-                   "training queries [default: the shipped priors].")
+              help="Relational priors (a folder written by `sgtool distill`): the planners "
+                   "of the learned priors (scout*, godhs, esc, bayes-search) load them, and a "
+                   "query is 'seen' when it is one of their training queries [default: the "
+                   "shipped priors].")
 @click.option("--episodes", default=20, show_default=True,
               help="Search episodes per house (the same for every seed).")
 @click.option("--seeds", default=5, show_default=True,

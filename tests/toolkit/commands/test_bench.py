@@ -115,9 +115,13 @@ def test_house_files_next_to_generated_houses_sort_by_id(tmp_path):
         ("house-3", 0, 0), ("house-3", 0, 1), ("house-3", 1, 0), ("house-3", 1, 1)]
     assert [h.id for h in res.houses] == ["house-3", "Cottage"]
     assert "1 generated houses (rooms 12-16) + houses from" in res.table
-    # --priors reaches the scout planners, unless an option names other weights
+    # --priors reaches every planner of the learned priors, unless an option names other
+    # weights; sbert uses none
     cfg = BenchConfig(priors_dir="/p", planner_options={"scout-noroom": {"weights_dir": "/q"}})
     assert planner_options_for(cfg, "scout") == {"weights_dir": "/p"}
+    assert planner_options_for(cfg, "bayes-search") == {"weights_dir": "/p"}
+    assert planner_options_for(cfg, "godhs") == planner_options_for(cfg, "esc") == \
+        {"weights_dir": "/p"}
     assert planner_options_for(cfg, "scout-noroom") == {"weights_dir": "/q"}
     assert planner_options_for(cfg, "sbert") == {}
 
