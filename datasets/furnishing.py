@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from sgtool.datasets.first_level import FLOOR_HOLDERS, extra_holders, holder_size
 from sgtool.datasets.house_inventory import Inventory
 from sgtool.datasets.house_plan import Piece, Plan, PlanRoom, Rect, snap
 from sgtool.datasets.presets import PRESETS, GeneratorPreset
@@ -22,6 +23,9 @@ from sgtool.datasets.sizes import (
     furniture_size,
 )
 from sgtool.datasets.synsets import ancestors
+
+EXTRA_ATTEMPTS = 8  # positions tried for an extra holder (first_level module)
+TOP_MAX_HEIGHT = 1.2  # m, highest top face an extra holder is stood on
 
 
 def _furniture_list(rng: np.random.Generator, room_type: str, inv: Inventory,
@@ -83,10 +87,12 @@ def _wall_candidate(rng: np.random.Generator, inner: Rect, w: float,
 
 
 def furnish_room(rng: np.random.Generator, room: PlanRoom, plan: Plan, inv: Inventory,
-                 pieces: list[Piece], preset: GeneratorPreset = PRESETS["default"]) -> None:
+                 pieces: list[Piece], preset: GeneratorPreset = PRESETS["default"]
+                 ) -> list[int]:
     """Draw and place the furniture of ``room``, appending the kept pieces to ``pieces``
     (whose length gives the index of the room's first piece); ``preset`` scales how many
-    pieces are drawn."""
+    pieces are drawn and adds extra holders (:mod:`sgtool.datasets.first_level`), whose
+    indices in ``pieces`` are returned."""
     space = RoomSpace(room, plan.openings)
     wanted = _furniture_list(rng, room.type, inv, preset)
     floor = [s for s in wanted if s not in STACKED_ON]
@@ -100,45 +106,7 @@ def furnish_room(rng: np.random.Generator, room: PlanRoom, plan: Plan, inv: Inve
     floor.sort(key=order_key)
     mine: list[Piece] = []
     for s in floor:
-        size = _jittered_size(rng, furniture_size(s))
-        w, d, h = size
-        placed = None
-        for _ in range(24):
-            if s in SEATS and any(p.synset in CENTRAL for p in mine):
-                cand = _seat_candidate(rng, [p for p in mine if p.synset in CENTRAL], w, d)
-            elif s in CENTRAL and _ < 12:
-                m = 0.75
-                x0, x1 = space.inner.x0 + m + w / 2, space.inner.x1 - m - w / 2
-                y0, y1 = space.inner.y0 + m + d / 2, space.inner.y1 - m - d / 2
-                if x1 < x0 or y1 < y0:
-                    cand = _wall_candidate(rng, space.inner, w, d)
-                else:
-                    cand = (snap(float(rng.uniform(x0, x1)), 0.01),
-                            snap(float(rng.uniform(y0, y1)), 0.01), 0.0)
-            else:
-                cand = _wall_candidate(rng, space.inner, w, d)
-            if cand is None:
-                continue
-            cx, cy, yaw = cand
-            box = _footprint(cx, cy, w, d, yaw)
-            if not box.inside(space.inner):
-                continue
-            if any(box.overlaps(p.box, 0.05) for p in mine):
-                continue
-            if any(box.overlaps(k) for k in space.keepouts):
-                continue
-            aff = inv.knowledge.affordances.get(s, ())
-            reach = [p.box for p in mine if p.affordances]
-            if aff:
-                reach.append(box)
-            if not space.free_ok(reach, box):
-                continue
-            placed = Piece(s, room.idx, box, 0.0, size, yaw % (2 * math.pi), None, False,
-                            aff, _initial_state(rng, aff))
-            break
-        if placed is not None:
-            space.add(placed.box)
-            mine.append(placed)
+        _place_floor(rng, s, furniture_size(s), room, space, inv, mine, 24)
     for s in stacked:
         bases = [p for p in mine if p.on is None and not p.top_used
                  and any(a in ancestors(p.synset) for a in STACKED_ON[s])]
@@ -154,7 +122,95 @@ def furnish_room(rng: np.random.Generator, room: PlanRoom, plan: Plan, inv: Inve
                            base.z0 + base.size[2], size, base.yaw,
                            len(pieces) + mine.index(base), True, aff,
                            _initial_state(rng, aff)))
+    first_extra = len(mine)
+    top_width: dict[int, float] = {}
+    for s in extra_holders(rng, room, inv, preset):
+        if not _place_floor(rng, s, holder_size(s), room, space, inv, mine, EXTRA_ATTEMPTS):
+            _place_on_top(rng, s, room, space, inv, mine, len(pieces), top_width)
+    extras = list(range(len(pieces) + first_extra, len(pieces) + len(mine)))
     pieces.extend(mine)
+    return extras
+
+
+def _place_floor(rng: np.random.Generator, s: str, base_size: tuple[float, float, float],
+                 room: PlanRoom, space: RoomSpace, inv: Inventory, mine: list[Piece],
+                 attempts: int) -> bool:
+    """Try ``attempts`` positions for a floor piece ``s`` (against a wall, in the open for
+    a table, at a table for a seat); the first that keeps the room crossable and every
+    holder reachable is appended to ``mine`` (True), else False."""
+    size = _jittered_size(rng, base_size)
+    w, d, h = size
+    for _ in range(attempts):
+        if s in SEATS and any(p.synset in CENTRAL for p in mine):
+            cand = _seat_candidate(rng, [p for p in mine if p.synset in CENTRAL], w, d)
+        elif s in CENTRAL and _ < 12:
+            m = 0.75
+            x0, x1 = space.inner.x0 + m + w / 2, space.inner.x1 - m - w / 2
+            y0, y1 = space.inner.y0 + m + d / 2, space.inner.y1 - m - d / 2
+            if x1 < x0 or y1 < y0:
+                cand = _wall_candidate(rng, space.inner, w, d)
+            else:
+                cand = (snap(float(rng.uniform(x0, x1)), 0.01),
+                        snap(float(rng.uniform(y0, y1)), 0.01), 0.0)
+        else:
+            cand = _wall_candidate(rng, space.inner, w, d)
+        if cand is None:
+            continue
+        cx, cy, yaw = cand
+        box = _footprint(cx, cy, w, d, yaw)
+        if not box.inside(space.inner):
+            continue
+        if any(box.overlaps(p.box, 0.05) for p in mine):
+            continue
+        if any(box.overlaps(k) for k in space.keepouts):
+            continue
+        aff = inv.knowledge.affordances.get(s, ())
+        reach = [p.box for p in mine if p.affordances]
+        if aff:
+            reach.append(box)
+        if not space.free_ok(reach, box):
+            continue
+        placed = Piece(s, room.idx, box, 0.0, size, yaw % (2 * math.pi), None, False,
+                       aff, _initial_state(rng, aff))
+        space.add(placed.box)
+        mine.append(placed)
+        return True
+    return False
+
+
+def _place_on_top(rng: np.random.Generator, s: str, room: PlanRoom, space: RoomSpace,
+                  inv: Inventory, mine: list[Piece], offset: int, used: dict[int, float]
+                  ) -> bool:
+    """Stand a small extra holder ``s`` on the top face of a low supporter of ``mine`` (a
+    table, counter, cabinet), next to the holders already there (``used``: the width taken
+    on each base, by index in ``mine``) at its front edge, if the robot can reach it there;
+    ``offset`` is the index of ``mine[0]`` in the house. The base's top face then holds no
+    small objects. Returns whether the holder was placed."""
+    size = _jittered_size(rng, holder_size(s))
+    w, d, _ = size
+    bases = [i for i, p in enumerate(mine)
+             if p.on is None and "supporter" in p.affordances and p.size[2] <= TOP_MAX_HEIGHT
+             and (p.top_used == (i in used)) and p.size[1] >= d
+             and used.get(i, 0.0) + w <= p.size[0]]
+    if s not in FLOOR_HOLDERS or not bases:
+        return False
+    i = bases[int(rng.integers(len(bases)))]
+    base = mine[i]
+    # along the base's width, at its front edge (local +y faces into the room)
+    lx = -base.size[0] / 2 + used.get(i, 0.0) + w / 2
+    ly = base.size[1] / 2 - d / 2
+    c, sn = math.cos(base.yaw), math.sin(base.yaw)
+    cx = (base.box.x0 + base.box.x1) / 2 + c * lx - sn * ly
+    cy = (base.box.y0 + base.box.y1) / 2 + sn * lx + c * ly
+    box = _footprint(cx, cy, w, d, base.yaw)
+    if not space.free_ok([box], None):
+        return False
+    used[i] = used.get(i, 0.0) + w + 0.02
+    base.top_used = True
+    aff = inv.knowledge.affordances.get(s, ())
+    mine.append(Piece(s, room.idx, box, base.z0 + base.size[2], size, base.yaw, offset + i,
+                      True, aff, _initial_state(rng, aff)))
+    return True
 
 
 def _seat_candidate(rng: np.random.Generator, tables: list[Piece], w: float,

@@ -52,10 +52,12 @@
    on the seed only.
 
 **Presets** (:mod:`sgtool.datasets.presets`): the steps above are the ``default`` preset;
-``symsearch`` runs the same steps with more furniture per room, more small objects per
-container and top face, and small objects from the long tail of the split (categories
-whose home is the room type, even on one source, drawn evenly, most draws going to
-categories unseen in training), for houses as dense as SymSearch's InteriorGS scenes.
+``symsearch`` runs the same steps with more furniture per room, extra first-level holders
+(baskets, boxes, bins, side tables, shelves, mostly empty:
+:mod:`~sgtool.datasets.first_level`), more small objects per container and top face, and
+small objects from the long tail of the split (categories whose home is the room type,
+even on one source, drawn evenly, most draws going to categories unseen in training), for
+houses as dense as SymSearch's InteriorGS scenes.
 
 The same seed gives the same bytes (numpy PCG64 stream, sorted iteration, 4-decimal
 canonical JSON).
@@ -162,10 +164,11 @@ def generate_house(seed: int, rooms: tuple[int, int] = (4, 12), split: str = "ev
         try:
             plan = floor_plan(rng, n_rooms, inv)
             pieces: list[Piece] = []
+            extras: set[int] = set()
             for r in plan.rooms:
-                furnish_room(rng, r, plan, inv, pieces, pre)
+                extras.update(furnish_room(rng, r, plan, inv, pieces, pre))
             room_types = {r.idx: r.type for r in plan.rooms}
-            objs = place_objects(rng, split, pieces, room_types, pre)
+            objs = place_objects(rng, split, pieces, room_types, pre, frozenset(extras))
             draft = load_house(_spec_dict(seed, split, plan, pieces, objs, []))
             starts = start_poses(rng, draft)
             return load_house(_spec_dict(seed, split, plan, pieces, objs, starts))

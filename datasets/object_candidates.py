@@ -78,6 +78,11 @@ def _novel(split: str) -> frozenset[str]:
     return frozenset(unseen_queries()) if split == "eval" else frozenset()
 
 
+def has_novel(split: str, names: tuple[str, ...]) -> bool:
+    """Whether any of the synsets ``names`` is unseen in training (:func:`_novel`)."""
+    return any(readable_name(c) in _novel(split) for c in names)
+
+
 @functools.cache
 def candidates(split: str, parent: str, relation: str, room_type: str, long_tail: bool = False,
                novel_share: float = 0.0) -> tuple[tuple[str, ...], np.ndarray]:

@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from sgtool.datasets.house_plan import Piece
-from sgtool.datasets.object_candidates import candidates
+from sgtool.datasets.object_candidates import candidates, has_novel
 from sgtool.datasets.presets import PRESETS, GeneratorPreset
 from sgtool.datasets.sizes import object_size
 from sgtool.datasets.synsets import readable_name
@@ -64,12 +64,18 @@ def _distinct_categories(rng: np.random.Generator, w: np.ndarray, n: int) -> lis
 
 def place_objects(rng: np.random.Generator, split: str, pieces: list[Piece],
                   room_types: dict[int, str],
-                  preset: GeneratorPreset = PRESETS["default"]) -> list[dict]:
+                  preset: GeneratorPreset = PRESETS["default"],
+                  extras: frozenset[int] = frozenset()) -> list[dict]:
     """Small-object records (spec ``objects`` entries without ids) for ``pieces``;
     ``room_types`` maps plan room index -> room type; ``preset`` sets the mean counts and
-    the candidate pool."""
+    the candidate pool (and scales the mean count of a pool without unseen categories);
+    of the pieces whose index is in ``extras`` (the extra holders of
+    :mod:`sgtool.datasets.first_level`) only ``preset.extra_fill_share`` are filled, the
+    others stay empty."""
     objs: list[dict] = []
     for pi, p in enumerate(pieces):
+        if pi in extras and rng.random() >= preset.extra_fill_share:
+            continue
         for relation in ("inside", "ontop"):
             if relation == "inside" and "container" not in p.affordances:
                 continue
@@ -82,6 +88,8 @@ def place_objects(rng: np.random.Generator, split: str, pieces: list[Piece],
                 continue
             lam = preset.lambda_inside if relation == "inside" else preset.lambda_ontop
             lam *= min(1.0, len(names) / FULL_POOL)
+            if preset.seen_pool_scale != 1.0 and not has_novel(split, names):
+                lam *= preset.seen_pool_scale
             slots = _slots(p, relation)
             n = min(int(rng.poisson(lam)), len(slots))
             if n == 0:

@@ -14,7 +14,13 @@ a house and where its small objects come from.
   every candidate weighs the same, and :attr:`GeneratorPreset.novel_share` of the draws go
   to categories the training split never mentions (SymSearch's unseen queries, SCOUT
   Table IX: 61 of 142). The room-type evidence rule is kept: a category is only placed in
-  a room type that has evidence for it.
+  a room type that has evidence for it. SymSearch's scenes are dense at the first level
+  too (408 objects of which 157 contained: about 250 explorable pieces, most holding
+  nothing), so each room also gets about :attr:`GeneratorPreset.extra_holders_per_m2`
+  extra holders per square metre (:mod:`sgtool.datasets.first_level`: baskets, boxes,
+  bins, chests, side tables, shelves from its room type's evidence), against a wall or,
+  where no wall is left, on the top face of a low table or cabinet; only
+  :attr:`GeneratorPreset.extra_fill_share` of them get small objects.
 """
 
 from __future__ import annotations
@@ -36,6 +42,9 @@ class GeneratorPreset:
     lambda_ontop: float = 1.3  # mean small objects per top face (Poisson)
     long_tail: bool = False  # admit and weigh small objects as the long tail (module doc)
     novel_share: float = 0.0  # long tail: share of draws from categories unseen in training
+    extra_holders_per_m2: float = 0.0  # extra first-level holders (first_level module)
+    extra_fill_share: float = 1.0  # share of the extra holders that get small objects
+    seen_pool_scale: float = 1.0  # mean count of a piece whose pool has no unseen category
 
 
 PRESETS: dict[str, GeneratorPreset] = {
@@ -43,7 +52,8 @@ PRESETS: dict[str, GeneratorPreset] = {
     "symsearch": GeneratorPreset(
         "symsearch", furniture_frequency_scale=3.0, furniture_count_scale=2.0,
         furniture_cap_scale=2, lambda_inside=8.0, lambda_ontop=6.0, long_tail=True,
-        novel_share=0.9),
+        novel_share=1.0, extra_holders_per_m2=2.5, extra_fill_share=0.25,
+        seen_pool_scale=0.5),
 }
 PRESET_NAMES: tuple[str, ...] = tuple(PRESETS)
 
