@@ -15,7 +15,7 @@ same spec.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
 from sgtool.canonical import canonical_float
@@ -55,25 +55,13 @@ def parse_house(d: Any, limits: SpecLimits = LIMITS) -> HouseSpec:
     if split not in ("eval", "train"):
         raise SpecError(f"split: expected 'eval' or 'train', got {split!r}")
     p = _Parser(limits)
-    rooms = tuple(p.room(f"rooms[{i}]", r)
-                  for i, r in enumerate(p.entries(d, "rooms", limits.rooms, min_len=1)))
-    room_ids = _unique_ids("rooms", rooms, "room_")
-    p.room_ids = room_ids
-    walls = tuple(p.wall(f"walls[{i}]", w)
-                  for i, w in enumerate(p.entries(d, "walls", limits.walls)))
-    _unique_ids("walls", walls, "wall_")
-    doors = tuple(p.door(f"doors[{i}]", x)
-                  for i, x in enumerate(p.entries(d, "doors", limits.doors)))
-    _unique_ids("doors", doors, "door_")
-    passages = tuple(p.passage(f"passages[{i}]", x) for i, x in
-                     enumerate(p.entries(d, "passages", limits.doors, required=False)))
-    _unique_ids("passages", passages, "pass_")
-    furniture = tuple(p.furniture(f"furniture[{i}]", x)
-                      for i, x in enumerate(p.entries(d, "furniture", limits.furniture)))
-    _unique_ids("furniture", furniture, "furn_")
-    objects = tuple(p.small_object(f"objects[{i}]", x)
-                    for i, x in enumerate(p.entries(d, "objects", limits.objects)))
-    _unique_ids("objects", objects, "obj_")
+    rooms = p.section(d, "rooms", p.room, limits.rooms, "room_", min_len=1)
+    p.room_ids = {r.id for r in rooms}
+    walls = p.section(d, "walls", p.wall, limits.walls, "wall_")
+    doors = p.section(d, "doors", p.door, limits.doors, "door_")
+    passages = p.section(d, "passages", p.passage, limits.doors, "pass_", required=False)
+    furniture = p.section(d, "furniture", p.furniture, limits.furniture, "furn_")
+    objects = p.section(d, "objects", p.small_object, limits.objects, "obj_")
     starts = tuple(p.start(f"starts[{i}]", x)
                    for i, x in enumerate(p.entries(d, "starts", limits.starts)))
     spec = HouseSpec(seed=seed, rooms=rooms, walls=walls, doors=doors, furniture=furniture,
@@ -92,6 +80,16 @@ class _Parser:
         self.room_ids: set[str] = set()
 
     # ----- shapes and scalars ---------------------------------------------------------
+    def section(self, d: Mapping[str, Any], key: str, parse: Callable[[str, Any], Any],
+                limit: int, prefix: str, min_len: int = 0, required: bool = True
+                ) -> tuple[Any, ...]:
+        """The entries under ``key``, each parsed by ``parse(where, entry)``, with unique
+        ids starting with ``prefix``."""
+        items = tuple(parse(f"{key}[{i}]", x) for i, x in
+                      enumerate(self.entries(d, key, limit, min_len, required)))
+        _unique_ids(key, items, prefix)
+        return items
+
     def entries(self, d: Mapping[str, Any], key: str, limit: int, min_len: int = 0,
                 required: bool = True) -> list[Any]:
         """The list under ``key`` (an empty list when absent and not ``required``)."""
