@@ -24,16 +24,24 @@ Protocol (SCOUT sec. VI, Table VII; MoMa-LLM's AUC-E):
 Outputs (in ``out_dir``): ``episodes.jsonl`` (one :class:`EpisodeResult` per line, ordered
 by planner, then house id (plain string order), episode index, seed), ``summary.md`` (Table
 VII-shaped table, the same next to the rows quoted from SCOUT Table VII, seen/unseen table,
-per-house and per-query tables, AUC-E budgets, settings, digest), ``summary.json``,
+per-house and per-query tables, AUC-E budgets, settings, digest), ``summary.json``
+(both hold no wall-clock figure: the same arguments give the same bytes on any executor and
+any number of workers), ``run.md``/``run.json`` (the table with the decision time and
+episodes per second, the run time, workers, executor and command: wall-clock figures),
 ``per_house.md``/``per_house.jsonl`` and ``per_query.md``/``per_query.jsonl`` (SR, SPL,
 steps per planner, pooled over seeds), and the efficiency curves
 ``efficiency_distance.png`` and ``efficiency_steps.png``. Every file is written to a temp
 file and renamed. Records are identical between runs except their ``wall`` figures; the
 digest in the summary leaves those out.
 
-``--workers N`` runs (house, planner) tasks in a process pool (spawned processes, each
-keeping its last houses and its planners); results are put back in the fixed order, so the
-output does not depend on N.
+Tasks are grouped by house (:func:`bench_tasks`): one task runs every planner on one
+house, so the house is built once in the whole run; when there are fewer houses than
+workers, a house's planners are split over several tasks. The tasks run on
+:mod:`sgtool.analysis.executor`'s local executor (``workers`` spawned processes, each keeping
+its last houses and its planners) or on Ray (``executor="ray"``, ``ray_address``); results
+are put back in the fixed order, so the output does not depend on the executor or N. A task
+that still fails after one retry is listed in the summary (``failed_tasks``) with its
+error; its episodes are missing from every table.
 """
 
 from __future__ import annotations
@@ -56,6 +64,7 @@ from sgtool.analysis.bench_houses import (
     generated_houses,
     load_house_files,
 )
+from sgtool.analysis.executor import Task, chunks, failure_lines, make_executor
 from sgtool.analysis.metrics import CostModel, breakdown, cost_models, seen_unseen, summarize
 from sgtool.analysis.paper_tables import TABLE_IX_SYMSEARCH
 from sgtool.analysis.report import (
@@ -69,6 +78,7 @@ from sgtool.analysis.report import (
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write
+from sgtool.planning.episode import SUCCESS_RULES
 from sgtool.redact import redact_options, redact_text, secret_values
 from sgtool.results import EpisodeResult, results_digest, write_jsonl
 
@@ -106,6 +116,9 @@ class BenchConfig:
     log_dir: str | None = None  # also record every episode as an MCAP log here
     house_files: tuple[str, ...] = ()  # house spec files or folders, after the generated
     priors_dir: str | None = None  # relational priors (vocabulary, scout weights)
+    success: str = "observed"  # success rule: observed | done (sgtool.planning.episode)
+    executor: str = "local"  # local | ray (sgtool.analysis.executor)
+    ray_address: str | None = None  # a Ray cluster; None: RAY_ADDRESS, else a local Ray
 
     def check(self) -> None:
         from sgtool.planning.registry import PLANNER_NAMES
@@ -133,13 +146,17 @@ class BenchConfig:
         lo, hi = self.rooms
         if not 4 <= lo <= hi <= 16:
             raise BenchError(f"--rooms: need 4 <= MIN <= MAX <= 16, got {lo}-{hi}")
+        if self.success not in SUCCESS_RULES:
+            raise BenchError(f"--success: one of {', '.join(SUCCESS_RULES)}, got "
+                             f"{self.success!r}")
         if "moma-llm" in self.planners:
             opts = self.planner_options.get("moma-llm", {})
             replay = opts.get("replay")
             if replay is not None and not Path(replay).is_file():
                 raise BenchError(f"--llm-replay: no such transcript {replay}")
-            if opts.get("transcript") and self.workers > 1:
-                raise BenchError("--llm-transcript needs --workers 1 (one file, one writer)")
+            if opts.get("transcript") and (self.workers > 1 or self.executor != "local"):
+                raise BenchError("--llm-transcript needs --workers 1 and the local executor "
+                                 "(one file, one writer)")
 
     def models(self) -> tuple[CostModel, CostModel]:
         return cost_models(self.distance_budget, self.step_budget)
@@ -150,8 +167,11 @@ class BenchConfig:
         d["rooms"] = list(self.rooms)
         d["planner_options"] = {k: {kk: str(vv) for kk, vv in redact_options(v).items()}
                                 for k, v in sorted(self.planner_options.items())}
-        d.pop("workers")  # does not change the results
+        for key in ("workers", "executor", "ray_address"):  # do not change the results
+            d.pop(key)
         d.pop("log_dir")
+        if self.success == "observed":  # the default: settings as before the option
+            d.pop("success")
         return d
 
 
@@ -166,12 +186,28 @@ class BenchResult:
     wall_s: float
     houses: tuple[BenchHouse, ...] = ()
     vocabulary_size: int = 0  # training queries of the priors
+    failed: tuple[str, ...] = ()  # one line per task that failed after its retry
 
     @property
     def side_by_side(self) -> str:
+        return self._side_by_side(timing=True)
+
+    @property
+    def results_table(self) -> str:
+        """:attr:`table` without its wall-clock columns: a function of the results alone."""
+        models = self.config.models()
+        return format_table(summarize(self.results, models, self.config.planners),
+                            models=models, title=_title(self.config), timing=False)
+
+    @property
+    def results_side_by_side(self) -> str:
+        return self._side_by_side(timing=False)
+
+    def _side_by_side(self, timing: bool) -> str:
         return format_side_by_side(
             summarize(self.results, self.config.models(), self.config.planners),
-            title="Ours next to SCOUT Table VII (SymSearch rows quoted from the paper)")
+            title="Ours next to SCOUT Table VII (SymSearch rows quoted from the paper)",
+            timing=timing)
 
     def breakdown_table(self, by: str) -> str:
         rows = breakdown(self.results, by, self.config.planners)
@@ -238,30 +274,55 @@ def _vocabulary(priors_dir: str | None) -> frozenset[str]:
     return training_queries(priors_dir)
 
 
-def _task(args: tuple[BenchConfig, BenchHouse, str]) -> list[EpisodeResult]:
+def _task(args: tuple[BenchConfig, BenchHouse, tuple[str, ...]]) -> list[EpisodeResult]:
+    """Every episode and seed of one house for each of the given planners."""
+    from sgtool.blas import single_blas_thread
+    from sgtool.semantics.priors import forget_default_scores
+
+    cfg, ref, names = args
+    # A task's results depend on the task alone, not on what its worker ran before nor on
+    # the machine's core count: the shared priors start from an empty score memo (their
+    # batches, and so the last bits of their scores, are the task's own), and the small
+    # products of the priors' MLP run on one BLAS thread (OpenBLAS splits them over every
+    # core, which changes bits and, on a busy machine, costs several times the work).
+    forget_default_scores()
+    with single_blas_thread():
+        return _task_episodes(cfg, ref, names)
+
+
+def _task_episodes(cfg: BenchConfig, ref: BenchHouse,
+                   names: tuple[str, ...]) -> list[EpisodeResult]:
     from sgtool.recorders.symbolic_environment.rollout import run_episode
     from sgtool.semantics.text import category_text
 
-    cfg, ref, name = args
     house, episodes = _house(ref, cfg.rooms, cfg.episodes, cfg.preset)
-    planner = _planner(name, planner_options_for(cfg, name))
     vocabulary = _vocabulary(cfg.priors_dir)
     out = []
-    for seed in range(cfg.seeds):
-        for i, ep in enumerate(episodes):
-            kw = dict(seed=seed, episode_index=i, avoid_rooms=ep.target_rooms,
-                      max_steps=cfg.max_steps, seen=category_text(ep.query) in vocabulary,
-                      house_id=ref.id, planner_name=name)
-            if cfg.log_dir is None:
-                out.append(run_episode(house, planner, ep.query, ep.targets, **kw))
-                continue
-            from sgtool.log.writer import LogWriter
+    for name in names:
+        planner = _planner(name, planner_options_for(cfg, name))
+        for seed in range(cfg.seeds):
+            for i, ep in enumerate(episodes):
+                kw = dict(seed=seed, episode_index=i, avoid_rooms=ep.target_rooms,
+                          max_steps=cfg.max_steps, seen=category_text(ep.query) in vocabulary,
+                          house_id=ref.id, planner_name=name, success=cfg.success)
+                if cfg.log_dir is None:
+                    out.append(run_episode(house, planner, ep.query, ep.targets, **kw))
+                    continue
+                from sgtool.log.writer import LogWriter
 
-            path = Path(cfg.log_dir) / name / ref.id / f"seed{seed}-ep{i}.mcap"
-            path.parent.mkdir(parents=True, exist_ok=True)
-            with LogWriter(path, seed=seed) as log:
-                out.append(run_episode(house, planner, ep.query, ep.targets, log=log, **kw))
+                path = Path(cfg.log_dir) / name / ref.id / f"seed{seed}-ep{i}.mcap"
+                path.parent.mkdir(parents=True, exist_ok=True)
+                with LogWriter(path, seed=seed) as log:
+                    out.append(run_episode(house, planner, ep.query, ep.targets, log=log, **kw))
     return out
+
+
+def bench_tasks(cfg: BenchConfig, houses: Sequence[BenchHouse]) -> list[Task]:
+    """The run's tasks, grouped by house: all planners of a house in one task, or, when
+    there are fewer houses than workers, the house's planners cut into that many runs."""
+    groups = -(-cfg.workers // max(1, len(houses)))  # ceil(workers / houses)
+    return [Task(f"{h.id}/{'+'.join(names)}", (cfg, h, names))
+            for h in houses for names in chunks(cfg.planners, groups)]
 
 
 # ----------------------------------------------------------------------------------------
@@ -270,35 +331,15 @@ def _task(args: tuple[BenchConfig, BenchHouse, str]) -> list[EpisodeResult]:
 def run_benchmark(cfg: BenchConfig, progress: bool | None = None) -> BenchResult:
     """Run every planner on every episode (module doc); nothing is written."""
     cfg.check()
+    executor = make_executor(cfg.executor, cfg.workers, cfg.ray_address)
     houses = prepare_houses(cfg)
     vocabulary = _vocabulary(cfg.priors_dir)  # a bad --priors fails before any episode
-    tasks = [(cfg, h, p) for h in houses for p in cfg.planners]
+    for name in cfg.planners:  # and so does a bad planner option (built here, kept)
+        _planner(name, planner_options_for(cfg, name))
     show = sys.stderr.isatty() if progress is None else progress
     t0 = time.perf_counter()
-    chunks: list[list[EpisodeResult]] = []
-    try:
-        from tqdm import tqdm
-    except ImportError:  # pragma: no cover - tqdm is a dependency
-        tqdm = None  # type: ignore[assignment]
-    bar = tqdm(total=len(tasks), desc="bench", unit="task", disable=not show,
-               file=sys.stderr) if tqdm else None
-    if cfg.workers == 1:
-        for t in tasks:
-            chunks.append(_task(t))
-            if bar:
-                bar.update(1)
-    else:
-        import multiprocessing as mp
-        from concurrent.futures import ProcessPoolExecutor
-
-        ctx = mp.get_context("spawn")
-        with ProcessPoolExecutor(max_workers=cfg.workers, mp_context=ctx) as pool:
-            for chunk in pool.map(_task, tasks, chunksize=1):
-                chunks.append(chunk)
-                if bar:
-                    bar.update(1)
-    if bar:
-        bar.close()
+    outcomes = executor.run(_task, bench_tasks(cfg, houses), progress=show, desc="bench")
+    chunks = [o.value for o in outcomes if o.ok]
     wall = time.perf_counter() - t0
     order = {p: i for i, p in enumerate(cfg.planners)}
     # through the JSONL form, so the summary is exactly what `sgtool eval` recomputes from
@@ -320,7 +361,8 @@ def run_benchmark(cfg: BenchConfig, progress: bool | None = None) -> BenchResult
         title=f"Seen vs unseen queries (SCOUT Table IX), episodes pooled over seeds; seen = "
               f"one of the {len(vocabulary)} training queries of {priors}")
     return BenchResult(cfg, tuple(results), throughput, table, seen_table,
-                       results_digest(results), wall, houses, len(vocabulary))
+                       results_digest(results), wall, houses, len(vocabulary),
+                       tuple(failure_lines(outcomes)))
 
 
 def prepare_houses(cfg: BenchConfig) -> tuple[BenchHouse, ...]:
@@ -339,7 +381,8 @@ def _title(cfg: BenchConfig) -> str:
     if cfg.house_files:
         parts.append(f"houses from {', '.join(cfg.house_files)}")
     return (f"Symbolic benchmark (SymSearch roll-out): {' + '.join(parts)}; {cfg.episodes} "
-            f"episodes per house x {cfg.seeds} seeds, N_max = {cfg.max_steps}")
+            f"episodes per house x {cfg.seeds} seeds, N_max = {cfg.max_steps}"
+            f"{'; success only on done() (MoMa-LLM)' if cfg.success == 'done' else ''}")
 
 
 def priors_fingerprint(weights_dir: str | os.PathLike[str] | None = None) -> str:
@@ -359,8 +402,9 @@ def priors_fingerprint(weights_dir: str | os.PathLike[str] | None = None) -> str
 
 def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
                   command: str = "") -> list[Path]:
-    """episodes.jsonl, summary.md, summary.json, per_house.md/.jsonl, per_query.md/.jsonl
-    and the two efficiency PNGs."""
+    """episodes.jsonl, summary.md, summary.json (no wall-clock figure), run.md, run.json
+    (timing, command), per_house.md/.jsonl, per_query.md/.jsonl and the two efficiency
+    PNGs."""
     from sgtool.analysis.curves import plot_efficiency
 
     out = Path(out_dir)
@@ -376,33 +420,49 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
         paths.append(atomic_write(out / f"per_{by}.jsonl", "".join(
             json.dumps(d, sort_keys=True, allow_nan=False) + "\n"
             for d in breakdown_records(rows, by))))
-    md = [res.table, res.side_by_side, res.seen_table, res.breakdown_table("house"),
-          res.breakdown_table("query"),
-          f"Episodes per second: one core, episode roll-outs only (house preparation "
-          f"excluded); whole run {res.wall_s:.1f} s with {cfg.workers} worker(s).",
+    md = [res.results_table, res.results_side_by_side, res.seen_table,
+          res.breakdown_table("house"), res.breakdown_table("query"),
+          *([f"Failed tasks (retried once; their episodes are in no table): "
+             f"{len(res.failed)}", *(f"- {line}" for line in res.failed)]
+            if res.failed else []),
           f"Digest of episodes.jsonl without wall-clock fields: {res.digest}",
           f"sgtool {__version__}; relational priors "
-          f"{priors_fingerprint(cfg.priors_dir)}"]
-    if command:  # secrets given as options (-O moma-llm.api_key=...) never reach a file
-        md.append(f"Command: `{redact_text(command, secret_values(cfg.planner_options))}`")
+          f"{priors_fingerprint(cfg.priors_dir)}; wall-clock figures and the command in "
+          f"run.md"]
     paths.append(atomic_write(out / "summary.md", "\n".join(md) + "\n"))
+    # secrets given as options (-O moma-llm.api_key=...) never reach a file
+    shown = redact_text(command, secret_values(cfg.planner_options)) if command else ""
+    run_md = [res.table,
+              f"Episodes per second: one core, episode roll-outs only (house preparation "
+              f"excluded); whole run {res.wall_s:.1f} s with {cfg.workers} worker(s) on the "
+              f"{cfg.executor} executor.", *([f"Command: `{shown}`"] if shown else [])]
+    paths.append(atomic_write(out / "run.md", "\n".join(run_md) + "\n"))
+    sums = summarize(res.results, cfg.models(), cfg.planners)
     summary = {
         "version": BENCH_VERSION,
         "settings": cfg.settings(),
         "budgets": {m.name: {"max": m.max_cost, "cost": m.label} for m in cfg.models()},
-        "planners": summary_dict(summarize(res.results, cfg.models(), cfg.planners)),
+        "planners": summary_dict(sums, timing=False),
         "seen_unseen": [asdict(s) for s in seen_unseen(res.results, cfg.planners)],
         "vocabulary": {"priors": cfg.priors_dir, "training_queries": res.vocabulary_size},
         "houses": [{"id": h.id, "source": h.source} for h in res.houses],
         "digest": res.digest,
+        "failed_tasks": list(res.failed),
         "sgtool_version": __version__,
         "priors_sha256_16": priors_fingerprint(cfg.priors_dir),
-        "wall": {"seconds": round(res.wall_s, 3), "workers": cfg.workers,
-                 "episodes_per_s": {k: round(v, 3) for k, v in res.throughput.items()}},
     }
     paths.append(atomic_write(
         out / "summary.json",
         json.dumps(strict_json(summary), indent=1, sort_keys=True, allow_nan=False) + "\n"))
+    run = {"wall": {"seconds": round(res.wall_s, 3), "workers": cfg.workers,
+                    "executor": cfg.executor,
+                    "episodes_per_s": {k: round(v, 3) for k, v in res.throughput.items()},
+                    "decision_s": {p: d["decision_s"]
+                                   for p, d in summary_dict(sums).items()}},
+           "command": shown}
+    paths.append(atomic_write(
+        out / "run.json",
+        json.dumps(strict_json(run), indent=1, sort_keys=True, allow_nan=False) + "\n"))
     return paths
 
 

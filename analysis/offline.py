@@ -23,8 +23,10 @@ actions (the closed loop closes an episode at the time of its last action).
 
 **A planner against a log** (:func:`replay_decisions`): the planner is reset with the
 episode's query and seed, then at every decision point it decides on the logged graph and
-its choice is compared with the logged action; then it is told the logged outcome
-(teacher forcing: its memory follows what was really done, not what it would have done).
+its choice is compared with the logged action; then it is told the logged outcome and the
+executor's message (:func:`executor_message`; teacher forcing: its memory follows what was
+really done, not what it would have done). An LLM planner replaying the log's own
+exchanges therefore sees the prompts of the run and matches every decision.
 Reported: exact agreement (same skill and target), same target, same room (the chosen and
 the logged node lie in the same room), and choices that name no node of the graph.
 
@@ -51,6 +53,7 @@ from sgtool.errors import SgtoolError
 from sgtool.log.records import Absent, Episode, LogRecord, SceneGraphRecord, given
 from sgtool.log.records import Action as LoggedAction
 from sgtool.planning.base import Action, Feedback
+from sgtool.planning.episode import NOT_CONFIRMED, check_success_rule
 from sgtool.results import EpisodeResult, read_jsonl, result_from_log_records
 from sgtool.scenegraph.graph import DoorNode, SceneGraph
 
@@ -290,6 +293,45 @@ def node_rooms(graph: SceneGraph, node_id: str | None) -> frozenset[str]:
     return frozenset([room]) if room else frozenset([n.id])
 
 
+def executor_message(action: LoggedAction) -> str:
+    """What the executor told the planner about ``action``: the ``message`` a symbolic log
+    records beside the planner's ``reason``; a closed-loop log's ``reason`` is the
+    simulator's own."""
+    msg = action.unknown.get("message")
+    return str(msg) if isinstance(msg, str) else str(given(action.reason, ""))
+
+
+def with_success_rule(r: EpisodeResult, rule: str | None) -> EpisodeResult:
+    """``r`` judged by the success rule ``rule`` (None: as recorded). ``done``: a success
+    needs the last action to be ``done()`` naming an object (the episode loop's
+    confirmation, :mod:`sgtool.planning.episode`); ``observed``: the target came into view,
+    which an episode ended unconfirmed under ``done`` also means."""
+    if rule is None:
+        return r
+    check_success_rule(rule)
+    if rule == "observed":
+        return _replace(r, success=True, end="found") if r.end == NOT_CONFIRMED else r
+    last = r.trace[-1] if r.trace else None
+    if r.success and not (last is not None and last.skill == "done" and last.target):
+        return _replace(r, success=False, end=NOT_CONFIRMED)
+    return r
+
+
+def log_exchanges(paths: Iterable[str | os.PathLike[str]]) -> list[tuple[str, dict[str, Any]]]:
+    """(file, exchange record) of the ``/sgtool/llm`` channels of the MCAP logs among
+    ``paths``, file by file in log-time order."""
+    from sgtool.llm.recorded import MCAP_MAGIC, read_transcript
+
+    out: list[tuple[str, dict[str, Any]]] = []
+    for path in paths:
+        p = Path(path)
+        with open(p, "rb") as f:
+            if f.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
+                continue
+        out.extend((str(p), rec) for rec in read_transcript(p))
+    return out
+
+
 def replay_decisions(planner: Any, episodes: Sequence[LoggedEpisode],
                      name: str | None = None) -> OfflineReport:
     """Ask ``planner`` at every logged decision point (module doc)."""
@@ -320,7 +362,7 @@ def replay_decisions(planner: Any, episodes: Sequence[LoggedEpisode],
             else:
                 skipped += 1
             planner.feedback(Feedback(
-                logged, d.action.outcome, str(given(d.action.reason, "")),  # type: ignore[arg-type]
+                logged, d.action.outcome, executor_message(d.action),  # type: ignore[arg-type]
                 float(given(d.action.travelled_m, 0.0))))
     return OfflineReport(name or getattr(planner, "name", "planner"), tuple(out), skipped)
 

@@ -63,15 +63,18 @@ def pipe_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
 
 def format_table(summaries: Sequence[PlannerSummary],
                  throughput: Mapping[str, float] | None = None,
-                 models: Sequence[CostModel] = (), title: str = "") -> str:
+                 models: Sequence[CostModel] = (), title: str = "",
+                 timing: bool = True) -> str:
     """Table VII's SymSearch columns plus AUC-E (both cost models) and, when given, the
-    measured throughput (episodes per second, a wall-clock figure)."""
-    header = ["Planner", *(h for _, h, _ in _COLUMNS), "Episodes"]
+    measured throughput (episodes per second, a wall-clock figure). ``timing=False`` leaves
+    out the decision time (wall clock), so the table depends on the results alone."""
+    columns = [c for c in _COLUMNS if timing or c[0] != "decision_s"]
+    header = ["Planner", *(h for _, h, _ in columns), "Episodes"]
     if throughput is not None:
         header.append("Episodes/s")
     rows = []
     for s in summaries:
-        row = [s.planner, *(fmt_stat(s.stats.get(k), spec) for k, _, spec in _COLUMNS),
+        row = [s.planner, *(fmt_stat(s.stats.get(k), spec) for k, _, spec in columns),
                f"{s.episodes} ({len(s.seeds)} seeds)"]
         if throughput is not None:
             row.append(_fmt(throughput.get(s.planner, math.nan), ".1f"))
@@ -80,7 +83,8 @@ def format_table(summaries: Sequence[PlannerSummary],
     if title:
         parts.append(title)
     parts.append(pipe_table(header, rows))
-    notes = ["mean ± std (ddof=1) over seeds; decision time = wall seconds per decision."]
+    notes = ["mean ± std (ddof=1) over seeds"
+             + ("; decision time = wall seconds per decision." if timing else ".")]
     if models:
         notes.append("AUC-E budgets: " + "; ".join(m.statement() for m in models) + ".")
     parts.append("\n".join(notes))
@@ -110,10 +114,12 @@ def format_seen_unseen(rows: Sequence[SplitSummary], title: str = "",
     return "\n".join(parts) + "\n"
 
 
-def format_side_by_side(summaries: Sequence[PlannerSummary], title: str = "") -> str:
+def format_side_by_side(summaries: Sequence[PlannerSummary], title: str = "",
+                        timing: bool = True) -> str:
     """Our Table VII columns next to the SymSearch rows quoted from SCOUT Table VII: one row
     per planner of ours (with the paper's agent of the same design, when there is one),
-    then the paper's agents we have no planner for."""
+    then the paper's agents we have no planner for. ``timing=False`` leaves out our
+    decision time (wall clock)."""
     header = ["Planner", "SCOUT agent (quoted)", "SR ours", "SR quoted", "SPL ours",
               "SPL quoted", "N steps ours", "N steps quoted", "Decision (s) ours",
               "Inference (s) quoted"]
@@ -135,6 +141,10 @@ def format_side_by_side(summaries: Sequence[PlannerSummary], title: str = "") ->
     rows = [row(s.planner, s, quoted_for(s.planner)) for s in summaries]
     ours = {s.planner for s in summaries}
     rows += [row("-", None, q) for q in TABLE_VII_SYMSEARCH if q.planner not in ours]
+    if not timing:
+        drop = header.index("Decision (s) ours")
+        header = header[:drop] + header[drop + 1:]
+        rows = [r[:drop] + r[drop + 1:] for r in rows]
     parts = [title] if title else []
     parts.append(pipe_table(header, rows))
     parts.append(f"Columns \"quoted\" are quoted from SCOUT Table VII ({SOURCE}): mean ± "
@@ -185,8 +195,10 @@ def breakdown_records(rows: Sequence[BreakdownRow], by: str) -> list[dict[str, o
     return out
 
 
-def summary_dict(summaries: Sequence[PlannerSummary]) -> dict[str, dict[str, object]]:
-    """JSON-ready summary: planner -> metric -> {mean, std, per_seed}."""
+def summary_dict(summaries: Sequence[PlannerSummary],
+                 timing: bool = True) -> dict[str, dict[str, object]]:
+    """JSON-ready summary: planner -> metric -> {mean, std, per_seed}; ``timing=False``
+    leaves out the decision time (wall clock)."""
     def num(x: float) -> float | None:
         return None if math.isnan(x) else round(x, 6)
 
@@ -195,7 +207,8 @@ def summary_dict(summaries: Sequence[PlannerSummary]) -> dict[str, dict[str, obj
             "episodes": s.episodes,
             "seeds": list(s.seeds),
             **{k: {"mean": num(v.mean), "std": num(v.std),
-                   "per_seed": [num(x) for x in v.per_seed]} for k, v in s.stats.items()},
+                   "per_seed": [num(x) for x in v.per_seed]} for k, v in s.stats.items()
+               if timing or k != "decision_s"},
         }
         for s in summaries
     }

@@ -17,7 +17,9 @@ Run by hand, e.g. (the figures of the closed-loop note)::
 
     HF_HUB_OFFLINE=1 .venv/bin/python benchmarks/closed_loop.py --out /tmp/closed-loop
 
-Episodes run one after the other in this process (wall-clock figures are not shared with
+The closed-loop benchmark proper is ``sgtool run-bench`` (resumable, noise profiles, the
+bench's tables); this script stays for quick comparisons. Episodes run one after the
+other in this process (wall-clock figures are not shared with
 other workers). Same command, same logs, except the measured decision times.
 """
 
@@ -49,6 +51,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--demo", action="store_true", help="use the demo house instead")
     ap.add_argument("--resolution", default="320x240", help="camera WxH (default 320x240)")
     ap.add_argument("--max-steps", type=int, default=50)
+    ap.add_argument("--navigation", choices=("live", "house"), default="live",
+                    help="live: on the robot's own map; house: on the ground truth (before "
+                    "issue 17)")
     ap.add_argument("--out", default="closed-loop-logs", help="folder for the episode logs")
     ap.add_argument("--force", action="store_true", help="overwrite existing logs")
     args = ap.parse_args(argv)
@@ -64,7 +69,7 @@ def main(argv: list[str] | None = None) -> int:
 
     w, _, h = args.resolution.lower().partition("x")
     opts = ClosedLoopOptions(camera=CameraConfig(width=int(w), height=int(h)),
-                             max_steps=args.max_steps)
+                             max_steps=args.max_steps, navigation=args.navigation)
     planners = [p.strip() for p in args.planners.split(",") if p.strip()]
     lo, hi = _rooms(args.rooms)
     if args.demo:

@@ -127,8 +127,10 @@ def run(name: str, episodes: int, fresh: bool) -> list[float]:
         parts = [list(p) for p in parts]
         if planner is None or fresh:
             opts: dict = {}
-            if name == "moma-llm":
+            if name in ("moma-llm", "unstructured-llm"):
                 opts = {"client": InstantLlm(), "stuck_repeats": 0}
+            elif name == "godhs-llm":  # its JSON requests get no JSON: the priors rank
+                opts = {"client": InstantLlm()}
             elif fresh and name.startswith(("scout", "sbert")):
                 from sgtool.semantics.encoder import default_encoder
 

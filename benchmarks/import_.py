@@ -8,7 +8,12 @@
    not ground truth), with the time per frame pair and the failed steps (Open3D failures,
    too little matched, motions implausible for the frame interval).
 
-Run by hand: ``.venv/bin/python benchmarks/import_.py [--quick] [--data DIR]``.
+4. ``--checks`` (issue 18) instead: the report lines saying where the intrinsics, depth scale,
+   up direction and floor of each real recording came from; the silent-wrong inputs of the
+   issue, built synthetically, each with the error or warning it now gives; the export round
+   trip of a replayed golden log (messages written = read back by rosbags, per topic).
+
+Run by hand: ``.venv/bin/python benchmarks/import_.py [--quick] [--checks] [--data DIR]``.
 """
 
 from __future__ import annotations
@@ -101,6 +106,116 @@ def odometry(data: Path, quick: bool) -> None:
         print(f"  (drift against {ref})")
 
 
+def provenance(data: Path, tmp: Path) -> None:
+    print("## where each parameter came from (import report lines)")
+    cases = [("rgbd", data / "rgbd" / name, []) for name in
+             ("icl-livingroom1-micro", "7scenes-redkitchen-every10", "open3d-testdata")]
+    cases.append(("bag", data / "logs" / "rosbag2-mcap" / "evo_nav2_turtlebot.mcap",
+                  ["--tf-frames", "map:base_footprint"]))
+    cases.append(("bag", data / "logs" / "evo" / "tf_example.bag",
+                  ["--tf-frames", "odom:base_link"]))
+    # a camera bag: the imported ICL frames written as a ROS 2 bag, imported without --info
+    cases.append(("bag", tmp / "icl_bag", ["--depth", "/camera/depth/image_raw", "--rgb",
+                                           "/camera/rgb/image_raw"]))
+    for kind, src, extra in cases:
+        if src.name == "icl_bag":
+            write_log_as_bag(tmp / "prov-icl-livingroom1-micro.mcap", src, "ros2-mcap")
+        out = tmp / f"prov-{src.stem}.mcap"
+        r = _cli(["import", kind, str(src), "-o", str(out), "--quiet", *extra])
+        shown = src.relative_to(data) if src.is_relative_to(data) else f"(ICL as a bag) {src.name}"
+        print(f"$ sgtool import {kind} {shown} {' '.join(extra)}".rstrip())
+        keep = ("wrote", "poses:", "intrinsics:", "depth scale:", "up:", "floor:", "warning")
+        for line in r.output.splitlines():
+            if line.startswith(keep) or line.startswith("sgtool: "):
+                print("  " + line)
+
+
+def _cli(args: list[str]):  # type: ignore[no-untyped-def]
+    from click.testing import CliRunner
+
+    from sgtool.cli import cli
+
+    return CliRunner().invoke(cli, args)
+
+
+def silent_cases(tmp: Path) -> None:
+    """The inputs of issue 18 that gave silently wrong results, and what they give now."""
+    import numpy as np
+    from support.bag_export import BagWriter
+    from support.logfixtures import synthetic_frame
+    from support.rgbd_folders import make_tum_folder
+
+    print("\n## issue 18's silent-wrong inputs (synthetic), and what they give now")
+    good = [100.0 + i / 30 for i in range(12)]
+    k = ["--intrinsics", "60,60,39.5,29.5", "--quiet"]
+    rng = np.random.default_rng(1)
+    folders = {
+        "interval time stamps": (make_tum_folder(tmp / "c1", list(rng.uniform(0.03, 0.034, 12)),
+                                                 ground_truth=False), k),
+        "duplicated time stamps": (make_tum_folder(tmp / "c2", good[:6] + good[5:]), k),
+        "time stamps in ms, not s (1000 fps)": (make_tum_folder(
+            tmp / "c2b", [100.0 + i / 1000 for i in range(12)]), k),
+        "mm depth at TUM scale 5000": (make_tum_folder(tmp / "c3", good, units_per_m=1000), k),
+        "desk top taken for the floor": (make_tum_folder(tmp / "c4", good, cam_height=0.42), k),
+        "intrinsics from the folder name": (make_tum_folder(
+            tmp / "rgbd_dataset_freiburg1_c5", good[:3],
+            k=CameraIntrinsics(640, 480, 517.3, 516.5, 318.6, 255.3)), ["--quiet"]),
+        "files listed but missing": (make_tum_folder(tmp / "c6", good, missing=(3,)), k),
+    }
+    bag = tmp / "c7"
+    with BagWriter(bag, "ros2-mcap") as w:
+        for i in range(3):
+            kk, rgb, depth, _, pose, _ = synthetic_frame(i)
+            t = 1_000_000 + i * 33_000_000
+            w.write("/cam/info", "sensor_msgs/msg/CameraInfo", t, w.camera_info(t, "c", kk))
+            w.write("/cam/depth", "sensor_msgs/msg/Image", t,  # one header stamp for all
+                    w.image(1_000_000, "c", np.round(depth * 1000).astype(np.uint16), "16UC1"))
+            w.write("/cam/rgb", "sensor_msgs/msg/Image", t, w.image(t, "c", rgb, "rgb8"))
+    ros2_mcap = bag / "c7.mcap"  # the bag's storage file: a ROS 2 MCAP recording
+    rows = [(name, ["import", "rgbd", str(root), "-o", str(tmp / f"o{i}.mcap"), *flags])
+            for i, (name, (root, flags)) in enumerate(folders.items())]
+    rows.append(("bag images all with one header stamp",
+                 ["import", "bag", str(bag), "-o", str(tmp / "oa.mcap"), "--depth",
+                  "/cam/depth", "--intrinsics", "60,60,31.5,23.5"]))
+    rows.append(("--rgb pointing at a 16UC1 topic",
+                 ["import", "bag", str(bag), "-o", str(tmp / "ob.mcap"), "--depth",
+                  "/cam/depth", "--rgb", "/cam/depth"]))
+    rows.append(("replay of a ROS 2 MCAP", ["replay", str(ros2_mcap)]))
+    handled = 0
+    for name, args in rows:
+        r = _cli(args)
+        msg = next((x for x in r.output.splitlines() if x.startswith("sgtool: ")), "")
+        outcome = "error" if r.exit_code == 2 else ("warning" if "warning" in msg else "ok?")
+        handled += outcome in ("error", "warning")
+        print(f"- {name}: {msg[len('sgtool: '):][:160]}")
+    print(f"{handled} of {len(rows)} now warn or fail (before: all silent or unhelpful)")
+
+
+def export_round_trip(tmp: Path) -> None:
+    from rosbags.highlevel import AnyReader
+    from rosbags.typesys import Stores, get_typestore
+
+    print("\n## export round trip: the golden house6-tour replayed, exported, read back")
+    derived = tmp / "derived.mcap"
+    _cli(["replay", str(REPO / "tests" / "golden" / "house6-tour.mcap"), "-o", str(derived),
+          "--no-progress"])
+    for fmt, out in (("ros2", tmp / "bag2"), ("ros1", tmp / "bag1.bag")):
+        t0 = time.perf_counter()
+        r = _cli(["export", "bag", str(derived), "-o", str(out), "--format", fmt])
+        dt = time.perf_counter() - t0
+        written = {ln.split()[0]: int(ln.split()[-1]) for ln in r.output.splitlines()[1:]
+                   if ln.startswith("  /")}
+        back: dict[str, int] = {}
+        with AnyReader([out], default_typestore=get_typestore(Stores.LATEST)) as rd:
+            for c, _, _ in rd.messages():
+                back[c.topic] = back.get(c.topic, 0) + 1
+        print(f"{fmt}: {sum(written.values())} messages in {dt:.2f} s; per topic "
+              "written/read back:")
+        for topic in sorted(written):
+            print(f"  {topic:<28} {written[topic]:>5} / {back.get(topic, 0):>5}")
+        print(f"  all equal: {written == back}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--data", type=Path,
@@ -108,9 +223,17 @@ def main() -> None:
                                                 REPO.parent / "shared" / "data")))
     ap.add_argument("--quick", action="store_true", help="20 frames for the odometry")
     ap.add_argument("--skip-import", action="store_true")
+    ap.add_argument("--checks", action="store_true",
+                    help="only the figures of issue 18 (provenance, checks, export)")
     args = ap.parse_args()
     if not (args.data / "rgbd").is_dir():
         raise SystemExit(f"{args.data}/rgbd is absent")
+    if args.checks:
+        with tempfile.TemporaryDirectory(prefix="sgtool-import-checks-") as tmp:
+            provenance(args.data, Path(tmp))
+            silent_cases(Path(tmp))
+            export_round_trip(Path(tmp))
+        return
     with tempfile.TemporaryDirectory(prefix="sgtool-import-bench-") as tmp:
         if not args.skip_import:
             folder_import(args.data, Path(tmp))

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from sgtool.blas import single_blas_thread
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
 from sgtool.log import schemas as S
@@ -163,14 +164,17 @@ def replay(
     on_refresh: Callable[[Refresh, SceneGraphStream], None] | None = None,
     progress: Any = None,
     compression: str = "zstd",
+    verify: bool = False,
 ) -> ReplayReport:
     """Replay ``log`` (module doc). ``on_refresh`` sees every refresh as it happens;
-    ``progress`` is anything with ``update(n)`` (a tqdm bar), advanced per frame."""
+    ``progress`` is anything with ``update(n)`` (a tqdm bar), advanced per frame;
+    ``verify`` checks every chunk CRC of the input as it is read (``sgtool doctor``
+    checks everything; without it damage still gives a one-line error, or a frame)."""
     src = Path(log)
     dst = Path(output) if output is not None else None
     if dst is not None and dst.exists() and src.exists() and dst.resolve() == src.resolve():
         raise SgtoolError("the output must not be the input log")
-    with LogReader(src) as reader:
+    with LogReader(src, verify=verify) as reader, single_blas_thread():
         reader.require(S.DEPTH, why="replay builds the map from depth images")
         opts = resolve_options(reader, options or ReplayOptions())
         report = ReplayReport(src, dst, opts, semantic=reader.has(S.IDS))

@@ -35,10 +35,13 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "replay": ("replay", "Rebuild voxel map, occupancy, Voronoi graph, rooms, scene graph."),
     "view": ("view", "Write a Rerun recording (.rrd) of a log, or open the viewer."),
     "import": ("import_", "Import ROS 1/2 bags and RGB-D folders into sgtool logs."),
+    "export": ("export", "Export a (derived) log as a ROS 1/2 bag: maps as ROS messages."),
     "distill": ("distill", "Train the relational priors (containment, co-occurrence) MLPs."),
     "bench": ("bench", "Run the symbolic object-search benchmark over planners."),
     "run": ("run", "Closed-loop search in PyBullet with a planner, logged to MCAP."),
+    "run-bench": ("run_bench", "Closed-loop benchmark: episodes x planners, one log each."),
     "eval": ("eval", "Recompute metrics from episode logs; evaluate planners offline."),
+    "llm": ("llm", "Serve a local GGUF chat model (llama.cpp) and check an LLM endpoint."),
 }
 
 CONTEXT_SETTINGS = {"help_option_names": ["-h", "--help"], "max_content_width": 100}

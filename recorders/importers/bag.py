@@ -22,8 +22,13 @@ one more pass over the images); the drift against the bag's own poses is reporte
 has them. ``--estimate-poses`` needs ``--depth``: a bag of trajectories alone (no image
 topic) is an error that suggests ``--tf-frames`` and ``--pose``.
 
-When a flag is missing or names the wrong thing, the error lists the bag's topics with
-their types and suggests flags. The bag is read in two passes (time stamps, transforms and
+When a flag is missing or names the wrong thing (a topic of another type, or whose first
+image has an encoding that does not fit the flag: ``--rgb`` on 16UC1 depth), the error lists
+the bag's topics with their types and suggests flags that fit their encodings. Without
+``--info``, the bag's only CameraInfo topic is used. As for folders (:mod:`.rgbd`), the
+depth images' header stamps (or record times, ``timestamps="bag"``), the depth scale and the
+floor are checked before the frames are written, and the report says where the intrinsics,
+depth scale, up and floor came from. The bag is read in two passes (time stamps, transforms and
 calibration; then the images), so memory stays at a few frames.
 
 This module drives the import; the steps are in :mod:`.bag_options` (flags),
@@ -50,13 +55,26 @@ from sgtool.recorders.importers.bag_index import BagIndex, index_bag
 from sgtool.recorders.importers.bag_options import BagOptions, check_options
 from sgtool.recorders.importers.bag_poses import PoseSource, pose_source_of
 from sgtool.recorders.importers.bag_sync import PlannedFrame, plan_frames
-from sgtool.recorders.importers.bag_topics import check_flags, describe_bag
+from sgtool.recorders.importers.bag_topics import check_flags, describe_bag, with_only_info
 from sgtool.recorders.importers.images import depth_to_metres
 from sgtool.recorders.importers.odometry import (
     DriftReport,
     OdometryResult,
     drift_where_known,
     estimate_with_progress,
+)
+from sgtool.recorders.importers.provenance import (
+    ESTIMATED_FLOORS,
+    FLOOR_ORIGINS,
+    Findings,
+    alignment_sources,
+    source_metadata,
+)
+from sgtool.recorders.importers.sanity import (
+    BAG_TIME_FIX,
+    depth_scale_problem,
+    floor_problem,
+    timestamp_problem,
 )
 from sgtool.recorders.importers.sink import (
     IMPORT_METADATA,
@@ -78,6 +96,7 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
     check_options(opts)
     with B.open_bag(path) as reader:
         topics = B.list_topics(reader)
+        opts = with_only_info(topics, opts)
         check_flags(path, topics, opts, reader)
         idx = index_bag(reader, opts, topics)
         has_tf = bool(idx.tf.links)
@@ -106,6 +125,11 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
             assert src is not None
             return _import_trajectory(path, out, src, opts, meta, kind)
         k = camera_of(path, idx, opts)
+        findings = Findings(opts.warn)
+        findings.problem(timestamp_problem(
+            sorted(idx.depth.stamps), f"{path}: --depth {opts.depth} ({opts.timestamps} times)",
+            BAG_TIME_FIX), given=opts.timestamps != "header")
+        check_depth_samples(idx, opts, findings)
         plan, notes = plan_frames(idx, src, opts, keep_unposed=estimate)
         if not plan:
             raise SgtoolError(
@@ -126,14 +150,25 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         meta["pose_source"] = pose_source
         by_k = {p.k_depth: p for p in plan}
         samples = [
-            DepthSample(depth_to_metres(raw, opts.depth_scale if opts.depth_scale and
-                                        raw.dtype == np.uint16 else scale), k, by_k[kk].pose)
+            DepthSample(depth_to_metres(raw, _scale(raw, scale, opts)), k, by_k[kk].pose)
             for kk, (raw, scale) in sorted(idx.samples.items()) if kk in by_k
         ]
         alignment = estimate_alignment([p.pose for p in plan], samples, up=opts.up,
                                        floor=opts.floor, floor_auto=opts.floor_auto)
+        if alignment.floor_method != "none":
+            findings.problem(
+                floor_problem([p.pose for p in plan], alignment.matrix, alignment.floor,
+                              FLOOR_ORIGINS[alignment.floor_method], opts.camera_height),
+                given=alignment.floor_method not in ESTIMATED_FLOORS)
+        sources = [("intrinsics", f"{k.fx:g},{k.fy:g},{k.cx:g},{k.cy:g}",
+                    "flag --intrinsics" if opts.intrinsics is not None else
+                    f"topic {opts.info}" + (f" ({opts.info_origin})" if opts.info_origin
+                                            else "")),
+                   ("depth scale", *_scale_origin(idx, opts)), *alignment_sources(alignment)]
         meta["intrinsics"] = f"{k.fx:g},{k.fy:g},{k.cx:g},{k.cy:g}"
-        meta["intrinsics_source"] = f"topic {opts.info}" if opts.intrinsics is None else "given"
+        meta.update(source_metadata(sources))
+        if findings.warnings:
+            meta["warnings"] = "\n".join(findings.warnings)
         n, has_rgb, has_ids = write_log(
             out, decode_frames(reader, plan, idx, opts, k), alignment=alignment, metadata=meta,
             total=len(plan), progress=opts.progress, notes=notes, compression=opts.compression,
@@ -141,9 +176,39 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
     return ImportReport(
         output=out, source=str(path), kind=kind, frames=n, poses=n, alignment=alignment,
         has_rgb=has_rgb, has_ids=has_ids, pose_source=pose_source, drift=drift,
-        notes=tuple(notes), drift_reference=reference,
+        notes=tuple(notes), drift_reference=reference, sources=tuple(sources),
+        warnings=tuple(findings.warnings),
         **(odometry_report_fields(odo) if odo is not None else {}),  # type: ignore[arg-type]
     )
+
+
+def _scale(raw: np.ndarray, scale: float, opts: BagOptions) -> float:
+    """Units per metre of a decoded depth image: --depth-scale for 16-bit images."""
+    return opts.depth_scale if opts.depth_scale and raw.dtype == np.uint16 else scale
+
+
+def _scale_origin(idx: BagIndex, opts: BagOptions) -> tuple[str, str]:
+    """(value, origin) of the depth scale of a bag import."""
+    raws = list(idx.samples.values())
+    if not raws:
+        return "-", "no depth"
+    raw, scale = raws[0]
+    if opts.depth_scale is not None and raw.dtype == np.uint16:
+        return f"{opts.depth_scale:g} units/m", "flag --depth-scale"
+    if raw.dtype == np.uint16:
+        return f"{scale:g} units/m", "the image encoding: 16-bit depth is millimetres in ROS"
+    return "metres", "the image encoding: 32FC1 depth is metres"
+
+
+def check_depth_samples(idx: BagIndex, opts: BagOptions, findings: Findings) -> None:
+    """The depth scale against the sampled depth images, before the frames are decoded."""
+    if not idx.samples:
+        return
+    raw0, scale0 = next(iter(idx.samples.values()))
+    _, origin = _scale_origin(idx, opts)
+    findings.problem(depth_scale_problem([raw for raw, _ in idx.samples.values()],
+                                         _scale(raw0, scale0, opts), origin),
+                     given=opts.depth_scale is not None)
 
 
 def _estimate(
@@ -214,7 +279,7 @@ def _import_trajectory(
     return ImportReport(
         output=out, source=str(path), kind=kind, frames=0, poses=len(samples),
         alignment=alignment, has_rgb=False, has_ids=False,
-        pose_source=src.describe,
+        pose_source=src.describe, sources=tuple(alignment_sources(alignment)),
         notes=(f"trajectory of {len(samples)} poses, no frames",)
         + ((f"{unresolved} sample times where the chain was incomplete (skipped)",)
            if unresolved else ()),

@@ -43,7 +43,9 @@ class BagIndex:
     zero_stamps: int = 0
 
 
-def _stamp_or_bagtime(header: Any, bag_t: int, idx: BagIndex) -> int:
+def _stamp_or_bagtime(header: Any, bag_t: int, idx: BagIndex, use_bag: bool = False) -> int:
+    if use_bag:
+        return int(bag_t)
     t = stamp_ns(header)
     if t == 0:
         idx.zero_stamps += 1
@@ -86,7 +88,7 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
                 continue
             for topic, ii in ((opts.depth, idx.depth), (opts.rgb, idx.rgb), (opts.ids, idx.ids)):
                 if c.topic == topic:
-                    t = _stamp_or_bagtime(msg.header, bag_t, idx)
+                    t = _stamp_or_bagtime(msg.header, bag_t, idx, opts.timestamps == "bag")
                     if topic == opts.depth and len(ii.stamps) in keep:
                         idx.samples[len(ii.stamps)] = decode_depth_message(msg, mt, topic)
                     ii.stamps.append(t)

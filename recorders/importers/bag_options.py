@@ -3,16 +3,20 @@ numeric ones, before the bag is opened."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
+from sgtool.errors import SgtoolError
 from sgtool.recorders.importers.checks import (
     check_counts,
     check_depth_scale,
+    check_height_band,
     check_non_negative,
     check_positive,
 )
+from sgtool.recorders.importers.sanity import DEFAULT_CAMERA_HEIGHT
 from sgtool.recorders.importers.textformats import PinholeParams
 
 
@@ -39,12 +43,19 @@ class BagOptions:
     estimate_poses: bool = False
     odometry: str = "rgbd+icp"
     depth_max: float = 4.0
+    camera_height: tuple[float, float] = DEFAULT_CAMERA_HEIGHT  # plausible band, m
+    warn: Callable[[str], None] | None = None  # shows a warning at once
+    timestamps: str = "header"  # image times: "header" stamps, or "bag" (record) times
+    info_origin: str = ""  # how --info was chosen, when not given ("the only CameraInfo topic")
 
 
 def check_options(opts: BagOptions) -> None:
     """The numeric options, before the bag is opened (user errors naming the flag)."""
     check_counts(opts.every, opts.limit)
     check_depth_scale(opts.depth_scale)
+    check_height_band(opts.camera_height)
+    if opts.timestamps not in ("header", "bag"):
+        raise SgtoolError(f"--timestamps {opts.timestamps!r}: give header or bag")
     check_positive(opts.depth_max, "--depth-max", "metres")
     check_non_negative(opts.max_dt_ns / 1e9, "--max-dt", "seconds")
     check_non_negative(opts.tf_tolerance_ns / 1e9, "--tf-tolerance", "seconds")

@@ -4,6 +4,7 @@ suggested flags (also ``sgtool import bag PATH --list``)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -11,23 +12,84 @@ from sgtool.errors import SgtoolError
 from sgtool.recorders.importers import bagfiles as B
 from sgtool.recorders.importers.bag_messages import add_tf_message
 from sgtool.recorders.importers.bag_options import BagOptions
+from sgtool.recorders.importers.images import (
+    COLOUR_ENCODINGS,
+    DEPTH_ENCODINGS,
+    ID_ENCODINGS,
+)
 from sgtool.recorders.importers.tftree import TfTree
 
+ROLE_FLAGS = {"depth": "--depth", "rgb": "--rgb", "ids": "--ids"}
+ROLE_NEEDS = {
+    "depth": "a depth encoding (16UC1/mono16 mm, 32FC1 m, compressedDepth)",
+    "rgb": "a colour encoding (rgb8, bgr8, mono8, bayer_*, yuv422, JPEG/PNG)",
+    "ids": "an integer encoding (8UC1, 16UC1, 32SC1)",
+}
 
-def suggest_flags(topics: list[B.TopicInfo], tf_frames: list[str] | None = None) -> list[str]:
-    """Flags guessed from topic names and types (depth/colour/camera_info/ids). Without a
-    depth topic, one item of alternatives for a trajectory: ``tf_frames`` (``--tf-frames
-    WORLD:FRAME`` when not given and the bag has tf) and the pose topics."""
+
+def roles_of(msgtype: str, encoding: str) -> set[str]:
+    """What an image topic can be used for, from its first message's encoding (Image) or
+    format (CompressedImage); every role when the encoding is not known."""
+    if msgtype.endswith("CompressedImage"):
+        fmt = encoding.lower().replace(" ", "")
+        if "compresseddepth" in fmt:
+            return {"depth"}
+        head = encoding.split(";")[0].strip()
+        if head in DEPTH_ENCODINGS:
+            return {"depth"}
+        return {"rgb", "depth"} if "png" in fmt and ";" not in fmt else {"rgb"}
+    roles = set()
+    if encoding in DEPTH_ENCODINGS:
+        roles.add("depth")
+    if encoding in COLOUR_ENCODINGS:
+        roles.add("rgb")
+    if encoding in ID_ENCODINGS:
+        roles.add("ids")
+    return roles or {"depth", "rgb", "ids"}
+
+
+def peek_encodings(reader: Any, topics: list[B.TopicInfo]) -> dict[str, str]:
+    """The encoding (Image) or format (CompressedImage) of each image topic's first
+    message."""
+    out = {}
+    for t in topics:
+        if t.msgtype not in B.IMAGE_TYPES or t.count == 0:
+            continue
+        for c, _, raw in reader.messages(B.connections_for(reader, t.topic)):
+            msg = reader.deserialize(raw, c.msgtype)
+            out[t.topic] = str(getattr(msg, "encoding", None) or getattr(msg, "format", ""))
+            break
+    return out
+
+
+def suggest_flags(topics: list[B.TopicInfo], tf_frames: list[str] | None = None,
+                  encodings: dict[str, str] | None = None) -> list[str]:
+    """Flags guessed from topic names and types (depth/colour/camera_info/ids), and from
+    the first message's encoding when ``encodings`` has it (a 16UC1 topic is never
+    suggested for --rgb). Without a depth topic, one item of alternatives for a trajectory:
+    ``tf_frames`` (``--tf-frames WORLD:FRAME`` when not given and the bag has tf) and the
+    pose topics."""
+    enc = encodings or {}
+    types = {t.topic: t.msgtype for t in topics}
+
+    def fits(topic: str, role: str) -> bool:
+        return topic not in enc or role in roles_of(types[topic], enc[topic])
+
     images = [t.topic for t in topics if t.msgtype in B.IMAGE_TYPES]
     infos = [t.topic for t in topics if t.msgtype in B.INFO_TYPES]
     poses = [t.topic for t in topics if t.msgtype in B.POSE_TYPES]
     tfs = [t.topic for t in topics if t.msgtype in B.TF_TYPES]
     out = []
-    depth = next((t for t in images if "depth" in t.lower()), None)
+    depth = next((t for t in images if "depth" in t.lower() and fits(t, "depth")), None)
+    if depth is None:  # a depth camera's topic need not say "depth": its encoding does
+        depth = next((t for t in images if t in enc and (
+            enc[t] in ("16UC1", "32FC1") or "compresseddepth" in enc[t].lower())), None)
     ids_words = ("instance", "segment", "label", "ids", "mask")
-    ids = next((t for t in images if any(w in t.lower() for w in ids_words)), None)
+    ids = next((t for t in images if t != depth and fits(t, "ids")
+                and any(w in t.lower() for w in ids_words)), None)
     rgb = next(
-        (t for t in images if t not in (depth, ids)
+        (t for t in images if t not in (depth, ids) and fits(t, "rgb")
+         and "depth" not in t.lower()
          and any(w in t.lower() for w in ("rgb", "color", "colour", "image"))),
         None,
     )
@@ -45,6 +107,17 @@ def suggest_flags(topics: list[B.TopicInfo], tf_frames: list[str] | None = None)
         if alternatives:
             out.append(" | ".join(alternatives))
     return out
+
+
+def with_only_info(topics: list[B.TopicInfo], opts: BagOptions) -> BagOptions:
+    """``opts`` with ``--info`` set to the bag's only CameraInfo topic when a depth topic is
+    imported without --info or --intrinsics."""
+    if opts.depth is None or opts.info is not None or opts.intrinsics is not None:
+        return opts
+    infos = [t.topic for t in topics if t.msgtype in B.INFO_TYPES]
+    if len(infos) != 1:
+        return opts
+    return replace(opts, info=infos[0], info_origin="the only CameraInfo topic")
 
 
 def peek_tf(reader: Any, topics: list[B.TopicInfo], max_messages: int = 500) -> TfTree:
@@ -81,7 +154,7 @@ def describe_bag(reader: Any, path: Path) -> str:
     if tree.links:
         lines.append("tf links (from /tf_static and the first /tf messages):")
         lines.extend("  " + d for d in tree.describe())
-    sugg = suggest_flags(topics, tf_frames=[])
+    sugg = suggest_flags(topics, tf_frames=[], encodings=peek_encodings(reader, topics))
     if sugg:
         lines.append("suggested flags: " + " ".join(sugg))
     tfs = tf_suggestions(tree)
@@ -96,7 +169,8 @@ def missing_message(
     tfs = None
     if reader is not None and any(t.msgtype in B.TF_TYPES for t in topics):
         tfs = tf_suggestions(peek_tf(reader, topics)) or None
-    sugg = suggest_flags(topics, tf_frames=tfs)
+    encodings = peek_encodings(reader, topics) if reader is not None else None
+    sugg = suggest_flags(topics, tf_frames=tfs, encodings=encodings)
     return (
         f"{path}: {what}. The bag's topics:\n{B.format_topics(topics)}"
         + (f"\nsuggested flags: {' '.join(sugg)}" if sugg else "")
@@ -119,6 +193,24 @@ def _check_topic(
         )
     if t.count == 0:
         raise SgtoolError(f"{path}: {flag} {topic} has no messages")
+
+
+def _check_encodings(path: Path, topics: list[B.TopicInfo], opts: BagOptions,
+                     reader: Any) -> None:
+    """Each image flag names a topic whose first message has an encoding for its role."""
+    wanted = {role: getattr(opts, role) for role in ROLE_FLAGS if getattr(opts, role)}
+    if not wanted:
+        return
+    encodings = peek_encodings(reader, [t for t in topics if t.topic in wanted.values()])
+    types = {t.topic: t.msgtype for t in topics}
+    for role, topic in wanted.items():
+        enc = encodings.get(topic)
+        if enc is None or role in roles_of(types[topic], enc):
+            continue
+        sugg = suggest_flags(topics, encodings=peek_encodings(reader, topics))
+        raise SgtoolError(
+            f"{path}: {ROLE_FLAGS[role]} {topic} carries {enc!r} images; {ROLE_FLAGS[role]} "
+            f"needs {ROLE_NEEDS[role]}" + (f"; suggested flags: {' '.join(sugg)}" if sugg else ""))
 
 
 def check_flags(
@@ -148,6 +240,8 @@ def check_flags(
     _check_topic(path, topics, opts.depth, "--depth", B.IMAGE_TYPES)
     _check_topic(path, topics, opts.rgb, "--rgb", B.IMAGE_TYPES)
     _check_topic(path, topics, opts.ids, "--ids", B.IMAGE_TYPES)
+    if reader is not None:
+        _check_encodings(path, topics, opts, reader)
     _check_topic(path, topics, opts.info, "--info", B.INFO_TYPES)
     _check_topic(path, topics, opts.pose, "--pose", B.POSE_TYPES)
     if opts.depth and opts.info is None and opts.intrinsics is None:

@@ -63,3 +63,25 @@ def check_counts(every: int, limit: int | None) -> None:
         raise SgtoolError(f"--every {every}: must be >= 1")
     if limit is not None and limit < 1:
         raise SgtoolError(f"--limit {limit}: must be >= 1")
+
+
+def check_height_band(band: tuple[float, float]) -> tuple[float, float]:
+    """``--camera-height MIN:MAX``: 0 <= MIN < MAX, in metres."""
+    lo, hi = band
+    if not (_is_number(lo) and _is_number(hi)) or not 0.0 <= float(lo) < float(hi):
+        raise SgtoolError(f"--camera-height {_show(lo)}:{_show(hi)}: give MIN:MAX in metres "
+                          "with 0 <= MIN < MAX")
+    return float(lo), float(hi)
+
+
+def parse_height_band(text: str) -> tuple[float, float]:
+    """``--camera-height`` text ``MIN:MAX`` (metres) -> the checked band."""
+    parts = text.replace(",", ":").split(":")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        band = (float(parts[0]), float(parts[1]))
+    except ValueError as e:
+        raise SgtoolError(f"--camera-height {text!r}: give MIN:MAX in metres, e.g. "
+                          "0.45:2.2") from e
+    return check_height_band(band)

@@ -1,5 +1,9 @@
 """Image decoding for the importers, with OpenCV: image files, and ROS ``sensor_msgs/Image``
-and ``sensor_msgs/CompressedImage`` messages (including ``compressedDepth``).
+and ``sensor_msgs/CompressedImage`` messages (including ``compressedDepth``, PNG or RVL).
+
+Colour ``Image`` encodings: rgb8/bgr8/rgba8/bgra8, mono8/mono16, Bayer (``bayer_rggb8``,
+``bggr``, ``gbrg``, ``grbg``; 8 and 16 bit) demosaiced by OpenCV, and YUV 4:2:2 (``yuv422``
+and ``uyvy`` are UYVY, ``yuv422_yuy2`` and ``yuyv`` are YUYV) converted by OpenCV.
 
 Colour comes out as (H, W, 3) uint8 RGB. Depth comes out as metres (float32, 0 = no
 return) through :func:`depth_to_metres`, or kept as uint16 millimetres when the source
@@ -92,7 +96,22 @@ _RAW = {
     "bgra8": (np.uint8, 4), "mono8": (np.uint8, 1), "8UC1": (np.uint8, 1),
     "8UC3": (np.uint8, 3), "mono16": (np.uint16, 1), "16UC1": (np.uint16, 1),
     "16SC1": (np.int16, 1), "32SC1": (np.int32, 1), "32FC1": (np.float32, 1),
+    **{f"bayer_{p}{bits}": (np.uint8 if bits == 8 else np.uint16, 1)
+       for p in ("rggb", "bggr", "gbrg", "grbg") for bits in (8, 16)},
+    "yuv422": (np.uint8, 2), "uyvy": (np.uint8, 2), "yuv422_yuy2": (np.uint8, 2),
+    "yuyv": (np.uint8, 2),
 }
+# OpenCV names a Bayer pattern by the second row's second and third pixels: ROS's
+# bayer_rggb is OpenCV's BayerBG (as cv_bridge maps them)
+_BAYER = {"rggb": cv2.COLOR_BayerBG2RGB, "bggr": cv2.COLOR_BayerRG2RGB,
+          "gbrg": cv2.COLOR_BayerGR2RGB, "grbg": cv2.COLOR_BayerGB2RGB}
+# ROS's "yuv422" is UYVY (cv_bridge); "yuv422_yuy2" is YUYV
+_YUV = {"yuv422": cv2.COLOR_YUV2RGB_UYVY, "uyvy": cv2.COLOR_YUV2RGB_UYVY,
+        "yuv422_yuy2": cv2.COLOR_YUV2RGB_YUY2, "yuyv": cv2.COLOR_YUV2RGB_YUY2}
+COLOUR_ENCODINGS = ("rgb8", "bgr8", "rgba8", "bgra8", "mono8", "8UC1", "8UC3", "mono16",
+                    *(e for e in _RAW if e.startswith("bayer_")), *_YUV)
+DEPTH_ENCODINGS = ("16UC1", "mono16", "32FC1")
+ID_ENCODINGS = ("8UC1", "mono8", "16UC1", "mono16", "16SC1", "32SC1")
 
 
 def decode_raw_image(msg: Any, topic: str) -> tuple[np.ndarray, str]:
@@ -132,7 +151,24 @@ def color_from_raw(a: np.ndarray, enc: str, topic: str) -> np.ndarray:
         return np.repeat(a[:, :, None], 3, axis=2)
     if enc == "mono16":
         return np.repeat((a >> 8).astype(np.uint8)[:, :, None], 3, axis=2)
+    if enc.startswith("bayer_") or enc in _YUV:
+        return _convert(a, enc, topic)
     raise SgtoolError(f"topic {topic}: image encoding {enc!r} is not a colour image")
+
+
+def _convert(a: np.ndarray, enc: str, topic: str) -> np.ndarray:
+    """Bayer demosaicing and YUV 4:2:2 conversion by OpenCV -> (H, W, 3) uint8 RGB."""
+    if enc in _YUV and a.shape[1] % 2:
+        raise SgtoolError(f"topic {topic}: a {enc} image needs an even width (two pixels "
+                          f"share U and V); this one is {a.shape[1]} pixels wide")
+    code = _YUV[enc] if enc in _YUV else _BAYER[enc[6:10]]
+    try:
+        rgb = cv2.cvtColor(np.ascontiguousarray(a), code)
+    except cv2.error as e:
+        raise SgtoolError(f"topic {topic}: OpenCV cannot convert this {a.shape[1]}x"
+                          f"{a.shape[0]} {enc} image ({str(e).strip().splitlines()[-1][:80]})"
+                          ) from None
+    return rgb if rgb.dtype == np.uint8 else (rgb >> 8).astype(np.uint8)
 
 
 def decode_color_message(msg: Any, msgtype: str, topic: str) -> np.ndarray:
@@ -179,10 +215,11 @@ def _decode_compressed_depth(data: bytes, fmt: str, topic: str) -> tuple[np.ndar
         raise SgtoolError(f"topic {topic}: compressedDepth message shorter than its header")
     _, qa, qb = struct.unpack("<iff", data[:12])
     if "rvl" in fmt.lower():
-        raise SgtoolError(f"topic {topic}: compressedDepth RVL ({fmt!r}) is not supported")
-    a = cv2.imdecode(np.frombuffer(data[12:], np.uint8), cv2.IMREAD_UNCHANGED)
-    if a is None or a.dtype != np.uint16:
-        raise SgtoolError(f"topic {topic}: compressedDepth PNG did not decode ({fmt!r})")
+        a = _decode_rvl_payload(data[12:], topic)
+    else:
+        a = cv2.imdecode(np.frombuffer(data[12:], np.uint8), cv2.IMREAD_UNCHANGED)
+        if a is None or a.dtype != np.uint16:
+            raise SgtoolError(f"topic {topic}: compressedDepth PNG did not decode ({fmt!r})")
     if fmt.split(";")[0].strip() == "32FC1":
         v = a.astype(np.float32)
         out = np.zeros(v.shape, np.float32)
@@ -190,6 +227,22 @@ def _decode_compressed_depth(data: bytes, fmt: str, topic: str) -> tuple[np.ndar
         out[ok] = qa / (v[ok] - qb)
         return out, 1.0
     return a, 1000.0
+
+
+def _decode_rvl_payload(payload: bytes, topic: str) -> np.ndarray:
+    """compressedDepth RVL after the 12-byte header: uint32 width, uint32 height, then the
+    RVL stream (:func:`~.rvl.decode_rvl`)."""
+    from sgtool.recorders.importers.rvl import decode_rvl
+
+    if len(payload) < 8:
+        raise SgtoolError(f"topic {topic}: compressedDepth RVL message shorter than its size")
+    w, h = struct.unpack("<II", payload[:8])
+    if not (0 < w <= 16384 and 0 < h <= 16384):
+        raise SgtoolError(f"topic {topic}: compressedDepth RVL image of {w}x{h} pixels")
+    try:
+        return decode_rvl(payload[8:], w, h)
+    except SgtoolError as e:
+        raise SgtoolError(f"topic {topic}: {e}") from e
 
 
 def decode_ids_message(msg: Any, msgtype: str, topic: str) -> np.ndarray:

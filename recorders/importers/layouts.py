@@ -27,6 +27,7 @@ import numpy as np
 
 from sgtool.errors import SgtoolError
 from sgtool.recorders.importers.poses import PoseTrack
+from sgtool.recorders.importers.sanity import timestamp_problem
 from sgtool.recorders.importers.textformats import (
     PinholeParams,
     read_intrinsics_file,
@@ -44,8 +45,10 @@ TUM_INTRINSICS = {
     "freiburg2": PinholeParams(520.9, 521.0, 325.1, 249.7, source="TUM freiburg2 calibration"),
     "freiburg3": PinholeParams(535.4, 539.2, 320.1, 247.6, source="TUM freiburg3 calibration"),
 }
-SEVEN_SCENES_INTRINSICS = PinholeParams(585.0, 585.0, 320.0, 240.0, source="7-Scenes default")
-PRIMESENSE_INTRINSICS = PinholeParams(525.0, 525.0, 319.5, 239.5, source="PrimeSense default")
+SEVEN_SCENES_INTRINSICS = PinholeParams(585.0, 585.0, 320.0, 240.0,
+                                        source="dataset default: 7-Scenes")
+PRIMESENSE_INTRINSICS = PinholeParams(525.0, 525.0, 319.5, 239.5,
+                                      source="dataset default: PrimeSense, as Open3D assumes")
 
 _IMAGE_EXT = (".png", ".jpg", ".jpeg", ".ppm", ".bmp", ".tif", ".tiff")
 _SEVEN = re.compile(r"^frame-(\d+)\.(color|depth|pose)\.(png|jpg|jpeg|txt)$")
@@ -166,10 +169,15 @@ def read_sequence(
     fps: float = 30.0,
     trajectory: Path | None = None,
     keep_unposed: bool = False,
+    timestamps: str = "file",
+    skip_missing: bool = False,
 ) -> FolderSequence:
     """List a folder's frames (see the module docstring). ``trajectory`` overrides the
     dataset's pose file (TUM text or Open3D .log); ``keep_unposed`` keeps frames the
-    ground truth does not cover (for pose estimation)."""
+    ground truth does not cover (for pose estimation). ``timestamps`` "file" takes the
+    listed times (checked: :func:`~.sanity.timestamp_problem`), "index" frame n at n / fps
+    in the listed order; ``skip_missing`` leaves out listed files that do not exist
+    (otherwise an error before anything is read)."""
     root = Path(root)
     if not root.is_dir():
         raise SgtoolError(f"{root}: no such folder" if not root.exists()
@@ -180,7 +188,8 @@ def read_sequence(
     if missing is not None:
         raise layout_error(root, layout, missing)
     if layout == "tum":
-        seq = _read_tum(root, max_dt_ns, trajectory, keep_unposed)
+        seq = _read_tum(root, max_dt_ns, trajectory, keep_unposed, timestamps, fps,
+                        skip_missing)
     elif layout == "7scenes":
         seq = _read_7scenes(root, fps, trajectory)
     elif layout == "open3d":
@@ -207,13 +216,43 @@ def _nearest(times: list[int], t: int) -> int | None:
     return min(cands, key=lambda j: abs(times[j] - t))
 
 
+def _missing_files(root: Path, lists: dict[str, list[tuple[int, str]]],
+                   skip_missing: bool) -> tuple[dict[str, list[tuple[int, str]]], list[str]]:
+    """Every file the lists name, checked up front: an error naming the count and the first
+    missing one, or with ``skip_missing`` the lists without them and a note."""
+    missing = {name: [(t, f) for t, f in rows if not (root / f).is_file()]
+               for name, rows in lists.items()}
+    n = sum(len(v) for v in missing.values())
+    if n == 0:
+        return lists, []
+    total = sum(len(v) for v in lists.values())
+    first = next(f for v in missing.values() for _, f in v)
+    per = ", ".join(f"{len(v)} of {name}" for name, v in missing.items() if v)
+    if not skip_missing:
+        raise SgtoolError(
+            f"{root}: {n} of the {total} files listed are missing ({per}; first: {first}); "
+            "give --skip-missing to import the frames that are there")
+    kept = {name: [r for r in rows if r not in set(missing[name])]
+            for name, rows in lists.items()}
+    return kept, [f"skipped {n} missing files ({per})"]
+
+
 def _read_tum(
-    root: Path, max_dt_ns: int, trajectory: Path | None, keep_unposed: bool
+    root: Path, max_dt_ns: int, trajectory: Path | None, keep_unposed: bool,
+    timestamps: str = "file", fps: float = 30.0, skip_missing: bool = False,
 ) -> FolderSequence:
-    rgb = read_tum_list(root / "rgb.txt")
-    depth = read_tum_list(root / "depth.txt")
+    lists, notes = _missing_files(
+        root, {"rgb.txt": read_tum_list(root / "rgb.txt"),
+               "depth.txt": read_tum_list(root / "depth.txt")}, skip_missing)
+    rgb, depth = lists["rgb.txt"], lists["depth.txt"]
     if not depth:
         raise SgtoolError(f"{root / 'depth.txt'} lists no depth images")
+    if timestamps == "index":
+        return _read_tum_by_index(root, rgb, depth, fps, notes)
+    for name, rows in (("depth.txt", depth), ("rgb.txt", rgb)):
+        problem = timestamp_problem([t for t, _ in rows], str(root / name))
+        if problem:
+            raise SgtoolError(problem)
     rgb_times = [t for t, _ in rgb]
     gt_path = trajectory or (root / "groundtruth.txt")
     track = None
@@ -243,21 +282,44 @@ def _read_tum(
             f"{root}: none of the {len(depth)} depth images is within the time span of "
             f"{gt_path.name}; give --estimate-poses to estimate their poses"
         )
-    notes = []
     if no_rgb:
         notes.append(f"{no_rgb} depth images had no colour image within {max_dt_ns / 1e6:g} ms")
     if no_pose:
         what = "kept without pose" if keep_unposed else "dropped"
         notes.append(f"{no_pose} depth images outside the ground truth ({what})")
-    intr = None
-    for key, params in TUM_INTRINSICS.items():
-        if key in root.resolve().name:
-            intr = params
     return FolderSequence(
-        "tum", root, tuple(frames), intr, 5000.0,
+        "tum", root, tuple(frames), _tum_intrinsics(root), 5000.0,
         "none" if track is None else ("trajectory" if trajectory else "ground truth"),
         tuple(notes),
     )
+
+
+def _tum_intrinsics(root: Path) -> PinholeParams | None:
+    """The TUM calibration the folder's name says (freiburg1/2/3), or None."""
+    name = root.resolve().name
+    for key, params in TUM_INTRINSICS.items():
+        if key in name:
+            return replace(params, source=f"folder-name default: {key!r} in {name!r} "
+                           f"({params.source})")
+    return None
+
+
+def _read_tum_by_index(root: Path, rgb: list[tuple[int, str]], depth: list[tuple[int, str]],
+                       fps: float, notes: list[str]) -> FolderSequence:
+    """``--timestamps index``: the depth images in the listed order, frame n at n / fps,
+    colour n with depth n; a ground truth (by time) cannot be matched and is not used."""
+    if rgb and len(rgb) != len(depth):
+        raise SgtoolError(
+            f"{root}: --timestamps index pairs colour n with depth n, but rgb.txt lists "
+            f"{len(rgb)} images and depth.txt {len(depth)}")
+    frames = tuple(
+        FolderFrame(round(i * 1e9 / fps), root / name, root / rgb[i][1] if rgb else None, None)
+        for i, (_, name) in enumerate(depth))
+    notes.append(f"--timestamps index: frame n at n/{fps:g} s in the listed order")
+    if (root / "groundtruth.txt").is_file():
+        notes.append("groundtruth.txt not used: its times cannot be matched to frame numbers")
+    return FolderSequence("tum", root, frames, _tum_intrinsics(root), 5000.0, "none",
+                          tuple(notes))
 
 
 def _read_7scenes(root: Path, fps: float, trajectory: Path | None) -> FolderSequence:
@@ -278,7 +340,8 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None) -> FolderSequ
         frames.append(FolderFrame(round(i * 1e9 / fps), files["depth"], files.get("color"), pose))
     intr = SEVEN_SCENES_INTRINSICS
     if (root / "camera-intrinsics.txt").is_file():
-        intr = read_intrinsics_file(root / "camera-intrinsics.txt")
+        intr = replace(read_intrinsics_file(root / "camera-intrinsics.txt"),
+                       source="file camera-intrinsics.txt")
     posed = sum(f.pose is not None for f in frames)
     if 0 < posed < len(frames):
         raise SgtoolError(f"{root}: {len(frames) - posed} of {len(frames)} frames have no pose.txt")
@@ -343,7 +406,7 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None) -> FolderSeque
     intr = None
     for p in sorted(root.glob("*.json")):
         try:
-            intr = read_intrinsics_file(p)
+            intr = replace(read_intrinsics_file(p), source=f"file {p.name}")
             break
         except SgtoolError:
             continue

@@ -7,10 +7,19 @@ trajectory an Open3D/Redwood folder comes with); estimate the z-up world alignme
 the poses and a few depth frames (:mod:`.upright`); write the frames (:mod:`.sink`). Log
 times are the dataset's time stamps (TUM) or frame number / fps. The images are read
 twice (odometry, then writing) rather than held in memory.
+
+Before the heavy work (:mod:`.sanity`, :mod:`.provenance`): every listed file exists (else
+an error, or ``skip_missing``), the listed time stamps increase at a camera's rate (else an
+error naming ``--timestamps index --fps N``), the depth of a few frames at the depth scale
+looks indoor (else an error naming the scale that fits), and after the world alignment the
+camera is within ``camera_height`` of the floor (else an error naming ``--floor``). A check
+of a value the user gave with a flag warns instead. The report says where the intrinsics,
+depth scale, up direction and floor came from.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -21,6 +30,7 @@ from sgtool.log.frame import CameraIntrinsics
 from sgtool.recorders.importers.checks import (
     check_counts,
     check_depth_scale,
+    check_height_band,
     check_non_negative,
     check_positive,
 )
@@ -37,6 +47,18 @@ from sgtool.recorders.importers.odometry import (
     OdometryResult,
     drift_where_known,
     estimate_with_progress,
+)
+from sgtool.recorders.importers.provenance import (
+    ESTIMATED_FLOORS,
+    FLOOR_ORIGINS,
+    Findings,
+    alignment_sources,
+    source_metadata,
+)
+from sgtool.recorders.importers.sanity import (
+    DEFAULT_CAMERA_HEIGHT,
+    depth_scale_problem,
+    floor_problem,
 )
 from sgtool.recorders.importers.sink import (
     ImportFrame,
@@ -68,11 +90,18 @@ class RgbdOptions:
     max_dt_ns: int = 20_000_000
     progress: bool = True
     compression: str = "zstd"
+    timestamps: str = "file"  # "file": the listed times (checked); "index": n / fps
+    skip_missing: bool = False
+    camera_height: tuple[float, float] = DEFAULT_CAMERA_HEIGHT  # plausible band, m
+    warn: Callable[[str], None] | None = None  # shows a warning at once
 
 
 def check_options(opts: RgbdOptions) -> None:
     """The numeric options, before anything is read (user errors naming the flag)."""
     check_counts(opts.every, opts.limit)
+    check_height_band(opts.camera_height)
+    if opts.timestamps not in ("file", "index"):
+        raise SgtoolError(f"--timestamps {opts.timestamps!r}: give file or index")
     check_depth_scale(opts.depth_scale)
     check_positive(opts.fps, "--fps", "frames per second")
     check_positive(opts.depth_max, "--depth-max", "metres")
@@ -142,15 +171,27 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     root, out = Path(root), Path(out)
     check_options(opts)
     seq = read_sequence(root, opts.layout, max_dt_ns=opts.max_dt_ns, fps=opts.fps,
-                        trajectory=opts.trajectory, keep_unposed=opts.estimate_poses)
+                        trajectory=opts.trajectory, keep_unposed=opts.estimate_poses,
+                        timestamps=opts.timestamps, skip_missing=opts.skip_missing)
     frames = list(seq.frames[:: opts.every])
     if opts.limit is not None:
         frames = frames[: opts.limit]
     if not frames:
         raise SgtoolError(f"{root}: no frames left after --every/--limit")
+    findings = Findings(opts.warn)
     scale = float(opts.depth_scale if opts.depth_scale is not None else seq.depth_scale)
-    first = read_depth_file(frames[0].depth_path)
-    k = camera_for(seq, opts, first.shape[1], first.shape[0])
+    scale_origin = ("flag --depth-scale" if opts.depth_scale is not None
+                    else f"dataset default: {seq.layout} layout")
+    picks = sample_indices(len(frames))
+    raws = [read_depth_file(frames[i].depth_path) for i in picks]
+    findings.problem(depth_scale_problem(raws, scale, scale_origin),
+                     given=opts.depth_scale is not None)
+    k = camera_for(seq, opts, raws[0].shape[1], raws[0].shape[0])
+    intr_origin = "flag --intrinsics" if opts.intrinsics is not None else \
+        (seq.intrinsics.source if seq.intrinsics is not None else "given")
+    if opts.intrinsics is None and intr_origin.startswith("folder-name default"):
+        findings.warning(f"intrinsics taken from the folder name ({intr_origin}); give "
+                         "--intrinsics fx,fy,cx,cy if the images come from another camera")
 
     notes = list(seq.notes)
     drift: DriftReport | None = None
@@ -171,12 +212,18 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         poses = [np.asarray(p) for p in source_poses]
         pose_source = f"{seq.pose_source} of the dataset"
 
-    samples = [
-        DepthSample(depth_to_metres(read_depth_file(frames[i].depth_path), scale), k, poses[i])
-        for i in sample_indices(len(frames))
-    ]
+    samples = [DepthSample(depth_to_metres(raw, scale), k, poses[i])
+               for raw, i in zip(raws, picks, strict=True)]
     alignment = estimate_alignment(poses, samples, up=opts.up, floor=opts.floor,
                                    floor_auto=opts.floor_auto)
+    if alignment.floor_method != "none":
+        findings.problem(
+            floor_problem(poses, alignment.matrix, alignment.floor,
+                          FLOOR_ORIGINS[alignment.floor_method], opts.camera_height),
+            given=alignment.floor_method not in ESTIMATED_FLOORS)
+    sources = [("intrinsics", f"{k.fx:g},{k.fy:g},{k.cx:g},{k.cy:g}", intr_origin),
+               ("depth scale", f"{scale:g} units/m", scale_origin),
+               *alignment_sources(alignment)]
 
     meta = {
         "source": str(root.resolve().name),
@@ -185,11 +232,12 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         "pose_source": pose_source,
         "depth_scale": f"{scale:g}",
         "intrinsics": f"{k.fx:g},{k.fy:g},{k.cx:g},{k.cy:g}",
-        "intrinsics_source": (opts.intrinsics or seq.intrinsics).source  # type: ignore[union-attr]
-        or "given",
+        **source_metadata(sources),
         "instance_ids": "absent",
         "frames_in_source": str(len(seq.frames)),
         "every": str(opts.every),
+        "timestamps": opts.timestamps,
+        **({"warnings": "\n".join(findings.warnings)} if findings.warnings else {}),
         **drift_metadata(drift, reference),
         **(odometry_metadata(odo) if odo is not None else {}),
     }
@@ -207,5 +255,6 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         output=out, source=str(root), kind=f"rgbd/{seq.layout}", frames=n, poses=len(poses),
         alignment=alignment, has_rgb=has_rgb, has_ids=has_ids, pose_source=pose_source,
         drift=drift, notes=tuple(notes), drift_reference=reference,
+        sources=tuple(sources), warnings=tuple(findings.warnings),
         **(odometry_report_fields(odo) if odo is not None else {}),  # type: ignore[arg-type]
     )

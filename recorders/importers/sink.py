@@ -64,6 +64,9 @@ class ImportReport:
     drift_reference: str = "ground truth"
     odometry_summary: str = ""  # OdometryResult.summary()
     odometry_reasons: tuple[tuple[str, int], ...] = ()  # failed steps per reason
+    # (parameter, value, origin) of the intrinsics, depth scale, up and floor
+    sources: tuple[tuple[str, str, str], ...] = ()
+    warnings: tuple[str, ...] = ()
 
     def lines(self) -> list[str]:
         a = self.alignment
@@ -75,6 +78,7 @@ class ImportReport:
             "colour: " + ("yes" if self.has_rgb else "no")
             + "; instance ids: " + ("yes" if self.has_ids else "none (geometry only)"),
         ]
+        out.extend(f"{name}: {value} [{origin}]" for name, value, origin in self.sources)
         if self.odometry_failures is not None:
             out.append("odometry: " + (self.odometry_summary or
                                        f"{self.odometry_failures} failed steps (previous "
@@ -82,6 +86,7 @@ class ImportReport:
         if self.drift is not None:
             out.append(f"drift against {self.drift_reference}: " + self.drift.summary())
         out.extend(f"note: {n}" for n in self.notes)
+        out.extend(f"warning: {w}" for w in self.warnings)
         return out
 
 

@@ -55,7 +55,8 @@ def _data_lines(path: Path) -> list[tuple[int, list[str]]]:
 
 
 def read_tum_list(path: Path) -> list[tuple[int, str]]:
-    """(time ns, relative file name) from a TUM ``rgb.txt`` / ``depth.txt``."""
+    """(time ns, relative file name) from a TUM ``rgb.txt`` / ``depth.txt``, in the file's
+    order (the importer checks that the times increase before it relies on them)."""
     out = []
     for n, parts in _data_lines(path):
         if len(parts) < 2:
@@ -64,7 +65,7 @@ def read_tum_list(path: Path) -> list[tuple[int, str]]:
             out.append((seconds_to_ns(parts[0]), parts[1]))
         except ValueError as e:
             raise SgtoolError(f"{path}:{n}: {e}") from e
-    return sorted(out)
+    return out
 
 
 def read_tum_trajectory(path: Path) -> list[tuple[int, np.ndarray]]:

@@ -13,6 +13,11 @@ Modules, one job each:
 - :mod:`~sgtool.recorders.sim.explore`: the scripted whole-house exploration;
 - :mod:`~sgtool.recorders.sim.noise`: seeded sensor faults;
 - :mod:`~sgtool.recorders.sim.recording`: :class:`LogRecorder` and :func:`record_house`;
+- :mod:`~sgtool.recorders.sim.live_skills`: the robot's skills on its own map and the
+  :class:`RobotBody` guard (no house on the robot side); :mod:`.execution` runs an action's
+  skill calls live or on the ground truth;
+- :mod:`~sgtool.recorders.sim.frontier_explore`: frontier exploration on the robot's map
+  (``sgtool record --explore frontier``), scored by :mod:`.coverage`;
 - :mod:`~sgtool.recorders.sim.closed_loop`: a planner searching the house on the scene
   graph built live (``sgtool run``): :func:`run_closed_loop` (``closed_loop.run_episode``),
   :func:`plan_skills` (planner actions to skills).

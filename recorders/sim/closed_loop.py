@@ -46,6 +46,14 @@ every other channel is identical, the scene graphs included). The writer writes
 ``OUT.XXXXXXXX.partial`` and renames it at the end: an error leaves no half-written log.
 
 Planner actions become simulator skills by :func:`sgtool.recorders.sim.skill_plan.plan_skills`.
+With ``navigation="live"`` (the default) the robot runs them on its own map
+(:mod:`sgtool.recorders.sim.live_skills`: the occupancy of the latest refresh, re-planned
+at every refresh; a goal its map cannot reach is a failed skill whose reason goes to the
+planner) and reaches the simulator only through a
+:class:`~sgtool.recorders.sim.live_skills.RobotBody` (motion with contacts, opening and
+closing); ``navigation="house"`` keeps the simulator's skills on the ground-truth
+occupancy (the behaviour before, for comparison). ``extra.navigation`` of the started
+Episode record says which, with the live settings.
 """
 
 from __future__ import annotations
@@ -55,7 +63,7 @@ import math
 import os
 import statistics
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -72,6 +80,8 @@ from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.planning.candidates import find_target
 from sgtool.planning.episode import SearchStep, run_search
 from sgtool.recorders.sim.camera import CameraConfig
+from sgtool.recorders.sim.execution import Executed, execute_live, execute_privileged
+from sgtool.recorders.sim.live_skills import LiveNavConfig, LiveSkills, RobotBody
 from sgtool.recorders.sim.navigation import RobotConfig
 from sgtool.recorders.sim.noise import PROFILES, NoiseProfile
 from sgtool.recorders.sim.recording import SOURCE, LogRecorder
@@ -96,6 +106,7 @@ from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 from sgtool.semantics.text import category_text
 
 N_MAX = 50  # high-level steps per episode (SymSearch's N_max)
+NAVIGATION = ("live", "house")
 
 
 # ----------------------------------------------------------------------------------------
@@ -116,9 +127,14 @@ class ClosedLoopOptions:
     frames: int | None = None  # frame budget (None: none)
     planner_seed: int = 0
     compression: str = "zstd"
+    # "live": the robot plans on its own map (issue 17); "house": on the ground truth (before)
+    navigation: str = "live"
+    live: LiveNavConfig = field(default_factory=LiveNavConfig)
 
     def mapping(self) -> ResolvedOptions:
         """The replay options this run builds with (``extra.mapping`` of the log)."""
+        if self.navigation not in NAVIGATION:
+            raise SgtoolError(f"navigation {self.navigation!r}: one of {', '.join(NAVIGATION)}")
         if self.every < 1:
             raise SgtoolError(f"--every {self.every}: must be >= 1")
         if self.classifier not in CLASSIFIERS:
@@ -249,24 +265,6 @@ class _LiveRecorder(LogRecorder):
             self.last_refresh = r
 
 
-def _execute(sim: Simulation, calls: Sequence[SkillCall]
-             ) -> tuple[str, str, float, int, bool]:
-    """Run ``calls`` until one does not succeed: (outcome, reason, metres, ticks, cut)
-    where ``cut`` says the frame budget stopped it."""
-    t0, d0 = sim.tick_index, sim.travelled_m
-    out: SkillOutcome | None = None
-    try:
-        for c in calls:
-            out = sim.look_around() if c.skill == "look_around" else \
-                getattr(sim, c.skill)(c.target)
-            if not out.success:
-                break
-    except StopSimulation as e:
-        return ("failure", f"stopped: {e}", sim.travelled_m - d0, sim.tick_index - t0, True)
-    assert out is not None
-    return (out.outcome, out.reason, sim.travelled_m - d0, sim.tick_index - t0, False)
-
-
 # ----------------------------------------------------------------------------------------
 # one episode
 # ----------------------------------------------------------------------------------------
@@ -278,8 +276,10 @@ class _Search:
 
     def __init__(self, sim: Simulation, rec: _LiveRecorder, agent: Planner, query: str,
                  max_steps: int,
-                 on_decision: Callable[[SceneGraph, Action], None] | None) -> None:
+                 on_decision: Callable[[SceneGraph, Action], None] | None,
+                 skills: LiveSkills | None = None) -> None:
         self.sim, self.rec, self.agent, self.query = sim, rec, agent, query
+        self.skills = skills  # None: the simulator's privileged skills
         self.max_steps = max_steps
         self.on_decision = on_decision
         self.steps = self.n_open = self.last_t = 0
@@ -297,9 +297,11 @@ class _Search:
         except StopSimulation:
             cut = True
         if not cut:
-            o, why, dist, ticks, cut = _execute(self.sim, (SkillCall("look_around", 0),))
+            ex = self._run((SkillCall("look_around", 0),))
+            cut = ex.cut
             self.last_t = self.rec.act(
-                self.sim, SkillOutcome("look_around", None, o, why, dist, ticks), 0.0,
+                self.sim, SkillOutcome("look_around", None, ex.outcome, ex.reason,
+                                       ex.travelled_m, ex.ticks), 0.0,
                 {"graph_time_ns": None, "planner": None})
         self._check(self.rec.last_refresh, cut)
 
@@ -343,7 +345,8 @@ class _Search:
         elif plan.invalid is not None:
             o, why, dist, ticks = "invalid", plan.invalid, 0.0, 0
         else:
-            o, why, dist, ticks, cut = _execute(self.sim, plan.calls)
+            ex = self._run(plan.calls)
+            o, why, dist, ticks, cut = ex.outcome, ex.reason, ex.travelled_m, ex.ticks, ex.cut
             if action.skill == "open" and o == "success":
                 self.n_open += 1
         outcome = SkillOutcome(action.skill, action.target, o, why, dist, ticks)
@@ -354,6 +357,11 @@ class _Search:
 
     def executed(self, step: SearchStep) -> None:
         pass
+
+    def _run(self, calls: tuple[SkillCall, ...]) -> Executed:
+        if self.skills is None:
+            return execute_privileged(self.sim, calls)
+        return execute_live(self.sim, self.skills, calls, self.rec.stream.current)
 
 
 def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
@@ -401,7 +409,9 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                 base, steps=0, travelled_m=0.0, shortest_m=shortest, frames=0,
                 extra=_started_extra(opts, sim, mapping, episode, episode_index)), 0)
             rec.write_instances(sim)
-            search = _Search(sim, rec, planner, query, opts.max_steps, on_decision)
+            skills = None if opts.navigation == "house" else LiveSkills(
+                RobotBody(sim), lambda: stream.current, opts.live)
+            search = _Search(sim, rec, planner, query, opts.max_steps, on_decision, skills)
             search.start()
             run_search(search, planner, query, seed=opts.planner_seed, recorder=search)
             end, steps, n_open = search.end, search.steps, search.n_open
@@ -455,5 +465,6 @@ def _started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOp
         "intrinsics": {"width": k.width, "height": k.height, "fx": k.fx, "fy": k.fy,
                        "cx": k.cx, "cy": k.cy},
         "robot": asdict(opts.robot),
+        "navigation": {"mode": opts.navigation, **opts.live.to_dict()},
         "noise": opts.noise.to_dict(), "noise_seed": opts.noise_seed,
     }

@@ -26,7 +26,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -105,6 +105,10 @@ class LogRecorder(SimObserver):
         if self.log_actions:
             self.log_action(sim, outcome)
 
+    def on_skill_of(self, sim: Simulation) -> Callable[[SkillOutcome], None]:
+        """``on_skill`` for ``sim`` as a one-argument function (the robot side's log)."""
+        return lambda outcome: self.on_skill(sim, outcome)
+
     def log_action(self, sim: Simulation, outcome: SkillOutcome, *,
                    decision_time_s: float = 0.0,
                    fields: Mapping[str, Any] | None = None) -> int:
@@ -133,6 +137,8 @@ class RecordOptions:
     start: int = 0  # index of the house's start pose
     script: ScriptOptions = field(default_factory=ScriptOptions)
     compression: str = "zstd"
+    explore: str = "script"  # or "frontier": frontier exploration on the robot's own map
+    every: int = 10  # frontier: frames between refreshes of the robot's map
 
 
 @dataclass(frozen=True)
@@ -147,6 +153,7 @@ class RecordReport:
     opened: tuple[str, ...]
     truncated: bool
     seconds: float  # wall-clock time of the run (reported, never logged)
+    coverage: tuple[tuple[float, float], ...] = ()  # frontier: (sim time s, floor share)
 
     def lines(self) -> list[str]:
         fps = self.frames / self.seconds if self.seconds > 0 else 0.0
@@ -154,7 +161,8 @@ class RecordReport:
             f"wrote {self.output} ({self.output.stat().st_size / 1e6:.1f} MB)",
             f"house {self.house_id}: {self.frames} frames, {self.actions} actions, "
             f"{self.travelled_m:.1f} m driven, {self.seconds:.1f} s ({fps:.1f} frames/s)",
-            f"rooms visited: {len(self.rooms_visited)} ({', '.join(self.rooms_visited)})",
+            f"{'goals' if self.coverage else 'rooms'} visited: {len(self.rooms_visited)} "
+            f"({', '.join(self.rooms_visited)})",
         ]
         if self.opened:
             out.append(f"opened: {', '.join(self.opened)}")
@@ -162,7 +170,22 @@ class RecordReport:
             out.append(f"missed {r}: {why}")
         if self.truncated:
             out.append("stopped at the frame budget before the exploration finished")
+        if self.coverage:
+            marks = [f"{m} min {100 * coverage_at(self.coverage, 60.0 * m):.1f} %"
+                     for m in (1, 2, 5) if self.coverage[-1][0] >= 60.0 * m]
+            t, c = self.coverage[-1]
+            out.append("floor seen: " + ", ".join([*marks, f"end ({t:.0f} s) {100 * c:.1f} %"]))
         return out
+
+
+def coverage_at(samples: Sequence[tuple[float, float]], t: float) -> float:
+    """The coverage of the last sample at or before ``t`` seconds (0 before the first)."""
+    best = 0.0
+    for ts, c in samples:
+        if ts > t + 1e-9:
+            break
+        best = c
+    return best
 
 
 def record_house(house: HouseSpec, output: str | os.PathLike[str],
@@ -193,9 +216,13 @@ def record_house(house: HouseSpec, output: str | os.PathLike[str],
         writer.write_record(Episode(kind="recording", source=SOURCE, house_id=hid,
                                     status="started", extra=_episode_extra(opts, sim)), 0)
         rec.write_instances(sim)
+        samples: list[tuple[float, float]] = []
         try:
-            sim.tick()  # the view at the start pose
-            explore_house(sim, opts.script, rep)
+            if opts.explore == "frontier":
+                _explore_live(sim, rec, opts, rep, samples)
+            else:
+                sim.tick()  # the view at the start pose
+                explore_house(sim, opts.script, rep)
         except StopSimulation:
             truncated = True
         writer.write_record(Episode(
@@ -208,7 +235,38 @@ def record_house(house: HouseSpec, output: str | os.PathLike[str],
         frames, actions = rec.frames, rec.actions
     return RecordReport(Path(output), hid, frames, actions, travelled, tuple(rep.visited),
                         dict(rep.missed), tuple(rep.opened), truncated,
-                        time.perf_counter() - t_wall)
+                        time.perf_counter() - t_wall, tuple(samples))
+
+
+def _explore_live(sim: Simulation, rec: LogRecorder, opts: RecordOptions,
+                  rep: ExplorationReport, samples: list[tuple[float, float]]) -> None:
+    """Frontier exploration on the robot's own map (:mod:`.frontier_explore`), sampling
+    the floor coverage at every refresh."""
+    from sgtool.recorders.sim.coverage import coverage, floor_points
+    from sgtool.recorders.sim.frontier_explore import LiveMap, explore_frontiers
+    from sgtool.recorders.sim.live_skills import LiveSkills, RobotBody
+    from sgtool.scenegraph.options import ResolvedOptions, builder_config, default_min_points
+    from sgtool.scenegraph.stream import Refresh, SceneGraphStream
+
+    floor = floor_points(sim.spec)
+    mapping = ResolvedOptions(every=opts.every, classifier="none",
+                              min_points=default_min_points(opts.camera.width,
+                                                            opts.camera.height),
+                              voxel_size=0.05, max_frames=None)
+    stream = SceneGraphStream(None, None, builder_config(mapping))
+    stream.instances(0, rec.last_instances)  # type: ignore[arg-type]
+
+    def sample(r: Refresh) -> None:
+        if r.layers is not None:
+            samples.append((r.time_ns / 1e9, coverage(r.layers.occupancy, floor)))
+
+    sim.observers.insert(sim.observers.index(rec) + 1, LiveMap(rec, stream, sample))
+    skills = LiveSkills(RobotBody(sim), lambda: stream.current)
+    sim.tick()  # the view at the start pose
+    fr = explore_frontiers(skills, rec.on_skill_of(sim))
+    rep.visited.extend(fr.goals)
+    rep.missed.update({g: "not reached" for g in fr.failed})
+    rep.opened.extend(fr.opened)
 
 
 def _episode_extra(opts: RecordOptions, sim: Simulation) -> dict[str, Any]:
@@ -222,5 +280,6 @@ def _episode_extra(opts: RecordOptions, sim: Simulation) -> dict[str, Any]:
         "robot": asdict(opts.robot),
         "noise": opts.noise.to_dict(),
         "script": asdict(opts.script),
+        **({"explore": opts.explore} if opts.explore != "script" else {}),
         "frame_budget": opts.frames,
     }

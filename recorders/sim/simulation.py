@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import replace
 from fractions import Fraction
 from typing import Any
 
@@ -207,18 +208,48 @@ class Simulation(Skills):
 
     # ----- maps -------------------------------------------------------------------------
     def occupancy(self, doors_passable: bool = False) -> OccupancyMap:
-        """Occupancy in the current door states with open panels as obstacles (cached)."""
+        """Occupancy in the current door states with open panels as obstacles (cached): the
+        ground truth the scripted recorder plans on. The closed loop's robot never calls
+        it (it plans on its own map, :mod:`.live_skills`)."""
+        return self._truth_map(doors_passable, self.robot)
+
+    def _truth_map(self, doors_passable: bool, robot: RobotConfig) -> OccupancyMap:
         panels = [b.panel.footprint(b.fraction) for bodies in self.world.panels.values()
                   for b in bodies if b.blocks]
         door_states = {d.id: self.world.states[d.id] for d in self.spec.doors}
-        key = (doors_passable, tuple(sorted(door_states.items())), tuple(panels))
+        key = (doors_passable, robot.radius, tuple(sorted(door_states.items())),
+               tuple(panels))
         occ = self._occ_cache.get(key)
         if occ is None:
             if len(self._occ_cache) > 64:
                 self._occ_cache.clear()
-            occ = nav.occupancy_with(self.spec, door_states, panels, self.robot, doors_passable)
+            occ = nav.occupancy_with(self.spec, door_states, panels, robot, doors_passable)
             self._occ_cache[key] = occ
         return occ
+
+    # ----- motion with contacts ---------------------------------------------------------
+    def in_contact(self, pose: Pose2 | None = None) -> bool:
+        """Whether the base disc at ``pose`` (default: now) touches a wall, a piece of
+        furniture, a closed door or an open panel: the simulator's physics (ground truth,
+        with one map cell of tolerance for the grid), never given to the robot."""
+        x, y = (self.base if pose is None else pose)[:2]
+        tol = replace(self.robot, radius=max(self.robot.radius - self.robot.resolution, 0.0))
+        occ = self._truth_map(False, tol)
+        r = int(math.floor((y - occ.origin[1]) / occ.resolution))
+        c = int(math.floor((x - occ.origin[0]) / occ.resolution))
+        return not occ.in_bounds(r, c) or bool(occ.blocked[r, c])
+
+    def drive(self, poses: Sequence[Pose2]) -> tuple[float, bool]:
+        """Follow per-tick poses until one would bring the base into contact (from a pose
+        that is not): (distance driven, whether a contact stopped it). The blocked pose is
+        not taken (no tick)."""
+        dist = 0.0
+        touching = self.in_contact()
+        for p in poses:
+            if not touching and self.in_contact(p):
+                return dist, True
+            dist += self._move((p,))
+        return dist, False
 
     # ----- targets and doors ------------------------------------------------------------
     def resolve(self, target: Target) -> Resolved | str:

@@ -22,7 +22,7 @@ a target not in the graph the planner saw  invalid, no motion
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from sgtool.planning.base import Action
 from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode, SceneGraph
@@ -38,6 +38,7 @@ class SkillCall:
 
     skill: str
     target: int | tuple[float, float]
+    node: str | None = field(default=None, compare=False)  # the graph node it came from
 
 
 @dataclass(frozen=True)
@@ -75,12 +76,13 @@ def plan_skills(graph: SceneGraph, action: Action) -> SkillPlan:
         if iid is None:
             return SkillPlan(invalid=f"{node.id} names no instance")
         if skill in ("open", "close"):
-            return SkillPlan((SkillCall("navigate", iid), SkillCall(skill, iid)))
-        return SkillPlan((SkillCall(skill, iid),))
+            return SkillPlan((SkillCall("navigate", iid, node.id),
+                              SkillCall(skill, iid, node.id)))
+        return SkillPlan((SkillCall(skill, iid, node.id),))
     assert isinstance(node, (RoomNode, RegionNode))
     what = "room" if isinstance(node, RoomNode) else (
         "frontier" if node.kind == "frontier" else "region")
     if skill in ("open", "close"):
         return SkillPlan(invalid=f"cannot {skill} a {what} ({node.id})")
     xy = (float(node.position[0]), float(node.position[1]))
-    return SkillPlan((SkillCall(skill, xy),))
+    return SkillPlan((SkillCall(skill, xy, node.id),))

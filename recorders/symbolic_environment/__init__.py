@@ -9,6 +9,8 @@ This package turns a :class:`~sgtool.house.spec.HouseSpec` into that environment
   prepared once (regions, places, travel distances for any door states);
 - :mod:`~sgtool.recorders.symbolic_environment.environment`: :class:`SymbolicEnv`, one
   episode's rules (start, what each action reveals, invalid and failed actions, the end);
+- :mod:`~sgtool.recorders.symbolic_environment.observation`: :class:`ObservedGraph`, the
+  episode's observed scene graph, updated with what each step changed (not rebuilt);
 - :mod:`~sgtool.recorders.symbolic_environment.rollout`: :func:`run_episode`, one episode
   with a planner through :func:`sgtool.planning.episode.run_search`, optionally logged;
   :func:`run_one`, the same for a script: any house spec, a planner or its name, a query.
@@ -16,6 +18,7 @@ This package turns a :class:`~sgtool.house.spec.HouseSpec` into that environment
 
 from sgtool.recorders.symbolic_environment.environment import N_MAX, StepOutcome, SymbolicEnv
 from sgtool.recorders.symbolic_environment.house import Region, SymbolicHouse
+from sgtool.recorders.symbolic_environment.observation import ObservedGraph
 from sgtool.recorders.symbolic_environment.regions import (
     MAX_REGIONS,
     MIN_REGION_STD,
@@ -34,6 +37,7 @@ __all__ = [
     "MIN_REGION_STD",
     "N_MAX",
     "EpisodeLog",
+    "ObservedGraph",
     "Region",
     "RunOneError",
     "StepOutcome",

@@ -55,7 +55,8 @@ import numpy as np
 
 from sgtool.planning.base import Action, Feedback
 from sgtool.recorders.symbolic_environment.house import SymbolicHouse
-from sgtool.scenegraph.graph import DoorNode, RegionNode, RobotState, RoomNode, SceneGraph
+from sgtool.recorders.symbolic_environment.observation import ObservedGraph
+from sgtool.scenegraph.graph import SceneGraph
 from sgtool.semantics.text import category_text
 
 N_MAX = 50  # SymSearch's maximum episode length (SCOUT sec. VI / appendix C)
@@ -101,6 +102,8 @@ class SymbolicEnv:
         self.explored_rooms: set[int] = set()
         self.known_rooms: set[int] = set()
         self.visible_doors: set[int] = set()
+        self._visible_furn: set[int] = set()  # furniture of the revealed regions
+        self._view = ObservedGraph(self)  # told of every change below
         # start: a random region of a random room (SCOUT V.C)
         if start_region is not None:
             reg = next(i for i, r in enumerate(house.regions) if r.id == start_region)
@@ -124,7 +127,9 @@ class SymbolicEnv:
     def _enter_room(self, ri: int, region: int) -> None:
         self.explored_rooms.add(ri)
         self.known_rooms.add(ri)
-        self.revealed_regions.add(region)
+        self._view.rooms_changed()
+        self._view.doors_changed()
+        self._reveal_region(region)
         for other, door in self.house.links[ri]:
             if door is not None:
                 self.visible_doors.add(door)
@@ -133,11 +138,15 @@ class SymbolicEnv:
             else:
                 self.known_rooms.add(other)
 
+    def _reveal_region(self, region: int) -> None:
+        self.revealed_regions.add(region)
+        self._view.regions_changed()
+        for f in self.house.regions[region].furniture:
+            self._visible_furn.add(f)
+            self._view.show_furniture(f)
+
     def visible_furniture(self) -> list[int]:
-        out = []
-        for reg in sorted(self.revealed_regions):
-            out.extend(self.house.regions[reg].furniture)
-        return sorted(out)
+        return sorted(self._visible_furn)
 
     def visible_objects(self) -> list[int]:
         return sorted(self.seen_objects)
@@ -150,6 +159,7 @@ class SymbolicEnv:
         closed = self.furn_state[f] == "closed"
         if not closed and h.explorable[f]:
             self.furn_explored.add(f)
+        self._view.show_furniture(f)
         new: list[int] = []
         stack = [j for j in reversed(h.nested[f]) if not (closed and h.enclosed[j])]
         while stack:
@@ -160,6 +170,7 @@ class SymbolicEnv:
             shut = self.obj_state[j] == "closed"
             if not shut:
                 self.obj_explored.add(j)
+            self._view.show_object(j)
             stack.extend(c for c in reversed(h.obj_children[j]) if not (shut and h.enclosed[c]))
         return new
 
@@ -168,8 +179,8 @@ class SymbolicEnv:
         return f"found {', '.join(names)}" if names else "nothing inside or on top"
 
     def _check_found(self) -> None:
-        if any(f in self._target_furn for f in self.visible_furniture()) or \
-           any(j in self._target_obj for j in self.visible_objects()):
+        if not (self._target_furn.isdisjoint(self._visible_furn) and
+                self._target_obj.isdisjoint(self.seen_objects)):
             self.success = True
             self.ended = True
 
@@ -186,65 +197,10 @@ class SymbolicEnv:
         return a if (dist[a], a) <= (dist[b], b) else b
 
     def observe(self) -> SceneGraph:
-        """The observed subgraph with travel distances from the agent (finite ones only)."""
-        h, spec = self.house, self.spec
-        dist = self._distances()
-        distances: dict[str, float] = {}
-
-        def put(node_id: str, place: int) -> None:
-            d = float(dist[place])
-            if math.isfinite(d):
-                distances[node_id] = d
-
-        rooms = []
-        for ri in sorted(self.known_rooms):
-            rid = h.room_ids[ri]
-            explored = ri in self.explored_rooms
-            cx, cy = spec.rooms[ri].centroid
-            neighbours = tuple(sorted({h.room_ids[o] for o, door in h.links[ri]
-                                       if o in self.known_rooms})) if explored else ()
-            rooms.append(RoomNode(
-                id=rid, category=h.room_names[ri] if explored else "unknown",
-                position=(float(cx), float(cy)), explored=explored,
-                category_scores=((h.room_names[ri], 1.0),) if explored else (),
-                neighbours=neighbours,
-            ))
-            put(rid, self._room_place(ri, dist))
-        regions = []
-        for ri in sorted(self.explored_rooms):
-            for reg in h.room_regions[ri]:
-                r = h.regions[reg]
-                revealed = reg in self.revealed_regions
-                regions.append(RegionNode(
-                    id=r.id, room=h.room_ids[ri], position=r.center,
-                    kind="region" if revealed else "frontier",
-                    frontier_type=None if revealed else "unexplored area",
-                ))
-                put(r.id, r.place)
-        objects = []
-        for f in self.visible_furniture():
-            objects.append(h.furniture_node(f, self.furn_state[f], f in self.furn_explored))
-            put(h.furn_node_id(f), h.furn_place[f])
-        for j in self.visible_objects():
-            o = spec.objects[j]
-            objects.append(h.object_node(j, self.obj_state[j],
-                                         bool(o.affordances) and j in self.obj_explored))
-            put(h.obj_node_id(j), h.furn_place[h.obj_furn[j]])
-        doors = []
-        for di in sorted(self.visible_doors):
-            d = spec.doors[di]
-            doors.append(DoorNode(
-                id=f"door:{di}", position=(float(d.center[0]), float(d.center[1])),
-                state="open" if di in self.open_doors else "closed",
-                rooms=tuple(h.room_ids[h.room_index[r]] for r in d.rooms), instance=-1,
-            ))
-            put(f"door:{di}", self._door_place(di, dist))
-        here = self.place
-        region = next((r.id for r in h.regions if r.place == here), None)
-        robot = RobotState(position=h.places[here], room=h.room_ids[h.place_room[here]],
-                           region=region)
-        return SceneGraph(robot=robot, rooms=tuple(rooms), regions=tuple(regions),
-                          objects=tuple(objects), doors=tuple(doors), distances=distances)
+        """The observed subgraph with travel distances from the agent (finite ones only),
+        kept up to date with each step's changes
+        (:class:`~sgtool.recorders.symbolic_environment.observation.ObservedGraph`)."""
+        return self._view.graph(self._distances())
 
     # ----- acting ---------------------------------------------------------------------
     def _lookup(self, node_id: str | None) -> tuple[str, int] | None:
@@ -258,7 +214,7 @@ class SymbolicEnv:
                 ri = int(rest)
                 return ("room", ri) if ri in self.known_rooms else None
             if prefix == "region":
-                reg = next((i for i, r in enumerate(h.regions) if r.id == node_id), None)
+                reg = h.region_index.get(node_id)
                 if reg is None or h.regions[reg].room not in self.explored_rooms:
                     return None
                 return "region", reg
@@ -269,7 +225,7 @@ class SymbolicEnv:
                 k = int(rest) - 1
                 nf = len(self.spec.furniture)
                 if 0 <= k < nf:
-                    return ("furniture", k) if k in set(self.visible_furniture()) else None
+                    return ("furniture", k) if k in self._visible_furn else None
                 j = k - nf
                 if 0 <= j < len(self.spec.objects):
                     return ("object", j) if j in self.seen_objects else None
@@ -351,7 +307,7 @@ class SymbolicEnv:
                     return self._outcome(a, "failure", f"{a.target} is already explored")
                 return self._outcome(a, "success", f"at {a.target}", self._move(reg.place, dist))
             d = self._move(reg.place, dist)
-            self.revealed_regions.add(i)
+            self._reveal_region(i)
             return self._outcome(a, "success", f"{len(reg.furniture)} objects in view", d)
         if kind == "door":
             place = self._door_place(i, dist)
@@ -369,11 +325,14 @@ class SymbolicEnv:
                 self.open_doors.add(i)
                 for r in self.spec.doors[i].rooms:
                     self.known_rooms.add(h.room_index[r])
+                self._view.rooms_changed()
+                self._view.doors_changed()
                 return self._outcome(a, "success", "door opened", d, opened=True)
             if not is_open:  # close
                 return self._outcome(a, "failure", f"{a.target} is already closed")
             d = self._move(place, dist)
             self.open_doors.discard(i)
+            self._view.doors_changed()
             return self._outcome(a, "success", "door closed", d)
         if kind == "object":
             return self._object_action(a, i, dist)
@@ -396,6 +355,7 @@ class SymbolicEnv:
                 return self._outcome(a, "failure", f"the {fu.category} is not open")
             d = self._move(place, dist)
             self.furn_state[i] = "closed"
+            self._view.show_furniture(i)
             return self._outcome(a, "success", f"{fu.category} closed", d)
         # navigate / explore: walk up; look into / onto a piece that is not closed, onto
         # the top of a closed one
@@ -434,9 +394,11 @@ class SymbolicEnv:
         d = self._move(place, dist)
         if skill == "close":
             self.obj_state[j] = "closed"
+            self._view.show_object(j)
             return self._outcome(a, "success", f"{o.category} closed", d)
         if opens:
             self.obj_state[j] = "open"
+            self._view.show_object(j)
         new = self._look(f)
         if opens or skill == "explore":
             return self._outcome(a, "success", self._found(new), d, opened=opens)

@@ -143,6 +143,26 @@ class SymbolicHouse:
         self._base = self._base_distances()
         self._graphs: dict[frozenset[int], csr_matrix] = {}
         self._rows: dict[tuple[frozenset[int], int], np.ndarray] = {}
+        self._lookups()
+
+    def _lookups(self) -> None:
+        """Per-house tables the episodes read at every step (computed once here)."""
+        spec = self.spec
+        self.room_centroids = tuple((float(r.centroid[0]), float(r.centroid[1]))
+                                    for r in spec.rooms)
+        self.region_index = {r.id: i for i, r in enumerate(self.regions)}
+        self.place_region: dict[int, str] = {}
+        for r in self.regions:
+            self.place_region.setdefault(r.place, r.id)
+        # a room's candidate places (its regions'), ascending, so the first nearest wins
+        self.room_places = tuple(tuple(sorted(self.regions[k].place for k in regs))
+                                 for regs in self.room_regions)
+        self.furn_ids = tuple(self.furn_node_id(f) for f in range(len(spec.furniture)))
+        self.obj_ids = tuple(self.obj_node_id(j) for j in range(len(spec.objects)))
+        self.obj_place = tuple(self.furn_place[f] for f in self.obj_furn)
+        self.obj_has_affordances = tuple(bool(o.affordances) for o in spec.objects)
+        self.door_rooms = tuple(tuple(self.room_ids[self.room_index[r]] for r in d.rooms)
+                                for d in spec.doors)
 
     # ----- ids ------------------------------------------------------------------------
     def furn_node_id(self, i: int) -> str:

@@ -19,10 +19,10 @@ import numpy as np
 from sgtool.errors import SgtoolError
 from sgtool.house.spec import HouseSpec, StartPose
 from sgtool.log.records import Action as LoggedAction
-from sgtool.log.records import Episode, SceneGraphRecord
+from sgtool.log.records import Episode, LlmExchange, SceneGraphRecord
 from sgtool.log.writer import LogWriter
 from sgtool.planning.base import Action, Planner
-from sgtool.planning.episode import SearchStep, run_search
+from sgtool.planning.episode import NOT_CONFIRMED, SearchStep, run_search, search_success
 from sgtool.recorders.symbolic_environment.environment import N_MAX, SymbolicEnv
 from sgtool.recorders.symbolic_environment.house import SymbolicHouse
 from sgtool.results import EpisodeResult, Step
@@ -63,15 +63,19 @@ class EpisodeLog:
         t_ns = step.index * SECOND_NS
         a, fb = step.action, step.feedback
         self.log.write_record(SceneGraphRecord.of_graph(step.graph), t_ns)
+        for ex in step.exchanges:  # the LLM exchanges of the decision (/sgtool/llm)
+            self.log.write_record(LlmExchange.from_json(ex), t_ns)
+        # the executor's message (what the planner was told) beside the planner's reason
         self.log.write_record(LoggedAction(
             skill=a.skill, target=a.target, outcome=fb.outcome, reason=a.reason,
             travelled_m=fb.travelled_m, decision_time_s=step.decision_s,
-            planner=self.planner, step=step.index), t_ns)
+            planner=self.planner, step=step.index, unknown={"message": fb.message}), t_ns)
 
     def close(self, steps: int, env: SymbolicEnv, shortest: float | None,
-              extra: dict[str, object]) -> None:
+              extra: dict[str, object], success: bool | None = None) -> None:
+        ok = env.success if success is None else success
         self.log.write_record(dataclasses.replace(
-            self.base, status="success" if env.success else "failure", steps=env.steps,
+            self.base, status="success" if ok else "failure", steps=env.steps,
             travelled_m=env.travelled,
             shortest_m=shortest, extra=extra,
         ), (steps + 1) * SECOND_NS)
@@ -81,7 +85,7 @@ def run_episode(house: SymbolicHouse, planner: Planner, query: str, targets: Seq
                 seed: int = 0, episode_index: int = 0, avoid_rooms: Sequence[str] = (),
                 max_steps: int = N_MAX, seen: bool | None = None, house_id: str = "",
                 planner_name: str | None = None, log: LogWriter | None = None,
-                start_region: str | None = None) -> EpisodeResult:
+                start_region: str | None = None, success: str = "observed") -> EpisodeResult:
     """Roll out one episode: observe, decide, act, feed back, until it ends.
 
     ``targets`` (spec ids of the query's instances) only serve the shortest path of SPL;
@@ -92,7 +96,8 @@ def run_episode(house: SymbolicHouse, planner: Planner, query: str, targets: Seq
     With ``log`` (an open :class:`sgtool.log.writer.LogWriter`) the episode is also
     recorded (:class:`EpisodeLog`); the closing record's ``extra`` holds seed,
     planner_seed, episode, seen, end, n_open, start_region. ``start_region`` (a region id,
-    ``region:<room>.<k>``) fixes the start instead of drawing it.
+    ``region:<room>.<k>``) fixes the start instead of drawing it. ``success`` is the
+    success rule (:func:`sgtool.planning.episode.search_success`: ``observed`` or ``done``).
     """
     name = planner_name or getattr(planner, "name", "planner")
     hid = house_id or f"house-{house.spec.seed}"
@@ -106,24 +111,26 @@ def run_episode(house: SymbolicHouse, planner: Planner, query: str, targets: Seq
                                            house_id=hid, query=query, planner=name,
                                            frames=0), name)
         recorder.started()
-    steps = run_search(env, planner, query, seed=pseed, recorder=recorder)
+    steps = run_search(env, planner, query, seed=pseed, recorder=recorder, success=success)
+    ok = search_success(env.success, steps, query, success)
+    end = env.end_reason if ok == env.success else NOT_CONFIRMED
     trace = tuple(Step(s.action.skill, s.action.target, s.feedback.outcome,
                        s.feedback.travelled_m) for s in steps)
     shortest = env.shortest_path(targets)
     result = EpisodeResult(
         planner=name, seed=int(seed), house=hid,
-        episode=int(episode_index), query=query, success=env.success, steps=env.steps,
+        episode=int(episode_index), query=query, success=ok, steps=env.steps,
         travelled_m=env.travelled, shortest_m=shortest,
         n_open=env.n_open, n_invalid=env.n_invalid, n_failure=env.n_failure, seen=seen,
-        end=env.end_reason, source="symbolic", trace=trace,
+        end=end, source="symbolic", trace=trace,
         wall={"decision_s": sum(s.decision_s for s in steps), "decisions": float(len(steps)),
               "episode_s": time.perf_counter() - t_start},
     )
     if recorder is not None:
         recorder.close(len(steps), env, shortest, {
             "seed": int(seed), "planner_seed": pseed, "episode": int(episode_index),
-            "seen": seen, "end": env.end_reason, "n_open": env.n_open,
-            "start_region": env.start_region})
+            "seen": seen, "end": end, "n_open": env.n_open,
+            "start_region": env.start_region}, success=ok)
     return result
 
 

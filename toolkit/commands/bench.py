@@ -7,15 +7,22 @@ import sys
 
 import click
 
-from sgtool.commands.options import llm_log_options, parse_rooms, planner_options
+from sgtool.commands.options import (
+    executor_options,
+    llm_log_options,
+    parse_rooms,
+    planner_options,
+    success_option,
+)
 from sgtool.datasets.presets import PRESET_NAMES
+from sgtool.errors import SgtoolError
 
 
 @click.command("bench")
 @click.option("--planners", default=None, metavar="LIST",
               help="Comma-separated planners to compare (random, greedy, sbert, sbert-noroom, "
-                   "scout, scout-noroom, scout-delta0, godhs, esc, bayes-search, moma-llm). "
-                   "Default: all but moma-llm.")
+                   "scout, scout-noroom, scout-delta0, godhs, esc, bayes-search, moma-llm, "
+                   "unstructured-llm, godhs-llm). Default: all but the LLM planners.")
 @click.option("--houses", default=10, show_default=True,
               help="Number of generated evaluation-split houses (house seeds HOUSE_SEED, +1, "
                    "...); 0 with --house benches the given houses only.")
@@ -35,11 +42,12 @@ from sgtool.datasets.presets import PRESET_NAMES
 @click.option("--seeds", default=5, show_default=True,
               help="Seeds 0..N-1; each draws the start regions and the planners' randomness; "
                    "metrics are reported as mean ± std over seeds.")
-@click.option("--workers", "-w", default=1, show_default=True,
-              help="Worker processes (results do not depend on it).")
+@executor_options("tasks (one house, its planners)")
 @click.option("-o", "--out", "out_dir", default="results", show_default=True,
               type=click.Path(file_okay=False),
-              help="Output folder: episodes.jsonl, summary.md, summary.json, per_house.md, "
+              help="Output folder: episodes.jsonl, summary.md, summary.json (the same bytes "
+                   "on any executor and worker count), run.md, run.json (wall-clock figures "
+                   "and the command), per_house.md, "
                    "per_house.jsonl, per_query.md, per_query.jsonl, efficiency_distance.png, "
                    "efficiency_steps.png.")
 @click.option("--rooms", default="12-16", show_default=True, metavar="MIN-MAX",
@@ -73,12 +81,14 @@ from sgtool.datasets.presets import PRESET_NAMES
                    "step) under LOG_DIR/PLANNER/HOUSE/, readable by `sgtool eval`.")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
+@success_option()
 def command(planners: str | None, houses: int, house_files: tuple[str, ...],
             priors_dir: str | None, episodes: int, seeds: int, workers: int, out_dir: str,
             rooms: str, preset: str, house_seed: int, max_steps: int, distance_budget: float,
             step_budget: float, llm_replay: str | None, llm_transcript: str | None,
             planner_option: tuple[str, ...], log_dir: str | None,
-            progress: bool | None) -> None:
+            progress: bool | None, success: str = "observed", executor: str = "local",
+            ray_address: str | None = None) -> None:
     """Run the symbolic object-search benchmark (SCOUT's SymSearch roll-out) on generated
     evaluation houses and/or house spec files and print a table in the shape of SCOUT's
     Table VII: success rate, SPL, high-level steps, decision time, and MoMa-LLM's AUC-E with
@@ -103,10 +113,14 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...],
                       max_steps=max_steps,
                       workers=workers, distance_budget=distance_budget,
                       step_budget=step_budget, planner_options=options, log_dir=log_dir,
-                      house_files=house_files, priors_dir=priors_dir)
+                      house_files=house_files, priors_dir=priors_dir, success=success,
+                      executor=executor, ray_address=ray_address)
     res = run_benchmark(cfg, progress=progress)
     paths = write_outputs(res, out_dir, command=shlex.join(["sgtool", *sys.argv[1:]]))
     click.echo(res.table)
     click.echo(res.side_by_side)
     click.echo(res.seen_table)
     click.echo(f"wrote {', '.join(str(p) for p in paths)}")
+    if res.failed:  # after the outputs, which list them all
+        raise SgtoolError(f"{len(res.failed)} task(s) failed after a retry, listed in "
+                          f"{out_dir}/summary.md; the first: {res.failed[0]}")

@@ -73,11 +73,17 @@ def _weights_dir() -> Path:
               help="Repetitions of each generation prompt, for diversity.")
 @click.option("--llm-max-queries", type=int, default=None,
               help="Label at most this many generated objects (cost cap).")
+@click.option("--llm-timeout", type=click.FloatRange(1.0, 3600.0), default=30.0,
+              show_default=True, help="Seconds to wait for one LLM answer.")
+@click.option("--llm-slice", default=None, metavar="ROOMS,CATEGORIES,OBJECTS",
+              help="A small generation: at most ROOMS room types, CATEGORIES object "
+                   "categories per room, OBJECTS objects per category [default: 12,8,10].")
 def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, as_json: bool,
             seed: int, holdout: float, epochs_containment: int, epochs_cooccurrence: int,
             keep: str, threads: int, source: str, llm_base_url: str | None, llm_model: str | None,
             llm_api_key: str | None, llm_cache: Path | None, llm_runs: int,
-            llm_max_queries: int | None) -> None:
+            llm_max_queries: int | None, llm_slice: str | None = None,
+            llm_timeout: float = 30.0) -> None:
     """Train the containment and co-occurrence MLPs (SCOUT sec. IV-C) or report on them.
 
     By default the training data come from the training split of the household knowledge
@@ -103,7 +109,9 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
     eval_sets = None
     if source == "llm":
         sets, room_types, fingerprint = _llm_sets(llm_base_url, llm_model, llm_api_key,
-                                                  llm_cache, llm_runs, llm_max_queries)
+                                                  llm_cache, llm_runs, llm_max_queries,
+                                                  _slice(llm_slice), llm_timeout)
+        _report_agreement(sets, training_sets(seed=seed))
     else:
         built = training_sets(seed=seed)
         sets = (built.containment, built.cooccurrence)
@@ -137,7 +145,32 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
         click.echo(f"wrote {target}")
 
 
-def _llm_sets(base_url, model, api_key, cache, runs, max_queries):
+def _slice(text: str | None) -> dict[str, int]:
+    if text is None:
+        return {}
+    try:
+        rooms, cats, objs = (int(x) for x in text.split(","))
+        if min(rooms, cats, objs) < 1:
+            raise ValueError
+    except ValueError:
+        raise SgtoolError(f"--llm-slice {text!r}: give ROOMS,CATEGORIES,OBJECTS, three "
+                          "integers >= 1, e.g. 3,2,3") from None
+    return {"max_rooms": rooms, "max_categories": cats, "max_objects": objs}
+
+
+def _report_agreement(sets, reference) -> None:
+    """How the LLM's labels agree with the BEHAVIOR-1K knowledge (stderr)."""
+    from sgtool.semantics.llm_knowledge import agreement
+
+    for llm, ref in zip(sets, (reference.containment, reference.cooccurrence), strict=True):
+        a = agreement(llm, ref)
+        rate = "-" if a.common == 0 else f"{100 * a.rate:.1f}%"
+        click.echo(f"LLM {a.relation} labels vs BEHAVIOR-1K: {a.common} of {a.llm_pairs} "
+                   f"pairs in both, agreement {rate} ({a.agree}/{a.common})", err=True)
+
+
+def _llm_sets(base_url, model, api_key, cache, runs, max_queries, slice_kw=None,
+              timeout_s=30.0):
     from sgtool.llm.client import LlmSettings, OpenAIChatClient
     from sgtool.semantics.cache import cache_root
     from sgtool.semantics.llm_knowledge import (
@@ -148,14 +181,15 @@ def _llm_sets(base_url, model, api_key, cache, runs, max_queries):
 
     cache = cache or (cache_root() / "llm-knowledge")
     try:
-        client = OpenAIChatClient(LlmSettings.resolve(base_url, model, api_key))
+        client = OpenAIChatClient(LlmSettings.resolve(base_url, model, api_key,
+                                                      timeout_s=timeout_s))
     except SgtoolError:
         if not (cache / "exchanges.jsonl").is_file():
             raise
         client = None  # a complete cache replays the generation offline
     asker = CachedAsker(client, cache)
     cont, cooc, rooms = generate_sets(
-        asker, GenerationConfig(runs=runs, max_queries=max_queries),
+        asker, GenerationConfig(runs=runs, max_queries=max_queries, **(slice_kw or {})),
         progress=sys.stderr.isatty())
     st = asker.stats
     click.echo(f"LLM knowledge: {len(rooms)} rooms, {len(cont.queries)} objects labelled; "

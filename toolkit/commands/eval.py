@@ -4,25 +4,30 @@
 from __future__ import annotations
 
 import json
+import sys
 from dataclasses import asdict
 from typing import Any
 
 import click
 
 from sgtool.canonical import strict_json
+from sgtool.commands.options import executor_options, success_option
 from sgtool.errors import SgtoolError
 
 
 @click.command("eval")
-@click.argument("inputs", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.argument("inputs", nargs=-1, required=True, type=click.Path())
 @click.option("-p", "--planner", "planners", multiple=True, metavar="NAME[,NAME]",
               help="Also ask these planners at every logged decision point (MCAP logs with "
                    "scene graphs) and compare their choices with what was done (repeatable "
                    "or comma-separated).")
 @click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
               help="Planner option, e.g. scout.delta=0.2 (repeatable).")
-@click.option("--llm-replay", type=click.Path(dir_okay=False), default=None,
-              help="moma-llm: answer from this JSONL transcript instead of an endpoint.")
+@click.option("--llm-replay", type=click.Path(dir_okay=False), multiple=True,
+              help="moma-llm: answer from this transcript (JSONL, or an MCAP log's "
+                   "/sgtool/llm channel; repeatable) instead of an endpoint [default: the "
+                   "exchanges of the MCAP inputs, when they have any].")
+@success_option(recorded=True)
 @click.option("--distance-budget", default=5000.0, show_default=True,
               help="AUC-E distance variant budget max (low-level steps: 0.1 m = 1, open = 30).")
 @click.option("--step-budget", default=50.0, show_default=True,
@@ -30,9 +35,14 @@ from sgtool.errors import SgtoolError
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of tables.")
 @click.option("-o", "--out", type=click.Path(dir_okay=False), default=None,
               help="Also write the output to this file (JSON if it ends in .json).")
+@executor_options("file reads (one per input)")
+@click.option("--progress/--no-progress", default=None,
+              help="Progress bar on stderr (default: when stderr is a terminal).")
 def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: tuple[str, ...],
-            llm_replay: str | None, distance_budget: float, step_budget: float, as_json: bool,
-            out: str | None) -> None:
+            llm_replay: tuple[str, ...], distance_budget: float, step_budget: float,
+            as_json: bool, out: str | None, success: str | None = None,
+            executor: str = "local", workers: int = 1, ray_address: str | None = None,
+            progress: bool | None = None) -> None:
     """Recompute the benchmark metrics (SR, SPL, steps, decision time, AUC-E with both
     budgets, seen/unseen) from recorded episodes: MCAP logs of closed-loop runs (their
     sgtool.Episode and sgtool.Action records) and/or episodes.jsonl files written by
@@ -46,15 +56,27 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
     one-line note on stderr names the file, the episode and the field (the JSON output
     lists the notes too). A shortest_m of 0 is accepted: the target is seen from the
     start."""
+    from sgtool.analysis.batch_eval import load_many
+    from sgtool.analysis.batch_inputs import expand_inputs
+    from sgtool.analysis.executor import make_executor
     from sgtool.analysis.metrics import cost_models, seen_unseen, summarize
-    from sgtool.analysis.offline import format_offline, load_results, replay_decisions
+    from sgtool.analysis.offline import (
+        format_offline,
+        log_exchanges,
+        replay_decisions,
+        with_success_rule,
+    )
     from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
     from sgtool.commands.options import planner_options
     from sgtool.files import atomic_write
+    from sgtool.llm.stats import answer_stats, format_stats
     from sgtool.planning.registry import make_planner
 
-    notes: list[str] = []
-    results, logged = load_results(inputs, notes)
+    runner = make_executor(executor, workers, ray_address)
+    inputs = tuple(map(str, expand_inputs(inputs, (".mcap",), "MCAP logs")))
+    show = progress if progress is not None else sys.stderr.isatty()
+    results, logged, notes, unread = load_many(inputs, runner, progress=show)
+    results = [with_success_rule(r, success) for r in results]
     for note in notes:
         click.echo(f"sgtool: note: {note}", err=True)
     if not results:
@@ -64,8 +86,10 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
     sums = summarize(results, models)
     names = [n.strip() for item in planners for n in item.split(",") if n.strip()]
     options = planner_options(planner_option)
-    if llm_replay:
-        options.setdefault("moma-llm", {})["replay"] = llm_replay
+    exchanges = log_exchanges(inputs)
+    replay = list(llm_replay) or sorted({src for src, _ in exchanges})
+    if replay and "moma-llm" in names:
+        options.setdefault("moma-llm", {}).setdefault("replay", replay)
     if names and not any(d.graph is not None for e in logged for d in e.decisions):
         raise SgtoolError("--planner needs MCAP logs with sgtool.SceneGraph records; "
                           "the inputs have none")
@@ -85,6 +109,8 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
                                     "decision_s": r.mean_decision_s()}
                         for r in reports},
         }
+        if exchanges:
+            doc["llm_answers"] = answer_stats(exchanges).as_dict()
         text = json.dumps(strict_json(doc), indent=1, sort_keys=True, allow_nan=False) + "\n"
     else:
         parts = [format_table(sums, models=models,
@@ -94,7 +120,12 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
             parts.append(format_seen_unseen(seen_unseen(results), title="Seen vs unseen queries"))
         if reports:
             parts.append(format_offline(reports))
+        if exchanges:
+            parts.append(format_stats(answer_stats(exchanges), "the logs") + "\n")
         text = "\n".join(parts)
     if out:
         atomic_write(out, text)
     click.echo(text, nl=False)
+    if unread:  # after the output, whose notes name each
+        raise SgtoolError(f"{len(unread)} of {len(inputs)} input(s) could not be read and are "
+                          f"left out of the metrics; the first: {unread[0]}")

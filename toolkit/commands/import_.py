@@ -57,6 +57,9 @@ def _print_report(report, as_json: bool) -> None:  # type: ignore[no-untyped-def
             "odometry_failure_reasons": dict(report.odometry_reasons)
             if report.odometry_failures is not None else None,
             "notes": list(report.notes),
+            "sources": {name: {"value": value, "origin": origin}
+                        for name, value, origin in report.sources},
+            "warnings": list(report.warnings),
         }
         click.echo(json.dumps(d, indent=2, sort_keys=True))
     else:
@@ -64,7 +67,18 @@ def _print_report(report, as_json: bool) -> None:  # type: ignore[no-untyped-def
             click.echo(line)
 
 
+def _warn(text: str) -> None:
+    """A warning of the import, shown on stderr as soon as it is found."""
+    click.echo(f"sgtool: warning: {text}", err=True)
+
+
 def _world_options(f):  # type: ignore[no-untyped-def]
+    f = click.option(
+        "--camera-height", default="0.45:2.2", show_default=True,
+        help="MIN:MAX metres: the band of plausible camera heights above the floor. An "
+        "estimated floor that puts the camera outside it is an error (the floor was not in "
+        "view: give --floor); a given --floor outside it, a warning.",
+    )(f)
     f = click.option(
         "--floor", default="auto", show_default=True,
         help="Floor height in the source world along the up direction: 'auto' (1st "
@@ -141,6 +155,10 @@ def command() -> None:
 @click.option("--pose", help="Pose topic (PoseStamped, PoseWithCovarianceStamped, "
               "TransformStamped, Odometry) giving the camera's optical frame in the world, "
               "instead of tf.")
+@click.option("--timestamps", type=click.Choice(["header", "bag"]), default="header",
+              show_default=True,
+              help="Image times: the header stamps (checked: distinct, a camera's rate), or the "
+              "times the bag recorded the messages.")
 @click.option("--tf-tolerance", type=float, default=0.05, show_default=True,
               help="How far (s) before/after a transform's samples a pose may be taken.")
 @_odometry_options(
@@ -154,9 +172,10 @@ def command() -> None:
 @_world_options
 @_common_options
 def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: str | None,
-        tf_frames: str | None, pose: str | None, tf_tolerance: float, estimate_poses: bool,
+        tf_frames: str | None, pose: str | None, timestamps: str, tf_tolerance: float,
+        estimate_poses: bool,
         odometry: str, depth_max: float, list_only: bool,
-        up: str, floor: str, output: str | None, intrinsics: str | None,
+        up: str, floor: str, camera_height: str, output: str | None, intrinsics: str | None,
         depth_scale: float | None, max_dt: float, every: int, limit: int | None,
         compression: str, force: bool, as_json: bool, quiet: bool) -> None:
     """Import a ROS 1 .bag, a ROS 2 bag folder (sqlite3 or MCAP) or a bare ROS 2 .mcap/.db3
@@ -174,6 +193,7 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
     """
     from sgtool.recorders.importers.bag import BagOptions, check_options, describe_bag, import_bag
     from sgtool.recorders.importers.bagfiles import open_bag
+    from sgtool.recorders.importers.checks import parse_height_band
     from sgtool.recorders.importers.textformats import parse_intrinsics
     from sgtool.recorders.importers.upright import parse_up
 
@@ -195,7 +215,8 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
         tf_tolerance_ns=int(tf_tolerance * 1e9), up=parse_up(up), floor=fl,
         floor_auto=floor_auto, every=every, limit=limit, progress=not quiet,
         compression=compression, estimate_poses=estimate_poses, odometry=odometry,
-        depth_max=depth_max,
+        depth_max=depth_max, camera_height=parse_height_band(camera_height), warn=_warn,
+        timestamps=timestamps,
     )
     check_options(opts)
     if not (depth or tf_frames or pose):
@@ -216,7 +237,16 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
               "(frame-XXXXXX.color/depth/pose), Open3D/Redwood (color|image/, depth/, "
               "*.log, intrinsics JSON).")
 @click.option("--fps", type=float, default=30.0, show_default=True,
-              help="Frame rate for layouts without time stamps (7-Scenes frame n is at n/fps).")
+              help="Frame rate for layouts without time stamps (7-Scenes frame n is at n/fps) "
+              "and for --timestamps index.")
+@click.option("--timestamps", type=click.Choice(["file", "index"]), default="file",
+              show_default=True,
+              help="TUM time stamps: 'file' takes rgb.txt/depth.txt's (checked: increasing, "
+              "distinct, a camera's rate), 'index' puts frame n at n/--fps in the listed "
+              "order and pairs colour n with depth n (the ground truth is then not used).")
+@click.option("--skip-missing", is_flag=True,
+              help="Import the frames whose files exist when rgb.txt/depth.txt list missing "
+              "ones (without it, missing files are an error before anything is read).")
 @click.option("--trajectory", type=click.Path(dir_okay=False, exists=True),
               help="Poses to use instead of the dataset's: an Open3D .log or a TUM file.")
 @_odometry_options(
@@ -228,8 +258,10 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
     depth_max_help="Depth beyond this (m) is ignored by the odometry (not by the import).")
 @_world_options
 @_common_options
-def rgbd(folder: str, layout: str, fps: float, trajectory: str | None, estimate_poses: bool,
-         odometry: str, depth_max: float, up: str, floor: str, output: str | None,
+def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bool,
+         trajectory: str | None, estimate_poses: bool,
+         odometry: str, depth_max: float, up: str, floor: str, camera_height: str,
+         output: str | None,
          intrinsics: str | None, depth_scale: float | None, max_dt: float, every: int,
          limit: int | None, compression: str, force: bool, as_json: bool,
          quiet: bool) -> None:
@@ -243,6 +275,7 @@ def rgbd(folder: str, layout: str, fps: float, trajectory: str | None, estimate_
       sgtool import rgbd rgbd_dataset_freiburg1_xyz -o fr1_xyz.mcap
       sgtool import rgbd 7scenes/redkitchen/seq-01 -o kitchen.mcap --estimate-poses
     """
+    from sgtool.recorders.importers.checks import parse_height_band
     from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
     from sgtool.recorders.importers.textformats import parse_intrinsics
     from sgtool.recorders.importers.upright import parse_up
@@ -255,6 +288,7 @@ def rgbd(folder: str, layout: str, fps: float, trajectory: str | None, estimate_
         trajectory=Path(trajectory) if trajectory else None, estimate_poses=estimate_poses,
         odometry=odometry, depth_max=depth_max, up=parse_up(up), floor=fl,
         floor_auto=floor_auto, every=every, limit=limit, max_dt_ns=int(max_dt * 1e9),
-        progress=not quiet, compression=compression,
+        progress=not quiet, compression=compression, timestamps=timestamps,
+        skip_missing=skip_missing, camera_height=parse_height_band(camera_height), warn=_warn,
     )
     _print_report(import_rgbd(folder, out, opts), as_json)

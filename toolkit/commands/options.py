@@ -142,3 +142,35 @@ def key_value_options(items: tuple[str, ...]) -> dict[str, Any]:
             raise SgtoolError(f"-O {item!r}: expected KEY=VALUE, e.g. -O delta=0.2")
         out[key.strip()] = parse_value(value.strip())
     return out
+
+
+def success_option(recorded: bool = False) -> Callable[[F], F]:
+    """``--success observed|done``: the success rule of an episode
+    (:func:`sgtool.planning.episode.search_success`); ``recorded``: no default (judge
+    recorded episodes as they were recorded)."""
+    return click.option(
+        "--success", type=click.Choice(["observed", "done"]),
+        default=None if recorded else "observed", show_default=not recorded,
+        help="Success rule: 'observed' (SymSearch: the target comes into view) or 'done' "
+             "(MoMa-LLM: the planner must then call done() on it; a wrong done() fails)"
+             + (" [default: as recorded]." if recorded else "."))
+
+
+def executor_options(what: str) -> Callable[[F], F]:
+    """``--executor local|ray``, ``--workers/-w N`` and ``--ray-address`` of the batch
+    commands (:func:`sgtool.analysis.executor.make_executor`); ``what`` names the tasks."""
+    return option_group([
+        click.option("--executor", type=click.Choice(["local", "ray"]), default="local",
+                     show_default=True,
+                     help=f"Where the {what} run: 'local' (this machine: -w worker "
+                     "processes) or 'ray' (a Ray cluster at --ray-address or RAY_ADDRESS, "
+                     "else a local Ray instance with -w CPUs; needs "
+                     "pip install 'sgtool[ray]'). The results do not depend on it."),
+        click.option("--workers", "-w", default=1, show_default=True,
+                     help="Worker processes (local), or CPUs of a local Ray instance "
+                     "(results do not depend on it)."),
+        click.option("--ray-address", default=None, metavar="HOST:PORT",
+                     help="Ray cluster to use with --executor ray (the head's address, "
+                     "as `ray start --head` prints it) [default: RAY_ADDRESS, else a local "
+                     "Ray instance]."),
+    ])

@@ -63,6 +63,11 @@ def _pair(option: str, text: str) -> tuple[float, float]:
               help="Index of the house's start pose (one per room in generated houses).")
 @click.option("--no-open-containers", is_flag=True,
               help="Do not open closed containers on the way (doors are still opened).")
+@click.option("--explore", type=click.Choice(["script", "frontier"]), default="script",
+              show_default=True,
+              help="script: the scripted tour of every room (it knows the house); frontier: "
+              "frontier exploration on the robot's own map, opening closed doors it sees "
+              "when no frontier is left; reports the share of the floor seen over time.")
 @click.option("--compression", type=click.Choice(["zstd", "lz4", "none"]), default="zstd",
               show_default=True, help="MCAP chunk compression.")
 @click.option("--force", is_flag=True, help="Overwrite the output log.")
@@ -70,8 +75,8 @@ def _pair(option: str, text: str) -> tuple[float, float]:
 def command(house_path: str | None, seed: int | None, rooms: str, output: str,
             frames: int | None, fps: float, noise: str, noise_seed: int, resolution: str,
             fov: float, depth_range: str, camera_height: float, tilt: float, speed: float,
-            start: int, no_open_containers: bool, compression: str, force: bool,
-            quiet: bool) -> None:
+            start: int, no_open_containers: bool, explore: str, compression: str,
+            force: bool, quiet: bool) -> None:
     """Record a robot exploring a house in PyBullet: RGB-D, instance ids, poses, the
     instances table with open/closed states, every action, to an MCAP log.
 
@@ -113,7 +118,7 @@ def command(house_path: str | None, seed: int | None, rooms: str, output: str,
     opts = RecordOptions(fps=fps, frames=frames, camera=camera, robot=robot, noise=profile,
                          seed=noise_seed, start=start,
                          script=ScriptOptions(open_containers=not no_open_containers),
-                         compression=compression)
+                         compression=compression, explore=explore)
     from tqdm import tqdm
 
     bar = tqdm(total=frames, unit="frame", desc="record", file=sys.stderr, leave=False,

@@ -14,11 +14,12 @@ from typing import Any
 
 import click
 
+from sgtool.commands.options import executor_options
 from sgtool.errors import SgtoolError
 
 
 @click.command("replay")
-@click.argument("log", type=click.Path(dir_okay=False))
+@click.argument("logs", metavar="LOG...", nargs=-1, required=True, type=click.Path())
 @click.option("-o", "--output", type=click.Path(dir_okay=False),
               help="Derived log to write: a copy of LOG's messages plus /map/occupancy, "
               "/map/voronoi, /map/rooms and /sgtool/scene_graph at every refresh. Without "
@@ -45,12 +46,21 @@ from sgtool.errors import SgtoolError
               "category accuracy, strict and with open-plan rooms merged.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of text.")
 @click.option("--force", is_flag=True, help="Overwrite the output files.")
+@click.option("--verify", is_flag=True,
+              help="Check every chunk CRC of LOG as it is read (slower; `sgtool doctor LOG` "
+              "checks a whole log without replaying it).")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
-def command(log: str, output: str | None, every: int | None, classifier: str | None,
-            min_points: int | None, voxel_size: float | None, max_frames: int | None,
-            rrd: str | None, score: bool, as_json: bool, force: bool,
-            progress: bool | None) -> None:
+@click.option("--out-dir", type=click.Path(file_okay=False), default=None,
+              help="Replay many logs (files, folders of *.mcap, quoted glob patterns) into "
+              "this folder, one DIR/NAME.mcap per LOG, byte-identical to one-by-one "
+              "replays; outputs that are complete already are kept unless --force.")
+@executor_options("replays (one per log, with --out-dir)")
+def command(logs: tuple[str, ...], output: str | None, every: int | None,
+            classifier: str | None, min_points: int | None, voxel_size: float | None,
+            max_frames: int | None, rrd: str | None, score: bool, as_json: bool, force: bool,
+            progress: bool | None, out_dir: str | None = None, executor: str = "local",
+            workers: int = 1, ray_address: str | None = None, verify: bool = False) -> None:
     """Replay LOG into a semantic voxel map, BEV occupancy, a Voronoi graph, rooms, objects,
     frontiers and the hierarchical scene graph, deterministically: the same log and options
     give a byte-identical output.
@@ -58,6 +68,11 @@ def command(log: str, output: str | None, every: int | None, classifier: str | N
     The graph refreshes every K frames and at every logged action; a closed door or
     container that opens drops its old voxels. Logs without instance ids (imported real
     data) give geometry only. Example: `sgtool replay run.mcap -o derived.mcap --score`.
+
+    Many logs: `sgtool replay 'runs/*.mcap' --out-dir derived/ [-w N | --executor ray]`
+    writes derived/NAME.mcap per log (the bytes a one-by-one replay writes), keeps those
+    already complete with these options (--force redoes them), lists a log that fails
+    twice with its error and exits 2 after the others are written.
 
     Inconsistent sensor data is refused (exit 2, one error naming the channel, the log
     time and the field), never guessed at: a transform that is not finite or whose
@@ -74,7 +89,22 @@ def command(log: str, output: str | None, every: int | None, classifier: str | N
     from sgtool.log import LogReader
     from sgtool.replayers.derived_log import ReplayOptions, replay
 
-    src = Path(log)
+    if out_dir is not None or len(logs) > 1 or Path(logs[0]).is_dir():
+        if out_dir is None:
+            raise SgtoolError("several logs (or a folder) replay into a folder: give "
+                              "--out-dir DIR")
+        for given, opt in ((output, "-o"), (rrd, "--rrd"), (score, "--score")):
+            if given:
+                raise SgtoolError(f"{opt} takes one log; leave it out with --out-dir")
+        _batch(logs, Path(out_dir), ReplayOptions(
+            every=every, classifier=classifier, min_points=min_points, voxel_size=voxel_size,
+            max_frames=max_frames), force=force, as_json=as_json, progress=progress,
+            executor=executor, workers=workers, ray_address=ray_address, verify=verify)
+        return
+    if executor != "local" or workers != 1 or ray_address:
+        raise SgtoolError("--executor, --workers and --ray-address run many logs: give "
+                          "--out-dir DIR")
+    src = Path(logs[0])
     dst = Path(output) if output else None
     if not src.exists():
         raise SgtoolError(f"{src}: no such file")
@@ -93,6 +123,10 @@ def command(log: str, output: str | None, every: int | None, classifier: str | N
         raise SgtoolError(f"-o {dst}: the output is an MCAP log; name it *.mcap")
     if voxel_size is not None and not 0.01 <= voxel_size <= 0.5:
         raise SgtoolError(f"--voxel-size {voxel_size}: must be 0.01..0.5 m")
+    from sgtool.log.inspect import foreign_log_problem
+
+    if (foreign := foreign_log_problem(src)) is not None:
+        raise SgtoolError(foreign)
     with LogReader(src) as r:
         total = r.frame_count() if r.has("/camera/depth") else 0
         house = r.house_json() if score else None
@@ -111,7 +145,8 @@ def command(log: str, output: str | None, every: int | None, classifier: str | N
                          voxel_size=voxel_size, max_frames=max_frames)
     with tqdm(total=total, unit="frame", desc="replay", file=sys.stderr, leave=False,
               disable=not show, dynamic_ncols=True) as bar:
-        report = replay(src, dst, opts, on_refresh=keep if score else None, progress=bar)
+        report = replay(src, dst, opts, on_refresh=keep if score else None, progress=bar,
+                        verify=verify)
     scores = None
     if score:
         scores = _score(house, final)  # type: ignore[arg-type]
@@ -129,6 +164,35 @@ def command(log: str, output: str | None, every: int | None, classifier: str | N
             click.echo(line)
     if rrd:
         click.echo(f"wrote {rrd}; open it with: rerun {rrd}")
+
+
+def _batch(logs: tuple[str, ...], out_dir: Path, opts: Any, *, force: bool, as_json: bool,
+           progress: bool | None, executor: str, workers: int,
+           ray_address: str | None, verify: bool = False) -> None:
+    """``--out-dir``: every log replayed on the executor (sgtool.analysis.batch_replay)."""
+    from dataclasses import asdict
+
+    from sgtool.analysis.batch_inputs import expand_inputs
+    from sgtool.analysis.batch_replay import out_folder, plan_jobs, replay_many
+    from sgtool.analysis.executor import make_executor
+
+    if opts.voxel_size is not None and not 0.01 <= opts.voxel_size <= 0.5:
+        raise SgtoolError(f"--voxel-size {opts.voxel_size}: must be 0.01..0.5 m")
+    runner = make_executor(executor, workers, ray_address)
+    inputs = expand_inputs(logs, (".mcap",))
+    jobs = plan_jobs(inputs, out_folder(out_dir), opts, verify=verify)
+    show = progress if progress is not None else sys.stderr.isatty()
+    report = replay_many(jobs, runner, force=force, progress=show)
+    if as_json:
+        click.echo(json.dumps({"logs": [asdict(r) for r in report.logs],
+                               "seconds": report.seconds}, sort_keys=True))
+    else:
+        for line in report.lines():
+            click.echo(line)
+    failed = [r for r in report.logs if r.status == "failed"]
+    if failed:
+        raise SgtoolError(f"{len(failed)} of {len(report.logs)} log(s) failed to replay "
+                          f"(after a retry); the first: {failed[0].input}: {failed[0].error}")
 
 
 def _score(house: str, final: dict[str, Any]) -> Any:

@@ -47,6 +47,17 @@ from sgtool.errors import SgtoolError
 @click.option("--min-points", type=click.IntRange(min=1), default=None,
               help="Points an instance needs in one frame to count as seen. Default: "
               "MoMa-LLM's 50 at 320x240 scaled by the image size.")
+@click.option("--navigation", type=click.Choice(["live", "house"]), default="live",
+              show_default=True,
+              help="live: the robot plans every motion on its own map (unknown space is not "
+              "driven through; a goal the map cannot reach fails with the reason); house: "
+              "the simulator plans on the house's ground truth (the privileged behaviour "
+              "before, for comparison).")
+@click.option("--optimistic", type=float, default=0.25, show_default=True, metavar="M",
+              help="live navigation: how far (m) past known free floor a path may run into "
+              "unknown space (at frontiers).")
+@click.option("--noise", default="none", show_default=True,
+              help="Sensor faults, as `sgtool record --noise` (none, mild, strong, overrides).")
 @click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="KEY=VALUE",
               help="Planner option, e.g. -O delta=0.2 (scout), -O model=gpt-4o-mini "
               "-O base_url=http://localhost:8000/v1 (moma-llm); repeatable. See "
@@ -63,8 +74,9 @@ from sgtool.errors import SgtoolError
 def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
             query: str | None, episode: int | None, max_steps: int, frames: int | None,
             resolution: str, fps: float, every: int, classifier: str, min_points: int | None,
-            planner_option: tuple[str, ...], planner_seed: int, llm_replay: str | None,
-            llm_transcript: str | None, output: str, force: bool, quiet: bool) -> None:
+            navigation: str, optimistic: float, noise: str, planner_option: tuple[str, ...],
+            planner_seed: int, llm_replay: str | None, llm_transcript: str | None, output: str,
+            force: bool, quiet: bool) -> None:
     """Search a house for an object in closed loop: PyBullet renders the camera, the scene
     graph is built live from the frames (the same refresh schedule as `sgtool replay`:
     every K frames and at every action), the planner chooses an action on it, the
@@ -85,8 +97,9 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
     Example: `sgtool run --planner scout --query bowl -o bowl.mcap`.
     """
     from sgtool.commands.options import house_from_options, parse_resolution
-    from sgtool.recorders.sim import CameraConfig
+    from sgtool.recorders.sim import CameraConfig, parse_noise
     from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
+    from sgtool.recorders.sim.live_skills import LiveNavConfig
 
     out = Path(output)
     if out.suffix != ".mcap":
@@ -122,7 +135,8 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
     index, ep = pick_episode(house, query=query, index=episode)
     opts = ClosedLoopOptions(fps=fps, camera=camera, every=every, classifier=classifier,
                              min_points=min_points, max_steps=max_steps, frames=frames,
-                             planner_seed=planner_seed)
+                             planner_seed=planner_seed, navigation=navigation,
+                             noise=parse_noise(noise), live=LiveNavConfig(optimistic=optimistic))
     from tqdm import tqdm
 
     bar = tqdm(total=frames, unit="frame", desc=f"run {name}", file=sys.stderr, leave=False,

@@ -29,7 +29,12 @@ def command(log: str, out: str | None, every: int, max_frames: int | None,
     the output of `sgtool replay`.
 
     Without -o the Rerun viewer is spawned (it needs a display); with -o the recording is
-    written to a file that `rerun view.rrd` opens later (`rerun rrd verify` checks it)."""
+    written to a file that `rerun view.rrd` opens later (`rerun rrd verify` checks it).
+
+    Opening a derived .mcap directly in Rerun (its own MCAP import) or in ROS tools does
+    not show the maps: they do not read foxglove.Grid/SceneUpdate. This command draws them;
+    for ROS tools, `sgtool export bag DERIVED.mcap -o OUT` writes them as
+    nav_msgs/OccupancyGrid and visualization_msgs/MarkerArray."""
     from tqdm import tqdm
 
     from sgtool.analysis.rerun_view import export

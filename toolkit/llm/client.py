@@ -37,6 +37,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from sgtool.errors import SgtoolError
+from sgtool.llm.constraints import Constraint
 from sgtool.llm.exchange import Message
 from sgtool.redact import redact_text
 
@@ -75,12 +76,17 @@ class ChatClient(Protocol):
     def complete(self, messages: list[Message]) -> ChatResult: ...
 
 
-def complete_within(client: ChatClient, messages: list[Message], timeout_s: float) -> ChatResult:
+def complete_within(client: ChatClient, messages: list[Message], timeout_s: float,
+                    constraint: Constraint | None = None) -> ChatResult:
     """``client.complete(messages)``, bounded by ``timeout_s`` when the client takes a
-    per-request timeout (``takes_timeout``); other clients (a replay) answer at once."""
+    per-request timeout (``takes_timeout``) and constrained by ``constraint`` when it takes
+    one (``takes_constraint``); other clients (a replay) answer at once, as recorded."""
+    kw: dict[str, Any] = {}
     if getattr(client, "takes_timeout", False):
-        return client.complete(messages, timeout_s=timeout_s)  # type: ignore[call-arg]
-    return client.complete(messages)
+        kw["timeout_s"] = timeout_s
+    if constraint is not None and getattr(client, "takes_constraint", False):
+        kw["constraint"] = constraint
+    return client.complete(messages, **kw)  # type: ignore[call-arg]
 
 
 def cut_reply(text: str, limit: int = MAX_REPLY_CHARS) -> tuple[str, int | None]:
@@ -135,6 +141,7 @@ class OpenAIChatClient:
 
     source = "endpoint"
     takes_timeout = True
+    takes_constraint = True
 
     def __init__(self, settings: LlmSettings) -> None:
         from openai import OpenAI
@@ -156,8 +163,10 @@ class OpenAIChatClient:
     def _short(self, e: BaseException) -> str:
         return redact_text(_short(e), [self.settings.api_key])
 
-    def complete(self, messages: list[Message], timeout_s: float | None = None) -> ChatResult:
-        """One request; ``timeout_s`` (at most the settings' timeout) bounds this one."""
+    def complete(self, messages: list[Message], timeout_s: float | None = None,
+                 constraint: Constraint | None = None) -> ChatResult:
+        """One request; ``timeout_s`` (at most the settings' timeout) bounds this one;
+        ``constraint`` (:mod:`sgtool.llm.constraints`) restricts the answer."""
         import openai
 
         timeout = self.settings.timeout_s if timeout_s is None \
@@ -167,6 +176,8 @@ class OpenAIChatClient:
             kwargs["temperature"] = self.settings.temperature
         if self.settings.max_tokens is not None:
             kwargs["max_tokens"] = self.settings.max_tokens
+        if constraint is not None:
+            kwargs.update(constraint.request_fields())
         t0 = time.perf_counter()
         try:
             resp = self._client.chat.completions.create(**kwargs)

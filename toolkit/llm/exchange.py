@@ -41,13 +41,18 @@ def exchange_record(
     query: str | None = None,
     source: str = "endpoint",
     truncated_from: int | None = None,
+    extra: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """A JSON-serialisable ``sgtool.LlmExchange`` record.
 
     ``attempt`` counts retries within one decision (0 = first try); ``step`` is the decision
     number within the episode; ``source`` is ``endpoint`` or ``replay``;
-    ``truncated_from`` the length of a reply that was cut to ``response``.
+    ``truncated_from`` the length of a reply that was cut to ``response``; ``extra``
+    adds fields beyond the schema (the planner's ``constraint`` and ``verdict``).
     """
+    unknown = dict(extra or {})
+    if truncated_from is not None:
+        unknown["response_truncated_from"] = int(truncated_from)
     return LlmExchange(
         model=str(model),
         messages=tuple({"role": m["role"], "content": m["content"]} for m in messages),
@@ -61,5 +66,5 @@ def exchange_record(
         step=step,
         query=query,
         source=source,
-        unknown={} if truncated_from is None else {"response_truncated_from": int(truncated_from)},
+        unknown=unknown,
     ).to_json()

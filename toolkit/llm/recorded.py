@@ -6,7 +6,8 @@ the identical prompt (matched by ``prompt_sha256``; several answers to one promp
 in recorded order), including recorded faults, which are raised again. A deterministic
 planner fed the same scene graphs therefore makes the same decisions without any endpoint.
 A prompt the transcript does not hold raises :class:`ReplayMiss`, which the planner turns
-into a clear failure instead of a guess.
+into a clear failure instead of a guess. An MCAP log with an ``/sgtool/llm`` channel is a
+transcript too, and several transcripts can be served as one (the logs of a bench run).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import logging
 import os
 import time
 from collections import deque
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -98,10 +100,18 @@ class TranscriptWriter:
             self.abort()
 
 
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
 def read_transcript(path: str | Path) -> list[dict[str, Any]]:
+    """The exchange records of a JSONL transcript, or of the ``/sgtool/llm`` channel of an
+    MCAP log (a closed-loop log, a bench ``--log-dir`` log), in recorded order."""
     path = Path(path)
     if not path.is_file():
         raise TranscriptError(f"LLM transcript not found: {path}")
+    with open(path, "rb") as fh:
+        if fh.read(len(MCAP_MAGIC)) == MCAP_MAGIC:
+            return _log_exchanges(path)
     out = []
     with open(path, encoding="utf-8") as fh:
         lines = fh.readlines()
@@ -125,14 +135,27 @@ def read_transcript(path: str | Path) -> list[dict[str, Any]]:
     return out
 
 
+def _log_exchanges(path: Path) -> list[dict[str, Any]]:
+    from sgtool.log.reader import LogReader
+
+    with LogReader(path) as log:
+        out = [rec.to_json() for _, rec in log.records(LlmExchange)]
+    for rec in out:
+        rec.setdefault("prompt_sha256", prompt_key(rec["messages"]))
+    return out
+
+
 class ReplayChatClient:
-    """Serves recorded responses by prompt; see the module doc."""
+    """Serves recorded responses by prompt; see the module doc. ``path`` is one transcript
+    (JSONL or MCAP log) or several, read in the order given."""
 
     source = "replay"
 
-    def __init__(self, path: str | Path, model: str | None = None) -> None:
-        self.path = Path(path)
-        records = read_transcript(self.path)
+    def __init__(self, path: str | Path | Sequence[str | Path], model: str | None = None
+                 ) -> None:
+        paths = [Path(path)] if isinstance(path, str | Path) else [Path(p) for p in path]
+        self.path = paths[0] if len(paths) == 1 else Path(f"{paths[0]} (+{len(paths) - 1})")
+        records = [rec for p in paths for rec in read_transcript(p)]
         self.model = model or (records[0]["model"] if records else "replay")
         self._queues: dict[str, deque[dict[str, Any]]] = {}
         for rec in records:

@@ -9,6 +9,7 @@ from the ``/tf`` transforms (world -> ... -> camera) in force at that time. The 
 
 from __future__ import annotations
 
+import bisect
 from collections.abc import Callable
 from typing import Any, TypeVar
 
@@ -35,7 +36,7 @@ class TransformBuffer:
         times = self._times.setdefault(child, [])
         vals = self._values.setdefault(child, [])
         if times and t_ns < times[-1]:
-            i = int(np.searchsorted(times, t_ns, side="right"))
+            i = bisect.bisect_right(times, t_ns)
             times.insert(i, t_ns)
             vals.insert(i, T)
         else:
@@ -44,18 +45,19 @@ class TransformBuffer:
 
     def lookup(self, t_ns: int, target: str, root: str = S.WORLD_FRAME) -> np.ndarray | None:
         """root_T_target at ``t_ns``, or None when the chain is not known yet."""
-        T = np.eye(4)  # noqa: N806
+        T = None  # noqa: N806 - the identity until the first link
         frame = target
         for _ in range(32):
             if frame == root:
-                return T
+                return np.eye(4) if T is None else T
             if frame not in self._parent:
                 return None
             times = self._times[frame]
-            i = int(np.searchsorted(times, t_ns, side="right")) - 1
+            i = bisect.bisect_right(times, t_ns) - 1
             if i < 0:
                 return None
-            T = self._values[frame][i] @ T  # noqa: N806
+            link = self._values[frame][i]
+            T = link.copy() if T is None else link @ T  # noqa: N806
             frame = self._parent[frame]
         return None
 

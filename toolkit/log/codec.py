@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from foxglove_schemas_protobuf.CameraCalibration_pb2 import CameraCalibration
 from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
@@ -174,15 +176,17 @@ def decode_transform(msg: FrameTransform) -> np.ndarray:
     translation is not finite or the rotation is not a quaternion that can be normalised
     (a zero quaternion is no rotation, not the identity)."""
     t, r = msg.translation, msg.rotation
-    if not np.all(np.isfinite([t.x, t.y, t.z])):
-        raise LogFormatError(f"field translation: ({t.x}, {t.y}, {t.z}) is not finite")
-    q = np.array([r.x, r.y, r.z, r.w])
-    if not np.all(np.isfinite(q)) or not np.linalg.norm(q) > 1e-6:
-        raise LogFormatError(f"field rotation: quaternion ({r.x}, {r.y}, {r.z}, {r.w}) "
+    tx, ty, tz = t.x, t.y, t.z
+    if not (math.isfinite(tx) and math.isfinite(ty) and math.isfinite(tz)):
+        raise LogFormatError(f"field translation: ({tx}, {ty}, {tz}) is not finite")
+    x, y, z, w = r.x, r.y, r.z, r.w
+    if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z) and math.isfinite(w)
+            and math.sqrt(x * x + y * y + z * z + w * w) > 1e-6):
+        raise LogFormatError(f"field rotation: quaternion ({x}, {y}, {z}, {w}) "
                              "cannot be normalised")
     T = np.eye(4)  # noqa: N806
-    T[:3, :3] = matrix_from_quat(r.x, r.y, r.z, r.w)
-    T[:3, 3] = (msg.translation.x, msg.translation.y, msg.translation.z)
+    T[:3, :3] = matrix_from_quat(x, y, z, w)
+    T[0, 3], T[1, 3], T[2, 3] = tx, ty, tz
     return T
 
 

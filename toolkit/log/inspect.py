@@ -3,6 +3,10 @@
 Works on any indexed MCAP file: on a foreign one (a ROS 2 recording) it lists topics,
 schemas and counts; on an sgtool log it adds the log schema version, frame count,
 camera, instances and the episode summary.
+
+:func:`foreign_log_problem` says what a file that is not an sgtool log is (a ROS 1 bag, a
+ROS 2 bag's sqlite3 or MCAP storage, another MCAP recording) and which ``sgtool import``
+command turns it into one, for commands that need an sgtool log (``sgtool replay``).
 """
 
 from __future__ import annotations
@@ -79,6 +83,65 @@ def summarize(path: str | os.PathLike[str]) -> dict[str, Any]:
         out["scene_graphs"] = r.message_count(S.RECORDS["scene_graph"].topic)
         out["episode"] = r.last_record("episode")
         return out
+
+
+ROS_IMAGE_SCHEMAS = ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage",
+                     "sensor_msgs/Image", "sensor_msgs/CompressedImage")
+ROS_POSE_WORDS = ("tf2_msgs", "geometry_msgs", "nav_msgs/msg/Odometry", "nav_msgs/Odometry")
+
+
+def _import_hint(path: Path, channels: list[tuple[str, str]]) -> str:
+    """Which ``sgtool import bag`` command fits a ROS recording with these (topic, schema)
+    channels."""
+    images = [t for t, sch in channels if sch in ROS_IMAGE_SCHEMAS]
+    poses = [t for t, sch in channels if any(w in sch for w in ROS_POSE_WORDS)]
+    listing = f"`sgtool import bag {path} --list` shows its topics and suggests the flags"
+    if images:
+        depth = next((t for t in images if "depth" in t.lower()), "TOPIC")
+        return (f"turn it into one with `sgtool import bag {path} -o OUT.mcap --depth {depth}` "
+                f"({listing})")
+    if poses:
+        return (f"it has no image topic, only poses: `sgtool import bag {path} -o OUT.mcap "
+                f"--tf-frames WORLD:FRAME` (or --pose TOPIC) imports the trajectory ({listing})")
+    return f"it has no image or pose topic sgtool can import ({listing})"
+
+
+def foreign_log_problem(path: str | os.PathLike[str]) -> str | None:
+    """One line saying what ``path`` is when it is a recording but not an sgtool log, and the
+    import command that turns it into one; None for an sgtool log, or for anything else (the
+    log reader's own error says what is wrong)."""
+    p = Path(path)
+    if not p.is_file():
+        return None
+    with open(p, "rb") as f:
+        head = f.read(16)
+    if head.startswith(b"#ROSBAG V2.0"):
+        return (f"{p} is a ROS 1 bag, not an sgtool log; turn it into one with `sgtool import "
+                f"bag {p} -o OUT.mcap` (`sgtool import bag {p} --list` shows its topics and "
+                "suggests the flags)")
+    if head.startswith(b"SQLite format 3\0"):
+        return (f"{p} is an SQLite file (a ROS 2 bag's storage?), not an sgtool log; turn a "
+                f"ROS 2 bag into one with `sgtool import bag {p.parent} -o OUT.mcap` "
+                f"(`--list` shows its topics and suggests the flags)")
+    if not head.startswith(b"\x89MCAP"):
+        return None
+    try:
+        with LogReader(p, check_version=False) as r:
+            if r.is_sgtool:
+                return None
+            profile = r._reader.get_header().profile
+            channels = [(c.topic, c.schema_name) for c in r.channels()]
+            encodings = sorted({c.message_encoding for c in r.channels()})
+    except Exception:  # noqa: BLE001 - damaged files: the reader's own error says it
+        return None
+    what = {"ros2": "a ROS 2 recording (MCAP, profile 'ros2')",
+            "ros1": "a ROS 1 recording (MCAP, profile 'ros1')"}.get(
+        profile, f"an MCAP file with profile {profile or ''!r}")
+    enc = f"{', '.join(encodings) or 'no'} messages on {len(channels)} topics"
+    if profile in ("ros1", "ros2") or encodings in (["cdr"], ["ros1"]):
+        return f"{p} is {what} with {enc}, not an sgtool log; {_import_hint(p, channels)}"
+    return (f"{p} is {what} with {enc}, not an sgtool log (profile 'sgtool'); sgtool imports "
+            "ROS 1/2 bags (`sgtool import bag`) and RGB-D folders (`sgtool import rgbd`)")
 
 
 def format_summary(s: dict[str, Any]) -> str:

@@ -30,6 +30,7 @@ from sgtool.errors import LogFormatError, MissingChannelError, SchemaVersionErro
 from sgtool.log import codec
 from sgtool.log import schemas as S
 from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler, TransformBuffer, decoded
+from sgtool.log.chunk_stream import ordered_messages
 from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.log.records import RECORD_TYPES, LogRecord
 from sgtool.log.summary_check import BoundedReader as _BoundedReader
@@ -80,8 +81,10 @@ class Decoded:
 class LogReader:
     """An open log. Use as a context manager or call :meth:`close`."""
 
-    def __init__(self, path: str | os.PathLike[str], *, check_version: bool = True) -> None:
+    def __init__(self, path: str | os.PathLike[str], *, check_version: bool = True,
+                 verify: bool = False) -> None:
         self.path = Path(path)
+        self.verify = verify
         if not self.path.exists():
             raise LogFormatError(f"{self.path}: no such file")
         if self.path.is_dir():
@@ -104,8 +107,9 @@ class LogReader:
         # reads are clamped to the file: a damaged length cannot allocate gigabytes
         self._f: IO[bytes] = _BoundedReader(io.FileIO(self.path, "rb"), size)
         try:
-            # chunk CRCs are checked as chunks are read: damaged bytes give a clear error
-            self._reader = SeekingReader(self._f, validate_crcs=True)
+            # chunk CRCs are checked as chunks are read when asked (``verify``; `sgtool
+            # doctor` checks them all): damaged bytes give a clear error either way
+            self._reader = SeekingReader(self._f, validate_crcs=verify)
             self._reader.get_header()
             summary = self._reader.get_summary()
         except InvalidMagic as e:
@@ -291,10 +295,8 @@ class LogReader:
     ) -> Iterator[Decoded]:
         """Decoded messages in log-time order, ``start_ns <= t < end_ns``."""
         topics = list(topics) if topics is not None else None
-        for schema, channel, message in self._checked(self._reader.iter_messages(
-            topics=topics, starting_at=start_ns, ending_before=end_ns,
-            log_time_order=True, reverse=reverse,
-        )):
+        for schema, channel, message in self._checked(self._iter(
+                topics, start_ns=start_ns, end_ns=end_ns, reverse=reverse)):
             yield Decoded(
                 channel.topic, int(message.log_time), schema.name if schema else "",
                 self._decode(schema, channel, message),
@@ -358,8 +360,20 @@ class LogReader:
                      ) -> Iterator[tuple[Schema | None, Channel, Message]]:
         """Undecoded (schema, channel, message) records in log-time order (ties in file
         order); :meth:`decode` decodes one."""
-        yield from self._checked(self._reader.iter_messages(
-            topics=list(topics) if topics is not None else None, log_time_order=True))
+        yield from self._checked(self._iter(list(topics) if topics is not None else None))
+
+    def _iter(self, topics: list[str] | None, *, start_ns: int | None = None,
+              end_ns: int | None = None, reverse: bool = False
+              ) -> Iterator[tuple[Schema | None, Channel, Message]]:
+        """Messages in log-time order (ties in file order): chunk by chunk
+        (:mod:`sgtool.log.chunk_stream`) when the file is chunked and read forwards, else
+        through the ``mcap`` reader."""
+        if self.summary.chunk_indexes and not reverse:
+            return ordered_messages(self._f, self.summary, topics, start_ns=start_ns,
+                                    end_ns=end_ns, verify=self.verify)
+        return self._reader.iter_messages(topics=topics, starting_at=start_ns,
+                                          ending_before=end_ns, log_time_order=True,
+                                          reverse=reverse)
 
     def _checked(self, it: Iterator[Any]) -> Iterator[Any]:
         """``it``, with damaged chunks (bad CRC, bad compression, bad records) turned into a

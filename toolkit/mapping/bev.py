@@ -123,7 +123,10 @@ class ColumnGrid:
 
     def _fit(self, sets: Sequence[np.ndarray], trajectory: Sequence[tuple[float, float]]
              ) -> None:
-        want = grid_extent(sets, self.resolution, self.config, trajectory)
+        self.cover(grid_extent(sets, self.resolution, self.config, trajectory))
+
+    def cover(self, want: tuple[int, int, int, int]) -> None:
+        """Grow the grid to cover the voxel-index extent ``want`` (keeping the flags)."""
         if self.extent is not None:
             o = self.extent
             want = (min(want[0], o[0]), min(want[1], o[1]), max(want[2], o[2]),
@@ -145,6 +148,15 @@ class ColumnGrid:
         for cols, flag in ((classes.occupied, self.OCC), (classes.floor, self.FLOOR)):
             if len(cols):
                 self.flags[cols[:, 1] - iy0, cols[:, 0] - ix0] |= flag
+
+    def merge(self, other: ColumnGrid) -> None:
+        """Grow to cover ``other`` and add its flags (e.g. a grid of carved cells only)."""
+        if other.extent is None:
+            return
+        self.cover(other.extent)
+        assert self.extent is not None
+        o, e = other.extent, self.extent
+        self.flags[o[1] - e[1]:o[3] - e[1] + 1, o[0] - e[0]:o[2] - e[0] + 1] |= other.flags
 
     def carve(self, fans: np.ndarray, level: int) -> None:
         """Mark the ground cells under camera rays that end on the floor (see

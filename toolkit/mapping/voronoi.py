@@ -262,6 +262,21 @@ def ridge_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None) -> Ridg
     return RidgeGraph(ridge, dist_m, flat, adj, comp)
 
 
+def chosen_component(occ: OccupancyGrid, rg: RidgeGraph,
+                     anchor: tuple[float, float] | None) -> int:
+    """The ridge component the graph is built on: the one of the ridge pixel nearest to
+    ``anchor`` (the robot), else the largest (ties: the lowest label); -1 without ridge."""
+    if len(rg.flat) == 0:
+        return -1
+    if anchor is not None:
+        pr, pc = np.divmod(rg.flat, rg.ridge.shape[1])
+        px, py = occ.center_of(pr, pc)
+        d2 = (px - anchor[0]) ** 2 + (py - anchor[1]) ** 2
+        return int(rg.component[int(np.argmin(d2))])
+    sizes = np.bincount(rg.component)
+    return int(np.flatnonzero(sizes == sizes.max())[0])
+
+
 def voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
                   anchor: tuple[float, float] | None = None,
                   ridge: RidgeGraph | None = None) -> VoronoiGraph:
@@ -277,14 +292,7 @@ def voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
     if len(rg.flat) == 0:
         return empty
     flat, adj, comp = rg.flat, rg.adj, rg.component
-    if anchor is not None:
-        pr, pc = np.divmod(flat, w)
-        px, py = occ.center_of(pr, pc)
-        d2 = (px - anchor[0]) ** 2 + (py - anchor[1]) ** 2
-        target = comp[int(np.argmin(d2))]
-    else:
-        sizes = np.bincount(comp)
-        target = int(np.flatnonzero(sizes == sizes.max())[0])
+    target = chosen_component(occ, rg, anchor)
     keep = np.flatnonzero(comp == target)
     flat = flat[keep]
     adj = adj[keep][:, keep].tocsr()

@@ -83,6 +83,19 @@ def unpack(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.nda
     return ix, iy, iz, keys & LABEL_MASK
 
 
+def _count_keys(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(sorted distinct keys, occurrences) of ``keys``: ``np.unique(keys,
+    return_counts=True)`` without its overhead (one in-place sort)."""
+    if keys.size == 0:
+        return keys, np.zeros(0, dtype=np.int64)
+    keys = np.sort(keys)
+    change = np.empty(keys.size, dtype=bool)
+    change[0] = True
+    np.not_equal(keys[1:], keys[:-1], out=change[1:])
+    first = np.flatnonzero(change)
+    return keys[first], np.diff(first, append=keys.size)
+
+
 @dataclass(frozen=True)
 class InstanceObservation:
     """What the map knows of one instance id."""
@@ -221,54 +234,72 @@ class VoxelMap:
         if idx.size == 0:
             return 0
         z = d[idx].astype(np.float64)
-        xc = ru[idx] * z
-        yc = rv[idx] * z
+        xc = ru[idx]
+        xc *= z
+        yc = rv[idx]
+        yc *= z
         T = np.asarray(frame.pose, dtype=np.float64)  # noqa: N806
-        wx = T[0, 0] * xc + T[0, 1] * yc + T[0, 2] * z + T[0, 3]
-        wy = T[1, 0] * xc + T[1, 1] * yc + T[1, 2] * z + T[1, 3]
-        wz = T[2, 0] * xc + T[2, 1] * yc + T[2, 2] * z + T[2, 3]
+        world = []
+        for r in range(3):  # T[r, 0] * xc + T[r, 1] * yc + T[r, 2] * z + T[r, 3], in place
+            w = T[r, 0] * xc
+            w += T[r, 1] * yc
+            w += T[r, 2] * z
+            w += T[r, 3]
+            world.append(w)
         if frame.ids is not None:
             lab = self.labels_of(np.asarray(frame.ids).reshape(-1)[idx])
         else:
             lab = np.zeros(idx.size, dtype=np.int64)
-        return self.integrate_points(np.stack([wx, wy, wz], axis=1), lab, viewpoint,
-                                     frame_index=frame.index)
+        return self._fuse(world[0], world[1], world[2], lab, viewpoint, frame.index)
 
     def integrate_points(self, xyz: np.ndarray, labels: np.ndarray,
                          viewpoint: tuple[float, float], frame_index: int = -1) -> int:
         """Fuse world points (N, 3) float64 with label indices (from :meth:`labels_of`)."""
+        xyz = np.asarray(xyz, dtype=np.float64)
+        return self._fuse(np.ascontiguousarray(xyz[:, 0]), np.ascontiguousarray(xyz[:, 1]),
+                          np.ascontiguousarray(xyz[:, 2]), np.asarray(labels, np.int64),
+                          viewpoint, frame_index)
+
+    def _fuse(self, wx: np.ndarray, wy: np.ndarray, wz: np.ndarray, labels: np.ndarray,
+              viewpoint: tuple[float, float], frame_index: int) -> int:
+        """Quantise, pack and count one frame's world points (module doc)."""
         inv = 1.0 / self.config.resolution
-        vx = np.floor(xyz[:, 0] * inv).astype(np.int64)
-        vy = np.floor(xyz[:, 1] * inv).astype(np.int64)
-        vz = np.floor(xyz[:, 2] * inv).astype(np.int64)
+        vx = np.floor(wx * inv).astype(np.int64)
+        vy = np.floor(wy * inv).astype(np.int64)
+        vz = np.floor(wz * inv).astype(np.int64)
         lim = OFFSET - 1
-        ok = (np.abs(vx) < lim) & (np.abs(vy) < lim) & (np.abs(vz) < lim)
-        if not ok.all():
-            vx, vy, vz, labels, xyz = vx[ok], vy[ok], vz[ok], labels[ok], xyz[ok]
+        if vx.size and not all(-lim < int(a.min()) and int(a.max()) < lim
+                               for a in (vx, vy, vz)):
+            ok = (np.abs(vx) < lim) & (np.abs(vy) < lim) & (np.abs(vz) < lim)
+            vx, vy, vz, labels = vx[ok], vy[ok], vz[ok], labels[ok]
+            wx, wy = wx[ok], wy[ok]
         if vx.size == 0:
             return 0
-        keys = pack(vx, vy, vz, labels)
-        uk, cnt = np.unique(keys, return_counts=True)
-        self._pending.append((uk, cnt.astype(np.int64)))
+        uk, cnt = _count_keys(pack(vx, vy, vz, labels))
+        self._pending.append((uk, cnt))
         self._pending_n += len(uk)
-        self._frame_stats(xyz, labels, viewpoint, frame_index)
+        # points per label from the distinct keys (far fewer than the points)
+        pts = np.bincount(uk & LABEL_MASK, weights=cnt).astype(np.int64)
+        self._frame_stats(wx, wy, labels, pts, viewpoint, frame_index)
         if self._pending_n >= self.config.flush_keys:
             self.flush()
         self.version += 1
         return int(vx.size)
 
-    def _frame_stats(self, xyz: np.ndarray, labels: np.ndarray,
-                     viewpoint: tuple[float, float], frame_index: int) -> None:
-        n_lab = max(len(self._label_ids), int(labels.max()) + 1 if labels.size else 0)
+    def _frame_stats(self, wx: np.ndarray, wy: np.ndarray, labels: np.ndarray,
+                     pts: np.ndarray, viewpoint: tuple[float, float], frame_index: int
+                     ) -> None:
+        """Per label of the frame: points (``pts``, indexed by label), frames, last frame,
+        closest viewpoint (from the mean x, y of its points)."""
+        n_lab = max(len(self._label_ids), len(pts))
         st = self._stats
         st.grow(n_lab)
-        pts = np.bincount(labels, minlength=n_lab)
         present = np.flatnonzero(pts)
         present = present[present > 0]
         if present.size == 0:
             return
-        sx = np.bincount(labels, weights=xyz[:, 0], minlength=n_lab)[present]
-        sy = np.bincount(labels, weights=xyz[:, 1], minlength=n_lab)[present]
+        sx = np.bincount(labels, weights=wx, minlength=n_lab)[present]
+        sy = np.bincount(labels, weights=wy, minlength=n_lab)[present]
         p = pts[present]
         st.points_max[present] = np.maximum(st.points_max[present], p)
         st.points_total[present] += p

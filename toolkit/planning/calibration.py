@@ -13,7 +13,7 @@ usable as the likelihoods of a search distribution:
   under-confident model.
 
 **Blending by novelty.** For a query far from the training vocabulary the learned models
-extrapolate; the sentence-encoder cosine (Eqs. 14-15) degrades more gracefully. With
+extrapolate; the sentence-encoder cosine (Eqs. 14-15) may degrade more gracefully. With
 ``sim(q) = max_t cos(E(q), E(t))`` over the training queries t (the weights' metadata
 ``training_queries``),
 
@@ -24,9 +24,30 @@ where ``s_cos' = clip((cos - cos_lo) / (cos_hi - cos_lo), 0, 1)`` maps the cosin
 useful range for name pairs is about 0.1-0.6) onto [0, 1]. A query in the training set has
 sim = 1 and keeps the learned scores unchanged. Without ``training_queries`` in the
 metadata there is no training-like set to measure against (the room types are rooms, not
-queries), so lambda = 1: no blending rather than a wrong one. Measured on the dense
-``symsearch`` preset houses (unseen queries, 88 episodes): success 0.67 with the learned
-scores alone, 0.72 with (lo, hi) = (0.55, 0.85), 0.53 with (0.7, 0.95) (too much cosine).
+queries), so lambda = 1: no blending rather than a wrong one.
+
+**Blend only where the cosine is the better judge** (``gate``, default on). Whether the
+cosine extrapolates better than the learned model is a measurable fact of each set of
+weights: ``sgtool distill`` reports, per relation, the ROC-AUC of both on query categories
+never seen in training (the weights' ``report.unseen``). Relation x is blended by (C3) only
+when
+
+    AUC_cos(x) > AUC_learned(x)                                                      (C4)
+
+and is the learned model unchanged otherwise (weights without a report keep (C3)). Why:
+on the unseen categories of the shipped weights, split by sim(q) into [0, .55), [.55, .7),
+[.7, .85), [.85, 1], the learned containment AUC is 0.835 / 0.858 / 0.931 / 0.939 against
+the cosine's 0.619 / 0.698 / 0.773 / 0.744, so the learned model is the better judge even
+for the queries least like the training ones, and (C3) lowered the AUC in every bin it
+touched (0.618 in the first); co-occurrence likewise (learned 0.691 / 0.667 / 0.741 / 0.685,
+cosine 0.617 / 0.493 / 0.691 / 0.580). On the dense ``symsearch`` bench houses (houses
+0-4, 2 seeds, 84 unseen-query episodes) ``bayes-search`` found 0.464 of the unseen targets
+with (C3) on both relations, 0.464 with (C3) on rooms only, 0.655 with no blend: the
+cosine's flat room scores spread the belief over rooms that do not hold the target. The
+everyday-object check set (:mod:`sgtool.semantics.everyday_rooms`, names outside
+BEHAVIOR-1K) is the one place where the cosine's room answers are better
+(``benchmarks/priors_check.py``); that is a statement about the learned model's room
+knowledge, to be fixed in training, not by a blend that costs the search.
 """
 
 from __future__ import annotations
@@ -55,12 +76,36 @@ def novelty_weight(similarity: float, lo: float, hi: float) -> float:
     return float(np.clip((similarity - lo) / (hi - lo), 0.0, 1.0))
 
 
+RELATIONS = ("containment", "cooccurrence")
+
+
+def blended_relations(report: object) -> frozenset[str]:
+    """The relations (C3) applies to under the gate (C4): those whose held-out ROC-AUC in
+    ``report["unseen"]`` (the weights' quality report) is higher for the cosine than for
+    the learned model; every relation when there is no such report."""
+    unseen = report.get("unseen") if isinstance(report, dict) else None
+    if not isinstance(unseen, dict):
+        return frozenset(RELATIONS)
+    out = set()
+    for rel in RELATIONS:
+        try:
+            learned = float(unseen[rel]["learned"]["auc"])
+            cos = float(unseen[rel]["cosine"]["auc"])
+        except (KeyError, TypeError, ValueError):
+            out.add(rel)  # nothing measured: keep the distance blend
+            continue
+        if cos > learned:
+            out.add(rel)
+    return frozenset(out)
+
+
 @dataclass(frozen=True)
 class BlendParams:
     lo: float = 0.55  # at or below this best-match cosine: cosine scores only
     hi: float = 0.85  # at or above: learned scores only
     cos_lo: float = 0.1
     cos_hi: float = 0.6
+    gate: bool = True  # (C4): blend a relation only where the held-out AUC favours cosine
 
 
 class BlendedPriors:
@@ -78,6 +123,12 @@ class BlendedPriors:
         self._encoder = encoder
         self._train_vecs: np.ndarray | None = None
         self._weights: dict[str, float] = {}
+        report = getattr(learned, "metadata", {}).get("report") if params.gate else None
+        self.blended_relations = blended_relations(report)
+
+    def blends(self, relation: str) -> bool:
+        """Whether ``relation`` (containment or cooccurrence) is blended at all, (C4)."""
+        return relation in self.blended_relations
 
     def can_score_room(self, name: str) -> bool:
         return can_score_room(self.learned, name)
@@ -102,8 +153,10 @@ class BlendedPriors:
                 self._weights[q] = novelty_weight(sim, self.params.lo, self.params.hi)
         return self._weights[q]
 
-    def _blend(self, learned: np.ndarray, cosine_fn, names: Sequence[str], query: str
-               ) -> np.ndarray:
+    def _blend(self, relation: str, learned: np.ndarray, cosine_fn, names: Sequence[str],
+               query: str) -> np.ndarray:
+        if not self.blends(relation):
+            return learned
         lam = self.learned_weight(query)
         if lam >= 1.0:
             return learned
@@ -112,8 +165,9 @@ class BlendedPriors:
         return lam * learned + (1.0 - lam) * cos
 
     def rooms(self, names: Sequence[str], query: str) -> np.ndarray:
-        return self._blend(self.learned.rooms(names, query), self.cosine.rooms, names, query)
+        return self._blend("containment", self.learned.rooms(names, query), self.cosine.rooms,
+                           names, query)
 
     def objects(self, names: Sequence[str], query: str) -> np.ndarray:
-        return self._blend(self.learned.objects(names, query), self.cosine.objects, names,
-                           query)
+        return self._blend("cooccurrence", self.learned.objects(names, query),
+                           self.cosine.objects, names, query)

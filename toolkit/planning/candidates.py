@@ -52,6 +52,18 @@ class Candidate:
     distance: float
     position: tuple[float, float]
 
+    def __init__(self, node_id: str, skill: Skill, kind: NodeKind, distance: float,
+                 position: tuple[float, float]) -> None:
+        # the dataclass's frozen __init__ sets each field through object.__setattr__;
+        # a decision builds ~100 candidates, so fill the instance dict at once (still
+        # frozen: assigning a field afterwards raises FrozenInstanceError)
+        d = self.__dict__
+        d["node_id"] = node_id
+        d["skill"] = skill
+        d["kind"] = kind
+        d["distance"] = distance
+        d["position"] = position
+
 
 @functools.lru_cache(maxsize=65536)
 def natural_key(node_id: str) -> tuple[str, tuple[tuple[int, int | str], ...]]:
@@ -109,30 +121,70 @@ def door_is_entrance(graph: SceneGraph, door: DoorNode) -> bool:
     return False
 
 
+_Entry = tuple[object, "Skill | None", str, tuple, str, tuple[float, float]]
+
+
+class _NodeMemo:
+    """What is fixed about a node, by node identity: its skill and kind (None when it is
+    not actionable), its natural sort key, id and (x, y).
+
+    Scene-graph nodes are frozen, and an incremental graph (the symbolic environment's)
+    hands the same node objects from step to step, so this is computed once per node. The
+    memo keeps each node alive while it holds it, so an id is never reused under it; it is
+    emptied when full."""
+
+    def __init__(self, limit: int = 1 << 13) -> None:
+        self.memo: dict[int, _Entry] = {}
+        self._limit = limit
+
+    def add(self, node: RoomNode | RegionNode | ObjectNode) -> _Entry:
+        skill: Skill | None
+        if isinstance(node, RoomNode):
+            skill, kind = (None if node.explored else "explore"), "room"
+        elif isinstance(node, RegionNode):
+            skill, kind = ("explore" if node.kind == "frontier" else None), "frontier"
+        else:
+            skill, kind = object_skill(node), "object"
+        if len(self.memo) >= self._limit:
+            self.memo.clear()
+        entry = (node, skill, kind, natural_key(node.id), node.id, node_xy(node))
+        self.memo[id(node)] = entry
+        return entry
+
+
+_STATIC = _NodeMemo()
+
+
 def actionable(graph: SceneGraph) -> list[Candidate]:
     """N_a in natural id order; unreachable nodes are left out."""
-    out: list[Candidate] = []
-
-    def add(node: RoomNode | RegionNode | ObjectNode | DoorNode, skill: Skill, kind: str) -> None:
-        d = distance_to(graph, node)
-        if d is not None:
-            out.append(Candidate(node.id, skill, kind, d, node_xy(node)))
-
-    for r in graph.rooms:
-        if not r.explored:
-            add(r, "explore", "room")
-    for f in graph.regions:
-        if f.kind == "frontier":
-            add(f, "explore", "frontier")
-    for o in graph.objects:
-        skill = object_skill(o)
-        if skill is not None:
-            add(o, skill, "object")
+    keyed: list[tuple[tuple, int, Candidate]] = []
+    dists = graph.distances
+    memo, add = _STATIC.memo, _STATIC.add
+    isfinite = math.isfinite
+    for group in (graph.rooms, graph.regions, graph.objects):
+        for node in group:
+            entry = memo.get(id(node))
+            if entry is None or entry[0] is not node:
+                entry = add(node)
+            if entry[1] is None:
+                continue
+            if dists:
+                d = dists.get(node.id)
+                if d is None or not isfinite(d):
+                    continue
+                d = float(d)
+            else:
+                d = distance_to(graph, node)  # type: ignore[assignment]
+            keyed.append((entry[3], len(keyed),
+                          Candidate(entry[4], entry[1], entry[2], d, entry[5])))
     for door in graph.doors:
         if door_is_entrance(graph, door):
-            add(door, "open", "door")
-    out.sort(key=lambda c: natural_key(c.node_id))
-    return out
+            d = distance_to(graph, door)
+            if d is not None:
+                keyed.append((natural_key(door.id), len(keyed),
+                              Candidate(door.id, "open", "door", d, node_xy(door))))
+    keyed.sort()  # by natural key, then (equal ids) in graph order, as a stable sort
+    return [c for _, _, c in keyed]
 
 
 def find_target(graph: SceneGraph, query: str) -> ObjectNode | None:

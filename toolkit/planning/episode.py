@@ -11,17 +11,30 @@ planner is built by the caller and reset here with the query and its seed.
 Per step: ``graph = env.observe()`` (None: nothing to decide on, the loop ends), then
 ``action = planner.decide(graph)`` (timed with the wall clock), ``recorder.decided``,
 ``feedback = env.execute(action)``, ``planner.feedback(feedback)``,
-``recorder.executed``; until ``env.ended``.
+``recorder.executed``; until ``env.ended``. A planner that keeps LLM exchanges
+(``exchanges``, moma-llm) has those of each decision in :attr:`SearchStep.exchanges`.
+
+**Success rules** (``success``): ``observed`` (SymSearch, the default): the episode succeeds
+when an object of the query comes into view (the environment ends it then). ``done``
+(MoMa-LLM): it succeeds only when the planner calls ``done()`` naming an object of the
+query in its graph. When the environment ends an episode because the target is in view,
+the loop asks the planner once more, on the graph that shows it (a step the environment
+does not execute or count): ``done(<an object of the query>)`` confirms the find, anything
+else fails the episode (end ``not_confirmed``). A ``done()`` earlier, without the target in
+view, fails it as under either rule. :func:`search_success` gives the verdict.
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
+from sgtool.errors import SgtoolError
 from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.scenegraph.graph import SceneGraph
+from sgtool.semantics.text import category_text
 
 
 class SearchEnvironment(Protocol):
@@ -48,6 +61,41 @@ class SearchStep:
     action: Action
     feedback: Feedback
     decision_s: float
+    exchanges: tuple[dict[str, Any], ...] = ()  # LLM exchanges of this decision
+
+
+SUCCESS_RULES = ("observed", "done")
+CONFIRMED = "target confirmed by done()"
+NOT_CONFIRMED = "not_confirmed"  # the end of an episode the planner did not confirm
+
+
+class SuccessRuleError(SgtoolError):
+    """An unknown success rule."""
+
+
+def check_success_rule(rule: str) -> str:
+    if rule not in SUCCESS_RULES:
+        raise SuccessRuleError(f"--success {rule!r}: one of {', '.join(SUCCESS_RULES)}")
+    return rule
+
+
+def confirms(step: SearchStep, query: str) -> bool:
+    """``step`` is ``done()`` naming an object of the query in the graph it was decided on."""
+    a = step.action
+    if a.skill != "done" or a.target is None:
+        return False
+    node = step.graph.node(a.target)
+    return node is not None and \
+        category_text(getattr(node, "category", "") or "") == category_text(query)
+
+
+def search_success(env_success: bool, steps: Sequence[SearchStep], query: str,
+                   rule: str = "observed") -> bool:
+    """The episode's success under ``rule`` (module doc), given the environment's verdict
+    (the target came into view)."""
+    if check_success_rule(rule) == "observed":
+        return bool(env_success)
+    return bool(env_success) and bool(steps) and confirms(steps[-1], query)
 
 
 class SearchRecorder(Protocol):
@@ -62,25 +110,50 @@ class SearchRecorder(Protocol):
 
 
 def run_search(env: SearchEnvironment, planner: Planner, query: str, *, seed: int = 0,
-               recorder: SearchRecorder | None = None) -> tuple[SearchStep, ...]:
-    """Run one episode of ``planner`` searching for ``query`` in ``env`` (module doc);
-    returns its steps."""
+               recorder: SearchRecorder | None = None,
+               success: str = "observed") -> tuple[SearchStep, ...]:
+    """Run one episode of ``planner`` searching for ``query`` in ``env`` under the success
+    rule ``success`` (module doc); returns its steps."""
+    check_success_rule(success)
     planner.reset(query, seed=seed)
     steps: list[SearchStep] = []
     while not env.ended:
         graph = env.observe()
         if graph is None:
             break
-        t0 = time.perf_counter()
-        action = planner.decide(graph)
-        dt = time.perf_counter() - t0
-        index = len(steps) + 1
-        if recorder is not None:
-            recorder.decided(index, graph, action, dt)
-        fb = env.execute(action)
-        planner.feedback(fb)
-        step = SearchStep(index, graph, action, fb, dt)
-        steps.append(step)
-        if recorder is not None:
-            recorder.executed(step)
+        steps.append(_step(planner, graph, len(steps) + 1, recorder, env.execute))
+    if success == "done" and getattr(env, "success", False):
+        graph = env.observe()
+        if graph is not None:
+            steps.append(_step(planner, graph, len(steps) + 1, recorder,
+                               lambda a: _confirmation(a, graph, query)))
     return tuple(steps)
+
+
+def _step(planner: Planner, graph: SceneGraph, index: int, recorder: SearchRecorder | None,
+          execute: Callable[[Action], Feedback]) -> SearchStep:
+    """Decide on ``graph`` (timed), record, execute, feed back, record."""
+    kept = getattr(planner, "exchanges", None)
+    n0 = len(kept) if isinstance(kept, list) else 0
+    t0 = time.perf_counter()
+    action = planner.decide(graph)
+    dt = time.perf_counter() - t0
+    kept = getattr(planner, "exchanges", None)
+    exchanges = tuple(kept[n0:]) if isinstance(kept, list) else ()
+    if recorder is not None:
+        recorder.decided(index, graph, action, dt)
+    fb = execute(action)
+    planner.feedback(fb)
+    step = SearchStep(index, graph, action, fb, dt, exchanges)
+    if recorder is not None:
+        recorder.executed(step)
+    return step
+
+
+def _confirmation(action: Action, graph: SceneGraph, query: str) -> Feedback:
+    """The outcome of the decision after the target came into view (``done`` rule)."""
+    probe = SearchStep(0, graph, action, Feedback(action, "success"), 0.0)
+    if confirms(probe, query):
+        return Feedback(action, "success", CONFIRMED)
+    return Feedback(action, "failure",
+                    f"the {query} was in view but the planner did not call done() on it")

@@ -9,10 +9,16 @@ the candidates of :func:`~sgtool.planning.candidates.actionable` (frontiers, une
 entrance doors, unexplored carriers):
 
 - R1, *object co-occurrence*: ``NearObj(n, o) ∧ CoOccur(o, q) -> Choose(n)``; the truth of
-  the body for candidate n is T_obj(n) = max over objects o within ``radius`` of n (n itself
-  included for a carrier) of the co-occurrence prior p_co(o, q). A candidate with no object
-  near it (an unexplored room, a door, a bare frontier) gets the mean co-occurrence of the
-  objects seen so far (ESC's "unknown" frontier: neither near likely nor unlikely things);
+  the body for a frontier is T_obj(n) = max over objects o within ``radius`` of n of the
+  co-occurrence prior p_co(o, q) (exploring there may reveal the target beside o). For a
+  carrier the body is about the carrier itself, T_obj(n) = p_co(n, q): checking a carrier
+  looks into or onto that one piece, not its neighbours, so a piece does not borrow the
+  score of a likely neighbour (in the dense ``symsearch`` houses, ~15 pieces per room, the
+  max over neighbours gave whole clusters of unlikely pieces the score of the one likely
+  piece among them, and ESC spent its 50 steps checking them: SR 0.28, below random's
+  0.37). A candidate with no object near it (an unexplored room, a door, a bare frontier)
+  gets the mean co-occurrence of the objects seen so far (ESC's "unknown" frontier:
+  neither near likely nor unlikely things);
 - R2, *room*: ``InRoom(n, r) ∧ Contains(r, q) -> Choose(n)``; T_room(n) = p_contains(r, q)
   of n's room, the mean over the prior's room types for unexplored or unscorable rooms and
   for space behind a door or a leading-out frontier;
@@ -67,10 +73,11 @@ def esc_scores(graph: SceneGraph, cands: list[Candidate], query: str, scorer: Re
     nodes = {n.id: n for n in (*graph.regions, *objs)}
     out = np.zeros(len(cands))
     for k, c in enumerate(cands):
-        near = [co_of[i] for i in objects_within(obj_xy, c.position, params.radius)]
         if c.kind == "object":
-            near.append(co_of.get(c.node_id, unknown_obj))
-        t_obj = max(near) if near else unknown_obj
+            t_obj = co_of.get(c.node_id, unknown_obj)
+        else:
+            near = [co_of[i] for i in objects_within(obj_xy, c.position, params.radius)]
+            t_obj = max(near) if near else unknown_obj
         node = nodes.get(c.node_id)
         leading_out = getattr(node, "frontier_type", None) == "leading out"
         room = getattr(node, "room", None) if c.kind in ("object", "frontier") else None

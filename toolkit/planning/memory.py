@@ -61,4 +61,8 @@ class EpisodeMemory:
         return len(fails) >= self.max_failures
 
     def filter(self, candidates: list[Candidate]) -> list[Candidate]:
-        return [c for c in candidates if not self.excluded(c)]
+        finished, failures = self.finished, self.failures
+        if not finished and not failures:
+            return list(candidates)
+        return [c for c in candidates
+                if not ((c.node_id in finished or c.node_id in failures) and self.excluded(c))]

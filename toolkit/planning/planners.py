@@ -9,6 +9,8 @@ failure, never as a success). Subclasses implement :meth:`NodeSelectionPlanner.c
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from sgtool.planning.base import Action, Feedback
@@ -19,6 +21,12 @@ from sgtool.scenegraph.graph import SceneGraph
 from sgtool.semantics.priors import RelationScorer
 
 GIVE_UP = "nothing left to explore"
+
+
+@functools.lru_cache(maxsize=1 << 13)
+def _round4(v: float) -> float:
+    """``round(v, 4)``, memoised: the same utilities come back at every decision."""
+    return round(v, 4)
 
 
 class NodeSelectionPlanner:
@@ -98,5 +106,5 @@ class UtilityPlanner(NodeSelectionPlanner):
         u = candidate_utilities(graph, cands, self.query, self.scorer, self.params)
         i = select_with_margin(u, [c.distance for c in cands], [c.node_id for c in cands],
                                self.params.delta)
-        scores = {c.node_id: round(v, 4) for c, v in zip(cands, u, strict=True)}
+        scores = dict(zip([c.node_id for c in cands], map(_round4, u), strict=True))
         return i, f"u={u[i]:.3f} (max {max(u):.3f}), d={cands[i].distance:.2f} m", scores

@@ -18,6 +18,10 @@ name                what it is
 ``bayes-search``    search theory: Bayes belief over places, p/c ratio rule with a
                     look-ahead (:mod:`sgtool.planning.search_theory`)
 ``moma-llm``        MoMa-LLM over an OpenAI-compatible chat endpoint or a transcript
+``unstructured-llm`` MoMa-LLM's ablation: the same, shown the raw JSON scene graph
+                    (:mod:`sgtool.planning.moma.unstructured`)
+``godhs-llm``       GODHS with an LLM ranking rooms and carriers
+                    (:mod:`sgtool.planning.llm_ranker`; the priors when it fails)
 ==================  ====================================================================
 
 Every planner comes wrapped in :class:`~sgtool.planning.timing.TimedPlanner`, so each
@@ -34,12 +38,18 @@ action carries its measured decision time. Options:
   ``esc``: ``w_obj``, ``w_room``, ``w_dist``, ``radius``; ``bayes-search``: ``step_cost``,
   ``open_cost``, ``reveal_cost``, ``top_k``, ``horizon``, ``step_budget`` (0: none),
   ``room_floor``, ``object_floor``, ``sharpness``, ``object_sharpness``, ``beyond``,
-  ``miss``, ``blend`` (false: learned scores only, no novelty blend);
+  ``miss``, ``region_weight``, ``blend`` (false: learned scores only, no novelty blend);
 - ``moma-llm``: ``base_url``, ``model``, ``api_key`` (else from the environment, see
   :mod:`sgtool.llm.client`), ``timeout_s``, ``temperature``, ``replay`` (a JSONL transcript
   to serve instead of an endpoint), ``transcript`` (append exchanges to this JSONL),
   ``on_exchange`` (callback per exchange record), ``max_attempts``, ``stuck_repeats``,
-  ``history_limit``, ``client`` (any object with ``model`` and ``complete(messages)``).
+  ``history_limit``, ``client`` (any object with ``model`` and ``complete(messages)``),
+  ``constraint`` (``auto`` (default), ``grammar``, ``json_schema``, ``none``:
+  :mod:`sgtool.llm.constraints`), ``reason_chars``, ``max_tokens``; ``unstructured-llm``:
+  the same;
+- ``godhs-llm``: the endpoint options of ``moma-llm`` (``base_url`` ... ``replay``,
+  ``client``, ``transcript``), ``carrier_threshold``, ``encoder``, ``weights_dir`` (the
+  fallback priors).
 """
 
 from __future__ import annotations
@@ -52,7 +62,7 @@ from sgtool.planning.base import Planner
 
 PLANNER_NAMES: tuple[str, ...] = (
     "random", "greedy", "sbert", "sbert-noroom", "scout", "scout-noroom", "scout-delta0",
-    "godhs", "esc", "bayes-search", "moma-llm",
+    "godhs", "esc", "bayes-search", "moma-llm", "unstructured-llm", "godhs-llm",
 )
 
 _UTILITY_KEYS = ("default_room", "default_frontier", "delta", "room_weight", "frontier_radius")
@@ -122,7 +132,7 @@ def _search(name: str, options: dict[str, Any]) -> Planner:
         keys = ("step_cost", "open_cost", "reveal_cost", "top_k", "horizon", "step_budget")
         kw = {k: type(getattr(SearchParams, k))(options.pop(k)) for k in keys if k in options}
         bkeys = ("room_floor", "object_floor", "sharpness", "object_sharpness", "beyond",
-                 "miss")
+                 "miss", "region_weight")
         bkw = {k: float(options.pop(k)) for k in bkeys if k in options}
         kw["belief"] = BeliefParams(**bkw)
         blend = str(options.pop("blend", True)).strip().lower() not in ("false", "0", "no")
@@ -142,26 +152,46 @@ def _search(name: str, options: dict[str, Any]) -> Planner:
                         max_failures=max_failures)
 
 
-def _moma(options: dict[str, Any]) -> Planner:
+def _llm_client(options: dict[str, Any]) -> Any:
+    """The chat client of an LLM planner: ``client``, else a ``replay`` transcript, else an
+    endpoint from ``base_url``/``model``/``api_key``/... (:mod:`sgtool.llm.client`)."""
     from sgtool.llm.client import LlmSettings, OpenAIChatClient
     from sgtool.llm.recorded import ReplayChatClient
-    from sgtool.planning.moma.planner import MomaLlmPlanner
 
     client = options.pop("client", None)
     replay = options.pop("replay", None)
     settings_kw = {k: options.pop(k) for k in
                    ("base_url", "model", "api_key", "timeout_s", "temperature", "max_tokens")
                    if k in options}
-    if client is None:
-        if replay:
-            client = ReplayChatClient(replay, model=settings_kw.get("model"))
-        else:
-            client = OpenAIChatClient(LlmSettings.resolve(**settings_kw))
+    if client is not None:
+        return client
+    if replay:
+        return ReplayChatClient(replay, model=settings_kw.get("model"))
+    return OpenAIChatClient(LlmSettings.resolve(**settings_kw))
+
+
+def _godhs_llm(options: dict[str, Any]) -> Planner:
+    from sgtool.planning.godhs import GodhsPlanner, PriorRanker
+    from sgtool.planning.llm_ranker import LlmRanker
+
+    client = _llm_client(options)
+    ranker = LlmRanker(client, fallback=PriorRanker(_priors(options, blend=False)),
+                       transcript=options.pop("transcript", None))
+    return GodhsPlanner(ranker, float(options.pop("carrier_threshold", 0.1)), name="godhs-llm",
+                        max_failures=int(options.pop("max_failures", 2)))
+
+
+def _moma(options: dict[str, Any], unstructured: bool = False) -> Planner:
+    from sgtool.planning.moma.planner import MomaLlmPlanner
+    from sgtool.planning.moma.unstructured import UnstructuredLlmPlanner
+
+    client = _llm_client(options)
     kw = {k: options.pop(k) for k in
           ("max_attempts", "stuck_repeats", "history_limit", "on_exchange", "transcript",
-           "decision_timeout_s")
+           "decision_timeout_s", "reason_chars")
           if k in options}
-    return MomaLlmPlanner(client, **kw)
+    cls = UnstructuredLlmPlanner if unstructured else MomaLlmPlanner
+    return cls(client, constraint=str(options.pop("constraint", "auto")), **kw)
 
 
 def _simple(cls_name: str) -> Callable[[dict[str, Any]], Planner]:
@@ -185,8 +215,10 @@ def make_planner(name: str, **options: Any) -> Planner:
         planner = _utility(key, options)
     elif key in ("godhs", "esc", "bayes-search"):
         planner = _search(key, options)
-    elif key == "moma-llm":
-        planner = _moma(options)
+    elif key in ("moma-llm", "unstructured-llm"):
+        planner = _moma(options, unstructured=key == "unstructured-llm")
+    elif key == "godhs-llm":
+        planner = _godhs_llm(options)
     else:
         raise UnknownPlannerError(
             f"unknown planner {name!r}; choose one of: {', '.join(PLANNER_NAMES)}"

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sgtool.planning.candidates import Candidate
-from sgtool.scenegraph.graph import SceneGraph
+from sgtool.scenegraph.graph import ObjectNode, SceneGraph
 from sgtool.semantics.priors import RelationScorer, can_score_room
 
 UNKNOWN_ROOM = frozenset({"", "unknown", "none"})
@@ -110,21 +110,84 @@ def room_utilities(graph: SceneGraph, query: str, scorer: RelationScorer,
     return out
 
 
+class ObjectTable:
+    """The object nodes of a graph as arrays: ids, categories, room ids, x and y, with the
+    row of each id (built once per ``graph.objects`` tuple: :func:`object_table`)."""
+
+    def __init__(self, objects: Sequence[ObjectNode]) -> None:
+        self.objects = objects
+        self.ids = [o.id for o in objects]
+        self.row = {i: k for k, i in enumerate(self.ids)}
+        self.categories = [o.category for o in objects]
+        rooms = [o.room for o in objects]
+        self.room_ids = sorted(set(rooms))
+        where = {r: k for k, r in enumerate(self.room_ids)}
+        self.room_of = np.array([where[r] for r in rooms], dtype=np.intp)
+        xy = np.array([o.position[:2] for o in objects], dtype=np.float64).reshape(-1, 2)
+        self.x, self.y = xy[:, 0], xy[:, 1]
+        self._scores: tuple[object, str, np.ndarray] | None = None
+
+    def raw_scores(self, scorer: RelationScorer, query: str) -> np.ndarray:
+        """u_q(o) of every object (Eq. 3), asked of the scorer once per (scorer, query)."""
+        hit = self._scores
+        if hit is not None and hit[0] is scorer and hit[1] == query:
+            return hit[2]
+        raw = np.asarray(scorer.objects(self.categories, query), dtype=np.float64)
+        self._scores = (scorer, query, raw)
+        return raw
+
+    def within(self, positions: Sequence[tuple[float, float]], radius: float) -> np.ndarray:
+        """(positions x objects) mask of the objects within ``radius`` of each position:
+        exactly the ids :func:`objects_within` gives (distances within a relative 1e-9 of
+        the radius are recomputed the same way, so a last-bit difference of the vectorised
+        squares cannot change the set)."""
+        p = np.asarray(positions, dtype=np.float64).reshape(-1, 2)
+        fx, fy = p[:, :1], p[:, 1:]
+        r2 = radius ** 2
+        d2 = (self.x[None, :] - fx) ** 2 + (self.y[None, :] - fy) ** 2
+        inside = d2 <= r2 * (1.0 - 1e-9)
+        for i, k in zip(*np.nonzero(~inside & (d2 <= r2 * (1.0 + 1e-9) + 1e-300)),
+                        strict=True):
+            x, y = float(self.x[k]), float(self.y[k])
+            qx, qy = positions[i]
+            inside[i, k] = (x - qx) ** 2 + (y - qy) ** 2 <= r2
+        return inside
+
+
+_TABLE: list[ObjectTable] = []  # the table of the last objects tuple seen
+
+
+def object_table(graph: SceneGraph) -> ObjectTable:
+    """The :class:`ObjectTable` of ``graph.objects``, reused while the same tuple comes back
+    (an incremental graph passes the same tuple until its objects change)."""
+    last = _TABLE[0] if _TABLE else None
+    if last is not None and last.objects is graph.objects:
+        return last
+    table = ObjectTable(graph.objects)
+    _TABLE[:] = [table]
+    return table
+
+
+def object_utility_array(table: ObjectTable, query: str, scorer: RelationScorer,
+                         params: UtilityParams, rooms: dict[str, float]) -> np.ndarray:
+    """Eqs. 3-4 for every row of ``table``, in one vectorised pass (the same float64
+    operations as :func:`room_influence` on each object)."""
+    raw = table.raw_scores(scorer, query)
+    if not params.room_influence:
+        return raw
+    room = np.array([rooms.get(r, params.default_room) for r in table.room_ids],
+                    dtype=np.float64)
+    return room_influence(room[table.room_of], raw, params.room_weight)  # type: ignore[return-value]
+
+
 def object_utilities(graph: SceneGraph, query: str, scorer: RelationScorer,
                      params: UtilityParams, rooms: dict[str, float]) -> dict[str, float]:
     """Eqs. 3-4 for every object node of the graph."""
-    objs = list(graph.objects)
-    if not objs:
+    if not graph.objects:
         return {}
-    raw = scorer.objects([o.category for o in objs], query)
-    out: dict[str, float] = {}
-    for o, s in zip(objs, raw, strict=True):
-        if params.room_influence:
-            r = rooms.get(o.room, params.default_room)
-            out[o.id] = float(room_influence(r, float(s), params.room_weight))
-        else:
-            out[o.id] = float(s)
-    return out
+    table = object_table(graph)
+    u = object_utility_array(table, query, scorer, params, rooms)
+    return dict(zip(table.ids, u.tolist(), strict=True))
 
 
 def candidate_utilities(
@@ -136,24 +199,47 @@ def candidate_utilities(
 ) -> list[float]:
     """u_q(n) for each candidate, in order (module doc for each node type)."""
     rooms = room_utilities(graph, query, scorer, params)
-    objects = object_utilities(graph, query, scorer, params, rooms)
-    obj_xy = [(o.id, float(o.position[0]), float(o.position[1])) for o in graph.objects]
+    table = object_table(graph)
+    u = object_utility_array(table, query, scorer, params, rooms) if graph.objects \
+        else np.zeros(0)
+    values = u.tolist()
     out: list[float] = []
+    frontiers: list[int] = []
     for c in candidates:
-        if c.kind == "room":
+        kind = c.kind
+        if kind == "object":
+            out.append(values[table.row[c.node_id]])
+        elif kind == "room":
             out.append(rooms.get(c.node_id, params.default_room))
-        elif c.kind == "door":
+        elif kind == "door":
             out.append(params.default_room)
-        elif c.kind == "object":
-            out.append(objects[c.node_id])
-        else:  # frontier
-            region = graph.node(c.node_id)
-            nearby = [objects[i] for i in objects_within(obj_xy, c.position,
-                                                         params.frontier_radius)]
+        else:  # frontier: filled below
+            frontiers.append(len(out))
+            out.append(math.nan)
+    if frontiers:
+        regions = {r.id: r for r in graph.regions}
+        nearby = _nearby_best(table, u, [candidates[k].position for k in frontiers],
+                              params.frontier_radius)
+        for k, best in zip(frontiers, nearby, strict=True):
+            region = regions.get(candidates[k].node_id)
             room_id = getattr(region, "room", None)
             if getattr(region, "frontier_type", None) == "leading out" or room_id is None:
                 fallback = params.default_frontier
             else:
                 fallback = rooms.get(room_id, params.default_room)
-            out.append(frontier_utility(nearby, fallback))
+            out[k] = frontier_utility(best, fallback)
     return [0.0 if math.isnan(u) else u for u in out]
+
+
+def _nearby_best(table: ObjectTable, u: np.ndarray, positions: list[tuple[float, float]],
+                 radius: float) -> list[list[float]]:
+    """Per position, the utilities of the objects within ``radius`` (their maximum only,
+    when no utility is NaN: all :func:`frontier_utility` needs)."""
+    if not len(u):
+        return [[] for _ in positions]
+    inside = table.within(positions, radius)
+    if np.isnan(u).any():
+        values = u.tolist()
+        return [[values[k] for k in np.flatnonzero(row).tolist()] for row in inside]
+    best = np.where(inside, u[None, :], -np.inf).max(axis=1).tolist()
+    return [[b] if b != -math.inf else [] for b in best]

@@ -20,11 +20,21 @@ labelled node is the only candidate.
 
 Graph distances come from one Dijkstra per distinct viewpoint node over the sparsified
 graph (hundreds of nodes), not an all-pairs table.
+
+Between refreshes most of this repeats: the objects keep their closest viewpoints, the
+map around old viewpoints stops changing, and the graph often stays the same. An
+:class:`AssignCache` (the builder keeps one) reuses exactly what cannot have changed, so
+results equal a run without it bit for bit: the Dijkstra row of a source node while the
+graph (its sparse adjacency) is unchanged, and the visibility of a viewpoint's nodes
+while the grid origin and resolution, those nodes' positions and every ``blocked`` cell
+in the window the segments can touch are unchanged. Candidates come from a k-d tree
+query (filtered by the same distance formula), not an objects x nodes matrix.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import hashlib
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -50,14 +60,110 @@ class Assignment:
     cost: np.ndarray  # (k,)
 
 
+@dataclass
+class AssignCache:
+    """What :func:`assign_objects` reuses between calls (module doc); mutable, one per
+    builder. ``hits``/``misses`` count reused and computed viewpoint visibilities."""
+
+    graph_key: bytes = b""
+    rows: dict[int, np.ndarray] = field(default_factory=dict)  # source node -> distances
+    sight: dict[tuple[float, float], tuple[bytes, np.ndarray]] = field(default_factory=dict)
+    hits: int = 0
+    misses: int = 0
+
+
+def _graph_key(graph: csr_matrix) -> bytes:
+    g = graph.tocsr()
+    h = hashlib.blake2b(digest_size=16)
+    h.update(repr(g.shape).encode())
+    for a in (g.indptr, g.indices, g.data):
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.digest()
+
+
+def _sight_key(occ: OccupancyGrid, blocked: np.ndarray, v: tuple[float, float],
+               targets: np.ndarray) -> bytes:
+    """Everything the segments from ``v`` to ``targets`` read: grid origin, resolution
+    and bounds of the window around them (2 cells of margin), the targets, and the
+    ``blocked`` cells in that window."""
+    xs = np.append(targets[:, 0], v[0])
+    ys = np.append(targets[:, 1], v[1])
+    r, c = occ.cell_of(np.asarray([xs.min(), xs.max()]), np.asarray([ys.min(), ys.max()]))
+    r0, r1, c0, c1 = int(r[0]) - 2, int(r[1]) + 3, int(c[0]) - 2, int(c[1]) + 3
+    h, w = blocked.shape
+    cr0, cr1, cc0, cc1 = max(r0, 0), min(r1, h), max(c0, 0), min(c1, w)
+    d = hashlib.blake2b(digest_size=16)
+    d.update(repr((occ.origin, occ.resolution, (r0, r1, c0, c1), (cr0, cr1, cc0, cc1),
+                   v)).encode())
+    d.update(np.ascontiguousarray(targets, dtype=np.float64).tobytes())
+    if cr0 < cr1 and cc0 < cc1:
+        d.update(np.ascontiguousarray(blocked[cr0:cr1, cc0:cc1]).tobytes())
+    return d.digest()
+
+
+def _visible_nodes(positions: np.ndarray, near_of: dict[tuple[float, float], np.ndarray],
+                   occ: OccupancyGrid, blocked: np.ndarray, cache: AssignCache | None
+                   ) -> dict[tuple[float, float], np.ndarray]:
+    """Per viewpoint: visibility of each of its near nodes (one batched line-of-sight
+    test for the viewpoints the cache cannot answer)."""
+    out: dict[tuple[float, float], np.ndarray] = {}
+    keys: dict[tuple[float, float], bytes] = {}
+    todo = []
+    for v, nodes in near_of.items():
+        if len(nodes) == 0:
+            out[v] = np.zeros(0, dtype=bool)
+            continue
+        if cache is not None:
+            keys[v] = _sight_key(occ, blocked, v, positions[nodes])
+            got = cache.sight.get(v)
+            if got is not None and got[0] == keys[v]:
+                out[v] = got[1]
+                cache.hits += 1
+                continue
+            cache.misses += 1
+        todo.append(v)
+    if todo:
+        seg_vp = np.concatenate([np.repeat(np.asarray([v]), len(near_of[v]), axis=0)
+                                 for v in todo])
+        seg_n = np.concatenate([near_of[v] for v in todo])
+        vis = line_of_sight(blocked, occ, seg_vp, positions[seg_n])
+        at = 0
+        for v in todo:
+            m = len(near_of[v])
+            out[v] = vis[at:at + m]
+            at += m
+    if cache is not None:
+        cache.sight = {v: (keys[v], out[v]) for v in keys}  # only the viewpoints in use
+    return out
+
+
+def _distance_rows(graph: csr_matrix, sources: np.ndarray, n: int,
+                   cache: AssignCache | None) -> np.ndarray:
+    """Dijkstra distances (len(sources), n) from each source, rows reused from the cache
+    while the graph is unchanged."""
+    if cache is None:
+        return dijkstra(graph, directed=False, indices=sources).reshape(len(sources), n)
+    key = _graph_key(graph)
+    if key != cache.graph_key:
+        cache.graph_key, cache.rows = key, {}
+    missing = [int(s) for s in sources.tolist() if int(s) not in cache.rows]
+    if missing:
+        got = dijkstra(graph, directed=False, indices=np.asarray(missing, dtype=np.int64))
+        for s, row in zip(missing, got.reshape(len(missing), n), strict=True):
+            cache.rows[s] = row
+    return np.stack([cache.rows[int(s)] for s in sources.tolist()])
+
+
 def assign_objects(positions: np.ndarray, node_room: np.ndarray, graph: csr_matrix,
                    objects: np.ndarray, viewpoints: np.ndarray,
                    occ: OccupancyGrid | None = None, blocked: np.ndarray | None = None,
-                   config: AssignConfig | None = None) -> Assignment:
+                   config: AssignConfig | None = None,
+                   cache: AssignCache | None = None) -> Assignment:
     """Node (hence room) of every object. ``positions`` (n, 2) node positions,
     ``node_room`` (n,) room index or -1, ``graph`` the sparse graph (m), ``objects`` (k, 2)
     object positions, ``viewpoints`` (k, 2) closest viewpoints (NaN: unknown);
-    ``occ``/``blocked`` give line of sight (occupied cells) when given."""
+    ``occ``/``blocked`` give line of sight (occupied cells) when given; ``cache`` reuses
+    work of earlier calls (module doc; the result is the same without it)."""
     cfg = config or AssignConfig()
     k = len(objects)
     node = np.full(k, -1, dtype=np.int64)
@@ -68,7 +174,7 @@ def assign_objects(positions: np.ndarray, node_room: np.ndarray, graph: csr_matr
     u = cfg.unit
     tree_all = cKDTree(positions)
     # viewpoint nodes per object: the nodes within reach of each distinct viewpoint,
-    # those visible from it when any is (one batched line-of-sight test)
+    # those visible from it when any is
     vp_key = [None if not np.all(np.isfinite(viewpoints[i])) else
               (float(viewpoints[i][0]), float(viewpoints[i][1])) for i in range(k)]
     distinct = sorted({v for v in vp_key if v is not None})
@@ -77,18 +183,10 @@ def assign_objects(positions: np.ndarray, node_room: np.ndarray, graph: csr_matr
         near_of[v] = np.asarray(sorted(tree_all.query_ball_point(v, cfg.viewpoint_radius)),
                                 dtype=np.int64)
     if cfg.line_of_sight and occ is not None and blocked is not None and distinct:
-        seg_vp = np.concatenate([np.repeat(np.asarray([v]), len(near_of[v]), axis=0)
-                                 for v in distinct] or [np.zeros((0, 2))])
-        seg_n = np.concatenate([near_of[v] for v in distinct])
-        vis = line_of_sight(blocked, occ, seg_vp, positions[seg_n]) if len(seg_n) else \
-            np.zeros(0, bool)
-        at = 0
+        vis = _visible_nodes(positions, near_of, occ, blocked, cache)
         for v in distinct:
-            m = len(near_of[v])
-            sel = vis[at:at + m]
-            if sel.any():
-                near_of[v] = near_of[v][sel]
-            at += m
+            if vis[v].any():
+                near_of[v] = near_of[v][vis[v]]
     for v in distinct:
         if len(near_of[v]) == 0:
             near_of[v] = np.asarray([int(tree_all.query(v)[1])], dtype=np.int64)
@@ -99,23 +197,27 @@ def assign_objects(positions: np.ndarray, node_room: np.ndarray, graph: csr_matr
         sources = np.unique(np.concatenate([near_of[v] for v in distinct]))
         row_of = np.full(n, -1, dtype=np.int64)
         row_of[sources] = np.arange(len(sources))
-        dist = dijkstra(graph, directed=False, indices=sources).reshape(len(sources), n)
+        dist = _distance_rows(graph, sources, n, cache)
         for v in distinct:
             vs = near_of[v]
             start = np.hypot(positions[vs, 0] - v[0], positions[vs, 1] - v[1])
             path_of[v] = np.min(dist[row_of[vs]] + start[:, None], axis=0) / u
-    # Euclidean term and candidates for all objects at once (objects x nodes)
-    d_on = np.hypot(objects[:, None, 0] - positions[None, :, 0],
-                    objects[:, None, 1] - positions[None, :, 1])
-    is_lab = node_room >= 0
-    euc_all = (d_on / u) ** cfg.exponent
+    # candidates: labelled nodes within the radius (a k-d tree proposes, the distance
+    # formula of the cost decides), else the nearest labelled node (ties: the lowest id)
+    lab_tree = cKDTree(positions[labelled])
+    proposals = lab_tree.query_ball_point(objects, cfg.candidate_radius + 1e-6)
     for i in range(k):
-        cand_mask = is_lab & (d_on[i] <= cfg.candidate_radius)
-        if not cand_mask.any():  # nearest labelled node (ties: the lowest id)
-            cand_mask = np.zeros(n, dtype=bool)
-            cand_mask[labelled[int(np.argmin(d_on[i, labelled]))]] = True
-        cand = np.flatnonzero(cand_mask)
-        euc = euc_all[i, cand]
+        ox, oy = objects[i, 0], objects[i, 1]
+        cand = labelled[np.asarray(sorted(proposals[i]), dtype=np.int64)]
+        d = np.hypot(ox - positions[cand, 0], oy - positions[cand, 1])
+        inside = d <= cfg.candidate_radius
+        if inside.any():
+            cand, d = cand[inside], d[inside]
+        else:
+            d_lab = np.hypot(ox - positions[labelled, 0], oy - positions[labelled, 1])
+            j = int(np.argmin(d_lab))
+            cand, d = labelled[j:j + 1], d_lab[j:j + 1]
+        euc = (d / u) ** cfg.exponent
         c = euc + path_of[vp_key[i]][cand] if vp_key[i] is not None else euc
         j = int(np.argmin(c))  # ties: the lowest node id (cand is sorted)
         if np.isfinite(c[j]):

@@ -55,7 +55,7 @@ import hashlib
 import math
 import time
 from collections import defaultdict
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -63,9 +63,16 @@ import numpy as np
 from sgtool.log.frame import Frame
 from sgtool.mapping.bev import ColumnGrid, classify_keys, floor_fans, floor_level
 from sgtool.mapping.grid import OCCUPIED, OccupancyGrid
-from sgtool.mapping.voronoi import RidgeGraph, VoronoiGraph, ridge_graph, voronoi_graph
+from sgtool.mapping.voronoi import (
+    RidgeGraph,
+    VoronoiGraph,
+    chosen_component,
+    ridge_graph,
+    voronoi_graph,
+)
 from sgtool.mapping.voxels import VoxelMap
 from sgtool.scenegraph.assembly import GraphParts, assemble_graph, robot_state
+from sgtool.scenegraph.assign import AssignCache
 from sgtool.scenegraph.builder_config import BuilderConfig
 from sgtool.scenegraph.categories import RoomClassifier
 from sgtool.scenegraph.door_evidence import DoorObservation, door_cells, observe_doors
@@ -122,6 +129,10 @@ class _Rooms:
 class SceneGraphBuilder:
     """Incremental scene-graph construction (module doc)."""
 
+    # the clock of the stage timings: wall time; a benchmark on a loaded machine may set
+    # ``time.thread_time`` (CPU time of the thread) instead
+    clock = staticmethod(time.perf_counter)
+
     def __init__(self, instances: Mapping[int, InstanceInfo] | None = None,
                  classifier: RoomClassifier | None = None,
                  config: BuilderConfig | None = None) -> None:
@@ -135,17 +146,34 @@ class SceneGraphBuilder:
         self.timings: dict[str, list[float]] = defaultdict(list)
         self.timings_scratch: dict[str, list[float]] = defaultdict(list)  # from_scratch=True
         self._fans: list[np.ndarray] = []  # per frame: rays to the nearest ground hit
-        self._carved = 0  # frames whose fans are carved into self._columns
+        self._carved = 0  # frames whose fans are carved into self._carve
+        self._carve: ColumnGrid | None = None  # carved ground cells (flags CARVED only)
+        self._carve_level: int | None = None
         self._columns: ColumnGrid | None = None
         self._level: int | None = None
         self._removals = -1
         self._ridge: tuple[bytes, RidgeGraph] | None = None
+        self._graph: tuple[tuple[bytes, int], VoronoiGraph] | None = None
         self._rooms = RoomTracker()
         self._frontiers = FrontierTracker()
         self._class_memo: dict[tuple[str, ...], list[tuple[str, float]]] = {}
         self._panel_memo: dict[bytes, object] = {}  # door openings from swung panels
+        self._assign_cache = AssignCache()  # Dijkstra rows and sight lines of assignment
         self._last: tuple[tuple, SceneGraph] | None = None
         self.layers: MapLayers | None = None
+        self._warm_classifier()
+
+    def _warm_classifier(self) -> None:
+        """Load the classifier's per-category evidence for every object category of the
+        instance table now, before frames arrive, rather than at the first refresh that
+        sees one (a classifier with a memoised ``votes(category)``, as the learned
+        containment model, is asked once per category; answers do not change)."""
+        votes = getattr(self.classifier, "votes", None)
+        if not callable(votes):
+            return
+        for cat in sorted({i.category for i in self.instances.values()
+                           if i.kind in OBJECT_KINDS}):
+            votes(cat)
 
     # ----- input ------------------------------------------------------------------------
     def set_instances(self, instances: Mapping[int, InstanceInfo]) -> list[int]:
@@ -158,10 +186,11 @@ class SceneGraphBuilder:
                 changed.append(iid)
                 self.voxels.forget_instance(iid)
         self.instances = dict(sorted(instances.items()))
+        self._warm_classifier()
         return changed
 
     def integrate(self, frame: Frame) -> None:
-        t0 = time.perf_counter()
+        t0 = self.clock()
         src = frame.base_pose if frame.base_pose is not None else frame.pose
         x, y = float(src[0, 3]), float(src[1, 3])
         if frame.base_pose is not None:
@@ -177,7 +206,7 @@ class SceneGraphBuilder:
         self.trajectory.append((x, y))
         self.robot = (x, y, yaw)
         self.frames_since_refresh += 1
-        self.timings["integrate"].append((time.perf_counter() - t0) * 1e3)
+        self.timings["integrate"].append((self.clock() - t0) * 1e3)
 
     def due(self) -> bool:
         """True when ``refresh_every`` frames were integrated since the last refresh."""
@@ -186,7 +215,7 @@ class SceneGraphBuilder:
     # ----- refresh ----------------------------------------------------------------------
     def refresh(self, time_ns: int | None = None, from_scratch: bool = False) -> SceneGraph:
         """The scene graph now (module doc). ``time_ns`` defaults to 0."""
-        t_all = time.perf_counter()
+        t_all = self.clock()
         stamp = int(time_ns or 0)
         key = (self.voxels.version, len(self.trajectory), self.robot,
                tuple((i, v.state) for i, v in self.instances.items()))
@@ -195,11 +224,14 @@ class SceneGraphBuilder:
             return dataclasses.replace(self._last[1], time_ns=stamp)
         if from_scratch:
             self._columns = None
+            self._carve = None
             self._ridge = None
+            self._graph = None
+            self._assign_cache = AssignCache()
             self._class_memo = {}
             self._panel_memo = {}
         timings = self.timings_scratch if from_scratch else self.timings
-        tick = _Ticker(timings)
+        tick = _Ticker(timings, self.clock)
         cfg = self.config
         occ = self._occupancy()
         tick("bev")
@@ -212,7 +244,7 @@ class SceneGraphBuilder:
         blocked = occ.grid == OCCUPIED
         graph_all = vg.csgraph()
         objects = place_objects(self._seen(OBJECT_KINDS), vg, node_room, graph_all, occ,
-                                blocked, cfg.assign)
+                                blocked, cfg.assign, self._assign_cache)
         tick("assign")
         regions, node_region = room_regions(vg, rooms.seg, rooms.room_ids, cfg.regions)
         objects = [place_in_room(o, node_room, rooms.room_ids, node_region) for o in objects]
@@ -250,7 +282,7 @@ class SceneGraphBuilder:
         self._last = (key, sg)
         self.frames_since_refresh = 0
         tick("assemble")
-        timings["refresh"].append((time.perf_counter() - t_all) * 1e3)
+        timings["refresh"].append((self.clock() - t_all) * 1e3)
         return sg
 
     # ----- stages -----------------------------------------------------------------------
@@ -266,25 +298,33 @@ class SceneGraphBuilder:
             cg = ColumnGrid(res, cfg)
             cg.add(classify_keys(keys, level, res, cfg, presorted=True), self.trajectory)
             self._columns, self._level, self._removals = cg, level, self.voxels.removals
-            self._carved = 0
         else:
             new = self.voxels.drain_new_keys()
             self._columns.add(classify_keys(new, level, res, cfg), self.trajectory)
+        # the carved ground lives in its own grid, kept while the floor level stays: a
+        # rebuild of the columns (a door opened) does not carve every frame again
+        if self._carve is None or self._carve_level != level:
+            self._carve, self._carve_level, self._carved = ColumnGrid(res, cfg), level, 0
         if self._carved < len(self._fans):
-            self._columns.carve(np.concatenate(self._fans[self._carved:]), level)
+            self._carve.carve(np.concatenate(self._fans[self._carved:]), level)
             self._carved = len(self._fans)
+        self._columns.merge(self._carve)
         return self._columns.occupancy(self.trajectory, level)
 
     def _voronoi(self, occ: OccupancyGrid, robot_xy: tuple[float, float] | None
                  ) -> VoronoiGraph:
         """The Voronoi graph of the robot's component; the ridge pixel graph is reused
-        while the occupancy grid is unchanged."""
+        while the occupancy grid is unchanged, the graph while its component is too."""
         cfg = self.config.voronoi
         digest = hashlib.blake2b(occ.grid.tobytes(), digest_size=16).digest() + repr(
             (occ.origin, occ.grid.shape)).encode()
         if self._ridge is None or self._ridge[0] != digest:
             self._ridge = (digest, ridge_graph(occ, cfg))
-        return voronoi_graph(occ, cfg, anchor=robot_xy, ridge=self._ridge[1])
+        key = (digest, chosen_component(occ, self._ridge[1], robot_xy))
+        if self._graph is None or self._graph[0] != key:  # same ridge, same component
+            self._graph = (key, voronoi_graph(occ, cfg, anchor=robot_xy,
+                                              ridge=self._ridge[1]))
+        return self._graph[1]
 
     def _segment(self, occ: OccupancyGrid, vg: VoronoiGraph) -> _Rooms:
         """Rooms: the door evidence cuts the graph; ids stay stable by overlap."""
@@ -318,11 +358,12 @@ class SceneGraphBuilder:
 
 
 class _Ticker:
-    def __init__(self, timings: dict[str, list[float]]) -> None:
+    def __init__(self, timings: dict[str, list[float]], clock: Callable[[], float]) -> None:
         self.timings = timings
-        self.t = time.perf_counter()
+        self.clock = clock
+        self.t = clock()
 
     def __call__(self, stage: str) -> None:
-        now = time.perf_counter()
+        now = self.clock()
         self.timings[stage].append((now - self.t) * 1e3)
         self.t = now

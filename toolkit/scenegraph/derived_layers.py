@@ -28,6 +28,7 @@ from foxglove_schemas_protobuf.SceneEntity_pb2 import SceneEntity
 from foxglove_schemas_protobuf.SceneEntityDeletion_pb2 import SceneEntityDeletion
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
 from foxglove_schemas_protobuf.TextPrimitive_pb2 import TextPrimitive
+from scipy.spatial import ConvexHull, QhullError
 
 from sgtool.colors import color_for
 from sgtool.log import codec
@@ -67,52 +68,59 @@ def voronoi_message(refresh: Refresh) -> Any | None:
     rooms = lay.node_rooms
     ent = SceneEntity(timestamp=codec.timestamp(refresh.time_ns), frame_id=S.WORLD_FRAME,
                       id="voronoi")
+    colors: dict[str | None, Color] = {}
+
+    def color(key: str | None) -> Color:
+        c = colors.get(key)
+        if c is None:
+            c = colors[key] = _color(key)
+        return c
+
+    xy = vg.positions.tolist()
+    points = [Point3(x=float(x), y=float(y), z=GRAPH_Z) for x, y in xy]
     if len(vg.edges):
         pts, cols = [], []
         for u, v in vg.edges.tolist():
             ru, rv = rooms[u], rooms[v]
-            c = _color(ru if ru == rv else None)
-            for n in (u, v):
-                x, y = vg.positions[n]
-                pts.append(Point3(x=float(x), y=float(y), z=GRAPH_Z))
-                cols.append(c)
+            c = color(ru if ru == rv else None)
+            pts += (points[u], points[v])
+            cols += (c, c)
         ent.lines.append(LinePrimitive(type=LinePrimitive.LINE_LIST, thickness=0.03,
                                        points=pts, colors=cols, color=_color(None)))
-    for n in range(len(vg)):
-        x, y = vg.positions[n]
+    for n, (x, y) in enumerate(xy):
         s = ent.spheres.add()
         s.pose.position.x, s.pose.position.y, s.pose.position.z = float(x), float(y), GRAPH_Z
         s.pose.orientation.w = 1.0
         s.size.x = s.size.y = s.size.z = 0.08
-        s.color.CopyFrom(_color(rooms[n]))
+        s.color.CopyFrom(color(rooms[n]))
     return SceneUpdate(deletions=[SceneEntityDeletion(
         timestamp=codec.timestamp(refresh.time_ns), type=SceneEntityDeletion.ALL)],
         entities=[ent])
 
 
 def _hull(points: np.ndarray, margin: float) -> np.ndarray:
-    """Convex hull (counter-clockwise) of the discs of radius ``margin`` around ``points``,
-    approximated by 8 points per disc."""
+    """Convex hull (counter-clockwise, from its lowest-x then lowest-y vertex) of the discs
+    of radius ``margin`` around ``points``, approximated by 8 points per disc; collinear
+    points are not vertices. Qhull (``scipy.spatial.ConvexHull``) finds it; a cloud that
+    spans no area (fewer than 3 points, or all on one line) is returned as its sorted
+    distinct points when it has fewer than 3, else as its two extreme points."""
     ang = np.arange(8) * (np.pi / 4)
     ring = np.stack([np.cos(ang), np.sin(ang)], axis=1) * margin
     cloud = (points[:, None, :] + ring[None, :, :]).reshape(-1, 2)
-    cloud = np.unique(np.round(cloud, 6), axis=0)  # sorted: Andrew's monotone chain
+    cloud = np.round(cloud, 6)
+    cloud = cloud[np.lexsort((cloud[:, 1], cloud[:, 0]))]  # sorted: cloud[0] is the start
+    keep = np.ones(len(cloud), dtype=bool)
+    keep[1:] = np.any(cloud[1:] != cloud[:-1], axis=1)
+    cloud = cloud[keep]
     if len(cloud) < 3:
         return cloud
-
-    def half(pts: np.ndarray) -> list[np.ndarray]:
-        out: list[np.ndarray] = []
-        for p in pts:
-            while len(out) >= 2:
-                a, b = out[-2], out[-1]
-                if (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) > 1e-12:
-                    break
-                out.pop()
-            out.append(p)
-        return out
-
-    lower, upper = half(cloud), half(cloud[::-1])
-    return np.asarray(lower[:-1] + upper[:-1])
+    try:
+        hull = ConvexHull(cloud)
+    except QhullError:  # all points on one line: its two ends
+        return cloud[[0, -1]]
+    vertices = hull.vertices  # counter-clockwise in 2-D
+    start = int(np.argmin(vertices))  # the smallest index is the lexicographic minimum
+    return cloud[np.roll(vertices, -start)]
 
 
 def rooms_message(refresh: Refresh) -> Any | None:

@@ -17,8 +17,9 @@ Node ids are strings with a layer prefix: ``room:3``, ``region:3.1``, ``frontier
 
 from __future__ import annotations
 
+import functools
 import json
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any, Literal
 
 from sgtool.canonical import canonical_float, canonical_floats
@@ -147,26 +148,26 @@ class SceneGraph:
     # ----- canonical form -------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
         def room(n: RoomNode) -> dict[str, Any]:
-            d = asdict(n)
+            d = _shallow(n)
             d["position"] = canonical_floats(n.position)
             d["category_scores"] = [[c, canonical_float(p)] for c, p in n.category_scores]
             d["neighbours"] = sorted(n.neighbours)
             return d
 
         def region(n: RegionNode) -> dict[str, Any]:
-            d = asdict(n)
+            d = _shallow(n)
             d["position"] = canonical_floats(n.position)
             d["size"] = canonical_float(n.size)
             return d
 
         def obj(n: ObjectNode) -> dict[str, Any]:
-            d = asdict(n)
+            d = _shallow(n)
             d["position"] = canonical_floats(n.position)
             d["affordances"] = sorted(n.affordances)
             return d
 
         def door(n: DoorNode) -> dict[str, Any]:
-            d = asdict(n)
+            d = _shallow(n)
             d["position"] = canonical_floats(n.position)
             d["rooms"] = sorted(n.rooms)
             return d
@@ -245,6 +246,17 @@ class SceneGraph:
     @classmethod
     def from_json(cls, text: str | bytes) -> SceneGraph:
         return cls.from_dict(json.loads(text))
+
+
+@functools.cache
+def _field_names(cls: type) -> tuple[str, ...]:
+    return tuple(f.name for f in fields(cls))
+
+
+def _shallow(node: Any) -> dict[str, Any]:
+    """The fields of a node as a dict: ``dataclasses.asdict`` without its deep copy (node
+    fields are immutable: strings, numbers, tuples)."""
+    return {name: getattr(node, name) for name in _field_names(type(node))}
 
 
 def _idkey(node_id: str) -> tuple[str, tuple[int | str, ...]]:

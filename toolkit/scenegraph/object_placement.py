@@ -14,7 +14,7 @@ import numpy as np
 from sgtool.mapping.grid import OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph
 from sgtool.mapping.voxels import VoxelMap
-from sgtool.scenegraph.assign import AssignConfig, assign_objects
+from sgtool.scenegraph.assign import AssignCache, AssignConfig, assign_objects
 from sgtool.scenegraph.instances import InstanceInfo
 
 OBJECT_KINDS = ("object", "furniture")
@@ -52,8 +52,10 @@ def seen_instances(voxels: VoxelMap, instances: Mapping[int, InstanceInfo],
 
 def place_objects(seen: list[SeenInstance], vg: VoronoiGraph, node_room: np.ndarray,
                   graph, occ: OccupancyGrid, blocked: np.ndarray,  # noqa: ANN001
-                  config: AssignConfig) -> list[PlacedObject]:
-    """Every seen object with its first-level ancestor and that ancestor's node."""
+                  config: AssignConfig, cache: AssignCache | None = None
+                  ) -> list[PlacedObject]:
+    """Every seen object with its first-level ancestor and that ancestor's node
+    (``cache``: see :class:`~sgtool.scenegraph.assign.AssignCache`)."""
     by_id = {info.id: (info, c, vp) for info, c, vp in seen}
 
     def top_of(iid: int) -> int:
@@ -71,7 +73,8 @@ def place_objects(seen: list[SeenInstance], vg: VoronoiGraph, node_room: np.ndar
         pts = np.asarray([by_id[i][1][:2] for i in tops], dtype=np.float64)
         vps = np.asarray([by_id[i][2] if by_id[i][2] is not None else (np.nan, np.nan)
                           for i in tops], dtype=np.float64)
-        asg = assign_objects(vg.positions, node_room, graph, pts, vps, occ, blocked, config)
+        asg = assign_objects(vg.positions, node_room, graph, pts, vps, occ, blocked, config,
+                             cache)
         nodes = asg.node
     else:
         nodes = np.full(len(tops), -1, dtype=np.int64)

@@ -32,7 +32,8 @@ from typing import Any
 import numpy as np
 
 from sgtool.errors import SgtoolError
-from sgtool.llm.client import ChatClient, LlmTransportError
+from sgtool.llm.client import DEFAULT_TIMEOUT_S, ChatClient, LlmTransportError, complete_within
+from sgtool.llm.constraints import Constraint
 from sgtool.llm.exchange import exchange_record, prompt_key
 from sgtool.llm.recorded import TranscriptWriter, read_transcript
 from sgtool.semantics.text import category_text
@@ -103,6 +104,8 @@ class CachedAsker:
                 if rec.get("response") is not None and not rec.get("error"):
                     self.answers[rec["prompt_sha256"]] = rec["response"]
         self.max_attempts = max_attempts
+        settings = getattr(client, "settings", None)
+        self.timeout_s = float(getattr(settings, "timeout_s", DEFAULT_TIMEOUT_S))
         self.stats = GenerationStats()
         self._writer: TranscriptWriter | None = None
 
@@ -122,9 +125,11 @@ class CachedAsker:
         if self._writer is None:
             self._writer = TranscriptWriter(self.path, append=True)
         last = ""
+        json_mode = Constraint("json_object", ()) \
+            if getattr(self.client, "takes_constraint", False) else None
         for attempt in range(self.max_attempts):
             try:
-                res = self.client.complete(messages)
+                res = complete_within(self.client, messages, self.timeout_s, json_mode)
             except LlmTransportError as e:
                 last = str(e)
                 self._writer.write(exchange_record(
@@ -263,3 +268,33 @@ def generate_sets(asker: CachedAsker, cfg: GenerationConfig = GenerationConfig()
     if not cont or not cooc:
         raise GenerationError("the LLM answers gave no containment or no co-occurrence pairs")
     return table_to_set("containment", cont), table_to_set("cooccurrence", cooc), tuple(rooms)
+
+
+@dataclass(frozen=True)
+class Agreement:
+    """How an LLM's relational set agrees with a reference set (BEHAVIOR-1K) on the pairs
+    both hold (node and query compared as words)."""
+
+    relation: str
+    common: int  # pairs in both sets
+    agree: int  # same side of the threshold: LLM >= 0.5 vs reference > 0
+    llm_pairs: int
+
+    @property
+    def rate(self) -> float:
+        return self.agree / self.common if self.common else float("nan")
+
+
+def agreement(llm: Any, reference: Any) -> Agreement:
+    """:class:`Agreement` of two :class:`~sgtool.semantics.relational_set.RelationalSet`."""
+    ref: dict[tuple[str, str], float] = {}
+    for (i, j), t in zip(reference.pairs.tolist(), reference.targets.tolist(), strict=True):
+        ref[(normalize_name(reference.nodes[i]), normalize_name(reference.queries[j]))] = t
+    common = agree = 0
+    for (i, j), t in zip(llm.pairs.tolist(), llm.targets.tolist(), strict=True):
+        r = ref.get((normalize_name(llm.nodes[i]), normalize_name(llm.queries[j])))
+        if r is None:
+            continue
+        common += 1
+        agree += int((t >= 0.5) == (r > 0))
+    return Agreement(llm.relation, common, agree, len(llm.targets))

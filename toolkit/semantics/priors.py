@@ -115,6 +115,12 @@ class LearnedPriors:
         """False for a room type the training data hardly covers (module doc)."""
         return category_text(name) not in self.unscored_rooms
 
+    def forget_scores(self) -> None:
+        """Empty the score memo. The MLP scores the names a memo misses as one batch, and a
+        score's last float32 bit can depend on its batch: a unit of work that starts from an
+        empty memo (a bench task) gives the same bits whatever ran before it in the process."""
+        self._memo = _Memo()
+
     def _mlp_scores(self, mlp: RelationMLP, names: Sequence[str], query: str) -> np.ndarray:
         texts = [category_text(n) for n in names]
         vecs = self.encoder.encode(texts + [category_text(query)])
@@ -203,3 +209,9 @@ def training_queries(weights_dir: str | Path | None = None) -> frozenset[str]:
 def default_priors() -> LearnedPriors:
     """The shipped distilled models with the process-wide encoder."""
     return LearnedPriors()
+
+
+def forget_default_scores() -> None:
+    """:meth:`LearnedPriors.forget_scores` of :func:`default_priors`, if it is loaded."""
+    if default_priors.cache_info().currsize:
+        default_priors().forget_scores()

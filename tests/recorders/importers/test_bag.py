@@ -252,14 +252,20 @@ def test_wrong_topic_types_name_topic_and_type(tmp_path):
             in r.output)
     r = run(base + ["--depth", TOPICS["rgb"], "--info", TOPICS["info"]])
     assert r.exit_code == 2
-    assert "topic /camera/rgb/image_raw: image encoding 'rgb8' is not a depth encoding" \
+    assert ("--depth /camera/rgb/image_raw carries 'rgb8' images; --depth needs a depth "
+            "encoding" in r.output)
+    assert "suggested flags: --depth /camera/depth/image_raw --rgb /camera/rgb/image_raw" \
+        in r.output
+    r = run(base + ["--depth", TOPICS["depth"], "--rgb", TOPICS["depth"]])
+    assert "--rgb /camera/depth/image_raw carries '16UC1' images; --rgb needs a colour" \
         in r.output
     r = run(base + ["--depth", TOPICS["depth"], "--info", TOPICS["depth"]])
     assert "--info /camera/depth/image_raw is a sensor_msgs/msg/Image topic" in r.output
     r = run(base + ["--depth", "/nope", "--info", TOPICS["info"]])
     assert "--depth /nope: no such topic" in r.output and "/camera/rgb/image_raw" in r.output
-    r = run(base + ["--depth", TOPICS["depth"]])
-    assert "CameraInfo topics: /camera/depth/camera_info" in r.output
+    r = run(base + ["--depth", TOPICS["depth"], "--ids", TOPICS["rgb"]])
+    assert "--ids /camera/rgb/image_raw carries 'rgb8' images; --ids needs an integer" \
+        in r.output
     r = run(base + ["--depth", TOPICS["depth"], "--info", TOPICS["info"],
                     "--tf-frames", "map:camera_optical_frame"])
     assert "frame 'map' is not in the tf tree" in r.output

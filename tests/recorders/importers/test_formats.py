@@ -10,6 +10,7 @@ import cv2
 import numpy as np
 import pytest
 from support.bag_export import typestore_for
+from support.rgbd_folders import room_depth
 
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
@@ -148,22 +149,6 @@ def test_rotation_to_z_maps_each_axis_up(axis):
     assert np.linalg.det(R) == pytest.approx(1.0)
 
 
-def room_depth(k: CameraIntrinsics, cam_height: float, pitch_deg: float) -> np.ndarray:
-    """Depth of a level floor seen by a camera ``cam_height`` above it, pitched down by
-    ``pitch_deg``; the upper image rows see a wall 3 m ahead."""
-    v, u = np.mgrid[0:k.height, 0:k.width]
-    ray = np.stack([(u - k.cx) / k.fx, (v - k.cy) / k.fy, np.ones_like(u, float)], -1)
-    p = np.radians(pitch_deg)
-    # camera-frame down direction of the world, and forward on the floor plane
-    down = np.array([0.0, np.cos(p), np.sin(p)])
-    fwd = np.array([0.0, -np.sin(p), np.cos(p)])
-    t_floor = cam_height / np.maximum(ray @ down, 1e-9)
-    t_floor[ray @ down <= 1e-6] = np.inf
-    t_wall = 3.0 / np.maximum(ray @ fwd, 1e-9)
-    t = np.minimum(t_floor, t_wall)
-    return (t * ray[..., 2]).astype(np.float32)
-
-
 def test_alignment_recovers_a_tilted_world_and_the_floor():
     """A world whose up is a tilted vector and whose floor is 0.7 m below its origin; the
     camera is pitched down 25 degrees (so the camera-up guess alone is 25 degrees off)."""
@@ -246,7 +231,12 @@ def test_raw_image_with_row_padding_and_bgr():
     msg = Image(header=Header(seq=0, stamp=Time(sec=0, nanosec=0), frame_id="c"), height=4,
                 width=5, encoding="yuv422", is_bigendian=0, step=10,
                 data=np.zeros(40, np.uint8))
-    with pytest.raises(SgtoolError, match=r"topic /rgb: image encoding 'yuv422'"):
+    with pytest.raises(SgtoolError, match=r"topic /rgb: a yuv422 image needs an even width"):
+        images.decode_color_message(msg, "sensor_msgs/msg/Image", "/rgb")
+    msg = Image(header=Header(seq=0, stamp=Time(sec=0, nanosec=0), frame_id="c"), height=4,
+                width=5, encoding="nv21", is_bigendian=0, step=10,
+                data=np.zeros(40, np.uint8))
+    with pytest.raises(SgtoolError, match=r"topic /rgb: image encoding 'nv21'"):
         images.decode_color_message(msg, "sensor_msgs/msg/Image", "/rgb")
 
 

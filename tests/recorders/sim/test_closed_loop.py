@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from support.scripted_planner import Scripted
 from support.semantics_fixtures import ChatServer
 
 from sgtool.analysis.offline import read_log_episodes, replay_decisions
@@ -25,7 +26,7 @@ from sgtool.datasets.generator import generate_house
 from sgtool.errors import SgtoolError
 from sgtool.log import LogReader, LogWriter
 from sgtool.log import schemas as S
-from sgtool.planning.base import Action, Feedback
+from sgtool.planning.base import Action
 from sgtool.planning.candidates import find_target
 from sgtool.planning.registry import make_planner
 from sgtool.recorders.sim import CameraConfig
@@ -228,28 +229,6 @@ def test_random_episode(house, tmp_path) -> None:
     assert all(d.graph is not None for d in logged.decisions[1:])
 
 
-class Scripted:
-    """A planner that plays fixed actions and remembers the feedback it gets."""
-
-    name = "scripted"
-
-    def __init__(self, actions) -> None:
-        self.actions = list(actions)
-        self.feedbacks: list[Feedback] = []
-        self.graphs: list[SceneGraph] = []
-
-    def reset(self, query: str, seed: int = 0) -> None:
-        pass
-
-    def decide(self, graph: SceneGraph) -> Action:
-        self.graphs.append(graph)
-        a = self.actions.pop(0)
-        return a(graph) if callable(a) else a
-
-    def feedback(self, fb: Feedback) -> None:
-        self.feedbacks.append(fb)
-
-
 def test_invalid_targets_and_done_in_the_loop(house, tmp_path) -> None:
     idx, ep = pick_episode(house, index=0)
     p = Scripted([Action("navigate", "obj:424242"),
@@ -358,6 +337,8 @@ def test_moma_llm_episode_and_its_replay(house, tmp_path) -> None:
     (["--planner", "scout", "-O", "nonsense=1"], "does not take option(s): nonsense"),
     (["--planner", "scout", "--llm-replay", "x.jsonl"], "are for --planner moma-llm"),
     (["--planner", "scout", "-o", "{exists}"], "exists; not overwriting it (use --force)"),
+    (["--planner", "scout", "--optimistic", "5"], "optimistic margin 5.0 m: must be 0..2"),
+    (["--planner", "scout", "--noise", "loud"], "unknown profile 'loud'"),
 ])
 def test_user_errors(tmp_path, args, message) -> None:
     (tmp_path / "bad.json").write_text("{not json")

@@ -35,7 +35,7 @@ def test_cli_writes_outputs_and_is_deterministic(tmp_path):
     files = sorted(p.name for p in (tmp_path / "a").iterdir())
     assert files == ["efficiency_distance.png", "efficiency_steps.png", "episodes.jsonl",
                      "per_house.jsonl", "per_house.md", "per_query.jsonl", "per_query.md",
-                     "summary.json", "summary.md"]
+                     "run.json", "run.md", "summary.json", "summary.md"]
     recs = read_jsonl(tmp_path / "a" / "episodes.jsonl")
     # 2 planners x 2 seeds x 2 houses x 2 episodes, ordered planner, house, episode, seed
     assert len(recs) == 16
@@ -58,6 +58,15 @@ def test_cli_writes_outputs_and_is_deterministic(tmp_path):
         _strip_wall(tmp_path / "b" / "episodes.jsonl")
     assert json.loads((tmp_path / "b" / "summary.json").read_text())["digest"] == \
         summary["digest"]
+    # the summaries hold no wall-clock figure: the same bytes with one worker or two;
+    # run.md/run.json hold the timing and the command
+    for name in ("summary.md", "summary.json", "per_house.md", "per_query.jsonl"):
+        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes()
+    assert "Decision time" not in (tmp_path / "a" / "summary.md").read_text()
+    run_md = (tmp_path / "b" / "run.md").read_text()
+    assert "Decision time" in run_md and "with 2 worker(s)" in run_md
+    run = json.loads((tmp_path / "b" / "run.json").read_text())
+    assert run["wall"]["workers"] == 2 and set(run["wall"]["decision_s"]) == {"random", "greedy"}
 
 
 def _toy_priors(folder, queries) -> str:

@@ -8,7 +8,13 @@ import numpy as np
 import pytest
 from support.semantics_fixtures import TableScorer
 
-from sgtool.planning.calibration import BlendedPriors, BlendParams, calibrate, novelty_weight
+from sgtool.planning.calibration import (
+    BlendedPriors,
+    BlendParams,
+    blended_relations,
+    calibrate,
+    novelty_weight,
+)
 
 
 def test_calibrate_floor_and_sharpness() -> None:
@@ -56,3 +62,35 @@ def test_blend_without_training_queries_is_the_learned_scorer() -> None:
     learned = TableScorer({"kitchen": 0.9}, {})
     b = BlendedPriors(learned, TableScorer({}, {}), None, AxisEncoder())
     assert b.rooms(["kitchen"], "tractor").tolist() == [0.9]
+
+
+def _report(learned_auc: float, cos_auc: float) -> dict:
+    rel = {"learned": {"auc": learned_auc}, "cosine": {"auc": cos_auc}}
+    return {"unseen": {"containment": rel, "cooccurrence": {
+        "learned": {"auc": 0.7}, "cosine": {"auc": 0.6}}}}
+
+
+def test_gate_blends_only_the_relations_where_cosine_measured_better() -> None:
+    # containment: cosine 0.8 > learned 0.6 -> blended; co-occurrence: learned better -> not
+    assert blended_relations(_report(0.6, 0.8)) == {"containment"}
+    assert blended_relations(_report(0.9, 0.7)) == set()
+    assert blended_relations(None) == {"containment", "cooccurrence"}  # nothing measured
+    assert blended_relations({"unseen": {"containment": {}}}) == {"containment",
+                                                                   "cooccurrence"}
+
+
+def test_gated_blend_keeps_learned_scores_where_learned_measured_better() -> None:
+    learned = TableScorer({"kitchen": 0.9}, {"fridge": 0.7})
+    learned.metadata = {"report": _report(0.6, 0.8)}  # type: ignore[attr-defined]
+    cosine = TableScorer({"kitchen": 0.35}, {"fridge": 0.6})
+    params = BlendParams(lo=0.5, hi=0.9, cos_lo=0.1, cos_hi=0.6)
+    b = BlendedPriors(learned, cosine, ["apple"], AxisEncoder(), params)
+    # rooms (containment) blended as in (C3): lambda("pear") = 0.75
+    assert b.rooms(["kitchen"], "pear")[0] == pytest.approx(0.75 * 0.9 + 0.25 * 0.5)
+    # objects (co-occurrence): the learned model measured better -> unchanged, even for a
+    # query with nothing like it in training
+    assert b.objects(["fridge"], "tractor").tolist() == [0.7]
+    # gate off: the distance blend on both relations
+    ungated = BlendedPriors(learned, cosine, ["apple"], AxisEncoder(),
+                            BlendParams(lo=0.5, hi=0.9, cos_lo=0.1, cos_hi=0.6, gate=False))
+    assert ungated.objects(["fridge"], "tractor")[0] == pytest.approx(1.0)

@@ -63,3 +63,24 @@ def test_distance_is_one_soft_rule_among_others() -> None:
     p = EscPlanner(SCORER, EscParams(w_obj=0.0))
     p.reset("frying pan")
     assert p.decide(g).target == "frontier:2"
+
+
+def test_a_carrier_is_scored_by_itself_not_by_its_neighbours() -> None:
+    """Two closed carriers 1 m apart (within the 2 m radius): a cabinet (co-occurrence 0.9)
+    and a wardrobe (0.1). A frontier between them takes the best neighbour (R1), but each
+    carrier is checked for itself: the wardrobe keeps its own 0.1."""
+    scorer = TableScorer(rooms={"kitchen": 0.8}, objects={"cabinet": 0.9, "wardrobe": 0.1})
+    objects = (
+        ObjectNode("obj:1", "cabinet", "region:1.1", "room:1", (3.0, 0.0, 0.0), state="closed"),
+        ObjectNode("obj:2", "wardrobe", "region:1.1", "room:1", (4.0, 0.0, 0.0),
+                   state="closed"),
+    )
+    regions = (RegionNode("region:1.1", "room:1", (0.0, 0.0)),
+               RegionNode("frontier:1", "room:1", (3.5, 0.0), "frontier", "unexplored area"))
+    g = SceneGraph(RobotState((0.0, 0.0), room="room:1"),
+                   rooms=(RoomNode("room:1", "kitchen", (0.0, 0.0)),), regions=regions,
+                   objects=objects, distances={"obj:1": 3.0, "obj:2": 4.0, "frontier:1": 3.5})
+    cands = actionable(g)
+    assert [c.node_id for c in cands] == ["frontier:1", "obj:1", "obj:2"]
+    s = esc_scores(g, cands, "frying pan", scorer, EscParams(w_obj=1.0, w_room=0.0, w_dist=0.0))
+    assert s.tolist() == pytest.approx([0.9, 0.9, 0.1])

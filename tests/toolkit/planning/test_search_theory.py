@@ -69,9 +69,9 @@ def test_bayes_update_after_an_empty_container() -> None:
     # (B5): P(n | fridge empty) = P(n) / (1 - P(fridge))
     for n in ("obj:2", "door:1"):
         assert after[n] == pytest.approx(before[n] / (1.0 - before["obj:1"]))
-    # the prior by hand: R(kitchen) = 0.05 + 0.95 * 0.9, C = 0.05 + 0.95 * s,
-    # Z = C(fridge) + C(wardrobe); the door holds R̄ (no room types listed: 0.3)
-    r, cf, cw = 0.05 + 0.95 * 0.9, 0.05 + 0.95 * 0.8, 0.05 + 0.95 * 0.2
+    # the prior by hand: R(kitchen) = 0.05 + 0.95 * 0.9, C = 0.05 + 0.95 * s^2 (object
+    # sharpness 2), Z = C(fridge) + C(wardrobe); the door holds R̄ (no room types: 0.3)
+    r, cf, cw = 0.05 + 0.95 * 0.9, 0.05 + 0.95 * 0.8 ** 2, 0.05 + 0.95 * 0.2 ** 2
     w = np.array([r * cf / (cf + cw), r * cw / (cf + cw), 0.3])
     assert [before[n] for n in ("obj:1", "obj:2", "door:1")] == pytest.approx(w / w.sum())
     # the kitchen's remaining mass (its wardrobe, ~0.21 unnormalised) is now below the
@@ -117,3 +117,22 @@ def test_registry_options() -> None:
     p = make_planner("bayes-search", horizon="2", step_cost=0.5, timed=False)
     assert (p.params.horizon, p.params.step_cost) == (2, 0.5)
     assert dataclasses.is_dataclass(p.params)
+
+
+def test_region_weight_scales_the_mass_of_an_unseen_region() -> None:
+    """A kitchen with one revealed region (fridge, wardrobe) and one unexplored-area
+    frontier: K = ω · n̄ · C̄ with n̄ = 2 carriers per revealed region and C̄ their mean C,
+    and the frontier's share of the kitchen is K / (C(fridge) + C(wardrobe) + K)."""
+    g = kitchen()
+    frontier = RegionNode("frontier:1", "room:1", (0.0, 5.0), "frontier", "unexplored area")
+    g = SceneGraph(g.robot, g.rooms, (*g.regions, frontier), g.objects, (),
+                   {**g.distances, "frontier:1": 5.0})
+    cands = actionable(g)
+    assert [c.node_id for c in cands] == ["frontier:1", "obj:1", "obj:2"]
+    cf, cw = 0.05 + 0.95 * 0.8 ** 2, 0.05 + 0.95 * 0.2 ** 2
+    for omega in (0.5, 1.0):
+        p = place_masses(g, cands, "q", SCORER, BeliefParams(region_weight=omega))
+        k = omega * 2 * (cf + cw) / 2
+        # one room: the masses are the kitchen's split, (B2)-(B3)
+        assert p.tolist() == pytest.approx([k / (cf + cw + k), cf / (cf + cw + k),
+                                            cw / (cf + cw + k)])

@@ -14,6 +14,7 @@ at), then the nearest, then the smallest id.
 
 from __future__ import annotations
 
+import json
 import math
 import re
 from dataclasses import dataclass
@@ -62,10 +63,30 @@ def _section(text: str, name: str) -> str:
     return " ".join(m.group(1).split()) if m else ""
 
 
+def _json_answer(text: str) -> tuple[str, str, str] | None:
+    """(command, analysis, reasoning) of a structured-output answer (a JSON object with a
+    ``command`` string, :func:`sgtool.llm.constraints.command_schema`), else None."""
+    if not text.lstrip().startswith("{"):
+        return None
+    try:
+        obj = json.loads(text)
+    except ValueError:
+        return None
+    if not isinstance(obj, dict) or not isinstance(obj.get("command"), str):
+        return None
+    return (obj["command"], " ".join(str(obj.get("analysis", "")).split()),
+            " ".join(str(obj.get("reasoning", "")).split()))
+
+
 def parse_response(text: str) -> Command:
-    """The command of an answer; the last "Command:" line wins, else the last call."""
+    """The command of an answer; the last "Command:" line wins, else the last call. A JSON
+    answer (structured outputs) gives its ``command``, ``analysis`` and ``reasoning``."""
     if not isinstance(text, str) or not text.strip():
         raise InvalidCommand("the answer is empty")
+    structured = _json_answer(text)
+    if structured is not None:
+        cmd = parse_response(f"Command: {structured[0]}")
+        return Command(cmd.name, cmd.args, structured[1], structured[2])
     call = None
     lines = _COMMAND_LINE.findall(text)
     for line in reversed(lines):

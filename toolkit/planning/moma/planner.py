@@ -25,7 +25,12 @@ The outcome of executed actions (:meth:`MomaLlmPlanner.feedback`) goes into the 
 planner rejected stay in the history as written, with ``invalid argument`` and the reason.
 Every request is logged as an ``sgtool.LlmExchange`` record: kept in
 :attr:`MomaLlmPlanner.exchanges`, passed to ``on_exchange`` and appended to ``transcript``
-(JSONL, replayable).
+(JSONL, replayable), with the answer's ``verdict`` (``ok`` or ``invalid: reason``) and the
+``constraint`` it was generated under. ``constraint`` (:mod:`sgtool.llm.constraints`):
+``grammar`` or ``json_schema`` restrict the answer to the valid commands of the current
+scene (:func:`~sgtool.planning.moma.choices.valid_commands`), ``auto`` asks the endpoint
+which it supports, ``none`` parses plain answers. :attr:`MomaLlmPlanner.invalid_commands`
+counts the rejected answers of the episode (MoMa-LLM's invalid actions).
 """
 
 from __future__ import annotations
@@ -37,11 +42,13 @@ from pathlib import Path
 from typing import Any
 
 from sgtool.llm.client import ChatClient, LlmTransportError, complete_within
+from sgtool.llm.constraints import REASON_CHARS, Constraint, check_kind, detect_kind
 from sgtool.llm.exchange import Message, exchange_record
 from sgtool.llm.recorded import ReplayMiss, TranscriptWriter
 from sgtool.planning.base import Action, Feedback
+from sgtool.planning.moma.choices import valid_commands
 from sgtool.planning.moma.commands import InvalidCommand, ground, parse_response
-from sgtool.planning.moma.scene_text import encode_scene, nearest_room, room_of
+from sgtool.planning.moma.scene_text import EncodedScene, encode_scene, nearest_room, room_of
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.semantics.text import category_text
 
@@ -106,12 +113,21 @@ class MomaLlmPlanner:
         on_exchange: Callable[[dict[str, Any]], None] | None = None,
         transcript: str | Path | None = None,
         decision_timeout_s: float = DECISION_TIMEOUT_S,
+        constraint: str = "none",
+        reason_chars: int = REASON_CHARS,
     ) -> None:
         if max_attempts < 1:
             raise ValueError("max_attempts must be >= 1")
         if not decision_timeout_s > 0:
             raise ValueError("decision_timeout_s must be > 0")
         self.decision_timeout_s = float(decision_timeout_s)
+        self.constraint = check_kind(constraint)
+        if self.constraint == "auto":
+            self.constraint = detect_kind(getattr(getattr(client, "settings", None),
+                                                  "base_url", None)) \
+                if getattr(client, "takes_constraint", False) else "none"
+        self.reason_chars = int(reason_chars)
+        self.invalid_commands = 0  # answers rejected (unparsable or not groundable)
         self.client = client
         self.max_attempts = int(max_attempts)
         self.stuck_repeats = int(stuck_repeats)
@@ -126,6 +142,7 @@ class MomaLlmPlanner:
 
     # ----- Planner protocol -------------------------------------------------------------
     def reset(self, query: str, seed: int = 0) -> None:
+        self.invalid_commands = 0
         self.query = query
         self.step = 0
         self.history = []
@@ -144,6 +161,7 @@ class MomaLlmPlanner:
             raise RuntimeError("moma-llm: reset(query) must be called before decide()")
         self.step += 1
         scene = encode_scene(graph)
+        constraint = self._constraint(graph, scene)
         messages: list[Message] = [
             {"role": "system", "content": system_prompt(self.query)},
             {"role": "user", "content": self.user_prompt(graph, scene.text)},
@@ -159,7 +177,7 @@ class MomaLlmPlanner:
                 break
             attempts += 1
             try:
-                result = complete_within(self.client, messages, left)
+                result = complete_within(self.client, messages, left, constraint)
             except ReplayMiss as e:
                 self._log(messages, None, 0.0, None, None, str(e), attempt)
                 return Action("done", None, reason=f"llm failure: {e}")
@@ -167,14 +185,15 @@ class MomaLlmPlanner:
                 self._log(messages, None, 0.0, None, None, str(e), attempt)
                 problems.append(str(e))
                 continue
-            self._log(messages, result.text, result.latency_s, result.prompt_tokens,
-                      result.completion_tokens, None, attempt, result.model, result.source,
-                      getattr(result, "truncated_from", None))
             cmd = None
             try:
                 cmd = parse_response(result.text)
                 action = ground(cmd, graph, scene, self.query)
             except InvalidCommand as e:
+                self.invalid_commands += 1
+                self._log(messages, result.text, result.latency_s, result.prompt_tokens,
+                          result.completion_tokens, None, attempt, result.model, result.source,
+                          getattr(result, "truncated_from", None), f"invalid: {e}")
                 problems.append(str(e))
                 if cmd is not None:  # MoMa-LLM keeps "invalid argument" in the history
                     self.history.append(HistoryEntry(cmd.name, None, None, "", "",
@@ -188,6 +207,9 @@ class MomaLlmPlanner:
                     )},
                 ]
                 continue
+            self._log(messages, result.text, result.latency_s, result.prompt_tokens,
+                      result.completion_tokens, None, attempt, result.model, result.source,
+                      getattr(result, "truncated_from", None), "ok")
             return self._accept(cmd.name, action, graph, scene.name_by_room)
         last = problems[-1] if problems else "no answer"
         return Action(
@@ -195,6 +217,13 @@ class MomaLlmPlanner:
             reason=f"llm failure: no valid command after {attempts} attempt"
                    f"{'' if attempts == 1 else 's'}: {last}",
         )
+
+    def _constraint(self, graph: SceneGraph, scene: EncodedScene) -> Constraint | None:
+        """The valid commands of this decision as a grammar or schema (``constraint``)."""
+        if self.constraint not in ("grammar", "json_schema"):
+            return None
+        commands = valid_commands(graph, scene, self.query)
+        return Constraint(self.constraint, commands, self.reason_chars) if commands else None
 
     # ----- pieces -----------------------------------------------------------------------
     def _accept(self, command: str, action: Action, graph: SceneGraph,
@@ -260,13 +289,18 @@ class MomaLlmPlanner:
     def _log(self, messages: list[Message], response: str | None, latency: float,
              ptok: int | None, ctok: int | None, error: str | None, attempt: int,
              model: str | None = None, source: str | None = None,
-             truncated_from: int | None = None) -> None:
+             truncated_from: int | None = None, verdict: str | None = None) -> None:
+        extra: dict[str, Any] = {}
+        if self.constraint in ("grammar", "json_schema"):
+            extra["constraint"] = self.constraint
+        if verdict is not None:
+            extra["verdict"] = verdict
         rec = exchange_record(
             model=model or self.client.model, messages=messages, response=response,
             latency_s=latency, prompt_tokens=ptok, completion_tokens=ctok, error=error,
             attempt=attempt, step=self.step, query=self.query,
             source=source or str(getattr(self.client, "source", "endpoint")),
-            truncated_from=truncated_from,
+            truncated_from=truncated_from, extra=extra,
         )
         self.exchanges.append(rec)
         if self._transcript is not None:

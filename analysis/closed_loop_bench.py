@@ -1,0 +1,340 @@
+"""The closed-loop benchmark (``sgtool run-bench``): N episodes x planners x noise profiles
+in PyBullet, one episode log per run, and the table of the symbolic bench.
+
+Houses are those of ``sgtool bench`` (:mod:`sgtool.analysis.bench_houses`): generated ones
+(``house-<seed>``, the generator ``preset``) and given files; episodes are the bench's
+(:func:`~sgtool.analysis.bench_houses.bench_episodes`: the first ``episodes`` of the same
+draw, so a house's episodes are those of the symbolic bench). Every (noise, planner,
+house, episode) is one :class:`RunTask`; :func:`run_task` runs it into its own log,
+``LOGS/NOISE/PLANNER/HOUSE/ep-K.mcap``, and returns a :class:`RunRow` read back from that
+log (:func:`sgtool.analysis.offline.read_log_episodes`), so a fresh run and a resumed one
+give the same row. A log that exists is complete (the writer renames its partial file only
+at the end), so a task whose log exists is not run again: the benchmark resumes. Ctrl-C
+stops the run and removes the interrupted episode's partial file: only complete logs stay.
+
+:func:`run_task` takes everything it needs and returns a plain row, so executors can
+spread tasks over processes or machines (:func:`run_closed_loop_bench` takes a ``runner``,
+``map`` by default, that maps ``run_task`` over the tasks in order).
+
+The outputs (:func:`write_outputs`): ``episodes.jsonl`` (the
+:class:`~sgtool.results.EpisodeResult` of every run), ``summary.md`` (per noise profile:
+SR / SPL / steps / decision time / AUC-E as the symbolic bench, then frames per second and
+failed skills per episode by reason) and the efficiency curves per noise profile.
+"""
+
+from __future__ import annotations
+
+import re
+import statistics
+from collections import Counter
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from sgtool.analysis.bench_houses import (
+    BenchHouse,
+    bench_episodes,
+    generated_houses,
+    load_house_files,
+)
+from sgtool.analysis.metrics import cost_models, summarize
+from sgtool.analysis.offline import read_log_episodes
+from sgtool.analysis.report import format_table, pipe_table
+from sgtool.errors import SgtoolError
+from sgtool.files import atomic_write
+from sgtool.log.records import Action
+from sgtool.log.writer import partial_files
+from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, run_episode
+from sgtool.recorders.sim.noise import parse_noise
+from sgtool.results import EpisodeResult, write_jsonl
+
+# failed-skill reasons, by the first pattern their text matches
+REASONS: tuple[tuple[str, str], ...] = (
+    ("unreachable on the robot's map", "unreachable on the map"),
+    ("no map yet", "unreachable on the map"),
+    ("stands on no free cell", "unreachable on the map"),
+    ("blocked by an obstacle", "contact"),
+    ("re-plans", "no progress"),
+    ("out of reach", "out of reach"),
+    ("not on free floor", "not on free floor"),
+    ("behind closed door", "behind closed doors"),
+    ("no collision-free path", "no path"),
+    ("already", "already open/closed"),
+    ("cannot be opened", "not openable"),
+    ("stands in the way", "robot in the way"),
+    ("stopped:", "frame budget"),
+)
+
+
+def reason_class(reason: str) -> str:
+    """The class of a failed skill's reason (:data:`REASONS`; "other" when none fits)."""
+    for pattern, name in REASONS:
+        if pattern in reason:
+            return name
+    return "other"
+
+
+@dataclass(frozen=True)
+class ClosedLoopBenchConfig:
+    planners: tuple[str, ...]
+    houses: int = 5  # generated houses, seeds house_seed, +1, ...
+    house_seed: int = 0
+    house_files: tuple[str, ...] = ()
+    episodes: int = 6  # per house
+    rooms: tuple[int, int] = (12, 16)
+    preset: str = "symsearch"
+    noise: tuple[str, ...] = ("none",)  # noise profiles (`sgtool record --noise` syntax)
+    options: ClosedLoopOptions = field(default_factory=ClosedLoopOptions)
+    planner_options: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    distance_budget: float = 5000.0
+    step_budget: float = 50.0
+
+    def check(self) -> None:
+        from sgtool.planning.registry import PLANNER_NAMES
+
+        if not self.planners:
+            raise SgtoolError("--planners: name at least one planner")
+        for p in self.planners:
+            if p not in PLANNER_NAMES:
+                raise SgtoolError(f"--planners: unknown planner {p!r}; choose from "
+                                  f"{', '.join(PLANNER_NAMES)}")
+        if len(set(self.planners)) != len(self.planners) or \
+                len(set(self.noise)) != len(self.noise):
+            raise SgtoolError("--planners/--noise: a name is given twice")
+        if self.episodes < 1:
+            raise SgtoolError(f"--episodes: must be >= 1, got {self.episodes}")
+        if self.houses < 0 or (self.houses == 0 and not self.house_files):
+            raise SgtoolError(f"--houses: must be >= 1, or >= 0 with --house, got "
+                              f"{self.houses}")
+        for n in self.noise:
+            parse_noise(n)
+            if not re.fullmatch(r"[A-Za-z0-9_.=,+-]+", n):
+                raise SgtoolError(f"--noise {n!r}: a profile name with overrides "
+                                  "(letters, digits, _ . = , + -) names a log folder")
+        self.options.mapping()
+
+
+@dataclass(frozen=True)
+class RunTask:
+    """One closed-loop episode to run: everything :func:`run_task` needs."""
+
+    house: BenchHouse
+    episode: int
+    planner: str
+    noise: str
+    output: Path
+    options: ClosedLoopOptions
+    planner_options: Mapping[str, Any]
+    rooms: tuple[int, int]
+    preset: str
+
+
+@dataclass(frozen=True)
+class RunRow:
+    """The result of one task: the episode's result, read back from its log, plus the
+    frames, the wall seconds of the run (None when the log was already there) and the
+    failed skills by reason class."""
+
+    task: RunTask
+    result: EpisodeResult
+    frames: int
+    seconds: float | None
+    failures: Mapping[str, int]
+
+
+def log_path(root: Path, noise: str, planner: str, house: str, episode: int) -> Path:
+    return root / noise / planner / house / f"ep-{episode:03d}.mcap"
+
+
+def _episodes(task: RunTask) -> list[Any]:
+    spec = task.house.load(task.rooms, task.preset)
+    mix = task.preset if task.house.spec is None else "default"
+    return bench_episodes(spec, task.episode + 1, mix)
+
+
+def run_task(task: RunTask) -> RunRow:
+    """Run one task into its log (unless the log is there already) and read its row back.
+    Ctrl-C removes the partial log and re-raises."""
+    from sgtool.planning.registry import make_planner
+
+    seconds: float | None = None
+    if not task.output.exists():
+        spec = task.house.load(task.rooms, task.preset)
+        eps = _episodes(task)
+        if task.episode >= len(eps):
+            raise SgtoolError(f"{task.house.id}: has {len(eps)} episodes, not "
+                              f"{task.episode + 1}")
+        opts = replace(task.options, noise=parse_noise(task.noise))
+        task.output.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            rep = run_episode(spec, eps[task.episode],
+                              make_planner(task.planner, **dict(task.planner_options)),
+                              task.output, opts, house_id=task.house.id,
+                              episode_index=task.episode)
+        except KeyboardInterrupt:
+            for p in partial_files(task.output):
+                p.unlink(missing_ok=True)
+            raise
+        seconds = rep.seconds
+    return _row(task, seconds)
+
+
+def _settings(opts: ClosedLoopOptions, noise: str) -> dict[str, Any]:
+    return {"max_steps": opts.max_steps, "frame_budget": opts.frames,
+            "size": [opts.camera.width, opts.camera.height],
+            "navigation": opts.navigation, "noise": parse_noise(noise).to_dict(),
+            "seed": opts.planner_seed}
+
+
+def _logged_settings(path: Path) -> dict[str, Any]:
+    from sgtool.log.reader import LogReader
+    from sgtool.log.records import Episode as LoggedEpisode
+
+    with LogReader(path) as r:
+        started = next((e for _, e in r.records(LoggedEpisode) if e.status == "started"),
+                       None)
+    x = dict(started.extras) if started is not None else {}
+    cam = x.get("camera") or {}
+    return {"max_steps": x.get("max_steps"), "frame_budget": x.get("frame_budget"),
+            "size": [cam.get("width"), cam.get("height")],
+            "navigation": (x.get("navigation") or {}).get("mode", "house"),
+            "noise": x.get("noise"), "seed": x.get("seed")}
+
+
+def _row(task: RunTask, seconds: float | None) -> RunRow:
+    if seconds is None and _logged_settings(task.output) != _settings(task.options,
+                                                                      task.noise):
+        raise SgtoolError(f"{task.output} was run with other settings (steps, frames, "
+                          "resolution, navigation, noise or seed); give another -o folder")
+    logged = read_log_episodes(task.output)
+    if len(logged) != 1:
+        raise SgtoolError(f"{task.output}: holds {len(logged)} episodes, not one; remove it "
+                          "to run the episode again")
+    ep = logged[0]
+    res = replace(ep.result(), seed=task.options.planner_seed)
+    fails = Counter(reason_class(d.action.reason or "") for d in ep.decisions
+                    if d.action.outcome == "failure")
+    return RunRow(task, res, int(ep.episode.frames or 0), seconds, dict(sorted(fails.items())))
+
+
+def bench_houses(cfg: ClosedLoopBenchConfig) -> tuple[BenchHouse, ...]:
+    gen = generated_houses(cfg.houses, cfg.house_seed)
+    return gen + load_house_files(cfg.house_files, taken=[h.id for h in gen])
+
+
+def tasks_of(cfg: ClosedLoopBenchConfig, logs: Path) -> list[RunTask]:
+    """Every (noise, house, episode, planner) of the run, in that nesting order (so a run
+    cut short has compared the planners on the same episodes)."""
+    houses = bench_houses(cfg)
+    out = []
+    for noise in cfg.noise:
+        for h in houses:
+            for k in range(cfg.episodes):
+                for planner in cfg.planners:
+                    out.append(RunTask(h, k, planner, noise,
+                                       log_path(logs, noise, planner, h.id, k), cfg.options,
+                                       dict(cfg.planner_options.get(planner, {})),
+                                       cfg.rooms, cfg.preset))
+    return out
+
+
+@dataclass(frozen=True)
+class ClosedLoopBenchResult:
+    config: ClosedLoopBenchConfig
+    rows: tuple[RunRow, ...]
+
+    def results(self, noise: str | None = None) -> list[EpisodeResult]:
+        return [r.result for r in self.rows if noise is None or r.task.noise == noise]
+
+    def table(self) -> str:
+        """Per noise profile: the bench table, then frames/s and failed skills by reason."""
+        cfg = self.config
+        models = cost_models(cfg.distance_budget, cfg.step_budget)
+        parts = []
+        for noise in cfg.noise:
+            rows = [r for r in self.rows if r.task.noise == noise]
+            parts.append(format_table(summarize([r.result for r in rows], models,
+                                                cfg.planners), models=models,
+                                      title=f"## Closed loop, noise {noise!r}"))
+            parts.append(_run_table(rows, cfg.planners))
+        return "\n".join(parts)
+
+
+def _run_table(rows: Sequence[RunRow], planners: Sequence[str]) -> str:
+    classes = sorted({k for r in rows for k in r.failures})
+    header = ["Planner", "Episodes", "Frames/ep", "Frames/s", "Ended", "Failed skills/ep",
+              *classes]
+    table = []
+    for p in planners:
+        rs = [r for r in rows if r.task.planner == p]
+        if not rs:
+            continue
+        n = len(rs)
+        timed = [r for r in rs if r.seconds]
+        fps = (f"{sum(r.frames for r in timed) / sum(r.seconds or 0 for r in timed):.1f}"
+               if timed else "-")
+        ends = Counter(r.result.end for r in rs)
+        total = sum(sum(r.failures.values()) for r in rs)
+        table.append([p, str(n), f"{statistics.mean(r.frames for r in rs):.0f}", fps,
+                      ", ".join(f"{k} {v}" for k, v in sorted(ends.items())),
+                      f"{total / n:.2f}",
+                      *(f"{sum(r.failures.get(c, 0) for r in rs) / n:.2f}" for c in classes)])
+    return (pipe_table(header, table) + "\nFrames/s: wall clock of the episodes run now "
+            "(resumed ones excluded); failed skills per episode by reason.\n")
+
+
+def iter_rows(tasks: Iterable[RunTask],
+              runner: Callable[[Callable[[RunTask], RunRow], Iterable[RunTask]],
+                               Iterable[RunRow]] = map) -> Iterator[RunRow]:
+    return iter(runner(run_task, tasks))
+
+
+def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
+                          progress: Any = None, runner: Any = map,
+                          report_only: bool = False) -> ClosedLoopBenchResult:
+    """Run (or resume) the benchmark into ``out_dir``/logs; ``progress`` is anything with
+    ``update(n)`` and ``total`` (a tqdm bar), advanced per episode. ``report_only``: run
+    nothing, read back the episodes whose logs are there (a run in progress, cut short)."""
+    cfg.check()
+    logs = Path(out_dir) / "logs"
+    tasks = tasks_of(cfg, logs)
+    if report_only:
+        tasks = [t for t in tasks if t.output.exists()]
+        if not tasks:
+            raise SgtoolError(f"no episode log of this run in {logs}")
+    if progress is not None:
+        progress.total = len(tasks)
+    rows = []
+    for row in iter_rows(tasks, runner):
+        rows.append(row)
+        if progress is not None:
+            progress.update(1)
+    return ClosedLoopBenchResult(cfg, tuple(rows))
+
+
+def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]:
+    """episodes.jsonl, summary.md and the efficiency curves (per noise profile)."""
+    from sgtool.analysis.curves import plot_efficiency
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    cfg = res.config
+    paths = [write_jsonl(res.results(), out / "episodes.jsonl")]
+    for noise in cfg.noise:
+        by_planner = [(p, [r for r in res.results(noise) if r.planner == p])
+                      for p in cfg.planners]
+        for model in cost_models(cfg.distance_budget, cfg.step_budget):
+            paths.append(plot_efficiency(by_planner, model,
+                                         out / f"efficiency_{noise}_{model.name}.png"))
+    paths.append(atomic_write(out / "summary.md", res.table()))
+    return paths
+
+
+def failed_skills(path: str | Path) -> Counter[str]:
+    """Failed skills of one closed-loop log by reason class (for scripts)."""
+    from sgtool.log.reader import LogReader
+
+    with LogReader(Path(path)) as r:
+        return Counter(reason_class(a.reason or "") for _, a in r.records(Action)
+                       if a.outcome == "failure")

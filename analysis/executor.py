@@ -1,0 +1,362 @@
+"""Independent tasks on a local process pool or on a Ray cluster, with the same results.
+
+A :class:`Task` is an id and the arguments of one call of a module-level function (so it
+pickles by reference and a Ray worker imports it). Tasks must be deterministic and seeded
+by what they carry (the benchmark's (seed, house, episode), a log's bytes), never by which
+worker runs them or when: then :meth:`run` gives the same outcomes whatever the executor,
+the number of workers or the order tasks finish, because it returns them in task order.
+
+- :class:`LocalExecutor`: ``workers == 1`` runs the tasks in this process; more use a pool
+  of spawned processes (each imports sgtool once and keeps what it caches between tasks).
+- :class:`RayExecutor`: connects to ``address`` (``--ray-address``, else ``RAY_ADDRESS``)
+  after checking that something listens there, else starts a local Ray instance with
+  ``num_cpus = workers`` (no dashboard, worker logs not forwarded); a Ray instance that is
+  already initialised in this process (a test's) is used as it is and left running.
+
+Both keep at most ``2 * workers`` tasks in flight (one in process), advance one progress
+bar (tqdm, on stderr) per finished task wherever it ran, retry a task that raised once,
+and then give up on it: its :class:`Outcome` carries the error as one line, for the
+caller's summary.
+Ctrl-C cancels the tasks not finished yet and re-raises, so a caller that writes its
+outputs from ``on_result`` (atomically) is left with complete outputs only.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import sys
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from sgtool.errors import SgtoolError
+
+EXECUTORS: tuple[str, ...] = ("local", "ray")
+RAY_INSTALL = "pip install 'sgtool[ray]'"
+RETRIES = 1  # a task that raised runs once more before it is reported
+
+
+class ExecutorError(SgtoolError):
+    """An executor that cannot be used (Ray missing or unreachable, a bad option)."""
+
+
+@dataclass(frozen=True)
+class Task:
+    """One call ``fn(args)``; ``id`` names it in the summary and the failure list."""
+
+    id: str
+    args: Any
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What a task returned, or its error (one line) after its last attempt."""
+
+    id: str
+    value: Any = None
+    error: str | None = None
+    attempts: int = 1
+
+    @property
+    def ok(self) -> bool:
+        return self.error is None
+
+
+def error_line(e: BaseException) -> str:
+    """``Type: first line of the message`` (a Ray task error is unwrapped to its cause)."""
+    cause = getattr(e, "cause", None)
+    if isinstance(cause, BaseException):
+        e = cause
+    text = str(e).strip().splitlines()
+    return f"{type(e).__name__}: {text[0]}" if text else type(e).__name__
+
+
+def failure_lines(outcomes: Sequence[Outcome]) -> list[str]:
+    """One line per failed task: ``ID: Type: message (after N attempts)``."""
+    return [f"{o.id}: {o.error} (after {o.attempts} attempts)" for o in outcomes if not o.ok]
+
+
+class _Executor:
+    """Retry, order, progress and Ctrl-C over a submit/wait/cancel back end."""
+
+    name = ""
+
+    def __init__(self, workers: int = 1) -> None:
+        if workers < 1:
+            raise ExecutorError(f"--workers: must be >= 1, got {workers}")
+        self.workers = workers
+
+    def run(self, fn: Callable[[Any], Any], tasks: Sequence[Task], *, progress: bool = False,
+            desc: str = "tasks", on_result: Callable[[Outcome], None] | None = None
+            ) -> list[Outcome]:
+        """Run every task (module doc); outcomes in task order. ``on_result`` sees each
+        final outcome as it arrives (finish order)."""
+        from tqdm import tqdm
+
+        ids = [t.id for t in tasks]
+        if len(set(ids)) != len(ids):
+            raise ValueError("task ids must be unique")
+        if not tasks:  # nothing to do: no pool, no Ray start-up
+            return []
+        done: dict[int, Outcome] = {}
+        with self._session(fn) as backend, tqdm(
+                total=len(tasks), desc=desc, unit="task", disable=not progress,
+                file=sys.stderr, dynamic_ncols=True) as bar:
+            queue = list(range(len(tasks)))[::-1]
+            attempts = [0] * len(tasks)
+            flight: dict[Any, int] = {}
+            try:
+                while queue or flight:
+                    while queue and len(flight) < backend.window:
+                        i = queue.pop()
+                        attempts[i] += 1
+                        flight[backend.submit(tasks[i].args)] = i
+                    handle, value, err = backend.wait_one(list(flight))
+                    i = flight.pop(handle)
+                    if err is not None and attempts[i] <= RETRIES:
+                        queue.append(i)
+                        continue
+                    out = Outcome(tasks[i].id, value, None if err is None else error_line(err),
+                                  attempts[i])
+                    done[i] = out
+                    if on_result is not None:
+                        on_result(out)
+                    bar.update(1)
+            except BaseException:
+                backend.cancel(list(flight))
+                raise
+        return [done[i] for i in range(len(tasks))]
+
+    def _session(self, fn: Callable[[Any], Any]) -> Any:
+        raise NotImplementedError
+
+
+class _Inline:
+    """One task at a time in this process."""
+
+    window = 1  # tasks in flight
+
+    def __init__(self, fn: Callable[[Any], Any]) -> None:
+        self.fn = fn
+        self.next = 0
+        self.results: dict[int, tuple[Any, BaseException | None]] = {}
+
+    def __enter__(self) -> _Inline:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+    def submit(self, args: Any) -> int:
+        self.next += 1
+        try:
+            self.results[self.next] = (self.fn(args), None)
+        except Exception as e:  # reported in the outcome, as a worker's would be
+            self.results[self.next] = (None, e)
+        return self.next
+
+    def wait_one(self, handles: list[int]) -> tuple[int, Any, BaseException | None]:
+        h = handles[0]
+        value, err = self.results.pop(h)
+        return h, value, err
+
+    def cancel(self, handles: list[int]) -> None:
+        return None
+
+
+class _Pool:
+    """A pool of spawned processes."""
+
+    def __init__(self, fn: Callable[[Any], Any], workers: int) -> None:
+        self.fn = fn
+        self.workers = workers
+        self.window = 2 * workers
+        self.pool = self._new_pool()
+
+    def _new_pool(self) -> Any:
+        import multiprocessing as mp
+        from concurrent.futures import ProcessPoolExecutor
+
+        return ProcessPoolExecutor(max_workers=self.workers,
+                                   mp_context=mp.get_context("spawn"))
+
+    def __enter__(self) -> _Pool:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.pool.shutdown(wait=exc[0] is None, cancel_futures=True)
+
+    def submit(self, args: Any) -> Any:
+        from concurrent.futures.process import BrokenProcessPool
+
+        try:
+            return self.pool.submit(self.fn, args)
+        except BrokenProcessPool:  # a worker died (killed, crashed): a new pool for the rest
+            self.pool.shutdown(wait=False, cancel_futures=True)
+            self.pool = self._new_pool()
+            return self.pool.submit(self.fn, args)
+
+    def wait_one(self, handles: list[Any]) -> tuple[Any, Any, BaseException | None]:
+        from concurrent.futures import FIRST_COMPLETED, wait
+
+        finished, _ = wait(handles, return_when=FIRST_COMPLETED)
+        f = min(finished, key=handles.index)
+        err = f.exception()
+        return f, (None if err is not None else f.result()), err
+
+    def cancel(self, handles: list[Any]) -> None:
+        for f in handles:
+            f.cancel()
+
+
+class LocalExecutor(_Executor):
+    """This process (``workers == 1``) or a pool of spawned processes."""
+
+    name = "local"
+
+    def _session(self, fn: Callable[[Any], Any]) -> Any:
+        return _Inline(fn) if self.workers == 1 else _Pool(fn, self.workers)
+
+
+def _ray_call(fn: Callable[[Any], Any], args: Any) -> Any:
+    return fn(args)
+
+
+class _RaySession:
+    def __init__(self, fn: Callable[[Any], Any], executor: RayExecutor) -> None:
+        self.fn = fn
+        self.executor = executor
+        self.started = False
+
+    def __enter__(self) -> _RaySession:
+        ray = import_ray()
+        self.started = self.executor.connect()
+        self.window = 2 * self.executor.workers
+        self.ray = ray
+        self.remote = ray.remote(_ray_call).options(num_cpus=1, max_retries=0)
+        self.fn_ref = ray.put(self.fn)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.started:
+            self.ray.shutdown()
+
+    def submit(self, args: Any) -> Any:
+        return self.remote.remote(self.fn_ref, args)
+
+    def wait_one(self, handles: list[Any]) -> tuple[Any, Any, BaseException | None]:
+        ready, _ = self.ray.wait(handles, num_returns=1)
+        ref = ready[0]
+        try:
+            return ref, self.ray.get(ref), None
+        except Exception as e:  # the task's exception, or a lost worker
+            return ref, None, e
+
+    def cancel(self, handles: list[Any]) -> None:
+        for ref in handles:
+            try:
+                self.ray.cancel(ref, force=True)
+            except Exception:  # already finished or gone: nothing to cancel
+                pass
+
+
+def import_ray() -> Any:
+    """The ``ray`` module, or one line saying how to install it."""
+    try:
+        import ray
+    except ImportError:
+        raise ExecutorError(f"--executor ray needs Ray, which is not installed: "
+                            f"{RAY_INSTALL}") from None
+    return ray
+
+
+def check_reachable(address: str, timeout_s: float = 3.0) -> None:
+    """Refuse an address where nothing listens (one line), rather than let Ray wait for
+    minutes. ``auto`` and ``local`` are Ray's own and are passed on unchecked."""
+    if address in ("auto", "local"):
+        return
+    hostport = address.split("://", 1)[-1].rstrip("/")
+    host, sep, port = hostport.rpartition(":")
+    if not sep or not port.isdigit() or not host:
+        raise ExecutorError(f"--ray-address {address!r}: give HOST:PORT (the head node's "
+                            "GCS address, e.g. 10.0.0.5:6379) or ray://HOST:PORT")
+    try:
+        with socket.create_connection((host, int(port)), timeout=timeout_s):
+            pass
+    except OSError as e:
+        raise ExecutorError(f"Ray cluster at {address} is not reachable ({e.strerror or e}); "
+                            "start one with `ray start --head` there, or leave out "
+                            "--ray-address and RAY_ADDRESS to start a local Ray") from None
+
+
+class RayExecutor(_Executor):
+    """Tasks as Ray tasks (one CPU each) on a cluster or a local Ray instance."""
+
+    name = "ray"
+
+    def __init__(self, workers: int = 1, address: str | None = None) -> None:
+        super().__init__(workers)
+        self.address = address or os.environ.get("RAY_ADDRESS") or None
+        import_ray()  # fail before any work when Ray is missing
+
+    def connect(self) -> bool:
+        """Initialise Ray unless it is; True when this call started it (and so must end
+        it)."""
+        ray = import_ray()
+        if ray.is_initialized():
+            return False
+        os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
+        common = dict(log_to_driver=False, configure_logging=False, include_dashboard=False)
+        if self.address:
+            check_reachable(self.address)
+            ray.init(address=self.address, **common)
+            self.workers = max(self.workers, int(ray.cluster_resources().get("CPU", 1)))
+        else:
+            ray.init(address="local", num_cpus=self.workers, **common)
+        return True
+
+    def _session(self, fn: Callable[[Any], Any]) -> Any:
+        return _RaySession(fn, self)
+
+
+Executor = LocalExecutor | RayExecutor
+
+
+def make_executor(name: str, workers: int = 1, address: str | None = None) -> Executor:
+    """The executor of ``--executor NAME`` (``--ray-address`` only with ``ray``)."""
+    if name == "local":
+        if address:
+            raise ExecutorError("--ray-address needs --executor ray")
+        return LocalExecutor(workers)
+    if name == "ray":
+        return RayExecutor(workers, address)
+    raise ExecutorError(f"--executor: one of {', '.join(EXECUTORS)}, got {name!r}")
+
+
+def as_map(executor: Executor, *, progress: bool = False, desc: str = "tasks",
+           task_id: Callable[[int, Any], str] = lambda i, _: f"task {i}"
+           ) -> Callable[[Callable[[Any], Any], Iterable[Any]], list[Any]]:
+    """A ``map``-like runner (``runner(fn, items)`` -> values in item order) on
+    ``executor``, for drivers that take one (the closed-loop benchmark's ``runner``); a
+    task that fails after its retry stops the run with one line once all have run."""
+    def run(fn: Callable[[Any], Any], items: Iterable[Any]) -> list[Any]:
+        tasks = [Task(task_id(i, x), x) for i, x in enumerate(items)]
+        outcomes = executor.run(fn, tasks, progress=progress, desc=desc)
+        failed = failure_lines(outcomes)
+        if failed:
+            raise ExecutorError(f"{len(failed)} of {len(tasks)} task(s) failed; the first: "
+                                f"{failed[0]}")
+        return [o.value for o in outcomes]
+    return run
+
+
+def chunks(items: Sequence[Any], parts: int) -> Iterator[tuple[Any, ...]]:
+    """``items`` cut into ``parts`` contiguous runs of near-equal length (none empty)."""
+    parts = max(1, min(parts, len(items)))
+    size, extra = divmod(len(items), parts)
+    start = 0
+    for k in range(parts):
+        end = start + size + (k < extra)
+        yield tuple(items[start:end])
+        start = end

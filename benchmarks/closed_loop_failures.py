@@ -1,0 +1,32 @@
+"""Failed skills per episode by reason in two ``sgtool run-bench`` output folders, over the
+episodes both hold (e.g. ``--navigation house`` before, ``live`` after):
+
+    .venv/bin/python benchmarks/closed_loop_failures.py BEFORE_DIR AFTER_DIR
+"""
+
+from __future__ import annotations
+
+import collections
+import sys
+from pathlib import Path
+
+from sgtool.analysis.closed_loop_bench import failed_skills
+
+
+def main(argv: list[str]) -> int:
+    before, after = Path(argv[0]), Path(argv[1])
+    common = [p.relative_to(before) for p in sorted(before.glob("logs/*/*/*/*.mcap"))
+              if (after / p.relative_to(before)).exists()]
+    for name, root in ((str(before), before), (str(after), after)):
+        total: collections.Counter[str] = collections.Counter()
+        for rel in common:
+            total += failed_skills(root / rel)
+        n = max(len(common), 1)
+        print(f"{name}: {len(common)} episodes, failed skills/episode "
+              f"{sum(total.values()) / n:.2f}: "
+              + ", ".join(f"{k} {v / n:.2f}" for k, v in sorted(total.items())))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,112 @@
+"""Run one benchmark command from two source trees in alternating rounds, side by side.
+
+On a shared, loaded machine wall-clock figures of two runs minutes apart mean little;
+this runs the same command with this tree's ``sgtool`` and with a baseline tree's (a
+``git worktree`` of an older commit) in alternating rounds, each in a fresh process, and
+prints per tree the median wall seconds, median CPU seconds (user + system of the child)
+and median peak RSS, and the ratio of the medians.
+
+The baseline tree is imported through a shadow package folder (``--base-pkg``, built
+here from ``--base``: ``sgtool`` -> ``BASE/toolkit`` plus the subpackage folders), put
+first on ``PYTHONPATH``.
+
+    git worktree add /tmp/replay-base HEAD
+    .venv/bin/python benchmarks/side_by_side.py --base /tmp/replay-base --rounds 3 -- \\
+        replay /tmp/sgtool-bench-replay/house3_10rooms_320x240_fps4.mcap -o {out} --force
+
+``{out}`` in the command becomes a per-tree output file; ``--frames N`` prints frames/s
+(N / median seconds) too.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+SUBPACKAGES = ("recorders", "replayers", "datasets", "analysis")
+
+
+def shadow_package(base: Path, folder: Path) -> Path:
+    """A folder whose ``sgtool`` package is the tree ``base`` (symlinks)."""
+    pkg = folder / "sgtool"
+    pkg.mkdir(parents=True, exist_ok=True)
+    for entry in (base / "toolkit").iterdir():
+        link = pkg / entry.name
+        if not link.exists():
+            link.symlink_to(entry)
+    for sub in SUBPACKAGES:
+        link = pkg / sub
+        if not link.exists():
+            link.symlink_to(base / sub)
+    return folder
+
+
+def run_once(args: list[str], pythonpath: str | None) -> tuple[float, float, float]:
+    """(wall s, CPU s, peak RSS MiB) of ``sgtool ARGS`` in a fresh process."""
+    env = dict(os.environ)
+    if pythonpath:
+        env["PYTHONPATH"] = pythonpath + os.pathsep + env.get("PYTHONPATH", "")
+    with tempfile.TemporaryFile() as err:
+        t0 = time.perf_counter()
+        proc = subprocess.Popen([sys.executable, "-c", _MAIN, *args], env=env,
+                                stdout=subprocess.DEVNULL, stderr=err)
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - t0
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        if proc.returncode != 0:
+            err.seek(0)
+            raise SystemExit(f"{' '.join(args)} failed: {err.read().decode()[-400:]}")
+    return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024.0
+
+
+_MAIN = "import sys; from sgtool.cli import main; sys.argv[0] = \"sgtool\"; sys.exit(main())"
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--base", type=Path, required=True, help="baseline source tree")
+    ap.add_argument("--base-pkg", type=Path,
+                    default=Path(tempfile.gettempdir()) / "sgtool-base-pkg")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--frames", type=int, default=0, help="frames per run, for frames/s")
+    ap.add_argument("command", nargs=argparse.REMAINDER, help="-- sgtool arguments")
+    a = ap.parse_args(argv)
+    cmd = [c for c in a.command if c != "--"]
+    pkg = str(shadow_package(a.base.resolve(), a.base_pkg))
+    trees = {"this tree": None, "baseline": pkg}
+    got: dict[str, list[tuple[float, float, float]]] = {k: [] for k in trees}
+    out_dir = Path(tempfile.mkdtemp(prefix="sgtool-side-"))
+    for r in range(a.rounds):
+        order = list(trees) if r % 2 == 0 else list(trees)[::-1]
+        for name in order:
+            args = [c.replace("{out}", str(out_dir / f"{name.replace(' ', '_')}.mcap"))
+                    for c in cmd]
+            got[name].append(run_once(args, trees[name]))
+            w, c, m = got[name][-1]
+            print(f"round {r + 1} {name:<10} wall {w:6.2f} s  cpu {c:6.2f} s  rss {m:.0f} MiB",
+                  file=sys.stderr)
+    print(f"{'tree':<10}{'wall s':>9}{'cpu s':>9}{'peak RSS MiB':>14}"
+          + (f"{'frames/s':>10}{'frames/cpu-s':>14}" if a.frames else ""))
+    med = {}
+    for name, runs in got.items():
+        w = statistics.median(x[0] for x in runs)
+        c = statistics.median(x[1] for x in runs)
+        m = statistics.median(x[2] for x in runs)
+        med[name] = (w, c)
+        extra = f"{a.frames / w:>10.1f}{a.frames / c:>14.1f}" if a.frames else ""
+        print(f"{name:<10}{w:>9.2f}{c:>9.2f}{m:>14.1f}{extra}")
+    bw, bc = med["baseline"]
+    tw, tc = med["this tree"]
+    print(f"speed-up (baseline / this tree): wall {bw / tw:.2f}x, cpu {bc / tc:.2f}x "
+          f"({a.rounds} alternating rounds)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

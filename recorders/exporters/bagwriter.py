@@ -1,0 +1,181 @@
+"""A thin writer of ROS bags over ``rosbags``: a ROS 1 ``.bag``, a ROS 2 sqlite3 bag or a
+ROS 2 MCAP bag, with builders for the messages sgtool writes (headers, transforms, poses,
+images, camera info).
+
+The ROS 1 Noetic type store of ``rosbags`` lacks ``tf2_msgs/TFMessage``; it is registered
+from its message definition. The writer refuses to overwrite (``rosbags`` does too): the
+exporter writes to a temporary name and renames.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+
+from sgtool.errors import SgtoolError
+from sgtool.log.frame import CameraIntrinsics
+from sgtool.recorders.importers.poses import tq_from_pose
+
+FORMATS = ("ros1", "ros2-sqlite3", "ros2-mcap")
+TF_MSG_DEF = "geometry_msgs/TransformStamped[] transforms\n"
+
+
+def typestore_for(fmt: str) -> Any:
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    if fmt == "ros1":
+        ts = get_typestore(Stores.ROS1_NOETIC)
+        if "tf2_msgs/msg/TFMessage" not in ts.fielddefs:
+            ts.register(get_types_from_msg(TF_MSG_DEF, "tf2_msgs/msg/TFMessage"))
+        return ts
+    return get_typestore(Stores.ROS2_HUMBLE)
+
+
+_NUMPY = {"byte": "uint8", "char": "uint8", "bool": "bool"}
+
+
+class BagWriter:
+    """A thin writer over ``rosbags``: ``write(topic, msgtype, t_ns, msg)``."""
+
+    def __init__(self, path: str | Path, fmt: str) -> None:
+        if fmt not in FORMATS:
+            raise SgtoolError(f"unknown bag format {fmt!r} ({', '.join(FORMATS)})")
+        self.path = Path(path)
+        if self.path.exists():
+            raise SgtoolError(f"{self.path} exists; not overwriting it")
+        self.fmt = fmt
+        self.ts = typestore_for(fmt)
+        if fmt == "ros1":
+            from rosbags.rosbag1 import Writer as W1
+
+            self._w: Any = W1(self.path)
+        else:
+            from rosbags.rosbag2 import StoragePlugin
+            from rosbags.rosbag2 import Writer as W2
+
+            plugin = StoragePlugin.MCAP if fmt == "ros2-mcap" else StoragePlugin.SQLITE3
+            self._w = W2(self.path, version=9, storage_plugin=plugin)
+        self._w.open()
+        self._conns: dict[str, Any] = {}
+        self.counts: dict[str, int] = {}  # messages written per topic
+        self._has_seq = any(n == "seq" for n, _ in self.ts.fielddefs["std_msgs/msg/Header"][1])
+
+    # ----- message builders ------------------------------------------------------------
+    def T(self, name: str) -> Any:  # noqa: N802
+        return self.ts.types[name]
+
+    def make(self, msgtype: str, **given: Any) -> Any:
+        """A ``msgtype`` message with the ``given`` fields and every other field at its
+        zero value (numbers 0, strings empty, arrays and sequences empty, nested messages
+        made the same way): one builder for the ROS 1 and ROS 2 spellings of a type."""
+        return self.T(msgtype)(**{name: given[name] if name in given else
+                                  self._zero(desc, name, msgtype)
+                                  for name, desc in self.ts.fielddefs[msgtype][1]})
+
+    def _zero(self, desc: tuple[Any, Any], name: str, msgtype: str) -> Any:
+        from rosbags.interfaces import Nodetype
+
+        kind, spec = desc
+        if kind == Nodetype.NAME:
+            return self.make(spec)
+        if kind == Nodetype.BASE:
+            base = spec[0]
+            return "" if base == "string" else False if base == "bool" else (
+                0.0 if base.startswith("float") else 0)
+        sub_kind, sub = spec[0]
+        if sub_kind == Nodetype.BASE and sub[0] != "string":
+            n = spec[1] if kind == Nodetype.ARRAY else 0
+            return np.zeros(n, dtype=_NUMPY.get(sub[0], sub[0]))
+        if kind == Nodetype.ARRAY:
+            return [self._zero(spec[0], name, msgtype) for _ in range(spec[1])]
+        return []
+
+    def header(self, t_ns: int, frame_id: str) -> Any:
+        stamp = self.T("builtin_interfaces/msg/Time")(sec=int(t_ns // 1_000_000_000),
+                                                       nanosec=int(t_ns % 1_000_000_000))
+        if self._has_seq:
+            return self.T("std_msgs/msg/Header")(seq=0, stamp=stamp, frame_id=frame_id)
+        return self.T("std_msgs/msg/Header")(stamp=stamp, frame_id=frame_id)
+
+    def transform_stamped(self, t_ns: int, parent: str, child: str, T: np.ndarray) -> Any:  # noqa: N803
+        tr, q = tq_from_pose(T)
+        g = "geometry_msgs/msg/"
+        return self.T(g + "TransformStamped")(
+            header=self.header(t_ns, parent), child_frame_id=child,
+            transform=self.T(g + "Transform")(
+                translation=self.T(g + "Vector3")(x=float(tr[0]), y=float(tr[1]), z=float(tr[2])),
+                rotation=self.T(g + "Quaternion")(x=float(q[0]), y=float(q[1]), z=float(q[2]),
+                                                  w=float(q[3])),
+            ),
+        )
+
+    def pose_stamped(self, t_ns: int, parent: str, T: np.ndarray) -> Any:  # noqa: N803
+        tr, q = tq_from_pose(T)
+        g = "geometry_msgs/msg/"
+        return self.T(g + "PoseStamped")(
+            header=self.header(t_ns, parent),
+            pose=self.T(g + "Pose")(
+                position=self.T(g + "Point")(x=float(tr[0]), y=float(tr[1]), z=float(tr[2])),
+                orientation=self.T(g + "Quaternion")(x=float(q[0]), y=float(q[1]), z=float(q[2]),
+                                                     w=float(q[3])),
+            ),
+        )
+
+    def tf(self, t_ns: int, transforms: list[Any]) -> Any:
+        return self.T("tf2_msgs/msg/TFMessage")(transforms=transforms)
+
+    def image(self, t_ns: int, frame_id: str, a: np.ndarray, encoding: str) -> Any:
+        a = np.ascontiguousarray(a)
+        h, w = a.shape[:2]
+        return self.T("sensor_msgs/msg/Image")(
+            header=self.header(t_ns, frame_id), height=h, width=w, encoding=encoding,
+            is_bigendian=0, step=int(a.strides[0]),
+            data=np.frombuffer(a.tobytes(), dtype=np.uint8),
+        )
+
+    def compressed(self, t_ns: int, frame_id: str, rgb: np.ndarray, fmt: str) -> Any:
+        ok, buf = cv2.imencode("." + fmt, cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+        if not ok:
+            raise SgtoolError(f"OpenCV cannot encode {fmt}")
+        return self.T("sensor_msgs/msg/CompressedImage")(
+            header=self.header(t_ns, frame_id), format=fmt,
+            data=np.asarray(buf, dtype=np.uint8).ravel(),
+        )
+
+    def camera_info(self, t_ns: int, frame_id: str, k: CameraIntrinsics) -> Any:
+        K = np.array([k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1], dtype=np.float64)  # noqa: N806
+        R = np.eye(3).ravel()  # noqa: N806
+        P = np.array([k.fx, 0, k.cx, 0, 0, k.fy, k.cy, 0, 0, 0, 1, 0], dtype=np.float64)  # noqa: N806
+        names = [n for n, _ in self.ts.fielddefs["sensor_msgs/msg/CameraInfo"][1]]
+        up = "K" in names  # ROS 1 spells the matrices in capitals
+        kw = {("D" if up else "d"): np.zeros(5), ("K" if up else "k"): K,
+              ("R" if up else "r"): R, ("P" if up else "p"): P}
+        roi = self.T("sensor_msgs/msg/RegionOfInterest")(x_offset=0, y_offset=0, height=0,
+                                                         width=0, do_rectify=False)
+        return self.T("sensor_msgs/msg/CameraInfo")(
+            header=self.header(t_ns, frame_id), height=k.height, width=k.width,
+            distortion_model="plumb_bob", binning_x=0, binning_y=0, roi=roi, **kw,
+        )
+
+    # ----- writing -----------------------------------------------------------------------
+    def write(self, topic: str, msgtype: str, t_ns: int, msg: Any) -> None:
+        conn = self._conns.get(topic)
+        if conn is None:
+            conn = self._w.add_connection(topic, msgtype, typestore=self.ts)
+            self._conns[topic] = conn
+        data = (self.ts.serialize_ros1(msg, msgtype) if self.fmt == "ros1"
+                else self.ts.serialize_cdr(msg, msgtype))
+        self._w.write(conn, int(t_ns), data)
+        self.counts[topic] = self.counts.get(topic, 0) + 1
+
+    def close(self) -> None:
+        self._w.close()
+
+    def __enter__(self) -> BagWriter:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()

@@ -1,0 +1,171 @@
+"""Sanity checks of an import before the heavy work: pure functions over the numbers a source
+gives, each returning a one-line problem that names the flag that fixes it (or None).
+
+The importers turn a problem into an error when the value came from a default or a guess
+(a silently wrong map is worse than no map) and into a warning when the user gave it with a
+flag (they know their data better than these bands do):
+
+- time stamps (:func:`timestamp_problem`): in the order the source lists its images they must
+  increase, be distinct and give a frame rate an RGB-D camera has; per-frame intervals
+  written where times belong give ~6000 "fps" and a sort that shuffles the frames;
+- depth scale (:func:`depth_scale_problem`): the median depth of the valid pixels and the far
+  end of the depth range (95th percentile) must be what indoor RGB-D gives; millimetres read
+  with TUM's 5000 units per metre make the world 5x too small. The scales that would fit are
+  named;
+- floor (:func:`floor_problem`): the camera's median height above the estimated floor must be
+  within a band (``--camera-height``, 0.5-2.2 m by default: hand-held, head- and robot-mounted
+  cameras); a desk top taken for the floor puts a hand-held camera 0.4 m above it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+# frame rates (Hz) that RGB-D cameras and their recordings have: a key-frame subsample of a
+# few seconds per frame up to a 90 Hz RealSense stream, with a margin
+MIN_FPS = 0.05
+MAX_FPS = 200.0
+# indoor RGB-D: the median valid depth and the far end (95th percentile) of one frame's range
+MEDIAN_DEPTH_M = (0.4, 6.0)
+FAR_DEPTH_M = (0.9, 12.0)
+# the depth scales (raw units per metre) datasets use: mm (ROS, RealSense, 7-Scenes, Redwood),
+# 1/5000 m (TUM RGB-D), 0.1 mm (some Azure Kinect / ZED exports), 1/4000 m (ScanNet-style)
+KNOWN_SCALES = (1000.0, 5000.0, 10000.0, 4000.0)
+DEFAULT_CAMERA_HEIGHT = (0.45, 2.2)  # m above the floor
+
+
+@dataclass(frozen=True)
+class TimingStats:
+    """What :func:`timestamp_problem` found in a list of time stamps (file order)."""
+
+    frames: int
+    backwards: int  # steps where the time goes back
+    duplicates: int  # steps where it stays
+    span_s: float
+    fps: float  # from the median positive step (0 when there is none)
+
+
+def timing_stats(times_ns: Sequence[int]) -> TimingStats:
+    t = np.asarray(times_ns, dtype=np.int64)
+    d = np.diff(t)
+    pos = d[d > 0]
+    fps = float(1e9 / np.median(pos)) if len(pos) else 0.0
+    span = float((t.max() - t.min()) / 1e9) if len(t) else 0.0
+    return TimingStats(len(t), int((d < 0).sum()), int((d == 0).sum()), span, fps)
+
+
+FOLDER_TIME_FIX = ("import the frames in the listed order with --timestamps index --fps N "
+                   "(N = the camera's frame rate)")
+BAG_TIME_FIX = "import with --timestamps bag (the times the messages were recorded)"
+
+
+def timestamp_problem(times_ns: Sequence[int], what: str,
+                      fix: str = FOLDER_TIME_FIX) -> str | None:
+    """The problem of the time stamps ``what`` lists (in its order), or None when they
+    increase at a plausible rate; ``fix`` names the flag (``--timestamps index --fps N``
+    for folders)."""
+    if len(times_ns) < 2:
+        return None
+    s = timing_stats(times_ns)
+    found = []
+    if s.backwards:
+        found.append(f"{s.backwards} of {s.frames - 1} steps go back in time")
+    if s.duplicates:
+        found.append(f"{s.duplicates} repeat a time stamp")
+    if not found and not MIN_FPS <= s.fps <= MAX_FPS:
+        found.append(f"{s.frames} frames span {s.span_s:.3g} s (~{s.fps:.4g} fps)")
+    if not found:
+        return None
+    looks = ""
+    if s.backwards and s.span_s * MAX_FPS < s.frames:  # small values up and down
+        looks = f"; {s.frames} frames in {s.span_s:.3g} s: they look like per-frame intervals"
+    return f"{what}: the time stamps are not times of frames ({'; '.join(found)}{looks}); {fix}"
+
+
+@dataclass(frozen=True)
+class DepthStats:
+    """Median and 95th percentile of the valid depth (metres at the scale checked)."""
+
+    median_m: float
+    far_m: float
+    valid: int
+
+
+def depth_stats(raw: Sequence[np.ndarray], scale: float) -> DepthStats:
+    """Over the valid pixels (not 0, not 65535 for 16-bit) of a few raw depth images."""
+    vals = []
+    for a in raw:
+        a = np.asarray(a)
+        v = a[(a > 0) & np.isfinite(a)] if a.dtype.kind == "f" else a[(a > 0) & (a != 65535)]
+        vals.append(v.astype(np.float64).ravel())
+    v = np.concatenate(vals) if vals else np.zeros(0)
+    if len(v) == 0:
+        return DepthStats(0.0, 0.0, 0)
+    return DepthStats(float(np.median(v)) / scale, float(np.percentile(v, 95)) / scale, len(v))
+
+
+def depth_plausible(s: DepthStats) -> bool:
+    return (MEDIAN_DEPTH_M[0] <= s.median_m <= MEDIAN_DEPTH_M[1]
+            and FAR_DEPTH_M[0] <= s.far_m <= FAR_DEPTH_M[1])
+
+
+def fitting_scales(raw: Sequence[np.ndarray], scale: float) -> list[tuple[float, DepthStats]]:
+    """The known scales (other than ``scale``) at which the depth looks indoor, nearest to a
+    2 m median first."""
+    out = []
+    for k in KNOWN_SCALES:
+        if k == scale:
+            continue
+        s = depth_stats(raw, k)
+        if depth_plausible(s):
+            out.append((k, s))
+    return sorted(out, key=lambda ks: abs(np.log(ks[1].median_m / 2.0)))
+
+
+def depth_scale_problem(raw: Sequence[np.ndarray], scale: float, origin: str) -> str | None:
+    """The problem of reading 16-bit ``raw`` depth at ``scale`` units per metre (which came
+    from ``origin``: a flag, a layout default), naming the scales that fit; None when the
+    depth looks indoor or is not 16-bit integers (metres need no scale)."""
+    ints = [a for a in raw if np.asarray(a).dtype.kind in "ui"]
+    if not ints:
+        return None
+    s = depth_stats(ints, scale)
+    if s.valid == 0 or depth_plausible(s):
+        return None
+    fits = fitting_scales(ints, scale)
+    if fits:
+        k, fs = fits[0]
+        fix = (f"--depth-scale {k:g} fits (median {fs.median_m:.2f} m); give it, or "
+               f"--depth-scale {scale:g} to keep this one")
+    else:
+        fix = "no usual scale fits; give the sensor's units with --depth-scale"
+    return (f"depth scale {scale:g} units/m ({origin}) looks wrong: median depth "
+            f"{s.median_m:.2f} m, 95 % within {s.far_m:.2f} m, outside indoor RGB-D "
+            f"({MEDIAN_DEPTH_M[0]:g}-{MEDIAN_DEPTH_M[1]:g} m median); {fix}")
+
+
+def camera_heights(poses: Sequence[np.ndarray], alignment_matrix: np.ndarray) -> np.ndarray:
+    """Height (z) of each camera in the aligned world."""
+    return np.array([float((alignment_matrix @ np.asarray(T))[2, 3]) for T in poses])
+
+
+def floor_problem(poses: Sequence[np.ndarray], alignment_matrix: np.ndarray, floor: float,
+                  origin: str, band: tuple[float, float]) -> str | None:
+    """The problem of a floor at source height ``floor`` (which came from ``origin``) that
+    puts the camera's median height outside ``band``; None when it is within."""
+    if not poses:
+        return None
+    h = float(np.median(camera_heights(poses, alignment_matrix)))
+    if band[0] <= h <= band[1]:
+        return None
+    cam = h + floor  # the camera's median height in the source world along up
+    example = cam - 1.3
+    return (f"the camera is {h:.2f} m above the floor ({origin}; at {floor:.3f} m in the "
+            f"source), outside --camera-height {band[0]:g}:{band[1]:g}"
+            + (": the floor is probably not in view and a table or counter was taken for it"
+               if h < band[0] else "")
+            + f"; give the floor's height with --floor (e.g. --floor {example:.2f} puts the "
+            "camera at 1.3 m), or a wider --camera-height")

@@ -1,0 +1,88 @@
+"""Running the simulator calls of one planner action (:mod:`.skill_plan`), two ways:
+
+- :func:`execute_live` (the closed loop's default, ``navigation="live"``): the robot plans
+  on its own map (:mod:`.live_skills`); goals come from the nodes of the graph the planner
+  decided on and its map layers;
+- :func:`execute_privileged` (``navigation="house"``, the behaviour before issue 17, kept
+  for comparison): the simulator's skills plan on the house's ground-truth occupancy.
+
+Both run the calls until one does not succeed and return an :class:`Executed`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from sgtool.recorders.sim.events import StopSimulation
+from sgtool.recorders.sim.live_skills import Goal, LiveSkills, goal_of_node
+from sgtool.recorders.sim.simulation import Simulation, SkillOutcome
+from sgtool.recorders.sim.skill_plan import SkillCall
+from sgtool.scenegraph.stream import Refresh
+
+
+@dataclass(frozen=True)
+class Executed:
+    outcome: str
+    reason: str
+    travelled_m: float
+    ticks: int
+    cut: bool  # the frame budget stopped it
+
+
+def execute_privileged(sim: Simulation, calls: Sequence[SkillCall]) -> Executed:
+    """Run ``calls`` with the simulator's own (ground-truth) skills."""
+    t0, d0 = sim.tick_index, sim.travelled_m
+    out: SkillOutcome | None = None
+    try:
+        for c in calls:
+            out = sim.look_around() if c.skill == "look_around" else \
+                getattr(sim, c.skill)(c.target)
+            if not out.success:
+                break
+    except StopSimulation as e:
+        return Executed("failure", f"stopped: {e}", sim.travelled_m - d0,
+                        sim.tick_index - t0, True)
+    assert out is not None
+    return Executed(out.outcome, out.reason, sim.travelled_m - d0, sim.tick_index - t0, False)
+
+
+def execute_live(sim: Simulation, skills: LiveSkills, calls: Sequence[SkillCall],
+                 decided: Refresh | None) -> Executed:
+    """Run ``calls`` with the robot's skills on its own map; ``decided`` is the refresh
+    the planner decided on (its graph names the nodes of the calls)."""
+    t0, d0 = sim.tick_index, sim.travelled_m
+    outcome, reason = "success", ""
+    try:
+        for c in calls:
+            if c.skill == "look_around":
+                out = skills.body.look_around()
+                outcome, reason = out.outcome, out.reason
+            elif c.skill in ("open", "close"):
+                assert isinstance(c.target, int)
+                out = getattr(skills.body, c.skill)(c.target)
+                outcome, reason = out.outcome, out.reason
+            else:
+                goal = _goal(c, decided)
+                run = skills.explore if c.skill == "explore" else skills.navigate
+                outcome, reason, _ = run(goal)
+            if outcome != "success":
+                break
+    except StopSimulation as e:
+        return Executed("failure", f"stopped: {e}", sim.travelled_m - d0,
+                        sim.tick_index - t0, True)
+    return Executed(outcome, reason, sim.travelled_m - d0, sim.tick_index - t0, False)
+
+
+def _goal(call: SkillCall, decided: Refresh | None) -> Goal:
+    node = None
+    if decided is not None and call.node is not None:
+        node = decided.graph.node(call.node)
+    if node is not None:
+        return goal_of_node(node, None if decided is None else decided.layers)
+    if isinstance(call.target, int):
+        raise ValueError(f"instance {call.target} without its graph node")
+    xy = np.array([call.target], dtype=np.float64)
+    return Goal(f"({xy[0, 0]:.2f}, {xy[0, 1]:.2f})", "point", xy)

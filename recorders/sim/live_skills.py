@@ -1,0 +1,265 @@
+"""The robot's skills on its own map: no ground truth on the robot side.
+
+In the closed loop (and ``sgtool record --explore frontier``) the robot plans every motion
+on the occupancy grid of the scene graph it is building (the map layers of the latest
+refresh, :attr:`sgtool.scenegraph.stream.SceneGraphStream.current`), made traversable by
+:func:`sgtool.mapping.live_paths.traversable` (obstacles grown by the robot radius, unknown
+blocked but for a short optimistic margin at frontiers). The simulator only executes
+motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
+
+- **The guard.** The robot side holds a :class:`RobotBody`, a view of the simulation
+  without the house: its pose, driving, turning on the spot, opening and closing by
+  instance id. Anything else (the spec, the ground-truth occupancy, the privileged
+  ``navigate``) raises :class:`PrivilegedAccess`.
+- **Goals** come from the graph the planner decided on: an object or door node's position
+  (stand within reach, nearest along the floor, facing it), a room or region node's
+  position (the reachable cell nearest to it within ``snap``), a frontier's cluster (its
+  nearest reachable cell, :func:`~sgtool.mapping.live_paths.nearest_reachable`).
+- **Re-planning.** A path is followed frame by frame; at every refresh of the map (every K
+  frames) or at a contact the goal and the path are planned again on the newer map. A goal
+  the map cannot reach is a failed skill whose reason says so; so are repeated contacts
+  and a goal not reached after ``max_replans`` plans.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from sgtool.errors import SgtoolError
+from sgtool.mapping.live_paths import (
+    descend,
+    nearest_reachable,
+    point_goal,
+    stand_goal,
+    traversable,
+)
+from sgtool.mapping.occupancy import OccupancyMap, geodesic_distances
+from sgtool.recorders.sim import navigation as nav
+from sgtool.recorders.sim.events import SkillOutcome
+from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode
+
+if TYPE_CHECKING:
+    from sgtool.recorders.sim.navigation import Pose2, RobotConfig
+    from sgtool.recorders.sim.simulation import Simulation
+    from sgtool.scenegraph.builder import MapLayers
+    from sgtool.scenegraph.stream import Refresh
+
+
+class PrivilegedAccess(SgtoolError):
+    """The robot side reached for what only the simulator may know."""
+
+
+@dataclass(frozen=True)
+class LiveNavConfig:
+    """How the robot plans on its own map."""
+
+    optimistic: float = 0.25  # m of unknown past known free floor a path may use
+    snap: float = 1.0  # m: a room or region goal's reachable cell may be this far
+    frontier_snap: float = 0.5  # m around a frontier's cells when none is reachable
+    slack: float = 0.3  # m: stands this much farther from the thing than the nearest
+    max_replans: int = 60
+    max_contacts: int = 3
+
+    def __post_init__(self) -> None:
+        if not 0 <= self.optimistic <= 2.0:
+            raise SgtoolError(f"optimistic margin {self.optimistic} m: must be 0..2")
+        if self.max_replans < 1 or self.max_contacts < 0:
+            raise SgtoolError("max re-plans must be >= 1 and max contacts >= 0")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"optimistic": self.optimistic, "snap": self.snap,
+                "frontier_snap": self.frontier_snap, "slack": self.slack,
+                "max_replans": self.max_replans, "max_contacts": self.max_contacts}
+
+
+class RobotBody:
+    """What the robot side may use of a :class:`Simulation` (module doc: the guard)."""
+
+    __slots__ = ("_sim",)
+
+    def __init__(self, sim: Simulation) -> None:
+        object.__setattr__(self, "_sim", sim)
+
+    def __getattr__(self, name: str) -> Any:
+        raise PrivilegedAccess(f"the robot has no access to the simulator's {name!r}")
+
+    @property
+    def base(self) -> Pose2:
+        return self._sim.base
+
+    @property
+    def config(self) -> RobotConfig:
+        return self._sim.robot
+
+    @property
+    def fps(self) -> float:
+        return self._sim.fps
+
+    @property
+    def tick_index(self) -> int:
+        return self._sim.tick_index
+
+    @property
+    def travelled_m(self) -> float:
+        return self._sim.travelled_m
+
+    def drive(self, poses: list[Pose2]) -> tuple[float, bool]:
+        return self._sim.drive(poses)
+
+    def look_around(self) -> SkillOutcome:
+        return self._sim.look_around()
+
+    def open(self, instance: int) -> SkillOutcome:
+        return self._sim.open(int(instance))
+
+    def close(self, instance: int) -> SkillOutcome:
+        return self._sim.close(int(instance))
+
+
+@dataclass(frozen=True, eq=False)
+class Goal:
+    """Where a skill goes: ``kind`` "stand" (within reach of ``points[0]``, facing it),
+    "point" (the reachable cell nearest ``points[0]``) or "cells" (the nearest reachable of
+    ``points``, a frontier's cluster)."""
+
+    label: str
+    kind: str
+    points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+
+    def face(self) -> tuple[float, float] | None:
+        if self.kind != "stand":
+            return None
+        return float(self.points[0, 0]), float(self.points[0, 1])
+
+
+def frontier_points(layers: MapLayers, frontier_id: str) -> np.ndarray | None:
+    """World centres of the cells of frontier ``frontier_id`` of a refresh (None when the
+    refresh has no such frontier)."""
+    if frontier_id not in layers.frontier_ids:
+        return None
+    f = layers.frontiers[layers.frontier_ids.index(frontier_id)]
+    x, y = layers.occupancy.center_of(f.cells[:, 0], f.cells[:, 1])
+    return np.stack([x, y], axis=1)
+
+
+def goal_of_node(node: Any, layers: MapLayers | None) -> Goal:
+    """The goal of a scene-graph node (module doc)."""
+    if isinstance(node, (ObjectNode, DoorNode)):
+        return Goal(node.id, "stand", np.array([node.position[:2]], dtype=np.float64))
+    if isinstance(node, RegionNode) and node.kind == "frontier" and layers is not None:
+        pts = frontier_points(layers, node.id)
+        if pts is not None and len(pts):
+            return Goal(node.id, "cells", pts)
+    assert isinstance(node, (RoomNode, RegionNode))
+    return Goal(node.id, "point", np.array([node.position[:2]], dtype=np.float64))
+
+
+class LiveSkills:
+    """Navigate, explore, open and close on the robot's own map (module doc).
+    ``current`` returns the latest refresh of the scene-graph stream."""
+
+    def __init__(self, body: RobotBody, current: Callable[[], Refresh | None],
+                 config: LiveNavConfig | None = None) -> None:
+        self.body = body
+        self.current = current
+        self.config = config or LiveNavConfig()
+        self.replans = 0  # plans made (for reports)
+        self.contacts = 0
+        self.bumps: list[tuple[float, float]] = []  # where the base touched something
+
+    # ----- planning ---------------------------------------------------------------------
+    def live_map(self, refresh: Refresh) -> OccupancyMap | None:
+        if refresh.layers is None:
+            return None
+        bumps = np.array(self.bumps, dtype=np.float64).reshape(-1, 2)
+        return traversable(refresh.layers.occupancy, self.body.config.radius,
+                           self.config.optimistic, bumps)
+
+    def select(self, goal: Goal, occ: OccupancyMap, dist: np.ndarray
+               ) -> tuple[float, float] | None:
+        """The cell to drive to for ``goal`` on ``occ`` (None: the map cannot reach it)."""
+        cfg = self.config
+        if goal.kind == "cells":
+            return nearest_reachable(occ, dist, goal.points, cfg.frontier_snap)
+        if goal.kind == "stand":
+            return stand_goal(occ, dist, goal.points[0], self.body.config.reach - 0.05,
+                              cfg.slack)
+        return point_goal(occ, dist, goal.points[0], cfg.snap)
+
+    # ----- skills -----------------------------------------------------------------------
+    def navigate(self, goal: Goal) -> tuple[str, str, float]:
+        """Drive to ``goal``, re-planning at every map refresh: (outcome, reason, metres)."""
+        body, cfg = self.body, self.config
+        step = body.config.speed / body.fps
+        turn = body.config.turn_speed / body.fps
+        driven, contacts = 0.0, 0
+        for _ in range(cfg.max_replans):
+            ref = self.current()
+            occ = None if ref is None else self.live_map(ref)
+            if ref is None or occ is None:
+                return "failure", "the robot has no map yet", driven
+            here = body.base[:2]
+            dist = geodesic_distances(occ, here)
+            target = self.select(goal, occ, dist)
+            path = None if target is None else descend(occ, dist, target)
+            self.replans += 1
+            if target is None or path is None:
+                return "failure", _unreachable(goal, dist), driven
+            pts = nav.smooth_path(occ, path)
+            if pts and math.dist(pts[0], here) < occ.resolution:
+                pts = pts[1:]
+            face = goal.face()
+            end = pts[-1] if pts else here
+            yaw = None if face is None or math.dist(face, end) < 1e-6 else \
+                math.atan2(face[1] - end[1], face[0] - end[0])
+            poses = nav.follow_poses(body.base, pts, step, turn, yaw)
+            arrived = True
+            for p in poses:
+                d, hit = body.drive([p])
+                driven += d
+                if hit:
+                    contacts += 1
+                    self.contacts += 1
+                    self.bumps.append(_bumped(body.base, p, body.config.radius))
+                    if contacts > cfg.max_contacts:
+                        return ("failure", f"{goal.label}: the way is blocked by an obstacle "
+                                "the robot's map does not show", driven)
+                    arrived = False
+                    break
+                now = self.current()
+                if now is not None and now.index != ref.index and p is not poses[-1]:
+                    arrived = False  # the map grew: plan again on it
+                    break
+            if arrived:
+                return "success", "", driven
+        return ("failure", f"{goal.label} not reached after {cfg.max_replans} re-plans",
+                driven)
+
+    def explore(self, goal: Goal) -> tuple[str, str, float]:
+        """Go to ``goal`` and look around there."""
+        o, why, d = self.navigate(goal)
+        if o == "success":
+            self.body.look_around()
+        return o, why, d
+
+
+def _bumped(here: Pose2, to: Pose2, radius: float) -> tuple[float, float]:
+    """Where the obstacle is that stopped a move from ``here`` to ``to``: one radius ahead
+    of ``to`` along the move (the bumper's touch, the robot's own sense)."""
+    dx, dy = to[0] - here[0], to[1] - here[1]
+    n = math.hypot(dx, dy)
+    if n < 1e-9:
+        return float(to[0]), float(to[1])
+    return float(to[0] + dx / n * radius), float(to[1] + dy / n * radius)
+
+
+def _unreachable(goal: Goal, dist: np.ndarray) -> str:
+    if not np.isfinite(dist).any():
+        return f"{goal.label} is unreachable: the robot stands on no free cell of its map"
+    return (f"{goal.label} is unreachable on the robot's map (no known free path; a closed "
+            "door or unexplored space may be in the way)")

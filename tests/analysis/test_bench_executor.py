@@ -1,0 +1,96 @@
+"""The bench on the executor: tasks grouped by house, a task that fails after its retry is
+listed in the summary (the other houses are still scored) and the command then exits with
+one line; a bad planner option stops the run before any episode."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from click.testing import CliRunner
+
+import sgtool.analysis.bench as bench
+from sgtool.analysis.bench import BenchConfig, bench_tasks, prepare_houses, run_benchmark
+from sgtool.cli import cli
+from sgtool.errors import SgtoolError
+
+SMALL = dict(planners=("random", "greedy"), houses=2, episodes=2, seeds=1, rooms=(4, 6),
+             preset="default")
+
+
+def test_tasks_are_grouped_by_house_and_split_when_workers_outnumber_houses():
+    cfg = BenchConfig(planners=("random", "greedy", "sbert"), houses=2)
+    ids = [t.id for t in bench_tasks(cfg, prepare_houses(cfg))]
+    assert ids == ["house-0/random+greedy+sbert", "house-1/random+greedy+sbert"]
+    cfg = BenchConfig(planners=("random", "greedy", "sbert"), houses=1, workers=3)
+    ids = [t.id for t in bench_tasks(cfg, prepare_houses(cfg))]
+    assert ids == ["house-0/random", "house-0/greedy", "house-0/sbert"]
+    cfg = BenchConfig(planners=("random", "greedy", "sbert"), houses=2, workers=3)
+    ids = [t.id for t in bench_tasks(cfg, prepare_houses(cfg))]
+    assert ids == ["house-0/random+greedy", "house-0/sbert", "house-1/random+greedy",
+                   "house-1/sbert"]
+
+
+@pytest.fixture
+def house_one_breaks(monkeypatch):
+    real = bench._house
+    calls: list[str] = []
+
+    def flaky(ref, *a, **kw):
+        calls.append(ref.id)
+        if ref.id == "house-1":
+            raise RuntimeError("the house fell down")
+        return real(ref, *a, **kw)
+
+    monkeypatch.setattr(bench, "_house", flaky)
+    return calls
+
+
+def test_a_failing_task_is_retried_once_then_listed(house_one_breaks, tmp_path):
+    res = run_benchmark(BenchConfig(**SMALL))
+    assert house_one_breaks == ["house-0", "house-1", "house-1"]  # one retry
+    assert res.failed == ("house-1/random+greedy: RuntimeError: the house fell down "
+                          "(after 2 attempts)",)
+    assert {r.house for r in res.results} == {"house-0"} and len(res.results) == 4
+    r = CliRunner().invoke(cli, ["bench", "--houses", "2", "--episodes", "2", "--seeds", "1",
+                                 "--rooms", "4-6", "--preset", "default", "--planners",
+                                 "random,greedy", "--no-progress", "-o", str(tmp_path)])
+    assert r.exit_code == 2
+    assert r.stderr.strip().splitlines() == [
+        f"sgtool: error: 1 task(s) failed after a retry, listed in {tmp_path}/summary.md; "
+        "the first: house-1/random+greedy: RuntimeError: the house fell down (after 2 "
+        "attempts)"]
+    md = (tmp_path / "summary.md").read_text()
+    assert ("Failed tasks (retried once; their episodes are in no table): 1\n- house-1/"
+            "random+greedy: RuntimeError: the house fell down (after 2 attempts)\n") in md
+    assert json.loads((tmp_path / "summary.json").read_text())["failed_tasks"] == list(
+        res.failed)
+
+
+def test_a_bad_planner_option_stops_the_run_before_any_episode(house_one_breaks):
+    with pytest.raises(SgtoolError, match="planner 'greedy' does not take option"):
+        run_benchmark(BenchConfig(**SMALL, planner_options={"greedy": {"bogus": 1}}))
+    assert house_one_breaks == []
+
+
+def test_a_task_gives_the_same_results_whatever_its_worker_ran_before():
+    """The shared priors' score memo is emptied per task (their batches, and so the last
+    bits of their scores, belong to the task): a house run after another in one process
+    ends with the memo it has when run first, and the same results."""
+    import copy
+
+    from sgtool.analysis.bench import _task
+    from sgtool.results import results_digest
+    from sgtool.semantics.priors import default_priors
+
+    cfg = BenchConfig(planners=("scout",), houses=2, episodes=2, seeds=1, rooms=(4, 6),
+                      preset="default")
+    first, second = bench_tasks(cfg, prepare_houses(cfg))
+    alone = _task(second.args)
+    memo_alone = copy.deepcopy(default_priors()._memo._memo)
+    _task(first.args)
+    assert default_priors()._memo._memo != memo_alone  # the other house scored other names
+    after_other = _task(second.args)
+    assert default_priors()._memo._memo == memo_alone
+    assert results_digest(after_other) == results_digest(alone)
+    assert {r.house for r in alone} == {"house-1"} and len(alone) == 2

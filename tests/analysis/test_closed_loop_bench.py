@@ -1,0 +1,120 @@
+"""`sgtool run-bench` (sgtool.analysis.closed_loop_bench) on one small house, at 64x48 with
+two steps per episode: logs per run, the table, resuming, Ctrl-C, the reason classes."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from sgtool.analysis import closed_loop_bench as clb
+from sgtool.cli import cli
+from sgtool.datasets.generator import generate_house
+from sgtool.house.io import save_house
+from sgtool.log.writer import partial_files
+
+ARGS = ["run-bench", "--planners", "random,greedy", "--houses", "0", "--episodes", "1",
+        "--resolution", "64x48", "--max-steps", "2", "--frames", "120", "--no-progress"]
+
+
+@pytest.fixture(scope="module")
+def house_file(tmp_path_factory) -> Path:
+    p = tmp_path_factory.mktemp("houses") / "small.json"
+    save_house(generate_house(6, rooms=(4, 4)), p)
+    return p
+
+
+def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkeypatch) -> None:
+    out = tmp_path / "rb"
+    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    logs = sorted(p.relative_to(out).as_posix() for p in out.rglob("*.mcap"))
+    assert logs == ["logs/none/greedy/small/ep-000.mcap",
+                    "logs/none/random/small/ep-000.mcap"]
+    summary = (out / "summary.md").read_text()
+    assert "## Closed loop, noise 'none'" in summary and "| random " in summary
+    assert "Frames/s" in summary and "Failed skills/ep" in summary
+    lines = (out / "episodes.jsonl").read_text().splitlines()
+    assert len(lines) == 2 and all('"house":"small"' in s for s in lines)
+    assert (out / "efficiency_none_steps.png").stat().st_size > 0
+    # a second run reads the logs back instead of running anything
+    monkeypatch.setattr(clb, "run_episode", lambda *a, **k: pytest.fail("ran again"))
+    again = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
+    assert again.exit_code == 0, again.output
+    assert (out / "episodes.jsonl").read_text().splitlines() == lines
+    assert "| random " in again.output  # frames/s "-": nothing was run
+    only = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                    "--planners", "random", "--report-only"])
+    assert only.exit_code == 0 and "| random " in only.output and "greedy" not in only.output
+    # other settings do not mix with the logs there
+    other = [*ARGS, "--house", str(house_file), "-o", str(out)]
+    other[other.index("--max-steps") + 1] = "3"
+    res = CliRunner().invoke(cli, other)
+    assert res.exit_code == 2 and "was run with other settings" in res.output
+
+
+def test_ctrl_c_leaves_only_complete_logs(house_file, tmp_path, monkeypatch) -> None:
+    out = tmp_path / "rb"
+
+    def interrupted(spec, episode, planner, output, *a, **k):
+        Path(f"{output}.abcdefgh.partial").write_bytes(b"half a log")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(clb, "run_episode", interrupted)
+    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
+    assert res.exit_code == 2
+    assert res.output.count("\n") == 1 and "interrupted" in res.output
+    first = out / "logs/none/random/small/ep-000.mcap"
+    assert not first.exists() and partial_files(first) == []
+
+
+def test_user_errors(tmp_path) -> None:
+    for args, msg in ((["--planners", "nope"], "unknown planner 'nope'"),
+                      (["--houses", "0"], "--houses: must be >= 1"),
+                      (["--noise", "loud"], "loud")):
+        res = CliRunner().invoke(cli, ["run-bench", *args, "-o", str(tmp_path / "x")])
+        assert res.exit_code == 2 and msg in res.output, res.output
+        assert "Traceback" not in res.output
+
+
+def test_reason_classes() -> None:
+    assert clb.reason_class("room:1 is unreachable on the robot's map (no known ...)") == \
+        "unreachable on the map"
+    assert clb.reason_class("obj:3: the way is blocked by an obstacle the robot's map "
+                            "does not show") == "contact"
+    assert clb.reason_class("(1.00, 2.00) is not on free floor") == "not on free floor"
+    assert clb.reason_class("furn_2 is out of reach: 1.20 m") == "out of reach"
+    assert clb.reason_class("something new") == "other"
+
+
+def _messages(path: Path) -> list[tuple[str, int, bytes]]:
+    """A log's messages, the decision time (wall clock, logged on purpose) zeroed."""
+    import re
+
+    from mcap.reader import make_reader
+
+    with open(path, "rb") as f:
+        return [(c.topic, m.log_time,
+                 re.sub(rb'"decision_time_s":[0-9.e-]+', b'"decision_time_s":0', m.data))
+                for _, c, m in make_reader(f).iter_messages()]
+
+
+def test_run_bench_on_two_worker_processes_writes_the_same_logs(house_file, tmp_path) -> None:
+    """`-w 2` runs the episodes on the local executor: the same logs (every message but the
+    measured decision time) and the same records as one after the other in this process."""
+    import json
+
+    runs = {}
+    for name, extra in (("one", []), ("two", ["-w", "2"])):
+        out = tmp_path / name
+        res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                       *extra])
+        assert res.exit_code == 0, res.output
+        recs = [json.loads(s) for s in (out / "episodes.jsonl").read_text().splitlines()]
+        for r in recs:
+            r.pop("wall"), r.pop("source")  # wall clock; the log's own path
+        logs = {p.relative_to(out).as_posix(): _messages(p) for p in out.rglob("*.mcap")}
+        runs[name] = (recs, logs)
+    assert runs["one"][0] == runs["two"][0] and len(runs["one"][0]) == 2
+    assert runs["one"][1] == runs["two"][1] and len(runs["one"][1]) == 2

@@ -1,0 +1,164 @@
+"""The local executor (in process and a pool of 2): results in task order, a failing task
+retried once then reported, Ctrl-C keeps what finished; option errors are one line, Ray
+missing or unreachable too (no Ray started here: see test_ray_executor.py)."""
+
+from __future__ import annotations
+
+import socket
+import sys
+
+import pytest
+
+from sgtool.analysis.executor import (
+    ExecutorError,
+    LocalExecutor,
+    Task,
+    check_reachable,
+    chunks,
+    error_line,
+    failure_lines,
+    make_executor,
+)
+
+CALLS: list[int] = []
+
+
+def square_but_three(x: int) -> int:
+    CALLS.append(x)
+    if x == 3:
+        raise ValueError(f"no square for {x}\nsecond line")
+    return x * x
+
+
+def interrupted_at_two(x: int) -> int:
+    if x == 2:
+        raise KeyboardInterrupt
+    return x
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_outcomes_in_task_order_and_a_failure_is_reported_after_one_retry(workers):
+    CALLS.clear()
+    tasks = [Task(f"t{i}", i) for i in range(6)]
+    seen = []
+    outs = LocalExecutor(workers).run(square_but_three, tasks, on_result=seen.append)
+    assert [o.id for o in outs] == ["t0", "t1", "t2", "t3", "t4", "t5"]
+    assert [o.value for o in outs] == [0, 1, 4, None, 16, 25]
+    bad = outs[3]
+    assert not bad.ok and bad.attempts == 2 and bad.error == "ValueError: no square for 3"
+    assert all(o.ok and o.attempts == 1 for o in outs if o.id != "t3")
+    assert failure_lines(outs) == ["t3: ValueError: no square for 3 (after 2 attempts)"]
+    assert sorted(o.id for o in seen) == [t.id for t in tasks]  # each final outcome once
+    if workers == 1:  # in this process: the failing task ran twice, the others once
+        assert sorted(CALLS) == [0, 1, 2, 3, 3, 4, 5]
+
+
+def test_ctrl_c_stops_the_run_and_keeps_what_finished():
+    seen = []
+    with pytest.raises(KeyboardInterrupt):
+        LocalExecutor(1).run(interrupted_at_two, [Task(str(i), i) for i in range(5)],
+                             on_result=seen.append)
+    assert [o.value for o in seen] == [0, 1]
+
+
+def test_chunks_cut_near_equal_contiguous_runs():
+    assert list(chunks("abcde", 2)) == [("a", "b", "c"), ("d", "e")]
+    assert list(chunks("abc", 5)) == [("a",), ("b",), ("c",)]
+    assert list(chunks("ab", 1)) == [("a", "b")]
+
+
+def test_option_errors_are_one_line():
+    with pytest.raises(ExecutorError, match="--workers: must be >= 1, got 0"):
+        make_executor("local", 0)
+    with pytest.raises(ExecutorError, match="--ray-address needs --executor ray"):
+        make_executor("local", 1, "127.0.0.1:6379")
+    with pytest.raises(ExecutorError, match="--executor: one of local, ray, got 'dask'"):
+        make_executor("dask", 1)
+    with pytest.raises(ValueError, match="unique"):
+        LocalExecutor(1).run(abs, [Task("a", 1), Task("a", 2)])
+
+
+def test_error_line_unwraps_a_cause_and_keeps_the_first_line():
+    class Wrapped(Exception):
+        cause = KeyError("k")
+
+    assert error_line(Wrapped("x")) == "KeyError: 'k'"
+    assert error_line(RuntimeError("one\ntwo")) == "RuntimeError: one"
+    assert error_line(RuntimeError()) == "RuntimeError"
+
+
+def test_ray_not_installed_says_how_to_install_it(monkeypatch):
+    monkeypatch.setitem(sys.modules, "ray", None)  # import ray -> ImportError
+    with pytest.raises(ExecutorError) as e:
+        make_executor("ray", 2)
+    assert str(e.value) == ("--executor ray needs Ray, which is not installed: "
+                            "pip install 'sgtool[ray]'")
+
+
+def test_unreachable_ray_cluster_is_one_line_and_quick():
+    with socket.socket() as s:  # a port nothing listens on (bound, then closed)
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    with pytest.raises(ExecutorError) as e:
+        check_reachable(f"127.0.0.1:{port}", timeout_s=2.0)
+    text = str(e.value)
+    assert "\n" not in text
+    assert text.startswith(f"Ray cluster at 127.0.0.1:{port} is not reachable (")
+    assert "ray start --head" in text
+    with pytest.raises(ExecutorError, match="give HOST:PORT"):
+        check_reachable("nohost")
+    check_reachable("auto")  # Ray's own: passed on
+
+
+def test_cli_ray_address_unreachable_is_one_line(tmp_path):
+    from click.testing import CliRunner
+
+    from sgtool.cli import cli
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    r = CliRunner().invoke(cli, ["bench", "--houses", "1", "--episodes", "1", "--seeds", "1",
+                                 "--planners", "random", "--executor", "ray",
+                                 "--ray-address", f"127.0.0.1:{port}", "--no-progress",
+                                 "-o", str(tmp_path / "o")])
+    assert r.exit_code == 2
+    assert r.stderr.strip().splitlines() == [
+        f"sgtool: error: Ray cluster at 127.0.0.1:{port} is not reachable (Connection "
+        "refused); start one with `ray start --head` there, or leave out --ray-address "
+        "and RAY_ADDRESS to start a local Ray"]
+    assert not (tmp_path / "o").exists()
+
+
+def test_as_map_gives_values_in_order_or_one_line_for_a_failure():
+    from sgtool.analysis.executor import as_map
+
+    run = as_map(LocalExecutor(2))
+    assert run(square_but_three, [5, 4, 2]) == [25, 16, 4]
+    with pytest.raises(ExecutorError) as e:
+        run(square_but_three, [1, 3])
+    assert str(e.value) == ("1 of 2 task(s) failed; the first: task 1: ValueError: no square "
+                            "for 3 (after 2 attempts)")
+
+
+def exit_hard_at_one(x: int) -> int:
+    import os
+
+    if x == 1:
+        os._exit(3)  # a worker that dies (killed, out of memory, crashed)
+    return x
+
+
+def test_a_dead_pool_worker_is_reported_and_the_pool_replaced():
+    outs = LocalExecutor(2).run(exit_hard_at_one, [Task(str(i), i) for i in range(4)])
+    assert [o.id for o in outs] == ["0", "1", "2", "3"]
+    assert not outs[1].ok and outs[1].error.startswith("BrokenProcessPool")
+    assert outs[1].attempts == 2
+    # the others ran, or shared a pool when it broke (twice: retried, then reported)
+    for o in outs:
+        if o.id != "1":
+            assert (o.ok and o.value == int(o.id)) or o.error.startswith("BrokenProcessPool")
+
+
+def test_no_tasks_starts_nothing():
+    assert LocalExecutor(2).run(abs, []) == []

@@ -1,0 +1,200 @@
+"""The import's sanity checks on synthetic TUM folders whose faults are known: interval time
+stamps, duplicated and backward times, millimetre depth read at TUM's 5000, a table taken
+for the floor, files listed but missing; and the report's statement of where each
+parameter came from."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from support.bag_export import BagWriter
+from support.logfixtures import synthetic_frame
+from support.rgbd_folders import make_tum_folder
+
+from sgtool.cli import cli
+from sgtool.errors import SgtoolError
+from sgtool.log import LogReader
+from sgtool.log.frame import CameraIntrinsics
+from sgtool.recorders.importers.bag import BagOptions, import_bag
+from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
+from sgtool.recorders.importers.sanity import (
+    depth_scale_problem,
+    floor_problem,
+    timestamp_problem,
+)
+from sgtool.recorders.importers.sink import IMPORT_METADATA
+from sgtool.recorders.importers.textformats import PinholeParams
+
+K = PinholeParams(60.0, 60.0, 39.5, 29.5)
+GOOD_TIMES = [100.0 + i / 30 for i in range(12)]
+
+
+def opts(**kw) -> RgbdOptions:  # type: ignore[no-untyped-def]
+    return RgbdOptions(intrinsics=kw.pop("intrinsics", K), progress=False, **kw)
+
+
+# ----- pure checks ---------------------------------------------------------------------------
+def test_timestamp_problems_are_named():
+    ns = [round(t * 1e9) for t in GOOD_TIMES]
+    assert timestamp_problem(ns, "depth.txt") is None
+    # per-frame intervals where times belong: 193 values around 0.033 s
+    rng = np.random.default_rng(0)
+    intervals = [round(v * 1e9) for v in rng.uniform(0.0300, 0.0316, 193)]
+    p = timestamp_problem(intervals, "depth.txt")
+    assert p is not None and "per-frame intervals" in p and "--timestamps index --fps N" in p
+    assert "go back in time" in p
+    dup = ns[:5] + ns[4:]
+    assert "1 repeat a time stamp" in timestamp_problem(dup, "d")  # type: ignore[operator]
+    fast = [i * 1_000_000 for i in range(50)]  # 1000 fps
+    assert "~1000 fps" in timestamp_problem(fast, "d")  # type: ignore[operator]
+
+
+def test_depth_scale_problem_names_the_scale_that_fits():
+    mm = np.full((10, 10), 2000, np.uint16)  # 2 m in millimetres
+    mm[0] = 3500
+    p = depth_scale_problem([mm], 5000.0, "dataset default: tum layout")
+    assert p is not None
+    assert "median depth 0.40 m" in p and "--depth-scale 1000 fits (median 2.00 m)" in p
+    assert depth_scale_problem([mm], 1000.0, "x") is None
+    assert depth_scale_problem([mm.astype(np.float32) / 1000], 1.0, "x") is None  # metres
+
+
+def test_floor_problem_band():
+    cam = np.eye(4)
+    cam[2, 3] = 1.0  # camera 1 m up in the source; floor estimate at 0.58 -> 0.42 m above
+    a = np.eye(4)
+    a[2, 3] = -0.58
+    p = floor_problem([cam], a, 0.58, "estimate", (0.45, 2.2))
+    assert p is not None and "0.42 m above the floor" in p and "--floor" in p
+    assert "(e.g. --floor -0.30 puts the camera at 1.3 m)" in p
+    assert floor_problem([cam], a, 0.58, "estimate", (0.3, 2.2)) is None
+
+
+# ----- the silent-wrong cases of issue 18 on folders ------------------------------------------
+def test_interval_timestamps_fail_and_index_imports(tmp_path):
+    rng = np.random.default_rng(1)
+    times = list(rng.uniform(0.030, 0.034, 12))
+    root = make_tum_folder(tmp_path / "f", times, ground_truth=False)
+    with pytest.raises(SgtoolError, match=r"per-frame intervals.*--timestamps index --fps N"):
+        import_rgbd(root, tmp_path / "a.mcap", opts())
+    assert not (tmp_path / "a.mcap").exists()
+    rep = import_rgbd(root, tmp_path / "b.mcap",
+                      opts(timestamps="index", fps=15.0, odometry="icp"))
+    assert rep.frames == 12
+    with LogReader(tmp_path / "b.mcap") as r:
+        times_ns = r.frame_times()
+    assert times_ns == [round(i * 1e9 / 15) for i in range(12)]  # listed order, n / fps
+
+
+def test_millimetre_depth_at_the_tum_default_fails_and_names_1000(tmp_path):
+    root = make_tum_folder(tmp_path / "f", GOOD_TIMES, units_per_m=1000.0)
+    with pytest.raises(SgtoolError, match=r"depth scale 5000 units/m \(dataset default: tum "
+                       r"layout\) looks wrong.*--depth-scale 1000 fits"):
+        import_rgbd(root, tmp_path / "a.mcap", opts())
+    rep = import_rgbd(root, tmp_path / "b.mcap", opts(depth_scale=1000.0))
+    assert ("depth scale", "1000 units/m", "flag --depth-scale") in rep.sources
+    assert rep.warnings == ()
+    # insisting on the wrong scale is a warning, shown at once
+    seen: list[str] = []
+    rep = import_rgbd(root, tmp_path / "c.mcap", opts(depth_scale=5000.0, warn=seen.append,
+                                                      floor=None, floor_auto=False))
+    assert len(seen) == 1 and "looks wrong" in seen[0] and rep.warnings == tuple(seen)
+
+
+def test_table_taken_for_the_floor_fails_and_names_floor(tmp_path):
+    root = make_tum_folder(tmp_path / "f", GOOD_TIMES, cam_height=0.42)
+    with pytest.raises(SgtoolError, match=r"camera is 0.42 m above the floor.*--floor"):
+        import_rgbd(root, tmp_path / "a.mcap", opts())
+    rep = import_rgbd(root, tmp_path / "b.mcap", opts(camera_height=(0.3, 2.2)))
+    assert rep.frames == 12
+    # the real floor given: the camera is 0.42 + 1.0 = 1.42 m above it, inside the band
+    given = import_rgbd(root, tmp_path / "c.mcap", opts(floor=-1.0))
+    assert ("floor", "-1.000 m in the source", "flag --floor") in given.sources
+    assert given.warnings == ()
+    # a given floor outside the band is the user's word: a warning, not an error
+    odd = import_rgbd(root, tmp_path / "d.mcap", opts(floor=0.2))
+    assert len(odd.warnings) == 1 and "camera is 0.22 m above the floor" in odd.warnings[0]
+
+
+def test_missing_files_are_checked_up_front(tmp_path):
+    root = make_tum_folder(tmp_path / "f", GOOD_TIMES, missing=(3, 7))
+    with pytest.raises(SgtoolError, match=r"4 of the 24 files listed are missing \(2 of "
+                       r"rgb.txt, 2 of depth.txt; first: rgb/0003.png\).*--skip-missing"):
+        import_rgbd(root, tmp_path / "a.mcap", opts())
+    rep = import_rgbd(root, tmp_path / "b.mcap", opts(skip_missing=True))
+    assert rep.frames == 10
+    assert "skipped 4 missing files (2 of rgb.txt, 2 of depth.txt)" in rep.notes
+
+
+def test_report_says_where_each_parameter_came_from(tmp_path):
+    fr1 = CameraIntrinsics(640, 480, 517.3, 516.5, 318.6, 255.3)
+    root = make_tum_folder(tmp_path / "rgbd_dataset_freiburg1_fake", GOOD_TIMES[:4], k=fr1)
+    out = tmp_path / "o.mcap"
+    r = CliRunner().invoke(cli, ["import", "rgbd", str(root), "-o", str(out), "--quiet"])
+    assert r.exit_code == 0, r.output
+    lines = r.output.splitlines()
+    assert ("intrinsics: 517.3,516.5,318.6,255.3 [folder-name default: 'freiburg1' in "
+            "'rgbd_dataset_freiburg1_fake' (TUM freiburg1 calibration)]") in lines
+    assert "depth scale: 5000 units/m [dataset default: tum layout]" in lines
+    assert any(x.startswith("up: (") and "[estimate: the normals of horizontal surfaces]" in x
+               for x in lines)
+    assert any(x.startswith("floor: ") and "[estimate: the lowest upward-facing" in x
+               for x in lines)
+    # the folder-name default is also a warning on stderr, before the work
+    assert "sgtool: warning: intrinsics taken from the folder name" in r.output
+    with LogReader(out) as rd:
+        meta = rd.metadata[IMPORT_METADATA]
+    assert meta["depth_scale_source"] == "dataset default: tum layout"
+    assert meta["floor_source"].startswith("estimate")
+
+
+def test_duplicated_and_backward_times_fail(tmp_path):
+    times = GOOD_TIMES[:6] + [GOOD_TIMES[5]] + GOOD_TIMES[6:]
+    root = make_tum_folder(tmp_path / "dup", times)
+    with pytest.raises(SgtoolError, match=r"1 repeat a time stamp.*--timestamps index"):
+        import_rgbd(root, tmp_path / "a.mcap", opts())
+    times = GOOD_TIMES[:4] + GOOD_TIMES[5:6] + GOOD_TIMES[4:5] + GOOD_TIMES[6:]
+    root = make_tum_folder(tmp_path / "back", times)
+    with pytest.raises(SgtoolError, match=r"1 of 11 steps go back in time"):
+        import_rgbd(root, tmp_path / "b.mcap", opts())
+
+
+def test_bag_with_one_header_stamp_fails_and_bag_times_import(tmp_path):
+    """A driver that stamps every image with the same time: the header stamps repeat; the
+    bag's record times are the way out."""
+    bag = tmp_path / "b"
+    with BagWriter(bag, "ros2-mcap") as w:
+        for i in range(5):
+            k, _, depth, _, pose, _ = synthetic_frame(i)
+            t = 1_000_000_000 + i * 33_333_333
+            w.write("/tf", "tf2_msgs/msg/TFMessage", t,
+                    w.tf(t, [w.transform_stamped(t, "map", "cam", pose)]))
+            w.write("/d/info", "sensor_msgs/msg/CameraInfo", t, w.camera_info(t, "cam", k))
+            w.write("/d/image", "sensor_msgs/msg/Image", t,
+                    w.image(1_000_000_000, "cam", np.round(depth * 1000).astype(np.uint16),
+                            "16UC1"))
+    base = BagOptions(depth="/d/image", progress=False, up=np.array([0, 0, 1.0]), floor=0.0,
+                      tf_frames=("map", "cam"))
+    with pytest.raises(SgtoolError, match=r"4 repeat a time stamp.*--timestamps bag"):
+        import_bag(bag, tmp_path / "a.mcap", base)
+    rep = import_bag(bag, tmp_path / "b.mcap", replace(base, timestamps="bag"))
+    assert rep.frames == 5
+
+
+def test_json_report_carries_sources_and_warnings(tmp_path):
+    root = make_tum_folder(tmp_path / "f", GOOD_TIMES)
+    out = tmp_path / "o.mcap"
+    r = CliRunner().invoke(cli, ["import", "rgbd", str(root), "-o", str(out), "--quiet",
+                                 "--json", "--intrinsics", "60,60,39.5,29.5", "--floor", "1.2"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.output[r.output.index("{"):])
+    assert d["sources"]["intrinsics"] == {"value": "60,60,39.5,29.5",
+                                          "origin": "flag --intrinsics"}
+    assert d["sources"]["floor"]["origin"] == "flag --floor"
+    # the camera is 1.4 - 1.2 = 0.2 m above the given floor: a warning, in the JSON too
+    assert len(d["warnings"]) == 1 and "camera is 0.20 m above the floor" in d["warnings"][0]
+    assert r.output.startswith("sgtool: warning: the camera is 0.20 m above the floor")

@@ -1,0 +1,59 @@
+"""`sgtool replay` on recordings that are not sgtool logs says what they are and which import
+command turns them into one (issue 18): a ROS 2 MCAP with camera topics, one with poses
+only, a ROS 1 bag, a ROS 2 bag's sqlite3 storage; sgtool logs pass."""
+
+from __future__ import annotations
+
+from click.testing import CliRunner
+from support.bag_export import write_frames_bag
+from support.logfixtures import synthetic_frame, write_log
+
+from sgtool.cli import cli
+from sgtool.log.frame import Frame
+from sgtool.log.inspect import foreign_log_problem
+
+
+def frames(n: int = 3) -> list[Frame]:
+    out = []
+    for i in range(n):
+        k, rgb, depth, ids, pose, _ = synthetic_frame(i)
+        out.append(Frame(index=i, time_ns=1_000 + i * 33_000_000, rgb=rgb, depth=depth,
+                         ids=ids, pose=pose, intrinsics=k))
+    return out
+
+
+def replay_error(path) -> str:  # type: ignore[no-untyped-def]
+    r = CliRunner().invoke(cli, ["replay", str(path)])
+    assert r.exit_code == 2 and "Traceback" not in r.output
+    assert len(r.output.strip().splitlines()) == 1
+    return r.output
+
+
+def test_ros2_mcap_with_camera_topics_points_to_import_bag(tmp_path):
+    bag = tmp_path / "cam"
+    write_frames_bag(frames(), bag, "ros2-mcap")
+    storage = bag / "cam.mcap"
+    out = replay_error(storage)
+    assert "is a ROS 2 recording (MCAP, profile 'ros2') with cdr messages on 5 topics" in out
+    assert f"sgtool import bag {storage} -o OUT.mcap --depth /camera/depth/image_raw" in out
+    assert "--list` shows its topics" in out
+
+
+def test_trajectory_only_ros1_and_sqlite(tmp_path):
+    bag = tmp_path / "b.bag"
+    write_frames_bag(frames(), bag, "ros1")
+    assert "is a ROS 1 bag, not an sgtool log; turn it into one with `sgtool import bag" \
+        in replay_error(bag)
+    db = tmp_path / "sq"
+    write_frames_bag(frames(), db, "ros2-sqlite3")
+    out = replay_error(db / "sq.db3")
+    assert "SQLite file (a ROS 2 bag's storage?)" in out and f"import bag {db} -o" in out
+
+
+def test_sgtool_logs_and_other_files_are_not_flagged(tmp_path):
+    log = write_log(tmp_path / "log.mcap", n=2)
+    assert foreign_log_problem(log) is None
+    text = tmp_path / "x.txt"
+    text.write_text("hello")
+    assert foreign_log_problem(text) is None  # the reader's own error says what is wrong
+    assert foreign_log_problem(tmp_path / "missing.mcap") is None

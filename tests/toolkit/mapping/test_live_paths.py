@@ -1,0 +1,105 @@
+"""Paths on the robot's own map (sgtool.mapping.live_paths), on hand-built grids.
+
+The grid: 10 cm cells, two rooms (free) side by side with a wall between them. The wall has
+a 1 m gap whose cells are unknown (a corridor the robot has not seen), and the rooms are
+also joined by a long known detour along the bottom. A planner on the live map must take
+the detour; with the detour walled off the goal is unreachable; an unknown sliver within
+the optimistic margin of free floor is usable.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from sgtool.mapping.live_paths import (
+    descend,
+    nearest_reachable,
+    point_goal,
+    stand_goal,
+    traversable,
+)
+from sgtool.mapping.occupancy import geodesic_distances, path_length
+
+RES = 0.1
+
+
+def two_rooms(detour: bool = True) -> OccupancyGrid:
+    """Rows 0..39 (y 0..4 m), cols 0..49 (x 0..5 m): a wall at cols 24-25 from row 8 up,
+    with an unknown 1 m gap at rows 26-35; below row 8 a known free corridor (the detour)
+    unless ``detour`` is False (then the wall goes down to the border)."""
+    g = np.full((40, 50), FREE, np.int8)
+    g[0, :] = g[-1, :] = OCCUPIED
+    g[:, 0] = g[:, -1] = OCCUPIED
+    g[(1 if not detour else 8):, 24:26] = OCCUPIED
+    g[26:36, 22:28] = UNKNOWN  # the unseen corridor through the wall (and its mouths)
+    return OccupancyGrid(g, (0.0, 0.0), RES)
+
+
+A, B = (1.0, 3.0), (4.0, 3.0)  # left and right room, level with the gap
+
+
+def test_an_unseen_corridor_is_not_used() -> None:
+    occ = traversable(two_rooms(), robot_radius=0.2, optimistic=0.2)
+    dist = geodesic_distances(occ, A)
+    path = descend(occ, dist, B)
+    assert path is not None
+    assert path[0] == pytest.approx((1.05, 3.05)) and path[-1] == pytest.approx((4.05, 3.05))
+    # the straight way through the gap is 3 m; the detour dips below row 8 (y < 0.8 m)
+    assert min(y for _, y in path) < 0.8
+    assert path_length(path) > 5.0
+    assert math.isclose(path_length(path), dist[30, 40], rel_tol=1e-9)
+    # no cell of the path is unknown
+    r = [int(y / RES) for _, y in path]
+    c = [int(x / RES) for x, _ in path]
+    assert not (two_rooms().grid[r, c] == UNKNOWN).any()
+
+
+def test_without_the_detour_the_goal_is_unreachable() -> None:
+    occ = traversable(two_rooms(detour=False), robot_radius=0.2, optimistic=0.2)
+    dist = geodesic_distances(occ, A)
+    assert not math.isfinite(dist[30, 40])
+    assert descend(occ, dist, B) is None
+    assert point_goal(occ, dist, B, snap=1.0) is None  # nothing reachable within 1 m of B
+
+
+def test_the_optimistic_margin_at_frontiers() -> None:
+    g = two_rooms().grid.copy()
+    grid = OccupancyGrid(g, (0.0, 0.0), RES)
+    # the gap's mouth cells (cols 22-23) lie 0.1-0.2 m from free floor: usable with a
+    # 0.2 m margin, not with none; the wall's own unknown cells (cols 24-25) never are
+    wide = traversable(grid, robot_radius=0.0, optimistic=0.2)
+    none = traversable(grid, robot_radius=0.0, optimistic=0.0)
+    assert not wide.blocked[30, 22] and not wide.blocked[30, 23]
+    assert none.blocked[30, 22] and none.blocked[30, 23]
+    assert wide.blocked[30, 24] and wide.blocked[30, 25]
+    # bumps: a point marks its cell as an obstacle, grown by the radius
+    bumped = traversable(grid, robot_radius=0.2, optimistic=0.2,
+                         obstacles=np.array([[1.05, 2.05]]))
+    assert bumped.blocked[20, 10] and bumped.blocked[20, 12]
+    assert not traversable(grid, 0.2, 0.2).blocked[20, 10]
+
+
+def test_goals_on_the_live_map() -> None:
+    occ = traversable(two_rooms(), robot_radius=0.2, optimistic=0.2)
+    dist = geodesic_distances(occ, A)
+    # a frontier's cluster: the gap's left mouth is reachable, the right mouth only the
+    # long way round: the nearest along the floor is on the left
+    cells = np.array([[2.25, 3.05], [2.25, 3.15], [2.75, 3.05]])
+    goal = nearest_reachable(occ, dist, cells)
+    assert goal == pytest.approx((2.25, 3.05))
+    # cells inside the wall: the reachable cell within the snap radius nearest the robot
+    wall = np.array([[2.45, 2.05]])
+    g2 = nearest_reachable(occ, dist, wall, snap=0.5)
+    assert g2 is not None and g2[0] < 2.4 and math.dist(g2, wall[0]) <= 0.5 + 1e-9
+    assert nearest_reachable(occ, dist, wall, snap=0.0) is None
+    # a stand for a thing in the wall: within reach, at most `slack` beyond the nearest
+    stand = stand_goal(occ, dist, (2.45, 1.55), reach=1.0, slack=0.1)
+    assert stand is not None and stand[0] < 2.45
+    d_best = min(math.dist((2.45, 1.55), occ.grid.center_of(r, c))
+                 for r, c in zip(*np.nonzero(np.isfinite(dist)), strict=True))
+    assert math.dist(stand, (2.45, 1.55)) <= d_best + 0.1 + 1e-9
+    assert stand_goal(occ, dist, (2.45, 1.55), reach=0.1) is None

@@ -1,0 +1,126 @@
+"""``sgtool run-bench``: the closed-loop benchmark (:mod:`sgtool.analysis.closed_loop_bench`)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from sgtool.commands.options import (
+    executor_options,
+    parse_resolution,
+    parse_rooms,
+    planner_options,
+)
+from sgtool.datasets.presets import PRESET_NAMES
+from sgtool.errors import SgtoolError
+
+
+@click.command("run-bench")
+@click.option("--planners", default=None, metavar="LIST",
+              help="Comma-separated planners (as `sgtool bench`). Default: all but moma-llm.")
+@click.option("--houses", default=5, show_default=True,
+              help="Generated evaluation houses (seeds HOUSE_SEED, +1, ...); 0 with --house "
+              "runs the given houses only.")
+@click.option("--house", "house_files", multiple=True, metavar="PATH",
+              type=click.Path(path_type=str),
+              help="A house spec JSON file or a folder of them (repeatable), checked first.")
+@click.option("--house-seed", default=0, show_default=True, help="Seed of the first house.")
+@click.option("--rooms", default="12-16", show_default=True, metavar="MIN-MAX",
+              help="Room count range of the generated houses.")
+@click.option("--preset", type=click.Choice(list(PRESET_NAMES)), default="symsearch",
+              show_default=True, help="Generator preset of the generated houses.")
+@click.option("--episodes", default=6, show_default=True,
+              help="Episodes per house: the first ones of `sgtool bench`'s episodes.")
+@click.option("--noise", "noise", multiple=True, metavar="PROFILE",
+              help="Sensor noise profile (none, mild, strong, with overrides as `sgtool "
+              "record --noise`); repeatable: every profile is a run. Default: none.")
+@click.option("--max-steps", default=50, show_default=True,
+              help="High-level planner steps per episode.")
+@click.option("--frames", type=click.IntRange(min=1), default=None,
+              help="Frame budget per episode. Default: none.")
+@click.option("--resolution", default="320x240", show_default=True,
+              help="Camera image size WIDTHxHEIGHT.")
+@click.option("--every", type=click.IntRange(min=1), default=10, show_default=True,
+              help="Refresh the scene graph every K frames (and at every action).")
+@click.option("--navigation", type=click.Choice(["live", "house"]), default="live",
+              show_default=True,
+              help="live: skills plan on the robot's own map; house: on the ground truth "
+              "(the privileged behaviour before issue 17, for comparison).")
+@click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
+              help="Extra planner option, e.g. scout.delta=0.2 (repeatable).")
+@click.option("-o", "--out", "out_dir", default="run-bench", show_default=True,
+              type=click.Path(file_okay=False),
+              help="Output folder: logs/NOISE/PLANNER/HOUSE/ep-K.mcap, episodes.jsonl, "
+              "summary.md, efficiency curves.")
+@click.option("--report-only", is_flag=True,
+              help="Run nothing: the tables of the episodes whose logs are there already.")
+@click.option("--progress/--no-progress", default=None,
+              help="Progress bar on stderr (default: when stderr is a terminal).")
+@executor_options("episodes (one closed-loop run each)")
+def command(planners: str | None, houses: int, house_files: tuple[str, ...], house_seed: int,
+            rooms: str, preset: str, episodes: int, noise: tuple[str, ...], max_steps: int,
+            frames: int | None, resolution: str, every: int, navigation: str,
+            planner_option: tuple[str, ...], out_dir: str, report_only: bool,
+            progress: bool | None, executor: str = "local", workers: int = 1,
+            ray_address: str | None = None) -> None:
+    """Run closed-loop search episodes in PyBullet for every planner on generated and given
+    houses (the houses and episodes of `sgtool bench`), under each noise profile: one
+    episode log per run (what `sgtool run` writes), then the table of the symbolic bench
+    (SR, SPL, steps, decision time, AUC-E) with frames per second and failed skills per
+    episode by reason, and the efficiency curves.
+
+    Resumable: an episode whose log exists is read back instead of run again (a log is
+    only there once complete). Ctrl-C stops the run and leaves only complete logs. With
+    `-w N` or `--executor ray` the episodes run in parallel (the same logs and tables).
+
+    Example: `sgtool run-bench --planners random,scout --houses 2 --episodes 3
+    --resolution 160x120 -o rb`.
+    """
+    from tqdm import tqdm
+
+    from sgtool.analysis.bench import DEFAULT_PLANNERS
+    from sgtool.analysis.closed_loop_bench import (
+        ClosedLoopBenchConfig,
+        run_closed_loop_bench,
+        write_outputs,
+    )
+    from sgtool.recorders.sim import CameraConfig
+    from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
+
+    names = tuple(p.strip().lower() for p in planners.split(",") if p.strip()) if planners \
+        else DEFAULT_PLANNERS
+    if max_steps < 1:
+        raise SgtoolError(f"--max-steps: must be >= 1, got {max_steps}")
+    width, height = parse_resolution(resolution)
+    if Path(out_dir).exists() and not Path(out_dir).is_dir():
+        raise SgtoolError(f"-o {out_dir}: not a folder")
+    opts = ClosedLoopOptions(camera=CameraConfig(width=width, height=height), every=every,
+                             max_steps=max_steps, frames=frames, navigation=navigation)
+    cfg = ClosedLoopBenchConfig(
+        planners=names, houses=houses, house_seed=house_seed, house_files=house_files,
+        episodes=episodes, rooms=parse_rooms(rooms), preset=preset,
+        noise=tuple(noise) or ("none",), options=opts,
+        planner_options=planner_options(planner_option))
+    show = sys.stderr.isatty() if progress is None else progress
+    runner = map  # in this process, one episode after the other
+    if (executor != "local" or workers > 1 or ray_address) and not report_only:
+        from sgtool.analysis.executor import as_map, make_executor
+
+        runner = as_map(make_executor(executor, workers, ray_address), progress=show,
+                        desc="run-bench", task_id=lambda _, t: str(t.output))
+        show = False  # the executor's bar counts the episodes
+    bar = tqdm(total=None, unit="episode", desc="run-bench", file=sys.stderr,
+               disable=not show, dynamic_ncols=True)
+    try:
+        res = run_closed_loop_bench(cfg, out_dir, progress=bar, report_only=report_only,
+                                    runner=runner)
+    except KeyboardInterrupt:
+        raise SgtoolError(f"interrupted; the complete episode logs are kept in {out_dir}/logs "
+                          "(run the same command again to resume)") from None
+    finally:
+        bar.close()
+    paths = write_outputs(res, out_dir)
+    click.echo(res.table())
+    click.echo(f"wrote {', '.join(str(p) for p in paths)}")

@@ -1,0 +1,145 @@
+"""Messages of an indexed MCAP file in log-time order, read chunk by chunk without a heap.
+
+The ``mcap`` package's :meth:`~mcap.reader.SeekingReader.iter_messages` puts every message
+of every chunk through a Python heap to merge chunks by log time. A log written by one
+writer (every sgtool log) has chunks that follow each other in time, so the merge is
+almost always a concatenation. :func:`ordered_messages` gives exactly the order of
+``iter_messages(log_time_order=True)`` (log time, then chunk offset, then position in the
+chunk) at a fraction of the cost: chunks are visited by (start time, offset) and the
+messages read so far are handed out, sorted, as soon as no chunk still to be read can hold
+an earlier one (a single sort of an already sorted list when chunks do not overlap).
+
+Chunk CRCs are checked only with ``verify=True`` (``sgtool replay --verify``; ``sgtool
+doctor`` always checks every CRC through :mod:`sgtool.log.file_check`). Lengths are
+checked against the chunk before they are used; any damage raises an exception that the
+reader (``LogReader._checked``) turns into its one-line
+:class:`~sgtool.errors.LogFormatError` pointing to ``sgtool doctor``.
+"""
+
+from __future__ import annotations
+
+import functools
+import struct
+import zlib
+from collections.abc import Iterator
+from typing import IO, Any
+
+from mcap.records import Channel, ChunkIndex, Message, Schema
+from mcap.summary import Summary
+
+
+class ChunkError(ValueError):
+    """Damage found in a chunk (the reader words it as a LogFormatError)."""
+
+
+_MESSAGE = 0x05
+_CHUNK_HEAD = struct.Struct("<QQQI")  # start time, end time, uncompressed size, crc
+_RECORD_HEAD = struct.Struct("<BQ")
+_MESSAGE_HEAD = struct.Struct("<HIQQ")  # channel, sequence, log time, publish time
+MAX_CHUNK_BYTES = 1 << 31  # an uncompressed chunk larger than this is damage
+
+Item = tuple[Schema | None, Channel, Message]
+_Key = tuple[int, int, int]  # log time, chunk offset, position in the chunk
+
+
+@functools.cache
+def _zstd() -> Any:
+    import zstandard
+
+    return zstandard.ZstdDecompressor()
+
+
+def chunk_records(f: IO[bytes], ci: ChunkIndex, verify: bool) -> bytes:
+    """The uncompressed records of the chunk that ``ci`` points to (CRC checked when
+    ``verify`` and the writer wrote one)."""
+    f.seek(ci.chunk_start_offset)
+    head = f.read(9 + _CHUNK_HEAD.size + 4)
+    if len(head) < 9 + _CHUNK_HEAD.size + 4 or head[0] != 0x06:
+        raise ChunkError(f"no chunk record at byte {ci.chunk_start_offset}")
+    _, _, size, crc = _CHUNK_HEAD.unpack_from(head, 9)
+    (name_len,) = struct.unpack_from("<I", head, 9 + _CHUNK_HEAD.size)
+    if name_len > 16:
+        raise ChunkError(f"chunk at byte {ci.chunk_start_offset}: bad compression name")
+    compression = f.read(name_len).decode("ascii", "replace")
+    (data_len,) = struct.unpack("<Q", f.read(8))
+    if data_len > ci.chunk_length or size > MAX_CHUNK_BYTES:
+        raise ChunkError(f"chunk at byte {ci.chunk_start_offset}: lengths do not fit")
+    data = f.read(data_len)
+    if len(data) != data_len:
+        raise ChunkError(f"chunk at byte {ci.chunk_start_offset} is cut short")
+    if compression == "zstd":
+        data = _zstd().decompress(data, max_output_size=size)
+    elif compression == "lz4":
+        import lz4.frame
+
+        data = lz4.frame.decompress(data)
+    elif compression:
+        raise ChunkError(f"chunk at byte {ci.chunk_start_offset}: unknown compression "
+                             f"{compression[:16]!r}")
+    if len(data) != size:
+        raise ChunkError(f"chunk at byte {ci.chunk_start_offset}: {len(data)} bytes "
+                             f"uncompressed, its header says {size}")
+    if verify and crc != 0 and zlib.crc32(data) != crc:
+        raise ChunkError(f"chunk at byte {ci.chunk_start_offset}: CRC mismatch")
+    return data
+
+
+def _messages_of(data: bytes, offset: int, summary: Summary, wanted: set[int] | None,
+                 start_ns: int | None, end_ns: int | None) -> list[tuple[_Key, Item]]:
+    out: list[tuple[_Key, Item]] = []
+    pos, n, index = 0, len(data), 0
+    channels, schemas = summary.channels, summary.schemas
+    while pos < n:
+        op, length = _RECORD_HEAD.unpack_from(data, pos)
+        body = pos + 9
+        pos = body + length
+        if pos > n:
+            raise ChunkError(f"chunk at byte {offset}: a record runs past its end")
+        if op != _MESSAGE:
+            index += 1
+            continue
+        if length < _MESSAGE_HEAD.size:
+            raise ChunkError(f"chunk at byte {offset}: a message record is too short")
+        cid, seq, t, pub = _MESSAGE_HEAD.unpack_from(data, body)
+        channel = channels[cid]  # KeyError: a message on an undefined channel
+        if ((wanted is None or cid in wanted) and (start_ns is None or t >= start_ns)
+                and (end_ns is None or t < end_ns)):
+            schema = schemas[channel.schema_id] if channel.schema_id else None
+            msg = Message(channel_id=cid, sequence=seq, log_time=t, publish_time=pub,
+                          data=data[body + _MESSAGE_HEAD.size:pos])
+            out.append(((t, offset, index), (schema, channel, msg)))
+        index += 1
+    return out
+
+
+def ordered_messages(f: IO[bytes], summary: Summary, topics: list[str] | None = None, *,
+                     start_ns: int | None = None, end_ns: int | None = None,
+                     verify: bool = False) -> Iterator[Item]:
+    """(schema, channel, message) of the chunked messages on ``topics`` (all when None)
+    with ``start_ns <= log time < end_ns``, in the order of the ``mcap`` reader's
+    ``iter_messages(log_time_order=True)`` (module doc)."""
+    wanted = None if topics is None else {
+        cid for cid, ch in summary.channels.items() if ch.topic in set(topics)}
+    chunks = sorted(
+        (ci for ci in summary.chunk_indexes
+         if (wanted is None or not ci.message_index_offsets
+             or wanted & ci.message_index_offsets.keys())
+         and (start_ns is None or ci.message_end_time >= start_ns)
+         and (end_ns is None or ci.message_start_time < end_ns)),
+        key=lambda ci: (ci.message_start_time, ci.chunk_start_offset))
+    pending: list[tuple[_Key, Item]] = []
+    for j, ci in enumerate(chunks):
+        pending.extend(_messages_of(chunk_records(f, ci, verify), ci.chunk_start_offset,
+                                    summary, wanted, start_ns, end_ns))
+        pending.sort(key=lambda e: e[0])
+        if j + 1 < len(chunks):
+            nxt = chunks[j + 1]
+            bound = (nxt.message_start_time, nxt.chunk_start_offset, -1)
+            cut = len(pending)
+            while cut and pending[cut - 1][0] > bound:
+                cut -= 1
+        else:
+            cut = len(pending)
+        for _, item in pending[:cut]:
+            yield item
+        del pending[:cut]

@@ -1,0 +1,173 @@
+"""Paths on the robot's own map: where it may drive on a grid it is still building (pure).
+
+The live map is the bird's-eye grid of the voxel map (:mod:`sgtool.mapping.bev`: free,
+occupied, unknown). :func:`traversable` turns it into an
+:class:`~sgtool.mapping.occupancy.OccupancyMap`, the grid the house planners use, so the
+existing geodesics and A* run on it unchanged:
+
+- a known obstacle blocks every cell whose centre is closer than the robot radius to it
+  (:func:`~sgtool.mapping.occupancy.inflate`);
+- an unknown cell is not traversable, except within ``optimistic`` metres of known free
+  floor: the short optimistic margin that lets a path end at (and slightly into) a
+  frontier, whose far side the camera sees on the way;
+- everything outside the grid is unknown.
+
+Goals on the live map (all pick among cells with a finite geodesic distance ``dist`` from
+the robot, ties by the lowest row, then column):
+
+- :func:`nearest_reachable`: of a set of world points (a frontier's cluster), the cell
+  nearest along the floor; points whose own cell is blocked fall back to the reachable
+  cells within ``snap`` metres of them;
+- :func:`point_goal`: the reachable cell nearest (straight line) to a point, within ``snap``;
+- :func:`stand_goal`: a place to stand at an object known only by its position: the
+  reachable cells nearest to it, of which the one nearest along the floor.
+
+:func:`descend` reads a shortest cell path off a distance field (steepest descent from
+the goal to the robot), so one Dijkstra run serves both the goal choice and the path.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from scipy import ndimage
+
+from sgtool.mapping.grid import OccupancyGrid
+from sgtool.mapping.occupancy import OccupancyMap, inflate
+
+_SQRT2 = math.sqrt(2.0)
+_STEPS = ((0, 1), (0, -1), (1, 0), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
+
+
+def traversable(grid: OccupancyGrid, robot_radius: float, optimistic: float = 0.25,
+                obstacles: np.ndarray | None = None) -> OccupancyMap:
+    """The live grid as a map to plan on (module doc): ``blocked`` = known obstacles grown
+    by ``robot_radius``, plus unknown cells farther than ``optimistic`` m from known free
+    floor. ``obstacles`` (world x, y; e.g. where the robot bumped into something) mark
+    their cells as obstacles too."""
+    if optimistic < 0:
+        raise ValueError("optimistic margin must be >= 0")
+    occupied = grid.occupied
+    if obstacles is not None and len(obstacles):
+        occ_map = OccupancyMap(grid, occupied)
+        rows, cols = _cells_of(occ_map, obstacles)
+        occupied = occupied.copy()
+        occupied[rows, cols] = True
+    blocked = inflate(occupied, robot_radius, grid.resolution)
+    unknown = grid.unknown
+    if unknown.any():
+        free = grid.free
+        if free.any():
+            to_free = ndimage.distance_transform_edt(~free, sampling=grid.resolution)
+            far = to_free > optimistic + 1e-9
+        else:
+            far = np.ones(grid.shape, bool)
+        blocked |= unknown & far
+    return OccupancyMap(grid, blocked, robot_radius)
+
+
+def _cells_of(occ: OccupancyMap, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    rows = np.floor((pts[:, 1] - occ.origin[1]) / occ.resolution).astype(np.int64)
+    cols = np.floor((pts[:, 0] - occ.origin[0]) / occ.resolution).astype(np.int64)
+    ok = (rows >= 0) & (rows < occ.shape[0]) & (cols >= 0) & (cols < occ.shape[1])
+    return rows[ok], cols[ok]
+
+
+def _centre(occ: OccupancyMap, r: int, c: int) -> tuple[float, float]:
+    return (occ.origin[0] + (c + 0.5) * occ.resolution,
+            occ.origin[1] + (r + 0.5) * occ.resolution)
+
+
+def _argmin(occ: OccupancyMap, score: np.ndarray) -> tuple[float, float] | None:
+    flat = score.ravel()
+    if flat.size == 0 or not np.isfinite(flat).any():
+        return None
+    r, c = divmod(int(np.argmin(flat)), occ.shape[1])
+    return _centre(occ, r, c)
+
+
+def nearest_reachable(occ: OccupancyMap, dist: np.ndarray, points: np.ndarray,
+                      snap: float = 0.5) -> tuple[float, float] | None:
+    """The cell of ``points`` (world x, y) nearest the robot along the floor; when none of
+    their own cells is reachable, the reachable cell within ``snap`` m of them nearest
+    along the floor. None when nothing qualifies."""
+    rows, cols = _cells_of(occ, points)
+    if rows.size == 0:
+        return None
+    mask = np.zeros(occ.shape, bool)
+    mask[rows, cols] = True
+    hit = _argmin(occ, np.where(mask, dist, np.inf))
+    if hit is not None or snap <= 0:
+        return hit
+    near = ndimage.distance_transform_edt(~mask, sampling=occ.resolution) <= snap + 1e-9
+    return _argmin(occ, np.where(near, dist, np.inf))
+
+
+def point_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float],
+               snap: float) -> tuple[float, float] | None:
+    """The reachable cell nearest (straight line) to ``xy`` within ``snap`` m, None when
+    there is none."""
+    X, Y = _centres(occ)
+    d = np.hypot(X - xy[0], Y - xy[1])
+    return _argmin(occ, np.where(np.isfinite(dist) & (d <= snap + 1e-9), d, np.inf))
+
+
+def stand_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], reach: float,
+               slack: float = 0.3) -> tuple[float, float] | None:
+    """Where to stand to work on a thing at ``xy``: of the reachable cells within ``reach``
+    m of it, those at most ``slack`` m farther than the nearest one, the one nearest along
+    the floor. None when no reachable cell is within ``reach``."""
+    X, Y = _centres(occ)
+    d = np.hypot(X - xy[0], Y - xy[1])
+    ok = np.isfinite(dist) & (d <= reach + 1e-9)
+    if not ok.any():
+        return None
+    best = float(d[ok].min())
+    return _argmin(occ, np.where(ok & (d <= best + slack + 1e-9), dist, np.inf))
+
+
+def _centres(occ: OccupancyMap) -> tuple[np.ndarray, np.ndarray]:
+    rows, cols = occ.shape
+    x = occ.origin[0] + (np.arange(cols) + 0.5) * occ.resolution
+    y = occ.origin[1] + (np.arange(rows) + 0.5) * occ.resolution
+    return np.meshgrid(x, y)
+
+
+def descend(occ: OccupancyMap, dist: np.ndarray, goal: Sequence[float]
+            ) -> list[tuple[float, float]] | None:
+    """A shortest path (cell centres, robot's cell first, goal's last) read off ``dist``,
+    the geodesic distances from the robot (:func:`~sgtool.mapping.occupancy.
+    geodesic_distances` on ``occ``); None when the goal's cell is unreachable. Each step
+    goes to the neighbour whose distance plus the step length equals the cell's own
+    (steepest descent; diagonals only past two free cells, as the graph)."""
+    r = int(math.floor((goal[1] - occ.origin[1]) / occ.resolution))
+    c = int(math.floor((goal[0] - occ.origin[0]) / occ.resolution))
+    if not occ.in_bounds(r, c) or not math.isfinite(dist[r, c]):
+        return None
+    blocked, res = occ.blocked, occ.resolution
+    h, w = occ.shape
+    path = [(r, c)]
+    for _ in range(h * w):
+        d = dist[r, c]
+        if d <= 1e-12:
+            break
+        nxt = None
+        for dr, dc in _STEPS:
+            rr, cc = r + dr, c + dc
+            if not (0 <= rr < h and 0 <= cc < w) or blocked[rr, cc]:
+                continue
+            if dr and dc and (blocked[r + dr, c] or blocked[r, c + dc]):
+                continue
+            step = res * (_SQRT2 if dr and dc else 1.0)
+            if abs(dist[rr, cc] + step - d) <= 1e-7:
+                nxt = (rr, cc)
+                break
+        if nxt is None:  # cannot happen on a distance field of this grid
+            return None
+        r, c = nxt
+        path.append(nxt)
+    path.reverse()
+    return [_centre(occ, pr, pc) for pr, pc in path]
