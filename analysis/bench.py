@@ -73,6 +73,8 @@ from sgtool.analysis.report import (
     format_seen_unseen,
     format_side_by_side,
     format_table,
+    llm_answer_lines,
+    llm_answer_totals,
     summary_dict,
 )
 from sgtool.canonical import strict_json
@@ -143,9 +145,11 @@ class BenchConfig:
 
         if self.preset not in PRESET_NAMES:
             raise BenchError(f"--preset: one of {', '.join(PRESET_NAMES)}, got {self.preset!r}")
+        from sgtool.datasets.generator import MAX_ROOMS
+
         lo, hi = self.rooms
-        if not 4 <= lo <= hi <= 16:
-            raise BenchError(f"--rooms: need 4 <= MIN <= MAX <= 16, got {lo}-{hi}")
+        if not 4 <= lo <= hi <= MAX_ROOMS:
+            raise BenchError(f"--rooms: need 4 <= MIN <= MAX <= {MAX_ROOMS}, got {lo}-{hi}")
         if self.success not in SUCCESS_RULES:
             raise BenchError(f"--success: one of {', '.join(SUCCESS_RULES)}, got "
                              f"{self.success!r}")
@@ -425,6 +429,7 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
           *([f"Failed tasks (retried once; their episodes are in no table): "
              f"{len(res.failed)}", *(f"- {line}" for line in res.failed)]
             if res.failed else []),
+          *llm_answer_lines(res.results, cfg.planners),
           f"Digest of episodes.jsonl without wall-clock fields: {res.digest}",
           f"sgtool {__version__}; relational priors "
           f"{priors_fingerprint(cfg.priors_dir)}; wall-clock figures and the command in "
@@ -451,6 +456,8 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
         "sgtool_version": __version__,
         "priors_sha256_16": priors_fingerprint(cfg.priors_dir),
     }
+    if answers := llm_answer_totals(res.results, cfg.planners):
+        summary["llm_answers"] = answers  # only for runs with an LLM planner
     paths.append(atomic_write(
         out / "summary.json",
         json.dumps(strict_json(summary), indent=1, sort_keys=True, allow_nan=False) + "\n"))

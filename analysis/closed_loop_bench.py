@@ -128,6 +128,7 @@ class RunTask:
     planner_options: Mapping[str, Any]
     rooms: tuple[int, int]
     preset: str
+    episodes: int  # the house's episodes in the run: the draw ``episode`` is taken from
 
 
 @dataclass(frozen=True)
@@ -147,10 +148,19 @@ def log_path(root: Path, noise: str, planner: str, house: str, episode: int) -> 
     return root / noise / planner / house / f"ep-{episode:03d}.mcap"
 
 
+_DRAWS: dict[tuple[Any, ...], list[Any]] = {}  # episodes per house and draw, per process
+
+
 def _episodes(task: RunTask) -> list[Any]:
-    spec = task.house.load(task.rooms, task.preset)
-    mix = task.preset if task.house.spec is None else "default"
-    return bench_episodes(spec, task.episode + 1, mix)
+    """The house's episodes of the run: the bench's draw of ``task.episodes`` (the draw
+    depends on its size, so this is what makes them the symbolic bench's episodes)."""
+    key = (task.house.id, task.rooms, task.preset, task.episodes)
+    if key not in _DRAWS:
+        spec = task.house.load(task.rooms, task.preset)
+        mix = task.preset if task.house.spec is None else "default"
+        _DRAWS.clear()  # one house at a time (tasks come house by house)
+        _DRAWS[key] = bench_episodes(spec, task.episodes, mix)
+    return _DRAWS[key]
 
 
 def run_task(task: RunTask) -> RunRow:
@@ -180,11 +190,12 @@ def run_task(task: RunTask) -> RunRow:
     return _row(task, seconds)
 
 
-def _settings(opts: ClosedLoopOptions, noise: str) -> dict[str, Any]:
-    return {"max_steps": opts.max_steps, "frame_budget": opts.frames,
+def _settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
+              ) -> dict[str, Any]:
+    return {"episode": episode, "max_steps": opts.max_steps, "frame_budget": opts.frames,
             "size": [opts.camera.width, opts.camera.height],
             "navigation": opts.navigation, "noise": parse_noise(noise).to_dict(),
-            "seed": opts.planner_seed}
+            "seed": opts.planner_seed, "success": opts.success}
 
 
 def _logged_settings(path: Path) -> dict[str, Any]:
@@ -196,17 +207,24 @@ def _logged_settings(path: Path) -> dict[str, Any]:
                        None)
     x = dict(started.extras) if started is not None else {}
     cam = x.get("camera") or {}
-    return {"max_steps": x.get("max_steps"), "frame_budget": x.get("frame_budget"),
+    ep = [x.get("episode_id"), started.query] if started is not None else None
+    return {"episode": ep, "max_steps": x.get("max_steps"),
+            "frame_budget": x.get("frame_budget"),
             "size": [cam.get("width"), cam.get("height")],
             "navigation": (x.get("navigation") or {}).get("mode", "house"),
-            "noise": x.get("noise"), "seed": x.get("seed")}
+            "noise": x.get("noise"), "seed": x.get("seed"),
+            "success": x.get("success", "observed")}
 
 
 def _row(task: RunTask, seconds: float | None) -> RunRow:
+    eps = _episodes(task) if seconds is None else []
+    want = [eps[task.episode].id, eps[task.episode].query] if task.episode < len(eps) \
+        else None
     if seconds is None and _logged_settings(task.output) != _settings(task.options,
-                                                                      task.noise):
-        raise SgtoolError(f"{task.output} was run with other settings (steps, frames, "
-                          "resolution, navigation, noise or seed); give another -o folder")
+                                                                      task.noise, want):
+        raise SgtoolError(f"{task.output} was run with other settings (episode, steps, "
+                          "frames, resolution, navigation, noise, seed or success rule); "
+                          "give another -o folder")
     logged = read_log_episodes(task.output)
     if len(logged) != 1:
         raise SgtoolError(f"{task.output}: holds {len(logged)} episodes, not one; remove it "
@@ -235,7 +253,7 @@ def tasks_of(cfg: ClosedLoopBenchConfig, logs: Path) -> list[RunTask]:
                     out.append(RunTask(h, k, planner, noise,
                                        log_path(logs, noise, planner, h.id, k), cfg.options,
                                        dict(cfg.planner_options.get(planner, {})),
-                                       cfg.rooms, cfg.preset))
+                                       cfg.rooms, cfg.preset, cfg.episodes))
     return out
 
 
@@ -252,11 +270,12 @@ class ClosedLoopBenchResult:
         cfg = self.config
         models = cost_models(cfg.distance_budget, cfg.step_budget)
         parts = []
+        rule = "; success only on done() (MoMa-LLM)" if cfg.options.success == "done" else ""
         for noise in cfg.noise:
             rows = [r for r in self.rows if r.task.noise == noise]
             parts.append(format_table(summarize([r.result for r in rows], models,
                                                 cfg.planners), models=models,
-                                      title=f"## Closed loop, noise {noise!r}"))
+                                      title=f"## Closed loop, noise {noise!r}{rule}"))
             parts.append(_run_table(rows, cfg.planners))
         return "\n".join(parts)
 

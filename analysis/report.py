@@ -28,6 +28,8 @@ from sgtool.analysis.paper_tables import (
     QuotedSplit,
     quoted_for,
 )
+from sgtool.llm.stats import COUNTS, invalid_rate_text
+from sgtool.results import EpisodeResult
 
 _COLUMNS: tuple[tuple[str, str, str], ...] = (
     # (stat key, header, format)
@@ -212,3 +214,29 @@ def summary_dict(summaries: Sequence[PlannerSummary],
         }
         for s in summaries
     }
+
+
+def llm_answer_totals(results: Sequence[EpisodeResult], planners: Sequence[str]
+                      ) -> dict[str, dict[str, int]]:
+    """planner -> summed LLM answer counts (``EpisodeResult.llm_answers``), for the planners
+    that asked an LLM."""
+    out = {}
+    for p in planners:
+        tot = {k: 0 for k in COUNTS}
+        for r in results:
+            if r.planner == p:
+                for k in COUNTS:
+                    tot[k] += int(r.llm_answers.get(k, 0))
+        if tot["requests"]:
+            out[p] = tot
+    return out
+
+
+def llm_answer_lines(results: Sequence[EpisodeResult], planners: Sequence[str]) -> list[str]:
+    """One line per planner that asked an LLM: its requests, valid and rejected answers (the
+    invalid-answer rate) and transport faults."""
+    return [f"LLM answers of {p}: {t['requests']} requests, {t['valid']} valid, "
+            f"{t['invalid']} rejected (invalid-answer rate "
+            f"{invalid_rate_text(t['valid'], t['invalid'])}), {t['faults']} faults, "
+            f"{t['unknown']} without verdict"
+            for p, t in llm_answer_totals(results, planners).items()]

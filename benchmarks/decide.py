@@ -113,6 +113,8 @@ class InstantLlm:
     def complete(self, messages):
         user = messages[1]["content"]
         m = re.search(r"^- ([^:\n]+): \[([^,\]]+)", user, re.M)
+        if m is None:  # not MoMa-LLM's scene text (unstructured-llm's raw JSON graph)
+            return ChatResult("Analysis: a.\nReasoning: b.\nCommand: done()", self.model, 0.0)
         room, obj = m.group(1), re.sub(r"^\d+ ", "", m.group(2))
         text = f"Analysis: a.\nReasoning: b.\nCommand: navigate({room}, {obj})"
         return ChatResult(text, self.model, 0.0)

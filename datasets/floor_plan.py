@@ -49,7 +49,7 @@ def _programme(rng: np.random.Generator, m: int, inv: Inventory) -> list[str]:
 def floor_plan(rng: np.random.Generator, n_rooms: int, inv: Inventory) -> Plan:
     """Rooms and openings of an ``n_rooms`` house (corridors included) for ``inv``'s
     split; raises :class:`PlanRetry` when the draw cannot be laid out."""
-    n_corr = 1 if n_rooms <= 7 else 2
+    n_corr = 1 if n_rooms <= 7 else 2 if n_rooms <= 16 else 3
     types = _programme(rng, n_rooms - n_corr, inv)
     order = [types[i] for i in rng.permutation(len(types))]
     # open plan: the kitchen with the living or dining room
@@ -119,14 +119,18 @@ def floor_plan(rng: np.random.Generator, n_rooms: int, inv: Inventory) -> Plan:
     plan = Plan()
     # corridor rooms
     split_x: list[float] = []
-    if n_corr == 2:
+    if n_corr > 1:
         xs, acc = [], 0.0
         for i in sides["n"][:-1]:
             acc += dims[i][0]
             xs.append(round(acc, 4))
         if not xs:
             raise PlanRetry
-        split_x = [min(xs, key=lambda x: (abs(x - length / 2), x))]
+        for k in range(1, n_corr):
+            left = [x for x in xs if not split_x or x > split_x[-1]]
+            if not left:
+                raise PlanRetry
+            split_x.append(min(left, key=lambda x, k=k: (abs(x - length * k / n_corr), x)))
     bounds = [0.0, *split_x, round(length, 4)]
     for a, b in zip(bounds[:-1], bounds[1:], strict=True):
         plan.rooms.append(PlanRoom(len(plan.rooms), "corridor", Rect(a, 0.0, b, wc), "c"))

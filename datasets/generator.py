@@ -6,15 +6,16 @@
    house always has a kitchen, a living room and a bathroom (and a bedroom from five rooms
    on); further rooms are drawn with the frequencies of the room types of the real
    household scenes of the chosen knowledge split, with caps (one kitchen, at most three
-   bedrooms, ...).
+   bedrooms, ...); once every type is at its cap (from 25 rooms with the evaluation
+   split) further rooms are bedrooms.
 2. **Floor plan.** A double-loaded corridor (1.3-1.7 m wide; two corridor rooms joined by
-   an open passage from eight rooms on) with rooms on both sides, each 2.5-6 m a side
-   (sizes per room type), plus "back rooms" reached only through another room (a closet or
-   bathroom behind a bedroom, a pantry behind the kitchen). The kitchen may share an open
-   plan with the living or dining room: no wall between them, only stubs either side of
-   a wide passage. Every other connection is a 0.9 m door that may be closed (bedrooms,
-   bathrooms, closets more often). Walls are 0.1 m thick and 2.5 m high, with gaps at
-   doors and passages.
+   an open passage from eight rooms on, three from 17; at most 30 rooms) with rooms on both
+   sides, each 2.5-6 m a side (sizes per room type), plus "back rooms" reached only
+   through another room (a closet or bathroom behind a bedroom, a pantry behind the
+   kitchen). The kitchen may share an open plan with the living or dining room: no wall
+   between them, only stubs either side of a wide passage. Every other connection is a
+   0.9 m door that may be closed (bedrooms, bathrooms, closets more often). Walls are
+   0.1 m thick and 2.5 m high, with gaps at doors and passages.
 3. **Furniture.** Per room, each furniture category of that room type's real inventories
    (:attr:`Knowledge.room_furniture` over the split's household scenes) is included with
    its frequency, in a count drawn around its mean count; pieces stand against walls
@@ -100,6 +101,8 @@ from sgtool.errors import SgtoolError
 from sgtool.house.io import load_house
 from sgtool.house.spec import HouseSpec
 
+MAX_ROOMS = 30  # corridors included; a third corridor room from 17 rooms on
+
 __all__ = ["HOUSE_ROOM_TYPES", "generate_house"]
 
 
@@ -146,12 +149,12 @@ def _wrap_angle(a: float) -> float:
 def generate_house(seed: int, rooms: tuple[int, int] = (4, 12), split: str = "eval",
                    max_attempts: int = 40, preset: str = "default") -> HouseSpec:
     """A furnished house for ``seed`` (see the module docstring). ``rooms`` is the range
-    of the room count, corridors included (inclusive, 4..16); ``preset`` names a
+    of the room count, corridors included (inclusive, 4..30); ``preset`` names a
     :mod:`sgtool.datasets.presets` entry ("default": as documented here; "symsearch":
     InteriorGS-dense houses with long-tail small objects)."""
     lo, hi = int(rooms[0]), int(rooms[1])
-    if not 4 <= lo <= hi <= 16:
-        raise SgtoolError(f"rooms: need 4 <= min <= max <= 16, got {lo}-{hi}")
+    if not 4 <= lo <= hi <= MAX_ROOMS:
+        raise SgtoolError(f"rooms: need 4 <= min <= max <= {MAX_ROOMS}, got {lo}-{hi}")
     if split not in ("eval", "train"):
         raise SgtoolError(f"split: expected 'eval' or 'train', got {split!r}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:

@@ -3,19 +3,24 @@
 ``containment`` is the distilled model shipped with sgtool
 (:class:`~sgtool.semantics.room_classification.ContainmentRoomClassifier`); ``frequency`` is
 naive Bayes over the BEHAVIOR-1K training scenes' room inventories, built here because it
-reads the knowledge; ``none`` leaves rooms unclassified.
+reads the knowledge; ``llm`` is MoMa-LLM's room classification
+(:class:`~sgtool.semantics.room_classification.LlmRoomClassifier`) over the containment
+model's room types, with the containment model as its fallback, asked through the chat
+client the caller gives (an endpoint, or a transcript replayed offline); ``none`` leaves rooms
+unclassified.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
+from typing import Any
 
 from sgtool.datasets.generator import HOUSE_ROOM_TYPES
 from sgtool.datasets.split import is_household_scene, training_knowledge
 from sgtool.errors import SgtoolError
 from sgtool.scenegraph.categories import FrequencyRoomClassifier, RoomClassifier
 from sgtool.scenegraph.options import CLASSIFIERS
-from sgtool.semantics.room_classification import ContainmentRoomClassifier
+from sgtool.semantics.room_classification import ContainmentRoomClassifier, LlmRoomClassifier
 
 
 def frequency_room_classifier(room_types: Iterable[str] | None = None, alpha: float = 1.0,
@@ -56,12 +61,30 @@ def frequency_room_classifier(room_types: Iterable[str] | None = None, alpha: fl
     return FrequencyRoomClassifier(table, alpha=alpha)
 
 
-def make_classifier(name: str) -> RoomClassifier | None:
-    """The room classifier a replay or a live builder uses, by name (``CLASSIFIERS``)."""
+class LlmClassifierError(SgtoolError):
+    """``llm`` was asked for without a chat client."""
+
+
+def make_classifier(name: str, client: Any | None = None, *, constraint: str = "auto",
+                    on_exchange: Callable[[dict], None] | None = None,
+                    timeout_s: float = 60.0) -> RoomClassifier | None:
+    """The room classifier a replay or a live builder uses, by name (``CLASSIFIERS``).
+    ``llm`` needs ``client`` (:mod:`sgtool.llm.client`, or a
+    :class:`~sgtool.llm.recorded.ReplayChatClient`); ``constraint``, ``on_exchange`` (called
+    with every exchange record) and ``timeout_s`` (per request) are its options."""
     if name == "containment":
         return ContainmentRoomClassifier()
     if name == "frequency":
         return frequency_room_classifier()
+    if name == "llm":
+        if client is None:
+            raise LlmClassifierError(
+                "the llm room classifier needs an endpoint or a recorded transcript "
+                "(sgtool replay --classifier llm --llm-base-url URL | --llm-replay FILE)")
+        learned = ContainmentRoomClassifier()
+        return LlmRoomClassifier(client, learned.room_types, constraint=constraint,
+                                 fallback=learned, on_exchange=on_exchange,
+                                 timeout_s=timeout_s)
     if name == "none":
         return None
     raise SgtoolError(f"unknown room classifier {name!r}; one of {', '.join(CLASSIFIERS)}")

@@ -165,11 +165,14 @@ def replay(
     progress: Any = None,
     compression: str = "zstd",
     verify: bool = False,
+    room_classifier: Callable[[str], Any] | None = None,
 ) -> ReplayReport:
     """Replay ``log`` (module doc). ``on_refresh`` sees every refresh as it happens;
     ``progress`` is anything with ``update(n)`` (a tqdm bar), advanced per frame;
     ``verify`` checks every chunk CRC of the input as it is read (``sgtool doctor``
-    checks everything; without it damage still gives a one-line error, or a frame)."""
+    checks everything; without it damage still gives a one-line error, or a frame);
+    ``room_classifier`` builds the classifier from the resolved name instead of
+    :func:`~sgtool.datasets.room_evidence.make_classifier` (``llm`` with a chat client)."""
     src = Path(log)
     dst = Path(output) if output is not None else None
     if dst is not None and dst.exists() and src.exists() and dst.resolve() == src.resolve():
@@ -178,7 +181,7 @@ def replay(
         reader.require(S.DEPTH, why="replay builds the map from depth images")
         opts = resolve_options(reader, options or ReplayOptions())
         report = ReplayReport(src, dst, opts, semantic=reader.has(S.IDS))
-        stream = SceneGraphStream(None, make_classifier(opts.classifier),
+        stream = SceneGraphStream(None, (room_classifier or make_classifier)(opts.classifier),
                                   builder_config(opts))
         t0 = time.perf_counter()
         if dst is None:

@@ -59,7 +59,10 @@ class EpisodeResult:
       (SCOUT Table IX); None when not known;
     - ``end``: why it ended ("found", "max_steps", "gave_up", "wrong_done", "stuck", ...);
     - ``wall``: wall-clock figures (``decision_s`` summed over decisions, ``decisions``,
-      ``episode_s``), the only non-deterministic part.
+      ``episode_s``), the only non-deterministic part;
+    - ``llm_answers``: an LLM planner's answer counts (:func:`sgtool.llm.stats.answer_counts`:
+      requests, valid, invalid (rejected), faults, unknown); empty, and absent from the
+      record, for other planners, so their records are as before.
     """
 
     planner: str
@@ -79,6 +82,7 @@ class EpisodeResult:
     source: str = "symbolic"
     trace: tuple[Step, ...] = ()
     wall: Mapping[str, float] = field(default_factory=dict)
+    llm_answers: Mapping[str, int] = field(default_factory=dict)
 
     @property
     def decision_s(self) -> float:
@@ -113,6 +117,8 @@ class EpisodeResult:
             "trace": [[s.skill, s.target, s.outcome, canonical_float(s.travelled_m)]
                       for s in self.trace],
             "wall": {k: round(float(v), 6) for k, v in sorted(self.wall.items())},
+            **({"llm_answers": {k: int(v) for k, v in sorted(self.llm_answers.items())}}
+               if self.llm_answers else {}),
         }
 
     def to_json(self) -> str:
@@ -149,6 +155,7 @@ class EpisodeResult:
             trace=tuple(Step(str(s[0]), s[1], str(s[2]), float(s[3]))
                         for s in d.get("trace", [])),
             wall=dict(d.get("wall", {})),
+            llm_answers={str(k): int(v) for k, v in (d.get("llm_answers") or {}).items()},
         )
 
 

@@ -35,7 +35,12 @@ One episode (:func:`run_episode`), all of it into one MCAP log:
    budget ("frames": the skill under way is cut and logged as a failure). The closing
    Episode record has status success/failure, steps, travelled_m, shortest_m (the
    episode's geodesic, :mod:`sgtool.datasets.episodes`), frames and ``extra`` (query,
-   planner, seed, end, n_open, mapping, episode).
+   planner, seed, end, n_open, mapping, episode). Under MoMa-LLM's success rule
+   (``success="done"``, :func:`~sgtool.planning.episode.search_success`) the planner is
+   asked once more on the graph that shows the target: that decision is logged as an
+   action (not a step, nothing executed) and only ``done(<an object of the query>)``
+   makes the episode a success, else it fails with end ``not_confirmed``; both Episode
+   records then carry ``extra.success: "done"``.
 
 Steps count every planner decision, invalid ones and ``done`` included (a step is spent),
 but not the opening look-around. Log time is the simulator's (``tick * 1e9 / fps``), never
@@ -78,7 +83,13 @@ from sgtool.log.records import LlmExchange
 from sgtool.log.writer import LogWriter
 from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.planning.candidates import find_target
-from sgtool.planning.episode import SearchStep, run_search
+from sgtool.planning.episode import (
+    NOT_CONFIRMED,
+    SearchStep,
+    check_success_rule,
+    run_search,
+    search_success,
+)
 from sgtool.recorders.sim.camera import CameraConfig
 from sgtool.recorders.sim.execution import Executed, execute_live, execute_privileged
 from sgtool.recorders.sim.live_skills import LiveNavConfig, LiveSkills, RobotBody
@@ -130,9 +141,11 @@ class ClosedLoopOptions:
     # "live": the robot plans on its own map (issue 17); "house": on the ground truth (before)
     navigation: str = "live"
     live: LiveNavConfig = field(default_factory=LiveNavConfig)
+    success: str = "observed"  # success rule (sgtool.planning.episode): observed | done
 
     def mapping(self) -> ResolvedOptions:
         """The replay options this run builds with (``extra.mapping`` of the log)."""
+        check_success_rule(self.success)
         if self.navigation not in NAVIGATION:
             raise SgtoolError(f"navigation {self.navigation!r}: one of {', '.join(NAVIGATION)}")
         if self.every < 1:
@@ -287,6 +300,7 @@ class _Search:
         self.decision_times: list[float] = []
         self._graph_time_ns = 0
         self._decision_s = 0.0
+        self._confirming = False  # the decision after the target came into view ("done")
 
     def start(self) -> None:
         """One frame, then a look around (logged as decided on no graph), so the first
@@ -325,11 +339,18 @@ class _Search:
         self._graph_time_ns = int(cur.time_ns)
         return cur.graph
 
+    @property
+    def success(self) -> bool:
+        """The target came into view (the environment's verdict)."""
+        return self.end == "found"
+
     def decided(self, index: int, graph: SceneGraph, action: Action,
                 decision_s: float) -> None:
         self.decision_times.append(decision_s)
         self._decision_s = decision_s
-        self.steps += 1
+        self._confirming = bool(self.end)  # asked once more after the end: not a step
+        if not self._confirming:
+            self.steps += 1
         _log_exchanges(self.agent, self.rec.writer, self.rec.last_time_ns)
         if self.on_decision is not None:
             self.on_decision(graph, action)
@@ -356,7 +377,15 @@ class _Search:
         return Feedback(action, o, why, dist)  # type: ignore[arg-type]
 
     def executed(self, step: SearchStep) -> None:
-        pass
+        """Log the confirmation decision (``done`` rule; nothing is executed) like any
+        action, so the log's last action is the ``done()`` that confirms the find."""
+        if not self._confirming:
+            return
+        fb = step.feedback
+        outcome = SkillOutcome(step.action.skill, step.action.target, fb.outcome,
+                               fb.message, 0.0, 0)
+        self.last_t = self.rec.act(self.sim, outcome, self._decision_s,
+                                   {"graph_time_ns": self._graph_time_ns})
 
     def _run(self, calls: tuple[SkillCall, ...]) -> Executed:
         if self.skills is None:
@@ -413,9 +442,11 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                 RobotBody(sim), lambda: stream.current, opts.live)
             search = _Search(sim, rec, planner, query, opts.max_steps, on_decision, skills)
             search.start()
-            run_search(search, planner, query, seed=opts.planner_seed, recorder=search)
-            end, steps, n_open = search.end, search.steps, search.n_open
-            success = end == "found"
+            trace = run_search(search, planner, query, seed=opts.planner_seed,
+                               recorder=search, success=opts.success)
+            steps, n_open = search.steps, search.n_open
+            success = search_success(search.success, trace, query, opts.success)
+            end = search.end if success == search.success else NOT_CONFIRMED
             t_end = max(rec.last_time_ns, search.last_t)
             writer.write_record(dataclasses.replace(
                 base, status="success" if success else "failure", steps=steps,
@@ -423,7 +454,8 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                 frames=rec.frames,
                 extra={"query": query, "planner": name, "seed": opts.planner_seed,
                        "episode": int(episode_index), "episode_id": episode.id,
-                       "end": end, "n_open": n_open, "mapping": mapping_record(mapping)},
+                       "end": end, "n_open": n_open, "mapping": mapping_record(mapping),
+                       **_rule(opts)},
             ), t_end)
             rec.refreshed(stream.finish(t_end))  # as replay ends: only if anything is new
             travelled, frames, refreshes = sim.travelled_m, rec.frames, rec.refreshes
@@ -466,5 +498,11 @@ def _started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOp
                        "cx": k.cx, "cy": k.cy},
         "robot": asdict(opts.robot),
         "navigation": {"mode": opts.navigation, **opts.live.to_dict()},
-        "noise": opts.noise.to_dict(), "noise_seed": opts.noise_seed,
+        "noise": opts.noise.to_dict(), "noise_seed": opts.noise_seed, **_rule(opts),
     }
+
+
+def _rule(opts: ClosedLoopOptions) -> dict[str, str]:
+    """``{"success": "done"}`` under MoMa-LLM's rule; nothing under the default (logs of
+    the default rule stay as they were)."""
+    return {} if opts.success == "observed" else {"success": opts.success}

@@ -18,6 +18,7 @@ import numpy as np
 
 from sgtool.errors import SgtoolError
 from sgtool.house.spec import HouseSpec, StartPose
+from sgtool.llm.stats import answer_counts
 from sgtool.log.records import Action as LoggedAction
 from sgtool.log.records import Episode, LlmExchange, SceneGraphRecord
 from sgtool.log.writer import LogWriter
@@ -125,6 +126,7 @@ def run_episode(house: SymbolicHouse, planner: Planner, query: str, targets: Seq
         end=end, source="symbolic", trace=trace,
         wall={"decision_s": sum(s.decision_s for s in steps), "decisions": float(len(steps)),
               "episode_s": time.perf_counter() - t_start},
+        llm_answers=answer_counts(ex for s in steps for ex in s.exchanges),
     )
     if recorder is not None:
         recorder.close(len(steps), env, shortest, {

@@ -52,6 +52,10 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
     other[other.index("--max-steps") + 1] = "3"
     res = CliRunner().invoke(cli, other)
     assert res.exit_code == 2 and "was run with other settings" in res.output
+    # nor does another success rule (MoMa-LLM's done rule)
+    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                   "--success", "done"])
+    assert res.exit_code == 2 and "success rule" in res.output
 
 
 def test_ctrl_c_leaves_only_complete_logs(house_file, tmp_path, monkeypatch) -> None:
@@ -118,3 +122,20 @@ def test_run_bench_on_two_worker_processes_writes_the_same_logs(house_file, tmp_
         runs[name] = (recs, logs)
     assert runs["one"][0] == runs["two"][0] and len(runs["one"][0]) == 2
     assert runs["one"][1] == runs["two"][1] and len(runs["one"][1]) == 2
+
+
+def test_episodes_are_the_symbolic_benchs() -> None:
+    """Episode k of a run of N episodes is episode k of the bench's draw of N (the draw
+    depends on N: the first round took the draw of k + 1)."""
+    from sgtool.analysis.bench_houses import bench_episodes
+
+    cfg = clb.ClosedLoopBenchConfig(planners=("random",), houses=1, house_seed=0,
+                                    episodes=3, rooms=(4, 6))
+    tasks = clb.tasks_of(cfg, Path("logs"))
+    spec = tasks[0].house.load(cfg.rooms, cfg.preset)
+    want = [(e.id, e.query) for e in bench_episodes(spec, 3, "symsearch")]
+    assert [(clb._episodes(t)[t.episode].id, clb._episodes(t)[t.episode].query)
+            for t in tasks] == want
+    (first,) = bench_episodes(spec, 1, "symsearch")
+    # why the draw size matters (house-0, 4-6 rooms): ep_0 is another episode
+    assert first.id == want[0][0] and first.query != want[0][1]

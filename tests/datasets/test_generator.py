@@ -25,7 +25,7 @@ from sgtool.house.spec import placement_problem
 from sgtool.mapping.occupancy import geodesic_distances
 
 CASES = [(0, (4, 12)), (1, (4, 12)), (2, (4, 4)), (3, (12, 12)), (4, (6, 9)), (5, (4, 12)),
-         (11, (8, 8))]
+         (11, (8, 8)), (3, (30, 30)), (6, (17, 24))]
 
 
 @pytest.fixture(scope="module")
@@ -185,10 +185,38 @@ def test_houses_use_only_their_split():
 def test_bad_arguments():
     with pytest.raises(SgtoolError, match="rooms"):
         generate_house(0, rooms=(3, 5))
+    with pytest.raises(SgtoolError, match="max <= 30"):
+        generate_house(0, rooms=(12, 31))
     with pytest.raises(SgtoolError, match="split"):
         generate_house(0, split="test")
     with pytest.raises(SgtoolError, match="seed"):
         generate_house(-1)
+
+
+# sha256 (first 16 hex) of the house JSON as the tree before 30-room support generated them:
+# houses of 4..16 rooms (the benchmarks' and golden logs' houses) must stay byte-identical
+OLD_HOUSES = {(3, 4): "dced227ec0b5eb80", (3, 8): "dc3c038dca0685f3",
+              (3, 12): "774b8cc430850985", (3, 16): "175777039fbb04c1",
+              (7, 16): "4a3ed8f571e85692"}
+
+
+@pytest.mark.parametrize("seed, n", sorted(OLD_HOUSES))
+def test_houses_up_to_16_rooms_are_unchanged(seed, n):
+    import hashlib
+
+    text = generate_house(seed, rooms=(n, n)).to_json()
+    assert hashlib.sha256(text.encode()).hexdigest()[:16] == OLD_HOUSES[seed, n]
+
+
+@pytest.mark.parametrize("n, corridors", [(7, 1), (8, 2), (16, 2), (17, 3), (30, 3)])
+def test_corridor_rooms_grow_with_the_house(n, corridors):
+    spec = generate_house(3, rooms=(n, n))
+    corr = sorted((r for r in spec.rooms if r.category == "corridor"), key=lambda r: r.bounds)
+    assert len(spec.rooms) == n and len(corr) == corridors
+    # the corridor rooms tile one strip end to end, each at least one room wide
+    for a, b in zip(corr[:-1], corr[1:], strict=True):
+        assert a.bounds[2] == pytest.approx(b.bounds[0])
+        assert a.bounds[2] - a.bounds[0] >= 2.5 - 1e-6
 
 
 def test_demo_house_is_shipped_and_matches_the_generator_layout():

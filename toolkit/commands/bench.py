@@ -51,7 +51,7 @@ from sgtool.errors import SgtoolError
                    "per_house.jsonl, per_query.md, per_query.jsonl, efficiency_distance.png, "
                    "efficiency_steps.png.")
 @click.option("--rooms", default="12-16", show_default=True, metavar="MIN-MAX",
-              help="Room count range of the generated houses (corridors included, 4..16); "
+              help="Room count range of the generated houses (corridors included, 4..30); "
                    "the default gives about as many first-level objects per house as "
                    "SymSearch's scenes.")
 @click.option("--preset", type=click.Choice(list(PRESET_NAMES)), default="symsearch",

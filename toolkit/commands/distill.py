@@ -75,6 +75,9 @@ def _weights_dir() -> Path:
               help="Label at most this many generated objects (cost cap).")
 @click.option("--llm-timeout", type=click.FloatRange(1.0, 3600.0), default=30.0,
               show_default=True, help="Seconds to wait for one LLM answer.")
+@click.option("--llm-max-tokens", type=click.IntRange(16, 8192), default=512,
+              show_default=True, help="Longest LLM answer, in tokens (a small model that does "
+              "not stop would otherwise fill the context).")
 @click.option("--llm-slice", default=None, metavar="ROOMS,CATEGORIES,OBJECTS",
               help="A small generation: at most ROOMS room types, CATEGORIES object "
                    "categories per room, OBJECTS objects per category [default: 12,8,10].")
@@ -83,7 +86,7 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
             keep: str, threads: int, source: str, llm_base_url: str | None, llm_model: str | None,
             llm_api_key: str | None, llm_cache: Path | None, llm_runs: int,
             llm_max_queries: int | None, llm_slice: str | None = None,
-            llm_timeout: float = 30.0) -> None:
+            llm_timeout: float = 30.0, llm_max_tokens: int = 512) -> None:
     """Train the containment and co-occurrence MLPs (SCOUT sec. IV-C) or report on them.
 
     By default the training data come from the training split of the household knowledge
@@ -110,7 +113,8 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
     if source == "llm":
         sets, room_types, fingerprint = _llm_sets(llm_base_url, llm_model, llm_api_key,
                                                   llm_cache, llm_runs, llm_max_queries,
-                                                  _slice(llm_slice), llm_timeout)
+                                                  _slice(llm_slice), llm_timeout,
+                                                  llm_max_tokens)
         _report_agreement(sets, training_sets(seed=seed))
     else:
         built = training_sets(seed=seed)
@@ -170,7 +174,7 @@ def _report_agreement(sets, reference) -> None:
 
 
 def _llm_sets(base_url, model, api_key, cache, runs, max_queries, slice_kw=None,
-              timeout_s=30.0):
+              timeout_s=30.0, max_tokens=512):
     from sgtool.llm.client import LlmSettings, OpenAIChatClient
     from sgtool.semantics.cache import cache_root
     from sgtool.semantics.llm_knowledge import (
@@ -182,7 +186,8 @@ def _llm_sets(base_url, model, api_key, cache, runs, max_queries, slice_kw=None,
     cache = cache or (cache_root() / "llm-knowledge")
     try:
         client = OpenAIChatClient(LlmSettings.resolve(base_url, model, api_key,
-                                                      timeout_s=timeout_s))
+                                                      timeout_s=timeout_s,
+                                                      max_tokens=max_tokens))
     except SgtoolError:
         if not (cache / "exchanges.jsonl").is_file():
             raise

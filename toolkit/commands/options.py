@@ -14,8 +14,13 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 
 def parse_rooms(text: str, option: str = "--rooms", lo_limit: int = 4,
-                hi_limit: int = 16) -> tuple[int, int]:
-    """A room-count range: ``N``, ``MIN-MAX`` or ``MIN,MAX``."""
+                hi_limit: int | None = None) -> tuple[int, int]:
+    """A room-count range: ``N``, ``MIN-MAX`` or ``MIN,MAX`` (at most the generator's
+    :data:`~sgtool.datasets.generator.MAX_ROOMS` unless ``hi_limit`` says otherwise)."""
+    if hi_limit is None:
+        from sgtool.datasets.generator import MAX_ROOMS
+
+        hi_limit = MAX_ROOMS
     parts = text.replace(",", "-").split("-")
     try:
         if len(parts) == 1:

@@ -15,7 +15,9 @@ from typing import Any
 import click
 
 from sgtool.commands.options import executor_options
+from sgtool.commands.room_llm import LlmOptions
 from sgtool.errors import SgtoolError
+from sgtool.scenegraph.options import CLASSIFIERS
 
 
 @click.command("replay")
@@ -27,10 +29,30 @@ from sgtool.errors import SgtoolError
 @click.option("--every", type=click.IntRange(min=1), default=None,
               help="Refresh the graph every K frames (and always at every action). "
               "Default: what the log was built with, else 10.")
-@click.option("--classifier", type=click.Choice(["containment", "frequency", "none"]),
+@click.option("--classifier", type=click.Choice(list(CLASSIFIERS)),
               default=None, help="Room categories from contents: the distilled containment "
-              "model, the naive-Bayes frequency model of the training knowledge, or none. "
-              "Default: the log's, else containment.")
+              "model, the naive-Bayes frequency model of the training knowledge, an LLM "
+              "(MoMa-LLM's room classification; give --llm-base-url or --llm-replay), or "
+              "none. Default: the log's, else containment.")
+@click.option("--llm-base-url", default=None,
+              help="--classifier llm: OpenAI-compatible endpoint (`sgtool llm serve` prints "
+              "one) [env SGTOOL_LLM_BASE_URL].")
+@click.option("--llm-model", default=None, help="--classifier llm: model name "
+              "[env SGTOOL_LLM_MODEL].")
+@click.option("--llm-api-key", default=None, help="--classifier llm: API key "
+              "[env SGTOOL_LLM_API_KEY].")
+@click.option("--llm-timeout", type=click.FloatRange(1.0, 3600.0), default=60.0,
+              show_default=True, help="--classifier llm: seconds per request.")
+@click.option("--llm-constraint", type=click.Choice(["auto", "grammar", "json_schema", "none"]),
+              default="auto", show_default=True,
+              help="--classifier llm: answers constrained to the room types by a llama.cpp "
+              "grammar or a JSON schema (auto: detected per endpoint), or parsed.")
+@click.option("--llm-replay", type=click.Path(dir_okay=False), multiple=True,
+              help="--classifier llm: answer from this transcript (JSONL, or an MCAP log's "
+              "/sgtool/llm; repeatable) instead of an endpoint: offline, same output bytes.")
+@click.option("--llm-transcript", type=click.Path(dir_okay=False), default=None,
+              help="--classifier llm: write every exchange to this JSONL transcript (for "
+              "--llm-replay); the report counts valid and rejected answers.")
 @click.option("--min-points", type=click.IntRange(min=1), default=None,
               help="Points an instance needs in one frame to count as seen. Default: the "
               "log's, else MoMa-LLM's 50 at 320x240 scaled by the image size.")
@@ -60,7 +82,11 @@ def command(logs: tuple[str, ...], output: str | None, every: int | None,
             classifier: str | None, min_points: int | None, voxel_size: float | None,
             max_frames: int | None, rrd: str | None, score: bool, as_json: bool, force: bool,
             progress: bool | None, out_dir: str | None = None, executor: str = "local",
-            workers: int = 1, ray_address: str | None = None, verify: bool = False) -> None:
+            workers: int = 1, ray_address: str | None = None, verify: bool = False,
+            llm_base_url: str | None = None, llm_model: str | None = None,
+            llm_api_key: str | None = None, llm_timeout: float = 60.0,
+            llm_constraint: str = "auto", llm_replay: tuple[str, ...] = (),
+            llm_transcript: str | None = None) -> None:
     """Replay LOG into a semantic voxel map, BEV occupancy, a Voronoi graph, rooms, objects,
     frontiers and the hierarchical scene graph, deterministically: the same log and options
     give a byte-identical output.
@@ -89,7 +115,12 @@ def command(logs: tuple[str, ...], output: str | None, every: int | None,
     from sgtool.log import LogReader
     from sgtool.replayers.derived_log import ReplayOptions, replay
 
+    llm = LlmOptions(llm_base_url, llm_model, llm_api_key, llm_timeout, llm_constraint,
+                     llm_replay, llm_transcript)
     if out_dir is not None or len(logs) > 1 or Path(logs[0]).is_dir():
+        if llm.given() or classifier == "llm":
+            raise SgtoolError("--classifier llm and the --llm-* options replay one log at a "
+                              "time; leave out --out-dir")
         if out_dir is None:
             raise SgtoolError("several logs (or a folder) replay into a folder: give "
                               "--out-dir DIR")
@@ -143,19 +174,23 @@ def command(logs: tuple[str, ...], output: str | None, every: int | None,
     show = progress if progress is not None else sys.stderr.isatty()
     opts = ReplayOptions(every=every, classifier=classifier, min_points=min_points,
                          voxel_size=voxel_size, max_frames=max_frames)
-    with tqdm(total=total, unit="frame", desc="replay", file=sys.stderr, leave=False,
-              disable=not show, dynamic_ncols=True) as bar:
+    with llm.room_classifier() as rooms, tqdm(
+            total=total, unit="frame", desc="replay", file=sys.stderr, leave=False,
+            disable=not show, dynamic_ncols=True) as bar:
         report = replay(src, dst, opts, on_refresh=keep if score else None, progress=bar,
-                        verify=verify)
+                        verify=verify, room_classifier=rooms.make)
     scores = None
     if score:
         scores = _score(house, final)  # type: ignore[arg-type]
     if rrd and dst is not None:
         write_view(dst, Path(rrd), show)
     if as_json:
-        click.echo(json.dumps(_as_dict(report, scores, rrd), sort_keys=True))
+        doc = _as_dict(report, scores, rrd)
+        if rooms.exchanges:
+            doc["llm_answers"] = rooms.stats().as_dict()
+        click.echo(json.dumps(doc, sort_keys=True))
         return
-    for line in report.lines():
+    for line in report.lines() + rooms.lines():
         click.echo(line)
     if scores is not None:
         from sgtool.replayers.score import score_lines

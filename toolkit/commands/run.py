@@ -12,7 +12,12 @@ from pathlib import Path
 
 import click
 
-from sgtool.commands.options import house_options, key_value_options, llm_log_options
+from sgtool.commands.options import (
+    house_options,
+    key_value_options,
+    llm_log_options,
+    success_option,
+)
 from sgtool.errors import SgtoolError
 
 
@@ -62,6 +67,7 @@ from sgtool.errors import SgtoolError
               help="Planner option, e.g. -O delta=0.2 (scout), -O model=gpt-4o-mini "
               "-O base_url=http://localhost:8000/v1 (moma-llm); repeatable. See "
               "sgtool.planning.registry.")
+@success_option()
 @click.option("--planner-seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the planner's randomness (random planner, tie-breaks).")
 @llm_log_options(
@@ -76,7 +82,7 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
             resolution: str, fps: float, every: int, classifier: str, min_points: int | None,
             navigation: str, optimistic: float, noise: str, planner_option: tuple[str, ...],
             planner_seed: int, llm_replay: str | None, llm_transcript: str | None, output: str,
-            force: bool, quiet: bool) -> None:
+            force: bool, quiet: bool, success: str = "observed") -> None:
     """Search a house for an object in closed loop: PyBullet renders the camera, the scene
     graph is built live from the frames (the same refresh schedule as `sgtool replay`:
     every K frames and at every action), the planner chooses an action on it, the
@@ -84,8 +90,9 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
     close = go there and open / close), and the outcome goes back to the planner.
 
     The episode starts with a look around; it succeeds as soon as the scene graph holds an
-    object of the query category (as in the symbolic benchmark, no done() needed), and
-    fails on done(), after --max-steps steps or when the --frames budget is spent.
+    object of the query category (as in the symbolic benchmark, no done() needed; with
+    `--success done` the planner must then call done() on it), and fails on done(), after
+    --max-steps steps or when the --frames budget is spent.
 
     Everything goes into one log: sensors, instance tables, the derived map layers and
     scene graphs, every action (outcome, reason, distance, decision time, the graph it was
@@ -135,7 +142,7 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
     index, ep = pick_episode(house, query=query, index=episode)
     opts = ClosedLoopOptions(fps=fps, camera=camera, every=every, classifier=classifier,
                              min_points=min_points, max_steps=max_steps, frames=frames,
-                             planner_seed=planner_seed, navigation=navigation,
+                             planner_seed=planner_seed, navigation=navigation, success=success,
                              noise=parse_noise(noise), live=LiveNavConfig(optimistic=optimistic))
     from tqdm import tqdm
 

@@ -12,6 +12,7 @@ from sgtool.commands.options import (
     parse_resolution,
     parse_rooms,
     planner_options,
+    success_option,
 )
 from sgtool.datasets.presets import PRESET_NAMES
 from sgtool.errors import SgtoolError
@@ -58,12 +59,14 @@ from sgtool.errors import SgtoolError
               help="Run nothing: the tables of the episodes whose logs are there already.")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
+@success_option()
 @executor_options("episodes (one closed-loop run each)")
 def command(planners: str | None, houses: int, house_files: tuple[str, ...], house_seed: int,
             rooms: str, preset: str, episodes: int, noise: tuple[str, ...], max_steps: int,
             frames: int | None, resolution: str, every: int, navigation: str,
             planner_option: tuple[str, ...], out_dir: str, report_only: bool,
-            progress: bool | None, executor: str = "local", workers: int = 1,
+            progress: bool | None, success: str = "observed", executor: str = "local",
+            workers: int = 1,
             ray_address: str | None = None) -> None:
     """Run closed-loop search episodes in PyBullet for every planner on generated and given
     houses (the houses and episodes of `sgtool bench`), under each noise profile: one
@@ -97,7 +100,8 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...], hou
     if Path(out_dir).exists() and not Path(out_dir).is_dir():
         raise SgtoolError(f"-o {out_dir}: not a folder")
     opts = ClosedLoopOptions(camera=CameraConfig(width=width, height=height), every=every,
-                             max_steps=max_steps, frames=frames, navigation=navigation)
+                             max_steps=max_steps, frames=frames, navigation=navigation,
+                             success=success)
     cfg = ClosedLoopBenchConfig(
         planners=names, houses=houses, house_seed=house_seed, house_files=house_files,
         episodes=episodes, rooms=parse_rooms(rooms), preset=preset,

@@ -123,8 +123,8 @@ class LlmSettings:
             raise LlmConfigError(
                 "no LLM endpoint configured: set SGTOOL_LLM_BASE_URL (and SGTOOL_LLM_API_KEY "
                 "if it needs one) or give the base URL (-O moma-llm.base_url=URL for bench, "
-                "eval and run; --llm-base-url for distill), or replay a recorded transcript "
-                "with --llm-replay FILE"
+                "eval and run; --llm-base-url for distill and replay --classifier llm), or "
+                "replay a recorded transcript with --llm-replay FILE"
             )
         try:
             timeout = float(timeout_s)

@@ -104,7 +104,7 @@ class Constraint:
 
     def request_fields(self) -> dict[str, Any]:
         """Keyword arguments for ``openai`` ``chat.completions.create``; kind
-        ``json_object``: any JSON object or array (llama.cpp, vLLM, OpenAI JSON mode)."""
+        ``json_object``: a JSON object (llama.cpp, vLLM, OpenAI JSON mode; never an array)."""
         if self.kind == "json_object":
             return {"response_format": {"type": "json_object"}}
         if self.bare and self.kind == "grammar":

@@ -68,8 +68,23 @@ def answer_stats(records: Iterable[tuple[str, Mapping[str, Any]]]) -> AnswerStat
                        latency)
 
 
+COUNTS = ("requests", "valid", "invalid", "faults", "unknown")
+
+
+def answer_counts(records: Iterable[Mapping[str, Any]]) -> dict[str, int]:
+    """The deterministic counts of :class:`AnswerStats` (``COUNTS``) over exchange records
+    (an episode's), for an :class:`~sgtool.results.EpisodeResult`; {} when there are none."""
+    s = answer_stats(("", r) for r in records)
+    return {k: int(getattr(s, k)) for k in COUNTS} if s.requests else {}
+
+
+def invalid_rate_text(valid: int, invalid: int) -> str:
+    """Rejected answers over judged ones as a percentage, "-" when none was judged."""
+    return f"{100 * invalid / (valid + invalid):.1f}%" if valid + invalid else "-"
+
+
 def format_stats(s: AnswerStats, where: str = "") -> str:
-    rate = "-" if math.isnan(s.invalid_rate) else f"{100 * s.invalid_rate:.1f}%"
+    rate = invalid_rate_text(s.valid, s.invalid)
     tps = "-" if math.isnan(s.tokens_per_s) else f"{s.tokens_per_s:.1f}"
     return (f"LLM answers{f' in {where}' if where else ''}: {s.requests} requests for "
             f"{s.decisions} decisions; {s.valid} valid, {s.invalid} rejected (invalid-answer "

@@ -85,8 +85,10 @@ def chunk_records(f: IO[bytes], ci: ChunkIndex, verify: bool) -> bytes:
 
 
 def _messages_of(data: bytes, offset: int, summary: Summary, wanted: set[int] | None,
-                 start_ns: int | None, end_ns: int | None) -> list[tuple[_Key, Item]]:
+                 start_ns: int | None, end_ns: int | None, views: bool = False
+                 ) -> list[tuple[_Key, Item]]:
     out: list[tuple[_Key, Item]] = []
+    payload: bytes | memoryview = memoryview(data) if views else data
     pos, n, index = 0, len(data), 0
     channels, schemas = summary.channels, summary.schemas
     while pos < n:
@@ -106,7 +108,7 @@ def _messages_of(data: bytes, offset: int, summary: Summary, wanted: set[int] | 
                 and (end_ns is None or t < end_ns)):
             schema = schemas[channel.schema_id] if channel.schema_id else None
             msg = Message(channel_id=cid, sequence=seq, log_time=t, publish_time=pub,
-                          data=data[body + _MESSAGE_HEAD.size:pos])
+                          data=payload[body + _MESSAGE_HEAD.size:pos])  # type: ignore[arg-type]
             out.append(((t, offset, index), (schema, channel, msg)))
         index += 1
     return out
@@ -114,10 +116,12 @@ def _messages_of(data: bytes, offset: int, summary: Summary, wanted: set[int] | 
 
 def ordered_messages(f: IO[bytes], summary: Summary, topics: list[str] | None = None, *,
                      start_ns: int | None = None, end_ns: int | None = None,
-                     verify: bool = False) -> Iterator[Item]:
+                     verify: bool = False, views: bool = False) -> Iterator[Item]:
     """(schema, channel, message) of the chunked messages on ``topics`` (all when None)
     with ``start_ns <= log time < end_ns``, in the order of the ``mcap`` reader's
-    ``iter_messages(log_time_order=True)`` (module doc)."""
+    ``iter_messages(log_time_order=True)`` (module doc). With ``views`` a message's
+    ``data`` is a read-only ``memoryview`` into its chunk instead of a copy (for callers
+    that parse it at once: an image is then copied once, by the parser, not twice)."""
     wanted = None if topics is None else {
         cid for cid, ch in summary.channels.items() if ch.topic in set(topics)}
     chunks = sorted(
@@ -130,7 +134,7 @@ def ordered_messages(f: IO[bytes], summary: Summary, topics: list[str] | None = 
     pending: list[tuple[_Key, Item]] = []
     for j, ci in enumerate(chunks):
         pending.extend(_messages_of(chunk_records(f, ci, verify), ci.chunk_start_offset,
-                                    summary, wanted, start_ns, end_ns))
+                                    summary, wanted, start_ns, end_ns, views))
         pending.sort(key=lambda e: e[0])
         if j + 1 < len(chunks):
             nxt = chunks[j + 1]

@@ -15,6 +15,7 @@ from google.protobuf.timestamp_pb2 import Timestamp
 from sgtool.errors import LogFormatError
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
+from sgtool.log.image_wire import RawImageView
 
 _DTYPES = {
     "rgb8": (np.dtype(np.uint8), 3),
@@ -50,9 +51,16 @@ def encode_image(t_ns: int, arr: np.ndarray, encoding: str, frame_id: str) -> Ra
 INTEGER_ENCODINGS = frozenset({"mono8", "8UC1", "mono16", "16UC1", "32SC1"})
 
 
-def decode_image(msg: RawImage) -> np.ndarray:
+def decode_image(msg: RawImage | RawImageView) -> np.ndarray:
     """The pixels of ``msg``; :class:`LogFormatError` (naming the field) when its
-    encoding, size, step and data disagree."""
+    encoding, size, step and data disagree. The array never shares memory with a
+    :class:`~sgtool.log.image_wire.RawImageView`'s chunk (it is copied out of it)."""
+    a = _pixels(msg)
+    return a.copy() if isinstance(msg.data, memoryview) else a
+
+
+def _pixels(msg: RawImage | RawImageView) -> np.ndarray:
+    """:func:`decode_image`, possibly a view of ``msg.data``."""
     if msg.encoding not in _DTYPES:
         raise LogFormatError(f"field encoding: unsupported image encoding "
                              f"{msg.encoding[:40]!r}")
@@ -63,10 +71,11 @@ def decode_image(msg: RawImage) -> np.ndarray:
     if msg.step < row:
         raise LogFormatError(f"field step: {msg.step} bytes, a row of {msg.width} "
                              f"{msg.encoding} pixels takes {row}")
-    if len(msg.data) != msg.step * msg.height:
-        raise LogFormatError(f"field data: {len(msg.data)} bytes, {msg.height} rows of "
+    data = msg.data  # a protobuf bytes field is copied on every access: read it once
+    if len(data) != msg.step * msg.height:
+        raise LogFormatError(f"field data: {len(data)} bytes, {msg.height} rows of "
                              f"{msg.step} bytes (step) take {msg.step * msg.height}")
-    buf = np.frombuffer(msg.data, dtype=np.uint8)
+    buf = np.frombuffer(data, dtype=np.uint8)
     if msg.step != row:  # rows padded
         buf = buf.reshape(msg.height, msg.step)[:, :row].copy()
     a = buf.view(dtype)
@@ -87,12 +96,15 @@ def depth_to_mm(depth_m: np.ndarray) -> np.ndarray:
     return mm.astype("<u2")
 
 
-def depth_from_image(msg: RawImage, scale: float = S.DEPTH_SCALE) -> np.ndarray:
+def depth_from_image(msg: RawImage | RawImageView, scale: float = S.DEPTH_SCALE
+                     ) -> np.ndarray:
     """Depth image -> float32 metres (0 = no return)."""
-    a = decode_image(msg)
+    a = _pixels(msg)  # converted below: no copy needed
     if msg.encoding == "32FC1":
         return np.nan_to_num(a.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
-    return a.astype(np.float32) / np.float32(scale)
+    out = a.astype(np.float32)
+    out /= np.float32(scale)  # in place: no second image
+    return out
 
 
 def encode_calibration(t_ns: int, k: CameraIntrinsics, frame_id: str) -> CameraCalibration:

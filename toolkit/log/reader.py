@@ -32,6 +32,7 @@ from sgtool.log import schemas as S
 from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler, TransformBuffer, decoded
 from sgtool.log.chunk_stream import ordered_messages
 from sgtool.log.frame import CameraIntrinsics, Frame
+from sgtool.log.image_wire import parse_raw_image
 from sgtool.log.records import RECORD_TYPES, LogRecord
 from sgtool.log.summary_check import BoundedReader as _BoundedReader
 from sgtool.log.summary_check import check_summary, read_attachment
@@ -257,7 +258,7 @@ class LogReader:
     def _decode(self, schema: Schema | None, channel: Channel, message: Message) -> Any:
         if channel.message_encoding == "json":
             try:
-                return json.loads(message.data)
+                return json.loads(bytes(message.data))  # bytes, or a view of its chunk
             except (ValueError, RecursionError) as e:
                 raise LogFormatError(
                     f"{self.path}: {channel.topic} message at {message.log_time} ns is not "
@@ -269,9 +270,13 @@ class LogReader:
                 raise LogFormatError(
                     f"{self.path}: {channel.topic} message at {message.log_time} ns is not a "
                     f"valid {schema.name} ({type(e).__name__}: {str(e)[:80]})") from None
-        return message.data
+        return bytes(message.data)  # a copy when it is a view of its chunk
 
     def _decode_protobuf(self, schema: Schema, channel: Channel, message: Message) -> Any:
+        if isinstance(message.data, memoryview) and schema.name == "foxglove.RawImage":
+            view = parse_raw_image(message.data)  # pixels left in the chunk (frames only)
+            if view is not None:
+                return view
         cls = _proto_class(schema.name)
         if cls is not None:
             msg = cls()
@@ -283,7 +288,7 @@ class LogReader:
 
             dec = DecoderFactory().decoder_for("protobuf", schema)
             self._decoders[channel.id] = dec
-        return dec(message.data) if dec else message.data
+        return dec(bytes(message.data)) if dec else bytes(message.data)
 
     def messages(
         self,
@@ -294,9 +299,16 @@ class LogReader:
         reverse: bool = False,
     ) -> Iterator[Decoded]:
         """Decoded messages in log-time order, ``start_ns <= t < end_ns``."""
+        return self._messages(topics, start_ns=start_ns, end_ns=end_ns, reverse=reverse)
+
+    def _messages(self, topics: Iterable[str] | None, *, start_ns: int | None = None,
+                  end_ns: int | None = None, reverse: bool = False, views: bool = False
+                  ) -> Iterator[Decoded]:
+        """:meth:`messages`; with ``views`` the payloads are parsed from views into their
+        chunk (no copy; :func:`~sgtool.log.chunk_stream.ordered_messages`)."""
         topics = list(topics) if topics is not None else None
         for schema, channel, message in self._checked(self._iter(
-                topics, start_ns=start_ns, end_ns=end_ns, reverse=reverse)):
+                topics, start_ns=start_ns, end_ns=end_ns, reverse=reverse, views=views)):
             yield Decoded(
                 channel.topic, int(message.log_time), schema.name if schema else "",
                 self._decode(schema, channel, message),
@@ -348,7 +360,7 @@ class LogReader:
         index = self._frame_index_before(start_ns) if start_ns is not None else 0
         asm = FrameAssembler(index=index, transforms=tf, calibration=calib,
                              where=str(self.path))
-        for d in self.messages(FRAME_TOPICS, start_ns=start_ns, end_ns=end_ns):
+        for d in self._messages(FRAME_TOPICS, start_ns=start_ns, end_ns=end_ns, views=True):
             fr = asm.push(d.topic, d.log_time_ns, d.message)
             if fr is not None:
                 yield fr
@@ -363,14 +375,14 @@ class LogReader:
         yield from self._checked(self._iter(list(topics) if topics is not None else None))
 
     def _iter(self, topics: list[str] | None, *, start_ns: int | None = None,
-              end_ns: int | None = None, reverse: bool = False
+              end_ns: int | None = None, reverse: bool = False, views: bool = False
               ) -> Iterator[tuple[Schema | None, Channel, Message]]:
         """Messages in log-time order (ties in file order): chunk by chunk
         (:mod:`sgtool.log.chunk_stream`) when the file is chunked and read forwards, else
         through the ``mcap`` reader."""
         if self.summary.chunk_indexes and not reverse:
             return ordered_messages(self._f, self.summary, topics, start_ns=start_ns,
-                                    end_ns=end_ns, verify=self.verify)
+                                    end_ns=end_ns, verify=self.verify, views=views)
         return self._reader.iter_messages(topics=topics, starting_at=start_ns,
                                           ending_before=end_ns, log_time_order=True,
                                           reverse=reverse)

@@ -33,7 +33,14 @@ def distance_field(obstacle: np.ndarray, resolution: float, with_features: bool 
     virtual obstacle border around the grid)."""
     padded = np.pad(~obstacle, 1, constant_values=False)
     if with_features:
-        dist, feat = ndimage.distance_transform_edt(padded, return_indices=True)
+        # scipy's distances from its own features, without its float64 temporaries: the
+        # squared offsets are small integers, so the square roots are bit for bit scipy's
+        feat = ndimage.distance_transform_edt(padded, return_distances=False,
+                                              return_indices=True)
+        h, w = padded.shape
+        dr = feat[0] - np.arange(h, dtype=feat.dtype)[:, None]
+        dc = feat[1] - np.arange(w, dtype=feat.dtype)[None, :]
+        dist = np.sqrt((dr * dr + dc * dc).astype(np.float64))
         return dist[1:-1, 1:-1] * resolution, feat[:, 1:-1, 1:-1] - 1
     dist = ndimage.distance_transform_edt(padded)
     return dist[1:-1, 1:-1] * resolution, None

@@ -95,7 +95,32 @@ class VoronoiGraph:
 
 def ridge_cells(free: np.ndarray, resolution: float, config: VoronoiConfig
                 ) -> tuple[np.ndarray, np.ndarray]:
-    """(ridge mask before thinning, clearance (m) of every cell); see the module doc."""
+    """(ridge mask before thinning, clearance (m) of every cell); see the module doc.
+
+    Computed on the bounding box of the free cells grown by one cell: every cell outside
+    it is an obstacle (clearance 0, never a ridge), and the ring of obstacles (or the
+    grid's border) around the box is strictly nearer to any free cell than whatever lies
+    beyond it, so the distances and nearest obstacles in the box are those of the whole
+    grid (checked cell for cell against the whole grid in the tests)."""
+    h, w = free.shape
+    rows = np.flatnonzero(free.any(axis=1))
+    if rows.size == 0:
+        return np.zeros((h, w), dtype=bool), np.zeros((h, w))
+    cols = np.flatnonzero(free.any(axis=0))
+    r0, r1 = max(int(rows[0]) - 1, 0), min(int(rows[-1]) + 2, h)
+    c0, c1 = max(int(cols[0]) - 1, 0), min(int(cols[-1]) + 2, w)
+    if (r0, r1, c0, c1) == (0, h, 0, w):
+        return _ridge_cells_whole(free, resolution, config)
+    ridge = np.zeros((h, w), dtype=bool)
+    dist_m = np.zeros((h, w))
+    ridge[r0:r1, c0:c1], dist_m[r0:r1, c0:c1] = _ridge_cells_whole(
+        free[r0:r1, c0:c1], resolution, config)
+    return ridge, dist_m
+
+
+def _ridge_cells_whole(free: np.ndarray, resolution: float, config: VoronoiConfig
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`ridge_cells` over the whole of ``free``."""
     dist_m, feat = distance_field(~free, resolution, with_features=True)
     assert feat is not None
     h, w = free.shape
@@ -128,111 +153,140 @@ def ridge_cells(free: np.ndarray, resolution: float, config: VoronoiConfig
     return ridge, dist_m
 
 
+def _zhang_suen_tables() -> tuple[np.ndarray, np.ndarray]:
+    """Per 8-neighbourhood code (bit i: neighbour p(i+2) of Zhang-Suen's p2 (north), p3,
+    ... p9 clockwise), whether the pixel is deleted in the first and second sub-iteration:
+    2 <= B <= 6 neighbours, A == 1 0->1 transition around, and the sub-iteration's two
+    products zero."""
+    first = np.zeros(256, dtype=bool)
+    second = np.zeros(256, dtype=bool)
+    for code in range(256):
+        p = [(code >> i) & 1 for i in range(8)]  # p2 .. p9
+        b = sum(p)
+        a = sum(1 for i in range(8) if p[i] == 0 and p[(i + 1) % 8] == 1)
+        if not (2 <= b <= 6 and a == 1):
+            continue
+        p2, _, p4, _, p6, _, p8, _ = p
+        first[code] = p2 * p4 * p6 == 0 and p4 * p6 * p8 == 0
+        second[code] = p2 * p4 * p8 == 0 and p2 * p6 * p8 == 0
+    return first, second
+
+
+_ZS_FIRST, _ZS_SECOND = _zhang_suen_tables()
+
+
 def thin(mask: np.ndarray) -> np.ndarray:
-    """Zhang-Suen thinning of a boolean image (vectorised; works on the mask's bounding
-    box)."""
+    """Zhang-Suen thinning of a boolean image. Each sub-iteration looks only at the pixels
+    still set (neighbourhood codes gathered from the padded image, deletion by table), all
+    against the image as the sub-iteration found it, as the parallel algorithm says."""
     if not mask.any():
         return mask.copy()
-    rr, cc = np.nonzero(mask)
-    r0, r1, c0, c1 = rr.min(), rr.max() + 1, cc.min(), cc.max() + 1
-    img = np.pad(mask[r0:r1, c0:c1], 1).astype(np.uint8)
+    h, w = mask.shape
+    ww = w + 2
+    img = np.zeros((h + 2) * ww, dtype=np.uint8)
+    img.reshape(h + 2, ww)[1:-1, 1:-1] = mask
+    idx = np.flatnonzero(img)
+    offsets = (-ww, -ww + 1, 1, ww + 1, ww, ww - 1, -1, -ww - 1)  # p2 .. p9
     while True:
         changed = False
-        for step in (0, 1):
-            p2 = img[:-2, 1:-1]
-            p3 = img[:-2, 2:]
-            p4 = img[1:-1, 2:]
-            p5 = img[2:, 2:]
-            p6 = img[2:, 1:-1]
-            p7 = img[2:, :-2]
-            p8 = img[1:-1, :-2]
-            p9 = img[:-2, :-2]
-            seq = (p2, p3, p4, p5, p6, p7, p8, p9, p2)
-            b = p2 + p3 + p4 + p5 + p6 + p7 + p8 + p9
-            a = sum(((seq[i] == 0) & (seq[i + 1] == 1)).astype(np.uint8) for i in range(8))
-            cond = (img[1:-1, 1:-1] == 1) & (b >= 2) & (b <= 6) & (a == 1)
-            if step == 0:
-                cond &= (p2 * p4 * p6 == 0) & (p4 * p6 * p8 == 0)
-            else:
-                cond &= (p2 * p4 * p8 == 0) & (p2 * p6 * p8 == 0)
-            if cond.any():
-                img[1:-1, 1:-1][cond] = 0
+        for table in (_ZS_FIRST, _ZS_SECOND):
+            code = np.zeros(len(idx), dtype=np.uint8)
+            for bit, off in enumerate(offsets):
+                code |= img[idx + off] << np.uint8(bit)
+            gone = table[code]
+            if gone.any():
+                img[idx[gone]] = 0
+                idx = idx[~gone]
                 changed = True
         if not changed:
             break
-    out = np.zeros_like(mask)
-    out[r0:r1, c0:c1] = img[1:-1, 1:-1].astype(bool)
-    return out
+    return img.reshape(h + 2, ww)[1:-1, 1:-1].astype(bool)
 
 
 def _pixel_graph(mask: np.ndarray) -> tuple[np.ndarray, csr_matrix]:
     """(flat indices of the mask's pixels in raster order, adjacency with step lengths in
-    cells): 4-neighbours always, diagonal neighbours only without a 4-neighbour detour."""
+    cells): 4-neighbours always, diagonal neighbours only without a 4-neighbour detour.
+    Neighbours are looked up for the set pixels only, in the zero-padded image."""
     h, w = mask.shape
-    flat = np.flatnonzero(mask.ravel())
-    index = np.full(h * w, -1, dtype=np.int64)
-    index[flat] = np.arange(len(flat))
-    m = np.pad(mask, 1)
-    core = m[1:-1, 1:-1]
+    ww = w + 2
+    img = np.zeros((h + 2) * ww, dtype=bool)
+    img.reshape(h + 2, ww)[1:-1, 1:-1] = mask
+    pidx = np.flatnonzero(img)
+    n = len(pidx)
+    pr, pc = np.divmod(pidx, ww)
+    flat = (pr - 1) * w + (pc - 1)
+    index = np.full(img.size, -1, dtype=np.int64)
+    index[pidx] = np.arange(n)
     src: list[np.ndarray] = []
     dst: list[np.ndarray] = []
     wts: list[np.ndarray] = []
     for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
-        nb = m[1 + dr:1 + dr + h, 1 + dc:1 + dc + w]
-        e = core & nb
+        e = img[pidx + dr * ww + dc]
         if dr and dc:
-            e &= ~m[1:1 + h, 1 + dc:1 + dc + w] & ~m[1 + dr:1 + dr + h, 1:1 + w]
-        r, c = np.nonzero(e)
-        src.append(index[r * w + c])
-        dst.append(index[(r + dr) * w + (c + dc)])
-        wts.append(np.full(len(r), _SQRT2 if dr and dc else 1.0))
+            e &= ~img[pidx + dc] & ~img[pidx + dr * ww]
+        s = np.flatnonzero(e)
+        src.append(s)
+        dst.append(index[pidx[s] + dr * ww + dc])
+        wts.append(np.full(len(s), _SQRT2 if dr and dc else 1.0))
     s, d, wt = np.concatenate(src), np.concatenate(dst), np.concatenate(wts)
-    n = len(flat)
     adj = csr_matrix((np.concatenate([wt, wt]), (np.concatenate([s, d]), np.concatenate([d, s]))),
                      shape=(n, n))
     adj.sort_indices()
     return flat, adj
 
 
+def _reverse_entries(adj: csr_matrix) -> np.ndarray:
+    """For each stored entry (i, j) of a symmetric CSR matrix with sorted indices, the
+    position of the entry (j, i)."""
+    n = adj.shape[0]
+    rows = np.repeat(np.arange(n, dtype=np.int64), np.diff(adj.indptr))
+    cols = adj.indices.astype(np.int64)
+    return np.searchsorted(rows * n + cols, cols * n + rows)
+
+
 def _trace_chains(adj: csr_matrix) -> list[tuple[list[int], list[float]]]:
     """Chains between key pixels (degree != 2) as (pixel list, cumulative length in cells
-    along it), each once; loops without a key pixel start at their lowest pixel."""
+    along it), each once; loops without a key pixel start at their lowest pixel. (A step
+    is marked walked in both directions by its CSR entry and the reverse entry's.)"""
     indptr = adj.indptr.tolist()
     indices = adj.indices.tolist()
     data = adj.data.tolist()
-    n = len(indptr) - 1
-    deg = [indptr[i + 1] - indptr[i] for i in range(n)]
-    used: set[tuple[int, int]] = set()
+    rev = _reverse_entries(adj).tolist()
+    deg = np.diff(adj.indptr)
+    two = (deg == 2).tolist()
+    used = bytearray(len(indices))
     chains: list[tuple[list[int], list[float]]] = []
 
     def walk(start: int, k: int) -> None:
-        nxt = indices[k]
-        if (start, nxt) in used:
+        if used[k]:
             return
         path = [start]
         cum = [0.0]
-        prev, cur, wgt = start, nxt, data[k]
+        total = 0.0
+        prev = start
         while True:
-            used.add((prev, cur))
-            used.add((cur, prev))
+            cur = indices[k]
+            used[k] = 1
+            used[rev[k]] = 1
+            total += data[k]
             path.append(cur)
-            cum.append(cum[-1] + wgt)
-            if deg[cur] != 2 or cur == start:
+            cum.append(total)
+            if not two[cur] or cur == start:
                 break
             a = indptr[cur]
-            j = a + 1 if indices[a] == prev else a
-            prev, cur, wgt = cur, indices[j], data[j]
-            if (prev, cur) in used:
+            k = a + 1 if indices[a] == prev else a
+            prev = cur
+            if used[k]:
                 break
         chains.append((path, cum))
 
-    for p in range(n):
-        if deg[p] != 2:
-            for k in range(indptr[p], indptr[p + 1]):
-                walk(p, k)
-    for p in range(n):  # pure loops
-        if deg[p] == 2 and (p, indices[indptr[p]]) not in used:
-            walk(p, indptr[p])
+    for p in np.flatnonzero(deg != 2).tolist():
+        for k in range(indptr[p], indptr[p + 1]):
+            walk(p, k)
+    for p in np.flatnonzero(deg == 2).tolist():  # pure loops
+        k = indptr[p]
+        if not used[k]:
+            walk(p, k)
     return chains
 
 
@@ -362,10 +416,12 @@ def voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
     lengths = np.asarray([edge_map[k][0] for k in keys], dtype=np.float64)
     edge_cells = tuple(edge_map[k][1] for k in keys)
     g = nx.Graph()
-    for i in range(len(order)):
-        g.add_node(i, pos=(float(positions[i, 0]), float(positions[i, 1])),
-                   clearance=float(clearance[i]), cell=(int(rows[i]), int(cols[i])))
-    for (u, v), lm in zip(keys, lengths.tolist(), strict=True):
-        g.add_edge(u, v, weight=lm)
+    g.add_nodes_from(
+        (i, {"pos": (x, y), "clearance": c, "cell": (r, q)})
+        for i, (x, y, c, r, q) in enumerate(zip(
+            positions[:, 0].tolist(), positions[:, 1].tolist(), clearance.tolist(),
+            rows.tolist(), cols.tolist(), strict=True)))
+    g.add_edges_from((u, v, {"weight": lm}) for (u, v), lm in zip(keys, lengths.tolist(),
+                                                                     strict=True))
     return VoronoiGraph(g, positions, clearance, np.stack([rows, cols], axis=1), edges,
                         lengths, edge_cells, rg.ridge, (h, w))

@@ -31,7 +31,9 @@ from the frames that follow (the scene-graph builder calls it when the instance 
 reports a new state).
 
 Everything is exact integer arithmetic after the float64 back-projection (elementwise, no
-BLAS), so the same frames give the same map bit for bit.
+BLAS; :mod:`sgtool.mapping.backproject` runs it in cache blocks, operation for operation),
+so the same frames give the same map bit for bit. Runs of equal neighbouring keys are
+collapsed before a frame's keys are sorted.
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sgtool.log.frame import CameraIntrinsics, Frame
+from sgtool.mapping.backproject import Scratch, within_packing, world_voxels
 
 AXIS_BITS = 17
 LABEL_BITS = 12
@@ -83,17 +86,32 @@ def unpack(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.nda
     return ix, iy, iz, keys & LABEL_MASK
 
 
-def _count_keys(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(sorted distinct keys, occurrences) of ``keys``: ``np.unique(keys,
-    return_counts=True)`` without its overhead (one in-place sort)."""
-    if keys.size == 0:
-        return keys, np.zeros(0, dtype=np.int64)
-    keys = np.sort(keys)
+def _runs(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(first index, length) of each run of equal neighbours in ``keys`` (non-empty)."""
     change = np.empty(keys.size, dtype=bool)
     change[0] = True
     np.not_equal(keys[1:], keys[:-1], out=change[1:])
     first = np.flatnonzero(change)
-    return keys[first], np.diff(first, append=keys.size)
+    return first, np.diff(first, append=keys.size)
+
+
+def _count_keys(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(sorted distinct keys, occurrences) of ``keys``: ``np.unique(keys,
+    return_counts=True)`` without its overhead. Neighbouring pixels mostly fall into the
+    same voxel, so runs of equal keys are collapsed first (in pixel order) and only the
+    runs are sorted."""
+    if keys.size == 0:
+        return keys, np.zeros(0, dtype=np.int64)
+    first, length = _runs(keys)
+    rk = keys[first]
+    if rk.size * 4 > keys.size:  # few repeats: sorting the keys themselves is cheaper
+        keys = np.sort(keys)
+        first, length = _runs(keys)
+        return keys[first], length
+    order = np.argsort(rk)
+    rk, length = rk[order], length[order]
+    first, _ = _runs(rk)
+    return rk[first], np.add.reduceat(length, first)
 
 
 @dataclass(frozen=True)
@@ -160,6 +178,7 @@ class VoxelMap:
         self._lut = np.zeros(1, dtype=np.int64)  # instance id -> label index (ids < _LUT_MAX)
         self._stats = _Stats()
         self._stats.grow(1)
+        self._scratch = Scratch()
         self._rays: dict[tuple[int, int, float, float, float, float], tuple[np.ndarray, ...]] = {}
         self.version = 0  # bumped whenever the voxels change
         self.removals = 0  # bumped by forget_instance (maps derived incrementally rebuild)
@@ -233,24 +252,19 @@ class VoxelMap:
             viewpoint = (float(src[0, 3]), float(src[1, 3]))
         if idx.size == 0:
             return 0
-        z = d[idx].astype(np.float64)
-        xc = ru[idx]
-        xc *= z
-        yc = rv[idx]
-        yc *= z
-        T = np.asarray(frame.pose, dtype=np.float64)  # noqa: N806
-        world = []
-        for r in range(3):  # T[r, 0] * xc + T[r, 1] * yc + T[r, 2] * z + T[r, 3], in place
-            w = T[r, 0] * xc
-            w += T[r, 1] * yc
-            w += T[r, 2] * z
-            w += T[r, 3]
-            world.append(w)
+        inv, lim = 1.0 / cfg.resolution, OFFSET - 1
+        safe = within_packing(frame.pose, ru, rv, cfg.max_range, inv, lim)
+        wx, wy, wz, keys, rng = world_voxels(d, idx, ru, rv, frame.pose, inv,
+                                             (SHIFT_X, SHIFT_Y, SHIFT_Z), OFFSET, self._scratch,
+                                             need_range=not safe)
         if frame.ids is not None:
             lab = self.labels_of(np.asarray(frame.ids).reshape(-1)[idx])
         else:
             lab = np.zeros(idx.size, dtype=np.int64)
-        return self._fuse(world[0], world[1], world[2], lab, viewpoint, frame.index)
+        if not (safe or all(-lim < v < lim for v in rng)):  # out of the packing, NaN
+            return self._fuse(wx.copy(), wy.copy(), wz, lab, viewpoint, frame.index)
+        np.add(keys, lab, out=keys)
+        return self._count(keys, wx, wy, lab, viewpoint, frame.index)
 
     def integrate_points(self, xyz: np.ndarray, labels: np.ndarray,
                          viewpoint: tuple[float, float], frame_index: int = -1) -> int:
@@ -275,7 +289,12 @@ class VoxelMap:
             wx, wy = wx[ok], wy[ok]
         if vx.size == 0:
             return 0
-        uk, cnt = _count_keys(pack(vx, vy, vz, labels))
+        return self._count(pack(vx, vy, vz, labels), wx, wy, labels, viewpoint, frame_index)
+
+    def _count(self, keys: np.ndarray, wx: np.ndarray, wy: np.ndarray, labels: np.ndarray,
+               viewpoint: tuple[float, float], frame_index: int) -> int:
+        """Count one frame's packed keys into the pending list and its statistics."""
+        uk, cnt = _count_keys(keys)
         self._pending.append((uk, cnt))
         self._pending_n += len(uk)
         # points per label from the distinct keys (far fewer than the points)
@@ -284,7 +303,7 @@ class VoxelMap:
         if self._pending_n >= self.config.flush_keys:
             self.flush()
         self.version += 1
-        return int(vx.size)
+        return int(keys.size)
 
     def _frame_stats(self, wx: np.ndarray, wy: np.ndarray, labels: np.ndarray,
                      pts: np.ndarray, viewpoint: tuple[float, float], frame_index: int

@@ -37,6 +37,23 @@ sharpness 1: 0.690 / 0.247 (houses 0-4, step cost 3); ω = 1, C sharpness 2: 0.7
 and 0.810 / 0.231; ω = 0.5: 0.720 / 0.271 and 0.760 / 0.236; ω = 2: 0.680 / 0.258 and
 0.790 / 0.225; ``scout`` on the same episodes: 0.670 / 0.237 and 0.730 / 0.212.
 
+**Furniture-level queries.** About a third of the bench's episodes ask for a piece of
+furniture ("find a dishwasher"). Such a target is a first-level piece: it is seen as soon
+as the space around it is revealed, and no carrier ever holds it, so (B2) spends mass on
+checking carriers that cannot pay. With φ(q) = P(q is a first-level piece | its name), a
+prior handed in by the caller (:mod:`sgtool.planning.furniture_prior`; the shipped table
+is (F1) of :mod:`sgtool.datasets.furniture_level`: 0 for a name outside the vocabulary of
+furniture and floor-standing holders, else the Beta-smoothed share of the name's
+BEHAVIOR-1K occurrences that stand alone), the belief is the mixture
+
+    P(n) = (1 - φ) P_O(n) + φ P_F(n),                                                (B6)
+    P_F(frontier f of r) ∝ R(r) / F_r,  P_F(room u) ∝ R̄,  P_F(door / out) ∝ R̄ · beyond,
+    P_F(carrier o) = 0,
+
+each component normalised over the candidates (P_O the object model (B1)-(B4)); when
+nothing is left to reveal, P = P_O. φ = 0 (a small object's name, or no prior) is the
+object model unchanged.
+
 **Bayes update.** A checked place that was empty leaves the candidate set while its C(o)
 stays in Z_r, so renormalising over the remaining candidates,
 
@@ -95,14 +112,60 @@ def room_probabilities(graph: SceneGraph, query: str, scorer: RelationScorer,
     return out
 
 
+def furniture_masses(graph: SceneGraph, cands: Sequence[Candidate],
+                     rooms: dict[str, float], unknown: float, params: BeliefParams) -> np.ndarray:
+    """P_F of (B6): the target is a first-level piece, seen when its space is revealed, so
+    no carrier holds it; a room's mass R(r) is split over its unexplored-area frontiers,
+    unexplored rooms get R̄ and space behind doors / leading-out frontiers R̄ · beyond.
+    Unnormalised (all zeros when nothing is left to reveal)."""
+    nodes = {n.id: n for n in graph.regions}
+    inner = [f for f in graph.regions
+             if f.kind == "frontier" and f.frontier_type != "leading out"]
+    per_room: dict[str, int] = {}
+    for f in inner:
+        per_room[f.room] = per_room.get(f.room, 0) + 1
+    out = np.zeros(len(cands))
+    for i, c in enumerate(cands):
+        node = nodes.get(c.node_id)
+        if c.kind == "object":
+            continue
+        if c.kind == "frontier" and node is not None and \
+                getattr(node, "frontier_type", None) != "leading out":
+            out[i] = rooms.get(node.room, unknown) / per_room.get(node.room, 1)
+        elif c.kind == "room":
+            out[i] = unknown
+        else:
+            out[i] = unknown * params.beyond
+    return out
+
+
 def place_masses(graph: SceneGraph, cands: Sequence[Candidate], query: str,
                  scorer: RelationScorer, params: BeliefParams,
-                 failures: Sequence[int] | None = None) -> np.ndarray:
-    """P(target at candidate) for each candidate, (B1)-(B5); sums to 1 (all zeros for none)."""
+                 failures: Sequence[int] | None = None,
+                 furniture: float = 0.0) -> np.ndarray:
+    """P(target at candidate) for each candidate, (B1)-(B6); sums to 1 (all zeros for none).
+    ``furniture``: φ(q) of (B6), the prior that the query is a first-level piece."""
     if not cands:
         return np.zeros(0)
     unknown = known_room_mean(scorer, query, params)
     rooms = room_probabilities(graph, query, scorer, params, unknown)
+    out = _object_masses(graph, cands, query, scorer, params, rooms, unknown)
+    if furniture > 0.0:
+        pf = furniture_masses(graph, cands, rooms, unknown, params)
+        if pf.sum() > 0 and out.sum() > 0:
+            out = (1.0 - furniture) * out / out.sum() + furniture * pf / pf.sum()
+        elif pf.sum() > 0:
+            out = pf
+    if failures is not None:
+        out = out * params.miss ** np.asarray(failures, dtype=float)
+    total = float(out.sum())
+    return out / total if total > 0 else np.full(len(cands), 1.0 / len(cands))
+
+
+def _object_masses(graph: SceneGraph, cands: Sequence[Candidate], query: str,
+                   scorer: RelationScorer, params: BeliefParams, rooms: dict[str, float],
+                   unknown: float) -> np.ndarray:
+    """P_O of (B1)-(B4), unnormalised."""
     carriers = [o for o in graph.objects if is_carrier(o)]
     c_of: dict[str, float] = {}
     if carriers:
@@ -134,7 +197,4 @@ def place_masses(graph: SceneGraph, cands: Sequence[Candidate], query: str,
             out[i] = unknown
         else:  # closed door, leading-out frontier: space beyond
             out[i] = unknown * params.beyond
-        if failures is not None and failures[i]:
-            out[i] *= params.miss ** failures[i]
-    total = float(out.sum())
-    return out / total if total > 0 else np.full(len(cands), 1.0 / len(cands))
+    return out

@@ -17,15 +17,17 @@ the target, then ranks them by the likelihood of holding it. Our reading:
    order, so the search still ends with everything checked.
 
 The ranker is a hook: :class:`PriorRanker` answers from the distilled priors (containment,
-co-occurrence); an LLM ranker (GODHS's original, a later change) implements the same
-:class:`Ranker` protocol and is passed to :class:`GodhsPlanner`; no LLM is called here. A
-ranker is asked about each (query, names) once: the scores are memoised by the scorer.
+co-occurrence); an LLM ranker (GODHS's original, :mod:`sgtool.planning.llm_ranker`)
+implements the same :class:`Ranker` protocol and is passed to :class:`GodhsPlanner`; no LLM
+is called here. A ranker is asked about each (query, names) once: the scores are memoised by
+the scorer. The planner's ``exchanges`` are its ranker's (none for the priors), so the
+episode loop logs an LLM ranker's exchanges like moma-llm's.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -77,6 +79,22 @@ class GodhsPlanner(NodeSelectionPlanner):
         self.name = name
         self.ranker = ranker
         self.carrier_threshold = float(carrier_threshold)
+
+    @property
+    def exchanges(self) -> list[dict[str, Any]] | None:
+        """The ranker's LLM exchanges, when it keeps them (``godhs-llm``), else None: the
+        episode loop takes each decision's new ones into the log (``/sgtool/llm``)."""
+        kept = getattr(self.ranker, "exchanges", None)
+        return kept if isinstance(kept, list) else None
+
+    def drain_exchanges(self) -> list[dict[str, Any]]:
+        """Exchanges since the last call (for a log writer, the closed loop), oldest first."""
+        kept = self.exchanges
+        if kept is None:
+            return []
+        out = list(kept)
+        kept.clear()
+        return out
 
     def choose(self, graph: SceneGraph, cands: list[Candidate]
                ) -> tuple[int, str, dict[str, float]]:

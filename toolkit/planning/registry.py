@@ -38,7 +38,9 @@ action carries its measured decision time. Options:
   ``esc``: ``w_obj``, ``w_room``, ``w_dist``, ``radius``; ``bayes-search``: ``step_cost``,
   ``open_cost``, ``reveal_cost``, ``top_k``, ``horizon``, ``step_budget`` (0: none),
   ``room_floor``, ``object_floor``, ``sharpness``, ``object_sharpness``, ``beyond``,
-  ``miss``, ``region_weight``, ``blend`` (false: learned scores only, no novelty blend);
+  ``miss``, ``region_weight``, ``blend`` (false: learned scores only, no novelty blend),
+  ``furniture_levels`` (name -> φ mapping or a table's path, default the shipped table;
+  "none": no furniture-level prior; :mod:`sgtool.planning.furniture_prior`);
 - ``moma-llm``: ``base_url``, ``model``, ``api_key`` (else from the environment, see
   :mod:`sgtool.llm.client`), ``timeout_s``, ``temperature``, ``replay`` (a JSONL transcript
   to serve instead of an endpoint), ``transcript`` (append exchanges to this JSONL),
@@ -123,6 +125,21 @@ def _priors(options: dict[str, Any], blend: bool) -> Any:
                          enc)
 
 
+def _furniture_levels(options: dict[str, Any]) -> Any:
+    """The ``furniture_levels`` option: a mapping, a table's path, "none"/"off", or absent
+    (the shipped table, :mod:`sgtool.planning.furniture_prior`)."""
+    from sgtool.planning.furniture_prior import load_levels
+
+    value = options.pop("furniture_levels", None)
+    if value is None:
+        return load_levels()
+    if isinstance(value, str):
+        if value.strip().lower() in ("none", "off", "false", "0", ""):
+            return None
+        return load_levels(value)
+    return value
+
+
 def _search(name: str, options: dict[str, Any]) -> Planner:
     max_failures = int(options.pop("max_failures", 2))
     if name == "bayes-search":
@@ -137,7 +154,8 @@ def _search(name: str, options: dict[str, Any]) -> Planner:
         kw["belief"] = BeliefParams(**bkw)
         blend = str(options.pop("blend", True)).strip().lower() not in ("false", "0", "no")
         scorer = _priors(options, blend=blend)
-        return SearchTheoryPlanner(scorer, SearchParams(**kw), max_failures=max_failures)
+        return SearchTheoryPlanner(scorer, SearchParams(**kw), max_failures=max_failures,
+                                   furniture_levels=_furniture_levels(options))
     if name == "esc":
         from sgtool.planning.esc import EscParams, EscPlanner
 

@@ -158,6 +158,7 @@ class SceneGraphBuilder:
         self._frontiers = FrontierTracker()
         self._class_memo: dict[tuple[str, ...], list[tuple[str, float]]] = {}
         self._panel_memo: dict[bytes, object] = {}  # door openings from swung panels
+        self._density: tuple[bytes, np.ndarray] | None = None  # door density of these cells
         self._assign_cache = AssignCache()  # Dijkstra rows and sight lines of assignment
         self._last: tuple[tuple, SceneGraph] | None = None
         self.layers: MapLayers | None = None
@@ -230,6 +231,7 @@ class SceneGraphBuilder:
             self._assign_cache = AssignCache()
             self._class_memo = {}
             self._panel_memo = {}
+            self._density = None
         timings = self.timings_scratch if from_scratch else self.timings
         tick = _Ticker(timings, self.clock)
         cfg = self.config
@@ -330,7 +332,12 @@ class SceneGraphBuilder:
         """Rooms: the door evidence cuts the graph; ids stay stable by overlap."""
         cfg = self.config.rooms
         cells = door_cells(occ, self.instances, self.voxels, self._panel_memo)
-        density = door_density(cells, occ.resolution, cfg.door_bandwidth)
+        key = hashlib.blake2b(cells.tobytes(), digest_size=16).digest() + repr(
+            (cells.shape, occ.resolution)).encode()
+        if self._density is None or self._density[0] != key:  # the same cells: same blur
+            self._density = (key, door_density(cells, occ.resolution, cfg.door_bandwidth))
+            self._density[1].setflags(write=False)
+        density = self._density[1]
         seg = segment_rooms(vg, density, cfg)
         numbers = self._rooms.assign([vg.positions[r] for r in seg.rooms], cfg.match_radius)
         return _Rooms(cells, density, seg, [f"room:{n}" for n in numbers])

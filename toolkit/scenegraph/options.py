@@ -13,7 +13,8 @@ from typing import Any
 from sgtool.mapping.voxels import VoxelConfig
 from sgtool.scenegraph.builder import BuilderConfig
 
-CLASSIFIERS = ("containment", "frequency", "none")
+# ``llm`` (MoMa-LLM's room classification) needs a chat client or a transcript from the caller
+CLASSIFIERS = ("containment", "frequency", "llm", "none")
 MIN_POINTS_320x240 = 50  # MoMa-LLM: an object is seen with > 50 points (256x256 camera)
 
 

@@ -112,7 +112,7 @@ class CachedAsker:
     def _messages(self, prompt: str) -> list[dict[str, str]]:
         return [{"role": "system", "content": SYSTEM}, {"role": "user", "content": prompt}]
 
-    def _ask(self, messages: list[dict[str, str]]) -> str:
+    def _ask(self, messages: list[dict[str, str]], json_object: bool = False) -> str:
         key = prompt_key(messages)
         if key in self.answers:
             self.stats.cached += 1
@@ -125,8 +125,10 @@ class CachedAsker:
         if self._writer is None:
             self._writer = TranscriptWriter(self.path, append=True)
         last = ""
+        # JSON mode forces an object: only for prompts that ask for one (an array answer
+        # would be impossible under it; SmolLM2 then invents objects of its own shape)
         json_mode = Constraint("json_object", ()) \
-            if getattr(self.client, "takes_constraint", False) else None
+            if json_object and getattr(self.client, "takes_constraint", False) else None
         for attempt in range(self.max_attempts):
             try:
                 res = complete_within(self.client, messages, self.timeout_s, json_mode)
@@ -148,8 +150,10 @@ class CachedAsker:
             "rerun the same command to resume"
         )
 
-    def ask_json(self, prompt: str, check: Callable[[Any], bool]) -> Any | None:
-        """Parsed JSON answer satisfying ``check``; one reminder on a bad answer, then None."""
+    def ask_json(self, prompt: str, check: Callable[[Any], bool], json_object: bool = False
+                 ) -> Any | None:
+        """Parsed JSON answer satisfying ``check``; one reminder on a bad answer, then None.
+        ``json_object``: the answer is a JSON object, so JSON mode may be requested."""
         self.stats.prompts += 1
         messages = self._messages(prompt)
         for reminder in (False, True):
@@ -157,7 +161,7 @@ class CachedAsker:
                 messages = self._messages(
                     prompt + "\nYour previous answer was not valid JSON of the requested "
                     "shape. Answer with the JSON only.")
-            text = self._ask(messages)
+            text = self._ask(messages, json_object)
             try:
                 data = extract_json(text)
             except ValueError:
@@ -244,7 +248,7 @@ def generate_sets(asker: CachedAsker, cfg: GenerationConfig = GenerationConfig()
         data = asker.ask_json(
             f"For the object '{q}', give for each of these rooms the probability (0 to 1) "
             f"that it is found there: {room_list}. Answer with a JSON object mapping each "
-            "room to its probability.", lambda d: isinstance(d, dict))
+            "room to its probability.", lambda d: isinstance(d, dict), json_object=True)
         if data:
             for r, v in data.items():
                 rn = normalize_name(r)

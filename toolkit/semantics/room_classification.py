@@ -96,14 +96,16 @@ class LlmRoomClassifier:
     ``on_exchange``) with ``purpose: room_classification``, so a transcript replays it
     (:class:`sgtool.llm.recorded.ReplayChatClient`). A fault or an answer that names no
     room type falls back to ``fallback`` (e.g. :class:`ContainmentRoomClassifier`), else
-    to unknown ([]).
+    to unknown ([]). A prompt a replayed transcript does not hold
+    (:class:`~sgtool.llm.recorded.ReplayMiss`) is raised instead: an offline replay either
+    matches its recording or says that it diverged.
     """
 
     name = "llm"
 
     def __init__(self, client: object, room_types: Sequence[str], *,
                  constraint: str = "auto", fallback: object | None = None,
-                 on_exchange: object | None = None) -> None:
+                 on_exchange: object | None = None, timeout_s: float = 60.0) -> None:
         from sgtool.llm.constraints import check_kind, detect_kind
 
         self.client = client
@@ -119,6 +121,7 @@ class LlmRoomClassifier:
         self.constraint = kind
         self.fallback = fallback
         self.on_exchange = on_exchange
+        self.timeout_s = float(timeout_s)
         self.exchanges: list[dict] = []
         self._cache: dict[tuple[str, ...], list[tuple[str, float]]] = {}
 
@@ -137,22 +140,28 @@ class LlmRoomClassifier:
         from sgtool.llm.client import LlmTransportError, complete_within
         from sgtool.llm.constraints import Constraint
         from sgtool.llm.exchange import exchange_record
+        from sgtool.llm.recorded import ReplayMiss
 
         messages = room_prompt(objects, self.room_types)
         constraint = Constraint(self.constraint, self.room_types, bare=True) \
             if self.constraint in ("grammar", "json_schema") else None
         try:
-            r = complete_within(self.client, messages, 60.0, constraint)  # type: ignore[arg-type]
+            r = complete_within(self.client, messages, self.timeout_s,  # type: ignore[arg-type]
+                                constraint)
+        except ReplayMiss:
+            raise  # an offline replay that diverged: no silent fallback
         except LlmTransportError as e:
             self._log(exchange_record(model=str(getattr(self.client, "model", "")),
                                       messages=messages, response=None, latency_s=0.0,
-                                      error=str(e), extra={"purpose": "room_classification"}))
+                                      error=str(e), extra={"purpose": "room_classification",
+                                                           "constraint": self.constraint}))
             return self._fall_back(raw)
         room = match_room_type(r.text, self.room_types)
         self._log(exchange_record(
             model=r.model, messages=messages, response=r.text, latency_s=r.latency_s,
             prompt_tokens=r.prompt_tokens, completion_tokens=r.completion_tokens,
             source=r.source, extra={"purpose": "room_classification",
+                                    "constraint": self.constraint,
                                     "verdict": "ok" if room else "invalid: no room type"}))
         return [(self._spelling[room], 1.0)] if room else self._fall_back(raw)
 

@@ -186,7 +186,7 @@ def test_run_bench_returns_the_tables():
 
 @pytest.mark.parametrize("args, message", [
     (["--planners", "random,oracle"], "unknown planner 'oracle'"),
-    (["--rooms", "3-20"], "need 4 <= MIN <= MAX <= 16"),
+    (["--rooms", "3-40"], "need 4 <= MIN <= MAX <= 30"),
     (["--rooms", "big"], "give N or MIN-MAX"),
     (["--seeds", "0"], "--seeds: must be >= 1"),
     (["--planners", "moma-llm", "--llm-replay", "/nonexistent/t.jsonl"],

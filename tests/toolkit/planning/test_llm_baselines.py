@@ -101,3 +101,33 @@ def test_read_likelihoods() -> None:
     assert got == {"living room": 0.7, "kitchen": 1.0}
     assert read_likelihoods("[0.1, 0.2]", names) is None
     assert read_likelihoods('{"garage": 1}', names) is None
+
+
+def test_godhs_llm_exchanges_reach_the_episode_log(tmp_path) -> None:
+    """godhs-llm exposes its ranker's exchanges like moma-llm, so a bench log holds them on
+    /sgtool/llm, each at the time of the decision that asked."""
+    from support.symbolic_fixtures import three_rooms
+
+    from sgtool.house.io import load_house
+    from sgtool.log.reader import LogReader
+    from sgtool.log.records import LlmExchange
+    from sgtool.log.writer import LogWriter
+    from sgtool.recorders.symbolic_environment import SymbolicHouse, run_episode
+
+    script = Script({"kitchen": 0.9, "bathroom": 0.1, "living room": 0.2},
+                    {"wardrobe": 0.9, "bed": 0.1})
+    planner = make_planner("godhs-llm", client=script, encoder=encoder())
+    path = tmp_path / "godhs.mcap"
+    with LogWriter(path, seed=0) as log:
+        run_episode(SymbolicHouse(load_house(three_rooms())), planner, "sweater", ["obj_5"],
+                    seed=0, house_id="three", log=log, max_steps=12)
+    with LogReader(path) as r:
+        logged = [rec for _, rec in r.records(LlmExchange)]
+    assert script.asked  # the ranker was asked (the house was explored first)
+    assert len(logged) == len(script.asked)
+    assert [x.to_json()["purpose"] for x in logged] == \
+        [f"godhs_{w}" for w in script.asked]
+    # drained once for a closed-loop writer, then empty
+    assert len(planner.drain_exchanges()) == len(script.asked)
+    assert planner.drain_exchanges() == []
+    assert make_planner("godhs", encoder=encoder()).exchanges is None
