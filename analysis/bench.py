@@ -101,6 +101,18 @@ class BenchError(SgtoolError):
     """A benchmark option that cannot work (unknown planner, bad range, missing transcript)."""
 
 
+def check_planner_list(planners: Sequence[str]) -> None:
+    """``--planners`` of a benchmark (symbolic or closed loop): at least one, each known."""
+    from sgtool.planning.registry import PLANNER_NAMES
+
+    if not planners:
+        raise BenchError("--planners: name at least one planner")
+    for p in planners:
+        if p not in PLANNER_NAMES:
+            raise BenchError(f"--planners: unknown planner {p!r}; choose from "
+                             f"{', '.join(PLANNER_NAMES)}")
+
+
 @dataclass(frozen=True)
 class BenchConfig:
     planners: tuple[str, ...] = DEFAULT_PLANNERS
@@ -123,14 +135,7 @@ class BenchConfig:
     ray_address: str | None = None  # a Ray cluster; None: RAY_ADDRESS, else a local Ray
 
     def check(self) -> None:
-        from sgtool.planning.registry import PLANNER_NAMES
-
-        if not self.planners:
-            raise BenchError("--planners: name at least one planner")
-        for p in self.planners:
-            if p not in PLANNER_NAMES:
-                raise BenchError(f"--planners: unknown planner {p!r}; choose from "
-                                 f"{', '.join(PLANNER_NAMES)}")
+        check_planner_list(self.planners)
         if len(set(self.planners)) != len(self.planners):
             raise BenchError("--planners: a planner is named twice")
         for name, value in (("--episodes", self.episodes), ("--seeds", self.seeds),

@@ -91,14 +91,9 @@ class ClosedLoopBenchConfig:
     step_budget: float = 50.0
 
     def check(self) -> None:
-        from sgtool.planning.registry import PLANNER_NAMES
+        from sgtool.analysis.bench import check_planner_list
 
-        if not self.planners:
-            raise SgtoolError("--planners: name at least one planner")
-        for p in self.planners:
-            if p not in PLANNER_NAMES:
-                raise SgtoolError(f"--planners: unknown planner {p!r}; choose from "
-                                  f"{', '.join(PLANNER_NAMES)}")
+        check_planner_list(self.planners)
         if len(set(self.planners)) != len(self.planners) or \
                 len(set(self.noise)) != len(self.noise):
             raise SgtoolError("--planners/--noise: a name is given twice")
