@@ -18,19 +18,23 @@ bar (tqdm, on stderr) per finished task wherever it ran, retry a task that raise
 and then give up on it: its :class:`Outcome` carries the error as one line, for the
 caller's summary.
 Ctrl-C cancels the tasks not finished yet and re-raises, so a caller that writes its
-outputs from ``on_result`` (atomically) is left with complete outputs only.
+outputs from ``on_result`` (atomically) is left with complete outputs only. A SIGTERM to
+the driver (turned into :class:`~sgtool.errors.Terminated` by the CLI) is passed on to the
+pool's workers, whose tasks then clean up as on Ctrl-C, and the driver waits for them.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
+import signal
 import socket
 import sys
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from sgtool.errors import SgtoolError
+from sgtool.errors import SgtoolError, Terminated, raise_terminated
 
 EXECUTORS: tuple[str, ...] = ("local", "ray")
 RAY_INSTALL = "pip install 'sgtool[ray]'"
@@ -178,24 +182,28 @@ class _Pool:
         import multiprocessing as mp
         from concurrent.futures import ProcessPoolExecutor
 
-        return ProcessPoolExecutor(max_workers=self.workers,
-                                   mp_context=mp.get_context("spawn"))
+        return ProcessPoolExecutor(max_workers=self.workers, mp_context=mp.get_context("spawn"),
+                                   initializer=_worker_setup)
 
     def __enter__(self) -> _Pool:
         return self
 
     def __exit__(self, *exc: object) -> None:
-        self.pool.shutdown(wait=exc[0] is None, cancel_futures=True)
+        killed = isinstance(exc[1], Terminated)
+        if killed:  # kill reached this process only: stop the tasks in flight too
+            _signal_workers(self.pool, signal.SIGTERM)
+        # after a kill, wait for the workers to clean up (their partial outputs)
+        self.pool.shutdown(wait=exc[0] is None or killed, cancel_futures=True)
 
     def submit(self, args: Any) -> Any:
         from concurrent.futures.process import BrokenProcessPool
 
         try:
-            return self.pool.submit(self.fn, args)
+            return self.pool.submit(_call_in_worker, self.fn, args)
         except BrokenProcessPool:  # a worker died (killed, crashed): a new pool for the rest
             self.pool.shutdown(wait=False, cancel_futures=True)
             self.pool = self._new_pool()
-            return self.pool.submit(self.fn, args)
+            return self.pool.submit(_call_in_worker, self.fn, args)
 
     def wait_one(self, handles: list[Any]) -> tuple[Any, Any, BaseException | None]:
         from concurrent.futures import FIRST_COMPLETED, wait
@@ -208,6 +216,38 @@ class _Pool:
     def cancel(self, handles: list[Any]) -> None:
         for f in handles:
             f.cancel()
+
+
+_IN_TASK = False  # in a pool worker: a task is running
+
+
+def _worker_setup() -> None:
+    """In each pool worker: SIGTERM interrupts a running task as Ctrl-C does (its outputs
+    are cleaned up) instead of ending the process mid-write; an idle worker ignores it and
+    leaves when the pool shuts down (dying would break the pool, which then kills the
+    other workers mid-cleanup)."""
+    signal.signal(signal.SIGTERM, _worker_sigterm)
+
+
+def _worker_sigterm(signum: int, frame: object) -> None:
+    if _IN_TASK:
+        raise_terminated(signum, frame)
+
+
+def _call_in_worker(fn: Callable[[Any], Any], args: Any) -> Any:
+    global _IN_TASK
+    _IN_TASK = True
+    try:
+        return fn(args)
+    finally:
+        _IN_TASK = False
+
+
+def _signal_workers(pool: Any, sig: int) -> None:
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):
+        if proc.is_alive():
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(proc.pid, sig)
 
 
 class LocalExecutor(_Executor):

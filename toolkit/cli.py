@@ -21,7 +21,7 @@ import sys
 import click
 
 from sgtool import __version__
-from sgtool.errors import SgtoolError
+from sgtool.errors import SgtoolError, Terminated, raise_terminated
 from sgtool.files import is_environment_error
 from sgtool.redact import redact_text
 
@@ -84,7 +84,10 @@ class LazyGroup(click.Group):
             raise UserError(os_error_text(e)) from e
         except KeyboardInterrupt as e:
             # not click's Abort (a blank line and "Aborted!"): one line, what was kept
-            raise Interrupted(getattr(e, "note", "") or "no output was left half-written") from e
+            out = Interrupted(getattr(e, "note", "") or "no output was left half-written")
+            if isinstance(e, Terminated):
+                out.exit_code = 143  # 128 + SIGTERM, as a shell reports a killed command
+            raise out from e
 
     def _available(self) -> dict[str, tuple[str, str]]:
         out = {}
@@ -125,6 +128,7 @@ def cli(verbose: int) -> None:
 
 
 def main(argv: list[str] | None = None) -> None:
+    _terminate_as_interrupt()
     try:
         rc = cli.main(args=argv, prog_name="sgtool", standalone_mode=False)
         _finished()
@@ -141,11 +145,20 @@ def main(argv: list[str] | None = None) -> None:
         sys.exit(e.exit_code)
     except click.exceptions.Exit as e:
         sys.exit(e.exit_code)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as e:
         click.echo("sgtool: interrupted", err=True)
-        sys.exit(130)
+        sys.exit(143 if isinstance(e, Terminated) else 130)
     except BrokenPipeError:
         sys.exit(0)
+
+
+def _terminate_as_interrupt() -> None:
+    """``kill`` (SIGTERM) cleans up as Ctrl-C does: partial outputs are removed and worker
+    processes stopped, instead of the process vanishing mid-write."""
+    try:
+        signal.signal(signal.SIGTERM, raise_terminated)
+    except ValueError:  # not the main thread (sgtool called from a thread of another tool)
+        pass
 
 
 def _finished() -> None:
@@ -153,6 +166,7 @@ def _finished() -> None:
     library's shutdown hooks) must not turn a complete run into a killed one."""
     try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
     except ValueError:  # not the main thread
         pass
 

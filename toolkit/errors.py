@@ -23,3 +23,13 @@ class MissingChannelError(LogFormatError):
 
 class SpecError(SgtoolError):
     """A house spec (or another JSON input) fails validation; the message names the field."""
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (``kill``), turned into an interrupt so that it cleans up as Ctrl-C does:
+    no half-written output is left, worker processes are stopped too."""
+
+
+def raise_terminated(signum: int, frame: object) -> None:
+    """A SIGTERM handler: raise :class:`Terminated` in the main thread."""
+    raise Terminated

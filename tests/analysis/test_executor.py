@@ -1,11 +1,16 @@
 """The local executor (in process and a pool of 2): results in task order, a failing task
-retried once then reported, Ctrl-C keeps what finished; option errors are one line, Ray
+retried once then reported, Ctrl-C keeps what finished, a kill of the driver stops the
+workers and leaves no partial output; option errors are one line, Ray
 missing or unreachable too (no Ray started here: see test_ray_executor.py)."""
 
 from __future__ import annotations
 
+import signal
 import socket
+import subprocess
 import sys
+import time
+from pathlib import Path
 
 import pytest
 
@@ -162,3 +167,59 @@ def test_a_dead_pool_worker_is_reported_and_the_pool_replaced():
 
 def test_no_tasks_starts_nothing():
     assert LocalExecutor(2).run(abs, []) == []
+
+
+KILLED_DRIVER = '''
+import os, sys, time
+from pathlib import Path
+from sgtool.analysis.executor import LocalExecutor, Task
+from sgtool.cli import _terminate_as_interrupt
+from sgtool.errors import Terminated
+from sgtool.files import atomic_output
+
+OUT = Path(sys.argv[1])
+
+def slow(i):
+    (OUT / f"pid-{i}").write_text(str(os.getpid()))
+    with atomic_output(OUT / f"out-{i}.bin") as tmp:
+        tmp.write_bytes(b"half")
+        time.sleep(120)
+
+if __name__ == "__main__":
+    _terminate_as_interrupt()
+    try:
+        LocalExecutor(2).run(slow, [Task(str(i), i) for i in range(2)])
+    except Terminated:
+        sys.exit(143)
+'''
+
+
+def _gone(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/status").read_text()
+    except FileNotFoundError:
+        return True
+    return "State:\tZ" in state  # exited, not yet reaped (no init reaps in a container)
+
+
+def test_kill_of_the_driver_stops_the_workers_and_leaves_no_partial_output(tmp_path):
+    script = tmp_path / "driver.py"
+    script.write_text(KILLED_DRIVER)
+    out = tmp_path / "out"
+    out.mkdir()
+    proc = subprocess.Popen([sys.executable, str(script), str(out)])
+    try:
+        deadline = time.monotonic() + 120
+        while len(list(out.glob("*.partial"))) < 2:  # both tasks are mid-write
+            assert proc.poll() is None and time.monotonic() < deadline
+            time.sleep(0.1)
+        pids = [int((out / f"pid-{i}").read_text()) for i in range(2)]
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=60) == 143
+    finally:
+        proc.kill()
+    assert sorted(p.name for p in out.iterdir()) == ["pid-0", "pid-1"]  # no partial, no out
+    deadline = time.monotonic() + 10
+    while not all(_gone(p) for p in pids) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert all(_gone(p) for p in pids)
