@@ -73,13 +73,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--base", type=Path, required=True, help="baseline source tree")
     ap.add_argument("--base-pkg", type=Path,
                     default=Path(tempfile.gettempdir()) / "sgtool-base-pkg")
+    ap.add_argument("--tree", type=Path, default=None,
+                    help="the tree to measure against the baseline (default: this one); "
+                    "e.g. a copy of the baseline with one engineer's files laid over it")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--frames", type=int, default=0, help="frames per run, for frames/s")
     ap.add_argument("command", nargs=argparse.REMAINDER, help="-- sgtool arguments")
     a = ap.parse_args(argv)
     cmd = [c for c in a.command if c != "--"]
     pkg = str(shadow_package(a.base.resolve(), a.base_pkg))
-    trees = {"this tree": None, "baseline": pkg}
+    this = (str(shadow_package(a.tree.resolve(), a.base_pkg.with_name(a.base_pkg.name + "-tree")))
+            if a.tree is not None else None)
+    trees = {"this tree": this, "baseline": pkg}
     got: dict[str, list[tuple[float, float, float]]] = {k: [] for k in trees}
     out_dir = Path(tempfile.mkdtemp(prefix="sgtool-side-"))
     for r in range(a.rounds):

@@ -8,7 +8,9 @@ message (same bytes, same channels and schemas, same order), the input's attachm
 its ``sgtool`` metadata, and after the message that caused each refresh the derived
 channels of :mod:`sgtool.scenegraph.derived_layers` at the refresh time. Derived channels of the
 input (a log that was already replayed, or a closed-loop log) are not copied: they are
-rebuilt. A metadata record ``sgtool.replay`` holds the options.
+rebuilt. A metadata record ``sgtool.replay`` holds the options. Input chunks go into the
+derived log as they are, not recompressed (:mod:`sgtool.log.chunk_copy`), wherever that
+gives the same messages in the same order (:func:`_can_copy`, :func:`_copyable`).
 
 Options default to what the log says it was built with: a closed-loop log records its
 mapping options in its ``sgtool.Episode`` record (``extra.mapping``), so replaying it with
@@ -38,6 +40,7 @@ from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
 from sgtool.log import schemas as S
 from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler
+from sgtool.log.chunk_copy import RawChunk, in_sequence
 from sgtool.log.reader import LogReader
 from sgtool.log.records import Episode, Instances
 from sgtool.log.writer import LogWriter
@@ -166,13 +169,17 @@ def replay(
     compression: str = "zstd",
     verify: bool = False,
     room_classifier: Callable[[str], Any] | None = None,
+    copy_chunks: bool = True,
 ) -> ReplayReport:
     """Replay ``log`` (module doc). ``on_refresh`` sees every refresh as it happens;
     ``progress`` is anything with ``update(n)`` (a tqdm bar), advanced per frame;
     ``verify`` checks every chunk CRC of the input as it is read (``sgtool doctor``
     checks everything; without it damage still gives a one-line error, or a frame);
     ``room_classifier`` builds the classifier from the resolved name instead of
-    :func:`~sgtool.datasets.room_evidence.make_classifier` (``llm`` with a chat client)."""
+    :func:`~sgtool.datasets.room_evidence.make_classifier` (``llm`` with a chat client);
+    ``copy_chunks`` copies the input's chunks into the derived log as they are where that
+    gives the same messages in the same order (:func:`_can_copy`), instead of writing them
+    message by message (recompressed)."""
     src = Path(log)
     dst = Path(output) if output is not None else None
     if dst is not None and dst.exists() and src.exists() and dst.resolve() == src.resolve():
@@ -198,7 +205,7 @@ def replay(
                 writer.add_metadata(REPLAY_METADATA, opts.to_metadata())
                 for a in reader.iter_attachments():
                     writer.attach(a.name, a.data, a.media_type, a.log_time)
-                _run(reader, stream, writer, opts, report, on_refresh, progress)
+                _run(reader, stream, writer, opts, report, on_refresh, progress, copy_chunks)
         report.seconds = time.perf_counter() - t0
         report.stages = stream.builder.stage_summary()
     return report
@@ -206,64 +213,129 @@ def replay(
 
 def _run(reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
          opts: ResolvedOptions, report: ReplayReport,
-         on_refresh: Callable[[Refresh, SceneGraphStream], None] | None, progress: Any
-         ) -> None:
-    frame_topics = set(FRAME_TOPICS)
-    needed = frame_topics | {_INSTANCES, _ACTION}
-    copied: dict[int, int] = {}  # input channel id -> output channel id
-    asm = FrameAssembler(where=str(reader.path))
-    last_t = 0
+         on_refresh: Callable[[Refresh, SceneGraphStream], None] | None, progress: Any,
+         copy_chunks: bool = False) -> None:
+    feed = _Feed(reader, stream, writer, opts, report, on_refresh, progress)
+    if copy_chunks and writer is not None and _can_copy(reader, writer, opts):
+        feed.keep_sequence = True
+        for chunk, items in reader.chunks(views=True):
+            copied = chunk is not None and _copyable(chunk, items) and writer.copy_chunk(chunk)
+            for schema, channel, message in items:
+                feed.message(schema, channel, message, write=not copied)
+    else:
+        for schema, channel, message in reader.raw_messages():
+            if not feed.message(schema, channel, message, write=writer is not None):
+                break
+    feed.end()
 
-    def refreshed(r: Refresh | None) -> None:
+
+def _can_copy(reader: LogReader, writer: LogWriter, opts: ResolvedOptions) -> bool:
+    """Input chunks can be copied into the derived log as they are (:mod:`sgtool.log.
+    chunk_copy`) when the whole log is replayed, it has no derived channels to rebuild,
+    its chunks follow each other in time and its channels keep their ids in the output."""
+    return (opts.max_frames is None and not reader.topics() & set(DERIVED_TOPICS)
+            and in_sequence(reader.summary.chunk_indexes)
+            and writer.copy_channels(reader.summary))
+
+
+def _copyable(chunk: RawChunk, items: list[Any]) -> bool:
+    """The messages of ``chunk`` (``items``, in log-time order) can be written as the
+    chunk: its indexes count them, and it holds no instance table or action record. A
+    refresh is written before the message that caused it; a frame's refresh is caused by
+    the first message of a later log time, so the copy, which puts the refresh after the
+    chunk, keeps the log-time order; an instance table or action record can cause a
+    refresh at its own log time, which must stay before it."""
+    counts: dict[int, int] = {}
+    for _, channel, _ in items:
+        if channel.topic in (_INSTANCES, _ACTION):
+            return False
+        counts[channel.id] = counts.get(channel.id, 0) + 1
+    return counts == chunk.counts
+
+
+class _Feed:
+    """Input messages, in log-time order, into the stream (frames, instance tables, action
+    records) and, when asked, into the derived log; refreshes into the derived log."""
+
+    def __init__(self, reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
+                 opts: ResolvedOptions, report: ReplayReport,
+                 on_refresh: Callable[[Refresh, SceneGraphStream], None] | None,
+                 progress: Any) -> None:
+        self.reader, self.stream, self.writer = reader, stream, writer
+        self.opts, self.report, self.on_refresh, self.progress = opts, report, on_refresh, progress
+        self.frame_topics = set(FRAME_TOPICS)
+        self.needed = self.frame_topics | {_INSTANCES, _ACTION}
+        self.copied: dict[int, int] = {}  # input channel id -> output channel id
+        self.asm = FrameAssembler(where=str(reader.path))
+        self.last_t = 0
+        self.keep_sequence = False  # written messages keep their sequence and publish time
+
+    def refreshed(self, r: Refresh | None) -> None:
         if r is None:
             return
-        report.refreshes += 1
-        report.last = r
-        if writer is not None:
-            write_refresh(writer, r)
-        if on_refresh is not None:
-            on_refresh(r, stream)
+        self.report.refreshes += 1
+        self.report.last = r
+        if self.writer is not None:
+            write_refresh(self.writer, r)
+        if self.on_refresh is not None:
+            self.on_refresh(r, self.stream)
 
-    def take_frame(fr: Any) -> bool:
+    def take_frame(self, fr: Any) -> bool:
         """Integrate a finished frame; False when the frame budget is spent."""
         if fr is None:
             return True
-        if opts.max_frames is not None and report.frames >= opts.max_frames:
+        report = self.report
+        if self.opts.max_frames is not None and report.frames >= self.opts.max_frames:
             report.truncated = True
             return False
         report.frames += 1
-        if progress is not None:
-            progress.update(1)
-        refreshed(stream.frame(fr))
+        if self.progress is not None:
+            self.progress.update(1)
+        self.refreshed(self.stream.frame(fr))
         return True
 
-    for schema, channel, message in reader.raw_messages():
+    def message(self, schema: Any, channel: Any, message: Any, write: bool) -> bool:
+        """Take one input message (``write``: also copy it into the derived log); False
+        when the frame budget is spent (the message is then not taken)."""
         topic = channel.topic
         t = int(message.log_time)
-        if topic in needed:
-            decoded = reader.decode(schema, channel, message)
-            if topic in frame_topics:
-                if not take_frame(asm.push(topic, t, decoded)):
-                    break
+        if topic in self.needed:
+            decoded = self.reader.decode(schema, channel, message)
+            if topic in self.frame_topics:
+                if not self.take_frame(self.asm.push(topic, t, decoded)):
+                    return False
             else:
-                if not take_frame(asm.flush()):
-                    break
+                if not self.take_frame(self.asm.flush()):
+                    return False
                 if topic == _INSTANCES:
-                    stream.instances(t, Instances.from_json(
-                        decoded, where=f"{reader.path}: {Instances.describe(t_ns=t)}"))
+                    self.stream.instances(t, Instances.from_json(
+                        decoded, where=f"{self.reader.path}: {Instances.describe(t_ns=t)}"))
                 else:
-                    refreshed(stream.action(t))
-        if writer is not None and topic not in DERIVED_TOPICS:
-            cid = copied.get(channel.id)
-            if cid is None:
-                cid = writer.copy_channel(
-                    topic, schema.name if schema else "", schema.encoding if schema else "",
-                    bytes(schema.data) if schema else b"", channel.message_encoding,
-                    dict(channel.metadata))
-                copied[channel.id] = cid
-            writer.write_raw(cid, t, bytes(message.data))
-        last_t = max(last_t, t)
-    else:
-        take_frame(asm.flush())
-    refreshed(stream.finish(last_t if not report.truncated else None))
+                    self.refreshed(self.stream.action(t))
+        if write and self.writer is not None and topic not in DERIVED_TOPICS:
+            self._write(schema, channel, message, t)
+        self.last_t = max(self.last_t, t)
+        return True
 
+    def _write(self, schema: Any, channel: Any, message: Any, t: int) -> None:
+        writer = self.writer
+        assert writer is not None
+        cid = self.copied.get(channel.id)
+        if cid is None:
+            cid = writer.copy_channel(
+                channel.topic, schema.name if schema else "", schema.encoding if schema else "",
+                bytes(schema.data) if schema else b"", channel.message_encoding,
+                dict(channel.metadata))
+            self.copied[channel.id] = cid
+        if self.keep_sequence:
+            writer.write_raw(cid, t, bytes(message.data), message.sequence,
+                             message.publish_time)
+        else:
+            writer.write_raw(cid, t, bytes(message.data))
+
+    def end(self) -> None:
+        """After the last message taken: the last frame (unless the budget is spent), the
+        last refresh."""
+        if not self.report.truncated:
+            self.take_frame(self.asm.flush())
+        self.refreshed(self.stream.finish(self.last_t if not self.report.truncated else None))

@@ -76,6 +76,11 @@ def decoded(where: str, topic: str, t_ns: int, fn: Callable[[Any], T], message: 
         raise LogFormatError(f"{prefix}{topic} message at {t_ns} ns: {e}") from None
 
 
+def _ids_image(msg: Any) -> np.ndarray:
+    """Instance ids as int32, copied once."""
+    return codec.decode_image(msg, np.int32)
+
+
 class FrameAssembler:
     """Groups decoded frame-topic messages, pushed in log order, into frames: the depth
     image of one log time with the RGB and id images of the same time, the calibration in
@@ -148,8 +153,7 @@ class FrameAssembler:
             if pending["ids"].encoding not in codec.INTEGER_ENCODINGS:
                 self._fail(S.IDS, t, f"field encoding: instance ids must be integers, not "
                            f"{pending['ids'].encoding[:40]!r}")
-            ids = decoded(self.where, S.IDS, t, codec.decode_image,
-                          pending["ids"]).astype(np.int32)
+            ids = decoded(self.where, S.IDS, t, _ids_image, pending["ids"])
         for topic, img in ((S.RGB, rgb), (S.IDS, ids)):
             if img is not None and img.shape[:2] != depth.shape:
                 self._fail(topic, t, f"fields width/height: {img.shape[1]}x{img.shape[0]} "

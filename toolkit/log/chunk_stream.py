@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import functools
 import struct
+import sys
 import zlib
 from collections.abc import Iterator
 from typing import IO, Any
@@ -49,26 +50,95 @@ def _zstd() -> Any:
     return zstandard.ZstdDecompressor()
 
 
-def chunk_records(f: IO[bytes], ci: ChunkIndex, verify: bool) -> bytes:
+def chunk_records(f: IO[bytes], ci: ChunkIndex, verify: bool,
+                  buffers: ChunkBuffers | None = None) -> bytes:
     """The uncompressed records of the chunk that ``ci`` points to (CRC checked when
-    ``verify`` and the writer wrote one)."""
+    ``verify`` and the writer wrote one); ``buffers`` as in :func:`chunk_data`."""
+    return chunk_data(read_chunk(f, ci), ci, verify, buffers)
+
+
+class ChunkBuffers:
+    """Buffers that zstd chunks are decompressed into and reused once nothing refers to
+    them any more: a fresh buffer for every chunk costs more than the decompression when
+    the caller allocates images between chunks (the freed pages go back to the system and
+    are faulted in again). For callers that take the messages as views
+    (``ordered_messages(views=True)``); a buffer stays taken while any view of it lives
+    (CPython reference counts: a view holds its buffer). Chunks above ``max_bytes`` are
+    not pooled (a reader keeps at most ``keep`` buffers while it is open)."""
+
+    def __init__(self, keep: int = 4, max_bytes: int = 32 << 20) -> None:
+        self._keep = keep
+        self._max_bytes = max_bytes
+        self._buffers: list[bytearray] = []
+
+    def take(self, size: int) -> bytearray | None:
+        """A buffer of at least ``size`` bytes that nothing refers to, or None when
+        ``keep`` buffers are all in use or ``size`` is above ``max_bytes``."""
+        if size > self._max_bytes:
+            return None
+        for i in range(len(self._buffers)):
+            if sys.getrefcount(self._buffers[i]) == 2:  # the list and the call's argument
+                if len(self._buffers[i]) < size:
+                    self._buffers[i] = bytearray(size)
+                return self._buffers[i]
+        if len(self._buffers) < self._keep:
+            self._buffers.append(bytearray(size))
+            return self._buffers[-1]
+        return None
+
+
+def _zstd_into(data: memoryview, size: int, buffers: ChunkBuffers | None
+               ) -> bytes | memoryview:
+    """``data`` decompressed (at most ``size`` bytes: more is damage, a shorter result is
+    checked by the caller), into a reused buffer when ``buffers`` has one free."""
+    buf = buffers.take(size) if buffers is not None else None
+    if buf is None:
+        return _zstd().decompress(data, max_output_size=size)
+    out = memoryview(buf)[:size]
+    reader = _zstd().stream_reader(data, read_size=len(data))
+    got = 0
+    while got < size:
+        n = reader.readinto(out[got:])
+        if n == 0:
+            break
+        got += n
+    if reader.read(1):
+        raise ChunkError(f"more than the {size} bytes the chunk header says")
+    return out[:got]
+
+
+def read_chunk(f: IO[bytes], ci: ChunkIndex) -> bytes:
+    """The chunk record that ``ci`` points to, as it is in the file (opcode, length, body;
+    :func:`chunk_data` decompresses it). The summary check has already bounded
+    ``ci.chunk_length`` by the file size."""
     f.seek(ci.chunk_start_offset)
-    head = f.read(9 + _CHUNK_HEAD.size + 4)
-    if len(head) < 9 + _CHUNK_HEAD.size + 4 or head[0] != 0x06:
+    record = f.read(ci.chunk_length)
+    if len(record) < 9 + _CHUNK_HEAD.size + 4 or record[0] != 0x06:
         raise ChunkError(f"no chunk record at byte {ci.chunk_start_offset}")
-    _, _, size, crc = _CHUNK_HEAD.unpack_from(head, 9)
-    (name_len,) = struct.unpack_from("<I", head, 9 + _CHUNK_HEAD.size)
-    if name_len > 16:
+    return record
+
+
+def chunk_data(record: bytes, ci: ChunkIndex, verify: bool,
+               buffers: ChunkBuffers | None = None) -> bytes:
+    """The uncompressed records of a chunk record of :func:`read_chunk` (CRC checked when
+    ``verify`` and the writer wrote one); zstd chunks into one of ``buffers`` (a
+    ``memoryview`` then) when given and one is free."""
+    _, _, size, crc = _CHUNK_HEAD.unpack_from(record, 9)
+    pos = 9 + _CHUNK_HEAD.size
+    (name_len,) = struct.unpack_from("<I", record, pos)
+    if name_len > 16 or pos + 4 + name_len + 8 > len(record):
         raise ChunkError(f"chunk at byte {ci.chunk_start_offset}: bad compression name")
-    compression = f.read(name_len).decode("ascii", "replace")
-    (data_len,) = struct.unpack("<Q", f.read(8))
+    compression = str(record[pos + 4:pos + 4 + name_len], "ascii", "replace")
+    pos += 4 + name_len
+    (data_len,) = struct.unpack_from("<Q", record, pos)
+    pos += 8
     if data_len > ci.chunk_length or size > MAX_CHUNK_BYTES:
         raise ChunkError(f"chunk at byte {ci.chunk_start_offset}: lengths do not fit")
-    data = f.read(data_len)
-    if len(data) != data_len:
+    if pos + data_len > len(record):
         raise ChunkError(f"chunk at byte {ci.chunk_start_offset} is cut short")
+    data: bytes | memoryview = memoryview(record)[pos:pos + data_len]
     if compression == "zstd":
-        data = _zstd().decompress(data, max_output_size=size)
+        data = _zstd_into(data, size, buffers)
     elif compression == "lz4":
         import lz4.frame
 
@@ -76,12 +146,14 @@ def chunk_records(f: IO[bytes], ci: ChunkIndex, verify: bool) -> bytes:
     elif compression:
         raise ChunkError(f"chunk at byte {ci.chunk_start_offset}: unknown compression "
                              f"{compression[:16]!r}")
+    else:
+        data = bytes(data)
     if len(data) != size:
         raise ChunkError(f"chunk at byte {ci.chunk_start_offset}: {len(data)} bytes "
                              f"uncompressed, its header says {size}")
     if verify and crc != 0 and zlib.crc32(data) != crc:
         raise ChunkError(f"chunk at byte {ci.chunk_start_offset}: CRC mismatch")
-    return data
+    return data  # type: ignore[return-value]
 
 
 def _messages_of(data: bytes, offset: int, summary: Summary, wanted: set[int] | None,
@@ -116,12 +188,14 @@ def _messages_of(data: bytes, offset: int, summary: Summary, wanted: set[int] | 
 
 def ordered_messages(f: IO[bytes], summary: Summary, topics: list[str] | None = None, *,
                      start_ns: int | None = None, end_ns: int | None = None,
-                     verify: bool = False, views: bool = False) -> Iterator[Item]:
+                     verify: bool = False, views: bool = False,
+                     buffers: ChunkBuffers | None = None) -> Iterator[Item]:
     """(schema, channel, message) of the chunked messages on ``topics`` (all when None)
     with ``start_ns <= log time < end_ns``, in the order of the ``mcap`` reader's
     ``iter_messages(log_time_order=True)`` (module doc). With ``views`` a message's
     ``data`` is a read-only ``memoryview`` into its chunk instead of a copy (for callers
-    that parse it at once: an image is then copied once, by the parser, not twice)."""
+    that parse it at once: an image is then copied once, by the parser, not twice), and
+    with ``buffers`` too the chunks are decompressed into reused buffers."""
     wanted = None if topics is None else {
         cid for cid, ch in summary.channels.items() if ch.topic in set(topics)}
     chunks = sorted(
@@ -133,7 +207,8 @@ def ordered_messages(f: IO[bytes], summary: Summary, topics: list[str] | None = 
         key=lambda ci: (ci.message_start_time, ci.chunk_start_offset))
     pending: list[tuple[_Key, Item]] = []
     for j, ci in enumerate(chunks):
-        pending.extend(_messages_of(chunk_records(f, ci, verify), ci.chunk_start_offset,
+        data = chunk_records(f, ci, verify, buffers if views else None)
+        pending.extend(_messages_of(data, ci.chunk_start_offset,
                                     summary, wanted, start_ns, end_ns, views))
         pending.sort(key=lambda e: e[0])
         if j + 1 < len(chunks):
@@ -147,3 +222,13 @@ def ordered_messages(f: IO[bytes], summary: Summary, topics: list[str] | None = 
         for _, item in pending[:cut]:
             yield item
         del pending[:cut]
+
+
+def chunk_messages(data: bytes, ci: ChunkIndex, summary: Summary, views: bool = False
+                   ) -> list[Item]:
+    """(schema, channel, message) of every message of one chunk (``data``: its
+    uncompressed records), in log-time order, ties in chunk order: the order
+    :func:`ordered_messages` gives them when no other chunk overlaps this one in time."""
+    found = _messages_of(data, ci.chunk_start_offset, summary, None, None, None, views)
+    found.sort(key=lambda e: e[0])
+    return [item for _, item in found]

@@ -11,6 +11,7 @@ from foxglove_schemas_protobuf.Grid_pb2 import Grid
 from foxglove_schemas_protobuf.PackedElementField_pb2 import PackedElementField
 from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
 from google.protobuf.timestamp_pb2 import Timestamp
+from numpy.typing import DTypeLike
 
 from sgtool.errors import LogFormatError
 from sgtool.log import schemas as S
@@ -51,11 +52,14 @@ def encode_image(t_ns: int, arr: np.ndarray, encoding: str, frame_id: str) -> Ra
 INTEGER_ENCODINGS = frozenset({"mono8", "8UC1", "mono16", "16UC1", "32SC1"})
 
 
-def decode_image(msg: RawImage | RawImageView) -> np.ndarray:
-    """The pixels of ``msg``; :class:`LogFormatError` (naming the field) when its
-    encoding, size, step and data disagree. The array never shares memory with a
+def decode_image(msg: RawImage | RawImageView, dtype: DTypeLike | None = None) -> np.ndarray:
+    """The pixels of ``msg`` (as ``dtype``, when given: converted as they are copied);
+    :class:`LogFormatError` (naming the field) when its encoding, size, step and data
+    disagree. The array never shares memory with a
     :class:`~sgtool.log.image_wire.RawImageView`'s chunk (it is copied out of it)."""
     a = _pixels(msg)
+    if dtype is not None:
+        return np.array(a, dtype=dtype)
     return a.copy() if isinstance(msg.data, memoryview) else a
 
 
@@ -196,10 +200,12 @@ def decode_transform(msg: FrameTransform) -> np.ndarray:
             and math.sqrt(x * x + y * y + z * z + w * w) > 1e-6):
         raise LogFormatError(f"field rotation: quaternion ({x}, {y}, {z}, {w}) "
                              "cannot be normalised")
-    T = np.eye(4)  # noqa: N806
-    T[:3, :3] = matrix_from_quat(x, y, z, w)
-    T[0, 3], T[1, 3], T[2, 3] = tx, ty, tz
-    return T
+    s = 2.0 / (x * x + y * y + z * z + w * w)  # matrix_from_quat's, in one array
+    return np.array([
+        [1 - s * (y * y + z * z), s * (x * y - z * w), s * (x * z + y * w), tx],
+        [s * (x * y + z * w), 1 - s * (x * x + z * z), s * (y * z - x * w), ty],
+        [s * (x * z - y * w), s * (y * z + x * w), 1 - s * (x * x + y * y), tz],
+        [0.0, 0.0, 0.0, 1.0]])
 
 
 def encode_grid(

@@ -61,9 +61,55 @@ def _timestamp_ok(buf: memoryview) -> bool:
     return True
 
 
+_SIZE_ENCODING = struct.Struct("<BIBIBB")  # width tag, width, height tag, height, encoding
+_STEP_DATA = struct.Struct("<BIB")  # step tag, step, data tag
+
+
+def _in_field_order(buf: memoryview) -> RawImageView | None:
+    """:func:`parse_raw_image` of the layout protobuf writes (fields by number, short
+    timestamp, encoding and frame id), in a few steps; None for any other layout."""
+    n = len(buf)
+    if n < 2 or buf[0] != _TIMESTAMP or buf[1] >= 0x80:
+        return None
+    pos = 2 + buf[1]
+    if pos + _SIZE_ENCODING.size > n or not _timestamp_ok(buf[2:pos]):
+        return None
+    wt, width, ht, height, et, elen = _SIZE_ENCODING.unpack_from(buf, pos)
+    pos += _SIZE_ENCODING.size
+    if wt != _WIDTH or ht != _HEIGHT or et != _ENCODING or elen >= 0x80:
+        return None
+    encoding = str(buf[pos:pos + elen], "utf-8")
+    pos += elen
+    if pos + _STEP_DATA.size > n:
+        return None
+    st, step, dt = _STEP_DATA.unpack_from(buf, pos)
+    if st != _STEP or dt != _DATA:
+        return None
+    size, pos = _varint(buf, pos + _STEP_DATA.size)
+    end = pos + size
+    if end > n:
+        return None
+    data = buf[pos:end]
+    frame_id = ""
+    if end < n:
+        if buf[end] != _FRAME_ID or end + 2 + buf[end + 1] != n or buf[end + 1] >= 0x80:
+            return None
+        frame_id = str(buf[end + 2:n], "utf-8")
+    return RawImageView(frame_id, width, height, encoding, step, data)
+
+
 def parse_raw_image(buf: memoryview) -> RawImageView | None:
     """The image in ``buf`` (protobuf ``foxglove.RawImage`` bytes), or None when they are
     not a plain, well-formed encoding of one (module doc)."""
+    try:
+        fast = _in_field_order(buf)
+    except (IndexError, ValueError):  # cut short, too long a varint, not UTF-8
+        fast = None
+    return fast if fast is not None else _any_order(buf)
+
+
+def _any_order(buf: memoryview) -> RawImageView | None:
+    """:func:`parse_raw_image`, fields in any order."""
     width = height = step = 0
     encoding = frame_id = ""
     data = buf[0:0]

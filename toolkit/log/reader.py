@@ -13,6 +13,7 @@ from the ``/tf`` transforms (world -> ... -> camera) in force at that time.
 
 from __future__ import annotations
 
+import bisect
 import io
 import json
 import os
@@ -21,16 +22,18 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any, TypeVar, overload
 
+from mcap.data_stream import ReadDataStream
 from mcap.exceptions import InvalidMagic, McapError
 from mcap.reader import SeekingReader
-from mcap.records import Attachment, Channel, Message, Schema
+from mcap.records import Attachment, Channel, Message, MessageIndex, Schema
 from mcap.summary import Summary
 
 from sgtool.errors import LogFormatError, MissingChannelError, SchemaVersionError, SgtoolError
+from sgtool.log import chunk_stream as cs
 from sgtool.log import codec
 from sgtool.log import schemas as S
 from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler, TransformBuffer, decoded
-from sgtool.log.chunk_stream import ordered_messages
+from sgtool.log.chunk_copy import RawChunk, raw_chunk
 from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.log.image_wire import parse_raw_image
 from sgtool.log.records import RECORD_TYPES, LogRecord
@@ -153,6 +156,7 @@ class LogReader:
                 f"{self.path}` says what is readable") from None
         self._decoders: dict[int, Any] = {}
         self._frame_times: list[int] | None = None
+        self._buffers = cs.ChunkBuffers()  # chunks decompressed for views, reused
         if check_version:
             self.check_version()
 
@@ -374,6 +378,18 @@ class LogReader:
         order); :meth:`decode` decodes one."""
         yield from self._checked(self._iter(list(topics) if topics is not None else None))
 
+    def chunks(self, *, views: bool = False) -> Iterator[tuple[RawChunk | None, list[cs.Item]]]:
+        """Each chunk in file order, as it is (:func:`~sgtool.log.chunk_copy.raw_chunk`: None
+        when its indexes do not allow a copy) with its messages in log-time order (that of
+        :meth:`raw_messages` when :func:`~sgtool.log.chunk_copy.in_sequence`)."""
+        def each() -> Iterator[tuple[RawChunk | None, list[cs.Item]]]:
+            for ci in sorted(self.summary.chunk_indexes, key=lambda c: c.chunk_start_offset):
+                record = cs.read_chunk(self._f, ci)
+                data = cs.chunk_data(record, ci, self.verify, self._buffers if views else None)
+                items = cs.chunk_messages(data, ci, self.summary, views)
+                yield raw_chunk(self._f, ci, record), items
+        return self._checked(each())
+
     def _iter(self, topics: list[str] | None, *, start_ns: int | None = None,
               end_ns: int | None = None, reverse: bool = False, views: bool = False
               ) -> Iterator[tuple[Schema | None, Channel, Message]]:
@@ -381,8 +397,9 @@ class LogReader:
         (:mod:`sgtool.log.chunk_stream`) when the file is chunked and read forwards, else
         through the ``mcap`` reader."""
         if self.summary.chunk_indexes and not reverse:
-            return ordered_messages(self._f, self.summary, topics, start_ns=start_ns,
-                                    end_ns=end_ns, verify=self.verify, views=views)
+            return cs.ordered_messages(self._f, self.summary, topics, start_ns=start_ns,
+                                    end_ns=end_ns, verify=self.verify, views=views,
+                                    buffers=self._buffers)
         return self._reader.iter_messages(topics=topics, starting_at=start_ns,
                                           ending_before=end_ns, log_time_order=True,
                                           reverse=reverse)
@@ -414,10 +431,6 @@ class LogReader:
         return self._frame_times
 
     def _index_times(self, topic: str) -> list[int]:
-
-        from mcap.data_stream import ReadDataStream
-        from mcap.records import MessageIndex
-
         cids = {cid for cid, ch in self.summary.channels.items() if ch.topic == topic}
         times: list[int] = []
         for ci in self.summary.chunk_indexes:
@@ -443,8 +456,6 @@ class LogReader:
         """The frame at or before ``t_ns`` (None before the first frame), found through the
         MCAP chunk index without reading the log from the start."""
         self.require(S.DEPTH, why="frames need depth images")
-        import bisect
-
         times = self.frame_times()
         i = bisect.bisect_right(times, int(t_ns)) - 1
         t_frame = times[i] if i >= 0 else None
@@ -476,8 +487,6 @@ class LogReader:
         return tf, calib
 
     def _frame_index_before(self, t_ns: int) -> int:
-        import bisect
-
         return bisect.bisect_left(self.frame_times(), t_ns)
 
     # ----- end --------------------------------------------------------------------------

@@ -31,13 +31,14 @@ from pathlib import Path
 from typing import IO, Any, overload
 
 import numpy as np
+from mcap.summary import Summary
 from mcap.writer import CompressionType, Writer
 from mcap_protobuf.schema import build_file_descriptor_set
 
 from sgtool import __version__
 from sgtool.errors import SgtoolError
 from sgtool.files import concerns, output_error, temp_beside
-from sgtool.log import codec
+from sgtool.log import chunk_copy, codec
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.records import RECORD_TYPES, LogRecord
@@ -114,6 +115,7 @@ class LogWriter:
         except OSError as e:
             raise output_error(e, self.path) from None
         self._stream: IO[bytes] = os.fdopen(fd, "wb")
+        self._compression = "" if compression == "none" else compression
         self._closed = False
         self.message_count = 0
         try:
@@ -172,7 +174,8 @@ class LogWriter:
         self._channels[kind.topic] = cid
         return cid
 
-    def _add(self, cid: int, t_ns: int, data: bytes) -> None:
+    def _add(self, cid: int, t_ns: int, data: bytes, sequence: int | None = None,
+             publish_ns: int | None = None) -> None:
         if self._closed:
             raise RuntimeError("log writer is closed")
         t_ns = int(t_ns)
@@ -188,8 +191,8 @@ class LogWriter:
         seq = self._sequence.get(cid, 0)
         self._sequence[cid] = seq + 1
         self._mcap.add_message(
-            channel_id=cid, log_time=t_ns, publish_time=t_ns, data=data, sequence=seq
-        )
+            channel_id=cid, log_time=t_ns, publish_time=t_ns if publish_ns is None else publish_ns,
+            data=data, sequence=seq if sequence is None else sequence)
         self.message_count += 1
 
     def copy_channel(self, topic: str, schema_name: str, schema_encoding: str,
@@ -214,9 +217,42 @@ class LogWriter:
         self._channels[topic] = cid
         return cid
 
-    def write_raw(self, channel_id: int, t_ns: int, data: bytes) -> None:
-        """Write already encoded message bytes on a channel of :meth:`copy_channel`."""
-        self._add(channel_id, t_ns, data)
+    def write_raw(self, channel_id: int, t_ns: int, data: bytes, sequence: int | None = None,
+                  publish_ns: int | None = None) -> None:
+        """Write already encoded message bytes on a channel of :meth:`copy_channel` (or
+        :meth:`copy_channels`); sequence number and publish time default to this writer's
+        count of the channel's messages and the log time."""
+        self._add(channel_id, t_ns, data, sequence, publish_ns)
+
+    def copy_channels(self, summary: Summary) -> bool:
+        """Register every schema and channel of another log's ``summary`` under its own
+        id, for :meth:`copy_chunk` and :meth:`write_raw`. False, and nothing registered,
+        when this writer has channels already, two channels share a topic, or the ids are
+        not 1..N (:func:`~sgtool.log.chunk_copy.ids_problem`)."""
+        topics = {ch.topic for ch in summary.channels.values()}
+        if (self._schemas or self._channels or len(topics) != len(summary.channels)
+                or chunk_copy.ids_problem(summary)):
+            return False
+        for sid, schema in sorted(summary.schemas.items()):
+            self._schemas[f"copied\0{sid}"] = self._mcap.register_schema(
+                name=schema.name, encoding=schema.encoding, data=bytes(schema.data))
+        for _, ch in sorted(summary.channels.items()):
+            self._channels[ch.topic] = self._mcap.register_channel(
+                topic=ch.topic, message_encoding=ch.message_encoding, schema_id=ch.schema_id,
+                metadata=dict(ch.metadata))
+        return True
+
+    def copy_chunk(self, chunk: chunk_copy.RawChunk) -> bool:
+        """Write a chunk of another log as it is (:mod:`sgtool.log.chunk_copy`), after the
+        messages written so far; its channels must come from :meth:`copy_channels`. False
+        (nothing written) when it is not compressed as this log is."""
+        if self._closed:
+            raise RuntimeError("log writer is closed")
+        if chunk.index.compression != self._compression:
+            return False
+        chunk_copy.append_chunk(self._mcap, self._stream, chunk)
+        self.message_count += sum(chunk.counts.values())
+        return True
 
     # ----- generic ----------------------------------------------------------------------
     def write_proto(self, topic: str, t_ns: int, msg: Any) -> None:

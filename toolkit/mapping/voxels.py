@@ -198,7 +198,7 @@ class VoxelMap:
 
     def labels_of(self, ids: np.ndarray) -> np.ndarray:
         """Label indices of instance ids (new ids get the next indices, in sorted order)."""
-        ids = ids.astype(np.int64, copy=False)
+        ids = ids if ids.dtype.kind in "iu" else ids.astype(np.int64)  # ints index as they are
         if ids.size == 0:
             return np.zeros(0, dtype=np.int64)
         lo, hi = int(ids.min()), int(ids.max())

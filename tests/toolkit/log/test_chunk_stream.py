@@ -6,13 +6,16 @@ from __future__ import annotations
 import random
 
 import pytest
+import zstandard
+from mcap.data_stream import RecordBuilder
 from mcap.reader import SeekingReader
+from mcap.records import Chunk, ChunkIndex
 from mcap.writer import CompressionType, Writer
 from support.logfixtures import write_log
 
 from sgtool.errors import LogFormatError
 from sgtool.log import LogReader
-from sgtool.log.chunk_stream import ordered_messages
+from sgtool.log.chunk_stream import ChunkBuffers, ChunkError, chunk_data, ordered_messages
 
 
 def _overlapping_log(path, seed: int, compression: CompressionType) -> None:
@@ -89,3 +92,61 @@ def test_replay_verify_flag_refuses_a_damaged_chunk(tmp_path):
     assert res.exit_code == 2 and "Traceback" not in res.output and "doctor" in res.output
     assert len(res.output.strip().splitlines()) == 1 and "CRC" in res.output
     assert not out.exists() and not list(tmp_path.glob("d.mcap*"))
+
+
+def test_buffers_are_reused_only_when_no_view_of_them_lives():
+    pool = ChunkBuffers(keep=2)
+    a = pool.take(100)
+    view = memoryview(a)[10:20]  # what a message's data is
+    del a
+    b = pool.take(50)
+    assert b is not None and len(b) == 50  # the second buffer
+    assert pool.take(10) is None  # both taken: the caller decompresses into a new one
+    del view
+    c = pool.take(200)  # the first one again, grown
+    assert c is not None and len(c) == 200
+    assert pool.take(10) is None  # ``b`` still lives
+    del b, c
+    assert pool.take(10) is not None
+    assert ChunkBuffers(max_bytes=1000).take(1001) is None  # huge chunks: not kept
+
+
+@pytest.mark.parametrize("compression", [CompressionType.ZSTD, CompressionType.LZ4])
+def test_views_into_reused_buffers_keep_their_bytes(tmp_path, compression):
+    path = tmp_path / "o.mcap"
+    _overlapping_log(path, 4, compression)
+    with open(path, "rb") as f:
+        r = SeekingReader(f)
+        s = r.get_summary()
+        want = _view(r.iter_messages(log_time_order=True))
+        pool = ChunkBuffers(keep=3)
+        # every view kept to the end: the pool runs dry and falls back to fresh buffers
+        kept = list(ordered_messages(f, s, views=True, buffers=pool))
+        assert all(isinstance(m.data, memoryview) for _, _, m in kept)
+        assert _view(kept) == want
+        # views dropped as they are read: buffers are reused, bytes still right
+        got = [(c.topic, m.log_time, m.sequence, bytes(m.data))
+               for _, c, m in ordered_messages(f, s, views=True, buffers=pool)]
+        assert got == want
+
+
+def _zstd_chunk(body: bytes, size: int) -> tuple[bytes, ChunkIndex]:
+    """A zstd chunk record of ``body`` whose header says ``size`` bytes, and its index."""
+    comp = zstandard.compress(body)
+    b = RecordBuilder()
+    Chunk(message_start_time=0, message_end_time=0, uncompressed_size=size,
+          uncompressed_crc=0, compression="zstd", data=comp).write(b)
+    raw = b.end()
+    return raw, ChunkIndex(message_start_time=0, message_end_time=0, chunk_start_offset=0,
+                           chunk_length=len(raw), message_index_offsets={},
+                           message_index_length=0, compression="zstd",
+                           compressed_size=len(comp), uncompressed_size=size)
+
+
+def test_a_zstd_chunk_longer_or_shorter_than_its_header_says_is_damage():
+    body = bytes(range(200)) * 3
+    for pool in (None, ChunkBuffers()):
+        assert bytes(chunk_data(*_zstd_chunk(body, 600), False, pool)) == body
+        for size in (599, 601):
+            with pytest.raises((ChunkError, zstandard.ZstdError)):
+                chunk_data(*_zstd_chunk(body, size), False, pool)

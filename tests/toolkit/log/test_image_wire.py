@@ -93,3 +93,30 @@ def test_frames_read_through_views_equal_frames_from_protobuf_messages():
             assert x.dtype == y.dtype and np.array_equal(x, y)
         assert a.rgb.flags.owndata  # copied out of the chunk: keeping a frame keeps no chunk
         assert a.intrinsics == b.intrinsics
+
+
+def test_the_field_order_shortcut_equals_the_general_parse():
+    from sgtool.log.image_wire import _any_order, _in_field_order
+
+    rng = np.random.default_rng(2)
+    seen = 0
+    for enc, shape, dtype, frame_id, t in [
+            ("rgb8", (6, 5, 3), np.uint8, "camera", 7), ("16UC1", (70, 90), np.uint16, "", 0),
+            ("32SC1", (2, 3), np.int32, "x" * 200, 1 << 40)]:  # long id: not the shortcut
+        arr = rng.integers(0, 200, shape).astype(dtype)
+        buf = memoryview(codec.encode_image(t, arr, enc, frame_id).SerializeToString())
+        fast = _in_field_order(buf)
+        assert _any_order(buf) == parse_raw_image(buf)
+        if fast is not None:
+            seen += 1
+            assert fast == _any_order(buf)
+            assert bytes(fast.data) == arr.tobytes()
+        else:
+            assert len(frame_id) >= 0x80
+    assert seen == 2
+    # fields out of protobuf's order are left to the general parse
+    msg = codec.encode_image(7, np.zeros((2, 2), np.uint8), "mono8", "cam").SerializeToString()
+    head = msg.index(b"\x15")  # width, then height: swap the two fixed32 fields
+    swapped = msg[:head] + msg[head + 5:head + 10] + msg[head:head + 5] + msg[head + 10:]
+    assert _in_field_order(memoryview(swapped)) is None
+    assert _any_order(memoryview(swapped)) == parse_raw_image(memoryview(msg))
