@@ -14,12 +14,21 @@ Targets (issue 20): median <= 25 ms at 16 rooms and <= 40 ms at 30 rooms, max <=
 median after the first refresh, first refresh <= 50 ms.
 
 Usage: ``python benchmarks/refresh_scaling.py [--rooms 4,8,16,30] [--seed 3]``
+
+Side by side with an older tree (``--against DIR``, e.g. ``git -C . archive HEAD | tar -x
+-C DIR``): each round runs the benchmark once per tree, each in a fresh process (the older
+tree imported through a shadow package on ``PYTHONPATH``, as ``benchmarks/side_by_side.py``
+does), the order alternating between rounds (``--rounds``, default 2); printed per tree the
+median over rounds of every figure, then base / this tree for the median refresh.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -58,7 +67,12 @@ def main(argv: list[str] | None = None) -> int:
                     "wall time")
     ap.add_argument("--cache", type=Path,
                     default=Path(tempfile.gettempdir()) / "sgtool-bench-replay")
+    ap.add_argument("--against", type=Path, help="an older source tree, run side by side")
+    ap.add_argument("--rounds", type=int, default=2, help="rounds with --against")
+    ap.add_argument("--json", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
+    if a.against is not None:
+        return side_by_side(a)
     if a.clock == "cpu":
         SceneGraphBuilder.clock = staticmethod(time.thread_time)
         # an older tree (run side by side through PYTHONPATH) reads time.perf_counter
@@ -82,12 +96,57 @@ def main(argv: list[str] | None = None) -> int:
         stages = {s: statistics.median(t[s]) for s in STAGES if t.get(s)}
         rows.append((n, rep.frames, len(ref), ref[0], med, mx, sum(ref) / 1e3,
                      statistics.median(t["integrate"]), stages, cpu))
+    if a.json:
+        print(json.dumps(rows))
+    else:
+        table(rows)
+    return 0
+
+
+def table(rows: list) -> None:  # type: ignore[type-arg]
     print(f"{'rooms':>5}{'frames':>7}{'refr':>6}{'first ms':>9}{'median':>8}{'max':>8}"
           f"{'max/med':>8}{'sum s':>7}{'integ ms':>9}{'cpu s':>7}  stage medians (ms)")
     for n, fr, cnt, first, med, mx, total, integ, stages, cpu in rows:
         st = " ".join(f"{k} {v:.1f}" for k, v in stages.items())
         print(f"{n:>5}{fr:>7}{cnt:>6}{first:>9.1f}{med:>8.1f}{mx:>8.1f}{mx / med:>8.2f}"
               f"{total:>7.2f}{integ:>9.2f}{cpu:>7.1f}  {st}")
+
+
+def side_by_side(a: argparse.Namespace) -> int:
+    """Alternating rounds of this benchmark with this tree and with ``a.against``."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from side_by_side import shadow_package  # noqa: PLC0415
+
+    pkg = shadow_package(a.against.resolve(), Path(tempfile.mkdtemp(prefix="refresh-base-")))
+    args = [sys.executable, str(Path(__file__).resolve()), "--json", "--rooms", a.rooms,
+            "--seed", str(a.seed), "--fps", str(a.fps), "--clock", a.clock,
+            "--cache", str(a.cache)]
+    trees = {"this tree": None, "base": str(pkg)}
+    got: dict[str, list[list]] = {k: [] for k in trees}  # type: ignore[type-arg]
+    for r in range(a.rounds):
+        for name in (list(trees) if r % 2 == 0 else list(trees)[::-1]):
+            env = dict(os.environ)
+            if trees[name]:
+                env["PYTHONPATH"] = trees[name] + os.pathsep + env.get("PYTHONPATH", "")
+            out = subprocess.run(args, env=env, capture_output=True, text=True, check=True)
+            got[name].append(json.loads(out.stdout.strip().splitlines()[-1]))
+            print(f"round {r + 1} {name}: median ms "
+                  + " ".join(f"{row[0]}r {row[4]:.1f}" for row in got[name][-1]),
+                  file=sys.stderr)
+    med: dict[str, list] = {}  # type: ignore[type-arg]
+    for name, runs in got.items():
+        rows = []
+        for i, first in enumerate(runs[0]):
+            per = [run[i] for run in runs]
+            fig = [statistics.median(row[j] for row in per) for j in range(1, 8)]
+            stages = {k: statistics.median(row[8][k] for row in per) for k in first[8]}
+            rows.append([first[0], *fig, stages, statistics.median(row[9] for row in per)])
+        med[name] = rows
+        print(f"{name} (median of {a.rounds} rounds):")
+        table(rows)
+    print("median refresh, base / this tree: " + ", ".join(
+        f"{b[0]} rooms {b[4]:.1f} / {t[4]:.1f} = {b[4] / t[4]:.2f}x"
+        for b, t in zip(med["base"], med["this tree"], strict=True)))
     return 0
 
 

@@ -120,6 +120,10 @@ class ColumnGrid:
         self.config = config
         self.flags = np.zeros((0, 0), dtype=np.uint8)
         self.extent: tuple[int, int, int, int] | None = None  # ix0, iy0, ix1, iy1
+        # the robot footprint of the trajectory points seen so far, over ``extent``:
+        # (extent, those points, the mask); only new points are stamped while it holds
+        self._footprint: tuple[tuple[int, int, int, int], list[tuple[float, float]],
+                               np.ndarray] | None = None
 
     def _fit(self, sets: Sequence[np.ndarray], trajectory: Sequence[tuple[float, float]]
              ) -> None:
@@ -190,20 +194,43 @@ class ColumnGrid:
         self._fit([], trajectory)
         assert self.extent is not None
         return occupancy_grid(self.flags, self.extent, self.resolution, self.config,
-                              trajectory, level)
+                              trajectory, level, self._footprint_of(trajectory))
+
+    def _footprint_of(self, trajectory: Sequence[tuple[float, float]]) -> np.ndarray:
+        """:func:`footprint` of ``trajectory`` over the current extent, stamping only the
+        points added since the last call when the extent and the earlier points are the
+        same (a union of disks: the same cells as stamping them all)."""
+        assert self.extent is not None
+        points = list(trajectory)
+        got = self._footprint
+        shape = self.flags.shape
+        if got is not None and got[0] == self.extent and points[:len(got[1])] == got[1]:
+            mask = got[2]
+            new = points[len(got[1]):]
+            if new:
+                mask = mask | footprint(new, self.extent, shape, self.resolution,
+                                        self.config.robot_radius)
+        else:
+            mask = footprint(points, self.extent, shape, self.resolution,
+                             self.config.robot_radius)
+        mask.setflags(write=False)
+        self._footprint = (self.extent, points, mask)
+        return mask
 
 
 def occupancy_grid(flags: np.ndarray, extent: tuple[int, int, int, int], resolution: float,
                    config: BevConfig, trajectory: Sequence[tuple[float, float]] = (),
-                   level: int = 0) -> OccupancyGrid:
+                   level: int = 0, stamped: np.ndarray | None = None) -> OccupancyGrid:
     """FREE / OCCUPIED / UNKNOWN from column flags (``ColumnGrid.OCC``/``FLOOR``) over the
-    voxel-index ``extent``, with the robot footprint along ``trajectory`` and small holes
-    filled."""
+    voxel-index ``extent``, with the robot footprint along ``trajectory`` (``stamped``:
+    that footprint, when the caller has it) and small holes filled."""
     ix0, iy0 = extent[0], extent[1]
     h, w = flags.shape
     grid = np.full((h, w), UNKNOWN, dtype=np.int8)
     grid[(flags & (ColumnGrid.FLOOR | ColumnGrid.CARVED)) != 0] = FREE
-    if len(trajectory):
+    if stamped is not None:
+        grid[stamped] = FREE
+    elif len(trajectory):
         grid[footprint(trajectory, extent, (h, w), resolution, config.robot_radius)] = FREE
     grid[(flags & ColumnGrid.OCC) != 0] = OCCUPIED
     fill_holes(grid, int(config.max_hole / resolution**2))

@@ -39,7 +39,9 @@ gives the same graph.
 from __future__ import annotations
 
 import math
+from bisect import bisect_left
 from dataclasses import dataclass, field
+from itertools import chain
 
 import networkx as nx
 import numpy as np
@@ -48,6 +50,13 @@ from scipy.sparse.csgraph import connected_components
 
 from sgtool.mapping.esdf import distance_field, obstacles
 from sgtool.mapping.grid import OccupancyGrid
+from sgtool.mapping.ridge_chains import _trace_chains
+from sgtool.mapping.ridge_window import (
+    RidgeFields,
+    ridge_fields,
+    ridge_from_fields,
+    update_fields,
+)
 
 _SQRT2 = math.sqrt(2.0)
 
@@ -65,9 +74,10 @@ class VoronoiConfig:
 class VoronoiGraph:
     """The sparsified graph. ``graph`` is a networkx Graph on nodes ``0..n-1`` with node
     attributes ``pos`` (x, y), ``clearance`` (m), ``cell`` (row, col) and edge attributes
-    ``weight`` (m along the ridge); the same data is in the arrays."""
+    ``weight`` (m along the ridge); the same data is in the arrays, which is what the
+    pipeline uses: the networkx view is built from them on first use (``built`` None)."""
 
-    graph: nx.Graph
+    built: nx.Graph | None
     positions: np.ndarray  # (n, 2) world x, y
     clearance: np.ndarray  # (n,) m
     cells: np.ndarray  # (n, 2) row, col
@@ -79,6 +89,15 @@ class VoronoiGraph:
 
     def __len__(self) -> int:
         return len(self.positions)
+
+    @property
+    def graph(self) -> nx.Graph:
+        """The networkx view (class doc), built once from the arrays."""
+        if self.built is None:
+            object.__setattr__(self, "built", _networkx_graph(
+                self.positions, self.clearance, self.cells, self.edges, self.lengths))
+        assert self.built is not None
+        return self.built
 
     def csgraph(self, keep: np.ndarray | None = None) -> csr_matrix:
         """Symmetric sparse adjacency (weights in m); ``keep`` masks edges."""
@@ -123,34 +142,7 @@ def _ridge_cells_whole(free: np.ndarray, resolution: float, config: VoronoiConfi
     """:func:`ridge_cells` over the whole of ``free``."""
     dist_m, feat = distance_field(~free, resolution, with_features=True)
     assert feat is not None
-    h, w = free.shape
-    ridge = np.zeros((h, w), dtype=bool)
-    ok = free & (dist_m >= config.min_clearance)
-    fr = feat[0].astype(np.int32).ravel()
-    fc = feat[1].astype(np.int32).ravel()
-    dflat = dist_m.ravel() / resolution
-    okf = ok.ravel()
-    min_sep = config.min_ridge / resolution
-    for step in (1, w):  # right and down neighbours in flat indices
-        a = np.flatnonzero(okf[:-step] & okf[step:])
-        if step == 1:
-            a = a[(a % w) != w - 1]  # no wrap-around between rows
-        b = a + step
-        sep2 = (fr[a] - fr[b]) ** 2 + (fc[a] - fc[b]) ** 2
-        thr = np.maximum(min_sep, config.ridge_ratio * np.minimum(dflat[a], dflat[b]))
-        keep = sep2 > thr * thr
-        a, b = a[keep], b[keep]
-        if a.size == 0:
-            continue
-        # imbalance: how much farther the other cell's obstacle is than one's own
-        ra, ca = np.divmod(a, w)
-        rb, cb = np.divmod(b, w)
-        imb_a = np.hypot(ra - fr[b], ca - fc[b]) - dflat[a]
-        imb_b = np.hypot(rb - fr[a], cb - fc[a]) - dflat[b]
-        pick_a = imb_a <= imb_b
-        ridge.ravel()[a[pick_a]] = True
-        ridge.ravel()[b[~pick_a]] = True
-    return ridge, dist_m
+    return ridge_from_fields(free, dist_m, feat, resolution, config), dist_m
 
 
 def _zhang_suen_tables() -> tuple[np.ndarray, np.ndarray]:
@@ -235,85 +227,62 @@ def _pixel_graph(mask: np.ndarray) -> tuple[np.ndarray, csr_matrix]:
     return flat, adj
 
 
-def _reverse_entries(adj: csr_matrix) -> np.ndarray:
-    """For each stored entry (i, j) of a symmetric CSR matrix with sorted indices, the
-    position of the entry (j, i)."""
-    n = adj.shape[0]
-    rows = np.repeat(np.arange(n, dtype=np.int64), np.diff(adj.indptr))
-    cols = adj.indices.astype(np.int64)
-    return np.searchsorted(rows * n + cols, cols * n + rows)
-
-
-def _trace_chains(adj: csr_matrix) -> list[tuple[list[int], list[float]]]:
-    """Chains between key pixels (degree != 2) as (pixel list, cumulative length in cells
-    along it), each once; loops without a key pixel start at their lowest pixel. (A step
-    is marked walked in both directions by its CSR entry and the reverse entry's.)"""
-    indptr = adj.indptr.tolist()
-    indices = adj.indices.tolist()
-    data = adj.data.tolist()
-    rev = _reverse_entries(adj).tolist()
-    deg = np.diff(adj.indptr)
-    two = (deg == 2).tolist()
-    used = bytearray(len(indices))
-    chains: list[tuple[list[int], list[float]]] = []
-
-    def walk(start: int, k: int) -> None:
-        if used[k]:
-            return
-        path = [start]
-        cum = [0.0]
-        total = 0.0
-        prev = start
-        while True:
-            cur = indices[k]
-            used[k] = 1
-            used[rev[k]] = 1
-            total += data[k]
-            path.append(cur)
-            cum.append(total)
-            if not two[cur] or cur == start:
-                break
-            a = indptr[cur]
-            k = a + 1 if indices[a] == prev else a
-            prev = cur
-            if used[k]:
-                break
-        chains.append((path, cum))
-
-    for p in np.flatnonzero(deg != 2).tolist():
-        for k in range(indptr[p], indptr[p + 1]):
-            walk(p, k)
-    for p in np.flatnonzero(deg == 2).tolist():  # pure loops
-        k = indptr[p]
-        if not used[k]:
-            walk(p, k)
-    return chains
-
-
 @dataclass(frozen=True, eq=False)
 class RidgeGraph:
     """The thinned ridge as a pixel graph, before choosing a component (what depends on
-    the occupancy grid only; the builder caches it while the grid does not change)."""
+    the free cells only; the builder caches it while they do not change, and the next
+    one is computed from it: :mod:`sgtool.mapping.ridge_window`)."""
 
     ridge: np.ndarray  # bool grid
     clearance: np.ndarray  # m per cell
     flat: np.ndarray  # flat cell index of each ridge pixel, raster order
     adj: csr_matrix  # pixel adjacency, step lengths in cells
     component: np.ndarray  # component label per pixel
+    fields: RidgeFields | None = None  # what the ridge was computed from
 
 
-def ridge_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None) -> RidgeGraph:
-    """Steps 1-2 of the module doc: ridge cells, thinning, pixel graph, components."""
+def ridge_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
+                previous: RidgeGraph | None = None) -> RidgeGraph:
+    """Steps 1-2 of the module doc: ridge cells, thinning, pixel graph, components.
+    ``previous``: the ridge graph of an earlier grid of the same size; the distance field
+    and the ridge cells are then recomputed only around the cells whose freedom changed
+    (:func:`sgtool.mapping.ridge_window.update_fields`; the same result)."""
     cfg = config or VoronoiConfig()
     free = ~obstacles(occ)
-    ridge0, dist_m = ridge_cells(free, occ.resolution, cfg)
-    ridge = thin(ridge0)
+    fields = None
+    if previous is not None and previous.fields is not None:
+        fields = update_fields(previous.fields, free, occ.resolution, cfg)
+    if fields is None:
+        fields = ridge_fields(free, occ.resolution, cfg)
+    ridge = thin(fields.ridge0)
     flat, adj = _pixel_graph(ridge)
     if len(flat):
         _, comp = connected_components(adj, directed=False)
     else:
         comp = np.zeros(0, dtype=np.int32)
-    return RidgeGraph(ridge, dist_m, flat, adj, comp)
+    return RidgeGraph(ridge, fields.dist_m, flat, adj, comp, fields)
+
+
+def submatrix(graph: csr_matrix, nodes: np.ndarray, where: np.ndarray | None = None
+              ) -> csr_matrix:
+    """``graph[nodes][:, nodes]`` for sorted ``nodes`` of a CSR matrix with sorted
+    indices, the same arrays in the same order, without scipy's general fancy indexing
+    (called per room and per refresh, its overhead dominated); ``where``: scratch space of
+    the matrix's size, -1 everywhere (as it is left)."""
+    if where is None:
+        where = np.full(graph.shape[0], -1, dtype=np.int64)
+    k = len(nodes)
+    where[nodes] = np.arange(k)
+    start, stop = graph.indptr[nodes], graph.indptr[nodes + 1]
+    count = stop - start
+    entry = np.repeat(start - np.concatenate([[0], np.cumsum(count)[:-1]]), count) + np.arange(
+        int(count.sum()))
+    col = where[graph.indices[entry]]
+    ok = col >= 0
+    row_len = np.bincount(np.repeat(np.arange(k), count)[ok], minlength=k)
+    indptr = np.concatenate([[0], np.cumsum(row_len)])
+    where[nodes] = -1
+    return csr_matrix((graph.data[entry[ok]], col[ok], indptr), shape=(k, k))
 
 
 def chosen_component(occ: OccupancyGrid, rg: RidgeGraph,
@@ -341,7 +310,7 @@ def voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
     res = occ.resolution
     dist_m = rg.clearance
     h, w = rg.ridge.shape
-    empty = VoronoiGraph(nx.Graph(), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2), np.int64),
+    empty = VoronoiGraph(None, np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2), np.int64),
                          np.zeros((0, 2), np.int64), np.zeros(0), (), rg.ridge, (h, w))
     if len(rg.flat) == 0:
         return empty
@@ -349,19 +318,19 @@ def voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
     target = chosen_component(occ, rg, anchor)
     keep = np.flatnonzero(comp == target)
     flat = flat[keep]
-    adj = adj[keep][:, keep].tocsr()
-    adj.sort_indices()
+    adj = submatrix(adj, keep)
     chains = _trace_chains(adj)
     n = adj.shape[0]
     deg = np.diff(adj.indptr)
     # drop short spurs (leaf chains ending at a junction)
     spur = cfg.min_spur / res
+    degree = deg.tolist()
     kept: list[tuple[list[int], list[float]]] = []
     for path, cum in chains:
         length = cum[-1]
-        a, b = path[0], path[-1]
-        leaf = deg[a] == 1 or deg[b] == 1
-        junction = deg[a] >= 3 or deg[b] >= 3
+        da, db = degree[path[0]], degree[path[-1]]
+        leaf = da == 1 or db == 1
+        junction = da >= 3 or db >= 3
         if leaf and junction and length < spur:
             continue
         kept.append((path, cum))
@@ -378,50 +347,58 @@ def voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
         elif (min(a, b), max(a, b)) in pairs and k < 2:
             k = 2
         pairs.add((min(a, b), max(a, b)))
-        cum_arr = np.asarray(cum)
+        last = len(path) - 1
         cuts = [0]
-        for i in range(1, k):
-            target_len = length * i / k
-            j = int(np.searchsorted(cum_arr, target_len))
-            j = min(max(j, cuts[-1] + 1), len(path) - 1)
-            if j < len(path) - 1:
+        for i in range(1, k):  # the first cumulative length reaching each even spacing
+            j = min(max(bisect_left(cum, length * i / k), cuts[-1] + 1), last)
+            if j < last:
                 cuts.append(j)
-        cuts.append(len(path) - 1)
+        cuts.append(last)
         for s0, s1 in zip(cuts[:-1], cuts[1:], strict=True):
-            seg = path[s0:s1 + 1]
-            segs.append((seg, float(cum_arr[s1] - cum_arr[s0])))
-            node_px.add(seg[0])
-            node_px.add(seg[-1])
+            segs.append((path[s0:s1 + 1], cum[s1] - cum[s0]))
+            node_px.add(path[s0])
+            node_px.add(path[s1])
     if not segs:
         node_px = {0} if n else set()  # a lone ridge cell
-    order = sorted(node_px, key=lambda p: int(flat[p]))
+    order = sorted(node_px)  # pixels are numbered in raster order of their cells
     node_id = {p: i for i, p in enumerate(order)}
     cells_flat = flat[np.asarray(order, dtype=np.int64)]
     rows, cols = np.divmod(cells_flat, w)
     xs, ys = occ.center_of(rows, cols)
     positions = np.stack([xs, ys], axis=1)
     clearance = dist_m[rows, cols]
-    edge_map: dict[tuple[int, int], tuple[float, np.ndarray]] = {}
+    best: dict[tuple[int, int], tuple[float, list[int]]] = {}
     for seg, length in segs:
         u, v = node_id[seg[0]], node_id[seg[-1]]
         if u == v:
             continue
         key = (min(u, v), max(u, v))
-        cells = flat[np.asarray(seg if u < v else seg[::-1], dtype=np.int64)]
         lm = length * res
-        if key not in edge_map or lm < edge_map[key][0]:
-            edge_map[key] = (lm, cells)
+        if key not in best or lm < best[key][0]:
+            best[key] = (lm, seg if u < v else seg[::-1])
+    edge_map: dict[tuple[int, int], tuple[float, np.ndarray]] = {}
+    if best:  # the cells of the chosen segments, gathered at once
+        pix = [seg for _, seg in best.values()]
+        cells_all = flat[np.fromiter(chain.from_iterable(pix), dtype=np.int64)]
+        bounds = np.cumsum([0] + [len(p) for p in pix]).tolist()
+        for i, (key, (lm, _)) in enumerate(best.items()):
+            edge_map[key] = (lm, cells_all[bounds[i]:bounds[i + 1]])
     keys = sorted(edge_map)
     edges = np.asarray(keys, dtype=np.int64).reshape(-1, 2)
     lengths = np.asarray([edge_map[k][0] for k in keys], dtype=np.float64)
     edge_cells = tuple(edge_map[k][1] for k in keys)
+    return VoronoiGraph(None, positions, clearance, np.stack([rows, cols], axis=1), edges,
+                        lengths, edge_cells, rg.ridge, (h, w))
+
+
+def _networkx_graph(positions: np.ndarray, clearance: np.ndarray, cells: np.ndarray,
+                    edges: np.ndarray, lengths: np.ndarray) -> nx.Graph:
     g = nx.Graph()
     g.add_nodes_from(
         (i, {"pos": (x, y), "clearance": c, "cell": (r, q)})
         for i, (x, y, c, r, q) in enumerate(zip(
             positions[:, 0].tolist(), positions[:, 1].tolist(), clearance.tolist(),
-            rows.tolist(), cols.tolist(), strict=True)))
-    g.add_edges_from((u, v, {"weight": lm}) for (u, v), lm in zip(keys, lengths.tolist(),
-                                                                     strict=True))
-    return VoronoiGraph(g, positions, clearance, np.stack([rows, cols], axis=1), edges,
-                        lengths, edge_cells, rg.ridge, (h, w))
+            cells[:, 0].tolist(), cells[:, 1].tolist(), strict=True)))
+    g.add_edges_from((u, v, {"weight": lm}) for (u, v), lm in zip(
+        edges.tolist(), lengths.tolist(), strict=True))
+    return g

@@ -19,7 +19,12 @@ alone. Candidates are nodes that have a room; with none within 2.5 m the nearest
 labelled node is the only candidate.
 
 Graph distances come from one Dijkstra per distinct viewpoint node over the sparsified
-graph (hundreds of nodes), not an all-pairs table.
+graph (hundreds of nodes), not an all-pairs table, stopped at ``search_limit`` metres
+(nodes farther are inf; nodes within are reached by the same relaxations, so their
+distances are the unlimited ones bit for bit). An object whose cheapest candidate costs
+less than ``search_limit / u`` has the assignment of an unlimited search (a candidate
+beyond the limit costs at least that much); any other object gets its viewpoint's full
+search. In a large house most searches stop after a few rooms.
 
 Between refreshes most of this repeats: the objects keep their closest viewpoints, the
 map around old viewpoints stops changing, and the graph often stays the same. An
@@ -52,6 +57,7 @@ class AssignConfig:
     unit: float = 0.075  # m: MoMa-LLM's voxel size, the unit of the cost
     exponent: float = 1.3
     line_of_sight: bool = True
+    search_limit: float = 10.0  # m: graph distances searched this far first (module doc)
 
 
 @dataclass(frozen=True)
@@ -66,7 +72,8 @@ class AssignCache:
     builder. ``hits``/``misses`` count reused and computed viewpoint visibilities."""
 
     graph_key: bytes = b""
-    rows: dict[int, np.ndarray] = field(default_factory=dict)  # source node -> distances
+    # (source node, search limit) -> distances
+    rows: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
     sight: dict[tuple[float, float], tuple[bytes, np.ndarray]] = field(default_factory=dict)
     hits: int = 0
     misses: int = 0
@@ -97,7 +104,7 @@ def _sight_key(occ: OccupancyGrid, blocked: np.ndarray, v: tuple[float, float],
                    v)).encode())
     d.update(np.ascontiguousarray(targets, dtype=np.float64).tobytes())
     if cr0 < cr1 and cc0 < cc1:
-        d.update(np.ascontiguousarray(blocked[cr0:cr1, cc0:cc1]).tobytes())
+        d.update(np.packbits(blocked[cr0:cr1, cc0:cc1], axis=1).tobytes())  # bits: 8x fewer bytes
     return d.digest()
 
 
@@ -138,20 +145,44 @@ def _visible_nodes(positions: np.ndarray, near_of: dict[tuple[float, float], np.
 
 
 def _distance_rows(graph: csr_matrix, sources: np.ndarray, n: int,
-                   cache: AssignCache | None) -> np.ndarray:
-    """Dijkstra distances (len(sources), n) from each source, rows reused from the cache
-    while the graph is unchanged."""
+                   cache: AssignCache | None, limit: float = np.inf) -> np.ndarray:
+    """Dijkstra distances (len(sources), n) from each source (inf beyond ``limit``: the
+    search stops there; the distances within it are the unlimited ones, bit for bit),
+    rows reused from the cache while the graph is unchanged."""
     if cache is None:
-        return dijkstra(graph, directed=False, indices=sources).reshape(len(sources), n)
+        return dijkstra(graph, directed=False, indices=sources,
+                        limit=limit).reshape(len(sources), n)
     key = _graph_key(graph)
     if key != cache.graph_key:
         cache.graph_key, cache.rows = key, {}
-    missing = [int(s) for s in sources.tolist() if int(s) not in cache.rows]
+    missing = [int(s) for s in sources.tolist() if (int(s), limit) not in cache.rows]
     if missing:
-        got = dijkstra(graph, directed=False, indices=np.asarray(missing, dtype=np.int64))
+        got = dijkstra(graph, directed=False, indices=np.asarray(missing, dtype=np.int64),
+                       limit=limit)
         for s, row in zip(missing, got.reshape(len(missing), n), strict=True):
-            cache.rows[s] = row
-    return np.stack([cache.rows[int(s)] for s in sources.tolist()])
+            cache.rows[(s, limit)] = row
+    return np.stack([cache.rows[(int(s), limit)] for s in sources.tolist()])
+
+
+def _path_terms(graph: csr_matrix, positions: np.ndarray,
+                near_of: dict[tuple[float, float], np.ndarray],
+                viewpoints: list[tuple[float, float]], n: int, u: float,
+                cache: AssignCache | None, limit: float
+                ) -> dict[tuple[float, float], np.ndarray]:
+    """Per viewpoint vp: min over its nodes v of (d_graph(v, node) + |vp - v|) / u for every
+    node (inf where every d_graph is beyond ``limit``)."""
+    out: dict[tuple[float, float], np.ndarray] = {}
+    if not viewpoints:
+        return out
+    sources = np.unique(np.concatenate([near_of[v] for v in viewpoints]))
+    row_of = np.full(n, -1, dtype=np.int64)
+    row_of[sources] = np.arange(len(sources))
+    dist = _distance_rows(graph, sources, n, cache, limit)
+    for v in viewpoints:
+        vs = near_of[v]
+        start = np.hypot(positions[vs, 0] - v[0], positions[vs, 1] - v[1])
+        out[v] = np.min(dist[row_of[vs]] + start[:, None], axis=0) / u
+    return out
 
 
 def assign_objects(positions: np.ndarray, node_room: np.ndarray, graph: csr_matrix,
@@ -191,17 +222,10 @@ def assign_objects(positions: np.ndarray, node_room: np.ndarray, graph: csr_matr
         if len(near_of[v]) == 0:
             near_of[v] = np.asarray([int(tree_all.query(v)[1])], dtype=np.int64)
     n = len(positions)
-    # path term per distinct viewpoint: min over its nodes v of d_graph(v, n) + |vp - v|
-    path_of: dict[tuple[float, float], np.ndarray] = {}
-    if distinct:
-        sources = np.unique(np.concatenate([near_of[v] for v in distinct]))
-        row_of = np.full(n, -1, dtype=np.int64)
-        row_of[sources] = np.arange(len(sources))
-        dist = _distance_rows(graph, sources, n, cache)
-        for v in distinct:
-            vs = near_of[v]
-            start = np.hypot(positions[vs, 0] - v[0], positions[vs, 1] - v[1])
-            path_of[v] = np.min(dist[row_of[vs]] + start[:, None], axis=0) / u
+    # path term per distinct viewpoint, first from searches stopped at the limit
+    limit = cfg.search_limit
+    path_of = _path_terms(graph, positions, near_of, distinct, n, u, cache, limit)
+    full_path: dict[tuple[float, float], np.ndarray] = {}
     # candidates: labelled nodes within the radius (a k-d tree proposes, the distance
     # formula of the cost decides), else the nearest labelled node (ties: the lowest id)
     lab_tree = cKDTree(positions[labelled])
@@ -218,7 +242,14 @@ def assign_objects(positions: np.ndarray, node_room: np.ndarray, graph: csr_matr
             j = int(np.argmin(d_lab))
             cand, d = labelled[j:j + 1], d_lab[j:j + 1]
         euc = (d / u) ** cfg.exponent
-        c = euc + path_of[vp_key[i]][cand] if vp_key[i] is not None else euc
+        vp = vp_key[i]
+        c = euc + path_of[vp][cand] if vp is not None else euc
+        if vp is not None and not c.min() < limit / u:
+            # the best may lie beyond the limit: this viewpoint's full search
+            if vp not in full_path:
+                full_path.update(_path_terms(graph, positions, near_of, [vp], n, u, cache,
+                                             np.inf))
+            c = euc + full_path[vp][cand]
         j = int(np.argmin(c))  # ties: the lowest node id (cand is sorted)
         if np.isfinite(c[j]):
             node[i], cost[i] = int(cand[j]), float(c[j])

@@ -9,7 +9,9 @@ caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
    since the last refresh only; a full rebuild happens when the floor level estimate moves
    or voxels were removed (an instance changed state);
 2. Voronoi graph (:mod:`sgtool.mapping.voronoi`): the ridge pixel graph is reused while the
-   occupancy grid is unchanged; the component is the robot's;
+   free cells are unchanged, else its distance field and ridge cells are recomputed around
+   the changed cells only (:mod:`sgtool.mapping.ridge_window`); the component is the
+   robot's;
 3. rooms (:mod:`sgtool.scenegraph.room_segmentation`): door cells of open doors
    (:mod:`sgtool.scenegraph.door_evidence`) cut the graph, ids are kept stable by overlap
    with the previous refresh;
@@ -62,7 +64,7 @@ import numpy as np
 
 from sgtool.log.frame import Frame
 from sgtool.mapping.bev import ColumnGrid, classify_keys, floor_fans, floor_level
-from sgtool.mapping.grid import OCCUPIED, OccupancyGrid
+from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
 from sgtool.mapping.voronoi import (
     RidgeGraph,
     VoronoiGraph,
@@ -75,7 +77,13 @@ from sgtool.scenegraph.assembly import GraphParts, assemble_graph, robot_state
 from sgtool.scenegraph.assign import AssignCache
 from sgtool.scenegraph.builder_config import BuilderConfig
 from sgtool.scenegraph.categories import RoomClassifier
-from sgtool.scenegraph.door_evidence import DoorObservation, door_cells, observe_doors
+from sgtool.scenegraph.door_evidence import (
+    DoorObservation,
+    door_cells_of,
+    observe_doors,
+    open_doors,
+)
+from sgtool.scenegraph.door_voxels import DoorVoxels
 from sgtool.scenegraph.frontier_ids import FrontierTracker
 from sgtool.scenegraph.frontiers import Frontier, find_frontiers
 from sgtool.scenegraph.graph import SceneGraph
@@ -87,6 +95,7 @@ from sgtool.scenegraph.object_placement import (
     place_objects,
     seen_instances,
 )
+from sgtool.scenegraph.regions import Regions as RoomRegions
 from sgtool.scenegraph.room_nodes import room_nodes, room_regions
 from sgtool.scenegraph.room_segmentation import (
     RoomSegmentation,
@@ -152,6 +161,7 @@ class SceneGraphBuilder:
         self._columns: ColumnGrid | None = None
         self._level: int | None = None
         self._removals = -1
+        self._door_voxels = DoorVoxels()  # the door keys, kept with the BEV columns
         self._ridge: tuple[bytes, RidgeGraph] | None = None
         self._graph: tuple[tuple[bytes, int], VoronoiGraph] | None = None
         self._rooms = RoomTracker()
@@ -159,6 +169,8 @@ class SceneGraphBuilder:
         self._class_memo: dict[tuple[str, ...], list[tuple[str, float]]] = {}
         self._panel_memo: dict[bytes, object] = {}  # door openings from swung panels
         self._density: tuple[bytes, np.ndarray] | None = None  # door density of these cells
+        self._centre_memo: dict[bytes, int] = {}  # room centres by their sub-graph
+        self._region_memo: dict[bytes, RoomRegions] = {}  # room clusterings by their inputs
         self._assign_cache = AssignCache()  # Dijkstra rows and sight lines of assignment
         self._last: tuple[tuple, SceneGraph] | None = None
         self.layers: MapLayers | None = None
@@ -232,6 +244,8 @@ class SceneGraphBuilder:
             self._class_memo = {}
             self._panel_memo = {}
             self._density = None
+            self._centre_memo = {}
+            self._region_memo = {}
         timings = self.timings_scratch if from_scratch else self.timings
         tick = _Ticker(timings, self.clock)
         cfg = self.config
@@ -248,7 +262,8 @@ class SceneGraphBuilder:
         objects = place_objects(self._seen(OBJECT_KINDS), vg, node_room, graph_all, occ,
                                 blocked, cfg.assign, self._assign_cache)
         tick("assign")
-        regions, node_region = room_regions(vg, rooms.seg, rooms.room_ids, cfg.regions)
+        regions, node_region = room_regions(vg, rooms.seg, rooms.room_ids, cfg.regions,
+                                            self._region_memo)
         objects = [place_in_room(o, node_room, rooms.room_ids, node_region) for o in objects]
         tick("regions")
         doors, unexplored_pos = observe_doors(
@@ -300,9 +315,15 @@ class SceneGraphBuilder:
             cg = ColumnGrid(res, cfg)
             cg.add(classify_keys(keys, level, res, cfg, presorted=True), self.trajectory)
             self._columns, self._level, self._removals = cg, level, self.voxels.removals
+            self._door_voxels.reset(keys, self.voxels.label_ids(), self._door_ids())
         else:
             new = self.voxels.drain_new_keys()
             self._columns.add(classify_keys(new, level, res, cfg), self.trajectory)
+            if self._door_voxels.stale(self._door_ids()):  # a new instance table
+                self._door_voxels.reset(self.voxels.entries()[0], self.voxels.label_ids(),
+                                        self._door_ids())
+            else:
+                self._door_voxels.add(new, self.voxels.label_ids())
         # the carved ground lives in its own grid, kept while the floor level stays: a
         # rebuild of the columns (a door opened) does not carve every frame again
         if self._carve is None or self._carve_level != level:
@@ -316,12 +337,15 @@ class SceneGraphBuilder:
     def _voronoi(self, occ: OccupancyGrid, robot_xy: tuple[float, float] | None
                  ) -> VoronoiGraph:
         """The Voronoi graph of the robot's component; the ridge pixel graph is reused
-        while the occupancy grid is unchanged, the graph while its component is too."""
+        while the free cells are unchanged (it depends on nothing else) and otherwise
+        computed from the previous one (only around the changed cells), the graph is
+        reused while the ridge, its component and the grid's placement are too."""
         cfg = self.config.voronoi
-        digest = hashlib.blake2b(occ.grid.tobytes(), digest_size=16).digest() + repr(
-            (occ.origin, occ.grid.shape)).encode()
+        digest = hashlib.blake2b((occ.grid == FREE).tobytes(), digest_size=16).digest() + \
+            repr((occ.origin, occ.grid.shape, occ.resolution)).encode()
         if self._ridge is None or self._ridge[0] != digest:
-            self._ridge = (digest, ridge_graph(occ, cfg))
+            previous = None if self._ridge is None else self._ridge[1]
+            self._ridge = (digest, ridge_graph(occ, cfg, previous=previous))
         key = (digest, chosen_component(occ, self._ridge[1], robot_xy))
         if self._graph is None or self._graph[0] != key:  # same ridge, same component
             self._graph = (key, voronoi_graph(occ, cfg, anchor=robot_xy,
@@ -331,14 +355,15 @@ class SceneGraphBuilder:
     def _segment(self, occ: OccupancyGrid, vg: VoronoiGraph) -> _Rooms:
         """Rooms: the door evidence cuts the graph; ids stay stable by overlap."""
         cfg = self.config.rooms
-        cells = door_cells(occ, self.instances, self.voxels, self._panel_memo)
+        cells = door_cells_of(occ, self._door_voxels.of(open_doors(self.instances)),
+                              self._panel_memo)
         key = hashlib.blake2b(cells.tobytes(), digest_size=16).digest() + repr(
             (cells.shape, occ.resolution)).encode()
         if self._density is None or self._density[0] != key:  # the same cells: same blur
             self._density = (key, door_density(cells, occ.resolution, cfg.door_bandwidth))
             self._density[1].setflags(write=False)
         density = self._density[1]
-        seg = segment_rooms(vg, density, cfg)
+        seg = segment_rooms(vg, density, cfg, self._centre_memo)
         numbers = self._rooms.assign([vg.positions[r] for r in seg.rooms], cfg.match_radius)
         return _Rooms(cells, density, seg, [f"room:{n}" for n in numbers])
 
@@ -352,6 +377,9 @@ class SceneGraphBuilder:
         nodes = nearest_visible(vg, np.flatnonzero(node_room >= 0),
                                 [f.medoid for f in frontiers], occ, blocked, cfg.entry_radius)
         return frontiers, [f"frontier:{i}" for i in fids], nodes
+
+    def _door_ids(self) -> list[int]:
+        return [iid for iid, v in self.instances.items() if v.kind == "door"]
 
     def _seen(self, kinds: tuple[str, ...]) -> list[SeenInstance]:
         return seen_instances(self.voxels, self.instances, kinds, self.config.voxels.min_points)

@@ -41,12 +41,23 @@ def door_cells(occ: OccupancyGrid, instances: Mapping[int, InstanceInfo], voxels
                panel_memo: dict[bytes, object]) -> np.ndarray:
     """Bool grid of the door evidence of the open (or state-unknown) doors (module doc);
     ``panel_memo`` caches the openings found from swung panels across calls."""
+    return door_cells_of(occ, voxels.voxels_of(open_doors(instances)), panel_memo)
+
+
+def open_doors(instances: Mapping[int, InstanceInfo]) -> list[int]:
+    """The door instances that are open or of unknown state."""
+    return [iid for iid, v in instances.items() if v.kind == "door" and v.state != "closed"]
+
+
+def door_cells_of(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
+                  panel_memo: dict[bytes, object]) -> np.ndarray:
+    """:func:`door_cells` from the voxels (ijk) of each open door, in any order (e.g. from
+    :class:`sgtool.scenegraph.door_voxels.DoorVoxels`)."""
     cells = np.zeros(occ.shape, dtype=bool)
     ix0 = int(round(occ.origin[0] / occ.resolution))
     iy0 = int(round(occ.origin[1] / occ.resolution))
-    doors = [iid for iid, v in instances.items() if v.kind == "door" and v.state != "closed"]
     occupied: np.ndarray | None = None
-    for ijk in voxels.voxels_of(doors).values():
+    for _, ijk in sorted(door_voxels.items()):
         if not len(ijk):
             continue
         r, c = ijk[:, 1] - iy0, ijk[:, 0] - ix0

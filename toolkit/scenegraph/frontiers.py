@@ -76,20 +76,21 @@ def reachable_free(occ: OccupancyGrid, start: tuple[float, float] | None,
 
 
 def frontier_cells(occ: OccupancyGrid, start: tuple[float, float] | None = None,
-                   snap: float = 0.5, min_pocket: float = 0.0) -> np.ndarray:
+                   snap: float = 0.5, min_pocket: float = 0.0,
+                   unknown_parts: tuple[np.ndarray, int] | None = None) -> np.ndarray:
     """Free cells (reachable from ``start``) 4-adjacent to unknown and not 8-adjacent to
     occupied; unknown pockets (4-connected) under ``min_pocket`` m^2 that do not touch the
     grid border do not count as unknown (the camera's blind ring around the robot, the
-    shadow of a chair: not places to explore)."""
+    shadow of a chair: not places to explore). ``unknown_parts``: :func:`unknown_parts`
+    of ``occ``, when the caller has it."""
     reach = reachable_free(occ, start, snap)
     unknown = occ.grid == UNKNOWN
     max_cells = int(min_pocket / occ.resolution**2)
     if max_cells > 0 and unknown.any():
-        lab, n = ndimage.label(unknown, structure=_FOUR)
+        lab, n = unknown_parts if unknown_parts is not None else _unknown_parts(occ)
         small = np.bincount(lab.ravel()) < max_cells
         small[0] = False
-        edge = np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]])
-        small[np.unique(edge)] = False
+        small[_border_labels(lab)] = False
         unknown = unknown & ~small[lab]
     unknown = np.pad(unknown, 1, constant_values=True)
     next_unknown = (unknown[:-2, 1:-1] | unknown[2:, 1:-1] | unknown[1:-1, :-2]
@@ -97,16 +98,25 @@ def frontier_cells(occ: OccupancyGrid, start: tuple[float, float] | None = None,
     return reach & next_unknown & ~near(occ.grid == OCCUPIED)
 
 
-def outside_footprint(occ: OccupancyGrid) -> np.ndarray:
+def _unknown_parts(occ: OccupancyGrid) -> tuple[np.ndarray, int]:
+    """The 4-connected components of the unknown cells (labels, count)."""
+    lab, n = ndimage.label(occ.grid == UNKNOWN, structure=_FOUR)
+    return lab, int(n)
+
+
+def _border_labels(lab: np.ndarray) -> np.ndarray:
+    return np.unique(np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]]))
+
+
+def outside_footprint(occ: OccupancyGrid,
+                      unknown_parts: tuple[np.ndarray, int] | None = None) -> np.ndarray:
     """Cells outside the hole-filled footprint of everything seen (free or occupied): the
     unknown cells 4-connected to the grid border (everything beyond the grid is unseen)."""
-    unknown = occ.grid == UNKNOWN
-    lab, n = ndimage.label(unknown, structure=_FOUR)
+    lab, n = unknown_parts if unknown_parts is not None else _unknown_parts(occ)
     if n == 0:
-        return unknown
-    edge = np.unique(np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]]))
+        return occ.grid == UNKNOWN
     out = np.zeros(n + 1, dtype=bool)
-    out[edge] = True
+    out[_border_labels(lab)] = True
     out[0] = False
     return out[lab]
 
@@ -115,12 +125,13 @@ def find_frontiers(occ: OccupancyGrid, start: tuple[float, float] | None = None,
                    config: FrontierConfig | None = None) -> list[Frontier]:
     """Frontier clusters in raster order of their medoid cells."""
     cfg = config or FrontierConfig()
-    mask = frontier_cells(occ, start, cfg.snap, cfg.min_pocket)
+    parts = _unknown_parts(occ)
+    mask = frontier_cells(occ, start, cfg.snap, cfg.min_pocket, parts)
     if not mask.any():
         return []
     res = occ.resolution
     lab, n = ndimage.label(mask, structure=_EIGHT)
-    outside = near(outside_footprint(occ))
+    outside = near(outside_footprint(occ, parts))
     min_cells = max(1, int(round(cfg.min_size / res)))
     max_cells = max(min_cells, int(round(cfg.max_size / res)))
     objs = ndimage.find_objects(lab)

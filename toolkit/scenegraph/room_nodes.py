@@ -10,6 +10,7 @@ through a closed door are unexplored room nodes.
 
 from __future__ import annotations
 
+import hashlib
 from collections import defaultdict
 from collections.abc import Mapping
 
@@ -23,6 +24,7 @@ from sgtool.scenegraph.graph import RoomNode
 from sgtool.scenegraph.instances import InstanceInfo
 from sgtool.scenegraph.object_placement import PlacedObject
 from sgtool.scenegraph.regions import RegionConfig, cluster_room
+from sgtool.scenegraph.regions import Regions as RoomRegions
 from sgtool.scenegraph.room_segmentation import RoomSegmentation, room_neighbours
 
 # region id -> (room id, its Voronoi node, its position)
@@ -30,17 +32,20 @@ Regions = dict[str, tuple[str, int, tuple[float, float]]]
 
 
 def room_regions(vg: VoronoiGraph, seg: RoomSegmentation, room_ids: list[str],
-                 config: RegionConfig) -> tuple[Regions, dict[int, str]]:
-    """The regions of every room, and the region id of every node of a room."""
+                 config: RegionConfig, memo: dict[bytes, RoomRegions] | None = None
+                 ) -> tuple[Regions, dict[int, str]]:
+    """The regions of every room, and the region id of every node of a room. ``memo``
+    keeps each room's clustering across calls, keyed by its inputs (node positions, edge
+    length, centre, config): an unchanged room clusters the same."""
     regions: Regions = {}
     node_region: dict[int, str] = {}
+    lengths = _room_edge_lengths(vg, seg)
     for i, nodes in enumerate(seg.rooms):
         rid = room_ids[i]
         num = rid.split(":", 1)[1]
-        inside = np.isin(vg.edges, nodes).all(axis=1) if len(vg.edges) else np.zeros(0, bool)
-        length = float(vg.lengths[inside].sum()) if len(vg.edges) else 0.0
+        length = float(lengths[i].sum()) if len(vg.edges) else 0.0
         centre = int(np.searchsorted(nodes, seg.centres[i]))
-        reg = cluster_room(vg.positions[nodes], length, centre, config)
+        reg = _clustered(vg.positions[nodes], length, centre, config, memo)
         for k, c in enumerate(reg.centres.tolist(), start=1):
             node = int(nodes[c])
             reg_id = f"region:{num}.{k}"
@@ -49,6 +54,37 @@ def room_regions(vg: VoronoiGraph, seg: RoomSegmentation, room_ids: list[str],
         for j, n in enumerate(nodes.tolist()):
             node_region[int(n)] = f"region:{num}.{int(reg.labels[j]) + 1}"
     return regions, node_region
+
+
+def _clustered(positions: np.ndarray, length: float, centre: int, config: RegionConfig,
+               memo: dict[bytes, RoomRegions] | None) -> RoomRegions:
+    if memo is None:
+        return cluster_room(positions, length, centre, config)
+    h = hashlib.blake2b(digest_size=16)
+    h.update(repr((positions.shape, positions.dtype.str, length, centre, config)).encode())
+    h.update(np.ascontiguousarray(positions).tobytes())
+    key = h.digest()
+    got = memo.get(key)
+    if got is None:
+        got = cluster_room(positions, length, centre, config)
+        if len(memo) > 1024:
+            memo.clear()
+        memo[key] = got
+    return got
+
+
+def _room_edge_lengths(vg: VoronoiGraph, seg: RoomSegmentation) -> list[np.ndarray]:
+    """Per room, the lengths of the Voronoi edges with both ends in it, in edge order (one
+    pass over the edges, not one per room)."""
+    if not len(vg.edges):
+        return [np.zeros(0) for _ in seg.rooms]
+    lab = seg.labels[vg.edges]
+    inside = np.flatnonzero((lab[:, 0] == lab[:, 1]) & (lab[:, 0] >= 0))
+    owner = lab[inside, 0]
+    order = np.argsort(owner, kind="stable")
+    bounds = np.searchsorted(owner[order], np.arange(seg.count + 1))
+    sel = vg.lengths[inside[order]]
+    return [sel[bounds[i]:bounds[i + 1]] for i in range(seg.count)]
 
 
 def room_nodes(

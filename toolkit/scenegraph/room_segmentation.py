@@ -45,10 +45,11 @@ from typing import Any
 
 import numpy as np
 from scipy import ndimage
+from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components, dijkstra
 from scipy.spatial import cKDTree
 
-from sgtool.mapping.voronoi import VoronoiGraph
+from sgtool.mapping.voronoi import VoronoiGraph, submatrix
 
 
 @dataclass(frozen=True)
@@ -176,8 +177,11 @@ class RoomSegmentation:
 
 
 def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
-                  config: RoomConfig | None = None) -> RoomSegmentation:
-    """Cut ``vg`` where the door density reaches the threshold; components are rooms."""
+                  config: RoomConfig | None = None,
+                  centre_memo: dict[bytes, int] | None = None) -> RoomSegmentation:
+    """Cut ``vg`` where the door density reaches the threshold; components are rooms.
+    ``centre_memo`` keeps each room's centre across calls, keyed by its sub-graph (a room
+    whose sub-graph is unchanged has the same centre: the same arrays, the same Dijkstra)."""
     cfg = config or RoomConfig()
     n, m = len(vg.positions), len(vg.edges)
     cut_e = np.zeros(m, dtype=bool)
@@ -186,8 +190,11 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
         flat = density.ravel()
         h, w = vg.shape
         cut_n = flat[vg.cells[:, 0] * w + vg.cells[:, 1]] >= cfg.door_threshold
-        for i, cells in enumerate(vg.edge_cells):
-            cut_e[i] = bool(flat[cells].max() >= cfg.door_threshold)
+        if m:  # the maximum density along every edge's cells, all edges in one pass
+            sizes = np.fromiter((len(c) for c in vg.edge_cells), dtype=np.int64, count=m)
+            starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+            peak = np.maximum.reduceat(flat[np.concatenate(vg.edge_cells)], starts)
+            cut_e = peak >= cfg.door_threshold
     keep = ~cut_e
     if m:
         keep &= ~cut_n[vg.edges[:, 0]] & ~cut_n[vg.edges[:, 1]]
@@ -206,18 +213,35 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
         labels[nodes] = len(rooms)
         rooms.append(nodes)
     graph = vg.csgraph(keep)
-    centres = tuple(_graph_centre(graph, nodes) for nodes in rooms)
+    where = np.full(n, -1, dtype=np.int64)
+    centres = tuple(_graph_centre(graph, nodes, where, centre_memo) for nodes in rooms)
     return RoomSegmentation(labels, cut_e, cut_n, tuple(rooms), centres)
 
 
-def _graph_centre(graph, nodes: np.ndarray) -> int:  # noqa: ANN001
-    """The node of minimum eccentricity within its room (ties: the lowest id)."""
+def _graph_centre(graph: csr_matrix, nodes: np.ndarray, where: np.ndarray,
+                  memo: dict[bytes, int] | None = None) -> int:
+    """The node of minimum eccentricity within its room (ties: the lowest id); ``where``
+    is scratch space (-1 everywhere, as it is left); ``memo``: see :func:`segment_rooms`."""
     if len(nodes) == 1:
         return int(nodes[0])
-    sub = graph[nodes][:, nodes]
+    sub = submatrix(graph, nodes, where)
+    key = None
+    if memo is not None:
+        h = hashlib.blake2b(digest_size=16)
+        for a in (sub.indptr, sub.indices, sub.data):
+            h.update(repr((a.dtype.str, a.shape)).encode())
+            h.update(np.ascontiguousarray(a).tobytes())
+        key = h.digest()
+        if key in memo:
+            return int(nodes[memo[key]])
     d = dijkstra(sub, directed=False)
     ecc = d.max(axis=1)
-    return int(nodes[int(np.argmin(ecc))])
+    best = int(np.argmin(ecc))
+    if memo is not None and key is not None:
+        if len(memo) > 1024:
+            memo.clear()
+        memo[key] = best
+    return int(nodes[best])
 
 
 def room_neighbours(vg: VoronoiGraph, seg: RoomSegmentation) -> list[tuple[int, int]]:
@@ -229,21 +253,41 @@ def room_neighbours(vg: VoronoiGraph, seg: RoomSegmentation) -> list[tuple[int, 
     g = vg.csgraph()
     centres = np.asarray(seg.centres, dtype=np.int64)
     dist, pred = dijkstra(g, directed=False, indices=centres, return_predecessors=True)
+    labels = seg.labels.tolist()
     for a in range(seg.count):
+        other = _other_rooms(pred[a].tolist(), labels, a)
         for b in range(a + 1, seg.count):
             t = int(centres[b])
-            if not np.isfinite(dist[a, t]):
-                continue
-            seen: set[int] = set()
-            node = t
-            while node >= 0:
-                lab = int(seg.labels[node])
-                if lab >= 0:
-                    seen.add(lab)
-                node = int(pred[a, node])
-            if seen == {a, b}:
+            if np.isfinite(dist[a, t]) and other(t) == b:
                 out.append((a, b))
     return out
+
+
+def _other_rooms(pred: list[int], labels: list[int], a: int):  # noqa: ANN202
+    """For the shortest-path tree ``pred`` from room ``a``'s centre: a function of a node
+    t giving the room other than ``a`` on the path to t (-1: none, -2: more than one).
+    Each tree node is climbed once; the values along a climbed path are kept."""
+    memo: dict[int, int] = {}
+
+    def with_label(v: int, node: int) -> int:
+        lab = labels[node]
+        if lab < 0 or lab == a or v == -2 or v == lab:
+            return v
+        return lab if v == -1 else -2
+
+    def other(t: int) -> int:
+        path = []
+        node = t
+        while node >= 0 and node not in memo:
+            path.append(node)
+            node = pred[node]
+        v = memo[node] if node >= 0 else -1
+        for n in reversed(path):
+            v = with_label(v, n)
+            memo[n] = v
+        return v
+
+    return other
 
 
 @dataclass

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from scipy.sparse import csr_matrix
 
-from sgtool.mapping.voronoi import _pixel_graph, _reverse_entries, _trace_chains, thin
+from sgtool.mapping.ridge_chains import _reverse_entries, _trace_chains
+from sgtool.mapping.voronoi import _pixel_graph, thin
 
 
 def reference_chains(adj: csr_matrix) -> list[tuple[list[int], list[float]]]:

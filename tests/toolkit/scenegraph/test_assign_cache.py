@@ -9,7 +9,7 @@ import pytest
 from scipy.sparse import csr_matrix
 
 from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
-from sgtool.scenegraph.assign import AssignCache, assign_objects
+from sgtool.scenegraph.assign import AssignCache, AssignConfig, assign_objects
 
 RES = 0.05
 
@@ -94,3 +94,28 @@ def test_cache_keeps_only_the_viewpoints_in_use():
     assign_objects(pos, room, graph, objs[:1], pos[[0]], occ, g == OCCUPIED, cache=cache)
     assert list(cache.sight) == [(float(pos[0, 0]), float(pos[0, 1]))]
     assert cache.hits == 1  # the same viewpoint, nodes and walls: reused
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_searches_stopped_at_a_limit_give_the_unlimited_assignment(seed):
+    """Graph distances are searched up to ``search_limit`` first; an object whose best
+    cost could lie beyond it gets its viewpoint's full search: the same nodes and costs
+    as unlimited searches, bit for bit, whatever the limit."""
+    rng = np.random.default_rng(100 + seed)
+    g, pos = _house(rng)
+    graph = _graph(pos, rng)
+    room = rng.integers(-1, 4, size=len(pos))
+    objs = rng.uniform((0.2, 0.2), (5.8, 3.8), size=(16, 2))
+    vps = pos[rng.integers(0, len(pos), size=16)] + rng.normal(0, 0.1, size=(16, 2))
+    occ = OccupancyGrid(g, (0.0, 0.0), RES)
+    blocked = occ.grid == OCCUPIED
+    want = assign_objects(pos, room, graph, objs, vps, occ, blocked,
+                          AssignConfig(search_limit=np.inf))
+    full_searches = 0
+    for limit in (0.3, 1.0, 2.5, 6.0, 30.0):
+        cache = AssignCache()
+        got = assign_objects(pos, room, graph, objs, vps, occ, blocked,
+                             AssignConfig(search_limit=limit), cache)
+        assert np.array_equal(got.node, want.node) and np.array_equal(got.cost, want.cost)
+        full_searches += sum(1 for _, lim in cache.rows if lim == np.inf)
+    assert full_searches > 0 and (want.node >= 0).all()

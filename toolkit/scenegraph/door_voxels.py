@@ -1,0 +1,70 @@
+"""The voxels of the door instances, kept up to date from the keys entering the voxel map.
+
+The door evidence of every refresh (:func:`sgtool.scenegraph.door_evidence.door_cells_of`)
+needs each door's voxels; asking the map (:meth:`~sgtool.mapping.voxels.VoxelMap.voxels_of`)
+scans every (voxel, label) key of the house at every refresh. :class:`DoorVoxels` keeps
+the door keys instead: the builder hands it the keys new since the last refresh (the ones
+the BEV columns are updated from) and, when it rebuilds those columns from every key (the
+floor level moved, voxels were removed), all keys. A door's voxels are then the same set
+``voxels_of`` gives (keys only enter the map between removals; any removal makes the
+builder rebuild), in another order, which no consumer depends on. A change of the set of
+door instances (a new instance table) also asks for a rebuild (:meth:`DoorVoxels.stale`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+
+from sgtool.mapping.voxels import LABEL_MASK, unpack
+
+
+class DoorVoxels:
+    """Door instance id -> its (voxel, label) keys (module doc)."""
+
+    def __init__(self) -> None:
+        self._doors: frozenset[int] = frozenset()
+        self._keys: dict[int, list[np.ndarray]] = {}
+
+    def stale(self, doors: Iterable[int]) -> bool:
+        """True when the door instances differ from those the keys were kept for."""
+        return frozenset(int(d) for d in doors) != self._doors
+
+    def reset(self, keys: np.ndarray, label_ids: np.ndarray, doors: Iterable[int]) -> None:
+        """Keep the door keys among ``keys`` (every key of the map) only."""
+        self._doors = frozenset(int(d) for d in doors)
+        self._keys = {}
+        self.add(keys, label_ids)
+
+    def add(self, keys: np.ndarray, label_ids: np.ndarray) -> None:
+        """Keys new in the map; ``label_ids`` the instance id of every label index."""
+        if not self._doors or len(keys) == 0:
+            return
+        n = len(label_ids)
+        if n < 2:
+            return
+        door_label = np.isin(label_ids, np.asarray(sorted(self._doors), dtype=np.int64))
+        door_label[0] = False  # label 0: no instance
+        lab = keys & LABEL_MASK
+        hit = door_label[np.minimum(lab, n - 1)] & (lab < n)  # overflow labels: no door
+        if not hit.any():
+            return
+        keys = keys[hit]
+        inst = label_ids[keys & LABEL_MASK]
+        for iid in np.unique(inst).tolist():
+            self._keys.setdefault(int(iid), []).append(keys[inst == iid])
+
+    def of(self, instance_ids: Iterable[int]) -> dict[int, np.ndarray]:
+        """Instance id -> ijk (M, 3) of its voxels (each once), for door instances."""
+        out: dict[int, np.ndarray] = {}
+        for iid in sorted(int(i) for i in instance_ids):
+            parts = self._keys.get(iid)
+            if not parts:
+                out[iid] = np.zeros((0, 3), np.int64)
+                continue
+            if len(parts) > 1:
+                parts[:] = [np.concatenate(parts)]
+            ix, iy, iz, _ = unpack(parts[0])
+            out[iid] = np.stack([ix, iy, iz], axis=1)
+        return out
