@@ -25,19 +25,11 @@ from sgtool.house.spec import Furniture, HouseSpec, spec_id_key
 FURNITURE_SHARE = 1 / 3  # SymSearch: about a third of the episodes ask for furniture
 
 
-def _near_piece(geo: EpisodeGeometry, f: Furniture) -> np.ndarray:
-    """Free cells of the piece's room within ``geo.reach`` of its footprint."""
-    lx, ly = f.to_local(geo.X, geo.Y)  # type: ignore[arg-type]
-    dx = np.maximum(np.abs(lx) - f.size[0] / 2, 0.0)
-    dy = np.maximum(np.abs(ly) - f.size[1] / 2, 0.0)
-    room = [r.id for r in geo.spec.rooms].index(f.room)
-    return (dx ** 2 + dy ** 2 <= geo.reach ** 2) & (geo.rooms == room) & ~geo.occ.blocked
-
-
-def furniture_episodes(spec: HouseSpec, n: int, seed: int = 0,
-                       reach: float = REACH) -> list[Episode]:
+def furniture_episodes(spec: HouseSpec, n: int, seed: int = 0, reach: float = REACH,
+                       geometry: EpisodeGeometry | None = None) -> list[Episode]:
     """``n`` furniture-target episodes of ``spec`` drawn with ``seed`` (categories without
-    replacement while they last, then again with other starts); ids ``fep_<i>``."""
+    replacement while they last, then again with other starts); ids ``fep_<i>``.
+    ``geometry``: the house's :class:`EpisodeGeometry` with this ``reach``, to share."""
     if n <= 0 or not spec.starts:
         return []
     small = {o.category for o in spec.objects}
@@ -45,9 +37,9 @@ def furniture_episodes(spec: HouseSpec, n: int, seed: int = 0,
     for f in spec.furniture:
         if f.category not in small:
             by_cat[f.category].append(f)
-    geo = EpisodeGeometry(spec, reach=reach)
-    masks = {f.id: _near_piece(geo, f) for fs in by_cat.values() for f in fs}
-    cats = sorted(c for c, fs in by_cat.items() if any(masks[f.id].any() for f in fs))
+    geo = geometry or EpisodeGeometry(spec, reach=reach)
+    near = {f.id: geo.near(f) for fs in by_cat.values() for f in fs}
+    cats = sorted(c for c, fs in by_cat.items() if any(near[f.id] is not None for f in fs))
     if not cats:
         return []
     rng = np.random.default_rng([seed, 1])
@@ -60,7 +52,8 @@ def furniture_episodes(spec: HouseSpec, n: int, seed: int = 0,
             starts = [s for s in spec.starts if s.room not in rooms] or list(spec.starts)
             start = starts[int(rng.integers(len(starts)))]
             d = geo.distances(start)
-            best = min((float(d[masks[f.id]].min()) for f in pieces if masks[f.id].any()),
+            best = min((float(d[w][m].min()) for w, m in
+                        (near[f.id] for f in pieces if near[f.id] is not None)),
                        default=math.inf)
             first = pieces[0]
             room = spec.room(first.room).category.replace("_", " ")
@@ -83,7 +76,9 @@ def symsearch_episodes(spec: HouseSpec, n: int, seed: int = 0,
     if not 0.0 <= furniture_share <= 1.0:
         raise ValueError(f"furniture_share must be in [0, 1], got {furniture_share}")
     n_furn = round(n * furniture_share) if spec.objects else n
-    eps = list_episodes(spec, n - n_furn, seed=seed, reach=reach) if n > n_furn else []
-    eps += furniture_episodes(spec, n_furn, seed=seed, reach=reach)
+    geo = EpisodeGeometry(spec, reach=reach)  # one occupancy for both kinds
+    eps = list_episodes(spec, n - n_furn, seed=seed, reach=reach, geometry=geo) \
+        if n > n_furn else []
+    eps += furniture_episodes(spec, n_furn, seed=seed, reach=reach, geometry=geo)
     order = np.random.default_rng([seed, 2]).permutation(len(eps))
     return [dataclasses.replace(eps[j], id=f"ep_{i}") for i, j in enumerate(order.tolist())]

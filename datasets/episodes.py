@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sgtool.datasets.footprint_reach import Window, full_mask, near_footprint
 from sgtool.house.spec import (
     Furniture,
     HouseSpec,
@@ -113,19 +114,32 @@ class EpisodeGeometry:
         self._room_index = {r.id: i for i, r in enumerate(spec.rooms)}
         self._roots = spec.root_furniture()
         self._dist: dict[tuple[float, float], np.ndarray] = {}
+        self._near: dict[str, tuple[Window, np.ndarray] | None] = {}
+
+    def near(self, piece: Furniture) -> tuple[Window, np.ndarray] | None:
+        """(window, mask over it) of the free cells of ``piece``'s room within ``reach`` of
+        its footprint (:func:`~sgtool.datasets.footprint_reach.near_footprint`), memoised
+        per piece id; None when there is no such cell."""
+        if piece.id in self._near:
+            return self._near[piece.id]
+        near = near_footprint(self.occ, self.X, self.Y, piece, self.reach)
+        if near is not None:
+            w, m = near
+            m = m & (self.rooms[w] == self._room_index[piece.room]) & ~self.occ.blocked[w]
+            near = (w, m) if m.any() else None
+        self._near[piece.id] = near
+        return near
+
+    def _piece(self, target_id: str) -> Furniture:
+        furn = self.spec.furniture_by_id()
+        if target_id not in furn:
+            target_id = self._roots[target_id]
+        return furn[target_id]
 
     def goal_mask(self, target_id: str) -> np.ndarray:
         """Free cells of the target's room within ``reach`` of its furniture's footprint (a
         small object's furniture is the piece at the bottom of its chain of parents)."""
-        furn = self.spec.furniture_by_id()
-        if target_id not in furn:
-            target_id = self._roots[target_id]
-        p = furn[target_id]
-        lx_ly = _to_local(p, self.X, self.Y)
-        dx = np.maximum(np.abs(lx_ly[0]) - p.size[0] / 2, 0.0)
-        dy = np.maximum(np.abs(lx_ly[1]) - p.size[1] / 2, 0.0)
-        near = dx ** 2 + dy ** 2 <= self.reach ** 2
-        return near & (self.rooms == self._room_index[p.room]) & ~self.occ.blocked
+        return full_mask(self.occ.shape, self.near(self._piece(target_id)))
 
     def distances(self, start: StartPose) -> np.ndarray:
         key = (start.x, start.y)
@@ -138,23 +152,19 @@ class EpisodeGeometry:
         d = self.distances(start)
         best = math.inf
         for oid in target_ids:
-            m = self.goal_mask(oid)
-            if m.any():
-                best = min(best, float(d[m].min()))
+            near = self.near(self._piece(oid))
+            if near is not None:
+                best = min(best, float(d[near[0]][near[1]].min()))
         return best
 
 
-def _to_local(p, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    c, s = math.cos(p.yaw), math.sin(p.yaw)
-    dx, dy = X - p.center[0], Y - p.center[1]
-    return (c * dx + s * dy, -s * dx + c * dy)
-
-
 def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
-                  reach: float = REACH) -> list[Episode]:
+                  reach: float = REACH,
+                  geometry: EpisodeGeometry | None = None) -> list[Episode]:
     """Search episodes in ``spec``: one per small-object category (sorted by category)
     when ``n`` is None, else ``n`` episodes drawn with ``seed`` (categories without
-    replacement while they last, then again with other starts)."""
+    replacement while they last, then again with other starts). ``geometry``: the house's
+    :class:`EpisodeGeometry` with this ``reach``, to share with other listings."""
     if not spec.objects or not spec.starts:
         return []
     by_cat: dict[str, list[str]] = defaultdict(list)
@@ -172,7 +182,7 @@ def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
             take = min(n - len(chosen), len(cats))
             chosen += [cats[i] for i in sorted(rng.choice(len(cats), size=take,
                                                           replace=False).tolist())]
-    geo = EpisodeGeometry(spec, reach=reach)
+    geo = geometry or EpisodeGeometry(spec, reach=reach)
     objs = spec.object_by_id()
     furn = spec.furniture_by_id()
     hidden_ids = hidden_objects(spec)

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sgtool.datasets.footprint_reach import near_footprint
 from sgtool.house.spec import HouseSpec, StartPose
 from sgtool.mapping.occupancy import geodesic_distances, house_occupancy
 from sgtool.mapping.raster import cell_centers, polygon_mask
@@ -72,10 +73,8 @@ def reachability(spec: HouseSpec, seed: int = 0, origin_room: str | None = None,
     for f in spec.furniture:
         if not f.affordances:
             continue
-        lx, ly = f.to_local(X, Y)
-        dx = np.maximum(np.abs(lx) - f.size[0] / 2, 0.0)
-        dy = np.maximum(np.abs(ly) - f.size[1] / 2, 0.0)
-        if not ((dx ** 2 + dy ** 2 <= (reach - robot_radius) ** 2) & ok).any():
+        near = near_footprint(occ, X, Y, f, reach - robot_radius)
+        if near is None or not (near[1] & ok[near[0]]).any():
             lost_furniture.append(f.id)
     return Reachability(origin.id, tuple(starts), tuple(lost_rooms), tuple(lost_furniture))
 

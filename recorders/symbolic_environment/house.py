@@ -78,6 +78,9 @@ class SymbolicHouse:
         self.obj_cat = tuple(category_text(o.category) for o in spec.objects)
         self._furn_nodes: dict[tuple[int, str | None, bool], ObjectNode] = {}
         self._obj_nodes: dict[tuple[int, str | None, bool], ObjectNode] = {}
+        # one position tuple per item, shared by the nodes of its states (so a planner's
+        # per-episode object table sees a state change as the same row)
+        self._positions: dict[tuple[str, int], tuple[float, ...]] = {}
         self._walkable_rooms()
         self.places: list[tuple[float, float]] = []
         self.place_room: list[int] = []
@@ -270,12 +273,19 @@ class SymbolicHouse:
                 id=self.furn_node_id(f), category=self.furn_cat[f],
                 parent=self.regions[self.region_of_furn[f]].id,
                 room=self.room_ids[self.room_index[fu.room]],
-                position=tuple(float(v) for v in fu.center),  # type: ignore[arg-type]
+                position=self._position("furn", f, fu.center),  # type: ignore[arg-type]
                 instance=f + 1, state=state,  # type: ignore[arg-type]
                 affordances=tuple(sorted(affs)), explored=explored,
             )
             self._furn_nodes[key] = node
         return node
+
+    def _position(self, kind: str, k: int, xyz: tuple[float, ...]) -> tuple[float, ...]:
+        key = (kind, k)
+        pos = self._positions.get(key)
+        if pos is None:
+            pos = self._positions[key] = tuple(float(v) for v in xyz)
+        return pos
 
     def parent_node_id(self, j: int) -> str:
         """Node id of small object ``j``'s parent (a piece of furniture or an object)."""
@@ -298,7 +308,7 @@ class SymbolicHouse:
                 id=self.obj_node_id(j), category=self.obj_cat[j],
                 parent=self.parent_node_id(j),
                 room=self.room_ids[self.room_index[o.room]],
-                position=tuple(float(v) for v in o.position),  # type: ignore[arg-type]
+                position=self._position("obj", j, o.position),  # type: ignore[arg-type]
                 instance=len(self.spec.furniture) + 1 + j, relation=o.relation,  # type: ignore[arg-type]
                 state=state, affordances=tuple(sorted(affs)),  # type: ignore[arg-type]
                 explored=explored,

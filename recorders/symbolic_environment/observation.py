@@ -51,6 +51,8 @@ class ObservedGraph:
         self._furn: list[int] = []  # visible furniture, ascending
         self._obj: list[int] = []  # seen small objects, ascending
         self._furn_nodes: dict[int, ObjectNode] = {}
+        self._room_nodes: dict[tuple[int, bool, tuple[str, ...]], RoomNode] = {}
+        self._region_nodes: dict[tuple[int, bool], RegionNode] = {}
         self._obj_nodes: dict[int, ObjectNode] = {}
         # what is rebuilt when it changed (None: to rebuild)
         self._objects: tuple[ObjectNode, ...] | None = None
@@ -60,6 +62,8 @@ class ObservedGraph:
         self._regions: tuple[tuple[RegionNode, ...], _Ids] | None = None
         self._doors: tuple[tuple[DoorNode, ...], tuple[tuple[str, int, int], ...]] | None = \
             None  # the nodes, (door id, place of each side) each
+        self._room_index: tuple[object, tuple[list[str], np.ndarray, np.ndarray]] | None = \
+            None  # (the rooms entry, its places for one look-up)
 
     # ----- what changed ---------------------------------------------------------------
     def show_furniture(self, f: int) -> None:
@@ -109,10 +113,15 @@ class ObservedGraph:
             name = h.room_names[ri]
             neighbours = tuple(sorted({h.room_ids[o] for o, _ in h.links[ri]
                                        if o in env.known_rooms})) if explored else ()
-            rooms.append(RoomNode(
-                id=h.room_ids[ri], category=name if explored else "unknown",
-                position=h.room_centroids[ri], explored=explored,
-                category_scores=((name, 1.0),) if explored else (), neighbours=neighbours))
+            key = (ri, explored, neighbours)
+            node = self._room_nodes.get(key)
+            if node is None:  # the same node object while the room is unchanged
+                node = self._room_nodes[key] = RoomNode(
+                    id=h.room_ids[ri], category=name if explored else "unknown",
+                    position=h.room_centroids[ri], explored=explored,
+                    category_scores=((name, 1.0),) if explored else (),
+                    neighbours=neighbours)
+            rooms.append(node)
         return tuple(rooms), tuple((h.room_ids[ri], h.room_places[ri]) for ri in known)
 
     def _build_regions(self) -> tuple[tuple[RegionNode, ...], _Ids]:
@@ -122,10 +131,13 @@ class ObservedGraph:
             for reg in h.room_regions[ri]:
                 r = h.regions[reg]
                 revealed = reg in env.revealed_regions
-                regions.append(RegionNode(
-                    id=r.id, room=h.room_ids[ri], position=r.center,
-                    kind="region" if revealed else "frontier",
-                    frontier_type=None if revealed else "unexplored area"))
+                node = self._region_nodes.get((reg, revealed))
+                if node is None:
+                    node = self._region_nodes[(reg, revealed)] = RegionNode(
+                        id=r.id, room=h.room_ids[ri], position=r.center,
+                        kind="region" if revealed else "frontier",
+                        frontier_type=None if revealed else "unexplored area")
+                regions.append(node)
                 places.append(r.place)
         return tuple(regions), ([r.id for r in regions], np.asarray(places, dtype=np.intp))
 
@@ -145,6 +157,23 @@ class ObservedGraph:
         places = [h.furn_place[f] for f in self._furn] + [h.obj_place[j] for j in self._obj]
         return ids, np.asarray(places, dtype=np.intp)
 
+    def _room_places(self) -> tuple[list[str], np.ndarray, np.ndarray]:
+        """The known rooms' ids, their regions' places end to end, and where each room's
+        start (for one ``reduceat``), kept with the rooms they are of."""
+        rooms = self._rooms
+        hit = self._room_index
+        if hit is not None and hit[0] is rooms:
+            return hit[1]
+        pairs = rooms[1] if rooms is not None else ()
+        rids = [r for r, ps in pairs]
+        sizes = [len(ps) for _, ps in pairs]
+        if 0 in sizes:
+            raise ValueError("a known room without regions")
+        flat = np.asarray([p for _, ps in pairs for p in ps], dtype=np.intp)
+        starts = np.cumsum([0, *sizes[:-1]]).astype(np.intp)
+        self._room_index = (rooms, (rids, flat, starts))
+        return self._room_index[1]
+
     def graph(self, dist: np.ndarray) -> SceneGraph:
         """The observed graph with travel distances ``dist`` (from the agent's place to
         every place of the house; only finite ones are kept)."""
@@ -161,10 +190,13 @@ class ObservedGraph:
         if self._items is None:
             self._items = self._build_items()
         distances: dict[str, float] = {}
-        for rid, room_places in self._rooms[1]:
-            d = float(min(dist[p] for p in room_places))
-            if math.isfinite(d):
-                distances[rid] = d
+        rids, flat, starts = self._room_places()
+        if rids:
+            near = np.minimum.reduceat(dist[flat], starts)  # each room's nearest region
+            if np.isnan(near).any():  # (never: distances are finite or inf) as min() does
+                near = np.array([min(dist[p] for p in ps) for _, ps in self._rooms[1]])
+            distances.update((r, d) for r, d in zip(rids, near.tolist(), strict=True)
+                             if math.isfinite(d))
         for ids, places in (self._regions[1], self._items):
             vals = dist[places]
             fin = np.isfinite(vals)

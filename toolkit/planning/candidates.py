@@ -154,35 +154,163 @@ class _NodeMemo:
 
 _STATIC = _NodeMemo()
 
+# (key, node id, skill, kind, (x, y)) of an actionable node, key its natural sort key
+_Ordered = list[tuple[tuple, str, "Skill", str, tuple[float, float]]]
+
+
+class _GroupOrder:
+    """The actionable nodes of one node tuple of a graph (rooms, regions or objects; doors
+    with the rooms tuple they are judged by), in natural id order, by tuple identity.
+
+    Node tuples are immutable and their nodes frozen, and an incremental graph passes the
+    same tuple while its nodes do not change, so the order is computed once per tuple; a
+    decision then only looks up distances. When a slot's tuple changes (a container
+    opened, objects revealed), the order is updated from the last one: the entries of nodes
+    that left are taken out and those of new nodes sorted in by key, which gives the order
+    of a fresh sort as long as no two keys are equal (else it is sorted afresh). Each slot
+    keeps its last tuple alive, so a node id is never reused under it."""
+
+    def __init__(self) -> None:
+        self.last: dict[str, tuple[tuple, tuple, _Ordered]] = {}
+        # per slot: id(node) of every node of the last tuple -> key of its entry (None
+        # when not actionable); None when two entries had equal keys
+        self.keys: dict[str, dict[int, tuple | None] | None] = {}
+
+    def nodes(self, slot: str, group: tuple) -> _Ordered:
+        hit = self.last.get(slot)
+        if hit is not None and hit[0] is group:
+            return hit[2]
+        keys = self.keys.get(slot) if hit is not None else None
+        out = self._update(hit[0], hit[2], keys, group) \
+            if keys is not None else None  # type: ignore[index]
+        if out is None:
+            out, keys = self._sorted(group)
+        self.last[slot] = (group, (), out)
+        self.keys[slot] = keys
+        return out
+
+    @staticmethod
+    def _entry(node: RoomNode | RegionNode | ObjectNode) -> _Entry:
+        entry = _STATIC.memo.get(id(node))
+        if entry is None or entry[0] is not node:
+            entry = _STATIC.add(node)
+        return entry
+
+    def _sorted(self, group: tuple) -> tuple[_Ordered, dict[int, tuple | None] | None]:
+        out: _Ordered = []
+        keys: dict[int, tuple | None] = {}
+        for node in group:
+            entry = self._entry(node)
+            if entry[1] is not None:
+                out.append((entry[3], entry[4], entry[1], entry[2], entry[5]))
+                keys[id(node)] = entry[3]
+            else:
+                keys[id(node)] = None
+        out.sort(key=_first)  # stable: equal ids stay in graph order
+        unique = all(a[0] < b[0] for a, b in zip(out, out[1:], strict=False))
+        return out, (keys if unique and len(keys) == len(group) else None)
+
+    def _update(self, prev: tuple, last: _Ordered, keys: dict[int, tuple | None],
+                group: tuple) -> _Ordered | None:
+        """``last`` (the order of ``prev``) updated to ``group`` (class doc); None to sort
+        afresh. ``keys`` is updated in place."""
+        if len(prev) == len(group):  # nodes replaced in place, the usual change: one pass
+            at = [k for k, (a, b) in enumerate(zip(prev, group, strict=True)) if a is not b]
+            new = [group[k] for k in at]
+            if len({id(n) for n in new} - keys.keys()) != len(new):
+                return None  # a node moved within the tuple, or is in it twice
+            gone = [id(prev[k]) for k in at]
+        else:
+            now = {id(n) for n in group}
+            if len(now) != len(group):
+                return None  # a node twice in the tuple
+            gone = [k for k in keys if k not in now]
+            new = [n for n in group if id(n) not in keys]
+        out = last
+        if gone:
+            drop = {keys.pop(k) for k in gone}
+            out = [e for e in last if e[0] not in drop]
+        added = []
+        for node in new:
+            entry = self._entry(node)
+            if entry[1] is None:
+                keys[id(node)] = None
+                continue
+            added.append((entry[3], entry[4], entry[1], entry[2], entry[5]))
+            keys[id(node)] = entry[3]
+        if added:
+            out = out + added
+            out.sort(key=_first)
+            if len({e[0] for e in out}) != len(out):
+                return None  # equal keys: their order is the graph's
+        return out
+
+    def doors(self, graph: SceneGraph) -> _Ordered:
+        hit = self.last.get("door")
+        if hit is not None and hit[0] is graph.doors and hit[1] is graph.rooms:
+            return hit[2]
+        out: _Ordered = [(natural_key(d.id), d.id, "open", "door", node_xy(d))
+                         for d in graph.doors if door_is_entrance(graph, d)]
+        out.sort(key=_first)
+        self.last["door"] = (graph.doors, graph.rooms, out)
+        return out
+
+
+def _first(entry: tuple) -> tuple:
+    return entry[0]
+
+
+_ORDER = _GroupOrder()
+
+
+def _in_order(groups: list[_Ordered]) -> _Ordered:
+    """The entries of ``groups`` (each in natural id order) sorted by natural key, then
+    group, then place in the group: the order of one stable sort of all of them. Groups
+    whose key ranges do not meet (rooms, regions, objects and doors have different id
+    prefixes) are put one after the other."""
+    runs = sorted((g for g in groups if g), key=lambda g: g[0][0])
+    if all(a[-1][0] < b[0][0] for a, b in zip(runs, runs[1:], strict=False)):
+        return [e for g in runs for e in g]
+    keyed = [(e[0], k, i, e) for k, g in enumerate(groups) for i, e in enumerate(g)]
+    keyed.sort(key=lambda t: t[:3])
+    return [t[3] for t in keyed]
+
 
 def actionable(graph: SceneGraph) -> list[Candidate]:
     """N_a in natural id order; unreachable nodes are left out."""
-    keyed: list[tuple[tuple, int, Candidate]] = []
     dists = graph.distances
-    memo, add = _STATIC.memo, _STATIC.add
-    isfinite = math.isfinite
+    if not dists:
+        return _actionable_without_distances(graph)
+    nodes = _in_order([_ORDER.nodes("room", graph.rooms),
+                       _ORDER.nodes("region", graph.regions),
+                       _ORDER.nodes("object", graph.objects), _ORDER.doors(graph)])
+    out = []
+    get, isfinite = dists.get, math.isfinite
+    for _, nid, skill, kind, xy in nodes:
+        d = get(nid)
+        if d is not None and isfinite(d):
+            out.append(Candidate(nid, skill, kind, float(d), xy))
+    return out
+
+
+def _actionable_without_distances(graph: SceneGraph) -> list[Candidate]:
+    """:func:`actionable` of a graph without travel distances (straight lines)."""
+    keyed: list[tuple[tuple, int, Candidate]] = []
     for group in (graph.rooms, graph.regions, graph.objects):
         for node in group:
-            entry = memo.get(id(node))
+            entry = _STATIC.memo.get(id(node))
             if entry is None or entry[0] is not node:
-                entry = add(node)
+                entry = _STATIC.add(node)
             if entry[1] is None:
                 continue
-            if dists:
-                d = dists.get(node.id)
-                if d is None or not isfinite(d):
-                    continue
-                d = float(d)
-            else:
-                d = distance_to(graph, node)  # type: ignore[assignment]
+            d = distance_to(graph, node)
             keyed.append((entry[3], len(keyed),
-                          Candidate(entry[4], entry[1], entry[2], d, entry[5])))
+                          Candidate(entry[4], entry[1], entry[2], d, entry[5])))  # type: ignore[arg-type]
     for door in graph.doors:
         if door_is_entrance(graph, door):
             d = distance_to(graph, door)
-            if d is not None:
-                keyed.append((natural_key(door.id), len(keyed),
-                              Candidate(door.id, "open", "door", d, node_xy(door))))
+            keyed.append((natural_key(door.id), len(keyed),
+                          Candidate(door.id, "open", "door", d, node_xy(door))))  # type: ignore[arg-type]
     keyed.sort()  # by natural key, then (equal ids) in graph order, as a stable sort
     return [c for _, _, c in keyed]
 
@@ -190,12 +318,24 @@ def actionable(graph: SceneGraph) -> list[Candidate]:
 def find_target(graph: SceneGraph, query: str) -> ObjectNode | None:
     """The nearest observed object of the query category (exact name match), or None."""
     best: tuple[float, str, ObjectNode] | None = None
-    want = category_text(query)
-    for o in graph.objects:
-        if category_text(o.category) != want:
-            continue
+    for o in _of_query(graph.objects, query):
         d = distance_to(graph, o)
         key = (d if d is not None else math.inf, o.id, o)
         if best is None or key[:2] < best[:2]:
             best = key
     return None if best is None else best[2]
+
+
+_QUERY_OBJECTS: list[tuple[tuple, str, list[ObjectNode]]] = []  # the last objects tuple's
+
+
+def _of_query(objects: tuple[ObjectNode, ...], query: str) -> list[ObjectNode]:
+    """The objects of the query category, in graph order; kept for the last (objects
+    tuple, query), which an incremental graph passes again until its objects change."""
+    last = _QUERY_OBJECTS[0] if _QUERY_OBJECTS else None
+    if last is not None and last[0] is objects and last[1] == query:
+        return last[2]
+    want = category_text(query)
+    found = [o for o in objects if category_text(o.category) == want]
+    _QUERY_OBJECTS[:] = [(objects, query, found)]
+    return found

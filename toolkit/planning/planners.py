@@ -16,7 +16,12 @@ import numpy as np
 from sgtool.planning.base import Action, Feedback
 from sgtool.planning.candidates import Candidate, actionable, find_target
 from sgtool.planning.memory import EpisodeMemory
-from sgtool.planning.utility import UtilityParams, candidate_utilities, select_with_margin
+from sgtool.planning.utility import (
+    EpisodeCache,
+    UtilityParams,
+    candidate_utilities,
+    select_with_margin,
+)
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.semantics.priors import RelationScorer
 
@@ -100,11 +105,17 @@ class UtilityPlanner(NodeSelectionPlanner):
         self.name = name
         self.scorer = scorer
         self.params = params
+        self.cache = EpisodeCache()
+
+    def reset(self, query: str, seed: int = 0) -> None:
+        super().reset(query, seed)
+        self.cache = EpisodeCache()  # per episode (its docstring)
 
     def choose(self, graph: SceneGraph, cands: list[Candidate]
                ) -> tuple[int, str, dict[str, float]]:
-        u = candidate_utilities(graph, cands, self.query, self.scorer, self.params)
-        i = select_with_margin(u, [c.distance for c in cands], [c.node_id for c in cands],
-                               self.params.delta)
-        scores = dict(zip([c.node_id for c in cands], map(_round4, u), strict=True))
+        u = candidate_utilities(graph, cands, self.query, self.scorer, self.params,
+                                self.cache)
+        ids = [c.node_id for c in cands]
+        i = select_with_margin(u, [c.distance for c in cands], ids, self.params.delta)
+        scores = dict(zip(ids, map(_round4, u), strict=True))
         return i, f"u={u[i]:.3f} (max {max(u):.3f}), d={cands[i].distance:.2f} m", scores

@@ -127,6 +127,25 @@ class ObjectTable:
         self.x, self.y = xy[:, 0], xy[:, 1]
         self._scores: tuple[object, str, np.ndarray] | None = None
 
+    def same_rows(self, objects: Sequence[ObjectNode]) -> bool:
+        """Whether ``objects`` give this table's rows: the same nodes, or nodes with the same
+        id, category, room and position object (a state change, as an incremental graph
+        makes when a container is opened)."""
+        if len(objects) != len(self.objects):
+            return False
+        for a, b in zip(self.objects, objects, strict=True):
+            if a is not b and (a.id != b.id or a.category != b.category or a.room != b.room
+                               or a.position is not b.position):
+                return False
+        return True
+
+    def with_objects(self, objects: Sequence[ObjectNode]) -> ObjectTable:
+        """This table for ``objects`` (:meth:`same_rows`), sharing its arrays and scores."""
+        table = object.__new__(ObjectTable)
+        table.__dict__.update(self.__dict__)
+        table.objects = objects
+        return table
+
     def raw_scores(self, scorer: RelationScorer, query: str) -> np.ndarray:
         """u_q(o) of every object (Eq. 3), asked of the scorer once per (scorer, query)."""
         hit = self._scores
@@ -168,6 +187,71 @@ def object_table(graph: SceneGraph) -> ObjectTable:
     return table
 
 
+class EpisodeCache:
+    """What :func:`candidate_utilities` may reuse between the decisions of one episode: the
+    room utilities of the last rooms tuple and the object table of the last objects tuple
+    (:meth:`ObjectTable.same_rows`: reused, with its scores, when only states changed).
+
+    The scorer is asked nothing it was not asked before in the episode, so its answers
+    are the ones it would give again (a scorer forgets its scores only between units of
+    work; make a new cache for each episode)."""
+
+    def __init__(self) -> None:
+        self._rooms: tuple[tuple, object, str, UtilityParams, dict[str, float]] | None = None
+        self._table: ObjectTable | None = None
+        self._objects: tuple[tuple, np.ndarray, list[float]] | None = None
+        self._nearby: tuple[np.ndarray, np.ndarray, list, float, list[list[float]]] | None = \
+            None
+
+    def rooms(self, graph: SceneGraph, query: str, scorer: RelationScorer,
+              params: UtilityParams) -> dict[str, float]:
+        hit = self._rooms
+        if hit is not None and hit[0] is graph.rooms and hit[1] is scorer and \
+                hit[2] == query and hit[3] == params:
+            return hit[4]
+        out = room_utilities(graph, query, scorer, params)
+        self._rooms = (graph.rooms, scorer, query, params, out)
+        return out
+
+    def table(self, graph: SceneGraph) -> ObjectTable:
+        last = self._table
+        if last is not None and last.objects is graph.objects:
+            return last
+        if last is not None and last.same_rows(graph.objects):
+            table = last.with_objects(graph.objects)
+        else:
+            table = ObjectTable(graph.objects)
+        self._table = table
+        return table
+
+    def object_utilities(self, table: ObjectTable, query: str, scorer: RelationScorer,
+                         params: UtilityParams, rooms: dict[str, float]
+                         ) -> tuple[np.ndarray, list[float]]:
+        """:func:`object_utility_array` of ``table`` (and as a list), kept while the
+        table's rows and the room utilities are the same."""
+        key = (table.x, scorer, query, params, rooms)
+        hit = self._objects
+        if hit is not None and all(a is b for a, b in zip(hit[0], key, strict=True)):
+            return hit[1], hit[2]
+        u = object_utility_array(table, query, scorer, params, rooms) if len(table.ids) \
+            else np.zeros(0)
+        self._objects = (key, u, u.tolist())
+        return u, self._objects[2]
+
+    def nearby_best(self, table: ObjectTable, u: np.ndarray,
+                    positions: list[tuple[float, float]], radius: float
+                    ) -> list[list[float]]:
+        """:func:`_nearby_best`, kept while the table's rows, the utilities, the frontier
+        positions and the radius are the same."""
+        hit = self._nearby
+        if hit is not None and hit[0] is table.x and hit[1] is u and hit[2] == positions \
+                and hit[3] == radius:
+            return hit[4]
+        out = _nearby_best(table, u, positions, radius)
+        self._nearby = (table.x, u, positions, radius, out)
+        return out
+
+
 def object_utility_array(table: ObjectTable, query: str, scorer: RelationScorer,
                          params: UtilityParams, rooms: dict[str, float]) -> np.ndarray:
     """Eqs. 3-4 for every row of ``table``, in one vectorised pass (the same float64
@@ -196,13 +280,19 @@ def candidate_utilities(
     query: str,
     scorer: RelationScorer,
     params: UtilityParams,
+    cache: EpisodeCache | None = None,
 ) -> list[float]:
-    """u_q(n) for each candidate, in order (module doc for each node type)."""
-    rooms = room_utilities(graph, query, scorer, params)
-    table = object_table(graph)
-    u = object_utility_array(table, query, scorer, params, rooms) if graph.objects \
-        else np.zeros(0)
-    values = u.tolist()
+    """u_q(n) for each candidate, in order (module doc for each node type). ``cache``: an
+    :class:`EpisodeCache` kept for the decisions of one episode."""
+    if cache is None:
+        rooms = room_utilities(graph, query, scorer, params)
+        table = object_table(graph)
+        u = object_utility_array(table, query, scorer, params, rooms) if graph.objects \
+            else np.zeros(0)
+        values = u.tolist()
+    else:
+        rooms, table = cache.rooms(graph, query, scorer, params), cache.table(graph)
+        u, values = cache.object_utilities(table, query, scorer, params, rooms)
     out: list[float] = []
     frontiers: list[int] = []
     for c in candidates:
@@ -218,8 +308,9 @@ def candidate_utilities(
             out.append(math.nan)
     if frontiers:
         regions = {r.id: r for r in graph.regions}
-        nearby = _nearby_best(table, u, [candidates[k].position for k in frontiers],
-                              params.frontier_radius)
+        positions = [candidates[k].position for k in frontiers]
+        nearby = _nearby_best(table, u, positions, params.frontier_radius) if cache is None \
+            else cache.nearby_best(table, u, positions, params.frontier_radius)
         for k, best in zip(frontiers, nearby, strict=True):
             region = regions.get(candidates[k].node_id)
             room_id = getattr(region, "room", None)
