@@ -76,10 +76,12 @@ passages), :mod:`~sgtool.datasets.walls`, :mod:`~sgtool.datasets.furnishing` and
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 
+from sgtool.canonical import canonical_float
 from sgtool.datasets.floor_plan import floor_plan
 from sgtool.datasets.furnishing import furnish_room
 from sgtool.datasets.house_inventory import house_inventory
@@ -99,11 +101,20 @@ from sgtool.datasets.synsets import readable_name
 from sgtool.datasets.walls import wall_segments
 from sgtool.errors import SgtoolError
 from sgtool.house.io import load_house
-from sgtool.house.spec import HouseSpec
+from sgtool.house.spec import HouseSpec, StartPose
 
 MAX_ROOMS = 30  # corridors included; a third corridor room from 17 rooms on
 
 __all__ = ["HOUSE_ROOM_TYPES", "generate_house"]
+
+
+def _with_starts(draft: HouseSpec, starts: list[dict]) -> HouseSpec:
+    """``draft`` (loaded from :func:`_spec_dict` without starts) with ``starts``: what
+    loading :func:`_spec_dict` with them gives (numbers made canonical as the parser does;
+    the poses lie inside their rooms by construction), without parsing the house twice."""
+    poses = tuple(StartPose(x=canonical_float(s["x"]), y=canonical_float(s["y"]),
+                            yaw=canonical_float(s["yaw"]), room=s["room"]) for s in starts)
+    return dataclasses.replace(draft, starts=poses)
 
 
 def _spec_dict(seed: int, split: str, plan: Plan, pieces: list[Piece], objs: list[dict],
@@ -174,7 +185,7 @@ def generate_house(seed: int, rooms: tuple[int, int] = (4, 12), split: str = "ev
             objs = place_objects(rng, split, pieces, room_types, pre, frozenset(extras))
             draft = load_house(_spec_dict(seed, split, plan, pieces, objs, []))
             starts = start_poses(rng, draft)
-            return load_house(_spec_dict(seed, split, plan, pieces, objs, starts))
+            return _with_starts(draft, starts)
         except PlanRetry:
             continue
     raise SgtoolError(f"could not build a house for seed {seed} in {max_attempts} attempts")

@@ -11,7 +11,7 @@ import numpy as np
 from sgtool.datasets.house_plan import PlanRetry
 from sgtool.house.spec import HouseSpec
 from sgtool.mapping.occupancy import geodesic_distances, house_occupancy
-from sgtool.mapping.raster import cell_centers
+from sgtool.mapping.raster import cell_centers, cell_window
 
 ROBOT_RADIUS = 0.2
 REACH = 1.0  # the robot must be able to stand within this of every container (m)
@@ -31,23 +31,35 @@ def start_poses(rng: np.random.Generator, spec: HouseSpec) -> list[dict]:
     starts = []
     for r in spec.rooms:
         x0, y0, x1, y1 = r.bounds
-        inside = (X > x0) & (X < x1) & (Y > y0) & (Y < y1) & reach
+        # every cell centre strictly inside the room lies in this window (row-major order
+        # kept, so argmin picks the same first cell as over the whole grid)
+        win = cell_window(occ, [x0, x1], [y0, y1])
+        if win is None:
+            raise PlanRetry
+        Xw, Yw = X[win], Y[win]
+        inside = (Xw > x0) & (Xw < x1) & (Yw > y0) & (Yw < y1) & reach[win]
         if not inside.any():
             raise PlanRetry
         cx, cy = r.centroid
-        d2 = np.where(inside, (X - cx) ** 2 + (Y - cy) ** 2, np.inf)
+        d2 = np.where(inside, (Xw - cx) ** 2 + (Yw - cy) ** 2, np.inf)
         i = int(np.argmin(d2))
         yaw = round(float(rng.uniform(-math.pi, math.pi)), 4)
-        starts.append({"x": round(float(X.ravel()[i]), 4), "y": round(float(Y.ravel()[i]), 4),
+        starts.append({"x": round(float(Xw.ravel()[i]), 4), "y": round(float(Yw.ravel()[i]), 4),
                        "yaw": yaw, "room": r.id})
+    m = REACH - ROBOT_RADIUS
     for f in spec.furniture:
         if not f.affordances:
             continue
         (ax, ay), (bx, by) = f.footprint()[0], f.footprint()[2]
         bx0, bx1 = min(ax, bx), max(ax, bx)
         by0, by1 = min(ay, by), max(ay, by)
-        dx = np.maximum(np.maximum(bx0 - X, X - bx1), 0.0)
-        dy = np.maximum(np.maximum(by0 - Y, Y - by1), 0.0)
-        if not ((dx ** 2 + dy ** 2 <= (REACH - ROBOT_RADIUS) ** 2) & reach).any():
+        # cells farther than m from the box cannot count: look at the box grown by m
+        win = cell_window(occ, [bx0 - m, bx1 + m], [by0 - m, by1 + m])
+        if win is None:
+            raise PlanRetry
+        Xw, Yw = X[win], Y[win]
+        dx = np.maximum(np.maximum(bx0 - Xw, Xw - bx1), 0.0)
+        dy = np.maximum(np.maximum(by0 - Yw, Yw - by1), 0.0)
+        if not ((dx ** 2 + dy ** 2 <= m ** 2) & reach[win]).any():
             raise PlanRetry
     return starts

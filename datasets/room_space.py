@@ -14,6 +14,8 @@ from sgtool.datasets.house_plan import WALL_T, Opening, PlanRoom, Rect
 from sgtool.datasets.robot_clearance import REACH, ROBOT_RADIUS
 
 _CELL = 0.05  # resolution of the in-room free-space checks
+_BLOCK_D2 = 20  # squared cell distance below ROBOT_RADIUS + _CELL / 2 (see free_ok)
+_BLOCK_CELLS = 4  # the largest row or column offset within _BLOCK_D2
 
 
 class RoomSpace:
@@ -25,6 +27,14 @@ class RoomSpace:
         self.cols = int(round(self.inner.width / _CELL))
         self.rows = int(round(self.inner.height / _CELL))
         self.occ = np.zeros((self.rows, self.cols), bool)
+        # cells the robot's centre cannot take: within _BLOCK_D2 (cells^2) of the walls or
+        # of an occupied cell; kept up to date by add(), so free_ok() only adds its box
+        self.blocked = np.zeros((self.rows, self.cols), bool)
+        w = _BLOCK_CELLS
+        self.blocked[:w, :] = self.blocked[-w:, :] = True
+        self.blocked[:, :w] = self.blocked[:, -w:] = True
+        self.ys = self.inner.y0 + (np.arange(self.rows) + 0.5) * _CELL
+        self.xs = self.inner.x0 + (np.arange(self.cols) + 0.5) * _CELL
         self.keepouts: list[Rect] = []
         self.approach: list[tuple[int, int]] = []
         for o in openings:
@@ -58,14 +68,38 @@ class RoomSpace:
         r1 = min(int(math.ceil((box.y1 - self.inner.y0) / _CELL - 1e-6)), self.rows)
         return slice(r0, r1), slice(c0, c1)
 
+    def _blocked_by(self, box: Rect) -> tuple[tuple[slice, slice], np.ndarray] | None:
+        """(window, mask) of the cells within _BLOCK_D2 of ``box``'s cells; None if none."""
+        rs, cs = self._cell_slices(box)
+        # the cells occ[rs, cs] marks (a negative stop counts from the end, as in numpy)
+        r0, r1, _ = rs.indices(self.rows)
+        c0, c1, _ = cs.indices(self.cols)
+        if r0 >= r1 or c0 >= c1:
+            return None
+        w = _BLOCK_CELLS
+        win = (slice(max(r0 - w, 0), min(r1 + w, self.rows)),
+               slice(max(c0 - w, 0), min(c1 + w, self.cols)))
+        r = np.arange(win[0].start, win[0].stop)
+        c = np.arange(win[1].start, win[1].stop)
+        dr = np.maximum(np.maximum(r0 - r, r - (r1 - 1)), 0)
+        dc = np.maximum(np.maximum(c0 - c, c - (c1 - 1)), 0)
+        return win, dr[:, None] ** 2 + dc[None, :] ** 2 <= _BLOCK_D2
+
     def free_ok(self, boxes_to_reach: Sequence[Rect], extra: Rect | None) -> bool:
-        """Can the robot cross between all openings and reach every box within REACH?"""
-        occ = self.occ.copy()
+        """Can the robot cross between all openings and reach every box within REACH?
+
+        A cell is free when its centre is at least ROBOT_RADIUS + half a cell from every
+        occupied cell and wall cell (the padded grid's Euclidean distance transform, as
+        :func:`free_mask_edt` computes it); in cells that is a squared distance of at least
+        25 (offsets of squared length 21-24 do not exist, 20 is 0.2236 m < 0.225 m), so
+        the blocked cells are those within a squared distance of 20 (``_BLOCK_D2``)."""
+        blocked = self.blocked
         if extra is not None:
-            occ[self._cell_slices(extra)] = True
-        padded = np.pad(occ, 1, constant_values=True)  # the walls
-        dist = ndimage.distance_transform_edt(~padded, sampling=_CELL)[1:-1, 1:-1]
-        free = dist >= ROBOT_RADIUS + _CELL / 2 - 1e-9
+            more = self._blocked_by(extra)
+            if more is not None:
+                blocked = blocked.copy()
+                blocked[more[0]] |= more[1]
+        free = ~blocked
         labels, _ = ndimage.label(free, structure=np.ones((3, 3), bool))
         if not self.approach:
             return True
@@ -75,16 +109,30 @@ class RoomSpace:
         main = labels == lab.pop()
         if not boxes_to_reach:
             return True
-        ys = self.inner.y0 + (np.arange(self.rows) + 0.5) * _CELL
-        xs = self.inner.x0 + (np.arange(self.cols) + 0.5) * _CELL
+        m = REACH - ROBOT_RADIUS
         for b in boxes_to_reach:
+            # only cells within m of the box can be near it: look at those rows and columns
+            rs, cs = self._cell_slices(Rect(b.x0 - m - _CELL, b.y0 - m - _CELL,
+                                            b.x1 + m + _CELL, b.y1 + m + _CELL))
+            xs, ys = self.xs[cs], self.ys[rs]
             dx = np.maximum(np.maximum(b.x0 - xs, xs - b.x1), 0.0)
             dy = np.maximum(np.maximum(b.y0 - ys, ys - b.y1), 0.0)
             near = (dy[:, None] ** 2 + dx[None, :] ** 2) <= (REACH - ROBOT_RADIUS) ** 2
             # the robot centre within REACH - radius of the box: its body within REACH
-            if not (near & main).any():
+            if not (near & main[rs, cs]).any():
                 return False
         return True
 
     def add(self, box: Rect) -> None:
         self.occ[self._cell_slices(box)] = True
+        more = self._blocked_by(box)
+        if more is not None:
+            self.blocked[more[0]] |= more[1]
+
+
+def free_mask_edt(occ: np.ndarray) -> np.ndarray:
+    """The free cells of an in-room occupancy grid by the distance transform (the
+    definition :meth:`RoomSpace.free_ok` implements incrementally; kept for the tests)."""
+    padded = np.pad(occ, 1, constant_values=True)  # the walls
+    dist = ndimage.distance_transform_edt(~padded, sampling=_CELL)[1:-1, 1:-1]
+    return dist >= ROBOT_RADIUS + _CELL / 2 - 1e-9

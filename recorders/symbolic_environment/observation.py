@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import bisect
 import math
+from itertools import compress
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -203,8 +204,8 @@ class ObservedGraph:
             if fin.all():
                 distances.update(zip(ids, vals.tolist(), strict=True))
             else:
-                distances.update((i, v) for i, v, ok in zip(ids, vals.tolist(), fin.tolist(),
-                                                            strict=True) if ok)
+                distances.update(zip(compress(ids, fin.tolist()), vals[fin].tolist(),
+                                     strict=True))
         for did, a, b in self._doors[1]:
             d = float(min(dist[a], dist[b]))
             if math.isfinite(d):
