@@ -69,6 +69,8 @@ def main(argv: list[str] | None = None) -> int:
                     default=Path(tempfile.gettempdir()) / "sgtool-bench-replay")
     ap.add_argument("--against", type=Path, help="an older source tree, run side by side")
     ap.add_argument("--rounds", type=int, default=2, help="rounds with --against")
+    ap.add_argument("--worst", type=int, default=0,
+                    help="also print the stage times of the N slowest refreshes per house")
     ap.add_argument("--json", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.against is not None:
@@ -96,11 +98,24 @@ def main(argv: list[str] | None = None) -> int:
         stages = {s: statistics.median(t[s]) for s in STAGES if t.get(s)}
         rows.append((n, rep.frames, len(ref), ref[0], med, mx, sum(ref) / 1e3,
                      statistics.median(t["integrate"]), stages, cpu))
+        if a.worst:
+            print_worst(n, t, a.worst)
     if a.json:
         print(json.dumps(rows))
     else:
         table(rows)
     return 0
+
+
+def print_worst(rooms: int, t: dict[str, list[float]], k: int) -> None:
+    """The ``k`` slowest refreshes after the first: their index and every stage's ms."""
+    ref = t["refresh"]
+    worst = sorted(range(1, len(ref)), key=lambda i: -ref[i])[:k]
+    stages = [s for s in STAGES if len(t.get(s, ())) == len(ref)]
+    print(f"{rooms} rooms, slowest refreshes (index: total ms | stages ms)", file=sys.stderr)
+    for i in worst:
+        print(f"  #{i:<4} {ref[i]:7.1f} | " + " ".join(f"{s} {t[s][i]:.1f}" for s in stages),
+              file=sys.stderr)
 
 
 def table(rows: list) -> None:  # type: ignore[type-arg]

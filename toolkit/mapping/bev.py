@@ -124,6 +124,8 @@ class ColumnGrid:
         # (extent, those points, the mask); only new points are stamped while it holds
         self._footprint: tuple[tuple[int, int, int, int], list[tuple[float, float]],
                                np.ndarray] | None = None
+        # the last occupancy grid made and its unknown components (see unknown_parts_of)
+        self._parts: tuple[np.ndarray, UnknownParts | None] | None = None
 
     def _fit(self, sets: Sequence[np.ndarray], trajectory: Sequence[tuple[float, float]]
              ) -> None:
@@ -193,8 +195,19 @@ class ColumnGrid:
         """The occupancy grid (module doc) of the flags plus the trajectory footprint."""
         self._fit([], trajectory)
         assert self.extent is not None
-        return occupancy_grid(self.flags, self.extent, self.resolution, self.config,
-                              trajectory, level, self._footprint_of(trajectory))
+        occ, parts = _occupancy_and_parts(self.flags, self.extent, self.resolution,
+                                          self.config, trajectory, level,
+                                          self._footprint_of(trajectory))
+        self._parts = (occ.grid, parts)
+        return occ
+
+    def unknown_parts_of(self, occ: OccupancyGrid) -> UnknownParts | None:
+        """The 4-connected components of the unknown cells of ``occ`` when it is the last
+        grid :meth:`occupancy` made (the labelling of the hole filling, the filled holes
+        taken out: label values may have gaps), else None."""
+        if self._parts is None or self._parts[0] is not occ.grid:
+            return None
+        return self._parts[1]
 
     def _footprint_of(self, trajectory: Sequence[tuple[float, float]]) -> np.ndarray:
         """:func:`footprint` of ``trajectory`` over the current extent, stamping only the
@@ -224,6 +237,16 @@ def occupancy_grid(flags: np.ndarray, extent: tuple[int, int, int, int], resolut
     """FREE / OCCUPIED / UNKNOWN from column flags (``ColumnGrid.OCC``/``FLOOR``) over the
     voxel-index ``extent``, with the robot footprint along ``trajectory`` (``stamped``:
     that footprint, when the caller has it) and small holes filled."""
+    return _occupancy_and_parts(flags, extent, resolution, config, trajectory, level,
+                                stamped)[0]
+
+
+def _occupancy_and_parts(flags: np.ndarray, extent: tuple[int, int, int, int],
+                         resolution: float, config: BevConfig,
+                         trajectory: Sequence[tuple[float, float]], level: int,
+                         stamped: np.ndarray | None
+                         ) -> tuple[OccupancyGrid, UnknownParts | None]:
+    """:func:`occupancy_grid` and its unknown components (:func:`fill_holes_parts`)."""
     ix0, iy0 = extent[0], extent[1]
     h, w = flags.shape
     grid = np.full((h, w), UNKNOWN, dtype=np.int8)
@@ -233,9 +256,9 @@ def occupancy_grid(flags: np.ndarray, extent: tuple[int, int, int, int], resolut
     elif len(trajectory):
         grid[footprint(trajectory, extent, (h, w), resolution, config.robot_radius)] = FREE
     grid[(flags & ColumnGrid.OCC) != 0] = OCCUPIED
-    fill_holes(grid, int(config.max_hole / resolution**2))
+    _, parts = fill_holes_parts(grid, int(config.max_hole / resolution**2))
     origin = (ix0 * resolution, iy0 * resolution)
-    return OccupancyGrid(grid, origin, resolution, (level + 1) * resolution)
+    return OccupancyGrid(grid, origin, resolution, (level + 1) * resolution), parts
 
 
 def occupancy_from_keys(keys: np.ndarray, resolution: float, config: BevConfig,
@@ -327,6 +350,9 @@ def footprint(trajectory: Sequence[tuple[float, float]], extent: tuple[int, int,
     return out
 
 
+UnknownParts = tuple[np.ndarray, int]  # (labels of 4-connected components, max label)
+
+
 def near(mask: np.ndarray) -> np.ndarray:
     """Cells 8-adjacent to (or in) ``mask`` (a 3x3 dilation by shifted ORs)."""
     p = np.pad(mask, 1)
@@ -349,12 +375,20 @@ def fill_holes(grid: np.ndarray, max_cells: int) -> int:
     """Turn enclosed unknown holes of at most ``max_cells`` cells (4-connected, bordered
     only by free cells, not touching the grid border) into free space, in place; returns
     the number of cells filled."""
+    return fill_holes_parts(grid, max_cells)[0]
+
+
+def fill_holes_parts(grid: np.ndarray, max_cells: int) -> tuple[int, UnknownParts | None]:
+    """:func:`fill_holes`, and the 4-connected components of the unknown cells left
+    (labels, an upper bound of the label values; None when ``max_cells`` <= 0 skips the
+    labelling). Filling turns whole components free, so the components left are those of
+    the labelling before it, the filled ones relabelled 0."""
     if max_cells <= 0:
-        return 0
+        return 0, None
     unknown = grid == UNKNOWN
     lab, n = ndimage.label(unknown)
     if n == 0:
-        return 0
+        return 0, (lab, 0)
     sizes = np.bincount(lab.ravel())
     bad = np.zeros(n + 1, dtype=bool)
     bad[0] = True
@@ -366,7 +400,8 @@ def fill_holes(grid: np.ndarray, max_cells: int) -> int:
     bad[np.unique(edge)] = True
     fill = ~bad[lab]
     grid[fill] = FREE
-    return int(fill.sum())
+    lab[fill] = 0
+    return int(fill.sum()), (lab, int(n))
 
 
 def line_of_sight(blocked: np.ndarray, occ: OccupancyGrid, a: np.ndarray, b: np.ndarray,

@@ -17,7 +17,6 @@ from collections.abc import Sequence
 from typing import Protocol
 
 import numpy as np
-from matplotlib.path import Path as MplPath
 
 from sgtool.house.geometry import Point, signed_area
 
@@ -82,6 +81,8 @@ def fill_polygon(grid: Grid, out: np.ndarray, polygon: Sequence[Point],
     win = cell_window(grid, [p[0] for p in polygon], [p[1] for p in polygon])
     if win is None:
         return
+    from matplotlib.path import Path as MplPath  # imported on first use: start-up time
+
     X, Y = cell_centers(grid, win)
     pts = np.column_stack([X.ravel(), Y.ravel()])
     # a small radius signed like the winding grows the path, so the border counts as inside

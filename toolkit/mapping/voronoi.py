@@ -42,8 +42,8 @@ import math
 from bisect import bisect_left
 from dataclasses import dataclass, field
 from itertools import chain
+from typing import TYPE_CHECKING
 
-import networkx as nx
 import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
@@ -57,6 +57,9 @@ from sgtool.mapping.ridge_window import (
     ridge_from_fields,
     update_fields,
 )
+
+if TYPE_CHECKING:  # networkx is imported only when the view is built (start-up time)
+    import networkx as nx
 
 _SQRT2 = math.sqrt(2.0)
 
@@ -393,6 +396,8 @@ def voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
 
 def _networkx_graph(positions: np.ndarray, clearance: np.ndarray, cells: np.ndarray,
                     edges: np.ndarray, lengths: np.ndarray) -> nx.Graph:
+    import networkx as nx
+
     g = nx.Graph()
     g.add_nodes_from(
         (i, {"pos": (x, y), "clearance": c, "cell": (r, q)})

@@ -18,12 +18,14 @@ are merged).
 Integration (:meth:`VoxelMap.integrate`): valid depth in ``[min_range, max_range)``
 (MoMa-LLM: 0-5 m) is back-projected with the intrinsics, moved to the world by the pose,
 quantised and packed; the frame's distinct keys with counts are kept aside and merged into
-the map every few frames (one ``searchsorted`` + ``insert`` for many frames). Per instance
-the map also keeps what the scene graph needs without scanning the voxels: the points per
-frame (an object counts as *seen* when one frame shows it with at least ``min_points``
-points; MoMa-LLM: > 50), the closest viewpoint it was seen from (MoMa-LLM keeps the closest
-viewpoint per object, used by the object-to-room cost), and the number and integer index
-sums of its voxels (its centroid, exact and independent of merge batching).
+the map every few frames (one ``searchsorted`` + ``insert`` for many frames, into a small
+sorted tail merged into the big array now and then: :mod:`sgtool.mapping.vote_store`).
+Per instance the map also keeps what the scene graph needs without scanning the voxels:
+the points per frame (an object counts as *seen* when one frame shows it with at least
+``min_points`` points; MoMa-LLM: > 50), the closest viewpoint it was seen from (MoMa-LLM
+keeps the closest viewpoint per object, used by the object-to-room cost), and the number
+and integer index sums of its voxels (its centroid, exact and independent of merge
+batching).
 
 Dynamic scenes: a door or a drawer that changes state leaves its old voxels behind;
 :meth:`VoxelMap.forget_instance` drops every vote of an instance so that it is rebuilt
@@ -44,6 +46,7 @@ import numpy as np
 
 from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.mapping.backproject import Scratch, within_packing, world_voxels
+from sgtool.mapping.vote_store import VoteStore, drain_keys
 
 AXIS_BITS = 17
 LABEL_BITS = 12
@@ -169,8 +172,7 @@ class VoxelMap:
 
     def __init__(self, config: VoxelConfig | None = None) -> None:
         self.config = config or VoxelConfig()
-        self._keys = np.zeros(0, dtype=np.int64)
-        self._counts = np.zeros(0, dtype=np.int64)
+        self._store = VoteStore()  # the sorted keys and counts, in two levels
         self._pending: list[tuple[np.ndarray, np.ndarray]] = []
         self._pending_n = 0
         self._label_ids: list[int] = [0]  # label index -> instance id
@@ -183,6 +185,7 @@ class VoxelMap:
         self.version = 0  # bumped whenever the voxels change
         self.removals = 0  # bumped by forget_instance (maps derived incrementally rebuild)
         self._new_keys: list[np.ndarray] = []  # entries new since the last drain
+        self._removed_keys: list[np.ndarray] = []  # entries removed since the last drain
         self._zhist = np.zeros(1 << AXIS_BITS, dtype=np.int64)  # entries per height level
 
     # ----- integration ------------------------------------------------------------------
@@ -346,17 +349,8 @@ class VoxelMap:
             cnt = np.add.reduceat(counts, starts)
         self._pending.clear()
         self._pending_n = 0
-        n = len(self._keys)
-        pos = np.searchsorted(self._keys, uk)
-        found = np.zeros(len(uk), dtype=bool)
-        inb = pos < n
-        found[inb] = self._keys[pos[inb]] == uk[inb]
-        self._counts[pos[found]] += cnt[found]
-        new = ~found
-        if new.any():
-            nk = uk[new]
-            self._keys = np.insert(self._keys, pos[new], nk)
-            self._counts = np.insert(self._counts, pos[new], cnt[new])
+        nk = self._store.add(uk, cnt)
+        if len(nk):
             self._voxel_stats(nk, +1)
             self._new_keys.append(nk)
             self._zhist += np.bincount((nk >> SHIFT_Z) & AXIS_MASK, minlength=1 << AXIS_BITS)
@@ -377,14 +371,14 @@ class VoxelMap:
         lab = self._label_of.get(int(instance_id))
         if lab is None or lab == 0 or lab == OVERFLOW_LABEL:
             return 0
-        self.flush()
-        mask = (self._keys & LABEL_MASK) == lab
+        keys, counts = self.entries()
+        mask = (keys & LABEL_MASK) == lab
         n = int(mask.sum())
         if n:
-            gone = self._keys[mask]
+            gone = keys[mask]
             self._zhist -= np.bincount((gone >> SHIFT_Z) & AXIS_MASK, minlength=1 << AXIS_BITS)
-            self._keys = self._keys[~mask]
-            self._counts = self._counts[~mask]
+            self._store.replace(keys[~mask], counts[~mask])
+            self._removed_keys.append(gone)
             self.removals += 1
             self.version += 1
         st = self._stats
@@ -404,21 +398,21 @@ class VoxelMap:
 
     def __len__(self) -> int:
         self.flush()
-        return len(self._keys)
+        return len(self._store)
 
     def entries(self) -> tuple[np.ndarray, np.ndarray]:
         """(sorted packed keys, vote counts) of every (voxel, label) pair."""
         self.flush()
-        return self._keys, self._counts
+        return self._store.arrays()
 
     def drain_new_keys(self) -> np.ndarray:
         """(voxel, label) keys that entered the map since the last call (unsorted)."""
         self.flush()
-        if not self._new_keys:
-            return np.zeros(0, dtype=np.int64)
-        out = np.concatenate(self._new_keys)
-        self._new_keys.clear()
-        return out
+        return drain_keys(self._new_keys)
+
+    def drain_removed_keys(self) -> np.ndarray:
+        """(voxel, label) keys removed since the last call (:meth:`forget_instance`)."""
+        return drain_keys(self._removed_keys)
 
     def level_histogram(self) -> tuple[int, np.ndarray]:
         """(lowest level, entries per height level from it up): the map's z histogram,

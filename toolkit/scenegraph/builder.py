@@ -6,8 +6,9 @@
 caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
 
 1. BEV occupancy (:mod:`sgtool.mapping.bev`): column flags are updated from the voxels new
-   since the last refresh only; a full rebuild happens when the floor level estimate moves
-   or voxels were removed (an instance changed state);
+   since the last refresh only; when voxels were removed (an instance changed state) only
+   the columns that held them are classified again (:mod:`sgtool.mapping.column_update`);
+   a full rebuild happens when the floor level estimate moves or the grid would shrink;
 2. Voronoi graph (:mod:`sgtool.mapping.voronoi`): the ridge pixel graph is reused while the
    free cells are unchanged, else its distance field and ridge cells are recomputed around
    the changed cells only (:mod:`sgtool.mapping.ridge_window`); the component is the
@@ -64,6 +65,7 @@ import numpy as np
 
 from sgtool.log.frame import Frame
 from sgtool.mapping.bev import ColumnGrid, classify_keys, floor_fans, floor_level
+from sgtool.mapping.column_update import fresh_extent, reclassify_columns
 from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
 from sgtool.mapping.voronoi import (
     RidgeGraph,
@@ -72,7 +74,7 @@ from sgtool.mapping.voronoi import (
     ridge_graph,
     voronoi_graph,
 )
-from sgtool.mapping.voxels import VoxelMap
+from sgtool.mapping.voxels import COLUMN_SHIFT, VoxelMap
 from sgtool.scenegraph.assembly import GraphParts, assemble_graph, robot_state
 from sgtool.scenegraph.assign import AssignCache
 from sgtool.scenegraph.builder_config import BuilderConfig
@@ -308,22 +310,6 @@ class SceneGraphBuilder:
         res = self.voxels.resolution
         lo, hist = self.voxels.level_histogram()
         level = floor_level(cfg, res, lo, hist)
-        if (self._columns is None or level != self._level
-                or self.voxels.removals != self._removals):
-            keys, _ = self.voxels.entries()
-            self.voxels.drain_new_keys()
-            cg = ColumnGrid(res, cfg)
-            cg.add(classify_keys(keys, level, res, cfg, presorted=True), self.trajectory)
-            self._columns, self._level, self._removals = cg, level, self.voxels.removals
-            self._door_voxels.reset(keys, self.voxels.label_ids(), self._door_ids())
-        else:
-            new = self.voxels.drain_new_keys()
-            self._columns.add(classify_keys(new, level, res, cfg), self.trajectory)
-            if self._door_voxels.stale(self._door_ids()):  # a new instance table
-                self._door_voxels.reset(self.voxels.entries()[0], self.voxels.label_ids(),
-                                        self._door_ids())
-            else:
-                self._door_voxels.add(new, self.voxels.label_ids())
         # the carved ground lives in its own grid, kept while the floor level stays: a
         # rebuild of the columns (a door opened) does not carve every frame again
         if self._carve is None or self._carve_level != level:
@@ -331,8 +317,48 @@ class SceneGraphBuilder:
         if self._carved < len(self._fans):
             self._carve.carve(np.concatenate(self._fans[self._carved:]), level)
             self._carved = len(self._fans)
+        rebuild = self._columns is None or level != self._level
+        removed = not rebuild and self.voxels.removals != self._removals
+        if removed and not self._columns_after_removal(level):
+            rebuild = True
+        if rebuild:
+            keys, _ = self.voxels.entries()
+            self.voxels.drain_new_keys()
+            self.voxels.drain_removed_keys()
+            cg = ColumnGrid(res, cfg)
+            cg.add(classify_keys(keys, level, res, cfg, presorted=True), self.trajectory)
+            self._columns, self._level, self._removals = cg, level, self.voxels.removals
+            self._door_voxels.reset(keys, self.voxels.label_ids(), self._door_ids())
+        elif not removed:
+            new = self.voxels.drain_new_keys()
+            self._columns.add(classify_keys(new, level, res, cfg), self.trajectory)
+            if self._door_voxels.stale(self._door_ids()):  # a new instance table
+                self._door_voxels.reset(self.voxels.entries()[0], self.voxels.label_ids(),
+                                        self._door_ids())
+            else:
+                self._door_voxels.add(new, self.voxels.label_ids())
+        assert self._columns is not None and self._carve is not None
         self._columns.merge(self._carve)
         return self._columns.occupancy(self.trajectory, level)
+
+    def _columns_after_removal(self, level: int) -> bool:
+        """Update the column grid for the keys new and removed since the last refresh by
+        classifying again only the columns that lost voxels; False when only a rebuild
+        gives the grid a rebuild would (its extent would shrink): rebuild then."""
+        cg, carve = self._columns, self._carve
+        assert cg is not None and carve is not None
+        keys, _ = self.voxels.entries()
+        new = self.voxels.drain_new_keys()
+        gone = self.voxels.drain_removed_keys()
+        cg.add(classify_keys(new, level, cg.resolution, cg.config), self.trajectory)
+        if not reclassify_columns(cg, keys, np.unique(gone >> COLUMN_SHIFT), level):
+            return False
+        cg.merge(carve)
+        if fresh_extent(cg, self.trajectory, carve) != cg.extent:
+            return False
+        self._removals = self.voxels.removals
+        self._door_voxels.reset(keys, self.voxels.label_ids(), self._door_ids())
+        return True
 
     def _voronoi(self, occ: OccupancyGrid, robot_xy: tuple[float, float] | None
                  ) -> VoronoiGraph:
@@ -372,7 +398,8 @@ class SceneGraphBuilder:
                         blocked: np.ndarray) -> tuple[list[Frontier], list[str], list[int]]:
         """Frontiers, their stable ids and their nearest visible room nodes."""
         cfg = self.config
-        frontiers = find_frontiers(occ, robot_xy, cfg.frontiers)
+        parts = None if self._columns is None else self._columns.unknown_parts_of(occ)
+        frontiers = find_frontiers(occ, robot_xy, cfg.frontiers, parts)
         fids = self._frontiers.assign([f.medoid for f in frontiers], cfg.frontier_match)
         nodes = nearest_visible(vg, np.flatnonzero(node_room >= 0),
                                 [f.medoid for f in frontiers], occ, blocked, cfg.entry_radius)

@@ -122,10 +122,13 @@ def outside_footprint(occ: OccupancyGrid,
 
 
 def find_frontiers(occ: OccupancyGrid, start: tuple[float, float] | None = None,
-                   config: FrontierConfig | None = None) -> list[Frontier]:
-    """Frontier clusters in raster order of their medoid cells."""
+                   config: FrontierConfig | None = None,
+                   unknown_parts: tuple[np.ndarray, int] | None = None) -> list[Frontier]:
+    """Frontier clusters in raster order of their medoid cells. ``unknown_parts``: the
+    4-connected components of the unknown cells of ``occ`` (labels, an upper bound of the
+    label values; any numbering), when the caller has them (the BEV's hole filling)."""
     cfg = config or FrontierConfig()
-    parts = _unknown_parts(occ)
+    parts = unknown_parts if unknown_parts is not None else _unknown_parts(occ)
     mask = frontier_cells(occ, start, cfg.snap, cfg.min_pocket, parts)
     if not mask.any():
         return []
