@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import statistics
 import subprocess
 import sys
@@ -33,17 +34,16 @@ SUBPACKAGES = ("recorders", "replayers", "datasets", "analysis")
 
 
 def shadow_package(base: Path, folder: Path) -> Path:
-    """A folder whose ``sgtool`` package is the tree ``base`` (symlinks)."""
+    """A folder whose ``sgtool`` package is the tree ``base`` (symlinks). A folder made
+    for another tree before is re-pointed: every link is made afresh."""
     pkg = folder / "sgtool"
-    pkg.mkdir(parents=True, exist_ok=True)
+    if pkg.exists():
+        shutil.rmtree(pkg)
+    pkg.mkdir(parents=True)
     for entry in (base / "toolkit").iterdir():
-        link = pkg / entry.name
-        if not link.exists():
-            link.symlink_to(entry)
+        (pkg / entry.name).symlink_to(entry)
     for sub in SUBPACKAGES:
-        link = pkg / sub
-        if not link.exists():
-            link.symlink_to(base / sub)
+        (pkg / sub).symlink_to(base / sub)
     return folder
 
 
