@@ -46,6 +46,8 @@ from sgtool.files import atomic_write
 from sgtool.log.records import Action
 from sgtool.log.writer import partial_files
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, run_episode
+from sgtool.recorders.sim.fallback_explore import is_fallback
+from sgtool.recorders.sim.frame_budget import frame_budget
 from sgtool.recorders.sim.noise import parse_noise
 from sgtool.results import EpisodeResult, write_jsonl
 
@@ -87,6 +89,7 @@ class ClosedLoopBenchConfig:
     noise: tuple[str, ...] = ("none",)  # noise profiles (`sgtool record --noise` syntax)
     options: ClosedLoopOptions = field(default_factory=ClosedLoopOptions)
     planner_options: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    frames_per_room: int | None = None  # frame budget per room (excludes options.frames)
     distance_budget: float = 5000.0
     step_budget: float = 50.0
 
@@ -108,6 +111,7 @@ class ClosedLoopBenchConfig:
                 raise SgtoolError(f"--noise {n!r}: a profile name with overrides "
                                   "(letters, digits, _ . = , + -) names a log folder")
         self.options.mapping()
+        frame_budget(self.options.frames, self.frames_per_room, 1)
 
 
 @dataclass(frozen=True)
@@ -124,38 +128,56 @@ class RunTask:
     rooms: tuple[int, int]
     preset: str
     episodes: int  # the house's episodes in the run: the draw ``episode`` is taken from
+    frames_per_room: int | None = None  # the frame budget per room of the house (or none)
 
 
 @dataclass(frozen=True)
 class RunRow:
     """The result of one task: the episode's result, read back from its log, plus the
-    frames, the wall seconds of the run (None when the log was already there) and the
-    failed skills by reason class."""
+    frames, the wall seconds of the run (None when the log was already there), the
+    failed skills by reason class and the goals of the robot's own exploration when the
+    graph offered the planner nothing (:mod:`sgtool.recorders.sim.fallback_explore`)."""
 
     task: RunTask
     result: EpisodeResult
     frames: int
     seconds: float | None
     failures: Mapping[str, int]
+    fallbacks: int = 0
 
 
 def log_path(root: Path, noise: str, planner: str, house: str, episode: int) -> Path:
     return root / noise / planner / house / f"ep-{episode:03d}.mcap"
 
 
-_DRAWS: dict[tuple[Any, ...], list[Any]] = {}  # episodes per house and draw, per process
+# the house and its episodes per house and draw, per process
+_DRAWS: dict[tuple[Any, ...], tuple[Any, list[Any]]] = {}
 
 
-def _episodes(task: RunTask) -> list[Any]:
-    """The house's episodes of the run: the bench's draw of ``task.episodes`` (the draw
-    depends on its size, so this is what makes them the symbolic bench's episodes)."""
+def _house(task: RunTask) -> tuple[Any, list[Any]]:
+    """The house's spec and its episodes of the run: the bench's draw of ``task.episodes``
+    (the draw depends on its size, so this is what makes them the symbolic bench's
+    episodes)."""
     key = (task.house.id, task.rooms, task.preset, task.episodes)
     if key not in _DRAWS:
         spec = task.house.load(task.rooms, task.preset)
         mix = task.preset if task.house.spec is None else "default"
         _DRAWS.clear()  # one house at a time (tasks come house by house)
-        _DRAWS[key] = bench_episodes(spec, task.episodes, mix)
+        _DRAWS[key] = (spec, bench_episodes(spec, task.episodes, mix))
     return _DRAWS[key]
+
+
+def _episodes(task: RunTask) -> list[Any]:
+    return _house(task)[1]
+
+
+def task_options(task: RunTask) -> ClosedLoopOptions:
+    """The task's options with its frame budget resolved (per room of its house)."""
+    if task.frames_per_room is None:
+        return task.options
+    rooms = len(_house(task)[0].rooms)
+    return replace(task.options, frames=frame_budget(task.options.frames,
+                                                     task.frames_per_room, rooms))
 
 
 def run_task(task: RunTask) -> RunRow:
@@ -165,12 +187,11 @@ def run_task(task: RunTask) -> RunRow:
 
     seconds: float | None = None
     if not task.output.exists():
-        spec = task.house.load(task.rooms, task.preset)
-        eps = _episodes(task)
+        spec, eps = _house(task)
         if task.episode >= len(eps):
             raise SgtoolError(f"{task.house.id}: has {len(eps)} episodes, not "
                               f"{task.episode + 1}")
-        opts = replace(task.options, noise=parse_noise(task.noise))
+        opts = replace(task_options(task), noise=parse_noise(task.noise))
         task.output.parent.mkdir(parents=True, exist_ok=True)
         try:
             rep = run_episode(spec, eps[task.episode],
@@ -215,7 +236,7 @@ def _row(task: RunTask, seconds: float | None) -> RunRow:
     eps = _episodes(task) if seconds is None else []
     want = [eps[task.episode].id, eps[task.episode].query] if task.episode < len(eps) \
         else None
-    if seconds is None and _logged_settings(task.output) != _settings(task.options,
+    if seconds is None and _logged_settings(task.output) != _settings(task_options(task),
                                                                       task.noise, want):
         raise SgtoolError(f"{task.output} was run with other settings (episode, steps, "
                           "frames, resolution, navigation, noise, seed or success rule); "
@@ -228,7 +249,9 @@ def _row(task: RunTask, seconds: float | None) -> RunRow:
     res = replace(ep.result(), seed=task.options.planner_seed)
     fails = Counter(reason_class(d.action.reason or "") for d in ep.decisions
                     if d.action.outcome == "failure")
-    return RunRow(task, res, int(ep.episode.frames or 0), seconds, dict(sorted(fails.items())))
+    fallbacks = sum(1 for d in ep.decisions if is_fallback(d.action.reason or ""))
+    return RunRow(task, res, int(ep.episode.frames or 0), seconds, dict(sorted(fails.items())),
+                  fallbacks)
 
 
 def bench_houses(cfg: ClosedLoopBenchConfig) -> tuple[BenchHouse, ...]:
@@ -248,7 +271,8 @@ def tasks_of(cfg: ClosedLoopBenchConfig, logs: Path) -> list[RunTask]:
                     out.append(RunTask(h, k, planner, noise,
                                        log_path(logs, noise, planner, h.id, k), cfg.options,
                                        dict(cfg.planner_options.get(planner, {})),
-                                       cfg.rooms, cfg.preset, cfg.episodes))
+                                       cfg.rooms, cfg.preset, cfg.episodes,
+                                       cfg.frames_per_room))
     return out
 
 
@@ -277,8 +301,8 @@ class ClosedLoopBenchResult:
 
 def _run_table(rows: Sequence[RunRow], planners: Sequence[str]) -> str:
     classes = sorted({k for r in rows for k in r.failures})
-    header = ["Planner", "Episodes", "Frames/ep", "Frames/s", "Ended", "Failed skills/ep",
-              *classes]
+    header = ["Planner", "Episodes", "Frames/ep", "Frames/s", "Ended", "Fallback/ep",
+              "Failed skills/ep", *classes]
     table = []
     for p in planners:
         rs = [r for r in rows if r.task.planner == p]
@@ -292,10 +316,12 @@ def _run_table(rows: Sequence[RunRow], planners: Sequence[str]) -> str:
         total = sum(sum(r.failures.values()) for r in rs)
         table.append([p, str(n), f"{statistics.mean(r.frames for r in rs):.0f}", fps,
                       ", ".join(f"{k} {v}" for k, v in sorted(ends.items())),
-                      f"{total / n:.2f}",
+                      f"{sum(r.fallbacks for r in rs) / n:.2f}", f"{total / n:.2f}",
                       *(f"{sum(r.failures.get(c, 0) for r in rs) / n:.2f}" for c in classes)])
     return (pipe_table(header, table) + "\nFrames/s: wall clock of the episodes run now "
-            "(resumed ones excluded); failed skills per episode by reason.\n")
+            "(resumed ones excluded); Fallback/ep: goals per episode of the robot's own "
+            "exploration when the graph offered the planner nothing; failed skills per "
+            "episode by reason.\n")
 
 
 def iter_rows(tasks: Iterable[RunTask],

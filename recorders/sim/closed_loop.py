@@ -56,7 +56,12 @@ With ``navigation="live"`` (the default) the robot runs them on its own map
 at every refresh; a goal its map cannot reach is a failed skill whose reason goes to the
 planner) and reaches the simulator only through a
 :class:`~sgtool.recorders.sim.live_skills.RobotBody` (motion with contacts, opening and
-closing); ``navigation="house"`` keeps the simulator's skills on the ground-truth
+closing). When the graph offers the planner nothing actionable (a cluttered start room
+leaves no room, region or frontier node) or the planner gives up while the robot's map
+still has reachable grid frontiers, the robot explores those on its own until the graph
+offers something new (:mod:`sgtool.recorders.sim.fallback_explore`: ``explore`` actions
+with reason ``fallback: ...``, decided on no graph; their frames and metres count, they
+are no steps). ``navigation="house"`` keeps the simulator's skills on the ground-truth
 occupancy (the behaviour before, for comparison). ``extra.navigation`` of the started
 Episode record says which, with the live settings.
 """
@@ -66,9 +71,8 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-import statistics
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -77,12 +81,11 @@ from sgtool.datasets.episodes import Episode, list_episodes
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
 from sgtool.house.spec import HouseSpec
-from sgtool.log.echo import as_logged
 from sgtool.log.records import Episode as LoggedEpisode
 from sgtool.log.records import LlmExchange
 from sgtool.log.writer import LogWriter
 from sgtool.planning.base import Action, Feedback, Planner
-from sgtool.planning.candidates import find_target
+from sgtool.planning.candidates import Candidate, actionable, find_target
 from sgtool.planning.episode import (
     NOT_CONFIRMED,
     SearchStep,
@@ -91,11 +94,14 @@ from sgtool.planning.episode import (
     search_success,
 )
 from sgtool.recorders.sim.camera import CameraConfig
+from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport
 from sgtool.recorders.sim.execution import Executed, execute_live, execute_privileged
+from sgtool.recorders.sim.fallback_explore import GAVE_UP, NO_ACTIONABLE, Fallback
+from sgtool.recorders.sim.live_recorder import LiveRecorder
 from sgtool.recorders.sim.live_skills import LiveNavConfig, LiveSkills, RobotBody
 from sgtool.recorders.sim.navigation import RobotConfig
 from sgtool.recorders.sim.noise import PROFILES, NoiseProfile
-from sgtool.recorders.sim.recording import SOURCE, LogRecorder
+from sgtool.recorders.sim.recording import SOURCE
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome, StopSimulation
 from sgtool.recorders.sim.skill_plan import (  # noqa: F401 (re-exported)
     DONE_MESSAGE,
@@ -104,7 +110,6 @@ from sgtool.recorders.sim.skill_plan import (  # noqa: F401 (re-exported)
     SkillPlan,
     plan_skills,
 )
-from sgtool.scenegraph.derived_layers import write_refresh
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.options import (
     CLASSIFIERS,
@@ -189,95 +194,6 @@ def pick_episode(house: HouseSpec, query: str | None = None, index: int | None =
     return k, eps[k]
 
 
-@dataclass(frozen=True)
-class ClosedLoopReport:
-    output: Path
-    house_id: str
-    planner: str
-    query: str
-    episode: str
-    success: bool
-    end: str
-    steps: int
-    travelled_m: float
-    shortest_m: float | None
-    frames: int
-    refreshes: int
-    n_open: int
-    decision_times: tuple[float, ...]  # wall clock per decision (reported and logged)
-    seconds: float  # wall clock of the run (reported, never logged)
-
-    @property
-    def spl(self) -> float | None:
-        if self.shortest_m is None:
-            return None
-        if not self.success:
-            return 0.0
-        return self.shortest_m / max(self.shortest_m, self.travelled_m, 1e-9)
-
-    @property
-    def frames_per_s(self) -> float:
-        return self.frames / self.seconds if self.seconds > 0 else 0.0
-
-    def lines(self) -> list[str]:
-        out = []
-        if self.output.exists():
-            out.append(f"wrote {self.output} ({self.output.stat().st_size / 1e6:.1f} MB)")
-        verdict = (f"found after {self.steps} steps" if self.success
-                   else f"not found ({self.end}) after {self.steps} steps")
-        out.append(f"{self.planner} searching for {self.query!r} in {self.house_id} "
-                   f"({self.episode}): {verdict}")
-        short = "unknown" if self.shortest_m is None else f"{self.shortest_m:.2f} m"
-        spl = "-" if self.spl is None else f"{self.spl:.3f}"
-        out.append(f"{self.travelled_m:.1f} m driven (shortest {short}, SPL {spl}), "
-                   f"{self.n_open} opened, {self.frames} frames, {self.refreshes} graph "
-                   "refreshes")
-        dt = self.decision_times
-        med = f"{statistics.median(dt):.4f} s" if dt else "-"
-        mx = f"{max(dt):.4f} s" if dt else "-"
-        out.append(f"{self.seconds:.1f} s ({self.frames_per_s:.1f} frames/s); decision "
-                   f"time median {med}, max {mx}")
-        return out
-
-
-# ----------------------------------------------------------------------------------------
-# the live recorder
-# ----------------------------------------------------------------------------------------
-class _LiveRecorder(LogRecorder):
-    """The log recorder that also feeds the scene-graph stream what it writes, in the
-    order it writes it, and writes the stream's refreshes."""
-
-    def __init__(self, writer: LogWriter, sim: Simulation, stream: SceneGraphStream,
-                 **kw: Any) -> None:
-        super().__init__(writer, sim, log_actions=False, **kw)
-        self.stream = stream
-        self.refreshes = 0
-        self.last_refresh: Refresh | None = None
-
-    def write_instances(self, sim: Simulation) -> None:
-        super().write_instances(sim)
-        assert self.last_instances is not None
-        self.stream.instances(sim.time_ns(), self.last_instances)
-
-    def on_tick(self, sim: Simulation) -> None:
-        super().on_tick(sim)
-        assert self.last_frame is not None
-        self.refreshed(self.stream.frame(as_logged(self.last_frame)))
-
-    def act(self, sim: Simulation, outcome: SkillOutcome, decision_time_s: float,
-            fields: Mapping[str, Any]) -> int:
-        """Log an action and refresh on it (as replay does at every action record)."""
-        t = self.log_action(sim, outcome, decision_time_s=decision_time_s, fields=fields)
-        self.refreshed(self.stream.action(t))
-        return t
-
-    def refreshed(self, r: Refresh | None) -> None:
-        if r is not None:
-            write_refresh(self.writer, r)
-            self.refreshes += 1
-            self.last_refresh = r
-
-
 # ----------------------------------------------------------------------------------------
 # one episode
 # ----------------------------------------------------------------------------------------
@@ -287,7 +203,7 @@ class _Search:
     action runs as simulator skills and is logged when it ends, then the graph refreshed on
     it decides whether the query is found."""
 
-    def __init__(self, sim: Simulation, rec: _LiveRecorder, agent: Planner, query: str,
+    def __init__(self, sim: Simulation, rec: LiveRecorder, agent: Planner, query: str,
                  max_steps: int,
                  on_decision: Callable[[SceneGraph, Action], None] | None,
                  skills: LiveSkills | None = None) -> None:
@@ -301,6 +217,8 @@ class _Search:
         self._graph_time_ns = 0
         self._decision_s = 0.0
         self._confirming = False  # the decision after the target came into view ("done")
+        # the robot's own exploration when the graph offers nothing (live navigation only)
+        self.fallback = None if skills is None else Fallback(skills, self._log_fallback)
 
     def start(self) -> None:
         """One frame, then a look around (logged as decided on no graph), so the first
@@ -336,8 +254,30 @@ class _Search:
         if cur is None:  # no frame at all (cannot happen with a frame budget >= 1)
             self.end = "frames"
             return None
+        if not self.end and self.fallback is not None and not actionable(cur.graph):
+            self._hand_over(NO_ACTIONABLE, ())
+            if self.end:  # the target came into view, or the frame budget is spent
+                return None
+            cur = self.rec.stream.current
+            assert cur is not None
         self._graph_time_ns = int(cur.time_ns)
         return cur.graph
+
+    def _hand_over(self, why: str, known: Sequence[Candidate]) -> None:
+        """The robot explores grid frontiers on its own (:mod:`.fallback_explore`) until
+        the graph offers a node not in ``known``."""
+        assert self.fallback is not None
+        if self.fallback.explore(why, known).cut and not self.end:
+            self.end = "frames"
+
+    def _log_fallback(self, outcome: SkillOutcome) -> bool:
+        """Log an action of the fallback (decided on no graph); True: the target is in
+        view."""
+        self.last_t = self.rec.act(self.sim, outcome, 0.0,
+                                   {"graph_time_ns": None, "planner": None})
+        if _found(self.rec.stream.current, self.query):
+            self.end = "found"
+        return self.end == "found"
 
     @property
     def success(self) -> bool:
@@ -360,6 +300,9 @@ class _Search:
         assert cur is not None
         plan = plan_skills(cur.graph, action)
         cut = False
+        if plan.done and action.target is None and self.fallback is not None and \
+                self.fallback.can_explore():
+            return self._give_up_handed_over(action, cur.graph)
         if plan.done:
             o, why, dist, ticks = "success", DONE_MESSAGE, 0.0, 0
             self.end = "gave_up" if action.target is None else "wrong_done"
@@ -375,6 +318,19 @@ class _Search:
                                    {"graph_time_ns": self._graph_time_ns})
         self._check(self.rec.stream.current, cut)  # found overrides a done
         return Feedback(action, o, why, dist)  # type: ignore[arg-type]
+
+    def _give_up_handed_over(self, action: Action, graph: SceneGraph) -> Feedback:
+        """The planner gave up but the robot's map has reachable frontiers: the give-up is
+        logged (its reason says so) and the robot explores until the graph offers a node
+        it did not offer before; the episode goes on."""
+        why = f"{GAVE_UP}: the robot explores them (fallback)"
+        outcome = SkillOutcome("done", None, "success", why, 0.0, 0)
+        self.last_t = self.rec.act(self.sim, outcome, self._decision_s,
+                                   {"graph_time_ns": self._graph_time_ns})
+        self._check(self.rec.stream.current, False)
+        if not self.end:
+            self._hand_over(GAVE_UP, actionable(graph))
+        return Feedback(action, "success", why, 0.0)
 
     def executed(self, step: SearchStep) -> None:
         """Log the confirmation decision (``done`` rule; nothing is executed) like any
@@ -428,7 +384,7 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                           metadata={"source": SOURCE, "house_id": hid, "planner": name,
                                     "query": query, "house_seed": str(house.seed)}) as writer:
             stream = SceneGraphStream(None, classifier, builder_config(mapping))
-            rec = _LiveRecorder(writer, sim, stream, noise=opts.noise, seed=opts.noise_seed,
+            rec = LiveRecorder(writer, sim, stream, noise=opts.noise, seed=opts.noise_seed,
                                 max_frames=opts.frames, planner=name, progress=progress)
             sim.observers.append(rec)
             base = LoggedEpisode(kind="search", status="started", source=SOURCE,

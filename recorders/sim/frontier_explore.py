@@ -84,7 +84,7 @@ def explore_frontiers(skills: LiveSkills, log: Callable[[SkillOutcome], None],
         ref = skills.current()
         if ref is None or ref.layers is None:
             break
-        pick = _next_frontier(skills, ref, failed_at, opts.forget)
+        pick = next_frontier(skills, ref, failed_at, opts.forget)
         door: int | None = None
         if pick is None:
             found = _next_door(skills, ref, doors_tried)
@@ -110,8 +110,11 @@ def explore_frontiers(skills: LiveSkills, log: Callable[[SkillOutcome], None],
     return rep
 
 
-def _next_frontier(skills: LiveSkills, ref: Refresh, failed_at: list[tuple[float, float]],
-                   forget: float) -> tuple[Goal, tuple[float, float]] | None:
+def next_frontier(skills: LiveSkills, ref: Refresh, failed_at: list[tuple[float, float]],
+                  forget: float) -> tuple[Goal, tuple[float, float]] | None:
+    """The frontier cluster of ``ref`` whose nearest reachable cell is nearest along the
+    floor on the robot's map, with that cell; clusters whose cell lies within ``forget`` of
+    a cell of ``failed_at`` are skipped (None: no frontier left)."""
     layers = ref.layers
     assert layers is not None
     occ = skills.live_map(ref)

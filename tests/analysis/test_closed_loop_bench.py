@@ -139,3 +139,36 @@ def test_episodes_are_the_symbolic_benchs() -> None:
     (first,) = bench_episodes(spec, 1, "symsearch")
     # why the draw size matters (house-0, 4-6 rooms): ep_0 is another episode
     assert first.id == want[0][0] and first.query != want[0][1]
+
+
+def test_frames_per_room_scales_the_budget_with_the_house(house_file, tmp_path) -> None:
+    """--frames-per-room 30 on a 4-room house: a budget of 120 frames, logged as such (and
+    the run resumes under the same option); with --frames too it is a one-line error."""
+    from sgtool.log.reader import LogReader
+    from sgtool.log.records import Episode as LoggedEpisode
+
+    args = [a for a in ARGS]
+    i = args.index("--frames")
+    args[i:i + 2] = ["--frames-per-room", "30", "--planners", "random"]
+    out = tmp_path / "rb"
+    res = CliRunner().invoke(cli, [*args, "--house", str(house_file), "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    with LogReader(out / "logs/none/random/small/ep-000.mcap") as r:
+        started = next(e for _, e in r.records(LoggedEpisode) if e.status == "started")
+    assert started.extras["frame_budget"] == 30 * 4
+    again = CliRunner().invoke(cli, [*args, "--house", str(house_file), "-o", str(out)])
+    assert again.exit_code == 0, again.output
+    both = CliRunner().invoke(cli, [*args, "--frames", "100", "--house", str(house_file),
+                                    "-o", str(tmp_path / "x")])
+    assert both.exit_code == 2 and both.output.count("\n") == 1
+    assert "either --frames or --frames-per-room" in both.output
+
+
+def test_frame_budget() -> None:
+    from sgtool.recorders.sim.frame_budget import FrameBudgetError, frame_budget
+
+    assert frame_budget(None, None, 12) is None
+    assert frame_budget(500, None, 12) == 500
+    assert frame_budget(None, 400, 13) == 5200
+    with pytest.raises(FrameBudgetError, match="not both"):
+        frame_budget(500, 400, 12)

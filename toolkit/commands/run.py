@@ -39,6 +39,8 @@ from sgtool.errors import SgtoolError
               help="High-level planner steps before the episode fails (SymSearch's N_max).")
 @click.option("--frames", type=click.IntRange(min=1), default=None,
               help="Frame budget: the episode fails when it is spent. Default: none.")
+@click.option("--frames-per-room", type=click.IntRange(min=1), default=None, metavar="N",
+              help="Frame budget of N x the house's room count (excludes --frames).")
 @click.option("--resolution", default="320x240", show_default=True,
               help="Camera image size WIDTHxHEIGHT.")
 @click.option("--fps", type=float, default=10.0, show_default=True,
@@ -79,6 +81,7 @@ from sgtool.errors import SgtoolError
 @click.option("--quiet", is_flag=True, help="No progress bar, no report.")
 def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
             query: str | None, episode: int | None, max_steps: int, frames: int | None,
+            frames_per_room: int | None,
             resolution: str, fps: float, every: int, classifier: str, min_points: int | None,
             navigation: str, optimistic: float, noise: str, planner_option: tuple[str, ...],
             planner_seed: int, llm_replay: str | None, llm_transcript: str | None, output: str,
@@ -106,6 +109,7 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
     from sgtool.commands.options import house_from_options, parse_resolution
     from sgtool.recorders.sim import CameraConfig, parse_noise
     from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
+    from sgtool.recorders.sim.frame_budget import frame_budget
     from sgtool.recorders.sim.live_skills import LiveNavConfig
 
     out = Path(output)
@@ -117,6 +121,7 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
         raise SgtoolError(f"-o {out} is a folder; name the log file")
     if not out.parent.exists():
         raise SgtoolError(f"-o {out}: folder {out.parent} does not exist")
+    frame_budget(frames, frames_per_room, 1)  # both given: one line, before the house is built
     if query is not None and episode is not None:
         raise SgtoolError("give either --query or --episode, not both")
     if not 0.1 <= fps <= 1000:
@@ -140,6 +145,7 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
     camera = CameraConfig(width=width, height=height)
     house, house_id = house_from_options(house_path, seed, rooms)
     index, ep = pick_episode(house, query=query, index=episode)
+    frames = frame_budget(frames, frames_per_room, len(house.rooms))
     opts = ClosedLoopOptions(fps=fps, camera=camera, every=every, classifier=classifier,
                              min_points=min_points, max_steps=max_steps, frames=frames,
                              planner_seed=planner_seed, navigation=navigation, success=success,

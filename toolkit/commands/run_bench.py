@@ -41,6 +41,9 @@ from sgtool.errors import SgtoolError
               help="High-level planner steps per episode.")
 @click.option("--frames", type=click.IntRange(min=1), default=None,
               help="Frame budget per episode. Default: none.")
+@click.option("--frames-per-room", type=click.IntRange(min=1), default=None, metavar="N",
+              help="Frame budget per episode of N x the house's room count (excludes "
+              "--frames).")
 @click.option("--resolution", default="320x240", show_default=True,
               help="Camera image size WIDTHxHEIGHT.")
 @click.option("--every", type=click.IntRange(min=1), default=10, show_default=True,
@@ -63,7 +66,8 @@ from sgtool.errors import SgtoolError
 @executor_options("episodes (one closed-loop run each)")
 def command(planners: str | None, houses: int, house_files: tuple[str, ...], house_seed: int,
             rooms: str, preset: str, episodes: int, noise: tuple[str, ...], max_steps: int,
-            frames: int | None, resolution: str, every: int, navigation: str,
+            frames: int | None, frames_per_room: int | None, resolution: str, every: int,
+            navigation: str,
             planner_option: tuple[str, ...], out_dir: str, report_only: bool,
             progress: bool | None, success: str = "observed", executor: str = "local",
             workers: int = 1,
@@ -106,7 +110,7 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...], hou
         planners=names, houses=houses, house_seed=house_seed, house_files=house_files,
         episodes=episodes, rooms=parse_rooms(rooms), preset=preset,
         noise=tuple(noise) or ("none",), options=opts,
-        planner_options=planner_options(planner_option))
+        planner_options=planner_options(planner_option), frames_per_room=frames_per_room)
     show = sys.stderr.isatty() if progress is None else progress
     runner = map  # in this process, one episode after the other
     if (executor != "local" or workers > 1 or ray_address) and not report_only:

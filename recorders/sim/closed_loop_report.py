@@ -1,0 +1,58 @@
+"""The report of one closed-loop episode (``sgtool run`` prints its :meth:`lines`)."""
+
+from __future__ import annotations
+
+import statistics
+from dataclasses import dataclass
+from pathlib import Path
+
+
+@dataclass(frozen=True)
+class ClosedLoopReport:
+    output: Path
+    house_id: str
+    planner: str
+    query: str
+    episode: str
+    success: bool
+    end: str
+    steps: int
+    travelled_m: float
+    shortest_m: float | None
+    frames: int
+    refreshes: int
+    n_open: int
+    decision_times: tuple[float, ...]  # wall clock per decision (reported and logged)
+    seconds: float  # wall clock of the run (reported, never logged)
+
+    @property
+    def spl(self) -> float | None:
+        if self.shortest_m is None:
+            return None
+        if not self.success:
+            return 0.0
+        return self.shortest_m / max(self.shortest_m, self.travelled_m, 1e-9)
+
+    @property
+    def frames_per_s(self) -> float:
+        return self.frames / self.seconds if self.seconds > 0 else 0.0
+
+    def lines(self) -> list[str]:
+        out = []
+        if self.output.exists():
+            out.append(f"wrote {self.output} ({self.output.stat().st_size / 1e6:.1f} MB)")
+        verdict = (f"found after {self.steps} steps" if self.success
+                   else f"not found ({self.end}) after {self.steps} steps")
+        out.append(f"{self.planner} searching for {self.query!r} in {self.house_id} "
+                   f"({self.episode}): {verdict}")
+        short = "unknown" if self.shortest_m is None else f"{self.shortest_m:.2f} m"
+        spl = "-" if self.spl is None else f"{self.spl:.3f}"
+        out.append(f"{self.travelled_m:.1f} m driven (shortest {short}, SPL {spl}), "
+                   f"{self.n_open} opened, {self.frames} frames, {self.refreshes} graph "
+                   "refreshes")
+        dt = self.decision_times
+        med = f"{statistics.median(dt):.4f} s" if dt else "-"
+        mx = f"{max(dt):.4f} s" if dt else "-"
+        out.append(f"{self.seconds:.1f} s ({self.frames_per_s:.1f} frames/s); decision "
+                   f"time median {med}, max {mx}")
+        return out

@@ -1,0 +1,115 @@
+"""The robot explores on its own when the scene graph gives the planner nothing to act on.
+
+In a cluttered start room the free floor after the first look-around can be many small
+pieces: the Voronoi graph is a couple of nodes, no room is segmented, so the scene graph
+has no room, region or frontier node and the planner gives up at once, although the
+robot's occupancy grid has frontier cells it can reach. Later in an episode the planner
+may have ruled out every node it is offered (failed twice, explored) while the grid still
+has reachable frontiers. In both cases the closed loop hands over to this module
+(:class:`Fallback`), which explores the grid's frontiers on the robot's own map (the
+frontier choice of ``record --explore frontier``,
+:func:`~sgtool.recorders.sim.frontier_explore.next_frontier`: the nearest reachable
+cluster along the floor, go there, look around) until the graph offers an actionable node
+(:func:`~sgtool.planning.candidates.actionable`) that was not on offer before, then hands
+back to the planner.
+
+Every goal is one ``sgtool.Action`` record, skill ``explore`` of the grid frontier's id,
+reason ``fallback: <why>`` (``fallback: <why>; <the failure>`` when it fails), decided on
+no graph (``graph_time_ns: null``, planner null, like the opening look-around): its frames
+and metres count in the episode (frame budget, path length of SPL) but it is no planner
+step. The robot side only: goals come from the live map (:class:`LiveSkills`), never from
+the house. The choice is deterministic (nearest along the floor, id order on ties), and a
+goal cell within ``forget`` of one gone to before in the episode is not a goal again, so
+repeated hand-overs end.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+from sgtool.planning.candidates import Candidate, actionable
+from sgtool.planning.memory import SAME_PLACE_M
+from sgtool.recorders.sim.events import SkillOutcome, StopSimulation
+from sgtool.recorders.sim.frontier_explore import next_frontier
+from sgtool.recorders.sim.live_skills import LiveSkills
+from sgtool.scenegraph.graph import SceneGraph
+
+NO_ACTIONABLE = "no actionable node"
+GAVE_UP = "the planner gave up while the robot's map has reachable frontiers"
+PREFIX = "fallback: "
+
+
+def is_fallback(reason: str | None) -> bool:
+    """``reason`` is that of an action of the fallback (module doc)."""
+    return bool(reason) and str(reason).startswith(PREFIX)
+
+
+@dataclass(frozen=True)
+class FallbackOptions:
+    max_goals: int = 12  # grid frontiers per hand-over
+    forget: float = 0.5  # m: goal cells this near one gone to before are not goals again
+
+
+@dataclass(frozen=True)
+class FallbackRun:
+    """What one hand-over did: frontiers gone to, whether the frame budget cut it and
+    whether ``log`` asked to stop (the target came into view)."""
+
+    goals: int
+    cut: bool = False
+    stopped: bool = False
+
+
+def new_candidates(graph: SceneGraph, known: Sequence[Candidate]) -> list[Candidate]:
+    """The actionable nodes of ``graph`` not in ``known`` (same id within
+    :data:`~sgtool.planning.memory.SAME_PLACE_M`, as the planners' memory keys nodes)."""
+    return [c for c in actionable(graph)
+            if not any(k.node_id == c.node_id and
+                       math.dist(k.position, c.position) <= SAME_PLACE_M for k in known)]
+
+
+@dataclass
+class Fallback:
+    """The hand-over of one episode (module doc): ``skills`` on the live map; ``log``
+    writes an action record and returns True to stop (the target is in view)."""
+
+    skills: LiveSkills
+    log: Callable[[SkillOutcome], bool]
+    options: FallbackOptions = field(default_factory=FallbackOptions)
+    gone_to: list[tuple[float, float]] = field(default_factory=list)  # goal cells so far
+
+    def can_explore(self) -> bool:
+        """The robot's map has a reachable grid frontier not gone to before."""
+        ref = self.skills.current()
+        return ref is not None and ref.layers is not None and \
+            next_frontier(self.skills, ref, self.gone_to, self.options.forget) is not None
+
+    def explore(self, why: str, known: Sequence[Candidate] = ()) -> FallbackRun:
+        """Go to grid frontiers until the graph offers a node not in ``known`` (or none is
+        left, or ``max_goals``, or the frame budget, or ``log`` says stop)."""
+        skills, body = self.skills, self.skills.body
+        n = 0
+        for _ in range(self.options.max_goals):
+            ref = skills.current()
+            if ref is None or ref.layers is None or new_candidates(ref.graph, known):
+                break
+            pick = next_frontier(skills, ref, self.gone_to, self.options.forget)
+            if pick is None:
+                break
+            goal, cell = pick
+            self.gone_to.append(cell)
+            t0, d0 = body.tick_index, body.travelled_m
+            cut = False
+            try:
+                o, fail, _ = skills.explore(goal)
+            except StopSimulation as e:
+                o, fail, cut = "failure", f"stopped: {e}", True
+            reason = PREFIX + why + (f"; {fail}" if o != "success" else "")
+            n += 1
+            stop = self.log(SkillOutcome("explore", goal.label, o, reason,
+                                         body.travelled_m - d0, body.tick_index - t0))
+            if cut or stop:
+                return FallbackRun(n, cut=cut, stopped=stop)
+        return FallbackRun(n)
