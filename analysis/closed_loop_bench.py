@@ -260,13 +260,15 @@ def bench_houses(cfg: ClosedLoopBenchConfig) -> tuple[BenchHouse, ...]:
 
 
 def tasks_of(cfg: ClosedLoopBenchConfig, logs: Path) -> list[RunTask]:
-    """Every (noise, house, episode, planner) of the run, in that nesting order (so a run
-    cut short has compared the planners on the same episodes)."""
+    """Every (noise, episode, house, planner) of the run, in that nesting order: episode k
+    of every house before episode k + 1, each with all planners, so a run cut short has
+    compared the planners on the same episodes, spread over all houses. The outputs list
+    them house by house (:func:`report_order`)."""
     houses = bench_houses(cfg)
     out = []
     for noise in cfg.noise:
-        for h in houses:
-            for k in range(cfg.episodes):
+        for k in range(cfg.episodes):
+            for h in houses:
                 for planner in cfg.planners:
                     out.append(RunTask(h, k, planner, noise,
                                        log_path(logs, noise, planner, h.id, k), cfg.options,
@@ -350,7 +352,21 @@ def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
         rows.append(row)
         if progress is not None:
             progress.update(1)
-    return ClosedLoopBenchResult(cfg, tuple(rows))
+    return ClosedLoopBenchResult(cfg, tuple(sorted(rows, key=report_order(cfg, tasks))))
+
+
+def report_order(cfg: ClosedLoopBenchConfig,
+                 tasks: Sequence[RunTask]) -> Callable[[RunRow], tuple[int, int, int, int]]:
+    """The sort key of the outputs: noise, house, episode, planner, each in run order."""
+    house_rank: dict[str, int] = {}
+    for t in tasks:
+        house_rank.setdefault(t.house.id, len(house_rank))
+
+    def key(row: RunRow) -> tuple[int, int, int, int]:
+        t = row.task
+        return (cfg.noise.index(t.noise), house_rank[t.house.id], t.episode,
+                cfg.planners.index(t.planner))
+    return key
 
 
 def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]:

@@ -172,3 +172,19 @@ def test_frame_budget() -> None:
     assert frame_budget(None, 400, 13) == 5200
     with pytest.raises(FrameBudgetError, match="not both"):
         frame_budget(500, 400, 12)
+
+
+def test_a_run_goes_episode_by_episode_and_reports_house_by_house() -> None:
+    """Episode k of every house runs before episode k + 1 (a run cut short compares the
+    planners over all houses); the outputs list the rows house by house."""
+    from types import SimpleNamespace
+
+    cfg = clb.ClosedLoopBenchConfig(planners=("random", "greedy"), houses=2, house_seed=0,
+                                    episodes=2, rooms=(4, 6))
+    tasks = clb.tasks_of(cfg, Path("logs"))
+    ran = [(t.episode, t.house.id, t.planner) for t in tasks]
+    assert ran == [(k, h, p) for k in (0, 1) for h in ("house-0", "house-1")
+                   for p in ("random", "greedy")]
+    rows = sorted((SimpleNamespace(task=t) for t in tasks), key=clb.report_order(cfg, tasks))
+    assert [(r.task.house.id, r.task.episode, r.task.planner) for r in rows] == [
+        (h, k, p) for h in ("house-0", "house-1") for k in (0, 1) for p in ("random", "greedy")]
