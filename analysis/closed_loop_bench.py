@@ -150,7 +150,10 @@ def log_path(root: Path, noise: str, planner: str, house: str, episode: int) -> 
     return root / noise / planner / house / f"ep-{episode:03d}.mcap"
 
 
-# the house and its episodes per house and draw, per process
+# the house and its episodes per house and draw, per process: houses a worker keeps (a
+# house is rebuilt when a run of more houses comes back to it: ~1 s against minutes for
+# its closed-loop episode)
+DRAWS_KEPT = 16
 _DRAWS: dict[tuple[Any, ...], tuple[Any, list[Any]]] = {}
 
 
@@ -162,7 +165,8 @@ def _house(task: RunTask) -> tuple[Any, list[Any]]:
     if key not in _DRAWS:
         spec = task.house.load(task.rooms, task.preset)
         mix = task.preset if task.house.spec is None else "default"
-        _DRAWS.clear()  # one house at a time (tasks come house by house)
+        if len(_DRAWS) >= DRAWS_KEPT:  # the oldest goes: tasks come episode by episode,
+            del _DRAWS[next(iter(_DRAWS))]  # cycling through the run's houses
         _DRAWS[key] = (spec, bench_episodes(spec, task.episodes, mix))
     return _DRAWS[key]
 

@@ -188,3 +188,17 @@ def test_a_run_goes_episode_by_episode_and_reports_house_by_house() -> None:
     rows = sorted((SimpleNamespace(task=t) for t in tasks), key=clb.report_order(cfg, tasks))
     assert [(r.task.house.id, r.task.episode, r.task.planner) for r in rows] == [
         (h, k, p) for h in ("house-0", "house-1") for k in (0, 1) for p in ("random", "greedy")]
+
+
+def test_a_worker_builds_each_house_once_when_tasks_cycle_through_houses(monkeypatch) -> None:
+    cfg = clb.ClosedLoopBenchConfig(planners=("random", "greedy"), houses=2, house_seed=0,
+                                    episodes=2, rooms=(4, 6))
+    tasks = clb.tasks_of(cfg, Path("logs"))
+    built = []
+    house_type = type(tasks[0].house)
+    monkeypatch.setattr(house_type, "load", lambda self, rooms, preset: built.append(self.id))
+    monkeypatch.setattr(clb, "bench_episodes", lambda spec, n, mix: ["ep"] * n)
+    monkeypatch.setattr(clb, "_DRAWS", {})
+    for t in tasks:  # episode 0 of both houses, then episode 1 of both
+        assert clb._episodes(t) == ["ep", "ep"]
+    assert built == ["house-0", "house-1"]
