@@ -7,9 +7,11 @@ chunk record byte for byte, then the input's message index records (their offset
 relative to the chunk, so they stay valid), and adds a chunk index pointing at the new
 place, and the chunk's messages to the statistics. The ``mcap`` package's writer has no
 such call, so this module writes those records beside it, into the same stream, and updates
-the writer's chunk index list and statistics (its private state: the package version is
-pinned, and ``tests/toolkit/log/test_chunk_copy.py`` reads every copy back and through
-``sgtool doctor``'s checks).
+the writer's chunk index list and statistics (its private state: :func:`writer_supported`
+checks that it is there and that the writer keeps no data-section CRC, which the copied
+bytes would miss; otherwise replay writes message by message.
+``tests/toolkit/log/test_chunk_copy.py`` reads every copy back and through ``sgtool
+doctor``'s checks).
 
 A copied chunk keeps the input's channel and schema ids, sequence numbers, publish times
 and CRC: the derived log must then give its input channels the input's ids
@@ -26,6 +28,7 @@ from mcap.records import ChunkIndex
 from mcap.summary import Summary
 from mcap.writer import Writer
 
+_CHUNK = 0x06
 _MESSAGE_INDEX = 0x07
 _RECORD_HEAD = struct.Struct("<BQ")
 _INDEX_HEAD = struct.Struct("<HI")  # channel id, length of the (time, offset) pairs
@@ -51,7 +54,9 @@ def raw_chunk(f: IO[bytes], ci: ChunkIndex, record: bytes) -> RawChunk | None:
     start = ci.chunk_start_offset + ci.chunk_length
     f.seek(start)
     data = f.read(ci.message_index_length)
-    if len(record) != ci.chunk_length or len(data) != ci.message_index_length:
+    if (len(record) != ci.chunk_length or len(data) != ci.message_index_length
+            or len(record) < _RECORD_HEAD.size
+            or _RECORD_HEAD.unpack_from(record) != (_CHUNK, len(record) - _RECORD_HEAD.size)):
         return None
     counts: dict[int, int] = {}
     offsets: dict[int, int] = {}
@@ -94,6 +99,15 @@ def in_sequence(chunks: list[ChunkIndex]) -> bool:
     ordered = sorted(chunks, key=lambda ci: ci.chunk_start_offset)
     return all(b.message_start_time >= a.message_end_time for a, b in
                zip(ordered, ordered[1:], strict=False))
+
+
+def writer_supported(writer: Writer) -> bool:
+    """``writer`` (an ``mcap`` package writer) has the private state :func:`append_chunk`
+    updates, and computes no data-section CRC (module doc)."""
+    private: Any = writer
+    return (isinstance(getattr(private, "_Writer__chunk_indices", None), list)
+            and hasattr(private, "_Writer__statistics")
+            and getattr(private, "_Writer__enable_data_crcs", None) is False)
 
 
 def append_chunk(writer: Writer, stream: IO[bytes], chunk: RawChunk) -> None:

@@ -228,10 +228,12 @@ class LogWriter:
         """Register every schema and channel of another log's ``summary`` under its own
         id, for :meth:`copy_chunk` and :meth:`write_raw`. False, and nothing registered,
         when this writer has channels already, two channels share a topic, or the ids are
-        not 1..N (:func:`~sgtool.log.chunk_copy.ids_problem`)."""
+        not 1..N (:func:`~sgtool.log.chunk_copy.ids_problem`), or the ``mcap`` writer
+        cannot take copied chunks (:func:`~sgtool.log.chunk_copy.writer_supported`)."""
         topics = {ch.topic for ch in summary.channels.values()}
         if (self._schemas or self._channels or len(topics) != len(summary.channels)
-                or chunk_copy.ids_problem(summary)):
+                or chunk_copy.ids_problem(summary)
+                or not chunk_copy.writer_supported(self._mcap)):
             return False
         for sid, schema in sorted(summary.schemas.items()):
             self._schemas[f"copied\0{sid}"] = self._mcap.register_schema(

@@ -11,7 +11,7 @@ from mcap.records import Channel, Schema
 from mcap.summary import Summary
 
 from sgtool.log import LogReader, LogWriter
-from sgtool.log.chunk_copy import ids_problem, in_sequence, raw_chunk
+from sgtool.log.chunk_copy import ids_problem, in_sequence, raw_chunk, writer_supported
 from sgtool.log.chunk_stream import read_chunk
 from sgtool.log.recover import scan
 
@@ -103,6 +103,26 @@ def test_damaged_message_indexes_are_not_copied(tmp_path):
             k: v + 1 for k, v in ci.message_index_offsets.items()})
         assert raw_chunk(r._f, moved, record) is None
         assert raw_chunk(r._f, dataclasses.replace(ci, message_index_length=5), record) is None
+        # a chunk record whose own length field disagrees with the index
+        bad_length = record[:1] + (len(record) - 8).to_bytes(8, "little") + record[9:]
+        assert raw_chunk(r._f, ci, bad_length) is None
+
+
+def test_no_copy_into_a_writer_without_the_state_it_updates_or_with_data_crcs(tmp_path):
+    """Copying writes into the mcap writer's private state: a writer that has it not, or
+    that keeps a data-section CRC the copied bytes would miss, takes no copies (replay
+    then writes message by message)."""
+    src = source_log(tmp_path / "in.mcap")
+    with LogReader(src) as r:
+        with LogWriter(tmp_path / "ok.mcap") as w:
+            assert writer_supported(w._mcap)
+        with LogWriter(tmp_path / "crc.mcap") as w:
+            w._mcap._Writer__enable_data_crcs = True
+            assert not writer_supported(w._mcap) and not w.copy_channels(r.summary)
+        with LogWriter(tmp_path / "renamed.mcap") as w:
+            w._mcap._renamed = w._mcap.__dict__.pop("_Writer__chunk_indices")
+            assert not writer_supported(w._mcap) and not w.copy_channels(r.summary)
+            w._mcap._Writer__chunk_indices = w._mcap._renamed  # let it close
 
 
 def summary(schemas, channels, chunks):
