@@ -63,7 +63,8 @@ class ChunkBuffers:
     the caller allocates images between chunks (the freed pages go back to the system and
     are faulted in again). For callers that take the messages as views
     (``ordered_messages(views=True)``); a buffer stays taken while any view of it lives
-    (CPython reference counts: a view holds its buffer). Chunks above ``max_bytes`` are
+    (a bytearray with views cannot change size: :func:`_unexported`; the reference count
+    alone would depend on the interpreter's version). Chunks above ``max_bytes`` are
     not pooled (a reader keeps at most ``keep`` buffers while it is open)."""
 
     def __init__(self, keep: int = 4, max_bytes: int = 32 << 20) -> None:
@@ -77,7 +78,8 @@ class ChunkBuffers:
         if size > self._max_bytes:
             return None
         for i in range(len(self._buffers)):
-            if sys.getrefcount(self._buffers[i]) == 2:  # the list and the call's argument
+            # free: no view of it lives, and no one holds it but the list and the call
+            if _unexported(self._buffers[i]) and sys.getrefcount(self._buffers[i]) <= 2:
                 if len(self._buffers[i]) < size:
                     self._buffers[i] = bytearray(size)
                 return self._buffers[i]
@@ -85,6 +87,18 @@ class ChunkBuffers:
             self._buffers.append(bytearray(size))
             return self._buffers[-1]
         return None
+
+
+def _unexported(buf: bytearray) -> bool:
+    """No view of ``buf`` lives (a memoryview, or an array made from one): a bytearray
+    with views refuses to change size. The first check of a buffer may reallocate it once
+    (it has no room to grow yet); later ones do not."""
+    try:
+        buf.append(0)
+    except BufferError:
+        return False
+    del buf[-1]
+    return True
 
 
 def _zstd_into(data: memoryview, size: int, buffers: ChunkBuffers | None
