@@ -118,6 +118,8 @@ class _Executor:
                         flight[backend.submit(tasks[i].args)] = i
                     handle, value, err = backend.wait_one(list(flight))
                     i = flight.pop(handle)
+                    if isinstance(err, KeyboardInterrupt):  # a worker was killed or Ctrl-C'd
+                        raise err  # stop the run, as in process
                     if err is not None and attempts[i] <= RETRIES:
                         queue.append(i)
                         continue

@@ -58,12 +58,16 @@ def test_outcomes_in_task_order_and_a_failure_is_reported_after_one_retry(worker
         assert sorted(CALLS) == [0, 1, 2, 3, 3, 4, 5]
 
 
-def test_ctrl_c_stops_the_run_and_keeps_what_finished():
+@pytest.mark.parametrize("workers", [1, 2])
+def test_ctrl_c_stops_the_run_and_keeps_what_finished(workers):
+    """In process or in a worker (a worker killed alone): the run stops, not retried."""
     seen = []
     with pytest.raises(KeyboardInterrupt):
-        LocalExecutor(1).run(interrupted_at_two, [Task(str(i), i) for i in range(5)],
-                             on_result=seen.append)
-    assert [o.value for o in seen] == [0, 1]
+        LocalExecutor(workers).run(interrupted_at_two, [Task(str(i), i) for i in range(5)],
+                                   on_result=seen.append)
+    if workers == 1:
+        assert [o.value for o in seen] == [0, 1]
+    assert 2 not in [o.value for o in seen] and len(seen) < 5
 
 
 def test_chunks_cut_near_equal_contiguous_runs():
