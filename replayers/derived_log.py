@@ -217,7 +217,6 @@ def _run(reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
          copy_chunks: bool = False) -> None:
     feed = _Feed(reader, stream, writer, opts, report, on_refresh, progress)
     if copy_chunks and writer is not None and _can_copy(reader, writer, opts):
-        feed.keep_sequence = True
         for chunk, items in reader.chunks(views=True):
             copied = chunk is not None and _copyable(chunk, items) and writer.copy_chunk(chunk)
             for schema, channel, message in items:
@@ -268,7 +267,6 @@ class _Feed:
         self.copied: dict[int, int] = {}  # input channel id -> output channel id
         self.asm = FrameAssembler(where=str(reader.path))
         self.last_t = 0
-        self.keep_sequence = False  # written messages keep their sequence and publish time
 
     def refreshed(self, r: Refresh | None) -> None:
         if r is None:
@@ -327,11 +325,8 @@ class _Feed:
                 bytes(schema.data) if schema else b"", channel.message_encoding,
                 dict(channel.metadata))
             self.copied[channel.id] = cid
-        if self.keep_sequence:
-            writer.write_raw(cid, t, bytes(message.data), message.sequence,
-                             message.publish_time)
-        else:
-            writer.write_raw(cid, t, bytes(message.data))
+        # as in a copied chunk: the input's sequence number and publish time
+        writer.write_raw(cid, t, bytes(message.data), message.sequence, message.publish_time)
 
     def end(self) -> None:
         """After the last message taken: the last frame (unless the budget is spent), the
