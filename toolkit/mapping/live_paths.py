@@ -5,8 +5,13 @@ occupied, unknown). :func:`traversable` turns it into an
 :class:`~sgtool.mapping.occupancy.OccupancyMap`, the grid the house planners use, so the
 existing geodesics and A* run on it unchanged:
 
-- a known obstacle blocks every cell whose centre is closer than the robot radius to it
-  (:func:`~sgtool.mapping.occupancy.inflate`);
+- a known obstacle blocks every cell whose centre is closer than the robot radius to the
+  obstacle cell's centre: the obstacle is taken at its cell's centre, as the house
+  generator's clearance and the simulator's contact check take it (the contact check lets
+  the base come half a cell closer still). Measured to the cell's nearer edge instead
+  (:func:`~sgtool.mapping.occupancy.inflate` with the full radius), every observed
+  obstacle grew by half a cell on top of the voxels' own rounding, and the robot's map
+  closed passages of generated houses that the robot fits through;
 - an unknown cell is not traversable, except within ``optimistic`` metres of known free
   floor: the short optimistic margin that lets a path end at (and slightly into) a
   frontier, whose far side the camera sees on the way;
@@ -43,10 +48,10 @@ _STEPS = ((0, 1), (0, -1), (1, 0), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
 
 def traversable(grid: OccupancyGrid, robot_radius: float, optimistic: float = 0.25,
                 obstacles: np.ndarray | None = None) -> OccupancyMap:
-    """The live grid as a map to plan on (module doc): ``blocked`` = known obstacles grown
-    by ``robot_radius``, plus unknown cells farther than ``optimistic`` m from known free
-    floor. ``obstacles`` (world x, y; e.g. where the robot bumped into something) mark
-    their cells as obstacles too."""
+    """The live grid as a map to plan on (module doc): ``blocked`` = cells whose centre is
+    closer than ``robot_radius`` to a known obstacle cell's centre, plus unknown cells
+    farther than ``optimistic`` m from known free floor. ``obstacles`` (world x, y; e.g.
+    where the robot bumped into something) mark their cells as obstacles too."""
     if optimistic < 0:
         raise ValueError("optimistic margin must be >= 0")
     occupied = grid.occupied
@@ -55,7 +60,9 @@ def traversable(grid: OccupancyGrid, robot_radius: float, optimistic: float = 0.
         rows, cols = _cells_of(occ_map, obstacles)
         occupied = occupied.copy()
         occupied[rows, cols] = True
-    blocked = inflate(occupied, robot_radius, grid.resolution)
+    # inflate measures to the obstacle cell's edge: half a cell less is to its centre
+    blocked = inflate(occupied, max(robot_radius - grid.resolution / 2.0, 0.0),
+                      grid.resolution)
     unknown = grid.unknown
     if unknown.any():
         free = grid.free

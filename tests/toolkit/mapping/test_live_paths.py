@@ -76,10 +76,12 @@ def test_the_optimistic_margin_at_frontiers() -> None:
     assert not wide.blocked[30, 22] and not wide.blocked[30, 23]
     assert none.blocked[30, 22] and none.blocked[30, 23]
     assert wide.blocked[30, 24] and wide.blocked[30, 25]
-    # bumps: a point marks its cell as an obstacle, grown by the radius
+    # bumps: a point marks its cell as an obstacle, grown by the radius between cell
+    # centres: the cells 0.1 m and 0.14 m away are blocked, the cell 0.2 m away is not
     bumped = traversable(grid, robot_radius=0.2, optimistic=0.2,
                          obstacles=np.array([[1.05, 2.05]]))
-    assert bumped.blocked[20, 10] and bumped.blocked[20, 12]
+    assert bumped.blocked[20, 10] and bumped.blocked[20, 11] and bumped.blocked[21, 11]
+    assert not bumped.blocked[20, 12] and not bumped.blocked[22, 10]
     assert not traversable(grid, 0.2, 0.2).blocked[20, 10]
 
 
