@@ -124,9 +124,10 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...], hou
     try:
         res = run_closed_loop_bench(cfg, out_dir, progress=bar, report_only=report_only,
                                     runner=runner)
-    except KeyboardInterrupt:
-        raise SgtoolError(f"interrupted; the complete episode logs are kept in {out_dir}/logs "
-                          "(run the same command again to resume)") from None
+    except KeyboardInterrupt as e:  # the CLI prints the note; exit 130 (143: killed)
+        e.note = (f"the complete episode logs are kept in {out_dir}/logs "  # type: ignore[attr-defined]
+                  "(run the same command again to resume)")
+        raise
     finally:
         bar.close()
     paths = write_outputs(res, out_dir)
