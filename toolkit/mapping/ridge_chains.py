@@ -4,12 +4,12 @@ once each, in a fixed order."""
 
 from __future__ import annotations
 
-from itertools import accumulate
-
 import numpy as np
 from scipy.sparse import csr_matrix
 
-__all__ = ["_reverse_entries", "_trace_chains"]
+from sgtool.mapping.sparsify import Chains, chain_cumsum
+
+__all__ = ["_reverse_entries", "_trace_chains", "trace_chain_arrays"]
 
 
 def _reverse_entries(adj: csr_matrix) -> np.ndarray:
@@ -22,6 +22,13 @@ def _reverse_entries(adj: csr_matrix) -> np.ndarray:
 
 
 def _trace_chains(adj: csr_matrix) -> list[tuple[list[int], list[float]]]:
+    """:func:`trace_chain_arrays` as a list of (pixel list, cumulative lengths)."""
+    ch = trace_chain_arrays(adj)
+    pix, cum, start = ch.pix.tolist(), ch.cum.tolist(), ch.start.tolist()
+    return [(pix[a:b], cum[a:b]) for a, b in zip(start[:-1], start[1:], strict=True)]
+
+
+def trace_chain_arrays(adj: csr_matrix) -> Chains:
     """Chains between key pixels (degree != 2) as (pixel list, cumulative length in cells
     along it), each once, in the order of a walk from every key pixel (ascending) along
     each of its CSR entries not walked yet; then loops without a key pixel, from their
@@ -32,13 +39,15 @@ def _trace_chains(adj: csr_matrix) -> list[tuple[list[int], list[float]]]:
     into a degree-2 pixel q has one successor (q's other entry), so the entries form
     linked lists headed by the entries of key pixels; pointer doubling gives each entry
     its head and depth. A chain and its reverse are the lists headed by its first entry
-    and by the reverse of its last; the walk takes the one whose head comes first."""
+    and by the reverse of its last; the walk takes the one whose head comes first.
+    Returned as :class:`~sgtool.mapping.sparsify.Chains` (cumulative lengths summed step
+    by step, :func:`~sgtool.mapping.sparsify.chain_cumsum`)."""
     n = adj.shape[0]
     indptr = adj.indptr.astype(np.int64)
     indices = adj.indices.astype(np.int64)
     e = len(indices)
     if e == 0:
-        return []
+        return Chains(np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros(0))
     deg = np.diff(indptr)
     row = np.repeat(np.arange(n, dtype=np.int64), deg)
     rev = _reverse_entries(adj)
@@ -58,7 +67,9 @@ def _trace_chains(adj: csr_matrix) -> list[tuple[list[int], list[float]]]:
         depth = depth + depth[up]
         up = nxt
     rooted = pred[up] < 0  # the rest lie on loops without a key pixel
-    chains: list[tuple[list[int], list[float]]] = []
+    pix_parts: list[np.ndarray] = []
+    sizes: list[np.ndarray] = []
+    steps: list[np.ndarray] = []
     if rooted.any():
         ks = np.flatnonzero(rooted)
         head = up[ks]
@@ -69,21 +80,34 @@ def _trace_chains(adj: csr_matrix) -> list[tuple[list[int], list[float]]]:
         stops = np.append(starts[1:], len(ks))
         heads = head[starts]
         walked = heads < rev[ks[stops - 1]]  # this direction's head comes first
-        data = adj.data[ks].tolist()
-        pix = indices[ks].tolist()
-        src = row[heads].tolist()
-        for h, a, b in zip(np.flatnonzero(walked).tolist(), starts[walked].tolist(),
-                           stops[walked].tolist(), strict=True):
-            chains.append(([src[h]] + pix[a:b], list(accumulate(data[a:b], initial=0.0))))
+        count = (stops - starts)[walked]
+        ks = ks[np.repeat(walked, stops - starts)]
+        # each chain: its head's source pixel, then the pixel each entry leads to
+        off = np.concatenate([[0], np.cumsum(count + 1)[:-1]])
+        pix = np.empty(int((count + 1).sum()), dtype=np.int64)
+        lead = np.zeros(len(pix), dtype=bool)
+        lead[off] = True
+        pix[off] = row[heads[walked]]
+        pix[~lead] = indices[ks]
+        pix_parts.append(pix)
+        sizes.append(count)
+        steps.append(adj.data[ks].astype(np.float64))
     if not rooted.all():
-        chains += _trace_loops(adj, rev, rooted)
-    return chains
+        for path, step in _trace_loops(adj, rev, rooted):
+            pix_parts.append(np.asarray(path, dtype=np.int64))
+            sizes.append(np.asarray([len(step)], dtype=np.int64))
+            steps.append(np.asarray(step, dtype=np.float64))
+    size = np.concatenate(sizes) if sizes else np.zeros(0, np.int64)
+    start = np.concatenate([[0], np.cumsum(size + 1)]).astype(np.int64)
+    pix = np.concatenate(pix_parts) if pix_parts else np.zeros(0, np.int64)
+    return Chains(pix, start, chain_cumsum(np.concatenate(steps) if steps else np.zeros(0),
+                                          size))
 
 
 def _trace_loops(adj: csr_matrix, rev: np.ndarray, walked: np.ndarray
                  ) -> list[tuple[list[int], list[float]]]:
     """The loops without a key pixel (every entry not ``walked``), each from its lowest
-    pixel along that pixel's first entry, step by step."""
+    pixel along that pixel's first entry, step by step: (pixels, step lengths)."""
     indptr = adj.indptr.tolist()
     indices = adj.indices.tolist()
     data = adj.data.tolist()
@@ -94,13 +118,12 @@ def _trace_loops(adj: csr_matrix, rev: np.ndarray, walked: np.ndarray
         k = indptr[p]
         if used[k]:
             continue
-        path, cum, total, prev = [p], [0.0], 0.0, p
+        path, step, prev = [p], [], p
         while True:
             cur = indices[k]
             used[k] = used[revl[k]] = 1
-            total += data[k]
+            step.append(data[k])
             path.append(cur)
-            cum.append(total)
             if cur == p:
                 break
             a = indptr[cur]
@@ -108,5 +131,6 @@ def _trace_loops(adj: csr_matrix, rev: np.ndarray, walked: np.ndarray
             prev = cur
             if used[k]:
                 break
-        chains.append((path, cum))
+        chains.append((path, step))
     return chains
+

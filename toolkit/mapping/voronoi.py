@@ -30,7 +30,8 @@ all-pairs Dijkstra to sparsify (O(N^2)). We compute the same diagram on the grid
    shorter than ``min_spur`` ending in a junction are dropped, and each chain gets
    ``round(length / node_spacing) - 1`` evenly spaced intermediate nodes. Edges weigh their
    length along the ridge and keep the cells they follow (for the door cut of
-   :mod:`sgtool.scenegraph.room_segmentation`).
+   :mod:`sgtool.scenegraph.room_segmentation`). All chains are cut at once, on arrays
+   (:mod:`sgtool.mapping.sparsify`, which states the rules exactly).
 
 Nodes are numbered in raster order of their cells, edges are sorted: the same grid always
 gives the same graph.
@@ -39,9 +40,7 @@ gives the same graph.
 from __future__ import annotations
 
 import math
-from bisect import bisect_left
 from dataclasses import dataclass, field
-from itertools import chain
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -50,13 +49,14 @@ from scipy.sparse.csgraph import connected_components
 
 from sgtool.mapping.esdf import distance_field, obstacles
 from sgtool.mapping.grid import OccupancyGrid
-from sgtool.mapping.ridge_chains import _trace_chains
+from sgtool.mapping.ridge_chains import trace_chain_arrays
 from sgtool.mapping.ridge_window import (
     RidgeFields,
     ridge_fields,
     ridge_from_fields,
     update_fields,
 )
+from sgtool.mapping.sparsify import sparsify
 
 if TYPE_CHECKING:  # networkx is imported only when the view is built (start-up time)
     import networkx as nx
@@ -103,11 +103,30 @@ class VoronoiGraph:
         return self.built
 
     def csgraph(self, keep: np.ndarray | None = None) -> csr_matrix:
-        """Symmetric sparse adjacency (weights in m); ``keep`` masks edges."""
+        """Symmetric sparse adjacency (weights in m); ``keep`` masks edges. The whole graph
+        (no ``keep``) is built once per graph; callers must not change it."""
+        if keep is None:
+            whole = self.__dict__.get("_whole")
+            if whole is None:
+                whole = self._adjacency(self.edges, self.lengths)
+                object.__setattr__(self, "_whole", whole)
+            return whole
+        return self._adjacency(self.edges[keep], self.lengths[keep])
+
+    def edge_cells_flat(self) -> tuple[np.ndarray, np.ndarray]:
+        """(the cells of every edge, concatenated in edge order; where each edge's start),
+        built once per graph (edges without cells: none, every edge has its ends)."""
+        got = self.__dict__.get("_edge_cells_flat")
+        if got is None:
+            m = len(self.edge_cells)
+            sizes = np.fromiter((len(c) for c in self.edge_cells), dtype=np.int64, count=m)
+            got = (np.concatenate(self.edge_cells) if m else np.zeros(0, dtype=np.int64),
+                   np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64))
+            object.__setattr__(self, "_edge_cells_flat", got)
+        return got
+
+    def _adjacency(self, e: np.ndarray, w: np.ndarray) -> csr_matrix:
         n = len(self.positions)
-        e, w = self.edges, self.lengths
-        if keep is not None:
-            e, w = e[keep], w[keep]
         if len(e) == 0:
             return csr_matrix((n, n))
         rows = np.concatenate([e[:, 0], e[:, 1]])
@@ -322,74 +341,17 @@ def voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
     keep = np.flatnonzero(comp == target)
     flat = flat[keep]
     adj = submatrix(adj, keep)
-    chains = _trace_chains(adj)
-    n = adj.shape[0]
-    deg = np.diff(adj.indptr)
-    # drop short spurs (leaf chains ending at a junction)
-    spur = cfg.min_spur / res
-    degree = deg.tolist()
-    kept: list[tuple[list[int], list[float]]] = []
-    for path, cum in chains:
-        length = cum[-1]
-        da, db = degree[path[0]], degree[path[-1]]
-        leaf = da == 1 or db == 1
-        junction = da >= 3 or db >= 3
-        if leaf and junction and length < spur:
-            continue
-        kept.append((path, cum))
-    step = cfg.node_spacing / res
-    node_px: set[int] = set()
-    segs: list[tuple[list[int], float]] = []
-    pairs: set[tuple[int, int]] = set()
-    for path, cum in kept:
-        length = cum[-1]
-        k = max(1, int(round(length / step)))
-        a, b = path[0], path[-1]
-        if a == b:
-            k = max(k, 3)
-        elif (min(a, b), max(a, b)) in pairs and k < 2:
-            k = 2
-        pairs.add((min(a, b), max(a, b)))
-        last = len(path) - 1
-        cuts = [0]
-        for i in range(1, k):  # the first cumulative length reaching each even spacing
-            j = min(max(bisect_left(cum, length * i / k), cuts[-1] + 1), last)
-            if j < last:
-                cuts.append(j)
-        cuts.append(last)
-        for s0, s1 in zip(cuts[:-1], cuts[1:], strict=True):
-            segs.append((path[s0:s1 + 1], cum[s1] - cum[s0]))
-            node_px.add(path[s0])
-            node_px.add(path[s1])
-    if not segs:
-        node_px = {0} if n else set()  # a lone ridge cell
-    order = sorted(node_px)  # pixels are numbered in raster order of their cells
-    node_id = {p: i for i, p in enumerate(order)}
-    cells_flat = flat[np.asarray(order, dtype=np.int64)]
+    pieces = sparsify(trace_chain_arrays(adj), np.diff(adj.indptr), adj.shape[0],
+                      cfg.min_spur / res, cfg.node_spacing / res, res)
+    cells_flat = flat[pieces.nodes]
     rows, cols = np.divmod(cells_flat, w)
     xs, ys = occ.center_of(rows, cols)
     positions = np.stack([xs, ys], axis=1)
     clearance = dist_m[rows, cols]
-    best: dict[tuple[int, int], tuple[float, list[int]]] = {}
-    for seg, length in segs:
-        u, v = node_id[seg[0]], node_id[seg[-1]]
-        if u == v:
-            continue
-        key = (min(u, v), max(u, v))
-        lm = length * res
-        if key not in best or lm < best[key][0]:
-            best[key] = (lm, seg if u < v else seg[::-1])
-    edge_map: dict[tuple[int, int], tuple[float, np.ndarray]] = {}
-    if best:  # the cells of the chosen segments, gathered at once
-        pix = [seg for _, seg in best.values()]
-        cells_all = flat[np.fromiter(chain.from_iterable(pix), dtype=np.int64)]
-        bounds = np.cumsum([0] + [len(p) for p in pix]).tolist()
-        for i, (key, (lm, _)) in enumerate(best.items()):
-            edge_map[key] = (lm, cells_all[bounds[i]:bounds[i + 1]])
-    keys = sorted(edge_map)
-    edges = np.asarray(keys, dtype=np.int64).reshape(-1, 2)
-    lengths = np.asarray([edge_map[k][0] for k in keys], dtype=np.float64)
-    edge_cells = tuple(edge_map[k][1] for k in keys)
+    cells_all = flat[pieces.cells]
+    bounds = pieces.cell_start.tolist()
+    edge_cells = tuple(cells_all[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True))
+    edges, lengths = pieces.edges, pieces.lengths
     return VoronoiGraph(None, positions, clearance, np.stack([rows, cols], axis=1), edges,
                         lengths, edge_cells, rg.ridge, (h, w))
 

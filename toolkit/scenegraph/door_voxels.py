@@ -26,6 +26,7 @@ class DoorVoxels:
     def __init__(self) -> None:
         self._doors: frozenset[int] = frozenset()
         self._keys: dict[int, list[np.ndarray]] = {}
+        self._ijk: dict[int, np.ndarray] = {}  # unpacked keys of a door, until it gets more
 
     def stale(self, doors: Iterable[int]) -> bool:
         """True when the door instances differ from those the keys were kept for."""
@@ -35,6 +36,7 @@ class DoorVoxels:
         """Keep the door keys among ``keys`` (every key of the map) only."""
         self._doors = frozenset(int(d) for d in doors)
         self._keys = {}
+        self._ijk = {}
         self.add(keys, label_ids)
 
     def add(self, keys: np.ndarray, label_ids: np.ndarray) -> None:
@@ -54,6 +56,7 @@ class DoorVoxels:
         inst = label_ids[keys & LABEL_MASK]
         for iid in np.unique(inst).tolist():
             self._keys.setdefault(int(iid), []).append(keys[inst == iid])
+            self._ijk.pop(int(iid), None)
 
     def of(self, instance_ids: Iterable[int]) -> dict[int, np.ndarray]:
         """Instance id -> ijk (M, 3) of its voxels (each once), for door instances."""
@@ -63,8 +66,12 @@ class DoorVoxels:
             if not parts:
                 out[iid] = np.zeros((0, 3), np.int64)
                 continue
-            if len(parts) > 1:
-                parts[:] = [np.concatenate(parts)]
-            ix, iy, iz, _ = unpack(parts[0])
-            out[iid] = np.stack([ix, iy, iz], axis=1)
+            got = self._ijk.get(iid)
+            if got is None:
+                if len(parts) > 1:
+                    parts[:] = [np.concatenate(parts)]
+                ix, iy, iz, _ = unpack(parts[0])
+                got = self._ijk[iid] = np.stack([ix, iy, iz], axis=1)
+                got.setflags(write=False)
+            out[iid] = got
         return out

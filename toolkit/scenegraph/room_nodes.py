@@ -51,8 +51,9 @@ def room_regions(vg: VoronoiGraph, seg: RoomSegmentation, room_ids: list[str],
             reg_id = f"region:{num}.{k}"
             regions[reg_id] = (rid, node, (float(vg.positions[node, 0]),
                                            float(vg.positions[node, 1])))
-        for j, n in enumerate(nodes.tolist()):
-            node_region[int(n)] = f"region:{num}.{int(reg.labels[j]) + 1}"
+        names = [f"region:{num}.{k}" for k in range(1, int(reg.labels.max(initial=-1)) + 2)]
+        node_region.update(zip(nodes.tolist(), [names[k] for k in reg.labels.tolist()],
+                               strict=True))
     return regions, node_region
 
 

@@ -124,24 +124,26 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray, min_width
     h, w = occupied.shape
     grown = ndimage.binary_dilation(occupied, structure=np.ones((3, 3), dtype=bool))
 
-    def share(p0: np.ndarray, direction: np.ndarray, lo: float, hi: float,
-              grid: np.ndarray = occupied) -> float:
-        f = np.linspace(lo, hi, max(2, int(np.ceil(2 * (hi - lo)))))
-        p = p0[None, :] + direction[None, :] * f[:, None]
-        c, r = np.round(p[:, 0]).astype(np.int64), np.round(p[:, 1]).astype(np.int64)
-        ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
-        return float(grid[r[ok], c[ok]].mean()) if ok.any() else 0.0
-
-    scored = []
+    # every (end, side, offset) of the panel: the shares of occupied cells along the wall
+    # side, the opening and the far jamb, sampled at once (:func:`_shares`)
+    rays = []
     for s, out in ((s0, -a), (s1, a)):
         for sign in (1.0, -1.0):
             d = sign * t
-            best = None
             for off in range(4):  # the wall line may lie a few cells beyond the panel's end
                 end = mean + a * s + out * off
-                wall = share(end, -d, 0.1 * width, 0.45 * width, grown)
-                opening = share(end, d, 0.15 * width, 0.85 * width)
-                jamb = share(end, d, 1.05 * width, 1.3 * width, grown)
+                rays += [(end, -d, 0.1 * width, 0.45 * width, True),
+                         (end, d, 0.15 * width, 0.85 * width, False),
+                         (end, d, 1.05 * width, 1.3 * width, True)]
+    shares = _shares(rays, occupied, grown)
+    scored = []
+    at = 0
+    for s, out in ((s0, -a), (s1, a)):
+        for sign in (1.0, -1.0):
+            best = None
+            for off in range(4):
+                wall, opening, jamb = shares[at:at + 3]
+                at += 3
                 cand = (wall + jamb - 2.0 * opening, off)
                 if best is None or cand[0] > best[0]:
                     best = cand
@@ -158,6 +160,30 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray, min_width
     r = np.round(p[:, 1]).astype(np.int64)
     ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
     return r[ok], c[ok]
+
+
+def _shares(rays: list[tuple[np.ndarray, np.ndarray, float, float, bool]],
+            occupied: np.ndarray, grown: np.ndarray) -> list[float]:
+    """Per ray (start, direction, from, to, on the grown grid): the share of occupied
+    cells at the points sampled every half cell from ``start + from * direction`` to
+    ``start + to * direction`` (points off the grid skipped; 0.0 with none on it). The
+    points of every ray are computed as one ray at a time would, the shares counted
+    for all at once."""
+    fs = [np.linspace(lo, hi, max(2, int(np.ceil(2 * (hi - lo))))) for _, _, lo, hi, _ in rays]
+    sizes = np.fromiter((len(f) for f in fs), dtype=np.int64, count=len(rays))
+    ray = np.repeat(np.arange(len(rays)), sizes)
+    p0 = np.stack([r[0] for r in rays])[ray]
+    direction = np.stack([r[1] for r in rays])[ray]
+    p = p0 + direction * np.concatenate(fs)[:, None]
+    c, r = np.round(p[:, 0]).astype(np.int64), np.round(p[:, 1]).astype(np.int64)
+    h, w = occupied.shape
+    ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+    on_grown = np.fromiter((g for *_, g in rays), dtype=bool, count=len(rays))[ray[ok]]
+    hit = np.where(on_grown, grown[r[ok], c[ok]], occupied[r[ok], c[ok]])
+    count = np.bincount(ray[ok], minlength=len(rays))
+    total = np.bincount(ray[ok], weights=hit.astype(np.float64), minlength=len(rays))
+    return [float(x / n) if n else 0.0 for x, n in zip(total.tolist(), count.tolist(),
+                                                        strict=True)]
 
 
 @dataclass(frozen=True, eq=False)
@@ -191,50 +217,73 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
         h, w = vg.shape
         cut_n = flat[vg.cells[:, 0] * w + vg.cells[:, 1]] >= cfg.door_threshold
         if m:  # the maximum density along every edge's cells, all edges in one pass
-            sizes = np.fromiter((len(c) for c in vg.edge_cells), dtype=np.int64, count=m)
-            starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
-            peak = np.maximum.reduceat(flat[np.concatenate(vg.edge_cells)], starts)
-            cut_e = peak >= cfg.door_threshold
+            cells, starts = vg.edge_cells_flat()
+            cut_e = np.maximum.reduceat(flat[cells], starts) >= cfg.door_threshold
     keep = ~cut_e
     if m:
         keep &= ~cut_n[vg.edges[:, 0]] & ~cut_n[vg.edges[:, 1]]
     labels = np.full(n, -1, dtype=np.int64)
     if n == 0:
         return RoomSegmentation(labels, cut_e, cut_n, (), ())
-    ncomp, comp = connected_components(vg.csgraph(keep), directed=False)
+    graph = vg.csgraph(keep)
+    ncomp, comp = connected_components(graph, directed=False)
     comp_len = np.zeros(ncomp)
     if m:
         np.add.at(comp_len, comp[vg.edges[keep, 0]], vg.lengths[keep])
     rooms: list[np.ndarray] = []
-    for c in range(ncomp):  # components are numbered by their lowest node already
-        nodes = np.flatnonzero((comp == c) & ~cut_n)
-        if len(nodes) == 0 or comp_len[c] < cfg.min_room_length:
+    by_comp = np.argsort(comp, kind="stable")  # nodes grouped by component, ascending
+    bounds = np.searchsorted(comp[by_comp], np.arange(ncomp + 1))
+    for c in np.flatnonzero(comp_len >= cfg.min_room_length).tolist():
+        # components are numbered by their lowest node already
+        nodes = by_comp[bounds[c]:bounds[c + 1]]
+        nodes = nodes[~cut_n[nodes]]
+        if len(nodes) == 0:
             continue
         labels[nodes] = len(rooms)
         rooms.append(nodes)
-    graph = vg.csgraph(keep)
     where = np.full(n, -1, dtype=np.int64)
-    centres = tuple(_graph_centre(graph, nodes, where, centre_memo) for nodes in rooms)
+    keys = _room_keys(vg, keep, labels, rooms) if centre_memo is not None else None
+    centres = tuple(_graph_centre(graph, nodes, where, centre_memo,
+                                  None if keys is None else keys[i])
+                    for i, nodes in enumerate(rooms))
     return RoomSegmentation(labels, cut_e, cut_n, tuple(rooms), centres)
 
 
+def _room_keys(vg: VoronoiGraph, keep: np.ndarray, labels: np.ndarray,
+               rooms: list[np.ndarray]) -> list[bytes]:
+    """Per room, a digest of its sub-graph: its node count and its kept edges (both ends
+    in the room, as every kept edge at a room node is) in edge order, as (local u, local
+    v, length); the sub-graph's arrays (:func:`sgtool.mapping.voronoi.submatrix`) are a
+    function of these alone (nodes and edges are sorted)."""
+    local = np.full(len(labels), -1, dtype=np.int64)
+    for nodes in rooms:
+        local[nodes] = np.arange(len(nodes))
+    e = vg.edges[keep]
+    w = np.ascontiguousarray(vg.lengths[keep], dtype=np.float64)
+    lab = labels[e[:, 0]] if len(e) else np.zeros(0, dtype=np.int64)
+    order = np.argsort(lab, kind="stable")
+    bounds = np.searchsorted(lab[order], np.arange(len(rooms) + 1))
+    lu, lv, lw = local[e[order, 0]], local[e[order, 1]], w[order]
+    keys = []
+    for i, nodes in enumerate(rooms):
+        a, b = int(bounds[i]), int(bounds[i + 1])
+        h = hashlib.blake2b(repr(len(nodes)).encode(), digest_size=16)
+        for arr in (lu[a:b], lv[a:b], lw[a:b]):
+            h.update(arr.tobytes())
+        keys.append(h.digest())
+    return keys
+
+
 def _graph_centre(graph: csr_matrix, nodes: np.ndarray, where: np.ndarray,
-                  memo: dict[bytes, int] | None = None) -> int:
+                  memo: dict[bytes, int] | None = None, key: bytes | None = None) -> int:
     """The node of minimum eccentricity within its room (ties: the lowest id); ``where``
-    is scratch space (-1 everywhere, as it is left); ``memo``: see :func:`segment_rooms`."""
+    is scratch space (-1 everywhere, as it is left); ``memo``: see :func:`segment_rooms`,
+    ``key`` the room's digest there (:func:`_room_keys`)."""
     if len(nodes) == 1:
         return int(nodes[0])
-    sub = submatrix(graph, nodes, where)
-    key = None
-    if memo is not None:
-        h = hashlib.blake2b(digest_size=16)
-        for a in (sub.indptr, sub.indices, sub.data):
-            h.update(repr((a.dtype.str, a.shape)).encode())
-            h.update(np.ascontiguousarray(a).tobytes())
-        key = h.digest()
-        if key in memo:
-            return int(nodes[memo[key]])
-    d = dijkstra(sub, directed=False)
+    if memo is not None and key is not None and key in memo:
+        return int(nodes[memo[key]])
+    d = dijkstra(submatrix(graph, nodes, where), directed=False)
     ecc = d.max(axis=1)
     best = int(np.argmin(ecc))
     if memo is not None and key is not None:
@@ -290,6 +339,29 @@ def _other_rooms(pred: list[int], labels: list[int], a: int):  # noqa: ANN202
     return other
 
 
+def _overlaps(known: dict[int, np.ndarray], room_positions: Sequence[np.ndarray],
+              radius: float) -> list[tuple[int, int, int]]:
+    """(-count, new room, old room) for every pair of a new room and an old room (node
+    positions ``known``) with ``count`` of the new room's nodes nearest (within
+    ``radius``) to a node of the old room; all nodes in one k-d tree query."""
+    old_ids = sorted(known)
+    if not old_ids or not room_positions:
+        return []
+    old_pos = np.concatenate([known[o] for o in old_ids])
+    old_lab = np.concatenate([np.full(len(known[o]), o) for o in old_ids])
+    if not len(old_pos):
+        return []
+    new = [np.asarray(p, dtype=np.float64).reshape(-1, 2) for p in room_positions]
+    owner = np.repeat(np.arange(len(new), dtype=np.int64), [len(p) for p in new])
+    d, j = cKDTree(old_pos).query(np.concatenate(new), k=1, distance_upper_bound=radius)
+    hit = np.isfinite(d)
+    span = int(old_lab.max()) + 1
+    pairs, counts = np.unique(owner[hit] * span + old_lab[j[hit]], return_counts=True)
+    rooms, labs = np.divmod(pairs, span)
+    return [(-c, i, lab) for i, lab, c in zip(rooms.tolist(), labs.tolist(), counts.tolist(),
+                                              strict=True)]
+
+
 @dataclass
 class _Known:
     positions: np.ndarray  # (k, 2) node positions of the room at the last refresh
@@ -307,21 +379,8 @@ class RoomTracker:
     def assign(self, room_positions: Sequence[np.ndarray], radius: float) -> list[int]:
         """Room numbers for this refresh's rooms (node positions of each)."""
         n_new = len(room_positions)
-        old_ids = sorted(self.known)
-        overlap: list[tuple[int, int, int]] = []  # (-count, new, old)
-        if old_ids and n_new:
-            old_pos = np.concatenate([self.known[o].positions for o in old_ids])
-            old_lab = np.concatenate([np.full(len(self.known[o].positions), o)
-                                      for o in old_ids])
-            tree = cKDTree(old_pos)
-            for i, pos in enumerate(room_positions):
-                d, j = tree.query(pos, k=1, distance_upper_bound=radius)
-                hit = np.isfinite(d)
-                if not hit.any():
-                    continue
-                labs, counts = np.unique(old_lab[j[hit]], return_counts=True)
-                for lab, c in zip(labs.tolist(), counts.tolist(), strict=True):
-                    overlap.append((-int(c), i, int(lab)))
+        overlap = _overlaps({o: k.positions for o, k in self.known.items()}, room_positions,
+                            radius)  # (-count, new, old)
         overlap.sort()
         result: list[int | None] = [None] * n_new
         used: set[int] = set()

@@ -213,3 +213,44 @@ def test_memoised_room_centres_and_regions_equal_fresh_ones() -> None:
         got = room_regions(vg, seg, ids, RegionConfig(region_length=2.0), region_memo)
         assert got == room_regions(vg, seg, ids, RegionConfig(region_length=2.0))
     assert hits >= 10 and centre_memo and region_memo
+
+
+def test_room_centres_from_one_memo_along_changing_graphs_equal_fresh_ones() -> None:
+    """One centre memo carried along graphs that change a little at a time (a few edge
+    lengths, by as little as one ulp, an edge dropped, the door evidence moved): every
+    centre equals the one computed without the memo, and rooms left as they were are
+    answered from it."""
+    memo: dict[bytes, int] = {}
+    hits = 0
+    for seed in range(6):
+        rng = np.random.default_rng(700 + seed)
+        vg = random_graph(seed)
+        density = np.zeros(vg.shape)
+        for _ in range(3):
+            r, c = vg.cells[int(rng.integers(len(vg)))]
+            density[r, c] = 1.0
+        for _step in range(8):
+            before = len(memo)
+            seg = segment_rooms(vg, density, RoomConfig(min_room_length=0.5), memo)
+            fresh = segment_rooms(vg, density, RoomConfig(min_room_length=0.5))
+            assert seg.centres == fresh.centres
+            assert all(np.array_equal(a, b) for a, b in zip(seg.rooms, fresh.rooms, strict=True))
+            hits += len(memo) - before < sum(len(r) > 1 for r in seg.rooms)
+            lengths, edges, cells = vg.lengths.copy(), vg.edges, vg.edge_cells
+            pick = rng.integers(0, len(lengths), size=2)
+            if rng.random() < 0.5:
+                lengths[pick] = np.nextafter(lengths[pick], np.inf)
+            else:
+                lengths[pick] *= rng.uniform(0.2, 3.0)
+            if rng.random() < 0.3 and len(edges) > 4:
+                drop = int(rng.integers(len(edges)))
+                keep = np.arange(len(edges)) != drop
+                edges, lengths = edges[keep], lengths[keep]
+                cells = tuple(c for i, c in enumerate(cells) if i != drop)
+            if rng.random() < 0.3:
+                density = np.zeros(vg.shape)
+                r, c = vg.cells[int(rng.integers(len(vg)))]
+                density[r, c] = 1.0
+            vg = VoronoiGraph(None, vg.positions, vg.clearance, vg.cells, edges, lengths,
+                              cells, vg.ridge, vg.shape)
+    assert hits >= 10

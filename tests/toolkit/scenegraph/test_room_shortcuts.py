@@ -1,0 +1,198 @@
+"""Shortcuts of the rooms stage (issue 20) equal the plain computation, bit for bit."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import ndimage
+from scipy.spatial import cKDTree
+
+from sgtool.mapping.bev import line_of_sight
+from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
+from sgtool.mapping.voronoi import VoronoiGraph
+from sgtool.scenegraph import room_segmentation
+from sgtool.scenegraph.door_evidence import _visible_labelled, door_cells_of
+from sgtool.scenegraph.room_segmentation import _overlaps, _shares, opening_from_panel
+
+
+def _share(p0: np.ndarray, direction: np.ndarray, lo: float, hi: float,
+           grid: np.ndarray) -> float:
+    """One ray at a time, as ``_opening`` sampled before its rays were batched."""
+    h, w = grid.shape
+    f = np.linspace(lo, hi, max(2, int(np.ceil(2 * (hi - lo)))))
+    p = p0[None, :] + direction[None, :] * f[:, None]
+    c, r = np.round(p[:, 0]).astype(np.int64), np.round(p[:, 1]).astype(np.int64)
+    ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+    return float(grid[r[ok], c[ok]].mean()) if ok.any() else 0.0
+
+
+def _reference_shares(rays, occupied, grown):  # noqa: ANN001, ANN202
+    return [_share(p0, d, lo, hi, grown if g else occupied) for p0, d, lo, hi, g in rays]
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_batched_shares_equal_one_ray_at_a_time(seed):
+    rng = np.random.default_rng(seed)
+    occupied = rng.random((int(rng.integers(10, 60)), int(rng.integers(10, 60)))) < 0.3
+    grown = ndimage.binary_dilation(occupied)
+    rays = []
+    for _ in range(48):
+        ang = rng.uniform(0, 2 * np.pi)
+        width = rng.uniform(2.0, 30.0)
+        lo = rng.uniform(0.0, 1.2) * width
+        rays.append((rng.uniform(-10, 70, size=2), np.array([np.cos(ang), np.sin(ang)]),
+                     lo, lo + rng.uniform(0.0, 0.8) * width, bool(rng.random() < 0.5)))
+    got = _shares(rays, occupied, grown)
+    want = _reference_shares(rays, occupied, grown)
+    assert got == want
+    assert any(0.0 < x < 1.0 for x in want) and 0.0 in want  # partial shares and off-grid
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_panel_openings_equal_the_ray_by_ray_search(seed, monkeypatch):
+    """A swung door panel in a wall with a gap (random hinge, side, length, clutter):
+    the doorway found with batched rays is the one found ray by ray."""
+    rng = np.random.default_rng(100 + seed)
+    occupied = np.zeros((80, 80), dtype=bool)
+    wall = int(rng.integers(30, 50))
+    gap0 = int(rng.integers(20, 40))
+    width = int(rng.integers(8, 18))
+    occupied[wall, :gap0] = True
+    occupied[wall, gap0 + width:] = True
+    side = 1 if rng.random() < 0.5 else -1
+    rows = wall + side * np.arange(1, width)
+    cols = np.full(len(rows), gap0)
+    occupied[rows, cols] = True
+    occupied |= rng.random(occupied.shape) < 0.03
+    got = opening_from_panel(rows, cols, occupied, min_width=8)
+    monkeypatch.setattr(room_segmentation, "_shares", _reference_shares)
+    want = opening_from_panel(rows, cols, occupied, min_width=8)
+    assert (got is None) == (want is None)
+    if want is not None:
+        assert got is not None
+        assert np.array_equal(got[0], want[0]) and np.array_equal(got[1], want[1])
+
+
+def _door_cells_one_by_one(occ, door_voxels, panel_memo):  # noqa: ANN001, ANN202
+    """``door_cells_of`` as it was: one door at a time."""
+    cells = np.zeros(occ.shape, dtype=bool)
+    ix0 = int(round(occ.origin[0] / occ.resolution))
+    iy0 = int(round(occ.origin[1] / occ.resolution))
+    occupied = None
+    for _, ijk in sorted(door_voxels.items()):
+        if not len(ijk):
+            continue
+        r, c = ijk[:, 1] - iy0, ijk[:, 0] - ix0
+        ok = occ.inside(r, c)
+        r, c = r[ok], c[ok]
+        passable = occ.grid[r, c] != OCCUPIED
+        if passable.any():
+            r, c = r[passable], c[passable]
+        else:
+            cell = np.unique(r * (occ.shape[1] + 1) + c)
+            r, c = np.divmod(cell, occ.shape[1] + 1)
+            if occupied is None:
+                occupied = occ.grid == OCCUPIED
+            got = opening_from_panel(r, c, occupied, int(0.4 / occ.resolution), memo=panel_memo)
+            if got is not None:
+                r, c = got
+        cells[r, c] = True
+    return cells
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_door_cells_of_all_doors_at_once_equal_one_door_at_a_time(seed):
+    """Doors with passable cells, doors seen as a swung panel in a wall with a gap (some
+    found as a doorway, some not), doors partly or wholly off the grid, empty doors."""
+    rng = np.random.default_rng(300 + seed)
+    h, w = 90, 120
+    g = np.full((h, w), FREE, dtype=np.int8)
+    doors: dict[int, np.ndarray] = {}
+    origin = (float(rng.integers(-20, 20)) * 0.05, float(rng.integers(-20, 20)) * 0.05)
+    ix0, iy0 = int(round(origin[0] / 0.05)), int(round(origin[1] / 0.05))
+    for iid in rng.permutation(12).tolist():
+        kind = rng.choice(["open", "panel", "off", "empty"])
+        if kind == "empty":
+            doors[iid] = np.zeros((0, 3), np.int64)
+            continue
+        r0, c0 = int(rng.integers(5, h - 25)), int(rng.integers(5, w - 25))
+        width = int(rng.integers(8, 16))
+        if kind == "panel":  # a wall with a gap, the panel swung from its jamb
+            g[r0, :c0] = OCCUPIED
+            g[r0, c0 + width:] = OCCUPIED
+            rows = r0 + np.arange(1, width)
+            cols = np.full(len(rows), c0)
+            g[rows, cols] = OCCUPIED
+        else:
+            rows = np.full(width, r0)
+            cols = c0 + np.arange(width)
+            g[rows[: width // 3], cols[: width // 3]] = OCCUPIED  # the lintel over part
+            if kind == "off":
+                rows = rows - 200 * int(rng.integers(0, 2))
+        z = rng.integers(0, 30, size=len(rows))
+        doors[iid] = np.stack([cols + ix0, rows + iy0, z], axis=1).astype(np.int64)
+    occ = OccupancyGrid(g, origin, 0.05)
+    got = door_cells_of(occ, doors, {})
+    want = _door_cells_one_by_one(occ, doors, {})
+    assert np.array_equal(got, want)
+    assert want.any()
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_door_sight_lines_of_all_doors_at_once_equal_one_door_at_a_time(seed):
+    rng = np.random.default_rng(900 + seed)
+    g = np.full((60, 80), FREE, dtype=np.int8)
+    for _ in range(6):
+        r, c = int(rng.integers(0, 55)), int(rng.integers(0, 75))
+        g[r:r + int(rng.integers(1, 5)), c:c + int(rng.integers(1, 20))] = OCCUPIED
+    occ = OccupancyGrid(g, (0.0, 0.0), 0.05)
+    blocked = g == OCCUPIED
+    pos = rng.uniform((0, 0), (4, 3), size=(50, 2))
+    vg = VoronoiGraph(None, pos, np.ones(50), np.zeros((50, 2), np.int64),
+                      np.zeros((0, 2), np.int64), np.zeros(0), (), np.zeros((1, 1), bool))
+    node_room = rng.integers(-1, 3, size=50)
+    points = [tuple(p) for p in rng.uniform((0, 0), (4, 3), size=(int(rng.integers(0, 9)), 2))]
+    got = _visible_labelled(points, vg, node_room, occ, blocked, 1.5)
+    labelled = np.flatnonzero(node_room >= 0)
+    tree = cKDTree(pos[labelled])
+    for p, near in zip(points, got, strict=True):
+        want = labelled[np.asarray(sorted(tree.query_ball_point(p, 1.5)), dtype=np.int64)]
+        if len(want):
+            want = want[line_of_sight(blocked, occ, pos[want],
+                                      np.repeat(np.asarray([p]), len(want), axis=0),
+                                      skip_end=0.3)]
+        assert near is not None and np.array_equal(near, want)
+    none = _visible_labelled(points, vg, np.full(50, -1), occ, blocked, 1.5)
+    assert none == [None] * len(points)
+
+
+def _overlaps_one_room_at_a_time(known, room_positions, radius):  # noqa: ANN001, ANN202
+    """``RoomTracker.assign``'s overlaps as they were computed: a query per new room."""
+    old_ids = sorted(known)
+    out = []
+    if old_ids and len(room_positions):
+        old_pos = np.concatenate([known[o] for o in old_ids])
+        old_lab = np.concatenate([np.full(len(known[o]), o) for o in old_ids])
+        tree = cKDTree(old_pos)
+        for i, pos in enumerate(room_positions):
+            d, j = tree.query(pos, k=1, distance_upper_bound=radius)
+            hit = np.isfinite(d)
+            if not hit.any():
+                continue
+            labs, counts = np.unique(old_lab[j[hit]], return_counts=True)
+            for lab, c in zip(labs.tolist(), counts.tolist(), strict=True):
+                out.append((-int(c), i, int(lab)))
+    return sorted(out)
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_room_overlaps_in_one_query_equal_a_query_per_room(seed):
+    rng = np.random.default_rng(1200 + seed)
+    known = {int(o): rng.uniform(0, 10, size=(int(rng.integers(1, 30)), 2))
+             for o in rng.choice(40, size=int(rng.integers(0, 8)), replace=False)}
+    new = [rng.uniform(0, 10, size=(int(rng.integers(1, 30)), 2))
+           for _ in range(int(rng.integers(0, 8)))]
+    radius = float(rng.uniform(0.2, 1.5))
+    got = sorted(_overlaps(known, new, radius))
+    assert got == _overlaps_one_room_at_a_time(known, new, radius)
+    assert all(isinstance(x, int) for t in got for x in t)
