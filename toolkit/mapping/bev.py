@@ -39,9 +39,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from sgtool.mapping.holes import UnknownParts, fill_holes_parts
 from sgtool.mapping.voxels import AXIS_BITS, AXIS_MASK, COLUMN_SHIFT, OFFSET, SHIFT_Z
 
 
@@ -126,10 +126,19 @@ class ColumnGrid:
                                np.ndarray] | None = None
         # the last occupancy grid made and its unknown components (see unknown_parts_of)
         self._parts: tuple[np.ndarray, UnknownParts | None] | None = None
+        self._track = TrackBox(resolution)  # the trajectory's cell bounds
 
     def _fit(self, sets: Sequence[np.ndarray], trajectory: Sequence[tuple[float, float]]
              ) -> None:
-        self.cover(grid_extent(sets, self.resolution, self.config, trajectory))
+        self.cover(grid_extent(sets, self.resolution, self.config,
+                               track=self._track.of(trajectory)))
+
+    def fitted_extent(self, sets: Sequence[np.ndarray],
+                      trajectory: Sequence[tuple[float, float]]) -> tuple[int, int, int, int]:
+        """:func:`grid_extent` of ``sets`` and ``trajectory`` (the trajectory's bounds kept
+        from the previous calls)."""
+        return grid_extent(sets, self.resolution, self.config,
+                           track=self._track.of(trajectory))
 
     def cover(self, want: tuple[int, int, int, int]) -> None:
         """Grow the grid to cover the voxel-index extent ``want`` (keeping the flags)."""
@@ -217,9 +226,9 @@ class ColumnGrid:
         points = list(trajectory)
         got = self._footprint
         shape = self.flags.shape
-        if got is not None and got[0] == self.extent and points[:len(got[1])] == got[1]:
+        new = None if got is None or got[0] != self.extent else appended(got[1], points)
+        if got is not None and new is not None:
             mask = got[2]
-            new = points[len(got[1]):]
             if new:
                 mask = mask | footprint(new, self.extent, shape, self.resolution,
                                         self.config.robot_radius)
@@ -249,16 +258,28 @@ def _occupancy_and_parts(flags: np.ndarray, extent: tuple[int, int, int, int],
     """:func:`occupancy_grid` and its unknown components (:func:`fill_holes_parts`)."""
     ix0, iy0 = extent[0], extent[1]
     h, w = flags.shape
-    grid = np.full((h, w), UNKNOWN, dtype=np.int8)
-    grid[(flags & (ColumnGrid.FLOOR | ColumnGrid.CARVED)) != 0] = FREE
-    if stamped is not None:
-        grid[stamped] = FREE
-    elif len(trajectory):
-        grid[footprint(trajectory, extent, (h, w), resolution, config.robot_radius)] = FREE
-    grid[(flags & ColumnGrid.OCC) != 0] = OCCUPIED
+    if stamped is None:
+        stamped = footprint(trajectory, extent, (h, w), resolution, config.robot_radius) \
+            if len(trajectory) else np.zeros((h, w), dtype=bool)
+    grid = cell_values(flags, stamped)
     _, parts = fill_holes_parts(grid, int(config.max_hole / resolution**2))
     origin = (ix0 * resolution, iy0 * resolution)
     return OccupancyGrid(grid, origin, resolution, (level + 1) * resolution), parts
+
+
+# the cell value of every code ``flags | stamped << 3`` (ColumnGrid flags, footprint bit):
+# occupied wins, then free (floor, carved or under the robot), else unknown
+_STAMPED = np.uint8(8)
+_CELL_VALUES = np.array([OCCUPIED if i & ColumnGrid.OCC else
+                         FREE if i & (ColumnGrid.FLOOR | ColumnGrid.CARVED | _STAMPED) else
+                         UNKNOWN for i in range(16)], dtype=np.int8)
+
+
+def cell_values(flags: np.ndarray, stamped: np.ndarray) -> np.ndarray:
+    """FREE / OCCUPIED / UNKNOWN of column ``flags`` (``ColumnGrid`` bits) and the robot's
+    footprint ``stamped`` (bool), in one table look-up."""
+    code = flags | (stamped.view(np.uint8) << 3)
+    return np.take(_CELL_VALUES, code)
 
 
 def occupancy_from_keys(keys: np.ndarray, resolution: float, config: BevConfig,
@@ -279,18 +300,21 @@ def occupancy_from_keys(keys: np.ndarray, resolution: float, config: BevConfig,
 
 
 def grid_extent(column_sets: Sequence[np.ndarray], resolution: float, config: BevConfig,
-                trajectory: Sequence[tuple[float, float]] = ()) -> tuple[int, int, int, int]:
-    """Snapped voxel-index extent (ix0, iy0, ix1, iy1) covering columns and trajectory."""
+                trajectory: Sequence[tuple[float, float]] = (),
+                track: tuple[int, int, int, int] | None = None) -> tuple[int, int, int, int]:
+    """Snapped voxel-index extent (ix0, iy0, ix1, iy1) covering columns and trajectory
+    (``track``: the trajectory's :func:`track_box`, when the caller has it)."""
     xs: list[int] = []
     ys: list[int] = []
     for cs in column_sets:
         if len(cs):
             xs += [int(cs[:, 0].min()), int(cs[:, 0].max())]
             ys += [int(cs[:, 1].min()), int(cs[:, 1].max())]
-    if len(trajectory):
-        t = np.floor(np.asarray(trajectory, dtype=np.float64).reshape(-1, 2) / resolution)
-        xs += [int(t[:, 0].min()), int(t[:, 0].max())]
-        ys += [int(t[:, 1].min()), int(t[:, 1].max())]
+    if track is None and len(trajectory):
+        track = track_box(trajectory, resolution)
+    if track is not None:
+        xs += [track[0], track[2]]
+        ys += [track[1], track[3]]
     if not xs:
         xs, ys = [0, 0], [0, 0]
     m, s = config.margin, max(1, config.snap)
@@ -299,6 +323,50 @@ def grid_extent(column_sets: Sequence[np.ndarray], resolution: float, config: Be
     ix1 = -((-(max(xs) + m + 1)) // s) * s - 1
     iy1 = -((-(max(ys) + m + 1)) // s) * s - 1
     return ix0, iy0, ix1, iy1
+
+
+def track_box(trajectory: Sequence[tuple[float, float]], resolution: float
+              ) -> tuple[int, int, int, int] | None:
+    """Cell bounds (ix0, iy0, ix1, iy1) of trajectory points (None without points)."""
+    if not len(trajectory):
+        return None
+    t = np.floor(np.asarray(trajectory, dtype=np.float64).reshape(-1, 2) / resolution)
+    return (int(t[:, 0].min()), int(t[:, 1].min()), int(t[:, 0].max()), int(t[:, 1].max()))
+
+
+def appended(seen: list[tuple[float, float]], trajectory: Sequence[tuple[float, float]]
+             ) -> list[tuple[float, float]] | None:
+    """The points of ``trajectory`` after the prefix ``seen``, None when ``trajectory``
+    does not start with ``seen``."""
+    n = len(seen)
+    if len(trajectory) < n or list(trajectory[:n]) != seen:
+        return None
+    return list(trajectory[n:])
+
+
+class TrackBox:
+    """:func:`track_box` of a trajectory that grows by appending: kept from one call to
+    the next, only the new points are converted (the min and max of the cell indices of
+    all points are those of the old bounds and the new points)."""
+
+    def __init__(self, resolution: float) -> None:
+        self.resolution = resolution
+        self._points: list[tuple[float, float]] = []
+        self._box: tuple[int, int, int, int] | None = None
+
+    def of(self, trajectory: Sequence[tuple[float, float]]) -> tuple[int, int, int, int] | None:
+        new = appended(self._points, trajectory)
+        if new is None:  # not an extension: start afresh
+            self._points, self._box = [], None
+            new = list(trajectory)
+        if new:
+            add = track_box(new, self.resolution)
+            assert add is not None
+            old = self._box or add
+            self._box = (min(old[0], add[0]), min(old[1], add[1]), max(old[2], add[2]),
+                         max(old[3], add[3]))
+            self._points += new
+        return self._box
 
 
 def floor_fans(depth: np.ndarray, pose: np.ndarray, fx: float, fy: float, cx: float,
@@ -350,58 +418,10 @@ def footprint(trajectory: Sequence[tuple[float, float]], extent: tuple[int, int,
     return out
 
 
-UnknownParts = tuple[np.ndarray, int]  # (labels of 4-connected components, max label)
-
-
-def near(mask: np.ndarray) -> np.ndarray:
-    """Cells 8-adjacent to (or in) ``mask`` (a 3x3 dilation by shifted ORs)."""
-    p = np.pad(mask, 1)
-    out = p[1:-1, 1:-1].copy()
-    h, w = mask.shape
-    for dr in (0, 1, 2):
-        for dc in (0, 1, 2):
-            if dr != 1 or dc != 1:
-                out |= p[dr:dr + h, dc:dc + w]
-    return out
-
-
 def disk(radius: int) -> np.ndarray:
     """Boolean disk structuring element of a radius in cells."""
     r = np.arange(-radius, radius + 1)
     return (r[:, None] ** 2 + r[None, :] ** 2) <= radius * radius
-
-
-def fill_holes(grid: np.ndarray, max_cells: int) -> int:
-    """Turn enclosed unknown holes of at most ``max_cells`` cells (4-connected, bordered
-    only by free cells, not touching the grid border) into free space, in place; returns
-    the number of cells filled."""
-    return fill_holes_parts(grid, max_cells)[0]
-
-
-def fill_holes_parts(grid: np.ndarray, max_cells: int) -> tuple[int, UnknownParts | None]:
-    """:func:`fill_holes`, and the 4-connected components of the unknown cells left
-    (labels, an upper bound of the label values; None when ``max_cells`` <= 0 skips the
-    labelling). Filling turns whole components free, so the components left are those of
-    the labelling before it, the filled ones relabelled 0."""
-    if max_cells <= 0:
-        return 0, None
-    unknown = grid == UNKNOWN
-    lab, n = ndimage.label(unknown)
-    if n == 0:
-        return 0, (lab, 0)
-    sizes = np.bincount(lab.ravel())
-    bad = np.zeros(n + 1, dtype=bool)
-    bad[0] = True
-    bad[sizes > max_cells] = True
-    # holes next to an obstacle are not holes in free space
-    near_occ = near(grid == OCCUPIED)
-    bad[np.unique(lab[near_occ & unknown])] = True
-    edge = np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]])
-    bad[np.unique(edge)] = True
-    fill = ~bad[lab]
-    grid[fill] = FREE
-    lab[fill] = 0
-    return int(fill.sum()), (lab, int(n))
 
 
 def line_of_sight(blocked: np.ndarray, occ: OccupancyGrid, a: np.ndarray, b: np.ndarray,

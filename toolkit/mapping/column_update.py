@@ -18,7 +18,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from sgtool.mapping.bev import ColumnGrid, classify_keys, grid_extent
+from sgtool.mapping.bev import ColumnGrid, classify_keys
 from sgtool.mapping.voxels import AXIS_BITS, AXIS_MASK, COLUMN_SHIFT, OFFSET
 
 _VOXEL_FLAGS = ColumnGrid.OCC | ColumnGrid.FLOOR
@@ -75,7 +75,7 @@ def fresh_extent(grid: ColumnGrid, trajectory: Sequence[tuple[float, float]],
     if len(rows):
         corners = np.array([[cols[0], rows[0]], [cols[-1], rows[-1]]], dtype=np.int64) + \
             np.array(grid.extent[:2], dtype=np.int64)
-    want = grid_extent([corners], grid.resolution, grid.config, trajectory)
+    want = grid.fitted_extent([corners], trajectory)
     if carved is not None and carved.extent is not None:
         o = carved.extent
         want = (min(want[0], o[0]), min(want[1], o[1]), max(want[2], o[2]),

@@ -54,7 +54,6 @@ frames, hence the same ids. Stage timings (wall clock, never in the graph) are k
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import math
 import time
 from collections import defaultdict
@@ -74,7 +73,7 @@ from sgtool.mapping.voronoi import (
     ridge_graph,
     voronoi_graph,
 )
-from sgtool.mapping.voxels import COLUMN_SHIFT, VoxelMap
+from sgtool.mapping.voxels import COLUMN_SHIFT, LABEL_MASK, VoxelMap
 from sgtool.scenegraph.assembly import GraphParts, assemble_graph, robot_state
 from sgtool.scenegraph.assign import AssignCache
 from sgtool.scenegraph.builder_config import BuilderConfig
@@ -128,6 +127,18 @@ class MapLayers:
 
 
 @dataclass(frozen=True, eq=False)
+class _Ridge:
+    """The ridge pixel graph of a free mask on a grid placement (``repr`` of origin, shape
+    and resolution); ``version`` counts the ridges computed since the last from-scratch
+    refresh, so a graph made from this ridge can be recognised by it."""
+
+    place: str
+    free: np.ndarray
+    version: int
+    ridge: RidgeGraph
+
+
+@dataclass(frozen=True, eq=False)
 class _Rooms:
     """The rooms stage of a refresh: door evidence, its density and the segmentation."""
 
@@ -164,13 +175,14 @@ class SceneGraphBuilder:
         self._level: int | None = None
         self._removals = -1
         self._door_voxels = DoorVoxels()  # the door keys, kept with the BEV columns
-        self._ridge: tuple[bytes, RidgeGraph] | None = None
-        self._graph: tuple[tuple[bytes, int], VoronoiGraph] | None = None
+        self._ridge: _Ridge | None = None
+        self._graph: tuple[tuple[int, int], VoronoiGraph] | None = None
         self._rooms = RoomTracker()
         self._frontiers = FrontierTracker()
         self._class_memo: dict[tuple[str, ...], list[tuple[str, float]]] = {}
         self._panel_memo: dict[bytes, object] = {}  # door openings from swung panels
-        self._density: tuple[bytes, np.ndarray] | None = None  # door density of these cells
+        # door density of these cells: (resolution, door cells, density)
+        self._density: tuple[float, np.ndarray, np.ndarray] | None = None
         self._centre_memo: dict[bytes, int] = {}  # room centres by their sub-graph
         self._region_memo: dict[bytes, RoomRegions] = {}  # room clusterings by their inputs
         self._assign_cache = AssignCache()  # Dijkstra rows and sight lines of assignment
@@ -261,16 +273,18 @@ class SceneGraphBuilder:
         tick("rooms")
         blocked = occ.grid == OCCUPIED
         graph_all = vg.csgraph()
-        objects = place_objects(self._seen(OBJECT_KINDS), vg, node_room, graph_all, occ,
-                                blocked, cfg.assign, self._assign_cache)
+        seen = self._seen(OBJECT_KINDS + ("door",))  # one pass over the instances seen
+        objects = place_objects([s for s in seen if s[0].kind in OBJECT_KINDS], vg,
+                                node_room, graph_all, occ, blocked, cfg.assign,
+                                self._assign_cache)
         tick("assign")
         regions, node_region = room_regions(vg, rooms.seg, rooms.room_ids, cfg.regions,
                                             self._region_memo)
         objects = [place_in_room(o, node_room, rooms.room_ids, node_region) for o in objects]
         tick("regions")
         doors, unexplored_pos = observe_doors(
-            self._seen(("door",)), vg, node_room, rooms.room_ids, occ, blocked, self._rooms,
-            cfg.door_radius, cfg.unexplored_offset)
+            [s for s in seen if s[0].kind == "door"], vg, node_room, rooms.room_ids, occ,
+            blocked, self._rooms, cfg.door_radius, cfg.unexplored_offset)
         tick("doors")
         frontiers, frontier_ids, f_nodes = self._frontier_stage(occ, vg, robot_xy, node_room,
                                                                 blocked)
@@ -293,7 +307,7 @@ class SceneGraphBuilder:
                             self.instances, distances, stamp)
         self.layers = MapLayers(
             occupancy=occ, voronoi=vg,
-            node_rooms=tuple(rooms.room_ids[int(i)] if i >= 0 else None for i in node_room),
+            node_rooms=tuple(rooms.room_ids[i] if i >= 0 else None for i in node_room.tolist()),
             segmentation=rooms.seg, door_cells=rooms.door_cells, door_density=rooms.density,
             doors=tuple(doors), frontiers=tuple(frontiers), frontier_ids=tuple(frontier_ids),
             robot_nodes=robot_nodes,
@@ -357,7 +371,11 @@ class SceneGraphBuilder:
         if fresh_extent(cg, self.trajectory, carve) != cg.extent:
             return False
         self._removals = self.voxels.removals
-        self._door_voxels.reset(keys, self.voxels.label_ids(), self._door_ids())
+        label_ids, doors = self.voxels.label_ids(), self._door_ids()
+        if self._door_voxels.stale(doors) or _any_door(gone, label_ids, doors):
+            self._door_voxels.reset(keys, label_ids, doors)
+        else:  # no door lost voxels: the door keys are those kept plus the new ones
+            self._door_voxels.add(new, label_ids)
         return True
 
     def _voronoi(self, occ: OccupancyGrid, robot_xy: tuple[float, float] | None
@@ -367,15 +385,20 @@ class SceneGraphBuilder:
         computed from the previous one (only around the changed cells), the graph is
         reused while the ridge, its component and the grid's placement are too."""
         cfg = self.config.voronoi
-        digest = hashlib.blake2b((occ.grid == FREE).tobytes(), digest_size=16).digest() + \
-            repr((occ.origin, occ.grid.shape, occ.resolution)).encode()
-        if self._ridge is None or self._ridge[0] != digest:
-            previous = None if self._ridge is None else self._ridge[1]
-            self._ridge = (digest, ridge_graph(occ, cfg, previous=previous))
-        key = (digest, chosen_component(occ, self._ridge[1], robot_xy))
+        free = occ.grid == FREE
+        free.setflags(write=False)  # kept to recognise the same free cells next time
+        place = repr((occ.origin, occ.grid.shape, occ.resolution))
+        got = self._ridge
+        if got is None or got.place != place or not np.array_equal(got.free, free):
+            previous = None if got is None else got.ridge
+            version = 0 if got is None else got.version + 1
+            self._ridge = _Ridge(place, free, version,
+                                 ridge_graph(occ, cfg, previous=previous))
+        ridge = self._ridge
+        assert ridge is not None
+        key = (ridge.version, chosen_component(occ, ridge.ridge, robot_xy))
         if self._graph is None or self._graph[0] != key:  # same ridge, same component
-            self._graph = (key, voronoi_graph(occ, cfg, anchor=robot_xy,
-                                              ridge=self._ridge[1]))
+            self._graph = (key, voronoi_graph(occ, cfg, anchor=robot_xy, ridge=ridge.ridge))
         return self._graph[1]
 
     def _segment(self, occ: OccupancyGrid, vg: VoronoiGraph) -> _Rooms:
@@ -383,12 +406,15 @@ class SceneGraphBuilder:
         cfg = self.config.rooms
         cells = door_cells_of(occ, self._door_voxels.of(open_doors(self.instances)),
                               self._panel_memo)
-        key = hashlib.blake2b(cells.tobytes(), digest_size=16).digest() + repr(
-            (cells.shape, occ.resolution)).encode()
-        if self._density is None or self._density[0] != key:  # the same cells: same blur
-            self._density = (key, door_density(cells, occ.resolution, cfg.door_bandwidth))
-            self._density[1].setflags(write=False)
-        density = self._density[1]
+        cells.setflags(write=False)  # kept to recognise the same cells next time
+        got = self._density
+        if got is None or got[0] != occ.resolution or not np.array_equal(got[1], cells):
+            # not the same cells: blur them (the same cells: the same blur)
+            got = (occ.resolution, cells, door_density(cells, occ.resolution,
+                                                       cfg.door_bandwidth))
+            got[2].setflags(write=False)
+            self._density = got
+        density = got[2]
         seg = segment_rooms(vg, density, cfg, self._centre_memo)
         numbers = self._rooms.assign([vg.positions[r] for r in seg.rooms], cfg.match_radius)
         return _Rooms(cells, density, seg, [f"room:{n}" for n in numbers])
@@ -417,6 +443,14 @@ class SceneGraphBuilder:
         t = self.timings_scratch if from_scratch else self.timings
         return {k: (float(np.median(v)), float(np.max(v)), len(v))
                 for k, v in sorted(t.items()) if v}
+
+
+def _any_door(keys: np.ndarray, label_ids: np.ndarray, doors: list[int]) -> bool:
+    """True when a (voxel, label) key is labelled with one of the ``doors`` (labels past
+    ``label_ids``: no instance)."""
+    lab = keys & LABEL_MASK
+    lab = lab[lab < len(label_ids)]
+    return bool(np.isin(label_ids[lab], np.asarray(doors, dtype=np.int64)).any())
 
 
 class _Ticker:

@@ -23,11 +23,13 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import ndimage
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
 
-from sgtool.mapping.bev import near
-from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from sgtool.mapping import holes
+from sgtool.mapping.grid import FREE, OccupancyGrid
+from sgtool.mapping.holes import UnknownParts
 
-_EIGHT = np.ones((3, 3), dtype=bool)
 _FOUR = ndimage.generate_binary_structure(2, 1)
 
 
@@ -57,117 +59,164 @@ def reachable_free(occ: OccupancyGrid, start: tuple[float, float] | None,
     """Free cells 4-connected to ``start`` (or to the free cell nearest to it within
     ``snap``); all free cells when ``start`` is None or not near free space."""
     free = occ.grid == FREE
-    if start is None or not free.any():
+    cell = _start_cell(occ, free, start, snap)
+    if cell is None:
         return free
+    lab, _ = ndimage.label(free, structure=_FOUR)
+    return lab == lab[cell]
+
+
+def _start_cell(occ: OccupancyGrid, free: np.ndarray, start: tuple[float, float] | None,
+                snap: float) -> tuple[int, int] | None:
+    """The free cell nearest to ``start`` within ``snap`` (ties: the first in raster
+    order); None when ``start`` is None or not near free space."""
+    if start is None or not free.any():
+        return None
     r, c = occ.cell_of(start[0], start[1])
     r, c = int(r), int(c)
     k = int(np.ceil(snap / occ.resolution))
     h, w = occ.shape
     r0, r1, c0, c1 = max(r - k, 0), min(r + k + 1, h), max(c - k, 0), min(c + k + 1, w)
     if r0 >= r1 or c0 >= c1:
-        return free
+        return None
     rr, cc = np.nonzero(free[r0:r1, c0:c1])
     if rr.size == 0:
-        return free
+        return None
     d2 = (rr + r0 - r) ** 2 + (cc + c0 - c) ** 2
     i = int(np.lexsort((cc, rr, d2))[0])
-    lab, _ = ndimage.label(free, structure=_FOUR)
-    return lab == lab[rr[i] + r0, cc[i] + c0]
+    return int(rr[i] + r0), int(cc[i] + c0)
 
 
 def frontier_cells(occ: OccupancyGrid, start: tuple[float, float] | None = None,
                    snap: float = 0.5, min_pocket: float = 0.0,
-                   unknown_parts: tuple[np.ndarray, int] | None = None) -> np.ndarray:
+                   unknown_parts: UnknownParts | None = None) -> np.ndarray:
     """Free cells (reachable from ``start``) 4-adjacent to unknown and not 8-adjacent to
     occupied; unknown pockets (4-connected) under ``min_pocket`` m^2 that do not touch the
     grid border do not count as unknown (the camera's blind ring around the robot, the
-    shadow of a chair: not places to explore). ``unknown_parts``: :func:`unknown_parts`
-    of ``occ``, when the caller has it."""
-    reach = reachable_free(occ, start, snap)
-    unknown = occ.grid == UNKNOWN
-    max_cells = int(min_pocket / occ.resolution**2)
-    if max_cells > 0 and unknown.any():
-        lab, n = unknown_parts if unknown_parts is not None else _unknown_parts(occ)
-        small = np.bincount(lab.ravel()) < max_cells
-        small[0] = False
-        small[_border_labels(lab)] = False
-        unknown = unknown & ~small[lab]
-    unknown = np.pad(unknown, 1, constant_values=True)
+    shadow of a chair: not places to explore). ``unknown_parts``: the
+    :class:`~sgtool.mapping.holes.UnknownParts` of ``occ``, when the caller has them."""
+    parts = unknown_parts if unknown_parts is not None else holes.unknown_parts(occ.grid)
+    rows, cols = _frontier_cells(occ, start, snap,
+                                 _unknown_kinds(parts, min_pocket, occ.resolution),
+                                 parts.near_occupied)
+    mask = np.zeros(occ.shape, dtype=bool)
+    mask[rows, cols] = True
+    return mask
+
+
+_COUNTS, _OUTSIDE = np.uint8(1), np.uint8(2)  # bits of _unknown_kinds
+
+
+def _unknown_kinds(parts: UnknownParts, min_pocket: float, resolution: float) -> np.ndarray:
+    """Per cell: ``_COUNTS`` for the unknown cells that count as unknown (not filled, not in
+    a pocket under ``min_pocket`` m^2 off the border), ``_OUTSIDE`` too for those outside
+    the footprint of what was seen (a component touching the grid border)."""
+    table = np.zeros(parts.count + 1, dtype=np.uint8)
+    counts = ~parts.filled
+    max_cells = int(min_pocket / resolution**2)
+    if max_cells > 0:
+        counts &= (parts.sizes >= max_cells) | parts.border
+    table[counts] = _COUNTS
+    table[parts.border & counts] |= _OUTSIDE
+    table[0] = 0
+    return parts.per_cell(table)
+
+
+def _frontier_cells(occ: OccupancyGrid, start: tuple[float, float] | None, snap: float,
+                    kinds: np.ndarray, near_occupied: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """Rows and columns, in raster order, of :func:`frontier_cells`; the free cells are
+    labelled only when some candidate needs the test of reaching the start."""
+    free = occ.grid == FREE
+    unknown = np.pad(kinds != 0, 1, constant_values=True)
     next_unknown = (unknown[:-2, 1:-1] | unknown[2:, 1:-1] | unknown[1:-1, :-2]
                     | unknown[1:-1, 2:])
-    return reach & next_unknown & ~near(occ.grid == OCCUPIED)
-
-
-def _unknown_parts(occ: OccupancyGrid) -> tuple[np.ndarray, int]:
-    """The 4-connected components of the unknown cells (labels, count)."""
-    lab, n = ndimage.label(occ.grid == UNKNOWN, structure=_FOUR)
-    return lab, int(n)
-
-
-def _border_labels(lab: np.ndarray) -> np.ndarray:
-    return np.unique(np.concatenate([lab[0], lab[-1], lab[:, 0], lab[:, -1]]))
+    rows, cols = np.nonzero(free & next_unknown & ~near_occupied)
+    cell = _start_cell(occ, free, start, snap)
+    if cell is not None and len(rows):
+        lab, _ = ndimage.label(free, structure=_FOUR)
+        keep = lab[rows, cols] == lab[cell]
+        rows, cols = rows[keep], cols[keep]
+    return rows, cols
 
 
 def outside_footprint(occ: OccupancyGrid,
-                      unknown_parts: tuple[np.ndarray, int] | None = None) -> np.ndarray:
+                      unknown_parts: UnknownParts | None = None) -> np.ndarray:
     """Cells outside the hole-filled footprint of everything seen (free or occupied): the
     unknown cells 4-connected to the grid border (everything beyond the grid is unseen)."""
-    lab, n = unknown_parts if unknown_parts is not None else _unknown_parts(occ)
-    if n == 0:
-        return occ.grid == UNKNOWN
-    out = np.zeros(n + 1, dtype=bool)
-    out[_border_labels(lab)] = True
-    out[0] = False
-    return out[lab]
+    parts = unknown_parts if unknown_parts is not None else holes.unknown_parts(occ.grid)
+    return (_unknown_kinds(parts, 0.0, occ.resolution) & _OUTSIDE) != 0
 
 
 def find_frontiers(occ: OccupancyGrid, start: tuple[float, float] | None = None,
                    config: FrontierConfig | None = None,
-                   unknown_parts: tuple[np.ndarray, int] | None = None) -> list[Frontier]:
+                   unknown_parts: UnknownParts | None = None) -> list[Frontier]:
     """Frontier clusters in raster order of their medoid cells. ``unknown_parts``: the
-    4-connected components of the unknown cells of ``occ`` (labels, an upper bound of the
-    label values; any numbering), when the caller has them (the BEV's hole filling)."""
+    :class:`~sgtool.mapping.holes.UnknownParts` of ``occ`` (the BEV's hole filling), when
+    the caller has them."""
     cfg = config or FrontierConfig()
-    parts = unknown_parts if unknown_parts is not None else _unknown_parts(occ)
-    mask = frontier_cells(occ, start, cfg.snap, cfg.min_pocket, parts)
-    if not mask.any():
+    parts = unknown_parts if unknown_parts is not None else holes.unknown_parts(occ.grid)
+    kinds = _unknown_kinds(parts, cfg.min_pocket, occ.resolution)
+    rows, cols = _frontier_cells(occ, start, cfg.snap, kinds, parts.near_occupied)
+    if len(rows) == 0:
         return []
     res = occ.resolution
-    lab, n = ndimage.label(mask, structure=_EIGHT)
-    outside = near(outside_footprint(occ, parts))
+    n, of = eight_components(rows, cols, occ.shape[1])
+    order = np.argsort(of, kind="stable")  # by cluster, raster order within one
+    ends = np.cumsum(np.bincount(of, minlength=n))
+    outside = holes.near_at((kinds & _OUTSIDE) != 0, rows, cols)
     min_cells = max(1, int(round(cfg.min_size / res)))
     max_cells = max(min_cells, int(round(cfg.max_size / res)))
-    objs = ndimage.find_objects(lab)
     out: list[Frontier] = []
-    for i, sl in enumerate(objs, start=1):
-        if sl is None:
+    for members in np.split(order, ends[:-1]):
+        if len(members) < min_cells:
             continue
-        rr, cc = np.nonzero(lab[sl] == i)
-        rr = rr + sl[0].start
-        cc = cc + sl[1].start
-        if len(rr) < min_cells:
-            continue
-        for pr, pc in _split(rr, cc, max_cells):
-            if len(pr) < min_cells:
+        rr, cc = rows[members], cols[members]
+        for piece in _split(rr, cc, max_cells):
+            if len(piece) < min_cells:
                 continue
+            pr, pc = rr[piece], cc[piece]
             mr, mc = _medoid(pr, pc)
             x, y = occ.center_of(mr, mc)
             out.append(Frontier(
                 cells=np.stack([pr, pc], axis=1), medoid=(float(x), float(y)),
                 medoid_cell=(mr, mc), size=float(len(pr) * res),
-                leading_out=bool(outside[pr, pc].any()),
+                leading_out=bool(outside[members[piece]].any()),
             ))
     out.sort(key=lambda f: f.medoid_cell)
     return out
 
 
-def _split(rr: np.ndarray, cc: np.ndarray, max_cells: int
-           ) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Cut a cluster into ceil(k / max_cells) runs along its principal axis."""
+def eight_components(rows: np.ndarray, cols: np.ndarray, width: int) -> tuple[int, np.ndarray]:
+    """The 8-connected components of the cells (``rows``, ``cols``) in raster order (a
+    grid ``width`` cells wide), found among those cells only: (count, component of each
+    cell, numbered 0..count-1). The same grouping as ``ndimage.label`` of the grid."""
+    k = len(rows)
+    stride = width + 2  # column -1 and width stay apart from the next row
+    key = rows.astype(np.int64) * stride + cols + 1  # increasing: raster order
+    src, dst = [], []
+    for step in (1, stride - 1, stride, stride + 1):  # E, SW, S, SE: every pair once
+        j = np.searchsorted(key, key + step)
+        hit = np.flatnonzero(j < k)
+        hit = hit[key[j[hit]] == key[hit] + step]
+        src.append(hit)
+        dst.append(j[hit])
+    a, b = np.concatenate(src), np.concatenate(dst)
+    indptr = np.zeros(k + 1, dtype=np.int64)
+    np.cumsum(np.bincount(a, minlength=k), out=indptr[1:])
+    graph = csr_matrix((np.ones(len(a), dtype=np.int8), b[np.argsort(a, kind="stable")],
+                        indptr), shape=(k, k))
+    n, labels = connected_components(graph, directed=False)
+    return int(n), labels
+
+
+def _split(rr: np.ndarray, cc: np.ndarray, max_cells: int) -> list[np.ndarray]:
+    """Cut a cluster into ceil(k / max_cells) runs along its principal axis: the indices
+    of each run's cells."""
     k = len(rr)
     parts = int(np.ceil(k / max_cells))
     if parts <= 1:
-        return [(rr, cc)]
+        return [np.arange(k)]
     pts = np.stack([rr, cc], axis=1).astype(np.float64)
     centred = pts - pts.mean(axis=0)
     cov = centred.T @ centred
@@ -177,8 +226,7 @@ def _split(rr: np.ndarray, cc: np.ndarray, max_cells: int
         axis = -axis  # a sign convention, for determinism
     proj = centred @ axis
     order = np.lexsort((cc, rr, proj))
-    chunks = np.array_split(order, parts)
-    return [(rr[c], cc[c]) for c in chunks]
+    return np.array_split(order, parts)
 
 
 def _medoid(rr: np.ndarray, cc: np.ndarray, cap: int = 256) -> tuple[int, int]:

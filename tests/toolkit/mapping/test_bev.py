@@ -11,13 +11,13 @@ from sgtool.mapping.bev import (
     ColumnGrid,
     classify_keys,
     estimate_floor_level,
-    fill_holes,
     floor_fans,
     line_of_sight,
     occupancy_from_keys,
 )
 from sgtool.mapping.esdf import distance_field
 from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN
+from sgtool.mapping.holes import fill_holes
 from sgtool.mapping.occupancy import inflate
 from sgtool.mapping.voxels import pack
 

@@ -1,14 +1,27 @@
-"""Frontiers from the hole filling's unknown labelling equal frontiers labelled afresh."""
+"""Frontiers from the hole filling's unknown labelling equal frontiers labelled afresh, and
+both equal the plain whole-grid search (``support.frontier_reference``)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 from scipy import ndimage
+from support.frontier_reference import (
+    plain_fill_holes,
+    plain_frontier_cells,
+    plain_frontiers,
+    plain_outside,
+)
 
-from sgtool.mapping.bev import fill_holes, fill_holes_parts
 from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
-from sgtool.scenegraph.frontiers import FrontierConfig, find_frontiers
+from sgtool.mapping.holes import fill_holes, fill_holes_parts, near, near_at, unknown_parts
+from sgtool.scenegraph.frontiers import (
+    FrontierConfig,
+    eight_components,
+    find_frontiers,
+    frontier_cells,
+    outside_footprint,
+)
 
 
 def _random_grid(rng: np.random.Generator) -> np.ndarray:
@@ -34,37 +47,84 @@ def _same_partition(a: np.ndarray, b: np.ndarray) -> bool:
     return len(np.unique(pairs[:, 0])) == len(pairs) == len(np.unique(pairs[:, 1]))
 
 
-@pytest.mark.parametrize("seed", range(40))
+def _summary(frontiers: list) -> list:  # type: ignore[type-arg]
+    return [(f.medoid_cell, f.medoid, f.size, f.leading_out, f.cells.tolist())
+            for f in frontiers]
+
+
+@pytest.mark.parametrize("seed", range(60))
 def test_parts_of_the_filling_give_the_same_frontiers(seed: int) -> None:
     rng = np.random.default_rng(seed)
     grid = _random_grid(rng)
     max_cells = int(rng.integers(1, 12))
     plain = grid.copy()
-    filled = fill_holes(plain, max_cells)
+    filled = plain_fill_holes(plain, max_cells)
+    other = grid.copy()
+    assert fill_holes(other, max_cells) == filled and np.array_equal(other, plain)
     got, parts = fill_holes_parts(grid, max_cells)
     assert got == filled and np.array_equal(grid, plain)
     assert parts is not None
-    lab, n = parts
+    assert int(parts.sizes[parts.filled].sum()) == filled
+    left = np.where(parts.filled[parts.labels], 0, parts.labels)  # the components left
     fresh, _ = ndimage.label(grid == UNKNOWN, structure=ndimage.generate_binary_structure(2, 1))
-    assert _same_partition(lab, fresh)
-    assert lab.max(initial=0) <= n
+    assert _same_partition(left, fresh)
+    assert parts.labels.max(initial=0) <= parts.count
+    assert np.array_equal(parts.near_occupied, near(grid == OCCUPIED))
     occ = OccupancyGrid(grid, (0.0, 0.0), 0.1)
     free = np.argwhere(grid == FREE)
     start = None if len(free) == 0 or seed % 5 == 0 else tuple(
         (free[int(rng.integers(len(free)))][::-1] + 0.5) * 0.1)
     cfg = FrontierConfig(min_pocket=float(rng.choice([0.0, 0.03, 0.08])), min_size=0.1,
-                         max_size=float(rng.choice([0.5, 2.5])))
-    want = find_frontiers(occ, start, cfg)
-    have = find_frontiers(occ, start, cfg, parts)
-    assert [(f.medoid_cell, f.size, f.leading_out) for f in have] == \
-        [(f.medoid_cell, f.size, f.leading_out) for f in want]
-    for f, g in zip(have, want, strict=True):
-        np.testing.assert_array_equal(f.cells, g.cells)
+                         max_size=float(rng.choice([0.3, 0.5, 2.5])))
+    want = plain_frontiers(occ, start, cfg)
+    assert _summary(find_frontiers(occ, start, cfg)) == _summary(want)
+    assert _summary(find_frontiers(occ, start, cfg, parts)) == _summary(want)
+    assert np.array_equal(frontier_cells(occ, start, cfg.snap, cfg.min_pocket, parts),
+                          plain_frontier_cells(occ, start, cfg.snap, cfg.min_pocket))
+    assert np.array_equal(outside_footprint(occ, parts), plain_outside(occ))
+    assert np.array_equal(outside_footprint(occ), plain_outside(occ))
 
 
-def test_every_hole_filled_leaves_no_labels() -> None:
+@pytest.mark.parametrize("seed", range(10))
+def test_near_at_equals_the_dilation(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    mask = rng.random((int(rng.integers(1, 30)), int(rng.integers(1, 30)))) < 0.1
+    rows, cols = np.nonzero(rng.random(mask.shape) < 0.5)
+    assert np.array_equal(near_at(mask, rows, cols), near(mask)[rows, cols])
+
+
+def test_every_hole_filled() -> None:
     grid = np.full((5, 5), FREE, dtype=np.int8)
     grid[2, 2] = UNKNOWN
-    filled, (lab, n) = fill_holes_parts(grid, 4)
-    assert filled == 1 and grid[2, 2] == FREE and n == 1 and not lab.any()
+    filled, parts = fill_holes_parts(grid, 4)
+    assert parts is not None
+    assert filled == 1 and grid[2, 2] == FREE and parts.count == 1
+    assert parts.filled.tolist() == [False, True] and parts.sizes[1] == 1
     assert fill_holes_parts(grid, 0) == (0, None)
+    assert unknown_parts(grid).count == 0
+
+
+def test_parts_name_border_components_and_sizes() -> None:
+    grid = np.full((6, 8), FREE, dtype=np.int8)
+    grid[0, 2:5] = UNKNOWN  # 3 cells on the border
+    grid[3:5, 3:5] = UNKNOWN  # 4 enclosed cells
+    grid[4, 6] = OCCUPIED
+    parts = unknown_parts(grid)
+    assert parts.count == 2 and parts.sizes[1:].tolist() == [3, 4]
+    assert parts.border.tolist() == [False, True, False]
+    assert not parts.filled.any()
+    assert parts.near_occupied[3, 5] and not parts.near_occupied[2, 2]
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_eight_components_equal_the_grid_labelling(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    h, w = int(rng.integers(1, 40)), int(rng.integers(1, 40))
+    mask = rng.random((h, w)) < float(rng.choice([0.05, 0.2, 0.5]))
+    rows, cols = np.nonzero(mask)
+    n, of = eight_components(rows, cols, w)
+    lab, m = ndimage.label(mask, structure=np.ones((3, 3), dtype=bool))
+    assert n == m and of.min(initial=0) >= 0 and of.max(initial=-1) < n
+    grid = np.zeros((h, w), dtype=np.int64)
+    grid[rows, cols] = of + 1
+    assert _same_partition(grid, lab)
