@@ -21,6 +21,7 @@ first on ``PYTHONPATH``.
 from __future__ import annotations
 
 import argparse
+import compileall
 import os
 import shutil
 import statistics
@@ -71,16 +72,29 @@ _MAIN = "import sys; from sgtool.cli import main; sys.argv[0] = \"sgtool\"; sys.
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--base", type=Path, required=True, help="baseline source tree")
-    ap.add_argument("--base-pkg", type=Path,
-                    default=Path(tempfile.gettempdir()) / "sgtool-base-pkg")
+    ap.add_argument("--base-pkg", type=Path, default=None,
+                    help="folder for the shadow packages (default: a fresh temporary one, "
+                    "so runs of several people at once never re-point each other's links)")
     ap.add_argument("--tree", type=Path, default=None,
                     help="the tree to measure against the baseline (default: this one); "
                     "e.g. a copy of the baseline with one engineer's files laid over it")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--frames", type=int, default=0, help="frames per run, for frames/s")
+    ap.add_argument("--no-compile", action="store_true",
+                    help="do not byte-compile the trees first (with PYTHONDONTWRITEBYTECODE a "
+                    "tree without __pycache__, e.g. a fresh `git archive`, compiles every "
+                    "module from source in every run, which the other tree may not)")
     ap.add_argument("command", nargs=argparse.REMAINDER, help="-- sgtool arguments")
     a = ap.parse_args(argv)
     cmd = [c for c in a.command if c != "--"]
+    if a.base_pkg is None:
+        a.base_pkg = Path(tempfile.mkdtemp(prefix="sgtool-base-pkg-"))
+    if not a.no_compile:
+        here = Path(__file__).resolve().parents[1]
+        for tree in (a.base, a.tree or here):
+            for sub in ("toolkit", *SUBPACKAGES):
+                compileall.compile_dir(str(tree.resolve() / sub), quiet=1)
+    load0 = os.getloadavg()[0]
     pkg = str(shadow_package(a.base.resolve(), a.base_pkg))
     this = (str(shadow_package(a.tree.resolve(), a.base_pkg.with_name(a.base_pkg.name + "-tree")))
             if a.tree is not None else None)
@@ -109,7 +123,8 @@ def main(argv: list[str] | None = None) -> int:
     bw, bc = med["baseline"]
     tw, tc = med["this tree"]
     print(f"speed-up (baseline / this tree): wall {bw / tw:.2f}x, cpu {bc / tc:.2f}x "
-          f"({a.rounds} alternating rounds)")
+          f"({a.rounds} alternating rounds; 1-minute load average {load0:.1f} at the start, "
+          f"{os.getloadavg()[0]:.1f} at the end)")
     return 0
 
 

@@ -12,6 +12,7 @@ lacks a prompt is one error line (the replay diverged), never a silent fallback.
 from __future__ import annotations
 
 import contextlib
+import sys
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
@@ -75,9 +76,12 @@ class LlmOptions:
         """A :class:`RoomLlm` whose factory builds the named classifier (the LLM client only
         when the name is ``llm``); the transcript is written on success, removed on error."""
         from sgtool.datasets.room_evidence import make_classifier
-        from sgtool.llm.recorded import ReplayMiss, TranscriptWriter
 
-        writer = TranscriptWriter(self.transcript, append=False) if self.transcript else None
+        writer = None
+        if self.transcript:  # the LLM modules (urllib, ssl) load only when asked for
+            from sgtool.llm.recorded import TranscriptWriter
+
+            writer = TranscriptWriter(self.transcript, append=False)
         out = RoomLlm(make=make_classifier)
 
         def log(rec: dict[str, Any]) -> None:
@@ -97,13 +101,18 @@ class LlmOptions:
         out.make = make
         try:
             yield out
-        except ReplayMiss as e:
+        except BaseException as e:
             if writer is not None:
                 writer.abort()
-            raise SgtoolError(f"--llm-replay: {e}") from None
-        except BaseException:
-            if writer is not None:
-                writer.abort()
+            if _is_replay_miss(e):
+                raise SgtoolError(f"--llm-replay: {e}") from None
             raise
         if writer is not None:
             writer.close()
+
+
+def _is_replay_miss(e: BaseException) -> bool:
+    """``e`` is the offline transcript's miss (:class:`sgtool.llm.recorded.ReplayMiss`);
+    its module is imported only when the LLM classifier ran, so nothing else loads it."""
+    recorded = sys.modules.get("sgtool.llm.recorded")
+    return recorded is not None and isinstance(e, recorded.ReplayMiss)

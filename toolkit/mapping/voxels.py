@@ -34,18 +34,20 @@ reports a new state).
 
 Everything is exact integer arithmetic after the float64 back-projection (elementwise, no
 BLAS; :mod:`sgtool.mapping.backproject` runs it in cache blocks, operation for operation),
-so the same frames give the same map bit for bit. Runs of equal neighbouring keys are
-collapsed before a frame's keys are sorted.
+so the same frames give the same map bit for bit. A frame's keys are counted by
+:func:`sgtool.mapping.key_count.count_keys` (runs of equal neighbours collapsed first).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.mapping.backproject import Scratch, within_packing, world_voxels
+from sgtool.mapping.key_count import count_keys
+from sgtool.mapping.label_stats import LabelStats, update_frame
 from sgtool.mapping.vote_store import VoteStore, drain_keys
 
 AXIS_BITS = 17
@@ -60,6 +62,8 @@ SHIFT_X = LABEL_BITS + 2 * AXIS_BITS
 VOXEL_SHIFT = LABEL_BITS  # key >> VOXEL_SHIFT = voxel key
 COLUMN_SHIFT = LABEL_BITS + AXIS_BITS  # key >> COLUMN_SHIFT = (x, y) column key
 _LUT_MAX = 1 << 22  # instance ids below this use a lookup table, above it np.unique
+DENSE_SHARE = 0.875  # frames with this share of valid pixels are computed in place
+_DROPPED = (1 << 63) - 1  # key of a discarded pixel: no voxel in the packing's range has it
 
 
 @dataclass(frozen=True)
@@ -89,34 +93,6 @@ def unpack(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.nda
     return ix, iy, iz, keys & LABEL_MASK
 
 
-def _runs(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(first index, length) of each run of equal neighbours in ``keys`` (non-empty)."""
-    change = np.empty(keys.size, dtype=bool)
-    change[0] = True
-    np.not_equal(keys[1:], keys[:-1], out=change[1:])
-    first = np.flatnonzero(change)
-    return first, np.diff(first, append=keys.size)
-
-
-def _count_keys(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(sorted distinct keys, occurrences) of ``keys``: ``np.unique(keys,
-    return_counts=True)`` without its overhead. Neighbouring pixels mostly fall into the
-    same voxel, so runs of equal keys are collapsed first (in pixel order) and only the
-    runs are sorted."""
-    if keys.size == 0:
-        return keys, np.zeros(0, dtype=np.int64)
-    first, length = _runs(keys)
-    rk = keys[first]
-    if rk.size * 4 > keys.size:  # few repeats: sorting the keys themselves is cheaper
-        keys = np.sort(keys)
-        first, length = _runs(keys)
-        return keys[first], length
-    order = np.argsort(rk)
-    rk, length = rk[order], length[order]
-    first, _ = _runs(rk)
-    return rk[first], np.add.reduceat(length, first)
-
-
 @dataclass(frozen=True)
 class InstanceObservation:
     """What the map knows of one instance id."""
@@ -132,41 +108,6 @@ class InstanceObservation:
     centroid: tuple[float, float, float] | None  # mean of those voxels' centres
 
 
-@dataclass
-class _Stats:
-    """Per label index arrays (grown on demand)."""
-
-    size: int = 0
-    points_max: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    points_total: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    frames: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    last_index: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    view_dist: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float64))
-    view_xy: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.float64))
-    vox_n: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    vox_sum: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.int64))
-
-    def grow(self, n: int) -> None:
-        if n <= self.size:
-            return
-        m = max(n, 2 * self.size, 64)
-        pad = m - self.size
-
-        def ext(a: np.ndarray, fill: float) -> np.ndarray:
-            shape = (pad,) + a.shape[1:]
-            return np.concatenate([a, np.full(shape, fill, dtype=a.dtype)])
-
-        self.points_max = ext(self.points_max, 0)
-        self.points_total = ext(self.points_total, 0)
-        self.frames = ext(self.frames, 0)
-        self.last_index = ext(self.last_index, -1)
-        self.view_dist = ext(self.view_dist, np.inf)
-        self.view_xy = ext(self.view_xy, np.nan)
-        self.vox_n = ext(self.vox_n, 0)
-        self.vox_sum = ext(self.vox_sum, 0)
-        self.size = m
-
-
 class VoxelMap:
     """The sparse semantic voxel map (module doc). Not thread-safe."""
 
@@ -178,7 +119,7 @@ class VoxelMap:
         self._label_ids: list[int] = [0]  # label index -> instance id
         self._label_of: dict[int, int] = {0: 0}  # instance id -> label index
         self._lut = np.zeros(1, dtype=np.int64)  # instance id -> label index (ids < _LUT_MAX)
-        self._stats = _Stats()
+        self._stats = LabelStats()
         self._stats.grow(1)
         self._scratch = Scratch()
         self._rays: dict[tuple[int, int, float, float, float, float], tuple[np.ndarray, ...]] = {}
@@ -249,14 +190,19 @@ class VoxelMap:
         d = depth.reshape(-1)
         cfg = self.config
         with np.errstate(invalid="ignore"):
-            idx = np.flatnonzero((d >= cfg.min_range) & (d < cfg.max_range))
+            valid = (d >= cfg.min_range) & (d < cfg.max_range)
         if viewpoint is None:
             src = frame.base_pose if frame.base_pose is not None else frame.pose
             viewpoint = (float(src[0, 3]), float(src[1, 3]))
-        if idx.size == 0:
+        n_ok = int(np.count_nonzero(valid))
+        if n_ok == 0:
             return 0
         inv, lim = 1.0 / cfg.resolution, OFFSET - 1
         safe = within_packing(frame.pose, ru, rv, cfg.max_range, inv, lim)
+        if safe and n_ok >= DENSE_SHARE * d.size:  # nearly every pixel: no gathers
+            self._integrate_dense(d, valid, ru, rv, frame, viewpoint)
+            return n_ok
+        idx = np.flatnonzero(valid)
         wx, wy, wz, keys, rng = world_voxels(d, idx, ru, rv, frame.pose, inv,
                                              (SHIFT_X, SHIFT_Y, SHIFT_Z), OFFSET, self._scratch,
                                              need_range=not safe)
@@ -268,6 +214,30 @@ class VoxelMap:
             return self._fuse(wx.copy(), wy.copy(), wz, lab, viewpoint, frame.index)
         np.add(keys, lab, out=keys)
         return self._count(keys, wx, wy, lab, viewpoint, frame.index)
+
+    def _integrate_dense(self, d: np.ndarray, valid: np.ndarray, ru: np.ndarray,
+                         rv: np.ndarray, frame: Frame, viewpoint: tuple[float, float]) -> None:
+        """:meth:`integrate` of a frame whose points are within the packing, computed for
+        every pixel in place: the invalid ones get id 0 (label 0, whose sums are never
+        read) and the key ``_DROPPED``, which the counting leaves out. The valid pixels get
+        the same bits, labels and counts as through the gathers."""
+        bad = np.flatnonzero(~valid)
+        cfg = self.config
+        with np.errstate(invalid="ignore", over="ignore"):  # NaN, inf of invalid pixels
+            wx, wy, _, keys, _ = world_voxels(d, None, ru, rv, frame.pose, 1.0 / cfg.resolution,
+                                              (SHIFT_X, SHIFT_Y, SHIFT_Z), OFFSET,
+                                              self._scratch, need_range=False)
+        if frame.ids is not None:
+            ids = np.asarray(frame.ids).reshape(-1)
+            if bad.size:
+                ids = ids.copy()
+                ids[bad] = 0
+            lab = self.labels_of(ids)
+            np.add(keys, lab, out=keys)
+        else:
+            lab = np.zeros(d.size, dtype=np.int64)
+        keys[bad] = _DROPPED
+        self._count(keys, wx, wy, lab, viewpoint, frame.index, drop=_DROPPED)
 
     def integrate_points(self, xyz: np.ndarray, labels: np.ndarray,
                          viewpoint: tuple[float, float], frame_index: int = -1) -> int:
@@ -295,43 +265,32 @@ class VoxelMap:
         return self._count(pack(vx, vy, vz, labels), wx, wy, labels, viewpoint, frame_index)
 
     def _count(self, keys: np.ndarray, wx: np.ndarray, wy: np.ndarray, labels: np.ndarray,
-               viewpoint: tuple[float, float], frame_index: int) -> int:
-        """Count one frame's packed keys into the pending list and its statistics."""
-        uk, cnt = _count_keys(keys)
+               viewpoint: tuple[float, float], frame_index: int, drop: int | None = None
+               ) -> int:
+        """Count one frame's packed keys into the pending list and its statistics (keys
+        equal to ``drop`` left out)."""
+        uk, cnt = count_keys(keys, drop)
         self._pending.append((uk, cnt))
         self._pending_n += len(uk)
         # points per label from the distinct keys (far fewer than the points)
-        pts = np.bincount(uk & LABEL_MASK, weights=cnt).astype(np.int64)
-        self._frame_stats(wx, wy, labels, pts, viewpoint, frame_index)
+        lab_u = uk & LABEL_MASK
+        pts = np.bincount(lab_u, weights=cnt).astype(np.int64)
+        n_lab = max(len(self._label_ids), len(pts))
+
+        def voxel_means() -> tuple[np.ndarray, np.ndarray]:
+            """Mean voxel centre (x, y) per label index, weighted by points."""
+            n = np.maximum(np.bincount(lab_u, weights=cnt, minlength=n_lab), 1.0)
+            res = self.config.resolution
+            return tuple(  # type: ignore[return-value]
+                np.bincount(lab_u, weights=cnt * (((uk >> sh) & AXIS_MASK) - (OFFSET - 0.5)),
+                            minlength=n_lab) * res / n for sh in (SHIFT_X, SHIFT_Y))
+
+        update_frame(self._stats, pts, voxel_means, labels, wx, wy, n_lab, viewpoint,
+                     frame_index, self.config.min_points, self.config.resolution)
         if self._pending_n >= self.config.flush_keys:
             self.flush()
         self.version += 1
         return int(keys.size)
-
-    def _frame_stats(self, wx: np.ndarray, wy: np.ndarray, labels: np.ndarray,
-                     pts: np.ndarray, viewpoint: tuple[float, float], frame_index: int
-                     ) -> None:
-        """Per label of the frame: points (``pts``, indexed by label), frames, last frame,
-        closest viewpoint (from the mean x, y of its points)."""
-        n_lab = max(len(self._label_ids), len(pts))
-        st = self._stats
-        st.grow(n_lab)
-        present = np.flatnonzero(pts)
-        present = present[present > 0]
-        if present.size == 0:
-            return
-        sx = np.bincount(labels, weights=wx, minlength=n_lab)[present]
-        sy = np.bincount(labels, weights=wy, minlength=n_lab)[present]
-        p = pts[present]
-        st.points_max[present] = np.maximum(st.points_max[present], p)
-        st.points_total[present] += p
-        st.frames[present] += 1
-        st.last_index[present] = frame_index
-        dist = np.hypot(sx / p - viewpoint[0], sy / p - viewpoint[1])
-        better = (p >= self.config.min_points) & (dist < st.view_dist[present])
-        sel = present[better]
-        st.view_dist[sel] = dist[better]
-        st.view_xy[sel] = viewpoint
 
     def flush(self) -> None:
         """Merge the pending frame keys into the sorted map."""

@@ -18,6 +18,7 @@ refresh.
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
@@ -35,6 +36,7 @@ from sgtool.log import codec
 from sgtool.log import schemas as S
 from sgtool.log.records import SceneGraphRecord
 from sgtool.log.writer import LogWriter
+from sgtool.scenegraph import scene_wire as sw
 from sgtool.scenegraph.stream import Refresh
 
 GRAPH_Z = 0.05  # m: height of the drawn graph above the floor
@@ -44,12 +46,24 @@ NO_ROOM = (0.55, 0.55, 0.55)
 DERIVED_TOPICS = (S.OCCUPANCY, S.VORONOI, S.ROOMS, S.RECORDS["scene_graph"].topic)
 
 
-def _color(key: str | None, alpha: float = 1.0) -> Color:
+def _rgba(key: str | None, alpha: float = 1.0) -> tuple[float, float, float, float]:
     if key is None:
         r, g, b = NO_ROOM
     else:
         r, g, b = (c / 255.0 for c in color_for(key))
-    return Color(r=r, g=g, b=b, a=alpha)
+    return r, g, b, alpha
+
+
+def _color(key: str | None, alpha: float = 1.0) -> Color:
+    r, g, b, a = _rgba(key, alpha)
+    return Color(r=r, g=g, b=b, a=a)
+
+
+# LinePrimitive.points / .colors and SceneEntity.spheres records (sgtool.scenegraph.scene_wire)
+_LINE_POINT = sw.field(5, sw.POINT3)
+_LINE_COLOR = sw.field(7, sw.COLOR)
+_SPHERE = sw.field(9, [*sw.field(1, [*sw.field(1, sw.POINT3), *sw.field(2, [b"\x21", "w"])]),
+                       *sw.field(2, sw.doubles(("sx", "sy", "sz"))), *sw.field(3, sw.COLOR)])
 
 
 def occupancy_message(refresh: Refresh) -> Any | None:
@@ -60,39 +74,38 @@ def occupancy_message(refresh: Refresh) -> Any | None:
 
 
 def voronoi_message(refresh: Refresh) -> Any | None:
-    """The Voronoi graph, edges and nodes coloured by room (module doc)."""
+    """The Voronoi graph, edges and nodes coloured by room (module doc). The points,
+    colours and spheres are parsed from wire bytes built at once
+    (:mod:`sgtool.scenegraph.scene_wire`): the same message as built one by one."""
     if refresh.layers is None:
         return None
     lay = refresh.layers
     vg = lay.voronoi
-    rooms = lay.node_rooms
     ent = SceneEntity(timestamp=codec.timestamp(refresh.time_ns), frame_id=S.WORLD_FRAME,
                       id="voronoi")
-    colors: dict[str | None, Color] = {}
-
-    def color(key: str | None) -> Color:
-        c = colors.get(key)
-        if c is None:
-            c = colors[key] = _color(key)
-        return c
-
-    xy = vg.positions.tolist()
-    points = [Point3(x=float(x), y=float(y), z=GRAPH_Z) for x, y in xy]
-    if len(vg.edges):
-        pts, cols = [], []
-        for u, v in vg.edges.tolist():
-            ru, rv = rooms[u], rooms[v]
-            c = color(ru if ru == rv else None)
-            pts += (points[u], points[v])
-            cols += (c, c)
-        ent.lines.append(LinePrimitive(type=LinePrimitive.LINE_LIST, thickness=0.03,
-                                       points=pts, colors=cols, color=_color(None)))
-    for n, (x, y) in enumerate(xy):
-        s = ent.spheres.add()
-        s.pose.position.x, s.pose.position.y, s.pose.position.z = float(x), float(y), GRAPH_Z
-        s.pose.orientation.w = 1.0
-        s.size.x = s.size.y = s.size.z = 0.08
-        s.color.CopyFrom(color(rooms[n]))
+    palette: dict[str | None, int] = {None: 0}
+    code = np.asarray([palette.setdefault(r, len(palette)) for r in lay.node_rooms],
+                      dtype=np.int64)
+    rgba = np.asarray([_rgba(k) for k in palette], dtype=np.float64)  # in code order
+    xy = np.asarray(vg.positions, dtype=np.float64).reshape(-1, 2)
+    edges = np.asarray(vg.edges, dtype=np.int64).reshape(-1, 2)
+    if len(edges):
+        cu, cv = code[edges[:, 0]], code[edges[:, 1]]
+        ends = xy[edges.reshape(-1)]  # u, v of every edge
+        col = rgba[np.repeat(np.where(cu == cv, cu, 0), 2)]
+        m = len(ends)
+        line = LinePrimitive(type=LinePrimitive.LINE_LIST, thickness=0.03, color=_color(None))
+        line.MergeFromString(
+            sw.records(_LINE_POINT, {"x": ends[:, 0], "y": ends[:, 1], "z": GRAPH_Z}, m)
+            + sw.records(_LINE_COLOR, {"r": col[:, 0], "g": col[:, 1], "b": col[:, 2],
+                                       "a": col[:, 3]}, m))
+        ent.lines.append(line)
+    if len(xy):
+        col = rgba[code]
+        ent.MergeFromString(sw.records(_SPHERE, {
+            "x": xy[:, 0], "y": xy[:, 1], "z": GRAPH_Z, "w": 1.0, "sx": 0.08, "sy": 0.08,
+            "sz": 0.08, "r": col[:, 0], "g": col[:, 1], "b": col[:, 2], "a": col[:, 3]},
+            len(xy)))
     return SceneUpdate(deletions=[SceneEntityDeletion(
         timestamp=codec.timestamp(refresh.time_ns), type=SceneEntityDeletion.ALL)],
         entities=[ent])
@@ -123,6 +136,15 @@ def _hull(points: np.ndarray, margin: float) -> np.ndarray:
     return cloud[np.roll(vertices, -start)]
 
 
+@functools.lru_cache(maxsize=1024)
+def _hull_of(points: bytes, margin: float) -> np.ndarray:
+    """:func:`_hull` of the float64 (x, y) pairs in ``points``, remembered: most rooms keep
+    their nodes from one refresh to the next (the result is read-only)."""
+    hull = _hull(np.frombuffer(points, dtype=np.float64).reshape(-1, 2), margin)
+    hull.setflags(write=False)
+    return hull
+
+
 def rooms_message(refresh: Refresh) -> Any | None:
     """Room outlines and labels (module doc)."""
     if refresh.layers is None:
@@ -139,7 +161,8 @@ def rooms_message(refresh: Refresh) -> Any | None:
     categories = {r.id: r.category for r in refresh.graph.rooms}
     for rid in sorted(by_room, key=lambda s: (len(s), s)):
         nodes = np.asarray(by_room[rid])
-        hull = _hull(vg.positions[nodes], ROOM_MARGIN)
+        hull = _hull_of(np.ascontiguousarray(vg.positions[nodes], dtype=np.float64).tobytes(),
+                        ROOM_MARGIN)
         ent = SceneEntity(timestamp=stamp, frame_id=S.WORLD_FRAME, id=rid)
         ent.lines.append(LinePrimitive(
             type=LinePrimitive.LINE_LOOP, thickness=0.05, color=_color(rid),

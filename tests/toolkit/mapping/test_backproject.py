@@ -14,6 +14,7 @@ import pytest
 
 from sgtool.log import LogReader
 from sgtool.mapping import backproject as bp
+from sgtool.mapping.key_count import count_keys
 from sgtool.mapping.voxels import (
     OFFSET,
     SHIFT_X,
@@ -21,7 +22,6 @@ from sgtool.mapping.voxels import (
     SHIFT_Z,
     VoxelConfig,
     VoxelMap,
-    _count_keys,
     pack,
 )
 
@@ -105,7 +105,7 @@ def test_count_keys_equals_unique_with_and_without_runs():
     runs = np.repeat(rng.integers(-50, 50, 800), rng.integers(1, 30, 800))  # mostly runs
     spread = rng.integers(-(1 << 40), 1 << 40, 5000)  # no runs: plain sort path
     for keys in (runs, spread, np.array([5]), np.zeros(0, np.int64)):
-        uk, cnt = _count_keys(keys.astype(np.int64))
+        uk, cnt = count_keys(keys.astype(np.int64))
         want_k, want_c = np.unique(keys, return_counts=True)
         assert np.array_equal(uk, want_k) and np.array_equal(cnt, want_c)
 
@@ -150,3 +150,24 @@ def test_the_packing_bound_holds_and_skipping_the_range_keeps_the_keys():
     nan = np.full((4, 4), np.nan)
     assert not bp.within_packing(nan, ru, rv, 5.0, 20.0, OFFSET - 1)
     assert not bp.within_packing(np.eye(4), ru, rv, np.inf, 20.0, OFFSET - 1)
+
+
+def test_float_packing_is_exact_at_the_edges_of_the_packing():
+    # one pixel on the optical axis at depth 0: the point is the camera position, so the
+    # voxel indices are chosen through the translation; every field at its extremes
+    ru = rv = np.zeros(1)
+    depth = np.zeros(1, np.float32)
+    edge = OFFSET - 3  # the largest magnitude within_packing lets through
+    values = (-edge, -edge + 1, -1, 0, 1, edge - 1, edge)
+    s = bp.Scratch()
+    for vx in values:
+        for vy in values:
+            for vz in values:
+                pose = np.eye(4)
+                pose[:3, 3] = (np.array([vx, vy, vz]) + 0.5) * 0.05
+                *_, keys, _ = bp.world_voxels(depth, None, ru, rv, pose, 20.0,
+                                              (SHIFT_X, SHIFT_Y, SHIFT_Z), OFFSET, s,
+                                              need_range=False)
+                assert int(keys[0]) == int(pack(np.int64(vx), np.int64(vy), np.int64(vz), 0))
+    with pytest.raises(ValueError):  # fields that could not be summed exactly
+        bp.world_voxels(depth, None, ru, rv, np.eye(4), 20.0, (50, 29, 12), OFFSET, s)
