@@ -38,6 +38,7 @@ from typing import Any
 from sgtool.blas import single_blas_thread
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
+from sgtool.heap import frozen_heap
 from sgtool.log import schemas as S
 from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler
 from sgtool.log.chunk_copy import RawChunk, in_sequence
@@ -190,22 +191,23 @@ def replay(
         report = ReplayReport(src, dst, opts, semantic=reader.has(S.IDS))
         stream = SceneGraphStream(None, (room_classifier or make_classifier)(opts.classifier),
                                   builder_config(opts))
-        t0 = time.perf_counter()
-        if dst is None:
-            _run(reader, stream, None, opts, report, on_refresh, progress)
-        else:
-            meta = dict(reader.metadata.get(S.METADATA_NAME, {}))
-            extra = {k: v for k, v in meta.items()
-                     if k not in ("sgtool_version", "log_schema_version", "seed")}
-            with LogWriter(dst, seed=reader.seed, compression=compression,
-                           metadata=extra) as writer:
-                for name, data in sorted(reader.metadata.items()):
-                    if name not in (S.METADATA_NAME, REPLAY_METADATA):
-                        writer.add_metadata(name, data)
-                writer.add_metadata(REPLAY_METADATA, opts.to_metadata())
-                for a in reader.iter_attachments():
-                    writer.attach(a.name, a.data, a.media_type, a.log_time)
-                _run(reader, stream, writer, opts, report, on_refresh, progress, copy_chunks)
+        with frozen_heap():  # what start-up loaded stays out of full collections
+            t0 = time.perf_counter()
+            if dst is None:
+                _run(reader, stream, None, opts, report, on_refresh, progress)
+            else:
+                meta = dict(reader.metadata.get(S.METADATA_NAME, {}))
+                extra = {k: v for k, v in meta.items()
+                         if k not in ("sgtool_version", "log_schema_version", "seed")}
+                with LogWriter(dst, seed=reader.seed, compression=compression,
+                               metadata=extra) as writer:
+                    for name, data in sorted(reader.metadata.items()):
+                        if name not in (S.METADATA_NAME, REPLAY_METADATA):
+                            writer.add_metadata(name, data)
+                    writer.add_metadata(REPLAY_METADATA, opts.to_metadata())
+                    for a in reader.iter_attachments():
+                        writer.attach(a.name, a.data, a.media_type, a.log_time)
+                    _run(reader, stream, writer, opts, report, on_refresh, progress, copy_chunks)
         report.seconds = time.perf_counter() - t0
         report.stages = stream.builder.stage_summary()
     return report
