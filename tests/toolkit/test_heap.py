@@ -38,3 +38,12 @@ def test_a_cycle_made_before_is_collected_after_the_block() -> None:
         assert alive() is not None
     gc.collect()  # unfrozen, the collector finds it
     assert alive() is None
+
+
+def test_a_nested_block_leaves_the_outer_freeze_alone() -> None:
+    with frozen_heap():
+        outer = gc.get_freeze_count()
+        with frozen_heap():
+            assert gc.get_freeze_count() == outer
+        assert gc.get_freeze_count() == outer  # the inner block did not unfreeze
+    assert gc.get_freeze_count() == 0

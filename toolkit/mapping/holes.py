@@ -63,8 +63,9 @@ def unknown_parts(grid: np.ndarray, near_occupied: np.ndarray | None = None) -> 
     labels, n = ndimage.label(grid == UNKNOWN, output=np.intp)
     sizes = np.bincount(labels.ravel(), minlength=n + 1)
     border = np.zeros(n + 1, dtype=bool)
-    border[np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]])] = True
-    border[0] = False
+    if n:  # (an empty grid has no components, and no border rows to read)
+        border[np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]])] = True
+        border[0] = False
     if near_occupied is None:
         near_occupied = near(grid == OCCUPIED)
     return UnknownParts(labels, int(n), sizes, border, np.zeros(n + 1, dtype=bool),

@@ -128,3 +128,11 @@ def test_eight_components_equal_the_grid_labelling(seed: int) -> None:
     grid = np.zeros((h, w), dtype=np.int64)
     grid[rows, cols] = of + 1
     assert _same_partition(grid, lab)
+
+
+@pytest.mark.parametrize("shape", [(0, 0), (0, 5), (5, 0)])
+def test_an_empty_grid_has_no_holes_and_no_frontiers(shape: tuple[int, int]) -> None:
+    g = np.full(shape, UNKNOWN, np.int8)
+    assert fill_holes(g.copy(), 10) == 0 == plain_fill_holes(g.copy(), 10)
+    assert unknown_parts(g).count == 0
+    assert find_frontiers(OccupancyGrid(g, (0.0, 0.0), 0.05), (0.0, 0.0)) == []
