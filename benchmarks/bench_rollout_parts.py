@@ -3,7 +3,7 @@
 Run by hand (not part of the test suite)::
 
     .venv/bin/python benchmarks/bench_rollout_parts.py [--planner scout] [--houses 2]
-        [--repeats 4] [--against CHECKOUT]
+        [--repeats 4] [--rounds 1] [--against CHECKOUT]
 
 For each house (``house-<i>``, the bench's preset, rooms and episode mix) it times the
 house preparation once (generation, the symbolic house, the episode list: CPU seconds),
@@ -14,8 +14,9 @@ minimum over the repeats (the same call, deterministic, so the minimum is the ti
 takes when nothing else runs), and the table sums them. The first repeat of the first
 house warms the process and is left out. ``--against CHECKOUT`` first runs the same in
 another checkout (loaded as :mod:`bench_throughput` does), then in this one, and prints the
-ratios; the minima make the two comparable under steady load, not under load that changes
-between the two.
+ratios; ``--rounds N`` runs N worker processes per tree, alternately (base, this, base,
+...), and takes each call's minimum over all of them, so that load that changes during the
+run reaches both trees.
 """
 
 from __future__ import annotations
@@ -56,12 +57,15 @@ def measure(args: argparse.Namespace) -> dict[str, float]:
         setattr(owner, name, g)
 
     timed(planners.NodeSelectionPlanner, "decide", "decide")
-    timed(planners, "actionable", "actionable")
-    timed(planners, "candidate_utilities", "utilities")
+    # the names the planners module calls (columns since round 4; lists before)
+    timed(planners, next(n for n in ("actionable_columns", "actionable")
+                         if hasattr(planners, n)), "actionable")
+    timed(planners, next(n for n in ("column_utilities", "candidate_utilities")
+                         if hasattr(planners, n)), "utilities")
     timed(environment.SymbolicEnv, "observe", "observe")
     timed(environment.SymbolicEnv, "execute", "execute")
     cfg = BenchConfig(planners=(args.planner,), houses=args.houses, episodes=20, seeds=3)
-    total = dict.fromkeys(PARTS, 0.0) | {"prepare": 0.0, "episodes": 0.0}
+    total: dict = {"prepare": 0.0, "episodes": 0.0, "calls": {p: [] for p in PARTS}}
     for ref in generated_houses(args.houses, 0):
         c0 = time.process_time()
         spec = ref.load(cfg.rooms, cfg.preset)
@@ -82,13 +86,23 @@ def measure(args: argparse.Namespace) -> dict[str, float]:
                 if ref.seed == 0 and k == 0:
                     continue  # warms the process
                 runs.append({p: list(v) for p, v in calls.items()})
-        for p in PARTS:
-            total[p] += sum(min(c) for c in zip(*(r.get(p, []) for r in runs), strict=True))
+        for p in PARTS:  # each call's minimum over the repeats
+            total["calls"][p] += [min(c) for c in zip(*(r.get(p, []) for r in runs),
+                                                      strict=True)]
         total["episodes"] += cfg.seeds * len(episodes)
     return total
 
 
-def run_tree(args: argparse.Namespace, site: Path | None) -> dict[str, float]:
+def summed(runs: list[dict]) -> dict[str, float]:
+    """The parts of worker runs of one tree: each call's minimum over all the runs, summed;
+    house preparation: the smallest."""
+    out = {p: sum(map(min, zip(*(r["calls"][p] for r in runs), strict=True)))
+           for p in PARTS}
+    return out | {"prepare": min(r["prepare"] for r in runs),
+                  "episodes": runs[0]["episodes"]}
+
+
+def run_tree(args: argparse.Namespace, site: Path | None) -> dict:
     env = dict(os.environ)
     if site is not None:
         env["PYTHONPATH"] = str(site) + os.pathsep + env.get("PYTHONPATH", "")
@@ -106,6 +120,8 @@ def main() -> None:
     ap.add_argument("--planner", default="scout")
     ap.add_argument("--houses", type=int, default=2)
     ap.add_argument("--repeats", type=int, default=4)
+    ap.add_argument("--rounds", type=int, default=1,
+                    help="worker processes per tree, run alternately")
     ap.add_argument("--against", type=Path, default=None)
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -119,9 +135,14 @@ def main() -> None:
         trees = {"base": site_of(args.against.resolve(), Path(tmp) / "base")} \
             if args.against else {}
         trees["this"] = None
-        rows = {t: run_tree(args, s) for t, s in trees.items()}
+        runs: dict[str, list[dict]] = {t: [] for t in trees}
+        for _ in range(args.rounds):  # alternating, so that both see the same load
+            for t, site in trees.items():
+                runs[t].append(run_tree(args, site))
+        rows = {t: summed(r) for t, r in runs.items()}
     print(f"{args.planner}, {args.houses} houses x 20 episodes x 3 seeds; roll-out parts: "
-          f"sums of per-call minima over {args.repeats} repeats (s); prepare: CPU s")
+          f"sums of per-call minima over {args.repeats} repeats x {args.rounds} rounds (s); "
+          "prepare: CPU s")
     print(f"{'':10s} " + " ".join(f"{p:>10s}" for p in (*PARTS, "rollout", "prepare")))
     for t, r in rows.items():
         rollout = r["observe"] + r["decide"] + r["execute"]

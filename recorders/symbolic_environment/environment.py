@@ -140,7 +140,7 @@ class SymbolicEnv:
 
     def _reveal_region(self, region: int) -> None:
         self.revealed_regions.add(region)
-        self._view.regions_changed()
+        self._view.regions_changed(self.house.regions[region].room)
         for f in self.house.regions[region].furniture:
             self._visible_furn.add(f)
             self._view.show_furniture(f)

@@ -41,6 +41,7 @@ if TYPE_CHECKING:
 
 
 _Ids = tuple[list[str], np.ndarray]  # node ids and their places (one distance look-up)
+_DoorPlaces = tuple[list[str], np.ndarray, np.ndarray]  # door ids, the places of each side
 
 
 class ObservedGraph:
@@ -54,6 +55,10 @@ class ObservedGraph:
         self._furn_nodes: dict[int, ObjectNode] = {}
         self._room_nodes: dict[tuple[int, bool, tuple[str, ...]], RoomNode] = {}
         self._region_nodes: dict[tuple[int, bool], RegionNode] = {}
+        self._room_parts: dict[int, RoomNode] = {}  # per known room index: its node
+        self._seen: tuple[set[int], set[int]] = (set(), set())  # rooms known, explored then
+        # per explored room index: its region nodes, their ids and places
+        self._region_parts: dict[int, tuple[list[RegionNode], list[str], list[int]]] = {}
         self._obj_nodes: dict[int, ObjectNode] = {}
         # what is rebuilt when it changed (None: to rebuild)
         self._objects: tuple[ObjectNode, ...] | None = None
@@ -61,8 +66,8 @@ class ObservedGraph:
         self._rooms: tuple[tuple[RoomNode, ...], tuple[tuple[str, tuple[int, ...]], ...]] | \
             None = None  # the nodes, (room id, its regions' places) each
         self._regions: tuple[tuple[RegionNode, ...], _Ids] | None = None
-        self._doors: tuple[tuple[DoorNode, ...], tuple[tuple[str, int, int], ...]] | None = \
-            None  # the nodes, (door id, place of each side) each
+        self._door_nodes: dict[tuple[int, bool], DoorNode] = {}
+        self._doors: tuple[tuple[DoorNode, ...], _DoorPlaces] | None = None
         self._room_index: tuple[object, tuple[list[str], np.ndarray, np.ndarray]] | None = \
             None  # (the rooms entry, its places for one look-up)
 
@@ -95,9 +100,14 @@ class ObservedGraph:
         """A room became known or explored."""
         self._rooms = None
 
-    def regions_changed(self) -> None:
-        """A region was revealed or a room explored (its regions appear)."""
+    def regions_changed(self, room: int | None = None) -> None:
+        """A region of room index ``room`` was revealed, or the room explored (its regions
+        appear); None: any room's."""
         self._regions = None
+        if room is None:
+            self._region_parts.clear()
+        else:
+            self._region_parts.pop(room, None)
 
     def doors_changed(self) -> None:
         """A door was seen, opened or closed."""
@@ -107,55 +117,97 @@ class ObservedGraph:
     def _build_rooms(self) -> tuple[tuple[RoomNode, ...], tuple[tuple[str, tuple[int, ...]],
                                                                  ...]]:
         env, h = self._env, self._h
+        # a room's node changes when it becomes known or explored, or a room linked to it
+        # becomes known (its neighbours); the sets only grow within an episode
+        seen_known, seen_explored = self._seen
+        if seen_known <= env.known_rooms and seen_explored <= env.explored_rooms:
+            new = env.known_rooms - seen_known
+            for ri in new | (env.explored_rooms - seen_explored):
+                self._room_parts.pop(ri, None)
+            for ri in new:
+                for o, _ in h.links[ri]:
+                    self._room_parts.pop(o, None)
+        else:
+            self._room_parts.clear()
+        self._seen = (set(env.known_rooms), set(env.explored_rooms))
         known = sorted(env.known_rooms)
         rooms = []
         for ri in known:
-            explored = ri in env.explored_rooms
-            name = h.room_names[ri]
-            neighbours = tuple(sorted({h.room_ids[o] for o, _ in h.links[ri]
-                                       if o in env.known_rooms})) if explored else ()
-            key = (ri, explored, neighbours)
-            node = self._room_nodes.get(key)
-            if node is None:  # the same node object while the room is unchanged
-                node = self._room_nodes[key] = RoomNode(
-                    id=h.room_ids[ri], category=name if explored else "unknown",
-                    position=h.room_centroids[ri], explored=explored,
-                    category_scores=((name, 1.0),) if explored else (),
-                    neighbours=neighbours)
+            node = self._room_parts.get(ri)
+            if node is None:
+                node = self._room_parts[ri] = self._room_node(ri)
             rooms.append(node)
         return tuple(rooms), tuple((h.room_ids[ri], h.room_places[ri]) for ri in known)
 
+    def _room_node(self, ri: int) -> RoomNode:
+        """The node of known room ``ri`` (the same object while the room is unchanged)."""
+        env, h = self._env, self._h
+        explored = ri in env.explored_rooms
+        name = h.room_names[ri]
+        neighbours = tuple(sorted({h.room_ids[o] for o, _ in h.links[ri]
+                                   if o in env.known_rooms})) if explored else ()
+        key = (ri, explored, neighbours)
+        node = self._room_nodes.get(key)
+        if node is None:
+            node = self._room_nodes[key] = RoomNode(
+                id=h.room_ids[ri], category=name if explored else "unknown",
+                position=h.room_centroids[ri], explored=explored,
+                category_scores=((name, 1.0),) if explored else (), neighbours=neighbours)
+        return node
+
     def _build_regions(self) -> tuple[tuple[RegionNode, ...], _Ids]:
+        regions: list[RegionNode] = []
+        ids: list[str] = []
+        places: list[int] = []
+        parts = self._region_parts
+        for ri in sorted(self._env.explored_rooms):
+            part = parts.get(ri)
+            if part is None:  # (kept per room until one of its regions changes)
+                part = parts[ri] = self._room_regions(ri)
+            regions += part[0]
+            ids += part[1]
+            places += part[2]
+        return tuple(regions), (ids, np.asarray(places, dtype=np.intp))
+
+    def _room_regions(self, ri: int) -> tuple[list[RegionNode], list[str], list[int]]:
+        """The region nodes of explored room ``ri``, their ids and places."""
         env, h = self._env, self._h
         regions, places = [], []
-        for ri in sorted(env.explored_rooms):
-            for reg in h.room_regions[ri]:
-                r = h.regions[reg]
-                revealed = reg in env.revealed_regions
-                node = self._region_nodes.get((reg, revealed))
-                if node is None:
-                    node = self._region_nodes[(reg, revealed)] = RegionNode(
-                        id=r.id, room=h.room_ids[ri], position=r.center,
-                        kind="region" if revealed else "frontier",
-                        frontier_type=None if revealed else "unexplored area")
-                regions.append(node)
-                places.append(r.place)
-        return tuple(regions), ([r.id for r in regions], np.asarray(places, dtype=np.intp))
+        for reg in h.room_regions[ri]:
+            r = h.regions[reg]
+            revealed = reg in env.revealed_regions
+            node = self._region_nodes.get((reg, revealed))
+            if node is None:
+                node = self._region_nodes[(reg, revealed)] = RegionNode(
+                    id=r.id, room=h.room_ids[ri], position=r.center,
+                    kind="region" if revealed else "frontier",
+                    frontier_type=None if revealed else "unexplored area")
+            regions.append(node)
+            places.append(r.place)
+        return regions, [r.id for r in regions], places
 
-    def _build_doors(self) -> tuple[tuple[DoorNode, ...], tuple[tuple[str, int, int], ...]]:
+    def _build_doors(self) -> tuple[tuple[DoorNode, ...], _DoorPlaces]:
         env, h = self._env, self._h
         seen = sorted(env.visible_doors)
-        doors = tuple(DoorNode(
-            id=f"door:{di}", position=(float(h.spec.doors[di].center[0]),
-                                       float(h.spec.doors[di].center[1])),
-            state="open" if di in env.open_doors else "closed", rooms=h.door_rooms[di],
-            instance=-1) for di in seen)
-        return doors, tuple((f"door:{di}", *h.door_sides[di]) for di in seen)
+        doors = []
+        for di in seen:
+            is_open = di in env.open_doors
+            node = self._door_nodes.get((di, is_open))
+            if node is None:  # the same node object while the door is unchanged
+                node = self._door_nodes[(di, is_open)] = DoorNode(
+                    id=f"door:{di}", position=(float(h.spec.doors[di].center[0]),
+                                               float(h.spec.doors[di].center[1])),
+                    state="open" if is_open else "closed", rooms=h.door_rooms[di],
+                    instance=-1)
+            doors.append(node)
+        sides = np.asarray([h.door_sides[di] for di in seen], dtype=np.intp).reshape(-1, 2)
+        return tuple(doors), ([d.id for d in doors], sides[:, 0], sides[:, 1])
 
     def _build_items(self) -> _Ids:
         h = self._h
-        ids = [h.furn_ids[f] for f in self._furn] + [h.obj_ids[j] for j in self._obj]
-        places = [h.furn_place[f] for f in self._furn] + [h.obj_place[j] for j in self._obj]
+        ids = [*map(h.furn_ids.__getitem__, self._furn), *map(h.obj_ids.__getitem__, self._obj)]
+        places = [*map(h.furn_place.__getitem__, self._furn),
+                  *map(h.obj_place.__getitem__, self._obj)]
         return ids, np.asarray(places, dtype=np.intp)
 
     def _room_places(self) -> tuple[list[str], np.ndarray, np.ndarray]:
@@ -186,30 +238,35 @@ class ObservedGraph:
         if self._doors is None:
             self._doors = self._build_doors()
         if self._objects is None:
-            self._objects = tuple(self._furn_nodes[f] for f in self._furn) + \
-                tuple(self._obj_nodes[j] for j in self._obj)
+            self._objects = (*map(self._furn_nodes.__getitem__, self._furn),
+                             *map(self._obj_nodes.__getitem__, self._obj))
         if self._items is None:
             self._items = self._build_items()
         distances: dict[str, float] = {}
         rids, flat, starts = self._room_places()
         if rids:
             near = np.minimum.reduceat(dist[flat], starts)  # each room's nearest region
-            if np.isnan(near).any():  # (never: distances are finite or inf) as min() does
-                near = np.array([min(dist[p] for p in ps) for _, ps in self._rooms[1]])
-            distances.update((r, d) for r, d in zip(rids, near.tolist(), strict=True)
-                             if math.isfinite(d))
+            if math.isfinite(np.add.reduce(near)):  # all finite (else the sum is not)
+                distances.update(zip(rids, near.tolist(), strict=True))
+            else:
+                if np.isnan(near).any():  # (never: distances are finite or inf) as min()
+                    near = np.array([min(dist[p] for p in ps) for _, ps in self._rooms[1]])
+                distances.update((r, d) for r, d in zip(rids, near.tolist(), strict=True)
+                                 if math.isfinite(d))
         for ids, places in (self._regions[1], self._items):
             vals = dist[places]
-            fin = np.isfinite(vals)
-            if fin.all():
+            if math.isfinite(np.add.reduce(vals)):  # all finite
                 distances.update(zip(ids, vals.tolist(), strict=True))
             else:
+                fin = np.isfinite(vals)
                 distances.update(zip(compress(ids, fin.tolist()), vals[fin].tolist(),
                                      strict=True))
-        for did, a, b in self._doors[1]:
-            d = float(min(dist[a], dist[b]))
-            if math.isfinite(d):
-                distances[did] = d
+        dids, a, b = self._doors[1]
+        if dids:  # each door's nearer side
+            vals = np.minimum(dist[a], dist[b])
+            fin = np.isfinite(vals)
+            distances.update(zip(compress(dids, fin.tolist()), vals[fin].tolist(),
+                                 strict=True))
         here = env.place
         robot = RobotState(position=h.places[here], room=h.room_ids[h.place_room[here]],
                            region=h.place_region.get(here))

@@ -31,7 +31,13 @@ from __future__ import annotations
 
 import functools
 import math
+from bisect import bisect_left
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from itertools import compress, repeat
+from operator import attrgetter, eq, is_, is_not
+
+import numpy as np
 
 from sgtool.planning.base import Skill
 from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode, SceneGraph
@@ -42,6 +48,7 @@ EXAMINE_AFFORDANCES = frozenset({"explore", "examine", "search"})
 CARRIER_AFFORDANCES = OPEN_AFFORDANCES | EXAMINE_AFFORDANCES | {"container", "supporter"}
 
 NodeKind = str  # "room" | "frontier" | "object" | "door"
+_CATEGORY = attrgetter("category")
 
 
 @dataclass(frozen=True)
@@ -110,12 +117,17 @@ def is_carrier(obj: ObjectNode) -> bool:
 
 def door_is_entrance(graph: SceneGraph, door: DoorNode) -> bool:
     """A closed door is worth opening when it joins a room that is unexplored or unknown."""
+    return _entrance(door, graph.room)
+
+
+def _entrance(door: DoorNode, room_of: Callable[[str], RoomNode | None]) -> bool:
+    """:func:`door_is_entrance`, ``room_of`` the graph's room of an id (None: unknown)."""
     if door.state != "closed":
         return False
     if not door.rooms:
         return True
     for rid in door.rooms:
-        room = graph.room(rid)
+        room = room_of(rid)
         if room is None or not room.explored:
             return True
     return False
@@ -213,23 +225,29 @@ class _GroupOrder:
     def _update(self, prev: tuple, last: _Ordered, keys: dict[int, tuple | None],
                 group: tuple) -> _Ordered | None:
         """``last`` (the order of ``prev``) updated to ``group`` (class doc); None to sort
-        afresh. ``keys`` is updated in place."""
-        if len(prev) == len(group):  # nodes replaced in place, the usual change: one pass
-            at = [k for k, (a, b) in enumerate(zip(prev, group, strict=True)) if a is not b]
+        afresh. ``keys`` is updated in place. Entries are taken out and put in by bisection
+        on the (unique) keys, which is where a sort of the whole would put them."""
+        if len(prev) == len(group):  # nodes replaced in place, the usual change
+            at = list(compress(range(len(group)), map(is_not, prev, group)))
             new = [group[k] for k in at]
             if len({id(n) for n in new} - keys.keys()) != len(new):
                 return None  # a node moved within the tuple, or is in it twice
-            gone = [id(prev[k]) for k in at]
+            gone: Iterable[int] = [id(prev[k]) for k in at]
         else:
-            now = {id(n) for n in group}
+            now = dict(zip(map(id, group), group, strict=True))
             if len(now) != len(group):
                 return None  # a node twice in the tuple
-            gone = [k for k in keys if k not in now]
-            new = [n for n in group if id(n) not in keys]
+            gone = keys.keys() - now.keys()
+            new = [now[k] for k in now.keys() - keys.keys()]
         out = last
-        if gone:
-            drop = {keys.pop(k) for k in gone}
-            out = [e for e in last if e[0] not in drop]
+        drop = [key for key in map(keys.pop, gone) if key is not None]
+        if drop:
+            out = list(last)
+            for key in drop:
+                k = bisect_left(out, (key,))  # (key,) sorts just before key's entry
+                if k == len(out) or out[k][0] != key:
+                    return None  # (never: a key of ``keys`` is in ``last``)
+                del out[k]
         added = []
         for node in new:
             entry = self._entry(node)
@@ -239,18 +257,24 @@ class _GroupOrder:
             added.append((entry[3], entry[4], entry[1], entry[2], entry[5]))
             keys[id(node)] = entry[3]
         if added:
-            out = out + added
-            out.sort(key=_first)
-            if len({e[0] for e in out}) != len(out):
-                return None  # equal keys: their order is the graph's
+            if out is last:
+                out = list(last)
+            for e in added:
+                k = bisect_left(out, (e[0],))
+                if k < len(out) and out[k][0] == e[0]:
+                    return None  # equal keys: their order is the graph's
+                out.insert(k, e)
         return out
 
     def doors(self, graph: SceneGraph) -> _Ordered:
         hit = self.last.get("door")
         if hit is not None and hit[0] is graph.doors and hit[1] is graph.rooms:
             return hit[2]
+        rooms: dict[str, RoomNode] = {}
+        for r in graph.rooms:  # the first room of an id, as graph.room
+            rooms.setdefault(r.id, r)
         out: _Ordered = [(natural_key(d.id), d.id, "open", "door", node_xy(d))
-                         for d in graph.doors if door_is_entrance(graph, d)]
+                         for d in graph.doors if _entrance(d, rooms.get)]
         out.sort(key=_first)
         self.last["door"] = (graph.doors, graph.rooms, out)
         return out
@@ -276,21 +300,105 @@ def _in_order(groups: list[_Ordered]) -> _Ordered:
     return [t[3] for t in keyed]
 
 
-def actionable(graph: SceneGraph) -> list[Candidate]:
-    """N_a in natural id order; unreachable nodes are left out."""
+@dataclass(frozen=True)
+class CandidateColumns:
+    """N_a as columns, one list per :class:`Candidate` field, in the order of
+    :func:`actionable`. Planners that score columns (:class:`~sgtool.planning.planners.
+    UtilityPlanner`) use them as they are; :meth:`candidates` builds the
+    :class:`Candidate` list for those that take one. The lists may be shared with the next
+    decision's columns: read them, never change them."""
+
+    ids: list[str]
+    skills: list[Skill]
+    kinds: list[NodeKind]
+    distances: list[float]
+    positions: list[tuple[float, float]]
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+    def candidates(self) -> list[Candidate]:
+        return list(map(Candidate, self.ids, self.skills, self.kinds, self.distances,
+                        self.positions))
+
+    def take(self, keep: list[int]) -> CandidateColumns:
+        """The rows ``keep`` (ascending indices)."""
+        return CandidateColumns(*([col[k] for k in keep] for col in (
+            self.ids, self.skills, self.kinds, self.distances, self.positions)))
+
+    @classmethod
+    def of(cls, candidates: list[Candidate]) -> CandidateColumns:
+        return cls([c.node_id for c in candidates], [c.skill for c in candidates],
+                   [c.kind for c in candidates], [c.distance for c in candidates],
+                   [c.position for c in candidates])
+
+
+# the ordered groups last put in order (kept alive, compared by identity) and their
+# (ids, skills, kinds, positions) columns; the columns of each group's last ordered list
+_LAST_ORDER: list[tuple[tuple[_Ordered, ...], tuple[list, list, list, list]]] = []
+_GROUP_COLUMNS: dict[int, tuple[_Ordered, list[list]]] = {}
+
+
+def _columns(entries: _Ordered) -> list[list]:
+    """(ids, skills, kinds, positions) of ``entries``."""
+    if not entries:
+        return [[], [], [], []]
+    return [list(c) for c in zip(*entries, strict=True)][1:]
+
+
+def _ordered_columns(groups: tuple[_Ordered, ...]) -> tuple[list, list, list, list]:
+    """The columns of :func:`_in_order` of ``groups``: those of each group end to end when
+    the groups' key ranges do not meet (kept per group while its ordered list is the
+    same), else of the merged order."""
+    last = _LAST_ORDER[0] if _LAST_ORDER else None
+    if last is not None and all(map(is_, last[0], groups)):
+        return last[1]
+    runs = sorted((k for k, g in enumerate(groups) if g), key=lambda k: groups[k][0][0])
+    if all(groups[a][-1][0] < groups[b][0][0] for a, b in zip(runs, runs[1:], strict=False)):
+        cols: list[list] = [[], [], [], []]
+        for k in runs:
+            hit = _GROUP_COLUMNS.get(k)
+            if hit is None or hit[0] is not groups[k]:
+                hit = _GROUP_COLUMNS[k] = (groups[k], _columns(groups[k]))
+            for col, part in zip(cols, hit[1], strict=True):
+                col += part
+    else:
+        cols = _columns(_in_order(list(groups)))
+    out = (cols[0], cols[1], cols[2], cols[3])
+    _LAST_ORDER[:] = [(groups, out)]  # type: ignore[list-item]
+    return out
+
+
+def actionable_columns(graph: SceneGraph) -> CandidateColumns:
+    """:func:`actionable` as columns (:class:`CandidateColumns`)."""
     dists = graph.distances
     if not dists:
+        return CandidateColumns.of(_actionable_without_distances(graph))
+    ids, skills, kinds, xy = _ordered_columns((
+        _ORDER.nodes("room", graph.rooms), _ORDER.nodes("region", graph.regions),
+        _ORDER.nodes("object", graph.objects), _ORDER.doors(graph)))
+    try:  # float64, as float(d); a missing id is unreachable
+        d = np.fromiter(map(dists.get, ids, repeat(math.inf)), dtype=np.float64,
+                        count=len(ids))
+    except (TypeError, ValueError):  # a distance that is None or no number
+        d = np.array([_finite_or_inf(dists.get(i)) for i in ids], dtype=np.float64)
+    if math.isfinite(np.add.reduce(d)):  # all finite (an inf or NaN makes the sum so)
+        return CandidateColumns(ids, skills, kinds, d.tolist(), xy)
+    fin = np.isfinite(d)
+    keep = np.flatnonzero(fin).tolist()
+    return CandidateColumns([ids[k] for k in keep], [skills[k] for k in keep],
+                            [kinds[k] for k in keep], d[fin].tolist(), [xy[k] for k in keep])
+
+
+def _finite_or_inf(d: object) -> float:
+    return math.inf if d is None else float(d)  # type: ignore[arg-type]
+
+
+def actionable(graph: SceneGraph) -> list[Candidate]:
+    """N_a in natural id order; unreachable nodes are left out."""
+    if not graph.distances:
         return _actionable_without_distances(graph)
-    nodes = _in_order([_ORDER.nodes("room", graph.rooms),
-                       _ORDER.nodes("region", graph.regions),
-                       _ORDER.nodes("object", graph.objects), _ORDER.doors(graph)])
-    out = []
-    get, isfinite = dists.get, math.isfinite
-    for _, nid, skill, kind, xy in nodes:
-        d = get(nid)
-        if d is not None and isfinite(d):
-            out.append(Candidate(nid, skill, kind, float(d), xy))
-    return out
+    return actionable_columns(graph).candidates()
 
 
 def _actionable_without_distances(graph: SceneGraph) -> list[Candidate]:
@@ -336,6 +444,10 @@ def _of_query(objects: tuple[ObjectNode, ...], query: str) -> list[ObjectNode]:
     if last is not None and last[0] is objects and last[1] == query:
         return last[2]
     want = category_text(query)
-    found = [o for o in objects if category_text(o.category) == want]
+    cats = list(map(_CATEGORY, objects))
+    if want in set(map(category_text, set(cats))):  # (mostly not: nothing in view)
+        found = list(compress(objects, map(eq, map(category_text, cats), repeat(want))))
+    else:
+        found = []
     _QUERY_OBJECTS[:] = [(objects, query, found)]
     return found

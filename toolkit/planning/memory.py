@@ -14,7 +14,7 @@ import math
 from dataclasses import dataclass, field
 
 from sgtool.planning.base import Feedback
-from sgtool.planning.candidates import Candidate
+from sgtool.planning.candidates import Candidate, CandidateColumns
 
 SAME_PLACE_M = 0.5  # a node within this distance of a remembered one with the same id is it
 
@@ -50,14 +50,17 @@ class EpisodeMemory:
             self.failures.setdefault(target, []).append(pos)
 
     def excluded(self, c: Candidate) -> bool:
+        return self._excluded(c.node_id, c.position)
+
+    def _excluded(self, node_id: str, position: tuple[float, float]) -> bool:
         def near(p: tuple[float, float]) -> bool:
             if math.isnan(p[0]):
                 return True  # position unknown: trust the id
-            return math.hypot(p[0] - c.position[0], p[1] - c.position[1]) <= SAME_PLACE_M
+            return math.hypot(p[0] - position[0], p[1] - position[1]) <= SAME_PLACE_M
 
-        if c.node_id in self.finished and near(self.finished[c.node_id]):
+        if node_id in self.finished and near(self.finished[node_id]):
             return True
-        fails = [p for p in self.failures.get(c.node_id, []) if near(p)]
+        fails = [p for p in self.failures.get(node_id, []) if near(p)]
         return len(fails) >= self.max_failures
 
     def filter(self, candidates: list[Candidate]) -> list[Candidate]:
@@ -66,3 +69,17 @@ class EpisodeMemory:
             return list(candidates)
         return [c for c in candidates
                 if not ((c.node_id in finished or c.node_id in failures) and self.excluded(c))]
+
+    def filter_columns(self, cols: CandidateColumns) -> CandidateColumns:
+        """:meth:`filter` of columns (the same object when nothing is left out)."""
+        finished, failures = self.finished, self.failures
+        if not finished and not failures:
+            return cols
+        pos = cols.positions
+        keep = [k for k, i in enumerate(cols.ids)
+                if not ((i in finished or i in failures) and self._excluded(i, pos[k]))]
+        return cols if len(keep) == len(cols.ids) else cols.take(keep)
+
+    def offered_columns(self, cols: CandidateColumns) -> None:
+        """:meth:`offered` of columns."""
+        self._last_position.update(zip(cols.ids, cols.positions, strict=True))

@@ -14,12 +14,17 @@ import functools
 import numpy as np
 
 from sgtool.planning.base import Action, Feedback
-from sgtool.planning.candidates import Candidate, actionable, find_target
+from sgtool.planning.candidates import (
+    Candidate,
+    CandidateColumns,
+    actionable_columns,
+    find_target,
+)
 from sgtool.planning.memory import EpisodeMemory
 from sgtool.planning.utility import (
     EpisodeCache,
     UtilityParams,
-    candidate_utilities,
+    column_utilities,
     select_with_margin,
 )
 from sgtool.scenegraph.graph import SceneGraph
@@ -56,13 +61,18 @@ class NodeSelectionPlanner:
         found = find_target(graph, self.query)
         if found is not None:
             return Action("done", target=found.id, reason=f"{found.category} observed")
-        cands = self.memory.filter(actionable(graph))
-        self.memory.offered(cands)
-        if not cands:
+        cols = self.memory.filter_columns(actionable_columns(graph))
+        self.memory.offered_columns(cols)
+        if not cols:
             return Action("done", target=None, reason=GIVE_UP)
-        i, reason, scores = self.choose(graph, cands)
-        c = cands[i]
-        return Action(c.skill, target=c.node_id, reason=reason, scores=scores)
+        i, reason, scores = self.choose_columns(graph, cols)
+        return Action(cols.skills[i], target=cols.ids[i], reason=reason, scores=scores)
+
+    def choose_columns(self, graph: SceneGraph, cols: CandidateColumns
+                       ) -> tuple[int, str, dict[str, float]]:
+        """:meth:`choose` on the candidates as columns; planners that score columns
+        override it, the others get the :class:`Candidate` list."""
+        return self.choose(graph, cols.candidates())
 
     def choose(self, graph: SceneGraph, cands: list[Candidate]
                ) -> tuple[int, str, dict[str, float]]:
@@ -82,6 +92,12 @@ class RandomPlanner(NodeSelectionPlanner):
                ) -> tuple[int, str, dict[str, float]]:
         i = int(self._rng.integers(len(cands)))
         return i, f"random among {len(cands)}", {}
+
+    def choose_columns(self, graph: SceneGraph, cols: CandidateColumns
+                       ) -> tuple[int, str, dict[str, float]]:
+        if type(self).choose is not RandomPlanner.choose:  # a subclass's own choice
+            return super().choose_columns(graph, cols)
+        return self.choose(graph, cols)  # type: ignore[arg-type]  # (only its length)
 
 
 class GreedyPlanner(NodeSelectionPlanner):
@@ -113,9 +129,19 @@ class UtilityPlanner(NodeSelectionPlanner):
 
     def choose(self, graph: SceneGraph, cands: list[Candidate]
                ) -> tuple[int, str, dict[str, float]]:
-        u = candidate_utilities(graph, cands, self.query, self.scorer, self.params,
-                                self.cache)
-        ids = [c.node_id for c in cands]
-        i = select_with_margin(u, [c.distance for c in cands], ids, self.params.delta)
+        return self._choose(graph, CandidateColumns.of(cands))
+
+    def choose_columns(self, graph: SceneGraph, cols: CandidateColumns
+                       ) -> tuple[int, str, dict[str, float]]:
+        if type(self).choose is not UtilityPlanner.choose:  # a subclass's own choice
+            return super().choose_columns(graph, cols)
+        return self._choose(graph, cols)
+
+    def _choose(self, graph: SceneGraph, cols: CandidateColumns
+                ) -> tuple[int, str, dict[str, float]]:
+        ids, dist = cols.ids, cols.distances
+        u = column_utilities(graph, ids, cols.kinds, cols.positions, self.query, self.scorer,
+                             self.params, self.cache)
+        i = select_with_margin(u, dist, ids, self.params.delta)
         scores = dict(zip(ids, map(_round4, u), strict=True))
-        return i, f"u={u[i]:.3f} (max {max(u):.3f}), d={cands[i].distance:.2f} m", scores
+        return i, f"u={u[i]:.3f} (max {max(u):.3f}), d={dist[i]:.2f} m", scores

@@ -15,6 +15,10 @@ import time
 from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.scenegraph.graph import SceneGraph
 
+# Action's fields in order, as TimedPlanner.decide builds one (else it uses replace)
+_PLAIN = tuple(f.name for f in dataclasses.fields(Action)) == \
+    ("skill", "target", "reason", "decision_time_s", "scores")
+
 
 class TimedPlanner:
     """Wraps a planner; ``decide`` returns the action with ``decision_time_s`` filled."""
@@ -33,7 +37,15 @@ class TimedPlanner:
         action = self.inner.decide(graph)
         dt = time.perf_counter() - t0
         self.decision_times.append(dt)
+        if _PLAIN and type(action) is Action:  # dataclasses.replace without its field walk
+            return Action(action.skill, action.target, action.reason, dt, action.scores)
         return dataclasses.replace(action, decision_time_s=dt)
+
+    @property
+    def exchanges(self) -> object:
+        """The wrapped planner's LLM exchanges (moma-llm), None when it keeps none: asked
+        before and after every decision, so not through :meth:`__getattr__`'s failure."""
+        return getattr(self.inner, "exchanges", None)
 
     def feedback(self, fb: Feedback) -> None:
         self.inner.feedback(fb)

@@ -22,6 +22,8 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from itertools import compress, repeat
+from operator import attrgetter, ge, is_, is_not, ne
 
 import numpy as np
 
@@ -30,6 +32,8 @@ from sgtool.scenegraph.graph import ObjectNode, SceneGraph
 from sgtool.semantics.priors import RelationScorer, can_score_room
 
 UNKNOWN_ROOM = frozenset({"", "unknown", "none"})
+_ID, _CATEGORY, _ROOM, _POSITION = (attrgetter(a) for a in ("id", "category", "room",
+                                                              "position"))
 
 
 @dataclass(frozen=True)
@@ -83,17 +87,15 @@ def select_with_margin(
     """
     if not utilities:
         raise ValueError("no actionable node to select from")
+    if not len(utilities) == len(distances) == len(ids):
+        raise ValueError("utilities, distances and ids differ in length")
     u_max = max(utilities)
     # tolerance: scores computed in float32 can differ in the last bits
     eps = 1e-9
-    best = None
-    for i, (u, d, nid) in enumerate(zip(utilities, distances, ids, strict=True)):
-        if u >= u_max - delta - eps:
-            key = (d, nid)
-            if best is None or key < best[0]:
-                best = (key, i)
-    assert best is not None
-    return best[1]
+    near = list(compress(range(len(utilities)),
+                         map(ge, utilities, repeat(u_max - delta - eps))))
+    # the first of the smallest (distance, id): min() keeps the first of equal keys
+    return min(near, key=lambda i: (distances[i], ids[i]))
 
 
 def room_utilities(graph: SceneGraph, query: str, scorer: RelationScorer,
@@ -116,14 +118,14 @@ class ObjectTable:
 
     def __init__(self, objects: Sequence[ObjectNode]) -> None:
         self.objects = objects
-        self.ids = [o.id for o in objects]
-        self.row = {i: k for k, i in enumerate(self.ids)}
-        self.categories = [o.category for o in objects]
-        rooms = [o.room for o in objects]
+        self.ids = list(map(_ID, objects))
+        self.row = dict(zip(self.ids, range(len(self.ids)), strict=True))
+        self.categories = list(map(_CATEGORY, objects))
+        rooms = list(map(_ROOM, objects))
         self.room_ids = sorted(set(rooms))
-        where = {r: k for k, r in enumerate(self.room_ids)}
-        self.room_of = np.array([where[r] for r in rooms], dtype=np.intp)
-        xy = np.array([o.position[:2] for o in objects], dtype=np.float64).reshape(-1, 2)
+        where = dict(zip(self.room_ids, range(len(self.room_ids)), strict=True))
+        self.room_of = np.array(list(map(where.__getitem__, rooms)), dtype=np.intp)
+        xy = _xy(list(map(_POSITION, objects)))
         self.x, self.y = xy[:, 0], xy[:, 1]
         self._scores: tuple[object, str, np.ndarray] | None = None
 
@@ -133,9 +135,11 @@ class ObjectTable:
         makes when a container is opened)."""
         if len(objects) != len(self.objects):
             return False
-        for a, b in zip(self.objects, objects, strict=True):
-            if a is not b and (a.id != b.id or a.category != b.category or a.room != b.room
-                               or a.position is not b.position):
+        mine = self.objects
+        for k in compress(range(len(objects)), map(is_not, mine, objects)):
+            a, b = mine[k], objects[k]
+            if a.id != b.id or a.category != b.category or a.room != b.room \
+                    or a.position is not b.position:
                 return False
         return True
 
@@ -173,6 +177,17 @@ class ObjectTable:
         return inside
 
 
+def _xy(positions: list[tuple]) -> np.ndarray:
+    """(n, 2) float64 array of the first two coordinates of each position."""
+    try:
+        xyz = np.array(positions, dtype=np.float64)
+    except ValueError:  # positions of different lengths
+        xyz = None
+    if xyz is None or xyz.ndim != 2 or xyz.shape[1] < 2:
+        return np.array([p[:2] for p in positions], dtype=np.float64).reshape(-1, 2)
+    return xyz[:, :2]
+
+
 _TABLE: list[ObjectTable] = []  # the table of the last objects tuple seen
 
 
@@ -199,7 +214,7 @@ class EpisodeCache:
     def __init__(self) -> None:
         self._rooms: tuple[tuple, object, str, UtilityParams, dict[str, float]] | None = None
         self._table: ObjectTable | None = None
-        self._objects: tuple[tuple, np.ndarray, list[float]] | None = None
+        self._objects: tuple[tuple, np.ndarray, dict[str, float]] | None = None
         self._nearby: tuple[np.ndarray, np.ndarray, list, float, list[list[float]]] | None = \
             None
 
@@ -226,16 +241,16 @@ class EpisodeCache:
 
     def object_utilities(self, table: ObjectTable, query: str, scorer: RelationScorer,
                          params: UtilityParams, rooms: dict[str, float]
-                         ) -> tuple[np.ndarray, list[float]]:
-        """:func:`object_utility_array` of ``table`` (and as a list), kept while the
+                         ) -> tuple[np.ndarray, dict[str, float]]:
+        """:func:`object_utility_array` of ``table`` (and by object id), kept while the
         table's rows and the room utilities are the same."""
         key = (table.x, scorer, query, params, rooms)
         hit = self._objects
-        if hit is not None and all(a is b for a, b in zip(hit[0], key, strict=True)):
+        if hit is not None and all(map(is_, hit[0], key)):
             return hit[1], hit[2]
         u = object_utility_array(table, query, scorer, params, rooms) if len(table.ids) \
             else np.zeros(0)
-        self._objects = (key, u, u.tolist())
+        self._objects = (key, u, dict(zip(table.ids, u.tolist(), strict=True)))
         return u, self._objects[2]
 
     def nearby_best(self, table: ObjectTable, u: np.ndarray,
@@ -284,42 +299,71 @@ def candidate_utilities(
 ) -> list[float]:
     """u_q(n) for each candidate, in order (module doc for each node type). ``cache``: an
     :class:`EpisodeCache` kept for the decisions of one episode."""
+    return column_utilities(graph, [c.node_id for c in candidates],
+                            [c.kind for c in candidates], [c.position for c in candidates],
+                            query, scorer, params, cache)
+
+
+def column_utilities(
+    graph: SceneGraph,
+    ids: Sequence[str],
+    kinds: Sequence[str],
+    positions: Sequence[tuple[float, float]],
+    query: str,
+    scorer: RelationScorer,
+    params: UtilityParams,
+    cache: EpisodeCache | None = None,
+) -> list[float]:
+    """:func:`candidate_utilities` of candidates given as columns (their ids, kinds and
+    positions: :class:`~sgtool.planning.candidates.CandidateColumns`)."""
     if cache is None:
         rooms = room_utilities(graph, query, scorer, params)
         table = object_table(graph)
         u = object_utility_array(table, query, scorer, params, rooms) if graph.objects \
             else np.zeros(0)
-        values = u.tolist()
+        by_id = dict(zip(table.ids, u.tolist(), strict=True))
     else:
         rooms, table = cache.rooms(graph, query, scorer, params), cache.table(graph)
-        u, values = cache.object_utilities(table, query, scorer, params, rooms)
-    out: list[float] = []
+        u, by_id = cache.object_utilities(table, query, scorer, params, rooms)
+    out: list = list(map(by_id.get, ids))  # objects' (the others are set below)
     frontiers: list[int] = []
-    for c in candidates:
-        kind = c.kind
-        if kind == "object":
-            out.append(values[table.row[c.node_id]])
-        elif kind == "room":
-            out.append(rooms.get(c.node_id, params.default_room))
+    for k in compress(range(len(kinds)), map(ne, kinds, repeat("object"))):
+        kind = kinds[k]
+        if kind == "room":
+            out[k] = rooms.get(ids[k], params.default_room)
         elif kind == "door":
-            out.append(params.default_room)
+            out[k] = params.default_room
         else:  # frontier: filled below
-            frontiers.append(len(out))
-            out.append(math.nan)
+            frontiers.append(k)
     if frontiers:
-        regions = {r.id: r for r in graph.regions}
-        positions = [candidates[k].position for k in frontiers]
-        nearby = _nearby_best(table, u, positions, params.frontier_radius) if cache is None \
-            else cache.nearby_best(table, u, positions, params.frontier_radius)
+        regions = _regions_by_id(graph.regions)
+        where = [positions[k] for k in frontiers]
+        nearby = _nearby_best(table, u, where, params.frontier_radius) if cache is None \
+            else cache.nearby_best(table, u, where, params.frontier_radius)
         for k, best in zip(frontiers, nearby, strict=True):
-            region = regions.get(candidates[k].node_id)
+            region = regions.get(ids[k])
             room_id = getattr(region, "room", None)
             if getattr(region, "frontier_type", None) == "leading out" or room_id is None:
                 fallback = params.default_frontier
             else:
                 fallback = rooms.get(room_id, params.default_room)
             out[k] = frontier_utility(best, fallback)
-    return [0.0 if math.isnan(u) else u for u in out]
+    if any(map(math.isnan, out)):
+        return [0.0 if math.isnan(v) else v for v in out]
+    return out
+
+
+_REGIONS: list[tuple[tuple, dict]] = []  # the last regions tuple's nodes by id
+
+
+def _regions_by_id(regions: tuple) -> dict:
+    """``{r.id: r}`` of a regions tuple, kept for the last one (an incremental graph passes
+    the same tuple until its regions change)."""
+    if _REGIONS and _REGIONS[0][0] is regions:
+        return _REGIONS[0][1]
+    out = {r.id: r for r in regions}
+    _REGIONS[:] = [(regions, out)]
+    return out
 
 
 def _nearby_best(table: ObjectTable, u: np.ndarray, positions: list[tuple[float, float]],
@@ -329,8 +373,8 @@ def _nearby_best(table: ObjectTable, u: np.ndarray, positions: list[tuple[float,
     if not len(u):
         return [[] for _ in positions]
     inside = table.within(positions, radius)
-    if np.isnan(u).any():
+    if math.isnan(np.add.reduce(u)):  # a NaN (or +inf and -inf: the same answer)
         values = u.tolist()
         return [[values[k] for k in np.flatnonzero(row).tolist()] for row in inside]
-    best = np.where(inside, u[None, :], -np.inf).max(axis=1).tolist()
+    best = np.maximum.reduce(np.where(inside, u[None, :], -np.inf), axis=1).tolist()
     return [[b] if b != -math.inf else [] for b in best]
