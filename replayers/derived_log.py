@@ -38,7 +38,7 @@ from typing import Any
 from sgtool.blas import single_blas_thread
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
-from sgtool.heap import frozen_heap
+from sgtool.heap import frozen_heap, small_pages
 from sgtool.log import schemas as S
 from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler
 from sgtool.log.chunk_copy import RawChunk, in_sequence
@@ -191,7 +191,7 @@ def replay(
         report = ReplayReport(src, dst, opts, semantic=reader.has(S.IDS))
         stream = SceneGraphStream(None, (room_classifier or make_classifier)(opts.classifier),
                                   builder_config(opts))
-        with frozen_heap():  # what start-up loaded stays out of full collections
+        with frozen_heap(), small_pages():  # no full-collection or huge-page stalls
             t0 = time.perf_counter()
             if dst is None:
                 _run(reader, stream, None, opts, report, on_refresh, progress)

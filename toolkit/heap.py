@@ -1,7 +1,7 @@
-"""Keep the garbage collector's full scans off the replay loop.
+"""Keep the garbage collector's full scans and huge-page faults off the replay loop.
 
-Replay starts by loading its models (the room classifier's weights, the sentence encoder's
-tables) and modules: hundreds of thousands of objects that live until the end. Python's
+Replay starts by loading its modules and models (the room classifier's weights, the
+sentence encoder's tables): objects that live until the end. Python's
 full (oldest-generation) collection walks every tracked object, so each of the two or
 three that a 30-room replay triggers paused one refresh for 26-28 ms, the slowest
 refreshes of the replay. :func:`frozen_heap` moves what exists at its start to the
@@ -10,13 +10,23 @@ full collection walks only the objects made since: 1.5-2.2 ms (measured on the 3
 benchmark log). At the end they go back to the oldest generation (:func:`gc.unfreeze`),
 so nothing stays exempt from collection after the block. Inside a block, or in a process
 that froze its heap itself, it does nothing (unfreezing would release their objects too).
+
+numpy asks the kernel for transparent huge pages for every large array (``madvise``); a
+fault on such an array can make the kernel compact memory to find a free 2 MB page, in
+kernel time charged to the thread. The voxel store's multi-megabyte arrays are allocated
+afresh when a door opens or the store merges its tail, and such refreshes of a 30-room
+replay took 37-50 ms of kernel time (57 ms against a 23 ms median). :func:`small_pages`
+turns numpy's request off inside the block (4 kB pages, more but cheap faults): the
+slowest 30-room refresh fell from 79-91 ms to 56-57 ms, the median unchanged (measured on
+the 30-room benchmark log).
 """
 
 from __future__ import annotations
 
 import contextlib
 import gc
-from collections.abc import Iterator
+import importlib
+from collections.abc import Callable, Iterator
 
 
 @contextlib.contextmanager
@@ -30,3 +40,29 @@ def frozen_heap() -> Iterator[None]:
         yield
     finally:
         gc.unfreeze()
+
+
+def _hugepage_setter() -> Callable[[bool], bool] | None:
+    """numpy's switch for ``madvise(MADV_HUGEPAGE)`` (private; None where it is missing)."""
+    for name in ("numpy._core.multiarray", "numpy.core.multiarray"):
+        try:
+            setter = getattr(importlib.import_module(name), "_set_madvise_hugepage", None)
+        except ImportError:
+            continue
+        if setter is not None:
+            return setter  # type: ignore[no-any-return]
+    return None
+
+
+@contextlib.contextmanager
+def small_pages() -> Iterator[None]:
+    """numpy arrays allocated inside the block do not ask for huge pages (module doc)."""
+    setter = _hugepage_setter()
+    if setter is None:
+        yield
+        return
+    before = setter(False)
+    try:
+        yield
+    finally:
+        setter(before)

@@ -47,3 +47,17 @@ def test_a_nested_block_leaves_the_outer_freeze_alone() -> None:
             assert gc.get_freeze_count() == outer
         assert gc.get_freeze_count() == outer  # the inner block did not unfreeze
     assert gc.get_freeze_count() == 0
+
+
+def test_small_pages_turns_numpy_huge_pages_off_inside_the_block_only() -> None:
+    from sgtool.heap import _hugepage_setter, small_pages
+
+    setter = _hugepage_setter()
+    assert setter is not None  # numpy 2.x has the switch
+    before = setter(True)
+    try:
+        with small_pages():
+            assert setter(False) is False  # off inside (setting it again returns that)
+        assert setter(True) is True  # restored on the way out
+    finally:
+        setter(before)
