@@ -26,6 +26,7 @@ from __future__ import annotations
 import contextlib
 import gc
 import importlib
+import threading
 from collections.abc import Callable, Iterator
 
 
@@ -35,6 +36,9 @@ def frozen_heap() -> Iterator[None]:
     if gc.get_freeze_count():  # frozen already (an enclosing block, or the host process)
         yield
         return
+    # garbage left by earlier work goes now: frozen, it would outlive the block (a worker
+    # running task after task would pile it up, frozen again before any full collection)
+    gc.collect()
     gc.freeze()
     try:
         yield
@@ -54,15 +58,27 @@ def _hugepage_setter() -> Callable[[bool], bool] | None:
     return None
 
 
+_PAGES_LOCK = threading.Lock()
+_pages_depth = [0, True]  # blocks inside small_pages now, numpy's setting before the first
+
+
 @contextlib.contextmanager
 def small_pages() -> Iterator[None]:
-    """numpy arrays allocated inside the block do not ask for huge pages (module doc)."""
+    """numpy arrays allocated inside the block do not ask for huge pages (module doc).
+    numpy's switch is one per process: the first block to enter turns it off, the last to
+    leave restores it (blocks in several threads may overlap in any order)."""
     setter = _hugepage_setter()
     if setter is None:
         yield
         return
-    before = setter(False)
+    with _PAGES_LOCK:
+        if _pages_depth[0] == 0:
+            _pages_depth[1] = setter(False)
+        _pages_depth[0] += 1
     try:
         yield
     finally:
-        setter(before)
+        with _PAGES_LOCK:
+            _pages_depth[0] -= 1
+            if _pages_depth[0] == 0:
+                setter(bool(_pages_depth[1]))

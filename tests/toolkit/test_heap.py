@@ -61,3 +61,34 @@ def test_small_pages_turns_numpy_huge_pages_off_inside_the_block_only() -> None:
         assert setter(True) is True  # restored on the way out
     finally:
         setter(before)
+
+
+def test_small_pages_blocks_overlapping_out_of_order_restore_the_setting() -> None:
+    from sgtool.heap import _hugepage_setter, small_pages
+
+    setter = _hugepage_setter()
+    assert setter is not None
+    before = setter(True)
+    try:
+        first, second = small_pages(), small_pages()
+        first.__enter__()
+        second.__enter__()
+        first.__exit__(None, None, None)  # the first leaves while the second is inside
+        assert setter(False) is False  # still off
+        second.__exit__(None, None, None)
+        assert setter(True) is True  # the last to leave restored it
+    finally:
+        setter(before)
+
+
+def test_garbage_from_before_the_block_does_not_outlive_it() -> None:
+    class Node:
+        other: object
+
+    for _ in range(3):  # task after task, as a bench worker runs them
+        a, b = Node(), Node()
+        a.other, b.other = b, a
+        dead = weakref.ref(a)
+        del a, b  # cyclic garbage, not yet collected
+        with frozen_heap():
+            assert dead() is None  # collected on entry, not frozen
