@@ -1,7 +1,8 @@
 """Doors in the scene graph: the grid cells that say "doorway" to the room segmentation,
 and each seen door's rooms.
 
-- :func:`door_cells`: the *passable* columns of each open (or state-unknown) door -- its
+- :func:`door_cells_of`: from the voxels of the open (or state-unknown) doors
+  (:func:`open_doors`), the *passable* columns of each door -- its
   opening under the lintel, not the swung panel, whose cells would cut the room it stands
   in -- else the panel's closed position
   (:func:`~sgtool.scenegraph.room_segmentation.opening_from_panel`), else all its columns.
@@ -21,7 +22,6 @@ from scipy.spatial import cKDTree
 from sgtool.mapping.bev import line_of_sight
 from sgtool.mapping.grid import OCCUPIED, OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph
-from sgtool.mapping.voxels import VoxelMap
 from sgtool.scenegraph.instances import InstanceInfo
 from sgtool.scenegraph.object_placement import SeenInstance
 from sgtool.scenegraph.room_segmentation import RoomTracker, opening_from_panel
@@ -37,13 +37,6 @@ class DoorObservation:
     node: int  # nearest visible node (-1: none)
 
 
-def door_cells(occ: OccupancyGrid, instances: Mapping[int, InstanceInfo], voxels: VoxelMap,
-               panel_memo: dict[bytes, object]) -> np.ndarray:
-    """Bool grid of the door evidence of the open (or state-unknown) doors (module doc);
-    ``panel_memo`` caches the openings found from swung panels across calls."""
-    return door_cells_of(occ, voxels.voxels_of(open_doors(instances)), panel_memo)
-
-
 def open_doors(instances: Mapping[int, InstanceInfo]) -> list[int]:
     """The door instances that are open or of unknown state."""
     return [iid for iid, v in instances.items() if v.kind == "door" and v.state != "closed"]
@@ -51,10 +44,11 @@ def open_doors(instances: Mapping[int, InstanceInfo]) -> list[int]:
 
 def door_cells_of(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
                   panel_memo: dict[bytes, object]) -> np.ndarray:
-    """:func:`door_cells` from the voxels (ijk) of each open door, in any order (e.g. from
-    :class:`sgtool.scenegraph.door_voxels.DoorVoxels`). The cells of every door are
-    looked up at once; only a door with no passable cell (a swung panel) is looked at on
-    its own."""
+    """Bool grid of the door evidence (module doc) from the voxels (ijk) of each open door,
+    in any order (e.g. from :class:`sgtool.scenegraph.door_voxels.DoorVoxels`);
+    ``panel_memo`` caches the openings found from swung panels across calls. The cells of
+    every door are looked up at once; only a door with no passable cell (a swung panel) is
+    looked at on its own."""
     cells = np.zeros(occ.shape, dtype=bool)
     parts = [ijk for _, ijk in sorted(door_voxels.items()) if len(ijk)]
     if not parts:
