@@ -15,7 +15,14 @@ first on ``PYTHONPATH``.
         replay /tmp/sgtool-bench-replay/house3_10rooms_320x240_fps4.mcap -o {out} --force
 
 ``{out}`` in the command becomes a per-tree output file; ``--frames N`` prints frames/s
-(N / median seconds) too.
+(N / median seconds) too. ``--md-figure ROW:COLUMN`` reads a figure the command writes
+into a markdown table (``{out}`` then names an output folder: its ``run.md``, else its
+``summary.md``) and prints its median per tree, e.g. the bench's own throughput column of
+each tree's default houses::
+
+    .venv/bin/python benchmarks/side_by_side.py --base /tmp/issue-time --rounds 5 \\
+        --md-figure scout:Episodes/s -- bench --planners scout --houses 10 --episodes 20 \\
+        --seeds 3 -w 2 -o {out}
 """
 
 from __future__ import annotations
@@ -46,6 +53,24 @@ def shadow_package(base: Path, folder: Path) -> Path:
     for sub in SUBPACKAGES:
         (pkg / sub).symlink_to(base / sub)
     return folder
+
+
+def md_figure(folder: Path, row: str, column: str) -> float:
+    """The number in ``column`` of the row whose first cell is ``row``, in the first
+    markdown table of ``folder``'s run.md (else summary.md) whose header has ``column``."""
+    md = next((f for f in (folder / "run.md", folder / "summary.md") if f.is_file()), None)
+    if md is None:
+        raise SystemExit(f"{folder}: no run.md or summary.md")
+    col = None
+    for line in md.read_text().splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if not line.startswith("|"):
+            col = None
+        elif col is None and column in cells:
+            col = cells.index(column)
+        elif col is not None and cells[0] == row:
+            return float(cells[col].split()[0])
+    raise SystemExit(f"{md}: no row {row!r} under a column {column!r}")
 
 
 def run_once(args: list[str], pythonpath: str | None) -> tuple[float, float, float]:
@@ -80,6 +105,9 @@ def main(argv: list[str] | None = None) -> int:
                     "e.g. a copy of the baseline with one engineer's files laid over it")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--frames", type=int, default=0, help="frames per run, for frames/s")
+    ap.add_argument("--md-figure", default=None, metavar="ROW:COLUMN",
+                    help="also read this figure from the markdown table the command writes "
+                    "into the {out} folder (module doc)")
     ap.add_argument("--no-compile", action="store_true",
                     help="do not byte-compile the trees first (with PYTHONDONTWRITEBYTECODE a "
                     "tree without __pycache__, e.g. a fresh `git archive`, compiles every "
@@ -100,16 +128,24 @@ def main(argv: list[str] | None = None) -> int:
             if a.tree is not None else None)
     trees = {"this tree": this, "baseline": pkg}
     got: dict[str, list[tuple[float, float, float]]] = {k: [] for k in trees}
+    figures: dict[str, list[float]] = {k: [] for k in trees}
     out_dir = Path(tempfile.mkdtemp(prefix="sgtool-side-"))
     for r in range(a.rounds):
         order = list(trees) if r % 2 == 0 else list(trees)[::-1]
         for name in order:
             args = [c.replace("{out}", str(out_dir / f"{name.replace(' ', '_')}.mcap"))
                     for c in cmd]
+            out = out_dir / f"{name.replace(' ', '_')}.mcap"
+            if out.is_dir():  # the last round's output folder
+                shutil.rmtree(out)
             got[name].append(run_once(args, trees[name]))
             w, c, m = got[name][-1]
-            print(f"round {r + 1} {name:<10} wall {w:6.2f} s  cpu {c:6.2f} s  rss {m:.0f} MiB",
-                  file=sys.stderr)
+            fig = ""
+            if a.md_figure:
+                figures[name].append(md_figure(out, *a.md_figure.rsplit(":", 1)))
+                fig = f"  {a.md_figure} {figures[name][-1]:g}"
+            print(f"round {r + 1} {name:<10} wall {w:6.2f} s  cpu {c:6.2f} s  "
+                  f"rss {m:.0f} MiB{fig}", file=sys.stderr)
     print(f"{'tree':<10}{'wall s':>9}{'cpu s':>9}{'peak RSS MiB':>14}"
           + (f"{'frames/s':>10}{'frames/cpu-s':>14}" if a.frames else ""))
     med = {}
@@ -120,6 +156,10 @@ def main(argv: list[str] | None = None) -> int:
         med[name] = (w, c)
         extra = f"{a.frames / w:>10.1f}{a.frames / c:>14.1f}" if a.frames else ""
         print(f"{name:<10}{w:>9.2f}{c:>9.2f}{m:>14.1f}{extra}")
+    if a.md_figure:
+        fb, ft = (statistics.median(figures[k]) for k in ("baseline", "this tree"))
+        print(f"{a.md_figure}: this tree {ft:g}, baseline {fb:g} (medians), "
+              f"this / baseline {ft / fb:.2f}x")
     bw, bc = med["baseline"]
     tw, tc = med["this tree"]
     print(f"speed-up (baseline / this tree): wall {bw / tw:.2f}x, cpu {bc / tc:.2f}x "
