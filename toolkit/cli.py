@@ -3,8 +3,9 @@
 Each subcommand lives in its own module ``sgtool.commands.<name>`` exposing ``command``
 (a click command or group), so ``sgtool --help`` stays fast and a missing optional piece
 never breaks the other commands. User errors (:class:`sgtool.errors.SgtoolError`) print as
-one line on stderr with exit code 2, and so does an :class:`OSError` that the user's
-environment causes (a read-only, missing or full destination: ``sgtool.files``). Ctrl-C
+one line on stderr with exit code 2; so do click's usage errors (a bad option value, a
+missing argument: :class:`UsageLine`) and an :class:`OSError` that the user's environment
+causes (a read-only, missing or full destination: ``sgtool.files``). Ctrl-C
 prints one line (what was kept, if anything) with exit code 130; once a command has
 finished, Ctrl-C no longer interrupts the exit (its outputs are complete). Anything else is
 a bug and keeps its traceback.
@@ -17,6 +18,7 @@ import importlib.util
 import logging
 import signal
 import sys
+from typing import Any
 
 import click
 
@@ -56,6 +58,28 @@ class UserError(click.ClickException):
         click.echo(f"sgtool: error: {redact_text(self.message)}", err=True)
 
 
+class UsageLine(click.ClickException):
+    """A click usage error (a bad option value, a missing argument, an unknown option or
+    command) as one line on stderr, exit code 2: ``sgtool import rgbd: error: Invalid value
+    for '--every': 'abc' is not a valid integer. (see --help)``, instead of click's usage,
+    hint and error lines."""
+
+    exit_code = 2
+
+    def show(self, file: object = None) -> None:
+        click.echo(self.message, err=True)
+
+
+def usage_line(e: click.UsageError) -> click.ClickException:
+    """``e`` as one line naming the command; a group called without a subcommand keeps
+    click's help text (that is not an error message)."""
+    if isinstance(e, click.exceptions.NoArgsIsHelpError):
+        return e
+    where = e.ctx.command_path if e.ctx is not None else "sgtool"
+    text = " ".join(e.format_message().split())
+    return UsageLine(f"{where}: error: {redact_text(text)} (see --help)")
+
+
 class Interrupted(click.ClickException):
     """Ctrl-C during a command: one line on stderr (what was kept), exit code 130."""
 
@@ -76,6 +100,8 @@ class LazyGroup(click.Group):
     def invoke(self, ctx: click.Context) -> object:
         try:
             return super().invoke(ctx)
+        except click.UsageError as e:  # a subcommand's arguments, or an unknown command
+            raise usage_line(e) from e
         except SgtoolError as e:
             raise UserError(str(e)) from e
         except OSError as e:
@@ -88,6 +114,13 @@ class LazyGroup(click.Group):
             if isinstance(e, Terminated):
                 out.exit_code = 143  # 128 + SIGTERM, as a shell reports a killed command
             raise out from e
+
+    def make_context(self, info_name: str | None, args: list[str],
+                     parent: click.Context | None = None, **extra: Any) -> click.Context:
+        try:
+            return super().make_context(info_name, args, parent, **extra)
+        except click.UsageError as e:  # the group's own options (``sgtool --bogus``)
+            raise usage_line(e) from e
 
     def _available(self) -> dict[str, tuple[str, str]]:
         out = {}

@@ -56,6 +56,7 @@ from sgtool.recorders.importers.bag_options import BagOptions, check_options
 from sgtool.recorders.importers.bag_poses import PoseSource, pose_source_of
 from sgtool.recorders.importers.bag_sync import PlannedFrame, plan_frames
 from sgtool.recorders.importers.bag_topics import check_flags, describe_bag, with_only_info
+from sgtool.recorders.importers.distortion import distortion_finding
 from sgtool.recorders.importers.images import depth_to_metres
 from sgtool.recorders.importers.odometry import (
     DriftReport,
@@ -137,6 +138,7 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
                 f"{src.describe if src else 'anywhere'}"
                 + (f" (tf links: {'; '.join(idx.tf.describe())})" if src and src.tree else "")
             )
+        _lens_distortion(idx, opts, k, findings, notes)
         drift = None
         odo: OdometryResult | None = None
         pose_source = src.describe if src else "none"
@@ -180,6 +182,20 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         warnings=tuple(findings.warnings),
         **(odometry_report_fields(odo) if odo is not None else {}),  # type: ignore[arg-type]
     )
+
+
+def _lens_distortion(idx: BagIndex, opts: BagOptions, k: CameraIntrinsics,
+                     findings: Findings, notes: list[str]) -> None:
+    """A note, or a warning when it moves pixels noticeably, for a CameraInfo with
+    distortion (sgtool does not undistort: :mod:`.distortion`)."""
+    found = distortion_finding(idx.distortion, str(opts.info), k)
+    if found is None:
+        return
+    text, serious = found
+    if serious:
+        findings.warning(text)
+    else:
+        notes.append(text)
 
 
 def _scale(raw: np.ndarray, scale: float, opts: BagOptions) -> float:

@@ -13,6 +13,7 @@ import numpy as np
 from sgtool.recorders.importers import bagfiles as B
 from sgtool.recorders.importers.bag_messages import (
     add_tf_message,
+    distortion_of_info,
     intrinsics_of_info,
     pose_of_message,
     stamp_ns,
@@ -38,6 +39,7 @@ class BagIndex:
     pose_samples: list[tuple[int, np.ndarray]] = field(default_factory=list)
     pose_frame: str = ""
     info: tuple[int, int, float, float, float, float] | None = None
+    distortion: tuple[str, tuple[float, ...]] | None = None  # of the first CameraInfo
     info_changes: int = 0
     samples: dict[int, tuple[np.ndarray, float]] = field(default_factory=dict)  # depth k ->
     zero_stamps: int = 0
@@ -75,7 +77,7 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
                 add_tf_message(idx.tf, msg, c.topic)
                 continue
             if c.topic == opts.pose:
-                t, parent, T = pose_of_message(msg, mt)  # noqa: N806
+                t, parent, T = pose_of_message(msg, mt, c.topic)  # noqa: N806
                 idx.pose_samples.append((t, T))
                 idx.pose_frame = idx.pose_frame or parent
                 continue
@@ -83,6 +85,7 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
                 k = intrinsics_of_info(msg)
                 if idx.info is None:
                     idx.info = k
+                    idx.distortion = distortion_of_info(msg)
                 elif k != idx.info:
                     idx.info_changes += 1
                 continue

@@ -1,36 +1,61 @@
 """Fields of ROS messages as sgtool needs them: header stamps, poses of pose-like and tf
-messages, and the intrinsics of ``CameraInfo`` (ROS 1 and ROS 2 spellings)."""
+messages, and the intrinsics and distortion of ``CameraInfo`` (ROS 1 and ROS 2 spellings).
+
+A pose whose translation is not finite, or whose quaternion is not finite or too short to be
+normalised, is refused in one line naming the topic, the message time and the field, as
+replay refuses such a transform in a log (``matrix_from_quat`` would turn a zero quaternion
+into the identity: a frame painted into the map with a made-up orientation)."""
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 
+from sgtool.errors import SgtoolError
 from sgtool.recorders.importers.poses import pose_from_tq
 from sgtool.recorders.importers.tftree import TfTree, frame_name
+
+MIN_QUATERNION_NORM = 1e-6  # shorter quaternions cannot be normalised (replay's limit too)
 
 
 def stamp_ns(header: Any) -> int:
     return int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)
 
 
-def transform_of(translation: Any, rotation: Any) -> np.ndarray:
-    return pose_from_tq(
-        (translation.x, translation.y, translation.z), (rotation.x, rotation.y, rotation.z,
-                                                        rotation.w)
-    )
+def transform_of(translation: Any, rotation: Any, where: str | None = None,
+                 fields: tuple[str, str] = ("translation", "rotation")) -> np.ndarray:
+    """parent_T_child of a ROS translation (or position) and quaternion. With ``where``
+    (the topic and time, for the message), a translation that is not finite or a quaternion
+    that cannot be normalised is a user error naming ``where`` and the field (``fields``:
+    the names of the translation and the rotation in the message)."""
+    t = (float(translation.x), float(translation.y), float(translation.z))
+    q = (float(rotation.x), float(rotation.y), float(rotation.z), float(rotation.w))
+    if where is not None:
+        if not all(math.isfinite(v) for v in t):
+            raise SgtoolError(f"{where}: field {fields[0]}: {t} is not finite")
+        if not (all(math.isfinite(v) for v in q) and math.hypot(*q) >= MIN_QUATERNION_NORM):
+            raise SgtoolError(f"{where}: field {fields[1]}: quaternion (x, y, z, w) = {q} "
+                              "cannot be normalised (not finite, or of length about 0)")
+    return pose_from_tq(t, q)
 
 
-def pose_of_message(msg: Any, msgtype: str) -> tuple[int, str, np.ndarray]:
-    """(stamp, parent frame, parent_T_child) of a pose-like message."""
+def pose_of_message(msg: Any, msgtype: str, topic: str) -> tuple[int, str, np.ndarray]:
+    """(stamp, parent frame, parent_T_child) of a pose-like message on ``topic``; a pose that
+    is not finite or has a zero quaternion is a user error (module doc)."""
+    t_ns = stamp_ns(msg.header)
+    where = f"{topic} message at {t_ns} ns (header stamp)"
     if msgtype.endswith("TransformStamped"):
-        T = transform_of(msg.transform.translation, msg.transform.rotation)  # noqa: N806
+        T = transform_of(msg.transform.translation, msg.transform.rotation, where,  # noqa: N806
+                         ("transform.translation", "transform.rotation"))
     elif msgtype.endswith("PoseStamped"):
-        T = transform_of(msg.pose.position, msg.pose.orientation)  # noqa: N806
+        T = transform_of(msg.pose.position, msg.pose.orientation, where,  # noqa: N806
+                         ("pose.position", "pose.orientation"))
     else:  # PoseWithCovarianceStamped, Odometry
-        T = transform_of(msg.pose.pose.position, msg.pose.pose.orientation)  # noqa: N806
-    return stamp_ns(msg.header), frame_name(msg.header.frame_id), T
+        T = transform_of(msg.pose.pose.position, msg.pose.pose.orientation, where,  # noqa: N806
+                         ("pose.pose.position", "pose.pose.orientation"))
+    return t_ns, frame_name(msg.header.frame_id), T
 
 
 def intrinsics_of_info(msg: Any) -> tuple[int, int, float, float, float, float]:
@@ -41,10 +66,27 @@ def intrinsics_of_info(msg: Any) -> tuple[int, int, float, float, float, float]:
     return int(msg.width), int(msg.height), float(k[0]), float(k[4]), float(k[2]), float(k[5])
 
 
-def add_tf_message(tree: TfTree, msg: Any, topic: str) -> None:
+def distortion_of_info(msg: Any) -> tuple[str, tuple[float, ...]]:
+    """(distortion model, coefficients D) of a ``CameraInfo``."""
+    d = getattr(msg, "d", None)
+    if d is None:
+        d = getattr(msg, "D", ())  # ROS 1 spelling
+    coeffs = tuple(float(v) for v in np.asarray(d, dtype=np.float64).ravel())
+    return str(getattr(msg, "distortion_model", "") or ""), coeffs
+
+
+def add_tf_message(tree: TfTree, msg: Any, topic: str, *, checked: bool = True) -> None:
     """Every transform of a ``tf2_msgs/TFMessage`` into ``tree`` (static when the topic is
-    ``/tf_static``)."""
+    ``/tf_static``). ``checked``: a transform that is not finite or has a zero quaternion is
+    a user error naming the topic, the stamp, the link and the field (module doc); a peek
+    for frame names only does not check."""
     static = topic.rstrip("/").endswith("tf_static")
-    for tr in msg.transforms:
-        tree.add(tr.header.frame_id, tr.child_frame_id, stamp_ns(tr.header),
-                 transform_of(tr.transform.translation, tr.transform.rotation), static=static)
+    for i, tr in enumerate(msg.transforms):
+        t_ns = stamp_ns(tr.header)
+        where = (f"{topic} message at {t_ns} ns (header stamp), transform "
+                 f"{frame_name(tr.header.frame_id)} -> {frame_name(tr.child_frame_id)}"
+                 if checked else None)
+        fields = (f"transforms[{i}].transform.translation", f"transforms[{i}].transform.rotation")
+        tree.add(tr.header.frame_id, tr.child_frame_id, t_ns,
+                 transform_of(tr.transform.translation, tr.transform.rotation, where, fields),
+                 static=static)

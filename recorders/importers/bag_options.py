@@ -1,5 +1,5 @@
 """The options of a bag import (the flags of ``sgtool import bag``) and the check of its
-numeric ones, before the bag is opened."""
+numeric ones and of flags that exclude each other, before the bag is opened."""
 
 from __future__ import annotations
 
@@ -50,7 +50,8 @@ class BagOptions:
 
 
 def check_options(opts: BagOptions) -> None:
-    """The numeric options, before the bag is opened (user errors naming the flag)."""
+    """The numeric options and flags that exclude each other, before the bag is opened
+    (user errors naming the flag)."""
     check_counts(opts.every, opts.limit)
     check_depth_scale(opts.depth_scale)
     check_height_band(opts.camera_height)
@@ -59,3 +60,8 @@ def check_options(opts: BagOptions) -> None:
     check_positive(opts.depth_max, "--depth-max", "metres")
     check_non_negative(opts.max_dt_ns / 1e9, "--max-dt", "seconds")
     check_non_negative(opts.tf_tolerance_ns / 1e9, "--tf-tolerance", "seconds")
+    if opts.pose is not None and opts.tf_frames is not None:
+        raise SgtoolError(
+            f"--tf-frames {':'.join(opts.tf_frames)} applies only to camera poses from the tf "
+            f"tree (without --pose); --pose {opts.pose} gives the camera poses directly: "
+            "give one of them")

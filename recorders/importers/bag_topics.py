@@ -130,7 +130,7 @@ def peek_tf(reader: Any, topics: list[B.TopicInfo], max_messages: int = 500) -> 
         for n, (c, _, raw) in enumerate(reader.messages(B.connections_for(reader, t.topic))):
             if n >= max_messages:
                 break
-            add_tf_message(tree, reader.deserialize(raw, c.msgtype), t.topic)
+            add_tf_message(tree, reader.deserialize(raw, c.msgtype), t.topic, checked=False)
     return tree.freeze()
 
 

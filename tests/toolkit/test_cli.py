@@ -1,0 +1,54 @@
+"""The ``sgtool`` command's usage errors: a bad option value, a missing argument, an output
+path that is a folder, an unknown option or command are ONE line on stderr naming the
+command (not click's usage / hint / error lines), with exit code 2, through the console
+script's ``main`` and through click's own standalone mode; --help is unchanged."""
+
+from __future__ import annotations
+
+import pytest
+from click.testing import CliRunner
+
+from sgtool.cli import cli, main
+
+CASES = [
+    (["import", "rgbd", "{d}", "-o", "{d}/x.mcap", "--every", "abc"],
+     "sgtool import rgbd: error: Invalid value for '--every': 'abc' is not a valid integer. "
+     "(see --help)"),
+    (["import", "rgbd"], "sgtool import rgbd: error: Missing argument 'FOLDER'. (see --help)"),
+    (["import", "rgbd", "{d}", "-o", "{d}"],
+     "sgtool import rgbd: error: Invalid value for '-o' / '--output': File '{d}' is a "
+     "directory. (see --help)"),
+    (["import", "rgbd", "{d}", "--no-such-flag"],
+     "sgtool import rgbd: error: No such option '--no-such-flag'. (see --help)"),
+    (["no-such-command"], "sgtool: error: No such command 'no-such-command'. (see --help)"),
+    (["--no-such-flag"], "sgtool: error: No such option '--no-such-flag'. (see --help)"),
+    (["import", "no-such-kind"], "sgtool import: error: No such command 'no-such-kind'. "
+     "(see --help)"),
+]
+
+
+@pytest.mark.parametrize("args, line", CASES)
+def test_usage_errors_are_one_line_through_main(tmp_path, capsys, args, line):
+    d = str(tmp_path)
+    with pytest.raises(SystemExit) as e:
+        main([a.format(d=d) for a in args])
+    assert e.value.code == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err == line.format(d=d) + "\n"
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("args, line", CASES[:3])
+def test_usage_errors_are_one_line_in_standalone_mode(tmp_path, args, line):
+    d = str(tmp_path)
+    r = CliRunner().invoke(cli, [a.format(d=d) for a in args], prog_name="sgtool")
+    assert r.exit_code == 2 and r.output == line.format(d=d) + "\n"
+
+
+def test_help_is_unchanged(capsys):
+    main(["import", "rgbd", "--help"])  # exit code 0: main returns
+    out = capsys.readouterr().out
+    assert out.startswith("Usage: sgtool import rgbd [OPTIONS] FOLDER\n") and "--every" in out
+    r = CliRunner().invoke(cli, ["import"], prog_name="sgtool")  # a group alone: its help
+    assert r.output.startswith("Usage: sgtool import [OPTIONS] COMMAND [ARGS]...")
+    assert "Commands:" in r.output and "error" not in r.output
