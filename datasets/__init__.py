@@ -33,7 +33,7 @@ def demo_house() -> HouseSpec:
     objects and start yaws are an older draw of the generator, kept on purpose. See
     :mod:`sgtool.datasets.demo` (``python -m sgtool.datasets.demo --check`` checks both).
     """
-    from sgtool.house.io import load_house
+    from sgtool.house.io import load_house_text
 
     text = resources.files("sgtool.datasets").joinpath("data", DEMO_HOUSE).read_text("utf-8")
-    return load_house(text)
+    return load_house_text(text)

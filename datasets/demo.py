@@ -30,7 +30,7 @@ from pathlib import Path
 
 from sgtool.datasets.generator import generate_house
 from sgtool.errors import SpecError
-from sgtool.house.io import load_house, save_house
+from sgtool.house.io import load_house_text, save_house
 from sgtool.house.spec import HouseSpec
 
 DEMO_SEED = 1
@@ -63,7 +63,7 @@ def check_demo(path: Path = DEMO_PATH) -> tuple[bool, str]:
         return False, f"demo house is missing: {path}"
     text = path.read_text(encoding="utf-8")
     try:
-        shipped = load_house(text)
+        shipped = load_house_text(text)
     except SpecError as e:
         return False, f"demo house is not a valid house spec: {e}"
     if shipped.to_json() != text:

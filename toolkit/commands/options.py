@@ -83,7 +83,7 @@ def house_from_options(path: str | None, seed: int | None, rooms: str) -> tuple[
     if path is not None:
         from sgtool.house.io import load_house
 
-        return load_house(path), Path(path).stem
+        return load_house(Path(path)), Path(path).stem  # a path, even one starting with "{"
     if seed is not None:
         from sgtool.datasets.generator import generate_house
 

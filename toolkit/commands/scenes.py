@@ -91,7 +91,7 @@ def show_cmd(house: str, output: str | None, dpi: int, no_objects: bool, force: 
     from sgtool.datasets.draw import draw_house
     from sgtool.house.io import load_house
 
-    spec = load_house(house)
+    spec = load_house(Path(house))  # a path, even one that starts with "{"
     out = check_output(output or Path(house).with_suffix(".png"), force=force,
                        suffixes=(".png", ".svg", ".pdf"), what="image")
     draw_house(spec, out, dpi=dpi, show_objects=not no_objects)
@@ -160,11 +160,13 @@ def episodes_cmd(house: str, count: int | None, seed: int, reach: float, preset:
     the start to the nearest target on the house's occupancy grid (closed doors
     passable). With --preset symsearch, a third of the episodes ask for furniture (SymSearch's
     non-interactive targets); COUNT defaults to the number of small-object categories."""
+    from pathlib import Path
+
     from sgtool.datasets.episode_mix import symsearch_episodes
     from sgtool.datasets.episodes import list_episodes
     from sgtool.house.io import load_house
 
-    spec = load_house(house)
+    spec = load_house(Path(house))  # a path, even one that starts with "{"
     if preset == "symsearch":
         n = count or len({o.category for o in spec.objects}) or len(spec.furniture)
         eps = symsearch_episodes(spec, n, seed=seed, reach=reach)

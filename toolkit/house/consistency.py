@@ -3,19 +3,43 @@ the house fits :attr:`SpecLimits.extent`, rooms do not overlap (beyond
 :attr:`SpecLimits.room_overlap`), walls lie at the rooms, every door and passage lies on
 the border of both its rooms (within :attr:`SpecLimits.opening_offset`), furniture stands
 in its room (centre inside, corners within :attr:`SpecLimits.furniture_outside`), start
-poses are in their rooms. Messages name the field (``doors[0].center: ...``).
+poses are in their rooms and on free floor (outside every piece of furniture's footprint).
+Messages name the field (``doors[0].center: ...``).
 
-Rooms are compared pairwise (at most ``limits.rooms``, bounding boxes first); everything
-else is linear in the number of entries times the polygon sizes.
+Doors and walls agree, so the simulator (walls) and the symbolic benchmark (the room
+graph of doors and passages) see the same house: no wall covers a door's or a passage's
+opening (the spec's rule "walls have gaps where doors and passages are"; the ends of an
+opening may touch a wall within :data:`_OPENING_EDGE`), and when a house has walls, a gap
+of :data:`_MIN_GAP` or more in the walls along the border of two rooms needs a door or a
+passage joining them. A house without walls is not checked for gaps (walls are
+optional), and a room walled off completely is consistent (both see it unreachable).
+
+Rooms are compared pairwise (at most ``limits.rooms``, bounding boxes first); openings
+against walls and starts against furniture with a bounding-box filter first (numpy);
+everything else is linear in the number of entries times the polygon sizes.
 """
 
 from __future__ import annotations
 
+import numpy as np
+
 from sgtool.errors import SpecError
-from sgtool.house.geometry import distance_to_polygon, overlap_area
+from sgtool.house.geometry import (
+    distance_to_polygon,
+    length_in_strip,
+    longest_uncovered,
+    opening_segment,
+    overlap_area,
+    point_in_polygon,
+    shared_borders,
+)
 from sgtool.house.spec import HouseSpec, SpecLimits
 
 _WALL_MARGIN = 1.0  # m a wall end may lie outside the rooms' bounding box
+_OPENING_EDGE = 0.05  # m at each end of an opening a wall may reach into (rounded corners)
+_COVERED = 1e-6  # m of an opening inside a wall's body that count as covered
+_BORDER_TOL = 0.05  # m two room edges may lie apart and still be one border
+_MIN_GAP = 0.3  # m of a border without a wall that connect two rooms (the robot is 0.4 m wide)
 
 
 def check_consistency(spec: HouseSpec, limits: SpecLimits) -> None:
@@ -54,6 +78,81 @@ def check_consistency(spec: HouseSpec, limits: SpecLimits) -> None:
     for i, s in enumerate(spec.starts):
         if not by_room[s.room].contains(s.x, s.y):
             raise SpecError(f"starts[{i}]: ({s.x}, {s.y}) is outside its room {s.room}")
+    _starts_on_free_floor(spec)
+    _openings_clear(spec)
+    _gaps_have_openings(spec)
+
+
+def _boxes(boxes: list[tuple[float, float, float, float]]) -> np.ndarray:
+    return np.asarray(boxes, dtype=np.float64).reshape(-1, 4)
+
+
+def _starts_on_free_floor(spec: HouseSpec) -> None:
+    """No start pose inside a piece of furniture's footprint (the robot could not move)."""
+    if not spec.starts or not spec.furniture:
+        return
+    feet = [f.footprint() for f in spec.furniture]
+    boxes = _boxes([(min(p[0] for p in c), min(p[1] for p in c),
+                     max(p[0] for p in c), max(p[1] for p in c)) for c in feet])
+    for i, s in enumerate(spec.starts):
+        near = np.flatnonzero((boxes[:, 0] <= s.x) & (s.x <= boxes[:, 2])
+                              & (boxes[:, 1] <= s.y) & (s.y <= boxes[:, 3]))
+        for k in near:
+            if point_in_polygon(s.x, s.y, feet[k]):
+                f = spec.furniture[k]
+                raise SpecError(f"starts[{i}]: ({s.x}, {s.y}) is inside furniture[{k}] "
+                                f"({f.id}, {f.category}); a start pose must be on free floor")
+
+
+def _openings_clear(spec: HouseSpec) -> None:
+    """No wall body covers a door's or a passage's opening (but its ends)."""
+    if not spec.walls:
+        return
+    walls = spec.walls
+    boxes = _boxes([(min(w.a[0], w.b[0]) - w.thickness / 2, min(w.a[1], w.b[1]) - w.thickness / 2,
+                     max(w.a[0], w.b[0]) + w.thickness / 2, max(w.a[1], w.b[1]) + w.thickness / 2)
+                    for w in walls])
+    for key, openings in (("doors", spec.doors), ("passages", spec.passages)):
+        for i, d in enumerate(openings):
+            p, q = opening_segment(d.center, max(d.width - 2 * _OPENING_EDGE, d.width / 2), d.yaw)
+            x0, x1 = min(p[0], q[0]), max(p[0], q[0])
+            y0, y1 = min(p[1], q[1]), max(p[1], q[1])
+            near = np.flatnonzero((boxes[:, 0] <= x1) & (x0 <= boxes[:, 2])
+                                  & (boxes[:, 1] <= y1) & (y0 <= boxes[:, 3]))
+            for k in near:
+                w = walls[k]
+                if length_in_strip(p, q, w.a, w.b, w.thickness / 2) > _COVERED:
+                    raise SpecError(f"{key}[{i}]: its opening ({d.id}) is covered by "
+                                    f"walls[{k}] ({w.id}); walls have gaps where doors and "
+                                    "passages are")
+
+
+def _gaps_have_openings(spec: HouseSpec) -> None:
+    """A gap in the walls between two rooms is a door or a passage of the spec."""
+    if not spec.walls:
+        return
+    rooms, graph = spec.rooms, spec.room_graph()
+    walls = [(w.a, w.b, w.thickness / 2) for w in spec.walls]
+    boxes = _boxes([(min(a[0], b[0]) - h, min(a[1], b[1]) - h, max(a[0], b[0]) + h,
+                     max(a[1], b[1]) + h) for a, b, h in walls])
+    near_by = [r.bounds for r in rooms]
+    t = _BORDER_TOL
+    for j in range(len(rooms)):
+        for i in range(j):
+            a, b = near_by[i], near_by[j]
+            if a[0] > b[2] + t or b[0] > a[2] + t or a[1] > b[3] + t or b[1] > a[3] + t \
+                    or rooms[i].id in graph[rooms[j].id]:
+                continue
+            for p, q in shared_borders(rooms[j].polygon, rooms[i].polygon, t):
+                x0, x1 = min(p[0], q[0]) - t, max(p[0], q[0]) + t
+                y0, y1 = min(p[1], q[1]) - t, max(p[1], q[1]) + t
+                near = np.flatnonzero((boxes[:, 0] <= x1) & (x0 <= boxes[:, 2])
+                                      & (boxes[:, 1] <= y1) & (y0 <= boxes[:, 3]))
+                gap, (gx, gy) = longest_uncovered(p, q, [walls[k] for k in near], t)
+                if gap >= _MIN_GAP:
+                    raise SpecError(f"rooms[{j}]: the walls between {rooms[j].id} and "
+                                    f"{rooms[i].id} have a {gap:.2f} m gap at ({gx:.2f}, "
+                                    f"{gy:.2f}) but no door or passage joins them")
 
 
 def _rooms_apart(spec: HouseSpec, tolerance: float) -> None:

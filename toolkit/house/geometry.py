@@ -7,6 +7,8 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+import numpy as np
+
 Point = tuple[float, float]
 Vec3 = tuple[float, float, float]
 
@@ -174,3 +176,124 @@ def _bounds(poly: Sequence[Point]) -> tuple[float, float, float, float]:
 
 def _boxes_meet(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> bool:
     return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+def self_crossing(poly: Sequence[Point], eps: float = 1e-9) -> tuple[int, int, bool] | None:
+    """Two edges of ``poly`` that make it not simple, as (i, j, proper) with edge k from
+    point k to point k + 1, or None for a simple polygon. ``proper``: edges that are not
+    neighbours meet (cross or touch); else two neighbouring edges fold back over each
+    other. Repeated consecutive points are skipped; O(n^2) in the points."""
+    keep = [k for k in range(len(poly)) if poly[k] != poly[(k + 1) % len(poly)]]
+    n = len(keep)
+    if n < 3:
+        return None
+    pts = [poly[k] for k in keep]
+    edges = [(pts[k], pts[(k + 1) % n]) for k in range(n)]
+    folded = None
+    for i in range(n):
+        for j in range(i + 1, n):
+            (a, b), (c, d) = edges[i], edges[j]
+            if j == i + 1 or (i == 0 and j == n - 1):
+                # neighbours share one point: they fold back when collinear and opposite
+                o, p, q = (b, a, d) if j == i + 1 else (a, b, c)
+                if folded is None and \
+                        abs(_cross(o, p, q)) <= eps * (1 + math.dist(o, p) * math.dist(o, q)) \
+                        and (p[0] - o[0]) * (q[0] - o[0]) + (p[1] - o[1]) * (q[1] - o[1]) > 0:
+                    folded = (keep[i], keep[j], False)
+            elif _segments_meet(a, b, c, d, eps):
+                return (keep[i], keep[j], True)
+    return folded
+
+
+def _segments_meet(a: Point, b: Point, c: Point, d: Point, eps: float) -> bool:
+    """Whether the closed segments a-b and c-d share a point (within ``eps``)."""
+    if max(a[0], b[0]) < min(c[0], d[0]) - eps or max(c[0], d[0]) < min(a[0], b[0]) - eps \
+            or max(a[1], b[1]) < min(c[1], d[1]) - eps \
+            or max(c[1], d[1]) < min(a[1], b[1]) - eps:
+        return False
+    d1, d2 = _cross(a, b, c), _cross(a, b, d)
+    d3, d4 = _cross(c, d, a), _cross(c, d, b)
+    if ((d1 > eps and d2 < -eps) or (d1 < -eps and d2 > eps)) and \
+            ((d3 > eps and d4 < -eps) or (d3 < -eps and d4 > eps)):
+        return True
+    return segment_distance(c[0], c[1], a, b) <= eps or segment_distance(d[0], d[1], a, b) <= eps \
+        or segment_distance(a[0], a[1], c, d) <= eps or segment_distance(b[0], b[1], c, d) <= eps
+
+
+def length_in_strip(p: Point, q: Point, a: Point, b: Point, half_width: float) -> float:
+    """Length of the part of segment p-q inside the rectangle around segment a-b of
+    half-width ``half_width`` (a wall's body: no caps beyond a and b); Liang-Barsky."""
+    length = math.dist(a, b)
+    if length == 0:
+        return 0.0
+    ux, uy = (b[0] - a[0]) / length, (b[1] - a[1]) / length
+
+    def local(r: Point) -> Point:
+        dx, dy = r[0] - a[0], r[1] - a[1]
+        return (dx * ux + dy * uy, -dx * uy + dy * ux)
+
+    (u0, v0), (u1, v1) = local(p), local(q)
+    t0, t1 = 0.0, 1.0
+    for d, lo, hi, start in ((u1 - u0, 0.0, length, u0), (v1 - v0, -half_width, half_width, v0)):
+        if d == 0:
+            if not lo <= start <= hi:
+                return 0.0
+            continue
+        ta, tb = (lo - start) / d, (hi - start) / d
+        t0, t1 = max(t0, min(ta, tb)), min(t1, max(ta, tb))
+        if t0 >= t1:
+            return 0.0
+    return (t1 - t0) * math.dist(p, q)
+
+
+def shared_borders(a: Sequence[Point], b: Sequence[Point],
+                   tol: float) -> list[tuple[Point, Point]]:
+    """The pieces of ``a``'s edges that lie along an edge of ``b`` (parallel, within
+    ``tol`` of it, overlapping by more than ``tol``): the border two rooms share. All edge
+    pairs at once (numpy), so 64-point rooms cost little."""
+    pa, pb = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    lengths = np.hypot(*(np.roll(pa, -1, axis=0) - pa).T)
+    u = (np.roll(pa, -1, axis=0) - pa) / np.maximum(lengths, 1e-300)[:, None]
+
+    def along_across(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        d = pts[None, :, :] - pa[:, None, :]  # (edge of a, point of b)
+        return (d[..., 0] * u[:, None, 0] + d[..., 1] * u[:, None, 1],
+                np.abs(-d[..., 0] * u[:, None, 1] + d[..., 1] * u[:, None, 0]))
+
+    tc, oc = along_across(pb)
+    td, od = along_across(np.roll(pb, -1, axis=0))
+    t0 = np.maximum(0.0, np.minimum(tc, td))
+    t1 = np.minimum(lengths[:, None], np.maximum(tc, td))
+    hit = (oc <= tol) & (od <= tol) & (lengths > tol)[:, None] & (t1 - t0 > tol)
+    out = []
+    for i, j in np.argwhere(hit):
+        (px, py), (ux, uy) = pa[i], u[i]
+        out.append(((float(px + t0[i, j] * ux), float(py + t0[i, j] * uy)),
+                    (float(px + t1[i, j] * ux), float(py + t1[i, j] * uy))))
+    return out
+
+
+def longest_uncovered(p: Point, q: Point, covers: Sequence[tuple[Point, Point, float]],
+                      tol: float) -> tuple[float, Point]:
+    """(length, midpoint) of the longest piece of segment p-q that none of ``covers``
+    (segments a-b with a half-width: walls) lies along; a cover counts when both its ends
+    are within its half-width plus ``tol`` of the line of p-q."""
+    length = math.dist(p, q)
+    ux, uy = (q[0] - p[0]) / length, (q[1] - p[1]) / length
+    spans = []
+    for a, b, half in covers:
+        off = max(abs(-(a[0] - p[0]) * uy + (a[1] - p[1]) * ux),
+                  abs(-(b[0] - p[0]) * uy + (b[1] - p[1]) * ux))
+        if off <= half + tol:
+            ta = (a[0] - p[0]) * ux + (a[1] - p[1]) * uy
+            tb = (b[0] - p[0]) * ux + (b[1] - p[1]) * uy
+            spans.append((min(ta, tb), max(ta, tb)))
+    best, at, t = 0.0, 0.0, 0.0
+    for s0, s1 in sorted(spans) + [(length, length)]:
+        s0 = min(s0, length)
+        if s0 - t > best:
+            best, at = s0 - t, (t + s0) / 2
+        t = max(t, s1)
+        if t >= length:
+            break
+    return best, (p[0] + at * ux, p[1] + at * uy)

@@ -1,9 +1,9 @@
-"""Reading and writing house specs: ``load_house`` (a path, JSON text or a parsed dict,
-validated by :func:`sgtool.house.parse.parse_house`; a version-1 file loads as the
-equivalent version-2 spec) and ``save_house`` (canonical JSON of the current version,
-written atomically). A file over :data:`MAX_FILE_BYTES` is refused unread, and JSON
-nested too deeply for the parser or holding an integer too long to convert is a one-line
-:class:`SpecError`, not a traceback."""
+"""Reading and writing house specs: ``load_house`` (a path or a parsed dict, validated by
+:func:`sgtool.house.parse.parse_house`; a version-1 file loads as the equivalent
+version-2 spec), ``load_house_text`` (JSON text) and ``save_house`` (canonical JSON of the
+current version, written atomically). A file over :data:`MAX_FILE_BYTES` is refused
+unread; JSON nested too deeply for the parser, holding an integer too long to convert or
+a key twice in one object is a one-line :class:`SpecError`, not a traceback."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from typing import Any
 
 from sgtool.errors import SpecError
 from sgtool.files import atomic_write
-from sgtool.house.parse import parse_house
+from sgtool.house.parse import json_object_pairs, parse_house
 from sgtool.house.spec import LIMITS, HouseSpec, SpecLimits
 
 MAX_FILE_BYTES = 64 * 1024 * 1024  # a house at every limit of SpecLimits is far smaller
@@ -28,42 +28,52 @@ def save_house(spec: HouseSpec, path: str | os.PathLike[str]) -> Path:
 
 def load_house(source: str | os.PathLike[str] | Mapping[str, Any],
                limits: SpecLimits = LIMITS) -> HouseSpec:
-    """Read and validate a house spec from a path, a JSON string or an already parsed dict.
+    """Read and validate a house spec from a file path or an already parsed dict.
 
-    Raises :class:`sgtool.errors.SpecError` whose message starts with the offending field
-    (``furniture[3].size: every side must be > 0``).
+    A ``Path`` is always a path (``{h1}.json`` loads). For compatibility a ``str`` that
+    starts with ``{`` and names no file is read as JSON text; new code passes text to
+    :func:`load_house_text`. Raises :class:`sgtool.errors.SpecError` whose message starts
+    with the file and the offending field (``h.json: furniture[3].size: every side must
+    be > 0``).
     """
     if isinstance(source, Mapping):
-        data: Any = source
-        where = "house spec"
-    else:
-        text_or_path = os.fspath(source)
-        if isinstance(source, str) and text_or_path.lstrip().startswith("{"):
-            raw, where = text_or_path, "house spec"
-        else:
-            p = Path(text_or_path)
-            where = str(p)
-            try:
-                if p.is_file() and p.stat().st_size > MAX_FILE_BYTES:
-                    raise SpecError(f"{p}: {p.stat().st_size} bytes, more than the limit of "
-                                    f"{MAX_FILE_BYTES} for a house spec")
-                raw = p.read_text(encoding="utf-8")
-            except FileNotFoundError:
-                raise SpecError(f"{p}: no such house spec file") from None
-            except (OSError, UnicodeDecodeError) as e:
-                raise SpecError(f"{p}: cannot read house spec: {e}") from None
-        try:
-            data = json.loads(raw)
-        except json.JSONDecodeError as e:
-            raise SpecError(f"{where}: not valid JSON ({e.msg} at line {e.lineno})") from None
-        except RecursionError:
-            raise SpecError(f"{where}: JSON nested too deeply to read") from None
-        except ValueError as e:  # e.g. an integer of more than 4300 digits
-            raise SpecError(f"{where}: not readable JSON ({str(e)[:80]})") from None
+        return parse_house(source, limits)
+    if isinstance(source, str) and source.lstrip().startswith("{") \
+            and not _is_file(source):
+        return load_house_text(source, limits)
+    p = Path(os.fspath(source))
     try:
-        return parse_house(data, limits)
+        if p.is_file() and p.stat().st_size > MAX_FILE_BYTES:
+            raise SpecError(f"{p}: {p.stat().st_size} bytes, more than the limit of "
+                            f"{MAX_FILE_BYTES} for a house spec")
+        raw = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise SpecError(f"{p}: no such house spec file") from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise SpecError(f"{p}: cannot read house spec: {e}") from None
+    try:
+        return load_house_text(raw, limits)
     except SpecError as e:
-        if where != "house spec":
-            raise SpecError(f"{where}: {e}") from None
-        raise
+        raise SpecError(f"{p}: {e}") from None
+
+
+def load_house_text(text: str, limits: SpecLimits = LIMITS) -> HouseSpec:
+    """Validate a house spec given as JSON text (a key given twice in one object is
+    refused, naming the field); :class:`SpecError` as :func:`load_house`."""
+    try:
+        data = json.loads(text, object_pairs_hook=json_object_pairs)
+    except json.JSONDecodeError as e:
+        raise SpecError(f"not valid JSON ({e.msg} at line {e.lineno})") from None
+    except RecursionError:
+        raise SpecError("JSON nested too deeply to read") from None
+    except ValueError as e:  # e.g. an integer of more than 4300 digits
+        raise SpecError(f"not readable JSON ({str(e)[:80]})") from None
+    return parse_house(data, limits)
+
+
+def _is_file(name: str) -> bool:
+    try:
+        return len(name) < 4096 and "\0" not in name and Path(name).is_file()
+    except (OSError, ValueError):
+        return False
 

@@ -18,25 +18,26 @@ from typing import Any
 from sgtool.errors import SpecError
 from sgtool.house.spec import SPEC_VERSION
 
-SUPPORTED_MAJORS = ("1", "2")
+KNOWN_VERSIONS = ("1.0", SPEC_VERSION)  # every version a house spec was ever written with
 _V2_FURNITURE_FIELDS = ("levels",)
 _V2_OBJECT_FIELDS = ("affordances", "state")
 
 
 def upgrade(d: Any) -> Mapping[str, Any]:
     """The document ``d`` as a document of the current version (``d`` itself when it is
-    one); raises :class:`SpecError` for an unknown version or a version-1 document that
-    uses version-2 fields."""
+    one); raises :class:`SpecError` for a version that is not exactly one of
+    :data:`KNOWN_VERSIONS` (``"2"``, ``"2.7"``, ``"2.banana"``, ``2.0``) or a version-1
+    document that uses version-2 fields."""
     if not isinstance(d, Mapping):
         raise SpecError("top level: expected a JSON object")
     version = d.get("version")
     if version is None:
         raise SpecError("version: missing")
-    major = version.split(".")[0] if isinstance(version, str) else None
-    if major not in SUPPORTED_MAJORS:
+    if not isinstance(version, str) or version not in KNOWN_VERSIONS:
         shown = repr(version) if len(repr(version)) <= 40 else repr(version)[:37] + "..."
         raise SpecError(f"version: {shown} is not supported (this sgtool reads "
-                        f"{' and '.join(m + '.x' for m in SUPPORTED_MAJORS)})")
+                        f"'MAJOR.MINOR' versions {' and '.join(KNOWN_VERSIONS)})")
+    major = version.split(".")[0]
     if major == SPEC_VERSION.split(".")[0]:
         return d
     _check_v1(d)

@@ -5,7 +5,10 @@ each entry, within :class:`~sgtool.house.spec.SpecLimits`), in
 :mod:`sgtool.house.nesting` (parents, depth, placement of small objects) and in
 :mod:`sgtool.house.consistency` (rooms, doors and furniture against each other); a
 failure raises :class:`sgtool.errors.SpecError` whose message starts with the offending
-field (``furniture[3].size: every side must be > 0``). Every list is measured against its
+field (``furniture[3].size: every side must be > 0``). Every JSON object may hold only
+the keys its entry knows, each once (a typo is named with the nearest known key: a
+misspelt optional key would otherwise fall back to its default silently); ids and names
+follow :mod:`sgtool.house.names`. Every list is measured against its
 limit before its entries are read and every number against ``limits.coordinate`` before
 it is converted, so a hostile file is refused in time linear in its size. Numbers are
 rounded to the canonical precision, so parsing the canonical text of a spec gives back the
@@ -14,6 +17,7 @@ same spec.
 
 from __future__ import annotations
 
+import difflib
 import math
 from collections.abc import Callable, Iterable, Mapping
 from typing import Any
@@ -21,8 +25,9 @@ from typing import Any
 from sgtool.canonical import canonical_float
 from sgtool.errors import SpecError
 from sgtool.house.consistency import check_consistency
-from sgtool.house.geometry import signed_area
+from sgtool.house.geometry import self_crossing, signed_area
 from sgtool.house.migrate import upgrade
+from sgtool.house.names import id_problem, name_problem
 from sgtool.house.nesting import check_nesting
 from sgtool.house.spec import (
     AFFORDANCES,
@@ -47,7 +52,10 @@ def parse_house(d: Any, limits: SpecLimits = LIMITS) -> HouseSpec:
     into a :class:`HouseSpec` of the current version (a version-1 document is migrated);
     raises :class:`SpecError` naming the offending field. Time is linear in the number
     of entries (rooms are compared pairwise, at most ``limits.rooms`` of them)."""
-    d = upgrade(d)
+    doc, d = d, upgrade(d)
+    _known_keys("top level", doc, _TOP_KEYS)  # the document as read (its repeated keys)
+    if "id" in d:
+        _house_id(d["id"])
     seed = d.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 63:
         raise SpecError("seed: expected an integer in [0, 2^63)")
@@ -70,6 +78,73 @@ def parse_house(d: Any, limits: SpecLimits = LIMITS) -> HouseSpec:
     check_consistency(spec, limits)
     check_nesting(furniture, objects, limits.depth)
     return spec
+
+
+_TOP_KEYS = frozenset({"version", "id", "seed", "split", "rooms", "walls", "doors", "passages",
+                       "furniture", "objects", "starts"})
+_ROOM_KEYS = frozenset({"id", "category", "polygon", "open_plan_group"})
+_WALL_KEYS = frozenset({"id", "a", "b", "thickness", "height"})
+_PASSAGE_KEYS = frozenset({"id", "center", "width", "yaw", "rooms"})
+_DOOR_KEYS = _PASSAGE_KEYS | {"state", "height", "thickness"}
+_FURNITURE_KEYS = frozenset({"id", "category", "synset", "room", "center", "size", "yaw",
+                             "affordances", "state", "levels"})
+_OBJECT_KEYS = frozenset({"id", "category", "synset", "parent", "relation", "room", "position",
+                          "size", "affordances", "state"})
+_START_KEYS = frozenset({"x", "y", "yaw", "room"})
+
+
+class JsonObject(dict):  # type: ignore[type-arg]
+    """A JSON object read with :func:`json_object_pairs` that had a key more than once
+    (the last value kept, as ``json`` does); the parser refuses it naming the field."""
+
+    duplicates: tuple[str, ...] = ()
+
+
+def json_object_pairs(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """``object_pairs_hook`` for ``json.loads``: a plain dict, or a :class:`JsonObject`
+    listing the keys given more than once."""
+    d = dict(pairs)
+    if len(d) == len(pairs):
+        return d
+    seen: set[str] = set()
+    repeated = []
+    for k, _ in pairs:
+        if k in seen:
+            repeated.append(k)
+        seen.add(k)
+    out = JsonObject(d)
+    out.duplicates = tuple(repeated)
+    return out
+
+
+def _known_keys(where: str, x: Mapping[str, Any], known: frozenset[str]) -> None:
+    """Refuse a key given twice or not in ``known`` (a typo would otherwise fall back to a
+    default silently), suggesting the nearest known key."""
+    dup = getattr(x, "duplicates", ())
+    if dup:
+        raise SpecError(f"{_field(where, dup[0])}: the key is given more than once")
+    unknown = x.keys() - known
+    if not unknown:
+        return
+    key = min(unknown, key=repr)
+    near = difflib.get_close_matches(key, sorted(known), n=1) if len(key) <= 64 else []
+    hint = f" (did you mean {near[0]!r}?)" if near else ""
+    raise SpecError(f"{_field(where, key)}: unknown key{hint}; known keys: "
+                    f"{', '.join(sorted(known))}")
+
+
+def _field(where: str, key: Any) -> str:
+    shown = key if isinstance(key, str) and len(key) <= 40 and key.isprintable() else _short(key)
+    return shown if where == "top level" else f"{where}.{shown}"
+
+
+def _house_id(v: Any) -> str:
+    if not isinstance(v, str):
+        raise SpecError(f"id: expected a string, got {_short(v)}")
+    problem = id_problem(v)
+    if problem:
+        raise SpecError(f"id: {_short(v)} {problem}")
+    return v
 
 
 class _Parser:
@@ -116,6 +191,9 @@ class _Parser:
         if len(v) > self.limits.name_length:
             raise SpecError(f"{where}: {len(v)} characters, more than the limit of "
                             f"{self.limits.name_length}")
+        problem = name_problem(v)
+        if problem:
+            raise SpecError(f"{where}: {_short(v)} {problem}")
         return v
 
     def number(self, where: str, v: Any) -> float:
@@ -191,7 +269,7 @@ class _Parser:
 
     # ----- entries --------------------------------------------------------------------
     def room(self, where: str, x: Any) -> Room:
-        x = _json_object(where, x)
+        x = _json_object(where, x, _ROOM_KEYS)
         poly_raw = _required(where, x, "polygon")
         if not isinstance(poly_raw, list):
             raise SpecError(f"{where}.polygon: expected a list of [x, y] points")
@@ -201,8 +279,12 @@ class _Parser:
             raise SpecError(f"{where}.polygon: {len(poly_raw)} points, more than the limit "
                             f"of {self.limits.polygon_points}")
         poly = tuple(self.numbers(f"{where}.polygon[{i}]", q, 2) for i, q in enumerate(poly_raw))
-        if abs(signed_area(poly)) < 1e-6:  # type: ignore[arg-type]
+        crossing = self_crossing(poly)  # type: ignore[arg-type]
+        if abs(signed_area(poly)) < 1e-6 and (crossing is None or not crossing[2]):  # type: ignore[arg-type]
             raise SpecError(f"{where}.polygon: has zero area")
+        if crossing is not None:
+            raise SpecError(f"{where}.polygon: edges cross (edges {crossing[0]} and "
+                            f"{crossing[1]}); a room is a simple polygon")
         group = x.get("open_plan_group")
         if group is not None:
             self.name(f"{where}.open_plan_group", group)
@@ -210,7 +292,7 @@ class _Parser:
                     polygon=poly, open_plan_group=group)  # type: ignore[arg-type]
 
     def wall(self, where: str, x: Any) -> Wall:
-        x = _json_object(where, x)
+        x = _json_object(where, x, _WALL_KEYS)
         a = self.numbers(f"{where}.a", _required(where, x, "a"), 2)
         b = self.numbers(f"{where}.b", _required(where, x, "b"), 2)
         if math.dist(a, b) < 1e-6:
@@ -230,7 +312,7 @@ class _Parser:
                 "rooms": self.room_pair(f"{where}.rooms", _required(where, x, "rooms"))}
 
     def door(self, where: str, x: Any) -> Door:
-        x = _json_object(where, x)
+        x = _json_object(where, x, _DOOR_KEYS)
         state = _required(where, x, "state")
         if state not in STATES:
             raise SpecError(f"{where}.state: expected 'open' or 'closed', got {_short(state)}")
@@ -240,11 +322,11 @@ class _Parser:
                     thickness=self.positive(where, x, "thickness", lim.wall_thickness, 0.1))
 
     def passage(self, where: str, x: Any) -> Passage:
-        x = _json_object(where, x)
+        x = _json_object(where, x, _PASSAGE_KEYS)
         return Passage(**self._opening(where, x, self.limits.passage_width))
 
     def furniture(self, where: str, x: Any) -> Furniture:
-        x = _json_object(where, x)
+        x = _json_object(where, x, _FURNITURE_KEYS)
         size = self.size(f"{where}.size", _required(where, x, "size"), self.limits.furniture_side)
         aff, state = self.affordances(where, x)
         return Furniture(
@@ -274,7 +356,7 @@ class _Parser:
         return out
 
     def small_object(self, where: str, x: Any) -> SmallObject:
-        x = _json_object(where, x)
+        x = _json_object(where, x, _OBJECT_KEYS)
         rel = _required(where, x, "relation")
         if rel not in RELATIONS:
             raise SpecError(f"{where}.relation: expected 'inside' or 'ontop', got {_short(rel)}")
@@ -289,7 +371,7 @@ class _Parser:
             affordances=aff, state=state)
 
     def start(self, where: str, x: Any) -> StartPose:
-        x = _json_object(where, x)
+        x = _json_object(where, x, _START_KEYS)
         return StartPose(x=self.number(f"{where}.x", _required(where, x, "x")),
                          y=self.number(f"{where}.y", _required(where, x, "y")),
                          yaw=self.number(f"{where}.yaw", x.get("yaw", 0.0)),
@@ -306,9 +388,10 @@ def _short(v: Any, n: int = 40) -> str:
     return r if len(r) <= n else r[:n - 3] + "..."
 
 
-def _json_object(where: str, x: Any) -> Mapping[str, Any]:
+def _json_object(where: str, x: Any, known: frozenset[str]) -> Mapping[str, Any]:
     if not isinstance(x, Mapping):
         raise SpecError(f"{where}: expected a JSON object")
+    _known_keys(where, x, known)
     return x
 
 
@@ -321,6 +404,9 @@ def _required(where: str, x: Mapping[str, Any], key: str) -> Any:
 def _unique_ids(key: str, items: Iterable[Any], prefix: str) -> set[str]:
     seen: set[str] = set()
     for i, it in enumerate(items):
+        problem = id_problem(it.id)
+        if problem:
+            raise SpecError(f"{key}[{i}].id: {_short(it.id)} {problem}")
         if not it.id.startswith(prefix):
             raise SpecError(f"{key}[{i}].id: {it.id!r} should start with {prefix!r}")
         if it.id in seen:

@@ -12,12 +12,15 @@ Conventions (all of them are checked on load):
 - ids are strings with a kind prefix, usually followed by a running number: ``room_0``,
   ``door_3``, ``pass_1`` (an open-plan passage: a gap in the wall without a door),
   ``wall_7``, ``furn_12`` (furniture and containers), ``obj_40`` (small objects); any
-  other suffix is allowed (``furn_shelf``);
+  other suffix is allowed (``furn_shelf``); an id (and the optional house ``id``) is a
+  safe file-name component and table cell, names hold no control characters
+  (:mod:`sgtool.house.names`); unknown and repeated keys are refused;
 - a room is a simple polygon (counter-clockwise or not) with a category ("kitchen");
   rooms of one open-plan space (kitchen + living room without a door between them) share
   ``open_plan_group``; rooms do not overlap;
 - a wall is a straight segment ``a``-``b`` with a thickness (centred on the segment) and a
-  height; walls have gaps where doors and passages are;
+  height; walls have gaps where doors and passages are, and (when a house has walls) a
+  gap between two rooms is a door or a passage;
 - a door is an opening of ``width`` centred at ``center``, lying along direction ``yaw``
   (the direction of the wall it sits in), joining two rooms whose borders it lies on;
   ``state`` is "open" or "closed"; a closed door is a panel of the wall's thickness
@@ -68,6 +71,7 @@ from sgtool.house.geometry import (
     polygon_centroid,
     signed_area,
 )
+from sgtool.house.names import decimal_int
 
 SPEC_VERSION = "2.0"
 AFFORDANCES = ("container", "openable", "supporter")
@@ -476,6 +480,8 @@ def placement_problem(obj: SmallObject, parent: Furniture | SmallObject,
 
 
 def spec_id_key(spec_id: str) -> tuple[str, int]:
-    """Sort key of a spec id in natural order: ``obj_2`` before ``obj_10``."""
+    """Sort key of a spec id in natural order: ``obj_2`` before ``obj_10`` (the number
+    read by :func:`sgtool.house.names.decimal_int`; ``obj_²`` sorts as a plain name)."""
     head, _, num = spec_id.rpartition("_")
-    return (head, int(num)) if num.isdigit() else (spec_id, -1)
+    n = decimal_int(num)
+    return (head, n) if n is not None else (spec_id, -1)

@@ -1,0 +1,40 @@
+"""`sgtool scenes` and `--house` take a house path as a path, even one that starts with "{";
+a refused house is one line naming the file and the field, exit 2."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from click.testing import CliRunner
+from support.datasets_fixtures import two_rooms
+
+from sgtool.cli import cli
+from sgtool.commands.options import house_from_options
+
+
+def _write(path: Path, doc: dict) -> Path:
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def test_a_house_file_named_with_a_brace_loads(tmp_path: Path) -> None:
+    p = _write(tmp_path / "{h1}.json", two_rooms())
+    r = CliRunner().invoke(cli, ["scenes", "episodes", str(p), "-n", "1"])
+    assert r.exit_code == 0, r.output
+    assert "apple" in r.output or "cup" in r.output
+    spec, house_id = house_from_options(str(p), None, "4-5")
+    assert house_id == "{h1}" and len(spec.rooms) == 2
+
+
+def test_a_refused_house_is_one_line_naming_file_and_field(tmp_path: Path) -> None:
+    p = _write(tmp_path / "typo.json", dict(two_rooms(), passage=[]))
+    r = CliRunner().invoke(cli, ["scenes", "episodes", str(p)])
+    assert r.exit_code == 2
+    lines = [x for x in r.output.splitlines() if x.strip()]
+    assert len(lines) == 1 and "typo.json: passage: unknown key (did you mean 'passages'?)" \
+        in lines[0]
+    q = _write(tmp_path / "{bad}.json", dict(two_rooms(), id="../../escape"))
+    r = CliRunner().invoke(cli, ["scenes", "show", str(q), "-o", str(tmp_path / "x.png")])
+    assert r.exit_code == 2 and "{bad}.json: id: '../../escape' contains '/'" in r.output
+    assert not (tmp_path / "x.png").exists()
