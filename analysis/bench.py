@@ -30,9 +30,8 @@ any number of workers), ``run.md``/``run.json`` (the table with the decision tim
 episodes per second, the run time, workers, executor and command: wall-clock figures),
 ``per_house.md``/``per_house.jsonl`` and ``per_query.md``/``per_query.jsonl`` (SR, SPL,
 steps per planner, pooled over seeds), and the efficiency curves
-``efficiency_distance.png`` and ``efficiency_steps.png``. Every file is written to a temp
-file and renamed. Records are identical between runs except their ``wall`` figures; the
-digest in the summary leaves those out.
+``efficiency_distance.png`` and ``efficiency_steps.png``, each written atomically. Records
+are identical between runs except their ``wall`` figures; the summary's digest leaves them out.
 
 Tasks are grouped by house (:func:`bench_tasks`): one task runs every planner on one
 house, so the house is built once in the whole run; when there are fewer houses than
@@ -63,6 +62,7 @@ from sgtool.analysis.bench_houses import (
     bench_episodes,
     generated_houses,
     load_house_files,
+    output_path,
 )
 from sgtool.analysis.executor import Task, chunks, failure_lines, make_executor
 from sgtool.analysis.metrics import CostModel, breakdown, cost_models, seen_unseen, summarize
@@ -322,7 +322,7 @@ def _task_episodes(cfg: BenchConfig, ref: BenchHouse,
                     continue
                 from sgtool.log.writer import LogWriter
 
-                path = Path(cfg.log_dir) / name / ref.id / f"seed{seed}-ep{i}.mcap"
+                path = output_path(cfg.log_dir, name, ref.id, f"seed{seed}-ep{i}.mcap")
                 path.parent.mkdir(parents=True, exist_ok=True)
                 with LogWriter(path, seed=seed) as log:
                     out.append(run_episode(house, planner, ep.query, ep.targets, log=log, **kw))

@@ -7,8 +7,10 @@ spec's own ``id`` when it has one, else by its file name without ``.json``.
 
 :func:`load_house_files` reads and checks every given file before anything runs and refuses
 the lot with one line per bad file (file and field, from :func:`sgtool.house.io.load_house`,
-plus the benchmark's own needs: at least one small object to search for, no id given
-twice). :func:`bench_episodes` lists a house's episodes with
+plus the benchmark's own needs: at least one small object to search for, a symbolic
+house that can be built (:func:`symbolic_house_problem`: every room has free floor), an id
+that can name a log folder (:func:`folder_name_problem`), no id given twice); a folder
+without house files is a problem too. :func:`bench_episodes` lists a house's episodes with
 :func:`sgtool.datasets.episodes.list_episodes`; a house without start poses gets one per
 reachable room first (:func:`sgtool.datasets.start_poses.with_start_poses`).
 """
@@ -54,12 +56,18 @@ def generated_houses(count: int, first_seed: int) -> tuple[BenchHouse, ...]:
                  for i in range(count))
 
 
+def folder_houses(folder: Path) -> list[Path]:
+    """The house files of a folder: its ``*.json`` entries, the suffix in any case
+    (``HOUSE.JSON``), sorted by name."""
+    return sorted(p for p in folder.iterdir() if p.name.lower().endswith(".json"))
+
+
 def house_paths(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
-    """Files as given, folders as their ``*.json`` files (sorted by name); a path that is
+    """Files as given, folders as their house files (:func:`folder_houses`); a path that is
     neither is kept, so that loading it reports it."""
     out: list[Path] = []
     for p in map(Path, paths):
-        out.extend(sorted(p.glob("*.json")) if p.is_dir() else [p])
+        out.extend(folder_houses(p) if p.is_dir() else [p])
     return out
 
 
@@ -70,9 +78,8 @@ def load_house_files(paths: Sequence[str | os.PathLike[str]],
     from sgtool.house.io import load_house
 
     files = house_paths(paths)
-    problems: list[str] = []
-    if paths and not files:
-        problems.append(f"{', '.join(map(str, paths))}: no *.json house files there")
+    problems = [f"{p}: no *.json house files there" for p in map(Path, paths)
+                if p.is_dir() and not folder_houses(p)]
     houses: list[BenchHouse] = []
     ids = {i: "a generated house" for i in taken}
     for f in files:
@@ -84,7 +91,15 @@ def load_house_files(paths: Sequence[str | os.PathLike[str]],
         if not spec.objects:
             problems.append(f"{f}: objects: no small objects, nothing to search for")
             continue
+        if bad := symbolic_house_problem(spec, f):
+            problems.append(bad)
+            continue
         hid = _house_id(spec, f)
+        bad = folder_name_problem(hid)
+        if bad:
+            problems.append(f"{f}: id: the house id {hid!r} (its \"id\", else the file "
+                            f"name) cannot name a log folder: {bad}")
+            continue
         if hid in ids:
             problems.append(f"{f}: id: house id {hid!r} is already used by {ids[hid]}")
             continue
@@ -93,6 +108,47 @@ def load_house_files(paths: Sequence[str | os.PathLike[str]],
     if problems:
         raise HouseFilesError("\n".join(problems))
     return tuple(houses)
+
+
+def symbolic_house_problem(spec: HouseSpec, where: str | os.PathLike[str]) -> str | None:
+    """Why the benchmark's symbolic house cannot be built from ``spec`` (read from
+    ``where``), as one line naming ``where`` and the room (a room without free floor for
+    the robot), or None. The check of :func:`load_house_files`, before any episode."""
+    from sgtool.recorders.symbolic_environment.house import SymbolicHouse
+
+    try:
+        SymbolicHouse(spec)
+    except ValueError as e:  # "room room_0 has no free floor"
+        return f"{where}: rooms: {e} (no cell where the robot fits: walls and furniture " \
+               "fill it)"
+    return None
+
+
+MAX_NAME_BYTES = 255  # a file-name component on common file systems (NAME_MAX)
+
+
+def folder_name_problem(name: str) -> str | None:
+    """Why ``name`` cannot be one folder name of an output (a house id in a log path), or
+    None: the rules of an id (:func:`sgtool.house.names.id_problem`) and the byte limit of
+    a file-name component."""
+    from sgtool.house.names import id_problem
+
+    bad = id_problem(name)
+    if bad is None and len(name.encode("utf-8", "surrogatepass")) > MAX_NAME_BYTES:
+        bad = f"more than {MAX_NAME_BYTES} bytes as a file name"
+    return bad
+
+
+def output_path(root: str | os.PathLike[str], *names: str) -> Path:
+    """``root / names[0] / names[1] / ...``, each name one folder or file name that stays
+    inside ``root`` (:func:`folder_name_problem`); otherwise an :class:`SgtoolError`, before
+    anything is written (the house files are checked first; this is the second defence)."""
+    for n in names:
+        bad = folder_name_problem(n)
+        if bad:
+            raise SgtoolError(f"{n!r} cannot name a folder or file inside {root}: "
+                              f"{bad}")
+    return Path(root).joinpath(*names)
 
 
 def _house_id(spec: HouseSpec, path: Path) -> str:

@@ -37,10 +37,12 @@ from sgtool.analysis.bench_houses import (
     bench_episodes,
     generated_houses,
     load_house_files,
+    output_path,
 )
 from sgtool.analysis.metrics import cost_models, summarize
 from sgtool.analysis.offline import read_log_episodes
 from sgtool.analysis.report import format_table, pipe_table
+from sgtool.analysis.run_bench_resume import check_resumable, task_settings
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write
 from sgtool.log.records import Action
@@ -147,7 +149,9 @@ class RunRow:
 
 
 def log_path(root: Path, noise: str, planner: str, house: str, episode: int) -> Path:
-    return root / noise / planner / house / f"ep-{episode:03d}.mcap"
+    """``root/NOISE/PLANNER/HOUSE/ep-K.mcap``; a name that would leave ``root`` (or is no
+    file name) is refused (:func:`~sgtool.analysis.bench_houses.output_path`)."""
+    return output_path(root, noise, planner, house, f"ep-{episode:03d}.mcap")
 
 
 # the house and its episodes per house and draw, per process: houses a worker keeps (a
@@ -161,7 +165,7 @@ def _house(task: RunTask) -> tuple[Any, list[Any]]:
     """The house's spec and its episodes of the run: the bench's draw of ``task.episodes``
     (the draw depends on its size, so this is what makes them the symbolic bench's
     episodes)."""
-    key = (task.house.id, task.rooms, task.preset, task.episodes)
+    key = (task.house, task.rooms, task.preset, task.episodes)  # a file's spec, too
     if key not in _DRAWS:
         spec = task.house.load(task.rooms, task.preset)
         mix = task.preset if task.house.spec is None else "default"
@@ -210,41 +214,14 @@ def run_task(task: RunTask) -> RunRow:
     return _row(task, seconds)
 
 
-def _settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
-              ) -> dict[str, Any]:
-    return {"episode": episode, "max_steps": opts.max_steps, "frame_budget": opts.frames,
-            "size": [opts.camera.width, opts.camera.height],
-            "navigation": opts.navigation, "noise": parse_noise(noise).to_dict(),
-            "seed": opts.planner_seed, "success": opts.success}
-
-
-def _logged_settings(path: Path) -> dict[str, Any]:
-    from sgtool.log.reader import LogReader
-    from sgtool.log.records import Episode as LoggedEpisode
-
-    with LogReader(path) as r:
-        started = next((e for _, e in r.records(LoggedEpisode) if e.status == "started"),
-                       None)
-    x = dict(started.extras) if started is not None else {}
-    cam = x.get("camera") or {}
-    ep = [x.get("episode_id"), started.query] if started is not None else None
-    return {"episode": ep, "max_steps": x.get("max_steps"),
-            "frame_budget": x.get("frame_budget"),
-            "size": [cam.get("width"), cam.get("height")],
-            "navigation": (x.get("navigation") or {}).get("mode", "house"),
-            "noise": x.get("noise"), "seed": x.get("seed"),
-            "success": x.get("success", "observed")}
-
-
 def _row(task: RunTask, seconds: float | None) -> RunRow:
-    eps = _episodes(task) if seconds is None else []
-    want = [eps[task.episode].id, eps[task.episode].query] if task.episode < len(eps) \
-        else None
-    if seconds is None and _logged_settings(task.output) != _settings(task_options(task),
-                                                                      task.noise, want):
-        raise SgtoolError(f"{task.output} was run with other settings (episode, steps, "
-                          "frames, resolution, navigation, noise, seed or success rule); "
-                          "give another -o folder")
+    if seconds is None:  # a log that was there: run with these settings, on this house?
+        spec, eps = _house(task)
+        want = [eps[task.episode].id, eps[task.episode].query] \
+            if task.episode < len(eps) else None
+        check_resumable(task.output, task_settings(task_options(task), task.noise, want),
+                        spec, task.house.source if task.house.spec is not None
+                        else task.house.id)
     logged = read_log_episodes(task.output)
     if len(logged) != 1:
         raise SgtoolError(f"{task.output}: holds {len(logged)} episodes, not one; remove it "

@@ -11,6 +11,7 @@ where SCOUT's two decimals would show zeros).
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping, Sequence
 
 from sgtool.analysis.metrics import (
@@ -52,7 +53,21 @@ def fmt_stat(s: Stat | None, spec: str) -> str:
     return f"{format(s.mean, spec)} ± {format(s.std, spec)}"
 
 
+# a line break of any kind (those str.splitlines knows) inside a table cell
+_LINE_BREAK = re.compile("\r\n|[\n\r\v\f\x1c\x1d\x1e\x85\u2028\u2029]")
+
+
+def table_cell(text: str) -> str:
+    """``text`` as one Markdown table cell: ``|`` escaped as ``\\|``, a line break shown as
+    ``\\n`` (a name given by the user, a house id or a category, stays in its cell)."""
+    return _LINE_BREAK.sub(r"\\n", text.replace("|", "\\|"))
+
+
 def pipe_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    """A Markdown pipe table, columns padded to their widest cell; every cell goes through
+    :func:`table_cell`."""
+    header = [table_cell(h) for h in header]
+    rows = [[table_cell(c) for c in r] for r in rows]
     widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h)
               for i, h in enumerate(header)]
 

@@ -112,7 +112,8 @@ class Simulation(Skills):
             return (start.x, start.y, start.yaw)
         if isinstance(start, int):
             if not self.spec.starts:
-                raise SgtoolError("the house spec has no start poses; give one")
+                raise SgtoolError("the house spec has no start poses: add a \"starts\" entry, "
+                                  "or give a start pose (x, y, yaw)")
             if not 0 <= start < len(self.spec.starts):
                 raise SgtoolError(f"start {start}: the house has {len(self.spec.starts)} "
                                   f"start poses (0..{len(self.spec.starts) - 1})")

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from sgtool.house.names import decimal_int
 from sgtool.planning.base import Action
 from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode, SceneGraph
 
@@ -55,7 +56,7 @@ def _instance(node: ObjectNode | DoorNode) -> int | None:
     if node.instance >= 0:
         return int(node.instance)
     _, _, num = node.id.partition(":")
-    return int(num) if num.isdigit() else None
+    return decimal_int(num)  # "obj:²" names none ("²".isdigit(), but int("²") fails)
 
 
 def plan_skills(graph: SceneGraph, action: Action) -> SkillPlan:

@@ -1,6 +1,7 @@
 """The bench on the executor: tasks grouped by house, a task that fails after its retry is
-listed in the summary (the other houses are still scored) and the command then exits with
-one line; a bad planner option stops the run before any episode."""
+listed in the result and its summary (the other houses are still scored), and the command
+then writes nothing (no tables that pass for a result) and exits with one line; a bad
+planner option stops the run before any episode."""
 
 from __future__ import annotations
 
@@ -54,16 +55,19 @@ def test_a_failing_task_is_retried_once_then_listed(house_one_breaks, tmp_path):
     assert {r.house for r in res.results} == {"house-0"} and len(res.results) == 4
     r = CliRunner().invoke(cli, ["bench", "--houses", "2", "--episodes", "2", "--seeds", "1",
                                  "--rooms", "4-6", "--preset", "default", "--planners",
-                                 "random,greedy", "--no-progress", "-o", str(tmp_path)])
+                                 "random,greedy", "--no-progress", "-o", str(tmp_path / "out")])
     assert r.exit_code == 2
     assert r.stderr.strip().splitlines() == [
-        f"sgtool: error: 1 task(s) failed after a retry, listed in {tmp_path}/summary.md; "
+        f"sgtool: error: 1 task(s) failed after a retry, nothing written to {tmp_path}/out; "
         "the first: house-1/random+greedy: RuntimeError: the house fell down (after 2 "
         "attempts)"]
-    md = (tmp_path / "summary.md").read_text()
+    assert not (tmp_path / "out").exists()  # no folder of tables that looks like a result
+    # the library's outputs still list the failed tasks
+    bench.write_outputs(res, tmp_path / "lib")
+    md = (tmp_path / "lib/summary.md").read_text()
     assert ("Failed tasks (retried once; their episodes are in no table): 1\n- house-1/"
             "random+greedy: RuntimeError: the house fell down (after 2 attempts)\n") in md
-    assert json.loads((tmp_path / "summary.json").read_text())["failed_tasks"] == list(
+    assert json.loads((tmp_path / "lib/summary.json").read_text())["failed_tasks"] == list(
         res.failed)
 
 

@@ -116,11 +116,11 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...],
                       house_files=house_files, priors_dir=priors_dir, success=success,
                       executor=executor, ray_address=ray_address)
     res = run_benchmark(cfg, progress=progress)
+    if res.failed:  # tables without some houses' episodes would pass for a result
+        raise SgtoolError(f"{len(res.failed)} task(s) failed after a retry, nothing written "
+                          f"to {out_dir}; the first: {res.failed[0]}")
     paths = write_outputs(res, out_dir, command=shlex.join(["sgtool", *sys.argv[1:]]))
     click.echo(res.table)
     click.echo(res.side_by_side)
     click.echo(res.seen_table)
     click.echo(f"wrote {', '.join(str(p) for p in paths)}")
-    if res.failed:  # after the outputs, which list them all
-        raise SgtoolError(f"{len(res.failed)} task(s) failed after a retry, listed in "
-                          f"{out_dir}/summary.md; the first: {res.failed[0]}")

@@ -60,7 +60,9 @@ def _pair(option: str, text: str) -> tuple[float, float]:
 @click.option("--speed", type=float, default=0.5, show_default=True,
               help="Driving speed (m/s); turning is 90 deg/s.")
 @click.option("--start", type=int, default=0, show_default=True,
-              help="Index of the house's start pose (one per room in generated houses).")
+              help="Index of the house's start pose (one per room in generated houses; a "
+              "house file without \"starts\" gets one per reachable room, as in `sgtool "
+              "bench`).")
 @click.option("--no-open-containers", is_flag=True,
               help="Do not open closed containers on the way (doors are still opened).")
 @click.option("--explore", type=click.Choice(["script", "frontier"]), default="script",
@@ -115,6 +117,14 @@ def command(house_path: str | None, seed: int | None, rooms: str, output: str,
     robot = replace(RobotConfig(), speed=speed)
     profile = parse_noise(noise)
     house, house_id = house_from_options(house_path, seed, rooms)
+    if not house.starts:  # a hand-made house: start poses as `sgtool bench` gives it
+        from sgtool.datasets.start_poses import with_start_poses
+
+        house = with_start_poses(house, house.seed)
+        if not house.starts:
+            raise SgtoolError(f"{house_path or house_id}: starts: none given, and none can "
+                              "be made (no free floor reachable from the first room); add a "
+                              "\"starts\" entry")
     opts = RecordOptions(fps=fps, frames=frames, camera=camera, robot=robot, noise=profile,
                          seed=noise_seed, start=start,
                          script=ScriptOptions(open_containers=not no_open_containers),

@@ -1,0 +1,96 @@
+"""Whether an episode log already in a ``run-bench`` folder may stand for a task: it must
+have been run with the task's settings (episode, steps, frames, resolution, navigation,
+noise, seed, success rule) on the same house.
+
+The house is compared in canonical form: the spec the log carries (its ``house.json``
+attachment) is parsed as any house file is and its canonical JSON compared with that of
+the house to run, so a log written by older code (another key order, a 1.x attachment)
+still resumes when the house is the same. A mismatch is one :class:`ResumeError` line
+naming the log and what differs.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from sgtool.errors import SgtoolError, SpecError
+from sgtool.house.spec import HouseSpec
+from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
+from sgtool.recorders.sim.noise import parse_noise
+
+_FIX = "give a fresh -o folder, or delete the log to run the episode again"
+
+
+class ResumeError(SgtoolError):
+    """An episode log of the output folder was run with other settings or another house."""
+
+
+def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
+                  ) -> dict[str, Any]:
+    """The settings a task's log must have been run with (as :func:`logged_settings`)."""
+    return {"episode": episode, "max_steps": opts.max_steps, "frame_budget": opts.frames,
+            "size": [opts.camera.width, opts.camera.height],
+            "navigation": opts.navigation, "noise": parse_noise(noise).to_dict(),
+            "seed": opts.planner_seed, "success": opts.success}
+
+
+def _logged(path: Path) -> tuple[dict[str, Any], str | None]:
+    """The settings an episode log was run with, and the house spec text it carries."""
+    from sgtool.log.reader import LogReader
+    from sgtool.log.records import Episode as LoggedEpisode
+
+    with LogReader(path) as r:
+        started = next((e for _, e in r.records(LoggedEpisode) if e.status == "started"),
+                       None)
+        house = r.house_json()
+    x = dict(started.extras) if started is not None else {}
+    cam = x.get("camera") or {}
+    ep = [x.get("episode_id"), started.query] if started is not None else None
+    return ({"episode": ep, "max_steps": x.get("max_steps"),
+             "frame_budget": x.get("frame_budget"),
+             "size": [cam.get("width"), cam.get("height")],
+             "navigation": (x.get("navigation") or {}).get("mode", "house"),
+             "noise": x.get("noise"), "seed": x.get("seed"),
+             "success": x.get("success", "observed")}, house)
+
+
+def same_house(logged: str | None, spec: HouseSpec) -> bool:
+    """Whether the house text a log carries is ``spec`` (compared in canonical form)."""
+    if logged is None:
+        return False
+    want = spec.to_json()
+    if logged == want:  # what this code attaches: no parsing needed
+        return True
+    from sgtool.house.io import load_house
+
+    try:
+        return load_house(json.loads(logged)).to_json() == want
+    except (SpecError, ValueError, RecursionError):
+        return False
+
+
+# the settings by their names in messages
+_LABELS = {"episode": "episode", "max_steps": "max steps", "frame_budget": "frame budget",
+           "size": "resolution", "navigation": "navigation", "noise": "noise", "seed": "seed",
+           "success": "success rule"}
+
+
+def settings_differences(logged: dict[str, Any], want: dict[str, Any]) -> list[str]:
+    """``NAME: X in the log, Y now`` for every setting that differs."""
+    return [f"{_LABELS.get(k, k)}: {json.dumps(logged.get(k))} in the log, {json.dumps(v)} now"
+            for k, v in want.items() if logged.get(k) != v]
+
+
+def check_resumable(path: Path, want: dict[str, Any], spec: HouseSpec, house: str) -> None:
+    """Raise :class:`ResumeError` unless the log ``path`` was run with the settings ``want``
+    (:func:`task_settings`) on the house ``spec`` (``house`` names it: a file, or a
+    generated house's id)."""
+    settings, logged_house = _logged(path)
+    diff = settings_differences(settings, want)
+    if diff:
+        raise ResumeError(f"{path} was run with other settings ({'; '.join(diff)}); {_FIX}")
+    if not same_house(logged_house, spec):
+        raise ResumeError(f"{path} was run on another house: the house of {house} changed "
+                          f"since; {_FIX}")

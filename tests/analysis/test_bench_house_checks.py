@@ -1,0 +1,108 @@
+"""House files that `sgtool bench` / `run-bench` cannot use are refused when the files are
+checked, before any episode and any output: an id that cannot name a log folder, a room
+without free floor for the robot, a folder without house files among other --house
+arguments; *.JSON counts in any case. Log paths never leave their output folder."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+from support.foreign_house import cottage, write_cottage
+
+from sgtool.analysis.bench_houses import (
+    HouseFilesError,
+    load_house_files,
+    output_path,
+    symbolic_house_problem,
+)
+from sgtool.analysis.closed_loop_bench import log_path
+from sgtool.cli import cli
+from sgtool.errors import SgtoolError
+from sgtool.house.io import load_house
+
+
+def _tiny() -> dict:
+    """One 0.6 x 0.6 m room filled by a 0.5 m cabinet: nowhere for the robot to stand."""
+    return {"version": "2.0", "seed": 3,
+            "rooms": [{"id": "room_0", "category": "kitchen",
+                       "polygon": [[0, 0], [0.6, 0], [0.6, 0.6], [0, 0.6]]}],
+            "walls": [], "doors": [],
+            "furniture": [{"id": "furn_0", "category": "cabinet", "synset": "cabinet.n.01",
+                           "room": "room_0", "center": [0.3, 0.3, 0.45],
+                           "size": [0.5, 0.5, 0.9],
+                           "affordances": ["container", "openable", "supporter"],
+                           "state": "closed"}],
+            "objects": [{"id": "obj_0", "category": "apple", "synset": "apple.n.01",
+                         "parent": "furn_0", "relation": "inside", "room": "room_0",
+                         "position": [0.3, 0.3, 0.3], "size": [0.08, 0.08, 0.08]}],
+            "starts": []}
+
+
+def test_paths_stay_inside_their_folder(tmp_path: Path) -> None:
+    assert output_path(tmp_path, "none", "greedy", "Villa Rosa", "ep-000.mcap") == \
+        tmp_path / "none/greedy/Villa Rosa/ep-000.mcap"
+    for bad in ("..", ".", "../../ESCAPED", "/tmp/ABSOLUTE", "a\\b", "line\nbreak", "",
+                "字" * 90):  # 90 characters, 270 bytes: too long for a file name
+        with pytest.raises(SgtoolError, match="cannot name a folder or file inside"):
+            output_path(tmp_path, "none", bad)
+        with pytest.raises(SgtoolError, match="cannot name a folder or file inside"):
+            log_path(tmp_path, "none", "greedy", bad, 0)
+
+
+def test_an_id_too_long_for_a_folder_name_is_refused_with_the_file(tmp_path: Path) -> None:
+    long_id = write_cottage(tmp_path, "long.json", id="字" * 90)
+    with pytest.raises(HouseFilesError) as e:
+        load_house_files([long_id])
+    assert str(e.value) == (f"{long_id}: id: the house id {'字' * 90!r} (its \"id\", else "
+                            "the file name) cannot name a log folder: more than 255 bytes "
+                            "as a file name")
+
+
+@pytest.mark.parametrize("house_id", ["../../ESCAPED", "/tmp/ABSOLUTE"])
+def test_run_bench_writes_nothing_for_an_id_that_leaves_the_folder(tmp_path: Path,
+                                                                    house_id: str) -> None:
+    f = write_cottage(tmp_path / "h", "x.json", id=house_id)
+    out = tmp_path / "a" / "b" / "rb"
+    res = CliRunner().invoke(cli, ["run-bench", "--houses", "0", "--house", str(f),
+                                   "--planners", "greedy", "--episodes", "1", "--resolution",
+                                   "64x48", "--frames", "10", "--no-progress", "-o", str(out)])
+    assert res.exit_code == 2 and "Traceback" not in res.output
+    assert len(res.output.strip().splitlines()) == 1 and str(f) in res.output
+    assert "id" in res.output
+    assert not (tmp_path / "a").exists() and not (tmp_path / "ESCAPED").exists()
+
+
+def test_a_room_without_free_floor_is_refused_before_any_episode(tmp_path: Path) -> None:
+    f = tmp_path / "tiny.json"
+    f.write_text(json.dumps(_tiny()))
+    line = (f"{f}: rooms: room room_0 has no free floor (no cell where the robot fits: walls "
+            "and furniture fill it)")
+    assert symbolic_house_problem(load_house(f), f) == line
+    assert symbolic_house_problem(load_house(cottage()), "cottage") is None
+    with pytest.raises(HouseFilesError) as e:
+        load_house_files([f])
+    assert str(e.value) == line
+    for cmd in (["bench", "--seeds", "1"], ["run-bench", "--resolution", "64x48"]):
+        out = tmp_path / cmd[0]
+        res = CliRunner().invoke(cli, [*cmd, "--houses", "0", "--house", str(f),
+                                       "--planners", "random", "--episodes", "1",
+                                       "--no-progress", "-o", str(out)])
+        assert res.exit_code == 2 and res.output.strip() == f"sgtool: error: {line}"
+        assert not out.exists()
+
+
+def test_folders_empty_among_others_and_upper_case_suffixes(tmp_path: Path) -> None:
+    good = write_cottage(tmp_path / "good")
+    (tmp_path / "empty").mkdir()
+    (tmp_path / "empty" / "notes.txt").write_text("no house")
+    with pytest.raises(HouseFilesError) as e:
+        load_house_files([tmp_path / "empty", good])
+    assert str(e.value) == f"{tmp_path / 'empty'}: no *.json house files there"
+    upper = write_cottage(tmp_path / "upper", "HOUSE.JSON")
+    write_cottage(tmp_path / "upper", "b.Json", id="other")
+    houses = load_house_files([tmp_path / "upper"])
+    assert [(h.id, h.source) for h in houses] == [("HOUSE", str(upper)),
+                                                  ("other", str(tmp_path / "upper/b.Json"))]

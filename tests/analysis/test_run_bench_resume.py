@@ -1,0 +1,73 @@
+"""`sgtool run-bench` resumes only from logs run with the same settings on the same house:
+a log of a changed house file is refused in one line naming the log, the message for other
+settings names what differs, and a log carrying the same house in another text form (older
+code, a 1.x attachment) still resumes (sgtool.analysis.run_bench_resume)."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from sgtool.analysis import closed_loop_bench as clb
+from sgtool.analysis.run_bench_resume import same_house, settings_differences
+from sgtool.cli import cli
+from sgtool.datasets.generator import generate_house
+from sgtool.house.io import save_house
+
+ARGS = ["run-bench", "--planners", "random", "--houses", "0", "--episodes", "1",
+        "--resolution", "64x48", "--max-steps", "2", "--frames", "60", "--no-progress"]
+
+
+def _closed(spec):
+    return dataclasses.replace(spec, doors=tuple(dataclasses.replace(d, state="closed")
+                                                 for d in spec.doors))
+
+
+def test_the_house_is_compared_in_canonical_form() -> None:
+    spec = generate_house(6, rooms=(4, 4))
+    assert same_house(spec.to_json(), spec)
+    assert same_house(json.dumps(spec.to_dict()), spec)  # other spacing, no indent
+    v1 = dict(spec.to_dict(), version="1.0")  # no 2.0 field used: the same house as 1.0
+    assert same_house(json.dumps(v1, sort_keys=False), spec)
+    assert not same_house(_closed(spec).to_json(), spec)
+    assert not same_house(None, spec)
+    assert not same_house("{not json", spec)
+    assert not same_house('{"version": "2.0"}', spec)
+
+
+def test_settings_differences_name_the_setting() -> None:
+    assert settings_differences({"max_steps": 2, "seed": 0}, {"max_steps": 3, "seed": 0}) \
+        == ["max steps: 2 in the log, 3 now"]
+
+
+def test_a_changed_house_file_is_not_resumed(tmp_path: Path, monkeypatch) -> None:
+    spec = generate_house(6, rooms=(4, 4))
+    house = tmp_path / "myhouse.json"
+    save_house(spec, house)
+    out = tmp_path / "rb"
+    cmd = [*ARGS, "--house", str(house), "-o", str(out)]
+    first = CliRunner().invoke(cli, cmd)
+    assert first.exit_code == 0, first.output
+    log = out / "logs/none/random/myhouse/ep-000.mcap"
+    monkeypatch.setattr(clb, "run_episode", lambda *a, **k: pytest.fail("ran again"))
+    # the same house in another text form (as an older writer might attach it): resumed
+    house.write_text(json.dumps(spec.to_dict()))
+    assert CliRunner().invoke(cli, cmd).exit_code == 0
+    # the same file name, another house: refused in one line naming the log
+    save_house(_closed(spec), house)
+    res = CliRunner().invoke(cli, cmd)
+    assert res.exit_code == 2 and "Traceback" not in res.output
+    assert res.output.strip().splitlines() == [
+        f"sgtool: error: {log} was run on another house: the house of {house} changed "
+        "since; give a fresh -o folder, or delete the log to run the episode again"]
+    # other settings: the message names them
+    save_house(spec, house)
+    other = list(cmd)
+    other[other.index("--max-steps") + 1] = "3"
+    res = CliRunner().invoke(cli, other)
+    assert res.exit_code == 2
+    assert "was run with other settings (max steps: 2 in the log, 3 now)" in res.output
