@@ -45,14 +45,43 @@ def check_non_negative(value: float, flag: str, unit: str = "") -> float:
     return float(value)
 
 
+FPS_RANGE = (0.1, 1000.0)  # frames per second, as `sgtool run` takes them
+MAX_FLOOR_M = 10_000.0  # |--floor|: a height in a building's (or a map's) frame
+MAX_DT_S = 60.0  # --max-dt: pairing colour with depth
+MAX_TF_TOLERANCE_S = 3600.0  # --tf-tolerance
+DEPTH_SCALE_RANGE = (1.0, 1e6)  # raw units per metre: metres to micrometres
+
+
+def check_range(value: float, flag: str, lo: float, hi: float, unit: str = "") -> float:
+    """``value`` if it is a finite number within ``lo``..``hi``."""
+    if not _is_number(value) or not lo <= float(value) <= hi:
+        raise SgtoolError(f"{flag} {_show(value)}: must be a number from {lo:g} to {hi:g}"
+                          + (f" ({unit})" if unit else ""))
+    return float(value)
+
+
+def seconds_option_ns(value: float, flag: str, hi: float) -> int:
+    """A duration flag in seconds (0..``hi``) -> integer nanoseconds."""
+    return int(check_range(value, flag, 0.0, hi, "seconds") * 1e9)
+
+
+def check_floor(value: float | None) -> float | None:
+    """``--floor`` in metres: finite, within +-:data:`MAX_FLOOR_M` (None = auto or none)."""
+    if value is None:
+        return None
+    return check_range(value, "--floor", -MAX_FLOOR_M, MAX_FLOOR_M,
+                       "metres along up; or auto, or none")
+
+
 def check_depth_scale(value: float | None) -> float | None:
     """``--depth-scale``: raw 16-bit depth units per metre (None = the source's)."""
     if value is None:
         return None
-    if not _is_number(value) or float(value) <= 0.0:
+    if not _is_number(value) or not DEPTH_SCALE_RANGE[0] <= float(value) <= DEPTH_SCALE_RANGE[1]:
         raise SgtoolError(
             f"--depth-scale {_show(value)}: give the raw depth units per metre, a positive "
-            "number (1000 for millimetres, 5000 for TUM RGB-D)"
+            "number (1000 for millimetres, 5000 for TUM RGB-D) from "
+            f"{DEPTH_SCALE_RANGE[0]:g} to {DEPTH_SCALE_RANGE[1]:g}"
         )
     return float(value)
 

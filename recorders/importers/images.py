@@ -34,8 +34,24 @@ def _read_image(path: Path) -> np.ndarray:
     return a
 
 
+def _jpeg_truncated(path: Path) -> bool:
+    """Whether a JPEG file lacks its end-of-image marker (a cut-off file, which libjpeg
+    decodes half grey with only a warning on stderr)."""
+    with open(path, "rb") as f:
+        if f.read(2) != b"\xff\xd8":
+            return False
+        f.seek(0, 2)
+        f.seek(max(0, f.tell() - 64))
+        tail = f.read().rstrip(b"\x00\r\n\t ")
+    return not tail.endswith(b"\xff\xd9")
+
+
 def read_color_file(path: Path) -> np.ndarray:
-    """An 8-bit colour (or grey) image file -> (H, W, 3) uint8 RGB."""
+    """An 8-bit colour (or grey) image file -> (H, W, 3) uint8 RGB; a truncated JPEG is a
+    user error."""
+    if Path(path).is_file() and _jpeg_truncated(Path(path)):
+        raise SgtoolError(f"{path}: truncated JPEG (no end-of-image marker): the file is cut "
+                          "off or damaged")
     a = _read_image(path)
     return _to_rgb(a, str(path))
 
@@ -260,9 +276,20 @@ def decode_ids_message(msg: Any, msgtype: str, topic: str) -> np.ndarray:
     return a.astype(np.int32)
 
 
-def resize_to(a: np.ndarray, width: int, height: int) -> np.ndarray:
-    """Resize an image to the depth image's size (area averaging for colour)."""
+ASPECT_TOL = 0.01  # relative difference of width/height ratios that still counts as equal
+
+
+def resize_to(a: np.ndarray, width: int, height: int, what: str = "a colour or id image"
+              ) -> np.ndarray:
+    """Resize an image to the depth image's size (area averaging for colour). An image of
+    another aspect ratio (640x360 colour for 640x480 depth) would no longer be registered to
+    the depth when stretched: a user error naming ``what``."""
     if a.shape[1] == width and a.shape[0] == height:
         return a
+    if abs(a.shape[1] * height / (a.shape[0] * width) - 1.0) > ASPECT_TOL:
+        raise SgtoolError(
+            f"{what}: {a.shape[1]}x{a.shape[0]} pixels, another aspect ratio than the "
+            f"{width}x{height} depth images; stretching it would misregister colour and "
+            "depth (crop or register the colour to the depth first)")
     interp = cv2.INTER_AREA if a.dtype == np.uint8 else cv2.INTER_NEAREST
     return cv2.resize(a, (width, height), interpolation=interp)

@@ -14,7 +14,8 @@
 - ``open3d`` (Open3D reconstruction system / Redwood): ``color/`` (or ``image/``, ``rgb/``)
   and ``depth/`` folders of images paired by name, a ``.log`` trajectory (camera-to-world)
   and an intrinsics JSON (``intrinsic_matrix``); depth in mm. Without a JSON, the PrimeSense
-  default 525, 525, 319.5, 239.5 that Open3D itself assumes. Frames are ``1/fps`` apart.
+  default 525, 525, 319.5, 239.5 that Open3D itself assumes. Frames are ``1/fps`` apart, in
+  natural name order ("2.png" before "10.png", as Open3D's ``sorted_alphanum``).
 """
 
 from __future__ import annotations
@@ -27,11 +28,12 @@ import numpy as np
 
 from sgtool.errors import SgtoolError
 from sgtool.recorders.importers.poses import PoseTrack
-from sgtool.recorders.importers.sanity import timestamp_problem
+from sgtool.recorders.importers.sanity import time_range_problem, timestamp_problem
 from sgtool.recorders.importers.textformats import (
     PinholeParams,
     read_intrinsics_file,
     read_open3d_log,
+    read_pose_file,
     read_tum_list,
     read_tum_trajectory,
 )
@@ -157,8 +159,22 @@ def _color_dir(root: Path) -> Path | None:
     return None
 
 
+def natural_key(name: str) -> tuple[tuple[int, int | str], ...]:
+    """Sort key of a file name by its numbers' values ("2.png" before "10.png"), as Open3D's
+    ``sorted_alphanum``."""
+    return tuple((0, int(t)) if t.isdigit() else (1, t) for t in re.split(r"(\d+)", name) if t)
+
+
 def _images(folder: Path) -> list[Path]:
-    return sorted(p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_EXT)
+    """The image files of ``folder`` in natural order (names numbered without zero padding
+    sort by value); names whose numbers tie ("1.png" and "01.png") are an error."""
+    found = sorted((p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_EXT),
+                   key=lambda p: (natural_key(p.name), p.name))
+    for a, b in zip(found, found[1:], strict=False):
+        if natural_key(a.name) == natural_key(b.name):
+            raise SgtoolError(f"{folder}: {a.name} and {b.name} have the same number; the "
+                              "frame order is ambiguous (keep one naming)")
+    return found
 
 
 def read_sequence(
@@ -191,7 +207,7 @@ def read_sequence(
         seq = _read_tum(root, max_dt_ns, trajectory, keep_unposed, timestamps, fps,
                         skip_missing)
     elif layout == "7scenes":
-        seq = _read_7scenes(root, fps, trajectory)
+        seq = _read_7scenes(root, fps, trajectory, skip_missing)
     elif layout == "open3d":
         seq = _read_open3d(root, fps, trajectory)
     else:  # pragma: no cover - missing_for_layout refuses unknown layouts
@@ -250,11 +266,14 @@ def _read_tum(
     if timestamps == "index":
         return _read_tum_by_index(root, rgb, depth, fps, notes)
     for name, rows in (("depth.txt", depth), ("rgb.txt", rgb)):
-        problem = timestamp_problem([t for t, _ in rows], str(root / name))
+        what = str(root / name)
+        problem = (time_range_problem([t for t, _ in rows], what)
+                   or timestamp_problem([t for t, _ in rows], what))
         if problem:
             raise SgtoolError(problem)
-    rgb_times = [t for t, _ in rgb]
     gt_path = trajectory or (root / "groundtruth.txt")
+    if trajectory is not None and trajectory.suffix == ".log":
+        return _read_tum_log_poses(root, rgb, depth, max_dt_ns, trajectory, notes)
     track = None
     if gt_path.is_file():
         # ground truth at ~100 Hz: interpolate over gaps up to 0.1 s, no extrapolation
@@ -265,12 +284,8 @@ def _read_tum(
     frames = []
     no_rgb = no_pose = 0
     for t, name in depth:
-        j = _nearest(rgb_times, t)
-        color = None
-        if j is not None and abs(rgb_times[j] - t) <= max_dt_ns:
-            color = root / rgb[j][1]
-        else:
-            no_rgb += 1
+        color = _colour_near(root, rgb, t, max_dt_ns)
+        no_rgb += color is None
         pose = track.at(t) if track is not None else None
         if track is not None and pose is None:
             no_pose += 1
@@ -292,6 +307,28 @@ def _read_tum(
         "none" if track is None else ("trajectory" if trajectory else "ground truth"),
         tuple(notes),
     )
+
+
+def _colour_near(root: Path, rgb: list[tuple[int, str]], t: int, max_dt_ns: int) -> Path | None:
+    """The colour image of ``rgb`` nearest to time ``t``, within ``max_dt_ns``."""
+    j = _nearest([r for r, _ in rgb], t)
+    return root / rgb[j][1] if j is not None and abs(rgb[j][0] - t) <= max_dt_ns else None
+
+
+def _read_tum_log_poses(root: Path, rgb: list[tuple[int, str]], depth: list[tuple[int, str]],
+                        max_dt_ns: int, trajectory: Path, notes: list[str]) -> FolderSequence:
+    """``--trajectory X.log`` for a TUM folder: an Open3D .log has no times, so its poses go
+    to the depth images in the listed order."""
+    poses = _external_poses(trajectory, len(depth))
+    assert poses is not None
+    frames = [FolderFrame(t, root / name, _colour_near(root, rgb, t, max_dt_ns), poses[i])
+              for i, (t, name) in enumerate(depth)]
+    no_rgb = sum(f.color_path is None for f in frames)
+    if no_rgb:
+        notes.append(f"{no_rgb} depth images had no colour image within {max_dt_ns / 1e6:g} ms")
+    notes.append(f"poses from {trajectory.name} in depth.txt's order (a .log has no times)")
+    return FolderSequence("tum", root, tuple(frames), _tum_intrinsics(root), 5000.0,
+                          "trajectory", tuple(notes))
 
 
 def _tum_intrinsics(root: Path) -> PinholeParams | None:
@@ -322,21 +359,44 @@ def _read_tum_by_index(root: Path, rgb: list[tuple[int, str]], depth: list[tuple
                           tuple(notes))
 
 
-def _read_7scenes(root: Path, fps: float, trajectory: Path | None) -> FolderSequence:
+def _seven_missing(root: Path, by_id: dict[int, dict[str, Path]],
+                   skip_missing: bool) -> tuple[list[int], list[str]]:
+    """The frame numbers to import. A frame with some files but no depth image, or without
+    colour when other frames have it, is an error naming it (as a missing file TUM lists),
+    or with ``skip_missing`` is left out with a note."""
+    colour = next((v["color"].suffix for v in by_id.values() if "color" in v), None)
+    need = {"depth": ".png", **({"color": colour} if colour else {})}
+    lacking = {i: [k for k in need if k not in v] for i, v in sorted(by_id.items())}
+    lacking = {i: lack for i, lack in lacking.items() if lack}
+    keep = sorted(i for i in by_id if i not in lacking)
+    if not lacking:
+        return keep, []
+    i, lack = next(iter(lacking.items()))
+    first = f"frame-{i:06d}.{lack[0]}{need[lack[0]]}"
+    if not skip_missing:
+        raise SgtoolError(f"{root}: {len(lacking)} of {len(by_id)} frames lack a depth or "
+                          f"colour image (first: {first} is missing); give --skip-missing to "
+                          "import the complete frames")
+    return keep, [f"skipped {len(lacking)} frames without depth or colour (first: {first})"]
+
+
+def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
+                  skip_missing: bool = False) -> FolderSequence:
     by_id: dict[int, dict[str, Path]] = {}
     for p in root.iterdir():
         m = _SEVEN.match(p.name)
         if m:
             by_id.setdefault(int(m.group(1)), {})[m.group(2)] = p
-    ext_poses = _external_poses(trajectory, len([i for i in by_id if "depth" in by_id[i]]))
+    ids, notes = _seven_missing(root, by_id, skip_missing)
+    ext_poses = _external_poses(trajectory, len(ids))
     frames = []
-    for n, i in enumerate(sorted(k for k, v in by_id.items() if "depth" in v)):
+    for n, i in enumerate(ids):
         files = by_id[i]
         pose = None
         if ext_poses is not None:
             pose = ext_poses[n]
         elif "pose" in files:
-            pose = _read_pose_matrix(files["pose"])
+            pose = read_pose_file(files["pose"])
         frames.append(FolderFrame(round(i * 1e9 / fps), files["depth"], files.get("color"), pose))
     intr = SEVEN_SCENES_INTRINSICS
     if (root / "camera-intrinsics.txt").is_file():
@@ -346,22 +406,13 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None) -> FolderSequ
     if 0 < posed < len(frames):
         raise SgtoolError(f"{root}: {len(frames) - posed} of {len(frames)} frames have no pose.txt")
     kind = "trajectory" if trajectory else ("ground truth" if posed else "none")
-    return FolderSequence("7scenes", root, tuple(frames), intr, 1000.0, kind)
+    return FolderSequence("7scenes", root, tuple(frames), intr, 1000.0, kind, tuple(notes))
 
 
-def _read_pose_matrix(path: Path) -> np.ndarray:
-    try:
-        m = np.loadtxt(path, dtype=np.float64)
-    except ValueError as e:
-        raise SgtoolError(f"{path}: expected a 4x4 pose matrix ({e})") from e
-    if m.shape != (4, 4) or not np.all(np.isfinite(m)):
-        raise SgtoolError(f"{path}: expected a 4x4 pose matrix, got shape {m.shape}")
-    return m
-
-
-def _external_poses(trajectory: Path | None, count: int) -> list[np.ndarray] | None:
+def _external_poses(trajectory: Path | None, count: int,
+                    hint: str = "") -> list[np.ndarray] | None:
     """Poses from a --trajectory file for frames in order (Open3D .log, or a TUM file whose
-    lines are taken in order)."""
+    lines are taken in order); ``hint`` says why the counts may differ."""
     if trajectory is None:
         return None
     if not trajectory.is_file():
@@ -371,8 +422,17 @@ def _external_poses(trajectory: Path | None, count: int) -> list[np.ndarray] | N
     else:
         poses = [T for _, T in read_tum_trajectory(trajectory)]
     if len(poses) != count:
-        raise SgtoolError(f"{trajectory} has {len(poses)} poses for {count} frames")
+        raise SgtoolError(f"{trajectory} has {len(poses)} poses for {count} frames{hint}")
     return poses
+
+
+def _is_intrinsics_json(path: Path) -> bool:
+    """Whether a JSON file means to be intrinsics (names 'intrinsic_matrix'): other JSON
+    files of a folder are not read as intrinsics; a malformed intrinsics file is an error."""
+    try:
+        return "intrinsic_matrix" in path.read_text(errors="replace")
+    except OSError as e:
+        raise SgtoolError(f"{path}: cannot read ({e.strerror})") from e
 
 
 def _read_open3d(root: Path, fps: float, trajectory: Path | None) -> FolderSequence:
@@ -402,14 +462,16 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None) -> FolderSeque
                 f"{root}: several trajectories ({', '.join(p.name for p in logs)}); "
                 "choose one with --trajectory"
             )
-    poses = _external_poses(traj, len(pairs)) if traj is not None else None
+    unpaired = sorted({c.stem for c in colors} - {d.stem for d in depths}, key=natural_key)
+    hint = (f" ({len(unpaired)} colour images have no depth image; first: depth/{unpaired[0]}.*"
+            f" for {by_stem[unpaired[0]].relative_to(root)})"
+            if unpaired and len(pairs) < len(colors) else "")
+    poses = _external_poses(traj, len(pairs), hint) if traj is not None else None
     intr = None
     for p in sorted(root.glob("*.json")):
-        try:
+        if _is_intrinsics_json(p):
             intr = replace(read_intrinsics_file(p), source=f"file {p.name}")
             break
-        except SgtoolError:
-            continue
     frames = tuple(
         FolderFrame(round(i * 1e9 / fps), d, c, poses[i] if poses is not None else None)
         for i, (d, c) in enumerate(pairs)

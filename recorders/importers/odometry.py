@@ -109,6 +109,9 @@ class FailedStep:
     frame: int
     reason: str
     detail: str = ""
+    dt_s: float = 0.0  # "motion": the time between the frames,
+    dist_m: float = 0.0  # the distance moved,
+    needed_s: float = 0.0  # and the time that motion needs within the limits
 
 
 @dataclass(frozen=True)
@@ -149,11 +152,26 @@ class OdometryResult:
         return f"{head}: " + ", ".join(parts)
 
     def warning(self, share: float = UNRELIABLE_SHARE) -> str | None:
-        """A note for the import when more than ``share`` of the steps failed."""
+        """A note for the import when more than ``share`` of the steps failed; when most
+        failures are motion too fast for the time between the frames, it names that
+        time and the spacing the motion needs (frames skipped at a frame rate taken as the
+        camera's)."""
         if not self.steps or self.failures <= share * self.steps:
             return None
-        return (f"odometry failed on {self.failures / self.steps:.0%} of the steps: the "
-                "estimated poses are unreliable (give the poses, or try another --odometry)")
+        head = (f"odometry failed on {self.failures / self.steps:.0%} of the steps: the "
+                "estimated poses are unreliable")
+        fast = [f for f in self.failed if f.reason == "motion"]
+        if 2 * len(fast) < self.failures:
+            return f"{head} (give the poses, or try another --odometry)"
+        dt = float(np.median([f.dt_s for f in fast]))
+        dist = float(np.median([f.dist_m for f in fast]))
+        need = float(np.median([f.needed_s for f in fast]))
+        rate = f"{1 / dt:.3g} fps" if dt > 0 else "no time"
+        return (f"{head}; {len(fast)} of the failures are motion too fast for the time between "
+                f"the frames: they are {dt:.3g} s apart in the log ({rate}) and moved a median "
+                f"{dist:.3f} m per step, plausible only ~{need:.2g} s apart; if frames were "
+                f"skipped, give the real spacing (folders: --fps {1 / max(need, 1e-3):.2g} or "
+                "less), else give the poses or try another --odometry")
 
 
 MIN_PATH_M = 0.01  # shorter reference paths get no drift percentage
@@ -304,6 +322,14 @@ class _Odometer:
         return np.asarray(T), failed
 
 
+def motion_time_needed(T: np.ndarray, limits: MotionLimits) -> float:  # noqa: N803
+    """The least time (s) in which the relative motion ``T`` is plausible under ``limits``."""
+    dist = float(np.linalg.norm(np.asarray(T)[:3, 3]))
+    turn = rotation_angle_deg(np.asarray(T))
+    return max((dist - limits.slack_m) / limits.max_speed,
+               (turn - limits.slack_deg) / limits.max_turn_deg, 0.0)
+
+
 def implausible_motion(T: np.ndarray, dt_s: float, limits: MotionLimits) -> str | None:  # noqa: N803
     """Why the relative motion ``T`` (prev_T_cur) cannot have happened in ``dt_s`` seconds
     under ``limits``, or None when it can."""
@@ -363,11 +389,17 @@ def estimate_trajectory(
         else:
             T, why = odo.motion(prev, cur, last)  # noqa: N806
             T = snap_motion(T)  # noqa: N806
-            if why is None and times_ns is not None:
-                detail = implausible_motion(T, (times_ns[i] - times_ns[i - 1]) / 1e9, limits)
-                why = ("motion", detail) if detail else None
+            step: FailedStep | None = None
             if why is not None:
-                failed.append(FailedStep(i, *why))
+                step = FailedStep(i, *why)
+            elif times_ns is not None:
+                dt = (times_ns[i] - times_ns[i - 1]) / 1e9
+                detail = implausible_motion(T, dt, limits)
+                if detail:
+                    step = FailedStep(i, "motion", detail, dt, float(np.linalg.norm(T[:3, 3])),
+                                      motion_time_needed(T, limits))
+            if step is not None:
+                failed.append(step)
                 T = last  # noqa: N806
             poses.append(poses[-1] @ T)
             last = T

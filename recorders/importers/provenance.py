@@ -28,6 +28,7 @@ FLOOR_ORIGINS = {
     "horizontal-surfaces": "estimate: the lowest upward-facing surfaces",
     "all-points": "estimate: the lowest depth points (few horizontal surfaces)",
     "none": "kept: not estimated (--floor none, or a trajectory without --floor)",
+    "no-depth": "kept: not estimated (no valid depth point in the sampled frames)",
 }
 ESTIMATED_FLOORS = ("horizontal-surfaces", "all-points")
 

@@ -28,11 +28,14 @@ import numpy as np
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.recorders.importers.checks import (
+    FPS_RANGE,
+    MAX_DT_S,
     check_counts,
     check_depth_scale,
+    check_floor,
     check_height_band,
-    check_non_negative,
     check_positive,
+    check_range,
 )
 from sgtool.recorders.importers.images import (
     depth_for_log,
@@ -59,6 +62,8 @@ from sgtool.recorders.importers.sanity import (
     DEFAULT_CAMERA_HEIGHT,
     depth_scale_problem,
     floor_problem,
+    no_depth_problem,
+    principal_point_problem,
 )
 from sgtool.recorders.importers.sink import (
     ImportFrame,
@@ -103,9 +108,10 @@ def check_options(opts: RgbdOptions) -> None:
     if opts.timestamps not in ("file", "index"):
         raise SgtoolError(f"--timestamps {opts.timestamps!r}: give file or index")
     check_depth_scale(opts.depth_scale)
-    check_positive(opts.fps, "--fps", "frames per second")
+    check_range(opts.fps, "--fps", *FPS_RANGE, "frames per second")
     check_positive(opts.depth_max, "--depth-max", "metres")
-    check_non_negative(opts.max_dt_ns / 1e9, "--max-dt", "seconds")
+    check_range(opts.max_dt_ns / 1e9, "--max-dt", 0.0, MAX_DT_S, "seconds")
+    check_floor(opts.floor)
 
 
 def drift_reference(seq: FolderSequence, trajectory: Path | None) -> str:
@@ -119,7 +125,12 @@ def drift_reference(seq: FolderSequence, trajectory: Path | None) -> str:
     return "the reference trajectory (reconstructed, not ground truth)"
 
 
-def camera_for(seq: FolderSequence, opts: RgbdOptions, width: int, height: int) -> CameraIntrinsics:
+def camera_for(seq: FolderSequence, opts: RgbdOptions, width: int, height: int,
+               findings: Findings | None = None) -> CameraIntrinsics:
+    """The camera of ``width`` x ``height`` depth images: the intrinsics given or the
+    layout's, for that size (a principal point outside the images is an error; one far from
+    their centre, for intrinsics without a size, a :func:`~.sanity.principal_point_problem`).
+    """
     p = opts.intrinsics or seq.intrinsics
     if p is None:
         raise SgtoolError(
@@ -131,6 +142,13 @@ def camera_for(seq: FolderSequence, opts: RgbdOptions, width: int, height: int) 
             f"intrinsics {p.source or ''} are for {p.width}x{p.height} images, the depth "
             f"images are {width}x{height}"
         )
+    origin = "flag --intrinsics" if opts.intrinsics is not None else p.source
+    if not (0 <= p.cx <= width and 0 <= p.cy <= height):
+        raise SgtoolError(f"intrinsics ({origin}): principal point ({p.cx:g}, {p.cy:g}) is "
+                          f"outside the {width}x{height} depth images")
+    if findings is not None and not (p.width and p.height):
+        findings.problem(principal_point_problem(p.cx, p.cy, width, height, origin),
+                         given=opts.intrinsics is not None)
     return CameraIntrinsics(width, height, float(p.fx), float(p.fy), float(p.cx), float(p.cy))
 
 
@@ -143,7 +161,8 @@ def _load(fr: FolderFrame, scale: float, size: tuple[int, int] | None = None):  
         )
     rgb = None
     if fr.color_path is not None:
-        rgb = resize_to(read_color_file(fr.color_path), raw.shape[1], raw.shape[0])
+        rgb = resize_to(read_color_file(fr.color_path), raw.shape[1], raw.shape[0],
+                        str(fr.color_path))
     return raw, rgb
 
 
@@ -184,9 +203,10 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
                     else f"dataset default: {seq.layout} layout")
     picks = sample_indices(len(frames))
     raws = [read_depth_file(frames[i].depth_path) for i in picks]
+    findings.problem(no_depth_problem(raws, str(root)), given=False)
     findings.problem(depth_scale_problem(raws, scale, scale_origin),
                      given=opts.depth_scale is not None)
-    k = camera_for(seq, opts, raws[0].shape[1], raws[0].shape[0])
+    k = camera_for(seq, opts, raws[0].shape[1], raws[0].shape[0], findings)
     intr_origin = "flag --intrinsics" if opts.intrinsics is not None else \
         (seq.intrinsics.source if seq.intrinsics is not None else "given")
     if opts.intrinsics is None and intr_origin.startswith("folder-name default"):
@@ -210,7 +230,8 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
             pose_source += f" (the dataset's {seq.pose_source} kept for the drift)"
     else:
         poses = [np.asarray(p) for p in source_poses]
-        pose_source = f"{seq.pose_source} of the dataset"
+        pose_source = (f"trajectory {opts.trajectory} (--trajectory)" if opts.trajectory
+                       else f"{seq.pose_source} of the dataset")
 
     samples = [DepthSample(depth_to_metres(raw, scale), k, poses[i])
                for raw, i in zip(raws, picks, strict=True)]

@@ -85,6 +85,25 @@ def timestamp_problem(times_ns: Sequence[int], what: str,
     return f"{what}: the time stamps are not times of frames ({'; '.join(found)}{looks}); {fix}"
 
 
+MAX_LOG_TIME_NS = 2**63 - 1  # a log's times are int64 nanoseconds >= 0 (up to year 2262)
+
+
+def time_range_problem(times_ns: Sequence[int], what: str,
+                       fix: str = FOLDER_TIME_FIX) -> str | None:
+    """The problem of time stamps a log cannot hold: negative, or beyond year 2262 (seconds
+    that are really milliseconds or microseconds); None when all are in range."""
+    if not times_ns:
+        return None
+    lo, hi = min(times_ns), max(times_ns)
+    if hi > MAX_LOG_TIME_NS:
+        return (f"{what}: time stamps up to {hi / 1e9:.4g} s are beyond year 2262: they look "
+                f"like milliseconds or microseconds, the format gives seconds; {fix}")
+    if lo < 0:
+        return (f"{what}: negative time stamps (from {lo / 1e9:.6g} s); a log's times start "
+                f"at 0 or later; {fix}")
+    return None
+
+
 @dataclass(frozen=True)
 class DepthStats:
     """Median and 95th percentile of the valid depth (metres at the scale checked)."""
@@ -105,6 +124,15 @@ def depth_stats(raw: Sequence[np.ndarray], scale: float) -> DepthStats:
     if len(v) == 0:
         return DepthStats(0.0, 0.0, 0)
     return DepthStats(float(np.median(v)) / scale, float(np.percentile(v, 95)) / scale, len(v))
+
+
+def no_depth_problem(raw: Sequence[np.ndarray], what: str) -> str | None:
+    """The problem of depth images without one valid pixel (all 0 or 65535: no return):
+    nothing to map, no floor to find; None when some pixel is valid."""
+    if depth_stats(raw, 1.0).valid:
+        return None
+    return (f"{what}: none of the {len(raw)} sampled depth images has a valid pixel (all 0 or "
+            "65535, no return): nothing to map")
 
 
 def depth_plausible(s: DepthStats) -> bool:
@@ -169,3 +197,16 @@ def floor_problem(poses: Sequence[np.ndarray], alignment_matrix: np.ndarray, flo
                if h < band[0] else "")
             + f"; give the floor's height with --floor (e.g. --floor {example:.2f} puts the "
             "camera at 1.3 m), or a wider --camera-height")
+
+
+def principal_point_problem(cx: float, cy: float, width: int, height: int,
+                            origin: str) -> str | None:
+    """The problem of a principal point more than a quarter of the image from the centre of
+    ``width`` x ``height`` images: intrinsics of another resolution (e.g. 320x240 numbers for
+    640x480 images) stretch the world; None when it is near the centre."""
+    if abs(cx - width / 2) <= width / 4 and abs(cy - height / 2) <= height / 4:
+        return None
+    return (f"intrinsics ({origin}): the principal point ({cx:g}, {cy:g}) is far from the "
+            f"centre ({width / 2:g}, {height / 2:g}) of the {width}x{height} depth images; they "
+            f"look like intrinsics of {2 * cx:.0f}x{2 * cy:.0f} images: give the intrinsics of "
+            f"{width}x{height} images with --intrinsics fx,fy,cx,cy")

@@ -36,6 +36,9 @@ def seconds_to_ns(text: str) -> int:
         raise ValueError(f"not a time stamp: {text!r}") from e
 
 
+MAX_TIME_NS = 2**63 - 1  # the largest time a log (int64 nanoseconds) holds: year 2262
+
+
 def ns_to_seconds_text(t_ns: int) -> str:
     """Integer nanoseconds -> "seconds.microseconds" as TUM files write them."""
     return f"{t_ns // 1_000_000_000}.{(t_ns % 1_000_000_000) // 1000:06d}"
@@ -82,6 +85,9 @@ def read_tum_trajectory(path: Path) -> list[tuple[int, np.ndarray]]:
             v = [float(x) for x in parts[1:]]
         except ValueError as e:
             raise SgtoolError(f"{path}:{n}: {e}") from e
+        if abs(t) > MAX_TIME_NS:
+            raise SgtoolError(f"{path}:{n}: time stamp {parts[0]} is beyond year 2262 in "
+                              "seconds: TUM files give seconds (not ms or us)")
         if not np.all(np.isfinite(v)) or np.linalg.norm(v[3:]) < 1e-6:
             raise SgtoolError(f"{path}:{n}: not a valid pose (NaN or zero quaternion)")
         out.append((t, pose_from_tq(v[:3], v[3:])))
@@ -97,8 +103,62 @@ def write_tum_trajectory(path: Path, poses: list[tuple[int, np.ndarray]]) -> Non
     path.write_text("\n".join(lines) + "\n")
 
 
+RIGID_TOL = 5e-3  # |R^T R - I|, |det R - 1| and the last row (7-Scenes: up to 5e-4)
+
+
+def rigid_problem(m: np.ndarray) -> tuple[int, str] | None:
+    """Why a finite 4x4 matrix is not a rigid pose, with the matrix row (0-3) to name:
+    the last row is not 0 0 0 1, or the rotation is not orthonormal with det +1 (within
+    :data:`RIGID_TOL`); None when it is rigid."""
+    last = m[3]
+    if np.abs(last - (0.0, 0.0, 0.0, 1.0)).max() > RIGID_TOL:
+        return 3, f"the last row is {' '.join(f'{v:g}' for v in last)}, not 0 0 0 1"
+    r = m[:3, :3]
+    ortho = float(np.abs(r.T @ r - np.eye(3)).max())
+    det = float(np.linalg.det(r))
+    if ortho > RIGID_TOL or abs(det - 1.0) > RIGID_TOL:
+        return 0, (f"the rotation is not orthonormal with det +1 (|R^T R - I| = {ortho:.3g}, "
+                   f"det {det:.4g}): not a rigid camera pose (scaled or sheared)")
+    return None
+
+
+def pose_matrix(path: Path, rows: list[tuple[int, list[str]]]) -> np.ndarray:
+    """The rigid camera-to-world 4x4 written as four text ``rows`` (line number, numbers) of
+    ``path``; a user error naming the line otherwise."""
+    out = []
+    for n, parts in rows:
+        if len(parts) != 4:
+            raise SgtoolError(f"{path}:{n}: expected a matrix row of four numbers, this one "
+                              f"has {len(parts)}")
+        try:
+            vals = [float(x) for x in parts]
+        except ValueError as e:
+            raise SgtoolError(f"{path}:{n}: {e}") from e
+        if not np.all(np.isfinite(vals)):
+            raise SgtoolError(f"{path}:{n}: a pose matrix row that is not finite "
+                              f"({' '.join(parts)})")
+        out.append(vals)
+    m = np.array(out, dtype=np.float64)
+    problem = rigid_problem(m)
+    if problem is not None:
+        row, text = problem
+        raise SgtoolError(f"{path}:{rows[row][0]}: {text}")
+    return m
+
+
+def read_pose_file(path: Path) -> np.ndarray:
+    """A 4x4 camera-to-world pose as text (7-Scenes ``frame-XXXXXX.pose.txt``), checked
+    rigid."""
+    rows = _data_lines(path)
+    if len(rows) != 4:
+        raise SgtoolError(f"{path}: expected a 4x4 pose matrix (four rows of four numbers), "
+                          f"found {len(rows)} rows")
+    return pose_matrix(path, rows)
+
+
 def read_open3d_log(path: Path) -> list[np.ndarray]:
-    """Camera-to-world 4x4 poses of an Open3D / Redwood ``.log`` trajectory, in order."""
+    """Camera-to-world 4x4 poses of an Open3D / Redwood ``.log`` trajectory, in order,
+    each checked rigid."""
     rows = _data_lines(path)
     if len(rows) % 5:
         raise SgtoolError(
@@ -110,13 +170,7 @@ def read_open3d_log(path: Path) -> list[np.ndarray]:
         n0, head = rows[b]
         if len(head) != 3:
             raise SgtoolError(f"{path}:{n0}: expected the block header 'i j n'")
-        try:
-            m = np.array([[float(x) for x in rows[b + k][1]] for k in range(1, 5)])
-        except ValueError as e:
-            raise SgtoolError(f"{path}:{rows[b + 1][0]}: {e}") from e
-        if m.shape != (4, 4) or not np.all(np.isfinite(m)):
-            raise SgtoolError(f"{path}:{rows[b + 1][0]}: expected four rows of four numbers")
-        poses.append(m)
+        poses.append(pose_matrix(path, rows[b + 1:b + 5]))
     return poses
 
 
@@ -141,27 +195,46 @@ class PinholeParams:
     source: str = ""
 
 
+def checked_pinhole(fx: float, fy: float, cx: float, cy: float, what: str, **kw: object
+                    ) -> PinholeParams:
+    """``PinholeParams`` whose numbers are finite, with fx, fy > 0 and cx, cy >= 0 (inside
+    the image: checked against its size by the importer); a user error naming ``what``."""
+    vals = (fx, fy, cx, cy)
+    if not all(np.isfinite(vals)):
+        raise SgtoolError(f"{what}: intrinsics fx,fy,cx,cy = {','.join(f'{v:g}' for v in vals)} "
+                          "are not finite")
+    if fx <= 0 or fy <= 0 or cx < 0 or cy < 0:
+        raise SgtoolError(f"{what}: intrinsics fx,fy,cx,cy = {','.join(f'{v:g}' for v in vals)}: "
+                          "focal lengths must be positive and the principal point inside the "
+                          "image")
+    return PinholeParams(float(fx), float(fy), float(cx), float(cy), **kw)  # type: ignore[arg-type]
+
+
 def read_intrinsics_file(path: Path) -> PinholeParams:
     """Open3D intrinsic JSON or a 3x3 matrix text file."""
     if path.suffix.lower() == ".json":
         try:
             d = json.loads(path.read_text())
             m = np.asarray(d["intrinsic_matrix"], dtype=np.float64).reshape(3, 3).T
-        except (json.JSONDecodeError, KeyError, ValueError, TypeError) as e:
+            w, h = d.get("width"), d.get("height")
+            size = (int(w) if w else None, int(h) if h else None)
+        except (json.JSONDecodeError, KeyError, ValueError, TypeError, AttributeError) as e:
             raise SgtoolError(
                 f"{path}: expected Open3D intrinsics JSON with 'width', 'height' and a "
                 f"9-number 'intrinsic_matrix' ({type(e).__name__}: {e})"
             ) from e
-        w, h = d.get("width"), d.get("height")
-        return PinholeParams(m[0, 0], m[1, 1], m[0, 2], m[1, 2],
-                             int(w) if w else None, int(h) if h else None, str(path.name))
+        if any(v is not None and v <= 0 for v in size):
+            raise SgtoolError(f"{path}: image size {w}x{h} is not positive")
+        return checked_pinhole(m[0, 0], m[1, 1], m[0, 2], m[1, 2], str(path), width=size[0],
+                               height=size[1], source=str(path.name))
     try:
         m = np.loadtxt(path, dtype=np.float64)
     except ValueError as e:
         raise SgtoolError(f"{path}: expected a 3x3 camera matrix ({e})") from e
     if m.shape != (3, 3) or abs(m[2, 2] - 1.0) > 1e-6 or m[0, 0] <= 0 or m[1, 1] <= 0:
         raise SgtoolError(f"{path}: expected a 3x3 camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]]")
-    return PinholeParams(m[0, 0], m[1, 1], m[0, 2], m[1, 2], source=str(path.name))
+    return checked_pinhole(m[0, 0], m[1, 1], m[0, 2], m[1, 2], str(path),
+                           source=str(path.name))
 
 
 def parse_intrinsics(text: str) -> PinholeParams:
@@ -173,9 +246,7 @@ def parse_intrinsics(text: str) -> PinholeParams:
         except ValueError:
             pass
         else:
-            if fx <= 0 or fy <= 0:
-                raise SgtoolError(f"--intrinsics {text!r}: focal lengths must be positive")
-            return PinholeParams(fx, fy, cx, cy, source="given")
+            return checked_pinhole(fx, fy, cx, cy, f"--intrinsics {text!r}", source="given")
     path = Path(text)
     if not path.is_file():
         raise SgtoolError(

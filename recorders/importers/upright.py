@@ -86,7 +86,7 @@ class WorldAlignment:
     floor: float  # source height of the floor along ``up`` (subtracted)
     up: tuple[float, float, float]  # the source world's up direction
     up_method: str  # "given", "camera-up", "horizontal-normals", "none"
-    floor_method: str  # "given", "none", "horizontal-surfaces", "all-points"
+    floor_method: str  # "given", "none", "no-depth", "horizontal-surfaces", "all-points"
 
     @classmethod
     def identity(cls) -> WorldAlignment:
@@ -216,7 +216,8 @@ def estimate_alignment(
     if floor is not None:
         fl, floor_method = float(floor), "given"
     elif not floor_auto or len(pts) == 0:
-        fl, floor_method = 0.0, "none"
+        # depth frames given but without one valid point: say so, not "none"
+        fl, floor_method = 0.0, "none" if not floor_auto or not samples else "no-depth"
     else:
         h = pts @ u
         upward = (nrm @ u) > np.cos(np.radians(20))

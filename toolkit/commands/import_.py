@@ -16,6 +16,12 @@ import click
 
 from sgtool.commands.options import option_group
 from sgtool.errors import SgtoolError
+from sgtool.recorders.importers.checks import (
+    MAX_DT_S,
+    MAX_TF_TOLERANCE_S,
+    check_floor,
+    seconds_option_ns,
+)
 
 
 def _floor(text: str) -> tuple[float | None, bool]:
@@ -25,9 +31,10 @@ def _floor(text: str) -> tuple[float | None, bool]:
     if s == "none":
         return None, False
     try:
-        return float(s), False
+        value = float(s)
     except ValueError as e:
         raise SgtoolError(f"--floor {text!r}: give auto, none or a height in metres") from e
+    return check_floor(value), False
 
 
 def _output(output: str | None, force: bool) -> Path:
@@ -105,8 +112,10 @@ _common_options = option_group([
                  help="Raw 16-bit depth units per metre (default: 1000 for bags and "
                  "7-Scenes/Open3D, 5000 for TUM)."),
     click.option("--max-dt", type=float, default=0.02, show_default=True,
-                 help="Largest time difference (s) when pairing colour (and ids) "
-                 "with a depth image."),
+                 help="Largest time difference (s, at most 60) when pairing colour (and ids) "
+                 "with a depth image. Colour of another size than the depth is resized to it "
+                 "when the aspect ratio is the same, and refused when it differs (it would "
+                 "no longer be registered to the depth)."),
     click.option("--every", type=int, default=1, show_default=True,
                  help="Keep every N-th frame."),
     click.option("--limit", type=int, default=None, help="Keep at most N frames."),
@@ -211,8 +220,9 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
     opts = BagOptions(
         rgb=rgb, depth=depth, ids=ids, info=info, tf_frames=frames, pose=pose,
         intrinsics=parse_intrinsics(intrinsics) if intrinsics else None,
-        depth_scale=depth_scale, max_dt_ns=int(max_dt * 1e9),
-        tf_tolerance_ns=int(tf_tolerance * 1e9), up=parse_up(up), floor=fl,
+        depth_scale=depth_scale, max_dt_ns=seconds_option_ns(max_dt, "--max-dt", MAX_DT_S),
+        tf_tolerance_ns=seconds_option_ns(tf_tolerance, "--tf-tolerance", MAX_TF_TOLERANCE_S),
+        up=parse_up(up), floor=fl,
         floor_auto=floor_auto, every=every, limit=limit, progress=not quiet,
         compression=compression, estimate_poses=estimate_poses, odometry=odometry,
         depth_max=depth_max, camera_height=parse_height_band(camera_height), warn=_warn,
@@ -237,8 +247,10 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
               "(frame-XXXXXX.color/depth/pose), Open3D/Redwood (color|image/, depth/, "
               "*.log, intrinsics JSON).")
 @click.option("--fps", type=float, default=30.0, show_default=True,
-              help="Frame rate for layouts without time stamps (7-Scenes frame n is at n/fps) "
-              "and for --timestamps index.")
+              help="Frame rate (0.1-1000) for layouts without time stamps (7-Scenes frame n "
+              "is at n/fps, Open3D frame i at i/fps) and for --timestamps index; give the "
+              "real spacing of the images when frames were skipped (odometry checks the "
+              "motion per step against it).")
 @click.option("--timestamps", type=click.Choice(["file", "index"]), default="file",
               show_default=True,
               help="TUM time stamps: 'file' takes rgb.txt/depth.txt's (checked: increasing, "
@@ -287,7 +299,8 @@ def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bo
         intrinsics=parse_intrinsics(intrinsics) if intrinsics else None, fps=fps,
         trajectory=Path(trajectory) if trajectory else None, estimate_poses=estimate_poses,
         odometry=odometry, depth_max=depth_max, up=parse_up(up), floor=fl,
-        floor_auto=floor_auto, every=every, limit=limit, max_dt_ns=int(max_dt * 1e9),
+        floor_auto=floor_auto, every=every, limit=limit,
+        max_dt_ns=seconds_option_ns(max_dt, "--max-dt", MAX_DT_S),
         progress=not quiet, compression=compression, timestamps=timestamps,
         skip_missing=skip_missing, camera_height=parse_height_band(camera_height), warn=_warn,
     )

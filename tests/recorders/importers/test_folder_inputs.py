@@ -1,0 +1,321 @@
+"""Bad RGB-D folder inputs and import options: each is refused in one line naming the file,
+the line or the flag (or, where the data can be used, imported with a note), and no log is
+written. Folders are built here from tiny synthetic images."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from sgtool.cli import cli
+from sgtool.errors import SgtoolError
+from sgtool.log.frame import CameraIntrinsics
+from sgtool.recorders.importers.checks import check_floor, seconds_option_ns
+from sgtool.recorders.importers.images import read_color_file, resize_to
+from sgtool.recorders.importers.layouts import FolderSequence, natural_key, read_sequence
+from sgtool.recorders.importers.odometry import FailedStep, OdometryResult
+from sgtool.recorders.importers.provenance import FLOOR_ORIGINS, Findings
+from sgtool.recorders.importers.rgbd import RgbdOptions, camera_for, import_rgbd
+from sgtool.recorders.importers.sanity import time_range_problem
+from sgtool.recorders.importers.textformats import (
+    PinholeParams,
+    parse_intrinsics,
+    read_intrinsics_file,
+    read_open3d_log,
+    read_pose_file,
+    write_open3d_log,
+)
+from sgtool.recorders.importers.upright import DepthSample, estimate_alignment
+
+W, H = 32, 24
+
+
+def _pose(x: float) -> np.ndarray:
+    T = np.eye(4)  # noqa: N806
+    T[0, 3] = x
+    return T
+
+
+def _depth(path: Path, value: int = 2000) -> None:
+    cv2.imwrite(str(path), np.full((H, W), value, np.uint16))
+
+
+def _colour(path: Path, w: int = W, h: int = H) -> None:
+    cv2.imwrite(str(path), np.full((h, w, 3), 128, np.uint8))
+
+
+def open3d_folder(root: Path, names: list[str]) -> Path:
+    """depth/NAME.png, image/NAME.jpg and traj.log whose pose i has x = i, in list order."""
+    (root / "depth").mkdir(parents=True)
+    (root / "image").mkdir()
+    for n in names:
+        _depth(root / "depth" / f"{n}.png")
+        _colour(root / "image" / f"{n}.jpg")
+    write_open3d_log(root / "traj.log", [_pose(float(i)) for i in range(len(names))])
+    return root
+
+
+def seven_folder(root: Path, n: int = 3, depth_value: int = 2000) -> Path:
+    root.mkdir(parents=True)
+    for i in range(n):
+        _depth(root / f"frame-{i:06d}.depth.png", depth_value)
+        _colour(root / f"frame-{i:06d}.color.png")
+        np.savetxt(root / f"frame-{i:06d}.pose.txt", _pose(0.1 * i))
+    return root
+
+
+# ----- item 1: frame order ---------------------------------------------------------------------
+def test_unpadded_names_sort_by_number_and_keep_their_poses(tmp_path):
+    seq = read_sequence(open3d_folder(tmp_path / "f", [str(i) for i in range(12)]))
+    assert [f.depth_path.stem for f in seq.frames] == [str(i) for i in range(12)]
+    assert [f.color_path.stem for f in seq.frames] == [str(i) for i in range(12)]
+    assert [f.pose[0, 3] for f in seq.frames] == [float(i) for i in range(12)]
+    assert sorted(["10.png", "2.png", "frame-1.png"], key=natural_key) == \
+        ["2.png", "10.png", "frame-1.png"]
+
+
+def test_names_whose_numbers_tie_are_refused(tmp_path):
+    root = open3d_folder(tmp_path / "f", ["0", "1", "2"])
+    _depth(root / "depth" / "01.png")
+    with pytest.raises(SgtoolError, match=r"01.png and 1.png have the same number; the frame "
+                       "order is ambiguous"):
+        read_sequence(root)
+
+
+# ----- items 4 and 12: rigid poses, named lines --------------------------------------------------
+LOG = "0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
+
+
+@pytest.mark.parametrize(("block", "match"), [
+    ("0 0 1\n2 0 0 0\n0 2 0 0\n0 0 2 0\n0 0 0 1\n", r"traj.log:7: the rotation is not "
+     r"orthonormal with det \+1 \(\|R\^T R - I\| = 3, det 8\)"),
+    ("0 0 1\n1 0.5 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n", r"traj.log:7: the rotation is not "
+     "orthonormal"),
+    ("0 0 1\n-1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n", r"traj.log:7: .*det -1"),
+    ("0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0.1 0 0 1\n", "traj.log:10: the last row is 0.1 0 0 1, "
+     "not 0 0 0 1"),
+    ("0 0 1\n1 0 0 0\n0 1 0 0\nnan 0 1 0\n0 0 0 1\n", "traj.log:9: a pose matrix row that is "
+     "not finite"),
+    ("0 0 1\n1 0 0 0\n0 1 0\n0 0 1 0\n0 0 0 1\n", "traj.log:8: expected a matrix row of four "
+     "numbers, this one has 3"),
+])
+def test_open3d_log_poses_must_be_rigid(tmp_path, block, match):
+    p = tmp_path / "traj.log"
+    p.write_text(LOG + block)
+    with pytest.raises(SgtoolError, match=match):
+        read_open3d_log(p)
+
+
+def test_nearly_orthonormal_float_text_is_accepted(tmp_path):
+    p = tmp_path / "traj.log"
+    p.write_text(LOG + "0 0 1\n1.0004 0 0 0\n0 0.9997 0 0\n0 0 1 0\n0 0 0 1\n")
+    assert len(read_open3d_log(p)) == 2
+
+
+def test_seven_scenes_pose_files_must_be_rigid(tmp_path):
+    p = tmp_path / "frame-000030.pose.txt"
+    p.write_text("1.5 0 0 0\n0 1.5 0 0\n0 0 1.5 0\n0 0 0 1\n")
+    with pytest.raises(SgtoolError, match="frame-000030.pose.txt:1: the rotation is not"):
+        read_pose_file(p)
+    p.write_text("1 0 0 0\nnan 1 0 0\n0 0 1 0\n0 0 0 1\n")
+    with pytest.raises(SgtoolError, match="pose.txt:2: a pose matrix row that is not finite"):
+        read_pose_file(p)
+    root = seven_folder(tmp_path / "s")
+    (root / "frame-000001.pose.txt").write_text("1 0 0 0\n0 1 0 0\n0 0 1 0\n0.1 0 0 1\n")
+    with pytest.raises(SgtoolError, match="frame-000001.pose.txt:4: the last row"):
+        read_sequence(root)
+
+
+def test_open3d_missing_depth_is_named(tmp_path):
+    root = open3d_folder(tmp_path / "f", ["00000", "00010", "00020"])
+    (root / "depth" / "00010.png").unlink()
+    with pytest.raises(SgtoolError, match=r"traj.log has 3 poses for 2 frames \(1 colour images "
+                       r"have no depth image; first: depth/00010\.\* for image/00010.jpg\)"):
+        read_sequence(root)
+    write_open3d_log(root / "traj.log", [_pose(0.0), _pose(2.0)])  # a pose per depth image
+    assert [f.pose[0, 3] for f in read_sequence(root).frames] == [0.0, 2.0]
+
+
+def test_trajectory_log_for_a_tum_folder_goes_in_listed_order(tmp_path):
+    root = tmp_path / "tum"
+    root.mkdir()
+    lines = []
+    for i in range(3):
+        _depth(root / f"d{i}.png")
+        lines.append(f"{10 + i / 30:.6f} d{i}.png")
+    (root / "depth.txt").write_text("\n".join(lines) + "\n")
+    (root / "rgb.txt").write_text("")
+    write_open3d_log(tmp_path / "t.log", [_pose(float(i)) for i in range(3)])
+    seq = read_sequence(root, trajectory=tmp_path / "t.log")
+    assert seq.pose_source == "trajectory"
+    assert [f.pose[0, 3] for f in seq.frames] == [0.0, 1.0, 2.0]
+
+
+# ----- item 6: intrinsics ----------------------------------------------------------------------
+def test_a_malformed_intrinsics_json_is_an_error(tmp_path):
+    root = open3d_folder(tmp_path / "f", ["0", "1"])
+    (root / "camera.json").write_text('{"intrinsic_matrix": [600, 0, 0, 0, 600, 0, 320, 240]}')
+    with pytest.raises(SgtoolError, match=r"camera.json: expected Open3D intrinsics JSON"):
+        read_sequence(root)
+    (root / "camera.json").write_text('{"other": 1}')  # not an intrinsics file: ignored
+    assert read_sequence(root).intrinsics.source.startswith("dataset default")
+
+
+@pytest.mark.parametrize("text", ["nan,525,319.5,239.5", "inf,525,319.5,239.5",
+                                  "525,525,nan,239.5", "525,525,-5000,239.5", "0,525,1,1"])
+def test_intrinsics_must_be_finite_and_positive(text):
+    with pytest.raises(SgtoolError, match=r"--intrinsics .*(not finite|must be positive)"):
+        parse_intrinsics(text)
+
+
+def test_intrinsics_files_are_checked(tmp_path):
+    p = tmp_path / "k.txt"
+    p.write_text("nan 0 320\n0 525 240\n0 0 1\n")
+    with pytest.raises(SgtoolError, match="k.txt: intrinsics .* not finite"):
+        read_intrinsics_file(p)
+
+
+def _seq(intr: PinholeParams) -> FolderSequence:
+    return FolderSequence("open3d", Path("f"), (), intr, 1000.0, "none")
+
+
+def test_principal_point_of_another_resolution():
+    small = PinholeParams(262.5, 262.5, 159.75, 119.75, source="file cam.json")
+    with pytest.raises(SgtoolError, match=r"principal point \(159.75, 119.75\) is far from the "
+                       r"centre \(320, 240\) of the 640x480 .* look like intrinsics of 320x240"):
+        camera_for(_seq(small), RgbdOptions(), 640, 480, Findings())
+    found = Findings()  # given with the flag: a warning
+    k = camera_for(_seq(small), RgbdOptions(intrinsics=small), 640, 480, found)
+    assert k.cx == 159.75 and "far from the centre" in found.warnings[0]
+    with pytest.raises(SgtoolError, match=r"principal point \(700, 240\) is outside the 640x480"):
+        camera_for(_seq(PinholeParams(525, 525, 700, 240)), RgbdOptions(), 640, 480)
+    assert camera_for(_seq(PinholeParams(525, 525, 319.5, 239.5)), RgbdOptions(), 640, 480,
+                      Findings()).fx == 525
+
+
+# ----- items 7 and 8: numeric options and time stamps ------------------------------------------
+@pytest.mark.parametrize(("opts", "match"), [
+    (dict(fps=1e-12), r"--fps 1e-12: must be a number from 0.1 to 1000"),
+    (dict(fps=1e12), r"--fps 1e\+12: must be a number from 0.1 to 1000"),
+    (dict(fps=float("nan")), r"--fps nan"),
+    (dict(floor=float("nan")), r"--floor nan: must be a number"),
+    (dict(floor=1e300), r"--floor 1e\+300: must be a number from -10000 to 10000"),
+])
+def test_options_are_checked_before_anything_is_read(tmp_path, opts, match):
+    with pytest.raises(SgtoolError, match=match):
+        import_rgbd(tmp_path / "nowhere", tmp_path / "x.mcap", RgbdOptions(**opts))
+    assert not (tmp_path / "x.mcap").exists()
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), 1e300, -1.0])
+def test_duration_flags(value):
+    with pytest.raises(SgtoolError, match="--max-dt .*must be a number from 0 to 60"):
+        seconds_option_ns(value, "--max-dt", 60.0)
+    assert seconds_option_ns(0.02, "--max-dt", 60.0) == 20_000_000
+    assert check_floor(None) is None and check_floor(-0.5) == -0.5
+
+
+@pytest.mark.parametrize("args", [["--max-dt", "nan"], ["--max-dt", "1e300"],
+                                  ["--floor", "nan"], ["--floor", "inf"], ["--fps", "1e-12"]])
+def test_cli_numeric_flags_give_one_line(tmp_path, args):
+    root = open3d_folder(tmp_path / "f", ["0", "1"])
+    r = CliRunner().invoke(cli, ["import", "rgbd", str(root), "-o", str(tmp_path / "x.mcap"),
+                                 *args])
+    assert r.exit_code == 2 and "Traceback" not in r.output, r.output
+    assert f"error: {args[0]} " in r.output and not (tmp_path / "x.mcap").exists()
+
+
+def test_cli_tf_tolerance_gives_one_line(tmp_path):
+    r = CliRunner().invoke(cli, ["import", "bag", str(tmp_path), "--depth", "/d",
+                                 "--tf-tolerance", "nan", "-o", str(tmp_path / "x.mcap")])
+    assert r.exit_code == 2 and "--tf-tolerance nan: must be a number" in r.output, r.output
+
+
+def _tum(root: Path, stamps: list[str]) -> Path:
+    root.mkdir()
+    for i in range(len(stamps)):
+        _depth(root / f"d{i}.png")
+    (root / "depth.txt").write_text("".join(f"{t} d{i}.png\n" for i, t in enumerate(stamps)))
+    (root / "rgb.txt").write_text("")
+    return root
+
+
+def test_tum_times_a_log_cannot_hold(tmp_path):
+    ms = _tum(tmp_path / "ms", ["1305031102160.407", "1305031102193.740"])
+    with pytest.raises(SgtoolError, match="depth.txt: time stamps up to 1.305e\\+12 s are "
+                       "beyond year 2262: they look like milliseconds"):
+        read_sequence(ms)
+    neg = _tum(tmp_path / "neg", ["-0.5", "-0.466"])
+    with pytest.raises(SgtoolError, match=r"depth.txt: negative time stamps \(from -0.5 s\)"):
+        read_sequence(neg)
+    assert len(read_sequence(neg, timestamps="index").frames) == 2
+    assert time_range_problem([0, 10**9], "x") is None
+
+
+# ----- item 9: no valid depth ------------------------------------------------------------------
+def test_all_invalid_depth_is_refused(tmp_path):
+    root = seven_folder(tmp_path / "s", depth_value=65535)
+    with pytest.raises(SgtoolError, match="none of the 3 sampled depth images has a valid pixel"):
+        import_rgbd(root, tmp_path / "x.mcap", RgbdOptions(progress=False))
+    assert not (tmp_path / "x.mcap").exists()
+
+
+def test_floor_not_estimated_for_want_of_depth_says_so():
+    k = CameraIntrinsics(W, H, 30.0, 30.0, W / 2, H / 2)
+    empty = [DepthSample(np.zeros((H, W), np.float32), k, np.eye(4))]
+    a = estimate_alignment([np.eye(4)], empty)
+    assert a.floor_method == "no-depth" and "no valid depth" in FLOOR_ORIGINS[a.floor_method]
+    assert estimate_alignment([np.eye(4)], empty, floor_auto=False).floor_method == "none"
+    assert estimate_alignment([np.eye(4)], []).floor_method == "none"
+
+
+# ----- item 10: odometry note ------------------------------------------------------------------
+def test_odometry_note_points_at_the_frame_spacing():
+    poses = tuple(np.eye(4) for _ in range(8))
+    failed = tuple(FailedStep(i, "motion", "", 1 / 30, 0.17, 0.1) for i in range(1, 8))
+    note = OdometryResult(poses, "rgbd+icp", failed).warning()
+    assert "odometry failed on 100% of the steps" in note
+    assert "0.0333 s apart in the log (30 fps)" in note and "0.170 m per step" in note
+    assert "--fps 10 or less" in note
+    other = OdometryResult(poses, "icp", tuple(FailedStep(i, "matches") for i in range(1, 8)))
+    assert other.warning().endswith("(give the poses, or try another --odometry)")
+
+
+# ----- item 11: 7-Scenes frames without depth or colour ----------------------------------------
+@pytest.mark.parametrize("kind", ["depth", "color"])
+def test_seven_scenes_frame_without_an_image(tmp_path, kind):
+    root = seven_folder(tmp_path / "s")
+    (root / f"frame-000001.{kind}.png").unlink()
+    with pytest.raises(SgtoolError, match=rf"1 of 3 frames lack a depth or colour image \(first: "
+                       rf"frame-000001\.{kind}\.png is missing\); give --skip-missing"):
+        read_sequence(root)
+    seq = read_sequence(root, skip_missing=True)
+    assert len(seq.frames) == 2 and "skipped 1 frames" in seq.notes[0]
+
+
+# ----- items 13 and 14: colour images ----------------------------------------------------------
+def test_colour_of_another_aspect_ratio_is_refused():
+    with pytest.raises(SgtoolError, match="c.jpg: 640x360 pixels, another aspect ratio than the "
+                       "640x480 depth images"):
+        resize_to(np.zeros((360, 640, 3), np.uint8), 640, 480, "c.jpg")
+    assert resize_to(np.zeros((240, 320, 3), np.uint8), 640, 480).shape == (480, 640, 3)
+
+
+def test_a_truncated_jpeg_is_named(tmp_path):
+    p = tmp_path / "c.jpg"
+    cv2.imwrite(str(p), np.random.default_rng(0).integers(0, 255, (48, 64, 3), np.uint8))
+    assert read_color_file(p).shape == (48, 64, 3)
+    p.write_bytes(p.read_bytes()[:-200])
+    with pytest.raises(SgtoolError, match="c.jpg: truncated JPEG"):
+        read_color_file(p)
+
+
+@pytest.mark.parametrize("value", [1e300, 1e-300, 0.5])
+def test_depth_scale_out_of_range(tmp_path, value):
+    with pytest.raises(SgtoolError, match=r"--depth-scale .*: give the raw depth units per "
+                       r"metre, a positive number .* from 1 to 1e\+06"):
+        import_rgbd(tmp_path, tmp_path / "x.mcap", RgbdOptions(depth_scale=value))
