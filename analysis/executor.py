@@ -320,7 +320,7 @@ def check_reachable(address: str, timeout_s: float = 3.0) -> None:
         return
     hostport = address.split("://", 1)[-1].rstrip("/")
     host, sep, port = hostport.rpartition(":")
-    if not sep or not port.isdigit() or not host:
+    if not sep or not port.isdecimal() or not host:
         raise ExecutorError(f"--ray-address {address!r}: give HOST:PORT (the head node's "
                             "GCS address, e.g. 10.0.0.5:6379) or ray://HOST:PORT")
     try:

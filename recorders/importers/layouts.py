@@ -162,7 +162,7 @@ def _color_dir(root: Path) -> Path | None:
 def natural_key(name: str) -> tuple[tuple[int, int | str], ...]:
     """Sort key of a file name by its numbers' values ("2.png" before "10.png"), as Open3D's
     ``sorted_alphanum``."""
-    return tuple((0, int(t)) if t.isdigit() else (1, t) for t in re.split(r"(\d+)", name) if t)
+    return tuple((0, int(t)) if t.isdecimal() else (1, t) for t in re.split(r"(\d+)", name) if t)
 
 
 def _images(folder: Path) -> list[Path]:

@@ -8,6 +8,8 @@ import sys
 
 import click
 
+from sgtool.errors import SgtoolError
+
 
 def _parse_rooms(value: str) -> tuple[int, int]:
     from sgtool.commands.options import parse_rooms
@@ -176,6 +178,10 @@ def episodes_cmd(house: str, count: int | None, seed: int, reach: float, preset:
         click.echo(json.dumps([e.to_dict() for e in eps], indent=1, sort_keys=True))
         return
     if not eps:
+        from sgtool.analysis.bench_houses import symbolic_house_problem
+
+        if bad := symbolic_house_problem(spec, house):  # e.g. a room without free floor
+            raise SgtoolError(bad)
         click.echo("no episodes: the house has no small objects or no start poses")
         return
     w = max(len(e.query) for e in eps)

@@ -64,7 +64,7 @@ def summarize(path: str | os.PathLike[str]) -> dict[str, Any]:
         out["readable"] = v is None or v[0] <= S.LOG_SCHEMA_VERSION[0]
         out["seed"] = r.seed
         hs = r.metadata.get(S.METADATA_NAME, {}).get("house_seed", "")
-        out["house_seed"] = int(hs) if hs.lstrip("-").isdigit() else None
+        out["house_seed"] = int(hs) if hs.lstrip("-").isdecimal() else None
         if not out["readable"]:
             return out
         out["frames"] = r.frame_count()

@@ -76,7 +76,7 @@ class Candidate:
 def natural_key(node_id: str) -> tuple[str, tuple[tuple[int, int | str], ...]]:
     """Sort ids naturally: ``room:2`` before ``room:10``, ``region:3.1`` before ``region:3.12``."""
     prefix, _, rest = node_id.partition(":")
-    return prefix, tuple((0, int(p)) if p.isdigit() else (1, p) for p in rest.split("."))
+    return prefix, tuple((0, int(p)) if p.isdecimal() else (1, p) for p in rest.split("."))
 
 
 def node_xy(node: RoomNode | RegionNode | ObjectNode | DoorNode) -> tuple[float, float]:

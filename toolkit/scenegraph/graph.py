@@ -264,5 +264,5 @@ def _idkey(node_id: str) -> tuple[str, tuple[int | str, ...]]:
     prefix, _, rest = node_id.partition(":")
     parts: list[int | str] = []
     for p in rest.split("."):
-        parts.append(int(p) if p.isdigit() else p)
+        parts.append(int(p) if p.isdecimal() else p)
     return prefix, tuple((0, p) if isinstance(p, int) else (1, p) for p in parts)  # type: ignore[misc]

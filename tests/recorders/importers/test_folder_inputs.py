@@ -319,3 +319,10 @@ def test_depth_scale_out_of_range(tmp_path, value):
     with pytest.raises(SgtoolError, match=r"--depth-scale .*: give the raw depth units per "
                        r"metre, a positive number .* from 1 to 1e\+06"):
         import_rgbd(tmp_path, tmp_path / "x.mcap", RgbdOptions(depth_scale=value))
+
+
+def test_file_names_with_superscripts_sort_as_text() -> None:
+    from sgtool.recorders.importers.layouts import natural_key as file_key
+
+    names = ["²1.png", "10.png", "2.png"]  # "²" alone: isdigit() but not int()
+    assert sorted(names, key=file_key) == ["2.png", "10.png", "²1.png"]

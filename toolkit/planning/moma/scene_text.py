@@ -104,7 +104,7 @@ def room_names(graph: SceneGraph) -> dict[str, str]:
     for r in rooms:
         b = base[r.id]
         suffix = r.id.rpartition(":")[2]
-        if b in ("room", "unexplored room") and suffix.isdigit():
+        if b in ("room", "unexplored room") and suffix.isdecimal():
             # rooms without a category keep their id number: "unexplored room 1" must not
             # turn into another room when room 1 gets explored and the others move up
             out[r.id] = f"{b} {int(suffix)}"
