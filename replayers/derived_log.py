@@ -11,6 +11,9 @@ input (a log that was already replayed, or a closed-loop log) are not copied: th
 rebuilt. A metadata record ``sgtool.replay`` holds the options. Input chunks go into the
 derived log as they are, not recompressed (:mod:`sgtool.log.chunk_copy`), wherever that
 gives the same messages in the same order (:func:`_can_copy`, :func:`_copyable`).
+With an output every input chunk's CRC is checked as it is read (a copied chunk would
+carry damage under a CRC that no longer matches, a rewritten one under a fresh CRC that
+hides it): a damaged log is refused in one line, and no derived log is left.
 
 Options default to what the log says it was built with: a closed-loop log records its
 mapping options in its ``sgtool.Episode`` record (``extra.mapping``), so replaying it with
@@ -174,8 +177,9 @@ def replay(
 ) -> ReplayReport:
     """Replay ``log`` (module doc). ``on_refresh`` sees every refresh as it happens;
     ``progress`` is anything with ``update(n)`` (a tqdm bar), advanced per frame;
-    ``verify`` checks every chunk CRC of the input as it is read (``sgtool doctor``
-    checks everything; without it damage still gives a one-line error, or a frame);
+    ``verify`` checks every chunk CRC of the input as it is read, always on with an
+    ``output`` (module doc; ``sgtool doctor`` checks everything; without it damage still
+    gives a one-line error, or a frame);
     ``room_classifier`` builds the classifier from the resolved name instead of
     :func:`~sgtool.datasets.room_evidence.make_classifier` (``llm`` with a chat client);
     ``copy_chunks`` copies the input's chunks into the derived log as they are where that
@@ -185,7 +189,7 @@ def replay(
     dst = Path(output) if output is not None else None
     if dst is not None and dst.exists() and src.exists() and dst.resolve() == src.resolve():
         raise SgtoolError("the output must not be the input log")
-    with LogReader(src, verify=verify) as reader, single_blas_thread():
+    with LogReader(src, verify=verify or dst is not None) as reader, single_blas_thread():
         reader.require(S.DEPTH, why="replay builds the map from depth images")
         opts = resolve_options(reader, options or ReplayOptions())
         report = ReplayReport(src, dst, opts, semantic=reader.has(S.IDS))

@@ -15,7 +15,12 @@ doctor``'s checks).
 
 A copied chunk keeps the input's channel and schema ids, sequence numbers, publish times
 and CRC: the derived log must then give its input channels the input's ids
-(:func:`ids_problem`), and the chunk must be compressed as the derived log asks.
+(:func:`ids_problem`), and the chunk must be compressed as the derived log asks. A damaged
+chunk must never be copied (the derived log would carry the damage under a CRC that no
+longer matches): :meth:`~sgtool.log.reader.LogReader.chunks`, which decompresses every
+chunk it hands out anyway, always checks the stored CRC of the uncompressed records (when
+the writer stored one), and a mismatch is the reader's one-line "damaged data" error that
+points to ``sgtool doctor``, whatever ``verify`` says.
 """
 
 from __future__ import annotations

@@ -380,12 +380,12 @@ class LogReader:
 
     def chunks(self, *, views: bool = False) -> Iterator[tuple[RawChunk | None, list[cs.Item]]]:
         """Each chunk in file order, as it is (:func:`~sgtool.log.chunk_copy.raw_chunk`: None
-        when its indexes do not allow a copy) with its messages in log-time order (that of
-        :meth:`raw_messages` when :func:`~sgtool.log.chunk_copy.in_sequence`)."""
+        when its indexes do not allow a copy; its CRC always checked: a copy keeps it) with
+        its messages in log-time order (that of :meth:`raw_messages` when in sequence)."""
         def each() -> Iterator[tuple[RawChunk | None, list[cs.Item]]]:
             for ci in sorted(self.summary.chunk_indexes, key=lambda c: c.chunk_start_offset):
                 record = cs.read_chunk(self._f, ci)
-                data = cs.chunk_data(record, ci, self.verify, self._buffers if views else None)
+                data = cs.chunk_data(record, ci, True, self._buffers if views else None)
                 items = cs.chunk_messages(data, ci, self.summary, views)
                 yield raw_chunk(self._f, ci, record), items
         return self._checked(each())

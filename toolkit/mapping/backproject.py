@@ -22,12 +22,15 @@ addition is exact and the sum is the packed integer itself. Adding ``2**52`` put
 integer into the low mantissa bits, where reading the float's bits as an int64 and
 subtracting those of ``2**52`` recovers it; one shift gives the key. No conversion is
 left, and the keys are the same integers as ``(v_x + o) << sx | (v_y + o) << sy | ...``.
-Points outside the packing give meaningless keys, as before (the caller discards them).
+Points outside the packing give meaningless keys (the caller refuses such a frame:
+:func:`beyond_packing`).
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from sgtool.errors import SgtoolError
 
 BLOCK = 32768  # points per block: the 5 float64 temporaries (256 KiB each) stay in L2
 _MAGIC = 2.0 ** 52  # integers in [0, 2**52) are the low mantissa bits of MAGIC + them
@@ -138,3 +141,29 @@ def within_packing(pose: np.ndarray, ru: np.ndarray, rv: np.ndarray, max_depth: 
                           abs(float(rv[-1])), 1.0)
     return all((abs(row[3]) + (abs(row[0]) + abs(row[1]) + abs(row[2])) * ext) * inv
                < limit - 2 for row in T[:3])  # False for NaN
+
+
+class MapRangeError(SgtoolError):
+    """A frame's points fall outside the range of the voxel keys (they would be lost)."""
+
+
+def beyond_packing(what: str, camera: np.ndarray | None, resolution: float, limit: int
+                   ) -> MapRangeError:
+    """The one-line error for a frame (``what``: "frame 3 at 0.100 s") whose points reach
+    voxel indices of magnitude ``limit`` or more (or are not finite): names the camera
+    position (``camera``, world_T_camera; None for bare points), the range in metres and
+    the fix."""
+    if camera is None:
+        who = "world points (or NaN) reach"
+    else:
+        t = np.asarray(camera, dtype=np.float64)
+        if not np.all(np.isfinite(t)):
+            return MapRangeError(f"{what}: the camera pose is not finite; the frame cannot "
+                                 "be mapped")
+        who = "the camera at ({}) m sees points".format(
+            ", ".join(f"{v:.1f}" for v in t[:3, 3].tolist()))
+    reach = (limit - 1) * resolution
+    return MapRangeError(
+        f"{what}: {who} beyond +-{reach:.1f} m of the world origin, the voxel map's range "
+        f"at {resolution:g} m voxels; recentre the trajectory near the origin (subtract "
+        "e.g. the first pose's position from every pose) and import it again")

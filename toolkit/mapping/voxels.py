@@ -17,9 +17,13 @@ are merged).
 
 Integration (:meth:`VoxelMap.integrate`): valid depth in ``[min_range, max_range)``
 (MoMa-LLM: 0-5 m) is back-projected with the intrinsics, moved to the world by the pose,
-quantised and packed; the frame's distinct keys with counts are kept aside and merged into
-the map every few frames (one ``searchsorted`` + ``insert`` for many frames, into a small
-sorted tail merged into the big array now and then: :mod:`sgtool.mapping.vote_store`).
+quantised and packed (a frame with points beyond the packing's range, or not finite, is
+refused with :class:`~sgtool.mapping.backproject.MapRangeError`: never dropped silently;
+the per-frame bound on the pose, :func:`~sgtool.mapping.backproject.within_packing`,
+spares valid frames the per-point range); the frame's distinct keys with counts are kept
+aside and merged into the map every few frames (one ``searchsorted`` + ``insert`` for
+many frames, into a small sorted tail merged into the big array now and then:
+:mod:`sgtool.mapping.vote_store`).
 Per instance the map also keeps what the scene graph needs without scanning the voxels:
 the points per frame (an object counts as *seen* when one frame shows it with at least
 ``min_points`` points; MoMa-LLM: > 50), the closest viewpoint it was seen from (MoMa-LLM
@@ -45,7 +49,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sgtool.log.frame import CameraIntrinsics, Frame
-from sgtool.mapping.backproject import Scratch, within_packing, world_voxels
+from sgtool.mapping.backproject import Scratch, beyond_packing, within_packing, world_voxels
 from sgtool.mapping.key_count import count_keys
 from sgtool.mapping.label_stats import LabelStats, update_frame
 from sgtool.mapping.vote_store import VoteStore, drain_keys
@@ -203,15 +207,16 @@ class VoxelMap:
             self._integrate_dense(d, valid, ru, rv, frame, viewpoint)
             return n_ok
         idx = np.flatnonzero(valid)
-        wx, wy, wz, keys, rng = world_voxels(d, idx, ru, rv, frame.pose, inv,
-                                             (SHIFT_X, SHIFT_Y, SHIFT_Z), OFFSET, self._scratch,
-                                             need_range=not safe)
+        wx, wy, _, keys, rng = world_voxels(d, idx, ru, rv, frame.pose, inv,
+                                            (SHIFT_X, SHIFT_Y, SHIFT_Z), OFFSET, self._scratch,
+                                            need_range=not safe)
+        if not (safe or all(-lim < v < lim for v in rng)):  # out of the packing, NaN
+            raise beyond_packing(f"frame {frame.index} at {frame.time_ns / 1e9:.3f} s",
+                                 frame.pose, cfg.resolution, lim)
         if frame.ids is not None:
             lab = self.labels_of(np.asarray(frame.ids).reshape(-1)[idx])
         else:
             lab = np.zeros(idx.size, dtype=np.int64)
-        if not (safe or all(-lim < v < lim for v in rng)):  # out of the packing, NaN
-            return self._fuse(wx.copy(), wy.copy(), wz, lab, viewpoint, frame.index)
         np.add(keys, lab, out=keys)
         return self._count(keys, wx, wy, lab, viewpoint, frame.index)
 
@@ -256,10 +261,8 @@ class VoxelMap:
         vz = np.floor(wz * inv).astype(np.int64)
         lim = OFFSET - 1
         if vx.size and not all(-lim < int(a.min()) and int(a.max()) < lim
-                               for a in (vx, vy, vz)):
-            ok = (np.abs(vx) < lim) & (np.abs(vy) < lim) & (np.abs(vz) < lim)
-            vx, vy, vz, labels = vx[ok], vy[ok], vz[ok], labels[ok]
-            wx, wy = wx[ok], wy[ok]
+                               for a in (vx, vy, vz)):  # out of the packing, NaN
+            raise beyond_packing(f"frame {frame_index}", None, self.config.resolution, lim)
         if vx.size == 0:
             return 0
         return self._count(pack(vx, vy, vz, labels), wx, wy, labels, viewpoint, frame_index)

@@ -20,8 +20,6 @@ from sgtool.mapping.voxels import (
     SHIFT_X,
     SHIFT_Y,
     SHIFT_Z,
-    VoxelConfig,
-    VoxelMap,
     pack,
 )
 
@@ -108,20 +106,6 @@ def test_count_keys_equals_unique_with_and_without_runs():
         uk, cnt = count_keys(keys.astype(np.int64))
         want_k, want_c = np.unique(keys, return_counts=True)
         assert np.array_equal(uk, want_k) and np.array_equal(cnt, want_c)
-
-
-def test_points_beyond_the_packing_are_dropped_as_before():
-    vm = VoxelMap(VoxelConfig(resolution=0.05))
-    from sgtool.log.frame import CameraIntrinsics, Frame
-
-    depth = np.full((4, 4), 2.0, np.float32)
-    pose = np.eye(4)
-    pose[0, 3] = (OFFSET - 2) * 0.05 - 0.01  # the frame straddles the packing's +x edge
-    k = CameraIntrinsics(4, 4, 2.0, 2.0, 1.5, 1.5)
-    used = vm.integrate(Frame(0, 0, None, depth, None, pose, k, None))
-    idx, _, _, world, _ = plain(depth, pose, 2.0, 2.0, 1.5, 1.5, 0.05)
-    inside = int((np.abs(np.floor(world[0] / 0.05)) < OFFSET - 1).sum())
-    assert 0 < used == inside < idx.size
 
 
 def test_the_packing_bound_holds_and_skipping_the_range_keeps_the_keys():
