@@ -113,7 +113,7 @@ def export(
             require_space(Path(rrd_path))  # type: ignore[arg-type]
             rec.save(tmp)
             progress = _watching_space(Path(rrd_path), progress)  # type: ignore[arg-type]
-        with LogReader(log_path) as r:
+        with LogReader(log_path, verify=True) as r:  # a damaged chunk: one line, no .rrd
             _export(rec, r, every=every, max_frames=max_frames, progress=progress,
                     voxels=voxels)
         rec.flush(timeout_sec=FLUSH_TIMEOUT_S)

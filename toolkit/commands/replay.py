@@ -69,8 +69,9 @@ from sgtool.scenegraph.options import CLASSIFIERS
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of text.")
 @click.option("--force", is_flag=True, help="Overwrite the output files.")
 @click.option("--verify", is_flag=True,
-              help="Check every chunk CRC of LOG as it is read (slower; `sgtool doctor LOG` "
-              "checks a whole log without replaying it).")
+              help="Check every chunk CRC of LOG as it is read (always on with -o or "
+              "--out-dir: a damaged chunk is never copied into a derived log; `sgtool doctor "
+              "LOG` checks a whole log without replaying it).")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
 @click.option("--out-dir", type=click.Path(file_okay=False), default=None,

@@ -69,3 +69,16 @@ def test_a_replay_that_rewrites_the_messages_refuses_the_damage_too(tmp_path):
     assert not out.exists()
     good = frames_log(tmp_path / "good.mcap", noise=b"x" * 100)
     assert replay(good, out, copy_chunks=False).frames == 4  # the control
+
+
+def test_view_refuses_a_damaged_chunk_in_one_line_and_writes_no_rrd(tmp_path, capsys):
+    pytest.importorskip("rerun")
+    path, offset = damaged_log(tmp_path)
+    rrd = tmp_path / "flip.rrd"
+    with pytest.raises(SystemExit) as e:
+        main(["view", str(path), "-o", str(rrd)])
+    err = capsys.readouterr().err
+    assert e.value.code == 2
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert f"chunk at byte {offset}: CRC mismatch" in err
+    assert not rrd.exists() and not list(tmp_path.glob("*.rrd*"))
