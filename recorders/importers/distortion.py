@@ -11,6 +11,8 @@ model k1..k4). A shift of ``WARN_SHIFT_PX`` or more is a warning, a smaller one 
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from sgtool.log.frame import CameraIntrinsics
@@ -37,8 +39,17 @@ def distortion_shift_px(model: str, coeffs: tuple[float, ...],
     c[: min(len(coeffs), 8)] = coeffs[:8]
     if not np.all(np.isfinite(c)):
         return None
+    with np.errstate(all="ignore"):  # implausible coefficients overflow: an inf shift
+        shift = _shift(model.strip().lower(), c, x, y, k)
+    if shift is None:
+        return None
+    return float(np.max(shift)) if np.all(np.isfinite(shift)) else math.inf
+
+
+def _shift(name: str, c: np.ndarray, x: np.ndarray, y: np.ndarray,
+           k: CameraIntrinsics) -> np.ndarray | None:
+    """The shift (pixels) of each ray (x, y), None for a model sgtool does not know."""
     r2 = x * x + y * y
-    name = model.strip().lower()
     if name in ("plumb_bob", "rational_polynomial", ""):
         k1, k2, p1, p2, k3, k4, k5, k6 = c
         radial = (1 + r2 * (k1 + r2 * (k2 + r2 * k3))) / (1 + r2 * (k4 + r2 * (k5 + r2 * k6)))
@@ -54,8 +65,7 @@ def distortion_shift_px(model: str, coeffs: tuple[float, ...],
         xd, yd = x * scale, y * scale
     else:
         return None
-    shift = np.hypot((xd - x) * k.fx, (yd - y) * k.fy)
-    return float(np.max(shift))
+    return np.hypot((xd - x) * k.fx, (yd - y) * k.fy)
 
 
 def distortion_finding(distortion: tuple[str, tuple[float, ...]] | None, topic: str,
@@ -69,8 +79,9 @@ def distortion_finding(distortion: tuple[str, tuple[float, ...]] | None, topic: 
         return None
     shift = distortion_shift_px(model, coeffs, k)
     listed = ",".join(f"{v:g}" for v in coeffs)
-    how_far = (f"it moves pixels by up to {shift:.1f} px" if shift is not None else
-               "its effect is not known to sgtool")
+    how_far = ("its effect is not known to sgtool" if shift is None else
+               "it moves pixels by more than 10,000 px (implausible coefficients)"
+               if shift > 1e4 else f"it moves pixels by up to {shift:.1f} px")
     text = (f"--info {topic} has {model or 'unnamed'} lens distortion (D={listed}) and sgtool "
             f"does not undistort: {how_far}, and depth points near the image edges are "
             "misplaced accordingly; import rectified images (image_rect topics) if the bag "

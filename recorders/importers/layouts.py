@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, replace
+from decimal import Decimal
 from pathlib import Path
 
 import numpy as np
@@ -159,15 +160,22 @@ def _color_dir(root: Path) -> Path | None:
     return None
 
 
-def natural_key(name: str) -> tuple[tuple[int, int | str], ...]:
-    """Sort key of a file name by its numbers' values ("2.png" before "10.png"), as Open3D's
-    ``sorted_alphanum``."""
-    return tuple((0, int(t)) if t.isdecimal() else (1, t) for t in re.split(r"(\d+)", name) if t)
+_NUMBER = re.compile(r"(\d+(?:\.\d+)?)")  # digits, with a fraction after one dot
+
+
+def natural_key(name: str) -> tuple[tuple[int, Decimal | str], ...]:
+    """Sort key of a file name by its numbers' values: "2.png" before "10.png", as Open3D's
+    ``sorted_alphanum``; a number with a fraction ("1305031103.05.png", a time stamp) is
+    one decimal number, so "X.05" comes before "X.1" as in time (``sorted_alphanum`` would
+    compare 5 with 1)."""
+    return tuple((0, Decimal(t)) if _NUMBER.fullmatch(t) else (1, t)
+                 for t in _NUMBER.split(name) if t)
 
 
 def _images(folder: Path) -> list[Path]:
     """The image files of ``folder`` in natural order (names numbered without zero padding
-    sort by value); names whose numbers tie ("1.png" and "01.png") are an error."""
+    sort by value); names whose numbers tie ("1.png" and "01.png", "2.5.png" and "2.50.png")
+    are an error."""
     found = sorted((p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_EXT),
                    key=lambda p: (natural_key(p.name), p.name))
     for a, b in zip(found, found[1:], strict=False):

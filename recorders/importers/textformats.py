@@ -114,6 +114,10 @@ def rigid_problem(m: np.ndarray) -> tuple[int, str] | None:
     if np.abs(last - (0.0, 0.0, 0.0, 1.0)).max() > RIGID_TOL:
         return 3, f"the last row is {' '.join(f'{v:g}' for v in last)}, not 0 0 0 1"
     r = m[:3, :3]
+    big = float(np.abs(r).max())
+    if big > 1e100:  # (r.T @ r would overflow; a rotation's entries are within +-1)
+        return 0, (f"the rotation is not orthonormal with det +1 (an entry of magnitude "
+                   f"{big:.4g}): not a rigid camera pose (scaled or sheared)")
     ortho = float(np.abs(r.T @ r - np.eye(3)).max())
     det = float(np.linalg.det(r))
     if ortho > RIGID_TOL or abs(det - 1.0) > RIGID_TOL:
@@ -218,7 +222,8 @@ def read_intrinsics_file(path: Path) -> PinholeParams:
             m = np.asarray(d["intrinsic_matrix"], dtype=np.float64).reshape(3, 3).T
             w, h = d.get("width"), d.get("height")
             size = (int(w) if w else None, int(h) if h else None)
-        except (json.JSONDecodeError, KeyError, ValueError, TypeError, AttributeError) as e:
+        except (json.JSONDecodeError, KeyError, ValueError, TypeError, AttributeError,
+                OverflowError) as e:  # (OverflowError: "width": 1e999)
             raise SgtoolError(
                 f"{path}: expected Open3D intrinsics JSON with 'width', 'height' and a "
                 f"9-number 'intrinsic_matrix' ({type(e).__name__}: {e})"

@@ -13,3 +13,10 @@ def test_node_ids_with_superscripts_sort_as_text() -> None:
     assert _idkey("obj:²") == ("obj", ((1, "²"),))
     assert sorted(["obj:10", "obj:²", "obj:2"], key=natural_key) == ["obj:2", "obj:10", "obj:²"]
     assert natural_key("room:١٢") == ("room", ((0, 12),))  # Arabic-Indic digits: a number
+
+
+def test_a_house_seed_that_is_no_integer_is_none() -> None:
+    from sgtool.log.inspect import _SEED
+
+    assert [bool(_SEED.fullmatch(s)) for s in ("12", "-3", "--5", "²", "1-", "")] == \
+        [True, True, False, False, False, False]

@@ -114,16 +114,22 @@ def _openings_clear(spec: HouseSpec) -> None:
                     for w in walls])
     for key, openings in (("doors", spec.doors), ("passages", spec.passages)):
         for i, d in enumerate(openings):
-            p, q = opening_segment(d.center, max(d.width - 2 * _OPENING_EDGE, d.width / 2), d.yaw)
+            p, q = opening_segment(d.center, d.width, d.yaw)
             x0, x1 = min(p[0], q[0]), max(p[0], q[0])
             y0, y1 = min(p[1], q[1]), max(p[1], q[1])
             near = np.flatnonzero((boxes[:, 0] <= x1) & (x0 <= boxes[:, 2])
                                   & (boxes[:, 1] <= y1) & (y0 <= boxes[:, 3]))
             for k in near:
                 w = walls[k]
-                if length_in_strip(p, q, w.a, w.b, w.thickness / 2) > _COVERED:
+                # a wall meeting the opening's end (a corner, a jamb) reaches in by half its
+                # thickness: only the opening's inner part counts (at least its middle half)
+                edge = _OPENING_EDGE + w.thickness / 2
+                a, b = opening_segment(d.center, max(d.width - 2 * edge, d.width / 2), d.yaw)
+                if length_in_strip(a, b, w.a, w.b, w.thickness / 2) > _COVERED:
+                    covered = length_in_strip(p, q, w.a, w.b, w.thickness / 2)
                     raise SpecError(f"{key}[{i}]: its opening ({d.id}) is covered by "
-                                    f"walls[{k}] ({w.id}); walls have gaps where doors and "
+                                    f"walls[{k}] ({w.id}) over {covered:.2f} m of its "
+                                    f"{d.width:.2f} m; walls have gaps where doors and "
                                     "passages are")
 
 

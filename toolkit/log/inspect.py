@@ -12,6 +12,7 @@ command turns it into one, for commands that need an sgtool log (``sgtool replay
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +20,8 @@ from sgtool.log import codec
 from sgtool.log import schemas as S
 from sgtool.log.assembly import decoded
 from sgtool.log.reader import LogReader
+
+_SEED = re.compile(r"-?\d{1,30}")  # a house seed in the metadata (any other text: none)
 
 
 def _fmt_time(t_ns: int) -> str:
@@ -64,7 +67,7 @@ def summarize(path: str | os.PathLike[str]) -> dict[str, Any]:
         out["readable"] = v is None or v[0] <= S.LOG_SCHEMA_VERSION[0]
         out["seed"] = r.seed
         hs = r.metadata.get(S.METADATA_NAME, {}).get("house_seed", "")
-        out["house_seed"] = int(hs) if hs.lstrip("-").isdecimal() else None
+        out["house_seed"] = int(hs) if _SEED.fullmatch(str(hs)) else None
         if not out["readable"]:
             return out
         out["frames"] = r.frame_count()

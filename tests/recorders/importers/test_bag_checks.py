@@ -162,6 +162,14 @@ def test_distortion_shift_of_known_models():
     assert small is not None and not small[1] and "does not undistort" in small[0]
 
 
+def test_implausible_distortion_is_a_warning_without_numpy_warnings(recwarn):
+    k = CameraIntrinsics(640, 480, 500.0, 500.0, 319.5, 239.5)
+    assert distortion_shift_px("plumb_bob", (1e300, 1e300, 0, 0, 1e300), k) > 1e4
+    text, warn = distortion_finding(("plumb_bob", (1e300, 0, 0, 0, 0)), "/info", k)
+    assert warn and "more than 10,000 px (implausible coefficients)" in text
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+
+
 def test_camera_info_with_distortion_is_reported(tmp_path):
     """A noticeable distortion is a warning (shown at once and kept in the log metadata),
     a slight one a note; zero coefficients say nothing."""

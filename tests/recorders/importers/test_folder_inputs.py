@@ -326,3 +326,36 @@ def test_file_names_with_superscripts_sort_as_text() -> None:
 
     names = ["²1.png", "10.png", "2.png"]  # "²" alone: isdigit() but not int()
     assert sorted(names, key=file_key) == ["2.png", "10.png", "²1.png"]
+
+
+def test_time_stamp_names_with_fractions_sort_in_time() -> None:
+    """A number with a fraction is one decimal number: "X.05" before "X.1" (time order),
+    and fixed-width TUM names keep their order; only equal values tie."""
+    from sgtool.recorders.importers.layouts import natural_key as file_key
+
+    names = ["1305031103.1.png", "1305031103.05.png", "1305031102.175304.png", "10.png"]
+    assert sorted(names, key=file_key) == ["10.png", "1305031102.175304.png",
+                                           "1305031103.05.png", "1305031103.1.png"]
+    assert file_key("2.5.png") == file_key("2.50.png")
+    assert file_key("1305031103.5.png") != file_key("1305031103.05.png")
+
+
+def test_huge_pose_entries_and_intrinsics_sizes_are_one_line(tmp_path, recwarn) -> None:
+    """Finite but huge numbers: no numpy overflow warning before the one-line refusal, no
+    OverflowError traceback."""
+    import numpy as np
+    import pytest
+
+    from sgtool.errors import SgtoolError
+    from sgtool.recorders.importers.textformats import read_intrinsics_file, rigid_problem
+
+    m = np.eye(4)
+    m[0, 0] = 1e200
+    row, why = rigid_problem(m)
+    assert row == 0 and "not orthonormal with det +1 (an entry of magnitude 1e+200)" in why
+    f = tmp_path / "camera.json"
+    f.write_text('{"width": 1e999, "height": 480, "intrinsic_matrix": '
+                 '[525, 0, 0, 0, 525, 0, 319.5, 239.5, 1]}')
+    with pytest.raises(SgtoolError, match="expected Open3D intrinsics JSON"):
+        read_intrinsics_file(f)
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]

@@ -205,6 +205,20 @@ def test_a_door_covered_by_a_wall_is_refused() -> None:
     _refused(d, r"^doors\[0\]: its opening \(door_0\) is covered by walls\[6\]")
 
 
+def test_a_door_beside_a_thick_corner_wall_loads() -> None:
+    """A wall that meets an opening's end reaches in by half its thickness: a door in a
+    corner of a 0.3 m outer wall loads (0.15 m of its 0.9 m are behind the wall's body)."""
+    d = two_rooms()
+    d["walls"][0]["thickness"] = 0.3
+    d["walls"][4] = {"id": "wall_4", "a": [4, 0.95], "b": [4, 4]}
+    del d["walls"][5]
+    d["doors"][0]["center"] = [4, 0.5]
+    assert load_house(d).doors[0].center[1] == pytest.approx(0.5)
+    d["walls"].append({"id": "wall_6", "a": [3.5, 0.6], "b": [4.5, 0.6]})  # across it
+    _refused(d, r"^doors\[0\]: its opening \(door_0\) is covered by walls\[5\] \(wall_6\) "
+                r"over 0\.10 m of its 0\.90 m")
+
+
 def test_a_passage_covered_by_a_wall_is_refused() -> None:
     d = two_rooms()
     door = d.pop("doors")[0]
