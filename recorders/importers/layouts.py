@@ -32,6 +32,7 @@ from sgtool.recorders.importers.poses import PoseTrack
 from sgtool.recorders.importers.sanity import time_range_problem, timestamp_problem
 from sgtool.recorders.importers.textformats import (
     PinholeParams,
+    is_open3d_log,
     read_intrinsics_file,
     read_open3d_log,
     read_pose_file,
@@ -280,7 +281,7 @@ def _read_tum(
         if problem:
             raise SgtoolError(problem)
     gt_path = trajectory or (root / "groundtruth.txt")
-    if trajectory is not None and trajectory.suffix == ".log":
+    if trajectory is not None and is_open3d_log(trajectory):
         return _read_tum_log_poses(root, rgb, depth, max_dt_ns, trajectory, notes)
     track = None
     if gt_path.is_file():
@@ -425,7 +426,7 @@ def _external_poses(trajectory: Path | None, count: int,
         return None
     if not trajectory.is_file():
         raise SgtoolError(f"--trajectory {trajectory}: no such file")
-    if trajectory.suffix == ".log":
+    if is_open3d_log(trajectory):
         poses = read_open3d_log(trajectory)
     else:
         poses = [T for _, T in read_tum_trajectory(trajectory)]

@@ -259,3 +259,17 @@ def parse_intrinsics(text: str) -> PinholeParams:
             "(Open3D JSON, or a 3x3 matrix as text)"
         )
     return read_intrinsics_file(path)
+
+
+def is_open3d_log(path: Path) -> bool:
+    """Whether a ``--trajectory`` file is an Open3D ``.log`` (any case of the suffix, and
+    a first line of three numbers: the frame ids of a 4x4 block) rather than a TUM
+    trajectory (eight numbers a line), whatever its name."""
+    if path.suffix.lower() != ".log" or not path.is_file():
+        return False
+    with path.open("rb") as f:
+        for raw in f:
+            line = raw.decode("utf-8", "replace").strip()
+            if line and not line.startswith("#"):
+                return len(line.split()) == 3
+    return False

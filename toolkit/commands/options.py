@@ -93,6 +93,21 @@ def house_from_options(path: str | None, seed: int | None, rooms: str) -> tuple[
     return demo_house(), "demo"
 
 
+def with_starts(house: Any, label: str) -> Any:
+    """``house`` with start poses: a hand-made house without ``starts`` gets one per
+    reachable room, as `sgtool bench` gives it; none possible is an error naming
+    ``label`` (the house file)."""
+    if house.starts:
+        return house
+    from sgtool.datasets.start_poses import with_start_poses
+
+    house = with_start_poses(house, house.seed)
+    if not house.starts:
+        raise SgtoolError(f"{label}: starts: none given, and none can be made (no free floor "
+                          "reachable from the first room); add a \"starts\" entry")
+    return house
+
+
 def option_group(options: Sequence[Callable[[F], F]]) -> Callable[[F], F]:
     """One decorator of several click options, listed in ``--help`` in the order given."""
     def decorate(f: F) -> F:

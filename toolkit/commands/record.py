@@ -90,7 +90,7 @@ def command(house_path: str | None, seed: int | None, rooms: str, output: str,
     """
     from dataclasses import replace
 
-    from sgtool.commands.options import house_from_options, parse_resolution
+    from sgtool.commands.options import house_from_options, parse_resolution, with_starts
     from sgtool.recorders.sim import (
         CameraConfig,
         RecordOptions,
@@ -117,14 +117,7 @@ def command(house_path: str | None, seed: int | None, rooms: str, output: str,
     robot = replace(RobotConfig(), speed=speed)
     profile = parse_noise(noise)
     house, house_id = house_from_options(house_path, seed, rooms)
-    if not house.starts:  # a hand-made house: start poses as `sgtool bench` gives it
-        from sgtool.datasets.start_poses import with_start_poses
-
-        house = with_start_poses(house, house.seed)
-        if not house.starts:
-            raise SgtoolError(f"{house_path or house_id}: starts: none given, and none can "
-                              "be made (no free floor reachable from the first room); add a "
-                              "\"starts\" entry")
+    house = with_starts(house, house_path or house_id)  # a hand-made house: as bench does
     opts = RecordOptions(fps=fps, frames=frames, camera=camera, robot=robot, noise=profile,
                          seed=noise_seed, start=start,
                          script=ScriptOptions(open_containers=not no_open_containers),

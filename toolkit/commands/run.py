@@ -106,7 +106,7 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
 
     Example: `sgtool run --planner scout --query bowl -o bowl.mcap`.
     """
-    from sgtool.commands.options import house_from_options, parse_resolution
+    from sgtool.commands.options import house_from_options, parse_resolution, with_starts
     from sgtool.recorders.sim import CameraConfig, parse_noise
     from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
     from sgtool.recorders.sim.frame_budget import frame_budget
@@ -144,6 +144,7 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
     width, height = parse_resolution(resolution)
     camera = CameraConfig(width=width, height=height)
     house, house_id = house_from_options(house_path, seed, rooms)
+    house = with_starts(house, house_path or house_id)  # a hand-made house: as bench does
     index, ep = pick_episode(house, query=query, index=episode)
     frames = frame_budget(frames, frames_per_room, len(house.rooms))
     opts = ClosedLoopOptions(fps=fps, camera=camera, every=every, classifier=classifier,

@@ -359,3 +359,16 @@ def test_huge_pose_entries_and_intrinsics_sizes_are_one_line(tmp_path, recwarn) 
     with pytest.raises(SgtoolError, match="expected Open3D intrinsics JSON"):
         read_intrinsics_file(f)
     assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+
+
+def test_a_trajectory_file_is_read_by_its_content_not_only_its_suffix(tmp_path) -> None:
+    """An Open3D .log (any case of the suffix) starts with three frame ids; a TUM
+    trajectory that happens to end in .log (eight numbers a line) is read as TUM."""
+    from sgtool.recorders.importers.textformats import is_open3d_log
+
+    o3d = tmp_path / "traj.LOG"
+    o3d.write_text("0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n")
+    tum = tmp_path / "groundtruth.log"
+    tum.write_text("# timestamp tx ty tz qx qy qz qw\n1.0 0 0 0 0 0 0 1\n")
+    assert is_open3d_log(o3d) and not is_open3d_log(tum)
+    assert not is_open3d_log(tmp_path / "traj.txt") and not is_open3d_log(tmp_path / "x.log")

@@ -45,3 +45,17 @@ def test_a_house_where_no_start_can_be_made_is_refused(tmp_path: Path) -> None:
     assert res.output.strip() == (
         f"sgtool: error: {tiny}: starts: none given, and none can be made (no free floor "
         "reachable from the first room); add a \"starts\" entry")
+
+
+def test_run_on_a_house_without_starts_starts_where_bench_would(tmp_path: Path) -> None:
+    """`sgtool run` gives a house file without starts the same start poses as record."""
+    house = write_cottage(tmp_path)  # "starts": []
+    out = tmp_path / "run.mcap"
+    res = CliRunner().invoke(cli, ["run", "--planner", "random", "--house", str(house),
+                                   "--episode", "0", "--frames", "30", "--resolution", "64x48",
+                                   "--quiet", "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    spec = load_house(house)
+    with LogReader(out) as r:
+        logged = load_house(json.loads(r.house_json() or "{}"))
+    assert logged.starts == with_start_poses(spec, spec.seed).starts
