@@ -50,7 +50,7 @@ from typing import Any
 
 from sgtool.analysis.validity import SEARCH_KIND, episode_problem
 from sgtool.errors import SgtoolError
-from sgtool.log.records import Absent, Episode, LogRecord, SceneGraphRecord, given
+from sgtool.log.records import ABSENT, Absent, Episode, LogRecord, SceneGraphRecord, given
 from sgtool.log.records import Action as LoggedAction
 from sgtool.planning.base import Action, Feedback
 from sgtool.planning.episode import NOT_CONFIRMED, check_success_rule
@@ -155,9 +155,12 @@ def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
 
 
 def _ended(opened: Episode | None) -> Episode:
-    """The closing record of an episode that has none (a killed run)."""
+    """The closing record of an episode that has none (a killed run): the opening record's
+    fields, but its steps, distance and frames (zero when it opened) are left to be derived
+    from the actions logged until the run stopped."""
     return dataclasses.replace(opened or Episode(kind="search", status="ended"),
-                               status="ended")
+                               status="ended", steps=ABSENT, travelled_m=ABSENT,
+                               frames=ABSENT)
 
 
 def _decided_on(action: LoggedAction, latest: SceneGraph | None, times: list[int],

@@ -74,7 +74,8 @@ def test_multi_episode_and_unfinished_logs(tmp_path, house):
         log.write_record("episode", 2, {"kind": "search", "status": "success", "steps": 1,
                                         "travelled_m": 2.0, "shortest_m": 1.0})
         log.write_record("episode", 3, {"kind": "search", "status": "started", "query": "mug",
-                                        "planner": "x"})
+                                        "planner": "x", "steps": 0, "travelled_m": 0.0,
+                                        "frames": 0})  # as the closed loop opens one
         log.write_record("action", 4, {"skill": "explore", "target": "room:1",
                                        "outcome": "success", "travelled_m": 3.0})
         log.write_record("action", 5, {"skill": "open", "target": "obj:1",

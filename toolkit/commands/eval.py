@@ -4,8 +4,10 @@
 from __future__ import annotations
 
 import json
+import math
 import sys
 from dataclasses import asdict
+from pathlib import Path
 from typing import Any
 
 import click
@@ -28,19 +30,21 @@ from sgtool.errors import SgtoolError
                    "/sgtool/llm channel; repeatable) instead of an endpoint [default: the "
                    "exchanges of the MCAP inputs, when they have any].")
 @success_option(recorded=True)
-@click.option("--distance-budget", default=5000.0, show_default=True,
+@click.option("--distance-budget", type=click.FloatRange(min=0, min_open=True), default=5000.0,
+              show_default=True,
               help="AUC-E distance variant budget max (low-level steps: 0.1 m = 1, open = 30).")
-@click.option("--step-budget", default=50.0, show_default=True,
-              help="AUC-E step variant budget max (high-level steps).")
+@click.option("--step-budget", type=click.FloatRange(min=0, min_open=True), default=50.0,
+              show_default=True, help="AUC-E step variant budget max (high-level steps).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of tables.")
 @click.option("-o", "--out", type=click.Path(dir_okay=False), default=None,
               help="Also write the output to this file (JSON if it ends in .json).")
+@click.option("--force", is_flag=True, help="Overwrite the -o file.")
 @executor_options("file reads (one per input)")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
 def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: tuple[str, ...],
             llm_replay: tuple[str, ...], distance_budget: float, step_budget: float,
-            as_json: bool, out: str | None, success: str | None = None,
+            as_json: bool, out: str | None, force: bool = False, success: str | None = None,
             executor: str = "local", workers: int = 1, ray_address: str | None = None,
             progress: bool | None = None) -> None:
     """Recompute the benchmark metrics (SR, SPL, steps, decision time, AUC-E with both
@@ -67,13 +71,20 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
         with_success_rule,
     )
     from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
-    from sgtool.commands.options import planner_options
+    from sgtool.commands.options import check_output, planner_options
     from sgtool.files import atomic_write
     from sgtool.llm.stats import answer_stats, format_stats
     from sgtool.planning.registry import make_planner
 
+    for name, value in (("--distance-budget", distance_budget), ("--step-budget", step_budget)):
+        if not math.isfinite(value):
+            raise SgtoolError(f"{name} {value}: must be a finite number > 0")
     runner = make_executor(executor, workers, ray_address)
     inputs = tuple(map(str, expand_inputs(inputs, (".mcap",), "MCAP logs")))
+    if out:
+        check_output(out, force=force)
+        if any(Path(out).resolve() == Path(i).resolve() for i in inputs):
+            raise SgtoolError(f"-o {out}: the output must not be an input")
     show = progress if progress is not None else sys.stderr.isatty()
     results, logged, notes, unread = load_many(inputs, runner, progress=show)
     results = [with_success_rule(r, success) for r in results]

@@ -15,6 +15,7 @@ from sgtool.errors import SgtoolError
 @click.argument("log", type=click.Path(dir_okay=False))
 @click.option("-o", "--out", type=click.Path(dir_okay=False),
               help="Write a Rerun recording (.rrd) instead of opening the viewer.")
+@click.option("--force", is_flag=True, help="Overwrite the -o file.")
 @click.option("--every", type=click.IntRange(min=1), default=1, show_default=True,
               help="Log one camera frame in K (maps, graphs and actions are always logged).")
 @click.option("--max-frames", type=click.IntRange(min=1), default=None,
@@ -22,7 +23,7 @@ from sgtool.errors import SgtoolError
 @click.option("--voxels/--no-voxels", default=True, show_default=True,
               help="Rebuild and show the semantic voxel map (needs the mapping pipeline).")
 def command(log: str, out: str | None, every: int, max_frames: int | None,
-            voxels: bool) -> None:
+            voxels: bool, force: bool = False) -> None:
     """Show LOG in Rerun: camera with RGB, depth and segmentation, the voxel map, BEV
     occupancy, the Voronoi graph coloured by room, room labels, objects, frontiers, the
     robot's path and its actions, on a frame timeline. Derived layers appear when LOG is
@@ -48,6 +49,10 @@ def command(log: str, out: str | None, every: int, max_frames: int | None,
             raise SgtoolError("the `rerun` viewer is not on PATH; use -o view.rrd")
     elif Path(out).resolve() == Path(log).resolve():
         raise SgtoolError("the output must not be the input log")
+    else:
+        from sgtool.commands.options import check_output
+
+        check_output(out, force=force)
     with LogReader(log) as r:
         total = r.frame_count() if r.has("/camera/depth") else 0
     if max_frames is not None:

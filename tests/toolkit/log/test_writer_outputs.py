@@ -295,3 +295,31 @@ def test_main_ignores_ctrl_c_once_the_command_is_done(tmp_path):
         assert signal.getsignal(signal.SIGINT) == signal.SIG_IGN
     finally:
         signal.signal(signal.SIGINT, before)
+
+
+def test_eval_and_view_never_overwrite_without_force(tmp_path):
+    """eval -o and view -o refuse an existing file (the input log included) unless --force,
+    and eval never writes over one of its inputs; budgets must be finite and > 0."""
+    from sgtool.results import EpisodeResult, write_jsonl
+
+    eps = write_jsonl([EpisodeResult("greedy", 0, "h", 0, "mug", True, 2, 3.0, 2.5)],
+                      tmp_path / "episodes.jsonl")
+    before = eps.read_bytes()
+    r = CliRunner().invoke(cli, ["eval", str(eps), "-o", str(eps)])
+    assert r.exit_code == 2 and f"{eps} exists; not overwriting it (use --force)" in r.output
+    r = CliRunner().invoke(cli, ["eval", str(eps), "-o", str(eps), "--force"])
+    assert r.exit_code == 2 and "the output must not be an input" in r.output
+    assert eps.read_bytes() == before
+    out = tmp_path / "e.txt"
+    assert CliRunner().invoke(cli, ["eval", str(eps), "-o", str(out)]).exit_code == 0
+    assert CliRunner().invoke(cli, ["eval", str(eps), "-o", str(out)]).exit_code == 2
+    assert CliRunner().invoke(cli, ["eval", str(eps), "-o", str(out), "--force"]).exit_code == 0
+    for bad in ("0", "-1", "nan", "inf"):
+        r = CliRunner().invoke(cli, ["eval", str(eps), "--distance-budget", bad])
+        assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1, (bad, r.output)
+    log = write_log(tmp_path / "run.mcap")
+    other = tmp_path / "other.mcap"
+    other.write_bytes(log.read_bytes())
+    r = CliRunner().invoke(cli, ["view", str(log), "-o", str(other), "--no-voxels"])
+    assert r.exit_code == 2 and "exists; not overwriting it (use --force)" in r.output
+    assert other.read_bytes() == log.read_bytes()
