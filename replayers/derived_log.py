@@ -308,6 +308,10 @@ class _Feed:
             if topic in self.frame_topics:
                 if not self.take_frame(self.asm.push(topic, t, decoded)):
                     return False
+                if self.opts.max_frames is not None and \
+                        self.report.frames >= self.opts.max_frames:
+                    self.report.truncated = True  # a frame past the budget: not copied
+                    return False
             else:
                 if not self.take_frame(self.asm.flush()):
                     return False

@@ -69,3 +69,16 @@ def test_what_is_not_copied(tmp_path):
     replay(first, again)
     replay(first, again_written, copy_chunks=False)
     assert again.read_bytes() == again_written.read_bytes()
+
+
+def test_max_frames_copies_exactly_that_many_frames(tmp_path):
+    """--max-frames N: the derived log holds the N frames that were integrated, not the
+    start of frame N + 1 (its images and poses arrive before the frame is complete)."""
+    out = tmp_path / "cut.mcap"
+    report = replay(TOUR, out, ReplayOptions(max_frames=20))
+    assert report.frames == 20 and report.truncated
+    with LogReader(out) as r:
+        assert r.message_count("/camera/depth") == 20
+        last_depth = max(d.log_time_ns for d in r.messages(["/camera/depth"]))
+        assert max(d.log_time_ns for d in r.messages(["/tf"])) <= last_depth
+        assert r.message_count("/camera/rgb") == 20
