@@ -50,6 +50,7 @@ from typing import Any
 
 from sgtool.analysis.validity import SEARCH_KIND, episode_problem
 from sgtool.errors import SgtoolError
+from sgtool.log.inspect import foreign_log_problem
 from sgtool.log.records import ABSENT, Absent, Episode, LogRecord, SceneGraphRecord, given
 from sgtool.log.records import Action as LoggedAction
 from sgtool.planning.base import Action, Feedback
@@ -194,6 +195,9 @@ def load_results(paths: Iterable[str | os.PathLike[str]], notes: list[str] | Non
         with open(p, "rb") as f:
             head = f.read(8)
         if head == b"\x89MCAP0\r\n":
+            foreign = foreign_log_problem(p)  # e.g. a bag exported from a derived log
+            if foreign is not None:
+                raise EvalInputError(foreign)
             for e in _search_episodes(p, read_log_episodes(p), notes):
                 r = _with_seen(e.result())
                 if _accepted(r, f"{p}: episode {e.index}", notes):

@@ -155,3 +155,21 @@ def test_seen_is_filled_from_the_split_when_a_log_lacks_it(tmp_path):
             log.write_record("episode", 2 * t + 1, {"kind": "search", "status": "failure"})
     results, _ = load_results([path])
     assert [r.seen for r in results] == [True, False]
+
+
+def test_a_ros2_mcap_with_sgtool_topic_names_is_called_foreign(tmp_path):
+    """A bag exported from a derived log (`sgtool export bag`) keeps sgtool's topic names;
+    eval says it is a ROS 2 recording, not that an sgtool record is damaged."""
+    from mcap.writer import Writer
+
+    path = tmp_path / "exported.mcap"
+    with open(path, "wb") as f:
+        w = Writer(f)
+        w.start(profile="ros2", library="test")
+        sid = w.register_schema("std_msgs/msg/String", "ros2msg", b"string data")
+        cid = w.register_channel("/sgtool/scene_graph", "cdr", sid)
+        w.add_message(cid, log_time=1, data=b"\x00\x01\x00\x00\x03\x00\x00\x00{}\x00",
+                      publish_time=1)
+        w.finish()
+    with pytest.raises(EvalInputError, match=r"is a ROS 2 recording .*not an sgtool log"):
+        load_results([path])
