@@ -109,13 +109,13 @@ def parse_noise(text: str | None) -> NoiseProfile:
     if parts and "=" not in parts[0]:
         if parts[0] not in PROFILES:
             raise SgtoolError(f"--noise {t}: unknown profile {parts[0]!r} (one of "
-                              f"{', '.join(PROFILES)}, or key=value overrides, or a .json file)")
+                              f"{', '.join(PROFILES)}, or NAME=VALUE overrides, or a .json file)")
         base = PROFILES[parts.pop(0)]
     items = []
     for s in parts:
         k, eq, v = s.partition("=")
         if not eq:
-            raise SgtoolError(f"--noise {t}: {s!r} is not key=value")
+            raise SgtoolError(f"--noise {t}: {s!r} is not NAME=VALUE")
         try:
             items.append((k.strip(), float(v)))
         except ValueError:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import shlex
 import sys
 
@@ -65,10 +66,12 @@ from sgtool.errors import SgtoolError
 @click.option("--house-seed", default=0, show_default=True, help="Seed of the first house.")
 @click.option("--max-steps", default=50, show_default=True,
               help="High-level actions per episode (SymSearch's N_max).")
-@click.option("--distance-budget", default=5000.0, show_default=True,
+@click.option("--distance-budget", type=click.FloatRange(min=0, min_open=True),
+              default=5000.0, show_default=True,
               help="AUC-E distance variant budget max, in low-level steps "
                    "(0.1 m of travel = 1, an open = 30; MoMa-LLM).")
-@click.option("--step-budget", default=50.0, show_default=True,
+@click.option("--step-budget", type=click.FloatRange(min=0, min_open=True), default=50.0,
+              show_default=True,
               help="AUC-E step variant budget max, in high-level steps.")
 @llm_log_options(
     transcript_help="moma-llm: append every LLM exchange to this JSONL transcript "
@@ -99,9 +102,12 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...],
     command gives the same episodes.jsonl except its wall-clock fields."""
     from sgtool.analysis.bench import DEFAULT_PLANNERS, BenchConfig, run_benchmark, write_outputs
 
+    for flag, value in (("--distance-budget", distance_budget), ("--step-budget", step_budget)):
+        if not math.isfinite(value):
+            raise SgtoolError(f"{flag} {value}: must be a finite number > 0")
     names = tuple(p.strip() for p in planners.split(",") if p.strip()) if planners \
         else DEFAULT_PLANNERS
-    options = planner_options(planner_option)
+    options = planner_options(planner_option, names)
     if llm_replay or llm_transcript:
         moma = options.setdefault("moma-llm", {})
         if llm_replay:

@@ -96,11 +96,17 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
     from sgtool.datasets.relational import evaluation_sets, training_sets
     from sgtool.semantics.distill import DistillConfig, distill, format_report, quality_report
 
+    if llm_slice is not None and source != "llm":
+        raise SgtoolError("--llm-slice is for --source llm")
     if report_only:
         wd = weights_dir or _weights_dir()
         if not (wd / "metadata.json").is_file():
             raise SgtoolError(f"{wd}: no metadata.json; not a folder of distilled weights")
-        seed = int(json.loads((wd / "metadata.json").read_text())["config"]["seed"])
+        try:
+            seed = int(json.loads((wd / "metadata.json").read_text())["config"]["seed"])
+        except (ValueError, KeyError, TypeError) as e:  # (JSONDecodeError is a ValueError)
+            raise SgtoolError(f"{wd / 'metadata.json'}: not the metadata `sgtool distill` "
+                              f"writes ({type(e).__name__}: {e})") from e
         built = training_sets(seed=seed)
         rep = quality_report(wd, (built.containment, built.cooccurrence),
                              eval_sets=evaluation_sets(seed=seed))

@@ -96,7 +96,7 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
     models = cost_models(distance_budget, step_budget)
     sums = summarize(results, models)
     names = [n.strip() for item in planners for n in item.split(",") if n.strip()]
-    options = planner_options(planner_option)
+    options = planner_options(planner_option, names)
     exchanges = log_exchanges(inputs)
     replay = list(llm_replay) or sorted({src for src, _ in exchanges})
     if replay and "moma-llm" in names:

@@ -141,14 +141,26 @@ def llm_log_options(transcript_help: str) -> Callable[[F], F]:
     ])
 
 
-def planner_options(items: tuple[str, ...]) -> dict[str, dict[str, Any]]:
-    """``-O PLANNER.KEY=VALUE`` values (bench, eval) as {planner: {key: value}}."""
+def planner_options(items: tuple[str, ...], planners: Sequence[str] | None = None
+                    ) -> dict[str, dict[str, Any]]:
+    """``-O PLANNER.KEY=VALUE`` values (bench, run-bench, eval) as {planner: {key: value}};
+    with ``planners`` (the run's), an option for a name that is no planner is an error (a
+    typo such as ``sout.delta`` would otherwise run everything with the defaults), one for
+    a planner not run a note."""
     out: dict[str, dict[str, Any]] = {}
     for item in items:
         key, eq, value = item.partition("=")
         name, dot, opt = key.partition(".")
         if not eq or not dot or not name or not opt:
             raise SgtoolError(f"--planner-option: expected PLANNER.KEY=VALUE, got {item!r}")
+        if planners is not None and name.strip() not in planners:
+            from sgtool.planning.registry import PLANNER_NAMES
+
+            if name.strip() not in PLANNER_NAMES:
+                raise SgtoolError(f"--planner-option {item!r}: {name.strip()!r} is no planner "
+                                  f"(those run: {', '.join(planners)})")
+            click.echo(f"sgtool: note: --planner-option {key.strip()}: {name.strip()!r} is not "
+                       "run; the option is unused", err=True)
         out.setdefault(name.strip(), {})[opt.strip()] = parse_value(value.strip())
     return out
 
@@ -186,7 +198,8 @@ def executor_options(what: str) -> Callable[[F], F]:
                      "processes) or 'ray' (a Ray cluster at --ray-address or RAY_ADDRESS, "
                      "else a local Ray instance with -w CPUs; needs "
                      "pip install 'sgtool[ray]'). The results do not depend on it."),
-        click.option("--workers", "-w", default=1, show_default=True,
+        click.option("--workers", "-w", type=click.IntRange(min=1), default=1,
+                     show_default=True,
                      help="Worker processes (local), or CPUs of a local Ray instance "
                      "(results do not depend on it)."),
         click.option("--ray-address", default=None, metavar="HOST:PORT",

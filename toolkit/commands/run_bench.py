@@ -20,7 +20,8 @@ from sgtool.errors import SgtoolError
 
 @click.command("run-bench")
 @click.option("--planners", default=None, metavar="LIST",
-              help="Comma-separated planners (as `sgtool bench`). Default: all but moma-llm.")
+              help="Comma-separated planners (as `sgtool bench`). Default: all but the LLM "
+              "planners.")
 @click.option("--houses", default=5, show_default=True,
               help="Generated evaluation houses (seeds HOUSE_SEED, +1, ...); 0 with --house "
               "runs the given houses only.")
@@ -110,7 +111,8 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...], hou
         planners=names, houses=houses, house_seed=house_seed, house_files=house_files,
         episodes=episodes, rooms=parse_rooms(rooms), preset=preset,
         noise=tuple(noise) or ("none",), options=opts,
-        planner_options=planner_options(planner_option), frames_per_room=frames_per_room)
+        planner_options=planner_options(planner_option, names),
+        frames_per_room=frames_per_room)
     show = sys.stderr.isatty() if progress is None else progress
     runner = map  # in this process, one episode after the other
     if (executor != "local" or workers > 1 or ray_address) and not report_only:

@@ -56,6 +56,7 @@ action carries its measured decision time. Options:
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -74,8 +75,13 @@ class UnknownPlannerError(SgtoolError):
     """A planner name that is not registered, or an option it does not take."""
 
 
-def _pop_params(options: dict[str, Any]) -> dict[str, Any]:
-    return {k: float(options.pop(k)) for k in _UTILITY_KEYS if k in options}
+def _pop_params(name: str, options: dict[str, Any]) -> dict[str, Any]:
+    out = {k: float(options.pop(k)) for k in _UTILITY_KEYS if k in options}
+    bad = next((k for k, v in out.items() if not math.isfinite(v) or v < 0), None)
+    if bad is not None:
+        raise UnknownPlannerError(f"planner {name!r}: option {bad}={out[bad]}: must be a finite "
+                                  "number >= 0")
+    return out
 
 
 def _utility(name: str, options: dict[str, Any]) -> Planner:
@@ -86,7 +92,7 @@ def _utility(name: str, options: dict[str, Any]) -> Planner:
     encoder = options.pop("encoder", None)
     weights_dir = options.pop("weights_dir", None)
     max_failures = int(options.pop("max_failures", 2))
-    params = _pop_params(options)
+    params = _pop_params(name, options)
     family, _, variant = name.partition("-")
     if variant == "noroom":
         params["room_influence"] = False
@@ -224,6 +230,27 @@ def _simple(cls_name: str) -> Callable[[dict[str, Any]], Planner]:
 def make_planner(name: str, **options: Any) -> Planner:
     """A fresh planner by name (see the module doc for names and options)."""
     timed = bool(options.pop("timed", True))
+    given = sorted(options)
+    try:
+        planner = _build(name, options)
+    except SgtoolError:
+        raise
+    except (ValueError, TypeError, AttributeError, OSError, KeyError) as e:
+        if not given:
+            raise  # the defaults failed: a bug, not the user's input
+        raise UnknownPlannerError(
+            f"planner {name!r}: a value of its option(s) {', '.join(given)} does not fit "
+            f"({type(e).__name__}: {e})") from e
+    if timed:
+        from sgtool.planning.timing import TimedPlanner
+
+        return TimedPlanner(planner)  # type: ignore[return-value]
+    return planner
+
+
+def _build(name: str, options: dict[str, Any]) -> Planner:
+    """The planner ``name`` built from ``options`` (each taken out as it is used; any left
+    is an error)."""
     key = name.strip().lower()
     if key == "random":
         planner = _simple("RandomPlanner")(options)
@@ -245,8 +272,4 @@ def make_planner(name: str, **options: Any) -> Planner:
         raise UnknownPlannerError(
             f"planner {name!r} does not take option(s): {', '.join(sorted(options))}"
         )
-    if timed:
-        from sgtool.planning.timing import TimedPlanner
-
-        return TimedPlanner(planner)  # type: ignore[return-value]
     return planner

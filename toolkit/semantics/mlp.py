@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write
 
 LAYER_SIZES: tuple[int, ...] = (768, 512, 256, 128, 1)
@@ -92,13 +93,17 @@ def load_mlp(path: str | Path, relation: str | None = None) -> RelationMLP:
 
     path = Path(path)
     if not path.is_file():
-        raise FileNotFoundError(f"relational model weights not found: {path}")
-    with safe_open(str(path), framework="numpy") as f:
-        meta = dict(f.metadata() or {})
-        ws, bs = [], []
-        for name in TENSOR_NAMES:
-            ws.append(np.asarray(f.get_tensor(f"{name}.weight"), np.float32))
-            bs.append(np.asarray(f.get_tensor(f"{name}.bias"), np.float32))
+        raise SgtoolError(f"relational model weights not found: {path}")
+    try:
+        with safe_open(str(path), framework="numpy") as f:
+            meta = dict(f.metadata() or {})
+            ws, bs = [], []
+            for name in TENSOR_NAMES:
+                ws.append(np.asarray(f.get_tensor(f"{name}.weight"), np.float32))
+                bs.append(np.asarray(f.get_tensor(f"{name}.bias"), np.float32))
+    except Exception as e:  # noqa: BLE001 - safetensors' own error types: a damaged file
+        raise SgtoolError(f"{path}: not readable relational model weights "
+                          f"({type(e).__name__}: {e}); `sgtool distill` writes them") from e
     return RelationMLP(
         relation=relation or meta.get("relation", path.stem),
         weights=tuple(ws),

@@ -100,10 +100,14 @@ class LearnedPriors:
         self.containment: RelationMLP = load_mlp(folder / CONTAINMENT_FILE, "containment")
         self.cooccurrence: RelationMLP = load_mlp(folder / COOCCURRENCE_FILE, "cooccurrence")
         meta_path = folder / METADATA_FILE
-        self.metadata: dict = json.loads(meta_path.read_text()) if meta_path.is_file() else {}
+        try:
+            self.metadata: dict = json.loads(meta_path.read_text()) \
+                if meta_path.is_file() else {}
+        except (json.JSONDecodeError, UnicodeDecodeError) as e:
+            raise SgtoolError(f"{meta_path}: not JSON ({e})") from e
         trained_with = self.containment.metadata.get("encoder")
         if trained_with and trained_with != self.encoder.model_id:
-            raise ValueError(
+            raise SgtoolError(
                 f"relational weights in {folder} were trained with encoder {trained_with!r}, "
                 f"not {self.encoder.model_id!r}"
             )

@@ -1,0 +1,92 @@
+"""Option values a user can get wrong are one line with exit 2, before any work and with no
+output: planner options (-O) of the wrong type, out of range or for a planner not run,
+AUC-E budgets, worker counts, damaged priors, distill options of another source; and a
+message with NAME=VALUE in it is not taken for a secret."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from sgtool.cli import cli
+from sgtool.semantics.priors import WEIGHTS_DIR
+
+BENCH = ["bench", "--houses", "1", "--episodes", "2", "--seeds", "1", "--rooms", "4-5"]
+
+
+def _one_line_error(args: list[str], tmp_path: Path, expect: str) -> None:
+    out = tmp_path / "out"
+    r = CliRunner().invoke(cli, [*args, "-o", str(out)])
+    lines = [ln for ln in r.output.splitlines() if ln.strip()]
+    assert r.exit_code == 2, r.output
+    assert len(lines) == 1 and expect in lines[0], r.output
+    assert not out.exists() or not any(out.rglob("*.*"))
+
+
+@pytest.mark.parametrize(("option", "expect"), [
+    ("scout.delta=abc", "planner 'scout': a value of its option(s) delta does not fit"),
+    ("scout.delta=nan", "planner 'scout': option delta=nan: must be a finite number >= 0"),
+    ("scout.delta=-5", "option delta=-5.0: must be a finite number >= 0"),
+    ("random.max_failures=abc", "planner 'random': a value of its option(s) max_failures"),
+    ("scout.encoder=foo", "planner 'scout': a value of its option(s) encoder does not fit"),
+    ("scout.weights_dir=/nonexistent", "relational model weights not found: /nonexistent"),
+    ("sout.delta=0.2", "'sout' is no planner (those run: random, scout)"),
+])
+def test_bad_planner_options(tmp_path: Path, option: str, expect: str) -> None:
+    _one_line_error([*BENCH, "--planners", "random,scout", "-O", option], tmp_path, expect)
+
+
+@pytest.mark.parametrize(("args", "expect"), [
+    (["--distance-budget", "0"], "Invalid value for '--distance-budget'"),
+    (["--step-budget", "-5"], "Invalid value for '--step-budget'"),
+    (["--distance-budget", "nan"], "--distance-budget nan: must be a finite number > 0"),
+    (["--step-budget", "inf"], "--step-budget inf: must be a finite number > 0"),
+    (["-w", "0"], "Invalid value for '--workers'"),
+])
+def test_bad_bench_values(tmp_path: Path, args: list[str], expect: str) -> None:
+    _one_line_error([*BENCH, "--planners", "random", *args], tmp_path, expect)
+
+
+def test_an_option_of_a_planner_not_run_is_a_note(tmp_path: Path) -> None:
+    from sgtool.commands.options import planner_options
+
+    assert planner_options(("greedy.x=1",), ("random",)) == {"greedy": {"x": 1}}
+
+
+def test_run_bench_workers_must_be_positive(tmp_path: Path) -> None:
+    _one_line_error(["run-bench", "--planners", "random", "--houses", "1", "--episodes", "1",
+                     "-w", "-1"], tmp_path, "Invalid value for '--workers'")
+
+
+def test_damaged_priors_are_one_line(tmp_path: Path) -> None:
+    pri = tmp_path / "pri"
+    shutil.copytree(WEIGHTS_DIR, pri, ignore=shutil.ignore_patterns("__*"))
+    (pri / "containment.safetensors").write_bytes(b"\xff" * 64)
+    expect = f"{pri / 'containment.safetensors'}: not readable relational model weights"
+    _one_line_error([*BENCH, "--planners", "scout", "--priors", str(pri)], tmp_path, expect)
+    r = CliRunner().invoke(cli, ["distill", "--report", "--weights", str(pri)])
+    assert r.exit_code == 2 and expect in r.output
+    (pri / "metadata.json").write_text("not json")
+    r = CliRunner().invoke(cli, ["distill", "--report", "--weights", str(pri)])
+    assert r.exit_code == 2 and "metadata.json: not the metadata `sgtool distill` writes" \
+        in r.output
+
+
+def test_distill_llm_slice_needs_the_llm_source(tmp_path: Path) -> None:
+    r = CliRunner().invoke(cli, ["distill", "--out", str(tmp_path / "w"), "--llm-slice",
+                                 "a,b,c"])
+    assert r.exit_code == 2 and "--llm-slice is for --source llm" in r.output
+    assert not (tmp_path / "w").exists()
+
+
+def test_noise_message_shows_name_value_unredacted() -> None:
+    from sgtool.errors import SgtoolError
+    from sgtool.recorders.sim.noise import parse_noise
+    from sgtool.redact import redact_text
+
+    with pytest.raises(SgtoolError) as e:
+        parse_noise("bogus")
+    assert "NAME=VALUE overrides" in redact_text(str(e.value))
