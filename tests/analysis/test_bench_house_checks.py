@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from support.datasets_fixtures import no_free_floor
 from support.foreign_house import cottage, write_cottage
 
 from sgtool.analysis.bench_houses import (
@@ -22,23 +23,6 @@ from sgtool.analysis.closed_loop_bench import log_path
 from sgtool.cli import cli
 from sgtool.errors import SgtoolError
 from sgtool.house.io import load_house
-
-
-def _tiny() -> dict:
-    """One 0.6 x 0.6 m room filled by a 0.5 m cabinet: nowhere for the robot to stand."""
-    return {"version": "2.0", "seed": 3,
-            "rooms": [{"id": "room_0", "category": "kitchen",
-                       "polygon": [[0, 0], [0.6, 0], [0.6, 0.6], [0, 0.6]]}],
-            "walls": [], "doors": [],
-            "furniture": [{"id": "furn_0", "category": "cabinet", "synset": "cabinet.n.01",
-                           "room": "room_0", "center": [0.3, 0.3, 0.45],
-                           "size": [0.5, 0.5, 0.9],
-                           "affordances": ["container", "openable", "supporter"],
-                           "state": "closed"}],
-            "objects": [{"id": "obj_0", "category": "apple", "synset": "apple.n.01",
-                         "parent": "furn_0", "relation": "inside", "room": "room_0",
-                         "position": [0.3, 0.3, 0.3], "size": [0.08, 0.08, 0.08]}],
-            "starts": []}
 
 
 def test_paths_stay_inside_their_folder(tmp_path: Path) -> None:
@@ -77,7 +61,7 @@ def test_run_bench_writes_nothing_for_an_id_that_leaves_the_folder(tmp_path: Pat
 
 def test_a_room_without_free_floor_is_refused_before_any_episode(tmp_path: Path) -> None:
     f = tmp_path / "tiny.json"
-    f.write_text(json.dumps(_tiny()))
+    f.write_text(json.dumps(no_free_floor()))
     line = (f"{f}: rooms: room room_0 has no free floor (no cell where the robot fits: walls "
             "and furniture fill it)")
     assert symbolic_house_problem(load_house(f), f) == line

@@ -42,3 +42,20 @@ def two_rooms(door_state: str = "open") -> dict:
         ],
         "starts": [{"x": 1, "y": 1, "yaw": 0, "room": "room_0"}],
     }
+
+
+def no_free_floor() -> dict:
+    """One 0.6 x 0.6 m room filled by a 0.5 m cabinet: nowhere for the robot to stand."""
+    return {"version": "2.0", "seed": 3,
+            "rooms": [{"id": "room_0", "category": "kitchen",
+                       "polygon": [[0, 0], [0.6, 0], [0.6, 0.6], [0, 0.6]]}],
+            "walls": [], "doors": [],
+            "furniture": [{"id": "furn_0", "category": "cabinet", "synset": "cabinet.n.01",
+                           "room": "room_0", "center": [0.3, 0.3, 0.45],
+                           "size": [0.5, 0.5, 0.9],
+                           "affordances": ["container", "openable", "supporter"],
+                           "state": "closed"}],
+            "objects": [{"id": "obj_0", "category": "apple", "synset": "apple.n.01",
+                         "parent": "furn_0", "relation": "inside", "room": "room_0",
+                         "position": [0.3, 0.3, 0.3], "size": [0.08, 0.08, 0.08]}],
+            "starts": []}

@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 
 from click.testing import CliRunner
-from support.datasets_fixtures import two_rooms
+from support.datasets_fixtures import no_free_floor, two_rooms
 
 from sgtool.cli import cli
 from sgtool.commands.options import house_from_options
@@ -43,19 +43,7 @@ def test_a_refused_house_is_one_line_naming_file_and_field(tmp_path: Path) -> No
 def test_episodes_of_a_house_without_free_floor_name_the_room(tmp_path: Path) -> None:
     """A room filled by its furniture gives no episodes: `scenes episodes` says why (the
     bench's check of house files), not "no small objects"."""
-    tiny = {"version": "2.0", "seed": 3,
-            "rooms": [{"id": "room_0", "category": "kitchen",
-                       "polygon": [[0, 0], [0.6, 0], [0.6, 0.6], [0, 0.6]]}],
-            "walls": [], "doors": [],
-            "furniture": [{"id": "furn_0", "category": "cabinet", "synset": "cabinet.n.01",
-                           "room": "room_0", "center": [0.3, 0.3, 0.45],
-                           "size": [0.5, 0.5, 0.9],
-                           "affordances": ["container", "openable", "supporter"],
-                           "state": "closed"}],
-            "objects": [{"id": "obj_0", "category": "apple", "synset": "apple.n.01",
-                         "parent": "furn_0", "relation": "inside", "room": "room_0",
-                         "position": [0.3, 0.3, 0.3], "size": [0.08, 0.08, 0.08]}],
-            "starts": []}
+    tiny = no_free_floor()
     p = _write(tmp_path / "tiny.json", tiny)
     r = CliRunner().invoke(cli, ["scenes", "episodes", str(p)])
     assert r.exit_code == 2
