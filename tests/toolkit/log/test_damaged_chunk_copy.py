@@ -36,6 +36,16 @@ def damaged_log(tmp_path):
     return path, ci.chunk_start_offset
 
 
+def _one_line_refusal(args: list[str], capsys) -> str:
+    """stderr of ``sgtool ARGS``, which must exit 2 with one line and no traceback."""
+    with pytest.raises(SystemExit) as e:
+        main(args)
+    err = capsys.readouterr().err
+    assert e.value.code == 2
+    assert err.count("\n") == 1 and "Traceback" not in err
+    return err
+
+
 def test_the_chunks_to_copy_are_crc_checked_even_without_verify(tmp_path):
     path, offset = damaged_log(tmp_path)
     with LogReader(path) as r, pytest.raises(LogFormatError) as e:
@@ -50,11 +60,7 @@ def test_the_chunks_to_copy_are_crc_checked_even_without_verify(tmp_path):
 def test_replay_refuses_a_damaged_chunk_in_one_line_and_writes_nothing(tmp_path, capsys):
     path, offset = damaged_log(tmp_path)
     out = tmp_path / "flip_d.mcap"
-    with pytest.raises(SystemExit) as e:
-        main(["replay", str(path), "-o", str(out)])
-    err = capsys.readouterr().err
-    assert e.value.code == 2
-    assert err.count("\n") == 1 and "Traceback" not in err
+    err = _one_line_refusal(["replay", str(path), "-o", str(out)], capsys)
     assert err.startswith(f"sgtool: error: {path}: damaged data")
     assert f"chunk at byte {offset}: CRC mismatch" in err
     assert f"`sgtool doctor {path}`" in err and "--recover" in err
@@ -75,10 +81,6 @@ def test_view_refuses_a_damaged_chunk_in_one_line_and_writes_no_rrd(tmp_path, ca
     pytest.importorskip("rerun")
     path, offset = damaged_log(tmp_path)
     rrd = tmp_path / "flip.rrd"
-    with pytest.raises(SystemExit) as e:
-        main(["view", str(path), "-o", str(rrd)])
-    err = capsys.readouterr().err
-    assert e.value.code == 2
-    assert err.count("\n") == 1 and "Traceback" not in err
+    err = _one_line_refusal(["view", str(path), "-o", str(rrd)], capsys)
     assert f"chunk at byte {offset}: CRC mismatch" in err
     assert not rrd.exists() and not list(tmp_path.glob("*.rrd*"))
