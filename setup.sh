@@ -53,6 +53,12 @@ if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
   echo "$want" > "$stamp"
 fi
 
+# mypy reads the package from .typecheck/sgtool: the folders laid out as the one import
+# name `sgtool` (setup.py's mapping) in symbolic links, so `mypy` runs with no arguments
+rm -rf .typecheck && mkdir -p .typecheck/sgtool
+for entry in toolkit/*; do ln -s "../../$entry" .typecheck/sgtool/; done
+for stage in recorders replayers datasets analysis; do ln -s "../../$stage" ".typecheck/sgtool/$stage"; done
+
 export HF_HUB_OFFLINE=1 TRANSFORMERS_OFFLINE=1 MPLBACKEND=Agg
 what="${1:-}"
 [ $# -gt 0 ] && shift
