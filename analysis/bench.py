@@ -56,7 +56,6 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from sgtool import __version__
 from sgtool.analysis.bench_houses import (
     BenchHouse,
     bench_episodes,
@@ -83,6 +82,7 @@ from sgtool.files import atomic_write
 from sgtool.planning.episode import SUCCESS_RULES
 from sgtool.redact import redact_options, redact_text, secret_values
 from sgtool.results import EpisodeResult, results_digest, write_jsonl
+from sgtool.version import __version__
 
 DEFAULT_PLANNERS: tuple[str, ...] = (
     "random", "greedy", "sbert-noroom", "sbert", "scout-noroom", "scout-delta0", "scout",

@@ -22,10 +22,10 @@ from typing import Any
 
 import click
 
-from sgtool import __version__
 from sgtool.errors import SgtoolError, Terminated, raise_terminated
 from sgtool.files import is_environment_error
 from sgtool.redact import redact_text
+from sgtool.version import __version__
 
 # command name -> module under sgtool.commands; order is the order of --help
 COMMANDS: dict[str, tuple[str, str]] = {

@@ -35,13 +35,13 @@ from mcap.summary import Summary
 from mcap.writer import CompressionType, Writer
 from mcap_protobuf.schema import build_file_descriptor_set
 
-from sgtool import __version__
 from sgtool.errors import SgtoolError
 from sgtool.files import concerns, output_error, temp_beside
 from sgtool.log import chunk_copy, codec
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.records import RECORD_TYPES, LogRecord
+from sgtool.version import __version__
 
 PARTIAL_SUFFIX = ".partial"
 PARTIAL_GLOB = "*.????????" + PARTIAL_SUFFIX  # OUT.XXXXXXXX.partial, see the module doc
