@@ -12,7 +12,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-import cv2
 import numpy as np
 
 from sgtool.errors import SgtoolError
@@ -137,6 +136,8 @@ class BagWriter:
         )
 
     def compressed(self, t_ns: int, frame_id: str, rgb: np.ndarray, fmt: str) -> Any:
+        import cv2  # OpenCV (the `import` extra) only for compressed images
+
         ok, buf = cv2.imencode("." + fmt, cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
         if not ok:
             raise SgtoolError(f"OpenCV cannot encode {fmt}")
