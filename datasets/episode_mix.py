@@ -52,9 +52,8 @@ def furniture_episodes(spec: HouseSpec, n: int, seed: int = 0, reach: float = RE
             starts = [s for s in spec.starts if s.room not in rooms] or list(spec.starts)
             start = starts[int(rng.integers(len(starts)))]
             d = geo.distances(start)
-            best = min((float(d[w][m].min()) for w, m in
-                        (near[f.id] for f in pieces if near[f.id] is not None)),
-                       default=math.inf)
+            reached = [nf for nf in (near[f.id] for f in pieces) if nf is not None]
+            best = min((float(d[w][m].min()) for w, m in reached), default=math.inf)
             first = pieces[0]
             room = spec.room(first.room).category.replace("_", " ")
             more = f" (+{len(pieces) - 1} more)" if len(pieces) > 1 else ""

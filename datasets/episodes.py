@@ -47,6 +47,12 @@ REACH = 1.0
 
 @dataclass(frozen=True)
 class Episode:
+    """One search episode of a house (:func:`list_episodes`): find ``query`` (a readable
+    category; ``synset`` its BEHAVIOR-1K synset) from ``start``. ``targets`` are the spec
+    ids of its instances (objects, then furniture), in ``target_rooms``; ``hidden`` when
+    every instance needs something opened to be seen; ``shortest_path`` the geodesic in
+    metres to the nearest place a target is seen from (inf when none can be reached)."""
+
     id: str
     query: str  # readable category
     synset: str
@@ -83,12 +89,12 @@ def _describe(spec: HouseSpec, obj_ids: list[str]) -> str:
     """Where the first instance is, through its chain of parents: "inside a closed box
     inside a closed cabinet in the kitchen (+2 more)"."""
     holders = spec.holder_by_id()
-    o = holders[obj_ids[0]]
+    o = spec.object_by_id()[obj_ids[0]]
     parts = []
     while True:
-        p = holders[o.parent]  # type: ignore[union-attr]
-        shut = enclosed(o, p)  # type: ignore[arg-type]
-        where = "inside" if o.relation == "inside" else "on a shelf of" if shut else "on top of"  # type: ignore[union-attr]
+        p = holders[o.parent]
+        shut = enclosed(o, p)
+        where = "inside" if o.relation == "inside" else "on a shelf of" if shut else "on top of"
         thing = f"{p.state} {p.category}" if p.state and shut else p.category
         article = "an" if thing[:1].lower() in "aeiou" else "a"
         parts.append(f"{where} {article} {thing}")

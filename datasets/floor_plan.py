@@ -62,13 +62,13 @@ def floor_plan(rng: np.random.Generator, n_rooms: int, inv: Inventory) -> Plan:
     back: list[tuple[str, str]] = []  # (type, host type)
     front = list(order)
     for t in list(order):
-        hosts = BACK_HOSTS.get(t)
-        if not hosts or (group and t in group) or rng.random() >= 0.45:
+        host_types = BACK_HOSTS.get(t)
+        if not host_types or (group and t in group) or rng.random() >= 0.45:
             continue
         if t == "bathroom" and sum(1 for x in front if x == "bathroom") < 2:
             continue
         used_hosts = Counter(h for _, h in back)
-        avail = [h for h in hosts if front.count(h) > used_hosts[h]
+        avail = [h for h in host_types if front.count(h) > used_hosts[h]
                  and not (group and h in group)]
         if not avail or len(front) <= 2:
             continue
@@ -130,13 +130,14 @@ def floor_plan(rng: np.random.Generator, n_rooms: int, inv: Inventory) -> Plan:
             left = [x for x in xs if not split_x or x > split_x[-1]]
             if not left:
                 raise PlanRetry
-            split_x.append(min(left, key=lambda x, k=k: (abs(x - length * k / n_corr), x)))
+            target = length * k / n_corr
+            split_x.append(min(left, key=lambda x: (abs(x - target), x)))
     bounds = [0.0, *split_x, round(length, 4)]
-    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
-        plan.rooms.append(PlanRoom(len(plan.rooms), "corridor", Rect(a, 0.0, b, wc), "c"))
-    for a, b in zip(plan.rooms[:-1], plan.rooms[1:], strict=True):
-        x = a.rect.x1
-        plan.openings.append(Opening("passage", (x, wc / 2), wc, False, (a.idx, b.idx)))
+    for lo, hi in zip(bounds[:-1], bounds[1:], strict=True):
+        plan.rooms.append(PlanRoom(len(plan.rooms), "corridor", Rect(lo, 0.0, hi, wc), "c"))
+    for west, east in zip(plan.rooms[:-1], plan.rooms[1:], strict=True):
+        x = west.rect.x1
+        plan.openings.append(Opening("passage", (x, wc / 2), wc, False, (west.idx, east.idx)))
     # front rooms
     front_room: dict[int, PlanRoom] = {}
     for s in ("n", "s"):
@@ -165,8 +166,8 @@ def floor_plan(rng: np.random.Generator, n_rooms: int, inv: Inventory) -> Plan:
         (wl, wh), (dl, dh) = ROOM_DIMS[t]
         w = min(uniform_snap(rng, wl, wh), host.rect.width)
         d = uniform_snap(rng, dl, dh)
-        left = rng.random() < 0.5
-        x0 = host.rect.x0 if left else round(host.rect.x1 - w, 4)
+        flush_left = rng.random() < 0.5
+        x0 = host.rect.x0 if flush_left else round(host.rect.x1 - w, 4)
         if host.side == "n":
             rect = Rect(x0, host.rect.y1, x0 + w, host.rect.y1 + d)
         else:

@@ -54,7 +54,8 @@ def _holds_things(synset: str, inv: Inventory) -> bool:
 def _jittered_size(rng: np.random.Generator, size: tuple[float, float, float]
             ) -> tuple[float, float, float]:
     f = rng.uniform(0.92, 1.08, size=3)
-    return tuple(round(float(s * k), 2) for s, k in zip(size, f, strict=True))  # type: ignore[return-value]
+    sx, sy, sz = size
+    return (round(float(sx * f[0]), 2), round(float(sy * f[1]), 2), round(float(sz * f[2]), 2))
 
 
 def _footprint(cx: float, cy: float, w: float, d: float, yaw: float) -> Rect:
@@ -140,6 +141,7 @@ def _place_floor(rng: np.random.Generator, s: str, base_size: tuple[float, float
     holder reachable is appended to ``mine`` (True), else False."""
     size = _jittered_size(rng, base_size)
     w, d, h = size
+    cand: tuple[float, float, float] | None
     for _ in range(attempts):
         if s in SEATS and any(p.synset in CENTRAL for p in mine):
             cand = _seat_candidate(rng, [p for p in mine if p.synset in CENTRAL], w, d)

@@ -127,7 +127,8 @@ def _spec_dict(seed: int, split: str, plan: Plan, pieces: list[Piece], objs: lis
                       "open_plan_group": r.group})
     walls = [{"id": f"wall_{i}", "a": list(a), "b": list(b), "thickness": WALL_T,
               "height": WALL_H} for i, (a, b) in enumerate(wall_segments(plan))]
-    doors, passages = [], []
+    doors: list[dict[str, object]] = []
+    passages: list[dict[str, object]] = []
     for o in plan.openings:
         rec = {"center": list(o.center), "width": o.width,
                "yaw": 0.0 if o.horizontal else math.pi / 2,

@@ -56,17 +56,19 @@ def place_openings(rng: np.random.Generator, plan: Plan) -> None:
                     best = (c, lo, hi)
             assert best is not None
             c, lo, hi = best
-            x = _door_center(rng, lo, hi)
-            if x is None:
+            door_x = _door_center(rng, lo, hi)
+            if door_x is None:
                 raise PlanRetry
             state = "closed" if rng.random() < P_CLOSED.get(r.type, P_CLOSED_DEFAULT) else "open"
-            plan.openings.append(Opening("door", (x, y), DOOR_W, True, (c.idx, r.idx), state))
+            plan.openings.append(Opening("door", (door_x, y), DOOR_W, True, (c.idx, r.idx),
+                                          state))
         elif r.side in ("nb", "sb"):
-            host = by_idx[r.host]  # type: ignore[index]
+            assert r.host is not None, "a back room names its host"
+            host = by_idx[r.host]
             y = r.rect.y0 if r.side == "nb" else r.rect.y1
-            x = _door_center(rng, r.rect.x0, r.rect.x1)
-            if x is None:
+            door_x = _door_center(rng, r.rect.x0, r.rect.x1)
+            if door_x is None:
                 raise PlanRetry
             state = "closed" if rng.random() < P_CLOSED.get(r.type, P_CLOSED_DEFAULT) else "open"
-            plan.openings.append(Opening("door", (x, y), DOOR_W, True, (host.idx, r.idx),
+            plan.openings.append(Opening("door", (door_x, y), DOOR_W, True, (host.idx, r.idx),
                                           state))

@@ -17,7 +17,7 @@ ceilings, doors, windows and lights (the building); nesting is not recorded ther
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 from sgtool.datasets.knowledge import Knowledge
 from sgtool.house.spec import HouseSpec, hidden_objects
@@ -105,6 +105,16 @@ def house_stats(specs: Iterable[HouseSpec]) -> SceneStats:
     )
 
 
+@dataclass
+class _SceneTally:
+    """One real scene's counts while :func:`inventory_stats` walks its rooms."""
+
+    rooms: int = 0
+    room_cats: set[str] = field(default_factory=set)
+    objects: int = 0
+    obj_cats: set[str] = field(default_factory=set)
+
+
 def inventory_stats(k: Knowledge, household_only: bool = False) -> SceneStats:
     """Table I columns of the real scenes in ``k`` (structure synsets left out)."""
     from sgtool.datasets.split import is_household_scene
@@ -113,25 +123,24 @@ def inventory_stats(k: Knowledge, household_only: bool = False) -> SceneStats:
     scenes = sorted({r.scene for r in rooms})
     room_cats: set[str] = set()
     obj_cats: set[str] = set()
-    per_scene: dict[str, dict[str, object]] = {
-        s: {"rooms": 0, "room_cats": set(), "objects": 0, "obj_cats": set()} for s in scenes}
+    per_scene = {s: _SceneTally() for s in scenes}
     for r in rooms:
         d = per_scene[r.scene]
-        d["rooms"] += 1  # type: ignore[operator]
-        d["room_cats"].add(r.room_type)  # type: ignore[union-attr]
+        d.rooms += 1
+        d.room_cats.add(r.room_type)
         room_cats.add(r.room_type)
         for s, n in r.items:
             if k.kind(s) in ("furniture", "object"):
-                d["objects"] += n  # type: ignore[operator]
-                d["obj_cats"].add(s)  # type: ignore[union-attr]
+                d.objects += n
+                d.obj_cats.add(s)
                 obj_cats.add(s)
     vals = list(per_scene.values())
     return SceneStats(
         scenes=len(scenes), room_categories=len(room_cats), object_categories=len(obj_cats),
-        rooms_per_scene=_mean([v["rooms"] for v in vals]),  # type: ignore[misc]
-        room_categories_per_scene=_mean([len(v["room_cats"]) for v in vals]),  # type: ignore[arg-type]
-        objects_per_scene=_mean([v["objects"] for v in vals]),  # type: ignore[misc]
-        object_categories_per_scene=_mean([len(v["obj_cats"]) for v in vals]),  # type: ignore[arg-type]
+        rooms_per_scene=_mean([v.rooms for v in vals]),
+        room_categories_per_scene=_mean([len(v.room_cats) for v in vals]),
+        objects_per_scene=_mean([v.objects for v in vals]),
+        object_categories_per_scene=_mean([len(v.obj_cats) for v in vals]),
         contained_per_scene=None,
     )
 

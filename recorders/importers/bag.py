@@ -39,6 +39,7 @@ time) and :mod:`.bag_frames` (pass 2: decoding).
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -54,7 +55,7 @@ from sgtool.recorders.importers.bag_frames import camera_of, decode_frames
 from sgtool.recorders.importers.bag_index import BagIndex, index_bag
 from sgtool.recorders.importers.bag_options import BagOptions, check_options
 from sgtool.recorders.importers.bag_poses import PoseSource, pose_source_of
-from sgtool.recorders.importers.bag_sync import PlannedFrame, plan_frames
+from sgtool.recorders.importers.bag_sync import PlannedFrame, plan_frames, planned_poses
 from sgtool.recorders.importers.bag_topics import check_flags, describe_bag, with_only_info
 from sgtool.recorders.importers.distortion import distortion_finding
 from sgtool.recorders.importers.images import depth_to_metres
@@ -150,16 +151,17 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
             if odo.warning():
                 notes.append(str(odo.warning()))
         meta["pose_source"] = pose_source
-        by_k = {p.k_depth: p for p in plan}
+        poses = planned_poses(plan)
+        by_k = {p.k_depth: pose for p, pose in zip(plan, poses, strict=True)}
         samples = [
-            DepthSample(depth_to_metres(raw, _scale(raw, scale, opts)), k, by_k[kk].pose)
+            DepthSample(depth_to_metres(raw, _scale(raw, scale, opts)), k, by_k[kk])
             for kk, (raw, scale) in sorted(idx.samples.items()) if kk in by_k
         ]
-        alignment = estimate_alignment([p.pose for p in plan], samples, up=opts.up,
+        alignment = estimate_alignment(poses, samples, up=opts.up,
                                        floor=opts.floor, floor_auto=opts.floor_auto)
         if alignment.floor_method != "none":
             findings.problem(
-                floor_problem([p.pose for p in plan], alignment.matrix, alignment.floor,
+                floor_problem(poses, alignment.matrix, alignment.floor,
                               FLOOR_ORIGINS[alignment.floor_method], opts.camera_height),
                 given=alignment.floor_method not in ESTIMATED_FLOORS)
         sources = [("intrinsics", f"{k.fx:g},{k.fy:g},{k.cx:g},{k.cy:g}",
@@ -180,7 +182,7 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         has_rgb=has_rgb, has_ids=has_ids, pose_source=pose_source, drift=drift,
         notes=tuple(notes), drift_reference=reference, sources=tuple(sources),
         warnings=tuple(findings.warnings),
-        **(odometry_report_fields(odo) if odo is not None else {}),  # type: ignore[arg-type]
+        **odometry_report_fields(odo),
     )
 
 
@@ -238,7 +240,7 @@ def _estimate(
     if opts.odometry == "rgbd" and not opts.rgb:
         raise SgtoolError("--odometry rgbd needs --rgb; use icp")
 
-    def gen():  # type: ignore[no-untyped-def]
+    def gen() -> Iterator[tuple[np.ndarray | None, np.ndarray]]:
         for fr in decode_frames(reader, plan, idx, opts, k):
             d = fr.depth.astype(np.float32) / 1000.0 if fr.depth.dtype == np.uint16 else fr.depth
             yield fr.rgb, d

@@ -58,8 +58,9 @@ def decode_frames(
         raw, scale = d["depth"]
         rgb = resize_to(d["rgb"], k.width, k.height) if "rgb" in d else None
         ids = resize_to(d["ids"], k.width, k.height) if "ids" in d else None
-        pose = plan[i].pose if plan[i].pose is not None else np.eye(4)
-        return ImportFrame(plan[i].t_ns, depth_for_log(raw, scale), pose, k, rgb=rgb, ids=ids)
+        planned = plan[i]
+        pose = planned.pose if planned.pose is not None else np.eye(4)
+        return ImportFrame(planned.t_ns, depth_for_log(raw, scale), pose, k, rgb=rgb, ids=ids)
 
     for c, _, raw in reader.messages(connections=conns):
         kind = topic_kind[c.topic]

@@ -90,7 +90,7 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
                     idx.info_changes += 1
                 continue
             for topic, ii in ((opts.depth, idx.depth), (opts.rgb, idx.rgb), (opts.ids, idx.ids)):
-                if c.topic == topic:
+                if topic is not None and c.topic == topic:
                     t = _stamp_or_bagtime(msg.header, bag_t, idx, opts.timestamps == "bag")
                     if topic == opts.depth and len(ii.stamps) in keep:
                         idx.samples[len(ii.stamps)] = decode_depth_message(msg, mt, topic)

@@ -23,6 +23,16 @@ class PlannedFrame:
     k_ids: int | None
 
 
+def planned_poses(plan: list[PlannedFrame]) -> list[np.ndarray]:
+    """The poses of ``plan`` in order, for a plan whose every frame is posed (by the pose
+    source, or after odometry filled the unposed ones in)."""
+    poses = []
+    for p in plan:
+        assert p.pose is not None, f"depth image {p.k_depth} was planned without a pose"
+        poses.append(p.pose)
+    return poses
+
+
 def nearest_within(stamps: list[int], order: list[int], t: int, max_dt: int) -> int | None:
     """Index (into ``stamps``) of the stamp nearest ``t`` within ``max_dt``; ``order`` is
     the argsort of ``stamps``."""

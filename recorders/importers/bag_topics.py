@@ -79,7 +79,7 @@ def suggest_flags(topics: list[B.TopicInfo], tf_frames: list[str] | None = None,
     infos = [t.topic for t in topics if t.msgtype in B.INFO_TYPES]
     poses = [t.topic for t in topics if t.msgtype in B.POSE_TYPES]
     tfs = [t.topic for t in topics if t.msgtype in B.TF_TYPES]
-    out = []
+    out: list[str] = []
     depth = next((t for t in images if "depth" in t.lower() and fits(t, "depth")), None)
     if depth is None:  # a depth camera's topic need not say "depth": its encoding does
         depth = next((t for t in images if t in enc and (

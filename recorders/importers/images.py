@@ -179,7 +179,7 @@ def _convert(a: np.ndarray, enc: str, topic: str) -> np.ndarray:
                           f"share U and V); this one is {a.shape[1]} pixels wide")
     code = _YUV[enc] if enc in _YUV else _BAYER[enc[6:10]]
     try:
-        rgb = cv2.cvtColor(np.ascontiguousarray(a), code)
+        rgb: np.ndarray = cv2.cvtColor(np.ascontiguousarray(a), code)
     except cv2.error as e:
         raise SgtoolError(f"topic {topic}: OpenCV cannot convert this {a.shape[1]}x"
                           f"{a.shape[0]} {enc} image ({str(e).strip().splitlines()[-1][:80]})"
@@ -233,9 +233,10 @@ def _decode_compressed_depth(data: bytes, fmt: str, topic: str) -> tuple[np.ndar
     if "rvl" in fmt.lower():
         a = _decode_rvl_payload(data[12:], topic)
     else:
-        a = cv2.imdecode(np.frombuffer(data[12:], np.uint8), cv2.IMREAD_UNCHANGED)
-        if a is None or a.dtype != np.uint16:
+        png = cv2.imdecode(np.frombuffer(data[12:], np.uint8), cv2.IMREAD_UNCHANGED)
+        if png is None or png.dtype != np.uint16:
             raise SgtoolError(f"topic {topic}: compressedDepth PNG did not decode ({fmt!r})")
+        a = png
     if fmt.split(";")[0].strip() == "32FC1":
         v = a.astype(np.float32)
         out = np.zeros(v.shape, np.float32)

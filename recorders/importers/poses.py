@@ -19,7 +19,8 @@ import numpy as np
 from sgtool.log.codec import matrix_from_quat, quat_from_matrix
 
 
-def pose_from_tq(t: Sequence[float], q_xyzw: Sequence[float]) -> np.ndarray:
+def pose_from_tq(t: Sequence[float] | np.ndarray, q_xyzw: Sequence[float] | np.ndarray
+                 ) -> np.ndarray:
     """4x4 pose from a translation and a quaternion (x, y, z, w); the quaternion need not be
     normalised (TUM files round to four decimals)."""
     T = np.eye(4)  # noqa: N806

@@ -19,7 +19,7 @@ depth scale, up direction and floor came from.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -79,6 +79,13 @@ from sgtool.recorders.importers.upright import DepthSample, estimate_alignment, 
 
 @dataclass(frozen=True)
 class RgbdOptions:
+    """How :func:`import_rgbd` reads a folder (the flags of ``sgtool import rgbd``):
+    ``layout`` (None: detected), ``depth_scale`` and ``intrinsics`` (None: the layout's),
+    ``fps``, a ``trajectory`` file or ``estimate_poses`` by ``odometry``, ``up`` and
+    ``floor`` (None: estimated), ``every``/``limit`` on the frames, ``timestamps``
+    (``file``: the listed times; ``index``: n / fps). :func:`check_options` checks them
+    before anything is read."""
+
     layout: str | None = None
     depth_scale: float | None = None  # raw units per metre; None = the layout's
     intrinsics: PinholeParams | None = None  # None = the layout's
@@ -152,14 +159,17 @@ def camera_for(seq: FolderSequence, opts: RgbdOptions, width: int, height: int,
     return CameraIntrinsics(width, height, float(p.fx), float(p.fy), float(p.cx), float(p.cy))
 
 
-def _load(fr: FolderFrame, scale: float, size: tuple[int, int] | None = None):  # type: ignore[no-untyped-def]
+def _load(fr: FolderFrame, scale: float, size: tuple[int, int] | None = None
+          ) -> tuple[np.ndarray, np.ndarray | None]:
+    """A folder frame's raw depth and its colour image (None without one) resized to the
+    depth image; a depth image whose size differs from ``size`` is refused."""
     raw = read_depth_file(fr.depth_path)
     if size is not None and (raw.shape[1], raw.shape[0]) != size:
         raise SgtoolError(
             f"{fr.depth_path}: {raw.shape[1]}x{raw.shape[0]} pixels, the first depth image has "
             f"{size[0]}x{size[1]}"
         )
-    rgb = None
+    rgb: np.ndarray | None = None
     if fr.color_path is not None:
         rgb = resize_to(read_color_file(fr.color_path), raw.shape[1], raw.shape[0],
                         str(fr.color_path))
@@ -172,7 +182,7 @@ def run_odometry(
 ) -> OdometryResult:
     size = (k.width, k.height)
 
-    def gen():  # type: ignore[no-untyped-def]
+    def gen() -> Iterator[tuple[np.ndarray | None, np.ndarray]]:
         for fr in frames:
             raw, rgb = _load(fr, scale, size)
             yield rgb, depth_to_metres(raw, scale)
@@ -263,7 +273,7 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         **(odometry_metadata(odo) if odo is not None else {}),
     }
 
-    def gen():  # type: ignore[no-untyped-def]
+    def gen() -> Iterator[ImportFrame]:
         size = (k.width, k.height)
         for fr, pose in zip(frames, poses, strict=True):
             raw, rgb = _load(fr, scale, size)
@@ -277,5 +287,5 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         alignment=alignment, has_rgb=has_rgb, has_ids=has_ids, pose_source=pose_source,
         drift=drift, notes=tuple(notes), drift_reference=reference,
         sources=tuple(sources), warnings=tuple(findings.warnings),
-        **(odometry_report_fields(odo) if odo is not None else {}),  # type: ignore[arg-type]
+        **odometry_report_fields(odo),
     )

@@ -22,6 +22,7 @@ import sys
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypedDict
 
 import numpy as np
 
@@ -47,6 +48,12 @@ class ImportFrame:
 
 @dataclass(frozen=True)
 class ImportReport:
+    """What an import wrote (``sgtool import`` prints :meth:`lines`): the log ``output``,
+    the ``source`` and its ``kind`` (``rgbd/tum``, ``bag/ros2``, ...), frames and poses
+    written, the world alignment (up, floor), whether colour and instance ids were there,
+    where the poses came from, their drift against a reference, odometry failures, where
+    each camera parameter came from, notes and warnings."""
+
     output: Path
     source: str
     kind: str  # "rgbd/tum", "rgbd/7scenes", "rgbd/open3d", "bag/ros1", "bag/ros2"...
@@ -70,11 +77,12 @@ class ImportReport:
 
     def lines(self) -> list[str]:
         a = self.alignment
+        ux, uy, uz = a.up
         out = [
             f"wrote {self.output}: {self.frames} frames from {self.kind} {self.source}",
             f"poses: {self.pose_source}",
-            "world: source up ({:.3f}, {:.3f}, {:.3f}) [{}] -> +z, floor {:.3f} m [{}] -> z=0"
-            .format(*a.up, a.up_method, a.floor, a.floor_method),
+            f"world: source up ({ux:.3f}, {uy:.3f}, {uz:.3f}) [{a.up_method}] -> +z, "
+            f"floor {a.floor:.3f} m [{a.floor_method}] -> z=0",
             "colour: " + ("yes" if self.has_rgb else "no")
             + "; instance ids: " + ("yes" if self.has_ids else "none (geometry only)"),
         ]
@@ -157,7 +165,17 @@ def odometry_metadata(res: OdometryResult) -> dict[str, str]:
          "frames": [f.frame for f in res.failed]}, sort_keys=True)}
 
 
-def odometry_report_fields(res: OdometryResult) -> dict[str, object]:
-    """The :class:`ImportReport` fields of an odometry run."""
+class OdometryReportFields(TypedDict, total=False):
+    """The :class:`ImportReport` fields an odometry run fills (none without one)."""
+
+    odometry_failures: int
+    odometry_summary: str
+    odometry_reasons: tuple[tuple[str, int], ...]
+
+
+def odometry_report_fields(res: OdometryResult | None) -> OdometryReportFields:
+    """The :class:`ImportReport` fields of an odometry run; empty when ``res`` is None."""
+    if res is None:
+        return {}
     return {"odometry_failures": res.failures, "odometry_summary": res.summary(),
             "odometry_reasons": tuple(res.reasons().items())}
