@@ -4,6 +4,12 @@ Every ``import``/``from`` of an ``sgtool`` module anywhere in a module (top leve
 function) is checked against the ranks below: a module may import its own layer and the
 layers of lower rank, never a layer of its own rank or above. ``recorders`` and
 ``replayers`` share a rank, so neither imports the other.
+
+The package ``sgtool`` itself (``toolkit/__init__.py``) is the public facade: it re-exports
+names of every layer (lazily), so it is a top layer beside the CLI, and no module of the
+package may import from it (``from sgtool import __version__`` in the core would be an
+import upwards; the version lives in ``sgtool.version``). The facade and the CLI share a
+rank: neither imports the other.
 """
 
 from __future__ import annotations
@@ -17,11 +23,14 @@ REPO = Path(__file__).resolve().parents[1]
 FOLDERS = {"toolkit": "sgtool", "recorders": "sgtool.recorders",
            "replayers": "sgtool.replayers", "datasets": "sgtool.datasets",
            "analysis": "sgtool.analysis"}
-RANK = {"core": 0, "datasets": 1, "recorders": 2, "replayers": 2, "analysis": 3, "commands": 4}
+RANK = {"core": 0, "datasets": 1, "recorders": 2, "replayers": 2, "analysis": 3, "commands": 4,
+        "facade": 4}
 
 
 def layer(module: str) -> str:
     """The layer of a dotted module name under ``sgtool``."""
+    if module == "sgtool":
+        return "facade"
     parts = module.split(".")
     if len(parts) > 1 and parts[1] in ("recorders", "replayers", "datasets", "analysis"):
         return parts[1]
@@ -68,7 +77,9 @@ def test_layer_of_module_names() -> None:
     assert layer("sgtool.datasets.generator") == "datasets"
     assert layer("sgtool.commands.replay") == "commands"
     assert layer("sgtool.cli") == "commands"
-    assert layer("sgtool") == "core"
+    assert layer("sgtool") == "facade"
+    assert layer("sgtool.version") == "core"
+    assert module_name(REPO / "toolkit" / "__init__.py") == "sgtool"
 
 
 def test_every_import_flows_down_the_layers() -> None:
@@ -87,6 +98,11 @@ def test_every_import_flows_down_the_layers() -> None:
     ("sgtool.datasets.x", "import sgtool.analysis.bench\n", "datasets imports analysis"),
     ("sgtool.analysis.x", "from sgtool.commands.options import parse_rooms\n",
      "analysis imports commands"),
+    ("sgtool.log.writer", "from sgtool import __version__\n", "core imports facade"),
+    ("sgtool.analysis.bench", "def f():\n    from sgtool import SceneGraph\n",
+     "analysis imports facade"),
+    ("sgtool.commands.run", "import sgtool\n", "commands imports facade"),
+    ("sgtool", "from sgtool.commands.run import command\n", "facade imports commands"),
 ])
 def test_a_broken_layer_is_reported(module: str, source: str, message: str) -> None:
     bad = violations(module, source, "probe.py")
@@ -99,3 +115,6 @@ def test_imports_down_the_layers_are_fine() -> None:
     assert violations("sgtool.commands.run", src, "probe.py") == []
     assert violations("sgtool.analysis.bench", src, "probe.py") == []
     assert len(violations("sgtool.datasets.generator", src, "probe.py")) == 2
+    # the facade re-exports every layer below the CLI
+    assert violations("sgtool", src, "probe.py") == []
+    assert violations("sgtool", "from sgtool.version import __version__\n", "x") == []

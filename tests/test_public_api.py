@@ -1,0 +1,201 @@
+"""The public Python API (``import sgtool``): light, complete, documented, typed.
+
+``sgtool/__init__.py`` is a facade: a table of public name -> ``module:attribute``
+imported on first use (PEP 562), mirrored by ``if TYPE_CHECKING:`` imports for mypy. These
+tests keep the table, the type-checking imports and the objects behind them in step.
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import importlib.metadata
+import inspect
+import json
+import subprocess
+import sys
+import typing
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+import sgtool
+
+REPO = Path(__file__).resolve().parents[1]
+INIT = REPO / "toolkit" / "__init__.py"
+
+# What a user needs without the CLI (issue 27): each group must stay in __all__.
+REQUIRED = {
+    "logs": ("LogReader", "LogWriter", "EpisodeRecord", "ActionRecord", "Instances",
+             "InstanceItem", "SceneGraphRecord", "LlmExchange"),
+    "replay": ("replay", "ReplayOptions", "SceneGraphStream", "Refresh"),
+    "scene graph": ("SceneGraph", "RoomNode", "RegionNode", "ObjectNode", "DoorNode",
+                    "RobotState"),
+    "planners": ("Planner", "Action", "Feedback", "make_planner", "planner_names"),
+    "symbolic episode": ("run_one", "EpisodeResult"),
+    "benchmark": ("BenchConfig", "run_benchmark", "BenchResult"),
+    "closed loop": ("run_closed_loop", "ClosedLoopOptions"),
+    "metrics": ("success_rate", "spl", "auc_e", "summarize"),
+    "houses": ("HouseSpec", "load_house"),
+    "errors": ("SgtoolError",),
+}
+
+# Public signatures whose annotation is a bare ``Any`` today, each with why it is left.
+# A new one fails the test; fixing one needs no change here.
+KNOWN_ANY = {
+    # engineer A is replacing the registry's options (issue 27 item 3); its signature is theirs
+    "make_planner:options": "stringly typed options: being replaced by typed dataclasses",
+    "LogReader.records:kw": "the time range of LogReader.messages passed through",
+    "LogReader.decode:return": "a protobuf message, a JSON dict or bytes, by the schema",
+    "LogWriter.write_proto:msg": "any protobuf message (google.protobuf is untyped here)",
+    "LogRecord.check:d": "any decoded JSON value, checked at run time",
+    "LogRecord.from_json:d": "any decoded JSON value, checked at run time",
+    "replay:progress": "anything with update(n) (a tqdm bar); no shared protocol yet",
+    "run_closed_loop:progress": "anything with update(n) (a tqdm bar); no shared protocol yet",
+}
+
+
+def _public() -> list[tuple[str, object]]:
+    return [(name, getattr(sgtool, name)) for name in sgtool.__all__]
+
+
+def test_import_sgtool_is_light() -> None:
+    """A fresh interpreter: ``import sgtool`` loads the version module and nothing heavy."""
+    code = ("import json, sys, sgtool; print(json.dumps(sorted(m for m in sys.modules if "
+            "m.split('.')[0] in ('sgtool', 'numpy', 'torch', 'pybullet', 'open3d', 'mcap'))))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, cwd=REPO).stdout
+    assert json.loads(out) == ["sgtool", "sgtool.version"]
+
+
+def test_the_names_a_user_needs_are_public() -> None:
+    missing = {group: [n for n in names if n not in sgtool.__all__]
+               for group, names in REQUIRED.items()}
+    assert not any(missing.values()), missing
+    assert len(set(sgtool.__all__)) == len(sgtool.__all__)
+
+
+def test_every_public_name_resolves_to_its_table_entry() -> None:
+    table = sgtool._EXPORTS
+    assert set(sgtool.__all__) == {*table, "planner_names"}
+    for name, target in table.items():
+        module, _, attribute = target.partition(":")
+        assert getattr(sgtool, name) is getattr(importlib.import_module(module), attribute), name
+
+
+def test_the_type_checking_imports_mirror_the_table() -> None:
+    """What mypy and IDEs see (the ``if TYPE_CHECKING:`` imports) is what run time gives."""
+    tree = ast.parse(INIT.read_text())
+    block = next(n for n in tree.body if isinstance(n, ast.If)
+                 and isinstance(n.test, ast.Name) and n.test.id == "TYPE_CHECKING")
+    seen: dict[str, str] = {}
+    for node in block.body:
+        assert isinstance(node, ast.ImportFrom) and node.module is not None
+        for alias in node.names:
+            seen[alias.asname or alias.name] = f"{node.module}:{alias.name}"
+    assert seen == sgtool._EXPORTS
+
+
+def _own_doc(obj: object) -> str:
+    """The object's own docstring: not a dataclass's generated signature, not inherited."""
+    doc = obj.__doc__ if (inspect.isclass(obj) or callable(obj)) else None
+    if inspect.isclass(obj) and doc and doc.startswith(f"{obj.__name__}("):
+        return ""  # dataclasses write "Name(field: type, ...)" when there is no docstring
+    return (doc or "").strip()
+
+
+def test_every_public_name_is_documented() -> None:
+    undocumented = [name for name, obj in _public() if not _own_doc(obj)]
+    assert not undocumented, f"public names without a docstring: {undocumented}"
+    foreign = [name for name, obj in _public()
+               if not getattr(obj, "__module__", "").startswith("sgtool")]
+    assert not foreign, f"public names defined outside sgtool: {foreign}"
+
+
+def test_dir_and_unknown_names() -> None:
+    assert set(sgtool.__all__) <= set(dir(sgtool))
+    assert "__version__" in dir(sgtool)
+    assert not hasattr(sgtool, "no_such_name")
+    with pytest.raises(AttributeError, match="no_such_name"):
+        sgtool.no_such_name  # noqa: B018
+    from sgtool import cli  # a submodule still imports through the facade
+
+    assert cli.__name__ == "sgtool.cli"
+
+
+def test_version_is_one_string() -> None:
+    from sgtool.version import __version__
+
+    assert sgtool.__version__ == __version__ == importlib.metadata.version("sgtool")
+
+
+def test_planner_names_build_planners() -> None:
+    names = sgtool.planner_names()
+    assert {"random", "greedy", "scout"} <= set(names)
+    for name in ("random", "greedy"):
+        planner = sgtool.make_planner(name)
+        assert all(callable(getattr(planner, m)) for m in ("reset", "decide", "feedback"))
+        assert planner.name == name
+
+
+def _signatures(name: str, obj: object) -> list[tuple[str, Callable[..., object]]]:
+    """(label, function) of a public function, or of a public class's own public methods
+    and its constructor; an overloaded function is checked by its overloads."""
+    out: list[tuple[str, Callable[..., object]]] = []
+    if inspect.isclass(obj):
+        for attr, raw in vars(obj).items():
+            if attr.startswith("_") and attr != "__init__":
+                continue
+            f = raw.__func__ if isinstance(raw, (classmethod, staticmethod)) else raw
+            f = f.fget if isinstance(f, property) else f
+            if inspect.isfunction(f):
+                out.append((f"{name}.{attr}", f))
+    elif inspect.isfunction(obj):
+        out.append((name, obj))
+    return [(label, g) for label, f in out for g in (typing.get_overloads(f) or [f])]
+
+
+def _bare_any(f: Callable[..., object]) -> list[str]:
+    """Parameters (and ``return``) annotated with exactly ``Any``."""
+    return [k for k, v in getattr(f, "__annotations__", {}).items()
+            if v is typing.Any or v in ("Any", "typing.Any")]
+
+
+def test_no_bare_any_in_public_signatures() -> None:
+    found = {f"{label}:{param}" for name, obj in _public()
+             for label, f in _signatures(name, obj) for param in _bare_any(f)}
+    new = sorted(found - set(KNOWN_ANY))
+    assert not new, f"bare Any in public signatures: {new}"
+    # the check sees what it should: a known case is found while it is still there
+    checked = {label for name, obj in _public() for label, _ in _signatures(name, obj)}
+    assert {"replay", "LogReader.records", "SceneGraph.objects_in", "run_one"} <= checked
+
+
+def test_public_names_annotate_every_parameter() -> None:
+    """Every parameter of the public functions and methods has an annotation (mypy checks
+    that they are right)."""
+    bare = []
+    for name, obj in _public():
+        for label, f in _signatures(name, obj):
+            for p in inspect.signature(f).parameters.values():
+                if p.name not in ("self", "cls") and p.annotation is inspect.Parameter.empty:
+                    bare.append(f"{label}({p.name})")
+    assert not bare, f"parameters without annotations: {bare}"
+
+
+def test_a_log_round_trip_through_the_public_names(tmp_path: Path) -> None:
+    """Write typed records with sgtool.LogWriter, read them back with sgtool.LogReader."""
+    path = tmp_path / "run.mcap"
+    opened = sgtool.EpisodeRecord(kind="search", status="started", query="mug", planner="me")
+    act = sgtool.ActionRecord(skill="navigate", target="room:1", outcome="success",
+                              travelled_m=1.23456789)
+    with sgtool.LogWriter(path, seed=7) as log:
+        log.write_record(opened, 0)
+        log.write_record(act, 1_000_000_000)
+    with sgtool.LogReader(path) as log:
+        assert log.seed == 7
+        assert list(log.records(sgtool.EpisodeRecord)) == [(0, opened)]
+        [(t, back)] = list(log.records(sgtool.ActionRecord))
+    assert t == 1_000_000_000 and back.target == "room:1"
+    assert back.travelled_m == 1.2346  # distances are rounded to 0.1 mm by the record
