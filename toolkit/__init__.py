@@ -20,7 +20,9 @@ replay                 :func:`replay` (a callback per refresh), :class:`ReplayOp
 scene graph            :class:`SceneGraph`, :class:`RoomNode`, :class:`RegionNode`,
                        :class:`ObjectNode`, :class:`DoorNode`, :class:`RobotState`
 planners               the :class:`Planner` protocol, :class:`Action`, :class:`Feedback`,
-                       :func:`make_planner`, :func:`planner_names`
+                       :func:`make_planner`, :func:`planner_names`; for writing one:
+                       :func:`actionable` (the nodes a planner may act on, as
+                       :class:`Candidate` s with skill and distance), :func:`find_target`
 houses                 :class:`HouseSpec`, :func:`load_house`, :func:`load_house_text`,
                        :func:`save_house`, :func:`generate_house`, :class:`SearchEpisode`,
                        :func:`list_episodes`
@@ -39,7 +41,8 @@ metrics                :func:`success_rate`, :func:`spl`, :func:`episode_spl`,
 logged decisions       :func:`load_results`, :func:`read_log_episodes`,
                        :class:`LoggedEpisode`, :func:`replay_decisions`,
                        :class:`OfflineReport`, :func:`format_offline`
-import and export      :func:`import_rgbd`, :class:`RgbdOptions`, :class:`ImportReport`,
+import and export      :func:`import_rgbd`, :class:`RgbdOptions` (:class:`PinholeParams`
+                       from :func:`parse_intrinsics`), :class:`ImportReport`,
                        :func:`export_bag`, :class:`ExportReport`
 errors                 :class:`SgtoolError` (every failure a user can cause),
                        :class:`LogFormatError`, :class:`SpecError`
@@ -107,10 +110,12 @@ if TYPE_CHECKING:  # the real types for mypy and IDEs; at run time __getattr__ i
     )
     from sgtool.log.writer import LogWriter
     from sgtool.planning.base import Action, Feedback, Planner
+    from sgtool.planning.candidates import Candidate, actionable, find_target
     from sgtool.planning.registry import make_planner
     from sgtool.recorders.exporters.bag_export import ExportReport, export_bag
     from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
     from sgtool.recorders.importers.sink import ImportReport
+    from sgtool.recorders.importers.textformats import PinholeParams, parse_intrinsics
     from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode
     from sgtool.recorders.sim.closed_loop import run_episode as run_closed_loop
     from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport
@@ -166,6 +171,9 @@ _EXPORTS: dict[str, str] = {
     "Action": "sgtool.planning.base:Action",
     "Feedback": "sgtool.planning.base:Feedback",
     "make_planner": "sgtool.planning.registry:make_planner",
+    "actionable": "sgtool.planning.candidates:actionable",
+    "Candidate": "sgtool.planning.candidates:Candidate",
+    "find_target": "sgtool.planning.candidates:find_target",
     # houses and their search episodes
     "HouseSpec": "sgtool.house.spec:HouseSpec",
     "load_house": "sgtool.house.io:load_house",
@@ -214,6 +222,8 @@ _EXPORTS: dict[str, str] = {
     # import and export
     "import_rgbd": "sgtool.recorders.importers.rgbd:import_rgbd",
     "RgbdOptions": "sgtool.recorders.importers.rgbd:RgbdOptions",
+    "PinholeParams": "sgtool.recorders.importers.textformats:PinholeParams",
+    "parse_intrinsics": "sgtool.recorders.importers.textformats:parse_intrinsics",
     "ImportReport": "sgtool.recorders.importers.sink:ImportReport",
     "export_bag": "sgtool.recorders.exporters.bag_export:export_bag",
     "ExportReport": "sgtool.recorders.exporters.bag_export:ExportReport",
@@ -227,6 +237,7 @@ __all__ = [
     "InstanceItem", "SceneGraphRecord", "LlmExchange", "replay", "ReplayOptions",
     "ReplayReport", "SceneGraphStream", "Refresh", "SceneGraph", "RoomNode", "RegionNode",
     "ObjectNode", "DoorNode", "RobotState", "Planner", "Action", "Feedback", "make_planner",
+    "actionable", "Candidate", "find_target",
     "HouseSpec", "load_house", "load_house_text", "save_house", "generate_house",
     "SearchEpisode", "list_episodes", "run_one", "SymbolicHouse", "EpisodeResult",
     "BenchConfig", "BenchResult", "run_benchmark", "write_bench_outputs", "run_closed_loop",
@@ -235,7 +246,8 @@ __all__ = [
     "CostModel", "cost_models", "metrics_of", "summarize", "PlannerSummary", "Stat",
     "format_table", "read_results", "write_results", "load_results", "read_log_episodes",
     "LoggedEpisode", "replay_decisions", "OfflineReport", "format_offline", "import_rgbd",
-    "RgbdOptions", "ImportReport", "export_bag", "ExportReport",
+    "RgbdOptions", "PinholeParams", "parse_intrinsics", "ImportReport", "export_bag",
+    "ExportReport",
 ]
 
 
