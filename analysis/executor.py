@@ -35,6 +35,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from sgtool.errors import SgtoolError, Terminated, raise_terminated
+from sgtool.extras import missing_message
 
 EXECUTORS: tuple[str, ...] = ("local", "ray")
 RAY_INSTALL = "pip install 'sgtool[ray]'"
@@ -308,8 +309,7 @@ def import_ray() -> Any:
     try:
         import ray
     except ImportError:
-        raise ExecutorError(f"--executor ray needs Ray, which is not installed: "
-                            f"{RAY_INSTALL}") from None
+        raise ExecutorError(missing_message("--executor ray", "ray")) from None
     return ray
 
 

@@ -23,6 +23,7 @@ from typing import Any
 import click
 
 from sgtool.errors import SgtoolError, Terminated, raise_terminated
+from sgtool.extras import missing_extra
 from sgtool.files import is_environment_error
 from sgtool.redact import redact_text
 from sgtool.version import __version__
@@ -104,6 +105,11 @@ class LazyGroup(click.Group):
             raise usage_line(e) from e
         except SgtoolError as e:
             raise UserError(str(e)) from e
+        except ModuleNotFoundError as e:  # an optional package (an extra) is not installed
+            missing = missing_extra(f"sgtool {ctx.invoked_subcommand}", e)
+            if missing is None:
+                raise
+            raise UserError(str(missing)) from e
         except OSError as e:
             if not is_environment_error(e):
                 raise
@@ -136,7 +142,13 @@ class LazyGroup(click.Group):
         avail = self._available()
         if cmd_name not in avail:
             return None
-        mod = importlib.import_module(f"sgtool.commands.{avail[cmd_name][0]}")
+        try:
+            mod = importlib.import_module(f"sgtool.commands.{avail[cmd_name][0]}")
+        except ModuleNotFoundError as e:  # an optional package (an extra) is not installed
+            missing = missing_extra(f"sgtool {cmd_name}", e)
+            if missing is None:
+                raise
+            raise missing from e
         return mod.command
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:

