@@ -192,3 +192,30 @@ def test_evaluate_logged_replays_the_logged_decisions(tmp_path: Path) -> None:
     row = table_rows(metrics)["greedy"]
     assert row[0] == f"{sgtool.success_rate(bench.results):.3f} ± 0.000"
     assert row[-1] == "3 (1 seeds)"
+
+
+def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                            capsys: pytest.CaptureFixture[str]) -> None:
+    """docs/api.md's code blocks, in order, in one namespace, from a folder that looks like
+    the repository root (the closed-loop block is left out: a PyBullet episode takes a
+    minute; tests/recorders/sim covers run_episode)."""
+    guide = (REPO / "docs" / "api.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", guide, re.DOTALL)
+    assert len(blocks) == 11
+    runnable = [b for b in blocks if "run_closed_loop(" not in b]
+    assert len(runnable) == len(blocks) - 1
+    for name in ("tests", "examples"):
+        (tmp_path / name).symlink_to(REPO / name)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "path", list(sys.path))  # the guide adds examples/ to it
+    namespace: dict[str, object] = {"__name__": "api_guide"}
+    for block in runnable:
+        exec(compile(block, "docs/api.md", "exec"), namespace)  # noqa: S102
+    out = capsys.readouterr().out
+    assert "my_planner:MyPlanner" in out and "| scout" in out  # the benchmark table
+    assert (tmp_path / "results" / "summary.md").is_file()
+    assert (tmp_path / "derived_bag").is_dir()
+    with sgtool.LogReader(tmp_path / "my.mcap") as log:
+        assert [r.skill for _, r in log.records(sgtool.ActionRecord)] == ["navigate"]
+    report = namespace["report"]
+    assert isinstance(report, sgtool.OfflineReport) and report.decisions > 0
