@@ -115,6 +115,13 @@ def check_planner_list(planners: Sequence[str]) -> None:
 
 @dataclass(frozen=True)
 class BenchConfig:
+    """The settings of a symbolic benchmark run (module doc): the planners (names for
+    :func:`sgtool.planning.registry.make_planner`), generated houses and their room range
+    and preset, house files, episodes per house, seeds, ``max_steps`` per episode, the
+    AUC-E budgets, options per planner, the success rule and where the tasks run.
+    :meth:`check` raises a one-line :class:`BenchError` for a setting that cannot work;
+    :meth:`settings` are the ones that can change results (written to summary.json)."""
+
     planners: tuple[str, ...] = DEFAULT_PLANNERS
     houses: int = 10
     episodes: int = 20  # per house
@@ -186,6 +193,13 @@ class BenchConfig:
 
 @dataclass(frozen=True)
 class BenchResult:
+    """What :func:`run_benchmark` returns: its ``config``, every episode's
+    :class:`~sgtool.results.EpisodeResult` (by planner, house, episode, seed), episodes per
+    second per planner (wall clock), the ``table`` and ``seen_table`` text, the
+    ``digest`` of the results without wall-clock figures, the run's ``wall_s``, its
+    houses, the number of training queries of the priors and one line per task that
+    ``failed``; :func:`write_outputs` writes it into a folder."""
+
     config: BenchConfig
     results: tuple[EpisodeResult, ...]
     throughput: dict[str, float]  # planner -> episodes per second of one core (wall-clock)

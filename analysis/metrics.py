@@ -103,6 +103,7 @@ def cost_models(distance_budget: float = DISTANCE_BUDGET, step_budget: float = S
 # episode-set metrics
 # ----------------------------------------------------------------------------------------
 def success_rate(results: Sequence[EpisodeResult]) -> float:
+    """The share of ``results`` that succeeded; NaN for no episodes."""
     if not results:
         return math.nan
     return sum(1 for r in results if r.success) / len(results)
@@ -116,6 +117,8 @@ def spl(results: Sequence[EpisodeResult]) -> float:
 
 
 def mean_steps(results: Sequence[EpisodeResult]) -> float:
+    """Mean high-level steps per episode (a failed episode counts all it spent); NaN for
+    no episodes."""
     return float(np.mean([r.steps for r in results])) if results else math.nan
 
 
@@ -224,6 +227,9 @@ def metrics_of(results: Sequence[EpisodeResult],
 
 @dataclass(frozen=True)
 class PlannerSummary:
+    """One planner's metrics (:func:`summarize`): its ``episodes`` over all seeds, the
+    ``seeds``, and per metric name (:data:`METRICS`) a :class:`Stat` over the seeds."""
+
     planner: str
     episodes: int  # all episodes over all seeds
     seeds: tuple[int, ...]

@@ -53,7 +53,7 @@ from sgtool.errors import SgtoolError
 from sgtool.log.inspect import foreign_log_problem
 from sgtool.log.records import ABSENT, Absent, Episode, LogRecord, SceneGraphRecord, given
 from sgtool.log.records import Action as LoggedAction
-from sgtool.planning.base import Action, Feedback
+from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.planning.episode import NOT_CONFIRMED, check_success_rule
 from sgtool.results import EpisodeResult, read_jsonl, result_from_log_records
 from sgtool.scenegraph.graph import DoorNode, SceneGraph
@@ -79,6 +79,11 @@ class Decision:
 
 @dataclass(frozen=True)
 class LoggedEpisode:
+    """One episode of an MCAP log (:func:`read_log_episodes`): the ``source`` file, its
+    ``index`` in the log, its closing ``sgtool.Episode`` record (the opening record's
+    fields merged in; made up for a killed run) and its decision points in log order;
+    :meth:`result` is its :class:`~sgtool.results.EpisodeResult`."""
+
     source: str
     index: int  # episode number within its log
     episode: Episode  # the closing Episode record (synthesised when missing)
@@ -258,6 +263,12 @@ class DecisionComparison:
 
 @dataclass(frozen=True)
 class OfflineReport:
+    """A planner's choices against the logged decisions (:func:`replay_decisions`): one
+    :class:`DecisionComparison` per decision point, and the points ``skipped`` for want
+    of a logged graph. :meth:`rate` is the share of decisions that ``agree`` (same skill
+    and target), have the same ``target``, the same ``room``, or are ``invalid`` (name no
+    node of the graph); NaN without decisions."""
+
     planner: str
     comparisons: tuple[DecisionComparison, ...]
     skipped: int  # decision points without a logged scene graph
@@ -339,7 +350,7 @@ def log_exchanges(paths: Iterable[str | os.PathLike[str]]) -> list[tuple[str, di
     return out
 
 
-def replay_decisions(planner: Any, episodes: Sequence[LoggedEpisode],
+def replay_decisions(planner: Planner, episodes: Sequence[LoggedEpisode],
                      name: str | None = None) -> OfflineReport:
     """Ask ``planner`` at every logged decision point (module doc)."""
     out: list[DecisionComparison] = []
@@ -375,6 +386,8 @@ def replay_decisions(planner: Any, episodes: Sequence[LoggedEpisode],
 
 
 def format_offline(reports: Sequence[OfflineReport]) -> str:
+    """The table ``sgtool eval -p`` prints: one row per report (decisions, the rates of
+    :meth:`OfflineReport.rate` in percent, mean decision time, skipped points)."""
     from sgtool.analysis.report import pipe_table
 
     def pct(x: float) -> str:

@@ -125,6 +125,12 @@ def stage_lines(stages: dict[str, tuple[float, float, int]]) -> list[str]:
 
 @dataclass
 class ReplayReport:
+    """What :func:`replay` did: its ``input`` and ``output`` (None without one), the
+    resolved ``options``, the frames integrated and refreshes made, whether the log has
+    instance ids (``semantic``), the ``last`` refresh, per-stage (median ms, max ms,
+    calls), the wall-clock ``seconds`` (reported, never written) and ``truncated`` when
+    ``max_frames`` stopped it; :meth:`lines` is what ``sgtool replay`` prints."""
+
     input: Path
     output: Path | None
     options: ResolvedOptions

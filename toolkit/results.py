@@ -170,6 +170,9 @@ def write_jsonl(results: Iterable[EpisodeResult], path: str | os.PathLike[str]) 
 
 
 def read_jsonl(path: str | os.PathLike[str]) -> list[EpisodeResult]:
+    """The episode records of a JSONL file (``episodes.jsonl`` of ``sgtool bench``: one
+    :class:`EpisodeResult` per line, blank lines skipped); anything else is a
+    :class:`ResultsFormatError` naming the file and the line."""
     p = Path(path)
     try:
         lines = p.read_text(encoding="utf-8").splitlines()

@@ -52,6 +52,10 @@ MAP_TYPES = {
 
 @dataclass(frozen=True)
 class ExportReport:
+    """What :func:`export_bag` wrote: the bag ``output`` and its ``fmt`` (ros1, ros2),
+    (ROS topic, type, messages) per topic, and whether the log had derived layers;
+    :meth:`lines` is what ``sgtool export bag`` prints."""
+
     output: Path
     fmt: str
     counts: tuple[tuple[str, str, int], ...]  # (ROS topic, type, messages)

@@ -130,6 +130,13 @@ NAVIGATION = ("live", "house")
 # ----------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class ClosedLoopOptions:
+    """How a closed-loop episode runs (:func:`run_episode`): frame rate, camera, robot,
+    sensor ``noise``; the mapping (a refresh every ``every`` frames, room ``classifier``,
+    ``min_points``, ``voxel_size``: recorded in the log, so ``sgtool replay`` rebuilds the
+    same graphs); ``max_steps`` high-level steps and a ``frames`` budget; ``navigation``
+    ``live`` (the robot's own map) or ``house`` (ground truth); the ``success`` rule.
+    :meth:`mapping` checks them (a one-line :class:`~sgtool.errors.SgtoolError`)."""
+
     fps: float = 10.0
     camera: CameraConfig = field(default_factory=CameraConfig)
     robot: RobotConfig = field(default_factory=RobotConfig)

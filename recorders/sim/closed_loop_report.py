@@ -9,6 +9,13 @@ from pathlib import Path
 
 @dataclass(frozen=True)
 class ClosedLoopReport:
+    """What one closed-loop episode did
+    (:func:`sgtool.recorders.sim.closed_loop.run_episode`): its log ``output``, house,
+    planner, query and episode id, ``success`` and why it ended, steps, metres travelled,
+    the shortest path (None when unknown), frames, refreshes, opens, and the wall-clock
+    decision times and run seconds (reported, never logged); :meth:`lines` is what
+    ``sgtool run`` prints."""
+
     output: Path
     house_id: str
     planner: str

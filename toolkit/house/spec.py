@@ -288,6 +288,12 @@ class StartPose:
 
 @dataclass(frozen=True)
 class HouseSpec:
+    """A house (DESIGN.md, "House spec"): rooms, walls, doors, passages, furniture, small
+    objects and start poses; immutable, checked when loaded
+    (:func:`sgtool.house.io.load_house`), written as canonical JSON by ``to_json()``.
+    ``seed`` is the generator's seed (or the file's), ``split`` the knowledge split that
+    furnished it."""
+
     seed: int
     rooms: tuple[Room, ...]
     walls: tuple[Wall, ...]

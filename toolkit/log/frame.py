@@ -18,6 +18,10 @@ import numpy as np
 
 @dataclass(frozen=True)
 class CameraIntrinsics:
+    """Pinhole camera intrinsics: the image is ``width`` x ``height`` pixels, ``fx``, ``fy``
+    the focal lengths and ``cx``, ``cy`` the principal point, all in pixels (:attr:`K` is
+    the 3x3 matrix)."""
+
     width: int
     height: int
     fx: float

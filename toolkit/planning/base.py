@@ -39,6 +39,10 @@ class Action:
 
 @dataclass(frozen=True)
 class Feedback:
+    """The outcome of an executed :class:`Action`, passed to :meth:`Planner.feedback`:
+    ``outcome`` (success, failure, invalid), the executor's ``message`` (why it failed,
+    what it revealed) and the metres ``travelled_m`` it took."""
+
     action: Action
     outcome: Outcome
     message: str = ""
@@ -46,6 +50,13 @@ class Feedback:
 
 
 class Planner(Protocol):
+    """What every planner implements. A :class:`typing.Protocol`: any object with these
+    members is a planner, no base class needed. ``name`` labels its rows in tables and
+    logs; :meth:`reset` starts each episode; :meth:`decide` is called once per step with
+    the scene graph in force and returns an :class:`Action` whose ``target`` is a node id
+    of that graph (or ``done``); :meth:`feedback` then reports that action's outcome.
+    A planner never touches a simulator."""
+
     name: str
 
     def reset(self, query: str, seed: int = 0) -> None:

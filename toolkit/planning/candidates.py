@@ -53,6 +53,10 @@ _CATEGORY = attrgetter("category")
 
 @dataclass(frozen=True)
 class Candidate:
+    """One actionable node (:func:`actionable`): its ``node_id``, the ``skill`` that acts on
+    it (module doc's table), its ``kind`` (room, frontier, object, door), the travel
+    ``distance`` from the robot in metres and its (x, y) ``position``."""
+
     node_id: str
     skill: Skill
     kind: NodeKind

@@ -94,6 +94,9 @@ class DoorNode:
 
 @dataclass(frozen=True)
 class RobotState:
+    """Where the robot is: ``position`` (x, y) in metres and ``yaw`` in radians in the
+    world frame, and the ``room`` and ``region`` node ids it stands in (None when none)."""
+
     position: tuple[float, float]
     yaw: float = 0.0
     room: str | None = None
