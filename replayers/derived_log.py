@@ -49,6 +49,7 @@ from sgtool.log.reader import LogReader
 from sgtool.log.records import Episode, Instances
 from sgtool.log.writer import LogWriter
 from sgtool.mapping.voxels import VoxelConfig
+from sgtool.progress import Progress
 from sgtool.scenegraph.derived_layers import DERIVED_TOPICS, write_refresh
 from sgtool.scenegraph.options import (
     CLASSIFIERS,
@@ -175,7 +176,7 @@ def replay(
     options: ReplayOptions | None = None,
     *,
     on_refresh: Callable[[Refresh, SceneGraphStream], None] | None = None,
-    progress: Any = None,
+    progress: Progress | None = None,
     compression: str = "zstd",
     verify: bool = False,
     room_classifier: Callable[[str], Any] | None = None,
@@ -225,7 +226,8 @@ def replay(
 
 def _run(reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
          opts: ResolvedOptions, report: ReplayReport,
-         on_refresh: Callable[[Refresh, SceneGraphStream], None] | None, progress: Any,
+         on_refresh: Callable[[Refresh, SceneGraphStream], None] | None,
+         progress: Progress | None,
          copy_chunks: bool = False) -> None:
     feed = _Feed(reader, stream, writer, opts, report, on_refresh, progress)
     if copy_chunks and writer is not None and _can_copy(reader, writer, opts):
@@ -271,7 +273,7 @@ class _Feed:
     def __init__(self, reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
                  opts: ResolvedOptions, report: ReplayReport,
                  on_refresh: Callable[[Refresh, SceneGraphStream], None] | None,
-                 progress: Any) -> None:
+                 progress: Progress | None) -> None:
         self.reader, self.stream, self.writer = reader, stream, writer
         self.opts, self.report, self.on_refresh, self.progress = opts, report, on_refresh, progress
         self.frame_topics = set(FRAME_TOPICS)

@@ -51,8 +51,6 @@ KNOWN_ANY = {
     "LogWriter.write_proto:msg": "any protobuf message (google.protobuf is untyped here)",
     "LogRecord.check:d": "any decoded JSON value, checked at run time",
     "LogRecord.from_json:d": "any decoded JSON value, checked at run time",
-    "replay:progress": "anything with update(n) (a tqdm bar); no shared protocol yet",
-    "run_closed_loop:progress": "anything with update(n) (a tqdm bar); no shared protocol yet",
 }
 
 

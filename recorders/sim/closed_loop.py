@@ -93,6 +93,7 @@ from sgtool.planning.episode import (
     run_search,
     search_success,
 )
+from sgtool.progress import Progress
 from sgtool.recorders.sim.camera import CameraConfig
 from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport
 from sgtool.recorders.sim.execution import Executed, execute_live, execute_privileged
@@ -359,7 +360,7 @@ class _Search:
 def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                 output: str | os.PathLike[str], options: ClosedLoopOptions | None = None, *,
                 house_id: str = "", episode_index: int = 0,
-                overwrite: bool = False, progress: Any = None,
+                overwrite: bool = False, progress: Progress | None = None,
                 on_decision: Callable[[SceneGraph, Action], None] | None = None
                 ) -> ClosedLoopReport:
     """Run one closed-loop search episode into the log ``output`` (module doc) through
