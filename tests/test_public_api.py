@@ -122,6 +122,21 @@ def test_dir_and_unknown_names() -> None:
     assert cli.__name__ == "sgtool.cli"
 
 
+def test_a_name_whose_extra_is_missing_is_one_line(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A public name whose module needs an extra that is not installed is one
+    SgtoolError line naming the extra; a module missing for another reason (a bug) is the
+    plain ModuleNotFoundError. Neither is cached in the package."""
+    monkeypatch.setitem(sys.modules, "pybullet", None)  # as if sgtool[sim] were absent
+    monkeypatch.setitem(sgtool._EXPORTS, "probe_sim", "pybullet:connect")
+    monkeypatch.setitem(sgtool._EXPORTS, "probe_bug", "sgtool.no_such_module:thing")
+    with pytest.raises(sgtool.SgtoolError) as missing:
+        sgtool.probe_sim  # noqa: B018
+    assert str(missing.value) == "sgtool.probe_sim needs PyBullet: pip install 'sgtool[sim]'"
+    with pytest.raises(ModuleNotFoundError, match="sgtool.no_such_module"):
+        sgtool.probe_bug  # noqa: B018
+    assert "probe_sim" not in vars(sgtool) and "probe_bug" not in vars(sgtool)
+
+
 def test_version_is_one_string() -> None:
     from sgtool.version import __version__
 

@@ -16,7 +16,8 @@ logs                   :class:`LogReader`, :class:`LogWriter`, :class:`Frame`,
                        :class:`ActionRecord`, :class:`Instances`, :class:`InstanceItem`,
                        :class:`SceneGraphRecord`, :class:`LlmExchange`, :class:`LogRecord`
 replay                 :func:`replay` (a callback per refresh), :class:`ReplayOptions`,
-                       :class:`ReplayReport`, :class:`SceneGraphStream`, :class:`Refresh`
+                       :class:`ReplayReport`, :class:`SceneGraphStream`, :class:`Refresh`,
+                       :class:`Progress` (what ``progress=`` takes: a tqdm bar)
 scene graph            :class:`SceneGraph`, :class:`RoomNode`, :class:`RegionNode`,
                        :class:`ObjectNode`, :class:`DoorNode`, :class:`RobotState`
 planners               the :class:`Planner` protocol, :class:`Action`, :class:`Feedback`,
@@ -112,6 +113,7 @@ if TYPE_CHECKING:  # the real types for mypy and IDEs; at run time __getattr__ i
     from sgtool.planning.base import Action, Feedback, Planner
     from sgtool.planning.candidates import Candidate, actionable, find_target
     from sgtool.planning.registry import make_planner
+    from sgtool.progress import Progress
     from sgtool.recorders.exporters.bag_export import ExportReport, export_bag
     from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
     from sgtool.recorders.importers.sink import ImportReport
@@ -157,6 +159,7 @@ _EXPORTS: dict[str, str] = {
     "replay": "sgtool.replayers.derived_log:replay",
     "ReplayOptions": "sgtool.replayers.derived_log:ReplayOptions",
     "ReplayReport": "sgtool.replayers.derived_log:ReplayReport",
+    "Progress": "sgtool.progress:Progress",
     "SceneGraphStream": "sgtool.scenegraph.stream:SceneGraphStream",
     "Refresh": "sgtool.scenegraph.stream:Refresh",
     # the scene graph
@@ -235,19 +238,18 @@ __all__ = [
     "planner_names", "SgtoolError", "LogFormatError", "SpecError", "LogReader", "LogWriter",
     "Frame", "CameraIntrinsics", "LogRecord", "EpisodeRecord", "ActionRecord", "Instances",
     "InstanceItem", "SceneGraphRecord", "LlmExchange", "replay", "ReplayOptions",
-    "ReplayReport", "SceneGraphStream", "Refresh", "SceneGraph", "RoomNode", "RegionNode",
-    "ObjectNode", "DoorNode", "RobotState", "Planner", "Action", "Feedback", "make_planner",
-    "actionable", "Candidate", "find_target",
-    "HouseSpec", "load_house", "load_house_text", "save_house", "generate_house",
-    "SearchEpisode", "list_episodes", "run_one", "SymbolicHouse", "EpisodeResult",
-    "BenchConfig", "BenchResult", "run_benchmark", "write_bench_outputs", "run_closed_loop",
-    "ClosedLoopOptions", "ClosedLoopReport", "pick_episode", "success_rate", "spl",
-    "episode_spl", "mean_steps", "mean_decision_time", "auc_e", "efficiency_curve",
-    "CostModel", "cost_models", "metrics_of", "summarize", "PlannerSummary", "Stat",
-    "format_table", "read_results", "write_results", "load_results", "read_log_episodes",
-    "LoggedEpisode", "replay_decisions", "OfflineReport", "format_offline", "import_rgbd",
-    "RgbdOptions", "PinholeParams", "parse_intrinsics", "ImportReport", "export_bag",
-    "ExportReport",
+    "ReplayReport", "Progress", "SceneGraphStream", "Refresh", "SceneGraph", "RoomNode",
+    "RegionNode", "ObjectNode", "DoorNode", "RobotState", "Planner", "Action", "Feedback",
+    "make_planner", "actionable", "Candidate", "find_target", "HouseSpec", "load_house",
+    "load_house_text", "save_house", "generate_house", "SearchEpisode", "list_episodes",
+    "run_one", "SymbolicHouse", "EpisodeResult", "BenchConfig", "BenchResult", "run_benchmark",
+    "write_bench_outputs", "run_closed_loop", "ClosedLoopOptions", "ClosedLoopReport",
+    "pick_episode", "success_rate", "spl", "episode_spl", "mean_steps", "mean_decision_time",
+    "auc_e", "efficiency_curve", "CostModel", "cost_models", "metrics_of", "summarize",
+    "PlannerSummary", "Stat", "format_table", "read_results", "write_results", "load_results",
+    "read_log_episodes", "LoggedEpisode", "replay_decisions", "OfflineReport", "format_offline",
+    "import_rgbd", "RgbdOptions", "PinholeParams", "parse_intrinsics", "ImportReport",
+    "export_bag", "ExportReport",
 ]
 
 
@@ -261,12 +263,23 @@ def planner_names() -> tuple[str, ...]:
 
 
 def __getattr__(name: str) -> object:
-    """A public name, imported from its module on first use and kept in the package."""
+    """A public name, imported from its module on first use and kept in the package. A
+    name whose stage needs an extra that is not installed raises
+    :class:`~sgtool.extras.MissingExtraError` (an :class:`SgtoolError`), one line:
+    ``sgtool.run_closed_loop needs PyBullet: pip install 'sgtool[sim]'``."""
     target = _EXPORTS.get(name)
     if target is None:
         raise AttributeError(f"module 'sgtool' has no attribute {name!r}")
     module, _, attribute = target.partition(":")
-    value = getattr(importlib.import_module(module), attribute)
+    try:
+        value = getattr(importlib.import_module(module), attribute)
+    except ModuleNotFoundError as e:
+        from sgtool.extras import missing_extra
+
+        missing = missing_extra(f"sgtool.{name}", e)
+        if missing is None:
+            raise
+        raise missing from None
     globals()[name] = value  # later look-ups skip __getattr__
     return value
 
