@@ -17,6 +17,7 @@ from pathlib import Path
 import click
 
 from sgtool.errors import SgtoolError
+from sgtool.extras import require
 
 
 def _weights_dir() -> Path:
@@ -113,6 +114,7 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
         click.echo(json.dumps(rep, indent=1, sort_keys=True) if as_json else format_report(rep))
         return
 
+    require("torch")  # training needs the `learn` extra (before minutes of data building)
     cfg = DistillConfig(seed=seed, holdout=holdout, epochs_containment=epochs_containment,
                         epochs_cooccurrence=epochs_cooccurrence, keep=keep, threads=threads)
     eval_sets = None
