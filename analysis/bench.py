@@ -355,7 +355,10 @@ def bench_tasks(cfg: BenchConfig, houses: Sequence[BenchHouse]) -> list[Task]:
 # the run
 # ----------------------------------------------------------------------------------------
 def run_benchmark(cfg: BenchConfig, progress: bool | None = None) -> BenchResult:
-    """Run every planner on every episode (module doc); nothing is written."""
+    """Run every planner on every episode (module doc) and return the results and their
+    tables; nothing is written (:func:`write_outputs` does). A setting that cannot work is
+    a one-line :class:`~sgtool.errors.SgtoolError` (:class:`BenchError`, a planner option)
+    before any episode runs."""
     cfg.check()
     executor = make_executor(cfg.executor, cfg.workers, cfg.ray_address)
     houses = prepare_houses(cfg)

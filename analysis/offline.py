@@ -352,7 +352,9 @@ def log_exchanges(paths: Iterable[str | os.PathLike[str]]) -> list[tuple[str, di
 
 def replay_decisions(planner: Planner, episodes: Sequence[LoggedEpisode],
                      name: str | None = None) -> OfflineReport:
-    """Ask ``planner`` at every logged decision point (module doc)."""
+    """Ask ``planner`` at every logged decision point of ``episodes`` (module doc: it
+    decides on the logged graph, then is told the logged outcome) and compare its choices
+    with the logged actions; ``name`` labels the report (default: the planner's name)."""
     out: list[DecisionComparison] = []
     skipped = 0
     for ep in episodes:

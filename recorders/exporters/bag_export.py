@@ -99,7 +99,9 @@ def _converters(w: BagWriter) -> dict[str, tuple[str, str, Callable[[int, Any], 
 
 def export_bag(log: str | Path, out: str | Path, fmt: str = "ros2",
                force: bool = False) -> ExportReport:
-    """Write ``log`` as a bag at ``out`` (see the module docstring)."""
+    """Write the sgtool log ``log`` (best a derived one) as a ROS bag at ``out`` (module
+    doc), ``fmt`` ``ros2`` (a bag folder) or ``ros1`` (a file); an existing ``out`` is
+    replaced only with ``force``. The bag appears under its name only when complete."""
     log, out = Path(log), Path(out)
     if fmt not in FORMATS:
         raise SgtoolError(f"--format {fmt!r}: give ros1 or ros2")

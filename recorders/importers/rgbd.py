@@ -195,7 +195,9 @@ def run_odometry(
 
 
 def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = None) -> ImportReport:
-    """Import an RGB-D folder into the log ``out`` (see the module docstring)."""
+    """Import the RGB-D folder ``root`` into the log ``out`` (module doc) and return what
+    was written; options and the folder's files are checked before any work, each problem
+    a one-line :class:`~sgtool.errors.SgtoolError`."""
     opts = opts or RgbdOptions()
     root, out = Path(root), Path(out)
     check_options(opts)

@@ -83,7 +83,12 @@ class Decoded:
 
 
 class LogReader:
-    """An open log. Use as a context manager or call :meth:`close`."""
+    """An open log (module doc). Opening checks the MCAP magic bytes, footer, summary and
+    the log schema version (a newer major version is refused); a missing, truncated or
+    damaged file is a one-line :class:`~sgtool.errors.LogFormatError` that names the
+    ``sgtool doctor`` line to run. :meth:`frames`, :meth:`records` (typed, checked) and
+    :meth:`messages` read in log-time order. Use as a context manager or call
+    :meth:`close`."""
 
     def __init__(self, path: str | os.PathLike[str], *, check_version: bool = True,
                  verify: bool = False) -> None:

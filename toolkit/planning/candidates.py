@@ -399,7 +399,9 @@ def _finite_or_inf(d: object) -> float:
 
 
 def actionable(graph: SceneGraph) -> list[Candidate]:
-    """N_a in natural id order; unreachable nodes are left out."""
+    """The nodes a planner may act on (SCOUT's N_a; the module doc's table says which
+    skill acts on which node), each a :class:`Candidate` with its travel distance, in
+    natural id order; unreachable nodes are left out."""
     if not graph.distances:
         return _actionable_without_distances(graph)
     return actionable_columns(graph).candidates()
