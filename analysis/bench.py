@@ -102,15 +102,24 @@ class BenchError(SgtoolError):
 
 
 def check_planner_list(planners: Sequence[str]) -> None:
-    """``--planners`` of a benchmark (symbolic or closed loop): at least one, each known."""
-    from sgtool.planning.registry import PLANNER_NAMES
+    """``--planners`` of a benchmark (symbolic or closed loop): at least one, each a
+    built-in planner, a registered plug-in or ``module:Name``
+    (:func:`sgtool.planning.registry.check_planner_name`), no two writing their logs into
+    one folder (:func:`~sgtool.planning.registry.planner_file_name`)."""
+    from sgtool.planning.registry import check_planner_name, planner_file_name
 
     if not planners:
         raise BenchError("--planners: name at least one planner")
+    folders: dict[str, str] = {}
     for p in planners:
-        if p not in PLANNER_NAMES:
-            raise BenchError(f"--planners: unknown planner {p!r}; choose from "
-                             f"{', '.join(PLANNER_NAMES)}")
+        try:
+            check_planner_name(p)
+        except SgtoolError as e:
+            raise BenchError(f"--planners: {e}") from None
+        other = folders.setdefault(planner_file_name(p), p)
+        if other != p:
+            raise BenchError(f"--planners: {other!r} and {p!r} would share the log folder "
+                             f"{planner_file_name(p)!r}")
 
 
 @dataclass(frozen=True)
@@ -318,6 +327,7 @@ def _task(args: tuple[BenchConfig, BenchHouse, tuple[str, ...]]) -> list[Episode
 
 def _task_episodes(cfg: BenchConfig, ref: BenchHouse,
                    names: tuple[str, ...]) -> list[EpisodeResult]:
+    from sgtool.planning.registry import planner_file_name
     from sgtool.recorders.symbolic_environment.rollout import run_episode
     from sgtool.semantics.text import category_text
 
@@ -336,7 +346,8 @@ def _task_episodes(cfg: BenchConfig, ref: BenchHouse,
                     continue
                 from sgtool.log.writer import LogWriter
 
-                path = output_path(cfg.log_dir, name, ref.id, f"seed{seed}-ep{i}.mcap")
+                path = output_path(cfg.log_dir, planner_file_name(name), ref.id,
+                                   f"seed{seed}-ep{i}.mcap")
                 path.parent.mkdir(parents=True, exist_ok=True)
                 with LogWriter(path, seed=seed) as log:
                     out.append(run_episode(house, planner, ep.query, ep.targets, log=log, **kw))

@@ -149,9 +149,13 @@ class RunRow:
 
 
 def log_path(root: Path, noise: str, planner: str, house: str, episode: int) -> Path:
-    """``root/NOISE/PLANNER/HOUSE/ep-K.mcap``; a name that would leave ``root`` (or is no
-    file name) is refused (:func:`~sgtool.analysis.bench_houses.output_path`)."""
-    return output_path(root, noise, planner, house, f"ep-{episode:03d}.mcap")
+    """``root/NOISE/PLANNER/HOUSE/ep-K.mcap`` (a plug-in ``module:Name`` as
+    ``module__Name``: :func:`sgtool.planning.registry.planner_file_name`); a name that
+    would leave ``root`` (or is no file name) is refused
+    (:func:`~sgtool.analysis.bench_houses.output_path`)."""
+    from sgtool.planning.registry import planner_file_name
+
+    return output_path(root, noise, planner_file_name(planner), house, f"ep-{episode:03d}.mcap")
 
 
 # the house and its episodes per house and draw, per process: houses a worker keeps (a

@@ -9,10 +9,17 @@ import sys
 import click
 
 from sgtool.commands.options import (
+    PLANNER_OPTION_HELP,
+    PLUGIN_HELP,
+    LlmEndpoint,
     executor_options,
+    list_planners_option,
+    llm_endpoint_options,
     llm_log_options,
     parse_rooms,
+    planner_names,
     planner_options,
+    shown_command,
     success_option,
 )
 from sgtool.datasets.presets import PRESET_NAMES
@@ -23,7 +30,9 @@ from sgtool.errors import SgtoolError
 @click.option("--planners", default=None, metavar="LIST",
               help="Comma-separated planners to compare (random, greedy, sbert, sbert-noroom, "
                    "scout, scout-noroom, scout-delta0, godhs, esc, bayes-search, moma-llm, "
-                   "unstructured-llm, godhs-llm). Default: all but the LLM planners.")
+                   "unstructured-llm, godhs-llm). Default: all but the LLM planners. "
+                   + PLUGIN_HELP)
+@list_planners_option()
 @click.option("--houses", default=10, show_default=True,
               help="Number of generated evaluation-split houses (house seeds HOUSE_SEED, +1, "
                    "...); 0 with --house benches the given houses only.")
@@ -76,9 +85,9 @@ from sgtool.errors import SgtoolError
 @llm_log_options(
     transcript_help="moma-llm: append every LLM exchange to this JSONL transcript "
     "(needs --workers 1).")
+@llm_endpoint_options("LLM planners")
 @click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
-              help="Extra planner option, e.g. scout.delta=0.2 or moma-llm.model=gpt-4o-mini "
-                   "(repeatable; see sgtool.planning.registry).")
+              help=PLANNER_OPTION_HELP)
 @click.option("--log-dir", type=click.Path(file_okay=False), default=None,
               help="Also record every episode as an MCAP log (scene graph and action per "
                    "step) under LOG_DIR/PLANNER/HOUSE/, readable by `sgtool eval`.")
@@ -91,7 +100,9 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...],
             step_budget: float, llm_replay: str | None, llm_transcript: str | None,
             planner_option: tuple[str, ...], log_dir: str | None,
             progress: bool | None, success: str = "observed", executor: str = "local",
-            ray_address: str | None = None) -> None:
+            ray_address: str | None = None, llm_base_url: str | None = None,
+            llm_model: str | None = None, llm_api_key: str | None = None,
+            llm_timeout: float | None = None) -> None:
     """Run the symbolic object-search benchmark (SCOUT's SymSearch roll-out) on generated
     evaluation houses and/or house spec files and print a table in the shape of SCOUT's
     Table VII: success rate, SPL, high-level steps, decision time, and MoMa-LLM's AUC-E with
@@ -105,9 +116,9 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...],
     for flag, value in (("--distance-budget", distance_budget), ("--step-budget", step_budget)):
         if not math.isfinite(value):
             raise SgtoolError(f"{flag} {value}: must be a finite number > 0")
-    names = tuple(p.strip() for p in planners.split(",") if p.strip()) if planners \
-        else DEFAULT_PLANNERS
+    names = planner_names(planners) if planners else DEFAULT_PLANNERS
     options = planner_options(planner_option, names)
+    LlmEndpoint(llm_base_url, llm_model, llm_api_key, llm_timeout).fill(options, names)
     if llm_replay or llm_transcript:
         moma = options.setdefault("moma-llm", {})
         if llm_replay:
@@ -125,7 +136,8 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...],
     if res.failed:  # tables without some houses' episodes would pass for a result
         raise SgtoolError(f"{len(res.failed)} task(s) failed after a retry, nothing written "
                           f"to {out_dir}; the first: {res.failed[0]}")
-    paths = write_outputs(res, out_dir, command=shlex.join(["sgtool", *sys.argv[1:]]))
+    command_line = shlex.join(shown_command(["sgtool", *sys.argv[1:]]))
+    paths = write_outputs(res, out_dir, command=command_line)
     click.echo(res.table)
     click.echo(res.side_by_side)
     click.echo(res.seen_table)

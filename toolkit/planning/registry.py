@@ -1,127 +1,104 @@
-"""Planners by name: ``make_planner(name, **options) -> Planner``.
+"""Planners by name: :data:`REGISTRY` is a table of name -> :class:`Entry` (factory, options
+dataclass, one-line summary), :func:`make_planner` builds one from a name and options.
 
-==================  ====================================================================
-name                what it is
-==================  ====================================================================
-``random``          uniform over actionable nodes (SCOUT's random agent)
-``greedy``          nearest actionable node
-``sbert``           SBERT cosine utilities with room influence (SCOUT Table VI defaults)
-``sbert-noroom``    the same without room influence ("w/o RI")
-``scout``           distilled containment/co-occurrence priors, Eqs. 1-4, 12-13
-                    (Table II defaults: room 0.7, frontier 0.6, delta 0.1, w 0.3)
-``scout-noroom``    SCOUT without room influence
-``scout-delta0``    SCOUT with delta = 0 (greedy on utility, Eq. 13)
-``godhs``           GODHS (SCOUT sec. VI, [12]): explore everything, then rooms by
-                    relevance, then identified carriers (:mod:`sgtool.planning.godhs`)
-``esc``             ESC-Interactive (MoMa-LLM's baseline): soft commonsense rules over
-                    frontiers and carriers (:mod:`sgtool.planning.esc`)
-``bayes-search``    search theory: Bayes belief over places, p/c ratio rule with a
-                    look-ahead (:mod:`sgtool.planning.search_theory`)
-``moma-llm``        MoMa-LLM over an OpenAI-compatible chat endpoint or a transcript
-``unstructured-llm`` MoMa-LLM's ablation: the same, shown the raw JSON scene graph
-                    (:mod:`sgtool.planning.moma.unstructured`)
-``godhs-llm``       GODHS with an LLM ranking rooms and carriers
-                    (:mod:`sgtool.planning.llm_ranker`; the priors when it fails)
-==================  ====================================================================
-
-Every planner comes wrapped in :class:`~sgtool.planning.timing.TimedPlanner`, so each
-action carries its measured decision time. Options:
-
-- all: ``timed`` (bool, default True), ``max_failures`` (node-selection planners: failed
-  attempts before a node is dropped, default 2);
-- ``sbert*``/``scout*``: ``default_room``, ``default_frontier``, ``delta``, ``room_weight``,
-  ``frontier_radius`` override the table defaults; ``encoder`` (a SentenceEncoder),
-  ``weights_dir`` (scout only: another set of distilled weights);
-- ``godhs``, ``esc``, ``bayes-search``: ``encoder``, ``weights_dir`` as for scout;
-  ``godhs``: ``carrier_threshold`` (default 0.1), ``ranker`` (any
-  :class:`~sgtool.planning.godhs.Ranker`, e.g. an LLM ranker; default the priors);
-  ``esc``: ``w_obj``, ``w_room``, ``w_dist``, ``radius``; ``bayes-search``: ``step_cost``,
-  ``open_cost``, ``reveal_cost``, ``top_k``, ``horizon``, ``step_budget`` (0: none),
-  ``room_floor``, ``object_floor``, ``sharpness``, ``object_sharpness``, ``beyond``,
-  ``miss``, ``region_weight``, ``blend`` (false: learned scores only, no novelty blend),
-  ``furniture_levels`` (name -> φ mapping or a table's path, default the shipped table;
-  "none": no furniture-level prior; :mod:`sgtool.planning.furniture_prior`);
-- ``moma-llm``: ``base_url``, ``model``, ``api_key`` (else from the environment, see
-  :mod:`sgtool.llm.client`), ``timeout_s``, ``temperature``, ``replay`` (a JSONL transcript
-  to serve instead of an endpoint), ``transcript`` (append exchanges to this JSONL),
-  ``on_exchange`` (callback per exchange record), ``max_attempts``, ``stuck_repeats``,
-  ``history_limit``, ``client`` (any object with ``model`` and ``complete(messages)``),
-  ``constraint`` (``auto`` (default), ``grammar``, ``json_schema``, ``none``:
-  :mod:`sgtool.llm.constraints`), ``reason_chars``, ``max_tokens``; ``unstructured-llm``:
-  the same;
-- ``godhs-llm``: the endpoint options of ``moma-llm`` (``base_url`` ... ``replay``,
-  ``client``, ``transcript``), ``carrier_threshold``, ``encoder``, ``weights_dir`` (the
-  fallback priors).
+The options of a planner are the fields of its family's dataclass
+(:mod:`sgtool.planning.planner_options`), checked and converted by
+:mod:`sgtool.planning.option_fields`; ``sgtool bench --list-planners`` prints them
+(:func:`describe_planners`). A name ``module:Name`` or one an installed package registers
+in the entry-point group ``sgtool.planners`` is a plug-in (:mod:`sgtool.planning.plugins`).
+Every planner comes wrapped in :class:`~sgtool.planning.timing.TimedPlanner` (option
+``timed``, default true), so each action carries its measured decision time.
 """
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Any
 
 from sgtool.errors import SgtoolError
+from sgtool.planning import plugins
 from sgtool.planning.base import Planner
-
-PLANNER_NAMES: tuple[str, ...] = (
-    "random", "greedy", "sbert", "sbert-noroom", "scout", "scout-noroom", "scout-delta0",
-    "godhs", "esc", "bayes-search", "moma-llm", "unstructured-llm", "godhs-llm",
+from sgtool.planning.option_fields import (
+    OptionMeta,
+    PlannerOptionError,
+    UnknownPlannerError,
+    build_options,
+    convert_options,
+    convert_value,
+    option_infos,
+    parse_text,
+)
+from sgtool.planning.planner_options import (
+    BayesSearchOptions,
+    EscOptions,
+    GodhsLlmOptions,
+    GodhsOptions,
+    LlmEndpointOptions,
+    MomaOptions,
+    NodeOptions,
+    SbertOptions,
+    ScoutOptions,
 )
 
-_UTILITY_KEYS = ("default_room", "default_frontier", "delta", "room_weight", "frontier_radius")
+__all__ = ["REGISTRY", "PLANNER_NAMES", "Entry", "UnknownPlannerError", "PlannerOptionError",
+           "make_planner", "options_of", "parse_option", "describe_planners", "is_llm_planner",
+           "check_planner_name", "planner_file_name"]
+
+TIMED = OptionMeta("wrap the planner in TimedPlanner: every action carries its decision "
+                   "time", "bool")
 
 
-class UnknownPlannerError(SgtoolError):
-    """A planner name that is not registered, or an option it does not take."""
+@dataclass(frozen=True)
+class Entry:
+    """A registered planner: ``factory(name, options)`` builds it from an instance of
+    ``options`` (the family's dataclass); ``fixed`` are options the name sets itself (not
+    settable)."""
+
+    factory: Callable[[str, Any], Planner]
+    options: type
+    summary: str
+    fixed: Mapping[str, Any] = field(default_factory=dict)
 
 
-def _pop_params(name: str, options: dict[str, Any]) -> dict[str, Any]:
-    out = {k: float(options.pop(k)) for k in _UTILITY_KEYS if k in options}
-    bad = next((k for k, v in out.items() if not math.isfinite(v) or v < 0), None)
-    if bad is not None:
-        raise UnknownPlannerError(f"planner {name!r}: option {bad}={out[bad]}: must be a finite "
-                                  "number >= 0")
-    return out
+# --------------------------------------------------------------------------------------
+# factories: each builds its planner from the family's options, as before the table
+# --------------------------------------------------------------------------------------
+def _node(name: str, o: NodeOptions) -> Planner:
+    from sgtool.planning import planners
+
+    cls = planners.RandomPlanner if name == "random" else planners.GreedyPlanner
+    return cls(max_failures=o.max_failures)
 
 
-def _utility(name: str, options: dict[str, Any]) -> Planner:
+def _utility(name: str, o: ScoutOptions | SbertOptions) -> Planner:
     from sgtool.planning.planners import UtilityPlanner
     from sgtool.planning.utility import UtilityParams
     from sgtool.semantics.priors import CosinePriors, LearnedPriors, default_priors
 
-    encoder = options.pop("encoder", None)
-    weights_dir = options.pop("weights_dir", None)
-    max_failures = int(options.pop("max_failures", 2))
-    params = _pop_params(name, options)
-    family, _, variant = name.partition("-")
-    if variant == "noroom":
-        params["room_influence"] = False
-    if variant == "delta0":
-        params["delta"] = 0.0
-    if family == "sbert":
-        scorer: Any = CosinePriors(encoder)
-        up = UtilityParams.sbert(**params)
+    params = UtilityParams(default_room=o.default_room, default_frontier=o.default_frontier,
+                           delta=0.0 if name == "scout-delta0" else o.delta,
+                           room_weight=o.room_weight, room_influence=not name.endswith("-noroom"),
+                           frontier_radius=o.frontier_radius)
+    scorer: Any
+    if isinstance(o, SbertOptions):
+        scorer = CosinePriors(o.encoder)
+    elif o.encoder is None and o.weights_dir is None:
+        scorer = default_priors()
     else:
-        if encoder is None and weights_dir is None:
-            scorer = default_priors()
-        else:
-            scorer = LearnedPriors(encoder, weights_dir)
-        up = UtilityParams.scout(**params)
-    return UtilityPlanner(name, scorer, up, max_failures=max_failures)
+        scorer = LearnedPriors(o.encoder, o.weights_dir)
+    return UtilityPlanner(name, scorer, params, max_failures=o.max_failures)
 
 
-def _priors(options: dict[str, Any], blend: bool) -> Any:
-    """The learned priors (``encoder``/``weights_dir`` options), optionally blended with the
-    cosine by query novelty (:mod:`sgtool.planning.calibration`)."""
+def _priors(encoder: Any, weights_dir: str | None, blend: bool) -> Any:
+    """The learned priors (``encoder``/``weights_dir``), optionally blended with the cosine
+    by query novelty (:mod:`sgtool.planning.calibration`)."""
     from sgtool.semantics.encoder import default_encoder
     from sgtool.semantics.priors import CosinePriors, LearnedPriors, default_priors
 
-    encoder = options.pop("encoder", None)
-    weights_dir = options.pop("weights_dir", None)
-    if encoder is None and weights_dir is None:
-        learned = default_priors()
-    else:
-        learned = LearnedPriors(encoder, weights_dir)
+    learned = default_priors() if encoder is None and weights_dir is None \
+        else LearnedPriors(encoder, weights_dir)
     if not blend:
         return learned
     from sgtool.planning.calibration import BlendedPriors
@@ -131,12 +108,11 @@ def _priors(options: dict[str, Any], blend: bool) -> Any:
                          enc)
 
 
-def _furniture_levels(options: dict[str, Any]) -> Any:
-    """The ``furniture_levels`` option: a mapping, a table's path, "none"/"off", or absent
-    (the shipped table, :mod:`sgtool.planning.furniture_prior`)."""
+def _furniture_levels(value: Any) -> Any:
+    """A mapping, a table's path, "none"/"off", or None (the shipped table,
+    :mod:`sgtool.planning.furniture_prior`)."""
     from sgtool.planning.furniture_prior import load_levels
 
-    value = options.pop("furniture_levels", None)
     if value is None:
         return load_levels()
     if isinstance(value, str):
@@ -146,130 +122,233 @@ def _furniture_levels(options: dict[str, Any]) -> Any:
     return value
 
 
-def _search(name: str, options: dict[str, Any]) -> Planner:
-    max_failures = int(options.pop("max_failures", 2))
-    if name == "bayes-search":
-        from sgtool.planning.belief import BeliefParams
-        from sgtool.planning.search_theory import SearchParams, SearchTheoryPlanner
+def _bayes(name: str, o: BayesSearchOptions) -> Planner:
+    from sgtool.planning.belief import BeliefParams
+    from sgtool.planning.search_theory import SearchParams, SearchTheoryPlanner
 
-        keys = ("step_cost", "open_cost", "reveal_cost", "top_k", "horizon", "step_budget")
-        kw = {k: type(getattr(SearchParams, k))(options.pop(k)) for k in keys if k in options}
-        bkeys = ("room_floor", "object_floor", "sharpness", "object_sharpness", "beyond",
-                 "miss", "region_weight")
-        bkw = {k: float(options.pop(k)) for k in bkeys if k in options}
-        kw["belief"] = BeliefParams(**bkw)
-        blend = str(options.pop("blend", True)).strip().lower() not in ("false", "0", "no")
-        scorer = _priors(options, blend=blend)
-        return SearchTheoryPlanner(scorer, SearchParams(**kw), max_failures=max_failures,
-                                   furniture_levels=_furniture_levels(options))
-    if name == "esc":
-        from sgtool.planning.esc import EscParams, EscPlanner
+    belief = BeliefParams(room_floor=o.room_floor, object_floor=o.object_floor,
+                          sharpness=o.sharpness, object_sharpness=o.object_sharpness,
+                          beyond=o.beyond, miss=o.miss, region_weight=o.region_weight)
+    params = SearchParams(step_cost=o.step_cost, open_cost=o.open_cost,
+                          reveal_cost=o.reveal_cost, top_k=o.top_k, horizon=o.horizon,
+                          step_budget=o.step_budget, belief=belief)
+    scorer = _priors(o.encoder, o.weights_dir, blend=o.blend)
+    return SearchTheoryPlanner(scorer, params, max_failures=o.max_failures,
+                               furniture_levels=_furniture_levels(o.furniture_levels))
 
-        keys = ("w_obj", "w_room", "w_dist", "radius")
-        kw = {k: float(options.pop(k)) for k in keys if k in options}
-        return EscPlanner(_priors(options, blend=False), EscParams(**kw),
-                          max_failures=max_failures)
+
+def _esc(name: str, o: EscOptions) -> Planner:
+    from sgtool.planning.esc import EscParams, EscPlanner
+
+    return EscPlanner(_priors(o.encoder, o.weights_dir, blend=False),
+                      EscParams(w_obj=o.w_obj, w_room=o.w_room, w_dist=o.w_dist,
+                                radius=o.radius), max_failures=o.max_failures)
+
+
+def _godhs(name: str, o: GodhsOptions) -> Planner:
     from sgtool.planning.godhs import GodhsPlanner, PriorRanker
 
-    ranker = options.pop("ranker", None) or PriorRanker(_priors(options, blend=False))
-    return GodhsPlanner(ranker, float(options.pop("carrier_threshold", 0.1)),
-                        max_failures=max_failures)
+    ranker = o.ranker or PriorRanker(_priors(o.encoder, o.weights_dir, blend=False))
+    return GodhsPlanner(ranker, o.carrier_threshold, max_failures=o.max_failures)
 
 
-def _llm_client(options: dict[str, Any]) -> Any:
+def _llm_client(o: LlmEndpointOptions) -> Any:
     """The chat client of an LLM planner: ``client``, else a ``replay`` transcript, else an
     endpoint from ``base_url``/``model``/``api_key``/... (:mod:`sgtool.llm.client`)."""
     from sgtool.llm.client import LlmSettings, OpenAIChatClient
     from sgtool.llm.recorded import ReplayChatClient
 
-    client = options.pop("client", None)
-    replay = options.pop("replay", None)
-    settings_kw = {k: options.pop(k) for k in
-                   ("base_url", "model", "api_key", "timeout_s", "temperature", "max_tokens")
-                   if k in options}
-    if client is not None:
-        return client
-    if replay:
-        return ReplayChatClient(replay, model=settings_kw.get("model"))
-    return OpenAIChatClient(LlmSettings.resolve(**settings_kw))
+    if o.client is not None:
+        return o.client
+    if o.replay:
+        return ReplayChatClient(o.replay, model=o.model)
+    return OpenAIChatClient(LlmSettings.resolve(
+        base_url=o.base_url, model=o.model, api_key=o.api_key, timeout_s=o.timeout_s,
+        temperature=o.temperature, max_tokens=o.max_tokens))
 
 
-def _godhs_llm(options: dict[str, Any]) -> Planner:
+def _godhs_llm(name: str, o: GodhsLlmOptions) -> Planner:
     from sgtool.planning.godhs import GodhsPlanner, PriorRanker
     from sgtool.planning.llm_ranker import LlmRanker
 
-    client = _llm_client(options)
-    ranker = LlmRanker(client, fallback=PriorRanker(_priors(options, blend=False)),
-                       transcript=options.pop("transcript", None))
-    return GodhsPlanner(ranker, float(options.pop("carrier_threshold", 0.1)), name="godhs-llm",
-                        max_failures=int(options.pop("max_failures", 2)))
+    client = _llm_client(o)
+    ranker = LlmRanker(client, fallback=PriorRanker(_priors(o.encoder, o.weights_dir,
+                                                            blend=False)),
+                       transcript=o.transcript)
+    return GodhsPlanner(ranker, o.carrier_threshold, name="godhs-llm",
+                        max_failures=o.max_failures)
 
 
-def _moma(options: dict[str, Any], unstructured: bool = False) -> Planner:
+def _moma(name: str, o: MomaOptions) -> Planner:
     from sgtool.planning.moma.planner import MomaLlmPlanner
     from sgtool.planning.moma.unstructured import UnstructuredLlmPlanner
 
-    client = _llm_client(options)
-    kw = {k: options.pop(k) for k in
-          ("max_attempts", "stuck_repeats", "history_limit", "on_exchange", "transcript",
-           "decision_timeout_s", "reason_chars")
-          if k in options}
-    cls = UnstructuredLlmPlanner if unstructured else MomaLlmPlanner
-    return cls(client, constraint=str(options.pop("constraint", "auto")), **kw)
+    cls = UnstructuredLlmPlanner if name == "unstructured-llm" else MomaLlmPlanner
+    return cls(_llm_client(o), max_attempts=o.max_attempts, stuck_repeats=o.stuck_repeats,
+               history_limit=o.history_limit, on_exchange=o.on_exchange,
+               transcript=o.transcript, decision_timeout_s=o.decision_timeout_s,
+               constraint=o.constraint, reason_chars=o.reason_chars)
 
 
-def _simple(cls_name: str) -> Callable[[dict[str, Any]], Planner]:
-    def make(options: dict[str, Any]) -> Planner:
-        from sgtool.planning import planners
+REGISTRY: Mapping[str, Entry] = MappingProxyType({
+    "random": Entry(_node, NodeOptions, "uniform over actionable nodes (SCOUT's random agent)"),
+    "greedy": Entry(_node, NodeOptions, "nearest actionable node"),
+    "sbert": Entry(_utility, SbertOptions,
+                   "SBERT cosine utilities with room influence (SCOUT Table VI defaults)"),
+    "sbert-noroom": Entry(_utility, SbertOptions, "sbert without room influence ('w/o RI')"),
+    "scout": Entry(_utility, ScoutOptions, "SCOUT: distilled containment/co-occurrence "
+                   "priors, Eqs. 1-4, 12-13 (Table II defaults)"),
+    "scout-noroom": Entry(_utility, ScoutOptions, "SCOUT without room influence"),
+    "scout-delta0": Entry(_utility, ScoutOptions, "SCOUT with delta = 0 (greedy on "
+                          "utility, Eq. 13)", fixed={"delta": 0.0}),
+    "godhs": Entry(_godhs, GodhsOptions, "GODHS: explore everything, then rooms by "
+                   "relevance, then identified carriers (sgtool.planning.godhs)"),
+    "esc": Entry(_esc, EscOptions, "ESC-Interactive: soft commonsense rules over frontiers "
+                 "and carriers (sgtool.planning.esc)"),
+    "bayes-search": Entry(_bayes, BayesSearchOptions, "search theory: Bayes belief over "
+                          "places, p/c rule with a look-ahead (sgtool.planning.search_theory)"),
+    "moma-llm": Entry(_moma, MomaOptions, "MoMa-LLM over an OpenAI-compatible chat endpoint "
+                      "or a transcript"),
+    "unstructured-llm": Entry(_moma, MomaOptions, "MoMa-LLM's ablation: shown the raw JSON "
+                              "scene graph (sgtool.planning.moma.unstructured)"),
+    "godhs-llm": Entry(_godhs_llm, GodhsLlmOptions, "GODHS with an LLM ranking rooms and "
+                       "carriers (sgtool.planning.llm_ranker; the priors when it fails)"),
+})
+PLANNER_NAMES: tuple[str, ...] = tuple(REGISTRY)
 
-        return getattr(planners, cls_name)(max_failures=int(options.pop("max_failures", 2)))
 
-    return make
+def is_llm_planner(name: str) -> bool:
+    """A built-in planner that talks to a chat endpoint (its options hold one)."""
+    entry = REGISTRY.get(name.strip().lower())
+    return entry is not None and issubclass(entry.options, LlmEndpointOptions)
+
+
+def _unknown(name: str) -> UnknownPlannerError:
+    return UnknownPlannerError(
+        f"unknown planner {name!r}; choose one of: {', '.join(PLANNER_NAMES)}, a name "
+        f"registered in the entry-point group {plugins.GROUP}, or module:Name (a plug-in)")
+
+
+def check_planner_name(name: str) -> None:
+    """``name`` is a built-in planner, a registered plug-in, or ``module:Name`` (written
+    right; not imported here); else one :class:`UnknownPlannerError` line."""
+    if name.strip().lower() in REGISTRY:
+        return
+    if plugins.is_spec(name):
+        plugins.check_spec(name)
+        return
+    if name not in plugins.entry_points():
+        raise _unknown(name)
+
+
+def planner_file_name(name: str) -> str:
+    """The folder or file-name component of planner ``name`` in log paths
+    (:func:`sgtool.planning.plugins.file_name`)."""
+    return plugins.file_name(name)
+
+
+def _factory(name: str) -> Callable[..., Any]:
+    """A plug-in's class or factory (entry point first, then ``module:Name``)."""
+    entry = plugins.entry_points().get(name)
+    if entry is None and not plugins.is_spec(name):
+        raise _unknown(name)
+    return plugins.load_factory(name, entry)
+
+
+def options_of(name: str) -> type | None:
+    """The options dataclass of planner ``name`` (a plug-in's ``Options``; importing it),
+    or None for a plug-in without one."""
+    entry = REGISTRY.get(name.strip().lower())
+    if entry is not None:
+        return entry.options
+    return plugins.options_class(_factory(name))
+
+
+def parse_option(name: str, key: str, text: str) -> Any:
+    """The value of ``-O NAME.KEY=TEXT``: checked against the planner's field (built-in,
+    or a plug-in's ``Options``), else the text parsed as int, float, true/false or text."""
+    if key == "timed":
+        return convert_value(name, key, TIMED, text, from_cli=True)
+    entry = REGISTRY.get(name.strip().lower())
+    if entry is not None and key in entry.fixed:
+        raise _fixed(name, key, entry.fixed[key])
+    cls = options_of(name)
+    if cls is None:
+        return parse_text(text)
+    return convert_options(name, cls, {key: text}, from_cli=True)[key]
+
+
+def _fixed(name: str, key: str, value: Any) -> PlannerOptionError:
+    return PlannerOptionError(f"planner {name!r}: option {key} is fixed at {value} by the "
+                              "name (set it on the family's main planner instead)")
 
 
 def make_planner(name: str, **options: Any) -> Planner:
-    """A fresh planner by name (see the module doc for names and options)."""
-    timed = bool(options.pop("timed", True))
-    given = sorted(options)
+    """A fresh planner by name (a built-in of :data:`REGISTRY` or a plug-in), built from
+    ``options`` (checked against its options dataclass: one line for an unknown key, a
+    value of the wrong type or out of range), wrapped in
+    :class:`~sgtool.planning.timing.TimedPlanner` unless ``timed=False``. A plug-in's
+    wrapper carries ``name`` as its name, so tables and logs list it as it was named."""
+    timed = convert_value(name, "timed", TIMED, options.pop("timed", True))
+    key = name.strip().lower()
+    entry = REGISTRY.get(key)
+    if entry is None:
+        planner = plugins.build_plugin(name, _factory(name), options)
+    else:
+        planner = _build(key, entry, options)
+    if not timed:
+        return planner
+    from sgtool.planning.timing import TimedPlanner
+
+    wrapped = TimedPlanner(planner)
+    if entry is None:
+        wrapped.name = name
+    return wrapped
+
+
+def _build(name: str, entry: Entry, options: dict[str, Any]) -> Planner:
+    """A built-in planner; a value that passes its field's check but fails in the planner
+    (a weights folder, a table) is one line naming the options given."""
+    for k in options:
+        if k in entry.fixed:
+            raise _fixed(name, k, entry.fixed[k])
+    opts = build_options(name, entry.options, options)
     try:
-        planner = _build(name, options)
+        return entry.factory(name, opts)
     except SgtoolError:
         raise
     except (ValueError, TypeError, AttributeError, OSError, KeyError) as e:
-        if not given:
+        if not options:
             raise  # the defaults failed: a bug, not the user's input
-        raise UnknownPlannerError(
-            f"planner {name!r}: a value of its option(s) {', '.join(given)} does not fit "
-            f"({type(e).__name__}: {e})") from e
-    if timed:
-        from sgtool.planning.timing import TimedPlanner
-
-        return TimedPlanner(planner)  # type: ignore[return-value]
-    return planner
+        raise PlannerOptionError(
+            f"planner {name!r}: a value of its option(s) {', '.join(sorted(options))} does "
+            f"not fit ({type(e).__name__}: {e})") from e
 
 
-def _build(name: str, options: dict[str, Any]) -> Planner:
-    """The planner ``name`` built from ``options`` (each taken out as it is used; any left
-    is an error)."""
-    key = name.strip().lower()
-    if key == "random":
-        planner = _simple("RandomPlanner")(options)
-    elif key == "greedy":
-        planner = _simple("GreedyPlanner")(options)
-    elif key in ("sbert", "sbert-noroom", "scout", "scout-noroom", "scout-delta0"):
-        planner = _utility(key, options)
-    elif key in ("godhs", "esc", "bayes-search"):
-        planner = _search(key, options)
-    elif key in ("moma-llm", "unstructured-llm"):
-        planner = _moma(options, unstructured=key == "unstructured-llm")
-    elif key == "godhs-llm":
-        planner = _godhs_llm(options)
-    else:
-        raise UnknownPlannerError(
-            f"unknown planner {name!r}; choose one of: {', '.join(PLANNER_NAMES)}"
-        )
-    if options:
-        raise UnknownPlannerError(
-            f"planner {name!r} does not take option(s): {', '.join(sorted(options))}"
-        )
-    return planner
+def describe_planners() -> str:
+    """Every built-in planner with its summary and options (name, kind, default, help),
+    the options every planner takes, and the plug-ins installed packages register."""
+    lines = ["Planners (-O PLANNER.KEY=VALUE sets an option; '(Python only)' options are "
+             "for make_planner):", ""]
+    for name, entry in REGISTRY.items():
+        lines.append(f"{name}: {entry.summary}")
+        for info in option_infos(entry.options):
+            if info.name in entry.fixed:
+                lines.append(f"    {info.name}: fixed at {entry.fixed[info.name]}")
+            else:
+                lines.append(f"    {info.line()}")
+        lines.append("")
+    lines.append("Every planner: timed (bool, default true): " + TIMED.help + ".")
+    lines.append("")
+    found = plugins.entry_points()
+    lines.append(f"Plug-ins registered in the entry-point group {plugins.GROUP}: "
+                 + ("none" if not found else ""))
+    for ep_name, ep in sorted(found.items()):
+        shadow = " (shadowed by the built-in planner)" if ep_name.lower() in REGISTRY else ""
+        lines.append(f"    {ep_name} = {ep.value}{shadow}")
+    lines.append("")
+    lines.append("module:Name (e.g. mypkg.planners:MyPlanner): a class or factory importable "
+                 "here (PYTHONPATH; with Ray, on every machine of the cluster), called with "
+                 "its -O options as keyword arguments; an 'Options' dataclass attribute "
+                 "checks them as for the built-ins.")
+    return "\n".join(lines)

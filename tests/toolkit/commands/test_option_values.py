@@ -27,11 +27,19 @@ def _one_line_error(args: list[str], tmp_path: Path, expect: str) -> None:
 
 
 @pytest.mark.parametrize(("option", "expect"), [
-    ("scout.delta=abc", "planner 'scout': a value of its option(s) delta does not fit"),
+    ("scout.delta=abc", "planner 'scout': option delta=abc: must be a number"),
     ("scout.delta=nan", "planner 'scout': option delta=nan: must be a finite number >= 0"),
-    ("scout.delta=-5", "option delta=-5.0: must be a finite number >= 0"),
-    ("random.max_failures=abc", "planner 'random': a value of its option(s) max_failures"),
-    ("scout.encoder=foo", "planner 'scout': a value of its option(s) encoder does not fit"),
+    ("scout.delta=-5", "planner 'scout': option delta=-5: must be >= 0"),
+    ("scout.default_room=1.5", "planner 'scout': option default_room=1.5: must be 0..1"),
+    ("random.max_failures=abc", "planner 'random': option max_failures=abc: must be an "
+     "integer"),
+    ("random.max_failures=0", "planner 'random': option max_failures=0: must be >= 1"),
+    ("random.max_failures=2.5", "option max_failures=2.5: must be an integer"),
+    ("scout.encoder=foo", "planner 'scout': option encoder=foo: a Python object, set from "
+     "Python only"),
+    ("scout.dleta=0.2", "planner 'scout' does not take option(s): dleta; did you mean "
+     "'delta'?"),
+    ("random.timed=maybe", "planner 'random': option timed=maybe: must be true or false"),
     ("scout.weights_dir=/nonexistent", "relational model weights not found: /nonexistent"),
     ("sout.delta=0.2", "'sout' is no planner (those run: random, scout)"),
 ])

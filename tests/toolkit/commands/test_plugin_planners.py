@@ -1,0 +1,248 @@
+"""Plug-in planners on the command line (``module:Name`` from PYTHONPATH): their rows sit
+beside the built-ins' in every table and log of ``sgtool bench`` (also in worker
+processes), ``eval -p`` asks them, failures are one line; ``-O PLANNER.KEY=VALUE`` on every
+command (the bare form of ``run`` deprecated), ``--list-planners``, and the one LLM option
+group."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from sgtool.cli import cli
+from sgtool.commands.options import (
+    LlmEndpoint,
+    planner_options,
+    run_planner_options,
+    split_planner_key,
+)
+from sgtool.errors import SgtoolError
+
+PLUGIN = textwrap.dedent('''
+    from sgtool.planning.planners import GreedyPlanner
+
+
+    class MyPlanner(GreedyPlanner):
+        """Greedy under its own name, with a knob that must arrive."""
+
+        def __init__(self, k=1):
+            super().__init__()
+            if k != 3:
+                raise ValueError(f"k={k}, expected 3")
+            self.name = "mine"
+
+
+    def raises():
+        raise RuntimeError("out of coffee")
+
+
+    def not_a_planner():
+        return "greedy"
+''')
+SMALL = ["--houses", "1", "--episodes", "2", "--seeds", "1", "--rooms", "4-5", "--preset",
+         "default", "--no-progress"]
+
+
+@pytest.fixture
+def plugin_dir(tmp_path: Path) -> Path:
+    d = tmp_path / "plugins"
+    d.mkdir()
+    (d / "mymod_cli.py").write_text(PLUGIN)
+    return d
+
+
+def _rows(md: str, planner: str) -> list[str]:
+    return [ln for ln in md.splitlines() if ln.startswith(f"| {planner} ")]
+
+
+def test_bench_runs_a_plugin_beside_greedy_in_worker_processes(plugin_dir: Path,
+                                                               tmp_path: Path) -> None:
+    """The issue's check, as a user types it: PYTHONPATH=DIR sgtool bench --planners
+    mymod:MyPlanner,greedy ... with two worker processes (each planner in its own task, so
+    the plug-in is imported in a worker). The plug-in is greedy under another name, so its
+    rows carry greedy's figures."""
+    out, logs = tmp_path / "out", tmp_path / "logs"
+    env = {**os.environ, "PYTHONPATH": str(plugin_dir), "HF_HUB_OFFLINE": "1",
+           "TRANSFORMERS_OFFLINE": "1", "MPLBACKEND": "Agg"}
+    cmd = [sys.executable, "-m", "sgtool.cli", "bench", "--planners",
+           "mymod_cli:MyPlanner,greedy", *SMALL, "-w", "2", "-O", "mymod_cli:MyPlanner.k=3",
+           "--log-dir", str(logs), "-o", str(out)]
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    summary = (out / "summary.md").read_text()
+    mine, greedy = _rows(summary, "mymod_cli:MyPlanner"), _rows(summary, "greedy")
+    assert len(mine) == len(greedy) == 3  # the table, the side-by-side, seen/unseen
+    for a, b in zip(mine, greedy, strict=True):
+        assert a.split("|")[2:] == b.split("|")[2:]
+    assert "mymod_cli:MyPlanner SR / SPL" in (out / "per_house.md").read_text()
+    assert "mymod_cli:MyPlanner SR / SPL" in (out / "per_query.md").read_text()
+    planners = json.loads((out / "summary.json").read_text())["planners"]
+    assert set(planners) == {"mymod_cli:MyPlanner", "greedy"}
+    assert planners["mymod_cli:MyPlanner"]["sr"] == planners["greedy"]["sr"]
+    episodes = [json.loads(x) for x in (out / "episodes.jsonl").read_text().splitlines()]
+    assert [e["planner"] for e in episodes] == ["mymod_cli:MyPlanner"] * 2 + ["greedy"] * 2
+    assert sorted(p.name for p in (logs / "mymod_cli__MyPlanner" / "house-0").iterdir()) == [
+        "seed0-ep0.mcap", "seed0-ep1.mcap"]
+
+
+def test_eval_asks_a_plugin_and_reads_its_logs(plugin_dir: Path, tmp_path: Path,
+                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.syspath_prepend(str(plugin_dir))
+    logs = tmp_path / "logs"
+    r = CliRunner().invoke(cli, ["bench", "--planners", "mymod_cli:MyPlanner", *SMALL,
+                                 "-O", "mymod_cli:MyPlanner.k=3", "--log-dir", str(logs),
+                                 "-o", str(tmp_path / "out")])
+    assert r.exit_code == 0, r.output
+    files = sorted(str(p) for p in logs.rglob("*.mcap"))
+    r = CliRunner().invoke(cli, ["eval", *files, "-p", "mymod_cli:MyPlanner,greedy",
+                                 "-O", "mymod_cli:MyPlanner.k=3", "--json"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.output)
+    assert list(doc["planners"]) == ["mymod_cli:MyPlanner"]  # the logs' own planner
+    offline = doc["offline"]
+    assert set(offline) == {"mymod_cli:MyPlanner", "greedy"}
+    assert offline["mymod_cli:MyPlanner"]["same_action"] == 1.0  # it decides as logged
+    assert offline["mymod_cli:MyPlanner"]["decisions"] == offline["greedy"]["decisions"] > 0
+
+
+@pytest.mark.parametrize(("planner", "message"), [
+    ("nomod_cli:X", "planner 'nomod_cli:X': cannot import module 'nomod_cli'"),
+    ("mymod_cli:raises", "planner 'mymod_cli:raises': raised RuntimeError: out of coffee"),
+    ("mymod_cli:not_a_planner", "planner 'mymod_cli:not_a_planner': returned a str, not a "
+     "Planner"),
+    ("mymod_cli:MyPlanner", "planner 'mymod_cli:MyPlanner': raised ValueError: k=1, "
+     "expected 3"),
+    ("mymod_cli", "unknown planner 'mymod_cli'"),
+])
+def test_a_failing_plugin_is_one_line_before_any_episode(plugin_dir: Path, tmp_path: Path,
+                                                         monkeypatch: pytest.MonkeyPatch,
+                                                         planner: str, message: str) -> None:
+    monkeypatch.syspath_prepend(str(plugin_dir))
+    out = tmp_path / "out"
+    r = CliRunner().invoke(cli, ["bench", "--planners", f"greedy,{planner}", *SMALL,
+                                 "-o", str(out)])
+    lines = [ln for ln in r.output.splitlines() if ln.strip()]
+    assert r.exit_code == 2 and len(lines) == 1 and message in lines[0], r.output
+    assert not out.exists()
+
+
+def test_log_paths_of_a_plugin_are_safe_and_fixed(monkeypatch: pytest.MonkeyPatch) -> None:
+    from sgtool.analysis.bench import BenchError, check_planner_list
+    from sgtool.analysis.closed_loop_bench import log_path
+    from sgtool.planning import plugins
+
+    # an installed package registering the name a__B (entry-point names are free text)
+    monkeypatch.setattr(plugins, "entry_points", lambda: {"a__B": object()})
+    assert log_path(Path("r"), "none", "pkg.mod:Cls", "house-0", 2) == Path(
+        "r/none/pkg.mod__Cls/house-0/ep-002.mcap")
+    with pytest.raises(BenchError, match="would share the log folder 'a__B'"):
+        check_planner_list(["a:B", "a__B"])
+    with pytest.raises(BenchError, match="a plug-in is named module:Name"):
+        check_planner_list(["greedy", "a:"])
+
+
+@pytest.mark.parametrize(("key", "planners", "expect"), [
+    ("scout.delta", (), ("scout", "delta")),
+    ("moma-llm.base_url", ("moma-llm",), ("moma-llm", "base_url")),
+    ("mymod:MyPlanner.k", (), ("mymod:MyPlanner", "k")),
+    ("pkg.mod:Cls.k", (), ("pkg.mod:Cls", "k")),
+    ("pkg.mod:Cls.Inner.k", ("pkg.mod:Cls.Inner",), ("pkg.mod:Cls.Inner", "k")),
+    ("my.ep.name.k", ("my.ep.name",), ("my.ep.name", "k")),  # an entry point with dots
+    ("delta", (), ("", "")),
+])
+def test_the_planner_part_may_hold_colons_and_dots(key: str, planners: tuple[str, ...],
+                                                   expect: tuple[str, str]) -> None:
+    assert split_planner_key(key, planners) == expect
+
+
+def test_option_values_are_typed_by_the_planners_fields(plugin_dir: Path,
+                                                        monkeypatch: pytest.MonkeyPatch
+                                                        ) -> None:
+    monkeypatch.syspath_prepend(str(plugin_dir))
+    got = planner_options(("scout.delta=0.2", "bayes-search.blend=no", "moma-llm.model=7b",
+                           "mymod_cli:MyPlanner.k=3", "mymod_cli:MyPlanner.tag=a.b"),
+                          ("scout", "bayes-search", "moma-llm", "mymod_cli:MyPlanner"))
+    assert got == {"scout": {"delta": 0.2}, "bayes-search": {"blend": False},
+                   "moma-llm": {"model": "7b"}, "mymod_cli:MyPlanner": {"k": 3, "tag": "a.b"}}
+    with pytest.raises(SgtoolError, match="expected PLANNER.KEY=VALUE"):
+        planner_options(("scout.del ta=1",), ("scout",))
+
+
+def test_run_takes_planner_dot_key_and_still_the_bare_form(
+        capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    assert run_planner_options(("scout.delta=0.2",), "scout") == {"delta": 0.2}
+    assert capsys.readouterr().err == ""
+    assert run_planner_options(("delta=0.2",), "scout") == {"delta": 0.2}
+    assert "write -O scout.delta=VALUE (the bare KEY=VALUE form is deprecated)" in \
+        capsys.readouterr().err
+    r = CliRunner().invoke(cli, ["run", "--planner", "scout", "-O", "scout.delta=-1",
+                                 "-o", str(tmp_path / "never.mcap")])
+    assert r.exit_code == 2 and "option delta=-1: must be >= 0" in r.output
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("command", [["bench"], ["run-bench"], ["run"], ["eval"]])
+def test_list_planners(command: list[str]) -> None:
+    r = CliRunner().invoke(cli, [*command, "--list-planners"])
+    assert r.exit_code == 0, r.output
+    assert r.output.startswith("Planners (-O PLANNER.KEY=VALUE")
+    assert "\nbayes-search: " in r.output and "    horizon (int, default 3): " in r.output
+    assert "Plug-ins registered in the entry-point group sgtool.planners" in r.output
+
+
+@pytest.mark.parametrize("command", [["bench"], ["run"], ["run-bench"], ["eval"], ["replay"],
+                                     ["distill"], ["llm", "check"]])
+def test_one_llm_option_group_everywhere(command: list[str]) -> None:
+    r = CliRunner().invoke(cli, [*command, "--help"])
+    assert r.exit_code == 0, r.output
+    for flag in ("--llm-base-url", "--llm-model", "--llm-api-key", "--llm-timeout"):
+        assert flag in r.output, (command, flag)
+    assert "[env SGTOOL_LLM_BASE_URL]" in " ".join(r.output.split())
+
+
+def test_the_llm_group_fills_llm_planners_and_o_wins(capsys: pytest.CaptureFixture[str]
+                                                     ) -> None:
+    opts = {"moma-llm": {"base_url": "http://given/v1"}}
+    LlmEndpoint("http://group/v1", "m", "k", 5.0).fill(opts, ["moma-llm", "godhs-llm",
+                                                              "scout"])
+    assert opts == {"moma-llm": {"base_url": "http://given/v1", "model": "m", "api_key": "k",
+                                 "timeout_s": 5.0},
+                    "godhs-llm": {"base_url": "http://group/v1", "model": "m", "api_key": "k",
+                                  "timeout_s": 5.0}}
+    LlmEndpoint(model="m").fill(opts, ["scout"])
+    assert "no LLM planner is run" in capsys.readouterr().err
+
+
+def test_bench_endpoint_comes_from_the_group_unless_o_names_one(tmp_path: Path) -> None:
+    """An unreachable endpoint's one-line error names the URL the planner was given."""
+    base = ["bench", "--planners", "moma-llm", *SMALL, "--episodes", "1", "--llm-timeout",
+            "2", "-o", str(tmp_path / "o")]
+    r = CliRunner().invoke(cli, [*base, "--llm-base-url", "http://127.0.0.1:9/v1"])
+    assert r.exit_code == 2 and "cannot reach the LLM endpoint http://127.0.0.1:9/v1" \
+        in r.output, r.output
+    r = CliRunner().invoke(cli, [*base, "--llm-base-url", "http://127.0.0.1:9/v1",
+                                 "-O", "moma-llm.base_url=http://127.0.0.1:7/v1"])
+    assert r.exit_code == 2 and "cannot reach the LLM endpoint http://127.0.0.1:7/v1" \
+        in r.output, r.output
+
+
+def test_an_api_key_of_the_group_is_never_written(tmp_path: Path,
+                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    key = "sk-group-SECRET-123456"
+    out = tmp_path / "out"
+    args = ["bench", "--planners", "random", *SMALL, "--llm-api-key", key, "-o", str(out)]
+    monkeypatch.setattr(sys, "argv", ["sgtool", *args])  # the command line in run.md
+    r = CliRunner().invoke(cli, args)
+    assert r.exit_code == 0, r.output
+    assert key not in r.output
+    for p in out.iterdir():
+        if p.suffix in (".md", ".json", ".jsonl"):
+            assert key not in p.read_text(), p.name
+    assert "--llm-api-key '<redacted>'" in (out / "run.md").read_text()

@@ -1,0 +1,150 @@
+"""Plug-in planners: ``module:Name`` imported from sys.path, names registered through the
+entry-point group ``sgtool.planners`` (a distribution's ``entry_points.txt`` on sys.path),
+options passed as keyword arguments (checked against an ``Options`` dataclass when there
+is one), and every failure one line naming the plug-in."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from sgtool.planning.option_fields import PlannerOptionError
+from sgtool.planning.plugins import GROUP, PluginError, entry_points, file_name
+from sgtool.planning.registry import (
+    UnknownPlannerError,
+    check_planner_name,
+    describe_planners,
+    make_planner,
+    parse_option,
+)
+
+PLUGIN = textwrap.dedent('''
+    from dataclasses import dataclass, field
+
+    from sgtool.planning.option_fields import option
+    from sgtool.planning.planners import GreedyPlanner
+
+
+    class MyPlanner(GreedyPlanner):
+        """Greedy under another name, with a knob."""
+
+        def __init__(self, k=1, label="x"):
+            super().__init__()
+            self.name = "mine"
+            self.k, self.label = k, label
+
+
+    class Typed(GreedyPlanner):
+        @dataclass(frozen=True)
+        class Options:
+            k: int = field(default=1, metadata=option("a knob", "int", lo=0))
+
+        def __init__(self, k=1):
+            super().__init__()
+            self.k = k
+
+
+    def factory(**kw):
+        return MyPlanner(**kw)
+
+
+    def raises(**kw):
+        raise ValueError("no GPU here")
+
+
+    def not_a_planner(**kw):
+        return 42
+
+
+    class Half:
+        name = "half"
+
+        def reset(self, query, seed=0):
+            pass
+''')
+
+
+@pytest.fixture
+def plugin_dir(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    (tmp_path / "mymod_plug.py").write_text(PLUGIN)
+    (tmp_path / "broken_plug.py").write_text("import not_installed_anywhere\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    return tmp_path
+
+
+def test_a_class_gets_its_options_and_carries_its_given_name(plugin_dir: Path) -> None:
+    p = make_planner("mymod_plug:MyPlanner", k=3, label="y")
+    assert p.name == "mymod_plug:MyPlanner"  # as named: the label of tables and logs
+    assert type(p).__name__ == "TimedPlanner"
+    assert (p.inner.k, p.inner.label) == (3, "y")  # type: ignore[attr-defined]
+    raw = make_planner("mymod_plug:factory", timed=False)
+    assert raw.name == "mine" and raw.k == 1  # type: ignore[attr-defined]
+
+
+def test_an_options_dataclass_checks_like_the_built_ins(plugin_dir: Path) -> None:
+    assert make_planner("mymod_plug:Typed", k="4").inner.k == 4  # type: ignore[attr-defined]
+    assert parse_option("mymod_plug:Typed", "k", "5") == 5
+    with pytest.raises(PlannerOptionError, match="option k=-1: must be >= 0"):
+        make_planner("mymod_plug:Typed", k=-1)
+    with pytest.raises(UnknownPlannerError, match="does not take option.*did you mean 'k'"):
+        make_planner("mymod_plug:Typed", kk=1)
+    # without one, -O text is parsed as int, float, true/false or text
+    assert parse_option("mymod_plug:MyPlanner", "k", "2") == 2
+    assert parse_option("mymod_plug:MyPlanner", "label", "abc") == "abc"
+
+
+@pytest.mark.parametrize(("name", "message"), [
+    ("nosuchmod_plug:X", "planner 'nosuchmod_plug:X': cannot import module 'nosuchmod_plug' "
+     "(ModuleNotFoundError: No module named 'nosuchmod_plug'); is its folder on PYTHONPATH?"),
+    ("broken_plug:X", "planner 'broken_plug:X': cannot import module 'broken_plug' "
+     "(ModuleNotFoundError: No module named 'not_installed_anywhere')"),
+    ("mymod_plug:Nope", "planner 'mymod_plug:Nope': 'mymod_plug' has no 'Nope'"),
+    ("mymod_plug:raises", "planner 'mymod_plug:raises': raised ValueError: no GPU here"),
+    ("mymod_plug:not_a_planner", "planner 'mymod_plug:not_a_planner': returned a int, not a "
+     "Planner (it lacks name, reset, decide, feedback)"),
+    ("mymod_plug:Half", "returned a Half, not a Planner (it lacks decide, feedback)"),
+    ("mymod_plug:", "planner 'mymod_plug:': a plug-in is named module:Name"),
+])
+def test_failures_are_one_line_naming_the_plugin(plugin_dir: Path, name: str,
+                                                 message: str) -> None:
+    with pytest.raises(PluginError) as e:
+        make_planner(name)
+    assert message in str(e.value) and "\n" not in str(e.value)
+
+
+def test_a_bad_option_of_a_plain_plugin_is_its_own_error(plugin_dir: Path) -> None:
+    with pytest.raises(PluginError, match="raised TypeError: .*unexpected keyword argument "
+                                          "'zz'"):
+        make_planner("mymod_plug:MyPlanner", zz=1)
+
+
+def test_entry_points_register_names(plugin_dir: Path) -> None:
+    dist = plugin_dir / "sgtool_fake_planners-1.0.dist-info"
+    dist.mkdir()
+    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: sgtool-fake-planners\n"
+                                   "Version: 1.0\n")
+    (dist / "entry_points.txt").write_text(
+        f"[{GROUP}]\nfake-greedy = mymod_plug:MyPlanner\nfake-broken = broken_plug:X\n"
+        "scout = mymod_plug:MyPlanner\n")
+    found = entry_points()
+    assert found["fake-greedy"].value == "mymod_plug:MyPlanner"
+    check_planner_name("fake-greedy")
+    p = make_planner("fake-greedy", k=2)
+    assert p.name == "fake-greedy" and p.inner.k == 2  # type: ignore[attr-defined]
+    with pytest.raises(PluginError, match="planner 'fake-broken': cannot load entry point "
+                                          "'broken_plug:X' of sgtool.planners"):
+        make_planner("fake-broken")
+    assert make_planner("scout", timed=False).name == "scout"  # the built-in wins
+    text = describe_planners()
+    assert "    fake-greedy = mymod_plug:MyPlanner\n" in text
+    assert "    scout = mymod_plug:MyPlanner (shadowed by the built-in planner)" in text
+
+
+def test_unknown_names_and_file_names() -> None:
+    with pytest.raises(UnknownPlannerError, match="unknown planner 'astar'; choose one of: "
+                                                  "random, .*or module:Name"):
+        check_planner_name("astar")
+    check_planner_name("pkg.sub:Cls.Inner")  # written right: not imported by the check
+    assert file_name("pkg.sub:Cls") == "pkg.sub__Cls" and file_name("scout") == "scout"

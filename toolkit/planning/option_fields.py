@@ -1,0 +1,271 @@
+"""Typed planner options: the field metadata of the options dataclasses, and the one check
+that turns given values (Python objects, or the text of ``-O P.KEY=VALUE``) into them.
+
+A field of an options dataclass carries :func:`option` metadata: its kind (``int``,
+``float``, ``bool``, ``str``, ``path``, ``choice``, or ``object``: a Python object such as
+an encoder, settable from Python only), a help line and its range. :func:`convert_options`
+checks a mapping of given values against the fields: an unknown key is one
+:class:`UnknownPlannerError` line naming the nearest known key (:mod:`difflib`), a value of
+the wrong type or out of range one :class:`PlannerOptionError` line naming the planner,
+the option and the rule.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import math
+import os
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from sgtool.errors import SgtoolError
+
+KINDS = ("int", "float", "bool", "str", "path", "choice", "object")
+_TRUE = ("true", "yes", "on", "1")
+_FALSE = ("false", "no", "off", "0")
+_META = "sgtool_option"
+
+
+class PlannerOptionError(SgtoolError):
+    """A planner option value that does not fit its field (type, range, Python-only)."""
+
+
+class UnknownPlannerError(PlannerOptionError):
+    """A planner name that is not registered, or an option it does not take."""
+
+
+@dataclass(frozen=True)
+class OptionMeta:
+    """What a field accepts: ``kind`` (:data:`KINDS`), ``lo``/``hi`` bounds of numbers
+    (``lo_open``: strictly above ``lo``), ``choices`` of a ``choice``, ``optional``: None
+    is a value (the default: "not set"), ``objects``: a ``path`` also takes Python objects
+    (a mapping, a list of paths) as they are."""
+
+    help: str
+    kind: str
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False
+    choices: tuple[str, ...] = ()
+    optional: bool = False
+    objects: bool = False
+
+    @property
+    def cli(self) -> bool:
+        """Settable with ``-O`` (everything but Python objects)."""
+        return self.kind != "object"
+
+    def range_text(self) -> str:
+        """The accepted values in words (empty when any value of the kind is)."""
+        if self.kind == "choice":
+            return "one of " + ", ".join(self.choices)
+        if self.lo is not None and self.hi is not None and not self.lo_open:
+            return f"{_num(self.lo)}..{_num(self.hi)}"
+        parts = []
+        if self.lo is not None:
+            parts.append(f"{'>' if self.lo_open else '>='} {_num(self.lo)}")
+        if self.hi is not None:
+            parts.append(f"<= {_num(self.hi)}")
+        return " and ".join(parts)
+
+
+def option(help: str, kind: str, *, lo: float | None = None, hi: float | None = None,
+           lo_open: bool = False, choices: Iterable[str] = (), optional: bool = False,
+           objects: bool = False) -> dict[str, OptionMeta]:
+    """Metadata for ``dataclasses.field(metadata=...)`` of an options field."""
+    if kind not in KINDS:
+        raise ValueError(f"kind {kind!r}: one of {KINDS}")
+    return {_META: OptionMeta(help, kind, lo, hi, lo_open, tuple(choices), optional,
+                              objects)}
+
+
+@dataclass(frozen=True)
+class OptionInfo:
+    """One option of a planner, as ``--list-planners`` prints it."""
+
+    name: str
+    kind: str
+    default: Any
+    meta: OptionMeta
+
+    def line(self) -> str:
+        """``name  kind  default  help [range]``; a Python object shows no default."""
+        if not self.meta.cli:
+            return f"{self.name} (Python only): {self.meta.help}"
+        rng = self.meta.range_text()
+        default = "" if self.default is None and "[default:" in self.meta.help else \
+            ", default " + ("none" if self.default is None else _text(self.default))
+        return (f"{self.name} ({self.kind}{default}): {self.meta.help}"
+                + (f" [{rng}]" if rng else ""))
+
+
+def option_infos(cls: type) -> tuple[OptionInfo, ...]:
+    """The options of an options dataclass, in field order."""
+    out = []
+    for f in dataclasses.fields(cls):
+        meta = f.metadata.get(_META)
+        if meta is None:
+            raise TypeError(f"{cls.__name__}.{f.name}: no option() metadata")
+        default = f.default if f.default is not dataclasses.MISSING else None
+        out.append(OptionInfo(f.name, meta.kind, default, meta))
+    return tuple(out)
+
+
+def parse_text(text: str) -> Any:
+    """A value of ``-O`` without a known field: int, float, true/false, else the text."""
+    for cast in (int, float):
+        try:
+            return cast(text)
+        except ValueError:
+            pass
+    if text.lower() in ("true", "false"):
+        return text.lower() == "true"
+    return text
+
+
+def nearest(key: str, known: Iterable[str]) -> str | None:
+    """The known name closest to ``key`` (difflib), or None when none is close."""
+    hits = difflib.get_close_matches(key, list(known), n=1, cutoff=0.6)
+    return hits[0] if hits else None
+
+
+def unknown_keys_error(planner: str, unknown: Iterable[str],
+                       known: Iterable[str]) -> UnknownPlannerError:
+    """``planner 'P' does not take option(s): k; nearest known: 'x'`` (or the known keys)."""
+    bad = sorted(unknown)
+    names = list(known)
+    near = nearest(bad[0], names)
+    hint = f"did you mean {near!r}?" if near else \
+        ("it takes: " + ", ".join(names) if names else "it takes no options")
+    return UnknownPlannerError(f"planner {planner!r} does not take option(s): "
+                               f"{', '.join(bad)}; {hint}")
+
+
+def convert_options(planner: str, cls: type, given: Mapping[str, Any],
+                    from_cli: bool = False) -> dict[str, Any]:
+    """``given`` checked against the fields of ``cls`` and converted to their kinds (only
+    the given keys); ``from_cli``: the values are ``-O`` text (Python objects refused)."""
+    infos = {i.name: i for i in option_infos(cls)}
+    unknown = [k for k in given if k not in infos]
+    if unknown:
+        raise unknown_keys_error(planner, unknown, infos)
+    return {k: convert_value(planner, k, infos[k].meta, v, from_cli) for k, v in given.items()}
+
+
+def build_options(planner: str, cls: type, given: Mapping[str, Any]) -> Any:
+    """An instance of ``cls`` from ``given`` (checked, converted), defaults elsewhere."""
+    return cls(**convert_options(planner, cls, given))
+
+
+def convert_value(planner: str, key: str, meta: OptionMeta, value: Any,
+                  from_cli: bool = False) -> Any:
+    """One value converted to its field's kind and checked against its range."""
+    def fail(why: str) -> PlannerOptionError:
+        return PlannerOptionError(f"planner {planner!r}: option {key}={_shown(value)}: {why}")
+
+    if meta.kind == "object":
+        if from_cli:
+            raise fail(f"a Python object, set from Python only (make_planner(..., {key}=...))")
+        return value
+    if value is None and (meta.optional or meta.objects):
+        return None
+    if meta.kind == "int":
+        out: Any = _to_int(value)
+        if out is None:
+            raise fail("must be an integer")
+    elif meta.kind == "float":
+        out = _to_float(value)
+        if out is None:
+            raise fail("must be a number")
+        if not math.isfinite(out):
+            raise fail("must be a finite number" + (f" {meta.range_text()}"
+                                                    if meta.range_text() else ""))
+    elif meta.kind == "bool":
+        out = _to_bool(value)
+        if out is None:
+            raise fail("must be true or false")
+        return out
+    elif meta.kind == "choice":
+        text = str(value).strip().lower() if isinstance(value, str) else None
+        if text not in meta.choices:
+            raise fail(f"must be one of {', '.join(meta.choices)}")
+        return text
+    elif meta.kind == "path":
+        if isinstance(value, str | os.PathLike):
+            return os.fspath(value)
+        if meta.objects and not from_cli:
+            return value
+        raise fail("must be a path")
+    else:  # str
+        if isinstance(value, str):
+            return value
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            return str(value)
+        raise fail("must be text")
+    if (meta.lo is not None and (out < meta.lo or (meta.lo_open and out == meta.lo))) or \
+            (meta.hi is not None and out > meta.hi):
+        raise fail(f"must be {meta.range_text()}")
+    return out
+
+
+def _to_int(value: Any) -> int | None:
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, int):
+        return value
+    if isinstance(value, float) and math.isfinite(value) and value.is_integer():
+        return int(value)
+    if isinstance(value, str):
+        try:
+            return int(value.strip())
+        except ValueError:
+            return None
+    return None
+
+
+def _to_float(value: Any) -> float | None:
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, int | float):
+        return float(value)
+    if isinstance(value, str):
+        try:
+            return float(value.strip())
+        except ValueError:
+            return None
+    return None
+
+
+def _to_bool(value: Any) -> bool | None:
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, int) and value in (0, 1):
+        return bool(value)
+    if isinstance(value, str):
+        low = value.strip().lower()
+        if low in _TRUE:
+            return True
+        if low in _FALSE:
+            return False
+    return None
+
+
+def _num(x: float) -> str:
+    return str(int(x)) if float(x).is_integer() else str(x)
+
+
+def _text(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return str(value)
+
+
+def _shown(value: Any) -> str:
+    """A value in a message: text as given, objects by their type (no long reprs)."""
+    if isinstance(value, str):
+        return value
+    if isinstance(value, int | float | bool):
+        return _text(value)
+    return f"<{type(value).__name__}>"

@@ -1,0 +1,125 @@
+"""Plug-in planners: a user's class or factory named ``module:Name``, or a name an installed
+package registers in the entry-point group ``sgtool.planners``.
+
+``module:Name`` (``Name`` may be dotted: ``mypkg.planners:Outer.Inner``) is imported with
+:mod:`importlib` from ``sys.path`` (``PYTHONPATH``); an entry point ``name = module:Name``
+in the group :data:`GROUP` names the same thing. Either is called with the planner's
+options as keyword arguments and must return a :class:`~sgtool.planning.base.Planner`
+(``name``, ``reset``, ``decide``, ``feedback``). When the class or factory has an
+attribute ``Options`` that is a dataclass whose fields carry
+:func:`~sgtool.planning.option_fields.option` metadata, the options are checked and
+converted against it as a built-in planner's are; otherwise they are passed as given
+(``-O`` text parsed as int, float, true/false or text). A plug-in that fails to import,
+raises, or returns something else is one :class:`PluginError` line naming it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import re
+from collections.abc import Callable, Mapping
+from importlib import metadata
+from typing import Any
+
+from sgtool.planning.base import Planner
+from sgtool.planning.option_fields import PlannerOptionError, convert_options
+
+GROUP = "sgtool.planners"
+_DOTTED = r"[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*"
+SPEC = re.compile(rf"({_DOTTED}):({_DOTTED})")
+PLANNER_PARTS = ("name", "reset", "decide", "feedback")
+
+
+class PluginError(PlannerOptionError):
+    """A plug-in planner that cannot be imported, raises, or is no Planner."""
+
+
+def is_spec(name: str) -> bool:
+    """``name`` is written ``module:Name`` (a ':' in it)."""
+    return ":" in name
+
+
+def check_spec(name: str) -> tuple[str, str]:
+    """(module, attribute path) of ``module:Name``; anything else is a :class:`PluginError`."""
+    m = SPEC.fullmatch(name.strip())
+    if m is None:
+        raise PluginError(f"planner {name!r}: a plug-in is named module:Name, e.g. "
+                          "mypkg.planners:MyPlanner")
+    return m.group(1), m.group(2)
+
+
+def entry_points() -> dict[str, metadata.EntryPoint]:
+    """The planners installed packages register (group :data:`GROUP`), by name; the first
+    of two distributions registering one name wins (``importlib.metadata``'s order)."""
+    out: dict[str, metadata.EntryPoint] = {}
+    for ep in metadata.entry_points(group=GROUP):
+        out.setdefault(ep.name, ep)
+    return out
+
+
+def load_factory(name: str, entry: metadata.EntryPoint | None = None) -> Callable[..., Any]:
+    """The class or factory of plug-in ``name``: ``entry`` loaded, else ``module:Name``
+    imported."""
+    if entry is not None:
+        where = f"entry point {entry.value!r} of {GROUP}"
+        try:
+            obj = entry.load()
+        except Exception as e:  # noqa: BLE001 - any import failure of user code is one line
+            raise PluginError(f"planner {name!r}: cannot load {where} "
+                              f"({type(e).__name__}: {e})") from None
+    else:
+        module, attr = check_spec(name)
+        try:
+            obj = importlib.import_module(module)
+        except Exception as e:  # noqa: BLE001
+            raise PluginError(f"planner {name!r}: cannot import module {module!r} "
+                              f"({type(e).__name__}: {e}); is its folder on PYTHONPATH?"
+                              ) from None
+        for part in attr.split("."):
+            if not hasattr(obj, part):
+                raise PluginError(f"planner {name!r}: {module!r} has no {attr!r}")
+            obj = getattr(obj, part)
+    if not callable(obj):
+        raise PluginError(f"planner {name!r}: {type(obj).__name__} object is not a class "
+                          "or factory")
+    return obj
+
+
+def options_class(factory: Callable[..., Any]) -> type | None:
+    """The factory's ``Options`` dataclass, or None."""
+    cls = getattr(factory, "Options", None)
+    return cls if isinstance(cls, type) and dataclasses.is_dataclass(cls) else None
+
+
+def plugin_options(name: str, factory: Callable[..., Any], given: Mapping[str, Any],
+                   from_cli: bool = False) -> dict[str, Any]:
+    """``given`` checked against the factory's ``Options`` when it has one, else as given."""
+    cls = options_class(factory)
+    if cls is None:
+        return dict(given)
+    try:
+        return convert_options(name, cls, given, from_cli=from_cli)
+    except TypeError as e:  # an Options field without option() metadata
+        raise PluginError(f"planner {name!r}: its Options dataclass: {e}") from None
+
+
+def build_plugin(name: str, factory: Callable[..., Any], options: Mapping[str, Any]) -> Planner:
+    """``factory(**options)``, checked to be a Planner; every failure one line."""
+    kw = plugin_options(name, factory, options)
+    try:
+        planner = factory(**kw)
+    except Exception as e:  # noqa: BLE001 - a user's planner failing is one line
+        raise PluginError(f"planner {name!r}: raised {type(e).__name__}: {e}") from None
+    missing = [p for p in PLANNER_PARTS if not hasattr(planner, p)
+               or (p != "name" and not callable(getattr(planner, p)))]
+    if missing:
+        raise PluginError(f"planner {name!r}: returned a {type(planner).__name__}, not a "
+                          f"Planner (it lacks {', '.join(missing)})")
+    return planner
+
+
+def file_name(name: str) -> str:
+    """The planner's folder or file-name component in log paths: the name, a ':' written
+    ``__`` (``mymod:MyPlanner`` -> ``mymod__MyPlanner``), the same for every run."""
+    return name.replace(":", "__")
