@@ -91,6 +91,14 @@ class Interrupted(click.ClickException):
         click.echo(f"sgtool: interrupted{tail}", err=True)
 
 
+class Killed(Interrupted):
+    """SIGTERM during a command (:class:`~sgtool.errors.Terminated`): the same line as
+    :class:`Interrupted`, exit code 143 (128 + SIGTERM, as a shell reports a killed
+    command)."""
+
+    exit_code = 143
+
+
 def os_error_text(e: OSError) -> str:
     """One line for an :class:`OSError`: ``Read-only file system: /data/out.mcap``."""
     reason = e.strerror or type(e).__name__
@@ -116,10 +124,8 @@ class LazyGroup(click.Group):
             raise UserError(os_error_text(e)) from e
         except KeyboardInterrupt as e:
             # not click's Abort (a blank line and "Aborted!"): one line, what was kept
-            out = Interrupted(getattr(e, "note", "") or "no output was left half-written")
-            if isinstance(e, Terminated):
-                out.exit_code = 143  # 128 + SIGTERM, as a shell reports a killed command
-            raise out from e
+            kind = Killed if isinstance(e, Terminated) else Interrupted
+            raise kind(getattr(e, "note", "") or "no output was left half-written") from e
 
     def make_context(self, info_name: str | None, args: list[str],
                      parent: click.Context | None = None, **extra: Any) -> click.Context:

@@ -54,7 +54,7 @@ def _hugepage_setter() -> Callable[[bool], bool] | None:
         except ImportError:
             continue
         if setter is not None:
-            return setter  # type: ignore[no-any-return]
+            return setter
     return None
 
 

@@ -33,7 +33,7 @@ from sgtool.house.geometry import (
     point_in_polygon,
     shared_borders,
 )
-from sgtool.house.spec import HouseSpec, SpecLimits
+from sgtool.house.spec import HouseSpec, Opening, SpecLimits
 
 _WALL_MARGIN = 1.0  # m a wall end may lie outside the rooms' bounding box
 _OPENING_EDGE = 0.05  # m at each end of an opening a wall may reach into (rounded corners)
@@ -56,7 +56,7 @@ def check_consistency(spec: HouseSpec, limits: SpecLimits) -> None:
                 raise SpecError(f"walls[{i}].{end}: ({x}, {y}) is more than {_WALL_MARGIN:g} m "
                                 "outside the rooms")
     by_room = {r.id: r for r in spec.rooms}
-    for key, openings in (("doors", spec.doors), ("passages", spec.passages)):
+    for key, openings in _openings(spec):
         for i, d in enumerate(openings):
             for rid in d.rooms:
                 off = distance_to_polygon(d.center[0], d.center[1], by_room[rid].polygon)
@@ -81,6 +81,11 @@ def check_consistency(spec: HouseSpec, limits: SpecLimits) -> None:
     _starts_on_free_floor(spec)
     _openings_clear(spec)
     _gaps_have_openings(spec)
+
+
+def _openings(spec: HouseSpec) -> tuple[tuple[str, tuple[Opening, ...]], ...]:
+    """The spec's doors and passages, each list with its key for messages."""
+    return (("doors", spec.doors), ("passages", spec.passages))
 
 
 def _boxes(boxes: list[tuple[float, float, float, float]]) -> np.ndarray:
@@ -112,7 +117,7 @@ def _openings_clear(spec: HouseSpec) -> None:
     boxes = _boxes([(min(w.a[0], w.b[0]) - w.thickness / 2, min(w.a[1], w.b[1]) - w.thickness / 2,
                      max(w.a[0], w.b[0]) + w.thickness / 2, max(w.a[1], w.b[1]) + w.thickness / 2)
                     for w in walls])
-    for key, openings in (("doors", spec.doors), ("passages", spec.passages)):
+    for key, openings in _openings(spec):
         for i, d in enumerate(openings):
             p, q = opening_segment(d.center, d.width, d.yaw)
             x0, x1 = min(p[0], q[0]), max(p[0], q[0])

@@ -70,10 +70,11 @@ def box_corners(center: Sequence[float], size: Sequence[float],
     """The four corners of an oriented rectangle, counter-clockwise."""
     c, s = math.cos(yaw), math.sin(yaw)
     hx, hy = size[0] / 2.0, size[1] / 2.0
-    out = []
-    for lx, ly in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)):
-        out.append((center[0] + c * lx - s * ly, center[1] + s * lx + c * ly))
-    return tuple(out)  # type: ignore[return-value]
+
+    def corner(lx: float, ly: float) -> Point:
+        return (center[0] + c * lx - s * ly, center[1] + s * lx + c * ly)
+
+    return corner(-hx, -hy), corner(hx, -hy), corner(hx, hy), corner(-hx, hy)
 
 
 def segment_distance(x: float, y: float, a: Point, b: Point) -> float:

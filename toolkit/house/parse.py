@@ -25,7 +25,7 @@ from typing import Any
 from sgtool.canonical import canonical_float
 from sgtool.errors import SpecError
 from sgtool.house.consistency import check_consistency
-from sgtool.house.geometry import self_crossing, signed_area
+from sgtool.house.geometry import Point, Vec3, self_crossing, signed_area
 from sgtool.house.migrate import upgrade
 from sgtool.house.names import id_problem, name_problem
 from sgtool.house.nesting import check_nesting
@@ -93,7 +93,7 @@ _OBJECT_KEYS = frozenset({"id", "category", "synset", "parent", "relation", "roo
 _START_KEYS = frozenset({"x", "y", "yaw", "room"})
 
 
-class JsonObject(dict):  # type: ignore[type-arg]
+class JsonObject(dict[str, Any]):
     """A JSON object read with :func:`json_object_pairs` that had a key more than once
     (the last value kept, as ``json`` does); the parser refuses it naming the field."""
 
@@ -216,6 +216,16 @@ class _Parser:
             return tuple(canonical_float(c) for c in v)
         return tuple(self.number(f"{where}[{i}]", c) for i, c in enumerate(v))
 
+    def point(self, where: str, v: Any) -> Point:
+        """Two numbers (x, y) as :meth:`numbers` reads them."""
+        x, y = self.numbers(where, v, 2)
+        return x, y
+
+    def vec3(self, where: str, v: Any) -> Vec3:
+        """Three numbers (x, y, z) as :meth:`numbers` reads them."""
+        x, y, z = self.numbers(where, v, 3)
+        return x, y, z
+
     def positive(self, where: str, x: Mapping[str, Any], key: str, limit: float,
                  default: float | None = None) -> float:
         """The number in (0, limit] under ``key`` (required when there is no ``default``)."""
@@ -227,8 +237,8 @@ class _Parser:
             raise SpecError(f"{where}.{key}: {v} is more than the limit of {limit:g}")
         return v
 
-    def size(self, where: str, v: Any, limit: float) -> tuple[float, ...]:
-        size = self.numbers(where, v, 3)
+    def size(self, where: str, v: Any, limit: float) -> Vec3:
+        size = self.vec3(where, v)
         if min(size) <= 0:
             raise SpecError(f"{where}: every side must be > 0, got {list(size)}")
         if max(size) > limit:
@@ -278,9 +288,9 @@ class _Parser:
         if len(poly_raw) > self.limits.polygon_points:
             raise SpecError(f"{where}.polygon: {len(poly_raw)} points, more than the limit "
                             f"of {self.limits.polygon_points}")
-        poly = tuple(self.numbers(f"{where}.polygon[{i}]", q, 2) for i, q in enumerate(poly_raw))
-        crossing = self_crossing(poly)  # type: ignore[arg-type]
-        if abs(signed_area(poly)) < 1e-6 and (crossing is None or not crossing[2]):  # type: ignore[arg-type]
+        poly = tuple(self.point(f"{where}.polygon[{i}]", q) for i, q in enumerate(poly_raw))
+        crossing = self_crossing(poly)
+        if abs(signed_area(poly)) < 1e-6 and (crossing is None or not crossing[2]):
             raise SpecError(f"{where}.polygon: has zero area")
         if crossing is not None:
             raise SpecError(f"{where}.polygon: edges cross (edges {crossing[0]} and "
@@ -289,16 +299,16 @@ class _Parser:
         if group is not None:
             self.name(f"{where}.open_plan_group", group)
         return Room(id=self.string(where, x, "id"), category=self.string(where, x, "category"),
-                    polygon=poly, open_plan_group=group)  # type: ignore[arg-type]
+                    polygon=poly, open_plan_group=group)
 
     def wall(self, where: str, x: Any) -> Wall:
         x = _json_object(where, x, _WALL_KEYS)
-        a = self.numbers(f"{where}.a", _required(where, x, "a"), 2)
-        b = self.numbers(f"{where}.b", _required(where, x, "b"), 2)
+        a = self.point(f"{where}.a", _required(where, x, "a"))
+        b = self.point(f"{where}.b", _required(where, x, "b"))
         if math.dist(a, b) < 1e-6:
             raise SpecError(f"{where}: has zero length (a == b)")
         lim = self.limits
-        return Wall(id=self.string(where, x, "id"), a=a, b=b,  # type: ignore[arg-type]
+        return Wall(id=self.string(where, x, "id"), a=a, b=b,
                     thickness=self.positive(where, x, "thickness", lim.wall_thickness, 0.1),
                     height=self.positive(where, x, "height", lim.wall_height, 2.5))
 
@@ -306,7 +316,7 @@ class _Parser:
         """``id``, ``center``, ``width`` (up to ``width``), ``yaw`` and ``rooms`` of a door
         or a passage."""
         return {"id": self.string(where, x, "id"),
-                "center": self.numbers(f"{where}.center", _required(where, x, "center"), 2),
+                "center": self.point(f"{where}.center", _required(where, x, "center")),
                 "width": self.positive(where, x, "width", width),
                 "yaw": self.number(f"{where}.yaw", x.get("yaw", 0.0)),
                 "rooms": self.room_pair(f"{where}.rooms", _required(where, x, "rooms"))}
@@ -333,8 +343,8 @@ class _Parser:
             id=self.string(where, x, "id"), category=self.string(where, x, "category"),
             synset=self.string(where, x, "synset"),
             room=self.room_ref(f"{where}.room", _required(where, x, "room")),
-            center=self.numbers(f"{where}.center", _required(where, x, "center"), 3),  # type: ignore[arg-type]
-            size=size,  # type: ignore[arg-type]
+            center=self.vec3(f"{where}.center", _required(where, x, "center")),
+            size=size,
             yaw=self.number(f"{where}.yaw", x.get("yaw", 0.0)),
             affordances=aff, state=state, levels=self.levels(f"{where}.levels", x, size[2]),
         )
@@ -366,8 +376,8 @@ class _Parser:
             id=self.string(where, x, "id"), category=self.string(where, x, "category"),
             synset=self.string(where, x, "synset"), parent=self.string(where, x, "parent"),
             relation=rel, room=self.room_ref(f"{where}.room", _required(where, x, "room")),
-            position=self.numbers(f"{where}.position", _required(where, x, "position"), 3),  # type: ignore[arg-type]
-            size=self.size(f"{where}.size", _required(where, x, "size"), side),  # type: ignore[arg-type]
+            position=self.vec3(f"{where}.position", _required(where, x, "position")),
+            size=self.size(f"{where}.size", _required(where, x, "size"), side),
             affordances=aff, state=state)
 
     def start(self, where: str, x: Any) -> StartPose:

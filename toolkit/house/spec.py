@@ -198,6 +198,9 @@ class Passage:
         return opening_segment(self.center, self.width, self.yaw)
 
 
+Opening = Door | Passage  # a gap in the walls between two rooms
+
+
 class _Affordances:
     """``is_container`` / ``is_openable`` of anything with ``affordances``."""
 
@@ -349,7 +352,8 @@ class HouseSpec:
     def room_graph(self) -> dict[str, tuple[str, ...]]:
         """Room id -> sorted neighbour ids, joined by doors (open or closed) or passages."""
         nb: dict[str, set[str]] = {r.id: set() for r in self.rooms}
-        for d in (*self.doors, *self.passages):
+        openings: tuple[Opening, ...] = (*self.doors, *self.passages)
+        for d in openings:
             a, b = d.rooms
             nb[a].add(b)
             nb[b].add(a)
@@ -435,18 +439,19 @@ def hidden_objects(spec: HouseSpec) -> set[str]:
     :func:`enclosed` in a closed parent (the reveal rule of the symbolic environment:
     walking up shows what is on top, opening shows what is inside). Linear time."""
     holders = spec.holder_by_id()
+    objects = spec.object_by_id()
     hidden: dict[str, bool] = {f.id: False for f in spec.furniture}
     for o in spec.objects:
         path = []
         cur: str = o.id
-        while cur not in hidden:
+        while cur not in hidden:  # not furniture: a small object
             path.append(cur)
-            cur = holders[cur].parent  # type: ignore[union-attr]
+            cur = objects[cur].parent
         for k in reversed(path):
-            child = holders[k]
-            parent = holders[child.parent]  # type: ignore[union-attr]
+            child = objects[k]
+            parent = holders[child.parent]
             hidden[k] = hidden[parent.id] or (parent.state == "closed" and
-                                              enclosed(child, parent))  # type: ignore[arg-type]
+                                              enclosed(child, parent))
     return {o.id for o in spec.objects if hidden[o.id]}
 
 

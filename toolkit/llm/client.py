@@ -86,7 +86,7 @@ def complete_within(client: ChatClient, messages: list[Message], timeout_s: floa
         kw["timeout_s"] = timeout_s
     if constraint is not None and getattr(client, "takes_constraint", False):
         kw["constraint"] = constraint
-    return client.complete(messages, **kw)  # type: ignore[call-arg]
+    return client.complete(messages, **kw)
 
 
 def cut_reply(text: str, limit: int = MAX_REPLY_CHARS) -> tuple[str, int | None]:

@@ -20,6 +20,7 @@ import os
 import socket
 from dataclasses import dataclass
 from pathlib import Path
+from types import ModuleType
 
 from sgtool.errors import SgtoolError
 from sgtool.extras import missing_message
@@ -87,7 +88,9 @@ def _port_in_use(port: int) -> bool:
         return s.connect_ex((HOST, port)) == 0
 
 
-def _xllamacpp():  # noqa: ANN202 - the optional module
+def _xllamacpp() -> ModuleType:
+    """The optional ``xllamacpp`` module; :class:`LlmServerError` naming the extra when it
+    is not installed."""
     try:
         import xllamacpp
     except ImportError:

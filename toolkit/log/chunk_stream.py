@@ -51,7 +51,7 @@ def _zstd() -> Any:
 
 
 def chunk_records(f: IO[bytes], ci: ChunkIndex, verify: bool,
-                  buffers: ChunkBuffers | None = None) -> bytes:
+                  buffers: ChunkBuffers | None = None) -> bytes | memoryview:
     """The uncompressed records of the chunk that ``ci`` points to (CRC checked when
     ``verify`` and the writer wrote one); ``buffers`` as in :func:`chunk_data`."""
     return chunk_data(read_chunk(f, ci), ci, verify, buffers)
@@ -133,7 +133,7 @@ def read_chunk(f: IO[bytes], ci: ChunkIndex) -> bytes:
 
 
 def chunk_data(record: bytes, ci: ChunkIndex, verify: bool,
-               buffers: ChunkBuffers | None = None) -> bytes:
+               buffers: ChunkBuffers | None = None) -> bytes | memoryview:
     """The uncompressed records of a chunk record of :func:`read_chunk` (CRC checked when
     ``verify`` and the writer wrote one); zstd chunks into one of ``buffers`` (a
     ``memoryview`` then) when given and one is free."""
@@ -150,27 +150,28 @@ def chunk_data(record: bytes, ci: ChunkIndex, verify: bool,
         raise ChunkError(f"chunk at byte {ci.chunk_start_offset}: lengths do not fit")
     if pos + data_len > len(record):
         raise ChunkError(f"chunk at byte {ci.chunk_start_offset} is cut short")
-    data: bytes | memoryview = memoryview(record)[pos:pos + data_len]
+    stored = memoryview(record)[pos:pos + data_len]
+    data: bytes | memoryview
     if compression == "zstd":
-        data = _zstd_into(data, size, buffers)
+        data = _zstd_into(stored, size, buffers)
     elif compression == "lz4":
         import lz4.frame
 
-        data = lz4.frame.decompress(data)
+        data = lz4.frame.decompress(stored)
     elif compression:
         raise ChunkError(f"chunk at byte {ci.chunk_start_offset}: unknown compression "
                              f"{compression[:16]!r}")
     else:
-        data = bytes(data)
+        data = bytes(stored)
     if len(data) != size:
         raise ChunkError(f"chunk at byte {ci.chunk_start_offset}: {len(data)} bytes "
                              f"uncompressed, its header says {size}")
     if verify and crc != 0 and zlib.crc32(data) != crc:
         raise ChunkError(f"chunk at byte {ci.chunk_start_offset}: CRC mismatch")
-    return data  # type: ignore[return-value]
+    return data
 
 
-def _messages_of(data: bytes, offset: int, summary: Summary, wanted: set[int] | None,
+def _messages_of(data: bytes | memoryview, offset: int, summary: Summary, wanted: set[int] | None,
                  start_ns: int | None, end_ns: int | None, views: bool = False
                  ) -> list[tuple[_Key, Item]]:
     out: list[tuple[_Key, Item]] = []
@@ -193,6 +194,7 @@ def _messages_of(data: bytes, offset: int, summary: Summary, wanted: set[int] | 
         if ((wanted is None or cid in wanted) and (start_ns is None or t >= start_ns)
                 and (end_ns is None or t < end_ns)):
             schema = schemas[channel.schema_id] if channel.schema_id else None
+            # with views, data is a memoryview where mcap's Message declares bytes
             msg = Message(channel_id=cid, sequence=seq, log_time=t, publish_time=pub,
                           data=payload[body + _MESSAGE_HEAD.size:pos])  # type: ignore[arg-type]
             out.append(((t, offset, index), (schema, channel, msg)))
@@ -238,7 +240,7 @@ def ordered_messages(f: IO[bytes], summary: Summary, topics: list[str] | None = 
         del pending[:cut]
 
 
-def chunk_messages(data: bytes, ci: ChunkIndex, summary: Summary, views: bool = False
+def chunk_messages(data: bytes | memoryview, ci: ChunkIndex, summary: Summary, views: bool = False
                    ) -> list[Item]:
     """(schema, channel, message) of every message of one chunk (``data``: its
     uncompressed records), in log-time order, ties in chunk order: the order

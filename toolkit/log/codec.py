@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from foxglove_schemas_protobuf.CameraCalibration_pb2 import CameraCalibration
@@ -10,6 +11,7 @@ from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
 from foxglove_schemas_protobuf.Grid_pb2 import Grid
 from foxglove_schemas_protobuf.PackedElementField_pb2 import PackedElementField
 from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
+from foxglove_schemas_protobuf.Vector2_pb2 import Vector2
 from google.protobuf.timestamp_pb2 import Timestamp
 from numpy.typing import DTypeLike
 
@@ -18,7 +20,7 @@ from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.image_wire import RawImageView
 
-_DTYPES = {
+_DTYPES: dict[str, tuple[np.dtype[Any], int]] = {
     "rgb8": (np.dtype(np.uint8), 3),
     "bgr8": (np.dtype(np.uint8), 3),
     "rgba8": (np.dtype(np.uint8), 4),
@@ -237,7 +239,5 @@ def decode_grid(msg: Grid) -> tuple[np.ndarray, tuple[float, float], float]:
     return a, (msg.pose.position.x, msg.pose.position.y), float(msg.cell_size.x)
 
 
-def _vec2(x: float, y: float):  # type: ignore[no-untyped-def]
-    from foxglove_schemas_protobuf.Vector2_pb2 import Vector2
-
+def _vec2(x: float, y: float) -> Vector2:
     return Vector2(x=x, y=y)

@@ -26,6 +26,7 @@ from mcap.records import (
 )
 
 from sgtool.log.file_walk import ChunkFacts, Layout, message_index_at
+from sgtool.log.mcap_records import FileBytes
 
 
 @dataclass(frozen=True)
@@ -41,7 +42,7 @@ class SummaryState:
         return self.present and (self.crc_ok or not self.crc_checked)
 
 
-def summary_state(buf: bytes | memoryview, lay: Layout) -> SummaryState:
+def summary_state(buf: FileBytes, lay: Layout) -> SummaryState:
     if lay.footer is None or not lay.footer[1].summary_start:
         return SummaryState(False, False, False)
     fo, f = lay.footer
@@ -54,7 +55,7 @@ def summary_state(buf: bytes | memoryview, lay: Layout) -> SummaryState:
     return SummaryState(True, True, ok)
 
 
-def check(buf: bytes | memoryview, lay: Layout, state: SummaryState) -> list[str]:
+def check(buf: FileBytes, lay: Layout, state: SummaryState) -> list[str]:
     """Everything that disagrees in a file the walk read without damage (empty: the file
     is complete)."""
     out: list[str] = []
@@ -169,7 +170,7 @@ def _statistics(lay: Layout, summary: list) -> list[str]:
     return out
 
 
-def _chunk_indexes(buf: bytes | memoryview, lay: Layout, summary: list) -> list[str]:
+def _chunk_indexes(buf: FileBytes, lay: Layout, summary: list) -> list[str]:
     idx = _of(summary, ChunkIndex)
     if not idx:
         return []
@@ -210,9 +211,9 @@ def _record_indexes(lay: Layout, summary: list) -> list[str]:
     for ai in a_idx:
         r = data.get(int(ai.offset))
         a = r.record if r is not None and r.opcode == Opcode.ATTACHMENT else None
-        if a is None or (ai.length, ai.name, ai.media_type, ai.log_time, ai.create_time,
-                         ai.data_size) != (9 + r.length, a.name, a.media_type, a.log_time,
-                                           a.create_time, len(a.data)):
+        if r is None or a is None or (
+                (ai.length, ai.name, ai.media_type, ai.log_time, ai.create_time, ai.data_size)
+                != (9 + r.length, a.name, a.media_type, a.log_time, a.create_time, len(a.data))):
             out.append(f"attachment index {ai.name!r} disagrees with the attachment at "
                        f"byte {ai.offset}")
     meta = [r for r in data.values() if r.opcode == Opcode.METADATA]
@@ -253,7 +254,7 @@ def _summary_offsets(lay: Layout, summary: list) -> list[str]:
     return out
 
 
-def expected_messages(buf: bytes | memoryview, lay: Layout, state: SummaryState
+def expected_messages(buf: FileBytes, lay: Layout, state: SummaryState
                       ) -> dict[int, list[tuple[int, int]]]:
     """For each chunk (by offset) the (channel id, log time) of every message its indexes
     say it holds: from the summary's chunk indexes when the summary is trusted, else from

@@ -13,7 +13,7 @@ the cross-checks of :mod:`sgtool.log.file_check`.
 from __future__ import annotations
 
 import zlib
-from collections.abc import Iterator
+from collections.abc import Generator, Iterator
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -22,6 +22,7 @@ from mcap.records import Channel, Chunk, Footer, Header, Message, MessageIndex, 
 
 from sgtool.log.mcap_records import (
     MAGIC,
+    FileBytes,
     Raw,
     RecordError,
     chunk_prefix,
@@ -102,7 +103,7 @@ class Item:
     source: Source
 
 
-def walk(buf: bytes | memoryview, lay: Layout) -> Iterator[Item]:
+def walk(buf: FileBytes, lay: Layout) -> Iterator[Item]:
     """Every readable record of ``buf`` (a whole MCAP file); ``lay`` says the rest."""
     size = lay.size
     lay.footer = footer_at_end(buf, size)
@@ -118,6 +119,7 @@ def walk(buf: bytes | memoryview, lay: Layout) -> Iterator[Item]:
             lay.damaged(f"closing magic at byte {pos} without a footer before it")
             pos = size
             break
+        raw: Raw | None
         try:
             raw = read_record(buf, pos, end)
         except RecordError as e:
@@ -138,8 +140,8 @@ def walk(buf: bytes | memoryview, lay: Layout) -> Iterator[Item]:
                             "writing)")
 
 
-def _after_damage(buf: bytes | memoryview, pos: int, end: int, lay: Layout, why: str
-                  ) -> Iterator[Item]:
+def _after_damage(buf: FileBytes, pos: int, end: int, lay: Layout, why: str
+                  ) -> Generator[Item, None, Raw | None]:
     """Handle bytes at ``pos`` that are not a record: read what can be read of them and
     return the next valid record (None: nothing valid follows)."""
     h = head(buf, pos, end)
@@ -248,7 +250,7 @@ def _chunk(offset: int, length: int, chunk: Chunk, lay: Layout, cut: bool = Fals
             yield Item(rec, "data")
 
 
-def message_index_at(buf: bytes | memoryview, offset: int, size: int) -> MessageIndex | None:
+def message_index_at(buf: FileBytes, offset: int, size: int) -> MessageIndex | None:
     """The message index record at ``offset`` (from a chunk index), None when there is
     none there."""
     try:

@@ -11,6 +11,7 @@ decoded as streams, so everything before the damage comes back).
 from __future__ import annotations
 
 import io
+import mmap
 import struct
 import zlib
 from dataclasses import dataclass
@@ -37,10 +38,14 @@ from mcap.records import (
     SummaryOffset,
 )
 
+# a whole MCAP file (or its start) in memory: bytes, a view, or a read-only mmap of the file
+# (slices of an mmap are bytes)
+FileBytes = bytes | memoryview | mmap.mmap
+
 MAGIC = bytes([137, 77, 67, 65, 80, 48, 13, 10])
 FOOTER_RECORD_SIZE = 9 + 20
-_MIN_LENGTH = {Opcode.HEADER: 8, Opcode.FOOTER: 20, Opcode.MESSAGE: 22, Opcode.CHUNK: 40,
-               Opcode.DATA_END: 4}
+_MIN_LENGTH: dict[int, int] = {Opcode.HEADER: 8, Opcode.FOOTER: 20, Opcode.MESSAGE: 22,
+                               Opcode.CHUNK: 40, Opcode.DATA_END: 4}
 _CLASSES: dict[int, Any] = {
     Opcode.HEADER: Header, Opcode.FOOTER: Footer, Opcode.SCHEMA: Schema,
     Opcode.CHANNEL: Channel, Opcode.MESSAGE_INDEX: MessageIndex,
@@ -73,7 +78,7 @@ class Raw:
         return self.offset + 9 + self.length
 
 
-def head(buf: bytes | memoryview, pos: int, end: int) -> tuple[int, int] | None:
+def head(buf: FileBytes, pos: int, end: int) -> tuple[int, int] | None:
     """(opcode, body length) of the record at ``pos``, or None when fewer than 9 bytes
     remain before ``end``."""
     if end - pos < 9:
@@ -143,7 +148,7 @@ def _parse_chunk(body: bytes | memoryview, complete: bool) -> Chunk:
                  uncompressed_crc=crc, compression=compression, data=bytes(data))
 
 
-def chunk_prefix(buf: bytes | memoryview, pos: int, size: int) -> Chunk | None:
+def chunk_prefix(buf: FileBytes, pos: int, size: int) -> Chunk | None:
     """The chunk whose record starts at ``pos`` and runs past ``size`` (the file was cut
     inside it), holding the compressed bytes that are there; None when even its header is
     cut or makes no sense."""
@@ -153,7 +158,7 @@ def chunk_prefix(buf: bytes | memoryview, pos: int, size: int) -> Chunk | None:
         return None
 
 
-def read_record(buf: bytes | memoryview, pos: int, end: int) -> Raw:
+def read_record(buf: FileBytes, pos: int, end: int) -> Raw:
     """The record at ``pos``, which must end by ``end``; :class:`RecordError` otherwise."""
     h = head(buf, pos, end)
     if h is None:
@@ -166,7 +171,7 @@ def read_record(buf: bytes | memoryview, pos: int, end: int) -> Raw:
     return Raw(pos, opcode, length, parse_body(opcode, buf[pos + 9:pos + 9 + length]))
 
 
-def _plausible_next(buf: bytes | memoryview, pos: int, end: int, opcodes: frozenset[int]
+def _plausible_next(buf: FileBytes, pos: int, end: int, opcodes: frozenset[int]
                     ) -> bool:
     """Is ``pos`` the end of the data, the closing magic, or a record head that fits?"""
     if pos == end or bytes(buf[pos:pos + 8]) == MAGIC:
@@ -175,7 +180,7 @@ def _plausible_next(buf: bytes | memoryview, pos: int, end: int, opcodes: frozen
     return h is not None and h[0] in opcodes and h[1] <= end - pos - 9
 
 
-def next_record_start(buf: bytes | memoryview, start: int, end: int,
+def next_record_start(buf: FileBytes, start: int, end: int,
                       opcodes: frozenset[int] = KNOWN_OPCODES) -> Raw | None:
     """The first record at or after ``start`` that parses whole and is followed by the
     end, the closing magic or another plausible record head (so a random byte that looks
@@ -267,7 +272,7 @@ def inner_records(data: bytes, complete: bool) -> tuple[list[Raw], list[str]]:
     return out, problems
 
 
-def footer_at_end(buf: bytes | memoryview, size: int) -> tuple[int, Footer] | None:
+def footer_at_end(buf: FileBytes, size: int) -> tuple[int, Footer] | None:
     """(offset, footer) of a file that ends with a footer record and the closing magic."""
     pos = size - 8 - FOOTER_RECORD_SIZE
     if pos < 8 or bytes(buf[size - 8:size]) != MAGIC:

@@ -39,6 +39,7 @@ from sgtool.log.image_wire import parse_raw_image
 from sgtool.log.records import RECORD_TYPES, LogRecord
 from sgtool.log.summary_check import BoundedReader as _BoundedReader
 from sgtool.log.summary_check import check_summary, read_attachment
+from sgtool.vocabulary import RecordName
 
 R = TypeVar("R", bound=LogRecord)
 
@@ -327,9 +328,9 @@ class LogReader:
     def records(self, kind: type[R], **kw: Any) -> Iterator[tuple[int, R]]: ...
 
     @overload
-    def records(self, kind: str, **kw: Any) -> Iterator[tuple[int, dict[str, Any]]]: ...
+    def records(self, kind: RecordName, **kw: Any) -> Iterator[tuple[int, dict[str, Any]]]: ...
 
-    def records(self, kind: type[LogRecord] | str, **kw: Any) -> Iterator[tuple[int, Any]]:
+    def records(self, kind: type[LogRecord] | RecordName, **kw: Any) -> Iterator[tuple[int, Any]]:
         """(log time, record) of one sgtool JSON channel, in time order, each checked
         against its schema (:mod:`sgtool.log.records`: a missing or mistyped field is a
         :class:`LogFormatError` naming the channel, the record and the field). ``kind`` a
@@ -348,13 +349,13 @@ class LogReader:
     def last_record(self, kind: type[R], at_ns: int | None = None) -> R | None: ...
 
     @overload
-    def last_record(self, kind: str, at_ns: int | None = None) -> dict[str, Any] | None: ...
+    def last_record(self, kind: RecordName, at_ns: int | None = None) -> dict[str, Any] | None: ...
 
-    def last_record(self, kind: type[LogRecord] | str, at_ns: int | None = None) -> Any:
+    def last_record(self, kind: type[LogRecord] | RecordName, at_ns: int | None = None) -> Any:
         """The last record of a channel (at or before ``at_ns``), checked as
         :meth:`records`; None when there is none."""
         end = None if at_ns is None else at_ns + 1
-        for _, rec in self.records(kind, end_ns=end, reverse=True):  # type: ignore[call-overload]
+        for _, rec in self.records(kind, end_ns=end, reverse=True):
             return rec
         return None
 

@@ -31,48 +31,59 @@ an enumeration is a :class:`~sgtool.errors.LogFormatError` naming the channel, t
 
 from __future__ import annotations
 
+import enum
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
-from typing import TYPE_CHECKING, Any, ClassVar, Final, TypeVar
+from typing import TYPE_CHECKING, Any, ClassVar, Final, Literal, TypeVar, overload
 
 from sgtool.canonical import canonical_float
 from sgtool.errors import LogFormatError
 from sgtool.log import schemas as S
+from sgtool.vocabulary import (
+    EpisodeKind,
+    EpisodeStatus,
+    InstanceKind,
+    OpenState,
+    Outcome,
+    RecordName,
+    Relation,
+)
 
 if TYPE_CHECKING:
     from sgtool.scenegraph.graph import SceneGraph
 
 T = TypeVar("T")
+D = TypeVar("D")
 R = TypeVar("R", bound="LogRecord")
 J = TypeVar("J", bound="JsonRecord")
 
 
-class Absent:
-    """The type of :data:`ABSENT`: a field the JSON record does not hold (not even null)."""
+class Absent(enum.Enum):
+    """The type of :data:`ABSENT`: a field the JSON record does not hold (not even null).
 
-    _it: ClassVar[Absent | None] = None
+    A one-member enum, so a field typed ``str | Absent`` is not a ``str`` to mypy until
+    ``is ABSENT`` (or :func:`given`) has taken the sentinel out. Falsy; ``repr`` is
+    ``ABSENT``; copies and pickles are the same object."""
 
-    def __new__(cls) -> Absent:
-        if cls._it is None:
-            cls._it = super().__new__(cls)
-        return cls._it
+    ABSENT = "ABSENT"
 
     def __repr__(self) -> str:
         return "ABSENT"
 
-    def __bool__(self) -> bool:
+    def __bool__(self) -> Literal[False]:
         return False
 
-    def __reduce__(self) -> tuple[type[Absent], tuple[()]]:
-        return (Absent, ())
+
+ABSENT: Final = Absent.ABSENT
 
 
-ABSENT: Final = Absent()
-
-
-def given(value: T | None | Absent, default: Any = None) -> Any:
-    """``value``, or ``default`` when the field is absent or null."""
-    return default if value is None or isinstance(value, Absent) else value
+@overload
+def given(value: T | None | Absent) -> T | None: ...
+@overload
+def given(value: T | None | Absent, default: D) -> T | D: ...
+def given(value: object, default: object = None) -> object:
+    """``value``, or ``default`` (None when not given) when the field is absent or null."""
+    return default if value is None or value is ABSENT else value
 
 
 # ----------------------------------------------------------------------------------------
@@ -169,7 +180,7 @@ class JsonRecord:
 class LogRecord(JsonRecord):
     """A record of one of sgtool's JSON channels."""
 
-    KIND: ClassVar[str] = ""
+    KIND: ClassVar[RecordName]  # each record type names its channel
 
     @classmethod
     def channel(cls) -> S.RecordKind:
@@ -218,11 +229,11 @@ class LogRecord(JsonRecord):
 class Episode(LogRecord):
     """``sgtool.Episode``: a run starts ("started") or ends (its final figures)."""
 
-    KIND: ClassVar[str] = "episode"
+    KIND: ClassVar[RecordName] = "episode"
     CANONICAL: ClassVar[tuple[str, ...]] = ("travelled_m", "shortest_m")
 
-    kind: str  # recording | search | import
-    status: str  # started | success | failure | ended
+    kind: EpisodeKind
+    status: EpisodeStatus
     source: str | Absent = ABSENT
     house_id: str | None | Absent = ABSENT
     query: str | None | Absent = ABSENT
@@ -252,11 +263,11 @@ class Action(LogRecord):
     scene graph it was decided on; null: decided on no graph; absent: the last graph at or
     before the action's log time."""
 
-    KIND: ClassVar[str] = "action"
+    KIND: ClassVar[RecordName] = "action"
     CANONICAL: ClassVar[tuple[str, ...]] = ("travelled_m",)
 
-    skill: str
-    outcome: str  # success | failure | invalid
+    skill: str  # open in the schema; sgtool writes sgtool.vocabulary.LoggedSkill values
+    outcome: Outcome
     target: str | None | Absent = ABSENT
     reason: str | Absent = ABSENT
     travelled_m: float | Absent = ABSENT
@@ -277,12 +288,12 @@ class InstanceItem(JsonRecord):
 
     id: int
     category: str
-    kind: str  # object | furniture | door | structure
+    kind: InstanceKind
     synset: str | None | Absent = ABSENT
-    state: str | None | Absent = ABSENT
+    state: OpenState | None | Absent = ABSENT
     affordances: tuple[str, ...] | Absent = ABSENT
     parent: int | None | Absent = ABSENT
-    relation: str | None | Absent = ABSENT
+    relation: Relation | None | Absent = ABSENT
     spec_id: str | None | Absent = ABSENT
 
 
@@ -290,7 +301,7 @@ class InstanceItem(JsonRecord):
 class Instances(LogRecord):
     """``sgtool.Instances``: the whole instance table (written again on every change)."""
 
-    KIND: ClassVar[str] = "instances"
+    KIND: ClassVar[RecordName] = "instances"
 
     instances: tuple[InstanceItem, ...]
 
@@ -310,7 +321,7 @@ class SceneGraphRecord(LogRecord):
     """``sgtool.SceneGraph``: the canonical JSON of a
     :class:`sgtool.scenegraph.graph.SceneGraph` (:meth:`graph` builds it back)."""
 
-    KIND: ClassVar[str] = "scene_graph"
+    KIND: ClassVar[RecordName] = "scene_graph"
 
     version: str
     time_ns: int | Absent = ABSENT
@@ -344,7 +355,7 @@ _LLM_TRANSCRIPT_FIELDS = {
 class LlmExchange(LogRecord):
     """``sgtool.LlmExchange``: one prompt and its answer (:mod:`sgtool.llm.exchange`)."""
 
-    KIND: ClassVar[str] = "llm_exchange"
+    KIND: ClassVar[RecordName] = "llm_exchange"
 
     model: str
     messages: tuple[Mapping[str, str], ...]
@@ -365,6 +376,6 @@ class LlmExchange(LogRecord):
         return {**base, "properties": {**base["properties"], **_LLM_TRANSCRIPT_FIELDS}}
 
 
-RECORD_TYPES: dict[str, type[LogRecord]] = {
+RECORD_TYPES: dict[RecordName, type[LogRecord]] = {
     c.KIND: c for c in (Episode, Instances, Action, SceneGraphRecord, LlmExchange)
 }

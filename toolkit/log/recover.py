@@ -26,7 +26,7 @@ from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import IO, Literal
 
 from mcap.records import Attachment, Channel, Message, Metadata, Schema, Statistics
 from mcap.writer import CompressionType, Writer
@@ -235,7 +235,7 @@ class _Copier:
     """Re-writes records into a fresh, indexed MCAP file with the input's header (read
     by the walk before any record is copied), renumbering nothing."""
 
-    def __init__(self, out: io.BufferedWriter) -> None:
+    def __init__(self, out: IO[bytes]) -> None:
         self.out = out
         self.layout: Layout | None = None
         self._w: Writer | None = None

@@ -18,6 +18,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+from sgtool.vocabulary import (
+    EPISODE_KINDS,
+    EPISODE_STATUSES,
+    INSTANCE_KINDS,
+    OPEN_STATES,
+    OUTCOMES,
+    RELATIONS,
+    RecordName,
+)
+
 # 1.1: sgtool.Action 1.1 adds the optional ``graph_time_ns``
 LOG_SCHEMA_VERSION: tuple[int, int] = (1, 1)
 PROFILE = "sgtool"
@@ -49,7 +59,7 @@ DEPTH_SCALE = 1000.0  # depth units per metre
 class RecordKind:
     """A JSON record type: its schema name, version, topic and JSON schema."""
 
-    key: str
+    key: RecordName
     schema_name: str
     version: str
     topic: str
@@ -78,7 +88,7 @@ _INT = {"type": "integer"}
 _BOOL = {"type": "boolean"}
 _NSTR = {"type": ["string", "null"]}
 
-RECORDS: dict[str, RecordKind] = {
+RECORDS: dict[RecordName, RecordKind] = {
     "episode": RecordKind(
         "episode",
         "sgtool.Episode",
@@ -86,12 +96,12 @@ RECORDS: dict[str, RecordKind] = {
         "/sgtool/episode",
         _obj(
             {
-                "kind": {"enum": ["recording", "search", "import"]},
+                "kind": {"enum": [*EPISODE_KINDS]},
                 "source": _STR,
                 "house_id": _NSTR,
                 "query": _NSTR,
                 "planner": _NSTR,
-                "status": {"enum": ["started", "success", "failure", "ended"]},
+                "status": {"enum": [*EPISODE_STATUSES]},
                 "steps": _INT,
                 "travelled_m": _NUM,
                 "shortest_m": {"type": ["number", "null"]},
@@ -115,11 +125,11 @@ RECORDS: dict[str, RecordKind] = {
                             "id": _INT,
                             "category": _STR,
                             "synset": _NSTR,
-                            "kind": {"enum": ["object", "furniture", "door", "structure"]},
-                            "state": {"enum": ["open", "closed", None]},
+                            "kind": {"enum": [*INSTANCE_KINDS]},
+                            "state": {"enum": [*OPEN_STATES, None]},
                             "affordances": {"type": "array", "items": _STR},
                             "parent": {"type": ["integer", "null"]},
-                            "relation": {"enum": ["inside", "ontop", None]},
+                            "relation": {"enum": [*RELATIONS, None]},
                             "spec_id": _NSTR,
                         },
                         ["id", "category", "kind"],
@@ -141,7 +151,7 @@ RECORDS: dict[str, RecordKind] = {
             {
                 "skill": _STR,
                 "target": _NSTR,
-                "outcome": {"enum": ["success", "failure", "invalid"]},
+                "outcome": {"enum": [*OUTCOMES]},
                 "reason": _STR,
                 "travelled_m": _NUM,
                 "decision_time_s": _NUM,

@@ -42,6 +42,7 @@ from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.records import RECORD_TYPES, LogRecord
 from sgtool.version import __version__
+from sgtool.vocabulary import RecordName
 
 PARTIAL_SUFFIX = ".partial"
 PARTIAL_GLOB = "*.????????" + PARTIAL_SUFFIX  # OUT.XXXXXXXX.partial, see the module doc
@@ -266,9 +267,9 @@ class LogWriter:
     def write_record(self, record: LogRecord, t_ns: int) -> None: ...
 
     @overload
-    def write_record(self, record: str, t_ns: int, data: Mapping[str, Any]) -> None: ...
+    def write_record(self, record: RecordName, t_ns: int, data: Mapping[str, Any]) -> None: ...
 
-    def write_record(self, record: LogRecord | str, t_ns: int,
+    def write_record(self, record: LogRecord | RecordName, t_ns: int,
                      data: Mapping[str, Any] | None = None) -> None:
         """Write a typed sgtool JSON record (:mod:`sgtool.log.records`) on its channel,
         checked against its schema first (a :class:`~sgtool.errors.LogFormatError` names

@@ -302,8 +302,18 @@ def reachable(occ: OccupancyMap, start_xy: Sequence[float]) -> np.ndarray:
     return np.isfinite(geodesic_distances(occ, start_xy))
 
 
+_NUMBER = (int, float, np.floating, np.integer)
+
+
 def _as_points(p: Sequence[float] | Iterable[Sequence[float]]) -> list[tuple[float, float]]:
-    seq = list(p)  # type: ignore[arg-type]
-    if len(seq) == 2 and all(isinstance(v, (int, float, np.floating, np.integer)) for v in seq):
+    """One (x, y) point, or several, as a list of points."""
+    seq: list[float | Sequence[float]] = list(p)
+    if len(seq) == 2 and isinstance(seq[0], _NUMBER) and isinstance(seq[1], _NUMBER):
         return [(float(seq[0]), float(seq[1]))]
-    return [(float(q[0]), float(q[1])) for q in seq]
+    return [_point(q) for q in seq]
+
+
+def _point(q: float | Sequence[float]) -> tuple[float, float]:
+    if isinstance(q, _NUMBER):
+        raise TypeError(f"expected an (x, y) point, got the number {q!r}")
+    return float(q[0]), float(q[1])

@@ -126,7 +126,8 @@ class VoxelMap:
         self._stats = LabelStats()
         self._stats.grow(1)
         self._scratch = Scratch()
-        self._rays: dict[tuple[int, int, float, float, float, float], tuple[np.ndarray, ...]] = {}
+        self._rays: dict[tuple[int, int, float, float, float, float],
+                         tuple[np.ndarray, np.ndarray]] = {}
         self.version = 0  # bumped whenever the voxels change
         self.removals = 0  # bumped by forget_instance (maps derived incrementally rebuild)
         self._new_keys: list[np.ndarray] = []  # entries new since the last drain
@@ -142,7 +143,7 @@ class VoxelMap:
             v = (np.arange(h, dtype=np.float64) - k.cy) / k.fy
             t = (np.tile(u, h), np.repeat(v, w))
             self._rays[key] = t
-        return t  # type: ignore[return-value]
+        return t
 
     def labels_of(self, ids: np.ndarray) -> np.ndarray:
         """Label indices of instance ids (new ids get the next indices, in sorted order)."""
@@ -164,7 +165,7 @@ class VoxelMap:
         uniq, inv = np.unique(ids, return_inverse=True)
         out = np.empty(len(uniq), dtype=np.int64)
         for j, i in enumerate(uniq.tolist()):
-            out[j] = self._label_of.get(i) if i in self._label_of else self._new_label(i)
+            out[j] = self._label_of[i] if i in self._label_of else self._new_label(i)
         return out[inv]
 
     def _new_label(self, instance_id: int) -> int:
@@ -284,9 +285,13 @@ class VoxelMap:
             """Mean voxel centre (x, y) per label index, weighted by points."""
             n = np.maximum(np.bincount(lab_u, weights=cnt, minlength=n_lab), 1.0)
             res = self.config.resolution
-            return tuple(  # type: ignore[return-value]
-                np.bincount(lab_u, weights=cnt * (((uk >> sh) & AXIS_MASK) - (OFFSET - 0.5)),
-                            minlength=n_lab) * res / n for sh in (SHIFT_X, SHIFT_Y))
+
+            def mean(sh: int) -> np.ndarray:
+                return np.bincount(lab_u, weights=cnt * (((uk >> sh) & AXIS_MASK)
+                                                         - (OFFSET - 0.5)),
+                                   minlength=n_lab) * res / n
+
+            return mean(SHIFT_X), mean(SHIFT_Y)
 
         update_frame(self._stats, pts, voxel_means, labels, wx, wy, n_lab, viewpoint,
                      frame_index, self.config.min_points, self.config.resolution)

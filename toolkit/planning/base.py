@@ -10,12 +10,12 @@ closed loop) reports the outcome back through :meth:`Planner.feedback`.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal, Protocol
+from typing import Protocol
 
 from sgtool.scenegraph.graph import SceneGraph
+from sgtool.vocabulary import Outcome, Skill
 
-Skill = Literal["navigate", "open", "close", "explore", "done"]
-Outcome = Literal["success", "failure", "invalid"]
+__all__ = ["Action", "Feedback", "Outcome", "Planner", "Skill"]
 
 
 @dataclass(frozen=True)

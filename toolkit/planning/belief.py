@@ -74,7 +74,7 @@ import numpy as np
 from sgtool.planning.calibration import calibrate
 from sgtool.planning.candidates import Candidate, is_carrier
 from sgtool.planning.utility import UNKNOWN_ROOM
-from sgtool.scenegraph.graph import SceneGraph
+from sgtool.scenegraph.graph import ObjectNode, RegionNode, SceneGraph
 from sgtool.semantics.priors import RelationScorer, can_score_room
 
 
@@ -182,7 +182,8 @@ def _object_masses(graph: SceneGraph, cands: Sequence[Candidate], query: str,
     for f in graph.regions:
         if f.kind == "frontier" and f.frontier_type != "leading out":
             z[f.room] = z.get(f.room, 0.0) + k_region
-    nodes = {n.id: n for n in (*graph.regions, *graph.objects)}
+    members: tuple[RegionNode | ObjectNode, ...] = (*graph.regions, *graph.objects)
+    nodes = {n.id: n for n in members}
     out = np.zeros(len(cands))
     for i, c in enumerate(cands):
         node = nodes.get(c.node_id)

@@ -52,11 +52,12 @@ knowledge, to be fixed in training, not by a blend that costs the search.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from sgtool.semantics.encoder import SentenceEncoder
 from sgtool.semantics.priors import RelationScorer, can_score_room
 from sgtool.semantics.text import category_text
 
@@ -113,7 +114,7 @@ class BlendedPriors:
     scores by the query's distance to the training queries, (C2)-(C3)."""
 
     def __init__(self, learned: RelationScorer, cosine: RelationScorer,
-                 training_queries: Sequence[str] | None, encoder: object | None,
+                 training_queries: Sequence[str] | None, encoder: SentenceEncoder | None,
                  params: BlendParams = BlendParams()) -> None:
         self.name = f"blend({learned.name},{cosine.name})"
         self.learned = learned
@@ -147,13 +148,14 @@ class BlendedPriors:
                 self._weights[q] = 1.0
             else:
                 if self._train_vecs is None:
-                    self._train_vecs = self._encoder.encode(self._training)  # type: ignore[attr-defined]
-                v = self._encoder.encode([q])[0]  # type: ignore[attr-defined]
+                    self._train_vecs = self._encoder.encode(self._training)
+                v = self._encoder.encode([q])[0]
                 sim = float(np.max(self._train_vecs @ v))
                 self._weights[q] = novelty_weight(sim, self.params.lo, self.params.hi)
         return self._weights[q]
 
-    def _blend(self, relation: str, learned: np.ndarray, cosine_fn, names: Sequence[str],
+    def _blend(self, relation: str, learned: np.ndarray,
+               cosine_fn: Callable[[Sequence[str], str], np.ndarray], names: Sequence[str],
                query: str) -> np.ndarray:
         if not self.blends(relation):
             return learned

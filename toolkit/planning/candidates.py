@@ -36,6 +36,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from itertools import compress, repeat
 from operator import attrgetter, eq, is_, is_not
+from typing import Literal
 
 import numpy as np
 
@@ -47,7 +48,7 @@ OPEN_AFFORDANCES = frozenset({"open", "openable"})
 EXAMINE_AFFORDANCES = frozenset({"explore", "examine", "search"})
 CARRIER_AFFORDANCES = OPEN_AFFORDANCES | EXAMINE_AFFORDANCES | {"container", "supporter"}
 
-NodeKind = str  # "room" | "frontier" | "object" | "door"
+NodeKind = Literal["room", "frontier", "object", "door"]
 _CATEGORY = attrgetter("category")
 
 
@@ -76,8 +77,11 @@ class Candidate:
         d["position"] = position
 
 
+NaturalKey = tuple[str, tuple[tuple[int, int | str], ...]]
+
+
 @functools.lru_cache(maxsize=65536)
-def natural_key(node_id: str) -> tuple[str, tuple[tuple[int, int | str], ...]]:
+def natural_key(node_id: str) -> NaturalKey:
     """Sort ids naturally: ``room:2`` before ``room:10``, ``region:3.1`` before ``region:3.12``."""
     prefix, _, rest = node_id.partition(":")
     return prefix, tuple((0, int(p)) if p.isdecimal() else (1, p) for p in rest.split("."))
@@ -94,6 +98,12 @@ def distance_to(graph: SceneGraph, node: RoomNode | RegionNode | ObjectNode | Do
     if graph.distances:
         d = graph.distances.get(node.id)
         return None if d is None or not math.isfinite(d) else float(d)
+    return _straight_line(graph, node)
+
+
+def _straight_line(graph: SceneGraph, node: RoomNode | RegionNode | ObjectNode | DoorNode
+                   ) -> float:
+    """The straight-line distance from the robot (a graph without travel distances)."""
     x, y = node_xy(node)
     rx, ry = graph.robot.position
     return math.hypot(x - rx, y - ry)
@@ -137,7 +147,8 @@ def _entrance(door: DoorNode, room_of: Callable[[str], RoomNode | None]) -> bool
     return False
 
 
-_Entry = tuple[object, "Skill | None", str, tuple, str, tuple[float, float]]
+# (node, skill (None: not actionable), kind, natural key, id, (x, y)) of a node
+_Entry = tuple[object, Skill | None, NodeKind, NaturalKey, str, tuple[float, float]]
 
 
 class _NodeMemo:
@@ -155,6 +166,7 @@ class _NodeMemo:
 
     def add(self, node: RoomNode | RegionNode | ObjectNode) -> _Entry:
         skill: Skill | None
+        kind: NodeKind
         if isinstance(node, RoomNode):
             skill, kind = (None if node.explored else "explore"), "room"
         elif isinstance(node, RegionNode):
@@ -171,7 +183,9 @@ class _NodeMemo:
 _STATIC = _NodeMemo()
 
 # (key, node id, skill, kind, (x, y)) of an actionable node, key its natural sort key
-_Ordered = list[tuple[tuple, str, "Skill", str, tuple[float, float]]]
+_Ordered = list[tuple[NaturalKey, str, Skill, NodeKind, tuple[float, float]]]
+# (ids, skills, kinds, positions) of an _Ordered list
+_Columns = tuple[list[str], list[Skill], list[NodeKind], list[tuple[float, float]]]
 
 
 class _GroupOrder:
@@ -197,8 +211,9 @@ class _GroupOrder:
         if hit is not None and hit[0] is group:
             return hit[2]
         keys = self.keys.get(slot) if hit is not None else None
-        out = self._update(hit[0], hit[2], keys, group) \
-            if keys is not None else None  # type: ignore[index]
+        out = None
+        if hit is not None and keys is not None:
+            out = self._update(hit[0], hit[2], keys, group)
         if out is None:
             out, keys = self._sorted(group)
         self.last[slot] = (group, (), out)
@@ -327,8 +342,10 @@ class CandidateColumns:
 
     def take(self, keep: list[int]) -> CandidateColumns:
         """The rows ``keep`` (ascending indices)."""
-        return CandidateColumns(*([col[k] for k in keep] for col in (
-            self.ids, self.skills, self.kinds, self.distances, self.positions)))
+        return CandidateColumns([self.ids[k] for k in keep], [self.skills[k] for k in keep],
+                                [self.kinds[k] for k in keep],
+                                [self.distances[k] for k in keep],
+                                [self.positions[k] for k in keep])
 
     @classmethod
     def of(cls, candidates: list[Candidate]) -> CandidateColumns:
@@ -339,18 +356,19 @@ class CandidateColumns:
 
 # the ordered groups last put in order (kept alive, compared by identity) and their
 # (ids, skills, kinds, positions) columns; the columns of each group's last ordered list
-_LAST_ORDER: list[tuple[tuple[_Ordered, ...], tuple[list, list, list, list]]] = []
-_GROUP_COLUMNS: dict[int, tuple[_Ordered, list[list]]] = {}
+_LAST_ORDER: list[tuple[tuple[_Ordered, ...], _Columns]] = []
+_GROUP_COLUMNS: dict[int, tuple[_Ordered, _Columns]] = {}
 
 
-def _columns(entries: _Ordered) -> list[list]:
+def _columns(entries: _Ordered) -> _Columns:
     """(ids, skills, kinds, positions) of ``entries``."""
     if not entries:
-        return [[], [], [], []]
-    return [list(c) for c in zip(*entries, strict=True)][1:]
+        return [], [], [], []
+    _, ids, skills, kinds, xy = zip(*entries, strict=True)
+    return list(ids), list(skills), list(kinds), list(xy)
 
 
-def _ordered_columns(groups: tuple[_Ordered, ...]) -> tuple[list, list, list, list]:
+def _ordered_columns(groups: tuple[_Ordered, ...]) -> _Columns:
     """The columns of :func:`_in_order` of ``groups``: those of each group end to end when
     the groups' key ranges do not meet (kept per group while its ordered list is the
     same), else of the merged order."""
@@ -359,17 +377,19 @@ def _ordered_columns(groups: tuple[_Ordered, ...]) -> tuple[list, list, list, li
         return last[1]
     runs = sorted((k for k, g in enumerate(groups) if g), key=lambda k: groups[k][0][0])
     if all(groups[a][-1][0] < groups[b][0][0] for a, b in zip(runs, runs[1:], strict=False)):
-        cols: list[list] = [[], [], [], []]
+        out: _Columns = ([], [], [], [])
         for k in runs:
             hit = _GROUP_COLUMNS.get(k)
             if hit is None or hit[0] is not groups[k]:
                 hit = _GROUP_COLUMNS[k] = (groups[k], _columns(groups[k]))
-            for col, part in zip(cols, hit[1], strict=True):
-                col += part
+            ids, skills, kinds, xy = hit[1]
+            out[0].extend(ids)
+            out[1].extend(skills)
+            out[2].extend(kinds)
+            out[3].extend(xy)
     else:
-        cols = _columns(_in_order(list(groups)))
-    out = (cols[0], cols[1], cols[2], cols[3])
-    _LAST_ORDER[:] = [(groups, out)]  # type: ignore[list-item]
+        out = _columns(_in_order(list(groups)))
+    _LAST_ORDER[:] = [(groups, out)]
     return out
 
 
@@ -394,8 +414,8 @@ def actionable_columns(graph: SceneGraph) -> CandidateColumns:
                             [kinds[k] for k in keep], d[fin].tolist(), [xy[k] for k in keep])
 
 
-def _finite_or_inf(d: object) -> float:
-    return math.inf if d is None else float(d)  # type: ignore[arg-type]
+def _finite_or_inf(d: float | None) -> float:
+    return math.inf if d is None else float(d)
 
 
 def actionable(graph: SceneGraph) -> list[Candidate]:
@@ -417,14 +437,14 @@ def _actionable_without_distances(graph: SceneGraph) -> list[Candidate]:
                 entry = _STATIC.add(node)
             if entry[1] is None:
                 continue
-            d = distance_to(graph, node)
+            d = _straight_line(graph, node)
             keyed.append((entry[3], len(keyed),
-                          Candidate(entry[4], entry[1], entry[2], d, entry[5])))  # type: ignore[arg-type]
+                          Candidate(entry[4], entry[1], entry[2], d, entry[5])))
     for door in graph.doors:
         if door_is_entrance(graph, door):
-            d = distance_to(graph, door)
+            d = _straight_line(graph, door)
             keyed.append((natural_key(door.id), len(keyed),
-                          Candidate(door.id, "open", "door", d, node_xy(door))))  # type: ignore[arg-type]
+                          Candidate(door.id, "open", "door", d, node_xy(door))))
     keyed.sort()  # by natural key, then (equal ids) in graph order, as a stable sort
     return [c for _, _, c in keyed]
 

@@ -43,9 +43,9 @@ import numpy as np
 
 from sgtool.planning.belief import BeliefParams, known_room_mean, room_probabilities
 from sgtool.planning.candidates import Candidate
-from sgtool.planning.planners import UtilityPlanner
+from sgtool.planning.planners import ScoringPlanner
 from sgtool.planning.utility import objects_within
-from sgtool.scenegraph.graph import SceneGraph
+from sgtool.scenegraph.graph import ObjectNode, RegionNode, SceneGraph
 from sgtool.semantics.priors import RelationScorer
 
 _RAW = BeliefParams(room_floor=0.0, object_floor=0.0)
@@ -70,7 +70,8 @@ def esc_scores(graph: SceneGraph, cands: list[Candidate], query: str, scorer: Re
     rooms = room_probabilities(graph, query, scorer, _RAW, unknown_room)
     obj_xy = [(o.id, float(o.position[0]), float(o.position[1])) for o in objs]
     d_max = max((c.distance for c in cands), default=0.0) or 1.0
-    nodes = {n.id: n for n in (*graph.regions, *objs)}
+    members: tuple[RegionNode | ObjectNode, ...] = (*graph.regions, *objs)
+    nodes = {n.id: n for n in members}
     out = np.zeros(len(cands))
     for k, c in enumerate(cands):
         if c.kind == "object":
@@ -87,13 +88,13 @@ def esc_scores(graph: SceneGraph, cands: list[Candidate], query: str, scorer: Re
     return out
 
 
-class EscPlanner(UtilityPlanner):
+class EscPlanner(ScoringPlanner[EscParams]):
     """ESC-Interactive: soft commonsense constraints over frontiers and carriers (a utility
     planner whose utility is the rule score and whose selection is the plain argmax)."""
 
     def __init__(self, scorer: RelationScorer, params: EscParams = EscParams(),
                  name: str = "esc", max_failures: int = 2) -> None:
-        super().__init__(name, scorer, params, max_failures)  # type: ignore[arg-type]
+        super().__init__(name, scorer, params, max_failures)
 
     def choose(self, graph: SceneGraph, cands: list[Candidate]
                ) -> tuple[int, str, dict[str, float]]:

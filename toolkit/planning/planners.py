@@ -10,6 +10,7 @@ failure, never as a success). Subclasses implement :meth:`NodeSelectionPlanner.c
 from __future__ import annotations
 
 import functools
+from typing import Generic, TypeVar
 
 import numpy as np
 
@@ -31,6 +32,8 @@ from sgtool.scenegraph.graph import SceneGraph
 from sgtool.semantics.priors import RelationScorer
 
 GIVE_UP = "nothing left to explore"
+
+P = TypeVar("P")  # a scoring planner's parameters (a frozen dataclass)
 
 
 @functools.lru_cache(maxsize=1 << 13)
@@ -90,14 +93,17 @@ class RandomPlanner(NodeSelectionPlanner):
 
     def choose(self, graph: SceneGraph, cands: list[Candidate]
                ) -> tuple[int, str, dict[str, float]]:
-        i = int(self._rng.integers(len(cands)))
-        return i, f"random among {len(cands)}", {}
+        return self._pick(len(cands))
 
     def choose_columns(self, graph: SceneGraph, cols: CandidateColumns
                        ) -> tuple[int, str, dict[str, float]]:
         if type(self).choose is not RandomPlanner.choose:  # a subclass's own choice
             return super().choose_columns(graph, cols)
-        return self.choose(graph, cols)  # type: ignore[arg-type]  # (only its length)
+        return self._pick(len(cols))
+
+    def _pick(self, n: int) -> tuple[int, str, dict[str, float]]:
+        i = int(self._rng.integers(n))
+        return i, f"random among {n}", {}
 
 
 class GreedyPlanner(NodeSelectionPlanner):
@@ -111,11 +117,11 @@ class GreedyPlanner(NodeSelectionPlanner):
         return i, f"nearest ({cands[i].distance:.2f} m)", {}
 
 
-class UtilityPlanner(NodeSelectionPlanner):
-    """Utility-driven selection (SCOUT Eqs. 1-4, 12-13) over any relation scorer: the
-    distilled priors give SCOUT, SBERT cosine gives the similarity baselines."""
+class ScoringPlanner(NodeSelectionPlanner, Generic[P]):
+    """A node-selection planner that scores candidates with a relation scorer, tuned by
+    ``params`` (its own parameter dataclass ``P``); ``cache`` lives for one episode."""
 
-    def __init__(self, name: str, scorer: RelationScorer, params: UtilityParams,
+    def __init__(self, name: str, scorer: RelationScorer, params: P,
                  max_failures: int = 2) -> None:
         super().__init__(max_failures=max_failures)
         self.name = name
@@ -126,6 +132,11 @@ class UtilityPlanner(NodeSelectionPlanner):
     def reset(self, query: str, seed: int = 0) -> None:
         super().reset(query, seed)
         self.cache = EpisodeCache()  # per episode (its docstring)
+
+
+class UtilityPlanner(ScoringPlanner[UtilityParams]):
+    """Utility-driven selection (SCOUT Eqs. 1-4, 12-13) over any relation scorer: the
+    distilled priors give SCOUT, SBERT cosine gives the similarity baselines."""
 
     def choose(self, graph: SceneGraph, cands: list[Candidate]
                ) -> tuple[int, str, dict[str, float]]:

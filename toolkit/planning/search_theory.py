@@ -85,7 +85,7 @@ import numpy as np
 from sgtool.planning.belief import BeliefParams, place_masses
 from sgtool.planning.candidates import Candidate
 from sgtool.planning.furniture_prior import furniture_level
-from sgtool.planning.planners import UtilityPlanner
+from sgtool.planning.planners import ScoringPlanner
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.semantics.priors import RelationScorer
 
@@ -168,7 +168,7 @@ def best_first(cands: Sequence[Candidate], p: np.ndarray, robot: tuple[float, fl
     return best[2], -best[0]
 
 
-class SearchTheoryPlanner(UtilityPlanner):
+class SearchTheoryPlanner(ScoringPlanner[SearchParams]):
     """Bayesian search with the p/c ratio rule and a short look-ahead (module doc).
     ``furniture_levels``: name -> φ of (B6) (:mod:`sgtool.planning.furniture_prior`);
     None: every query is taken for a small object."""
@@ -176,7 +176,7 @@ class SearchTheoryPlanner(UtilityPlanner):
     def __init__(self, scorer: RelationScorer, params: SearchParams = SearchParams(),
                  name: str = "bayes-search", max_failures: int = 2,
                  furniture_levels: Mapping[str, float] | None = None) -> None:
-        super().__init__(name, scorer, params, max_failures)  # type: ignore[arg-type]
+        super().__init__(name, scorer, params, max_failures)
         self.steps = 0
         self.furniture_levels = furniture_levels
         self.furniture = 0.0

@@ -24,6 +24,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from itertools import compress, repeat
 from operator import attrgetter, ge, is_, is_not, ne
+from typing import TypedDict, TypeVar, Unpack
 
 import numpy as np
 
@@ -36,6 +37,18 @@ _ID, _CATEGORY, _ROOM, _POSITION = (attrgetter(a) for a in ("id", "category", "r
                                                               "position"))
 
 
+class UtilityOptions(TypedDict, total=False):
+    """Keyword arguments of :meth:`UtilityParams.scout` and :meth:`UtilityParams.sbert`:
+    any of the :class:`UtilityParams` fields."""
+
+    default_room: float
+    default_frontier: float
+    delta: float
+    room_weight: float
+    room_influence: bool
+    frontier_radius: float
+
+
 @dataclass(frozen=True)
 class UtilityParams:
     default_room: float = 0.7  # Table II: default room exploration score
@@ -46,20 +59,22 @@ class UtilityParams:
     frontier_radius: float = 2.0  # metres; objects this close inform a frontier
 
     @classmethod
-    def scout(cls, **kw: float | bool) -> UtilityParams:
-        return cls(**kw)  # type: ignore[arg-type]
+    def scout(cls, **kw: Unpack[UtilityOptions]) -> UtilityParams:
+        return cls(**kw)
 
     @classmethod
-    def sbert(cls, **kw: float | bool) -> UtilityParams:
+    def sbert(cls, **kw: Unpack[UtilityOptions]) -> UtilityParams:
         """Table VI, SBERT row."""
-        base = {"default_room": 0.3, "default_frontier": 0.25, "delta": 0.05,
-                "room_weight": 0.3}
+        base: UtilityOptions = {"default_room": 0.3, "default_frontier": 0.25, "delta": 0.05,
+                                "room_weight": 0.3}
         base.update(kw)
-        return cls(**base)  # type: ignore[arg-type]
+        return cls(**base)
 
 
-def room_influence(room_score: float | np.ndarray, object_score: float | np.ndarray,
-                   w: float) -> float | np.ndarray:
+_Score = TypeVar("_Score", float, np.ndarray)
+
+
+def room_influence(room_score: _Score, object_score: _Score, w: float) -> _Score:
     """Eq. 4: u_q(r_o) * (w + (1 - w) * u_q(o))."""
     return room_score * (w + (1.0 - w) * object_score)
 
@@ -276,7 +291,7 @@ def object_utility_array(table: ObjectTable, query: str, scorer: RelationScorer,
         return raw
     room = np.array([rooms.get(r, params.default_room) for r in table.room_ids],
                     dtype=np.float64)
-    return room_influence(room[table.room_of], raw, params.room_weight)  # type: ignore[return-value]
+    return room_influence(room[table.room_of], raw, params.room_weight)
 
 
 def object_utilities(graph: SceneGraph, query: str, scorer: RelationScorer,

@@ -176,7 +176,8 @@ def _visible_nodes(positions: np.ndarray, near_of: dict[tuple[float, float], np.
     for v, nodes in near_of.items():
         if len(nodes) == 0:
             out[v] = np.zeros(0, dtype=bool)
-    todo = [(v, None) for v in views]  # (viewpoint, the segments to test; None: all)
+    # (viewpoint, the segments to test; None: all)
+    todo: list[tuple[tuple[float, float], np.ndarray | None]] = [(v, None) for v in views]
     kept: dict[tuple[float, float], tuple[tuple, bytes]] = {}
     if cache is not None and views:
         targets = [positions[near_of[v]] for v in views]

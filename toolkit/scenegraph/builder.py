@@ -344,6 +344,7 @@ class SceneGraphBuilder:
             self._columns, self._level, self._removals = cg, level, self.voxels.removals
             self._door_voxels.reset(keys, self.voxels.label_ids(), self._door_ids())
         elif not removed:
+            assert self._columns is not None  # not rebuilt: the columns exist
             new = self.voxels.drain_new_keys()
             self._columns.add(classify_keys(new, level, res, cfg), self.trajectory)
             if self._door_voxels.stale(self._door_ids()):  # a new instance table

@@ -72,8 +72,8 @@ def _start_cell(occ: OccupancyGrid, free: np.ndarray, start: tuple[float, float]
     order); None when ``start`` is None or not near free space."""
     if start is None or not free.any():
         return None
-    r, c = occ.cell_of(start[0], start[1])
-    r, c = int(r), int(c)
+    row, col = occ.cell_of(start[0], start[1])
+    r, c = int(row), int(col)
     k = int(np.ceil(snap / occ.resolution))
     h, w = occ.shape
     r0, r1, c0, c1 = max(r - k, 0), min(r + k + 1, h), max(c - k, 0), min(c + k + 1, w)

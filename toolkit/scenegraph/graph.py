@@ -17,19 +17,17 @@ Node ids are strings with a layer prefix: ``room:3``, ``region:3.1``, ``frontier
 
 from __future__ import annotations
 
-import functools
 import json
 from dataclasses import dataclass, field, fields
 from typing import Any, Literal
 
 from sgtool.canonical import canonical_float, canonical_floats
+from sgtool.vocabulary import OpenState, Relation
 
 SCENE_GRAPH_VERSION = "1.0"
 
 RegionKind = Literal["region", "frontier"]
 FrontierType = Literal["unexplored area", "leading out"]
-Relation = Literal["inside", "ontop"]
-OpenState = Literal["open", "closed"]
 
 
 
@@ -251,21 +249,27 @@ class SceneGraph:
         return cls.from_dict(json.loads(text))
 
 
-@functools.cache
+_FIELD_NAMES: dict[type, tuple[str, ...]] = {}
+
+
 def _field_names(cls: type) -> tuple[str, ...]:
-    return tuple(f.name for f in fields(cls))
+    """The field names of a dataclass, computed once per class."""
+    names = _FIELD_NAMES.get(cls)
+    if names is None:
+        names = _FIELD_NAMES[cls] = tuple(f.name for f in fields(cls))
+    return names
 
 
-def _shallow(node: Any) -> dict[str, Any]:
+def _shallow(node: object) -> dict[str, Any]:
     """The fields of a node as a dict: ``dataclasses.asdict`` without its deep copy (node
     fields are immutable: strings, numbers, tuples)."""
     return {name: getattr(node, name) for name in _field_names(type(node))}
 
 
-def _idkey(node_id: str) -> tuple[str, tuple[int | str, ...]]:
+def _idkey(node_id: str) -> tuple[str, tuple[tuple[int, int] | tuple[int, str], ...]]:
     """Sort ids naturally: room:2 before room:10, region:3.1 before region:3.12."""
     prefix, _, rest = node_id.partition(":")
     parts: list[int | str] = []
     for p in rest.split("."):
         parts.append(int(p) if p.isdecimal() else p)
-    return prefix, tuple((0, p) if isinstance(p, int) else (1, p) for p in parts)  # type: ignore[misc]
+    return prefix, tuple((0, p) if isinstance(p, int) else (1, p) for p in parts)

@@ -15,10 +15,18 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any
 
-InstanceKind = Literal["object", "furniture", "door", "structure"]
-KINDS: tuple[str, ...] = ("object", "furniture", "door", "structure")
+from sgtool.vocabulary import (
+    INSTANCE_KINDS,
+    OPEN_STATES,
+    RELATIONS,
+    InstanceKind,
+    OpenState,
+    Relation,
+)
+
+KINDS: tuple[InstanceKind, ...] = INSTANCE_KINDS
 
 
 @dataclass(frozen=True)
@@ -29,21 +37,21 @@ class InstanceInfo:
     id: int
     category: str
     kind: InstanceKind = "object"
-    state: Literal["open", "closed"] | None = None
+    state: OpenState | None = None
     affordances: tuple[str, ...] = ()
     parent: int | None = None
-    relation: Literal["inside", "ontop"] | None = None
+    relation: Relation | None = None
     synset: str | None = None
     spec_id: str | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
             raise ValueError(f"instance {self.id}: kind must be one of {KINDS}, got {self.kind!r}")
-        if self.state not in (None, "open", "closed"):
+        if self.state is not None and self.state not in OPEN_STATES:
             raise ValueError(
                 f"instance {self.id}: state must be open/closed/None, got {self.state!r}"
             )
-        if self.relation not in (None, "inside", "ontop"):
+        if self.relation is not None and self.relation not in RELATIONS:
             raise ValueError(
                 f"instance {self.id}: relation must be inside/ontop/None, got {self.relation!r}"
             )

@@ -10,6 +10,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.sparse import csr_matrix
 
 from sgtool.mapping.grid import OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph
@@ -20,13 +21,13 @@ from sgtool.scenegraph.instances import InstanceInfo
 OBJECT_KINDS = ("object", "furniture")
 
 # (info, voxel centroid, closest viewpoint) of an instance seen well enough
-SeenInstance = tuple[InstanceInfo, tuple[float, ...], tuple[float, float] | None]
+SeenInstance = tuple[InstanceInfo, tuple[float, float, float], tuple[float, float] | None]
 
 
 @dataclass(frozen=True)
 class PlacedObject:
     instance: int
-    position: tuple[float, ...]
+    position: tuple[float, float, float]
     top: int  # first-level ancestor (itself when first-level)
     node: int  # Voronoi node of the first-level ancestor, -1 when unassigned
     parent_instance: int | None  # the seen parent of a nested object
@@ -38,7 +39,7 @@ def seen_instances(voxels: VoxelMap, instances: Mapping[int, InstanceInfo],
                    kinds: tuple[str, ...], min_points: int) -> list[SeenInstance]:
     """(info, voxel centroid, closest viewpoint) of the instances of ``kinds`` seen with at
     least ``min_points`` points in one frame, in id order."""
-    out = []
+    out: list[SeenInstance] = []
     for iid in voxels.observed_instances():
         info = instances.get(iid)
         if info is None or info.kind not in kinds:
@@ -51,7 +52,7 @@ def seen_instances(voxels: VoxelMap, instances: Mapping[int, InstanceInfo],
 
 
 def place_objects(seen: list[SeenInstance], vg: VoronoiGraph, node_room: np.ndarray,
-                  graph, occ: OccupancyGrid, blocked: np.ndarray,  # noqa: ANN001
+                  graph: csr_matrix, occ: OccupancyGrid, blocked: np.ndarray,
                   config: AssignConfig, cache: AssignCache | None = None
                   ) -> list[PlacedObject]:
     """Every seen object with its first-level ancestor and that ancestor's node
@@ -84,8 +85,8 @@ def place_objects(seen: list[SeenInstance], vg: VoronoiGraph, node_room: np.ndar
         info, c, _vp = by_id[iid]
         top = top_of(iid)
         parent_id = info.parent if (top != iid and info.parent is not None) else None
-        out.append(PlacedObject(iid, tuple(float(v) for v in c), top, node_of_top[top],
-                                parent_id))
+        out.append(PlacedObject(iid, (float(c[0]), float(c[1]), float(c[2])), top,
+                                node_of_top[top], parent_id))
     return out
 
 

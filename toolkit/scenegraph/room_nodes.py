@@ -102,10 +102,10 @@ def room_nodes(
         nb[room_ids[b]].add(room_ids[a])
     for d in doors:
         joined = list(d.rooms) + ([d.unexplored_room] if d.unexplored_room else [])
-        for a in joined:
-            for b in joined:
-                if a != b and a in nb:
-                    nb[a].add(b)
+        for one in joined:
+            for other in joined:
+                if one != other and one in nb:
+                    nb[one].add(other)
     cats: dict[str, list[str]] = defaultdict(list)
     voters: dict[str, list[str]] = defaultdict(list)
     for o in objects:

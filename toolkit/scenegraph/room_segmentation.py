@@ -39,7 +39,7 @@ passes its id to the explored room found beyond that door later.
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -136,19 +136,19 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray, min_width
                          (end, d, 0.15 * width, 0.85 * width, False),
                          (end, d, 1.05 * width, 1.3 * width, True)]
     shares = _shares(rays, occupied, grown)
-    scored = []
+    scored: list[tuple[float, float, float, int, np.ndarray]] = []
     at = 0
     for s, out in ((s0, -a), (s1, a)):
         for sign in (1.0, -1.0):
-            best = None
+            side: tuple[float, int] | None = None  # (score, offset) of the best offset
             for off in range(4):
                 wall, opening, jamb = shares[at:at + 3]
                 at += 3
                 cand = (wall + jamb - 2.0 * opening, off)
-                if best is None or cand[0] > best[0]:
-                    best = cand
-            assert best is not None
-            scored.append((best[0], s, sign, best[1], out))
+                if side is None or cand[0] > side[0]:
+                    side = cand
+            assert side is not None
+            scored.append((side[0], s, sign, side[1], out))
     scored.sort(key=lambda x: -x[0])
     best, second = scored[0], scored[1]
     if best[0] < 1.0 or best[0] - second[0] < 0.5:
@@ -312,7 +312,7 @@ def room_neighbours(vg: VoronoiGraph, seg: RoomSegmentation) -> list[tuple[int, 
     return out
 
 
-def _other_rooms(pred: list[int], labels: list[int], a: int):  # noqa: ANN202
+def _other_rooms(pred: list[int], labels: list[int], a: int) -> Callable[[int], int]:
     """For the shortest-path tree ``pred`` from room ``a``'s centre: a function of a node
     t giving the room other than ``a`` on the path to t (-1: none, -2: more than one).
     Each tree node is climbed once; the values along a climbed path are kept."""

@@ -8,13 +8,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from sgtool.mapping.voronoi import VoronoiGraph
 from sgtool.scenegraph.assembly import GraphParts
 
 
-def node_distances(vg: VoronoiGraph, graph, robot_xy: tuple[float, float] | None,  # noqa: ANN001
+def node_distances(vg: VoronoiGraph, graph: csr_matrix, robot_xy: tuple[float, float] | None,
                    entries: tuple[int, ...]) -> np.ndarray:
     """Per Voronoi node: the shortest path from ``robot_xy`` through one of its entry
     nodes (inf where unreachable, everywhere without entries)."""
@@ -42,8 +43,8 @@ def travel_distances(vg: VoronoiGraph, dist_node: np.ndarray,
 
     for i, rid in enumerate(parts.room_ids):
         put(rid, dist_node[parts.seg.centres[i]])
-    for reg_id, node in parts.regions.items():
-        put(reg_id, dist_node[node[1]])
+    for reg_id, region in parts.regions.items():
+        put(reg_id, dist_node[region[1]])
     obj_dist: dict[int, float] = {}
     for o in parts.objects:
         if o.node >= 0 and o.top == o.instance:

@@ -38,8 +38,12 @@ import numpy as np
 from sgtool.files import atomic_write
 from sgtool.semantics.encoder import SentenceEncoder, default_encoder
 from sgtool.semantics.metrics import separation_summary
-from sgtool.semantics.mlp import load_mlp, save_mlp
+from sgtool.semantics.mlp import RelationMLP, load_mlp, save_mlp
 from sgtool.semantics.priors import CONTAINMENT_FILE, COOCCURRENCE_FILE, METADATA_FILE
+from sgtool.semantics.relational_set import RelationalSet
+
+# (containment, co-occurrence)
+SetPair = tuple[RelationalSet, RelationalSet]
 
 METADATA_VERSION = 4  # 3: room_evidence; 4: training_queries
 FILES = {"containment": CONTAINMENT_FILE, "cooccurrence": COOCCURRENCE_FILE}
@@ -59,11 +63,12 @@ class DistillConfig:
     threads: int = 1
 
 
-def _encode_set(encoder: SentenceEncoder, rs) -> tuple[np.ndarray, np.ndarray]:
+def _encode_set(encoder: SentenceEncoder, rs: RelationalSet) -> tuple[np.ndarray, np.ndarray]:
     return encoder.encode(list(rs.nodes)), encoder.encode(list(rs.queries))
 
 
-def evaluate_set(rs, node_emb: np.ndarray, query_emb: np.ndarray, mlp) -> dict[str, Any]:
+def evaluate_set(rs: RelationalSet, node_emb: np.ndarray, query_emb: np.ndarray,
+                 mlp: RelationMLP) -> dict[str, Any]:
     """Learned score vs cosine similarity on the pairs of ``rs`` (binary label: target > 0)."""
     if len(rs) == 0:
         return {"pairs": 0}
@@ -87,12 +92,12 @@ def distill(
     out_dir: str | Path,
     cfg: DistillConfig = DistillConfig(),
     *,
-    sets: tuple[Any, Any],
+    sets: SetPair,
     split_fingerprint: str | None = None,
     room_types: tuple[str, ...] | None = None,
     encoder: SentenceEncoder | None = None,
     progress: bool = False,
-    eval_sets: tuple[Any, Any] | None = None,
+    eval_sets: SetPair | None = None,
 ) -> dict[str, Any]:
     """Train both models into ``out_dir`` and return the metadata written there.
 
@@ -126,7 +131,7 @@ def distill(
         "models": {},
         "report": {},
     }
-    mlps = {}
+    mlps: dict[str, RelationMLP] = {}
     for rs, loss, epochs in ((cont, "mse", cfg.epochs_containment),
                              (cooc, "bce", cfg.epochs_cooccurrence)):
         node_emb, query_emb = _encode_set(encoder, rs)
@@ -162,7 +167,7 @@ def distill(
     return meta
 
 
-def room_evidence(containment) -> dict[str, Any]:
+def room_evidence(containment: RelationalSet) -> dict[str, Any]:
     """How much the containment pairs say about each room type: ``queries`` (the number of
     query categories with pairs) and ``positives`` (room type -> how many of them have a
     target above 0 there, i.e. are stated to be found in it)."""
@@ -172,8 +177,8 @@ def room_evidence(containment) -> dict[str, Any]:
             "positives": {n: int(c) for n, c in zip(containment.nodes, counts, strict=True)}}
 
 
-def _report(mlps: dict, encoder: SentenceEncoder, eval_sets, train_sets, held: set[str]
-            ) -> dict[str, Any]:
+def _report(mlps: dict[str, RelationMLP], encoder: SentenceEncoder, eval_sets: SetPair | None,
+            train_sets: SetPair, held: set[str]) -> dict[str, Any]:
     out: dict[str, Any] = {}
     if eval_sets is not None:
         names = {rs.queries[i] for rs in eval_sets for i in np.unique(rs.pairs[:, 1])}
@@ -196,9 +201,9 @@ def write_json_atomic(path: Path, obj: Any) -> None:
 
 def quality_report(
     weights_dir: str | Path,
-    sets: tuple[Any, Any],
+    sets: SetPair,
     encoder: SentenceEncoder | None = None,
-    eval_sets: tuple[Any, Any] | None = None,
+    eval_sets: SetPair | None = None,
 ) -> dict[str, Any]:
     """Recompute the report of the weights in ``weights_dir`` from the files themselves.
 

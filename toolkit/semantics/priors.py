@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import functools
 import json
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Protocol
 
@@ -75,7 +75,10 @@ class _Memo:
     def __init__(self) -> None:
         self._memo: dict[tuple[str, str], dict[str, float]] = {}
 
-    def scores(self, relation: str, names: Sequence[str], query: str, compute) -> np.ndarray:
+    def scores(self, relation: str, names: Sequence[str], query: str,
+               compute: Callable[[Sequence[str], str], np.ndarray]) -> np.ndarray:
+        """Scores of ``names`` for ``query``; ``compute(missing names, query)`` scores those
+        not yet memoised."""
         memo = self._memo.setdefault((relation, query), {})
         missing = sorted({n for n in names if n not in memo})
         if missing:

@@ -15,12 +15,17 @@ Same interface as the frequency classifier of :mod:`sgtool.scenegraph.categories
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from sgtool.semantics.priors import LearnedPriors, default_priors
 from sgtool.semantics.text import category_text
+
+if TYPE_CHECKING:
+    from sgtool.llm.client import ChatClient
+    from sgtool.scenegraph.categories import RoomClassifier
 
 EPS = 1e-3  # floor of p_contains so that one unusual object cannot veto a room
 
@@ -103,9 +108,10 @@ class LlmRoomClassifier:
 
     name = "llm"
 
-    def __init__(self, client: object, room_types: Sequence[str], *,
-                 constraint: str = "auto", fallback: object | None = None,
-                 on_exchange: object | None = None, timeout_s: float = 60.0) -> None:
+    def __init__(self, client: ChatClient, room_types: Sequence[str], *,
+                 constraint: str = "auto", fallback: RoomClassifier | None = None,
+                 on_exchange: Callable[[dict[str, Any]], object] | None = None,
+                 timeout_s: float = 60.0) -> None:
         from sgtool.llm.constraints import check_kind, detect_kind
 
         self.client = client
@@ -122,7 +128,7 @@ class LlmRoomClassifier:
         self.fallback = fallback
         self.on_exchange = on_exchange
         self.timeout_s = float(timeout_s)
-        self.exchanges: list[dict] = []
+        self.exchanges: list[dict[str, Any]] = []
         self._cache: dict[tuple[str, ...], list[tuple[str, float]]] = {}
 
     def classify(self, object_categories: list[str]) -> list[tuple[str, float]]:
@@ -146,8 +152,7 @@ class LlmRoomClassifier:
         constraint = Constraint(self.constraint, self.room_types, bare=True) \
             if self.constraint in ("grammar", "json_schema") else None
         try:
-            r = complete_within(self.client, messages, self.timeout_s,  # type: ignore[arg-type]
-                                constraint)
+            r = complete_within(self.client, messages, self.timeout_s, constraint)
         except ReplayMiss:
             raise  # an offline replay that diverged: no silent fallback
         except LlmTransportError as e:
@@ -168,7 +173,7 @@ class LlmRoomClassifier:
     def _fall_back(self, raw: list[str]) -> list[tuple[str, float]]:
         return list(self.fallback.classify(raw)) if self.fallback is not None else []
 
-    def _log(self, rec: dict) -> None:
+    def _log(self, rec: dict[str, Any]) -> None:
         self.exchanges.append(rec)
         if callable(self.on_exchange):
             self.on_exchange(rec)

@@ -22,10 +22,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from sgtool.semantics.mlp import LAYER_SIZES
+
+if TYPE_CHECKING:
+    import torch
 
 
 @dataclass(frozen=True)
@@ -56,10 +60,13 @@ class TrainResult:
         return self.history[self.best_epoch - 1]["val_loss"] if self.history else math.nan
 
 
-def build_torch_mlp():  # -> torch.nn.Module
+def build_torch_mlp() -> torch.nn.Module:
+    """The torch model of :class:`sgtool.semantics.mlp.RelationMLP` (untrained): the
+    layers of ``LAYER_SIZES`` as ``net.0`` ... ``net.6``, ReLU between them; its forward
+    pass gives logits (n,)."""
     import torch
 
-    layers: list = []
+    layers: list[torch.nn.Module] = []
     for i in range(len(LAYER_SIZES) - 1):
         layers.append(torch.nn.Linear(LAYER_SIZES[i], LAYER_SIZES[i + 1]))
         if i < len(LAYER_SIZES) - 2:
@@ -70,8 +77,9 @@ def build_torch_mlp():  # -> torch.nn.Module
             super().__init__()
             self.net = torch.nn.Sequential(*layers)
 
-        def forward(self, x):  # logits
-            return self.net(x).squeeze(-1)
+        def forward(self, x: torch.Tensor) -> torch.Tensor:  # logits
+            out: torch.Tensor = self.net(x).squeeze(-1)
+            return out
 
     return Net()
 
@@ -126,14 +134,14 @@ def train_relation(
         y_all = torch.from_numpy(targets)
         w_all = torch.from_numpy(weights)
 
-        def inputs(idx: np.ndarray):
+        def inputs(idx: np.ndarray) -> torch.Tensor:
             p = p_all[torch.from_numpy(idx)]
             return torch.cat([nodes[p[:, 0]], queries[p[:, 1]]], dim=1)
 
         model = build_torch_mlp()
         opt = torch.optim.Adam(model.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
 
-        def loss_fn(logits, y, w):
+        def loss_fn(logits: torch.Tensor, y: torch.Tensor, w: torch.Tensor) -> torch.Tensor:
             if loss == "bce":
                 per = torch.nn.functional.binary_cross_entropy_with_logits(
                     logits, y, reduction="none")

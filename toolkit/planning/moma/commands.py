@@ -17,11 +17,14 @@ from __future__ import annotations
 import json
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TypeVar
 
-from sgtool.planning.base import Action
+from sgtool.planning.base import Action, Skill
 from sgtool.planning.candidates import (
     OPEN_AFFORDANCES,
+    NaturalKey,
     distance_to,
     door_is_entrance,
     find_target,
@@ -29,7 +32,7 @@ from sgtool.planning.candidates import (
     object_skill,
 )
 from sgtool.planning.moma.scene_text import EncodedScene, singular
-from sgtool.scenegraph.graph import DoorNode, ObjectNode, SceneGraph
+from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, SceneGraph
 from sgtool.semantics.text import category_text
 
 ARITY = {"navigate": 2, "go_to_and_open": 2, "close": 2, "explore": 1, "done": 0}
@@ -149,8 +152,14 @@ def resolve_room(name: str, scene: EncodedScene) -> str:
     raise InvalidCommand(f"room '{name}' does not exist; rooms are: {known}")
 
 
-def _pick(graph: SceneGraph, nodes: list, prefer) -> str:
-    def key(n) -> tuple:
+_Node = TypeVar("_Node", RegionNode, ObjectNode, DoorNode)
+
+
+def _pick(graph: SceneGraph, nodes: list[_Node], prefer: Callable[[_Node], bool]) -> str:
+    """The id of the node of ``nodes`` that ``prefer`` picks, nearest first, then the
+    first in natural id order."""
+
+    def key(n: _Node) -> tuple[int, float, NaturalKey]:
         d = distance_to(graph, n)
         return (0 if prefer(n) else 1, math.inf if d is None else d, natural_key(n.id))
 
@@ -194,6 +203,10 @@ def resolve_object(graph: SceneGraph, room_id: str, name: str, skill: str,
     return _pick(graph, objs, lambda o: object_skill(o) is not None)
 
 
+# the skill of a command that names an object
+_SKILL_OF: dict[str, Skill] = {"navigate": "navigate", "go_to_and_open": "open", "close": "close"}
+
+
 def ground(cmd: Command, graph: SceneGraph, scene: EncodedScene, query: str) -> Action:
     """The :class:`Action` a parsed command stands for on ``graph``."""
     reason = cmd.reasoning or cmd.analysis
@@ -223,7 +236,7 @@ def ground(cmd: Command, graph: SceneGraph, scene: EncodedScene, query: str) -> 
         raise InvalidCommand(
             f"the {room_name} is unexplored; explore({room_name}) first"
         )
-    skill = {"navigate": "navigate", "go_to_and_open": "open", "close": "close"}[cmd.name]
+    skill = _SKILL_OF[cmd.name]
     target = resolve_object(graph, room_id, cmd.args[1], skill, scene)
     node = graph.node(target)
     if skill == "open" and getattr(node, "state", None) == "open":
@@ -233,4 +246,4 @@ def ground(cmd: Command, graph: SceneGraph, scene: EncodedScene, query: str) -> 
         raise InvalidCommand(f"the {cmd.args[1]} in the {room_name} cannot be opened")
     if skill == "close" and getattr(node, "state", None) != "open":
         raise InvalidCommand(f"the {cmd.args[1]} in the {room_name} is not open")
-    return Action(skill, target=target, reason=reason)  # type: ignore[arg-type]
+    return Action(skill, target=target, reason=reason)

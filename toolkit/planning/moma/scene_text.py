@@ -25,7 +25,7 @@ from collections import Counter
 from dataclasses import dataclass, field
 
 from sgtool.planning.candidates import distance_to, natural_key, node_xy
-from sgtool.scenegraph.graph import ObjectNode, SceneGraph
+from sgtool.scenegraph.graph import ObjectNode, RegionNode, SceneGraph
 from sgtool.semantics.text import category_text
 
 NEAR_ROBOT_M = 2.5
@@ -192,7 +192,7 @@ def room_of(graph: SceneGraph, node_id: str) -> str | None:
     if room is not None:
         return room
     rooms = getattr(n, "rooms", ())
-    explored = [r for r in rooms if (graph.room(r) is not None and graph.room(r).explored)]
+    explored = [r for r in rooms if (rn := graph.room(r)) is not None and rn.explored]
     return (explored or list(rooms) or [None])[0]
 
 
@@ -200,7 +200,8 @@ def nearest_room(graph: SceneGraph, xy: tuple[float, float]) -> str | None:
     """Room of the graph node nearest to ``xy`` (regions and objects, then room centres):
     MoMa-LLM's realignment of a past action's position to the current graph."""
     best: tuple[float, str] | None = None
-    for n in (*graph.regions, *graph.objects):
+    nodes: tuple[RegionNode | ObjectNode, ...] = (*graph.regions, *graph.objects)
+    for n in nodes:
         x, y = node_xy(n)
         d = math.hypot(x - xy[0], y - xy[1])
         if best is None or (d, n.room) < best:
