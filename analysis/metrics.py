@@ -28,8 +28,9 @@ same as the mean curve when every seed has the same episodes).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 
@@ -236,9 +237,13 @@ class PlannerSummary:
     stats: dict[str, Stat]
 
 
-def group_by(results: Sequence[EpisodeResult], key: Callable[[EpisodeResult], object]
-             ) -> dict[object, list[EpisodeResult]]:
-    out: dict[object, list[EpisodeResult]] = {}
+K = TypeVar("K", bound=Hashable)
+
+
+def group_by(results: Sequence[EpisodeResult], key: Callable[[EpisodeResult], K]
+             ) -> dict[K, list[EpisodeResult]]:
+    """``results`` by ``key``, each group in input order, keys in order of first appearance."""
+    out: dict[K, list[EpisodeResult]] = {}
     for r in results:
         out.setdefault(key(r), []).append(r)
     return out
@@ -261,11 +266,11 @@ def summarize(results: Sequence[EpisodeResult], models: Sequence[CostModel] = CO
     for p in order:
         rs = by_planner.get(p, [])
         by_seed = group_by(rs, lambda r: r.seed)
-        seeds = sorted(by_seed)  # type: ignore[type-var]
+        seeds = sorted(by_seed)
         per_seed = [metrics_of(by_seed[s], models) for s in seeds]
         names = list(per_seed[0]) if per_seed else [*METRICS]
         stats = {k: Stat.of([m[k] for m in per_seed]) for k in names}
-        out.append(PlannerSummary(p, len(rs), tuple(int(s) for s in seeds), stats))  # type: ignore[arg-type]
+        out.append(PlannerSummary(p, len(rs), tuple(int(s) for s in seeds), stats))
     return out
 
 
@@ -320,9 +325,9 @@ def breakdown(results: Sequence[EpisodeResult], by: str,
     if by not in ("house", "query"):
         raise ValueError(f"by must be 'house' or 'query', got {by!r}")
     order = list(planners) if planners is not None else planner_order(results)
-    groups = group_by(results, lambda r: (getattr(r, by), r.planner))
+    groups = group_by(results, lambda r: (r.house if by == "house" else r.query, r.planner))
     out = []
-    for key in sorted({k for k, _ in groups}):  # type: ignore[misc]
+    for key in sorted({k for k, _ in groups}):
         for p in order:
             rs = groups.get((key, p))
             if not rs:

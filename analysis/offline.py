@@ -113,7 +113,8 @@ def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
     p = Path(path)
     with LogReader(p) as log:
         stream: list[tuple[int, int, LogRecord]] = []
-        for order, kind in enumerate((SceneGraphRecord, Episode, LoggedAction)):
+        kinds: tuple[type[LogRecord], ...] = (SceneGraphRecord, Episode, LoggedAction)
+        for order, kind in enumerate(kinds):
             for t, rec in log.records(kind):
                 stream.append((t, order, rec))
     # at equal times: the graph first, then opening episode records, then actions, then
@@ -382,9 +383,9 @@ def replay_decisions(planner: Planner, episodes: Sequence[LoggedEpisode],
             else:
                 skipped += 1
             planner.feedback(Feedback(
-                logged, d.action.outcome, executor_message(d.action),  # type: ignore[arg-type]
+                logged, d.action.outcome, executor_message(d.action),
                 float(given(d.action.travelled_m, 0.0))))
-    return OfflineReport(name or getattr(planner, "name", "planner"), tuple(out), skipped)
+    return OfflineReport(name or str(getattr(planner, "name", "planner")), tuple(out), skipped)
 
 
 def format_offline(reports: Sequence[OfflineReport]) -> str:

@@ -104,23 +104,23 @@ def export(
     log_path = Path(log_path)
     rid = hashlib.sha256(log_path.name.encode()).hexdigest()[:32]
     rec = rr.RecordingStream(APP_ID, recording_id=rid, send_properties=False)
-    target = contextlib.nullcontext(None) if spawn or rrd_path is None \
-        else atomic_output(rrd_path)
+    out = None if spawn or rrd_path is None else Path(rrd_path)
+    target = contextlib.nullcontext(None) if out is None else atomic_output(out)
     with target as tmp:
         if spawn:
             rec.spawn()
-        elif tmp is not None:
-            require_space(Path(rrd_path))  # type: ignore[arg-type]
+        elif out is not None and tmp is not None:
+            require_space(out)
             rec.save(tmp)
-            progress = _watching_space(Path(rrd_path), progress)  # type: ignore[arg-type]
+            progress = _watching_space(out, progress)
         with LogReader(log_path, verify=True) as r:  # a damaged chunk: one line, no .rrd
             _export(rec, r, every=every, max_frames=max_frames, progress=progress,
                     voxels=voxels)
         rec.flush(timeout_sec=FLUSH_TIMEOUT_S)
-        if tmp is not None:
-            require_space(Path(rrd_path))  # type: ignore[arg-type]
+        if out is not None and tmp is not None:
+            require_space(out)
         rec.disconnect()
-    return Path(rrd_path) if rrd_path is not None and not spawn else None
+    return out
 
 
 def _watching_space(rrd_path: Path, progress: Callable[[int], None] | None

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import asdict
+from functools import partial
 
 from sgtool.house.spec import HouseSpec
 from sgtool.scenegraph.builder import MapLayers
@@ -44,19 +45,20 @@ def score(spec: HouseSpec, instances: Mapping[int, InstanceInfo], layers: MapLay
     """``{"strict": Quality, "merged": Quality}`` of ``graph`` (module doc)."""
     rooms_by_spec = ({f.id: f.room for f in spec.furniture}
                      | {o.id: o.room for o in spec.objects})
-    object_gt = {}
+    object_gt: dict[str, str] = {}
     for o in graph.objects:
         info = instances.get(o.instance)
         if info is not None and info.spec_id in rooms_by_spec:
             object_gt[o.id] = rooms_by_spec[info.spec_id]
-    args = dict(
+    of_graph = partial(
+        evaluate,
         node_xy=layers.voronoi.positions, node_rooms=layers.node_rooms,
         room_categories={r.id: r.category for r in graph.rooms if r.explored},
         object_rooms={o.id: o.room for o in graph.objects}, object_gt=object_gt,
         polygons={r.id: r.polygon for r in spec.rooms},
         gt_categories={r.id: r.category for r in spec.rooms},
     )
-    return {"strict": evaluate(**args), "merged": evaluate(**args, merge=passage_groups(spec))}
+    return {"strict": of_graph(), "merged": of_graph(merge=passage_groups(spec))}
 
 
 def score_lines(scores: Mapping[str, Quality]) -> list[str]:

@@ -440,8 +440,7 @@ def drift_where_known(estimated: Sequence[np.ndarray],
                       reference: Sequence[np.ndarray | None]) -> DriftReport | None:
     """The drift of ``estimated`` against the frames that have a ``reference`` pose (None:
     that frame has none); None when fewer than two have one."""
-    known = [i for i, p in enumerate(reference) if p is not None]
+    known = [(i, p) for i, p in enumerate(reference) if p is not None]
     if len(known) < 2:
         return None
-    return drift_against([estimated[i] for i in known],
-                         [reference[i] for i in known])  # type: ignore[misc]
+    return drift_against([estimated[i] for i, _ in known], [p for _, p in known])

@@ -199,7 +199,8 @@ class PinholeParams:
     source: str = ""
 
 
-def checked_pinhole(fx: float, fy: float, cx: float, cy: float, what: str, **kw: object
+def checked_pinhole(fx: float, fy: float, cx: float, cy: float, what: str, *,
+                    width: int | None = None, height: int | None = None, source: str = ""
                     ) -> PinholeParams:
     """``PinholeParams`` whose numbers are finite, with fx, fy > 0 and cx, cy >= 0 (inside
     the image: checked against its size by the importer); a user error naming ``what``."""
@@ -211,7 +212,8 @@ def checked_pinhole(fx: float, fy: float, cx: float, cy: float, what: str, **kw:
         raise SgtoolError(f"{what}: intrinsics fx,fy,cx,cy = {','.join(f'{v:g}' for v in vals)}: "
                           "focal lengths must be positive and the principal point inside the "
                           "image")
-    return PinholeParams(float(fx), float(fy), float(cx), float(cy), **kw)  # type: ignore[arg-type]
+    return PinholeParams(float(fx), float(fy), float(cx), float(cy), width=width,
+                         height=height, source=source)
 
 
 def read_intrinsics_file(path: Path) -> PinholeParams:

@@ -84,7 +84,7 @@ from sgtool.house.spec import HouseSpec
 from sgtool.log.records import Episode as LoggedEpisode
 from sgtool.log.records import LlmExchange
 from sgtool.log.writer import LogWriter
-from sgtool.planning.base import Action, Feedback, Planner
+from sgtool.planning.base import Action, Feedback, Outcome, Planner
 from sgtool.planning.candidates import Candidate, actionable, find_target
 from sgtool.planning.episode import (
     NOT_CONFIRMED,
@@ -308,6 +308,7 @@ class _Search:
         assert cur is not None
         plan = plan_skills(cur.graph, action)
         cut = False
+        o: Outcome
         if plan.done and action.target is None and self.fallback is not None and \
                 self.fallback.can_explore():
             return self._give_up_handed_over(action, cur.graph)
@@ -325,7 +326,7 @@ class _Search:
         self.last_t = self.rec.act(self.sim, outcome, self._decision_s,
                                    {"graph_time_ns": self._graph_time_ns})
         self._check(self.rec.stream.current, cut)  # found overrides a done
-        return Feedback(action, o, why, dist)  # type: ignore[arg-type]
+        return Feedback(action, o, why, dist)
 
     def _give_up_handed_over(self, action: Action, graph: SceneGraph) -> Feedback:
         """The planner gave up but the robot's map has reachable frontiers: the give-up is

@@ -6,6 +6,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from sgtool.planning.base import Outcome
+
 if TYPE_CHECKING:
     from sgtool.recorders.sim.simulation import Simulation
 
@@ -20,7 +22,7 @@ class SkillOutcome:
 
     skill: str
     target: str | None
-    outcome: str  # success | failure | invalid
+    outcome: Outcome
     reason: str = ""
     travelled_m: float = 0.0
     ticks: int = 0

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sgtool.planning.base import Outcome
 from sgtool.recorders.sim.events import StopSimulation
 from sgtool.recorders.sim.live_skills import Goal, LiveSkills, goal_of_node
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome
@@ -25,7 +26,7 @@ from sgtool.scenegraph.stream import Refresh
 
 @dataclass(frozen=True)
 class Executed:
-    outcome: str
+    outcome: Outcome
     reason: str
     travelled_m: float
     ticks: int
@@ -54,7 +55,8 @@ def execute_live(sim: Simulation, skills: LiveSkills, calls: Sequence[SkillCall]
     """Run ``calls`` with the robot's skills on its own map; ``decided`` is the refresh
     the planner decided on (its graph names the nodes of the calls)."""
     t0, d0 = sim.tick_index, sim.travelled_m
-    outcome, reason = "success", ""
+    outcome: Outcome = "success"
+    reason = ""
     try:
         for c in calls:
             if c.skill == "look_around":

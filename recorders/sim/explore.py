@@ -20,6 +20,7 @@ the same run.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -103,7 +104,7 @@ def _nearest_room(sim: Simulation, rooms: list[str]) -> str | None:
 
 
 def _go_to_room(sim: Simulation, room: str, opts: ScriptOptions, rep: ExplorationReport,
-                do) -> str | None:  # type: ignore[no-untyped-def]
+                do: Callable[[SkillOutcome], SkillOutcome]) -> str | None:
     """Navigate to ``room``, opening the closed doors in the way; None on arrival, else
     the reason it failed."""
     for _ in range(opts.max_door_attempts + 1):
@@ -125,7 +126,7 @@ def _go_to_room(sim: Simulation, room: str, opts: ScriptOptions, rep: Exploratio
 
 
 def _open_containers(sim: Simulation, room: str, rep: ExplorationReport,
-                     do) -> None:  # type: ignore[no-untyped-def]
+                     do: Callable[[SkillOutcome], SkillOutcome]) -> None:
     """Open every closed openable container of ``room``, nearest (straight line) first."""
     todo = [f for f in sim.spec.furniture
             if f.room == room and f.is_openable and sim.states.get(f.id) == "closed"]

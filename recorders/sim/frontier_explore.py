@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -35,25 +36,31 @@ from sgtool.recorders.sim.events import SimObserver, SkillOutcome
 from sgtool.recorders.sim.live_skills import Goal, LiveSkills, frontier_points
 from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 
+if TYPE_CHECKING:
+    from sgtool.recorders.sim.recording import LogRecorder
+
 
 class LiveMap(SimObserver):
     """Feeds the stream what ``recorder`` writes (frames as logged, instance tables), after
     the recorder in the observers; ``on_refresh`` hears of every refresh."""
 
-    def __init__(self, recorder: object, stream: SceneGraphStream,
+    def __init__(self, recorder: LogRecorder, stream: SceneGraphStream,
                  on_refresh: Callable[[Refresh], None] | None = None) -> None:
         self.recorder = recorder
         self.stream = stream
         self.on_refresh = on_refresh
 
     def on_tick(self, sim: object) -> None:
-        r = self.stream.frame(as_logged(self.recorder.last_frame))  # type: ignore[attr-defined]
+        frame = self.recorder.last_frame
+        assert frame is not None, "the recorder, before this observer, wrote the tick's frame"
+        r = self.stream.frame(as_logged(frame))
         if r is not None and self.on_refresh is not None:
             self.on_refresh(r)
 
     def on_state(self, sim: object, spec_id: str, state: str) -> None:
         rec = self.recorder
-        self.stream.instances(rec.last_time_ns, rec.last_instances)  # type: ignore[attr-defined]
+        assert rec.last_instances is not None, "the recorder wrote the new instance table"
+        self.stream.instances(rec.last_time_ns, rec.last_instances)
 
 
 @dataclass

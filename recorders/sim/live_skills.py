@@ -39,6 +39,7 @@ from sgtool.mapping.live_paths import (
     traversable,
 )
 from sgtool.mapping.occupancy import OccupancyMap, geodesic_distances
+from sgtool.planning.base import Outcome
 from sgtool.recorders.sim import navigation as nav
 from sgtool.recorders.sim.events import SkillOutcome
 from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode
@@ -192,7 +193,7 @@ class LiveSkills:
         return point_goal(occ, dist, goal.points[0], cfg.snap)
 
     # ----- skills -----------------------------------------------------------------------
-    def navigate(self, goal: Goal) -> tuple[str, str, float]:
+    def navigate(self, goal: Goal) -> tuple[Outcome, str, float]:
         """Drive to ``goal``, re-planning at every map refresh: (outcome, reason, metres)."""
         body, cfg = self.body, self.config
         step = body.config.speed / body.fps
@@ -240,7 +241,7 @@ class LiveSkills:
         return ("failure", f"{goal.label} not reached after {cfg.max_replans} re-plans",
                 driven)
 
-    def explore(self, goal: Goal) -> tuple[str, str, float]:
+    def explore(self, goal: Goal) -> tuple[Outcome, str, float]:
         """Go to ``goal`` and look around there."""
         o, why, d = self.navigate(goal)
         if o == "success":

@@ -254,7 +254,8 @@ def _explore_live(sim: Simulation, rec: LogRecorder, opts: RecordOptions,
                                                             opts.camera.height),
                               voxel_size=0.05, max_frames=None)
     stream = SceneGraphStream(None, None, builder_config(mapping))
-    stream.instances(0, rec.last_instances)  # type: ignore[arg-type]
+    assert rec.last_instances is not None, "record_house writes the instance table first"
+    stream.instances(0, rec.last_instances)
 
     def sample(r: Refresh) -> None:
         if r.layers is not None:

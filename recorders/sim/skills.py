@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from sgtool.mapping.occupancy import astar, geodesic_distances, nearest_free_cell
+from sgtool.planning.base import Outcome
 from sgtool.recorders.sim import articulation as art
 from sgtool.recorders.sim import navigation as nav
 from sgtool.recorders.sim.build import set_panel
@@ -57,9 +58,12 @@ class Skills:
         def _change_state(self, sid: str, state: str) -> None: ...
 
     def _report(self, outcome: SkillOutcome) -> SkillOutcome:
+        from sgtool.recorders.sim.simulation import Simulation  # the class this is mixed into
+
+        assert isinstance(self, Simulation)
         if self._depth == 0:
             for o in self.observers:
-                o.on_skill(self, outcome)  # type: ignore[arg-type]
+                o.on_skill(self, outcome)
         return outcome
 
     def _step(self) -> float:
@@ -79,7 +83,7 @@ class Skills:
         if isinstance(r, str):
             return self._report(SkillOutcome("navigate", label, "invalid", r))
         dist, reason = self._go_to(r)
-        outcome = "success" if reason is None else "failure"
+        outcome: Outcome = "success" if reason is None else "failure"
         return self._report(SkillOutcome("navigate", label, outcome, reason or "", dist,
                                          self.tick_index - t0))
 
@@ -127,12 +131,13 @@ class Skills:
 
     def _closed_doors_towards(self, r: Resolved) -> list[str] | None:
         occ = self.occupancy(doors_passable=True)
-        goal: tuple[float, float] | None = r.point
+        goal = r.point
         if r.kind == "room":
             geo = geodesic_distances(occ, self.base[:2])
-            goal = nav.room_viewpoint(occ, geo, self.spec.room(r.label))
-            if goal is None:
+            viewpoint = nav.room_viewpoint(occ, geo, self.spec.room(r.label))
+            if viewpoint is None:
                 return None
+            goal = viewpoint
         path = astar(occ, self.base[:2], goal, max_snap=1.5)
         if path is None:
             return None

@@ -61,6 +61,7 @@ def resolve_instance(spec: HouseSpec, inst: Instance,
                      base: tuple[float, float, float]) -> Resolved | str:
     label = inst.spec_id or f"{inst.category} {inst.id}"
     sid = inst.spec_id
+    front: art.Box2 | None
     if inst.kind == DOOR and sid:
         d = next(d for d in spec.doors if d.id == sid)
         box = (d.center[0], d.center[1], d.width, d.thickness, d.yaw)

@@ -53,7 +53,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sgtool.planning.base import Action, Feedback
+from sgtool.planning.base import Action, Feedback, Outcome
 from sgtool.recorders.symbolic_environment.house import SymbolicHouse
 from sgtool.recorders.symbolic_environment.observation import ObservedGraph
 from sgtool.scenegraph.graph import SceneGraph
@@ -265,9 +265,9 @@ class SymbolicEnv:
         feedback only."""
         return self.step(action).feedback
 
-    def _outcome(self, action: Action, outcome: str, message: str, travelled: float = 0.0,
+    def _outcome(self, action: Action, outcome: Outcome, message: str, travelled: float = 0.0,
             opened: bool = False) -> StepOutcome:
-        return StepOutcome(Feedback(action, outcome, message, travelled), opened)  # type: ignore[arg-type]
+        return StepOutcome(Feedback(action, outcome, message, travelled), opened)
 
     def _execute(self, a: Action) -> StepOutcome:
         h = self.house
@@ -297,18 +297,19 @@ class SymbolicEnv:
             n = len(h.regions[reg].furniture)
             return self._outcome(a, "success", f"entered {h.room_names[i]}: {n} objects in view", d)
         if kind == "region":
-            reg = h.regions[i]
+            region = h.regions[i]
             if skill in ("open", "close"):
                 return self._outcome(a, "invalid", f"cannot {skill} a region")
-            if not math.isfinite(dist[reg.place]):
+            if not math.isfinite(dist[region.place]):
                 return self._outcome(a, "failure", f"{a.target} cannot be reached")
             if i in self.revealed_regions:
                 if skill == "explore":
                     return self._outcome(a, "failure", f"{a.target} is already explored")
-                return self._outcome(a, "success", f"at {a.target}", self._move(reg.place, dist))
-            d = self._move(reg.place, dist)
+                return self._outcome(a, "success", f"at {a.target}",
+                                     self._move(region.place, dist))
+            d = self._move(region.place, dist)
             self._reveal_region(i)
-            return self._outcome(a, "success", f"{len(reg.furniture)} objects in view", d)
+            return self._outcome(a, "success", f"{len(region.furniture)} objects in view", d)
         if kind == "door":
             place = self._door_place(i, dist)
             if not math.isfinite(dist[place]):

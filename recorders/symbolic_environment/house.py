@@ -80,7 +80,7 @@ class SymbolicHouse:
         self._obj_nodes: dict[tuple[int, str | None, bool], ObjectNode] = {}
         # one position tuple per item, shared by the nodes of its states (so a planner's
         # per-episode object table sees a state change as the same row)
-        self._positions: dict[tuple[str, int], tuple[float, ...]] = {}
+        self._positions: dict[tuple[str, int], tuple[float, float, float]] = {}
         self._walkable_rooms()
         self.places: list[tuple[float, float]] = []
         self.place_room: list[int] = []
@@ -273,18 +273,20 @@ class SymbolicHouse:
                 id=self.furn_node_id(f), category=self.furn_cat[f],
                 parent=self.regions[self.region_of_furn[f]].id,
                 room=self.room_ids[self.room_index[fu.room]],
-                position=self._position("furn", f, fu.center),  # type: ignore[arg-type]
+                position=self._position("furn", f, fu.center),
                 instance=f + 1, state=state,  # type: ignore[arg-type]
                 affordances=tuple(sorted(affs)), explored=explored,
             )
             self._furn_nodes[key] = node
         return node
 
-    def _position(self, kind: str, k: int, xyz: tuple[float, ...]) -> tuple[float, ...]:
+    def _position(self, kind: str, k: int, xyz: tuple[float, float, float]
+                  ) -> tuple[float, float, float]:
         key = (kind, k)
         pos = self._positions.get(key)
         if pos is None:
-            pos = self._positions[key] = tuple(float(v) for v in xyz)
+            x, y, z = xyz
+            pos = self._positions[key] = (float(x), float(y), float(z))
         return pos
 
     def parent_node_id(self, j: int) -> str:
@@ -308,7 +310,7 @@ class SymbolicHouse:
                 id=self.obj_node_id(j), category=self.obj_cat[j],
                 parent=self.parent_node_id(j),
                 room=self.room_ids[self.room_index[o.room]],
-                position=self._position("obj", j, o.position),  # type: ignore[arg-type]
+                position=self._position("obj", j, o.position),
                 instance=len(self.spec.furniture) + 1 + j, relation=o.relation,  # type: ignore[arg-type]
                 state=state, affordances=tuple(sorted(affs)),  # type: ignore[arg-type]
                 explored=explored,

@@ -100,7 +100,7 @@ def run_episode(house: SymbolicHouse, planner: Planner, query: str, targets: Seq
     ``region:<room>.<k>``) fixes the start instead of drawing it. ``success`` is the
     success rule (:func:`sgtool.planning.episode.search_success`: ``observed`` or ``done``).
     """
-    name = planner_name or getattr(planner, "name", "planner")
+    name = planner_name or str(getattr(planner, "name", "planner"))
     hid = house_id or f"house-{house.spec.seed}"
     env = SymbolicEnv(house, query, seed=seed, episode_index=episode_index,
                       avoid_rooms=avoid_rooms, max_steps=max_steps, start_region=start_region)

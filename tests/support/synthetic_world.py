@@ -213,7 +213,7 @@ def world_of_house(spec: Any, panel_thickness: float = 0.05) -> HouseWorld:
         spec_ids[dr.id] = nxt
         nxt += 1
     for f in spec.furniture:
-        boxes.append(Box(tuple(f.center), tuple(f.size), nxt, f.yaw))  # type: ignore[arg-type]
+        boxes.append(Box(f.center, f.size, nxt, f.yaw))
         spec_ids[f.id] = nxt
         infos.append(InstanceInfo(nxt, f.category, "furniture", state=f.state,
                                   affordances=tuple(f.affordances), synset=f.synset,
@@ -223,7 +223,7 @@ def world_of_house(spec: Any, panel_thickness: float = 0.05) -> HouseWorld:
     for ob in spec.objects:
         parent = furn.get(ob.parent)
         yaw = parent.yaw if parent is not None else 0.0
-        boxes.append(Box(tuple(ob.position), tuple(ob.size), nxt, yaw))  # type: ignore[arg-type]
+        boxes.append(Box(ob.position, ob.size, nxt, yaw))
         spec_ids[ob.id] = nxt
         infos.append(InstanceInfo(nxt, ob.category, "object", synset=ob.synset,
                                   parent=spec_ids.get(ob.parent), relation=ob.relation,
