@@ -368,7 +368,9 @@ def replay_decisions(planner: Planner, episodes: Sequence[LoggedEpisode],
         for step, d in enumerate(ep.decisions):
             if not d.decided:
                 continue
-            logged = Action(d.action.skill, given(d.action.target))
+            # a logged skill need not be a planner Skill (a recorded tour logs look_around,
+            # a LoggedSkill; the schema admits any string): compared and fed back as logged
+            logged = Action(d.action.skill, given(d.action.target))  # type: ignore[arg-type]
             if d.graph is not None:
                 t0 = time.perf_counter()
                 chosen = planner.decide(d.graph)

@@ -54,7 +54,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sgtool.planning.base import Action, Feedback, Outcome
-from sgtool.recorders.symbolic_environment.house import SymbolicHouse
+from sgtool.recorders.symbolic_environment.house import SymbolicHouse, spec_state
 from sgtool.recorders.symbolic_environment.observation import ObservedGraph
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.semantics.text import category_text
@@ -93,8 +93,8 @@ class SymbolicEnv:
         self.end_reason = ""
         # dynamic state
         self.open_doors: set[int] = set(house.initially_open())
-        self.furn_state: list[str | None] = [f.state for f in self.spec.furniture]
-        self.obj_state: list[str | None] = [o.state for o in self.spec.objects]
+        self.furn_state = [spec_state(f.state) for f in self.spec.furniture]
+        self.obj_state = [spec_state(o.state) for o in self.spec.objects]
         self.furn_explored: set[int] = set()  # contents revealed (looked at, not closed)
         self.obj_explored: set[int] = set()
         self.seen_objects: set[int] = set()

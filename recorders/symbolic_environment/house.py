@@ -27,6 +27,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 from scipy import ndimage
@@ -44,8 +45,28 @@ from sgtool.mapping.occupancy import (
 from sgtool.recorders.symbolic_environment.regions import cluster_regions
 from sgtool.scenegraph.graph import ObjectNode
 from sgtool.semantics.text import category_text
+from sgtool.vocabulary import OPEN_STATES, RELATIONS, OpenState, Relation
 
 _EXAMINE = "examine"
+_V = TypeVar("_V", bound=str)
+
+
+def _member(value: str, allowed: tuple[_V, ...]) -> _V:
+    """``value`` as the member of ``allowed`` it equals; ValueError for any other."""
+    for a in allowed:
+        if a == value:
+            return a
+    raise ValueError(f"{value!r} is not one of {', '.join(allowed)}")
+
+
+def spec_state(state: str | None) -> OpenState | None:
+    """A house spec's ``state`` (the parser admits "open", "closed" or none) as typed."""
+    return None if state is None else _member(state, OPEN_STATES)
+
+
+def spec_relation(relation: str) -> Relation:
+    """A house spec's ``relation`` (the parser admits "inside" or "ontop") as typed."""
+    return _member(relation, RELATIONS)
 
 
 @dataclass(frozen=True)
@@ -76,8 +97,8 @@ class SymbolicHouse:
         self.room_names = tuple(category_text(r.category) for r in spec.rooms)
         self.furn_cat = tuple(category_text(f.category) for f in spec.furniture)
         self.obj_cat = tuple(category_text(o.category) for o in spec.objects)
-        self._furn_nodes: dict[tuple[int, str | None, bool], ObjectNode] = {}
-        self._obj_nodes: dict[tuple[int, str | None, bool], ObjectNode] = {}
+        self._furn_nodes: dict[tuple[int, OpenState | None, bool], ObjectNode] = {}
+        self._obj_nodes: dict[tuple[int, OpenState | None, bool], ObjectNode] = {}
         # one position tuple per item, shared by the nodes of its states (so a planner's
         # per-episode object table sees a state change as the same row)
         self._positions: dict[tuple[str, int], tuple[float, float, float]] = {}
@@ -260,7 +281,7 @@ class SymbolicHouse:
             self._rows[key] = row
         return row
 
-    def furniture_node(self, f: int, state: str | None, explored: bool) -> ObjectNode:
+    def furniture_node(self, f: int, state: OpenState | None, explored: bool) -> ObjectNode:
         """The node of furniture ``f`` in a given state (memoised: nodes are frozen)."""
         key = (f, state, explored)
         node = self._furn_nodes.get(key)
@@ -274,7 +295,7 @@ class SymbolicHouse:
                 parent=self.regions[self.region_of_furn[f]].id,
                 room=self.room_ids[self.room_index[fu.room]],
                 position=self._position("furn", f, fu.center),
-                instance=f + 1, state=state,  # type: ignore[arg-type]
+                instance=f + 1, state=state,
                 affordances=tuple(sorted(affs)), explored=explored,
             )
             self._furn_nodes[key] = node
@@ -295,7 +316,8 @@ class SymbolicHouse:
         f = self.furn_index.get(parent)
         return self.furn_node_id(f) if f is not None else self.obj_node_id(self.obj_index[parent])
 
-    def object_node(self, j: int, state: str | None = None, explored: bool = False) -> ObjectNode:
+    def object_node(self, j: int, state: OpenState | None = None,
+                    explored: bool = False) -> ObjectNode:
         """The node of small object ``j`` (nested in its parent) in ``state`` (an openable
         object's; None for others). An object without affordances has the node of house
         spec 1; a container or openable one lists them (with "examine" for a container)."""
@@ -311,8 +333,8 @@ class SymbolicHouse:
                 parent=self.parent_node_id(j),
                 room=self.room_ids[self.room_index[o.room]],
                 position=self._position("obj", j, o.position),
-                instance=len(self.spec.furniture) + 1 + j, relation=o.relation,  # type: ignore[arg-type]
-                state=state, affordances=tuple(sorted(affs)),  # type: ignore[arg-type]
+                instance=len(self.spec.furniture) + 1 + j, relation=spec_relation(o.relation),
+                state=state, affordances=tuple(sorted(affs)),
                 explored=explored,
             )
             self._obj_nodes[key] = node
