@@ -42,7 +42,7 @@ def redact_options(options: Any) -> Any:
     return options
 
 
-def secret_values(options: Any) -> list[str]:
+def secret_values(options: object) -> list[str]:
     """The values of the keys named like secrets in ``options``, at any depth."""
     out: list[str] = []
     if isinstance(options, Mapping):

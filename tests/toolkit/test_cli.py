@@ -5,10 +5,12 @@ script's ``main`` and through click's own standalone mode; --help is unchanged."
 
 from __future__ import annotations
 
+import click
 import pytest
 from click.testing import CliRunner
 
-from sgtool.cli import cli, main
+from sgtool.cli import Interrupted, Killed, LazyGroup, cli, main
+from sgtool.errors import Terminated
 
 CASES = [
     (["import", "rgbd", "{d}", "-o", "{d}/x.mcap", "--every", "abc"],
@@ -52,3 +54,34 @@ def test_help_is_unchanged(capsys):
     r = CliRunner().invoke(cli, ["import"], prog_name="sgtool")  # a group alone: its help
     assert r.output.startswith("Usage: sgtool import [OPTIONS] COMMAND [ARGS]...")
     assert "Commands:" in r.output and "error" not in r.output
+
+
+class _OneCommand(LazyGroup):
+    """A group whose one command ``go`` raises ``exc``."""
+
+    def __init__(self, exc: BaseException) -> None:
+        super().__init__(name="sgtool")
+        self.exc = exc
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return ["go"]
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command:
+        exc = self.exc
+
+        @click.command("go")
+        def go() -> None:
+            raise exc
+
+        return go
+
+
+@pytest.mark.parametrize("exc, kind, code", [(KeyboardInterrupt(), Interrupted, 130),
+                                             (Terminated(), Killed, 143)])
+def test_an_interrupt_is_one_line_with_its_exit_code(capsys, exc, kind, code):
+    with pytest.raises(Interrupted) as e:
+        _OneCommand(exc).main(["go"], standalone_mode=False)
+    assert type(e.value) is kind and e.value.exit_code == code
+    assert Interrupted.exit_code == 130  # a kill does not change the Ctrl-C code
+    e.value.show()
+    assert capsys.readouterr().err == "sgtool: interrupted; no output was left half-written\n"

@@ -23,7 +23,7 @@ _V2_FURNITURE_FIELDS = ("levels",)
 _V2_OBJECT_FIELDS = ("affordances", "state")
 
 
-def upgrade(d: Any) -> Mapping[str, Any]:
+def upgrade(d: object) -> Mapping[str, Any]:
     """The document ``d`` as a document of the current version (``d`` itself when it is
     one); raises :class:`SpecError` for a version that is not exactly one of
     :data:`KNOWN_VERSIONS` (``"2"``, ``"2.7"``, ``"2.banana"``, ``2.0``) or a version-1

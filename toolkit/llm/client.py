@@ -214,7 +214,7 @@ class OpenAIChatClient:
         )
 
 
-def reply_text(resp: Any, where: str = "the endpoint") -> str:
+def reply_text(resp: object, where: str = "the endpoint") -> str:
     """``choices[0].message.content`` of a chat reply (an object or plain dicts), or a
     :class:`LlmTransportError` naming what is missing."""
     choices = _field(resp, "choices")

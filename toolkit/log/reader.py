@@ -325,22 +325,29 @@ class LogReader:
             )
 
     @overload
-    def records(self, kind: type[R], **kw: Any) -> Iterator[tuple[int, R]]: ...
+    def records(self, kind: type[R], *, start_ns: int | None = None, end_ns: int | None = None,
+                reverse: bool = False) -> Iterator[tuple[int, R]]: ...
 
     @overload
-    def records(self, kind: RecordName, **kw: Any) -> Iterator[tuple[int, dict[str, Any]]]: ...
+    def records(self, kind: RecordName, *, start_ns: int | None = None,
+                end_ns: int | None = None, reverse: bool = False
+                ) -> Iterator[tuple[int, dict[str, Any]]]: ...
 
-    def records(self, kind: type[LogRecord] | RecordName, **kw: Any) -> Iterator[tuple[int, Any]]:
+    def records(self, kind: type[LogRecord] | RecordName, *, start_ns: int | None = None,
+                end_ns: int | None = None, reverse: bool = False
+                ) -> Iterator[tuple[int, LogRecord | dict[str, Any]]]:
         """(log time, record) of one sgtool JSON channel, in time order, each checked
         against its schema (:mod:`sgtool.log.records`: a missing or mistyped field is a
         :class:`LogFormatError` naming the channel, the record and the field). ``kind`` a
         record type (``Episode``) gives typed records; a kind name (``"episode"``) gives
-        the checked JSON dicts. ``kw``: the time range of :meth:`messages`."""
+        the checked JSON dicts. ``start_ns``, ``end_ns``, ``reverse``: as in
+        :meth:`messages`."""
         rtype = RECORD_TYPES[kind] if isinstance(kind, str) else kind
         if not self.has(rtype.channel().topic):
             return
-        for i, d in enumerate(self.messages([rtype.channel().topic], **kw)):
-            index = None if kw.get("reverse") else i
+        for i, d in enumerate(self.messages([rtype.channel().topic], start_ns=start_ns,
+                                            end_ns=end_ns, reverse=reverse)):
+            index = None if reverse else i
             rec = rtype.from_json(
                 d.message, where=f"{self.path}: {rtype.describe(index, d.log_time_ns)}")
             yield d.log_time_ns, (d.message if isinstance(kind, str) else rec)
@@ -351,7 +358,8 @@ class LogReader:
     @overload
     def last_record(self, kind: RecordName, at_ns: int | None = None) -> dict[str, Any] | None: ...
 
-    def last_record(self, kind: type[LogRecord] | RecordName, at_ns: int | None = None) -> Any:
+    def last_record(self, kind: type[LogRecord] | RecordName, at_ns: int | None = None
+                    ) -> LogRecord | dict[str, Any] | None:
         """The last record of a channel (at or before ``at_ns``), checked as
         :meth:`records`; None when there is none."""
         end = None if at_ns is None else at_ns + 1
@@ -502,5 +510,5 @@ class LogReader:
     def __enter__(self) -> LogReader:
         return self
 
-    def __exit__(self, *exc: Any) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()

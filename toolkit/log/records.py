@@ -95,7 +95,7 @@ _JSON_TYPES: dict[str, tuple[type, ...]] = {
 }
 
 
-def _json_type(v: Any) -> str:
+def _json_type(v: object) -> str:
     if isinstance(v, bool):
         return "boolean"
     for name in ("null", "string", "integer", "number", "object", "array"):
@@ -104,13 +104,14 @@ def _json_type(v: Any) -> str:
     return type(v).__name__
 
 
-def _is(v: Any, t: str) -> bool:
+def _is(v: object, t: str) -> bool:
     if isinstance(v, bool) and t in ("number", "integer"):
         return False
     return isinstance(v, _JSON_TYPES[t])
 
 
-def schema_problem(value: Any, schema: Mapping[str, Any], path: str = "") -> tuple[str, str] | None:
+def schema_problem(value: object, schema: Mapping[str, Any], path: str = ""
+                   ) -> tuple[str, str] | None:
     """The first (field path, problem) of ``value`` against ``schema``; None when it fits."""
     enum = schema.get("enum")
     if enum is not None and not any(value == e and type(value) is type(e) for e in enum):
@@ -192,7 +193,7 @@ class LogRecord(JsonRecord):
         return cls.channel().schema
 
     @classmethod
-    def check(cls, d: Any, where: str) -> None:
+    def check(cls, d: object, where: str) -> None:
         """Raise :class:`LogFormatError` naming ``where`` and the field when ``d`` is not a
         valid JSON form of this record type."""
         p = schema_problem(d, cls.json_schema())
@@ -213,9 +214,10 @@ class LogRecord(JsonRecord):
         return out
 
     @classmethod
-    def from_json(cls: type[R], d: Any, *, where: str = "") -> R:
+    def from_json(cls: type[R], d: object, *, where: str = "") -> R:
         """The record of a JSON object; :class:`LogFormatError` when it is not valid."""
         cls.check(d, where or cls.describe())
+        assert isinstance(d, Mapping)  # checked: every record schema is a JSON object
         return cls._build(d)
 
     def checked_json(self, where: str = "") -> dict[str, Any]:

@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -35,6 +35,9 @@ from sgtool.planning.moma.scene_text import room_names
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.semantics.llm_knowledge import extract_json
 from sgtool.semantics.text import category_text
+
+if TYPE_CHECKING:
+    from sgtool.planning.godhs import Ranker
 
 SYSTEM = ("You are a robot searching a house for an object. Answer only with JSON, no prose.")
 TIMEOUT_S = 60.0
@@ -64,9 +67,11 @@ def read_likelihoods(text: str, names: Sequence[str]) -> dict[str, float] | None
     out: dict[str, float] = {}
     for n in names:
         v = by_words.get(category_text(n))
+        if not isinstance(v, (int, float, str)):  # a JSON value that is no number or text
+            continue
         try:
-            p = float(v)  # type: ignore[arg-type]
-        except (TypeError, ValueError):
+            p = float(v)
+        except ValueError:
             continue
         if math.isfinite(p):
             out[n] = min(max(p, 0.0), 1.0)
@@ -76,7 +81,7 @@ def read_likelihoods(text: str, names: Sequence[str]) -> dict[str, float] | None
 class LlmRanker:
     """Rooms and carriers ranked by an LLM (module doc)."""
 
-    def __init__(self, client: ChatClient, fallback: Any | None = None,
+    def __init__(self, client: ChatClient, fallback: Ranker | None = None,
                  transcript: str | Path | None = None) -> None:
         self.client = client
         self.fallback = fallback

@@ -67,7 +67,7 @@ def assemble_graph(parts: GraphParts, robot: RobotState, instances: Mapping[int,
         if room is None:
             continue
         region_nodes.append(RegionNode(id=fid, room=room, position=f.medoid,
-                                       kind="frontier", frontier_type=f.type,  # type: ignore[arg-type]
+                                       kind="frontier", frontier_type=f.type,
                                        size=f.size))
     object_nodes = []
     for o in parts.objects:
@@ -82,7 +82,7 @@ def assemble_graph(parts: GraphParts, robot: RobotState, instances: Mapping[int,
             explored=info.state != "closed",
         ))
     door_nodes = [DoorNode(
-        id=f"door:{d.instance}", position=d.position, state=d.state,  # type: ignore[arg-type]
+        id=f"door:{d.instance}", position=d.position, state=d.state,
         rooms=tuple(sorted(d.rooms + ((d.unexplored_room,) if d.unexplored_room else ()))),
         instance=d.instance) for d in parts.doors]
     return SceneGraph(robot=robot, rooms=tuple(parts.rooms), regions=tuple(region_nodes),

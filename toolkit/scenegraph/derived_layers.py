@@ -19,10 +19,10 @@ refresh.
 from __future__ import annotations
 
 import functools
-from typing import Any
 
 import numpy as np
 from foxglove_schemas_protobuf.Color_pb2 import Color
+from foxglove_schemas_protobuf.Grid_pb2 import Grid
 from foxglove_schemas_protobuf.LinePrimitive_pb2 import LinePrimitive
 from foxglove_schemas_protobuf.Point3_pb2 import Point3
 from foxglove_schemas_protobuf.SceneEntity_pb2 import SceneEntity
@@ -66,14 +66,14 @@ _SPHERE = sw.field(9, [*sw.field(1, [*sw.field(1, sw.POINT3), *sw.field(2, [b"\x
                        *sw.field(2, sw.doubles(("sx", "sy", "sz"))), *sw.field(3, sw.COLOR)])
 
 
-def occupancy_message(refresh: Refresh) -> Any | None:
+def occupancy_message(refresh: Refresh) -> Grid | None:
     if refresh.layers is None:
         return None
     occ = refresh.layers.occupancy
     return codec.encode_grid(refresh.time_ns, occ.grid, occ.origin, occ.resolution)
 
 
-def voronoi_message(refresh: Refresh) -> Any | None:
+def voronoi_message(refresh: Refresh) -> SceneUpdate | None:
     """The Voronoi graph, edges and nodes coloured by room (module doc). The points,
     colours and spheres are parsed from wire bytes built at once
     (:mod:`sgtool.scenegraph.scene_wire`): the same message as built one by one."""
@@ -145,7 +145,7 @@ def _hull_of(points: bytes, margin: float) -> np.ndarray:
     return hull
 
 
-def rooms_message(refresh: Refresh) -> Any | None:
+def rooms_message(refresh: Refresh) -> SceneUpdate | None:
     """Room outlines and labels (module doc)."""
     if refresh.layers is None:
         return None

@@ -25,13 +25,14 @@ from sgtool.mapping.voronoi import VoronoiGraph
 from sgtool.scenegraph.instances import InstanceInfo
 from sgtool.scenegraph.object_placement import SeenInstance
 from sgtool.scenegraph.room_segmentation import RoomTracker, opening_from_panel
+from sgtool.vocabulary import OpenState
 
 
 @dataclass(frozen=True, eq=False)
 class DoorObservation:
     instance: int
     position: tuple[float, float]
-    state: str
+    state: OpenState
     rooms: tuple[str, ...]  # explored rooms on either side, nearest first
     unexplored_room: str | None
     node: int  # nearest visible node (-1: none)

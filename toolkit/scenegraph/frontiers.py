@@ -29,6 +29,7 @@ from scipy.sparse.csgraph import connected_components
 from sgtool.mapping import holes
 from sgtool.mapping.grid import FREE, OccupancyGrid
 from sgtool.mapping.holes import UnknownParts
+from sgtool.scenegraph.graph import FrontierType
 
 _FOUR = ndimage.generate_binary_structure(2, 1)
 
@@ -50,7 +51,7 @@ class Frontier:
     leading_out: bool
 
     @property
-    def type(self) -> str:
+    def type(self) -> FrontierType:
         return "leading out" if self.leading_out else "unexplored area"
 
 

@@ -195,7 +195,7 @@ def _report(mlps: dict[str, RelationMLP], encoder: SentenceEncoder, eval_sets: S
     return out
 
 
-def write_json_atomic(path: Path, obj: Any) -> None:
+def write_json_atomic(path: Path, obj: object) -> None:
     atomic_write(path, json.dumps(obj, indent=1, sort_keys=True, allow_nan=True) + "\n")
 
 

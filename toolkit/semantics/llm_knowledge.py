@@ -289,7 +289,7 @@ class Agreement:
         return self.agree / self.common if self.common else float("nan")
 
 
-def agreement(llm: Any, reference: Any) -> Agreement:
+def agreement(llm: RelationalSet, reference: RelationalSet) -> Agreement:
     """:class:`Agreement` of two :class:`~sgtool.semantics.relational_set.RelationalSet`."""
     ref: dict[tuple[str, str], float] = {}
     for (i, j), t in zip(reference.pairs.tolist(), reference.targets.tolist(), strict=True):
