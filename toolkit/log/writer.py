@@ -29,7 +29,7 @@ import os
 from collections.abc import Mapping
 from pathlib import Path
 from types import TracebackType
-from typing import IO, Any, overload
+from typing import IO, TYPE_CHECKING, Any, overload
 
 import numpy as np
 from mcap.summary import Summary
@@ -44,6 +44,9 @@ from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.records import RECORD_TYPES, LogRecord
 from sgtool.version import __version__
 from sgtool.vocabulary import RecordName
+
+if TYPE_CHECKING:
+    from google.protobuf.message import Message
 
 PARTIAL_SUFFIX = ".partial"
 PARTIAL_GLOB = "*.????????" + PARTIAL_SUFFIX  # OUT.XXXXXXXX.partial, see the module doc
@@ -259,7 +262,7 @@ class LogWriter:
         return True
 
     # ----- generic ----------------------------------------------------------------------
-    def write_proto(self, topic: str, t_ns: int, msg: Any) -> None:
+    def write_proto(self, topic: str, t_ns: int, msg: Message) -> None:
         """Write any protobuf message (e.g. a Foxglove SceneUpdate) on ``topic``."""
         cid = self._proto_channel(topic, type(msg))
         self._add(cid, t_ns, msg.SerializeToString(deterministic=True))
