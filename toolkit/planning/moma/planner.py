@@ -45,14 +45,15 @@ from sgtool.llm.client import ChatClient, LlmTransportError, complete_within
 from sgtool.llm.constraints import REASON_CHARS, Constraint, check_kind, detect_kind
 from sgtool.llm.exchange import Message, exchange_record
 from sgtool.llm.recorded import ReplayMiss, TranscriptWriter
-from sgtool.planning.base import Action, Feedback
+from sgtool.planning.base import Action, Feedback, Outcome
 from sgtool.planning.moma.choices import valid_commands
 from sgtool.planning.moma.commands import InvalidCommand, ground, parse_response
 from sgtool.planning.moma.scene_text import EncodedScene, encode_scene, nearest_room, room_of
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.semantics.text import category_text
 
-OUTCOME_TEXT = {"success": "success", "failure": "failure", "invalid": "invalid argument"}
+OUTCOME_TEXT: dict[Outcome, str] = {"success": "success", "failure": "failure",
+                                    "invalid": "invalid argument"}
 
 
 def with_article(noun: str) -> str:
@@ -93,7 +94,7 @@ class HistoryEntry:
     position: tuple[float, float] | None
     label: str  # object words at decision time ("" for explore)
     room_name: str  # as shown then (used only if nothing better is known now)
-    outcome: str | None = None
+    outcome: Outcome | None = None
     message: str = ""
     text: str = ""  # a rejected command as the model wrote it (no node to realign)
 
