@@ -2,7 +2,8 @@
 # Set up sgtool in .venv (idempotent) and run the demo or the tests.
 #
 #   bash setup.sh demo [ARGS...]   set up, then `sgtool demo` (record, replay, bench)
-#   bash setup.sh test [ARGS...]   set up, then the test suite (pytest ARGS)
+#   bash setup.sh test [ARGS...]   set up, then mypy (stops on a type error), then the test
+#                                  suite (pytest ARGS)
 #   bash setup.sh                  set up only
 #
 # Needs Python >= 3.11 (python3, or $PYTHON). Installs the Debian packages it needs
@@ -68,7 +69,10 @@ what="${1:-}"
 [ $# -gt 0 ] && shift
 case "$what" in
   demo) exec .venv/bin/sgtool demo "$@" ;;
-  test) exec .venv/bin/python -m pytest -q "$@" ;;
+  test)
+    # the whole package against pyproject.toml's [tool.mypy]; a type error stops the run
+    .venv/bin/mypy || die "mypy reports type errors (above); the tests were not run"
+    exec .venv/bin/python -m pytest -q "$@" ;;
   "") echo "setup.sh: ready; run .venv/bin/sgtool --help" ;;
   *) die "unknown action '$what' (demo or test)" ;;
 esac

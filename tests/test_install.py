@@ -128,6 +128,8 @@ def test_this_environment_is_the_pinned_one():
 def test_setup_sh_installs_every_extra_with_the_constraints():
     text = (REPO / "setup.sh").read_text()
     assert "-c constraints.txt" in text and "'.[all,dev]'" in text
+    # the test command type-checks first and stops on an error
+    assert text.index(".venv/bin/mypy || die") < text.index("-m pytest")
 
 
 def test_license_type_hints_and_long_description_ship():
