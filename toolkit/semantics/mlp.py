@@ -15,7 +15,7 @@ computed once per query (:meth:`RelationMLP.query_bias`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +35,11 @@ class RelationMLP:
     weights: tuple[np.ndarray, ...]
     biases: tuple[np.ndarray, ...]
     metadata: dict[str, str]
+    # derived in __post_init__: the first layer's node and query halves and the later
+    # layers, transposed, float32, contiguous (x @ W^T)
+    _w_node: np.ndarray = field(init=False, repr=False, compare=False)
+    _w_query: np.ndarray = field(init=False, repr=False, compare=False)
+    _rest: tuple[np.ndarray, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         dims = [self.weights[0].shape[1]] + [w.shape[0] for w in self.weights]
@@ -42,7 +47,6 @@ class RelationMLP:
             raise ValueError(f"{self.relation}: layer sizes {dims} != {list(LAYER_SIZES)}")
         half = LAYER_SIZES[0] // 2
         w0 = self.weights[0]
-        # cached transposes, float32, contiguous (x @ W^T)
         object.__setattr__(self, "_w_node", np.ascontiguousarray(w0[:, :half].T, np.float32))
         object.__setattr__(self, "_w_query", np.ascontiguousarray(w0[:, half:].T, np.float32))
         object.__setattr__(
@@ -61,13 +65,13 @@ class RelationMLP:
 
     def logits(self, node_vecs: np.ndarray, query_vec: np.ndarray) -> np.ndarray:
         """Logits for every row of ``node_vecs`` (n, 384) against one query vector (384,)."""
-        h = np.atleast_2d(np.asarray(node_vecs, np.float32)) @ self._w_node  # type: ignore[attr-defined]
+        h = np.atleast_2d(np.asarray(node_vecs, np.float32)) @ self._w_node
         return self._tail(h + self.query_bias(query_vec))
 
     def _tail(self, h0: np.ndarray) -> np.ndarray:
         """Layers after the first pre-activation ``h0`` -> logits (n,)."""
         h = np.maximum(h0, 0.0)
-        rest: tuple[np.ndarray, ...] = self._rest  # type: ignore[attr-defined]
+        rest = self._rest
         for i, w in enumerate(rest):
             h = h @ w + self.biases[i + 1]
             if i < len(rest) - 1:
@@ -83,7 +87,7 @@ class RelationMLP:
         """Scores for rows of concatenated inputs (n, 768) (Eq. 8 layout)."""
         x = np.atleast_2d(np.asarray(x, np.float32))
         half = LAYER_SIZES[0] // 2
-        h0 = x[:, :half] @ self._w_node + x[:, half:] @ self._w_query + self.biases[0]  # type: ignore[attr-defined]
+        h0 = x[:, :half] @ self._w_node + x[:, half:] @ self._w_query + self.biases[0]
         return 1.0 / (1.0 + np.exp(-self._tail(h0)))
 
 
