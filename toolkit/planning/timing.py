@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import time
 
+from sgtool.errors import SgtoolError
 from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.scenegraph.graph import SceneGraph
 
@@ -20,8 +21,15 @@ _PLAIN = tuple(f.name for f in dataclasses.fields(Action)) == \
     ("skill", "target", "reason", "decision_time_s", "scores")
 
 
+class PlannerContractError(SgtoolError):
+    """A planner broke the :class:`~sgtool.planning.base.Planner` contract (its ``decide``
+    returned something that is not an :class:`~sgtool.planning.base.Action`)."""
+
+
 class TimedPlanner:
-    """Wraps a planner; ``decide`` returns the action with ``decision_time_s`` filled."""
+    """Wraps a planner; ``decide`` returns the action with ``decision_time_s`` filled, and
+    raises :class:`PlannerContractError` naming the planner when ``decide`` returns no
+    :class:`~sgtool.planning.base.Action` (a plug-in's mistake, caught where it happens)."""
 
     def __init__(self, inner: Planner) -> None:
         self.inner = inner
@@ -39,6 +47,10 @@ class TimedPlanner:
         self.decision_times.append(dt)
         if _PLAIN and type(action) is Action:  # dataclasses.replace without its field walk
             return Action(action.skill, action.target, action.reason, dt, action.scores)
+        if not isinstance(action, Action):
+            raise PlannerContractError(
+                f"planner {self.name!r}: decide() returned a {type(action).__name__}, not an "
+                "sgtool.Action (e.g. Action('navigate', node_id))")
         return dataclasses.replace(action, decision_time_s=dt)
 
     @property

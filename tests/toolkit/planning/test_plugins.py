@@ -58,6 +58,15 @@ PLUGIN = textwrap.dedent('''
         return 42
 
 
+    class Candidates(GreedyPlanner):
+        """Returns the Candidate it picked instead of an Action (a plug-in's mistake)."""
+
+        def decide(self, graph):
+            from sgtool.planning.candidates import actionable
+
+            return actionable(graph)[0]
+
+
     class Half:
         name = "half"
 
@@ -148,3 +157,17 @@ def test_unknown_names_and_file_names() -> None:
         check_planner_name("astar")
     check_planner_name("pkg.sub:Cls.Inner")  # written right: not imported by the check
     assert file_name("pkg.sub:Cls") == "pkg.sub__Cls" and file_name("scout") == "scout"
+
+
+def test_a_decision_that_is_no_action_is_one_line_naming_the_plugin(plugin_dir: Path) -> None:
+    from support.planning_world import World
+
+    from sgtool.planning.timing import PlannerContractError
+
+    planner = make_planner("mymod_plug:Candidates")
+    graph = World(0).graph()
+    planner.reset("mug")
+    with pytest.raises(PlannerContractError) as e:
+        planner.decide(graph)
+    assert str(e.value) == ("planner 'mymod_plug:Candidates': decide() returned a Candidate, "
+                            "not an sgtool.Action (e.g. Action('navigate', node_id))")
