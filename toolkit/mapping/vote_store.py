@@ -36,6 +36,16 @@ def _member(keys: np.ndarray, uk: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return pos, found
 
 
+def spans(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The indices ``lo[0]..hi[0]-1, lo[1]..hi[1]-1, ...`` in one array (empty spans
+    allowed)."""
+    n = np.maximum(hi - lo, 0)
+    total = int(n.sum())
+    if total == 0:
+        return np.zeros(0, dtype=np.int64)
+    return np.repeat(lo - (np.cumsum(n) - n), n) + np.arange(total, dtype=np.int64)
+
+
 class VoteStore:
     """Distinct sorted int64 keys with int64 vote counts (module doc)."""
 
@@ -73,6 +83,25 @@ class VoteStore:
         """(sorted keys, counts) of everything, the tail merged in."""
         self._merge()
         return self._keys, self._counts
+
+    def within(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(sorted keys, counts) of the entries with ``lo[i] <= key < hi[i]`` for some i
+        (sorted, disjoint ranges), read from both levels without merging the tail: the
+        same entries :meth:`arrays` holds in those ranges."""
+        parts = []
+        for keys, counts in ((self._keys, self._counts),
+                             (self._tail_keys, self._tail_counts)):
+            if len(keys):
+                idx = spans(np.searchsorted(keys, lo), np.searchsorted(keys, hi))
+                parts.append((keys[idx], counts[idx]))
+        if not parts:
+            return _EMPTY, _EMPTY
+        if len(parts) == 1:
+            return parts[0]
+        keys = np.concatenate([p[0] for p in parts])
+        counts = np.concatenate([p[1] for p in parts])
+        order = np.argsort(keys, kind="stable")  # main and tail never share a key
+        return keys[order], counts[order]
 
     def replace(self, keys: np.ndarray, counts: np.ndarray) -> None:
         """Set the whole content (sorted distinct ``keys``), e.g. after a removal."""

@@ -34,7 +34,12 @@ batching).
 Dynamic scenes: a door or a drawer that changes state leaves its old voxels behind;
 :meth:`VoxelMap.forget_instance` drops every vote of an instance so that it is rebuilt
 from the frames that follow (the scene-graph builder calls it when the instance table
-reports a new state).
+reports a new state). Labels are votes over frames: a frame that dropped the instance's
+label (id 0) or swapped it (another id) voted its voxels under another label, so the
+instance takes along every voxel it *wins* (most votes, as :meth:`VoxelMap.voxels`) with
+all the votes in it, not only its own label's entries. Free-space evidence from the
+robot's body (:meth:`VoxelMap.clear_unlabelled_around`) drops the voxels that never had an
+instance's label where the robot stood.
 
 Everything is exact integer arithmetic after the float64 back-projection (elementwise, no
 BLAS; :mod:`sgtool.mapping.backproject` runs it in cache blocks, operation for operation),
@@ -44,6 +49,7 @@ so the same frames give the same map bit for bit. A frame's keys are counted by
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,7 +58,7 @@ from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.mapping.backproject import Scratch, beyond_packing, within_packing, world_voxels
 from sgtool.mapping.key_count import count_keys
 from sgtool.mapping.label_stats import LabelStats, update_frame
-from sgtool.mapping.vote_store import VoteStore, drain_keys
+from sgtool.mapping.vote_store import VoteStore, drain_keys, spans
 
 AXIS_BITS = 17
 LABEL_BITS = 12
@@ -110,6 +116,25 @@ class InstanceObservation:
     view_distance: float  # xy distance from that viewpoint to its points' centroid
     voxels: int  # distinct voxels it voted for
     centroid: tuple[float, float, float] | None  # mean of those voxels' centres
+
+
+def winning_entries(keys: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """Index of the winning entry of every voxel of the sorted (voxel, label) ``keys``
+    (one per voxel, in order): the most votes, ties to the lower label index."""
+    if len(keys) == 0:
+        return np.zeros(0, dtype=np.int64)
+    vk = keys >> VOXEL_SHIFT
+    starts = np.flatnonzero(np.concatenate([[True], vk[1:] != vk[:-1]]))
+    best = np.maximum.reduceat(counts, starts)
+    group = np.repeat(np.arange(len(starts)), np.diff(np.append(starts, len(keys))))
+    cand = np.flatnonzero(counts == best[group])  # sorted: lower labels first in a group
+    g = group[cand]
+    return cand[np.concatenate([[True], g[1:] != g[:-1]])]
+
+
+def _voxel_bounds(voxel_keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Key ranges [lo, hi) holding every label's entry of the sorted distinct voxels."""
+    return voxel_keys << VOXEL_SHIFT, (voxel_keys + 1) << VOXEL_SHIFT
 
 
 class VoxelMap:
@@ -333,21 +358,29 @@ class VoxelMap:
             st.vox_sum[:m, col] += sign * np.rint(s).astype(np.int64)
 
     def forget_instance(self, instance_id: int) -> int:
-        """Drop every vote of an instance (it moved or changed state); returns the number of
-        (voxel, label) entries removed. Its observation counts restart too."""
+        """Drop an instance (it moved or changed state): every vote of it, and every voxel
+        it wins (most votes, ties to the lower label as :meth:`voxels`) with the votes of
+        the other labels in it (module doc: a frame that missed or swapped its label must
+        not leave its geometry behind). Returns the number of (voxel, label) entries
+        removed. Its observation counts restart too."""
         lab = self._label_of.get(int(instance_id))
         if lab is None or lab == 0 or lab == OVERFLOW_LABEL:
             return 0
         keys, counts = self.entries()
         mask = (keys & LABEL_MASK) == lab
+        if mask.any():
+            lo, hi = _voxel_bounds(np.unique(keys[mask] >> VOXEL_SHIFT))
+            idx = spans(np.searchsorted(keys, lo), np.searchsorted(keys, hi))
+            win = idx[winning_entries(keys[idx], counts[idx])]
+            won_vk = keys[win[(keys[win] & LABEL_MASK) == lab]] >> VOXEL_SHIFT
+            mask[idx[np.isin(keys[idx] >> VOXEL_SHIFT, won_vk)]] = True
         n = int(mask.sum())
         if n:
             gone = keys[mask]
-            self._zhist -= np.bincount((gone >> SHIFT_Z) & AXIS_MASK, minlength=1 << AXIS_BITS)
-            self._store.replace(keys[~mask], counts[~mask])
-            self._removed_keys.append(gone)
-            self.removals += 1
-            self.version += 1
+            others = gone[(gone & LABEL_MASK) != lab]
+            if len(others):  # other labels' votes in the voxels it won
+                self._voxel_stats(others, -1)
+            self._remove(mask, gone)
         st = self._stats
         st.vox_n[lab] = 0
         st.vox_sum[lab] = 0
@@ -357,6 +390,54 @@ class VoxelMap:
         st.view_dist[lab] = np.inf
         st.view_xy[lab] = np.nan
         return n
+
+    def clear_unlabelled_around(self, points: np.ndarray, radius: float, zlo: int,
+                                zhi: int) -> int:
+        """Free-space evidence of the robot's body: drop the voxels at levels
+        ``zlo..zhi`` whose column centre lies within ``radius`` m of one of the world
+        ``points`` (k, 2) and that never got an instance's label (label 0 their only
+        entry: a dropped detection, a door panel seen mid-swing). A voxel with an
+        instance's vote stays (an instance's geometry goes with :meth:`forget_instance`;
+        a drifted pose must not wipe a labelled wall). Entries are looked up in those
+        columns only; returns the number removed."""
+        pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        if not len(pts):
+            return 0
+        self.flush()
+        res = self.config.resolution
+        reach = int(math.ceil(radius / res)) + 1
+        d = np.arange(-reach, reach + 1)
+        cx = np.floor(pts[:, 0] / res).astype(np.int64)[:, None, None] + d[None, :, None]
+        cy = np.floor(pts[:, 1] / res).astype(np.int64)[:, None, None] + d[None, None, :]
+        near = (((cx + 0.5) * res - pts[:, 0, None, None]) ** 2
+                + ((cy + 0.5) * res - pts[:, 1, None, None]) ** 2) <= radius * radius
+        cx, cy = np.broadcast_arrays(cx, cy)
+        cols = np.unique(((cx[near] + OFFSET) << AXIS_BITS) | (cy[near] + OFFSET))
+        keys, _ = self._store.within(cols << COLUMN_SHIFT, (cols + 1) << COLUMN_SHIFT)
+        if not len(keys):
+            return 0
+        vk = keys >> VOXEL_SHIFT
+        alone = np.concatenate([[True], vk[1:] != vk[:-1]]) & \
+            np.concatenate([vk[1:] != vk[:-1], [True]])  # the voxel's only entry
+        iz = ((keys >> SHIFT_Z) & AXIS_MASK) - OFFSET
+        gone = keys[alone & ((keys & LABEL_MASK) == 0) & (iz >= zlo) & (iz <= zhi)]
+        if not len(gone):
+            return 0
+        all_keys, _ = self.entries()
+        mask = np.zeros(len(all_keys), dtype=bool)
+        mask[np.searchsorted(all_keys, gone)] = True
+        self._voxel_stats(gone, -1)
+        self._remove(mask, gone)
+        return int(len(gone))
+
+    def _remove(self, mask: np.ndarray, gone: np.ndarray) -> None:
+        """Drop the entries ``mask`` of :meth:`entries` (their keys ``gone``)."""
+        keys, counts = self._store.arrays()
+        self._zhist -= np.bincount((gone >> SHIFT_Z) & AXIS_MASK, minlength=1 << AXIS_BITS)
+        self._store.replace(keys[~mask], counts[~mask])
+        self._removed_keys.append(gone)
+        self.removals += 1
+        self.version += 1
 
     # ----- queries ----------------------------------------------------------------------
     @property
@@ -399,13 +480,19 @@ class VoxelMap:
         vk = keys >> VOXEL_SHIFT
         starts = np.flatnonzero(np.concatenate([[True], vk[1:] != vk[:-1]]))
         total = np.add.reduceat(counts, starts)
-        best = np.maximum.reduceat(counts, starts)
-        group = np.repeat(np.arange(len(starts)), np.diff(np.append(starts, len(keys))))
-        cand = np.flatnonzero(counts == best[group])  # sorted: lower labels first in a group
-        g = group[cand]
-        win = cand[np.concatenate([[True], g[1:] != g[:-1]])]  # one per voxel, in order
+        win = winning_entries(keys, counts)
         ix, iy, iz, lab = unpack(keys[win])
         return np.stack([ix, iy, iz], axis=1), lab, total
+
+    def winning_labels(self, voxel_keys: np.ndarray) -> np.ndarray:
+        """The winning label index (as :meth:`voxels`) of each of the sorted distinct voxel
+        keys (``key >> VOXEL_SHIFT``) of voxels in the map, looked up in those voxels only."""
+        self.flush()
+        keys, counts = self._store.within(*_voxel_bounds(voxel_keys))
+        win = keys[winning_entries(keys, counts)]
+        if len(win) != len(voxel_keys) or ((win >> VOXEL_SHIFT) != voxel_keys).any():
+            raise ValueError("winning_labels: a voxel is not in the map")
+        return win & LABEL_MASK
 
     def instance_id(self, label: int) -> int:
         return self._label_ids[label] if 0 <= label < len(self._label_ids) else -1

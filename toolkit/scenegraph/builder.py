@@ -13,9 +13,10 @@ caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
    free cells are unchanged, else its distance field and ridge cells are recomputed around
    the changed cells only (:mod:`sgtool.mapping.ridge_window`); the component is the
    robot's;
-3. rooms (:mod:`sgtool.scenegraph.room_segmentation`): door cells of open doors
-   (:mod:`sgtool.scenegraph.door_evidence`) cut the graph, ids are kept stable by overlap
-   with the previous refresh;
+3. rooms (:mod:`sgtool.scenegraph.room_segmentation`): door cells of the voxels the open
+   doors win (:mod:`sgtool.scenegraph.door_evidence`,
+   :meth:`sgtool.scenegraph.door_voxels.DoorVoxels.won`) cut the graph, ids are kept
+   stable by overlap with the previous refresh;
 4. objects (:mod:`sgtool.scenegraph.object_placement`, :mod:`sgtool.scenegraph.assign`):
    instances seen with enough points, placed at their voxel centroid, first-level ones
    assigned by MoMa-LLM's weighted travel distance from their closest viewpoint, nested
@@ -36,6 +37,12 @@ caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
    the Voronoi graph (entry: the visible nodes within ``entry_radius``; object and
    frontier: their node plus the straight last leg);
 9. assembly of the nodes into the graph (:mod:`sgtool.scenegraph.assembly`).
+
+Before the stages, the robot's body is free-space evidence: the voxels in the BEV height
+band within ``BODY_RADIUS`` of the trajectory points new since the last refresh that never
+had an instance's label are dropped
+(:meth:`~sgtool.mapping.voxels.VoxelMap.clear_unlabelled_around`); a later frame that sees
+something there puts it back.
 
 Each stage is one method of :class:`SceneGraphBuilder` or one function of those modules;
 ``refresh`` runs them in this order and times each.
@@ -107,7 +114,9 @@ from sgtool.scenegraph.room_segmentation import (
 from sgtool.scenegraph.travel import node_distances, travel_distances
 from sgtool.scenegraph.visibility import entry_nodes, nearest_visible
 
-__all__ = ["BuilderConfig", "DoorObservation", "MapLayers", "SceneGraphBuilder"]
+BODY_RADIUS = 0.2  # m: unlabelled voxels this close to where the robot stood are dropped
+
+__all__ = ["BODY_RADIUS", "BuilderConfig", "DoorObservation", "MapLayers", "SceneGraphBuilder"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -165,6 +174,8 @@ class SceneGraphBuilder:
         self.trajectory: list[tuple[float, float]] = []
         self.robot: tuple[float, float, float] | None = None
         self.frames_since_refresh = 0
+        self._cleared = 0  # trajectory points whose body cleared the voxels around them
+        self.cleared_entries = 0  # voxel entries dropped by the robot's body
         self.timings: dict[str, list[float]] = defaultdict(list)
         self.timings_scratch: dict[str, list[float]] = defaultdict(list)  # from_scratch=True
         self._fans: list[np.ndarray] = []  # per frame: rays to the nearest ground hit
@@ -244,6 +255,7 @@ class SceneGraphBuilder:
         """The scene graph now (module doc). ``time_ns`` defaults to 0."""
         t_all = self.clock()
         stamp = int(time_ns or 0)
+        self._clear_footprint()
         key = (self.voxels.version, len(self.trajectory), self.robot,
                tuple((i, v.state) for i, v in self.instances.items()))
         if not from_scratch and self._last is not None and self._last[0] == key:
@@ -319,6 +331,23 @@ class SceneGraphBuilder:
         return sg
 
     # ----- stages -----------------------------------------------------------------------
+    def _clear_footprint(self) -> None:
+        """The robot's body is free-space evidence (module doc): drop the unlabelled voxels
+        of the BEV height band within ``BODY_RADIUS`` of the trajectory points new since
+        the last refresh."""
+        if self._cleared >= len(self.trajectory):
+            return
+        pts = np.asarray(self.trajectory[self._cleared:], dtype=np.float64)
+        self._cleared = len(self.trajectory)
+        cfg = self.config.bev
+        res = self.voxels.resolution
+        lo, hist = self.voxels.level_histogram()
+        level = floor_level(cfg, res, lo, hist)
+        tol = int(round(cfg.floor_tolerance / res))
+        top = int(round(cfg.band_top / res))
+        self.cleared_entries += self.voxels.clear_unlabelled_around(
+            pts, BODY_RADIUS, level + tol + 1, level + top)
+
     def _occupancy(self) -> OccupancyGrid:
         cfg = self.config.bev
         res = self.voxels.resolution
@@ -405,8 +434,8 @@ class SceneGraphBuilder:
     def _segment(self, occ: OccupancyGrid, vg: VoronoiGraph) -> _Rooms:
         """Rooms: the door evidence cuts the graph; ids stay stable by overlap."""
         cfg = self.config.rooms
-        cells = door_cells_of(occ, self._door_voxels.of(open_doors(self.instances)),
-                              self._panel_memo)
+        won = self._door_voxels.won(open_doors(self.instances), self.voxels.winning_labels)
+        cells = door_cells_of(occ, won, self._panel_memo)
         cells.setflags(write=False)  # kept to recognise the same cells next time
         got = self._density
         if got is None or got[0] != occ.resolution or not np.array_equal(got[1], cells):

@@ -9,15 +9,21 @@ floor level moved, voxels were removed), all keys. A door's voxels are then the 
 ``voxels_of`` gives (keys only enter the map between removals; any removal makes the
 builder rebuild), in another order, which no consumer depends on. A change of the set of
 door instances (a new instance table) also asks for a rebuild (:meth:`DoorVoxels.stale`).
+
+Door *evidence* is the voxels a door wins (:meth:`DoorVoxels.won`): labels are votes over
+frames, so a frame that gave another object's pixels a door's id (a swapped label) adds
+a minority door vote there and no doorway. Only the kept door keys' voxels can be won by
+a door, so their winners are looked up in those voxels alone
+(:meth:`~sgtool.mapping.voxels.VoxelMap.winning_labels`), never by a scan of the map.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 
 import numpy as np
 
-from sgtool.mapping.voxels import LABEL_MASK, unpack
+from sgtool.mapping.voxels import LABEL_MASK, VOXEL_SHIFT, unpack
 
 
 class DoorVoxels:
@@ -57,6 +63,29 @@ class DoorVoxels:
         for iid in np.unique(inst).tolist():
             self._keys.setdefault(int(iid), []).append(keys[inst == iid])
             self._ijk.pop(int(iid), None)
+
+    def won(self, instance_ids: Iterable[int],
+            winning_labels: Callable[[np.ndarray], np.ndarray]) -> dict[int, np.ndarray]:
+        """Instance id -> ijk (M, 3) of the voxels each door wins (module doc);
+        ``winning_labels`` gives the winning label of sorted distinct voxel keys (the map's
+        :meth:`~sgtool.mapping.voxels.VoxelMap.winning_labels`)."""
+        ids = sorted(int(i) for i in instance_ids)
+        keys = {}
+        for iid in ids:
+            parts = self._keys.get(iid)
+            if parts and len(parts) > 1:
+                parts[:] = [np.concatenate(parts)]
+            keys[iid] = parts[0] if parts else np.zeros(0, np.int64)
+        out = {iid: np.zeros((0, 3), np.int64) for iid in ids}
+        if not any(len(k) for k in keys.values()):
+            return out
+        vk = np.unique(np.concatenate(list(keys.values())) >> VOXEL_SHIFT)
+        win = winning_labels(vk)
+        for iid, k in keys.items():
+            mine = k[win[np.searchsorted(vk, k >> VOXEL_SHIFT)] == (k & LABEL_MASK)]
+            ix, iy, iz, _ = unpack(mine)
+            out[iid] = np.stack([ix, iy, iz], axis=1)
+        return out
 
     def of(self, instance_ids: Iterable[int]) -> dict[int, np.ndarray]:
         """Instance id -> ijk (M, 3) of its voxels (each once), for door instances."""

@@ -63,3 +63,25 @@ def test_keys_found_in_main_or_tail_get_votes_and_are_not_new() -> None:
     assert list(store.add(np.array([1, 7]), np.array([4, 4]))) == []
     k, c = store.arrays()
     assert list(k) == [1, 5, 7, 9] and list(c) == [5, 3, 7, 1]
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_within_ranges_equals_the_merged_arrays_sliced(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    store = VoteStore(min_tail=int(rng.integers(1, 200)), tail_factor=int(rng.integers(1, 64)))
+    for _ in range(int(rng.integers(1, 30))):
+        uk = np.unique(rng.integers(0, 2000, size=int(rng.integers(1, 60))))
+        store.add(uk.astype(np.int64), rng.integers(1, 9, size=len(uk)).astype(np.int64))
+    edges = np.unique(rng.integers(0, 2100, size=2 * int(rng.integers(1, 12))))
+    if len(edges) % 2:
+        edges = edges[:-1]
+    lo, hi = edges[0::2].astype(np.int64), edges[1::2].astype(np.int64)
+    tail = len(store._tail_keys)
+    got_k, got_c = store.within(lo, hi)
+    assert len(store._tail_keys) == tail  # read without merging the tail
+    keys, counts = store.arrays()
+    inside = np.zeros(len(keys), dtype=bool)
+    for a, b in zip(lo.tolist(), hi.tolist(), strict=True):
+        inside |= (keys >= a) & (keys < b)
+    np.testing.assert_array_equal(got_k, keys[inside])
+    np.testing.assert_array_equal(got_c, counts[inside])
