@@ -119,9 +119,11 @@ def _message_indexes(lay: Layout) -> list[str]:
 def _summary_copies(lay: Layout, summary: list) -> list[str]:
     """Summary copies that differ from the data section's definition or are missing from
     it (a writer may define a channel without messages in the summary only), and summary
-    channels whose schema the summary lacks: readers find channels through the summary."""
+    channels whose schema is defined nowhere. The summary may repeat the channels without
+    their schemas (the specification makes each group optional): readers then take the
+    schemas from the data section."""
     out = []
-    s_schemas = {s.id for s in _of(summary, Schema)}
+    s_schemas = {s.id for s in _of(summary, Schema)} | set(lay.schemas)
     s_channels = {c.id: c for c in _of(summary, Channel)}
     if s_channels:
         for cid in sorted(set(lay.channels) - set(s_channels)):
@@ -129,7 +131,7 @@ def _summary_copies(lay: Layout, summary: list) -> list[str]:
         for c in s_channels.values():
             if c.schema_id and c.schema_id not in s_schemas:
                 out.append(f"summary channel {c.id} ({c.topic!r}) names schema "
-                           f"{c.schema_id}, which the summary lacks")
+                           f"{c.schema_id}, which is defined nowhere")
     for s in _of(summary, Schema):
         d = lay.schemas.get(s.id)
         if d is not None and (d.name, d.encoding, bytes(d.data)) != (s.name, s.encoding,
@@ -149,6 +151,7 @@ def _statistics(lay: Layout, summary: list) -> list[str]:
         return []
     st = stats[0]
     msgs = [(cid, t) for c in lay.chunks for cid, t, _ in c.messages]
+    msgs += [(cid, t) for cid, t, _ in lay.loose]
     counts = Counter(cid for cid, _ in msgs)
     attachments = sum(r.opcode == Opcode.ATTACHMENT and not lay.in_summary(r.offset)
                       for r in lay.top)

@@ -1,13 +1,14 @@
 """Walking an MCAP file record by record without trusting it.
 
 :func:`walk` yields every readable schema, channel, message, attachment and metadata record
-of a file (those inside chunks too) and fills a :class:`Layout` with where everything was
-and what went wrong. It never stops at damage: a record that does not parse is skipped up
-to the next valid record (resynchronisation), a record whose length field is damaged is
-read up to where the next record starts, a chunk whose compressed data is cut or damaged
-gives the messages decoded before the damage (``salvaged``), and the records after the
-data section (summary copies of schemas and channels, indexes, statistics) are kept for
-the cross-checks of :mod:`sgtool.log.file_check`.
+of a file (those inside chunks, and messages outside them) and fills a :class:`Layout`
+with where everything was and what went wrong. It never stops at damage: a record that
+does not parse is skipped up to the next valid record (resynchronisation), a record whose
+length field is damaged is read up to where the next record starts, a chunk whose
+compressed data is cut or damaged gives the messages decoded before the damage
+(``salvaged``), and the records after the data section (summary copies of schemas and
+channels, indexes, statistics) are kept for the cross-checks of
+:mod:`sgtool.log.file_check`.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ from sgtool.log.mcap_records import (
     next_record_start,
     parse_body,
     read_record,
+    trailing_is_damage,
 )
 
 Source = Literal["data", "summary", "salvaged"]
@@ -62,6 +64,9 @@ class Layout:
     header: Header | None = None
     footer: tuple[int, Footer] | None = None
     chunks: list[ChunkFacts] = field(default_factory=list)
+    # messages of the data section outside any chunk (the specification allows them):
+    # channel, log time, offset
+    loose: list[tuple[int, int, int]] = field(default_factory=list)
     top: list[Raw] = field(default_factory=list)  # records outside chunks, in file order
     data_end: Raw | None = None
     schemas: dict[int, Any] = field(default_factory=dict)  # of the data section, by id
@@ -122,6 +127,8 @@ def walk(buf: FileBytes, lay: Layout) -> Iterator[Item]:
         raw: Raw | None
         try:
             raw = read_record(buf, pos, end)
+            if trailing_is_damage(buf, raw, end):
+                raise RecordError(f"{raw.trailing} bytes after its fields look like damage")
         except RecordError as e:
             raw = yield from _after_damage(buf, pos, end, lay, str(e))
             if raw is None:
@@ -202,7 +209,11 @@ def _top(raw: Raw, lay: Layout) -> Iterator[Item]:
         if lay.chunks and not lay.in_summary(raw.offset):
             lay.chunks[-1].indexes.setdefault(rec.channel_id, raw)
     elif op == Opcode.MESSAGE:
-        lay.damaged(f"a message record outside any chunk at byte {raw.offset}")
+        if lay.in_summary(raw.offset):
+            lay.damaged(f"a message record in the summary section at byte {raw.offset}")
+        else:
+            lay.loose.append((int(rec.channel_id), int(rec.log_time), raw.offset))
+            yield Item(rec, "data")
     elif op in (Opcode.SCHEMA, Opcode.CHANNEL, Opcode.ATTACHMENT, Opcode.METADATA):
         summary = lay.in_summary(raw.offset)
         if not summary and op in (Opcode.SCHEMA, Opcode.CHANNEL):

@@ -1,11 +1,15 @@
 """Parsing MCAP records without trusting them (pure functions over bytes).
 
 Every length is checked against the bytes that are really there before anything is
-allocated; a record parses only when its body is exactly one record of its type (no bytes
-missing, none left over, the attachment CRC right). :func:`next_record_start` finds the
-next plausible record after damaged bytes (resynchronisation), and :func:`decompress`
-gives the readable prefix of a truncated or damaged compressed chunk (zstd and lz4 are
-decoded as streams, so everything before the damage comes back).
+allocated; a record parses only when its body holds one whole record of its type (no bytes
+missing, the attachment CRC right). Bytes after the last field are allowed where the MCAP
+specification allows them (fields a newer writer appends: every record but a message, a
+chunk, whose records fill it, and the fixed-size data end and footer);
+:func:`trailing_is_damage` tells them from a length field grown by damage.
+:func:`next_record_start` finds the next plausible record after damaged bytes
+(resynchronisation), and :func:`decompress` gives the readable prefix of a truncated or
+damaged compressed chunk (zstd and lz4 are decoded as streams, so everything before the
+damage comes back).
 """
 
 from __future__ import annotations
@@ -55,6 +59,8 @@ _CLASSES: dict[int, Any] = {
     Opcode.SUMMARY_OFFSET: SummaryOffset, Opcode.DATA_END: DataEnd,
 }
 KNOWN_OPCODES = frozenset(_CLASSES) | {Opcode.MESSAGE, Opcode.CHUNK}
+# records whose size the specification fixes (no fields can be appended)
+_FIXED_SIZE = frozenset({Opcode.DATA_END, Opcode.FOOTER})
 CHUNK_OPCODES = frozenset({Opcode.SCHEMA, Opcode.CHANNEL, Opcode.MESSAGE})
 _ZSTD_STEP = 16 * 1024  # compressed bytes fed per call: the granularity of a salvage
 
@@ -72,6 +78,7 @@ class Raw:
     opcode: int
     length: int
     record: Any
+    trailing: int = 0  # bytes after the last field the record type defines
 
     @property
     def end(self) -> int:
@@ -88,25 +95,30 @@ def head(buf: FileBytes, pos: int, end: int) -> tuple[int, int] | None:
 
 
 def parse_body(opcode: int, body: bytes | memoryview) -> Any:
-    """The record of ``opcode`` in ``body``; :class:`RecordError` unless ``body`` is
-    exactly one valid record."""
+    """The record of ``opcode`` in ``body``; :class:`RecordError` unless ``body`` holds
+    one valid record (and only bytes a newer writer may append after it)."""
+    return _parse(opcode, body)[0]
+
+
+def _parse(opcode: int, body: bytes | memoryview) -> tuple[Any, int]:
+    """(record, bytes its fields take) of :func:`parse_body`."""
     n = len(body)
     if n < _MIN_LENGTH.get(opcode, 0):
         raise RecordError(f"{n} bytes are too few for opcode 0x{opcode:02x}")
     if opcode == Opcode.CHUNK:
-        return _parse_chunk(body, complete=True)
+        return _parse_chunk(body, complete=True), n
     if opcode == Opcode.MESSAGE:  # the common records, parsed without a stream
         cid, seq, log_time, publish_time = struct.unpack_from("<HIQQ", body, 0)
         return Message(channel_id=cid, sequence=seq, log_time=log_time,
-                       publish_time=publish_time, data=bytes(body[22:]))
+                       publish_time=publish_time, data=bytes(body[22:])), n
     if opcode == Opcode.MESSAGE_INDEX:
         if n < 6:
             raise RecordError("message index cut short")
         cid, rl = struct.unpack_from("<HI", body, 0)
-        if rl % 16 or 6 + rl != n:
+        if rl % 16 or 6 + rl > n:
             raise RecordError(f"message index of {n} bytes says {rl} bytes of entries")
         return MessageIndex(channel_id=cid, records=list(
-            struct.iter_unpack("<QQ", body[6:])))
+            struct.iter_unpack("<QQ", body[6:6 + rl]))), 6 + rl
     stream = ReadDataStream(io.BytesIO(bytes(body)))
     try:
         if opcode in _CLASSES:
@@ -117,13 +129,14 @@ def parse_body(opcode: int, body: bytes | memoryview) -> Any:
         raise
     except Exception as e:  # noqa: BLE001 - the mcap parsers raise many kinds on garbage
         raise RecordError(f"{type(e).__name__}: {str(e)[:80]}") from None
-    if stream.count != n:
-        raise RecordError(f"record of {n} bytes holds {stream.count} bytes of fields")
+    used = stream.count
+    if used != n and opcode in _FIXED_SIZE:
+        raise RecordError(f"record of {n} bytes holds {used} bytes of fields")
     if opcode == Opcode.ATTACHMENT:
-        stored = struct.unpack_from("<I", body, n - 4)[0]
-        if stored != 0 and zlib.crc32(bytes(body[: n - 4])) != stored:
+        stored = struct.unpack_from("<I", body, used - 4)[0]
+        if stored != 0 and zlib.crc32(bytes(body[: used - 4])) != stored:
             raise RecordError("attachment CRC does not match its bytes")
-    return rec
+    return rec, used
 
 
 def _parse_chunk(body: bytes | memoryview, complete: bool) -> Chunk:
@@ -168,7 +181,19 @@ def read_record(buf: FileBytes, pos: int, end: int) -> Raw:
         raise RecordError(f"unknown opcode 0x{opcode:02x}")
     if length > end - pos - 9:
         raise RecordError(f"record of {length} bytes runs past the end ({end - pos - 9} left)")
-    return Raw(pos, opcode, length, parse_body(opcode, buf[pos + 9:pos + 9 + length]))
+    rec, used = _parse(opcode, buf[pos + 9:pos + 9 + length])
+    return Raw(pos, opcode, length, rec, length - used)
+
+
+def trailing_is_damage(buf: FileBytes, raw: Raw, end: int) -> bool:
+    """Whether the bytes after the fields of ``raw`` (which a newer writer may append) are
+    rather a length field grown by damage: they hold a whole record themselves, or the
+    record does not end where the end, the closing magic or another record begins."""
+    if not raw.trailing:
+        return False
+    if next_record_start(buf, raw.end - raw.trailing, raw.end) is not None:
+        return True
+    return not _plausible_next(buf, raw.end, end, KNOWN_OPCODES)
 
 
 def _plausible_next(buf: FileBytes, pos: int, end: int, opcodes: frozenset[int]

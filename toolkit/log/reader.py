@@ -30,12 +30,13 @@ from mcap.summary import Summary
 
 from sgtool.errors import LogFormatError, MissingChannelError, SchemaVersionError, SgtoolError
 from sgtool.log import chunk_stream as cs
-from sgtool.log import codec
+from sgtool.log import codec, walk_index
 from sgtool.log import schemas as S
 from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler, TransformBuffer, decoded
 from sgtool.log.chunk_copy import RawChunk, raw_chunk
 from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.log.image_wire import parse_raw_image
+from sgtool.log.log_file import require_regular_file
 from sgtool.log.records import RECORD_TYPES, LogRecord
 from sgtool.log.summary_check import BoundedReader as _BoundedReader
 from sgtool.log.summary_check import check_summary, read_attachment
@@ -99,6 +100,7 @@ class LogReader:
             raise LogFormatError(f"{self.path}: no such file")
         if self.path.is_dir():
             raise LogFormatError(f"{self.path} is a folder; expected an MCAP file")
+        require_regular_file(self.path)
         with open(self.path, "rb") as f:
             if f.read(8) != _MAGIC:
                 raise LogFormatError(
@@ -139,20 +141,23 @@ class LogReader:
                 f"{self.path}: not a readable MCAP file ({type(e).__name__}); "
                 f"`sgtool doctor {self.path}` says what is wrong"
             ) from e
-        if summary is None:
-            self._f.close()
-            raise LogFormatError(
-                f"{self.path}: the file has no summary section (truncated or still being "
-                f"written); recover it with `sgtool doctor {self.path} --recover OUT.mcap`"
-            )
-        self.summary: Summary = summary
+        # the summary is optional in MCAP, and so is each of its parts: when it does not say
+        # everything (no statistics, schemas it lacks, messages outside chunks ...), the
+        # file is read once and indexed from its records (:mod:`sgtool.log.walk_index`)
+        self._walked: list[walk_index.Entry] | None = None
         try:
-            check_summary(self._f, size, summary)
-            self.metadata: dict[str, dict[str, str]] = {
-                m.name: dict(m.metadata) for m in self._reader.iter_metadata()
-            }
+            if summary is not None:
+                check_summary(self._f, size, summary)
+            if walk_index.needs_walk(summary):
+                walked = walk_index.walk_log(self.path, size)
+                summary, self._walked = walked.summary, walked.messages
+                self.metadata: dict[str, dict[str, str]] = walked.metadata
+            else:
+                self.metadata = {m.name: dict(m.metadata) for m in self._reader.iter_metadata()}
         except LogFormatError as e:
             self._f.close()
+            if str(e).startswith(str(self.path)):
+                raise
             raise LogFormatError(f"{self.path}: {e}; `sgtool doctor {self.path}` says what "
                                  "is readable and --recover copies it") from None
         except Exception as e:  # noqa: BLE001 - the mcap library on damaged records
@@ -160,6 +165,8 @@ class LogReader:
             raise LogFormatError(
                 f"{self.path}: damaged metadata ({type(e).__name__}); `sgtool doctor "
                 f"{self.path}` says what is readable") from None
+        assert summary is not None
+        self.summary: Summary = summary
         self._decoders: dict[int, Any] = {}
         self._frame_times: list[int] | None = None
         self._buffers = cs.ChunkBuffers()  # chunks decompressed for views, reused
@@ -410,6 +417,8 @@ class LogReader:
         """Messages in log-time order (ties in file order): chunk by chunk
         (:mod:`sgtool.log.chunk_stream`) when the file is chunked and read forwards, else
         through the ``mcap`` reader."""
+        if self._walked is not None:
+            return self._from_walk(topics, start_ns, end_ns, reverse)
         if self.summary.chunk_indexes and not reverse:
             return cs.ordered_messages(self._f, self.summary, topics, start_ns=start_ns,
                                     end_ns=end_ns, verify=self.verify, views=views,
@@ -417,6 +426,17 @@ class LogReader:
         return self._reader.iter_messages(topics=topics, starting_at=start_ns,
                                           ending_before=end_ns, log_time_order=True,
                                           reverse=reverse)
+
+    def _from_walk(self, topics: list[str] | None, start_ns: int | None, end_ns: int | None,
+                   reverse: bool) -> Iterator[tuple[Schema | None, Channel, Message]]:
+        """The messages of a file indexed by a walk, as :meth:`_iter` gives them."""
+        assert self._walked is not None
+        entries = reversed(self._walked) if reverse else iter(self._walked)
+        for e in entries:
+            t = int(e[2].log_time)
+            if ((topics is None or e[1].topic in topics)
+                    and (start_ns is None or t >= start_ns) and (end_ns is None or t < end_ns)):
+                yield e
 
     def _checked(self, it: Iterator[Any]) -> Iterator[Any]:
         """``it``, with damaged chunks (bad CRC, bad compression, bad records) turned into a
@@ -445,6 +465,8 @@ class LogReader:
         return self._frame_times
 
     def _index_times(self, topic: str) -> list[int]:
+        if self._walked is not None:
+            return [int(m.log_time) for _, ch, m in self._walked if ch.topic == topic]
         cids = {cid for cid, ch in self.summary.channels.items() if ch.topic == topic}
         times: list[int] = []
         for ci in self.summary.chunk_indexes:

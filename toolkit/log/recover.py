@@ -35,9 +35,11 @@ from sgtool.errors import LogFormatError, SgtoolError
 from sgtool.files import atomic_open
 from sgtool.log.file_check import SummaryState, check, expected_messages, summary_state
 from sgtool.log.file_walk import Item, Layout, walk
+from sgtool.log.log_file import require_regular_file
 from sgtool.log.mcap_records import MAGIC
 
 Status = Literal["complete", "unverified", "truncated", "corrupt"]
+_OUTSIDE_CHUNKS = -1  # the key of messages outside chunks among the per-chunk counts
 
 
 @dataclass
@@ -75,6 +77,7 @@ def _diagnose(buf: mmap.mmap, diag: Diagnosis, writer: _Copier | None) -> None:
     unknown = _consume(walk(buf, lay), diag, writer)
     read = {c.offset: Counter((cid, t) for cid, t, _ in c.messages if cid not in unknown)
             for c in lay.chunks}
+    read[_OUTSIDE_CHUNKS] = Counter((cid, t) for cid, t, _ in lay.loose if cid not in unknown)
     state = summary_state(buf, lay)
     diag.checks = _checks(lay, state)
     problems = list(lay.problems) + diag.problems
@@ -91,16 +94,18 @@ def _diagnose(buf: mmap.mmap, diag: Diagnosis, writer: _Copier | None) -> None:
 def _verified(lay: Layout) -> Status:
     """"complete" when CRCs cover every message, else "unverified": every record reads and
     every index agrees, but damage inside the messages of a chunk without a CRC (the
-    writer wrote none) cannot be seen."""
+    writer wrote none), or of messages outside chunks without a data section CRC, cannot be
+    seen."""
     if lay.data_end is not None and lay.data_end.record.data_section_crc:
         return "complete"
-    return "complete" if all(c.header.uncompressed_crc for c in lay.chunks) else "unverified"
+    covered = all(c.header.uncompressed_crc for c in lay.chunks) and not lay.loose
+    return "complete" if covered else "unverified"
 
 
 def _checks(lay: Layout, state: SummaryState) -> dict[str, str]:
     chunks = [c for c in lay.chunks if c.header.uncompressed_crc]
     out = {"chunks": f"{sum(c.intact for c in chunks)} of {len(lay.chunks)} verified"
-           if chunks else "no CRCs written"}
+           if chunks else "no CRCs written" if lay.chunks else "no chunks"}
     out["summary"] = ("absent" if not state.present else "not written"
                       if not state.crc_checked else "ok" if state.crc_ok else "mismatch")
     if lay.data_end is not None:
@@ -145,8 +150,9 @@ def _account_losses(buf: mmap.mmap, lay: Layout, state: SummaryState,
 def scan(path: str | os.PathLike[str]) -> Diagnosis:
     """Read the whole file and say whether it is complete, truncated or corrupt."""
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         raise LogFormatError(f"{p}: no such file")
+    require_regular_file(p)
     _require_magic(p)
     diag = Diagnosis(str(p), p.stat().st_size)
     with open(p, "rb") as f, _mapped(f, diag.size) as buf:
@@ -286,8 +292,9 @@ def recover(path: str | os.PathLike[str], out: str | os.PathLike[str],
     the input file.
     """
     src, dst = Path(path), Path(out)
-    if not src.is_file():
+    if not src.exists():
         raise LogFormatError(f"{src}: no such file")
+    require_regular_file(src)
     if dst.exists() and os.path.samefile(src, dst):
         raise SgtoolError(f"refusing to write the recovered log over its input {src}")
     if dst.is_dir():
