@@ -402,7 +402,13 @@ class LogReader:
     def chunks(self, *, views: bool = False) -> Iterator[tuple[RawChunk | None, list[cs.Item]]]:
         """Each chunk in file order, as it is (:func:`~sgtool.log.chunk_copy.raw_chunk`: None
         when its indexes do not allow a copy; its CRC always checked: a copy keeps it) with
-        its messages in log-time order (that of :meth:`raw_messages` when in sequence)."""
+        its messages in log-time order (that of :meth:`raw_messages` when in sequence). A
+        file indexed by a walk (its summary says too little; messages may lie outside
+        chunks) is one group of every message, with no chunk to copy."""
+        walked = self._walked
+        if walked is not None:
+            return iter([(None, list(walked))])
+
         def each() -> Iterator[tuple[RawChunk | None, list[cs.Item]]]:
             for ci in sorted(self.summary.chunk_indexes, key=lambda c: c.chunk_start_offset):
                 record = cs.read_chunk(self._f, ci)
