@@ -256,6 +256,7 @@ class SceneGraphBuilder:
         t_all = self.clock()
         stamp = int(time_ns or 0)
         self._clear_footprint()
+        t_body = self.clock()
         key = (self.voxels.version, len(self.trajectory), self.robot,
                tuple((i, v.state) for i, v in self.instances.items()))
         if not from_scratch and self._last is not None and self._last[0] == key:
@@ -273,6 +274,7 @@ class SceneGraphBuilder:
             self._centre_memo = {}
             self._region_memo = {}
         timings = self.timings_scratch if from_scratch else self.timings
+        timings["body"].append((t_body - t_all) * 1e3)  # the body's free space (and flush)
         tick = _Ticker(timings, self.clock)
         cfg = self.config
         occ = self._occupancy()
