@@ -58,7 +58,7 @@ from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.mapping.backproject import Scratch, beyond_packing, within_packing, world_voxels
 from sgtool.mapping.key_count import count_keys
 from sgtool.mapping.label_stats import LabelStats, update_frame
-from sgtool.mapping.vote_store import VoteStore, drain_keys, spans
+from sgtool.mapping.vote_store import VoteStore, drain_keys, sorted_unique, spans
 
 AXIS_BITS = 17
 LABEL_BITS = 12
@@ -369,7 +369,7 @@ class VoxelMap:
         keys, counts = self.entries()
         mask = (keys & LABEL_MASK) == lab
         if mask.any():
-            lo, hi = _voxel_bounds(np.unique(keys[mask] >> VOXEL_SHIFT))
+            lo, hi = _voxel_bounds(sorted_unique(keys[mask] >> VOXEL_SHIFT))
             idx = spans(np.searchsorted(keys, lo), np.searchsorted(keys, hi))
             win = idx[winning_entries(keys[idx], counts[idx])]
             won_vk = keys[win[(keys[win] & LABEL_MASK) == lab]] >> VOXEL_SHIFT
@@ -412,7 +412,7 @@ class VoxelMap:
         near = (((cx + 0.5) * res - pts[:, 0, None, None]) ** 2
                 + ((cy + 0.5) * res - pts[:, 1, None, None]) ** 2) <= radius * radius
         cx, cy = np.broadcast_arrays(cx, cy)
-        cols = np.unique(((cx[near] + OFFSET) << AXIS_BITS) | (cy[near] + OFFSET))
+        cols = sorted_unique(((cx[near] + OFFSET) << AXIS_BITS) | (cy[near] + OFFSET))
         keys, _ = self._store.within(cols << COLUMN_SHIFT, (cols + 1) << COLUMN_SHIFT)
         if not len(keys):
             return 0

@@ -23,6 +23,7 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
+from sgtool.mapping.vote_store import sorted_unique
 from sgtool.mapping.voxels import LABEL_MASK, VOXEL_SHIFT, unpack
 
 
@@ -70,22 +71,24 @@ class DoorVoxels:
         ``winning_labels`` gives the winning label of sorted distinct voxel keys (the map's
         :meth:`~sgtool.mapping.voxels.VoxelMap.winning_labels`)."""
         ids = sorted(int(i) for i in instance_ids)
-        keys = {}
+        parts = []
         for iid in ids:
-            parts = self._keys.get(iid)
-            if parts and len(parts) > 1:
-                parts[:] = [np.concatenate(parts)]
-            keys[iid] = parts[0] if parts else np.zeros(0, np.int64)
-        out = {iid: np.zeros((0, 3), np.int64) for iid in ids}
-        if not any(len(k) for k in keys.values()):
-            return out
-        vk = np.unique(np.concatenate(list(keys.values())) >> VOXEL_SHIFT)
-        win = winning_labels(vk)
-        for iid, k in keys.items():
-            mine = k[win[np.searchsorted(vk, k >> VOXEL_SHIFT)] == (k & LABEL_MASK)]
-            ix, iy, iz, _ = unpack(mine)
-            out[iid] = np.stack([ix, iy, iz], axis=1)
-        return out
+            got = self._keys.get(iid)
+            if got and len(got) > 1:
+                got[:] = [np.concatenate(got)]
+            parts.append(got[0] if got else np.zeros(0, np.int64))
+        sizes = np.array([len(p) for p in parts], dtype=np.int64)
+        if not sizes.sum():
+            return {iid: np.zeros((0, 3), np.int64) for iid in ids}
+        keys = np.concatenate(parts)  # door by door, in id order
+        door = np.repeat(np.arange(len(ids)), sizes)
+        vk_all = keys >> VOXEL_SHIFT
+        vk = sorted_unique(vk_all)
+        mine = winning_labels(vk)[np.searchsorted(vk, vk_all)] == (keys & LABEL_MASK)
+        ix, iy, iz, _ = unpack(keys[mine])
+        ijk = np.stack([ix, iy, iz], axis=1)
+        split = np.cumsum(np.bincount(door[mine], minlength=len(ids)))[:-1]
+        return dict(zip(ids, np.split(ijk, split), strict=True))
 
     def of(self, instance_ids: Iterable[int]) -> dict[int, np.ndarray]:
         """Instance id -> ijk (M, 3) of its voxels (each once), for door instances."""

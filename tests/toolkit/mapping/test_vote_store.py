@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sgtool.mapping.vote_store import VoteStore
+from sgtool.mapping.vote_store import VoteStore, sorted_unique
 
 
 def _reference_add(keys: np.ndarray, counts: np.ndarray, uk: np.ndarray, cnt: np.ndarray
@@ -85,3 +85,10 @@ def test_within_ranges_equals_the_merged_arrays_sliced(seed: int) -> None:
         inside |= (keys >= a) & (keys < b)
     np.testing.assert_array_equal(got_k, keys[inside])
     np.testing.assert_array_equal(got_c, counts[inside])
+
+
+@pytest.mark.parametrize("n", [0, 1, 2, 50, 3000])
+def test_sorted_unique_equals_numpy_unique(n: int) -> None:
+    a = np.random.default_rng(n).integers(-(1 << 40), 1 << 40, n) // 1000  # repeats
+    a = np.concatenate([a, a[: n // 3]])
+    np.testing.assert_array_equal(sorted_unique(a), np.unique(a))
