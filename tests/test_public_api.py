@@ -1,8 +1,9 @@
 """The public Python API (``import sgtool``): light, complete, documented, typed.
 
-``sgtool/__init__.py`` is a facade: a table of public name -> ``module:attribute``
-imported on first use (PEP 562), mirrored by ``if TYPE_CHECKING:`` imports for mypy. These
-tests keep the table, the type-checking imports and the objects behind them in step.
+``sgtool/__init__.py`` is a facade: each public name is imported from its module on first
+use (PEP 562), by the ``from M import A as NAME`` lines of the stub ``__init__.pyi``, which
+type checkers read. These tests keep the stub, ``__all__`` and the objects behind them in
+step.
 """
 
 from __future__ import annotations
@@ -79,17 +80,21 @@ def test_every_public_name_resolves_to_its_table_entry() -> None:
         assert getattr(sgtool, name) is getattr(importlib.import_module(module), attribute), name
 
 
-def test_the_type_checking_imports_mirror_the_table() -> None:
-    """What mypy and IDEs see (the ``if TYPE_CHECKING:`` imports) is what run time gives."""
-    tree = ast.parse(INIT.read_text())
-    block = next(n for n in tree.body if isinstance(n, ast.If)
-                 and isinstance(n.test, ast.Name) and n.test.id == "TYPE_CHECKING")
+def test_the_stub_declares_what_run_time_gives() -> None:
+    """What mypy and IDEs see (the stub's imports and ``__all__``) is what run time gives."""
+    tree = ast.parse((INIT.parent / "__init__.pyi").read_text())
     seen: dict[str, str] = {}
-    for node in block.body:
-        assert isinstance(node, ast.ImportFrom) and node.module is not None
-        for alias in node.names:
-            seen[alias.asname or alias.name] = f"{node.module}:{alias.name}"
+    declared: list[str] = []
+    for node in tree.body:
+        if isinstance(node, ast.ImportFrom) and node.module != "sgtool.version":
+            assert node.module is not None
+            for alias in node.names:
+                assert alias.asname is not None, f"{alias.name}: write 'import A as NAME'"
+                seen[alias.asname] = f"{node.module}:{alias.name}"
+        elif isinstance(node, ast.Assign) and getattr(node.targets[0], "id", "") == "__all__":
+            declared = list(ast.literal_eval(node.value))
     assert seen == sgtool._EXPORTS
+    assert declared == sgtool.__all__  # static tools read the stub's list
 
 
 def _own_doc(obj: object) -> str:

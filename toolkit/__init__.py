@@ -60,197 +60,26 @@ A few names differ from their defining module's to stay unambiguous at the top l
 
 from __future__ import annotations
 
+import ast
 import importlib
-from typing import TYPE_CHECKING
+from pathlib import Path
 
 from sgtool.version import __version__ as __version__
 
-if TYPE_CHECKING:  # the real types for mypy and IDEs; at run time __getattr__ imports them
-    from sgtool.analysis.bench import BenchConfig, BenchResult, run_benchmark
-    from sgtool.analysis.bench import write_outputs as write_bench_outputs
-    from sgtool.analysis.metrics import (
-        CostModel,
-        PlannerSummary,
-        Stat,
-        auc_e,
-        cost_models,
-        efficiency_curve,
-        episode_spl,
-        mean_decision_time,
-        mean_steps,
-        metrics_of,
-        spl,
-        success_rate,
-        summarize,
-    )
-    from sgtool.analysis.offline import (
-        LoggedEpisode,
-        OfflineReport,
-        format_offline,
-        load_results,
-        read_log_episodes,
-        replay_decisions,
-    )
-    from sgtool.analysis.report import format_table
-    from sgtool.datasets.episodes import Episode as SearchEpisode
-    from sgtool.datasets.episodes import list_episodes
-    from sgtool.datasets.generator import generate_house
-    from sgtool.errors import LogFormatError, SgtoolError, SpecError
-    from sgtool.house.io import load_house, load_house_text, save_house
-    from sgtool.house.spec import HouseSpec
-    from sgtool.log.frame import CameraIntrinsics, Frame
-    from sgtool.log.reader import LogReader
-    from sgtool.log.records import Action as ActionRecord
-    from sgtool.log.records import Episode as EpisodeRecord
-    from sgtool.log.records import (
-        InstanceItem,
-        Instances,
-        LlmExchange,
-        LogRecord,
-        SceneGraphRecord,
-    )
-    from sgtool.log.writer import LogWriter
-    from sgtool.planning.base import Action, Feedback, Planner
-    from sgtool.planning.candidates import Candidate, actionable, find_target
-    from sgtool.planning.registry import make_planner
-    from sgtool.progress import Progress
-    from sgtool.recorders.exporters.bag_export import ExportReport, export_bag
-    from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
-    from sgtool.recorders.importers.sink import ImportReport
-    from sgtool.recorders.importers.textformats import PinholeParams, parse_intrinsics
-    from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode
-    from sgtool.recorders.sim.closed_loop import run_episode as run_closed_loop
-    from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport
-    from sgtool.recorders.symbolic_environment.house import SymbolicHouse
-    from sgtool.recorders.symbolic_environment.rollout import run_one
-    from sgtool.replayers.derived_log import ReplayOptions, ReplayReport, replay
-    from sgtool.results import EpisodeResult
-    from sgtool.results import read_jsonl as read_results
-    from sgtool.results import write_jsonl as write_results
-    from sgtool.scenegraph.graph import (
-        DoorNode,
-        ObjectNode,
-        RegionNode,
-        RobotState,
-        RoomNode,
-        SceneGraph,
-    )
-    from sgtool.scenegraph.stream import Refresh, SceneGraphStream
+
+def _read_stub() -> dict[str, str]:
+    """public name -> "module:attribute", from the ``from M import A as NAME`` lines of
+    ``__init__.pyi`` (the one list of public names; ``sgtool.version`` is imported above)."""
+    tree = ast.parse((Path(__file__).parent / "__init__.pyi").read_text(encoding="utf-8"))
+    return {alias.asname or alias.name: f"{node.module}:{alias.name}"
+            for node in tree.body if isinstance(node, ast.ImportFrom)
+            and node.module is not None and node.module != "sgtool.version"
+            for alias in node.names}
+
 
 # public name -> "module:attribute" it is imported from on first use
-_EXPORTS: dict[str, str] = {
-    # errors
-    "SgtoolError": "sgtool.errors:SgtoolError",
-    "LogFormatError": "sgtool.errors:LogFormatError",
-    "SpecError": "sgtool.errors:SpecError",
-    # logs and their typed records
-    "LogReader": "sgtool.log.reader:LogReader",
-    "LogWriter": "sgtool.log.writer:LogWriter",
-    "Frame": "sgtool.log.frame:Frame",
-    "CameraIntrinsics": "sgtool.log.frame:CameraIntrinsics",
-    "LogRecord": "sgtool.log.records:LogRecord",
-    "EpisodeRecord": "sgtool.log.records:Episode",
-    "ActionRecord": "sgtool.log.records:Action",
-    "Instances": "sgtool.log.records:Instances",
-    "InstanceItem": "sgtool.log.records:InstanceItem",
-    "SceneGraphRecord": "sgtool.log.records:SceneGraphRecord",
-    "LlmExchange": "sgtool.log.records:LlmExchange",
-    # replay: a log into scene graphs
-    "replay": "sgtool.replayers.derived_log:replay",
-    "ReplayOptions": "sgtool.replayers.derived_log:ReplayOptions",
-    "ReplayReport": "sgtool.replayers.derived_log:ReplayReport",
-    "Progress": "sgtool.progress:Progress",
-    "SceneGraphStream": "sgtool.scenegraph.stream:SceneGraphStream",
-    "Refresh": "sgtool.scenegraph.stream:Refresh",
-    # the scene graph
-    "SceneGraph": "sgtool.scenegraph.graph:SceneGraph",
-    "RoomNode": "sgtool.scenegraph.graph:RoomNode",
-    "RegionNode": "sgtool.scenegraph.graph:RegionNode",
-    "ObjectNode": "sgtool.scenegraph.graph:ObjectNode",
-    "DoorNode": "sgtool.scenegraph.graph:DoorNode",
-    "RobotState": "sgtool.scenegraph.graph:RobotState",
-    # planners
-    "Planner": "sgtool.planning.base:Planner",
-    "Action": "sgtool.planning.base:Action",
-    "Feedback": "sgtool.planning.base:Feedback",
-    "make_planner": "sgtool.planning.registry:make_planner",
-    "actionable": "sgtool.planning.candidates:actionable",
-    "Candidate": "sgtool.planning.candidates:Candidate",
-    "find_target": "sgtool.planning.candidates:find_target",
-    # houses and their search episodes
-    "HouseSpec": "sgtool.house.spec:HouseSpec",
-    "load_house": "sgtool.house.io:load_house",
-    "load_house_text": "sgtool.house.io:load_house_text",
-    "save_house": "sgtool.house.io:save_house",
-    "generate_house": "sgtool.datasets.generator:generate_house",
-    "SearchEpisode": "sgtool.datasets.episodes:Episode",
-    "list_episodes": "sgtool.datasets.episodes:list_episodes",
-    # the symbolic benchmark
-    "run_one": "sgtool.recorders.symbolic_environment.rollout:run_one",
-    "SymbolicHouse": "sgtool.recorders.symbolic_environment.house:SymbolicHouse",
-    "EpisodeResult": "sgtool.results:EpisodeResult",
-    "BenchConfig": "sgtool.analysis.bench:BenchConfig",
-    "BenchResult": "sgtool.analysis.bench:BenchResult",
-    "run_benchmark": "sgtool.analysis.bench:run_benchmark",
-    "write_bench_outputs": "sgtool.analysis.bench:write_outputs",
-    # the closed loop (PyBullet: sgtool[sim])
-    "run_closed_loop": "sgtool.recorders.sim.closed_loop:run_episode",
-    "ClosedLoopOptions": "sgtool.recorders.sim.closed_loop:ClosedLoopOptions",
-    "ClosedLoopReport": "sgtool.recorders.sim.closed_loop_report:ClosedLoopReport",
-    "pick_episode": "sgtool.recorders.sim.closed_loop:pick_episode",
-    # metrics
-    "success_rate": "sgtool.analysis.metrics:success_rate",
-    "spl": "sgtool.analysis.metrics:spl",
-    "episode_spl": "sgtool.analysis.metrics:episode_spl",
-    "mean_steps": "sgtool.analysis.metrics:mean_steps",
-    "mean_decision_time": "sgtool.analysis.metrics:mean_decision_time",
-    "auc_e": "sgtool.analysis.metrics:auc_e",
-    "efficiency_curve": "sgtool.analysis.metrics:efficiency_curve",
-    "CostModel": "sgtool.analysis.metrics:CostModel",
-    "cost_models": "sgtool.analysis.metrics:cost_models",
-    "metrics_of": "sgtool.analysis.metrics:metrics_of",
-    "summarize": "sgtool.analysis.metrics:summarize",
-    "PlannerSummary": "sgtool.analysis.metrics:PlannerSummary",
-    "Stat": "sgtool.analysis.metrics:Stat",
-    "format_table": "sgtool.analysis.report:format_table",
-    "read_results": "sgtool.results:read_jsonl",
-    "write_results": "sgtool.results:write_jsonl",
-    # planners against logged decisions
-    "load_results": "sgtool.analysis.offline:load_results",
-    "read_log_episodes": "sgtool.analysis.offline:read_log_episodes",
-    "LoggedEpisode": "sgtool.analysis.offline:LoggedEpisode",
-    "replay_decisions": "sgtool.analysis.offline:replay_decisions",
-    "OfflineReport": "sgtool.analysis.offline:OfflineReport",
-    "format_offline": "sgtool.analysis.offline:format_offline",
-    # import and export
-    "import_rgbd": "sgtool.recorders.importers.rgbd:import_rgbd",
-    "RgbdOptions": "sgtool.recorders.importers.rgbd:RgbdOptions",
-    "PinholeParams": "sgtool.recorders.importers.textformats:PinholeParams",
-    "parse_intrinsics": "sgtool.recorders.importers.textformats:parse_intrinsics",
-    "ImportReport": "sgtool.recorders.importers.sink:ImportReport",
-    "export_bag": "sgtool.recorders.exporters.bag_export:export_bag",
-    "ExportReport": "sgtool.recorders.exporters.bag_export:ExportReport",
-}
-
-# every public name (the table's and planner_names), spelled out for tools that read
-# __all__ without running the module; tests/test_public_api.py keeps it in step
-__all__ = [
-    "planner_names", "SgtoolError", "LogFormatError", "SpecError", "LogReader", "LogWriter",
-    "Frame", "CameraIntrinsics", "LogRecord", "EpisodeRecord", "ActionRecord", "Instances",
-    "InstanceItem", "SceneGraphRecord", "LlmExchange", "replay", "ReplayOptions",
-    "ReplayReport", "Progress", "SceneGraphStream", "Refresh", "SceneGraph", "RoomNode",
-    "RegionNode", "ObjectNode", "DoorNode", "RobotState", "Planner", "Action", "Feedback",
-    "make_planner", "actionable", "Candidate", "find_target", "HouseSpec", "load_house",
-    "load_house_text", "save_house", "generate_house", "SearchEpisode", "list_episodes",
-    "run_one", "SymbolicHouse", "EpisodeResult", "BenchConfig", "BenchResult", "run_benchmark",
-    "write_bench_outputs", "run_closed_loop", "ClosedLoopOptions", "ClosedLoopReport",
-    "pick_episode", "success_rate", "spl", "episode_spl", "mean_steps", "mean_decision_time",
-    "auc_e", "efficiency_curve", "CostModel", "cost_models", "metrics_of", "summarize",
-    "PlannerSummary", "Stat", "format_table", "read_results", "write_results", "load_results",
-    "read_log_episodes", "LoggedEpisode", "replay_decisions", "OfflineReport", "format_offline",
-    "import_rgbd", "RgbdOptions", "PinholeParams", "parse_intrinsics", "ImportReport",
-    "export_bag", "ExportReport",
-]
+_EXPORTS: dict[str, str] = _read_stub()
+__all__ = ["planner_names", *_EXPORTS]
 
 
 def planner_names() -> tuple[str, ...]:
