@@ -145,12 +145,6 @@ class SymbolicEnv:
             self._visible_furn.add(f)
             self._view.show_furniture(f)
 
-    def visible_furniture(self) -> list[int]:
-        return sorted(self._visible_furn)
-
-    def visible_objects(self) -> list[int]:
-        return sorted(self.seen_objects)
-
     def _look(self, f: int) -> list[int]:
         """Walk-up view of furniture ``f``: reveal what is on it, and what is in it when it
         is not closed, then what is on / in each revealed object by the same rule (module

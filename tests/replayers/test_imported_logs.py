@@ -25,16 +25,12 @@ from pathlib import Path
 
 import networkx as nx
 import numpy as np
-import pytest
 from scipy import ndimage
 
 from sgtool.log import LogReader
+from sgtool.mapping import bev
 from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
-
-builder_mod = pytest.importorskip(
-    "sgtool.scenegraph.builder", reason="the scene-graph builder is not in this checkout"
-)
-bev = pytest.importorskip("sgtool.mapping.bev", reason="the mapping pipeline is absent")
+from sgtool.scenegraph import builder as builder_mod
 
 
 def replay(log: Path):  # type: ignore[no-untyped-def]

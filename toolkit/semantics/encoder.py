@@ -120,9 +120,6 @@ class SentenceEncoder:
                 out[i] = self._memory[t]
             return out
 
-    def encode_one(self, text: str) -> np.ndarray:
-        return self.encode([text])[0]
-
     def cached(self, text: str) -> np.ndarray | None:
         """The vector of ``text`` if it is in memory (no disk or model access)."""
         return self._memory.get(text)
