@@ -93,12 +93,14 @@ def export(
     voxels: Callable[[Any], Iterator[tuple[int, int, np.ndarray, np.ndarray, float]]]
     | None = None,
     spawn: bool = False,
+    warn: Callable[[str], None] | None = None,
 ) -> Path | None:
     """Write ``log_path`` as a Rerun recording to ``rrd_path`` (atomically), or stream it
     to a spawned viewer when ``spawn`` is set. ``every`` logs one camera frame in K (maps,
     graphs and actions are always logged). ``voxels``, when given, is called with the open
     reader and yields (frame index, t_ns, voxel centres (N,3), colours (N,3) uint8,
-    voxel size) to draw the semantic voxel map over time."""
+    voxel size) to draw the semantic voxel map over time. ``warn``, when given, receives
+    one-line notes about the log (frames without a camera pose)."""
     import rerun as rr
 
     log_path = Path(log_path)
@@ -114,8 +116,12 @@ def export(
             rec.save(tmp)
             progress = _watching_space(out, progress)
         with LogReader(log_path, verify=True) as r:  # a damaged chunk: one line, no .rrd
-            _export(rec, r, every=every, max_frames=max_frames, progress=progress,
-                    voxels=voxels)
+            unposed, framed = _export(rec, r, every=every, max_frames=max_frames,
+                                      progress=progress, voxels=voxels)
+        if unposed and warn is not None:
+            warn(f"{unposed} of {framed} frames have no camera pose: {S.TF} has no chain "
+                 f"{S.WORLD_FRAME} -> {S.CAMERA_FRAME} at their time (a missing link or a "
+                 "cycle); they are shown without one")
         rec.flush(timeout_sec=FLUSH_TIMEOUT_S)
         if out is not None and tmp is not None:
             require_space(out)
@@ -135,7 +141,8 @@ def _watching_space(rrd_path: Path, progress: Callable[[int], None] | None
 def _export(
     rec: Any, r: LogReader, *, every: int, max_frames: int | None,
     progress: Callable[[int], None] | None, voxels: Any,
-) -> None:
+) -> tuple[int, int]:
+    """Log everything; returns (frames without a camera pose, frames logged)."""
     import rerun as rr
 
     tr = r.time_range()
@@ -155,19 +162,25 @@ def _export(
         rec.log("world/camera/image", rr.AnnotationContext(ctx), static=True)
     # camera frames
     path_xy: list[tuple[float, float, float]] = []
+    unposed = framed = 0  # frames whose camera pose /tf does not give (a missing link, a cycle)
     if r.has(S.DEPTH):
         for n, fr in enumerate(r.frames()):
             if max_frames is not None and n >= max_frames:
                 break
             if progress:
                 progress(1)
+            framed += 1
             base = fr.base_pose if fr.base_pose is not None else fr.pose
+            here = None
             if np.all(np.isfinite(base)):
-                path_xy.append((float(base[0, 3]), float(base[1, 3]), 0.02))
+                here = (float(base[0, 3]), float(base[1, 3]), 0.02)
+                path_xy.append(here)
+            posed = bool(np.all(np.isfinite(fr.pose)))
+            unposed += not posed
             if fr.index % every:
                 continue
             stamp(fr.index, fr.time_ns)
-            if np.all(np.isfinite(fr.pose)):
+            if posed:
                 rec.log("world/camera", rr.Transform3D(
                     translation=fr.pose[:3, 3].astype(np.float32),
                     mat3x3=fr.pose[:3, :3].astype(np.float32)))
@@ -181,8 +194,9 @@ def _export(
             if fr.ids is not None:
                 rec.log("world/camera/image/segmentation",
                         rr.SegmentationImage(fr.ids.astype(np.uint16)))
-            rec.log("world/robot", rr.Points3D([path_xy[-1]], radii=0.15,
-                                               colors=[(230, 80, 40)]))
+            if here is not None:
+                rec.log("world/robot", rr.Points3D([here], radii=0.15,
+                                                   colors=[(230, 80, 40)]))
             if len(path_xy) > 1:
                 rec.log("world/robot/path", rr.LineStrips3D([np.array(path_xy, np.float32)],
                                                            radii=0.02, colors=[(230, 80, 40)]))
@@ -234,6 +248,7 @@ def _export(
         if a.get("travelled_m"):
             text += f" [{a['travelled_m']:.2f} m]"
         rec.log("actions", rr.TextLog(text, level=level))
+    return unposed, framed
 
 
 def _log_scene_graph(rec: Any, g: dict[str, Any]) -> None:

@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 import rerun as rr
 from click.testing import CliRunner
@@ -69,3 +70,33 @@ def test_view_of_a_replayed_log_with_voxels_and_derived_layers(tmp_path):
     r = CliRunner().invoke(cli, ["view", str(derived), "-o", str(out)])
     assert r.exit_code == 0, r.output
     rrd_verify(out)
+
+
+@pytest.mark.parametrize("links", [
+    [],  # no /tf at all: no camera link, no base link
+    [("base", "camera"), ("camera", "base")],  # a cycle: neither reaches the world
+])
+def test_view_of_a_log_without_a_camera_pose(tmp_path, links):
+    """Frames whose camera and base poses cannot be composed from /tf (a missing link or a
+    cycle) are shown without a pose and without a robot marker, not an IndexError."""
+    from support.logfixtures import DT, synthetic_frame
+
+    from sgtool.log import LogWriter
+
+    log = tmp_path / "run.mcap"
+    with LogWriter(log, seed=7) as w:
+        for i in range(3):
+            k, rgb, depth, ids, _, _ = synthetic_frame(i)
+            if i == 0:
+                w.write_calibration(0, k)
+            for parent, child in links:
+                w.write_transform(i * DT, parent, child, np.eye(4))
+            w.write_rgb(i * DT, rgb)
+            w.write_depth(i * DT, depth)
+            w.write_ids(i * DT, ids)
+    out = tmp_path / "view.rrd"
+    r = CliRunner().invoke(cli, ["view", str(log), "-o", str(out), "--no-voxels"])
+    assert r.exit_code == 0, r.output
+    rrd_verify(out)
+    assert "note: 3 of 3 frames have no camera pose: /tf has no chain world -> camera" in (
+        r.output)

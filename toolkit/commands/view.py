@@ -68,6 +68,7 @@ def command(log: str, out: str | None, every: int, max_frames: int | None,
                 return voxel_snapshots(reader, every=max(every, 10), max_frames=max_frames)
     with tqdm(total=total, unit="frame", desc="view", disable=None) as bar:
         export(log, out, every=every, max_frames=max_frames, progress=bar.update,
-               voxels=voxel_source, spawn=out is None)
+               voxels=voxel_source, spawn=out is None,
+               warn=lambda m: click.echo(f"note: {m}", err=True))
     if out:
         click.echo(f"wrote {out}; open it with: rerun {out}")
