@@ -12,15 +12,23 @@ use their own temporary file, and the last rename wins with a complete file.
 themselves (the log writer); :class:`OutputError` is the one-line user error for a
 destination that cannot be written (read-only, missing, full), made by
 :func:`output_error` from the :class:`OSError`.
+
+Folders of outputs (a benchmark's results, a batch of derived logs) go through
+:func:`output_folder`: built beside the target and moved in complete, a non-empty target
+refused without ``force``, and ``force`` replacing only what sgtool wrote there (the
+folder's :data:`MANIFEST` lists it); files a user put in the folder survive.
 """
 
 from __future__ import annotations
 
 import contextlib
 import errno
+import fnmatch
+import json
 import os
+import shutil
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import IO
 
@@ -137,3 +145,201 @@ def atomic_write(path: str | os.PathLike[str], data: str | bytes) -> Path:
     with atomic_open(path, "wb") as fh:
         fh.write(data.encode("utf-8") if isinstance(data, str) else data)
     return Path(path)
+
+
+# ----------------------------------------------------------------------------------------
+# output folders
+# ----------------------------------------------------------------------------------------
+# the file in an output folder that lists what sgtool wrote there: JSON
+# {"command": NAME, "files": [top-level names, sorted]}
+MANIFEST = ".sgtool-output"
+
+
+def _plain_name(name: object) -> bool:
+    """One entry of a folder (no separator, not ``.``/``..``, not the manifest)."""
+    return (isinstance(name, str) and name not in ("", ".", "..", MANIFEST)
+            and "/" not in name and os.sep not in name and "\0" not in name)
+
+
+def read_manifest(folder: str | os.PathLike[str]) -> tuple[str | None, frozenset[str]]:
+    """The command and the entry names the :data:`MANIFEST` of ``folder`` lists;
+    ``(None, frozenset())`` when there is none or it cannot be read. Only plain names
+    (one entry of the folder) are returned, whatever the file holds."""
+    try:
+        doc = json.loads(Path(folder, MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return None, frozenset()
+    if not isinstance(doc, dict):
+        return None, frozenset()
+    command = doc.get("command")
+    files = doc.get("files")
+    names = frozenset(n for n in files if _plain_name(n)) if isinstance(files, list) \
+        else frozenset()
+    return (command if isinstance(command, str) else None), names
+
+
+def manifest_text(command: str, names: Sequence[str]) -> str:
+    """The :data:`MANIFEST` of a folder ``command`` wrote ``names`` into."""
+    files = sorted({n for n in names if _plain_name(n)})
+    return json.dumps({"command": command, "files": files}, indent=1, sort_keys=True) + "\n"
+
+
+def _matches(name: str, known: Sequence[str]) -> bool:
+    return any(fnmatch.fnmatchcase(name, pattern) for pattern in known)
+
+
+def sgtool_entries(folder: Path, known: Sequence[str] = ()) -> set[str]:
+    """The entries of ``folder`` sgtool wrote: those its :data:`MANIFEST` lists, those
+    matching a pattern of ``known`` (a command's fixed output names), and the manifest."""
+    try:
+        present = set(os.listdir(folder))
+    except FileNotFoundError:
+        return set()
+    _, listed = read_manifest(folder)
+    ours = {n for n in present if n in listed or _matches(n, known)}
+    if MANIFEST in present:
+        ours.add(MANIFEST)
+    return ours
+
+
+def _is_own(folder: Path, command: str, known: Sequence[str]) -> bool:
+    """A folder ``command`` wrote (its manifest says so; without one, every entry matches
+    ``known``), or an empty one."""
+    present = os.listdir(folder)
+    owner, _ = read_manifest(folder)
+    if owner is not None:
+        return owner == command
+    return all(_matches(n, known) for n in present)
+
+
+def _folder_target(target: str | os.PathLike[str], option: str) -> Path:
+    path = Path(target)
+    if path.is_symlink() and path.is_dir():  # a link to a folder: the folder is the target
+        path = Path(os.path.realpath(path))
+    if path.exists() and not path.is_dir():
+        raise SgtoolError(f"{option} {target}: is a file, not a folder")
+    return path
+
+
+@contextlib.contextmanager
+def output_folder(target: str | os.PathLike[str], *, force: bool, command: str = "sgtool",
+                  option: str = "-o", known: Sequence[str] = (),
+                  resume: bool = False) -> Iterator[Path]:
+    """Yield the folder to write a command's outputs into; ``target`` gets them complete.
+
+    Build (the default): the yielded folder is new and empty, a uniquely named hidden
+    folder beside ``target`` (``.NAME.XXXXXXXX.partial``, same parent, so the same file
+    system); on a clean exit it becomes ``target``:
+
+    - a missing or empty ``target`` is replaced by it in one rename;
+    - a non-empty ``target`` is refused in one line (:class:`~sgtool.errors.SgtoolError`
+      naming ``option`` and ``--force``) before the block runs, unless ``force``; with
+      ``force`` the entries sgtool wrote there before (:func:`sgtool_entries`: the
+      :data:`MANIFEST`'s list, names matching ``known``) and the entries of the same name
+      as a new output are moved aside, the new entries moved in, and the moved-aside ones
+      deleted; any other entry (a user's file) stays. A failure or Ctrl-C while moving
+      puts every entry back where it was.
+
+    The new :data:`MANIFEST` lists the top-level entries of the yielded folder, for the
+    next ``--force``. On any exception (Ctrl-C included) the yielded folder is removed and
+    ``target`` is as it was; a :class:`KeyboardInterrupt` gets a ``note`` saying so (what
+    the CLI prints). The yielded folder's entries are moved, not copied: paths into it are
+    stale once the block ends (name outputs as ``target / name``). Only SIGKILL can leave
+    the hidden folder behind. A parent that cannot be written is one
+    :class:`OutputError` line.
+
+    Resume (``resume=True``, for a command that keeps writing into a folder of its own,
+    such as ``run-bench``'s episode logs): when ``target`` is missing, empty, or a folder
+    of the same ``command`` (its :data:`MANIFEST` says so; without one, every entry
+    matches ``known``), the yielded folder is ``target`` itself, created when missing, and
+    the command must write every file atomically (:func:`atomic_write`, a log writer's
+    partial file): an interruption then leaves complete files only, which the next run
+    takes up. On exit, clean or not, the manifest lists what it listed plus the entries
+    that appeared. With ``force``, or for another command's folder (refused without
+    ``force``), it builds as above: a fresh run that replaces what sgtool wrote.
+    """
+    path = _folder_target(target, option)
+    exists = path.is_dir()
+    busy = exists and any(os.scandir(path))
+    if resume and not force and (not busy or _is_own(path, command, known)):
+        with _in_place(path, command, known) as out:
+            yield out
+        return
+    if busy and not force:
+        raise SgtoolError(f"{option} {target}: the folder is not empty; not writing into it "
+                          "(--force replaces what sgtool wrote there and keeps other files)")
+    parent = path.parent
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        stage = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".partial", dir=parent))
+        os.chmod(stage, 0o777 & ~_umask())  # mkdtemp makes 0700; give the usual mode
+    except OSError as e:
+        raise output_error(e, target) from None
+    try:
+        yield stage
+        atomic_write(stage / MANIFEST, manifest_text(command, os.listdir(stage)))
+        try:
+            _commit(stage, path, sgtool_entries(path, known) if path.is_dir() else set())
+        except OSError as e:
+            if is_environment_error(e):
+                raise output_error(e, target, note=f"{target} is as it was") from None
+            raise
+    except KeyboardInterrupt as e:
+        e.note = (f"{target} is as it was: the outputs of the interrupted run "  # type: ignore[attr-defined]
+                  "were discarded")
+        raise
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+def _commit(stage: Path, target: Path, old: set[str]) -> None:
+    """Move the entries of ``stage`` into ``target`` (module doc of :func:`output_folder`);
+    ``old`` are the entries of ``target`` that sgtool wrote."""
+    if not target.exists() or not any(os.scandir(target)):
+        os.replace(stage, target)  # one rename; an empty folder is replaced by it
+        return
+    new = sorted(os.listdir(stage))
+    away = sorted((old | set(new)) & set(os.listdir(target)))
+    backup = Path(tempfile.mkdtemp(prefix=".sgtool-previous.", dir=target))
+    moved: list[str] = []
+    placed: list[str] = []
+    try:
+        for name in away:
+            os.replace(target / name, backup / name)
+            moved.append(name)
+        for name in new:
+            os.replace(stage / name, target / name)
+            placed.append(name)
+    except BaseException:
+        for name in reversed(placed):
+            os.replace(target / name, stage / name)
+        for name in reversed(moved):
+            os.replace(backup / name, target / name)
+        shutil.rmtree(backup, ignore_errors=True)
+        raise
+    shutil.rmtree(backup, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def _in_place(target: Path, command: str, known: Sequence[str]) -> Iterator[Path]:
+    """:func:`output_folder`'s resume: ``target`` itself, its manifest kept up to date."""
+    try:
+        target.mkdir(parents=True, exist_ok=True)
+        before = set(os.listdir(target))
+    except OSError as e:
+        raise output_error(e, target) from None
+    ours = sgtool_entries(target, known) - {MANIFEST}
+    if not (target / MANIFEST).exists():  # mark the folder as this command's first
+        atomic_write(target / MANIFEST, manifest_text(command, sorted(ours)))
+
+    def mark() -> None:
+        now = set(os.listdir(target))
+        atomic_write(target / MANIFEST, manifest_text(command, sorted((ours | (now - before))
+                                                                      & now)))
+    try:
+        yield target
+    except BaseException:
+        with contextlib.suppress(OSError, SgtoolError):  # the first error is the one to tell
+            mark()
+        raise
+    mark()

@@ -1,0 +1,220 @@
+"""sgtool.files.output_folder: a folder of outputs appears complete, refuses a non-empty
+target without force, and force replaces only what sgtool wrote there."""
+
+from __future__ import annotations
+
+import errno
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import pytest
+
+from sgtool.errors import SgtoolError
+from sgtool.files import MANIFEST, OutputError, output_folder, read_manifest
+
+
+def _tree(folder: Path) -> dict[str, str]:
+    """Every file under ``folder`` (relative path -> text)."""
+    return {str(p.relative_to(folder)): p.read_text() for p in sorted(folder.rglob("*"))
+            if p.is_file()}
+
+
+def _write(folder: Path, **files: str) -> None:
+    for name, text in files.items():
+        (folder / name).write_text(text)
+
+
+def test_a_new_folder_appears_complete_with_its_manifest(tmp_path: Path) -> None:
+    out = tmp_path / "res"
+    with output_folder(out, force=False, command="bench") as stage:
+        assert stage.parent == tmp_path and stage.name.startswith(".res.")
+        assert not out.exists()  # nothing at the target while the outputs are written
+        _write(stage, **{"a.txt": "1", "b.txt": "2"})
+    assert _tree(out) == {"a.txt": "1", "b.txt": "2", MANIFEST: (out / MANIFEST).read_text()}
+    assert read_manifest(out) == ("bench", frozenset({"a.txt", "b.txt"}))
+    assert os.listdir(tmp_path) == ["res"]  # no temporary folder left
+    assert (out.stat().st_mode & 0o777) == (0o777 & ~_umask())
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def test_an_empty_folder_is_filled_without_force(tmp_path: Path) -> None:
+    out = tmp_path / "res"
+    out.mkdir()
+    with output_folder(out, force=False) as stage:
+        _write(stage, **{"a.txt": "1"})
+    assert (out / "a.txt").read_text() == "1"
+
+
+def test_a_non_empty_folder_is_refused_in_one_line(tmp_path: Path) -> None:
+    out = tmp_path / "res"
+    out.mkdir()
+    _write(out, **{"summary.md": "mine"})
+    with pytest.raises(SgtoolError) as e, output_folder(out, force=False, option="-o") as _:
+        raise AssertionError("the block must not run")
+    assert "\n" not in str(e.value) and "--force" in str(e.value) and "-o" in str(e.value)
+    assert _tree(out) == {"summary.md": "mine"}
+    assert os.listdir(tmp_path) == ["res"]
+
+
+def test_force_replaces_what_sgtool_wrote_and_keeps_the_users_files(tmp_path: Path) -> None:
+    out = tmp_path / "res"
+    with output_folder(out, force=False, command="c") as stage:
+        _write(stage, **{"old.txt": "stale", "same.txt": "v1"})
+        (stage / "logs").mkdir()
+        _write(stage / "logs", **{"x.log": "v1"})
+    _write(out, **{"notes.md": "mine"})  # the user's, unlisted
+    with output_folder(out, force=True, command="c") as stage:
+        _write(stage, **{"same.txt": "v2", "new.txt": "v2"})
+    files = _tree(out)
+    del files[MANIFEST]
+    # old.txt and logs/ were sgtool's and are not in the new outputs: gone
+    assert files == {"same.txt": "v2", "new.txt": "v2", "notes.md": "mine"}
+    assert read_manifest(out) == ("c", frozenset({"same.txt", "new.txt"}))
+    assert sorted(os.listdir(tmp_path)) == ["res"]
+    assert not [n for n in os.listdir(out) if n.startswith(".sgtool-previous")]
+
+
+def test_force_without_a_manifest_replaces_the_known_names_only(tmp_path: Path) -> None:
+    out = tmp_path / "res"
+    out.mkdir()
+    _write(out, **{"episodes.jsonl": "old", "efficiency_x.png": "old", "mine.txt": "mine"})
+    with output_folder(out, force=True, known=("episodes.jsonl", "efficiency_*.png")) as s:
+        _write(s, **{"episodes.jsonl": "new"})
+    files = _tree(out)
+    del files[MANIFEST]
+    assert files == {"episodes.jsonl": "new", "mine.txt": "mine"}
+
+
+def test_a_manifest_naming_paths_outside_the_folder_removes_nothing_there(
+        tmp_path: Path) -> None:
+    out = tmp_path / "res"
+    out.mkdir()
+    (tmp_path / "precious").write_text("keep")
+    (out / MANIFEST).write_text(json.dumps({"command": "c", "files": ["../precious", ".."]}))
+    with output_folder(out, force=True, command="c") as stage:
+        _write(stage, **{"a.txt": "1"})
+    assert (tmp_path / "precious").read_text() == "keep"
+    assert (out / "a.txt").read_text() == "1"
+
+
+@pytest.mark.parametrize("error", [KeyboardInterrupt, RuntimeError])
+@pytest.mark.parametrize("force", [False, True])
+def test_an_interrupted_run_leaves_the_earlier_state(tmp_path: Path, error: type,
+                                                     force: bool) -> None:
+    out = tmp_path / "res"
+    if force:
+        with output_folder(out, force=False, command="c") as stage:
+            _write(stage, **{"a.txt": "old"})
+        _write(out, **{"mine.txt": "mine"})
+    before = _tree(out) if out.exists() else None
+    with pytest.raises(error) as e, output_folder(out, force=force, command="c") as stage:
+        _write(stage, **{"a.txt": "new", "b.txt": "new"})
+        raise error()
+    assert (_tree(out) if out.exists() else None) == before
+    assert os.listdir(tmp_path) == (["res"] if force else [])
+    if error is KeyboardInterrupt:  # what the CLI prints: true
+        assert "is as it was" in e.value.note  # type: ignore[attr-defined]
+
+
+def test_an_interrupt_while_moving_in_puts_everything_back(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    out = tmp_path / "res"
+    with output_folder(out, force=False, command="c") as stage:
+        _write(stage, **{"a.txt": "old", "b.txt": "old"})
+    _write(out, **{"mine.txt": "mine"})
+    before = _tree(out)
+    real = os.replace
+    calls = []
+
+    def replace(src: object, dst: object) -> None:
+        calls.append(src)
+        if len(calls) == 5:  # after the old entries moved aside, amid the new ones
+            raise KeyboardInterrupt
+        real(src, dst)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(os, "replace", replace)
+    with pytest.raises(KeyboardInterrupt), output_folder(out, force=True, command="c") as s:
+        _write(s, **{"a.txt": "new", "b.txt": "new", "c.txt": "new"})
+    monkeypatch.setattr(os, "replace", real)
+    assert len(calls) > 5  # the roll-back ran
+    assert _tree(out) == before
+    assert os.listdir(tmp_path) == ["res"]
+    assert sorted(os.listdir(out)) == sorted(before)
+
+
+def read_only(folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Make ``folder`` read-only; as root (who writes anyway) refuse its new entries the way
+    the kernel does for a user."""
+    folder.chmod(0o555)
+    if os.geteuid() != 0:
+        return
+    real = tempfile.mkdtemp
+
+    def mkdtemp(*args: object, dir: str | os.PathLike[str] | None = None,
+                **kw: object) -> str:
+        if dir is not None and Path(dir).resolve() == folder.resolve():
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(dir))
+        return real(*args, dir=dir, **kw)  # type: ignore[call-overload, no-any-return]
+
+    monkeypatch.setattr(tempfile, "mkdtemp", mkdtemp)
+
+
+def test_a_read_only_parent_is_one_line(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    parent = tmp_path / "ro"
+    parent.mkdir()
+    read_only(parent, monkeypatch)
+    try:
+        with pytest.raises(OutputError) as e, output_folder(parent / "res", force=False):
+            raise AssertionError("the block must not run")
+    finally:
+        parent.chmod(0o755)
+    assert "\n" not in str(e.value) and "Permission denied" in str(e.value)
+    assert os.listdir(parent) == []
+
+
+def test_a_file_is_not_a_folder(tmp_path: Path) -> None:
+    (tmp_path / "res").write_text("x")
+    with pytest.raises(SgtoolError, match="not a folder"), output_folder(tmp_path / "res",
+                                                                          force=True):
+        raise AssertionError("the block must not run")
+
+
+def test_resume_writes_in_place_into_a_folder_of_its_own(tmp_path: Path) -> None:
+    out = tmp_path / "rb"
+    with pytest.raises(KeyboardInterrupt), output_folder(out, force=False, command="run-bench",
+                                                         resume=True) as folder:
+        assert folder == out
+        _write(folder, **{"ep-0.log": "done"})
+        raise KeyboardInterrupt  # the complete files stay, for the next run
+    assert read_manifest(out) == ("run-bench", frozenset({"ep-0.log"}))
+    with output_folder(out, force=False, command="run-bench", resume=True) as folder:
+        assert folder == out and (folder / "ep-0.log").read_text() == "done"
+        _write(folder, **{"ep-1.log": "done"})
+    assert read_manifest(out) == ("run-bench", frozenset({"ep-0.log", "ep-1.log"}))
+    # another command's folder is refused; force starts afresh beside it
+    with pytest.raises(SgtoolError, match="--force"), \
+            output_folder(out, force=False, command="bench", resume=True):
+        raise AssertionError("the block must not run")
+    _write(out, **{"mine.txt": "mine"})
+    with output_folder(out, force=True, command="run-bench", resume=True) as folder:
+        assert folder != out
+        _write(folder, **{"ep-0.log": "again"})
+    files = _tree(out)
+    del files[MANIFEST]
+    assert files == {"ep-0.log": "again", "mine.txt": "mine"}
+
+
+def test_resume_takes_a_folder_of_known_names_without_a_manifest(tmp_path: Path) -> None:
+    out = tmp_path / "rb"
+    (out / "logs").mkdir(parents=True)
+    with output_folder(out, force=False, command="run-bench", known=("logs",),
+                       resume=True) as folder:
+        assert folder == out
+    assert read_manifest(out) == ("run-bench", frozenset({"logs"}))
