@@ -44,6 +44,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "run": ("run", "Closed-loop search in PyBullet with a planner, logged to MCAP."),
     "run-bench": ("run_bench", "Closed-loop benchmark: episodes x planners, one log each."),
     "eval": ("eval", "Recompute metrics from episode logs; evaluate planners offline."),
+    "study": ("study", "Studies over many recordings: scene-graph quality vs sensor noise."),
     "llm": ("llm", "Serve a local GGUF chat model (llama.cpp) and check an LLM endpoint."),
 }
 

@@ -1,0 +1,197 @@
+"""``sgtool study``: studies over many recordings; ``sgtool study noise`` is the
+perception-noise study (:mod:`sgtool.analysis.noise_study`)."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+import click
+
+from sgtool.commands.options import (
+    executor_options,
+    parse_resolution,
+    parse_rooms,
+    planner_names,
+)
+from sgtool.errors import SgtoolError
+
+OUTPUTS = ("summary.md", "results.json", "results.csv", "plots", "closed_loop")
+
+
+def default_cache() -> Path:
+    """``$XDG_CACHE_HOME/sgtool/study-noise``, else ``~/.cache/sgtool/study-noise``."""
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "sgtool" / "study-noise"
+
+
+@click.group("study")
+def command() -> None:
+    """Studies over many recordings: `sgtool study noise` measures scene-graph quality
+    against sensor noise."""
+
+
+@command.command("noise")
+@click.option("--houses", default=5, show_default=True, type=click.IntRange(min=0),
+              help="Generated houses (seeds HOUSE_SEED, +1, ...; the houses of `sgtool "
+              "record --seed`); 0 with --house studies the given houses only.")
+@click.option("--house-seed", default=0, show_default=True, type=click.IntRange(min=0),
+              help="Seed of the first generated house.")
+@click.option("--house", "house_files", multiple=True, metavar="FILE",
+              type=click.Path(path_type=str),
+              help="A house spec JSON file or a folder of them (repeatable), studied after "
+              "the generated houses.")
+@click.option("--rooms", default="8-8", show_default=True, metavar="MIN-MAX",
+              help="Room count range of the generated houses.")
+@click.option("--factor", "factors", multiple=True, metavar="NAME=L1,L2,...",
+              help="A noise factor and its levels (repeatable): depth_sigma, holes, "
+              "label_swap, label_dropout, drift_xy, drift_yaw (fields and units of `sgtool "
+              "record --noise`); each level is recorded with that fault alone. Default: "
+              "every factor at levels including mild's and strong's values.")
+@click.option("--profile", "profiles", multiple=True, metavar="NAME",
+              help="A whole noise profile to study as well (repeatable; mild, strong). "
+              "Default: mild and strong, unless --factor is given.")
+@click.option("--resolution", default="160x120", show_default=True,
+              help="Camera image size WIDTHxHEIGHT of the recordings.")
+@click.option("--fps", default=4.0, show_default=True, type=float,
+              help="Frames per second of log time of the recordings.")
+@click.option("--frames", default=None, type=click.IntRange(min=1),
+              help="Stop each recording after this many frames. Default: when the scripted "
+              "tour has visited every room.")
+@click.option("--noise-seed", default=0, show_default=True, type=int,
+              help="Seed of the sensor faults.")
+@click.option("--cache", "cache_dir", default=None, type=click.Path(file_okay=False),
+              help="Folder of recorded logs, keyed by house, noise and recording settings: "
+              "a log recorded once is reused by every later study [default: "
+              "$XDG_CACHE_HOME/sgtool/study-noise, else ~/.cache/sgtool/study-noise].")
+@click.option("--closed-loop", "closed_loop", default=None, metavar="PLANNERS",
+              help="Also run closed-loop search episodes (`sgtool run-bench`) of these "
+              "comma-separated planners on the first --closed-loop-houses houses, under "
+              "each --closed-loop-noise profile, and report SR/SPL.")
+@click.option("--closed-loop-noise", default="none,mild", show_default=True, metavar="LIST",
+              help="Comma-separated noise profiles of the closed-loop runs (the first is the "
+              "reference of the SR differences).")
+@click.option("--episodes", default=3, show_default=True, type=click.IntRange(min=1),
+              help="Closed-loop episodes per house (the first of `sgtool bench`'s).")
+@click.option("--closed-loop-houses", default=0, show_default=True, type=click.IntRange(min=0),
+              help="Houses of the closed-loop runs: the first N of the study (0: all).")
+@click.option("--frames-per-room", default=60, show_default=True, type=click.IntRange(min=1),
+              help="Closed-loop frame budget per episode: N x the house's room count.")
+@click.option("--max-steps", default=50, show_default=True, type=click.IntRange(min=1),
+              help="Closed-loop high-level planner steps per episode.")
+@click.option("-o", "--out", "out_dir", required=True, type=click.Path(file_okay=False),
+              help="Output folder: summary.md, results.json, results.csv (one row per "
+              "house x condition), plots/FACTOR.png, closed_loop/ (episode logs and tables).")
+@click.option("--force", is_flag=True,
+              help="Write into a non-empty -o folder, replacing what sgtool wrote there.")
+@click.option("--progress/--no-progress", default=None,
+              help="Progress bar on stderr (default: when stderr is a terminal).")
+@executor_options("recordings and replays (one per house and noise setting)")
+def noise(houses: int, house_seed: int, house_files: tuple[str, ...], rooms: str,
+          factors: tuple[str, ...], profiles: tuple[str, ...], resolution: str, fps: float,
+          frames: int | None, noise_seed: int, cache_dir: str | None,
+          closed_loop: str | None, closed_loop_noise: str, episodes: int,
+          closed_loop_houses: int, frames_per_room: int, max_steps: int, out_dir: str,
+          force: bool, progress: bool | None, executor: str = "local", workers: int = 1,
+          ray_address: str | None = None) -> None:
+    """Scene-graph quality against perception noise: for each noise factor at each level
+    (and each whole profile), record the scripted tour of every house with that noise
+    (`sgtool record --noise`), or reuse the log of --cache, replay it and score the final
+    graph (`sgtool replay --score`, merged scores: rooms found vs true, Voronoi purity,
+    ARI, objects in the right room). With --closed-loop, the SR/SPL of those planners under
+    --closed-loop-noise on the same episodes (`sgtool run-bench --noise`).
+
+    Writes summary.md, results.json, results.csv and plots/ (quality vs noise level per
+    factor: a point per house, the median line). The same inputs give byte-identical
+    tables on any executor and worker count.
+
+    Example: `sgtool study noise --houses 5 --rooms 8-8 --factor label_dropout=0.01,0.05
+    --profile mild -w 2 -o study`.
+    """
+    from sgtool.analysis.bench_houses import generated_houses, load_house_files
+    from sgtool.analysis.executor import as_map, make_executor
+    from sgtool.analysis.noise_study import (
+        DEFAULT_LEVELS,
+        DEFAULT_PROFILES,
+        ClosedLoopSettings,
+        RecordingSettings,
+        StudyConfig,
+        conditions_of,
+        parse_factor,
+        run_closed_loop,
+        run_study,
+    )
+    from sgtool.analysis.noise_study_plots import plot_study
+    from sgtool.analysis.noise_study_tables import results_csv, results_json, summary_md
+    from sgtool.files import atomic_write, output_folder
+    from sgtool.recorders.sim.noise import parse_noise
+
+    chosen: dict[str, tuple[float, ...]] = {}
+    for text in factors:
+        name, levels = parse_factor(text)
+        if name in chosen:
+            raise SgtoolError(f"--factor {name}: given twice; list its levels once")
+        chosen[name] = levels
+    if not factors:
+        chosen = dict(DEFAULT_LEVELS)
+    profile_list = tuple(profiles) if profiles else (() if factors else DEFAULT_PROFILES)
+    conditions = conditions_of(chosen, profile_list)
+    width, height = parse_resolution(resolution)
+    settings = RecordingSettings(width, height, fps, frames, noise_seed)
+    settings.check()
+    room_range = parse_rooms(rooms)
+    gen = generated_houses(houses, house_seed)
+    all_houses = gen + (load_house_files(house_files, taken=[h.id for h in gen])
+                        if house_files else ())
+    planners = planner_names(closed_loop) if closed_loop else ()
+    cl_noise = tuple(n.strip() for n in closed_loop_noise.split(",") if n.strip())
+    for n in cl_noise:
+        parse_noise(n)
+    if closed_loop is not None and not planners:
+        raise SgtoolError("--closed-loop: give at least one planner")
+    if planners and not cl_noise:
+        raise SgtoolError("--closed-loop-noise: give at least one profile")
+    cfg = StudyConfig(all_houses, conditions, room_range, settings,
+                      ClosedLoopSettings(planners, cl_noise, episodes, closed_loop_houses,
+                                         frames_per_room, max_steps))
+    cfg.check()
+    if planners:
+        from sgtool.analysis.closed_loop_bench import ClosedLoopBenchConfig
+
+        ClosedLoopBenchConfig(planners=planners, houses=1, episodes=episodes,
+                              noise=cl_noise).check()  # names, profiles: before any work
+    cache = Path(cache_dir) if cache_dir else default_cache()
+    if cache.exists() and not cache.is_dir():
+        raise SgtoolError(f"--cache {cache}: is a file, not a folder")
+    show = sys.stderr.isatty() if progress is None else progress
+    runner = make_executor(executor, workers, ray_address)
+    with output_folder(out_dir, force=force, command="study noise", known=OUTPUTS) as out:
+        res = run_study(cfg, cache, runner, progress=show)
+        if planners:
+            cl = run_closed_loop(cfg, res.specs, out / "closed_loop",
+                                 runner=as_map(runner, progress=show, desc="closed loop",
+                                               task_id=lambda _, t: str(t.output)))
+            _write_closed_loop(cl, out / "closed_loop")
+            res = _with_closed_loop(res, cl)
+        atomic_write(out / "summary.md", summary_md(res))
+        atomic_write(out / "results.json", results_json(res))
+        atomic_write(out / "results.csv", results_csv(res))
+        plot_study(res, out / "plots")
+        summary = summary_md(res)
+    click.echo(summary, nl=False)
+    click.echo(f"{len(res.cells)} cells ({res.recorded} log(s) recorded now, the others from "
+               f"{cache}); wrote {out_dir}/summary.md, results.json, results.csv, plots/")
+
+
+def _write_closed_loop(cl: Any, folder: Path) -> None:
+    from sgtool.analysis.closed_loop_bench import write_outputs
+
+    write_outputs(cl, folder)
+
+
+def _with_closed_loop(res: Any, cl: Any) -> Any:
+    from dataclasses import replace
+
+    return replace(res, closed_loop=cl)
