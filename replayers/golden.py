@@ -27,10 +27,11 @@ import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 from sgtool.files import atomic_write
 from sgtool.replayers.derived_log import ReplayOptions, replay
+from sgtool.replayers.golden_layers import LayerSummary
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 
@@ -173,12 +174,16 @@ def _door_changes(a: Any, b: Any, tol: float) -> list[str]:
 
 
 def _region_changes(a: Any, b: Any, tol: float) -> list[str]:
+    layer = "frontiers" if a.kind == "frontier" else "regions"
     if (a.room, a.kind, a.frontier_type) != (b.room, b.kind, b.frontier_type):
-        return [f"regions: {a.id} {a.kind}/{a.frontier_type} in {a.room} -> "
-                f"{b.kind}/{b.frontier_type} in {b.room}"]
+        return [f"{layer}: {a.id} {_region_kind(a)} in {a.room} -> "
+                f"{_region_kind(b)} in {b.room}"]
+    out = []
     if (d := _moved(a, b, tol)) is not None:
-        return [f"regions: {a.id} moved {d:.2f} m"]
-    return []
+        out.append(f"{layer}: {a.id} moved {d:.2f} m")
+    if abs(a.size - b.size) > tol:
+        out.append(f"{layer}: {a.id} length {a.size:.2f} -> {b.size:.2f} m")
+    return out
 
 
 def _region_kind(g: Any) -> str:
@@ -192,8 +197,10 @@ _LAYERS: tuple[tuple[str, Callable[[SceneGraph], Sequence[Any]], Callable[[Any],
     ("objects", lambda g: g.objects, lambda n: f"{n.category} in {n.room}", _object_changes),
     ("doors", lambda g: g.doors, lambda n: f"({n.state}, {_fmt_list(sorted(n.rooms))})",
      _door_changes),
-    ("regions", lambda g: g.regions, lambda n: f"({_region_kind(n)} in {n.room})",
-     _region_changes),
+    ("regions", lambda g: [r for r in g.regions if r.kind != "frontier"],
+     lambda n: f"(in {n.room})", _region_changes),
+    ("frontiers", lambda g: [r for r in g.regions if r.kind == "frontier"],
+     lambda n: f"({_region_kind(n)} in {n.room}, {n.size:.2f} m)", _region_changes),
 )
 
 
@@ -210,38 +217,162 @@ def _distance_changes(expected: SceneGraph, actual: SceneGraph, tol: float) -> l
     return [f"distances: {n} differ, largest {worst[0]:.3f} m ({worst[1]})"] if n else []
 
 
-def diff_graphs(expected: SceneGraph, actual: SceneGraph, tol: float = 1e-4) -> list[str]:
+ROUNDING = "the canonical JSON differs below the tolerance (rounding)"
+
+
+def _members(g: SceneGraph) -> dict[str, str]:
+    """Object and (non-frontier) region id -> the room it lies in: what tells a merge or a
+    split of rooms from a room that is simply gone or new."""
+    out = {o.id: o.room for o in g.objects}
+    out.update({r.id: r.room for r in g.regions if r.kind != "frontier"})
+    return out
+
+
+def _area(s: LayerSummary | None, room: str) -> str:
+    a = s.area(room) if s is not None else None
+    return "" if a is None else f", {a:.2f} m²"
+
+
+def _room_set_changes(expected: SceneGraph, actual: SceneGraph,
+                      layers: tuple[LayerSummary | None, LayerSummary | None]) -> list[str]:
+    """Rooms removed or added, told apart from rooms merged into a kept room or split off
+    one (their objects and regions went to, or came from, that one room), with areas."""
+    e, a = _by_id(expected.rooms), _by_id(actual.rooms)
+    me, ma = _members(expected), _members(actual)
+    both = me.keys() & ma.keys()
+    out = []
+    for k in sorted(e.keys() - a.keys()):
+        into = {ma[m] for m in both if me[m] == k}
+        if len(into) == 1 and (t := next(iter(into))) in e and t in a:
+            out.append(f"rooms: {k} ({e[k].category}{_area(layers[0], k)}) merged into {t} "
+                       f"({a[t].category}{_area(layers[1], t)})")
+        else:
+            out.append(f"rooms: - {k} ({e[k].category}{_area(layers[0], k)})")
+    for k in sorted(a.keys() - e.keys()):
+        came = {me[m] for m in both if ma[m] == k}
+        if len(came) == 1 and (f := next(iter(came))) in e and f in a:
+            out.append(f"rooms: {f} ({e[f].category}{_area(layers[0], f)}) split into {f} "
+                       f"({a[f].category}{_area(layers[1], f)}) + {k} "
+                       f"({a[k].category}{_area(layers[1], k)})")
+        else:
+            out.append(f"rooms: + {k} ({a[k].category}{_area(layers[1], k)})")
+    return out
+
+
+def _area_changes(expected: SceneGraph,
+                  layers: tuple[LayerSummary | None, LayerSummary | None],
+                  tol: float) -> list[str]:
+    """Areas of the rooms in both refreshes (when both have a :class:`LayerSummary`)."""
+    se, sa = layers
+    if se is None or sa is None:
+        return []
+    out = []
+    for r in expected.rooms:
+        x, y = se.area(r.id), sa.area(r.id)
+        if x is not None and y is not None and abs(x - y) > tol:
+            out.append(f"rooms: {r.id} area {x:.2f} -> {y:.2f} m²")
+    return out
+
+
+def _voronoi_changes(layers: tuple[LayerSummary | None, LayerSummary | None]) -> list[str]:
+    se, sa = layers
+    if se is None or sa is None or \
+            (se.voronoi_nodes, se.voronoi_edges) == (sa.voronoi_nodes, sa.voronoi_edges):
+        return []
+    return [f"voronoi: {se.voronoi_nodes} nodes, {se.voronoi_edges} edges -> "
+            f"{sa.voronoi_nodes} nodes, {sa.voronoi_edges} edges"]
+
+
+def diff_graphs(expected: SceneGraph, actual: SceneGraph, tol: float = 1e-4,
+                layers: tuple[LayerSummary | None, LayerSummary | None] = (None, None)
+                ) -> list[str]:
     """What differs between two scene graphs, one line per difference, grouped by layer
-    (empty when they are equal up to ``tol`` in positions and distances)."""
-    out: list[str] = []
+    (empty when they are equal up to ``tol`` in positions (m), distances (m), category
+    scores and room areas (m²)): rooms removed, added, merged or split (with their areas
+    when ``layers``, the two refreshes' :class:`LayerSummary`, give them), categories,
+    objects moved or assigned to another room, doors, edges, regions and frontiers, the
+    robot, distances and the Voronoi graph size. Equal up to ``tol`` but not byte-equal:
+    the one line :data:`ROUNDING`."""
+    out: list[str] = _room_set_changes(expected, actual, layers)
     for layer, nodes, describe, changes in _LAYERS:
         e, a = _by_id(nodes(expected)), _by_id(nodes(actual))
-        out += _added_removed(layer, e, a, describe)
+        if layer != "rooms":
+            out += _added_removed(layer, e, a, describe)
         for k in sorted(e.keys() & a.keys()):
             out += changes(e[k], a[k], tol)
+        if layer == "rooms":
+            out += _area_changes(expected, layers, tol)
+    out += _voronoi_changes(layers)
     er, ar = expected.robot, actual.robot
     if (er.room, er.region) != (ar.room, ar.region):
         out.append(f"robot: in {er.room}/{er.region} -> {ar.room}/{ar.region}")
     out += _distance_changes(expected, actual, tol)
     if not out and expected.to_json() != actual.to_json():
-        out.append("the canonical JSON differs below the tolerance (rounding)")
+        out.append(ROUNDING)
     return out
 
 
-def describe_mismatch(expected: Sequence[str], actual: Sequence[tuple[Refresh, str]],
-                      limit: int = 40) -> list[str]:
-    """The first refresh whose graph differs, with :func:`diff_graphs` of it."""
+class RefreshInfo(Protocol):
+    """What a report says of a refresh: :class:`~sgtool.scenegraph.stream.Refresh` or a
+    pinned refresh's metadata."""
+
+    @property
+    def time_ns(self) -> int: ...
+    @property
+    def frames(self) -> int: ...
+    @property
+    def reason(self) -> str: ...
+
+
+def refresh_head(i: int, ref: RefreshInfo) -> str:
+    """``refresh 3 at 12.400 s (after 40 frames, every)``."""
+    return f"refresh {i} at {ref.time_ns / 1e9:.3f} s (after {ref.frames} frames, {ref.reason})"
+
+
+def describe_mismatch(expected: Sequence[str], actual: Sequence[tuple[RefreshInfo, str]],
+                      limit: int = 40, tol: float = 1e-4, exact: bool = True,
+                      layers: Sequence[tuple[LayerSummary | None, LayerSummary | None]] = ()
+                      ) -> list[str]:
+    """The first refresh whose graph differs, with :func:`diff_graphs` of it; empty when
+    none does. ``exact``: any byte of difference counts (below ``tol`` it reads
+    :data:`ROUNDING`); else only differences beyond ``tol``. ``layers``: per refresh, the
+    expected and actual :class:`LayerSummary` (areas, Voronoi graph size)."""
     for i, (exp, (ref, got)) in enumerate(zip(expected, actual, strict=False)):
-        if exp != got:
-            lines = diff_graphs(SceneGraph.from_json(exp), SceneGraph.from_json(got))
-            head = (f"refresh {i} at {ref.time_ns / 1e9:.3f} s (after {ref.frames} frames, "
-                    f"{ref.reason}) differs:")
-            more = [f"  ... and {len(lines) - limit} more"] if len(lines) > limit else []
-            return [head] + ["  " + x for x in lines[:limit]] + more
+        if exp == got and not (i < len(layers) and layers[i][0] != layers[i][1]):
+            continue
+        pair = layers[i] if i < len(layers) else (None, None)
+        lines = diff_graphs(SceneGraph.from_json(exp), SceneGraph.from_json(got), tol, pair)
+        if not exact:
+            lines = [x for x in lines if x != ROUNDING]
+        if not lines:
+            continue
+        head = refresh_head(i, ref) + " differs:"
+        more = [f"  ... and {len(lines) - limit} more"] if len(lines) > limit else []
+        return [head] + ["  " + x for x in lines[:limit]] + more
     if len(expected) != len(actual):
         return [f"{len(actual)} refreshes where {len(expected)} were expected; the first "
                 f"{min(len(expected), len(actual))} agree"]
     return []
+
+
+# quality figure, how a report names it, its format
+QUALITY_FIGURES = (("purity", "purity", ".3f"), ("ari", "ARI", ".3f"), ("rooms", "rooms", "d"),
+                   ("object_accuracy", "objects in the right room", ".1%"))
+
+
+def quality_lines(before: dict[str, Any] | None, after: dict[str, Any] | None) -> list[str]:
+    """``quality (merged): purity 0.950 -> 0.910, ...``: the figures that differ."""
+    if before is None or after is None:
+        return []
+    out = []
+    for variant in sorted(before.keys() & after.keys()):
+        b, a = before[variant], after[variant]
+        parts = [f"{label} {format(b[k], spec)} -> {format(a[k], spec)}"
+                 for k, label, spec in QUALITY_FIGURES
+                 if k in b and k in a and b[k] != a[k]]
+        if parts:
+            out.append(f"quality ({variant}): " + ", ".join(parts))
+    return out
 
 
 def expectations(folder: Path, cases: Sequence[GoldenCase] = CASES) -> dict[str, object]:

@@ -44,6 +44,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "run": ("run", "Closed-loop search in PyBullet with a planner, logged to MCAP."),
     "run-bench": ("run_bench", "Closed-loop benchmark: episodes x planners, one log each."),
     "eval": ("eval", "Recompute metrics from episode logs; evaluate planners offline."),
+    "golden": ("golden", "Pin the replay of your logs; check it after a change (exit 0/1/2)."),
+    "diff": ("diff", "What differs, layer by layer, between the scene graphs of two logs."),
     "study": ("study", "Studies over many recordings: scene-graph quality vs sensor noise."),
     "llm": ("llm", "Serve a local GGUF chat model (llama.cpp) and check an LLM endpoint."),
 }

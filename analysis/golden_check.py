@@ -1,0 +1,360 @@
+"""Golden-log regression for any logs: pin their replay, check it after a change, update.
+
+:func:`pin_logs` replays each log (on an executor: ``-w N`` or Ray) and writes its pin
+into a folder (:mod:`sgtool.replayers.golden_pins` is the format): the canonical scene
+graph of every refresh, the refresh times and map-layer summaries, the quality figures
+when the log carries its house, and for an episode log the planner's decisions at its
+decision points. :func:`check_pins` replays every pinned log with the current code (options
+given override the pinned ones) and compares: a :class:`LogCheck` per log says whether it
+is unchanged, changed (the first refresh that differs, layer by layer, the quality figures
+before and after, the first decision that differs) or could not be checked (an error, one
+line). :func:`update_pins` writes the changed logs' new pins.
+
+**Planner decisions** (episode logs: a log whose ``sgtool.Episode`` records name a planner
+and a query): the planner, built with its defaults, is asked at every logged decision
+point on the *replayed* graph in force at that point (the last refresh at or before the
+action's ``graph_time_ns``, else its log time) and told the logged outcome (teacher
+forcing, as :func:`sgtool.analysis.offline.replay_decisions`); its choices are pinned. So a
+change of the mapping that changes a graph a planner decides on, or a change of the
+planner, shows as the first decision that differs. LLM planners are not re-asked (they need
+an endpoint); their logs pin graphs and figures only.
+"""
+
+from __future__ import annotations
+
+import bisect
+import dataclasses
+import shutil
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+from sgtool.analysis.executor import Executor, LocalExecutor, Task
+from sgtool.errors import SgtoolError
+from sgtool.replayers.derived_log import ReplayOptions
+from sgtool.replayers.golden import describe_mismatch, quality_lines, sha256_file
+from sgtool.replayers.golden_pins import (
+    Capture,
+    Decision,
+    PinError,
+    Pinned,
+    PinSet,
+    RefreshMeta,
+    capture,
+    load_expected,
+    options_dict,
+    overridden,
+    pinned_entry,
+    read_pins,
+    write_capture,
+    write_index,
+)
+from sgtool.version import __version__
+
+Status = Literal["unchanged", "changed", "error"]
+
+
+# ----- planner decisions ------------------------------------------------------------------
+def planner_decisions(log: str | Path, graphs: Sequence[str], refreshes: Sequence[RefreshMeta]
+                      ) -> tuple[str | None, tuple[Decision, ...] | None]:
+    """(planner, its decisions) at the decision points of an episode log, on the replayed
+    graphs (module doc); (None, None) for a log that is no episode log or whose planner
+    needs an endpoint."""
+    from sgtool.analysis.offline import read_log_episodes, replay_decisions
+    from sgtool.log.records import given
+    from sgtool.planning.registry import is_llm_planner, make_planner
+    from sgtool.scenegraph.graph import SceneGraph
+
+    episodes = [e for e in read_log_episodes(log) if given(e.episode.query)]
+    names = {str(given(e.episode.planner)) for e in episodes if given(e.episode.planner)}
+    if len(names) != 1 or not any(e.decisions for e in episodes):
+        return None, None
+    name = names.pop()
+    if is_llm_planner(name):
+        return None, None
+    times = [m.time_ns for m in refreshes]
+    parsed: dict[int, SceneGraph] = {}
+
+    def graph_at(t: int) -> SceneGraph | None:
+        i = bisect.bisect_right(times, t) - 1
+        if i < 0:
+            return None
+        if i not in parsed:
+            parsed[i] = SceneGraph.from_json(graphs[i])
+        return parsed[i]
+
+    replayed = []
+    for ep in episodes:
+        ds = []
+        for d in ep.decisions:
+            gt = d.action.graph_time_ns
+            t = gt if isinstance(gt, int) else d.t_ns
+            ds.append(dataclasses.replace(d, graph=graph_at(t) if d.decided else None))
+        replayed.append(dataclasses.replace(ep, decisions=tuple(ds)))
+    try:
+        planner = make_planner(name, timed=False)
+    except SgtoolError:
+        return None, None
+    report = replay_decisions(planner, replayed, name)
+    return name, tuple(Decision(c.episode, c.step, c.chosen[0], c.chosen[1])
+                       for c in report.comparisons)
+
+
+def capture_log(log: str | Path, options: ReplayOptions) -> Capture:
+    """:func:`~sgtool.replayers.golden_pins.capture` plus the planner decisions."""
+    cap = capture(log, options)
+    planner, decisions = planner_decisions(log, cap.graphs, cap.refreshes)
+    return dataclasses.replace(cap, planner=planner, decisions=decisions)
+
+
+# ----- pin ----------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class _PinTask:
+    log: str
+    options: ReplayOptions
+
+
+def _pin_task(t: _PinTask) -> Capture:
+    return capture_log(t.log, t.options)
+
+
+def pin_name(log: Path) -> str:
+    """A pinned log's name: its file name without ``.mcap``."""
+    return log.name[:-5] if log.name.endswith(".mcap") else log.name
+
+
+def _run(executor: Executor | None, fn: Callable[[Any], Any], tasks: list[Task],
+         desc: str, progress: bool) -> list[Any]:
+    runner = executor or LocalExecutor(1)
+    return runner.run(fn, tasks, progress=progress, desc=desc)
+
+
+def pin_logs(logs: Sequence[str | Path], folder: str | Path,
+             options: ReplayOptions | None = None, *, copy: bool = False,
+             executor: Executor | None = None, progress: bool = False,
+             why: str | None = None) -> PinSet:
+    """Pin ``logs`` into ``folder`` (created when missing; logs pinned there before under
+    other names are kept, the same name is replaced): replay each with ``options``, write
+    its graphs and refresh files and the index. ``copy``: copy each log into the folder
+    first (the pin then refers to the copy)."""
+    root = Path(folder)
+    opts = options or ReplayOptions()
+    paths = [Path(p) for p in logs]
+    names = [pin_name(p) for p in paths]
+    for p in paths:
+        if not p.is_file():
+            raise SgtoolError(f"{p}: no such log")
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise SgtoolError(f"two logs are named {dup[0]}.mcap; pin them into separate folders")
+    if root.exists() and not root.is_dir():
+        raise SgtoolError(f"--dir {root} is a file; give a folder")
+    old = read_pins(root).logs if (root / "expected.json").is_file() else {}
+    outcomes = _run(executor, _pin_task,
+                    [Task(str(p), _PinTask(str(p), opts)) for p in paths], "pin", progress)
+    failed = [o for o in outcomes if not o.ok]
+    if failed:
+        raise SgtoolError(f"{failed[0].id}: could not be replayed: {failed[0].error}")
+    root.mkdir(parents=True, exist_ok=True)
+    pins = PinSet(root, dict(old), sgtool_version=__version__)
+    for p, name, o in zip(paths, names, outcomes, strict=True):
+        log = p
+        if copy:
+            log = root / f"{name}.mcap"
+            if not log.exists() or log.resolve() != p.resolve():
+                tmp = root / f".{name}.mcap.partial"
+                shutil.copyfile(p, tmp)
+                tmp.replace(log)
+        pin = pinned_entry(name, log, root, opts, o.value, why)
+        write_capture(pins, pin, o.value)
+        pins.logs[name] = pin
+    write_index(pins)
+    return pins
+
+
+# ----- check --------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class LogCheck:
+    """What checking one pinned log found (module doc). ``lines``: the layer-by-layer
+    report of the first refresh that differs (its first line names the refresh);
+    ``layers``: lines per layer in it; ``quality``: the pinned and the current figures
+    (``{"strict"|"merged": {figure: value}}``, None without a house); ``decision``: the
+    first planner decision that differs; ``capture``: the new replay, kept for
+    :func:`update_pins` when asked."""
+
+    name: str
+    status: Status
+    log: str
+    options: dict[str, Any] = field(default_factory=dict)
+    refreshes: tuple[int, int] = (0, 0)  # pinned, now
+    first: str | None = None
+    lines: tuple[str, ...] = ()
+    layers: dict[str, int] = field(default_factory=dict)
+    quality: tuple[dict[str, Any] | None, dict[str, Any] | None] = (None, None)
+    decision: str | None = None
+    error: str | None = None
+    capture: Capture | None = None
+    differing: int = 0  # refreshes whose graph is not byte-identical (or missing)
+
+    def report(self) -> list[str]:
+        """The per-log report (text lines)."""
+        head = f"{self.name}: {self.status}"
+        if self.status == "error":
+            return [f"{head}: {self.error}"]
+        opts = ", ".join(f"{k} {v}" for k, v in sorted(self.options.items()))
+        out = [head + f" ({self.log}, {self.refreshes[1]} refreshes"
+               + (f"; replayed with {opts})" if opts else ")")]
+        if self.status == "unchanged":
+            return out
+        out += ["  " + x for x in self.lines]
+        if self.lines:
+            out.append(f"  {self.differing} of {max(self.refreshes)} refreshes are not "
+                       "byte-identical")
+        out += ["  " + x for x in quality_lines(*self.quality)]
+        if self.decision:
+            out.append("  " + self.decision)
+        return out
+
+
+@dataclass(frozen=True)
+class _CheckTask:
+    folder: str
+    pin: Pinned
+    options: ReplayOptions
+    tolerance: float
+    keep: bool  # return the capture of a changed log (for --update)
+
+
+def _layer_counts(lines: Sequence[str]) -> dict[str, int]:
+    out: dict[str, int] = {}
+    for x in lines[1:]:
+        layer = x.strip().split(":", 1)[0]
+        if layer.startswith("..."):
+            continue
+        out[layer] = out.get(layer, 0) + 1
+    return out
+
+
+def first_decision_change(pinned: Sequence[Decision] | None, now: Sequence[Decision] | None,
+                          planner: str | None) -> str | None:
+    """``decisions: scout at episode 0, step 3: navigate(room:2) -> explore(frontier:4)``."""
+    if pinned is None and now is None:
+        return None
+    if pinned is None or now is None:
+        return (f"decisions: {'now' if pinned is None else 'no longer'} an episode log with "
+                f"planner decisions")
+    for a, b in zip(pinned, now, strict=False):
+        if a != b:
+            where = f"episode {a.episode}, step {a.step}"
+            if (a.episode, a.step) != (b.episode, b.step):
+                where += f" (now episode {b.episode}, step {b.step})"
+            return f"decisions: {planner} at {where}: {a.text()} -> {b.text()}"
+    if len(pinned) != len(now):
+        return (f"decisions: {len(now)} where {len(pinned)} were pinned; the first "
+                f"{min(len(pinned), len(now))} agree")
+    return None
+
+
+def _check_task(t: _CheckTask) -> LogCheck:
+    folder, pin = Path(t.folder), t.pin
+    pins = PinSet(folder, {pin.name: pin})
+    log = pin.log_path(folder)
+    base = LogCheck(pin.name, "error", str(log), options_dict(t.options))
+    try:
+        if not log.is_file():
+            raise PinError(f"pinned log {log} is missing (moved or deleted? put it back, or "
+                           f"pin it again with `sgtool golden pin {log.name} --dir {folder}`)")
+        if sha256_file(log) != pin.log_sha256:
+            raise PinError(f"{log} is not the pinned log (its sha256 differs); pin it again "
+                           "if it was re-recorded on purpose")
+        expected, metas = load_expected(pins, pin.name)
+        cap = capture_log(log, t.options)
+    except SgtoolError as e:
+        return dataclasses.replace(base, error=str(e).splitlines()[0])
+    exact = t.tolerance <= 0
+    actual = list(zip(cap.refreshes, cap.graphs, strict=True))
+    layers = ([(m.layers, c.layers) for m, c in zip(metas, cap.refreshes, strict=False)]
+              if metas is not None else [])
+    lines = describe_mismatch(expected, actual, tol=t.tolerance, exact=exact, layers=layers)
+    decision = first_decision_change(pin.decisions, cap.decisions, cap.planner or pin.planner)
+    quality = (pin.quality, cap.quality)
+    q_changed = bool(quality_lines(*quality)) and (exact or bool(lines))
+    changed = bool(lines) or decision is not None or q_changed
+    first = lines[0].removesuffix(" differs:") if lines else None
+    differing = sum(e != g for e, g in zip(expected, cap.graphs, strict=False)) + \
+        abs(len(expected) - len(cap.graphs))
+    return dataclasses.replace(
+        base, status="changed" if changed else "unchanged",
+        refreshes=(pin.refreshes, len(cap.graphs)), first=first, lines=tuple(lines),
+        layers=_layer_counts(lines), quality=quality, decision=decision,
+        capture=cap if changed and t.keep else None, differing=differing)
+
+
+@dataclass(frozen=True)
+class CheckReport:
+    """Every pinned log's :class:`LogCheck`, in name order; the ``pins`` checked and the
+    ``options`` that overrode the pinned ones."""
+
+    pins: PinSet
+    logs: tuple[LogCheck, ...]
+    options: ReplayOptions = field(default_factory=ReplayOptions)
+    tolerance: float = 0.0
+
+    @property
+    def exit_code(self) -> int:
+        """0 unchanged, 1 changed, 2 an error (before changes)."""
+        if any(c.status == "error" for c in self.logs):
+            return 2
+        return 1 if any(c.status == "changed" for c in self.logs) else 0
+
+    def counts(self) -> dict[str, int]:
+        out = {"unchanged": 0, "changed": 0, "error": 0}
+        for c in self.logs:
+            out[c.status] += 1
+        return out
+
+
+def check_pins(folder: str | Path, options: ReplayOptions | None = None, *,
+               tolerance: float = 0.0, executor: Executor | None = None,
+               names: Sequence[str] | None = None, keep: bool = False,
+               progress: bool = False) -> CheckReport:
+    """Check every pinned log of ``folder`` (or those in ``names``) against the current
+    code (module doc). ``options``: set fields override the pinned options; ``tolerance``
+    (m, m², scores): differences up to it pass (0: byte-exact graphs); ``keep``: keep the
+    new replay of changed logs for :func:`update_pins`."""
+    pins = read_pins(folder)
+    chosen = sorted(pins.logs) if names is None else list(names)
+    for n in chosen:
+        if n not in pins.logs:
+            raise PinError(f"{pins.folder}: no pinned log named {n!r} (pinned: "
+                           f"{', '.join(sorted(pins.logs)) or 'none'})")
+    tasks = [Task(n, _CheckTask(str(pins.folder), pins.logs[n],
+                                overridden(pins.logs[n].options, options), tolerance, keep))
+             for n in chosen]
+    outcomes = _run(executor, _check_task, tasks, "check", progress)
+    logs = tuple(o.value if o.ok else LogCheck(o.id, "error", pins.logs[o.id].log,
+                                               error=o.error) for o in outcomes)
+    return CheckReport(pins, logs, options or ReplayOptions(), tolerance)
+
+
+def update_pins(report: CheckReport) -> list[str]:
+    """Re-pin the changed logs of ``report`` (checked with ``keep``) with the options they
+    were checked with; what was accepted, one line per log."""
+    pins = report.pins
+    accepted = []
+    for c in report.logs:
+        if c.status != "changed" or c.capture is None:
+            continue
+        old = pins.logs[c.name]
+        opts = overridden(old.options, report.options)
+        pin = pinned_entry(c.name, old.log_path(pins.folder), pins.folder, opts, c.capture,
+                           old.why)
+        write_capture(pins, pin, c.capture)
+        pins.logs[c.name] = pin
+        what = c.first or "planner decisions or quality figures"
+        accepted.append(f"updated {c.name}: accepted the change from {what} "
+                        f"({sum(c.layers.values())} differences in it)")
+    if accepted:
+        write_index(dataclasses.replace(pins, sgtool_version=__version__))
+    return accepted

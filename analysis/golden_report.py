@@ -1,0 +1,90 @@
+"""A golden check as text, Markdown and JUnit XML (pure functions of a
+:class:`~sgtool.analysis.golden_check.CheckReport`).
+
+The text and Markdown reports give, per log, :meth:`LogCheck.report
+<sgtool.analysis.golden_check.LogCheck.report>` and then one summary table over all logs:
+status, refreshes pinned and now, the first refresh that differs, the number of
+differences per layer in it, the merged purity before and after and the first decision
+that differs. The JUnit report has one test case per log (a failure for a changed log, an
+error for a log that could not be checked) for CI systems.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+from xml.sax.saxutils import escape, quoteattr
+
+from sgtool.analysis.golden_check import CheckReport, LogCheck
+from sgtool.analysis.report import pipe_table
+
+LAYERS = ("rooms", "objects", "doors", "edges", "regions", "frontiers", "voronoi")
+HEADER = ("log", "status", "refreshes", "first difference", *LAYERS, "purity (merged)",
+          "decisions")
+
+
+def _purity(q: tuple[dict[str, Any] | None, dict[str, Any] | None]) -> str:
+    b, a = q
+    if b is None or a is None or "merged" not in b or "merged" not in a:
+        return "-"
+    x, y = b["merged"].get("purity"), a["merged"].get("purity")
+    if x is None or y is None:
+        return "-"
+    return f"{x:.3f}" if x == y else f"{x:.3f} -> {y:.3f}"
+
+
+def summary_rows(logs: Sequence[LogCheck]) -> list[list[str]]:
+    rows = []
+    for c in logs:
+        pinned, now = c.refreshes
+        if c.status == "error":
+            rows.append([c.name, "error", "-", c.error or "", *("-" for _ in LAYERS), "-", "-"])
+            continue
+        rows.append([c.name, c.status, str(now) if pinned == now else f"{pinned} -> {now}",
+                     c.first or "-", *(str(c.layers.get(k, 0)) for k in LAYERS),
+                     _purity(c.quality), "changed" if c.decision else "-"])
+    return rows
+
+
+def summary_line(report: CheckReport) -> str:
+    n = report.counts()
+    return (f"{len(report.logs)} pinned log(s): {n['unchanged']} unchanged, {n['changed']} "
+            f"changed, {n['error']} error(s)")
+
+
+def text_report(report: CheckReport) -> list[str]:
+    """What ``sgtool golden check`` prints."""
+    out: list[str] = []
+    for c in report.logs:
+        out += c.report()
+    out += ["", pipe_table(HEADER, summary_rows(report.logs)), summary_line(report)]
+    return out
+
+
+def markdown_report(report: CheckReport) -> str:
+    """``--report FILE.md``: the per-log reports as sections, then the summary table."""
+    parts = [f"# Golden check of {report.pins.folder}", "", summary_line(report), ""]
+    for c in report.logs:
+        lines = c.report()
+        parts += [f"## {c.name}: {c.status}", "", "```", *lines, "```", ""]
+    parts += ["## Summary", "", pipe_table(HEADER, summary_rows(report.logs)), ""]
+    return "\n".join(parts)
+
+
+def junit_report(report: CheckReport) -> str:
+    """``--junit FILE.xml``: one ``testcase`` per log (JUnit XML as CI systems read it)."""
+    n = report.counts()
+    cases = []
+    for c in report.logs:
+        body = ""
+        text = escape("\n".join(c.report()))
+        if c.status == "changed":
+            body = f"<failure message={quoteattr(c.first or 'changed')}>{text}</failure>"
+        elif c.status == "error":
+            body = f"<error message={quoteattr(c.error or 'error')}>{text}</error>"
+        cases.append(f'  <testcase classname="sgtool.golden" name={quoteattr(c.name)}>'
+                     f"{body}</testcase>")
+    return ("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
+            f"<testsuite name=\"sgtool golden\" tests=\"{len(report.logs)}\" "
+            f"failures=\"{n['changed']}\" errors=\"{n['error']}\">\n"
+            + "\n".join(cases) + "\n</testsuite>\n")

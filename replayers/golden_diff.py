@@ -1,0 +1,129 @@
+"""``sgtool diff A B``: what differs, layer by layer, between the scene graphs of two logs.
+
+A log with ``/sgtool/scene_graph`` records (a derived log, a closed-loop log) is read as it
+is: its graphs in log-time order, the room areas and Voronoi graph size from its
+``/map/rooms`` and ``/map/voronoi`` messages at the same log times
+(:func:`~sgtool.replayers.golden_layers.summary_of_messages`), the frames of a refresh
+counted from its depth images. Any other log is replayed with the options given
+(:func:`~sgtool.replayers.golden_pins.capture`, which also scores it when it carries its
+house). The report is :func:`~sgtool.replayers.golden.describe_mismatch` of the two
+sequences (the first refresh that differs), the quality figures of both when both have
+them, and the first logged action (skill and target) that differs.
+"""
+
+from __future__ import annotations
+
+import bisect
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from sgtool.errors import SgtoolError
+from sgtool.log import schemas as S
+from sgtool.log.reader import LogReader
+from sgtool.log.records import Action, SceneGraphRecord, given
+from sgtool.replayers.derived_log import ReplayOptions
+from sgtool.replayers.golden import describe_mismatch, quality_lines
+from sgtool.replayers.golden_layers import summary_of_messages
+from sgtool.replayers.golden_pins import RefreshMeta, capture
+
+
+@dataclass(frozen=True)
+class LogGraphs:
+    """The scene graphs of one log: canonical JSON and refresh metadata, in order; how they
+    were obtained (``"logged"`` or ``"replayed"``), quality figures, logged actions."""
+
+    path: str
+    source: str
+    graphs: list[str]
+    refreshes: list[RefreshMeta]
+    quality: dict[str, Any] | None = None
+    actions: list[tuple[str, str | None]] = field(default_factory=list)
+
+
+def log_graphs(path: str | os.PathLike[str], options: ReplayOptions | None = None
+               ) -> LogGraphs:
+    """The graphs of ``path`` (module doc: logged when it has them, else replayed)."""
+    p = Path(path)
+    if not p.is_file():
+        raise SgtoolError(f"{p}: no such file")
+    with LogReader(p) as r:
+        actions = [(a.skill, given(a.target)) for _, a in r.records(Action)]
+        logged = r.has(S.RECORDS["scene_graph"].topic)
+        if logged and options is not None and any(v is not None for v in vars(options).values()):
+            raise SgtoolError(f"{p} holds scene graphs already (a derived log); replay options "
+                              "apply to logs that are replayed")
+        if logged:
+            frames = [d.log_time_ns for d in r.messages([S.DEPTH])] if r.has(S.DEPTH) else []
+            graphs: list[str] = []
+            metas: list[RefreshMeta] = []
+            maps: dict[str, dict[int, Any]] = {S.VORONOI: {}, S.ROOMS: {}}
+            for topic, by_time in maps.items():
+                if r.has(topic):
+                    for d in r.messages([topic]):
+                        by_time[d.log_time_ns] = d.message
+            for t, rec in r.records(SceneGraphRecord):
+                graphs.append(rec.graph().to_json())
+                layers = summary_of_messages(maps[S.VORONOI].get(t), maps[S.ROOMS].get(t))
+                metas.append(RefreshMeta(t, bisect.bisect_right(frames, t), "logged", layers))
+            return LogGraphs(str(p), "logged", graphs, metas, None, actions)
+    cap = capture(p, options or ReplayOptions())
+    return LogGraphs(str(p), "replayed", cap.graphs, cap.refreshes, cap.quality, actions)
+
+
+@dataclass(frozen=True)
+class LogDiff:
+    """:func:`diff_logs`' result: ``lines`` (the first refresh that differs, layer by
+    layer; empty when the sequences agree), quality lines, the first action that differs."""
+
+    a: LogGraphs
+    b: LogGraphs
+    lines: list[str]
+    quality: list[str]
+    action: str | None
+
+    @property
+    def same(self) -> bool:
+        return not self.lines and not self.quality and self.action is None
+
+    def report(self) -> list[str]:
+        head = (f"{self.a.path} ({self.a.source}, {len(self.a.graphs)} refreshes) vs "
+                f"{self.b.path} ({self.b.source}, {len(self.b.graphs)} refreshes): "
+                + ("the same scene graphs" if self.same else "they differ"))
+        return [head, *self.lines, *self.quality, *([self.action] if self.action else [])]
+
+    def to_dict(self) -> dict[str, Any]:
+        counts: dict[str, int] = {}
+        for x in self.lines[1:]:
+            k = x.strip().split(":", 1)[0]
+            counts[k] = counts.get(k, 0) + 1
+        return {"a": self.a.path, "b": self.b.path, "same": self.same,
+                "sources": [self.a.source, self.b.source],
+                "refreshes": [len(self.a.graphs), len(self.b.graphs)],
+                "first": self.lines[0].removesuffix(" differs:") if self.lines else None,
+                "differences": [x.strip() for x in self.lines[1:]], "layers": counts,
+                "quality": self.quality, "action": self.action}
+
+
+def first_action_change(a: list[tuple[str, str | None]], b: list[tuple[str, str | None]]
+                        ) -> str | None:
+    for i, (x, y) in enumerate(zip(a, b, strict=False)):
+        if x != y:
+            return f"actions: {i} {x[0]}({x[1] or ''}) -> {y[0]}({y[1] or ''})"
+    if len(a) != len(b):
+        return (f"actions: {len(b)} where {len(a)} were logged; the first "
+                f"{min(len(a), len(b))} agree")
+    return None
+
+
+def diff_logs(a: str | os.PathLike[str], b: str | os.PathLike[str],
+              options: ReplayOptions | None = None, tolerance: float = 0.0) -> LogDiff:
+    """What differs between the scene graphs of ``a`` and ``b`` (module doc); ``options``
+    replay the logs that hold no graphs; ``tolerance`` as in ``sgtool golden check``."""
+    ga, gb = log_graphs(a, options), log_graphs(b, options)
+    layers = [(x.layers, y.layers) for x, y in zip(ga.refreshes, gb.refreshes, strict=False)]
+    lines = describe_mismatch(ga.graphs, list(zip(gb.refreshes, gb.graphs, strict=True)),
+                              tol=tolerance, exact=tolerance <= 0, layers=layers)
+    return LogDiff(ga, gb, lines, quality_lines(ga.quality, gb.quality),
+                   first_action_change(ga.actions, gb.actions))

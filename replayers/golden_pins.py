@@ -1,0 +1,328 @@
+"""The pin format of golden logs: what ``sgtool golden pin`` writes and ``check`` reads.
+
+A pin folder holds ``expected.json`` (the index, :data:`INDEX`) and per pinned log ``NAME``:
+
+- ``NAME.graphs.jsonl.gz``: the canonical JSON of every scene graph of the log's replay, one
+  per line, gzip'd byte-stably (:func:`~sgtool.replayers.golden.write_graphs`);
+- ``NAME.refreshes.jsonl.gz`` (optional): per refresh its log time, frames and reason and
+  the :class:`~sgtool.replayers.golden_layers.LayerSummary` of its map layers;
+- ``NAME.mcap`` when the log was copied in (``--copy``).
+
+The index is ``{"format": 2, "sgtool_version": ..., "cases": {NAME: entry}}``; an entry
+holds the log's path (relative to the folder when it lies below it), sha256 and size, the
+replay options given (unset ones resolve as a replay resolves them) and what they resolved
+to, the number of refreshes and the sha256 of the final graph and of the whole sequence
+(:func:`~sgtool.replayers.golden.sequence_digest`), and when the log has them the quality
+figures of the final graph (:func:`sgtool.replayers.score.score_dict`) and the planner's
+decisions. ``docs/golden.md`` documents every field. Format 1 (one ``replay`` option set
+for all cases, logs beside the index) is still read; a newer format is refused in one line
+naming both versions, and a damaged index or graphs file in one line naming the file.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import zlib
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from sgtool.canonical import canonical_float
+from sgtool.errors import SgtoolError
+from sgtool.files import atomic_write
+from sgtool.replayers.derived_log import ReplayOptions, replay
+from sgtool.replayers.golden import (
+    EXPECTED,
+    read_graphs,
+    sequence_digest,
+    sha256_file,
+    write_graphs,
+)
+from sgtool.replayers.golden_layers import LayerSummary, layer_summary
+from sgtool.scenegraph.stream import Refresh, SceneGraphStream
+from sgtool.version import __version__
+
+INDEX = EXPECTED
+PIN_FORMAT = 2
+_OPTION_FIELDS = ("every", "classifier", "min_points", "voxel_size", "max_frames")
+
+
+class PinError(SgtoolError):
+    """A pin folder that cannot be used: missing, damaged, newer than this sgtool, or a
+    pinned log that moved or changed."""
+
+
+@dataclass(frozen=True)
+class RefreshMeta:
+    """When a refresh happened (log time in ns, frames integrated, why) and its layers."""
+
+    time_ns: int
+    frames: int
+    reason: str
+    layers: LayerSummary | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        d: dict[str, Any] = {"time_ns": self.time_ns, "frames": self.frames,
+                             "reason": self.reason}
+        if self.layers is not None:
+            d.update(self.layers.to_dict())
+        return d
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> RefreshMeta:
+        layers = LayerSummary.from_dict(d) if "voronoi" in d else None
+        return cls(int(d["time_ns"]), int(d["frames"]), str(d["reason"]), layers)
+
+
+@dataclass(frozen=True)
+class Decision:
+    """One planner decision at a logged decision point: episode and step of the log, the
+    chosen skill and target."""
+
+    episode: int
+    step: int
+    skill: str
+    target: str | None
+
+    def text(self) -> str:
+        return f"{self.skill}({self.target or ''})"
+
+
+@dataclass(frozen=True)
+class Capture:
+    """A replay as a pin keeps it: every graph's canonical JSON, every refresh's metadata,
+    the resolved options, the final graph's quality figures (None without a house), and the
+    planner's decisions (None for a log that is no episode log)."""
+
+    graphs: list[str]
+    refreshes: list[RefreshMeta]
+    resolved: dict[str, Any]
+    quality: dict[str, dict[str, float | int]] | None = None
+    planner: str | None = None
+    decisions: tuple[Decision, ...] | None = None
+
+
+@dataclass(frozen=True)
+class Pinned:
+    """One pinned log (an entry of the index; module doc)."""
+
+    name: str
+    log: str  # as stored: relative to the folder when below it
+    log_sha256: str
+    refreshes: int
+    final_sha256: str
+    sequence_sha256: str
+    options: ReplayOptions = field(default_factory=ReplayOptions)
+    log_bytes: int | None = None
+    resolved: dict[str, Any] | None = None
+    quality: dict[str, dict[str, float | int]] | None = None
+    planner: str | None = None
+    decisions: tuple[Decision, ...] | None = None
+    why: str | None = None
+    sgtool_version: str | None = None
+
+    def log_path(self, folder: Path) -> Path:
+        p = Path(self.log)
+        return p if p.is_absolute() else folder / p
+
+    def to_dict(self) -> dict[str, Any]:
+        d: dict[str, Any] = {
+            "log": self.log, "log_sha256": self.log_sha256, "refreshes": self.refreshes,
+            "final_sha256": self.final_sha256, "sequence_sha256": self.sequence_sha256,
+            "options": options_dict(self.options)}
+        for k, v in (("log_bytes", self.log_bytes), ("resolved", self.resolved),
+                     ("quality", self.quality), ("planner", self.planner),
+                     ("why", self.why), ("sgtool_version", self.sgtool_version)):
+            if v is not None:
+                d[k] = v
+        if self.decisions is not None:
+            d["decisions"] = [[x.episode, x.step, x.skill, x.target] for x in self.decisions]
+        return d
+
+
+@dataclass(frozen=True)
+class PinSet:
+    """A pin folder's index: its format, the sgtool version that last wrote it, the logs."""
+
+    folder: Path
+    logs: dict[str, Pinned]
+    format: int = PIN_FORMAT
+    sgtool_version: str = __version__
+
+    def graphs_path(self, name: str) -> Path:
+        return self.folder / f"{name}.graphs.jsonl.gz"
+
+    def refreshes_path(self, name: str) -> Path:
+        return self.folder / f"{name}.refreshes.jsonl.gz"
+
+
+def options_dict(o: ReplayOptions) -> dict[str, Any]:
+    """The options that are set (None: the log's recorded value, else the default)."""
+    return {k: v for k, v in asdict(o).items() if v is not None}
+
+
+def options_from(d: Mapping[str, Any], where: str) -> ReplayOptions:
+    unknown = set(d) - set(_OPTION_FIELDS)
+    if unknown:
+        raise PinError(f"{where}: damaged pin file (unknown replay option "
+                       f"{sorted(unknown)[0]!r})")
+    return ReplayOptions(**{k: d[k] for k in _OPTION_FIELDS if k in d})
+
+
+def overridden(pinned: ReplayOptions, given: ReplayOptions | None) -> ReplayOptions:
+    """``pinned`` with every option that is set in ``given`` replaced."""
+    if given is None:
+        return pinned
+    return ReplayOptions(**(asdict(pinned) | options_dict(given)))
+
+
+# ----- capture ---------------------------------------------------------------------------
+def capture(log: str | os.PathLike[str], options: ReplayOptions, *,
+            quality: bool = True) -> Capture:
+    """Replay ``log`` with ``options`` and keep what a pin needs (no planner decisions:
+    those are :mod:`sgtool.analysis.golden_check`'s). ``quality``: score the final graph
+    when the log carries its house."""
+    from sgtool.log.reader import LogReader
+
+    graphs: list[str] = []
+    metas: list[RefreshMeta] = []
+    last: dict[str, Any] = {}
+
+    def keep(r: Refresh, s: SceneGraphStream) -> None:
+        graphs.append(r.graph.to_json())
+        metas.append(RefreshMeta(r.time_ns, r.frames, r.reason, layer_summary(r.layers)))
+        last["refresh"], last["stream"] = r, s
+
+    report = replay(log, None, options, on_refresh=keep)
+    figures = None
+    if quality:
+        with LogReader(log) as reader:
+            house = reader.house_json()
+        ref = last.get("refresh")
+        if house is not None and ref is not None and ref.layers is not None:
+            from sgtool.house.io import load_house
+            from sgtool.replayers.score import score, score_dict
+
+            spec = load_house(json.loads(house))
+            figures = score_dict(score(spec, last["stream"].builder.instances, ref.layers,
+                                       ref.graph))
+            figures = {k: {f: canonical_float(v) if isinstance(v, float) else v
+                           for f, v in q.items()} for k, q in figures.items()}
+    return Capture(graphs, metas, asdict(report.options), figures)
+
+
+# ----- reading and writing ------------------------------------------------------------------
+def _damaged(path: Path, why: str) -> PinError:
+    return PinError(f"{path}: damaged pin file ({why}); pin the log again with `sgtool golden "
+                    "pin` or restore the file")
+
+
+def read_pins(folder: str | os.PathLike[str]) -> PinSet:
+    """The index of a pin folder (module doc). One-line :class:`PinError` when the folder
+    or its index is missing or damaged, or the format is newer than :data:`PIN_FORMAT`."""
+    root = Path(folder)
+    path = root / INDEX
+    if not root.is_dir():
+        raise PinError(f"{root}: no such pin folder (make one with `sgtool golden pin LOG "
+                       f"--dir {root}`)")
+    if not path.is_file():
+        raise PinError(f"{root}: no {INDEX}, so nothing is pinned there (pin logs with "
+                       f"`sgtool golden pin LOG --dir {root}`)")
+    try:
+        doc = json.loads(path.read_bytes())
+    except (ValueError, UnicodeDecodeError) as e:
+        raise _damaged(path, f"not JSON: {str(e).splitlines()[0]}") from None
+    if not isinstance(doc, dict) or not isinstance(doc.get("cases"), dict):
+        raise _damaged(path, "no 'cases' object")
+    fmt = doc.get("format")
+    if not isinstance(fmt, int) or fmt < 1:
+        raise _damaged(path, f"format {fmt!r} is no version number")
+    if fmt > PIN_FORMAT:
+        raise PinError(f"{path}: pin format {fmt} is newer than this sgtool reads (format "
+                       f"{PIN_FORMAT}, sgtool {__version__}); upgrade sgtool, or pin again")
+    common = doc.get("replay", {}) if fmt == 1 else {}
+    logs: dict[str, Pinned] = {}
+    for name, e in sorted(doc["cases"].items()):
+        try:
+            logs[name] = _entry(name, e, common, fmt, path)
+        except (KeyError, TypeError, ValueError) as err:
+            raise _damaged(path, f"entry {name!r}: {type(err).__name__} {err}") from None
+    return PinSet(root, logs, fmt, str(doc.get("sgtool_version", "")))
+
+
+def _entry(name: str, e: Mapping[str, Any], common: Mapping[str, Any], fmt: int,
+           path: Path) -> Pinned:
+    options = options_from(common if fmt == 1 else e.get("options", {}), f"{path}: {name}")
+    decisions = None
+    if e.get("decisions") is not None:
+        decisions = tuple(Decision(int(ep), int(st), str(sk), None if t is None else str(t))
+                          for ep, st, sk, t in e["decisions"])
+    return Pinned(
+        name=name, log=str(e.get("log", f"{name}.mcap")), log_sha256=str(e["log_sha256"]),
+        refreshes=int(e["refreshes"]), final_sha256=str(e["final_sha256"]),
+        sequence_sha256=str(e["sequence_sha256"]), options=options,
+        log_bytes=None if e.get("log_bytes") is None else int(e["log_bytes"]),
+        resolved=e.get("resolved"), quality=e.get("quality"), planner=e.get("planner"),
+        decisions=decisions, why=e.get("why"), sgtool_version=e.get("sgtool_version"))
+
+
+def write_index(pins: PinSet) -> Path:
+    """Write the index of ``pins`` (format :data:`PIN_FORMAT`) atomically."""
+    doc = {"format": PIN_FORMAT, "sgtool_version": pins.sgtool_version,
+           "cases": {k: v.to_dict() for k, v in sorted(pins.logs.items())}}
+    return atomic_write(pins.folder / INDEX, json.dumps(doc, indent=2, sort_keys=True) + "\n")
+
+
+def load_expected(pins: PinSet, name: str) -> tuple[list[str], list[RefreshMeta] | None]:
+    """The pinned graphs of log ``name`` (checked against the sequence digest) and its
+    refresh metadata (None when the pin has none); one-line :class:`PinError` when a file
+    is damaged."""
+    pin = pins.logs[name]
+    gpath = pins.graphs_path(name)
+    if not gpath.is_file():
+        raise PinError(f"{gpath}: missing pin file of {name}; pin the log again with "
+                       "`sgtool golden pin` or restore the file")
+    try:
+        graphs = read_graphs(gpath)
+    except (OSError, EOFError, zlib.error, UnicodeDecodeError) as e:
+        raise _damaged(gpath, f"{type(e).__name__}: {e}") from None
+    if len(graphs) != pin.refreshes or sequence_digest(graphs) != pin.sequence_sha256:
+        raise _damaged(gpath, "its graphs do not match the digest in the index")
+    rpath = pins.refreshes_path(name)
+    if not rpath.is_file():
+        return graphs, None
+    try:
+        metas = [RefreshMeta.from_dict(json.loads(line)) for line in read_graphs(rpath)]
+    except (OSError, EOFError, zlib.error, UnicodeDecodeError, ValueError, KeyError,
+            TypeError) as e:
+        raise _damaged(rpath, f"{type(e).__name__}: {e}") from None
+    if len(metas) != len(graphs):
+        raise _damaged(rpath, f"{len(metas)} refreshes where the graphs are {len(graphs)}")
+    return graphs, metas
+
+
+def pinned_entry(name: str, log: Path, folder: Path, options: ReplayOptions, cap: Capture,
+                 why: str | None = None) -> Pinned:
+    """The index entry of ``cap``, a capture of ``log`` with ``options``."""
+    graphs = cap.graphs
+    try:
+        stored = str(log.resolve().relative_to(folder.resolve()))
+    except ValueError:
+        stored = str(log.resolve())
+    return Pinned(
+        name=name, log=stored, log_sha256=sha256_file(log), refreshes=len(graphs),
+        final_sha256=hashlib.sha256(graphs[-1].encode()).hexdigest() if graphs else "",
+        sequence_sha256=sequence_digest(graphs), options=options,
+        log_bytes=log.stat().st_size, resolved=cap.resolved, quality=cap.quality,
+        planner=cap.planner, decisions=cap.decisions, why=why, sgtool_version=__version__)
+
+
+def write_capture(pins: PinSet, pin: Pinned, cap: Capture) -> None:
+    """Write the graphs and refresh files of ``pin`` (the index is :func:`write_index`'s)."""
+    write_graphs(pins.graphs_path(pin.name), cap.graphs)
+    lines = [json.dumps(m.to_dict(), sort_keys=True, separators=(",", ":"))
+             for m in cap.refreshes]
+    write_graphs(pins.refreshes_path(pin.name), lines)

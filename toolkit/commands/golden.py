@@ -1,0 +1,167 @@
+"""``sgtool golden pin|check``: pin the replay of your own logs, check it after a change.
+
+The work is :mod:`sgtool.analysis.golden_check` (pin format:
+:mod:`sgtool.replayers.golden_pins`, documented in ``docs/golden.md``); this module parses
+options and prints or writes the reports (:mod:`sgtool.analysis.golden_report`).
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, TypeVar
+
+import click
+
+from sgtool.commands.options import executor_options, option_group
+from sgtool.errors import SgtoolError
+from sgtool.scenegraph.options import CLASSIFIERS
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def replay_options(what: str) -> Callable[[F], F]:
+    """``--every``, ``--classifier``, ``--min-points``, ``--voxel-size``, ``--max-frames``
+    (as ``sgtool replay``'s; unset: ``what``)."""
+    return option_group([
+        click.option("--every", type=click.IntRange(min=1), default=None,
+                     help=f"Refresh the graph every K frames (and at every action) [{what}]."),
+        click.option("--classifier", type=click.Choice([c for c in CLASSIFIERS if c != "llm"]),
+                     default=None, help=f"Room classifier [{what}]."),
+        click.option("--min-points", type=click.IntRange(min=1), default=None,
+                     help=f"Points an instance needs in one frame to count as seen [{what}]."),
+        click.option("--voxel-size", type=click.FloatRange(0.01, 0.5), default=None,
+                     help=f"Voxel edge in metres [{what}]."),
+        click.option("--max-frames", type=click.IntRange(min=1), default=None,
+                     help=f"Stop after this many frames [{what}]."),
+    ])
+
+
+def make_options(every: int | None, classifier: str | None, min_points: int | None,
+                 voxel_size: float | None, max_frames: int | None) -> Any:
+    from sgtool.replayers.derived_log import ReplayOptions
+
+    return ReplayOptions(every=every, classifier=classifier, min_points=min_points,
+                         voxel_size=voxel_size, max_frames=max_frames)
+
+
+def _show(progress: bool | None) -> bool:
+    return progress if progress is not None else sys.stderr.isatty()
+
+
+@click.group("golden")
+def command() -> None:
+    """Golden-log regression for your own logs: `pin` the replay of logs once, `check`
+    it after changing code or a parameter (exit 0 unchanged, 1 changed, 2 an error), read
+    what changed layer by layer, `check --update` to accept a change on purpose.
+
+    \b
+    sgtool golden pin runs/*.mcap --dir golden/
+    sgtool golden check --dir golden/ -w 2
+    sgtool golden check --dir golden/ --voxel-size 0.08   # what would this change?
+    sgtool golden check --dir golden/ --update            # accept it
+
+    The pin format is documented in docs/golden.md; `pytest --sgtool-golden DIR` runs one
+    test per pinned log."""
+
+
+@command.command("pin")
+@click.argument("logs", metavar="LOG...", nargs=-1, required=True, type=click.Path())
+@click.option("--dir", "folder", required=True, type=click.Path(file_okay=False),
+              help="Pin folder (created when missing; logs pinned there before under other "
+              "names are kept).")
+@click.option("--copy", is_flag=True,
+              help="Copy each log into the folder and pin the copy (for small logs kept "
+              "with the tests).")
+@click.option("--why", default=None, help="A note kept with each pin (what it covers).")
+@replay_options("the log's, else the replay default")
+@executor_options("replays (one per log)")
+@click.option("--progress/--no-progress", default=None,
+              help="Progress bar on stderr (default: when stderr is a terminal).")
+def pin(logs: tuple[str, ...], folder: str, copy: bool, why: str | None, every: int | None,
+        classifier: str | None, min_points: int | None, voxel_size: float | None,
+        max_frames: int | None, executor: str, workers: int, ray_address: str | None,
+        progress: bool | None) -> None:
+    """Replay every LOG and pin what a check needs into DIR: the log's digest and place,
+    the replay options, every refresh's canonical scene graph (compressed), the quality
+    figures when the log carries its house, the planner's decisions for an episode log."""
+    from sgtool.analysis.batch_inputs import expand_inputs
+    from sgtool.analysis.executor import make_executor
+    from sgtool.analysis.golden_check import pin_logs
+
+    inputs = expand_inputs(logs, (".mcap",))
+    runner = make_executor(executor, workers, ray_address)
+    pins = pin_logs(inputs, Path(folder),
+                    make_options(every, classifier, min_points, voxel_size, max_frames),
+                    copy=copy, executor=runner, progress=_show(progress), why=why)
+    for p in inputs:
+        from sgtool.analysis.golden_check import pin_name
+
+        e = pins.logs[pin_name(Path(p))]
+        extra = ", quality figures" if e.quality else ""
+        extra += f", {len(e.decisions)} {e.planner} decisions" if e.decisions else ""
+        click.echo(f"pinned {e.name}: {e.refreshes} refreshes{extra} ({e.log})")
+    click.echo(f"wrote {Path(folder) / 'expected.json'}; check with: sgtool golden check "
+               f"--dir {folder}")
+
+
+@command.command("check")
+@click.option("--dir", "folder", required=True, type=click.Path(file_okay=False),
+              help="Pin folder written by `sgtool golden pin`.")
+@click.option("--log", "names", multiple=True, metavar="NAME",
+              help="Check only this pinned log (repeatable).")
+@replay_options("as pinned; given here it overrides the pinned option for every log")
+@click.option("--tolerance", type=click.FloatRange(min=0.0), default=0.0, show_default=True,
+              help="Let differences up to this pass: positions and distances (m), room "
+              "areas (m²), category scores (0: the graphs must be byte-identical).")
+@click.option("--update", is_flag=True,
+              help="Re-pin the changed logs (with the options checked) and print what was "
+              "accepted; exit 0 then.")
+@click.option("--report", "report_md", type=click.Path(dir_okay=False), default=None,
+              help="Also write the report as Markdown to this file.")
+@click.option("--junit", type=click.Path(dir_okay=False), default=None,
+              help="Also write a JUnit XML file (one test case per log) for CI.")
+@executor_options("checks (one per log)")
+@click.option("--progress/--no-progress", default=None,
+              help="Progress bar on stderr (default: when stderr is a terminal).")
+def check(folder: str, names: tuple[str, ...], every: int | None, classifier: str | None,
+          min_points: int | None, voxel_size: float | None, max_frames: int | None,
+          tolerance: float, update: bool, report_md: str | None, junit: str | None,
+          executor: str, workers: int, ray_address: str | None,
+          progress: bool | None) -> None:
+    """Replay every pinned log with the current code and compare: per log the first
+    refresh (frame, log time) that differs and what differs in it layer by layer (rooms
+    added, removed, merged or split with their areas; categories; objects moved or
+    re-assigned; doors; frontiers; the Voronoi graph size), the quality figures before and
+    after, the first planner decision that differs; then a summary table. Exit 0 when
+    nothing changed, 1 when something did, 2 when a log could not be checked."""
+    from sgtool.analysis.executor import make_executor
+    from sgtool.analysis.golden_check import check_pins, update_pins
+    from sgtool.analysis.golden_report import junit_report, markdown_report, text_report
+    from sgtool.files import atomic_write
+
+    runner = make_executor(executor, workers, ray_address)
+    report = check_pins(Path(folder),
+                        make_options(every, classifier, min_points, voxel_size, max_frames),
+                        tolerance=tolerance, executor=runner, names=names or None,
+                        keep=update, progress=_show(progress))
+    for line in text_report(report):
+        click.echo(line)
+    if report_md:
+        atomic_write(report_md, markdown_report(report))
+    if junit:
+        atomic_write(junit, junit_report(report))
+    code = report.exit_code
+    if update:
+        for line in update_pins(report):
+            click.echo(line)
+        code = 2 if code == 2 else 0
+    if code == 2:
+        first = next(c for c in report.logs if c.status == "error")
+        raise SgtoolError(f"{report.counts()['error']} pinned log(s) could not be checked; "
+                          f"the first: {first.name}: {first.error}")
+    if code:
+        click.echo("changed on purpose? accept it with: sgtool golden check --dir "
+                   f"{folder} --update", err=True)
+        raise click.exceptions.Exit(code)
