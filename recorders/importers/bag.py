@@ -58,7 +58,7 @@ from sgtool.recorders.importers.bag_poses import PoseSource, pose_source_of
 from sgtool.recorders.importers.bag_sync import PlannedFrame, plan_frames, planned_poses
 from sgtool.recorders.importers.bag_topics import check_flags, describe_bag, with_only_info
 from sgtool.recorders.importers.distortion import distortion_finding
-from sgtool.recorders.importers.images import depth_to_metres
+from sgtool.recorders.importers.images import ResizeLog, depth_to_metres
 from sgtool.recorders.importers.odometry import (
     DriftReport,
     OdometryResult,
@@ -126,8 +126,8 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         if opts.depth is None:
             assert src is not None
             return _import_trajectory(path, out, src, opts, meta, kind)
-        k = camera_of(path, idx, opts)
         findings = Findings(opts.warn)
+        k = camera_of(path, idx, opts, findings)
         findings.problem(timestamp_problem(
             sorted(idx.depth.stamps), f"{path}: --depth {opts.depth} ({opts.timestamps} times)",
             BAG_TIME_FIX), given=opts.timestamps != "header")
@@ -173,15 +173,18 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         meta.update(source_metadata(sources))
         if findings.warnings:
             meta["warnings"] = "\n".join(findings.warnings)
+        resizes = ResizeLog()
         n, has_rgb, has_ids = write_log(
-            out, decode_frames(reader, plan, idx, opts, k), alignment=alignment, metadata=meta,
-            total=len(plan), progress=opts.progress, notes=notes, compression=opts.compression,
+            out, decode_frames(reader, plan, idx, opts, k, resizes), alignment=alignment,
+            metadata=meta, total=len(plan), progress=opts.progress, notes=notes,
+            compression=opts.compression, resizes=resizes,
         )
     return ImportReport(
         output=out, source=str(path), kind=kind, frames=n, poses=n, alignment=alignment,
         has_rgb=has_rgb, has_ids=has_ids, pose_source=pose_source, drift=drift,
         notes=tuple(notes), drift_reference=reference, sources=tuple(sources),
-        warnings=tuple(findings.warnings),
+        warnings=tuple(findings.warnings), resizes=tuple(resizes.lines()),
+        resize_counts=tuple(resizes.as_dicts()),
         **odometry_report_fields(odo),
     )
 

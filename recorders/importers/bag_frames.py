@@ -17,19 +17,24 @@ from sgtool.recorders.importers.bag_index import BagIndex
 from sgtool.recorders.importers.bag_options import BagOptions
 from sgtool.recorders.importers.bag_sync import PlannedFrame
 from sgtool.recorders.importers.images import (
+    ResizeLog,
     decode_color_message,
     decode_depth_message,
     decode_ids_message,
     depth_for_log,
     resize_to,
 )
+from sgtool.recorders.importers.provenance import Findings
+from sgtool.recorders.importers.sanity import principal_point_problem
 from sgtool.recorders.importers.sink import ImportFrame
 
 
 def decode_frames(
-    reader: Any, plan: list[PlannedFrame], idx: BagIndex, opts: BagOptions, k: CameraIntrinsics
+    reader: Any, plan: list[PlannedFrame], idx: BagIndex, opts: BagOptions, k: CameraIntrinsics,
+    resizes: ResizeLog | None = None,
 ) -> Iterator[ImportFrame]:
-    """The planned frames in time order, decoding only the images they use."""
+    """The planned frames in time order, decoding only the images they use; colour and id
+    images resized to the depth images are counted in ``resizes``."""
     need: dict[str, dict[int, Any]] = {
         "depth": {p.k_depth: i for i, p in enumerate(plan)},
         "rgb": {},
@@ -56,8 +61,10 @@ def decode_frames(
     def build(i: int) -> ImportFrame:
         d = decoded.pop(i)
         raw, scale = d["depth"]
-        rgb = resize_to(d["rgb"], k.width, k.height) if "rgb" in d else None
-        ids = resize_to(d["ids"], k.width, k.height) if "ids" in d else None
+        rgb = (resize_to(d["rgb"], k.width, k.height, f"topic {opts.rgb}", resizes, "colour")
+               if "rgb" in d else None)
+        ids = (resize_to(d["ids"], k.width, k.height, f"topic {opts.ids}", resizes, "ids")
+               if "ids" in d else None)
         planned = plan[i]
         pose = planned.pose if planned.pose is not None else np.eye(4)
         return ImportFrame(planned.t_ns, depth_for_log(raw, scale), pose, k, rgb=rgb, ids=ids)
@@ -96,7 +103,29 @@ def decode_frames(
         next_i += 1
 
 
-def camera_of(path: Path, idx: BagIndex, opts: BagOptions) -> CameraIntrinsics:
+def camera_of(path: Path, idx: BagIndex, opts: BagOptions,
+              findings: Findings | None = None) -> CameraIntrinsics:
+    """The depth camera from ``--intrinsics`` or ``--info``, checked against the sampled
+    depth images: another size is an error; a principal point far from their centre
+    (:func:`~.sanity.principal_point_problem`) an error for CameraInfo, a warning in
+    ``findings`` for a flag."""
+    k = _camera_of(path, idx, opts)
+    if not (0 <= k.cx <= k.width and 0 <= k.cy <= k.height):
+        raise SgtoolError(f"{path}: intrinsics ({_intrinsics_origin(opts)}): principal point "
+                          f"({k.cx:g}, {k.cy:g}) is outside the {k.width}x{k.height} depth "
+                          "images")
+    if findings is not None:
+        findings.problem(principal_point_problem(k.cx, k.cy, k.width, k.height,
+                                                 _intrinsics_origin(opts)),
+                         given=opts.intrinsics is not None)
+    return k
+
+
+def _intrinsics_origin(opts: BagOptions) -> str:
+    return "flag --intrinsics" if opts.intrinsics is not None else f"topic {opts.info}"
+
+
+def _camera_of(path: Path, idx: BagIndex, opts: BagOptions) -> CameraIntrinsics:
     if not idx.samples:
         raise SgtoolError(f"{path}: --depth {opts.depth} has no messages")
     raw, _ = next(iter(idx.samples.values()))

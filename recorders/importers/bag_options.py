@@ -47,6 +47,7 @@ class BagOptions:
     warn: Callable[[str], None] | None = None  # shows a warning at once
     timestamps: str = "header"  # image times: "header" stamps, or "bag" (record) times
     info_origin: str = ""  # how --info was chosen, when not given ("the only CameraInfo topic")
+    allow_drop: bool = False  # depth images without a pose may be more than 10 %
 
 
 def check_options(opts: BagOptions) -> None:

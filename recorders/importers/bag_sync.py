@@ -8,9 +8,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sgtool.errors import SgtoolError
 from sgtool.recorders.importers.bag_index import BagIndex
 from sgtool.recorders.importers.bag_options import BagOptions
 from sgtool.recorders.importers.bag_poses import PoseSource
+from sgtool.recorders.importers.sanity import dropped_problem
 from sgtool.recorders.importers.tftree import frame_name
 
 
@@ -56,7 +58,9 @@ def plan_frames(
 ) -> tuple[list[PlannedFrame], list[str]]:
     """The frames to write: depth images in time order with their pose (None when
     ``src`` is None or, with ``keep_unposed``, when it does not cover the time) and the
-    colour/id images paired with them."""
+    colour/id images paired with them. Dropping more than
+    :data:`~.sanity.MAX_DROPPED` of the images for want of a pose is an error naming the
+    flags, unless ``opts.allow_drop``."""
     notes = []
     seen: set[int] = set()
     rgb_order = sorted(range(len(idx.rgb.stamps)), key=lambda i: idx.rgb.stamps[i])
@@ -83,6 +87,15 @@ def plan_frames(
     if no_pose and src is not None:
         what = "kept, estimated" if keep_unposed else "dropped"
         notes.append(f"{no_pose} depth images without a pose from {src.describe} ({what})")
+        if not keep_unposed and not opts.allow_drop:
+            problem = dropped_problem(
+                no_pose, len(seen), f"no pose from {src.describe} within --tf-tolerance "
+                f"{opts.tf_tolerance_ns / 1e9:g} s of their time",
+                "give --tf-tolerance S to take poses further from the samples, "
+                "--estimate-poses to estimate them by odometry, or --allow-drop to import "
+                "only the posed frames")
+            if problem:
+                raise SgtoolError(problem)
     if dup:
         notes.append(f"{dup} depth images repeated a time stamp (dropped)")
     if no_rgb:

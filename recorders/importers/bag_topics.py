@@ -80,24 +80,22 @@ def suggest_flags(topics: list[B.TopicInfo], tf_frames: list[str] | None = None,
     poses = [t.topic for t in topics if t.msgtype in B.POSE_TYPES]
     tfs = [t.topic for t in topics if t.msgtype in B.TF_TYPES]
     out: list[str] = []
-    depth = next((t for t in images if "depth" in t.lower() and fits(t, "depth")), None)
-    if depth is None:  # a depth camera's topic need not say "depth": its encoding does
-        depth = next((t for t in images if t in enc and (
-            enc[t] in ("16UC1", "32FC1") or "compresseddepth" in enc[t].lower())), None)
+    named = [t for t in images if "depth" in t.lower() and fits(t, "depth")]
+    if not named:  # a depth camera's topic need not say "depth": its encoding does
+        named = [t for t in images if t in enc and (
+            enc[t] in ("16UC1", "32FC1") or "compresseddepth" in enc[t].lower())]
+    depth = min(named, key=lambda t: depth_rank(t, enc.get(t)), default=None)
     ids_words = ("instance", "segment", "label", "ids", "mask")
     ids = next((t for t in images if t != depth and fits(t, "ids")
                 and any(w in t.lower() for w in ids_words)), None)
-    rgb = next(
-        (t for t in images if t not in (depth, ids) and fits(t, "rgb")
-         and "depth" not in t.lower()
-         and any(w in t.lower() for w in ("rgb", "color", "colour", "image"))),
-        None,
-    )
+    colour = [t for t in images if t not in (depth, ids) and fits(t, "rgb")
+              and "depth" not in t.lower()
+              and any(w in t.lower() for w in ("rgb", "color", "colour", "image"))]
+    rgb = min(colour, key=lambda t: colour_rank(t, enc.get(t), types[t], depth), default=None)
     out.extend(f"{flag} {topic}" for flag, topic in (("--depth", depth), ("--rgb", rgb),
                                                      ("--ids", ids)) if topic)
     if infos:
-        ns = depth.rsplit("/", 1)[0] if depth else ""
-        out.append(f"--info {next((t for t in infos if ns and t.startswith(ns)), infos[0])}")
+        out.append(f"--info {min(infos, key=lambda t: (-_shared_parts(t, depth or ''), t))}")
     if not depth:
         alternatives = (list(tf_frames) if tf_frames is not None else
                         ["--tf-frames WORLD:FRAME"] if tfs else [])
@@ -107,6 +105,57 @@ def suggest_flags(topics: list[B.TopicInfo], tf_frames: list[str] | None = None,
         if alternatives:
             out.append(" | ".join(alternatives))
     return out
+
+
+_ALIGNED_WORDS = ("aligned", "registered")
+
+
+def _parts(topic: str) -> list[str]:
+    return [p for p in topic.split("/") if p]
+
+
+def _shared_parts(a: str, b: str) -> int:
+    """How many leading path components two topic names share."""
+    n = 0
+    for x, y in zip(_parts(a), _parts(b), strict=False):
+        if x != y:
+            break
+        n += 1
+    return n
+
+
+def depth_rank(topic: str, encoding: str | None) -> tuple[int, int, str]:
+    """Sort key of a depth topic for the suggestions: depth aligned (registered) to the
+    colour camera first, then the sensor's native encoding (16UC1/mono16, then
+    compressedDepth/PNG, then 32FC1, then unknown), then the name."""
+    aligned = 0 if any(w in topic.lower() for w in _ALIGNED_WORDS) else 1
+    e = (encoding or "").lower()
+    native = (0 if e in ("16uc1", "mono16") else 1 if "compresseddepth" in e or "png" in e
+              else 2 if e == "32fc1" else 3)
+    return aligned, native, topic
+
+
+_COLOUR_RANK = {"rgb8": 0, "bgr8": 0, "rgba8": 0, "bgra8": 0, "8uc3": 0}
+
+
+def colour_rank(topic: str, encoding: str | None, msgtype: str, depth: str | None
+                ) -> tuple[int, int, str]:
+    """Sort key of a colour topic for the suggestions: the depth topic's own camera first
+    (the most leading path components shared, the colour stream a depth aligned "to_color"
+    names), then native colour (rgb8/bgr8/...), compressed JPEG/PNG, YUV, Bayer, grey,
+    unknown; then the name."""
+    shared = _shared_parts(topic, depth) if depth else 0
+    if depth and "to_color" in depth.lower() and "color" in topic.lower():
+        shared += 1
+    e = (encoding or "").lower()
+    if msgtype.endswith("CompressedImage"):
+        native = 1 if e else 5
+    elif e in _COLOUR_RANK:
+        native = 0
+    else:
+        native = (2 if e.startswith(("yuv", "uyvy", "yuyv")) else 3 if e.startswith("bayer")
+                  else 4 if e in ("mono8", "mono16", "8uc1") else 5)
+    return -shared, native, topic
 
 
 def with_only_info(topics: list[B.TopicInfo], opts: BagOptions) -> BagOptions:

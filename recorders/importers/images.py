@@ -49,11 +49,57 @@ def _jpeg_truncated(path: Path) -> bool:
 def read_color_file(path: Path) -> np.ndarray:
     """An 8-bit colour (or grey) image file -> (H, W, 3) uint8 RGB; a truncated JPEG is a
     user error."""
+    return read_color_file_kind(path)[0]
+
+
+def read_color_file_kind(path: Path) -> tuple[np.ndarray, str]:
+    """:func:`read_color_file` and the file's pixel kind (:func:`pixel_kind`, before the
+    conversion to 8-bit RGB)."""
     if Path(path).is_file() and _jpeg_truncated(Path(path)):
         raise SgtoolError(f"{path}: truncated JPEG (no end-of-image marker): the file is cut "
                           "off or damaged")
     a = _read_image(path)
-    return _to_rgb(a, str(path))
+    return _to_rgb(a, str(path)), pixel_kind(a)
+
+
+def pixel_kind(a: np.ndarray) -> str:
+    """Bit depth and channel count of a decoded image, e.g. ``8-bit 3-channel``."""
+    ch = 1 if a.ndim == 2 else int(a.shape[2])
+    return f"{a.dtype.itemsize * 8}-bit {ch}-channel"
+
+
+_PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+_PNG_CHANNELS = {0: 1, 2: 3, 3: 3, 4: 2, 6: 4}  # PNG colour type -> channels as decoded
+
+
+def header_kind(path: Path) -> str | None:
+    """The pixel kind (:func:`pixel_kind`) a PNG file's header declares, read from its
+    first 26 bytes without decoding; None for other formats or an unreadable header. A
+    palette PNG decodes to 8-bit 3-channel."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(26)
+    except OSError:
+        return None
+    if len(head) < 26 or head[:8] != _PNG_MAGIC or head[12:16] != b"IHDR":
+        return None
+    bits, ctype = head[24], head[25]
+    if ctype not in _PNG_CHANNELS:
+        return None
+    bits = 8 if ctype == 3 or bits <= 8 else 16
+    return f"{bits}-bit {_PNG_CHANNELS[ctype]}-channel"
+
+
+def colour_kind_problem(kind: str, path: Path | str, first: str, first_path: Path | str
+                        ) -> str | None:
+    """The problem of a colour image of pixel kind ``kind`` in a folder whose first colour
+    image (``first_path``) is ``first``: another bit depth or channel count (a 16-bit grey
+    PNG among 8-bit colour frames turns near-black) is not the same camera stream."""
+    if kind == first:
+        return None
+    return (f"{path}: a {kind} image among colour frames that are {first} (the first, "
+            f"{Path(first_path).name}): not the same colour stream (a depth or infrared image "
+            "in the colour folder?); remove or convert it")
 
 
 def read_depth_file(path: Path) -> np.ndarray:
@@ -230,12 +276,18 @@ def _decode_compressed_depth(data: bytes, fmt: str, topic: str) -> tuple[np.ndar
     if len(data) < 12:
         raise SgtoolError(f"topic {topic}: compressedDepth message shorter than its header")
     _, qa, qb = struct.unpack("<iff", data[:12])
-    if "rvl" in fmt.lower():
-        a = _decode_rvl_payload(data[12:], topic)
+    payload = data[12:]
+    # the payload's magic decides, not the label: some drivers label PNG payloads "rvl"
+    if "rvl" in fmt.lower() and not payload.startswith(_PNG_MAGIC):
+        a = _decode_rvl_payload(payload, topic)
     else:
-        png = cv2.imdecode(np.frombuffer(data[12:], np.uint8), cv2.IMREAD_UNCHANGED)
-        if png is None or png.dtype != np.uint16:
-            raise SgtoolError(f"topic {topic}: compressedDepth PNG did not decode ({fmt!r})")
+        png = cv2.imdecode(np.frombuffer(payload, np.uint8), cv2.IMREAD_UNCHANGED)
+        if png is None or png.dtype != np.uint16 or png.ndim != 2:
+            what = ("a PNG that is not single-channel 16-bit" if png is not None else
+                    "a PNG that OpenCV cannot decode" if payload.startswith(_PNG_MAGIC) else
+                    f"not a PNG (it starts with {payload[:8].hex()})")
+            raise SgtoolError(f"topic {topic}: compressedDepth format {fmt!r}: the payload "
+                              f"after the 12-byte header is {what}")
         a = png
     if fmt.split(";")[0].strip() == "32FC1":
         v = a.astype(np.float32)
@@ -280,11 +332,34 @@ def decode_ids_message(msg: Any, msgtype: str, topic: str) -> np.ndarray:
 ASPECT_TOL = 0.01  # relative difference of width/height ratios that still counts as equal
 
 
-def resize_to(a: np.ndarray, width: int, height: int, what: str = "a colour or id image"
-              ) -> np.ndarray:
+class ResizeLog:
+    """The resizes of one import: how many images of a stream (``colour``, ``ids``) went from
+    which size to which, for the report and ``--json``."""
+
+    def __init__(self) -> None:
+        self.counts: dict[tuple[str, int, int, int, int], int] = {}
+
+    def add(self, stream: str, src: tuple[int, int], dst: tuple[int, int]) -> None:
+        key = (stream, src[0], src[1], dst[0], dst[1])
+        self.counts[key] = self.counts.get(key, 0) + 1
+
+    def lines(self) -> list[str]:
+        """One line per (stream, size -> size), in a stable order."""
+        return [f"{stream} resized from {w0}x{h0} to the {w1}x{h1} depth images "
+                f"({n} {'frame' if n == 1 else 'frames'})"
+                for (stream, w0, h0, w1, h1), n in sorted(self.counts.items())]
+
+    def as_dicts(self) -> list[dict[str, object]]:
+        return [{"stream": stream, "from": [w0, h0], "to": [w1, h1], "frames": n}
+                for (stream, w0, h0, w1, h1), n in sorted(self.counts.items())]
+
+
+def resize_to(a: np.ndarray, width: int, height: int, what: str = "a colour or id image",
+              log: ResizeLog | None = None, stream: str = "colour") -> np.ndarray:
     """Resize an image to the depth image's size (area averaging for colour). An image of
     another aspect ratio (640x360 colour for 640x480 depth) would no longer be registered to
-    the depth when stretched: a user error naming ``what``."""
+    the depth when stretched: a user error naming ``what``. Each resize is counted in
+    ``log`` under ``stream``."""
     if a.shape[1] == width and a.shape[0] == height:
         return a
     if abs(a.shape[1] * height / (a.shape[0] * width) - 1.0) > ASPECT_TOL:
@@ -292,5 +367,7 @@ def resize_to(a: np.ndarray, width: int, height: int, what: str = "a colour or i
             f"{what}: {a.shape[1]}x{a.shape[0]} pixels, another aspect ratio than the "
             f"{width}x{height} depth images; stretching it would misregister colour and "
             "depth (crop or register the colour to the depth first)")
+    if log is not None:
+        log.add(stream, (a.shape[1], a.shape[0]), (width, height))
     interp = cv2.INTER_AREA if a.dtype == np.uint8 else cv2.INTER_NEAREST
     return cv2.resize(a, (width, height), interpolation=interp)

@@ -75,6 +75,7 @@ class FolderSequence:
     depth_scale: float  # raw depth units per metre
     pose_source: str  # "ground truth" | "trajectory" | "none"
     notes: tuple[str, ...] = ()
+    dropped: int = 0  # depth images left out because the poses do not cover their time
 
 
 LAYOUT_NAMES = {"tum": "TUM RGB-D", "7scenes": "7-Scenes", "open3d": "Open3D/Redwood"}
@@ -314,7 +315,7 @@ def _read_tum(
     return FolderSequence(
         "tum", root, tuple(frames), _tum_intrinsics(root), 5000.0,
         "none" if track is None else ("trajectory" if trajectory else "ground truth"),
-        tuple(notes),
+        tuple(notes), dropped=0 if keep_unposed else no_pose,
     )
 
 

@@ -38,9 +38,12 @@ from sgtool.recorders.importers.checks import (
     check_range,
 )
 from sgtool.recorders.importers.images import (
+    ResizeLog,
+    colour_kind_problem,
     depth_for_log,
     depth_to_metres,
-    read_color_file,
+    header_kind,
+    read_color_file_kind,
     read_depth_file,
     resize_to,
 )
@@ -61,6 +64,7 @@ from sgtool.recorders.importers.provenance import (
 from sgtool.recorders.importers.sanity import (
     DEFAULT_CAMERA_HEIGHT,
     depth_scale_problem,
+    dropped_problem,
     floor_problem,
     no_depth_problem,
     principal_point_problem,
@@ -106,6 +110,7 @@ class RgbdOptions:
     skip_missing: bool = False
     camera_height: tuple[float, float] = DEFAULT_CAMERA_HEIGHT  # plausible band, m
     warn: Callable[[str], None] | None = None  # shows a warning at once
+    allow_drop: bool = False  # frames the poses do not cover may be more than 10 %
 
 
 def check_options(opts: RgbdOptions) -> None:
@@ -136,7 +141,8 @@ def camera_for(seq: FolderSequence, opts: RgbdOptions, width: int, height: int,
                findings: Findings | None = None) -> CameraIntrinsics:
     """The camera of ``width`` x ``height`` depth images: the intrinsics given or the
     layout's, for that size (a principal point outside the images is an error; one far from
-    their centre, for intrinsics without a size, a :func:`~.sanity.principal_point_problem`).
+    their centre a :func:`~.sanity.principal_point_problem`, whatever size the intrinsics
+    say).
     """
     p = opts.intrinsics or seq.intrinsics
     if p is None:
@@ -153,16 +159,47 @@ def camera_for(seq: FolderSequence, opts: RgbdOptions, width: int, height: int,
     if not (0 <= p.cx <= width and 0 <= p.cy <= height):
         raise SgtoolError(f"intrinsics ({origin}): principal point ({p.cx:g}, {p.cy:g}) is "
                           f"outside the {width}x{height} depth images")
-    if findings is not None and not (p.width and p.height):
+    if findings is not None:
         findings.problem(principal_point_problem(p.cx, p.cy, width, height, origin),
                          given=opts.intrinsics is not None)
     return CameraIntrinsics(width, height, float(p.fx), float(p.fy), float(p.cx), float(p.cy))
 
 
-def _load(fr: FolderFrame, scale: float, size: tuple[int, int] | None = None
+@dataclass(frozen=True)
+class ColourStream:
+    """The pixel kind (:func:`~.images.pixel_kind`) of a folder's first colour image, which
+    every other colour image must have."""
+
+    kind: str
+    path: Path
+
+    @classmethod
+    def of(cls, frames: list[FolderFrame]) -> ColourStream | None:
+        """The first colour image's kind, and every PNG colour header checked against it
+        (cheap: 26 bytes a file), before any heavy work; None without colour."""
+        paths = [f.color_path for f in frames if f.color_path is not None]
+        if not paths:
+            return None
+        _, kind = read_color_file_kind(paths[0])
+        stream = cls(kind, paths[0])
+        for path in paths[1:]:
+            head = header_kind(path)
+            if head is not None:
+                stream.check(head, path)
+        return stream
+
+    def check(self, kind: str, path: Path) -> None:
+        problem = colour_kind_problem(kind, path, self.kind, self.path)
+        if problem is not None:
+            raise SgtoolError(problem)
+
+
+def _load(fr: FolderFrame, scale: float, size: tuple[int, int] | None = None,
+          colour: ColourStream | None = None, resizes: ResizeLog | None = None,
           ) -> tuple[np.ndarray, np.ndarray | None]:
     """A folder frame's raw depth and its colour image (None without one) resized to the
-    depth image; a depth image whose size differs from ``size`` is refused."""
+    depth image (counted in ``resizes``); a depth image whose size differs from ``size``, or
+    a colour image of another kind than ``colour``'s, is refused."""
     raw = read_depth_file(fr.depth_path)
     if size is not None and (raw.shape[1], raw.shape[0]) != size:
         raise SgtoolError(
@@ -171,20 +208,22 @@ def _load(fr: FolderFrame, scale: float, size: tuple[int, int] | None = None
         )
     rgb: np.ndarray | None = None
     if fr.color_path is not None:
-        rgb = resize_to(read_color_file(fr.color_path), raw.shape[1], raw.shape[0],
-                        str(fr.color_path))
+        rgb, kind = read_color_file_kind(fr.color_path)
+        if colour is not None:
+            colour.check(kind, fr.color_path)
+        rgb = resize_to(rgb, raw.shape[1], raw.shape[0], str(fr.color_path), resizes)
     return raw, rgb
 
 
 def run_odometry(
     frames: list[FolderFrame], k: CameraIntrinsics, scale: float, opts: RgbdOptions,
-    start: np.ndarray | None,
+    start: np.ndarray | None, colour: ColourStream | None = None,
 ) -> OdometryResult:
     size = (k.width, k.height)
 
     def gen() -> Iterator[tuple[np.ndarray | None, np.ndarray]]:
         for fr in frames:
-            raw, rgb = _load(fr, scale, size)
+            raw, rgb = _load(fr, scale, size, colour)
             yield rgb, depth_to_metres(raw, scale)
 
     if opts.odometry == "rgbd" and any(f.color_path is None for f in frames):
@@ -209,6 +248,15 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         frames = frames[: opts.limit]
     if not frames:
         raise SgtoolError(f"{root}: no frames left after --every/--limit")
+    if not opts.allow_drop:
+        problem = dropped_problem(
+            seq.dropped, len(seq.frames) + seq.dropped,
+            f"the {seq.pose_source} of {root.name} does not cover their time",
+            "give --estimate-poses to estimate the poses of all frames, or --allow-drop to "
+            "import only the covered ones")
+        if problem:
+            raise SgtoolError(f"{root}: {problem}")
+    colour = ColourStream.of(frames)
     findings = Findings(opts.warn)
     scale = float(opts.depth_scale if opts.depth_scale is not None else seq.depth_scale)
     scale_origin = ("flag --depth-scale" if opts.depth_scale is not None
@@ -232,7 +280,7 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     source_poses = [f.pose for f in frames]
     if opts.estimate_poses or seq.pose_source == "none":
         # start at the first reference pose, so the estimate lives in the dataset's world
-        odo = run_odometry(frames, k, scale, opts, source_poses[0])
+        odo = run_odometry(frames, k, scale, opts, source_poses[0], colour)
         poses = list(odo.poses)
         if odo.warning():
             notes.append(str(odo.warning()))
@@ -275,19 +323,22 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         **(odometry_metadata(odo) if odo is not None else {}),
     }
 
+    resizes = ResizeLog()
+
     def gen() -> Iterator[ImportFrame]:
         size = (k.width, k.height)
         for fr, pose in zip(frames, poses, strict=True):
-            raw, rgb = _load(fr, scale, size)
+            raw, rgb = _load(fr, scale, size, colour, resizes)
             yield ImportFrame(fr.time_ns, depth_for_log(raw, scale), pose, k, rgb=rgb)
 
     n, has_rgb, has_ids = write_log(out, gen(), alignment=alignment, metadata=meta,
                                     total=len(frames), progress=opts.progress, notes=notes,
-                                    compression=opts.compression)
+                                    compression=opts.compression, resizes=resizes)
     return ImportReport(
         output=out, source=str(root), kind=f"rgbd/{seq.layout}", frames=n, poses=len(poses),
         alignment=alignment, has_rgb=has_rgb, has_ids=has_ids, pose_source=pose_source,
         drift=drift, notes=tuple(notes), drift_reference=reference,
         sources=tuple(sources), warnings=tuple(findings.warnings),
+        resizes=tuple(resizes.lines()), resize_counts=tuple(resizes.as_dicts()),
         **odometry_report_fields(odo),
     )

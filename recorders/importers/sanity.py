@@ -199,14 +199,41 @@ def floor_problem(poses: Sequence[np.ndarray], alignment_matrix: np.ndarray, flo
             "camera at 1.3 m), or a wider --camera-height")
 
 
+# how far (a fraction of the image size, per axis) a principal point may be from the image
+# centre: real cameras stay within a few per cent; intrinsics of half or double the
+# resolution put it a quarter of the image off
+PRINCIPAL_POINT_OFF = 0.125
+
+
+def _size(pixels: float) -> int:
+    """An image size near ``pixels`` (twice a principal point): the nearest multiple of 8."""
+    return max(8, 8 * round(pixels / 8))
+
+
 def principal_point_problem(cx: float, cy: float, width: int, height: int,
                             origin: str) -> str | None:
-    """The problem of a principal point more than a quarter of the image from the centre of
-    ``width`` x ``height`` images: intrinsics of another resolution (e.g. 320x240 numbers for
-    640x480 images) stretch the world; None when it is near the centre."""
-    if abs(cx - width / 2) <= width / 4 and abs(cy - height / 2) <= height / 4:
+    """The problem of a principal point more than :data:`PRINCIPAL_POINT_OFF` of the image
+    from the centre of ``width`` x ``height`` images: intrinsics of another resolution (e.g.
+    320x240 numbers for 640x480 images, whatever size the intrinsics claim) stretch the
+    world; None when it is near the centre."""
+    if (abs(cx - width / 2) <= PRINCIPAL_POINT_OFF * width
+            and abs(cy - height / 2) <= PRINCIPAL_POINT_OFF * height):
         return None
     return (f"intrinsics ({origin}): the principal point ({cx:g}, {cy:g}) is far from the "
             f"centre ({width / 2:g}, {height / 2:g}) of the {width}x{height} depth images; they "
-            f"look like intrinsics of {2 * cx:.0f}x{2 * cy:.0f} images: give the intrinsics of "
+            f"look like intrinsics of {_size(2 * cx)}x{_size(2 * cy)} images: give the intrinsics of "
             f"{width}x{height} images with --intrinsics fx,fy,cx,cy")
+
+
+MAX_DROPPED = 0.10  # share of the frames an import may drop without --allow-drop
+
+
+def dropped_problem(dropped: int, total: int, why: str, fixes: str) -> str | None:
+    """The problem of dropping ``dropped`` of ``total`` frames (``why``: "no pose from tf
+    world -> cam") when that is more than :data:`MAX_DROPPED`: a map of the rest is not the
+    recording; ``fixes`` names the flags (``--tf-tolerance``, ``--estimate-poses``,
+    ``--allow-drop``). None at or under the share."""
+    if total <= 0 or dropped <= MAX_DROPPED * total:
+        return None
+    return (f"{dropped} of {total} frames ({100 * dropped / total:.0f} %, more than "
+            f"{100 * MAX_DROPPED:.0f} %) would be dropped: {why}; {fixes}")

@@ -30,6 +30,7 @@ from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.records import Episode
 from sgtool.log.writer import LogWriter
+from sgtool.recorders.importers.images import ResizeLog
 from sgtool.recorders.importers.odometry import DriftReport, OdometryResult
 from sgtool.recorders.importers.upright import WorldAlignment
 
@@ -74,6 +75,11 @@ class ImportReport:
     # (parameter, value, origin) of the intrinsics, depth scale, up and floor
     sources: tuple[tuple[str, str, str], ...] = ()
     warnings: tuple[str, ...] = ()
+    # every resize of colour or id images to the depth images (:class:`~.images.ResizeLog`)
+    resizes: tuple[str, ...] = ()
+    resize_counts: tuple[dict[str, object], ...] = ()
+    # the import's checks before the heavy work: (check, verdict) lines
+    checks: tuple[tuple[str, str], ...] = ()
 
     def lines(self) -> list[str]:
         a = self.alignment
@@ -93,6 +99,8 @@ class ImportReport:
                                        "motion kept)"))
         if self.drift is not None:
             out.append(f"drift against {self.drift_reference}: " + self.drift.summary())
+        out.extend(f"check: {name}: {verdict}" for name, verdict in self.checks)
+        out.extend(f"resized: {r}" for r in self.resizes)
         out.extend(f"note: {n}" for n in self.notes)
         out.extend(f"warning: {w}" for w in self.warnings)
         return out
@@ -108,11 +116,13 @@ def write_log(
     progress: bool = True,
     notes: Iterable[str] = (),
     compression: str = "zstd",
+    resizes: ResizeLog | None = None,
 ) -> tuple[int, bool, bool]:
     """Write the frames; returns (frame count, any colour, any ids). Raises
     :class:`SgtoolError` (leaving no output) when there is no frame at all. Chunks are zstd
     by default: on ICL-NUIM and 7-Scenes 22 % smaller than lz4 (0.60 vs 0.77 MB/frame) for
-    1.4-1.6x the import time (63 vs 88 frames/s; ``benchmarks/import_.py``)."""
+    1.4-1.6x the import time (63 vs 88 frames/s; ``benchmarks/import_.py``). The resizes
+    counted in ``resizes`` while the frames were made go into the ``ended`` episode record."""
     from tqdm import tqdm
 
     out = Path(out)
@@ -146,7 +156,9 @@ def write_log(
             raise SgtoolError("nothing to import: no frame has both a depth image and a pose")
         w.write_record(Episode(
             kind="import", status="ended", source=meta.get("source", ""), frames=n,
-            extra={"notes": list(notes), "instance_ids": has_ids, "colour": has_rgb},
+            extra={"notes": list(notes), "instance_ids": has_ids, "colour": has_rgb,
+                   **({"resizes": resizes.lines()} if resizes is not None and resizes.counts
+                      else {})},
         ), max(last_t, first_t))
     return n, has_rgb, has_ids
 

@@ -67,6 +67,8 @@ def _print_report(report, as_json: bool) -> None:  # type: ignore[no-untyped-def
             "sources": {name: {"value": value, "origin": origin}
                         for name, value, origin in report.sources},
             "warnings": list(report.warnings),
+            "resizes": [dict(r) for r in report.resize_counts],
+            "checks": {name: verdict for name, verdict in report.checks},
         }
         click.echo(json.dumps(d, indent=2, sort_keys=True))
     else:
@@ -123,6 +125,9 @@ _common_options = option_group([
                  default="zstd", show_default=True,
                  help="MCAP chunk compression (lz4: ~1.4x faster import, ~30 % larger)."),
     click.option("--force", is_flag=True, help="Overwrite the output log."),
+    click.option("--allow-drop", is_flag=True,
+                 help="Import the frames that have a pose even when more than 10 % of the "
+                 "depth images have none (without it, an error)."),
     click.option("--json", "as_json", is_flag=True, help="Print the report as JSON."),
     click.option("--quiet", is_flag=True, help="No progress bars."),
 ])
@@ -186,7 +191,8 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
         odometry: str, depth_max: float, list_only: bool,
         up: str, floor: str, camera_height: str, output: str | None, intrinsics: str | None,
         depth_scale: float | None, max_dt: float, every: int, limit: int | None,
-        compression: str, force: bool, as_json: bool, quiet: bool) -> None:
+        compression: str, force: bool, allow_drop: bool, as_json: bool,
+        quiet: bool) -> None:
     """Import a ROS 1 .bag, a ROS 2 bag folder (sqlite3 or MCAP) or a bare ROS 2 .mcap/.db3
     file at PATH.
 
@@ -226,7 +232,7 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
         floor_auto=floor_auto, every=every, limit=limit, progress=not quiet,
         compression=compression, estimate_poses=estimate_poses, odometry=odometry,
         depth_max=depth_max, camera_height=parse_height_band(camera_height), warn=_warn,
-        timestamps=timestamps,
+        timestamps=timestamps, allow_drop=allow_drop,
     )
     check_options(opts)
     if not (depth or tf_frames or pose):
@@ -275,7 +281,7 @@ def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bo
          odometry: str, depth_max: float, up: str, floor: str, camera_height: str,
          output: str | None,
          intrinsics: str | None, depth_scale: float | None, max_dt: float, every: int,
-         limit: int | None, compression: str, force: bool, as_json: bool,
+         limit: int | None, compression: str, force: bool, allow_drop: bool, as_json: bool,
          quiet: bool) -> None:
     """Import an RGB-D image folder (TUM RGB-D, 7-Scenes, Open3D/Redwood) at FOLDER.
 
@@ -303,5 +309,6 @@ def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bo
         max_dt_ns=seconds_option_ns(max_dt, "--max-dt", MAX_DT_S),
         progress=not quiet, compression=compression, timestamps=timestamps,
         skip_missing=skip_missing, camera_height=parse_height_band(camera_height), warn=_warn,
+        allow_drop=allow_drop,
     )
     _print_report(import_rgbd(folder, out, opts), as_json)

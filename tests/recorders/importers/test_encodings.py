@@ -193,4 +193,5 @@ def test_suggestions_follow_the_encodings():
     sugg = suggest_flags(topics, encodings={"/a/image": "16UC1", "/b/image_color": "rgb8"})
     assert sugg == ["--depth /a/image", "--rgb /b/image_color", "--info /b/info"]
     sugg = suggest_flags(topics, encodings={"/a/image": "bayer_rggb8", "/b/image_color": "rgb8"})
-    assert "--depth /a/image" not in sugg and sugg[0] == "--rgb /a/image"
+    # the native rgb8 topic over the Bayer one that comes first by name
+    assert "--depth /a/image" not in sugg and sugg[0] == "--rgb /b/image_color"
