@@ -69,7 +69,10 @@ from sgtool.scenegraph.options import CLASSIFIERS
 @click.option("--out-dir", type=click.Path(file_okay=False), default=None,
               help="Replay many logs (files, folders of *.mcap, quoted glob patterns) into "
               "this folder, one DIR/NAME.mcap per LOG, byte-identical to one-by-one "
-              "replays; outputs that are complete already are kept unless --force.")
+              "replays; outputs that are complete already are kept unless --force. A "
+              "non-empty folder that no --out-dir run wrote is refused unless --force; "
+              "--force replays all into a folder beside DIR, moved in complete, replacing "
+              "what sgtool wrote there and keeping other files.")
 @executor_options("replays (one per log, with --out-dir)")
 def command(logs: tuple[str, ...], output: str | None, every: int | None,
             classifier: str | None, min_points: int | None, voxel_size: float | None,
@@ -153,7 +156,7 @@ def command(logs: tuple[str, ...], output: str | None, every: int | None,
         raise SgtoolError(foreign)
     with LogReader(src) as r:
         total = r.frame_count() if r.has("/camera/depth") else 0
-        house = r.house_json() if score else None
+        house = r.house_spec() if score else None  # validated like a house file
     if score and house is None:
         raise SgtoolError(f"{src} has no house spec attachment (house.json): --score needs "
                           "the ground truth of a simulated log")
@@ -174,7 +177,7 @@ def command(logs: tuple[str, ...], output: str | None, every: int | None,
                         verify=verify, room_classifier=rooms.make)
     scores = None
     if score:
-        scores = _score(house, final)  # type: ignore[arg-type]
+        scores = _score(house, final)
     if rrd and dst is not None:
         write_view(dst, Path(rrd), show)
     if as_json:
@@ -201,7 +204,7 @@ def _batch(logs: tuple[str, ...], out_dir: Path, opts: Any, *, force: bool, as_j
     from dataclasses import asdict
 
     from sgtool.analysis.batch_inputs import expand_inputs
-    from sgtool.analysis.batch_replay import out_folder, plan_jobs, replay_many
+    from sgtool.analysis.batch_replay import out_folder, plan_jobs, replay_into
     from sgtool.analysis.executor import make_executor
 
     if opts.voxel_size is not None and not 0.01 <= opts.voxel_size <= 0.5:
@@ -210,7 +213,7 @@ def _batch(logs: tuple[str, ...], out_dir: Path, opts: Any, *, force: bool, as_j
     inputs = expand_inputs(logs, (".mcap",))
     jobs = plan_jobs(inputs, out_folder(out_dir), opts, verify=verify)
     show = progress if progress is not None else sys.stderr.isatty()
-    report = replay_many(jobs, runner, force=force, progress=show)
+    report = replay_into(jobs, out_dir, runner, force=force, progress=show)
     if as_json:
         click.echo(json.dumps({"logs": [asdict(r) for r in report.logs],
                                "seconds": report.seconds}, sort_keys=True))
@@ -223,13 +226,11 @@ def _batch(logs: tuple[str, ...], out_dir: Path, opts: Any, *, force: bool, as_j
                           f"(after a retry); the first: {failed[0].input}: {failed[0].error}")
 
 
-def _score(house: str, final: dict[str, Any]) -> Any:
-    from sgtool.house.io import load_house
+def _score(spec: Any, final: dict[str, Any]) -> Any:
     from sgtool.replayers.score import score
 
     if "refresh" not in final:
         raise SgtoolError("the log produced no scene graph to score (no frames?)")
-    spec = load_house(json.loads(house))
     ref, stream = final["refresh"], final["stream"]
     if ref.layers is None:
         raise SgtoolError("the last refresh has no map layers to score")

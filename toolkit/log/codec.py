@@ -189,18 +189,34 @@ def encode_transform(t_ns: int, parent: str, child: str, T: np.ndarray) -> Frame
     return msg
 
 
+MAX_TRANSLATION_M = 1e9  # beyond any map: a transform this far is damage, not a pose
+
+
+def _numbers(*values: float) -> str:
+    return ", ".join(f"{v:.6g}" for v in values)
+
+
 def decode_transform(msg: FrameTransform) -> np.ndarray:
-    """parent_T_child of ``msg``; :class:`LogFormatError` (naming the field) when the
-    translation is not finite or the rotation is not a quaternion that can be normalised
-    (a zero quaternion is no rotation, not the identity)."""
+    """parent_T_child of ``msg``; :class:`LogFormatError` (naming the field, numbers to 6
+    significant digits) when the translation is not finite or beyond
+    :data:`MAX_TRANSLATION_M` on an axis (its products would overflow downstream) or the
+    rotation is not a quaternion that can be normalised (a zero quaternion is no rotation,
+    not the identity)."""
     t, r = msg.translation, msg.rotation
     tx, ty, tz = t.x, t.y, t.z
     if not (math.isfinite(tx) and math.isfinite(ty) and math.isfinite(tz)):
-        raise LogFormatError(f"field translation: ({tx}, {ty}, {tz}) is not finite")
+        raise LogFormatError(f"field translation: ({_numbers(tx, ty, tz)}) is not finite")
+    if max(abs(tx), abs(ty), abs(tz)) > MAX_TRANSLATION_M:
+        raise LogFormatError(f"field translation: ({_numbers(tx, ty, tz)}) m is beyond "
+                             f"+-{MAX_TRANSLATION_M:g} m on an axis")
     x, y, z, w = r.x, r.y, r.z, r.w
-    if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z) and math.isfinite(w)
-            and math.sqrt(x * x + y * y + z * z + w * w) > 1e-6):
-        raise LogFormatError(f"field rotation: quaternion ({x}, {y}, {z}, {w}) "
+    big = max(abs(x), abs(y), abs(z), abs(w))
+    scale = big if 0 < big and not 1e-100 < big < 1e100 else 1.0  # no square over/underflows
+    if math.isfinite(big):
+        x, y, z, w = x / scale, y / scale, z / scale, w / scale
+    if not (math.isfinite(big)
+            and scale * math.sqrt(x * x + y * y + z * z + w * w) > 1e-6):
+        raise LogFormatError(f"field rotation: quaternion ({_numbers(r.x, r.y, r.z, r.w)}) "
                              "cannot be normalised")
     s = 2.0 / (x * x + y * y + z * z + w * w)  # matrix_from_quat's, in one array
     return np.array([

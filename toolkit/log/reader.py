@@ -20,7 +20,7 @@ import os
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any, TypeVar, overload
+from typing import IO, TYPE_CHECKING, Any, TypeVar, overload
 
 from mcap.data_stream import ReadDataStream
 from mcap.exceptions import InvalidMagic, McapError
@@ -28,9 +28,15 @@ from mcap.reader import SeekingReader
 from mcap.records import Attachment, Channel, Message, MessageIndex, Schema
 from mcap.summary import Summary
 
-from sgtool.errors import LogFormatError, MissingChannelError, SchemaVersionError, SgtoolError
+from sgtool.errors import (
+    LogFormatError,
+    MissingChannelError,
+    SchemaVersionError,
+    SgtoolError,
+    SpecError,
+)
 from sgtool.log import chunk_stream as cs
-from sgtool.log import codec, walk_index
+from sgtool.log import codec, message_check, walk_index
 from sgtool.log import schemas as S
 from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler, TransformBuffer, decoded
 from sgtool.log.chunk_copy import RawChunk, raw_chunk
@@ -42,13 +48,16 @@ from sgtool.log.summary_check import BoundedReader as _BoundedReader
 from sgtool.log.summary_check import check_summary, read_attachment
 from sgtool.vocabulary import RecordName
 
+if TYPE_CHECKING:
+    from sgtool.house.spec import HouseSpec
+
 R = TypeVar("R", bound=LogRecord)
 
 _PROTO_CLASSES: dict[str, Any] = {}
 _MAGIC = bytes([137, 77, 67, 65, 80, 48, 13, 10])
 
 
-def _proto_class(schema_name: str) -> Any:
+def proto_class(schema_name: str) -> Any:
     """The Foxglove protobuf class for a schema name, or None for other schemas."""
     if schema_name in _PROTO_CLASSES:
         return _PROTO_CLASSES[schema_name]
@@ -168,6 +177,7 @@ class LogReader:
         assert summary is not None
         self.summary: Summary = summary
         self._decoders: dict[int, Any] = {}
+        self._channel_problems: dict[int, str | None] = {}  # "" not known yet
         self._frame_times: list[int] | None = None
         self._buffers = cs.ChunkBuffers()  # chunks decompressed for views, reused
         if check_version:
@@ -271,8 +281,41 @@ class LogReader:
             raise LogFormatError(f"{self.path}: attachment {S.HOUSE_ATTACHMENT} is not "
                                  "UTF-8 text") from None
 
+    def house_spec(self) -> HouseSpec | None:
+        """The house attachment validated as a house file given on the command line is
+        (:func:`sgtool.house.io.load_house_text`); None when the log has none. A
+        :class:`~sgtool.errors.SpecError` naming the log and the attachment when it is not
+        UTF-8, not JSON (or nested too deeply to read) or not a valid house spec."""
+        from sgtool.house.io import load_house_text
+
+        where = f"{self.path}: attachment {S.HOUSE_ATTACHMENT}"
+        try:
+            text = self.house_json()
+        except LogFormatError as e:
+            raise SpecError(str(e)) from None
+        if text is None:
+            return None
+        try:
+            return load_house_text(text)
+        except SpecError as e:
+            raise SpecError(f"{where}: {e}") from None
+
     # ----- messages ---------------------------------------------------------------------
+    def _contract(self, schema: Schema | None, channel: Channel) -> None:
+        """Refuse, in one line, a channel of an sgtool log whose topic sgtool reads with
+        another schema or encoding than it has
+        (:func:`~sgtool.log.message_check.channel_problem`): its messages would reach the
+        frame assembly or the record checks as something else."""
+        problem = self._channel_problems.get(channel.id, "")
+        if problem == "":
+            problem = (message_check.channel_problem(schema, channel)
+                       if self.is_sgtool else None)
+            self._channel_problems[channel.id] = problem
+        if problem is not None:
+            raise LogFormatError(f"{self.path}: {problem}")
+
     def _decode(self, schema: Schema | None, channel: Channel, message: Message) -> Any:
+        self._contract(schema, channel)
         if channel.message_encoding == "json":
             try:
                 return json.loads(bytes(message.data))  # bytes, or a view of its chunk
@@ -294,7 +337,7 @@ class LogReader:
             view = parse_raw_image(message.data)  # pixels left in the chunk (frames only)
             if view is not None:
                 return view
-        cls = _proto_class(schema.name)
+        cls = proto_class(schema.name)
         if cls is not None:
             msg = cls()
             msg.ParseFromString(message.data)
@@ -380,6 +423,12 @@ class LogReader:
     ) -> Iterator[Frame]:
         """Frames in log-time order (see the module docstring)."""
         self.require(S.DEPTH, why="frames need depth images")
+        for _, ch in sorted(self.summary.channels.items()):
+            if ch.topic in FRAME_TOPICS:
+                problem = message_check.channel_problem(
+                    self.summary.schemas.get(ch.schema_id), ch)
+                if problem is not None:
+                    raise LogFormatError(f"{self.path}: {problem}")
         tf, calib = (self._state_before(start_ns) if start_ns is not None
                      else (TransformBuffer(), None))
         index = self._frame_index_before(start_ns) if start_ns is not None else 0

@@ -313,9 +313,53 @@ class Instances(LogRecord):
                    unknown={k: v for k, v in d.items() if k != "instances"})
 
     @classmethod
+    def check(cls, d: object, where: str) -> None:
+        """The schema check, then every entry in range: ``id`` in 1 ..
+        :data:`INSTANCE_ID_MAX` and given once, ``parent`` null or in that range, a
+        non-empty ``category`` (``kind``, ``state`` and ``relation`` are enumerations of the
+        schema); :class:`LogFormatError` naming the entry and the field."""
+        super().check(d, where)
+        assert isinstance(d, Mapping)
+        seen: set[int] = set()
+        for i, item in enumerate(d["instances"]):
+            problem = _instance_problem(item, seen)
+            if problem is not None:
+                key, why = problem
+                raise LogFormatError(f"{where}: field 'instances[{i}].{key}' {why}")
+            seen.add(item["id"])
+
+    @classmethod
     def of(cls, items: list[dict[str, Any]]) -> Instances:
         """The record of a list of item dicts (checked when written)."""
         return cls(tuple(InstanceItem._build(x) for x in items))
+
+
+INSTANCE_ID_MAX = 2**31 - 1  # ids are the int32 pixel values of the instance images
+
+
+def short_number(v: float) -> str:
+    """``v`` for a message: an integer of more than 15 digits or a float as ``%.6g``
+    (``1e+300``), never a 300-digit number."""
+    if isinstance(v, int) and not isinstance(v, bool) and abs(v) >= 10**15:
+        return f"{float(v):.6g}" if abs(v) < 10**308 else f"an integer of {len(str(abs(v)))} digits"
+    return f"{v:.6g}" if isinstance(v, float) else str(v)
+
+
+def _instance_problem(item: Mapping[str, Any], seen: set[int]) -> tuple[str, str] | None:
+    """(field, problem) of an instance table entry already checked against the schema."""
+    ids = f"1 .. {INSTANCE_ID_MAX} (instance ids are the int32 pixel values of the instance " \
+          "images; 0 means none)"
+    iid = item["id"]
+    if not 1 <= iid <= INSTANCE_ID_MAX:
+        return "id", f"is {short_number(iid)}, outside {ids}"
+    if iid in seen:
+        return "id", f"{iid} is given twice"
+    parent = item.get("parent")
+    if parent is not None and not 1 <= parent <= INSTANCE_ID_MAX:
+        return "parent", f"is {short_number(parent)}, outside {ids}"
+    if not item["category"].strip():
+        return "category", "is empty"
+    return None
 
 
 @dataclass(frozen=True)
