@@ -91,7 +91,9 @@ def _raise_interrupt(signum: int, frame: object) -> None:
 
 @command.command("check", context_settings=CONTEXT)
 @llm_endpoint_options("the endpoint to check (none: a local server started for the check)",
-                      timeout=300.0)
+                      timeout=300.0,
+                      timeout_help="Deadline of the whole check in wall-clock seconds (the "
+                                   "speed request and the decision together).")
 @click.option("--base-url", default=None, hidden=True, help="Old name of --llm-base-url.")
 @click.option("--model-name", default=None, hidden=True, help="Old name of --llm-model.")
 @_model_option
@@ -108,10 +110,14 @@ def check(base_url: str | None, model_name: str | None, gguf: Path | None, threa
           max_tokens: int, constraint: str, reason_chars: int, as_json: bool,
           llm_base_url: str | None = None, llm_model: str | None = None,
           llm_api_key: str | None = None, llm_timeout: float = 300.0) -> None:
-    """Print tokens/s of an endpoint and whether one scene decision parsed."""
+    """Print tokens/s of an endpoint and whether one scene decision parsed.
+
+    --llm-timeout is the deadline of the whole check (the speed request and the decision
+    together, wall-clock, a slow or trickled reply included): at the deadline the check
+    stops with one line saying so (exit 2)."""
     import os
 
-    from sgtool.llm.check import decision_check, generation_speed
+    from sgtool.llm.check import check_endpoint
     from sgtool.llm.client import LlmSettings, OpenAIChatClient
 
     base_url = llm_base_url or base_url
@@ -127,12 +133,11 @@ def check(base_url: str | None, model_name: str | None, gguf: Path | None, threa
                                        timeout_s=llm_timeout, temperature=0.0,
                                        max_tokens=max_tokens)
         client = OpenAIChatClient(settings)
-        speed = generation_speed(client)
         graph, query = _scene()
         # room for both reasoning lines (a token per character at worst) and the command
         decider = OpenAIChatClient(replace(settings, max_tokens=2 * reason_chars + 60))
-        dec = decision_check(decider, graph, query, constraint=constraint,
-                             reason_chars=reason_chars)
+        speed, dec = check_endpoint(client, decider, graph, query, llm_timeout,
+                                    constraint=constraint, reason_chars=reason_chars)
     figures = {
         "endpoint": client.where, "model": settings.model,
         "completion_tokens": speed.completion_tokens,

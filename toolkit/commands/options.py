@@ -175,11 +175,13 @@ class LlmEndpoint:
                 mine.setdefault(k, v)
 
 
-def llm_endpoint_options(what: str, timeout: float | None = None) -> Callable[[F], F]:
+def llm_endpoint_options(what: str, timeout: float | None = None,
+                         timeout_help: str | None = None) -> Callable[[F], F]:
     """The LLM option group: ``--llm-base-url``, ``--llm-model``, ``--llm-api-key``,
     ``--llm-timeout`` (the same flags on every command that talks to an endpoint; read
     with :func:`llm_endpoint`); ``what`` says what they are for, ``timeout`` is the
-    command's default (None: the planner's own)."""
+    command's default (None: the planner's own), ``timeout_help`` replaces the help of
+    ``--llm-timeout`` (a command whose timeout means something else)."""
     return option_group([
         click.option("--llm-base-url", default=None, metavar="URL",
                      help=f"{what}: OpenAI-compatible endpoint (`sgtool llm serve` prints "
@@ -190,8 +192,12 @@ def llm_endpoint_options(what: str, timeout: float | None = None) -> Callable[[F
                      "to an output [env SGTOOL_LLM_API_KEY]."),
         click.option("--llm-timeout", type=click.FloatRange(1.0, 3600.0), default=timeout,
                      show_default=timeout is not None,
-                     help=f"{what}: seconds per request"
-                     + ("." if timeout is not None else " [default: the planner's, 30].")),
+                     help=timeout_help or (
+                         f"{what}: wall-clock seconds per request (connecting, headers and "
+                         "body together, a trickled reply included); an LLM planner's "
+                         "decision has its own deadline over all its attempts "
+                         "(-O moma-llm.decision_timeout_s, 60)"
+                         + ("." if timeout is not None else " [default: the planner's, 30]."))),
     ])
 
 

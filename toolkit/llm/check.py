@@ -5,13 +5,18 @@
 (prompt processing included, as a planner sees it). :func:`decision_check` asks a
 ``moma-llm`` planner for one decision on a scene graph, with ``max_attempts`` requests, and
 reports whether an answer parsed and grounded, and how long the decision took.
+:func:`check_endpoint` runs both under one wall-clock deadline (``sgtool llm check``): a
+request or decision still running at the deadline is cut, and the check fails with one
+line (:class:`CheckFailed`) naming the deadline.
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
+from sgtool.errors import SgtoolError
 from sgtool.llm.client import ChatClient, LlmTransportError, complete_within
 from sgtool.llm.constraints import REASON_CHARS
 from sgtool.scenegraph.graph import SceneGraph
@@ -65,3 +70,34 @@ def decision_check(client: ChatClient, graph: SceneGraph, query: str,
     ok = any(e.get("verdict") == "ok" for e in planner.exchanges)
     text = f"{action.skill}({action.target or ''})" if ok else action.reason
     return DecisionCheck(ok, text, len(planner.exchanges), dt, planner.constraint)
+
+
+class CheckFailed(SgtoolError):
+    """The check could not measure the endpoint (a fault, or its deadline passed)."""
+
+
+def check_endpoint(client: ChatClient, decider: ChatClient, graph: SceneGraph, query: str,
+                   deadline_s: float, constraint: str = "auto",
+                   reason_chars: int = REASON_CHARS,
+                   clock: Callable[[], float] = time.monotonic
+                   ) -> tuple[SpeedResult, DecisionCheck]:
+    """:func:`generation_speed` with ``client``, then :func:`decision_check` with
+    ``decider``, both within ``deadline_s`` wall seconds from now; :class:`CheckFailed`
+    (one line) when the speed request fails or either step is cut at the deadline."""
+    deadline = clock() + float(deadline_s)
+    why = f"the check's deadline of {deadline_s:g} s (--llm-timeout)"
+    try:
+        speed = generation_speed(client, timeout_s=max(deadline - clock(), 1e-3))
+    except LlmTransportError as e:
+        if clock() >= deadline:
+            raise CheckFailed(f"llm check: no complete reply to the speed request within "
+                              f"{why}: {e}") from None
+        raise CheckFailed(f"llm check: the speed request failed: {e}") from None
+    left = deadline - clock()
+    if left <= 0:
+        raise CheckFailed(f"llm check: {why} was spent by the speed request")
+    dec = decision_check(decider, graph, query, constraint=constraint, timeout_s=left,
+                         reason_chars=reason_chars)
+    if not dec.parsed and clock() >= deadline:
+        raise CheckFailed(f"llm check: no scene decision within {why}: {dec.action}")
+    return speed, dec

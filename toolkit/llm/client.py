@@ -27,12 +27,21 @@ so a runaway endpoint cannot fill the log or the transcript. The API key never a
 an error message (:mod:`sgtool.redact`). :meth:`OpenAIChatClient.complete` takes a
 ``timeout_s`` for this one request, so a caller can keep a deadline over several attempts
 (:func:`complete_within`).
+
+Deadlines are wall-clock: a request's timeout bounds the whole request (connecting, sending,
+the reply's headers and its body together), not each socket read, so an endpoint that
+trickles its reply a byte at a time is cut at the deadline like one that says nothing.
+The request runs on a worker thread that the caller waits for at most the timeout; at the
+deadline the caller gets a :class:`LlmTransportError` and the worker's connections are
+closed (the worker ends at its next read, bounded by the same timeout per read).
 """
 
 from __future__ import annotations
 
 import os
+import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -148,12 +157,13 @@ class OpenAIChatClient:
 
         self.settings = settings
         self.model = settings.model
-        self._client = OpenAI(
+        self._new_client: Callable[[], Any] = lambda: OpenAI(
             base_url=settings.base_url,
             api_key=settings.api_key or "sk-no-key-needed",
             timeout=settings.timeout_s,
             max_retries=0,
         )
+        self._client = self._new_client()
         self.replies = 0  # HTTP replies received (any status): the endpoint exists
 
     @property
@@ -180,9 +190,10 @@ class OpenAIChatClient:
             kwargs.update(constraint.request_fields())
         t0 = time.perf_counter()
         try:
-            resp = self._client.chat.completions.create(**kwargs)
-        except openai.APITimeoutError as e:
-            raise LlmTransportError(f"{self.where}: no reply within {timeout:g} s") from e
+            resp = self._create_within(kwargs, timeout)
+        except (openai.APITimeoutError, RequestDeadline) as e:
+            raise LlmTransportError(
+                f"{self.where}: no reply within {timeout:.3g} s") from e
         except openai.APIStatusError as e:
             self.replies += 1
             raise LlmTransportError(
@@ -212,6 +223,53 @@ class OpenAIChatClient:
             completion_tokens=_count(_field(usage, "completion_tokens")),
             truncated_from=full,
         )
+
+
+    def _create_within(self, kwargs: dict[str, Any], timeout: float) -> Any:
+        """``chat.completions.create(**kwargs)`` on a worker thread, waited for at most
+        ``timeout`` wall seconds (module doc); :class:`RequestDeadline` when it is not done
+        by then. An interrupt (Ctrl-C) while waiting abandons the request the same way."""
+        client = self._client
+        box: dict[str, Any] = {}
+
+        def run() -> None:
+            try:
+                box["reply"] = client.chat.completions.create(**kwargs)
+            except BaseException as e:  # noqa: BLE001 - handed to the waiting caller
+                box["error"] = e
+
+        worker = threading.Thread(target=run, name="sgtool-llm-request", daemon=True)
+        worker.start()
+        try:
+            worker.join(timeout)
+        except BaseException:
+            self._abandon(client)
+            raise
+        if worker.is_alive():
+            self._abandon(client)
+            raise RequestDeadline(f"no reply within {timeout:.3g} s")
+        if "error" in box:
+            raise box["error"]
+        return box["reply"]
+
+    def _abandon(self, client: Any) -> None:
+        """Leave ``client`` to its worker: later requests use a fresh one, and its
+        connections are closed (on another thread: closing must not wait for the worker)."""
+        if client is self._client:
+            self._client = self._new_client()
+        threading.Thread(target=_close_quietly, args=(client,), name="sgtool-llm-close",
+                         daemon=True).start()
+
+
+class RequestDeadline(Exception):
+    """A request was not complete at its wall-clock deadline."""
+
+
+def _close_quietly(client: Any) -> None:
+    try:
+        client.close()
+    except Exception:  # noqa: BLE001, S110 - an abandoned client; nothing to report
+        pass
 
 
 def reply_text(resp: object, where: str = "the endpoint") -> str:

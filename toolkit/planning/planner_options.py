@@ -144,7 +144,8 @@ class LlmEndpointOptions:
     api_key: str | None = field(default=None, metadata=option(
         "API key [default: SGTOOL_LLM_API_KEY, OPENAI_API_KEY]", "str", optional=True))
     timeout_s: float = field(default=30.0, metadata=option(
-        "seconds per request", "float", lo=0.0, lo_open=True))
+        "wall-clock seconds per request (connecting, headers and body together)", "float",
+        lo=0.0, lo_open=True))
     temperature: float | None = field(default=None, metadata=option(
         "sampling temperature [default: not sent, the server's]", "float", lo=0.0, hi=2.0,
         optional=True))
