@@ -1,16 +1,19 @@
-"""Golden logs: small recorded logs whose replayed scene graphs are pinned by digest.
+"""Golden logs: logs whose replayed scene graphs are pinned, and the readable diff of two.
 
-``tests/golden/`` holds, per case of :data:`CASES`, the recorded log ``NAME.mcap`` (under
-2 MB), the canonical JSON of every scene graph its replay produces
-(``NAME.graphs.jsonl.gz``, written deterministically), and ``expected.json`` with the
-digests: the sha256 of the log, of the final graph and of the whole refresh sequence. The
-regression test replays each log and, on a mismatch, prints a readable diff
-(:func:`diff_graphs`: rooms, objects, doors, frontiers, edges) of the first refresh that
-differs, not just two hashes.
+``tests/golden/`` holds the project's own golden logs, one per case of :data:`CASES`: the
+recorded log ``NAME.mcap`` (under 2 MB), pinned with the same code and format users pin
+their own logs with (``sgtool golden pin``; :mod:`sgtool.replayers.golden_pins` is the
+format, :mod:`sgtool.analysis.golden_check` pins and checks): ``NAME.graphs.jsonl.gz`` (the
+canonical JSON of every scene graph of its replay, written deterministically) and
+``expected.json`` with the digests: the sha256 of the log, of the final graph and of the
+whole refresh sequence. A check replays each log and, on a mismatch, reports what differs
+in the first refresh that differs (:func:`describe_mismatch`, :func:`diff_graphs`: rooms
+added, removed, merged or split, categories, objects, doors, regions, frontiers, edges,
+distances, Voronoi graph size), not just two hashes.
 
 Regenerate on purpose only, and say why in the commit::
 
-    .venv/bin/python tests/golden/regenerate.py            # recompute expectations from the logs
+    .venv/bin/python tests/golden/regenerate.py            # re-pin from the logs
     .venv/bin/python tests/golden/regenerate.py --record   # re-record the logs first (PyBullet)
 
 The first after a deliberate change of the replay pipeline or of the shipped weights;
@@ -35,8 +38,7 @@ from sgtool.replayers.golden_layers import LayerSummary
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 
-EXPECTED = "expected.json"
-FORMAT = 1
+EXPECTED = "expected.json"  # the index of a pin folder (sgtool.replayers.golden_pins)
 REPLAY = ReplayOptions(every=10, classifier="containment")
 
 
@@ -373,21 +375,3 @@ def quality_lines(before: dict[str, Any] | None, after: dict[str, Any] | None) -
         if parts:
             out.append(f"quality ({variant}): " + ", ".join(parts))
     return out
-
-
-def expectations(folder: Path, cases: Sequence[GoldenCase] = CASES) -> dict[str, object]:
-    """Replay every case's log, write its graphs file, return the ``expected.json`` text."""
-    entries: dict[str, object] = {}
-    for case in cases:
-        log = folder / f"{case.name}.mcap"
-        got = replay_graphs(log)
-        graphs = [g for _, g in got]
-        write_graphs(folder / f"{case.name}.graphs.jsonl.gz", graphs)
-        entries[case.name] = {
-            "why": case.why, "log_sha256": sha256_file(log), "refreshes": len(graphs),
-            "final_sha256": hashlib.sha256(graphs[-1].encode()).hexdigest() if graphs else "",
-            "sequence_sha256": sequence_digest(graphs),
-        }
-    return {"format": FORMAT, "replay": {"every": REPLAY.every,
-                                         "classifier": REPLAY.classifier},
-            "cases": entries}

@@ -1,26 +1,26 @@
 """Regenerate the golden logs of ``tests/golden`` (on purpose only; say why in the commit).
 
-    .venv/bin/python tests/golden/regenerate.py            # recompute expectations from the logs
+    .venv/bin/python tests/golden/regenerate.py            # re-pin from the same logs
     .venv/bin/python tests/golden/regenerate.py --record   # re-record the logs first (PyBullet)
 
 The first after a deliberate change of the replay pipeline or of the shipped weights; the
-second after a change of the recorder or of the house generator. The cases, the replay
-options and the digests are :mod:`sgtool.replayers.golden`'s; recording lives here because
-it needs the simulator, which the replayers never import.
+second after a change of the recorder or of the house generator. The cases and the replay
+options are :mod:`sgtool.replayers.golden`'s; pinning is ``sgtool golden pin``'s own code
+(:func:`sgtool.analysis.golden_check.pin_logs`, the format users pin their logs in);
+recording lives here because it needs the simulator, which the replayers never import.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
-import os
 import sys
 from pathlib import Path
 
+from sgtool.analysis.golden_check import pin_logs
 from sgtool.datasets.generator import generate_house
 from sgtool.recorders.sim.camera import CameraConfig
 from sgtool.recorders.sim.recording import RecordOptions, record_house
-from sgtool.replayers.golden import CASES, EXPECTED, GoldenCase, default_folder, expectations
+from sgtool.replayers.golden import CASES, REPLAY, GoldenCase, default_folder
 
 
 def record_case(case: GoldenCase, folder: Path) -> Path:
@@ -48,12 +48,10 @@ def main(argv: list[str] | None = None) -> int:
         for case in CASES:
             path = record_case(case, folder)
             print(f"recorded {path} ({path.stat().st_size / 1e6:.2f} MB)", file=sys.stderr)
-    doc = expectations(folder)
-    tmp = folder / (EXPECTED + ".partial")
-    tmp.write_text(json.dumps(doc, indent=2, sort_keys=True) + "\n")
-    os.replace(tmp, folder / EXPECTED)
-    for name, e in doc["cases"].items():  # type: ignore[union-attr]
-        print(f"{name}: {e['refreshes']} refreshes, final {e['final_sha256'][:16]}",
+    for case in CASES:
+        pins = pin_logs([folder / f"{case.name}.mcap"], folder, REPLAY, why=case.why)
+        e = pins.logs[case.name]
+        print(f"{case.name}: {e.refreshes} refreshes, final {e.final_sha256[:16]}",
               file=sys.stderr)
     return 0
 

@@ -1,50 +1,51 @@
 """Golden-log regression: the committed logs must replay to the committed scene graphs.
 
-On a mismatch the failure shows what changed in the first refresh that differs (rooms,
-objects, doors, edges, frontiers), not two hashes. To accept a deliberate change, run
-``python tests/golden/regenerate.py`` and say why in the commit (tests/golden/README.md).
+The project's golden logs are checked with the code users check their own pinned logs
+with (``sgtool golden check``): on a mismatch the failure shows what changed in the first
+refresh that differs (rooms, objects, doors, edges, frontiers), not two hashes. To accept
+a deliberate change, run ``python tests/golden/regenerate.py`` and say why in the commit
+(tests/golden/README.md).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import json
 
 import pytest
 from support.paths import GOLDEN
 
+from sgtool.analysis.golden_check import check_pins
 from sgtool.replayers.golden import (
     CASES,
-    EXPECTED,
-    describe_mismatch,
+    REPLAY,
     diff_graphs,
     read_graphs,
-    replay_graphs,
     sequence_digest,
-    sha256_file,
 )
+from sgtool.replayers.golden_pins import read_pins
 from sgtool.scenegraph.graph import SceneGraph
 
-EXPECT = json.loads((GOLDEN / EXPECTED).read_text())
+PINS = read_pins(GOLDEN)
+
+
+def test_the_golden_folder_is_a_pin_folder_of_the_cases():
+    assert sorted(PINS.logs) == sorted(c.name for c in CASES)
+    for pin in PINS.logs.values():
+        assert pin.options == REPLAY
+        assert pin.log_path(GOLDEN) == GOLDEN / f"{pin.name}.mcap"
+        assert pin.log_path(GOLDEN).stat().st_size < 2_000_000
+        graphs = read_graphs(GOLDEN / f"{pin.name}.graphs.jsonl.gz")
+        assert sequence_digest(graphs) == pin.sequence_sha256
 
 
 @pytest.mark.parametrize("case", [c.name for c in CASES])
 def test_golden_log_replays_to_the_committed_graphs(case):
-    e = EXPECT["cases"][case]
-    log = GOLDEN / f"{case}.mcap"
-    assert log.stat().st_size < 2_000_000
-    assert sha256_file(log) == e["log_sha256"], (
-        f"{log.name} is not the log the expectations were made from; regenerate with "
-        "`python tests/golden/regenerate.py`")
-    expected = read_graphs(GOLDEN / f"{case}.graphs.jsonl.gz")
-    assert sequence_digest(expected) == e["sequence_sha256"]
-    got = replay_graphs(log)
-    problems = describe_mismatch(expected, got)
-    if problems:
-        pytest.fail(f"{case}: the replayed scene graphs changed\n" + "\n".join(problems)
+    check = check_pins(GOLDEN, names=[case]).logs[0]
+    if check.status != "unchanged":
+        pytest.fail(f"{case}: the replayed scene graphs changed\n" + "\n".join(check.report())
                     + "\n(deliberate? `python tests/golden/regenerate.py`, and say why in the "
                     "commit)", pytrace=False)
-    assert sequence_digest([g for _, g in got]) == e["sequence_sha256"]
+    assert check.refreshes == (PINS.logs[case].refreshes,) * 2
 
 
 def test_the_golden_cases_cover_what_they_claim():
