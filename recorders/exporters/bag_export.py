@@ -1,69 +1,115 @@
 """``sgtool export bag``: an sgtool log (typically a derived log of ``sgtool replay``) as a
 ROS 1 ``.bag`` or a ROS 2 bag folder (MCAP storage), written with ``rosbags`` so that RViz,
-``ros2 bag``, Foxglove and Rerun's ROS importers show the maps.
+``ros2 bag``, ``image_proc``, Foxglove and Rerun's ROS importers use it.
 
-Topics, each message at its log time (the header stamp is the log time too):
+Topics (sgtool topic -> ROS topic, type):
 
-- ``/camera/depth``, ``/camera/rgb``, ``/camera/instances`` -> ``/camera/.../image_raw``,
-  ``sensor_msgs/Image`` with the same encoding and bytes;
-- ``/camera/calibration`` -> ``/camera/camera_info``, ``sensor_msgs/CameraInfo``;
-- ``/tf`` -> ``/tf``, ``tf2_msgs/TFMessage``;
-- ``/map/occupancy`` -> ``/map/occupancy``, ``nav_msgs/OccupancyGrid``;
-- ``/map/voronoi``, ``/map/rooms`` -> same topics, ``visualization_msgs/MarkerArray``;
-- ``/sgtool/scene_graph`` -> same topic, ``std_msgs/String`` (its JSON), and
-  ``/map/objects``, ``MarkerArray`` of the graph's objects.
+- ``/camera/depth``, ``/camera/rgb``, ``/camera/instances`` -> ``/camera/NAME/image_raw``,
+  ``sensor_msgs/Image`` with the same encoding and bytes, and with every image a
+  ``/camera/NAME/camera_info`` (``sensor_msgs/CameraInfo`` of the calibration in force)
+  of the same stamp and frame, as ``image_proc``/``depth_image_proc`` pair them;
+- ``/tf`` -> ``/tf`` (``tf2_msgs/TFMessage``) for the links that move, and one latched
+  ``/tf_static`` message, at the first stamp, holding every link whose transform never
+  changes in the log (``/tf_static`` of the log is taken as fixed too);
+- ``/map/occupancy`` -> ``nav_msgs/OccupancyGrid``; ``/map/voronoi``, ``/map/rooms`` ->
+  ``visualization_msgs/MarkerArray``; ``/sgtool/scene_graph`` -> ``std_msgs/String`` (its
+  JSON) and ``/map/objects`` (``MarkerArray`` of the graph's objects). These, and
+  ``/tf_static``, are latched: transient-local QoS in ROS 2, latching in ROS 1.
 
-The bag is written in a temporary folder beside OUT and moved to OUT when complete, so an
-error leaves no half-written bag; an existing OUT is refused unless ``force``.
+Time base: a message's bag time and header stamp are its log time plus ``time_base_s``
+seconds (default 1 s), so no message falls on stamp 0 (ROS 1's ``rosbag play`` starts at
+``TIME_MIN`` and drops what is at zero; ``tf2`` treats stamp 0 as "latest").
+
+Frames are renamed to REP-105's by default (``world`` -> ``map``, ``base`` ->
+``base_link``, ``camera`` -> ``camera_optical_frame``: sgtool's camera frame is an optical
+one, x right, y down, z forward); ``frames`` gives another mapping (``{}`` keeps sgtool's).
+
+The format follows ``out``'s name unless given: ``NAME.bag`` is ROS 1, anything else a
+ROS 2 bag folder. Compression: zstd chunks in the ROS 2 MCAP file, lz4 (or bz2) chunks in
+ROS 1. ``distro`` (humble, jazzy) sets the ROS 2 message types and ``metadata.yaml``
+layout (:mod:`sgtool.recorders.exporters.bagwriter`).
+
+A ROS 1 bag is written beside ``out`` and renamed; a ROS 2 bag folder goes through
+:func:`sgtool.files.output_folder`: an existing non-empty ``out`` is refused unless
+``force``, and ``force`` replaces only the files sgtool wrote there (other files stay). A
+ROS 1 ``out`` that is not a ROS 1 bag is never replaced. An error leaves nothing behind.
 """
 
 from __future__ import annotations
 
 import os
 import shutil
-import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
 from sgtool.errors import SgtoolError
-from sgtool.files import output_error
+from sgtool.files import atomic_output, output_folder
 from sgtool.log import codec
 from sgtool.log import schemas as S
+from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.reader import LogReader
 from sgtool.recorders.exporters import ros_maps
-from sgtool.recorders.exporters.bagwriter import BagWriter
+from sgtool.recorders.exporters.bagwriter import COMPRESSIONS, DISTROS, BagWriter
 
 FORMATS = {"ros1": "ros1", "ros2": "ros2-mcap"}
+DEFAULT_COMPRESSION = {"ros1": "lz4", "ros2": "zstd"}
+DEFAULT_TIME_BASE_S = 1.0
+REP105 = {S.WORLD_FRAME: "map", S.BASE_FRAME: "base_link",
+          S.CAMERA_FRAME: "camera_optical_frame"}
+ROS1_MAGIC = b"#ROSBAG V2.0\n"
+TF_STATIC = "/tf_static"
 GRAPH_TOPIC = S.RECORDS["scene_graph"].topic
-IMAGE_TOPICS = {S.DEPTH: "/camera/depth/image_raw", S.RGB: "/camera/rgb/image_raw",
-                S.IDS: "/camera/instances/image_raw"}
-INFO_TOPIC = "/camera/camera_info"
+IMAGE_TOPICS = {S.DEPTH: "/camera/depth", S.RGB: "/camera/rgb", S.IDS: "/camera/instances"}
 OBJECTS_TOPIC = "/map/objects"
-MAP_TYPES = {
-    S.OCCUPANCY: "nav_msgs/msg/OccupancyGrid",
-    S.VORONOI: "visualization_msgs/msg/MarkerArray",
-    S.ROOMS: "visualization_msgs/msg/MarkerArray",
+IMAGE, INFO, TF_TYPE = ("sensor_msgs/msg/Image", "sensor_msgs/msg/CameraInfo",
+                        "tf2_msgs/msg/TFMessage")
+MARKERS, STRING = "visualization_msgs/msg/MarkerArray", "std_msgs/msg/String"
+
+# ROS topic -> (sgtool source topic, ROS type, latched)
+OUTPUTS: dict[str, tuple[str, str, bool]] = {
+    **{f"{ns}/image_raw": (src, IMAGE, False) for src, ns in IMAGE_TOPICS.items()},
+    **{f"{ns}/camera_info": (src, INFO, False) for src, ns in IMAGE_TOPICS.items()},
+    S.TF: (S.TF, TF_TYPE, False),
+    TF_STATIC: (S.TF, TF_TYPE, True),
+    S.OCCUPANCY: (S.OCCUPANCY, "nav_msgs/msg/OccupancyGrid", True),
+    S.VORONOI: (S.VORONOI, MARKERS, True),
+    S.ROOMS: (S.ROOMS, MARKERS, True),
+    GRAPH_TOPIC: (GRAPH_TOPIC, STRING, True),
+    OBJECTS_TOPIC: (GRAPH_TOPIC, MARKERS, True),
 }
+
+
+class Progress(Protocol):
+    """What :func:`export_bag` reports progress to (a ``tqdm`` bar fits): ``total`` is set
+    to the number of log messages to convert, ``update(n)`` called as they are."""
+
+    total: float | None
+
+    def update(self, n: float = 1) -> Any: ...
 
 
 @dataclass(frozen=True)
 class ExportReport:
     """What :func:`export_bag` wrote: the bag ``output`` and its ``fmt`` (ros1, ros2),
-    (ROS topic, type, messages) per topic, and whether the log had derived layers;
-    :meth:`lines` is what ``sgtool export bag`` prints."""
+    (ROS topic, type, messages) per topic, whether the log had derived layers, the time
+    base (seconds added to log times) and the compression; :meth:`lines` is what
+    ``sgtool export bag`` prints."""
 
     output: Path
     fmt: str
     counts: tuple[tuple[str, str, int], ...]  # (ROS topic, type, messages)
     derived: bool  # the log had derived layers
+    time_base_s: float = DEFAULT_TIME_BASE_S
+    compression: str = "none"
 
     def lines(self) -> list[str]:
         total = sum(n for _, _, n in self.counts)
-        out = [f"wrote {self.output} ({self.fmt}): {total} messages"]
+        out = [f"wrote {self.output} ({self.fmt}, {self.compression}): {total} messages, "
+               f"stamps = log time + {self.time_base_s:g} s"]
         w = max((len(t) for t, _, _ in self.counts), default=5)
         out.extend(f"  {t:<{w}}  {ty}  {n}" for t, ty, n in self.counts)
         if not self.derived:
@@ -72,90 +118,205 @@ class ExportReport:
         return out
 
 
+def format_for(out: Path, fmt: str | None) -> str:
+    """The bag format: ``fmt`` when given, else ros1 for ``NAME.bag``, ros2 otherwise; a
+    ROS 2 bag (a folder) named ``.bag`` is refused."""
+    is_bag = out.suffix.lower() == ".bag"
+    if fmt is None:
+        return "ros1" if is_bag else "ros2"
+    if fmt not in FORMATS:
+        raise SgtoolError(f"--format {fmt!r}: give ros1 or ros2")
+    if fmt == "ros2" and is_bag:
+        raise SgtoolError(f"-o {out}: a .bag name is a ROS 1 bag file, but --format ros2 "
+                          "writes a bag folder; drop .bag or use --format ros1")
+    return fmt
+
+
+def select_outputs(names: Iterable[str] | None) -> list[str]:
+    """The ROS topics to write for ``names`` (ROS topics or sgtool topics; None: all).
+    An sgtool topic selects every ROS topic made from it; an unknown name is refused."""
+    if names is None:
+        return list(OUTPUTS)
+    chosen: list[str] = []
+    for name in names:
+        hits = [t for t, (src, _, _) in OUTPUTS.items() if name in (t, src)]
+        if not hits:
+            known = sorted(set(OUTPUTS) | {src for src, _, _ in OUTPUTS.values()})
+            raise SgtoolError(f"--topics {name}: not a topic the export writes or reads "
+                              f"({', '.join(known)})")
+        chosen.extend(t for t in hits if t not in chosen)
+    return [t for t in OUTPUTS if t in chosen]
+
+
+def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
+               force: bool = False, *, time_base_s: float = DEFAULT_TIME_BASE_S,
+               frames: Mapping[str, str] | None = None, distro: str = "humble",
+               compression: str | None = None, topics: Iterable[str] | None = None,
+               progress: Progress | None = None) -> ExportReport:
+    """Write the sgtool log ``log`` (best a derived one) as a ROS bag at ``out`` (module
+    doc): ``fmt`` ros1 or ros2 (None: from ``out``'s name), stamps at log time +
+    ``time_base_s`` seconds, frames renamed by ``frames`` (None: REP-105), ``compression``
+    (None: zstd for ros2, lz4 for ros1), only the ROS or sgtool ``topics`` given (None:
+    all). The bag appears under its name only when complete."""
+    log, out = Path(log), Path(out)
+    fmt = format_for(out, fmt)
+    compression = compression or DEFAULT_COMPRESSION[fmt]
+    if compression not in COMPRESSIONS[FORMATS[fmt]]:
+        raise SgtoolError(f"--compression {compression}: a {fmt} bag takes "
+                          f"{', '.join(COMPRESSIONS[FORMATS[fmt]])}")
+    if distro not in DISTROS:
+        raise SgtoolError(f"--distro {distro!r}: give {' or '.join(DISTROS)}")
+    if not np.isfinite(time_base_s) or time_base_s < 0:
+        raise SgtoolError(f"--time-base {time_base_s}: give seconds >= 0")
+    chosen = select_outputs(topics)
+    if not log.is_file():
+        raise SgtoolError(f"{log}: no such file")
+    if out.resolve() == log.resolve():
+        raise SgtoolError(f"-o {out}: the output must not be the input log")
+    if not out.parent.is_dir():
+        raise SgtoolError(f"-o {out}: folder {out.parent} does not exist")
+    if fmt == "ros1":
+        _check_ros1_target(out, force)
+    elif out.exists() and not out.is_dir():
+        raise SgtoolError(f"-o {out} is a file; a ROS 2 bag is a folder (not replacing it)")
+    base_ns = int(round(time_base_s * 1e9))
+    with LogReader(log) as r:
+        if not r.is_sgtool:
+            raise SgtoolError(f"{log} is not an sgtool log (`sgtool info {log}` says what it "
+                              "is); export works on sgtool logs and their replays")
+        tr = r.time_range()
+        if tr is not None and tr[0] + base_ns <= 0:
+            raise SgtoolError(f"--time-base {time_base_s:g}: the first message would be at "
+                              "stamp 0; give a time base > 0")
+        derived = r.has(GRAPH_TOPIC) or r.has(S.OCCUPANCY)
+        names = frames if frames is not None else REP105
+
+        def writer(path: Path) -> BagWriter:
+            return BagWriter(path, FORMATS[fmt], frames=names, compression=compression,
+                             distro=distro if fmt == "ros2" else None)
+        if fmt == "ros1":
+            with atomic_output(out) as tmp:
+                tmp.unlink()  # rosbags creates the file itself
+                try:
+                    counts = _write(r, writer(tmp), chosen, base_ns, progress)
+                except BaseException:
+                    tmp.unlink(missing_ok=True)
+                    raise
+        else:
+            with output_folder(out, force=force, command="export bag", option="-o",
+                               known=("metadata.yaml", f"{out.name}.mcap")) as stage:
+                inner = stage / out.name  # rosbags names the MCAP file after its folder
+                counts = _write(r, writer(inner), chosen, base_ns, progress)
+                for entry in os.listdir(inner):
+                    os.replace(inner / entry, stage / entry)
+                shutil.rmtree(inner)
+    return ExportReport(out, fmt, tuple(counts), derived, time_base_s, compression)
+
+
+def _check_ros1_target(out: Path, force: bool) -> None:
+    """An existing ROS 1 ``out`` is replaced only with ``force`` and only if it is a ROS 1
+    bag (what ``export bag`` writes), never a folder or another file."""
+    if out.is_dir():
+        raise SgtoolError(f"-o {out} is a folder; a ROS 1 bag is a file (not replacing it)")
+    if not out.exists():
+        return
+    if not force:
+        raise SgtoolError(f"{out} exists; not overwriting it (use --force)")
+    try:
+        with open(out, "rb") as fh:
+            head = fh.read(len(ROS1_MAGIC))
+    except OSError as e:
+        raise SgtoolError(f"-o {out}: cannot read it ({e.strerror}); not replacing it") from None
+    if head != ROS1_MAGIC:
+        raise SgtoolError(f"-o {out} is not a ROS 1 bag; --force replaces only a bag, "
+                          "not replacing it")
+
+
+def _static_links(r: LogReader) -> tuple[dict[tuple[str, str], np.ndarray], int]:
+    """The (parent, child) links whose transform is the same in every ``/tf`` message of
+    the log, and every link of its ``/tf_static``, with their transform; and the log time
+    of the earliest of their messages."""
+    seen: dict[tuple[str, str], np.ndarray] = {}
+    first: dict[tuple[str, str], int] = {}
+    moving: set[tuple[str, str]] = set()
+    topics = [t for t in (S.TF, TF_STATIC) if r.has(t)]
+    for d in r.messages(topics):
+        key = (d.message.parent_frame_id, d.message.child_frame_id)
+        T = codec.decode_transform(d.message)  # noqa: N806
+        if key in seen and d.topic == S.TF and not np.array_equal(seen[key], T):
+            moving.add(key)
+        seen.setdefault(key, T)
+        first.setdefault(key, d.log_time_ns)
+    static = {k: v for k, v in seen.items() if k not in moving}
+    return static, min((first[k] for k in static), default=0)
+
+
 def _image(w: BagWriter, t_ns: int, msg: Any) -> Any:
-    return w.make("sensor_msgs/msg/Image", header=w.header(t_ns, msg.frame_id),
+    return w.make(IMAGE, header=w.header(t_ns, msg.frame_id),
                   height=int(msg.height), width=int(msg.width), encoding=msg.encoding,
                   is_bigendian=0, step=int(msg.step),
                   data=np.frombuffer(bytes(msg.data), dtype=np.uint8))
 
 
-def _converters(w: BagWriter) -> dict[str, tuple[str, str, Callable[[int, Any], Any]]]:
-    """sgtool topic -> (ROS topic, ROS type, convert(t_ns, decoded message))."""
-    tf_type = "tf2_msgs/msg/TFMessage"
-    out: dict[str, tuple[str, str, Callable[[int, Any], Any]]] = {
-        src: (dst, "sensor_msgs/msg/Image", lambda t, m: _image(w, t, m))
-        for src, dst in IMAGE_TOPICS.items()
-    }
-    out[S.CALIBRATION] = (INFO_TOPIC, "sensor_msgs/msg/CameraInfo",
-                          lambda t, m: w.camera_info(t, m.frame_id, codec.decode_calibration(m)))
-    out[S.TF] = (S.TF, tf_type, lambda t, m: w.tf(t, [w.transform_stamped(
-        t, m.parent_frame_id, m.child_frame_id, codec.decode_transform(m))]))
-    out[S.OCCUPANCY] = (S.OCCUPANCY, MAP_TYPES[S.OCCUPANCY],
-                        lambda t, m: ros_maps.occupancy_grid(w, t, m))
-    for topic in (S.VORONOI, S.ROOMS):
-        out[topic] = (topic, MAP_TYPES[topic], lambda t, m: ros_maps.marker_array(w, t, m))
-    return out
-
-
-def export_bag(log: str | Path, out: str | Path, fmt: str = "ros2",
-               force: bool = False) -> ExportReport:
-    """Write the sgtool log ``log`` (best a derived one) as a ROS bag at ``out`` (module
-    doc), ``fmt`` ``ros2`` (a bag folder) or ``ros1`` (a file); an existing ``out`` is
-    replaced only with ``force``. The bag appears under its name only when complete."""
-    log, out = Path(log), Path(out)
-    if fmt not in FORMATS:
-        raise SgtoolError(f"--format {fmt!r}: give ros1 or ros2")
-    if not log.is_file():
-        raise SgtoolError(f"{log}: no such file")
-    if out.resolve() == log.resolve():
-        raise SgtoolError(f"-o {out}: the output must not be the input log")
-    if (out.exists() or out.is_symlink()) and not force:
-        raise SgtoolError(f"{out} exists; not overwriting it (use --force)")
-    if not out.parent.is_dir():
-        raise SgtoolError(f"-o {out}: folder {out.parent} does not exist")
-    with LogReader(log) as r:
-        if not r.is_sgtool:
-            raise SgtoolError(f"{log} is not an sgtool log (`sgtool info {log}` says what it "
-                              "is); export works on sgtool logs and their replays")
-        derived = r.has(GRAPH_TOPIC) or r.has(S.OCCUPANCY)
-        try:  # the bag is made under its own name in a unique temporary folder beside OUT
-            tmp_dir = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".partial",
-                                            dir=out.parent))
-        except OSError as e:
-            raise output_error(e, out) from None
-        try:
-            counts = _write(r, tmp_dir / out.name, FORMATS[fmt])
-            _remove(out)
-            os.replace(tmp_dir / out.name, out)
-        finally:
-            shutil.rmtree(tmp_dir, ignore_errors=True)
-    return ExportReport(out, fmt, tuple(counts), derived)
-
-
-def _remove(p: Path) -> None:
-    """An existing output (a ROS 2 bag is a folder) before it is replaced (--force)."""
-    if p.is_dir() and not p.is_symlink():
-        shutil.rmtree(p)
-    elif p.exists() or p.is_symlink():
-        p.unlink()
-
-
-def _write(r: LogReader, tmp: Path, fmt: str) -> list[tuple[str, str, int]]:
-    with BagWriter(tmp, fmt) as w:
-        conv = _converters(w)
-        types: dict[str, str] = {}
-        topics = [t for t in [*conv, GRAPH_TOPIC] if r.has(t)]
+def _write(r: LogReader, w: BagWriter, chosen: list[str], base_ns: int,
+           progress: Progress | None) -> list[tuple[str, str, int]]:
+    """Convert the messages of ``r`` feeding the ``chosen`` ROS topics into ``w``."""
+    want = set(chosen)
+    sources = {OUTPUTS[t][0] for t in chosen}
+    if want & {f"{ns}/camera_info" for ns in IMAGE_TOPICS.values()}:
+        sources.add(S.CALIBRATION)
+    if S.TF in sources:
+        sources.add(TF_STATIC)
+    topics = [t for t in OUTPUTS_ORDER if t in sources and r.has(t)]
+    if progress is not None:
+        progress.total = sum(r.message_count(t) for t in topics)
+    with w:
+        static, t_static = _static_links(r) if S.TF in sources else ({}, 0)
+        if static and TF_STATIC in want:
+            t0 = t_static + base_ns
+            w.write(TF_STATIC, TF_TYPE, t0, w.tf(t0, [
+                w.transform_stamped(t0, p, c, T) for (p, c), T in sorted(static.items())]),
+                latched=True)
+        calib: CameraIntrinsics | None = None
+        converters = _converters(w)
         for d in r.messages(topics):
-            t = d.log_time_ns
-            if d.topic == GRAPH_TOPIC:
-                for dst, ty, msg in ((GRAPH_TOPIC, "std_msgs/msg/String",
-                                      ros_maps.graph_string(w, d.message)),
-                                     (OBJECTS_TOPIC, "visualization_msgs/msg/MarkerArray",
-                                      ros_maps.object_markers(w, t, d.message))):
-                    w.write(dst, ty, t, msg)
-                    types[dst] = ty
-                continue
-            dst, ty, make = conv[d.topic]
-            w.write(dst, ty, t, make(t, d.message))
-            types[dst] = ty
-        return [(topic, types[topic], n) for topic, n in sorted(w.counts.items())]
+            if progress is not None:
+                progress.update(1)
+            t = d.log_time_ns + base_ns
+            if d.topic == S.CALIBRATION:
+                calib = codec.decode_calibration(d.message)
+            elif d.topic == TF_STATIC:
+                continue  # in the one /tf_static message above
+            elif d.topic == S.TF:
+                key = (d.message.parent_frame_id, d.message.child_frame_id)
+                if key not in static and S.TF in want:
+                    w.write(S.TF, TF_TYPE, t, w.tf(t, [w.transform_stamped(
+                        t, key[0], key[1], codec.decode_transform(d.message))]))
+            elif d.topic in IMAGE_TOPICS:
+                ns = IMAGE_TOPICS[d.topic]
+                if f"{ns}/image_raw" in want:
+                    w.write(f"{ns}/image_raw", IMAGE, t, _image(w, t, d.message))
+                if f"{ns}/camera_info" in want and calib is not None:
+                    w.write(f"{ns}/camera_info", INFO, t,
+                            w.camera_info(t, d.message.frame_id or S.CAMERA_FRAME, calib))
+            else:
+                for dst, make in converters[d.topic]:
+                    if dst in want:
+                        w.write(dst, OUTPUTS[dst][1], t, make(t, d.message),
+                                latched=OUTPUTS[dst][2])
+        return [(topic, OUTPUTS[topic][1], n) for topic, n in sorted(w.counts.items())]
+
+
+OUTPUTS_ORDER = (S.CALIBRATION, S.TF, TF_STATIC, *IMAGE_TOPICS, S.OCCUPANCY, S.VORONOI,
+                 S.ROOMS, GRAPH_TOPIC)
+
+
+def _converters(w: BagWriter) -> dict[str, list[tuple[str, Callable[[int, Any], Any]]]]:
+    """sgtool map topic -> [(ROS topic, convert(t_ns, decoded message))]."""
+    return {
+        S.OCCUPANCY: [(S.OCCUPANCY, lambda t, m: ros_maps.occupancy_grid(w, t, m))],
+        S.VORONOI: [(S.VORONOI, lambda t, m: ros_maps.marker_array(w, t, m))],
+        S.ROOMS: [(S.ROOMS, lambda t, m: ros_maps.marker_array(w, t, m))],
+        GRAPH_TOPIC: [(GRAPH_TOPIC, lambda t, m: ros_maps.graph_string(w, m)),
+                      (OBJECTS_TOPIC, lambda t, m: ros_maps.object_markers(w, t, m))],
+    }

@@ -8,32 +8,88 @@ from __future__ import annotations
 
 import click
 
+from sgtool.errors import SgtoolError
+
 
 @click.group("export")
 def command() -> None:
     """Export sgtool logs to other tools' formats."""
 
 
+def _frames(style: str, pairs: tuple[str, ...]) -> dict[str, str]:
+    """The frame renaming of ``--frames STYLE`` and ``--frame OLD=NEW`` pairs."""
+    from sgtool.recorders.exporters.bag_export import REP105
+
+    names = dict(REP105) if style == "rep105" else {}
+    for pair in pairs:
+        old, sep, new = pair.partition("=")
+        if not sep or not old.strip() or not new.strip():
+            raise SgtoolError(f"--frame {pair!r}: give OLD=NEW, e.g. camera=camera_link")
+        names[old.strip()] = new.strip()
+    return names
+
+
 @command.command("bag")
 @click.argument("log", type=click.Path(dir_okay=False))
 @click.option("-o", "--output", required=True, type=click.Path(),
-              help="The bag to write: a ROS 1 .bag file, or a ROS 2 bag folder (MCAP storage).")
-@click.option("--format", "fmt", type=click.Choice(["ros1", "ros2"]), default="ros2",
-              show_default=True, help="ROS 1 bag or ROS 2 bag (MCAP storage).")
-@click.option("--force", is_flag=True, help="Replace an existing OUT.")
-def bag(log: str, output: str, fmt: str, force: bool) -> None:
+              help="The bag to write: NAME.bag is a ROS 1 bag file, any other name a ROS 2 "
+                   "bag folder (MCAP storage).")
+@click.option("--format", "fmt", type=click.Choice(["ros1", "ros2"]), default=None,
+              help="ROS 1 bag or ROS 2 bag (MCAP storage) [default: from -o's name].")
+@click.option("--distro", type=click.Choice(["humble", "jazzy"]), default="humble",
+              show_default=True,
+              help="ROS 2 distribution whose metadata.yaml layout and types are written "
+                   "(a humble bag also plays on jazzy).")
+@click.option("--time-base", "time_base", type=float, default=1.0, show_default=True,
+              metavar="SECONDS",
+              help="Bag time and header stamps = log time + SECONDS (keeps every message off "
+                   "stamp 0).")
+@click.option("--frames", "frame_style", type=click.Choice(["rep105", "sgtool"]),
+              default="rep105", show_default=True,
+              help="Frame names: REP-105 (map, base_link, camera_optical_frame) or sgtool's "
+                   "(world, base, camera).")
+@click.option("--frame", "frame_pairs", multiple=True, metavar="OLD=NEW",
+              help="Rename one frame (repeatable), after --frames.")
+@click.option("--compression", type=click.Choice(["zstd", "lz4", "bz2", "none"]),
+              default=None,
+              help="Chunk compression [default: zstd for ros2, lz4 for ros1; ros2 takes zstd "
+                   "or none, ros1 lz4, bz2 or none].")
+@click.option("--topics", "topics", default=None, metavar="T1,T2,...",
+              help="Only these topics (ROS or sgtool names, comma-separated); an sgtool "
+                   "topic selects every ROS topic made from it.")
+@click.option("--progress/--no-progress", default=True, show_default=True,
+              help="Show a progress bar.")
+@click.option("--force", is_flag=True,
+              help="Replace an existing OUT: a ROS 1 bag, or the files sgtool wrote in a ROS "
+                   "2 bag folder (other files there stay).")
+def bag(log: str, output: str, fmt: str | None, distro: str, time_base: float,
+        frame_style: str, frame_pairs: tuple[str, ...], compression: str | None,
+        topics: str | None, progress: bool, force: bool) -> None:
     """Write LOG (a derived log of `sgtool replay`, or any sgtool log) as a ROS bag that
-    RViz, `ros2 bag`, Foxglove and Rerun's ROS importers understand: the occupancy as
-    nav_msgs/OccupancyGrid, the Voronoi graph, rooms and objects as
+    RViz, `ros2 bag`, image_proc, Foxglove and Rerun's ROS importers understand: the
+    occupancy as nav_msgs/OccupancyGrid, the Voronoi graph, rooms and objects as
     visualization_msgs/MarkerArray, the scene graph as std_msgs/String JSON, the camera
-    images, CameraInfo and /tf.
+    images each with a CameraInfo of the same stamp, /tf and a latched /tf_static for the
+    fixed transforms. Maps and /tf_static are latched (transient-local QoS in ROS 2).
 
     \b
     Example:
       sgtool replay run.mcap -o derived.mcap
-      sgtool export bag derived.mcap -o derived_bag --format ros2
+      sgtool export bag derived.mcap -o derived_bag            # ROS 2 (humble)
+      sgtool export bag derived.mcap -o derived.bag            # ROS 1
+      sgtool export bag derived.mcap -o maps --topics /map/occupancy,/tf
     """
+    from tqdm import tqdm
+
     from sgtool.recorders.exporters.bag_export import export_bag
 
-    for line in export_bag(log, output, fmt, force).lines():
+    names = [t.strip() for t in topics.split(",") if t.strip()] if topics else None
+    if topics is not None and not names:
+        raise SgtoolError("--topics: give at least one topic")
+    with tqdm(unit="msg", desc="export", disable=None if progress else True,
+              leave=False) as bar:
+        report = export_bag(log, output, fmt, force, time_base_s=time_base,
+                            frames=_frames(frame_style, frame_pairs), distro=distro,
+                            compression=compression, topics=names, progress=bar)
+    for line in report.lines():
         click.echo(line)

@@ -1,11 +1,15 @@
 """`sgtool export bag`: a derived log as ROS 1 and ROS 2 bags, read back by rosbags'
-AnyReader: every message written is read back on its topic, the occupancy grids hold the
-derived log's cells, the markers the graph's lines, rooms close their outlines, and an
-existing output is refused without --force."""
+AnyReader: every message written is read back on its topic with its type, the occupancy
+grids hold the derived log's cells, the markers the graph's lines, rooms close their
+outlines, each image has a CameraInfo of the same stamp and frame, fixed transforms are on
+/tf_static once, no stamp is 0, frames follow REP-105, maps are latched, bags are
+compressed, and an existing output is refused without --force and replaced only where
+sgtool wrote it."""
 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -30,7 +34,9 @@ from sgtool.recorders.exporters.ros_maps import DELETEALL, LINE_LIST, LINE_STRIP
 GOLDEN = Path(__file__).resolve().parents[2] / "golden" / "house6-tour.mcap"
 
 
-def read_bag(path: Path) -> dict[str, list[tuple[int, object]]]:
+def read_bag(path: Path, types: dict[str, str] | None = None
+             ) -> dict[str, list[tuple[int, object]]]:
+    """Every message of the bag by topic, deserialised; ``types`` gets topic -> type."""
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
 
@@ -38,7 +44,14 @@ def read_bag(path: Path) -> dict[str, list[tuple[int, object]]]:
     with AnyReader([path], default_typestore=get_typestore(Stores.LATEST)) as r:
         for c, t, raw in r.messages():
             out.setdefault(c.topic, []).append((t, r.deserialize(raw, c.msgtype)))
+            if types is not None:
+                types[c.topic] = c.msgtype
     return out
+
+
+def stamp_ns(msg: object) -> int:
+    st = msg.header.stamp  # type: ignore[attr-defined]
+    return int(st.sec) * 1_000_000_000 + int(st.nanosec)
 
 
 def log_with_rooms(path: Path, n: int = 4) -> Path:
@@ -72,31 +85,55 @@ def log_with_rooms(path: Path, n: int = 4) -> Path:
     return path
 
 
+ALL_TOPICS = {
+    "/camera/depth/image_raw", "/camera/rgb/image_raw", "/camera/instances/image_raw",
+    "/camera/depth/camera_info", "/camera/rgb/camera_info", "/camera/instances/camera_info",
+    "/tf", "/tf_static", "/map/occupancy", "/map/voronoi", "/map/rooms", "/map/objects",
+    "/sgtool/scene_graph"}
+
+
 @pytest.mark.parametrize("fmt", ["ros1", "ros2"])
 def test_every_channel_round_trips_through_rosbags(tmp_path, fmt):
     log = log_with_rooms(tmp_path / "d.mcap")
     out = tmp_path / ("o.bag" if fmt == "ros1" else "o")
-    rep = export_bag(log, out, fmt)
-    got = read_bag(out)
+    rep = export_bag(log, out)  # the format from the name
+    assert rep.fmt == fmt
+    types: dict[str, str] = {}
+    got = read_bag(out, types)
     assert {t: len(v) for t, v in got.items()} == {t: n for t, _, n in rep.counts}
-    assert {t for t, _, _ in rep.counts} == {
-        "/camera/depth/image_raw", "/camera/rgb/image_raw", "/camera/instances/image_raw",
-        "/camera/camera_info", "/tf", "/map/occupancy", "/map/voronoi", "/map/rooms",
-        "/map/objects", "/sgtool/scene_graph"}
+    assert {t: ty for t, ty, _ in rep.counts} == types
+    assert set(types) == ALL_TOPICS
     with LogReader(log) as r:
         grid_msg = next(iter(r.messages([S.OCCUPANCY]))).message
         depth0 = codec.decode_image(next(iter(r.messages([S.DEPTH]))).message)
-        n_tf = r.message_count(S.TF)
     cells, origin, res = codec.decode_grid(grid_msg)
     _, grid = got["/map/occupancy"][0]
     assert (grid.info.width, grid.info.height) == (5, 4)
     assert grid.info.resolution == pytest.approx(res)
     assert (grid.info.origin.position.x, grid.info.origin.position.y) == origin
     assert np.array_equal(np.asarray(grid.data, np.int8).reshape(4, 5), cells)
+    assert grid.header.frame_id == "map"
     _, img = got["/camera/depth/image_raw"][0]
-    assert img.encoding == "16UC1"
+    assert img.encoding == "16UC1" and img.header.frame_id == "camera_optical_frame"
     assert np.array_equal(np.frombuffer(bytes(img.data), "<u2").reshape(depth0.shape), depth0)
-    assert len(got["/tf"]) == n_tf
+    # world -> base moves (one /tf per frame), base -> camera is fixed (one /tf_static)
+    assert len(got["/tf"]) == 4
+    assert all(m.transforms[0].child_frame_id == "base_link" for _, m in got["/tf"])
+    (t_static, static), = got["/tf_static"]
+    assert [(x.header.frame_id, x.child_frame_id) for x in static.transforms] == [
+        ("base_link", "camera_optical_frame")]
+    assert t_static == 1_000_000_000 == stamp_ns(static.transforms[0])
+    # a CameraInfo with every image: same stamp, same frame; nothing at stamp 0
+    for ns in ("depth", "rgb", "instances"):
+        imgs, infos = got[f"/camera/{ns}/image_raw"], got[f"/camera/{ns}/camera_info"]
+        assert len(imgs) == len(infos) == 4
+        for (ti, im), (tc, ci) in zip(imgs, infos, strict=True):
+            assert ti == tc == stamp_ns(im) == stamp_ns(ci)
+            assert im.header.frame_id == ci.header.frame_id
+            assert (ci.width, ci.height) == (im.width, im.height)
+    assert [t for t, _ in got["/camera/depth/image_raw"]] == [
+        1_000_000_000 + i * DT for i in range(4)]
+    assert min(t for msgs in got.values() for t, _ in msgs) == 1_000_000_000
     _, vor = got["/map/voronoi"][0]
     line = vor.markers[0]
     assert line.type == LINE_LIST and [(p.x, p.y) for p in line.points] == [(0, 0), (1, 2)]
@@ -111,6 +148,82 @@ def test_every_channel_round_trips_through_rosbags(tmp_path, fmt):
     assert labels == ["obj:3 cabinet", "obj:4 apple"]
     _, graph = got["/sgtool/scene_graph"][0]
     assert json.loads(graph.data)["objects"][1]["category"] == "apple"
+
+
+def test_ros2_metadata_qos_distro_and_compression(tmp_path):
+    """Maps and /tf_static offer transient-local QoS, images volatile; humble writes
+    metadata version 5 with QoS as a YAML string, jazzy version 9 with its distro; the
+    MCAP chunks are zstd."""
+    import yaml
+    from mcap.reader import make_reader
+
+    log = log_with_rooms(tmp_path / "d.mcap")
+    for distro, version in (("humble", 5), ("jazzy", 9)):
+        out = tmp_path / distro
+        export_bag(log, out, distro=distro)
+        info = yaml.safe_load((out / "metadata.yaml").read_text())[
+            "rosbag2_bagfile_information"]
+        assert info["version"] == version
+        assert info.get("ros_distro") == (None if distro == "humble" else "jazzy")
+        qos = {}
+        for tm in info["topics_with_message_count"]:
+            prof = tm["topic_metadata"]["offered_qos_profiles"]
+            assert isinstance(prof, str) == (distro == "humble")
+            assert ("type_description_hash" in tm["topic_metadata"]) == (distro == "jazzy")
+            prof = yaml.safe_load(prof) if isinstance(prof, str) else prof
+            qos[tm["topic_metadata"]["name"]] = (prof[0]["durability"], prof[0]["depth"])
+        # humble spells the policies as numbers, jazzy as names
+        latched, volatile = ((1, 1), (2, 10)) if distro == "humble" else (
+            ("transient_local", 1), ("volatile", 10))
+        assert qos["/map/occupancy"] == qos["/tf_static"] == latched
+        assert qos["/camera/depth/image_raw"] == volatile
+        with open(out / f"{distro}.mcap", "rb") as fh:
+            chunks = [c for c in make_reader(fh).get_summary().chunk_indexes]
+        assert chunks and {c.compression for c in chunks} == {"zstd"}
+        assert len(read_bag(out)["/map/occupancy"]) == 1
+
+
+def test_topics_time_base_and_frame_names(tmp_path):
+    log = log_with_rooms(tmp_path / "d.mcap")
+    out = tmp_path / "o.bag"
+    rep = export_bag(log, out, topics=["/camera/depth", "/map/occupancy"], time_base_s=5,
+                     frames={"world": "odom"})
+    got = read_bag(out)
+    assert set(got) == {"/camera/depth/image_raw", "/camera/depth/camera_info",
+                        "/map/occupancy"} == {t for t, _, _ in rep.counts}
+    assert got["/map/occupancy"][0][1].header.frame_id == "odom"
+    assert got["/camera/depth/image_raw"][0][1].header.frame_id == "camera"  # not renamed
+    assert got["/camera/depth/image_raw"][0][0] == 5_000_000_000
+    with pytest.raises(SgtoolError, match="--topics /nope: not a topic"):
+        export_bag(log, tmp_path / "x", topics=["/nope"])
+    with pytest.raises(SgtoolError, match="would be at stamp 0"):
+        export_bag(log, tmp_path / "x", time_base_s=0)
+    with pytest.raises(SgtoolError, match="a .bag name is a ROS 1 bag file"):
+        export_bag(log, tmp_path / "x.bag", "ros2")
+    with pytest.raises(SgtoolError, match="--compression zstd: a ros1 bag takes"):
+        export_bag(log, tmp_path / "x.bag", compression="zstd")
+    assert not list(tmp_path.glob("x*")) and not list(tmp_path.glob(".x*"))
+
+
+def test_force_replaces_only_what_sgtool_wrote(tmp_path):
+    log = log_with_rooms(tmp_path / "d.mcap")
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    with pytest.raises(SgtoolError, match="not empty"):
+        export_bag(log, out)
+    export_bag(log, out, force=True)
+    export_bag(log, out, force=True)
+    assert (out / "notes.txt").read_text() == "mine"
+    assert {p.name for p in out.iterdir()} == {"notes.txt", "o.mcap", "metadata.yaml",
+                                               ".sgtool-output"}
+    assert "/tf_static" in read_bag(out)
+    # a ROS 1 target that is not a bag is never replaced
+    other = tmp_path / "other.bag"
+    other.write_text("not a bag")
+    with pytest.raises(SgtoolError, match="is not a ROS 1 bag"):
+        export_bag(log, other, force=True)
+    assert other.read_text() == "not a bag"
 
 
 def test_a_replayed_log_round_trips_grid_for_grid(tmp_path):
@@ -130,22 +243,25 @@ def test_a_replayed_log_round_trips_grid_for_grid(tmp_path):
         assert len(got["/sgtool/scene_graph"]) == rd.message_count("/sgtool/scene_graph")
     assert len(grids) >= 2 and len(got["/map/occupancy"]) == len(grids)
     for (t, cells), (tb, msg) in zip(grids, got["/map/occupancy"], strict=True):
-        assert t == tb
+        assert t + 1_000_000_000 == tb  # the default time base: log time + 1 s
         assert np.array_equal(np.asarray(msg.data, np.int8).reshape(cells.shape), cells)
-    assert f"/map/occupancy               nav_msgs/msg/OccupancyGrid  {len(grids)}" in r.output
+    assert re.search(rf"/map/occupancy +nav_msgs/msg/OccupancyGrid +{len(grids)}\n", r.output)
     # an existing output is refused, replaced with --force
     r = CliRunner().invoke(cli, ["export", "bag", str(derived), "-o", str(out)])
-    assert r.exit_code == 2 and "exists; not overwriting it (use --force)" in r.output
+    assert r.exit_code == 2 and "not empty" in r.output and "--force" in r.output
     r = CliRunner().invoke(cli, ["export", "bag", str(derived), "-o", str(out), "--force"])
     assert r.exit_code == 0 and len(read_bag(out)["/map/occupancy"]) == len(grids)
     assert not [p for p in tmp_path.iterdir() if p.name.endswith(".partial")]
-    assert sorted(p.name for p in out.iterdir()) == ["bag.mcap", "metadata.yaml"]
+    assert sorted(p.name for p in out.iterdir()) == [".sgtool-output", "bag.mcap",
+                                                     "metadata.yaml"]
 
 
 def test_not_an_sgtool_log_and_bad_format(tmp_path):
     log = log_with_rooms(tmp_path / "d.mcap")
     with pytest.raises(SgtoolError, match="--format 'ros3': give ros1 or ros2"):
         export_bag(log, tmp_path / "o", "ros3")
+    with pytest.raises(SgtoolError, match="--distro 'iron'"):
+        export_bag(log, tmp_path / "o", distro="iron")
     with pytest.raises(SgtoolError, match="no such file"):
         export_bag(tmp_path / "nope.mcap", tmp_path / "o")
     with pytest.raises(SgtoolError, match=r"folder .*missing does not exist"):
