@@ -24,7 +24,8 @@ all-pairs Dijkstra to sparsify (O(N^2)). We compute the same diagram on the grid
 2. **Thinning.** Zhang-Suen thinning (1984) makes the ridge one cell wide; the pixel graph
    joins 8-neighbours, skipping a diagonal step when a 4-neighbour path exists.
 3. **Component.** The component holding the ridge cell nearest to ``anchor`` (the robot),
-   else the largest (ties: the one with the lowest cell).
+   else the largest (ties: the one with the lowest cell); with a trajectory, also every
+   component it passed through (:func:`visited_components`).
 4. **Sparsification** (MoMa-LLM: keep nodes of degree != 2, join them along degree-2
    chains, re-insert a node every 0.6 m): chains are traced once (linear time), spurs
    shorter than ``min_spur`` ending in a junction are dropped, and each chain gets
@@ -322,11 +323,39 @@ def chosen_component(occ: OccupancyGrid, rg: RidgeGraph,
     return int(np.flatnonzero(sizes == sizes.max())[0])
 
 
+def visited_components(occ: OccupancyGrid, rg: RidgeGraph,
+                       anchor: tuple[float, float] | None,
+                       trajectory: np.ndarray | None = None) -> tuple[int, ...]:
+    """The ridge components the graph is built on, sorted: :func:`chosen_component` and
+    every component the ``trajectory`` (k, 2 world x, y) passed through. A trajectory
+    point passed through the component of its nearest ridge pixel when it lies within
+    that pixel's clearance (inside the free disc the pixel stands for); the robot drove
+    there, so a phantom obstacle that splits the ridge (a stray voxel in a doorway) does
+    not drop the rooms behind it. Empty without ridge."""
+    first = chosen_component(occ, rg, anchor)
+    if first < 0:
+        return ()
+    if trajectory is None or len(trajectory) == 0 or int(rg.component.max()) == 0:
+        return (first,)
+    from scipy.spatial import cKDTree
+
+    pr, pc = np.divmod(rg.flat, rg.ridge.shape[1])
+    px, py = occ.center_of(pr, pc)
+    pts = np.asarray(trajectory, dtype=np.float64).reshape(-1, 2)
+    dist, near = cKDTree(np.stack([px, py], axis=1)).query(pts)
+    inside = dist <= rg.clearance[pr[near], pc[near]]
+    comps = np.unique(np.append(rg.component[near[inside]], first))
+    return tuple(int(c) for c in comps)
+
+
 def voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
                   anchor: tuple[float, float] | None = None,
-                  ridge: RidgeGraph | None = None) -> VoronoiGraph:
+                  ridge: RidgeGraph | None = None,
+                  trajectory: np.ndarray | None = None) -> VoronoiGraph:
     """The sparsified generalized Voronoi graph of the explored free space of ``occ``
-    (``ridge``: a :func:`ridge_graph` of the same grid, to skip steps 1-2)."""
+    (``ridge``: a :func:`ridge_graph` of the same grid, to skip steps 1-2); with a
+    ``trajectory``, over every component it passed through
+    (:func:`visited_components`), else over the anchor's."""
     cfg = config or VoronoiConfig()
     rg = ridge if ridge is not None else ridge_graph(occ, cfg)
     res = occ.resolution
@@ -337,8 +366,8 @@ def voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
     if len(rg.flat) == 0:
         return empty
     flat, adj, comp = rg.flat, rg.adj, rg.component
-    target = chosen_component(occ, rg, anchor)
-    keep = np.flatnonzero(comp == target)
+    targets = visited_components(occ, rg, anchor, trajectory)
+    keep = np.flatnonzero(np.isin(comp, np.asarray(targets, dtype=comp.dtype)))
     flat = flat[keep]
     adj = submatrix(adj, keep)
     pieces = sparsify(trace_chain_arrays(adj), np.diff(adj.indptr), adj.shape[0],

@@ -11,8 +11,9 @@ caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
    a full rebuild happens when the floor level estimate moves or the grid would shrink;
 2. Voronoi graph (:mod:`sgtool.mapping.voronoi`): the ridge pixel graph is reused while the
    free cells are unchanged, else its distance field and ridge cells are recomputed around
-   the changed cells only (:mod:`sgtool.mapping.ridge_window`); the component is the
-   robot's;
+   the changed cells only (:mod:`sgtool.mapping.ridge_window`); the components are the
+   robot's and every one its trajectory passed through
+   (:func:`~sgtool.mapping.voronoi.visited_components`);
 3. rooms (:mod:`sgtool.scenegraph.room_segmentation`): door cells of the voxels the open
    doors win (:mod:`sgtool.scenegraph.door_evidence`,
    :meth:`sgtool.scenegraph.door_voxels.DoorVoxels.won`) cut the graph, ids are kept
@@ -76,8 +77,8 @@ from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
 from sgtool.mapping.voronoi import (
     RidgeGraph,
     VoronoiGraph,
-    chosen_component,
     ridge_graph,
+    visited_components,
     voronoi_graph,
 )
 from sgtool.mapping.voxels import COLUMN_SHIFT, LABEL_MASK, VoxelMap
@@ -187,7 +188,7 @@ class SceneGraphBuilder:
         self._removals = -1
         self._door_voxels = DoorVoxels()  # the door keys, kept with the BEV columns
         self._ridge: _Ridge | None = None
-        self._graph: tuple[tuple[int, int], VoronoiGraph] | None = None
+        self._graph: tuple[tuple[int, tuple[int, ...]], VoronoiGraph] | None = None
         self._rooms = RoomTracker()
         self._frontiers = FrontierTracker()
         self._class_memo: dict[tuple[str, ...], list[tuple[str, float]]] = {}
@@ -412,10 +413,10 @@ class SceneGraphBuilder:
 
     def _voronoi(self, occ: OccupancyGrid, robot_xy: tuple[float, float] | None
                  ) -> VoronoiGraph:
-        """The Voronoi graph of the robot's component; the ridge pixel graph is reused
-        while the free cells are unchanged (it depends on nothing else) and otherwise
-        computed from the previous one (only around the changed cells), the graph is
-        reused while the ridge, its component and the grid's placement are too."""
+        """The Voronoi graph of the components the robot passed through; the ridge pixel
+        graph is reused while the free cells are unchanged (it depends on nothing else)
+        and otherwise computed from the previous one (only around the changed cells), the
+        graph is reused while the ridge, its components and the grid's placement are."""
         cfg = self.config.voronoi
         free = occ.grid == FREE
         free.setflags(write=False)  # kept to recognise the same free cells next time
@@ -428,9 +429,11 @@ class SceneGraphBuilder:
                                  ridge_graph(occ, cfg, previous=previous))
         ridge = self._ridge
         assert ridge is not None
-        key = (ridge.version, chosen_component(occ, ridge.ridge, robot_xy))
-        if self._graph is None or self._graph[0] != key:  # same ridge, same component
-            self._graph = (key, voronoi_graph(occ, cfg, anchor=robot_xy, ridge=ridge.ridge))
+        track = np.asarray(self.trajectory, dtype=np.float64).reshape(-1, 2)
+        key = (ridge.version, visited_components(occ, ridge.ridge, robot_xy, track))
+        if self._graph is None or self._graph[0] != key:  # same ridge, same components
+            self._graph = (key, voronoi_graph(occ, cfg, anchor=robot_xy, ridge=ridge.ridge,
+                                              trajectory=track))
         return self._graph[1]
 
     def _segment(self, occ: OccupancyGrid, vg: VoronoiGraph) -> _Rooms:
