@@ -12,6 +12,13 @@ atomically (:func:`sgtool.files.atomic_write`) as each task finishes, so the out
 only ever holds complete logs (no shared folder is needed on a cluster for the outputs;
 the workers must be able to read the inputs). A log whose replay fails twice is reported
 with its error and gets no output; the others are written all the same.
+
+:func:`replay_into` is the command's whole run on the output folder
+(:func:`sgtool.files.output_folder`): a new folder, or one an earlier ``--out-dir`` run
+wrote, is written in place, log by log, so that a run cut short is taken up again by the
+same command; another non-empty folder is refused unless ``force``; with ``force`` every
+log is replayed again into a folder beside the target, moved in complete (replacing what
+sgtool wrote there, keeping other files), and Ctrl-C leaves the target as it was.
 """
 
 from __future__ import annotations
@@ -21,11 +28,12 @@ import tempfile
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
+from dataclasses import replace as replace_field
 from pathlib import Path
 
 from sgtool.analysis.executor import Executor, Outcome, Task
 from sgtool.errors import LogFormatError, SgtoolError
-from sgtool.files import atomic_write
+from sgtool.files import atomic_write, output_folder
 from sgtool.log.reader import LogReader
 from sgtool.replayers.derived_log import REPLAY_METADATA, ReplayOptions, replay, resolve_options
 
@@ -163,10 +171,26 @@ def replay_many(jobs: Sequence[ReplayJob], executor: Executor, *, force: bool = 
     return BatchReport(tuple(results), time.perf_counter() - t0)
 
 
+def replay_into(jobs: Sequence[ReplayJob], out_dir: str | os.PathLike[str],
+                executor: Executor, *, force: bool = False,
+                progress: bool = False) -> BatchReport:
+    """:func:`replay_many` of ``jobs`` (planned into ``out_dir`` by :func:`plan_jobs`)
+    through :func:`sgtool.files.output_folder` (module doc): in place into a new folder or
+    one of an earlier run, or, with ``force``, built beside ``out_dir`` and moved in
+    complete. The report names the outputs under ``out_dir``."""
+    target = out_folder(out_dir)
+    with output_folder(target, force=force, command="replay", option="--out-dir",
+                       resume=True) as root:
+        staged = [replace_field(j, output=str(root / Path(j.output).name)) for j in jobs]
+        report = replay_many(staged, executor, force=force, progress=progress)
+    final = {s.output: j.output for s, j in zip(staged, jobs, strict=True)}
+    return BatchReport(tuple(replace_field(r, output=final[r.output]) for r in report.logs),
+                       report.seconds)
+
+
 def out_folder(path: str | os.PathLike[str]) -> Path:
-    """The output folder, created when missing; one line when it is a file."""
+    """The output folder (it may not exist yet); one line when it is a file."""
     p = Path(path)
     if p.exists() and not p.is_dir():
         raise SgtoolError(f"--out-dir {p} is a file; give a folder")
-    p.mkdir(parents=True, exist_ok=True)
     return p

@@ -78,7 +78,7 @@ from sgtool.analysis.report import (
 )
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
-from sgtool.files import atomic_write
+from sgtool.files import atomic_write, output_folder
 from sgtool.planning.episode import SUCCESS_RULES
 from sgtool.redact import redact_options, redact_text, secret_values
 from sgtool.results import EpisodeResult, results_digest, write_jsonl
@@ -440,11 +440,21 @@ def priors_fingerprint(weights_dir: str | os.PathLike[str] | None = None) -> str
     return h.hexdigest()[:16]
 
 
+# the names write_outputs gives its files (what ``--force`` may replace in a folder without
+# a manifest: :func:`sgtool.files.output_folder`)
+OUTPUT_NAMES: tuple[str, ...] = (
+    "episodes.jsonl", "summary.md", "summary.json", "run.md", "run.json", "per_house.md",
+    "per_house.jsonl", "per_query.md", "per_query.jsonl", "efficiency_*.png",
+)
+
+
 def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
                   command: str = "") -> list[Path]:
     """episodes.jsonl, summary.md, summary.json (no wall-clock figure), run.md, run.json
     (timing, command), per_house.md/.jsonl, per_query.md/.jsonl and the two efficiency
-    PNGs."""
+    PNGs (:data:`OUTPUT_NAMES`), each written atomically into ``out_dir`` (created when
+    missing); the commands write into the folder of :func:`sgtool.files.output_folder`,
+    so that the set appears complete."""
     from sgtool.analysis.curves import plot_efficiency
 
     out = Path(out_dir)
@@ -514,15 +524,21 @@ def run_bench(planners: Sequence[str] = DEFAULT_PLANNERS, houses: int = 10, epis
               rooms: tuple[int, int] = DEFAULT_ROOMS, max_steps: int = 50, house_seed: int = 0,
               planner_options: Mapping[str, Mapping[str, Any]] | None = None,
               progress: bool | None = None, house_files: Sequence[str] = (),
-              priors_dir: str | None = None) -> str:
+              priors_dir: str | None = None, force: bool = True) -> str:
     """Run the benchmark and return its table text (Table VII shape, then Table IX);
-    with ``out_dir``, also write the outputs there (see :func:`write_outputs`)."""
+    with ``out_dir``, also write the outputs there (see :func:`write_outputs`), built
+    beside it and moved in complete (:func:`sgtool.files.output_folder`): with ``force``
+    they replace the outputs of an earlier run there (other files stay), without it a
+    non-empty ``out_dir`` is refused."""
     cfg = BenchConfig(planners=tuple(planners), houses=houses, episodes=episodes, seeds=seeds,
                       rooms=(int(rooms[0]), int(rooms[1])), house_seed=house_seed,
                       max_steps=max_steps, workers=workers,
                       planner_options=dict(planner_options or {}),
                       house_files=tuple(map(str, house_files)), priors_dir=priors_dir)
-    res = run_benchmark(cfg, progress=progress)
-    if out_dir is not None:
-        write_outputs(res, out_dir)
+    if out_dir is None:
+        res = run_benchmark(cfg, progress=progress)
+    else:
+        with output_folder(out_dir, force=force, command="bench", known=OUTPUT_NAMES) as out:
+            res = run_benchmark(cfg, progress=progress)
+            write_outputs(res, out)
     return res.table + "\n" + res.seen_table

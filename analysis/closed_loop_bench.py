@@ -354,8 +354,14 @@ def report_order(cfg: ClosedLoopBenchConfig,
     return key
 
 
+# the names of a run-bench folder's entries (what ``--force`` may replace, and what marks a
+# folder without a manifest as a run-bench folder: :func:`sgtool.files.output_folder`)
+OUTPUT_NAMES: tuple[str, ...] = ("logs", "episodes.jsonl", "summary.md", "efficiency_*.png")
+
+
 def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]:
-    """episodes.jsonl, summary.md and the efficiency curves (per noise profile)."""
+    """episodes.jsonl, summary.md and the efficiency curves (per noise profile), each
+    written atomically into ``out_dir``."""
     from sgtool.analysis.curves import plot_efficiency
 
     out = Path(out_dir)

@@ -71,7 +71,8 @@ def test_a_log_that_fails_is_reported_and_the_others_are_written(logs, tmp_path)
     assert r.stderr.startswith(f"sgtool: error: 1 of 3 log(s) failed to replay (after a "
                                f"retry); the first: {bad}: ")
     assert len(r.stderr.strip().splitlines()) == 1
-    assert sorted(f.name for f in out.iterdir()) == ["run6.mcap", "run8.mcap"]
+    assert sorted(f.name for f in out.iterdir()) == [".sgtool-output", "run6.mcap",
+                                                     "run8.mcap"]
 
 
 def test_folder_and_glob_inputs_and_json(logs, tmp_path):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import shlex
 import sys
+from pathlib import Path
 
 import click
 
@@ -24,6 +25,7 @@ from sgtool.commands.options import (
 )
 from sgtool.datasets.presets import PRESET_NAMES
 from sgtool.errors import SgtoolError
+from sgtool.files import output_folder
 
 
 @click.command("bench")
@@ -59,7 +61,11 @@ from sgtool.errors import SgtoolError
                    "on any executor and worker count), run.md, run.json (wall-clock figures "
                    "and the command), per_house.md, "
                    "per_house.jsonl, per_query.md, per_query.jsonl, efficiency_distance.png, "
-                   "efficiency_steps.png.")
+                   "efficiency_steps.png. Built beside OUT and moved in complete; a "
+                   "non-empty OUT is refused unless --force.")
+@click.option("--force", is_flag=True,
+              help="Write into a non-empty OUT: replaces what sgtool wrote there (an earlier "
+                   "bench's files), keeps other files.")
 @click.option("--rooms", default="12-16", show_default=True, metavar="MIN-MAX",
               help="Room count range of the generated houses (corridors included, 4..30); "
                    "the default gives about as many first-level objects per house as "
@@ -96,6 +102,7 @@ from sgtool.errors import SgtoolError
 @success_option()
 def command(planners: str | None, houses: int, house_files: tuple[str, ...],
             priors_dir: str | None, episodes: int, seeds: int, workers: int, out_dir: str,
+            force: bool,
             rooms: str, preset: str, house_seed: int, max_steps: int, distance_budget: float,
             step_budget: float, llm_replay: str | None, llm_transcript: str | None,
             planner_option: tuple[str, ...], log_dir: str | None,
@@ -111,7 +118,13 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...],
     (SCOUT Table IX; seen = a training query of the priors). Writes per-episode JSONL, the
     summary, per-house and per-query tables and the efficiency curves to OUT. The same
     command gives the same episodes.jsonl except its wall-clock fields."""
-    from sgtool.analysis.bench import DEFAULT_PLANNERS, BenchConfig, run_benchmark, write_outputs
+    from sgtool.analysis.bench import (
+        DEFAULT_PLANNERS,
+        OUTPUT_NAMES,
+        BenchConfig,
+        run_benchmark,
+        write_outputs,
+    )
 
     for flag, value in (("--distance-budget", distance_budget), ("--step-budget", step_budget)):
         if not math.isfinite(value):
@@ -132,12 +145,15 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...],
                       step_budget=step_budget, planner_options=options, log_dir=log_dir,
                       house_files=house_files, priors_dir=priors_dir, success=success,
                       executor=executor, ray_address=ray_address)
-    res = run_benchmark(cfg, progress=progress)
-    if res.failed:  # tables without some houses' episodes would pass for a result
-        raise SgtoolError(f"{len(res.failed)} task(s) failed after a retry, nothing written "
-                          f"to {out_dir}; the first: {res.failed[0]}")
     command_line = shlex.join(shown_command(["sgtool", *sys.argv[1:]]))
-    paths = write_outputs(res, out_dir, command=command_line)
+    # OUT is checked before any episode runs, and gets the outputs complete or not at all
+    with output_folder(out_dir, force=force, command="bench", known=OUTPUT_NAMES) as stage:
+        res = run_benchmark(cfg, progress=progress)
+        if res.failed:  # tables without some houses' episodes would pass for a result
+            raise SgtoolError(f"{len(res.failed)} task(s) failed after a retry, nothing "
+                              f"written to {out_dir}; the first: {res.failed[0]}")
+        written = [p.name for p in write_outputs(res, stage, command=command_line)]
+    paths = [Path(out_dir) / name for name in written]
     click.echo(res.table)
     click.echo(res.side_by_side)
     click.echo(res.seen_table)

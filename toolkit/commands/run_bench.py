@@ -23,6 +23,7 @@ from sgtool.commands.options import (
 )
 from sgtool.datasets.presets import PRESET_NAMES
 from sgtool.errors import SgtoolError
+from sgtool.files import output_folder
 
 
 @click.command("run-bench")
@@ -67,7 +68,11 @@ from sgtool.errors import SgtoolError
 @click.option("-o", "--out", "out_dir", default="run-bench", show_default=True,
               type=click.Path(file_okay=False),
               help="Output folder: logs/NOISE/PLANNER/HOUSE/ep-K.mcap, episodes.jsonl, "
-              "summary.md, efficiency curves.")
+              "summary.md, efficiency curves. A run-bench folder is resumed; another "
+              "non-empty folder is refused unless --force.")
+@click.option("--force", is_flag=True,
+              help="Start afresh: the run is built beside OUT and moved in complete, "
+              "replacing what sgtool wrote there (earlier logs included); other files stay.")
 @click.option("--report-only", is_flag=True,
               help="Run nothing: the tables of the episodes whose logs are there already.")
 @click.option("--progress/--no-progress", default=None,
@@ -79,7 +84,8 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...], hou
             frames: int | None, frames_per_room: int | None, resolution: str, every: int,
             navigation: str,
             planner_option: tuple[str, ...], out_dir: str, report_only: bool,
-            progress: bool | None, success: str = "observed", executor: str = "local",
+            progress: bool | None, force: bool = False, success: str = "observed",
+            executor: str = "local",
             workers: int = 1, ray_address: str | None = None,
             llm_base_url: str | None = None, llm_model: str | None = None,
             llm_api_key: str | None = None, llm_timeout: float | None = None) -> None:
@@ -90,7 +96,8 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...], hou
     episode by reason, and the efficiency curves.
 
     Resumable: an episode whose log exists is read back instead of run again (a log is
-    only there once complete). Ctrl-C stops the run and leaves only complete logs. With
+    only there once complete). Ctrl-C stops the run and leaves only complete logs (with
+    --force: OUT as it was). With
     `-w N` or `--executor ray` the episodes run in parallel (the same logs and tables).
 
     Example: `sgtool run-bench --planners random,scout --houses 2 --episodes 3
@@ -100,6 +107,7 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...], hou
 
     from sgtool.analysis.bench import DEFAULT_PLANNERS
     from sgtool.analysis.closed_loop_bench import (
+        OUTPUT_NAMES,
         ClosedLoopBenchConfig,
         run_closed_loop_bench,
         write_outputs,
@@ -113,6 +121,10 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...], hou
     width, height = parse_resolution(resolution)
     if Path(out_dir).exists() and not Path(out_dir).is_dir():
         raise SgtoolError(f"-o {out_dir}: not a folder")
+    if report_only and force:
+        raise SgtoolError("--report-only reads the run in OUT as it is; leave out --force")
+    if report_only and not Path(out_dir).is_dir():
+        raise SgtoolError(f"no episode log of this run in {Path(out_dir) / 'logs'}")
     opts = ClosedLoopOptions(camera=CameraConfig(width=width, height=height), every=every,
                              max_steps=max_steps, frames=frames, navigation=navigation,
                              success=success)
@@ -132,17 +144,22 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...], hou
         runner = as_map(make_executor(executor, workers, ray_address), progress=show,
                         desc="run-bench", task_id=lambda _, t: str(t.output))
         show = False  # the executor's bar counts the episodes
-    bar = tqdm(total=None, unit="episode", desc="run-bench", file=sys.stderr,
-               disable=not show, dynamic_ncols=True)
-    try:
-        res = run_closed_loop_bench(cfg, out_dir, progress=bar, report_only=report_only,
-                                    runner=runner)
-    except KeyboardInterrupt as e:  # the CLI prints the note; exit 130 (143: killed)
-        e.note = (f"the complete episode logs are kept in {out_dir}/logs "  # type: ignore[attr-defined]
-                  "(run the same command again to resume)")
-        raise
-    finally:
-        bar.close()
-    paths = write_outputs(res, out_dir)
+    # a run-bench folder (or a new one) is written in place, episode log by episode log, so
+    # that a run cut short resumes; --force builds a fresh run beside OUT
+    with output_folder(out_dir, force=force, command="run-bench", known=OUTPUT_NAMES,
+                       resume=True) as root:
+        bar = tqdm(total=None, unit="episode", desc="run-bench", file=sys.stderr,
+                   disable=not show, dynamic_ncols=True)
+        try:
+            res = run_closed_loop_bench(cfg, root, progress=bar, report_only=report_only,
+                                        runner=runner)
+        except KeyboardInterrupt as e:  # the CLI prints the note; exit 130 (143: killed)
+            e.note = (f"the complete episode logs are kept in {out_dir}/logs "  # type: ignore[attr-defined]
+                      "(run the same command again to resume)")
+            raise  # (with --force, output_folder says OUT is as it was instead)
+        finally:
+            bar.close()
+        written = [p.name for p in write_outputs(res, root)]
+    paths = [Path(out_dir) / name for name in written]
     click.echo(res.table())
     click.echo(f"wrote {', '.join(str(p) for p in paths)}")
