@@ -93,8 +93,9 @@ def parse_factor(text: str) -> tuple[str, tuple[float, ...]]:
             v = float(p)
         except ValueError:
             raise SgtoolError(f"--factor {text!r}: level {p!r} is not a number") from None
+        kw: dict[str, Any] = {name: v}
         try:
-            replace(PROFILES[NONE], **{name: v})  # the profile's own checks (>= 0, finite, <= 1)
+            replace(PROFILES[NONE], **kw)  # the profile's own checks (>= 0, finite, <= 1)
         except SgtoolError as e:
             raise SgtoolError(f"--factor {text!r}: level {p}: {e}") from None
         if v not in levels:

@@ -18,6 +18,7 @@ import math
 import statistics
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict
+from pathlib import Path
 from typing import Any
 
 from sgtool.analysis.noise_study import (
@@ -161,8 +162,12 @@ def summary_md(res: StudyResult) -> str:
     houses = [h.id for h in cfg.houses]
     out = ["# Perception-noise study", ""]
     frames = "until the scripted tour ends" if s.frames is None else f"at most {s.frames}"
-    out += [f"Houses: {', '.join(houses)} (generated ones with {cfg.rooms[0]}-{cfg.rooms[1]} "
-            f"rooms). Recording: {s.width}x{s.height}, {s.fps:g} fps, noise seed "
+    named = [h.id if h.spec is None else f"{h.id} (file {Path(h.source).name})"
+             for h in cfg.houses]
+    gen = (f"; generated with {cfg.rooms[0]}-{cfg.rooms[1]} rooms as `sgtool record --seed`"
+           if any(h.spec is None for h in cfg.houses) else "")
+    out += [f"Houses: {', '.join(named)}{gen}. Recording: {s.width}x{s.height}, "
+            f"{s.fps:g} fps, noise seed "
             f"{s.noise_seed}, frames {frames}. Replay with the log's options; scores of the "
             "final graph, merged (rooms joined by a doorless passage count as one).", "",
             "Medians over houses, [min, max] after them; 'rooms found/true': explored rooms "

@@ -1,0 +1,166 @@
+"""The perception-noise study (`sgtool study noise`): its cells are the scores `sgtool replay
+--score` gives for the log `sgtool record --noise` writes, the tables are byte-identical
+when the study runs again (from the cache, on two workers), and bad input is one line."""
+
+from __future__ import annotations
+
+import csv
+import json
+import re
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+from support.small_house import small_house
+
+from sgtool.analysis.noise_study import (
+    FACTORS,
+    NONE,
+    PROFILE,
+    RecordingSettings,
+    cache_key,
+    conditions_of,
+    parse_factor,
+)
+from sgtool.cli import cli
+from sgtool.errors import SgtoolError
+
+TINY = ("--resolution", "64x48", "--fps", "2")
+
+
+def _study(house: Path, cache: Path, out: Path, *extra: str):  # type: ignore[no-untyped-def]
+    return CliRunner().invoke(cli, [
+        "study", "noise", "--houses", "0", "--house", str(house), *TINY,
+        "--factor", "label_dropout=0.2,0.05", "--cache", str(cache), "-o", str(out),
+        "--no-progress", *extra])
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    root = tmp_path_factory.mktemp("study")
+    house = root / "small.json"
+    house.write_text(small_house().to_json())
+    r = _study(house, root / "cache", root / "first")
+    assert r.exit_code == 0, r.output
+    assert "3 log(s) recorded now" in r.output
+    return {"root": root, "house": house, "cache": root / "cache", "out": root / "first"}
+
+
+def test_cells_are_the_scores_of_record_then_replay_score(study: dict[str, Path]) -> None:
+    root = study["root"]
+    log = root / "direct.mcap"
+    rec = CliRunner().invoke(cli, ["record", "--house", str(study["house"]), *TINY,
+                                   "--noise", "none,label_dropout=0.2", "-o", str(log),
+                                   "--quiet"])
+    assert rec.exit_code == 0, rec.output
+    rep = CliRunner().invoke(cli, ["replay", str(log), "--score", "--json"])
+    assert rep.exit_code == 0, rep.output
+    direct = json.loads(rep.output)["score"]
+    doc = json.loads((study["out"] / "results.json").read_text())
+    cell = next(c for c in doc["cells"] if c["noise"] == "none,label_dropout=0.2")
+    assert cell["factor"] == "label_dropout" and cell["level"] == "0.2"
+    for variant in ("merged", "strict"):
+        want = dict(direct[variant])
+        want["room_error_vs_true"] = want["rooms"] - want["gt_rooms"]
+        assert cell[variant] == want
+    # the cache holds the very log `sgtool record` writes for that house and noise
+    cached = [p for p in (study["cache"] / "small").glob("*.mcap")
+              if json.loads(p.with_suffix(".json").read_text())["noise"]
+              == "none,label_dropout=0.2"]
+    assert len(cached) == 1 and cached[0].read_bytes() == log.read_bytes()
+
+
+def test_tables_list_every_condition_once(study: dict[str, Path]) -> None:
+    out = study["out"]
+    rows = list(csv.DictReader((out / "results.csv").open()))
+    assert [(r["house"], r["factor"], r["level"]) for r in rows] == [
+        ("small", "none", "0"), ("small", "label_dropout", "0.05"),
+        ("small", "label_dropout", "0.2")]
+    doc = json.loads((out / "results.json").read_text())
+    for r, c in zip(rows, doc["cells"], strict=True):
+        assert float(r["merged_purity"]) == c["merged"]["purity"]
+        assert int(r["merged_rooms"]) == c["merged"]["rooms"]
+    text = (out / "summary.md").read_text()
+    assert "## label_dropout (per object and frame)" in text
+    assert re.search(r"^\| label_dropout=0\.2 +\| 2/2 \d\.\d{3} \d+\.\d%", text, re.M)
+    assert "Houses: small (file " in text
+    assert (out / "plots" / "label_dropout.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_second_run_reuses_the_cache_and_writes_the_same_bytes(study: dict[str, Path]) -> None:
+    again = study["root"] / "again"
+    r = _study(study["house"], study["cache"], again, "-w", "2")
+    assert r.exit_code == 0, r.output
+    assert "0 log(s) recorded now" in r.output
+    for name in ("summary.md", "results.json", "results.csv"):
+        assert (again / name).read_bytes() == (study["out"] / name).read_bytes(), name
+
+
+def test_a_non_empty_output_folder_is_refused_without_force(study: dict[str, Path]) -> None:
+    r = _study(study["house"], study["cache"], study["out"])
+    assert r.exit_code == 2
+    assert r.output.count("\n") == 1 and "not empty" in r.output and "--force" in r.output
+
+
+@pytest.mark.parametrize(("args", "says"), [
+    (("--factor", "blur=0.1"), "unknown factor 'blur'"),
+    (("--factor", "holes=0.1,lots"), "level 'lots' is not a number"),
+    (("--factor", "holes=-0.1"), "must be >= 0"),
+    (("--factor", "label_swap=2"), "a probability, at most 1"),
+    (("--factor", "holes"), "give NAME=L1,L2"),
+    (("--profile", "awful"), "unknown profile"),
+])
+def test_bad_input_is_one_line(tmp_path: Path, args: tuple[str, ...], says: str) -> None:
+    r = CliRunner().invoke(cli, ["study", "noise", "--houses", "1", *args,
+                                 "--cache", str(tmp_path / "c"), "-o", str(tmp_path / "o")])
+    assert r.exit_code == 2, r.output
+    assert r.output.count("\n") == 1 and says in r.output, r.output
+    assert not (tmp_path / "o").exists() and not (tmp_path / "c").exists()
+
+
+def test_factor_levels_and_conditions() -> None:
+    assert parse_factor("holes=0.05, 1e-2,0.05") == ("holes", (0.05, 0.01))
+    conds = conditions_of({"holes": (0.05, 0.0, 0.01), "depth_sigma": (0.001,)},
+                          ("strong", "none"))
+    assert [(c.factor, c.level, c.noise) for c in conds] == [
+        (NONE, "0", "none"),
+        ("depth_sigma", "0.001", "none,depth_sigma=0.001"),
+        ("holes", "0.01", "none,holes=0.01"), ("holes", "0.05", "none,holes=0.05"),
+        (PROFILE, "strong", "strong")]
+    assert set(FACTORS) == {"depth_sigma", "holes", "label_swap", "label_dropout",
+                            "drift_xy", "drift_yaw"}
+    with pytest.raises(SgtoolError, match="unknown factor"):
+        parse_factor("name=1")
+
+
+def test_cache_key_changes_with_every_recording_input() -> None:
+    house = {"generated": 3, "rooms": [8, 8]}
+    base = cache_key(house, "none", RecordingSettings())
+    assert base == cache_key(dict(house), "none", RecordingSettings())
+    others = {cache_key({"generated": 4, "rooms": [8, 8]}, "none", RecordingSettings()),
+              cache_key(house, "mild", RecordingSettings()),
+              cache_key(house, "none", RecordingSettings(width=320, height=240)),
+              cache_key(house, "none", RecordingSettings(fps=10.0)),
+              cache_key(house, "none", RecordingSettings(frames=50)),
+              cache_key(house, "none", RecordingSettings(noise_seed=1))}
+    assert base not in others and len(others) == 6
+
+
+def test_closed_loop_rows_are_the_run_bench_episodes(study: dict[str, Path]) -> None:
+    out = study["root"] / "closed"
+    r = _study(study["house"], study["cache"], out, "--closed-loop", "scout",
+               "--closed-loop-noise", "none,holes=0.05", "--episodes", "1",
+               "--frames-per-room", "30")
+    assert r.exit_code == 0, r.output
+    runs = [json.loads(line) for line in (out / "closed_loop" / "episodes.jsonl").open()]
+    assert len(runs) == 2  # one episode, two profiles
+    doc = json.loads((out / "results.json").read_text())
+    rows = doc["closed_loop"]
+    assert [(x["noise"], x["planner"], x["episode"]) for x in rows] == [
+        ("none", "scout", 0), ("holes=0.05", "scout", 0)]
+    assert [x["success"] for x in rows] == [e["success"] for e in runs]
+    assert [x["query"] for x in rows] == [e["query"] for e in runs]
+    text = (out / "summary.md").read_text()
+    sr = [f"{float(x['success']):.3f}" for x in rows]
+    assert re.search(rf"^\| scout +\| none +\| 1 +\| {sr[0]} ", text, re.M)
+    assert re.search(rf"^\| scout +\| holes=0\.05 +\| 1 +\| {sr[1]} ", text, re.M)
