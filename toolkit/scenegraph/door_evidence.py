@@ -4,7 +4,8 @@ and each seen door's rooms.
 - :func:`door_cells_of`: from the voxels of the open (or state-unknown) doors
   (:func:`open_doors`), the *passable* columns of each door -- its
   opening under the lintel, not the swung panel, whose cells would cut the room it stands
-  in -- else the panel's closed position
+  in (when they are at least ``PASSABLE_SHARE`` of its columns: a panel smeared by depth
+  noise or drift reaches a few passable columns) -- else the panel's closed position
   (:func:`~sgtool.scenegraph.room_segmentation.opening_from_panel`), else all its columns.
 - :func:`observe_doors`: the rooms on either side of a door from the visible Voronoi nodes
   within ``door_radius``; a closed door with only one explored side leads to an unexplored
@@ -27,6 +28,8 @@ from sgtool.scenegraph.object_placement import SeenInstance
 from sgtool.scenegraph.room_segmentation import RoomTracker, opening_from_panel
 from sgtool.vocabulary import OpenState
 
+PASSABLE_SHARE = 0.25  # passable share of a door's columns that makes them its opening
+
 
 @dataclass(frozen=True, eq=False)
 class DoorObservation:
@@ -48,8 +51,8 @@ def door_cells_of(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
     """Bool grid of the door evidence (module doc) from the voxels (ijk) of each open door,
     in any order (e.g. from :class:`sgtool.scenegraph.door_voxels.DoorVoxels`);
     ``panel_memo`` caches the openings found from swung panels across calls. The cells of
-    every door are looked up at once; only a door with no passable cell (a swung panel) is
-    looked at on its own."""
+    every door are looked up at once; only a door with too few passable cells (a swung
+    panel) is looked at on its own."""
     cells = np.zeros(occ.shape, dtype=bool)
     parts = [ijk for _, ijk in sorted(door_voxels.items()) if len(ijk)]
     if not parts:
@@ -62,11 +65,17 @@ def door_cells_of(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
     ok = occ.inside(r, c)
     r, c, door = r[ok], c[ok], door[ok]
     passable = occ.grid[r, c] != OCCUPIED
-    open_door = np.zeros(len(parts), dtype=bool)
-    open_door[door[passable]] = True
-    cells[r[passable], c[passable]] = True  # the passable cells of a door with any
+    # a door's opening is its passable columns when they are a fair share of its columns
+    # (a lintel over the opening); a few passable columns of a smeared panel are not
+    cell_id = door * occ.grid.size + r * occ.shape[1] + c
+    first = np.unique(cell_id, return_index=True)[1]
+    n_cells = np.bincount(door[first], minlength=len(parts))
+    n_pass = np.bincount(door[first][passable[first]], minlength=len(parts))
+    open_door = n_pass >= np.maximum(PASSABLE_SHARE * n_cells, 1)
+    use = passable & open_door[door]
+    cells[r[use], c[use]] = True  # the passable cells of a door with an opening
     occupied: np.ndarray | None = None
-    for i in np.flatnonzero(~open_door).tolist():  # doors seen as their panel only
+    for i in np.flatnonzero(~open_door).tolist():  # doors seen as their panel (mostly)
         mine = door == i
         if not mine.any():
             continue

@@ -11,7 +11,7 @@ from sgtool.mapping.bev import line_of_sight
 from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph
 from sgtool.scenegraph import room_segmentation
-from sgtool.scenegraph.door_evidence import _visible_labelled, door_cells_of
+from sgtool.scenegraph.door_evidence import PASSABLE_SHARE, _visible_labelled, door_cells_of
 from sgtool.scenegraph.room_segmentation import _overlaps, _shares, opening_from_panel
 
 
@@ -74,7 +74,7 @@ def test_panel_openings_equal_the_ray_by_ray_search(seed, monkeypatch):
 
 
 def _door_cells_one_by_one(occ, door_voxels, panel_memo):  # noqa: ANN001, ANN202
-    """``door_cells_of`` as it was: one door at a time."""
+    """``door_cells_of`` one door at a time."""
     cells = np.zeros(occ.shape, dtype=bool)
     ix0 = int(round(occ.origin[0] / occ.resolution))
     iy0 = int(round(occ.origin[1] / occ.resolution))
@@ -86,7 +86,9 @@ def _door_cells_one_by_one(occ, door_voxels, panel_memo):  # noqa: ANN001, ANN20
         ok = occ.inside(r, c)
         r, c = r[ok], c[ok]
         passable = occ.grid[r, c] != OCCUPIED
-        if passable.any():
+        n_cells = len(set(zip(r.tolist(), c.tolist(), strict=True)))
+        n_pass = len(set(zip(r[passable].tolist(), c[passable].tolist(), strict=True)))
+        if n_pass and n_pass >= PASSABLE_SHARE * n_cells:
             r, c = r[passable], c[passable]
         else:
             cell = np.unique(r * (occ.shape[1] + 1) + c)
@@ -196,3 +198,28 @@ def test_room_overlaps_in_one_query_equal_a_query_per_room(seed):
     got = sorted(_overlaps(known, new, radius))
     assert got == _overlaps_one_room_at_a_time(known, new, radius)
     assert all(isinstance(x, int) for t in got for x in t)
+
+
+def test_a_few_passable_columns_of_a_smeared_panel_do_not_make_its_opening():
+    """A swung panel whose noisy voxels reach 2 free columns (of 17) is still a panel: its
+    cells are those of the panel alone, not those 2 cells (an opening of 2 cells barely
+    cuts the rooms apart)."""
+    g = np.full((60, 60), FREE, dtype=np.int8)
+    g[20, :10] = OCCUPIED
+    g[20, 26:] = OCCUPIED  # the wall, a 16-cell gap at columns 10-25
+    rows = 20 + np.arange(1, 16)
+    g[rows, 10] = OCCUPIED  # the panel swung from the jamb at column 10
+    panel = np.stack([np.full(15, 10), rows, np.zeros(15, np.int64)], axis=1)
+    stray = np.array([[12, 30, 0], [13, 30, 0]])
+    occ = OccupancyGrid(g, (0.0, 0.0), 0.05)
+    alone = door_cells_of(occ, {1: panel.astype(np.int64)}, {})
+    assert alone.sum() >= 15  # the panel's doorway, else its cells
+    cells = door_cells_of(occ, {1: np.concatenate([panel, stray]).astype(np.int64)}, {})
+    assert np.array_equal(cells, alone) and not cells[30, 12:14].any()
+    # a fair share of passable columns (a lintel over the opening) is the opening
+    lintel = np.stack([np.arange(10, 26), np.full(16, 20), np.full(16, 44)], axis=1)
+    g2 = g.copy()
+    g2[20, 10:26] = FREE
+    opened = door_cells_of(OccupancyGrid(g2, (0.0, 0.0), 0.05),
+                           {1: np.concatenate([panel, lintel]).astype(np.int64)}, {})
+    assert opened[20, 10:26].all() and opened.sum() == 16
