@@ -41,7 +41,14 @@ from sgtool.results import EpisodeResult
 # per-episode quantities
 # ----------------------------------------------------------------------------------------
 def episode_spl(success: bool, shortest: float | None, travelled: float) -> float:
-    """S * l / max(l, p); NaN when l is unknown (the episode is left out of SPL)."""
+    """S * l / max(l, p); NaN when l is unknown (None or NaN: the episode is left out of
+    SPL). A ``travelled`` p that is no finite number >= 0, or a negative ``shortest`` l,
+    raises ValueError: such figures would score SPL 1 (``sgtool eval`` refuses them first,
+    :mod:`sgtool.analysis.validity`)."""
+    if not (math.isfinite(travelled) and travelled >= 0.0):
+        raise ValueError(f"SPL: travelled {travelled} m is not a finite number >= 0")
+    if shortest is not None and shortest < 0.0:
+        raise ValueError(f"SPL: shortest path {shortest} m is negative")
     if not success:
         return 0.0
     if shortest is None or not math.isfinite(shortest):

@@ -67,11 +67,14 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
     action, and it is then told what was really done.
 
     Only search episodes are scored: logs of recordings and imports are skipped with a note.
-    An episode whose figures cannot be true (negative steps or counts, a negative or
-    non-finite travelled_m or shortest_m) is refused: it is left out of every metric and a
-    one-line note on stderr names the file, the episode and the field (the JSON output
-    lists the notes too). A shortest_m of 0 is accepted: the target is seen from the
-    start."""
+    An episode whose figures cannot be true, or contradict each other, is refused: it is
+    left out of every metric and a one-line note on stderr names the file, the episode and
+    the contradiction (the JSON output lists the notes too). Refused: negative steps or
+    counts; a negative or non-finite travelled_m or shortest_m; travel without a step
+    (steps 0, travelled_m > 0); more opens than steps; a success that travelled less than
+    its shortest path by more than 5.5 m + 10% of it (the path ends 1 m from the target, a
+    camera sees it from up to 6 m: a success with 0 m travelled towards a target 9.48 m
+    away is refused). A shortest_m of 0 is accepted: the target is seen from the start."""
     from sgtool.analysis.batch_eval import load_many
     from sgtool.analysis.batch_inputs import expand_inputs
     from sgtool.analysis.executor import make_executor
