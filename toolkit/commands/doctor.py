@@ -28,6 +28,12 @@ def _report(d: Diagnosis) -> str:
     if d.salvaged_messages:
         lines.append(f"  of which {d.salvaged_messages} were decoded from cut or damaged "
                      "chunks, up to the cut or the damage (no CRC covers them)")
+    if d.unverified_messages:
+        lines.append(f"  of which {d.unverified_messages} no CRC covers: each was decoded and "
+                     "checked against its schema (where sgtool can decode its encoding)")
+    if d.dropped_messages:
+        lines.append(f"dropped: {d.dropped_messages} messages that no CRC covers and that fail "
+                     "their check (not readable, not copied)")
     checks = ", ".join(f"{k} {v}" for k, v in d.checks.items())
     if checks:
         lines.append(f"CRCs: {checks}")
@@ -53,6 +59,18 @@ def _report(d: Diagnosis) -> str:
     return "\n".join(lines)
 
 
+def _recovered(d: Diagnosis, out: str) -> str:
+    """The copy's verdict: what it holds, what of it no CRC vouched for, what was dropped."""
+    line = f"recovered {d.readable_messages} messages into {out}"
+    if d.unverified_messages:
+        line += (f"; {d.unverified_messages} of them copied unverified (no CRC covered them; "
+                 "the copy's chunks holding them carry no CRC either, so `sgtool doctor` "
+                 "calls the copy unverified)")
+    if d.dropped_messages:
+        line += f"; {d.dropped_messages} dropped (they fail their check)"
+    return line
+
+
 @click.command("doctor")
 @click.argument("log", type=click.Path(dir_okay=False))
 @click.option(
@@ -71,7 +89,10 @@ def command(log: str, out: str | None, force: bool, as_json: bool) -> None:
     summary copies agree with the records. With --recover OUT, copy what is readable into
     a new log: damaged records are skipped up to the next valid one, channels whose
     definition is damaged are read with their summary copy, and the readable prefix of a
-    cut or damaged compressed chunk is decoded.
+    cut or damaged compressed chunk is decoded. A message that no CRC covers (its chunk
+    has none, or is damaged) is decoded and checked against its schema first: one that
+    fails is dropped and counted; the others are copied into chunks written without a CRC,
+    so the copy is "unverified", never "complete", when it holds them.
 
     A file whose writer wrote no CRCs over its messages (many ROS 2 recordings) is at best
     "unverified": nothing is found wrong, but damage inside a message cannot be seen.
@@ -90,7 +111,7 @@ def command(log: str, out: str | None, force: bool, as_json: bool) -> None:
     else:
         click.echo(_report(d))
         if out:
-            click.echo(f"recovered {d.readable_messages} messages into {out}")
+            click.echo(_recovered(d, out))
         elif d.status == "unverified":
             click.echo("unverified: every record reads and every index agrees, but the "
                        "writer wrote no CRCs over (some of) the messages, so damage inside "

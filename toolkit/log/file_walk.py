@@ -104,8 +104,14 @@ class Layout:
 
 @dataclass(frozen=True)
 class Item:
+    """A record read by :func:`walk`; ``covered``: a message whose bytes a CRC vouches
+    for, that of its chunk or, outside chunks, the data section's
+    (:func:`data_section_verified`); False for the messages of a damaged chunk or of a
+    chunk written without a CRC."""
+
     record: Any  # Schema | Channel | Message | Attachment | Metadata
     source: Source
+    covered: bool = False
 
 
 def walk(buf: FileBytes, lay: Layout) -> Iterator[Item]:
@@ -118,6 +124,7 @@ def walk(buf: FileBytes, lay: Layout) -> Iterator[Item]:
         if 8 <= f.summary_start <= end and f.summary_crc and f.summary_crc == zlib.crc32(
                 bytes(buf[f.summary_start:end + 9 + 16])):
             lay.trusted_summary_start = int(f.summary_start)
+    loose_covered = data_section_verified(buf, lay.footer)
     pos = 8
     while pos < end:
         if pos == size - 8 and bytes(buf[pos:size]) == MAGIC:
@@ -136,7 +143,7 @@ def walk(buf: FileBytes, lay: Layout) -> Iterator[Item]:
         if raw.opcode == Opcode.CHUNK:
             yield from _chunk(raw.offset, raw.length, raw.record, lay)
         else:
-            yield from _top(raw, lay)
+            yield from _top(raw, lay, loose_covered)
         pos = raw.end
         lay.last_good_offset = pos
     if lay.footer is not None and pos == end:
@@ -193,7 +200,22 @@ def _after_damage(buf: FileBytes, pos: int, end: int, lay: Layout, why: str
     return found
 
 
-def _top(raw: Raw, lay: Layout) -> Iterator[Item]:
+def data_section_verified(buf: FileBytes, footer: tuple[int, Footer] | None) -> bool:
+    """The data end record (right before the summary section, or before the footer when
+    there is none) holds a data-section CRC, and the bytes before it match it: every
+    record of the data section, messages outside chunks included, is as written."""
+    if footer is None:
+        return False
+    foff, f = footer
+    pos = (int(f.summary_start) if f.summary_start else foff) - 13  # opcode, length, crc
+    if pos < 8 or pos + 13 > foff or buf[pos] != Opcode.DATA_END or int.from_bytes(
+            bytes(buf[pos + 1:pos + 9]), "little") != 4:
+        return False
+    crc = int.from_bytes(bytes(buf[pos + 9:pos + 13]), "little")
+    return crc != 0 and zlib.crc32(memoryview(buf)[:pos]) == crc
+
+
+def _top(raw: Raw, lay: Layout, loose_covered: bool = False) -> Iterator[Item]:
     lay.top.append(raw)
     op, rec = raw.opcode, raw.record
     if op == Opcode.HEADER:
@@ -213,7 +235,7 @@ def _top(raw: Raw, lay: Layout) -> Iterator[Item]:
             lay.damaged(f"a message record in the summary section at byte {raw.offset}")
         else:
             lay.loose.append((int(rec.channel_id), int(rec.log_time), raw.offset))
-            yield Item(rec, "data")
+            yield Item(rec, "data", covered=loose_covered)
     elif op in (Opcode.SCHEMA, Opcode.CHANNEL, Opcode.ATTACHMENT, Opcode.METADATA):
         summary = lay.in_summary(raw.offset)
         if not summary and op in (Opcode.SCHEMA, Opcode.CHANNEL):
@@ -255,7 +277,8 @@ def _chunk(offset: int, length: int, chunk: Chunk, lay: Layout, cut: bool = Fals
         rec = r.record
         if isinstance(rec, Message):
             facts.messages.append((int(rec.channel_id), int(rec.log_time), r.offset))
-            yield Item(rec, "salvaged" if facts.salvaged else "data")
+            yield Item(rec, "salvaged" if facts.salvaged else "data",
+                       covered=not facts.salvaged and bool(chunk.uncompressed_crc))
         else:
             lay.define(rec)
             yield Item(rec, "data")

@@ -37,9 +37,11 @@ from sgtool.log.file_check import SummaryState, check, expected_messages, summar
 from sgtool.log.file_walk import Item, Layout, walk
 from sgtool.log.log_file import require_regular_file
 from sgtool.log.mcap_records import MAGIC
+from sgtool.log.message_check import message_problem
 
 Status = Literal["complete", "unverified", "truncated", "corrupt"]
 _OUTSIDE_CHUNKS = -1  # the key of messages outside chunks among the per-chunk counts
+_CRC_FLAG = "_Writer__enable_crcs"  # the mcap writer's private switch of chunk CRCs
 
 
 @dataclass
@@ -56,6 +58,10 @@ class Diagnosis:
     first_time_ns: int | None = None
     last_time_ns: int | None = None
     salvaged_messages: int = 0  # read from damaged chunks: not covered by a CRC
+    # readable messages no CRC covers (damaged chunks, chunks without a CRC, outside
+    # chunks without a data-section CRC): each decoded and checked (message_check) first
+    unverified_messages: int = 0
+    dropped_messages: int = 0  # no CRC covers them and they fail their check: not copied
     lost_messages: int = 0  # that the indexes or statistics know of
     lost_unknown: bool = False  # some damaged or cut data had no index: more may be lost
     lost: dict[str, dict[str, int | None]] = field(default_factory=dict)  # per topic
@@ -184,9 +190,19 @@ def _consume(items: Iterator[Item], diag: Diagnosis, writer: _Copier | None) -> 
     orphans: list[Item] = []
     seen_channels: set[int] = set()
 
+    dropped: Counter[str] = Counter()
+    first_drop: dict[str, str] = {}
+
     def take(it: Item, ch: Channel) -> None:
         r = it.record
         schema = schemas.get(ch.schema_id) or spare_schemas.get(ch.schema_id)
+        if not it.covered:
+            problem = message_problem(schema, ch, r.data)
+            if problem is not None:
+                dropped[ch.topic] += 1
+                first_drop.setdefault(ch.topic, f"at {int(r.log_time)} ns: {problem}")
+                return
+            diag.unverified_messages += 1
         seen_channels.add(ch.id)
         diag.readable_messages += 1
         diag.salvaged_messages += it.source == "salvaged"
@@ -194,7 +210,7 @@ def _consume(items: Iterator[Item], diag: Diagnosis, writer: _Copier | None) -> 
         diag.first_time_ns = t if diag.first_time_ns is None else min(diag.first_time_ns, t)
         diag.last_time_ns = t if diag.last_time_ns is None else max(diag.last_time_ns, t)
         if writer is not None:
-            writer.message(schema, ch, r)
+            writer.message(schema, ch, r, it.covered)
 
     for it in items:
         r = it.record
@@ -230,6 +246,10 @@ def _consume(items: Iterator[Item], diag: Diagnosis, writer: _Copier | None) -> 
                              "of its definition (the data section's is damaged)")
     for cid, n in sorted(unknown.items()):
         diag.problems.append(f"{n} messages of channel {cid}, defined nowhere, skipped")
+    for topic, n in sorted(dropped.items()):
+        diag.problems.append(f"{n} messages of {topic[:80]} that no CRC covers dropped: they "
+                             f"fail their check (the first {first_drop[topic]})")
+    diag.dropped_messages = sum(dropped.values())
     if writer is not None:  # channels without messages are kept too
         for _, ch in sorted({**spare_channels, **channels}.items()):
             writer.channel(schemas.get(ch.schema_id) or spare_schemas.get(ch.schema_id), ch)
@@ -239,7 +259,13 @@ def _consume(items: Iterator[Item], diag: Diagnosis, writer: _Copier | None) -> 
 
 class _Copier:
     """Re-writes records into a fresh, indexed MCAP file with the input's header (read
-    by the walk before any record is copied), renumbering nothing."""
+    by the walk before any record is copied), renumbering nothing.
+
+    A message that no CRC covered in the input goes into a chunk written without a CRC
+    (the chunk in progress is closed when that changes): the copy's CRCs vouch only for
+    what the input's did, so ``sgtool doctor`` calls a copy holding such messages
+    "unverified", never "complete". The ``mcap`` writer has no per-chunk switch: this
+    sets its private flag (checked to be there)."""
 
     def __init__(self, out: IO[bytes]) -> None:
         self.out = out
@@ -247,12 +273,16 @@ class _Copier:
         self._w: Writer | None = None
         self.schema_ids: dict[int, int] = {}
         self.channel_ids: dict[int, int] = {}
+        self._crcs = True  # the chunk in progress gets a CRC
 
     @property
     def w(self) -> Writer:
         if self._w is None:
             h = self.layout.header if self.layout is not None else None
             self._w = Writer(self.out, compression=CompressionType.ZSTD)
+            if not isinstance(getattr(self._w, _CRC_FLAG, None), bool):
+                raise SgtoolError("this version of the mcap package cannot write chunks "
+                                  "without a CRC; recovery needs it")
             self._w.start(profile=h.profile if h else "",
                           library=h.library if h else "sgtool doctor")
         return self._w
@@ -270,11 +300,25 @@ class _Copier:
                 ch.topic, ch.message_encoding, sid, dict(ch.metadata)
             )
 
-    def message(self, schema: Schema | None, ch: Channel, m: Message) -> None:
+    def message(self, schema: Schema | None, ch: Channel, m: Message, covered: bool) -> None:
+        """Copy ``m``; ``covered``: a CRC covered it in the input (class doc)."""
         self.channel(schema, ch)
+        if covered != self._crcs:
+            self._crc_chunks(covered)
         self.w.add_message(
             self.channel_ids[ch.id], m.log_time, m.data, m.publish_time, m.sequence
         )
+
+    def _crc_chunks(self, on: bool) -> None:
+        self.w.flush()  # the chunk in progress keeps its setting
+        setattr(self.w, _CRC_FLAG, on)
+        self._crcs = on
+
+    def finish(self) -> None:
+        """Close the last chunk and write the summary (with its CRC)."""
+        if not self._crcs:
+            self._crc_chunks(True)
+        self.w.finish()
 
     def attachment(self, a: Attachment) -> None:
         self.w.add_attachment(a.create_time, a.log_time, a.name, a.media_type, a.data)
@@ -308,5 +352,5 @@ def recover(path: str | os.PathLike[str], out: str | os.PathLike[str],
     with open(src, "rb") as f, _mapped(f, diag.size) as buf, atomic_open(dst, "wb") as o:
         copier = _Copier(o)
         _diagnose(buf, diag, copier)
-        copier.w.finish()
+        copier.finish()
     return diag

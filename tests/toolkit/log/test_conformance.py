@@ -149,7 +149,8 @@ def check_case(json_path: Path, work: Path) -> dict[str, int]:
     rd = recover(path, out)
     assert rd.status == d.status and rd.readable_messages == n_messages, case.name
     assert _recovered(out) == want, case.name
-    assert scan(out).status == "complete", case.name
+    # the copy vouches for what the input vouched for: its unverified messages stay so
+    assert scan(out).status == d.status, case.name
     return {"written": n_messages, "recovered": rd.readable_messages}
 
 
