@@ -279,7 +279,7 @@ def _check_task(t: _CheckTask) -> LogCheck:
     lines = describe_mismatch(expected, actual, tol=t.tolerance, exact=exact, layers=layers)
     decision = first_decision_change(pin.decisions, cap.decisions, cap.planner or pin.planner)
     quality = (pin.quality, cap.quality)
-    q_changed = bool(quality_lines(*quality)) and (exact or bool(lines))
+    q_changed = bool(quality_lines(*quality, changed_only=True)) and (exact or bool(lines))
     changed = bool(lines) or decision is not None or q_changed
     first = lines[0].removesuffix(" differs:") if lines else None
     differing = sum(e != g for e, g in zip(expected, cap.graphs, strict=False)) + \

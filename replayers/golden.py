@@ -223,10 +223,10 @@ ROUNDING = "the canonical JSON differs below the tolerance (rounding)"
 
 
 def _members(g: SceneGraph) -> dict[str, str]:
-    """Object and (non-frontier) region id -> the room it lies in: what tells a merge or a
+    """Object, region and frontier id -> the room it lies in: what tells a merge or a
     split of rooms from a room that is simply gone or new."""
     out = {o.id: o.room for o in g.objects}
-    out.update({r.id: r.room for r in g.regions if r.kind != "frontier"})
+    out.update({r.id: r.room for r in g.regions})
     return out
 
 
@@ -362,16 +362,21 @@ QUALITY_FIGURES = (("purity", "purity", ".3f"), ("ari", "ARI", ".3f"), ("rooms",
                    ("object_accuracy", "objects in the right room", ".1%"))
 
 
-def quality_lines(before: dict[str, Any] | None, after: dict[str, Any] | None) -> list[str]:
-    """``quality (merged): purity 0.950 -> 0.910, ...``: the figures that differ."""
+def quality_lines(before: dict[str, Any] | None, after: dict[str, Any] | None,
+                  changed_only: bool = False) -> list[str]:
+    """``quality (merged): purity 0.950 -> 0.910, ARI 0.900 (same), ...``: the figures
+    before and after as printed (purity and ARI to 3 decimals, rooms, objects in the right
+    room to 0.1%), per variant; ``changed_only``: only variants with a figure that differs
+    as printed. Empty unless both are given."""
     if before is None or after is None:
         return []
     out = []
     for variant in sorted(before.keys() & after.keys()):
         b, a = before[variant], after[variant]
-        parts = [f"{label} {format(b[k], spec)} -> {format(a[k], spec)}"
-                 for k, label, spec in QUALITY_FIGURES
-                 if k in b and k in a and b[k] != a[k]]
-        if parts:
-            out.append(f"quality ({variant}): " + ", ".join(parts))
+        pairs = [(label, format(b[k], spec), format(a[k], spec))
+                 for k, label, spec in QUALITY_FIGURES if k in b and k in a]
+        if changed_only and all(x == y for _, x, y in pairs):
+            continue
+        out.append(f"quality ({variant}): " + ", ".join(
+            f"{label} {x} -> {y}" if x != y else f"{label} {x} (same)" for label, x, y in pairs))
     return out

@@ -6,7 +6,7 @@ is: its graphs in log-time order, the room areas and Voronoi graph size from its
 (:func:`~sgtool.replayers.golden_layers.summary_of_messages`), the frames of a refresh
 counted from its depth images. Any other log is replayed with the options given
 (:func:`~sgtool.replayers.golden_pins.capture`, which also scores it when it carries its
-house). The report is :func:`~sgtool.replayers.golden.describe_mismatch` of the two
+house; with ``max_frames``, its actions up to the last refresh count). The report is :func:`~sgtool.replayers.golden.describe_mismatch` of the two
 sequences (the first refresh that differs), the quality figures of both when both have
 them, and the first logged action (skill and target) that differs.
 """
@@ -51,9 +51,6 @@ def log_graphs(path: str | os.PathLike[str], options: ReplayOptions | None = Non
     with LogReader(p) as r:
         actions = [(a.skill, given(a.target)) for _, a in r.records(Action)]
         logged = r.has(S.RECORDS["scene_graph"].topic)
-        if logged and options is not None and any(v is not None for v in vars(options).values()):
-            raise SgtoolError(f"{p} holds scene graphs already (a derived log); replay options "
-                              "apply to logs that are replayed")
         if logged:
             frames = [d.log_time_ns for d in r.messages([S.DEPTH])] if r.has(S.DEPTH) else []
             graphs: list[str] = []
@@ -68,7 +65,12 @@ def log_graphs(path: str | os.PathLike[str], options: ReplayOptions | None = Non
                 layers = summary_of_messages(maps[S.VORONOI].get(t), maps[S.ROOMS].get(t))
                 metas.append(RefreshMeta(t, bisect.bisect_right(frames, t), "logged", layers))
             return LogGraphs(str(p), "logged", graphs, metas, None, actions)
-    cap = capture(p, options or ReplayOptions())
+    opts = options or ReplayOptions()
+    cap = capture(p, opts)
+    if opts.max_frames is not None and cap.refreshes:  # the actions the replay got to
+        with LogReader(p) as r:
+            end = cap.refreshes[-1].time_ns
+            actions = [(a.skill, given(a.target)) for t, a in r.records(Action) if t <= end]
     return LogGraphs(str(p), "replayed", cap.graphs, cap.refreshes, cap.quality, actions)
 
 
@@ -83,9 +85,11 @@ class LogDiff:
     quality: list[str]
     action: str | None
 
+    quality_changed: bool = False
+
     @property
     def same(self) -> bool:
-        return not self.lines and not self.quality and self.action is None
+        return not self.lines and self.action is None and not self.quality_changed
 
     def report(self) -> list[str]:
         head = (f"{self.a.path} ({self.a.source}, {len(self.a.graphs)} refreshes) vs "
@@ -126,4 +130,5 @@ def diff_logs(a: str | os.PathLike[str], b: str | os.PathLike[str],
     lines = describe_mismatch(ga.graphs, list(zip(gb.refreshes, gb.graphs, strict=True)),
                               tol=tolerance, exact=tolerance <= 0, layers=layers)
     return LogDiff(ga, gb, lines, quality_lines(ga.quality, gb.quality),
-                   first_action_change(ga.actions, gb.actions))
+                   first_action_change(ga.actions, gb.actions),
+                   bool(quality_lines(ga.quality, gb.quality, changed_only=True)))

@@ -1,0 +1,142 @@
+"""The pytest plug-in of golden logs (entry point ``pytest11``: loaded by any pytest run in
+an environment where sgtool is installed; it does nothing unless asked).
+
+- ``pytest --sgtool-golden DIR`` (repeatable) adds one test case per log pinned in ``DIR``
+  (by ``sgtool golden pin``), named ``DIR::NAME``: it replays the log with the current code
+  and fails with the layer-by-layer report when anything changed, or with the one-line
+  error when the log cannot be checked. ``--sgtool-golden-tolerance X`` lets differences up
+  to X pass (as ``sgtool golden check --tolerance``); ``--sgtool-golden-update`` re-pins
+  changed logs instead of failing.
+- The fixture ``sgtool_golden`` checks logs from a lab's own tests, snapshot style:
+  ``sgtool_golden.check(log, folder, **replay_options)`` pins the log into ``folder`` on
+  first use (the test then fails once, saying so: commit the pin), and afterwards fails
+  with the report when its replay changed (re-pins under ``--sgtool-golden-update``).
+
+The module imports only pytest and the standard library at load time: sgtool's replay
+code is imported when a golden test runs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    group = parser.getgroup("sgtool-golden", "sgtool golden logs")
+    group.addoption("--sgtool-golden", action="append", default=[], metavar="DIR",
+                    help="Add one test per log pinned in DIR (`sgtool golden pin`); "
+                    "repeatable.")
+    group.addoption("--sgtool-golden-tolerance", type=float, default=0.0, metavar="X",
+                    help="Golden logs: let differences up to X pass (m, m², scores).")
+    group.addoption("--sgtool-golden-update", action="store_true",
+                    help="Golden logs: re-pin changed logs instead of failing.")
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line("markers", "sgtool_golden: a golden-log check (sgtool)")
+    folders = [str(Path(d)) for d in config.getoption("sgtool_golden", default=[]) or []]
+    for d in folders:  # collect each pin folder's index even outside the test paths
+        index = str(Path(d) / "expected.json")
+        if index not in config.args:
+            config.args.append(index)
+
+
+def pytest_collect_file(file_path: Path, parent: pytest.Collector) -> pytest.Collector | None:
+    if file_path.name != "expected.json":
+        return None
+    wanted = {Path(d).resolve() for d in parent.config.getoption("sgtool_golden") or []}
+    if file_path.parent.resolve() not in wanted:
+        return None
+    return GoldenFolder.from_parent(parent, path=file_path)
+
+
+class GoldenFolder(pytest.File):
+    """A pin folder's index: one :class:`GoldenLog` per pinned log."""
+
+    def collect(self) -> Iterator[pytest.Item]:
+        from sgtool.errors import SgtoolError
+        from sgtool.replayers.golden_pins import read_pins
+
+        try:
+            pins = read_pins(self.path.parent)
+        except SgtoolError as e:
+            raise self.CollectError(str(e)) from None
+        for name in sorted(pins.logs):
+            item = GoldenLog.from_parent(self, name=name)
+            item.add_marker("sgtool_golden")
+            yield item
+
+
+class GoldenFailure(Exception):
+    """A changed or unusable golden log: the report is the failure message."""
+
+
+class GoldenLog(pytest.Item):
+    """One pinned log, checked with the current code."""
+
+    def runtest(self) -> None:
+        from sgtool.analysis.golden_check import check_pins, update_pins
+
+        cfg = self.config
+        update = bool(cfg.getoption("sgtool_golden_update"))
+        report = check_pins(self.path.parent, tolerance=cfg.getoption("sgtool_golden_tolerance"),
+                            names=[self.name], keep=update)
+        c = report.logs[0]
+        if c.status == "changed" and update:
+            update_pins(report)
+            return
+        if c.status != "unchanged":
+            raise GoldenFailure("\n".join(c.report()))
+
+    def repr_failure(self, excinfo: pytest.ExceptionInfo[BaseException],
+                     style: Any = None) -> str:
+        if isinstance(excinfo.value, GoldenFailure):
+            return str(excinfo.value) + ("\n(deliberate? `sgtool golden check --dir "
+                                         f"{self.path.parent} --update`)")
+        return str(super().repr_failure(excinfo))
+
+    def reportinfo(self) -> tuple[Path, int | None, str]:
+        return self.path, None, f"sgtool golden: {self.name}"
+
+
+class GoldenFixture:
+    """What the ``sgtool_golden`` fixture gives a test (module doc)."""
+
+    def __init__(self, update: bool, tolerance: float) -> None:
+        self.update = update
+        self.tolerance = tolerance
+
+    def check(self, log: str | Path, folder: str | Path, **options: Any) -> None:
+        """Pin ``log`` into ``folder`` on first use, else check it (module doc);
+        ``options``: replay options (``every``, ``voxel_size``, ...)."""
+        from sgtool.analysis.golden_check import check_pins, pin_logs, pin_name, update_pins
+        from sgtool.replayers.derived_log import ReplayOptions
+        from sgtool.replayers.golden_pins import INDEX, read_pins
+
+        log, folder = Path(log), Path(folder)
+        name = pin_name(log)
+        known = (folder / INDEX).is_file() and name in read_pins(folder).logs
+        if not known:
+            pin_logs([log], folder, ReplayOptions(**options))
+            pytest.fail(f"pinned {log} into {folder} (first run); commit the pin and run "
+                        "again", pytrace=False)
+        report = check_pins(folder, ReplayOptions(**options) if options else None,
+                            tolerance=self.tolerance, names=[name], keep=self.update)
+        c = report.logs[0]
+        if c.status == "changed" and self.update:
+            update_pins(report)
+            return
+        if c.status != "unchanged":
+            pytest.fail("\n".join(c.report()), pytrace=False)
+
+
+@pytest.fixture
+def sgtool_golden(request: pytest.FixtureRequest) -> GoldenFixture:
+    """Check logs against their pins from a test (:class:`GoldenFixture`)."""
+    cfg = request.config
+    return GoldenFixture(bool(cfg.getoption("sgtool_golden_update")),
+                         float(cfg.getoption("sgtool_golden_tolerance")))

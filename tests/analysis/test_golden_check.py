@@ -1,0 +1,236 @@
+"""sgtool golden pin / check / diff on a small real log (the first 30 frames of a golden log:
+3 refreshes), through the command line as a user runs it."""
+
+from __future__ import annotations
+
+import gzip
+import json
+import shutil
+import signal
+
+import pytest
+from support.paths import GOLDEN
+
+from sgtool.analysis.golden_check import check_pins, first_decision_change, planner_decisions
+from sgtool.cli import main
+from sgtool.log import LogReader, LogWriter
+from sgtool.log.records import Episode
+from sgtool.replayers.golden_pins import PIN_FORMAT, Decision, read_pins
+
+FRAMES = ["--max-frames", "30"]
+
+
+def sgtool(capsys, *args):
+    """(exit code, stdout, stderr) of ``sgtool ARGS``."""
+    handlers = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
+    try:
+        main([str(a) for a in args])
+        code = 0
+    except SystemExit as e:
+        code = int(e.code or 0)
+    finally:
+        signal.signal(signal.SIGINT, handlers[0])
+        signal.signal(signal.SIGTERM, handlers[1])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+@pytest.fixture(scope="module")
+def log(tmp_path_factory):
+    dst = tmp_path_factory.mktemp("logs") / "small.mcap"
+    shutil.copyfile(GOLDEN / "house10-start.mcap", dst)
+    return dst
+
+
+@pytest.fixture
+def pinned(log, tmp_path, capsys):
+    """A pin folder of ``log`` (copied in), replayed for 30 frames."""
+    folder = tmp_path / "g"
+    code, out, _ = sgtool(capsys, "golden", "pin", log, "--dir", folder, "--copy", *FRAMES)
+    assert code == 0, out
+    return folder
+
+
+def test_pin_then_check_is_unchanged(pinned, log, capsys):
+    pins = read_pins(pinned)
+    pin = pins.logs["small"]
+    assert pins.format == PIN_FORMAT
+    assert pin.log == "small.mcap" and (pinned / "small.mcap").read_bytes() == log.read_bytes()
+    assert pin.refreshes == 4 and pin.options.max_frames == 30  # 3 every 10 frames, 1 action
+    assert pin.resolved["every"] == 10 and pin.resolved["voxel_size"] == 0.05
+    assert pin.quality is not None and set(pin.quality) == {"strict", "merged"}  # house in log
+    assert pin.decisions is None  # a recording, no planner
+    # the pin is small: compressed graphs and refresh summaries, well under the log
+    small = sum(p.stat().st_size for p in pinned.iterdir() if p.suffix != ".mcap")
+    assert small < log.stat().st_size / 20
+    code, out, _ = sgtool(capsys, "golden", "check", "--dir", pinned)
+    assert code == 0, out
+    assert "small: unchanged" in out
+    assert "1 pinned log(s): 1 unchanged, 0 changed, 0 error(s)" in out
+
+
+def test_a_coarser_voxel_size_is_reported_layer_by_layer(pinned, tmp_path, capsys):
+    md, xml = tmp_path / "r.md", tmp_path / "j.xml"
+    code, out, err = sgtool(capsys, "golden", "check", "--dir", pinned, "--voxel-size", "0.08",
+                            "--report", md, "--junit", xml)
+    assert code == 1
+    assert "small: changed" in out and "voxel_size 0.08" in out
+    # the first refresh that differs, by index, log time, frames and reason
+    assert "refresh 0 at 3.000 s (after 10 frames, every) differs:" in out
+    for layer in ("rooms:", "objects:", "frontiers:", "voronoi:"):
+        assert f"    {layer}" in out, layer
+    assert "m²" in out  # room areas
+    assert "quality (" in out  # the figures before and after: the log carries its house
+    assert "| small | changed |" in out.replace("  ", " ").replace("| small ", "| small ")
+    assert "--update" in err
+    assert "## small: changed" in md.read_text()
+    junit = xml.read_text()
+    assert 'tests="1" failures="1" errors="0"' in junit and "<failure" in junit
+
+
+def test_tolerance_lets_float_level_changes_pass(pinned, capsys):
+    # a refactor that moves last bits: one object shifted by 2 mm in every pinned graph
+    pins = read_pins(pinned)
+    path = pins.graphs_path("small")
+    graphs = [json.loads(line) for line in gzip.open(path).read().splitlines()]
+    for g in graphs:
+        o = g["objects"][0]
+        o["position"][0] = round(o["position"][0] + 0.002, 4)
+    lines = [json.dumps(g, sort_keys=True, separators=(",", ":")) for g in graphs]
+    from sgtool.replayers.golden import sequence_digest, write_graphs
+
+    write_graphs(path, lines)
+    index = json.loads((pinned / "expected.json").read_text())
+    index["cases"]["small"]["sequence_sha256"] = sequence_digest(lines)
+    (pinned / "expected.json").write_text(json.dumps(index))
+    code, out, _ = sgtool(capsys, "golden", "check", "--dir", pinned)
+    assert code == 1
+    assert f"objects: {graphs[0]['objects'][0]['id']}" in out and "moved 0.002 m" in out
+    code, out, _ = sgtool(capsys, "golden", "check", "--dir", pinned, "--tolerance", "0.005")
+    assert code == 0, out
+
+
+def test_update_accepts_a_deliberate_change(pinned, capsys):
+    code, out, _ = sgtool(capsys, "golden", "check", "--dir", pinned, "--voxel-size", "0.08",
+                          "--update")
+    assert code == 0
+    assert "updated small: accepted the change from refresh 0 at 3.000 s" in out
+    assert read_pins(pinned).logs["small"].options.voxel_size == 0.08
+    code, out, _ = sgtool(capsys, "golden", "check", "--dir", pinned)
+    assert code == 0, out
+
+
+def test_a_moved_log_is_one_line_naming_it(log, tmp_path, capsys):
+    mine = tmp_path / "runs" / "small.mcap"
+    mine.parent.mkdir()
+    shutil.copyfile(log, mine)
+    folder = tmp_path / "g"
+    assert sgtool(capsys, "golden", "pin", mine, "--dir", folder, *FRAMES)[0] == 0
+    assert read_pins(folder).logs["small"].log == str(mine.resolve())  # not below DIR
+    mine.rename(tmp_path / "elsewhere.mcap")
+    code, out, err = sgtool(capsys, "golden", "check", "--dir", folder)
+    assert code == 2
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert str(mine) in err and "missing" in err
+    assert "small: error:" in out
+
+
+def test_a_changed_log_is_refused(pinned, capsys):
+    p = pinned / "small.mcap"
+    data = bytearray(p.read_bytes())
+    data[-100] ^= 0xFF
+    p.write_bytes(bytes(data))
+    code, _, err = sgtool(capsys, "golden", "check", "--dir", pinned)
+    assert code == 2 and "is not the pinned log" in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("damage", ["index", "graphs"])
+def test_a_damaged_pin_file_is_one_line_naming_it(pinned, capsys, damage):
+    target = pinned / ("expected.json" if damage == "index" else "small.graphs.jsonl.gz")
+    target.write_bytes(target.read_bytes()[: len(target.read_bytes()) // 2])
+    code, _, err = sgtool(capsys, "golden", "check", "--dir", pinned)
+    assert code == 2
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert str(target) in err and "damaged pin file" in err
+
+
+def test_a_newer_pin_format_is_refused_naming_both_versions(pinned, capsys):
+    index = json.loads((pinned / "expected.json").read_text())
+    index["format"] = PIN_FORMAT + 1
+    (pinned / "expected.json").write_text(json.dumps(index))
+    code, _, err = sgtool(capsys, "golden", "check", "--dir", pinned)
+    assert code == 2 and err.count("\n") == 1
+    assert f"pin format {PIN_FORMAT + 1} is newer" in err and f"(format {PIN_FORMAT}," in err
+
+
+def test_check_on_two_workers_reports_as_one(pinned, capsys):
+    code, out, _ = sgtool(capsys, "golden", "check", "--dir", pinned, "-w", "2",
+                          "--no-progress")
+    assert code == 0 and "small: unchanged" in out
+
+
+def test_diff_of_derived_logs(log, tmp_path, capsys):
+    d1, d2 = tmp_path / "d1.mcap", tmp_path / "d2.mcap"
+    assert sgtool(capsys, "replay", log, "-o", d1, *FRAMES)[0] == 0
+    assert sgtool(capsys, "replay", log, "-o", d2, "--voxel-size", "0.06", *FRAMES)[0] == 0
+    code, out, _ = sgtool(capsys, "diff", d1, d1)
+    assert code == 0 and "the same scene graphs" in out
+    code, out, _ = sgtool(capsys, "diff", d1, d2)
+    assert code == 1 and "they differ" in out
+    assert "refresh 0 at 3.000 s (after 10 frames, logged) differs:" in out
+    assert "  voronoi: " in out and "area" in out
+    code, out, _ = sgtool(capsys, "diff", d1, d2, "--json")
+    doc = json.loads(out)
+    assert code == 1 and doc["same"] is False and doc["refreshes"] == [4, 4]
+    assert doc["first"].startswith("refresh 0 at 3.000 s") and doc["layers"]["rooms"] >= 1
+    # a raw log is replayed with the options given: the same graphs as its derived log
+    code, out, _ = sgtool(capsys, "diff", log, d1, *FRAMES)
+    assert code == 0, out
+
+
+def episode_log(src, dst, planner):
+    """``src`` with Episode records that make it a search episode of ``planner``."""
+    with LogReader(src) as r, LogWriter(dst, seed=r.seed) as w:
+        w.attach_house(r.house_json())
+        ids: dict[int, int] = {}
+        last = 0
+        w.write_record(Episode(kind="search", status="started", query="mug", planner=planner), 0)
+        for schema, ch, m in r.raw_messages():
+            if ch.topic == "/sgtool/episode":
+                continue
+            if ch.id not in ids:
+                ids[ch.id] = w.copy_channel(ch.topic, schema.name, schema.encoding,
+                                            bytes(schema.data), ch.message_encoding,
+                                            dict(ch.metadata))
+            w.write_raw(ids[ch.id], m.log_time, bytes(m.data), m.sequence, m.publish_time)
+            last = max(last, m.log_time)
+        w.write_record(Episode(kind="search", status="failure", query="mug", planner=planner),
+                       last)
+    return dst
+
+
+def test_episode_logs_pin_the_planners_decisions(log, tmp_path, capsys):
+    ep = episode_log(log, tmp_path / "episode.mcap", "greedy")
+    folder = tmp_path / "g"
+    code, out, _ = sgtool(capsys, "golden", "pin", ep, "--dir", folder)
+    assert code == 0 and "greedy decisions" in out
+    pin = read_pins(folder).logs["episode"]
+    assert pin.planner == "greedy" and pin.decisions
+    assert {d.episode for d in pin.decisions} == {0}
+    # the decisions are a function of the replayed graphs: the same again
+    report = check_pins(folder)
+    assert report.exit_code == 0 and report.logs[0].decision is None
+    from sgtool.replayers.golden_pins import capture
+
+    cap = capture(ep, pin.options, quality=False)
+    assert planner_decisions(ep, cap.graphs, cap.refreshes) == ("greedy", pin.decisions)
+
+
+def test_the_first_decision_that_differs_is_named():
+    a = (Decision(0, 1, "navigate", "room:1"), Decision(0, 3, "explore", "frontier:2"))
+    b = (a[0], Decision(0, 3, "navigate", "room:2"))
+    assert first_decision_change(a, a, "scout") is None
+    assert first_decision_change(a, b, "scout") == (
+        "decisions: scout at episode 0, step 3: explore(frontier:2) -> navigate(room:2)")
+    assert first_decision_change(a, a[:1], "scout") == (
+        "decisions: 1 where 2 were pinned; the first 1 agree")
