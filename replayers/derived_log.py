@@ -6,11 +6,12 @@ instance tables, frames (assembled by :class:`~sgtool.log.assembly.FrameAssemble
 action records. With an output it also writes the derived log: a copy of every input
 message (same bytes, same channels and schemas, same order), the input's attachments and
 its ``sgtool`` metadata, and after the message that caused each refresh the derived
-channels of :mod:`sgtool.scenegraph.derived_layers` at the refresh time. Derived channels of the
-input (a log that was already replayed, or a closed-loop log) are not copied: they are
-rebuilt. A metadata record ``sgtool.replay`` holds the options. Input chunks go into the
-derived log as they are, not recompressed (:mod:`sgtool.log.chunk_copy`), wherever that
-gives the same messages in the same order (:func:`_can_copy`, :func:`_copyable`).
+channels of :mod:`sgtool.scenegraph.derived_layers` and the scene graph as a Foxglove
+``SceneUpdate`` (:mod:`sgtool.replayers.graph_scene`, ``/map/graph``) at the refresh time.
+Derived channels of the input (a log that was already replayed, or a closed-loop log) are
+not copied: they are rebuilt. A metadata record ``sgtool.replay`` holds the options. Input
+chunks go into the derived log as they are, not recompressed (:mod:`sgtool.log.chunk_copy`),
+wherever that gives the same messages in the same order (:func:`_can_copy`, :func:`_copyable`).
 With an output every input chunk's CRC is checked as it is read (a copied chunk would
 carry damage under a CRC that no longer matches, a rewritten one under a fresh CRC that
 hides it): a damaged log is refused in one line, and no derived log is left.
@@ -50,6 +51,7 @@ from sgtool.log.records import Episode, Instances
 from sgtool.log.writer import LogWriter
 from sgtool.mapping.voxels import VoxelConfig
 from sgtool.progress import Progress
+from sgtool.replayers.graph_scene import graph_scene_update
 from sgtool.scenegraph.derived_layers import DERIVED_TOPICS, write_refresh
 from sgtool.scenegraph.options import (
     CLASSIFIERS,
@@ -61,6 +63,7 @@ from sgtool.scenegraph.options import (
 from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 
 REPLAY_METADATA = "sgtool.replay"
+REBUILT_TOPICS = frozenset({*DERIVED_TOPICS, S.GRAPH_SCENE})  # not copied: written anew
 _INSTANCES = S.RECORDS["instances"].topic
 _ACTION = S.RECORDS["action"].topic
 _EPISODE = S.RECORDS["episode"].topic
@@ -75,6 +78,7 @@ class ReplayOptions:
     min_points: int | None = None  # points in one frame for an instance to count as seen
     voxel_size: float | None = None  # m
     max_frames: int | None = None  # stop after this many frames
+    tf_time: str = "log"  # what pairs /tf with frames: "log" time or header "stamp"
 
 
 def resolve_options(reader: LogReader, options: ReplayOptions) -> ResolvedOptions:
@@ -142,6 +146,7 @@ class ReplayReport:
     stages: dict[str, tuple[float, float, int]] = field(default_factory=dict)
     seconds: float = 0.0  # wall clock of the run (reported, never written)
     truncated: bool = False  # stopped at max_frames
+    warnings: list[str] = field(default_factory=list)  # one line each (/tf stamps)
 
     def lines(self) -> list[str]:
         out = []
@@ -157,6 +162,7 @@ class ReplayReport:
             out.append("the log has no instance ids: semantics are absent, so the graph has "
                        "geometry only (occupancy, Voronoi graph, rooms without door cuts, "
                        "frontiers; no objects, doors or room categories)")
+        out.extend(f"warning: {w}" for w in self.warnings)
         if self.truncated:
             out.append(f"stopped after {self.frames} frames (--max-frames)")
         if self.last is not None:
@@ -198,6 +204,7 @@ def replay(
         raise SgtoolError("the output must not be the input log")
     with LogReader(src, verify=verify or dst is not None) as reader, single_blas_thread():
         reader.require(S.DEPTH, why="replay builds the map from depth images")
+        tf_time = (options or ReplayOptions()).tf_time
         opts = resolve_options(reader, options or ReplayOptions())
         report = ReplayReport(src, dst, opts, semantic=reader.has(S.IDS))
         stream = SceneGraphStream(None, (room_classifier or make_classifier)(opts.classifier),
@@ -205,7 +212,7 @@ def replay(
         with frozen_heap(), small_pages():  # no full-collection or huge-page stalls
             t0 = time.perf_counter()
             if dst is None:
-                _run(reader, stream, None, opts, report, on_refresh, progress)
+                _run(reader, stream, None, opts, report, on_refresh, progress, tf_time=tf_time)
             else:
                 meta = dict(reader.metadata.get(S.METADATA_NAME, {}))
                 extra = {k: v for k, v in meta.items()
@@ -215,10 +222,13 @@ def replay(
                     for name, data in sorted(reader.metadata.items()):
                         if name not in (S.METADATA_NAME, REPLAY_METADATA):
                             writer.add_metadata(name, data)
-                    writer.add_metadata(REPLAY_METADATA, opts.to_metadata())
+                    # tf_time only when not the default: default replays stay as they were
+                    writer.add_metadata(REPLAY_METADATA, {**opts.to_metadata(), **(
+                        {"tf_time": tf_time} if tf_time != "log" else {})})
                     for a in reader.iter_attachments():
                         writer.attach(a.name, a.data, a.media_type, a.log_time)
-                    _run(reader, stream, writer, opts, report, on_refresh, progress, copy_chunks)
+                    _run(reader, stream, writer, opts, report, on_refresh, progress, copy_chunks,
+                         tf_time=tf_time)
         report.seconds = time.perf_counter() - t0
         report.stages = stream.builder.stage_summary()
     return report
@@ -228,8 +238,8 @@ def _run(reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
          opts: ResolvedOptions, report: ReplayReport,
          on_refresh: Callable[[Refresh, SceneGraphStream], None] | None,
          progress: Progress | None,
-         copy_chunks: bool = False) -> None:
-    feed = _Feed(reader, stream, writer, opts, report, on_refresh, progress)
+         copy_chunks: bool = False, tf_time: str = "log") -> None:
+    feed = _Feed(reader, stream, writer, opts, report, on_refresh, progress, tf_time)
     if copy_chunks and writer is not None and _can_copy(reader, writer, opts):
         for chunk, items in reader.chunks(views=True):
             copied = chunk is not None and _copyable(chunk, items) and writer.copy_chunk(chunk)
@@ -240,13 +250,16 @@ def _run(reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
             if not feed.message(schema, channel, message, write=writer is not None):
                 break
     feed.end()
+    note = feed.asm.tf_stamp_note()
+    if note is not None:
+        report.warnings.append(note)
 
 
 def _can_copy(reader: LogReader, writer: LogWriter, opts: ResolvedOptions) -> bool:
     """Input chunks can be copied into the derived log as they are (:mod:`sgtool.log.
     chunk_copy`) when the whole log is replayed, it has no derived channels to rebuild,
     its chunks follow each other in time and its channels keep their ids in the output."""
-    return (opts.max_frames is None and not reader.topics() & set(DERIVED_TOPICS)
+    return (opts.max_frames is None and not reader.topics() & REBUILT_TOPICS
             and in_sequence(reader.summary.chunk_indexes)
             and writer.copy_channels(reader.summary))
 
@@ -273,13 +286,13 @@ class _Feed:
     def __init__(self, reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
                  opts: ResolvedOptions, report: ReplayReport,
                  on_refresh: Callable[[Refresh, SceneGraphStream], None] | None,
-                 progress: Progress | None) -> None:
+                 progress: Progress | None, tf_time: str = "log") -> None:
         self.reader, self.stream, self.writer = reader, stream, writer
         self.opts, self.report, self.on_refresh, self.progress = opts, report, on_refresh, progress
         self.frame_topics = set(FRAME_TOPICS)
         self.needed = self.frame_topics | {_INSTANCES, _ACTION}
         self.copied: dict[int, int] = {}  # input channel id -> output channel id
-        self.asm = FrameAssembler(where=str(reader.path))
+        self.asm = FrameAssembler(where=str(reader.path), tf_time=tf_time)
         self.last_t = 0
 
     def refreshed(self, r: Refresh | None) -> None:
@@ -289,6 +302,8 @@ class _Feed:
         self.report.last = r
         if self.writer is not None:
             write_refresh(self.writer, r)
+            self.writer.write_proto(S.GRAPH_SCENE, r.time_ns,
+                                    graph_scene_update(r.time_ns, r.graph.to_dict()))
         if self.on_refresh is not None:
             self.on_refresh(r, self.stream)
 
@@ -328,7 +343,7 @@ class _Feed:
                         decoded, where=f"{self.reader.path}: {Instances.describe(t_ns=t)}"))
                 else:
                     self.refreshed(self.stream.action(t))
-        if write and self.writer is not None and topic not in DERIVED_TOPICS:
+        if write and self.writer is not None and topic not in REBUILT_TOPICS:
             self._write(schema, channel, message, t)
         self.last_t = max(self.last_t, t)
         return True

@@ -31,7 +31,11 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from sgtool.house.spec import HouseSpec
+from sgtool.log import codec
+from sgtool.log import schemas as S
 from sgtool.log.frame import Frame
 from sgtool.log.records import Action, Episode, Instances
 from sgtool.log.writer import LogWriter
@@ -91,7 +95,9 @@ class LogRecorder(SimObserver):
         if self.faults is not None:
             f = self.faults.apply(f)
         self.writer.write_frame(f.time_ns, depth=f.depth, pose=f.pose, intrinsics=f.intrinsics,
-                                rgb=f.rgb, ids=f.ids, base_pose=f.base_pose)
+                                rgb=f.rgb, base_pose=f.base_pose)
+        if f.ids is not None:  # after the depth image, as write_frame orders them
+            self.writer.write_proto(S.IDS, f.time_ns, instance_image(f.time_ns, f.ids))
         self.last_time_ns = f.time_ns
         self.last_frame = f
         self.frames += 1
@@ -125,6 +131,15 @@ class LogRecorder(SimObserver):
         self.actions += 1
         return t
 
+
+
+def instance_image(t_ns: int, ids: np.ndarray) -> Any:
+    """The instance-id image as a Foxglove ``RawImage`` in an encoding Foxglove's Image
+    panel shows: ``16UC1`` (exact ids, 0 = none) when every id fits in 0..65535, else
+    ``32SC1`` (exact, but not drawn by Foxglove; sgtool's readers take both)."""
+    fits = ids.size == 0 or (int(ids.min()) >= 0 and int(ids.max()) <= S.IDS_MAX_16)
+    return codec.encode_image(t_ns, ids, S.IDS_ENCODING_16 if fits else S.IDS_ENCODING,
+                              S.CAMERA_FRAME)
 
 @dataclass(frozen=True)
 class RecordOptions:

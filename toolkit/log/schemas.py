@@ -29,7 +29,9 @@ from sgtool.vocabulary import (
 )
 
 # 1.1: sgtool.Action 1.1 adds the optional ``graph_time_ns``
-LOG_SCHEMA_VERSION: tuple[int, int] = (1, 1)
+# 1.2: instance ids may be 16UC1 (what Foxglove's Image panel shows); derived logs add the
+#      ``/map/graph`` SceneUpdate (objects, doors, frontiers, edges with metadata)
+LOG_SCHEMA_VERSION: tuple[int, int] = (1, 2)
 PROFILE = "sgtool"
 METADATA_NAME = "sgtool"
 HOUSE_ATTACHMENT = "house.json"
@@ -47,11 +49,14 @@ TF = "/tf"
 OCCUPANCY = "/map/occupancy"
 VORONOI = "/map/voronoi"
 ROOMS = "/map/rooms"
+GRAPH_SCENE = "/map/graph"  # the scene graph's objects, doors, frontiers and edges
 
 # encodings of the RawImage channels
 RGB_ENCODING = "rgb8"
 DEPTH_ENCODING = "16UC1"  # millimetres, little endian, 0 = no return
 IDS_ENCODING = "32SC1"  # instance ids, little endian int32, 0 = none
+IDS_ENCODING_16 = "16UC1"  # instance ids that fit 0..IDS_MAX_16 (Foxglove shows it)
+IDS_MAX_16 = 65535
 DEPTH_SCALE = 1000.0  # depth units per metre
 
 
