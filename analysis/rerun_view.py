@@ -13,7 +13,10 @@ nothing of sgtool's JSON records; so sgtool logs everything natively with the Re
 - ``actions``: the actions with their outcomes (``TextLog``).
 
 Two timelines: ``frame`` (frame index) and ``sim_time`` (log time since the start). Export is
-deterministic for a given log (the recording id is derived from the log's path name).
+deterministic for a given log (the recording id is derived from the log's bytes:
+:func:`recording_id`). The robot's path is logged in pieces of :data:`PATH_CHUNK` points
+(``world/robot/path/K``), each re-logged only while it grows, so the recording grows
+linearly with the number of frames.
 
 The ``.rrd`` is written atomically (:func:`sgtool.files.atomic_output`): an error or Ctrl-C
 leaves nothing at its path. Rerun's file sink does not report write errors (on a full disk
@@ -42,6 +45,7 @@ from sgtool.log import schemas as S
 APP_ID = "sgtool"
 FREE_MARGIN = 16 * 1024 * 1024  # bytes that must stay free beside the .rrd while writing
 FLUSH_TIMEOUT_S = 600.0
+PATH_CHUNK = 100  # path points per ``world/robot/path/K`` entity (the path is logged in pieces)
 
 
 def require_space(rrd_path: Path) -> None:
@@ -50,6 +54,17 @@ def require_space(rrd_path: Path) -> None:
     st = os.statvfs(rrd_path.parent)
     if st.f_bavail * st.f_frsize < FREE_MARGIN:
         raise output_error(OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)), rrd_path)
+
+
+def recording_id(log_path: Path) -> str:
+    """The Rerun recording id of a log: the SHA-256 of its bytes (32 hex digits), so two
+    different logs never merge in the viewer however they are named, and viewing the same
+    log twice gives the same recording."""
+    try:
+        with open(log_path, "rb") as fh:
+            return hashlib.file_digest(fh, "sha256").hexdigest()[:32]
+    except OSError:
+        return hashlib.sha256(str(log_path).encode()).hexdigest()[:32]  # the reader says why
 
 
 def _time(rec: Any, frame: int | None, t_ns: int) -> None:
@@ -104,7 +119,7 @@ def export(
     import rerun as rr
 
     log_path = Path(log_path)
-    rid = hashlib.sha256(log_path.name.encode()).hexdigest()[:32]
+    rid = recording_id(log_path)
     rec = rr.RecordingStream(APP_ID, recording_id=rid, send_properties=False)
     out = None if spawn or rrd_path is None else Path(rrd_path)
     target = contextlib.nullcontext(None) if out is None else atomic_output(out)
@@ -162,6 +177,7 @@ def _export(
         rec.log("world/camera/image", rr.AnnotationContext(ctx), static=True)
     # camera frames
     path_xy: list[tuple[float, float, float]] = []
+    pieces_done = 0  # path pieces before this one are complete in the recording
     unposed = framed = 0  # frames whose camera pose /tf does not give (a missing link, a cycle)
     if r.has(S.DEPTH):
         for n, fr in enumerate(r.frames()):
@@ -197,9 +213,14 @@ def _export(
             if here is not None:
                 rec.log("world/robot", rr.Points3D([here], radii=0.15,
                                                    colors=[(230, 80, 40)]))
-            if len(path_xy) > 1:
-                rec.log("world/robot/path", rr.LineStrips3D([np.array(path_xy, np.float32)],
-                                                           radii=0.02, colors=[(230, 80, 40)]))
+            if len(path_xy) > 1:  # only the current piece: data linear in the frames
+                last = (len(path_xy) - 2) // PATH_CHUNK
+                for j in range(pieces_done, last + 1):  # finish pieces skipped by --every
+                    # piece j: points j*C .. (j+1)*C, sharing its first with piece j - 1
+                    piece = path_xy[j * PATH_CHUNK:(j + 1) * PATH_CHUNK + 1]
+                    rec.log(f"world/robot/path/{j}", rr.LineStrips3D(
+                        [np.array(piece, np.float32)], radii=0.02, colors=[(230, 80, 40)]))
+                pieces_done = last
     # voxel map over time (computed by the caller)
     if voxels is not None:
         for idx, t_ns, centres, cols, size in voxels(r):

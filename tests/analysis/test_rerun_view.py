@@ -100,3 +100,43 @@ def test_view_of_a_log_without_a_camera_pose(tmp_path, links):
     rrd_verify(out)
     assert "note: 3 of 3 frames have no camera pose: /tf has no chain world -> camera" in (
         r.output)
+
+
+def test_recording_id_follows_the_content_not_the_name(tmp_path):
+    """Two different run.mcap from two folders are two recordings; one log is one."""
+    from sgtool.analysis.rerun_view import recording_id
+
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    a = write_log(tmp_path / "a" / "run.mcap", n=3)
+    b = write_log(tmp_path / "b" / "run.mcap", n=4)
+    assert recording_id(a) != recording_id(b)
+    assert recording_id(a) == recording_id(a) and len(recording_id(a)) == 32
+
+
+def test_path_pieces_with_every(tmp_path, monkeypatch):
+    """The path in pieces of PATH_CHUNK points, frames skipped by --every included."""
+    import sgtool.analysis.rerun_view as rv
+
+    monkeypatch.setattr(rv, "PATH_CHUNK", 3)
+    logged: dict[str, list] = {}
+
+    class Rec(rr.RecordingStream):
+        def log(self, entity, archetype, static=False):  # type: ignore[override]
+            if entity.startswith("world/robot/path/"):
+                logged[entity] = archetype
+
+    from sgtool.log import LogReader
+
+    log = write_log(tmp_path / "run.mcap", n=12)
+    with LogReader(log) as r:
+        rec = Rec("test")
+        rec.memory_recording()
+        rv._export(rec, r, every=5, max_frames=None, progress=None, voxels=None)
+    # 12 points: pieces 0..3 of points [0..3], [3..6], [6..9], [9..10] (frame 10 last logged)
+    xs = {k: [round(float(p[0]), 2) for p in np.array(
+        v.strips.as_arrow_array().to_pylist()[0], float).reshape(-1, 3)]
+        for k, v in logged.items()}
+    assert sorted(xs) == [f"world/robot/path/{k}" for k in range(4)]
+    assert xs["world/robot/path/0"] == [0.0, 0.05, 0.1, 0.15]
+    assert xs["world/robot/path/2"] == [0.3, 0.35, 0.4, 0.45]
