@@ -52,6 +52,13 @@ from sgtool.scenegraph.options import CLASSIFIERS
               help="Voxel edge in metres. Default: the log's, else 0.05.")
 @click.option("--max-frames", type=click.IntRange(min=1), default=None,
               help="Stop after this many frames.")
+@click.option("--tf-time", type=click.Choice(["log", "stamp"]), default="log",
+              show_default=True,
+              help="The time that pairs /tf transforms with camera frames: the log time each "
+              "message was recorded at, or the messages' header stamps (sgtool's own logs "
+              "stamp every message with its log time). Pairing by log time, /tf stamps more "
+              "than 0.05 s from their log times are warned about (the largest offset named), "
+              "more than 1 s refused.")
 @click.option("--rrd", type=click.Path(dir_okay=False),
               help="Also write a Rerun recording of the derived log (needs -o).")
 @click.option("--score", is_flag=True,
@@ -82,7 +89,7 @@ def command(logs: tuple[str, ...], output: str | None, every: int | None,
             llm_base_url: str | None = None, llm_model: str | None = None,
             llm_api_key: str | None = None, llm_timeout: float = 60.0,
             llm_constraint: str = "auto", llm_replay: tuple[str, ...] = (),
-            llm_transcript: str | None = None) -> None:
+            llm_transcript: str | None = None, tf_time: str = "log") -> None:
     """Replay LOG into a semantic voxel map, BEV occupancy, a Voronoi graph, rooms, objects,
     frontiers and the hierarchical scene graph, deterministically: the same log and options
     give a byte-identical output.
@@ -125,8 +132,9 @@ def command(logs: tuple[str, ...], output: str | None, every: int | None,
                 raise SgtoolError(f"{opt} takes one log; leave it out with --out-dir")
         _batch(logs, Path(out_dir), ReplayOptions(
             every=every, classifier=classifier, min_points=min_points, voxel_size=voxel_size,
-            max_frames=max_frames), force=force, as_json=as_json, progress=progress,
-            executor=executor, workers=workers, ray_address=ray_address, verify=verify)
+            max_frames=max_frames, tf_time=tf_time), force=force, as_json=as_json,
+            progress=progress, executor=executor, workers=workers, ray_address=ray_address,
+            verify=verify)
         return
     if executor != "local" or workers != 1 or ray_address:
         raise SgtoolError("--executor, --workers and --ray-address run many logs: give "
@@ -169,7 +177,7 @@ def command(logs: tuple[str, ...], output: str | None, every: int | None,
 
     show = progress if progress is not None else sys.stderr.isatty()
     opts = ReplayOptions(every=every, classifier=classifier, min_points=min_points,
-                         voxel_size=voxel_size, max_frames=max_frames)
+                         voxel_size=voxel_size, max_frames=max_frames, tf_time=tf_time)
     with llm.room_classifier() as rooms, tqdm(
             total=total, unit="frame", desc="replay", file=sys.stderr, leave=False,
             disable=not show, dynamic_ncols=True) as bar:
@@ -276,6 +284,8 @@ def _as_dict(report: Any, scores: Any, rrd: str | None) -> dict[str, Any]:
         },
         "rrd": rrd,
     }
+    if report.warnings:
+        out["warnings"] = list(report.warnings)
     if scores is not None:
         out["score"] = score_dict(scores)
     return out

@@ -5,12 +5,24 @@ messages of the same log time, the camera calibration in force and the camera po
 from the ``/tf`` transforms (world -> ... -> camera) in force at that time. The reader
 (:meth:`sgtool.log.reader.LogReader.frames`) and replay
 (:mod:`sgtool.replayers.derived_log`) both assemble frames with :class:`FrameAssembler`.
+
+**Which time pairs /tf with frames** (``tf_time``): by default the *log time*, the time
+each message was recorded (sgtool's writers stamp every message with its log time, so the
+two agree exactly in sgtool's own logs). A log whose ``/tf`` header stamps disagree with
+their log times is checked, since pairing by one time or the other builds another map:
+an offset beyond :data:`TF_STAMP_WARN_S` is noted (:meth:`FrameAssembler.tf_stamp_note`,
+naming the largest offset and ``--tf-time``), one beyond :data:`TF_STAMP_REFUSE_S` is
+refused (:class:`LogFormatError`). With ``tf_time="stamp"`` transforms are keyed by their
+header stamps and a frame's pose is looked up at its depth image's header stamp (a
+transform still counts only once it has been read, in log order); the offsets are then
+not checked. A stamp of 0 (unset) counts as the log time.
 """
 
 from __future__ import annotations
 
 import bisect
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any, TypeVar
 
 import numpy as np
@@ -63,6 +75,42 @@ class TransformBuffer:
 
 
 FRAME_TOPICS = (S.RGB, S.DEPTH, S.IDS, S.CALIBRATION, S.TF)
+TF_TIMES = ("log", "stamp")  # what pairs /tf with frames (module doc)
+TF_STAMP_WARN_S = 0.05  # /tf stamps further than this from their log times: a note
+TF_STAMP_REFUSE_S = 1.0  # ... further than this: refused (pairing by log time)
+TF_TIME_OPTION = "--tf-time stamp"  # how a user of replay pairs by stamps instead
+
+
+def stamp_ns(message: Any) -> int | None:
+    """The header stamp of a decoded message in ns (its ``timestamp``), None when it has
+    none or it is 0 (unset)."""
+    ts = getattr(message, "timestamp", None)
+    if ts is None:
+        return None
+    try:
+        t = int(ts.seconds) * 1_000_000_000 + int(ts.nanos)
+    except (AttributeError, TypeError, ValueError):
+        return None
+    return t or None
+
+
+@dataclass
+class TfStampOffsets:
+    """How far ``/tf`` header stamps lie from their log times (stamp minus log time):
+    ``checked`` messages with a stamp, ``beyond`` those past :data:`TF_STAMP_WARN_S`, and
+    the ``worst`` offset (largest in size, signed, ns) with the log time it was met at."""
+
+    checked: int = 0
+    beyond: int = 0
+    worst_ns: int = 0
+    worst_at_ns: int = 0
+
+    def add(self, log_ns: int, offset_ns: int) -> None:
+        self.checked += 1
+        if abs(offset_ns) > TF_STAMP_WARN_S * 1e9:
+            self.beyond += 1
+        if abs(offset_ns) > abs(self.worst_ns):
+            self.worst_ns, self.worst_at_ns = offset_ns, log_ns
 _IMAGES = {S.DEPTH: "depth", S.RGB: "rgb", S.IDS: "ids"}
 
 
@@ -95,16 +143,38 @@ class FrameAssembler:
     whose quaternion cannot be normalised, a calibration with a short K or a focal length
     that is not positive, a depth image with no calibration before it, images whose size
     differs from the calibration's or from each other, zero-size images, instance ids in
-    a non-integer encoding, two images of one channel at one log time."""
+    a non-integer encoding, two images of one channel at one log time, and (pairing by log
+    time) a ``/tf`` header stamp more than :data:`TF_STAMP_REFUSE_S` from its log time.
+
+    ``tf_time`` (one of :data:`TF_TIMES`) is the time that pairs ``/tf`` with frames
+    (module doc); :attr:`tf_offsets` sums up how far the stamps lie from the log times."""
 
     def __init__(self, index: int = 0, transforms: TransformBuffer | None = None,
-                 calibration: CameraIntrinsics | None = None, where: str = "") -> None:
+                 calibration: CameraIntrinsics | None = None, where: str = "",
+                 tf_time: str = "log") -> None:
+        if tf_time not in TF_TIMES:
+            raise ValueError(f"tf_time must be one of {', '.join(TF_TIMES)}, not {tf_time!r}")
         self.index = index
         self.transforms = transforms or TransformBuffer()
         self.calibration = calibration
         self.where = where
+        self.tf_time = tf_time
+        self.tf_offsets = TfStampOffsets()
         self._pending: dict[str, Any] = {}
         self._t: int | None = None
+
+    def tf_stamp_note(self) -> str | None:
+        """One line when ``/tf`` stamps disagreed with their log times beyond
+        :data:`TF_STAMP_WARN_S` while pairing by log time (naming the largest offset and
+        the option that pairs by stamps), else None."""
+        o = self.tf_offsets
+        if self.tf_time != "log" or not o.beyond:
+            return None
+        prefix = f"{self.where}: " if self.where else ""
+        return (f"{prefix}{o.beyond} of {o.checked} {S.TF} message(s) have header stamps "
+                f"more than {TF_STAMP_WARN_S:g} s from their log times (at most "
+                f"{o.worst_ns / 1e9:+.3f} s, at log time {o.worst_at_ns} ns); frames were "
+                f"paired with {S.TF} by log time ({TF_TIME_OPTION} pairs them by stamps)")
 
     def push(self, topic: str, t_ns: int, message: Any) -> Frame | None:
         out = None
@@ -114,7 +184,8 @@ class FrameAssembler:
         self._t = t_ns
         if topic == S.TF:
             T = decoded(self.where, topic, t_ns, codec.decode_transform, message)  # noqa: N806
-            self.transforms.add(t_ns, message.parent_frame_id, message.child_frame_id, T)
+            self.transforms.add(self._tf_key(t_ns, message), message.parent_frame_id,
+                                message.child_frame_id, T)
         elif topic == S.CALIBRATION:
             self.calibration = decoded(self.where, topic, t_ns, codec.decode_calibration,
                                        message)
@@ -125,6 +196,23 @@ class FrameAssembler:
                            "time (each frame needs its own log time)")
             self._pending[key] = message
         return out
+
+    def _tf_key(self, t_ns: int, message: Any) -> int:
+        """The time a transform is kept under: its stamp (``tf_time`` "stamp") or its log
+        time, whose distance from the stamp is checked (module doc)."""
+        stamp = stamp_ns(message)
+        if stamp is None:
+            return t_ns
+        if self.tf_time == "stamp":
+            return stamp
+        offset = stamp - t_ns
+        self.tf_offsets.add(t_ns, offset)
+        if abs(offset) > TF_STAMP_REFUSE_S * 1e9:
+            self._fail(S.TF, t_ns, f"its header stamp is {offset / 1e9:+.3f} s from its log "
+                       f"time (more than {TF_STAMP_REFUSE_S:g} s): frames are paired with "
+                       f"{S.TF} by log time, which would build another map than its stamps "
+                       f"say; {TF_TIME_OPTION} pairs them by stamps")
+        return t_ns
 
     def _fail(self, topic: str, t_ns: int, why: str) -> None:
         prefix = f"{self.where}: " if self.where else ""
@@ -158,10 +246,13 @@ class FrameAssembler:
             if img is not None and img.shape[:2] != depth.shape:
                 self._fail(topic, t, f"fields width/height: {img.shape[1]}x{img.shape[0]} "
                            f"pixels, the depth image is {depth.shape[1]}x{depth.shape[0]}")
-        pose = self.transforms.lookup(t, depth_msg.frame_id or S.CAMERA_FRAME)
+        at = t
+        if self.tf_time == "stamp":
+            at = stamp_ns(depth_msg) or t
+        pose = self.transforms.lookup(at, depth_msg.frame_id or S.CAMERA_FRAME)
         if pose is None:
             pose = np.full((4, 4), np.nan)
         fr = Frame(index=self.index, time_ns=t, rgb=rgb, depth=depth, ids=ids, pose=pose,
-                   intrinsics=k, base_pose=self.transforms.lookup(t, S.BASE_FRAME))
+                   intrinsics=k, base_pose=self.transforms.lookup(at, S.BASE_FRAME))
         self.index += 1
         return fr
