@@ -210,6 +210,7 @@ def record_task_log(task: StudyTask) -> bool:
         return False
     from sgtool.datasets.start_poses import with_start_poses
     from sgtool.house.io import load_house_text
+    from sgtool.log.writer import partial_files
     from sgtool.recorders.sim import CameraConfig, RecordOptions, parse_noise, record_house
 
     spec = load_house_text(task.spec_text)
@@ -220,7 +221,13 @@ def record_task_log(task: StudyTask) -> bool:
                          camera=CameraConfig(width=s.width, height=s.height),
                          noise=parse_noise(task.noise), seed=s.noise_seed)
     out.parent.mkdir(parents=True, exist_ok=True)
-    record_house(spec, out, opts, house_id=task.house)
+    before = set(partial_files(out))
+    try:
+        record_house(spec, out, opts, house_id=task.house)
+    except KeyboardInterrupt:  # Ctrl-C or a kill: no partial file of ours stays behind
+        for p in set(partial_files(out)) - before:
+            p.unlink(missing_ok=True)
+        raise
     return True
 
 

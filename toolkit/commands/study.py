@@ -18,6 +18,7 @@ from sgtool.commands.options import (
 )
 from sgtool.errors import SgtoolError
 
+CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 OUTPUTS = ("summary.md", "results.json", "results.csv", "plots", "closed_loop")
 
 
@@ -27,13 +28,13 @@ def default_cache() -> Path:
     return Path(base) / "sgtool" / "study-noise"
 
 
-@click.group("study")
+@click.group("study", context_settings=CONTEXT)
 def command() -> None:
     """Studies over many recordings: `sgtool study noise` measures scene-graph quality
     against sensor noise."""
 
 
-@command.command("noise")
+@command.command("noise", context_settings=CONTEXT)
 @click.option("--houses", default=5, show_default=True, type=click.IntRange(min=0),
               help="Generated houses (seeds HOUSE_SEED, +1, ...; the houses of `sgtool "
               "record --seed`); 0 with --house studies the given houses only.")
