@@ -10,7 +10,10 @@ the lot with one line per bad file (file and field, from :func:`sgtool.house.io.
 plus the benchmark's own needs: at least one small object to search for, a symbolic
 house that can be built (:func:`symbolic_house_problem`: every room has free floor), an id
 that can name a log folder (:func:`folder_name_problem`), no id given twice); a folder
-without house files is a problem too. :func:`bench_episodes` lists a house's episodes with
+without house files is a problem too, and a file of a folder that holds no house spec at
+all (a stray ``manifest.json``) says that a folder is read as houses (:func:`folder_note`).
+Generated houses are opt-in next to house files (:func:`generated_count`).
+:func:`bench_episodes` lists a house's episodes with
 :func:`sgtool.datasets.episodes.list_episodes`; a house without start poses gets one per
 reachable room first (:func:`sgtool.datasets.start_poses.with_start_poses`).
 """
@@ -51,6 +54,15 @@ class BenchHouse:
         return generate_house(int(self.seed or 0), rooms=rooms, split="eval", preset=preset)
 
 
+def generated_count(given: int | None, house_files: Sequence[str], default: int) -> int:
+    """How many generated houses a run benches: ``given`` when the user gave a number;
+    otherwise ``default`` without house files and none with them (next to a user's own
+    houses, generated ones are opt-in, so that the tables hold only the user's houses)."""
+    if given is not None:
+        return given
+    return 0 if house_files else default
+
+
 def generated_houses(count: int, first_seed: int) -> tuple[BenchHouse, ...]:
     return tuple(BenchHouse(f"house-{first_seed + i}", "generated", seed=first_seed + i)
                  for i in range(count))
@@ -65,10 +77,35 @@ def folder_houses(folder: Path) -> list[Path]:
 def house_paths(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
     """Files as given, folders as their house files (:func:`folder_houses`); a path that is
     neither is kept, so that loading it reports it."""
-    out: list[Path] = []
+    return [f for f, _ in _house_sources(paths)]
+
+
+def _house_sources(paths: Iterable[str | os.PathLike[str]]) -> list[tuple[Path, Path | None]]:
+    """:func:`house_paths`, each with the folder it was found in (None: given as a file)."""
+    out: list[tuple[Path, Path | None]] = []
     for p in map(Path, paths):
-        out.extend(folder_houses(p) if p.is_dir() else [p])
+        out.extend([(f, p) for f in folder_houses(p)] if p.is_dir() else [(p, None)])
     return out
+
+
+def _not_a_house(path: Path) -> bool:
+    """A file that holds no house spec at all (not a JSON object with ``rooms``)."""
+    try:
+        raw: Any = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return True
+    return not (isinstance(raw, dict) and "rooms" in raw)
+
+
+def folder_note(path: Path, folder: Path) -> str:
+    """What a problem of ``path``, found in ``folder``, ends with when ``path`` is no house
+    spec (a stray ``manifest.json``): that a folder is read as houses, and how to give
+    files instead."""
+    if not _not_a_house(path):
+        return ""
+    return (f" (a folder given to --house is read as houses: every *.json in {folder} is "
+            "one; give the house files one by one with --house FILE, or move the other "
+            "file out)")
 
 
 def load_house_files(paths: Sequence[str | os.PathLike[str]],
@@ -77,16 +114,16 @@ def load_house_files(paths: Sequence[str | os.PathLike[str]],
     (the generated houses). Raises :class:`HouseFilesError` listing every problem."""
     from sgtool.house.io import load_house
 
-    files = house_paths(paths)
+    files = _house_sources(paths)
     problems = [f"{p}: no *.json house files there" for p in map(Path, paths)
                 if p.is_dir() and not folder_houses(p)]
     houses: list[BenchHouse] = []
     ids = {i: "a generated house" for i in taken}
-    for f in files:
+    for f, folder in files:
         try:
             spec = load_house(f)
         except SpecError as e:
-            problems.append(str(e))
+            problems.append(str(e) + (folder_note(f, folder) if folder is not None else ""))
             continue
         if not spec.objects:
             problems.append(f"{f}: objects: no small objects, nothing to search for")

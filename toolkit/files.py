@@ -255,8 +255,10 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
     the command must write every file atomically (:func:`atomic_write`, a log writer's
     partial file): an interruption then leaves complete files only, which the next run
     takes up. On exit, clean or not, the manifest lists what it listed plus the entries
-    that appeared. With ``force``, or for another command's folder (refused without
-    ``force``), it builds as above: a fresh run that replaces what sgtool wrote.
+    that appeared; an exception before any entry appeared leaves ``target`` as it was
+    (a folder created for the run is removed again). With ``force``, or for another
+    command's folder (refused without ``force``), it builds as above: a fresh run that
+    replaces what sgtool wrote.
     """
     path = _folder_target(target, option)
     exists = path.is_dir()
@@ -269,11 +271,13 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
         raise SgtoolError(f"{option} {target}: the folder is not empty; not writing into it "
                           "(--force replaces what sgtool wrote there and keeps other files)")
     parent = path.parent
+    made: list[Path] = []
     try:
-        parent.mkdir(parents=True, exist_ok=True)
+        made = _make_folders(parent)
         stage = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".partial", dir=parent))
         os.chmod(stage, 0o777 & ~_umask())  # mkdtemp makes 0700; give the usual mode
     except OSError as e:
+        _remove_empty(made)
         raise output_error(e, target) from None
     try:
         yield stage
@@ -284,12 +288,32 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
             if is_environment_error(e):
                 raise output_error(e, target, note=f"{target} is as it was") from None
             raise
-    except KeyboardInterrupt as e:
-        e.note = (f"{target} is as it was: the outputs of the interrupted run "  # type: ignore[attr-defined]
-                  "were discarded")
-        raise
-    finally:
+    except BaseException as e:
+        if isinstance(e, KeyboardInterrupt):  # what the CLI prints
+            e.note = (f"{target} is as it was: the outputs of the interrupted run "  # type: ignore[attr-defined]
+                      "were discarded")
         shutil.rmtree(stage, ignore_errors=True)
+        _remove_empty(made)  # the folders made for the target, when still empty
+        raise
+    shutil.rmtree(stage, ignore_errors=True)  # emptied by the moves, or moved in whole
+
+
+def _make_folders(folder: Path) -> list[Path]:
+    """``folder.mkdir(parents=True, exist_ok=True)``; the folders it made, outermost
+    first."""
+    missing = [p for p in (folder, *folder.parents) if not p.exists()][::-1]
+    folder.mkdir(parents=True, exist_ok=True)
+    return missing
+
+
+def _remove_empty(folders: list[Path]) -> None:
+    """Remove ``folders`` (made by :func:`_make_folders`) again, innermost first, as long
+    as they are empty."""
+    for p in reversed(folders):
+        try:
+            p.rmdir()
+        except OSError:
+            return
 
 
 def _commit(stage: Path, target: Path, old: set[str]) -> None:
@@ -323,13 +347,16 @@ def _commit(stage: Path, target: Path, old: set[str]) -> None:
 @contextlib.contextmanager
 def _in_place(target: Path, command: str, known: Sequence[str]) -> Iterator[Path]:
     """:func:`output_folder`'s resume: ``target`` itself, its manifest kept up to date."""
+    made: list[Path] = []
     try:
-        target.mkdir(parents=True, exist_ok=True)
+        made = _make_folders(target)
         before = set(os.listdir(target))
     except OSError as e:
+        _remove_empty(made)
         raise output_error(e, target) from None
     ours = sgtool_entries(target, known) - {MANIFEST}
-    if not (target / MANIFEST).exists():  # mark the folder as this command's first
+    marked = MANIFEST not in before
+    if marked:  # mark the folder as this command's first
         atomic_write(target / MANIFEST, manifest_text(command, sorted(ours)))
 
     def mark() -> None:
@@ -340,6 +367,10 @@ def _in_place(target: Path, command: str, known: Sequence[str]) -> Iterator[Path
         yield target
     except BaseException:
         with contextlib.suppress(OSError, SgtoolError):  # the first error is the one to tell
-            mark()
+            if marked and set(os.listdir(target)) - before <= {MANIFEST}:
+                (target / MANIFEST).unlink()  # nothing written: the folder as it was
+                _remove_empty(made)
+            else:
+                mark()
         raise
     mark()

@@ -3,13 +3,12 @@ target without force, and force replaces only what sgtool wrote there."""
 
 from __future__ import annotations
 
-import errno
 import json
 import os
-import tempfile
 from pathlib import Path
 
 import pytest
+from support.read_only import make_read_only
 
 from sgtool.errors import SgtoolError
 from sgtool.files import MANIFEST, OutputError, output_folder, read_manifest
@@ -149,27 +148,10 @@ def test_an_interrupt_while_moving_in_puts_everything_back(
     assert sorted(os.listdir(out)) == sorted(before)
 
 
-def read_only(folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """Make ``folder`` read-only; as root (who writes anyway) refuse its new entries the way
-    the kernel does for a user."""
-    folder.chmod(0o555)
-    if os.geteuid() != 0:
-        return
-    real = tempfile.mkdtemp
-
-    def mkdtemp(*args: object, dir: str | os.PathLike[str] | None = None,
-                **kw: object) -> str:
-        if dir is not None and Path(dir).resolve() == folder.resolve():
-            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(dir))
-        return real(*args, dir=dir, **kw)  # type: ignore[call-overload, no-any-return]
-
-    monkeypatch.setattr(tempfile, "mkdtemp", mkdtemp)
-
-
 def test_a_read_only_parent_is_one_line(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     parent = tmp_path / "ro"
     parent.mkdir()
-    read_only(parent, monkeypatch)
+    make_read_only(parent, monkeypatch)
     try:
         with pytest.raises(OutputError) as e, output_folder(parent / "res", force=False):
             raise AssertionError("the block must not run")

@@ -35,14 +35,16 @@ from sgtool.files import output_folder
                    "unstructured-llm, godhs-llm). Default: all but the LLM planners. "
                    + PLUGIN_HELP)
 @list_planners_option()
-@click.option("--houses", default=10, show_default=True,
+@click.option("--houses", type=click.IntRange(min=0), default=None,
               help="Number of generated evaluation-split houses (house seeds HOUSE_SEED, +1, "
-                   "...); 0 with --house benches the given houses only.")
+                   "...). [default: 10; with --house: 0, the given houses only]")
 @click.option("--house", "house_files", multiple=True, metavar="PATH",
               type=click.Path(path_type=str),
-              help="A house spec JSON file, or a folder of them, to bench as well (repeatable); "
-                   "named by the spec's id or the file name. Every file is checked first; "
-                   "a bad one stops the run before any episode, naming file and field.")
+              help="A house spec JSON file, or a folder of them (every *.json there is read "
+                   "as a house), to bench (repeatable); named by the spec's id or the file "
+                   "name. Generated houses join them only when --houses N is given. Every "
+                   "file is checked first; a bad one stops the run before any episode, "
+                   "naming file and field.")
 @click.option("--priors", "priors_dir", default=None, metavar="DIR",
               type=click.Path(file_okay=False, path_type=str),
               help="Relational priors (a folder written by `sgtool distill`): the planners "
@@ -100,7 +102,7 @@ from sgtool.files import output_folder
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
 @success_option()
-def command(planners: str | None, houses: int, house_files: tuple[str, ...],
+def command(planners: str | None, houses: int | None, house_files: tuple[str, ...],
             priors_dir: str | None, episodes: int, seeds: int, workers: int, out_dir: str,
             force: bool,
             rooms: str, preset: str, house_seed: int, max_steps: int, distance_budget: float,
@@ -125,6 +127,7 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...],
         run_benchmark,
         write_outputs,
     )
+    from sgtool.analysis.bench_houses import generated_count
 
     for flag, value in (("--distance-budget", distance_budget), ("--step-budget", step_budget)):
         if not math.isfinite(value):
@@ -138,7 +141,8 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...],
             moma["replay"] = llm_replay
         if llm_transcript:
             moma["transcript"] = llm_transcript
-    cfg = BenchConfig(planners=names, houses=houses, episodes=episodes, seeds=seeds,
+    cfg = BenchConfig(planners=names, houses=generated_count(houses, house_files, 10),
+                      episodes=episodes, seeds=seeds,
                       rooms=parse_rooms(rooms), preset=preset, house_seed=house_seed,
                       max_steps=max_steps,
                       workers=workers, distance_budget=distance_budget,

@@ -31,12 +31,14 @@ from sgtool.files import output_folder
               help="Comma-separated planners (as `sgtool bench`). Default: all but the LLM "
               "planners. " + PLUGIN_HELP)
 @list_planners_option()
-@click.option("--houses", default=5, show_default=True,
-              help="Generated evaluation houses (seeds HOUSE_SEED, +1, ...); 0 with --house "
-              "runs the given houses only.")
+@click.option("--houses", type=click.IntRange(min=0), default=None,
+              help="Generated evaluation houses (seeds HOUSE_SEED, +1, ...). [default: 5; "
+              "with --house: 0, the given houses only]")
 @click.option("--house", "house_files", multiple=True, metavar="PATH",
               type=click.Path(path_type=str),
-              help="A house spec JSON file or a folder of them (repeatable), checked first.")
+              help="A house spec JSON file or a folder of them (every *.json there is read as "
+              "a house; repeatable), checked first. Generated houses join them only when "
+              "--houses N is given.")
 @click.option("--house-seed", default=0, show_default=True, help="Seed of the first house.")
 @click.option("--rooms", default="12-16", show_default=True, metavar="MIN-MAX",
               help="Room count range of the generated houses.")
@@ -79,7 +81,7 @@ from sgtool.files import output_folder
               help="Progress bar on stderr (default: when stderr is a terminal).")
 @success_option()
 @executor_options("episodes (one closed-loop run each)")
-def command(planners: str | None, houses: int, house_files: tuple[str, ...], house_seed: int,
+def command(planners: str | None, houses: int | None, house_files: tuple[str, ...], house_seed: int,
             rooms: str, preset: str, episodes: int, noise: tuple[str, ...], max_steps: int,
             frames: int | None, frames_per_room: int | None, resolution: str, every: int,
             navigation: str,
@@ -106,6 +108,7 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...], hou
     from tqdm import tqdm
 
     from sgtool.analysis.bench import DEFAULT_PLANNERS
+    from sgtool.analysis.bench_houses import generated_count
     from sgtool.analysis.closed_loop_bench import (
         OUTPUT_NAMES,
         ClosedLoopBenchConfig,
@@ -131,7 +134,8 @@ def command(planners: str | None, houses: int, house_files: tuple[str, ...], hou
     options = planner_options(planner_option, names)
     LlmEndpoint(llm_base_url, llm_model, llm_api_key, llm_timeout).fill(options, names)
     cfg = ClosedLoopBenchConfig(
-        planners=names, houses=houses, house_seed=house_seed, house_files=house_files,
+        planners=names, houses=generated_count(houses, house_files, 5), house_seed=house_seed,
+        house_files=house_files,
         episodes=episodes, rooms=parse_rooms(rooms), preset=preset,
         noise=tuple(noise) or ("none",), options=opts,
         planner_options=options,

@@ -33,6 +33,7 @@ from sgtool.house.geometry import (
     point_in_polygon,
     shared_borders,
 )
+from sgtool.house.names import id_note
 from sgtool.house.spec import HouseSpec, Opening, SpecLimits
 
 _WALL_MARGIN = 1.0  # m a wall end may lie outside the rooms' bounding box
@@ -54,7 +55,7 @@ def check_consistency(spec: HouseSpec, limits: SpecLimits) -> None:
             if not (x0 - _WALL_MARGIN <= x <= x1 + _WALL_MARGIN
                     and y0 - _WALL_MARGIN <= y <= y1 + _WALL_MARGIN):
                 raise SpecError(f"walls[{i}].{end}: ({x}, {y}) is more than {_WALL_MARGIN:g} m "
-                                "outside the rooms")
+                                f"outside the rooms{id_note('walls', i, w.id)}")
     by_room = {r.id: r for r in spec.rooms}
     for key, openings in _openings(spec):
         for i, d in enumerate(openings):
@@ -63,18 +64,20 @@ def check_consistency(spec: HouseSpec, limits: SpecLimits) -> None:
                 if off > limits.opening_offset:
                     raise SpecError(f"{key}[{i}].center: ({d.center[0]}, {d.center[1]}) is "
                                     f"{off:.2f} m from its room {rid} (more than "
-                                    f"{limits.opening_offset:g} m)")
+                                    f"{limits.opening_offset:g} m)"
+                                    f"{id_note(key, i, d.id)}")
     for i, f in enumerate(spec.furniture):
         room = by_room[f.room]
         if not room.contains(f.center[0], f.center[1]):
             raise SpecError(f"furniture[{i}].center: ({f.center[0]}, {f.center[1]}) is outside "
-                            f"its room {f.room}")
+                            f"its room {f.room}{id_note('furniture', i, f.id)}")
         for cx, cy in f.footprint():
             off = distance_to_polygon(cx, cy, room.polygon)
             if off > limits.furniture_outside:
                 raise SpecError(f"furniture[{i}].size: a corner ({cx:.2f}, {cy:.2f}) is "
                                 f"{off:.2f} m outside its room {f.room} (more than "
-                                f"{limits.furniture_outside:g} m)")
+                                f"{limits.furniture_outside:g} m)"
+                                f"{id_note('furniture', i, f.id)}")
     for i, s in enumerate(spec.starts):
         if not by_room[s.room].contains(s.x, s.y):
             raise SpecError(f"starts[{i}]: ({s.x}, {s.y}) is outside its room {s.room}")

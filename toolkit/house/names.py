@@ -57,3 +57,12 @@ def decimal_int(text: str) -> int | None:
     if text.isdecimal() and len(text) <= _MAX_DECIMAL_DIGITS:
         return int(text)
     return None
+
+
+def id_note(key: str, index: int, entry_id: object) -> str:
+    """What a message about entry ``index`` of the list ``key`` ends with so that the entry
+    can be found by its id, not only by its index: `` (furniture[84] is 'cabinet_3')``;
+    empty when ``entry_id`` is not a valid id (the message is then about the id)."""
+    if not isinstance(entry_id, str) or id_problem(entry_id) is not None:
+        return ""
+    return f" ({key}[{index}] is {entry_id!r})"

@@ -27,7 +27,7 @@ from sgtool.errors import SpecError
 from sgtool.house.consistency import check_consistency
 from sgtool.house.geometry import Point, Vec3, self_crossing, signed_area
 from sgtool.house.migrate import upgrade
-from sgtool.house.names import id_problem, name_problem
+from sgtool.house.names import id_note, id_problem, name_problem
 from sgtool.house.nesting import check_nesting
 from sgtool.house.spec import (
     AFFORDANCES,
@@ -147,6 +147,26 @@ def _house_id(v: Any) -> str:
     return v
 
 
+# the lists whose entries are many and alike (hundreds of pieces of furniture in a house):
+# a message about one of their entries names its id as well as its index
+_NAMED_BY_ID = frozenset({"furniture"})
+
+
+def _parse_entry(parse: Callable[[str, Any], Any], key: str, i: int, x: Any) -> Any:
+    """``parse`` entry ``i`` of ``key``; for the lists of :data:`_NAMED_BY_ID`, its error
+    names the entry's id as well (:func:`sgtool.house.names.id_note`)."""
+    if key not in _NAMED_BY_ID:
+        return parse(f"{key}[{i}]", x)
+    try:
+        return parse(f"{key}[{i}]", x)
+    except SpecError as e:
+        raw = x.get("id") if isinstance(x, Mapping) else None
+        note = id_note(key, i, raw) if not str(e).startswith(f"{key}[{i}].id") else ""
+        if not note:
+            raise
+        raise SpecError(f"{e}{note}") from None
+
+
 class _Parser:
     """Field rules of each kind of entry, within ``limits``."""
 
@@ -160,7 +180,7 @@ class _Parser:
                 ) -> tuple[Any, ...]:
         """The entries under ``key``, each parsed by ``parse(where, entry)``, with unique
         ids starting with ``prefix``."""
-        items = tuple(parse(f"{key}[{i}]", x) for i, x in
+        items = tuple(_parse_entry(parse, key, i, x) for i, x in
                       enumerate(self.entries(d, key, limit, min_len, required)))
         _unique_ids(key, items, prefix)
         return items
