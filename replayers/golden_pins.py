@@ -26,7 +26,7 @@ import json
 import os
 import zlib
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
@@ -47,7 +47,6 @@ from sgtool.version import __version__
 
 INDEX = EXPECTED
 PIN_FORMAT = 2
-_OPTION_FIELDS = ("every", "classifier", "min_points", "voxel_size", "max_frames")
 
 
 class PinError(SgtoolError):
@@ -160,16 +159,20 @@ class PinSet:
 
 
 def options_dict(o: ReplayOptions) -> dict[str, Any]:
-    """The options that are set (None: the log's recorded value, else the default)."""
-    return {k: v for k, v in asdict(o).items() if v is not None}
+    """The options that are set: those that differ from :class:`ReplayOptions`' defaults
+    (an unset option is the log's recorded value, else the replay default)."""
+    default = ReplayOptions()
+    return {f.name: getattr(o, f.name) for f in fields(ReplayOptions)
+            if getattr(o, f.name) != getattr(default, f.name)}
 
 
 def options_from(d: Mapping[str, Any], where: str) -> ReplayOptions:
-    unknown = set(d) - set(_OPTION_FIELDS)
+    known = {f.name for f in fields(ReplayOptions)}
+    unknown = set(d) - known
     if unknown:
-        raise PinError(f"{where}: damaged pin file (unknown replay option "
-                       f"{sorted(unknown)[0]!r})")
-    return ReplayOptions(**{k: d[k] for k in _OPTION_FIELDS if k in d})
+        raise PinError(f"{where}: replay option {sorted(unknown)[0]!r} is unknown to this "
+                       f"sgtool ({__version__}); upgrade sgtool, or pin again")
+    return ReplayOptions(**{k: v for k, v in d.items() if k in known})
 
 
 def overridden(pinned: ReplayOptions, given: ReplayOptions | None) -> ReplayOptions:

@@ -1,0 +1,65 @@
+"""The golden pytest plug-in as a lab uses it: `pytest --sgtool-golden DIR` in a subprocess
+(one test per pinned log) and the checked-in example test with the fixture."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+from support.paths import GOLDEN, REPO
+
+from sgtool.analysis.golden_check import pin_logs
+from sgtool.replayers.derived_log import ReplayOptions
+
+
+def pytest_run(*args, cwd):
+    env = {**os.environ, "HF_HUB_OFFLINE": "1", "TRANSFORMERS_OFFLINE": "1", "MPLBACKEND": "Agg"}
+    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+                           "-p", "no:dash", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, env=env, timeout=600)
+    return done.returncode, done.stdout + done.stderr
+
+
+def test_one_test_per_pinned_log_and_the_report_as_failure(tmp_path):
+    logs = []
+    for name in ("a", "b"):
+        logs.append(tmp_path / f"{name}.mcap")
+        shutil.copyfile(GOLDEN / "house10-start.mcap", logs[-1])
+    folder = tmp_path / "pins"
+    pin_logs(logs, folder, ReplayOptions(max_frames=20), copy=True)
+    code, out = pytest_run("--sgtool-golden", folder, cwd=tmp_path)
+    assert code == 0, out
+    assert "2 passed" in out
+    # b's pin holds the graphs of 8 cm voxels, but says 5 cm (a mapping change in effect):
+    # its test fails with the layer-by-layer report
+    pin_logs([folder / "b.mcap"], folder, ReplayOptions(max_frames=20, voxel_size=0.08))
+    index = json.loads((folder / "expected.json").read_text())
+    del index["cases"]["b"]["options"]["voxel_size"]
+    (folder / "expected.json").write_text(json.dumps(index))
+    code, out = pytest_run("--sgtool-golden", folder, "-rf", cwd=tmp_path)
+    assert code == 1, out
+    assert "1 failed, 1 passed" in out
+    assert "b: changed" in out and "refresh 0 at" in out and "rooms:" in out
+    assert "sgtool golden check --dir" in out  # how to accept it
+    code, out = pytest_run("--sgtool-golden", folder, "--sgtool-golden-update", cwd=tmp_path)
+    assert code == 0 and "2 passed" in out
+    code, out = pytest_run("--sgtool-golden", folder, cwd=tmp_path)
+    assert code == 0 and "2 passed" in out
+
+
+def test_a_damaged_pin_folder_is_a_collection_error_naming_it(tmp_path):
+    folder = tmp_path / "pins"
+    folder.mkdir()
+    (folder / "expected.json").write_text("{not json")
+    code, out = pytest_run("--sgtool-golden", folder, cwd=tmp_path)
+    assert code != 0
+    assert f"{folder / 'expected.json'}: damaged pin file" in out
+
+
+def test_the_example_test_runs_with_the_fixture():
+    code, out = pytest_run("examples/test_golden_logs.py", cwd=REPO)
+    assert code == 0, out
+    assert "2 passed" in out
