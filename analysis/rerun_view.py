@@ -10,7 +10,15 @@ nothing of sgtool's JSON records; so sgtool logs everything natively with the Re
 - ``world/map/voronoi``: the Voronoi graph coloured by room (``LineStrips3D``);
 - ``world/map/voxels``: the semantic voxel map when the caller passes one per refresh;
 - ``world/graph/rooms|objects|frontiers``: scene-graph nodes with labels;
+- ``graph``: the scene graph as ``GraphNodes``/``GraphEdges`` (rooms, regions, frontiers,
+  objects and doors; edges object -> parent, region -> room, door -> rooms, room ->
+  neighbour), for Rerun's graph view;
 - ``actions``: the actions with their outcomes (``TextLog``).
+
+Every recording carries a default blueprint (:func:`blueprint`): the 3D map with the
+robot and the graph, a bird's-eye view of the occupancy grid with the Voronoi graph and
+rooms, the camera's RGB, depth and segmentation, the scene graph's graph view and the
+action log.
 
 Two timelines: ``frame`` (frame index) and ``sim_time`` (log time since the start). Export is
 deterministic for a given log (the recording id is derived from the log's bytes:
@@ -54,6 +62,32 @@ def require_space(rrd_path: Path) -> None:
     st = os.statvfs(rrd_path.parent)
     if st.f_bavail * st.f_frsize < FREE_MARGIN:
         raise output_error(OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)), rrd_path)
+
+
+def blueprint() -> Any:
+    """The default layout of an sgtool recording (module doc)."""
+    import rerun.blueprint as rrb
+
+    cam = "world/camera/image"
+    return rrb.Blueprint(rrb.Horizontal(
+        rrb.Vertical(
+            rrb.Spatial3DView(name="3D map", origin="world"),
+            rrb.Spatial3DView(name="Bird's-eye map", origin="world", contents=[
+                "+ world/map/occupancy", "+ world/map/voronoi/**", "+ world/map/rooms/**",
+                "+ world/robot/**", "+ world/graph/**"]),
+        ),
+        rrb.Vertical(
+            rrb.Horizontal(
+                rrb.Spatial2DView(name="RGB", origin=cam, contents=[f"+ {cam}/rgb"]),
+                rrb.Spatial2DView(name="Depth", origin=cam, contents=[f"+ {cam}/depth"]),
+                rrb.Spatial2DView(name="Segmentation", origin=cam,
+                                  contents=[f"+ {cam}/segmentation"]),
+            ),
+            rrb.GraphView(name="Scene graph", origin="graph"),
+            rrb.TextLogView(name="Actions", origin="actions"),
+        ),
+        column_shares=[3, 2],
+    ), collapse_panels=False)
 
 
 def recording_id(log_path: Path) -> str:
@@ -125,10 +159,10 @@ def export(
     target = contextlib.nullcontext(None) if out is None else atomic_output(out)
     with target as tmp:
         if spawn:
-            rec.spawn()
+            rec.spawn(default_blueprint=blueprint())
         elif out is not None and tmp is not None:
             require_space(out)
-            rec.save(tmp)
+            rec.save(tmp, default_blueprint=blueprint())
             progress = _watching_space(out, progress)
         with LogReader(log_path, verify=True) as r:  # a damaged chunk: one line, no .rrd
             unposed, framed = _export(rec, r, every=every, max_frames=max_frames,
@@ -272,8 +306,59 @@ def _export(
     return unposed, framed
 
 
+def graph_nodes_edges(g: dict[str, Any]) -> tuple[list[str], list[str], list[tuple[float, float]],
+                                                   list[tuple[int, int, int]],
+                                                   list[tuple[str, str]]]:
+    """The scene graph record ``g`` as graph-view nodes (ids, labels, 2D positions,
+    colours) and edges between node ids (module doc); an edge to a node the graph does not
+    hold is left out."""
+    ids: list[str] = []
+    labels: list[str] = []
+    pos: list[tuple[float, float]] = []
+    cols: list[tuple[int, int, int]] = []
+
+    def node(nid: str, label: str, xy: Any, col: tuple[int, int, int]) -> None:
+        ids.append(nid)
+        labels.append(label)
+        pos.append((float(xy[0]), -float(xy[1])))  # the graph view's y points down
+        cols.append(col)
+
+    for rm in g.get("rooms") or ():
+        node(rm["id"], f"{rm['id']} {rm.get('category') or ''}".strip(), rm["position"],
+             color_for(rm["id"]))
+    for x in g.get("regions") or ():
+        kind = x.get("kind") or "region"
+        col = ((40, 200, 255) if x.get("frontier_type") == "leading out" else (255, 200, 40)
+               ) if kind == "frontier" else (150, 150, 150)
+        node(x["id"], x["id"], x["position"], col)
+    for o in g.get("objects") or ():
+        state = f" ({o['state']})" if o.get("state") else ""
+        node(o["id"], f"{o['category']}{state}", o["position"], color_for(o.get("room") or o["id"]))
+    for d in g.get("doors") or ():
+        node(d["id"], f"door ({d.get('state') or '?'})", d["position"],
+             (50, 200, 50) if d.get("state") == "open" else (220, 50, 50))
+    known = set(ids)
+    edges: list[tuple[str, str]] = []
+    for o in g.get("objects") or ():
+        edges.append((o["id"], o.get("parent") or ""))
+    for x in g.get("regions") or ():
+        edges.append((x["id"], x.get("room") or ""))
+    for d in g.get("doors") or ():
+        edges.extend((d["id"], r) for r in d.get("rooms") or ())
+    for rm in g.get("rooms") or ():
+        edges.extend((rm["id"], n) for n in rm.get("neighbours") or () if rm["id"] < n)
+    return ids, labels, pos, cols, [(a, b) for a, b in edges if a in known and b in known]
+
+
 def _log_scene_graph(rec: Any, g: dict[str, Any]) -> None:
     import rerun as rr
+
+    ids, labels, pos, cols, edges = graph_nodes_edges(g)
+    if ids:
+        rec.log("graph", rr.GraphNodes(ids, labels=labels, positions=pos, colors=cols),
+                rr.GraphEdges(edges, graph_type="undirected"))
+    else:
+        rec.log("graph", rr.Clear(recursive=False))
 
     rooms = g.get("rooms", [])
     if rooms:

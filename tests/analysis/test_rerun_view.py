@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import sys
@@ -70,6 +71,43 @@ def test_view_of_a_replayed_log_with_voxels_and_derived_layers(tmp_path):
     r = CliRunner().invoke(cli, ["view", str(derived), "-o", str(out)])
     assert r.exit_code == 0, r.output
     rrd_verify(out)
+    printed = rrd_print(out)
+    assert "Blueprint" in printed and "ViewBlueprint" in printed  # the default layout
+    assert re.search(r" /graph - data columns: \[GraphEdges:edges .*GraphNodes:node_ids", printed)
+
+
+def rrd_print(path: Path) -> str:
+    """`rerun rrd print PATH` (the venv's rerun, else the one on PATH)."""
+    exe = str(Path(sys.executable).parent / "rerun")
+    if not Path(exe).exists():
+        exe = shutil.which("rerun") or "rerun"
+    res = subprocess.run([exe, "rrd", "print", str(path)], capture_output=True, text=True,
+                         timeout=120)
+    assert res.returncode == 0, res.stderr
+    return res.stdout + res.stderr
+
+
+def test_graph_nodes_and_edges():
+    from sgtool.analysis.rerun_view import graph_nodes_edges
+
+    g = {"rooms": [{"id": "room:1", "category": "kitchen", "position": [0, 0],
+                    "neighbours": ["room:2"]},
+                   {"id": "room:2", "category": "hall", "position": [4, 0],
+                    "neighbours": ["room:1"]}],
+         "regions": [{"id": "region:1.1", "kind": "region", "room": "room:1",
+                      "position": [1, 2]}],
+         "objects": [{"id": "obj:3", "category": "cabinet", "parent": "region:1.1",
+                      "room": "room:1", "position": [1, 2, 0.5], "state": "closed"},
+                     {"id": "obj:4", "category": "apple", "parent": "obj:9",
+                      "room": "room:1", "position": [1, 2, 0.9]}],
+         "doors": [{"id": "door:5", "position": [2, 0], "rooms": ["room:1", "room:2"],
+                    "state": "open"}]}
+    ids, labels, pos, _, edges = graph_nodes_edges(g)
+    assert ids == ["room:1", "room:2", "region:1.1", "obj:3", "obj:4", "door:5"]
+    assert labels[3] == "cabinet (closed)" and pos[2] == (1.0, -2.0)
+    # obj:4's parent obj:9 is not in the graph: no edge; room neighbours once
+    assert edges == [("obj:3", "region:1.1"), ("region:1.1", "room:1"), ("door:5", "room:1"),
+                     ("door:5", "room:2"), ("room:1", "room:2")]
 
 
 @pytest.mark.parametrize("links", [
