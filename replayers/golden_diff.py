@@ -6,9 +6,10 @@ is: its graphs in log-time order, the room areas and Voronoi graph size from its
 (:func:`~sgtool.replayers.golden_layers.summary_of_messages`), the frames of a refresh
 counted from its depth images. Any other log is replayed with the options given
 (:func:`~sgtool.replayers.golden_pins.capture`, which also scores it when it carries its
-house; with ``max_frames``, its actions up to the last refresh count). The report is :func:`~sgtool.replayers.golden.describe_mismatch` of the two
-sequences (the first refresh that differs), the quality figures of both when both have
-them, and the first logged action (skill and target) that differs.
+house; with ``max_frames``, its actions up to the last refresh count). The report is
+:func:`~sgtool.replayers.golden.describe_mismatch` of the two sequences (the first refresh
+that differs), the quality figures of both when both have them, and the first logged
+action (skill and target) that differs.
 """
 
 from __future__ import annotations

@@ -248,9 +248,9 @@ def read_pins(folder: str | os.PathLike[str]) -> PinSet:
                        f"{PIN_FORMAT}, sgtool {__version__}); upgrade sgtool, or pin again")
     common = doc.get("replay", {}) if fmt == 1 else {}
     logs: dict[str, Pinned] = {}
-    for name, e in sorted(doc["cases"].items()):
+    for name, entry in sorted(doc["cases"].items()):
         try:
-            logs[name] = _entry(name, e, common, fmt, path)
+            logs[name] = _entry(name, entry, common, fmt, path)
         except (KeyError, TypeError, ValueError) as err:
             raise _damaged(path, f"entry {name!r}: {type(err).__name__} {err}") from None
     return PinSet(root, logs, fmt, str(doc.get("sgtool_version", "")))

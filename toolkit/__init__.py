@@ -45,6 +45,11 @@ logged decisions       :func:`load_results`, :func:`read_log_episodes`,
 import and export      :func:`import_rgbd`, :class:`RgbdOptions` (:class:`PinholeParams`
                        from :func:`parse_intrinsics`), :class:`ImportReport`,
                        :func:`export_bag`, :class:`ExportReport`
+golden logs            :func:`pin_logs`, :func:`check_pins` (a :class:`CheckReport` of
+                       :class:`LogCheck` s), :func:`update_pins`, :func:`read_pins`
+                       (:class:`PinSet` of :class:`Pinned`), :func:`diff_logs`
+                       (:class:`LogDiff`), :func:`diff_graphs`, :func:`describe_mismatch`,
+                       :func:`replay_graphs`
 errors                 :class:`SgtoolError` (every failure a user can cause),
                        :class:`LogFormatError`, :class:`SpecError`
 =====================  =====================================================================

@@ -100,6 +100,20 @@ from sgtool.recorders.importers.textformats import parse_intrinsics as parse_int
 from sgtool.recorders.importers.sink import ImportReport as ImportReport
 from sgtool.recorders.exporters.bag_export import export_bag as export_bag
 from sgtool.recorders.exporters.bag_export import ExportReport as ExportReport
+# golden logs: pin a log's replay, check it after a change, diff two logs
+from sgtool.analysis.golden_check import pin_logs as pin_logs
+from sgtool.analysis.golden_check import check_pins as check_pins
+from sgtool.analysis.golden_check import update_pins as update_pins
+from sgtool.analysis.golden_check import CheckReport as CheckReport
+from sgtool.analysis.golden_check import LogCheck as LogCheck
+from sgtool.replayers.golden_pins import read_pins as read_pins
+from sgtool.replayers.golden_pins import PinSet as PinSet
+from sgtool.replayers.golden_pins import Pinned as Pinned
+from sgtool.replayers.golden_diff import diff_logs as diff_logs
+from sgtool.replayers.golden_diff import LogDiff as LogDiff
+from sgtool.replayers.golden import replay_graphs as replay_graphs
+from sgtool.replayers.golden import diff_graphs as diff_graphs
+from sgtool.replayers.golden import describe_mismatch as describe_mismatch
 
 
 def planner_names() -> tuple[str, ...]: ...
@@ -120,5 +134,7 @@ __all__ = [
     "PlannerSummary", "Stat", "format_table", "read_results", "write_results", "load_results",
     "read_log_episodes", "LoggedEpisode", "replay_decisions", "OfflineReport", "format_offline",
     "import_rgbd", "RgbdOptions", "PinholeParams", "parse_intrinsics", "ImportReport",
-    "export_bag", "ExportReport",
+    "export_bag", "ExportReport", "pin_logs", "check_pins", "update_pins", "CheckReport",
+    "LogCheck", "read_pins", "PinSet", "Pinned", "diff_logs", "LogDiff", "replay_graphs",
+    "diff_graphs", "describe_mismatch",
 ]
