@@ -201,7 +201,7 @@ def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     minute; tests/recorders/sim covers run_episode)."""
     guide = (REPO / "docs" / "api.md").read_text()
     blocks = re.findall(r"```python\n(.*?)```", guide, re.DOTALL)
-    assert len(blocks) == 11
+    assert len(blocks) == 12
     runnable = [b for b in blocks if "run_closed_loop(" not in b]
     assert len(runnable) == len(blocks) - 1
     for name in ("tests", "examples"):
@@ -219,3 +219,6 @@ def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
         assert [r.skill for _, r in log.records(sgtool.ActionRecord)] == ["navigate"]
     report = namespace["report"]
     assert isinstance(report, sgtool.OfflineReport) and report.decisions > 0
+    checked, what_if = namespace["checked"], namespace["what_if"]  # the golden-logs block
+    assert isinstance(checked, sgtool.CheckReport) and checked.exit_code == 0
+    assert isinstance(what_if, sgtool.CheckReport) and what_if.exit_code == 1
