@@ -1,6 +1,8 @@
-"""Seeded mutants of a log file (bit flips, overwrites, truncations) and the judgement of
-what a command did with one: for tests/toolkit/log/test_fuzz.py (in-process) and
-benchmarks/fuzz_cli.py (through the CLI).
+"""Seeded mutants of a log file (bit flips, overwrites, truncations), crafted logs
+(tests/support/crafted_logs.py: wrong schemas and encodings, bad house attachments, /tf
+trees with cycles or without the camera link, instance tables out of range) and the
+judgement of what a command did with one: for tests/toolkit/log/test_fuzz.py (in-process)
+and benchmarks/fuzz_cli.py (through the CLI).
 
 A mutant knows which bytes it changed, so the chunks it left whole are known from the
 original's layout: recovery must give back at least their messages. A "complete" verdict
@@ -126,3 +128,34 @@ def view_or_none(path: Path) -> tuple | None:
         return reader_view(path)
     except SgtoolError:
         return None
+
+
+# crafted logs (tests/support/crafted_logs.py): what replay (with and without --score)
+# must do with each; "error" is a one-line refusal. Every other command may read or refuse
+# one (never a traceback); doctor must call each "complete" (they are valid MCAP files) and
+# recovery must keep every message.
+_READ_BY_REPLAY = {"valid", "tf-huge-quaternion", "no-house", "house-not-json", "house-deep",
+                   "house-not-utf8", "house-invalid"}
+_SCORED = {"valid", "tf-huge-quaternion"}
+
+
+def crafted_expectation(name: str) -> dict[str, str]:
+    """{"replay": "clean" | "error", "score": ...} for the crafted log ``name``."""
+    return {"replay": "clean" if name in _READ_BY_REPLAY else "error",
+            "score": "clean" if name in _SCORED else "error"}
+
+
+def crafted_logs(work: Path) -> list[tuple[str, Path]]:
+    """Every crafted log of :data:`support.crafted_logs.CRAFTS`, written under ``work``."""
+    from support.crafted_logs import CRAFTS
+
+    return [(name, build(work / f"crafted-{i:02d}.mcap"))
+            for i, (name, build) in enumerate(CRAFTS.items())]
+
+
+def message_count(path: Path) -> int:
+    """Messages of a valid log, as a reader counts them."""
+    from sgtool.log import LogReader
+
+    with LogReader(path, check_version=False) as r:
+        return sum(1 for _ in r.raw_messages())

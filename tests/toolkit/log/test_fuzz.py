@@ -4,8 +4,11 @@ recorded sgtool log and of a real ROS 2 MCAP, run in-process through the functio
 (load_results). Each call succeeds or raises one SgtoolError; a "complete" verdict is
 given only to a mutant a reader sees exactly as the original (tests/support/log_fuzz.py
 says why header and metadata values are not part of that view); recovery gives back at
-least the messages of the chunks the mutant left whole. ``benchmarks/fuzz_cli.py`` runs
-the same campaign through the CLI.
+least the messages of the chunks the mutant left whole. Crafted logs (valid MCAP files
+with wrong content: schemas, encodings, house attachments, /tf trees, instance tables) go
+through the same functions, replay also with the house scoring, frames as ``view`` reads
+them: each is read or refused in one line as tests/support/log_fuzz.py expects.
+``benchmarks/fuzz_cli.py`` runs both campaigns through the CLI.
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ from typing import Any
 
 import pytest
 from support.log_fuzz import campaign as prepare
+from support.log_fuzz import crafted_expectation, crafted_logs, message_count
 from support.logfixtures import write_log
 
 from sgtool.errors import SgtoolError
@@ -112,3 +116,61 @@ def test_fuzz_ros2_mcap(shared_data_dir, tmp_path):
     _print(f"{N_MUTANTS} mutants of the ROS 2 MCAP talker.mcap", table)
     assert not failures, "\n".join(failures[:10])
     assert table["info", "clean"] > 0 and table["info", "error"] > 0
+
+
+def _scored(path: Path) -> Any:
+    """replay --score in-process: the house attachment validated, the graph scored."""
+    from sgtool.log import LogReader
+    from sgtool.replayers.derived_log import ReplayOptions, replay
+    from sgtool.replayers.score import score
+
+    with LogReader(path) as r:
+        spec = r.house_spec()
+    if spec is None:
+        raise SgtoolError(f"{path} has no house spec attachment")
+    final: dict[str, Any] = {}
+    replay(path, None, ReplayOptions(every=100, voxel_size=0.2),
+           on_refresh=lambda ref, stream: final.update(ref=ref, stream=stream))
+    return score(spec, final["stream"].builder.instances, final["ref"].layers,
+                 final["ref"].graph)
+
+
+def _frames(path: Path) -> int:
+    from sgtool.log import LogReader
+
+    with LogReader(path) as r:
+        return sum(1 for _ in r.frames())
+
+
+def test_fuzz_crafted_logs(tmp_path):
+    """Every crafted log: no crash; doctor "complete", recovery keeps every message;
+    replay (and replay --score) read or refuse it as expected, never a silently wrong
+    result (an out-of-range instance table used to give an empty graph)."""
+    table: Counter[tuple[str, str]] = Counter()
+    failures: list[str] = []
+    out = tmp_path / "recovered.mcap"
+    for name, path in crafted_logs(tmp_path):
+        res = _commands(path, out)
+        res["score"] = _run(lambda p=path: _scored(p))
+        res["frames"] = _run(lambda p=path: _frames(p))
+        want = crafted_expectation(name)
+        for cmd, (outcome, value) in res.items():
+            if outcome == "crash":
+                failures.append(f"{name} {cmd}: {value}")
+            elif cmd in want and outcome != want[cmd]:
+                failures.append(f"{name} {cmd}: {outcome}, expected {want[cmd]}: {value}")
+                outcome = "wrong"
+            elif cmd == "doctor" and value.status != "complete":
+                failures.append(f"{name} doctor: {value.status} {value.problems[:2]}")
+                outcome = "wrong"
+            elif cmd == "recover" and value.readable_messages != message_count(path):
+                failures.append(f"{name} recover: {value.readable_messages} messages kept")
+                outcome = "wrong"
+            table[cmd, outcome] += 1
+    cmds = ["info", "doctor", "recover", "replay", "score", "frames", "eval"]
+    print(f"\n{table['doctor', 'clean']} crafted logs")
+    print(f"{'':8}" + "".join(f"{c:>9}" for c in cmds))
+    for outcome in ("clean", "error", "crash", "wrong"):
+        print(f"{outcome:8}" + "".join(f"{table[c, outcome]:>9}" for c in cmds))
+    assert not failures, "\n".join(failures[:10])
+    assert table["replay", "clean"] > 0 and table["replay", "error"] > 0
