@@ -213,7 +213,7 @@ def _is_own(folder: Path, command: str, known: Sequence[str]) -> bool:
 
 
 def _folder_target(target: str | os.PathLike[str], option: str) -> Path:
-    path = Path(target)
+    path = Path(os.path.abspath(target))  # "." has a name and a parent to build beside
     if path.is_symlink() and path.is_dir():  # a link to a folder: the folder is the target
         path = Path(os.path.realpath(path))
     if path.exists() and not path.is_dir():

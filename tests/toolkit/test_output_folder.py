@@ -200,3 +200,16 @@ def test_resume_takes_a_folder_of_known_names_without_a_manifest(tmp_path: Path)
                        resume=True) as folder:
         assert folder == out
     assert read_manifest(out) == ("run-bench", frozenset({"logs"}))
+
+
+def test_the_current_folder_is_built_beside_it(tmp_path: Path,
+                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    out = tmp_path / "res"
+    out.mkdir()
+    _write(out, **{"mine.txt": "mine"})
+    monkeypatch.chdir(out)
+    with output_folder(".", force=True) as stage:
+        assert stage.parent == tmp_path
+        _write(stage, **{"a.txt": "1"})
+    assert sorted(os.listdir(out)) == [MANIFEST, "a.txt", "mine.txt"]
+    assert os.listdir(tmp_path) == ["res"]
