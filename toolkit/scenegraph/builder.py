@@ -16,8 +16,9 @@ caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
    (:func:`~sgtool.mapping.voronoi.visited_components`);
 3. rooms (:mod:`sgtool.scenegraph.room_segmentation`): door cells of the voxels the open
    doors win (:mod:`sgtool.scenegraph.door_evidence`,
-   :meth:`sgtool.scenegraph.door_voxels.DoorVoxels.won`) cut the graph, ids are kept
-   stable by overlap with the previous refresh;
+   :meth:`sgtool.scenegraph.door_voxels.DoorVoxels.won`), within ``DOOR_REACH`` of
+   their median (:func:`sgtool.scenegraph.door_voxels.near_median`), cut the graph, ids
+   are kept stable by overlap with the previous refresh;
 4. objects (:mod:`sgtool.scenegraph.object_placement`, :mod:`sgtool.scenegraph.assign`):
    instances seen with enough points, placed at their voxel centroid, first-level ones
    assigned by MoMa-LLM's weighted travel distance from their closest viewpoint, nested
@@ -92,7 +93,7 @@ from sgtool.scenegraph.door_evidence import (
     observe_doors,
     open_doors,
 )
-from sgtool.scenegraph.door_voxels import DoorVoxels
+from sgtool.scenegraph.door_voxels import DoorVoxels, near_median
 from sgtool.scenegraph.frontier_ids import FrontierTracker
 from sgtool.scenegraph.frontiers import Frontier, find_frontiers
 from sgtool.scenegraph.graph import SceneGraph
@@ -116,8 +117,10 @@ from sgtool.scenegraph.travel import node_distances, travel_distances
 from sgtool.scenegraph.visibility import entry_nodes, nearest_visible
 
 BODY_RADIUS = 0.2  # m: unlabelled voxels this close to where the robot stood are dropped
+DOOR_REACH = 1.5  # m: a door's evidence is its won voxels this close to their median
 
-__all__ = ["BODY_RADIUS", "BuilderConfig", "DoorObservation", "MapLayers", "SceneGraphBuilder"]
+__all__ = ["BODY_RADIUS", "DOOR_REACH", "BuilderConfig", "DoorObservation", "MapLayers",
+           "SceneGraphBuilder"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -440,6 +443,8 @@ class SceneGraphBuilder:
         """Rooms: the door evidence cuts the graph; ids stay stable by overlap."""
         cfg = self.config.rooms
         won = self._door_voxels.won(open_doors(self.instances), self.voxels.winning_labels)
+        reach = DOOR_REACH / self.voxels.resolution
+        won = {iid: near_median(ijk, reach) for iid, ijk in won.items()}
         cells = door_cells_of(occ, won, self._panel_memo)
         cells.setflags(write=False)  # kept to recognise the same cells next time
         got = self._density

@@ -14,7 +14,9 @@ Door *evidence* is the voxels a door wins (:meth:`DoorVoxels.won`): labels are v
 frames, so a frame that gave another object's pixels a door's id (a swapped label) adds
 a minority door vote there and no doorway. Only the kept door keys' voxels can be won by
 a door, so their winners are looked up in those voxels alone
-(:meth:`~sgtool.mapping.voxels.VoxelMap.winning_labels`), never by a scan of the map.
+(:meth:`~sgtool.mapping.voxels.VoxelMap.winning_labels`), never by a scan of the map. A
+swapped frame can still leave a blob a door wins elsewhere (an object seen in that frame
+only); the door's evidence is the won voxels near their median (:func:`near_median`).
 """
 
 from __future__ import annotations
@@ -25,6 +27,20 @@ import numpy as np
 
 from sgtool.mapping.vote_store import sorted_unique
 from sgtool.mapping.voxels import LABEL_MASK, VOXEL_SHIFT, unpack
+
+
+def near_median(ijk: np.ndarray, reach: float) -> np.ndarray:
+    """The voxels (ijk rows) within ``reach`` voxels (xy distance) of their median x and
+    median y: a door's voxels are one panel and its opening, so votes that a swapped
+    label left elsewhere in the house (a few frames against hundreds) are dropped; the
+    median stays with the majority. Order kept."""
+    if len(ijk) == 0:
+        return ijk
+    mx = float(np.median(ijk[:, 0]))
+    my = float(np.median(ijk[:, 1]))
+    d2 = (ijk[:, 0] - mx) ** 2 + (ijk[:, 1] - my) ** 2
+    keep = d2 <= reach * reach
+    return ijk if keep.all() else ijk[keep]
 
 
 class DoorVoxels:
