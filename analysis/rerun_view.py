@@ -143,24 +143,39 @@ def export(
     | None = None,
     spawn: bool = False,
     warn: Callable[[str], None] | None = None,
+    live: Any = None,
+    hold: Callable[[], None] | None = None,
 ) -> Path | None:
     """Write ``log_path`` as a Rerun recording to ``rrd_path`` (atomically), or stream it
-    to a spawned viewer when ``spawn`` is set. ``every`` logs one camera frame in K (maps,
-    graphs and actions are always logged). ``voxels``, when given, is called with the open
-    reader and yields (frame index, t_ns, voxel centres (N,3), colours (N,3) uint8,
-    voxel size) to draw the semantic voxel map over time. ``warn``, when given, receives
-    one-line notes about the log (frames without a camera pose)."""
+    to a spawned viewer when ``spawn`` is set, or to ``live`` (a
+    :class:`~sgtool.analysis.rerun_live.LiveTarget`: spawn, connect, serve; the web
+    viewer's address goes to ``warn``). ``hold``, when given, is called after everything is
+    sent and before the stream closes (a served recording lives until it returns).
+    ``every`` logs one camera frame in K (maps, graphs and actions are always logged).
+    ``voxels``, when given, is called with the open reader and yields (frame index, t_ns,
+    voxel centres (N,3), colours (N,3) uint8, voxel size) to draw the semantic voxel map
+    over time. ``warn``, when given, receives one-line notes about the log (frames without
+    a camera pose)."""
     import rerun as rr
 
     log_path = Path(log_path)
     rid = recording_id(log_path)
-    rec = rr.RecordingStream(APP_ID, recording_id=rid, send_properties=False)
-    out = None if spawn or rrd_path is None else Path(rrd_path)
+    if spawn and live is None:
+        from sgtool.analysis.rerun_live import LiveTarget
+
+        live = LiveTarget("spawn")
+    out = None if live is not None or rrd_path is None else Path(rrd_path)
     target = contextlib.nullcontext(None) if out is None else atomic_output(out)
     with target as tmp:
-        if spawn:
-            rec.spawn(default_blueprint=blueprint())
-        elif out is not None and tmp is not None:
+        if live is not None:
+            from sgtool.analysis.rerun_live import open_stream
+
+            rec, where = open_stream(live, rid)
+            if where is not None and warn is not None:
+                warn(f"web viewer at {where}")
+        else:
+            rec = rr.RecordingStream(APP_ID, recording_id=rid, send_properties=False)
+        if out is not None and tmp is not None:
             require_space(out)
             rec.save(tmp, default_blueprint=blueprint())
             progress = _watching_space(out, progress)
@@ -174,6 +189,8 @@ def export(
         rec.flush(timeout_sec=FLUSH_TIMEOUT_S)
         if out is not None and tmp is not None:
             require_space(out)
+        if hold is not None:
+            hold()
         rec.disconnect()
     return out
 

@@ -61,6 +61,10 @@ from sgtool.scenegraph.options import CLASSIFIERS
               "more than 1 s refused.")
 @click.option("--rrd", type=click.Path(dir_okay=False),
               help="Also write a Rerun recording of the derived log (needs -o).")
+@click.option("--rerun", "rerun_to", default=None, metavar="spawn|connect[:URL]|serve[:PORT]",
+              help="Stream every refresh (maps, scene graph, robot) to Rerun while replaying: "
+              "spawn a viewer, connect to one, or serve a web viewer (headless machines; "
+              "waits for Ctrl-C at the end).")
 @click.option("--score", is_flag=True,
               help="Score the final graph against the house spec in the log: room count "
               "error, Voronoi node purity and adjusted Rand index, object-to-room and room "
@@ -89,7 +93,8 @@ def command(logs: tuple[str, ...], output: str | None, every: int | None,
             llm_base_url: str | None = None, llm_model: str | None = None,
             llm_api_key: str | None = None, llm_timeout: float = 60.0,
             llm_constraint: str = "auto", llm_replay: tuple[str, ...] = (),
-            llm_transcript: str | None = None, tf_time: str = "log") -> None:
+            llm_transcript: str | None = None, tf_time: str = "log",
+            rerun_to: str | None = None) -> None:
     """Replay LOG into a semantic voxel map, BEV occupancy, a Voronoi graph, rooms, objects,
     frontiers and the hierarchical scene graph, deterministically: the same log and options
     give a byte-identical output.
@@ -127,7 +132,8 @@ def command(logs: tuple[str, ...], output: str | None, every: int | None,
         if out_dir is None:
             raise SgtoolError("several logs (or a folder) replay into a folder: give "
                               "--out-dir DIR")
-        for given, opt in ((output, "-o"), (rrd, "--rrd"), (score, "--score")):
+        for given, opt in ((output, "-o"), (rrd, "--rrd"), (score, "--score"),
+                           (rerun_to, "--rerun")):
             if given:
                 raise SgtoolError(f"{opt} takes one log; leave it out with --out-dir")
         _batch(logs, Path(out_dir), ReplayOptions(
@@ -181,8 +187,16 @@ def command(logs: tuple[str, ...], output: str | None, every: int | None,
     with llm.room_classifier() as rooms, tqdm(
             total=total, unit="frame", desc="replay", file=sys.stderr, leave=False,
             disable=not show, dynamic_ncols=True) as bar:
-        report = replay(src, dst, opts, on_refresh=keep if score else None, progress=bar,
-                        verify=verify, room_classifier=rooms.make)
+        live = None
+        if rerun_to is not None:
+            from sgtool.analysis.rerun_live import LiveReplay
+
+            live = LiveReplay.start(rerun_to, src, lambda m: click.echo(m, err=True))
+        on_refresh = keep if score else None
+        report = replay(src, dst, opts, on_refresh=live.chain(on_refresh) if live else on_refresh,
+                        progress=bar, verify=verify, room_classifier=rooms.make)
+    if live is not None:
+        live.finish(lambda m: click.echo(m, err=True))
     scores = None
     if score:
         scores = _score(house, final)

@@ -22,15 +22,20 @@ from sgtool.errors import SgtoolError
               help="Stop after this many camera frames.")
 @click.option("--voxels/--no-voxels", default=True, show_default=True,
               help="Rebuild and show the semantic voxel map (needs the mapping pipeline).")
+@click.option("--rerun", "rerun_to", default=None, metavar="spawn|connect[:URL]|serve[:PORT]",
+              help="Where to stream instead of -o: spawn a viewer (the default without -o), "
+              "connect to a running one, or serve a web viewer from here (headless "
+              "machines; waits for Ctrl-C).")
 def command(log: str, out: str | None, every: int, max_frames: int | None,
-            voxels: bool, force: bool = False) -> None:
+            voxels: bool, force: bool = False, rerun_to: str | None = None) -> None:
     """Show LOG in Rerun: camera with RGB, depth and segmentation, the voxel map, BEV
     occupancy, the Voronoi graph coloured by room, room labels, objects, frontiers, the
     robot's path and its actions, on a frame timeline. Derived layers appear when LOG is
     the output of `sgtool replay`.
 
     Without -o the Rerun viewer is spawned (it needs a display); with -o the recording is
-    written to a file that `rerun view.rrd` opens later (`rerun rrd verify` checks it).
+    written to a file that `rerun view.rrd` opens later (`rerun rrd verify` checks it); on
+    a headless machine `--rerun serve` serves a web viewer (port 9090, gRPC 9876).
 
     Opening a derived .mcap directly in Rerun (its own MCAP import) or in ROS tools does
     not show the maps: they do not read foxglove.Grid/SceneUpdate. This command draws them;
@@ -38,15 +43,23 @@ def command(log: str, out: str | None, every: int, max_frames: int | None,
     nav_msgs/OccupancyGrid and visualization_msgs/MarkerArray."""
     from tqdm import tqdm
 
+    from sgtool.analysis.rerun_live import LiveTarget, parse_target
     from sgtool.analysis.rerun_view import export
     from sgtool.log import LogReader
 
+    live = None
+    if rerun_to is not None and out is not None:
+        raise SgtoolError("-o writes a file, --rerun streams: give one of them")
     if out is None:
-        if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        live = parse_target(rerun_to) if rerun_to is not None else LiveTarget("spawn")
+        if live.mode == "spawn" and not (os.environ.get("DISPLAY")
+                                         or os.environ.get("WAYLAND_DISPLAY")):
             raise SgtoolError("no display to open the Rerun viewer on; write a file with "
-                              "-o view.rrd and open it with `rerun view.rrd` elsewhere")
-        if shutil.which("rerun") is None:
-            raise SgtoolError("the `rerun` viewer is not on PATH; use -o view.rrd")
+                              "-o view.rrd and open it with `rerun view.rrd` elsewhere, or "
+                              "serve a web viewer from here with --rerun serve")
+        if live.mode == "spawn" and shutil.which("rerun") is None:
+            raise SgtoolError("the `rerun` viewer is not on PATH; use -o view.rrd or "
+                              "--rerun serve")
     elif Path(out).resolve() == Path(log).resolve():
         raise SgtoolError("the output must not be the input log")
     else:
@@ -68,7 +81,21 @@ def command(log: str, out: str | None, every: int, max_frames: int | None,
                 return voxel_snapshots(reader, every=max(every, 10), max_frames=max_frames)
     with tqdm(total=total, unit="frame", desc="view", disable=None) as bar:
         export(log, out, every=every, max_frames=max_frames, progress=bar.update,
-               voxels=voxel_source, spawn=out is None,
-               warn=lambda m: click.echo(f"note: {m}", err=True))
+               voxels=voxel_source, live=live,
+               warn=lambda m: click.echo(f"note: {m}", err=True),
+               hold=_serve_until_interrupted if live is not None and live.mode == "serve"
+               else None)
     if out:
         click.echo(f"wrote {out}; open it with: rerun {out}")
+
+
+def _serve_until_interrupted() -> None:
+    """Keep a served recording up until Ctrl-C."""
+    import time
+
+    click.echo("rerun: everything sent; still serving, press Ctrl-C to stop", err=True)
+    try:
+        while True:
+            time.sleep(1.0)
+    except KeyboardInterrupt:
+        pass

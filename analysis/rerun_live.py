@@ -1,0 +1,208 @@
+"""Watching sgtool in Rerun while it runs: where a recording stream goes (``--rerun``),
+and a live view of a replay's refreshes.
+
+``--rerun`` takes one of:
+
+- ``spawn``: start a native Rerun viewer (needs a display and ``rerun`` on PATH);
+- ``connect`` or ``connect:URL``: stream to a running viewer (default
+  ``rerun+http://127.0.0.1:9876/proxy``, what ``rerun`` listens on);
+- ``serve``, ``serve:WEB_PORT`` or ``serve:WEB_PORT:GRPC_PORT``: serve the recording over
+  gRPC (port :data:`GRPC_PORT`) and a web viewer over HTTP (port :data:`WEB_PORT`) from
+  this process, for a headless machine: open ``http://HOST:WEB_PORT`` in a browser (forward the two
+  ports over SSH). The server lives as long as the command; ``serve`` waits for Ctrl-C
+  after the work is done so the recording stays viewable.
+
+:class:`LiveReplay` logs each refresh of a replay (occupancy, Voronoi graph, rooms, the
+scene graph as points and as a graph view, the robot's position) on the ``frame`` and
+``sim_time`` timelines, with the default blueprint of :mod:`sgtool.analysis.rerun_view`.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from sgtool.analysis.rerun_view import (
+    APP_ID,
+    _log_scene_graph,
+    _scene_update_strips,
+    blueprint,
+)
+from sgtool.errors import SgtoolError
+
+GRPC_PORT = 9876
+WEB_PORT = 9090
+DEFAULT_CONNECT = f"rerun+http://127.0.0.1:{GRPC_PORT}/proxy"
+MODES = ("spawn", "connect", "serve")
+
+
+@dataclass(frozen=True)
+class LiveTarget:
+    """Where a live recording goes: ``mode`` (spawn, connect, serve), the viewer ``url``
+    for connect, the HTTP ``web_port`` and gRPC ``grpc_port`` for serve."""
+
+    mode: str
+    url: str = DEFAULT_CONNECT
+    web_port: int = WEB_PORT
+    grpc_port: int = GRPC_PORT
+
+
+def parse_target(text: str, option: str = "--rerun") -> LiveTarget:
+    """``spawn``, ``connect[:URL]``, ``serve[:WEB_PORT[:GRPC_PORT]]`` (module doc); a bare
+    ``rerun+http://...`` URL means connect. Anything else is one line."""
+    mode, sep, arg = text.partition(":")
+    if text.startswith("rerun+http") or text.startswith("rerun://"):
+        return LiveTarget("connect", url=text)
+    if mode == "spawn" and not sep:
+        return LiveTarget("spawn")
+    if mode == "connect":
+        return LiveTarget("connect", url=arg or DEFAULT_CONNECT)
+    if mode == "serve":
+        if not sep:
+            return LiveTarget("serve")
+        ports = arg.split(":")
+        if len(ports) <= 2 and all(p.isdigit() and 0 < int(p) < 65536 for p in ports):
+            web = int(ports[0])
+            return LiveTarget("serve", web_port=web,
+                              grpc_port=int(ports[1]) if len(ports) == 2 else GRPC_PORT)
+        raise SgtoolError(f"{option} {text}: give serve:WEB_PORT or serve:WEB_PORT:GRPC_PORT "
+                          "with port numbers 1..65535")
+    raise SgtoolError(f"{option} {text!r}: give spawn, connect[:URL] or serve[:WEB_PORT]")
+
+
+def has_display() -> bool:
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def check_target(target: LiveTarget, option: str = "--rerun") -> None:
+    """Refuse in one line what cannot work here: spawning without a display or without
+    the ``rerun`` viewer on PATH (naming ``serve`` for a headless machine)."""
+    if target.mode != "spawn":
+        return
+    if not has_display():
+        raise SgtoolError(f"{option} spawn: no display to open the Rerun viewer on; on a "
+                          f"headless machine use {option} serve (a web viewer on port "
+                          f"{WEB_PORT}) or write a file")
+    if shutil.which("rerun") is None:
+        raise SgtoolError(f"{option} spawn: the `rerun` viewer is not on PATH; use "
+                          f"{option} serve or write a file")
+
+
+def open_stream(target: LiveTarget, recording_id: str) -> tuple[Any, str | None]:
+    """A Rerun recording stream sent to ``target`` with the default blueprint, and for
+    serve the web viewer's address to tell the user."""
+    import rerun as rr
+
+    check_target(target)
+    rec = rr.RecordingStream(APP_ID, recording_id=recording_id, send_properties=False)
+    bp = blueprint()
+    where = None
+    if target.mode == "spawn":
+        rec.spawn(default_blueprint=bp)
+    elif target.mode == "connect":
+        rec.connect_grpc(target.url, default_blueprint=bp)
+    else:
+        url = rec.serve_grpc(grpc_port=target.grpc_port, default_blueprint=bp)
+        rr.serve_web_viewer(web_port=target.web_port, open_browser=False, connect_to=url)
+        where = f"http://localhost:{target.web_port}/?url={url}"
+    return rec, where
+
+
+class LiveReplay:
+    """Logs a replay's refreshes to a live recording (module doc): pass :meth:`refresh`
+    (or :meth:`chain`) as ``replay``'s ``on_refresh``, then call :meth:`finish`."""
+
+    def __init__(self, rec: Any, target: LiveTarget | None = None) -> None:
+        import rerun as rr
+
+        self.rec = rec
+        self.target = target
+        self.refreshes = 0
+        rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+
+    @classmethod
+    def start(cls, text: str, log_path: Any, echo: Callable[[str], None]) -> LiveReplay:
+        """Parse ``--rerun TEXT``, open the stream (its recording id from the log's bytes)
+        and tell the user where to look through ``echo``."""
+        from pathlib import Path
+
+        from sgtool.analysis.rerun_view import recording_id
+
+        target = parse_target(text)
+        rec, where = open_stream(target, recording_id(Path(log_path)))
+        if where is not None:
+            echo(f"rerun: web viewer at {where} (gRPC port {target.grpc_port})")
+        return cls(rec, target)
+
+    def chain(self, other: Callable[[Any, Any], None] | None) -> Callable[[Any, Any], None]:
+        """An ``on_refresh`` that logs the refresh and then calls ``other`` (if any)."""
+        def both(ref: Any, stream: Any) -> None:
+            self.refresh(ref, stream)
+            if other is not None:
+                other(ref, stream)
+        return both
+
+    def finish(self, echo: Callable[[str], None], wait: Callable[[], None] | None = None
+               ) -> None:
+        """Flush; for serve, keep serving until Ctrl-C (``wait``: how to wait, by default
+        sleeping until a KeyboardInterrupt) so the recording stays viewable."""
+        import time
+
+        self.close()
+        if self.target is None or self.target.mode != "serve":
+            return
+        echo("rerun: done; still serving the recording, press Ctrl-C to stop")
+        try:
+            if wait is not None:
+                wait()
+            else:
+                while True:
+                    time.sleep(1.0)
+        except KeyboardInterrupt:
+            pass
+
+    def refresh(self, ref: Any, stream: Any) -> None:
+        import rerun as rr
+
+        from sgtool.log import codec
+        from sgtool.scenegraph.derived_layers import (
+            occupancy_message,
+            rooms_message,
+            voronoi_message,
+        )
+
+        rec = self.rec
+        rr.set_time("frame", sequence=self.refreshes, recording=rec)
+        rr.set_time("sim_time", duration=np.timedelta64(int(ref.time_ns), "ns"), recording=rec)
+        self.refreshes += 1
+        grid = occupancy_message(ref)
+        if grid is not None:
+            cells, origin, res = codec.decode_grid(grid)
+            h, w = cells.shape
+            rec.log("world/map/occupancy", rr.GridMap(
+                data=cells.tobytes(), format=rr.components.ImageFormat(
+                    width=w, height=h, color_model="L", channel_datatype="U8"),
+                cell_size=res, translation=[origin[0], origin[1], -0.01],
+                colormap=rr.components.Colormap.RvizMap))
+        for entity, make in (("world/map/voronoi", voronoi_message),
+                             ("world/map/rooms", rooms_message)):
+            upd = make(ref)
+            if upd is not None:
+                strips, colors = _scene_update_strips(upd)
+                rec.log(entity, rr.LineStrips3D(strips, colors=colors, radii=0.02)
+                        if strips else rr.Clear(recursive=False))
+        g = ref.graph.to_dict()
+        _log_scene_graph(rec, g)
+        robot = g.get("robot") or {}
+        if robot.get("position"):
+            x, y = robot["position"][:2]
+            rec.log("world/robot", rr.Points3D([(x, y, 0.02)], radii=0.15,
+                                               colors=[(230, 80, 40)]))
+
+    def close(self) -> None:
+        self.rec.flush()

@@ -1,0 +1,79 @@
+"""Live Rerun: ``--rerun`` parsing and its one-line refusals, and ``sgtool replay LOG
+--rerun serve`` serving a web viewer over HTTP while it runs (and until Ctrl-C)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+from support.paths import GOLDEN
+
+from sgtool.analysis.rerun_live import DEFAULT_CONNECT, LiveTarget, parse_target
+from sgtool.cli import cli
+from sgtool.errors import SgtoolError
+
+
+def test_parse_target():
+    assert parse_target("spawn") == LiveTarget("spawn")
+    assert parse_target("connect") == LiveTarget("connect", url=DEFAULT_CONNECT)
+    url = "rerun+http://10.0.0.2:9876/proxy"
+    assert parse_target(f"connect:{url}") == parse_target(url) == LiveTarget("connect", url=url)
+    assert parse_target("serve") == LiveTarget("serve")
+    assert parse_target("serve:8000:8001") == LiveTarget("serve", web_port=8000,
+                                                         grpc_port=8001)
+    for bad in ("show", "serve:http", "serve:70000", "spawn:now"):
+        with pytest.raises(SgtoolError, match="--rerun"):
+            parse_target(bad)
+
+
+def test_headless_view_names_serve(tmp_path, monkeypatch):
+    from support.logfixtures import write_log
+
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    log = write_log(tmp_path / "run.mcap", n=2)
+    r = CliRunner().invoke(cli, ["view", str(log)])
+    assert r.exit_code == 2 and "--rerun serve" in r.output
+    r = CliRunner().invoke(cli, ["view", str(log), "--rerun", "spawn"])
+    assert r.exit_code == 2 and "--rerun serve" in r.output
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def test_replay_serves_a_web_viewer_while_it_runs(tmp_path):
+    web, grpc = free_port(), free_port()
+    exe = Path(sys.executable).parent / "sgtool"
+    env = {**os.environ, "HF_HUB_OFFLINE": "1", "MPLBACKEND": "Agg"}
+    proc = subprocess.Popen(
+        [str(exe), "replay", str(GOLDEN / "house10-start.mcap"), "--max-frames", "30",
+         "--no-progress", "--rerun", f"serve:{web}:{grpc}"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        status, deadline = None, time.monotonic() + 120  # a bound on waiting, not a check
+        while status is None and time.monotonic() < deadline and proc.poll() is None:
+            try:
+                with urllib.request.urlopen(f"http://127.0.0.1:{web}/", timeout=5) as resp:
+                    status, page = resp.status, resp.read()
+            except OSError:
+                time.sleep(0.5)
+        assert status == 200 and page, proc.stderr.read() if proc.poll() is not None else ""
+        proc.send_signal(signal.SIGINT)  # the served recording lives until Ctrl-C
+        out, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert f"web viewer at http://localhost:{web}/" in err
+    assert proc.returncode in (0, 130), err
