@@ -10,6 +10,7 @@ a deliberate change, run ``python tests/golden/regenerate.py`` and say why in th
 from __future__ import annotations
 
 import dataclasses
+import json
 
 import pytest
 from support.paths import GOLDEN
@@ -18,6 +19,8 @@ from sgtool.analysis.golden_check import check_pins
 from sgtool.replayers.golden import (
     CASES,
     REPLAY,
+    ROUNDING,
+    describe_mismatch,
     diff_graphs,
     read_graphs,
     sequence_digest,
@@ -77,3 +80,72 @@ def test_diff_names_what_changed():
     assert f"objects: - {g.objects[1].id}" in text
     assert f"doors: {door.id} state {door.state} -> closed" in text
     assert diff_graphs(g, g) == []
+
+
+def _merged(g, keep, gone):
+    """``g`` with room ``gone`` merged into ``keep``: its objects, regions and frontiers
+    now lie in ``keep``."""
+    def move(n):
+        return dataclasses.replace(n, room=keep) if n.room == gone else n
+    return dataclasses.replace(
+        g, rooms=tuple(r for r in g.rooms if r.id != gone),
+        objects=tuple(move(o) for o in g.objects), regions=tuple(move(r) for r in g.regions))
+
+
+def test_diff_tells_merged_and_split_rooms_from_removed_and_added_ones():
+    from sgtool.replayers.golden_layers import LayerSummary
+
+    g = SceneGraph.from_json(read_graphs(GOLDEN / "house6-tour.graphs.jsonl.gz")[-1])
+    keep, gone = (r.id for r in g.rooms[:2])
+    merged = _merged(g, keep, gone)
+    cat = {r.id: r.category for r in g.rooms}
+    areas = (LayerSummary(40, 41, {keep: 10.0, gone: 6.5}), LayerSummary(39, 40, {keep: 16.5}))
+    text = "\n".join(diff_graphs(g, merged, layers=areas))
+    assert (f"rooms: {gone} ({cat[gone]}, 6.50 m²) merged into {keep} ({cat[keep]}, "
+            "16.50 m²)") in text
+    assert f"rooms: {keep} area 10.00 -> 16.50 m²" in text
+    assert "voronoi: 40 nodes, 41 edges -> 39 nodes, 40 edges" in text
+    assert f"rooms: - {gone}" not in text
+    back = "\n".join(diff_graphs(merged, g, layers=areas[::-1]))
+    assert (f"rooms: {keep} ({cat[keep]}, 16.50 m²) split into {keep} ({cat[keep]}, "
+            f"10.00 m²) + {gone} ({cat[gone]}, 6.50 m²)") in back
+    # a room whose contents vanish with it is removed, not merged
+    bare = dataclasses.replace(merged, objects=(), regions=())
+    assert f"rooms: - {gone} ({cat[gone]})" in diff_graphs(
+        dataclasses.replace(g, objects=(), regions=()), bare)
+
+
+def test_tolerance_and_exactness_of_describe_mismatch():
+    graphs = read_graphs(GOLDEN / "house10-start.graphs.jsonl.gz")[:3]
+    g = SceneGraph.from_json(graphs[1])
+    o = g.objects[0]
+    nudged = dataclasses.replace(g, objects=(dataclasses.replace(
+        o, position=(o.position[0] + 0.003, *o.position[1:])),) + g.objects[1:])
+
+    class Ref:
+        time_ns, frames, reason = 2_500_000_000, 20, "every"
+
+    actual = [(Ref, graphs[0]), (Ref, nudged.to_json()), (Ref, graphs[2])]
+    lines = describe_mismatch(graphs, actual, tol=0.0)
+    assert lines[0] == "refresh 1 at 2.500 s (after 20 frames, every) differs:"
+    assert lines[1] == f"  objects: {o.id} {o.category} moved 0.003 m"
+    assert describe_mismatch(graphs, actual, tol=0.005, exact=False) == []
+    # exact: a difference below the tolerance still counts, as rounding
+    assert describe_mismatch(graphs, actual, tol=0.005) == [
+        "refresh 1 at 2.500 s (after 20 frames, every) differs:", f"  {ROUNDING}"]
+    assert describe_mismatch(graphs, [(Ref, x) for x in graphs[:2]], tol=0.0) == [
+        "2 refreshes where 3 were expected; the first 2 agree"]
+
+
+def test_format_1_pin_folders_are_still_read(tmp_path):
+    for f in GOLDEN.glob("house10-start.*"):
+        (tmp_path / f.name).symlink_to(f)
+    pin = PINS.logs["house10-start"]
+    (tmp_path / "expected.json").write_text(json.dumps({
+        "format": 1, "replay": {"every": 10, "classifier": "containment"},
+        "cases": {"house10-start": {k: getattr(pin, k) for k in (
+            "log_sha256", "refreshes", "final_sha256", "sequence_sha256")}}}))
+    old = read_pins(tmp_path)
+    assert old.format == 1
+    assert old.logs["house10-start"].options == REPLAY
+    assert old.logs["house10-start"].log_path(tmp_path) == tmp_path / "house10-start.mcap"
