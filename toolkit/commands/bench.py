@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 import shlex
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import click
@@ -98,7 +100,8 @@ from sgtool.files import output_folder
               help=PLANNER_OPTION_HELP)
 @click.option("--log-dir", type=click.Path(file_okay=False), default=None,
               help="Also record every episode as an MCAP log (scene graph and action per "
-                   "step) under LOG_DIR/PLANNER/HOUSE/, readable by `sgtool eval`.")
+                   "step) under LOG_DIR/PLANNER/HOUSE/, readable by `sgtool eval`; built "
+                   "beside LOG_DIR and moved in complete, as OUT (--force likewise).")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
 @success_option()
@@ -150,13 +153,27 @@ def command(planners: str | None, houses: int | None, house_files: tuple[str, ..
                       house_files=house_files, priors_dir=priors_dir, success=success,
                       executor=executor, ray_address=ray_address)
     command_line = shlex.join(shown_command(["sgtool", *sys.argv[1:]]))
-    # OUT is checked before any episode runs, and gets the outputs complete or not at all
-    with output_folder(out_dir, force=force, command="bench", known=OUTPUT_NAMES) as stage:
-        res = run_benchmark(cfg, progress=progress)
-        if res.failed:  # tables without some houses' episodes would pass for a result
-            raise SgtoolError(f"{len(res.failed)} task(s) failed after a retry, nothing "
-                              f"written to {out_dir}; the first: {res.failed[0]}")
-        written = [p.name for p in write_outputs(res, stage, command=command_line)]
+    # OUT (and LOG_DIR) are checked before any episode runs, and get the outputs complete
+    # or not at all
+    try:
+        with output_folder(out_dir, force=force, command="bench", known=OUTPUT_NAMES) as stage, \
+                contextlib.ExitStack() as stack:
+            logs: Path | None = None
+            if log_dir is not None:  # the logs' own folder, or a part of OUT
+                logs = stage if Path(log_dir).resolve() == Path(out_dir).resolve() else \
+                    stack.enter_context(output_folder(log_dir, force=force, command="bench",
+                                                      option="--log-dir"))
+            res = run_benchmark(replace(cfg, log_dir=None if logs is None else str(logs)),
+                                progress=progress)
+            if res.failed:  # tables without some houses' episodes would pass for a result
+                raise SgtoolError(f"{len(res.failed)} task(s) failed after a retry, nothing "
+                                  f"written to {out_dir}; the first: {res.failed[0]}")
+            written = [p.name for p in write_outputs(res, stage, command=command_line)]
+    except KeyboardInterrupt as e:
+        if log_dir is not None:  # (output_folder's note names one folder)
+            e.note = (f"{out_dir} and {log_dir} are as they were: the outputs of the "  # type: ignore[attr-defined]
+                      "interrupted run were discarded")
+        raise
     paths = [Path(out_dir) / name for name in written]
     click.echo(res.table)
     click.echo(res.side_by_side)

@@ -123,6 +123,34 @@ def test_ctrl_c_during_bench_leaves_the_earlier_state(tmp_path: Path,
     assert os.listdir(tmp_path) == (["d"] if earlier else [])  # no temporary folder left
 
 
+def test_bench_log_dir_is_an_output_folder_too(tmp_path: Path,
+                                               monkeypatch: pytest.MonkeyPatch):
+    logs, out = tmp_path / "logs", tmp_path / "d"
+    logs.mkdir()
+    (logs / "notes.txt").write_text("mine\n")
+    msg = _one_line_error(*_run([*BENCH, "-o", out, "--log-dir", logs]))
+    assert "--log-dir" in msg and "--force" in msg and not out.exists()
+    assert _run([*BENCH, "-o", out, "--log-dir", logs, "--force"])[0] == 0
+    assert sorted(p.relative_to(logs).as_posix() for p in logs.rglob("*.mcap")) == \
+        ["random/house-0/seed0-ep0.mcap"]
+    assert (logs / "notes.txt").read_text() == "mine\n"
+    # the logs in OUT itself: one folder, one manifest listing both
+    both = tmp_path / "both"
+    assert _run([*BENCH, "-o", both, "--log-dir", both])[0] == 0
+    assert read_manifest(both) == ("bench", frozenset(BENCH_FILES | {"random"}))
+    # Ctrl-C: both folders as they were
+    before = _tree(logs), _tree(out)
+
+    def interrupted(*args: object, **kw: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(bench_module, "write_outputs", interrupted)
+    code, output = _run([*BENCH, "-o", out, "--log-dir", logs, "--force"])
+    assert code == 130 and f"{out} and {logs} are as they were" in output
+    assert (_tree(logs), _tree(out)) == before
+    assert sorted(os.listdir(tmp_path)) == ["both", "d", "logs"]
+
+
 # ----------------------------------------------------------------------------------------
 # run-bench -o
 # ----------------------------------------------------------------------------------------
