@@ -2,15 +2,20 @@
 
     .venv/bin/python benchmarks/fuzz_cli.py [--mutants 50] [--seed 14] [--ros2 PATH]
                                             [--commands info,doctor,recover,replay,view,eval]
+                                            [--no-crafted] [--timeout 120]
 
 Seeded bit flips, record-head flips, overwrites and truncations of a small recorded sgtool
 log (written here with support.logfixtures.write_log) and of a real ROS 2 MCAP (default:
-the Nav2 recording in ../shared/data/logs/rosbag2-mcap/, skipped when absent). Every
-mutant goes through `sgtool info`, `doctor`, `doctor --recover`, `replay`, `view -o` and
-`eval`; prints a table mutants x commands -> clean (exit 0) / error (exit != 0, one
-line, no traceback) / traceback / wrong (doctor says complete but a reader sees changes,
-or recovery gives back fewer messages than the chunks the mutant left whole), then the
-first failures. Run by hand: about 1 s per mutant and command on 2 cores.
+the Nav2 recording in ../shared/data/logs/rosbag2-mcap/, skipped when absent), then the
+crafted logs of tests/support/crafted_logs.py (wrong schemas and encodings, bad house
+attachments, /tf cycles, instance tables out of range), also through `replay --score`.
+Every log goes through `sgtool info`, `doctor`, `doctor --recover`, `replay`, `view -o`
+and `eval`; prints a table logs x commands -> clean (exit 0) / error (exit != 0, ending
+in one `sgtool: error:` line, no traceback) / traceback / hang (no exit within
+--timeout seconds) / wrong (doctor says complete but a reader sees changes, recovery
+gives back fewer messages than the chunks the mutant left whole, or a crafted log read
+where it must be refused or the other way round), then the first failures. Run by hand:
+about 1 s per log and command on 2 cores.
 """
 
 from __future__ import annotations
@@ -25,36 +30,44 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests"))  # the test support modules
 from support.log_fuzz import campaign as prepare  # noqa: E402
+from support.log_fuzz import crafted_expectation, crafted_logs, message_count  # noqa: E402
 from support.logfixtures import write_log  # noqa: E402
 
 SGTOOL = str(Path(sys.executable).parent / "sgtool")
-OUTCOMES = ("clean", "error", "traceback", "wrong")
+OUTCOMES = ("clean", "error", "traceback", "hang", "wrong")
+TIMEOUT_S = 120.0
 
 
 def argv(cmd: str, log: Path, work: Path) -> list[str]:
+    replay = ["replay", str(log), "--every", "100", "--voxel-size", "0.2", "--no-progress"]
     return {
         "info": ["info", str(log)],
         "doctor": ["doctor", str(log), "--json"],
         "recover": ["doctor", str(log), "--recover", str(work / "rec.mcap"), "--force",
                     "--json"],
-        "replay": ["replay", str(log), "--every", "100", "--voxel-size", "0.2",
-                   "--no-progress"],
-        "view": ["view", str(log), "-o", str(work / "view.rrd")],
+        "replay": replay,
+        "score": [*replay, "--score"],
+        "view": ["view", str(log), "-o", str(work / "view.rrd"), "--force"],
         "eval": ["eval", str(log)],
     }[cmd]
 
 
 def run(cmd: str, log: Path, work: Path) -> tuple[str, str]:
     """(outcome, output) of one command."""
-    p = subprocess.run([SGTOOL, *argv(cmd, log, work)], capture_output=True, text=True,
-                       timeout=600, check=False)
+    try:
+        p = subprocess.run([SGTOOL, *argv(cmd, log, work)], capture_output=True, text=True,
+                           timeout=TIMEOUT_S, check=False)
+    except subprocess.TimeoutExpired:
+        return "hang", f"no exit within {TIMEOUT_S:g} s"
     out = p.stdout + p.stderr
     if "Traceback (most recent call last)" in out:
         return "traceback", out.strip().splitlines()[-1]
     if p.returncode == 0 or (cmd in ("doctor", "recover") and p.returncode == 1):
         return "clean", p.stdout
-    lines = p.stderr.strip().splitlines()
-    return ("error", lines[0]) if len(lines) == 1 else ("traceback", out[-300:])
+    lines = p.stderr.strip().splitlines()  # notes (sgtool: note: ...) may come first
+    if lines and lines[-1].startswith("sgtool: error:"):
+        return "error", lines[-1]
+    return "traceback", out[-300:]
 
 
 def campaign(src: Path, n: int, seed: int, commands: list[str], work: Path
@@ -77,8 +90,34 @@ def campaign(src: Path, n: int, seed: int, commands: list[str], work: Path
                     outcome, text = "wrong", (f"recovered {d['readable_messages']}, fewer "
                                               "than the whole chunks hold")
             table[cmd, outcome] += 1
-            if outcome in ("traceback", "wrong"):
+            if outcome in ("traceback", "hang", "wrong"):
                 failures.append(f"{src.name} {m.name} {cmd}: {text}")
+        print(".", end="", flush=True, file=sys.stderr)
+    print(file=sys.stderr)
+    return table, failures
+
+
+def crafted_campaign(commands: list[str], work: Path) -> tuple[Counter, list[str]]:
+    """The crafted logs through ``commands`` and ``replay --score``, judged as
+    tests/toolkit/log/test_fuzz.py judges them in-process."""
+    import json
+
+    table: Counter[tuple[str, str]] = Counter()
+    failures: list[str] = []
+    for name, log in crafted_logs(work / "crafted"):
+        want = crafted_expectation(name)
+        for cmd in [*commands, "score"]:
+            outcome, text = run(cmd, log, work)
+            if outcome in ("clean", "error") and cmd in want and outcome != want[cmd]:
+                outcome, text = "wrong", f"{outcome}, expected {want[cmd]}: {text[:200]}"
+            elif cmd in ("doctor", "recover") and outcome == "clean":
+                d = json.loads(text)
+                if d["status"] != "complete" or (
+                        cmd == "recover" and d["readable_messages"] != message_count(log)):
+                    outcome, text = "wrong", f"{d['status']}, {d['readable_messages']} messages"
+            table[cmd, outcome] += 1
+            if outcome in ("traceback", "hang", "wrong"):
+                failures.append(f"crafted {name} {cmd}: {text}")
         print(".", end="", flush=True, file=sys.stderr)
     print(file=sys.stderr)
     return table, failures
@@ -92,15 +131,21 @@ def print_table(title: str, table: Counter, commands: list[str]) -> None:
 
 
 def main() -> None:
+    global TIMEOUT_S
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--mutants", type=int, default=50)
     ap.add_argument("--seed", type=int, default=14)
     ap.add_argument("--ros2", type=Path, default=REPO.parent / "shared" / "data" / "logs"
                     / "rosbag2-mcap" / "evo_nav2_turtlebot.mcap")
     ap.add_argument("--commands", default="info,doctor,recover,replay,view,eval")
+    ap.add_argument("--no-crafted", action="store_true", help="skip the crafted logs")
+    ap.add_argument("--timeout", type=float, default=TIMEOUT_S,
+                    help="seconds a command may run before it counts as a hang")
     a = ap.parse_args()
+    TIMEOUT_S = a.timeout
     commands = [c for c in a.commands.split(",") if c]
     failures: list[str] = []
+    totals: Counter[str] = Counter()
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         sources = [write_log(work / "small.mcap", n=12, flush_interval_ns=300_000_000)]
@@ -112,7 +157,16 @@ def main() -> None:
             table, f = campaign(src, a.mutants, a.seed, commands, work)
             print_table(f"{a.mutants} mutants of {src.name}", table, commands)
             failures += f
-    print(f"\n{len(failures)} failures")
+            totals.update({o: n for (_, o), n in table.items()})
+        if not a.no_crafted:
+            (work / "crafted").mkdir()
+            table, f = crafted_campaign(commands, work)
+            print_table("crafted logs (tests/support/crafted_logs.py)", table,
+                        [*commands, "score"])
+            failures += f
+            totals.update({o: n for (_, o), n in table.items()})
+    print("\ntotal: " + ", ".join(f"{o} {totals[o]}" for o in OUTCOMES))
+    print(f"{len(failures)} failures")
     for line in failures[:30]:
         print("  " + line)
 
