@@ -20,7 +20,8 @@ from sgtool.house.spec import HouseSpec
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
 from sgtool.recorders.sim.noise import parse_noise
 
-_FIX = "give a fresh -o folder, or delete the log to run the episode again"
+_FIX = ("give a fresh -o folder, --force to run every episode again, or delete the log to "
+        "run the episode again")
 
 
 class ResumeError(SgtoolError):
