@@ -32,7 +32,7 @@ import hashlib
 import json
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -170,6 +170,7 @@ class StudyTask:
     spec_text: str
     settings: RecordingSettings
     log: str  # the cached log's path
+    key_json: str = ""  # what the log is recorded from, written beside it as KEY.json
 
 
 @dataclass(frozen=True)
@@ -194,8 +195,6 @@ def house_key(house: BenchHouse, spec_text: str, rooms: tuple[int, int]) -> dict
 
 def cache_key(house: Mapping[str, Any], noise: str, settings: RecordingSettings) -> str:
     """The hex sha256 (first 20 digits) of everything a recording depends on."""
-    from dataclasses import asdict
-
     doc = {"format": CACHE_FORMAT, "house": dict(house), "noise": noise,
            "settings": asdict(settings)}
     text = json.dumps(doc, sort_keys=True, separators=(",", ":"))
@@ -228,14 +227,14 @@ def record_task_log(task: StudyTask) -> bool:
         for p in set(partial_files(out)) - before:
             p.unlink(missing_ok=True)
         raise
+    if task.key_json:
+        atomic_write(out.with_suffix(".json"), task.key_json)
     return True
 
 
 def score_log(log: str | Path) -> tuple[int, dict[str, dict[str, float | int]]]:
     """Replay ``log`` (its own options) and score the final graph against the house in it:
     (frames, {"merged": ..., "strict": ...}), the figures of ``sgtool replay --score``."""
-    from dataclasses import asdict
-
     from sgtool.house.io import load_house_text
     from sgtool.log import LogReader
     from sgtool.replayers.derived_log import ReplayOptions, replay
@@ -310,7 +309,7 @@ class StudyConfig:
 def plan_tasks(cfg: StudyConfig, cache: Path) -> tuple[list[StudyTask], dict[str, str]]:
     """The study's tasks, one per (house, noise setting), houses outer; and the house id
     -> spec JSON text. Logs live in ``cache/HOUSE/KEY.mcap`` beside ``KEY.json`` (the
-    key's contents, for whoever looks)."""
+    key's contents, for whoever looks), both written by the task that records the log."""
     tasks: list[StudyTask] = []
     specs: dict[str, str] = {}
     noises = list(dict.fromkeys(c.noise for c in cfg.conditions))
@@ -320,24 +319,12 @@ def plan_tasks(cfg: StudyConfig, cache: Path) -> tuple[list[StudyTask], dict[str
         hk = house_key(h, text, cfg.rooms)
         for n in noises:
             key = cache_key(hk, n, cfg.settings)
+            doc = {"format": CACHE_FORMAT, "house_id": h.id, "house": hk, "noise": n,
+                   "settings": asdict(cfg.settings)}
             tasks.append(StudyTask(h.id, n, text, cfg.settings,
-                                   str(cache / h.id / f"{key}.mcap")))
+                                   str(cache / h.id / f"{key}.mcap"),
+                                   json.dumps(doc, indent=2, sort_keys=True) + "\n"))
     return tasks, specs
-
-
-def write_keys(tasks: Sequence[StudyTask], cfg: StudyConfig) -> None:
-    """``KEY.json`` beside each cached log: what it was recorded from."""
-    from dataclasses import asdict
-
-    by_id = {h.id: h for h in cfg.houses}
-    for t in tasks:
-        side = Path(t.log).with_suffix(".json")
-        if side.exists() or not Path(t.log).exists():
-            continue
-        doc = {"house_id": t.house,
-               "house": house_key(by_id[t.house], t.spec_text, cfg.rooms),
-               "noise": t.noise, "settings": asdict(t.settings), "format": CACHE_FORMAT}
-        atomic_write(side, json.dumps(doc, indent=2, sort_keys=True) + "\n")
 
 
 @dataclass(frozen=True)
@@ -378,7 +365,6 @@ def run_study(cfg: StudyConfig, cache: str | Path, executor: Any,
     tasks, specs = plan_tasks(cfg, root)
     outcomes = executor.run(run_task, [Task(f"{t.house} {t.noise}", t) for t in tasks],
                             progress=progress, desc="study noise")
-    write_keys(tasks, cfg)
     failed = failure_lines(outcomes)
     if failed:
         raise SgtoolError(f"{len(failed)} of {len(tasks)} recording(s) failed; the first: "
