@@ -124,6 +124,20 @@ def test_a_decision_of_many_attempts_ends_at_the_decision_deadline():
     assert elapsed < TRICKLE_S / 3
 
 
+def test_a_server_answering_after_the_request_timeout_ends_at_the_decision_deadline():
+    # the campaign's 70 s answers against a 60 s request timeout and 5 attempts, scaled
+    # down: answers after 1.4 s, requests of at most 1 s, a decision deadline of 1.5 s
+    late = [{"sleep": 1.4, "text": "Command: explore(kitchen)"}] * 5
+    with ChatServer(late) as srv:
+        p = MomaLlmPlanner(client(srv.base_url, timeout_s=1.0), max_attempts=5,
+                           decision_timeout_s=1.5)
+        p.reset("milk")
+        a = p.decide(house())
+    assert a.reason == ("llm failure: no valid command after 2 attempts: the decision "
+                        "deadline of 1.5 s is spent")
+    assert len(p.exchanges) == 2 and all(e["response"] is None for e in p.exchanges)
+
+
 def test_llm_check_has_one_deadline_and_says_so_in_one_line():
     with TrickleServer("body") as srv:
         r = CliRunner().invoke(cli, ["llm", "check", "--llm-base-url", srv.base_url,
