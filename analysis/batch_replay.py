@@ -35,7 +35,13 @@ from sgtool.analysis.executor import Executor, Outcome, Task
 from sgtool.errors import LogFormatError, SgtoolError
 from sgtool.files import atomic_write, output_folder
 from sgtool.log.reader import LogReader
-from sgtool.replayers.derived_log import REPLAY_METADATA, ReplayOptions, replay, resolve_options
+from sgtool.replayers.derived_log import (
+    REPLAY_METADATA,
+    ReplayOptions,
+    replay,
+    replay_metadata,
+    resolve_options,
+)
 
 
 @dataclass(frozen=True)
@@ -122,7 +128,7 @@ def is_complete(job: ReplayJob) -> bool:
         with LogReader(dst) as done:
             meta = done.metadata.get(REPLAY_METADATA)
         with LogReader(job.input) as src:
-            wanted = resolve_options(src, job.options).to_metadata()
+            wanted = replay_metadata(resolve_options(src, job.options), job.options.tf_time)
     except (LogFormatError, OSError):
         return False
     return meta == wanted

@@ -109,6 +109,12 @@ def resolve_options(reader: LogReader, options: ReplayOptions) -> ResolvedOption
                            voxel_size=float(vs), max_frames=options.max_frames)
 
 
+def replay_metadata(opts: ResolvedOptions, tf_time: str = "log") -> dict[str, str]:
+    """The ``sgtool.replay`` metadata of a derived log: the resolved options, and
+    ``tf_time`` when it is not the default "log" (default replays stay as they were)."""
+    return {**opts.to_metadata(), **({"tf_time": tf_time} if tf_time != "log" else {})}
+
+
 def _image_size(reader: LogReader) -> tuple[int, int] | None:
     """(width, height) of the camera: its first calibration, else its first depth image."""
     for topic in (S.CALIBRATION, S.DEPTH):
@@ -222,9 +228,7 @@ def replay(
                     for name, data in sorted(reader.metadata.items()):
                         if name not in (S.METADATA_NAME, REPLAY_METADATA):
                             writer.add_metadata(name, data)
-                    # tf_time only when not the default: default replays stay as they were
-                    writer.add_metadata(REPLAY_METADATA, {**opts.to_metadata(), **(
-                        {"tf_time": tf_time} if tf_time != "log" else {})})
+                    writer.add_metadata(REPLAY_METADATA, replay_metadata(opts, tf_time))
                     for a in reader.iter_attachments():
                         writer.attach(a.name, a.data, a.media_type, a.log_time)
                     _run(reader, stream, writer, opts, report, on_refresh, progress, copy_chunks,

@@ -135,3 +135,18 @@ def test_replay_help_says_which_time_it_uses():
     text = " ".join(CliRunner().invoke(cli, ["replay", "-h"]).output.split())
     assert "The time that pairs /tf transforms with camera frames" in text
     assert "[default: log]" in text
+
+
+def test_a_derived_log_of_the_other_tf_time_is_not_complete(tmp_path):
+    from sgtool.analysis.batch_replay import ReplayJob, is_complete
+    from sgtool.replayers.derived_log import ReplayOptions, replay
+
+    log = tf_log(tmp_path / "ok.mcap", 0.0)
+    out = tmp_path / "derived.mcap"
+    replay(log, out)  # pairing by log time
+    by_log = ReplayJob(str(log), str(out), ReplayOptions(), False)
+    by_stamp = ReplayJob(str(log), str(out), ReplayOptions(tf_time="stamp"), False)
+    assert is_complete(by_log) and not is_complete(by_stamp)
+    out.unlink()
+    replay(log, out, ReplayOptions(tf_time="stamp"))
+    assert is_complete(by_stamp) and not is_complete(by_log)
