@@ -13,8 +13,10 @@ and a live view of a replay's refreshes.
   after the work is done so the recording stays viewable.
 
 :class:`LiveReplay` logs each refresh of a replay (occupancy, Voronoi graph, rooms, the
-scene graph as points and as a graph view, the robot's position) on the ``frame`` and
-``sim_time`` timelines, with the default blueprint of :mod:`sgtool.analysis.rerun_view`.
+scene graph as points and as a graph view, the robot's position), or each decision of a
+closed-loop run (the graph, the robot, the action), on the ``frame`` (refresh or decision
+count) and ``sim_time`` timelines, with the default blueprint of
+:mod:`sgtool.analysis.rerun_view`.
 """
 
 from __future__ import annotations
@@ -126,15 +128,19 @@ class LiveReplay:
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
 
     @classmethod
-    def start(cls, text: str, log_path: Any, echo: Callable[[str], None]) -> LiveReplay:
-        """Parse ``--rerun TEXT``, open the stream (its recording id from the log's bytes)
-        and tell the user where to look through ``echo``."""
+    def start(cls, text: str, source: Any, echo: Callable[[str], None]) -> LiveReplay:
+        """Parse ``--rerun TEXT``, open the stream and tell the user where to look through
+        ``echo``. The recording id comes from ``source``: a log's bytes (a path to an
+        existing file), else the text given (a run's description)."""
+        import hashlib
         from pathlib import Path
 
         from sgtool.analysis.rerun_view import recording_id
 
         target = parse_target(text)
-        rec, where = open_stream(target, recording_id(Path(log_path)))
+        rid = (recording_id(Path(source)) if Path(str(source)).is_file()
+               else hashlib.sha256(str(source).encode()).hexdigest()[:32])
+        rec, where = open_stream(target, rid)
         if where is not None:
             echo(f"rerun: web viewer at {where} (gRPC port {target.grpc_port})")
         return cls(rec, target)
@@ -198,11 +204,33 @@ class LiveReplay:
                         if strips else rr.Clear(recursive=False))
         g = ref.graph.to_dict()
         _log_scene_graph(rec, g)
+        self._robot(g)
+
+    def decision(self, graph: Any, action: Any) -> None:
+        """A closed-loop decision (``run_episode``'s ``on_decision``): the scene graph it
+        was made on, the robot and the action chosen, at the graph's time."""
+        import rerun as rr
+
+        g = graph.to_dict()
+        t = int(g.get("time_ns") or 0)
+        rr.set_time("frame", sequence=self.refreshes, recording=self.rec)
+        rr.set_time("sim_time", duration=np.timedelta64(t, "ns"), recording=self.rec)
+        self.refreshes += 1
+        _log_scene_graph(self.rec, g)
+        self._robot(g)
+        text = f"{action.skill}({action.target or ''})"
+        if action.reason:
+            text += f": {action.reason}"
+        self.rec.log("actions", rr.TextLog(text, level="INFO"))
+
+    def _robot(self, g: dict[str, Any]) -> None:
+        import rerun as rr
+
         robot = g.get("robot") or {}
         if robot.get("position"):
             x, y = robot["position"][:2]
-            rec.log("world/robot", rr.Points3D([(x, y, 0.02)], radii=0.15,
-                                               colors=[(230, 80, 40)]))
+            self.rec.log("world/robot", rr.Points3D([(x, y, 0.02)], radii=0.15,
+                                                    colors=[(230, 80, 40)]))
 
     def close(self) -> None:
         self.rec.flush()

@@ -77,3 +77,32 @@ def test_replay_serves_a_web_viewer_while_it_runs(tmp_path):
             proc.communicate()
     assert f"web viewer at http://localhost:{web}/" in err
     assert proc.returncode in (0, 130), err
+
+
+def test_live_replay_logs_refreshes_and_decisions_in_strict_mode():
+    """Every archetype LiveReplay logs for a refresh and a decision is valid (strict mode
+    raises on bad input), into a memory recording."""
+    import rerun as rr
+
+    from sgtool.analysis.rerun_live import LiveReplay
+    from sgtool.planning.base import Action
+    from sgtool.replayers.derived_log import ReplayOptions, replay
+
+    rr.set_strict_mode(True)
+    try:
+        rec = rr.RecordingStream("test")
+        rec.memory_recording()
+        live = LiveReplay(rec)
+        graphs = []
+
+        def both(ref, stream):
+            live.refresh(ref, stream)
+            graphs.append(ref.graph)
+
+        replay(GOLDEN / "house10-start.mcap", None, ReplayOptions(max_frames=30),
+               on_refresh=both)
+        live.decision(graphs[-1], Action("navigate", "room:0", reason="closest"))
+        live.close()
+    finally:
+        rr.set_strict_mode(False)
+    assert live.refreshes == len(graphs) + 1 >= 3

@@ -87,6 +87,10 @@ from sgtool.errors import SgtoolError
               help="The episode log to write (OUT.mcap).")
 @click.option("--force", is_flag=True, help="Overwrite the output log.")
 @click.option("--quiet", is_flag=True, help="No progress bar, no report.")
+@click.option("--rerun", "rerun_to", default=None, metavar="spawn|connect[:URL]|serve[:PORT]",
+              help="Stream every decision (scene graph, robot, action) to Rerun while the "
+              "episode runs: spawn a viewer, connect to one, or serve a web viewer (headless "
+              "machines; waits for Ctrl-C at the end).")
 def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
             query: str | None, episode: int | None, max_steps: int, frames: int | None,
             frames_per_room: int | None,
@@ -95,7 +99,8 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
             planner_seed: int, llm_replay: str | None, llm_transcript: str | None, output: str,
             force: bool, quiet: bool, success: str = "observed",
             llm_base_url: str | None = None, llm_model: str | None = None,
-            llm_api_key: str | None = None, llm_timeout: float | None = None) -> None:
+            llm_api_key: str | None = None, llm_timeout: float | None = None,
+            rerun_to: str | None = None) -> None:
     """Search a house for an object in closed loop: PyBullet renders the camera, the scene
     graph is built live from the frames (the same refresh schedule as `sgtool replay`:
     every K frames and at every action), the planner chooses an action on it, the
@@ -173,13 +178,20 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
                disable=quiet or not sys.stderr.isatty(), dynamic_ncols=True)
     from sgtool.planning.registry import make_planner
 
+    live = None
+    if rerun_to is not None:
+        from sgtool.analysis.rerun_live import LiveReplay
+
+        live = LiveReplay.start(rerun_to, f"run {house_id} {index} {name} {out}",
+                                lambda m: click.echo(m, err=True))
     try:
         report = run_episode(house, ep, make_planner(name, **options), out, opts,
                              house_id=house_id, episode_index=index, overwrite=force,
-                             progress=bar)
+                             progress=bar, on_decision=live.decision if live else None)
     finally:
         bar.close()
     if not quiet:
         for line in report.lines():
             click.echo(line)
-
+    if live is not None:  # after the report: serve keeps the recording up until Ctrl-C
+        live.finish(lambda m: click.echo(m, err=True))
