@@ -149,6 +149,19 @@ def test_llm_check_has_one_deadline_and_says_so_in_one_line():
                                "request within the check's deadline of 1 s (--llm-timeout)")
 
 
+def test_llm_check_cuts_a_slow_decision_at_the_same_deadline():
+    script = [{"text": "kitchen bathroom"}, {"sleep": 3.0, "text": "late"}]
+    with ChatServer(script) as srv:
+        r = CliRunner().invoke(cli, ["llm", "check", "--llm-base-url", srv.base_url,
+                                     "--llm-model", "m", "--llm-timeout", "1",
+                                     "--constraint", "none"])
+    assert r.exit_code == 2, r.output
+    lines = r.output.strip().splitlines()
+    assert len(lines) == 1
+    assert lines[0].startswith("sgtool: error: llm check: no scene decision within the "
+                               "check's deadline of 1 s (--llm-timeout): llm failure: ")
+
+
 def test_llm_timeout_help_says_what_the_deadline_covers():
     text = " ".join(CliRunner().invoke(cli, ["llm", "check", "-h"]).output.split())
     assert "Deadline of the whole check in wall-clock seconds" in text
