@@ -117,3 +117,19 @@ def test_the_crafted_control_is_read_whole(tmp_path):
     with LogReader(log) as r:
         assert len(list(r.frames())) == 3
         assert len(r.last_record(Instances).instances) == len(INSTANCES)
+
+
+@pytest.mark.parametrize("craft, words", [
+    ("house-not-json", "not valid JSON"), ("house-deep", "JSON nested too deeply")])
+def test_replay_score_refuses_a_bad_house_attachment_in_one_line(craft, words, tmp_path):
+    """`sgtool replay --score` used to raise JSONDecodeError / RecursionError."""
+    from click.testing import CliRunner
+
+    from sgtool.cli import cli
+
+    log = CRAFTS[craft](tmp_path / "log.mcap")
+    res = CliRunner().invoke(cli, ["replay", str(log), "--score", "--every", "100",
+                                   "--voxel-size", "0.2", "--no-progress"])
+    assert res.exit_code == 2, res.output
+    assert "Traceback" not in res.output
+    assert f"attachment house.json: {words}" in res.output
