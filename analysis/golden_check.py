@@ -23,18 +23,21 @@ an endpoint); their logs pin graphs and figures only.
 from __future__ import annotations
 
 import bisect
+import contextlib
 import dataclasses
 import shutil
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
 from sgtool.analysis.executor import Executor, LocalExecutor, Task
 from sgtool.errors import SgtoolError
+from sgtool.files import atomic_output, output_folder, read_manifest
 from sgtool.replayers.derived_log import ReplayOptions
 from sgtool.replayers.golden import describe_mismatch, quality_lines, sha256_file
 from sgtool.replayers.golden_pins import (
+    INDEX,
     Capture,
     Decision,
     PinError,
@@ -47,6 +50,7 @@ from sgtool.replayers.golden_pins import (
     overridden,
     pinned_entry,
     read_pins,
+    stored_path,
     write_capture,
     write_index,
 )
@@ -130,14 +134,33 @@ def _run(executor: Executor | None, fn: Callable[[Any], Any], tasks: list[Task],
     return runner.run(fn, tasks, progress=progress, desc=desc)
 
 
+PIN_COMMAND = "sgtool golden"
+PIN_FILES = (INDEX, "*.graphs.jsonl.gz", "*.refreshes.jsonl.gz", "*.mcap")
+
+
+@contextlib.contextmanager
+def pin_folder(root: Path) -> Iterator[Path]:
+    """The folder to write pins of ``root`` into (:func:`sgtool.files.output_folder`): a
+    new or empty ``root`` is built beside and moved in complete (a non-empty folder that
+    holds no pins is refused); a pin folder sgtool made is written in place, file by file
+    atomically, the index last; a pin folder without sgtool's manifest (one kept with a
+    project's tests) likewise, as it is."""
+    if (root / INDEX).is_file() and read_manifest(root)[0] != PIN_COMMAND:
+        yield root
+        return
+    with output_folder(root, force=False, command=PIN_COMMAND, option="--dir",
+                       known=PIN_FILES, resume=(root / INDEX).is_file()) as out:
+        yield out
+
+
 def pin_logs(logs: Sequence[str | Path], folder: str | Path,
              options: ReplayOptions | None = None, *, copy: bool = False,
              executor: Executor | None = None, progress: bool = False,
              why: str | None = None) -> PinSet:
-    """Pin ``logs`` into ``folder`` (created when missing; logs pinned there before under
+    """Pin ``logs`` into ``folder`` (:func:`pin_folder`; logs pinned there before under
     other names are kept, the same name is replaced): replay each with ``options``, write
     its graphs and refresh files and the index. ``copy``: copy each log into the folder
-    first (the pin then refers to the copy)."""
+    (the pin then refers to the copy)."""
     root = Path(folder)
     opts = options or ReplayOptions()
     paths = [Path(p) for p in logs]
@@ -150,27 +173,30 @@ def pin_logs(logs: Sequence[str | Path], folder: str | Path,
         raise SgtoolError(f"two logs are named {dup[0]}.mcap; pin them into separate folders")
     if root.exists() and not root.is_dir():
         raise SgtoolError(f"--dir {root} is a file; give a folder")
-    old = read_pins(root).logs if (root / "expected.json").is_file() else {}
+    if root.is_dir() and not (root / INDEX).is_file() and any(root.iterdir()):
+        raise SgtoolError(f"--dir {root}: the folder holds files but no pins "
+                          f"({INDEX}); pin into a new or empty folder")
+    old = read_pins(root).logs if (root / INDEX).is_file() else {}
     outcomes = _run(executor, _pin_task,
                     [Task(str(p), _PinTask(str(p), opts)) for p in paths], "pin", progress)
     failed = [o for o in outcomes if not o.ok]
     if failed:
         raise SgtoolError(f"{failed[0].id}: could not be replayed: {failed[0].error}")
-    root.mkdir(parents=True, exist_ok=True)
-    pins = PinSet(root, dict(old), sgtool_version=__version__)
-    for p, name, o in zip(paths, names, outcomes, strict=True):
-        log = p
-        if copy:
-            log = root / f"{name}.mcap"
-            if not log.exists() or log.resolve() != p.resolve():
-                tmp = root / f".{name}.mcap.partial"
-                shutil.copyfile(p, tmp)
-                tmp.replace(log)
-        pin = pinned_entry(name, log, root, opts, o.value, why)
-        write_capture(pins, pin, o.value)
-        pins.logs[name] = pin
-    write_index(pins)
-    return pins
+    logs_now = dict(old)
+    with pin_folder(root) as out:
+        staged = PinSet(out, logs_now, sgtool_version=__version__)
+        for p, name, o in zip(paths, names, outcomes, strict=True):
+            stored = stored_path(p, root)
+            if copy:
+                stored = f"{name}.mcap"
+                if not (root / stored).exists() or (root / stored).resolve() != p.resolve():
+                    with atomic_output(out / stored) as tmp:
+                        shutil.copyfile(p, tmp)
+            pin = pinned_entry(name, p, stored, opts, o.value, why)
+            write_capture(staged, pin, o.value)
+            logs_now[name] = pin
+        write_index(staged)
+    return PinSet(root, logs_now, sgtool_version=__version__)
 
 
 # ----- check --------------------------------------------------------------------------------
@@ -340,21 +366,25 @@ def check_pins(folder: str | Path, options: ReplayOptions | None = None, *,
 
 def update_pins(report: CheckReport) -> list[str]:
     """Re-pin the changed logs of ``report`` (checked with ``keep``) with the options they
-    were checked with; what was accepted, one line per log."""
+    were checked with (in place: :func:`pin_folder`); what was accepted, one line per
+    log."""
     pins = report.pins
     accepted = []
-    for c in report.logs:
-        if c.status != "changed" or c.capture is None:
-            continue
-        old = pins.logs[c.name]
-        opts = overridden(old.options, report.options)
-        pin = pinned_entry(c.name, old.log_path(pins.folder), pins.folder, opts, c.capture,
-                           old.why)
-        write_capture(pins, pin, c.capture)
-        pins.logs[c.name] = pin
-        what = c.first or "planner decisions or quality figures"
-        accepted.append(f"updated {c.name}: accepted the change from {what} "
-                        f"({sum(c.layers.values())} differences in it)")
-    if accepted:
-        write_index(dataclasses.replace(pins, sgtool_version=__version__))
+    changed = [c for c in report.logs if c.status == "changed" and c.capture is not None]
+    if not changed:
+        return []
+    with pin_folder(pins.folder) as out:
+        staged = PinSet(out, pins.logs, sgtool_version=__version__)
+        for c in changed:
+            assert c.capture is not None
+            old = pins.logs[c.name]
+            opts = overridden(old.options, report.options)
+            pin = pinned_entry(c.name, old.log_path(pins.folder), old.log, opts, c.capture,
+                               old.why)
+            write_capture(staged, pin, c.capture)
+            pins.logs[c.name] = pin
+            what = c.first or "planner decisions or quality figures"
+            accepted.append(f"updated {c.name}: accepted the change from {what} "
+                            f"({sum(c.layers.values())} differences in it)")
+        write_index(staged)
     return accepted

@@ -307,14 +307,20 @@ def load_expected(pins: PinSet, name: str) -> tuple[list[str], list[RefreshMeta]
     return graphs, metas
 
 
-def pinned_entry(name: str, log: Path, folder: Path, options: ReplayOptions, cap: Capture,
-                 why: str | None = None) -> Pinned:
-    """The index entry of ``cap``, a capture of ``log`` with ``options``."""
-    graphs = cap.graphs
+def stored_path(log: Path, folder: Path) -> str:
+    """How the index names ``log``: relative to ``folder`` when it lies below it, else
+    absolute."""
     try:
-        stored = str(log.resolve().relative_to(folder.resolve()))
+        return str(log.resolve().relative_to(folder.resolve()))
     except ValueError:
-        stored = str(log.resolve())
+        return str(log.resolve())
+
+
+def pinned_entry(name: str, log: Path, stored: str, options: ReplayOptions, cap: Capture,
+                 why: str | None = None) -> Pinned:
+    """The index entry of ``cap``, a capture of ``log`` (its bytes are digested; the index
+    names it ``stored``: :func:`stored_path`) with ``options``."""
+    graphs = cap.graphs
     return Pinned(
         name=name, log=stored, log_sha256=sha256_file(log), refreshes=len(graphs),
         final_sha256=hashlib.sha256(graphs[-1].encode()).hexdigest() if graphs else "",

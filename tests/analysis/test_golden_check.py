@@ -234,3 +234,22 @@ def test_the_first_decision_that_differs_is_named():
         "decisions: scout at episode 0, step 3: explore(frontier:2) -> navigate(room:2)")
     assert first_decision_change(a, a[:1], "scout") == (
         "decisions: 1 where 2 were pinned; the first 1 agree")
+
+
+def test_pins_are_added_in_place_and_a_foreign_folder_is_refused(log, tmp_path, capsys):
+    folder = tmp_path / "g"
+    assert sgtool(capsys, "golden", "pin", log, "--dir", folder, *FRAMES)[0] == 0
+    assert (folder / ".sgtool-output").is_file()  # built beside, moved in, with a manifest
+    other = tmp_path / "other.mcap"
+    shutil.copyfile(log, other)
+    assert sgtool(capsys, "golden", "pin", other, "--dir", folder, "--copy", *FRAMES)[0] == 0
+    assert sorted(read_pins(folder).logs) == ["other", "small"]
+    assert sorted(p.name for p in folder.iterdir() if not p.name.startswith(".")) == [
+        "expected.json", "other.graphs.jsonl.gz", "other.mcap", "other.refreshes.jsonl.gz",
+        "small.graphs.jsonl.gz", "small.refreshes.jsonl.gz"]
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("a user's file")
+    code, _, err = sgtool(capsys, "golden", "pin", log, "--dir", mine, *FRAMES)
+    assert code == 2 and "holds files but no pins" in err
+    assert [p.name for p in mine.iterdir()] == ["notes.txt"]
