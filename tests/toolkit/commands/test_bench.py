@@ -33,9 +33,9 @@ def test_cli_writes_outputs_and_is_deterministic(tmp_path):
     assert "| random" in a.output and "| greedy" in a.output and "AUC-E budgets" in a.output
     assert "Unseen SR" in a.output
     files = sorted(p.name for p in (tmp_path / "a").iterdir())
-    assert files == [".sgtool-output", "efficiency_distance.png", "efficiency_steps.png", "episodes.jsonl",
-                     "per_house.jsonl", "per_house.md", "per_query.jsonl", "per_query.md",
-                     "run.json", "run.md", "summary.json", "summary.md"]
+    assert files == [".sgtool-output", "efficiency_distance.png", "efficiency_steps.png",
+                     "episodes.jsonl", "per_house.jsonl", "per_house.md", "per_query.jsonl",
+                     "per_query.md", "run.json", "run.md", "summary.json", "summary.md"]
     recs = read_jsonl(tmp_path / "a" / "episodes.jsonl")
     # 2 planners x 2 seeds x 2 houses x 2 episodes, ordered planner, house, episode, seed
     assert len(recs) == 16
