@@ -13,9 +13,10 @@ and a live view of a replay's refreshes.
   after the work is done so the recording stays viewable.
 
 :class:`LiveReplay` logs each refresh of a replay (occupancy, Voronoi graph, rooms, the
-scene graph as points and as a graph view, the robot's position), or each decision of a
-closed-loop run (the graph, the robot, the action), on the ``frame`` (refresh or decision
-count) and ``sim_time`` timelines, with the default blueprint of
+scene graph as points and as a graph view, the robot's position), each decision of a
+closed-loop run (the graph, the robot, the action) or each frame of a recording (camera
+images, robot, path), on the ``frame`` (refresh, decision or frame count) and ``sim_time``
+timelines, with the default blueprint of
 :mod:`sgtool.analysis.rerun_view`.
 """
 
@@ -31,9 +32,11 @@ import numpy as np
 
 from sgtool.analysis.rerun_view import (
     APP_ID,
+    RobotPath,
     _log_scene_graph,
     _scene_update_strips,
     blueprint,
+    log_camera,
 )
 from sgtool.errors import SgtoolError
 
@@ -125,6 +128,7 @@ class LiveReplay:
         self.rec = rec
         self.target = target
         self.refreshes = 0
+        self.path = RobotPath()
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
 
     @classmethod
@@ -205,6 +209,38 @@ class LiveReplay:
         g = ref.graph.to_dict()
         _log_scene_graph(rec, g)
         self._robot(g)
+
+    def frame(self, fr: Any) -> None:
+        """A recorded frame: the camera (pose, pinhole, RGB, depth, segmentation) and the
+        robot with its path, at the frame's index and time."""
+        import rerun as rr
+
+        rr.set_time("frame", sequence=int(fr.index), recording=self.rec)
+        rr.set_time("sim_time", duration=np.timedelta64(int(fr.time_ns), "ns"),
+                    recording=self.rec)
+        log_camera(self.rec, fr)
+        self.path.log(self.rec, self.path.add(fr))
+
+    def observer(self) -> Any:
+        """A simulation observer that shows each frame the log recorder has just written
+        (pass it to ``record_house``'s ``observers``, after the recorder)."""
+        from sgtool.recorders.sim.events import SimObserver
+        from sgtool.recorders.sim.recording import LogRecorder
+
+        live = self
+
+        class Frames(SimObserver):
+            def __init__(self) -> None:
+                self.last: Any = None
+
+            def on_tick(self, sim: Any) -> None:
+                rec = next((o for o in sim.observers if isinstance(o, LogRecorder)), None)
+                fr = rec.last_frame if rec is not None else None
+                if fr is not None and fr is not self.last:
+                    self.last = fr
+                    live.frame(fr)
+
+        return Frames()
 
     def decision(self, graph: Any, action: Any) -> None:
         """A closed-loop decision (``run_episode``'s ``on_decision``): the scene graph it

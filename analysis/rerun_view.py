@@ -49,6 +49,7 @@ from sgtool.colors import color_for
 from sgtool.files import atomic_output, output_error
 from sgtool.log import LogReader, codec
 from sgtool.log import schemas as S
+from sgtool.log.frame import Frame
 
 APP_ID = "sgtool"
 FREE_MARGIN = 16 * 1024 * 1024  # bytes that must stay free beside the .rrd while writing
@@ -195,6 +196,65 @@ def export(
     return out
 
 
+def log_camera(rec: Any, fr: Frame) -> None:
+    """A frame's camera at the current time: its pose (when /tf gives one), pinhole, RGB,
+    depth and instance segmentation."""
+    import rerun as rr
+
+    if np.all(np.isfinite(fr.pose)):
+        rec.log("world/camera", rr.Transform3D(
+            translation=fr.pose[:3, 3].astype(np.float32),
+            mat3x3=fr.pose[:3, :3].astype(np.float32)))
+    k = fr.intrinsics
+    rec.log("world/camera/image", rr.Pinhole(
+        image_from_camera=k.K.astype(np.float32), resolution=[k.width, k.height],
+        camera_xyz=rr.ViewCoordinates.RDF, image_plane_distance=0.3))
+    if fr.rgb is not None:
+        rec.log("world/camera/image/rgb", rr.Image(fr.rgb))
+    rec.log("world/camera/image/depth", rr.DepthImage(fr.depth, meter=1.0))
+    if fr.ids is not None:
+        rec.log("world/camera/image/segmentation",
+                rr.SegmentationImage(fr.ids.astype(np.uint16)))
+
+
+class RobotPath:
+    """The robot's path, logged in pieces of :data:`PATH_CHUNK` points
+    (``world/robot/path/K``, module doc): :meth:`add` every frame, :meth:`log` when the
+    frame is shown."""
+
+    def __init__(self) -> None:
+        self.points: list[tuple[float, float, float]] = []
+        self.done = 0  # pieces before this one are complete in the recording
+
+    def add(self, fr: Frame) -> tuple[float, float, float] | None:
+        """The frame's base position (the camera's without a base pose), appended to the
+        path; None when /tf does not give it."""
+        base = fr.base_pose if fr.base_pose is not None else fr.pose
+        if not np.all(np.isfinite(base)):
+            return None
+        here = (float(base[0, 3]), float(base[1, 3]), 0.02)
+        self.points.append(here)
+        return here
+
+    def log(self, rec: Any, here: tuple[float, float, float] | None) -> None:
+        """The robot at ``here`` (when known) and the pieces that changed since the last
+        call: only the current one, plus any finished while frames were not shown."""
+        import rerun as rr
+
+        if here is not None:
+            rec.log("world/robot", rr.Points3D([here], radii=0.15, colors=[(230, 80, 40)]))
+        pts = self.points
+        if len(pts) < 2:
+            return
+        last = (len(pts) - 2) // PATH_CHUNK
+        for j in range(self.done, last + 1):
+            # piece j: points j*C .. (j+1)*C, sharing its first with piece j - 1
+            piece = pts[j * PATH_CHUNK:(j + 1) * PATH_CHUNK + 1]
+            rec.log(f"world/robot/path/{j}", rr.LineStrips3D(
+                [np.array(piece, np.float32)], radii=0.02, colors=[(230, 80, 40)]))
+        self.done = last
+
+
 def _watching_space(rrd_path: Path, progress: Callable[[int], None] | None
                     ) -> Callable[[int], None]:
     def tick(n: int) -> None:
@@ -227,8 +287,7 @@ def _export(
         ]
         rec.log("world/camera/image", rr.AnnotationContext(ctx), static=True)
     # camera frames
-    path_xy: list[tuple[float, float, float]] = []
-    pieces_done = 0  # path pieces before this one are complete in the recording
+    path = RobotPath()
     unposed = framed = 0  # frames whose camera pose /tf does not give (a missing link, a cycle)
     if r.has(S.DEPTH):
         for n, fr in enumerate(r.frames()):
@@ -237,41 +296,13 @@ def _export(
             if progress:
                 progress(1)
             framed += 1
-            base = fr.base_pose if fr.base_pose is not None else fr.pose
-            here = None
-            if np.all(np.isfinite(base)):
-                here = (float(base[0, 3]), float(base[1, 3]), 0.02)
-                path_xy.append(here)
-            posed = bool(np.all(np.isfinite(fr.pose)))
-            unposed += not posed
+            here = path.add(fr)
+            unposed += not bool(np.all(np.isfinite(fr.pose)))
             if fr.index % every:
                 continue
             stamp(fr.index, fr.time_ns)
-            if posed:
-                rec.log("world/camera", rr.Transform3D(
-                    translation=fr.pose[:3, 3].astype(np.float32),
-                    mat3x3=fr.pose[:3, :3].astype(np.float32)))
-            k = fr.intrinsics
-            rec.log("world/camera/image", rr.Pinhole(
-                image_from_camera=k.K.astype(np.float32), resolution=[k.width, k.height],
-                camera_xyz=rr.ViewCoordinates.RDF, image_plane_distance=0.3))
-            if fr.rgb is not None:
-                rec.log("world/camera/image/rgb", rr.Image(fr.rgb))
-            rec.log("world/camera/image/depth", rr.DepthImage(fr.depth, meter=1.0))
-            if fr.ids is not None:
-                rec.log("world/camera/image/segmentation",
-                        rr.SegmentationImage(fr.ids.astype(np.uint16)))
-            if here is not None:
-                rec.log("world/robot", rr.Points3D([here], radii=0.15,
-                                                   colors=[(230, 80, 40)]))
-            if len(path_xy) > 1:  # only the current piece: data linear in the frames
-                last = (len(path_xy) - 2) // PATH_CHUNK
-                for j in range(pieces_done, last + 1):  # finish pieces skipped by --every
-                    # piece j: points j*C .. (j+1)*C, sharing its first with piece j - 1
-                    piece = path_xy[j * PATH_CHUNK:(j + 1) * PATH_CHUNK + 1]
-                    rec.log(f"world/robot/path/{j}", rr.LineStrips3D(
-                        [np.array(piece, np.float32)], radii=0.02, colors=[(230, 80, 40)]))
-                pieces_done = last
+            log_camera(rec, fr)
+            path.log(rec, here)
     # voxel map over time (computed by the caller)
     if voxels is not None:
         for idx, t_ns, centres, cols, size in voxels(r):

@@ -106,3 +106,33 @@ def test_live_replay_logs_refreshes_and_decisions_in_strict_mode():
     finally:
         rr.set_strict_mode(False)
     assert live.refreshes == len(graphs) + 1 >= 3
+
+
+def test_live_frames_of_a_recording_in_strict_mode(tmp_path):
+    """record --rerun: the observer shows every frame the recorder wrote, once, with valid
+    archetypes (strict mode), into a memory recording."""
+    import rerun as rr
+    from support.small_house import small_house
+
+    from sgtool.analysis.rerun_live import LiveReplay
+    from sgtool.recorders.sim import CameraConfig, RecordOptions, record_house
+
+    shown = []
+    rr.set_strict_mode(True)
+    try:
+        rec = rr.RecordingStream("test")
+        rec.memory_recording()
+        live = LiveReplay(rec)
+        frame = live.frame
+
+        def count(fr):
+            shown.append(fr.index)
+            frame(fr)
+
+        live.frame = count  # type: ignore[method-assign]
+        rep = record_house(small_house(), tmp_path / "rec.mcap", RecordOptions(
+            camera=CameraConfig(width=80, height=60), frames=12), observers=[live.observer()])
+    finally:
+        rr.set_strict_mode(False)
+    assert len(shown) == rep.frames == 12 and shown == sorted(set(shown))
+    assert len(live.path.points) == 12

@@ -74,11 +74,16 @@ def _pair(option: str, text: str) -> tuple[float, float]:
               show_default=True, help="MCAP chunk compression.")
 @click.option("--force", is_flag=True, help="Overwrite the output log.")
 @click.option("--quiet", is_flag=True, help="No progress bar, no report.")
+@click.option("--rerun", "rerun_to", default=None, metavar="spawn|connect[:URL]|serve[:PORT]",
+              help="Stream every frame (camera images, robot, path) to Rerun while recording: "
+              "spawn a viewer, connect to one, or serve a web viewer (headless machines; "
+              "waits for Ctrl-C at the end).")
 def command(house_path: str | None, seed: int | None, rooms: str, output: str,
             frames: int | None, fps: float, noise: str, noise_seed: int, resolution: str,
             fov: float, depth_range: str, camera_height: float, tilt: float, speed: float,
             start: int, no_open_containers: bool, explore: str, compression: str,
-            force: bool, quiet: bool) -> None:
+            force: bool, quiet: bool,
+            rerun_to: str | None = None) -> None:
     """Record a robot exploring a house in PyBullet: RGB-D, instance ids, poses, the
     instances table with open/closed states, every action, to an MCAP log.
 
@@ -126,11 +131,20 @@ def command(house_path: str | None, seed: int | None, rooms: str, output: str,
 
     bar = tqdm(total=frames, unit="frame", desc="record", file=sys.stderr, leave=False,
                disable=quiet or not sys.stderr.isatty(), dynamic_ncols=True)
+    live = None
+    if rerun_to is not None:
+        from sgtool.analysis.rerun_live import LiveReplay
+
+        live = LiveReplay.start(rerun_to, f"record {house_id} {out}",
+                                lambda m: click.echo(m, err=True))
     try:
-        report = record_house(house, out, opts, house_id=house_id, progress=bar)
+        report = record_house(house, out, opts, house_id=house_id, progress=bar,
+                              observers=[live.observer()] if live else ())
     finally:
         bar.close()
     if not quiet:
         for line in report.lines():
             click.echo(line)
+    if live is not None:  # after the report: serve keeps the recording up until Ctrl-C
+        live.finish(lambda m: click.echo(m, err=True))
 
