@@ -14,9 +14,10 @@ Per decision (MoMa-LLM sec. III-C/D; reference notes):
    the answer and a feedback message naming the problem and the valid choices, and ask
    again. This feedback reaches the model (MoMa-LLM's own feedback strings were dropped by
    a role filter: the defect noted in the reference notes). At most ``max_attempts``
-   requests per decision, all within ``decision_timeout_s`` (60 s by default: each request
-   waits at most what is left of it); then the decision fails clearly (``done`` without
-   target, reason "llm failure: ...");
+   requests per decision, all within ``decision_timeout_s`` (60 s by default, wall-clock:
+   each request, a slow or trickled reply included, is cut at what is left of it,
+   :mod:`sgtool.llm.client`); then the decision fails clearly (``done`` without target,
+   reason "llm failure: ...");
 5. stuck detector: the same grounded action chosen ``stuck_repeats`` times in a row ends
    the episode (``done`` without target, reason "stuck: ...").
 
