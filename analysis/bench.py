@@ -24,6 +24,8 @@ Protocol (SCOUT sec. VI, Table VII; MoMa-LLM's AUC-E):
 Outputs (in ``out_dir``): ``episodes.jsonl`` (one :class:`EpisodeResult` per line, ordered
 by planner, then house id (plain string order), episode index, seed), ``summary.md`` (Table
 VII-shaped table, the same next to the rows quoted from SCOUT Table VII, seen/unseen table,
+SR and SPL with bootstrap intervals over houses and the paired comparisons of
+:mod:`sgtool.analysis.intervals` (every planner against ``reference``, or every pair),
 per-house and per-query tables, AUC-E budgets, settings, digest), ``summary.json``
 (both hold no wall-clock figure: the same arguments give the same bytes on any executor and
 any number of workers), ``run.md``/``run.json`` (the table with the decision time and
@@ -64,11 +66,22 @@ from sgtool.analysis.bench_houses import (
     output_path,
 )
 from sgtool.analysis.executor import Task, chunks, failure_lines, make_executor
+from sgtool.analysis.intervals import (
+    DEFAULT_BOOTSTRAP,
+    Bootstrap,
+    PairedComparison,
+    PlannerIntervals,
+    comparison_pairs,
+    paired_comparison,
+    planner_intervals,
+)
 from sgtool.analysis.metrics import CostModel, breakdown, cost_models, seen_unseen, summarize
 from sgtool.analysis.paper_tables import TABLE_IX_SYMSEARCH
 from sgtool.analysis.report import (
     breakdown_records,
     format_breakdown,
+    format_intervals,
+    format_paired,
     format_seen_unseen,
     format_side_by_side,
     format_table,
@@ -149,6 +162,8 @@ class BenchConfig:
     success: str = "observed"  # success rule: observed | done (sgtool.planning.episode)
     executor: str = "local"  # local | ray (sgtool.analysis.executor)
     ray_address: str | None = None  # a Ray cluster; None: RAY_ADDRESS, else a local Ray
+    reference: str | None = None  # paired comparisons against it (None: scout, else first)
+    all_pairs: bool = False  # paired comparisons of every pair of planners instead
 
     def check(self) -> None:
         check_planner_list(self.planners)
@@ -171,6 +186,9 @@ class BenchConfig:
         lo, hi = self.rooms
         if not 4 <= lo <= hi <= MAX_ROOMS:
             raise BenchError(f"--rooms: need 4 <= MIN <= MAX <= {MAX_ROOMS}, got {lo}-{hi}")
+        if self.reference is not None and self.reference not in self.planners:
+            raise BenchError(f"--reference: {self.reference!r} is not one of --planners "
+                             f"({', '.join(self.planners)})")
         if self.success not in SUCCESS_RULES:
             raise BenchError(f"--success: one of {', '.join(SUCCESS_RULES)}, got "
                              f"{self.success!r}")
@@ -192,7 +210,8 @@ class BenchConfig:
         d["rooms"] = list(self.rooms)
         d["planner_options"] = {k: {kk: str(vv) for kk, vv in redact_options(v).items()}
                                 for k, v in sorted(self.planner_options.items())}
-        for key in ("workers", "executor", "ray_address"):  # do not change the results
+        for key in ("workers", "executor", "ray_address",  # do not change the results
+                    "reference", "all_pairs"):
             d.pop(key)
         d.pop("log_dir")
         if self.success == "observed":  # the default: settings as before the option
@@ -240,6 +259,26 @@ class BenchResult:
             summarize(self.results, self.config.models(), self.config.planners),
             title="Ours next to SCOUT Table VII (SymSearch rows quoted from the paper)",
             timing=timing)
+
+    def intervals(self, boot: Bootstrap = DEFAULT_BOOTSTRAP) -> list[PlannerIntervals]:
+        """SR and SPL per planner with cluster-bootstrap intervals over houses."""
+        return [planner_intervals(self.results, p, boot=boot) for p in self.config.planners]
+
+    def comparisons(self, boot: Bootstrap = DEFAULT_BOOTSTRAP) -> list[PairedComparison]:
+        """The paired comparisons of the config's pairs (:func:`~sgtool.analysis.
+        intervals.comparison_pairs`), intervals over houses."""
+        pairs = comparison_pairs(self.config.planners, self.config.reference,
+                                 self.config.all_pairs)
+        return [paired_comparison(self.results, a, b, boot=boot) for a, b in pairs]
+
+    def interval_tables(self, boot: Bootstrap = DEFAULT_BOOTSTRAP) -> str:
+        """The intervals per planner, then the paired comparisons (text)."""
+        return format_intervals(
+            self.intervals(boot), boot,
+            title="SR and SPL with bootstrap intervals over houses, episodes pooled over "
+                  "seeds") + "\n" + format_paired(
+            self.comparisons(boot), boot,
+            title="Paired comparisons on the same episodes")
 
     def breakdown_table(self, by: str) -> str:
         rows = breakdown(self.results, by, self.config.planners)
@@ -471,7 +510,7 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
             json.dumps(d, sort_keys=True, allow_nan=False) + "\n"
             for d in breakdown_records(rows, by))))
     md = [res.results_table, res.results_side_by_side, res.seen_table,
-          res.breakdown_table("house"), res.breakdown_table("query"),
+          res.interval_tables(), res.breakdown_table("house"), res.breakdown_table("query"),
           *([f"Failed tasks (retried once; their episodes are in no table): "
              f"{len(res.failed)}", *(f"- {line}" for line in res.failed)]
             if res.failed else []),
@@ -495,6 +534,9 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
         "budgets": {m.name: {"max": m.max_cost, "cost": m.label} for m in cfg.models()},
         "planners": summary_dict(sums, timing=False),
         "seen_unseen": [asdict(s) for s in seen_unseen(res.results, cfg.planners)],
+        "intervals": {"bootstrap": DEFAULT_BOOTSTRAP.to_dict(), "cluster": "house",
+                      "planners": {r.planner: r.to_dict() for r in res.intervals()},
+                      "paired": [c.to_dict() for c in res.comparisons()]},
         "vocabulary": {"priors": cfg.priors_dir, "training_queries": res.vocabulary_size},
         "houses": [{"id": h.id, "source": h.source} for h in res.houses],
         "digest": res.digest,

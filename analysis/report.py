@@ -14,6 +14,7 @@ import math
 import re
 from collections.abc import Mapping, Sequence
 
+from sgtool.analysis.intervals import Bootstrap, Interval, PairedComparison, PlannerIntervals
 from sgtool.analysis.metrics import (
     BreakdownRow,
     CostModel,
@@ -255,3 +256,60 @@ def llm_answer_lines(results: Sequence[EpisodeResult], planners: Sequence[str]) 
             f"{invalid_rate_text(t['valid'], t['invalid'])}), {t['faults']} faults, "
             f"{t['unknown']} without verdict"
             for p, t in llm_answer_totals(results, planners).items()]
+
+
+def fmt_interval(iv: Interval, spec: str = ".3f", signed: bool = False) -> str:
+    """``value [low, high]``; ``value [-]`` without an interval, ``-`` without a value;
+    ``signed`` prints a + before positive numbers (differences)."""
+    def num(x: float) -> str:
+        if math.isinf(x):
+            return "inf" if x > 0 else "-inf"
+        return format(x, ("+" if signed else "") + spec)
+
+    if math.isnan(iv.value):
+        return "-"
+    if math.isnan(iv.low) or math.isnan(iv.high):
+        return f"{num(iv.value)} [-]"
+    return f"{num(iv.value)} [{num(iv.low)}, {num(iv.high)}]"
+
+
+def format_intervals(rows: Sequence[PlannerIntervals], boot: Bootstrap,
+                     cluster: str = "house", title: str = "") -> str:
+    """SR and SPL per planner with their cluster-bootstrap intervals (episodes pooled over
+    seeds), then the bootstrap settings."""
+    header = ["Planner", f"{cluster.capitalize()}s", "Episodes", "SR [95 % CI]",
+              "SPL [95 % CI]"]
+    if boot.level != 0.95:
+        header = [h.replace("95 %", f"{boot.level * 100:g} %") for h in header]
+    body = [[r.planner, str(r.clusters), str(r.episodes), fmt_interval(r.sr),
+             fmt_interval(r.spl)] for r in rows]
+    parts = [title] if title else []
+    parts.append(pipe_table(header, body))
+    parts.append(boot.statement(cluster) + "; an interval needs two or more "
+                 f"{cluster}s (\"[-]\" otherwise).")
+    return "\n".join(parts) + "\n"
+
+
+def format_paired(rows: Sequence[PairedComparison], boot: Bootstrap, cluster: str = "house",
+                  title: str = "", labels: Sequence[str] | None = None,
+                  label_header: str = "House") -> str:
+    """Paired comparisons, one row each: SPL ratio, SR and SPL differences with intervals
+    and the wins / losses / ties over clusters; ``labels`` adds a first column (e.g. the
+    house of a per-house comparison)."""
+    level = f"{boot.level * 100:g} %"
+    header = ["Planner", "Reference", "Paired episodes", f"SPL ratio [{level} CI]",
+              f"SR diff [{level} CI]", f"SPL diff [{level} CI]",
+              f"{cluster.capitalize()}s W/L/T"]
+    body = [[r.planner, r.reference, str(r.episodes), fmt_interval(r.spl_ratio),
+             fmt_interval(r.sr_diff, signed=True), fmt_interval(r.spl_diff, signed=True),
+             f"{r.wins}/{r.losses}/{r.ties}"] for r in rows]
+    if labels is not None:
+        header = [label_header, *header]
+        body = [[label, *row] for label, row in zip(labels, body, strict=True)]
+    parts = [title] if title else []
+    parts.append(pipe_table(header, body))
+    parts.append(f"Same (house, episode, seed) episodes for both planners. SPL ratio = the "
+                 f"planner's mean SPL / the reference's; diff = planner - reference; W/L/T "
+                 f"= {cluster}s where the planner's paired SPL is higher / lower / equal. "
+                 + boot.statement(cluster) + ".")
+    return "\n".join(parts) + "\n"

@@ -104,6 +104,14 @@ from sgtool.files import output_folder
                    "beside LOG_DIR and moved in complete, as OUT (--force likewise).")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
+@click.option("--reference", default=None, metavar="PLANNER",
+              help="Paired comparisons (summary.md, summary.json) of every other planner "
+                   "against this one on the same episodes: SPL ratio, SR and SPL "
+                   "differences with bootstrap intervals over houses, wins/losses/ties per "
+                   "house. [default: scout when benched, else the first planner]")
+@click.option("--all-pairs", is_flag=True,
+              help="Paired comparisons of every pair of planners instead of against "
+                   "--reference.")
 @success_option()
 def command(planners: str | None, houses: int | None, house_files: tuple[str, ...],
             priors_dir: str | None, episodes: int, seeds: int, workers: int, out_dir: str,
@@ -114,7 +122,8 @@ def command(planners: str | None, houses: int | None, house_files: tuple[str, ..
             progress: bool | None, success: str = "observed", executor: str = "local",
             ray_address: str | None = None, llm_base_url: str | None = None,
             llm_model: str | None = None, llm_api_key: str | None = None,
-            llm_timeout: float | None = None) -> None:
+            llm_timeout: float | None = None, reference: str | None = None,
+            all_pairs: bool = False) -> None:
     """Run the symbolic object-search benchmark (SCOUT's SymSearch roll-out) on generated
     evaluation houses and/or house spec files and print a table in the shape of SCOUT's
     Table VII: success rate, SPL, high-level steps, decision time, and MoMa-LLM's AUC-E with
@@ -151,7 +160,8 @@ def command(planners: str | None, houses: int | None, house_files: tuple[str, ..
                       workers=workers, distance_budget=distance_budget,
                       step_budget=step_budget, planner_options=options, log_dir=log_dir,
                       house_files=house_files, priors_dir=priors_dir, success=success,
-                      executor=executor, ray_address=ray_address)
+                      executor=executor, ray_address=ray_address, reference=reference,
+                      all_pairs=all_pairs)
     command_line = shlex.join(shown_command(["sgtool", *sys.argv[1:]]))
     # OUT (and LOG_DIR) are checked before any episode runs, and get the outputs complete
     # or not at all
@@ -178,4 +188,5 @@ def command(planners: str | None, houses: int | None, house_files: tuple[str, ..
     click.echo(res.table)
     click.echo(res.side_by_side)
     click.echo(res.seen_table)
+    click.echo(res.interval_tables())
     click.echo(f"wrote {', '.join(str(p) for p in paths)}")

@@ -51,6 +51,20 @@ def test_cli_writes_outputs_and_is_deterministic(tmp_path):
     assert summary["budgets"]["steps"]["max"] == 50.0
     assert set(summary["planners"]) == {"random", "greedy"}
     assert summary["digest"] == results_digest(recs)
+    # bootstrap intervals over the 2 houses and, without scout, greedy against the first
+    # planner (the bytes of these lines are compared across worker counts below)
+    iv = summary["intervals"]
+    assert iv["bootstrap"]["resamples"] == 10000 and iv["cluster"] == "house"
+    assert iv["planners"]["random"]["clusters"] == 2
+    assert iv["planners"]["random"]["episodes"] == 8
+    (pair,) = iv["paired"]
+    assert (pair["planner"], pair["reference"], pair["episodes"]) == ("greedy", "random", 8)
+    assert pair["wins"] + pair["losses"] + pair["ties"] == 2
+    summary_md = (tmp_path / "a" / "summary.md").read_text()
+    assert "SR and SPL with bootstrap intervals over houses" in summary_md
+    assert "Paired comparisons on the same episodes" in summary_md
+    assert "10000 resamples, seed 0" in summary_md and "| greedy  | random" in summary_md
+    assert "Paired comparisons" in a.output
     # same command again, with two worker processes: same records up to wall-clock
     b = runner.invoke(cli, ["bench", *TINY, "-o", str(tmp_path / "b"), "--workers", "2"])
     assert b.exit_code == 0, b.output
@@ -192,12 +206,26 @@ def test_run_bench_returns_the_tables():
     (["--planners", "moma-llm", "--llm-replay", "/nonexistent/t.jsonl"],
      "no such transcript"),
     (["-O", "scout-delta"], "expected PLANNER.KEY=VALUE"),
+    (["--planners", "random,greedy", "--reference", "scout"],
+     "--reference: 'scout' is not one of --planners"),
 ])
 def test_cli_option_errors(tmp_path, args, message):
     r = CliRunner().invoke(cli, ["bench", "-o", str(tmp_path), "--no-progress", *args])
     assert r.exit_code == 2
     assert message in r.output
     assert not (tmp_path / "episodes.jsonl").exists()
+
+
+def test_all_pairs_compares_every_pair(tmp_path):
+    r = CliRunner().invoke(cli, ["bench", "--houses", "2", "--episodes", "1", "--seeds", "1",
+                                 "--planners", "random,greedy,scout", "--all-pairs",
+                                 "--no-progress", "-o", str(tmp_path / "o")])
+    assert r.exit_code == 0, r.output
+    paired = json.loads((tmp_path / "o" / "summary.json").read_text())["intervals"]["paired"]
+    assert [(p["planner"], p["reference"]) for p in paired] == [
+        ("greedy", "random"), ("scout", "random"), ("scout", "greedy")]
+    settings = json.loads((tmp_path / "o" / "summary.json").read_text())["settings"]
+    assert "all_pairs" not in settings and "reference" not in settings  # no result changes
 
 
 def test_config_check_rejects_duplicates():
