@@ -59,7 +59,14 @@ def test_a_damaged_pin_folder_is_a_collection_error_naming_it(tmp_path):
     assert f"{folder / 'expected.json'}: damaged pin file" in out
 
 
-def test_the_example_test_runs_with_the_fixture():
-    code, out = pytest_run("examples/test_golden_logs.py", cwd=REPO)
+def test_the_example_test_runs_with_the_fixture(tmp_path, monkeypatch):
+    """examples/test_golden_logs.py against a pin folder made here with the current code
+    (SGTOOL_GOLDEN_DIR), so that a deliberate mapping change fails tests/golden once, not
+    this test too."""
+    pins = tmp_path / "pins"
+    pin_logs([GOLDEN / "house6-tour.mcap", GOLDEN / "house10-start.mcap"], pins,
+             ReplayOptions(every=10, classifier="containment"), copy=True)
+    monkeypatch.setenv("SGTOOL_GOLDEN_DIR", str(pins))
+    code, out = pytest_run(REPO / "examples" / "test_golden_logs.py", cwd=REPO)
     assert code == 0, out
     assert "2 passed" in out
