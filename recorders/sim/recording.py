@@ -36,7 +36,7 @@ import numpy as np
 from sgtool.house.spec import HouseSpec
 from sgtool.log import codec
 from sgtool.log import schemas as S
-from sgtool.log.frame import Frame
+from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.log.records import Action, Episode, Instances
 from sgtool.log.writer import LogWriter
 from sgtool.recorders.sim.camera import CameraConfig, base_T_camera
@@ -52,6 +52,7 @@ from sgtool.recorders.sim.simulation import (
 )
 
 SOURCE = "pybullet"
+STATIC_TOL = 1e-9  # m / rotation entries: base -> camera still counts as the static link
 
 
 class LogRecorder(SimObserver):
@@ -78,6 +79,8 @@ class LogRecorder(SimObserver):
         self.last_time_ns = 0
         self.last_frame: Frame | None = None
         self.last_instances: Instances | None = None
+        self._calibration: CameraIntrinsics | None = None  # the last one written
+        self._static: np.ndarray | None = None  # base_T_camera as on /tf_static
         profile = noise or PROFILES["none"]
         structure = [i.id for i in sim.instances if i.kind == STRUCTURE]
         self.faults = None if profile.is_clean else SensorFaults(
@@ -94,15 +97,39 @@ class LogRecorder(SimObserver):
         f = sim.render()
         if self.faults is not None:
             f = self.faults.apply(f)
-        self.writer.write_frame(f.time_ns, depth=f.depth, pose=f.pose, intrinsics=f.intrinsics,
-                                rgb=f.rgb, base_pose=f.base_pose)
-        if f.ids is not None:  # after the depth image, as write_frame orders them
-            self.writer.write_proto(S.IDS, f.time_ns, instance_image(f.time_ns, f.ids))
+        self.write_frame(f)
         self.last_time_ns = f.time_ns
         self.last_frame = f
         self.frames += 1
         if self.progress is not None:
             self.progress.update(1)
+
+    def write_frame(self, f: Frame) -> None:
+        """One frame, in the order :meth:`LogWriter.write_frame` writes it (calibration when
+        it changes, transforms, RGB, depth, ids), with two differences: the base -> camera
+        link, which does not move, goes once to ``/tf_static`` (again on ``/tf`` only at a
+        frame where it differs by more than :data:`STATIC_TOL`, e.g. under pose noise),
+        and the ids are :func:`instance_image`'s."""
+        w, t = self.writer, f.time_ns
+        if f.intrinsics != self._calibration:
+            w.write_calibration(t, f.intrinsics)
+            self._calibration = f.intrinsics
+        if f.base_pose is None:
+            w.write_transform(t, S.WORLD_FRAME, S.CAMERA_FRAME, f.pose)
+        else:
+            w.write_transform(t, S.WORLD_FRAME, S.BASE_FRAME, f.base_pose)
+            base_T_cam = np.linalg.inv(f.base_pose) @ f.pose  # noqa: N806
+            if self._static is None:
+                self._static = base_T_cam
+                w.write_proto(S.TF_STATIC, t, codec.encode_transform(
+                    t, S.BASE_FRAME, S.CAMERA_FRAME, base_T_cam))
+            elif not np.allclose(base_T_cam, self._static, rtol=0.0, atol=STATIC_TOL):
+                w.write_transform(t, S.BASE_FRAME, S.CAMERA_FRAME, base_T_cam)
+        if f.rgb is not None:
+            w.write_rgb(t, f.rgb)
+        w.write_depth(t, f.depth)
+        if f.ids is not None:
+            w.write_proto(S.IDS, t, instance_image(t, f.ids))
 
     def on_state(self, sim: Simulation, spec_id: str, state: str) -> None:
         self.write_instances(sim)

@@ -2,7 +2,8 @@
 
 A *frame* is the depth message at one log time together with the RGB and instance-id
 messages of the same log time, the camera calibration in force and the camera pose composed
-from the ``/tf`` transforms (world -> ... -> camera) in force at that time. The reader
+from the ``/tf`` transforms (world -> ... -> camera) in force at that time (links that do not
+move may come once on ``/tf_static``). The reader
 (:meth:`sgtool.log.reader.LogReader.frames`) and replay
 (:mod:`sgtool.replayers.derived_log`) both assemble frames with :class:`FrameAssembler`.
 
@@ -74,7 +75,7 @@ class TransformBuffer:
         return None
 
 
-FRAME_TOPICS = (S.RGB, S.DEPTH, S.IDS, S.CALIBRATION, S.TF)
+FRAME_TOPICS = (S.RGB, S.DEPTH, S.IDS, S.CALIBRATION, S.TF, S.TF_STATIC)
 TF_TIMES = ("log", "stamp")  # what pairs /tf with frames (module doc)
 TF_STAMP_WARN_S = 0.05  # /tf stamps further than this from their log times: a note
 TF_STAMP_REFUSE_S = 1.0  # ... further than this: refused (pairing by log time)
@@ -182,7 +183,7 @@ class FrameAssembler:
             out = self.flush()
             self._pending = {}
         self._t = t_ns
-        if topic == S.TF:
+        if topic in (S.TF, S.TF_STATIC):  # /tf_static: links written once
             T = decoded(self.where, topic, t_ns, codec.decode_transform, message)  # noqa: N806
             self.transforms.add(self._tf_key(t_ns, message), message.parent_frame_id,
                                 message.child_frame_id, T)

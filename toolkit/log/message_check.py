@@ -36,6 +36,7 @@ PROTO_TOPICS: dict[str, str] = {
     S.IDS: "foxglove.RawImage",
     S.CALIBRATION: "foxglove.CameraCalibration",
     S.TF: "foxglove.FrameTransform",
+    S.TF_STATIC: "foxglove.FrameTransform",
     S.OCCUPANCY: "foxglove.Grid",
 }
 _RECORD_TOPICS = {k.topic: k for k in S.RECORDS.values()}

@@ -563,8 +563,13 @@ class LogReader:
             calib = decoded(str(self.path), d.topic, d.log_time_ns, codec.decode_calibration,
                             d.message)
             break
-        # the latest transform of each link before t, newest first, until the camera
-        # chain is complete
+        # the links written once (/tf_static), then the latest transform of each link
+        # before t, newest first, until the camera chain is complete
+        if self.has(S.TF_STATIC):
+            for d in self.messages([S.TF_STATIC], end_ns=t_ns):
+                tf.add(d.log_time_ns, d.message.parent_frame_id, d.message.child_frame_id,
+                       decoded(str(self.path), d.topic, d.log_time_ns,
+                               codec.decode_transform, d.message))
         seen: set[str] = set()
         for d in self.messages([S.TF], end_ns=t_ns, reverse=True):
             child = d.message.child_frame_id

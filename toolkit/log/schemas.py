@@ -29,8 +29,9 @@ from sgtool.vocabulary import (
 )
 
 # 1.1: sgtool.Action 1.1 adds the optional ``graph_time_ns``
-# 1.2: instance ids may be 16UC1 (what Foxglove's Image panel shows); derived logs add the
-#      ``/map/graph`` SceneUpdate (objects, doors, frontiers, edges with metadata)
+# 1.2: instance ids may be 16UC1 (what Foxglove's Image panel shows); fixed transforms
+#      (base -> camera) once on ``/tf_static``; derived logs add the ``/map/graph``
+#      SceneUpdate (objects, doors, frontiers, edges with metadata)
 LOG_SCHEMA_VERSION: tuple[int, int] = (1, 2)
 PROFILE = "sgtool"
 METADATA_NAME = "sgtool"
@@ -46,6 +47,7 @@ DEPTH = "/camera/depth"
 IDS = "/camera/instances"
 CALIBRATION = "/camera/calibration"
 TF = "/tf"
+TF_STATIC = "/tf_static"  # transforms that do not change, written once (FrameTransform)
 OCCUPANCY = "/map/occupancy"
 VORONOI = "/map/voronoi"
 ROOMS = "/map/rooms"

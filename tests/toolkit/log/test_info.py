@@ -25,11 +25,11 @@ def test_info_on_sgtool_log(tmp_path):
     path = write_log(tmp_path / "run.mcap")
     r = CliRunner().invoke(cli, ["info", str(path)])
     assert r.exit_code == 0, r.output
-    assert "schema version 1.1" in r.output and "frames 12" in r.output
+    assert "schema version 1.2" in r.output and "frames 12" in r.output
     assert "/camera/rgb" in r.output and "foxglove.RawImage" in r.output
     assert "episode: kind=recording, status=ended" in r.output
     j = json.loads(CliRunner().invoke(cli, ["info", "--json", str(path)]).output)
-    assert j["frames"] == 12 and j["log_schema_version"] == "1.1" and j["seed"] == 7
+    assert j["frames"] == 12 and j["log_schema_version"] == "1.2" and j["seed"] == 7
     counts = {c["topic"]: c["messages"] for c in j["channels"]}
     assert counts["/camera/depth"] == 12 and counts["/tf"] == 24
     assert j["camera"] == {"width": 64, "height": 48, "fx": pytest.approx(41.569, abs=1e-3),
