@@ -19,11 +19,17 @@ spread tasks over processes or machines (:func:`run_closed_loop_bench` takes a `
 The outputs (:func:`write_outputs`): ``episodes.jsonl`` (the
 :class:`~sgtool.results.EpisodeResult` of every run), ``summary.md`` (per noise profile:
 SR / SPL / steps / decision time / AUC-E as the symbolic bench, then frames per second and
-failed skills per episode by reason) and the efficiency curves per noise profile.
+failed skills per episode by reason; then the statistics that separate planners,
+:mod:`sgtool.analysis.closed_loop_tables`: SR and SPL with bootstrap intervals over houses,
+paired comparisons over houses and per house, SR against the frame budget per room with
+AUC-E on frames, and, with symbolic bench results, Kendall's tau between the two planner
+orders), ``summary.json`` (the same statistics as numbers) and the efficiency curves per
+noise profile (distance, steps and frames per room).
 """
 
 from __future__ import annotations
 
+import json
 import re
 import statistics
 from collections import Counter
@@ -39,10 +45,19 @@ from sgtool.analysis.bench_houses import (
     load_house_files,
     output_path,
 )
-from sgtool.analysis.metrics import cost_models, summarize
+from sgtool.analysis.closed_loop_tables import (
+    format_agreement,
+    format_frame_curves,
+    frame_curves,
+    frames_model,
+    interval_tables,
+    symbolic_agreement,
+)
+from sgtool.analysis.metrics import CostModel, cost_models, summarize
 from sgtool.analysis.offline import read_log_episodes
 from sgtool.analysis.report import format_table, pipe_table
 from sgtool.analysis.run_bench_resume import check_resumable, task_settings
+from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write
 from sgtool.log.records import Action
@@ -94,6 +109,8 @@ class ClosedLoopBenchConfig:
     frames_per_room: int | None = None  # frame budget per room (excludes options.frames)
     distance_budget: float = 5000.0
     step_budget: float = 50.0
+    reference: str | None = None  # paired comparisons against it (None: scout, else first)
+    all_pairs: bool = False  # paired comparisons of every pair of planners instead
 
     def check(self) -> None:
         from sgtool.analysis.bench import check_planner_list
@@ -102,6 +119,9 @@ class ClosedLoopBenchConfig:
         if len(set(self.planners)) != len(self.planners) or \
                 len(set(self.noise)) != len(self.noise):
             raise SgtoolError("--planners/--noise: a name is given twice")
+        if self.reference is not None and self.reference not in self.planners:
+            raise SgtoolError(f"--reference: {self.reference!r} is not one of --planners "
+                              f"({', '.join(self.planners)})")
         if self.episodes < 1:
             raise SgtoolError(f"--episodes: must be >= 1, got {self.episodes}")
         if self.houses < 0 or (self.houses == 0 and not self.house_files):
@@ -265,11 +285,54 @@ def tasks_of(cfg: ClosedLoopBenchConfig, logs: Path) -> list[RunTask]:
 
 @dataclass(frozen=True)
 class ClosedLoopBenchResult:
+    """The rows of a run, and optionally the episodes of a symbolic bench to compare the
+    planner order with (``symbolic``, from ``symbolic_source``)."""
+
     config: ClosedLoopBenchConfig
     rows: tuple[RunRow, ...]
+    symbolic: tuple[EpisodeResult, ...] = ()
+    symbolic_source: str = ""
 
     def results(self, noise: str | None = None) -> list[EpisodeResult]:
         return [r.result for r in self.rows if noise is None or r.task.noise == noise]
+
+    def frames_model(self, noise: str) -> CostModel:
+        """Frames per room of the house, per episode of ``noise``
+        (:func:`~sgtool.analysis.closed_loop_tables.frames_model`)."""
+        rooms: dict[str, int] = {}
+        per_room = {}
+        for r in self.rows:
+            if r.task.noise != noise:
+                continue
+            if r.task.house.id not in rooms:
+                rooms[r.task.house.id] = max(1, len(_house(r.task)[0].rooms))
+            per_room[r.result.key()] = r.frames / rooms[r.task.house.id]
+        budget = self.config.frames_per_room
+        return frames_model(per_room, None if budget is None else float(budget))
+
+    def statistics(self, noise: str) -> tuple[str, dict[str, Any]]:
+        """The tables that separate planners under ``noise`` (module doc): text, dict."""
+        cfg = self.config
+        results = self.results(noise)
+        text, data = interval_tables(results, cfg.planners, cfg.reference, cfg.all_pairs)
+        model = self.frames_model(noise)
+        budgets, curves = frame_curves(results, cfg.planners, model)
+        parts = [text, format_frame_curves(
+            budgets, curves, title="SR against the frame budget (frames per room)")]
+        data["frames"] = {"max_per_room": model.max_cost,
+                          "budgets_per_room": list(budgets),
+                          "planners": {c.planner: {"auc_e": round(c.auc_e, 6),
+                                                   "sr_within": [round(v, 6)
+                                                                 for v in c.sr_within]}
+                                       for c in curves}}
+        if self.symbolic:
+            matched, taus = symbolic_agreement(results, self.symbolic, cfg.planners)
+            parts.append(format_agreement(matched, len(self.symbolic), taus,
+                                          self.symbolic_source))
+            data["symbolic_agreement"] = {"source": self.symbolic_source,
+                                          "matched_episodes": matched,
+                                          "kendall": [t.to_dict() for t in taus]}
+        return "\n".join(parts), data
 
     def table(self) -> str:
         """Per noise profile: the bench table, then frames/s and failed skills by reason."""
@@ -283,7 +346,13 @@ class ClosedLoopBenchResult:
                                                 cfg.planners), models=models,
                                       title=f"## Closed loop, noise {noise!r}{rule}"))
             parts.append(_run_table(rows, cfg.planners))
+            parts.append(self.statistics(noise)[0])
         return "\n".join(parts)
+
+    def summary(self) -> dict[str, Any]:
+        """summary.json: per noise profile the statistics of :meth:`statistics`."""
+        return {"planners": list(self.config.planners),
+                "noise": {n: self.statistics(n)[1] for n in self.config.noise}}
 
 
 def _run_table(rows: Sequence[RunRow], planners: Sequence[str]) -> str:
@@ -356,12 +425,13 @@ def report_order(cfg: ClosedLoopBenchConfig,
 
 # the names of a run-bench folder's entries (what ``--force`` may replace, and what marks a
 # folder without a manifest as a run-bench folder: :func:`sgtool.files.output_folder`)
-OUTPUT_NAMES: tuple[str, ...] = ("logs", "episodes.jsonl", "summary.md", "efficiency_*.png")
+OUTPUT_NAMES: tuple[str, ...] = ("logs", "episodes.jsonl", "summary.md", "summary.json",
+                                 "efficiency_*.png")
 
 
 def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]:
-    """episodes.jsonl, summary.md and the efficiency curves (per noise profile), each
-    written atomically into ``out_dir``."""
+    """episodes.jsonl, summary.md, summary.json and the efficiency curves (per noise
+    profile: distance, steps, frames per room), each written atomically into ``out_dir``."""
     from sgtool.analysis.curves import plot_efficiency
 
     out = Path(out_dir)
@@ -371,10 +441,13 @@ def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]
     for noise in cfg.noise:
         by_planner = [(p, [r for r in res.results(noise) if r.planner == p])
                       for p in cfg.planners]
-        for model in cost_models(cfg.distance_budget, cfg.step_budget):
+        for model in (*cost_models(cfg.distance_budget, cfg.step_budget),
+                      res.frames_model(noise)):
             paths.append(plot_efficiency(by_planner, model,
                                          out / f"efficiency_{noise}_{model.name}.png"))
     paths.append(atomic_write(out / "summary.md", res.table()))
+    paths.append(atomic_write(out / "summary.json", json.dumps(
+        strict_json(res.summary()), indent=1, sort_keys=True, allow_nan=False) + "\n"))
     return paths
 
 
@@ -385,3 +458,34 @@ def failed_skills(path: str | Path) -> Counter[str]:
     with LogReader(Path(path)) as r:
         return Counter(reason_class(a.reason or "") for _, a in r.records(Action)
                        if a.outcome == "failure")
+
+
+def load_symbolic(path: str | Path) -> tuple[EpisodeResult, ...]:
+    """The episodes of a symbolic bench (``sgtool bench``): its output folder or its
+    ``episodes.jsonl``; a one-line :class:`~sgtool.errors.SgtoolError` when there are none."""
+    from sgtool.results import read_jsonl
+
+    p = Path(path)
+    file = p / "episodes.jsonl" if p.is_dir() else p
+    if not file.is_file():
+        raise SgtoolError(f"--symbolic {path}: no episodes.jsonl of a `sgtool bench` there")
+    results = tuple(read_jsonl(file))
+    if not results:
+        raise SgtoolError(f"--symbolic {path}: holds no episode")
+    return results
+
+
+def run_symbolic(cfg: ClosedLoopBenchConfig) -> tuple[EpisodeResult, ...]:
+    """The symbolic bench (one seed) on the run's houses and episodes, with its planners,
+    step budget and success rule: the symbolic order on the same episodes."""
+    from sgtool.analysis.bench import BenchConfig, run_benchmark
+
+    bench = BenchConfig(planners=cfg.planners, houses=cfg.houses, episodes=cfg.episodes,
+                        seeds=1, rooms=cfg.rooms, preset=cfg.preset,
+                        house_seed=cfg.house_seed, max_steps=cfg.options.max_steps,
+                        planner_options=cfg.planner_options, house_files=cfg.house_files,
+                        success=cfg.options.success)
+    res = run_benchmark(bench, progress=False)
+    if res.failed:
+        raise SgtoolError(f"the symbolic bench failed: {res.failed[0]}")
+    return res.results

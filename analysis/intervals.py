@@ -70,8 +70,10 @@ class Bootstrap:
 
     def statement(self, cluster: str = "house") -> str:
         """One sentence for a table's notes."""
+        kept = "an episode's seeds" if cluster == "episode" else \
+            f"a {cluster}'s episodes and seeds"
         return (f"{self.level * 100:g} % cluster-bootstrap intervals: {cluster}s resampled "
-                f"with replacement (a {cluster}'s episodes and seeds kept together), "
+                f"with replacement ({kept} kept together), "
                 f"{self.resamples} resamples, seed {self.seed}, percentile interval")
 
     def to_dict(self) -> dict[str, object]:

@@ -3,6 +3,7 @@ two steps per episode: logs per run, the table, resuming, Ctrl-C, the reason cla
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -38,6 +39,17 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
     lines = (out / "episodes.jsonl").read_text().splitlines()
     assert len(lines) == 2 and all('"house":"small"' in s for s in lines)
     assert (out / "efficiency_none_steps.png").stat().st_size > 0
+    assert (out / "efficiency_none_frames.png").stat().st_size > 0
+    # the statistics that separate planners (closed_loop_tables): one house, one episode,
+    # so no interval ("[-]"); greedy against the first planner; frames per room
+    assert "SR and SPL with bootstrap intervals over houses" in summary
+    assert "Paired comparisons over houses" in summary and "| greedy  | random" in summary
+    assert "Paired comparisons per house (intervals over its episodes)" in summary
+    assert "SR against the frame budget (frames per room)" in summary and "[-]" in summary
+    stats = json.loads((out / "summary.json").read_text())["noise"]["none"]
+    assert [(d["planner"], d["reference"]) for d in stats["paired"]] == [("greedy", "random")]
+    assert stats["paired_per_house"][0]["house"] == "small"
+    assert stats["frames"]["max_per_room"] == 30.0  # --frames 120 in 4 rooms, rounded up
     # a second run reads the logs back instead of running anything
     monkeypatch.setattr(clb, "run_episode", lambda *a, **k: pytest.fail("ran again"))
     again = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
@@ -56,6 +68,33 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
     res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
                                    "--success", "done"])
     assert res.exit_code == 2 and "success rule" in res.output
+
+
+def test_kendall_tau_against_a_symbolic_bench(house_file, tmp_path) -> None:
+    """--symbolic DIR reads a `sgtool bench` folder and adds the tau of the two orders (on
+    the episodes of the same house, episode and query); --report-only runs nothing."""
+    sym = tmp_path / "sym"
+    res = CliRunner().invoke(cli, ["bench", "--houses", "0", "--house", str(house_file),
+                                   "--episodes", "1", "--seeds", "1", "--planners",
+                                   "random,greedy", "--no-progress", "-o", str(sym)])
+    assert res.exit_code == 0, res.output
+    out = tmp_path / "rb"
+    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                   "--symbolic", str(sym)])
+    assert res.exit_code == 0, res.output
+    assert f"Agreement with the symbolic order (--symbolic {sym}; 2 symbolic episodes of " \
+        "the same (house, episode, query))" in res.output
+    agreement = json.loads((out / "summary.json").read_text())["noise"]["none"][
+        "symbolic_agreement"]
+    assert agreement["matched_episodes"] == 2
+    assert [k["metric"] for k in agreement["kendall"]] == ["spl", "sr"]
+    for args, msg in ((["--symbolic", str(tmp_path / "none")], "no episodes.jsonl"),
+                      (["--symbolic", str(sym), "--with-symbolic"], "give one of them"),
+                      (["--reference", "scout"], "--reference: 'scout' is not one of")):
+        bad = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                       "--report-only", *args])
+        assert bad.exit_code == 2 and msg in bad.output and bad.output.count("\n") == 1, \
+            bad.output
 
 
 def test_ctrl_c_leaves_only_complete_logs(house_file, tmp_path, monkeypatch) -> None:

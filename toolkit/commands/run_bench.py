@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -79,6 +80,22 @@ from sgtool.files import output_folder
               help="Run nothing: the tables of the episodes whose logs are there already.")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
+@click.option("--reference", default=None, metavar="PLANNER",
+              help="Paired comparisons of every other planner against this one on the same "
+              "episodes, over houses and per house (SPL ratio, SR and SPL differences with "
+              "bootstrap intervals, wins/losses/ties). [default: scout when run, else the "
+              "first planner]")
+@click.option("--all-pairs", is_flag=True,
+              help="Paired comparisons of every pair of planners instead of against "
+              "--reference.")
+@click.option("--symbolic", "symbolic_dir", default=None, metavar="DIR",
+              type=click.Path(path_type=str),
+              help="A `sgtool bench` output folder (or its episodes.jsonl): the table adds "
+              "Kendall's tau between its planner order and the closed loop's, on the "
+              "episodes of the same house, episode and query when there are any.")
+@click.option("--with-symbolic", is_flag=True,
+              help="Run the symbolic bench (one seed) on the same houses and episodes for "
+              "that Kendall tau (seconds to minutes; excludes --symbolic).")
 @success_option()
 @executor_options("episodes (one closed-loop run each)")
 def command(planners: str | None, houses: int | None, house_files: tuple[str, ...], house_seed: int,
@@ -90,7 +107,9 @@ def command(planners: str | None, houses: int | None, house_files: tuple[str, ..
             executor: str = "local",
             workers: int = 1, ray_address: str | None = None,
             llm_base_url: str | None = None, llm_model: str | None = None,
-            llm_api_key: str | None = None, llm_timeout: float | None = None) -> None:
+            llm_api_key: str | None = None, llm_timeout: float | None = None,
+            reference: str | None = None, all_pairs: bool = False,
+            symbolic_dir: str | None = None, with_symbolic: bool = False) -> None:
     """Run closed-loop search episodes in PyBullet for every planner on generated and given
     houses (the houses and episodes of `sgtool bench`), under each noise profile: one
     episode log per run (what `sgtool run` writes), then the table of the symbolic bench
@@ -112,7 +131,9 @@ def command(planners: str | None, houses: int | None, house_files: tuple[str, ..
     from sgtool.analysis.closed_loop_bench import (
         OUTPUT_NAMES,
         ClosedLoopBenchConfig,
+        load_symbolic,
         run_closed_loop_bench,
+        run_symbolic,
         write_outputs,
     )
     from sgtool.recorders.sim import CameraConfig
@@ -139,7 +160,11 @@ def command(planners: str | None, houses: int | None, house_files: tuple[str, ..
         episodes=episodes, rooms=parse_rooms(rooms), preset=preset,
         noise=tuple(noise) or ("none",), options=opts,
         planner_options=options,
-        frames_per_room=frames_per_room)
+        frames_per_room=frames_per_room, reference=reference, all_pairs=all_pairs)
+    if symbolic_dir is not None and with_symbolic:
+        raise SgtoolError("--symbolic and --with-symbolic: give one of them")
+    cfg.check()
+    symbolic = load_symbolic(symbolic_dir) if symbolic_dir is not None else ()
     show = sys.stderr.isatty() if progress is None else progress
     runner: Any = map  # in this process, one episode after the other
     if (executor != "local" or workers > 1 or ray_address) and not report_only:
@@ -163,6 +188,11 @@ def command(planners: str | None, houses: int | None, house_files: tuple[str, ..
             raise  # (with --force, output_folder says OUT is as it was instead)
         finally:
             bar.close()
+        if with_symbolic:
+            res = replace(res, symbolic=run_symbolic(cfg),
+                          symbolic_source="the symbolic bench on these episodes, 1 seed")
+        elif symbolic_dir is not None:
+            res = replace(res, symbolic=symbolic, symbolic_source=f"--symbolic {symbolic_dir}")
         written = [p.name for p in write_outputs(res, root)]
     paths = [Path(out_dir) / name for name in written]
     click.echo(res.table())

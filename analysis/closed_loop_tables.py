@@ -1,0 +1,152 @@
+"""The tables of ``sgtool run-bench`` that separate planners: bootstrap intervals and paired
+comparisons (:mod:`sgtool.analysis.intervals`) over houses and, per house, over its
+episodes; SR against the frame budget (per room of the house) with AUC-E on frames; the
+agreement of the closed loop's planner order with the symbolic bench's (Kendall's tau).
+
+Pure functions of episode records and their frame counts: text for ``summary.md`` and
+JSON-ready dicts for ``summary.json``, nothing read or written here.
+
+Frame-budget curve: an episode that succeeded after ``f`` frames in a house of ``R``
+rooms counts as solved for every budget of at least ``f / R`` frames per room; the curve
+is MoMa-LLM's efficiency curve on that cost (:func:`sgtool.analysis.metrics.curve_of`)
+and AUC-E its area over [0, max]. It reads a budget off one unbudgeted run (the planners
+do not know the budget), so no single ``--frames-per-room`` decides the table; the max is
+the run's own ``--frames-per-room`` when it has one, else the most frames per room any
+episode used.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+from sgtool.analysis.intervals import (
+    DEFAULT_BOOTSTRAP,
+    Bootstrap,
+    RankAgreement,
+    by_episode,
+    by_house,
+    comparison_pairs,
+    kendall_tau,
+    paired_comparison,
+    planner_intervals,
+)
+from sgtool.analysis.metrics import CostModel, auc_e_of, spl, success_rate
+from sgtool.analysis.report import format_intervals, format_paired, pipe_table
+from sgtool.results import EpisodeResult
+
+EpisodeKey = tuple[str, int, str, int]  # EpisodeResult.key(): planner, seed, house, episode
+BUDGET_FRACTIONS: tuple[float, ...] = (0.25, 0.5, 0.75, 1.0)  # of the curve's max
+
+
+def frames_model(frames_per_room: Mapping[EpisodeKey, float],
+                 budget: float | None = None) -> CostModel:
+    """The cost model "frames per room" of the episodes in ``frames_per_room`` (keyed by
+    :meth:`~sgtool.results.EpisodeResult.key`); max ``budget``, else the largest cost
+    (rounded up; at least 1)."""
+    top = budget if budget is not None else \
+        max(1.0, math.ceil(max(frames_per_room.values(), default=1.0)))
+    return CostModel("frames", "frames per room of the house", float(top),
+                     lambda r: float(frames_per_room[r.key()]))
+
+
+@dataclass(frozen=True)
+class FrameCurveRow:
+    """One planner's AUC-E on frames and its SR within each budget (frames per room)."""
+
+    planner: str
+    episodes: int
+    auc_e: float
+    sr_within: tuple[float, ...]
+
+
+def frame_curves(results: Sequence[EpisodeResult], planners: Sequence[str],
+                 model: CostModel) -> tuple[tuple[float, ...], list[FrameCurveRow]]:
+    """The budgets (:data:`BUDGET_FRACTIONS` of the model's max, rounded up to whole
+    frames per room) and per planner its AUC-E and SR within each budget: the share of
+    its episodes that succeeded at a cost of at most the budget (the curve's value at
+    its steps, not between them)."""
+    budgets = tuple(float(math.ceil(model.max_cost * f)) for f in BUDGET_FRACTIONS)
+    rows = []
+    for p in planners:
+        rs = [r for r in results if r.planner == p]
+        if not rs:
+            continue
+        costs = [model.cost(r) for r in rs]
+        rows.append(FrameCurveRow(p, len(rs), auc_e_of(rs, model), tuple(
+            sum(1 for r, c in zip(rs, costs, strict=True) if r.success and c <= b) / len(rs)
+            for b in budgets)))
+    return budgets, rows
+
+
+def format_frame_curves(budgets: Sequence[float], rows: Sequence[FrameCurveRow],
+                        title: str = "") -> str:
+    header = ["Planner", "Episodes", "AUC-E frames ↑",
+              *(f"SR ≤ {b:.0f} f/room" for b in budgets)]
+    body = [[r.planner, str(r.episodes), f"{r.auc_e:.3f}",
+             *(f"{v:.3f}" for v in r.sr_within)] for r in rows]
+    parts = [title] if title else []
+    parts.append(pipe_table(header, body))
+    parts.append("SR ≤ b: share of all episodes solved within b frames per room of the "
+                 "house; AUC-E frames: area under that curve over [0, "
+                 f"{budgets[-1]:.0f}] / {budgets[-1]:.0f}.")
+    return "\n".join(parts) + "\n"
+
+
+def symbolic_agreement(closed: Sequence[EpisodeResult], symbolic: Sequence[EpisodeResult],
+                       planners: Sequence[str]) -> tuple[int, list[RankAgreement]]:
+    """Kendall's tau between the closed loop's and the symbolic bench's planner scores
+    (SPL, then SR; episodes pooled). The symbolic episodes are those of the same (house,
+    episode, query) as a closed-loop episode when there are any (their count is returned,
+    0 when none match: then all symbolic episodes count)."""
+    wanted = {(r.house, r.episode, r.query) for r in closed}
+    same = [r for r in symbolic if (r.house, r.episode, r.query) in wanted]
+    pool = same or list(symbolic)
+    out = []
+    for name, fn in (("spl", spl), ("sr", success_rate)):
+        a = {p: fn([r for r in closed if r.planner == p]) for p in planners}
+        b = {p: fn([r for r in pool if r.planner == p]) for p in planners}
+        out.append(kendall_tau({p: v for p, v in a.items() if not math.isnan(v)},
+                               {p: v for p, v in b.items() if not math.isnan(v)}, name))
+    return len(same), out
+
+
+def format_agreement(matched: int, total: int, rows: Sequence[RankAgreement],
+                     source: str) -> str:
+    what = (f"{matched} symbolic episodes of the same (house, episode, query)" if matched
+            else f"all {total} symbolic episodes (none of the same house, episode and query)")
+    lines = [f"Agreement with the symbolic order ({source}; {what}): Kendall tau-b over the "
+             "planners"]
+    for r in rows:
+        tau = "-" if math.isnan(r.tau) else f"{r.tau:+.3f} (p = {r.p_value:.3f})"
+        lines.append(f"- by {r.metric.upper()}: {tau}, {len(r.planners)} planners")
+    return "\n".join(lines) + "\n"
+
+
+def interval_tables(results: Sequence[EpisodeResult], planners: Sequence[str],
+                    reference: str | None = None, all_pairs: bool = False,
+                    boot: Bootstrap = DEFAULT_BOOTSTRAP) -> tuple[str, dict[str, object]]:
+    """SR and SPL with intervals over houses, the paired comparisons over houses, then
+    the same comparisons in each house (intervals over its episodes): text and dict."""
+    present = [p for p in planners if any(r.planner == p for r in results)]
+    ivs = [planner_intervals(results, p, by_house, boot) for p in present]
+    pairs = comparison_pairs(present, reference if reference in present else None,
+                             all_pairs)
+    overall = [paired_comparison(results, a, b, by_house, boot) for a, b in pairs]
+    houses = sorted({r.house for r in results})
+    per_house = [(h, paired_comparison([r for r in results if r.house == h], a, b,
+                                       by_episode, boot))
+                 for h in houses for a, b in pairs]
+    text = "\n".join([
+        format_intervals(ivs, boot, title="SR and SPL with bootstrap intervals over houses"),
+        format_paired(overall, boot, title="Paired comparisons over houses"),
+        format_paired([c for _, c in per_house], boot, cluster="episode",
+                      title="Paired comparisons per house (intervals over its episodes)",
+                      labels=[h for h, _ in per_house])])
+    data: dict[str, object] = {
+        "bootstrap": boot.to_dict(),
+        "planners": {r.planner: r.to_dict() for r in ivs},
+        "paired": [c.to_dict() for c in overall],
+        "paired_per_house": [{"house": h, **c.to_dict()} for h, c in per_house]}
+    return text, data

@@ -1,0 +1,94 @@
+"""sgtool.analysis.closed_loop_tables on hand-made episodes: the frame-budget curve, the
+agreement with a symbolic order, the interval tables over houses and per house."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from sgtool.analysis.closed_loop_tables import (
+    format_agreement,
+    format_frame_curves,
+    frame_curves,
+    frames_model,
+    interval_tables,
+    symbolic_agreement,
+)
+from sgtool.analysis.intervals import Bootstrap
+from sgtool.results import EpisodeResult
+
+
+def ep(planner: str, house: str, episode: int, success: bool, travelled: float = 10.0,
+       query: str = "mug", seed: int = 0) -> EpisodeResult:
+    return EpisodeResult(planner=planner, seed=seed, house=house, episode=episode,
+                         query=query, success=success, steps=3, travelled_m=travelled,
+                         shortest_m=5.0)
+
+
+def test_frame_curves_count_the_episodes_solved_within_each_budget() -> None:
+    # "fast" solves its two episodes at 10 and 30 frames per room, "slow" one at 90, fails
+    # the other (which used 100)
+    rows = [ep("fast", "h", 0, True), ep("fast", "h", 1, True),
+            ep("slow", "h", 0, True), ep("slow", "h", 1, False)]
+    per_room = {rows[0].key(): 10.0, rows[1].key(): 30.0, rows[2].key(): 90.0,
+                rows[3].key(): 100.0}
+    model = frames_model(per_room)
+    assert model.max_cost == 100.0 and model.name == "frames"
+    assert frames_model(per_room, budget=40.0).max_cost == 40.0
+    budgets, curves = frame_curves(rows, ["fast", "slow", "absent"], model)
+    assert budgets == (25.0, 50.0, 75.0, 100.0)
+    fast, slow = curves
+    assert fast.sr_within == (0.5, 1.0, 1.0, 1.0) and slow.sr_within == (0.0, 0.0, 0.0, 0.5)
+    # AUC-E (trapezoids, MoMa-LLM): fast's curve (0,0)-(10,.5)-(30,1)-(100,1): area
+    # 2.5 + 15 + 70 = 87.5 of 100; slow's (0,0)-(90,.5)-(100,.5): 22.5 + 5 = 27.5
+    assert fast.auc_e == pytest.approx(0.875) and slow.auc_e == pytest.approx(0.275)
+    text = format_frame_curves(budgets, curves)
+    assert "| SR ≤ 25 f/room" in text and "| fast " in text and "absent" not in text
+
+
+def test_symbolic_agreement_uses_the_same_episodes_when_there_are() -> None:
+    closed = [ep(p, "h", e, ok) for p, oks in (("a", (1, 1)), ("b", (1, 0)), ("c", (0, 0)))
+              for e, ok in enumerate(oks)]
+    # the symbolic bench: same order on the same episodes, reversed on another house
+    symbolic = [ep(p, "h", e, ok, seed=s) for s in range(2)
+                for p, oks in (("a", (1, 1)), ("b", (1, 0)), ("c", (1, 0)))
+                for e, ok in enumerate(oks)]
+    symbolic += [ep(p, "other", 0, p == "c") for p in "abc"]
+    matched, (by_spl, by_sr) = symbolic_agreement(closed, symbolic, ["a", "b", "c"])
+    assert matched == 12
+    # SR a 1 > b .5 > c 0 in the loop; a 1 > b .5 = c .5 symbolically: tau-b
+    # (2 concordant, 0 discordant, one tie on one side) / sqrt(3 * 2) = 0.816
+    assert by_sr.tau == pytest.approx(2 / math.sqrt(6)) and by_sr.metric == "sr"
+    assert by_spl.tau == pytest.approx(2 / math.sqrt(6))
+    # nothing of the same house, episode and query: all symbolic episodes count
+    other = [ep(p, "x", 0, p == "c") for p in "abc"]
+    matched, (by_spl, by_sr) = symbolic_agreement(closed, other, ["a", "b", "c"])
+    # there only c succeeds: (a, c) and (b, c) discordant, (a, b) tied: -2 / sqrt(6)
+    assert matched == 0 and by_sr.tau == pytest.approx(-2 / math.sqrt(6))
+    flat = [ep(p, "x", 0, True) for p in "abc"]  # one value for all: no order
+    matched, (by_spl, by_sr) = symbolic_agreement(closed, flat, ["a", "b", "c"])
+    assert math.isnan(by_sr.tau)
+    text = format_agreement(0, 3, [by_spl, by_sr], "--symbolic x")
+    assert "all 3 symbolic episodes" in text and "by SR: -" in text
+
+
+def test_interval_tables_over_houses_and_per_house() -> None:
+    rows = [ep(p, f"h{h}", e, p == "scout" or e == 0, travelled=5.0)
+            for h in range(3) for e in range(2) for p in ("random", "scout")]
+    text, data = interval_tables(rows, ["random", "scout", "absent"],
+                                 boot=Bootstrap(resamples=500))
+    assert "Paired comparisons over houses" in text and "| h2    | random" in text
+    assert "episodes resampled with replacement (an episode's seeds kept together)" in text
+    (pair,) = data["paired"]
+    # random solves one of two in every house at SPL 1, scout both: ratio exactly 0.5
+    assert pair["planner"] == "random" and pair["reference"] == "scout"
+    assert pair["spl_ratio"] == {"value": 0.5, "low": 0.5, "high": 0.5}
+    assert (pair["wins"], pair["losses"], pair["ties"]) == (0, 3, 0)
+    per_house = data["paired_per_house"]
+    assert [d["house"] for d in per_house] == ["h0", "h1", "h2"]
+    assert all((d["wins"], d["losses"], d["ties"]) == (0, 1, 1) for d in per_house)
+    assert set(data["planners"]) == {"random", "scout"}
+    _, every = interval_tables(rows, ["random", "scout"], all_pairs=True,
+                               boot=Bootstrap(resamples=500))
+    assert [(d["planner"], d["reference"]) for d in every["paired"]] == [("scout", "random")]
