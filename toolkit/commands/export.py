@@ -93,3 +93,26 @@ def bag(log: str, output: str, fmt: str | None, distro: str, time_base: float,
                             compression=compression, topics=names, progress=bar)
     for line in report.lines():
         click.echo(line)
+
+
+@command.command("foxglove-layout")
+@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
+              help="Where to write the layout (JSON).")
+@click.option("--force", is_flag=True, help="Overwrite OUT.")
+def foxglove_layout(output: str, force: bool) -> None:
+    """Write the Foxglove layout shipped with sgtool: a 3D panel with the maps and the
+    scene graph (/map/occupancy, /map/voronoi, /map/rooms, /map/graph) following the
+    robot, the RGB, depth and instance images, and the scene graph and action records.
+    Import it in Foxglove with Layouts > Import from file, then open a log or a derived
+    log."""
+    from importlib.resources import files
+
+    from sgtool.commands.options import check_output
+    from sgtool.files import atomic_write
+
+    check_output(output, force=force, suffixes=(".json",), what="layout")
+    atomic_write(output, files("sgtool").joinpath(LAYOUT).read_text(encoding="utf-8"))
+    click.echo(f"wrote {output}; import it in Foxglove: Layouts > Import from file")
+
+
+LAYOUT = "foxglove_layout.json"  # package data of sgtool

@@ -1,0 +1,39 @@
+"""`sgtool export foxglove-layout` writes the shipped layout; every topic its panels name
+is a topic of a derived log (so no panel is empty by a typo)."""
+
+from __future__ import annotations
+
+import json
+
+from click.testing import CliRunner
+from support.paths import GOLDEN
+
+from sgtool.cli import cli
+from sgtool.log import LogReader
+from sgtool.replayers.derived_log import ReplayOptions, replay
+
+
+def panel_topics(layout: dict) -> set[str]:
+    out: set[str] = set()
+    for cfg in layout["configById"].values():
+        out |= set(cfg.get("topics", {}))
+        if "imageTopic" in cfg.get("imageMode", {}):
+            out.add(cfg["imageMode"]["imageTopic"])
+        if "topicPath" in cfg:
+            out.add(cfg["topicPath"])
+    return out
+
+
+def test_layout_names_topics_of_a_derived_log(tmp_path):
+    out = tmp_path / "layout.json"
+    r = CliRunner().invoke(cli, ["export", "foxglove-layout", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    layout = json.loads(out.read_text())
+    derived = tmp_path / "derived.mcap"
+    replay(GOLDEN / "house10-start.mcap", derived, ReplayOptions(max_frames=30))
+    with LogReader(derived) as rd:
+        topics = rd.topics()
+    assert panel_topics(layout) <= set(topics)
+    assert "/map/graph" in panel_topics(layout)
+    r = CliRunner().invoke(cli, ["export", "foxglove-layout", "-o", str(out)])
+    assert r.exit_code == 2 and "--force" in r.output
