@@ -35,6 +35,15 @@ def sgtool(capsys, *args):
     return code, out.out, out.err
 
 
+def summary_row(out, name):
+    """The cells of ``name``'s row of the summary table."""
+    for line in out.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if line.startswith("|") and cells[0] == name:
+            return cells
+    raise AssertionError(f"no summary row for {name}")
+
+
 @pytest.fixture(scope="module")
 def log(tmp_path_factory):
     dst = tmp_path_factory.mktemp("logs") / "small.mcap"
@@ -81,7 +90,9 @@ def test_a_coarser_voxel_size_is_reported_layer_by_layer(pinned, tmp_path, capsy
         assert f"    {layer}" in out, layer
     assert "m²" in out  # room areas
     assert "quality (" in out  # the figures before and after: the log carries its house
-    assert "| small | changed |" in out.replace("  ", " ").replace("| small ", "| small ")
+    row = summary_row(out, "small")
+    assert row[1] == "changed" and row[3].startswith("refresh 0 at 3.000 s")
+    assert int(row[4]) >= 1 and int(row[5]) >= 1  # rooms, objects differences
     assert "--update" in err
     assert "## small: changed" in md.read_text()
     junit = xml.read_text()
@@ -224,6 +235,18 @@ def test_episode_logs_pin_the_planners_decisions(log, tmp_path, capsys):
 
     cap = capture(ep, pin.options, quality=False)
     assert planner_decisions(ep, cap.graphs, cap.refreshes) == ("greedy", pin.decisions)
+    # a pinned decision that the planner no longer takes is named in the report
+    index = json.loads((folder / "expected.json").read_text())
+    first = index["cases"]["episode"]["decisions"][0]
+    index["cases"]["episode"]["decisions"][0] = [first[0], first[1], "navigate", "room:99"]
+    (folder / "expected.json").write_text(json.dumps(index))
+    code, out, _ = sgtool(capsys, "golden", "check", "--dir", folder)
+    d = pin.decisions[0]
+    assert code == 1
+    assert (f"decisions: greedy at episode 0, step {d.step}: navigate(room:99) -> "
+            f"{d.text()}") in out
+    row = summary_row(out, "episode")
+    assert row[1] == "changed" and row[-1] == "changed"  # status, decisions
 
 
 def test_the_first_decision_that_differs_is_named():
