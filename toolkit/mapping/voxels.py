@@ -39,7 +39,9 @@ label (id 0) or swapped it (another id) voted its voxels under another label, so
 instance takes along every voxel it *wins* (most votes, as :meth:`VoxelMap.voxels`) with
 all the votes in it, not only its own label's entries. Free-space evidence from the
 robot's body (:meth:`VoxelMap.clear_unlabelled_around`) drops the voxels that never had an
-instance's label where the robot stood.
+instance's label where the robot stood; free-space evidence from depth
+(:meth:`VoxelMap.clear_seen_through`, :mod:`sgtool.mapping.free_space`) drops the weak
+voxels that later views saw through.
 
 Everything is exact integer arithmetic after the float64 back-projection (elementwise, no
 BLAS; :mod:`sgtool.mapping.backproject` runs it in cache blocks, operation for operation),
@@ -50,12 +52,14 @@ so the same frames give the same map bit for bit. A frame's keys are counted by
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.mapping.backproject import Scratch, beyond_packing, within_packing, world_voxels
+from sgtool.mapping.free_space import FreeSpaceConfig, View, seen_through
 from sgtool.mapping.key_count import count_keys
 from sgtool.mapping.label_stats import LabelStats, update_frame
 from sgtool.mapping.vote_store import VoteStore, drain_keys, sorted_unique, spans
@@ -158,6 +162,11 @@ class VoxelMap:
         self._new_keys: list[np.ndarray] = []  # entries new since the last drain
         self._removed_keys: list[np.ndarray] = []  # entries removed since the last drain
         self._zhist = np.zeros(1 << AXIS_BITS, dtype=np.int64)  # entries per height level
+        # free-space evidence (clear_seen_through): entries new since its last call, and
+        # the weak voxels it watches (sorted voxel keys) with their misses
+        self._unwatched: list[np.ndarray] = []
+        self._weak = np.zeros(0, dtype=np.int64)
+        self._misses = np.zeros(0, dtype=np.int64)
 
     # ----- integration ------------------------------------------------------------------
     def _ray_table(self, k: CameraIntrinsics, h: int, w: int) -> tuple[np.ndarray, np.ndarray]:
@@ -345,6 +354,7 @@ class VoxelMap:
         if len(nk):
             self._voxel_stats(nk, +1)
             self._new_keys.append(nk)
+            self._unwatched.append(nk)
             self._zhist += np.bincount((nk >> SHIFT_Z) & AXIS_MASK, minlength=1 << AXIS_BITS)
 
     def _voxel_stats(self, keys: np.ndarray, sign: int) -> None:
@@ -426,6 +436,60 @@ class VoxelMap:
         all_keys, _ = self.entries()
         mask = np.zeros(len(all_keys), dtype=bool)
         mask[np.searchsorted(all_keys, gone)] = True
+        self._voxel_stats(gone, -1)
+        self._remove(mask, gone)
+        return int(len(gone))
+
+    def clear_seen_through(self, views: Sequence[View], zlo: int, zhi: int,
+                           config: FreeSpaceConfig | None = None) -> int:
+        """Projective free-space evidence (:mod:`sgtool.mapping.free_space`): every voxel
+        at levels ``zlo..zhi`` with at most ``weak_votes`` votes counts the ``views`` that
+        saw through it (misses, kept across calls); a voxel whose misses reach its votes
+        is dropped with all its entries. A voxel with more votes is no longer watched (its
+        votes only grow); a dropped one that a later frame sees again starts anew.
+        Returns the number of (voxel, label) entries removed."""
+        cfg = config or FreeSpaceConfig()
+        self.flush()
+        new = drain_keys(self._unwatched)
+        if len(new):
+            iz = ((new >> SHIFT_Z) & AXIS_MASK) - OFFSET
+            nv = sorted_unique(new[(iz >= zlo) & (iz <= zhi)] >> VOXEL_SHIFT)
+            fresh = nv[~np.isin(nv, self._weak, assume_unique=True)]
+            if len(fresh):
+                weak = np.concatenate([self._weak, fresh])
+                misses = np.concatenate([self._misses, np.zeros(len(fresh), np.int64)])
+                order = np.argsort(weak, kind="stable")
+                self._weak, self._misses = weak[order], misses[order]
+        if not len(self._weak):
+            return 0
+        keys, counts = self._store.within(*_voxel_bounds(self._weak))
+        vk = keys >> VOXEL_SHIFT
+        votes = np.bincount(np.searchsorted(self._weak, vk), weights=counts,
+                            minlength=len(self._weak)).astype(np.int64)
+        iz = ((self._weak >> (SHIFT_Z - VOXEL_SHIFT)) & AXIS_MASK) - OFFSET
+        keep = (votes > 0) & (votes <= cfg.weak_votes) & (iz >= zlo) & (iz <= zhi)
+        self._weak, self._misses, votes = self._weak[keep], self._misses[keep], votes[keep]
+        if not len(self._weak) or not views:
+            return 0
+        w = self._weak
+        res = self.config.resolution
+        centres = np.stack([(((w >> (SHIFT_X - VOXEL_SHIFT)) & AXIS_MASK) - OFFSET + 0.5) * res,
+                            (((w >> (SHIFT_Y - VOXEL_SHIFT)) & AXIS_MASK) - OFFSET + 0.5) * res,
+                            (iz[keep] + 0.5) * res], axis=1)
+        for view in views:
+            self._misses += seen_through(centres, view, cfg.margin, self.config.min_range,
+                                         self.config.max_range, res)
+        drop = self._misses >= votes
+        if not drop.any():
+            return 0
+        gone_vk = w[drop]
+        self._weak, self._misses = w[~drop], self._misses[~drop]
+        all_keys, _ = self.entries()
+        lo, hi = _voxel_bounds(gone_vk)
+        idx = spans(np.searchsorted(all_keys, lo), np.searchsorted(all_keys, hi))
+        mask = np.zeros(len(all_keys), dtype=bool)
+        mask[idx] = True
+        gone = all_keys[idx]
         self._voxel_stats(gone, -1)
         self._remove(mask, gone)
         return int(len(gone))

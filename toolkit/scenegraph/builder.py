@@ -74,6 +74,7 @@ import numpy as np
 from sgtool.log.frame import Frame
 from sgtool.mapping.bev import ColumnGrid, classify_keys, floor_fans, floor_level
 from sgtool.mapping.column_update import fresh_extent, reclassify_columns
+from sgtool.mapping.free_space import View
 from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
 from sgtool.mapping.voronoi import (
     RidgeGraph,
@@ -179,6 +180,8 @@ class SceneGraphBuilder:
         self.robot: tuple[float, float, float] | None = None
         self.frames_since_refresh = 0
         self._cleared = 0  # trajectory points whose body cleared the voxels around them
+        self._views: list[View] = []  # depth frames not yet used as free-space evidence
+        self.seen_through_entries = 0  # voxel entries dropped as seen through by depth
         self.cleared_entries = 0  # voxel entries dropped by the robot's body
         self.timings: dict[str, list[float]] = defaultdict(list)
         self.timings_scratch: dict[str, list[float]] = defaultdict(list)  # from_scratch=True
@@ -240,6 +243,9 @@ class SceneGraphBuilder:
         else:  # camera optical axis (z) projected on the floor
             yaw = math.atan2(float(src[1, 2]), float(src[0, 2]))
         self.voxels.integrate(frame, (x, y))
+        if np.all(np.isfinite(frame.pose)):
+            self._views.append(View.of(frame.pose, frame.intrinsics, np.asarray(frame.depth),
+                                       self.config.voxels.min_range))
         k = frame.intrinsics
         vc = self.config.voxels
         self._fans.append(floor_fans(np.asarray(frame.depth), np.asarray(frame.pose), k.fx,
@@ -341,16 +347,22 @@ class SceneGraphBuilder:
         """The robot's body is free-space evidence (module doc): drop the unlabelled voxels
         of the BEV height band within ``BODY_RADIUS`` of the trajectory points new since
         the last refresh."""
-        if self._cleared >= len(self.trajectory):
+        if self._cleared >= len(self.trajectory) and not self._views:
             return
-        pts = np.asarray(self.trajectory[self._cleared:], dtype=np.float64)
-        self._cleared = len(self.trajectory)
         cfg = self.config.bev
         res = self.voxels.resolution
         lo, hist = self.voxels.level_histogram()
         level = floor_level(cfg, res, lo, hist)
         tol = int(round(cfg.floor_tolerance / res))
         top = int(round(cfg.band_top / res))
+        if self._views:
+            views, self._views = self._views, []
+            self.seen_through_entries += self.voxels.clear_seen_through(
+                views, level + tol + 1, level + top, self.config.free_space)
+        if self._cleared >= len(self.trajectory):
+            return
+        pts = np.asarray(self.trajectory[self._cleared:], dtype=np.float64)
+        self._cleared = len(self.trajectory)
         self.cleared_entries += self.voxels.clear_unlabelled_around(
             pts, BODY_RADIUS, level + tol + 1, level + top)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from sgtool.mapping.bev import BevConfig
+from sgtool.mapping.free_space import FreeSpaceConfig
 from sgtool.mapping.voronoi import VoronoiConfig
 from sgtool.mapping.voxels import VoxelConfig
 from sgtool.scenegraph.assign import AssignConfig
@@ -17,6 +18,7 @@ from sgtool.scenegraph.room_segmentation import RoomConfig
 class BuilderConfig:
     voxels: VoxelConfig = VoxelConfig()
     bev: BevConfig = BevConfig()
+    free_space: FreeSpaceConfig = FreeSpaceConfig()  # depth rays clear weak voxels
     voronoi: VoronoiConfig = VoronoiConfig()
     rooms: RoomConfig = RoomConfig()
     assign: AssignConfig = AssignConfig()
