@@ -207,16 +207,22 @@ _LAYERS: tuple[tuple[str, Callable[[SceneGraph], Sequence[Any]], Callable[[Any],
 
 
 def _distance_changes(expected: SceneGraph, actual: SceneGraph, tol: float) -> list[str]:
-    worst, n = (0.0, ""), 0
+    """One line: how many robot distances differ beyond ``tol``, how many nodes gained or
+    lost one, and the largest change."""
+    worst, n, gone = (0.0, ""), 0, 0
     for k in sorted(expected.distances.keys() | actual.distances.keys()):
         a, b = expected.distances.get(k), actual.distances.get(k)
         if a is None or b is None:
-            n += 1
-            worst = max(worst, (math.inf, k))
+            gone += 1
         elif abs(a - b) > tol:
             n += 1
             worst = max(worst, (abs(a - b), k))
-    return [f"distances: {n} differ, largest {worst[0]:.3f} m ({worst[1]})"] if n else []
+    if not n and not gone:
+        return []
+    parts = [f"{n} differ" + (f", largest {worst[0]:.3f} m ({worst[1]})" if n else "")]
+    if gone:
+        parts.append(f"{gone} new or gone")
+    return ["distances: " + "; ".join(parts)]
 
 
 ROUNDING = "the canonical JSON differs below the tolerance (rounding)"
