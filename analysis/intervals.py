@@ -98,6 +98,7 @@ class Interval:
         return bool(self.low > x or self.high < x)
 
     def to_dict(self) -> dict[str, float | None]:
+        """Rounded to 6 decimals; None for NaN or an infinite bound (a ratio over 0)."""
         def num(v: float) -> float | None:
             return None if math.isnan(v) or math.isinf(v) else round(v, 6)
 
