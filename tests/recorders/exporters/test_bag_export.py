@@ -266,3 +266,24 @@ def test_not_an_sgtool_log_and_bad_format(tmp_path):
         export_bag(tmp_path / "nope.mcap", tmp_path / "o")
     with pytest.raises(SgtoolError, match=r"folder .*missing does not exist"):
         export_bag(log, tmp_path / "missing" / "o")
+
+
+def test_cli_options(tmp_path):
+    log = log_with_rooms(tmp_path / "d.mcap")
+    out = tmp_path / "o"
+    r = CliRunner().invoke(cli, ["export", "bag", str(log), "-o", str(out), "--frames",
+                                 "sgtool", "--frame", "camera=cam", "--topics",
+                                 "/camera/depth, /tf", "--time-base", "2", "--no-progress"])
+    assert r.exit_code == 0, r.output
+    assert "(ros2, zstd)" in r.output and "log time + 2 s" in r.output
+    got = read_bag(out)
+    assert set(got) == {"/camera/depth/image_raw", "/camera/depth/camera_info", "/tf",
+                        "/tf_static"}
+    assert got["/camera/depth/image_raw"][0][1].header.frame_id == "cam"
+    assert got["/tf"][0][1].transforms[0].header.frame_id == "world"
+    for bad, says in ((["--frame", "camera"], "--frame 'camera': give OLD=NEW"),
+                      (["--topics", ","], "--topics: give at least one topic"),
+                      (["--compression", "lz4"], "a ros2 bag takes none, zstd")):
+        r = CliRunner().invoke(cli, ["export", "bag", str(log), "-o", str(tmp_path / "x"),
+                                     *bad])
+        assert r.exit_code == 2 and says in r.output, r.output
