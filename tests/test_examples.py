@@ -172,7 +172,7 @@ def test_import_replay_export_writes_a_readable_bag(tmp_path: Path) -> None:
     counts = _bag_counts(tmp_path / "out" / "derived_bag")
     assert counts["/camera/depth/image_raw"] == counts["/camera/rgb/image_raw"] == 24
     assert counts["/map/occupancy"] == counts["/sgtool/scene_graph"] == refreshes
-    assert f"derived_bag (ros2): {sum(counts.values())} messages" in out
+    assert f"derived_bag (ros2, zstd): {sum(counts.values())} messages" in out
 
 
 def test_evaluate_logged_replays_the_logged_decisions(tmp_path: Path) -> None:
