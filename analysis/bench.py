@@ -82,6 +82,7 @@ from sgtool.analysis.report import (
     format_breakdown,
     format_intervals,
     format_paired,
+    format_paired_split,
     format_seen_unseen,
     format_side_by_side,
     format_table,
@@ -264,12 +265,16 @@ class BenchResult:
         """SR and SPL per planner with cluster-bootstrap intervals over houses."""
         return [planner_intervals(self.results, p, boot=boot) for p in self.config.planners]
 
-    def comparisons(self, boot: Bootstrap = DEFAULT_BOOTSTRAP) -> list[PairedComparison]:
+    def comparisons(self, boot: Bootstrap = DEFAULT_BOOTSTRAP,
+                    seen: bool | None = None) -> list[PairedComparison]:
         """The paired comparisons of the config's pairs (:func:`~sgtool.analysis.
-        intervals.comparison_pairs`), intervals over houses."""
+        intervals.comparison_pairs`), intervals over houses; ``seen`` True / False: on
+        the episodes of seen / unseen queries only."""
         pairs = comparison_pairs(self.config.planners, self.config.reference,
                                  self.config.all_pairs)
-        return [paired_comparison(self.results, a, b, boot=boot) for a, b in pairs]
+        results = self.results if seen is None else \
+            [r for r in self.results if r.seen is seen]
+        return [paired_comparison(results, a, b, boot=boot) for a, b in pairs]
 
     def interval_tables(self, boot: Bootstrap = DEFAULT_BOOTSTRAP) -> str:
         """The intervals per planner, then the paired comparisons (text)."""
@@ -278,7 +283,9 @@ class BenchResult:
             title="SR and SPL with bootstrap intervals over houses, episodes pooled over "
                   "seeds") + "\n" + format_paired(
             self.comparisons(boot), boot,
-            title="Paired comparisons on the same episodes")
+            title="Paired comparisons on the same episodes") + "\n" + format_paired_split(
+            self.comparisons(boot, seen=True), self.comparisons(boot, seen=False), boot,
+            title="Paired comparisons on seen and on unseen queries")
 
     def breakdown_table(self, by: str) -> str:
         rows = breakdown(self.results, by, self.config.planners)
@@ -536,7 +543,9 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
         "seen_unseen": [asdict(s) for s in seen_unseen(res.results, cfg.planners)],
         "intervals": {"bootstrap": DEFAULT_BOOTSTRAP.to_dict(), "cluster": "house",
                       "planners": {r.planner: r.to_dict() for r in res.intervals()},
-                      "paired": [c.to_dict() for c in res.comparisons()]},
+                      "paired": [c.to_dict() for c in res.comparisons()],
+                      "paired_seen": [c.to_dict() for c in res.comparisons(seen=True)],
+                      "paired_unseen": [c.to_dict() for c in res.comparisons(seen=False)]},
         "vocabulary": {"priors": cfg.priors_dir, "training_queries": res.vocabulary_size},
         "houses": [{"id": h.id, "source": h.source} for h in res.houses],
         "digest": res.digest,

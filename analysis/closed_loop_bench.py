@@ -46,6 +46,7 @@ from sgtool.analysis.bench_houses import (
     output_path,
 )
 from sgtool.analysis.closed_loop_tables import (
+    budget_comparisons,
     format_agreement,
     format_frame_curves,
     frame_curves,
@@ -317,14 +318,17 @@ class ClosedLoopBenchResult:
         text, data = interval_tables(results, cfg.planners, cfg.reference, cfg.all_pairs)
         model = self.frames_model(noise)
         budgets, curves = frame_curves(results, cfg.planners, model)
+        within, within_data = budget_comparisons(results, cfg.planners, model, budgets,
+                                                 cfg.reference, cfg.all_pairs)
         parts = [text, format_frame_curves(
-            budgets, curves, title="SR against the frame budget (frames per room)")]
+            budgets, curves, title="SR against the frame budget (frames per room)"), within]
         data["frames"] = {"max_per_room": model.max_cost,
                           "budgets_per_room": list(budgets),
                           "planners": {c.planner: {"auc_e": round(c.auc_e, 6),
                                                    "sr_within": [round(v, 6)
                                                                  for v in c.sr_within]}
-                                       for c in curves}}
+                                       for c in curves},
+                          "paired_sr_diff": within_data}
         if self.symbolic:
             matched, taus = symbolic_agreement(results, self.symbolic, cfg.planners)
             parts.append(format_agreement(matched, len(self.symbolic), taus,

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from sgtool.analysis.intervals import (
     DEFAULT_BOOTSTRAP,
@@ -33,7 +33,7 @@ from sgtool.analysis.intervals import (
     planner_intervals,
 )
 from sgtool.analysis.metrics import CostModel, auc_e_of, spl, success_rate
-from sgtool.analysis.report import format_intervals, format_paired, pipe_table
+from sgtool.analysis.report import fmt_interval, format_intervals, format_paired, pipe_table
 from sgtool.results import EpisodeResult
 
 EpisodeKey = tuple[str, int, str, int]  # EpisodeResult.key(): planner, seed, house, episode
@@ -92,6 +92,40 @@ def format_frame_curves(budgets: Sequence[float], rows: Sequence[FrameCurveRow],
                  "house; AUC-E frames: area under that curve over [0, "
                  f"{budgets[-1]:.0f}] / {budgets[-1]:.0f}.")
     return "\n".join(parts) + "\n"
+
+
+def within_budget(results: Sequence[EpisodeResult], model: CostModel,
+                  budget: float) -> list[EpisodeResult]:
+    """``results`` as a run with ``budget`` would have scored them: an episode whose cost
+    exceeds the budget did not succeed (module doc)."""
+    return [r if not r.success or model.cost(r) <= budget else replace(r, success=False)
+            for r in results]
+
+
+def budget_comparisons(results: Sequence[EpisodeResult], planners: Sequence[str],
+                       model: CostModel, budgets: Sequence[float],
+                       reference: str | None = None, all_pairs: bool = False,
+                       boot: Bootstrap = DEFAULT_BOOTSTRAP
+                       ) -> tuple[str, list[dict[str, object]]]:
+    """Per pair of planners (:func:`~sgtool.analysis.intervals.comparison_pairs`), the
+    paired SR difference within each frame budget, intervals over houses: text, dicts."""
+    present = [p for p in planners if any(r.planner == p for r in results)]
+    pairs = comparison_pairs(present, reference if reference in present else None,
+                             all_pairs)
+    scored = [within_budget(results, model, b) for b in budgets]
+    body: list[list[str]] = []
+    data: list[dict[str, object]] = []
+    for a, b in pairs:
+        diffs = [paired_comparison(rs, a, b, by_house, boot).sr_diff for rs in scored]
+        body.append([a, b, *(fmt_interval(d, signed=True) for d in diffs)])
+        data.append({"planner": a, "reference": b,
+                     "sr_diff_within": [d.to_dict() for d in diffs]})
+    header = ["Planner", "Reference", *(f"SR diff ≤ {x:.0f} f/room" for x in budgets)]
+    text = "\n".join([
+        "Paired SR difference within each frame budget (planner - reference)",
+        pipe_table(header, body),
+        "An episode over the budget counts as failed; " + boot.statement("house") + "."])
+    return text + "\n", data
 
 
 def symbolic_agreement(closed: Sequence[EpisodeResult], symbolic: Sequence[EpisodeResult],

@@ -8,12 +8,14 @@ import math
 import pytest
 
 from sgtool.analysis.closed_loop_tables import (
+    budget_comparisons,
     format_agreement,
     format_frame_curves,
     frame_curves,
     frames_model,
     interval_tables,
     symbolic_agreement,
+    within_budget,
 )
 from sgtool.analysis.intervals import Bootstrap
 from sgtool.results import EpisodeResult
@@ -92,3 +94,19 @@ def test_interval_tables_over_houses_and_per_house() -> None:
     _, every = interval_tables(rows, ["random", "scout"], all_pairs=True,
                                boot=Bootstrap(resamples=500))
     assert [(d["planner"], d["reference"]) for d in every["paired"]] == [("scout", "random")]
+
+
+def test_within_a_budget_the_slow_planner_fails() -> None:
+    # in each of 3 houses: "fast" solves at 10 frames per room, "slow" at 90
+    rows = [ep(p, f"h{h}", 0, True) for h in range(3) for p in ("fast", "slow")]
+    per_room = {r.key(): 10.0 if r.planner == "fast" else 90.0 for r in rows}
+    model = frames_model(per_room, budget=100.0)
+    assert [r.success for r in within_budget(rows, model, 50.0)] == [True, False] * 3
+    text, data = budget_comparisons(rows, ["fast", "slow"], model, (50.0, 100.0),
+                                    reference="slow", boot=Bootstrap(resamples=500))
+    (pair,) = data
+    assert (pair["planner"], pair["reference"]) == ("fast", "slow")
+    # +1 in every house at 50 frames per room, no difference with 100
+    assert pair["sr_diff_within"] == [{"value": 1.0, "low": 1.0, "high": 1.0},
+                                      {"value": 0.0, "low": 0.0, "high": 0.0}]
+    assert "| SR diff ≤ 50 f/room" in text and "+1.000 [+1.000, +1.000]" in text

@@ -63,6 +63,9 @@ def test_cli_writes_outputs_and_is_deterministic(tmp_path):
     summary_md = (tmp_path / "a" / "summary.md").read_text()
     assert "SR and SPL with bootstrap intervals over houses" in summary_md
     assert "Paired comparisons on the same episodes" in summary_md
+    assert "Paired comparisons on seen and on unseen queries" in summary_md
+    assert len(iv["paired_seen"]) == len(iv["paired_unseen"]) == 1
+    assert iv["paired_seen"][0]["episodes"] + iv["paired_unseen"][0]["episodes"] == 8
     assert "10000 resamples, seed 0" in summary_md and "| greedy  | random" in summary_md
     assert "Paired comparisons" in a.output
     # same command again, with two worker processes: same records up to wall-clock
