@@ -76,11 +76,15 @@ def test_bench_runs_a_plugin_beside_greedy_in_worker_processes(plugin_dir: Path,
            "--log-dir", str(logs), "-o", str(out)]
     r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr
-    summary = (out / "summary.md").read_text()
+    summary, paired = (out / "summary.md").read_text().split(
+        "Paired comparisons on the same episodes")
     mine, greedy = _rows(summary, "mymod_cli:MyPlanner"), _rows(summary, "greedy")
-    assert len(mine) == len(greedy) == 3  # the table, the side-by-side, seen/unseen
+    assert len(mine) == len(greedy) == 4  # the table, the side-by-side, seen/unseen, intervals
     for a, b in zip(mine, greedy, strict=True):
         assert a.split("|")[2:] == b.split("|")[2:]
+    # greedy against the first planner, itself under another name: no difference, a tie
+    (row, *_) = _rows(paired, "greedy")
+    assert "mymod_cli:MyPlanner" in row and "+0.000 [-]" in row and "0/0/1" in row
     assert "mymod_cli:MyPlanner SR / SPL" in (out / "per_house.md").read_text()
     assert "mymod_cli:MyPlanner SR / SPL" in (out / "per_query.md").read_text()
     planners = json.loads((out / "summary.json").read_text())["planners"]
