@@ -6,6 +6,8 @@ and each seen door's rooms.
   opening under the lintel, not the swung panel, whose cells would cut the room it stands
   in (when they are at least ``PASSABLE_SHARE`` of its columns: a panel smeared by depth
   noise or drift reaches a few passable columns) -- else the panel's closed position
+  (from its core columns, those with at least ``CORE_SHARE`` of its fullest column's
+  voxels)
   (:func:`~sgtool.scenegraph.room_segmentation.opening_from_panel`), else all its columns.
 - :func:`observe_doors`: the rooms on either side of a door from the visible Voronoi nodes
   within ``door_radius``; a closed door with only one explored side leads to an unexplored
@@ -29,6 +31,7 @@ from sgtool.scenegraph.room_segmentation import RoomTracker, opening_from_panel
 from sgtool.vocabulary import OpenState
 
 PASSABLE_SHARE = 0.25  # passable share of a door's columns that makes them its opening
+CORE_SHARE = 0.5  # a panel's column holds at least this share of its fullest column's voxels
 
 
 @dataclass(frozen=True, eq=False)
@@ -79,7 +82,10 @@ def door_cells_of(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
         mine = door == i
         if not mine.any():
             continue
-        cell = np.unique(r[mine] * (occ.shape[1] + 1) + c[mine])
+        cell, count = np.unique(r[mine] * (occ.shape[1] + 1) + c[mine], return_counts=True)
+        # the panel's core: columns holding at least half the most voxels any column holds
+        # (a panel smeared by depth noise or drift grows thin columns beside it)
+        cell = cell[count >= CORE_SHARE * count.max()]
         pr, pc = np.divmod(cell, occ.shape[1] + 1)
         if occupied is None:
             occupied = occ.grid == OCCUPIED

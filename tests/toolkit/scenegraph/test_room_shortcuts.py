@@ -223,3 +223,24 @@ def test_a_few_passable_columns_of_a_smeared_panel_do_not_make_its_opening():
     opened = door_cells_of(OccupancyGrid(g2, (0.0, 0.0), 0.05),
                            {1: np.concatenate([panel, lintel]).astype(np.int64)}, {})
     assert opened[20, 10:26].all() and opened.sum() == 16
+
+
+def test_thin_columns_beside_a_panel_are_not_part_of_it():
+    """A swung panel (15 columns of 40 voxels) with thin columns beside it (3 voxels each:
+    depth noise, drift) gives the cells of the panel alone: the panel rule looks at the
+    columns holding at least CORE_SHARE of the fullest column's voxels."""
+    g = np.full((60, 60), FREE, dtype=np.int8)
+    g[20, :10] = OCCUPIED
+    g[20, 26:] = OCCUPIED
+    rows = 20 + np.arange(1, 16)
+    g[rows, 10] = OCCUPIED
+    g[rows, 11] = OCCUPIED  # the smear is occupied too (in the band)
+    z = np.arange(40)
+    panel = np.stack([np.repeat(np.full(15, 10), 40), np.repeat(rows, 40), np.tile(z, 15)],
+                     axis=1)
+    smear = np.stack([np.repeat(np.full(15, 11), 3), np.repeat(rows, 3), np.tile(z[:3], 15)],
+                     axis=1)
+    occ = OccupancyGrid(g, (0.0, 0.0), 0.05)
+    alone = door_cells_of(occ, {1: panel.astype(np.int64)}, {})
+    both = door_cells_of(occ, {1: np.concatenate([panel, smear]).astype(np.int64)}, {})
+    assert alone.any() and np.array_equal(both, alone)
