@@ -1,26 +1,24 @@
 """``sgtool distill``: train the relational priors, or report how well they separate.
 
-Training writes into a temporary folder beside the output and moves the three files
-(containment.safetensors, cooccurrence.safetensors, metadata.json) in only when both models
-are done, so an interrupted run never leaves a mixed set.
+The work is in :mod:`sgtool.analysis.priors_training` (training writes into a temporary
+folder inside the output and moves the three files in only when both models are done, so
+an interrupted run never leaves a mixed set); this module parses the options into a
+:class:`~sgtool.analysis.priors_training.DistillRequest` and prints the report.
 """
 
 from __future__ import annotations
 
 import json
-import os
-import shutil
-import sys
-import tempfile
-from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
 from sgtool.commands.options import llm_endpoint_options
 from sgtool.errors import SgtoolError
-from sgtool.extras import require
+
+if TYPE_CHECKING:
+    from sgtool.analysis.priors_training import LlmSource
 
 
 def _weights_dir() -> Path:
@@ -81,78 +79,49 @@ def _weights_dir() -> Path:
               help="A small generation: at most ROOMS room types, CATEGORIES object "
                    "categories per room, OBJECTS objects per category [default: 12,8,10].")
 def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, as_json: bool,
-            seed: int, holdout: float, epochs_containment: int, epochs_cooccurrence: int,
-            keep: str, threads: int, source: str, llm_base_url: str | None, llm_model: str | None,
-            llm_api_key: str | None, llm_cache: Path | None, llm_runs: int,
-            llm_max_queries: int | None, llm_slice: str | None = None,
-            llm_timeout: float = 30.0, llm_max_tokens: int = 512) -> None:
+            source: str, llm_slice: str | None = None, **given: Any) -> None:
     """Train the containment and co-occurrence MLPs (SCOUT sec. IV-C) or report on them.
 
     By default the training data come from the training split of the household knowledge
     only, the encoder is the bundled all-MiniLM-L6-v2, and the run is deterministic: the
     same seed writes byte-identical files. Takes about a minute on 2 CPU cores.
     """
-    from sgtool.datasets.relational import evaluation_sets, training_sets
-    from sgtool.semantics.distill import DistillConfig, distill, format_report, quality_report
+    from sgtool.analysis.priors_training import (
+        DistillRequest,
+        train_priors,
+        training_lines,
+        weights_report,
+    )
+    from sgtool.semantics.distill import format_report
 
     if llm_slice is not None and source != "llm":
         raise SgtoolError("--llm-slice is for --source llm")
     if report_only:
-        wd = weights_dir or _weights_dir()
-        if not (wd / "metadata.json").is_file():
-            raise SgtoolError(f"{wd}: no metadata.json; not a folder of distilled weights")
-        try:
-            seed = int(json.loads((wd / "metadata.json").read_text())["config"]["seed"])
-        except (ValueError, KeyError, TypeError) as e:  # (JSONDecodeError is a ValueError)
-            raise SgtoolError(f"{wd / 'metadata.json'}: not the metadata `sgtool distill` "
-                              f"writes ({type(e).__name__}: {e})") from e
-        built = training_sets(seed=seed)
-        rep = quality_report(wd, (built.containment, built.cooccurrence),
-                             eval_sets=evaluation_sets(seed=seed))
+        rep = weights_report(weights_dir or _weights_dir())
         click.echo(json.dumps(rep, indent=1, sort_keys=True) if as_json else format_report(rep))
         return
-
-    require("torch")  # training needs the `learn` extra (before minutes of data building)
-    cfg = DistillConfig(seed=seed, holdout=holdout, epochs_containment=epochs_containment,
-                        epochs_cooccurrence=epochs_cooccurrence, keep=keep, threads=threads)
-    eval_sets = None
-    if source == "llm":
-        sets, room_types, fingerprint = _llm_sets(llm_base_url, llm_model, llm_api_key,
-                                                  llm_cache, llm_runs, llm_max_queries,
-                                                  _slice(llm_slice), llm_timeout,
-                                                  llm_max_tokens)
-        _report_agreement(sets, training_sets(seed=seed))
-    else:
-        built = training_sets(seed=seed)
-        sets = (built.containment, built.cooccurrence)
-        room_types, fingerprint = built.room_types, built.split_fingerprint
-        eval_sets = evaluation_sets(seed=seed)
+    llm = {k: given.pop(k) for k in list(given) if k.startswith("llm_")}
     target = out_dir or _weights_dir()
-    try:
-        target.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=".distill-", dir=target))
-    except OSError as e:
-        raise SgtoolError(f"cannot write weights to {target} ({e.strerror}); "
-                          "choose a folder with --out") from e
-    try:
-        meta = distill(tmp, cfg, sets=sets, split_fingerprint=fingerprint,
-                       room_types=room_types, progress=sys.stderr.isatty(),
-                       eval_sets=eval_sets)
-        for name in ("containment.safetensors", "cooccurrence.safetensors", "metadata.json"):
-            os.replace(tmp / name, target / name)
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-    rep = meta["report"]
+    request = DistillRequest(target=target, **given,
+                             llm=_llm_source(llm, llm_slice) if source == "llm" else None)
+    meta = train_priors(request, note=lambda m: click.echo(m, err=True))
     if as_json:
         click.echo(json.dumps(meta, indent=1, sort_keys=True))
-    else:
-        for rel in ("containment", "cooccurrence"):
-            m = meta["models"][rel]
-            click.echo(f"{rel}: {m['data']['pairs']} pairs ({m['data']['positives']} positive), "
-                       f"{m['data']['queries']} queries, kept epoch {m['best_epoch']}, "
-                       f"val loss {m['history'][m['best_epoch'] - 1]['val_loss']:.4f}")
-        click.echo(format_report(rep))
-        click.echo(f"wrote {target}")
+        return
+    for line in training_lines(meta):
+        click.echo(line)
+    click.echo(format_report(meta["report"]))
+    click.echo(f"wrote {target}")
+
+
+def _llm_source(llm: dict[str, Any], llm_slice: str | None) -> LlmSource:
+    """The ``--llm-*`` options (without the ``llm_`` prefix) as a checked LLM source."""
+    from sgtool.analysis.priors_training import LlmSource
+
+    return LlmSource(base_url=llm["llm_base_url"], model=llm["llm_model"],
+                     api_key=llm["llm_api_key"], cache=llm["llm_cache"], runs=llm["llm_runs"],
+                     max_queries=llm["llm_max_queries"], slice=_slice(llm_slice),
+                     timeout_s=llm["llm_timeout"], max_tokens=llm["llm_max_tokens"])
 
 
 def _slice(text: str | None) -> dict[str, int]:
@@ -166,49 +135,3 @@ def _slice(text: str | None) -> dict[str, int]:
         raise SgtoolError(f"--llm-slice {text!r}: give ROOMS,CATEGORIES,OBJECTS, three "
                           "integers >= 1, e.g. 3,2,3") from None
     return {"max_rooms": rooms, "max_categories": cats, "max_objects": objs}
-
-
-def _report_agreement(sets: Sequence[Any], reference: Any) -> None:
-    """How the LLM's labels agree with the BEHAVIOR-1K knowledge (stderr)."""
-    from sgtool.semantics.llm_knowledge import agreement
-
-    for llm, ref in zip(sets, (reference.containment, reference.cooccurrence), strict=True):
-        a = agreement(llm, ref)
-        rate = "-" if a.common == 0 else f"{100 * a.rate:.1f}%"
-        click.echo(f"LLM {a.relation} labels vs BEHAVIOR-1K: {a.common} of {a.llm_pairs} "
-                   f"pairs in both, agreement {rate} ({a.agree}/{a.common})", err=True)
-
-
-def _llm_sets(base_url: str | None, model: str | None, api_key: str | None,
-              cache: Path | None, runs: int, max_queries: int | None,
-              slice_kw: dict[str, int] | None = None, timeout_s: float = 30.0,
-              max_tokens: int = 512) -> tuple[tuple[Any, Any], Any, str]:
-    from sgtool.llm.client import LlmSettings, OpenAIChatClient
-    from sgtool.semantics.cache import cache_root
-    from sgtool.semantics.llm_knowledge import (
-        CachedAsker,
-        GenerationConfig,
-        generate_sets,
-    )
-
-    cache = cache or (cache_root() / "llm-knowledge")
-    try:
-        client = OpenAIChatClient(LlmSettings.resolve(base_url, model, api_key,
-                                                      timeout_s=timeout_s,
-                                                      max_tokens=max_tokens))
-    except SgtoolError:
-        if not (cache / "exchanges.jsonl").is_file():
-            raise
-        client = None  # a complete cache replays the generation offline
-    asker = CachedAsker(client, cache)
-    cont, cooc, rooms = generate_sets(
-        asker, GenerationConfig(runs=runs, max_queries=max_queries, **(slice_kw or {})),
-        progress=sys.stderr.isatty())
-    st = asker.stats
-    click.echo(f"LLM knowledge: {len(rooms)} rooms, {len(cont.queries)} objects labelled; "
-               f"{st.prompts} prompts ({st.cached} cached, {st.requested} asked, "
-               f"{st.skipped} skipped)", err=True)
-    import hashlib
-
-    fp = hashlib.sha256((cont.fingerprint() + cooc.fingerprint()).encode()).hexdigest()
-    return (cont, cooc), rooms, f"llm:{fp}"

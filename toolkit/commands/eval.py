@@ -1,18 +1,20 @@
 
-"""``sgtool eval``: metrics from recorded episodes; planners evaluated against logged decisions."""
+"""``sgtool eval``: metrics from recorded episodes; planners evaluated against logged decisions.
+
+The work is in :mod:`sgtool.analysis.eval_run`; this module checks the options, the output
+and the inputs into an :class:`~sgtool.analysis.eval_run.EvalRequest`, writes the -o file
+and prints the result."""
 
 from __future__ import annotations
 
-import json
 import math
 import sys
-from dataclasses import asdict
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
-from sgtool.canonical import strict_json
 from sgtool.commands.options import (
     PLANNER_OPTION_HELP,
     PLUGIN_HELP,
@@ -23,6 +25,9 @@ from sgtool.commands.options import (
     success_option,
 )
 from sgtool.errors import SgtoolError
+
+if TYPE_CHECKING:
+    from sgtool.analysis.eval_run import EvalRequest
 
 
 @click.command("eval")
@@ -52,13 +57,8 @@ from sgtool.errors import SgtoolError
 @executor_options("file reads (one per input)")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
-def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: tuple[str, ...],
-            llm_replay: tuple[str, ...], distance_budget: float, step_budget: float,
-            as_json: bool, out: str | None, force: bool = False, success: str | None = None,
-            executor: str = "local", workers: int = 1, ray_address: str | None = None,
-            progress: bool | None = None, llm_base_url: str | None = None,
-            llm_model: str | None = None, llm_api_key: str | None = None,
-            llm_timeout: float | None = None) -> None:
+def command(inputs: tuple[str, ...], out: str | None, force: bool = False,
+            **given: Any) -> None:
     """Recompute the benchmark metrics (SR, SPL, steps, decision time, AUC-E with both
     budgets, seen/unseen) from recorded episodes: MCAP logs of closed-loop runs (their
     sgtool.Episode and sgtool.Action records) and/or episodes.jsonl files written by
@@ -75,90 +75,71 @@ def command(inputs: tuple[str, ...], planners: tuple[str, ...], planner_option: 
     its shortest path by more than 5.5 m + 10% of it (the path ends 1 m from the target, a
     camera sees it from up to 6 m: a success with 0 m travelled towards a target 9.48 m
     away is refused). A shortest_m of 0 is accepted: the target is seen from the start."""
-    from sgtool.analysis.batch_eval import load_many
-    from sgtool.analysis.batch_inputs import expand_inputs
-    from sgtool.analysis.executor import make_executor
-    from sgtool.analysis.metrics import cost_models, seen_unseen, summarize
-    from sgtool.analysis.offline import (
-        format_offline,
-        log_exchanges,
-        replay_decisions,
-        with_success_rule,
-    )
-    from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
-    from sgtool.commands.options import check_output, planner_names, planner_options
+    from sgtool.analysis.eval_run import evaluate
     from sgtool.files import atomic_write
-    from sgtool.llm.stats import answer_stats, format_stats
-    from sgtool.planning.registry import check_planner_name, make_planner
 
-    for name, value in (("--distance-budget", distance_budget), ("--step-budget", step_budget)):
+    request = _request(inputs, out, force, EvalArgs(**given))
+    outcome = evaluate(request, note=lambda m: click.echo(m, err=True))
+    if out:
+        atomic_write(out, outcome.text)
+    click.echo(outcome.text, nl=False)
+    if outcome.unread:  # after the output, whose notes name each
+        raise SgtoolError(f"{len(outcome.unread)} of {len(request.inputs)} input(s) could not "
+                          f"be read and are left out of the metrics; the first: "
+                          f"{outcome.unread[0]}")
+
+
+@dataclass(frozen=True)
+class EvalArgs:
+    """The options of `sgtool eval` besides the inputs and the output, as given."""
+
+    planners: tuple[str, ...]
+    planner_option: tuple[str, ...]
+    llm_replay: tuple[str, ...]
+    distance_budget: float
+    step_budget: float
+    as_json: bool
+    success: str | None = None
+    executor: str = "local"
+    workers: int = 1
+    ray_address: str | None = None
+    progress: bool | None = None
+    llm_base_url: str | None = None
+    llm_model: str | None = None
+    llm_api_key: str | None = None
+    llm_timeout: float | None = None
+
+
+def _request(inputs: tuple[str, ...], out: str | None, force: bool, args: EvalArgs
+             ) -> EvalRequest:
+    """The option, output and input checks: finite budgets, the executor, the inputs (MCAP
+    logs found in folders), the -o file (not an input), the planners and their options."""
+    from sgtool.analysis.batch_inputs import expand_inputs
+    from sgtool.analysis.eval_run import EvalRequest
+    from sgtool.analysis.executor import make_executor
+    from sgtool.commands.options import check_output, planner_names, planner_options
+    from sgtool.planning.registry import check_planner_name
+
+    for name, value in (("--distance-budget", args.distance_budget),
+                        ("--step-budget", args.step_budget)):
         if not math.isfinite(value):
             raise SgtoolError(f"{name} {value}: must be a finite number > 0")
-    runner = make_executor(executor, workers, ray_address)
-    inputs = tuple(map(str, expand_inputs(inputs, (".mcap",), "MCAP logs")))
+    runner = make_executor(args.executor, args.workers, args.ray_address)
+    files = tuple(map(str, expand_inputs(inputs, (".mcap",), "MCAP logs")))
     if out:
         check_output(out, force=force)
-        if any(Path(out).resolve() == Path(i).resolve() for i in inputs):
+        if any(Path(out).resolve() == Path(i).resolve() for i in files):
             raise SgtoolError(f"-o {out}: the output must not be an input")
-    show = progress if progress is not None else sys.stderr.isatty()
-    results, logged, notes, unread = load_many([Path(i) for i in inputs], runner,
-                                               progress=show)
-    results = [with_success_rule(r, success) for r in results]
-    for note in notes:
-        click.echo(f"sgtool: note: {note}", err=True)
-    if not results:
-        why = f" ({len(notes)} skipped or refused, see the notes)" if notes else ""
-        raise SgtoolError("no search episodes to score in " + ", ".join(inputs) + why)
-    models = cost_models(distance_budget, step_budget)
-    sums = summarize(results, models)
-    names = [n for item in planners for n in planner_names(item)]
+    names = [n for item in args.planners for n in planner_names(item)]
     for n in names:
         check_planner_name(n)
-    options = planner_options(planner_option, names)
-    endpoint = LlmEndpoint(llm_base_url, llm_model, llm_api_key, llm_timeout)
-    endpoint.fill(options, names)
-    exchanges = log_exchanges(inputs)
-    replay = list(llm_replay) or sorted({src for src, _ in exchanges})
-    moma = options.get("moma-llm", {})
-    # the logs' own exchanges answer, unless an endpoint is named (flag or -O)
-    if replay and "moma-llm" in names and (llm_replay or not moma.get("base_url")):
-        options.setdefault("moma-llm", {}).setdefault("replay", replay)
-    if names and not any(d.graph is not None for e in logged for d in e.decisions):
-        raise SgtoolError("--planner needs MCAP logs with sgtool.SceneGraph records; "
-                          "the inputs have none")
-    reports = [replay_decisions(make_planner(n, **options.get(n, {})), logged, name=n)
-               for n in names]
-    if as_json or (out and out.endswith(".json")):
-        doc: dict[str, Any] = {
-            "episodes": len(results),
-            "notes": notes,
-            "budgets": {m.name: {"max": m.max_cost, "cost": m.label} for m in models},
-            "planners": summary_dict(sums),
-            "seen_unseen": [asdict(s) for s in seen_unseen(results)],
-            "offline": {r.planner: {"decisions": r.decisions, "same_action": r.rate("agree"),
-                                    "same_target": r.rate("target"),
-                                    "same_room": r.rate("room"),
-                                    "not_in_graph": r.rate("invalid"), "skipped": r.skipped,
-                                    "decision_s": r.mean_decision_s()}
-                        for r in reports},
-        }
-        if exchanges:
-            doc["llm_answers"] = answer_stats(exchanges).as_dict()
-        text = json.dumps(strict_json(doc), indent=1, sort_keys=True, allow_nan=False) + "\n"
-    else:
-        parts = [format_table(sums, models=models,
-                              title=f"Metrics recomputed from {len(results)} episode(s) in "
-                                    f"{len(inputs)} file(s)")]
-        if any(r.seen is not None for r in results):
-            parts.append(format_seen_unseen(seen_unseen(results), title="Seen vs unseen queries"))
-        if reports:
-            parts.append(format_offline(reports))
-        if exchanges:
-            parts.append(format_stats(answer_stats(exchanges), "the logs") + "\n")
-        text = "\n".join(parts)
-    if out:
-        atomic_write(out, text)
-    click.echo(text, nl=False)
-    if unread:  # after the output, whose notes name each
-        raise SgtoolError(f"{len(unread)} of {len(inputs)} input(s) could not be read and are "
-                          f"left out of the metrics; the first: {unread[0]}")
+    options = planner_options(args.planner_option, names)
+    LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
+                args.llm_timeout).fill(options, names)
+    return EvalRequest(inputs=files, runner=runner, planners=tuple(names),
+                       planner_options=options, llm_replay=args.llm_replay,
+                       success=args.success, distance_budget=args.distance_budget,
+                       step_budget=args.step_budget,
+                       as_json=args.as_json or bool(out and out.endswith(".json")),
+                       progress=args.progress if args.progress is not None
+                       else sys.stderr.isatty())

@@ -5,7 +5,7 @@
 URL and model name the other commands take. ``sgtool llm check`` measures generation
 speed and asks the ``moma-llm`` planner for one decision on a generated house: against
 ``--llm-base-url`` (or ``SGTOOL_LLM_BASE_URL``), else against a local server it starts for the
-duration of the check.
+duration of the check (:mod:`sgtool.analysis.llm_check_run`).
 """
 
 from __future__ import annotations
@@ -13,17 +13,11 @@ from __future__ import annotations
 import json
 import signal
 import time
-from contextlib import ExitStack
-from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import click
 
 from sgtool.commands.options import F, llm_endpoint_options
-
-if TYPE_CHECKING:
-    from sgtool.scenegraph.graph import SceneGraph
 
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
@@ -115,57 +109,14 @@ def check(base_url: str | None, model_name: str | None, gguf: Path | None, threa
     --llm-timeout is the deadline of the whole check (the speed request and the decision
     together, wall-clock, a slow or trickled reply included): at the deadline the check
     stops with one line saying so (exit 2)."""
-    import os
+    from sgtool.analysis.llm_check_run import LlmCheckRequest, run_check
 
-    from sgtool.llm.check import check_endpoint
-    from sgtool.llm.client import LlmSettings, OpenAIChatClient
-
-    base_url = llm_base_url or base_url
-    model_name = llm_model or model_name
-    with ExitStack() as stack:
-        url = base_url or os.environ.get("SGTOOL_LLM_BASE_URL")
-        if url is None:
-            from sgtool.llm.server import start_server
-
-            server = stack.enter_context(start_server(gguf, threads=threads))
-            url, model_name = server.base_url, model_name or server.alias
-        settings = LlmSettings.resolve(base_url=url, model=model_name, api_key=llm_api_key,
-                                       timeout_s=llm_timeout, temperature=0.0,
-                                       max_tokens=max_tokens)
-        client = OpenAIChatClient(settings)
-        graph, query = _scene()
-        # room for both reasoning lines (a token per character at worst) and the command
-        decider = OpenAIChatClient(replace(settings, max_tokens=2 * reason_chars + 60))
-        speed, dec = check_endpoint(client, decider, graph, query, llm_timeout,
-                                    constraint=constraint, reason_chars=reason_chars)
-    figures = {
-        "endpoint": client.where, "model": settings.model,
-        "completion_tokens": speed.completion_tokens,
-        "tokens_per_s": None if speed.tokens_per_s is None else round(speed.tokens_per_s, 2),
-        "decision_parsed": dec.parsed, "decision": dec.action, "requests": dec.requests,
-        "decision_s": round(dec.decision_s, 3), "constraint": dec.constraint,
-        "query": query,
-    }
+    result = run_check(LlmCheckRequest(
+        base_url=llm_base_url or base_url, model=llm_model or model_name,
+        api_key=llm_api_key, timeout_s=llm_timeout, gguf=gguf, threads=threads,
+        max_tokens=max_tokens, constraint=constraint, reason_chars=reason_chars))
     if as_json:
-        click.echo(json.dumps(figures, sort_keys=True))
+        click.echo(json.dumps(result.figures, sort_keys=True))
         return
-    tps = "unknown (no token count)" if speed.tokens_per_s is None \
-        else f"{speed.tokens_per_s:.1f}"
-    click.echo(f"endpoint {figures['endpoint']}, model {settings.model}")
-    click.echo(f"generation: {speed.completion_tokens} tokens in {speed.latency_s:.2f} s "
-               f"= {tps} tokens/s")
-    click.echo(f"scene decision (find {query}, constraint {dec.constraint}): "
-               f"{'parsed' if dec.parsed else 'NOT parsed'}: {dec.action} "
-               f"({dec.decision_s:.2f} s)")
-
-
-def _scene() -> tuple[SceneGraph, str]:
-    """The first graph of the first episode of generated house 0 (a fixed scene)."""
-    from sgtool.datasets.episodes import list_episodes
-    from sgtool.datasets.generator import generate_house
-    from sgtool.recorders.symbolic_environment import SymbolicEnv, SymbolicHouse
-
-    spec = generate_house(0)
-    ep = list_episodes(spec, n=1, seed=0)[0]
-    env = SymbolicEnv(SymbolicHouse(spec), ep.query, avoid_rooms=ep.target_rooms)
-    return env.observe(), ep.query
+    for line in result.lines:
+        click.echo(line)

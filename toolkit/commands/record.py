@@ -1,19 +1,24 @@
 """``sgtool record``: simulate a robot exploring a house in PyBullet and log it to MCAP.
 
-The work is done in :mod:`sgtool.recorders.sim`; this module parses options, picks the
-house (a spec file, a generated house, or the demo house shipped in the package), shows
-a progress bar and prints the report.
+The work is done in :mod:`sgtool.recorders.sim` (through
+:func:`sgtool.analysis.sim_session.record_tour`: progress bar, live viewer, report); this
+module parses the options into :class:`RecordArgs`, checks the output and the inputs and
+picks the house (a spec file, a generated house, or the demo house shipped in the package).
 """
 
 from __future__ import annotations
 
-import sys
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import click
 
-from sgtool.commands.options import house_options
+from sgtool.commands.options import check_log_output, house_options
 from sgtool.errors import SgtoolError
+
+if TYPE_CHECKING:
+    from sgtool.analysis.sim_session import RecordRequest
 
 
 def _pair(option: str, text: str) -> tuple[float, float]:
@@ -78,12 +83,7 @@ def _pair(option: str, text: str) -> tuple[float, float]:
               help="Stream every frame (camera images, robot, path) to Rerun while recording: "
               "spawn a viewer, connect to one, or serve a web viewer (headless machines; "
               "waits for Ctrl-C at the end).")
-def command(house_path: str | None, seed: int | None, rooms: str, output: str,
-            frames: int | None, fps: float, noise: str, noise_seed: int, resolution: str,
-            fov: float, depth_range: str, camera_height: float, tilt: float, speed: float,
-            start: int, no_open_containers: bool, explore: str, compression: str,
-            force: bool, quiet: bool,
-            rerun_to: str | None = None) -> None:
+def command(**given: Any) -> None:
     """Record a robot exploring a house in PyBullet: RGB-D, instance ids, poses, the
     instances table with open/closed states, every action, to an MCAP log.
 
@@ -93,8 +93,46 @@ def command(house_path: str | None, seed: int | None, rooms: str, output: str,
     house shipped with sgtool. The same house, options and seeds give a byte-identical
     log. Example: `sgtool record -o demo.mcap && sgtool info demo.mcap`.
     """
+    from sgtool.analysis.sim_session import record_tour
+
+    args = RecordArgs(**given)
+    out = check_log_output(args.output, force=args.force)
+    request = _request(args, out)
+    record_tour(request, show=click.echo, note=lambda m: click.echo(m, err=True))
+
+
+@dataclass(frozen=True)
+class RecordArgs:
+    """The options of `sgtool record` as given (the click parameters, by name)."""
+
+    house_path: str | None
+    seed: int | None
+    rooms: str
+    output: str
+    frames: int | None
+    fps: float
+    noise: str
+    noise_seed: int
+    resolution: str
+    fov: float
+    depth_range: str
+    camera_height: float
+    tilt: float
+    speed: float
+    start: int
+    no_open_containers: bool
+    explore: str
+    compression: str
+    force: bool
+    quiet: bool
+    rerun_to: str | None = None
+
+
+def _request(args: RecordArgs, out: Path) -> RecordRequest:
+    """The input check: the options, then the house (with start poses)."""
     from dataclasses import replace
 
+    from sgtool.analysis.sim_session import RecordRequest
     from sgtool.commands.options import house_from_options, parse_resolution, with_starts
     from sgtool.recorders.sim import (
         CameraConfig,
@@ -102,49 +140,22 @@ def command(house_path: str | None, seed: int | None, rooms: str, output: str,
         RobotConfig,
         ScriptOptions,
         parse_noise,
-        record_house,
     )
 
-    out = Path(output)
-    if out.suffix != ".mcap":
-        raise SgtoolError(f"-o {out}: the output is an MCAP log; name it *.mcap")
-    if out.exists() and not force:
-        raise SgtoolError(f"{out} exists; not overwriting it (use --force)")
-    if not out.parent.exists():
-        raise SgtoolError(f"-o {out}: folder {out.parent} does not exist")
-    if frames is not None and frames < 1:
-        raise SgtoolError(f"--frames {frames}: must be >= 1")
-    width, height = parse_resolution(resolution)
-    dmin, dmax = _pair("--depth-range", depth_range)
-    camera = CameraConfig(width=width, height=height, vfov_deg=fov, mount_height=camera_height,
-                          tilt_deg=tilt, depth_min=dmin, depth_max=dmax,
-                          near=min(0.05, dmin))
-    robot = replace(RobotConfig(), speed=speed)
-    profile = parse_noise(noise)
-    house, house_id = house_from_options(house_path, seed, rooms)
-    house = with_starts(house, house_path or house_id)  # a hand-made house: as bench does
-    opts = RecordOptions(fps=fps, frames=frames, camera=camera, robot=robot, noise=profile,
-                         seed=noise_seed, start=start,
-                         script=ScriptOptions(open_containers=not no_open_containers),
-                         compression=compression, explore=explore)
-    from tqdm import tqdm
-
-    bar = tqdm(total=frames, unit="frame", desc="record", file=sys.stderr, leave=False,
-               disable=quiet or not sys.stderr.isatty(), dynamic_ncols=True)
-    live = None
-    if rerun_to is not None:
-        from sgtool.analysis.rerun_live import LiveReplay
-
-        live = LiveReplay.start(rerun_to, f"record {house_id} {out}",
-                                lambda m: click.echo(m, err=True))
-    try:
-        report = record_house(house, out, opts, house_id=house_id, progress=bar,
-                              observers=[live.observer()] if live else ())
-    finally:
-        bar.close()
-    if not quiet:
-        for line in report.lines():
-            click.echo(line)
-    if live is not None:  # after the report: serve keeps the recording up until Ctrl-C
-        live.finish(lambda m: click.echo(m, err=True))
-
+    if args.frames is not None and args.frames < 1:
+        raise SgtoolError(f"--frames {args.frames}: must be >= 1")
+    width, height = parse_resolution(args.resolution)
+    dmin, dmax = _pair("--depth-range", args.depth_range)
+    camera = CameraConfig(width=width, height=height, vfov_deg=args.fov,
+                          mount_height=args.camera_height, tilt_deg=args.tilt,
+                          depth_min=dmin, depth_max=dmax, near=min(0.05, dmin))
+    profile = parse_noise(args.noise)
+    house, house_id = house_from_options(args.house_path, args.seed, args.rooms)
+    house = with_starts(house, args.house_path or house_id)  # a hand-made house: as bench
+    opts = RecordOptions(fps=args.fps, frames=args.frames, camera=camera,
+                         robot=replace(RobotConfig(), speed=args.speed), noise=profile,
+                         seed=args.noise_seed, start=args.start,
+                         script=ScriptOptions(open_containers=not args.no_open_containers),
+                         compression=args.compression, explore=args.explore)
+    return RecordRequest(house=house, house_id=house_id, output=out, options=opts,
+                         quiet=args.quiet, rerun_to=args.rerun_to)

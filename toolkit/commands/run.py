@@ -1,20 +1,23 @@
 """``sgtool run``: one closed-loop object search in PyBullet, logged to MCAP.
 
-The work is done in :mod:`sgtool.recorders.sim.closed_loop`; this module parses options,
-picks the house and the episode, checks the output, shows a progress bar of frames and
-prints the report.
+The work is done in :mod:`sgtool.recorders.sim.closed_loop` (through
+:func:`sgtool.analysis.sim_session.run_search`: progress bar, live viewer, report); this
+module parses the options into :class:`RunArgs`, checks the output and the inputs (planner,
+house, episode) and hands a :class:`~sgtool.analysis.sim_session.SearchRequest` over.
 """
 
 from __future__ import annotations
 
-import sys
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import click
 
 from sgtool.commands.options import (
     PLUGIN_HELP,
     LlmEndpoint,
+    check_log_output,
     house_options,
     list_planners_option,
     llm_endpoint_options,
@@ -23,6 +26,9 @@ from sgtool.commands.options import (
     success_option,
 )
 from sgtool.errors import SgtoolError
+
+if TYPE_CHECKING:
+    from sgtool.analysis.sim_session import SearchRequest
 
 
 @click.command("run")
@@ -91,16 +97,7 @@ from sgtool.errors import SgtoolError
               help="Stream every decision (scene graph, robot, action) to Rerun while the "
               "episode runs: spawn a viewer, connect to one, or serve a web viewer (headless "
               "machines; waits for Ctrl-C at the end).")
-def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
-            query: str | None, episode: int | None, max_steps: int, frames: int | None,
-            frames_per_room: int | None,
-            resolution: str, fps: float, every: int, classifier: str, min_points: int | None,
-            navigation: str, optimistic: float, noise: str, planner_option: tuple[str, ...],
-            planner_seed: int, llm_replay: str | None, llm_transcript: str | None, output: str,
-            force: bool, quiet: bool, success: str = "observed",
-            llm_base_url: str | None = None, llm_model: str | None = None,
-            llm_api_key: str | None = None, llm_timeout: float | None = None,
-            rerun_to: str | None = None) -> None:
+def command(**given: Any) -> None:
     """Search a house for an object in closed loop: PyBullet renders the camera, the scene
     graph is built live from the frames (the same refresh schedule as `sgtool replay`:
     every K frames and at every action), the planner chooses an action on it, the
@@ -121,77 +118,104 @@ def command(planner: str, house_path: str | None, seed: int | None, rooms: str,
 
     Example: `sgtool run --planner scout --query bowl -o bowl.mcap`.
     """
-    from sgtool.commands.options import house_from_options, parse_resolution, with_starts
-    from sgtool.recorders.sim import CameraConfig, parse_noise
-    from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
-    from sgtool.recorders.sim.frame_budget import frame_budget
-    from sgtool.recorders.sim.live_skills import LiveNavConfig
+    from sgtool.analysis.sim_session import run_search
 
-    out = Path(output)
-    if out.suffix != ".mcap":
-        raise SgtoolError(f"-o {out}: the output is an MCAP log; name it *.mcap")
-    if out.exists() and not force:
-        raise SgtoolError(f"{out} exists; not overwriting it (use --force)")
-    if out.is_dir():
-        raise SgtoolError(f"-o {out} is a folder; name the log file")
-    if not out.parent.exists():
-        raise SgtoolError(f"-o {out}: folder {out.parent} does not exist")
-    frame_budget(frames, frames_per_room, 1)  # both given: one line, before the house is built
-    if query is not None and episode is not None:
-        raise SgtoolError("give either --query or --episode, not both")
-    if not 0.1 <= fps <= 1000:
-        raise SgtoolError(f"--fps {fps}: must be 0.1..1000")
+    args = RunArgs(**given)
+    out = check_log_output(args.output, force=args.force)
+    request = _request(args, out)
+    run_search(request, show=click.echo, note=lambda m: click.echo(m, err=True))
+
+
+@dataclass(frozen=True)
+class RunArgs:
+    """The options of `sgtool run` as given (the click parameters, by name)."""
+
+    planner: str
+    house_path: str | None
+    seed: int | None
+    rooms: str
+    query: str | None
+    episode: int | None
+    max_steps: int
+    frames: int | None
+    frames_per_room: int | None
+    resolution: str
+    fps: float
+    every: int
+    classifier: str
+    min_points: int | None
+    navigation: str
+    optimistic: float
+    noise: str
+    planner_option: tuple[str, ...]
+    planner_seed: int
+    llm_replay: str | None
+    llm_transcript: str | None
+    output: str
+    force: bool
+    quiet: bool
+    success: str = "observed"
+    llm_base_url: str | None = None
+    llm_model: str | None = None
+    llm_api_key: str | None = None
+    llm_timeout: float | None = None
+    rerun_to: str | None = None
+
+
+def _planner(args: RunArgs) -> tuple[str, dict[str, Any]]:
+    """The planner's name and its checked options (-O, the LLM endpoint, --llm-replay and
+    --llm-transcript)."""
     from sgtool.planning.registry import PLANNER_NAMES, check_planner_name, is_llm_planner
 
-    name = planner.strip()
+    name = args.planner.strip()
     name = name.lower() if name.lower() in PLANNER_NAMES else name
     check_planner_name(name)
-    options = run_planner_options(planner_option, name)
-    endpoint = LlmEndpoint(llm_base_url, llm_model, llm_api_key, llm_timeout)
+    options = run_planner_options(args.planner_option, name)
+    endpoint = LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
+                           args.llm_timeout)
     if endpoint.given() and not is_llm_planner(name):
         raise SgtoolError("--llm-base-url, --llm-model, --llm-api-key and --llm-timeout are "
                           "for an LLM planner (moma-llm, unstructured-llm, godhs-llm)")
     for k, v in endpoint.given().items():
         options.setdefault(k, v)
-    if (llm_replay or llm_transcript) and not is_llm_planner(name):
+    if (args.llm_replay or args.llm_transcript) and not is_llm_planner(name):
         raise SgtoolError("--llm-replay and --llm-transcript are for --planner moma-llm "
                           "(or another LLM planner)")
-    if llm_replay:
-        if not Path(llm_replay).is_file():
-            raise SgtoolError(f"--llm-replay {llm_replay}: no such file")
-        options["replay"] = llm_replay
-    if llm_transcript:
-        options["transcript"] = llm_transcript
-    width, height = parse_resolution(resolution)
-    camera = CameraConfig(width=width, height=height)
-    house, house_id = house_from_options(house_path, seed, rooms)
-    house = with_starts(house, house_path or house_id)  # a hand-made house: as bench does
-    index, ep = pick_episode(house, query=query, index=episode)
-    frames = frame_budget(frames, frames_per_room, len(house.rooms))
-    opts = ClosedLoopOptions(fps=fps, camera=camera, every=every, classifier=classifier,
-                             min_points=min_points, max_steps=max_steps, frames=frames,
-                             planner_seed=planner_seed, navigation=navigation, success=success,
-                             noise=parse_noise(noise), live=LiveNavConfig(optimistic=optimistic))
-    from tqdm import tqdm
+    if args.llm_replay:
+        if not Path(args.llm_replay).is_file():
+            raise SgtoolError(f"--llm-replay {args.llm_replay}: no such file")
+        options["replay"] = args.llm_replay
+    if args.llm_transcript:
+        options["transcript"] = args.llm_transcript
+    return name, options
 
-    bar = tqdm(total=frames, unit="frame", desc=f"run {name}", file=sys.stderr, leave=False,
-               disable=quiet or not sys.stderr.isatty(), dynamic_ncols=True)
-    from sgtool.planning.registry import make_planner
 
-    live = None
-    if rerun_to is not None:
-        from sgtool.analysis.rerun_live import LiveReplay
+def _request(args: RunArgs, out: Path) -> SearchRequest:
+    """The input check: options, planner, house and episode, in the order a user's mistake
+    is best reported (before the house is built where possible)."""
+    from sgtool.analysis.sim_session import SearchRequest
+    from sgtool.commands.options import house_from_options, parse_resolution, with_starts
+    from sgtool.recorders.sim import CameraConfig, parse_noise
+    from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode
+    from sgtool.recorders.sim.frame_budget import frame_budget
+    from sgtool.recorders.sim.live_skills import LiveNavConfig
 
-        live = LiveReplay.start(rerun_to, f"run {house_id} {index} {name} {out}",
-                                lambda m: click.echo(m, err=True))
-    try:
-        report = run_episode(house, ep, make_planner(name, **options), out, opts,
-                             house_id=house_id, episode_index=index, overwrite=force,
-                             progress=bar, on_decision=live.decision if live else None)
-    finally:
-        bar.close()
-    if not quiet:
-        for line in report.lines():
-            click.echo(line)
-    if live is not None:  # after the report: serve keeps the recording up until Ctrl-C
-        live.finish(lambda m: click.echo(m, err=True))
+    frame_budget(args.frames, args.frames_per_room, 1)  # both given: before the house
+    if args.query is not None and args.episode is not None:
+        raise SgtoolError("give either --query or --episode, not both")
+    if not 0.1 <= args.fps <= 1000:
+        raise SgtoolError(f"--fps {args.fps}: must be 0.1..1000")
+    name, options = _planner(args)
+    width, height = parse_resolution(args.resolution)
+    house, house_id = house_from_options(args.house_path, args.seed, args.rooms)
+    house = with_starts(house, args.house_path or house_id)  # a hand-made house: as bench
+    index, ep = pick_episode(house, query=args.query, index=args.episode)
+    opts = ClosedLoopOptions(
+        fps=args.fps, camera=CameraConfig(width=width, height=height), every=args.every,
+        classifier=args.classifier, min_points=args.min_points, max_steps=args.max_steps,
+        frames=frame_budget(args.frames, args.frames_per_room, len(house.rooms)),
+        planner_seed=args.planner_seed, navigation=args.navigation, success=args.success,
+        noise=parse_noise(args.noise), live=LiveNavConfig(optimistic=args.optimistic))
+    return SearchRequest(house=house, house_id=house_id, episode_index=index, episode=ep,
+                         planner=name, output=out, options=opts, planner_options=options,
+                         force=args.force, quiet=args.quiet, rerun_to=args.rerun_to)

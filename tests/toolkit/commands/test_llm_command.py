@@ -9,8 +9,8 @@ import sys
 from click.testing import CliRunner
 from support.semantics_fixtures import ChatServer, answer
 
+from sgtool.analysis.llm_check_run import check_scene as _scene
 from sgtool.cli import cli
-from sgtool.commands.llm import _scene
 from sgtool.planning.moma.choices import valid_commands
 from sgtool.planning.moma.scene_text import encode_scene
 

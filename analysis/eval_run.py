@@ -1,0 +1,141 @@
+"""The work of `sgtool eval`: read recorded episodes, recompute the metrics, replay the
+logged decisions to other planners, and render the result as text tables or one JSON
+document.
+
+The command checks the options, the output and the planners and builds an
+:class:`EvalRequest`; :func:`evaluate` reads and scores, and returns the text with the
+inputs that could not be read (the command writes the text, then refuses those in one
+line). ``note`` receives the notes meant for stderr, one per skipped or refused episode.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from sgtool.canonical import strict_json
+from sgtool.errors import SgtoolError
+
+if TYPE_CHECKING:
+    from sgtool.analysis.executor import Executor
+
+Echo = Callable[[str], None]
+
+
+@dataclass(frozen=True)
+class EvalRequest:
+    """A checked `sgtool eval`: the input files (MCAP logs, episodes.jsonl), the planners to
+    replay with their checked options, transcripts answering moma-llm (empty: the logs'
+    own exchanges), the success rule (None: as recorded), the AUC-E budgets (distance in
+    low-level steps, high-level steps), JSON or tables, the executor of the reads and
+    whether to show progress (stderr)."""
+
+    inputs: tuple[str, ...]
+    runner: Executor
+    planners: tuple[str, ...] = ()
+    planner_options: dict[str, dict[str, Any]] = field(default_factory=dict)
+    llm_replay: tuple[str, ...] = ()
+    success: str | None = None
+    distance_budget: float = 5000.0
+    step_budget: float = 50.0
+    as_json: bool = False
+    progress: bool = False
+
+
+@dataclass(frozen=True)
+class EvalOutcome:
+    """The rendered result and the inputs left out because they could not be read."""
+
+    text: str
+    unread: list[str]
+
+
+def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
+    """Score the request's episodes and replay its planners on the logged decisions."""
+    from sgtool.analysis.batch_eval import load_many
+    from sgtool.analysis.metrics import cost_models, summarize
+    from sgtool.analysis.offline import log_exchanges, with_success_rule
+
+    results, logged, notes, unread = load_many([Path(i) for i in request.inputs], request.runner,
+                                               progress=request.progress)
+    results = [with_success_rule(r, request.success) for r in results]
+    for text in notes:
+        note(f"sgtool: note: {text}")
+    if not results:
+        why = f" ({len(notes)} skipped or refused, see the notes)" if notes else ""
+        raise SgtoolError("no search episodes to score in "
+                          + ", ".join(request.inputs) + why)
+    models = cost_models(request.distance_budget, request.step_budget)
+    exchanges = log_exchanges(request.inputs)
+    reports = _replays(request, logged, exchanges)
+    render = _as_json if request.as_json else _as_tables
+    text = render(request, results, notes, models, summarize(results, models), reports,
+                  exchanges)
+    return EvalOutcome(text=text, unread=list(unread))
+
+
+def _replays(request: EvalRequest, logged: Sequence[Any], exchanges: Sequence[Any]
+             ) -> list[Any]:
+    """One offline report per planner of the request, on the logged decision points."""
+    from sgtool.analysis.offline import replay_decisions
+    from sgtool.planning.registry import make_planner
+
+    names, options = request.planners, {k: dict(v) for k, v in
+                                        request.planner_options.items()}
+    replay = list(request.llm_replay) or sorted({src for src, _ in exchanges})
+    moma = options.get("moma-llm", {})
+    # the logs' own exchanges answer, unless an endpoint is named (flag or -O)
+    if replay and "moma-llm" in names and (request.llm_replay or not moma.get("base_url")):
+        options.setdefault("moma-llm", {}).setdefault("replay", replay)
+    if names and not any(d.graph is not None for e in logged for d in e.decisions):
+        raise SgtoolError("--planner needs MCAP logs with sgtool.SceneGraph records; "
+                          "the inputs have none")
+    return [replay_decisions(make_planner(n, **options.get(n, {})), logged, name=n)
+            for n in names]
+
+
+def _as_json(request: EvalRequest, results: Sequence[Any], notes: Sequence[str],
+             models: Sequence[Any], sums: Any, reports: Sequence[Any],
+             exchanges: Sequence[Any]) -> str:
+    from sgtool.analysis.metrics import seen_unseen
+    from sgtool.analysis.report import summary_dict
+    from sgtool.llm.stats import answer_stats
+
+    doc: dict[str, Any] = {
+        "episodes": len(results),
+        "notes": list(notes),
+        "budgets": {m.name: {"max": m.max_cost, "cost": m.label} for m in models},
+        "planners": summary_dict(sums),
+        "seen_unseen": [asdict(s) for s in seen_unseen(results)],
+        "offline": {r.planner: {"decisions": r.decisions, "same_action": r.rate("agree"),
+                                "same_target": r.rate("target"), "same_room": r.rate("room"),
+                                "not_in_graph": r.rate("invalid"), "skipped": r.skipped,
+                                "decision_s": r.mean_decision_s()}
+                    for r in reports},
+    }
+    if exchanges:
+        doc["llm_answers"] = answer_stats(exchanges).as_dict()
+    return json.dumps(strict_json(doc), indent=1, sort_keys=True, allow_nan=False) + "\n"
+
+
+def _as_tables(request: EvalRequest, results: Sequence[Any], notes: Sequence[str],
+               models: Sequence[Any], sums: Any, reports: Sequence[Any],
+               exchanges: Sequence[Any]) -> str:
+    from sgtool.analysis.metrics import seen_unseen
+    from sgtool.analysis.offline import format_offline
+    from sgtool.analysis.report import format_seen_unseen, format_table
+    from sgtool.llm.stats import answer_stats, format_stats
+
+    parts = [format_table(sums, models=models,
+                          title=f"Metrics recomputed from {len(results)} episode(s) in "
+                                f"{len(request.inputs)} file(s)")]
+    if any(r.seen is not None for r in results):
+        parts.append(format_seen_unseen(seen_unseen(results), title="Seen vs unseen queries"))
+    if reports:
+        parts.append(format_offline(reports))
+    if exchanges:
+        parts.append(format_stats(answer_stats(exchanges), "the logs") + "\n")
+    return "\n".join(parts)

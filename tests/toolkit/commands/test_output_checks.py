@@ -1,0 +1,74 @@
+"""The one output check (:func:`sgtool.commands.options.check_output`) on every writing
+command that uses it: a target in a read-only folder, in a missing folder, an existing
+file without --force and a folder are each refused in one line (exit 2) before any work,
+and leave nothing behind (the existing file keeps its bytes; click's own check of
+``dir_okay=False`` names a folder first)."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+from support.read_only import make_read_only
+
+from sgtool.cli import cli
+from sgtool.datasets import demo_house
+from sgtool.house.io import save_house
+
+GOLDEN_LOG = Path(__file__).resolve().parents[2] / "golden" / "house6-tour.mcap"
+
+# command line with {out} for the output and {house} for a house spec; the output's suffix
+COMMANDS = {
+    "record": (["record", "--frames", "1", "-o", "{out}"], ".mcap"),
+    "run": (["run", "--planner", "random", "--frames", "1", "-o", "{out}"], ".mcap"),
+    "eval": (["eval", str(GOLDEN_LOG), "-o", "{out}"], ".txt"),
+    "scenes generate": (["scenes", "generate", "-o", "{out}"], ".json"),
+    "scenes show": (["scenes", "show", "{house}", "-o", "{out}"], ".png"),
+    "view": (["view", str(GOLDEN_LOG), "-o", "{out}"], ".rrd"),
+}
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {p.relative_to(folder).as_posix(): p.read_bytes()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+@pytest.mark.parametrize("target", ["read-only", "missing", "existing", "folder"])
+@pytest.mark.parametrize("name", sorted(COMMANDS))
+def test_a_bad_target_is_one_line_and_leaves_nothing(name: str, target: str, tmp_path: Path,
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    args, suffix = COMMANDS[name]
+    house = tmp_path / "inputs" / "house.json"
+    house.parent.mkdir()
+    save_house(demo_house(), house)
+    where = tmp_path / "where"
+    where.mkdir()
+    out = where / f"out{suffix}"
+    if target == "missing":
+        out = where / "no" / "such" / f"out{suffix}"
+    elif target == "existing":
+        out.write_bytes(b"the user's file")
+    elif target == "folder":
+        out.mkdir()
+        (out / "keep").write_bytes(b"the user's file")
+    before = _files(where)
+    if target == "read-only":
+        make_read_only(where, monkeypatch)
+    line = [a.replace("{out}", str(out)).replace("{house}", str(house)) for a in args]
+    if target == "folder":
+        line.append("--force")
+    try:
+        r = CliRunner().invoke(cli, line)
+    finally:
+        where.chmod(0o755)
+    assert r.exit_code == 2, r.output
+    assert len(r.output.strip().splitlines()) == 1 and "Traceback" not in r.output, r.output
+    expected = {"read-only": "Permission denied", "missing": "does not exist",
+                "existing": r"not overwriting it \(use --force\)",
+                "folder": "is a (folder|directory)"}[target]
+    assert re.search(expected, r.output), r.output
+    assert _files(where) == before  # the existing file keeps its bytes; no temp file left
+    assert sorted(p.relative_to(where).as_posix() for p in where.rglob("*")) == \
+        sorted({*before, *(["out" + suffix] if target == "folder" else [])})
