@@ -47,6 +47,7 @@ error; its episodes are missing from every table.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -276,16 +277,33 @@ class BenchResult:
             [r for r in self.results if r.seen is seen]
         return [paired_comparison(results, a, b, boot=boot) for a, b in pairs]
 
-    def interval_tables(self, boot: Bootstrap = DEFAULT_BOOTSTRAP) -> str:
+    @functools.cached_property
+    def statistics(self) -> tuple[list[PlannerIntervals], list[PairedComparison],
+                                  list[PairedComparison], list[PairedComparison]]:
+        """With the default bootstrap, computed once: :meth:`intervals`, then
+        :meth:`comparisons` on all, seen and unseen queries."""
+        return (self.intervals(), self.comparisons(), self.comparisons(seen=True),
+                self.comparisons(seen=False))
+
+    def interval_tables(self) -> str:
         """The intervals per planner, then the paired comparisons (text)."""
-        return format_intervals(
-            self.intervals(boot), boot,
-            title="SR and SPL with bootstrap intervals over houses, episodes pooled over "
-                  "seeds") + "\n" + format_paired(
-            self.comparisons(boot), boot,
-            title="Paired comparisons on the same episodes") + "\n" + format_paired_split(
-            self.comparisons(boot, seen=True), self.comparisons(boot, seen=False), boot,
-            title="Paired comparisons on seen and on unseen queries")
+        ivs, pairs, seen, unseen = self.statistics
+        boot = DEFAULT_BOOTSTRAP
+        return "\n".join([
+            format_intervals(ivs, boot, title="SR and SPL with bootstrap intervals over "
+                                              "houses, episodes pooled over seeds"),
+            format_paired(pairs, boot, title="Paired comparisons on the same episodes"),
+            format_paired_split(seen, unseen, boot,
+                                title="Paired comparisons on seen and on unseen queries")])
+
+    def interval_dict(self) -> dict[str, Any]:
+        """The same as :meth:`interval_tables`, JSON-ready (summary.json)."""
+        ivs, pairs, seen, unseen = self.statistics
+        return {"bootstrap": DEFAULT_BOOTSTRAP.to_dict(), "cluster": "house",
+                "planners": {r.planner: r.to_dict() for r in ivs},
+                "paired": [c.to_dict() for c in pairs],
+                "paired_seen": [c.to_dict() for c in seen],
+                "paired_unseen": [c.to_dict() for c in unseen]}
 
     def breakdown_table(self, by: str) -> str:
         rows = breakdown(self.results, by, self.config.planners)
@@ -541,11 +559,7 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
         "budgets": {m.name: {"max": m.max_cost, "cost": m.label} for m in cfg.models()},
         "planners": summary_dict(sums, timing=False),
         "seen_unseen": [asdict(s) for s in seen_unseen(res.results, cfg.planners)],
-        "intervals": {"bootstrap": DEFAULT_BOOTSTRAP.to_dict(), "cluster": "house",
-                      "planners": {r.planner: r.to_dict() for r in res.intervals()},
-                      "paired": [c.to_dict() for c in res.comparisons()],
-                      "paired_seen": [c.to_dict() for c in res.comparisons(seen=True)],
-                      "paired_unseen": [c.to_dict() for c in res.comparisons(seen=False)]},
+        "intervals": res.interval_dict(),
         "vocabulary": {"priors": cfg.priors_dir, "training_queries": res.vocabulary_size},
         "houses": [{"id": h.id, "source": h.source} for h in res.houses],
         "digest": res.digest,

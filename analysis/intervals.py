@@ -27,6 +27,7 @@ closed loop's and the symbolic bench's) by a metric: tau-b of ``scipy.stats.kend
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Hashable, Mapping, Sequence
 from dataclasses import dataclass
@@ -105,10 +106,14 @@ class Interval:
         return {"value": num(self.value), "low": num(self.low), "high": num(self.high)}
 
 
+@functools.lru_cache(maxsize=8)
 def resample_indices(clusters: int, boot: Bootstrap = DEFAULT_BOOTSTRAP) -> np.ndarray:
-    """The drawn clusters of every resample: ``(resamples, clusters)`` indices."""
+    """The drawn clusters of every resample: ``(resamples, clusters)`` indices (read-only,
+    the same array for the same arguments)."""
     rng = np.random.default_rng(boot.seed)
-    return rng.integers(0, clusters, size=(boot.resamples, clusters))
+    out = rng.integers(0, clusters, size=(boot.resamples, clusters))
+    out.setflags(write=False)
+    return out
 
 
 def _ratio(num: float, den: float) -> float:
