@@ -13,7 +13,7 @@ priors memo as a bench task does. Every call of ``observe``, ``decide`` (and wit
 minimum over the repeats (the same call, deterministic, so the minimum is the time it
 takes when nothing else runs), and the table sums them. The first repeat of the first
 house warms the process and is left out. ``--against CHECKOUT`` first runs the same in
-another checkout (loaded as :mod:`bench_throughput` does), then in this one, and prints the
+another checkout (:func:`harness.alternate_trees`), then in this one, and prints the
 ratios; ``--rounds N`` runs N worker processes per tree, alternately (base, this, base,
 ...), and takes each call's minimum over all of them, so that load that changes during the
 run reaches both trees.
@@ -23,12 +23,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import subprocess
-import sys
-import tempfile
 import time
 from pathlib import Path
+
+from harness import add_output_options, alternate_trees, emit
 
 PARTS = ("observe", "decide", "actionable", "utilities", "execute")
 
@@ -102,19 +100,6 @@ def summed(runs: list[dict]) -> dict[str, float]:
                   "episodes": runs[0]["episodes"]}
 
 
-def run_tree(args: argparse.Namespace, site: Path | None) -> dict:
-    env = dict(os.environ)
-    if site is not None:
-        env["PYTHONPATH"] = str(site) + os.pathsep + env.get("PYTHONPATH", "")
-    cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", "--planner",
-           args.planner, "--houses", str(args.houses), "--repeats", str(args.repeats)]
-    done = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False,
-                          cwd=tempfile.gettempdir())
-    if done.returncode != 0:
-        sys.exit(f"worker failed:\n{done.stderr.strip()}")
-    return json.loads(done.stdout.strip().splitlines()[-1])
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--planner", default="scout")
@@ -124,22 +109,15 @@ def main() -> None:
                     help="worker processes per tree, run alternately")
     ap.add_argument("--against", type=Path, default=None)
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
-    args = ap.parse_args()
+    args = add_output_options(ap).parse_args()
     if args.worker:
         print(json.dumps(measure(args)))
         return
-    sys.path.insert(0, str(Path(__file__).parent))
-    from bench_throughput import site_of
-
-    with tempfile.TemporaryDirectory() as tmp:
-        trees = {"base": site_of(args.against.resolve(), Path(tmp) / "base")} \
-            if args.against else {}
-        trees["this"] = None
-        runs: dict[str, list[dict]] = {t: [] for t in trees}
-        for _ in range(args.rounds):  # alternating, so that both see the same load
-            for t, site in trees.items():
-                runs[t].append(run_tree(args, site))
-        rows = {t: summed(r) for t, r in runs.items()}
+    worker = ["--worker", "--planner", args.planner, "--houses", str(args.houses),
+              "--repeats", str(args.repeats)]
+    runs = alternate_trees(Path(__file__), worker, args.against, args.rounds,
+                           labels=("base", "this"))  # alternating: both see the same load
+    rows = {t: summed(r) for t, r in runs.items()}
     print(f"{args.planner}, {args.houses} houses x 20 episodes x 3 seeds; roll-out parts: "
           f"sums of per-call minima over {args.repeats} repeats x {args.rounds} rounds (s); "
           "prepare: CPU s")
@@ -156,6 +134,7 @@ def main() -> None:
             sum(n[p] for p in ("observe", "decide", "execute"))
         print(f"{'base/this':10s} " + " ".join(
             f"{ratio.get(p, float('nan')):10.2f}" for p in (*PARTS, "rollout", "prepare")))
+    emit({"planner": args.planner, "houses": args.houses, "sums_s": rows}, args.json_out)
 
 
 if __name__ == "__main__":

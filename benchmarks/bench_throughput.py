@@ -29,16 +29,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import statistics
-import subprocess
-import sys
-import tempfile
 import time
 from pathlib import Path
 
-ROOTS = {"toolkit": "", "recorders": "recorders", "replayers": "replayers",
-         "datasets": "datasets", "analysis": "analysis"}  # as setup.py maps them
+from harness import add_output_options, alternate_trees, emit
+
 DEFAULT = "env-only,random,sbert,scout"
 
 
@@ -111,34 +107,16 @@ def worker(args: argparse.Namespace) -> dict:
     return out
 
 
-def site_of(checkout: Path, into: Path) -> Path:
-    """A folder to put on PYTHONPATH so ``import sgtool`` loads ``checkout``'s code (the
-    package-dir mapping of setup.py, as symbolic links)."""
-    pkg = into / "sgtool"
-    pkg.mkdir(parents=True)
-    for entry in (checkout / "toolkit").iterdir():
-        (pkg / entry.name).symlink_to(entry)
-    for folder, name in ROOTS.items():
-        if name:
-            (pkg / name).symlink_to(checkout / folder)
-    return into
-
-
-def run_repeat(args: argparse.Namespace, site: Path | None) -> dict:
-    env = dict(os.environ)
-    if args.blas_threads:
-        env["OPENBLAS_NUM_THREADS"] = env["OMP_NUM_THREADS"] = str(args.blas_threads)
-    if site is not None:
-        env["PYTHONPATH"] = str(site) + os.pathsep + env.get("PYTHONPATH", "")
-    cmd = [sys.executable, str(Path(__file__).resolve()), "--worker",
-           "--houses", str(args.houses), "--episodes", str(args.episodes), "--seeds",
-           str(args.seeds), "--planners", args.planners, "--rooms", args.rooms,
-           "--preset", args.preset]
-    done = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False,
-                          cwd=tempfile.gettempdir())
-    if done.returncode != 0:
-        sys.exit(f"worker failed:\n{done.stderr.strip()}")
-    return json.loads(done.stdout.strip().splitlines()[-1])
+def run_repeats(args: argparse.Namespace) -> dict[str, list[dict]]:
+    """Per tree ("base" with --against, "this"), one worker document per repeat, the trees
+    alternating."""
+    env = {"OPENBLAS_NUM_THREADS": str(args.blas_threads),
+           "OMP_NUM_THREADS": str(args.blas_threads)} if args.blas_threads else None
+    worker_args = ["--worker", "--houses", str(args.houses), "--episodes", str(args.episodes),
+                   "--seeds", str(args.seeds), "--planners", args.planners, "--rooms",
+                   args.rooms, "--preset", args.preset]
+    return alternate_trees(Path(__file__), worker_args, args.against, args.repeats,
+                           labels=("base", "this"), env=env)
 
 
 def report(runs: dict[str, list[dict]], planners: list[str]) -> None:
@@ -178,20 +156,13 @@ def main() -> None:
     ap.add_argument("--blas-threads", type=int, default=0,
                     help="BLAS threads of the measured processes (default: the library's)")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
-    args = ap.parse_args()
+    args = add_output_options(ap).parse_args()
     if args.worker:
         print(json.dumps(worker(args)))
         return
     planners = args.planners.split(",")
-    with tempfile.TemporaryDirectory() as tmp:
-        trees: dict[str, Path | None] = {}
-        if args.against is not None:
-            trees["base"] = site_of(args.against.resolve(), Path(tmp) / "base")
-        trees["this"] = None
-        runs: dict[str, list[dict]] = {t: [] for t in trees}
-        for _ in range(args.repeats):
-            for t, site in trees.items():
-                runs[t].append(run_repeat(args, site))
+    runs = run_repeats(args)
+    trees = list(runs)
     n = args.houses * args.episodes * args.seeds
     print(f"{args.houses} houses (preset {args.preset}, {args.rooms} rooms) x {args.episodes} "
           f"episodes x {args.seeds} seeds = {n} episodes per planner and phase; episodes "
@@ -199,6 +170,7 @@ def main() -> None:
           + (" alternating between the trees" if len(trees) == 2 else "")
           + (f"; {args.blas_threads} BLAS thread(s)" if args.blas_threads else ""))
     report(runs, planners)
+    emit({"planners": planners, "episodes_per_planner": n, "runs": runs}, args.json_out)
 
 
 if __name__ == "__main__":

@@ -2,9 +2,9 @@
 message (decoded, rechunked, recompressed), in one process, alternating rounds.
 
 Per round, ``replay(LOG, OUT)`` with ``copy_chunks=True`` and ``copy_chunks=False``
-(median CPU seconds, ``time.process_time``, one BLAS thread); then both derived logs are
-read back and compared message for message (topic, log time, bytes, order), and the share
-of input chunks the copy took as they are is printed.
+(median CPU seconds, ``time.process_time``, one BLAS thread, :func:`harness.alternate`);
+then both derived logs are read back and compared message for message (topic, log time,
+bytes, order), and the share of input chunks the copy took as they are is printed.
 
 Usage: ``python benchmarks/chunk_copy.py [LOG] [--rounds 3]`` (default LOG: the 10-room
 benchmark log of ``benchmarks/replay.py`` when it is cached).
@@ -13,10 +13,11 @@ benchmark log of ``benchmarks/replay.py`` when it is cached).
 from __future__ import annotations
 
 import argparse
-import statistics
 import tempfile
-import time
+from collections.abc import Callable
 from pathlib import Path
+
+from harness import add_output_options, alternate, emit
 
 from sgtool.blas import single_blas_thread
 from sgtool.log import LogReader
@@ -44,24 +45,28 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("log", type=Path, nargs="?", default=DEFAULT)
     ap.add_argument("--rounds", type=int, default=3)
-    a = ap.parse_args(argv)
+    a = add_output_options(ap).parse_args(argv)
     out = Path(tempfile.mkdtemp(prefix="sgtool-chunk-copy-"))
-    cpu: dict[bool, list[float]] = {True: [], False: []}
-    frames = 0
+    frames: dict[bool, int] = {}
+
+    def case(copy: bool) -> Callable[[], None]:
+        def run() -> None:
+            frames[copy] = replay(a.log, out / f"{copy}.mcap", copy_chunks=copy).frames
+        return run
+
     with single_blas_thread():
-        for r in range(a.rounds):
-            for copy in ((True, False) if r % 2 == 0 else (False, True)):
-                t0 = time.process_time()
-                frames = replay(a.log, out / f"{copy}.mcap", copy_chunks=copy).frames
-                cpu[copy].append(time.process_time() - t0)
+        timings = alternate({"copied": case(True), "rewritten": case(False)}, a.rounds)
     same = read_back(out / "True.mcap") == read_back(out / "False.mcap")
     got, total = copied_share(a.log, out / "True.mcap")
-    c, w = statistics.median(cpu[True]), statistics.median(cpu[False])
-    print(f"{a.log.name}: {frames} frames, median CPU s of {a.rounds} alternating rounds")
-    print(f"  chunks copied      {c:7.2f} s  {frames / c:6.1f} frames/CPU-s")
-    print(f"  message by message {w:7.2f} s  {frames / w:6.1f} frames/CPU-s")
+    c, w = timings["copied"].cpu_s, timings["rewritten"].cpu_s
+    n = frames[True]
+    print(f"{a.log.name}: {n} frames, median CPU s of {a.rounds} alternating rounds")
+    print(f"  chunks copied      {c:7.2f} s  {n / c:6.1f} frames/CPU-s")
+    print(f"  message by message {w:7.2f} s  {n / w:6.1f} frames/CPU-s")
     print(f"  saved {w - c:.2f} CPU s ({(w - c) / w:.0%}); {got} of {total} input chunks "
           f"copied as they are; same messages in the same order: {same}")
+    emit({"log": str(a.log), "frames": n, "timings": timings, "same": same,
+          "chunks_copied": got, "chunks": total}, a.json_out)
     return 0 if same else 1
 
 

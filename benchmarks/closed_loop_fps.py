@@ -1,9 +1,9 @@
 """Frames per second of ``sgtool run`` in this checkout against another checkout of sgtool
 (e.g. the previous commit: ``git worktree add /tmp/cl-base HEAD``), side by side.
 
-Each round runs the same episode once per checkout, alternating, each as its own
-``sgtool run`` process; the other checkout's code is imported by pointing the editable
-install's package map at it. Prints every run and the medians and their ratio.
+Each round runs the same episode once per checkout, the order alternating, each as its own
+``sgtool run`` process; the other checkout's code is imported through a shadow package
+(:func:`harness.shadow_tree`). Prints every run and the medians and their ratio.
 
     .venv/bin/python benchmarks/closed_loop_fps.py --base /tmp/cl-base --rounds 3
 """
@@ -13,30 +13,20 @@ from __future__ import annotations
 import argparse
 import re
 import statistics
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
-HERE = Path(__file__).resolve().parents[1]
-BOOT = """
-import sys
-import __editable___sgtool_0_1_0_finder as f
-f.MAPPING.update({{k: v.replace({here!r}, {root!r}) for k, v in f.MAPPING.items()}})
-from sgtool.cli import main
-sys.argv = ["sgtool", *sys.argv[1:]]
-sys.exit(main())
-"""
+from harness import round_order, sgtool_output, shadow_tree
 
 
-def run(root: Path, args: list[str]) -> float:
-    code = BOOT.format(here=str(HERE), root=str(root))
+def run(pythonpath: str | None, args: list[str]) -> float:
+    """frames/s of one `sgtool run` with the tree on ``pythonpath`` (None: this one)."""
     with tempfile.TemporaryDirectory() as tmp:
-        out = subprocess.run([sys.executable, "-c", code, "run", *args, "-o",
-                              f"{tmp}/ep.mcap"], capture_output=True, text=True, check=True)
-    m = re.search(r"\(([\d.]+) frames/s\)", out.stdout)
+        out = sgtool_output(["run", *args, "-o", f"{tmp}/ep.mcap"], pythonpath)
+    m = re.search(r"\(([\d.]+) frames/s\)", out)
     if m is None:
-        raise SystemExit(f"no frames/s in the output of {root}:\n{out.stdout}{out.stderr}")
+        raise SystemExit(f"no frames/s in the output of {pythonpath or 'this tree'}:\n{out}")
     return float(m.group(1))
 
 
@@ -54,10 +44,11 @@ def main(argv: list[str] | None = None) -> int:
     common = ["--planner", args.planner, "--seed", args.seed, "--rooms", args.rooms,
               "--episode", args.episode, "--frames", args.frames, "--resolution",
               args.resolution]  # not --quiet: the report carries frames/s
+    trees = {"base": shadow_tree(Path(args.base)), "this": None}
     fps: dict[str, list[float]] = {"this": [], "base": []}
     for k in range(args.rounds):
-        for name, root in (("base", Path(args.base)), ("this", HERE)):
-            fps[name].append(run(root, common))
+        for name in round_order(list(trees), k):
+            fps[name].append(run(trees[name], common))
             print(f"round {k}: {name} {fps[name][-1]:.1f} frames/s", flush=True)
     med = {k: statistics.median(v) for k, v in fps.items()}
     print(f"median frames/s: this {med['this']:.1f}, base {med['base']:.1f}, ratio "

@@ -16,21 +16,13 @@ from __future__ import annotations
 import argparse
 import copy
 import json
-import time
+
+from harness import best_of
 
 from sgtool.datasets import demo_house
 from sgtool.errors import SpecError
 from sgtool.house.parse import parse_house
 from sgtool.house.spec import LIMITS, SpecLimits
-
-
-def _best(f, repeats: int = 3) -> float:
-    out = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        f()
-        out.append(time.perf_counter() - t0)
-    return min(out)
 
 
 def main() -> None:
@@ -44,7 +36,7 @@ def main() -> None:
     for n in sorted({min(k, args.max) for k in (1_000, 10_000, 100_000, args.max)}):
         doc = copy.deepcopy(base)
         doc["objects"] = [dict(one, id=f"obj_{k}") for k in range(n)]
-        t = _best(lambda d=doc, k=n: parse_house(d, SpecLimits(objects=k)))
+        t = best_of(lambda d=doc, k=n: parse_house(d, SpecLimits(objects=k)), 3).wall_s
         print(f"{n:>9} {t:>8.3f} {t / n * 1e6:>10.1f}")
 
     def refuse() -> None:
@@ -54,7 +46,7 @@ def main() -> None:
             return
         raise AssertionError("not refused")
     print(f"refusing {len(doc['objects'])} objects with the default limit "
-          f"({LIMITS.objects}): {_best(refuse) * 1e3:.2f} ms")
+          f"({LIMITS.objects}): {best_of(refuse, 3).wall_s * 1e3:.2f} ms")
 
 
 if __name__ == "__main__":

@@ -20,10 +20,11 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 import tempfile
 import time
 from pathlib import Path
+
+from harness import REPO, support
 
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.recorders.importers.bag import BagOptions, import_bag
@@ -32,10 +33,7 @@ from sgtool.recorders.importers.layouts import read_sequence
 from sgtool.recorders.importers.odometry import METHODS, drift_against, estimate_trajectory
 from sgtool.recorders.importers.rgbd import RgbdOptions, camera_for, import_rgbd
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))  # the test support modules
-from support.bag_export import write_log_as_bag  # noqa: E402
-
-REPO = Path(__file__).resolve().parents[1]
+write_log_as_bag = support("bag_export").write_log_as_bag
 
 
 def folder_import(data: Path, tmp: Path) -> None:
@@ -141,9 +139,9 @@ def _cli(args: list[str]):  # type: ignore[no-untyped-def]
 def silent_cases(tmp: Path) -> None:
     """The inputs of issue 18 that gave silently wrong results, and what they give now."""
     import numpy as np
-    from support.bag_export import BagWriter
-    from support.logfixtures import synthetic_frame
-    from support.rgbd_folders import make_tum_folder
+    BagWriter = support("bag_export").BagWriter  # noqa: N806
+    synthetic_frame = support("logfixtures").synthetic_frame
+    make_tum_folder = support("rgbd_folders").make_tum_folder
 
     print("\n## issue 18's silent-wrong inputs (synthetic), and what they give now")
     good = [100.0 + i / 30 for i in range(12)]

@@ -21,12 +21,11 @@ from __future__ import annotations
 
 import argparse
 import os
-import statistics
-import time
 from pathlib import Path
 
 import cv2
 import numpy as np
+from harness import add_output_options, alternate, emit
 
 from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.mapping.voxels import VoxelConfig, VoxelMap
@@ -38,10 +37,11 @@ VOXEL = 0.05
 MAX_RANGE = 5.0
 
 
-def load(folder: Path) -> list[tuple[np.ndarray, np.ndarray]]:
-    """(depth uint16 mm with 0 = none, camera-to-world 4x4) per frame, in order."""
+def load(folder: Path, limit: int | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(depth uint16 mm with 0 = none, camera-to-world 4x4) per frame, in order (the first
+    ``limit`` when given)."""
     out = []
-    for p in sorted(folder.glob("frame-*.depth.png")):
+    for p in sorted(folder.glob("frame-*.depth.png"))[:limit]:
         d = cv2.imread(str(p), cv2.IMREAD_UNCHANGED).astype(np.uint16)
         d[d == 65535] = 0  # 7-Scenes: no return
         pose = np.loadtxt(str(p).replace(".depth.png", ".pose.txt"))
@@ -85,28 +85,31 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--data", type=Path, default=DATA)
-    a = ap.parse_args(argv)
+    ap.add_argument("--frames", type=int, default=None, help="only the first N frames")
+    a = add_output_options(ap).parse_args(argv)
     if not a.data.is_dir():
         raise SystemExit(f"{a.data}: no 7-Scenes frames (set SGTOOL_SHARED_DATA)")
-    frames = load(a.data)
+    frames = load(a.data, a.frames)
     ids = tiles(*frames[0][0].shape)
-    runs: dict[str, list[float]] = {"sgtool VoxelMap": [], "Open3D VoxelBlockGrid": []}
     size: dict[str, int] = {}
-    for r in range(a.rounds):
-        order = list(runs) if r % 2 == 0 else list(runs)[::-1]
-        for name in order:
-            t0 = time.process_time()
-            got = ours(frames, ids) if name.startswith("sgtool") else open3d(frames)
-            runs[name].append(len(frames) / (time.process_time() - t0))
-            size[name] = len(got) if name.startswith("sgtool") else \
-                int(got.hashmap().size())
+
+    def run_ours() -> None:
+        size["sgtool VoxelMap"] = len(ours(frames, ids))
+
+    def run_open3d() -> None:
+        size["Open3D VoxelBlockGrid"] = int(open3d(frames).hashmap().size())
+
+    timings = alternate({"sgtool VoxelMap": run_ours, "Open3D VoxelBlockGrid": run_open3d},
+                        a.rounds)
+    rates = {name: t.per_cpu_s(len(frames)) for name, t in timings.items()}
     print(f"{len(frames)} frames 640x480 of {a.data.name}, {VOXEL} m voxels, range "
           f"{MAX_RANGE} m; frames per CPU-second, median of {a.rounds} alternating rounds")
-    base = statistics.median(runs["Open3D VoxelBlockGrid"])
-    for name, got in runs.items():
+    base = rates["Open3D VoxelBlockGrid"]
+    for name, rate in rates.items():
         unit = "(voxel, label) entries" if name.startswith("sgtool") else "blocks of 16^3"
-        print(f"  {name:<24}{statistics.median(got):>8.1f}  {statistics.median(got) / base:.2f}x"
-              f"  ({size[name]} {unit})")
+        print(f"  {name:<24}{rate:>8.1f}  {rate / base:.2f}x  ({size[name]} {unit})")
+    emit({"frames": len(frames), "frames_per_cpu_s": rates, "sizes": size,
+          "timings": timings}, a.json_out)
     return 0
 
 

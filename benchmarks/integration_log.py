@@ -19,11 +19,10 @@ import hashlib
 import json
 import os
 import statistics
-import subprocess
-import sys
-import tempfile
 import time
 from pathlib import Path
+
+from harness import add_output_options, alternate_trees, emit
 
 
 def measure(log: str, repeats: int) -> dict[str, object]:
@@ -54,42 +53,24 @@ def measure(log: str, repeats: int) -> dict[str, object]:
     return {"frames": len(frames), "cpu": times, "digest": sorted(digests)}
 
 
-def run_tree(log: str, repeats: int, pythonpath: str | None) -> dict[str, object]:
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
-    if pythonpath:
-        env["PYTHONPATH"] = pythonpath + os.pathsep + env.get("PYTHONPATH", "")
-    code = (f"import json, sys; sys.path.insert(0, {str(Path(__file__).parent)!r}); "
-            f"import integration_log as m; print(json.dumps(m.measure({log!r}, {repeats})))")
-    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
-                         text=True, check=True)
-    return json.loads(out.stdout.strip().splitlines()[-1])
-
-
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("log")
     ap.add_argument("--against", type=Path, default=None, help="baseline source tree")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--repeats", type=int, default=2, help="integrations per process")
-    a = ap.parse_args(argv)
-    sys.path.insert(0, str(Path(__file__).parent))
-    from side_by_side import shadow_package
-
-    trees: dict[str, str | None] = {"this tree": None}
-    if a.against is not None:
-        trees["baseline"] = str(shadow_package(a.against.resolve(),
-                                               Path(tempfile.mkdtemp(prefix="sgtool-int-"))))
-    got: dict[str, list[float]] = {k: [] for k in trees}
-    digests: dict[str, set[str]] = {k: set() for k in trees}
-    frames = 0
-    for r in range(a.rounds):
-        for name in (list(trees) if r % 2 == 0 else list(trees)[::-1]):
-            res = run_tree(a.log, a.repeats, trees[name])
-            frames = int(res["frames"])  # type: ignore[call-overload]
-            got[name].append(statistics.median(res["cpu"]))  # type: ignore[arg-type]
-            digests[name].update(res["digest"])  # type: ignore[arg-type]
-            print(f"round {r + 1} {name:<10} cpu {got[name][-1]:.3f} s", file=sys.stderr)
-    med = {k: statistics.median(v) for k, v in got.items()}
+    ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
+    a = add_output_options(ap).parse_args(argv)
+    if a.worker:
+        print(json.dumps(measure(a.log, a.repeats)))
+        return 0
+    docs = alternate_trees(Path(__file__), [str(Path(a.log).resolve()), "--worker",
+                                            "--repeats", str(a.repeats)],
+                           a.against, a.rounds, env={"OPENBLAS_NUM_THREADS": "1"})
+    frames = int(next(iter(docs.values()))[0]["frames"])
+    med = {k: statistics.median(statistics.median(d["cpu"]) for d in v)
+           for k, v in docs.items()}
+    digests = {k: {x for d in v for x in d["digest"]} for k, v in docs.items()}
     for name, c in med.items():
         print(f"{name:<10} {c:7.3f} CPU-s  {1e3 * c / frames:6.3f} ms/frame  "
               f"{frames / c:7.1f} frames/CPU-s  map digest {','.join(sorted(digests[name]))}")
@@ -98,6 +79,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"speed-up (baseline / this tree): {med['baseline'] / med['this tree']:.2f}x "
               f"({a.rounds} alternating rounds, load average {os.getloadavg()[0]:.1f}); "
               f"same map: {same}")
+    emit({"frames": frames, "cpu_s_median": med, "runs": docs,
+          "digests": {k: sorted(v) for k, v in digests.items()}}, a.json_out)
     return 0
 
 

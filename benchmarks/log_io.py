@@ -15,10 +15,10 @@ from __future__ import annotations
 import argparse
 import statistics
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
+from harness import add_output_options, emit, timed
 
 from sgtool.log import CameraIntrinsics, LogReader, LogWriter
 
@@ -43,39 +43,48 @@ def render(i: int, w: int, h: int) -> tuple:
     return k, rgb, depth, ids, pose
 
 
-def bench(w: int, h: int, compression: str, n: int, frames: list) -> tuple[float, float, float]:
+def bench(w: int, h: int, compression: str, n: int, frames: list) -> dict[str, float]:
+    """One write and read-back of ``n`` frames: frames/s written and read (wall, as
+    printed, and per CPU-second) and bytes per frame."""
     with tempfile.TemporaryDirectory() as d:
         path = Path(d) / "b.mcap"
-        t0 = time.perf_counter()
-        with LogWriter(path, compression=compression) as log:
-            for i in range(n):
-                k, rgb, depth, ids, pose = frames[i % len(frames)]
-                log.write_frame(i * 33_333_333, rgb=rgb, depth=depth, ids=ids, pose=pose,
-                                intrinsics=k, base_pose=pose)
-        t_write = time.perf_counter() - t0
+
+        def write() -> None:
+            with LogWriter(path, compression=compression) as log:
+                for i in range(n):
+                    k, rgb, depth, ids, pose = frames[i % len(frames)]
+                    log.write_frame(i * 33_333_333, rgb=rgb, depth=depth, ids=ids, pose=pose,
+                                    intrinsics=k, base_pose=pose)
+
+        def read() -> int:
+            with LogReader(path) as r:
+                return sum(1 for _ in r.frames())
+
+        _, wrote = timed(write)
         size = path.stat().st_size
-        t0 = time.perf_counter()
-        with LogReader(path) as r:
-            m = sum(1 for _ in r.frames())
-        t_read = time.perf_counter() - t0
+        m, red = timed(read)
         assert m == n
-    return n / t_write, n / t_read, size / n
+    return {"write_fps": n / wrote.wall_s, "read_fps": n / red.wall_s,
+            "write_per_cpu_s": n / max(wrote.cpu_s, 1e-9),
+            "read_per_cpu_s": n / max(red.cpu_s, 1e-9), "bytes_per_frame": size / n}
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--frames", type=int, default=300)
     ap.add_argument("--repeats", type=int, default=3)
-    a = ap.parse_args()
+    a = add_output_options(ap).parse_args()
+    rows = []
     print(f"{'resolution':<10} {'compr':<5} {'write fps':>10} {'read fps':>9} {'KB/frame':>9}")
     for w, h in [(320, 240), (640, 480)]:
         frames = [render(i, w, h) for i in range(60)]
         for comp in ["zstd", "lz4"]:
             runs = [bench(w, h, comp, a.frames, frames) for _ in range(a.repeats)]
-            wf = statistics.median(r[0] for r in runs)
-            rf = statistics.median(r[1] for r in runs)
-            kb = statistics.median(r[2] for r in runs) / 1024
-            print(f"{w}x{h:<6} {comp:<5} {wf:>10.0f} {rf:>9.0f} {kb:>9.1f}")
+            med = {k: statistics.median(r[k] for r in runs) for k in runs[0]}
+            print(f"{w}x{h:<6} {comp:<5} {med['write_fps']:>10.0f} {med['read_fps']:>9.0f} "
+                  f"{med['bytes_per_frame'] / 1024:>9.1f}")
+            rows.append({"resolution": f"{w}x{h}", "compression": comp, **med})
+    emit({"frames": a.frames, "repeats": a.repeats, "medians": rows}, a.json_out)
 
 
 if __name__ == "__main__":

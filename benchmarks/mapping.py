@@ -34,6 +34,7 @@ import tracemalloc
 from pathlib import Path
 
 import numpy as np
+from harness import support
 
 from sgtool.datasets.generator import generate_house
 from sgtool.datasets.room_evidence import frequency_room_classifier
@@ -44,16 +45,10 @@ from sgtool.mapping.voxels import VoxelConfig
 from sgtool.replayers.score import score, score_lines
 from sgtool.scenegraph.builder import BuilderConfig, SceneGraphBuilder
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))  # the test support modules
-from support.synthetic_world import (  # noqa: E402
-    HouseWorld,
-    base_pose,
-    camera_pose,
-    look_around,
-    render,
-    walk,
-    world_of_house,
-)
+_world = support("synthetic_world")
+HouseWorld, base_pose, camera_pose = _world.HouseWorld, _world.base_pose, _world.camera_pose
+look_around, render, walk = _world.look_around, _world.render, _world.walk
+world_of_house = _world.world_of_house
 
 VFOV = 60.0
 HEIGHT = 1.2

@@ -22,15 +22,14 @@ benchmark log of ``benchmarks/replay.py`` when it is cached).
 from __future__ import annotations
 
 import argparse
-import statistics
 import tempfile
-import time
 from collections.abc import Callable
 from pathlib import Path
 
 from foxglove_schemas_protobuf.CameraCalibration_pb2 import CameraCalibration
 from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
 from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
+from harness import add_output_options, alternate, emit
 from mcap.reader import make_reader
 
 from sgtool.log import LogReader
@@ -73,7 +72,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("log", type=Path, nargs="?", default=DEFAULT)
     ap.add_argument("--rounds", type=int, default=5)
-    a = ap.parse_args(argv)
+    a = add_output_options(ap).parse_args(argv)
     readers: dict[str, Callable[[Path], int]] = {
         "mcap raw": mcap_raw,
         "mcap + protobuf": mcap_protobuf,
@@ -81,18 +80,21 @@ def main(argv: list[str] | None = None) -> int:
         "LogReader.frames": ours,
         "LogReader.frames --verify": lambda p: ours(p, verify=True),
     }
-    rates: dict[str, list[float]] = {k: [] for k in readers}
-    for r in range(a.rounds):
-        order = list(readers) if r % 2 == 0 else list(readers)[::-1]
-        for name in order:
-            t0 = time.process_time()
-            n = readers[name](a.log)
-            rates[name].append(n / (time.process_time() - t0))
-    floor = statistics.median(rates["mcap raw"])
+    counts: dict[str, int] = {}
+
+    def case(name: str) -> Callable[[], None]:
+        def run() -> None:
+            counts[name] = readers[name](a.log)
+        return run
+
+    timings = alternate({name: case(name) for name in readers}, a.rounds)
+    rates = {name: t.per_cpu_s(counts[name]) for name, t in timings.items()}
+    floor = rates["mcap raw"]
     print(f"{a.log.name}: frames per CPU-second, median of {a.rounds} alternating rounds")
-    for name, got in rates.items():
-        med = statistics.median(got)
+    for name, med in rates.items():
         print(f"  {name:<27}{med:>8.0f}   {med / floor:.2f}x mcap raw")
+    emit({"log": str(a.log), "frames": counts, "frames_per_cpu_s": rates, "timings": timings},
+         a.json_out)
     return 0
 
 

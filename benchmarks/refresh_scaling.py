@@ -26,14 +26,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
 import types
 from pathlib import Path
+
+from harness import alternate_trees
 
 from sgtool.datasets.generator import generate_house
 from sgtool.recorders.sim.recording import RecordOptions, record_house
@@ -45,13 +45,17 @@ STAGES = ("bev", "voronoi", "rooms", "assign", "regions", "doors", "frontiers",
           "categories", "distances", "assemble")
 
 
-def recorded(seed: int, rooms: int, fps: float, cache: Path) -> Path:
+def recorded(seed: int, rooms: int, fps: float, cache: Path, frames: int | None = None
+             ) -> Path:
+    """The recording of house ``seed`` with ``rooms`` rooms at 320x240 (the whole tour, or
+    its first ``frames``), made once into ``cache``."""
     cache.mkdir(parents=True, exist_ok=True)
-    log = cache / f"house{seed}_{rooms}rooms_320x240_fps{fps:g}.mcap"
+    cut = f"_{frames}frames" if frames else ""
+    log = cache / f"house{seed}_{rooms}rooms_320x240_fps{fps:g}{cut}.mcap"
     if not log.exists():
         t0 = time.perf_counter()
         rep = record_house(generate_house(seed, rooms=(rooms, rooms)), log,
-                           RecordOptions(fps=fps), house_id=f"house-{seed}")
+                           RecordOptions(fps=fps, frames=frames), house_id=f"house-{seed}")
         print(f"  recorded {log.name}: {rep.frames} frames in {time.perf_counter() - t0:.0f} s",
               file=sys.stderr)
     return log
@@ -71,6 +75,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--rounds", type=int, default=2, help="rounds with --against")
     ap.add_argument("--worst", type=int, default=0,
                     help="also print the stage times of the N slowest refreshes per house")
+    ap.add_argument("--frames", type=int, default=None,
+                    help="record only the first N frames of each house (default: its tour)")
     ap.add_argument("--json", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.against is not None:
@@ -81,7 +87,7 @@ def main(argv: list[str] | None = None) -> int:
         builder_module.time = types.SimpleNamespace(perf_counter=time.thread_time)
     rows = []
     for n in (int(r) for r in a.rooms.split(",")):
-        log = recorded(a.seed, n, a.fps, a.cache)
+        log = recorded(a.seed, n, a.fps, a.cache, a.frames)
         seen: dict[str, object] = {}
 
         def keep(ref, stream, seen=seen) -> None:  # type: ignore[no-untyped-def]  # noqa: ANN001
@@ -129,25 +135,11 @@ def table(rows: list) -> None:  # type: ignore[type-arg]
 
 def side_by_side(a: argparse.Namespace) -> int:
     """Alternating rounds of this benchmark with this tree and with ``a.against``."""
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
-    from side_by_side import shadow_package  # noqa: PLC0415
-
-    pkg = shadow_package(a.against.resolve(), Path(tempfile.mkdtemp(prefix="refresh-base-")))
-    args = [sys.executable, str(Path(__file__).resolve()), "--json", "--rooms", a.rooms,
-            "--seed", str(a.seed), "--fps", str(a.fps), "--clock", a.clock,
-            "--cache", str(a.cache)]
-    trees = {"this tree": None, "base": str(pkg)}
-    got: dict[str, list[list]] = {k: [] for k in trees}  # type: ignore[type-arg]
-    for r in range(a.rounds):
-        for name in (list(trees) if r % 2 == 0 else list(trees)[::-1]):
-            env = dict(os.environ)
-            if trees[name]:
-                env["PYTHONPATH"] = trees[name] + os.pathsep + env.get("PYTHONPATH", "")
-            out = subprocess.run(args, env=env, capture_output=True, text=True, check=True)
-            got[name].append(json.loads(out.stdout.strip().splitlines()[-1]))
-            print(f"round {r + 1} {name}: median ms "
-                  + " ".join(f"{row[0]}r {row[4]:.1f}" for row in got[name][-1]),
-                  file=sys.stderr)
+    args = ["--json", "--rooms", a.rooms, "--seed", str(a.seed), "--fps", str(a.fps),
+            "--clock", a.clock, "--cache", str(a.cache.resolve()),
+            *(["--frames", str(a.frames)] if a.frames else [])]
+    got = alternate_trees(Path(__file__), args, a.against, a.rounds,
+                          labels=("base", "this tree"))
     med: dict[str, list] = {}  # type: ignore[type-arg]
     for name, runs in got.items():
         rows = []

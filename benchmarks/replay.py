@@ -39,13 +39,16 @@ from sgtool.replayers.derived_log import ReplayOptions, replay, stage_lines
 from sgtool.replayers.score import score, score_lines
 
 
-def recorded(seed: int, fps: float, cache: Path) -> Path:
+def recorded(seed: int, fps: float, cache: Path, frames: int | None = None) -> Path:
+    """The recording of the 10-room house ``seed`` at 320x240 (the whole tour, or its first
+    ``frames``), made once into ``cache``."""
     cache.mkdir(parents=True, exist_ok=True)
-    log = cache / f"house{seed}_10rooms_320x240_fps{fps:g}.mcap"
+    cut = f"_{frames}frames" if frames else ""
+    log = cache / f"house{seed}_10rooms_320x240_fps{fps:g}{cut}.mcap"
     if not log.exists():
         t0 = time.perf_counter()
-        rep = record_house(generate_house(seed, rooms=(10, 10)), log, RecordOptions(fps=fps),
-                           house_id=f"house-{seed}")
+        rep = record_house(generate_house(seed, rooms=(10, 10)), log,
+                           RecordOptions(fps=fps, frames=frames), house_id=f"house-{seed}")
         print(f"  recorded {log.name}: {rep.frames} frames in {time.perf_counter() - t0:.0f} s",
               file=sys.stderr)
     return log
@@ -64,10 +67,12 @@ def main(argv: list[str] | None = None) -> int:
                     help="time a from-scratch rebuild at every N-th refresh")
     ap.add_argument("--cache", type=Path,
                     default=Path(tempfile.gettempdir()) / "sgtool-bench-replay")
+    ap.add_argument("--frames", type=int, default=None,
+                    help="record only the first N frames (default: the whole tour)")
     a = ap.parse_args(argv)
     opts = ReplayOptions(every=a.every)
     for seed in (int(s) for s in a.seeds.split(",")):
-        log = recorded(seed, a.fps, a.cache)
+        log = recorded(seed, a.fps, a.cache, a.frames)
         pairs: list[tuple[float, float]] = []
         last: dict[str, object] = {}
 

@@ -1,6 +1,6 @@
 """The closed-loop benchmark next to the symbolic one on the same houses and episodes.
 
-    .venv/bin/python benchmarks/closed_loop_vs_symbolic.py RUN_BENCH_DIR BENCH_DIR
+    .venv/bin/python tools/closed_loop_vs_symbolic.py RUN_BENCH_DIR BENCH_DIR
 
 RUN_BENCH_DIR is an ``sgtool run-bench`` output folder (complete or cut short: its
 ``episodes.jsonl``, e.g. after ``--report-only``), BENCH_DIR an ``sgtool bench`` one with

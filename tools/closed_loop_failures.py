@@ -1,7 +1,7 @@
 """Failed skills per episode by reason in two ``sgtool run-bench`` output folders, over the
 episodes both hold (e.g. ``--navigation house`` before, ``live`` after):
 
-    .venv/bin/python benchmarks/closed_loop_failures.py BEFORE_DIR AFTER_DIR
+    .venv/bin/python tools/closed_loop_failures.py BEFORE_DIR AFTER_DIR
 """
 
 from __future__ import annotations

@@ -12,10 +12,10 @@ while others edit and test it. Tests run one mutation at a time (the machine is 
 
 Usage (from the repository root, by hand)::
 
-    python benchmarks/mutations.py                      # the default test files
-    python benchmarks/mutations.py --tests tests/toolkit/scenegraph/test_parts.py \
+    python tools/mutations.py                      # the default test files
+    python tools/mutations.py --tests tests/toolkit/scenegraph/test_parts.py \
         tests/toolkit/mapping/test_voronoi.py       # e.g. the "before" column
-    python benchmarks/mutations.py --only door          # mutations whose parameter matches
+    python tools/mutations.py --only door          # mutations whose parameter matches
 """
 
 from __future__ import annotations
