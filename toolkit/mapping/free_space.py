@@ -44,11 +44,11 @@ RADII = (1, 2, 4, 8)  # pixel half-widths of the neighbourhoods a view keeps
 class View:
     """One depth frame as free-space evidence: camera-to-world ``pose`` (4 x 4, optical
     axes: x right, y down, z forward), intrinsics and :func:`near_depth` of its depth at
-    every radius of ``RADII`` (float32 m; 0 = no evidence)."""
+    every radius of ``RADII`` (``levels[i]``: float32 m, 0 = no evidence)."""
 
     pose: np.ndarray
     intrinsics: CameraIntrinsics
-    levels: tuple[np.ndarray, ...]
+    levels: np.ndarray  # (len(RADII), h, w)
 
     @classmethod
     def of(cls, pose: np.ndarray, intrinsics: CameraIntrinsics, depth: np.ndarray,
@@ -64,7 +64,7 @@ class View:
                 level = _min3(level)
                 r += 1
             levels.append(level)
-        return cls(np.asarray(pose, dtype=np.float64), intrinsics, tuple(levels))
+        return cls(np.asarray(pose, dtype=np.float64), intrinsics, np.stack(levels))
 
 
 def _min3(a: np.ndarray) -> np.ndarray:
@@ -106,7 +106,7 @@ def seen_through(centres: np.ndarray, view: View, margin: float, min_range: floa
     cam = (centres - t) @ rot  # R^T (p - t), row vectors
     z = cam[:, 2]
     k = view.intrinsics
-    h, w = view.levels[0].shape
+    h, w = view.levels.shape[1:]
     ok = (z >= min_range) & (z < max_range)
     idx = np.flatnonzero(ok)
     if not len(idx):
@@ -119,7 +119,7 @@ def seen_through(centres: np.ndarray, view: View, margin: float, min_range: floa
     inside = (u >= 0) & (u < w) & (v >= 0) & (v < h) & (level < len(RADII))
     idx, zi, level = idx[inside], zi[inside], level[inside]
     ui, vi = u[inside].astype(np.int64), v[inside].astype(np.int64)
-    d = np.stack(view.levels)[level, vi, ui]
+    d = view.levels[level, vi, ui]
     out = np.zeros(n, dtype=bool)
     out[idx] = (d > 0) & (d > zi + margin)
     return out

@@ -44,7 +44,10 @@ Before the stages, the robot's body is free-space evidence: the voxels in the BE
 band within ``BODY_RADIUS`` of the trajectory points new since the last refresh that never
 had an instance's label are dropped
 (:meth:`~sgtool.mapping.voxels.VoxelMap.clear_unlabelled_around`); a later frame that sees
-something there puts it back.
+something there puts it back. Depth is free-space evidence too: every ``VIEW_STRIDE``-th
+frame since the last refresh counts a miss on each weak voxel of the band it saw through
+(:meth:`~sgtool.mapping.voxels.VoxelMap.clear_seen_through`,
+:mod:`sgtool.mapping.free_space`).
 
 Each stage is one method of :class:`SceneGraphBuilder` or one function of those modules;
 ``refresh`` runs them in this order and times each.
@@ -119,9 +122,10 @@ from sgtool.scenegraph.visibility import entry_nodes, nearest_visible
 
 BODY_RADIUS = 0.2  # m: unlabelled voxels this close to where the robot stood are dropped
 DOOR_REACH = 1.5  # m: a door's evidence is its won voxels this close to their median
+VIEW_STRIDE = 2  # every this many frames, one is free-space evidence (neighbours see alike)
 
-__all__ = ["BODY_RADIUS", "DOOR_REACH", "BuilderConfig", "DoorObservation", "MapLayers",
-           "SceneGraphBuilder"]
+__all__ = ["BODY_RADIUS", "DOOR_REACH", "VIEW_STRIDE", "BuilderConfig", "DoorObservation",
+           "MapLayers", "SceneGraphBuilder"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -243,7 +247,7 @@ class SceneGraphBuilder:
         else:  # camera optical axis (z) projected on the floor
             yaw = math.atan2(float(src[1, 2]), float(src[0, 2]))
         self.voxels.integrate(frame, (x, y))
-        if np.all(np.isfinite(frame.pose)):
+        if len(self.trajectory) % VIEW_STRIDE == 0 and np.all(np.isfinite(frame.pose)):
             self._views.append(View.of(frame.pose, frame.intrinsics, np.asarray(frame.depth),
                                        self.config.voxels.min_range))
         k = frame.intrinsics
