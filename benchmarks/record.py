@@ -27,6 +27,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from harness import add_output_options, emit, round_order
 
 from sgtool.datasets import demo_house
 from sgtool.log.writer import LogWriter
@@ -123,7 +124,8 @@ def main() -> None:
                     "a third)")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--resolutions", default="320x240,640x480")
-    args = ap.parse_args()
+    args = add_output_options(ap).parse_args()
+    rows: list[dict] = []
     house = demo_house()
     print(f"demo house: {len(house.rooms)} rooms, {len(house.furniture)} pieces, "
           f"{len(house.objects)} objects; {args.rounds} alternating rounds, medians")
@@ -136,11 +138,14 @@ def main() -> None:
             n = args.frames if w * h <= 320 * 240 else max(args.frames // 3, 20)
             poses = _poses(house, cam, n)
             bare, rec, mb = [], [], 0.0
-            for _ in range(args.rounds):
-                bare.append(_bare(house, cam, poses))
-                fps, frames, mb = _record(house, cam, n, Path(tmp) / "rec.mcap")
-                assert frames == n
-                rec.append(fps)
+            for k in range(args.rounds):
+                for case in round_order(["bare", "record"], k):
+                    if case == "bare":
+                        bare.append(_bare(house, cam, poses))
+                        continue
+                    fps, frames, mb = _record(house, cam, n, Path(tmp) / "rec.mcap")
+                    assert frames == n
+                    rec.append(fps)
             st = _stages(house, cam, poses, Path(tmp) / "stages.mcap")
             b, r = statistics.median(bare), statistics.median(rec)
             print(f"{res:<10} {n:>6} {b:>9.1f} {r:>10.1f} {r / b:>6.2f} "
@@ -148,6 +153,9 @@ def main() -> None:
                   f"{st['write'] * 1e3:>8.2f} {mb:>8.3f}")
             print(f"{'':<10} rounds: bare {', '.join(f'{x:.1f}' for x in bare)}; "
                   f"record {', '.join(f'{x:.1f}' for x in rec)}")
+            rows.append({"resolution": res, "frames": n, "bare_fps": bare, "record_fps": rec,
+                         "stages_s_per_frame": st, "mb_per_frame": mb})
+    emit({"rounds": args.rounds, "resolutions": rows}, args.json_out)
 
 
 if __name__ == "__main__":
