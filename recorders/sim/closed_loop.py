@@ -102,6 +102,7 @@ from sgtool.recorders.sim.live_recorder import LiveRecorder
 from sgtool.recorders.sim.live_skills import LiveNavConfig, LiveSkills, RobotBody
 from sgtool.recorders.sim.navigation import RobotConfig
 from sgtool.recorders.sim.noise import PROFILES, NoiseProfile
+from sgtool.recorders.sim.reachability import FailedGoals, reachable_view
 from sgtool.recorders.sim.recording import SOURCE
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome, StopSimulation
 from sgtool.recorders.sim.skill_plan import (  # noqa: F401 (re-exported)
@@ -225,8 +226,15 @@ class _Search:
         self._graph_time_ns = 0
         self._decision_s = 0.0
         self._confirming = False  # the decision after the target came into view ("done")
+        # live navigation: the planner sees the graph with the robot's reachability
+        # (:mod:`.reachability`); failed goals are not offered again from the same place
+        self.failed = FailedGoals()
+        self.withheld: dict[str, int] = {}  # reason -> nodes withheld, summed over decisions
+        self._seen: SceneGraph | None = None  # the graph the planner saw last
+        self._withheld_now: dict[str, str] = {}
         # the robot's own exploration when the graph offers nothing (live navigation only)
-        self.fallback = None if skills is None else Fallback(skills, self._log_fallback)
+        self.fallback = None if skills is None else Fallback(skills, self._log_fallback,
+                                                             view=self._view)
 
     def start(self) -> None:
         """One frame, then a look around (logged as decided on no graph), so the first
@@ -262,14 +270,30 @@ class _Search:
         if cur is None:  # no frame at all (cannot happen with a frame budget >= 1)
             self.end = "frames"
             return None
-        if not self.end and self.fallback is not None and not actionable(cur.graph):
+        graph = self._view(cur)
+        if not self.end and self.fallback is not None and not actionable(graph):
             self._hand_over(NO_ACTIONABLE, ())
             if self.end:  # the target came into view, or the frame budget is spent
                 return None
             cur = self.rec.stream.current
             assert cur is not None
+            graph = self._view(cur)
+        for why in self._withheld_now.values():
+            self.withheld[why] = self.withheld.get(why, 0) + 1
         self._graph_time_ns = int(cur.time_ns)
-        return cur.graph
+        self._seen = graph
+        return graph
+
+    def _view(self, refresh: Refresh) -> SceneGraph:
+        """The graph of ``refresh`` as the planner sees it: with live navigation, goals
+        the robot's map cannot reach (or that failed from the same place) withheld
+        (:func:`~sgtool.recorders.sim.reachability.reachable_view`; the reasons of the
+        last view in ``_withheld_now``)."""
+        if self.skills is None:
+            return refresh.graph
+        view = reachable_view(refresh, self.skills, self.failed)
+        self._withheld_now = view.withheld
+        return view.graph
 
     def _hand_over(self, why: str, known: Sequence[Candidate]) -> None:
         """The robot explores grid frontiers on its own (:mod:`.fallback_explore`) until
@@ -311,7 +335,7 @@ class _Search:
         o: Outcome
         if plan.done and action.target is None and self.fallback is not None and \
                 self.fallback.can_explore():
-            return self._give_up_handed_over(action, cur.graph)
+            return self._give_up_handed_over(action, self._seen or cur.graph)
         if plan.done:
             o, why, dist, ticks = "success", DONE_MESSAGE, 0.0, 0
             self.end = "gave_up" if action.target is None else "wrong_done"
@@ -322,6 +346,8 @@ class _Search:
             o, why, dist, ticks, cut = ex.outcome, ex.reason, ex.travelled_m, ex.ticks, ex.cut
             if action.skill == "open" and o == "success":
                 self.n_open += 1
+            if o == "failure" and not cut and action.target is not None:
+                self.failed.failed(action.target)  # not offered again from the same place
         outcome = SkillOutcome(action.skill, action.target, o, why, dist, ticks)
         self.last_t = self.rec.act(self.sim, outcome, self._decision_s,
                                    {"graph_time_ns": self._graph_time_ns})
@@ -420,7 +446,7 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                 extra={"query": query, "planner": name, "seed": opts.planner_seed,
                        "episode": int(episode_index), "episode_id": episode.id,
                        "end": end, "n_open": n_open, "mapping": mapping_record(mapping),
-                       **_rule(opts)},
+                       **_withheld(search), **_rule(opts)},
             ), t_end)
             rec.refreshed(stream.finish(t_end))  # as replay ends: only if anything is new
             travelled, frames, refreshes = sim.travelled_m, rec.frames, rec.refreshes
@@ -465,6 +491,12 @@ def _started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOp
         "navigation": {"mode": opts.navigation, **opts.live.to_dict()},
         "noise": opts.noise.to_dict(), "noise_seed": opts.noise_seed, **_rule(opts),
     }
+
+
+def _withheld(search: _Search) -> dict[str, Any]:
+    """``{"withheld": {reason: count}}``: goals not offered to the planner, summed over
+    its decisions (live navigation; nothing when none was withheld)."""
+    return {"withheld": dict(sorted(search.withheld.items()))} if search.withheld else {}
 
 
 def _rule(opts: ClosedLoopOptions) -> dict[str, str]:

@@ -35,6 +35,7 @@ from sgtool.recorders.sim.events import SkillOutcome, StopSimulation
 from sgtool.recorders.sim.frontier_explore import next_frontier
 from sgtool.recorders.sim.live_skills import LiveSkills
 from sgtool.scenegraph.graph import SceneGraph
+from sgtool.scenegraph.stream import Refresh
 
 NO_ACTIONABLE = "no actionable node"
 GAVE_UP = "the planner gave up while the robot's map has reachable frontiers"
@@ -73,11 +74,14 @@ def new_candidates(graph: SceneGraph, known: Sequence[Candidate]) -> list[Candid
 @dataclass
 class Fallback:
     """The hand-over of one episode (module doc): ``skills`` on the live map; ``log``
-    writes an action record and returns True to stop (the target is in view)."""
+    writes an action record and returns True to stop (the target is in view); ``view``
+    is the graph the planner would see of a refresh (its own graph when None; the closed
+    loop's withholds goals the robot cannot reach, :mod:`.reachability`)."""
 
     skills: LiveSkills
     log: Callable[[SkillOutcome], bool]
     options: FallbackOptions = field(default_factory=FallbackOptions)
+    view: Callable[[Refresh], SceneGraph] | None = None
     gone_to: list[tuple[float, float]] = field(default_factory=list)  # goal cells so far
 
     def can_explore(self) -> bool:
@@ -93,7 +97,9 @@ class Fallback:
         n = 0
         for _ in range(self.options.max_goals):
             ref = skills.current()
-            if ref is None or ref.layers is None or new_candidates(ref.graph, known):
+            if ref is None or ref.layers is None:
+                break
+            if new_candidates(ref.graph if self.view is None else self.view(ref), known):
                 break
             pick = next_frontier(skills, ref, self.gone_to, self.options.forget)
             if pick is None:

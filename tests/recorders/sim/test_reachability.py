@@ -1,0 +1,101 @@
+"""Reachability on the robot's own map in the graph the planner sees (recorders/sim/
+reachability.py).
+
+Checked: the windowed goal cell equals the cell the skill drives to (LiveSkills.select on
+the whole grid) for stand, point and frontier goals all over a small map with a wall, a
+gap and unknown space; a failed goal is withheld while the same cell would be tried again
+and offered once the map moves it; in the closed loop the planner is not offered the room
+behind a closed door that its map cannot reach (test_live_navigation's situation), and
+the reason is counted into the closing Episode record.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+from support.scripted_planner import Scripted
+
+from sgtool.datasets.generator import generate_house
+from sgtool.log import LogReader
+from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from sgtool.mapping.live_paths import traversable
+from sgtool.mapping.occupancy import geodesic_distances
+from sgtool.planning.base import Action
+from sgtool.planning.candidates import actionable
+from sgtool.recorders.sim import CameraConfig
+from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
+from sgtool.recorders.sim.live_skills import Goal, LiveSkills
+from sgtool.recorders.sim.navigation import RobotConfig
+from sgtool.recorders.sim.reachability import UNREACHABLE, FailedGoals, goal_cell
+
+
+@dataclass
+class _Body:  # what LiveSkills reads of the robot for goal choice
+    base: tuple[float, float, float]
+    config: RobotConfig
+
+
+def _map():
+    g = np.full((40, 60), FREE, dtype=np.int8)
+    g[:, 30] = OCCUPIED  # a wall at x = 3.0..3.1 m
+    g[18:24, 30] = FREE  # with a 0.6 m gap
+    g[:, 50:] = UNKNOWN  # unknown past x = 5 m
+    g[5:9, 10:14] = OCCUPIED  # a box
+    grid = OccupancyGrid(g, (0.0, 0.0), 0.1)
+    occ = traversable(grid, 0.2, 0.25)
+    return occ, geodesic_distances(occ, (1.0, 2.0))
+
+
+def test_goal_cell_is_the_cell_the_skill_drives_to() -> None:
+    occ, dist = _map()
+    skills = LiveSkills(_Body((1.0, 2.0, 0.0), RobotConfig()), lambda: None)
+    rng = np.random.default_rng(3)
+    kinds = {"stand": 0, "point": 0, "cells": 0}
+    for xy in rng.uniform((-0.5, -0.5), (6.5, 4.5), size=(150, 2)):
+        for kind in ("stand", "point"):
+            goal = Goal("g", kind, xy[None, :])
+            want = skills.select(goal, occ, dist)
+            assert goal_cell(skills, goal, occ, dist) == want
+            kinds[kind] += want is None
+        cells = xy + rng.uniform(-0.4, 0.4, size=(5, 2))
+        goal = Goal("f", "cells", cells)
+        want = skills.select(goal, occ, dist)
+        assert goal_cell(skills, goal, occ, dist) == want
+        kinds["cells"] += want is None
+    # both outcomes occur for every kind (the box, the unknown and the grid's edge)
+    assert all(0 < n < 150 for n in kinds.values()), kinds
+
+
+def test_a_failed_goal_waits_until_the_map_moves_it() -> None:
+    f = FailedGoals(same=0.5)
+    assert not f.blocks("obj:3", (1.0, 1.0))  # never failed
+    f.failed("obj:3")
+    assert f.blocks("obj:3", (1.0, 1.0))  # the first look records the cell
+    assert f.blocks("obj:3", (1.3, 1.2))  # within 0.5 m: the same attempt
+    assert not f.blocks("obj:3", (2.0, 1.0))  # the map moved it: tried again
+    assert not f.blocks("obj:3", (1.0, 1.0))  # and forgotten until it fails again
+
+
+@pytest.fixture(scope="module")
+def house():
+    return generate_house(6, rooms=(4, 4))
+
+
+def test_the_planner_is_not_offered_a_room_its_map_cannot_reach(house, tmp_path) -> None:
+    # episode 0 starts in a room whose only door to room:1 is closed (test_live_navigation):
+    # the scene graph knows room:1, the robot's map holds no way there
+    idx, ep = pick_episode(house, index=0)
+    p = Scripted([Action("done")])
+    out = tmp_path / "view.mcap"
+    run_episode(house, ep, p, out,
+                ClosedLoopOptions(camera=CameraConfig(width=160, height=120), max_steps=1),
+                episode_index=idx)
+    seen = p.graphs[0]
+    assert seen.node("room:1") is not None and "room:1" not in seen.distances
+    assert "room:1" not in {c.node_id for c in actionable(seen)}
+    assert actionable(seen)  # something else is on offer (the fallback did not run)
+    with LogReader(out) as r:
+        episodes = [e for _, e in r.records("episode")]
+    assert episodes[-1]["extra"]["withheld"][UNREACHABLE] >= 1
