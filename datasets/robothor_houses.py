@@ -14,14 +14,16 @@ What is taken from the data and what is derived (docs/houses-robothor.md says wh
 - **Coordinates**: AI2-THOR (x, y up, z) -> spec (x, z, y): a mirror image of the scene,
   which changes no distance. Every box is the object's axis-aligned box (``yaw`` 0).
 - **Furniture**: every object without a parent receptacle (floor-standing pieces, and
-  things lying on the floor such as a baseball bat), except wall decoration
-  (:data:`DROPPED`). ``Drawer`` and ``Shelf`` parts join the piece whose footprint holds
-  them (:func:`host_of`): a piece with drawers is an openable container (closed unless a
-  drawer is open), unless something rests on one of its lower shelves (open shelving the
-  reveal rule would otherwise hide); a shelf holding objects becomes one of the piece's
-  ``levels`` (height of the objects' bottoms above the piece's bottom, 1 cm groups).
-- **Small objects**: every object with a parent receptacle. Its parent is the smallest
-  listed receptacle (by box volume); a shelf or drawer stands for its piece. ``Box``
+  things lying on the floor such as a baseball bat) and every fixed one (neither
+  pickupable nor moveable: a desk AI2-THOR lists "on" the chair pushed under it), except
+  wall decoration (:data:`DROPPED`). ``Drawer`` and ``Shelf`` parts join the piece
+  whose footprint holds them (:func:`host_of`): a piece with drawers is an openable
+  container (closed unless a drawer is open), unless something rests on one of its lower
+  shelves (open shelving the reveal rule would otherwise hide); a shelf holding objects
+  becomes one of the piece's ``levels`` (height of the objects' bottoms above the piece's
+  bottom, 1 cm groups).
+- **Small objects**: every other object with a parent receptacle. Its parent is the
+  smallest listed receptacle (by box volume); a shelf or drawer stands for its piece. ``Box``
   parents (openable) hold their objects ``inside`` when the box encloses them (centre
   moved into the box if needed), everything else is ``ontop``, its bottom moved onto the
   nearest support surface of the parent (the validator allows 1 cm) and its centre into
@@ -88,6 +90,7 @@ class Thing:
     parents: tuple[str, ...]
     openable: bool
     is_open: bool
+    fixed: bool = False  # neither pickupable nor moveable: a piece of furniture
 
     @property
     def bottom(self) -> float:
@@ -114,7 +117,8 @@ def thing(obj: Mapping[str, Any]) -> Thing:
                  center=(float(c["x"]), float(c["z"]), float(c["y"])),
                  size=(float(s["x"]), float(s["z"]), float(s["y"])),
                  parents=tuple(str(p) for p in obj.get("parentReceptacles") or ()),
-                 openable=bool(obj.get("openable")), is_open=bool(obj.get("isOpen")))
+                 openable=bool(obj.get("openable")), is_open=bool(obj.get("isOpen")),
+                 fixed=not obj.get("pickupable") and not obj.get("moveable"))
 
 
 def type_words(object_type: str) -> str:
@@ -192,7 +196,7 @@ def convert_scene(objects: Sequence[Mapping[str, Any]], seed: int = 0) -> HouseS
     things = [thing(o) for o in objects]
     by_id = {t.id: t for t in things}
     kept = [t for t in things if t.type not in DROPPED]
-    pieces = [t for t in kept if not t.parents and t.type not in PARTS]
+    pieces = [t for t in kept if (t.fixed or not t.parents) and t.type not in PARTS]
     if not pieces:
         raise SgtoolError("robothor scene has no furniture")
     part_host: dict[str, Thing] = {}
@@ -203,15 +207,14 @@ def convert_scene(objects: Sequence[Mapping[str, Any]], seed: int = 0) -> HouseS
                 pieces.append(t)
             else:
                 part_host[t.id] = host
-    smalls = [t for t in kept if t.parents]
+    smalls = [t for t in kept if t.parents and not t.fixed and t.type not in PARTS]
 
     # ----- parents: the smallest listed receptacle, parts standing for their piece -------
     parent_of: dict[str, Thing] = {}
     on_shelf: set[str] = set()
-    small_ids = {t.id for t in smalls}
+    holders = {t.id for t in smalls} | {p.id for p in pieces} | set(part_host)
     for t in smalls:
-        listed = [by_id[p] for p in t.parents if p in by_id and by_id[p].type not in DROPPED]
-        listed = [p for p in listed if p.id in small_ids or not p.parents]
+        listed = [by_id[p] for p in t.parents if p in holders]
         if not listed:
             continue
         p = min(listed, key=lambda q: (q.volume, q.id))
