@@ -157,14 +157,16 @@ def main() -> None:
             table, f = campaign(src, a.mutants, a.seed, commands, work)
             print_table(f"{a.mutants} mutants of {src.name}", table, commands)
             failures += f
-            totals.update({o: n for (_, o), n in table.items()})
+            for (_, o), n in table.items():
+                totals[o] += n
         if not a.no_crafted:
             (work / "crafted").mkdir()
             table, f = crafted_campaign(commands, work)
             print_table("crafted logs (tests/support/crafted_logs.py)", table,
                         [*commands, "score"])
             failures += f
-            totals.update({o: n for (_, o), n in table.items()})
+            for (_, o), n in table.items():
+                totals[o] += n
     print("\ntotal: " + ", ".join(f"{o} {totals[o]}" for o in OUTCOMES))
     print(f"{len(failures)} failures")
     for line in failures[:30]:

@@ -1,12 +1,12 @@
 """What sgtool reads each of its channels as, and whether one message fits it.
 
 sgtool reads its frame topics as Foxglove protobuf messages (images as
-``foxglove.RawImage``, the calibration as ``foxglove.CameraCalibration``, ``/tf`` as
-``foxglove.FrameTransform``, the occupancy grid as ``foxglove.Grid``) and its records as
-JSON (:data:`sgtool.log.schemas.RECORDS`). :func:`channel_problem` says, in one line
-naming the channel, its message encoding and its schema, why a channel of one of those
-topics cannot be read so (a depth channel in CDR, or with no schema); None when it can, or
-when the topic is not one of sgtool's.
+``foxglove.RawImage``, the calibration as ``foxglove.CameraCalibration``, ``/tf`` and
+``/tf_static`` as ``foxglove.FrameTransform``, the occupancy grid as ``foxglove.Grid``) and
+its records as JSON (:data:`sgtool.log.schemas.RECORDS`). :func:`channel_problem` says, in
+one line naming the channel, its message encoding and its schema, why a channel of one of
+those topics cannot be read so (a depth channel in CDR, or with no schema); None when it
+can, or when the topic is not one of sgtool's.
 
 :func:`message_problem` decodes one message the way the reader and replay do and checks it
 as they would: an image must decode to the size its width, height, step and encoding
