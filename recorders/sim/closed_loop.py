@@ -431,6 +431,8 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
             rec.write_instances(sim)
             skills = None if opts.navigation == "house" else LiveSkills(
                 RobotBody(sim), lambda: stream.current, opts.live)
+            if skills is not None:  # end a skill as soon as the target is in the graph
+                skills.stop_when = lambda: _found(stream.current, query)
             search = _Search(sim, rec, planner, query, opts.max_steps, on_decision, skills)
             search.start()
             trace = run_search(search, planner, query, seed=opts.planner_seed,

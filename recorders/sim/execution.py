@@ -60,8 +60,7 @@ def execute_live(sim: Simulation, skills: LiveSkills, calls: Sequence[SkillCall]
     try:
         for c in calls:
             if c.skill == "look_around":
-                out = skills.body.look_around()
-                outcome, reason = out.outcome, out.reason
+                outcome, reason, _ = skills.look_around()
             elif c.skill in ("open", "close"):
                 assert isinstance(c.target, int)
                 out = getattr(skills.body, c.skill)(c.target)

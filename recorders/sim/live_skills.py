@@ -15,10 +15,18 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   (stand within reach, nearest along the floor, facing it), a room or region node's
   position (the reachable cell nearest to it within ``snap``), a frontier's cluster (its
   nearest reachable cell, :func:`~sgtool.mapping.live_paths.nearest_reachable`).
-- **Re-planning.** A path is followed frame by frame; at every refresh of the map (every K
-  frames) or at a contact the goal and the path are planned again on the newer map. A goal
-  the map cannot reach is a failed skill whose reason says so; so are repeated contacts
-  and a goal not reached after ``max_replans`` plans.
+- **Re-planning.** A path is followed frame by frame, turning while driving
+  (:func:`~sgtool.recorders.sim.motion.drive_while_turning`: no stop-and-turn at each
+  waypoint or re-plan); at every refresh of the map (every K frames) or at a contact the
+  goal and the path are planned again on the newer map. A goal the map cannot reach is a
+  failed skill whose reason says so; so are repeated contacts and a goal not reached
+  after ``max_replans`` plans.
+- **Looking around** (:meth:`LiveSkills.look_around`) turns only toward unknown space
+  near the robot on its own map (:func:`~sgtool.recorders.sim.motion.sweep`), the shorter
+  way, and stops when a refresh during the turn shows no cell known that was not before.
+- **Stopping early.** ``stop_when`` (the closed loop's: the target is in the graph) is
+  asked at every refresh during a skill; when it says so the skill ends there, a success
+  with reason :data:`IN_VIEW`.
 """
 
 from __future__ import annotations
@@ -42,6 +50,7 @@ from sgtool.mapping.occupancy import OccupancyMap, geodesic_distances
 from sgtool.planning.base import Outcome
 from sgtool.recorders.sim import navigation as nav
 from sgtool.recorders.sim.events import SkillOutcome
+from sgtool.recorders.sim.motion import drive_while_turning, sweep
 from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode
 
 if TYPE_CHECKING:
@@ -49,6 +58,9 @@ if TYPE_CHECKING:
     from sgtool.recorders.sim.simulation import Simulation
     from sgtool.scenegraph.builder import MapLayers
     from sgtool.scenegraph.stream import Refresh
+
+
+IN_VIEW = "the target came into view"
 
 
 class PrivilegedAccess(SgtoolError):
@@ -100,6 +112,12 @@ class RobotBody:
     @property
     def fps(self) -> float:
         return self._sim.fps
+
+    @property
+    def hfov(self) -> float:
+        """The camera's horizontal field of view (radians)."""
+        k = self._sim.intrinsics
+        return 2.0 * math.atan(k.width / (2.0 * k.fx))
 
     @property
     def tick_index(self) -> int:
@@ -172,6 +190,19 @@ class LiveSkills:
         self.replans = 0  # plans made (for reports)
         self.contacts = 0
         self.bumps: list[tuple[float, float]] = []  # where the base touched something
+        # asked at every refresh during a skill: True ends the skill (module doc)
+        self.stop_when: Callable[[], bool] | None = None
+        self._asked = -1  # index of the last refresh stop_when was asked on
+
+    def _stop(self) -> bool:
+        """Whether ``stop_when`` says stop, asked once per refresh."""
+        if self.stop_when is None:
+            return False
+        now = self.current()
+        if now is None or now.index == self._asked:
+            return False
+        self._asked = now.index
+        return self.stop_when()
 
     # ----- planning ---------------------------------------------------------------------
     def live_map(self, refresh: Refresh) -> OccupancyMap | None:
@@ -218,11 +249,13 @@ class LiveSkills:
             end = pts[-1] if pts else here
             yaw = None if face is None or math.dist(face, end) < 1e-6 else \
                 math.atan2(face[1] - end[1], face[0] - end[0])
-            poses = nav.follow_poses(body.base, pts, step, turn, yaw)
+            poses = drive_while_turning(body.base, pts, step, turn, yaw)
             arrived = True
             for p in poses:
                 d, hit = body.drive([p])
                 driven += d
+                if self._stop():
+                    return "success", IN_VIEW, driven
                 if hit:
                     contacts += 1
                     self.contacts += 1
@@ -244,9 +277,49 @@ class LiveSkills:
     def explore(self, goal: Goal) -> tuple[Outcome, str, float]:
         """Go to ``goal`` and look around there."""
         o, why, d = self.navigate(goal)
-        if o == "success":
-            self.body.look_around()
+        if o == "success" and why != IN_VIEW:
+            o, why, _ = self.look_around()
         return o, why, d
+
+    def look_around(self) -> tuple[Outcome, str, float]:
+        """Turn on the spot toward the unknown space around (module doc): the whole way
+        round before the robot has a map."""
+        body = self.body
+        ref = self.current()
+        if ref is None or ref.layers is None:
+            angle = 2.0 * math.pi
+        else:
+            angle = sweep(ref.layers.occupancy, body.base, body.hfov)
+        if angle == 0.0:
+            return "success", "nothing unknown around", 0.0
+        turn = body.config.turn_speed / body.fps
+        x, y, a = body.base
+        pieces = max(1, math.ceil(abs(angle) / (math.pi / 2) - 1e-9))
+        poses: list[Pose2] = []
+        cur = body.base
+        for q in range(1, pieces + 1):
+            seg = nav.turn_poses(cur, a + angle * q / pieces, turn)
+            poses += seg
+            cur = seg[-1] if seg else cur
+        seen_at = None if ref is None else ref.index
+        known = None if ref is None or ref.layers is None else _known(ref.layers)
+        for p in poses:
+            body.drive([p])
+            if self._stop():
+                return "success", IN_VIEW, 0.0
+            now = self.current()
+            if now is None or now.layers is None or now.index == seen_at:
+                continue
+            k = _known(now.layers)
+            if known is not None and k <= known:
+                return "success", "nothing new in view", 0.0
+            seen_at, known = now.index, k
+        return "success", "", 0.0
+
+
+def _known(layers: MapLayers) -> int:
+    """Cells of the map that are known (free or occupied)."""
+    return int(np.count_nonzero(layers.occupancy.grid != -1))
 
 
 def _bumped(here: Pose2, to: Pose2, radius: float) -> tuple[float, float]:
