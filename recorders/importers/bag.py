@@ -55,9 +55,11 @@ from sgtool.recorders.importers.bag_frames import camera_of, decode_frames
 from sgtool.recorders.importers.bag_index import BagIndex, index_bag
 from sgtool.recorders.importers.bag_options import BagOptions, check_options
 from sgtool.recorders.importers.bag_poses import PoseSource, pose_source_of
+from sgtool.recorders.importers.bag_scale import bag_scale_fit, bag_scale_problem
 from sgtool.recorders.importers.bag_sync import PlannedFrame, plan_frames, planned_poses
 from sgtool.recorders.importers.bag_topics import check_flags, describe_bag, with_only_info
 from sgtool.recorders.importers.distortion import distortion_finding
+from sgtool.recorders.importers.floor import floor_confidence_problem, frame_floor_problem
 from sgtool.recorders.importers.images import ResizeLog, depth_to_metres
 from sgtool.recorders.importers.odometry import (
     DriftReport,
@@ -74,6 +76,9 @@ from sgtool.recorders.importers.provenance import (
 )
 from sgtool.recorders.importers.sanity import (
     BAG_TIME_FIX,
+    camera_heights,
+    clock_offset_s,
+    clock_problem,
     depth_scale_problem,
     floor_problem,
     timestamp_problem,
@@ -132,6 +137,22 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
             sorted(idx.depth.stamps), f"{path}: --depth {opts.depth} ({opts.timestamps} times)",
             BAG_TIME_FIX), given=opts.timestamps != "header")
         check_depth_samples(idx, opts, findings)
+        checks: list[tuple[str, str]] = []
+        if opts.timestamps == "header" and src is not None and src.tree is not None:
+            offset = clock_offset_s([r - t for r, t in zip(idx.depth.received,
+                                                           idx.depth.stamps, strict=True)],
+                                    idx.tf_latency_ns)
+            if offset is not None:
+                checks.append(("clock", f"images recorded {offset:+.3f} s after their stamps "
+                               "relative to /tf"))
+            findings.problem(clock_problem(offset, f"{path}: --depth {opts.depth}"),
+                             given=opts.time_offset_ns != 0)
+        if src is not None:
+            fit = bag_scale_fit(reader, idx, opts, src, k)
+            if fit is not None:
+                checks.append(("depth scale against the poses", fit.describe()))
+            findings.problem(bag_scale_problem(fit, opts, src, _scale_origin(idx, opts)[1]),
+                             given=opts.depth_scale is not None)
         plan, notes = plan_frames(idx, src, opts, keep_unposed=estimate)
         if not plan:
             raise SgtoolError(
@@ -145,6 +166,12 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         pose_source = src.describe if src else "none"
         reference = f"the bag's poses ({src.describe})" if src else "none"
         if estimate:
+            if opts.floor is None and opts.floor_auto and opts.up is None:
+                # before the odometry: the floor of each sampled frame on its own
+                findings.problem(frame_floor_problem(
+                    [depth_to_metres(raw, _scale(raw, scale, opts))
+                     for raw, scale in idx.samples.values()], k, opts.camera_height),
+                    given=False)
             plan, drift, odo, pose_source = _estimate(reader, plan, idx, opts, k, src)
             meta.update(drift_metadata(drift, reference))
             meta.update(odometry_metadata(odo))
@@ -159,11 +186,17 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         ]
         alignment = estimate_alignment(poses, samples, up=opts.up,
                                        floor=opts.floor, floor_auto=opts.floor_auto)
+        findings.problem(floor_confidence_problem(
+            alignment.floor, alignment.floor_confidence, alignment.floor_method,
+            alignment.floor_detail, float(np.median(camera_heights(poses, alignment.matrix))),
+            opts.camera_height), given=False)
         if alignment.floor_method != "none":
             findings.problem(
                 floor_problem(poses, alignment.matrix, alignment.floor,
                               FLOOR_ORIGINS[alignment.floor_method], opts.camera_height),
                 given=alignment.floor_method not in ESTIMATED_FLOORS)
+        if alignment.floor_detail:
+            checks.append(("floor", alignment.floor_detail))
         sources = [("intrinsics", f"{k.fx:g},{k.fy:g},{k.cx:g},{k.cy:g}",
                     "flag --intrinsics" if opts.intrinsics is not None else
                     f"topic {opts.info}" + (f" ({opts.info_origin})" if opts.info_origin
@@ -184,7 +217,7 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         has_rgb=has_rgb, has_ids=has_ids, pose_source=pose_source, drift=drift,
         notes=tuple(notes), drift_reference=reference, sources=tuple(sources),
         warnings=tuple(findings.warnings), resizes=tuple(resizes.lines()),
-        resize_counts=tuple(resizes.as_dicts()),
+        resize_counts=tuple(resizes.as_dicts()), checks=tuple(checks),
         **odometry_report_fields(odo),
     )
 

@@ -28,6 +28,7 @@ from sgtool.recorders.importers.upright import sample_indices
 class ImageIndex:
     stamps: list[int] = field(default_factory=list)
     frames: list[str] = field(default_factory=list)
+    received: list[int] = field(default_factory=list)  # the bag's record times
 
 
 @dataclass
@@ -43,6 +44,8 @@ class BagIndex:
     info_changes: int = 0
     samples: dict[int, tuple[np.ndarray, float]] = field(default_factory=dict)  # depth k ->
     zero_stamps: int = 0
+    # record time minus header stamp of each dynamic /tf transform (ns)
+    tf_latency_ns: list[int] = field(default_factory=list)
 
 
 def _stamp_or_bagtime(header: Any, bag_t: int, idx: BagIndex, use_bag: bool = False) -> int:
@@ -75,6 +78,9 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
             mt = B.normalise_type(c.msgtype)
             if c.topic in tf_topics:
                 add_tf_message(idx.tf, msg, c.topic)
+                if not c.topic.rstrip("/").endswith("tf_static"):
+                    idx.tf_latency_ns.extend(int(bag_t) - stamp_ns(tr.header)
+                                             for tr in msg.transforms)
                 continue
             if c.topic == opts.pose:
                 t, parent, T = pose_of_message(msg, mt, c.topic)  # noqa: N806
@@ -92,9 +98,11 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
             for topic, ii in ((opts.depth, idx.depth), (opts.rgb, idx.rgb), (opts.ids, idx.ids)):
                 if topic is not None and c.topic == topic:
                     t = _stamp_or_bagtime(msg.header, bag_t, idx, opts.timestamps == "bag")
+                    t += opts.time_offset_ns
                     if topic == opts.depth and len(ii.stamps) in keep:
                         idx.samples[len(ii.stamps)] = decode_depth_message(msg, mt, topic)
                     ii.stamps.append(t)
+                    ii.received.append(int(bag_t))
                     ii.frames.append(frame_name(msg.header.frame_id))
     finally:
         bar.close()

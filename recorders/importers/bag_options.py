@@ -19,6 +19,8 @@ from sgtool.recorders.importers.checks import (
 from sgtool.recorders.importers.sanity import DEFAULT_CAMERA_HEIGHT
 from sgtool.recorders.importers.textformats import PinholeParams
 
+MAX_TIME_OFFSET_S = 3600.0  # --time-offset
+
 
 @dataclass(frozen=True)
 class BagOptions:
@@ -48,6 +50,7 @@ class BagOptions:
     timestamps: str = "header"  # image times: "header" stamps, or "bag" (record) times
     info_origin: str = ""  # how --info was chosen, when not given ("the only CameraInfo topic")
     allow_drop: bool = False  # depth images without a pose may be more than 10 %
+    time_offset_ns: int = 0  # added to the images' times (header stamps or record times)
 
 
 def check_options(opts: BagOptions) -> None:
@@ -61,6 +64,9 @@ def check_options(opts: BagOptions) -> None:
     check_positive(opts.depth_max, "--depth-max", "metres")
     check_non_negative(opts.max_dt_ns / 1e9, "--max-dt", "seconds")
     check_non_negative(opts.tf_tolerance_ns / 1e9, "--tf-tolerance", "seconds")
+    if abs(opts.time_offset_ns) > MAX_TIME_OFFSET_S * 1e9:
+        raise SgtoolError(f"--time-offset {opts.time_offset_ns / 1e9:g}: must be within "
+                          f"+-{MAX_TIME_OFFSET_S:g} seconds")
     if opts.pose is not None and opts.tf_frames is not None:
         raise SgtoolError(
             f"--tf-frames {':'.join(opts.tf_frames)} applies only to camera poses from the tf "

@@ -25,12 +25,13 @@ UP_ORIGINS = {
 }
 FLOOR_ORIGINS = {
     "given": "flag --floor",
+    "horizontal-plane": "estimate: the lowest large horizontal plane",
     "horizontal-surfaces": "estimate: the lowest upward-facing surfaces",
     "all-points": "estimate: the lowest depth points (few horizontal surfaces)",
     "none": "kept: not estimated (--floor none, or a trajectory without --floor)",
     "no-depth": "kept: not estimated (no valid depth point in the sampled frames)",
 }
-ESTIMATED_FLOORS = ("horizontal-surfaces", "all-points")
+ESTIMATED_FLOORS = ("horizontal-plane", "horizontal-surfaces", "all-points")
 
 
 def alignment_sources(a: WorldAlignment) -> list[tuple[str, str, str]]:

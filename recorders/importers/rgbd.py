@@ -37,6 +37,7 @@ from sgtool.recorders.importers.checks import (
     check_positive,
     check_range,
 )
+from sgtool.recorders.importers.floor import floor_confidence_problem, frame_floor_problem
 from sgtool.recorders.importers.images import (
     ResizeLog,
     colour_kind_problem,
@@ -63,11 +64,18 @@ from sgtool.recorders.importers.provenance import (
 )
 from sgtool.recorders.importers.sanity import (
     DEFAULT_CAMERA_HEIGHT,
+    camera_heights,
     depth_scale_problem,
     dropped_problem,
     floor_problem,
     no_depth_problem,
     principal_point_problem,
+)
+from sgtool.recorders.importers.scale_check import (
+    ScaleFit,
+    fit_scale,
+    geometric_scale_problem,
+    pair_indices,
 )
 from sgtool.recorders.importers.sink import (
     ImportFrame,
@@ -233,6 +241,20 @@ def run_odometry(
                                   times_ns=[f.time_ns for f in frames], progress=opts.progress)
 
 
+def check_scale_by_geometry(frames: list[FolderFrame], k: CameraIntrinsics, scale: float,
+                            origin: str, pose_source: str, findings: Findings,
+                            given: bool) -> ScaleFit | None:
+    """The depth scale against the metric poses (:mod:`.scale_check`), on a few pairs of
+    nearby frames, before any heavy work; the fit (None without a usable pair)."""
+    poses = [np.asarray(f.pose) for f in frames]
+    pairs = [(depth_to_metres(read_depth_file(frames[i].depth_path), scale),
+              depth_to_metres(read_depth_file(frames[j].depth_path), scale), poses[i], poses[j])
+             for i, j in pair_indices(poses)]
+    fit = fit_scale(pairs, k)
+    findings.problem(geometric_scale_problem(fit, scale, origin, pose_source), given=given)
+    return fit
+
+
 def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = None) -> ImportReport:
     """Import the RGB-D folder ``root`` into the log ``out`` (module doc) and return what
     was written; options and the folder's files are checked before any work, each problem
@@ -267,6 +289,12 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     findings.problem(depth_scale_problem(raws, scale, scale_origin),
                      given=opts.depth_scale is not None)
     k = camera_for(seq, opts, raws[0].shape[1], raws[0].shape[0], findings)
+    checks: list[tuple[str, str]] = []
+    if seq.pose_source != "none" and all(f.pose is not None for f in frames):
+        fit = check_scale_by_geometry(frames, k, scale, scale_origin, seq.pose_source,
+                                      findings, given=opts.depth_scale is not None)
+        checks.append(("depth scale against the poses",
+                       fit.describe() if fit else "no frame pair ICP could align"))
     intr_origin = "flag --intrinsics" if opts.intrinsics is not None else \
         (seq.intrinsics.source if seq.intrinsics is not None else "given")
     if opts.intrinsics is None and intr_origin.startswith("folder-name default"):
@@ -279,6 +307,10 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     reference = drift_reference(seq, opts.trajectory)
     source_poses = [f.pose for f in frames]
     if opts.estimate_poses or seq.pose_source == "none":
+        if opts.floor is None and opts.floor_auto and opts.up is None:
+            # before the odometry: the floor of each sampled frame on its own
+            findings.problem(frame_floor_problem([depth_to_metres(r, scale) for r in raws],
+                                                 k, opts.camera_height), given=False)
         # start at the first reference pose, so the estimate lives in the dataset's world
         odo = run_odometry(frames, k, scale, opts, source_poses[0], colour)
         poses = list(odo.poses)
@@ -297,11 +329,17 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
                for raw, i in zip(raws, picks, strict=True)]
     alignment = estimate_alignment(poses, samples, up=opts.up, floor=opts.floor,
                                    floor_auto=opts.floor_auto)
+    findings.problem(floor_confidence_problem(
+        alignment.floor, alignment.floor_confidence, alignment.floor_method,
+        alignment.floor_detail, float(np.median(camera_heights(poses, alignment.matrix))),
+        opts.camera_height), given=False)
     if alignment.floor_method != "none":
         findings.problem(
             floor_problem(poses, alignment.matrix, alignment.floor,
                           FLOOR_ORIGINS[alignment.floor_method], opts.camera_height),
             given=alignment.floor_method not in ESTIMATED_FLOORS)
+    if alignment.floor_detail:
+        checks.append(("floor", alignment.floor_detail))
     sources = [("intrinsics", f"{k.fx:g},{k.fy:g},{k.cx:g},{k.cy:g}", intr_origin),
                ("depth scale", f"{scale:g} units/m", scale_origin),
                *alignment_sources(alignment)]
@@ -340,5 +378,5 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         drift=drift, notes=tuple(notes), drift_reference=reference,
         sources=tuple(sources), warnings=tuple(findings.warnings),
         resizes=tuple(resizes.lines()), resize_counts=tuple(resizes.as_dicts()),
-        **odometry_report_fields(odo),
+        checks=tuple(checks), **odometry_report_fields(odo),
     )

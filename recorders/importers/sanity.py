@@ -221,8 +221,8 @@ def principal_point_problem(cx: float, cy: float, width: int, height: int,
         return None
     return (f"intrinsics ({origin}): the principal point ({cx:g}, {cy:g}) is far from the "
             f"centre ({width / 2:g}, {height / 2:g}) of the {width}x{height} depth images; they "
-            f"look like intrinsics of {_size(2 * cx)}x{_size(2 * cy)} images: give the intrinsics of "
-            f"{width}x{height} images with --intrinsics fx,fy,cx,cy")
+            f"look like intrinsics of {_size(2 * cx)}x{_size(2 * cy)} images: give the "
+            f"intrinsics of {width}x{height} images with --intrinsics fx,fy,cx,cy")
 
 
 MAX_DROPPED = 0.10  # share of the frames an import may drop without --allow-drop
@@ -237,3 +237,31 @@ def dropped_problem(dropped: int, total: int, why: str, fixes: str) -> str | Non
         return None
     return (f"{dropped} of {total} frames ({100 * dropped / total:.0f} %, more than "
             f"{100 * MAX_DROPPED:.0f} %) would be dropped: {why}; {fixes}")
+
+
+MAX_CLOCK_OFFSET_S = 0.05  # image stamps this much later than their record time vs /tf's
+
+
+def clock_offset_s(image_latency_ns: Sequence[int], tf_latency_ns: Sequence[int]
+                   ) -> float | None:
+    """How much earlier (s) than /tf the images were recorded relative to their stamps:
+    median(record - stamp) of the images minus that of the /tf transforms. A camera's
+    images arrive after their stamps (latency, > 0); images stamped later than /tf stamps
+    the same instant arrive "before" their stamps (< 0). None without both."""
+    if not image_latency_ns or not tf_latency_ns:
+        return None
+    return float(np.median(image_latency_ns) - np.median(tf_latency_ns)) / 1e9
+
+
+def clock_problem(offset_s: float | None, what: str) -> str | None:
+    """The problem of image stamps later than the bag recorded them, relative to /tf, by
+    more than :data:`MAX_CLOCK_OFFSET_S` (the images are then paired with poses from the
+    future), naming ``--time-offset`` with the shift that fits and ``--timestamps bag``;
+    None otherwise (a camera's latency, offset > 0, is not a clock error)."""
+    if offset_s is None or offset_s >= -MAX_CLOCK_OFFSET_S:
+        return None
+    return (f"{what}: the image stamps are {-offset_s:.3f} s later than the times the bag "
+            "recorded them, relative to /tf (by the bag's record times): the images would "
+            "take the poses of that much later; give --time-offset "
+            f"{offset_s:.3f} to shift the image times, or --timestamps bag to use the record "
+            "times")

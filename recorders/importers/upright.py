@@ -17,10 +17,9 @@ Up direction:
   degrees, so walls never enter and pixels at wall/floor corners (normals in between)
   drop out of the last pass.
 
-Floor height: the 1st percentile of the heights of upward-facing horizontal surface points
-(floor, tables), when there are enough of them, else the 1st percentile of all points: a
-robust "lowest surface" that ignores a few outliers. When the floor is not in view the
-lowest visible surface (a counter) is taken; ``--floor`` overrides.
+Floor height: the lowest large horizontal plane of the sampled frames, with a confidence
+(:mod:`.floor`); without any upward-facing surface, the 1st percentile of all points
+(``all-points``, confidence 0). ``--floor`` overrides.
 
 The transform and how it was found are recorded in the log metadata (``sgtool.import``).
 """
@@ -86,7 +85,9 @@ class WorldAlignment:
     floor: float  # source height of the floor along ``up`` (subtracted)
     up: tuple[float, float, float]  # the source world's up direction
     up_method: str  # "given", "camera-up", "horizontal-normals", "none"
-    floor_method: str  # "given", "none", "no-depth", "horizontal-surfaces", "all-points"
+    floor_method: str  # "given", "none", "no-depth", "horizontal-plane", "all-points"
+    floor_confidence: float = 1.0  # of an estimated floor (:mod:`.floor`); 1 when given
+    floor_detail: str = ""  # what the estimate is made of (:meth:`.FloorEstimate.describe`)
 
     @classmethod
     def identity(cls) -> WorldAlignment:
@@ -109,6 +110,7 @@ class WorldAlignment:
             "up_method": self.up_method,
             "floor_height_in_source": f"{self.floor:.4f}",
             "floor_method": self.floor_method,
+            **({"floor_estimate": self.floor_detail} if self.floor_detail else {}),
         }
 
 
@@ -219,10 +221,10 @@ def estimate_alignment(
         # depth frames given but without one valid point: say so, not "none"
         fl, floor_method = 0.0, "none" if not floor_auto or not samples else "no-depth"
     else:
-        h = pts @ u
-        upward = (nrm @ u) > np.cos(np.radians(20))
-        if upward.sum() >= max(100, 0.01 * len(pts)):
-            fl, floor_method = float(np.percentile(h[upward], 1.0)), "horizontal-surfaces"
-        else:
-            fl, floor_method = float(np.percentile(h, 1.0)), "all-points"
+        from sgtool.recorders.importers.floor import estimate_floor
+
+        est = estimate_floor(samples, u)
+        assert est is not None  # there are points
+        return WorldAlignment(R, est.height, (float(u[0]), float(u[1]), float(u[2])), up_method,
+                              est.method, est.confidence, est.describe())
     return WorldAlignment(R, fl, (float(u[0]), float(u[1]), float(u[2])), up_method, floor_method)

@@ -37,6 +37,15 @@ def _floor(text: str) -> tuple[float | None, bool]:
     return check_floor(value), False
 
 
+def _offset_ns(seconds: float) -> int:
+    """``--time-offset`` in seconds (finite) -> integer nanoseconds."""
+    import math
+
+    if not math.isfinite(seconds):
+        raise SgtoolError(f"--time-offset {seconds!r}: give a number of seconds")
+    return round(seconds * 1e9) if abs(seconds) < 1e6 else int(math.copysign(1e15, seconds))
+
+
 def _output(output: str | None, force: bool) -> Path:
     if not output:
         raise SgtoolError("give the output log with -o OUT.mcap")
@@ -175,6 +184,10 @@ def command() -> None:
               "times the bag recorded the messages.")
 @click.option("--tf-tolerance", type=float, default=0.05, show_default=True,
               help="How far (s) before/after a transform's samples a pose may be taken.")
+@click.option("--time-offset", type=float, default=0.0, show_default=True,
+              help="Seconds added to the image times before they are paired with poses "
+              "(a camera clock off from /tf's: image stamps later than the bag recorded them "
+              "are an error that names the offset that fits).")
 @_odometry_options(
     estimate_help="Estimate the camera poses by RGB-D odometry even when the bag has tf (the "
     "drift against the bag's poses is reported). Needs --depth. A bag without tf and without "
@@ -187,7 +200,7 @@ def command() -> None:
 @_common_options
 def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: str | None,
         tf_frames: str | None, pose: str | None, timestamps: str, tf_tolerance: float,
-        estimate_poses: bool,
+        time_offset: float, estimate_poses: bool,
         odometry: str, depth_max: float, list_only: bool,
         up: str, floor: str, camera_height: str, output: str | None, intrinsics: str | None,
         depth_scale: float | None, max_dt: float, every: int, limit: int | None,
@@ -233,6 +246,7 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
         compression=compression, estimate_poses=estimate_poses, odometry=odometry,
         depth_max=depth_max, camera_height=parse_height_band(camera_height), warn=_warn,
         timestamps=timestamps, allow_drop=allow_drop,
+        time_offset_ns=_offset_ns(time_offset),
     )
     check_options(opts)
     if not (depth or tf_frames or pose):

@@ -142,7 +142,7 @@ def test_report_says_where_each_parameter_came_from(tmp_path):
     assert "depth scale: 5000 units/m [dataset default: tum layout]" in lines
     assert any(x.startswith("up: (") and "[estimate: the normals of horizontal surfaces]" in x
                for x in lines)
-    assert any(x.startswith("floor: ") and "[estimate: the lowest upward-facing" in x
+    assert any(x.startswith("floor: ") and "[estimate: the lowest large horizontal plane" in x
                for x in lines)
     # the folder-name default is also a warning on stderr, before the work
     assert "sgtool: warning: intrinsics taken from the folder name" in r.output

@@ -23,8 +23,8 @@ from support.rgbd_folders import make_tum_folder
 from sgtool.cli import cli
 from sgtool.errors import SgtoolError
 from sgtool.recorders.importers.bag import BagOptions, import_bag
-from sgtool.recorders.importers.bagfiles import TopicInfo
 from sgtool.recorders.importers.bag_topics import suggest_flags
+from sgtool.recorders.importers.bagfiles import TopicInfo
 from sgtool.recorders.importers.images import decode_depth_message, header_kind
 from sgtool.recorders.importers.layouts import FolderSequence
 from sgtool.recorders.importers.provenance import Findings

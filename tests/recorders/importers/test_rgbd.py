@@ -133,7 +133,7 @@ def test_7scenes_ground_truth_and_z_up_world(rgbd_data, tmp_path):
     rep = import_rgbd(folder, out, RgbdOptions(**QUIET))
     assert rep.frames == 100 and rep.pose_source == "ground truth of the dataset"
     a = rep.alignment
-    assert a.up_method == "horizontal-normals" and a.floor_method == "horizontal-surfaces"
+    assert a.up_method == "horizontal-normals" and a.floor_method == "horizontal-plane"
     gt = [np.loadtxt(p) for p in sorted(folder.glob("frame-*.pose.txt"))]
     with LogReader(out) as r:
         A = alignment_of(r)  # noqa: N806

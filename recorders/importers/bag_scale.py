@@ -1,0 +1,63 @@
+"""The depth scale of a bag checked against its metric poses (``/tf`` or ``--pose``) before
+the frames are written: a few pairs of nearby 16-bit depth images are decoded (one pass over
+the depth topic, deserialising only those) and their ICP motion compared with the poses'
+(:mod:`.scale_check`)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from sgtool.log.frame import CameraIntrinsics
+from sgtool.recorders.importers import bagfiles as B
+from sgtool.recorders.importers.bag_index import BagIndex
+from sgtool.recorders.importers.bag_options import BagOptions
+from sgtool.recorders.importers.bag_poses import PoseSource
+from sgtool.recorders.importers.images import decode_depth_message, depth_to_metres
+from sgtool.recorders.importers.scale_check import (
+    ScaleFit,
+    fit_scale,
+    geometric_scale_problem,
+    pair_indices,
+)
+
+
+def bag_scale_fit(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
+                  k: CameraIntrinsics) -> ScaleFit | None:
+    """How far the 16-bit depth's geometry moves against the poses of ``src``
+    (:func:`~.scale_check.fit_scale`); None without a usable pair or for depth that is not
+    16-bit (metres need no scale)."""
+    if not idx.samples or next(iter(idx.samples.values()))[0].dtype != np.uint16:
+        return None
+    explicit = opts.tf_frames is not None or opts.pose is not None
+    posed: list[tuple[int, np.ndarray]] = []
+    for kk in sorted(range(len(idx.depth.stamps)), key=lambda i: idx.depth.stamps[i]):
+        T = src.at(idx.depth.stamps[kk], None if explicit else idx.depth.frames[kk])  # noqa: N806
+        if T is not None:
+            posed.append((kk, T))
+    pairs = pair_indices([T for _, T in posed])
+    if not pairs:
+        return None
+    need = {posed[i][0] for p in pairs for i in p}
+    got: dict[int, np.ndarray] = {}
+    count = 0
+    for c, _, raw in reader.messages(connections=B.connections_for(reader, str(opts.depth))):
+        if count in need:
+            a, scale = decode_depth_message(reader.deserialize(raw, c.msgtype),
+                                            B.normalise_type(c.msgtype), c.topic)
+            s = opts.depth_scale if opts.depth_scale and a.dtype == np.uint16 else scale
+            got[count] = depth_to_metres(a, s)
+            if len(got) == len(need):
+                break
+        count += 1
+    quads = [(got[posed[i][0]], got[posed[j][0]], posed[i][1], posed[j][1])
+             for i, j in pairs if posed[i][0] in got and posed[j][0] in got
+             and got[posed[i][0]].shape == (k.height, k.width)]
+    return fit_scale(quads, k)
+
+
+def bag_scale_problem(fit: ScaleFit | None, opts: BagOptions, src: PoseSource,
+                      origin: str) -> str | None:
+    """The problem of the fit (naming the ``--depth-scale`` that fits), or None."""
+    return geometric_scale_problem(fit, opts.depth_scale or 1000.0, origin, src.describe)

@@ -1,0 +1,154 @@
+"""The depth scale checked against metric poses: geometry must move as the poses do.
+
+Reading depth at a wrong scale ``s`` times too large scales every point cloud by ``s``, so
+the motion that aligns two nearby frames has ``s`` times the translation of the true
+motion, while poses from ground truth, a trajectory or ``/tf`` stay metric. For a few pairs
+of nearby frames (a sample spread over the sequence, each with its neighbour at least
+:data:`MIN_STEP_M` away), the poses' rotation is kept and only the factor on their
+translation is fitted, point-to-plane ICP style (a full 6-DoF ICP trades a small rotation for
+a translation on small steps and misjudges the length); that factor estimates ``s``. The
+scale that fits is ``scale * s`` (snapped to a usual scale within 10 %).
+
+Only a clear, consistent disagreement counts: ``s`` outside 1 +- :data:`TOLERANCE`, every
+pair's ratio within 35 % of it, at least two pairs, and ``s`` between 0.2 and 20 (geometry
+that barely moves, a scene that cannot pin the motion down, gives no verdict).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from sgtool.log.frame import CameraIntrinsics
+from sgtool.recorders.importers.sanity import KNOWN_SCALES
+
+MIN_STEP_M = 0.02  # pose translation of a pair (m)
+MAX_GAP = 6  # frames to look ahead for a neighbour far enough away
+TOLERANCE = 0.2  # |s - 1| a scale may be off without a verdict
+PAIRS = 6
+
+
+@dataclass(frozen=True)
+class ScaleFit:
+    """The ratio of geometric to pose translation over ``pairs`` frame pairs, and how far
+    the single pairs' ratios spread (max relative deviation from ``ratio``)."""
+
+    ratio: float
+    pairs: int
+    spread: float
+
+    def describe(self) -> str:
+        return (f"depth moves {self.ratio:.2f}x as far as the poses over {self.pairs} frame "
+                f"pairs (spread {self.spread:.2f})")
+
+    def consistent(self) -> bool:
+        return self.pairs >= 2 and self.spread <= 0.35 and 0.2 < self.ratio < 20.0
+
+
+def pair_indices(poses: Sequence[np.ndarray], n_pairs: int = PAIRS) -> list[tuple[int, int]]:
+    """(i, j) frame pairs spread over the sequence: j the first frame after i at least
+    :data:`MIN_STEP_M` away (within :data:`MAX_GAP` frames)."""
+    n = len(poses)
+    if n < 2:
+        return []
+    out = []
+    for i in np.unique(np.linspace(0, n - 2, min(n_pairs, n - 1)).round().astype(int)):
+        for j in range(i + 1, min(n, i + 1 + MAX_GAP)):
+            if np.linalg.norm(poses[j][:3, 3] - poses[i][:3, 3]) >= MIN_STEP_M:
+                out.append((int(i), j))
+                break
+    return out
+
+
+def translation_scale(d0: np.ndarray, d1: np.ndarray, k: CameraIntrinsics,
+                      rel: np.ndarray) -> tuple[float, float, float] | None:
+    """The factor ``s`` on the poses' translation that best aligns frame j's points with
+    frame i's surfaces, the poses' rotation kept: point-to-plane residuals
+    ``n . (R p + s t - q)`` are linear in ``s``, solved by least squares over nearest
+    neighbours within 10, 4 then 2 % of the median depth (so the check does not depend on
+    the scale it checks), 5 rounds each. Returns (s, share of points matched, RMS of the
+    translation along the matched normals in metres at the scale checked: how much the
+    pair says about ``s``); None without enough points."""
+    from scipy.spatial import cKDTree
+
+    from sgtool.recorders.importers.upright import DepthSample, surface_points
+
+    eye = np.eye(4)
+    stride = max(1, d0.shape[1] // 160)
+    q, nq = surface_points(DepthSample(d0, k, eye), stride=stride)
+    p, _ = surface_points(DepthSample(d1, k, eye), stride=stride)
+    if len(q) < 50 or len(p) < 50:
+        return None
+    med = float(np.median(q[:, 2]))
+    R, t = rel[:3, :3], rel[:3, 3]  # noqa: N806
+    pr = p @ R.T
+    tree = cKDTree(q)
+    s_fit = 1.0
+    ok = np.zeros(len(p), bool)
+    b = np.zeros(0)
+    for frac in (0.10, 0.04, 0.02):
+        for _ in range(5):
+            dist, idx = tree.query(pr + s_fit * t, distance_upper_bound=frac * med)
+            ok = np.isfinite(dist)
+            if ok.sum() < 50:
+                return None
+            n = nq[idx[ok]]
+            a = np.einsum("ij,ij->i", n, pr[ok] - q[idx[ok]])
+            b = n @ t
+            den = float(b @ b)
+            if den <= 0:
+                return None
+            s_fit = -float(a @ b) / den
+    return s_fit, float(ok.mean()), float(np.sqrt(np.mean(b**2)))
+
+
+MIN_MATCHED = 0.3  # share of a pair's points matched
+MIN_ALONG_M = 0.005  # RMS pose translation along the matched normals
+
+
+def fit_scale(pairs: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]],
+              k: CameraIntrinsics) -> ScaleFit | None:
+    """The fit over ``(depth_i, depth_j, pose_i, pose_j)`` (depth in metres at the scale
+    checked; world_T_camera poses): :func:`translation_scale` per pair, pairs matched under
+    :data:`MIN_MATCHED` or moving under :data:`MIN_ALONG_M` along the surfaces' normals
+    left out, the rest combined weighted by that motion; None without a usable pair."""
+    ratios, weights = [], []
+    for d0, d1, p0, p1 in pairs:
+        rel = np.linalg.inv(p0) @ p1  # camera j in camera i
+        if float(np.linalg.norm(rel[:3, 3])) < MIN_STEP_M:
+            continue
+        got = translation_scale(d0, d1, k, rel)
+        if got is None or got[1] < MIN_MATCHED or got[2] < MIN_ALONG_M:
+            continue
+        ratios.append(got[0])
+        weights.append(got[2] ** 2)
+    if not ratios:
+        return None
+    r = float(np.average(ratios, weights=weights))
+    spread = max(abs(x / r - 1.0) for x in ratios) if r > 0 else float("inf")
+    return ScaleFit(r, len(ratios), spread)
+
+
+def snap_scale(value: float) -> float:
+    """A usual depth scale within 10 % of ``value``, else ``value`` to 2 significant
+    digits."""
+    for s in KNOWN_SCALES:
+        if abs(value / s - 1.0) <= 0.10:
+            return s
+    return float(f"{value:.2g}")
+
+
+def geometric_scale_problem(fit: ScaleFit | None, scale: float, origin: str,
+                            pose_source: str) -> str | None:
+    """The problem of depth at ``scale`` units/m (from ``origin``) whose geometry moves
+    ``fit.ratio`` times as far as the metric poses (``pose_source``) say, naming the scale
+    that fits; None without a clear, consistent disagreement."""
+    if fit is None or not fit.consistent() or abs(fit.ratio - 1.0) <= TOLERANCE:
+        return None
+    fits = snap_scale(scale * fit.ratio)
+    return (f"depth scale {scale:g} units/m ({origin}) disagrees with the {pose_source}: "
+            f"between {fit.pairs} pairs of nearby frames the depth geometry moves "
+            f"{fit.ratio:.2f}x as far as the poses (the poses' translation fitted to the depth); "
+            f"--depth-scale {fits:g} fits; give it, or --depth-scale {scale:g} to keep this one")

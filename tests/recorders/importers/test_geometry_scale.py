@@ -1,0 +1,115 @@
+"""The depth scale checked against metric poses: depth in 0.1 mm units read at TUM's 5000
+units/m looks indoor by its statistics (2x too deep) but moves twice as far as the ground
+truth between nearby frames; the error names --depth-scale 10000, which imports."""
+
+from __future__ import annotations
+
+import pytest
+from support.rgbd_scenes import look_at, make_scene_folder, room
+
+from sgtool.errors import SgtoolError
+from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
+from sgtool.recorders.importers.scale_check import ScaleFit, geometric_scale_problem, snap_scale
+from sgtool.recorders.importers.textformats import PinholeParams
+
+K = PinholeParams(60.0, 60.0, 39.5, 29.5)
+# 20 frames walking 2.2 cm a frame through a 5 x 4 m room while turning
+POSES = [look_at((-1.0 + 0.02 * i, -0.5 + 0.01 * i, 1.4), (2.5, 1.0 - 0.03 * i, 0.5))
+         for i in range(20)]
+
+
+def test_tenth_millimetre_depth_names_the_scale_that_fits(tmp_path):
+    root = make_scene_folder(tmp_path / "f", room(), POSES, units_per_m=10000.0)
+    with pytest.raises(SgtoolError, match=r"depth scale 5000 units/m \(dataset default: tum "
+                       r"layout\) disagrees with the ground truth: between 6 pairs .* moves "
+                       r"2.0\dx as far as the poses.*--depth-scale 10000 fits"):
+        import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
+    assert not (tmp_path / "a.mcap").exists()
+    rep = import_rgbd(root, tmp_path / "b.mcap", RgbdOptions(intrinsics=K, progress=False,
+                                                             depth_scale=10000.0))
+    assert rep.frames == 20 and rep.warnings == ()
+    assert abs(rep.alignment.floor) < 0.01  # the true room: the floor at 0, camera 1.4 m up
+
+
+def test_the_right_scale_passes(tmp_path):
+    root = make_scene_folder(tmp_path / "f", room(), POSES, units_per_m=5000.0)
+    rep = import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
+    assert rep.frames == 20 and rep.warnings == ()
+
+
+def test_no_verdict_without_a_clear_consistent_ratio():
+    assert geometric_scale_problem(None, 1000.0, "x", "ground truth") is None
+    # geometry that does not move (a static scene under moving poses): no verdict
+    assert geometric_scale_problem(ScaleFit(0.02, 6, 0.1), 1000.0, "x", "gt") is None
+    assert geometric_scale_problem(ScaleFit(2.0, 6, 0.9), 1000.0, "x", "gt") is None  # spread
+    assert geometric_scale_problem(ScaleFit(1.1, 6, 0.1), 1000.0, "x", "gt") is None
+    p = geometric_scale_problem(ScaleFit(0.2, 6, 0.1), 1000.0, "x", "gt")
+    assert p is None  # at the bound: no verdict
+    assert "--depth-scale 5000 fits" in str(
+        geometric_scale_problem(ScaleFit(4.9, 6, 0.1), 1000.0, "x", "gt"))
+    assert snap_scale(9700.0) == 10000.0 and snap_scale(2345.0) == 2300.0
+
+
+def test_bag_depth_at_half_millimetres_names_the_scale_that_fits(tmp_path):
+    """16UC1 depth in 0.5 mm units (ROS says millimetres): 2x too deep, still indoor by its
+    statistics; the /tf poses say otherwise."""
+    from support.bag_export import BagWriter
+    from support.rgbd_scenes import K as SK
+    from support.rgbd_scenes import render
+
+    from sgtool.recorders.importers.bag import BagOptions, import_bag
+
+    bag = tmp_path / "b.bag"
+    t0, dt = 1_700_000_000_000_000_000, 33_000_000
+    with BagWriter(bag, "ros1") as w:
+        for i, pose in enumerate(POSES):
+            t = t0 + i * dt
+            w.write("/tf", "tf2_msgs/msg/TFMessage", t,
+                    w.tf(t, [w.transform_stamped(t, "map", "cam", pose)]))
+            w.write("/info", "sensor_msgs/msg/CameraInfo", t, w.camera_info(t, "cam", SK))
+            raw = (render(room(), pose) * 2000).round().astype("uint16")
+            w.write("/depth", "sensor_msgs/msg/Image", t, w.image(t, "cam", raw, "16UC1"))
+    opts = dict(depth="/depth", info="/info", progress=False)
+    with pytest.raises(SgtoolError, match=r"depth scale 1000 units/m \(the image encoding.*\) "
+                       r"disagrees with the tf map -> cam: .* moves 2.0\dx as far.*"
+                       r"--depth-scale 2000 fits"):
+        import_bag(bag, tmp_path / "a.mcap", BagOptions(**opts))
+    rep = import_bag(bag, tmp_path / "b.mcap", BagOptions(depth_scale=2000.0, **opts))
+    assert rep.frames == 20 and rep.warnings == ()
+
+
+def test_real_icl_pixels_in_tenth_millimetres_name_10000(shared_data_dir, tmp_path):
+    """ICL-NUIM livingroom frames (mm) re-written in 0.1 mm units as a TUM folder with their
+    trajectory as ground truth: read at TUM's 5000 they look indoor (2x deep), and the
+    geometry names --depth-scale 10000."""
+    import cv2
+    import numpy as np
+
+    from sgtool.recorders.importers.poses import tq_from_pose
+    from sgtool.recorders.importers.textformats import read_open3d_log
+
+    icl = shared_data_dir / "rgbd" / "icl-livingroom1-micro"
+    poses = read_open3d_log(icl / "open3d_estimated_trajectory.log")[:40]
+    root = tmp_path / "icl_tum"
+    (root / "depth").mkdir(parents=True)
+    (root / "rgb").mkdir()
+    rgb_l, depth_l, gt = [], [], []
+    for i, pose in enumerate(poses):
+        t = 100.0 + i / 30
+        mm = cv2.imread(str(icl / "depth" / f"{i:05d}.png"), cv2.IMREAD_UNCHANGED)
+        cv2.imwrite(str(root / "depth" / f"{i:05d}.png"),
+                    (mm.astype(np.uint32) * 10).clip(0, 65535).astype(np.uint16))
+        (root / "rgb" / f"{i:05d}.jpg").write_bytes((icl / "image" / f"{i:05d}.jpg").read_bytes())
+        rgb_l.append(f"{t:.6f} rgb/{i:05d}.jpg")
+        depth_l.append(f"{t:.6f} depth/{i:05d}.png")
+        tr, q = tq_from_pose(pose)
+        gt.append(f"{t:.6f} " + " ".join(f"{v:.9f}" for v in (*tr, *q)))
+    for name, lines in (("rgb.txt", rgb_l), ("depth.txt", depth_l), ("groundtruth.txt", gt)):
+        (root / name).write_text("\n".join(lines) + "\n")
+    k = PinholeParams(525.0, 525.0, 319.5, 239.5)
+    with pytest.raises(SgtoolError, match=r"depth scale 5000 units/m .* disagrees with the "
+                       r"ground truth.*--depth-scale 10000 fits"):
+        import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=k, progress=False))
+    rep = import_rgbd(root, tmp_path / "b.mcap", RgbdOptions(intrinsics=k, progress=False,
+                                                             depth_scale=10000.0))
+    assert rep.frames == 40 and rep.warnings == ()
