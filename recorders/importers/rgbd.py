@@ -294,7 +294,7 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         fit = check_scale_by_geometry(frames, k, scale, scale_origin, seq.pose_source,
                                       findings, given=opts.depth_scale is not None)
         checks.append(("depth scale against the poses",
-                       fit.describe() if fit else "no frame pair ICP could align"))
+                       fit.describe() if fit else "no verdict: no frame pair pins the motion down"))
     intr_origin = "flag --intrinsics" if opts.intrinsics is not None else \
         (seq.intrinsics.source if seq.intrinsics is not None else "given")
     if opts.intrinsics is None and intr_origin.startswith("folder-name default"):

@@ -48,6 +48,14 @@ def test_the_floor_in_view_is_found_with_confidence(tmp_path):
     a = rep.alignment
     assert a.floor_method == "horizontal-plane"
     assert abs(a.floor) < 0.005 and a.floor_confidence >= 0.9
+    # the report says what the floor and the scale checks found
+    checks = dict(rep.checks)
+    assert checks["floor"].startswith("confidence 1.00: ")
+    assert "camera 1.25 m above it" in checks["floor"]
+    # a camera sliding sideways past walls it faces: nothing to judge the scale by
+    assert checks["depth scale against the poses"] == ("no verdict: no frame pair pins the "
+                                                       "motion down")
+    assert any(line.startswith("check: floor: confidence") for line in rep.lines())
 
 
 def test_no_horizontal_surface_is_an_error_not_a_fallback(tmp_path):

@@ -35,6 +35,8 @@ def test_the_right_scale_passes(tmp_path):
     root = make_scene_folder(tmp_path / "f", room(), POSES, units_per_m=5000.0)
     rep = import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
     assert rep.frames == 20 and rep.warnings == ()
+    assert dict(rep.checks)["depth scale against the poses"].startswith(
+        "depth moves 1.00x as far as the poses over 6 frame pairs")
 
 
 def test_no_verdict_without_a_clear_consistent_ratio():
