@@ -22,6 +22,8 @@ import argparse
 import statistics
 import time
 
+from harness import add_output_options, emit, timed
+
 from sgtool.commands.options import parse_rooms
 from sgtool.datasets.episode_mix import symsearch_episodes
 from sgtool.datasets.episodes import list_episodes
@@ -48,14 +50,17 @@ def main() -> None:
     ap.add_argument("--planners", default="random,greedy,sbert,scout")
     ap.add_argument("--rooms", default=None, help="MIN-MAX for every preset")
     ap.add_argument("--no-bench", action="store_true", help="figures only, no roll-outs")
-    a = ap.parse_args()
+    a = add_output_options(ap).parse_args()
+    doc: dict[str, dict] = {}
     unseen = frozenset(category_text(q) for q in unseen_queries())
     planners = {n: make_planner(n) for n in a.planners.split(",") if n}
     for preset in a.presets.split(","):
         rooms = parse_rooms(a.rooms) if a.rooms else ROOMS[preset]
-        t0 = time.perf_counter()
-        specs = [generate_house(s, rooms=rooms, preset=preset) for s in range(a.houses)]
-        ms = (time.perf_counter() - t0) / a.houses * 1000
+        specs, gen = timed(lambda rooms=rooms, preset=preset: [
+            generate_house(s, rooms=rooms, preset=preset) for s in range(a.houses)])
+        ms = gen.wall_s / a.houses * 1000
+        doc[preset] = {"rooms": list(rooms), "generation": gen, "ms_per_house": ms,
+                       "sr": {}}
         st = house_stats(specs)
         eps = {s.seed: (symsearch_episodes(s, a.episodes, seed=s.seed) if preset == "symsearch"
                         else list_episodes(s, a.episodes, seed=s.seed)) for s in specs}
@@ -68,6 +73,8 @@ def main() -> None:
               f"{st.object_categories_per_scene:.1f}, contained/scene "
               f"{st.contained_per_scene:.1f}, furniture/scene {st.furniture_per_scene:.1f}")
         n_unseen = sum(category_text(e.query) in unseen for e in flat)
+        doc[preset]["episodes"] = len(flat)
+        doc[preset]["unseen_share"] = n_unseen / len(flat)
         print(f"episodes {len(flat)}: unseen queries {n_unseen / len(flat):.3f} "
               f"(small-object episodes: {sum(small) / max(len(small), 1):.3f}), furniture "
               f"targets {sum(furn) / len(flat):.3f}, hidden "
@@ -93,12 +100,14 @@ def main() -> None:
                         ok.append(r.success)
                 per_seed.append(sum(ok) / len(ok))
             sd = statistics.pstdev(per_seed) if len(per_seed) > 1 else 0.0
+            doc[preset]["sr"][name] = {"per_seed": per_seed, "mean": statistics.mean(per_seed)}
             print(f"  {name:<8} SR {statistics.mean(per_seed):.3f} ± {sd:.3f}  seen "
                   f"{_rate([s for s, se, _ in rows if se])}  unseen "
                   f"{_rate([s for s, se, _ in rows if not se])}  furniture "
                   f"{_rate([s for s, _, f in rows if f])}  small "
                   f"{_rate([s for s, _, f in rows if not f])}  "
                   f"[{time.perf_counter() - t1:.0f} s]", flush=True)
+    emit(doc, a.json_out)
 
 
 if __name__ == "__main__":
