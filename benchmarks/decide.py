@@ -25,6 +25,7 @@ import statistics
 import time
 
 import numpy as np
+from harness import add_output_options, emit
 
 from sgtool.llm.client import ChatResult
 from sgtool.planning.base import Feedback
@@ -162,7 +163,8 @@ def run(name: str, episodes: int, fresh: bool) -> list[float]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--episodes", type=int, default=10)
-    args = ap.parse_args()
+    args = add_output_options(ap).parse_args()
+    rows: dict[str, dict[str, float]] = {}
     from sgtool.semantics.encoder import default_encoder
 
     parts, _ = house(0)
@@ -184,6 +186,9 @@ def main() -> None:
         p90 = float(np.percentile(warm, 90))
         print(f"{name:<14} {statistics.median(warm) * 1e3:>9.3f} ms {p90 * 1e3:>7.3f} ms "
               f"{statistics.median(first) * 1e3:>12.3f} ms {len(warm):>7}")
+        rows[name] = {"warm_median_s": statistics.median(warm), "warm_p90_s": p90,
+                      "first_median_s": statistics.median(first), "warm_decisions": len(warm)}
+    emit({"episodes": args.episodes, "planners": rows}, args.json_out)
 
 
 if __name__ == "__main__":
