@@ -31,6 +31,8 @@ import time
 import tracemalloc
 from pathlib import Path
 
+from harness import add_output_options, emit, timed
+
 from sgtool.datasets.generator import generate_house
 from sgtool.house.io import load_house
 from sgtool.log import LogReader
@@ -69,8 +71,9 @@ def main(argv: list[str] | None = None) -> int:
                     default=Path(tempfile.gettempdir()) / "sgtool-bench-replay")
     ap.add_argument("--frames", type=int, default=None,
                     help="record only the first N frames (default: the whole tour)")
-    a = ap.parse_args(argv)
+    a = add_output_options(ap).parse_args(argv)
     opts = ReplayOptions(every=a.every)
+    doc: dict[str, dict] = {}
     for seed in (int(s) for s in a.seeds.split(",")):
         log = recorded(seed, a.fps, a.cache, a.frames)
         pairs: list[tuple[float, float]] = []
@@ -89,9 +92,8 @@ def main(argv: list[str] | None = None) -> int:
         out1 = a.cache / f"derived{seed}_a.mcap"
         out2 = a.cache / f"derived{seed}_b.mcap"
         rep = replay(log, out1, opts, on_refresh=on_refresh)
-        t0 = time.perf_counter()
-        rep2 = replay(log, out2, opts)
-        wall2 = time.perf_counter() - t0
+        rep2, second = timed(lambda log=log, out2=out2: replay(log, out2, opts))
+        wall2 = second.wall_s
         same = sha(out1) == sha(out2)
         tracemalloc.start()
         replay(log, None, opts)
@@ -125,6 +127,11 @@ def main(argv: list[str] | None = None) -> int:
               f"{len(g.doors)} doors")
         for line in score_lines(q):
             print(line)
+        doc[str(seed)] = {"frames": rep.frames, "refreshes": rep.refreshes,
+                          "integration_s": integ, "refresh_s": refresh,
+                          "second_replay": second, "peak_traced_mib": peak / 2**20,
+                          "byte_identical": same, "refresh_pairs_ms": pairs}
+    emit(doc, a.json_out)
     return 0
 
 
