@@ -39,7 +39,7 @@ def command(out_dir: str, frames: int | None, houses: int, episodes: int, seeds:
     (scored against the house, with a Rerun recording), then benchmark planners on the
     symbolic benchmark and print its table. Outputs go to OUT (overwritten)."""
     from sgtool.analysis.demo_pipeline import DemoRequest, run_demo
-    from sgtool.commands.replay import write_view
+    from sgtool.analysis.replay_run import write_view
 
     out = Path(out_dir)
     if out.exists() and not out.is_dir():

@@ -1,23 +1,34 @@
 """``sgtool replay LOG -o derived.mcap``: rebuild the scene graph of a log, frame by frame.
 
-The work is done in :mod:`sgtool.replayers`; this module parses options, shows a progress
-bar, prints the report, the per-stage timings and, with ``--score``, the quality of the
-final graph against the house the log was recorded in.
+The work is done in :mod:`sgtool.analysis.replay_run` (on :mod:`sgtool.replayers`); this
+module parses the options, checks the outputs and the input log, and hands a request over:
+one log (with a progress bar, the report, the per-stage timings and, with ``--score``, the
+quality of the final graph against the house the log was recorded in) or, with
+``--out-dir``, many.
 """
 
 from __future__ import annotations
 
-import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
-from sgtool.commands.options import executor_options, llm_endpoint_options
+from sgtool.commands.options import (
+    check_log_output,
+    check_output,
+    executor_options,
+    llm_endpoint_options,
+)
 from sgtool.commands.room_llm import LlmOptions
 from sgtool.errors import SgtoolError
 from sgtool.scenegraph.options import CLASSIFIERS
+
+if TYPE_CHECKING:
+    from sgtool.analysis.replay_run import BatchReplayRequest, ReplayRequest
+    from sgtool.replayers.derived_log import ReplayOptions
 
 
 @click.command("replay")
@@ -85,16 +96,7 @@ from sgtool.scenegraph.options import CLASSIFIERS
               "--force replays all into a folder beside DIR, moved in complete, replacing "
               "what sgtool wrote there and keeping other files.")
 @executor_options("replays (one per log, with --out-dir)")
-def command(logs: tuple[str, ...], output: str | None, every: int | None,
-            classifier: str | None, min_points: int | None, voxel_size: float | None,
-            max_frames: int | None, rrd: str | None, score: bool, as_json: bool, force: bool,
-            progress: bool | None, out_dir: str | None = None, executor: str = "local",
-            workers: int = 1, ray_address: str | None = None, verify: bool = False,
-            llm_base_url: str | None = None, llm_model: str | None = None,
-            llm_api_key: str | None = None, llm_timeout: float = 60.0,
-            llm_constraint: str = "auto", llm_replay: tuple[str, ...] = (),
-            llm_transcript: str | None = None, tf_time: str = "log",
-            rerun_to: str | None = None) -> None:
+def command(**given: Any) -> None:
     """Replay LOG into a semantic voxel map, BEV occupancy, a Voronoi graph, rooms, objects,
     frontiers and the hierarchical scene graph, deterministically: the same log and options
     give a byte-identical output.
@@ -118,52 +120,130 @@ def command(logs: tuple[str, ...], output: str | None, every: int | None,
     log time (frames are told apart by log time, so they would merge). A damaged log is
     refused too; `sgtool doctor LOG --recover OUT` copies what is readable.
     """
-    from tqdm import tqdm
+    args = ReplayArgs(**given)
+    if args.out_dir is not None or len(args.logs) > 1 or Path(args.logs[0]).is_dir():
+        from sgtool.analysis.replay_run import replay_many
 
-    from sgtool.log import LogReader
-    from sgtool.replayers.derived_log import ReplayOptions, replay
-
-    llm = LlmOptions(llm_base_url, llm_model, llm_api_key, llm_timeout, llm_constraint,
-                     llm_replay, llm_transcript)
-    if out_dir is not None or len(logs) > 1 or Path(logs[0]).is_dir():
-        if llm.given() or classifier == "llm":
-            raise SgtoolError("--classifier llm and the --llm-* options replay one log at a "
-                              "time; leave out --out-dir")
-        if out_dir is None:
-            raise SgtoolError("several logs (or a folder) replay into a folder: give "
-                              "--out-dir DIR")
-        for given, opt in ((output, "-o"), (rrd, "--rrd"), (score, "--score"),
-                           (rerun_to, "--rerun")):
-            if given:
-                raise SgtoolError(f"{opt} takes one log; leave it out with --out-dir")
-        _batch(logs, Path(out_dir), ReplayOptions(
-            every=every, classifier=classifier, min_points=min_points, voxel_size=voxel_size,
-            max_frames=max_frames, tf_time=tf_time), force=force, as_json=as_json,
-            progress=progress, executor=executor, workers=workers, ray_address=ray_address,
-            verify=verify)
+        replay_many(_batch_request(args), show=click.echo)
         return
-    if executor != "local" or workers != 1 or ray_address:
+    from sgtool.analysis.replay_run import replay_one
+
+    replay_one(_request(args), show=click.echo, note=lambda m: click.echo(m, err=True))
+
+
+@dataclass(frozen=True)
+class ReplayArgs:
+    """The options of `sgtool replay` as given (the click parameters, by name)."""
+
+    logs: tuple[str, ...]
+    output: str | None
+    every: int | None
+    classifier: str | None
+    min_points: int | None
+    voxel_size: float | None
+    max_frames: int | None
+    rrd: str | None
+    score: bool
+    as_json: bool
+    force: bool
+    progress: bool | None
+    out_dir: str | None = None
+    executor: str = "local"
+    workers: int = 1
+    ray_address: str | None = None
+    verify: bool = False
+    llm_base_url: str | None = None
+    llm_model: str | None = None
+    llm_api_key: str | None = None
+    llm_timeout: float = 60.0
+    llm_constraint: str = "auto"
+    llm_replay: tuple[str, ...] = ()
+    llm_transcript: str | None = None
+    tf_time: str = "log"
+    rerun_to: str | None = None
+
+    def llm(self) -> LlmOptions:
+        """The ``--llm-*`` options of ``--classifier llm``."""
+        return LlmOptions(self.llm_base_url, self.llm_model, self.llm_api_key,
+                          self.llm_timeout, self.llm_constraint, self.llm_replay,
+                          self.llm_transcript)
+
+    def show_progress(self) -> bool:
+        """``--progress/--no-progress``, else whether stderr is a terminal."""
+        return self.progress if self.progress is not None else sys.stderr.isatty()
+
+
+def _options(args: ReplayArgs) -> ReplayOptions:
+    """The replay options, ``--voxel-size`` checked."""
+    from sgtool.replayers.derived_log import ReplayOptions
+
+    if args.voxel_size is not None and not 0.01 <= args.voxel_size <= 0.5:
+        raise SgtoolError(f"--voxel-size {args.voxel_size}: must be 0.01..0.5 m")
+    return ReplayOptions(every=args.every, classifier=args.classifier,
+                         min_points=args.min_points, voxel_size=args.voxel_size,
+                         max_frames=args.max_frames, tf_time=args.tf_time)
+
+
+def _batch_request(args: ReplayArgs) -> BatchReplayRequest:
+    """The checks of ``--out-dir``: no one-log option, then the replay options."""
+    from sgtool.analysis.replay_run import BatchReplayRequest
+
+    if args.llm().given() or args.classifier == "llm":
+        raise SgtoolError("--classifier llm and the --llm-* options replay one log at a "
+                          "time; leave out --out-dir")
+    if args.out_dir is None:
+        raise SgtoolError("several logs (or a folder) replay into a folder: give "
+                          "--out-dir DIR")
+    for given, opt in ((args.output, "-o"), (args.rrd, "--rrd"), (args.score, "--score"),
+                       (args.rerun_to, "--rerun")):
+        if given:
+            raise SgtoolError(f"{opt} takes one log; leave it out with --out-dir")
+    return BatchReplayRequest(
+        logs=args.logs, out_dir=Path(args.out_dir), options=_options(args), force=args.force,
+        as_json=args.as_json, progress=args.show_progress(), executor=args.executor,
+        workers=args.workers, ray_address=args.ray_address, verify=args.verify)
+
+
+def _request(args: ReplayArgs) -> ReplayRequest:
+    """The checks of one log: the mode, the outputs (the one output check), the options,
+    then the input log (sgtool's, with a house spec when scored)."""
+    from sgtool.analysis.replay_run import ReplayRequest
+
+    if args.executor != "local" or args.workers != 1 or args.ray_address:
         raise SgtoolError("--executor, --workers and --ray-address run many logs: give "
                           "--out-dir DIR")
-    src = Path(logs[0])
-    dst = Path(output) if output else None
+    src = Path(args.logs[0])
     if not src.exists():
         raise SgtoolError(f"{src}: no such file")
-    if dst is None and rrd:
+    dst = _outputs(args, src)
+    opts = _options(args)
+    frames, house = _read_input(src, args.score)
+    if args.max_frames is not None:
+        frames = min(frames, args.max_frames)
+    return ReplayRequest(log=src, output=dst, options=opts, rooms=args.llm().room_classifier,
+                         frames=frames, house=house, rrd=args.rrd, rerun_to=args.rerun_to,
+                         as_json=args.as_json, progress=args.show_progress(),
+                         verify=args.verify)
+
+
+def _outputs(args: ReplayArgs, src: Path) -> Path | None:
+    """``-o`` (a log) and ``--rrd``: neither the input log, each through the one output
+    check; ``--rrd`` needs ``-o``."""
+    if args.output is None and args.rrd:
         raise SgtoolError("--rrd views the derived log: give -o derived.mcap as well")
-    for p, opt in ((dst, "-o"), (Path(rrd) if rrd else None, "--rrd")):
-        if p is None:
-            continue
-        if p.resolve() == src.resolve():
-            raise SgtoolError(f"{opt} {p}: the output must not be the input log")
-        if p.exists() and not force:
-            raise SgtoolError(f"{p} exists; not overwriting it (use --force)")
-        if not p.parent.exists():
-            raise SgtoolError(f"{opt} {p}: folder {p.parent} does not exist")
-    if dst is not None and dst.suffix != ".mcap":
-        raise SgtoolError(f"-o {dst}: the output is an MCAP log; name it *.mcap")
-    if voxel_size is not None and not 0.01 <= voxel_size <= 0.5:
-        raise SgtoolError(f"--voxel-size {voxel_size}: must be 0.01..0.5 m")
+    for given, opt in ((args.output, "-o"), (args.rrd, "--rrd")):
+        if given and Path(given).resolve() == src.resolve():
+            raise SgtoolError(f"{opt} {given}: the output must not be the input log")
+    dst = check_log_output(args.output, force=args.force) if args.output else None
+    if args.rrd:
+        check_output(args.rrd, force=args.force, option="--rrd")
+    return dst
+
+
+def _read_input(src: Path, score: bool) -> tuple[int, Any]:
+    """(frames, house spec or None) of the input log: an sgtool log (a foreign one is
+    refused naming what it is), with a house spec when ``score``."""
+    from sgtool.log import LogReader
     from sgtool.log.inspect import foreign_log_problem
 
     if (foreign := foreign_log_problem(src)) is not None:
@@ -174,132 +254,4 @@ def command(logs: tuple[str, ...], output: str | None, every: int | None,
     if score and house is None:
         raise SgtoolError(f"{src} has no house spec attachment (house.json): --score needs "
                           "the ground truth of a simulated log")
-    if max_frames is not None:
-        total = min(total, max_frames)
-    final: dict[str, Any] = {}
-
-    def keep(ref, stream) -> None:  # type: ignore[no-untyped-def]  # noqa: ANN001
-        final["refresh"], final["stream"] = ref, stream
-
-    show = progress if progress is not None else sys.stderr.isatty()
-    opts = ReplayOptions(every=every, classifier=classifier, min_points=min_points,
-                         voxel_size=voxel_size, max_frames=max_frames, tf_time=tf_time)
-    with llm.room_classifier() as rooms, tqdm(
-            total=total, unit="frame", desc="replay", file=sys.stderr, leave=False,
-            disable=not show, dynamic_ncols=True) as bar:
-        live = None
-        if rerun_to is not None:
-            from sgtool.analysis.rerun_live import LiveReplay
-
-            live = LiveReplay.start(rerun_to, src, lambda m: click.echo(m, err=True))
-        on_refresh = keep if score else None
-        report = replay(src, dst, opts, on_refresh=live.chain(on_refresh) if live else on_refresh,
-                        progress=bar, verify=verify, room_classifier=rooms.make)
-    if live is not None:
-        live.finish(lambda m: click.echo(m, err=True))
-    scores = None
-    if score:
-        scores = _score(house, final)
-    if rrd and dst is not None:
-        write_view(dst, Path(rrd), show)
-    if as_json:
-        doc = _as_dict(report, scores, rrd)
-        if rooms.exchanges:
-            doc["llm_answers"] = rooms.stats().as_dict()
-        click.echo(json.dumps(doc, sort_keys=True))
-        return
-    for line in report.lines() + rooms.lines():
-        click.echo(line)
-    if scores is not None:
-        from sgtool.replayers.score import score_lines
-
-        for line in score_lines(scores):
-            click.echo(line)
-    if rrd:
-        click.echo(f"wrote {rrd}; open it with: rerun {rrd}")
-
-
-def _batch(logs: tuple[str, ...], out_dir: Path, opts: Any, *, force: bool, as_json: bool,
-           progress: bool | None, executor: str, workers: int,
-           ray_address: str | None, verify: bool = False) -> None:
-    """``--out-dir``: every log replayed on the executor (sgtool.analysis.batch_replay)."""
-    from dataclasses import asdict
-
-    from sgtool.analysis.batch_inputs import expand_inputs
-    from sgtool.analysis.batch_replay import out_folder, plan_jobs, replay_into
-    from sgtool.analysis.executor import make_executor
-
-    if opts.voxel_size is not None and not 0.01 <= opts.voxel_size <= 0.5:
-        raise SgtoolError(f"--voxel-size {opts.voxel_size}: must be 0.01..0.5 m")
-    runner = make_executor(executor, workers, ray_address)
-    inputs = expand_inputs(logs, (".mcap",))
-    jobs = plan_jobs(inputs, out_folder(out_dir), opts, verify=verify)
-    show = progress if progress is not None else sys.stderr.isatty()
-    report = replay_into(jobs, out_dir, runner, force=force, progress=show)
-    if as_json:
-        click.echo(json.dumps({"logs": [asdict(r) for r in report.logs],
-                               "seconds": report.seconds}, sort_keys=True))
-    else:
-        for line in report.lines():
-            click.echo(line)
-    failed = [r for r in report.logs if r.status == "failed"]
-    if failed:
-        raise SgtoolError(f"{len(failed)} of {len(report.logs)} log(s) failed to replay "
-                          f"(after a retry); the first: {failed[0].input}: {failed[0].error}")
-
-
-def _score(spec: Any, final: dict[str, Any]) -> Any:
-    from sgtool.replayers.score import score
-
-    if "refresh" not in final:
-        raise SgtoolError("the log produced no scene graph to score (no frames?)")
-    ref, stream = final["refresh"], final["stream"]
-    if ref.layers is None:
-        raise SgtoolError("the last refresh has no map layers to score")
-    return score(spec, stream.builder.instances, ref.layers, ref.graph)
-
-
-def write_view(derived: Path, rrd: Path, show: bool) -> None:
-    """A Rerun recording of a derived log with the voxel map (``sgtool view`` with its
-    defaults), with a progress bar when ``show``."""
-    from tqdm import tqdm
-
-    from sgtool.analysis.rerun_view import export
-    from sgtool.log import LogReader
-    from sgtool.replayers.voxels import voxel_snapshots
-
-    with LogReader(derived) as r:
-        total = r.frame_count()
-    with tqdm(total=total, unit="frame", desc="view", file=sys.stderr, leave=False,
-              disable=not show, dynamic_ncols=True) as bar:
-        export(derived, rrd, progress=bar.update,
-               voxels=lambda reader: voxel_snapshots(reader, every=10))
-
-
-def _as_dict(report: Any, scores: Any, rrd: str | None) -> dict[str, Any]:
-    from dataclasses import asdict
-
-    from sgtool.replayers.score import score_dict
-
-    g = report.last.graph if report.last is not None else None
-    out: dict[str, Any] = {
-        "input": str(report.input), "output": str(report.output) if report.output else None,
-        "options": asdict(report.options), "frames": report.frames,
-        "refreshes": report.refreshes, "semantic": report.semantic,
-        "truncated": report.truncated, "seconds": report.seconds,
-        "stages_ms": {k: {"median": v[0], "max": v[1], "calls": v[2]}
-                      for k, v in report.stages.items()},
-        "graph": None if g is None else {
-            "rooms": sum(r.explored for r in g.rooms),
-            "unexplored_rooms": sum(not r.explored for r in g.rooms),
-            "objects": len(g.objects), "frontiers": len(g.frontiers()),
-            "doors": len(g.doors),
-            "categories": {r.id: r.category for r in g.rooms if r.explored},
-        },
-        "rrd": rrd,
-    }
-    if report.warnings:
-        out["warnings"] = list(report.warnings)
-    if scores is not None:
-        out["score"] = score_dict(scores)
-    return out
+    return total, house

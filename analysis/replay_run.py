@@ -1,0 +1,198 @@
+"""`sgtool replay` after its checks: one log replayed into a derived log (with a progress
+bar, an optional live Rerun stream, a Rerun recording and the score of the final graph), or
+many logs into a folder on an executor (:mod:`sgtool.analysis.batch_replay`).
+
+The command checks the options, the outputs and the inputs and builds these requests; the
+work is :func:`sgtool.replayers.derived_log.replay`. ``show`` receives the report's lines
+(stdout), ``note`` the viewer's messages (stderr).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections.abc import Callable
+from contextlib import AbstractContextManager
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from sgtool.errors import SgtoolError
+
+if TYPE_CHECKING:
+    from sgtool.replayers.derived_log import ReplayOptions
+
+Echo = Callable[[str], None]
+
+
+@dataclass(frozen=True)
+class ReplayRequest:
+    """A checked one-log replay: ``log`` into ``output`` (None: nothing written) with
+    ``options``; ``house`` is the log's house spec when the final graph is scored (None:
+    no score); ``frames`` sizes the progress bar; ``rooms`` makes the room classifier
+    context (:meth:`sgtool.commands.room_llm.LlmOptions.room_classifier`)."""
+
+    log: Path
+    output: Path | None
+    options: ReplayOptions
+    rooms: Callable[[], AbstractContextManager[Any]]
+    frames: int = 0
+    house: Any = None
+    rrd: str | None = None
+    rerun_to: str | None = None
+    as_json: bool = False
+    progress: bool = False
+    verify: bool = False
+
+
+@dataclass(frozen=True)
+class BatchReplayRequest:
+    """A checked ``--out-dir`` replay: every log of ``logs`` (files, folders, glob
+    patterns) into ``out_dir`` on the executor named by ``executor``/``workers``/
+    ``ray_address`` (:func:`sgtool.analysis.executor.make_executor`)."""
+
+    logs: tuple[str, ...]
+    out_dir: Path
+    options: ReplayOptions
+    force: bool = False
+    as_json: bool = False
+    progress: bool = False
+    executor: str = "local"
+    workers: int = 1
+    ray_address: str | None = None
+    verify: bool = False
+
+
+def replay_one(request: ReplayRequest, show: Echo, note: Echo) -> None:
+    """Replay one log as ``request`` says and show the report (text or one JSON line),
+    the LLM answer counts and the score."""
+    from tqdm import tqdm
+
+    from sgtool.replayers.derived_log import replay
+
+    final: dict[str, Any] = {}
+
+    def keep(ref: Any, stream: Any) -> None:
+        final["refresh"], final["stream"] = ref, stream
+
+    with request.rooms() as rooms, tqdm(
+            total=request.frames, unit="frame", desc="replay", file=sys.stderr, leave=False,
+            disable=not request.progress, dynamic_ncols=True) as bar:
+        live = None
+        if request.rerun_to is not None:
+            from sgtool.analysis.rerun_live import LiveReplay
+
+            live = LiveReplay.start(request.rerun_to, request.log, note)
+        on_refresh = keep if request.house is not None else None
+        report = replay(request.log, request.output, request.options,
+                        on_refresh=live.chain(on_refresh) if live else on_refresh,
+                        progress=bar, verify=request.verify, room_classifier=rooms.make)
+    if live is not None:
+        live.finish(note)
+    scores = _score(request.house, final) if request.house is not None else None
+    if request.rrd is not None and request.output is not None:
+        write_view(request.output, Path(request.rrd), request.progress)
+    _show_report(request, report, rooms, scores, show)
+
+
+def _show_report(request: ReplayRequest, report: Any, rooms: Any, scores: Any,
+                 show: Echo) -> None:
+    rrd = request.rrd
+    if request.as_json:
+        doc = replay_dict(report, scores, rrd)
+        if rooms.exchanges:
+            doc["llm_answers"] = rooms.stats().as_dict()
+        show(json.dumps(doc, sort_keys=True))
+        return
+    for line in report.lines() + rooms.lines():
+        show(line)
+    if scores is not None:
+        from sgtool.replayers.score import score_lines
+
+        for line in score_lines(scores):
+            show(line)
+    if rrd:
+        show(f"wrote {rrd}; open it with: rerun {rrd}")
+
+
+def replay_many(request: BatchReplayRequest, show: Echo) -> None:
+    """``--out-dir``: every log replayed on the executor
+    (:func:`sgtool.analysis.batch_replay.replay_into`); a log that failed twice is one
+    error line after the others are written."""
+    from sgtool.analysis.batch_inputs import expand_inputs
+    from sgtool.analysis.batch_replay import out_folder, plan_jobs, replay_into
+    from sgtool.analysis.executor import make_executor
+
+    runner = make_executor(request.executor, request.workers, request.ray_address)
+    inputs = expand_inputs(request.logs, (".mcap",))
+    jobs = plan_jobs(inputs, out_folder(request.out_dir), request.options,
+                     verify=request.verify)
+    report = replay_into(jobs, request.out_dir, runner, force=request.force,
+                         progress=request.progress)
+    if request.as_json:
+        show(json.dumps({"logs": [asdict(r) for r in report.logs],
+                         "seconds": report.seconds}, sort_keys=True))
+    else:
+        for line in report.lines():
+            show(line)
+    failed = [r for r in report.logs if r.status == "failed"]
+    if failed:
+        raise SgtoolError(f"{len(failed)} of {len(report.logs)} log(s) failed to replay "
+                          f"(after a retry); the first: {failed[0].input}: {failed[0].error}")
+
+
+def _score(spec: Any, final: dict[str, Any]) -> Any:
+    from sgtool.replayers.score import score
+
+    if "refresh" not in final:
+        raise SgtoolError("the log produced no scene graph to score (no frames?)")
+    ref, stream = final["refresh"], final["stream"]
+    if ref.layers is None:
+        raise SgtoolError("the last refresh has no map layers to score")
+    return score(spec, stream.builder.instances, ref.layers, ref.graph)
+
+
+def write_view(derived: Path, rrd: Path, show: bool) -> None:
+    """A Rerun recording of a derived log with the voxel map (``sgtool view`` with its
+    defaults), with a progress bar when ``show``."""
+    from tqdm import tqdm
+
+    from sgtool.analysis.rerun_view import export
+    from sgtool.log import LogReader
+    from sgtool.replayers.voxels import voxel_snapshots
+
+    with LogReader(derived) as r:
+        total = r.frame_count()
+    with tqdm(total=total, unit="frame", desc="view", file=sys.stderr, leave=False,
+              disable=not show, dynamic_ncols=True) as bar:
+        export(derived, rrd, progress=bar.update,
+               voxels=lambda reader: voxel_snapshots(reader, every=10))
+
+
+def replay_dict(report: Any, scores: Any, rrd: str | None) -> dict[str, Any]:
+    """The ``--json`` object of a one-log replay: the report, the final graph's counts,
+    the score (when scored) and the Rerun recording's path."""
+    from sgtool.replayers.score import score_dict
+
+    g = report.last.graph if report.last is not None else None
+    out: dict[str, Any] = {
+        "input": str(report.input), "output": str(report.output) if report.output else None,
+        "options": asdict(report.options), "frames": report.frames,
+        "refreshes": report.refreshes, "semantic": report.semantic,
+        "truncated": report.truncated, "seconds": report.seconds,
+        "stages_ms": {k: {"median": v[0], "max": v[1], "calls": v[2]}
+                      for k, v in report.stages.items()},
+        "graph": None if g is None else {
+            "rooms": sum(r.explored for r in g.rooms),
+            "unexplored_rooms": sum(not r.explored for r in g.rooms),
+            "objects": len(g.objects), "frontiers": len(g.frontiers()),
+            "doors": len(g.doors),
+            "categories": {r.id: r.category for r in g.rooms if r.explored},
+        },
+        "rrd": rrd,
+    }
+    if report.warnings:
+        out["warnings"] = list(report.warnings)
+    if scores is not None:
+        out["score"] = score_dict(scores)
+    return out
