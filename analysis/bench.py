@@ -104,11 +104,11 @@ DEFAULT_PLANNERS: tuple[str, ...] = (
     "godhs", "esc", "bayes-search",
 )
 BENCH_VERSION = "1.0"
-# Room-count range and generator preset of the benchmark houses. With the symsearch preset,
-# 12-16 rooms give ~380 objects and ~234 explorable first-level pieces per house (InteriorGS,
-# SCOUT Table I: 408 objects, ~250 first-level), where the random planner's SR (0.37 over
-# 10 houses x 20 episodes x 3 seeds) matches SymSearch's 0.381; on the sparse default
-# houses random reaches ~0.85 within N_max = 50, so SR barely separates planners.
+# Room-count range and generator preset of the benchmark houses: with the symsearch preset,
+# 12-16 rooms come close to the object and first-level counts of SCOUT's InteriorGS houses
+# (SCOUT Table I: 408 objects, ~250 first-level) and the random planner's success rate to
+# SymSearch's; the sparse default houses let random succeed too often to separate planners
+# (the counts and rates: docs/experiments/moved-from-docstrings.md).
 DEFAULT_ROOMS: tuple[int, int] = (12, 16)
 
 
@@ -383,7 +383,7 @@ def _task(args: tuple[BenchConfig, BenchHouse, tuple[str, ...]]) -> list[Episode
     # products of the priors' MLP run on one BLAS thread (OpenBLAS splits them over every
     # core, which changes bits and, on a busy machine, costs several times the work).
     # What the worker holds already (modules, models) stays out of the collector's full
-    # scans, which otherwise took 7 % of the roll-outs.
+    # scans (sgtool.heap.frozen_heap).
     forget_default_scores()
     with single_blas_thread(), frozen_heap():
         return _task_episodes(cfg, ref, names)

@@ -180,8 +180,8 @@ def log_path(root: Path, noise: str, planner: str, house: str, episode: int) -> 
 
 
 # the house and its episodes per house and draw, per process: houses a worker keeps (a
-# house is rebuilt when a run of more houses comes back to it: ~1 s against minutes for
-# its closed-loop episode)
+# house is rebuilt when a run of more houses comes back to it, a small cost beside its
+# closed-loop episode)
 DRAWS_KEPT = 16
 _DRAWS: dict[tuple[Any, ...], tuple[Any, list[Any]]] = {}
 

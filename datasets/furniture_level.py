@@ -19,9 +19,8 @@ pooled share m_k of q's kind k (furniture or object, pooled over V),
     φ(q) = 0                                            otherwise,
 
 the posterior mean of "an instance of q stands alone" (empirical Bayes: a name of V the
-knowledge never mentions gets its kind's pooled share). Measured (training knowledge):
-m_furniture ≈ 1.0, so every furniture name gets φ ≈ 1 (sofa 25 / 0: 1.0); ``trash can``
-19 / 0: 0.95; ``sack`` 24 / 35: 0.42.
+knowledge never mentions gets its kind's pooled share). Worked values from the training
+knowledge are in ``docs/experiments/moved-from-docstrings.md``.
 
 :func:`write_levels` writes the table the core ships (``furniture_level.json``, names with
 φ > 0, rounded to 3 decimals); ``tests/datasets/test_furniture_level.py`` checks that the

@@ -25,11 +25,10 @@ seen, with graded scores, and sampled room types where it never was, with score 
 - negatives: 8 times as many room types as q has rooms with evidence (at least 16), drawn
   uniformly from the room types q was never seen in (seeded; uniform, unlike the
   co-occurrence negatives, because how many things a room type holds is a fair prior for
-  "q is in r" and kitchens should stay likely). Scoring all 39 room types per object, as
-  an LLM can, makes 95% of the targets zero, and an MSE model on such data learned the
-  constant 0 (measured: held-out AUC 0.55, below cosine); with 2 negatives per positive
-  the model varied a lot with the sample (ranks of the true room in training-split houses
-  0.25 on average), with 8 per positive it ranks the true room better (0.22-0.24).
+  "q is in r" and kitchens should stay likely). Not every room type per object: most of
+  those targets would be zero and an MSE model on them learns the constant 0; 8 negatives
+  per positive rather than 2, which left the model varying with the sample (the runs
+  behind both choices: ``docs/experiments/moved-from-docstrings.md``).
 
 Co-occurrence, D_co-occur = {((o, q), y)} with binary y (SCOUT found binary labels better
 for this relation): does o stand at the places where q is found? A *place* is a scanned

@@ -31,12 +31,9 @@ def frequency_room_classifier(room_types: Iterable[str] | None = None, alpha: fl
     frequency: a kitchen's eleven cabinets count once, so one category cannot swamp
     the evidence), restricted to ``room_types`` (default: the room types the house
     generator uses). ``small_objects`` adds the activity-derived small-object counts
-    per room type.
-
-    Measured on the rooms of twelve evaluation-split houses (seeds 100-111, 8-12 rooms,
-    classified from their furniture; alpha 1): 67% with document frequencies, 55% with
-    raw counts; adding the small-object counts lowers both (52%, 64% -> 49% when the
-    small objects are classified too), so they are off by default."""
+    per room type. The small-object counts are off by default: they lowered the room
+    accuracy on evaluation-split houses, as raw counts did against document frequencies
+    (``docs/experiments/moved-from-docstrings.md``)."""
     k = training_knowledge()
     if room_types is None:
         room_types = (*HOUSE_ROOM_TYPES, "corridor")

@@ -1,9 +1,9 @@
 """One BLAS thread for the small matrix products of replay.
 
 OpenBLAS splits even tiny products (the room classifier's 18 x 768 @ 768 x 512) over its
-threads; on a busy machine waking them costs far more than the product (measured: 170 ms
-per classifier call with 2 threads under load, 0.25 ms with one). Replay is one thread of
-small products, so it runs with one BLAS thread, limited by ``threadpoolctl`` (a dependency).
+threads; on a busy machine waking them costs far more than the product itself (figures in
+``docs/experiments/moved-from-docstrings.md``). Replay is one thread of small products, so it
+runs with one BLAS thread, limited by ``threadpoolctl`` (a dependency).
 """
 
 from __future__ import annotations

@@ -2,23 +2,21 @@
 
 Replay starts by loading its modules and models (the room classifier's weights, the
 sentence encoder's tables): objects that live until the end. Python's
-full (oldest-generation) collection walks every tracked object, so each of the two or
-three that a 30-room replay triggers paused one refresh for 26-28 ms, the slowest
-refreshes of the replay. :func:`frozen_heap` moves what exists at its start to the
-collector's permanent generation (:func:`gc.freeze`) for the duration of the block, so a
-full collection walks only the objects made since: 1.5-2.2 ms (measured on the 30-room
-benchmark log). At the end they go back to the oldest generation (:func:`gc.unfreeze`),
+full (oldest-generation) collection walks every tracked object, so each one a long replay
+triggers pauses a refresh for as long as the walk over those start-up objects.
+:func:`frozen_heap` moves what exists at its start to the collector's permanent generation
+(:func:`gc.freeze`) for the duration of the block, so a full collection walks only the
+objects made since. At the end they go back to the oldest generation (:func:`gc.unfreeze`),
 so nothing stays exempt from collection after the block. Inside a block, or in a process
 that froze its heap itself, it does nothing (unfreezing would release their objects too).
 
 numpy asks the kernel for transparent huge pages for every large array (``madvise``); a
 fault on such an array can make the kernel compact memory to find a free 2 MB page, in
 kernel time charged to the thread. The voxel store's multi-megabyte arrays are allocated
-afresh when a door opens or the store merges its tail, and such refreshes of a 30-room
-replay took 37-50 ms of kernel time (57 ms against a 23 ms median). :func:`small_pages`
-turns numpy's request off inside the block (4 kB pages, more but cheap faults): the
-slowest 30-room refresh fell from 79-91 ms to 56-57 ms, the median unchanged (measured on
-the 30-room benchmark log).
+afresh when a door opens or the store merges its tail, so those refreshes pay such faults.
+:func:`small_pages` turns numpy's request off inside the block (4 kB pages, more but cheap
+faults). What both blocks saved on the 30-room benchmark log is in
+``docs/experiments/moved-from-docstrings.md``.
 """
 
 from __future__ import annotations

@@ -11,27 +11,12 @@ when there is one, else the identity). Three methods:
   depth clouds, correspondence radii 0.2, 0.08, 0.03 m, started from the previous motion;
 - ``rgbd+icp`` (default): RGB-D odometry for the initial motion, refined by ICP.
 
-Measured with ``benchmarks/import_.py`` (frame to frame over the whole sequence):
-
-=================================  ========  =========  ===============  ============
-sequence                            method    ATE (m)    final error      ms per pair
-=================================  ========  =========  ===============  ============
-7-Scenes redkitchen, 100 frames     rgbd       0.542      0.95 m, 48 deg   ~540
-(every 10th Kinect frame, 6.75 m)   icp        0.156      0.15 m, 1.5 deg  ~240
-                                    rgbd+icp   0.154      0.15 m, 1.5 deg  ~1250
-ICL-NUIM livingroom1, 211 frames    rgbd       0.037      0.05 m, 2.0 deg  ~640
-(3.71 m; reference: Open3D's        icp        0.022      0.02 m, 1.1 deg  ~150
-reconstruction, not ground truth)   rgbd+icp   0.022      0.02 m, 1.1 deg  ~800
-=================================  ========  =========  ===============  ============
-
-RGB-D odometry alone loses track on 7-Scenes' large steps (0.1 m / 4 degrees between the
-kept frames; its depth is also not registered to the colour); ICP gets the same accuracy
-with or without the RGB-D start on these sequences and is 4-5x faster. The default keeps
-the photometric start because ICP alone slides along geometry without structure (a bare
-wall, a corridor), where the image texture still constrains the motion (on a textured
-wall ICP reports no motion at all while RGB-D odometry follows the 3 cm steps:
-``tests/recorders/importers/test_odometry.py``); ``--odometry icp``
-is the fast choice for cluttered rooms. (Times on 2 shared cores, with other work running.)
+The default keeps the photometric start because ICP alone slides along geometry without
+structure (a bare wall, a corridor), where the image texture still constrains the motion
+(on a textured wall ICP reports no motion at all while RGB-D odometry follows the 3 cm
+steps: ``tests/recorders/importers/test_odometry.py``); ``--odometry icp`` is the cheaper
+choice for cluttered rooms. Accuracy and time per method on 7-Scenes and ICL-NUIM
+(``benchmarks/import_.py``) are in ``docs/experiments/moved-from-docstrings.md``.
 
 A step fails, keeps the previous motion (constant velocity) and is counted when
 - Open3D reports failure (RGB-D odometry did not converge, a depth image has under 50
@@ -43,20 +28,17 @@ A step fails, keeps the previous motion (constant velocity) and is counted when
   :attr:`MotionLimits.max_speed` or :attr:`MotionLimits.max_turn_deg` plus a fixed
   allowance per step (checked when the frame times are given).
 
-Odometry that loses track often still "succeeds": on plain walls seen by a robot turning
-in place (the first frames of ``sgtool record``) Open3D's RGB-D odometry reports success
-for 0.76 m steps in 0.1 s and then for 27 m, 163 degree ones, compounding into an error of
-40 m over a 0.1 m path; the checks turn those steps into failures. On real data the
-defaults leave correct steps alone: the matched share of a step is at least 0.35 on
-7-Scenes (every 10th frame) and 0.96 on ICL-NUIM, and the fastest reference steps are
-1.3 m/s / 48 deg/s (ICL-NUIM at 30 Hz: 4.3 cm of the 7 cm a step may have), 0.43 m/s /
-22 deg/s (7-Scenes) and 0.57 m/s / 50 deg/s (TUM fr1_xyz ground truth at 10 Hz).
+Odometry that loses track often still "succeeds" (on plain walls seen by a robot turning
+in place, the first frames of ``sgtool record``, Open3D's RGB-D odometry reports success
+for steps of metres); the checks turn those steps into failures. The default limits are
+set to leave the correct steps of 7-Scenes, ICL-NUIM and TUM alone (the matched shares and
+step speeds seen there: ``docs/experiments/moved-from-docstrings.md``).
 
-Determinism: Open3D's RGB-D odometry (and multi-threaded ICP) differ between runs in the
-last bits (measured: up to 1e-15). Each relative motion is therefore snapped to a grid of
-1e-8 (translation in metres, rotation vector in radians) before it is composed, so the
-same frames give the same poses and the same log bytes; a value within 1e-15 of a grid
-boundary could still flip, a chance of about 2e-7 per number.
+Determinism: Open3D's RGB-D odometry (and multi-threaded ICP) may differ between runs in
+the last bits. Each relative motion is therefore snapped to a grid of 1e-8 (translation in
+metres, rotation vector in radians) before it is composed, so the same frames give the
+same poses and the same log bytes; a value closer to a grid boundary than the run-to-run
+difference could still flip (a chance of that difference over the grid step per number).
 
 Drift (:func:`drift_against`) compares an estimate with a reference trajectory (ground
 truth where the dataset has it) after expressing both from the same first pose: absolute

