@@ -156,6 +156,8 @@ class ClosedLoopOptions:
     navigation: str = "live"
     live: LiveNavConfig = field(default_factory=LiveNavConfig)
     success: str = "observed"  # success rule (sgtool.planning.episode): observed | done
+    # a tick turning on the spot less than this from the last frame's heading is no frame
+    turn_render_deg: float = 20.0
 
     def mapping(self) -> ResolvedOptions:
         """The replay options this run builds with (``extra.mapping`` of the log)."""
@@ -167,6 +169,8 @@ class ClosedLoopOptions:
         if self.classifier not in CLASSIFIERS:
             raise SgtoolError(f"unknown room classifier {self.classifier!r}; one of "
                               f"{', '.join(CLASSIFIERS)}")
+        if not 0.0 <= self.turn_render_deg <= 90.0:
+            raise SgtoolError(f"turn render angle {self.turn_render_deg} deg: must be 0..90")
         if not 0.01 <= self.voxel_size <= 0.5:
             raise SgtoolError(f"voxel size {self.voxel_size} m: must be 0.01..0.5")
         mp = self.min_points if self.min_points is not None else default_min_points(
@@ -420,7 +424,8 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                                     "query": query, "house_seed": str(house.seed)}) as writer:
             stream = SceneGraphStream(None, classifier, builder_config(mapping))
             rec = LiveRecorder(writer, sim, stream, noise=opts.noise, seed=opts.noise_seed,
-                                max_frames=opts.frames, planner=name, progress=progress)
+                                max_frames=opts.frames, planner=name, progress=progress,
+                                turn_render=math.radians(opts.turn_render_deg))
             sim.observers.append(rec)
             base = LoggedEpisode(kind="search", status="started", source=SOURCE,
                                  house_id=hid, query=query, planner=name)
@@ -491,7 +496,8 @@ def _started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOp
                        "cx": k.cx, "cy": k.cy},
         "robot": asdict(opts.robot),
         "navigation": {"mode": opts.navigation, **opts.live.to_dict()},
-        "noise": opts.noise.to_dict(), "noise_seed": opts.noise_seed, **_rule(opts),
+        "noise": opts.noise.to_dict(), "noise_seed": opts.noise_seed,
+        "turn_render_deg": opts.turn_render_deg, **_rule(opts),
     }
 
 

@@ -31,7 +31,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from sgtool.log.echo import as_logged
-from sgtool.mapping.occupancy import geodesic_distances
 from sgtool.recorders.sim.events import SimObserver, SkillOutcome
 from sgtool.recorders.sim.live_skills import Goal, LiveSkills, frontier_points
 from sgtool.scenegraph.stream import Refresh, SceneGraphStream
@@ -124,10 +123,10 @@ def next_frontier(skills: LiveSkills, ref: Refresh, failed_at: list[tuple[float,
     a cell of ``failed_at`` are skipped (None: no frontier left)."""
     layers = ref.layers
     assert layers is not None
-    occ = skills.live_map(ref)
-    if occ is None or not layers.frontiers:
+    planned = skills.plan_map(ref)
+    if planned is None or not layers.frontiers:
         return None
-    dist = geodesic_distances(occ, skills.body.base[:2])
+    occ, dist = planned
     best: tuple[float, Goal, tuple[float, float]] | None = None
     for fid in layers.frontier_ids:
         pts = frontier_points(layers, fid)

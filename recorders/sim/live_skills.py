@@ -32,6 +32,7 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -91,53 +92,66 @@ class LiveNavConfig:
 
 
 class RobotBody:
-    """What the robot side may use of a :class:`Simulation` (module doc: the guard)."""
+    """What the robot side may use of a :class:`Simulation` (module doc: the guard).
 
-    __slots__ = ("_sim",)
+    The body holds no reference to the simulation: it has no instance attributes at all
+    (no ``__dict__``, no slots but the weak reference), the simulation is kept in a
+    module-private table keyed by the body, and reading or setting any other attribute
+    raises :class:`PrivilegedAccess`."""
+
+    __slots__ = ("__weakref__",)
 
     def __init__(self, sim: Simulation) -> None:
-        object.__setattr__(self, "_sim", sim)
+        _BODIES[self] = sim
 
     def __getattr__(self, name: str) -> Any:
         raise PrivilegedAccess(f"the robot has no access to the simulator's {name!r}")
 
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise PrivilegedAccess(f"the robot body cannot hold {name!r}")
+
     @property
     def base(self) -> Pose2:
-        return self._sim.base
+        return _BODIES[self].base
 
     @property
     def config(self) -> RobotConfig:
-        return self._sim.robot
+        return _BODIES[self].robot
 
     @property
     def fps(self) -> float:
-        return self._sim.fps
+        return _BODIES[self].fps
 
     @property
     def hfov(self) -> float:
         """The camera's horizontal field of view (radians)."""
-        k = self._sim.intrinsics
+        k = _BODIES[self].intrinsics
         return 2.0 * math.atan(k.width / (2.0 * k.fx))
 
     @property
     def tick_index(self) -> int:
-        return self._sim.tick_index
+        return _BODIES[self].tick_index
 
     @property
     def travelled_m(self) -> float:
-        return self._sim.travelled_m
+        return _BODIES[self].travelled_m
 
     def drive(self, poses: list[Pose2]) -> tuple[float, bool]:
-        return self._sim.drive(poses)
+        return _BODIES[self].drive(poses)
 
     def look_around(self) -> SkillOutcome:
-        return self._sim.look_around()
+        return _BODIES[self].look_around()
 
     def open(self, instance: int) -> SkillOutcome:
-        return self._sim.open(int(instance))
+        return _BODIES[self].open(int(instance))
 
     def close(self, instance: int) -> SkillOutcome:
-        return self._sim.close(int(instance))
+        return _BODIES[self].close(int(instance))
+
+
+# the simulation behind each body (RobotBody's doc): weak keys, so a body's entry goes
+# with it
+_BODIES: weakref.WeakKeyDictionary[RobotBody, Simulation] = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True, eq=False)
@@ -193,6 +207,7 @@ class LiveSkills:
         # asked at every refresh during a skill: True ends the skill (module doc)
         self.stop_when: Callable[[], bool] | None = None
         self._asked = -1  # index of the last refresh stop_when was asked on
+        self._planned: tuple[tuple, tuple[OccupancyMap, np.ndarray] | None] | None = None
 
     def _stop(self) -> bool:
         """Whether ``stop_when`` says stop, asked once per refresh."""
@@ -211,6 +226,19 @@ class LiveSkills:
         bumps = np.array(self.bumps, dtype=np.float64).reshape(-1, 2)
         return traversable(refresh.layers.occupancy, self.body.config.radius,
                            self.config.optimistic, bumps)
+
+    def plan_map(self, refresh: Refresh) -> tuple[OccupancyMap, np.ndarray] | None:
+        """:meth:`live_map` of ``refresh`` and the geodesic distances on it from where
+        the robot stands (None: no map). Kept for the last (refresh, pose, bumps), so the
+        reachability check of a decision and the skill's first plan share one Dijkstra
+        run; the arrays are shared: read them, never change them."""
+        key = (refresh.index, id(refresh), self.body.base[:2], len(self.bumps))
+        if self._planned is not None and self._planned[0] == key:
+            return self._planned[1]
+        occ = self.live_map(refresh)
+        out = None if occ is None else (occ, geodesic_distances(occ, key[2]))
+        self._planned = (key, out)
+        return out
 
     def select(self, goal: Goal, occ: OccupancyMap, dist: np.ndarray
                ) -> tuple[float, float] | None:
@@ -232,11 +260,11 @@ class LiveSkills:
         driven, contacts = 0.0, 0
         for _ in range(cfg.max_replans):
             ref = self.current()
-            occ = None if ref is None else self.live_map(ref)
-            if ref is None or occ is None:
+            planned = None if ref is None else self.plan_map(ref)
+            if ref is None or planned is None:
                 return "failure", "the robot has no map yet", driven
             here = body.base[:2]
-            dist = geodesic_distances(occ, here)
+            occ, dist = planned
             target = self.select(goal, occ, dist)
             path = None if target is None else descend(occ, dist, target)
             self.replans += 1

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import ndimage
 
-from sgtool.mapping.occupancy import OccupancyMap, geodesic_distances
+from sgtool.mapping.occupancy import OccupancyMap
 from sgtool.planning.candidates import actionable
 from sgtool.recorders.sim.live_skills import Goal, LiveSkills, goal_of_node
 from sgtool.scenegraph.graph import SceneGraph
@@ -172,11 +172,11 @@ def reachable_view(refresh: Refresh, skills: LiveSkills,
     cands = actionable(graph)
     if not cands:
         return View(graph)
-    occ = None if refresh.layers is None else skills.live_map(refresh)
-    if occ is None:
+    planned = skills.plan_map(refresh)
+    if planned is None:
         return View(_without(graph, {c.node_id for c in cands}, {}),
                     {c.node_id: NO_MAP for c in cands})
-    dist = geodesic_distances(occ, skills.body.base[:2])
+    occ, dist = planned
     withheld: dict[str, str] = {}
     live: dict[str, float] = {}
     for c in cands:

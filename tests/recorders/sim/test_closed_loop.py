@@ -253,8 +253,9 @@ def test_invalid_targets_and_done_in_the_loop(house, tmp_path) -> None:
 def test_frame_budget_cuts_the_episode(house, tmp_path) -> None:
     idx, ep = pick_episode(house, index=0)
     out = tmp_path / "budget.mcap"
-    rep = run_episode(house, ep, make_planner("greedy"), out, ClosedLoopOptions(camera=OPTS.camera,
-                                                                   frames=25))
+    # every tick a frame, so the 25 frames end inside the opening look-around
+    rep = run_episode(house, ep, make_planner("greedy"), out, ClosedLoopOptions(
+        camera=OPTS.camera, frames=25, turn_render_deg=0.0))
     assert (rep.frames, rep.end, rep.success) == (25, "frames", False)
     with LogReader(out) as r:
         assert r.frame_count() == 25

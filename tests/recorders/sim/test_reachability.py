@@ -12,6 +12,7 @@ the reason is counted into the closing Episode record.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -99,3 +100,35 @@ def test_the_planner_is_not_offered_a_room_its_map_cannot_reach(house, tmp_path)
     with LogReader(out) as r:
         episodes = [e for _, e in r.records("episode")]
     assert episodes[-1]["extra"]["withheld"][UNREACHABLE] >= 1
+
+
+def test_the_robot_body_holds_no_simulation(house) -> None:
+    from sgtool.recorders.sim import Simulation
+    from sgtool.recorders.sim.live_skills import PrivilegedAccess, RobotBody
+
+    with Simulation(house, start=0) as sim:
+        body = RobotBody(sim)
+        with pytest.raises(PrivilegedAccess, match="_sim"):
+            body._sim  # noqa: B018 (the old plain attribute)
+        with pytest.raises(PrivilegedAccess):
+            vars(body)  # no instance dict to look into
+        with pytest.raises(PrivilegedAccess):
+            body.spy = sim
+        assert body.base == sim.base and body.fps == sim.fps
+        assert 0 < body.hfov < 3.1
+
+
+def test_one_dijkstra_run_per_refresh_and_pose() -> None:
+    occ, _ = _map()
+    body = _Body((1.0, 2.0, 0.0), RobotConfig())
+    skills = LiveSkills(body, lambda: None)
+    ref = SimpleNamespace(index=4, layers=SimpleNamespace(occupancy=occ.grid))
+    first = skills.plan_map(ref)
+    assert first is not None and skills.plan_map(ref) is first  # the view, then the skill
+    d = first[1]
+    assert d[20, 10] == 0.0 and np.isinf(d[6, 11])  # from the robot's cell; the box
+    body.base = (2.0, 2.0, 0.0)  # moved: planned afresh
+    moved = skills.plan_map(ref)
+    assert moved is not first and moved[1][20, 20] == 0.0
+    skills.bumps.append((2.5, 2.0))  # a bump changes the map
+    assert skills.plan_map(ref) is not moved
