@@ -351,11 +351,13 @@ def visited_components(occ: OccupancyGrid, rg: RidgeGraph,
 def voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
                   anchor: tuple[float, float] | None = None,
                   ridge: RidgeGraph | None = None,
-                  trajectory: np.ndarray | None = None) -> VoronoiGraph:
+                  trajectory: np.ndarray | None = None,
+                  components: tuple[int, ...] | None = None) -> VoronoiGraph:
     """The sparsified generalized Voronoi graph of the explored free space of ``occ``
     (``ridge``: a :func:`ridge_graph` of the same grid, to skip steps 1-2); with a
     ``trajectory``, over every component it passed through
-    (:func:`visited_components`), else over the anchor's."""
+    (:func:`visited_components`), else over the anchor's; ``components``: what
+    :func:`visited_components` gives for these arguments, when the caller has it."""
     cfg = config or VoronoiConfig()
     rg = ridge if ridge is not None else ridge_graph(occ, cfg)
     res = occ.resolution
@@ -366,7 +368,8 @@ def voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
     if len(rg.flat) == 0:
         return empty
     flat, adj, comp = rg.flat, rg.adj, rg.component
-    targets = visited_components(occ, rg, anchor, trajectory)
+    targets = (components if components is not None
+               else visited_components(occ, rg, anchor, trajectory))
     keep = np.flatnonzero(np.isin(comp, np.asarray(targets, dtype=comp.dtype)))
     flat = flat[keep]
     adj = submatrix(adj, keep)

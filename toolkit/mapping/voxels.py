@@ -454,12 +454,15 @@ class VoxelMap:
         if len(new):
             iz = ((new >> SHIFT_Z) & AXIS_MASK) - OFFSET
             nv = sorted_unique(new[(iz >= zlo) & (iz <= zhi)] >> VOXEL_SHIFT)
-            fresh = nv[~np.isin(nv, self._weak, assume_unique=True)]
-            if len(fresh):
-                weak = np.concatenate([self._weak, fresh])
-                misses = np.concatenate([self._misses, np.zeros(len(fresh), np.int64)])
-                order = np.argsort(weak, kind="stable")
-                self._weak, self._misses = weak[order], misses[order]
+            at = np.searchsorted(self._weak, nv)
+            known = np.zeros(len(nv), dtype=bool)
+            inside = at < len(self._weak)
+            known[inside] = self._weak[at[inside]] == nv[inside]
+            fresh = nv[~known]
+            if len(fresh):  # merged in order (both sorted, disjoint)
+                where = np.searchsorted(self._weak, fresh)
+                self._weak = np.insert(self._weak, where, fresh)
+                self._misses = np.insert(self._misses, where, 0)
         if not len(self._weak):
             return 0
         keys, counts = self._store.within(*_voxel_bounds(self._weak))

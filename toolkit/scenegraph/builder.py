@@ -452,7 +452,7 @@ class SceneGraphBuilder:
         key = (ridge.version, visited_components(occ, ridge.ridge, robot_xy, track))
         if self._graph is None or self._graph[0] != key:  # same ridge, same components
             self._graph = (key, voronoi_graph(occ, cfg, anchor=robot_xy, ridge=ridge.ridge,
-                                              trajectory=track))
+                                              trajectory=track, components=key[1]))
         return self._graph[1]
 
     def _segment(self, occ: OccupancyGrid, vg: VoronoiGraph) -> _Rooms:
