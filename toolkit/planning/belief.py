@@ -54,6 +54,16 @@ each component normalised over the candidates (P_O the object model (B1)-(B4)); 
 nothing is left to reveal, P = P_O. φ = 0 (a small object's name, or no prior) is the
 object model unchanged.
 
+**Room types already explored** (``seen_type_weight`` η, 1 = off). A house holds few
+rooms of a type (one kitchen, as a rule), so a room of a type already explored is less
+likely behind the next door. With n_t the explored rooms of type t in the graph,
+
+    R̄ = Σ_t η^{n_t} R(t) / Σ_t η^{n_t}                                               (B7)
+
+over the scored room types: for a kitchen thing, the unknown rooms lose mass once the
+kitchen is explored (its own carriers gain it), and gain it while no kitchen has been
+seen. η = 1 is the plain mean of :func:`known_room_mean`.
+
 **Bayes update.** A checked place that was empty leaves the candidate set while its C(o)
 stays in Z_r, so renormalising over the remaining candidates,
 
@@ -66,6 +76,7 @@ the imperfect-detection update P(n) (1 - β) / (1 - β P(n)) up to normalisation
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -76,6 +87,7 @@ from sgtool.planning.candidates import Candidate, is_carrier
 from sgtool.planning.utility import UNKNOWN_ROOM
 from sgtool.scenegraph.graph import ObjectNode, RegionNode, SceneGraph
 from sgtool.semantics.priors import RelationScorer, can_score_room
+from sgtool.semantics.text import category_text
 
 
 @dataclass(frozen=True)
@@ -88,6 +100,7 @@ class BeliefParams:
     miss: float = 0.5  # mass factor per failed attempt on a node (1 - beta)
     fallback_room: float = 0.3  # R̄ when the prior lists no room types
     region_weight: float = 0.5  # ω of K = ω n̄ C̄, (B2)-(B3) (module doc)
+    seen_type_weight: float = 1.0  # η of (B7): weight of a room type per sighting; 1: off
 
 
 def known_room_mean(scorer: RelationScorer, query: str, params: BeliefParams) -> float:
@@ -97,6 +110,21 @@ def known_room_mean(scorer: RelationScorer, query: str, params: BeliefParams) ->
         return params.fallback_room
     return float(np.mean(calibrate(scorer.rooms(types, query), params.room_floor,
                                    params.sharpness)))
+
+
+def unexplored_room_mean(graph: SceneGraph, scorer: RelationScorer, query: str,
+                         params: BeliefParams) -> float:
+    """R̄ of (B7): the mean calibrated containment over the scored room types, each type
+    weighted by η^(number of explored rooms of that type); R̄ of :func:`known_room_mean`
+    when η = 1 or the scorer lists no room types."""
+    types = [t for t in getattr(scorer, "room_types", ()) if can_score_room(scorer, t)]
+    eta = params.seen_type_weight
+    if not types or eta >= 1.0:
+        return known_room_mean(scorer, query, params)
+    seen = Counter(category_text(r.category) for r in graph.rooms if r.explored)
+    w = np.array([eta ** seen[category_text(t)] for t in types])
+    r = calibrate(scorer.rooms(types, query), params.room_floor, params.sharpness)
+    return float(np.dot(w, r) / w.sum())
 
 
 def room_probabilities(graph: SceneGraph, query: str, scorer: RelationScorer,
@@ -147,7 +175,7 @@ def place_masses(graph: SceneGraph, cands: Sequence[Candidate], query: str,
     ``furniture``: φ(q) of (B6), the prior that the query is a first-level piece."""
     if not cands:
         return np.zeros(0)
-    unknown = known_room_mean(scorer, query, params)
+    unknown = unexplored_room_mean(graph, scorer, query, params)
     rooms = room_probabilities(graph, query, scorer, params, unknown)
     out = _object_masses(graph, cands, query, scorer, params, rooms, unknown)
     if furniture > 0.0:

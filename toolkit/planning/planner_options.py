@@ -121,6 +121,9 @@ class BayesSearchOptions(NodeOptions):
         "mass factor per failed attempt on a node (1 - beta)", "float", lo=0.0, hi=1.0))
     region_weight: float = field(default=0.5, metadata=option(
         "omega of K = omega n C, the mass of an unseen region (B2)-(B3)", "float", lo=0.0))
+    seen_type_weight: float = field(default=1.0, metadata=option(
+        "eta of (B7): weight of a room type in an unexplored room's mean per explored room "
+        "of that type; 1: off", "float", lo=0.0, hi=1.0))
     blend: bool = field(default=True, metadata=option(
         "blend the learned scores with the cosine by query novelty", "bool"))
     furniture_levels: str | Mapping[str, float] | None = field(default=None, metadata=option(

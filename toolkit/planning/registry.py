@@ -122,18 +122,23 @@ def _furniture_levels(value: Any) -> Any:
     return value
 
 
+BAYES_ROOMS_SEEN_TYPE_WEIGHT = 0.3  # eta of (B7) for bayes-rooms
+
+
 def _bayes(name: str, o: BayesSearchOptions) -> Planner:
     from sgtool.planning.belief import BeliefParams
     from sgtool.planning.search_theory import SearchParams, SearchTheoryPlanner
 
     belief = BeliefParams(room_floor=o.room_floor, object_floor=o.object_floor,
                           sharpness=o.sharpness, object_sharpness=o.object_sharpness,
-                          beyond=o.beyond, miss=o.miss, region_weight=o.region_weight)
+                          beyond=o.beyond, miss=o.miss, region_weight=o.region_weight,
+                          seen_type_weight=(BAYES_ROOMS_SEEN_TYPE_WEIGHT
+                                            if name == "bayes-rooms" else o.seen_type_weight))
     params = SearchParams(step_cost=o.step_cost, open_cost=o.open_cost,
                           reveal_cost=o.reveal_cost, top_k=o.top_k, horizon=o.horizon,
                           step_budget=o.step_budget, belief=belief)
     scorer = _priors(o.encoder, o.weights_dir, blend=o.blend)
-    return SearchTheoryPlanner(scorer, params, max_failures=o.max_failures,
+    return SearchTheoryPlanner(scorer, params, name=name, max_failures=o.max_failures,
                                furniture_levels=_furniture_levels(o.furniture_levels))
 
 
@@ -207,6 +212,10 @@ REGISTRY: Mapping[str, Entry] = MappingProxyType({
                  "and carriers (sgtool.planning.esc)"),
     "bayes-search": Entry(_bayes, BayesSearchOptions, "search theory: Bayes belief over "
                           "places, p/c rule with a look-ahead (sgtool.planning.search_theory)"),
+    "bayes-rooms": Entry(_bayes, BayesSearchOptions, "bayes-search whose unexplored rooms "
+                         "discount the room types already explored, (B7) of "
+                         "sgtool.planning.belief",
+                         fixed={"seen_type_weight": BAYES_ROOMS_SEEN_TYPE_WEIGHT}),
     "moma-llm": Entry(_moma, MomaOptions, "MoMa-LLM over an OpenAI-compatible chat endpoint "
                       "or a transcript"),
     "unstructured-llm": Entry(_moma, MomaOptions, "MoMa-LLM's ablation: shown the raw JSON "

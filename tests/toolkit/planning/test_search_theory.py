@@ -136,3 +136,39 @@ def test_region_weight_scales_the_mass_of_an_unseen_region() -> None:
         # one room: the masses are the kitchen's split, (B2)-(B3)
         assert p.tolist() == pytest.approx([k / (cf + cw + k), cf / (cf + cw + k),
                                             cw / (cf + cw + k)])
+
+
+class TypedScorer(TableScorer):
+    """A table scorer that lists the room types it knows (what R̄ averages over)."""
+
+    room_types = ("kitchen", "bedroom")
+
+
+def test_explored_room_types_leave_the_mean_of_unexplored_rooms() -> None:
+    from sgtool.planning.belief import known_room_mean, unexplored_room_mean
+
+    scorer = TypedScorer(rooms={"kitchen": 0.9, "bedroom": 0.1}, objects={"fridge": 0.8})
+    g = kitchen()  # one explored kitchen, a door to an unknown room
+    rk, rb = 0.05 + 0.95 * 0.9, 0.05 + 0.95 * 0.1
+    off = BeliefParams()
+    assert unexplored_room_mean(g, scorer, "q", off) == pytest.approx((rk + rb) / 2)
+    assert unexplored_room_mean(g, scorer, "q", off) == known_room_mean(scorer, "q", off)
+    # (B7): the one kitchen seen counts eta = 0.3 in the mean over the types
+    on = BeliefParams(seen_type_weight=0.3)
+    assert unexplored_room_mean(g, scorer, "q", on) == pytest.approx((0.3 * rk + rb) / 1.3)
+    # so the door to the unknown room holds less against the kitchen's own carriers
+    cands = actionable(g)
+    ids = [c.node_id for c in cands]
+    p_off = dict(zip(ids, place_masses(g, cands, "q", scorer, off), strict=True))
+    p_on = dict(zip(ids, place_masses(g, cands, "q", scorer, on), strict=True))
+    assert p_on["door:1"] < p_off["door:1"]
+    assert p_on["obj:1"] > p_off["obj:1"]
+
+
+def test_bayes_rooms_is_bayes_search_with_the_seen_type_weight() -> None:
+    p = make_planner("bayes-rooms")
+    assert p.name == "bayes-rooms"
+    assert p.inner.params.belief.seen_type_weight == 0.3
+    base = make_planner("bayes-search")
+    assert base.name == "bayes-search"
+    assert base.inner.params.belief.seen_type_weight == 1.0
