@@ -6,7 +6,9 @@
 - :func:`execute_privileged` (``navigation="house"``, the behaviour before issue 17, kept
   for comparison): the simulator's skills plan on the house's ground-truth occupancy.
 
-Both run the calls until one does not succeed and return an :class:`Executed`.
+Both run the calls until one does not succeed (live: or ends because the target came
+into view, :data:`~sgtool.recorders.sim.live_skills.IN_VIEW`) and return an
+:class:`Executed`.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ import numpy as np
 
 from sgtool.planning.base import Outcome
 from sgtool.recorders.sim.events import StopSimulation
-from sgtool.recorders.sim.live_skills import Goal, LiveSkills, goal_of_node
+from sgtool.recorders.sim.live_skills import IN_VIEW, Goal, LiveSkills, goal_of_node
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome
 from sgtool.recorders.sim.skill_plan import SkillCall
 from sgtool.scenegraph.stream import Refresh
@@ -69,8 +71,8 @@ def execute_live(sim: Simulation, skills: LiveSkills, calls: Sequence[SkillCall]
                 goal = _goal(c, decided)
                 run = skills.explore if c.skill == "explore" else skills.navigate
                 outcome, reason, _ = run(goal)
-            if outcome != "success":
-                break
+            if outcome != "success" or reason == IN_VIEW:
+                break  # a failure, or the target came into view: the rest is moot
     except StopSimulation as e:
         return Executed("failure", f"stopped: {e}", sim.travelled_m - d0,
                         sim.tick_index - t0, True)

@@ -85,3 +85,23 @@ def test_the_look_around_turns_toward_unknown_space_only() -> None:
     assert 0 < left < math.pi
     # off the map is unknown: a robot at the edge of its map turns toward the outside
     assert sweep(_grid(None), (3.9, 0.0, math.pi), hfov) != 0.0
+
+
+def test_an_action_ends_when_its_navigation_brings_the_target_into_view() -> None:
+    # open = navigate then open: when the drive stops because the target came into view,
+    # the open is not attempted (from wherever the robot stopped, out of reach)
+    from types import SimpleNamespace
+
+    from sgtool.recorders.sim.execution import execute_live
+    from sgtool.recorders.sim.live_skills import IN_VIEW
+    from sgtool.recorders.sim.skill_plan import SkillCall
+
+    def never(*a):
+        raise AssertionError("opened after the target came into view")
+
+    skills = SimpleNamespace(navigate=lambda goal: ("success", IN_VIEW, 1.5),
+                             body=SimpleNamespace(open=never))
+    sim = SimpleNamespace(tick_index=0, travelled_m=0.0)
+    ex = execute_live(sim, skills, (SkillCall("navigate", (1.0, 2.0)), SkillCall("open", 5)),
+                      None)
+    assert (ex.outcome, ex.reason, ex.cut) == ("success", IN_VIEW, False)
