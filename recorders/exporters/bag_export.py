@@ -52,6 +52,7 @@ from sgtool.log import codec
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.reader import LogReader
+from sgtool.output_check import check_output
 from sgtool.recorders.exporters import ros_maps
 from sgtool.recorders.exporters.bagwriter import COMPRESSIONS, DISTROS, BagWriter
 
@@ -173,10 +174,10 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
         raise SgtoolError(f"{log}: no such file")
     if out.resolve() == log.resolve():
         raise SgtoolError(f"-o {out}: the output must not be the input log")
-    if not out.parent.is_dir():
-        raise SgtoolError(f"-o {out}: folder {out.parent} does not exist")
     if fmt == "ros1":
         _check_ros1_target(out, force)
+    elif not out.parent.is_dir():
+        raise SgtoolError(f"-o {out}: folder {out.parent} does not exist")
     elif out.exists() and not out.is_dir():
         raise SgtoolError(f"-o {out} is a file; a ROS 2 bag is a folder (not replacing it)")
     base_ns = int(round(time_base_s * 1e9))
@@ -214,14 +215,12 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
 
 
 def _check_ros1_target(out: Path, force: bool) -> None:
-    """An existing ROS 1 ``out`` is replaced only with ``force`` and only if it is a ROS 1
-    bag (what ``export bag`` writes), never a folder or another file."""
-    if out.is_dir():
-        raise SgtoolError(f"-o {out} is a folder; a ROS 1 bag is a file (not replacing it)")
+    """The one output check of a file (:func:`sgtool.output_check.check_output`); an
+    existing ROS 1 ``out`` is replaced only with ``force`` and only if it is a ROS 1 bag
+    (what ``export bag`` writes), never another file."""
+    check_output(out, force=force)
     if not out.exists():
         return
-    if not force:
-        raise SgtoolError(f"{out} exists; not overwriting it (use --force)")
     try:
         with open(out, "rb") as fh:
             head = fh.read(len(ROS1_MAGIC))

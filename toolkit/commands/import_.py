@@ -14,7 +14,7 @@ from typing import Any
 
 import click
 
-from sgtool.commands.options import option_group
+from sgtool.commands.options import check_log_output, option_group
 from sgtool.errors import SgtoolError
 from sgtool.recorders.importers.checks import (
     MAX_DT_S,
@@ -47,14 +47,10 @@ def _offset_ns(seconds: float) -> int:
 
 
 def _output(output: str | None, force: bool) -> Path:
+    """``-o``: given, then the one output check of a log."""
     if not output:
         raise SgtoolError("give the output log with -o OUT.mcap")
-    out = Path(output)
-    if out.exists() and not force:
-        raise SgtoolError(f"{out} exists; not overwriting it (use --force)")
-    if out.suffix != ".mcap":
-        raise SgtoolError(f"-o {out}: the output is an MCAP log; name it *.mcap")
-    return out
+    return check_log_output(output, force=force)
 
 
 def _print_report(report, as_json: bool) -> None:  # type: ignore[no-untyped-def]
@@ -198,14 +194,8 @@ def command() -> None:
               help="List the bag's topics, tf links and suggested flags, and stop.")
 @_world_options
 @_common_options
-def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: str | None,
-        tf_frames: str | None, pose: str | None, timestamps: str, tf_tolerance: float,
-        time_offset: float, estimate_poses: bool,
-        odometry: str, depth_max: float, list_only: bool,
-        up: str, floor: str, camera_height: str, output: str | None, intrinsics: str | None,
-        depth_scale: float | None, max_dt: float, every: int, limit: int | None,
-        compression: str, force: bool, allow_drop: bool, as_json: bool,
-        quiet: bool) -> None:
+def bag(path: str, list_only: bool, output: str | None, force: bool, as_json: bool,
+        **given: Any) -> None:
     """Import a ROS 1 .bag, a ROS 2 bag folder (sqlite3 or MCAP) or a bare ROS 2 .mcap/.db3
     file at PATH.
 
@@ -219,24 +209,52 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
         --rgb /camera/rgb/image_color --info /camera/depth/camera_info
       sgtool import bag tf_example.bag -o traj.mcap --tf-frames odom:base_link
     """
-    from sgtool.recorders.importers.bag import BagOptions, check_options, describe_bag, import_bag
+    from sgtool.recorders.importers.bag import check_options, describe_bag, import_bag
     from sgtool.recorders.importers.bagfiles import open_bag
-    from sgtool.recorders.importers.checks import parse_height_band
-    from sgtool.recorders.importers.textformats import parse_intrinsics
-    from sgtool.recorders.importers.upright import parse_up
 
     if list_only:
         with open_bag(path) as reader:
             click.echo(describe_bag(reader, Path(path)))
         return
-    frames = None
-    if tf_frames is not None:
-        parts = tf_frames.split(":")
-        if len(parts) != 2 or not all(parts):
-            raise SgtoolError(f"--tf-frames {tf_frames!r}: give WORLD:CAMERA, e.g. map:camera")
-        frames = (parts[0], parts[1])
+    opts = _bag_options(**given)
+    check_options(opts)
+    if not (opts.depth or opts.tf_frames or opts.pose):
+        # nothing to import yet: the error lists the topics and suggests flags
+        from sgtool.recorders.importers.bag import check_flags
+        from sgtool.recorders.importers.bagfiles import list_topics
+
+        with open_bag(path) as reader:
+            check_flags(Path(path), list_topics(reader), opts, reader)
+    _print_report(import_bag(path, _output(output, force), opts), as_json)
+
+
+def _tf_frames(text: str | None) -> tuple[str, str] | None:
+    """``--tf-frames WORLD:CAMERA``."""
+    if text is None:
+        return None
+    parts = text.split(":")
+    if len(parts) != 2 or not all(parts):
+        raise SgtoolError(f"--tf-frames {text!r}: give WORLD:CAMERA, e.g. map:camera")
+    return parts[0], parts[1]
+
+
+def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None, info: str | None,
+                 tf_frames: str | None, pose: str | None, timestamps: str,
+                 tf_tolerance: float, time_offset: float, estimate_poses: bool,
+                 odometry: str, depth_max: float, up: str, floor: str, camera_height: str,
+                 intrinsics: str | None, depth_scale: float | None, max_dt: float,
+                 every: int, limit: int | None, compression: str, allow_drop: bool,
+                 quiet: bool) -> Any:
+    """The options of `sgtool import bag` (other than the output), each checked, as
+    :class:`sgtool.recorders.importers.bag.BagOptions`."""
+    from sgtool.recorders.importers.bag import BagOptions
+    from sgtool.recorders.importers.checks import parse_height_band
+    from sgtool.recorders.importers.textformats import parse_intrinsics
+    from sgtool.recorders.importers.upright import parse_up
+
+    frames = _tf_frames(tf_frames)
     fl, floor_auto = _floor(floor)
-    opts = BagOptions(
+    return BagOptions(
         rgb=rgb, depth=depth, ids=ids, info=info, tf_frames=frames, pose=pose,
         intrinsics=parse_intrinsics(intrinsics) if intrinsics else None,
         depth_scale=depth_scale, max_dt_ns=seconds_option_ns(max_dt, "--max-dt", MAX_DT_S),
@@ -248,15 +266,6 @@ def bag(path: str, depth: str | None, rgb: str | None, ids: str | None, info: st
         timestamps=timestamps, allow_drop=allow_drop,
         time_offset_ns=_offset_ns(time_offset),
     )
-    check_options(opts)
-    if not (depth or tf_frames or pose):
-        # nothing to import yet: the error lists the topics and suggests flags
-        from sgtool.recorders.importers.bag import check_flags
-        from sgtool.recorders.importers.bagfiles import list_topics
-
-        with open_bag(path) as reader:
-            check_flags(Path(path), list_topics(reader), opts, reader)
-    _print_report(import_bag(path, _output(output, force), opts), as_json)
 
 
 @command.command("rgbd")

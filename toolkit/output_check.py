@@ -1,0 +1,52 @@
+"""The one check of an output file name a writing command or exporter is given, before any
+work: not a folder, the right suffix, an existing folder that takes a new file, and no
+existing file unless ``force``. Each failure is one :class:`~sgtool.errors.SgtoolError`
+line naming the option; nothing is left behind."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from sgtool.errors import SgtoolError
+
+
+def check_output(path: str | Path, *, force: bool = False, option: str = "-o",
+                 suffixes: Sequence[str] = (), what: str = "output") -> Path:
+    """The one check of an output file name a command may write, before any work: it is
+    not a folder, it has one of ``suffixes`` (when given), its folder exists and takes a new
+    file (a probe file is made there and removed), and it does not exist unless ``force``.
+    Each failure is one :class:`SgtoolError` line; nothing is left behind."""
+    p = Path(path)
+    if p.is_dir():
+        raise SgtoolError(f"{option} {p} is a folder; give a file name")
+    if suffixes and p.suffix.lower() not in suffixes:
+        raise SgtoolError(f"{option} {p}: the {what} must end in {' or '.join(suffixes)}")
+    if not p.parent.exists():
+        raise SgtoolError(f"{option} {p}: folder {p.parent} does not exist")
+    if p.exists() and not force:
+        raise SgtoolError(f"{p} exists; not overwriting it (use --force)")
+    _probe_folder(p)
+    return p
+
+
+def check_log_output(path: str | Path, *, force: bool = False, option: str = "-o") -> Path:
+    """:func:`check_output` of an MCAP log to write (``*.mcap``)."""
+    if Path(path).suffix != ".mcap" and not Path(path).is_dir():
+        raise SgtoolError(f"{option} {path}: the output is an MCAP log; name it *.mcap")
+    return check_output(path, force=force, option=option)
+
+
+def _probe_folder(path: Path) -> None:
+    """A one-line error now when the folder of ``path`` takes no new file (read-only, or
+    not a folder), rather than after the work."""
+    import os
+
+    from sgtool.files import output_error, temp_beside
+
+    try:
+        fd, probe = temp_beside(path, ".probe")
+    except OSError as e:
+        raise output_error(e, path) from None
+    os.close(fd)
+    probe.unlink(missing_ok=True)
