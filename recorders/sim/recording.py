@@ -161,12 +161,9 @@ class LogRecorder(SimObserver):
 
 
 def instance_image(t_ns: int, ids: np.ndarray) -> Any:
-    """The instance-id image as a Foxglove ``RawImage`` in an encoding Foxglove's Image
-    panel shows: ``16UC1`` (exact ids, 0 = none) when every id fits in 0..65535, else
-    ``32SC1`` (exact, but not drawn by Foxglove; sgtool's readers take both)."""
-    fits = ids.size == 0 or (int(ids.min()) >= 0 and int(ids.max()) <= S.IDS_MAX_16)
-    return codec.encode_image(t_ns, ids, S.IDS_ENCODING_16 if fits else S.IDS_ENCODING,
-                              S.CAMERA_FRAME)
+    """The instance-id image of a frame (:func:`sgtool.log.codec.encode_ids`)."""
+    return codec.encode_ids(t_ns, ids, S.CAMERA_FRAME)
+
 
 @dataclass(frozen=True)
 class RecordOptions:

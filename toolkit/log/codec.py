@@ -54,6 +54,14 @@ def encode_image(t_ns: int, arr: np.ndarray, encoding: str, frame_id: str) -> Ra
 INTEGER_ENCODINGS = frozenset({"mono8", "8UC1", "mono16", "16UC1", "32SC1"})
 
 
+def encode_ids(t_ns: int, ids: np.ndarray, frame_id: str) -> RawImage:
+    """An instance-id image as a ``RawImage`` in an encoding Foxglove's Image panel shows:
+    ``16UC1`` (exact ids, 0 = none) when every id fits in 0..65535, else ``32SC1`` (exact,
+    not drawn by Foxglove; sgtool's readers take both)."""
+    fits = ids.size == 0 or (int(ids.min()) >= 0 and int(ids.max()) <= S.IDS_MAX_16)
+    return encode_image(t_ns, ids, S.IDS_ENCODING_16 if fits else S.IDS_ENCODING, frame_id)
+
+
 def decode_image(msg: RawImage | RawImageView, dtype: DTypeLike | None = None) -> np.ndarray:
     """The pixels of ``msg`` (as ``dtype``, when given: converted as they are copied);
     :class:`LogFormatError` (naming the field) when its encoding, size, step and data

@@ -316,7 +316,9 @@ class LogWriter:
         self.write_proto(S.DEPTH, t_ns, codec.encode_image(t_ns, mm, S.DEPTH_ENCODING, frame_id))
 
     def write_ids(self, t_ns: int, ids: np.ndarray, frame_id: str = S.CAMERA_FRAME) -> None:
-        self.write_proto(S.IDS, t_ns, codec.encode_image(t_ns, ids, S.IDS_ENCODING, frame_id))
+        """Instance ids as :func:`~sgtool.log.codec.encode_ids` writes them (16UC1 when they
+        fit, else 32SC1)."""
+        self.write_proto(S.IDS, t_ns, codec.encode_ids(t_ns, ids, frame_id))
 
     def write_calibration(
         self, t_ns: int, k: CameraIntrinsics, frame_id: str = S.CAMERA_FRAME
