@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import contextlib
 import math
 import shlex
 import sys
-from dataclasses import replace
-from pathlib import Path
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -27,7 +26,9 @@ from sgtool.commands.options import (
 )
 from sgtool.datasets.presets import PRESET_NAMES
 from sgtool.errors import SgtoolError
-from sgtool.files import output_folder
+
+if TYPE_CHECKING:
+    from sgtool.analysis.bench_run import BenchRunRequest
 
 
 @click.command("bench")
@@ -113,17 +114,7 @@ from sgtool.files import output_folder
               help="Paired comparisons of every pair of planners instead of against "
                    "--reference.")
 @success_option()
-def command(planners: str | None, houses: int | None, house_files: tuple[str, ...],
-            priors_dir: str | None, episodes: int, seeds: int, workers: int, out_dir: str,
-            force: bool,
-            rooms: str, preset: str, house_seed: int, max_steps: int, distance_budget: float,
-            step_budget: float, llm_replay: str | None, llm_transcript: str | None,
-            planner_option: tuple[str, ...], log_dir: str | None,
-            progress: bool | None, success: str = "observed", executor: str = "local",
-            ray_address: str | None = None, llm_base_url: str | None = None,
-            llm_model: str | None = None, llm_api_key: str | None = None,
-            llm_timeout: float | None = None, reference: str | None = None,
-            all_pairs: bool = False) -> None:
+def command(**given: Any) -> None:
     """Run the symbolic object-search benchmark (SCOUT's SymSearch roll-out) on generated
     evaluation houses and/or house spec files and print a table in the shape of SCOUT's
     Table VII: success rate, SPL, high-level steps, decision time, and MoMa-LLM's AUC-E with
@@ -132,61 +123,86 @@ def command(planners: str | None, houses: int | None, house_files: tuple[str, ..
     (SCOUT Table IX; seen = a training query of the priors). Writes per-episode JSONL, the
     summary, per-house and per-query tables and the efficiency curves to OUT. The same
     command gives the same episodes.jsonl except its wall-clock fields."""
-    from sgtool.analysis.bench import (
-        DEFAULT_PLANNERS,
-        OUTPUT_NAMES,
-        BenchConfig,
-        run_benchmark,
-        write_outputs,
-    )
-    from sgtool.analysis.bench_houses import generated_count
+    from sgtool.analysis.bench_run import bench_into
 
-    for flag, value in (("--distance-budget", distance_budget), ("--step-budget", step_budget)):
+    bench_into(_request(BenchArgs(**given)), show=click.echo)
+
+
+@dataclass(frozen=True)
+class BenchArgs:
+    """The options of `sgtool bench` as given (the click parameters, by name)."""
+
+    planners: str | None
+    houses: int | None
+    house_files: tuple[str, ...]
+    priors_dir: str | None
+    episodes: int
+    seeds: int
+    workers: int
+    out_dir: str
+    force: bool
+    rooms: str
+    preset: str
+    house_seed: int
+    max_steps: int
+    distance_budget: float
+    step_budget: float
+    llm_replay: str | None
+    llm_transcript: str | None
+    planner_option: tuple[str, ...]
+    log_dir: str | None
+    progress: bool | None
+    success: str = "observed"
+    executor: str = "local"
+    ray_address: str | None = None
+    llm_base_url: str | None = None
+    llm_model: str | None = None
+    llm_api_key: str | None = None
+    llm_timeout: float | None = None
+    reference: str | None = None
+    all_pairs: bool = False
+
+
+def _request(args: BenchArgs) -> BenchRunRequest:
+    """The input check: the budgets, the planners and their options; the house files are
+    checked by the run before any episode, the folders by the run's output check."""
+    from sgtool.analysis.bench import BenchConfig
+    from sgtool.analysis.bench_houses import generated_count
+    from sgtool.analysis.bench_run import BenchRunRequest
+
+    for flag, value in (("--distance-budget", args.distance_budget),
+                        ("--step-budget", args.step_budget)):
         if not math.isfinite(value):
             raise SgtoolError(f"{flag} {value}: must be a finite number > 0")
-    names = planner_names(planners) if planners else DEFAULT_PLANNERS
-    options = planner_options(planner_option, names)
-    LlmEndpoint(llm_base_url, llm_model, llm_api_key, llm_timeout).fill(options, names)
-    if llm_replay or llm_transcript:
-        moma = options.setdefault("moma-llm", {})
-        if llm_replay:
-            moma["replay"] = llm_replay
-        if llm_transcript:
-            moma["transcript"] = llm_transcript
-    cfg = BenchConfig(planners=names, houses=generated_count(houses, house_files, 10),
-                      episodes=episodes, seeds=seeds,
-                      rooms=parse_rooms(rooms), preset=preset, house_seed=house_seed,
-                      max_steps=max_steps,
-                      workers=workers, distance_budget=distance_budget,
-                      step_budget=step_budget, planner_options=options, log_dir=log_dir,
-                      house_files=house_files, priors_dir=priors_dir, success=success,
-                      executor=executor, ray_address=ray_address, reference=reference,
-                      all_pairs=all_pairs)
+    names, options = _planners(args)
+    cfg = BenchConfig(planners=names, houses=generated_count(args.houses, args.house_files, 10),
+                      episodes=args.episodes, seeds=args.seeds,
+                      rooms=parse_rooms(args.rooms), preset=args.preset,
+                      house_seed=args.house_seed, max_steps=args.max_steps,
+                      workers=args.workers, distance_budget=args.distance_budget,
+                      step_budget=args.step_budget, planner_options=options,
+                      log_dir=args.log_dir, house_files=args.house_files,
+                      priors_dir=args.priors_dir, success=args.success,
+                      executor=args.executor, ray_address=args.ray_address,
+                      reference=args.reference, all_pairs=args.all_pairs)
     command_line = shlex.join(shown_command(["sgtool", *sys.argv[1:]]))
-    # OUT (and LOG_DIR) are checked before any episode runs, and get the outputs complete
-    # or not at all
-    try:
-        with output_folder(out_dir, force=force, command="bench", known=OUTPUT_NAMES) as stage, \
-                contextlib.ExitStack() as stack:
-            logs: Path | None = None
-            if log_dir is not None:  # the logs' own folder, or a part of OUT
-                logs = stage if Path(log_dir).resolve() == Path(out_dir).resolve() else \
-                    stack.enter_context(output_folder(log_dir, force=force, command="bench",
-                                                      option="--log-dir"))
-            res = run_benchmark(replace(cfg, log_dir=None if logs is None else str(logs)),
-                                progress=progress)
-            if res.failed:  # tables without some houses' episodes would pass for a result
-                raise SgtoolError(f"{len(res.failed)} task(s) failed after a retry, nothing "
-                                  f"written to {out_dir}; the first: {res.failed[0]}")
-            written = [p.name for p in write_outputs(res, stage, command=command_line)]
-    except KeyboardInterrupt as e:
-        if log_dir is not None:  # (output_folder's note names one folder)
-            e.note = (f"{out_dir} and {log_dir} are as they were: the outputs of the "  # type: ignore[attr-defined]
-                      "interrupted run were discarded")
-        raise
-    paths = [Path(out_dir) / name for name in written]
-    click.echo(res.table)
-    click.echo(res.side_by_side)
-    click.echo(res.seen_table)
-    click.echo(res.interval_tables())
-    click.echo(f"wrote {', '.join(str(p) for p in paths)}")
+    return BenchRunRequest(config=cfg, out_dir=args.out_dir, command_line=command_line,
+                           force=args.force, progress=args.progress)
+
+
+def _planners(args: BenchArgs) -> tuple[tuple[str, ...], dict[str, dict[str, Any]]]:
+    """The planners run and their checked options (``-O``, the LLM endpoint, the
+    moma-llm transcripts)."""
+    from sgtool.analysis.bench import DEFAULT_PLANNERS
+
+    names = planner_names(args.planners) if args.planners else DEFAULT_PLANNERS
+    options = planner_options(args.planner_option, names)
+    LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
+                args.llm_timeout).fill(options, names)
+    if args.llm_replay or args.llm_transcript:
+        moma = options.setdefault("moma-llm", {})
+        if args.llm_replay:
+            moma["replay"] = args.llm_replay
+        if args.llm_transcript:
+            moma["transcript"] = args.llm_transcript
+    return names, options

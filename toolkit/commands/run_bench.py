@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import sys
-from dataclasses import replace
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -24,7 +23,10 @@ from sgtool.commands.options import (
 )
 from sgtool.datasets.presets import PRESET_NAMES
 from sgtool.errors import SgtoolError
-from sgtool.files import output_folder
+
+if TYPE_CHECKING:
+    from sgtool.analysis.closed_loop_bench import ClosedLoopBenchConfig
+    from sgtool.analysis.closed_loop_bench_run import RunBenchRequest
 
 
 @click.command("run-bench")
@@ -98,18 +100,7 @@ from sgtool.files import output_folder
               "that Kendall tau (seconds to minutes; excludes --symbolic).")
 @success_option()
 @executor_options("episodes (one closed-loop run each)")
-def command(planners: str | None, houses: int | None, house_files: tuple[str, ...], house_seed: int,
-            rooms: str, preset: str, episodes: int, noise: tuple[str, ...], max_steps: int,
-            frames: int | None, frames_per_room: int | None, resolution: str, every: int,
-            navigation: str,
-            planner_option: tuple[str, ...], out_dir: str, report_only: bool,
-            progress: bool | None, force: bool = False, success: str = "observed",
-            executor: str = "local",
-            workers: int = 1, ray_address: str | None = None,
-            llm_base_url: str | None = None, llm_model: str | None = None,
-            llm_api_key: str | None = None, llm_timeout: float | None = None,
-            reference: str | None = None, all_pairs: bool = False,
-            symbolic_dir: str | None = None, with_symbolic: bool = False) -> None:
+def command(**given: Any) -> None:
     """Run closed-loop search episodes in PyBullet for every planner on generated and given
     houses (the houses and episodes of `sgtool bench`), under each noise profile: one
     episode log per run (what `sgtool run` writes), then the table of the symbolic bench
@@ -124,76 +115,101 @@ def command(planners: str | None, houses: int | None, house_files: tuple[str, ..
     Example: `sgtool run-bench --planners random,scout --houses 2 --episodes 3
     --resolution 160x120 -o rb`.
     """
-    from tqdm import tqdm
+    from sgtool.analysis.closed_loop_bench_run import run_bench_into
 
+    run_bench_into(_request(RunBenchArgs(**given)), show=click.echo)
+
+
+@dataclass(frozen=True)
+class RunBenchArgs:
+    """The options of `sgtool run-bench` as given (the click parameters, by name)."""
+
+    planners: str | None
+    houses: int | None
+    house_files: tuple[str, ...]
+    house_seed: int
+    rooms: str
+    preset: str
+    episodes: int
+    noise: tuple[str, ...]
+    max_steps: int
+    frames: int | None
+    frames_per_room: int | None
+    resolution: str
+    every: int
+    navigation: str
+    planner_option: tuple[str, ...]
+    out_dir: str
+    report_only: bool
+    progress: bool | None
+    force: bool = False
+    success: str = "observed"
+    executor: str = "local"
+    workers: int = 1
+    ray_address: str | None = None
+    llm_base_url: str | None = None
+    llm_model: str | None = None
+    llm_api_key: str | None = None
+    llm_timeout: float | None = None
+    reference: str | None = None
+    all_pairs: bool = False
+    symbolic_dir: str | None = None
+    with_symbolic: bool = False
+
+
+def _request(args: RunBenchArgs) -> RunBenchRequest:
+    """The checks: the options and the output folder's mode, then the run's configuration
+    (:meth:`ClosedLoopBenchConfig.check`) and the symbolic results to show beside it."""
+    from sgtool.analysis.closed_loop_bench import load_symbolic
+    from sgtool.analysis.closed_loop_bench_run import RunBenchRequest
+
+    _check_folder(args)
+    cfg = _config(args)
+    if args.symbolic_dir is not None and args.with_symbolic:
+        raise SgtoolError("--symbolic and --with-symbolic: give one of them")
+    cfg.check()
+    symbolic = load_symbolic(args.symbolic_dir) if args.symbolic_dir is not None else ()
+    return RunBenchRequest(
+        config=cfg, out_dir=args.out_dir, force=args.force, report_only=args.report_only,
+        progress=args.progress, executor=args.executor, workers=args.workers,
+        ray_address=args.ray_address, symbolic_dir=args.symbolic_dir, symbolic=symbolic,
+        with_symbolic=args.with_symbolic)
+
+
+def _check_folder(args: RunBenchArgs) -> None:
+    """``-o`` is a folder (or new); ``--report-only`` reads one as it is."""
+    out_dir = args.out_dir
+    if Path(out_dir).exists() and not Path(out_dir).is_dir():
+        raise SgtoolError(f"-o {out_dir}: not a folder")
+    if args.report_only and args.force:
+        raise SgtoolError("--report-only reads the run in OUT as it is; leave out --force")
+    if args.report_only and not Path(out_dir).is_dir():
+        raise SgtoolError(f"no episode log of this run in {Path(out_dir) / 'logs'}")
+
+
+def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
+    """The closed-loop bench configuration of the options (the planners' options
+    checked)."""
     from sgtool.analysis.bench import DEFAULT_PLANNERS
     from sgtool.analysis.bench_houses import generated_count
-    from sgtool.analysis.closed_loop_bench import (
-        OUTPUT_NAMES,
-        ClosedLoopBenchConfig,
-        load_symbolic,
-        run_closed_loop_bench,
-        run_symbolic,
-        write_outputs,
-    )
+    from sgtool.analysis.closed_loop_bench import ClosedLoopBenchConfig
     from sgtool.recorders.sim import CameraConfig
     from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
 
-    names = planner_names(planners) if planners else DEFAULT_PLANNERS
-    if max_steps < 1:
-        raise SgtoolError(f"--max-steps: must be >= 1, got {max_steps}")
-    width, height = parse_resolution(resolution)
-    if Path(out_dir).exists() and not Path(out_dir).is_dir():
-        raise SgtoolError(f"-o {out_dir}: not a folder")
-    if report_only and force:
-        raise SgtoolError("--report-only reads the run in OUT as it is; leave out --force")
-    if report_only and not Path(out_dir).is_dir():
-        raise SgtoolError(f"no episode log of this run in {Path(out_dir) / 'logs'}")
-    opts = ClosedLoopOptions(camera=CameraConfig(width=width, height=height), every=every,
-                             max_steps=max_steps, frames=frames, navigation=navigation,
-                             success=success)
-    options = planner_options(planner_option, names)
-    LlmEndpoint(llm_base_url, llm_model, llm_api_key, llm_timeout).fill(options, names)
-    cfg = ClosedLoopBenchConfig(
-        planners=names, houses=generated_count(houses, house_files, 5), house_seed=house_seed,
-        house_files=house_files,
-        episodes=episodes, rooms=parse_rooms(rooms), preset=preset,
-        noise=tuple(noise) or ("none",), options=opts,
-        planner_options=options,
-        frames_per_room=frames_per_room, reference=reference, all_pairs=all_pairs)
-    if symbolic_dir is not None and with_symbolic:
-        raise SgtoolError("--symbolic and --with-symbolic: give one of them")
-    cfg.check()
-    symbolic = load_symbolic(symbolic_dir) if symbolic_dir is not None else ()
-    show = sys.stderr.isatty() if progress is None else progress
-    runner: Any = map  # in this process, one episode after the other
-    if (executor != "local" or workers > 1 or ray_address) and not report_only:
-        from sgtool.analysis.executor import as_map, make_executor
-
-        runner = as_map(make_executor(executor, workers, ray_address), progress=show,
-                        desc="run-bench", task_id=lambda _, t: str(t.output))
-        show = False  # the executor's bar counts the episodes
-    # a run-bench folder (or a new one) is written in place, episode log by episode log, so
-    # that a run cut short resumes; --force builds a fresh run beside OUT
-    with output_folder(out_dir, force=force, command="run-bench", known=OUTPUT_NAMES,
-                       resume=True) as root:
-        bar = tqdm(total=None, unit="episode", desc="run-bench", file=sys.stderr,
-                   disable=not show, dynamic_ncols=True)
-        try:
-            res = run_closed_loop_bench(cfg, root, progress=bar, report_only=report_only,
-                                        runner=runner)
-        except KeyboardInterrupt as e:  # the CLI prints the note; exit 130 (143: killed)
-            e.note = (f"the complete episode logs are kept in {out_dir}/logs "  # type: ignore[attr-defined]
-                      "(run the same command again to resume)")
-            raise  # (with --force, output_folder says OUT is as it was instead)
-        finally:
-            bar.close()
-        if with_symbolic:
-            res = replace(res, symbolic=run_symbolic(cfg),
-                          symbolic_source="the symbolic bench on these episodes, 1 seed")
-        elif symbolic_dir is not None:
-            res = replace(res, symbolic=symbolic, symbolic_source=f"--symbolic {symbolic_dir}")
-        written = [p.name for p in write_outputs(res, root)]
-    paths = [Path(out_dir) / name for name in written]
-    click.echo(res.table())
-    click.echo(f"wrote {', '.join(str(p) for p in paths)}")
+    names = planner_names(args.planners) if args.planners else DEFAULT_PLANNERS
+    if args.max_steps < 1:
+        raise SgtoolError(f"--max-steps: must be >= 1, got {args.max_steps}")
+    width, height = parse_resolution(args.resolution)
+    opts = ClosedLoopOptions(camera=CameraConfig(width=width, height=height),
+                             every=args.every, max_steps=args.max_steps, frames=args.frames,
+                             navigation=args.navigation, success=args.success)
+    options = planner_options(args.planner_option, names)
+    LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
+                args.llm_timeout).fill(options, names)
+    return ClosedLoopBenchConfig(
+        planners=names, houses=generated_count(args.houses, args.house_files, 5),
+        house_seed=args.house_seed, house_files=args.house_files, episodes=args.episodes,
+        rooms=parse_rooms(args.rooms), preset=args.preset,
+        noise=tuple(args.noise) or ("none",), options=opts, planner_options=options,
+        frames_per_room=args.frames_per_room, reference=args.reference,
+        all_pairs=args.all_pairs)

@@ -5,9 +5,11 @@ from __future__ import annotations
 import os
 import shutil
 from pathlib import Path
+from typing import Any
 
 import click
 
+from sgtool.commands.options import check_output
 from sgtool.errors import SgtoolError
 
 
@@ -41,61 +43,34 @@ def command(log: str, out: str | None, every: int, max_frames: int | None,
     not show the maps: they do not read foxglove.Grid/SceneUpdate. This command draws them;
     for ROS tools, `sgtool export bag DERIVED.mcap -o OUT` writes them as
     nav_msgs/OccupancyGrid and visualization_msgs/MarkerArray."""
-    from tqdm import tqdm
+    from sgtool.analysis.view_run import ViewRequest, view_log
 
+    live = _target(log, out, force, rerun_to)
+    view_log(ViewRequest(log=log, output=out, every=every,
+                         max_frames=max_frames, voxels=voxels, live=live),
+             show=click.echo, note=lambda m: click.echo(m, err=True))
+
+
+def _target(log: str, out: str | None, force: bool, rerun_to: str | None) -> Any:
+    """The output check: ``-o`` through :func:`check_output` (not the input log), else the
+    live target of ``--rerun`` (default: spawn a viewer, which needs a display and the
+    ``rerun`` program); None when writing a file."""
     from sgtool.analysis.rerun_live import LiveTarget, parse_target
-    from sgtool.analysis.rerun_view import export
-    from sgtool.log import LogReader
 
-    live = None
     if rerun_to is not None and out is not None:
         raise SgtoolError("-o writes a file, --rerun streams: give one of them")
-    if out is None:
-        live = parse_target(rerun_to) if rerun_to is not None else LiveTarget("spawn")
-        if live.mode == "spawn" and not (os.environ.get("DISPLAY")
-                                         or os.environ.get("WAYLAND_DISPLAY")):
-            raise SgtoolError("no display to open the Rerun viewer on; write a file with "
-                              "-o view.rrd and open it with `rerun view.rrd` elsewhere, or "
-                              "serve a web viewer from here with --rerun serve")
-        if live.mode == "spawn" and shutil.which("rerun") is None:
-            raise SgtoolError("the `rerun` viewer is not on PATH; use -o view.rrd or "
-                              "--rerun serve")
-    elif Path(out).resolve() == Path(log).resolve():
-        raise SgtoolError("the output must not be the input log")
-    else:
-        from sgtool.commands.options import check_output
-
+    if out is not None:
+        if Path(out).resolve() == Path(log).resolve():
+            raise SgtoolError("the output must not be the input log")
         check_output(out, force=force)
-    with LogReader(log) as r:
-        total = r.frame_count() if r.has("/camera/depth") else 0
-    if max_frames is not None:
-        total = min(total, max_frames)
-    voxel_source = None
-    if voxels:
-        try:
-            from sgtool.replayers.voxels import voxel_snapshots
-        except ImportError:
-            voxel_source = None
-        else:
-            def voxel_source(reader):  # type: ignore[no-untyped-def]
-                return voxel_snapshots(reader, every=max(every, 10), max_frames=max_frames)
-    with tqdm(total=total, unit="frame", desc="view", disable=None) as bar:
-        export(log, out, every=every, max_frames=max_frames, progress=bar.update,
-               voxels=voxel_source, live=live,
-               warn=lambda m: click.echo(f"note: {m}", err=True),
-               hold=_serve_until_interrupted if live is not None and live.mode == "serve"
-               else None)
-    if out:
-        click.echo(f"wrote {out}; open it with: rerun {out}")
-
-
-def _serve_until_interrupted() -> None:
-    """Keep a served recording up until Ctrl-C."""
-    import time
-
-    click.echo("rerun: everything sent; still serving, press Ctrl-C to stop", err=True)
-    try:
-        while True:
-            time.sleep(1.0)
-    except KeyboardInterrupt:
-        pass
+        return None
+    live = parse_target(rerun_to) if rerun_to is not None else LiveTarget("spawn")
+    if live.mode == "spawn" and not (os.environ.get("DISPLAY")
+                                     or os.environ.get("WAYLAND_DISPLAY")):
+        raise SgtoolError("no display to open the Rerun viewer on; write a file with "
+                          "-o view.rrd and open it with `rerun view.rrd` elsewhere, or "
+                          "serve a web viewer from here with --rerun serve")
+    if live.mode == "spawn" and shutil.which("rerun") is None:
+        raise SgtoolError("the `rerun` viewer is not on PATH; use -o view.rrd or "
+                          "--rerun serve")
+    return live
