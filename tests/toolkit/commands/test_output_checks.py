@@ -19,7 +19,8 @@ from sgtool.house.io import save_house
 
 GOLDEN_LOG = Path(__file__).resolve().parents[2] / "golden" / "house6-tour.mcap"
 
-# command line with {out} for the output and {house} for a house spec; the output's suffix
+# command line with {out} for the output, {house} for a house spec and {inputs} for its
+# folder (writable); the output's suffix
 COMMANDS = {
     "record": (["record", "--frames", "1", "-o", "{out}"], ".mcap"),
     "run": (["run", "--planner", "random", "--frames", "1", "-o", "{out}"], ".mcap"),
@@ -27,6 +28,11 @@ COMMANDS = {
     "scenes generate": (["scenes", "generate", "-o", "{out}"], ".json"),
     "scenes show": (["scenes", "show", "{house}", "-o", "{out}"], ".png"),
     "view": (["view", str(GOLDEN_LOG), "-o", "{out}"], ".rrd"),
+    "replay": (["replay", str(GOLDEN_LOG), "-o", "{out}", "--no-progress"], ".mcap"),
+    "replay --rrd": (["replay", str(GOLDEN_LOG), "-o", "{inputs}/derived.mcap", "--rrd",
+                      "{out}", "--no-progress"], ".rrd"),
+    "import rgbd": (["import", "rgbd", "{inputs}", "-o", "{out}", "--quiet"], ".mcap"),
+    "export bag": (["export", "bag", str(GOLDEN_LOG), "-o", "{out}"], ".bag"),
 }
 
 
@@ -56,7 +62,8 @@ def test_a_bad_target_is_one_line_and_leaves_nothing(name: str, target: str, tmp
     before = _files(where)
     if target == "read-only":
         make_read_only(where, monkeypatch)
-    line = [a.replace("{out}", str(out)).replace("{house}", str(house)) for a in args]
+    line = [a.replace("{out}", str(out)).replace("{house}", str(house))
+            .replace("{inputs}", str(house.parent)) for a in args]
     if target == "folder":
         line.append("--force")
     try:
