@@ -172,3 +172,44 @@ def test_bayes_rooms_is_bayes_search_with_the_seen_type_weight() -> None:
     base = make_planner("bayes-search")
     assert base.name == "bayes-search"
     assert base.inner.params.belief.seen_type_weight == 1.0
+
+
+def _best_by_loop(cands: list[Candidate], p: np.ndarray, params: SearchParams,
+                  robot: tuple[float, float]) -> tuple[int, float]:
+    """best_first's look-ahead written as one sequence_value call per ordering."""
+    import itertools
+
+    from sgtool.planning.search_theory import detour_factor, extra_cost, sequence_value
+
+    extra = np.array([extra_cost(c, params) for c in cands])
+    first = np.array([c.distance for c in cands]) + extra
+    ratio = p / first
+    top = sorted(range(len(cands)), key=lambda i: (-ratio[i], cands[i].node_id))[:params.top_k]
+    rho = detour_factor(cands, robot)
+    legs = np.zeros((len(cands), len(cands)))
+    for a in top:
+        for b in top:
+            d = cands[a].position[0] - cands[b].position[0], \
+                cands[a].position[1] - cands[b].position[1]
+            legs[a, b] = rho * float(np.hypot(*d)) + extra[b]
+    best = None
+    for order in itertools.permutations(top, params.horizon):
+        key = (-sequence_value(order, p, first, legs), tuple(cands[i].node_id for i in order))
+        if best is None or key < best[0]:
+            best = (key, order[0])
+    assert best is not None
+    return best[1], -best[0][0]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_look_ahead_equals_one_sequence_value_per_ordering(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n = 9
+    xs = rng.integers(0, 4, n).astype(float)  # few distinct positions: ties happen
+    cands = [Candidate(f"obj:{i}", "open" if i % 2 else "navigate", "object",
+                       float(abs(xs[i]) + 1.0), (float(xs[i]), 0.0)) for i in range(n)]
+    p = rng.choice([0.05, 0.1, 0.2], n)
+    p = p / p.sum()
+    params = SearchParams(step_budget=0)
+    assert best_first(cands, p, (0.0, 0.0), params) == \
+        _best_by_loop(cands, p, params, (0.0, 0.0))
