@@ -27,8 +27,10 @@ PANELS: tuple[tuple[str, str, float], ...] = (
 MARKERS = "osD^v<>ph*"
 
 
-def _label(c: Condition) -> str:
-    return "0" if c.factor == NONE and c.level == "0" else c.level
+def _label(c: Condition, factor: str) -> str:
+    if c.factor == NONE:
+        return "none" if factor == PROFILE else "0"
+    return c.level
 
 
 def plot_factor(res: StudyResult, factor: str, conds: Sequence[Condition],
@@ -60,7 +62,7 @@ def plot_factor(res: StudyResult, factor: str, conds: Sequence[Condition],
         ax.plot(xs, med, color="black", linewidth=1.6, marker="_", markersize=12,
                 label="median")
         ax.set_xticks(xs)
-        ax.set_xticklabels([_label(c) for c in conds], fontsize=8)
+        ax.set_xticklabels([_label(c, factor) for c in conds], fontsize=8)
         ax.set_ylabel(label, fontsize=9)
         ax.grid(True, alpha=0.3)
         if key == "purity":
