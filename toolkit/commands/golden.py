@@ -138,9 +138,9 @@ def check(folder: str, names: tuple[str, ...], every: int | None, classifier: st
     nothing changed, 1 when something did, 2 when a log could not be checked."""
     from sgtool.analysis.executor import make_executor
     from sgtool.analysis.golden_check import check_pins, update_pins
-    from sgtool.analysis.golden_report import junit_report, markdown_report, text_report
-    from sgtool.files import atomic_write
+    from sgtool.analysis.golden_report import text_report
 
+    _check_report_files(report_md, junit)
     runner = make_executor(executor, workers, ray_address)
     report = check_pins(Path(folder),
                         make_options(every, classifier, min_points, voxel_size, max_frames),
@@ -148,10 +148,7 @@ def check(folder: str, names: tuple[str, ...], every: int | None, classifier: st
                         keep=update, progress=_show(progress))
     for line in text_report(report):
         click.echo(line)
-    if report_md:
-        atomic_write(report_md, markdown_report(report))
-    if junit:
-        atomic_write(junit, junit_report(report))
+    _write_report_files(report, report_md, junit)
     code = report.exit_code
     if update:
         for line in update_pins(report):
@@ -165,3 +162,24 @@ def check(folder: str, names: tuple[str, ...], every: int | None, classifier: st
         click.echo("changed on purpose? accept it with: sgtool golden check --dir "
                    f"{folder} --update", err=True)
         raise click.exceptions.Exit(code)
+
+
+def _check_report_files(report_md: str | None, junit: str | None) -> None:
+    """``--report`` and ``--junit`` through the one output check before any replay (each
+    is replaced when it exists: a report of the last check)."""
+    from sgtool.commands.options import check_output
+
+    for path, option in ((report_md, "--report"), (junit, "--junit")):
+        if path:
+            check_output(path, force=True, option=option)
+
+
+def _write_report_files(report: Any, report_md: str | None, junit: str | None) -> None:
+    """The Markdown report and the JUnit XML of a check, each written atomically."""
+    from sgtool.analysis.golden_report import junit_report, markdown_report
+    from sgtool.files import atomic_write
+
+    if report_md:
+        atomic_write(report_md, markdown_report(report))
+    if junit:
+        atomic_write(junit, junit_report(report))

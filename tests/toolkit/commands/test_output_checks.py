@@ -79,3 +79,17 @@ def test_a_bad_target_is_one_line_and_leaves_nothing(name: str, target: str, tmp
     assert _files(where) == before  # the existing file keeps its bytes; no temp file left
     assert sorted(p.relative_to(where).as_posix() for p in where.rglob("*")) == \
         sorted({*before, *(["out" + suffix] if target == "folder" else [])})
+
+
+@pytest.mark.parametrize("option", ["--report", "--junit"])
+def test_golden_check_reports_are_checked_before_any_replay(option: str,
+                                                            tmp_path: Path) -> None:
+    # a report goes into a missing folder: refused before the pin folder is even read
+    # (that folder does not exist either; its own error would come after)
+    out = tmp_path / "no" / "such" / "report.txt"
+    r = CliRunner().invoke(cli, ["golden", "check", "--dir", str(tmp_path / "pins"), option,
+                                 str(out)])
+    assert r.exit_code == 2, r.output
+    assert len(r.output.strip().splitlines()) == 1 and "Traceback" not in r.output
+    assert f"{option} {out}: folder {out.parent} does not exist" in r.output
+    assert list(tmp_path.iterdir()) == []  # nothing made: no pin folder, no report folder
