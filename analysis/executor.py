@@ -38,7 +38,6 @@ from sgtool.errors import SgtoolError, Terminated, raise_terminated
 from sgtool.extras import missing_message
 
 EXECUTORS: tuple[str, ...] = ("local", "ray")
-RAY_INSTALL = "pip install 'sgtool[ray]'"
 RETRIES = 1  # a task that raised runs once more before it is reported
 
 

@@ -43,7 +43,6 @@ from sgtool.errors import SgtoolError
 GRPC_PORT = 9876
 WEB_PORT = 9090
 DEFAULT_CONNECT = f"rerun+http://127.0.0.1:{GRPC_PORT}/proxy"
-MODES = ("spawn", "connect", "serve")
 
 
 @dataclass(frozen=True)

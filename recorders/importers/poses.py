@@ -101,10 +101,6 @@ class PoseTrack:
     def __len__(self) -> int:
         return len(self.times)
 
-    @property
-    def span_ns(self) -> tuple[int, int] | None:
-        return (self.times[0], self.times[-1]) if self.times else None
-
     def at(self, t_ns: int) -> np.ndarray | None:
         """The pose at ``t_ns`` or None when the track does not cover that time."""
         if not self.times:

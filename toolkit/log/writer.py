@@ -147,7 +147,6 @@ class LogWriter:
         self._channels: dict[str, int] = {}
         self._sequence: dict[int, int] = {}
         self._last_calibration: CameraIntrinsics | None = None
-        self._static_sent: set[tuple[str, str]] = set()
 
     # ----- channels ---------------------------------------------------------------------
     def _proto_channel(self, topic: str, message_class: Any) -> int:
