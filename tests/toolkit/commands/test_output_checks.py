@@ -33,6 +33,7 @@ COMMANDS = {
                       "{out}", "--no-progress"], ".rrd"),
     "import rgbd": (["import", "rgbd", "{inputs}", "-o", "{out}", "--quiet"], ".mcap"),
     "export bag": (["export", "bag", str(GOLDEN_LOG), "-o", "{out}"], ".bag"),
+    "export foxglove-layout": (["export", "foxglove-layout", "-o", "{out}"], ".json"),
 }
 
 
