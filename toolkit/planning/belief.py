@@ -64,6 +64,17 @@ over the scored room types: for a kitchen thing, the unknown rooms lose mass onc
 kitchen is explored (its own carriers gain it), and gain it while no kitchen has been
 seen. η = 1 is the plain mean of :func:`known_room_mean`.
 
+**Many carriers of one kind** (``instance_exponent`` γ, 1 = off). C(o) scores a carrier's
+category ("is a spatula found with a cabinet"), not one instance of it: a kitchen with
+twenty closed cabinets and one countertop would hold twenty times the cabinet's mass and
+send the search through every cabinet before the countertop. With n the carriers of o's
+category in o's room (checked ones included, as in Z_r),
+
+    C'(o) = C(o) · n^(γ - 1)                                                         (B8)
+
+so the n together hold C · n^γ: γ = 1 is (B2) unchanged, γ = 0 gives the category one share
+whatever its count, γ = 0.5 grows it with the square root of the count.
+
 **Bayes update.** A checked place that was empty leaves the candidate set while its C(o)
 stays in Z_r, so renormalising over the remaining candidates,
 
@@ -101,6 +112,7 @@ class BeliefParams:
     fallback_room: float = 0.3  # R̄ when the prior lists no room types
     region_weight: float = 0.5  # ω of K = ω n̄ C̄, (B2)-(B3) (module doc)
     seen_type_weight: float = 1.0  # η of (B7): weight of a room type per sighting; 1: off
+    instance_exponent: float = 1.0  # γ of (B8): mass of n like carriers ∝ n^γ; 1: off
 
 
 def known_room_mean(scorer: RelationScorer, query: str, params: BeliefParams) -> float:
@@ -190,6 +202,14 @@ def place_masses(graph: SceneGraph, cands: Sequence[Candidate], query: str,
     return out / total if total > 0 else np.full(len(cands), 1.0 / len(cands))
 
 
+def split_instances(carriers: Sequence[ObjectNode], c_of: dict[str, float],
+                    gamma: float) -> dict[str, float]:
+    """(B8): each of the n carriers of one category in one room gets C · n^(γ - 1)."""
+    n: Counter[tuple[str, str]] = Counter((o.room, category_text(o.category)) for o in carriers)
+    return {o.id: c_of[o.id] * n[(o.room, category_text(o.category))] ** (gamma - 1.0)
+            for o in carriers}
+
+
 def _object_masses(graph: SceneGraph, cands: Sequence[Candidate], query: str,
                    scorer: RelationScorer, params: BeliefParams, rooms: dict[str, float],
                    unknown: float) -> np.ndarray:
@@ -200,6 +220,8 @@ def _object_masses(graph: SceneGraph, cands: Sequence[Candidate], query: str,
         cs = calibrate(scorer.objects([o.category for o in carriers], query),
                        params.object_floor, params.object_sharpness)
         c_of = {o.id: float(c) for o, c in zip(carriers, cs, strict=True)}
+        if params.instance_exponent != 1.0:
+            c_of = split_instances(carriers, c_of, params.instance_exponent)
     revealed = sum(1 for r in graph.regions if r.kind != "frontier")
     per_region = max(1.0, len(carriers) / max(1, revealed))
     mean_c = float(np.mean(list(c_of.values()))) if c_of else 0.5

@@ -124,6 +124,9 @@ class BayesSearchOptions(NodeOptions):
     seen_type_weight: float = field(default=1.0, metadata=option(
         "eta of (B7): weight of a room type in an unexplored room's mean per explored room "
         "of that type; 1: off", "float", lo=0.0, hi=1.0))
+    instance_exponent: float = field(default=1.0, metadata=option(
+        "gamma of (B8): n carriers of one category in a room hold C n^gamma; 1: off",
+        "float", lo=0.0, hi=1.0))
     blend: bool = field(default=True, metadata=option(
         "blend the learned scores with the cosine by query novelty", "bool"))
     furniture_levels: str | Mapping[str, float] | None = field(default=None, metadata=option(

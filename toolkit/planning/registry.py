@@ -123,6 +123,7 @@ def _furniture_levels(value: Any) -> Any:
 
 
 BAYES_ROOMS_SEEN_TYPE_WEIGHT = 0.3  # eta of (B7) for bayes-rooms
+BAYES_ROOMS_INSTANCE_EXPONENT = 0.5  # gamma of (B8) for bayes-rooms
 
 
 def _bayes(name: str, o: BayesSearchOptions) -> Planner:
@@ -133,7 +134,9 @@ def _bayes(name: str, o: BayesSearchOptions) -> Planner:
                           sharpness=o.sharpness, object_sharpness=o.object_sharpness,
                           beyond=o.beyond, miss=o.miss, region_weight=o.region_weight,
                           seen_type_weight=(BAYES_ROOMS_SEEN_TYPE_WEIGHT
-                                            if name == "bayes-rooms" else o.seen_type_weight))
+                                            if name == "bayes-rooms" else o.seen_type_weight),
+                          instance_exponent=(BAYES_ROOMS_INSTANCE_EXPONENT
+                                             if name == "bayes-rooms" else o.instance_exponent))
     params = SearchParams(step_cost=o.step_cost, open_cost=o.open_cost,
                           reveal_cost=o.reveal_cost, top_k=o.top_k, horizon=o.horizon,
                           step_budget=o.step_budget, belief=belief)
@@ -213,9 +216,10 @@ REGISTRY: Mapping[str, Entry] = MappingProxyType({
     "bayes-search": Entry(_bayes, BayesSearchOptions, "search theory: Bayes belief over "
                           "places, p/c rule with a look-ahead (sgtool.planning.search_theory)"),
     "bayes-rooms": Entry(_bayes, BayesSearchOptions, "bayes-search whose unexplored rooms "
-                         "discount the room types already explored, (B7) of "
-                         "sgtool.planning.belief",
-                         fixed={"seen_type_weight": BAYES_ROOMS_SEEN_TYPE_WEIGHT}),
+                         "discount the room types already explored and whose like carriers "
+                         "share their category's mass, (B7)-(B8) of sgtool.planning.belief",
+                         fixed={"seen_type_weight": BAYES_ROOMS_SEEN_TYPE_WEIGHT,
+                                "instance_exponent": BAYES_ROOMS_INSTANCE_EXPONENT}),
     "moma-llm": Entry(_moma, MomaOptions, "MoMa-LLM over an OpenAI-compatible chat endpoint "
                       "or a transcript"),
     "unstructured-llm": Entry(_moma, MomaOptions, "MoMa-LLM's ablation: shown the raw JSON "

@@ -165,13 +165,53 @@ def test_explored_room_types_leave_the_mean_of_unexplored_rooms() -> None:
     assert p_on["obj:1"] > p_off["obj:1"]
 
 
-def test_bayes_rooms_is_bayes_search_with_the_seen_type_weight() -> None:
+def test_bayes_rooms_is_bayes_search_with_eta_and_gamma() -> None:
     p = make_planner("bayes-rooms")
     assert p.name == "bayes-rooms"
     assert p.inner.params.belief.seen_type_weight == 0.3
+    assert p.inner.params.belief.instance_exponent == 0.5
     base = make_planner("bayes-search")
     assert base.name == "bayes-search"
     assert base.inner.params.belief.seen_type_weight == 1.0
+    assert base.inner.params.belief.instance_exponent == 1.0
+
+
+def cabinet_kitchen() -> SceneGraph:
+    """An explored kitchen with four closed cabinets and one countertop, all 1 m away."""
+    cabinets = tuple(ObjectNode(f"obj:{i}", "cabinet", "region:1.1", "room:1",
+                                (float(i), 1.0, 0.0), state="closed", affordances=("open",))
+                     for i in range(1, 5))
+    counter = ObjectNode("obj:9", "countertop", "region:1.1", "room:1", (0.0, -1.0, 0.0),
+                         affordances=("examine",))
+    return SceneGraph(
+        RobotState((0.0, 0.0), room="room:1"),
+        rooms=(RoomNode("room:1", "kitchen", (0.0, 0.0)),),
+        regions=(RegionNode("region:1.1", "room:1", (0.0, 0.0)),),
+        objects=(*cabinets, counter),
+        distances={o.id: 1.0 for o in (*cabinets, counter)},
+    )
+
+
+def test_like_carriers_share_their_category_mass() -> None:
+    # a spatula: a cabinet and a countertop score alike, so with (B2) the four cabinets
+    # hold four times the countertop's mass; with (B8) gamma = 0 they hold one share
+    scorer = TableScorer(rooms={"kitchen": 0.9}, objects={"cabinet": 0.6, "countertop": 0.6})
+    g = cabinet_kitchen()
+    cands = actionable(g)
+    ids = [c.node_id for c in cands]
+    for gamma, cabinets_to_counter in ((1.0, 4.0), (0.5, 2.0), (0.0, 1.0)):
+        params = BeliefParams(instance_exponent=gamma)
+        p = dict(zip(ids, place_masses(g, cands, "spatula", scorer, params), strict=True))
+        cab = sum(p[f"obj:{i}"] for i in range(1, 5))
+        assert cab / p["obj:9"] == pytest.approx(cabinets_to_counter)
+    # the countertop is looked at first once the cabinets share their mass
+    planner = SearchTheoryPlanner(scorer, SearchParams(
+        belief=BeliefParams(instance_exponent=0.5)))
+    planner.reset("spatula")
+    assert planner.decide(g).target == "obj:9"
+    planner = SearchTheoryPlanner(scorer)
+    planner.reset("spatula")
+    assert planner.decide(g).target != "obj:9"
 
 
 def _best_by_loop(cands: list[Candidate], p: np.ndarray, params: SearchParams,
