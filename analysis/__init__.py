@@ -4,7 +4,7 @@ Modules (import them directly; this package imports nothing on its own):
 
 - :mod:`sgtool.results`: the per-episode record (:class:`EpisodeResult`), its JSONL
   file, the digest without wall-clock figures, the mapping from log records;
-- :mod:`sgtool.analysis.metrics`: SR, SPL, steps, decision time, MoMa-LLM's AUC-E (distance
+- :mod:`sgtool.analysis.search_metrics`: SR, SPL, steps, decision time, MoMa-LLM's AUC-E (distance
   plus open cost, and step budget), mean ± std over seeds, seen/unseen breakdown;
 - :mod:`sgtool.analysis.report`: tables in the shape of SCOUT's Tables VII and IX;
 - :mod:`sgtool.analysis.curves`: efficiency curves as PNG;

@@ -76,7 +76,6 @@ from sgtool.analysis.intervals import (
     paired_comparison,
     planner_intervals,
 )
-from sgtool.analysis.metrics import CostModel, breakdown, cost_models, seen_unseen, summarize
 from sgtool.analysis.paper_tables import TABLE_IX_SYMSEARCH
 from sgtool.analysis.report import (
     breakdown_records,
@@ -91,6 +90,7 @@ from sgtool.analysis.report import (
     llm_answer_totals,
     summary_dict,
 )
+from sgtool.analysis.search_metrics import CostModel, breakdown, cost_models, seen_unseen, summarize
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write, output_folder

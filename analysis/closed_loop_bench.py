@@ -54,10 +54,10 @@ from sgtool.analysis.closed_loop_tables import (
     interval_tables,
     symbolic_agreement,
 )
-from sgtool.analysis.metrics import CostModel, cost_models, summarize
 from sgtool.analysis.offline import read_log_episodes
 from sgtool.analysis.report import format_table, pipe_table
 from sgtool.analysis.run_bench_resume import check_resumable, task_settings
+from sgtool.analysis.search_metrics import CostModel, cost_models, summarize
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write

@@ -8,7 +8,7 @@ JSON-ready dicts for ``summary.json``, nothing read or written here.
 
 Frame-budget curve: an episode that succeeded after ``f`` frames in a house of ``R``
 rooms counts as solved for every budget of at least ``f / R`` frames per room; the curve
-is MoMa-LLM's efficiency curve on that cost (:func:`sgtool.analysis.metrics.curve_of`)
+is MoMa-LLM's efficiency curve on that cost (:func:`sgtool.analysis.search_metrics.curve_of`)
 and AUC-E its area over [0, max]. It reads a budget off one unbudgeted run (the planners
 do not know the budget), so no single ``--frames-per-room`` decides the table; the max is
 the run's own ``--frames-per-room`` when it has one, else the most frames per room any
@@ -32,8 +32,8 @@ from sgtool.analysis.intervals import (
     paired_comparison,
     planner_intervals,
 )
-from sgtool.analysis.metrics import CostModel, auc_e_of, spl, success_rate
 from sgtool.analysis.report import fmt_interval, format_intervals, format_paired, pipe_table
+from sgtool.analysis.search_metrics import CostModel, auc_e_of, spl, success_rate
 from sgtool.results import EpisodeResult
 
 EpisodeKey = tuple[str, int, str, int]  # EpisodeResult.key(): planner, seed, house, episode

@@ -2,7 +2,7 @@
 
 MoMa-LLM's efficiency curve (and SCOUT's Fig. 8 for the step budget): the share of all
 episodes solved within each budget, drawn as the same polyline whose area is AUC-E
-(:func:`sgtool.analysis.metrics.efficiency_curve`); the legend gives each planner's AUC-E.
+(:func:`sgtool.analysis.search_metrics.efficiency_curve`); the legend gives each planner's AUC-E.
 Drawn with matplotlib's Agg backend (no display needed); the PNG carries no timestamp.
 """
 
@@ -13,7 +13,7 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
-from sgtool.analysis.metrics import CostModel, curve_area, curve_of
+from sgtool.analysis.search_metrics import CostModel, curve_area, curve_of
 from sgtool.files import atomic_write
 from sgtool.results import EpisodeResult
 

@@ -56,8 +56,8 @@ class EvalOutcome:
 def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
     """Score the request's episodes and replay its planners on the logged decisions."""
     from sgtool.analysis.batch_eval import load_many
-    from sgtool.analysis.metrics import cost_models, summarize
     from sgtool.analysis.offline import log_exchanges, with_success_rule
+    from sgtool.analysis.search_metrics import cost_models, summarize
 
     results, logged, notes, unread = load_many([Path(i) for i in request.inputs], request.runner,
                                                progress=request.progress)
@@ -100,8 +100,8 @@ def _replays(request: EvalRequest, logged: Sequence[Any], exchanges: Sequence[An
 def _as_json(request: EvalRequest, results: Sequence[Any], notes: Sequence[str],
              models: Sequence[Any], sums: Any, reports: Sequence[Any],
              exchanges: Sequence[Any]) -> str:
-    from sgtool.analysis.metrics import seen_unseen
     from sgtool.analysis.report import summary_dict
+    from sgtool.analysis.search_metrics import seen_unseen
     from sgtool.llm.stats import answer_stats
 
     doc: dict[str, Any] = {
@@ -124,9 +124,9 @@ def _as_json(request: EvalRequest, results: Sequence[Any], notes: Sequence[str],
 def _as_tables(request: EvalRequest, results: Sequence[Any], notes: Sequence[str],
                models: Sequence[Any], sums: Any, reports: Sequence[Any],
                exchanges: Sequence[Any]) -> str:
-    from sgtool.analysis.metrics import seen_unseen
     from sgtool.analysis.offline import format_offline
     from sgtool.analysis.report import format_seen_unseen, format_table
+    from sgtool.analysis.search_metrics import seen_unseen
     from sgtool.llm.stats import answer_stats, format_stats
 
     parts = [format_table(sums, models=models,

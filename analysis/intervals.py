@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sgtool.analysis.metrics import episode_spl
+from sgtool.analysis.search_metrics import episode_spl
 from sgtool.results import EpisodeResult
 
 RESAMPLES = 10_000  # bootstrap resamples of every interval

@@ -204,7 +204,7 @@ def summary_md(res: StudyResult) -> str:
 def closed_loop_records(cl: Any) -> list[dict[str, Any]]:
     """One record per closed-loop episode: planner, noise, house, episode, query, success,
     SPL, steps, frames, end."""
-    from sgtool.analysis.metrics import episode_spl
+    from sgtool.analysis.search_metrics import episode_spl
 
     out = []
     for r in cl.rows:
@@ -221,7 +221,7 @@ def closed_loop_md(cl: Any) -> list[str]:
     """SR and SPL per planner and noise profile, and the paired difference of SR to the
     first profile (the same episodes), with its 95 % interval (normal approximation of the
     paired differences, clipped to [-1, 1])."""
-    from sgtool.analysis.metrics import episode_spl
+    from sgtool.analysis.search_metrics import episode_spl
 
     cfg = cl.config
     recs: dict[tuple[str, str], dict[tuple[str, int], Any]] = {}

@@ -15,13 +15,6 @@ import re
 from collections.abc import Mapping, Sequence
 
 from sgtool.analysis.intervals import Bootstrap, Interval, PairedComparison, PlannerIntervals
-from sgtool.analysis.metrics import (
-    BreakdownRow,
-    CostModel,
-    PlannerSummary,
-    SplitSummary,
-    Stat,
-)
 from sgtool.analysis.paper_tables import (
     SOURCE,
     SOURCE_IX,
@@ -29,6 +22,13 @@ from sgtool.analysis.paper_tables import (
     QuotedRow,
     QuotedSplit,
     quoted_for,
+)
+from sgtool.analysis.search_metrics import (
+    BreakdownRow,
+    CostModel,
+    PlannerSummary,
+    SplitSummary,
+    Stat,
 )
 from sgtool.llm.stats import COUNTS, invalid_rate_text
 from sgtool.results import EpisodeResult

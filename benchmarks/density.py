@@ -28,8 +28,8 @@ from sgtool.commands.options import parse_rooms
 from sgtool.datasets.episode_mix import symsearch_episodes
 from sgtool.datasets.episodes import list_episodes
 from sgtool.datasets.generator import generate_house
+from sgtool.datasets.scene_stats import house_stats
 from sgtool.datasets.split import unseen_queries
-from sgtool.datasets.stats import house_stats
 from sgtool.planning.registry import make_planner
 from sgtool.recorders.symbolic_environment import SymbolicHouse, run_episode
 from sgtool.semantics.text import category_text

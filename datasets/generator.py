@@ -69,7 +69,7 @@ The steps live in their own modules; this one runs them in order and assembles t
 :mod:`~sgtool.datasets.floor_plan` (1, 2), :mod:`~sgtool.datasets.openings` (doors and
 passages), :mod:`~sgtool.datasets.walls`, :mod:`~sgtool.datasets.furnishing` and
 :mod:`~sgtool.datasets.room_space` (3), :mod:`~sgtool.datasets.object_candidates` and
-:mod:`~sgtool.datasets.object_placement` (4), :mod:`~sgtool.datasets.robot_clearance`
+:mod:`~sgtool.datasets.small_objects` (4), :mod:`~sgtool.datasets.robot_clearance`
 (start poses and 5).
 """
 
@@ -94,9 +94,9 @@ from sgtool.datasets.house_plan import (
     Plan,
     PlanRetry,
 )
-from sgtool.datasets.object_placement import place_objects
 from sgtool.datasets.presets import get_preset
 from sgtool.datasets.robot_clearance import start_poses
+from sgtool.datasets.small_objects import place_objects
 from sgtool.datasets.synsets import readable_name
 from sgtool.datasets.walls import wall_segments
 from sgtool.errors import SgtoolError

@@ -2,7 +2,7 @@
 
 :func:`replay` reads a log once, in log-time order (ties in file order, i.e. the order the
 recorder wrote them), and feeds a :class:`~sgtool.scenegraph.stream.SceneGraphStream`:
-instance tables, frames (assembled by :class:`~sgtool.log.assembly.FrameAssembler`) and
+instance tables, frames (assembled by :class:`~sgtool.log.frame_assembly.FrameAssembler`) and
 action records. With an output it also writes the derived log: a copy of every input
 message (same bytes, same channels and schemas, same order), the input's attachments and
 its ``sgtool`` metadata, and after the message that caused each refresh the derived
@@ -44,8 +44,8 @@ from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
 from sgtool.heap import frozen_heap, small_pages
 from sgtool.log import schemas as S
-from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler
 from sgtool.log.chunk_copy import RawChunk, in_sequence
+from sgtool.log.frame_assembly import FRAME_TOPICS, FrameAssembler
 from sgtool.log.reader import LogReader
 from sgtool.log.records import Episode, Instances
 from sgtool.log.writer import LogWriter

@@ -15,7 +15,7 @@ corridor, else away from the robot, and where the open panel does not cut throug
 furniture or walls.
 
 Containers (openable furniture): the front face is the box's local +y side (the side
-that faces the room, see :mod:`sgtool.datasets.object_placement`). Fronts up to
+that faces the room, see :mod:`sgtool.datasets.small_objects`). Fronts up to
 :data:`DOUBLE_DOOR_WIDTH` wide get one door hinged on the left, wider ones two doors hinged
 on either side, so an open door sticks out at most half the front's width.
 """

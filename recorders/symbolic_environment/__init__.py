@@ -3,7 +3,7 @@
 SCOUT (sec. V) evaluates high-level search decisions on scene graphs without a simulator.
 This package turns a :class:`~sgtool.house.spec.HouseSpec` into that environment:
 
-- :mod:`~sgtool.recorders.symbolic_environment.regions`: a room's regions, its furniture
+- :mod:`~sgtool.recorders.symbolic_environment.furniture_regions`: a room's regions, its furniture
   clustered by k-means with k chosen by BIC (X-means);
 - :mod:`~sgtool.recorders.symbolic_environment.house`: :class:`SymbolicHouse`, the house
   prepared once (regions, places, travel distances for any door states);
@@ -17,13 +17,13 @@ This package turns a :class:`~sgtool.house.spec.HouseSpec` into that environment
 """
 
 from sgtool.recorders.symbolic_environment.environment import N_MAX, StepOutcome, SymbolicEnv
-from sgtool.recorders.symbolic_environment.house import Region, SymbolicHouse
-from sgtool.recorders.symbolic_environment.observation import ObservedGraph
-from sgtool.recorders.symbolic_environment.regions import (
+from sgtool.recorders.symbolic_environment.furniture_regions import (
     MAX_REGIONS,
     MIN_REGION_STD,
     cluster_regions,
 )
+from sgtool.recorders.symbolic_environment.house import Region, SymbolicHouse
+from sgtool.recorders.symbolic_environment.observation import ObservedGraph
 from sgtool.recorders.symbolic_environment.rollout import (
     EpisodeLog,
     RunOneError,

@@ -42,7 +42,7 @@ from sgtool.mapping.occupancy import (
     house_occupancy,
     world_to_cell,
 )
-from sgtool.recorders.symbolic_environment.regions import cluster_regions
+from sgtool.recorders.symbolic_environment.furniture_regions import cluster_regions
 from sgtool.scenegraph.graph import ObjectNode
 from sgtool.semantics.text import category_text
 from sgtool.vocabulary import OPEN_STATES, RELATIONS, OpenState, Relation

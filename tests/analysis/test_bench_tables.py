@@ -7,7 +7,6 @@ import dataclasses
 
 import pytest
 
-from sgtool.analysis.metrics import breakdown, seen_unseen, summarize
 from sgtool.analysis.paper_tables import TABLE_IX_SYMSEARCH, TABLE_VII_SYMSEARCH, quoted_for
 from sgtool.analysis.report import (
     breakdown_records,
@@ -15,6 +14,7 @@ from sgtool.analysis.report import (
     format_seen_unseen,
     format_side_by_side,
 )
+from sgtool.analysis.search_metrics import breakdown, seen_unseen, summarize
 from sgtool.results import EpisodeResult
 
 BASE = EpisodeResult(planner="random", seed=0, house="villa", episode=0, query="mug",

@@ -11,7 +11,7 @@ import math
 import pytest
 from click.testing import CliRunner
 
-from sgtool.analysis.metrics import episode_spl
+from sgtool.analysis.search_metrics import episode_spl
 from sgtool.analysis.validity import (
     RULES,
     SHORTFALL_M,

@@ -11,8 +11,8 @@ import pytest
 from sgtool.datasets.episode_mix import furniture_episodes, symsearch_episodes
 from sgtool.datasets.generator import generate_house
 from sgtool.datasets.object_candidates import candidates
+from sgtool.datasets.scene_stats import house_stats
 from sgtool.datasets.split import evaluation_knowledge, unseen_queries
-from sgtool.datasets.stats import house_stats
 from sgtool.datasets.synsets import readable_name
 from sgtool.errors import SgtoolError
 

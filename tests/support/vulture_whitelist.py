@@ -94,7 +94,7 @@ _.CASES  # replayers/golden.py: the golden cases (tests/golden/regenerate.py)
 _.house_paths  # analysis/bench_houses.py: tests only
 _._episodes  # analysis/closed_loop_bench.py: tests only
 _.failed_skills  # analysis/closed_loop_bench.py: tools/closed_loop_failures.py only
-_.sr_at  # analysis/metrics.py: tests only
+_.sr_at  # analysis/search_metrics.py: tests only
 _.free_mask_edt  # datasets/room_space.py: tests only
 _.read_color_file  # recorders/importers/images.py: tests, benchmarks/import_.py
 _.write_tum_trajectory  # recorders/importers/textformats.py: tests (fixture writer)

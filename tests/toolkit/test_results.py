@@ -7,8 +7,8 @@ import json
 import pytest
 
 from sgtool.analysis.curves import plot_efficiency
-from sgtool.analysis.metrics import COST_MODELS, STEP_COST, seen_unseen, summarize
 from sgtool.analysis.report import format_seen_unseen, format_table, summary_dict
+from sgtool.analysis.search_metrics import COST_MODELS, STEP_COST, seen_unseen, summarize
 from sgtool.log.records import Action, Episode
 from sgtool.results import (
     EpisodeResult,

@@ -118,7 +118,12 @@ def stats_cmd(houses: int, seed: int, rooms: tuple[int, int], split: str, preset
 
     from sgtool.datasets.generator import generate_house
     from sgtool.datasets.knowledge import load_knowledge
-    from sgtool.datasets.stats import PAPER_TABLE_I, format_table, house_stats, inventory_stats
+    from sgtool.datasets.scene_stats import (
+        PAPER_TABLE_I,
+        format_table,
+        house_stats,
+        inventory_stats,
+    )
 
     specs = [generate_house(s, rooms=rooms, split=split, preset=preset)
              for s in tqdm(range(seed, seed + houses), desc="houses", unit="house",

@@ -18,7 +18,7 @@ from typing import Any
 
 from sgtool.log import codec
 from sgtool.log import schemas as S
-from sgtool.log.assembly import decoded
+from sgtool.log.frame_assembly import decoded
 from sgtool.log.reader import LogReader
 
 _SEED = re.compile(r"-?\d{1,30}")  # a house seed in the metadata (any other text: none)

@@ -38,9 +38,9 @@ from sgtool.errors import (
 from sgtool.log import chunk_stream as cs
 from sgtool.log import codec, message_check, walk_index
 from sgtool.log import schemas as S
-from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler, TransformBuffer, decoded
 from sgtool.log.chunk_copy import RawChunk, raw_chunk
 from sgtool.log.frame import CameraIntrinsics, Frame
+from sgtool.log.frame_assembly import FRAME_TOPICS, FrameAssembler, TransformBuffer, decoded
 from sgtool.log.image_wire import parse_raw_image
 from sgtool.log.log_file import require_regular_file
 from sgtool.log.records import RECORD_TYPES, LogRecord

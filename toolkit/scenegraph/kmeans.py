@@ -2,7 +2,7 @@
 
 Used for the regions of a room being mapped (:mod:`sgtool.scenegraph.regions`: Voronoi
 nodes, planar distance) and for the regions of a symbolic benchmark house
-(:mod:`sgtool.recorders.symbolic_environment.regions`: furniture positions, squared
+(:mod:`sgtool.recorders.symbolic_environment.furniture_regions`: furniture positions, squared
 distance, k chosen by BIC). The result depends on the points, ``first`` and the metric
 only:
 

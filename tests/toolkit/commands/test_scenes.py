@@ -11,7 +11,7 @@ from click.testing import CliRunner
 
 from sgtool.cli import cli
 from sgtool.datasets.generator import generate_house
-from sgtool.datasets.stats import house_stats
+from sgtool.datasets.scene_stats import house_stats
 from sgtool.house.io import load_house
 
 

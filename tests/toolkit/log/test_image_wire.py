@@ -12,7 +12,7 @@ from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
 
 from sgtool.log import LogReader, codec
 from sgtool.log import schemas as S
-from sgtool.log.assembly import FRAME_TOPICS, FrameAssembler
+from sgtool.log.frame_assembly import FRAME_TOPICS, FrameAssembler
 from sgtool.log.image_wire import parse_raw_image
 
 GOLDEN = Path(__file__).resolve().parents[2] / "golden" / "house6-tour.mcap"

@@ -16,7 +16,7 @@ from sgtool.cli import cli
 from sgtool.errors import LogFormatError
 from sgtool.log import CameraIntrinsics, LogReader, LogWriter, codec
 from sgtool.log import schemas as S
-from sgtool.log.assembly import (
+from sgtool.log.frame_assembly import (
     FRAME_TOPICS,
     TF_STAMP_REFUSE_S,
     TF_STAMP_WARN_S,

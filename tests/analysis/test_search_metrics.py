@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from sgtool.analysis.metrics import (
+from sgtool.analysis.search_metrics import (
     DISTANCE_COST,
     STEP_COST,
     Stat,
