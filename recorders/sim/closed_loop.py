@@ -152,7 +152,7 @@ class ClosedLoopOptions:
     frames: int | None = None  # frame budget (None: none)
     planner_seed: int = 0
     compression: str = "zstd"
-    # "live": the robot plans on its own map (issue 17); "house": on the ground truth (before)
+    # "live": the robot plans on its own map; "house": on the ground truth (privileged)
     navigation: str = "live"
     live: LiveNavConfig = field(default_factory=LiveNavConfig)
     success: str = "observed"  # success rule (sgtool.planning.episode): observed | done

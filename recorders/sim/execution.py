@@ -3,8 +3,8 @@
 - :func:`execute_live` (the closed loop's default, ``navigation="live"``): the robot plans
   on its own map (:mod:`.live_skills`); goals come from the nodes of the graph the planner
   decided on and its map layers;
-- :func:`execute_privileged` (``navigation="house"``, the behaviour before issue 17, kept
-  for comparison): the simulator's skills plan on the house's ground-truth occupancy.
+- :func:`execute_privileged` (``navigation="house"``, privileged, kept for comparison): the
+  simulator's skills plan on the house's ground-truth occupancy.
 
 Both run the calls until one does not succeed (live: or ends because the target came
 into view, :data:`~sgtool.recorders.sim.live_skills.IN_VIEW`) and return an

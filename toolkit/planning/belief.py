@@ -18,7 +18,8 @@ calibrated co-occurrence of carrier o:
   so far in the graph, so K adapts to sparse and dense houses alike). ω
   (``region_weight``, 0.5) discounts a region for the second action its carriers need:
   exploring it only reveals them, checking one is another step, so per action a region
-  finds about half of what its mass says (0.5 measured best of 0.5, 1 and 2, below);
+  finds about half of what its mass says (how the value was chosen:
+  docs/experiments/moved-from-docstrings.md);
 - R̄ is the mean calibrated containment over the room types the prior knows (what an
   unknown room is expected to be); ``beyond`` weights space that may hold more than one
   room (a leading-out frontier, a door);
@@ -30,12 +31,6 @@ calibrated co-occurrence of carrier o:
   multiplies its odds by a constant, which for the low base rates of a dense house widens
   the ratios between pieces (odds(s) / odds(s') > s / s'); s² is the milder version of
   that correction (the full odds ratio overweights the model's mistakes).
-
-Measured on the dense ``symsearch`` bench houses, one seed, 100 episodes per house range
-(houses 0-4 / houses 100-104), SR / SPL of ``bayes-search`` with step cost 3: ω = 1,
-sharpness 1: 0.690 / 0.247 (houses 0-4, step cost 3); ω = 1, C sharpness 2: 0.700 / 0.262
-and 0.810 / 0.231; ω = 0.5: 0.720 / 0.271 and 0.760 / 0.236; ω = 2: 0.680 / 0.258 and
-0.790 / 0.225; ``scout`` on the same episodes: 0.670 / 0.237 and 0.730 / 0.212.
 
 **Furniture-level queries.** About a third of the bench's episodes ask for a piece of
 furniture ("find a dishwasher"). Such a target is a first-level piece: it is seen as soon

@@ -6,9 +6,9 @@ usable as the likelihoods of a search distribution:
 
     p = floor + (1 - floor) * s ** sharpness                                         (C1)
 
-- ``floor`` > 0: a place the model rules out is not impossible (the co-occurrence model's
-  AUC on unseen queries is ~0.70, see the weights' ``report``); without a floor a Bayes
-  posterior never recovers from a prior of 0;
+- ``floor`` > 0: a place the model rules out is not impossible (the models err on unseen
+  queries: their AUC is in the weights' ``report``); without a floor a Bayes posterior
+  never recovers from a prior of 0;
 - ``sharpness`` (1 = as trained) tempers (< 1) or sharpens (> 1) an over- or
   under-confident model.
 
@@ -34,20 +34,11 @@ when
 
     AUC_cos(x) > AUC_learned(x)                                                      (C4)
 
-and is the learned model unchanged otherwise (weights without a report keep (C3)). Why:
-on the unseen categories of the shipped weights, split by sim(q) into [0, .55), [.55, .7),
-[.7, .85), [.85, 1], the learned containment AUC is 0.835 / 0.858 / 0.931 / 0.939 against
-the cosine's 0.619 / 0.698 / 0.773 / 0.744, so the learned model is the better judge even
-for the queries least like the training ones, and (C3) lowered the AUC in every bin it
-touched (0.618 in the first); co-occurrence likewise (learned 0.691 / 0.667 / 0.741 / 0.685,
-cosine 0.617 / 0.493 / 0.691 / 0.580). On the dense ``symsearch`` bench houses (houses
-0-4, 2 seeds, 84 unseen-query episodes) ``bayes-search`` found 0.464 of the unseen targets
-with (C3) on both relations, 0.464 with (C3) on rooms only, 0.655 with no blend: the
-cosine's flat room scores spread the belief over rooms that do not hold the target. The
-everyday-object check set (:mod:`sgtool.semantics.everyday_rooms`, names outside
-BEHAVIOR-1K) is the one place where the cosine's room answers are better
-(``benchmarks/priors_check.py``); that is a statement about the learned model's room
-knowledge, to be fixed in training, not by a blend that costs the search.
+and is the learned model unchanged otherwise (weights without a report keep (C3)). The
+measurements behind the gate (AUC per similarity bin, the search with and without the
+blend) are in docs/experiments/moved-from-docstrings.md; the everyday-object check set
+(:mod:`sgtool.semantics.everyday_rooms`, names outside BEHAVIOR-1K) is checked by
+``benchmarks/priors_check.py``.
 """
 
 from __future__ import annotations

@@ -13,10 +13,9 @@ entrance doors, unexplored carriers):
   co-occurrence prior p_co(o, q) (exploring there may reveal the target beside o). For a
   carrier the body is about the carrier itself, T_obj(n) = p_co(n, q): checking a carrier
   looks into or onto that one piece, not its neighbours, so a piece does not borrow the
-  score of a likely neighbour (in the dense ``symsearch`` houses, ~15 pieces per room, the
-  max over neighbours gave whole clusters of unlikely pieces the score of the one likely
-  piece among them, and ESC spent its 50 steps checking them: SR 0.28, below random's
-  0.37). A candidate with no object near it (an unexplored room, a door, a bare frontier)
+  score of a likely neighbour (in dense houses the max over neighbours gives whole
+  clusters of unlikely pieces the score of the one likely piece among them). A candidate
+  with no object near it (an unexplored room, a door, a bare frontier)
   gets the mean co-occurrence of the objects seen so far (ESC's "unknown" frontier:
   neither near likely nor unlikely things);
 - R2, *room*: ``InRoom(n, r) ∧ Contains(r, q) -> Choose(n)``; T_room(n) = p_contains(r, q)

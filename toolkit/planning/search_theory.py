@@ -33,44 +33,24 @@ distribution is rebuilt from the new graph (B5), so the plan is re-made at every
 (receding horizon). Everything is deterministic (ties broken by node id): the seed is not
 used.
 
-**Dense houses** (the bench's ``symsearch`` preset: ~230 first-level pieces in 12-16 rooms,
-most of them empty, 50 actions). There ``bayes-search`` had fallen behind ``scout`` (SR
-0.597 vs 0.665, unseen queries 0.489 vs 0.688, 10 houses x 20 episodes x 3 seeds). Measured
-causes and fixes, houses 0-4 (and 100-104 as a second range, never tuned on alone):
+**Dense houses** (the bench's ``symsearch`` preset: many first-level pieces per room, most
+of them empty, a fixed action budget) shape the defaults:
 
-- *the novelty blend* (:mod:`~sgtool.planning.calibration`, (C3)) gave unseen queries the
-  cosine's flat room scores: unseen SR 0.464 with it, 0.464 blending rooms only, 0.655
-  without (houses 0-4, 2 seeds). The learned model is the better judge at every distance
-  from the training queries (held-out AUC by similarity bin, calibration module doc), so
-  the blend is now gated by the weights' own held-out AUC, (C4);
-- *empty pieces*: each checked piece costs an action, and most are empty; what the belief
-  spends on unlikely pieces is what the co-occurrence model's balanced training inflates.
-  C is sharpened (exponent 2, a base-rate correction) and an unseen region counts at half
-  its expected carrier mass (ω = 0.5), :mod:`~sgtool.planning.belief`;
-- *the price of an action*: with 50 actions for ~230 places the budget binds before the
-  distance does (every failed episode of the bench ends at N_max), so a = 3 m per action:
-  SR / SPL 0.610 / 0.249 with a = 1, 0.660 / 0.250 with a = 2, 0.690 / 0.247 with a = 3
-  (houses 0-4, 1 seed, no blend). The look-ahead stays at 3 of the best 5: horizon 1 /
-  2 / 3 gave 0.790 / 0.219, 0.740 / 0.227, 0.760 / 0.228 (houses 100-104, a = 2); 3 of the
-  best 8, 0.620 / 0.235 against 0.660 / 0.250 (houses 0-4).
-
-- *furniture-level targets* (about a third of the episodes): they are found by revealing
-  space, never inside a carrier, yet the object model spent their mass on carriers. The
+- the novelty blend of :mod:`~sgtool.planning.calibration` is gated by the weights' own
+  held-out AUC, (C4), since a blend that gives unseen queries the cosine's flat room
+  scores spreads the belief over rooms that do not hold the target;
+- C is sharpened (exponent 2, a base-rate correction) and an unseen region counts at half
+  its expected carrier mass (ω = 0.5), :mod:`~sgtool.planning.belief`: each checked piece
+  costs an action and most are empty;
+- the price of an action is a = 3 m: with few actions for many places the budget binds
+  before the distance does; the look-ahead orders 3 of the best 5 places;
+- furniture-level targets are found by revealing space, never inside a carrier, so the
   furniture-level prior φ(q) ((B6) of :mod:`~sgtool.planning.belief`, (F1) of
-  :mod:`sgtool.datasets.furniture_level`) moves it to frontiers, rooms and doors: on those
-  episodes SR / SPL / steps 0.949 / 0.406 / 16.3 -> 0.986 / 0.436 / 9.6 (houses 0-9) and
-  0.977 / 0.386 / 14.9 -> 1.000 / 0.406 / 8.8 (houses 100-109), the small-object episodes
-  unchanged (0.570 / 0.142 and 0.625 / 0.132 -> 0.131); a graded φ from raw BEHAVIOR-1K
-  counts for every name (small objects included, unseen names at the pooled 0.26) cost
-  the small-object episodes SR 0.606 -> 0.523, so φ is 0 outside the vocabulary of
-  furniture and floor-standing holders.
+  :mod:`sgtool.datasets.furniture_level`) moves their mass to frontiers, rooms and doors;
+  φ is 0 outside the vocabulary of furniture and floor-standing holders.
 
-Without φ (round 1, 10 houses x 20 episodes x 3 seeds, ``sgtool bench``): houses 0-9 SR
-0.707 / SPL 0.237 against scout's 0.665 / 0.217; houses 100-109 (``--house-seed 100``)
-0.750 / 0.222 against 0.708 / 0.208. With φ: houses 0-9 0.720 / 0.247 (1.14x scout's SPL;
-seen queries 0.694 / 0.290 vs 0.650 / 0.248, unseen 0.762 / 0.179 vs 0.688 / 0.168);
-houses 100-109 0.758 / 0.229 against 0.708 / 0.208 (1.10x; seen 0.751 / 0.274 vs
-0.719 / 0.237, unseen 0.772 / 0.151 vs 0.689 / 0.157).
+The runs that chose these values (SR/SPL per setting, houses and seeds) are in
+docs/experiments/moved-from-docstrings.md.
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
 """On-disk embedding cache: one SQLite table keyed by (model id, text).
 
-Encoding a text costs ~1-5 ms and the same few thousand category names come back in every
-planner decision, every training run and every test session, so embeddings are kept on
-disk. SQLite (stdlib) gives atomic writes and safe concurrent readers/writers across the
+The same few thousand category names come back in every planner decision, every training
+run and every test session, and encoding one is not free, so embeddings are kept on disk.
+SQLite (stdlib) gives atomic writes and safe concurrent readers/writers across the
 processes that run side by side (benchmark workers, tests); vectors are stored as raw
 little-endian float32 bytes. The cache is an accelerator only: any SQLite error degrades to
 "not cached" with one warning, never to a failure.

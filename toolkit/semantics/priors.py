@@ -23,11 +23,10 @@ positive for fewer than :data:`MIN_ROOM_EVIDENCE` of the training queries (the w
 ``room_evidence``), is one the prior cannot score, and a planner treats a room of that type
 as an uncategorised one (SCOUT Eq. 2: the default room exploration score). Names the model
 was not trained on at all are scored by the model (open vocabulary: a "laundry room" scores
-like the utility room, a little lower). Measured on 10 training-split houses (200 episodes x
-3 seeds), SCOUT with room influence: SR 0.893 / SPL 0.173 when every room type is scored;
-0.908 / 0.183 with a cut at 5 queries, 0.948 / 0.193 at 10 (1%, the value used), 0.945 /
-0.195 at 20; the cut is the knee of that curve and the natural "fewer than one in a hundred"
-(higher cuts drift towards no room influence at all, every room at the default score).
+like the utility room, a little lower). The cut
+is 1 % of the training queries, the natural "fewer than one in a hundred" (higher cuts drift
+towards no room influence at all, every room at the default score; the runs that chose it
+are in docs/experiments/moved-from-docstrings.md).
 """
 
 from __future__ import annotations

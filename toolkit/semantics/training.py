@@ -8,10 +8,8 @@ of epochs; the final weights are kept by default (``keep="last"``), or the epoch
 lowest validation loss (``keep="best"``). Why "last": the validation pairs are random pairs
 of training queries whose zero targets are often plausible places the knowledge happens not
 to mention (a pillow in a living room), so validation loss rises while the model still
-improves at what the planner needs. Measured on training-split houses (12 houses, 96
-episodes): the true room's rank percentile among the house's rooms 0.246 with the best-
-validation checkpoint (epoch 7) vs 0.212 after 30 epochs, and room classification from
-furniture 33% vs 66%.
+improves at what the planner needs (the comparison of the two checkpoints is in
+docs/experiments/moved-from-docstrings.md).
 
 Determinism: seeded torch and numpy generators, ``torch.use_deterministic_algorithms``,
 one intra-op thread (different thread counts may sum in a different order), shuffling by
