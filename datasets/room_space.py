@@ -89,10 +89,11 @@ class RoomSpace:
         """Can the robot cross between all openings and reach every box within REACH?
 
         A cell is free when its centre is at least ROBOT_RADIUS + half a cell from every
-        occupied cell and wall cell (the padded grid's Euclidean distance transform, as
-        :func:`free_mask_edt` computes it); in cells that is a squared distance of at least
-        25 (offsets of squared length 21-24 do not exist, 20 is 0.2236 m < 0.225 m), so
-        the blocked cells are those within a squared distance of 20 (``_BLOCK_D2``)."""
+        occupied cell and wall cell (the padded grid's Euclidean distance transform, the
+        definition ``free_mask_edt`` in tests/support/room_space_reference.py computes); in
+        cells that is a squared distance of at least 25 (offsets of squared length 21-24 do
+        not exist, 20 is 0.2236 m < 0.225 m), so the blocked cells are those within a squared
+        distance of 20 (``_BLOCK_D2``)."""
         blocked = self.blocked
         if extra is not None:
             more = self._blocked_by(extra)
@@ -128,11 +129,3 @@ class RoomSpace:
         more = self._blocked_by(box)
         if more is not None:
             self.blocked[more[0]] |= more[1]
-
-
-def free_mask_edt(occ: np.ndarray) -> np.ndarray:
-    """The free cells of an in-room occupancy grid by the distance transform (the
-    definition :meth:`RoomSpace.free_ok` implements incrementally; kept for the tests)."""
-    padded = np.pad(occ, 1, constant_values=True)  # the walls
-    dist = ndimage.distance_transform_edt(~padded, sampling=_CELL)[1:-1, 1:-1]
-    return dist >= ROBOT_RADIUS + _CELL / 2 - 1e-9

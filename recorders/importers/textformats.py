@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from sgtool.errors import SgtoolError
-from sgtool.recorders.importers.poses import pose_from_tq, tq_from_pose
+from sgtool.recorders.importers.poses import pose_from_tq
 
 
 def seconds_to_ns(text: str) -> int:
@@ -37,11 +37,6 @@ def seconds_to_ns(text: str) -> int:
 
 
 MAX_TIME_NS = 2**63 - 1  # the largest time a log (int64 nanoseconds) holds: year 2262
-
-
-def ns_to_seconds_text(t_ns: int) -> str:
-    """Integer nanoseconds -> "seconds.microseconds" as TUM files write them."""
-    return f"{t_ns // 1_000_000_000}.{(t_ns % 1_000_000_000) // 1000:06d}"
 
 
 def _data_lines(path: Path) -> list[tuple[int, list[str]]]:
@@ -92,15 +87,6 @@ def read_tum_trajectory(path: Path) -> list[tuple[int, np.ndarray]]:
             raise SgtoolError(f"{path}:{n}: not a valid pose (NaN or zero quaternion)")
         out.append((t, pose_from_tq(v[:3], v[3:])))
     return sorted(out, key=lambda tp: tp[0])
-
-
-def write_tum_trajectory(path: Path, poses: list[tuple[int, np.ndarray]]) -> None:
-    lines = ["# timestamp tx ty tz qx qy qz qw"]
-    for t, T in poses:  # noqa: N806
-        tr, q = tq_from_pose(T)
-        vals = " ".join(f"{v:.9f}" for v in (*tr, *q))
-        lines.append(f"{ns_to_seconds_text(t)} {vals}")
-    path.write_text("\n".join(lines) + "\n")
 
 
 RIGID_TOL = 5e-3  # |R^T R - I|, |det R - 1| and the last row (7-Scenes: up to 5e-4)
@@ -176,14 +162,6 @@ def read_open3d_log(path: Path) -> list[np.ndarray]:
             raise SgtoolError(f"{path}:{n0}: expected the block header 'i j n'")
         poses.append(pose_matrix(path, rows[b + 1:b + 5]))
     return poses
-
-
-def write_open3d_log(path: Path, poses: list[np.ndarray]) -> None:
-    lines = []
-    for i, T in enumerate(poses):  # noqa: N806
-        lines.append(f"{i} {i} {i + 1}")
-        lines.extend(" ".join(f"{v:.8f}" for v in row) for row in np.asarray(T))
-    path.write_text("\n".join(lines) + "\n")
 
 
 @dataclass(frozen=True)

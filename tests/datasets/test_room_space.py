@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 from scipy import ndimage
+from support.room_space_reference import free_mask_edt
 
 from sgtool.datasets.house_plan import Opening, PlanRoom, Rect
 from sgtool.datasets.robot_clearance import REACH, ROBOT_RADIUS
-from sgtool.datasets.room_space import _CELL, RoomSpace, free_mask_edt
+from sgtool.datasets.room_space import _CELL, RoomSpace
 
 
 def _reference_free_ok(space: RoomSpace, boxes: list[Rect], extra: Rect | None) -> bool:
@@ -16,7 +17,7 @@ def _reference_free_ok(space: RoomSpace, boxes: list[Rect], extra: Rect | None) 
     occ = space.occ.copy()
     if extra is not None:
         occ[space._cell_slices(extra)] = True
-    free = free_mask_edt(occ)
+    free = free_mask_edt(occ, _CELL)
     labels, _ = ndimage.label(free, structure=np.ones((3, 3), bool))
     if not space.approach:
         return True
@@ -52,10 +53,10 @@ def test_blocked_cells_match_the_distance_transform() -> None:
     rng = np.random.default_rng(7)
     for _ in range(20):
         space = RoomSpace(*_room())
-        assert np.array_equal(~space.blocked, free_mask_edt(space.occ))
+        assert np.array_equal(~space.blocked, free_mask_edt(space.occ, _CELL))
         for _ in range(6):
             space.add(_box(rng))
-            assert np.array_equal(~space.blocked, free_mask_edt(space.occ))
+            assert np.array_equal(~space.blocked, free_mask_edt(space.occ, _CELL))
 
 
 def test_free_ok_matches_the_whole_room_check() -> None:

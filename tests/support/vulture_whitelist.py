@@ -95,10 +95,7 @@ _.house_paths  # analysis/bench_houses.py: tests only
 _._episodes  # analysis/closed_loop_bench.py: tests only
 _.failed_skills  # analysis/closed_loop_bench.py: tools/closed_loop_failures.py only
 _.sr_at  # analysis/search_metrics.py: tests only
-_.free_mask_edt  # datasets/room_space.py: tests only
 _.read_color_file  # recorders/importers/images.py: tests, benchmarks/import_.py
-_.write_tum_trajectory  # recorders/importers/textformats.py: tests (fixture writer)
-_.write_open3d_log  # recorders/importers/textformats.py: tests (fixture writer)
 _.default_folder  # replayers/golden.py: tests/golden/regenerate.py only
 _.replay_graphs  # replayers/golden.py: tests/test_install.py only
 _.occupancy_from_keys  # toolkit/mapping/bev.py: tests only

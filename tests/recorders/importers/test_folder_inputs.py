@@ -10,6 +10,7 @@ import cv2
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from support.trajectory_files import write_open3d_log
 
 from sgtool.cli import cli
 from sgtool.errors import SgtoolError
@@ -27,7 +28,6 @@ from sgtool.recorders.importers.textformats import (
     read_intrinsics_file,
     read_open3d_log,
     read_pose_file,
-    write_open3d_log,
 )
 from sgtool.recorders.importers.upright import DepthSample, estimate_alignment
 

@@ -11,6 +11,11 @@ import numpy as np
 import pytest
 from support.bag_export import typestore_for
 from support.rgbd_folders import room_depth
+from support.trajectory_files import (
+    ns_to_seconds_text,
+    write_open3d_log,
+    write_tum_trajectory,
+)
 
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
@@ -47,14 +52,14 @@ def trans(x: float, y: float, z: float) -> np.ndarray:
 def test_seconds_to_ns_is_exact():
     assert textformats.seconds_to_ns("1305031102.160407") == 1305031102160407000
     assert textformats.seconds_to_ns("0.000000001") == 1
-    assert textformats.ns_to_seconds_text(1305031102160407000) == "1305031102.160407"
+    assert ns_to_seconds_text(1305031102160407000) == "1305031102.160407"
 
 
 def test_tum_trajectory_round_trip(tmp_path: Path):
     poses = [(1_000_000_000 + i * 10_000_000, trans(i, 2 * i, 0.5) @ rot_z(10 * i))
              for i in range(5)]
     p = tmp_path / "gt.txt"
-    textformats.write_tum_trajectory(p, poses)
+    write_tum_trajectory(p, poses)
     back = textformats.read_tum_trajectory(p)
     assert [t for t, _ in back] == [t for t, _ in poses]
     for (_, a), (_, b) in zip(poses, back, strict=True):
@@ -72,7 +77,7 @@ def test_tum_trajectory_errors_name_the_line(tmp_path: Path):
 def test_open3d_log_round_trip_and_bad_block(tmp_path: Path):
     poses = [trans(0.1 * i, 0, 0) @ rot_z(5 * i) for i in range(3)]
     p = tmp_path / "traj.log"
-    textformats.write_open3d_log(p, poses)
+    write_open3d_log(p, poses)
     back = textformats.read_open3d_log(p)
     assert len(back) == 3 and all(np.allclose(a, b, atol=1e-8) for a, b in zip(poses, back,
                                                                               strict=True))

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from support.trajectory_files import ns_to_seconds_text
 
 from sgtool.cli import cli
 from sgtool.errors import SgtoolError
@@ -24,7 +25,6 @@ from sgtool.recorders.importers.poses import pose_difference
 from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
 from sgtool.recorders.importers.sink import IMPORT_METADATA
 from sgtool.recorders.importers.textformats import (
-    ns_to_seconds_text,
     parse_intrinsics,
     read_open3d_log,
     read_tum_trajectory,
