@@ -64,11 +64,6 @@ CASES: tuple[GoldenCase, ...] = (
 )
 
 
-def default_folder() -> Path:
-    """``tests/golden`` of the source checkout this module lives in."""
-    return Path(__file__).resolve().parent.parent / "tests" / "golden"
-
-
 # ----- digests and files ---------------------------------------------------------------
 def sha256_file(path: str | os.PathLike[str]) -> str:
     h = hashlib.sha256()

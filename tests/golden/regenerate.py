@@ -20,7 +20,9 @@ from sgtool.analysis.golden_check import pin_logs
 from sgtool.datasets.generator import generate_house
 from sgtool.recorders.sim.camera import CameraConfig
 from sgtool.recorders.sim.recording import RecordOptions, record_house
-from sgtool.replayers.golden import CASES, REPLAY, GoldenCase, default_folder
+from sgtool.replayers.golden import CASES, REPLAY, GoldenCase
+
+GOLDEN_FOLDER = Path(__file__).resolve().parent  # tests/golden of this checkout
 
 
 def record_case(case: GoldenCase, folder: Path) -> Path:
@@ -42,7 +44,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--record", action="store_true",
                     help="re-record the logs with PyBullet first")
     a = ap.parse_args(argv)
-    folder = a.folder or default_folder()
+    folder = a.folder or GOLDEN_FOLDER
     folder.mkdir(parents=True, exist_ok=True)
     if a.record:
         for case in CASES:

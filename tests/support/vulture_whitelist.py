@@ -96,7 +96,6 @@ _._episodes  # analysis/closed_loop_bench.py: tests only
 _.failed_skills  # analysis/closed_loop_bench.py: tools/closed_loop_failures.py only
 _.sr_at  # analysis/search_metrics.py: tests only
 _.read_color_file  # recorders/importers/images.py: tests, benchmarks/import_.py
-_.default_folder  # replayers/golden.py: tests/golden/regenerate.py only
 _.replay_graphs  # replayers/golden.py: tests/test_install.py only
 _.occupancy_from_keys  # toolkit/mapping/bev.py: tests only
 _.near_depth  # toolkit/mapping/free_space.py: tests only
