@@ -102,7 +102,6 @@ _.near_depth  # toolkit/mapping/free_space.py: tests only
 _.fill_holes  # toolkit/mapping/holes.py: tests only
 _.shortest_path_length  # toolkit/mapping/occupancy.py: tests only
 _.path_length  # toolkit/mapping/occupancy.py: tests only
-_.reachable  # toolkit/mapping/occupancy.py: dead; remove after 18:40 (G2 owns mapping)
 _.ridge_cells  # toolkit/mapping/voronoi.py: tests only
 _.sequence_value  # toolkit/planning/search_theory.py: tests only
 _.candidate_utilities  # toolkit/planning/utility.py: tests, benchmarks/bench_rollout_parts.py

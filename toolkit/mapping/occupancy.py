@@ -297,11 +297,6 @@ def path_length(path: Sequence[Sequence[float]]) -> float:
     return float(sum(math.dist(path[i], path[i + 1]) for i in range(len(path) - 1)))
 
 
-def reachable(occ: OccupancyMap, start_xy: Sequence[float]) -> np.ndarray:
-    """Bool grid of the free cells connected to ``start_xy``."""
-    return np.isfinite(geodesic_distances(occ, start_xy))
-
-
 _NUMBER = (int, float, np.floating, np.integer)
 
 
