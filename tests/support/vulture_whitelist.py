@@ -52,14 +52,14 @@ _.rooms_per_scene  # datasets/scene_stats.py: SceneStats field (printed by `scen
 _.room_categories_per_scene  # datasets/scene_stats.py: SceneStats field
 _.objects_per_scene  # datasets/scene_stats.py: SceneStats field
 _.object_categories_per_scene  # datasets/scene_stats.py: SceneStats field
-_.max_translation_m  # recorders/importers/odometry.py: OdometryCheck field
+_.max_translation_m  # recorders/importers/odometry.py: DriftReport field
 _.replans  # recorders/sim/live_skills.py: skill outcome counter
 _.stopped  # recorders/sim/fallback_explore.py: exploration outcome field
 _.served  # toolkit/llm/recorded.py: counter of replayed answers
 _.remaining  # toolkit/llm/recorded.py: answers not yet replayed
 _.prompt_sha256  # toolkit/log/records.py: logged record field
 _.invalid_commands  # toolkit/planning/moma/planner.py: counter of rejected LLM commands
-_.unexplored_rooms  # toolkit/planning/moma/scene_text.py: SceneText field
+_.unexplored_rooms  # toolkit/planning/moma/scene_text.py: EncodedScene field
 _.seen_through_entries  # toolkit/scenegraph/builder.py: builder statistics
 _.cleared_entries  # toolkit/scenegraph/builder.py: builder statistics
 _.cut_edges  # toolkit/scenegraph/room_segmentation.py: segmentation result field
@@ -68,22 +68,22 @@ _.segmentation  # toolkit/scenegraph/builder.py: room-layout result field
 _.total_points  # toolkit/mapping/voxels.py: per-instance statistics field
 _.view_distance  # toolkit/mapping/voxels.py: per-instance statistics field
 _.model_loads  # toolkit/semantics/encoder.py: counter of weight loads
-_.best_val_loss  # toolkit/semantics/training.py: TrainingResult property
+_.best_val_loss  # toolkit/semantics/training.py: TrainResult property
 _.scout  # toolkit/planning/utility.py: UtilityParams preset (tests, benchmarks)
 _.sbert  # toolkit/planning/utility.py: UtilityParams preset, Table VI (tests, benchmarks)
-_.containers  # toolkit/house/spec.py: House method, public API (docs/api.md)
+_.containers  # toolkit/house/spec.py: HouseSpec method, public API
 _.children  # toolkit/scenegraph/graph.py: SceneGraph method, public API
-_.offered  # toolkit/planning/memory.py: Memory method
-_.frame_at  # toolkit/log/reader.py: reader method, public API
+_.offered  # toolkit/planning/memory.py: EpisodeMemory method
+_.frame_at  # toolkit/log/reader.py: LogReader method, public API
 _.to_record  # toolkit/scenegraph/instances.py: Instance -> log record
 _.excludes  # analysis/intervals.py: Interval method
-_.goal_mask  # datasets/episodes.py: Episode method
+_.goal_mask  # datasets/episodes.py: EpisodeGeometry method
 _.pose_stamped  # recorders/exporters/bagwriter.py: message builder, one per ROS type
 _.image  # recorders/exporters/bagwriter.py: message builder
 _.compressed  # recorders/exporters/bagwriter.py: message builder
 _.ray_depth  # recorders/sim/simulation.py: Simulation method
 _.teleport  # recorders/sim/simulation.py: Simulation method (benchmarks/record.py)
-_.value_at  # toolkit/mapping/grid.py: Grid method
+_.value_at  # toolkit/mapping/grid.py: OccupancyGrid method
 _.integrate_points  # toolkit/mapping/voxels.py: VoxelMap method
 _.voxels_of  # toolkit/mapping/voxels.py: VoxelMap method
 _.RECORD_NAMES  # toolkit/vocabulary.py: vocabulary table (tests/toolkit/test_vocabulary.py)
