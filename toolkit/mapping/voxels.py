@@ -5,8 +5,9 @@ grid over 30 m (400^3 float32, ~256 MB; paper sec. III-B "Dynamic RGB-D mapping"
 occupies a tiny share of such a cube, so we keep only observed voxels: every back-projected
 point becomes the key ``(ix, iy, iz, label)`` packed into one int64 (17 bits per axis,
 offset by 2^16 so negative indices fit: +-3.2 km at 5 cm; 12 label bits), and the map is
-the sorted array of distinct keys with the number of points that voted for each. A voxel
-may carry votes for several labels; its label is the one with most votes. Sorting puts
+the sorted array of distinct keys with the number of points that voted for each (and the
+number of frames that did: :meth:`VoxelMap.frame_counts`). A voxel may carry votes for
+several labels; its label is the one with most votes. Sorting puts
 the keys of one (x, y) column next to each other, ordered by height, which is what the
 bird's-eye view needs (:mod:`sgtool.mapping.bev`).
 
@@ -147,6 +148,7 @@ class VoxelMap:
     def __init__(self, config: VoxelConfig | None = None) -> None:
         self.config = config or VoxelConfig()
         self._store = VoteStore()  # the sorted keys and counts, in two levels
+        self._frames = VoteStore()  # the same keys, the number of frames that voted each
         self._pending: list[tuple[np.ndarray, np.ndarray]] = []
         self._pending_n = 0
         self._label_ids: list[int] = [0]  # label index -> instance id
@@ -340,6 +342,7 @@ class VoxelMap:
             return
         if len(self._pending) == 1:
             uk, cnt = self._pending[0]
+            frames = np.ones(len(uk), dtype=np.int64)
         else:
             keys = np.concatenate([p[0] for p in self._pending])
             counts = np.concatenate([p[1] for p in self._pending])
@@ -348,9 +351,11 @@ class VoxelMap:
             starts = np.flatnonzero(np.concatenate([[True], keys[1:] != keys[:-1]]))
             uk = keys[starts]
             cnt = np.add.reduceat(counts, starts)
+            frames = np.diff(np.append(starts, len(keys)))  # a frame's keys are distinct
         self._pending.clear()
         self._pending_n = 0
         nk = self._store.add(uk, cnt)
+        self._frames.add(uk, frames)
         if len(nk):
             self._voxel_stats(nk, +1)
             self._new_keys.append(nk)
@@ -502,6 +507,8 @@ class VoxelMap:
         keys, counts = self._store.arrays()
         self._zhist -= np.bincount((gone >> SHIFT_Z) & AXIS_MASK, minlength=1 << AXIS_BITS)
         self._store.replace(keys[~mask], counts[~mask])
+        fkeys, frames = self._frames.arrays()  # the same keys in the same order
+        self._frames.replace(fkeys[~mask], frames[~mask])
         self._removed_keys.append(gone)
         self.removals += 1
         self.version += 1
@@ -560,6 +567,19 @@ class VoxelMap:
         if len(win) != len(voxel_keys) or ((win >> VOXEL_SHIFT) != voxel_keys).any():
             raise ValueError("winning_labels: a voxel is not in the map")
         return win & LABEL_MASK
+
+    def frame_counts(self, keys: np.ndarray) -> np.ndarray:
+        """The number of frames that voted each of the distinct (voxel, label) ``keys`` of
+        the map (any order); a key not in the map raises ValueError."""
+        self.flush()
+        order = np.argsort(keys, kind="stable")
+        sk = keys[order]
+        got, frames = self._frames.within(sk, sk + 1)
+        if len(got) != len(sk) or (got != sk).any():
+            raise ValueError("frame_counts: a key is not in the map")
+        out = np.empty(len(keys), dtype=np.int64)
+        out[order] = frames
+        return out
 
     def instance_id(self, label: int) -> int:
         return self._label_ids[label] if 0 <= label < len(self._label_ids) else -1

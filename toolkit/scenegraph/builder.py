@@ -17,7 +17,8 @@ caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
 3. rooms (:mod:`sgtool.scenegraph.room_segmentation`): door cells of the voxels the open
    doors win (:mod:`sgtool.scenegraph.door_evidence`,
    :meth:`sgtool.scenegraph.door_voxels.DoorVoxels.won`), within ``DOOR_REACH`` of
-   their median (:func:`sgtool.scenegraph.door_voxels.near_median`), cut the graph, ids
+   their median (:func:`sgtool.scenegraph.door_voxels.near_median`), in columns where at
+   least ``DOOR_MIN_FRAMES`` frames gave the door a voxel, cut the graph, ids
    are kept stable by overlap with the previous refresh;
 4. objects (:mod:`sgtool.scenegraph.object_placement`, :mod:`sgtool.scenegraph.assign`):
    instances seen with enough points, placed at their voxel centroid, first-level ones
@@ -122,10 +123,11 @@ from sgtool.scenegraph.visibility import entry_nodes, nearest_visible
 
 BODY_RADIUS = 0.2  # m: unlabelled voxels this close to where the robot stood are dropped
 DOOR_REACH = 1.5  # m: a door's evidence is its won voxels this close to their median
+DOOR_MIN_FRAMES = 2  # a door column is evidence with a voxel this many frames gave the door
 VIEW_STRIDE = 2  # every this many frames, one is free-space evidence (neighbours see alike)
 
-__all__ = ["BODY_RADIUS", "DOOR_REACH", "VIEW_STRIDE", "BuilderConfig", "DoorObservation",
-           "MapLayers", "SceneGraphBuilder"]
+__all__ = ["BODY_RADIUS", "DOOR_MIN_FRAMES", "DOOR_REACH", "VIEW_STRIDE", "BuilderConfig",
+           "DoorObservation", "MapLayers", "SceneGraphBuilder"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -458,7 +460,8 @@ class SceneGraphBuilder:
     def _segment(self, occ: OccupancyGrid, vg: VoronoiGraph) -> _Rooms:
         """Rooms: the door evidence cuts the graph; ids stay stable by overlap."""
         cfg = self.config.rooms
-        won = self._door_voxels.won(open_doors(self.instances), self.voxels.winning_labels)
+        won = self._door_voxels.won(open_doors(self.instances), self.voxels.winning_labels,
+                                    self.voxels.frame_counts, DOOR_MIN_FRAMES)
         reach = DOOR_REACH / self.voxels.resolution
         won = {iid: near_median(ijk, reach) for iid, ijk in won.items()}
         cells = door_cells_of(occ, won, self._panel_memo)

@@ -15,8 +15,12 @@ frames, so a frame that gave another object's pixels a door's id (a swapped labe
 a minority door vote there and no doorway. Only the kept door keys' voxels can be won by
 a door, so their winners are looked up in those voxels alone
 (:meth:`~sgtool.mapping.voxels.VoxelMap.winning_labels`), never by a scan of the map. A
-swapped frame can still leave a blob a door wins elsewhere (an object seen in that frame
-only); the door's evidence is the won voxels near their median (:func:`near_median`).
+swapped frame can still give a door the part of an object that frame alone saw (no other
+vote there): those columns hold door voxels that one frame each gave, so a door's column
+is evidence only when it holds a voxel that several frames gave the door's label (the
+builder asks for two; a door seen in fewer frames so far asks for fewer). A blob a door
+wins farther away is dropped: the door's evidence is the won voxels near their median
+(:func:`near_median`).
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ from collections.abc import Callable, Iterable
 import numpy as np
 
 from sgtool.mapping.vote_store import sorted_unique
-from sgtool.mapping.voxels import LABEL_MASK, VOXEL_SHIFT, unpack
+from sgtool.mapping.voxels import COLUMN_SHIFT, LABEL_MASK, VOXEL_SHIFT, unpack
 
 
 def near_median(ijk: np.ndarray, reach: float) -> np.ndarray:
@@ -41,6 +45,17 @@ def near_median(ijk: np.ndarray, reach: float) -> np.ndarray:
     d2 = (ijk[:, 0] - mx) ** 2 + (ijk[:, 1] - my) ** 2
     keep = d2 <= reach * reach
     return ijk if keep.all() else ijk[keep]
+
+
+def _same_column(keys: np.ndarray, door: np.ndarray, strong: np.ndarray) -> np.ndarray:
+    """Which of the (voxel, label) ``keys`` (of the doors ``door``) share their (x, y)
+    column with a ``strong`` key of the same door."""
+    col = (door.astype(np.int64) << 40) | (keys >> COLUMN_SHIFT)
+    anchor = np.sort(col[strong])
+    if not len(anchor):
+        return strong.copy()
+    at = np.minimum(np.searchsorted(anchor, col), len(anchor) - 1)
+    return anchor[at] == col
 
 
 class DoorVoxels:
@@ -82,10 +97,16 @@ class DoorVoxels:
             self._ijk.pop(int(iid), None)
 
     def won(self, instance_ids: Iterable[int],
-            winning_labels: Callable[[np.ndarray], np.ndarray]) -> dict[int, np.ndarray]:
+            winning_labels: Callable[[np.ndarray], np.ndarray],
+            frame_counts: Callable[[np.ndarray], np.ndarray] | None = None,
+            min_frames: int = 1) -> dict[int, np.ndarray]:
         """Instance id -> ijk (M, 3) of the voxels each door wins (module doc);
         ``winning_labels`` gives the winning label of sorted distinct voxel keys (the map's
-        :meth:`~sgtool.mapping.voxels.VoxelMap.winning_labels`)."""
+        :meth:`~sgtool.mapping.voxels.VoxelMap.winning_labels`). With ``frame_counts`` (the
+        map's :meth:`~sgtool.mapping.voxels.VoxelMap.frame_counts`) a won voxel counts
+        only in a column where the door holds a voxel that at least ``need`` frames gave
+        its label, ``need`` = ``min_frames``, or the median of the door's won voxels' frame
+        counts when that is lower (a door seen in one frame so far keeps its voxels)."""
         ids = sorted(int(i) for i in instance_ids)
         parts = []
         for iid in ids:
@@ -100,7 +121,16 @@ class DoorVoxels:
         door = np.repeat(np.arange(len(ids)), sizes)
         vk_all = keys >> VOXEL_SHIFT
         vk = sorted_unique(vk_all)
-        mine = winning_labels(vk)[np.searchsorted(vk, vk_all)] == (keys & LABEL_MASK)
+        at = np.searchsorted(vk, vk_all)
+        mine = winning_labels(vk)[at] == (keys & LABEL_MASK)
+        if frame_counts is not None and min_frames > 1 and mine.any():
+            won_at = np.flatnonzero(mine)
+            frames = frame_counts(keys[won_at])
+            need = np.full(len(ids), min_frames, dtype=np.int64)
+            for j in np.unique(door[won_at]).tolist():
+                need[j] = min(min_frames, int(np.median(frames[door[won_at] == j])))
+            strong = frames >= need[door[won_at]]
+            mine[won_at] = _same_column(keys[won_at], door[won_at], strong)
         ix, iy, iz, _ = unpack(keys[mine])
         ijk = np.stack([ix, iy, iz], axis=1)
         split = np.cumsum(np.bincount(door[mine], minlength=len(ids)))[:-1]

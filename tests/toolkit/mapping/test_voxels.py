@@ -139,3 +139,39 @@ def test_frames_without_ids_build_geometry() -> None:
     ijk, lab, _ = vm.voxels()
     assert len(ijk) > 0 and set(lab.tolist()) == {0}
     assert vm.observed_instances() == []
+
+
+def _points(n: int, x: float, y: float = 0.0, z: float = 0.5) -> np.ndarray:
+    """``n`` world points inside the voxel holding (x, y, z) (5 cm voxels)."""
+    return np.tile([[x, y, z]], (n, 1)) + np.linspace(0.0, 0.01, n)[:, None]
+
+
+def test_frames_count_each_frame_once_per_entry() -> None:
+    vm = VoxelMap(VoxelConfig(flush_keys=10**9))  # every frame pending until one flush
+    door, sofa = (int(v) for v in vm.labels_of(np.array([7, 8])))
+    vm.integrate_points(_points(40, 1.02), np.full(40, door), (0.0, 0.0), 0)  # one close frame
+    for i in range(1, 4):  # three far frames, 3 points each
+        vm.integrate_points(_points(3, 1.02), np.full(3, sofa), (0.0, 0.0), i)
+    keys, counts = vm.entries()
+    assert counts.tolist() == [40, 9]  # points: the door's one frame wins
+    np.testing.assert_array_equal(vm.frame_counts(keys[::-1]), [3, 1])  # any order
+    assert (keys & 4095).tolist() == [door, sofa]
+    with pytest.raises(ValueError):
+        vm.frame_counts(keys[-1:] + 1)  # a key not in the map (the next label)
+
+
+def test_frame_counts_survive_batching_and_removal() -> None:
+    world = BoxWorld((Box((2.5, 0.5, 0.5), (0.5, 2.0, 1.0), 2),
+                      Box((3.5, -1.0, 1.0), (0.3, 0.3, 2.0), 3)), floor_instance=1)
+    frames = [make_frame(world, 0.2 * i, 0.1 * i, 0.3 * i - 0.5, K, index=i) for i in range(8)]
+    a, b = VoxelMap(VoxelConfig(flush_keys=1)), VoxelMap(VoxelConfig(flush_keys=10**9))
+    for f in frames:
+        a.integrate(f)
+        b.integrate(f)
+    ka, _ = a.entries()
+    fa = a.frame_counts(ka)
+    np.testing.assert_array_equal(fa, b.frame_counts(ka))
+    assert fa.min() >= 1 and fa.max() <= len(frames)
+    a.forget_instance(3)  # the frame counts of the entries left are unchanged
+    kept, _ = a.entries()
+    np.testing.assert_array_equal(a.frame_counts(kept), fa[np.isin(ka, kept)])
