@@ -39,24 +39,30 @@ def _report(d: Diagnosis) -> str:
         lines.append(f"CRCs: {checks}")
     if d.lost_chunks:
         lines.append(f"damaged or cut chunks: {d.lost_chunks}")
-    if d.lost_messages or d.lost_unknown:
-        if not d.lost_unknown:
-            lines.append(f"lost: {d.lost_messages} messages")
-        elif d.lost_messages:
-            lines.append(f"lost: {d.lost_messages} messages, and more that no index counts")
-        else:
-            lines.append("lost: messages that no index counts (the cut or damaged data has "
-                         "no index)")
-        for topic, e in sorted(d.lost.items()):
-            span = ""
-            if e["first_ns"] is not None and e["last_ns"] is not None:
-                span = f", log time {_s(e['first_ns'])} .. {_s(e['last_ns'])} s"
-            lines.append(f"  {topic}: {e['messages']}{span}")
+    lines += _lost_lines(d)
     for p in d.problems[:10]:
         lines.append(f"  - {p}")
     if len(d.problems) > 10:
         lines.append(f"  ... and {len(d.problems) - 10} more problems")
     return "\n".join(lines)
+
+
+def _lost_lines(d: Diagnosis) -> list[str]:
+    """What the report says of the messages lost (none: no line), per topic."""
+    if not (d.lost_messages or d.lost_unknown):
+        return []
+    if not d.lost_unknown:
+        lines = [f"lost: {d.lost_messages} messages"]
+    elif d.lost_messages:
+        lines = [f"lost: {d.lost_messages} messages, and more that no index counts"]
+    else:
+        lines = ["lost: messages that no index counts (the cut or damaged data has no index)"]
+    for topic, e in sorted(d.lost.items()):
+        span = ""
+        if e["first_ns"] is not None and e["last_ns"] is not None:
+            span = f", log time {_s(e['first_ns'])} .. {_s(e['last_ns'])} s"
+        lines.append(f"  {topic}: {e['messages']}{span}")
+    return lines
 
 
 def _recovered(d: Diagnosis, out: str) -> str:

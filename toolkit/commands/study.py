@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import os
 import sys
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -18,8 +19,10 @@ from sgtool.commands.options import (
 )
 from sgtool.errors import SgtoolError
 
+if TYPE_CHECKING:
+    from sgtool.analysis.noise_study_run import NoiseStudyRequest
+
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
-OUTPUTS = ("summary.md", "results.json", "results.csv", "plots", "closed_loop")
 
 
 def default_cache() -> Path:
@@ -90,13 +93,7 @@ def command() -> None:
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
 @executor_options("recordings and replays (one per house and noise setting)")
-def noise(houses: int, house_seed: int, house_files: tuple[str, ...], rooms: str,
-          factors: tuple[str, ...], profiles: tuple[str, ...], resolution: str, fps: float,
-          frames: int | None, noise_seed: int, cache_dir: str | None,
-          closed_loop: str | None, closed_loop_noise: str, episodes: int,
-          closed_loop_houses: int, frames_per_room: int, max_steps: int, out_dir: str,
-          force: bool, progress: bool | None, executor: str = "local", workers: int = 1,
-          ray_address: str | None = None) -> None:
+def noise(**given: Any) -> None:
     """Scene-graph quality against perception noise: for each noise factor at each level
     (and each whole profile), record the scripted tour of every house with that noise
     (`sgtool record --noise`), or reuse the log of --cache, replay it and score the final
@@ -111,23 +108,81 @@ def noise(houses: int, house_seed: int, house_files: tuple[str, ...], rooms: str
     Example: `sgtool study noise --houses 5 --rooms 8-8 --factor label_dropout=0.01,0.05
     --profile mild -w 2 -o study`.
     """
+    from sgtool.analysis.noise_study_run import study_into
+
+    study_into(_request(NoiseArgs(**given)), show=click.echo)
+
+
+@dataclass(frozen=True)
+class NoiseArgs:
+    """The options of `sgtool study noise` as given (the click parameters, by name)."""
+
+    houses: int
+    house_seed: int
+    house_files: tuple[str, ...]
+    rooms: str
+    factors: tuple[str, ...]
+    profiles: tuple[str, ...]
+    resolution: str
+    fps: float
+    frames: int | None
+    noise_seed: int
+    cache_dir: str | None
+    closed_loop: str | None
+    closed_loop_noise: str
+    episodes: int
+    closed_loop_houses: int
+    frames_per_room: int
+    max_steps: int
+    out_dir: str
+    force: bool
+    progress: bool | None
+    executor: str = "local"
+    workers: int = 1
+    ray_address: str | None = None
+
+
+def _request(args: NoiseArgs) -> NoiseStudyRequest:
+    """The input check: the conditions, the recording settings, the houses, the
+    closed-loop part (names and profiles before any work) and the cache folder."""
     from sgtool.analysis.bench_houses import generated_houses, load_house_files
-    from sgtool.analysis.executor import as_map, make_executor
+    from sgtool.analysis.noise_study import RecordingSettings, StudyConfig
+    from sgtool.analysis.noise_study_run import NoiseStudyRequest
+
+    conditions = _conditions(args.factors, args.profiles)
+    width, height = parse_resolution(args.resolution)
+    settings = RecordingSettings(width, height, args.fps, args.frames, args.noise_seed)
+    settings.check()
+    room_range = parse_rooms(args.rooms)
+    gen = generated_houses(args.houses, args.house_seed)
+    all_houses = gen + (load_house_files(args.house_files, taken=[h.id for h in gen])
+                        if args.house_files else ())
+    cfg = StudyConfig(all_houses, conditions, room_range, settings, _closed_loop(args))
+    cfg.check()
+    if cfg.closed_loop.planners:
+        from sgtool.analysis.closed_loop_bench import ClosedLoopBenchConfig
+
+        ClosedLoopBenchConfig(planners=cfg.closed_loop.planners, houses=1,
+                              episodes=args.episodes, noise=cfg.closed_loop.noise
+                              ).check()  # names, profiles: before any work
+    cache = Path(args.cache_dir) if args.cache_dir else default_cache()
+    if cache.exists() and not cache.is_dir():
+        raise SgtoolError(f"--cache {cache}: is a file, not a folder")
+    return NoiseStudyRequest(
+        config=cfg, cache=cache, out_dir=args.out_dir, force=args.force,
+        progress=sys.stderr.isatty() if args.progress is None else args.progress,
+        executor=args.executor, workers=args.workers, ray_address=args.ray_address)
+
+
+def _conditions(factors: tuple[str, ...], profiles: tuple[str, ...]) -> Any:
+    """The study's conditions: ``--factor`` levels (each factor once; none: the default
+    levels) and ``--profile`` profiles (none: the defaults unless factors are given)."""
     from sgtool.analysis.noise_study import (
         DEFAULT_LEVELS,
         DEFAULT_PROFILES,
-        ClosedLoopSettings,
-        RecordingSettings,
-        StudyConfig,
         conditions_of,
         parse_factor,
-        run_closed_loop,
-        run_study,
     )
-    from sgtool.analysis.noise_study_plots import plot_study
-    from sgtool.analysis.noise_study_tables import results_csv, results_json, summary_md
-    from sgtool.files import atomic_write, output_folder
-    from sgtool.recorders.sim.noise import parse_noise
 
     chosen: dict[str, tuple[float, ...]] = {}
     for text in factors:
@@ -138,61 +193,22 @@ def noise(houses: int, house_seed: int, house_files: tuple[str, ...], rooms: str
     if not factors:
         chosen = dict(DEFAULT_LEVELS)
     profile_list = tuple(profiles) if profiles else (() if factors else DEFAULT_PROFILES)
-    conditions = conditions_of(chosen, profile_list)
-    width, height = parse_resolution(resolution)
-    settings = RecordingSettings(width, height, fps, frames, noise_seed)
-    settings.check()
-    room_range = parse_rooms(rooms)
-    gen = generated_houses(houses, house_seed)
-    all_houses = gen + (load_house_files(house_files, taken=[h.id for h in gen])
-                        if house_files else ())
-    planners = planner_names(closed_loop) if closed_loop else ()
-    cl_noise = tuple(n.strip() for n in closed_loop_noise.split(",") if n.strip())
+    return conditions_of(chosen, profile_list)
+
+
+def _closed_loop(args: NoiseArgs) -> Any:
+    """The closed-loop settings: ``--closed-loop`` planners under each
+    ``--closed-loop-noise`` profile (each parsed)."""
+    from sgtool.analysis.noise_study import ClosedLoopSettings
+    from sgtool.recorders.sim.noise import parse_noise
+
+    planners = planner_names(args.closed_loop) if args.closed_loop else ()
+    cl_noise = tuple(n.strip() for n in args.closed_loop_noise.split(",") if n.strip())
     for n in cl_noise:
         parse_noise(n)
-    if closed_loop is not None and not planners:
+    if args.closed_loop is not None and not planners:
         raise SgtoolError("--closed-loop: give at least one planner")
     if planners and not cl_noise:
         raise SgtoolError("--closed-loop-noise: give at least one profile")
-    cfg = StudyConfig(all_houses, conditions, room_range, settings,
-                      ClosedLoopSettings(planners, cl_noise, episodes, closed_loop_houses,
-                                         frames_per_room, max_steps))
-    cfg.check()
-    if planners:
-        from sgtool.analysis.closed_loop_bench import ClosedLoopBenchConfig
-
-        ClosedLoopBenchConfig(planners=planners, houses=1, episodes=episodes,
-                              noise=cl_noise).check()  # names, profiles: before any work
-    cache = Path(cache_dir) if cache_dir else default_cache()
-    if cache.exists() and not cache.is_dir():
-        raise SgtoolError(f"--cache {cache}: is a file, not a folder")
-    show = sys.stderr.isatty() if progress is None else progress
-    runner = make_executor(executor, workers, ray_address)
-    with output_folder(out_dir, force=force, command="study noise", known=OUTPUTS) as out:
-        res = run_study(cfg, cache, runner, progress=show)
-        if planners:
-            cl = run_closed_loop(cfg, res.specs, out / "closed_loop",
-                                 runner=as_map(runner, progress=show, desc="closed loop",
-                                               task_id=lambda _, t: str(t.output)))
-            _write_closed_loop(cl, out / "closed_loop")
-            res = _with_closed_loop(res, cl)
-        atomic_write(out / "summary.md", summary_md(res))
-        atomic_write(out / "results.json", results_json(res))
-        atomic_write(out / "results.csv", results_csv(res))
-        plot_study(res, out / "plots")
-        summary = summary_md(res)
-    click.echo(summary, nl=False)
-    click.echo(f"{len(res.cells)} cells ({res.recorded} log(s) recorded now, the others from "
-               f"{cache}); wrote {out_dir}/summary.md, results.json, results.csv, plots/")
-
-
-def _write_closed_loop(cl: Any, folder: Path) -> None:
-    from sgtool.analysis.closed_loop_bench import write_outputs
-
-    write_outputs(cl, folder)
-
-
-def _with_closed_loop(res: Any, cl: Any) -> Any:
-    from dataclasses import replace
-
-    return replace(res, closed_loop=cl)
+    return ClosedLoopSettings(planners, cl_noise, args.episodes, args.closed_loop_houses,
+                              args.frames_per_room, args.max_steps)
