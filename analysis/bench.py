@@ -351,7 +351,18 @@ def _planner(name: str, options: Mapping[str, Any]) -> Any:
     return p
 
 
-PRIORS_PLANNERS = ("scout", "scout-noroom", "scout-delta0", "godhs", "esc", "bayes-search")
+def _priors_planners() -> tuple[str, ...]:
+    """The built-in planners whose options name a folder of distilled priors
+    (``weights_dir``): read off the registry, so a new one cannot be forgotten here."""
+    from dataclasses import fields
+
+    from sgtool.planning.registry import REGISTRY
+
+    return tuple(name for name, entry in REGISTRY.items()
+                 if any(f.name == "weights_dir" for f in fields(entry.options)))
+
+
+PRIORS_PLANNERS = _priors_planners()
 
 
 def planner_options_for(cfg: BenchConfig, name: str) -> dict[str, Any]:

@@ -150,6 +150,10 @@ def test_house_files_next_to_generated_houses_sort_by_id(tmp_path):
         {"weights_dir": "/p"}
     assert planner_options_for(cfg, "scout-noroom") == {"weights_dir": "/q"}
     assert planner_options_for(cfg, "sbert") == {}
+    # read off the registry: every planner with a weights_dir option, new ones included
+    assert planner_options_for(cfg, "bayes-rooms") == {"weights_dir": "/p"}
+    assert planner_options_for(cfg, "godhs-llm") == {"weights_dir": "/p"}
+    assert planner_options_for(cfg, "moma-llm") == {}
 
 
 def test_bad_house_files_stop_the_run_before_anything_is_written(tmp_path):
