@@ -159,7 +159,7 @@ def write_view(derived: Path, rrd: Path, show: bool) -> None:
 
     from sgtool.analysis.rerun_view import export
     from sgtool.log import LogReader
-    from sgtool.replayers.voxels import voxel_snapshots
+    from sgtool.replayers.voxel_timeline import voxel_snapshots
 
     with LogReader(derived) as r:
         total = r.frame_count()

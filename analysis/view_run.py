@@ -59,7 +59,7 @@ def _voxel_source(request: ViewRequest) -> Callable[[Any], Any] | None:
     if not request.voxels:
         return None
     try:
-        from sgtool.replayers.voxels import voxel_snapshots
+        from sgtool.replayers.voxel_timeline import voxel_snapshots
     except ImportError:
         return None
 

@@ -18,8 +18,8 @@ from typing import Any
 from sgtool.datasets.generator import HOUSE_ROOM_TYPES
 from sgtool.datasets.split import is_household_scene, training_knowledge
 from sgtool.errors import SgtoolError
+from sgtool.scenegraph.build_options import CLASSIFIERS
 from sgtool.scenegraph.categories import FrequencyRoomClassifier, RoomClassifier
-from sgtool.scenegraph.options import CLASSIFIERS
 from sgtool.semantics.room_classification import ContainmentRoomClassifier, LlmRoomClassifier
 
 

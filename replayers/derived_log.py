@@ -52,14 +52,14 @@ from sgtool.log.writer import LogWriter
 from sgtool.mapping.voxels import VoxelConfig
 from sgtool.progress import Progress
 from sgtool.replayers.graph_scene import graph_scene_update
-from sgtool.scenegraph.derived_layers import DERIVED_TOPICS, write_refresh
-from sgtool.scenegraph.options import (
+from sgtool.scenegraph.build_options import (
     CLASSIFIERS,
     MIN_POINTS_320x240,
     ResolvedOptions,
     builder_config,
     default_min_points,
 )
+from sgtool.scenegraph.derived_layers import DERIVED_TOPICS, write_refresh
 from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 
 REPLAY_METADATA = "sgtool.replay"

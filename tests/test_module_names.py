@@ -24,11 +24,7 @@ SAME_MEANING: dict[str, str] = {
 
 # basename -> the rename still to make (the modules mean different things; their folders were
 # being edited by other engineers when this test was written). Remove a line with the rename.
-RENAME_PENDING: dict[str, str] = {
-    "voxels.py": "replayers/voxels.py is the voxel map over time for viewers: voxel_timeline.py",
-    "options.py": "toolkit/scenegraph/options.py are the build options: build_options.py",
-    "instances.py": "recorders/sim/instances.py maps PyBullet bodies: body_instances.py",
-}
+RENAME_PENDING: dict[str, str] = {}
 
 
 def _modules_by_basename() -> dict[str, list[str]]:

@@ -4,7 +4,7 @@ Modules, one job each:
 
 - :mod:`~sgtool.recorders.sim.camera`: camera config, mounting, OpenGL matrices, depth
   from the depth buffer, instance ids from the segmentation mask (pure functions);
-- :mod:`~sgtool.recorders.sim.instances`: the instance table (ids in spec order);
+- :mod:`~sgtool.recorders.sim.body_instances`: the instance table (ids in spec order);
 - :mod:`~sgtool.recorders.sim.articulation`: hinged door panels of doors and containers;
 - :mod:`~sgtool.recorders.sim.build`: the house as PyBullet bodies;
 - :mod:`~sgtool.recorders.sim.navigation`: occupancy in the current door states, goals,
@@ -27,6 +27,7 @@ Importing this package does not import PyBullet; building a :class:`Simulation` 
 
 from __future__ import annotations
 
+from sgtool.recorders.sim.body_instances import Instance, instance_table
 from sgtool.recorders.sim.camera import CameraConfig
 from sgtool.recorders.sim.closed_loop import (
     ClosedLoopOptions,
@@ -38,7 +39,6 @@ from sgtool.recorders.sim.closed_loop import (
 )
 from sgtool.recorders.sim.closed_loop import run_episode as run_closed_loop
 from sgtool.recorders.sim.explore import ExplorationReport, ScriptOptions, explore_house
-from sgtool.recorders.sim.instances import Instance, instance_table
 from sgtool.recorders.sim.navigation import RobotConfig
 from sgtool.recorders.sim.noise import PROFILES, NoiseProfile, SensorFaults, parse_noise
 from sgtool.recorders.sim.recording import (

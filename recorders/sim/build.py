@@ -33,8 +33,8 @@ import numpy as np
 
 from sgtool.house.spec import Furniture, HouseSpec
 from sgtool.recorders.sim import articulation as art
+from sgtool.recorders.sim.body_instances import Instance, initial_states, instance_table
 from sgtool.recorders.sim.camera import uid_lut
-from sgtool.recorders.sim.instances import Instance, initial_states, instance_table
 
 FLOOR_MARGIN = 1.0  # floor slab beyond the house bounds (m)
 FLOOR_T = 0.1

@@ -112,14 +112,14 @@ from sgtool.recorders.sim.skill_plan import (  # noqa: F401 (re-exported)
     SkillPlan,
     plan_skills,
 )
-from sgtool.scenegraph.graph import SceneGraph
-from sgtool.scenegraph.options import (
+from sgtool.scenegraph.build_options import (
     CLASSIFIERS,
     ResolvedOptions,
     builder_config,
     default_min_points,
     mapping_record,
 )
+from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 from sgtool.semantics.text import category_text
 

@@ -18,8 +18,8 @@ from sgtool.house.spec import Door, HouseSpec, room_at
 from sgtool.mapping.occupancy import nearest_free_cell
 from sgtool.recorders.sim import articulation as art
 from sgtool.recorders.sim import navigation as nav
+from sgtool.recorders.sim.body_instances import DOOR
 from sgtool.recorders.sim.build import World, door_obstacles
-from sgtool.recorders.sim.instances import DOOR
 from sgtool.recorders.sim.navigation import RobotConfig
 
 MAX_OBSTACLE_HEIGHT = 1.8  # panels starting above this do not block the base (m)

@@ -39,9 +39,9 @@ from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.log.records import Action, Episode, Instances
 from sgtool.log.writer import LogWriter
+from sgtool.recorders.sim.body_instances import STRUCTURE
 from sgtool.recorders.sim.camera import CameraConfig, base_T_camera
 from sgtool.recorders.sim.explore import ExplorationReport, ScriptOptions, explore_house
-from sgtool.recorders.sim.instances import STRUCTURE
 from sgtool.recorders.sim.navigation import RobotConfig
 from sgtool.recorders.sim.noise import PROFILES, NoiseProfile, SensorFaults
 from sgtool.recorders.sim.simulation import (
@@ -284,7 +284,7 @@ def _explore_live(sim: Simulation, rec: LogRecorder, opts: RecordOptions,
     from sgtool.recorders.sim.coverage import coverage, floor_points
     from sgtool.recorders.sim.frontier_explore import LiveMap, explore_frontiers
     from sgtool.recorders.sim.live_skills import LiveSkills, RobotBody
-    from sgtool.scenegraph.options import ResolvedOptions, builder_config, default_min_points
+    from sgtool.scenegraph.build_options import ResolvedOptions, builder_config, default_min_points
     from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 
     floor = floor_points(sim.spec)

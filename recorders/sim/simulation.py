@@ -35,6 +35,7 @@ from sgtool.log.frame import Frame
 from sgtool.mapping.occupancy import OccupancyMap
 from sgtool.recorders.sim import articulation as art
 from sgtool.recorders.sim import navigation as nav
+from sgtool.recorders.sim.body_instances import Instance
 from sgtool.recorders.sim.build import World, build_world, pybullet, remove_panel, set_panel
 from sgtool.recorders.sim.camera import (
     CameraConfig,
@@ -47,7 +48,6 @@ from sgtool.recorders.sim.camera import (
     view_matrix,
 )
 from sgtool.recorders.sim.events import SimObserver, SkillOutcome, StopSimulation
-from sgtool.recorders.sim.instances import Instance
 from sgtool.recorders.sim.navigation import Pose2, RobotConfig
 from sgtool.recorders.sim.opening import OpeningPlanner
 from sgtool.recorders.sim.skills import Skills

@@ -13,8 +13,8 @@ import numpy as np
 
 from sgtool.house.spec import HouseSpec
 from sgtool.recorders.sim import articulation as art
+from sgtool.recorders.sim.body_instances import DOOR, FURNITURE, OBJECT, Instance
 from sgtool.recorders.sim.build import World
-from sgtool.recorders.sim.instances import DOOR, FURNITURE, OBJECT, Instance
 
 Target = str | int | tuple[float, float] | Sequence[float]
 

@@ -25,9 +25,9 @@ from sgtool.log import schemas as S
 from sgtool.log.echo import as_logged
 from sgtool.log.records import Instances
 from sgtool.replayers.derived_log import ReplayOptions, replay
+from sgtool.scenegraph.build_options import default_min_points
 from sgtool.scenegraph.derived_layers import DERIVED_TOPICS, _hull
 from sgtool.scenegraph.graph import SceneGraph
-from sgtool.scenegraph.options import default_min_points
 from sgtool.scenegraph.stream import SceneGraphStream
 
 TOUR = GOLDEN / "house6-tour.mcap"
@@ -183,7 +183,7 @@ def test_a_stream_fed_live_equals_the_replay_of_its_log(tmp_path):
     got = []
     replay(log, None, cfg_opts, on_refresh=lambda ref, s: got.append(ref.graph.to_json()))
     from sgtool.replayers.derived_log import resolve_options
-    from sgtool.scenegraph.options import builder_config
+    from sgtool.scenegraph.build_options import builder_config
 
     with LogReader(log) as r:
         resolved = resolve_options(r, cfg_opts)

@@ -16,7 +16,7 @@ import click
 
 from sgtool.commands.options import executor_options, option_group
 from sgtool.errors import SgtoolError
-from sgtool.scenegraph.options import CLASSIFIERS
+from sgtool.scenegraph.build_options import CLASSIFIERS
 
 F = TypeVar("F", bound=Callable[..., Any])
 

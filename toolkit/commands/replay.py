@@ -24,7 +24,7 @@ from sgtool.commands.options import (
 )
 from sgtool.commands.room_llm import LlmOptions
 from sgtool.errors import SgtoolError
-from sgtool.scenegraph.options import CLASSIFIERS
+from sgtool.scenegraph.build_options import CLASSIFIERS
 
 if TYPE_CHECKING:
     from sgtool.analysis.replay_run import BatchReplayRequest, ReplayRequest

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from support.small_house import small_house
 
-from sgtool.recorders.sim.instances import instance_table
+from sgtool.recorders.sim.body_instances import instance_table
 
 
 def test_small_house_is_a_valid_spec() -> None:

@@ -9,8 +9,8 @@ import pytest
 from support.nested_house import nested_house
 
 from sgtool.house.io import load_house
+from sgtool.recorders.sim.body_instances import OBJECT, instance_table
 from sgtool.recorders.sim.build import build_world, pybullet, shelf_boards
-from sgtool.recorders.sim.instances import OBJECT, instance_table
 
 
 @pytest.fixture(scope="module")
