@@ -66,6 +66,11 @@ from sgtool.analysis.bench_houses import (
     load_house_files,
     output_path,
 )
+from sgtool.analysis.bench_priors import (
+    planner_options_for,
+    priors_fingerprint,
+    training_vocabulary,
+)
 from sgtool.analysis.executor import Task, chunks, failure_lines, make_executor
 from sgtool.analysis.intervals import (
     DEFAULT_BOOTSTRAP,
@@ -351,36 +356,6 @@ def _planner(name: str, options: Mapping[str, Any]) -> Any:
     return p
 
 
-def _priors_planners() -> tuple[str, ...]:
-    """The built-in planners whose options name a folder of distilled priors
-    (``weights_dir``): read off the registry, so a new one cannot be forgotten here."""
-    from dataclasses import fields
-
-    from sgtool.planning.registry import REGISTRY
-
-    return tuple(name for name, entry in REGISTRY.items()
-                 if any(f.name == "weights_dir" for f in fields(entry.options)))
-
-
-PRIORS_PLANNERS = _priors_planners()
-
-
-def planner_options_for(cfg: BenchConfig, name: str) -> dict[str, Any]:
-    """The options ``name`` is built with: the configured ones, and for the planners that
-    use the learned priors (:data:`PRIORS_PLANNERS`) the weights of ``cfg.priors_dir``
-    unless an option names other weights."""
-    opts = dict(cfg.planner_options.get(name, {}))
-    if cfg.priors_dir is not None and name in PRIORS_PLANNERS:
-        opts.setdefault("weights_dir", cfg.priors_dir)
-    return opts
-
-
-def _vocabulary(priors_dir: str | None) -> frozenset[str]:
-    from sgtool.semantics.priors import training_queries
-
-    return training_queries(priors_dir)
-
-
 def _task(args: tuple[BenchConfig, BenchHouse, tuple[str, ...]]) -> list[EpisodeResult]:
     """Every episode and seed of one house for each of the given planners."""
     from sgtool.blas import single_blas_thread
@@ -407,7 +382,7 @@ def _task_episodes(cfg: BenchConfig, ref: BenchHouse,
     from sgtool.semantics.text import category_text
 
     house, episodes = _house(ref, cfg.rooms, cfg.episodes, cfg.preset)
-    vocabulary = _vocabulary(cfg.priors_dir)
+    vocabulary = training_vocabulary(cfg.priors_dir)
     out = []
     for name in names:
         planner = _planner(name, planner_options_for(cfg, name))
@@ -448,7 +423,7 @@ def run_benchmark(cfg: BenchConfig, progress: bool | None = None) -> BenchResult
     cfg.check()
     executor = make_executor(cfg.executor, cfg.workers, cfg.ray_address)
     houses = prepare_houses(cfg)
-    vocabulary = _vocabulary(cfg.priors_dir)  # a bad --priors fails before any episode
+    vocabulary = training_vocabulary(cfg.priors_dir)  # a bad --priors fails before any episode
     for name in cfg.planners:  # and so does a bad planner option (built here, kept)
         _planner(name, planner_options_for(cfg, name))
     show = sys.stderr.isatty() if progress is None else progress
@@ -498,21 +473,6 @@ def _title(cfg: BenchConfig) -> str:
     return (f"Symbolic benchmark (SymSearch roll-out): {' + '.join(parts)}; {cfg.episodes} "
             f"episodes per house x {cfg.seeds} seeds, N_max = {cfg.max_steps}"
             f"{'; success only on done() (MoMa-LLM)' if cfg.success == 'done' else ''}")
-
-
-def priors_fingerprint(weights_dir: str | os.PathLike[str] | None = None) -> str:
-    """SHA-256 (first 16 hex digits) of the relational-prior weights the scout planners load
-    (the shipped ones by default), so a table can be traced to the priors behind it."""
-    import hashlib
-
-    from sgtool.semantics.priors import WEIGHTS_DIR
-
-    h = hashlib.sha256()
-    for p in sorted(Path(weights_dir or WEIGHTS_DIR).glob("*")):
-        if p.is_file() and (p.suffix == ".safetensors" or p.name == "metadata.json"):
-            h.update(p.name.encode())
-            h.update(p.read_bytes())
-    return h.hexdigest()[:16]
 
 
 # the names write_outputs gives its files (what ``--force`` may replace in a folder without
