@@ -1,11 +1,11 @@
 """The Voronoi ridge cells (step 1 of :mod:`sgtool.mapping.voronoi`) recomputed only where
 the free space changed, with the same result as computing them from scratch.
 
-Between two refreshes the free cells change in a small window around where the camera
-looked (under 1 % of a house's grid at the median, measured on the 16- and 30-room
-benchmark logs), but the distance field with its nearest obstacles (the feature
-transform) and the ridge cells were computed over the whole grid. :func:`update_fields`
-recomputes them in a window around the changed cells and keeps the rest, exactly:
+Between two refreshes the free cells change in a small window around where the camera looked
+(a small share of a house's grid), but the distance field with its nearest obstacles (the
+feature transform) and the ridge cells were computed over the whole grid.
+:func:`update_fields` recomputes them in a window around the changed cells and keeps the
+rest, exactly:
 
 - **Distance field.** Let D be the bounding box of the cells whose freedom changed. A
   cell whose old distance to its nearest obstacle is *less than* its distance to D keeps
