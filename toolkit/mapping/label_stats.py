@@ -121,3 +121,18 @@ def update_frame(st: LabelStats, pts: np.ndarray,
     sel = cand[better]
     st.view_dist[sel] = dist[better]
     st.view_xy[sel] = viewpoint
+
+
+@dataclass(frozen=True)
+class InstanceObservation:
+    """What the map knows of one instance id."""
+
+    id: int
+    max_points: int  # most points of it in one frame
+    total_points: int
+    frames: int  # frames it appeared in
+    last_index: int  # frame index of its last appearance
+    viewpoint: tuple[float, float] | None  # closest viewpoint (x, y) among seen frames
+    view_distance: float  # xy distance from that viewpoint to its points' centroid
+    voxels: int  # distinct voxels it voted for
+    centroid: tuple[float, float, float] | None  # mean of those voxels' centres

@@ -62,20 +62,25 @@ from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.mapping.backproject import Scratch, beyond_packing, within_packing, world_voxels
 from sgtool.mapping.free_space import FreeSpaceConfig, View, seen_through
 from sgtool.mapping.key_count import count_keys
-from sgtool.mapping.label_stats import LabelStats, update_frame
+from sgtool.mapping.label_stats import InstanceObservation, LabelStats, update_frame
 from sgtool.mapping.vote_store import VoteStore, drain_keys, sorted_unique, spans
+from sgtool.mapping.voxel_keys import (  # the key layout (callers import it from here too)
+    AXIS_BITS,
+    AXIS_MASK,
+    COLUMN_SHIFT,
+    LABEL_MASK,
+    OFFSET,
+    OVERFLOW_LABEL,
+    SHIFT_X,
+    SHIFT_Y,
+    SHIFT_Z,
+    VOXEL_SHIFT,
+    pack,
+    unpack,
+    voxel_bounds,
+    winning_entries,
+)
 
-AXIS_BITS = 17
-LABEL_BITS = 12
-OFFSET = 1 << (AXIS_BITS - 1)
-AXIS_MASK = (1 << AXIS_BITS) - 1
-LABEL_MASK = (1 << LABEL_BITS) - 1
-OVERFLOW_LABEL = LABEL_MASK
-SHIFT_Z = LABEL_BITS
-SHIFT_Y = LABEL_BITS + AXIS_BITS
-SHIFT_X = LABEL_BITS + 2 * AXIS_BITS
-VOXEL_SHIFT = LABEL_BITS  # key >> VOXEL_SHIFT = voxel key
-COLUMN_SHIFT = LABEL_BITS + AXIS_BITS  # key >> COLUMN_SHIFT = (x, y) column key
 _LUT_MAX = 1 << 22  # instance ids below this use a lookup table, above it np.unique
 DENSE_SHARE = 0.875  # frames with this share of valid pixels are computed in place
 _DROPPED = (1 << 63) - 1  # key of a discarded pixel: no voxel in the packing's range has it
@@ -88,58 +93,6 @@ class VoxelConfig:
     max_range: float = 5.0  # m; farther depth is ignored (MoMa-LLM: 0-5 m)
     min_points: int = 50  # an instance counts as seen with this many points in one frame
     flush_keys: int = 150_000  # merge pending frame keys into the map beyond this many
-
-
-def pack(ix: np.ndarray, iy: np.ndarray, iz: np.ndarray, label: np.ndarray | int) -> np.ndarray:
-    """Pack signed voxel indices and a label index into int64 keys (caller checks range)."""
-    return (
-        ((ix + OFFSET) << SHIFT_X)
-        | ((iy + OFFSET) << SHIFT_Y)
-        | ((iz + OFFSET) << SHIFT_Z)
-        | np.asarray(label, dtype=np.int64)
-    )
-
-
-def unpack(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(ix, iy, iz, label) of packed keys, indices signed."""
-    ix = ((keys >> SHIFT_X) & AXIS_MASK) - OFFSET
-    iy = ((keys >> SHIFT_Y) & AXIS_MASK) - OFFSET
-    iz = ((keys >> SHIFT_Z) & AXIS_MASK) - OFFSET
-    return ix, iy, iz, keys & LABEL_MASK
-
-
-@dataclass(frozen=True)
-class InstanceObservation:
-    """What the map knows of one instance id."""
-
-    id: int
-    max_points: int  # most points of it in one frame
-    total_points: int
-    frames: int  # frames it appeared in
-    last_index: int  # frame index of its last appearance
-    viewpoint: tuple[float, float] | None  # closest viewpoint (x, y) among seen frames
-    view_distance: float  # xy distance from that viewpoint to its points' centroid
-    voxels: int  # distinct voxels it voted for
-    centroid: tuple[float, float, float] | None  # mean of those voxels' centres
-
-
-def winning_entries(keys: np.ndarray, counts: np.ndarray) -> np.ndarray:
-    """Index of the winning entry of every voxel of the sorted (voxel, label) ``keys``
-    (one per voxel, in order): the most votes, ties to the lower label index."""
-    if len(keys) == 0:
-        return np.zeros(0, dtype=np.int64)
-    vk = keys >> VOXEL_SHIFT
-    starts = np.flatnonzero(np.concatenate([[True], vk[1:] != vk[:-1]]))
-    best = np.maximum.reduceat(counts, starts)
-    group = np.repeat(np.arange(len(starts)), np.diff(np.append(starts, len(keys))))
-    cand = np.flatnonzero(counts == best[group])  # sorted: lower labels first in a group
-    g = group[cand]
-    return cand[np.concatenate([[True], g[1:] != g[:-1]])]
-
-
-def _voxel_bounds(voxel_keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Key ranges [lo, hi) holding every label's entry of the sorted distinct voxels."""
-    return voxel_keys << VOXEL_SHIFT, (voxel_keys + 1) << VOXEL_SHIFT
 
 
 class VoxelMap:
@@ -384,7 +337,7 @@ class VoxelMap:
         keys, counts = self.entries()
         mask = (keys & LABEL_MASK) == lab
         if mask.any():
-            lo, hi = _voxel_bounds(sorted_unique(keys[mask] >> VOXEL_SHIFT))
+            lo, hi = voxel_bounds(sorted_unique(keys[mask] >> VOXEL_SHIFT))
             idx = spans(np.searchsorted(keys, lo), np.searchsorted(keys, hi))
             win = idx[winning_entries(keys[idx], counts[idx])]
             won_vk = keys[win[(keys[win] & LABEL_MASK) == lab]] >> VOXEL_SHIFT
@@ -470,7 +423,7 @@ class VoxelMap:
                 self._misses = np.insert(self._misses, where, 0)
         if not len(self._weak):
             return 0
-        keys, counts = self._store.within(*_voxel_bounds(self._weak))
+        keys, counts = self._store.within(*voxel_bounds(self._weak))
         vk = keys >> VOXEL_SHIFT
         votes = np.bincount(np.searchsorted(self._weak, vk), weights=counts,
                             minlength=len(self._weak)).astype(np.int64)
@@ -493,7 +446,7 @@ class VoxelMap:
         gone_vk = w[drop]
         self._weak, self._misses = w[~drop], self._misses[~drop]
         all_keys, _ = self.entries()
-        lo, hi = _voxel_bounds(gone_vk)
+        lo, hi = voxel_bounds(gone_vk)
         idx = spans(np.searchsorted(all_keys, lo), np.searchsorted(all_keys, hi))
         mask = np.zeros(len(all_keys), dtype=bool)
         mask[idx] = True
@@ -562,7 +515,7 @@ class VoxelMap:
         """The winning label index (as :meth:`voxels`) of each of the sorted distinct voxel
         keys (``key >> VOXEL_SHIFT``) of voxels in the map, looked up in those voxels only."""
         self.flush()
-        keys, counts = self._store.within(*_voxel_bounds(voxel_keys))
+        keys, counts = self._store.within(*voxel_bounds(voxel_keys))
         win = keys[winning_entries(keys, counts)]
         if len(win) != len(voxel_keys) or ((win >> VOXEL_SHIFT) != voxel_keys).any():
             raise ValueError("winning_labels: a voxel is not in the map")
