@@ -137,6 +137,53 @@ class BayesSearchOptions(NodeOptions):
 
 
 @dataclass(frozen=True)
+class VoiOptions(NodeOptions):
+    """voi: the belief of bayes-rooms, actions valued by what they reveal per cost
+    (sgtool.planning.voi)."""
+
+    step_cost: float = field(default=3.0, metadata=option(
+        "a of (V2): metres per action", "float", lo=0.0))
+    open_cost: float = field(default=0.5, metadata=option(
+        "b of (V2): extra cost of an open", "float", lo=0.0))
+    follow_steps: float = field(default=1.0, metadata=option(
+        "f of (V2): actions after a reveal before what it showed is checked", "float",
+        lo=0.0))
+    top_k: int = field(default=5, metadata=option(
+        "places ranked by p/c that the look-ahead orders", "int", lo=1))
+    horizon: int = field(default=3, metadata=option(
+        "places per look-ahead sequence", "int", lo=1))
+    step_budget: int = field(default=50, metadata=option(
+        "actions per episode (N_max) the step price assumes; 0: none", "int", lo=0))
+    room_floor: float = field(default=0.05, metadata=option(
+        "(C1) floor of the room probability R", "float", lo=0.0, hi=1.0))
+    object_floor: float = field(default=0.05, metadata=option(
+        "(C1) floor of the carrier probability C", "float", lo=0.0, hi=1.0))
+    sharpness: float = field(default=1.0, metadata=option(
+        "(C1) exponent of R", "float", lo=0.0))
+    object_sharpness: float = field(default=2.0, metadata=option(
+        "(C1) exponent of C", "float", lo=0.0))
+    beyond: float = field(default=1.0, metadata=option(
+        "(B4) weight of the space behind a door or a leading-out frontier", "float", lo=0.0))
+    miss: float = field(default=0.5, metadata=option(
+        "mass factor per failed attempt on a node (1 - beta)", "float", lo=0.0, hi=1.0))
+    region_weight: float = field(default=1.0, metadata=option(
+        "omega of K = omega n C, the mass of an unseen region (B2)-(B3)", "float", lo=0.0))
+    seen_type_weight: float = field(default=0.3, metadata=option(
+        "eta of (B7): weight of a room type in an unexplored room's mean per explored room "
+        "of that type; 1: off", "float", lo=0.0, hi=1.0))
+    instance_exponent: float = field(default=0.5, metadata=option(
+        "gamma of (B8): n carriers of one category in a room hold C n^gamma; 1: off",
+        "float", lo=0.0, hi=1.0))
+    blend: bool = field(default=True, metadata=option(
+        "blend the learned scores with the cosine by query novelty", "bool"))
+    furniture_levels: str | Mapping[str, float] | None = field(default=None, metadata=option(
+        "furniture-level prior table (JSON) or 'none' [default: the shipped table]", "path",
+        objects=True))
+    encoder: Any = field(default=None, metadata=_ENCODER)
+    weights_dir: str | None = field(default=None, metadata=_WEIGHTS)
+
+
+@dataclass(frozen=True)
 class LlmEndpointOptions:
     """The chat endpoint of an LLM planner: ``client``, else a ``replay`` transcript, else
     ``base_url``/``model``/``api_key`` (unset: the ``SGTOOL_LLM_*`` environment variables,

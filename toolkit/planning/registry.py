@@ -40,6 +40,7 @@ from sgtool.planning.planner_options import (
     NodeOptions,
     SbertOptions,
     ScoutOptions,
+    VoiOptions,
 )
 
 __all__ = ["REGISTRY", "PLANNER_NAMES", "Entry", "UnknownPlannerError", "PlannerOptionError",
@@ -145,6 +146,23 @@ def _bayes(name: str, o: BayesSearchOptions) -> Planner:
                                furniture_levels=_furniture_levels(o.furniture_levels))
 
 
+def _voi(name: str, o: VoiOptions) -> Planner:
+    from sgtool.planning.belief import BeliefParams
+    from sgtool.planning.voi import VoiParams, VoiPlanner
+
+    belief = BeliefParams(room_floor=o.room_floor, object_floor=o.object_floor,
+                          sharpness=o.sharpness, object_sharpness=o.object_sharpness,
+                          beyond=o.beyond, miss=o.miss, region_weight=o.region_weight,
+                          seen_type_weight=o.seen_type_weight,
+                          instance_exponent=o.instance_exponent)
+    params = VoiParams(step_cost=o.step_cost, open_cost=o.open_cost,
+                       follow_steps=o.follow_steps, top_k=o.top_k, horizon=o.horizon,
+                       step_budget=o.step_budget, belief=belief)
+    return VoiPlanner(_priors(o.encoder, o.weights_dir, blend=o.blend), params, name=name,
+                      max_failures=o.max_failures,
+                      furniture_levels=_furniture_levels(o.furniture_levels))
+
+
 def _esc(name: str, o: EscOptions) -> Planner:
     from sgtool.planning.esc import EscParams, EscPlanner
 
@@ -220,6 +238,9 @@ REGISTRY: Mapping[str, Entry] = MappingProxyType({
                          "share their category's mass, (B7)-(B8) of sgtool.planning.belief",
                          fixed={"seen_type_weight": BAYES_ROOMS_SEEN_TYPE_WEIGHT,
                                 "instance_exponent": BAYES_ROOMS_INSTANCE_EXPONENT}),
+    "voi": Entry(_voi, VoiOptions, "value of information: bayes-rooms' belief, each action "
+                 "valued by what it finds per cost, a reveal paying for the check it needs "
+                 "(sgtool.planning.voi)"),
     "moma-llm": Entry(_moma, MomaOptions, "MoMa-LLM over an OpenAI-compatible chat endpoint "
                       "or a transcript"),
     "unstructured-llm": Entry(_moma, MomaOptions, "MoMa-LLM's ablation: shown the raw JSON "

@@ -1,0 +1,348 @@
+"""``voi``: search by value of information, looking weighed against opening.
+
+The belief is that of ``bayes-rooms`` ((B1)-(B8) of :mod:`sgtool.planning.belief`, kept
+per episode and updated incrementally here, :class:`EpisodeBelief`). What differs is what an
+action is worth. Every action costs one step of the budget and its travel; what it buys
+is the chance of seeing the target now, or of being one step from it:
+
+- checking a carrier o (``open`` a closed one, walk up to an open one) resolves p_o at
+  once: whether the target is on or in it;
+- revealing space (an unexplored-area frontier, an unexplored room, a closed door, a
+  leading-out frontier) shows first-level pieces, so a furniture-level target is seen at
+  once, but a small object on or in a revealed piece needs a further check, so its share
+  of the node's mass is paid with ``follow_steps`` more actions.
+
+With p_i the belief mass of candidate i, split (B6) into the share found on arrival and
+the share that needs a follow-up check,
+
+    p_i = p_i^now + p_i^next,   p^now = φ P_F + (1 - φ) P_O [i a carrier],
+                                p^next = (1 - φ) P_O [i reveals space]                (V1)
+
+its expected cost in metres-equivalent is
+
+    c_i = d_i + a_t + b·[open] + f · a_t · p_i^next / p_i                             (V2)
+
+(d_i travel, a_t the price of an action (S3) of :mod:`sgtool.planning.search_theory`, b
+the extra of an open, f = ``follow_steps``). This replaces the region discount ω of (B2):
+the region's mass stays what the belief says (ω = 1), and what revealing it cannot buy at
+once is charged as the cost of the step that will. A room, door or frontier is therefore
+worth visiting exactly when its mass per step-and-a-bit beats the best carrier's mass per
+step; twenty closed cabinets of one kind hold the category's mass C n^γ between them (B8),
+so a likely room that has not been seen is visited before the cheap containers are
+exhausted. Places are ordered by (S2) (the best ordering of ``horizon`` of the ``top_k``
+places by p/c, detection probability per expected cost), with the costs (V2) on every leg.
+
+Everything is deterministic (ties broken by node id); the seed is not used.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from sgtool.planning.belief import BeliefParams
+from sgtool.planning.calibration import calibrate
+from sgtool.planning.candidates import (
+    Candidate,
+    CandidateColumns,
+    is_carrier,
+)
+from sgtool.planning.furniture_prior import furniture_level
+from sgtool.planning.planners import ScoringPlanner
+from sgtool.planning.search_theory import _orderings, sequence_values, step_price
+from sgtool.planning.utility import UNKNOWN_ROOM
+from sgtool.scenegraph.graph import ObjectNode, RegionNode, RoomNode, SceneGraph
+from sgtool.semantics.priors import RelationScorer, can_score_room
+from sgtool.semantics.text import category_text
+
+REVEAL_KINDS = frozenset({"room", "frontier", "door"})
+
+
+def voi_belief() -> BeliefParams:
+    """The belief of ``voi``: (B7) η = 0.3, (B8) γ = 0.5 as ``bayes-rooms``, ω = 1 (V2)."""
+    return BeliefParams(region_weight=1.0, seen_type_weight=0.3, instance_exponent=0.5)
+
+
+@dataclass(frozen=True)
+class VoiParams:
+    step_cost: float = 3.0  # a of (V2), metres per action
+    open_cost: float = 0.5  # b of (V2)
+    follow_steps: float = 1.0  # f of (V2): actions after a reveal to check what it showed
+    top_k: int = 5
+    horizon: int = 3
+    step_budget: int = 50  # actions per episode (N_max) of the step price (S3); 0: none
+    belief: BeliefParams = field(default_factory=voi_belief)
+
+
+# what the belief needs of one node: (code, room id, carrier index or -1)
+_CARRIER, _OBJECT, _INNER, _OUT = 0, 1, 2, 3
+
+
+class EpisodeBelief:
+    """(B1)-(B8) of :mod:`sgtool.planning.belief` for one episode and query, equal to
+    :func:`~sgtool.planning.belief.place_masses` up to rounding, computed from what changed:
+    the calibrated scores are kept per category, the carrier table per objects tuple, the
+    frontier table per regions tuple, the room table per rooms tuple (an incremental graph
+    passes the same tuple while nothing in it changed)."""
+
+    def __init__(self, scorer: RelationScorer, query: str, params: BeliefParams,
+                 furniture: float = 0.0) -> None:
+        self.scorer = scorer
+        self.query = query
+        self.params = params
+        self.furniture = furniture
+        self._c: dict[str, float] = {}  # calibrated C per category as given
+        self._r: dict[str, float] = {}  # calibrated R per room category as given
+        self._types: tuple[list[str], np.ndarray] | None = None
+        self._rbar: dict[tuple[int, ...], float] = {}
+        self._objects: tuple[ObjectNode, ...] | None = None
+        self._obj_table: tuple[dict[str, tuple[int, str, float]], dict[str, float], float,
+                               int] = ({}, {}, 0.5, 0)
+        self._regions: tuple[RegionNode, ...] | None = None
+        self._reg_table: tuple[dict[str, tuple[int, str]], list[str], dict[str, int], int] = \
+            ({}, [], {}, 0)
+        self._rooms: tuple[RoomNode, ...] | None = None
+        self._room_table: tuple[dict[str, float], float] = ({}, params.fallback_room)
+
+    # ----- scores ----------------------------------------------------------------------
+    def _carrier_scores(self, cats: Sequence[str]) -> list[float]:
+        miss = sorted({c for c in cats if c not in self._c})
+        if miss:
+            p = self.params
+            cs = calibrate(self.scorer.objects(miss, self.query), p.object_floor,
+                           p.object_sharpness)
+            self._c.update(zip(miss, map(float, cs), strict=True))
+        return [self._c[c] for c in cats]
+
+    def _room_score(self, cat: str) -> float:
+        r = self._r.get(cat)
+        if r is None:
+            p = self.params
+            r = self._r[cat] = float(calibrate(self.scorer.rooms([cat], self.query),
+                                               p.room_floor, p.sharpness)[0])
+        return r
+
+    def _unknown(self, rooms: tuple[RoomNode, ...]) -> float:
+        """R̄ of (B7)."""
+        p = self.params
+        if self._types is None:
+            types = [t for t in getattr(self.scorer, "room_types", ())
+                     if can_score_room(self.scorer, t)]
+            cal = calibrate(self.scorer.rooms(types, self.query), p.room_floor,
+                            p.sharpness) if types else np.zeros(0)
+            self._types = (types, np.asarray(cal, dtype=np.float64))
+        types, cal = self._types
+        if not types:
+            return p.fallback_room
+        if p.seen_type_weight >= 1.0:
+            return float(np.mean(cal))
+        seen = Counter(category_text(r.category) for r in rooms if r.explored)
+        key = tuple(seen[category_text(t)] for t in types)
+        hit = self._rbar.get(key)
+        if hit is None:
+            w = np.array([p.seen_type_weight ** n for n in key])
+            hit = self._rbar[key] = float(np.dot(w, cal) / w.sum())
+        return hit
+
+    # ----- tables per node tuple -------------------------------------------------------
+    def _room_masses(self, graph: SceneGraph) -> tuple[dict[str, float], float]:
+        if graph.rooms is not self._rooms:
+            unknown = self._unknown(graph.rooms)
+            out = {r.id: unknown for r in graph.rooms}
+            for r in graph.rooms:
+                if r.explored and r.category.lower() not in UNKNOWN_ROOM and \
+                        can_score_room(self.scorer, r.category):
+                    out[r.id] = self._room_score(r.category)
+            self._rooms, self._room_table = graph.rooms, (out, unknown)
+        return self._room_table
+
+    def _carriers(self, graph: SceneGraph
+                  ) -> tuple[dict[str, tuple[int, str, float]], dict[str, float], float, int]:
+        """Per object id (code, room, C' of (B8)); Z_r's carrier part; C̄; carrier count."""
+        if graph.objects is self._objects:
+            return self._obj_table
+        carriers = [o for o in graph.objects if is_carrier(o)]
+        c = self._carrier_scores([o.category for o in carriers])
+        gamma = self.params.instance_exponent
+        if gamma != 1.0 and carriers:
+            keys = [(o.room, category_text(o.category)) for o in carriers]
+            n = Counter(keys)
+            c = [v * n[k] ** (gamma - 1.0) for v, k in zip(c, keys, strict=True)]
+        table: dict[str, tuple[int, str, float]] = {}
+        zc: dict[str, float] = {}
+        for o, v in zip(carriers, c, strict=True):
+            zc[o.room] = zc.get(o.room, 0.0) + v
+        for o in graph.objects:
+            table.setdefault(o.id, (_OBJECT, o.room, 0.0))
+        for o, v in zip(carriers, c, strict=True):
+            table[o.id] = (_CARRIER, o.room, v)
+        mean_c = float(np.mean(c)) if c else 0.5
+        self._objects, self._obj_table = graph.objects, (table, zc, mean_c, len(carriers))
+        return self._obj_table
+
+    def _frontiers(self, graph: SceneGraph
+                   ) -> tuple[dict[str, tuple[int, str]], list[str], dict[str, int], int]:
+        """Per region id (code, room); the rooms of the inner frontiers in graph order,
+        their count per room; the revealed regions' count."""
+        if graph.regions is self._regions:
+            return self._reg_table
+        table: dict[str, tuple[int, str]] = {}
+        inner: list[str] = []
+        revealed = 0
+        for f in graph.regions:
+            if f.kind != "frontier":
+                revealed += 1
+                code = _OBJECT  # a revealed region is no candidate; never read
+            elif f.frontier_type != "leading out":
+                inner.append(f.room)
+                code = _INNER
+            else:
+                code = _OUT
+            table.setdefault(f.id, (code, f.room))
+        self._regions, self._reg_table = graph.regions, (table, inner, Counter(inner), revealed)
+        return self._reg_table
+
+    # ----- the belief ------------------------------------------------------------------
+    def masses(self, graph: SceneGraph, ids: Sequence[str], kinds: Sequence[str],
+               failures: Sequence[int] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(P, P^next): the belief over the candidates ``ids`` (of ``kinds``), normalised,
+        and the part of each that a follow-up check must find, (V1)."""
+        n = len(ids)
+        if not n:
+            return np.zeros(0), np.zeros(0)
+        p = self.params
+        rooms, unknown = self._room_masses(graph)
+        objs, zc, mean_c, ncar = self._carriers(graph)
+        regs, inner, per_room, revealed = self._frontiers(graph)
+        per_region = max(1.0, ncar / max(1, revealed))
+        k = p.region_weight * per_region * mean_c  # K of (B2)-(B3)
+        z = dict(zc)
+        for r in inner:
+            z[r] = z.get(r, 0.0) + k
+        beyond = unknown * p.beyond
+        po = np.empty(n)
+        pf = np.zeros(n)
+        reveal = np.zeros(n, dtype=bool)
+        phi = self.furniture
+        for i, (nid, kind) in enumerate(zip(ids, kinds, strict=True)):
+            if kind == "object":
+                code, room, c = objs.get(nid, (_OUT, "", 0.0))
+                if code == _OUT:  # not a node of the graph: space beyond, as (B4)
+                    po[i] = beyond
+                    continue
+                zr = z.get(room) or (c if code == _CARRIER else 1.0)
+                po[i] = rooms.get(room, unknown) * (c if code == _CARRIER else mean_c) / zr
+                continue
+            reveal[i] = True
+            if kind == "frontier":
+                code, room = regs.get(nid, (_OUT, ""))
+                if code == _INNER:
+                    po[i] = rooms.get(room, unknown) * k / (z.get(room) or k)
+                    if phi > 0.0:
+                        pf[i] = rooms.get(room, unknown) / per_room.get(room, 1)
+                    continue
+            if kind == "room":
+                po[i] = pf[i] = unknown
+            else:  # a closed door, a leading-out frontier: space beyond
+                po[i] = pf[i] = beyond
+        if phi > 0.0:
+            so, sf = float(po.sum()), float(pf.sum())
+            if sf > 0 and so > 0:
+                po = (1.0 - phi) * po / so
+                pf = phi * pf / sf
+            elif sf > 0:
+                po, pf = np.zeros(n), pf
+            else:
+                pf = np.zeros(n)
+        else:
+            pf = np.zeros(n)
+        total_now = po + pf
+        if failures is not None and any(failures):
+            f = p.miss ** np.asarray(failures, dtype=float)
+            po, pf, total_now = po * f, pf * f, total_now * f
+        s = float(total_now.sum())
+        if s <= 0:
+            return np.full(n, 1.0 / n), np.zeros(n)
+        nxt = np.where(reveal, po, 0.0) / s
+        return total_now / s, nxt
+
+
+class VoiPlanner(ScoringPlanner[VoiParams]):
+    """Value-of-information search (module doc). ``furniture_levels``: name -> φ of (B6)
+    (:mod:`sgtool.planning.furniture_prior`); None: every query is a small object."""
+
+    def __init__(self, scorer: RelationScorer, params: VoiParams = VoiParams(),
+                 name: str = "voi", max_failures: int = 2,
+                 furniture_levels: Mapping[str, float] | None = None) -> None:
+        super().__init__(name, scorer, params, max_failures)
+        self.steps = 0
+        self.furniture_levels = furniture_levels
+        self.belief = EpisodeBelief(scorer, "", params.belief)
+
+    def reset(self, query: str, seed: int = 0) -> None:
+        super().reset(query, seed)
+        self.steps = 0
+        self.belief = EpisodeBelief(self.scorer, query, self.params.belief,
+                                    furniture_level(self.furniture_levels, query))
+
+    def choose(self, graph: SceneGraph, cands: list[Candidate]
+               ) -> tuple[int, str, dict[str, float]]:
+        return self.choose_columns(graph, CandidateColumns.of(cands))
+
+    def choose_columns(self, graph: SceneGraph, cols: CandidateColumns
+                       ) -> tuple[int, str, dict[str, float]]:
+        fails_of = self.memory.failures
+        fails = [len(fails_of.get(i, ())) for i in cols.ids] if fails_of else None
+        p, nxt = self.belief.masses(graph, cols.ids, cols.kinds, fails)
+        budget = self.params.step_budget
+        left = budget - self.steps if budget > 0 else None
+        self.steps += 1
+        i, value = self.best_first(cols, p, nxt, graph.robot.position, left)
+        scores = dict(zip(cols.ids, np.round(p, 4).tolist(), strict=True))
+        return i, (f"p={p[i]:.3f}, d={cols.distances[i]:.2f} m, "
+                   f"value={value:.4f}"), scores
+
+    def best_first(self, cols: CandidateColumns, p: np.ndarray, nxt: np.ndarray,
+                   robot: tuple[float, float], steps_left: int | None) -> tuple[int, float]:
+        """Index of the candidate to check first and the value of its ordering, (V2) and
+        (S2)."""
+        prm = self.params
+        step = step_price(p, steps_left, prm.step_cost)
+        opens = np.fromiter((s == "open" for s in cols.skills), dtype=bool, count=len(cols))
+        share = np.divide(nxt, p, out=np.zeros_like(p), where=p > 0)
+        extra = step + prm.open_cost * opens + prm.follow_steps * step * share
+        dist = np.asarray(cols.distances, dtype=np.float64)
+        first = dist + extra
+        ratio = p / first
+        keys = cols.ids  # ties: node ids as strings, as (S2) of bayes-search
+        ranked = sorted(range(len(cols)), key=lambda k: (-ratio[k], keys[k]))
+        top = ranked[: max(1, prm.top_k)]
+        h = min(prm.horizon, len(top))
+        if h <= 1:
+            return top[0], float(ratio[top[0]])
+        xy = np.asarray(cols.positions, dtype=np.float64)
+        rho = _detour(xy, dist, robot)
+        sub = xy[top]
+        legs_top = rho * np.hypot(sub[:, None, 0] - sub[None, :, 0],
+                                  sub[:, None, 1] - sub[None, :, 1]) + extra[top][None, :]
+        orders = _orderings(len(top), h)
+        v = sequence_values(orders, p[top], first[top], legs_top)
+        best = v.max()
+        ties = np.flatnonzero(v == best)
+        k = min(ties, key=lambda t: tuple(keys[top[j]] for j in orders[t]))
+        return int(top[orders[k, 0]]), float(v[k])
+
+
+def _detour(xy: np.ndarray, dist: np.ndarray, robot: tuple[float, float]) -> float:
+    """ρ of (S2): median travel / straight-line distance, clipped to [1, 3]."""
+    e = np.hypot(xy[:, 0] - robot[0], xy[:, 1] - robot[1])
+    far = e > 0.5
+    if not far.any():
+        return 1.0
+    return float(np.clip(np.median(dist[far] / e[far]), 1.0, 3.0))
+
+
+__all__ = ["REVEAL_KINDS", "EpisodeBelief", "VoiParams", "VoiPlanner", "voi_belief"]
