@@ -14,7 +14,16 @@ of ``decide`` wall time (``Action.decision_time_s``), measured side by side in o
 command, so its row is the cost of encoding the scene, parsing and grounding, *without*
 any model latency (SCOUT reports ~300 s per decision for real LLM calls).
 
+``--dense N`` measures instead on the bench's dense houses (generated, ``symsearch``
+preset, house seeds 0..N-1, ~230 explorable pieces each): the bench's first ``--episodes``
+episodes of each house are rolled out in the symbolic environment by each of
+``--planners`` in turn (episode by episode, so a change of machine load hits every planner
+alike), and every ``decide`` call is timed (wall seconds, the planner's whole decision:
+candidates, belief, choice). The first decision of each episode is reported apart (a new
+query: its scores are computed then).
+
     .venv/bin/python benchmarks/decide.py [--episodes 10]
+    .venv/bin/python benchmarks/decide.py --dense 2 --episodes 5 --planners scout,bayes-rooms,voi
 """
 
 from __future__ import annotations
@@ -160,10 +169,72 @@ def run(name: str, episodes: int, fresh: bool) -> list[float]:
     return times
 
 
+class _Clocked:
+    """A planner whose ``decide`` calls are timed into ``times`` (wall seconds)."""
+
+    def __init__(self, planner, times: list[float], first: list[float]) -> None:
+        self.planner, self.name = planner, planner.name
+        self.times, self.first, self._fresh = times, first, True
+
+    def reset(self, query: str, seed: int = 0) -> None:
+        self.planner.reset(query, seed)
+        self._fresh = True
+
+    def decide(self, graph):
+        t0 = time.perf_counter()
+        a = self.planner.decide(graph)
+        (self.first if self._fresh else self.times).append(time.perf_counter() - t0)
+        self._fresh = False
+        return a
+
+    def feedback(self, fb) -> None:
+        self.planner.feedback(fb)
+
+
+def run_dense(names: list[str], houses: int, episodes: int) -> dict[str, dict[str, float]]:
+    """Decision times on the bench's dense houses (module doc), per planner."""
+    from sgtool.analysis.bench_houses import bench_episodes
+    from sgtool.datasets.generator import generate_house
+    from sgtool.recorders.symbolic_environment import SymbolicHouse, run_episode
+
+    times: dict[str, list[float]] = {n: [] for n in names}
+    first: dict[str, list[float]] = {n: [] for n in names}
+    planners = {n: _Clocked(make_planner(n, timed=False), times[n], first[n]) for n in names}
+    for seed in range(houses):
+        spec = generate_house(seed, rooms=(12, 16), split="eval", preset="symsearch")
+        house = SymbolicHouse(spec)
+        eps = bench_episodes(spec, episodes, "symsearch")
+        print(f"house {seed}: {len(spec.furniture)} pieces, {len(spec.objects)} objects")
+        for i, ep in enumerate(eps):
+            for n in names:
+                run_episode(house, planners[n], ep.query, ep.targets, seed=0,
+                            episode_index=i, avoid_rooms=ep.target_rooms)
+    rows: dict[str, dict[str, float]] = {}
+    print(f"{'planner':<14} {'median':>10} {'p90':>10} {'first':>10} {'decisions':>10}")
+    for n in names:
+        t = times[n] or [0.0]
+        p90 = float(np.percentile(t, 90))
+        f = statistics.median(first[n]) if first[n] else 0.0
+        print(f"{n:<14} {statistics.median(t) * 1e3:>7.3f} ms {p90 * 1e3:>7.3f} ms "
+              f"{f * 1e3:>7.3f} ms {len(times[n]):>10}")
+        rows[n] = {"median_s": statistics.median(t), "p90_s": p90, "first_median_s": f,
+                   "decisions": len(times[n])}
+    return rows
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--episodes", type=int, default=10)
+    ap.add_argument("--dense", type=int, default=0, metavar="N",
+                    help="measure on N dense bench houses instead (module doc)")
+    ap.add_argument("--planners", default="scout,bayes-search,bayes-rooms,voi",
+                    help="planners of --dense (comma-separated)")
     args = add_output_options(ap).parse_args()
+    if args.dense:
+        names = [n.strip() for n in args.planners.split(",") if n.strip()]
+        emit({"dense_houses": args.dense, "episodes": args.episodes,
+              "planners": run_dense(names, args.dense, args.episodes)}, args.json_out)
+        return
     rows: dict[str, dict[str, float]] = {}
     from sgtool.semantics.encoder import default_encoder
 

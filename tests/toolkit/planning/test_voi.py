@@ -1,0 +1,164 @@
+"""voi: the incremental belief equals bayes-rooms' (B1)-(B8), a reveal pays for the check it
+needs (V1)-(V2), like containers do not outweigh a surface, and the registry row."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from support.semantics_fixtures import TableScorer, house
+
+from sgtool.planning.base import Action, Feedback
+from sgtool.planning.belief import BeliefParams, place_masses
+from sgtool.planning.candidates import actionable
+from sgtool.planning.planner_options import VoiOptions
+from sgtool.planning.registry import make_planner
+from sgtool.planning.search_theory import SearchTheoryPlanner
+from sgtool.planning.voi import EpisodeBelief, VoiParams, VoiPlanner, voi_belief
+from sgtool.scenegraph.graph import ObjectNode, RegionNode, RobotState, RoomNode, SceneGraph
+
+
+class TypedScorer(TableScorer):
+    """A table scorer that lists the room types it scores, for (B7)."""
+
+    room_types = ("kitchen", "bathroom", "living_room", "bedroom")
+
+
+SCORER = TypedScorer(rooms={"kitchen": 0.9, "bathroom": 0.2, "living_room": 0.4,
+                            "bedroom": 0.1},
+                     objects={"fridge": 0.8, "bottom_cabinet": 0.6, "countertop": 0.5,
+                              "sink": 0.3, "sofa": 0.1, "coffee_table": 0.2}, default=0.05)
+BAYES_ROOMS = BeliefParams(seen_type_weight=0.3, instance_exponent=0.5)
+
+
+def _compare(graph: SceneGraph, belief: EpisodeBelief, params: BeliefParams, phi: float,
+             failures: list[int] | None = None) -> None:
+    cands = actionable(graph)
+    want = place_masses(graph, cands, "pan", SCORER, params, failures, phi)
+    got, nxt = belief.masses(graph, [c.node_id for c in cands], [c.kind for c in cands],
+                             failures)
+    assert got.tolist() == pytest.approx(want.tolist(), rel=1e-12, abs=1e-15)
+    assert np.all((nxt >= 0) & (nxt <= got + 1e-15))
+
+
+@pytest.mark.parametrize("phi", [0.0, 0.4])
+@pytest.mark.parametrize("params", [BeliefParams(), BAYES_ROOMS,
+                                    BeliefParams(region_weight=1.0, instance_exponent=0.0)])
+def test_belief_equals_place_masses(params: BeliefParams, phi: float) -> None:
+    """The same numbers as bayes-search's belief on the fixture house (rooms scored and
+    unexplored, a door, frontiers of both kinds, two cabinets of one category in different
+    rooms, non-carriers), with and without the furniture-level mixture (B6)."""
+    belief = EpisodeBelief(SCORER, "pan", params, phi)
+    _compare(house(), belief, params, phi)
+    # failed attempts, (B5)'s imperfect-detection update
+    cands = actionable(house())
+    _compare(house(), belief, params, phi, [1 if i == 0 else 0 for i in range(len(cands))])
+
+
+def test_belief_follows_the_graph_it_is_given() -> None:
+    """One episode's belief on successive graphs: an extra cabinet in the kitchen (a new
+    objects tuple, (B8) splits the category's mass), then the fridge opened."""
+    belief = EpisodeBelief(SCORER, "pan", BAYES_ROOMS)
+    _compare(house(), belief, BAYES_ROOMS, 0.0)
+    extra = ObjectNode("obj:15", "bottom_cabinet", "region:1.1", "room:1", (-2.0, -1.0, 0.0),
+                       state="closed", affordances=("open",))
+    g = house([extra])
+    _compare(g, belief, BAYES_ROOMS, 0.0)
+    fridge = ObjectNode("obj:10", "fridge", "region:1.1", "room:1", (1.0, -1.0, 0.0),
+                        state="open", affordances=("open",), explored=True)
+    g2 = SceneGraph(g.robot, g.rooms, g.regions, (fridge, *g.objects[1:]), g.doors,
+                    g.distances)
+    _compare(g2, belief, BAYES_ROOMS, 0.0)
+
+
+def test_only_a_reveal_has_mass_that_needs_a_follow_up() -> None:
+    g = house()
+    cands = actionable(g)
+    belief = EpisodeBelief(SCORER, "pan", BAYES_ROOMS, 0.0)
+    p, nxt = belief.masses(g, [c.node_id for c in cands], [c.kind for c in cands])
+    for c, pi, ni in zip(cands, p, nxt, strict=True):
+        # a small object behind a frontier, a door or in an unexplored room is one check
+        # further; on or in a carrier it is found by the check itself
+        assert ni == (pi if c.kind != "object" else 0.0), c.node_id
+    # a furniture-level target is seen on the reveal: only the object-model share waits
+    belief = EpisodeBelief(SCORER, "pan", BAYES_ROOMS, 0.5)
+    p, nxt = belief.masses(g, [c.node_id for c in cands], [c.kind for c in cands])
+    reveal = np.array([c.kind != "object" for c in cands])
+    assert np.all(nxt[reveal] < p[reveal]) and np.all(nxt[~reveal] == 0.0)
+
+
+def _kitchen(cabinets: int, frontier: bool = True) -> SceneGraph:
+    """A kitchen with one revealed region holding ``cabinets`` closed bottom cabinets 2 m
+    from the robot and a countertop 3 m away, and (``frontier``) an unexplored-area
+    frontier 2 m away."""
+    objs = [ObjectNode(f"obj:{k + 1}", "bottom_cabinet", "region:1.1", "room:1",
+                       (2.0, 0.1 * k, 0.0), state="closed", affordances=("open",))
+            for k in range(cabinets)]
+    objs.append(ObjectNode("obj:99", "countertop", "region:1.1", "room:1", (-3.0, 0.0, 0.0),
+                           affordances=("explore",)))
+    regions = (RegionNode("region:1.1", "room:1", (0.0, 0.0)),
+               RegionNode("frontier:1", "room:1", (0.0, 2.0), "frontier", "unexplored area"))
+    regions = regions if frontier else regions[:1]
+    dist = {o.id: abs(o.position[0]) for o in objs} | {"frontier:1": 2.0}
+    return SceneGraph(RobotState((0.0, 0.0), room="room:1"),
+                      (RoomNode("room:1", "kitchen", (0.0, 0.0)),), regions, tuple(objs), (),
+                      dist)
+
+
+def test_twenty_cabinets_do_not_outweigh_the_countertop() -> None:
+    """Each cabinet scores above the countertop, but the twenty share their category's
+    mass (B8): voi walks to the countertop first, bayes-search (γ = 1) opens a cabinet."""
+    g = _kitchen(20, frontier=False)
+    voi = VoiPlanner(SCORER)
+    voi.reset("spatula")
+    a = voi.decide(g)
+    assert (a.skill, a.target) == ("navigate", "obj:99")
+    bayes = SearchTheoryPlanner(SCORER)
+    bayes.reset("spatula")
+    assert bayes.decide(g).skill == "open"
+
+
+def test_a_reveal_pays_for_the_check_it_needs() -> None:
+    """One cabinet and a frontier whose unseen region holds as much mass (K = n̄ C̄ with
+    n̄ = 1, ω = 1), both 2 m away: with f = 0 the two are worth the same and the node id
+    decides (the frontier); with f = 1 the frontier costs a second step, so the cabinet
+    goes first."""
+    g = _kitchen(1)
+    g = SceneGraph(g.robot, g.rooms, g.regions, g.objects[:1], (), g.distances)
+    params = VoiParams(belief=voi_belief())
+    p = VoiPlanner(SCORER, dataclasses.replace(params, follow_steps=0.0))
+    p.reset("spatula")
+    a = p.decide(g)
+    assert a.scores["frontier:1"] == a.scores["obj:1"] == 0.5
+    assert a.target == "frontier:1"
+    p = VoiPlanner(SCORER, params)
+    p.reset("spatula")
+    assert p.decide(g).target == "obj:1"
+
+
+def test_the_cabinet_it_opened_leaves_the_belief() -> None:
+    g = _kitchen(3)
+    p = VoiPlanner(SCORER)
+    p.reset("spatula")
+    first = p.decide(g)
+    p.feedback(Feedback(first, "success", "nothing inside"))
+    objs = tuple(dataclasses.replace(o, state="open", explored=True) if o.id == first.target
+                 else o for o in g.objects)
+    a = p.decide(SceneGraph(g.robot, g.rooms, g.regions, objs, (), g.distances))
+    assert first.target not in a.scores and sum(a.scores.values()) == pytest.approx(1.0,
+                                                                                    abs=1e-3)
+    assert isinstance(a, Action) and a.target != first.target
+
+
+def test_registry_row_and_options() -> None:
+    p = make_planner("voi", follow_steps="2", horizon=2, timed=False)
+    assert isinstance(p, VoiPlanner)
+    assert (p.params.follow_steps, p.params.horizon) == (2.0, 2)
+    # the options' defaults are the planner's own
+    opts, params = VoiOptions(), VoiParams()
+    for k in ("step_cost", "open_cost", "follow_steps", "top_k", "horizon", "step_budget"):
+        assert getattr(opts, k) == getattr(params, k), k
+    for k in ("room_floor", "object_floor", "sharpness", "object_sharpness", "beyond", "miss",
+              "region_weight", "seen_type_weight", "instance_exponent"):
+        assert getattr(opts, k) == getattr(params.belief, k), k
