@@ -5,19 +5,34 @@ run built beside it), then its table shown.
 The command checks the options and builds :class:`RunBenchRequest`; the run is
 :func:`sgtool.analysis.closed_loop_bench.run_closed_loop_bench`, the folder
 :func:`sgtool.files.output_folder`. ``show`` receives the table and the files written.
+
+On an executor (``-w N``, ``--executor ray``) the episodes go through
+:class:`EpisodeRunner`: every log reaches the folder as its episode finishes, whichever
+machine ran it (a worker that sees the folder writes it there; one on another machine
+sends it back, :func:`run_task_on`), so a driver killed at any moment leaves the finished
+episodes' logs for the next run to resume from. ``run.json`` records, per episode, whether
+it ran now, its wall seconds and the Ray node that ran it (``""``: this machine).
 """
 
 from __future__ import annotations
 
+import json
 import sys
-from collections.abc import Callable, Sequence
+import tempfile
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from sgtool.analysis.closed_loop_bench import ClosedLoopBenchConfig
+from sgtool.analysis.closed_loop_bench import ClosedLoopBenchConfig, RunRow, RunTask
+from sgtool.analysis.executor import Executor, FolderMark
 
 Echo = Callable[[str], None]
+RunFn = Callable[[RunTask], RunRow]
+
+# run.json: where and how long each episode of the last run ran (not in summary.*: wall
+# clock and placement differ from run to run)
+RUN_FILE = "run.json"
 
 
 @dataclass(frozen=True)
@@ -49,11 +64,11 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
 
     from sgtool.analysis.closed_loop_bench import OUTPUT_NAMES, run_closed_loop_bench
     from sgtool.analysis.closed_loop_bench import write_outputs as write_tables
-    from sgtool.files import output_folder
+    from sgtool.files import atomic_write, output_folder
 
-    runner, show_bar = _runner(request)
     with output_folder(request.out_dir, force=request.force, command="run-bench",
-                       known=OUTPUT_NAMES, resume=True) as root:
+                       known=(*OUTPUT_NAMES, RUN_FILE), resume=True) as root:
+        runner, show_bar = _runner(request, root)
         bar = tqdm(total=None, unit="episode", desc="run-bench", file=sys.stderr,
                    disable=not show_bar, dynamic_ncols=True)
         try:
@@ -67,22 +82,114 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
             bar.close()
         res = _with_symbolic(request, res)
         written = [p.name for p in write_tables(res, root)]
+        if not request.report_only:
+            nodes = runner.nodes if isinstance(runner, EpisodeRunner) else {}
+            written.append(atomic_write(root / RUN_FILE, run_record(
+                res.rows, root, nodes, request.executor)).name)
     show(res.table())
     show(f"wrote {', '.join(str(Path(request.out_dir) / name) for name in written)}")
 
 
-def _runner(request: RunBenchRequest) -> tuple[Any, bool]:
+def _runner(request: RunBenchRequest, root: Path) -> tuple[Any, bool]:
     """(map over the episodes, whether to show this module's bar): in this process one
-    after the other, else on the executor (whose bar counts the episodes)."""
+    after the other, else on the executor (whose bar counts the episodes it runs)."""
     show = sys.stderr.isatty() if request.progress is None else request.progress
     parallel = request.executor != "local" or request.workers > 1 or request.ray_address
     if not parallel or request.report_only:
         return map, show
-    from sgtool.analysis.executor import as_map, make_executor
+    from sgtool.analysis.executor import make_executor
 
-    runner = as_map(make_executor(request.executor, request.workers, request.ray_address),
-                    progress=show, desc="run-bench", task_id=lambda _, t: str(t.output))
-    return runner, False
+    executor = make_executor(request.executor, request.workers, request.ray_address)
+    return EpisodeRunner(executor, root, progress=show), False
+
+
+@dataclass(frozen=True)
+class Shipped:
+    """A task's row and its log's bytes, from a worker that does not see the output
+    folder (another machine): the driver writes the log."""
+
+    row: RunRow
+    log: bytes
+
+
+def run_task_on(fn: RunFn, folder: FolderMark, task: RunTask) -> RunRow | Shipped:
+    """``fn(task)`` on a worker: into the output folder when the worker sees it
+    (:meth:`FolderMark.here`), else into a temporary folder of its own, the log sent back
+    (:class:`Shipped`; the row names ``task.output`` as a run in the folder would)."""
+    if folder.here():
+        return fn(task)
+    with tempfile.TemporaryDirectory(prefix="sgtool-run-bench-") as tmp:
+        local = replace(task, output=Path(tmp) / task.output.name)
+        row = fn(local)
+        data = local.output.read_bytes()
+    result = replace(row.result, source=str(task.output))
+    return Shipped(replace(row, task=task, result=result), data)
+
+
+class EpisodeRunner:
+    """``runner(fn, tasks)`` for :func:`~sgtool.analysis.closed_loop_bench.
+    run_closed_loop_bench` on an executor: the rows in task order. A task whose log is in
+    the folder is read back here (not sent to a worker: a worker elsewhere would not see
+    the log); the partial files an earlier, killed run left beside the logs still to run
+    are removed; every other task runs on the executor (:func:`run_task_on`), and a log
+    sent back is written (atomically) as its task finishes. A task that failed after its
+    retry stops the run with one line once all have run (the finished logs stay).
+    :attr:`nodes` maps each log run to the Ray node that ran it."""
+
+    def __init__(self, executor: Executor, root: Path, *, progress: bool = False) -> None:
+        self.executor = executor
+        self.root = root
+        self.progress = progress
+        self.nodes: dict[Path, str] = {}
+
+    def __call__(self, fn: RunFn, items: Iterable[RunTask]) -> list[RunRow]:
+        from functools import partial
+
+        from sgtool.analysis.executor import ExecutorError, Outcome, Task, failure_lines
+        from sgtool.files import atomic_write
+        from sgtool.log.writer import partial_files
+
+        tasks = list(items)
+        rows: dict[int, RunRow] = {i: fn(t) for i, t in enumerate(tasks) if t.output.exists()}
+        todo = [i for i in range(len(tasks)) if i not in rows]
+        for i in todo:
+            for p in partial_files(tasks[i].output):
+                p.unlink(missing_ok=True)
+
+        def arrived(out: Outcome) -> None:
+            if isinstance(out.value, Shipped):
+                task = out.value.row.task
+                task.output.parent.mkdir(parents=True, exist_ok=True)
+                atomic_write(task.output, out.value.log)
+            if out.ok:
+                self.nodes[Path(out.id)] = out.node
+
+        outcomes = self.executor.run(
+            partial(run_task_on, fn, FolderMark.of(self.root)),
+            [Task(str(tasks[i].output), tasks[i]) for i in todo],
+            progress=self.progress, desc="run-bench", on_result=arrived)
+        failed = failure_lines(outcomes)
+        if failed:
+            raise ExecutorError(f"{len(failed)} of {len(todo)} episode(s) failed; the first: "
+                                f"{failed[0]}")
+        for i, out in zip(todo, outcomes, strict=True):
+            rows[i] = out.value.row if isinstance(out.value, Shipped) else out.value
+        return [rows[i] for i in range(len(tasks))]
+
+
+def run_record(rows: Sequence[RunRow], root: Path, nodes: dict[Path, str],
+               executor: str) -> str:
+    """run.json: per episode (report order) its log (relative to ``root``), whether it ran
+    now (else it was read back), its wall seconds and the Ray node that ran it."""
+    episodes = []
+    for r in rows:
+        log = r.task.output
+        episodes.append({"log": log.relative_to(root).as_posix() if log.is_relative_to(root)
+                         else str(log), "ran": r.seconds is not None,
+                         "seconds": None if r.seconds is None else round(r.seconds, 3),
+                         "node": nodes.get(log, "")})
+    return json.dumps({"executor": executor, "episodes": episodes}, indent=1,
+                      sort_keys=True) + "\n"
 
 
 def _with_symbolic(request: RunBenchRequest, res: Any) -> Any:

@@ -16,7 +16,12 @@ the number of workers or the order tasks finish, because it returns them in task
 Both keep at most ``2 * workers`` tasks in flight (one in process), advance one progress
 bar (tqdm, on stderr) per finished task wherever it ran, retry a task that raised once,
 and then give up on it: its :class:`Outcome` carries the error as one line, for the
-caller's summary.
+caller's summary, and the Ray node it ran on (``node``; empty on this machine).
+
+Files a task writes land on the machine that runs it. :class:`FolderMark` tells a task
+whether it sees the driver's output folder itself (same machine, same folder), so that it
+writes there directly; elsewhere it must send its files back with its value for the
+driver to write (what ``run-bench`` does, :mod:`sgtool.analysis.closed_loop_bench_run`).
 Ctrl-C cancels the tasks not finished yet and re-raises, so a caller that writes its
 outputs from ``on_result`` (atomically) is left with complete outputs only. A SIGTERM to
 the driver (turned into :class:`~sgtool.errors.Terminated` by the CLI) is passed on to the
@@ -32,6 +37,7 @@ import socket
 import sys
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from sgtool.errors import SgtoolError, Terminated, raise_terminated
@@ -61,6 +67,7 @@ class Outcome:
     value: Any = None
     error: str | None = None
     attempts: int = 1
+    node: str = ""  # the Ray node (hex id) of the last attempt; "" on this machine
 
     @property
     def ok(self) -> bool:
@@ -123,8 +130,11 @@ class _Executor:
                     if err is not None and attempts[i] <= RETRIES:
                         queue.append(i)
                         continue
+                    node = ""
+                    if isinstance(value, _Placed):
+                        node, value = value.node, value.value
                     out = Outcome(tasks[i].id, value, None if err is None else error_line(err),
-                                  attempts[i])
+                                  attempts[i], node)
                     done[i] = out
                     if on_result is not None:
                         on_result(out)
@@ -261,8 +271,57 @@ class LocalExecutor(_Executor):
         return _Inline(fn) if self.workers == 1 else _Pool(fn, self.workers)
 
 
-def _ray_call(fn: Callable[[Any], Any], args: Any) -> Any:
-    return fn(args)
+@dataclass(frozen=True)
+class _Placed:
+    """A Ray task's value and the node it ran on (unwrapped into the :class:`Outcome`)."""
+
+    node: str
+    value: Any
+
+
+def _ray_call(fn: Callable[[Any], Any], args: Any) -> _Placed:
+    import ray
+
+    return _Placed(ray.get_runtime_context().get_node_id(), fn(args))
+
+
+def machine_id() -> str:
+    """This machine: its host name and, on Linux, its boot id (two containers of one host
+    share the boot id but not, in general, their folders: :class:`FolderMark` also compares
+    the folder itself)."""
+    try:
+        boot = Path("/proc/sys/kernel/random/boot_id").read_text().strip()
+    except OSError:
+        boot = ""
+    return f"{socket.gethostname()}/{boot}"
+
+
+@dataclass(frozen=True)
+class FolderMark:
+    """A folder of the driver, as a task elsewhere can recognise it: the machine and the
+    folder's (device, inode). :meth:`here` is True only where the path names that very
+    folder: on the driver's machine (any process or Ray node there). On another machine it
+    is False even when the folder is shared (NFS): such a task sends its files back."""
+
+    path: str
+    machine: str
+    device: int
+    inode: int
+
+    @classmethod
+    def of(cls, path: str | os.PathLike[str]) -> FolderMark:
+        st = os.stat(path)
+        return cls(os.fspath(Path(path).absolute()), machine_id(), st.st_dev, st.st_ino)
+
+    def here(self) -> bool:
+        """Whether this process sees the marked folder at ``path``."""
+        if machine_id() != self.machine:
+            return False
+        try:
+            st = os.stat(self.path)
+        except OSError:
+            return False
+        return (st.st_dev, st.st_ino) == (self.device, self.inode)
 
 
 class _RaySession:
