@@ -24,6 +24,8 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
 - **Looking around** (:meth:`LiveSkills.look_around`) turns only toward unknown space
   near the robot on its own map (:func:`~sgtool.recorders.sim.motion.sweep`), the shorter
   way, and stops when a refresh during the turn shows no cell known that was not before.
+  Where a look-around ended so (not cut short by the target or the frame budget) is kept
+  in :attr:`LiveSkills.looked`: looking again from there shows nothing new.
 - **Stopping early.** ``stop_when`` (the closed loop's: the target is in the graph) is
   asked at every refresh during a skill; when it says so the skill ends there, a success
   with reason :data:`IN_VIEW`.
@@ -204,6 +206,8 @@ class LiveSkills:
         self.replans = 0  # plans made (for reports)
         self.contacts = 0
         self.bumps: list[tuple[float, float]] = []  # where the base touched something
+        # where a look-around turned toward all the unknown it could (module doc), in order
+        self.looked: list[tuple[float, float]] = []
         # asked at every refresh during a skill: True ends the skill (module doc)
         self.stop_when: Callable[[], bool] | None = None
         self._asked = -1  # index of the last refresh stop_when was asked on
@@ -319,6 +323,7 @@ class LiveSkills:
         else:
             angle = sweep(ref.layers.occupancy, body.base, body.hfov)
         if angle == 0.0:
+            self.looked.append(_xy(body.base))
             return "success", "nothing unknown around", 0.0
         turn = body.config.turn_speed / body.fps
         x, y, a = body.base
@@ -340,9 +345,15 @@ class LiveSkills:
                 continue
             k = _known(now.layers)
             if known is not None and k <= known:
+                self.looked.append(_xy(body.base))
                 return "success", "nothing new in view", 0.0
             seen_at, known = now.index, k
+        self.looked.append(_xy(body.base))
         return "success", "", 0.0
+
+
+def _xy(pose: Pose2) -> tuple[float, float]:
+    return float(pose[0]), float(pose[1])
 
 
 def _known(layers: MapLayers) -> int:

@@ -21,7 +21,12 @@ the goal) on the robot's map, from where the robot stands:
 - failed before (:class:`FailedGoals`): a node whose skill failed is withheld while the
   cell the robot would drive to for it is within ``same`` metres of the one of the
   failure (the same attempt would be made again); it is offered again once the map moves
-  that cell (a door opened, a bump marked, more floor seen).
+  that cell (a door opened, a bump marked, more floor seen);
+- looked from there before: a frontier, room or region node (a goal the skill goes to and
+  looks around at) whose cell is within ``same`` metres of a place where the robot has
+  already looked around toward all the unknown it could (``LiveSkills.looked``): going
+  there to look again shows nothing new (the frontier stayed because it cannot be seen
+  from there); the counterpart of the symbolic environment dropping an explored frontier.
 
 Nothing else of the graph changes (nodes, ids, the other distances); the logged scene
 graphs are the stream's, untouched, so replay still rebuilds them byte for byte. When the
@@ -49,6 +54,7 @@ from sgtool.scenegraph.stream import Refresh
 UNREACHABLE = "unreachable on the robot's map"
 FAILED_BEFORE = "failed before from the same place"
 NO_MAP = "the robot has no map yet"
+LOOKED = "looked around from there before"
 
 
 @dataclass(frozen=True)
@@ -177,6 +183,7 @@ def reachable_view(refresh: Refresh, skills: LiveSkills,
         return View(_without(graph, {c.node_id for c in cands}, {}),
                     {c.node_id: NO_MAP for c in cands})
     occ, dist = planned
+    same = FailedGoals.same if failed is None else failed.same
     withheld: dict[str, str] = {}
     live: dict[str, float] = {}
     for c in cands:
@@ -189,9 +196,18 @@ def reachable_view(refresh: Refresh, skills: LiveSkills,
         if failed is not None and failed.blocks(c.node_id, cell):
             withheld[c.node_id] = FAILED_BEFORE
             continue
+        if c.skill == "explore" and _looked_near(skills.looked, cell, same):
+            withheld[c.node_id] = LOOKED
+            continue
         r, col = occ.grid.cell_of(cell[0], cell[1])
         live[c.node_id] = float(dist[int(r), int(col)])
     return View(_without(graph, set(withheld), live), withheld)
+
+
+def _looked_near(looked: list[tuple[float, float]], cell: tuple[float, float],
+                 same: float) -> bool:
+    """Whether the robot looked around within ``same`` metres of ``cell``."""
+    return any(math.dist(p, cell) <= same for p in looked)
 
 
 def _without(graph: SceneGraph, drop: Iterable[str], live: dict[str, float]) -> SceneGraph:

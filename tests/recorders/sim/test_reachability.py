@@ -29,7 +29,13 @@ from sgtool.recorders.sim import CameraConfig
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
 from sgtool.recorders.sim.live_skills import Goal, LiveSkills
 from sgtool.recorders.sim.navigation import RobotConfig
-from sgtool.recorders.sim.reachability import UNREACHABLE, FailedGoals, goal_cell
+from sgtool.recorders.sim.reachability import (
+    LOOKED,
+    UNREACHABLE,
+    FailedGoals,
+    goal_cell,
+    reachable_view,
+)
 
 
 @dataclass
@@ -132,3 +138,55 @@ def test_one_dijkstra_run_per_refresh_and_pose() -> None:
     assert moved is not first and moved[1][20, 20] == 0.0
     skills.bumps.append((2.5, 2.0))  # a bump changes the map
     assert skills.plan_map(ref) is not moved
+
+
+def _frontier_refresh(occ, index: int = 1):
+    """A refresh of the small map whose graph offers two frontiers: ``region:1`` near
+    (4.0, 1.0) and ``region:2`` near (2.0, 3.5)."""
+    from sgtool.scenegraph.graph import RegionNode, RobotState, SceneGraph
+
+    graph = SceneGraph(
+        robot=RobotState((1.0, 2.0)),
+        regions=(RegionNode("region:1", "room:0", (4.0, 1.0), kind="frontier"),
+                 RegionNode("region:2", "room:0", (2.0, 3.5), kind="frontier")),
+        distances={"region:1": 3.2, "region:2": 1.8})
+    layers = SimpleNamespace(occupancy=occ.grid, frontier_ids=[], frontiers=[])
+    return SimpleNamespace(index=index, graph=graph, layers=layers)
+
+
+def test_a_frontier_looked_at_from_its_cell_is_not_offered_again() -> None:
+    # the robot went to region:1's cell and looked around there; the frontier stayed in
+    # the graph (it cannot be seen from there): before, every planner was offered the same
+    # useless explore again (a step each, repeated explores of one frontier in the logs)
+    occ, _ = _map()
+    body = _Body((1.0, 2.0, 0.0), RobotConfig())
+    skills = LiveSkills(body, lambda: None)
+    ref = _frontier_refresh(occ)
+    view = reachable_view(ref, skills, FailedGoals())
+    assert {c.node_id for c in actionable(view.graph)} == {"region:1", "region:2"}
+    body.base = (4.0, 1.0, 0.0)
+    skills.looked.append((4.0, 1.0))
+    view = reachable_view(ref, skills, FailedGoals())
+    assert view.withheld == {"region:1": LOOKED}
+    assert {c.node_id for c in actionable(view.graph)} == {"region:2"}
+    # looking around elsewhere (1 m away) does not withhold it
+    skills.looked[:] = [(4.0, 2.0)]
+    assert reachable_view(ref, skills, FailedGoals()).withheld == {}
+
+
+def test_look_around_records_where_it_looked() -> None:
+    occ, _ = _map()
+
+    class Turning(_Body):
+        hfov = 1.0
+        fps = 10.0
+
+        def drive(self, poses):
+            self.base = poses[-1]
+            return 0.0, False
+
+    body = Turning((1.0, 2.0, 0.0), RobotConfig())
+    known = SimpleNamespace(index=1, layers=SimpleNamespace(occupancy=occ.grid))
+    skills = LiveSkills(body, lambda: known)
+    skills.look_around()  # the refresh never changes: the whole sweep, then recorded
+    assert skills.looked == [(1.0, 2.0)]
