@@ -19,7 +19,7 @@ from __future__ import annotations
 import json
 import sys
 import tempfile
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -66,9 +66,11 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
     from sgtool.analysis.closed_loop_bench import write_outputs as write_tables
     from sgtool.files import atomic_write, output_folder
 
+    executor, bars = _executor(request)
     with output_folder(request.out_dir, force=request.force, command="run-bench",
                        known=(*OUTPUT_NAMES, RUN_FILE), resume=True) as root:
-        runner, show_bar = _runner(request, root)
+        runner = EpisodeRunner(executor, root, progress=bars)
+        show_bar = bars and executor is None
         bar = tqdm(total=None, unit="episode", desc="run-bench", file=sys.stderr,
                    disable=not show_bar, dynamic_ncols=True)
         try:
@@ -83,24 +85,22 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
         res = _with_symbolic(request, res)
         written = [p.name for p in write_tables(res, root)]
         if not request.report_only:
-            nodes = runner.nodes if isinstance(runner, EpisodeRunner) else {}
             written.append(atomic_write(root / RUN_FILE, run_record(
-                res.rows, root, nodes, request.executor)).name)
+                res.rows, root, runner.nodes, request.executor)).name)
     show(res.table())
     show(f"wrote {', '.join(str(Path(request.out_dir) / name) for name in written)}")
 
 
-def _runner(request: RunBenchRequest, root: Path) -> tuple[Any, bool]:
-    """(map over the episodes, whether to show this module's bar): in this process one
-    after the other, else on the executor (whose bar counts the episodes it runs)."""
+def _executor(request: RunBenchRequest) -> tuple[Executor | None, bool]:
+    """(the executor, None to run in this process one after the other; whether to show a
+    progress bar: the executor's counts the episodes it runs, else this module's)."""
     show = sys.stderr.isatty() if request.progress is None else request.progress
     parallel = request.executor != "local" or request.workers > 1 or request.ray_address
     if not parallel or request.report_only:
-        return map, show
+        return None, show
     from sgtool.analysis.executor import make_executor
 
-    executor = make_executor(request.executor, request.workers, request.ray_address)
-    return EpisodeRunner(executor, root, progress=show), False
+    return make_executor(request.executor, request.workers, request.ray_address), show
 
 
 @dataclass(frozen=True)
@@ -128,33 +128,44 @@ def run_task_on(fn: RunFn, folder: FolderMark, task: RunTask) -> RunRow | Shippe
 
 class EpisodeRunner:
     """``runner(fn, tasks)`` for :func:`~sgtool.analysis.closed_loop_bench.
-    run_closed_loop_bench` on an executor: the rows in task order. A task whose log is in
-    the folder is read back here (not sent to a worker: a worker elsewhere would not see
-    the log); the partial files an earlier, killed run left beside the logs still to run
-    are removed; every other task runs on the executor (:func:`run_task_on`), and a log
-    sent back is written (atomically) as its task finishes. A task that failed after its
-    retry stops the run with one line once all have run (the finished logs stay).
-    :attr:`nodes` maps each log run to the Ray node that ran it."""
+    run_closed_loop_bench`: the rows in task order. The partial files an earlier, killed
+    run left beside a log still to run are removed first. Without an executor the tasks
+    run here one after the other (rows as they come). On one, a task whose log is in the
+    folder is read back here (a worker elsewhere would not see the log) and every other
+    task runs on the executor (:func:`run_task_on`); a log sent back is written
+    (atomically) as its task finishes; a task that failed after its retry stops the run
+    with one line once all have run (the finished logs stay). :attr:`nodes` maps each log
+    run now to the Ray node that ran it (``""``: this machine)."""
 
-    def __init__(self, executor: Executor, root: Path, *, progress: bool = False) -> None:
+    def __init__(self, executor: Executor | None, root: Path, *,
+                 progress: bool = False) -> None:
         self.executor = executor
         self.root = root
         self.progress = progress
         self.nodes: dict[Path, str] = {}
 
-    def __call__(self, fn: RunFn, items: Iterable[RunTask]) -> list[RunRow]:
+    def __call__(self, fn: RunFn, items: Iterable[RunTask]) -> Iterator[RunRow]:
+        if self.executor is None:
+            return (self._here(fn, t) for t in items)
+        return iter(self._on_executor(self.executor, fn, list(items)))
+
+    def _here(self, fn: RunFn, task: RunTask) -> RunRow:
+        if not task.output.exists():
+            _remove_partials(task)
+            self.nodes[task.output] = ""
+        return fn(task)
+
+    def _on_executor(self, executor: Executor, fn: RunFn, tasks: list[RunTask]
+                     ) -> list[RunRow]:
         from functools import partial
 
         from sgtool.analysis.executor import ExecutorError, Outcome, Task, failure_lines
         from sgtool.files import atomic_write
-        from sgtool.log.writer import partial_files
 
-        tasks = list(items)
         rows: dict[int, RunRow] = {i: fn(t) for i, t in enumerate(tasks) if t.output.exists()}
         todo = [i for i in range(len(tasks)) if i not in rows]
         for i in todo:
-            for p in partial_files(tasks[i].output):
-                p.unlink(missing_ok=True)
+            _remove_partials(tasks[i])
 
         def arrived(out: Outcome) -> None:
             if isinstance(out.value, Shipped):
@@ -164,7 +175,7 @@ class EpisodeRunner:
             if out.ok:
                 self.nodes[Path(out.id)] = out.node
 
-        outcomes = self.executor.run(
+        outcomes = executor.run(
             partial(run_task_on, fn, FolderMark.of(self.root)),
             [Task(str(tasks[i].output), tasks[i]) for i in todo],
             progress=self.progress, desc="run-bench", on_result=arrived)
@@ -175,6 +186,15 @@ class EpisodeRunner:
         for i, out in zip(todo, outcomes, strict=True):
             rows[i] = out.value.row if isinstance(out.value, Shipped) else out.value
         return [rows[i] for i in range(len(tasks))]
+
+
+def _remove_partials(task: RunTask) -> None:
+    """The partial files of ``task``'s log that a killed run left (its writer, killed,
+    could not remove them)."""
+    from sgtool.log.writer import partial_files
+
+    for p in partial_files(task.output):
+        p.unlink(missing_ok=True)
 
 
 def run_record(rows: Sequence[RunRow], root: Path, nodes: dict[Path, str],

@@ -17,6 +17,7 @@ import pytest
 from sgtool.analysis.executor import (
     ExecutorError,
     LocalExecutor,
+    Outcome,
     Task,
     check_reachable,
     chunks,
@@ -226,3 +227,25 @@ def test_kill_of_the_driver_stops_the_workers_and_leaves_no_partial_output(tmp_p
     while not all(_gone(p) for p in pids) and time.monotonic() < deadline:
         time.sleep(0.1)
     assert all(_gone(p) for p in pids)
+
+
+def test_a_folder_mark_is_recognised_only_where_that_very_folder_is(tmp_path):
+    from dataclasses import replace
+
+    from sgtool.analysis.executor import FolderMark
+
+    out = tmp_path / "out"
+    out.mkdir()
+    mark = FolderMark.of(out)
+    assert mark.here() and mark.path == str(out)
+    assert not replace(mark, machine="elsewhere/0").here()  # another machine
+    out.rename(tmp_path / "old")  # the old folder is kept, so the new one has another inode
+    out.mkdir()
+    assert not mark.here()  # the same path, another folder
+    out.rmdir()
+    assert not mark.here()  # no folder there
+
+
+def test_a_task_on_this_machine_names_no_node():
+    outs = LocalExecutor(1).run(abs, [Task("a", -2)])
+    assert outs == [Outcome("a", 2, None, 1, "")]
