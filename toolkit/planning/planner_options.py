@@ -145,9 +145,9 @@ class VoiOptions(NodeOptions):
         "a of (V2): metres per action", "float", lo=0.0))
     open_cost: float = field(default=0.5, metadata=option(
         "b of (V2): extra cost of an open", "float", lo=0.0))
-    follow_steps: float = field(default=1.0, metadata=option(
-        "f of (V2): actions after a reveal before what it showed is checked", "float",
-        lo=0.0))
+    follow_steps: float | None = field(default=None, metadata=option(
+        "f of (V2): actions after a reveal before what it showed is checked [default: "
+        "estimated from the revealed places, (V3)]", "float", lo=0.0, optional=True))
     top_k: int = field(default=5, metadata=option(
         "places ranked by p/c that the look-ahead orders", "int", lo=1))
     horizon: int = field(default=3, metadata=option(

@@ -70,7 +70,8 @@ def voi_belief() -> BeliefParams:
 class VoiParams:
     step_cost: float = 3.0  # a of (V2), metres per action
     open_cost: float = 0.5  # b of (V2)
-    follow_steps: float = 1.0  # f of (V2): actions after a reveal to check what it showed
+    # f of (V2): actions after a reveal to check what it showed; None: f̂ of (V3)
+    follow_steps: float | None = None
     top_k: int = 5
     horizon: int = 3
     step_budget: int = 50  # actions per episode (N_max) of the step price (S3); 0: none
@@ -106,6 +107,9 @@ class EpisodeBelief:
             ({}, [], {}, 0)
         self._rooms: tuple[RoomNode, ...] | None = None
         self._room_table: tuple[dict[str, float], float] = ({}, params.fallback_room)
+        self.follow = 1.0  # f̂ of (V3) for the last objects tuple
+        # id(node) -> (node, is a carrier, category text); holds the node, so the id stays
+        self._nodes: dict[int, tuple[ObjectNode, bool, str]] = {}
 
     # ----- scores ----------------------------------------------------------------------
     def _carrier_scores(self, cats: Sequence[str]) -> list[float]:
@@ -164,23 +168,32 @@ class EpisodeBelief:
         """Per object id (code, room, C' of (B8)); Z_r's carrier part; C̄; carrier count."""
         if graph.objects is self._objects:
             return self._obj_table
-        carriers = [o for o in graph.objects if is_carrier(o)]
+        memo = self._nodes
+        if len(memo) > 1 << 14:
+            memo.clear()
+        info = []
+        for o in graph.objects:
+            e = memo.get(id(o))
+            if e is None or e[0] is not o:
+                e = memo[id(o)] = (o, is_carrier(o), category_text(o.category))
+            info.append(e)
+        carriers = [e[0] for e in info if e[1]]
         c = self._carrier_scores([o.category for o in carriers])
         gamma = self.params.instance_exponent
         if gamma != 1.0 and carriers:
-            keys = [(o.room, category_text(o.category)) for o in carriers]
+            keys = [(e[0].room, e[2]) for e in info if e[1]]
             n = Counter(keys)
             c = [v * n[k] ** (gamma - 1.0) for v, k in zip(c, keys, strict=True)]
         table: dict[str, tuple[int, str, float]] = {}
         zc: dict[str, float] = {}
         for o, v in zip(carriers, c, strict=True):
             zc[o.room] = zc.get(o.room, 0.0) + v
+            table[o.id] = (_CARRIER, o.room, v)
         for o in graph.objects:
             table.setdefault(o.id, (_OBJECT, o.room, 0.0))
-        for o, v in zip(carriers, c, strict=True):
-            table[o.id] = (_CARRIER, o.room, v)
         mean_c = float(np.mean(c)) if c else 0.5
         self._objects, self._obj_table = graph.objects, (table, zc, mean_c, len(carriers))
+        self.follow = expected_checks(carriers, c)
         return self._obj_table
 
     def _frontiers(self, graph: SceneGraph
@@ -270,6 +283,24 @@ class EpisodeBelief:
         return total_now / s, nxt
 
 
+def expected_checks(carriers: Sequence[ObjectNode], c: Sequence[float]) -> float:
+    """f̂ of (V3): the mean over revealed places (carriers grouped by parent: a region, or a
+    piece holding small carriers) of the expected checks to find a target that is there,
+    Σ_j j w_j with w_j the carriers' C' shares in decreasing order; 1 with no carriers."""
+    ids = {o.id for o in carriers}
+    groups: dict[str, list[float]] = {}
+    for o, v in zip(carriers, c, strict=True):
+        if o.parent not in ids:
+            groups.setdefault(o.parent, []).append(v)
+    if not groups:
+        return 1.0
+    total = 0.0
+    for vals in groups.values():
+        vals.sort(reverse=True)
+        total += sum(j * w for j, w in enumerate(vals, 1)) / sum(vals)
+    return total / len(groups)
+
+
 class VoiPlanner(ScoringPlanner[VoiParams]):
     """Value-of-information search (module doc). ``furniture_levels``: name -> φ of (B6)
     (:mod:`sgtool.planning.furniture_prior`); None: every query is a small object."""
@@ -313,13 +344,18 @@ class VoiPlanner(ScoringPlanner[VoiParams]):
         step = step_price(p, steps_left, prm.step_cost)
         opens = np.fromiter((s == "open" for s in cols.skills), dtype=bool, count=len(cols))
         share = np.divide(nxt, p, out=np.zeros_like(p), where=p > 0)
-        extra = step + prm.open_cost * opens + prm.follow_steps * step * share
+        follow = self.belief.follow if prm.follow_steps is None else prm.follow_steps
+        extra = step + prm.open_cost * opens + follow * step * share
         dist = np.asarray(cols.distances, dtype=np.float64)
         first = dist + extra
         ratio = p / first
         keys = cols.ids  # ties: node ids as strings, as (S2) of bayes-search
-        ranked = sorted(range(len(cols)), key=lambda k: (-ratio[k], keys[k]))
-        top = ranked[: max(1, prm.top_k)]
+        k_top = max(1, prm.top_k)
+        pool: Sequence[int] = range(len(cols))
+        if len(cols) > k_top:  # only the places at or above the k-th best ratio can rank
+            kth = np.partition(ratio, len(cols) - k_top)[len(cols) - k_top]
+            pool = np.flatnonzero(ratio >= kth).tolist()
+        top = sorted(pool, key=lambda k: (-ratio[k], keys[k]))[:k_top]
         h = min(prm.horizon, len(top))
         if h <= 1:
             return top[0], float(ratio[top[0]])
