@@ -52,7 +52,6 @@ from sgtool.analysis.validity import SEARCH_KIND, episode_problem
 from sgtool.errors import SgtoolError
 from sgtool.log.inspect import foreign_log_problem
 from sgtool.log.records import ABSENT, Absent, Episode, LogRecord, SceneGraphRecord, given
-from sgtool.log.records import Action as LoggedAction
 from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.planning.episode import NOT_CONFIRMED, check_success_rule
 from sgtool.results import EpisodeResult, read_jsonl, result_from_log_records
@@ -69,7 +68,7 @@ class EvalInputError(SgtoolError):
 class Decision:
     t_ns: int
     graph: SceneGraph | None
-    action: LoggedAction
+    action: Action
 
     @property
     def decided(self) -> bool:
@@ -113,7 +112,7 @@ def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
     p = Path(path)
     with LogReader(p) as log:
         stream: list[tuple[int, int, LogRecord]] = []
-        kinds: tuple[type[LogRecord], ...] = (SceneGraphRecord, Episode, LoggedAction)
+        kinds: tuple[type[LogRecord], ...] = (SceneGraphRecord, Episode, Action)
         for order, kind in enumerate(kinds):
             for t, rec in log.records(kind):
                 stream.append((t, order, rec))
@@ -154,7 +153,7 @@ def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
             elif rec.status in _TERMINAL:
                 close(rec if opened is None else opened.merged(rec))
         else:
-            assert isinstance(rec, LoggedAction)
+            assert isinstance(rec, Action)
             decisions.append(Decision(t, _decided_on(rec, graph, graph_times, graphs), rec))
     if opened is not None or decisions:
         close(_ended(opened))
@@ -170,7 +169,7 @@ def _ended(opened: Episode | None) -> Episode:
                                frames=ABSENT)
 
 
-def _decided_on(action: LoggedAction, latest: SceneGraph | None, times: list[int],
+def _decided_on(action: Action, latest: SceneGraph | None, times: list[int],
                 graphs: list[SceneGraph]) -> SceneGraph | None:
     """The graph an action was decided on (module doc): by its ``graph_time_ns`` when it
     has the field, else ``latest`` (the last graph at or before the action)."""
@@ -312,7 +311,7 @@ def node_rooms(graph: SceneGraph, node_id: str | None) -> frozenset[str]:
     return frozenset([room]) if room else frozenset([n.id])
 
 
-def executor_message(action: LoggedAction) -> str:
+def executor_message(action: Action) -> str:
     """What the executor told the planner about ``action``: the ``message`` a symbolic log
     records beside the planner's ``reason``; a closed-loop log's ``reason`` is the
     simulator's own."""
@@ -368,9 +367,9 @@ def replay_decisions(planner: Planner, episodes: Sequence[LoggedEpisode],
         for step, d in enumerate(ep.decisions):
             if not d.decided:
                 continue
-            # a logged skill need not be a planner Skill (a recorded tour logs look_around,
-            # a LoggedSkill; the schema admits any string): compared and fed back as logged
-            logged = Action(d.action.skill, given(d.action.target))  # type: ignore[arg-type]
+            # the logged action is compared and fed back as logged (its skill need not be a
+            # planner's: a recorded tour logs look_around)
+            logged = d.action
             if d.graph is not None:
                 t0 = time.perf_counter()
                 chosen = planner.decide(d.graph)
@@ -385,7 +384,7 @@ def replay_decisions(planner: Planner, episodes: Sequence[LoggedEpisode],
             else:
                 skipped += 1
             planner.feedback(Feedback(
-                logged, d.action.outcome, executor_message(d.action),
+                logged, logged.result, executor_message(logged),
                 float(given(d.action.travelled_m, 0.0))))
     return OfflineReport(name or str(getattr(planner, "name", "planner")), tuple(out), skipped)
 

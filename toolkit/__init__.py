@@ -56,8 +56,8 @@ errors                 :class:`SgtoolError` (every failure a user can cause),
 
 A few names differ from their defining module's to stay unambiguous at the top level:
 :class:`EpisodeRecord` and :class:`ActionRecord` are ``sgtool.log.records.Episode`` and
-``Action`` (the planner's :class:`Action` is another type), :class:`SearchEpisode` is
-``sgtool.datasets.episodes.Episode``, :func:`run_closed_loop` is
+``Action`` (:class:`ActionRecord` is the planner's :class:`Action`: one type),
+:class:`SearchEpisode` is ``sgtool.datasets.episodes.Episode``, :func:`run_closed_loop` is
 ``sgtool.recorders.sim.closed_loop.run_episode``, :func:`write_bench_outputs` is
 ``sgtool.analysis.bench.write_outputs``, :func:`read_results`/:func:`write_results` are
 ``sgtool.results.read_jsonl``/``write_jsonl``.

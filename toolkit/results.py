@@ -24,8 +24,7 @@ from typing import Any
 from sgtool.canonical import canonical_float
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write
-from sgtool.log.records import Action as LoggedAction
-from sgtool.log.records import Episode, given
+from sgtool.log.records import Action, Episode, given
 
 RESULT_VERSION = "1.0"
 
@@ -213,7 +212,7 @@ def results_digest(results: Sequence[EpisodeResult]) -> str:
 # ----------------------------------------------------------------------------------------
 # from log records
 # ----------------------------------------------------------------------------------------
-def result_from_log_records(episode: Episode, actions: Sequence[LoggedAction],
+def result_from_log_records(episode: Episode, actions: Sequence[Action],
                             source: str = "log") -> EpisodeResult:
     """An :class:`EpisodeResult` from the records of one episode of a log.
 
@@ -229,7 +228,7 @@ def result_from_log_records(episode: Episode, actions: Sequence[LoggedAction],
     """
     extra = episode.extras
     trace = tuple(
-        Step(a.skill, given(a.target), a.outcome, float(given(a.travelled_m, 0.0)))
+        Step(a.skill, a.target, a.result, float(given(a.travelled_m, 0.0)))
         for a in actions
     )
     status = episode.status

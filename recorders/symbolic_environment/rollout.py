@@ -19,7 +19,6 @@ import numpy as np
 from sgtool.errors import SgtoolError
 from sgtool.house.spec import HouseSpec, StartPose
 from sgtool.llm.stats import answer_counts
-from sgtool.log.records import Action as LoggedAction
 from sgtool.log.records import Episode, LlmExchange, SceneGraphRecord
 from sgtool.log.writer import LogWriter
 from sgtool.planning.base import Action, Planner
@@ -42,9 +41,9 @@ def planner_seed(seed: int, house_seed: int, episode_index: int) -> int:
 class EpisodeLog:
     """Records a symbolic episode into an open log: an ``sgtool.Episode`` record "started"
     at t = 0, then per step k (t = k s) the ``sgtool.SceneGraph`` the planner saw and the
-    ``sgtool.Action`` it took, and (:meth:`close`) the closing Episode record at
-    t = (steps + 1) s. Distances are rounded by the records themselves
-    (:class:`sgtool.log.records.Action`)."""
+    ``sgtool.Action`` it took (the planner's :class:`~sgtool.log.records.Action`,
+    executed), and (:meth:`close`) the closing Episode record at t = (steps + 1) s.
+    Distances are rounded by the records themselves."""
 
     def __init__(self, log: LogWriter, base: Episode, planner: str) -> None:
         self.log = log
@@ -62,14 +61,13 @@ class EpisodeLog:
 
     def executed(self, step: SearchStep) -> None:
         t_ns = step.index * SECOND_NS
-        a, fb = step.action, step.feedback
+        fb = step.feedback
         self.log.write_record(SceneGraphRecord.of_graph(step.graph), t_ns)
         for ex in step.exchanges:  # the LLM exchanges of the decision (/sgtool/llm)
             self.log.write_record(LlmExchange.from_json(ex), t_ns)
         # the executor's message (what the planner was told) beside the planner's reason
-        self.log.write_record(LoggedAction(
-            skill=a.skill, target=a.target, outcome=fb.outcome, reason=a.reason,
-            travelled_m=fb.travelled_m, decision_time_s=step.decision_s,
+        self.log.write_record(step.action.executed(
+            fb.outcome, fb.travelled_m, decision_time_s=step.decision_s,
             planner=self.planner, step=step.index, unknown={"message": fb.message}), t_ns)
 
     def close(self, steps: int, env: SymbolicEnv, shortest: float | None,

@@ -80,7 +80,7 @@ def test_absent_is_one_falsy_object() -> None:
     assert pickle.loads(pickle.dumps(ABSENT)) is ABSENT
     assert copy.deepcopy(ABSENT) is ABSENT
     a = Action(skill="done", outcome="success")
-    assert a.target is ABSENT and "target" not in a.to_json()
+    assert a.step is ABSENT and "step" not in a.to_json()
     assert pickle.loads(pickle.dumps(a)) == a
 
 

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import enum
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from typing import TYPE_CHECKING, Any, ClassVar, Final, Literal, TypeVar, overload
 
 from sgtool.canonical import canonical_float
@@ -147,14 +147,15 @@ class JsonRecord:
 
     unknown: Mapping[str, Any] = field(default_factory=dict, kw_only=True, compare=True)
     CANONICAL: ClassVar[tuple[str, ...]] = ()  # float fields written canonically rounded
+    NOT_LOGGED: ClassVar[tuple[str, ...]] = ()  # in-memory fields, neither written nor read
 
     def to_json(self) -> dict[str, Any]:
-        """The JSON object as written: absent fields left out, tuples as lists, the
-        :data:`CANONICAL` fields rounded by :func:`sgtool.canonical.canonical_float` (so
-        every writer writes distances alike)."""
+        """The JSON object as written: absent fields and the :data:`NOT_LOGGED` fields left
+        out, tuples as lists, the :data:`CANONICAL` fields rounded by
+        :func:`sgtool.canonical.canonical_float` (so every writer writes distances alike)."""
         out = dict(self.unknown)
         for f in fields(self):
-            if f.name == "unknown":
+            if f.name == "unknown" or f.name in self.NOT_LOGGED:
                 continue
             v = getattr(self, f.name)
             if isinstance(v, Absent):
@@ -169,7 +170,7 @@ class JsonRecord:
     @classmethod
     def _build(cls: type[J], d: Mapping[str, Any]) -> J:
         """The record of an already checked JSON object."""
-        names = {f.name for f in fields(cls)} - {"unknown"}
+        names = {f.name for f in fields(cls)} - {"unknown", *cls.NOT_LOGGED}
         kw: dict[str, Any] = {}
         for k in names:
             v = d.get(k, ABSENT)
@@ -261,27 +262,96 @@ class Episode(LogRecord):
 
 @dataclass(frozen=True)
 class Action(LogRecord):
-    """``sgtool.Action``: one executed action. ``graph_time_ns`` (1.1): the log time of the
-    scene graph it was decided on; null: decided on no graph; absent: the last graph at or
-    before the action's log time."""
+    """``sgtool.Action``: a high-level action on a scene-graph node, as a planner decides it
+    and as a log holds it once executed. One type serves both: a planner returns
+    ``Action(skill, target, reason=..., scores=...)``; whoever executes it fills the
+    outcome and the log fields (:meth:`executed`) and writes that record.
+
+    The planner's part (positional in this order):
+
+    - ``skill``: ``navigate`` (go to a room, region, frontier or object node), ``open`` (go
+      to and open an object or a door: MoMa-LLM's go_to_and_open), ``close``, ``explore``
+      (an unexplored room or a frontier), ``done`` (the target is observed; ``target`` is
+      the found object's node id, or None when giving up). A planner returns one of
+      :data:`sgtool.vocabulary.SKILLS`; sgtool's recorders log
+      :data:`~sgtool.vocabulary.LOGGED_SKILLS`; the schema admits any string;
+    - ``target``: the id of a node of the graph the planner was given (None for ``done``);
+    - ``reason``: why, in words;
+    - ``decision_time_s``: seconds the planner took to decide, filled by the caller
+      (:class:`sgtool.planning.timing.TimedPlanner`), not by the planner;
+    - ``scores``: the planner's scores per node id; kept in memory, never logged.
+
+    The executor's part, :data:`ABSENT` until executed: ``outcome`` (the writer refuses a
+    record without one), ``travelled_m`` (metres, rounded to 0.1 mm on write), ``planner``
+    (its name), ``step`` (the index in the episode) and ``graph_time_ns`` (1.1): the log
+    time of the scene graph it was decided on; null: decided on no graph; absent: the last
+    graph at or before the action's log time.
+
+    The planner's fields are never :data:`ABSENT` (a planner always has a target, maybe
+    None, and a reason, maybe empty). A log record that lacks one reads as its default and
+    names it in ``absent``; :meth:`to_json` leaves such a field out while it still holds its
+    default, so a record read and written again is byte-identical.
+    """
 
     KIND: ClassVar[RecordName] = "action"
     CANONICAL: ClassVar[tuple[str, ...]] = ("travelled_m",)
+    NOT_LOGGED: ClassVar[tuple[str, ...]] = ("scores", "absent")
+    PLANNER_DEFAULTS: ClassVar[Mapping[str, object]] = {
+        "target": None, "reason": "", "decision_time_s": 0.0}
 
-    skill: str  # open in the schema; sgtool writes sgtool.vocabulary.LoggedSkill values
-    outcome: Outcome
-    target: str | None | Absent = ABSENT
-    reason: str | Absent = ABSENT
+    skill: str
+    target: str | None = None
+    reason: str = ""
+    decision_time_s: float = 0.0
+    scores: dict[str, float] = field(default_factory=dict)
+    outcome: Outcome | Absent = ABSENT
     travelled_m: float | Absent = ABSENT
-    decision_time_s: float | Absent = ABSENT
     planner: str | None | Absent = ABSENT
     step: int | Absent = ABSENT
     graph_time_ns: int | None | Absent = ABSENT
+    # planner fields the logged record did not hold (see the class doc)
+    absent: frozenset[str] = field(default=frozenset(), kw_only=True)
+
+    @classmethod
+    def _build(cls, d: Mapping[str, Any]) -> Action:
+        missing = frozenset(k for k in cls.PLANNER_DEFAULTS if k not in d)
+        record = super()._build({**{k: cls.PLANNER_DEFAULTS[k] for k in missing}, **d})
+        return replace(record, absent=missing) if missing else record
+
+    def to_json(self) -> dict[str, Any]:
+        out = super().to_json()
+        for name in self.absent:
+            if getattr(self, name) == self.PLANNER_DEFAULTS[name]:
+                del out[name]
+        return out
 
     @property
     def decided(self) -> bool:
         """False for an action decided on no graph (``graph_time_ns`` null)."""
         return self.graph_time_ns is not None
+
+    @property
+    def result(self) -> Outcome:
+        """The outcome of an executed action (every record read from a log has one);
+        :class:`LogFormatError` for an action not executed yet."""
+        if isinstance(self.outcome, Absent):
+            raise LogFormatError(f"{self.describe()}: the action {self.skill!r} on "
+                                 f"{self.target!r} has no outcome (not executed)")
+        return self.outcome
+
+    def executed(self, outcome: Outcome, travelled_m: float, *,
+                 planner: str | None | Absent = ABSENT, step: int | Absent = ABSENT,
+                 graph_time_ns: int | None | Absent = ABSENT,
+                 decision_time_s: float | None = None,
+                 unknown: Mapping[str, Any] | None = None) -> Action:
+        """The record the executor writes: this action with its ``outcome``, the metres
+        ``travelled_m`` and the log fields given (``decision_time_s`` and ``unknown`` stay
+        the action's when None)."""
+        return replace(
+            self, outcome=outcome, travelled_m=travelled_m, planner=planner, step=step,
+            graph_time_ns=graph_time_ns,
+            decision_time_s=self.decision_time_s if decision_time_s is None else decision_time_s,
+            unknown=self.unknown if unknown is None else unknown)
 
 
 @dataclass(frozen=True)

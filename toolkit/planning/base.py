@@ -5,36 +5,22 @@ never touches a simulator; it sees only :class:`~sgtool.scenegraph.graph.SceneGr
 returns :class:`Action`s whose ``target`` is the id of a node of the graph it was given
 (or None for ``done``). Whoever executes the action (the symbolic benchmark, the PyBullet
 closed loop) reports the outcome back through :meth:`Planner.feedback`.
+
+:class:`Action` is the one action type of planning and logs
+(:class:`sgtool.log.records.Action`, re-exported here): the record an executor writes is
+the planner's action with its outcome filled in.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Protocol
 
+from sgtool.log.records import Action
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.vocabulary import Outcome, Skill
 
 __all__ = ["Action", "Feedback", "Outcome", "Planner", "Skill"]
-
-
-@dataclass(frozen=True)
-class Action:
-    """A high-level action on a scene-graph node.
-
-    - ``navigate(target)``: go to a room, region, frontier or object node;
-    - ``open(target)``: go to and open an object or a door (MoMa-LLM's go_to_and_open);
-    - ``close(target)``: close an object or door;
-    - ``explore(target)``: explore an unexplored room or a frontier;
-    - ``done()``: the target is observed; ``target`` is the node id of the found object.
-    """
-
-    skill: Skill
-    target: str | None = None
-    reason: str = ""
-    # seconds the planner took to decide; filled by the caller, not by the planner
-    decision_time_s: float = 0.0
-    scores: dict[str, float] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

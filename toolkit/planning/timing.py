@@ -17,8 +17,9 @@ from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.scenegraph.graph import SceneGraph
 
 # Action's fields in order, as TimedPlanner.decide builds one (else it uses replace)
-_PLAIN = tuple(f.name for f in dataclasses.fields(Action)) == \
-    ("skill", "target", "reason", "decision_time_s", "scores")
+_PLAIN = tuple(f.name for f in dataclasses.fields(Action)) == (
+    "unknown", "skill", "target", "reason", "decision_time_s", "scores", "outcome", "travelled_m",
+    "planner", "step", "graph_time_ns", "absent")
 
 
 class PlannerContractError(SgtoolError):
@@ -46,7 +47,9 @@ class TimedPlanner:
         dt = time.perf_counter() - t0
         self.decision_times.append(dt)
         if _PLAIN and type(action) is Action:  # dataclasses.replace without its field walk
-            return Action(action.skill, action.target, action.reason, dt, action.scores)
+            return Action(action.skill, action.target, action.reason, dt, action.scores,
+                          action.outcome, action.travelled_m, action.planner, action.step,
+                          action.graph_time_ns, unknown=action.unknown, absent=action.absent)
         if not isinstance(action, Action):
             raise PlannerContractError(
                 f"planner {self.name!r}: decide() returned a {type(action).__name__}, not an "
