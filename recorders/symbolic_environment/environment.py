@@ -48,8 +48,9 @@ Everything is deterministic: the start comes from ``numpy.random.default_rng`` s
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import ClassVar, Literal
 
 import numpy as np
 
@@ -60,6 +61,10 @@ from sgtool.scenegraph.graph import SceneGraph
 from sgtool.semantics.text import category_text
 
 N_MAX = 50  # SymSearch's maximum episode length (SCOUT sec. VI / appendix C)
+
+NodeKind = Literal["room", "region", "door", "furniture", "object"]
+# a skill on one kind of node: (env, action, the node's index, distances) -> outcome
+Handler = Callable[["SymbolicEnv", Action, int, np.ndarray], "StepOutcome"]
 
 
 @dataclass(frozen=True)
@@ -197,32 +202,31 @@ class SymbolicEnv:
         return self._view.graph(self._distances())
 
     # ----- acting ---------------------------------------------------------------------
-    def _lookup(self, node_id: str | None) -> tuple[str, int] | None:
+    def _lookup(self, node_id: str | None) -> tuple[NodeKind, int] | None:
         """(kind, index) of an observed node, None when it is not in the observed graph."""
         if not node_id:
             return None
-        h = self.house
-        prefix, _, rest = node_id.partition(":")
+        prefix, _, number = node_id.partition(":")
         try:
             if prefix == "room":
-                ri = int(rest)
-                return ("room", ri) if ri in self.known_rooms else None
+                room = int(number)
+                return ("room", room) if room in self.known_rooms else None
             if prefix == "region":
-                reg = h.region_index.get(node_id)
-                if reg is None or h.regions[reg].room not in self.explored_rooms:
+                region = self.house.region_index.get(node_id)
+                if region is None or self.house.regions[region].room not in self.explored_rooms:
                     return None
-                return "region", reg
+                return "region", region
             if prefix == "door":
-                di = int(rest)
-                return ("door", di) if di in self.visible_doors else None
-            if prefix == "obj":
-                k = int(rest) - 1
-                nf = len(self.spec.furniture)
-                if 0 <= k < nf:
-                    return ("furniture", k) if k in self._visible_furn else None
-                j = k - nf
-                if 0 <= j < len(self.spec.objects):
-                    return ("object", j) if j in self.seen_objects else None
+                door = int(number)
+                return ("door", door) if door in self.visible_doors else None
+            if prefix == "obj":  # obj:1.. are the furniture, then the small objects
+                furniture = int(number) - 1
+                n_furniture = len(self.spec.furniture)
+                if 0 <= furniture < n_furniture:
+                    return ("furniture", furniture) if furniture in self._visible_furn else None
+                obj = furniture - n_furniture
+                if 0 <= obj < len(self.spec.objects):
+                    return ("object", obj) if obj in self.seen_objects else None
         except ValueError:
             return None
         return None
@@ -263,143 +267,176 @@ class SymbolicEnv:
             opened: bool = False) -> StepOutcome:
         return StepOutcome(Feedback(action, outcome, message, travelled), opened)
 
-    def _execute(self, a: Action) -> StepOutcome:
-        h = self.house
-        if a.skill == "done":
+    def _execute(self, action: Action) -> StepOutcome:
+        """The action's effect: ``done`` ends the episode; any other skill goes to the
+        handler of its target's node kind (:data:`_HANDLERS`), or is invalid when the
+        target is not an observed node."""
+        if action.skill == "done":
             self.ended = True
-            self.end_reason = "gave_up" if a.target is None else "wrong_done"
-            return self._outcome(a, "success", "episode ended by the planner")
-        found = self._lookup(a.target)
+            self.end_reason = "gave_up" if action.target is None else "wrong_done"
+            return self._outcome(action, "success", "episode ended by the planner")
+        found = self._lookup(action.target)
         if found is None:
-            return self._outcome(a, "invalid", f"{a.target!r} is not a node of the observed graph")
-        kind, i = found
-        dist = self._distances()
-        skill = a.skill
-        if kind == "room":
-            if skill in ("open", "close"):
-                return self._outcome(a, "invalid", f"cannot {skill} a room")
-            place = self._room_place(i, dist)
-            if not math.isfinite(dist[place]):
-                return self._outcome(a, "failure", f"{a.target} cannot be reached")
-            if i in self.explored_rooms:
-                if skill == "explore":
-                    return self._outcome(a, "failure", f"{a.target} is already explored")
-                return self._outcome(a, "success", f"at {a.target}", self._move(place, dist))
-            reg = next(r for r in h.room_regions[i] if h.regions[r].place == place)
-            d = self._move(place, dist)
-            self._enter_room(i, reg)
-            n = len(h.regions[reg].furniture)
-            return self._outcome(a, "success", f"entered {h.room_names[i]}: {n} objects in view", d)
-        if kind == "region":
-            region = h.regions[i]
-            if skill in ("open", "close"):
-                return self._outcome(a, "invalid", f"cannot {skill} a region")
-            if not math.isfinite(dist[region.place]):
-                return self._outcome(a, "failure", f"{a.target} cannot be reached")
-            if i in self.revealed_regions:
-                if skill == "explore":
-                    return self._outcome(a, "failure", f"{a.target} is already explored")
-                return self._outcome(a, "success", f"at {a.target}",
-                                     self._move(region.place, dist))
-            d = self._move(region.place, dist)
-            self._reveal_region(i)
-            return self._outcome(a, "success", f"{len(region.furniture)} objects in view", d)
-        if kind == "door":
-            place = self._door_place(i, dist)
-            if not math.isfinite(dist[place]):
-                return self._outcome(a, "failure", f"{a.target} cannot be reached")
-            is_open = i in self.open_doors
+            return self._outcome(action, "invalid",
+                                 f"{action.target!r} is not a node of the observed graph")
+        node_kind, index = found
+        return self._HANDLERS[node_kind](self, action, index, self._distances())
+
+    def _unreachable(self, action: Action) -> StepOutcome:
+        return self._outcome(action, "failure", f"{action.target} cannot be reached")
+
+    def _act_on_room(self, action: Action, room: int, distances: np.ndarray) -> StepOutcome:
+        """Walk to the room's nearest region; an unexplored room is entered (explored)."""
+        house, skill = self.house, action.skill
+        if skill in ("open", "close"):
+            return self._outcome(action, "invalid", f"cannot {skill} a room")
+        place = self._room_place(room, distances)
+        if not math.isfinite(distances[place]):
+            return self._unreachable(action)
+        if room in self.explored_rooms:
             if skill == "explore":
-                return self._outcome(a, "invalid", "cannot explore a door; open it")
-            if skill == "navigate":
-                return self._outcome(a, "success", f"at {a.target}", self._move(place, dist))
-            if skill == "open":
-                if is_open:
-                    return self._outcome(a, "failure", f"{a.target} is already open")
-                d = self._move(place, dist)
-                self.open_doors.add(i)
-                for r in self.spec.doors[i].rooms:
-                    self.known_rooms.add(h.room_index[r])
-                self._view.rooms_changed()
-                self._view.doors_changed()
-                return self._outcome(a, "success", "door opened", d, opened=True)
-            if not is_open:  # close
-                return self._outcome(a, "failure", f"{a.target} is already closed")
-            d = self._move(place, dist)
-            self.open_doors.discard(i)
+                return self._outcome(action, "failure", f"{action.target} is already explored")
+            return self._outcome(action, "success", f"at {action.target}",
+                                 self._move(place, distances))
+        region = next(r for r in house.room_regions[room] if house.regions[r].place == place)
+        travelled = self._move(place, distances)
+        self._enter_room(room, region)
+        in_view = len(house.regions[region].furniture)
+        return self._outcome(action, "success",
+                             f"entered {house.room_names[room]}: {in_view} objects in view",
+                             travelled)
+
+    def _act_on_region(self, action: Action, index: int, distances: np.ndarray
+                       ) -> StepOutcome:
+        """Walk to a region; a frontier is revealed with its furniture."""
+        region, skill = self.house.regions[index], action.skill
+        if skill in ("open", "close"):
+            return self._outcome(action, "invalid", f"cannot {skill} a region")
+        if not math.isfinite(distances[region.place]):
+            return self._unreachable(action)
+        if index in self.revealed_regions:
+            if skill == "explore":
+                return self._outcome(action, "failure", f"{action.target} is already explored")
+            return self._outcome(action, "success", f"at {action.target}",
+                                 self._move(region.place, distances))
+        travelled = self._move(region.place, distances)
+        self._reveal_region(index)
+        return self._outcome(action, "success", f"{len(region.furniture)} objects in view",
+                             travelled)
+
+    def _act_on_door(self, action: Action, door: int, distances: np.ndarray) -> StepOutcome:
+        """Walk to the door's nearer side; open it (the rooms behind become known) or close
+        it; any skill but explore, navigate and open closes."""
+        place = self._door_place(door, distances)
+        if not math.isfinite(distances[place]):
+            return self._unreachable(action)
+        skill, is_open = action.skill, door in self.open_doors
+        if skill == "explore":
+            return self._outcome(action, "invalid", "cannot explore a door; open it")
+        if skill == "navigate":
+            return self._outcome(action, "success", f"at {action.target}",
+                                 self._move(place, distances))
+        if skill == "open":
+            if is_open:
+                return self._outcome(action, "failure", f"{action.target} is already open")
+            travelled = self._move(place, distances)
+            self.open_doors.add(door)
+            for room_id in self.spec.doors[door].rooms:
+                self.known_rooms.add(self.house.room_index[room_id])
+            self._view.rooms_changed()
             self._view.doors_changed()
-            return self._outcome(a, "success", "door closed", d)
-        if kind == "object":
-            return self._object_action(a, i, dist)
-        # furniture
-        fu = self.spec.furniture[i]
-        place = h.furn_place[i]
-        if not math.isfinite(dist[place]):
-            return self._outcome(a, "failure", f"{a.target} cannot be reached")
-        state = self.furn_state[i]
+            return self._outcome(action, "success", "door opened", travelled, opened=True)
+        if not is_open:
+            return self._outcome(action, "failure", f"{action.target} is already closed")
+        travelled = self._move(place, distances)
+        self.open_doors.discard(door)
+        self._view.doors_changed()
+        return self._outcome(action, "success", "door closed", travelled)
+
+    def _act_on_furniture(self, action: Action, furniture: int, distances: np.ndarray
+                          ) -> StepOutcome:
+        """Open or close a piece (explore on a closed piece opens it), or walk up to it and
+        look into / onto it (module doc)."""
+        piece, place = self.spec.furniture[furniture], self.house.furn_place[furniture]
+        if not math.isfinite(distances[place]):
+            return self._unreachable(action)
+        skill, state = action.skill, self.furn_state[furniture]
         if skill == "open" or (skill == "explore" and state == "closed"):
-            if not fu.is_openable:
-                return self._outcome(a, "failure", f"a {fu.category} cannot be opened")
+            if not piece.is_openable:
+                return self._outcome(action, "failure", f"a {piece.category} cannot be opened")
             if state == "open":
-                return self._outcome(a, "failure", f"the {fu.category} is already open")
-            d = self._move(place, dist)
-            self.furn_state[i] = "open"
-            return self._outcome(a, "success", self._found(self._look(i)), d, opened=True)
+                return self._outcome(action, "failure", f"the {piece.category} is already open")
+            travelled = self._move(place, distances)
+            self.furn_state[furniture] = "open"
+            return self._outcome(action, "success", self._found(self._look(furniture)),
+                                 travelled, opened=True)
         if skill == "close":
             if state != "open":
-                return self._outcome(a, "failure", f"the {fu.category} is not open")
-            d = self._move(place, dist)
-            self.furn_state[i] = "closed"
-            self._view.show_furniture(i)
-            return self._outcome(a, "success", f"{fu.category} closed", d)
+                return self._outcome(action, "failure", f"the {piece.category} is not open")
+            travelled = self._move(place, distances)
+            self.furn_state[furniture] = "closed"
+            self._view.show_furniture(furniture)
+            return self._outcome(action, "success", f"{piece.category} closed", travelled)
         # navigate / explore: walk up; look into / onto a piece that is not closed, onto
         # the top of a closed one
-        fresh = h.explorable[i] and i not in self.furn_explored and state != "closed"
+        fresh = (self.house.explorable[furniture] and furniture not in self.furn_explored
+                 and state != "closed")
         if skill == "explore" and not fresh:
-            return self._outcome(a, "failure", f"nothing left to explore at the {fu.category}")
-        d = self._move(place, dist)
-        new = self._look(i)
+            return self._outcome(action, "failure",
+                                 f"nothing left to explore at the {piece.category}")
+        travelled = self._move(place, distances)
+        revealed = self._look(furniture)
         if fresh:
-            return self._outcome(a, "success", self._found(new), d)
-        if new:
-            return self._outcome(a, "success", f"at the {fu.category}; {self._found(new)}", d)
-        return self._outcome(a, "success", f"at the {fu.category}", d)
+            return self._outcome(action, "success", self._found(revealed), travelled)
+        if revealed:
+            return self._outcome(action, "success",
+                                 f"at the {piece.category}; {self._found(revealed)}", travelled)
+        return self._outcome(action, "success", f"at the {piece.category}", travelled)
 
-    def _object_action(self, a: Action, j: int, dist: np.ndarray) -> StepOutcome:
+    def _act_on_object(self, action: Action, index: int, distances: np.ndarray
+                       ) -> StepOutcome:
         """A skill on a revealed small object: the agent walks to its furniture (and looks
         at it); only an openable object can be opened or closed, only a container
         explored."""
-        h, o = self.house, self.spec.objects[j]
-        f = h.obj_furn[j]
-        place = h.furn_place[f]
-        skill, state = a.skill, self.obj_state[j]
+        obj, furniture = self.spec.objects[index], self.house.obj_furn[index]
+        place = self.house.furn_place[furniture]
+        skill, state = action.skill, self.obj_state[index]
         opens = skill == "open" or (skill == "explore" and state == "closed")
-        applies = skill == "navigate" or (o.is_openable and (opens or skill == "close")) or \
-            (skill == "explore" and o.is_container)
+        applies = skill == "navigate" or (obj.is_openable and (opens or skill == "close")) or \
+            (skill == "explore" and obj.is_container)
         if not applies:
-            return self._outcome(a, "invalid", f"cannot {skill} a {o.category}")
-        if not math.isfinite(dist[place]):
-            return self._outcome(a, "failure", f"{a.target} cannot be reached")
+            return self._outcome(action, "invalid", f"cannot {skill} a {obj.category}")
+        if not math.isfinite(distances[place]):
+            return self._unreachable(action)
         if opens and state == "open":
-            return self._outcome(a, "failure", f"the {o.category} is already open")
+            return self._outcome(action, "failure", f"the {obj.category} is already open")
         if skill == "close" and state != "open":
-            return self._outcome(a, "failure", f"the {o.category} is not open")
-        if skill == "explore" and not opens and j in self.obj_explored:
-            return self._outcome(a, "failure", f"nothing left to explore at the {o.category}")
-        d = self._move(place, dist)
+            return self._outcome(action, "failure", f"the {obj.category} is not open")
+        if skill == "explore" and not opens and index in self.obj_explored:
+            return self._outcome(action, "failure",
+                                 f"nothing left to explore at the {obj.category}")
+        travelled = self._move(place, distances)
         if skill == "close":
-            self.obj_state[j] = "closed"
-            self._view.show_object(j)
-            return self._outcome(a, "success", f"{o.category} closed", d)
+            self.obj_state[index] = "closed"
+            self._view.show_object(index)
+            return self._outcome(action, "success", f"{obj.category} closed", travelled)
         if opens:
-            self.obj_state[j] = "open"
-            self._view.show_object(j)
-        new = self._look(f)
+            self.obj_state[index] = "open"
+            self._view.show_object(index)
+        revealed = self._look(furniture)
         if opens or skill == "explore":
-            return self._outcome(a, "success", self._found(new), d, opened=opens)
-        if new:
-            return self._outcome(a, "success", f"at {a.target}; {self._found(new)}", d)
-        return self._outcome(a, "success", f"at {a.target}", d)
+            return self._outcome(action, "success", self._found(revealed), travelled,
+                                 opened=opens)
+        if revealed:
+            return self._outcome(action, "success", f"at {action.target}; "
+                                 f"{self._found(revealed)}", travelled)
+        return self._outcome(action, "success", f"at {action.target}", travelled)
+
+    # the handler of each kind of node an action can target (:meth:`_lookup`'s kinds)
+    _HANDLERS: ClassVar[Mapping[NodeKind, Handler]] = {
+        "room": _act_on_room, "region": _act_on_region, "door": _act_on_door,
+        "furniture": _act_on_furniture, "object": _act_on_object,
+    }
 
     # ----- figures --------------------------------------------------------------------
     def shortest_path(self, targets: Sequence[str]) -> float | None:
