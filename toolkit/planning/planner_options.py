@@ -147,7 +147,12 @@ class VoiOptions(NodeOptions):
         "b of (V2): extra cost of an open", "float", lo=0.0))
     follow_steps: float | None = field(default=None, metadata=option(
         "f of (V2): actions after a reveal before what it showed is checked [default: "
-        "estimated from the revealed places, (V3)]", "float", lo=0.0, optional=True))
+        "estimated from the revealed places by follow_rule]", "float", lo=0.0,
+        optional=True))
+    follow_rule: str = field(default="prefix", metadata=option(
+        "how a reveal's follow-up is priced when follow_steps is unset: prefix (V4, the "
+        "best initial segment of checks) or mean (V3, the expected number of checks)",
+        "choice", choices=("prefix", "mean")))
     top_k: int = field(default=5, metadata=option(
         "places ranked by p/c that the look-ahead orders", "int", lo=1))
     horizon: int = field(default=3, metadata=option(

@@ -156,7 +156,8 @@ def _voi(name: str, o: VoiOptions) -> Planner:
                           seen_type_weight=o.seen_type_weight,
                           instance_exponent=o.instance_exponent)
     params = VoiParams(step_cost=o.step_cost, open_cost=o.open_cost,
-                       follow_steps=o.follow_steps, top_k=o.top_k, horizon=o.horizon,
+                       follow_steps=o.follow_steps, follow_rule=o.follow_rule,
+                       top_k=o.top_k, horizon=o.horizon,
                        step_budget=o.step_budget, belief=belief)
     return VoiPlanner(_priors(o.encoder, o.weights_dir, blend=o.blend), params, name=name,
                       max_failures=o.max_failures,

@@ -72,6 +72,7 @@ class VoiParams:
     open_cost: float = 0.5  # b of (V2)
     # f of (V2): actions after a reveal to check what it showed; None: f̂ of (V3)
     follow_steps: float | None = None
+    follow_rule: str = "prefix"  # f unset: "prefix" (V4) or "mean" (V3)
     top_k: int = 5
     horizon: int = 3
     step_budget: int = 50  # actions per episode (N_max) of the step price (S3); 0: none
@@ -108,6 +109,7 @@ class EpisodeBelief:
         self._rooms: tuple[RoomNode, ...] | None = None
         self._room_table: tuple[dict[str, float], float] = ({}, params.fallback_room)
         self.follow = 1.0  # f̂ of (V3) for the last objects tuple
+        self.profile = np.ones(1)  # W̄ of (V4) for the last objects tuple
         # id(node) -> (node, is a carrier, category text); holds the node, so the id stays
         self._nodes: dict[int, tuple[ObjectNode, bool, str]] = {}
 
@@ -193,7 +195,7 @@ class EpisodeBelief:
             table.setdefault(o.id, (_OBJECT, o.room, 0.0))
         mean_c = float(np.mean(c)) if c else 0.5
         self._objects, self._obj_table = graph.objects, (table, zc, mean_c, len(carriers))
-        self.follow = expected_checks(carriers, c)
+        self.follow, self.profile = expected_checks(carriers, c), share_profile(carriers, c)
         return self._obj_table
 
     def _frontiers(self, graph: SceneGraph
@@ -301,6 +303,50 @@ def expected_checks(carriers: Sequence[ObjectNode], c: Sequence[float]) -> float
     return total / len(groups)
 
 
+def share_profile(carriers: Sequence[ObjectNode], c: Sequence[float],
+                  longest: int = 32) -> np.ndarray:
+    """W̄ of (V4): W̄_k, k = 1.., the share of a revealed place's mass that its k likeliest
+    carriers hold (C' shares in decreasing order, summed), averaged over the revealed
+    places (carriers grouped by parent, as :func:`expected_checks`); ends at 1, at most
+    ``longest`` long; [1] with no carriers."""
+    ids = {o.id for o in carriers}
+    groups: dict[str, list[float]] = {}
+    for o, v in zip(carriers, c, strict=True):
+        if o.parent not in ids:
+            groups.setdefault(o.parent, []).append(v)
+    if not groups:
+        return np.ones(1)
+    m = min(longest, max(len(g) for g in groups.values()))
+    out = np.zeros(m)
+    for vals in groups.values():
+        w = np.sort(np.asarray(vals, dtype=np.float64))[::-1][:m]
+        cum = np.cumsum(w) / sum(vals)
+        out[: len(cum)] += cum
+        out[len(cum):] += 1.0
+    out /= len(groups)
+    out[-1] = 1.0
+    return out
+
+
+def prefix_costs(base: np.ndarray, p: np.ndarray, nxt: np.ndarray, profile: np.ndarray,
+                 step: float) -> np.ndarray:
+    """c_eff of (V4): p / max_k (p - p^next + p^next W̄_k) / (c + k a_t), k = 0..len(W̄)
+    (W̄_0 = 0), the cost at which checking node i alone would be worth its best initial
+    segment of reveal and checks; c where p^next = 0 (W̄ ends at 1, so c_eff <= c + K a_t
+    for the profile's length K)."""
+    out = base.copy()
+    rows = np.flatnonzero(nxt > 0)
+    if not len(rows):
+        return out
+    w = np.concatenate(([0.0], profile))
+    k = np.arange(len(w), dtype=np.float64)
+    now, later = p[rows] - nxt[rows], nxt[rows]
+    v = (now[:, None] + later[:, None] * w[None, :]) / (base[rows, None] + k[None, :] * step)
+    best = v.max(axis=1)
+    out[rows] = np.where(best > 0, p[rows] / np.where(best > 0, best, 1.0), base[rows])
+    return out
+
+
 class VoiPlanner(ScoringPlanner[VoiParams]):
     """Value-of-information search (module doc). ``furniture_levels``: name -> φ of (B6)
     (:mod:`sgtool.planning.furniture_prior`); None: every query is a small object."""
@@ -344,10 +390,15 @@ class VoiPlanner(ScoringPlanner[VoiParams]):
         step = step_price(p, steps_left, prm.step_cost)
         opens = np.fromiter((s == "open" for s in cols.skills), dtype=bool, count=len(cols))
         share = np.divide(nxt, p, out=np.zeros_like(p), where=p > 0)
-        follow = self.belief.follow if prm.follow_steps is None else prm.follow_steps
-        extra = step + prm.open_cost * opens + follow * step * share
         dist = np.asarray(cols.distances, dtype=np.float64)
-        first = dist + extra
+        if prm.follow_steps is None and prm.follow_rule == "prefix":
+            base = dist + step + prm.open_cost * opens
+            first = prefix_costs(base, p, nxt, self.belief.profile, step)
+            extra = first - dist
+        else:
+            follow = self.belief.follow if prm.follow_steps is None else prm.follow_steps
+            extra = step + prm.open_cost * opens + follow * step * share
+            first = dist + extra
         ratio = p / first
         keys = cols.ids  # ties: node ids as strings, as (S2) of bayes-search
         k_top = max(1, prm.top_k)

@@ -15,7 +15,15 @@ from sgtool.planning.candidates import actionable
 from sgtool.planning.planner_options import VoiOptions
 from sgtool.planning.registry import make_planner
 from sgtool.planning.search_theory import SearchTheoryPlanner
-from sgtool.planning.voi import EpisodeBelief, VoiParams, VoiPlanner, voi_belief
+from sgtool.planning.voi import (
+    EpisodeBelief,
+    VoiParams,
+    VoiPlanner,
+    expected_checks,
+    prefix_costs,
+    share_profile,
+    voi_belief,
+)
 from sgtool.scenegraph.graph import ObjectNode, RegionNode, RobotState, RoomNode, SceneGraph
 
 
@@ -162,3 +170,33 @@ def test_registry_row_and_options() -> None:
     for k in ("room_floor", "object_floor", "sharpness", "object_sharpness", "beyond", "miss",
               "region_weight", "seen_type_weight", "instance_exponent"):
         assert getattr(opts, k) == getattr(params.belief, k), k
+
+
+def test_share_profile_and_expected_checks() -> None:
+    """Two revealed regions: one with carriers of C' 3 and 1 (shares 0.75, 0.25), one with
+    a single carrier; a small box inside the first carrier is no place of its own."""
+    objs = [ObjectNode("obj:1", "a", "region:1.1", "room:1", (0.0, 0.0, 0.0), state="closed"),
+            ObjectNode("obj:2", "b", "region:1.1", "room:1", (0.0, 0.0, 0.0), state="closed"),
+            ObjectNode("obj:3", "c", "region:1.2", "room:1", (0.0, 0.0, 0.0), state="closed"),
+            ObjectNode("obj:4", "box", "obj:1", "room:1", (0.0, 0.0, 0.0), state="closed")]
+    c = [1.0, 3.0, 2.0, 5.0]
+    assert share_profile(objs, c).tolist() == pytest.approx([(0.75 + 1.0) / 2, 1.0])
+    # expected checks: 1 * 0.75 + 2 * 0.25 in the first region, 1 in the second
+    assert expected_checks(objs, c) == pytest.approx((1.25 + 1.0) / 2)
+    assert share_profile([], []).tolist() == [1.0] and expected_checks([], []) == 1.0
+
+
+def test_prefix_costs_take_the_best_initial_segment() -> None:
+    """A reveal of mass 0.5, all of it behind a check (c = 10, a_t = 3): with W̄ = (0.5, 1)
+    the best segment is reveal + two checks, 0.5 / 16; with W̄ = (0.9, 1) reveal + one
+    check, 0.45 / 13. A carrier (no follow-up mass) keeps its cost."""
+    base, p = np.array([10.0, 4.0]), np.array([0.5, 0.5])
+    nxt = np.array([0.5, 0.0])
+    assert prefix_costs(base, p, nxt, np.array([0.5, 1.0]), 3.0).tolist() == \
+        pytest.approx([16.0, 4.0])
+    assert prefix_costs(base, p, nxt, np.array([0.9, 1.0]), 3.0).tolist() == \
+        pytest.approx([0.5 / (0.45 / 13.0), 4.0])
+    # a furniture-level share (0.4) is found on the reveal itself: the reveal alone, 0.4 /
+    # 10, beats 0.45 / 13 and 0.5 / 16, so 0.5 costs 10 / 0.8
+    assert prefix_costs(np.array([10.0]), np.array([0.5]), np.array([0.1]),
+                        np.array([0.5, 1.0]), 3.0).tolist() == pytest.approx([12.5])
