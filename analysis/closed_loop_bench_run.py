@@ -11,7 +11,8 @@ On an executor (``-w N``, ``--executor ray``) the episodes go through
 machine ran it (a worker that sees the folder writes it there; one on another machine
 sends it back, :func:`run_task_on`), so a driver killed at any moment leaves the finished
 episodes' logs for the next run to resume from. ``run.json`` records, per episode, whether
-it ran now, its wall seconds and the Ray node that ran it (``""``: this machine).
+it ran now, its wall seconds, the Ray node that ran it (``""``: this machine) and whether
+its log was sent back.
 """
 
 from __future__ import annotations
@@ -86,7 +87,7 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
         written = [p.name for p in write_tables(res, root)]
         if not request.report_only:
             written.append(atomic_write(root / RUN_FILE, run_record(
-                res.rows, root, runner.nodes, request.executor)).name)
+                res.rows, root, runner, request.executor)).name)
     show(res.table())
     show(f"wrote {', '.join(str(Path(request.out_dir) / name) for name in written)}")
 
@@ -135,7 +136,8 @@ class EpisodeRunner:
     task runs on the executor (:func:`run_task_on`); a log sent back is written
     (atomically) as its task finishes; a task that failed after its retry stops the run
     with one line once all have run (the finished logs stay). :attr:`nodes` maps each log
-    run now to the Ray node that ran it (``""``: this machine)."""
+    run now to the Ray node that ran it (``""``: this machine); :attr:`sent` holds the
+    logs sent back."""
 
     def __init__(self, executor: Executor | None, root: Path, *,
                  progress: bool = False) -> None:
@@ -143,6 +145,7 @@ class EpisodeRunner:
         self.root = root
         self.progress = progress
         self.nodes: dict[Path, str] = {}
+        self.sent: set[Path] = set()
 
     def __call__(self, fn: RunFn, items: Iterable[RunTask]) -> Iterator[RunRow]:
         if self.executor is None:
@@ -172,6 +175,7 @@ class EpisodeRunner:
                 task = out.value.row.task
                 task.output.parent.mkdir(parents=True, exist_ok=True)
                 atomic_write(task.output, out.value.log)
+                self.sent.add(task.output)
             if out.ok:
                 self.nodes[Path(out.id)] = out.node
 
@@ -197,17 +201,18 @@ def _remove_partials(task: RunTask) -> None:
         p.unlink(missing_ok=True)
 
 
-def run_record(rows: Sequence[RunRow], root: Path, nodes: dict[Path, str],
+def run_record(rows: Sequence[RunRow], root: Path, runner: EpisodeRunner,
                executor: str) -> str:
     """run.json: per episode (report order) its log (relative to ``root``), whether it ran
-    now (else it was read back), its wall seconds and the Ray node that ran it."""
+    now (else it was read back), its wall seconds, the Ray node that ran it and whether
+    the log was sent back (``runner``'s records)."""
     episodes = []
     for r in rows:
         log = r.task.output
         episodes.append({"log": log.relative_to(root).as_posix() if log.is_relative_to(root)
                          else str(log), "ran": r.seconds is not None,
                          "seconds": None if r.seconds is None else round(r.seconds, 3),
-                         "node": nodes.get(log, "")})
+                         "node": runner.nodes.get(log, ""), "sent": log in runner.sent})
     return json.dumps({"executor": executor, "episodes": episodes}, indent=1,
                       sort_keys=True) + "\n"
 

@@ -288,7 +288,10 @@ def _ray_call(fn: Callable[[Any], Any], args: Any) -> _Placed:
 def machine_id() -> str:
     """This machine: its host name and, on Linux, its boot id (two containers of one host
     share the boot id but not, in general, their folders: :class:`FolderMark` also compares
-    the folder itself)."""
+    the folder itself). ``SGTOOL_MACHINE_ID``, when set, stands for it: a Ray node started
+    with it set to another value acts as a machine of its own (it sends its files back)."""
+    if os.environ.get("SGTOOL_MACHINE_ID"):
+        return os.environ["SGTOOL_MACHINE_ID"]
     try:
         boot = Path("/proc/sys/kernel/random/boot_id").read_text().strip()
     except OSError:

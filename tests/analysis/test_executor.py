@@ -246,6 +246,15 @@ def test_a_folder_mark_is_recognised_only_where_that_very_folder_is(tmp_path):
     assert not mark.here()  # no folder there
 
 
+def test_sgtool_machine_id_makes_a_process_another_machine(tmp_path, monkeypatch):
+    from sgtool.analysis.executor import FolderMark
+
+    mark = FolderMark.of(tmp_path)
+    monkeypatch.setenv("SGTOOL_MACHINE_ID", "node2")
+    assert not mark.here()
+    assert FolderMark.of(tmp_path).here()  # marked there, seen there
+
+
 def test_a_task_on_this_machine_names_no_node():
     outs = LocalExecutor(1).run(abs, [Task("a", -2)])
     assert outs == [Outcome("a", 2, None, 1, "")]

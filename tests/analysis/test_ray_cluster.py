@@ -1,12 +1,15 @@
 """`sgtool run-bench --executor ray` on a real two-node Ray cluster on this machine: a head
 (`ray start --head`, 1 CPU, resource ``head``) and a second node (`ray start --address`,
-1 CPU, resource ``node2``, its own temp dir), each a process of its own. The driver is the
-CLI in a process of its own too. One small generated house, 2 episodes per planner for 2
-planners at 48x36 with a frame budget: the episodes run on both nodes (run.json names the
-node of each), the results equal a `-w 1` run's (summary.json byte for byte; the records
-and every log message but the measured decision time), the logs reach the output folder
-while the driver still runs, and a driver killed with SIGKILL mid-run resumes: the
-finished episodes are not run again, no partial log stays, the result is the same.
+1 CPU, resource ``node2``, its own temp dir), each a process of its own. The second node
+acts as another machine (``SGTOOL_MACHINE_ID``): it does not write into the output folder
+but sends its logs back to the driver, as a node without the folder would. The driver is
+the CLI in a process of its own too. One small generated house, 2 episodes per planner
+for 2 planners at 48x36 with a frame budget: the episodes run on both nodes (run.json
+names the node of each, and which logs were sent back), the results equal a `-w 1` run's
+(summary.json byte for byte; the records and every log message but the measured decision
+time), the logs reach the output folder while the driver still runs, and a driver killed
+with SIGKILL mid-run resumes: the finished episodes are not run again, no partial log
+stays, the result is the same.
 
 Ray starts slowly on busy cores: generous deadlines, no timed assertion. The nodes are
 stopped through their process groups (``ray stop`` would stop every Ray on the machine,
@@ -51,11 +54,12 @@ import sys, time, ray
 ray.init(address=sys.argv[1], log_to_driver=False, configure_logging=False)
 deadline = time.monotonic() + float(sys.argv[2])
 while True:
-    alive = sorted(n["NodeID"] for n in ray.nodes() if n["Alive"])
+    alive = [n for n in ray.nodes() if n["Alive"]]
     if len(alive) >= 2 or time.monotonic() > deadline:
         break
     time.sleep(0.5)
-print(" ".join(alive))
+print(" ".join(("node2" if "node2" in n["Resources"] else "head") + "=" + n["NodeID"]
+               for n in alive))
 """
 
 
@@ -63,7 +67,7 @@ print(" ".join(alive))
 class Cluster:
     address: str
     env: dict[str, str]
-    node_ids: frozenset[str]
+    nodes: dict[str, str]  # head, node2 -> Ray node id
 
 
 def _free_port() -> int:
@@ -133,13 +137,13 @@ def cluster() -> Iterator[Cluster]:
                 assert time.monotonic() < deadline, "the head did not start"
                 time.sleep(0.2)
         nodes.append(_start_node(["--address", address, "--resources", '{"node2": 1}'],
-                                 temp / "node2", env))
+                                 temp / "node2", {**env, "SGTOOL_MACHINE_ID": "node2"}))
         found = subprocess.run([sys.executable, "-c", NODES, address, str(START_S)], env=env,
                                capture_output=True, text=True, timeout=START_S + 120)
-        ids = found.stdout.split()
-        assert found.returncode == 0 and len(ids) == 2, (
+        ids = dict(w.split("=") for w in found.stdout.split())
+        assert found.returncode == 0 and sorted(ids) == ["head", "node2"], (
             f"{found.stdout}{found.stderr[-2000:]}\n{_tail(temp / 'node2.out')}")
-        yield Cluster(address, env, frozenset(ids))
+        yield Cluster(address, env, ids)
     finally:
         for proc in reversed(nodes):
             _stop_node(proc)
@@ -217,7 +221,9 @@ def test_run_bench_runs_on_both_nodes_streams_logs_and_equals_one_worker(
     assert any(0 < n < EPISODES for n in logs_while_running), logs_while_running
     ran = _run_json(out)
     assert len(ran) == EPISODES and all(e["ran"] for e in ran.values())
-    assert {e["node"] for e in ran.values()} == cluster.node_ids  # both nodes ran episodes
+    assert {e["node"] for e in ran.values()} == set(cluster.nodes.values())  # both nodes
+    for e in ran.values():  # node2 sent its logs back, the head wrote into the folder
+        assert e["sent"] is (e["node"] == cluster.nodes["node2"])
     _assert_same_results(out, reference)
 
 

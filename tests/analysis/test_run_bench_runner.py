@@ -57,7 +57,7 @@ def test_a_partial_log_of_a_killed_run_is_removed_and_run_json_says_what_ran(
     assert run["executor"] == "local"
     [ep] = run["episodes"]
     assert ep["log"] == "logs/none/random/small/ep-000.mcap" and ep["ran"] is True
-    assert ep["seconds"] > 0 and ep["node"] == ""
+    assert ep["seconds"] > 0 and ep["node"] == "" and ep["sent"] is False
     # resumed: read back, not run
     again = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
     assert again.exit_code == 0, again.output
@@ -95,3 +95,4 @@ def test_a_worker_that_does_not_see_the_folder_sends_its_log_back(
         assert replace(a.result, wall={}, source="") == replace(b.result, wall={}, source="")
         assert (a.frames, a.failures) == (b.frames, b.failures)
     assert runner.nodes == {r.task.output: "" for r in shipped.rows}
+    assert runner.sent == {r.task.output for r in shipped.rows}
