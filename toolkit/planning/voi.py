@@ -1,36 +1,50 @@
 """``voi``: search by value of information, looking weighed against opening.
 
-The belief is that of ``bayes-rooms`` ((B1)-(B8) of :mod:`sgtool.planning.belief`, kept
-per episode and updated incrementally here, :class:`EpisodeBelief`). What differs is what an
-action is worth. Every action costs one step of the budget and its travel; what it buys
-is the chance of seeing the target now, or of being one step from it:
+The belief is that of ``bayes-rooms`` ((B1)-(B8) of :mod:`sgtool.planning.belief`: (B7)
+η = 0.3, (B8) γ = 0.5), kept per episode and updated from what changed,
+:class:`EpisodeBelief`; it equals :func:`~sgtool.planning.belief.place_masses`. What
+differs is what an action is worth. Every action costs one step of the budget and its
+travel; what it buys differs by kind:
 
 - checking a carrier o (``open`` a closed one, walk up to an open one) resolves p_o at
-  once: whether the target is on or in it;
+  once: the target is on or in it, or not;
 - revealing space (an unexplored-area frontier, an unexplored room, a closed door, a
-  leading-out frontier) shows first-level pieces, so a furniture-level target is seen at
-  once, but a small object on or in a revealed piece needs a further check, so its share
-  of the node's mass is paid with ``follow_steps`` more actions.
+  leading-out frontier) shows first-level pieces: a furniture-level target is seen at
+  once, a small object on or in a revealed piece only after a further check of that piece.
 
-With p_i the belief mass of candidate i, split (B6) into the share found on arrival and
-the share that needs a follow-up check,
+With p_i the belief mass of candidate i, split by (B6) into the part seen on arrival and
+the part that needs follow-up checks,
 
     p_i = p_i^now + p_i^next,   p^now = φ P_F + (1 - φ) P_O [i a carrier],
                                 p^next = (1 - φ) P_O [i reveals space]                (V1)
 
-its expected cost in metres-equivalent is
+and c_i = d_i + a_t + b·[open] its cost in metres-equivalent (d_i travel, a_t the price of
+an action, (S3) of :mod:`sgtool.planning.search_theory`, b the extra of an open), a reveal
+is priced with the checks it needs:
 
-    c_i = d_i + a_t + b·[open] + f · a_t · p_i^next / p_i                             (V2)
+    c'_i = c_i + f · a_t · p_i^next / p_i           (f = ``follow_steps`` when set)     (V2)
 
-(d_i travel, a_t the price of an action (S3) of :mod:`sgtool.planning.search_theory`, b
-the extra of an open, f = ``follow_steps``). This replaces the region discount ω of (B2):
-the region's mass stays what the belief says (ω = 1), and what revealing it cannot buy at
-once is charged as the cost of the step that will. A room, door or frontier is therefore
-worth visiting exactly when its mass per step-and-a-bit beats the best carrier's mass per
-step; twenty closed cabinets of one kind hold the category's mass C n^γ between them (B8),
-so a likely room that has not been seen is visited before the cheap containers are
-exhausted. Places are ordered by (S2) (the best ordering of ``horizon`` of the ``top_k``
-places by p/c, detection probability per expected cost), with the costs (V2) on every leg.
+    f̂ = mean over revealed places of Σ_j j w_j                     (``follow_rule`` mean)  (V3)
+
+    c'_i = p_i / max_{k=0..K} (p_i^now + p_i^next W̄_k) / (c_i + k a_t)
+                                                              (``follow_rule`` prefix)  (V4)
+
+A revealed place is the set of carriers sharing a parent (a region); w_j are its carriers'
+C' shares in decreasing order (the order the ratio rule checks them), W̄_k the share its k
+likeliest carriers hold, averaged over the revealed places (W̄_0 = 0, W̄_K = 1). (V3)
+charges the expected number of checks; (V4), the default, values a reveal by its best
+initial segment (reveal, then the k likeliest pieces), the ratio that orders a chain of
+actions in optimal search under precedence constraints (Sidney 1975; Kadane & Simon 1977):
+a reveal whose region's mass sits on one likely piece is nearly as good as checking that
+piece, one whose mass is spread pays for the checks. The region's mass is what the belief
+says (ω = 1 of (B2)-(B3)): what a reveal cannot buy at once is charged as cost instead
+of a discount. So a room, door or frontier is worth its price exactly when its mass per
+step-and-checks beats the best carrier's mass per step; and since the n carriers of one
+category in a room hold C n^γ between them (B8), twenty closed cabinets do not outweigh
+one countertop, and a likely room that has not been seen is worth its visit before the
+cheap containers are exhausted. Places are ordered by (S2) (the best ordering of
+``horizon`` of the ``top_k`` places by p/c', detection probability per expected cost),
+with c' on every leg.
 
 Everything is deterministic (ties broken by node id); the seed is not used.
 """

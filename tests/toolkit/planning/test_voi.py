@@ -200,3 +200,53 @@ def test_prefix_costs_take_the_best_initial_segment() -> None:
     # 10, beats 0.45 / 13 and 0.5 / 16, so 0.5 costs 10 / 0.8
     assert prefix_costs(np.array([10.0]), np.array([0.5]), np.array([0.1]),
                         np.array([0.5, 1.0]), 3.0).tolist() == pytest.approx([12.5])
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_invariants_on_random_worlds(seed: int) -> None:
+    """As every planner (test_invariants): acts on nodes of the graph, done exactly when the
+    target is in view, finds it iff it exists (everything is reachable there)."""
+    from support.planning_world import World
+
+    from sgtool.semantics.text import same_category
+
+    world = World(seed)
+    planner = VoiPlanner(TableScorer(rooms={"kitchen": 0.9},
+                                     objects={"fridge": 0.8, "bottom_cabinet": 0.6},
+                                     default=0.2))
+    planner.reset(world.query, seed=seed)
+    target = None
+    for _ in range(60):
+        g = world.graph()
+        a = planner.decide(g)
+        observed = {o.id for o in g.objects if same_category(o.category, world.query)}
+        if a.skill == "done":
+            assert (a.target in observed) if a.target is not None else not observed
+            target = a.target
+            break
+        assert not observed and a.target in g.node_ids()
+        planner.feedback(world.execute(a))
+    exists = any(same_category(o.category, world.query)
+                 for objs in [world.objects, *world.hidden.values()] for o in objs)
+    assert (target is not None) == exists
+
+
+def test_with_the_shipped_priors_a_search_ends_the_same_way_twice() -> None:
+    from support.planning_world import World
+    from support.semantics_fixtures import encoder
+
+    def play() -> list[str | None]:
+        p, w = make_planner("voi", encoder=encoder()), World(1)
+        p.reset(w.query, seed=1)
+        out: list[str | None] = []
+        for _ in range(60):
+            a = p.decide(w.graph())
+            out.append(a.target)
+            if a.skill == "done":
+                break
+            p.feedback(w.execute(a))
+        return out
+
+    first = play()
+    assert first[-1] is not None and len(first) < 60
+    assert first == play()
