@@ -74,14 +74,10 @@ def folder_houses(folder: Path) -> list[Path]:
     return sorted(p for p in folder.iterdir() if p.name.lower().endswith(".json"))
 
 
-def house_paths(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
-    """Files as given, folders as their house files (:func:`folder_houses`); a path that is
-    neither is kept, so that loading it reports it."""
-    return [f for f, _ in _house_sources(paths)]
-
-
 def _house_sources(paths: Iterable[str | os.PathLike[str]]) -> list[tuple[Path, Path | None]]:
-    """:func:`house_paths`, each with the folder it was found in (None: given as a file)."""
+    """Files as given, folders as their house files (:func:`folder_houses`), each with the
+    folder it was found in (None: given as a file); a path that is neither is kept, so that
+    loading it reports it."""
     out: list[tuple[Path, Path | None]] = []
     for p in map(Path, paths):
         out.extend([(f, p) for f in folder_houses(p)] if p.is_dir() else [(p, None)])

@@ -61,7 +61,6 @@ from sgtool.analysis.search_metrics import CostModel, cost_models, summarize
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write
-from sgtool.log.records import Action
 from sgtool.log.writer import partial_files
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, run_episode
 from sgtool.recorders.sim.fallback_explore import is_fallback
@@ -198,10 +197,6 @@ def _house(task: RunTask) -> tuple[Any, list[Any]]:
             del _DRAWS[next(iter(_DRAWS))]  # cycling through the run's houses
         _DRAWS[key] = (spec, bench_episodes(spec, task.episodes, mix))
     return _DRAWS[key]
-
-
-def _episodes(task: RunTask) -> list[Any]:
-    return _house(task)[1]
 
 
 def task_options(task: RunTask) -> ClosedLoopOptions:
@@ -453,15 +448,6 @@ def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]
     paths.append(atomic_write(out / "summary.json", json.dumps(
         strict_json(res.summary()), indent=1, sort_keys=True, allow_nan=False) + "\n"))
     return paths
-
-
-def failed_skills(path: str | Path) -> Counter[str]:
-    """Failed skills of one closed-loop log by reason class (for scripts)."""
-    from sgtool.log.reader import LogReader
-
-    with LogReader(Path(path)) as r:
-        return Counter(reason_class(a.reason or "") for _, a in r.records(Action)
-                       if a.outcome == "failure")
 
 
 def load_symbolic(path: str | Path) -> tuple[EpisodeResult, ...]:

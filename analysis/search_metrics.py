@@ -187,14 +187,6 @@ def curve_of(results: Sequence[EpisodeResult], model: CostModel
                             model.max_cost)
 
 
-def sr_at(xs: np.ndarray, ys: np.ndarray, budgets: Sequence[float]) -> np.ndarray:
-    """The curve's value at each budget (linear between vertices, as the trapezoids are)."""
-    # vertical runs (equal x) must take their highest y: interpolate on the last vertex
-    # of each run of equal x
-    keep = np.append(xs[1:] != xs[:-1], True)
-    return np.interp(np.asarray(budgets, float), xs[keep], ys[keep])
-
-
 # ----------------------------------------------------------------------------------------
 # aggregation over seeds
 # ----------------------------------------------------------------------------------------

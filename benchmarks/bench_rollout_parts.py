@@ -9,7 +9,7 @@ For each house (``house-<i>``, the bench's preset, rooms and episode mix) it tim
 house preparation once (generation, the symbolic house, the episode list: CPU seconds),
 then rolls out the bench's 20 episodes x 3 seeds ``--repeats`` times, each from an empty
 priors memo as a bench task does. Every call of ``observe``, ``decide`` (and within it
-``actionable`` and ``candidate_utilities``) and ``execute`` is timed; a call's time is its
+``actionable`` and ``column_utilities``) and ``execute`` is timed; a call's time is its
 minimum over the repeats (the same call, deterministic, so the minimum is the time it
 takes when nothing else runs), and the table sums them. The first repeat of the first
 house warms the process and is left out. ``--against CHECKOUT`` first runs the same in

@@ -28,7 +28,7 @@ from harness import REPO, support
 
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.recorders.importers.bag import BagOptions, import_bag
-from sgtool.recorders.importers.images import depth_to_metres, read_color_file, read_depth_file
+from sgtool.recorders.importers.images import depth_to_metres, read_color_file_kind, read_depth_file
 from sgtool.recorders.importers.layouts import read_sequence
 from sgtool.recorders.importers.odometry import METHODS, drift_against, estimate_trajectory
 from sgtool.recorders.importers.rgbd import RgbdOptions, camera_for, import_rgbd
@@ -84,7 +84,7 @@ def odometry(data: Path, quick: bool) -> None:
         frames = list(seq.frames[: 20 if quick else None])
         first = read_depth_file(frames[0].depth_path)
         k: CameraIntrinsics = camera_for(seq, RgbdOptions(), first.shape[1], first.shape[0])
-        loaded = [(read_color_file(f.color_path), depth_to_metres(
+        loaded = [(read_color_file_kind(f.color_path)[0], depth_to_metres(
             read_depth_file(f.depth_path), seq.depth_scale)) for f in frames]
         truth = [f.pose for f in frames]
         for method in METHODS:

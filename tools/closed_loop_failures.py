@@ -10,7 +10,16 @@ import collections
 import sys
 from pathlib import Path
 
-from sgtool.analysis.closed_loop_bench import failed_skills
+from sgtool.analysis.closed_loop_bench import reason_class
+from sgtool.log.reader import LogReader
+from sgtool.log.records import Action
+
+
+def failed_skills(path: Path) -> collections.Counter[str]:
+    """Failed skills of one closed-loop log by reason class."""
+    with LogReader(path) as r:
+        return collections.Counter(reason_class(a.reason) for _, a in r.records(Action)
+                                   if a.outcome == "failure")
 
 
 def main(argv: list[str]) -> int:

@@ -46,15 +46,10 @@ def _jpeg_truncated(path: Path) -> bool:
     return not tail.endswith(b"\xff\xd9")
 
 
-def read_color_file(path: Path) -> np.ndarray:
-    """An 8-bit colour (or grey) image file -> (H, W, 3) uint8 RGB; a truncated JPEG is a
-    user error."""
-    return read_color_file_kind(path)[0]
-
-
 def read_color_file_kind(path: Path) -> tuple[np.ndarray, str]:
-    """:func:`read_color_file` and the file's pixel kind (:func:`pixel_kind`, before the
-    conversion to 8-bit RGB)."""
+    """A colour (or grey) image file as (H, W, 3) uint8 RGB, and the file's pixel kind
+    (:func:`pixel_kind`, before the conversion to 8-bit RGB); a truncated JPEG is a user
+    error."""
     if Path(path).is_file() and _jpeg_truncated(Path(path)):
         raise SgtoolError(f"{path}: truncated JPEG (no end-of-image marker): the file is cut "
                           "off or damaged")

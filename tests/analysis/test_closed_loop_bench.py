@@ -19,6 +19,11 @@ ARGS = ["run-bench", "--planners", "random,greedy", "--houses", "0", "--episodes
         "--resolution", "64x48", "--max-steps", "2", "--frames", "120", "--no-progress"]
 
 
+def _episodes(task: clb.RunTask) -> list:
+    """The episode list a worker draws for the task's house (the worker's memo)."""
+    return clb._house(task)[1]
+
+
 @pytest.fixture(scope="module")
 def house_file(tmp_path_factory) -> Path:
     p = tmp_path_factory.mktemp("houses") / "small.json"
@@ -175,7 +180,7 @@ def test_episodes_are_the_symbolic_benchs() -> None:
     tasks = clb.tasks_of(cfg, Path("logs"))
     spec = tasks[0].house.load(cfg.rooms, cfg.preset)
     want = [(e.id, e.query) for e in bench_episodes(spec, 3, "symsearch")]
-    assert [(clb._episodes(t)[t.episode].id, clb._episodes(t)[t.episode].query)
+    assert [(_episodes(t)[t.episode].id, _episodes(t)[t.episode].query)
             for t in tasks] == want
     (first,) = bench_episodes(spec, 1, "symsearch")
     # why the draw size matters (house-0, 4-6 rooms): ep_0 is another episode
@@ -245,5 +250,5 @@ def test_a_worker_builds_each_house_once_when_tasks_cycle_through_houses(monkeyp
     monkeypatch.setattr(clb, "bench_episodes", lambda spec, n, mix: ["ep"] * n)
     monkeypatch.setattr(clb, "_DRAWS", {})
     for t in tasks:  # episode 0 of both houses, then episode 1 of both
-        assert clb._episodes(t) == ["ep", "ep"]
+        assert _episodes(t) == ["ep", "ep"]
     assert built == ["house-0", "house-1"]

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 import pytest
 
 from sgtool.analysis.search_metrics import (
@@ -21,7 +20,6 @@ from sgtool.analysis.search_metrics import (
     mean_steps,
     seen_unseen,
     spl,
-    sr_at,
     success_rate,
     summarize,
 )
@@ -75,13 +73,6 @@ def test_auc_e_bounds_and_ties():
     # ties: two solved at 25 of 2 episodes -> y jumps 0 -> 1 at x = 25 (after a ramp from
     # (0,0)); area = 25 * 0.25 (ramp to the first vertex at y=0.5) + 0 + 25 * 1 = 31.25
     assert auc_e([25, 25], [True, True], 50) == pytest.approx(31.25 / 50)
-
-
-def test_sr_at_reads_the_curve():
-    xs, ys = efficiency_curve([10, 20, 30, 60], [True, True, False, True], 50)
-    np.testing.assert_allclose(sr_at(xs, ys, [0, 10, 15, 20, 50]), [0, 0.25, 0.375, 0.5, 0.5])
-    xs, ys = efficiency_curve([0, 0], [True, True], 50)
-    assert sr_at(xs, ys, [0])[0] == 1.0  # vertical run at x = 0 takes its top
 
 
 def test_distance_cost_is_momallm_low_level():

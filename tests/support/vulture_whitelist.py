@@ -5,9 +5,10 @@ vulture matches by name only (``_.name`` marks any attribute, function or variab
 
 - dynamic: reached by a framework (click, pytest, the module protocol, a C library's
   config object) or read by name;
-- contract: a field of a result dataclass or a public method that callers may read;
-- reached only from tests, benchmarks or tools: kept in the package for now, listed in the
-  dead-code report of issue 33 as candidates to move to tests/support or delete.
+- contract: a field of a result dataclass, or a public API or library function a user
+  may call although nothing in the package does;
+- reached only from tests or benchmarks, in files another engineer was changing when the
+  rest moved to tests/support: still to move to tests/support or delete.
 """
 # ruff: noqa: B018, F821
 
@@ -89,22 +90,15 @@ _.voxels_of  # toolkit/mapping/voxels.py: VoxelMap method
 _.RECORD_NAMES  # toolkit/vocabulary.py: vocabulary table (tests/toolkit/test_vocabulary.py)
 _.LOGGED_SKILLS  # toolkit/vocabulary.py: vocabulary table
 _.CASES  # replayers/golden.py: the golden cases (tests/golden/regenerate.py)
+_.replay_graphs  # replayers/golden.py: public API (sgtool.replay_graphs)
 
-# ----- reached only from tests, benchmarks or tools (candidates to move or delete) --------
-_.house_paths  # analysis/bench_houses.py: tests only
-_._episodes  # analysis/closed_loop_bench.py: tests only
-_.failed_skills  # analysis/closed_loop_bench.py: tools/closed_loop_failures.py only
-_.sr_at  # analysis/search_metrics.py: tests only
-_.read_color_file  # recorders/importers/images.py: tests, benchmarks/import_.py
-_.replay_graphs  # replayers/golden.py: tests/test_install.py only
+# ----- reached only from tests or benchmarks: still to move (see the module doc) -------------
 _.occupancy_from_keys  # toolkit/mapping/bev.py: tests only
 _.near_depth  # toolkit/mapping/free_space.py: tests only
 _.fill_holes  # toolkit/mapping/holes.py: tests only
 _.shortest_path_length  # toolkit/mapping/occupancy.py: tests only
 _.path_length  # toolkit/mapping/occupancy.py: tests only
 _.ridge_cells  # toolkit/mapping/voronoi.py: tests only
-_.sequence_value  # toolkit/planning/search_theory.py: tests only
-_.candidate_utilities  # toolkit/planning/utility.py: tests, benchmarks/bench_rollout_parts.py
 _.reachable_free  # toolkit/scenegraph/frontiers.py: tests/support/frontier_reference.py only
 _.frontier_cells  # toolkit/scenegraph/frontiers.py: tests only
 _.outside_footprint  # toolkit/scenegraph/frontiers.py: tests only

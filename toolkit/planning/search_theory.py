@@ -110,17 +110,6 @@ def detour_factor(cands: Sequence[Candidate], robot: tuple[float, float]) -> flo
     return float(np.clip(np.median(ratios), 1.0, 3.0)) if ratios else 1.0
 
 
-def sequence_value(order: Sequence[int], p: np.ndarray, first_cost: np.ndarray,
-                   legs: np.ndarray) -> float:
-    """V of (S2) for an ordering of candidate indices."""
-    cost = float(first_cost[order[0]])
-    left = 1.0
-    for a, b in itertools.pairwise(order):
-        left -= float(p[a])
-        cost += max(left, 0.0) * float(legs[a, b])
-    return float(sum(p[i] for i in order)) / cost
-
-
 def best_first(cands: Sequence[Candidate], p: np.ndarray, robot: tuple[float, float],
                params: SearchParams, steps_left: int | None = None) -> tuple[int, float]:
     """Index of the candidate to check first and the value of its ordering (module doc)."""
@@ -155,8 +144,10 @@ def _orderings(n: int, h: int) -> np.ndarray:
 
 def sequence_values(orders: np.ndarray, p: np.ndarray, first_cost: np.ndarray,
                     legs: np.ndarray) -> np.ndarray:
-    """:func:`sequence_value` of every row of ``orders`` (candidate indices), with the same
-    floating-point operations in the same order, so equal to it bit for bit."""
+    """V of (S2) for every row of ``orders`` (candidate indices): ``p`` per candidate,
+    ``first_cost`` the cost of reaching each first, ``legs[a, b]`` the leg from a to b. The
+    legs are summed left to right, so a row's value is the same bit for bit as one
+    ordering's loop."""
     pp = p[orders]
     cost = first_cost[orders[:, 0]].astype(np.float64)
     left = np.ones(len(orders))

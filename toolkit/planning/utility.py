@@ -28,7 +28,6 @@ from typing import TypedDict, TypeVar, Unpack
 
 import numpy as np
 
-from sgtool.planning.candidates import Candidate
 from sgtool.scenegraph.graph import ObjectNode, SceneGraph
 from sgtool.semantics.priors import RelationScorer, can_score_room
 
@@ -218,7 +217,7 @@ def object_table(graph: SceneGraph) -> ObjectTable:
 
 
 class EpisodeCache:
-    """What :func:`candidate_utilities` may reuse between the decisions of one episode: the
+    """What :func:`column_utilities` may reuse between the decisions of one episode: the
     room utilities of the last rooms tuple and the object table of the last objects tuple
     (:meth:`ObjectTable.same_rows`: reused, with its scores, when only states changed).
 
@@ -304,21 +303,6 @@ def object_utilities(graph: SceneGraph, query: str, scorer: RelationScorer,
     return dict(zip(table.ids, u.tolist(), strict=True))
 
 
-def candidate_utilities(
-    graph: SceneGraph,
-    candidates: Sequence[Candidate],
-    query: str,
-    scorer: RelationScorer,
-    params: UtilityParams,
-    cache: EpisodeCache | None = None,
-) -> list[float]:
-    """u_q(n) for each candidate, in order (module doc for each node type). ``cache``: an
-    :class:`EpisodeCache` kept for the decisions of one episode."""
-    return column_utilities(graph, [c.node_id for c in candidates],
-                            [c.kind for c in candidates], [c.position for c in candidates],
-                            query, scorer, params, cache)
-
-
 def column_utilities(
     graph: SceneGraph,
     ids: Sequence[str],
@@ -329,8 +313,10 @@ def column_utilities(
     params: UtilityParams,
     cache: EpisodeCache | None = None,
 ) -> list[float]:
-    """:func:`candidate_utilities` of candidates given as columns (their ids, kinds and
-    positions: :class:`~sgtool.planning.candidates.CandidateColumns`)."""
+    """u_q(n) for each candidate, in order (module doc for each node type), the candidates
+    given as columns (their ids, kinds and positions:
+    :class:`~sgtool.planning.candidates.CandidateColumns`). ``cache``: an
+    :class:`EpisodeCache` kept for the decisions of one episode."""
     if cache is None:
         rooms = room_utilities(graph, query, scorer, params)
         table = object_table(graph)

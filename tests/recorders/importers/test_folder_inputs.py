@@ -16,7 +16,7 @@ from sgtool.cli import cli
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.recorders.importers.checks import check_floor, seconds_option_ns
-from sgtool.recorders.importers.images import read_color_file, resize_to
+from sgtool.recorders.importers.images import read_color_file_kind, resize_to
 from sgtool.recorders.importers.layouts import FolderSequence, natural_key, read_sequence
 from sgtool.recorders.importers.odometry import FailedStep, OdometryResult
 from sgtool.recorders.importers.provenance import FLOOR_ORIGINS, Findings
@@ -308,10 +308,10 @@ def test_colour_of_another_aspect_ratio_is_refused():
 def test_a_truncated_jpeg_is_named(tmp_path):
     p = tmp_path / "c.jpg"
     cv2.imwrite(str(p), np.random.default_rng(0).integers(0, 255, (48, 64, 3), np.uint8))
-    assert read_color_file(p).shape == (48, 64, 3)
+    assert read_color_file_kind(p)[0].shape == (48, 64, 3)
     p.write_bytes(p.read_bytes()[:-200])
     with pytest.raises(SgtoolError, match="c.jpg: truncated JPEG"):
-        read_color_file(p)
+        read_color_file_kind(p)
 
 
 @pytest.mark.parametrize("value", [1e300, 1e-300, 0.5])

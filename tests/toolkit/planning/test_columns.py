@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 import pytest
+from support.candidate_utilities import candidate_utilities
 from support.planning_walk import SCORER, plain_actionable, step
 from support.semantics_fixtures import house
 
@@ -23,7 +24,7 @@ from sgtool.planning.candidates import (
 )
 from sgtool.planning.memory import EpisodeMemory
 from sgtool.planning.planners import GreedyPlanner, RandomPlanner, UtilityPlanner
-from sgtool.planning.utility import UtilityParams, candidate_utilities, select_with_margin
+from sgtool.planning.utility import UtilityParams, select_with_margin
 from sgtool.scenegraph.graph import SceneGraph
 
 

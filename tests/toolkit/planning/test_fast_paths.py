@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 import pytest
+from support.candidate_utilities import candidate_utilities
 from support.semantics_fixtures import TableScorer, house
 
 from sgtool.planning.base import Action, Feedback
@@ -19,7 +20,6 @@ from sgtool.planning.planners import UtilityPlanner
 from sgtool.planning.utility import (
     ObjectTable,
     UtilityParams,
-    candidate_utilities,
     object_table,
     objects_within,
     room_utilities,
@@ -35,7 +35,7 @@ SCORER = TableScorer(
 
 def plain_utilities(graph: SceneGraph, cands: list[Candidate], query: str,
                     params: UtilityParams) -> list[float]:
-    """The per-node code the vectorised :func:`candidate_utilities` replaced."""
+    """The per-node code the vectorised utilities (:func:`column_utilities`) replaced."""
     rooms = room_utilities(graph, query, SCORER, params)
     raw = SCORER.objects([o.category for o in graph.objects], query)
     objects = {}

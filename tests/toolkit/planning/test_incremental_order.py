@@ -2,7 +2,7 @@
 :func:`actionable`'s order kept per node tuple and updated when the tuple changes (nodes
 replaced, added, removed; equal natural keys; key ranges of the groups that meet), and the
 utilities of :class:`EpisodeCache` (room utilities per rooms tuple, the object table reused
-over state changes) against :func:`candidate_utilities` without it, on seeded random walks
+over state changes) against the utilities without it, on seeded random walks
 of a graph."""
 
 from __future__ import annotations
@@ -11,11 +11,12 @@ import dataclasses
 
 import numpy as np
 import pytest
+from support.candidate_utilities import candidate_utilities
 from support.planning_walk import SCORER, as_tuples, plain_actionable, step
 from support.semantics_fixtures import house
 
 from sgtool.planning.candidates import actionable, natural_key
-from sgtool.planning.utility import EpisodeCache, UtilityParams, candidate_utilities
+from sgtool.planning.utility import EpisodeCache, UtilityParams
 from sgtool.scenegraph.graph import ObjectNode
 
 

@@ -219,7 +219,9 @@ def _best_by_loop(cands: list[Candidate], p: np.ndarray, params: SearchParams,
     """best_first's look-ahead written as one sequence_value call per ordering."""
     import itertools
 
-    from sgtool.planning.search_theory import detour_factor, extra_cost, sequence_value
+    from support.search_reference import sequence_value
+
+    from sgtool.planning.search_theory import detour_factor, extra_cost
 
     extra = np.array([extra_cost(c, params) for c in cands])
     first = np.array([c.distance for c in cands]) + extra

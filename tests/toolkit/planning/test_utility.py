@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 
 import pytest
+from support.candidate_utilities import candidate_utilities
 from support.semantics_fixtures import TableScorer, house
 
 from sgtool.planning.base import Feedback
@@ -12,7 +13,6 @@ from sgtool.planning.candidates import actionable
 from sgtool.planning.planners import UtilityPlanner
 from sgtool.planning.utility import (
     UtilityParams,
-    candidate_utilities,
     frontier_utility,
     room_influence,
     room_utilities,
