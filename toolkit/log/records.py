@@ -17,8 +17,11 @@ and no spaces), ``from_json(d)`` reads one back; ``from_json(r.to_json()) == r``
 ``from_json(d).to_json() == d`` for every valid ``d``. JSON distinguishes a field that is
 absent from one that is null, and so do the records: a field not given is :data:`ABSENT`
 and is left out of ``to_json()``; ``None`` is written as null (the Action field
-``graph_time_ns`` means different things absent and null). Keys a record type does not
-know (a newer minor schema version) are kept in ``unknown`` and written back.
+``graph_time_ns`` means different things absent and null). The exception are the fields a
+planner fills in an :class:`Action` (it is also what planners return): they have plain
+defaults, and a record read without one remembers that in ``absent`` instead. Keys a
+record type does not know (a newer minor schema version) are kept in ``unknown`` and
+written back.
 
 **Checked.** Both directions check the JSON form against the record's JSON schema, the
 one registered with the channel (:mod:`sgtool.log.schemas`; an LlmExchange also has the
