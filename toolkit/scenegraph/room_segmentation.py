@@ -78,9 +78,14 @@ def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
     how much the surroundings look like a doorway seen from the hinge: wall running away
     on one side (share of occupied cells 0.1-0.45 panel widths along it), a clear opening
     on the other (share of occupied cells along the panel's closed position, which must be
-    low) and the far jamb just beyond it. The best hinge and side must score well and
-    clearly beat every alternative; otherwise None (the caller then uses the panel's own
-    cells), as for cells that are not one panel at least ``min_width`` cells long."""
+    low) and the far jamb just beyond it; the score is wall + jamb - 2 opening. The best
+    hinge and side must score well and clearly beat every alternative. When none does (a
+    free end whose far-jamb ray hits furniture can come close to a hinge whose opening
+    ray, for a panel smeared longer than its doorway, reaches the far wall), they are
+    scored again by the wall line alone: the lesser of the wall and jamb shares minus the
+    opening's (at least ``LINE_LEAST``, ``LINE_MARGIN`` ahead of every alternative).
+    Otherwise None (the caller then uses the panel's own cells), as for cells that are not
+    one panel at least ``min_width`` cells long."""
     if len(rows) < 2:
         return None
     # work in a window around the panel (everything looked at is within 1.3 widths)
@@ -136,30 +141,59 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray, min_width
                          (end, d, 0.15 * width, 0.85 * width, False),
                          (end, d, 1.05 * width, 1.3 * width, True)]
     shares = _shares(rays, occupied, grown)
-    scored: list[tuple[float, float, float, int, np.ndarray]] = []
-    at = 0
-    for s, out in ((s0, -a), (s1, a)):
-        for sign in (1.0, -1.0):
-            side: tuple[float, int] | None = None  # (score, offset) of the best offset
-            for off in range(4):
-                wall, opening, jamb = shares[at:at + 3]
-                at += 3
-                cand = (wall + jamb - 2.0 * opening, off)
-                if side is None or cand[0] > side[0]:
-                    side = cand
-            assert side is not None
-            scored.append((side[0], s, sign, side[1], out))
-    scored.sort(key=lambda x: -x[0])
-    best, second = scored[0], scored[1]
-    if best[0] < 1.0 or best[0] - second[0] < 0.5:
+    best = _clear_best(shares, s0, s1, a, _sum_score, 1.0, 0.5)
+    if best is None:  # ambiguous: ask for the wall line on both sides of the opening
+        best = _clear_best(shares, s0, s1, a, _line_score, LINE_LEAST, LINE_MARGIN)
+    if best is None:
         return None
-    end, d = mean + a * best[1] + best[4] * best[3], best[2] * t
+    _, s_end, sign, off, out = best
+    end, d = mean + a * s_end + out * off, sign * t
     f = np.linspace(0.0, width, int(np.ceil(2 * width)) + 1)[:, None]
     p = end[None, :] + d[None, :] * f
     c = np.round(p[:, 0]).astype(np.int64)
     r = np.round(p[:, 1]).astype(np.int64)
     ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
     return r[ok], c[ok]
+
+
+LINE_LEAST = 0.5  # the wall-line score a hinge needs (0 to 1: wall on both sides, clear)
+LINE_MARGIN = 0.25  # and its lead over every other hinge and side
+
+
+def _sum_score(wall: float, opening: float, jamb: float) -> float:
+    """Wall on one side, far jamb on the other, a clear opening between."""
+    return wall + jamb - 2.0 * opening
+
+
+def _line_score(wall: float, opening: float, jamb: float) -> float:
+    """The wall line on *both* sides of a clear opening: a panel's free end, whose far-jamb
+    ray can hit any obstacle in the room, has no wall beside it."""
+    return min(wall, jamb) - opening
+
+
+def _clear_best(shares: list[float], s0: float, s1: float, a: np.ndarray,
+                score: Callable[[float, float, float], float], least: float, margin: float
+                ) -> tuple[float, float, float, int, np.ndarray] | None:
+    """The (score, end, side sign, offset, outward axis) of the best hinge and side under
+    ``score`` of the (wall, opening, jamb) shares, when it scores at least ``least`` and
+    beats every other hinge and side by ``margin``; else None."""
+    scored: list[tuple[float, float, float, int, np.ndarray]] = []
+    at = 0
+    for s, out in ((s0, -a), (s1, a)):
+        for sign in (1.0, -1.0):
+            side: tuple[float, int] | None = None  # (score, offset) of the best offset
+            for off in range(4):
+                cand = (score(*shares[at:at + 3]), off)
+                at += 3
+                if side is None or cand[0] > side[0]:
+                    side = cand
+            assert side is not None
+            scored.append((side[0], s, sign, side[1], out))
+    scored.sort(key=lambda x: -x[0])
+    best, second = scored[0], scored[1]
+    if best[0] < least or best[0] - second[0] < margin:
+        return None
+    return best
 
 
 def _shares(rays: list[tuple[np.ndarray, np.ndarray, float, float, bool]],

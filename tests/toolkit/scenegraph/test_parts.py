@@ -94,6 +94,27 @@ def test_swung_panel_gives_its_doorway() -> None:
     assert opening_from_panel(rows[:4], cols[:4], occupied, min_width=8) is None
 
 
+
+def test_smeared_panel_beside_a_cupboard_still_gives_its_doorway() -> None:
+    """Depth noise smears the wall to 7 cells and the panel to 26 cells (doorway 18), its
+    hinge end inside the wall: the opening ray from the hinge reaches the far wall (share
+    0.27, sum score 1.46); a cupboard where the far-jamb ray of the free end looks scores
+    that end 1.0. Within 0.5 of each other, the sum rule alone gave up (the panel's own
+    cells then cut the room); the wall line (min of wall and jamb, minus the opening: 0.73
+    against 0.0) finds the hinge."""
+    occupied = np.zeros((80, 100), dtype=bool)
+    occupied[14:21, :] = True  # the smeared wall ...
+    occupied[14:21, 40:58] = False  # ... with an 18-cell doorway
+    rows = np.arange(18, 44)  # the panel, hinged at (18, 40), swung into +row
+    cols = np.full(len(rows), 40)
+    occupied[rows, cols] = True
+    occupied[40:50, 64:76] = True  # the cupboard
+    got = opening_from_panel(rows, cols, occupied, min_width=8)
+    assert got is not None
+    r, c = got
+    assert np.all((r >= 14) & (r <= 20))  # along the wall ...
+    assert c.min() <= 41 and c.max() >= 57  # ... across the whole doorway
+
 # ----- assignment -----------------------------------------------------------------------
 def test_assignment_goes_around_the_wall_not_through_it() -> None:
     """A wall at x = 4 with a doorway at y 2.6-3.0. The object stands against the wall in
