@@ -57,6 +57,10 @@ SMOKE: dict[str, Smoke] = {
     "benchmarks/closed_loop.py": Smoke(
         ("--planners", "random", "--episodes", "1", "--house-seeds", "0", "--rooms", "4-4",
          "--resolution", "32x24", "--max-steps", "1", "--out", "{tmp}/logs"), marks=("slow",)),
+    "benchmarks/closed_loop_efficiency.py": Smoke(
+        ("--base", "{repo}", "--planners", "random", "--houses", "1", "--rooms", "4-4",
+         "--resolution", "32x24", "--option", "max_steps=1", "--json", "{tmp}/o.json"),
+        marks=("slow",)),
     "benchmarks/closed_loop_fps.py": Smoke(
         ("--base", "{repo}", "--rounds", "1", "--rooms", "4-4", "--seed", "0", "--episode",
          "0", "--frames", "10", "--resolution", "32x24"), marks=("slow",)),
@@ -92,6 +96,10 @@ SMOKE: dict[str, Smoke] = {
         marks=("slow",)),
     "benchmarks/replay.py": Smoke(
         ("--frames", "12", "--compare", "1", "--cache", "{tmp}/cache"), marks=("slow",)),
+    "benchmarks/resolution_study.py": Smoke(
+        ("--resolutions", "32x24", "--cases", "house10-start", "--planners", "random",
+         "--rooms", "4-4", "--option", "max_steps=1", "--json", "{tmp}/o.json"),
+        marks=("slow",)),
     "benchmarks/side_by_side.py": Smoke(
         ("--base", "{repo}", "--rounds", "1", "--no-compile", "--", "info", "{log}"),
         marks=("slow",)),

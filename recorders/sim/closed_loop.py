@@ -6,11 +6,14 @@ One episode (:func:`run_episode`), all of it into one MCAP log:
    an ``sgtool.Episode`` record "started" (query, planner, the camera, robot and mapping
    settings: ``extra.mapping`` is what ``sgtool replay`` rebuilds with by default) and the
    instances table;
-2. every simulator tick is a logged frame (:class:`~sgtool.recorders.sim.recording.LogRecorder`)
-   and is fed, *as the log holds it* (:func:`sgtool.log.echo.as_logged`, after the sensor
-   faults), to a :class:`~sgtool.scenegraph.stream.SceneGraphStream`, the refresh schedule
-   replay uses: a refresh every K frames, and one at every action record, each written as
-   the derived channels ``/map/occupancy``, ``/map/voronoi``, ``/map/rooms`` and
+2. every simulator tick the map needs is a logged frame (the camera moved
+   ``render_step_m`` metres or turned ``turn_render_deg`` since the last frame, a door or
+   container changed, a skill ended: :mod:`sgtool.recorders.sim.keyframes`,
+   :class:`~sgtool.recorders.sim.live_recorder.LiveRecorder`) and is fed, *as the log
+   holds it* (:func:`sgtool.log.echo.as_logged`, after the sensor faults), to a
+   :class:`~sgtool.scenegraph.stream.SceneGraphStream`, the refresh schedule replay uses:
+   a refresh every K frames, and one at every action record, each written as the derived
+   channels ``/map/occupancy``, ``/map/voronoi``, ``/map/rooms`` and
    ``/sgtool/scene_graph`` right after the message that caused it. Instance tables (a door
    or container changed state) go to the stream as they are written. Since replay feeds
    the same stream the same messages in the same order, ``sgtool replay`` of the episode
@@ -98,6 +101,7 @@ from sgtool.recorders.sim.camera import CameraConfig
 from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport
 from sgtool.recorders.sim.execution import Executed, execute_live, execute_privileged
 from sgtool.recorders.sim.fallback_explore import GAVE_UP, NO_ACTIONABLE, Fallback
+from sgtool.recorders.sim.keyframes import KeyframeRule
 from sgtool.recorders.sim.live_recorder import LiveRecorder
 from sgtool.recorders.sim.live_skills import LiveNavConfig, LiveSkills, RobotBody
 from sgtool.recorders.sim.navigation import RobotConfig
@@ -156,8 +160,15 @@ class ClosedLoopOptions:
     navigation: str = "live"
     live: LiveNavConfig = field(default_factory=LiveNavConfig)
     success: str = "observed"  # success rule (sgtool.planning.episode): observed | done
-    # a tick turning on the spot less than this from the last frame's heading is no frame
+    # which ticks are frames (:mod:`.keyframes`): a frame every this many degrees turned
+    # and metres driven since the last one (both 0: every tick)
     turn_render_deg: float = 20.0
+    render_step_m: float = 0.25
+
+    def keyframes(self) -> KeyframeRule:
+        """Which ticks are frames (a one-line :class:`~sgtool.errors.SgtoolError` when
+        out of range)."""
+        return KeyframeRule(float(self.render_step_m), math.radians(self.turn_render_deg))
 
     def mapping(self) -> ResolvedOptions:
         """The replay options this run builds with (``extra.mapping`` of the log)."""
@@ -169,8 +180,7 @@ class ClosedLoopOptions:
         if self.classifier not in CLASSIFIERS:
             raise SgtoolError(f"unknown room classifier {self.classifier!r}; one of "
                               f"{', '.join(CLASSIFIERS)}")
-        if not 0.0 <= self.turn_render_deg <= 90.0:
-            raise SgtoolError(f"turn render angle {self.turn_render_deg} deg: must be 0..90")
+        self.keyframes()
         if not 0.01 <= self.voxel_size <= 0.5:
             raise SgtoolError(f"voxel size {self.voxel_size} m: must be 0.01..0.5")
         mp = self.min_points if self.min_points is not None else default_min_points(
@@ -425,7 +435,7 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
             stream = SceneGraphStream(None, classifier, builder_config(mapping))
             rec = LiveRecorder(writer, sim, stream, noise=opts.noise, seed=opts.noise_seed,
                                 max_frames=opts.frames, planner=name, progress=progress,
-                                turn_render=math.radians(opts.turn_render_deg))
+                                keyframes=opts.keyframes())
             sim.observers.append(rec)
             base = LoggedEpisode(kind="search", status="started", source=SOURCE,
                                  house_id=hid, query=query, planner=name)
@@ -497,7 +507,8 @@ def _started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOp
         "robot": asdict(opts.robot),
         "navigation": {"mode": opts.navigation, **opts.live.to_dict()},
         "noise": opts.noise.to_dict(), "noise_seed": opts.noise_seed,
-        "turn_render_deg": opts.turn_render_deg, **_rule(opts),
+        "turn_render_deg": opts.turn_render_deg, "render_step_m": opts.render_step_m,
+        **_rule(opts),
     }
 
 

@@ -5,20 +5,25 @@
 (after the sensor faults), and every instance table go to a
 :class:`~sgtool.scenegraph.stream.SceneGraphStream` in the order they are written, an
 action record refreshes the stream as replay does, and each refresh is written as the
-derived channels right after the message that caused it. A tick that only turns the
-robot on the spot by less than ``turn_render`` radians since the last frame is no frame
-(not rendered, logged or mapped: the views of a turn overlap), so the clock ticks on but
-the log, the map and the frame count skip it.
+derived channels right after the message that caused it.
+
+Only the ticks the map needs are frames (:class:`~sgtool.recorders.sim.keyframes.KeyframeRule`:
+the camera moved or turned enough since the last frame, or a door or container changed);
+the others are not rendered, logged or mapped, so the clock ticks on but the log, the map
+and the frame count skip them. When a skill ends on a tick that was no frame, that pose is
+rendered before the action is logged (:meth:`LiveRecorder.act`, at that tick's time,
+within the frame budget), so the refresh at the action sees where the robot stands.
 """
 
 from __future__ import annotations
 
-import math
+import dataclasses
 from collections.abc import Mapping
 from typing import Any
 
 from sgtool.log.echo import as_logged
 from sgtool.log.writer import LogWriter
+from sgtool.recorders.sim.keyframes import KeyframeRule
 from sgtool.recorders.sim.recording import LogRecorder
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome
 from sgtool.scenegraph.derived_layers import write_refresh
@@ -30,45 +35,60 @@ class LiveRecorder(LogRecorder):
     order it writes it, and writes the stream's refreshes."""
 
     def __init__(self, writer: LogWriter, sim: Simulation, stream: SceneGraphStream,
-                 turn_render: float = 0.0, **kw: Any) -> None:
+                 keyframes: KeyframeRule | None = None, **kw: Any) -> None:
         super().__init__(writer, sim, log_actions=False, **kw)
         self.stream = stream
         self.refreshes = 0
         self.last_refresh: Refresh | None = None
-        # a tick that only turns the base less than this (radians) from the last frame's
-        # heading is not rendered, logged nor mapped (0: every tick is a frame)
-        self.turn_render = float(turn_render)
+        # which ticks are frames (None: every tick)
+        self.keyframes = keyframes or KeyframeRule(0.0, 0.0)
         self.skipped = 0  # ticks not rendered
         self._rendered: tuple[float, float, float] | None = None  # base at the last frame
+        self._changed = False  # a door or container changed since the last frame
+        self._pending: int | None = None  # the last tick, when it was no frame
 
     def write_instances(self, sim: Simulation) -> None:
         super().write_instances(sim)
         assert self.last_instances is not None
         self.stream.instances(sim.time_ns(), self.last_instances)
 
+    def on_state(self, sim: Simulation, spec_id: str, state: str) -> None:
+        super().on_state(sim, spec_id, state)
+        self._changed = True
+
     def on_tick(self, sim: Simulation) -> None:
-        if self._turn_only(sim.base):
+        if not self.keyframes.is_frame(self._rendered, sim.base, self._changed):
             self.skipped += 1
+            self._pending = sim.tick_index
             return
         super().on_tick(sim)
+        self._framed(sim)
+
+    def _framed(self, sim: Simulation) -> None:
+        """Bookkeeping after a frame was written: feed it to the stream."""
         self._rendered = sim.base
+        self._changed = False
+        self._pending = None
         assert self.last_frame is not None
         self.refreshed(self.stream.frame(as_logged(self.last_frame)))
 
-    def _turn_only(self, base: tuple[float, float, float]) -> bool:
-        """Whether a tick at ``base`` only turned the robot on the spot by less than
-        :attr:`turn_render` since the last frame (so it is not a frame)."""
-        last = self._rendered
-        if self.turn_render <= 0 or last is None:
-            return False
-        if abs(base[0] - last[0]) > 1e-9 or abs(base[1] - last[1]) > 1e-9:
-            return False
-        turned = abs(math.atan2(math.sin(base[2] - last[2]), math.cos(base[2] - last[2])))
-        return turned < self.turn_render - 1e-9
+    def flush(self, sim: Simulation) -> None:
+        """Render the last tick when it was no frame and nothing ticked since (the pose a
+        skill ended at), at that tick's time; nothing when the frame budget is spent or
+        the robot stands as at the last frame."""
+        k = self._pending
+        if k is None or k != sim.tick_index - 1 or self.budget_spent \
+                or (sim.base == self._rendered and not self._changed):
+            return
+        self.skipped -= 1
+        self.record_frame(dataclasses.replace(sim.render(), index=k, time_ns=sim.time_ns(k)))
+        self._framed(sim)
 
     def act(self, sim: Simulation, outcome: SkillOutcome, decision_time_s: float,
             fields: Mapping[str, Any]) -> int:
-        """Log an action and refresh on it (as replay does at every action record)."""
+        """Log an action and refresh on it (as replay does at every action record); the
+        pose the skill ended at is rendered first when it was no frame (:meth:`flush`)."""
+        self.flush(sim)
         t = self.log_action(sim, outcome, decision_time_s=decision_time_s, fields=fields)
         self.refreshed(self.stream.action(t))
         return t

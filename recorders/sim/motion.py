@@ -14,6 +14,7 @@ the headings a look-around needs on the robot's own map.
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Sequence
 
@@ -27,7 +28,7 @@ def _along(pts: list[tuple[float, float]], cum: list[float], s: float) -> tuple[
     """The point ``s`` metres along the polyline ``pts`` (cumulative lengths ``cum``)."""
     if s >= cum[-1]:
         return pts[-1]
-    k = max(i for i in range(len(cum)) if cum[i] <= s)
+    k = bisect.bisect_right(cum, s) - 1  # the last i with cum[i] <= s
     seg = cum[k + 1] - cum[k]
     t = 0.0 if seg <= 0 else (s - cum[k]) / seg
     a, b = pts[k], pts[k + 1]
@@ -55,7 +56,7 @@ def drive_while_turning(pose: Pose2, waypoints: Sequence[Sequence[float]], step:
         while True:  # each frame advances, or turns toward the segment (then advances)
             if total - s < 1e-9:
                 break
-            k = max(i for i in range(len(cum) - 1) if cum[i] <= s + 1e-12)
+            k = min(bisect.bisect_right(cum, s + 1e-12), len(cum) - 1) - 1
             seg_dir = math.atan2(pts[k + 1][1] - pts[k][1], pts[k + 1][0] - pts[k][0])
             ax, ay = _along(pts, cum, min(s + lookahead, total))
             want = math.atan2(ay - y, ax - x) if math.hypot(ax - x, ay - y) > 1e-9 \

@@ -14,8 +14,10 @@ most ``speed / fps`` metres and ``turn_speed / fps`` radians per frame.
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -64,9 +66,7 @@ def occupancy_with(spec: HouseSpec, door_states: Mapping[str, str], extra: Seque
     """The house's occupancy with doors in ``door_states`` (spec id -> open/closed) and the
     ``extra`` footprints (open panels) marked occupied; ``doors_passable`` treats closed
     doors as free (for "would it be reachable if the doors were open")."""
-    doors = tuple(replace(d, state=door_states.get(d.id, d.state)) for d in spec.doors)
-    base = house_occupancy(replace(spec, doors=doors), robot.resolution, robot.radius,
-                           closed_doors_free=doors_passable)
+    base = _house_map(spec, door_states, robot, doors_passable)
     if not extra:
         return base
     occ = base.occupied.copy()
@@ -74,6 +74,36 @@ def occupancy_with(spec: HouseSpec, door_states: Mapping[str, str], extra: Seque
         fill_box_grown(base, occ, (x, y), (sx, sy), yaw)
     return OccupancyMap.of_occupied(occ, base.origin, base.resolution, robot.radius,
                                     doors_passable)
+
+
+# the house maps of the last few specs, by door states and robot (house_occupancy is the
+# costly part of occupancy_with, asked again at every opening and every new panel layout)
+_SPECS_KEPT = 4
+_HOUSE_MAPS: dict[int, tuple[weakref.ref[HouseSpec], dict[tuple[Any, ...], OccupancyMap]]] = {}
+
+
+def _house_map(spec: HouseSpec, door_states: Mapping[str, str], robot: RobotConfig,
+               doors_passable: bool) -> OccupancyMap:
+    """:func:`house_occupancy` of ``spec`` with the doors in ``door_states``, kept per
+    spec (compared by identity: a spec is frozen) for the next call with the same states."""
+    states = tuple(door_states.get(d.id, d.state) for d in spec.doors)
+    key = (states, robot.resolution, robot.radius, doors_passable)
+    entry = _HOUSE_MAPS.get(id(spec))
+    if entry is None or entry[0]() is not spec:
+        if len(_HOUSE_MAPS) >= _SPECS_KEPT:
+            del _HOUSE_MAPS[next(iter(_HOUSE_MAPS))]
+        entry = (weakref.ref(spec), {})
+        _HOUSE_MAPS[id(spec)] = entry
+    maps = entry[1]
+    occ = maps.get(key)
+    if occ is None:
+        doors = tuple(replace(d, state=s) for d, s in zip(spec.doors, states, strict=True))
+        occ = house_occupancy(replace(spec, doors=doors), robot.resolution, robot.radius,
+                              closed_doors_free=doors_passable)
+        if len(maps) > 64:
+            maps.clear()
+        maps[key] = occ
+    return occ
 
 
 def box_distance_grid(grid: OccupancyMap, box: Box2) -> np.ndarray:
@@ -173,6 +203,35 @@ def line_is_free(grid: OccupancyMap, a: Sequence[float], b: Sequence[float]) -> 
     return not grid.blocked[row, col].any()
 
 
+def lines_are_free(grid: OccupancyMap, a: Sequence[float],
+                   ends: Sequence[Sequence[float]]) -> np.ndarray:
+    """:func:`line_is_free` of the segments from ``a`` to each of ``ends`` (bool per end),
+    in one pass over all their samples: the same samples, so the same answers."""
+    counts = [max(2, int(math.ceil(math.dist(a, b) / (grid.resolution / 4))) + 1)
+              for b in ends]
+    n = np.asarray(counts, dtype=np.int64)
+    starts = np.concatenate(([0], np.cumsum(n)[:-1]))
+    seg = np.repeat(np.arange(len(counts)), n)
+    idx = np.arange(int(n.sum()), dtype=np.int64) - np.repeat(starts, n)
+    # np.linspace(0, 1, n): arange(n) * (1 / (n - 1)), the last sample exactly 1
+    t = idx * np.repeat(1.0 / (n - 1), n)
+    t[starts + n - 1] = 1.0
+    e = np.asarray(ends, dtype=np.float64).reshape(-1, 2)
+    x = a[0] + (e[seg, 0] - a[0]) * t
+    y = a[1] + (e[seg, 1] - a[1]) * t
+    col = np.floor((x - grid.origin[0]) / grid.resolution + 1e-9).astype(int)
+    row = np.floor((y - grid.origin[1]) / grid.resolution + 1e-9).astype(int)
+    rows, cols = grid.shape
+    out = (row < 0) | (col < 0) | (row >= rows) | (col >= cols)
+    bad = out.copy()
+    ok = ~out
+    bad[ok] = grid.blocked[row[ok], col[ok]]
+    return ~np.logical_or.reduceat(bad, starts)
+
+
+SMOOTH_BATCH = 16  # later points tried at once by smooth_path (farthest first)
+
+
 def smooth_path(grid: OccupancyMap, pts: Sequence[tuple[float, float]]
                 ) -> list[tuple[float, float]]:
     """String pulling: from each kept point jump to the farthest later point still in
@@ -183,10 +242,13 @@ def smooth_path(grid: OccupancyMap, pts: Sequence[tuple[float, float]]
     i = 0
     while i < len(pts) - 1:
         j = i + 1
-        for k in range(len(pts) - 1, i + 1, -1):
-            if line_is_free(grid, pts[i], pts[k]):
-                j = k
-                break
+        hi = len(pts) - 1
+        while hi > i + 1 and j == i + 1:  # batches of candidates, farthest first
+            lo = max(i + 2, hi - SMOOTH_BATCH + 1)
+            free = lines_are_free(grid, pts[i], [pts[k] for k in range(hi, lo - 1, -1)])
+            if free.any():
+                j = hi - int(np.argmax(free))
+            hi = lo - 1
         out.append(pts[j])
         i = j
     return out

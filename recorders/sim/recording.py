@@ -92,9 +92,17 @@ class LogRecorder(SimObserver):
         self.writer.write_record(self.last_instances, sim.time_ns())
 
     def on_tick(self, sim: Simulation) -> None:
-        if self.max_frames is not None and self.frames >= self.max_frames:
+        if self.budget_spent:
             raise StopSimulation(f"frame budget of {self.max_frames} reached")
-        f = sim.render()
+        self.record_frame(sim.render())
+
+    @property
+    def budget_spent(self) -> bool:
+        """Whether the frame budget is spent (the next frame would exceed it)."""
+        return self.max_frames is not None and self.frames >= self.max_frames
+
+    def record_frame(self, f: Frame) -> None:
+        """Write a rendered frame (with the sensor faults applied) and count it."""
         if self.faults is not None:
             f = self.faults.apply(f)
         self.write_frame(f)

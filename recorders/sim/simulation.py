@@ -90,6 +90,8 @@ class Simulation(Skills):
         self.observers: list[SimObserver] = []
         self._depth = 0  # nesting of skills; only top-level ones are reported
         self._occ_cache: dict[tuple[Any, ...], OccupancyMap] = {}
+        self._layouts = 0  # bumped whenever a panel gets a new layout (the cache key)
+        self._contact_map: tuple[tuple[Any, ...], OccupancyMap] | None = None
         self._opening = OpeningPlanner(house, self.world, self.robot)
         for sid in sorted(self.world.panels, key=spec_id_key):  # open what the spec says is open
             if self.world.states[sid] == "open":
@@ -214,6 +216,13 @@ class Simulation(Skills):
         it (it plans on its own map, :mod:`.live_skills`)."""
         return self._truth_map(doors_passable, self.robot)
 
+    def _panel_key(self) -> tuple[Any, ...]:
+        """What the truth maps depend on besides the robot: the door states and every
+        panel's opening (its layout by :attr:`_layouts`), cheap to build per tick."""
+        return (self._layouts, tuple(self.world.states[d.id] for d in self.spec.doors),
+                tuple((b.fraction, b.removed) for bodies in self.world.panels.values()
+                      for b in bodies))
+
     def _truth_map(self, doors_passable: bool, robot: RobotConfig) -> OccupancyMap:
         panels = [b.panel.footprint(b.fraction) for bodies in self.world.panels.values()
                   for b in bodies if b.blocks]
@@ -234,8 +243,12 @@ class Simulation(Skills):
         furniture, a closed door or an open panel: the simulator's physics (ground truth,
         with one map cell of tolerance for the grid), never given to the robot."""
         x, y = (self.base if pose is None else pose)[:2]
-        tol = replace(self.robot, radius=max(self.robot.radius - self.robot.resolution, 0.0))
-        occ = self._truth_map(False, tol)
+        key = self._panel_key()
+        if self._contact_map is None or self._contact_map[0] != key:
+            tol = replace(self.robot,
+                          radius=max(self.robot.radius - self.robot.resolution, 0.0))
+            self._contact_map = (key, self._truth_map(False, tol))
+        occ = self._contact_map[1]
         r = int(math.floor((y - occ.origin[1]) / occ.resolution))
         c = int(math.floor((x - occ.origin[0]) / occ.resolution))
         return not occ.in_bounds(r, c) or bool(occ.blocked[r, c])
@@ -265,6 +278,7 @@ class Simulation(Skills):
     def _set_open(self, sid: str, fraction: float, layout: list[art.Panel] | None) -> None:
         """Put ``sid``'s panels at ``fraction`` open in ``layout`` (None: taken away, which
         happens at fraction 1; until then they stay closed)."""
+        self._layouts += 1
         for i, b in enumerate(self.world.panels[sid]):
             if layout is None:
                 if fraction >= 1.0:

@@ -99,3 +99,36 @@ def test_approach_goal_stands_square_in_front() -> None:
     assert ly > cab.size[1] / 2 and abs(lx) <= cab.size[0] / 2 - 0.15 + 1e-9
     d = art.point_box_distance(x, y, box)
     assert robot.approach[0] <= d <= robot.approach[1]
+
+
+def _string_pull_one_by_one(grid, pts):
+    """smooth_path as it was: one line_is_free per later point, farthest first."""
+    if len(pts) <= 2:
+        return list(pts)
+    out, i = [pts[0]], 0
+    while i < len(pts) - 1:
+        j = next((k for k in range(len(pts) - 1, i + 1, -1)
+                  if nav.line_is_free(grid, pts[i], pts[k])), i + 1)
+        out.append(pts[j])
+        i = j
+    return out
+
+
+def test_batched_sight_checks_equal_one_line_at_a_time() -> None:
+    """lines_are_free samples each segment as line_is_free does (the same answers), and
+    smooth_path's batches keep the farthest visible point: random grids and point sets,
+    cells off the grid and degenerate segments included."""
+    from sgtool.mapping.occupancy import OccupancyMap
+
+    rng = np.random.default_rng(0)
+    for _ in range(150):
+        occ = rng.random((40, 50)) < rng.uniform(0.0, 0.3)
+        origin = (float(rng.uniform(-2, 2)), float(rng.uniform(-2, 2)))
+        grid = OccupancyMap.of_occupied(occ, origin, 0.05, 0.0, False)
+        m = int(rng.integers(2, 60))
+        pts = [(float(x), float(y))
+               for x, y in zip(rng.uniform(-2.5, 3, m), rng.uniform(-2.5, 2.5, m), strict=True)]
+        pts.append(pts[-1])  # a zero-length segment
+        free = nav.lines_are_free(grid, pts[0], pts[1:])
+        assert list(free) == [nav.line_is_free(grid, pts[0], b) for b in pts[1:]]
+        assert nav.smooth_path(grid, pts) == _string_pull_one_by_one(grid, pts)
