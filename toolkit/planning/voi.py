@@ -122,8 +122,10 @@ class EpisodeBelief:
             ({}, [], {}, 0)
         self._rooms: tuple[RoomNode, ...] | None = None
         self._room_table: tuple[dict[str, float], float] = ({}, params.fallback_room)
-        self.follow = 1.0  # f̂ of (V3) for the last objects tuple
-        self.profile = np.ones(1)  # W̄ of (V4) for the last objects tuple
+        self._carrier_list: list[ObjectNode] = []  # the last objects tuple's carriers
+        self._carrier_c: list[float] = []  # and their C' (B8)
+        self._follow: float | None = None  # f̂ of (V3), computed when asked
+        self._profile: np.ndarray | None = None  # W̄ of (V4), computed when asked
         # id(node) -> (node, is a carrier, category text); holds the node, so the id stays
         self._nodes: dict[int, tuple[ObjectNode, bool, str]] = {}
 
@@ -200,17 +202,30 @@ class EpisodeBelief:
             keys = [(e[0].room, e[2]) for e in info if e[1]]
             n = Counter(keys)
             c = [v * n[k] ** (gamma - 1.0) for v, k in zip(c, keys, strict=True)]
-        table: dict[str, tuple[int, str, float]] = {}
         zc: dict[str, float] = {}
         for o, v in zip(carriers, c, strict=True):
             zc[o.room] = zc.get(o.room, 0.0) + v
-            table[o.id] = (_CARRIER, o.room, v)
-        for o in graph.objects:
-            table.setdefault(o.id, (_OBJECT, o.room, 0.0))
+        table = {o.id: (_OBJECT, o.room, 0.0) for o in reversed(graph.objects)}
+        table.update((o.id, (_CARRIER, o.room, v)) for o, v in zip(carriers, c, strict=True))
         mean_c = float(np.mean(c)) if c else 0.5
         self._objects, self._obj_table = graph.objects, (table, zc, mean_c, len(carriers))
-        self.follow, self.profile = expected_checks(carriers, c), share_profile(carriers, c)
+        self._carrier_list, self._carrier_c = carriers, c
+        self._follow = self._profile = None
         return self._obj_table
+
+    @property
+    def follow(self) -> float:
+        """f̂ of (V3) for the last objects tuple (1 before any)."""
+        if self._follow is None:
+            self._follow = expected_checks(self._carrier_list, self._carrier_c)
+        return self._follow
+
+    @property
+    def profile(self) -> np.ndarray:
+        """W̄ of (V4) for the last objects tuple ([1] before any)."""
+        if self._profile is None:
+            self._profile = share_profile(self._carrier_list, self._carrier_c)
+        return self._profile
 
     def _frontiers(self, graph: SceneGraph
                    ) -> tuple[dict[str, tuple[int, str]], list[str], dict[str, int], int]:
@@ -331,15 +346,19 @@ def share_profile(carriers: Sequence[ObjectNode], c: Sequence[float],
     if not groups:
         return np.ones(1)
     m = min(longest, max(len(g) for g in groups.values()))
-    out = np.zeros(m)
+    out = [0.0] * m
     for vals in groups.values():
-        w = np.sort(np.asarray(vals, dtype=np.float64))[::-1][:m]
-        cum = np.cumsum(w) / sum(vals)
-        out[: len(cum)] += cum
-        out[len(cum):] += 1.0
-    out /= len(groups)
-    out[-1] = 1.0
-    return out
+        total, cum = sum(vals), 0.0  # (the sum in graph order)
+        vals.sort(reverse=True)
+        for k in range(m):
+            if k < len(vals):
+                cum += vals[k]
+                out[k] += cum / total
+            else:
+                out[k] += 1.0
+    prof = np.asarray(out) / len(groups)
+    prof[-1] = 1.0
+    return prof
 
 
 def prefix_costs(base: np.ndarray, p: np.ndarray, nxt: np.ndarray, profile: np.ndarray,
@@ -443,7 +462,11 @@ def _detour(xy: np.ndarray, dist: np.ndarray, robot: tuple[float, float]) -> flo
     far = e > 0.5
     if not far.any():
         return 1.0
-    return float(np.clip(np.median(dist[far] / e[far]), 1.0, 3.0))
+    r = dist[far] / e[far]
+    n = len(r)
+    mid = np.partition(r, [(n - 1) // 2, n // 2])  # the median, as np.median
+    med = mid[n // 2] if n % 2 else 0.5 * (mid[n // 2 - 1] + mid[n // 2])
+    return float(np.clip(med, 1.0, 3.0))
 
 
 __all__ = ["REVEAL_KINDS", "EpisodeBelief", "VoiParams", "VoiPlanner", "voi_belief"]
