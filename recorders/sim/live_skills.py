@@ -21,6 +21,12 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   goal and the path are planned again on the newer map. A goal the map cannot reach is a
   failed skill whose reason says so; so are repeated contacts and a goal not reached
   after ``max_replans`` plans.
+- **Bumps.** Where the base touched something the map does not show is marked blocked
+  (:attr:`LiveSkills.bumps`, grown by the robot's radius like any obstacle) for the rest
+  of the episode; when those marks leave the robot less than ``sealed_m2`` of reachable
+  floor while the map without them leaves more (contacts at a door frame or a swinging
+  panel can ring the robot in), they are dropped: otherwise every goal would be
+  unreachable and the search would end there.
 - **Looking around** (:meth:`LiveSkills.look_around`) turns only toward unknown space
   near the robot on its own map (:func:`~sgtool.recorders.sim.motion.sweep`), the shorter
   way, and stops when a refresh during the turn shows no cell known that was not before.
@@ -80,17 +86,21 @@ class LiveNavConfig:
     slack: float = 0.3  # m: stands this much farther from the thing than the nearest
     max_replans: int = 60
     max_contacts: int = 3
+    sealed_m2: float = 2.0  # bump marks leaving the robot less floor than this are dropped
 
     def __post_init__(self) -> None:
         if not 0 <= self.optimistic <= 2.0:
             raise SgtoolError(f"optimistic margin {self.optimistic} m: must be 0..2")
+        if not 0.0 <= self.sealed_m2 <= 100.0:
+            raise SgtoolError(f"sealed area {self.sealed_m2} m2: must be 0..100")
         if self.max_replans < 1 or self.max_contacts < 0:
             raise SgtoolError("max re-plans must be >= 1 and max contacts >= 0")
 
     def to_dict(self) -> dict[str, Any]:
         return {"optimistic": self.optimistic, "snap": self.snap,
                 "frontier_snap": self.frontier_snap, "slack": self.slack,
-                "max_replans": self.max_replans, "max_contacts": self.max_contacts}
+                "max_replans": self.max_replans, "max_contacts": self.max_contacts,
+                "sealed_m2": self.sealed_m2}
 
 
 class RobotBody:
@@ -206,6 +216,7 @@ class LiveSkills:
         self.replans = 0  # plans made (for reports)
         self.contacts = 0
         self.bumps: list[tuple[float, float]] = []  # where the base touched something
+        self.sealed = 0  # times the bump marks were dropped because they walled it in
         # where a look-around turned toward all the unknown it could (module doc), in order
         self.looked: list[tuple[float, float]] = []
         # asked at every refresh during a skill: True ends the skill (module doc)
@@ -241,8 +252,26 @@ class LiveSkills:
             return self._planned[1]
         occ = self.live_map(refresh)
         out = None if occ is None else (occ, geodesic_distances(occ, key[2]))
+        if out is not None and self.bumps and self._sealed(out[0], out[1]):
+            # the robot's own bump marks wall it in: forget them (module doc)
+            kept = self.bumps
+            self.bumps = []
+            occ = self.live_map(refresh)
+            assert occ is not None
+            free = (occ, geodesic_distances(occ, key[2]))
+            if self._sealed(*free):
+                self.bumps = kept  # sealed without them too: they were not the cause
+            else:
+                self.sealed += 1
+                out = free
+                key = (*key[:3], 0)
         self._planned = (key, out)
         return out
+
+    def _sealed(self, occ: OccupancyMap, dist: np.ndarray) -> bool:
+        """The floor the robot can reach on ``occ`` is less than ``config.sealed_m2``."""
+        cells = int(np.count_nonzero(np.isfinite(dist)))
+        return cells * occ.resolution ** 2 < self.config.sealed_m2
 
     def select(self, goal: Goal, occ: OccupancyMap, dist: np.ndarray
                ) -> tuple[float, float] | None:
