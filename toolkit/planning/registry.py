@@ -240,8 +240,8 @@ REGISTRY: Mapping[str, Entry] = MappingProxyType({
                          fixed={"seen_type_weight": BAYES_ROOMS_SEEN_TYPE_WEIGHT,
                                 "instance_exponent": BAYES_ROOMS_INSTANCE_EXPONENT}),
     "voi": Entry(_voi, VoiOptions, "value of information: bayes-rooms' belief, each action "
-                 "valued by what it finds per cost, a reveal paying for the check it needs "
-                 "(sgtool.planning.voi)"),
+                 "valued by what it finds per cost, a reveal priced with the checks it "
+                 "needs (sgtool.planning.voi)"),
     "moma-llm": Entry(_moma, MomaOptions, "MoMa-LLM over an OpenAI-compatible chat endpoint "
                       "or a transcript"),
     "unstructured-llm": Entry(_moma, MomaOptions, "MoMa-LLM's ablation: shown the raw JSON "
