@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import gc
 import os
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -22,6 +24,32 @@ def shared_data_dir() -> Path:
     if not d.is_dir():
         pytest.skip(f"third-party data folder {d} is absent (a fresh clone has no ../shared)")
     return d
+
+
+def pytest_collection_finish(session: pytest.Session) -> None:
+    """Freeze the session's heap once the test modules are imported (:func:`gc.freeze`).
+
+    ``sgtool.heap.frozen_heap`` (every replay and bench run) starts with a full
+    :func:`gc.collect` unless the process froze its heap itself; in a test session that
+    collection walks every object the suite has imported and cached (torch, the test
+    modules, their data), hundreds of thousands, at each replay. Frozen here, the blocks do
+    nothing, as they do in a host process that froze its heap, and their outputs are the
+    same. ``tests/toolkit/test_heap.py`` tests the blocks themselves in an unfrozen heap
+    (fixture :func:`unfrozen_heap`)."""
+    gc.collect()
+    gc.freeze()
+
+
+@pytest.fixture
+def unfrozen_heap() -> Iterator[None]:
+    """The collector as in a process that froze nothing (for tests of ``sgtool.heap``);
+    the session's heap is frozen again afterwards."""
+    gc.unfreeze()
+    try:
+        yield
+    finally:
+        gc.collect()
+        gc.freeze()
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
