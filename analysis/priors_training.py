@@ -50,7 +50,9 @@ class LlmSource:
 class DistillRequest:
     """A checked `sgtool distill` training run: the weights folder to write, the training
     configuration (:class:`sgtool.semantics.distill.DistillConfig` fields) and the data
-    source (``llm`` None: the training split of the household knowledge)."""
+    source (``llm`` None: the training split of the household knowledge). ``room_blend``:
+    train on the widened room knowledge and write a held-out-fitted room blend
+    (:func:`blend_training`)."""
 
     target: Path
     seed: int = 0
@@ -60,6 +62,7 @@ class DistillRequest:
     keep: str = "last"
     threads: int = 1
     llm: LlmSource | None = None
+    room_blend: bool = False
 
 
 def weights_report(weights: Path) -> dict[str, Any]:
@@ -94,6 +97,8 @@ def train_priors(request: DistillRequest, note: Echo) -> dict[str, Any]:
                         threads=request.threads)
     eval_sets = None
     if request.llm is not None:
+        if request.room_blend:
+            raise SgtoolError("--room-blend needs --source knowledge")
         sets, room_types, fingerprint = _llm_sets(request.llm, note)
         _report_agreement(sets, training_sets(seed=request.seed), note)
     else:
@@ -101,16 +106,119 @@ def train_priors(request: DistillRequest, note: Echo) -> dict[str, Any]:
         sets = (built.containment, built.cooccurrence)
         room_types, fingerprint = built.room_types, built.split_fingerprint
         eval_sets = evaluation_sets(seed=request.seed)
+        if request.room_blend:
+            sets = (widened_containment(built.containment, room_types), built.cooccurrence)
     tmp = _stage(request.target)
     try:
         meta: dict[str, Any] = distill(tmp, cfg, sets=sets, split_fingerprint=fingerprint,
                                        room_types=room_types, progress=sys.stderr.isatty(),
                                        eval_sets=eval_sets)
-        for name in WEIGHT_FILES:
+        files: tuple[str, ...] = WEIGHT_FILES
+        if request.room_blend:
+            from sgtool.semantics.room_blend import BLEND_FILE, VECTORS_FILE, save_room_blend
+
+            blend, fit = blend_training(sets, cfg, room_types, fingerprint, meta, tmp, note)
+            save_room_blend(tmp, blend, {"fit": fit})
+            meta["room_blend"] = fit
+            files = (*WEIGHT_FILES, BLEND_FILE, VECTORS_FILE)
+        for name in files:
             os.replace(tmp / name, request.target / name)
+        if not request.room_blend:
+            from sgtool.semantics.room_blend import BLEND_FILE, VECTORS_FILE
+
+            for name in (BLEND_FILE, VECTORS_FILE):  # no stale blend
+                (request.target / name).unlink(missing_ok=True)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return meta
+
+
+BLEND_HOLDOUT = 0.2  # share of the training names held out to fit the room blend on
+
+
+def widened_containment(containment: Any, room_types: Sequence[str]) -> Any:
+    """The containment set with the room knowledge widened
+    (:mod:`sgtool.semantics.room_knowledge`): room types a house does not have folded into
+    the household type of most alike contents, then ProcTHOR's room annotations
+    (:mod:`sgtool.datasets.room_annotations`, the shipped table) added."""
+    from sgtool.datasets.room_annotations import load_levels, room_targets
+    from sgtool.semantics.room_knowledge import add_room_targets, fold_room_types
+
+    return add_room_targets(fold_room_types(containment, room_types),
+                            room_targets(load_levels()))
+
+
+def blend_training(sets: Any, cfg: Any, room_types: Sequence[str], fingerprint: str | None,
+                   meta: dict[str, Any], work: Path, note: Echo) -> tuple[Any, dict[str, Any]]:
+    """The room blend of a training and its fit report: a second model is
+    trained without :data:`BLEND_HOLDOUT` of the query names (into ``work/heldout``), the
+    blend's parameters are fitted on those names
+    (:func:`sgtool.semantics.room_blend.fit_room_blend`), and the document holds them with
+    the room table and training names of the full training (``meta``) and, under
+    ``fit``, the held-out top-1 accuracy of the learned model, the cosine and the blend."""
+    from dataclasses import replace
+
+    from sgtool.semantics.distill import distill
+    from sgtool.semantics.encoder import default_encoder
+    from sgtool.semantics.everyday_rooms import scoreable_room_types
+    from sgtool.semantics.priors import CosinePriors, LearnedPriors
+    from sgtool.semantics.room_blend import (
+        RoomBlend,
+        fit_room_blend,
+    )
+    from sgtool.semantics.room_knowledge import room_table
+
+    cont = sets[0]
+    note(f"room blend: training without {BLEND_HOLDOUT:.0%} of the names to fit on")
+    ho_cfg = replace(cfg, holdout=BLEND_HOLDOUT, epochs_cooccurrence=1)
+    ho_meta = distill(work / "heldout", ho_cfg, sets=sets, split_fingerprint=fingerprint,
+                      room_types=tuple(room_types))
+    enc = default_encoder()
+    learned = LearnedPriors(enc, work / "heldout")
+    rooms = scoreable_room_types(learned)
+    train_q = set(ho_meta["training_queries"])
+    held = heldout_names(cont, set(ho_meta["heldout_queries"]), rooms)
+    params, acc = fit_room_blend(room_table(cont.subset_queries(train_q), room_types),
+                                 sorted(train_q), held, rooms, learned.rooms, enc)
+    cosine = CosinePriors(enc)
+    fit = {"heldout_names": len(held), "rooms": list(rooms), "blend_top1": acc,
+           "learned_top1": top1(held, rooms, learned.rooms),
+           "cosine_top1": top1(held, rooms, cosine.rooms),
+           "holdout": BLEND_HOLDOUT, "seed": cfg.seed}
+    note(f"room blend: held-out top-1 learned {fit['learned_top1']:.3f}, cosine "
+         f"{fit['cosine_top1']:.3f}, blend {acc:.3f} ({len(held)} names)")
+    full = set(meta["training_queries"])
+    return RoomBlend(room_table(cont.subset_queries(full), room_types), sorted(full), params,
+                     enc), fit
+
+
+def heldout_names(containment: Any, held: set[str], rooms: Sequence[str]) -> list[Any]:
+    """The held-out names with a target of 1 in one of ``rooms`` (their best rooms),
+    sorted."""
+    from sgtool.semantics.room_blend import HeldOutName
+    from sgtool.semantics.text import category_text
+
+    keep = {category_text(r) for r in rooms}
+    best: dict[str, set[str]] = {}
+    for (n, q), y in zip(containment.pairs, containment.targets, strict=True):
+        name, room = containment.queries[int(q)], category_text(containment.nodes[int(n)])
+        if name in held and room in keep and y >= 0.999:
+            best.setdefault(name, set()).add(room)
+    return [HeldOutName(n, frozenset(r)) for n, r in sorted(best.items())]
+
+
+def top1(held: Sequence[Any], rooms: Sequence[str],
+         score: Callable[[Sequence[str], str], Any]) -> float:
+    """Share of ``held`` whose top-scored room (first on ties) is one of its best rooms."""
+    from sgtool.semantics.text import category_text
+
+    if not held:
+        return 0.0
+    hits = 0
+    for h in held:
+        s = list(score(rooms, h.name))
+        hits += category_text(rooms[s.index(max(s))]) in h.best_rooms
+    return hits / len(held)
 
 
 def training_lines(meta: dict[str, Any]) -> list[str]:

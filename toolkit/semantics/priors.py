@@ -42,9 +42,13 @@ import numpy as np
 from sgtool.errors import SgtoolError
 from sgtool.semantics.encoder import SentenceEncoder, default_encoder
 from sgtool.semantics.mlp import RelationMLP, load_mlp
+from sgtool.semantics.room_blend import load_room_blend
 from sgtool.semantics.text import category_text
 
 WEIGHTS_DIR = Path(__file__).resolve().parent / "weights"
+# distilled on the widened room knowledge, with a held-out-fitted room blend
+# (:mod:`sgtool.semantics.room_blend`; ``sgtool distill --room-blend``); loaded on request
+BLEND_WEIGHTS_DIR = Path(__file__).resolve().parent / "weights_blend"
 CONTAINMENT_FILE = "containment.safetensors"
 COOCCURRENCE_FILE = "cooccurrence.safetensors"
 METADATA_FILE = "metadata.json"
@@ -116,6 +120,7 @@ class LearnedPriors:
         self._memo = _Memo()
         self.unscored_rooms = unscored_room_types(self.metadata.get("room_evidence"),
                                                   min_room_evidence)
+        self.room_blend = load_room_blend(folder, self.encoder)
 
     def can_score_room(self, name: str) -> bool:
         """False for a room type the training data hardly covers (module doc)."""
@@ -133,10 +138,16 @@ class LearnedPriors:
         return mlp(vecs[:-1], vecs[-1])
 
     def rooms(self, names: Sequence[str], query: str) -> np.ndarray:
-        """p_contains(r, q) for room categories ``names`` (Eq. 11)."""
-        return self._memo.scores(
-            "containment", names, query, lambda ns, q: self._mlp_scores(self.containment, ns, q)
-        )
+        """p_contains(r, q) for room categories ``names`` (Eq. 11); blended with the
+        neighbour knowledge by query novelty when the weights folder has a room blend
+        (:mod:`sgtool.semantics.room_blend`)."""
+        return self._memo.scores("containment", names, query, self._room_scores)
+
+    def _room_scores(self, names: Sequence[str], query: str) -> np.ndarray:
+        learned = self._mlp_scores(self.containment, names, query)
+        if self.room_blend is None:
+            return learned
+        return self.room_blend.blend(names, query, learned)
 
     def objects(self, names: Sequence[str], query: str) -> np.ndarray:
         """p_co-occur(o, q) for object categories ``names`` (Eq. 10)."""
