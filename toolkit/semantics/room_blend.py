@@ -199,12 +199,22 @@ def blend_scores(p: RoomBlendParams, nb: np.ndarray, cos: np.ndarray, sim: float
     return lam * np.clip(learned, 0.0, 1.0) + (1.0 - lam) * know
 
 
+def tied_hit(scores: np.ndarray, best: np.ndarray) -> float:
+    """Top-1 hit of ``scores`` against the boolean mask ``best``, ties shared: the share of
+    the top-scored rooms (within 1e-9 of the maximum) that are best rooms. A blend whose
+    knowledge side saturates at 1 for several rooms cannot tell them apart, and a planner
+    ranking by these scores cannot either, so a tie is not a hit by list order."""
+    top = scores >= float(np.max(scores)) - 1e-9
+    return float(best[top].sum()) / float(top.sum())
+
+
 def fit_room_blend(table: Mapping[str, Sequence[str]], training_names: Sequence[str],
                    held_out: Sequence[HeldOutName], rooms: Sequence[str],
                    learned: Callable[[Sequence[str], str], np.ndarray],
                    encoder: SentenceEncoder) -> tuple[RoomBlendParams, float]:
     """The grid point of :data:`PARAM_GRID` with the best top-1 accuracy over ``rooms`` on
-    ``held_out`` (a hit: the top room is one of the name's best rooms), and that accuracy.
+    ``held_out`` (:func:`tied_hit`: the top room is one of the name's best rooms; a tie
+    at the top counts the share of best rooms among the tied ones), and that accuracy.
     ``table`` and ``training_names`` must not contain the held-out names, ``learned`` is a
     model trained without them. Ties go to the first grid point in
     :func:`itertools.product` order."""
@@ -220,9 +230,8 @@ def fit_room_blend(table: Mapping[str, Sequence[str]], training_names: Sequence[
     best: tuple[float, RoomBlendParams] | None = None
     for values in itertools.product(*(PARAM_GRID[k] for k in keys)):
         p = RoomBlendParams(**dict(zip(keys, values, strict=True)))
-        hits = sum(bool(g[int(np.argmax(blend_scores(p, *q)))])
-                   for g, q in zip(gold, parts[p.neighbours], strict=True))
-        acc = hits / len(held_out)
+        acc = sum(tied_hit(blend_scores(p, *q), g)
+                  for g, q in zip(gold, parts[p.neighbours], strict=True)) / len(held_out)
         if best is None or acc > best[0]:
             best = (acc, p)
     assert best is not None

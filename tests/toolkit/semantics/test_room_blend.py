@@ -147,3 +147,12 @@ def test_the_shipped_blend_weights_load_and_the_default_ones_stay_unblended() ->
         s = blended.rooms(rooms, query)
         assert rooms[int(np.argmax(s))] == room, (query, s)
         assert 0.0 <= s.min() and s.max() <= 1.0
+
+
+def test_a_tie_at_the_top_is_a_shared_hit() -> None:
+    from sgtool.semantics.room_blend import tied_hit
+
+    best = np.array([False, True, False])
+    assert tied_hit(np.array([0.2, 0.9, 0.1]), best) == 1.0
+    assert tied_hit(np.array([1.0, 1.0, 0.1]), best) == 0.5  # not a hit by list order
+    assert tied_hit(np.array([1.0, 0.5, 0.1]), best) == 0.0
