@@ -130,7 +130,7 @@ class InstanceObservation:
     id: int
     max_points: int  # most points of it in one frame
     total_points: int
-    frames: int  # frames it appeared in
+    frames: int  # frames it appeared in (kept when the map forgets it: it exists)
     last_index: int  # frame index of its last appearance
     viewpoint: tuple[float, float] | None  # closest viewpoint (x, y) among seen frames
     view_distance: float  # xy distance from that viewpoint to its points' centroid

@@ -330,7 +330,8 @@ class VoxelMap:
         it wins (most votes, ties to the lower label as :meth:`voxels`) with the votes of
         the other labels in it (module doc: a frame that missed or swapped its label must
         not leave its geometry behind). Returns the number of (voxel, label) entries
-        removed. Its observation counts restart too."""
+        removed. Its observation counts restart too, but for the frames it appeared in:
+        that it exists is still known (:mod:`sgtool.scenegraph.object_evidence`)."""
         lab = self._label_of.get(int(instance_id))
         if lab is None or lab == 0 or lab == OVERFLOW_LABEL:
             return 0
@@ -354,7 +355,6 @@ class VoxelMap:
         st.vox_sum[lab] = 0
         st.points_max[lab] = 0
         st.points_total[lab] = 0
-        st.frames[lab] = 0
         st.view_dist[lab] = np.inf
         st.view_xy[lab] = np.nan
         return n

@@ -21,7 +21,10 @@ caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
    least ``DOOR_MIN_FRAMES`` frames gave the door a voxel, cut the graph, ids
    are kept stable by overlap with the previous refresh;
 4. objects (:mod:`sgtool.scenegraph.object_placement`, :mod:`sgtool.scenegraph.assign`):
-   instances seen with enough points, placed at their voxel centroid, first-level ones
+   instances seen with enough points in a frame, given points by at least
+   ``OBJECT_EVIDENCE.min_frames`` frames and winning a voxel
+   (:mod:`sgtool.scenegraph.object_evidence`), placed at the centroid of the voxels they
+   win, first-level ones
    assigned by MoMa-LLM's weighted travel distance from their closest viewpoint, nested
    ones (``inside``/``ontop`` a seen parent) in their parent's room with the parent as
    node parent;
@@ -103,6 +106,7 @@ from sgtool.scenegraph.frontier_ids import FrontierTracker
 from sgtool.scenegraph.frontiers import Frontier, find_frontiers
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.instances import InstanceInfo
+from sgtool.scenegraph.object_evidence import EvidenceRule
 from sgtool.scenegraph.object_placement import (
     OBJECT_KINDS,
     SeenInstance,
@@ -124,10 +128,11 @@ from sgtool.scenegraph.visibility import entry_nodes, nearest_visible
 BODY_RADIUS = 0.2  # m: unlabelled voxels this close to where the robot stood are dropped
 DOOR_REACH = 1.5  # m: a door's evidence is its won voxels this close to their median
 DOOR_MIN_FRAMES = 2  # a door column is evidence with a voxel this many frames gave the door
+OBJECT_EVIDENCE = EvidenceRule()  # frames and won voxels that make an object
 VIEW_STRIDE = 2  # every this many frames, one is free-space evidence (neighbours see alike)
 
-__all__ = ["BODY_RADIUS", "DOOR_MIN_FRAMES", "DOOR_REACH", "VIEW_STRIDE", "BuilderConfig",
-           "DoorObservation", "MapLayers", "SceneGraphBuilder"]
+__all__ = ["BODY_RADIUS", "DOOR_MIN_FRAMES", "DOOR_REACH", "OBJECT_EVIDENCE", "VIEW_STRIDE",
+           "BuilderConfig", "DoorObservation", "MapLayers", "SceneGraphBuilder"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -494,7 +499,8 @@ class SceneGraphBuilder:
         return [iid for iid, v in self.instances.items() if v.kind == "door"]
 
     def _seen(self, kinds: tuple[str, ...]) -> list[SeenInstance]:
-        return seen_instances(self.voxels, self.instances, kinds, self.config.voxels.min_points)
+        return seen_instances(self.voxels, self.instances, kinds, self.config.voxels.min_points,
+                              OBJECT_EVIDENCE)
 
     def stage_summary(self, from_scratch: bool = False) -> dict[str, tuple[float, float, int]]:
         """Per stage: (median ms, max ms, count) of the incremental refreshes (or of the

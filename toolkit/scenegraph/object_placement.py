@@ -14,9 +14,11 @@ from scipy.sparse import csr_matrix
 
 from sgtool.mapping.grid import OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph
-from sgtool.mapping.voxels import VoxelMap
+from sgtool.mapping.vote_store import sorted_unique
+from sgtool.mapping.voxels import LABEL_MASK, VOXEL_SHIFT, VoxelMap
 from sgtool.scenegraph.assign import AssignCache, AssignConfig, assign_objects
 from sgtool.scenegraph.instances import InstanceInfo
+from sgtool.scenegraph.object_evidence import EvidenceRule, WonVoxels, is_object, won_voxels
 
 OBJECT_KINDS = ("object", "furniture")
 
@@ -36,10 +38,14 @@ class PlacedObject:
 
 
 def seen_instances(voxels: VoxelMap, instances: Mapping[int, InstanceInfo],
-                   kinds: tuple[str, ...], min_points: int) -> list[SeenInstance]:
+                   kinds: tuple[str, ...], min_points: int,
+                   evidence: EvidenceRule | None = None) -> list[SeenInstance]:
     """(info, voxel centroid, closest viewpoint) of the instances of ``kinds`` seen with at
-    least ``min_points`` points in one frame, in id order."""
+    least ``min_points`` points in one frame, in id order. With an ``evidence`` rule, an
+    instance of :data:`OBJECT_KINDS` must also have the evidence it asks for and stands at
+    the centroid of the voxels it wins (:mod:`sgtool.scenegraph.object_evidence`)."""
     out: list[SeenInstance] = []
+    frames: dict[int, int] = {}
     for iid in voxels.observed_instances():
         info = instances.get(iid)
         if info is None or info.kind not in kinds:
@@ -48,7 +54,35 @@ def seen_instances(voxels: VoxelMap, instances: Mapping[int, InstanceInfo],
         if obs is None or obs.max_points < min_points or obs.centroid is None:
             continue
         out.append((info, obs.centroid, obs.viewpoint))
-    return out
+        frames[iid] = obs.frames
+    if evidence is None:
+        return out
+    weigh = [info.id for info, _, _ in out if info.kind in OBJECT_KINDS]
+    labels = voxels.labels_of(np.asarray(weigh, dtype=np.int64))
+    won = _won_by(voxels, labels)
+    kept: list[SeenInstance] = []
+    label_of = dict(zip(weigh, labels.tolist(), strict=True))
+    for info, c, vp in out:
+        if info.kind in OBJECT_KINDS:
+            lab = label_of[info.id]
+            at = won.centroid(lab, voxels.resolution)
+            if at is None or not is_object(frames[info.id], int(won.count[lab]), evidence):
+                continue
+            c = at
+        kept.append((info, c, vp))
+    return kept
+
+
+def _won_by(voxels: VoxelMap, labels: np.ndarray) -> WonVoxels:
+    """The voxels each of ``labels`` wins, looked up among the voxels they got votes in."""
+    n = int(labels.max()) + 1 if len(labels) else 0
+    keys, _ = voxels.entries()
+    if n == 0 or len(keys) == 0:
+        return won_voxels(np.zeros(0, np.int64), np.zeros(0, np.int64), n)
+    mine = np.zeros(LABEL_MASK + 1, dtype=bool)
+    mine[labels] = True
+    vk = sorted_unique(keys[mine[keys & LABEL_MASK]] >> VOXEL_SHIFT)
+    return won_voxels(vk, voxels.winning_labels(vk), n)
 
 
 def place_objects(seen: list[SeenInstance], vg: VoronoiGraph, node_room: np.ndarray,
