@@ -25,8 +25,8 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   (:attr:`LiveSkills.bumps`, grown by the robot's radius like any obstacle) for the rest
   of the episode; when those marks leave the robot less than ``sealed_m2`` of reachable
   floor while the map without them leaves more (contacts at a door frame or a swinging
-  panel can ring the robot in), they are dropped: otherwise every goal would be
-  unreachable and the search would end there.
+  panel can ring the robot in), the oldest are dropped until it has that much again:
+  otherwise every goal would be unreachable and the search would end there.
 - **Looking around** (:meth:`LiveSkills.look_around`) turns only toward unknown space
   near the robot on its own map (:func:`~sgtool.recorders.sim.motion.sweep`), the shorter
   way, and stops when a refresh during the turn shows no cell known that was not before.
@@ -86,7 +86,7 @@ class LiveNavConfig:
     slack: float = 0.3  # m: stands this much farther from the thing than the nearest
     max_replans: int = 60
     max_contacts: int = 3
-    sealed_m2: float = 2.0  # bump marks leaving the robot less floor than this are dropped
+    sealed_m2: float = 2.0  # bump marks leaving the robot less floor are dropped, oldest first
 
     def __post_init__(self) -> None:
         if not 0 <= self.optimistic <= 2.0:
@@ -253,18 +253,20 @@ class LiveSkills:
         occ = self.live_map(refresh)
         out = None if occ is None else (occ, geodesic_distances(occ, key[2]))
         if out is not None and self.bumps and self._sealed(out[0], out[1]):
-            # the robot's own bump marks wall it in: forget them (module doc)
+            # the robot's own bump marks wall it in: forget the oldest (module doc)
             kept = self.bumps
-            self.bumps = []
-            occ = self.live_map(refresh)
-            assert occ is not None
-            free = (occ, geodesic_distances(occ, key[2]))
-            if self._sealed(*free):
-                self.bumps = kept  # sealed without them too: they were not the cause
+            for k in range(1, len(kept) + 1):
+                self.bumps = kept[k:]
+                occ = self.live_map(refresh)
+                assert occ is not None
+                free = (occ, geodesic_distances(occ, key[2]))
+                if not self._sealed(*free):
+                    self.sealed += 1
+                    out = free
+                    key = (*key[:3], len(self.bumps))
+                    break
             else:
-                self.sealed += 1
-                out = free
-                key = (*key[:3], 0)
+                self.bumps = kept  # sealed without them too: they were not the cause
         self._planned = (key, out)
         return out
 
