@@ -123,6 +123,7 @@ from sgtool.scenegraph.build_options import (
     default_min_points,
     mapping_record,
 )
+from sgtool.scenegraph.categories import RoomClassifier
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 from sgtool.semantics.text import category_text
@@ -420,7 +421,7 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
         raise SgtoolError(f"--frames {opts.frames}: must be >= 1")
     mapping = opts.mapping()
     name = str(getattr(planner, "name", "planner"))
-    classifier = make_classifier(mapping.classifier)
+    classifier = _classifier(mapping.classifier)
     hid = house_id or f"house-{house.seed}"
     query = episode.query
     shortest = episode.shortest_path if math.isfinite(episode.shortest_path) else None
@@ -476,6 +477,18 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
         success=success, end=end, steps=steps, travelled_m=travelled, shortest_m=shortest,
         frames=frames, refreshes=refreshes, n_open=n_open,
         decision_times=tuple(search.decision_times), seconds=time.perf_counter() - t_wall)
+
+
+# the room classifiers of this process by name: loading one (weights, room-type vectors)
+# and its memoised per-category votes cost about a second per episode; answers never change
+_CLASSIFIERS: dict[str, RoomClassifier | None] = {}
+
+
+def _classifier(name: str) -> RoomClassifier | None:
+    """The room classifier ``name`` (:func:`make_classifier`), one per process."""
+    if name not in _CLASSIFIERS:
+        _CLASSIFIERS[name] = make_classifier(name)
+    return _CLASSIFIERS[name]
 
 
 def _found(refresh: Refresh | None, query: str) -> bool:

@@ -132,3 +132,22 @@ def test_batched_sight_checks_equal_one_line_at_a_time() -> None:
         free = nav.lines_are_free(grid, pts[0], pts[1:])
         assert list(free) == [nav.line_is_free(grid, pts[0], b) for b in pts[1:]]
         assert nav.smooth_path(grid, pts) == _string_pull_one_by_one(grid, pts)
+
+
+def test_house_maps_are_kept_per_spec_and_door_states() -> None:
+    """occupancy_with keeps the house map of a spec and door states: the same states give
+    the same map, other states their own (a closed door blocks, an open one does not), and
+    extra footprints never change the kept map."""
+    h = small_house(door="closed")
+    robot = nav.RobotConfig()
+    closed = nav.occupancy_with(h, {"door_0": "closed"}, [], robot)
+    opened = nav.occupancy_with(h, {"door_0": "open"}, [], robot)
+    assert nav.occupancy_with(h, {"door_0": "closed"}, [], robot) is closed
+    assert opened.blocked.sum() < closed.blocked.sum()
+    boxed = nav.occupancy_with(h, {"door_0": "open"}, [(1.0, 2.5, 0.4, 0.4, 0.0)], robot)
+    assert boxed.blocked.sum() > opened.blocked.sum()
+    again = nav.occupancy_with(h, {"door_0": "open"}, [], robot)
+    assert again is opened and np.array_equal(again.blocked, opened.blocked)
+    other = small_house(door="closed")  # an equal spec, another object: its own entry
+    assert np.array_equal(nav.occupancy_with(other, {"door_0": "closed"}, [], robot).blocked,
+                          closed.blocked)
