@@ -189,24 +189,11 @@ def _argmin_cell(grid: OccupancyMap, score: np.ndarray) -> tuple[float, float] |
 # ----------------------------------------------------------------------------------------
 # paths
 # ----------------------------------------------------------------------------------------
-def line_is_free(grid: OccupancyMap, a: Sequence[float], b: Sequence[float]) -> bool:
-    """True when every sample (every quarter cell) of segment a-b lies in a free cell."""
-    n = max(2, int(math.ceil(math.dist(a, b) / (grid.resolution / 4))) + 1)
-    t = np.linspace(0.0, 1.0, n)
-    x = a[0] + (b[0] - a[0]) * t
-    y = a[1] + (b[1] - a[1]) * t
-    col = np.floor((x - grid.origin[0]) / grid.resolution + 1e-9).astype(int)
-    row = np.floor((y - grid.origin[1]) / grid.resolution + 1e-9).astype(int)
-    rows, cols = grid.shape
-    if (row < 0).any() or (col < 0).any() or (row >= rows).any() or (col >= cols).any():
-        return False
-    return not grid.blocked[row, col].any()
-
-
 def lines_are_free(grid: OccupancyMap, a: Sequence[float],
                    ends: Sequence[Sequence[float]]) -> np.ndarray:
-    """:func:`line_is_free` of the segments from ``a`` to each of ``ends`` (bool per end),
-    in one pass over all their samples: the same samples, so the same answers."""
+    """Per end of ``ends``: whether every sample (every quarter cell, both ends included)
+    of the segment from ``a`` to it lies in a free cell of the grid, all segments in one
+    pass; a segment leaving the grid is not free."""
     counts = [max(2, int(math.ceil(math.dist(a, b) / (grid.resolution / 4))) + 1)
               for b in ends]
     n = np.asarray(counts, dtype=np.int64)
