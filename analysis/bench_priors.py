@@ -6,7 +6,6 @@ weights traces a table to the priors behind it."""
 from __future__ import annotations
 
 import os
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -50,10 +49,10 @@ def priors_fingerprint(weights_dir: str | os.PathLike[str] | None = None) -> str
     (the shipped ones by default), so a table can be traced to the priors behind it."""
     import hashlib
 
-    from sgtool.semantics.priors import WEIGHTS_DIR
+    from sgtool.semantics.priors import weights_folder
 
     h = hashlib.sha256()
-    for p in sorted(Path(weights_dir or WEIGHTS_DIR).glob("*")):
+    for p in sorted(weights_folder(weights_dir).glob("*")):
         if p.is_file() and (p.suffix == ".safetensors" or p.name == "metadata.json"):
             h.update(p.name.encode())
             h.update(p.read_bytes())

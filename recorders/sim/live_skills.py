@@ -216,7 +216,6 @@ class LiveSkills:
         self.replans = 0  # plans made (for reports)
         self.contacts = 0
         self.bumps: list[tuple[float, float]] = []  # where the base touched something
-        self.sealed = 0  # times the bump marks were dropped because they walled it in
         # where a look-around turned toward all the unknown it could (module doc), in order
         self.looked: list[tuple[float, float]] = []
         # asked at every refresh during a skill: True ends the skill (module doc)
@@ -261,7 +260,6 @@ class LiveSkills:
                 assert occ is not None
                 free = (occ, geodesic_distances(occ, key[2]))
                 if not self._sealed(*free):
-                    self.sealed += 1
                     out = free
                     key = (*key[:3], len(self.bumps))
                     break

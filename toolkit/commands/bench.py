@@ -50,7 +50,8 @@ if TYPE_CHECKING:
                    "naming file and field.")
 @click.option("--priors", "priors_dir", default=None, metavar="DIR",
               type=click.Path(file_okay=False, path_type=str),
-              help="Relational priors (a folder written by `sgtool distill`): the planners "
+              help="Relational priors (a folder written by `sgtool distill`, or `blend` for "
+                   "the shipped priors with the room blend): the planners "
                    "of the learned priors (scout*, godhs, esc, bayes-search) load them, and a "
                    "query is 'seen' when it is one of their training queries [default: the "
                    "shipped priors].")

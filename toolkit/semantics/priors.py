@@ -49,12 +49,26 @@ WEIGHTS_DIR = Path(__file__).resolve().parent / "weights"
 # distilled on the widened room knowledge, with a held-out-fitted room blend
 # (:mod:`sgtool.semantics.room_blend`; ``sgtool distill --room-blend``); loaded on request
 BLEND_WEIGHTS_DIR = Path(__file__).resolve().parent / "weights_blend"
+# names a user may give instead of a weights folder (``--priors blend``)
+NAMED_WEIGHTS = {"shipped": WEIGHTS_DIR, "blend": BLEND_WEIGHTS_DIR}
 CONTAINMENT_FILE = "containment.safetensors"
 COOCCURRENCE_FILE = "cooccurrence.safetensors"
 METADATA_FILE = "metadata.json"
 # a trained room type is scored when its containment targets are positive for at least this
 # share of the training query categories (module doc)
 MIN_ROOM_EVIDENCE = 0.01
+
+
+def weights_folder(weights_dir: str | Path | None) -> Path:
+    """The folder of distilled priors ``weights_dir`` names: the shipped priors for None or
+    ``"shipped"``, the shipped room-blend priors for ``"blend"`` (unless a folder of that
+    name exists), else the path itself."""
+    if weights_dir is None:
+        return WEIGHTS_DIR
+    name = str(weights_dir)
+    if name in NAMED_WEIGHTS and not Path(name).is_dir():
+        return NAMED_WEIGHTS[name]
+    return Path(weights_dir)
 
 
 class RelationScorer(Protocol):
@@ -101,7 +115,7 @@ class LearnedPriors:
         min_room_evidence: float = MIN_ROOM_EVIDENCE,
     ) -> None:
         self.encoder = encoder or default_encoder()
-        folder = Path(weights_dir) if weights_dir is not None else WEIGHTS_DIR
+        folder = weights_folder(weights_dir)
         self.weights_dir = folder
         self.containment: RelationMLP = load_mlp(folder / CONTAINMENT_FILE, "containment")
         self.cooccurrence: RelationMLP = load_mlp(folder / COOCCURRENCE_FILE, "cooccurrence")
@@ -205,8 +219,7 @@ def training_queries(weights_dir: str | Path | None = None) -> frozenset[str]:
     shipped ones by default) were trained on, from the ``training_queries`` of their
     ``metadata.json`` (written by ``sgtool distill`` since metadata version 4). A query is
     *seen* by those priors when its :func:`category_text` is in this set."""
-    folder = Path(weights_dir) if weights_dir is not None else WEIGHTS_DIR
-    path = folder / METADATA_FILE
+    path = weights_folder(weights_dir) / METADATA_FILE
     try:
         meta = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:

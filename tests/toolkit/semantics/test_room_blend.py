@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -135,8 +136,8 @@ def test_the_shipped_blend_weights_load_and_the_default_ones_stay_unblended() ->
 
     enc = encoder()
     assert LearnedPriors(enc).room_blend is None  # the baselines' priors are unchanged
-    blended = LearnedPriors(enc, BLEND_WEIGHTS_DIR)
-    assert blended.room_blend is not None
+    blended = LearnedPriors(enc, "blend")  # the name `--priors blend` gives
+    assert blended.weights_dir == BLEND_WEIGHTS_DIR and blended.room_blend is not None
     doc = json.loads((BLEND_WEIGHTS_DIR / BLEND_FILE).read_text())
     fit = doc["fit"]  # fitted on names held out of a second training
     assert fit["heldout_names"] > 100 and fit["blend_top1"] >= fit["learned_top1"]
@@ -147,6 +148,18 @@ def test_the_shipped_blend_weights_load_and_the_default_ones_stay_unblended() ->
         s = blended.rooms(rooms, query)
         assert rooms[int(np.argmax(s))] == room, (query, s)
         assert 0.0 <= s.min() and s.max() <= 1.0
+
+
+def test_named_weights_resolve_unless_a_folder_of_that_name_exists(tmp_path,
+                                                                  monkeypatch) -> None:
+    from sgtool.semantics.priors import BLEND_WEIGHTS_DIR, WEIGHTS_DIR, weights_folder
+
+    assert weights_folder(None) == WEIGHTS_DIR == weights_folder("shipped")
+    assert weights_folder("blend") == BLEND_WEIGHTS_DIR
+    assert weights_folder(tmp_path) == tmp_path
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "blend").mkdir()  # a user's own folder called blend wins over the name
+    assert weights_folder("blend") == Path("blend")
 
 
 def test_a_tie_at_the_top_is_a_shared_hit() -> None:
