@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import functools
 import json
+import os
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Protocol
@@ -59,7 +60,7 @@ METADATA_FILE = "metadata.json"
 MIN_ROOM_EVIDENCE = 0.01
 
 
-def weights_folder(weights_dir: str | Path | None) -> Path:
+def weights_folder(weights_dir: str | os.PathLike[str] | None) -> Path:
     """The folder of distilled priors ``weights_dir`` names: the shipped priors for None or
     ``"shipped"``, the shipped room-blend priors for ``"blend"`` (unless a folder of that
     name exists), else the path itself."""
