@@ -1,10 +1,14 @@
 """How a door or container opens in the simulation: which of its candidate panel layouts
-to swing, so that the open panels leave every room as connected as before and the robot
-free to leave (else the panels are taken away instead of swung).
+to swing, so that the open panels leave every room as connected as before, stay clear of
+the robot's base disc and leave the robot free to leave (else the panels are taken away
+instead of swung).
 
 Doors: into a room rather than a corridor, else away from the robot, clear of furniture
-and walls (:func:`~sgtool.recorders.sim.articulation.swing_choices`). Single container
-doors: hinged on the side away from the robot first.
+and walls (:func:`~sgtool.recorders.sim.articulation.swing_choices`). Container doors:
+single ones hinged on the side away from the robot first; a layout whose open panel would
+stand in a wall, in another piece of furniture or in front of another container (where
+that one's doors swing and its inside is seen from), at the panel's height, is never
+taken: such a panel would cut through the piece or hide what is in it.
 """
 
 from __future__ import annotations
@@ -14,7 +18,7 @@ import math
 import numpy as np
 from scipy import ndimage
 
-from sgtool.house.spec import Door, HouseSpec, room_at
+from sgtool.house.spec import Door, Furniture, HouseSpec, room_at
 from sgtool.mapping.occupancy import nearest_free_cell
 from sgtool.recorders.sim import articulation as art
 from sgtool.recorders.sim import navigation as nav
@@ -55,14 +59,36 @@ class OpeningPlanner:
                            list(art.container_panels(f, -away))]
             else:
                 options = [list(art.container_panels(f))]
+            options = [o for o in options if not self._in_furniture(sid, o)]
         before, blocked0, _ = self._room_floor(sid, [], base)
         for opt in options:
             fps = [p.footprint(1.0) for p in opt if p.z0 < MAX_OBSTACLE_HEIGHT]
+            if any(art.point_box_distance(x, y, fp) < self.robot.radius for fp in fps):
+                continue  # the open panel would stand on the robot's base
             after, blocked1, robot_ok = self._room_floor(sid, fps, base)
             added = blocked1 - blocked0
             if robot_ok and all(after[r] >= before[r] - added for r in before):
                 return opt
         return None
+
+    def _in_furniture(self, sid: str, layout: list[art.Panel]) -> bool:
+        """Whether an open panel of ``layout`` (a container's) overlaps a wall, another
+        piece of furniture whose height range meets the panel's, or the space in front of
+        another container (:func:`front_zone`) at such a height."""
+        boxes = [p.footprint(1.0) for p in layout]
+        for f in self.spec.furniture:
+            if f.id == sid:
+                continue
+            zones = [(f.center[0], f.center[1], f.size[0], f.size[1], f.yaw)]
+            if f.is_container:
+                zones.append(front_zone(f))
+            for p, b in zip(layout, boxes, strict=True):
+                if f.bottom < p.z0 + p.height and p.z0 < f.top and \
+                        any(art.boxes_overlap(b, z) for z in zones):
+                    return True
+        walls = [((w.a[0] + w.b[0]) / 2, (w.a[1] + w.b[1]) / 2, w.length, w.thickness, w.yaw)
+                 for w in self.spec.walls]
+        return any(art.boxes_overlap(b, wb) for b in boxes for wb in walls)
 
     def _room_floor(self, skip: str, extra: list[art.Box2], base: tuple[float, float, float]
                     ) -> tuple[dict[str, int], int, bool]:
@@ -84,6 +110,17 @@ class OpeningPlanner:
         robot_ok = cell is not None and bool(main[cell])
         return ({rid: int((m & main).sum()) for rid, m in self._room_masks.items()},
                 int(occ.blocked.sum()), robot_ok)
+
+
+def front_zone(f: Furniture) -> art.Box2:
+    """The floor in front of container ``f`` (its front is the local +y face) that its own
+    doors sweep and from which what is inside is seen: as wide as the piece, as deep as
+    one of its door panels (half the width for double doors)."""
+    sx, sy = f.size[0], f.size[1]
+    depth = sx if sx <= art.DOUBLE_DOOR_WIDTH else sx / 2.0
+    c, s = math.cos(f.yaw), math.sin(f.yaw)
+    ly = sy / 2.0 + depth / 2.0
+    return (f.center[0] - s * ly, f.center[1] + c * ly, sx, depth, f.yaw)
 
 
 def room_side(spec: HouseSpec, d: Door) -> int | None:
