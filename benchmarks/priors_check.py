@@ -23,16 +23,27 @@ BEHAVIOR-1K categories is ~0.89 against the cosine's ~0.71).
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
 
 from sgtool.planning.calibration import BlendedPriors, BlendParams
 from sgtool.semantics.encoder import default_encoder
 from sgtool.semantics.everyday_rooms import (
     EVERYDAY_ROOMS,
-    format_checks,
+    RoomCheck,
     room_check,
     scoreable_room_types,
 )
 from sgtool.semantics.priors import CosinePriors, LearnedPriors
+
+
+def format_checks(checks: Sequence[RoomCheck], show_misses: bool = False) -> str:
+    """One line per scorer (accuracy, hits / n), optionally its misses."""
+    lines = []
+    for c in checks:
+        lines.append(f"  {c.scorer:<28} top-1 {c.accuracy:.3f} ({c.hits}/{c.n})")
+        if show_misses:
+            lines += [f"    {m.name}: {m.expected} -> {m.got}" for m in c.misses]
+    return "\n".join(lines)
 
 
 def main() -> None:

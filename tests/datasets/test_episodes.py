@@ -8,11 +8,12 @@ import math
 import numpy as np
 import pytest
 from support.datasets_fixtures import two_rooms
+from support.path_lengths import path_length
 
 import sgtool.datasets as ds
 from sgtool.datasets.episodes import EpisodeGeometry, list_episodes
 from sgtool.house.io import load_house
-from sgtool.mapping.occupancy import astar, path_length, world_to_cell
+from sgtool.mapping.occupancy import astar, world_to_cell
 
 
 def test_demo_episodes_are_consistent():

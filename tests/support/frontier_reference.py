@@ -12,9 +12,8 @@ from sgtool.mapping.holes import near
 from sgtool.scenegraph.frontiers import (
     Frontier,
     FrontierConfig,
-    _medoid,
-    _split,
-    reachable_free,
+    cluster_medoid,
+    split_cluster,
 )
 
 _EIGHT = np.ones((3, 3), dtype=bool)
@@ -38,6 +37,27 @@ def plain_fill_holes(grid: np.ndarray, max_cells: int) -> int:
     fill = ~bad[lab]
     grid[fill] = FREE
     return int(fill.sum())
+
+
+def reachable_free(occ: OccupancyGrid, start: tuple[float, float] | None,
+                   snap: float = 0.5) -> np.ndarray:
+    """Free cells 4-connected to the free cell nearest to ``start`` (ties: the first in
+    raster order) among those at most ``ceil(snap / resolution)`` rows and columns from
+    its cell; all free cells when ``start`` is None or no free cell is that near."""
+    free = occ.grid == FREE
+    if start is None or not free.any():
+        return free
+    row, col = (int(v) for v in occ.cell_of(start[0], start[1]))
+    k = int(np.ceil(snap / occ.resolution))
+    cells = np.argwhere(free)  # raster order
+    offset = cells - np.array([row, col])
+    inside = (np.abs(offset) <= k).all(axis=1)
+    cells, offset = cells[inside], offset[inside]
+    if not len(cells):
+        return free
+    r, c = cells[int(np.argmin((offset ** 2).sum(axis=1)))]  # argmin: the first of ties
+    lab, _ = ndimage.label(free, structure=_FOUR)
+    return lab == lab[r, c]
 
 
 def _border_labels(lab: np.ndarray) -> np.ndarray:
@@ -91,11 +111,11 @@ def plain_frontiers(occ: OccupancyGrid, start: tuple[float, float] | None,
         cc = cc + sl[1].start
         if len(rr) < min_cells:
             continue
-        for piece in _split(rr, cc, max_cells):
+        for piece in split_cluster(rr, cc, max_cells):
             pr, pc = rr[piece], cc[piece]
             if len(pr) < min_cells:
                 continue
-            mr, mc = _medoid(pr, pc)
+            mr, mc = cluster_medoid(pr, pc)
             x, y = occ.center_of(mr, mc)
             out.append(Frontier(cells=np.stack([pr, pc], axis=1), medoid=(float(x), float(y)),
                                 medoid_cell=(mr, mc), size=float(len(pr) * res),

@@ -6,9 +6,10 @@ vulture matches by name only (``_.name`` marks any attribute, function or variab
 - dynamic: reached by a framework (click, pytest, the module protocol, a C library's
   config object) or read by name;
 - contract: a field of a result dataclass, or a public API or library function a user
-  may call although nothing in the package does;
-- reached only from tests or benchmarks, in files another engineer was changing when the
-  rest moved to tests/support: still to move to tests/support or delete.
+  may call although nothing in the package does.
+
+A package function that only tests or benchmarks call is not whitelisted: it moves to
+``tests/support`` (a reference implementation or a test helper) or is deleted.
 """
 # ruff: noqa: B018, F821
 
@@ -45,7 +46,6 @@ _._server  # toolkit/llm/server.py: keeps the llama.cpp server object alive
 _.holds  # analysis/validity.py: Rule field, rendered into the docs of the rules
 _.inference_s  # analysis/paper_tables.py: field looked up by name in analysis/report.py
 _.RECORD_BY_SCHEMA  # toolkit/log/schemas.py: schema -> record table, a public lookup
-_.study_into  # analysis/noise_study_run.py: new (engineer O), its command is being wired
 _.PARTIAL_GLOB  # toolkit/log/writer.py: the partial-file pattern named in the module doc
 
 # ----- contract: fields and methods of results that callers may read -------------------------
@@ -91,18 +91,5 @@ _.RECORD_NAMES  # toolkit/vocabulary.py: vocabulary table (tests/toolkit/test_vo
 _.LOGGED_SKILLS  # toolkit/vocabulary.py: vocabulary table
 _.CASES  # replayers/golden.py: the golden cases (tests/golden/regenerate.py)
 _.replay_graphs  # replayers/golden.py: public API (sgtool.replay_graphs)
-
-# ----- reached only from tests or benchmarks: still to move (see the module doc) -------------
-_.occupancy_from_keys  # toolkit/mapping/bev.py: tests only
-_.near_depth  # toolkit/mapping/free_space.py: tests only
-_.fill_holes  # toolkit/mapping/holes.py: tests only
-_.shortest_path_length  # toolkit/mapping/occupancy.py: tests only
-_.path_length  # toolkit/mapping/occupancy.py: tests only
-_.ridge_cells  # toolkit/mapping/voronoi.py: tests only
-_.reachable_free  # toolkit/scenegraph/frontiers.py: tests/support/frontier_reference.py only
-_.frontier_cells  # toolkit/scenegraph/frontiers.py: tests only
-_.outside_footprint  # toolkit/scenegraph/frontiers.py: tests only
-_.scoreable_room_types  # toolkit/semantics/everyday_rooms.py: tests, benchmarks/priors_check
-_.room_check  # toolkit/semantics/everyday_rooms.py: tests, benchmarks/priors_check
-_.format_checks  # toolkit/semantics/everyday_rooms.py: tests, benchmarks/priors_check
-_.same_category  # toolkit/semantics/text.py: tests only
+_.room_check  # toolkit/semantics/everyday_rooms.py: a user scores own priors (module doc)
+_.accuracy  # toolkit/semantics/everyday_rooms.py: RoomCheck property (top-1 share)

@@ -282,23 +282,6 @@ def cell_values(flags: np.ndarray, stamped: np.ndarray) -> np.ndarray:
     return np.take(_CELL_VALUES, code)
 
 
-def occupancy_from_keys(keys: np.ndarray, resolution: float, config: BevConfig,
-                        trajectory: Sequence[tuple[float, float]] = (),
-                        level: int | None = None) -> OccupancyGrid:
-    """From-scratch BEV of packed voxel keys (sorted or not)."""
-    if level is None:
-        if keys.size:
-            iz = ((keys >> SHIFT_Z) & AXIS_MASK) - OFFSET
-            lo = int(iz.min())
-            level = floor_level(config, resolution, lo, np.bincount(iz - lo))
-        else:
-            level = floor_level(config, resolution, 0, np.zeros(0, np.int64))
-    presorted = bool(keys.size < 2 or np.all(keys[1:] >= keys[:-1]))
-    cg = ColumnGrid(resolution, config)
-    cg.add(classify_keys(keys, level, resolution, config, presorted), trajectory)
-    return cg.occupancy(trajectory, level)
-
-
 def grid_extent(column_sets: Sequence[np.ndarray], resolution: float, config: BevConfig,
                 trajectory: Sequence[tuple[float, float]] = (),
                 track: tuple[int, int, int, int] | None = None) -> tuple[int, int, int, int]:

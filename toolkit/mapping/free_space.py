@@ -10,8 +10,10 @@ height band makes its column an obstacle for good.
 Instead of tracing every ray through the grid (OctoMap), the test is projective (as a
 TSDF update): a voxel centre is projected into a view; when the view's depth at that
 pixel is farther than the centre by more than ``margin``, the view saw through it (a
-miss). The depth used is the smallest over the voxel's whole image (:func:`near_depth`
-over a square of its projected half-diagonal), so a ray grazing a thin thing or passing
+miss). The depth used is the smallest over the voxel's whole image (the *near depth*
+over a square of its projected half-diagonal: the smallest depth of each pixel's
+(2 r + 1)^2 neighbourhood, 0 where any of them has no valid depth, the border's pixels
+repeated beyond the image), so a ray grazing a thin thing or passing
 beside a surface never clears the voxel holding it, and a pixel without depth (a hole,
 out of range) is no evidence either way. Only *weak* voxels
 (at most ``weak_votes`` votes) are tested: a voxel with more is a surface seen many
@@ -43,8 +45,8 @@ RADII = (1, 2, 4, 8)  # pixel half-widths of the neighbourhoods a view keeps
 @dataclass(frozen=True, eq=False)
 class View:
     """One depth frame as free-space evidence: camera-to-world ``pose`` (4 x 4, optical
-    axes: x right, y down, z forward), intrinsics and :func:`near_depth` of its depth at
-    every radius of ``RADII`` (``levels[i]``: float32 m, 0 = no evidence)."""
+    axes: x right, y down, z forward), intrinsics and the near depth (module doc) of its
+    depth at every radius of ``RADII`` (``levels[i]``: float32 m, 0 = no evidence)."""
 
     pose: np.ndarray
     intrinsics: CameraIntrinsics
@@ -53,8 +55,9 @@ class View:
     @classmethod
     def of(cls, pose: np.ndarray, intrinsics: CameraIntrinsics, depth: np.ndarray,
            min_range: float) -> View:
-        """The view of a depth image: its :func:`near_depth` at every radius of ``RADII``,
-        each grown from the one before by repeated 3 x 3 minima (the same values)."""
+        """The view of a depth image: its near depth at every radius of ``RADII`` (depths
+        below ``min_range`` or not finite are invalid), each grown from the one before by
+        repeated 3 x 3 minima."""
         d = np.asarray(depth, dtype=np.float32)
         level = np.where(np.isfinite(d) & (d >= min_range), d, np.float32(0.0))
         levels = []
@@ -76,18 +79,6 @@ def _min3(a: np.ndarray) -> np.ndarray:
     np.minimum(c[:, 1:], b[:, :-1], out=c[:, 1:])
     np.minimum(c[:, :-1], b[:, 1:], out=c[:, :-1])
     return c
-
-
-def near_depth(depth: np.ndarray, min_range: float, radius: int = 1) -> np.ndarray:
-    """The smallest depth of each pixel's (2 ``radius`` + 1)^2 neighbourhood (float32), 0
-    where any of them has no valid depth (below ``min_range``, not finite): a pixel with
-    a hole or an edge nearby is no evidence. Beyond the image border the border's pixels
-    repeat."""
-    d = np.asarray(depth, dtype=np.float32)
-    out = np.where(np.isfinite(d) & (d >= min_range), d, np.float32(0.0))
-    for _ in range(radius):
-        out = _min3(out)
-    return out
 
 
 def seen_through(centres: np.ndarray, view: View, margin: float, min_range: float,

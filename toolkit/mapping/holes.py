@@ -72,17 +72,12 @@ def unknown_parts(grid: np.ndarray, near_occupied: np.ndarray | None = None) -> 
                         near_occupied)
 
 
-def fill_holes(grid: np.ndarray, max_cells: int) -> int:
-    """Turn enclosed unknown holes of at most ``max_cells`` cells (4-connected, bordered
-    only by free cells, not touching the grid border) into free space, in place; returns
-    the number of cells filled."""
-    return fill_holes_parts(grid, max_cells)[0]
-
-
 def fill_holes_parts(grid: np.ndarray, max_cells: int) -> tuple[int, UnknownParts | None]:
-    """:func:`fill_holes`, and the :class:`UnknownParts` of the grid before the filling
-    (None when ``max_cells`` <= 0 skips the labelling). Filling turns whole components
-    free, so the unknown components left are those of that labelling, less the filled."""
+    """Turn enclosed unknown holes of at most ``max_cells`` cells (4-connected, bordered
+    only by free cells, not touching the grid border) into free space, in place: (the
+    number of cells filled, the :class:`UnknownParts` of the grid before the filling; None
+    when ``max_cells`` <= 0 skips the labelling). Filling turns whole components free, so
+    the unknown components left are those of that labelling, less the filled."""
     if max_cells <= 0:
         return 0, None
     parts = unknown_parts(grid)

@@ -229,15 +229,6 @@ def geodesic_distances(occ: OccupancyMap, start_xy: Sequence[float] | Iterable[S
     return out
 
 
-def shortest_path_length(occ: OccupancyMap, a: Sequence[float], b: Sequence[float],
-                         max_snap: float = 0.5) -> float:
-    """Geodesic distance (m) between world points a and b (``inf`` when not connected)."""
-    cb = nearest_free_cell(occ, b[0], b[1], max_snap)
-    if cb is None:
-        return math.inf
-    return float(geodesic_distances(occ, a, max_snap)[cb])
-
-
 def astar(occ: OccupancyMap, start_xy: Sequence[float], goal_xy: Sequence[float],
           max_snap: float = 0.5) -> list[tuple[float, float]] | None:
     """A shortest 8-connected path from start to goal as world points (cell centres, first
@@ -290,11 +281,6 @@ def astar(occ: OccupancyMap, start_xy: Sequence[float], goal_xy: Sequence[float]
         path.append(came[path[-1]])
     path.reverse()
     return [cell_to_world(occ, *divmod(int(flat[n]), cols)) for n in path]
-
-
-def path_length(path: Sequence[Sequence[float]]) -> float:
-    """Summed Euclidean length of a polyline."""
-    return float(sum(math.dist(path[i], path[i + 1]) for i in range(len(path) - 1)))
 
 
 _NUMBER = (int, float, np.floating, np.integer)

@@ -24,8 +24,10 @@ rest, exactly:
   the cells whose values changed, grown by two cells, and its interior is kept.
 
 From scratch (:func:`ridge_fields`) the field is computed on the free cells' bounding
-box grown by one cell, as :func:`sgtool.mapping.voronoi.ridge_cells` does; cells outside
-it are obstacles (distance 0, their own nearest obstacle).
+box grown by one cell: cells outside it are obstacles (distance 0, their own nearest
+obstacle), and the ring of obstacles (or the grid's border) around the box is strictly
+nearer to any free cell than whatever lies beyond it, so the distances and nearest
+obstacles in the box are those of the whole grid (checked cell for cell in the tests).
 """
 
 from __future__ import annotations

@@ -49,13 +49,12 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
-from sgtool.mapping.esdf import distance_field, obstacles
+from sgtool.mapping.esdf import obstacles
 from sgtool.mapping.grid import OccupancyGrid
 from sgtool.mapping.ridge_chains import trace_chain_arrays
 from sgtool.mapping.ridge_window import (
     RidgeFields,
     ridge_fields,
-    ridge_from_fields,
     update_fields,
 )
 from sgtool.mapping.sparsify import sparsify
@@ -134,39 +133,6 @@ class VoronoiGraph:
         rows = np.concatenate([e[:, 0], e[:, 1]])
         cols = np.concatenate([e[:, 1], e[:, 0]])
         return csr_matrix((np.concatenate([w, w]), (rows, cols)), shape=(n, n))
-
-
-def ridge_cells(free: np.ndarray, resolution: float, config: VoronoiConfig
-                ) -> tuple[np.ndarray, np.ndarray]:
-    """(ridge mask before thinning, clearance (m) of every cell); see the module doc.
-
-    Computed on the bounding box of the free cells grown by one cell: every cell outside
-    it is an obstacle (clearance 0, never a ridge), and the ring of obstacles (or the
-    grid's border) around the box is strictly nearer to any free cell than whatever lies
-    beyond it, so the distances and nearest obstacles in the box are those of the whole
-    grid (checked cell for cell against the whole grid in the tests)."""
-    h, w = free.shape
-    rows = np.flatnonzero(free.any(axis=1))
-    if rows.size == 0:
-        return np.zeros((h, w), dtype=bool), np.zeros((h, w))
-    cols = np.flatnonzero(free.any(axis=0))
-    r0, r1 = max(int(rows[0]) - 1, 0), min(int(rows[-1]) + 2, h)
-    c0, c1 = max(int(cols[0]) - 1, 0), min(int(cols[-1]) + 2, w)
-    if (r0, r1, c0, c1) == (0, h, 0, w):
-        return _ridge_cells_whole(free, resolution, config)
-    ridge = np.zeros((h, w), dtype=bool)
-    dist_m = np.zeros((h, w))
-    ridge[r0:r1, c0:c1], dist_m[r0:r1, c0:c1] = _ridge_cells_whole(
-        free[r0:r1, c0:c1], resolution, config)
-    return ridge, dist_m
-
-
-def _ridge_cells_whole(free: np.ndarray, resolution: float, config: VoronoiConfig
-                       ) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`ridge_cells` over the whole of ``free``."""
-    dist_m, feat = distance_field(~free, resolution, with_features=True)
-    assert feat is not None
-    return ridge_from_fields(free, dist_m, feat, resolution, config), dist_m
 
 
 def _zhang_suen_tables() -> tuple[np.ndarray, np.ndarray]:

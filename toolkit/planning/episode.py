@@ -34,7 +34,7 @@ from typing import Any, Protocol
 from sgtool.errors import SgtoolError
 from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.scenegraph.graph import SceneGraph
-from sgtool.semantics.text import category_text
+from sgtool.semantics.text import same_category
 
 
 class SearchEnvironment(Protocol):
@@ -85,8 +85,7 @@ def confirms(step: SearchStep, query: str) -> bool:
     if a.skill != "done" or a.target is None:
         return False
     node = step.graph.node(a.target)
-    return node is not None and \
-        category_text(getattr(node, "category", "") or "") == category_text(query)
+    return node is not None and same_category(getattr(node, "category", "") or "", query)
 
 
 def search_success(env_success: bool, steps: Sequence[SearchStep], query: str,

@@ -55,18 +55,6 @@ class Frontier:
         return "leading out" if self.leading_out else "unexplored area"
 
 
-def reachable_free(occ: OccupancyGrid, start: tuple[float, float] | None,
-                   snap: float = 0.5) -> np.ndarray:
-    """Free cells 4-connected to ``start`` (or to the free cell nearest to it within
-    ``snap``); all free cells when ``start`` is None or not near free space."""
-    free = occ.grid == FREE
-    cell = _start_cell(occ, free, start, snap)
-    if cell is None:
-        return free
-    lab, _ = ndimage.label(free, structure=_FOUR)
-    return lab == lab[cell]
-
-
 def _start_cell(occ: OccupancyGrid, free: np.ndarray, start: tuple[float, float] | None,
                 snap: float) -> tuple[int, int] | None:
     """The free cell nearest to ``start`` within ``snap`` (ties: the first in raster
@@ -86,23 +74,6 @@ def _start_cell(occ: OccupancyGrid, free: np.ndarray, start: tuple[float, float]
     d2 = (rr + r0 - r) ** 2 + (cc + c0 - c) ** 2
     i = int(np.lexsort((cc, rr, d2))[0])
     return int(rr[i] + r0), int(cc[i] + c0)
-
-
-def frontier_cells(occ: OccupancyGrid, start: tuple[float, float] | None = None,
-                   snap: float = 0.5, min_pocket: float = 0.0,
-                   unknown_parts: UnknownParts | None = None) -> np.ndarray:
-    """Free cells (reachable from ``start``) 4-adjacent to unknown and not 8-adjacent to
-    occupied; unknown pockets (4-connected) under ``min_pocket`` m^2 that do not touch the
-    grid border do not count as unknown (the camera's blind ring around the robot, the
-    shadow of a chair: not places to explore). ``unknown_parts``: the
-    :class:`~sgtool.mapping.holes.UnknownParts` of ``occ``, when the caller has them."""
-    parts = unknown_parts if unknown_parts is not None else holes.unknown_parts(occ.grid)
-    rows, cols = _frontier_cells(occ, start, snap,
-                                 _unknown_kinds(parts, min_pocket, occ.resolution),
-                                 parts.near_occupied)
-    mask = np.zeros(occ.shape, dtype=bool)
-    mask[rows, cols] = True
-    return mask
 
 
 _COUNTS, _OUTSIDE = np.uint8(1), np.uint8(2)  # bits of _unknown_kinds
@@ -126,7 +97,10 @@ def _unknown_kinds(parts: UnknownParts, min_pocket: float, resolution: float) ->
 def _frontier_cells(occ: OccupancyGrid, start: tuple[float, float] | None, snap: float,
                     kinds: np.ndarray, near_occupied: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray]:
-    """Rows and columns, in raster order, of :func:`frontier_cells`; the free cells are
+    """Rows and columns, in raster order, of the frontier cells: free cells (4-connected to
+    the free cell :func:`_start_cell` finds, when it finds one) 4-adjacent to a cell of
+    ``kinds`` (:func:`_unknown_kinds`: unknown pockets under ``min_pocket`` off the border
+    do not count) and not 8-adjacent to occupied (``near_occupied``). The free cells are
     labelled only when some candidate needs the test of reaching the start."""
     free = occ.grid == FREE
     unknown = np.pad(kinds != 0, 1, constant_values=True)
@@ -139,14 +113,6 @@ def _frontier_cells(occ: OccupancyGrid, start: tuple[float, float] | None, snap:
         keep = lab[rows, cols] == lab[cell]
         rows, cols = rows[keep], cols[keep]
     return rows, cols
-
-
-def outside_footprint(occ: OccupancyGrid,
-                      unknown_parts: UnknownParts | None = None) -> np.ndarray:
-    """Cells outside the hole-filled footprint of everything seen (free or occupied): the
-    unknown cells 4-connected to the grid border (everything beyond the grid is unseen)."""
-    parts = unknown_parts if unknown_parts is not None else holes.unknown_parts(occ.grid)
-    return (_unknown_kinds(parts, 0.0, occ.resolution) & _OUTSIDE) != 0
 
 
 def find_frontiers(occ: OccupancyGrid, start: tuple[float, float] | None = None,
@@ -173,11 +139,11 @@ def find_frontiers(occ: OccupancyGrid, start: tuple[float, float] | None = None,
         if len(members) < min_cells:
             continue
         rr, cc = rows[members], cols[members]
-        for piece in _split(rr, cc, max_cells):
+        for piece in split_cluster(rr, cc, max_cells):
             if len(piece) < min_cells:
                 continue
             pr, pc = rr[piece], cc[piece]
-            mr, mc = _medoid(pr, pc)
+            mr, mc = cluster_medoid(pr, pc)
             x, y = occ.center_of(mr, mc)
             out.append(Frontier(
                 cells=np.stack([pr, pc], axis=1), medoid=(float(x), float(y)),
@@ -211,7 +177,7 @@ def eight_components(rows: np.ndarray, cols: np.ndarray, width: int) -> tuple[in
     return int(n), labels
 
 
-def _split(rr: np.ndarray, cc: np.ndarray, max_cells: int) -> list[np.ndarray]:
+def split_cluster(rr: np.ndarray, cc: np.ndarray, max_cells: int) -> list[np.ndarray]:
     """Cut a cluster into ceil(k / max_cells) runs along its principal axis: the indices
     of each run's cells."""
     k = len(rr)
@@ -230,7 +196,10 @@ def _split(rr: np.ndarray, cc: np.ndarray, max_cells: int) -> list[np.ndarray]:
     return np.array_split(order, parts)
 
 
-def _medoid(rr: np.ndarray, cc: np.ndarray, cap: int = 256) -> tuple[int, int]:
+def cluster_medoid(rr: np.ndarray, cc: np.ndarray, cap: int = 256) -> tuple[int, int]:
+    """The cell (row, col) of the cluster (``rr``, ``cc``) with the least summed Euclidean
+    distance to the others, among at most ``cap`` evenly spaced cells of it (ties: the
+    first in the given order)."""
     k = len(rr)
     idx = np.arange(k) if k <= cap else np.linspace(0, k - 1, cap).round().astype(np.int64)
     r, c = rr[idx].astype(np.float64), cc[idx].astype(np.float64)

@@ -108,13 +108,3 @@ def room_check(scorer: RelationScorer, rooms: Sequence[str],
             misses.append(RoomMiss(o.name, o.room, got))
     return RoomCheck(getattr(scorer, "name", type(scorer).__name__), len(objects),
                      len(objects) - len(misses), tuple(misses))
-
-
-def format_checks(checks: Sequence[RoomCheck], show_misses: bool = False) -> str:
-    """One line per scorer (accuracy, hits / n), optionally its misses."""
-    lines = []
-    for c in checks:
-        lines.append(f"  {c.scorer:<28} top-1 {c.accuracy:.3f} ({c.hits}/{c.n})")
-        if show_misses:
-            lines += [f"    {m.name}: {m.expected} -> {m.got}" for m in c.misses]
-    return "\n".join(lines)

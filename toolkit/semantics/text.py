@@ -28,5 +28,6 @@ def category_text(name: str) -> str:
 
 def same_category(a: str, b: str) -> bool:
     """Exact match of two category names after :func:`category_text` (no embeddings): the
-    test the planners use to decide that the query object has been observed."""
+    test that an object is of the query's category (a ``done`` that names one confirms
+    the search: :func:`sgtool.planning.episode.confirms`)."""
     return category_text(a) == category_text(b)

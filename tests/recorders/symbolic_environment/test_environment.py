@@ -8,10 +8,11 @@ import math
 
 import numpy as np
 import pytest
+from support.path_lengths import shortest_path_length
 from support.symbolic_fixtures import three_rooms
 
 from sgtool.house.io import load_house
-from sgtool.mapping.occupancy import house_occupancy, shortest_path_length
+from sgtool.mapping.occupancy import house_occupancy
 from sgtool.planning.base import Action, Feedback
 from sgtool.recorders.symbolic_environment import (
     SymbolicEnv,

@@ -10,6 +10,7 @@ import math
 import numpy as np
 import pytest
 from support.datasets_fixtures import two_rooms
+from support.path_lengths import path_length, shortest_path_length
 
 from sgtool.errors import SpecError
 from sgtool.house.io import load_house, save_house
@@ -19,8 +20,6 @@ from sgtool.mapping.occupancy import (
     cell_to_world,
     geodesic_distances,
     house_occupancy,
-    path_length,
-    shortest_path_length,
     world_to_cell,
 )
 

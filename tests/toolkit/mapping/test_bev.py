@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from support.bev_reference import occupancy_from_keys
 from support.synthetic_world import camera_pose
 
 from sgtool.mapping.bev import (
@@ -13,11 +14,10 @@ from sgtool.mapping.bev import (
     estimate_floor_level,
     floor_fans,
     line_of_sight,
-    occupancy_from_keys,
 )
 from sgtool.mapping.esdf import distance_field
 from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN
-from sgtool.mapping.holes import fill_holes
+from sgtool.mapping.holes import fill_holes_parts
 from sgtool.mapping.occupancy import inflate
 from sgtool.mapping.voxels import pack
 
@@ -79,8 +79,8 @@ def test_small_enclosed_holes_are_filled() -> None:
     grid[7, 9] = OCCUPIED
     grid[0, 5] = UNKNOWN  # on the border: kept
     grid[2:5, 7:10] = UNKNOWN  # 9 cells: too big
-    filled = fill_holes(grid, 4)
-    assert filled == 4
+    filled, parts = fill_holes_parts(grid, 4)
+    assert filled == 4 and parts is not None and parts.filled.sum() == 1
     assert (grid[2:4, 2:4] == FREE).all()
     assert (grid[5:7, 7:9] == UNKNOWN).all() and grid[0, 5] == UNKNOWN
     assert (grid[2:5, 7:10] == UNKNOWN).all()

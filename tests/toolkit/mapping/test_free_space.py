@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
+from support.free_space_reference import near_depth
 from support.synthetic_world import camera_pose
 
 from sgtool.log.frame import CameraIntrinsics, Frame
-from sgtool.mapping.free_space import FreeSpaceConfig, View, near_depth, seen_through
+from sgtool.mapping.free_space import RADII, FreeSpaceConfig, View, seen_through
 from sgtool.mapping.voxels import VoxelMap, unpack
 
 K = CameraIntrinsics.from_fov(40, 30, 60)
@@ -22,10 +24,24 @@ def test_near_depth_takes_the_nearest_neighbour_and_holes_spread() -> None:
     d = np.full((5, 6), 4.0, dtype=np.float32)
     d[2, 2] = 1.0  # a thin thing
     d[0, 5] = 0.0  # a hole
-    got = near_depth(d, 0.1, 1)
+    assert RADII[0] == 1
+    got = View.of(POSE, K, d, 0.1).levels[0]
     assert (got[1:4, 1:4] == 1.0).all()  # the thin thing's pixel and its neighbours
     assert got[0, 4] == 0.0 and got[1, 5] == 0.0  # next to the hole: no evidence
     assert got[4, 0] == 4.0
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_view_levels_are_the_near_depth_at_every_radius(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    h, w = int(rng.integers(1, 40)), int(rng.integers(1, 40))
+    d = rng.uniform(0.0, 6.0, (h, w)).astype(np.float32)  # below 0.3 m: invalid
+    d[rng.random((h, w)) < 0.02] = np.nan
+    d[rng.random((h, w)) < 0.02] = np.inf
+    levels = View.of(POSE, K, d, 0.3).levels
+    assert levels.shape == (len(RADII), h, w) and levels.dtype == np.float32
+    for level, radius in zip(levels, RADII, strict=True):
+        assert np.array_equal(level, near_depth(d, 0.3, radius))
 
 
 def test_a_point_in_front_of_the_seen_surface_is_seen_through() -> None:

@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 import pytest
+from support.path_lengths import path_length
 
 from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.live_paths import (
@@ -22,7 +23,7 @@ from sgtool.mapping.live_paths import (
     stand_goal,
     traversable,
 )
-from sgtool.mapping.occupancy import geodesic_distances, path_length
+from sgtool.mapping.occupancy import geodesic_distances
 
 RES = 0.1
 

@@ -45,7 +45,7 @@ def test_min_clearance_decides_which_doorways_the_graph_crosses() -> None:
     """The Voronoi graph goes through a doorway only when its ridge there is clear by
     ``min_clearance``. In a doorway of an even number k of cells the ridge runs between
     the two middle cells, which are k/2 cells from the jambs, and a ridge needs both cells
-    of the pair clear (:func:`sgtool.mapping.voronoi.ridge_cells`):
+    of the pair clear (:func:`sgtool.mapping.ridge_window.ridge_from_fields`):
 
     - 14 cells (0.42 m): clearance 7 x 3 cm = 0.21 m, just above the default 0.2 m: the
       graph crosses; at 1.2 x 0.2 = 0.24 m it does not;

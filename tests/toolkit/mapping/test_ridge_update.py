@@ -9,10 +9,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy import ndimage
+from support.ridge_reference import whole_grid_ridge
 
 from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.ridge_window import ridge_fields, update_fields
-from sgtool.mapping.voronoi import VoronoiConfig, _ridge_cells_whole, ridge_graph
+from sgtool.mapping.voronoi import VoronoiConfig, ridge_graph
 
 RES = 0.05
 CFG = VoronoiConfig()
@@ -49,7 +50,7 @@ def assert_whole_grid(fields, free: np.ndarray) -> None:  # noqa: ANN001
     padded = np.pad(free, 1, constant_values=False)
     ref_feat = ndimage.distance_transform_edt(padded, return_distances=False,
                                               return_indices=True)[:, 1:-1, 1:-1] - 1
-    ref_ridge, ref_dist = _ridge_cells_whole(free, RES, CFG)
+    ref_ridge, ref_dist = whole_grid_ridge(free, RES, CFG)
     assert np.array_equal(fields.free, free)
     assert np.array_equal(fields.feat, ref_feat)
     assert np.array_equal(fields.dist_m, ref_dist)

@@ -1,15 +1,18 @@
 """Shortcuts of the Voronoi ridge stage equal the plain computation bit for bit: the
-distance field from scipy's feature transform alone, and the ridge computed on the free
-cells' bounding box (plus one cell) instead of the whole grid."""
+distance field from scipy's feature transform alone, and the ridge computed from scratch on
+the free cells' bounding box (plus one cell, :func:`sgtool.mapping.ridge_window.ridge_fields`)
+instead of the whole grid (``support.ridge_reference``)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 from scipy import ndimage
+from support.ridge_reference import whole_grid_ridge
 
 from sgtool.mapping.esdf import distance_field
-from sgtool.mapping.voronoi import VoronoiConfig, _ridge_cells_whole, ridge_cells
+from sgtool.mapping.ridge_window import ridge_fields
+from sgtool.mapping.voronoi import VoronoiConfig
 
 RES = 0.05
 
@@ -46,12 +49,13 @@ def test_distance_field_equals_scipy(seed: int) -> None:
 def test_ridge_on_the_free_box_equals_the_whole_grid(seed: int) -> None:
     free = random_free(seed)
     cfg = VoronoiConfig()
-    ridge, dist = ridge_cells(free, RES, cfg)
-    ref_ridge, ref_dist = _ridge_cells_whole(free, RES, cfg)
-    assert np.array_equal(ridge, ref_ridge) and np.array_equal(dist, ref_dist)
-    assert ridge.any()  # rooms wide enough to have a centre line
+    fields = ridge_fields(free, RES, cfg)
+    ref_ridge, ref_dist = whole_grid_ridge(free, RES, cfg)
+    assert np.array_equal(fields.ridge0, ref_ridge) and np.array_equal(fields.dist_m, ref_dist)
+    assert fields.ridge0.any()  # rooms wide enough to have a centre line
 
 
 def test_no_free_cell_no_ridge() -> None:
-    ridge, dist = ridge_cells(np.zeros((5, 7), dtype=bool), RES, VoronoiConfig())
+    fields = ridge_fields(np.zeros((5, 7), dtype=bool), RES, VoronoiConfig())
+    ridge, dist = fields.ridge0, fields.dist_m
     assert ridge.shape == dist.shape == (5, 7) and not ridge.any() and not dist.any()
