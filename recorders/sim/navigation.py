@@ -24,7 +24,8 @@ from scipy import ndimage
 
 from sgtool.errors import SgtoolError
 from sgtool.house.spec import HouseSpec, Room
-from sgtool.mapping.occupancy import OccupancyMap, house_occupancy
+from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
+from sgtool.mapping.occupancy import OccupancyMap, house_occupancy, inflate
 from sgtool.mapping.raster import cell_centers, fill_box_grown, polygon_mask
 from sgtool.recorders.sim.articulation import Box2
 
@@ -72,8 +73,29 @@ def occupancy_with(spec: HouseSpec, door_states: Mapping[str, str], extra: Seque
     occ = base.occupied.copy()
     for x, y, sx, sy, yaw in extra:
         fill_box_grown(base, occ, (x, y), (sx, sy), yaw)
-    return OccupancyMap.of_occupied(occ, base.origin, base.resolution, robot.radius,
-                                    doors_passable)
+    return with_occupied(base, occ)
+
+
+def with_occupied(base: OccupancyMap, occupied: np.ndarray) -> OccupancyMap:
+    """The map of ``occupied`` (``base.occupied`` plus cells), equal to
+    ``OccupancyMap.of_occupied(occupied, ...)`` with ``base``'s origin, resolution, radius
+    and door rule; only the window around the added cells is grown by the radius (a cell
+    is blocked when it is in ``base`` or near an added cell, and every cell near an added
+    cell lies in that window)."""
+    res, radius = base.resolution, base.robot_radius
+    if not base.occupied.any():  # (the distance transform needs an occupied cell)
+        return OccupancyMap.of_occupied(occupied, base.origin, res, radius,
+                                        base.closed_doors_free)
+    added = occupied & ~base.occupied
+    blocked = base.blocked.copy()
+    if added.any():
+        rows, cols = np.nonzero(added)
+        k = int(math.ceil((radius + res / 2.0) / res)) + 1
+        win = (slice(max(int(rows.min()) - k, 0), int(rows.max()) + k + 1),
+               slice(max(int(cols.min()) - k, 0), int(cols.max()) + k + 1))
+        blocked[win] |= inflate(occupied[win], radius, res)
+    grid = OccupancyGrid(np.where(occupied, OCCUPIED, FREE).astype(np.int8), base.origin, res)
+    return OccupancyMap(grid, blocked, radius, base.closed_doors_free)
 
 
 # the house maps of the last few specs, by door states and robot (house_occupancy is the

@@ -8,9 +8,10 @@ import math
 import numpy as np
 from support.small_house import small_house
 
-from sgtool.mapping.occupancy import astar, geodesic_distances, world_to_cell
+from sgtool.mapping.occupancy import OccupancyMap, astar, geodesic_distances, world_to_cell
 from sgtool.recorders.sim import articulation as art
 from sgtool.recorders.sim import navigation as nav
+from sgtool.recorders.sim.navigation import with_occupied
 
 
 def line_is_free(grid, a, b) -> bool:
@@ -166,3 +167,25 @@ def test_house_maps_are_kept_per_spec_and_door_states() -> None:
     other = small_house(door="closed")  # an equal spec, another object: its own entry
     assert np.array_equal(nav.occupancy_with(other, {"door_0": "closed"}, [], robot).blocked,
                           closed.blocked)
+
+
+def test_with_occupied_equals_the_map_grown_from_scratch() -> None:
+    """Adding occupied cells to a map grows only the window around them by the radius; the
+    blocked and occupied cells equal those of the map built from scratch (random grids,
+    radii and added blocks, a base without an occupied cell included)."""
+    rng = np.random.default_rng(0)
+    for trial in range(200):
+        shape = (int(rng.integers(5, 60)), int(rng.integers(5, 60)))
+        occ0 = rng.random(shape) < rng.uniform(0.0, 0.3)
+        radius = float(rng.choice([0.0, 0.05, 0.12, 0.2, 0.33]))
+        base = OccupancyMap.of_occupied(occ0, (0.3, -1.2), 0.05, radius, bool(trial % 2))
+        occ = occ0.copy()
+        for _ in range(int(rng.integers(0, 4))):
+            r, c = int(rng.integers(0, shape[0])), int(rng.integers(0, shape[1]))
+            occ[r:r + int(rng.integers(1, 6)), c:c + int(rng.integers(1, 6))] = True
+        got = with_occupied(base, occ)
+        want = OccupancyMap.of_occupied(occ, base.origin, 0.05, radius, base.closed_doors_free)
+        assert np.array_equal(got.blocked, want.blocked), trial
+        assert np.array_equal(got.occupied, want.occupied), trial
+        assert (got.origin, got.robot_radius, got.closed_doors_free) == \
+            (want.origin, want.robot_radius, want.closed_doors_free)
