@@ -38,6 +38,7 @@ from sgtool.log.file_walk import Item, Layout, walk
 from sgtool.log.log_file import require_regular_file
 from sgtool.log.mcap_records import MAGIC
 from sgtool.log.message_check import message_problem
+from sgtool.output_check import check_output
 
 Status = Literal["complete", "unverified", "truncated", "corrupt"]
 _OUTSIDE_CHUNKS = -1  # the key of messages outside chunks among the per-chunk counts
@@ -333,7 +334,9 @@ def recover(path: str | os.PathLike[str], out: str | os.PathLike[str],
 
     Messages are written in the order they were found; the MCAP index of the new file lets
     readers iterate them in log-time order. ``out`` is written atomically and must not be
-    the input file.
+    the input file; it passes the one output check (:func:`sgtool.output_check.check_output`,
+    its errors naming ``--recover``, the option of ``sgtool doctor`` that gives it) before
+    anything is read.
     """
     src, dst = Path(path), Path(out)
     if not src.exists():
@@ -341,13 +344,8 @@ def recover(path: str | os.PathLike[str], out: str | os.PathLike[str],
     require_regular_file(src)
     if dst.exists() and os.path.samefile(src, dst):
         raise SgtoolError(f"refusing to write the recovered log over its input {src}")
-    if dst.is_dir():
-        raise SgtoolError(f"{dst} is a folder, not a file name")
-    if dst.exists() and not overwrite:
-        raise SgtoolError(f"{dst} exists; not overwriting it (use --force)")
+    check_output(dst, force=overwrite, option="--recover")
     _require_magic(src)
-    if not dst.parent.exists():
-        raise SgtoolError(f"folder {dst.parent} does not exist")
     diag = Diagnosis(str(src), src.stat().st_size)
     with open(src, "rb") as f, _mapped(f, diag.size) as buf, atomic_open(dst, "wb") as o:
         copier = _Copier(o)

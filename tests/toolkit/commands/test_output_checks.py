@@ -25,6 +25,7 @@ COMMANDS = {
     "record": (["record", "--frames", "1", "-o", "{out}"], ".mcap"),
     "run": (["run", "--planner", "random", "--frames", "1", "-o", "{out}"], ".mcap"),
     "eval": (["eval", str(GOLDEN_LOG), "-o", "{out}"], ".txt"),
+    "doctor --recover": (["doctor", str(GOLDEN_LOG), "--recover", "{out}"], ".mcap"),
     "scenes generate": (["scenes", "generate", "-o", "{out}"], ".json"),
     "scenes show": (["scenes", "show", "{house}", "-o", "{out}"], ".png"),
     "view": (["view", str(GOLDEN_LOG), "-o", "{out}"], ".rrd"),
