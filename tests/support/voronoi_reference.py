@@ -8,9 +8,10 @@ from bisect import bisect_left
 from itertools import chain
 
 import numpy as np
+from scipy.sparse import csr_matrix
 
 from sgtool.mapping.grid import OccupancyGrid
-from sgtool.mapping.ridge_chains import _trace_chains
+from sgtool.mapping.ridge_chains import trace_chain_arrays
 from sgtool.mapping.voronoi import (
     RidgeGraph,
     VoronoiConfig,
@@ -39,7 +40,7 @@ def reference_voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = N
     keep = np.flatnonzero(comp == target)
     flat = flat[keep]
     adj = submatrix(adj, keep)
-    chains = _trace_chains(adj)
+    chains = chain_lists(adj)
     n = adj.shape[0]
     deg = np.diff(adj.indptr)
     # drop short spurs (leaf chains ending at a junction)
@@ -109,3 +110,11 @@ def reference_voronoi_graph(occ: OccupancyGrid, config: VoronoiConfig | None = N
     edge_cells = tuple(edge_map[k][1] for k in keys)
     return VoronoiGraph(None, positions, clearance, np.stack([rows, cols], axis=1), edges,
                         lengths, edge_cells, rg.ridge, (h, w))
+
+
+def chain_lists(adj: csr_matrix) -> list[tuple[list[int], list[float]]]:
+    """:func:`~sgtool.mapping.ridge_chains.trace_chain_arrays` as a list of (pixel list,
+    cumulative lengths in cells), one per chain, in its order."""
+    ch = trace_chain_arrays(adj)
+    pix, cum, start = ch.pix.tolist(), ch.cum.tolist(), ch.start.tolist()
+    return [(pix[a:b], cum[a:b]) for a, b in zip(start[:-1], start[1:], strict=True)]

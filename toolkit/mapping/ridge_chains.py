@@ -9,23 +9,14 @@ from scipy.sparse import csr_matrix
 
 from sgtool.mapping.sparsify import Chains, chain_cumsum
 
-__all__ = ["_reverse_entries", "_trace_chains", "trace_chain_arrays"]
 
-
-def _reverse_entries(adj: csr_matrix) -> np.ndarray:
+def reverse_entries(adj: csr_matrix) -> np.ndarray:
     """For each stored entry (i, j) of a symmetric CSR matrix with sorted indices, the
     position of the entry (j, i)."""
     n = adj.shape[0]
     rows = np.repeat(np.arange(n, dtype=np.int64), np.diff(adj.indptr))
     cols = adj.indices.astype(np.int64)
     return np.searchsorted(rows * n + cols, cols * n + rows)
-
-
-def _trace_chains(adj: csr_matrix) -> list[tuple[list[int], list[float]]]:
-    """:func:`trace_chain_arrays` as a list of (pixel list, cumulative lengths)."""
-    ch = trace_chain_arrays(adj)
-    pix, cum, start = ch.pix.tolist(), ch.cum.tolist(), ch.start.tolist()
-    return [(pix[a:b], cum[a:b]) for a, b in zip(start[:-1], start[1:], strict=True)]
 
 
 def trace_chain_arrays(adj: csr_matrix) -> Chains:
@@ -50,7 +41,7 @@ def trace_chain_arrays(adj: csr_matrix) -> Chains:
         return Chains(np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros(0))
     deg = np.diff(indptr)
     row = np.repeat(np.arange(n, dtype=np.int64), deg)
-    rev = _reverse_entries(adj)
+    rev = reverse_entries(adj)
     # successor of entry k (row[k] -> q): q's other entry when q has degree 2
     q = indices
     mid = np.flatnonzero(deg[q] == 2)

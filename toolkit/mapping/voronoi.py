@@ -185,7 +185,7 @@ def thin(mask: np.ndarray) -> np.ndarray:
     return img.reshape(h + 2, ww)[1:-1, 1:-1].astype(bool)
 
 
-def _pixel_graph(mask: np.ndarray) -> tuple[np.ndarray, csr_matrix]:
+def pixel_graph(mask: np.ndarray) -> tuple[np.ndarray, csr_matrix]:
     """(flat indices of the mask's pixels in raster order, adjacency with step lengths in
     cells): 4-neighbours always, diagonal neighbours only without a 4-neighbour detour.
     Neighbours are looked up for the set pixels only, in the zero-padded image."""
@@ -245,7 +245,7 @@ def ridge_graph(occ: OccupancyGrid, config: VoronoiConfig | None = None,
     if fields is None:
         fields = ridge_fields(free, occ.resolution, cfg)
     ridge = thin(fields.ridge0)
-    flat, adj = _pixel_graph(ridge)
+    flat, adj = pixel_graph(ridge)
     if len(flat):
         _, comp = connected_components(adj, directed=False)
     else:

@@ -8,9 +8,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy.sparse import csr_matrix
+from support.voronoi_reference import chain_lists
 
-from sgtool.mapping.ridge_chains import _reverse_entries, _trace_chains
-from sgtool.mapping.voronoi import _pixel_graph, thin
+from sgtool.mapping.ridge_chains import reverse_entries
+from sgtool.mapping.voronoi import pixel_graph, thin
 
 
 def reference_chains(adj: csr_matrix) -> list[tuple[list[int], list[float]]]:
@@ -82,7 +83,7 @@ def reference_thin(mask: np.ndarray) -> np.ndarray:
     return out
 
 
-def reference_pixel_graph(mask: np.ndarray) -> tuple[np.ndarray, csr_matrix]:
+def referencepixel_graph(mask: np.ndarray) -> tuple[np.ndarray, csr_matrix]:
     """The pixel graph as it was (dense shifted masks over the whole image)."""
     h, w = mask.shape
     flat = np.flatnonzero(mask.ravel())
@@ -128,8 +129,8 @@ def random_mask(seed: int, size: int = 60) -> np.ndarray:
 @pytest.mark.parametrize("seed", range(12))
 def test_chains_equal_the_reference_walk(seed: int) -> None:
     mask = thin(random_mask(seed))
-    _, adj = _pixel_graph(mask)
-    got = _trace_chains(adj)
+    _, adj = pixel_graph(mask)
+    got = chain_lists(adj)
     assert got == reference_chains(adj)
     assert len(got) > 5  # the masks do have junctions, ends and loops
 
@@ -149,20 +150,20 @@ def test_pixel_graph_equals_the_dense_reference(seed: int) -> None:
     mask = random_mask(seed, size=int(20 + 9 * seed))
     mask[-1, :] = True  # pixels on the border
     for m in (mask, thin(mask)):
-        flat, adj = _pixel_graph(m)
-        ref_flat, ref_adj = reference_pixel_graph(m)
+        flat, adj = pixel_graph(m)
+        ref_flat, ref_adj = referencepixel_graph(m)
         assert np.array_equal(flat, ref_flat) and flat.dtype == ref_flat.dtype
         for part in ("indptr", "indices", "data"):
             assert np.array_equal(getattr(adj, part), getattr(ref_adj, part))
         assert adj.nnz > 0
 
 
-def test_pure_loop_and_reverse_entries() -> None:
+def test_pure_loop_andreverse_entries() -> None:
     ring = np.zeros((9, 9), dtype=bool)
     ring[2, 2:7] = ring[6, 2:7] = ring[2:7, 2] = ring[2:7, 6] = True
-    _, adj = _pixel_graph(ring)
-    (path, cum), = _trace_chains(adj)  # one loop, from its lowest pixel back to it
+    _, adj = pixel_graph(ring)
+    (path, cum), = chain_lists(adj)  # one loop, from its lowest pixel back to it
     assert path[0] == path[-1] == 0 and len(path) == 17 and cum[-1] == pytest.approx(16.0)
-    rev = _reverse_entries(adj)
+    rev = reverse_entries(adj)
     rows = np.repeat(np.arange(adj.shape[0]), np.diff(adj.indptr))
     assert (adj.indices[rev] == rows).all() and (rows[rev] == adj.indices).all()
