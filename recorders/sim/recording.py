@@ -158,10 +158,10 @@ class LogRecorder(SimObserver):
         record (e.g. ``graph_time_ns``). Returns the record's log time."""
         t = sim.time_ns(max(sim.tick_index - 1, 0)) if outcome.ticks else sim.time_ns()
         t = max(t, self.last_time_ns)
-        record = Action(
-            skill=outcome.skill, target=outcome.target, outcome=outcome.outcome,
-            reason=outcome.reason, travelled_m=outcome.travelled_m,
-            decision_time_s=float(decision_time_s), planner=self.planner, step=self.actions)
+        decided = Action(outcome.skill, outcome.target, reason=outcome.reason,
+                         decision_time_s=float(decision_time_s))
+        record = decided.executed(outcome.outcome, outcome.travelled_m, planner=self.planner,
+                                  step=self.actions)
         self.writer.write_record(dataclasses.replace(record, **(fields or {})), t)
         self.actions += 1
         return t
