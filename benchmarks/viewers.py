@@ -13,12 +13,10 @@ import argparse
 import os
 import shutil
 import statistics
-import sys
 import tempfile
-import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from harness import support, timed
 
 
 def size(p: Path) -> int:
@@ -35,7 +33,7 @@ def main() -> None:
     ap.add_argument("--derived", type=Path, default=None)
     ap.add_argument("-r", "--repeat", type=int, default=3)
     a = ap.parse_args()
-    from support.logfixtures import write_log
+    write_log = support("logfixtures").write_log
 
     from sgtool.analysis.rerun_view import export
 
@@ -45,9 +43,8 @@ def main() -> None:
         times, sizes = [], []
         for i in range(a.repeat):
             out = tmp / f"v{i}.rrd"
-            t0 = time.perf_counter()
-            export(log, out)
-            times.append(time.perf_counter() - t0)
+            _, sample = timed(lambda out=out: export(log, out))
+            times.append(sample.wall_s)
             sizes.append(out.stat().st_size / 1e6)
         print(f"view {a.frames} frames: {spread(times)} s, rrd {spread(sizes)} MB "
               f"(log {log.stat().st_size / 1e6:.2f} MB)")
@@ -59,9 +56,8 @@ def main() -> None:
                 times, ratios = [], []
                 for i in range(a.repeat):
                     out = tmp / f"{i}{name}"
-                    t0 = time.perf_counter()
-                    export_bag(a.derived, out, fmt)
-                    times.append(time.perf_counter() - t0)
+                    _, sample = timed(lambda out=out, fmt=fmt: export_bag(a.derived, out, fmt))
+                    times.append(sample.wall_s)
                     ratios.append(size(out) / 1e6 / mb)
                 print(f"export {fmt}: {spread(times)} s, {spread([mb / t for t in times])} "
                       f"derived MB/s, bag/derived {spread(ratios)} (derived {mb:.2f} MB)")
