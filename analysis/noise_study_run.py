@@ -4,7 +4,9 @@ summary shown.
 
 The command checks the options and builds :class:`NoiseStudyRequest`; the study is
 :func:`sgtool.analysis.noise_study.run_study`, the closed-loop part
-:func:`sgtool.analysis.noise_study.run_closed_loop`, the folder
+:func:`sgtool.analysis.noise_study.run_closed_loop` (its episodes run as `run-bench`'s do:
+:class:`~sgtool.analysis.closed_loop_bench_run.EpisodeRunner`, logs written as they finish,
+sent back from other nodes), the folder
 :func:`sgtool.files.output_folder`. ``show`` receives the summary and the closing line.
 """
 
@@ -43,7 +45,8 @@ class NoiseStudyRequest:
 def study_into(request: NoiseStudyRequest, show: Echo) -> None:
     """Run the study into ``request.out_dir``: summary.md, results.json, results.csv,
     plots/ and, with closed-loop planners, closed_loop/; then show the summary."""
-    from sgtool.analysis.executor import as_map, make_executor
+    from sgtool.analysis.closed_loop_bench_run import EpisodeRunner
+    from sgtool.analysis.executor import make_executor
     from sgtool.analysis.noise_study import run_closed_loop, run_study
     from sgtool.analysis.noise_study_plots import plot_study
     from sgtool.analysis.noise_study_tables import results_csv, results_json, summary_md
@@ -58,8 +61,8 @@ def study_into(request: NoiseStudyRequest, show: Echo) -> None:
             from sgtool.analysis.closed_loop_bench import write_outputs
 
             cl = run_closed_loop(cfg, res.specs, out / "closed_loop",
-                                 runner=as_map(runner, progress=show_bars, desc="closed loop",
-                                               task_id=lambda _, t: str(t.output)))
+                                 runner=EpisodeRunner(runner, out / "closed_loop",
+                                                      progress=show_bars))
             write_outputs(cl, out / "closed_loop")
             res = replace(res, closed_loop=cl)
         atomic_write(out / "summary.md", summary_md(res))

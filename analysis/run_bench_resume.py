@@ -1,6 +1,8 @@
 """Whether an episode log already in a ``run-bench`` folder may stand for a task: it must
-have been run with the task's settings (episode, steps, frames, resolution, navigation,
-noise, seed, success rule) on the same house.
+have been run with the task's settings (episode, steps, frames, resolution, which ticks
+are frames, navigation, noise, seed, success rule) on the same house. A log without the
+frame settings (``render_step_m``, ``turn_render_deg``: older code rendered other ticks)
+is not reused.
 
 The house is compared in canonical form: the spec the log carries (its ``house.json``
 attachment) is parsed as any house file is and its canonical JSON compared with that of
@@ -33,6 +35,8 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
     """The settings a task's log must have been run with (as :func:`logged_settings`)."""
     return {"episode": episode, "max_steps": opts.max_steps, "frame_budget": opts.frames,
             "size": [opts.camera.width, opts.camera.height],
+            "render_step_m": float(opts.render_step_m),
+            "turn_render_deg": float(opts.turn_render_deg),
             "navigation": opts.navigation, "noise": parse_noise(noise).to_dict(),
             "seed": opts.planner_seed, "success": opts.success}
 
@@ -52,6 +56,8 @@ def _logged(path: Path) -> tuple[dict[str, Any], str | None]:
     return ({"episode": ep, "max_steps": x.get("max_steps"),
              "frame_budget": x.get("frame_budget"),
              "size": [cam.get("width"), cam.get("height")],
+             "render_step_m": x.get("render_step_m"),
+             "turn_render_deg": x.get("turn_render_deg"),
              "navigation": (x.get("navigation") or {}).get("mode", "house"),
              "noise": x.get("noise"), "seed": x.get("seed"),
              "success": x.get("success", "observed")}, house)
@@ -74,8 +80,9 @@ def same_house(logged: str | None, spec: HouseSpec) -> bool:
 
 # the settings by their names in messages
 _LABELS = {"episode": "episode", "max_steps": "max steps", "frame_budget": "frame budget",
-           "size": "resolution", "navigation": "navigation", "noise": "noise", "seed": "seed",
-           "success": "success rule"}
+           "size": "resolution", "render_step_m": "render step (m)",
+           "turn_render_deg": "turn render angle (deg)", "navigation": "navigation",
+           "noise": "noise", "seed": "seed", "success": "success rule"}
 
 
 def settings_differences(logged: dict[str, Any], want: dict[str, Any]) -> list[str]:

@@ -22,11 +22,13 @@ from collections.abc import Mapping
 from typing import Any
 
 from sgtool.log.echo import as_logged
+from sgtool.log.records import Instances
 from sgtool.log.writer import LogWriter
 from sgtool.recorders.sim.keyframes import KeyframeRule
 from sgtool.recorders.sim.recording import LogRecorder
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome
 from sgtool.scenegraph.derived_layers import write_refresh
+from sgtool.scenegraph.instances import instances_from_record
 from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 
 
@@ -48,9 +50,12 @@ class LiveRecorder(LogRecorder):
         self._pending: int | None = None  # the last tick, when it was no frame
 
     def write_instances(self, sim: Simulation) -> None:
-        super().write_instances(sim)
-        assert self.last_instances is not None
-        self.stream.instances(sim.time_ns(), self.last_instances)
+        """Write the instance table (as :class:`LogRecorder` does) and hand the stream the
+        JSON form the writer checked and wrote, read once."""
+        t = sim.time_ns()
+        self.last_instances = Instances.of(sim.instance_records())
+        written = self.writer.write_record(self.last_instances, t)
+        self.stream.instance_table(t, instances_from_record(written))
 
     def on_state(self, sim: Simulation, spec_id: str, state: str) -> None:
         super().on_state(sim, spec_id, state)

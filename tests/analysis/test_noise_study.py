@@ -164,3 +164,30 @@ def test_closed_loop_rows_are_the_run_bench_episodes(study: dict[str, Path]) -> 
     sr = [f"{float(x['success']):.3f}" for x in rows]
     assert re.search(rf"^\| scout +\| none +\| 1 +\| {sr[0]} ", text, re.M)
     assert re.search(rf"^\| scout +\| holes=0\.05 +\| 1 +\| {sr[1]} ", text, re.M)
+
+
+def test_closed_loop_episodes_run_as_run_bench_runs_them(study: dict[str, Path],
+                                                         monkeypatch) -> None:
+    """The study's closed loop goes through run-bench's episode runner (logs land in the
+    output folder as episodes finish, and come back from other nodes): every task passes
+    through it, its log in the study's closed_loop/logs."""
+    from sgtool.analysis.closed_loop_bench_run import EpisodeRunner
+
+    seen: list[Path] = []
+    call = EpisodeRunner.__call__
+
+    def spy(self, fn, items):  # type: ignore[no-untyped-def]
+        items = list(items)
+        seen.extend(t.output for t in items)
+        return call(self, fn, items)
+
+    monkeypatch.setattr(EpisodeRunner, "__call__", spy)
+    out = study["root"] / "runner"
+    r = _study(study["house"], study["cache"], out, "--closed-loop", "scout", "--episodes",
+               "1", "--frames-per-room", "20")
+    assert r.exit_code == 0, r.output
+    runs = [json.loads(line) for line in (out / "closed_loop" / "episodes.jsonl").open()]
+    assert len(seen) == len(runs) >= 1  # one task per noise profile, each through it
+    for p in seen:
+        assert p.parts[-6:-4] == ("closed_loop", "logs") and p.name == "ep-000.mcap"
+        assert out.joinpath(*p.parts[-6:]).exists()

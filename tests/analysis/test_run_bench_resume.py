@@ -72,3 +72,28 @@ def test_a_changed_house_file_is_not_resumed(tmp_path: Path, monkeypatch) -> Non
     res = CliRunner().invoke(cli, other)
     assert res.exit_code == 2
     assert "was run with other settings (max steps: 2 in the log, 3 now)" in res.output
+
+
+def test_a_log_of_other_frame_settings_is_not_resumed(tmp_path: Path) -> None:
+    """Which ticks are frames is a setting of the log: a run with another render step or
+    turn angle does not reuse it (the message names the setting), the same ones do."""
+    from sgtool.analysis.run_bench_resume import _logged, task_settings
+    from sgtool.recorders.sim.camera import CameraConfig
+    from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
+
+    spec = generate_house(6, rooms=(4, 4))
+    house = tmp_path / "myhouse.json"
+    save_house(spec, house)
+    out = tmp_path / "rb"
+    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house), "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    logged, _ = _logged(out / "logs/none/random/myhouse/ep-000.mcap")
+    opts = ClosedLoopOptions(camera=CameraConfig(width=64, height=48), max_steps=2, frames=60)
+    ep = logged["episode"]
+    assert settings_differences(logged, task_settings(opts, "none", ep)) == []
+    assert settings_differences(
+        logged, task_settings(dataclasses.replace(opts, render_step_m=0.5), "none", ep)) \
+        == ["render step (m): 0.25 in the log, 0.5 now"]
+    assert settings_differences(
+        logged, task_settings(dataclasses.replace(opts, turn_render_deg=0.0), "none", ep)) \
+        == ["turn render angle (deg): 20.0 in the log, 0.0 now"]

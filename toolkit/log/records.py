@@ -35,6 +35,7 @@ an enumeration is a :class:`~sgtool.errors.LogFormatError` naming the channel, t
 from __future__ import annotations
 
 import enum
+import json
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from typing import TYPE_CHECKING, Any, ClassVar, Final, Literal, TypeVar, overload
@@ -157,28 +158,39 @@ class JsonRecord:
         out, tuples as lists, the :data:`CANONICAL` fields rounded by
         :func:`sgtool.canonical.canonical_float` (so every writer writes distances alike)."""
         out = dict(self.unknown)
-        for f in fields(self):
-            if f.name == "unknown" or f.name in self.NOT_LOGGED:
-                continue
-            v = getattr(self, f.name)
+        for name in _logged_names(type(self)):
+            v = getattr(self, name)
             if isinstance(v, Absent):
                 continue
             if isinstance(v, tuple):
                 v = [x.to_json() if isinstance(x, JsonRecord) else x for x in v]
-            elif f.name in self.CANONICAL and isinstance(v, float):
+            elif name in self.CANONICAL and isinstance(v, float):
                 v = canonical_float(v)
-            out[f.name] = v
+            out[name] = v
         return out
 
     @classmethod
     def _build(cls: type[J], d: Mapping[str, Any]) -> J:
         """The record of an already checked JSON object."""
-        names = {f.name for f in fields(cls)} - {"unknown", *cls.NOT_LOGGED}
+        names = _logged_names(cls)
         kw: dict[str, Any] = {}
         for k in names:
             v = d.get(k, ABSENT)
             kw[k] = tuple(v) if isinstance(v, list) else v
         return cls(**kw, unknown={k: v for k, v in d.items() if k not in names})
+
+
+_NAMES: dict[type, tuple[str, ...]] = {}  # record type -> its logged field names
+
+
+def _logged_names(cls: type[JsonRecord]) -> tuple[str, ...]:
+    """The names of the fields of ``cls`` that are written and read, in declaration order
+    (``unknown`` and :data:`JsonRecord.NOT_LOGGED` left out)."""
+    names = _NAMES.get(cls)
+    if names is None:
+        names = _NAMES[cls] = tuple(f.name for f in fields(cls)
+                                    if f.name != "unknown" and f.name not in cls.NOT_LOGGED)
+    return names
 
 
 @dataclass(frozen=True)
@@ -402,12 +414,41 @@ class Instances(LogRecord):
             seen.add(item["id"])
 
     @classmethod
+    def check_since(cls, d: object, where: str, checked: set[str]) -> None:
+        """:meth:`check`, with the items whose JSON text (sorted keys, no spaces) is in
+        ``checked`` taken as checked (they passed in an earlier table of the same writer:
+        an item's check depends on the item alone, besides ids given once, which is checked
+        over all items); the texts of the items that pass are added to ``checked``. A
+        failure raises the error :meth:`check` of the whole table raises."""
+        items = d.get("instances") if isinstance(d, dict) else None
+        if not isinstance(d, dict) or not isinstance(items, list):
+            cls.check(d, where)
+            return
+        try:
+            texts = [json.dumps(x, sort_keys=True, separators=(",", ":")) for x in items]
+        except (TypeError, ValueError):  # not JSON: the whole check names the field
+            cls.check(d, where)
+            raise
+        new = [x for x, t in zip(items, texts, strict=True) if t not in checked]
+        try:
+            cls.check({**d, "instances": new}, where)
+        except LogFormatError:
+            cls.check(d, where)  # the error with the item's index in the whole table
+            raise
+        if len({x["id"] for x in items}) != len(items):
+            cls.check(d, where)  # an id given twice: raises, naming the item
+        if len(checked) > _CHECKED_KEPT:
+            checked.clear()
+        checked.update(texts)
+
+    @classmethod
     def of(cls, items: list[dict[str, Any]]) -> Instances:
         """The record of a list of item dicts (checked when written)."""
         return cls(tuple(InstanceItem._build(x) for x in items))
 
 
 INSTANCE_ID_MAX = 2**31 - 1  # ids are the int32 pixel values of the instance images
+_CHECKED_KEPT = 100_000  # item texts a writer remembers as checked (then it starts over)
 
 
 def short_number(v: float) -> str:

@@ -41,7 +41,7 @@ from sgtool.files import concerns, output_error, temp_beside
 from sgtool.log import chunk_copy, codec
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
-from sgtool.log.records import RECORD_TYPES, LogRecord
+from sgtool.log.records import RECORD_TYPES, Instances, LogRecord
 from sgtool.version import __version__
 from sgtool.vocabulary import RecordName
 
@@ -122,6 +122,7 @@ class LogWriter:
         self._stream: IO[bytes] = os.fdopen(fd, "wb")
         self._compression = "" if compression == "none" else compression
         self._closed = False
+        self._checked_items: set[str] = set()  # instance-table items checked (JSON texts)
         self.message_count = 0
         try:
             self._mcap = Writer(
@@ -267,16 +268,22 @@ class LogWriter:
         self._add(cid, t_ns, msg.SerializeToString(deterministic=True))
 
     @overload
-    def write_record(self, record: LogRecord, t_ns: int) -> None: ...
+    def write_record(self, record: LogRecord, t_ns: int) -> dict[str, Any]: ...
 
     @overload
-    def write_record(self, record: RecordName, t_ns: int, data: Mapping[str, Any]) -> None: ...
+    def write_record(self, record: RecordName, t_ns: int, data: Mapping[str, Any]
+                     ) -> dict[str, Any]: ...
 
     def write_record(self, record: LogRecord | RecordName, t_ns: int,
-                     data: Mapping[str, Any] | None = None) -> None:
+                     data: Mapping[str, Any] | None = None) -> dict[str, Any]:
         """Write a typed sgtool JSON record (:mod:`sgtool.log.records`) on its channel,
         checked against its schema first (a :class:`~sgtool.errors.LogFormatError` names
-        the field that is wrong).
+        the field that is wrong); returns the JSON object written (what a reader of the
+        log gets back).
+
+        An instance table checks only the items this writer has not checked before in an
+        earlier table (:meth:`~sgtool.log.records.Instances.check_since`: a table written
+        again on every door that opens differs from the last in an item or two).
 
         ``write_record(kind, t_ns, dict)`` (the form before typed records) reads the dict
         as that kind's record and writes it the same way."""
@@ -289,9 +296,15 @@ class LogWriter:
         if not isinstance(record, LogRecord):
             raise TypeError(f"write_record takes an sgtool.log.records record, not "
                             f"{type(record).__name__}")
-        d = record.checked_json(record.describe(t_ns=int(t_ns)) + " to write")
+        where = record.describe(t_ns=int(t_ns)) + " to write"
+        if isinstance(record, Instances):
+            d = record.to_json()
+            record.check_since(d, where, self._checked_items)
+        else:
+            d = record.checked_json(where)
         cid = self._json_channel(record.channel())
         self._add(cid, t_ns, json.dumps(d, sort_keys=True, separators=(",", ":")).encode())
+        return d
 
     def attach(self, name: str, data: bytes, media_type: str, t_ns: int = 0) -> None:
         self._mcap.add_attachment(

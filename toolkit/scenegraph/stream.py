@@ -5,6 +5,7 @@ is fed the events of a log in the order they were written:
 
 - :meth:`~SceneGraphStream.instances`: a new ``sgtool.Instances`` table (a door or a
   container changed state: the builder drops that instance's voxels);
+  :meth:`~SceneGraphStream.instance_table` takes it already read;
 - :meth:`~SceneGraphStream.frame`: a camera frame, integrated into the voxel map; every
   ``every`` frames the graph layers refresh (reason ``"every"``);
 - :meth:`~SceneGraphStream.action`: an ``sgtool.Action`` record: the graph refreshes now
@@ -74,8 +75,14 @@ class SceneGraphStream:
     def instances(self, t_ns: int, record: Instances) -> list[int]:
         """A new instance table (an ``sgtool.Instances`` record); returns the instances whose
         state changed."""
+        return self.instance_table(t_ns, instances_from_record(record.to_json()))
+
+    def instance_table(self, t_ns: int, table: Mapping[int, InstanceInfo]) -> list[int]:
+        """:meth:`instances` of the table already read
+        (:func:`~sgtool.scenegraph.instances.instances_from_record` of the record's JSON
+        form, e.g. the one the log writer returned when it wrote it)."""
         first = not self.builder.instances
-        changed = self.builder.set_instances(instances_from_record(record.to_json()))
+        changed = self.builder.set_instances(table)
         if changed or (first and self.frames):
             self._dirty = True
         return changed

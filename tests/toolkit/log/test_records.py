@@ -160,3 +160,28 @@ def test_a_record_that_is_not_json_is_a_log_format_error(tmp_path) -> None:
     _raw_log(path, "action", [(7, b"{not json")])
     with LogReader(path) as r, pytest.raises(LogFormatError, match="/sgtool/action.*not JSON"):
         list(r.records(Action))
+
+
+def _table(*items: tuple[int, str, str | None]) -> Instances:
+    return Instances(tuple(InstanceItem(id=i, category=c, kind="furniture", state=s)
+                           for i, c, s in items))
+
+
+def test_instance_tables_written_again_check_what_changed(tmp_path) -> None:
+    """A writer checks each instance-table item once: a second table with one item changed
+    is written as the first (the same JSON a reader gets), a changed item that is wrong
+    is refused naming its index in the whole table, and an id given twice is refused even
+    when both items passed before."""
+    first = _table((1, "fridge", "closed"), (2, "door", "closed"), (3, "sofa", None))
+    with LogWriter(tmp_path / "x.mcap") as w:
+        assert w.write_record(first, 0) == first.to_json()
+        again = _table((1, "fridge", "open"), (2, "door", "closed"), (3, "sofa", None))
+        assert w.write_record(again, 1) == again.to_json()
+        bad = _table((1, "fridge", "open"), (2, "door", "closed"), (3, " ", None))
+        with pytest.raises(LogFormatError, match=re.escape("'instances[2].category' is empty")):
+            w.write_record(bad, 2)
+        twice = _table((1, "fridge", "open"), (1, "fridge", "open"), (3, "sofa", None))
+        with pytest.raises(LogFormatError, match=re.escape("'instances[1].id' 1 is given twice")):
+            w.write_record(twice, 3)
+    got = [d for _, d in LogReader(tmp_path / "x.mcap").records("instances")]
+    assert got == [first.to_json(), again.to_json()]
