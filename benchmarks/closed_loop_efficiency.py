@@ -16,6 +16,12 @@ differences.
         --planners random,greedy,scout,bayes-search --houses 2 --episodes 1 \\
         --resolution 96x72
 
+``--jobs J`` runs J workers per tree (the houses split between them) and both trees'
+workers at the same time, so both see the same load:
+
+    nice -n 5 .venv/bin/python benchmarks/closed_loop_efficiency.py --base /tmp/cl-base \\
+        --houses 4 --episodes 1 --jobs 2 --json eff.json
+
 ``--option KEY=VALUE`` sets a field of ``ClosedLoopOptions`` (a number or a word) in each
 tree that has the field, e.g. ``--option render_step_m=0`` for every driving tick a
 frame; the printout says which fields each tree applied.
@@ -30,6 +36,7 @@ import statistics
 import sys
 import tempfile
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import fields, replace
 from pathlib import Path
 from typing import Any
@@ -117,19 +124,45 @@ def _median_runs(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return out
 
 
-def _alternate(args: list[str], base: Path | None, tree: Path | None, rounds: int
-               ) -> dict[str, list[Any]]:
+def _alternate(args: list[str], base: Path | None, tree: Path | None, rounds: int,
+               groups: list[list[str]] | None = None) -> dict[str, list[Any]]:
     """The worker's documents per tree (``base``: none when None; ``this``: ``tree``, or
-    this checkout when None), the order alternating over the rounds."""
+    this checkout when None), the order alternating over the rounds. With ``groups``
+    (house arguments per worker, :func:`_house_groups`) each round runs one worker per
+    tree and group, all at once (both trees under the same load), and a round's document
+    per tree holds the groups' episodes in order."""
     trees: dict[str, str | None] = {}
     if base is not None:
         trees["base"] = shadow_tree(base)
     trees["this"] = None if tree is None else shadow_tree(tree)
     out: dict[str, list[Any]] = {name: [] for name in trees}
     for r in range(rounds):
-        for name in round_order(list(trees), r):
-            text = run_script(Path(__file__), args, trees[name])
-            out[name].append(json.loads(text.strip().splitlines()[-1]))
+        if groups is None:
+            for name in round_order(list(trees), r):
+                text = run_script(Path(__file__), args, trees[name])
+                out[name].append(json.loads(text.strip().splitlines()[-1]))
+            continue
+        jobs = [(name, g) for g in groups for name in round_order(list(trees), r)]
+        with ThreadPoolExecutor(len(jobs)) as pool:
+            texts = list(pool.map(lambda j: run_script(Path(__file__), args + j[1],
+                                                       trees[j[0]]), jobs))
+        for name in trees:
+            docs = [json.loads(t.strip().splitlines()[-1])
+                    for (n, _), t in zip(jobs, texts, strict=True) if n == name]
+            out[name].append({"episodes": [e for d in docs for e in d["episodes"]],
+                              "applied": docs[0]["applied"]})
+    return out
+
+
+def _house_groups(first: int, count: int, jobs: int) -> list[list[str]]:
+    """``--house-seed``/``--houses`` arguments splitting houses ``first .. first+count-1``
+    into ``jobs`` contiguous groups (as even as they go)."""
+    jobs = max(1, min(jobs, count))
+    out, seed = [], first
+    for j in range(jobs):
+        n = count // jobs + (1 if j < count % jobs else 0)
+        out.append(["--house-seed", str(seed), "--houses", str(n)])
+        seed += n
     return out
 
 
@@ -148,6 +181,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--resolution", default="96x72")
     ap.add_argument("--every", type=int, default=10)
     ap.add_argument("--rounds", type=int, default=1)
+    ap.add_argument("--jobs", type=int, default=1, help="worker processes per tree, the "
+                    "houses split between them, all trees' workers at once (1: one worker "
+                    "per tree, one tree after the other)")
     ap.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
                     help="a ClosedLoopOptions field for this tree (repeatable)")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
@@ -156,11 +192,15 @@ def main(argv: list[str] | None = None) -> int:
     if a.worker:
         print(json.dumps(worker(a)))
         return 0
-    common = ["--worker", "--planners", a.planners, "--houses", str(a.houses),
-              "--house-seed", str(a.house_seed), "--episodes", str(a.episodes),
+    common = ["--worker", "--planners", a.planners, "--episodes", str(a.episodes),
               "--rooms", a.rooms, "--resolution", a.resolution, "--every", str(a.every)]
     common += [x for o in a.option for x in ("--option", o)]
-    got = _alternate(common, a.base, a.tree, a.rounds)
+    if a.jobs > 1:
+        got = _alternate(common, a.base, a.tree, a.rounds,
+                         _house_groups(a.house_seed, a.houses, a.jobs))
+    else:
+        got = _alternate(common + ["--houses", str(a.houses), "--house-seed",
+                                   str(a.house_seed)], a.base, a.tree, a.rounds)
     for name, runs in got.items():
         print(f"{name}: options applied: {', '.join(runs[0]['applied']) or 'none'}")
     per = {name: _median_runs(runs) for name, runs in got.items()}
