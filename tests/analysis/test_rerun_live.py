@@ -69,7 +69,15 @@ def test_replay_serves_a_web_viewer_while_it_runs(tmp_path):
             except OSError:
                 time.sleep(0.5)
         assert status == 200 and page, proc.stderr.read() if proc.poll() is not None else ""
-        proc.send_signal(signal.SIGINT)  # the served recording lives until Ctrl-C
+        # the served recording lives until Ctrl-C; one sent while rerun's native code holds
+        # the interpreter (a flush) may be swallowed there, so press it again, as a user would
+        deadline = time.monotonic() + 120
+        while proc.poll() is None and time.monotonic() < deadline:
+            proc.send_signal(signal.SIGINT)
+            try:
+                proc.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                pass
         out, err = proc.communicate(timeout=120)
     finally:
         if proc.poll() is None:
