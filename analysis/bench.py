@@ -345,7 +345,10 @@ def _house(ref: BenchHouse, rooms: tuple[int, int], episodes: int,
     return entry
 
 
-def _planner(name: str, options: Mapping[str, Any]) -> Any:
+def cached_planner(name: str, options: Mapping[str, Any]) -> Any:
+    """The planner ``make_planner(name, **options)`` builds, built once per process for each
+    name and options (compared by their text) and handed out again after; a bad name or
+    option raises as :func:`~sgtool.planning.registry.make_planner` does."""
     from sgtool.planning.registry import make_planner
 
     key = (name, json.dumps({k: str(v) for k, v in sorted(options.items())}))
@@ -356,8 +359,10 @@ def _planner(name: str, options: Mapping[str, Any]) -> Any:
     return p
 
 
-def _task(args: tuple[BenchConfig, BenchHouse, tuple[str, ...]]) -> list[EpisodeResult]:
-    """Every episode and seed of one house for each of the given planners."""
+def run_task(args: tuple[BenchConfig, BenchHouse, tuple[str, ...]]) -> list[EpisodeResult]:
+    """Every episode and seed of one house for each of the given planners (the ``args`` of a
+    :func:`bench_tasks` task), in planner, seed, episode order. The results depend on the
+    task alone: not on what the process ran before, nor on the machine's core count."""
     from sgtool.blas import single_blas_thread
     from sgtool.heap import frozen_heap
     from sgtool.semantics.priors import forget_default_scores
@@ -385,7 +390,7 @@ def _task_episodes(cfg: BenchConfig, ref: BenchHouse,
     vocabulary = training_vocabulary(cfg.priors_dir)
     out = []
     for name in names:
-        planner = _planner(name, planner_options_for(cfg, name))
+        planner = cached_planner(name, planner_options_for(cfg, name))
         for seed in range(cfg.seeds):
             for i, ep in enumerate(episodes):
                 kw = dict(seed=seed, episode_index=i, avoid_rooms=ep.target_rooms,
@@ -425,10 +430,10 @@ def run_benchmark(cfg: BenchConfig, progress: bool | None = None) -> BenchResult
     houses = prepare_houses(cfg)
     vocabulary = training_vocabulary(cfg.priors_dir)  # a bad --priors fails before any episode
     for name in cfg.planners:  # and so does a bad planner option (built here, kept)
-        _planner(name, planner_options_for(cfg, name))
+        cached_planner(name, planner_options_for(cfg, name))
     show = sys.stderr.isatty() if progress is None else progress
     t0 = time.perf_counter()
-    outcomes = executor.run(_task, bench_tasks(cfg, houses), progress=show, desc="bench")
+    outcomes = executor.run(run_task, bench_tasks(cfg, houses), progress=show, desc="bench")
     chunks = [o.value for o in outcomes if o.ok]
     wall = time.perf_counter() - t0
     order = {p: i for i, p in enumerate(cfg.planners)}

@@ -34,9 +34,10 @@ PARTS = ("observe", "decide", "actionable", "utilities", "execute")
 def measure(args: argparse.Namespace) -> dict[str, float]:
     import sgtool.planning.planners as planners
     import sgtool.recorders.symbolic_environment.environment as environment
-    from sgtool.analysis.bench import BenchConfig, _planner, planner_options_for
+    from sgtool.analysis.bench import BenchConfig, planner_options_for
     from sgtool.analysis.bench_houses import bench_episodes, generated_houses
     from sgtool.blas import single_blas_thread
+    from sgtool.planning.registry import make_planner
     from sgtool.recorders.symbolic_environment.house import SymbolicHouse
     from sgtool.recorders.symbolic_environment.rollout import run_episode
     from sgtool.semantics.priors import forget_default_scores
@@ -64,13 +65,14 @@ def measure(args: argparse.Namespace) -> dict[str, float]:
     timed(environment.SymbolicEnv, "execute", "execute")
     cfg = BenchConfig(planners=(args.planner,), houses=args.houses, episodes=20, seeds=3)
     total: dict = {"prepare": 0.0, "episodes": 0.0, "calls": {p: [] for p in PARTS}}
+    # one planner for every house, as a bench worker keeps the planners it built
+    planner = make_planner(args.planner, **planner_options_for(cfg, args.planner))
     for ref in generated_houses(args.houses, 0):
         c0 = time.process_time()
         spec = ref.load(cfg.rooms, cfg.preset)
         house = SymbolicHouse(spec)
         episodes = bench_episodes(spec, cfg.episodes, cfg.preset)
         total["prepare"] += time.process_time() - c0
-        planner = _planner(args.planner, planner_options_for(cfg, args.planner))
         runs = []
         with single_blas_thread():
             for k in range(args.repeats + (1 if ref.seed == 0 else 0)):

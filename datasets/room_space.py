@@ -13,8 +13,8 @@ from scipy import ndimage
 from sgtool.datasets.house_plan import WALL_T, Opening, PlanRoom, Rect
 from sgtool.datasets.robot_clearance import REACH, ROBOT_RADIUS
 
-_CELL = 0.05  # resolution of the in-room free-space checks
-_BLOCK_D2 = 20  # squared cell distance below ROBOT_RADIUS + _CELL / 2 (see free_ok)
+CELL = 0.05  # m: side of a cell of a room's free-space grid (RoomSpace: occ, blocked)
+_BLOCK_D2 = 20  # squared cell distance below ROBOT_RADIUS + CELL / 2 (see free_ok)
 _BLOCK_CELLS = 4  # the largest row or column offset within _BLOCK_D2
 
 
@@ -24,8 +24,8 @@ class RoomSpace:
     def __init__(self, room: PlanRoom, openings: list[Opening]):
         self.room = room
         self.inner = room.rect.shrink(WALL_T / 2)
-        self.cols = int(round(self.inner.width / _CELL))
-        self.rows = int(round(self.inner.height / _CELL))
+        self.cols = int(round(self.inner.width / CELL))
+        self.rows = int(round(self.inner.height / CELL))
         self.occ = np.zeros((self.rows, self.cols), bool)
         # cells the robot's centre cannot take: within _BLOCK_D2 (cells^2) of the walls or
         # of an occupied cell; kept up to date by add(), so free_ok() only adds its box
@@ -33,8 +33,8 @@ class RoomSpace:
         w = _BLOCK_CELLS
         self.blocked[:w, :] = self.blocked[-w:, :] = True
         self.blocked[:, :w] = self.blocked[:, -w:] = True
-        self.ys = self.inner.y0 + (np.arange(self.rows) + 0.5) * _CELL
-        self.xs = self.inner.x0 + (np.arange(self.cols) + 0.5) * _CELL
+        self.ys = self.inner.y0 + (np.arange(self.rows) + 0.5) * CELL
+        self.xs = self.inner.x0 + (np.arange(self.cols) + 0.5) * CELL
         self.keepouts: list[Rect] = []
         self.approach: list[tuple[int, int]] = []
         for o in openings:
@@ -57,15 +57,15 @@ class RoomSpace:
             self.approach.append(self.cell(*ap))
 
     def cell(self, x: float, y: float) -> tuple[int, int]:
-        r = int(math.floor((y - self.inner.y0) / _CELL))
-        c = int(math.floor((x - self.inner.x0) / _CELL))
+        r = int(math.floor((y - self.inner.y0) / CELL))
+        c = int(math.floor((x - self.inner.x0) / CELL))
         return (min(max(r, 0), self.rows - 1), min(max(c, 0), self.cols - 1))
 
     def _cell_slices(self, box: Rect) -> tuple[slice, slice]:
-        c0 = max(int(math.floor((box.x0 - self.inner.x0) / _CELL + 1e-6)), 0)
-        c1 = min(int(math.ceil((box.x1 - self.inner.x0) / _CELL - 1e-6)), self.cols)
-        r0 = max(int(math.floor((box.y0 - self.inner.y0) / _CELL + 1e-6)), 0)
-        r1 = min(int(math.ceil((box.y1 - self.inner.y0) / _CELL - 1e-6)), self.rows)
+        c0 = max(int(math.floor((box.x0 - self.inner.x0) / CELL + 1e-6)), 0)
+        c1 = min(int(math.ceil((box.x1 - self.inner.x0) / CELL - 1e-6)), self.cols)
+        r0 = max(int(math.floor((box.y0 - self.inner.y0) / CELL + 1e-6)), 0)
+        r1 = min(int(math.ceil((box.y1 - self.inner.y0) / CELL - 1e-6)), self.rows)
         return slice(r0, r1), slice(c0, c1)
 
     def _blocked_by(self, box: Rect) -> tuple[tuple[slice, slice], np.ndarray] | None:
@@ -113,8 +113,8 @@ class RoomSpace:
         m = REACH - ROBOT_RADIUS
         for b in boxes_to_reach:
             # only cells within m of the box can be near it: look at those rows and columns
-            rs, cs = self._cell_slices(Rect(b.x0 - m - _CELL, b.y0 - m - _CELL,
-                                            b.x1 + m + _CELL, b.y1 + m + _CELL))
+            rs, cs = self._cell_slices(Rect(b.x0 - m - CELL, b.y0 - m - CELL,
+                                            b.x1 + m + CELL, b.y1 + m + CELL))
             xs, ys = self.xs[cs], self.ys[rs]
             dx = np.maximum(np.maximum(b.x0 - xs, xs - b.x1), 0.0)
             dy = np.maximum(np.maximum(b.y0 - ys, ys - b.y1), 0.0)

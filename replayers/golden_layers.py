@@ -19,7 +19,7 @@ import numpy as np
 from sgtool.canonical import canonical_float
 from sgtool.house.geometry import signed_area
 from sgtool.scenegraph.builder import MapLayers
-from sgtool.scenegraph.derived_layers import ROOM_MARGIN, _hull_of
+from sgtool.scenegraph.derived_layers import ROOM_MARGIN, room_hull_of
 
 
 @dataclass(frozen=True)
@@ -46,7 +46,7 @@ class LayerSummary:
 def outline_area(points: np.ndarray) -> float:
     """Area in m² of the outline of ``points`` ((n, 2) x, y) as ``/map/rooms`` draws it."""
     pts = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
-    hull = _hull_of(pts.tobytes(), ROOM_MARGIN)
+    hull = room_hull_of(pts.tobytes(), ROOM_MARGIN)
     return canonical_float(abs(signed_area([(float(x), float(y)) for x, y in hull.tolist()]))
                            if len(hull) >= 3 else 0.0)
 

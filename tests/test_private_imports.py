@@ -19,18 +19,9 @@ REPO = Path(__file__).resolve().parents[1]
 FOLDERS = ("tests", "benchmarks", "tools", "examples")
 
 PENDING: dict[str, int] = {
-    "benchmarks/bench_rollout_parts.py": 1,
     "benchmarks/closed_loop_efficiency.py": 1,
-    "tests/analysis/test_bench_executor.py": 1,
-    "tests/datasets/test_room_space.py": 1,
-    "tests/replayers/test_derived_log.py": 1,
-    "tests/toolkit/log/test_image_wire.py": 2,
     "tests/toolkit/scenegraph/test_refresh_shortcuts.py": 1,
-    "tests/toolkit/scenegraph/test_room_shortcuts.py": 3,
-    "tests/toolkit/scenegraph/test_scene_wire.py": 3,
     "tests/toolkit/semantics/test_distill.py": 1,
-    "tests/toolkit/semantics/test_llm_knowledge_agreement.py": 1,
-    "tests/toolkit/test_decimal_ids.py": 2,
     "tests/toolkit/test_heap.py": 2,
 }
 

@@ -83,18 +83,18 @@ def test_a_task_gives_the_same_results_whatever_its_worker_ran_before():
     ends with the memo it has when run first, and the same results."""
     import copy
 
-    from sgtool.analysis.bench import _task
+    from sgtool.analysis.bench import run_task
     from sgtool.results import results_digest
     from sgtool.semantics.priors import default_priors
 
     cfg = BenchConfig(planners=("scout",), houses=2, episodes=2, seeds=1, rooms=(4, 6),
                       preset="default")
     first, second = bench_tasks(cfg, prepare_houses(cfg))
-    alone = _task(second.args)
+    alone = run_task(second.args)
     memo_alone = copy.deepcopy(default_priors()._memo._memo)
-    _task(first.args)
+    run_task(first.args)
     assert default_priors()._memo._memo != memo_alone  # the other house scored other names
-    after_other = _task(second.args)
+    after_other = run_task(second.args)
     assert default_priors()._memo._memo == memo_alone
     assert results_digest(after_other) == results_digest(alone)
     assert {r.house for r in alone} == {"house-1"} and len(alone) == 2

@@ -9,7 +9,7 @@ from support.room_space_reference import free_mask_edt
 
 from sgtool.datasets.house_plan import Opening, PlanRoom, Rect
 from sgtool.datasets.robot_clearance import REACH, ROBOT_RADIUS
-from sgtool.datasets.room_space import _CELL, RoomSpace
+from sgtool.datasets.room_space import CELL, RoomSpace
 
 
 def _reference_free_ok(space: RoomSpace, boxes: list[Rect], extra: Rect | None) -> bool:
@@ -17,7 +17,7 @@ def _reference_free_ok(space: RoomSpace, boxes: list[Rect], extra: Rect | None) 
     occ = space.occ.copy()
     if extra is not None:
         occ[space._cell_slices(extra)] = True
-    free = free_mask_edt(occ, _CELL)
+    free = free_mask_edt(occ, CELL)
     labels, _ = ndimage.label(free, structure=np.ones((3, 3), bool))
     if not space.approach:
         return True
@@ -25,8 +25,8 @@ def _reference_free_ok(space: RoomSpace, boxes: list[Rect], extra: Rect | None) 
     if 0 in lab or len(lab) != 1:
         return False
     main = labels == lab.pop()
-    ys = space.inner.y0 + (np.arange(space.rows) + 0.5) * _CELL
-    xs = space.inner.x0 + (np.arange(space.cols) + 0.5) * _CELL
+    ys = space.inner.y0 + (np.arange(space.rows) + 0.5) * CELL
+    xs = space.inner.x0 + (np.arange(space.cols) + 0.5) * CELL
     for b in boxes:
         dx = np.maximum(np.maximum(b.x0 - xs, xs - b.x1), 0.0)
         dy = np.maximum(np.maximum(b.y0 - ys, ys - b.y1), 0.0)
@@ -53,10 +53,10 @@ def test_blocked_cells_match_the_distance_transform() -> None:
     rng = np.random.default_rng(7)
     for _ in range(20):
         space = RoomSpace(*_room())
-        assert np.array_equal(~space.blocked, free_mask_edt(space.occ, _CELL))
+        assert np.array_equal(~space.blocked, free_mask_edt(space.occ, CELL))
         for _ in range(6):
             space.add(_box(rng))
-            assert np.array_equal(~space.blocked, free_mask_edt(space.occ, _CELL))
+            assert np.array_equal(~space.blocked, free_mask_edt(space.occ, CELL))
 
 
 def test_free_ok_matches_the_whole_room_check() -> None:

@@ -26,7 +26,7 @@ from sgtool.log.echo import as_logged
 from sgtool.log.records import Instances
 from sgtool.replayers.derived_log import ReplayOptions, replay
 from sgtool.scenegraph.build_options import default_min_points
-from sgtool.scenegraph.derived_layers import DERIVED_TOPICS, _hull
+from sgtool.scenegraph.derived_layers import DERIVED_TOPICS, room_hull
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.stream import SceneGraphStream
 
@@ -206,7 +206,7 @@ def test_a_stream_fed_live_equals_the_replay_of_its_log(tmp_path):
 
 def test_room_outline_is_the_convex_hull_grown_by_the_margin():
     pts = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0], [1.0, 0.5]])
-    hull = _hull(pts, 0.3)
+    hull = room_hull(pts, 0.3)
     assert hull[:, 0].min() == pytest.approx(-0.3) and hull[:, 0].max() == pytest.approx(2.3)
     assert hull[:, 1].min() == pytest.approx(-0.3) and hull[:, 1].max() == pytest.approx(1.3)
     # counter-clockwise: positive signed area

@@ -126,11 +126,14 @@ def _llm_source(llm: dict[str, Any], llm_slice: str | None) -> LlmSource:
 
     return LlmSource(base_url=llm["llm_base_url"], model=llm["llm_model"],
                      api_key=llm["llm_api_key"], cache=llm["llm_cache"], runs=llm["llm_runs"],
-                     max_queries=llm["llm_max_queries"], slice=_slice(llm_slice),
+                     max_queries=llm["llm_max_queries"], slice=parse_llm_slice(llm_slice),
                      timeout_s=llm["llm_timeout"], max_tokens=llm["llm_max_tokens"])
 
 
-def _slice(text: str | None) -> dict[str, int]:
+def parse_llm_slice(text: str | None) -> dict[str, int]:
+    """The ``--llm-slice ROOMS,CATEGORIES,OBJECTS`` value as the LLM source's generation
+    limits (``max_rooms``, ``max_categories``, ``max_objects``; empty for None: the
+    defaults); anything but three integers >= 1 is a one-line :class:`SgtoolError`."""
     if text is None:
         return {}
     try:

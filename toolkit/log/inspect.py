@@ -21,7 +21,13 @@ from sgtool.log import schemas as S
 from sgtool.log.frame_assembly import decoded
 from sgtool.log.reader import LogReader
 
-_SEED = re.compile(r"-?\d{1,30}")  # a house seed in the metadata (any other text: none)
+_SEED = re.compile(r"-?\d{1,30}")
+
+
+def house_seed_of(text: str) -> int | None:
+    """The house seed written as ``text`` in a log's metadata: an integer of at most 30
+    decimal digits (any script), optionally negative; None for any other text."""
+    return int(text) if _SEED.fullmatch(text) else None
 
 
 def _fmt_time(t_ns: int) -> str:
@@ -67,7 +73,7 @@ def summarize(path: str | os.PathLike[str]) -> dict[str, Any]:
         out["readable"] = v is None or v[0] <= S.LOG_SCHEMA_VERSION[0]
         out["seed"] = r.seed
         hs = r.metadata.get(S.METADATA_NAME, {}).get("house_seed", "")
-        out["house_seed"] = int(hs) if _SEED.fullmatch(str(hs)) else None
+        out["house_seed"] = house_seed_of(str(hs))
         if not out["readable"]:
             return out
         out["frames"] = r.frame_count()

@@ -29,7 +29,6 @@ The query counts as found when an object whose category equals the query after
 
 from __future__ import annotations
 
-import functools
 import math
 from bisect import bisect_left
 from collections.abc import Callable, Iterable
@@ -41,7 +40,15 @@ from typing import Literal
 import numpy as np
 
 from sgtool.planning.base import Skill
-from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode, SceneGraph
+from sgtool.scenegraph.graph import (
+    DoorNode,
+    NaturalKey,
+    ObjectNode,
+    RegionNode,
+    RoomNode,
+    SceneGraph,
+    natural_key,
+)
 from sgtool.semantics.text import category_text
 
 OPEN_AFFORDANCES = frozenset({"open", "openable"})
@@ -75,16 +82,6 @@ class Candidate:
         d["kind"] = kind
         d["distance"] = distance
         d["position"] = position
-
-
-NaturalKey = tuple[str, tuple[tuple[int, int | str], ...]]
-
-
-@functools.lru_cache(maxsize=65536)
-def natural_key(node_id: str) -> NaturalKey:
-    """Sort ids naturally: ``room:2`` before ``room:10``, ``region:3.1`` before ``region:3.12``."""
-    prefix, _, rest = node_id.partition(":")
-    return prefix, tuple((0, int(p)) if p.isdecimal() else (1, p) for p in rest.split("."))
 
 
 def node_xy(node: RoomNode | RegionNode | ObjectNode | DoorNode) -> tuple[float, float]:

@@ -54,7 +54,9 @@ def _rgba(key: str | None, alpha: float = 1.0) -> tuple[float, float, float, flo
     return r, g, b, alpha
 
 
-def _color(key: str | None, alpha: float = 1.0) -> Color:
+def room_color(key: str | None, alpha: float = 1.0) -> Color:
+    """The Foxglove colour of room ``key`` (:func:`sgtool.colors.color_for`, channels 0 to
+    1), grey (``NO_ROOM``) for None; opacity ``alpha``."""
     r, g, b, a = _rgba(key, alpha)
     return Color(r=r, g=g, b=b, a=a)
 
@@ -94,7 +96,8 @@ def voronoi_message(refresh: Refresh) -> SceneUpdate | None:
         ends = xy[edges.reshape(-1)]  # u, v of every edge
         col = rgba[np.repeat(np.where(cu == cv, cu, 0), 2)]
         m = len(ends)
-        line = LinePrimitive(type=LinePrimitive.LINE_LIST, thickness=0.03, color=_color(None))
+        line = LinePrimitive(type=LinePrimitive.LINE_LIST, thickness=0.03,
+                             color=room_color(None))
         line.MergeFromString(
             sw.records(_LINE_POINT, {"x": ends[:, 0], "y": ends[:, 1], "z": GRAPH_Z}, m)
             + sw.records(_LINE_COLOR, {"r": col[:, 0], "g": col[:, 1], "b": col[:, 2],
@@ -111,12 +114,13 @@ def voronoi_message(refresh: Refresh) -> SceneUpdate | None:
         entities=[ent])
 
 
-def _hull(points: np.ndarray, margin: float) -> np.ndarray:
-    """Convex hull (counter-clockwise, from its lowest-x then lowest-y vertex) of the discs
-    of radius ``margin`` around ``points``, approximated by 8 points per disc; collinear
-    points are not vertices. Qhull (``scipy.spatial.ConvexHull``) finds it; a cloud that
-    spans no area (fewer than 3 points, or all on one line) is returned as its sorted
-    distinct points when it has fewer than 3, else as its two extreme points."""
+def room_hull(points: np.ndarray, margin: float) -> np.ndarray:
+    """Convex hull, as (k, 2) vertices (counter-clockwise, from its lowest-x then lowest-y
+    vertex), of the discs of radius ``margin`` (m) around ``points`` ((n, 2), m),
+    approximated by 8 points per disc; collinear points are not vertices. Qhull
+    (``scipy.spatial.ConvexHull``) finds it; a cloud that spans no area (fewer than 3
+    points, or all on one line) is returned as its sorted distinct points when it has fewer
+    than 3, else as its two extreme points."""
     ang = np.arange(8) * (np.pi / 4)
     ring = np.stack([np.cos(ang), np.sin(ang)], axis=1) * margin
     cloud = (points[:, None, :] + ring[None, :, :]).reshape(-1, 2)
@@ -137,10 +141,10 @@ def _hull(points: np.ndarray, margin: float) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=1024)
-def _hull_of(points: bytes, margin: float) -> np.ndarray:
-    """:func:`_hull` of the float64 (x, y) pairs in ``points``, remembered: most rooms keep
-    their nodes from one refresh to the next (the result is read-only)."""
-    hull = _hull(np.frombuffer(points, dtype=np.float64).reshape(-1, 2), margin)
+def room_hull_of(points: bytes, margin: float) -> np.ndarray:
+    """:func:`room_hull` of the float64 (x, y) pairs in ``points``, remembered: most rooms
+    keep their nodes from one refresh to the next (the result is read-only)."""
+    hull = room_hull(np.frombuffer(points, dtype=np.float64).reshape(-1, 2), margin)
     hull.setflags(write=False)
     return hull
 
@@ -161,18 +165,19 @@ def rooms_message(refresh: Refresh) -> SceneUpdate | None:
     categories = {r.id: r.category for r in refresh.graph.rooms}
     for rid in sorted(by_room, key=lambda s: (len(s), s)):
         nodes = np.asarray(by_room[rid])
-        hull = _hull_of(np.ascontiguousarray(vg.positions[nodes], dtype=np.float64).tobytes(),
-                        ROOM_MARGIN)
+        hull = room_hull_of(
+            np.ascontiguousarray(vg.positions[nodes], dtype=np.float64).tobytes(), ROOM_MARGIN)
         ent = SceneEntity(timestamp=stamp, frame_id=S.WORLD_FRAME, id=rid)
         ent.lines.append(LinePrimitive(
-            type=LinePrimitive.LINE_LOOP, thickness=0.05, color=_color(rid),
+            type=LinePrimitive.LINE_LOOP, thickness=0.05, color=room_color(rid),
             points=[Point3(x=float(x), y=float(y), z=GRAPH_Z) for x, y in hull.tolist()]))
         cx, cy = (float(v) for v in vg.positions[nodes].mean(axis=0))
         room = refresh.graph.room(rid)
         if room is not None:
             cx, cy = room.position
         t = TextPrimitive(billboard=True, font_size=14.0, scale_invariant=True,
-                          color=_color(rid), text=f"{rid} {categories.get(rid, 'unknown')}")
+                          color=room_color(rid),
+                          text=f"{rid} {categories.get(rid, 'unknown')}")
         t.pose.position.x, t.pose.position.y, t.pose.position.z = cx, cy, LABEL_Z
         t.pose.orientation.w = 1.0
         ent.texts.append(t)

@@ -106,7 +106,7 @@ def observe_doors(
     out = []
     unexplored_pos: dict[str, tuple[float, float]] = {}
     points = [(float(c[0]), float(c[1])) for _, c, _ in seen]
-    visible = _visible_labelled(points, vg, node_room, occ, blocked, door_radius)
+    visible = visible_labelled_nodes(points, vg, node_room, occ, blocked, door_radius)
     for (info, _c, _vp), pos, near in zip(seen, points, visible, strict=True):
         rooms: list[str] = []
         nearest = -1
@@ -134,12 +134,14 @@ def observe_doors(
     return out, unexplored_pos
 
 
-def _visible_labelled(points: list[tuple[float, float]], vg: VoronoiGraph,
-                      node_room: np.ndarray, occ: OccupancyGrid, blocked: np.ndarray,
-                      radius: float) -> list[np.ndarray | None]:
-    """Per point: the labelled nodes within ``radius`` whose segment to it is clear but
-    for its last 0.3 m (ascending; None without any labelled node), for all points in
-    one query and one batched line-of-sight test."""
+def visible_labelled_nodes(points: list[tuple[float, float]], vg: VoronoiGraph,
+                           node_room: np.ndarray, occ: OccupancyGrid, blocked: np.ndarray,
+                           radius: float) -> list[np.ndarray | None]:
+    """Per point (x, y in m): the indices of the nodes of ``vg`` with a room
+    (``node_room >= 0``) within ``radius`` m whose segment to the point is clear of
+    ``blocked`` cells of ``occ`` but for its last 0.3 m (ascending; None for every point
+    when no node has a room). All points in one k-d tree query and one batched
+    line-of-sight test (:func:`sgtool.mapping.bev.line_of_sight`)."""
     labelled = np.flatnonzero(node_room >= 0)
     if not len(labelled):
         return [None] * len(points)

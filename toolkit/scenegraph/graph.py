@@ -17,6 +17,7 @@ Node ids are strings with a layer prefix: ``room:3``, ``region:3.1``, ``frontier
 
 from __future__ import annotations
 
+import functools
 import json
 from dataclasses import dataclass, field, fields
 from typing import Any, Literal
@@ -182,10 +183,10 @@ class SceneGraph:
                 "room": self.robot.room,
                 "region": self.robot.region,
             },
-            "rooms": [room(n) for n in sorted(self.rooms, key=lambda n: _idkey(n.id))],
-            "regions": [region(n) for n in sorted(self.regions, key=lambda n: _idkey(n.id))],
-            "objects": [obj(n) for n in sorted(self.objects, key=lambda n: _idkey(n.id))],
-            "doors": [door(n) for n in sorted(self.doors, key=lambda n: _idkey(n.id))],
+            "rooms": [room(n) for n in sorted(self.rooms, key=_by_id)],
+            "regions": [region(n) for n in sorted(self.regions, key=_by_id)],
+            "objects": [obj(n) for n in sorted(self.objects, key=_by_id)],
+            "doors": [door(n) for n in sorted(self.doors, key=_by_id)],
             "distances": {k: canonical_float(v) for k, v in sorted(self.distances.items())},
         }
 
@@ -260,16 +261,24 @@ def _field_names(cls: type) -> tuple[str, ...]:
     return names
 
 
+def _by_id(node: RoomNode | RegionNode | ObjectNode | DoorNode) -> NaturalKey:
+    return natural_key(node.id)
+
+
 def _shallow(node: object) -> dict[str, Any]:
     """The fields of a node as a dict: ``dataclasses.asdict`` without its deep copy (node
     fields are immutable: strings, numbers, tuples)."""
     return {name: getattr(node, name) for name in _field_names(type(node))}
 
 
-def _idkey(node_id: str) -> tuple[str, tuple[tuple[int, int] | tuple[int, str], ...]]:
-    """Sort ids naturally: room:2 before room:10, region:3.1 before region:3.12."""
+NaturalKey = tuple[str, tuple[tuple[int, int | str], ...]]
+
+
+@functools.lru_cache(maxsize=65536)
+def natural_key(node_id: str) -> NaturalKey:
+    """The sort key of a node id in natural order: ``room:2`` before ``room:10``,
+    ``region:3.1`` before ``region:3.12``. The layer prefix (text before the first ``:``)
+    sorts as text, then each ``.``-separated part: decimal digits of any script
+    (``str.isdecimal``) by value, before any other part, which sorts as text."""
     prefix, _, rest = node_id.partition(":")
-    parts: list[int | str] = []
-    for p in rest.split("."):
-        parts.append(int(p) if p.isdecimal() else p)
-    return prefix, tuple((0, p) if isinstance(p, int) else (1, p) for p in parts)
+    return prefix, tuple((0, int(p)) if p.isdecimal() else (1, p) for p in rest.split("."))

@@ -130,7 +130,7 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray, min_width
     grown = ndimage.binary_dilation(occupied, structure=np.ones((3, 3), dtype=bool))
 
     # every (end, side, offset) of the panel: the shares of occupied cells along the wall
-    # side, the opening and the far jamb, sampled at once (:func:`_shares`)
+    # side, the opening and the far jamb, sampled at once (:func:`ray_shares`)
     rays = []
     for s, out in ((s0, -a), (s1, a)):
         for sign in (1.0, -1.0):
@@ -140,7 +140,7 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray, min_width
                 rays += [(end, -d, 0.1 * width, 0.45 * width, True),
                          (end, d, 0.15 * width, 0.85 * width, False),
                          (end, d, 1.05 * width, 1.3 * width, True)]
-    shares = _shares(rays, occupied, grown)
+    shares = ray_shares(rays, occupied, grown)
     best = _clear_best(shares, s0, s1, a, _sum_score, 1.0, 0.5)
     if best is None:  # ambiguous: ask for the wall line on both sides of the opening
         best = _clear_best(shares, s0, s1, a, _line_score, LINE_LEAST, LINE_MARGIN)
@@ -196,13 +196,14 @@ def _clear_best(shares: list[float], s0: float, s1: float, a: np.ndarray,
     return best
 
 
-def _shares(rays: list[tuple[np.ndarray, np.ndarray, float, float, bool]],
-            occupied: np.ndarray, grown: np.ndarray) -> list[float]:
-    """Per ray (start, direction, from, to, on the grown grid): the share of occupied
-    cells at the points sampled every half cell from ``start + from * direction`` to
-    ``start + to * direction`` (points off the grid skipped; 0.0 with none on it). The
-    points of every ray are computed as one ray at a time would, the shares counted
-    for all at once."""
+def ray_shares(rays: list[tuple[np.ndarray, np.ndarray, float, float, bool]],
+               occupied: np.ndarray, grown: np.ndarray) -> list[float]:
+    """Per ray (start, direction, from, to, on the grown grid; in (column, row) cells of
+    ``occupied``, ``grown`` being that grid dilated): the share of occupied cells at the
+    points sampled every half cell from ``start + from * direction`` to
+    ``start + to * direction``, rounded to cells (points off the grid skipped; 0.0 with
+    none on it). The points of every ray are computed as one ray at a time would, the
+    shares counted for all at once."""
     fs = [np.linspace(lo, hi, max(2, int(np.ceil(2 * (hi - lo))))) for _, _, lo, hi, _ in rays]
     sizes = np.fromiter((len(f) for f in fs), dtype=np.int64, count=len(rays))
     ray = np.repeat(np.arange(len(rays)), sizes)
@@ -373,8 +374,8 @@ def _other_rooms(pred: list[int], labels: list[int], a: int) -> Callable[[int], 
     return other
 
 
-def _overlaps(known: dict[int, np.ndarray], room_positions: Sequence[np.ndarray],
-              radius: float) -> list[tuple[int, int, int]]:
+def room_overlaps(known: dict[int, np.ndarray], room_positions: Sequence[np.ndarray],
+                  radius: float) -> list[tuple[int, int, int]]:
     """(-count, new room, old room) for every pair of a new room and an old room (node
     positions ``known``) with ``count`` of the new room's nodes nearest (within
     ``radius``) to a node of the old room; all nodes in one k-d tree query."""
@@ -413,8 +414,8 @@ class RoomTracker:
     def assign(self, room_positions: Sequence[np.ndarray], radius: float) -> list[int]:
         """Room numbers for this refresh's rooms (node positions of each)."""
         n_new = len(room_positions)
-        overlap = _overlaps({o: k.positions for o, k in self.known.items()}, room_positions,
-                            radius)  # (-count, new, old)
+        overlap = room_overlaps({o: k.positions for o, k in self.known.items()},
+                                room_positions, radius)  # (-count, new, old)
         overlap.sort()
         result: list[int | None] = [None] * n_new
         used: set[int] = set()

@@ -11,8 +11,8 @@ from sgtool.mapping.bev import line_of_sight
 from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph
 from sgtool.scenegraph import room_segmentation
-from sgtool.scenegraph.door_evidence import PASSABLE_SHARE, _visible_labelled, door_cells_of
-from sgtool.scenegraph.room_segmentation import _overlaps, _shares, opening_from_panel
+from sgtool.scenegraph.door_evidence import PASSABLE_SHARE, door_cells_of, visible_labelled_nodes
+from sgtool.scenegraph.room_segmentation import opening_from_panel, ray_shares, room_overlaps
 
 
 def _share(p0: np.ndarray, direction: np.ndarray, lo: float, hi: float,
@@ -42,7 +42,7 @@ def test_batched_shares_equal_one_ray_at_a_time(seed):
         lo = rng.uniform(0.0, 1.2) * width
         rays.append((rng.uniform(-10, 70, size=2), np.array([np.cos(ang), np.sin(ang)]),
                      lo, lo + rng.uniform(0.0, 0.8) * width, bool(rng.random() < 0.5)))
-    got = _shares(rays, occupied, grown)
+    got = ray_shares(rays, occupied, grown)
     want = _reference_shares(rays, occupied, grown)
     assert got == want
     assert any(0.0 < x < 1.0 for x in want) and 0.0 in want  # partial shares and off-grid
@@ -65,7 +65,7 @@ def test_panel_openings_equal_the_ray_by_ray_search(seed, monkeypatch):
     occupied[rows, cols] = True
     occupied |= rng.random(occupied.shape) < 0.03
     got = opening_from_panel(rows, cols, occupied, min_width=8)
-    monkeypatch.setattr(room_segmentation, "_shares", _reference_shares)
+    monkeypatch.setattr(room_segmentation, "ray_shares", _reference_shares)
     want = opening_from_panel(rows, cols, occupied, min_width=8)
     assert (got is None) == (want is None)
     if want is not None:
@@ -154,7 +154,7 @@ def test_door_sight_lines_of_all_doors_at_once_equal_one_door_at_a_time(seed):
                       np.zeros((0, 2), np.int64), np.zeros(0), (), np.zeros((1, 1), bool))
     node_room = rng.integers(-1, 3, size=50)
     points = [tuple(p) for p in rng.uniform((0, 0), (4, 3), size=(int(rng.integers(0, 9)), 2))]
-    got = _visible_labelled(points, vg, node_room, occ, blocked, 1.5)
+    got = visible_labelled_nodes(points, vg, node_room, occ, blocked, 1.5)
     labelled = np.flatnonzero(node_room >= 0)
     tree = cKDTree(pos[labelled])
     for p, near in zip(points, got, strict=True):
@@ -164,7 +164,7 @@ def test_door_sight_lines_of_all_doors_at_once_equal_one_door_at_a_time(seed):
                                       np.repeat(np.asarray([p]), len(want), axis=0),
                                       skip_end=0.3)]
         assert near is not None and np.array_equal(near, want)
-    none = _visible_labelled(points, vg, np.full(50, -1), occ, blocked, 1.5)
+    none = visible_labelled_nodes(points, vg, np.full(50, -1), occ, blocked, 1.5)
     assert none == [None] * len(points)
 
 
@@ -195,7 +195,7 @@ def test_room_overlaps_in_one_query_equal_a_query_per_room(seed):
     new = [rng.uniform(0, 10, size=(int(rng.integers(1, 30)), 2))
            for _ in range(int(rng.integers(0, 8)))]
     radius = float(rng.uniform(0.2, 1.5))
-    got = sorted(_overlaps(known, new, radius))
+    got = sorted(room_overlaps(known, new, radius))
     assert got == _overlaps_one_room_at_a_time(known, new, radius)
     assert all(isinstance(x, int) for t in got for x in t)
 

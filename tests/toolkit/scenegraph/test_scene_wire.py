@@ -20,9 +20,9 @@ from sgtool.log import schemas as S
 from sgtool.scenegraph import scene_wire as sw
 from sgtool.scenegraph.derived_layers import (
     GRAPH_Z,
-    _color,
-    _hull,
-    _hull_of,
+    room_color,
+    room_hull,
+    room_hull_of,
     voronoi_message,
 )
 
@@ -37,17 +37,17 @@ def _one_by_one(refresh: SimpleNamespace) -> SceneUpdate:
     if len(vg.edges):
         pts, cols = [], []
         for u, v in vg.edges.tolist():
-            c = _color(rooms[u] if rooms[u] == rooms[v] else None)
+            c = room_color(rooms[u] if rooms[u] == rooms[v] else None)
             pts += (points[u], points[v])
             cols += (c, c)
         ent.lines.append(LinePrimitive(type=LinePrimitive.LINE_LIST, thickness=0.03,
-                                       points=pts, colors=cols, color=_color(None)))
+                                       points=pts, colors=cols, color=room_color(None)))
     for n, (x, y) in enumerate(xy):
         s = ent.spheres.add()
         s.pose.position.x, s.pose.position.y, s.pose.position.z = float(x), float(y), GRAPH_Z
         s.pose.orientation.w = 1.0
         s.size.x = s.size.y = s.size.z = 0.08
-        s.color.CopyFrom(_color(rooms[n]))
+        s.color.CopyFrom(room_color(rooms[n]))
     return SceneUpdate(deletions=[SceneEntityDeletion(
         timestamp=codec.timestamp(refresh.time_ns), type=SceneEntityDeletion.ALL)],
         entities=[ent])
@@ -100,8 +100,8 @@ def test_hull_memo_is_the_hull_and_read_only() -> None:
     rng = np.random.default_rng(3)
     for _ in range(5):
         pts = rng.normal(size=(int(rng.integers(1, 12)), 2))
-        got = _hull_of(np.ascontiguousarray(pts).tobytes(), 0.3)
-        np.testing.assert_array_equal(got, _hull(pts, 0.3))
+        got = room_hull_of(np.ascontiguousarray(pts).tobytes(), 0.3)
+        np.testing.assert_array_equal(got, room_hull(pts, 0.3))
         assert not got.flags.writeable
-        again = _hull_of(np.ascontiguousarray(pts).tobytes(), 0.3)
+        again = room_hull_of(np.ascontiguousarray(pts).tobytes(), 0.3)
         assert again is got  # remembered

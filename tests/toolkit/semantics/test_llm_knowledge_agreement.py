@@ -8,7 +8,7 @@ import pytest
 from click.testing import CliRunner
 
 from sgtool.cli import cli
-from sgtool.commands.distill import _slice
+from sgtool.commands.distill import parse_llm_slice
 from sgtool.errors import SgtoolError
 from sgtool.semantics.llm_knowledge import agreement
 from sgtool.semantics.relational_set import table_to_set
@@ -28,11 +28,11 @@ def test_agreement_on_common_pairs() -> None:
 
 
 def test_slice_option() -> None:
-    assert _slice(None) == {}
-    assert _slice("3,2,4") == {"max_rooms": 3, "max_categories": 2, "max_objects": 4}
+    assert parse_llm_slice(None) == {}
+    assert parse_llm_slice("3,2,4") == {"max_rooms": 3, "max_categories": 2, "max_objects": 4}
     for bad in ("3,2", "a,b,c", "0,1,1"):
         with pytest.raises(SgtoolError, match="--llm-slice"):
-            _slice(bad)
+            parse_llm_slice(bad)
     r = CliRunner().invoke(cli, ["distill", "--source", "llm", "--llm-slice", "1,2"])
     assert r.exit_code == 2 and r.output.startswith("sgtool: error: --llm-slice '1,2'")
 
