@@ -112,7 +112,7 @@ SMOKE: dict[str, Smoke] = {
 
 def _scripts() -> set[str]:
     found = {f"benchmarks/{p.name}" for p in BENCHMARKS.glob("*.py") if p.name not in NOT_SCRIPTS}
-    return found | {f"tools/{p.name}" for p in TOOLS.glob("*.py")}
+    return found | {f"tools/{p.name}" for p in TOOLS.glob("*.py") if p.name not in NOT_SCRIPTS}
 
 
 def test_every_script_has_a_smoke_run() -> None:

@@ -1,6 +1,6 @@
 """Crafted sgtool logs: well-formed MCAP files whose content is wrong in one way a writer
 (or an attacker) could make it wrong, for tests/toolkit/log/test_fuzz.py (in-process) and
-benchmarks/fuzz_cli.py (through the CLI).
+tools/fuzz_cli.py (through the CLI).
 
 Every craft starts from the same three-frame log (calibration, /tf world -> base ->
 camera, RGB, depth and instance images, an instance table, an episode and a house

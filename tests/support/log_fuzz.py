@@ -2,7 +2,7 @@
 (tests/support/crafted_logs.py: wrong schemas and encodings, bad house attachments, /tf
 trees with cycles or without the camera link, instance tables out of range) and the
 judgement of what a command did with one: for tests/toolkit/log/test_fuzz.py (in-process)
-and benchmarks/fuzz_cli.py (through the CLI).
+and tools/fuzz_cli.py (through the CLI).
 
 A mutant knows which bytes it changed, so the chunks it left whole are known from the
 original's layout: recovery must give back at least their messages. A "complete" verdict

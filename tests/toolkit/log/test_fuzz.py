@@ -8,7 +8,7 @@ least the messages of the chunks the mutant left whole. Crafted logs (valid MCAP
 with wrong content: schemas, encodings, house attachments, /tf trees, instance tables) go
 through the same functions, replay also with the house scoring, frames as ``view`` reads
 them: each is read or refused in one line as tests/support/log_fuzz.py expects.
-``benchmarks/fuzz_cli.py`` runs both campaigns through the CLI.
+``tools/fuzz_cli.py`` runs both campaigns through the CLI.
 """
 
 from __future__ import annotations

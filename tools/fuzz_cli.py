@@ -1,21 +1,25 @@
 """The log fuzz campaign of tests/toolkit/log/test_fuzz.py, through the CLI (subprocesses).
 
-    .venv/bin/python benchmarks/fuzz_cli.py [--mutants 50] [--seed 14] [--ros2 PATH]
-                                            [--commands info,doctor,recover,replay,view,eval]
-                                            [--no-crafted] [--timeout 120]
+Usage (from the repository root, by hand; ``tests/`` on the path for the test support
+modules the campaign is built from)::
+
+    PYTHONPATH=tests .venv/bin/python tools/fuzz_cli.py [--mutants 50] [--seed 14]
+        [--ros2 PATH] [--commands info,doctor,recover,replay,view,eval]
+        [--crafted NAME,...] [--no-crafted] [--timeout 120]
 
 Seeded bit flips, record-head flips, overwrites and truncations of a small recorded sgtool
 log (written here with support.logfixtures.write_log) and of a real ROS 2 MCAP (default:
 the Nav2 recording in ../shared/data/logs/rosbag2-mcap/, skipped when absent), then the
 crafted logs of tests/support/crafted_logs.py (wrong schemas and encodings, bad house
-attachments, /tf cycles, instance tables out of range), also through `replay --score`.
-Every log goes through `sgtool info`, `doctor`, `doctor --recover`, `replay`, `view -o`
-and `eval`; prints a table logs x commands -> clean (exit 0) / error (exit != 0, ending
-in one `sgtool: error:` line, no traceback) / traceback / hang (no exit within
---timeout seconds) / wrong (doctor says complete but a reader sees changes, recovery
-gives back fewer messages than the chunks the mutant left whole, or a crafted log read
-where it must be refused or the other way round), then the first failures. Run by hand:
-about 1 s per log and command on 2 cores.
+attachments, /tf cycles, instance tables out of range; ``--crafted`` picks some by name),
+also through `replay --score`. Every log goes through `sgtool info`, `doctor`,
+`doctor --recover`, `replay`, `view -o` and `eval`; prints a table logs x commands ->
+clean (exit 0) / error (exit != 0, ending in one `sgtool: error:` line, no traceback) /
+traceback / hang (no exit within --timeout seconds) / wrong (doctor says complete but a
+reader sees changes, recovery gives back fewer messages than the chunks the mutant left
+whole, or a crafted log read where it must be refused or the other way round), then the
+first failures. Exits 1 when there is any failure. tests/test_tools.py runs it with tiny
+arguments.
 """
 
 from __future__ import annotations
@@ -27,14 +31,21 @@ import tempfile
 from collections import Counter
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "tests"))  # the test support modules
-from support.log_fuzz import campaign as prepare  # noqa: E402
-from support.log_fuzz import crafted_expectation, crafted_logs, message_count  # noqa: E402
-from support.logfixtures import write_log  # noqa: E402
+try:
+    from support.crafted_logs import CRAFTS
+    from support.log_fuzz import campaign as prepare
+    from support.log_fuzz import crafted_expectation, crafted_logs, message_count
+    from support.logfixtures import write_log
+except ModuleNotFoundError as e:  # run without tests/ on the path
+    if e.name != "support":
+        raise
+    sys.exit("fuzz_cli: the test support modules are not importable: run it as "
+             "PYTHONPATH=tests .venv/bin/python tools/fuzz_cli.py (from the repository root)")
 
+REPO = Path(__file__).resolve().parents[1]
 SGTOOL = str(Path(sys.executable).parent / "sgtool")
 OUTCOMES = ("clean", "error", "traceback", "hang", "wrong")
+COMMANDS = ("info", "doctor", "recover", "replay", "view", "eval")  # of argv, besides score
 TIMEOUT_S = 120.0
 
 
@@ -97,14 +108,17 @@ def campaign(src: Path, n: int, seed: int, commands: list[str], work: Path
     return table, failures
 
 
-def crafted_campaign(commands: list[str], work: Path) -> tuple[Counter, list[str]]:
-    """The crafted logs through ``commands`` and ``replay --score``, judged as
-    tests/toolkit/log/test_fuzz.py judges them in-process."""
+def crafted_campaign(commands: list[str], work: Path, names: set[str]
+                     ) -> tuple[Counter, list[str]]:
+    """The crafted logs called ``names`` through ``commands`` and ``replay --score``,
+    judged as tests/toolkit/log/test_fuzz.py judges them in-process."""
     import json
 
     table: Counter[tuple[str, str]] = Counter()
     failures: list[str] = []
     for name, log in crafted_logs(work / "crafted"):
+        if name not in names:
+            continue
         want = crafted_expectation(name)
         for cmd in [*commands, "score"]:
             outcome, text = run(cmd, log, work)
@@ -137,13 +151,20 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=14)
     ap.add_argument("--ros2", type=Path, default=REPO.parent / "shared" / "data" / "logs"
                     / "rosbag2-mcap" / "evo_nav2_turtlebot.mcap")
-    ap.add_argument("--commands", default="info,doctor,recover,replay,view,eval")
+    ap.add_argument("--commands", default=",".join(COMMANDS))
+    ap.add_argument("--crafted", default=",".join(CRAFTS),
+                    help="the crafted logs to run, by name [default: all]")
     ap.add_argument("--no-crafted", action="store_true", help="skip the crafted logs")
     ap.add_argument("--timeout", type=float, default=TIMEOUT_S,
                     help="seconds a command may run before it counts as a hang")
     a = ap.parse_args()
     TIMEOUT_S = a.timeout
     commands = [c for c in a.commands.split(",") if c]
+    crafted = {c for c in a.crafted.split(",") if c}
+    for given, known, what in ((commands, COMMANDS, "--commands"), (crafted, CRAFTS, "--crafted")):
+        unknown = sorted(set(given) - set(known))
+        if unknown:
+            ap.error(f"{what}: unknown {', '.join(unknown)} (known: {', '.join(known)})")
     failures: list[str] = []
     totals: Counter[str] = Counter()
     with tempfile.TemporaryDirectory() as tmp:
@@ -161,7 +182,7 @@ def main() -> None:
                 totals[o] += n
         if not a.no_crafted:
             (work / "crafted").mkdir()
-            table, f = crafted_campaign(commands, work)
+            table, f = crafted_campaign(commands, work, crafted)
             print_table("crafted logs (tests/support/crafted_logs.py)", table,
                         [*commands, "score"])
             failures += f
@@ -171,6 +192,8 @@ def main() -> None:
     print(f"{len(failures)} failures")
     for line in failures[:30]:
         print("  " + line)
+    if failures:
+        sys.exit(1)
 
 
 if __name__ == "__main__":

@@ -1,0 +1,40 @@
+"""The scripts of ``tools/`` that tests/test_benchmarks.py does not run: a smoke run of each
+with tiny arguments (exit 0, no figure checked), so none rots silently.
+
+``tools/fuzz_cli.py`` drives the CLI in subprocesses over the mutants and crafted logs of
+``tests/support`` (it needs ``tests/`` on ``PYTHONPATH``, as its usage says); here one
+mutant and one crafted log go through ``sgtool info`` (and ``replay --score``).
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+FUZZ_CLI = REPO / "tools" / "fuzz_cli.py"
+OFFLINE = {"HF_HUB_OFFLINE": "1", "TRANSFORMERS_OFFLINE": "1", "MPLBACKEND": "Agg"}
+
+
+def _run(args: list[str], pythonpath: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, **OFFLINE, "PYTHONPATH": pythonpath}
+    return subprocess.run([sys.executable, str(FUZZ_CLI), *args], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=600, check=False)
+
+
+def test_fuzz_cli_runs_with_tiny_arguments(tmp_path: Path) -> None:
+    proc = _run(["--mutants", "1", "--commands", "info", "--crafted", "depth-cdr",
+                 "--ros2", str(tmp_path / "absent.mcap")], str(REPO / "tests"), tmp_path)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    assert "1 mutants of small.mcap" in proc.stdout
+    assert "crafted logs" in proc.stdout and "0 failures" in proc.stdout
+
+
+def test_fuzz_cli_without_the_support_modules_says_how_to_run_it(tmp_path: Path) -> None:
+    proc = _run(["--mutants", "1"], "", tmp_path)
+    assert proc.returncode == 1
+    assert proc.stderr.strip().splitlines() == [
+        "fuzz_cli: the test support modules are not importable: run it as "
+        "PYTHONPATH=tests .venv/bin/python tools/fuzz_cli.py (from the repository root)"]
