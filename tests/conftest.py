@@ -11,6 +11,14 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 
+# One BLAS thread in the test processes and every process they start (CLI subprocesses,
+# benchmark scripts, Ray nodes, pytest-xdist workers). The suite is many small matrix
+# products (the sentence encoder runs one text at a time); OpenBLAS splits even those over
+# its threads, and on busy or shared cores waking them costs many times the product itself
+# (docs/experiments/suite-time.md). Results do not depend on it: OpenBLAS partitions the
+# output, not the sums. A value set by the caller is kept.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 
 def shared_data() -> Path:
     """``../shared/data`` beside the repository (override with SGTOOL_SHARED_DATA)."""
