@@ -3,7 +3,8 @@
 #
 #   bash setup.sh demo [ARGS...]   set up, then `sgtool demo` (record, replay, bench)
 #   bash setup.sh test [ARGS...]   set up, then mypy (stops on a type error), then the test
-#                                  suite (pytest ARGS)
+#                                  suite (pytest ARGS) in one pytest-xdist worker per CPU (at
+#                                  most 4; SGTOOL_TEST_WORKERS=N sets it, 0 runs in one process)
 #   bash setup.sh                  set up only
 #
 # Needs Python >= 3.11 (python3, or $PYTHON). Installs the Debian packages it needs
@@ -72,7 +73,9 @@ case "$what" in
   test)
     # the whole package against pyproject.toml's [tool.mypy]; a type error stops the run
     .venv/bin/mypy || die "mypy reports type errors (above); the tests were not run"
-    exec .venv/bin/python -m pytest -q "$@" ;;
+    # a worker takes a whole test file at a time (every Ray test to one worker:
+    # tests/conftest.py), so module fixtures are built once
+    exec .venv/bin/python -m pytest -q -n "${SGTOOL_TEST_WORKERS:-auto}" --dist loadfile "$@" ;;
   "") echo "setup.sh: ready; run .venv/bin/sgtool --help" ;;
   *) die "unknown action '$what' (demo or test)" ;;
 esac

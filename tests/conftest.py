@@ -1,11 +1,14 @@
-"""Shared test helpers: where the third-party data lives, small synthetic frames."""
+"""Shared test set-up: where the third-party data lives, one BLAS thread, the frozen session
+heap, ``ci_only`` tests, and how pytest-xdist workers share the suite (``-n``)."""
 
 from __future__ import annotations
 
 import gc
 import os
+import tempfile
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -18,6 +21,17 @@ REPO = Path(__file__).resolve().parents[1]
 # (docs/experiments/suite-time.md). Results do not depend on it: OpenBLAS partitions the
 # output, not the sums. A value set by the caller is kept.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+# One embedding cache per test session, made here so that pytest-xdist workers (which
+# inherit this process's environment) share it: a text is encoded once per session, not
+# once per worker (support.semantics_fixtures points SGTOOL_CACHE at it).
+if "SGTOOL_TEST_CACHE" not in os.environ:
+    os.environ["SGTOOL_TEST_CACHE"] = tempfile.mkdtemp(prefix="sgtool-test-cache-")
+
+# Tests that start a Ray instance run one after another in one pytest-xdist worker (two
+# Ray clusters on two cores at once would starve each other's start-up deadlines).
+RAY_STARTERS = ("tests/analysis/test_ray_executor.py::", "tests/analysis/test_ray_cluster.py::",
+                "[benchmarks/ray_scale.py]")
+MAX_AUTO_WORKERS = 4  # each worker imports torch and the encoder: about 1.5 GB
 
 
 def shared_data() -> Path:
@@ -69,3 +83,32 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     for item in items:
         if "ci_only" in item.keywords:
             item.add_marker(skip)
+
+
+def xdist_scope(nodeid: str) -> str:
+    """The unit of work of a pytest-xdist worker: the test's file (module fixtures are built
+    once), or ``ray`` for every test that starts a Ray instance."""
+    if any(mark in nodeid for mark in RAY_STARTERS):
+        return "ray"
+    return nodeid.split("::", 1)[0]
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config: pytest.Config, log: Any) -> Any:
+    """``--dist loadfile`` (as ``bash setup.sh test`` runs) hands out :func:`xdist_scope`
+    units; any other ``--dist`` is xdist's own."""
+    if config.getoption("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    class FileOrRayScheduling(LoadFileScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return xdist_scope(nodeid)
+
+    return FileOrRayScheduling(config, log)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
+    """``-n auto``: one worker per CPU this process may use, at most MAX_AUTO_WORKERS."""
+    return max(1, min(len(os.sched_getaffinity(0)), MAX_AUTO_WORKERS))
