@@ -6,7 +6,9 @@ whose colour has alpha 0 before touching its triangles, so :class:`ViewCulling` 
 0 on the bodies that lie entirely outside the camera's view pyramid before each image, and
 gives the others back their colour. A body outside the pyramid covers no pixel and, with
 shadows off, changes no other pixel either, so the images (colour, depth and instance ids)
-are exactly those of the whole house; only the time to draw them changes.
+are exactly those of the whole house; only the time to draw them changes. The pyramid ends
+at the renderer's far plane plus :data:`FAR_MARGIN_M`: TinyRenderer draws nothing beyond
+the far plane (its depth test starts there), so a box wholly beyond it is dropped too.
 
 :func:`outside_view` is the test (pure): a body's axis-aligned box is outside when all 8 of
 its corners lie beyond the same side plane of the pyramid, or all behind the camera. The
@@ -24,15 +26,18 @@ import numpy as np
 from sgtool.log.frame import CameraIntrinsics
 
 MARGIN_PX = 4.0  # pixels the view pyramid is widened by on every side
+FAR_MARGIN_M = 0.25  # metres past the far plane a dropped box must lie at least
 _CORNERS = np.array(list(itertools.product((0, 1), repeat=3)), dtype=bool)  # (8, 3)
 
 
 def outside_view(lo: np.ndarray, hi: np.ndarray, world_T_camera: np.ndarray,  # noqa: N803
-                 k: CameraIntrinsics, margin_px: float = MARGIN_PX) -> np.ndarray:
+                 k: CameraIntrinsics, far: float | None = None,
+                 margin_px: float = MARGIN_PX) -> np.ndarray:
     """bool (N,): whether the box ``[lo[i], hi[i]]`` (world metres, (N, 3) each) lies
     entirely outside the view pyramid of a camera at ``world_T_camera`` (optical frame: x
     right, y down, z forward) with intrinsics ``k``, the pyramid widened by ``margin_px``
-    pixels on each side. No far plane: a box beyond the sensor's range is kept."""
+    pixels on each side and cut at ``far`` metres along the optical axis (None: not
+    cut)."""
     lo = np.asarray(lo, dtype=np.float64).reshape(-1, 3)
     hi = np.asarray(hi, dtype=np.float64).reshape(-1, 3)
     corners = np.where(_CORNERS[None], hi[:, None, :], lo[:, None, :])  # (N, 8, 3)
@@ -41,8 +46,11 @@ def outside_view(lo: np.ndarray, hi: np.ndarray, world_T_camera: np.ndarray,  # 
     x, y, z = cam[..., 0], cam[..., 1], cam[..., 2]
     tx = (k.width / 2.0 + margin_px) / k.fx  # tangent of the widened half-angles
     ty = (k.height / 2.0 + margin_px) / k.fy
-    return ((z <= 0.0).all(axis=1) | (x > tx * z).all(axis=1) | (x < -tx * z).all(axis=1)
-            | (y > ty * z).all(axis=1) | (y < -ty * z).all(axis=1))
+    out = ((z <= 0.0).all(axis=1) | (x > tx * z).all(axis=1) | (x < -tx * z).all(axis=1)
+           | (y > ty * z).all(axis=1) | (y < -ty * z).all(axis=1))
+    if far is not None:
+        out |= (z > far).all(axis=1)
+    return out
 
 
 class ViewCulling:
@@ -71,14 +79,15 @@ class ViewCulling:
         self.hidden = np.zeros(len(kept), dtype=bool)
 
     def show_only_visible(self, world_T_camera: np.ndarray,  # noqa: N803
-                          k: CameraIntrinsics) -> None:
-        """Hide the bodies outside the view of a camera at ``world_T_camera`` and show the
-        others again (only bodies whose state changes are touched)."""
+                          k: CameraIntrinsics, far: float | None = None) -> None:
+        """Hide the bodies outside the view of a camera at ``world_T_camera`` (cut at
+        ``far`` metres, None: not cut) and show the others again (only bodies whose state
+        changes are touched)."""
         pb, cid = self._pb, self._client
         for i in self._movable:
             lo, hi = pb.getAABB(int(self.uids[i]), physicsClientId=cid)
             self._lo[i], self._hi[i] = lo, hi
-        hide = outside_view(self._lo, self._hi, world_T_camera, k)
+        hide = outside_view(self._lo, self._hi, world_T_camera, k, far)
         for i in np.flatnonzero(hide != self.hidden).tolist():
             r, g, b, a = self._colours[i]
             pb.changeVisualShape(int(self.uids[i]), -1,

@@ -47,7 +47,7 @@ from sgtool.recorders.sim.camera import (
     se2_matrix,
     view_matrix,
 )
-from sgtool.recorders.sim.culling import ViewCulling
+from sgtool.recorders.sim.culling import FAR_MARGIN_M, ViewCulling
 from sgtool.recorders.sim.events import SimObserver, SkillOutcome, StopSimulation
 from sgtool.recorders.sim.navigation import Pose2, RobotConfig
 from sgtool.recorders.sim.opening import OpeningPlanner
@@ -170,7 +170,7 @@ class Simulation(Skills):
         pb, cfg = self._pb, self.camera
         pose = self.camera_matrix()
         if self.culling is not None:
-            self.culling.show_only_visible(pose, self.intrinsics)
+            self.culling.show_only_visible(pose, self.intrinsics, cfg.far + FAR_MARGIN_M)
         _, _, rgba, buf, seg = pb.getCameraImage(
             cfg.width, cfg.height, view_matrix(pose), self._proj,
             renderer=pb.ER_TINY_RENDERER, flags=pb.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX,

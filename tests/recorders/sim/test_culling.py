@@ -1,5 +1,6 @@
-"""View culling: bodies outside the camera's view are not drawn, and the images are exactly
-those of the whole house (colour, depth, ids), with doors and containers moving."""
+"""View culling: bodies outside the camera's view (or wholly beyond its far plane) are not
+drawn, and the images are exactly those of the whole house (colour, depth, ids), with doors
+and containers moving."""
 
 from __future__ import annotations
 
@@ -45,6 +46,10 @@ def test_outside_view_of_boxes_around_a_camera() -> None:
     assert got == {"ahead": False, "behind": True, "left, outside 45 degrees": True,
                    "above the view": True, "straddling the left edge": False,
                    "around the camera": False}
+    # cut at a far plane: a box wholly beyond it is out, one reaching into it stays
+    far = np.array([[6.5, -0.2, 0.8], [5.5, -0.2, 0.8]]), np.array([[7.0, 0.2, 1.2]] * 2)
+    assert outside_view(*far, cam, k, far=6.25).tolist() == [True, False]
+    assert outside_view(*far, cam, k).tolist() == [False, False]
 
 
 def test_culled_images_equal_the_whole_house() -> None:
