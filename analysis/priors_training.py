@@ -140,7 +140,9 @@ def widened_containment(containment: Any, room_types: Sequence[str]) -> Any:
     """The containment set with the room knowledge widened
     (:mod:`sgtool.semantics.room_knowledge`): room types a house does not have folded into
     the household type of most alike contents, then ProcTHOR's room annotations
-    (:mod:`sgtool.datasets.room_annotations`, the shipped table) added."""
+    (:mod:`sgtool.datasets.room_annotations`, the shipped table) added: a name both sources
+    know gets the mean of their targets per annotated room type, a new name its
+    annotations (:func:`sgtool.semantics.room_knowledge.add_room_targets`)."""
     from sgtool.datasets.room_annotations import load_levels, room_targets
     from sgtool.semantics.room_knowledge import add_room_targets, fold_room_types
 

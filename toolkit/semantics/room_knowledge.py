@@ -14,9 +14,14 @@ scorer (:mod:`sgtool.semantics.room_blend`) reads at run time:
   each name to the larger of its own and the folded room's. The likeness comes from the
   data, not from the room names (whose sentence similarity puts a pantry next to a dining
   room and a storage room next to a bedroom).
-- :func:`add_room_targets`: room targets of another source (:func:`merge` rule: a pair
-  already in the set keeps the larger target; new names bring their pairs, zeros
-  included, so "a soap bar is never in a kitchen" is trained as such).
+- :func:`add_room_targets`: room targets of another source. A name the set already knows
+  gets, for each room type the other source annotates, the mean of the two sources'
+  targets (:data:`MEAN`; a room type the set has no pair for counts 0 there: the name was
+  never seen in it); its other pairs stay. Two sources that disagree (ProcTHOR places a
+  pillow "often" in living rooms, BEHAVIOR-1K's scenes and activities only in bedrooms)
+  then give a graded answer, not a tie at 1 that the largest room type wins. New names
+  bring their pairs as they are, zeros included, so "a soap bar is never in a kitchen" is
+  trained as such. (:data:`MAX`, the larger target, is the rule of the first widening.)
 - :func:`room_table`: per scored room type, the names whose target there is at least
   ``min_target`` (sorted), the neighbour scorer's evidence.
 
@@ -36,6 +41,9 @@ from sgtool.semantics.text import category_text
 MIN_LIKENESS = 0.25
 # a name is evidence for a room type in the neighbour table from this target on
 MIN_TARGET = 0.5
+# how add_room_targets merges a known name's pair with another source's
+MEAN = "mean"
+MAX = "max"
 
 
 def set_to_table(rs: RelationalSet) -> dict[tuple[str, str], float]:
@@ -92,18 +100,27 @@ def fold_room_types(rs: RelationalSet, scored: Sequence[str],
     return table_to_set(rs.relation, table)
 
 
-def add_room_targets(rs: RelationalSet,
-                     extra: Mapping[str, Mapping[str, float]]) -> RelationalSet:
+def add_room_targets(rs: RelationalSet, extra: Mapping[str, Mapping[str, float]],
+                     merge: str = MEAN) -> RelationalSet:
     """``rs`` with the room targets ``extra`` (``{name: {room type: target}}``, names and
     room types compared by :func:`category_text`, room types matched to the set's
-    spelling where the set has them) added: a pair in both keeps the larger target."""
+    spelling where the set has them) added. For a name with pairs in ``rs``, each room type
+    of ``extra`` gets the mean of the two targets (``merge`` :data:`MEAN`; a missing pair
+    counts 0) or the larger one (:data:`MAX`); a name new to ``rs`` brings its pairs."""
+    if merge not in (MEAN, MAX):
+        raise ValueError(f"merge is {MEAN!r} or {MAX!r}, not {merge!r}")
     table = set_to_table(rs)
+    known = {q for (_, q) in table}
     spelling = {category_text(n): n for n in rs.nodes}
     for name in sorted(extra):
         q = category_text(name)
         for room, y in sorted(extra[name].items()):
             node = spelling.get(category_text(room), room)
-            table[(node, q)] = max(float(y), table.get((node, q), 0.0))
+            old = table.get((node, q), 0.0)
+            if q not in known or merge == MAX:
+                table[(node, q)] = max(float(y), old)
+            else:
+                table[(node, q)] = (float(y) + old) / 2.0
     return table_to_set(rs.relation, table)
 
 

@@ -46,17 +46,29 @@ def test_fold_moves_a_room_type_into_the_scored_one_alike_in_contents() -> None:
     assert set_to_table(fold_room_types(rs, SCORED, 0.9)) == pytest.approx(TABLE)
 
 
-def test_add_room_targets_keeps_the_larger_and_brings_new_names_with_their_zeros() -> None:
+def test_add_room_targets_averages_a_known_name_and_brings_new_names_with_zeros() -> None:
     rs = table_to_set("containment", TABLE)
     out = set_to_table(add_room_targets(rs, {
-        "Apple": {"kitchen": 0.25, "bedroom": 0.0},  # known pair keeps 1.0; a new room type
+        # apple is known (kitchen 1.0): the other source says kitchen 0.25, bedroom 1.0
+        "Apple": {"kitchen": 0.25, "bedroom": 1.0},
         "soap bar": {"bathroom": 1.0, "kitchen": 0.0},
     }))
-    assert out[("kitchen", "apple")] == 1.0
-    assert out[("bedroom", "apple")] == 0.0
+    assert out[("kitchen", "apple")] == pytest.approx((1.0 + 0.25) / 2)
+    assert out[("bedroom", "apple")] == pytest.approx(0.5)  # never seen there: 0 and 1
     assert out[("bathroom", "soap bar")] == 1.0
     assert out[("kitchen", "soap bar")] == 0.0  # "never in a kitchen" is trained
+    assert out[("private_office", "desk")] == 1.0  # pairs the source does not name stay
     assert len(out) == len(TABLE) + 3
+
+
+def test_add_room_targets_max_rule_keeps_the_larger() -> None:
+    rs = table_to_set("containment", TABLE)
+    extra = {"Apple": {"kitchen": 0.25, "bedroom": 1.0}}
+    out = set_to_table(add_room_targets(rs, extra, merge="max"))
+    assert out[("kitchen", "apple")] == 1.0
+    assert out[("bedroom", "apple")] == 1.0
+    with pytest.raises(ValueError, match="merge"):
+        add_room_targets(rs, extra, merge="min")
 
 
 def test_room_table_lists_names_from_the_target_threshold() -> None:
