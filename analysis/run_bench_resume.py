@@ -41,7 +41,7 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
             "seed": opts.planner_seed, "success": opts.success}
 
 
-def _logged(path: Path) -> tuple[dict[str, Any], str | None]:
+def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
     """The settings an episode log was run with, and the house spec text it carries."""
     from sgtool.log.reader import LogReader
     from sgtool.log.records import Episode as LoggedEpisode
@@ -95,7 +95,7 @@ def check_resumable(path: Path, want: dict[str, Any], spec: HouseSpec, house: st
     """Raise :class:`ResumeError` unless the log ``path`` was run with the settings ``want``
     (:func:`task_settings`) on the house ``spec`` (``house`` names it: a file, or a
     generated house's id)."""
-    settings, logged_house = _logged(path)
+    settings, logged_house = logged_settings(path)
     diff = settings_differences(settings, want)
     if diff:
         raise ResumeError(f"{path} was run with other settings ({'; '.join(diff)}); {_FIX}")

@@ -77,7 +77,7 @@ def test_a_changed_house_file_is_not_resumed(tmp_path: Path, monkeypatch) -> Non
 def test_a_log_of_other_frame_settings_is_not_resumed(tmp_path: Path) -> None:
     """Which ticks are frames is a setting of the log: a run with another render step or
     turn angle does not reuse it (the message names the setting), the same ones do."""
-    from sgtool.analysis.run_bench_resume import _logged, task_settings
+    from sgtool.analysis.run_bench_resume import logged_settings, task_settings
     from sgtool.recorders.sim.camera import CameraConfig
     from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
 
@@ -87,7 +87,7 @@ def test_a_log_of_other_frame_settings_is_not_resumed(tmp_path: Path) -> None:
     out = tmp_path / "rb"
     res = CliRunner().invoke(cli, [*ARGS, "--house", str(house), "-o", str(out)])
     assert res.exit_code == 0, res.output
-    logged, _ = _logged(out / "logs/none/random/myhouse/ep-000.mcap")
+    logged, _ = logged_settings(out / "logs/none/random/myhouse/ep-000.mcap")
     opts = ClosedLoopOptions(camera=CameraConfig(width=64, height=48), max_steps=2, frames=60)
     ep = logged["episode"]
     assert settings_differences(logged, task_settings(opts, "none", ep)) == []
