@@ -27,11 +27,11 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 if "SGTOOL_TEST_CACHE" not in os.environ:
     os.environ["SGTOOL_TEST_CACHE"] = tempfile.mkdtemp(prefix="sgtool-test-cache-")
 
-# Tests that start a Ray instance run one after another in one pytest-xdist worker (two
-# Ray clusters on two cores at once would starve each other's start-up deadlines).
+# Tests that start a Ray instance run one after another in one pytest-xdist worker, so the
+# suite never runs two Ray instances at once (each sizes itself to the machine's CPUs).
 RAY_STARTERS = ("tests/analysis/test_ray_executor.py::", "tests/analysis/test_ray_cluster.py::",
                 "[benchmarks/ray_scale.py]")
-MAX_AUTO_WORKERS = 4  # each worker imports torch and the encoder: about 1.5 GB
+MAX_AUTO_WORKERS = 4  # each worker holds its own torch, encoder and test data in memory
 
 
 def shared_data() -> Path:
@@ -111,4 +111,8 @@ def pytest_xdist_make_scheduler(config: pytest.Config, log: Any) -> Any:
 @pytest.hookimpl(optionalhook=True)
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     """``-n auto``: one worker per CPU this process may use, at most MAX_AUTO_WORKERS."""
-    return max(1, min(len(os.sched_getaffinity(0)), MAX_AUTO_WORKERS))
+    if hasattr(os, "sched_getaffinity"):  # Linux: the CPUs this process may run on
+        cpus = len(os.sched_getaffinity(0))
+    else:
+        cpus = os.cpu_count() or 1
+    return max(1, min(cpus, MAX_AUTO_WORKERS))
