@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import gc
 import os
+import shutil
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
@@ -24,8 +25,10 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 # One embedding cache per test session, made here so that pytest-xdist workers (which
 # inherit this process's environment) share it: a text is encoded once per session, not
 # once per worker (support.semantics_fixtures points SGTOOL_CACHE at it).
+# The process that made it removes it when the session ends.
+_MADE_CACHE: str | None = None
 if "SGTOOL_TEST_CACHE" not in os.environ:
-    os.environ["SGTOOL_TEST_CACHE"] = tempfile.mkdtemp(prefix="sgtool-test-cache-")
+    _MADE_CACHE = os.environ["SGTOOL_TEST_CACHE"] = tempfile.mkdtemp(prefix="sgtool-test-cache-")
 
 # Tests that start a Ray instance run one after another in one pytest-xdist worker, so the
 # suite never runs two Ray instances at once (each sizes itself to the machine's CPUs).
@@ -83,6 +86,12 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     for item in items:
         if "ci_only" in item.keywords:
             item.add_marker(skip)
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    """Remove the session's embedding cache (when this process made it)."""
+    if _MADE_CACHE is not None:
+        shutil.rmtree(_MADE_CACHE, ignore_errors=True)
 
 
 def xdist_scope(nodeid: str) -> str:
