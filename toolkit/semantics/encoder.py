@@ -98,7 +98,12 @@ class SentenceEncoder:
         return self._model
 
     def _run_model(self, texts: list[str]) -> np.ndarray:
-        return self._load().encode(texts)
+        # one BLAS thread: waking a pool for the model's small products costs more than
+        # they do, and the vectors are the same bits either way (sgtool.blas)
+        from sgtool.blas import single_blas_thread
+
+        with single_blas_thread():
+            return self._load().encode(texts)
 
     def encode(self, texts: Sequence[str]) -> np.ndarray:
         """Unit vectors, shape (len(texts), 384), float32, rows in the order of ``texts``."""
