@@ -35,7 +35,7 @@ import os
 import signal
 import socket
 import sys
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -435,23 +435,6 @@ def make_executor(name: str, workers: int = 1, address: str | None = None) -> Ex
     if name == "ray":
         return RayExecutor(workers, address)
     raise ExecutorError(f"--executor: one of {', '.join(EXECUTORS)}, got {name!r}")
-
-
-def as_map(executor: Executor, *, progress: bool = False, desc: str = "tasks",
-           task_id: Callable[[int, Any], str] = lambda i, _: f"task {i}"
-           ) -> Callable[[Callable[[Any], Any], Iterable[Any]], list[Any]]:
-    """A ``map``-like runner (``runner(fn, items)`` -> values in item order) on
-    ``executor``, for drivers that take one (the closed-loop benchmark's ``runner``); a
-    task that fails after its retry stops the run with one line once all have run."""
-    def run(fn: Callable[[Any], Any], items: Iterable[Any]) -> list[Any]:
-        tasks = [Task(task_id(i, x), x) for i, x in enumerate(items)]
-        outcomes = executor.run(fn, tasks, progress=progress, desc=desc)
-        failed = failure_lines(outcomes)
-        if failed:
-            raise ExecutorError(f"{len(failed)} of {len(tasks)} task(s) failed; the first: "
-                                f"{failed[0]}")
-        return [o.value for o in outcomes]
-    return run
 
 
 def chunks(items: Sequence[Any], parts: int) -> Iterator[tuple[Any, ...]]:

@@ -139,17 +139,6 @@ def test_cli_ray_address_unreachable_is_one_line(tmp_path):
     assert not (tmp_path / "o").exists()
 
 
-def test_as_map_gives_values_in_order_or_one_line_for_a_failure():
-    from sgtool.analysis.executor import as_map
-
-    run = as_map(LocalExecutor(2))
-    assert run(square_but_three, [5, 4, 2]) == [25, 16, 4]
-    with pytest.raises(ExecutorError) as e:
-        run(square_but_three, [1, 3])
-    assert str(e.value) == ("1 of 2 task(s) failed; the first: task 1: ValueError: no square "
-                            "for 3 (after 2 attempts)")
-
-
 def exit_hard_at_one(x: int) -> int:
     import os
 
