@@ -1,5 +1,6 @@
 """Shared test set-up: where the third-party data lives, one BLAS thread, the frozen session
-heap, ``ci_only`` tests, and how pytest-xdist workers share the suite (``-n``)."""
+heap, signal handlers restored after each test, ``ci_only`` tests, and how pytest-xdist
+workers share the suite (``-n``)."""
 
 from __future__ import annotations
 
@@ -75,6 +76,20 @@ def unfrozen_heap() -> Iterator[None]:
     finally:
         gc.collect()
         gc.freeze()
+
+
+@pytest.fixture(autouse=True)
+def signal_handlers() -> Iterator[None]:
+    """Each test starts with the session's SIGINT/SIGTERM handlers: ``sgtool.cli.main``
+    called in process ignores Ctrl-C once its command is done (``_finished``), and an
+    ignored signal is inherited across exec by every subprocess a later test starts (a
+    served replay would then never stop on Ctrl-C)."""
+    import signal
+
+    saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    yield
+    for s, handler in saved.items():
+        signal.signal(s, handler)
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
