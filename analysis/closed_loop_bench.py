@@ -185,7 +185,7 @@ DRAWS_KEPT = 16
 _DRAWS: dict[tuple[Any, ...], tuple[Any, list[Any]]] = {}
 
 
-def _house(task: RunTask) -> tuple[Any, list[Any]]:
+def house_episodes(task: RunTask) -> tuple[Any, list[Any]]:
     """The house's spec and its episodes of the run: the bench's draw of ``task.episodes``
     (the draw depends on its size, so this is what makes them the symbolic bench's
     episodes)."""
@@ -203,7 +203,7 @@ def task_options(task: RunTask) -> ClosedLoopOptions:
     """The task's options with its frame budget resolved (per room of its house)."""
     if task.frames_per_room is None:
         return task.options
-    rooms = len(_house(task)[0].rooms)
+    rooms = len(house_episodes(task)[0].rooms)
     return replace(task.options, frames=frame_budget(task.options.frames,
                                                      task.frames_per_room, rooms))
 
@@ -215,7 +215,7 @@ def run_task(task: RunTask) -> RunRow:
 
     seconds: float | None = None
     if not task.output.exists():
-        spec, eps = _house(task)
+        spec, eps = house_episodes(task)
         if task.episode >= len(eps):
             raise SgtoolError(f"{task.house.id}: has {len(eps)} episodes, not "
                               f"{task.episode + 1}")
@@ -236,7 +236,7 @@ def run_task(task: RunTask) -> RunRow:
 
 def _row(task: RunTask, seconds: float | None) -> RunRow:
     if seconds is None:  # a log that was there: run with these settings, on this house?
-        spec, eps = _house(task)
+        spec, eps = house_episodes(task)
         want = [eps[task.episode].id, eps[task.episode].query] \
             if task.episode < len(eps) else None
         check_resumable(task.output, task_settings(task_options(task), task.noise, want),
@@ -301,7 +301,7 @@ class ClosedLoopBenchResult:
             if r.task.noise != noise:
                 continue
             if r.task.house.id not in rooms:
-                rooms[r.task.house.id] = max(1, len(_house(r.task)[0].rooms))
+                rooms[r.task.house.id] = max(1, len(house_episodes(r.task)[0].rooms))
             per_room[r.result.key()] = r.frames / rooms[r.task.house.id]
         budget = self.config.frames_per_room
         return frames_model(per_room, None if budget is None else float(budget))

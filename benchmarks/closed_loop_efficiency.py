@@ -53,12 +53,8 @@ def _value(text: str) -> Any:
 
 def worker(args: argparse.Namespace) -> dict[str, Any]:
     """Run the episodes with the ``sgtool`` on the path; one JSON document."""
-    from sgtool.analysis.closed_loop_bench import (
-        ClosedLoopBenchConfig,
-        _house,
-        run_task,
-        tasks_of,
-    )
+    from sgtool.analysis import closed_loop_bench
+    from sgtool.analysis.closed_loop_bench import ClosedLoopBenchConfig, run_task, tasks_of
     from sgtool.analysis.search_metrics import episode_spl
     from sgtool.recorders.sim.camera import CameraConfig
     from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
@@ -77,8 +73,13 @@ def worker(args: argparse.Namespace) -> dict[str, Any]:
     out = []
     with tempfile.TemporaryDirectory() as tmp:
         tasks = tasks_of(cfg, Path(tmp))
+        # houses built before the clock starts (older trees, e.g. the issue's base, call
+        # the function _house)
+        house_episodes = getattr(closed_loop_bench, "house_episodes", None)
+        if house_episodes is None:
+            house_episodes = closed_loop_bench._house
         for t in tasks:
-            _house(t)  # houses built before the clock starts
+            house_episodes(t)
         for t in tasks:
             c0 = time.process_time()
             row = run_task(t)

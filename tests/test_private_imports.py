@@ -18,12 +18,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 FOLDERS = ("tests", "benchmarks", "tools", "examples")
 
-PENDING: dict[str, int] = {
-    "benchmarks/closed_loop_efficiency.py": 1,
-    "tests/toolkit/scenegraph/test_refresh_shortcuts.py": 1,
-    "tests/toolkit/semantics/test_distill.py": 1,
-    "tests/toolkit/test_heap.py": 2,
-}
+PENDING: dict[str, int] = {}
 
 
 def private_imports(source: str) -> list[str]:

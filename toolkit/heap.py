@@ -44,8 +44,9 @@ def frozen_heap() -> Iterator[None]:
         gc.unfreeze()
 
 
-def _hugepage_setter() -> Callable[[bool], bool] | None:
-    """numpy's switch for ``madvise(MADV_HUGEPAGE)`` (private; None where it is missing)."""
+def hugepage_setter() -> Callable[[bool], bool] | None:
+    """numpy's switch for ``madvise(MADV_HUGEPAGE)``: a function taking the new setting and
+    returning the old (a private numpy function; None where it is missing)."""
     for name in ("numpy._core.multiarray", "numpy.core.multiarray"):
         try:
             setter = getattr(importlib.import_module(name), "_set_madvise_hugepage", None)
@@ -65,7 +66,7 @@ def small_pages() -> Iterator[None]:
     """numpy arrays allocated inside the block do not ask for huge pages (module doc).
     numpy's switch is one per process: the first block to enter turns it off, the last to
     leave restores it (blocks in several threads may overlap in any order)."""
-    setter = _hugepage_setter()
+    setter = hugepage_setter()
     if setter is None:
         yield
         return

@@ -21,7 +21,7 @@ ARGS = ["run-bench", "--planners", "random,greedy", "--houses", "0", "--episodes
 
 def _episodes(task: clb.RunTask) -> list:
     """The episode list a worker draws for the task's house (the worker's memo)."""
-    return clb._house(task)[1]
+    return clb.house_episodes(task)[1]
 
 
 @pytest.fixture(scope="module")

@@ -65,9 +65,9 @@ def test_a_nested_block_leaves_the_outer_freeze_alone() -> None:
 
 
 def test_small_pages_turns_numpy_huge_pages_off_inside_the_block_only() -> None:
-    from sgtool.heap import _hugepage_setter, small_pages
+    from sgtool.heap import hugepage_setter, small_pages
 
-    setter = _hugepage_setter()
+    setter = hugepage_setter()
     assert setter is not None  # numpy 2.x has the switch
     before = setter(True)
     try:
@@ -79,9 +79,9 @@ def test_small_pages_turns_numpy_huge_pages_off_inside_the_block_only() -> None:
 
 
 def test_small_pages_blocks_overlapping_out_of_order_restore_the_setting() -> None:
-    from sgtool.heap import _hugepage_setter, small_pages
+    from sgtool.heap import hugepage_setter, small_pages
 
-    setter = _hugepage_setter()
+    setter = hugepage_setter()
     assert setter is not None
     before = setter(True)
     try:

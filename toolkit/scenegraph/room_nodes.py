@@ -39,7 +39,7 @@ def room_regions(vg: VoronoiGraph, seg: RoomSegmentation, room_ids: list[str],
     length, centre, config): an unchanged room clusters the same."""
     regions: Regions = {}
     node_region: dict[int, str] = {}
-    lengths = _room_edge_lengths(vg, seg)
+    lengths = room_edge_lengths(vg, seg)
     for i, nodes in enumerate(seg.rooms):
         rid = room_ids[i]
         num = rid.split(":", 1)[1]
@@ -74,7 +74,7 @@ def _clustered(positions: np.ndarray, length: float, centre: int, config: Region
     return got
 
 
-def _room_edge_lengths(vg: VoronoiGraph, seg: RoomSegmentation) -> list[np.ndarray]:
+def room_edge_lengths(vg: VoronoiGraph, seg: RoomSegmentation) -> list[np.ndarray]:
     """Per room, the lengths of the Voronoi edges with both ends in it, in edge order (one
     pass over the edges, not one per room)."""
     if not len(vg.edges):

@@ -63,7 +63,9 @@ class DistillConfig:
     threads: int = 1
 
 
-def _encode_set(encoder: SentenceEncoder, rs: RelationalSet) -> tuple[np.ndarray, np.ndarray]:
+def encode_set(encoder: SentenceEncoder, rs: RelationalSet) -> tuple[np.ndarray, np.ndarray]:
+    """The sentence vectors of ``rs``'s node texts and of its query texts, in their
+    order: shapes (len(rs.nodes), dim) and (len(rs.queries), dim)."""
     return encoder.encode(list(rs.nodes)), encoder.encode(list(rs.queries))
 
 
@@ -134,7 +136,7 @@ def distill(
     mlps: dict[str, RelationMLP] = {}
     for rs, loss, epochs in ((cont, "mse", cfg.epochs_containment),
                              (cooc, "bce", cfg.epochs_cooccurrence)):
-        node_emb, query_emb = _encode_set(encoder, rs)
+        node_emb, query_emb = encode_set(encoder, rs)
         train = rs.subset_queries(train_q)
         tcfg = TrainConfig(epochs=epochs, batch_size=cfg.batch_size, lr=cfg.lr,
                            weight_decay=cfg.weight_decay, val_fraction=cfg.val_fraction,
@@ -184,12 +186,12 @@ def _report(mlps: dict[str, RelationMLP], encoder: SentenceEncoder, eval_sets: S
         names = {rs.queries[i] for rs in eval_sets for i in np.unique(rs.pairs[:, 1])}
         group: dict[str, Any] = {"queries": len(names)}
         for rs in eval_sets:
-            group[rs.relation] = evaluate_set(rs, *_encode_set(encoder, rs), mlps[rs.relation])
+            group[rs.relation] = evaluate_set(rs, *encode_set(encoder, rs), mlps[rs.relation])
         out["unseen"] = group
     if held:
         group = {"queries": len(held)}
         for rs in train_sets:
-            group[rs.relation] = evaluate_set(rs.subset_queries(held), *_encode_set(encoder, rs),
+            group[rs.relation] = evaluate_set(rs.subset_queries(held), *encode_set(encoder, rs),
                                               mlps[rs.relation])
         out["heldout"] = group
     return out

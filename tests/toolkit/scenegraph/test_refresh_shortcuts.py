@@ -19,7 +19,7 @@ from sgtool.mapping.voxels import VoxelConfig
 from sgtool.scenegraph.builder import BuilderConfig, SceneGraphBuilder
 from sgtool.scenegraph.door_evidence import open_doors
 from sgtool.scenegraph.regions import RegionConfig
-from sgtool.scenegraph.room_nodes import _room_edge_lengths, room_regions
+from sgtool.scenegraph.room_nodes import room_edge_lengths, room_regions
 from sgtool.scenegraph.room_segmentation import (
     RoomConfig,
     RoomSegmentation,
@@ -172,7 +172,7 @@ def check_room_stage(seed: int) -> tuple[int, int]:
             d = dijkstra(graph[nodes][:, nodes], directed=False)
             assert centre == int(nodes[int(np.argmin(d.max(axis=1)))])
     assert room_neighbours(vg, seg) == neighbours_by_walking(vg, seg)
-    for i, got in enumerate(_room_edge_lengths(vg, seg)):
+    for i, got in enumerate(room_edge_lengths(vg, seg)):
         inside = np.isin(vg.edges, seg.rooms[i]).all(axis=1)
         assert float(got.sum()) == float(vg.lengths[inside].sum())
     return seg.count, len(room_neighbours(vg, seg))

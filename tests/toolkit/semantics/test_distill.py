@@ -115,7 +115,7 @@ def test_shipped_weights_are_what_distill_writes(tmp_path) -> None:
 
     from sgtool.commands.distill import command
     from sgtool.datasets.relational import training_sets
-    from sgtool.semantics.distill import _encode_set
+    from sgtool.semantics.distill import encode_set
     from sgtool.semantics.mlp import load_mlp
     from sgtool.semantics.priors import WEIGHTS_DIR
 
@@ -134,7 +134,7 @@ def test_shipped_weights_are_what_distill_writes(tmp_path) -> None:
     sets = training_sets(seed=int(shipped["config"]["seed"]))
     enc = encoder()
     for rel, rs in (("containment", sets.containment), ("cooccurrence", sets.cooccurrence)):
-        nodes, queries = _encode_set(enc, rs)
+        nodes, queries = encode_set(enc, rs)
         x = np.concatenate([nodes[rs.pairs[:, 0]], queries[rs.pairs[:, 1]]], axis=1)
         a = load_mlp(tmp_path / f"{rel}.safetensors", rel).pairs(x)
         b = load_mlp(WEIGHTS_DIR / f"{rel}.safetensors", rel).pairs(x)
