@@ -9,7 +9,7 @@ with its default parameters and the folder's ``training_queries``; gated by the 
 held-out AUC, (C4), so it is the learned model wherever that beats the cosine), and the
 same blend ungated.
 
-    .venv/bin/python benchmarks/priors_check.py [WEIGHTS_DIR ...] [--misses]
+    .venv/bin/python benchmarks/priors_check.py [WEIGHTS_DIR ...] [--misses] [--json PATH]
 
 Measured (74 objects, 11 scoreable rooms; learned / cosine / ungated blend top-1): shipped
 0.541 / 0.622 / 0.649; retrained on this machine with ``sgtool distill --seed S``: S=0
@@ -24,6 +24,9 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Sequence
+from typing import Any
+
+from harness import add_output_options, emit
 
 from sgtool.planning.calibration import BlendedPriors, BlendParams
 from sgtool.semantics.encoder import default_encoder
@@ -46,14 +49,23 @@ def format_checks(checks: Sequence[RoomCheck], show_misses: bool = False) -> str
     return "\n".join(lines)
 
 
+def check_doc(c: RoomCheck) -> dict[str, Any]:
+    """One scorer's figures and misses (JSON-ready)."""
+    return {"scorer": c.scorer, "accuracy": c.accuracy, "hits": c.hits, "n": c.n,
+            "misses": [{"name": m.name, "expected": m.expected, "got": m.got}
+                       for m in c.misses]}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("weights", nargs="*", help="weights folders [default: the shipped ones]")
     ap.add_argument("--misses", action="store_true", help="list the objects each one misses")
+    add_output_options(ap)
     args = ap.parse_args()
     enc = default_encoder()
     cosine = CosinePriors(enc)
     print(f"{len(EVERYDAY_ROOMS)} everyday objects")
+    folders = []
     for folder in args.weights or [None]:
         try:
             learned = LearnedPriors(enc, folder)
@@ -67,6 +79,9 @@ def main() -> None:
         print(f"{folder or 'shipped priors'}: {len(rooms)} rooms ({', '.join(rooms)})")
         checks = [room_check(s, rooms) for s in (learned, cosine, blended, ungated)]
         print(format_checks(checks, show_misses=args.misses))
+        folders.append({"folder": str(folder) if folder else None, "rooms": list(rooms),
+                        "checks": [check_doc(c) for c in checks]})
+    emit({"objects": len(EVERYDAY_ROOMS), "folders": folders}, args.json_out)
 
 
 if __name__ == "__main__":
