@@ -24,15 +24,16 @@ of small objects per room type, small objects per room of each type, and the mos
 frequent categories of bathrooms, kitchens and bedrooms.
 
 Usage: ``HF_HUB_OFFLINE=1 .venv/bin/python benchmarks/house_semantics.py [--houses 10]
-[--rooms 12-16] [--top 10] [--json]``
+[--rooms 12-16] [--top 10] [--json PATH]`` (``--json -``: the figures as JSON on stdout
+instead of the table)
 """
 
 from __future__ import annotations
 
 import argparse
-import json
-import sys
 from collections import Counter, defaultdict
+
+from harness import add_output_options, emit
 
 from sgtool.datasets.generator import generate_house
 from sgtool.datasets.knowledge import Knowledge, ancestors, readable_name
@@ -151,19 +152,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--houses", type=int, default=10)
     ap.add_argument("--rooms", default="12-16")
     ap.add_argument("--top", type=int, default=10)
-    ap.add_argument("--json", action="store_true")
+    add_output_options(ap)
     a = ap.parse_args(argv)
     lo, _, hi = a.rooms.partition("-")
     rooms = (int(lo), int(hi or lo))
     out = [measure("eval", range(EVAL_SEEDS.start, EVAL_SEEDS.start + a.houses), rooms, a.top),
            measure("train", range(TRAIN_SEEDS.start, TRAIN_SEEDS.start + a.houses), rooms,
                    a.top)]
-    if a.json:
-        json.dump(out, sys.stdout, indent=1)
-        print()
-    else:
+    if a.json_out != "-":
         for m in out:
             _print(m)
+    emit({"splits": out}, a.json_out)
     return 0
 
 
