@@ -17,6 +17,8 @@ Run by hand, e.g. (the figures of the closed-loop note)::
 
     HF_HUB_OFFLINE=1 .venv/bin/python benchmarks/closed_loop.py --out /tmp/closed-loop
 
+``--json PATH`` also writes the per-episode rows and the per-planner figures as JSON.
+
 The closed-loop benchmark proper is ``sgtool run-bench`` (resumable, noise profiles, the
 bench's tables); this script stays for quick comparisons. Episodes run one after the
 other in this process (wall-clock figures are not shared with
@@ -26,11 +28,14 @@ other workers). Same command, same logs, except the measured decision times.
 from __future__ import annotations
 
 import argparse
+import math
 import shlex
 import statistics
 import sys
-import time
 from pathlib import Path
+from typing import Any
+
+from harness import add_output_options, emit, timed
 
 from sgtool.datasets.episodes import list_episodes
 
@@ -38,6 +43,11 @@ from sgtool.datasets.episodes import list_episodes
 def _rooms(text: str) -> tuple[int, int]:
     lo, _, hi = text.replace(",", "-").partition("-")
     return int(lo), int(hi or lo)
+
+
+def _finite(x: float | None) -> float | None:
+    """``x``, or None for NaN (JSON has no NaN)."""
+    return None if x is None or math.isnan(x) else x
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -56,6 +66,7 @@ def main(argv: list[str] | None = None) -> int:
                     "issue 17)")
     ap.add_argument("--out", default="closed-loop-logs", help="folder for the episode logs")
     ap.add_argument("--force", action="store_true", help="overwrite existing logs")
+    add_output_options(ap)
     args = ap.parse_args(argv)
 
     from click.testing import CliRunner
@@ -90,6 +101,7 @@ def main(argv: list[str] | None = None) -> int:
     rows: dict[str, list] = {p: [] for p in planners}
     logs: list[str] = []
     commands: list[str] = []
+    episodes: list[dict[str, Any]] = []
     for (hid, house, flags), n in zip(houses, per, strict=True):
         eps = list_episodes(house)
         picks = sorted({round(i * len(eps) / n) for i in range(n)}) if n else []
@@ -111,6 +123,12 @@ def main(argv: list[str] | None = None) -> int:
                       f"{'yes' if rep.success else 'no':<5} {rep.steps:>5} "
                       f"{rep.travelled_m:>6.1f} {short:>6} {spl:>5} {rep.frames:>6} "
                       f"{rep.frames_per_s:>6.1f} {med:>7.2f}  {rep.end}", flush=True)
+                episodes.append({
+                    "planner": p, "house": hid, "episode": k, "query": ep.query,
+                    "success": rep.success, "steps": rep.steps, "travelled_m": rep.travelled_m,
+                    "shortest_m": rep.shortest_m, "spl": rep.spl, "frames": rep.frames,
+                    "frames_per_s": rep.frames_per_s, "decision_ms_median": _finite(med),
+                    "end": str(rep.end), "log": str(path)})
                 commands.append(shlex.join(
                     ["sgtool", "run", "--planner", p, *flags, "--episode", str(k),
                      "--resolution", args.resolution, "--max-steps", str(args.max_steps),
@@ -118,6 +136,7 @@ def main(argv: list[str] | None = None) -> int:
     print()
     print("| Planner | Episodes | SR | SPL | Mean steps | Median decision (ms) | Frames/s |")
     print("|---|---|---|---|---|---|---|")
+    summary: dict[str, dict[str, Any]] = {}
     for p, reps in rows.items():
         sr = sum(r.success for r in reps) / len(reps)
         spls = [r.spl for r in reps if r.spl is not None]
@@ -128,14 +147,18 @@ def main(argv: list[str] | None = None) -> int:
         fps = sum(r.frames for r in reps) / sum(r.seconds for r in reps)
         print(f"| {p} | {len(reps)} | {sr:.3f} | {spl:.3f} | {steps:.1f} | {med:.2f} | "
               f"{fps:.1f} |")
+        summary[p] = {"episodes": len(reps), "sr": sr, "spl": _finite(spl),
+                      "mean_steps": steps, "decision_ms_median": _finite(med),
+                      "frames_per_s": fps}
     print()
-    t0 = time.perf_counter()
-    r = CliRunner().invoke(cli, ["eval", *logs])
-    print(f"$ sgtool eval {out}/*.mcap   ({time.perf_counter() - t0:.1f} s)")
+    r, eval_time = timed(lambda: CliRunner().invoke(cli, ["eval", *logs]))
+    print(f"$ sgtool eval {out}/*.mcap   ({eval_time.wall_s:.1f} s)")
     print(r.output, end="")
     if commands:
         print("\nEach log again, one by one (same logs except the decision times):")
         print(f"  {commands[0]}\n  ... ({len(commands)} commands, one per log)")
+    emit({"planners": summary, "episodes": episodes, "eval": eval_time,
+          "eval_exit_code": r.exit_code}, args.json_out)
     return 0 if r.exit_code == 0 else 1
 
 
