@@ -7,10 +7,12 @@
 
 Each command runs as a subprocess; its CPU time is the sum over the process tree (the
 command, pool workers, Ray's raylet, GCS and workers), sampled every 0.1 s with psutil, so
-a process's last 0.1 s may be missed. Runs of one repeat are interleaved, so a load that
-changes over time hits every variant alike; medians are printed. `bench` then compares the
-outputs byte for byte (wall-clock fields aside), `replay` compares every derived log with
-a one-by-one `sgtool replay LOG -o`.
+a process's last 0.1 s may be missed (the harness's in-process timing cannot see the tree).
+Runs of one repeat are interleaved, the order reversed every other repeat
+(:func:`harness.round_order`), so a load that changes over time hits every variant alike;
+medians are printed. `bench` then compares the outputs byte for byte (wall-clock fields
+aside), `replay` compares every derived log with a one-by-one `sgtool replay LOG -o`. Every
+command takes ``--json PATH`` (the figures as JSON).
 """
 
 from __future__ import annotations
@@ -24,8 +26,10 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import psutil
+from harness import add_output_options, emit, round_order, timed
 
 SGTOOL = str(Path(sys.executable).with_name("sgtool"))
 VARIANTS = {"local -w 1": ["--executor", "local", "-w", "1"],
@@ -79,7 +83,8 @@ def bench(a: argparse.Namespace) -> None:
     work = Path(tempfile.mkdtemp(prefix="ray-scale-"))
     figures: dict[str, list[tuple[float, float]]] = {k: [] for k in VARIANTS}
     for rep in range(a.repeat):
-        for name, extra in VARIANTS.items():
+        for name in round_order(list(VARIANTS), rep):
+            extra = VARIANTS[name]
             out = work / f"{rep}-{name.split()[0]}{extra[-1]}"
             wall, cpu, _ = measured([SGTOOL, *args, *extra, "-o", str(out)])
             figures[name].append((wall, cpu))
@@ -88,11 +93,16 @@ def bench(a: argparse.Namespace) -> None:
     base = statistics.median(c for _, c in figures["local -w 1"])
     print("| executor | wall s (median) | CPU-s (median) | CPU-s per episode | CPU vs -w 1 |")
     print("|---|---|---|---|---|")
+    table: dict[str, dict[str, Any]] = {}
     for name, runs in figures.items():
         wall = statistics.median(w for w, _ in runs)
         cpu = statistics.median(c for _, c in runs)
         print(f"| {name} | {wall:.1f} | {cpu:.1f} | {cpu / n_eps:.3f} | {cpu / base:.2f} |")
+        table[name] = {"wall_s": wall, "cpu_s": cpu, "cpu_s_per_episode": cpu / n_eps,
+                       "cpu_vs_w1": cpu / base,
+                       "runs": [{"wall_s": w, "cpu_s": c} for w, c in runs]}
     ref = work / "0-local1"
+    identical: dict[str, bool] = {}
     for out in sorted(work.iterdir()):
         same = []
         for f in sorted(ref.iterdir()):
@@ -105,7 +115,10 @@ def bench(a: argparse.Namespace) -> None:
         print(f"{out.name} vs {ref.name}: " + ", ".join(
             f"{n} {'identical' if s else 'DIFFERS'}" for n, s in same)
             + " (episodes.jsonl without its wall-clock fields)")
+        identical[out.name] = all(s for _, s in same)
     shutil.rmtree(work)
+    emit({"command": ["sgtool", *args], "episodes_per_run": n_eps, "executors": table,
+          "identical_to_local1": identical}, a.json_out)
 
 
 def replay(a: argparse.Namespace) -> None:
@@ -113,14 +126,19 @@ def replay(a: argparse.Namespace) -> None:
     work = Path(tempfile.mkdtemp(prefix="ray-scale-replay-"))
     one = work / "one"
     one.mkdir()
-    t0 = time.perf_counter()
-    for p in logs:
-        subprocess.run([SGTOOL, "replay", str(p), "-o", str(one / p.name), "--no-progress"],
-                       check=True, capture_output=True)
-    print(f"one by one: {len(logs)} logs in {time.perf_counter() - t0:.1f} s "
+
+    def one_by_one() -> None:
+        for p in logs:
+            subprocess.run([SGTOOL, "replay", str(p), "-o", str(one / p.name), "--no-progress"],
+                           check=True, capture_output=True)
+
+    _, took = timed(one_by_one)
+    print(f"one by one: {len(logs)} logs in {took.wall_s:.1f} s "
           "(one process each)", flush=True)
+    runs: list[dict[str, Any]] = []
     for rep in range(a.repeat):
-        for name, extra in VARIANTS.items():
+        for name in round_order(list(VARIANTS), rep):
+            extra = VARIANTS[name]
             out = work / f"{rep}-{name.split()[0]}{extra[-1]}"
             wall, cpu, text = measured([SGTOOL, "replay", str(a.log_dir), "--out-dir", str(out),
                                         "--no-progress", *extra])
@@ -130,7 +148,10 @@ def replay(a: argparse.Namespace) -> None:
                   f"({len(logs) / wall * 60:.1f} logs/minute), {cpu:.1f} CPU-s; "
                   f"{'all byte-identical' if same else 'OUTPUTS DIFFER'} to one-by-one; "
                   f"{text.splitlines()[-1]}", flush=True)
+            runs.append({"repeat": rep, "executor": name, "wall_s": wall, "cpu_s": cpu,
+                         "logs_per_minute": len(logs) / wall * 60, "identical": same})
     shutil.rmtree(work)
+    emit({"logs": len(logs), "one_by_one_wall_s": took.wall_s, "runs": runs}, a.json_out)
 
 
 STARTUP = """
@@ -158,6 +179,9 @@ def startup(a: argparse.Namespace) -> None:
     print("Ray fixed cost, local instance of 2 CPUs (medians of "
           f"{a.repeat}): " + ", ".join(f"{n} {statistics.median(r[i] for r in runs):.2f} s"
                                         for i, n in enumerate(names)))
+    emit({"repeat": a.repeat, "medians_s": {n: statistics.median(r[i] for r in runs)
+                                            for i, n in enumerate(names)},
+          "runs": [dict(zip(names, r, strict=True)) for r in runs]}, a.json_out)
 
 
 def main() -> None:
@@ -174,6 +198,8 @@ def main() -> None:
     r.add_argument("--repeat", type=int, default=1)
     s = sub.add_parser("startup")
     s.add_argument("--repeat", type=int, default=3)
+    for sp in (b, r, s):
+        add_output_options(sp)
     a = ap.parse_args()
     {"bench": bench, "replay": replay, "startup": startup}[a.what](a)
 
