@@ -321,7 +321,9 @@ class BenchResult:
 # ----------------------------------------------------------------------------------------
 # one worker task: one house, one planner, every seed and episode
 # ----------------------------------------------------------------------------------------
-_HOUSES: OrderedDict[tuple[str, str, tuple[int, int], str], Any] = OrderedDict()
+# a house and its episodes, by everything they depend on: the draw of ``bench_episodes``
+# depends on how many episodes are drawn, so N episodes are not the first N of a larger draw
+_HOUSES: OrderedDict[tuple[str, str, tuple[int, int], str, int], Any] = OrderedDict()
 _PLANNERS: dict[tuple[str, str], Any] = {}
 
 
@@ -329,11 +331,11 @@ def _house(ref: BenchHouse, rooms: tuple[int, int], episodes: int,
            preset: str = "default") -> tuple[Any, list[Any]]:
     from sgtool.recorders.symbolic_environment.house import SymbolicHouse
 
-    key = (ref.id, ref.source, rooms, preset)
+    key = (ref.id, ref.source, rooms, preset, episodes)
     hit = _HOUSES.get(key)
-    if hit is not None and len(hit[1]) >= episodes:
+    if hit is not None:
         _HOUSES.move_to_end(key)
-        return hit[0], hit[1][:episodes]
+        return hit
     spec = ref.load(rooms, preset)
     # the preset's episode mix (furniture-level targets) is for generated houses; a given
     # house file is searched for its small objects, as list_episodes lists them

@@ -5,6 +5,7 @@ planner option stops the run before any episode."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import pytest
@@ -98,3 +99,21 @@ def test_a_task_gives_the_same_results_whatever_its_worker_ran_before():
     assert default_priors()._memo._memo == memo_alone
     assert results_digest(after_other) == results_digest(alone)
     assert {r.house for r in alone} == {"house-1"} and len(alone) == 2
+
+
+def test_a_task_gives_the_same_episodes_after_a_larger_draw_of_the_same_house():
+    """The episode draw depends on how many are drawn, so a process that benched a house
+    with more episodes before must not hand out the first N of that draw: it gave other
+    queries than a fresh process (a local bench then differed from the same bench on
+    Ray's fresh workers)."""
+    from sgtool.analysis.bench import run_task
+    from sgtool.results import results_digest
+
+    small = BenchConfig(planners=("random",), houses=1, episodes=2, seeds=1, rooms=(4, 6),
+                        preset="default")
+    large = dataclasses.replace(small, episodes=5)
+    (task,) = bench_tasks(small, prepare_houses(small))
+    (larger,) = bench_tasks(large, prepare_houses(large))
+    fresh = run_task(task.args)
+    run_task(larger.args)
+    assert results_digest(run_task(task.args)) == results_digest(fresh)
