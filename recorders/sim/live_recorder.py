@@ -22,7 +22,6 @@ from collections.abc import Mapping
 from typing import Any
 
 from sgtool.log.echo import as_logged
-from sgtool.log.records import Instances
 from sgtool.log.writer import LogWriter
 from sgtool.recorders.sim.keyframes import KeyframeRule
 from sgtool.recorders.sim.recording import LogRecorder
@@ -49,13 +48,12 @@ class LiveRecorder(LogRecorder):
         self._changed = False  # a door or container changed since the last frame
         self._pending: int | None = None  # the last tick, when it was no frame
 
-    def write_instances(self, sim: Simulation) -> None:
+    def write_instances(self, sim: Simulation) -> dict[str, Any]:
         """Write the instance table (as :class:`LogRecorder` does) and hand the stream the
         JSON form the writer checked and wrote, read once."""
-        t = sim.time_ns()
-        self.last_instances = Instances.of(sim.instance_records())
-        written = self.writer.write_record(self.last_instances, t)
-        self.stream.instance_table(t, instances_from_record(written))
+        written = super().write_instances(sim)
+        self.stream.instance_table(sim.time_ns(), instances_from_record(written))
+        return written
 
     def on_state(self, sim: Simulation, spec_id: str, state: str) -> None:
         super().on_state(sim, spec_id, state)

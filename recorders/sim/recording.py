@@ -87,9 +87,10 @@ class LogRecorder(SimObserver):
             profile, seed, structure,
             base_T_camera(sim.camera.mount_height, sim.camera.tilt_deg))
 
-    def write_instances(self, sim: Simulation) -> None:
+    def write_instances(self, sim: Simulation) -> dict[str, Any]:
+        """Write the simulation's instance table; returns the JSON object written."""
         self.last_instances = Instances.of(sim.instance_records())
-        self.writer.write_record(self.last_instances, sim.time_ns())
+        return self.writer.write_record(self.last_instances, sim.time_ns())
 
     def on_tick(self, sim: Simulation) -> None:
         if self.budget_spent:
