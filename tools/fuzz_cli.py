@@ -100,12 +100,18 @@ def campaign(src: Path, n: int, seed: int, commands: list[str], work: Path
                 if cmd == "recover" and c.too_few(m, d["readable_messages"]):
                     outcome, text = "wrong", (f"recovered {d['readable_messages']}, fewer "
                                               "than the whole chunks hold")
-            table[cmd, outcome] += 1
-            if outcome in ("traceback", "hang", "wrong"):
-                failures.append(f"{src.name} {m.name} {cmd}: {text}")
+            _tally(table, failures, cmd, outcome, f"{src.name} {m.name} {cmd}: {text}")
         print(".", end="", flush=True, file=sys.stderr)
     print(file=sys.stderr)
     return table, failures
+
+
+def _tally(table: Counter, failures: list[str], cmd: str, outcome: str, line: str) -> None:
+    """Count ``outcome`` of ``cmd``; a traceback, hang or wrong result adds ``line`` to
+    the failures."""
+    table[cmd, outcome] += 1
+    if outcome in ("traceback", "hang", "wrong"):
+        failures.append(line)
 
 
 def crafted_campaign(commands: list[str], work: Path, names: set[str]
@@ -129,9 +135,7 @@ def crafted_campaign(commands: list[str], work: Path, names: set[str]
                 if d["status"] != "complete" or (
                         cmd == "recover" and d["readable_messages"] != message_count(log)):
                     outcome, text = "wrong", f"{d['status']}, {d['readable_messages']} messages"
-            table[cmd, outcome] += 1
-            if outcome in ("traceback", "hang", "wrong"):
-                failures.append(f"crafted {name} {cmd}: {text}")
+            _tally(table, failures, cmd, outcome, f"crafted {name} {cmd}: {text}")
         print(".", end="", flush=True, file=sys.stderr)
     print(file=sys.stderr)
     return table, failures
