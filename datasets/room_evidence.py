@@ -3,7 +3,9 @@
 ``containment`` is the distilled model shipped with sgtool
 (:class:`~sgtool.semantics.room_classification.ContainmentRoomClassifier`); ``frequency`` is
 naive Bayes over the BEHAVIOR-1K training scenes' room inventories, built here because it
-reads the knowledge; ``llm`` is MoMa-LLM's room classification
+reads the knowledge, with the containment model for a room none of whose categories the
+inventories name (the default: ``benchmarks/room_classifiers.py`` compares them); ``llm``
+is MoMa-LLM's room classification
 (:class:`~sgtool.semantics.room_classification.LlmRoomClassifier`) over the containment
 model's room types, with the containment model as its fallback, asked through the chat
 client the caller gives (an endpoint, or a transcript replayed offline); ``none`` leaves rooms
@@ -24,7 +26,9 @@ from sgtool.semantics.room_classification import ContainmentRoomClassifier, LlmR
 
 
 def frequency_room_classifier(room_types: Iterable[str] | None = None, alpha: float = 1.0,
-                              small_objects: bool = False) -> FrequencyRoomClassifier:
+                              small_objects: bool = False,
+                              fallback: RoomClassifier | None = None
+                              ) -> FrequencyRoomClassifier:
     """A :class:`FrequencyRoomClassifier` from
     :func:`sgtool.datasets.split.training_knowledge`: per room type, in how
     many rooms of the household training scenes each category occurs (document
@@ -33,7 +37,8 @@ def frequency_room_classifier(room_types: Iterable[str] | None = None, alpha: fl
     generator uses). ``small_objects`` adds the activity-derived small-object counts
     per room type. The small-object counts are off by default: they lowered the room
     accuracy on evaluation-split houses, as raw counts did against document frequencies
-    (``docs/experiments/moved-from-docstrings.md``)."""
+    (``docs/experiments/moved-from-docstrings.md``). ``fallback`` answers for a room none of
+    whose categories the table names."""
     k = training_knowledge()
     if room_types is None:
         room_types = (*HOUSE_ROOM_TYPES, "corridor")
@@ -55,7 +60,7 @@ def frequency_room_classifier(room_types: Iterable[str] | None = None, alpha: fl
                 name = k.name(synset)
                 row[name] = row.get(name, 0.0) + float(n)
     table = {r: row for r, row in table.items() if row}
-    return FrequencyRoomClassifier(table, alpha=alpha)
+    return FrequencyRoomClassifier(table, alpha=alpha, fallback=fallback)
 
 
 class LlmClassifierError(SgtoolError):
@@ -72,7 +77,7 @@ def make_classifier(name: str, client: Any | None = None, *, constraint: str = "
     if name == "containment":
         return ContainmentRoomClassifier()
     if name == "frequency":
-        return frequency_room_classifier()
+        return frequency_room_classifier(fallback=ContainmentRoomClassifier())
     if name == "llm":
         if client is None:
             raise LlmClassifierError(

@@ -19,7 +19,8 @@ hides it): a damaged log is refused in one line, and no derived log is left.
 Options default to what the log says it was built with: a closed-loop log records its
 mapping options in its ``sgtool.Episode`` record (``extra.mapping``), so replaying it with
 the defaults rebuilds the same graphs it decided on. Otherwise: a refresh every 10 frames
-and at every action, the containment room classifier, and MoMa-LLM's "seen" threshold of 50
+and at every action, the frequency room classifier (the containment model for a room none
+of whose categories it knows), and MoMa-LLM's "seen" threshold of 50
 points per frame scaled by the image size (``50 * W * H / 320 / 240``, at least 5).
 
 Logs without instance ids (imported real data) replay to geometry only: voxels,
@@ -91,7 +92,7 @@ def resolve_options(reader: LogReader, options: ReplayOptions) -> ResolvedOption
             break
     size = _image_size(reader)
     every = options.every if options.every is not None else int(recorded.get("every", 10))
-    clf = options.classifier or str(recorded.get("classifier", "containment"))
+    clf = options.classifier or str(recorded.get("classifier", "frequency"))
     if clf not in CLASSIFIERS:
         raise SgtoolError(f"unknown room classifier {clf!r}; one of {', '.join(CLASSIFIERS)}")
     mp = options.min_points if options.min_points is not None else recorded.get("min_points")

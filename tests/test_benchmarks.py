@@ -91,6 +91,7 @@ SMOKE: dict[str, Smoke] = {
     "benchmarks/ray_scale.py": Smoke(("replay", "{logs}", "--repeat", "1"), needs="ray",
                                      marks=("ci_only",)),
     "benchmarks/read_floor.py": Smoke(("{log}", "--rounds", "1")),
+    "benchmarks/room_classifiers.py": Smoke(("--houses", "1")),
     "benchmarks/record.py": Smoke(("--frames", "3", "--rounds", "1", "--resolutions",
                                    "32x24")),
     "benchmarks/refresh_scaling.py": Smoke(

@@ -150,7 +150,7 @@ class ClosedLoopOptions:
     noise: NoiseProfile = field(default_factory=lambda: PROFILES["none"])
     noise_seed: int = 0
     every: int = 10  # frames between graph refreshes (and one at every action)
-    classifier: str = "containment"
+    classifier: str = "frequency"
     min_points: int | None = None  # None: MoMa-LLM's 50 at 320x240, scaled
     voxel_size: float = 0.05
     max_steps: int = N_MAX

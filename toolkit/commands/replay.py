@@ -44,7 +44,7 @@ if TYPE_CHECKING:
               default=None, help="Room categories from contents: the distilled containment "
               "model, the naive-Bayes frequency model of the training knowledge, an LLM "
               "(MoMa-LLM's room classification; give --llm-base-url or --llm-replay), or "
-              "none. Default: the log's, else containment.")
+              "none. Default: the log's, else frequency.")
 @llm_endpoint_options("--classifier llm", timeout=60.0)
 @click.option("--llm-constraint", type=click.Choice(["auto", "grammar", "json_schema", "none"]),
               default="auto", show_default=True,

@@ -60,9 +60,10 @@ if TYPE_CHECKING:
 @click.option("--every", type=click.IntRange(min=1), default=10, show_default=True,
               help="Refresh the scene graph every K frames (and always at every action).")
 @click.option("--classifier", type=click.Choice(["containment", "frequency", "none"]),
-              default="containment", show_default=True,
-              help="Room categories from contents: the distilled containment model, the "
-              "naive-Bayes frequency model of the training knowledge, or none.")
+              default="frequency", show_default=True,
+              help="Room categories from contents: the naive-Bayes frequency model of the "
+              "training knowledge (the containment model for a room none of whose "
+              "objects it knows), the distilled containment model alone, or none.")
 @click.option("--min-points", type=click.IntRange(min=1), default=None,
               help="Points an instance needs in one frame to count as seen. Default: "
               "MoMa-LLM's 50 at 320x240 scaled by the image size.")

@@ -17,7 +17,8 @@ room-type frequencies). Categories outside V carry no evidence and are skipped.
 Categories are compared after :func:`sgtool.semantics.text.category_text` ("Bottom_cabinet"
 = "bottom cabinet"). ``sgtool.datasets.room_evidence.frequency_room_classifier`` builds the
 table from the training part of the BEHAVIOR-1K knowledge only (never the evaluation part
-that furnishes benchmark houses).
+that furnishes benchmark houses). A room none of whose categories is in V gets the
+``fallback`` classifier's answer (none: unknown).
 """
 
 from __future__ import annotations
@@ -42,11 +43,13 @@ class FrequencyRoomClassifier:
     name = "frequency"
 
     def __init__(self, table: Mapping[str, Mapping[str, float]], alpha: float = 1.0,
-                 prior: Mapping[str, float] | None = None) -> None:
+                 prior: Mapping[str, float] | None = None,
+                 fallback: RoomClassifier | None = None) -> None:
         if not table:
             raise ValueError("the room-type table is empty")
         if alpha <= 0:
             raise ValueError("alpha must be > 0")
+        self.fallback = fallback
         counts: dict[str, dict[str, float]] = {}
         for room, row in table.items():
             acc: dict[str, float] = {}
@@ -78,7 +81,7 @@ class FrequencyRoomClassifier:
     def classify(self, object_categories: list[str]) -> list[tuple[str, float]]:
         cats = [c for c in (category_text(x) for x in object_categories) if c in self.vocabulary]
         if not cats:
-            return []
+            return self.fallback.classify(object_categories) if self.fallback else []
         score = {}
         for r in self.room_types:
             lp, lu = self._log_p[r], self._log_unseen[r]

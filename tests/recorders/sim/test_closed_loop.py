@@ -148,12 +148,12 @@ def test_scout_episode_log(scout_log, house) -> None:
         assert r.schema_version == S.LOG_SCHEMA_VERSION
         started, ended = [rec for _, rec in r.records("episode")]
         assert started["status"] == "started" and started["query"] == ep.query
-        assert started["extra"]["mapping"] == {"every": 10, "classifier": "containment",
+        assert started["extra"]["mapping"] == {"every": 10, "classifier": "frequency",
                                                "min_points": 12, "voxel_size": 0.05}
         assert ended["status"] == "success" and ended["planner"] == "scout"
         assert ended["shortest_m"] == pytest.approx(ep.shortest_path, abs=1e-3)
         assert ended["extra"]["end"] == "found" and ended["extra"]["query"] == ep.query
-        assert ended["frames"] == r.frame_count() > 40
+        assert ended["frames"] == r.frame_count() > 20
         actions = list(r.records("action"))
         graphs = {t for t, _ in r.records("scene_graph")}
         look = actions[0][1]
@@ -180,7 +180,7 @@ def test_replay_reproduces_the_live_scene_graphs(scout_log, tmp_path) -> None:
     r = CliRunner().invoke(cli, ["replay", str(path), "-o", str(derived)])  # default options
     assert r.exit_code == 0, r.output
     live, again = messages(path, [GRAPH]), messages(derived, [GRAPH])
-    assert len(live) > 5 and live == again
+    assert len(live) >= 3 and live == again  # several refreshes, byte for byte
     assert messages(path, list(DERIVED_TOPICS)) == messages(derived, list(DERIVED_TOPICS))
 
 

@@ -119,7 +119,7 @@ def test_done_rule_log_replays_into_the_same_graphs(runs, tmp_path) -> None:
     with LogReader(path) as a, LogReader(derived) as b:
         live = [bytes(m.data) for _, _, m in a.raw_messages([GRAPH])]
         again = [bytes(m.data) for _, _, m in b.raw_messages([GRAPH])]
-    assert len(live) > 5 and live == again
+    assert len(live) >= 3 and live == again  # several refreshes, byte for byte
 
 
 def test_cli_success_option(tmp_path) -> None:
