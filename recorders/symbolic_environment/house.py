@@ -43,11 +43,11 @@ from sgtool.mapping.occupancy import (
     world_to_cell,
 )
 from sgtool.recorders.symbolic_environment.furniture_regions import cluster_regions
+from sgtool.scenegraph.examined import EXAMINE, examinable
 from sgtool.scenegraph.graph import ObjectNode
 from sgtool.semantics.text import category_text
 from sgtool.vocabulary import OPEN_STATES, RELATIONS, OpenState, Relation
 
-_EXAMINE = "examine"
 _V = TypeVar("_V", bound=str)
 
 
@@ -288,8 +288,8 @@ class SymbolicHouse:
         if node is None:
             fu = self.spec.furniture[f]
             affs = set(fu.affordances)
-            if affs & {"container", "supporter"}:
-                affs.add(_EXAMINE)
+            if examinable(affs):
+                affs.add(EXAMINE)
             node = ObjectNode(
                 id=self.furn_node_id(f), category=self.furn_cat[f],
                 parent=self.regions[self.region_of_furn[f]].id,
@@ -326,8 +326,8 @@ class SymbolicHouse:
         if node is None:
             o = self.spec.objects[j]
             affs = set(o.affordances)
-            if "container" in affs:
-                affs.add(_EXAMINE)
+            if examinable(affs, small_object=True):
+                affs.add(EXAMINE)
             node = ObjectNode(
                 id=self.obj_node_id(j), category=self.obj_cat[j],
                 parent=self.parent_node_id(j),

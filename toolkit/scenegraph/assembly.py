@@ -5,10 +5,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
 
 from sgtool.mapping.voronoi import VoronoiGraph
 from sgtool.scenegraph.door_evidence import DoorObservation
+from sgtool.scenegraph.examined import EXAMINE, examinable
 from sgtool.scenegraph.frontiers import Frontier
 from sgtool.scenegraph.graph import (
     DoorNode,
@@ -57,7 +59,11 @@ def robot_state(robot: tuple[float, float, float] | None, robot_nodes: tuple[int
 
 
 def assemble_graph(parts: GraphParts, robot: RobotState, instances: Mapping[int, InstanceInfo],
-                   distances: dict[str, float], time_ns: int) -> SceneGraph:
+                   distances: dict[str, float], time_ns: int,
+                   examined: AbstractSet[int] = frozenset()) -> SceneGraph:
+    """The graph of one refresh; an examinable piece (a container or supporter) is
+    ``explored`` once ``examined`` holds it and it is not closed
+    (:mod:`sgtool.scenegraph.examined`), any other object once it is not closed."""
     node_room = parts.seg.labels
     region_nodes = [RegionNode(id=rid, room=room, position=pos)
                     for rid, (room, _n, pos) in parts.regions.items()]
@@ -74,12 +80,17 @@ def assemble_graph(parts: GraphParts, robot: RobotState, instances: Mapping[int,
         if o.room is None:
             continue
         info = instances[o.instance]
+        affs = set(info.affordances)
+        looked = True
+        if examinable(affs, info.kind == "object"):  # :mod:`sgtool.scenegraph.examined`
+            affs.add(EXAMINE)
+            looked = o.instance in examined
         object_nodes.append(ObjectNode(
             id=f"obj:{o.instance}", category=info.category,
             parent=o.parent, room=o.room, position=o.position, instance=o.instance,
             relation=info.relation if o.parent.startswith("obj:") else None,
-            state=info.state, affordances=tuple(sorted(info.affordances)),
-            explored=info.state != "closed",
+            state=info.state, affordances=tuple(sorted(affs)),
+            explored=info.state != "closed" and looked,
         ))
     door_nodes = [DoorNode(
         id=f"door:{d.instance}", position=d.position, state=d.state,

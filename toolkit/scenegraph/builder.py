@@ -102,6 +102,7 @@ from sgtool.scenegraph.door_evidence import (
     open_doors,
 )
 from sgtool.scenegraph.door_voxels import DoorVoxels, near_median
+from sgtool.scenegraph.examined import close_views
 from sgtool.scenegraph.frontier_ids import FrontierTracker
 from sgtool.scenegraph.frontiers import Frontier, find_frontiers
 from sgtool.scenegraph.graph import SceneGraph
@@ -188,6 +189,9 @@ class SceneGraphBuilder:
         self.instances: dict[int, InstanceInfo] = dict(sorted((instances or {}).items()))
         self.classifier = classifier
         self.trajectory: list[tuple[float, float]] = []
+        # instances looked at from close by (:mod:`sgtool.scenegraph.examined`), in any state
+        # since their last state change
+        self.examined: set[int] = set()
         self.robot: tuple[float, float, float] | None = None
         self.frames_since_refresh = 0
         self._cleared = 0  # trajectory points whose body cleared the voxels around them
@@ -241,6 +245,7 @@ class SceneGraphBuilder:
             if old is not None and old.state != new.state:
                 changed.append(iid)
                 self.voxels.forget_instance(iid)
+                self.examined.discard(iid)
         self.instances = dict(sorted(instances.items()))
         self._warm_classifier()
         return changed
@@ -254,6 +259,9 @@ class SceneGraphBuilder:
         else:  # camera optical axis (z) projected on the floor
             yaw = math.atan2(float(src[1, 2]), float(src[0, 2]))
         self.voxels.integrate(frame, (x, y))
+        if frame.ids is not None:
+            self.examined.update(close_views(frame.ids, frame.depth,
+                                             self.config.voxels.min_points))
         if len(self.trajectory) % VIEW_STRIDE == 0 and np.all(np.isfinite(frame.pose)):
             self._views.append(View.of(frame.pose, frame.intrinsics, np.asarray(frame.depth),
                                        self.config.voxels.min_range))
@@ -339,7 +347,7 @@ class SceneGraphBuilder:
                                      parts)
         tick("distances")
         sg = assemble_graph(parts, robot_state(self.robot, robot_nodes, vg, parts),
-                            self.instances, distances, stamp)
+                            self.instances, distances, stamp, self.examined)
         self.layers = MapLayers(
             occupancy=occ, voronoi=vg,
             node_rooms=tuple(rooms.room_ids[i] if i >= 0 else None for i in node_room.tolist()),

@@ -26,6 +26,7 @@ from sgtool.datasets.generator import generate_house
 from sgtool.errors import SgtoolError
 from sgtool.log import LogReader, LogWriter
 from sgtool.log import schemas as S
+from sgtool.log.records import Instances
 from sgtool.planning.base import Action
 from sgtool.planning.candidates import find_target
 from sgtool.planning.registry import make_planner
@@ -38,6 +39,7 @@ from sgtool.recorders.sim.closed_loop import (
     run_episode,
 )
 from sgtool.scenegraph.derived_layers import DERIVED_TOPICS
+from sgtool.scenegraph.examined import EXAMINE, close_views
 from sgtool.scenegraph.graph import (
     DoorNode,
     ObjectNode,
@@ -172,6 +174,32 @@ def test_scout_episode_log(scout_log, house) -> None:
             assert r.has(topic), topic
         assert r.has(S.RECORDS["instances"].topic)
         assert find_target(SceneGraph.from_dict(r.last_record("scene_graph")), ep.query)
+
+
+def test_pieces_count_as_searched_only_once_seen_from_close_by(scout_log) -> None:
+    """A container or supporter that is not closed is explored exactly when a frame of the
+    log gave it the mapping's min_points pixels at a mean depth within EXAMINE_RANGE_M (as
+    the symbolic environment reveals what a piece holds only when the agent walks up)."""
+    path, _ = scout_log
+    with LogReader(path) as r:
+        started = next(rec for _, rec in r.records("episode"))
+        min_points = started["extra"]["mapping"]["min_points"]
+        first = next(iter(r.records(Instances)))[1]
+        close: set[int] = set()
+        for fr in r.frames():
+            close.update(close_views(fr.ids, fr.depth, min_points))
+        graph = SceneGraph.from_dict(r.last_record("scene_graph"))
+    states = {i.id: i.state for i in first.instances}
+    pieces = [o for o in graph.objects if EXAMINE in o.affordances]
+    assert pieces and any(o.explored for o in pieces) and any(not o.explored for o in pieces)
+    for o in pieces:
+        if o.explored:
+            assert o.state != "closed" and o.instance in close, o
+        elif o.state != "closed" and states.get(o.instance) == o.state:
+            assert o.instance not in close, o
+    # what is not a carrier is explored unless closed, as before
+    assert all(o.explored == (o.state != "closed") for o in graph.objects
+               if EXAMINE not in o.affordances)
 
 
 def test_replay_reproduces_the_live_scene_graphs(scout_log, tmp_path) -> None:
