@@ -27,6 +27,7 @@ EXAMINE = "examine"  # the affordance of an examinable node (as the symbolic env
 CARRIER_AFFORDANCES = frozenset({"container", "supporter"})  # of furniture
 OBJECT_CARRIER_AFFORDANCES = frozenset({"container"})  # of a small object
 EXAMINE_RANGE_M = 2.0  # mean depth of its pixels at which a piece counts as looked at
+_DENSE_IDS = 1 << 20  # below this largest id, count per id without sorting
 
 
 def examinable(affordances: Iterable[str], small_object: bool = False) -> bool:
@@ -41,11 +42,16 @@ def close_views(ids: np.ndarray, depth: np.ndarray, min_points: int,
     """The instance ids (> 0) of one frame with at least ``min_points`` pixels of finite,
     positive depth whose mean depth is at most ``max_depth`` m, ascending."""
     lab = np.asarray(ids).ravel()
-    d = np.asarray(depth, dtype=np.float64).ravel()
+    d = np.asarray(depth).ravel()
     ok = (lab > 0) & np.isfinite(d) & (d > 0)
     if not ok.any():
         return []
-    lab, d = lab[ok].astype(np.int64), d[ok]
+    lab, d = lab[ok].astype(np.int64), d[ok].astype(np.float64)
+    if int(lab.max()) < _DENSE_IDS:  # ids index counts directly (the simulator's)
+        count = np.bincount(lab)
+        total = np.bincount(lab, weights=d)
+        near = (count >= max(1, int(min_points))) & (total <= max_depth * count)
+        return [int(i) for i in np.flatnonzero(near)]
     uniq, inv = np.unique(lab, return_inverse=True)
     count = np.bincount(inv, minlength=len(uniq))
     total = np.bincount(inv, weights=d, minlength=len(uniq))

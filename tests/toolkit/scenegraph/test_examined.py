@@ -27,6 +27,8 @@ def test_near_enough_pixels_count_and_far_or_few_do_not() -> None:
     assert close_views(ids, depth, min_points=10) == [5, 9]  # 9: exactly at the range
     assert close_views(ids, depth, min_points=3) == [5, 7, 9]
     assert close_views(ids, depth, min_points=10, max_depth=3.0) == [5, 6, 9]
+    big = ids.astype(np.int64) << 24  # ids too large to count by index: the sorted path
+    assert close_views(big, depth, min_points=10) == [5 << 24, 9 << 24]
 
 
 def test_the_mean_depth_decides_and_invalid_depth_is_ignored() -> None:
