@@ -106,7 +106,7 @@ from sgtool.recorders.sim.live_recorder import LiveRecorder
 from sgtool.recorders.sim.live_skills import LiveNavConfig, LiveSkills, RobotBody
 from sgtool.recorders.sim.navigation import RobotConfig
 from sgtool.recorders.sim.noise import PROFILES, NoiseProfile
-from sgtool.recorders.sim.reachability import FailedGoals, reachable_view
+from sgtool.recorders.sim.reachability import FAILED_BEFORE, FailedGoals, reachable_view
 from sgtool.recorders.sim.recording import SOURCE
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome, StopSimulation
 from sgtool.recorders.sim.skill_plan import (  # noqa: F401 (re-exported)
@@ -293,6 +293,10 @@ class _Search:
             cur = self.rec.stream.current
             assert cur is not None
             graph = self._view(cur)
+        if not self.end and self.skills is not None and not actionable(graph) and \
+                self.failed.release(n for n, why in self._withheld_now.items()
+                                    if why == FAILED_BEFORE):
+            graph = self._view(cur)  # a goal that failed is tried once more
         for why in self._withheld_now.values():
             self.withheld[why] = self.withheld.get(why, 0) + 1
         self._graph_time_ns = int(cur.time_ns)

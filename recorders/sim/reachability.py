@@ -21,7 +21,9 @@ the goal) on the robot's map, from where the robot stands:
 - failed before (:class:`FailedGoals`): a node whose skill failed is withheld while the
   cell the robot would drive to for it is within ``same`` metres of the one of the
   failure (the same attempt would be made again); it is offered again once the map moves
-  that cell (a door opened, a bump marked, more floor seen);
+  that cell (a door opened, a bump marked, more floor seen), and once more when nothing
+  else is left to do (:meth:`FailedGoals.release`: a door whose opening a passing contact
+  stopped must not wall the robot in for the rest of the episode);
 - looked from there before: a frontier, room or region node (a goal the skill goes to and
   looks around at) whose cell is within ``same`` metres of a place where the robot has
   already looked around toward all the unknown it could (``LiveSkills.looked``): going
@@ -73,9 +75,22 @@ class FailedGoals:
 
     same: float = 0.5
     cells: dict[str, tuple[float, float] | None] = field(default_factory=dict)
+    retries: int = 1  # times a withheld node is released when nothing else is left
+    released: dict[str, int] = field(default_factory=dict)
 
     def failed(self, node_id: str) -> None:
         self.cells[node_id] = None
+
+    def release(self, node_ids: Iterable[str]) -> list[str]:
+        """Offer these withheld nodes again (nothing else is actionable), each at most
+        ``retries`` times in an episode; the ones released, in id order."""
+        out = []
+        for n in sorted(set(node_ids)):
+            if n in self.cells and self.released.get(n, 0) < self.retries:
+                del self.cells[n]
+                self.released[n] = self.released.get(n, 0) + 1
+                out.append(n)
+        return out
 
     def blocks(self, node_id: str, cell: tuple[float, float]) -> bool:
         """Whether going to ``cell`` for ``node_id`` repeats a failed attempt (module

@@ -86,6 +86,19 @@ def test_a_failed_goal_waits_until_the_map_moves_it() -> None:
     assert not f.blocks("obj:3", (1.0, 1.0))  # and forgotten until it fails again
 
 
+def test_a_failed_goal_is_released_once_when_nothing_else_is_left() -> None:
+    f = FailedGoals(same=0.5)
+    for n in ("door:4", "obj:3"):
+        f.failed(n)
+        assert f.blocks(n, (1.0, 1.0))
+    assert f.release(["obj:3", "door:4", "obj:9"]) == ["door:4", "obj:3"]  # 9 never failed
+    assert not f.blocks("door:4", (1.0, 1.0))  # offered again from the same place
+    f.failed("door:4")  # and it failed again
+    assert f.blocks("door:4", (1.0, 1.0))
+    assert f.release(["door:4"]) == []  # released once per episode only
+    assert f.blocks("door:4", (1.0, 1.0))
+
+
 @pytest.fixture(scope="module")
 def house():
     return generate_house(6, rooms=(4, 4))
