@@ -29,11 +29,12 @@ from sgtool.analysis.intervals import (
     by_house,
     comparison_pairs,
     kendall_tau,
+    kendall_tau_interval,
     paired_comparison,
     planner_intervals,
 )
 from sgtool.analysis.report import fmt_interval, format_intervals, format_paired, pipe_table
-from sgtool.analysis.search_metrics import CostModel, auc_e_of, spl, success_rate
+from sgtool.analysis.search_metrics import CostModel, auc_e_of, episode_spl, spl, success_rate
 from sgtool.results import EpisodeResult
 
 EpisodeKey = tuple[str, int, str, int]  # EpisodeResult.key(): planner, seed, house, episode
@@ -129,21 +130,33 @@ def budget_comparisons(results: Sequence[EpisodeResult], planners: Sequence[str]
 
 
 def symbolic_agreement(closed: Sequence[EpisodeResult], symbolic: Sequence[EpisodeResult],
-                       planners: Sequence[str]) -> tuple[int, list[RankAgreement]]:
+                       planners: Sequence[str], boot: Bootstrap = DEFAULT_BOOTSTRAP
+                       ) -> tuple[int, list[RankAgreement]]:
     """Kendall's tau between the closed loop's and the symbolic bench's planner scores
-    (SPL, then SR; episodes pooled). The symbolic episodes are those of the same (house,
-    episode, query) as a closed-loop episode when there are any (their count is returned,
-    0 when none match: then all symbolic episodes count)."""
+    (SPL, then SR; episodes pooled), with its cluster-bootstrap interval over houses
+    (:func:`~sgtool.analysis.intervals.kendall_tau_interval`). The symbolic episodes are
+    those of the same (house, episode, query) as a closed-loop episode when there are any
+    (their count is returned, 0 when none match: then all symbolic episodes count)."""
     wanted = {(r.house, r.episode, r.query) for r in closed}
     same = [r for r in symbolic if (r.house, r.episode, r.query) in wanted]
     pool = same or list(symbolic)
     out = []
-    for name, fn in (("spl", spl), ("sr", success_rate)):
+    for name, fn, value in (("spl", spl, _episode_spl), ("sr", success_rate, _success)):
         a = {p: fn([r for r in closed if r.planner == p]) for p in planners}
         b = {p: fn([r for r in pool if r.planner == p]) for p in planners}
-        out.append(kendall_tau({p: v for p, v in a.items() if not math.isnan(v)},
-                               {p: v for p, v in b.items() if not math.isnan(v)}, name))
+        tau = kendall_tau({p: v for p, v in a.items() if not math.isnan(v)},
+                          {p: v for p, v in b.items() if not math.isnan(v)}, name)
+        low, high = kendall_tau_interval(closed, pool, tau.planners, value, by_house, boot)
+        out.append(replace(tau, low=low, high=high))
     return len(same), out
+
+
+def _episode_spl(r: EpisodeResult) -> float:
+    return episode_spl(r.success, r.shortest_m, r.travelled_m)
+
+
+def _success(r: EpisodeResult) -> float:
+    return float(r.success)
 
 
 def format_agreement(matched: int, total: int, rows: Sequence[RankAgreement],
@@ -153,7 +166,8 @@ def format_agreement(matched: int, total: int, rows: Sequence[RankAgreement],
     lines = [f"Agreement with the symbolic order ({source}; {what}): Kendall tau-b over the "
              "planners"]
     for r in rows:
-        tau = "-" if math.isnan(r.tau) else f"{r.tau:+.3f} (p = {r.p_value:.3f})"
+        span = "" if math.isnan(r.low) else f" [{r.low:+.3f}, {r.high:+.3f}]"
+        tau = "-" if math.isnan(r.tau) else f"{r.tau:+.3f}{span} (p = {r.p_value:.3f})"
         lines.append(f"- by {r.metric.upper()}: {tau}, {len(r.planners)} planners")
     return "\n".join(lines) + "\n"
 

@@ -302,13 +302,16 @@ class RankAgreement:
     planners: tuple[str, ...]
     tau: float
     p_value: float
+    low: float = math.nan  # bootstrap interval of tau (:func:`kendall_tau_interval`)
+    high: float = math.nan
 
     def to_dict(self) -> dict[str, object]:
         def num(v: float) -> float | None:
             return None if math.isnan(v) else round(v, 6)
 
         return {"metric": self.metric, "planners": list(self.planners),
-                "tau": num(self.tau), "p_value": num(self.p_value)}
+                "tau": num(self.tau), "p_value": num(self.p_value),
+                "low": num(self.low), "high": num(self.high)}
 
 
 def kendall_tau(a: Mapping[str, float], b: Mapping[str, float],
@@ -327,3 +330,53 @@ def kendall_tau(a: Mapping[str, float], b: Mapping[str, float],
         return RankAgreement(metric, names, math.nan, math.nan)
     res = kendalltau(xs, ys)
     return RankAgreement(metric, names, float(res.statistic), float(res.pvalue))
+
+
+def kendall_tau_interval(a: Sequence[EpisodeResult], b: Sequence[EpisodeResult],
+                         planners: Sequence[str], value: Callable[[EpisodeResult], float],
+                         cluster: Cluster = by_house,
+                         boot: Bootstrap = DEFAULT_BOOTSTRAP) -> tuple[float, float]:
+    """Bootstrap interval of Kendall's tau-b between the planners' mean ``value`` over
+    ``a`` and over ``b``: the clusters (houses) of ``a`` and ``b`` together are resampled,
+    the same draw for both sides, and tau taken on each resample (tau-b = Σ s_x s_y /
+    sqrt(Σ s_x² Σ s_y²) over the pairs of planners, s the sign of a pair's difference, as
+    scipy's; resamples where it is undefined are left out); (NaN, NaN) with fewer than two
+    clusters or planners."""
+    keys = _cluster_keys([*a, *b], cluster)
+    names = list(dict.fromkeys(planners))
+    if len(keys) < 2 or len(names) < 2:
+        return math.nan, math.nan
+    row = {k: i for i, k in enumerate(keys)}
+    col = {p: j for j, p in enumerate(names)}
+    sides = []
+    for results in (a, b):
+        sums = np.zeros((len(keys), len(names)))
+        counts = np.zeros((len(keys), len(names)))
+        for r in results:
+            j = col.get(r.planner)
+            if j is not None:
+                i = row[cluster(r)]
+                sums[i, j] += value(r)
+                counts[i, j] += 1
+        sides.append((sums, counts))
+    idx = resample_indices(len(keys), boot)
+    means = []
+    for sums, counts in sides:
+        n = counts[idx].sum(axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            means.append(sums[idx].sum(axis=1) / n)
+    x, y = means
+    lo, hi = np.triu_indices(len(names), k=1)
+    ok = np.isfinite(x[:, lo]) & np.isfinite(x[:, hi]) & np.isfinite(y[:, lo]) & \
+        np.isfinite(y[:, hi])  # pairs of planners with a score on both sides
+    sx = np.where(ok, np.sign(x[:, lo] - x[:, hi]), 0.0)
+    sy = np.where(ok, np.sign(y[:, lo] - y[:, hi]), 0.0)
+    den = np.sqrt((sx * sx).sum(axis=1) * (sy * sy).sum(axis=1))
+    with np.errstate(invalid="ignore", divide="ignore"):  # tau-b: sum sx sy / sqrt(...)
+        tau_b = (sx * sy).sum(axis=1) / den
+    taus = tau_b[den > 0]
+    if not taus.size:
+        return math.nan, math.nan
+    ordered = np.sort(taus)
+    half = (1.0 - boot.level) / 2.0
+    return _quantile(ordered, half), _quantile(ordered, 1.0 - half)

@@ -14,6 +14,7 @@ from sgtool.analysis.intervals import (
     by_episode,
     comparison_pairs,
     kendall_tau,
+    kendall_tau_interval,
     paired_comparison,
     planner_intervals,
     ratio_interval,
@@ -156,3 +157,46 @@ def test_kendall_tau() -> None:
     assert one.tau == pytest.approx(1 / 3) and one.planners == ("a", "b", "c")
     assert math.isnan(kendall_tau({"a": 1.0}, {"a": 1.0}).tau)
     assert math.isnan(kendall_tau({"a": 1.0, "b": 1.0}, {"a": 1.0, "b": 2.0}).tau)
+
+
+def _spl(r: EpisodeResult) -> float:
+    return r.shortest_m / max(r.travelled_m, r.shortest_m) if r.success else 0.0
+
+
+def test_kendall_tau_interval_of_an_order_every_house_agrees_on() -> None:
+    # three planners, SPL 0.5 / 0.25 / 0 in every house, on both sides: every resample
+    # gives tau 1; reversed on one side, -1
+    a = [ep(p, f"h{h}", 0, p != "c", travelled=t) for h in range(4)
+         for p, t in (("a", 10.0), ("b", 20.0), ("c", 10.0))]
+    b = [ep(p, f"h{h}", 0, p != "a", travelled=t) for h in range(4)
+         for p, t in (("a", 10.0), ("b", 20.0), ("c", 10.0))]
+    assert kendall_tau_interval(a, a, ["a", "b", "c"], _spl, boot=SMALL) == (1.0, 1.0)
+    assert kendall_tau_interval(a, b, ["a", "b", "c"], _spl, boot=SMALL) == (-1.0, -1.0)
+    assert all(math.isnan(x) for x in kendall_tau_interval(a[:3], a[:3], ["a", "b", "c"],
+                                                            _spl, boot=SMALL))  # one house
+
+
+def test_kendall_tau_interval_is_scipys_tau_b_on_each_resample() -> None:
+    from scipy.stats import kendalltau
+
+    rng = np.random.default_rng(3)
+    names = ["p0", "p1", "p2", "p3", "p4"]
+    # coarse values make ties, the case tau-b corrects for
+    a = [ep(p, f"h{h}", e, bool(rng.random() < 0.7), travelled=float(rng.integers(5, 8)))
+         for h in range(5) for e in range(2) for p in names]
+    b = [ep(p, f"h{h}", e, bool(rng.random() < 0.6), travelled=float(rng.integers(5, 8)))
+         for h in range(5) for e in range(2) for p in names]
+    boot = Bootstrap(resamples=300)
+    low, high = kendall_tau_interval(a, b, names, _spl, boot=boot)
+    houses = [f"h{h}" for h in range(5)]
+    taus = []
+    for draw in resample_indices(5, boot):
+        pick = [houses[k] for k in draw]
+        def mean(rs, p, pick=pick):
+            vals = [_spl(r) for h in pick for r in rs if r.house == h and r.planner == p]
+            return sum(vals) / len(vals)
+        x = [mean(a, p) for p in names]
+        y = [mean(b, p) for p in names]
+        if len(set(x)) > 1 and len(set(y)) > 1:
+            taus.append(kendalltau(x, y).statistic)
+    assert (low, high) == pytest.approx((np.quantile(taus, 0.025), np.quantile(taus, 0.975)))
