@@ -1,8 +1,8 @@
 """Whether an episode log already in a ``run-bench`` folder may stand for a task: it must
 have been run with the task's settings (episode, steps, frames, resolution, which ticks
-are frames, navigation, noise, seed, success rule) on the same house. A log without the
-frame settings (``render_step_m``, ``turn_render_deg``: older code rendered other ticks)
-is not reused.
+are frames, navigation, noise, seed, success rule, room classifier) on the same house.
+A log without the frame settings (``render_step_m``, ``turn_render_deg``: older code
+rendered other ticks) is not reused.
 
 The house is compared in canonical form: the spec the log carries (its ``house.json``
 attachment) is parsed as any house file is and its canonical JSON compared with that of
@@ -38,7 +38,8 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
             "render_step_m": float(opts.render_step_m),
             "turn_render_deg": float(opts.turn_render_deg),
             "navigation": opts.navigation, "noise": parse_noise(noise).to_dict(),
-            "seed": opts.planner_seed, "success": opts.success}
+            "seed": opts.planner_seed, "success": opts.success,
+            "classifier": opts.classifier}
 
 
 def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
@@ -60,7 +61,9 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              "turn_render_deg": x.get("turn_render_deg"),
              "navigation": (x.get("navigation") or {}).get("mode", "house"),
              "noise": x.get("noise"), "seed": x.get("seed"),
-             "success": x.get("success", "observed")}, house)
+             "success": x.get("success", "observed"),
+             # logs from before the default changed recorded no other classifier
+             "classifier": (x.get("mapping") or {}).get("classifier", "containment")}, house)
 
 
 def same_house(logged: str | None, spec: HouseSpec) -> bool:
@@ -82,7 +85,8 @@ def same_house(logged: str | None, spec: HouseSpec) -> bool:
 _LABELS = {"episode": "episode", "max_steps": "max steps", "frame_budget": "frame budget",
            "size": "resolution", "render_step_m": "render step (m)",
            "turn_render_deg": "turn render angle (deg)", "navigation": "navigation",
-           "noise": "noise", "seed": "seed", "success": "success rule"}
+           "noise": "noise", "seed": "seed", "success": "success rule",
+           "classifier": "room classifier"}
 
 
 def settings_differences(logged: dict[str, Any], want: dict[str, Any]) -> list[str]:

@@ -97,3 +97,8 @@ def test_a_log_of_other_frame_settings_is_not_resumed(tmp_path: Path) -> None:
     assert settings_differences(
         logged, task_settings(dataclasses.replace(opts, turn_render_deg=0.0), "none", ep)) \
         == ["turn render angle (deg): 20.0 in the log, 0.0 now"]
+    # the room categories the planners saw are a setting too
+    assert settings_differences(
+        logged, task_settings(dataclasses.replace(opts, classifier="containment"), "none",
+                              ep)) \
+        == ['room classifier: "frequency" in the log, "containment" now']
