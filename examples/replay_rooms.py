@@ -2,7 +2,7 @@
 
 Run::
 
-    python examples/replay_rooms.py tests/golden/house6-tour.mcap
+    python examples/replay_rooms.py tests/golden/house6-tour.mcap --classifier containment
     python examples/replay_rooms.py run.mcap --every 5 --max-frames 100
 
 Each refresh prints one header line (its index, log time, why it refreshed and the frames
@@ -30,6 +30,10 @@ def main() -> None:
     parser.add_argument("--every", type=int, default=None,
                         help="frames between refreshes (default: what the log says, else 10)")
     parser.add_argument("--max-frames", type=int, default=None, help="stop after N frames")
+    parser.add_argument("--classifier", choices=("frequency", "containment", "none"),
+                        default=None, help="room categories from contents (default: what "
+                        "the log says, else frequency; the golden logs are pinned with "
+                        "containment)")
     args = parser.parse_args()
 
     def on_refresh(refresh: sgtool.Refresh, stream: sgtool.SceneGraphStream) -> None:
@@ -40,7 +44,8 @@ def main() -> None:
         for line in room_lines(graph):
             print(line)
 
-    options = sgtool.ReplayOptions(every=args.every, max_frames=args.max_frames)
+    options = sgtool.ReplayOptions(every=args.every, max_frames=args.max_frames,
+                                   classifier=args.classifier)
     report = sgtool.replay(args.log, options=options, on_refresh=on_refresh)
     print(f"{report.frames} frames, {report.refreshes} refreshes")
 

@@ -52,7 +52,7 @@ def test_every_example_says_how_to_run_it(script: str) -> None:
 def test_replay_rooms_prints_the_golden_graphs_rooms() -> None:
     """Per refresh, each room with its category and object count: the same as the golden
     graphs of the log's replay (tests/golden/)."""
-    out = run("replay_rooms.py", GOLDEN / "house6-tour.mcap")
+    out = run("replay_rooms.py", GOLDEN / "house6-tour.mcap", "--classifier", "containment")
     golden = [sgtool.SceneGraph.from_json(line) for line in
               gzip.open(GOLDEN / "house6-tour.graphs.jsonl.gz", "rt").read().splitlines()]
     printed: list[tuple[int, int, set[tuple[str, str, int, bool]]]] = []
