@@ -48,12 +48,10 @@ def close_views(ids: np.ndarray, depth: np.ndarray, min_points: int,
         return []
     lab, d = lab[ok].astype(np.int64), d[ok].astype(np.float64)
     if int(lab.max()) < _DENSE_IDS:  # ids index counts directly (the simulator's)
-        count = np.bincount(lab)
-        total = np.bincount(lab, weights=d)
-        near = (count >= max(1, int(min_points))) & (total <= max_depth * count)
-        return [int(i) for i in np.flatnonzero(near)]
-    uniq, inv = np.unique(lab, return_inverse=True)
-    count = np.bincount(inv, minlength=len(uniq))
-    total = np.bincount(inv, weights=d, minlength=len(uniq))
-    near = (count >= max(1, int(min_points))) & (total <= max_depth * count)
-    return [int(i) for i in uniq[near]]
+        ids_of, index = None, lab
+    else:
+        ids_of, index = np.unique(lab, return_inverse=True)
+    count = np.bincount(index)
+    total = np.bincount(index, weights=d)
+    near = np.flatnonzero((count >= max(1, int(min_points))) & (total <= max_depth * count))
+    return [int(i) for i in (near if ids_of is None else ids_of[near])]
