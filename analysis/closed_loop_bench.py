@@ -62,7 +62,7 @@ from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write
 from sgtool.log.writer import partial_files
-from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, run_episode
+from sgtool.recorders.sim.closed_loop import WENT_ON, ClosedLoopOptions, run_episode
 from sgtool.recorders.sim.fallback_explore import is_fallback
 from sgtool.recorders.sim.frame_budget import frame_budget
 from sgtool.recorders.sim.noise import parse_noise
@@ -157,8 +157,9 @@ class RunTask:
 class RunRow:
     """The result of one task: the episode's result, read back from its log, plus the
     frames, the wall seconds of the run (None when the log was already there), the
-    failed skills by reason class and the goals of the robot's own exploration when the
-    graph offered the planner nothing (:mod:`sgtool.recorders.sim.fallback_explore`)."""
+    failed skills by reason class, the goals of the robot's own exploration when the
+    graph offered the planner nothing (:mod:`sgtool.recorders.sim.fallback_explore`) and
+    the frontiers an explore that showed nothing new went on to (``went_on``)."""
 
     task: RunTask
     result: EpisodeResult
@@ -166,6 +167,7 @@ class RunRow:
     seconds: float | None
     failures: Mapping[str, int]
     fallbacks: int = 0
+    went_on: int = 0
 
 
 def log_path(root: Path, noise: str, planner: str, house: str, episode: int) -> Path:
@@ -250,9 +252,11 @@ def _row(task: RunTask, seconds: float | None) -> RunRow:
     res = replace(ep.result(), seed=task.options.planner_seed)
     fails = Counter(reason_class(d.action.reason or "") for d in ep.decisions
                     if d.action.outcome == "failure")
-    fallbacks = sum(1 for d in ep.decisions if is_fallback(d.action.reason or ""))
+    reasons = [d.action.reason or "" for d in ep.decisions]
+    went_on = sum(1 for r in reasons if r.startswith(WENT_ON))
+    fallbacks = sum(1 for r in reasons if is_fallback(r))
     return RunRow(task, res, int(ep.episode.frames or 0), seconds, dict(sorted(fails.items())),
-                  fallbacks)
+                  fallbacks, went_on)
 
 
 def bench_houses(cfg: ClosedLoopBenchConfig) -> tuple[BenchHouse, ...]:
@@ -357,7 +361,7 @@ class ClosedLoopBenchResult:
 def _run_table(rows: Sequence[RunRow], planners: Sequence[str]) -> str:
     classes = sorted({k for r in rows for k in r.failures})
     header = ["Planner", "Episodes", "Frames/ep", "Frames/s", "Ended", "Fallback/ep",
-              "Failed skills/ep", *classes]
+              "Went on/ep", "Failed skills/ep", *classes]
     table = []
     for p in planners:
         rs = [r for r in rows if r.task.planner == p]
@@ -371,12 +375,14 @@ def _run_table(rows: Sequence[RunRow], planners: Sequence[str]) -> str:
         total = sum(sum(r.failures.values()) for r in rs)
         table.append([p, str(n), f"{statistics.mean(r.frames for r in rs):.0f}", fps,
                       ", ".join(f"{k} {v}" for k, v in sorted(ends.items())),
-                      f"{sum(r.fallbacks for r in rs) / n:.2f}", f"{total / n:.2f}",
+                      f"{sum(r.fallbacks for r in rs) / n:.2f}",
+                      f"{sum(r.went_on for r in rs) / n:.2f}", f"{total / n:.2f}",
                       *(f"{sum(r.failures.get(c, 0) for r in rs) / n:.2f}" for c in classes)])
     return (pipe_table(header, table) + "\nFrames/s: wall clock of the episodes run now "
             "(resumed ones excluded); Fallback/ep: goals per episode of the robot's own "
-            "exploration when the graph offered the planner nothing; failed skills per "
-            "episode by reason.\n")
+            "exploration when the graph offered the planner nothing; Went on/ep: frontiers "
+            "per episode an explore that showed no new object, door or room went on to; "
+            "failed skills per episode by reason.\n")
 
 
 def iter_rows(tasks: Iterable[RunTask],

@@ -1,6 +1,7 @@
 """Whether an episode log already in a ``run-bench`` folder may stand for a task: it must
 have been run with the task's settings (episode, steps, frames, resolution, which ticks
-are frames, navigation, noise, seed, success rule, room classifier) on the same house.
+are frames, navigation, noise, seed, success rule, room classifier, how far an explore
+goes on) on the same house.
 A log without the frame settings (``render_step_m``, ``turn_render_deg``: older code
 rendered other ticks) is not reused.
 
@@ -39,7 +40,7 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
             "turn_render_deg": float(opts.turn_render_deg),
             "navigation": opts.navigation, "noise": parse_noise(noise).to_dict(),
             "seed": opts.planner_seed, "success": opts.success,
-            "classifier": opts.classifier}
+            "classifier": opts.classifier, "explore_on": opts.explore_on}
 
 
 def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
@@ -63,7 +64,9 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              "noise": x.get("noise"), "seed": x.get("seed"),
              "success": x.get("success", "observed"),
              # logs from before the default changed recorded no other classifier
-             "classifier": (x.get("mapping") or {}).get("classifier", "containment")}, house)
+             "classifier": (x.get("mapping") or {}).get("classifier", "containment"),
+             # logs from before explores went on: an explore ended where it was sent
+             "explore_on": x.get("explore_on", 0)}, house)
 
 
 def same_house(logged: str | None, spec: HouseSpec) -> bool:
@@ -86,7 +89,7 @@ _LABELS = {"episode": "episode", "max_steps": "max steps", "frame_budget": "fram
            "size": "resolution", "render_step_m": "render step (m)",
            "turn_render_deg": "turn render angle (deg)", "navigation": "navigation",
            "noise": "noise", "seed": "seed", "success": "success rule",
-           "classifier": "room classifier"}
+           "classifier": "room classifier", "explore_on": "explore on (frontiers)"}
 
 
 def settings_differences(logged: dict[str, Any], want: dict[str, Any]) -> list[str]:

@@ -46,12 +46,13 @@ One episode (:func:`run_episode`), all of it into one MCAP log:
    records then carry ``extra.success: "done"``.
 
 Steps count every planner decision, invalid ones and ``done`` included (a step is spent),
-but not the opening look-around. Log time is the simulator's (``tick * 1e9 / fps``), never
-the wall clock: the same house, episode, options and planner seed give the same log except
-the measured fields, ``decision_time_s`` of the actions and ``latency_s`` of the LLM
-exchanges (so the file bytes differ too, through the compressed chunks; every message on
-every other channel is identical, the scene graphs included). The writer writes
-``OUT.XXXXXXXX.partial`` and renames it at the end: an error leaves no half-written log.
+but not the opening look-around nor the frontiers an explore went on to. Log time is the
+simulator's (``tick * 1e9 / fps``), never the wall clock: the same house, episode,
+options and planner seed give the same log except the measured fields,
+``decision_time_s`` of the actions and ``latency_s`` of the LLM exchanges (so the file
+bytes differ too, through the compressed chunks; every message on every other channel
+is identical, the scene graphs included). The writer writes ``OUT.XXXXXXXX.partial``
+and renames it at the end: an error leaves no half-written log.
 
 Planner actions become simulator skills by :func:`sgtool.recorders.sim.skill_plan.plan_skills`.
 With ``navigation="live"`` (the default) the robot runs them on its own map
@@ -64,8 +65,17 @@ leaves no room, region or frontier node) or the planner gives up while the robot
 still has reachable grid frontiers, the robot explores those on its own until the graph
 offers something new (:mod:`sgtool.recorders.sim.fallback_explore`: ``explore`` actions
 with reason ``fallback: ...``, decided on no graph; their frames and metres count, they
-are no steps). ``navigation="house"`` keeps the simulator's skills on the ground-truth
-occupancy (the behaviour before, for comparison). ``extra.navigation`` of the started
+are no steps). An ``explore`` of the planner that succeeds but leaves no object, door or
+room on offer that was not when it was decided **goes on** (:meth:`_Search.go_on`): the
+planner chooses again among the frontiers only and the robot explores the one chosen, at
+most ``explore_on`` times (default 0: never) or until something new is on offer; each is logged
+as an ``explore`` with reason :data:`WENT_ON` and its decision time, and counts no step.
+So an explore reveals what lies there, as the symbolic environment's reveals a region's
+furniture, and not one more metre of floor behind a chair. When the robot's bump
+marks wall off every goal (:meth:`LiveSkills.forget_bumps`), they are dropped before the
+hand-over (counted as ``extra.bumps_forgotten`` of the closing Episode record).
+``navigation="house"`` keeps the simulator's skills on the ground-truth occupancy (the
+behaviour before, for comparison). ``extra.navigation`` of the started
 Episode record says which, with the live settings.
 """
 
@@ -100,10 +110,15 @@ from sgtool.progress import Progress
 from sgtool.recorders.sim.camera import CameraConfig
 from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport
 from sgtool.recorders.sim.execution import Executed, execute_live, execute_privileged
-from sgtool.recorders.sim.fallback_explore import GAVE_UP, NO_ACTIONABLE, Fallback
+from sgtool.recorders.sim.fallback_explore import (
+    GAVE_UP,
+    NO_ACTIONABLE,
+    Fallback,
+    new_candidates,
+)
 from sgtool.recorders.sim.keyframes import KeyframeRule
 from sgtool.recorders.sim.live_recorder import LiveRecorder
-from sgtool.recorders.sim.live_skills import LiveNavConfig, LiveSkills, RobotBody
+from sgtool.recorders.sim.live_skills import IN_VIEW, LiveNavConfig, LiveSkills, RobotBody
 from sgtool.recorders.sim.navigation import RobotConfig
 from sgtool.recorders.sim.noise import PROFILES, NoiseProfile
 from sgtool.recorders.sim.reachability import FAILED_BEFORE, FailedGoals, reachable_view
@@ -129,6 +144,8 @@ from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 from sgtool.semantics.text import category_text
 
 N_MAX = 50  # high-level steps per episode (SymSearch's N_max)
+# the reason of an explore that goes on (:meth:`_Search.go_on`): no step
+WENT_ON = "went on: the last explore showed no new object, door or room"
 NAVIGATION = ("live", "house")
 
 
@@ -141,7 +158,8 @@ class ClosedLoopOptions:
     sensor ``noise``; the mapping (a refresh every ``every`` frames, room ``classifier``,
     ``min_points``, ``voxel_size``: recorded in the log, so ``sgtool replay`` rebuilds the
     same graphs); ``max_steps`` high-level steps and a ``frames`` budget; ``navigation``
-    ``live`` (the robot's own map) or ``house`` (ground truth); the ``success`` rule.
+    ``live`` (the robot's own map) or ``house`` (ground truth); the ``success`` rule;
+    ``explore_on``, how many frontiers an explore that showed nothing new goes on to.
     :meth:`mapping` checks them (a one-line :class:`~sgtool.errors.SgtoolError`)."""
 
     fps: float = 10.0
@@ -165,6 +183,9 @@ class ClosedLoopOptions:
     # and metres driven since the last one (both 0: every tick)
     turn_render_deg: float = 20.0
     render_step_m: float = 0.25
+    # an explore that showed no new object, door or room goes on to up to this many
+    # frontiers the planner chooses, no steps (live navigation; 0: it does not)
+    explore_on: int = 0
 
     def keyframes(self) -> KeyframeRule:
         """Which ticks are frames (a one-line :class:`~sgtool.errors.SgtoolError` when
@@ -182,6 +203,8 @@ class ClosedLoopOptions:
             raise SgtoolError(f"unknown room classifier {self.classifier!r}; one of "
                               f"{', '.join(CLASSIFIERS)}")
         self.keyframes()
+        if self.explore_on < 0:
+            raise SgtoolError(f"--explore-on {self.explore_on}: must be >= 0")
         if not 0.01 <= self.voxel_size <= 0.5:
             raise SgtoolError(f"voxel size {self.voxel_size} m: must be 0.01..0.5")
         mp = self.min_points if self.min_points is not None else default_min_points(
@@ -230,8 +253,11 @@ class _Search:
     def __init__(self, sim: Simulation, rec: LiveRecorder, agent: Planner, query: str,
                  max_steps: int,
                  on_decision: Callable[[SceneGraph, Action], None] | None,
-                 skills: LiveSkills | None = None) -> None:
+                 skills: LiveSkills | None = None, explore_on: int = 0) -> None:
         self.sim, self.rec, self.agent, self.query = sim, rec, agent, query
+        self.explore_on = explore_on
+        # after an explore: the non-frontier nodes on offer when it was decided (go_on)
+        self._on_known: list[Candidate] | None = None
         self.skills = skills  # None: the simulator's privileged skills
         self.max_steps = max_steps
         self.on_decision = on_decision
@@ -245,6 +271,7 @@ class _Search:
         # (:mod:`.reachability`); failed goals are not offered again from the same place
         self.failed = FailedGoals()
         self.withheld: dict[str, int] = {}  # reason -> nodes withheld, summed over decisions
+        self.forgot_bumps = 0  # times the bump marks were dropped (they walled off all)
         self._seen: SceneGraph | None = None  # the graph the planner saw last
         self._withheld_now: dict[str, str] = {}
         # the robot's own exploration when the graph offers nothing (live navigation only)
@@ -286,6 +313,16 @@ class _Search:
             self.end = "frames"
             return None
         graph = self._view(cur)
+        if self._on_known is not None:
+            graph = self.go_on(graph)
+            if self.end:
+                return None
+            cur = self.rec.stream.current
+            assert cur is not None
+        if not self.end and self.skills is not None and not actionable(graph) and \
+                self.skills.forget_bumps():
+            self.forgot_bumps += 1
+            graph = self._view(cur)  # the robot's bump marks walled off every goal
         if not self.end and self.fallback is not None and not actionable(graph):
             self._hand_over(NO_ACTIONABLE, ())
             if self.end:  # the target came into view, or the frame budget is spent
@@ -371,7 +408,55 @@ class _Search:
         self.last_t = self.rec.act(self.sim, outcome, self._decision_s,
                                    {"graph_time_ns": self._graph_time_ns})
         self._check(self.rec.stream.current, cut)  # found overrides a done
+        if action.skill == "explore" and o == "success" and why != IN_VIEW and \
+                self._seen is not None:
+            self._on_known = [c for c in actionable(self._seen) if c.kind != "frontier"]
         return Feedback(action, o, why, dist)
+
+    def go_on(self, graph: SceneGraph) -> SceneGraph:
+        """After a planner's explore (module doc): while the view ``graph`` offers no
+        object, door or room that was not on offer when the explore was decided, up to
+        ``explore_on`` times, the planner chooses among the frontiers only and the robot
+        explores the one chosen, logged as an action with reason :data:`WENT_ON` and no
+        step (a choice that is no frontier ends it). The view to decide on next."""
+        known, self._on_known = self._on_known, None
+        if known is None or self.skills is None:
+            return graph
+        for _ in range(self.explore_on):
+            if self.end or new_candidates(graph, known, frontiers=False):
+                break
+            cur = self.rec.stream.current
+            assert cur is not None
+            drop = {c.node_id for c in actionable(graph) if c.kind != "frontier"}
+            only = _without_nodes(graph, drop)
+            fronts = {c.node_id for c in actionable(only)}
+            if not fronts:
+                break
+            t0 = time.perf_counter()
+            action = self.agent.decide(only)
+            dt = time.perf_counter() - t0
+            self.decision_times.append(dt)
+            _log_exchanges(self.agent, self.rec.writer, self.rec.last_time_ns)
+            if self.on_decision is not None:
+                self.on_decision(only, action)
+            if action.skill != "explore" or action.target not in fronts:
+                break
+            ex = self._run(plan_skills(cur.graph, action).calls)
+            why = WENT_ON + (f"; {ex.reason}" if ex.outcome != "success" else "")
+            self.last_t = self.rec.act(
+                self.sim, SkillOutcome("explore", action.target, ex.outcome, why,
+                                       ex.travelled_m, ex.ticks), dt,
+                {"graph_time_ns": int(cur.time_ns)})
+            self.agent.feedback(Feedback(action, ex.outcome, ex.reason, ex.travelled_m))
+            if ex.outcome == "failure" and not ex.cut:
+                self.failed.failed(str(action.target))
+            self._check(self.rec.stream.current, ex.cut)
+            if self.end or ex.outcome != "success" or ex.reason == IN_VIEW:
+                break
+            now = self.rec.stream.current
+            assert now is not None
+            graph = self._view(now)
+        return graph
 
     def _give_up_handed_over(self, action: Action, graph: SceneGraph) -> Feedback:
         """The planner gave up but the robot's map has reachable frontiers: the give-up is
@@ -453,7 +538,8 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                 RobotBody(sim), lambda: stream.current, opts.live)
             if skills is not None:  # end a skill as soon as the target is in the graph
                 skills.stop_when = lambda: _found(stream.current, query)
-            search = _Search(sim, rec, planner, query, opts.max_steps, on_decision, skills)
+            search = _Search(sim, rec, planner, query, opts.max_steps, on_decision, skills,
+                             opts.explore_on)
             search.start()
             trace = run_search(search, planner, query, seed=opts.planner_seed,
                                recorder=search, success=opts.success)
@@ -495,6 +581,13 @@ def _classifier(name: str) -> RoomClassifier | None:
     return _CLASSIFIERS[name]
 
 
+def _without_nodes(graph: SceneGraph, drop: set[str]) -> SceneGraph:
+    """``graph`` with the nodes ``drop`` made unreachable (out of its distances; an empty
+    dict would mean "straight lines to every node")."""
+    dists = {k: v for k, v in graph.distances.items() if k not in drop}
+    return dataclasses.replace(graph, distances=dists or {"robot": 0.0})
+
+
 def _found(refresh: Refresh | None, query: str) -> bool:
     return refresh is not None and find_target(refresh.graph, query) is not None
 
@@ -525,14 +618,22 @@ def _started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOp
         "navigation": {"mode": opts.navigation, **opts.live.to_dict()},
         "noise": opts.noise.to_dict(), "noise_seed": opts.noise_seed,
         "turn_render_deg": opts.turn_render_deg, "render_step_m": opts.render_step_m,
+        "explore_on": opts.explore_on,
         **_rule(opts),
     }
 
 
 def _withheld(search: _Search) -> dict[str, Any]:
     """``{"withheld": {reason: count}}``: goals not offered to the planner, summed over
-    its decisions (live navigation; nothing when none was withheld)."""
-    return {"withheld": dict(sorted(search.withheld.items()))} if search.withheld else {}
+    its decisions (live navigation; nothing when none was withheld), and
+    ``{"bumps_forgotten": n}`` when the robot's bump marks were dropped n times because
+    they walled off every goal."""
+    out: dict[str, Any] = {}
+    if search.withheld:
+        out["withheld"] = dict(sorted(search.withheld.items()))
+    if search.forgot_bumps:
+        out["bumps_forgotten"] = search.forgot_bumps
+    return out
 
 
 def _rule(opts: ClosedLoopOptions) -> dict[str, str]:

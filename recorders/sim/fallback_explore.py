@@ -63,12 +63,15 @@ class FallbackRun:
     stopped: bool = False
 
 
-def new_candidates(graph: SceneGraph, known: Sequence[Candidate]) -> list[Candidate]:
+def new_candidates(graph: SceneGraph, known: Sequence[Candidate], frontiers: bool = True
+                   ) -> list[Candidate]:
     """The actionable nodes of ``graph`` not in ``known`` (same id within
-    :data:`~sgtool.planning.memory.SAME_PLACE_M`, as the planners' memory keys nodes)."""
+    :data:`~sgtool.planning.memory.SAME_PLACE_M`, as the planners' memory keys nodes);
+    frontier nodes only when ``frontiers``."""
     return [c for c in actionable(graph)
-            if not any(k.node_id == c.node_id and
-                       math.dist(k.position, c.position) <= SAME_PLACE_M for k in known)]
+            if (frontiers or c.kind != "frontier") and
+            not any(k.node_id == c.node_id and
+                    math.dist(k.position, c.position) <= SAME_PLACE_M for k in known)]
 
 
 @dataclass

@@ -26,7 +26,10 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   of the episode; when those marks leave the robot less than ``sealed_m2`` of reachable
   floor while the map without them leaves more (contacts at a door frame or a swinging
   panel can ring the robot in), the oldest are dropped until it has that much again:
-  otherwise every goal would be unreachable and the search would end there.
+  otherwise every goal would be unreachable and the search would end there. When the
+  marks wall off every goal of the graph while leaving more floor than that (a room whose
+  only open door frame the robot brushed), the closed loop drops them all
+  (:meth:`LiveSkills.forget_bumps`).
 - **Looking around** (:meth:`LiveSkills.look_around`) turns only toward unknown space
   near the robot on its own map (:func:`~sgtool.recorders.sim.motion.sweep`), the shorter
   way, and stops when a refresh during the turn shows no cell known that was not before.
@@ -267,6 +270,16 @@ class LiveSkills:
                 self.bumps = kept  # sealed without them too: they were not the cause
         self._planned = (key, out)
         return out
+
+    def forget_bumps(self) -> int:
+        """Drop every bump mark (the closed loop calls this when its view of the graph
+        offers the planner nothing: marks at a door frame can wall off every goal while
+        leaving the robot more than ``sealed_m2``); the number dropped."""
+        n = len(self.bumps)
+        if n:
+            self.bumps = []
+            self._planned = None
+        return n
 
     def _sealed(self, occ: OccupancyMap, dist: np.ndarray) -> bool:
         """The floor the robot can reach on ``occ`` is less than ``config.sealed_m2``."""

@@ -102,3 +102,7 @@ def test_a_log_of_other_frame_settings_is_not_resumed(tmp_path: Path) -> None:
         logged, task_settings(dataclasses.replace(opts, classifier="containment"), "none",
                               ep)) \
         == ['room classifier: "frequency" in the log, "containment" now']
+    # so is how far an explore goes on
+    assert settings_differences(
+        logged, task_settings(dataclasses.replace(opts, explore_on=3), "none", ep)) \
+        == ["explore on (frontiers): 0 in the log, 3 now"]

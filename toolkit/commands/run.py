@@ -73,6 +73,12 @@ if TYPE_CHECKING:
               "driven through; a goal the map cannot reach fails with the reason); house: "
               "the simulator plans on the house's ground truth (the privileged behaviour "
               "before, for comparison).")
+@click.option("--explore-on", type=click.IntRange(min=0), default=0, show_default=True,
+              metavar="N",
+              help="live navigation: after an explore that showed no new object, door or "
+              "room, the planner picks among the frontiers only and the robot goes on "
+              "there, up to N times, no step each (0: never; a step is then one planner "
+              "decision, as in the papers).")
 @click.option("--optimistic", type=float, default=0.25, show_default=True, metavar="M",
               help="live navigation: how far (m) past known free floor a path may run into "
               "unknown space (at frontiers).")
@@ -161,6 +167,7 @@ class RunArgs:
     llm_api_key: str | None = None
     llm_timeout: float | None = None
     rerun_to: str | None = None
+    explore_on: int = 0
 
 
 def _planner(args: RunArgs) -> tuple[str, dict[str, Any]]:
@@ -216,7 +223,8 @@ def _request(args: RunArgs, out: Path) -> SearchRequest:
         classifier=args.classifier, min_points=args.min_points, max_steps=args.max_steps,
         frames=frame_budget(args.frames, args.frames_per_room, len(house.rooms)),
         planner_seed=args.planner_seed, navigation=args.navigation, success=args.success,
-        noise=parse_noise(args.noise), live=LiveNavConfig(optimistic=args.optimistic))
+        noise=parse_noise(args.noise), live=LiveNavConfig(optimistic=args.optimistic),
+        explore_on=args.explore_on)
     return SearchRequest(house=house, house_id=house_id, episode_index=index, episode=ep,
                          planner=name, output=out, options=opts, planner_options=options,
                          force=args.force, quiet=args.quiet, rerun_to=args.rerun_to)

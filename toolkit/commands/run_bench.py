@@ -64,6 +64,12 @@ if TYPE_CHECKING:
               "less CPU: docs/experiments/issue30-efficiency.md).")
 @click.option("--every", type=click.IntRange(min=1), default=10, show_default=True,
               help="Refresh the scene graph every K frames (and at every action).")
+@click.option("--explore-on", type=click.IntRange(min=0), default=0, show_default=True,
+              metavar="N",
+              help="live navigation: after an explore that showed no new object, door or "
+              "room, the planner picks among the frontiers only and the robot goes on "
+              "there, up to N times, no step each (0: never; a step is then one planner "
+              "decision, as in the papers).")
 @click.option("--navigation", type=click.Choice(["live", "house"]), default="live",
               show_default=True,
               help="live: skills plan on the robot's own map; house: on the ground truth "
@@ -156,6 +162,7 @@ class RunBenchArgs:
     all_pairs: bool = False
     symbolic_dir: str | None = None
     with_symbolic: bool = False
+    explore_on: int = 0
 
 
 def _request(args: RunBenchArgs) -> RunBenchRequest:
@@ -203,7 +210,8 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
     width, height = parse_resolution(args.resolution)
     opts = ClosedLoopOptions(camera=CameraConfig(width=width, height=height),
                              every=args.every, max_steps=args.max_steps, frames=args.frames,
-                             navigation=args.navigation, success=args.success)
+                             navigation=args.navigation, success=args.success,
+                             explore_on=args.explore_on)
     options = planner_options(args.planner_option, names)
     LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
                 args.llm_timeout).fill(options, names)

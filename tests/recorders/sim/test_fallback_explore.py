@@ -83,7 +83,7 @@ def test_empty_first_graph_reaches_a_room_with_the_fallback(house, tmp_path,
     _empty_near_start(monkeypatch, (ep.start.x, ep.start.y))
     # without the fallback: nothing to act on, greedy gives up at step 1
     with monkeypatch.context() as m:
-        m.setattr(cl.Fallback, "explore", lambda self, why, known=(): FallbackRun(0))
+        m.setattr(cl.Fallback, "explore", lambda self, why, known=(), **kw: FallbackRun(0))
         m.setattr(cl.Fallback, "can_explore", lambda self: False)
         before = run_episode(house, ep, make_planner("greedy"), tmp_path / "before.mcap",
                              OPTS, episode_index=idx)
@@ -97,8 +97,9 @@ def test_empty_first_graph_reaches_a_room_with_the_fallback(house, tmp_path,
     assert first.rooms and actionable(first), "the planner's first graph offers a room"
     acts = _actions(out)
     assert acts[0]["skill"] == "look_around"
-    fallback = [a for a in acts if is_fallback(a.get("reason"))]
-    assert fallback and acts[1:1 + len(fallback)] == fallback  # before the first decision
+    decided = next(i for i, a in enumerate(acts) if a["planner"] is not None)
+    fallback = [a for a in acts[:decided] if is_fallback(a.get("reason"))]
+    assert fallback and acts[1:decided] == fallback  # before the first decision
     for a in fallback:
         assert a["skill"] == "explore" and a["target"].startswith("frontier:")
         assert a["reason"].startswith("fallback: no actionable node")
@@ -169,3 +170,121 @@ def test_fallback_options_bound_a_hand_over() -> None:
     assert FallbackOptions().max_goals >= 1 and FallbackOptions().forget > 0
     assert is_fallback("fallback: no actionable node") and not is_fallback("stopped: x")
     assert not is_fallback(None)
+
+
+def _nearest_frontier(g) -> Action:
+    fs = [c for c in actionable(g) if c.kind == "frontier"]
+    if not fs:
+        return Action("done")
+    return Action("explore", min(fs, key=lambda c: (c.distance, c.node_id)).node_id)
+
+
+def test_an_explore_that_shows_nothing_new_goes_on(house, tmp_path) -> None:
+    """After a planner's explore whose graph offers no object, door or room it was not
+    offered before, the planner chooses again among the frontiers only (it is shown
+    nothing else) and the robot explores there, at most ``explore_on`` times, each an
+    action with reason WENT_ON that is no step; it stops at the first graph that offers
+    something new. With ``explore_on`` 0 there is none."""
+    idx, ep = _open_start(house)
+    runs = {}
+    for on in (0, 3):
+        p = Scripted([_nearest_frontier] * 30)
+        out = tmp_path / f"on{on}.mcap"
+        rep = run_episode(house, ep, p, out, dataclasses.replace(OPTS, max_steps=5,
+                                                                 explore_on=on),
+                          episode_index=idx)
+        runs[on] = (p, _actions(out), rep)
+    p0, acts0, rep0 = runs[0]
+    assert not any(a["reason"].startswith(cl.WENT_ON) for a in acts0)
+    assert len(p0.graphs) == rep0.steps
+    p2, acts2, rep2 = runs[3]
+    decided = [a for a in acts2 if a["graph_time_ns"] is not None]
+    assert len(decided) == len(p2.graphs)  # every decision is logged, went-on ones too
+    on = [k for k, a in enumerate(decided) if a["reason"].startswith(cl.WENT_ON)]
+    assert on, "some explore of the nearest frontier showed nothing new"
+    assert rep2.steps == len(p2.graphs) - len(on)  # going on is no step
+    for k in on:
+        # only frontiers were on offer, and the explore before it showed nothing new
+        assert {c.kind for c in actionable(p2.graphs[k])} == {"frontier"}
+        assert decided[k]["skill"] == "explore"
+        prev = k - 1
+        while prev in on:
+            prev -= 1
+        assert k - prev <= 3  # at most explore_on in a row
+        assert decided[prev]["skill"] == "explore" and decided[prev]["outcome"] == "success"
+        base = [c for c in actionable(p2.graphs[prev]) if c.kind != "frontier"]
+        assert not new_candidates(p2.graphs[k], base, frontiers=False)
+    # a run of went-on legs shorter than explore_on ended because something new was on
+    # offer (or no frontier was left, or the target came into view)
+    checked = 0
+    for k in on:
+        run = 1 + (k - 1 in on) + (k - 1 in on and k - 2 in on)
+        if k + 1 in on or k + 1 >= len(decided) or run >= 3 or \
+                decided[k]["outcome"] != "success":
+            continue
+        start = k - run
+        base = [c for c in actionable(p2.graphs[start]) if c.kind != "frontier"]
+        assert new_candidates(p2.graphs[k + 1], base, frontiers=False) or \
+            not any(c.kind == "frontier" for c in actionable(p2.graphs[k + 1]))
+        checked += 1
+    assert checked >= 1
+
+
+def test_bump_marks_that_wall_off_every_goal_are_forgotten(house, tmp_path,
+                                                           monkeypatch) -> None:
+    """Bump marks can wall off every goal while leaving the robot more floor than the
+    sealed rule guards (a room whose open door frame it brushed): then the closed loop
+    drops them, the planner is offered the graph's goals again and the closing Episode
+    record counts it; without that the episode ends there."""
+    import numpy as np
+
+    from sgtool.log.records import Episode as LoggedEpisode
+    from sgtool.mapping.occupancy import OccupancyMap
+    from sgtool.recorders.sim.live_skills import LiveNavConfig, LiveSkills
+
+    idx, ep = _open_start(house)
+    real_map = LiveSkills.live_map
+
+    def walled(self, refresh):
+        occ = real_map(self, refresh)
+        if occ is None or not self.bumps:
+            return occ
+        # with a bump mark, only a disc of 0.3 m around the robot is floor (the sealed
+        # rule off): what the marks across a door frame do to a small room
+        h, w = occ.shape
+        x = occ.origin[0] + (np.arange(w) + 0.5) * occ.resolution
+        y = occ.origin[1] + (np.arange(h) + 0.5) * occ.resolution
+        X, Y = np.meshgrid(x, y)
+        bx, by = self.body.base[:2]
+        far = np.hypot(X - bx, Y - by) > 0.3
+        return OccupancyMap(occ.grid, occ.blocked | far, occ.robot_radius)
+
+    monkeypatch.setattr(LiveSkills, "live_map", walled)
+    real_observe = cl._Search.observe
+
+    def observe(self):
+        if self.steps == 1 and self.skills is not None and not self.skills.bumps:
+            self.skills.bumps.append((-50.0, -50.0))  # a contact (its place is moot here)
+            self.skills._planned = None
+        return real_observe(self)
+
+    monkeypatch.setattr(cl._Search, "observe", observe)
+    ends = {}
+    for forget in (False, True):
+        with monkeypatch.context() as m:
+            if not forget:
+                m.setattr(LiveSkills, "forget_bumps", lambda self: 0)
+            p = Scripted([_nearest_frontier, lambda g: Action("done")])
+            out = tmp_path / f"forget{forget}.mcap"
+            opts = dataclasses.replace(OPTS, max_steps=2, explore_on=0,
+                                       live=LiveNavConfig(sealed_m2=0.0))
+            rep = run_episode(house, ep, p, out, opts, episode_index=idx)
+            with LogReader(out) as r:
+                closing = [e for _, e in r.records(LoggedEpisode) if e.status != "started"]
+            ends[forget] = (rep, p, closing[0].extras)
+    rep, p, extra = ends[False]  # walled off: nothing on offer, the planner gives up
+    assert rep.end == "gave_up" and not actionable(p.graphs[1])
+    assert "bumps_forgotten" not in extra
+    rep, p, extra = ends[True]  # the marks dropped: the goals are on offer again
+    assert rep.end != "gave_up" and actionable(p.graphs[1])
+    assert extra["bumps_forgotten"] == 1
