@@ -1,0 +1,124 @@
+"""Two ``sgtool run-bench`` output folders of the same episodes, compared paired.
+
+``run-bench`` compares planners within one run; this compares one planner across two
+runs (two code versions, two option settings) on the episodes both hold: per planner
+the SR and SPL of each run, the paired SR difference and SPL ratio (B against A) with
+cluster-bootstrap intervals over houses (:func:`sgtool.analysis.intervals.paired_comparison`),
+then the SR of each run within frame budgets per room of the house, with the paired SR
+difference within each budget and, within each run, every planner against
+``--reference`` at those budgets.
+
+Episodes are matched by (house, episode, seed); frames come from each log's closing
+Episode record, the rooms of the house from the log's ``house.json`` attachment.
+
+    sgtool run-bench --planners scout,random --houses 6 --episodes 6 --rooms 8-16 \\
+        --preset symsearch --resolution 96x72 -o A --explore-on 0
+    sgtool run-bench ... -o B --explore-on 3
+    .venv/bin/python benchmarks/run_bench_ab.py A B --budgets 50,80 --reference random
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+from pathlib import Path
+
+from sgtool.analysis.closed_loop_tables import within_budget
+from sgtool.analysis.intervals import paired_comparison, planner_intervals
+from sgtool.analysis.report import fmt_interval
+from sgtool.analysis.search_metrics import CostModel
+from sgtool.errors import SgtoolError
+from sgtool.log.reader import LogReader
+from sgtool.results import EpisodeResult, read_jsonl
+
+
+def _frames_per_room(r: EpisodeResult) -> float:
+    with LogReader(r.source) as log:
+        ep = log.last_record("episode")
+        spec = log.house_spec()
+    frames = float((ep or {}).get("frames") or 0)
+    rooms = max(1, len(spec.rooms)) if spec is not None else 1
+    return frames / rooms
+
+
+def load(folder: Path) -> tuple[list[EpisodeResult], dict[tuple[str, int, str, int], float]]:
+    """The episodes of a run-bench folder and their frames per room (by result key)."""
+    path = folder / "episodes.jsonl"
+    if not path.is_file():
+        raise SgtoolError(f"{folder}: no episodes.jsonl (not a finished run-bench folder)")
+    results = list(read_jsonl(path))
+    return results, {r.key(): _frames_per_room(r) for r in results}
+
+
+def _within(results: list[EpisodeResult], frames: dict[tuple[str, int, str, int], float],
+            budget: float) -> list[EpisodeResult]:
+    """``results`` scored within ``budget`` frames per room (over it: failed)."""
+    model = CostModel("frames", "frames per room", budget, lambda r: frames[r.key()])
+    return within_budget(results, model, budget)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("a", type=Path, help="run-bench output folder A (the baseline)")
+    ap.add_argument("b", type=Path, help="run-bench output folder B")
+    ap.add_argument("--budgets", default="50,80",
+                    help="frame budgets per room of the house, comma-separated")
+    ap.add_argument("--reference", default="random",
+                    help="planner the others are compared with within each run")
+    ap.add_argument("--json", type=Path, help="also write the figures here")
+    args = ap.parse_args(argv)
+    try:
+        budgets = [float(x) for x in args.budgets.split(",") if x.strip()]
+        (ra, fa), (rb, fb) = load(args.a), load(args.b)
+    except (SgtoolError, ValueError) as e:
+        print(f"run_bench_ab: {e}", file=sys.stderr)
+        return 2
+    planners = [p for p in dict.fromkeys(r.planner for r in ra)
+                if any(r.planner == p for r in rb)]
+    out: dict[str, object] = {"a": str(args.a), "b": str(args.b), "planners": {}}
+    print(f"A = {args.a}, B = {args.b}; intervals: 95 % cluster bootstrap over houses\n")
+    print("| planner | SR A | SR B | SR B - A | SPL A | SPL B | SPL B / A | wins/losses/ties |")
+    print("|---|---|---|---|---|---|---|---|")
+    for p in planners:
+        both = [dataclasses.replace(r, planner="A") for r in ra if r.planner == p] + \
+               [dataclasses.replace(r, planner="B") for r in rb if r.planner == p]
+        c = paired_comparison(both, "B", "A")
+        ia, ib = planner_intervals(both, "A"), planner_intervals(both, "B")
+        print(f"| {p} | {fmt_interval(ia.sr)} | {fmt_interval(ib.sr)} | "
+              f"{fmt_interval(c.sr_diff, signed=True)} | {fmt_interval(ia.spl)} | "
+              f"{fmt_interval(ib.spl)} | {fmt_interval(c.spl_ratio)} | "
+              f"{c.wins}/{c.losses}/{c.ties} |")
+        out["planners"][p] = {"a": ia.to_dict(), "b": ib.to_dict(),  # type: ignore[index]
+                              "b_vs_a": c.to_dict()}
+    rows = []
+    for b in budgets:
+        sa, sb = _within(ra, fa, b), _within(rb, fb, b)
+        for p in planners:
+            both = [dataclasses.replace(r, planner="A") for r in sa if r.planner == p] + \
+                   [dataclasses.replace(r, planner="B") for r in sb if r.planner == p]
+            c = paired_comparison(both, "B", "A")
+            ref = [] if p == args.reference else [
+                paired_comparison(s, p, args.reference).sr_diff for s in (sa, sb)]
+            ia, ib = planner_intervals(both, "A"), planner_intervals(both, "B")
+            rows.append((b, p, ia.sr, ib.sr, c.sr_diff, ref))
+    print(f"\nSR within a frame budget per room (over it: failed); vs: planner - "
+          f"{args.reference} in the same run\n")
+    print("| f/room | planner | SR A | SR B | SR B - A | vs ref A | vs ref B |")
+    print("|---|---|---|---|---|---|---|")
+    for b, p, sa_, sb_, d, ref in rows:
+        refs = [fmt_interval(x, signed=True) for x in ref] or ["", ""]
+        print(f"| {b:.0f} | {p} | {fmt_interval(sa_)} | {fmt_interval(sb_)} | "
+              f"{fmt_interval(d, signed=True)} | {refs[0]} | {refs[1]} |")
+    out["budgets"] = [{"frames_per_room": b, "planner": p, "sr_a": sa_.to_dict(),
+                       "sr_b": sb_.to_dict(), "b_minus_a": d.to_dict(),
+                       "vs_reference": [x.to_dict() for x in ref]}
+                      for b, p, sa_, sb_, d, ref in rows]
+    if args.json:
+        args.json.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
