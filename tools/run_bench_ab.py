@@ -14,7 +14,7 @@ Episode record, the rooms of the house from the log's ``house.json`` attachment.
     sgtool run-bench --planners scout,random --houses 6 --episodes 6 --rooms 8-16 \\
         --preset symsearch --resolution 96x72 -o A --explore-on 0
     sgtool run-bench ... -o B --explore-on 3
-    .venv/bin/python benchmarks/run_bench_ab.py A B --budgets 50,80 --reference random
+    .venv/bin/python tools/run_bench_ab.py A B --budgets 50,80 --reference random
 """
 
 from __future__ import annotations
@@ -34,7 +34,10 @@ from sgtool.log.reader import LogReader
 from sgtool.results import EpisodeResult, read_jsonl
 
 
-def _frames_per_room(r: EpisodeResult) -> float:
+def _frames_per_room(r: EpisodeResult) -> float | None:
+    """Frames per room of the house of ``r``'s log; None without a readable log."""
+    if not Path(r.source).is_file():
+        return None
     with LogReader(r.source) as log:
         ep = log.last_record("episode")
         spec = log.house_spec()
@@ -43,13 +46,18 @@ def _frames_per_room(r: EpisodeResult) -> float:
     return frames / rooms
 
 
-def load(folder: Path) -> tuple[list[EpisodeResult], dict[tuple[str, int, str, int], float]]:
-    """The episodes of a run-bench folder and their frames per room (by result key)."""
+def load(folder: Path) -> tuple[list[EpisodeResult],
+                                dict[tuple[str, int, str, int], float] | None]:
+    """The episodes of a run-bench folder and their frames per room (by result key; None
+    when some episode's log is not there)."""
     path = folder / "episodes.jsonl"
     if not path.is_file():
         raise SgtoolError(f"{folder}: no episodes.jsonl (not a finished run-bench folder)")
     results = list(read_jsonl(path))
-    return results, {r.key(): _frames_per_room(r) for r in results}
+    frames = {r.key(): _frames_per_room(r) for r in results}
+    if any(v is None for v in frames.values()):
+        return results, None
+    return results, {k: v for k, v in frames.items() if v is not None}
 
 
 def _within(results: list[EpisodeResult], frames: dict[tuple[str, int, str, int], float],
@@ -92,8 +100,12 @@ def main(argv: list[str] | None = None) -> int:
               f"{c.wins}/{c.losses}/{c.ties} |")
         out["planners"][p] = {"a": ia.to_dict(), "b": ib.to_dict(),  # type: ignore[index]
                               "b_vs_a": c.to_dict()}
+    if fa is None or fb is None:
+        print("\nframe budgets: not scored (some episode logs are not there)")
+        budgets = []
     rows = []
     for b in budgets:
+        assert fa is not None and fb is not None
         sa, sb = _within(ra, fa, b), _within(rb, fb, b)
         for p in planners:
             both = [dataclasses.replace(r, planner="A") for r in sa if r.planner == p] + \
