@@ -311,6 +311,18 @@ def success_option(recorded: bool = False) -> Callable[[F], F]:
              + (" [default: as recorded]." if recorded else "."))
 
 
+def explore_on_option() -> Callable[[F], F]:
+    """``--explore-on N`` of the closed-loop commands
+    (:attr:`sgtool.recorders.sim.closed_loop.ClosedLoopOptions.explore_on`)."""
+    return click.option(
+        "--explore-on", type=click.IntRange(min=0), default=0, show_default=True,
+        metavar="N",
+        help="live navigation: after an explore that showed no new object, door or room, "
+             "the planner picks among the frontiers only and the robot goes on there, up "
+             "to N times, no step each (0: never; a step is then one planner decision, as "
+             "in the papers).")
+
+
 def executor_options(what: str) -> Callable[[F], F]:
     """``--executor local|ray``, ``--workers/-w N`` and ``--ray-address`` of the batch
     commands (:func:`sgtool.analysis.executor.make_executor`); ``what`` names the tasks."""

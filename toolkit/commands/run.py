@@ -18,6 +18,7 @@ from sgtool.commands.options import (
     PLUGIN_HELP,
     LlmEndpoint,
     check_log_output,
+    explore_on_option,
     house_options,
     list_planners_option,
     llm_endpoint_options,
@@ -73,12 +74,7 @@ if TYPE_CHECKING:
               "driven through; a goal the map cannot reach fails with the reason); house: "
               "the simulator plans on the house's ground truth (the privileged behaviour "
               "before, for comparison).")
-@click.option("--explore-on", type=click.IntRange(min=0), default=0, show_default=True,
-              metavar="N",
-              help="live navigation: after an explore that showed no new object, door or "
-              "room, the planner picks among the frontiers only and the robot goes on "
-              "there, up to N times, no step each (0: never; a step is then one planner "
-              "decision, as in the papers).")
+@explore_on_option()
 @click.option("--optimistic", type=float, default=0.25, show_default=True, metavar="M",
               help="live navigation: how far (m) past known free floor a path may run into "
               "unknown space (at frontiers).")

@@ -13,6 +13,7 @@ from sgtool.commands.options import (
     PLUGIN_HELP,
     LlmEndpoint,
     executor_options,
+    explore_on_option,
     list_planners_option,
     llm_endpoint_options,
     parse_resolution,
@@ -64,12 +65,7 @@ if TYPE_CHECKING:
               "less CPU: docs/experiments/issue30-efficiency.md).")
 @click.option("--every", type=click.IntRange(min=1), default=10, show_default=True,
               help="Refresh the scene graph every K frames (and at every action).")
-@click.option("--explore-on", type=click.IntRange(min=0), default=0, show_default=True,
-              metavar="N",
-              help="live navigation: after an explore that showed no new object, door or "
-              "room, the planner picks among the frontiers only and the robot goes on "
-              "there, up to N times, no step each (0: never; a step is then one planner "
-              "decision, as in the papers).")
+@explore_on_option()
 @click.option("--navigation", type=click.Choice(["live", "house"]), default="live",
               show_default=True,
               help="live: skills plan on the robot's own map; house: on the ground truth "

@@ -1,0 +1,88 @@
+"""The options of a closed-loop episode (:class:`ClosedLoopOptions`), checked in one place.
+
+:func:`sgtool.recorders.sim.closed_loop.run_episode` runs with them; ``sgtool run`` and
+``sgtool run-bench`` build them from their command lines, and run-bench's resume check
+compares them with what a log recorded.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from sgtool.errors import SgtoolError
+from sgtool.planning.episode import check_success_rule
+from sgtool.recorders.sim.camera import CameraConfig
+from sgtool.recorders.sim.keyframes import KeyframeRule
+from sgtool.recorders.sim.live_skills import LiveNavConfig
+from sgtool.recorders.sim.navigation import RobotConfig
+from sgtool.recorders.sim.noise import PROFILES, NoiseProfile
+from sgtool.scenegraph.build_options import CLASSIFIERS, ResolvedOptions, default_min_points
+
+N_MAX = 50  # high-level steps per episode (SymSearch's N_max)
+NAVIGATION = ("live", "house")
+
+
+@dataclass(frozen=True)
+class ClosedLoopOptions:
+    """How a closed-loop episode runs
+    (:func:`~sgtool.recorders.sim.closed_loop.run_episode`): frame rate, camera, robot,
+    sensor ``noise``; the mapping (a refresh every ``every`` frames, room ``classifier``,
+    ``min_points``, ``voxel_size``: recorded in the log, so ``sgtool replay`` rebuilds the
+    same graphs); ``max_steps`` high-level steps and a ``frames`` budget; ``navigation``
+    ``live`` (the robot's own map) or ``house`` (ground truth); the ``success`` rule;
+    ``explore_on``, how many frontiers an explore that showed nothing new goes on to.
+    :meth:`mapping` checks them (a one-line :class:`~sgtool.errors.SgtoolError`)."""
+
+    fps: float = 10.0
+    camera: CameraConfig = field(default_factory=CameraConfig)
+    robot: RobotConfig = field(default_factory=RobotConfig)
+    noise: NoiseProfile = field(default_factory=lambda: PROFILES["none"])
+    noise_seed: int = 0
+    every: int = 10  # frames between graph refreshes (and one at every action)
+    classifier: str = "frequency"
+    min_points: int | None = None  # None: MoMa-LLM's 50 at 320x240, scaled
+    voxel_size: float = 0.05
+    max_steps: int = N_MAX
+    frames: int | None = None  # frame budget (None: none)
+    planner_seed: int = 0
+    compression: str = "zstd"
+    # "live": the robot plans on its own map; "house": on the ground truth (privileged)
+    navigation: str = "live"
+    live: LiveNavConfig = field(default_factory=LiveNavConfig)
+    success: str = "observed"  # success rule (sgtool.planning.episode): observed | done
+    # which ticks are frames (:mod:`.keyframes`): a frame every this many degrees turned
+    # and metres driven since the last one (both 0: every tick)
+    turn_render_deg: float = 20.0
+    render_step_m: float = 0.25
+    # an explore that showed no new object, door or room goes on to up to this many
+    # frontiers the planner chooses, no steps (live navigation; 0: it does not)
+    explore_on: int = 0
+
+    def keyframes(self) -> KeyframeRule:
+        """Which ticks are frames (a one-line :class:`~sgtool.errors.SgtoolError` when
+        out of range)."""
+        return KeyframeRule(float(self.render_step_m), math.radians(self.turn_render_deg))
+
+    def mapping(self) -> ResolvedOptions:
+        """The replay options this run builds with (``extra.mapping`` of the log)."""
+        check_success_rule(self.success)
+        if self.navigation not in NAVIGATION:
+            raise SgtoolError(f"navigation {self.navigation!r}: one of {', '.join(NAVIGATION)}")
+        if self.every < 1:
+            raise SgtoolError(f"--every {self.every}: must be >= 1")
+        if self.classifier not in CLASSIFIERS:
+            raise SgtoolError(f"unknown room classifier {self.classifier!r}; one of "
+                              f"{', '.join(CLASSIFIERS)}")
+        self.keyframes()
+        if self.explore_on < 0:
+            raise SgtoolError(f"--explore-on {self.explore_on}: must be >= 0")
+        if not 0.01 <= self.voxel_size <= 0.5:
+            raise SgtoolError(f"voxel size {self.voxel_size} m: must be 0.01..0.5")
+        mp = self.min_points if self.min_points is not None else default_min_points(
+            self.camera.width, self.camera.height)
+        if mp < 1:
+            raise SgtoolError(f"min points {mp}: must be >= 1")
+        return ResolvedOptions(every=int(self.every), classifier=self.classifier,
+                               min_points=int(mp), voxel_size=float(self.voxel_size),
+                               max_frames=None)
