@@ -121,7 +121,12 @@ from sgtool.recorders.sim.fallback_explore import (
 )
 from sgtool.recorders.sim.live_recorder import LiveRecorder
 from sgtool.recorders.sim.live_skills import IN_VIEW, LiveSkills, RobotBody
-from sgtool.recorders.sim.reachability import FAILED_BEFORE, FailedGoals, reachable_view
+from sgtool.recorders.sim.reachability import (
+    FAILED_BEFORE,
+    FailedGoals,
+    reachable_view,
+    without_nodes,
+)
 from sgtool.recorders.sim.recording import SOURCE
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome, StopSimulation
 from sgtool.recorders.sim.skill_plan import (  # noqa: F401 (re-exported)
@@ -340,8 +345,8 @@ class _Search:
         self.last_t = self.rec.act(self.sim, outcome, self._decision_s,
                                    {"graph_time_ns": self._graph_time_ns})
         self._check(self.rec.stream.current, cut)  # found overrides a done
-        if action.skill == "explore" and o == "success" and why != IN_VIEW and \
-                self._seen is not None:
+        if self.explore_on and self.skills is not None and action.skill == "explore" and \
+                o == "success" and why != IN_VIEW and self._seen is not None:
             self._on_known = [c for c in actionable(self._seen) if c.kind != "frontier"]
         return Feedback(action, o, why, dist)
 
@@ -360,7 +365,7 @@ class _Search:
             cur = self.rec.stream.current
             assert cur is not None
             drop = {c.node_id for c in actionable(graph) if c.kind != "frontier"}
-            only = _without_nodes(graph, drop)
+            only = without_nodes(graph, drop)
             fronts = {c.node_id for c in actionable(only)}
             if not fronts:
                 break
@@ -511,13 +516,6 @@ def _classifier(name: str) -> RoomClassifier | None:
     if name not in _CLASSIFIERS:
         _CLASSIFIERS[name] = make_classifier(name)
     return _CLASSIFIERS[name]
-
-
-def _without_nodes(graph: SceneGraph, drop: set[str]) -> SceneGraph:
-    """``graph`` with the nodes ``drop`` made unreachable (out of its distances; an empty
-    dict would mean "straight lines to every node")."""
-    dists = {k: v for k, v in graph.distances.items() if k not in drop}
-    return dataclasses.replace(graph, distances=dists or {"robot": 0.0})
 
 
 def _found(refresh: Refresh | None, query: str) -> bool:

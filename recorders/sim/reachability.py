@@ -195,7 +195,7 @@ def reachable_view(refresh: Refresh, skills: LiveSkills,
         return View(graph)
     planned = skills.plan_map(refresh)
     if planned is None:
-        return View(_without(graph, {c.node_id for c in cands}, {}),
+        return View(without_nodes(graph, {c.node_id for c in cands}),
                     {c.node_id: NO_MAP for c in cands})
     occ, dist = planned
     same = FailedGoals.same if failed is None else failed.same
@@ -216,7 +216,7 @@ def reachable_view(refresh: Refresh, skills: LiveSkills,
             continue
         r, col = occ.grid.cell_of(cell[0], cell[1])
         live[c.node_id] = float(dist[int(r), int(col)])
-    return View(_without(graph, set(withheld), live), withheld)
+    return View(without_nodes(graph, set(withheld), live), withheld)
 
 
 def _looked_near(looked: list[tuple[float, float]], cell: tuple[float, float],
@@ -225,11 +225,14 @@ def _looked_near(looked: list[tuple[float, float]], cell: tuple[float, float],
     return any(math.dist(p, cell) <= same for p in looked)
 
 
-def _without(graph: SceneGraph, drop: Iterable[str], live: dict[str, float]) -> SceneGraph:
-    """``graph`` with ``drop`` taken out of its distances and ``live`` put in."""
+def without_nodes(graph: SceneGraph, drop: Iterable[str],
+                  live: dict[str, float] | None = None) -> SceneGraph:
+    """``graph`` with the nodes ``drop`` taken out of its distances (so not actionable)
+    and the distances ``live`` put in; an empty result keeps ``{"robot": 0.0}`` (an empty
+    dict would mean "straight lines to every node")."""
     gone = set(drop)
     dists = {k: v for k, v in graph.distances.items() if k not in gone}
-    dists.update(live)
+    dists.update(live or {})
     if not dists and graph.distances == {} and not gone:
         return graph
     if not dists:  # an empty dict means "no distances: straight lines" to the candidates
