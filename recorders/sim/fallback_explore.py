@@ -21,6 +21,18 @@ step. The robot side only: goals come from the live map (:class:`LiveSkills`), n
 the house. The choice is deterministic (nearest along the floor, id order on ties), and a
 goal cell within ``forget`` of one gone to before in the episode is not a goal again, so
 repeated hand-overs end.
+
+When the graph's layers have no frontier the robot can reach, the fallback goes to an
+**open edge** instead (:func:`open_edges`): the frontier rule of the scene graph
+(MoMa-LLM's: free cells next to unknown, *not next to occupied*) finds nothing in a
+cluttered room whose unknown floor is fringed with glimpses of furniture (a bed top seen
+edgewise leaves a speckle of occupied cells along every boundary), and the planner used to
+give up with unseen floor in reach. An open edge is a cluster of cells the robot's map can
+reach (finite geodesic distance) that touch an unknown cell, near obstacles or not, of at
+least ``min_edge`` metres; the nearest along the floor whose cell is not within ``forget``
+of a goal gone to, nor within ``forget`` of a place the robot looked around from
+(``LiveSkills.looked``), is gone to and looked around at, logged as ``explore`` of
+``edge:ROW-COL`` (its cell on the robot's grid).
 """
 
 from __future__ import annotations
@@ -29,11 +41,15 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
+import numpy as np
+from scipy import ndimage
+
+from sgtool.mapping.occupancy import OccupancyMap
 from sgtool.planning.candidates import Candidate, actionable
 from sgtool.planning.memory import SAME_PLACE_M
 from sgtool.recorders.sim.events import SkillOutcome, StopSimulation
 from sgtool.recorders.sim.frontier_explore import next_frontier
-from sgtool.recorders.sim.live_skills import LiveSkills
+from sgtool.recorders.sim.live_skills import Goal, LiveSkills
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.stream import Refresh
 
@@ -51,6 +67,7 @@ def is_fallback(reason: str | None) -> bool:
 class FallbackOptions:
     max_goals: int = 12  # grid frontiers per hand-over
     forget: float = 0.5  # m: goal cells this near one gone to before are not goals again
+    min_edge: float = 0.3  # m: the least open edge (cells x resolution) worth a visit
 
 
 @dataclass(frozen=True)
@@ -90,8 +107,18 @@ class Fallback:
     def can_explore(self) -> bool:
         """The robot's map has a reachable grid frontier not gone to before."""
         ref = self.skills.current()
-        return ref is not None and ref.layers is not None and \
-            next_frontier(self.skills, ref, self.gone_to, self.options.forget) is not None
+        return ref is not None and ref.layers is not None and self._next(ref) is not None
+
+    def _next(self, ref: Refresh) -> tuple[Goal, tuple[float, float]] | None:
+        """A frontier of the graph's layers, else an open edge (module doc)."""
+        pick = next_frontier(self.skills, ref, self.gone_to, self.options.forget)
+        if pick is not None:
+            return pick
+        planned = self.skills.plan_map(ref)
+        if planned is None:
+            return None
+        avoid = self.gone_to + list(self.skills.looked)
+        return next_edge(*planned, avoid, self.options.forget, self.options.min_edge)
 
     def explore(self, why: str, known: Sequence[Candidate] = ()) -> FallbackRun:
         """Go to grid frontiers until the graph offers a node not in ``known`` (or none is
@@ -104,7 +131,7 @@ class Fallback:
                 break
             if new_candidates(ref.graph if self.view is None else self.view(ref), known):
                 break
-            pick = next_frontier(skills, ref, self.gone_to, self.options.forget)
+            pick = self._next(ref)
             if pick is None:
                 break
             goal, cell = pick
@@ -122,3 +149,44 @@ class Fallback:
             if cut or stop:
                 return FallbackRun(n, cut=cut, stopped=stop)
         return FallbackRun(n)
+
+
+def open_edges(occ: OccupancyMap, dist: np.ndarray, min_cells: int) -> list[np.ndarray]:
+    """The open edges of the robot's map (module doc): 8-connected clusters of cells with
+    a finite ``dist`` 8-adjacent to an unknown cell of ``occ.grid``, of at least
+    ``min_cells`` cells; each as (k, 2) rows and columns in raster order, the clusters in
+    raster order of their first cell."""
+    reach = np.isfinite(dist)
+    unknown = occ.grid.unknown
+    edge = reach & ndimage.binary_dilation(unknown, structure=np.ones((3, 3), bool))
+    lab, n = ndimage.label(edge, structure=np.ones((3, 3), bool))
+    rows, cols = np.nonzero(lab)  # raster order
+    of = lab[rows, cols]
+    order = np.argsort(of, kind="stable")  # by cluster, raster order within one
+    ends = np.cumsum(np.bincount(of, minlength=n + 1)[1:])
+    out = [np.stack([rows[m], cols[m]], axis=1) for m in np.split(order, ends[:-1])
+           if len(m) >= min_cells]
+    out.sort(key=lambda c: (int(c[0, 0]), int(c[0, 1])))
+    return out
+
+
+def next_edge(occ: OccupancyMap, dist: np.ndarray, avoid: Sequence[tuple[float, float]],
+              forget: float, min_edge: float) -> tuple[Goal, tuple[float, float]] | None:
+    """The open edge whose nearest cell (along the floor; raster order on ties) is nearest,
+    skipping edges whose nearest cell lies within ``forget`` of a point of ``avoid``: the
+    goal (``edge:ROW-COL``, its cells) and that cell; None when none is left."""
+    best: tuple[float, Goal, tuple[float, float]] | None = None
+    min_cells = max(1, int(round(min_edge / occ.resolution)))
+    for cells in open_edges(occ, dist, min_cells):
+        d = dist[cells[:, 0], cells[:, 1]]
+        i = int(np.argmin(d))
+        r, c = int(cells[i, 0]), int(cells[i, 1])
+        x, y = occ.grid.center_of(r, c)
+        cell = (float(x), float(y))
+        if any(math.dist(cell, p) <= forget for p in avoid):
+            continue
+        if best is None or float(d[i]) < best[0] - 1e-9:
+            xs, ys = occ.grid.center_of(cells[:, 0], cells[:, 1])
+            goal = Goal(f"edge:{r}-{c}", "cells", np.stack([xs, ys], axis=1))
+            best = (float(d[i]), goal, cell)
+    return None if best is None else (best[1], best[2])

@@ -17,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 from support.scripted_planner import Scripted
@@ -24,6 +25,9 @@ from support.scripted_planner import Scripted
 from sgtool.cli import cli
 from sgtool.datasets.generator import generate_house
 from sgtool.log import LogReader
+from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from sgtool.mapping.live_paths import traversable
+from sgtool.mapping.occupancy import geodesic_distances
 from sgtool.planning.base import Action
 from sgtool.planning.candidates import actionable
 from sgtool.planning.registry import make_planner
@@ -35,8 +39,11 @@ from sgtool.recorders.sim.fallback_explore import (
     FallbackRun,
     is_fallback,
     new_candidates,
+    next_edge,
+    open_edges,
 )
 from sgtool.scenegraph.builder import SceneGraphBuilder
+from sgtool.scenegraph.frontiers import find_frontiers
 
 OPTS = ClosedLoopOptions(camera=CameraConfig(width=96, height=72), frames=900)
 GRAPH = "/sgtool/scene_graph"
@@ -288,3 +295,59 @@ def test_bump_marks_that_wall_off_every_goal_are_forgotten(house, tmp_path,
     rep, p, extra = ends[True]  # the marks dropped: the goals are on offer again
     assert rep.end != "gave_up" and actionable(p.graphs[1])
     assert extra["bumps_forgotten"] == 1
+
+
+def _pocket_grid() -> OccupancyGrid:
+    """A walled 2 x 3 m room at 5 cm, its floor seen but for an unknown pocket of 0.3 m^2
+    (12 x 10 cells) in the middle: under the scene graph's ``min_pocket`` (0.5 m^2), so
+    the frontier rule finds nothing there."""
+    g = np.full((60, 40), FREE, dtype=np.int8)
+    g[24:36, 15:25] = UNKNOWN
+    g[:, 0] = g[:, -1] = g[0, :] = g[-1, :] = OCCUPIED
+    return OccupancyGrid(g, (0.0, 0.0), 0.05)
+
+
+def test_open_edges_where_the_frontier_rule_finds_none() -> None:
+    grid = _pocket_grid()
+    start = (1.0, 0.5)
+    assert find_frontiers(grid, start) == []
+    occ = traversable(grid, 0.2, 0.25)
+    dist = geodesic_distances(occ, start)
+    edges = open_edges(occ, dist, 6)
+    assert len(edges) == 1  # the ring of reachable cells round the pocket (and in it)
+    rows, cols = edges[0][:, 0], edges[0][:, 1]
+    assert np.isfinite(dist[rows, cols]).all()
+    assert rows.min() == 23 and rows.max() == 36 and cols.min() == 14 and cols.max() == 25
+    pick = next_edge(occ, dist, [], 0.5, 0.3)
+    assert pick is not None
+    goal, cell = pick
+    r, c = (int(v) for v in occ.grid.cell_of(*cell))
+    assert goal.label == f"edge:{r}-{c}" and goal.kind == "cells"
+    assert dist[r, c] == dist[rows, cols].min() and r == 23  # the side facing the robot
+    # a place looked around from (or gone to) within ``forget``: no edge left to go to
+    assert next_edge(occ, dist, [cell], 0.5, 0.3) is None
+    assert open_edges(occ, dist, len(rows) + 1) == []  # shorter than min_edge: none
+    # seen floor all round, no unknown: no edge
+    seen = OccupancyGrid(np.where(grid.grid == UNKNOWN, FREE, grid.grid), (0.0, 0.0), 0.05)
+    occ2 = traversable(seen, 0.2, 0.25)
+    assert open_edges(occ2, geodesic_distances(occ2, start), 1) == []
+
+
+def test_a_cluttered_room_is_explored_not_given_up(tmp_path) -> None:
+    """House 5 of the closed-loop bench (8-16 rooms, symsearch), episode 4 at 160x120:
+    the random planner opens the door out of the start room into a bedroom whose floor is
+    fringed with glimpses of a bed; the graph then offers nothing and has no frontier the
+    robot can reach, and the episode used to end ``gave_up`` after 4 steps. The fallback
+    goes to an open edge of the bedroom instead and the magazine comes into view."""
+    from sgtool.analysis.bench_houses import bench_episodes, generated_houses
+
+    spec = generated_houses(6, 0)[5].load((8, 16), "symsearch")
+    ep = bench_episodes(spec, 6, "symsearch")[4]
+    assert ep.query == "magazine"
+    out = tmp_path / "magazine.mcap"
+    rep = run_episode(spec, ep, make_planner("random"), out,
+                      ClosedLoopOptions(camera=CameraConfig(width=160, height=120)),
+                      house_id="house-5", episode_index=4)
+    edges = [a for a in _actions(out) if str(a["target"]).startswith("edge:")]
+    assert edges and all(is_fallback(a["reason"]) for a in edges)
+    assert rep.end == "found" and rep.success
