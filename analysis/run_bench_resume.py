@@ -40,7 +40,8 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
             "turn_render_deg": float(opts.turn_render_deg),
             "navigation": opts.navigation, "noise": parse_noise(noise).to_dict(),
             "seed": opts.planner_seed, "success": opts.success,
-            "classifier": opts.classifier, "explore_on": opts.explore_on}
+            "classifier": opts.classifier, "explore_on": opts.explore_on,
+            "look_in": float(opts.live.look_in) if opts.navigation == "live" else None}
 
 
 def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
@@ -66,7 +67,11 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              # logs from before the default changed recorded no other classifier
              "classifier": (x.get("mapping") or {}).get("classifier", "containment"),
              # logs from before explores went on: an explore ended where it was sent
-             "explore_on": x.get("explore_on", 0)}, house)
+             "explore_on": x.get("explore_on", 0),
+             # logs from before the robot looked into what it opened: it stayed there
+             "look_in": (float((x.get("navigation") or {}).get("look_in", 0.0))
+                         if (x.get("navigation") or {}).get("mode") == "live" else None)},
+            house)
 
 
 def same_house(logged: str | None, spec: HouseSpec) -> bool:
@@ -89,7 +94,8 @@ _LABELS = {"episode": "episode", "max_steps": "max steps", "frame_budget": "fram
            "size": "resolution", "render_step_m": "render step (m)",
            "turn_render_deg": "turn render angle (deg)", "navigation": "navigation",
            "noise": "noise", "seed": "seed", "success": "success rule",
-           "classifier": "room classifier", "explore_on": "explore on (frontiers)"}
+           "classifier": "room classifier", "explore_on": "explore on (frontiers)",
+           "look_in": "look in (m)"}
 
 
 def settings_differences(logged: dict[str, Any], want: dict[str, Any]) -> list[str]:

@@ -23,6 +23,7 @@ from sgtool.recorders.sim.events import StopSimulation
 from sgtool.recorders.sim.live_skills import IN_VIEW, Goal, LiveSkills, goal_of_node
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome
 from sgtool.recorders.sim.skill_plan import SkillCall
+from sgtool.scenegraph.graph import ObjectNode
 from sgtool.scenegraph.stream import Refresh
 
 
@@ -67,6 +68,9 @@ def execute_live(sim: Simulation, skills: LiveSkills, calls: Sequence[SkillCall]
                 assert isinstance(c.target, int)
                 out = getattr(skills.body, c.skill)(c.target)
                 outcome, reason = out.outcome, out.reason
+                at = _container_at(c, decided) if c.skill == "open" else None
+                if outcome == "success" and at is not None:
+                    outcome, reason, _ = skills.look_in(at)
             else:
                 goal = _goal(c, decided)
                 run = skills.explore if c.skill == "explore" else skills.navigate
@@ -77,6 +81,15 @@ def execute_live(sim: Simulation, skills: LiveSkills, calls: Sequence[SkillCall]
         return Executed("failure", f"stopped: {e}", sim.travelled_m - d0,
                         sim.tick_index - t0, True)
     return Executed(outcome, reason, sim.travelled_m - d0, sim.tick_index - t0, False)
+
+
+def _container_at(call: SkillCall, decided: Refresh | None) -> tuple[float, float] | None:
+    """Where the object node of ``call`` is in the graph decided on (None: a door, or no
+    such node): the container an ``open`` looks into."""
+    node = None if decided is None or call.node is None else decided.graph.node(call.node)
+    if not isinstance(node, ObjectNode):
+        return None
+    return float(node.position[0]), float(node.position[1])
 
 
 def _goal(call: SkillCall, decided: Refresh | None) -> Goal:

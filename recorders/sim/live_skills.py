@@ -35,6 +35,13 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   way, and stops when a refresh during the turn shows no cell known that was not before.
   Where a look-around ended so (not cut short by the target or the frame budget) is kept
   in :attr:`LiveSkills.looked`: looking again from there shows nothing new.
+- **Looking in** (off by default). After opening a container the robot stands within
+  reach of it, too near for the tilted camera to see its lower shelves (and the swung
+  panel may hide the rest); with ``look_in`` > 0, :meth:`LiveSkills.look_in` backs it off,
+  still facing the container, to ``look_in`` metres from the container's node, as far as
+  its map leaves the floor free behind it, so the frames show what the opening revealed.
+  Off because at 1.4 m it found no more targets in 36 episodes and its metres lowered
+  SPL (docs/experiments/issue30-closed-loop.md).
 - **Stopping early.** ``stop_when`` (the closed loop's: the target is in the graph) is
   asked at every refresh during a skill; when it says so the skill ends there, a success
   with reason :data:`IN_VIEW`.
@@ -90,12 +97,15 @@ class LiveNavConfig:
     max_replans: int = 60
     max_contacts: int = 3
     sealed_m2: float = 2.0  # bump marks leaving the robot less floor are dropped, oldest first
+    look_in: float = 0.0  # m from an opened container the robot backs off to (0: stays)
 
     def __post_init__(self) -> None:
         if not 0 <= self.optimistic <= 2.0:
             raise SgtoolError(f"optimistic margin {self.optimistic} m: must be 0..2")
         if not 0.0 <= self.sealed_m2 <= 100.0:
             raise SgtoolError(f"sealed area {self.sealed_m2} m2: must be 0..100")
+        if not (0.0 <= self.look_in <= 3.0):
+            raise SgtoolError(f"look-in distance {self.look_in} m: must be 0..3")
         if self.max_replans < 1 or self.max_contacts < 0:
             raise SgtoolError("max re-plans must be >= 1 and max contacts >= 0")
 
@@ -103,7 +113,7 @@ class LiveNavConfig:
         return {"optimistic": self.optimistic, "snap": self.snap,
                 "frontier_snap": self.frontier_snap, "slack": self.slack,
                 "max_replans": self.max_replans, "max_contacts": self.max_contacts,
-                "sealed_m2": self.sealed_m2}
+                "sealed_m2": self.sealed_m2, "look_in": self.look_in}
 
 
 class RobotBody:
@@ -347,6 +357,41 @@ class LiveSkills:
                 return "success", "", driven
         return ("failure", f"{goal.label} not reached after {cfg.max_replans} re-plans",
                 driven)
+
+    def look_in(self, at: tuple[float, float]) -> tuple[Outcome, str, float]:
+        """Back straight away from ``at`` (module doc: looking in), keeping the heading,
+        until ``config.look_in`` metres from it, a cell blocked on the robot's map, or a
+        contact: (outcome, reason, metres); always a success (IN_VIEW when the target
+        came into view)."""
+        body = self.body
+        x, y, yaw = body.base
+        away = math.dist((x, y), at)
+        ref = self.current()
+        planned = None if ref is None else self.plan_map(ref)
+        if self.config.look_in <= away or planned is None:
+            return "success", "", 0.0
+        occ = planned[0]
+        step = body.config.speed / body.fps
+        ux, uy = x - at[0], y - at[1]
+        n = math.hypot(ux, uy)
+        if n < 1e-9:
+            ux, uy = -math.cos(yaw), -math.sin(yaw)
+        else:
+            ux, uy = ux / n, uy / n
+        driven = 0.0
+        for k in range(1, int(math.ceil((self.config.look_in - away) / step)) + 1):
+            s = min(k * step, self.config.look_in - away)
+            p = (x + ux * s, y + uy * s, yaw)
+            r, c = occ.grid.cell_of(p[0], p[1])
+            if not occ.in_bounds(int(r), int(c)) or occ.blocked[int(r), int(c)]:
+                break
+            d, hit = body.drive([p])
+            driven += d
+            if self._stop():
+                return "success", IN_VIEW, driven
+            if hit:
+                break
+        return "success", "", driven
 
     def explore(self, goal: Goal) -> tuple[Outcome, str, float]:
         """Go to ``goal`` and look around there."""

@@ -106,3 +106,9 @@ def test_a_log_of_other_frame_settings_is_not_resumed(tmp_path: Path) -> None:
     assert settings_differences(
         logged, task_settings(dataclasses.replace(opts, explore_on=3), "none", ep)) \
         == ["explore on (frontiers): 0 in the log, 3 now"]
+    # and how far the robot backs off from what it opened
+    assert logged["look_in"] == 0.0
+    assert settings_differences(
+        logged, task_settings(dataclasses.replace(
+            opts, live=dataclasses.replace(opts.live, look_in=1.4)), "none", ep)) \
+        == ["look in (m): 0.0 in the log, 1.4 now"]

@@ -323,6 +323,17 @@ def explore_on_option() -> Callable[[F], F]:
              "in the papers).")
 
 
+def look_in_option() -> Callable[[F], F]:
+    """``--look-in M`` of the closed-loop commands
+    (:attr:`sgtool.recorders.sim.live_skills.LiveNavConfig.look_in`)."""
+    return click.option(
+        "--look-in", type=click.FloatRange(0.0, 3.0), default=0.0, show_default=True,
+        metavar="M",
+        help="live navigation: after opening a container the robot backs off, facing it, "
+             "to M metres from it (its map permitting) so the camera sees what the opening "
+             "revealed, e.g. 1.4 (0: it stays where it opened it).")
+
+
 def executor_options(what: str) -> Callable[[F], F]:
     """``--executor local|ray``, ``--workers/-w N`` and ``--ray-address`` of the batch
     commands (:func:`sgtool.analysis.executor.make_executor`); ``what`` names the tasks."""

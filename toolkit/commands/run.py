@@ -23,6 +23,7 @@ from sgtool.commands.options import (
     list_planners_option,
     llm_endpoint_options,
     llm_log_options,
+    look_in_option,
     run_planner_options,
     success_option,
 )
@@ -75,6 +76,7 @@ if TYPE_CHECKING:
               "the simulator plans on the house's ground truth (the privileged behaviour "
               "before, for comparison).")
 @explore_on_option()
+@look_in_option()
 @click.option("--optimistic", type=float, default=0.25, show_default=True, metavar="M",
               help="live navigation: how far (m) past known free floor a path may run into "
               "unknown space (at frontiers).")
@@ -164,6 +166,7 @@ class RunArgs:
     llm_timeout: float | None = None
     rerun_to: str | None = None
     explore_on: int = 0
+    look_in: float = 0.0
 
 
 def _planner(args: RunArgs) -> tuple[str, dict[str, Any]]:
@@ -219,7 +222,8 @@ def _request(args: RunArgs, out: Path) -> SearchRequest:
         classifier=args.classifier, min_points=args.min_points, max_steps=args.max_steps,
         frames=frame_budget(args.frames, args.frames_per_room, len(house.rooms)),
         planner_seed=args.planner_seed, navigation=args.navigation, success=args.success,
-        noise=parse_noise(args.noise), live=LiveNavConfig(optimistic=args.optimistic),
+        noise=parse_noise(args.noise), live=LiveNavConfig(optimistic=args.optimistic,
+                                                             look_in=args.look_in),
         explore_on=args.explore_on)
     return SearchRequest(house=house, house_id=house_id, episode_index=index, episode=ep,
                          planner=name, output=out, options=opts, planner_options=options,

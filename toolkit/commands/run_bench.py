@@ -16,6 +16,7 @@ from sgtool.commands.options import (
     explore_on_option,
     list_planners_option,
     llm_endpoint_options,
+    look_in_option,
     parse_resolution,
     parse_rooms,
     planner_names,
@@ -66,6 +67,7 @@ if TYPE_CHECKING:
 @click.option("--every", type=click.IntRange(min=1), default=10, show_default=True,
               help="Refresh the scene graph every K frames (and at every action).")
 @explore_on_option()
+@look_in_option()
 @click.option("--navigation", type=click.Choice(["live", "house"]), default="live",
               show_default=True,
               help="live: skills plan on the robot's own map; house: on the ground truth "
@@ -159,6 +161,7 @@ class RunBenchArgs:
     symbolic_dir: str | None = None
     with_symbolic: bool = False
     explore_on: int = 0
+    look_in: float = 0.0
 
 
 def _request(args: RunBenchArgs) -> RunBenchRequest:
@@ -199,6 +202,7 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
     from sgtool.analysis.closed_loop_bench import ClosedLoopBenchConfig
     from sgtool.recorders.sim import CameraConfig
     from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
+    from sgtool.recorders.sim.live_skills import LiveNavConfig
 
     names = planner_names(args.planners) if args.planners else DEFAULT_PLANNERS
     if args.max_steps < 1:
@@ -207,7 +211,8 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
     opts = ClosedLoopOptions(camera=CameraConfig(width=width, height=height),
                              every=args.every, max_steps=args.max_steps, frames=args.frames,
                              navigation=args.navigation, success=args.success,
-                             explore_on=args.explore_on)
+                             explore_on=args.explore_on,
+                             live=LiveNavConfig(look_in=args.look_in))
     options = planner_options(args.planner_option, names)
     LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
                 args.llm_timeout).fill(options, names)

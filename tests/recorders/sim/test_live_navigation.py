@@ -13,6 +13,7 @@ default.)
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import pytest
@@ -20,11 +21,18 @@ from support.scripted_planner import Scripted
 
 from sgtool.datasets.generator import generate_house
 from sgtool.log import LogReader
+from sgtool.log.codec import decode_transform
 from sgtool.planning.base import Action
+from sgtool.planning.candidates import actionable
 from sgtool.planning.registry import make_planner
 from sgtool.recorders.sim import CameraConfig, Simulation
-from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
-from sgtool.recorders.sim.live_skills import PrivilegedAccess, RobotBody
+from sgtool.recorders.sim.closed_loop import (
+    ClosedLoopOptions,
+    list_episodes,
+    pick_episode,
+    run_episode,
+)
+from sgtool.recorders.sim.live_skills import LiveNavConfig, PrivilegedAccess, RobotBody
 
 OPTS = ClosedLoopOptions(camera=CameraConfig(width=160, height=120))
 
@@ -43,7 +51,7 @@ def test_unreachable_goal_fails_with_its_reason_in_the_log(house, tmp_path) -> N
     # episode 0 starts in a room whose only door to room:1 is closed: after the look
     # around the graph knows room:1 through that door, but the map holds no way there
     idx, ep = pick_episode(house, index=0)
-    p = Scripted([_unexplored_room, Action("done")])
+    p = Scripted([_unexplored_room] + [Action("done")] * 20)  # give-ups may hand over
     out = tmp_path / "unreachable.mcap"
     run_episode(house, ep, p, out, OPTS, episode_index=idx)
     fb = p.feedbacks[0]
@@ -57,7 +65,7 @@ def test_unreachable_goal_fails_with_its_reason_in_the_log(house, tmp_path) -> N
     assert acts[1]["reason"] == fb.message
     assert started["extra"]["navigation"]["mode"] == "live"
     # the privileged simulator planned on the whole house and knew why
-    p2 = Scripted([_unexplored_room, Action("done")])
+    p2 = Scripted([_unexplored_room] + [Action("done")] * 20)
     run_episode(house, ep, p2, tmp_path / "house.mcap",
                 ClosedLoopOptions(camera=OPTS.camera, navigation="house"), episode_index=idx)
     assert "behind closed door" in p2.feedbacks[0].message
@@ -93,3 +101,47 @@ def test_the_robot_body_has_no_house_and_contacts_stop_it(house) -> None:
         assert hit and 0 < driven < 20.0
         assert not sim.in_contact() and sim.in_contact(poses[round(driven / 0.05)])
         assert math.isclose(sim.travelled_m, driven)
+
+
+
+def _open_first_container(g):
+    cands = [c for c in actionable(g) if c.skill == "open" and c.node_id.startswith("obj:")]
+    return Action("open", cands[0].node_id) if cands else Action("done")
+
+
+def _last_pose(path) -> tuple[float, float, float]:
+    with LogReader(path) as r:
+        last = [m.message for m in r.messages(["/tf"])][-1]
+    t = decode_transform(last)
+    return float(t[0, 3]), float(t[1, 3]), math.atan2(t[1, 0], t[0, 0])
+
+
+def test_after_opening_a_container_the_robot_backs_off_to_look_in(house, tmp_path) -> None:
+    """The open skill ends within reach of the container, too near for the tilted camera
+    to see its lower shelves; with ``look_in`` the robot then backs straight off, still
+    facing it, to ``look_in`` metres from the container's node (its map permitting)."""
+    ends = {}
+    for look in (0.0, 1.4):
+        opts = dataclasses.replace(OPTS, live=LiveNavConfig(look_in=look), max_steps=1)
+        for k in range(len(list_episodes(house))):
+            idx, ep = pick_episode(house, index=k)
+            p = Scripted([_open_first_container, Action("done")])
+            out = tmp_path / f"open-{look}-{k}.mcap"
+            run_episode(house, ep, p, out, opts, episode_index=idx)
+            fb = p.feedbacks[0] if p.feedbacks else None
+            if fb is not None and fb.action.skill == "open" and fb.outcome == "success":
+                break
+        else:
+            pytest.fail("no episode of the house opens a container first")
+        with LogReader(out) as r:
+            started = next(r.records("episode"))[1]
+        assert started["extra"]["navigation"]["look_in"] == look
+        node = p.graphs[0].node(fb.action.target)
+        x, y, yaw = _last_pose(out)
+        ends[look] = (k, math.dist((x, y), node.position[:2]),
+                      math.atan2(node.position[1] - y, node.position[0] - x) - yaw)
+    k0, stand, _ = ends[0.0]
+    k1, backed, off = ends[1.4]
+    assert k0 == k1  # the same episode, the same container
+    assert stand < 1.3 and stand + 0.1 < backed <= 1.4 + 1e-6
+    assert abs(math.atan2(math.sin(off), math.cos(off))) < math.radians(10)  # facing it
