@@ -40,8 +40,7 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   panel may hide the rest); with ``look_in`` > 0, :meth:`LiveSkills.look_in` backs it off,
   still facing the container, to ``look_in`` metres from the container's node, as far as
   its map leaves the floor free behind it, so the frames show what the opening revealed.
-  Off because at 1.4 m it found no more targets in 36 episodes and its metres lowered
-  SPL (docs/experiments/issue30-closed-loop.md).
+  Off by default: its measured cost and effect are in the project's experiment notes.
 - **Stopping early.** ``stop_when`` (the closed loop's: the target is in the graph) is
   asked at every refresh during a skill; when it says so the skill ends there, a success
   with reason :data:`IN_VIEW`.
