@@ -105,7 +105,8 @@ class Fallback:
     gone_to: list[tuple[float, float]] = field(default_factory=list)  # goal cells so far
 
     def can_explore(self) -> bool:
-        """The robot's map has a reachable grid frontier not gone to before."""
+        """The robot's map has a reachable grid frontier (or open edge) not gone to
+        before."""
         ref = self.skills.current()
         return ref is not None and ref.layers is not None and self._next(ref) is not None
 
