@@ -44,6 +44,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import ndimage
 
+from sgtool.mapping.holes import near
 from sgtool.mapping.occupancy import OccupancyMap
 from sgtool.planning.candidates import Candidate, actionable
 from sgtool.planning.memory import SAME_PLACE_M
@@ -159,7 +160,7 @@ def open_edges(occ: OccupancyMap, dist: np.ndarray, min_cells: int) -> list[np.n
     raster order of their first cell."""
     reach = np.isfinite(dist)
     unknown = occ.grid.unknown
-    edge = reach & ndimage.binary_dilation(unknown, structure=np.ones((3, 3), bool))
+    edge = reach & near(unknown)
     lab, n = ndimage.label(edge, structure=np.ones((3, 3), bool))
     rows, cols = np.nonzero(lab)  # raster order
     of = lab[rows, cols]
