@@ -365,9 +365,11 @@ class LiveSkills:
         body = self.body
         x, y, yaw = body.base
         away = math.dist((x, y), at)
+        if self.config.look_in <= away:  # off (0), or far enough already: no map needed
+            return "success", "", 0.0
         ref = self.current()
         planned = None if ref is None else self.plan_map(ref)
-        if self.config.look_in <= away or planned is None:
+        if planned is None:
             return "success", "", 0.0
         occ = planned[0]
         step = body.config.speed / body.fps
