@@ -110,6 +110,7 @@ SMOKE: dict[str, Smoke] = {
     "tools/closed_loop_failures.py": Smoke(("{tmp}", "{tmp}")),
     "tools/closed_loop_vs_symbolic.py": Smoke(("{bench}", "{bench}")),
     "tools/mutations.py": Smoke(("--list",)),
+    "tools/open_reveals.py": Smoke(("{bench}",)),
     "tools/run_bench_ab.py": Smoke(("{bench}", "{bench}", "--json", "{tmp}/ab.json")),
 }
 

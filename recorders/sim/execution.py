@@ -70,7 +70,7 @@ def execute_live(sim: Simulation, skills: LiveSkills, calls: Sequence[SkillCall]
                 outcome, reason = out.outcome, out.reason
                 at = _container_at(c, decided) if c.skill == "open" else None
                 if outcome == "success" and at is not None:
-                    outcome, reason, _ = skills.look_in(at)
+                    outcome, reason, _ = skills.look_in(at, str(c.node))
             else:
                 goal = _goal(c, decided)
                 run = skills.explore if c.skill == "explore" else skills.navigate

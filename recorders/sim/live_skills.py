@@ -36,11 +36,13 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   Where a look-around ended so (not cut short by the target or the frame budget) is kept
   in :attr:`LiveSkills.looked`: looking again from there shows nothing new.
 - **Looking in** (off by default). After opening a container the robot stands within
-  reach of it, too near for the tilted camera to see its lower shelves (and the swung
-  panel may hide the rest); with ``look_in`` > 0, :meth:`LiveSkills.look_in` backs it off,
-  still facing the container, to ``look_in`` metres from the container's node, as far as
-  its map leaves the floor free behind it, so the frames show what the opening revealed.
-  Off by default: its measured cost and effect are in the project's experiment notes.
+  reach of it, too near for the tilted camera to see its lower shelves, and often beside
+  its front, looking at a side board; with ``look_in`` > 0, :meth:`LiveSkills.look_in`
+  drives it to ``look_in`` metres from the container's node in front of its opening as
+  its map shows it (:func:`~sgtool.mapping.live_paths.view_goal`: the middle of the
+  widest fan of open directions round the container) and turns it to face the container,
+  so the frames show what the opening revealed. Off by default: its measured cost and
+  effect are in the project's experiment notes.
 - **Stopping early.** ``stop_when`` (the closed loop's: the target is in the graph) is
   asked at every refresh during a skill; when it says so the skill ends there, a success
   with reason :data:`IN_VIEW`.
@@ -63,6 +65,7 @@ from sgtool.mapping.live_paths import (
     point_goal,
     stand_goal,
     traversable,
+    view_goal,
 )
 from sgtool.mapping.occupancy import OccupancyMap, geodesic_distances
 from sgtool.planning.base import Outcome
@@ -181,15 +184,17 @@ _BODIES: weakref.WeakKeyDictionary[RobotBody, Simulation] = weakref.WeakKeyDicti
 @dataclass(frozen=True, eq=False)
 class Goal:
     """Where a skill goes: ``kind`` "stand" (within reach of ``points[0]``, facing it),
-    "point" (the reachable cell nearest ``points[0]``) or "cells" (the nearest reachable of
-    ``points``, a frontier's cluster)."""
+    "view" (where a container at ``points[0]`` is seen whole, facing it:
+    :func:`~sgtool.mapping.live_paths.view_goal`), "point" (the reachable cell nearest
+    ``points[0]``) or "cells" (the nearest reachable of ``points``, a frontier's
+    cluster)."""
 
     label: str
     kind: str
     points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
 
     def face(self) -> tuple[float, float] | None:
-        if self.kind != "stand":
+        if self.kind not in ("stand", "view"):
             return None
         return float(self.points[0, 0]), float(self.points[0, 1])
 
@@ -304,6 +309,8 @@ class LiveSkills:
         if goal.kind == "stand":
             return stand_goal(occ, dist, goal.points[0], self.body.config.reach - 0.05,
                               cfg.slack)
+        if goal.kind == "view":
+            return view_goal(occ, dist, goal.points[0], cfg.look_in)
         return point_goal(occ, dist, goal.points[0], cfg.snap)
 
     # ----- skills -----------------------------------------------------------------------
@@ -357,42 +364,24 @@ class LiveSkills:
         return ("failure", f"{goal.label} not reached after {cfg.max_replans} re-plans",
                 driven)
 
-    def look_in(self, at: tuple[float, float]) -> tuple[Outcome, str, float]:
-        """Back straight away from ``at`` (module doc: looking in), keeping the heading,
-        until ``config.look_in`` metres from it, a cell blocked on the robot's map, or a
-        contact: (outcome, reason, metres); always a success (IN_VIEW when the target
-        came into view)."""
-        body = self.body
-        x, y, yaw = body.base
-        away = math.dist((x, y), at)
-        if self.config.look_in <= away:  # off (0), or far enough already: no map needed
+    def look_in(self, at: tuple[float, float], label: str = "container"
+                ) -> tuple[Outcome, str, float]:
+        """Drive to where the opened container at ``at`` is seen whole (module doc: looking
+        in), facing it: (outcome, reason, metres); always a success (IN_VIEW when the
+        target came into view), since the opening is done whether or not the robot gets
+        there."""
+        if self.config.look_in <= 0.0:  # off: no map needed
             return "success", "", 0.0
         ref = self.current()
         planned = None if ref is None else self.plan_map(ref)
         if planned is None:
             return "success", "", 0.0
-        occ = planned[0]
-        step = body.config.speed / body.fps
-        ux, uy = x - at[0], y - at[1]
-        n = math.hypot(ux, uy)
-        if n < 1e-9:
-            ux, uy = -math.cos(yaw), -math.sin(yaw)
-        else:
-            ux, uy = ux / n, uy / n
-        driven = 0.0
-        for k in range(1, int(math.ceil((self.config.look_in - away) / step)) + 1):
-            s = min(k * step, self.config.look_in - away)
-            p = (x + ux * s, y + uy * s, yaw)
-            r, c = occ.grid.cell_of(p[0], p[1])
-            if not occ.in_bounds(int(r), int(c)) or occ.blocked[int(r), int(c)]:
-                break
-            d, hit = body.drive([p])
-            driven += d
-            if self._stop():
-                return "success", IN_VIEW, driven
-            if hit:
-                break
-        return "success", "", driven
+        goal = Goal(f"a view into {label}", "view", np.array([at], dtype=np.float64))
+        there = self.select(goal, *planned)
+        if there is None or math.dist(there, self.body.base[:2]) <= planned[0].resolution:
+            return "success", "", 0.0
+        outcome, why, driven = self.navigate(goal)
+        return "success", (IN_VIEW if outcome == "success" and why == IN_VIEW else ""), driven
 
     def explore(self, goal: Goal) -> tuple[Outcome, str, float]:
         """Go to ``goal`` and look around there."""

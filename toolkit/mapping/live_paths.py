@@ -25,7 +25,11 @@ the robot, ties by the lowest row, then column):
   cells within ``snap`` metres of them;
 - :func:`point_goal`: the reachable cell nearest (straight line) to a point, within ``snap``;
 - :func:`stand_goal`: a place to stand at an object known only by its position: the
-  reachable cells nearest to it, of which the one nearest along the floor.
+  reachable cells nearest to it, of which the one nearest along the floor;
+- :func:`view_goal`: a place to look into a container from: ``distance`` m from it, in
+  the middle of the widest fan of directions in which the map is open from the
+  container's own blocked cells out to that distance (a piece stands with its back to a
+  wall and its sides often against others, so the open fan faces its front).
 
 :func:`descend` reads a shortest cell path off a distance field (steepest descent from
 the goal to the robot), so one Dijkstra run serves both the goal choice and the path.
@@ -134,6 +138,68 @@ def stand_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], reach: 
         return None
     best = float(d[ok].min())
     return _argmin(occ, np.where(ok & (d <= best + slack + 1e-9), dist, np.inf))
+
+
+VIEW_DIRECTIONS = 36  # directions tried round a container by view_goal (10 degrees apart)
+
+
+def view_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], distance: float,
+              exit_within: float = 0.8) -> tuple[float, float] | None:
+    """Where to look into a container at ``xy`` from (module doc): of
+    :data:`VIEW_DIRECTIONS` rays from ``xy``, a ray is *open* when, after leaving the
+    blocked cells round ``xy`` within ``exit_within`` m (the container and the robot-radius
+    margin about it), every cell it crosses out to ``distance`` m is free and the cell at
+    ``distance`` is reachable. The result is the end of the ray bisecting the widest
+    circular run of open rays (when that ray is not open itself, the end of the run's
+    middle ray; of equally wide runs, the one whose end is nearest along the floor; all
+    rays open: the nearest end of any). None when no ray is open."""
+    n = VIEW_DIRECTIONS
+    radii = np.arange(0.0, distance + 1e-9, occ.resolution / 2.0)
+    if radii.size == 0 or radii[-1] < distance - 1e-9:
+        radii = np.append(radii, distance)
+
+    def end_of(angle: float) -> tuple[int, int] | None:
+        rows, cols = _cells_of(occ, np.stack([xy[0] + radii * math.cos(angle),
+                                              xy[1] + radii * math.sin(angle)], axis=1))
+        if rows.size != radii.size:  # leaves the grid
+            return None
+        blocked = occ.blocked[rows, cols]
+        free = np.flatnonzero(~blocked)
+        if free.size == 0 or radii[free[0]] > exit_within + 1e-9 \
+                or blocked[free[0]:].any() or not math.isfinite(dist[rows[-1], cols[-1]]):
+            return None
+        return int(rows[-1]), int(cols[-1])
+
+    ends = [end_of(2.0 * math.pi * k / n) for k in range(n)]
+    open_ = [e is not None for e in ends]
+    if not any(open_):
+        return None
+    if all(open_):
+        runs = [(k, 1) for k in range(n)]
+    else:
+        runs = []
+        k, start = 0, open_.index(False) + 1  # runs start after a closed ray
+        while k < n:
+            if not open_[(start + k) % n]:
+                k += 1
+                continue
+            first, length = (start + k) % n, 0
+            while k < n and open_[(start + k) % n]:
+                length, k = length + 1, k + 1
+            runs.append((first, length))
+    widest = max(length for _, length in runs)
+    best: tuple[float, int, int] | None = None
+    for first, length in runs:
+        if length != widest:
+            continue
+        end = end_of(2.0 * math.pi * (first + (length - 1) / 2.0) / n) \
+            or ends[(first + (length - 1) // 2) % n]
+        assert end is not None
+        key = (float(dist[end]), end[0], end[1])
+        if best is None or key < best:
+            best = key
+    assert best is not None
+    return _centre(occ, best[1], best[2])
 
 
 def _centres(occ: OccupancyMap) -> tuple[np.ndarray, np.ndarray]:

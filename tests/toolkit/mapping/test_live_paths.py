@@ -17,11 +17,13 @@ from support.path_lengths import path_length
 
 from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.live_paths import (
+    VIEW_DIRECTIONS,
     descend,
     nearest_reachable,
     point_goal,
     stand_goal,
     traversable,
+    view_goal,
 )
 from sgtool.mapping.occupancy import geodesic_distances
 
@@ -106,3 +108,51 @@ def test_goals_on_the_live_map() -> None:
                  for r, c in zip(*np.nonzero(np.isfinite(dist)), strict=True))
     assert math.dist(stand, (2.45, 1.55)) <= d_best + 0.1 + 1e-9
     assert stand_goal(occ, dist, (2.45, 1.55), reach=0.1) is None
+
+
+def kitchen_row(neighbours: bool = True) -> OccupancyGrid:
+    """A 4 x 4 m room (10 cm cells, walls round it) with a 0.8 x 0.8 m fridge against its
+    top wall (x 1.6..2.4, y 3.1..3.9), and with ``neighbours`` a counter on either side of
+    it along the wall (x 0.1..1.6 and 2.4..3.9, 0.6 m deep)."""
+    g = np.full((40, 40), FREE, np.int8)
+    g[0, :] = g[-1, :] = OCCUPIED
+    g[:, 0] = g[:, -1] = OCCUPIED
+    g[31:39, 16:24] = OCCUPIED  # the fridge
+    if neighbours:
+        g[33:39, 1:16] = OCCUPIED
+        g[33:39, 24:39] = OCCUPIED
+    return OccupancyGrid(g, (0.0, 0.0), RES)
+
+
+@pytest.mark.parametrize("neighbours", [True, False])
+def test_a_container_is_looked_into_from_in_front_of_it(neighbours) -> None:
+    """With its back to the wall (and counters at its sides, or free floor there), the
+    open fan round the fridge faces the room: the view point is straight in front of it at
+    the asked distance, even for a robot standing off to its side."""
+    occ = traversable(kitchen_row(neighbours), robot_radius=0.25)
+    fridge = (2.0, 3.5)
+    dist = geodesic_distances(occ, (0.6, 2.2))  # beside the fridge, by the left counter
+    v = view_goal(occ, dist, fridge, 1.4)
+    assert v is not None
+    # in front (within one ray's spacing of straight down the room), not at the robot's
+    # side, at the distance asked (to a cell)
+    bearing = math.degrees(math.atan2(v[1] - fridge[1], v[0] - fridge[0]))
+    assert abs(bearing - -90.0) <= 360.0 / VIEW_DIRECTIONS
+    assert abs(math.dist(v, fridge) - 1.4) <= RES
+
+
+def test_a_free_standing_container_is_looked_into_from_the_nearest_side() -> None:
+    """Open all round (a box in the middle of the room): the view point nearest the robot
+    along the floor; boxed in (no ray leaves it): None."""
+    g = np.full((40, 40), FREE, np.int8)
+    g[0, :] = g[-1, :] = OCCUPIED
+    g[:, 0] = g[:, -1] = OCCUPIED
+    g[18:22, 18:22] = OCCUPIED  # a 0.4 m box at (2, 2)
+    occ = traversable(OccupancyGrid(g, (0.0, 0.0), RES), robot_radius=0.25)
+    dist = geodesic_distances(occ, (3.5, 2.0))  # east of it
+    v = view_goal(occ, dist, (2.0, 2.0), 1.0)
+    assert v is not None and v[0] > 2.9 and abs(v[1] - 2.0) <= RES
+    g[10:30, 10] = g[10:30, 30] = g[10, 10:31] = g[30, 10:31] = OCCUPIED  # a ring round it
+    occ = traversable(OccupancyGrid(g, (0.0, 0.0), RES), robot_radius=0.25)
+    dist = geodesic_distances(occ, (3.5, 2.0))
+    assert view_goal(occ, dist, (2.0, 2.0), 1.0) is None
