@@ -329,9 +329,10 @@ def look_in_option() -> Callable[[F], F]:
     return click.option(
         "--look-in", type=click.FloatRange(0.0, 3.0), default=0.0, show_default=True,
         metavar="M",
-        help="live navigation: after opening a container the robot backs off, facing it, "
-             "to M metres from it (its map permitting) so the camera sees what the opening "
-             "revealed, e.g. 1.4 (0: it stays where it opened it).")
+        help="live navigation: after opening a container the robot drives to M metres "
+             "from it, in front of its opening as its map shows it, and faces it, so the "
+             "camera sees what the opening revealed, e.g. 1.4 (0: it stays where it "
+             "opened it).")
 
 
 def executor_options(what: str) -> Callable[[F], F]:
