@@ -27,12 +27,10 @@ def target_holders(log: Path, query: str) -> set[int]:
     """Instance ids of the pieces that hold an object named ``query`` in ``log``'s last
     instance table."""
     with LogReader(log) as r:
-        table = None
-        for _, t in r.records(Instances, reverse=True):
-            table = t
-            break
-    if table is None:
+        last = next(r.records(Instances, reverse=True), None)
+    if last is None:
         return set()
+    table = last[1]
     return {int(i.parent) for i in table.instances
             if i.kind == "object" and i.category == query and isinstance(i.parent, int)}
 
