@@ -37,6 +37,7 @@ the goal to the robot), so one Dijkstra run serves both the goal choice and the 
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 
@@ -176,17 +177,14 @@ def view_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], distance
         return None
     if all(open_):
         runs = [(k, 1) for k in range(n)]
-    else:
+    else:  # from a closed ray round the circle: each group of open rays is a run
+        start = open_.index(False)
+        around = [(start + i) % n for i in range(n)]
         runs = []
-        k, start = 0, open_.index(False) + 1  # runs start after a closed ray
-        while k < n:
-            if not open_[(start + k) % n]:
-                k += 1
-                continue
-            first, length = (start + k) % n, 0
-            while k < n and open_[(start + k) % n]:
-                length, k = length + 1, k + 1
-            runs.append((first, length))
+        for is_open, group in itertools.groupby(around, key=lambda i: open_[i]):
+            if is_open:
+                g = list(group)
+                runs.append((g[0], len(g)))
     widest = max(length for _, length in runs)
     best: tuple[float, int, int] | None = None
     for first, length in runs:
