@@ -39,9 +39,10 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
             "render_step_m": float(opts.render_step_m),
             "turn_render_deg": float(opts.turn_render_deg),
             "navigation": opts.navigation, "noise": parse_noise(noise).to_dict(),
-            "seed": opts.planner_seed, "success": opts.success,
+            "seed": opts.planner_seed, "episode_seeds": True, "success": opts.success,
             "classifier": opts.classifier, "explore_on": opts.explore_on,
-            "look_in": float(opts.live.look_in) if opts.navigation == "live" else None}
+            "look_in": float(opts.live.look_in) if opts.navigation == "live" else None,
+            "peek": bool(opts.live.peek) if opts.navigation == "live" else None}
 
 
 def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
@@ -63,6 +64,8 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              "turn_render_deg": x.get("turn_render_deg"),
              "navigation": (x.get("navigation") or {}).get("mode", "house"),
              "noise": x.get("noise"), "seed": x.get("seed"),
+             # logs from before each episode drew its planner seed: all drew the run's
+             "episode_seeds": "planner_seed" in x,
              "success": x.get("success", "observed"),
              # logs from before the default changed recorded no other classifier
              "classifier": (x.get("mapping") or {}).get("classifier", "containment"),
@@ -70,7 +73,10 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              "explore_on": x.get("explore_on", 0),
              # logs from before the robot looked into what it opened: it stayed there
              "look_in": (float((x.get("navigation") or {}).get("look_in", 0.0))
-                         if (x.get("navigation") or {}).get("mode") == "live" else None)},
+                         if (x.get("navigation") or {}).get("mode") == "live" else None),
+             # logs from before the head tilted into containers: it never did
+             "peek": (bool((x.get("navigation") or {}).get("peek", False))
+                      if (x.get("navigation") or {}).get("mode") == "live" else None)},
             house)
 
 
@@ -93,9 +99,10 @@ def same_house(logged: str | None, spec: HouseSpec) -> bool:
 _LABELS = {"episode": "episode", "max_steps": "max steps", "frame_budget": "frame budget",
            "size": "resolution", "render_step_m": "render step (m)",
            "turn_render_deg": "turn render angle (deg)", "navigation": "navigation",
-           "noise": "noise", "seed": "seed", "success": "success rule",
+           "noise": "noise", "seed": "seed",
+           "episode_seeds": "planner seed per episode", "success": "success rule",
            "classifier": "room classifier", "explore_on": "explore on (frontiers)",
-           "look_in": "look in (m)"}
+           "look_in": "look in (m)", "peek": "peek into containers"}
 
 
 def settings_differences(logged: dict[str, Any], want: dict[str, Any]) -> list[str]:

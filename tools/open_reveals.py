@@ -1,5 +1,5 @@
-"""How often opening the container that holds the target shows it, per planner, in
-``sgtool run-bench`` output folders.
+"""How often opening the container that holds the target (or walking up to the piece that
+holds it) shows it, per planner, in ``sgtool run-bench`` output folders.
 
 The symbolic environment reveals a container's contents when it is opened; in the closed
 loop the robot's camera has to see them. For every ``open`` of a piece that holds the
@@ -7,7 +7,8 @@ target (the log's instance table: an object of the query's category whose parent
 piece) this counts whether the episode ended found on that action (the closed loop ends
 an episode at the first refresh whose graph shows the target, so a found episode's last
 action is the one that showed it). The rest were found later, from elsewhere, or not at
-all.
+all. Walking up to a piece that holds the target (``navigate``, which examines it) is
+counted the same way.
 
     .venv/bin/python tools/open_reveals.py RUN_DIR [RUN_DIR ...]
 """
@@ -35,22 +36,26 @@ def target_holders(log: Path, query: str) -> set[int]:
             if i.kind == "object" and i.category == query and isinstance(i.parent, int)}
 
 
-def reveals(result: EpisodeResult) -> tuple[int, int]:
-    """(opens of a piece holding the target, those that ended the episode found) of one
-    episode."""
+def reveals(result: EpisodeResult) -> dict[str, tuple[int, int]]:
+    """Per skill (``open``, ``navigate``: walking up to a piece examines it), the actions
+    on a piece holding the target in one episode and those that ended it found."""
+    out = {"open": (0, 0), "navigate": (0, 0)}
     if not Path(result.source).is_file():
-        return 0, 0
+        return out
     holders = target_holders(Path(result.source), result.query)
-    opens = shown = 0
     for k, step in enumerate(result.trace):
         node = step.target
-        if step.skill != "open" or not node or not node.startswith("obj:"):
+        if step.skill not in out or not node or not node.startswith("obj:"):
             continue
         if int(node.split(":", 1)[1]) not in holders:
             continue
-        opens += 1
-        shown += int(result.success and k == len(result.trace) - 1)
-    return opens, shown
+        n, s = out[step.skill]
+        out[step.skill] = (n + 1, s + int(result.success and k == len(result.trace) - 1))
+    return out
+
+
+WHAT = {"open": "opens of the target's container showed it",
+        "navigate": "walks up to the target's container or supporter showed it"}
 
 
 def main(argv: list[str]) -> int:
@@ -63,15 +68,15 @@ def main(argv: list[str]) -> int:
             print(f"{folder}: no episodes.jsonl (not a run-bench output folder)",
                   file=sys.stderr)
             return 2
-        opens: collections.Counter[str] = collections.Counter()
-        shown: collections.Counter[str] = collections.Counter()
+        acts: collections.Counter[tuple[str, str]] = collections.Counter()
+        shown: collections.Counter[tuple[str, str]] = collections.Counter()
         for r in read_jsonl(path):
-            o, s = reveals(r)
-            opens[r.planner] += o
-            shown[r.planner] += s
-        for planner in sorted(opens):
-            print(f"{folder}: {planner}: {shown[planner]}/{opens[planner]} opens of the "
-                  "target's container showed it")
+            for skill, (n, s) in reveals(r).items():
+                acts[r.planner, skill] += n
+                shown[r.planner, skill] += s
+        for planner, skill in sorted(acts):
+            print(f"{folder}: {planner}: {shown[planner, skill]}/{acts[planner, skill]} "
+                  f"{WHAT[skill]}")
     return 0
 
 

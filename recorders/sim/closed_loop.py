@@ -102,6 +102,7 @@ from sgtool.planning.candidates import Candidate, actionable, find_target
 from sgtool.planning.episode import (
     NOT_CONFIRMED,
     SearchStep,
+    planner_seed,
     run_search,
     search_success,
 )
@@ -478,7 +479,8 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
             search = _Search(sim, rec, planner, query, opts.max_steps, on_decision, skills,
                              opts.explore_on)
             search.start()
-            trace = run_search(search, planner, query, seed=opts.planner_seed,
+            pseed = planner_seed(opts.planner_seed, house.seed, episode_index)
+            trace = run_search(search, planner, query, seed=pseed,
                                recorder=search, success=opts.success)
             steps, n_open = search.steps, search.n_open
             success = search_success(search.success, trace, query, opts.success)
@@ -489,6 +491,7 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                 travelled_m=sim.travelled_m, shortest_m=shortest,
                 frames=rec.frames,
                 extra={"query": query, "planner": name, "seed": opts.planner_seed,
+                       "planner_seed": pseed,
                        "episode": int(episode_index), "episode_id": episode.id,
                        "end": end, "n_open": n_open, "mapping": mapping_record(mapping),
                        **_withheld(search), **_rule(opts)},
@@ -538,8 +541,10 @@ def _started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOp
         "episode": int(index), "episode_id": episode.id,
         "targets": list(episode.targets), "target_rooms": list(episode.target_rooms),
         "hidden": episode.hidden, "description": episode.description,
-        "seed": opts.planner_seed, "max_steps": opts.max_steps, "frame_budget": opts.frames,
-        "fps": opts.fps, "start_pose": [round(v, 6) for v in sim.base],
+        "seed": opts.planner_seed,
+        "planner_seed": planner_seed(opts.planner_seed, sim.spec.seed, index),
+        "max_steps": opts.max_steps, "frame_budget": opts.frames, "fps": opts.fps,
+        "start_pose": [round(v, 6) for v in sim.base],
         "start_room": episode.start.room,
         "camera": asdict(opts.camera),
         "intrinsics": {"width": k.width, "height": k.height, "fx": k.fx, "fy": k.fy,

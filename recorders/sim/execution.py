@@ -70,11 +70,17 @@ def execute_live(sim: Simulation, skills: LiveSkills, calls: Sequence[SkillCall]
                 outcome, reason = out.outcome, out.reason
                 at = _container_at(c, decided) if c.skill == "open" else None
                 if outcome == "success" and at is not None:
-                    outcome, reason, _ = skills.look_in(at, str(c.node))
+                    outcome, reason, _ = skills.peek(at)
+                    if reason != IN_VIEW:
+                        outcome, reason, _ = skills.look_in(at[:2], str(c.node))
             else:
                 goal = _goal(c, decided)
                 run = skills.explore if c.skill == "explore" else skills.navigate
                 outcome, reason, _ = run(goal)
+                at = _container_at(c, decided, open_only=True) \
+                    if c.skill == "navigate" else None
+                if outcome == "success" and reason != IN_VIEW and at is not None:
+                    outcome, reason, _ = skills.peek(at)  # examining an open container
             if outcome != "success" or reason == IN_VIEW:
                 break  # a failure, or the target came into view: the rest is moot
     except StopSimulation as e:
@@ -83,13 +89,19 @@ def execute_live(sim: Simulation, skills: LiveSkills, calls: Sequence[SkillCall]
     return Executed(outcome, reason, sim.travelled_m - d0, sim.tick_index - t0, False)
 
 
-def _container_at(call: SkillCall, decided: Refresh | None) -> tuple[float, float] | None:
+def _container_at(call: SkillCall, decided: Refresh | None, open_only: bool = False
+                  ) -> tuple[float, float, float] | None:
     """Where the object node of ``call`` is in the graph decided on (None: a door, or no
-    such node): the container an ``open`` looks into."""
+    such node): the container an ``open`` looks into. ``open_only``: only a container
+    that is not closed (a navigate to it examines it), else None."""
     node = None if decided is None or call.node is None else decided.graph.node(call.node)
     if not isinstance(node, ObjectNode):
         return None
-    return float(node.position[0]), float(node.position[1])
+    if open_only and (node.state == "closed"
+                      or all(a.lower() != "container" for a in node.affordances)):
+        return None
+    x, y, z = node.position
+    return float(x), float(y), float(z)
 
 
 def _goal(call: SkillCall, decided: Refresh | None) -> Goal:

@@ -8,7 +8,8 @@ action record refreshes the stream as replay does, and each refresh is written a
 derived channels right after the message that caused it.
 
 Only the ticks the map needs are frames (:class:`~sgtool.recorders.sim.keyframes.KeyframeRule`:
-the camera moved or turned enough since the last frame, or a door or container changed);
+the camera moved or turned enough since the last frame, or a door or container changed,
+or the head tilted: each tick of a deliberate look into a container is a frame);
 the others are not rendered, logged or mapped, so the clock ticks on but the log, the map
 and the frame count skip them. When a skill ends on a tick that was no frame, that pose is
 rendered before the action is logged (:meth:`LiveRecorder.act`, at that tick's time,
@@ -45,6 +46,7 @@ class LiveRecorder(LogRecorder):
         self.keyframes = keyframes or KeyframeRule(0.0, 0.0)
         self.skipped = 0  # ticks not rendered
         self._rendered: tuple[float, float, float] | None = None  # base at the last frame
+        self._tilt: float | None = None  # the head's tilt at the last frame (degrees)
         self._changed = False  # a door or container changed since the last frame
         self._pending: int | None = None  # the last tick, when it was no frame
 
@@ -60,7 +62,8 @@ class LiveRecorder(LogRecorder):
         self._changed = True
 
     def on_tick(self, sim: Simulation) -> None:
-        if not self.keyframes.is_frame(self._rendered, sim.base, self._changed):
+        if not self.keyframes.is_frame(self._rendered, sim.base,
+                                       self._changed or self._tilted(sim) > 0.0):
             self.skipped += 1
             self._pending = sim.tick_index
             return
@@ -70,10 +73,15 @@ class LiveRecorder(LogRecorder):
     def _framed(self, sim: Simulation) -> None:
         """Bookkeeping after a frame was written: feed it to the stream."""
         self._rendered = sim.base
+        self._tilt = sim.head_tilt_deg
         self._changed = False
         self._pending = None
         assert self.last_frame is not None
         self.refreshed(self.stream.frame(as_logged(self.last_frame)))
+
+    def _tilted(self, sim: Simulation) -> float:
+        """Degrees the head tilted since the last frame (0 before the first)."""
+        return 0.0 if self._tilt is None else abs(sim.head_tilt_deg - self._tilt)
 
     def flush(self, sim: Simulation) -> None:
         """Render the last tick when it was no frame and nothing ticked since (the pose a
@@ -81,7 +89,8 @@ class LiveRecorder(LogRecorder):
         the robot stands as at the last frame."""
         k = self._pending
         if k is None or k != sim.tick_index - 1 or self.budget_spent \
-                or (sim.base == self._rendered and not self._changed):
+                or (sim.base == self._rendered and not self._changed
+                    and not self._tilted(sim)):
             return
         self.skipped -= 1
         self.record_frame(dataclasses.replace(sim.render(), index=k, time_ns=sim.time_ns(k)))

@@ -43,6 +43,14 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   widest fan of open directions round the container) and turns it to face the container,
   so the frames show what the opening revealed. Off by default: its measured cost and
   effect are in the project's experiment notes.
+- **Peeking** (``peek``, off by default). The camera sits on a pan-tilt head: after
+  opening a container, or walking up to one that stands open (examining it: a sink, a
+  bookcase, a bucket), the robot tilts it down until the optical axis meets the point at
+  half the height of the container's node above the floor
+  (:func:`~sgtool.recorders.sim.motion.peek_tilt`; within reach, the fixed tilt leaves
+  a floor-standing piece's lower shelves below the view) and back, at its turning
+  speed, every tick a frame (an object needs points in two frames); no metres. The
+  log's base -> camera transform moves on ``/tf`` while the head is tilted.
 - **Stopping early.** ``stop_when`` (the closed loop's: the target is in the graph) is
   asked at every refresh during a skill; when it says so the skill ends there, a success
   with reason :data:`IN_VIEW`.
@@ -71,10 +79,11 @@ from sgtool.mapping.occupancy import OccupancyMap, geodesic_distances
 from sgtool.planning.base import Outcome
 from sgtool.recorders.sim import navigation as nav
 from sgtool.recorders.sim.events import SkillOutcome
-from sgtool.recorders.sim.motion import drive_while_turning, sweep
+from sgtool.recorders.sim.motion import drive_while_turning, head_tilts, peek_tilt, sweep
 from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode
 
 if TYPE_CHECKING:
+    from sgtool.recorders.sim.camera import CameraConfig
     from sgtool.recorders.sim.navigation import Pose2, RobotConfig
     from sgtool.recorders.sim.simulation import Simulation
     from sgtool.scenegraph.builder import MapLayers
@@ -100,6 +109,7 @@ class LiveNavConfig:
     max_contacts: int = 3
     sealed_m2: float = 2.0  # bump marks leaving the robot less floor are dropped, oldest first
     look_in: float = 0.0  # m from an opened container the robot backs off to (0: stays)
+    peek: bool = False  # tilt the camera down into an opened container and back
 
     def __post_init__(self) -> None:
         if not 0 <= self.optimistic <= 2.0:
@@ -115,7 +125,7 @@ class LiveNavConfig:
         return {"optimistic": self.optimistic, "snap": self.snap,
                 "frontier_snap": self.frontier_snap, "slack": self.slack,
                 "max_replans": self.max_replans, "max_contacts": self.max_contacts,
-                "sealed_m2": self.sealed_m2, "look_in": self.look_in}
+                "sealed_m2": self.sealed_m2, "look_in": self.look_in, "peek": self.peek}
 
 
 class RobotBody:
@@ -163,8 +173,21 @@ class RobotBody:
     def travelled_m(self) -> float:
         return _BODIES[self].travelled_m
 
+    @property
+    def camera(self) -> CameraConfig:
+        """The camera's mounting and optics (height, configured tilt, field of view)."""
+        return _BODIES[self].camera
+
+    @property
+    def head_tilt(self) -> float:
+        """The camera's tilt now (degrees down from the horizontal)."""
+        return _BODIES[self].head_tilt_deg
+
     def drive(self, poses: list[Pose2]) -> tuple[float, bool]:
         return _BODIES[self].drive(poses)
+
+    def tilt_head(self, tilts_deg: list[float]) -> None:
+        _BODIES[self].tilt_head(tilts_deg)
 
     def look_around(self) -> SkillOutcome:
         return _BODIES[self].look_around()
@@ -382,6 +405,26 @@ class LiveSkills:
             return "success", "", 0.0
         outcome, why, driven = self.navigate(goal)
         return "success", (IN_VIEW if outcome == "success" and why == IN_VIEW else ""), driven
+
+    def peek(self, at: tuple[float, float, float]) -> tuple[Outcome, str, float]:
+        """Tilt the camera down into the opened container whose node is at ``at`` and
+        back (module doc: peeking): (outcome, reason, metres); always a success with no
+        metres (IN_VIEW when the target came into view)."""
+        body = self.body
+        cam = body.camera
+        goal = peek_tilt(cam.mount_height, cam.tilt_deg, body.base[:2], at) \
+            if self.config.peek else None
+        if goal is None:
+            return "success", "", 0.0
+        step = math.degrees(body.config.turn_speed / body.fps)
+        found = False
+        for t in head_tilts(body.head_tilt, goal, step):
+            body.tilt_head([t])
+            if self._stop():
+                found = True
+                break
+        body.tilt_head(head_tilts(body.head_tilt, cam.tilt_deg, step))
+        return "success", (IN_VIEW if found else ""), 0.0
 
     def explore(self, goal: Goal) -> tuple[Outcome, str, float]:
         """Go to ``goal`` and look around there."""

@@ -10,6 +10,11 @@ the headings a look-around needs on the robot's own map.
 - :func:`sweep`: the turn (signed radians) that brings every bearing of unknown space
   near the robot into the camera's horizontal field of view, the shorter way round;
   0 when nothing around is unknown.
+- :func:`peek_tilt` and :func:`head_tilts`: the camera tilt that aims into an opened
+  container seen from where the robot stands (the optical axis at half the height of the
+  container's node above the floor below it, so a floor-standing piece's lower shelves
+  and bottom board are in view), and the per-frame tilts of the head's motion there and
+  back.
 """
 
 from __future__ import annotations
@@ -118,3 +123,26 @@ def sweep(grid: OccupancyGrid, pose: Pose2, hfov: float, radius: float = 3.0,
         return 0.0
     best = plus if plus <= minus else -minus
     return max(-two_pi, min(two_pi, best))
+
+
+def peek_tilt(mount_height: float, tilt_deg: float, base_xy: Sequence[float],
+              at: Sequence[float], max_tilt: float = 75.0, min_gain: float = 5.0
+              ) -> float | None:
+    """The downward tilt (degrees) that puts the optical axis of a camera ``mount_height``
+    above the floor at ``base_xy`` on the point at half the height of ``at`` (x, y, z: a
+    container node's position) above the floor under it, at most ``max_tilt``; None when
+    that is less than ``min_gain`` degrees below the configured ``tilt_deg`` (the camera
+    sees there already)."""
+    d = math.hypot(float(at[0]) - float(base_xy[0]), float(at[1]) - float(base_xy[1]))
+    z = 0.5 * max(float(at[2]), 0.0)
+    tilt = min(math.degrees(math.atan2(mount_height - z, max(d, 1e-6))), max_tilt)
+    return tilt if tilt >= tilt_deg + min_gain else None
+
+
+def head_tilts(start: float, goal: float, step: float) -> list[float]:
+    """Tilts (degrees) from ``start`` to ``goal``, at most ``step`` apart, ending on
+    ``goal`` and excluding ``start``; empty when they are equal."""
+    if step <= 0.0:
+        raise ValueError(f"head step {step}: must be > 0")
+    n = math.ceil(abs(goal - start) / step - 1e-9)
+    return [start + (goal - start) * k / n for k in range(1, n + 1)]

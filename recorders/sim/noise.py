@@ -143,7 +143,9 @@ def _override(base: NoiseProfile, items: Iterable[tuple[str, Any]], where: str,
 
 class SensorFaults:
     """Applies a :class:`NoiseProfile` to a sequence of frames, seeded and in order
-    (frame k's faults depend on the seed and frames 0..k only)."""
+    (frame k's faults depend on the seed and frames 0..k only). ``base_T_camera``: the
+    camera's mounting on the base, used as given where a frame's base -> camera link
+    equals it (a tilted head gives other links, taken from the frame)."""
 
     def __init__(self, profile: NoiseProfile, seed: int, structure_ids: Iterable[int] = (),
                  base_T_camera: np.ndarray | None = None) -> None:
@@ -238,5 +240,8 @@ class SensorFaults:
             self._true_prev = true
         est_base = se2_matrix(*self._est)
         est_base[2, 3] = base[2, 3]
-        base_T_cam = np.linalg.inv(base) @ pose if self._base_T_cam is None else self._base_T_cam
+        base_T_cam = np.linalg.inv(base) @ pose  # noqa: N806
+        if self._base_T_cam is not None and np.allclose(base_T_cam, self._base_T_cam,
+                                                        rtol=0.0, atol=1e-9):
+            base_T_cam = self._base_T_cam  # the mounting as given (not rounded again)
         return est_base @ base_T_cam, est_base

@@ -81,6 +81,7 @@ class LogRecorder(SimObserver):
         self.last_instances: Instances | None = None
         self._calibration: CameraIntrinsics | None = None  # the last one written
         self._static: np.ndarray | None = None  # base_T_camera as on /tf_static
+        self._link_moved = False  # the last base -> camera on /tf is not the static one
         profile = noise or PROFILES["none"]
         structure = [i.id for i in sim.instances if i.kind == STRUCTURE]
         self.faults = None if profile.is_clean else SensorFaults(
@@ -118,7 +119,9 @@ class LogRecorder(SimObserver):
         it changes, transforms, RGB, depth, ids), with two differences: the base -> camera
         link, which does not move, goes once to ``/tf_static`` (again on ``/tf`` only at a
         frame where it differs by more than :data:`STATIC_TOL`, e.g. under pose noise),
-        and the ids are :func:`instance_image`'s."""
+        and the ids are :func:`instance_image`'s. A link that moved (a tilted head) is
+        written on ``/tf`` again at the first frame it is back at the mounting, since a
+        reader takes the latest ``/tf`` link at or before a frame."""
         w, t = self.writer, f.time_ns
         if f.intrinsics != self._calibration:
             w.write_calibration(t, f.intrinsics)
@@ -134,6 +137,10 @@ class LogRecorder(SimObserver):
                     t, S.BASE_FRAME, S.CAMERA_FRAME, base_T_cam))
             elif not np.allclose(base_T_cam, self._static, rtol=0.0, atol=STATIC_TOL):
                 w.write_transform(t, S.BASE_FRAME, S.CAMERA_FRAME, base_T_cam)
+                self._link_moved = True
+            elif self._link_moved:  # back to the mounting: /tf says so, as readers use it
+                w.write_transform(t, S.BASE_FRAME, S.CAMERA_FRAME, self._static)
+                self._link_moved = False
         if f.rgb is not None:
             w.write_rgb(t, f.rgb)
         w.write_depth(t, f.depth)

@@ -85,6 +85,7 @@ class Simulation(Skills):
         self._connected = True
         self.intrinsics = self.camera.intrinsics()
         self._proj = projection_matrix(self.camera)
+        self.head_tilt_deg = self.camera.tilt_deg  # the head's tilt now (tilt_head)
         self._base_T_cam = base_T_camera(self.camera.mount_height, self.camera.tilt_deg)
         self.tick_index = 0
         self.travelled_m = 0.0
@@ -216,6 +217,19 @@ class Simulation(Skills):
             self.base = p
             self.tick()
         return dist
+
+    def tilt_head(self, tilts_deg: Sequence[float]) -> None:
+        """Tilt the camera (a pan-tilt head on the mast) through ``tilts_deg``, downward
+        degrees from the horizontal, one tick each; the base stays. The camera keeps the
+        last tilt until the next call (at first the configured ``camera.tilt_deg``)."""
+        for t in tilts_deg:
+            t = float(t)
+            if not (math.isfinite(t) and -60.0 <= t <= 80.0):
+                raise SgtoolError(f"head tilt {t} deg: must be -60..80")
+            if t != self.head_tilt_deg:
+                self.head_tilt_deg = t
+                self._base_T_cam = base_T_camera(self.camera.mount_height, t)
+            self.tick()
 
     # ----- maps -------------------------------------------------------------------------
     def occupancy(self, doors_passable: bool = False) -> OccupancyMap:

@@ -14,15 +14,19 @@ import dataclasses
 import time
 from collections.abc import Sequence
 
-import numpy as np
-
 from sgtool.errors import SgtoolError
 from sgtool.house.spec import HouseSpec, StartPose
 from sgtool.llm.stats import answer_counts
 from sgtool.log.records import Episode, LlmExchange, SceneGraphRecord
 from sgtool.log.writer import LogWriter
 from sgtool.planning.base import Action, Planner
-from sgtool.planning.episode import NOT_CONFIRMED, SearchStep, run_search, search_success
+from sgtool.planning.episode import (
+    NOT_CONFIRMED,
+    SearchStep,
+    planner_seed,
+    run_search,
+    search_success,
+)
 from sgtool.recorders.symbolic_environment.environment import N_MAX, SymbolicEnv
 from sgtool.recorders.symbolic_environment.house import SymbolicHouse
 from sgtool.results import EpisodeResult, Step
@@ -30,12 +34,6 @@ from sgtool.scenegraph.graph import SceneGraph
 from sgtool.semantics.text import category_text
 
 SECOND_NS = 1_000_000_000
-
-
-def planner_seed(seed: int, house_seed: int, episode_index: int) -> int:
-    """The planner's seed for an episode (a 32-bit draw from the three numbers)."""
-    ss = np.random.SeedSequence([int(seed), int(house_seed), int(episode_index), 1])
-    return int(ss.generate_state(1)[0])
 
 
 class EpisodeLog:

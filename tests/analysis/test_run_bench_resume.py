@@ -112,3 +112,16 @@ def test_a_log_of_other_frame_settings_is_not_resumed(tmp_path: Path) -> None:
         logged, task_settings(dataclasses.replace(
             opts, live=dataclasses.replace(opts.live, look_in=1.4)), "none", ep)) \
         == ["look in (m): 0.0 in the log, 1.4 now"]
+    # a log from before each episode drew its own planner seed is not reused
+    assert logged["episode_seeds"] is True
+    assert settings_differences(dict(logged, episode_seeds=False),
+                                task_settings(opts, "none", ep)) \
+        == ["planner seed per episode: false in the log, true now"]
+    # and whether the head tilted into the containers it opened (the default both ways)
+    peek = opts.live.peek
+    assert logged["peek"] is peek
+    assert settings_differences(
+        logged, task_settings(dataclasses.replace(
+            opts, live=dataclasses.replace(opts.live, peek=not peek)), "none", ep)) \
+        == [f"peek into containers: {str(peek).lower()} in the log, "
+            f"{str(not peek).lower()} now"]

@@ -335,6 +335,17 @@ def look_in_option() -> Callable[[F], F]:
              "opened it).")
 
 
+def peek_option() -> Callable[[F], F]:
+    """``--peek/--no-peek`` of the closed-loop commands
+    (:attr:`sgtool.recorders.sim.live_skills.LiveNavConfig.peek`)."""
+    return click.option(
+        "--peek/--no-peek", default=False, show_default=True,
+        help="live navigation: after opening a container, or walking up to one that "
+             "stands open, the robot tilts its camera down into it and back (a pan-tilt "
+             "head; no metres), so the frames show its lower shelves, which the mast's "
+             "fixed tilt leaves out of view within reach.")
+
+
 def executor_options(what: str) -> Callable[[F], F]:
     """``--executor local|ray``, ``--workers/-w N`` and ``--ray-address`` of the batch
     commands (:func:`sgtool.analysis.executor.make_executor`); ``what`` names the tasks."""

@@ -24,6 +24,7 @@ from sgtool.commands.options import (
     llm_endpoint_options,
     llm_log_options,
     look_in_option,
+    peek_option,
     run_planner_options,
     success_option,
 )
@@ -77,6 +78,7 @@ if TYPE_CHECKING:
               "before, for comparison).")
 @explore_on_option()
 @look_in_option()
+@peek_option()
 @click.option("--optimistic", type=float, default=0.25, show_default=True, metavar="M",
               help="live navigation: how far (m) past known free floor a path may run into "
               "unknown space (at frontiers).")
@@ -90,7 +92,9 @@ if TYPE_CHECKING:
 @llm_endpoint_options("LLM planners")
 @success_option()
 @click.option("--planner-seed", type=click.IntRange(min=0), default=0, show_default=True,
-              help="Seed of the planner's randomness (random planner, tie-breaks).")
+              help="Seed of the planner's randomness (the random planner): the episode's "
+                   "planner draws from a seed made of it, the house seed and the episode "
+                   "index, as in `sgtool bench`.")
 @llm_log_options(
     transcript_help="moma-llm: append every LLM exchange to this JSONL transcript (replay it "
     "later with --llm-replay).")
@@ -167,6 +171,7 @@ class RunArgs:
     rerun_to: str | None = None
     explore_on: int = 0
     look_in: float = 0.0
+    peek: bool = False
 
 
 def _planner(args: RunArgs) -> tuple[str, dict[str, Any]]:
@@ -222,8 +227,8 @@ def _request(args: RunArgs, out: Path) -> SearchRequest:
         classifier=args.classifier, min_points=args.min_points, max_steps=args.max_steps,
         frames=frame_budget(args.frames, args.frames_per_room, len(house.rooms)),
         planner_seed=args.planner_seed, navigation=args.navigation, success=args.success,
-        noise=parse_noise(args.noise), live=LiveNavConfig(optimistic=args.optimistic,
-                                                             look_in=args.look_in),
+        noise=parse_noise(args.noise),
+        live=LiveNavConfig(optimistic=args.optimistic, look_in=args.look_in, peek=args.peek),
         explore_on=args.explore_on)
     return SearchRequest(house=house, house_id=house_id, episode_index=index, episode=ep,
                          planner=name, output=out, options=opts, planner_options=options,

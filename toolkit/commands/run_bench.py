@@ -19,6 +19,7 @@ from sgtool.commands.options import (
     look_in_option,
     parse_resolution,
     parse_rooms,
+    peek_option,
     planner_names,
     planner_options,
     success_option,
@@ -68,6 +69,7 @@ if TYPE_CHECKING:
               help="Refresh the scene graph every K frames (and at every action).")
 @explore_on_option()
 @look_in_option()
+@peek_option()
 @click.option("--navigation", type=click.Choice(["live", "house"]), default="live",
               show_default=True,
               help="live: skills plan on the robot's own map; house: on the ground truth "
@@ -162,6 +164,7 @@ class RunBenchArgs:
     with_symbolic: bool = False
     explore_on: int = 0
     look_in: float = 0.0
+    peek: bool = False
 
 
 def _request(args: RunBenchArgs) -> RunBenchRequest:
@@ -212,7 +215,7 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
                              every=args.every, max_steps=args.max_steps, frames=args.frames,
                              navigation=args.navigation, success=args.success,
                              explore_on=args.explore_on,
-                             live=LiveNavConfig(look_in=args.look_in))
+                             live=LiveNavConfig(look_in=args.look_in, peek=args.peek))
     options = planner_options(args.planner_option, names)
     LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
                 args.llm_timeout).fill(options, names)

@@ -31,6 +31,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+import numpy as np
+
 from sgtool.errors import SgtoolError
 from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.scenegraph.graph import SceneGraph
@@ -106,6 +108,14 @@ class SearchRecorder(Protocol):
 
     def executed(self, step: SearchStep) -> None:
         """``step`` was executed and its feedback given to the planner."""
+
+
+def planner_seed(seed: int, house_seed: int, episode_index: int) -> int:
+    """The planner's seed for an episode (a 32-bit draw from the three numbers): a run's
+    ``seed`` gives every episode its own stream, so a seeded planner's draws are not the
+    same sequence in every episode."""
+    ss = np.random.SeedSequence([int(seed), int(house_seed), int(episode_index), 1])
+    return int(ss.generate_state(1)[0])
 
 
 def run_search(env: SearchEnvironment, planner: Planner, query: str, *, seed: int = 0,

@@ -29,6 +29,7 @@ from sgtool.log import schemas as S
 from sgtool.log.records import Instances
 from sgtool.planning.base import Action
 from sgtool.planning.candidates import find_target
+from sgtool.planning.episode import planner_seed
 from sgtool.planning.registry import make_planner
 from sgtool.recorders.sim import CameraConfig
 from sgtool.recorders.sim.closed_loop import (
@@ -255,6 +256,11 @@ def test_random_episode(house, tmp_path) -> None:
     assert (res.planner, res.steps, res.success, res.episode) == (
         "random", rep.steps, rep.success, idx)
     assert all(d.graph is not None for d in logged.decisions[1:])
+    # the planner drew from the episode's own seed (as the symbolic bench's), which the
+    # log keeps: another episode of the run draws another stream
+    assert logged.episode.extras["seed"] == 1
+    assert logged.episode.extras["planner_seed"] == planner_seed(1, house.seed, idx) \
+        != planner_seed(1, house.seed, idx + 1)
 
 
 def test_invalid_targets_and_done_in_the_loop(house, tmp_path) -> None:

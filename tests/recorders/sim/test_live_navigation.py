@@ -16,11 +16,16 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import numpy as np
 import pytest
+from click.testing import CliRunner
 from support.scripted_planner import Scripted
 
+from sgtool.cli import cli
 from sgtool.datasets.generator import generate_house
+from sgtool.errors import SgtoolError
 from sgtool.log import LogReader
+from sgtool.log import schemas as S
 from sgtool.log.codec import decode_transform
 from sgtool.planning.base import Action
 from sgtool.planning.candidates import actionable
@@ -33,8 +38,10 @@ from sgtool.recorders.sim.closed_loop import (
     run_episode,
 )
 from sgtool.recorders.sim.live_skills import LiveNavConfig, PrivilegedAccess, RobotBody
+from sgtool.recorders.sim.motion import head_tilts, peek_tilt
 
 OPTS = ClosedLoopOptions(camera=CameraConfig(width=160, height=120))
+GRAPH_TOPIC = S.RECORDS["scene_graph"].topic
 
 
 @pytest.fixture(scope="module")
@@ -110,8 +117,10 @@ def _open_first_container(g):
 
 
 def _last_pose(path) -> tuple[float, float, float]:
+    """The base's last pose on ``/tf`` (not a base -> camera link of a tilted head)."""
     with LogReader(path) as r:
-        last = [m.message for m in r.messages(["/tf"])][-1]
+        last = [m.message for m in r.messages(["/tf"])
+                if m.message.child_frame_id == S.BASE_FRAME][-1]
     t = decode_transform(last)
     return float(t[0, 3]), float(t[1, 3]), math.atan2(t[1, 0], t[0, 0])
 
@@ -123,7 +132,8 @@ def test_after_opening_a_container_the_robot_looks_in_from_in_front(house, tmp_p
     it."""
     ends = {}
     for look in (0.0, 1.4):
-        opts = dataclasses.replace(OPTS, live=LiveNavConfig(look_in=look), max_steps=1)
+        opts = dataclasses.replace(OPTS, live=LiveNavConfig(look_in=look, peek=False),
+                                   max_steps=1)
         for k in range(len(list_episodes(house))):
             idx, ep = pick_episode(house, index=k)
             p = Scripted([_open_first_container, Action("done")])
@@ -146,3 +156,149 @@ def test_after_opening_a_container_the_robot_looks_in_from_in_front(house, tmp_p
     assert k0 == k1  # the same episode, the same container
     assert stand < 1.3 and abs(backed - 1.4) <= 0.15  # there, to a cell of its map
     assert abs(math.atan2(math.sin(off), math.cos(off))) < math.radians(10)  # facing it
+
+
+def _tilt(base_T_cam) -> float:
+    """The camera's downward tilt (degrees) of a base -> camera link: the optical z axis
+    is (cos t, 0, -sin t) in the base frame."""
+    return math.degrees(math.asin(-float(base_T_cam[2, 2])))
+
+
+def test_the_head_peek_shows_a_cabinet_bottom_the_mast_tilt_misses(house) -> None:
+    """Standing 0.75 m in front of an opened container, the camera at its configured 15
+    degrees leaves the bottom shelf below the view; tilted by ``peek_tilt`` it shows what
+    stands there (pixel counts of the objects inside, by the simulator's ids)."""
+    inside: dict[str, list[str]] = {}
+    for o in house.objects:
+        if o.relation == "inside":
+            inside.setdefault(o.parent, []).append(o.id)
+    fixed = peeked = hidden = 0
+    with Simulation(house, camera=CameraConfig(width=160, height=120)) as sim:
+        by = {i.spec_id: i.id for i in sim.instances if i.spec_id}
+        t0 = sim.tick_index
+        with pytest.raises(SgtoolError, match="head tilt"):
+            sim.tilt_head([95.0])
+        for f in house.furniture:
+            if f.id not in inside or f.id not in sim.world.panels:
+                continue
+            cx, cy, cz = f.center
+            x, y = cx - math.sin(f.yaw) * 0.75, cy + math.cos(f.yaw) * 0.75  # front: +y
+            pose = (x, y, math.atan2(cy - y, cx - x))
+            if sim.in_contact(pose):
+                continue
+            sim.teleport(pose)
+            sim._set_open(f.id, 1.0, sim._layout_for_opening(f.id))
+            before = sim.render().ids
+            tilt = peek_tilt(1.2, 15.0, pose[:2], (cx, cy, cz))
+            assert tilt is not None and tilt > 40.0
+            ticks = sim.tick_index
+            sim.tilt_head([tilt])
+            assert sim.tick_index == ticks + 1
+            link = np.linalg.inv(sim.base_matrix()) @ sim.camera_matrix()
+            assert _tilt(link) == pytest.approx(tilt)
+            after = sim.render().ids
+            sim.tilt_head([15.0])
+            for i in (by[o] for o in inside[f.id]):
+                a, b = int((before == i).sum()), int((after == i).sum())
+                fixed += a >= 12
+                peeked += b >= 12
+                hidden += a == 0 and b >= 12
+        assert sim.tick_index > t0
+    assert hidden >= 1 and peeked > fixed
+
+
+def test_after_opening_a_container_the_robot_peeks_in_and_back(house, tmp_path) -> None:
+    """With ``peek`` the open is followed by the head's tilt down to ``peek_tilt`` of the
+    container's node and back, every tick a frame, no metres; the log's base -> camera
+    link follows the head (and is back at the mounting on ``/tf`` after), so the replay
+    builds the same graphs."""
+    runs = {}
+    for peek in (False, True):
+        opts = dataclasses.replace(OPTS, live=LiveNavConfig(peek=peek), max_steps=1)
+        for k in range(len(list_episodes(house))):
+            idx, ep = pick_episode(house, index=k)
+            p = Scripted([_open_first_container, Action("done")])
+            out = tmp_path / f"peek-{peek}-{k}.mcap"
+            run_episode(house, ep, p, out, opts, episode_index=idx)
+            fb = p.feedbacks[0] if p.feedbacks else None
+            if fb is not None and fb.action.skill == "open" and fb.outcome == "success":
+                break
+        else:
+            pytest.fail("no episode of the house opens a container first")
+        with LogReader(out) as r:
+            frames = list(r.frames())
+            started = next(r.records("episode"))[1]
+        assert started["extra"]["navigation"]["peek"] is peek
+        tilts = [_tilt(np.linalg.inv(f.base_pose) @ f.pose) for f in frames]
+        runs[peek] = (k, out, fb, tilts, p.graphs[0].node(fb.action.target), frames)
+    k0, _, fb0, flat, _, frames0 = runs[False]
+    k1, out, fb1, tilts, node, frames1 = runs[True]
+    assert k0 == k1 and fb1.travelled_m == fb0.travelled_m  # the same stand, no metres
+    assert max(flat) == pytest.approx(15.0) and tilts[-1] == pytest.approx(15.0)
+    low = [i for i, t in enumerate(tilts) if t > 15.0 + 1e-6]
+    stand = frames1[low[0]].base_pose
+    goal = peek_tilt(1.2, 15.0, (stand[0, 3], stand[1, 3]), node.position)
+    assert goal is not None and max(tilts) == pytest.approx(goal)
+    # one frame a tick down and back up, the base standing still
+    assert low == list(range(low[0], low[-1] + 1))
+    assert len(low) == 2 * len(head_tilts(15.0, goal, 9.0)) - 1
+    assert len(frames1) == len(frames0) + len(low) + 1
+    assert all(np.array_equal(frames1[i].base_pose, stand) for i in low)
+    derived = tmp_path / "peek-replayed.mcap"
+    r = CliRunner().invoke(cli, ["replay", str(out), "-o", str(derived)])
+    assert r.exit_code == 0, r.output
+    assert _graphs(out) == _graphs(derived) and len(_graphs(out)) >= 2
+
+
+def _graphs(path) -> list[bytes]:
+    with LogReader(path) as r:
+        return [bytes(m.data) for _, _, m in r.raw_messages([GRAPH_TOPIC])]
+
+
+def _open_containers(g) -> list[str]:
+    """Navigate candidates of ``g`` that are containers standing open."""
+    out = []
+    for c in actionable(g):
+        node = g.node(c.node_id)
+        if c.skill == "navigate" and "container" in getattr(node, "affordances", ()) \
+                and node.state != "closed":
+            out.append(c.node_id)
+    return out
+
+
+def _examine_or_explore(g):
+    """Examine an open container once one is on offer, else open the first door on offer,
+    else explore the first frontier."""
+    found = _open_containers(g)
+    if found:
+        return Action("navigate", found[0])
+    doors = [c.node_id for c in actionable(g) if c.kind == "door"]
+    if doors:
+        return Action("open", doors[0])
+    frontiers = [c.node_id for c in actionable(g) if c.kind == "frontier"]
+    return Action("explore", frontiers[0]) if frontiers else Action("done")
+
+
+def test_examining_an_open_container_peeks_into_it(house, tmp_path) -> None:
+    """A navigate to a container that stands open (a bookcase, a sink) examines it; with
+    ``peek`` the head then tilts into it and back, as after an open; driving elsewhere
+    or opening a door does not tilt it."""
+    idx, ep = pick_episode(house, index=3)  # its fifth action examines a bookcase
+    p = Scripted([_examine_or_explore] * 8)
+    out = tmp_path / "examine.mcap"
+    opts = dataclasses.replace(OPTS, live=LiveNavConfig(peek=True), max_steps=8)
+    run_episode(house, ep, p, out, opts, episode_index=idx)
+    steps = [k for k, fb in enumerate(p.feedbacks) if fb.action.skill == "navigate"]
+    assert steps, "the episode never examined an open container"
+    k = steps[0]
+    fb = p.feedbacks[k]
+    node = p.graphs[k].node(fb.action.target)
+    assert fb.outcome == "success" and node.state != "closed"
+    with LogReader(out) as r:
+        acts = [t for t, a in r.records("action")]
+        frames = list(r.frames())
+    t0, t1 = acts[k], acts[k + 1]  # the look-around is action 0
+    tilt = [(f.time_ns, _tilt(np.linalg.inv(f.base_pose) @ f.pose)) for f in frames]
+    assert all(t == pytest.approx(15.0) for ns, t in tilt if ns <= t0)  # before: none
+    assert max(t for ns, t in tilt if t0 < ns <= t1) > 20.0
+    assert tilt[-1][1] == pytest.approx(15.0)

@@ -1,14 +1,16 @@
 """Motion that sees while it moves (recorders/sim/motion.py): turning while driving along
-a path, and the look-around turn toward unknown space only."""
+a path, the look-around turn toward unknown space only, and the head's tilt into an
+opened container."""
 
 from __future__ import annotations
 
 import math
 
 import numpy as np
+import pytest
 
 from sgtool.mapping.grid import FREE, UNKNOWN, OccupancyGrid
-from sgtool.recorders.sim.motion import drive_while_turning, sweep
+from sgtool.recorders.sim.motion import drive_while_turning, head_tilts, peek_tilt, sweep
 from sgtool.recorders.sim.navigation import follow_poses, wrap_angle
 
 STEP, TURN = 0.05, math.radians(9.0)
@@ -105,3 +107,26 @@ def test_an_action_ends_when_its_navigation_brings_the_target_into_view() -> Non
     ex = execute_live(sim, skills, (SkillCall("navigate", (1.0, 2.0)), SkillCall("open", 5)),
                       None)
     assert (ex.outcome, ex.reason, ex.cut) == ("success", IN_VIEW, False)
+
+
+def test_peek_tilt_aims_at_half_the_height_of_the_container_node() -> None:
+    # a cabinet node at 0.465 m (0.93 m tall) seen from 0.76 m by a camera at 1.2 m:
+    # the axis meets (x, y, 0.2325)
+    tilt = peek_tilt(1.2, 15.0, (0.0, 0.0), (0.76, 0.0, 0.465))
+    assert tilt == pytest.approx(math.degrees(math.atan2(1.2 - 0.2325, 0.76)))
+    assert 51.0 < tilt < 52.5
+    # far away the configured tilt sees it already; very close the head stops at its limit
+    assert peek_tilt(1.2, 15.0, (0.0, 0.0), (3.0, 0.0, 0.4)) is None
+    assert peek_tilt(1.2, 15.0, (1.0, 1.0), (1.0, 1.05, 0.3), max_tilt=70.0) == 70.0
+
+
+def test_head_tilts_step_to_the_goal_and_back() -> None:
+    down = head_tilts(15.0, 51.85, 9.0)
+    assert len(down) == 5 and down[-1] == 51.85 and 15.0 not in down
+    steps = np.diff([15.0, *down])
+    assert np.all(steps > 0) and np.all(steps <= 9.0 + 1e-9)
+    up = head_tilts(51.85, 15.0, 9.0)
+    assert up[-1] == 15.0 and len(up) == 5
+    assert head_tilts(15.0, 15.0, 9.0) == []
+    with pytest.raises(ValueError):
+        head_tilts(15.0, 30.0, 0.0)

@@ -98,6 +98,19 @@ def test_drift_follows_odometry_and_is_seeded() -> None:
     assert np.allclose(a[0], clean[0])  # the first frame is the true pose
 
 
+def test_drift_keeps_a_tilted_head_link() -> None:
+    """The mounting given to the faults is the untilted one; a frame whose camera is on a
+    tilted head keeps that frame's base -> camera link under drift."""
+    faults = SensorFaults(NoiseProfile("d", drift_xy=0.02), 3, base_T_camera=CAM)
+    tilted = base_T_camera(1.2, 50.0)
+    for i in range(20):
+        f = _frame(i, base=(0.05 * i, 0.0, 0.0))
+        if i % 2:
+            f = replace(f, pose=f.base_pose @ tilted)
+        g = faults.apply(f)
+        assert np.allclose(np.linalg.inv(g.base_pose) @ g.pose, tilted if i % 2 else CAM)
+
+
 def test_fault_streams_are_independent() -> None:
     """Adding depth holes does not change which labels get dropped."""
     p1 = NoiseProfile("a", label_dropout=0.5)
