@@ -43,7 +43,7 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   widest fan of open directions round the container) and turns it to face the container,
   so the frames show what the opening revealed. Off by default: its measured cost and
   effect are in the project's experiment notes.
-- **Peeking** (``peek``, off by default). The camera sits on a pan-tilt head: after
+- **Peeking** (``peek``, on by default). The camera sits on a pan-tilt head: after
   opening a container, or walking up to one that stands open (examining it: a sink, a
   bookcase, a bucket), the robot tilts it down until the optical axis meets the point at
   half the height of the container's node above the floor
@@ -109,7 +109,7 @@ class LiveNavConfig:
     max_contacts: int = 3
     sealed_m2: float = 2.0  # bump marks leaving the robot less floor are dropped, oldest first
     look_in: float = 0.0  # m from an opened container the robot backs off to (0: stays)
-    peek: bool = False  # tilt the camera down into an opened container and back
+    peek: bool = True  # tilt the camera down into an opened container and back
 
     def __post_init__(self) -> None:
         if not 0 <= self.optimistic <= 2.0:

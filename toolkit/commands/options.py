@@ -339,7 +339,7 @@ def peek_option() -> Callable[[F], F]:
     """``--peek/--no-peek`` of the closed-loop commands
     (:attr:`sgtool.recorders.sim.live_skills.LiveNavConfig.peek`)."""
     return click.option(
-        "--peek/--no-peek", default=False, show_default=True,
+        "--peek/--no-peek", default=True, show_default=True,
         help="live navigation: after opening a container, or walking up to one that "
              "stands open, the robot tilts its camera down into it and back (a pan-tilt "
              "head; no metres), so the frames show its lower shelves, which the mast's "

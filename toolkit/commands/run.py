@@ -171,7 +171,7 @@ class RunArgs:
     rerun_to: str | None = None
     explore_on: int = 0
     look_in: float = 0.0
-    peek: bool = False
+    peek: bool = True
 
 
 def _planner(args: RunArgs) -> tuple[str, dict[str, Any]]:

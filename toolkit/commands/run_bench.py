@@ -164,7 +164,7 @@ class RunBenchArgs:
     with_symbolic: bool = False
     explore_on: int = 0
     look_in: float = 0.0
-    peek: bool = False
+    peek: bool = True
 
 
 def _request(args: RunBenchArgs) -> RunBenchRequest:
