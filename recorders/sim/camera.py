@@ -88,6 +88,9 @@ def se2_matrix(x: float, y: float, yaw: float, z: float = 0.0) -> np.ndarray:
                      [0.0, 0.0, 0.0, 1.0]])
 
 
+LINK_TOL = 1e-9  # m / rotation entries: a base -> camera link this close is the mounting
+
+
 def base_T_camera(mount_height: float, tilt_deg: float) -> np.ndarray:  # noqa: N802
     """The camera's optical frame in the base frame (x forward, y left, z up): at
     ``mount_height`` above the base origin, optical axis along +x pitched down by

@@ -35,7 +35,7 @@ import numpy as np
 
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import Frame
-from sgtool.recorders.sim.camera import se2_matrix
+from sgtool.recorders.sim.camera import LINK_TOL, se2_matrix
 
 
 @dataclass(frozen=True)
@@ -242,6 +242,6 @@ class SensorFaults:
         est_base[2, 3] = base[2, 3]
         base_T_cam = np.linalg.inv(base) @ pose  # noqa: N806
         if self._base_T_cam is not None and np.allclose(base_T_cam, self._base_T_cam,
-                                                        rtol=0.0, atol=1e-9):
+                                                        rtol=0.0, atol=LINK_TOL):
             base_T_cam = self._base_T_cam  # the mounting as given (not rounded again)
         return est_base @ base_T_cam, est_base

@@ -40,7 +40,7 @@ from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.log.records import Action, Episode, Instances
 from sgtool.log.writer import LogWriter
 from sgtool.recorders.sim.body_instances import STRUCTURE
-from sgtool.recorders.sim.camera import CameraConfig, base_T_camera
+from sgtool.recorders.sim.camera import LINK_TOL, CameraConfig, base_T_camera
 from sgtool.recorders.sim.explore import ExplorationReport, ScriptOptions, explore_house
 from sgtool.recorders.sim.navigation import RobotConfig
 from sgtool.recorders.sim.noise import PROFILES, NoiseProfile, SensorFaults
@@ -52,7 +52,7 @@ from sgtool.recorders.sim.simulation import (
 )
 
 SOURCE = "pybullet"
-STATIC_TOL = 1e-9  # m / rotation entries: base -> camera still counts as the static link
+STATIC_TOL = LINK_TOL  # base -> camera this close still counts as the static link
 
 
 class LogRecorder(SimObserver):

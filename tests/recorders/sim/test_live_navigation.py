@@ -116,6 +116,20 @@ def _open_first_container(g):
     return Action("open", cands[0].node_id) if cands else Action("done")
 
 
+def _first_open(house, opts, stem):
+    """(episode index, log, planner, feedback) of the first episode of ``house`` whose
+    first action opens a container successfully (logs ``STEM-K.mcap``)."""
+    for k in range(len(list_episodes(house))):
+        idx, ep = pick_episode(house, index=k)
+        p = Scripted([_open_first_container, Action("done")])
+        out = stem.with_name(f"{stem.name}-{k}.mcap")
+        run_episode(house, ep, p, out, opts, episode_index=idx)
+        fb = p.feedbacks[0] if p.feedbacks else None
+        if fb is not None and fb.action.skill == "open" and fb.outcome == "success":
+            return k, out, p, fb
+    pytest.fail("no episode of the house opens a container first")
+
+
 def _last_pose(path) -> tuple[float, float, float]:
     """The base's last pose on ``/tf`` (not a base -> camera link of a tilted head)."""
     with LogReader(path) as r:
@@ -134,16 +148,7 @@ def test_after_opening_a_container_the_robot_looks_in_from_in_front(house, tmp_p
     for look in (0.0, 1.4):
         opts = dataclasses.replace(OPTS, live=LiveNavConfig(look_in=look, peek=False),
                                    max_steps=1)
-        for k in range(len(list_episodes(house))):
-            idx, ep = pick_episode(house, index=k)
-            p = Scripted([_open_first_container, Action("done")])
-            out = tmp_path / f"open-{look}-{k}.mcap"
-            run_episode(house, ep, p, out, opts, episode_index=idx)
-            fb = p.feedbacks[0] if p.feedbacks else None
-            if fb is not None and fb.action.skill == "open" and fb.outcome == "success":
-                break
-        else:
-            pytest.fail("no episode of the house opens a container first")
+        k, out, p, fb = _first_open(house, opts, tmp_path / f"open-{look}")
         with LogReader(out) as r:
             started = next(r.records("episode"))[1]
         assert started["extra"]["navigation"]["look_in"] == look
@@ -215,16 +220,7 @@ def test_after_opening_a_container_the_robot_peeks_in_and_back(house, tmp_path) 
     runs = {}
     for peek in (False, True):
         opts = dataclasses.replace(OPTS, live=LiveNavConfig(peek=peek), max_steps=1)
-        for k in range(len(list_episodes(house))):
-            idx, ep = pick_episode(house, index=k)
-            p = Scripted([_open_first_container, Action("done")])
-            out = tmp_path / f"peek-{peek}-{k}.mcap"
-            run_episode(house, ep, p, out, opts, episode_index=idx)
-            fb = p.feedbacks[0] if p.feedbacks else None
-            if fb is not None and fb.action.skill == "open" and fb.outcome == "success":
-                break
-        else:
-            pytest.fail("no episode of the house opens a container first")
+        k, out, p, fb = _first_open(house, opts, tmp_path / f"peek-{peek}")
         with LogReader(out) as r:
             frames = list(r.frames())
             started = next(r.records("episode"))[1]
