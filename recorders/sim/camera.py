@@ -34,6 +34,9 @@ _OPTICAL_T_GL = np.diag([1.0, -1.0, -1.0, 1.0])
 UID_MASK = 0xFFFFFF  # low 24 bits of a segmentation value: the body's unique id
 
 
+TILT_MIN, TILT_MAX = -60.0, 80.0  # degrees down from the horizontal, mast or head
+
+
 @dataclass(frozen=True)
 class CameraConfig:
     """The robot's RGB-D camera.
@@ -66,8 +69,9 @@ class CameraConfig:
                               "as 16-bit millimetres, at most 65 m")
         if not 0.1 <= self.mount_height <= 3.0:
             raise SgtoolError(f"camera height {self.mount_height} m: must be 0.1..3")
-        if not -60.0 <= self.tilt_deg <= 80.0:
-            raise SgtoolError(f"camera tilt {self.tilt_deg} deg: must be -60..80")
+        if not TILT_MIN <= self.tilt_deg <= TILT_MAX:
+            raise SgtoolError(f"camera tilt {self.tilt_deg} deg: must be "
+                              f"{TILT_MIN:g}..{TILT_MAX:g}")
 
     @property
     def far(self) -> float:

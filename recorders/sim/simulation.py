@@ -38,6 +38,8 @@ from sgtool.recorders.sim import navigation as nav
 from sgtool.recorders.sim.body_instances import Instance
 from sgtool.recorders.sim.build import World, build_world, pybullet, remove_panel, set_panel
 from sgtool.recorders.sim.camera import (
+    TILT_MAX,
+    TILT_MIN,
     CameraConfig,
     base_T_camera,
     depth_from_buffer,
@@ -224,8 +226,8 @@ class Simulation(Skills):
         last tilt until the next call (at first the configured ``camera.tilt_deg``)."""
         for t in tilts_deg:
             t = float(t)
-            if not (math.isfinite(t) and -60.0 <= t <= 80.0):
-                raise SgtoolError(f"head tilt {t} deg: must be -60..80")
+            if not (math.isfinite(t) and TILT_MIN <= t <= TILT_MAX):
+                raise SgtoolError(f"head tilt {t} deg: must be {TILT_MIN:g}..{TILT_MAX:g}")
             if t != self.head_tilt_deg:
                 self.head_tilt_deg = t
                 self._base_T_cam = base_T_camera(self.camera.mount_height, t)
