@@ -159,6 +159,10 @@ class VoiOptions(NodeOptions):
         "places per look-ahead sequence", "int", lo=1))
     step_budget: int = field(default=50, metadata=option(
         "actions per episode (N_max) the step price assumes; 0: none", "int", lo=0))
+    step_rule: str = field(default="slack", metadata=option(
+        "the price of an action: slack ((V5), lowered while every place could still be "
+        "checked within the steps left) or floor ((S3), never below step_cost)",
+        "choice", choices=("slack", "floor")))
     room_floor: float = field(default=0.05, metadata=option(
         "(C1) floor of the room probability R", "float", lo=0.0, hi=1.0))
     object_floor: float = field(default=0.05, metadata=option(

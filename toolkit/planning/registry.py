@@ -158,7 +158,7 @@ def _voi(name: str, o: VoiOptions) -> Planner:
     params = VoiParams(step_cost=o.step_cost, open_cost=o.open_cost,
                        follow_steps=o.follow_steps, follow_rule=o.follow_rule,
                        top_k=o.top_k, horizon=o.horizon,
-                       step_budget=o.step_budget, belief=belief)
+                       step_budget=o.step_budget, step_rule=o.step_rule, belief=belief)
     return VoiPlanner(_priors(o.encoder, o.weights_dir, blend=o.blend), params, name=name,
                       max_failures=o.max_failures,
                       furniture_levels=_furniture_levels(o.furniture_levels))

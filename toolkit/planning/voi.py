@@ -46,6 +46,21 @@ cheap containers are exhausted. Places are ordered by (S2) (the best ordering of
 ``horizon`` of the ``top_k`` places by p/c', detection probability per expected cost),
 with c' on every leg.
 
+**The price of an action** (``step_rule``). SPL counts metres only; a = 3 m per action
+stands for the step budget, which matters only when it can run out. (S3) of
+:mod:`sgtool.planning.search_theory` raises a when the mass is spread over more places
+than steps are left and never lowers it; the default, ``slack``, also lowers it while the
+budget cannot bind:
+
+    a_t = a · max(N_eff / s, min(1, N_rem / s)),                                       (V5)
+    N_rem = #checks + #regions (1 + n̄) + #spaces m̄ (1 + n̄)
+
+s the steps left, N_rem the actions that would check every place with mass: one per
+carrier, a reveal and its n̄ carriers per unseen region (n̄ of (B2)), m̄ regions' worth
+per unexplored room, closed door or leading-out frontier (m̄ the mean number of regions of
+the rooms seen). In a small house with steps to spare the search orders by travel, as
+SPL does; in a dense one, whose places outnumber the steps, (V5) is (S3).
+
 Everything is deterministic (ties broken by node id); the seed is not used.
 """
 
@@ -90,6 +105,7 @@ class VoiParams:
     top_k: int = 5
     horizon: int = 3
     step_budget: int = 50  # actions per episode (N_max) of the step price (S3); 0: none
+    step_rule: str = "slack"  # "slack": a_t of (V5); "floor": a_t of (S3)
     belief: BeliefParams = field(default_factory=voi_belief)
 
 
@@ -122,10 +138,12 @@ class EpisodeBelief:
             ({}, [], {}, 0)
         self._rooms: tuple[RoomNode, ...] | None = None
         self._room_table: tuple[dict[str, float], float] = ({}, params.fallback_room)
+        self._regions_per_room = 1.0  # m̄ of (V5) for the last regions tuple
         self._carrier_list: list[ObjectNode] = []  # the last objects tuple's carriers
         self._carrier_c: list[float] = []  # and their C' (B8)
         self._follow: float | None = None  # f̂ of (V3), computed when asked
         self._profile: np.ndarray | None = None  # W̄ of (V4), computed when asked
+        self.remaining = 0.0  # N_rem of (V5) for the last candidates
         # id(node) -> (node, is a carrier, category text); holds the node, so the id stays
         self._nodes: dict[int, tuple[ObjectNode, bool, str]] = {}
 
@@ -236,6 +254,7 @@ class EpisodeBelief:
         table: dict[str, tuple[int, str]] = {}
         inner: list[str] = []
         revealed = 0
+        self._regions_per_room = len(graph.regions) / max(1, len({f.room for f in graph.regions}))
         for f in graph.regions:
             if f.kind != "frontier":
                 revealed += 1
@@ -271,12 +290,15 @@ class EpisodeBelief:
         pf = np.zeros(n)
         reveal = np.zeros(n, dtype=bool)
         phi = self.furniture
+        n_check = n_region = n_space = 0  # for N_rem of (V5)
         for i, (nid, kind) in enumerate(zip(ids, kinds, strict=True)):
             if kind == "object":
                 code, room, c = objs.get(nid, (_OUT, "", 0.0))
                 if code == _OUT:  # not a node of the graph: space beyond, as (B4)
                     po[i] = beyond
+                    n_space += 1
                     continue
+                n_check += 1
                 zr = z.get(room) or (c if code == _CARRIER else 1.0)
                 po[i] = rooms.get(room, unknown) * (c if code == _CARRIER else mean_c) / zr
                 continue
@@ -284,14 +306,18 @@ class EpisodeBelief:
             if kind == "frontier":
                 code, room = regs.get(nid, (_OUT, ""))
                 if code == _INNER:
+                    n_region += 1
                     po[i] = rooms.get(room, unknown) * k / (z.get(room) or k)
                     if phi > 0.0:
                         pf[i] = rooms.get(room, unknown) / per_room.get(room, 1)
                     continue
+            n_space += 1
             if kind == "room":
                 po[i] = pf[i] = unknown
             else:  # a closed door, a leading-out frontier: space beyond
                 po[i] = pf[i] = beyond
+        self.remaining = remaining_actions(n_check, n_region, n_space, per_region,
+                                           self._regions_per_room)
         if phi > 0.0:
             so, sf = float(po.sum()), float(pf.sum())
             if sf > 0 and so > 0:
@@ -312,6 +338,25 @@ class EpisodeBelief:
             return np.full(n, 1.0 / n), np.zeros(n)
         nxt = np.where(reveal, po, 0.0) / s
         return total_now / s, nxt
+
+
+def remaining_actions(checks: int, regions: int, spaces: int, per_region: float,
+                      regions_per_room: float) -> float:
+    """N_rem of (V5): the actions that would check every place the belief gives mass, one
+    per carrier, 1 + n̄ per unseen region (the reveal and its carriers), m̄ (1 + n̄) per
+    unexplored room or space beyond a door or leading-out frontier (m̄ regions per room)."""
+    per_space = max(1.0, regions_per_room) * (1.0 + per_region)
+    return checks + regions * (1.0 + per_region) + spaces * per_space
+
+
+def slack_step_price(p: np.ndarray, steps_left: int | None, base: float,
+                     remaining: float) -> float:
+    """a_t of (V5): a · max(N_eff / s, min(1, N_rem / s)), s the steps left; ``base`` when
+    there is no budget."""
+    if not steps_left or steps_left <= 0 or not len(p):
+        return base
+    n_eff = 1.0 / max(float(np.sum(p * p)), 1e-12)
+    return base * max(n_eff / steps_left, min(1.0, remaining / steps_left))
 
 
 def expected_checks(carriers: Sequence[ObjectNode], c: Sequence[float]) -> float:
@@ -420,7 +465,10 @@ class VoiPlanner(ScoringPlanner[VoiParams]):
         """Index of the candidate to check first and the value of its ordering, (V2) and
         (S2)."""
         prm = self.params
-        step = step_price(p, steps_left, prm.step_cost)
+        if prm.step_rule == "slack":
+            step = slack_step_price(p, steps_left, prm.step_cost, self.belief.remaining)
+        else:
+            step = step_price(p, steps_left, prm.step_cost)
         opens = np.fromiter((s == "open" for s in cols.skills), dtype=bool, count=len(cols))
         share = np.divide(nxt, p, out=np.zeros_like(p), where=p > 0)
         dist = np.asarray(cols.distances, dtype=np.float64)

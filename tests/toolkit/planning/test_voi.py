@@ -21,7 +21,9 @@ from sgtool.planning.voi import (
     VoiPlanner,
     expected_checks,
     prefix_costs,
+    remaining_actions,
     share_profile,
+    slack_step_price,
     voi_belief,
 )
 from sgtool.scenegraph.graph import ObjectNode, RegionNode, RobotState, RoomNode, SceneGraph
@@ -116,9 +118,11 @@ def _kitchen(cabinets: int, frontier: bool = True) -> SceneGraph:
 
 def test_twenty_cabinets_do_not_outweigh_the_countertop() -> None:
     """Each cabinet scores above the countertop, but the twenty share their category's
-    mass (B8): voi walks to the countertop first, bayes-search (γ = 1) opens a cabinet."""
+    mass (B8): where the steps are scarce (21 places, 21 steps, so (V5) is (S3)) voi walks
+    to the countertop first, bayes-search (γ = 1) opens a cabinet. (With 50 steps for the
+    21 places voi opens the cabinets, 0.1 m apart, on its way: metres are what is scarce.)"""
     g = _kitchen(20, frontier=False)
-    voi = VoiPlanner(SCORER)
+    voi = VoiPlanner(SCORER, VoiParams(step_budget=21))
     voi.reset("spatula")
     a = voi.decide(g)
     assert (a.skill, a.target) == ("navigate", "obj:99")
@@ -134,7 +138,7 @@ def test_a_reveal_pays_for_the_check_it_needs() -> None:
     goes first."""
     g = _kitchen(1)
     g = SceneGraph(g.robot, g.rooms, g.regions, g.objects[:1], (), g.distances)
-    params = VoiParams(belief=voi_belief())
+    params = VoiParams(step_rule="floor", belief=voi_belief())
     p = VoiPlanner(SCORER, dataclasses.replace(params, follow_steps=0.0))
     p.reset("spatula")
     a = p.decide(g)
@@ -165,11 +169,59 @@ def test_registry_row_and_options() -> None:
     assert (p.params.follow_steps, p.params.horizon) == (2.0, 2)
     # the options' defaults are the planner's own
     opts, params = VoiOptions(), VoiParams()
-    for k in ("step_cost", "open_cost", "follow_steps", "top_k", "horizon", "step_budget"):
+    for k in ("step_cost", "open_cost", "follow_steps", "top_k", "horizon", "step_budget",
+              "step_rule"):
         assert getattr(opts, k) == getattr(params, k), k
     for k in ("room_floor", "object_floor", "sharpness", "object_sharpness", "beyond", "miss",
               "region_weight", "seen_type_weight", "instance_exponent"):
         assert getattr(opts, k) == getattr(params.belief, k), k
+
+
+def test_remaining_actions_and_the_slack_price() -> None:
+    """N_rem = 4 carriers + 2 regions (1 + n̄) + 1 room m̄ (1 + n̄) with n̄ = 3, m̄ = 2:
+    4 + 8 + 8 = 20; with 40 steps left a = 3 costs 1.5; with 10 left it is a; a belief
+    spread over more places than steps are left raises it as (S3)."""
+    assert remaining_actions(4, 2, 1, 3.0, 2.0) == 20.0
+    assert remaining_actions(4, 2, 1, 3.0, 0.5) == 4 + 8 + 4  # at least one region a room
+    p = np.full(4, 0.25)  # N_eff = 4
+    assert slack_step_price(p, 40, 3.0, 20.0) == pytest.approx(1.5)
+    assert slack_step_price(p, 10, 3.0, 20.0) == pytest.approx(3.0)
+    assert slack_step_price(p, 2, 3.0, 20.0) == pytest.approx(6.0)  # N_eff / s = 2
+    assert slack_step_price(p, None, 3.0, 20.0) == 3.0  # no budget: a
+
+
+def _sink_and_cabinet() -> SceneGraph:
+    """An open sink 1 m from the robot, a closed bottom cabinet (C twice the sink's) 3 m
+    away on the other side."""
+    objs = (ObjectNode("obj:1", "sink", "region:1.1", "room:1", (1.0, 0.0, 0.0),
+                       affordances=("explore",)),
+            ObjectNode("obj:2", "bottom_cabinet", "region:1.1", "room:1", (-3.0, 0.0, 0.0),
+                       state="closed", affordances=("open",)))
+    return SceneGraph(RobotState((0.0, 0.0), room="room:1"),
+                      (RoomNode("room:1", "kitchen", (0.0, 0.0)),),
+                      (RegionNode("region:1.1", "room:1", (0.0, 0.0)),), objs, (),
+                      {"obj:1": 1.0, "obj:2": 3.0})
+
+
+def test_with_steps_to_spare_travel_decides() -> None:
+    """Two places, 50 steps: (V5) prices an action at a N_rem / s = 3 * 2 / 50 = 0.12 m, so
+    the near sink (cost 1.12) beats the cabinet (3.62 with the open) unless the cabinet is
+    more than 3.2 times likelier; (S3) keeps a = 3 m (4 against 6.5, 1.6 times). The
+    priors make it 2.9 times likelier. With 2 steps left the budget binds and (V5) is
+    (S3)."""
+    g = _sink_and_cabinet()
+    slack = VoiPlanner(SCORER)
+    slack.reset("spatula")
+    a = slack.decide(g)
+    ratio = a.scores["obj:2"] / a.scores["obj:1"]
+    assert 1.6 < ratio < 3.2  # so the two rules disagree
+    assert a.target == "obj:1"
+    floor = VoiPlanner(SCORER, VoiParams(step_rule="floor"))
+    floor.reset("spatula")
+    assert floor.decide(g).target == "obj:2"
+    tight = VoiPlanner(SCORER, VoiParams(step_budget=2))
+    tight.reset("spatula")
+    assert tight.decide(g).target == "obj:2"
 
 
 def test_share_profile_and_expected_checks() -> None:
