@@ -22,11 +22,14 @@ refreshes during the skill. At equal log times a closing Episode record comes af
 actions (the closed loop closes an episode at the time of its last action).
 
 **A planner against a log** (:func:`replay_decisions`): the planner is reset with the
-episode's query and seed, then at every decision point it decides on the logged graph and
-its choice is compared with the logged action; then it is told the logged outcome and the
-executor's message (:func:`executor_message`; teacher forcing: its memory follows what was
-really done, not what it would have done). An LLM planner replaying the log's own
-exchanges therefore sees the prompts of the run and matches every decision.
+episode's query and seed, then at every decision point it decides on the logged graph as
+the live planner was shown it (:meth:`~sgtool.log.records.Action.shown`: the Action
+record's ``view_distances`` when it has them, which the closed loop's live navigation
+writes) and its choice is compared with the logged action; then it is told the logged
+outcome and the executor's message (:func:`executor_message`; teacher forcing: its
+memory follows what was really done, not what it would have done). An LLM planner
+replaying the log's own exchanges therefore sees the prompts of the run and matches every
+decision.
 Reported: exact agreement (same skill and target), same target, same room (the chosen and
 the logged node lie in the same room), and choices that name no node of the graph.
 
@@ -372,7 +375,7 @@ def replay_decisions(planner: Planner, episodes: Sequence[LoggedEpisode],
             logged = d.action
             if d.graph is not None:
                 t0 = time.perf_counter()
-                chosen = planner.decide(d.graph)
+                chosen = planner.decide(logged.shown(d.graph))
                 dt = time.perf_counter() - t0
                 valid = chosen.skill == "done" or chosen.target in d.graph.node_ids()
                 lr = node_rooms(d.graph, logged.target)

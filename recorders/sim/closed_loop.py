@@ -90,6 +90,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
+from sgtool.canonical import canonical_float
 from sgtool.datasets.episodes import Episode, list_episodes
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
@@ -203,6 +204,7 @@ class _Search:
         self.end = ""
         self.decision_times: list[float] = []
         self._graph_time_ns = 0
+        self._shown: dict[str, Any] = {}  # the view's distances for the log (decided())
         self._decision_s = 0.0
         self._confirming = False  # the decision after the target came into view ("done")
         # live navigation: the planner sees the graph with the robot's reachability
@@ -275,6 +277,8 @@ class _Search:
         for why in self._withheld_now.values():
             self.withheld[why] = self.withheld.get(why, 0) + 1
         self._graph_time_ns = int(cur.time_ns)
+        graph = graph.canonical()  # as a replay of the log will show it
+        self._shown = _shown(graph, cur.graph)
         self._seen = graph
         return graph
 
@@ -344,7 +348,7 @@ class _Search:
                 self.failed.failed(action.target)  # not offered again from the same place
         outcome = SkillOutcome(action.skill, action.target, o, why, dist, ticks)
         self.last_t = self.rec.act(self.sim, outcome, self._decision_s,
-                                   {"graph_time_ns": self._graph_time_ns})
+                                   {"graph_time_ns": self._graph_time_ns, **self._shown})
         self._check(self.rec.stream.current, cut)  # found overrides a done
         if self.explore_on and self.skills is not None and action.skill == "explore" and \
                 o == "success" and why != IN_VIEW and self._seen is not None:
@@ -371,6 +375,7 @@ class _Search:
             if not fronts:
                 break
             t0 = time.perf_counter()
+            only = only.canonical()
             action = self.agent.decide(only)
             dt = time.perf_counter() - t0
             self.decision_times.append(dt)
@@ -384,7 +389,7 @@ class _Search:
             self.last_t = self.rec.act(
                 self.sim, SkillOutcome("explore", action.target, ex.outcome, why,
                                        ex.travelled_m, ex.ticks), dt,
-                {"graph_time_ns": int(cur.time_ns)})
+                {"graph_time_ns": int(cur.time_ns), **_shown(only, cur.graph)})
             self.agent.feedback(Feedback(action, ex.outcome, ex.reason, ex.travelled_m))
             if ex.outcome == "failure" and not ex.cut:
                 self.failed.failed(str(action.target))
@@ -403,7 +408,7 @@ class _Search:
         why = f"{GAVE_UP}: the robot explores them (fallback)"
         outcome = SkillOutcome("done", None, "success", why, 0.0, 0)
         self.last_t = self.rec.act(self.sim, outcome, self._decision_s,
-                                   {"graph_time_ns": self._graph_time_ns})
+                                   {"graph_time_ns": self._graph_time_ns, **self._shown})
         self._check(self.rec.stream.current, False)
         if not self.end:
             self._hand_over(GAVE_UP, actionable(graph))
@@ -418,7 +423,7 @@ class _Search:
         outcome = SkillOutcome(step.action.skill, step.action.target, fb.outcome,
                                fb.message, 0.0, 0)
         self.last_t = self.rec.act(self.sim, outcome, self._decision_s,
-                                   {"graph_time_ns": self._graph_time_ns})
+                                   {"graph_time_ns": self._graph_time_ns, **self._shown})
 
     def _run(self, calls: tuple[SkillCall, ...]) -> Executed:
         if self.skills is None:
@@ -556,6 +561,15 @@ def _started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOp
         "explore_on": opts.explore_on,
         **_rule(opts),
     }
+
+
+def _shown(view: SceneGraph, logged: SceneGraph) -> dict[str, Any]:
+    """``{"view_distances": ...}`` when the planner was shown ``view`` with other distances
+    than the ``logged`` graph's (the Action record's field: an offline replay shows a planner
+    the same graph); empty when they are the same."""
+    if view.distances == {k: canonical_float(v) for k, v in logged.distances.items()}:
+        return {}
+    return {"view_distances": dict(view.distances)}
 
 
 def _withheld(search: _Search) -> dict[str, Any]:

@@ -47,6 +47,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import ndimage
 
+from sgtool.canonical import canonical_float
 from sgtool.mapping.occupancy import OccupancyMap
 from sgtool.planning.candidates import actionable
 from sgtool.recorders.sim.live_skills import Goal, LiveSkills, goal_of_node
@@ -215,7 +216,8 @@ def reachable_view(refresh: Refresh, skills: LiveSkills,
             withheld[c.node_id] = LOOKED
             continue
         r, col = occ.grid.cell_of(cell[0], cell[1])
-        live[c.node_id] = float(dist[int(r), int(col)])
+        # rounded as the log writes it, so a replay from the log shows the same numbers
+        live[c.node_id] = canonical_float(dist[int(r), int(col)])
     return View(without_nodes(graph, set(withheld), live), withheld)
 
 

@@ -129,11 +129,19 @@ def schema_problem(value: object, schema: Mapping[str, Any], path: str = ""
         for key in schema.get("required", ()):
             if key not in value:
                 return (f"{path}.{key}" if path else key), "is missing"
-        for key, sub in schema.get("properties", {}).items():
+        props = schema.get("properties", {})
+        for key, sub in props.items():
             if key in value:
                 p = schema_problem(value[key], sub, f"{path}.{key}" if path else key)
                 if p is not None:
                     return p
+        extra = schema.get("additionalProperties")
+        if isinstance(extra, Mapping):
+            for key, v in value.items():
+                if key not in props:
+                    p = schema_problem(v, extra, f"{path}.{key}" if path else key)
+                    if p is not None:
+                        return p
     if isinstance(value, list) and "items" in schema:
         for i, item in enumerate(value):
             p = schema_problem(item, schema["items"], f"{path}[{i}]")
@@ -300,7 +308,10 @@ class Action(LogRecord):
     record without one), ``travelled_m`` (metres, rounded to 0.1 mm on write), ``planner``
     (its name), ``step`` (the index in the episode) and ``graph_time_ns`` (1.1): the log
     time of the scene graph it was decided on; null: decided on no graph; absent: the last
-    graph at or before the action's log time.
+    graph at or before the action's log time; ``view_distances`` (1.2): the ``distances``
+    of the graph as the planner was shown it, when they differ from the logged graph's (the
+    closed loop's live navigation shows the robot's own geodesics and withholds the goals
+    it cannot reach: a node missing here was not on offer); absent: the logged graph's.
 
     The planner's fields are never :data:`ABSENT` (a planner always has a target, maybe
     None, and a reason, maybe empty). A log record that lacks one reads as its default and
@@ -324,6 +335,7 @@ class Action(LogRecord):
     planner: str | None | Absent = ABSENT
     step: int | Absent = ABSENT
     graph_time_ns: int | None | Absent = ABSENT
+    view_distances: Mapping[str, float] | Absent = ABSENT
     # planner fields the logged record did not hold (see the class doc)
     absent: frozenset[str] = field(default=frozenset(), kw_only=True)
 
@@ -335,6 +347,10 @@ class Action(LogRecord):
 
     def to_json(self) -> dict[str, Any]:
         out = super().to_json()
+        if "view_distances" in out:
+            out["view_distances"] = {  # numbers rounded; anything else is left to check()
+                k: canonical_float(v) if isinstance(v, (int, float)) and
+                not isinstance(v, bool) else v for k, v in sorted(out["view_distances"].items())}
         for name in self.absent:
             if getattr(self, name) == self.PLANNER_DEFAULTS[name]:
                 del out[name]
@@ -344,6 +360,13 @@ class Action(LogRecord):
     def decided(self) -> bool:
         """False for an action decided on no graph (``graph_time_ns`` null)."""
         return self.graph_time_ns is not None
+
+    def shown(self, graph: SceneGraph) -> SceneGraph:
+        """``graph`` (the logged graph this action was decided on) as the planner was shown
+        it: with :attr:`view_distances` when the record holds them."""
+        if isinstance(self.view_distances, Absent):
+            return graph
+        return replace(graph, distances=dict(self.view_distances))
 
     @property
     def result(self) -> Outcome:

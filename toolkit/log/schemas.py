@@ -149,10 +149,12 @@ RECORDS: dict[RecordName, RecordKind] = {
     # 1.1: optional graph_time_ns, the log time of the sgtool.SceneGraph the action was
     # decided on (null: decided on no graph, e.g. the closed loop's opening look-around;
     # absent: the last graph at or before the action's log time)
+    # 1.2: optional view_distances, node id -> metres: the distances of that graph as the
+    # planner was shown it (absent: the logged graph's)
     "action": RecordKind(
         "action",
         "sgtool.Action",
-        "1.1",
+        "1.2",
         "/sgtool/action",
         _obj(
             {
@@ -165,6 +167,7 @@ RECORDS: dict[RecordName, RecordKind] = {
                 "planner": _NSTR,
                 "step": _INT,
                 "graph_time_ns": {"type": ["integer", "null"]},
+                "view_distances": {"type": "object", "additionalProperties": _NUM},
             },
             ["skill", "outcome"],
         ),

@@ -190,6 +190,11 @@ class SceneGraph:
             "distances": {k: canonical_float(v) for k, v in sorted(self.distances.items())},
         }
 
+    def canonical(self) -> SceneGraph:
+        """This graph as its canonical JSON reads back (floats rounded as
+        :meth:`to_json` writes them): the graph a reader of the log gets."""
+        return SceneGraph.from_json(self.to_json())
+
     def to_json(self) -> str:
         """Canonical JSON: byte-identical for equal graphs."""
         return json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"))

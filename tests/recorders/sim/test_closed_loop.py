@@ -11,6 +11,7 @@ and then from its transcript; user errors; the graph_time_ns pairing of `sgtool 
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import re
 from pathlib import Path
@@ -242,6 +243,28 @@ def test_same_inputs_same_log_but_decision_times(scout_log, house, tmp_path) -> 
     assert rep.success and rep.end == "found"
     assert messages(path, [GRAPH]) == messages(again, [GRAPH])
     assert masked(path) == masked(again)
+
+
+def test_a_replay_shows_the_planner_the_graph_it_was_shown(house, tmp_path) -> None:
+    """Live navigation shows the planner the graph with the robot's own distances and the
+    goals it cannot reach withheld; the Action record keeps those distances, so the logged
+    graph as shown (``Action.shown``) is, decision for decision, the graph the planner got,
+    and greedy (which goes by distance) makes every logged choice again offline."""
+    idx, ep = pick_episode(house, index=1)
+    out = tmp_path / "greedy.mcap"
+    given: list[SceneGraph] = []
+    run_episode(house, ep, make_planner("greedy"), out,
+                dataclasses.replace(OPTS, max_steps=6), episode_index=idx,
+                on_decision=lambda g, a: given.append(g))
+    (logged,) = read_log_episodes(out)
+    decided = [d for d in logged.decisions if d.decided]
+    assert len(decided) == len(given) >= 2
+    assert any(d.action.view_distances for d in decided)
+    for d, g in zip(decided, given, strict=True):
+        assert d.graph is not None
+        assert d.action.shown(d.graph) == g
+    rep = replay_decisions(make_planner("greedy"), [logged])
+    assert rep.decisions == len(given) and rep.rate("agree") == 1.0
 
 
 # ----- other planners and endings -----------------------------------------------------

@@ -234,7 +234,8 @@ def test_after_opening_a_container_the_robot_peeks_in_and_back(house, tmp_path) 
     low = [i for i, t in enumerate(tilts) if t > 15.0 + 1e-6]
     stand = frames1[low[0]].base_pose
     goal = peek_tilt(1.2, 15.0, (stand[0, 3], stand[1, 3]), node.position)
-    assert goal is not None and max(tilts) == pytest.approx(goal)
+    # (the planner's graph is the log's, positions to 0.1 mm; the skill aims at the raw one)
+    assert goal is not None and max(tilts) == pytest.approx(goal, abs=0.01)
     # one frame a tick down and back up, the base standing still
     assert low == list(range(low[0], low[-1] + 1))
     assert len(low) == 2 * len(head_tilts(15.0, goal, 9.0)) - 1

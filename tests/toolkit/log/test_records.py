@@ -36,6 +36,8 @@ SAMPLES = [
            decision_time_s=0.0, planner=None, step=0, graph_time_ns=None),
     Action(skill="explore", outcome="failure", target="room:1", graph_time_ns=10),
     Action(skill="done", outcome="success"),
+    Action(skill="navigate", outcome="success", target="room:0", graph_time_ns=10,
+           view_distances={"room:0": 2.5, "obj:3": 0.75}),
     Instances((InstanceItem(id=1, category="fridge", kind="furniture", state="closed",
                             affordances=("container", "openable"), parent=None,
                             relation=None, synset="fridge.n.01", spec_id="f0"),
@@ -75,6 +77,18 @@ def test_absent_and_null_differ_and_unknown_keys_survive() -> None:
     assert Action.from_json(future).to_json() == future
 
 
+def test_an_action_shows_the_graph_with_the_distances_the_planner_saw() -> None:
+    """``view_distances`` replace the logged graph's distances (written rounded, keys
+    sorted); without them the logged graph is what was shown."""
+    a = Action(skill="navigate", outcome="success", target="room:0",
+               view_distances={"room:0": 2.123456, "obj:9": 1.0})
+    assert a.to_json()["view_distances"] == {"obj:9": 1.0, "room:0": 2.1235}
+    shown = Action.from_json(a.to_json()).shown(GRAPH)
+    assert shown.distances == {"obj:9": 1.0, "room:0": 2.1235}
+    assert shown.rooms == GRAPH.rooms and shown.robot == GRAPH.robot
+    assert Action(skill="done", outcome="success").shown(GRAPH) is GRAPH
+
+
 def test_the_graph_record_is_the_graph_json() -> None:
     rec = SceneGraphRecord.of_graph(GRAPH)
     assert json.dumps(rec.to_json(), sort_keys=True, separators=(",", ":")) == GRAPH.to_json()
@@ -102,6 +116,8 @@ def test_typed_write_is_byte_identical_to_the_dict_write(tmp_path) -> None:
 @pytest.mark.parametrize("record, field", [
     (Action(skill="navigate", outcome="success", travelled_m="far"), "travelled_m"),
     (Action(skill="navigate", outcome="maybe"), "outcome"),
+    (Action(skill="navigate", outcome="success", view_distances={"room:0": "far"}),
+     "view_distances.room:0"),
     (Episode(kind="search", status="started", steps=1.5), "steps"),
     (Instances((InstanceItem(id=1, category="cup", kind="thing"),)), "instances[0].kind"),
     (LlmExchange(model="m", messages=({"role": "user", "content": "x"},), attempt=True),
