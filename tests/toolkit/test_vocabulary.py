@@ -29,7 +29,7 @@ from sgtool.vocabulary import (
 SCHEMA_SHA256 = {
     "episode": "09a772f2cd73b39c60a9ef1a2689d2220978bcfbc5d9aff52e924e59884cba49",
     "instances": "3a7144fe8a9f4bcfbd2d10db092c8adef810eda86696e0b0cd0e39c992add11d",
-    "action": "b28ed902c7c1bbfc7c562f81404dc4212a52747f5a7b423f69c3ac584dc36fea",
+    "action": "9a37e0244a879ed2d3622b932947537a31fdb048995b5fe543ab9f4783ff6e06",
     "scene_graph": "d75746a34e204e347ce74f3eba19ac3715d2c79915dbcfc496545997f41253ed",
     "llm_exchange": "ebee81511fa0b81154bcbf905d2fa55e1dd344f1af15df72ee35b147bbfb7ac4",
 }
