@@ -89,8 +89,12 @@ def step_price(p: np.ndarray, steps_left: int | None, base: float) -> float:
     steps left: a · max(1, N_eff / steps_left) with N_eff = 1 / Σ p² (module doc)."""
     if not steps_left or steps_left <= 0 or not len(p):
         return base
-    n_eff = 1.0 / max(float(np.sum(p * p)), 1e-12)
-    return base * max(1.0, n_eff / steps_left)
+    return base * max(1.0, effective_places(p) / steps_left)
+
+
+def effective_places(p: np.ndarray) -> float:
+    """N_eff of (S3): 1 / Σ p², the inverse Simpson index of the belief."""
+    return 1.0 / max(float(np.sum(p * p)), 1e-12)
 
 
 def extra_cost(c: Candidate, params: SearchParams, step: float | None = None) -> float:

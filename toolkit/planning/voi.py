@@ -81,7 +81,12 @@ from sgtool.planning.candidates import (
 )
 from sgtool.planning.furniture_prior import furniture_level
 from sgtool.planning.planners import ScoringPlanner
-from sgtool.planning.search_theory import _orderings, sequence_values, step_price
+from sgtool.planning.search_theory import (
+    _orderings,
+    effective_places,
+    sequence_values,
+    step_price,
+)
 from sgtool.planning.utility import UNKNOWN_ROOM
 from sgtool.scenegraph.graph import ObjectNode, RegionNode, RoomNode, SceneGraph
 from sgtool.semantics.priors import RelationScorer, can_score_room
@@ -355,8 +360,7 @@ def slack_step_price(p: np.ndarray, steps_left: int | None, base: float,
     there is no budget."""
     if not steps_left or steps_left <= 0 or not len(p):
         return base
-    n_eff = 1.0 / max(float(np.sum(p * p)), 1e-12)
-    return base * max(n_eff / steps_left, min(1.0, remaining / steps_left))
+    return base * max(effective_places(p) / steps_left, min(1.0, remaining / steps_left))
 
 
 def expected_checks(carriers: Sequence[ObjectNode], c: Sequence[float]) -> float:
