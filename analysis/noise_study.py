@@ -202,10 +202,11 @@ def cache_key(house: Mapping[str, Any], noise: str, settings: RecordingSettings)
 
 
 def record_task_log(task: StudyTask) -> bool:
-    """Record ``task.log`` unless it is there (a log only appears once complete); True when
+    """Record ``task.log`` unless it is there (a log only appears once complete; one that
+    no longer opens, cut off or damaged in the cache, is recorded again); True when
     recorded now."""
     out = Path(task.log)
-    if out.is_file():
+    if out.is_file() and _opens(out):
         return False
     from sgtool.datasets.start_poses import with_start_poses
     from sgtool.house.io import load_house_text
@@ -230,6 +231,17 @@ def record_task_log(task: StudyTask) -> bool:
     if task.key_json:
         atomic_write(out.with_suffix(".json"), task.key_json)
     return True
+
+
+def _opens(log: Path) -> bool:
+    """Whether ``log`` opens as an MCAP file (its start and end magic and summary)."""
+    from sgtool.log import LogReader
+
+    try:
+        with LogReader(log):
+            return True
+    except (SgtoolError, OSError):
+        return False
 
 
 def score_log(log: str | Path) -> tuple[int, dict[str, dict[str, float | int]]]:

@@ -166,13 +166,33 @@ def options_dict(o: ReplayOptions) -> dict[str, Any]:
             if getattr(o, f.name) != getattr(default, f.name)}
 
 
+_OPTION_TYPES: dict[str, tuple[type, ...]] = {
+    "every": (int,), "classifier": (str,), "min_points": (int,), "voxel_size": (float, int),
+    "max_frames": (int,), "tf_time": (str,)}  # of ReplayOptions' fields (None: unset)
+
+
 def options_from(d: Mapping[str, Any], where: str) -> ReplayOptions:
+    """The replay options of a pin entry; one-line :class:`PinError` for an option this
+    sgtool does not know or a value of the wrong type."""
+    if not isinstance(d, Mapping):
+        raise PinError(f"{where}: replay options must be an object, not {_json_kind(d)}")
     known = {f.name for f in fields(ReplayOptions)}
     unknown = set(d) - known
     if unknown:
         raise PinError(f"{where}: replay option {sorted(unknown)[0]!r} is unknown to this "
                        f"sgtool ({__version__}); upgrade sgtool, or pin again")
+    for k, v in sorted(d.items()):
+        kinds = _OPTION_TYPES.get(k, (object,))
+        if v is not None and (isinstance(v, bool) or not isinstance(v, kinds)):
+            raise PinError(f"{where}: replay option {k!r} is {_json_kind(v)} {v!r}; expected "
+                           f"{' or '.join(t.__name__ for t in kinds)}")
     return ReplayOptions(**{k: v for k, v in d.items() if k in known})
+
+
+def _json_kind(v: Any) -> str:
+    """What a JSON value is, for a message: "a list", "a string", ..."""
+    return {dict: "an object", list: "a list", str: "a string", bool: "a boolean",
+            int: "a number", float: "a number", type(None): "null"}.get(type(v), type(v).__name__)
 
 
 def overridden(pinned: ReplayOptions, given: ReplayOptions | None) -> ReplayOptions:
@@ -252,19 +272,26 @@ def read_pins(folder: str | os.PathLike[str]) -> PinSet:
         try:
             logs[name] = _entry(name, entry, common, fmt, path)
         except (KeyError, TypeError, ValueError) as err:
-            raise _damaged(path, f"entry {name!r}: {type(err).__name__} {err}") from None
+            raise _damaged(path, f"entry {name!r}: {err}") from None
     return PinSet(root, logs, fmt, str(doc.get("sgtool_version", "")))
 
 
 def _entry(name: str, e: Mapping[str, Any], common: Mapping[str, Any], fmt: int,
            path: Path) -> Pinned:
+    if not isinstance(e, Mapping):
+        raise TypeError(f"must be an object, not {_json_kind(e)}")
+    for key, kinds in (("log", (str,)), ("quality", (dict,)), ("resolved", (dict,)),
+                       ("planner", (str,)), ("why", (str,)), ("decisions", (list,))):
+        if e.get(key) is not None and not isinstance(e[key], kinds):
+            raise TypeError(f"{key!r} is {_json_kind(e[key])}, expected "
+                            f"{' or '.join(_json_kind(t()) for t in kinds)}")
     options = options_from(common if fmt == 1 else e.get("options", {}), f"{path}: {name}")
     decisions = None
     if e.get("decisions") is not None:
         decisions = tuple(Decision(int(ep), int(st), str(sk), None if t is None else str(t))
                           for ep, st, sk, t in e["decisions"])
     return Pinned(
-        name=name, log=str(e.get("log", f"{name}.mcap")), log_sha256=str(e["log_sha256"]),
+        name=name, log=str(e.get("log") or f"{name}.mcap"), log_sha256=str(e["log_sha256"]),
         refreshes=int(e["refreshes"]), final_sha256=str(e["final_sha256"]),
         sequence_sha256=str(e["sequence_sha256"]), options=options,
         log_bytes=None if e.get("log_bytes") is None else int(e["log_bytes"]),

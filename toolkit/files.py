@@ -77,6 +77,10 @@ def output_error(e: OSError, path: str | os.PathLike[str] | None = None,
     error names): ``cannot write PATH: No space left on device (nothing was written)``."""
     where = path if path is not None else (e.filename or "the output")
     reason = e.strerror or type(e).__name__
+    if isinstance(e, (FileExistsError, NotADirectoryError)) and path is not None:
+        file = next((p for p in Path(path).parents if p.is_file()), None)
+        if file is not None:  # a folder on the way is a file
+            reason = f"{file} is a file, not a folder"
     return OutputError(f"cannot write {where}: {reason}" + (f" ({note})" if note else ""))
 
 

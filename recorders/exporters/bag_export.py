@@ -149,6 +149,9 @@ def select_outputs(names: Iterable[str] | None) -> list[str]:
     return [t for t in OUTPUTS if t in chosen]
 
 
+_MAX_STAMP_S = 2**31 - 1  # ROS time: int32 seconds (builtin_interfaces/Time)
+
+
 def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
                force: bool = False, *, time_base_s: float = DEFAULT_TIME_BASE_S,
                frames: Mapping[str, str] | None = None, distro: str = "humble",
@@ -189,6 +192,10 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
         if tr is not None and tr[0] + base_ns <= 0:
             raise SgtoolError(f"--time-base {time_base_s:g}: the first message would be at "
                               "stamp 0; give a time base > 0")
+        if tr is not None and (tr[1] + base_ns) // 1_000_000_000 > _MAX_STAMP_S:
+            raise SgtoolError(f"--time-base {time_base_s:g}: the last message's stamp would "
+                              f"pass {_MAX_STAMP_S} s, the largest a ROS time holds (a signed "
+                              "32-bit count of seconds)")
         derived = r.has(GRAPH_TOPIC) or r.has(S.OCCUPANCY)
         names = frames if frames is not None else REP105
 

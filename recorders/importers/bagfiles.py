@@ -107,7 +107,29 @@ def open_bag(path: str | Path) -> Iterator[Any]:
             raise SgtoolError(f"{path}: not a readable ROS bag ({type(e).__name__}: {e})") from e
         except Exception as e:  # the bag readers raise assorted errors on garbage
             raise SgtoolError(f"{path}: not a readable ROS bag ({type(e).__name__}: {e})") from e
-        yield reader
+        try:
+            yield reader
+        except Exception as e:
+            if not damaged_bag(e):
+                raise
+            raise SgtoolError(f"{path}: damaged or truncated bag, a message cannot be read "
+                              f"({type(e).__name__}: {e})") from e
+
+
+_DAMAGE_MODULES = ("rosbags.", "backports.zstd", "zstandard", "compression.zstd", "lz4",
+                   "mcap.")
+
+
+def damaged_bag(exc: BaseException) -> bool:
+    """Whether ``exc``, raised while reading a bag's messages, says the file is damaged
+    (a bag reader's, a decompressor's or a record decoder's error), not a bug of ours."""
+    import struct
+    import zlib
+
+    if isinstance(exc, (EOFError, struct.error, zlib.error)):
+        return True
+    return any(type(exc).__module__.startswith(m) or type(exc).__module__ == m.rstrip(".")
+               for m in _DAMAGE_MODULES)
 
 
 def list_topics(reader: Any) -> list[TopicInfo]:

@@ -28,7 +28,13 @@ INVALID_U16 = 65535
 def _read_image(path: Path) -> np.ndarray:
     if not Path(path).is_file():
         raise SgtoolError(f"{path}: no such image file")
-    a = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    # decoded from the bytes: cv2.imread takes the name as UTF-8 text and crashes on a
+    # file name that is not (a folder named in another encoding)
+    try:
+        data = np.fromfile(path, dtype=np.uint8)
+    except OSError as e:
+        raise SgtoolError(f"{path}: cannot read ({e.strerror or e})") from None
+    a = cv2.imdecode(data, cv2.IMREAD_UNCHANGED) if data.size else None
     if a is None:
         raise SgtoolError(f"{path}: OpenCV cannot read this image")
     return a

@@ -60,11 +60,18 @@ def parse_value(text: str) -> Any:
     return parse_text(text)
 
 
+DEFAULT_ROOMS_TEXT = "4-12"  # --rooms of a house generated with --seed
+
+
 def house_from_options(path: str | None, seed: int | None, rooms: str) -> tuple[Any, str]:
     """(HouseSpec, house id) of ``--house``, ``--seed`` (with ``--rooms``) or the demo
     house shipped with sgtool; both given is an error."""
     if path is not None and seed is not None:
         raise SgtoolError("give either --house or --seed, not both")
+    parsed = parse_rooms(rooms)  # a bad range is an error, with or without --seed
+    if seed is None and rooms != DEFAULT_ROOMS_TEXT:
+        raise SgtoolError(f"--rooms {rooms}: the room count of a house generated with --seed; "
+                          "give --seed N as well")
     if path is not None:
         from sgtool.house.io import load_house
 
@@ -72,7 +79,7 @@ def house_from_options(path: str | None, seed: int | None, rooms: str) -> tuple[
     if seed is not None:
         from sgtool.datasets.generator import generate_house
 
-        return generate_house(seed, rooms=parse_rooms(rooms)), f"house-{seed}"
+        return generate_house(seed, rooms=parsed), f"house-{seed}"
     from sgtool.datasets import demo_house
 
     return demo_house(), "demo"
@@ -110,7 +117,8 @@ def house_options(seed_help: str, rooms_help: str) -> Callable[[F], F]:
                      help="House spec (JSON, see `sgtool scenes`). Default: the demo house "
                      "shipped with sgtool, unless --seed is given."),
         click.option("--seed", type=int, default=None, help=seed_help),
-        click.option("--rooms", default="4-12", show_default=True, metavar="MIN-MAX",
+        click.option("--rooms", default=DEFAULT_ROOMS_TEXT, show_default=True,
+                     metavar="MIN-MAX",
                      help=rooms_help),
     ])
 

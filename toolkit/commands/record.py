@@ -146,6 +146,8 @@ def _request(args: RecordArgs, out: Path) -> RecordRequest:
         raise SgtoolError(f"--frames {args.frames}: must be >= 1")
     width, height = parse_resolution(args.resolution)
     dmin, dmax = _pair("--depth-range", args.depth_range)
+    if not 0.0 < dmin < dmax:
+        raise SgtoolError(f"--depth-range {args.depth_range}: need 0 < MIN < MAX (metres)")
     camera = CameraConfig(width=width, height=height, vfov_deg=args.fov,
                           mount_height=args.camera_height, tilt_deg=args.tilt,
                           depth_min=dmin, depth_max=dmax, near=min(0.05, dmin))

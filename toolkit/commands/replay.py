@@ -236,7 +236,8 @@ def _outputs(args: ReplayArgs, src: Path) -> Path | None:
             raise SgtoolError(f"{opt} {given}: the output must not be the input log")
     dst = check_log_output(args.output, force=args.force) if args.output else None
     if args.rrd:
-        check_output(args.rrd, force=args.force, option="--rrd")
+        check_output(args.rrd, force=args.force, option="--rrd", suffixes=(".rrd",),
+                     what="Rerun recording")
     return dst
 
 

@@ -62,7 +62,7 @@ def _target(log: str, out: str | None, force: bool, rerun_to: str | None) -> Any
     if out is not None:
         if Path(out).resolve() == Path(log).resolve():
             raise SgtoolError("the output must not be the input log")
-        check_output(out, force=force)
+        check_output(out, force=force, suffixes=(".rrd",), what="Rerun recording")
         return None
     live = parse_target(rerun_to) if rerun_to is not None else LiveTarget("spawn")
     if live.mode == "spawn" and not (os.environ.get("DISPLAY")

@@ -316,7 +316,9 @@ class LogWriter:
         self.attach(S.HOUSE_ATTACHMENT, data, "application/json")
 
     def add_metadata(self, name: str, data: dict[str, str]) -> None:
-        self._mcap.add_metadata(name, data)
+        """Add an MCAP metadata record. MCAP strings are UTF-8: text that holds an OS file
+        name's undecodable bytes (``surrogateescape``) keeps them as ``\\xNN`` escapes."""
+        self._mcap.add_metadata(_utf8(name), {_utf8(k): _utf8(v) for k, v in data.items()})
 
     # ----- sensors ----------------------------------------------------------------------
     def write_rgb(self, t_ns: int, rgb: np.ndarray, frame_id: str = S.CAMERA_FRAME) -> None:
@@ -438,3 +440,13 @@ class LogWriter:
             self.abort()
             if isinstance(exc, OSError) and concerns(exc, self.partial_path, self.path):
                 raise output_error(exc, self.path) from None
+
+
+def _utf8(text: str) -> str:
+    """``text`` as valid UTF-8: lone surrogates (undecodable bytes of a file name) become
+    ``\\xNN`` escapes; other text is returned unchanged."""
+    try:
+        text.encode("utf-8")
+        return text
+    except UnicodeEncodeError:
+        return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")

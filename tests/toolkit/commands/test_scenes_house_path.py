@@ -23,7 +23,7 @@ def test_a_house_file_named_with_a_brace_loads(tmp_path: Path) -> None:
     r = CliRunner().invoke(cli, ["scenes", "episodes", str(p), "-n", "1"])
     assert r.exit_code == 0, r.output
     assert "apple" in r.output or "cup" in r.output
-    spec, house_id = house_from_options(str(p), None, "4-5")
+    spec, house_id = house_from_options(str(p), None, "4-12")
     assert house_id == "{h1}" and len(spec.rooms) == 2
 
 

@@ -318,7 +318,7 @@ def test_eval_and_view_never_overwrite_without_force(tmp_path):
         r = CliRunner().invoke(cli, ["eval", str(eps), "--distance-budget", bad])
         assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1, (bad, r.output)
     log = write_log(tmp_path / "run.mcap")
-    other = tmp_path / "other.mcap"
+    other = tmp_path / "other.rrd"  # an existing file under the name -o gives
     other.write_bytes(log.read_bytes())
     r = CliRunner().invoke(cli, ["view", str(log), "-o", str(other), "--no-voxels"])
     assert r.exit_code == 2 and "exists; not overwriting it (use --force)" in r.output
