@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from sgtool.errors import SgtoolError
 from sgtool.house.spec import HouseSpec
 
 if TYPE_CHECKING:
@@ -115,3 +116,6 @@ def run_search(request: SearchRequest, show: Echo, note: Echo) -> None:
                              episode_index=request.episode_index, overwrite=request.force,
                              progress=bar, on_decision=live.decision if live else None)
     _finish(report, live, request.quiet, show, note)
+    miss = getattr(planner, "replay_miss", None)
+    if miss:  # as `sgtool replay` says it: the episode left the recorded transcript
+        raise SgtoolError(f"{miss} ({request.output} holds the episode up to there)")

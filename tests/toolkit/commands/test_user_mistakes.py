@@ -153,3 +153,14 @@ def test_a_cut_off_cached_study_log_is_recorded_again(tmp_path, monkeypatch):
                      settings=RecordingSettings(), key_json="")
     assert record_task_log(task) and recorded == [log]
     assert not record_task_log(task)  # whole now: kept
+
+
+def test_a_run_that_leaves_its_recorded_transcript_is_an_error(tmp_path):
+    empty = tmp_path / "t.jsonl"
+    empty.write_text("")
+    out = tmp_path / "run.mcap"
+    err = _refusal(["run", "-p", "moma-llm", "--llm-replay", str(empty), "--frames", "200",
+                    "--resolution", "32x24", "--quiet", "-o", str(out)])
+    assert "holds no (more) responses" in err and "holds the episode up to there" in err
+    with LogReader(out) as r:  # the episode so far is a whole log
+        assert r.frame_count() > 0

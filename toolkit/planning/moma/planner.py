@@ -130,6 +130,7 @@ class MomaLlmPlanner:
                 if getattr(client, "takes_constraint", False) else "none"
         self.reason_chars = int(reason_chars)
         self.invalid_commands = 0  # answers rejected (unparsable or not groundable)
+        self.replay_miss: str | None = None  # the recorded transcript ran out (this episode)
         self.client = client
         self.max_attempts = int(max_attempts)
         self.stuck_repeats = int(stuck_repeats)
@@ -145,6 +146,7 @@ class MomaLlmPlanner:
     # ----- Planner protocol -------------------------------------------------------------
     def reset(self, query: str, seed: int = 0) -> None:
         self.invalid_commands = 0
+        self.replay_miss = None
         self.query = query
         self.step = 0
         self.history = []
@@ -182,6 +184,7 @@ class MomaLlmPlanner:
                 result = complete_within(self.client, messages, left, constraint)
             except ReplayMiss as e:
                 self._log(messages, None, 0.0, None, None, str(e), attempt)
+                self.replay_miss = str(e)
                 return Action("done", None, reason=f"llm failure: {e}")
             except LlmTransportError as e:
                 self._log(messages, None, 0.0, None, None, str(e), attempt)
