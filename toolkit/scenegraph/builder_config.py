@@ -34,3 +34,6 @@ class BuilderConfig:
     corridor: str | None = "corridor"  # the type of an empty narrow room (None: unknown)
     corridor_clearance: float = 0.9  # m: no node of a narrow room is farther from a wall
     corridor_length: float = 3.0  # m: the span of its nodes at least
+    # a container or supporter is examined once close frames saw into (onto) enough of it
+    # (sgtool.scenegraph.examined.look_into); False: from any close view, the older rule
+    look_inside: bool = True
