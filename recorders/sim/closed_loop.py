@@ -126,6 +126,7 @@ from sgtool.recorders.sim.live_skills import IN_VIEW, LiveSkills, RobotBody
 from sgtool.recorders.sim.reachability import (
     FAILED_BEFORE,
     FailedGoals,
+    not_seen_into,
     reachable_view,
     without_nodes,
 )
@@ -144,7 +145,6 @@ from sgtool.scenegraph.build_options import (
     mapping_record,
 )
 from sgtool.scenegraph.categories import RoomClassifier
-from sgtool.scenegraph.examined import EXAMINE
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 from sgtool.semantics.text import category_text
@@ -348,7 +348,7 @@ class _Search:
             if o == "failure" and not cut and action.target is not None:
                 self.failed.failed(action.target)  # not offered again from the same place
             elif o == "success" and not cut and action.skill == "navigate" and \
-                    _not_seen_into(self.rec.stream.current, action.target):
+                    not_seen_into(self.rec.stream.current, action.target):
                 # stood at it and still did not see into it: not again from there
                 self.failed.failed(str(action.target))
         outcome = SkillOutcome(action.skill, action.target, o, why, dist, ticks)
@@ -533,15 +533,6 @@ def _classifier(name: str) -> RoomClassifier | None:
 
 def _found(refresh: Refresh | None, query: str) -> bool:
     return refresh is not None and find_target(refresh.graph, query) is not None
-
-
-def _not_seen_into(refresh: Refresh | None, target: str | None) -> bool:
-    """Whether ``target`` is an examinable object of the refresh's graph that is not
-    ``explored`` (:mod:`sgtool.scenegraph.examined`: its inside was not seen)."""
-    if refresh is None or target is None:
-        return False
-    node = next((n for n in refresh.graph.objects if n.id == target), None)
-    return node is not None and EXAMINE in node.affordances and not node.explored
 
 
 def _log_exchanges(agent: Any, writer: LogWriter, t_ns: int) -> None:

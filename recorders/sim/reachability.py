@@ -51,6 +51,7 @@ from sgtool.canonical import canonical_float
 from sgtool.mapping.occupancy import OccupancyMap
 from sgtool.planning.candidates import actionable
 from sgtool.recorders.sim.live_skills import Goal, LiveSkills, goal_of_node
+from sgtool.scenegraph.examined import EXAMINE
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.stream import Refresh
 
@@ -240,3 +241,13 @@ def without_nodes(graph: SceneGraph, drop: Iterable[str],
     if not dists:  # an empty dict means "no distances: straight lines" to the candidates
         dists = {"robot": 0.0}
     return dataclasses.replace(graph, distances=dists)
+
+
+def not_seen_into(refresh: Refresh | None, target: str | None) -> bool:
+    """Whether ``target`` is an examinable object of the refresh's graph that is not
+    ``explored`` (:mod:`sgtool.scenegraph.examined`: its inside was not seen): a
+    ``navigate`` to it that ends so is held back as a failed goal."""
+    if refresh is None or target is None:
+        return False
+    node = next((n for n in refresh.graph.objects if n.id == target), None)
+    return node is not None and EXAMINE in node.affordances and not node.explored

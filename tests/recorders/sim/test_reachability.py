@@ -238,7 +238,7 @@ def test_bump_marks_that_wall_the_robot_in_are_dropped() -> None:
 def test_a_navigate_that_did_not_see_into_its_piece_counts_as_failed() -> None:
     """After a ``navigate`` the closed loop holds the target back from the same place
     when the graph still has it unsearched (its node ``examine``-able, not explored)."""
-    from sgtool.recorders.sim.closed_loop import _not_seen_into
+    from sgtool.recorders.sim.reachability import not_seen_into
     from sgtool.scenegraph.graph import ObjectNode, RobotState, SceneGraph
     from sgtool.scenegraph.stream import Refresh
 
@@ -248,9 +248,9 @@ def test_a_navigate_that_did_not_see_into_its_piece_counts_as_failed() -> None:
         graph = SceneGraph(RobotState((0.0, 0.0)), objects=(node,))
         return Refresh(0, 0, 1, "frames", graph, None)
 
-    assert _not_seen_into(refresh(False, ("container", "examine")), "obj:7")
-    assert not _not_seen_into(refresh(True, ("container", "examine")), "obj:7")
-    assert not _not_seen_into(refresh(False, ("openable",)), "obj:7")  # nothing to see into
-    assert not _not_seen_into(refresh(False, ("container", "examine")), "obj:8")
-    assert not _not_seen_into(None, "obj:7") and not _not_seen_into(
+    assert not_seen_into(refresh(False, ("container", "examine")), "obj:7")
+    assert not not_seen_into(refresh(True, ("container", "examine")), "obj:7")
+    assert not not_seen_into(refresh(False, ("openable",)), "obj:7")  # nothing to see into
+    assert not not_seen_into(refresh(False, ("container", "examine")), "obj:8")
+    assert not not_seen_into(None, "obj:7") and not not_seen_into(
         refresh(False, ("examine",)), None)
