@@ -41,6 +41,7 @@ from sgtool.recorders.sim.simulation import Simulation
 from sgtool.scenegraph.examined import (
     FramePoints,
     PieceView,
+    carrier_kinds,
     close_views,
     examinable,
     look_into,
@@ -80,8 +81,7 @@ def views(seed: int, rooms: tuple[int, int], pixels: int, shares: list[float],
                 continue
             piece = by_spec[f.id]
             content = [by_spec[o] for o in held[f.id] if o in by_spec]
-            affs = {a.lower() for a in f.affordances}
-            cont, sup = "container" in affs, "supporter" in affs
+            cont, sup = carrier_kinds(f.affordances)
             kind = ("C" if cont else "") + ("S" if sup else "")
             c, s = math.cos(f.yaw), math.sin(f.yaw)
             for d, th in itertools.product(DISTANCES, ANGLES):

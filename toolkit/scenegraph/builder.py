@@ -103,11 +103,10 @@ from sgtool.scenegraph.door_evidence import (
 )
 from sgtool.scenegraph.door_voxels import DoorVoxels, near_median
 from sgtool.scenegraph.examined import (
-    CARRIER_AFFORDANCES,
     FramePoints,
     PieceView,
+    carrier_kinds,
     close_views,
-    examinable,
     look_into,
 )
 from sgtool.scenegraph.frontier_ids import FrontierTracker
@@ -295,18 +294,17 @@ class SceneGraphBuilder:
             if iid in self.examined:
                 continue
             info = self.instances.get(iid)
-            small = info is not None and info.kind == "object"
-            if not (self.config.look_inside and info is not None
-                    and examinable(info.affordances, small)):
+            container, supporter = (False, False) if info is None else \
+                carrier_kinds(info.affordances, info.kind == "object")
+            if not (self.config.look_inside and (container or supporter)):
                 self.examined.add(iid)
                 continue
-            kinds = {a.lower() for a in info.affordances} & CARRIER_AFFORDANCES
             if points is None:
                 points = FramePoints.of(ids, depth, frame.pose, frame.intrinsics,
                                         self.config.voxels.resolution)
             view = self._pieces.setdefault(iid, PieceView())
             look_into(view, iid, points)
-            if view.searched("container" in kinds, "supporter" in kinds and not small):
+            if view.searched(container, supporter):
                 self.examined.add(iid)
 
     def due(self) -> bool:

@@ -46,11 +46,19 @@ EXAMINE_RANGE_M = 2.0  # mean depth of its pixels at which a piece counts as loo
 _DENSE_IDS = 1 << 20  # below this largest id, count per id without sorting
 
 
+def carrier_kinds(affordances: Iterable[str], small_object: bool = False
+                  ) -> tuple[bool, bool]:
+    """(container, supporter): how a piece of furniture (a small object: ``small_object``,
+    which only contains) with these affordances holds things."""
+    kinds = OBJECT_CARRIER_AFFORDANCES if small_object else CARRIER_AFFORDANCES
+    have = {a.lower() for a in affordances} & kinds
+    return "container" in have, "supporter" in have
+
+
 def examinable(affordances: Iterable[str], small_object: bool = False) -> bool:
     """Whether a piece of furniture (a small object: ``small_object``) with these
     affordances holds things one sees only from close by."""
-    kinds = OBJECT_CARRIER_AFFORDANCES if small_object else CARRIER_AFFORDANCES
-    return any(a.lower() in kinds for a in affordances)
+    return any(carrier_kinds(affordances, small_object))
 
 
 def close_views(ids: np.ndarray, depth: np.ndarray, min_points: int,
