@@ -24,6 +24,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import typing
 import zlib
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field, fields
@@ -166,9 +167,17 @@ def options_dict(o: ReplayOptions) -> dict[str, Any]:
             if getattr(o, f.name) != getattr(default, f.name)}
 
 
-_OPTION_TYPES: dict[str, tuple[type, ...]] = {
-    "every": (int,), "classifier": (str,), "min_points": (int,), "voxel_size": (float, int),
-    "max_frames": (int,), "tf_time": (str,)}  # of ReplayOptions' fields (None: unset)
+def _option_types() -> dict[str, tuple[type, ...]]:
+    """ReplayOptions' field -> the JSON types its value may have (its annotation less
+    None, which means unset; a float option takes an integer too)."""
+    out: dict[str, tuple[type, ...]] = {}
+    for name, hint in typing.get_type_hints(ReplayOptions).items():
+        kinds = tuple(t for t in (typing.get_args(hint) or (hint,)) if t is not type(None))
+        out[name] = (*kinds, int) if float in kinds else kinds
+    return out
+
+
+_OPTION_TYPES = _option_types()
 
 
 def options_from(d: Mapping[str, Any], where: str) -> ReplayOptions:
