@@ -23,10 +23,15 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   after ``max_replans`` plans.
 - **Bumps.** Where the base touched something the map does not show is marked blocked
   (:attr:`LiveSkills.bumps`, grown by the robot's radius like any obstacle) for the rest
-  of the episode; when those marks leave the robot less than ``sealed_m2`` of reachable
-  floor while the map without them leaves more (contacts at a door frame or a swinging
-  panel can ring the robot in), the oldest are dropped until it has that much again:
-  otherwise every goal would be unreachable and the search would end there. When the
+  of the episode, unless they **wall the robot in or off**: when the marks leave it less
+  than ``sealed_m2`` of reachable floor while the map without them leaves more (contacts
+  at a door frame or a swinging panel can ring the robot in), or cut it off from more
+  than ``sealed_m2`` of floor the map without them reaches (a mark is put one radius
+  ahead of the move, so scraping a corner of a narrow passage marks the passage itself,
+  and everything past it would stay unreachable for the rest of the episode), the
+  oldest are dropped until neither holds. A way that is really blocked costs a skill its
+  ``max_contacts`` again, and that goal is held back; ``sealed_m2`` = 0 turns the rule
+  off. When the
   marks wall off every goal of the graph while leaving more floor than that (a room whose
   only open door frame the robot brushed), the closed loop drops them all
   (:meth:`LiveSkills.forget_bumps`).
@@ -107,7 +112,9 @@ class LiveNavConfig:
     slack: float = 0.3  # m: stands this much farther from the thing than the nearest
     max_replans: int = 60
     max_contacts: int = 3
-    sealed_m2: float = 2.0  # bump marks leaving the robot less floor are dropped, oldest first
+    # bump marks leaving the robot less floor, or taking more from it, are dropped, oldest
+    # first (module doc); 0: kept
+    sealed_m2: float = 2.0
     look_in: float = 0.0  # m from an opened container the robot backs off to (0: stays)
     peek: bool = True  # tilt the camera down into an opened container and back
 
@@ -291,22 +298,39 @@ class LiveSkills:
             return self._planned[1]
         occ = self.live_map(refresh)
         out = None if occ is None else (occ, geodesic_distances(occ, key[2]))
-        if out is not None and self.bumps and self._sealed(out[0], out[1]):
-            # the robot's own bump marks wall it in: forget the oldest (module doc)
-            kept = self.bumps
-            for k in range(1, len(kept) + 1):
-                self.bumps = kept[k:]
-                occ = self.live_map(refresh)
-                assert occ is not None
-                free = (occ, geodesic_distances(occ, key[2]))
-                if not self._sealed(*free):
-                    out = free
-                    key = (*key[:3], len(self.bumps))
-                    break
-            else:
-                self.bumps = kept  # sealed without them too: they were not the cause
+        if out is not None and self.bumps and self.config.sealed_m2 > 0:
+            out, key = self._unsealed(refresh, out, key)
         self._planned = (key, out)
         return out
+
+    def _unsealed(self, refresh: Refresh, planned: tuple[OccupancyMap, np.ndarray],
+                  key: tuple) -> tuple[tuple[OccupancyMap, np.ndarray], tuple]:
+        """``planned`` (the map with the bump marks and its distances) when the marks do
+        not wall the robot in or off (module doc); else the oldest marks dropped from
+        :attr:`bumps` until they do not, and the map and key without them."""
+        kept = self.bumps
+        self.bumps = []
+        bare = self.live_map(refresh)
+        self.bumps = kept
+        assert bare is not None
+        cell_m2 = bare.resolution ** 2
+        floor = int(np.count_nonzero(np.isfinite(geodesic_distances(bare, key[2]))))
+
+        def sealed(dist: np.ndarray) -> bool:
+            cells = int(np.count_nonzero(np.isfinite(dist)))
+            return (cells * cell_m2 < self.config.sealed_m2 < floor * cell_m2) or \
+                (floor - cells) * cell_m2 > self.config.sealed_m2
+
+        if not sealed(planned[1]):
+            return planned, key
+        for k in range(1, len(kept) + 1):
+            self.bumps = kept[k:]
+            occ = self.live_map(refresh)
+            assert occ is not None
+            free = (occ, geodesic_distances(occ, key[2]))
+            if not sealed(free[1]):
+                return free, (*key[:3], len(self.bumps))
+        raise AssertionError("the map without bump marks walls nothing off")  # k = len
 
     def forget_bumps(self) -> int:
         """Drop every bump mark (the closed loop calls this when its view of the graph
@@ -317,11 +341,6 @@ class LiveSkills:
             self.bumps = []
             self._planned = None
         return n
-
-    def _sealed(self, occ: OccupancyMap, dist: np.ndarray) -> bool:
-        """The floor the robot can reach on ``occ`` is less than ``config.sealed_m2``."""
-        cells = int(np.count_nonzero(np.isfinite(dist)))
-        return cells * occ.resolution ** 2 < self.config.sealed_m2
 
     def select(self, goal: Goal, occ: OccupancyMap, dist: np.ndarray
                ) -> tuple[float, float] | None:

@@ -28,7 +28,7 @@ from sgtool.planning.base import Action
 from sgtool.planning.candidates import actionable
 from sgtool.recorders.sim import CameraConfig
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
-from sgtool.recorders.sim.live_skills import Goal, LiveSkills
+from sgtool.recorders.sim.live_skills import Goal, LiveNavConfig, LiveSkills
 from sgtool.recorders.sim.navigation import RobotConfig
 from sgtool.recorders.sim.reachability import (
     LOOKED,
@@ -233,6 +233,30 @@ def test_bump_marks_that_wall_the_robot_in_are_dropped() -> None:
     skills.bumps.append((2.0, 3.0))
     skills.plan_map(SimpleNamespace(index=5, layers=ref.layers))
     assert skills.bumps == [*left, (2.0, 3.0)]
+
+
+def test_bump_marks_that_wall_off_the_way_past_a_passage_are_dropped() -> None:
+    # a mark goes one radius ahead of the move, so scraping a corner of a narrow passage
+    # marks the passage itself: grown by the robot's radius it cut the robot off from
+    # everything past it for the rest of the episode, though it kept plenty of floor (a
+    # voi episode searched 5 rooms of 15 and gave up with the way to the rest marked)
+    occ, _ = _map()  # the wall at x = 3 m has a 0.6 m gap at y = 1.8..2.4 m
+    ref = SimpleNamespace(index=4, layers=SimpleNamespace(occupancy=occ.grid))
+    gap, corner = [(3.05, 1.95), (3.05, 2.25)], (0.5, 3.5)
+    for sealed_m2, left in ((2.0, [gap[1], corner]), (0.0, [*gap, corner])):
+        skills = LiveSkills(_Body((1.0, 2.0, 0.0), RobotConfig()), lambda: None,
+                            LiveNavConfig(sealed_m2=sealed_m2))
+        skills.bumps.extend([*gap, corner])
+        planned = skills.plan_map(ref)
+        assert planned is not None
+        m, d = planned
+        # the oldest goes, and that opens the passage; the corner's takes < 2 m2 and stays
+        assert skills.bumps == left
+        assert np.isfinite(d[20, 40]) == (sealed_m2 > 0)  # (4.05, 2.05): past the wall
+        assert np.isfinite(d[20, 15])  # the robot's side, either way
+        # the map planned on is the one without the dropped mark
+        assert np.array_equal(m.blocked, traversable(occ.grid, 0.2, 0.25,
+                                                     np.array(left)).blocked)
 
 
 def test_a_navigate_that_did_not_see_into_its_piece_counts_as_failed() -> None:
