@@ -10,7 +10,10 @@ look_into` and :meth:`~sgtool.scenegraph.examined.PieceView.searched` at each
 ``--share``, on top of the close view). Printed per kind (C container, S supporter, CS
 both): *recall*, the share of views showing the contents that count the piece examined,
 and *searched but unseen*, the share of views not showing them that count it examined
-anyway (a piece a planner then never looks at again).
+anyway (a piece a planner then never looks at again). Each is given over views (the
+contents: any held object in view) and over (view, held object) pairs: a search is for one
+object, and a carrier that shows one of its things may hide another (the peach on a
+refrigerator's top shelf while those on its middle one are in view).
 
 One frame is the hardest case: the live graph adds up the frames, so recall there is
 higher for long pieces only partly in one frame.
@@ -65,9 +68,8 @@ def _held(spec: Any) -> dict[str, list[str]]:
 
 
 def views(seed: int, rooms: tuple[int, int], pixels: int, shares: list[float],
-          size: tuple[int, int]) -> list[tuple[str, bool, bool, list[bool]]]:
-    """(kind, contents in view, old rule, new rule per share) of every view of house
-    ``seed``."""
+          size: tuple[int, int]) -> list[View]:
+    """Every view of house ``seed``."""
     spec = generate_house(seed, rooms, preset="symsearch")
     held = _held(spec)
     spec = dataclasses.replace(spec, furniture=tuple(
@@ -95,14 +97,26 @@ def views(seed: int, rooms: tuple[int, int], pixels: int, shares: list[float],
                     sim.teleport(pose)
                     fr = sim.render()
                     ids, depth = np.asarray(fr.ids), np.asarray(fr.depth)
-                    vis = max(int((ids == i).sum()) for i in content) >= pixels
+                    each = [int((ids == i).sum()) >= pixels for i in content]
                     old = piece in close_views(ids, depth, 50)
                     v = PieceView()
                     look_into(v, piece, FramePoints.of(ids, depth, fr.pose, fr.intrinsics,
                                                        0.05))
-                    out.append((kind, vis, old,
-                                [old and v.searched(cont, sup, sh) for sh in shares]))
+                    out.append(View(kind, any(each), tuple(each), old,
+                                    tuple(old and v.searched(cont, sup, sh) for sh in shares)))
     return out
+
+
+@dataclasses.dataclass(frozen=True)
+class View:
+    """One view of a carrier: its kind, whether any / each held object is in view, and
+    whether the old rule and the new one at each share count it examined."""
+
+    kind: str
+    any_in_view: bool
+    each_in_view: tuple[bool, ...]
+    old: bool
+    new: tuple[bool, ...]
 
 
 def _rates(seen: list[Any], unseen: list[Any], pick: Any) -> dict[str, float | None]:
@@ -111,19 +125,28 @@ def _rates(seen: list[Any], unseen: list[Any], pick: Any) -> dict[str, float | N
             "searched_unseen": sum(map(pick, unseen)) / len(unseen) if unseen else None}
 
 
-def table(rows: list[tuple[str, bool, bool, list[bool]]], shares: list[float]
-          ) -> dict[str, dict[str, Any]]:
-    """Per kind and "all": views, contents in view, recall and searched-but-unseen of the
-    old rule and of the new one at each share."""
+def _rules(rows: list[View], shares: list[float], per_object: bool) -> dict[str, Any]:
+    """Recall and searched-but-unseen of the old rule and the new ones, over views (the
+    contents: any held object in view) or, with ``per_object``, over (view, held object)
+    pairs (that object in view: a search for it)."""
+    items = [(r, vis) for r in rows for vis in (r.each_in_view if per_object
+                                                 else (r.any_in_view,))]
+    seen = [r for r, vis in items if vis]
+    unseen = [r for r, vis in items if not vis]
+    return {"pairs" if per_object else "views": len(items), "in_view": len(seen),
+            "old": _rates(seen, unseen, lambda r: r.old),
+            "new": {f"{sh:g}": _rates(seen, unseen, lambda r, i=i: r.new[i])
+                    for i, sh in enumerate(shares)}}
+
+
+def table(rows: list[View], shares: list[float]) -> dict[str, dict[str, Any]]:
+    """Per kind and "all": over views and over (view, held object) pairs, the rates of
+    the old rule and of the new one at each share."""
     out: dict[str, dict[str, Any]] = {}
-    for kind in sorted({r[0] for r in rows}) + ["all"]:
-        sel = [r for r in rows if kind in ("all", r[0])]
-        seen = [r for r in sel if r[1]]
-        unseen = [r for r in sel if not r[1]]
-        out[kind] = {"views": len(sel), "contents_in_view": len(seen),
-                     "old": _rates(seen, unseen, lambda r: r[2]),
-                     "new": {f"{sh:g}": _rates(seen, unseen, lambda r, i=i: r[3][i])
-                             for i, sh in enumerate(shares)}}
+    for kind in sorted({r.kind for r in rows}) + ["all"]:
+        sel = [r for r in rows if kind in ("all", r.kind)]
+        out[kind] = {"views": _rules(sel, shares, False),
+                     "objects": _rules(sel, shares, True)}
     return out
 
 
@@ -186,14 +209,20 @@ def measure(args: argparse.Namespace) -> dict[str, Any]:
 
     def pct(x: float | None) -> str:
         return "-" if x is None else f"{x:.2f}"
-    print("kind  views  in view  old: recall / searched-unseen  "
-          + "  ".join(f"share {s:g}: recall / searched-unseen" for s in shares))
+
+    def pair(r: dict[str, Any]) -> str:
+        return f"{pct(r['recall'])} / {pct(r['searched_unseen'])}"
+    print("recall / searched but unseen; per view (any held object in view) and per held "
+          "object")
+    print("kind  over     n      in view  old            "
+          + "  ".join(f"share {s:g}    " for s in shares))
     for kind, t in doc.items():
-        cells = [f"{pct(t['new'][f'{s:g}']['recall'])} / "
-                 f"{pct(t['new'][f'{s:g}']['searched_unseen'])}" for s in shares]
-        print(f"{kind:<5} {t['views']:>5}  {t['contents_in_view']:>7}  "
-              f"{pct(t['old']['recall'])} / {pct(t['old']['searched_unseen'])}  "
-              + "  ".join(cells))
+        for over in ("views", "objects"):
+            r = t[over]
+            n = r["views" if over == "views" else "pairs"]
+            cells = [pair(r["new"][f"{s:g}"]) for s in shares]
+            print(f"{kind:<5} {over:<7} {n:>6} {r['in_view']:>7}  {pair(r['old'])}  "
+                  + "  ".join(cells))
     return {"houses": args.houses, "rooms": args.rooms, "pixels": args.pixels,
             "resolution": args.resolution, "kinds": doc}
 
