@@ -9,7 +9,8 @@ with reason "fallback: no actionable node", decided on no graph, their frames an
 counted; a planner that gives up while the map has reachable frontiers hands over to the
 fallback, which stops as soon as the graph offers a node it did not offer before, and that
 episode's log replays into the same scene graphs byte for byte; the fallback is
-deterministic and uses the robot's side only (the true map made to raise).
+deterministic and uses the robot's side only (the true map made to raise); with no grid
+frontier it goes to open edges of the robot's map.
 """
 
 from __future__ import annotations
@@ -333,12 +334,35 @@ def test_open_edges_where_the_frontier_rule_finds_none() -> None:
     assert open_edges(occ2, geodesic_distances(occ2, start), 1) == []
 
 
+def test_with_no_grid_frontier_the_hand_over_goes_to_open_edges(house, tmp_path,
+                                                                monkeypatch) -> None:
+    """The frontier rule made to find nothing (a cluttered room: its unknown pockets are
+    under ``min_pocket``): a planner that gives up hands over to the fallback, which goes
+    to open edges of the robot's map, logged as ``explore`` of ``edge:`` goals."""
+    from sgtool.recorders.sim import fallback_explore as fe
+
+    monkeypatch.setattr(fe, "next_frontier", lambda *a, **k: None)
+    idx, ep = _open_start(house)
+    out = tmp_path / "edges.mcap"
+    rep = run_episode(house, ep, Scripted([lambda g: Action("done")] * 40), out, OPTS,
+                      episode_index=idx)
+    acts = _actions(out)
+    edges = [a for a in acts if str(a["target"]).startswith("edge:")]
+    assert edges and all(is_fallback(a["reason"]) and a["skill"] == "explore"
+                         for a in edges)
+    assert all(a["graph_time_ns"] is None and a["planner"] is None for a in edges)
+    assert edges[0]["travelled_m"] > 0
+    assert not any(str(a["target"]).startswith("frontier:") and is_fallback(a["reason"])
+                   for a in acts)  # no grid frontier was offered
+    assert rep.travelled_m >= sum(a["travelled_m"] for a in edges) - 1e-3  # logged: 4 d.p.
+
+
 def test_a_cluttered_room_is_explored_not_given_up(tmp_path) -> None:
     """House 5 of the closed-loop bench (8-16 rooms, symsearch), episode 4 at 160x120:
     the random planner opens the door out of the start room into a bedroom whose floor is
-    fringed with glimpses of a bed; the graph then offers nothing and has no frontier the
-    robot can reach, and the episode used to end ``gave_up`` after 4 steps. The fallback
-    goes to an open edge of the bedroom instead and the magazine comes into view."""
+    fringed with glimpses of a bed; the episode once ended ``gave_up`` after 4 steps (the
+    graph offered nothing and no frontier was reachable). It finds the magazine; any open
+    edge it goes to is the fallback's."""
     from sgtool.analysis.bench_houses import bench_episodes, generated_houses
 
     spec = generated_houses(6, 0)[5].load((8, 16), "symsearch")
@@ -348,6 +372,6 @@ def test_a_cluttered_room_is_explored_not_given_up(tmp_path) -> None:
     rep = run_episode(spec, ep, make_planner("random"), out,
                       ClosedLoopOptions(camera=CameraConfig(width=160, height=120)),
                       house_id="house-5", episode_index=4)
-    edges = [a for a in _actions(out) if str(a["target"]).startswith("edge:")]
-    assert edges and all(is_fallback(a["reason"]) for a in edges)
     assert rep.end == "found" and rep.success
+    edges = [a for a in _actions(out) if str(a["target"]).startswith("edge:")]
+    assert all(is_fallback(a["reason"]) for a in edges)
