@@ -12,7 +12,9 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   instance id. Anything else (the spec, the ground-truth occupancy, the privileged
   ``navigate``) raises :class:`PrivilegedAccess`.
 - **Goals** come from the graph the planner decided on: an object or door node's position
-  (stand within reach, nearest along the floor, facing it), a room or region node's
+  (stand within reach, nearest along the floor, facing it; at a container, in front of
+  its opening when the map shows one, :func:`~sgtool.mapping.live_paths.front_goal`: from
+  the side its boards hide the inside), a room or region node's
   position (the reachable cell nearest to it within ``snap``), a frontier's cluster (its
   nearest reachable cell, :func:`~sgtool.mapping.live_paths.nearest_reachable`).
 - **Re-planning.** A path is followed frame by frame, turning while driving
@@ -78,6 +80,7 @@ import numpy as np
 from sgtool.errors import SgtoolError
 from sgtool.mapping.live_paths import (
     descend,
+    front_goal,
     nearest_reachable,
     point_goal,
     stand_goal,
@@ -219,7 +222,9 @@ _BODIES: weakref.WeakKeyDictionary[RobotBody, Simulation] = weakref.WeakKeyDicti
 @dataclass(frozen=True, eq=False)
 class Goal:
     """Where a skill goes: ``kind`` "stand" (within reach of ``points[0]``, facing it),
-    "view" (where a container at ``points[0]`` is seen whole, facing it:
+    "front" (a container at ``points[0]``: standing so, in front of its opening when the
+    map shows one, :func:`~sgtool.mapping.live_paths.front_goal`), "view" (where a
+    container at ``points[0]`` is seen whole, facing it:
     :func:`~sgtool.mapping.live_paths.view_goal`), "point" (the reachable cell nearest
     ``points[0]``) or "cells" (the nearest reachable of ``points``, a frontier's
     cluster)."""
@@ -229,7 +234,7 @@ class Goal:
     points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
 
     def face(self) -> tuple[float, float] | None:
-        if self.kind not in ("stand", "view"):
+        if self.kind not in ("stand", "front", "view"):
             return None
         return float(self.points[0, 0]), float(self.points[0, 1])
 
@@ -247,7 +252,10 @@ def frontier_points(layers: MapLayers, frontier_id: str) -> np.ndarray | None:
 def goal_of_node(node: Any, layers: MapLayers | None) -> Goal:
     """The goal of a scene-graph node (module doc)."""
     if isinstance(node, (ObjectNode, DoorNode)):
-        return Goal(node.id, "stand", np.array([node.position[:2]], dtype=np.float64))
+        front = isinstance(node, ObjectNode) and \
+            any(a.lower() == "container" for a in node.affordances)
+        return Goal(node.id, "front" if front else "stand",
+                    np.array([node.position[:2]], dtype=np.float64))
     if isinstance(node, RegionNode) and node.kind == "frontier" and layers is not None:
         pts = frontier_points(layers, node.id)
         if pts is not None and len(pts):
@@ -353,9 +361,11 @@ class LiveSkills:
         cfg = self.config
         if goal.kind == "cells":
             return nearest_reachable(occ, dist, goal.points, cfg.frontier_snap)
-        if goal.kind == "stand":
-            return stand_goal(occ, dist, goal.points[0], self.body.config.reach - 0.05,
-                              cfg.slack)
+        if goal.kind in ("stand", "front"):
+            reach = self.body.config.reach - 0.05
+            front = front_goal(occ, dist, goal.points[0], reach, cfg.slack) \
+                if goal.kind == "front" else None
+            return front or stand_goal(occ, dist, goal.points[0], reach, cfg.slack)
         if goal.kind == "view":
             return view_goal(occ, dist, goal.points[0], cfg.look_in)
         return point_goal(occ, dist, goal.points[0], cfg.snap)

@@ -151,14 +151,16 @@ def goal_cell(skills: LiveSkills, goal: Goal, occ: OccupancyMap, dist: np.ndarra
               ) -> tuple[float, float] | None:
     """The cell :meth:`LiveSkills.select` drives to for ``goal`` (the same rule: stand
     within reach, point within ``snap``, nearest of a frontier's cells or within
-    ``frontier_snap`` of them), computed on a window around the goal; None: unreachable."""
+    ``frontier_snap`` of them), computed on a window around the goal; None: unreachable.
+    A ``front`` goal is taken as ``stand``: it is reachable exactly when that is (the
+    skill falls back to it), and its cell in front of the opening is chosen on the way."""
     cfg = skills.config
     pts = np.asarray(goal.points, dtype=np.float64).reshape(-1, 2)
     if len(pts) == 0:
         return None
     if goal.kind == "cells":
         radius = cfg.frontier_snap
-    elif goal.kind == "stand":
+    elif goal.kind in ("stand", "front"):
         radius = skills.body.config.reach - 0.05
     else:
         radius = cfg.snap
@@ -180,7 +182,7 @@ def goal_cell(skills: LiveSkills, goal: Goal, occ: OccupancyMap, dist: np.ndarra
     X, Y = _centres(occ, win)
     off = np.hypot(X - pts[0, 0], Y - pts[0, 1])
     ok = np.isfinite(d) & (off <= radius + 1e-9)
-    if goal.kind == "stand":
+    if goal.kind in ("stand", "front"):
         if not ok.any():
             return None
         best = float(off[ok].min())

@@ -26,6 +26,8 @@ the robot, ties by the lowest row, then column):
 - :func:`point_goal`: the reachable cell nearest (straight line) to a point, within ``snap``;
 - :func:`stand_goal`: a place to stand at an object known only by its position: the
   reachable cells nearest to it, of which the one nearest along the floor;
+- :func:`front_goal`: a place to stand at a container to open or look into it, within
+  reach in front of its opening (the middle of its open fan, :func:`open_fan`, as below);
 - :func:`view_goal`: a place to look into a container from: ``distance`` m from it, in
   the middle of the widest fan of directions in which the map is open from the
   container's own blocked cells out to that distance (a piece stands with its back to a
@@ -154,6 +156,15 @@ def view_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], distance
     circular run of open rays (when that ray is not open itself, the end of the run's
     middle ray; of equally wide runs, the one whose end is nearest along the floor; all
     rays open: the nearest end of any). None when no ray is open."""
+    fan = open_fan(occ, dist, xy, distance, exit_within)
+    return None if fan is None else _centre(occ, *fan[1])
+
+
+def open_fan(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], distance: float,
+             exit_within: float = 0.8) -> tuple[float, tuple[int, int]] | None:
+    """The bisector (radians) of the widest run of open rays round ``xy`` out to
+    ``distance`` and the cell :func:`view_goal` takes on it (its rules); None when no ray
+    is open."""
     n = VIEW_DIRECTIONS
     radii = np.arange(0.0, distance + 1e-9, occ.resolution / 2.0)
     if radii.size == 0 or radii[-1] < distance - 1e-9:
@@ -186,18 +197,45 @@ def view_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], distance
                 g = list(group)
                 runs.append((g[0], len(g)))
     widest = max(length for _, length in runs)
-    best: tuple[float, int, int] | None = None
+    best: tuple[float, int, int, float] | None = None
     for first, length in runs:
         if length != widest:
             continue
-        end = end_of(2.0 * math.pi * (first + (length - 1) / 2.0) / n) \
-            or ends[(first + (length - 1) // 2) % n]
+        angle = 2.0 * math.pi * (first + (length - 1) / 2.0) / n
+        end = end_of(angle) or ends[(first + (length - 1) // 2) % n]
         assert end is not None
-        key = (float(dist[end]), end[0], end[1])
-        if best is None or key < best:
+        key = (float(dist[end]), end[0], end[1], angle)
+        if best is None or key[:3] < best[:3]:
             best = key
     assert best is not None
-    return _centre(occ, best[1], best[2])
+    return math.remainder(best[3], 2.0 * math.pi), (best[1], best[2])
+
+
+def front_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], reach: float,
+               slack: float = 0.3, half_angle: float = math.radians(30.0)
+               ) -> tuple[float, float] | None:
+    """Where to stand to open or look into a container at ``xy``, in front of its opening:
+    :func:`stand_goal`'s rule (within ``reach``, at most ``slack`` farther than the
+    nearest such cell, then nearest along the floor) over the reachable cells whose
+    bearing from ``xy`` lies within ``half_angle`` of the bisector of its open fan
+    (:func:`open_fan` out to ``reach``: a piece stands with its back to a wall and its
+    sides often against others, so the fan faces its front). None when there is no fan
+    or no such cell (then :func:`stand_goal` is the way to stand).
+
+    From 60 degrees off a cabinet's front its side board hides the inside; from in front
+    the camera sees in."""
+    fan = open_fan(occ, dist, xy, reach)
+    if fan is None:
+        return None
+    X, Y = _centres(occ)
+    dx, dy = X - xy[0], Y - xy[1]
+    d = np.hypot(dx, dy)
+    off = np.abs(np.remainder(np.arctan2(dy, dx) - fan[0] + math.pi, 2.0 * math.pi) - math.pi)
+    ok = np.isfinite(dist) & (d <= reach + 1e-9) & (off <= half_angle + 1e-9)
+    if not ok.any():
+        return None
+    best = float(d[ok].min())
+    return _argmin(occ, np.where(ok & (d <= best + slack + 1e-9), dist, np.inf))
 
 
 def _centres(occ: OccupancyMap) -> tuple[np.ndarray, np.ndarray]:

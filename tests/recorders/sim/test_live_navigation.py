@@ -163,6 +163,31 @@ def test_after_opening_a_container_the_robot_looks_in_from_in_front(house, tmp_p
     assert abs(math.atan2(math.sin(off), math.cos(off))) < math.radians(10)  # facing it
 
 
+def test_a_container_is_opened_from_in_front_of_it(tmp_path) -> None:
+    """The open skill stands in front of the container's opening as the robot's map shows
+    it (``front_goal``), within reach: checked against the house's own placement of the
+    piece (its front is local +y), which the robot never reads. In this episode (house 1
+    of 4 rooms, episode 1) the nearest stand within reach is 64 degrees off the front,
+    where the side board hides the inside; the front stand is 31 degrees off."""
+    house = generate_house(1, rooms=(4, 4))
+    idx, ep = pick_episode(house, index=1)
+    p = Scripted([_open_first_container, Action("done")])
+    out = tmp_path / "front.mcap"
+    run_episode(house, ep, p, out,
+                dataclasses.replace(OPTS, live=LiveNavConfig(peek=False), max_steps=1),
+                episode_index=idx)
+    fb = p.feedbacks[0]
+    assert (fb.action.skill, fb.outcome) == ("open", "success")
+    node = p.graphs[0].node(fb.action.target)
+    piece = min(house.furniture, key=lambda f: math.dist(f.center[:2], node.position[:2]))
+    assert math.dist(piece.center[:2], node.position[:2]) < 0.3
+    x, y, _ = _last_pose(out)
+    front = piece.yaw + math.pi / 2
+    bearing = math.atan2(y - piece.center[1], x - piece.center[0])
+    off = abs(math.remainder(bearing - front, 2 * math.pi))
+    assert off < math.radians(40) and math.dist((x, y), node.position[:2]) < 1.0
+
+
 def _tilt(base_T_cam) -> float:
     """The camera's downward tilt (degrees) of a base -> camera link: the optical z axis
     is (cos t, 0, -sin t) in the base frame."""

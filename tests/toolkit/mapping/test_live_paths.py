@@ -19,6 +19,7 @@ from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.live_paths import (
     VIEW_DIRECTIONS,
     descend,
+    front_goal,
     nearest_reachable,
     point_goal,
     stand_goal,
@@ -174,3 +175,25 @@ def test_a_bump_is_marked_at_the_mapped_corner_the_move_clipped() -> None:
     assert touch_point(g, (to[0] + 0.05, to[1]), to, 0.2) == pytest.approx((to[0] - 0.2, to[1]))
     # open floor: straight ahead
     assert touch_point(g, (1.0, 2.0), (1.0, 2.5), 0.2) == pytest.approx((1.0, 2.7))
+
+
+def test_a_container_is_opened_from_in_front_of_it() -> None:
+    """The fridge of kitchen_row without counters, the robot at its left side: the nearest
+    stand within reach is beside it (its side board towards the robot); the front stand
+    is within reach and within 30 degrees of straight in front of it, facing the room.
+    Boxed in (no open fan): None, and the caller stands as before."""
+    occ = traversable(kitchen_row(False), robot_radius=0.25)
+    fridge = (2.0, 3.5)
+    dist = geodesic_distances(occ, (0.6, 3.5))  # left of the fridge, level with it
+    side = stand_goal(occ, dist, fridge, reach=0.95, slack=0.3)
+    assert side is not None
+    assert abs(math.degrees(math.atan2(side[1] - fridge[1], side[0] - fridge[0]))) > 120
+    front = front_goal(occ, dist, fridge, reach=0.95, slack=0.3)
+    assert front is not None and math.dist(front, fridge) <= 0.95 + 1e-9
+    bearing = math.degrees(math.atan2(front[1] - fridge[1], front[0] - fridge[0]))
+    assert abs(bearing - -90.0) <= 30.0 + 1e-9
+    g = kitchen_row(False).grid.copy()
+    g[26, 11:30] = g[26:39, 11] = g[26:39, 29] = OCCUPIED  # walled in, the robot outside
+    boxed = traversable(OccupancyGrid(g, (0.0, 0.0), RES), robot_radius=0.25)
+    d2 = geodesic_distances(boxed, (0.6, 3.5))
+    assert front_goal(boxed, d2, fridge, reach=0.95) is None
