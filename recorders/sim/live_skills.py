@@ -35,11 +35,10 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   cut it off from more than ``sealed_m2`` of floor the map without them reaches
   (scraping both sides of a narrow passage marks the passage itself, and everything past
   it would stay unreachable for the rest of the episode), the oldest are dropped until
-  neither holds. A way that is really blocked costs a skill its
-  ``max_contacts`` again, and that goal is held back; ``sealed_m2`` = 0 turns the rule
-  off. When the
-  marks wall off every goal of the graph while leaving more floor than that (a room whose
-  only open door frame the robot brushed), the closed loop drops them all
+  neither holds. A way that is really blocked costs a skill its ``max_contacts`` again,
+  and that goal is held back; ``sealed_m2`` = 0 turns the rule off. When the marks wall
+  off every goal of the graph while leaving more floor than that (a room whose only open
+  door frame the robot brushed), the closed loop drops them all
   (:meth:`LiveSkills.forget_bumps`).
 - **Looking around** (:meth:`LiveSkills.look_around`) turns only toward unknown space
   near the robot on its own map (:func:`~sgtool.recorders.sim.motion.sweep`), the shorter

@@ -35,6 +35,8 @@ the robot, ties by the lowest row, then column):
 
 :func:`descend` reads a shortest cell path off a distance field (steepest descent from
 the goal to the robot), so one Dijkstra run serves both the goal choice and the path.
+:func:`touch_point` reads off the map where a move the simulator stopped touched
+something (the bump mark the robot then adds to its map).
 """
 
 from __future__ import annotations
