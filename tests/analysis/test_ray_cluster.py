@@ -140,7 +140,9 @@ def cluster() -> Iterator[Cluster]:
                                  temp / "node2", {**env, "SGTOOL_MACHINE_ID": "node2"}))
         found = subprocess.run([sys.executable, "-c", NODES, address, str(START_S)], env=env,
                                capture_output=True, text=True, timeout=START_S + 120)
-        ids = dict(w.split("=") for w in found.stdout.split())
+        # the last line holds the ids (Ray may print to stdout before it)
+        lines = found.stdout.strip().splitlines()
+        ids = dict(w.split("=", 1) for w in (lines[-1].split() if lines else ()) if "=" in w)
         assert found.returncode == 0 and sorted(ids) == ["head", "node2"], (
             f"{found.stdout}{found.stderr[-2000:]}\n{_tail(temp / 'node2.out')}")
         yield Cluster(address, env, ids)
