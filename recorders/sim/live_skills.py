@@ -25,21 +25,17 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   after ``max_replans`` plans.
 - **Bumps.** Where the base touched something the map does not show is marked blocked
   (:attr:`LiveSkills.bumps`, grown by the robot's radius like any obstacle) for the rest
-  of the episode. The mark goes one radius from the blocked pose toward the nearest
-  known obstacle on the side the move faced, or straight ahead when the map shows none
-  there (:func:`~sgtool.mapping.live_paths.touch_point`): a move that clips a mapped
-  wall's corner touches it beside the move, and a mark ahead of the move would close the
-  way round the corner. Marks are dropped when they **wall the robot in or off**: when
-  they leave it less than ``sealed_m2`` of reachable floor while the map without them
-  leaves more (contacts at a door frame or a swinging panel can ring the robot in), or
-  cut it off from more than ``sealed_m2`` of floor the map without them reaches
-  (scraping both sides of a narrow passage marks the passage itself, and everything past
-  it would stay unreachable for the rest of the episode), the oldest are dropped until
-  neither holds. A way that is really blocked costs a skill its ``max_contacts`` again,
-  and that goal is held back; ``sealed_m2`` = 0 turns the rule off. When the marks wall
-  off every goal of the graph while leaving more floor than that (a room whose only open
-  door frame the robot brushed), the closed loop drops them all
-  (:meth:`LiveSkills.forget_bumps`).
+  of the episode, unless they **wall the robot in or off**: when the marks leave it less
+  than ``sealed_m2`` of reachable floor while the map without them leaves more (contacts
+  at a door frame or a swinging panel can ring the robot in), or cut it off from more
+  than ``sealed_m2`` of floor the map without them reaches (a mark is put one radius
+  ahead of the move, so scraping a corner of a narrow passage marks the passage itself,
+  and everything past it would stay unreachable for the rest of the episode), the
+  oldest are dropped until neither holds. A way that is really blocked costs a skill its
+  ``max_contacts`` again, and that goal is held back; ``sealed_m2`` = 0 turns the rule
+  off. When the marks wall off every goal of the graph while leaving more floor than
+  that (a room whose only open door frame the robot brushed), the closed loop drops them
+  all (:meth:`LiveSkills.forget_bumps`).
 - **Looking around** (:meth:`LiveSkills.look_around`) turns only toward unknown space
   near the robot on its own map (:func:`~sgtool.recorders.sim.motion.sweep`), the shorter
   way, and stops when a refresh during the turn shows no cell known that was not before.
@@ -83,7 +79,6 @@ from sgtool.mapping.live_paths import (
     nearest_reachable,
     point_goal,
     stand_goal,
-    touch_point,
     traversable,
     view_goal,
 )
@@ -405,8 +400,7 @@ class LiveSkills:
                 if hit:
                     contacts += 1
                     self.contacts += 1
-                    self.bumps.append(touch_point(occ.grid, body.base, p,
-                                                  body.config.radius))
+                    self.bumps.append(_bumped(body.base, p, body.config.radius))
                     if contacts > cfg.max_contacts:
                         return ("failure", f"{goal.label}: the way is blocked by an obstacle "
                                 "the robot's map does not show", driven)
@@ -513,6 +507,16 @@ def _xy(pose: Pose2) -> tuple[float, float]:
 def _known(layers: MapLayers) -> int:
     """Cells of the map that are known (free or occupied)."""
     return int(np.count_nonzero(layers.occupancy.grid != -1))
+
+
+def _bumped(here: Pose2, to: Pose2, radius: float) -> tuple[float, float]:
+    """Where the obstacle is that stopped a move from ``here`` to ``to``: one radius ahead
+    of ``to`` along the move (the bumper's touch, the robot's own sense)."""
+    dx, dy = to[0] - here[0], to[1] - here[1]
+    n = math.hypot(dx, dy)
+    if n < 1e-9:
+        return float(to[0]), float(to[1])
+    return float(to[0] + dx / n * radius), float(to[1] + dy / n * radius)
 
 
 def _unreachable(goal: Goal, dist: np.ndarray) -> str:

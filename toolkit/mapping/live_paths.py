@@ -35,8 +35,6 @@ the robot, ties by the lowest row, then column):
 
 :func:`descend` reads a shortest cell path off a distance field (steepest descent from
 the goal to the robot), so one Dijkstra run serves both the goal choice and the path.
-:func:`touch_point` reads off the map where a move the simulator stopped touched
-something (the bump mark the robot then adds to its map).
 """
 
 from __future__ import annotations
@@ -283,34 +281,3 @@ def descend(occ: OccupancyMap, dist: np.ndarray, goal: Sequence[float]
     path.reverse()
     return [_centre(occ, pr, pc) for pr, pc in path]
 
-
-def touch_point(grid: OccupancyGrid, here: Sequence[float], to: Sequence[float],
-                radius: float, near: float | None = None) -> tuple[float, float]:
-    """Where the base of ``radius`` touched what stopped a move from ``here`` to ``to``
-    (world x, y), read off the robot's own map: one radius from ``to`` toward the nearest
-    known obstacle cell whose centre lies within ``near`` (default: the radius plus two
-    cells) of ``to`` on the side the move faced (at most 90 degrees off it); with none
-    there, one radius straight ahead of ``to`` (an obstacle the map does not show).
-
-    A move that clips the corner of a mapped wall (the map places it a fraction of a cell
-    off) touches it beside the move, not ahead: a mark ahead would close the passage round
-    the corner, while one toward the wall moves the next path off it by about a cell."""
-    dx, dy = float(to[0]) - float(here[0]), float(to[1]) - float(here[1])
-    n = math.hypot(dx, dy)
-    ux, uy = (dx / n, dy / n) if n > 1e-9 else (0.0, 0.0)
-    reach = radius + 2 * grid.resolution if near is None else near
-    res = grid.resolution
-    r0, c0 = (int(v) for v in grid.cell_of(float(to[0]), float(to[1])))
-    k = int(math.ceil(reach / res)) + 1
-    h, w = grid.shape
-    rs, cs = slice(max(r0 - k, 0), min(r0 + k + 1, h)), slice(max(c0 - k, 0), min(c0 + k + 1, w))
-    rr, cc = np.nonzero(grid.occupied[rs, cs])
-    if len(rr) and n > 1e-9:
-        x = grid.origin[0] + (cc + cs.start + 0.5) * res - float(to[0])
-        y = grid.origin[1] + (rr + rs.start + 0.5) * res - float(to[1])
-        d = np.hypot(x, y)
-        ok = (d <= reach) & (d > 1e-9) & (x * ux + y * uy >= 0.0)
-        if ok.any():
-            j = int(np.flatnonzero(ok)[np.argmin(d[ok])])  # first of the nearest: row order
-            return (float(to[0]) + x[j] / d[j] * radius, float(to[1]) + y[j] / d[j] * radius)
-    return float(to[0]) + ux * radius, float(to[1]) + uy * radius

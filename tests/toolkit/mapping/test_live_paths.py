@@ -23,7 +23,6 @@ from sgtool.mapping.live_paths import (
     nearest_reachable,
     point_goal,
     stand_goal,
-    touch_point,
     traversable,
     view_goal,
 )
@@ -158,23 +157,6 @@ def test_a_free_standing_container_is_looked_into_from_the_nearest_side() -> Non
     occ = traversable(OccupancyGrid(g, (0.0, 0.0), RES), robot_radius=0.25)
     dist = geodesic_distances(occ, (3.5, 2.0))
     assert view_goal(occ, dist, (2.0, 2.0), 1.0) is None
-
-
-def test_a_bump_is_marked_at_the_mapped_corner_the_move_clipped() -> None:
-    """The wall of two_rooms ends at row 8 (its lowest cells' centres at y 0.85): a move
-    to the right along the corridor below it, stopped 0.2 m left of and below the
-    corner cell's centre, touched the corner (0.28 m off, the nearest mapped cell), not
-    the free corridor ahead; moving away from the corner, or on open floor, the mark is
-    one radius straight ahead."""
-    g = two_rooms()
-    corner = ((24 + 0.5) * RES, (8 + 0.5) * RES)
-    to = (corner[0] - 0.2, corner[1] - 0.2)
-    x, y = touch_point(g, (to[0] - 0.05, to[1]), to, 0.2)
-    assert (x, y) == pytest.approx((to[0] + 0.2 / math.sqrt(2), to[1] + 0.2 / math.sqrt(2)))
-    # the corner behind the move does not count: only the side the move faced
-    assert touch_point(g, (to[0] + 0.05, to[1]), to, 0.2) == pytest.approx((to[0] - 0.2, to[1]))
-    # open floor: straight ahead
-    assert touch_point(g, (1.0, 2.0), (1.0, 2.5), 0.2) == pytest.approx((1.0, 2.7))
 
 
 def test_a_container_is_opened_from_in_front_of_it() -> None:
