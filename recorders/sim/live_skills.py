@@ -87,6 +87,7 @@ from sgtool.planning.base import Outcome
 from sgtool.recorders.sim import navigation as nav
 from sgtool.recorders.sim.events import SkillOutcome
 from sgtool.recorders.sim.motion import drive_while_turning, head_tilts, peek_tilt, sweep
+from sgtool.scenegraph.examined import carrier_kinds
 from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, RoomNode
 
 if TYPE_CHECKING:
@@ -246,8 +247,7 @@ def frontier_points(layers: MapLayers, frontier_id: str) -> np.ndarray | None:
 def goal_of_node(node: Any, layers: MapLayers | None) -> Goal:
     """The goal of a scene-graph node (module doc)."""
     if isinstance(node, (ObjectNode, DoorNode)):
-        front = isinstance(node, ObjectNode) and \
-            any(a.lower() == "container" for a in node.affordances)
+        front = isinstance(node, ObjectNode) and carrier_kinds(node.affordances)[0]
         return Goal(node.id, "front" if front else "stand",
                     np.array([node.position[:2]], dtype=np.float64))
     if isinstance(node, RegionNode) and node.kind == "frontier" and layers is not None:
