@@ -136,7 +136,13 @@ def stand_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], reach: 
     the floor. None when no reachable cell is within ``reach``."""
     X, Y = _centres(occ)
     d = np.hypot(X - xy[0], Y - xy[1])
-    ok = np.isfinite(dist) & (d <= reach + 1e-9)
+    return _stand_among(occ, dist, d, np.isfinite(dist) & (d <= reach + 1e-9), slack)
+
+
+def _stand_among(occ: OccupancyMap, dist: np.ndarray, d: np.ndarray, ok: np.ndarray,
+                 slack: float) -> tuple[float, float] | None:
+    """Of the cells ``ok``, those at most ``slack`` farther (``d``: m from the thing) than
+    the nearest one, the one nearest along the floor (``dist``); None when none is ok."""
     if not ok.any():
         return None
     best = float(d[ok].min())
@@ -232,10 +238,7 @@ def front_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], reach: 
     d = np.hypot(dx, dy)
     off = np.abs(np.remainder(np.arctan2(dy, dx) - fan[0] + math.pi, 2.0 * math.pi) - math.pi)
     ok = np.isfinite(dist) & (d <= reach + 1e-9) & (off <= half_angle + 1e-9)
-    if not ok.any():
-        return None
-    best = float(d[ok].min())
-    return _argmin(occ, np.where(ok & (d <= best + slack + 1e-9), dist, np.inf))
+    return _stand_among(occ, dist, d, ok, slack)
 
 
 def _centres(occ: OccupancyMap) -> tuple[np.ndarray, np.ndarray]:
