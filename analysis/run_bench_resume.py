@@ -42,6 +42,8 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
             "seed": opts.planner_seed, "episode_seeds": True, "success": opts.success,
             "classifier": opts.classifier, "explore_on": opts.explore_on,
             "look_in": float(opts.live.look_in) if opts.navigation == "live" else None,
+            "look_in_beyond": (float(opts.live.look_in_beyond)
+                               if opts.navigation == "live" else None),
             "peek": bool(opts.live.peek) if opts.navigation == "live" else None}
 
 
@@ -74,6 +76,10 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              # logs from before the robot looked into what it opened: it stayed there
              "look_in": (float((x.get("navigation") or {}).get("look_in", 0.0))
                          if (x.get("navigation") or {}).get("mode") == "live" else None),
+             # logs from before looking in from the side only: after every open
+             "look_in_beyond": (float((x.get("navigation") or {}).get("look_in_beyond", 0.0))
+                                if (x.get("navigation") or {}).get("mode") == "live"
+                                else None),
              # logs from before the head tilted into containers: it never did
              "peek": (bool((x.get("navigation") or {}).get("peek", False))
                       if (x.get("navigation") or {}).get("mode") == "live" else None)},
@@ -102,7 +108,8 @@ _LABELS = {"episode": "episode", "max_steps": "max steps", "frame_budget": "fram
            "noise": "noise", "seed": "seed",
            "episode_seeds": "planner seed per episode", "success": "success rule",
            "classifier": "room classifier", "explore_on": "explore on (frontiers)",
-           "look_in": "look in (m)", "peek": "peek into containers"}
+           "look_in": "look in (m)",
+           "look_in_beyond": "look in beyond (deg)", "peek": "peek into containers"}
 
 
 def settings_differences(logged: dict[str, Any], want: dict[str, Any]) -> list[str]:

@@ -72,7 +72,7 @@ def execute_live(sim: Simulation, skills: LiveSkills, calls: Sequence[SkillCall]
                 if outcome == "success" and at is not None:
                     outcome, reason, _ = skills.peek(at)
                     if reason != IN_VIEW:
-                        outcome, reason, _ = skills.look_in(at[:2], str(c.node))
+                        outcome, reason, _ = skills.look_in(at, str(c.node))
             else:
                 goal = _goal(c, decided)
                 run = skills.explore if c.skill == "explore" else skills.navigate

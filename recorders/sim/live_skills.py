@@ -41,14 +41,17 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   way, and stops when a refresh during the turn shows no cell known that was not before.
   Where a look-around ended so (not cut short by the target or the frame budget) is kept
   in :attr:`LiveSkills.looked`: looking again from there shows nothing new.
-- **Looking in** (off by default). After opening a container the robot stands within
-  reach of it, too near for the tilted camera to see its lower shelves, and often beside
-  its front, looking at a side board; with ``look_in`` > 0, :meth:`LiveSkills.look_in`
-  drives it to ``look_in`` metres from the container's node in front of its opening as
-  its map shows it (:func:`~sgtool.mapping.live_paths.view_goal`: the middle of the
-  widest fan of open directions round the container) and turns it to face the container,
-  so the frames show what the opening revealed. Off by default: its measured cost and
-  effect are in the project's experiment notes.
+- **Looking in** (on by default, after opens from the side). After opening a container
+  the robot stands within reach of it, too near for the tilted camera to see its lower
+  shelves, and often beside its front, looking at a side board; with ``look_in`` > 0,
+  :meth:`LiveSkills.look_in` drives it to ``look_in`` metres from the container's node
+  in front of its opening as its map shows it
+  (:func:`~sgtool.mapping.live_paths.view_goal`: the middle of the widest fan of open
+  directions round the container), turns it to face the container and peeks, so the
+  frames show what the opening revealed. With ``look_in_beyond`` > 0 only after an open
+  made from more than that many degrees off the fan's bisector (where no stand in front
+  was within reach, the side board hides the inside). On by default (the defaults of
+  :class:`LiveNavConfig`); how they were chosen is in the project's experiment notes.
 - **Peeking** (``peek``, on by default). The camera sits on a pan-tilt head: after
   opening a container, or walking up to one that stands open (examining it: a sink, a
   bookcase, a bucket), the robot tilts it down until the optical axis meets the point at
@@ -77,6 +80,7 @@ from sgtool.mapping.live_paths import (
     descend,
     front_goal,
     nearest_reachable,
+    open_fan,
     point_goal,
     stand_goal,
     traversable,
@@ -118,7 +122,10 @@ class LiveNavConfig:
     # bump marks leaving the robot less floor, or taking more from it, are dropped, oldest
     # first (module doc); 0: kept
     sealed_m2: float = 2.0
-    look_in: float = 0.0  # m from an opened container the robot backs off to (0: stays)
+    look_in: float = 1.4  # m from an opened container the robot backs off to (0: stays)
+    # degrees: look in only from a stand more than this off the container's open fan
+    # (0: after every open)
+    look_in_beyond: float = 45.0
     peek: bool = True  # tilt the camera down into an opened container and back
 
     def __post_init__(self) -> None:
@@ -128,6 +135,8 @@ class LiveNavConfig:
             raise SgtoolError(f"sealed area {self.sealed_m2} m2: must be 0..100")
         if not (0.0 <= self.look_in <= 3.0):
             raise SgtoolError(f"look-in distance {self.look_in} m: must be 0..3")
+        if not (0.0 <= self.look_in_beyond <= 180.0):
+            raise SgtoolError(f"look-in angle {self.look_in_beyond} degrees: must be 0..180")
         if self.max_replans < 1 or self.max_contacts < 0:
             raise SgtoolError("max re-plans must be >= 1 and max contacts >= 0")
 
@@ -135,7 +144,8 @@ class LiveNavConfig:
         return {"optimistic": self.optimistic, "snap": self.snap,
                 "frontier_snap": self.frontier_snap, "slack": self.slack,
                 "max_replans": self.max_replans, "max_contacts": self.max_contacts,
-                "sealed_m2": self.sealed_m2, "look_in": self.look_in, "peek": self.peek}
+                "sealed_m2": self.sealed_m2, "look_in": self.look_in,
+                "look_in_beyond": self.look_in_beyond, "peek": self.peek}
 
 
 class RobotBody:
@@ -415,24 +425,37 @@ class LiveSkills:
         return ("failure", f"{goal.label} not reached after {cfg.max_replans} re-plans",
                 driven)
 
-    def look_in(self, at: tuple[float, float], label: str = "container"
+    def look_in(self, at: tuple[float, float, float], label: str = "container"
                 ) -> tuple[Outcome, str, float]:
-        """Drive to where the opened container at ``at`` is seen whole (module doc: looking
-        in), facing it: (outcome, reason, metres); always a success (IN_VIEW when the
-        target came into view), since the opening is done whether or not the robot gets
-        there."""
-        if self.config.look_in <= 0.0:  # off: no map needed
+        """Drive to where the opened container whose node is at ``at`` is seen whole
+        (module doc: looking in), facing it, and peek into it there: (outcome, reason,
+        metres); always a success (IN_VIEW when the target came into view), since the
+        opening is done whether or not the robot gets there. With ``look_in_beyond`` > 0
+        only when the robot stands more than that many degrees off the container's open
+        fan (:func:`~sgtool.mapping.live_paths.open_fan`)."""
+        cfg = self.config
+        if cfg.look_in <= 0.0:  # off: no map needed
             return "success", "", 0.0
         ref = self.current()
         planned = None if ref is None else self.plan_map(ref)
         if planned is None:
             return "success", "", 0.0
-        goal = Goal(f"a view into {label}", "view", np.array([at], dtype=np.float64))
+        here = self.body.base[:2]
+        if cfg.look_in_beyond > 0.0:
+            fan = open_fan(*planned, at[:2], cfg.look_in)
+            if fan is None or off_bearing(at[:2], here, fan[0]) <= cfg.look_in_beyond:
+                return "success", "", 0.0
+        goal = Goal(f"a view into {label}", "view", np.array([at[:2]], dtype=np.float64))
         there = self.select(goal, *planned)
-        if there is None or math.dist(there, self.body.base[:2]) <= planned[0].resolution:
+        if there is None or math.dist(there, here) <= planned[0].resolution:
             return "success", "", 0.0
         outcome, why, driven = self.navigate(goal)
-        return "success", (IN_VIEW if outcome == "success" and why == IN_VIEW else ""), driven
+        if outcome == "success" and why == IN_VIEW:
+            return "success", IN_VIEW, driven
+        if outcome == "success":
+            _, why, _ = self.peek(at)
+            return "success", why, driven
+        return "success", "", driven
 
     def peek(self, at: tuple[float, float, float]) -> tuple[Outcome, str, float]:
         """Tilt the camera down into the opened container whose node is at ``at`` and
@@ -498,6 +521,14 @@ class LiveSkills:
             seen_at, known = now.index, k
         self.looked.append(_xy(body.base))
         return "success", "", 0.0
+
+
+def off_bearing(at: tuple[float, float], here: tuple[float, float], bisector: float
+                ) -> float:
+    """Degrees between the bearing from ``at`` to ``here`` and ``bisector`` (radians),
+    0..180."""
+    b = math.atan2(here[1] - at[1], here[0] - at[0])
+    return abs(math.degrees(math.remainder(b - bisector, 2.0 * math.pi)))
 
 
 def _xy(pose: Pose2) -> tuple[float, float]:

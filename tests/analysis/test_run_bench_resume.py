@@ -107,11 +107,17 @@ def test_a_log_of_other_frame_settings_is_not_resumed(tmp_path: Path) -> None:
         logged, task_settings(dataclasses.replace(opts, explore_on=3), "none", ep)) \
         == ["explore on (frontiers): 0 in the log, 3 now"]
     # and how far the robot backs off from what it opened
-    assert logged["look_in"] == 0.0
+    assert logged["look_in"] == 1.4
     assert settings_differences(
         logged, task_settings(dataclasses.replace(
-            opts, live=dataclasses.replace(opts.live, look_in=1.4)), "none", ep)) \
-        == ["look in (m): 0.0 in the log, 1.4 now"]
+            opts, live=dataclasses.replace(opts.live, look_in=0.0)), "none", ep)) \
+        == ["look in (m): 1.4 in the log, 0.0 now"]
+    # and after which opens it does
+    assert logged["look_in_beyond"] == 45.0
+    assert settings_differences(
+        logged, task_settings(dataclasses.replace(
+            opts, live=dataclasses.replace(opts.live, look_in_beyond=0.0)), "none", ep)) \
+        == ["look in beyond (deg): 45.0 in the log, 0.0 now"]
     # a log from before each episode drew its own planner seed is not reused
     assert logged["episode_seeds"] is True
     assert settings_differences(dict(logged, episode_seeds=False),

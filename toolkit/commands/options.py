@@ -335,12 +335,23 @@ def look_in_option() -> Callable[[F], F]:
     """``--look-in M`` of the closed-loop commands
     (:attr:`sgtool.recorders.sim.live_skills.LiveNavConfig.look_in`)."""
     return click.option(
-        "--look-in", type=click.FloatRange(0.0, 3.0), default=0.0, show_default=True,
+        "--look-in", type=click.FloatRange(0.0, 3.0), default=1.4, show_default=True,
         metavar="M",
         help="live navigation: after opening a container the robot drives to M metres "
              "from it, in front of its opening as its map shows it, and faces it, so the "
-             "camera sees what the opening revealed, e.g. 1.4 (0: it stays where it "
-             "opened it).")
+             "camera sees what the opening revealed (0: it stays where it opened it; "
+             "--look-in-beyond says after which opens).")
+
+
+def look_in_beyond_option() -> Callable[[F], F]:
+    """``--look-in-beyond DEG`` of the closed-loop commands
+    (:attr:`sgtool.recorders.sim.live_skills.LiveNavConfig.look_in_beyond`)."""
+    return click.option(
+        "--look-in-beyond", type=click.FloatRange(0.0, 180.0), default=45.0,
+        show_default=True, metavar="DEG",
+        help="live navigation: look in (--look-in) only after an open made from more "
+             "than DEG degrees off the container's front as the robot's map shows it (the "
+             "side board hides the inside from there; 0: after every open).")
 
 
 def peek_option() -> Callable[[F], F]:

@@ -23,6 +23,7 @@ from sgtool.commands.options import (
     list_planners_option,
     llm_endpoint_options,
     llm_log_options,
+    look_in_beyond_option,
     look_in_option,
     peek_option,
     run_planner_options,
@@ -78,6 +79,7 @@ if TYPE_CHECKING:
               "before, for comparison).")
 @explore_on_option()
 @look_in_option()
+@look_in_beyond_option()
 @peek_option()
 @click.option("--optimistic", type=float, default=0.25, show_default=True, metavar="M",
               help="live navigation: how far (m) past known free floor a path may run into "
@@ -170,7 +172,8 @@ class RunArgs:
     llm_timeout: float | None = None
     rerun_to: str | None = None
     explore_on: int = 0
-    look_in: float = 0.0
+    look_in: float = 1.4
+    look_in_beyond: float = 45.0
     peek: bool = True
 
 
@@ -228,7 +231,8 @@ def _request(args: RunArgs, out: Path) -> SearchRequest:
         frames=frame_budget(args.frames, args.frames_per_room, len(house.rooms)),
         planner_seed=args.planner_seed, navigation=args.navigation, success=args.success,
         noise=parse_noise(args.noise),
-        live=LiveNavConfig(optimistic=args.optimistic, look_in=args.look_in, peek=args.peek),
+        live=LiveNavConfig(optimistic=args.optimistic, look_in=args.look_in,
+                           look_in_beyond=args.look_in_beyond, peek=args.peek),
         explore_on=args.explore_on)
     return SearchRequest(house=house, house_id=house_id, episode_index=index, episode=ep,
                          planner=name, output=out, options=opts, planner_options=options,

@@ -16,6 +16,7 @@ from sgtool.commands.options import (
     explore_on_option,
     list_planners_option,
     llm_endpoint_options,
+    look_in_beyond_option,
     look_in_option,
     parse_resolution,
     parse_rooms,
@@ -69,6 +70,7 @@ if TYPE_CHECKING:
               help="Refresh the scene graph every K frames (and at every action).")
 @explore_on_option()
 @look_in_option()
+@look_in_beyond_option()
 @peek_option()
 @click.option("--navigation", type=click.Choice(["live", "house"]), default="live",
               show_default=True,
@@ -163,7 +165,8 @@ class RunBenchArgs:
     symbolic_dir: str | None = None
     with_symbolic: bool = False
     explore_on: int = 0
-    look_in: float = 0.0
+    look_in: float = 1.4
+    look_in_beyond: float = 45.0
     peek: bool = True
 
 
@@ -215,7 +218,9 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
                              every=args.every, max_steps=args.max_steps, frames=args.frames,
                              navigation=args.navigation, success=args.success,
                              explore_on=args.explore_on,
-                             live=LiveNavConfig(look_in=args.look_in, peek=args.peek))
+                             live=LiveNavConfig(look_in=args.look_in,
+                                                look_in_beyond=args.look_in_beyond,
+                                                peek=args.peek))
     options = planner_options(args.planner_option, names)
     LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
                 args.llm_timeout).fill(options, names)

@@ -37,7 +37,12 @@ from sgtool.recorders.sim.closed_loop import (
     pick_episode,
     run_episode,
 )
-from sgtool.recorders.sim.live_skills import LiveNavConfig, PrivilegedAccess, RobotBody
+from sgtool.recorders.sim.live_skills import (
+    LiveNavConfig,
+    PrivilegedAccess,
+    RobotBody,
+    off_bearing,
+)
 from sgtool.recorders.sim.motion import head_tilts, peek_tilt
 
 OPTS = ClosedLoopOptions(camera=CameraConfig(width=160, height=120))
@@ -146,7 +151,8 @@ def test_after_opening_a_container_the_robot_looks_in_from_in_front(house, tmp_p
     it."""
     ends = {}
     for look in (0.0, 1.4):
-        opts = dataclasses.replace(OPTS, live=LiveNavConfig(look_in=look, peek=False),
+        opts = dataclasses.replace(OPTS, live=LiveNavConfig(look_in=look, look_in_beyond=0.0,
+                                                            peek=False),
                                    max_steps=1)
         k, out, p, fb = _first_open(house, opts, tmp_path / f"open-{look}")
         with LogReader(out) as r:
@@ -186,6 +192,47 @@ def test_a_container_is_opened_from_in_front_of_it(tmp_path) -> None:
     bearing = math.atan2(y - piece.center[1], x - piece.center[0])
     off = abs(math.remainder(bearing - front, 2 * math.pi))
     assert off < math.radians(40) and math.dist((x, y), node.position[:2]) < 1.0
+
+
+@pytest.mark.parametrize("beyond", [60.0, 10.0])
+def test_looking_in_only_after_an_open_from_the_side(tmp_path, beyond) -> None:
+    """With ``look_in_beyond`` the robot looks in only when it opened the container from
+    more than that many degrees off the container's open fan on its map. Here (the episode
+    of the test above) it opens from 31 degrees off the piece's front: within 60 degrees
+    it stays where it opened, beyond 10 degrees it backs off to 1.4 m in front."""
+    house = generate_house(1, rooms=(4, 4))
+    idx, ep = pick_episode(house, index=1)
+    p = Scripted([_open_first_container, Action("done")])
+    out = tmp_path / "side.mcap"
+    live = LiveNavConfig(peek=False, look_in=1.4, look_in_beyond=beyond)
+    run_episode(house, ep, p, out, dataclasses.replace(OPTS, live=live, max_steps=1),
+                episode_index=idx)
+    fb = p.feedbacks[0]
+    assert (fb.action.skill, fb.outcome) == ("open", "success")
+    with LogReader(out) as r:
+        started = next(r.records("episode"))[1]
+    assert started["extra"]["navigation"]["look_in_beyond"] == beyond
+    node = p.graphs[0].node(fb.action.target)
+    x, y, _ = _last_pose(out)
+    d = math.dist((x, y), node.position[:2])
+    if beyond == 60.0:
+        assert d < 1.0  # where it opened (the test above)
+    else:
+        assert abs(d - 1.4) <= 0.15
+
+
+def test_a_look_in_angle_is_checked() -> None:
+    with pytest.raises(SgtoolError, match="must be 0..180"):
+        LiveNavConfig(look_in=1.4, look_in_beyond=200.0)
+    assert LiveNavConfig(look_in=1.4, look_in_beyond=45.0).to_dict()["look_in_beyond"] == 45.0
+
+
+def test_off_bearing_is_the_angle_from_the_fan_bisector() -> None:
+    assert off_bearing((0.0, 0.0), (1.0, 0.0), 0.0) == pytest.approx(0.0)
+    assert off_bearing((0.0, 0.0), (0.0, 2.0), 0.0) == pytest.approx(90.0)
+    assert off_bearing((1.0, 1.0), (0.0, 1.0), math.radians(170.0)) == pytest.approx(10.0)
+    assert off_bearing((0.0, 0.0), (-1.0, -0.01), math.radians(179.0)) == \
+        pytest.approx(1.0 + math.degrees(math.atan(0.01)), abs=1e-6)
 
 
 def _tilt(base_T_cam) -> float:
