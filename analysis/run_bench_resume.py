@@ -42,9 +42,14 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
             "seed": opts.planner_seed, "episode_seeds": True, "success": opts.success,
             "classifier": opts.classifier, "explore_on": opts.explore_on,
             "look_in": float(opts.live.look_in) if opts.navigation == "live" else None,
-            "look_in_beyond": (float(opts.live.look_in_beyond)
+            "look_in_beyond": (_beyond(opts.live.look_in, opts.live.look_in_beyond)
                                if opts.navigation == "live" else None),
             "peek": bool(opts.live.peek) if opts.navigation == "live" else None}
+
+
+def _beyond(look_in: float, beyond: float) -> float | None:
+    """The look-in angle as a setting: none while looking in is off (it changes nothing)."""
+    return float(beyond) if float(look_in) > 0.0 else None
 
 
 def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
@@ -77,7 +82,8 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              "look_in": (float((x.get("navigation") or {}).get("look_in", 0.0))
                          if (x.get("navigation") or {}).get("mode") == "live" else None),
              # logs from before looking in from the side only: after every open
-             "look_in_beyond": (float((x.get("navigation") or {}).get("look_in_beyond", 0.0))
+             "look_in_beyond": (_beyond((x.get("navigation") or {}).get("look_in", 0.0),
+                                        (x.get("navigation") or {}).get("look_in_beyond", 0.0))
                                 if (x.get("navigation") or {}).get("mode") == "live"
                                 else None),
              # logs from before the head tilted into containers: it never did

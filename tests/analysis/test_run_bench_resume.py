@@ -111,9 +111,12 @@ def test_a_log_of_other_frame_settings_is_not_resumed(tmp_path: Path) -> None:
     assert settings_differences(
         logged, task_settings(dataclasses.replace(
             opts, live=dataclasses.replace(opts.live, look_in=0.0)), "none", ep)) \
-        == ["look in (m): 1.4 in the log, 0.0 now"]
-    # and after which opens it does
+        == ["look in (m): 1.4 in the log, 0.0 now",
+            "look in beyond (deg): 45.0 in the log, null now"]
+    # and after which opens it does (nothing to compare while it is off)
     assert logged["look_in_beyond"] == 45.0
+    assert task_settings(dataclasses.replace(opts, live=dataclasses.replace(
+        opts.live, look_in=0.0, look_in_beyond=10.0)), "none", ep)["look_in_beyond"] is None
     assert settings_differences(
         logged, task_settings(dataclasses.replace(
             opts, live=dataclasses.replace(opts.live, look_in_beyond=0.0)), "none", ep)) \
