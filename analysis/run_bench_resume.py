@@ -44,7 +44,9 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
             "look_in": float(opts.live.look_in) if opts.navigation == "live" else None,
             "look_in_beyond": (_beyond(opts.live.look_in, opts.live.look_in_beyond)
                                if opts.navigation == "live" else None),
-            "peek": bool(opts.live.peek) if opts.navigation == "live" else None}
+            "peek": bool(opts.live.peek) if opts.navigation == "live" else None,
+            "sight_lines": (bool(opts.live.sight_lines) if opts.navigation == "live"
+                            else None)}
 
 
 def _beyond(look_in: float, beyond: float) -> float | None:
@@ -88,7 +90,10 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
                                 else None),
              # logs from before the head tilted into containers: it never did
              "peek": (bool((x.get("navigation") or {}).get("peek", False))
-                      if (x.get("navigation") or {}).get("mode") == "live" else None)},
+                      if (x.get("navigation") or {}).get("mode") == "live" else None),
+             # logs from before the sight lines: every unknown bearing was turned to
+             "sight_lines": (bool((x.get("navigation") or {}).get("sight_lines", False))
+                             if (x.get("navigation") or {}).get("mode") == "live" else None)},
             house)
 
 
@@ -115,7 +120,8 @@ _LABELS = {"episode": "episode", "max_steps": "max steps", "frame_budget": "fram
            "episode_seeds": "planner seed per episode", "success": "success rule",
            "classifier": "room classifier", "explore_on": "explore on (frontiers)",
            "look_in": "look in (m)",
-           "look_in_beyond": "look in beyond (deg)", "peek": "peek into containers"}
+           "look_in_beyond": "look in beyond (deg)", "peek": "peek into containers",
+           "sight_lines": "sight lines"}
 
 
 def settings_differences(logged: dict[str, Any], want: dict[str, Any]) -> list[str]:

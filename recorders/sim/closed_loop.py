@@ -122,7 +122,7 @@ from sgtool.recorders.sim.fallback_explore import (
     new_candidates,
 )
 from sgtool.recorders.sim.live_recorder import LiveRecorder
-from sgtool.recorders.sim.live_skills import IN_VIEW, LiveSkills, RobotBody
+from sgtool.recorders.sim.live_skills import IN_VIEW, LiveSkills, RobotBody, camera_sight
 from sgtool.recorders.sim.reachability import (
     FAILED_BEFORE,
     FailedGoals,
@@ -483,7 +483,8 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                 extra=_started_extra(opts, sim, mapping, episode, episode_index)), 0)
             rec.write_instances(sim)
             skills = None if opts.navigation == "house" else LiveSkills(
-                RobotBody(sim), lambda: stream.current, opts.live)
+                RobotBody(sim), lambda: stream.current, opts.live,
+                sight=camera_sight(stream, sim.camera.mount_height))
             if skills is not None:  # end a skill as soon as the target is in the graph
                 skills.stop_when = lambda: _found(stream.current, query)
             search = _Search(sim, rec, planner, query, opts.max_steps, on_decision, skills,

@@ -9,7 +9,9 @@ the headings a look-around needs on the robot's own map.
   behind the robot, a sharp corner); at the end it turns to ``final_yaw`` when given.
 - :func:`sweep`: the turn (signed radians) that brings every bearing of unknown space
   near the robot into the camera's horizontal field of view, the shorter way round;
-  0 when nothing around is unknown.
+  0 when nothing around is unknown. Given what the camera cannot see over (the voxel
+  columns reaching above it: walls, wardrobes), only unknown space in sight counts, so
+  the robot does not turn to the room behind a wall; space behind a table or a bed does.
 - :func:`peek_tilt` and :func:`head_tilts`: the camera tilt that aims into an opened
   container seen from where the robot stands (the optical axis at half the height of the
   container's node above the floor below it, so a floor-standing piece's lower shelves
@@ -82,12 +84,15 @@ def drive_while_turning(pose: Pose2, waypoints: Sequence[Sequence[float]], step:
 
 
 def sweep(grid: OccupancyGrid, pose: Pose2, hfov: float, radius: float = 3.0,
-          sectors: int = 24, min_cells: int = 4) -> float:
+          sectors: int = 24, min_cells: int = 4, blockers: np.ndarray | None = None
+          ) -> float:
     """The turn (radians, + counter-clockwise) from ``pose``'s heading that brings every
     sector of bearings holding at least ``min_cells`` unknown cells within ``radius`` m
     into the horizontal field of view ``hfov`` (module doc); the shorter way round, 0 when
     no sector qualifies, at most one full turn. Cells outside the grid count as unknown
-    (the map has not reached them)."""
+    (the map has not reached them). With ``blockers`` (a bool mask over ``grid``: what the
+    camera cannot see over) only unknown cells in sight count: the straight line to them
+    crosses no blocker."""
     x, y, a = pose
     res = grid.resolution
     n = int(math.ceil(radius / res))
@@ -102,6 +107,8 @@ def sweep(grid: OccupancyGrid, pose: Pose2, hfov: float, radius: float = 3.0,
     unknown = ~inside
     unknown[inside] = grid.grid[rr[inside], cc[inside]] == -1
     sel = near & unknown
+    if blockers is not None and sel.any():
+        sel[sel] = _in_sight(blockers, grid, x, y, cx[sel], cy[sel])
     if not sel.any():
         return 0.0
     bearing = np.arctan2(cy[sel] - y, cx[sel] - x)
@@ -123,6 +130,25 @@ def sweep(grid: OccupancyGrid, pose: Pose2, hfov: float, radius: float = 3.0,
         return 0.0
     best = plus if plus <= minus else -minus
     return max(-two_pi, min(two_pi, best))
+
+
+def _in_sight(blockers: np.ndarray, grid: OccupancyGrid, x: float, y: float,
+              cx: np.ndarray, cy: np.ndarray) -> np.ndarray:
+    """Whether the straight line from (x, y) to each point (cx, cy) crosses no ``blockers``
+    cell of ``grid`` short of the point's own cell (sampled every half cell; off the grid
+    nothing blocks)."""
+    res = grid.resolution
+    reach = float(np.max(np.hypot(cx - x, cy - y)))
+    m = max(2, int(math.ceil(2.0 * reach / res)))
+    t = np.arange(m, dtype=np.float64)[None, :] / m
+    r, c = grid.cell_of(x + t * (cx - x)[:, None], y + t * (cy - y)[:, None])
+    h, w = grid.shape
+    inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+    blocked = np.zeros(r.shape, dtype=bool)
+    blocked[inside] = blockers[r[inside], c[inside]]
+    own_r, own_c = grid.cell_of(cx, cy)
+    blocked &= ~((r == own_r[:, None]) & (c == own_c[:, None]))
+    return np.asarray(~blocked.any(axis=1), dtype=bool)
 
 
 def peek_tilt(mount_height: float, tilt_deg: float, base_xy: Sequence[float],

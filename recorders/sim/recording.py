@@ -299,7 +299,7 @@ def _explore_live(sim: Simulation, rec: LogRecorder, opts: RecordOptions,
     the floor coverage at every refresh."""
     from sgtool.recorders.sim.coverage import coverage, floor_points
     from sgtool.recorders.sim.frontier_explore import LiveMap, explore_frontiers
-    from sgtool.recorders.sim.live_skills import LiveSkills, RobotBody
+    from sgtool.recorders.sim.live_skills import LiveSkills, RobotBody, camera_sight
     from sgtool.scenegraph.build_options import ResolvedOptions, builder_config, default_min_points
     from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 
@@ -317,7 +317,8 @@ def _explore_live(sim: Simulation, rec: LogRecorder, opts: RecordOptions,
             samples.append((r.time_ns / 1e9, coverage(r.layers.occupancy, floor)))
 
     sim.observers.insert(sim.observers.index(rec) + 1, LiveMap(rec, stream, sample))
-    skills = LiveSkills(RobotBody(sim), lambda: stream.current)
+    skills = LiveSkills(RobotBody(sim), lambda: stream.current,
+                        sight=camera_sight(stream, sim.camera.mount_height))
     sim.tick()  # the view at the start pose
     fr = explore_frontiers(skills, rec.on_skill_of(sim))
     rep.visited.extend(fr.goals)

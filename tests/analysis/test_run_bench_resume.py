@@ -134,3 +134,9 @@ def test_a_log_of_other_frame_settings_is_not_resumed(tmp_path: Path) -> None:
             opts, live=dataclasses.replace(opts.live, peek=not peek)), "none", ep)) \
         == [f"peek into containers: {str(peek).lower()} in the log, "
             f"{str(not peek).lower()} now"]
+    # and whether the look-arounds kept to the camera's sight lines (off by default)
+    assert logged["sight_lines"] is False
+    assert settings_differences(
+        logged, task_settings(dataclasses.replace(
+            opts, live=dataclasses.replace(opts.live, sight_lines=True)), "none", ep)) \
+        == ["sight lines: false in the log, true now"]

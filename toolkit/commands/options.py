@@ -365,6 +365,17 @@ def peek_option() -> Callable[[F], F]:
              "fixed tilt leaves out of view within reach.")
 
 
+def sight_lines_option() -> Callable[[F], F]:
+    """``--sight-lines/--no-sight-lines`` of the closed-loop commands
+    (:attr:`sgtool.recorders.sim.live_skills.LiveNavConfig.sight_lines`)."""
+    return click.option(
+        "--sight-lines/--no-sight-lines", default=False, show_default=True,
+        help="live navigation: a look-around turns only toward unknown space the camera "
+             "can see from where the robot stands, past what its own map shows lower "
+             "than the camera (a table, a bed) but not past what reaches above it (a "
+             "wall, a wardrobe); fewer frames turning, less seen on the way.")
+
+
 def executor_options(what: str) -> Callable[[F], F]:
     """``--executor local|ray``, ``--workers/-w N`` and ``--ray-address`` of the batch
     commands (:func:`sgtool.analysis.executor.make_executor`); ``what`` names the tasks."""

@@ -27,6 +27,7 @@ from sgtool.commands.options import (
     look_in_option,
     peek_option,
     run_planner_options,
+    sight_lines_option,
     success_option,
 )
 from sgtool.errors import SgtoolError
@@ -81,6 +82,7 @@ if TYPE_CHECKING:
 @look_in_option()
 @look_in_beyond_option()
 @peek_option()
+@sight_lines_option()
 @click.option("--optimistic", type=float, default=0.25, show_default=True, metavar="M",
               help="live navigation: how far (m) past known free floor a path may run into "
               "unknown space (at frontiers).")
@@ -175,6 +177,7 @@ class RunArgs:
     look_in: float = 1.4
     look_in_beyond: float = 45.0
     peek: bool = True
+    sight_lines: bool = False
 
 
 def _planner(args: RunArgs) -> tuple[str, dict[str, Any]]:
@@ -232,7 +235,8 @@ def _request(args: RunArgs, out: Path) -> SearchRequest:
         planner_seed=args.planner_seed, navigation=args.navigation, success=args.success,
         noise=parse_noise(args.noise),
         live=LiveNavConfig(optimistic=args.optimistic, look_in=args.look_in,
-                           look_in_beyond=args.look_in_beyond, peek=args.peek),
+                           look_in_beyond=args.look_in_beyond, peek=args.peek,
+                           sight_lines=args.sight_lines),
         explore_on=args.explore_on)
     return SearchRequest(house=house, house_id=house_id, episode_index=index, episode=ep,
                          planner=name, output=out, options=opts, planner_options=options,

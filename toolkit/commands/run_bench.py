@@ -23,6 +23,7 @@ from sgtool.commands.options import (
     peek_option,
     planner_names,
     planner_options,
+    sight_lines_option,
     success_option,
 )
 from sgtool.datasets.presets import PRESET_NAMES
@@ -72,6 +73,7 @@ if TYPE_CHECKING:
 @look_in_option()
 @look_in_beyond_option()
 @peek_option()
+@sight_lines_option()
 @click.option("--navigation", type=click.Choice(["live", "house"]), default="live",
               show_default=True,
               help="live: skills plan on the robot's own map; house: on the ground truth "
@@ -168,6 +170,7 @@ class RunBenchArgs:
     look_in: float = 1.4
     look_in_beyond: float = 45.0
     peek: bool = True
+    sight_lines: bool = False
 
 
 def _request(args: RunBenchArgs) -> RunBenchRequest:
@@ -220,7 +223,8 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
                              explore_on=args.explore_on,
                              live=LiveNavConfig(look_in=args.look_in,
                                                 look_in_beyond=args.look_in_beyond,
-                                                peek=args.peek))
+                                                peek=args.peek,
+                                                sight_lines=args.sight_lines))
     options = planner_options(args.planner_option, names)
     LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
                 args.llm_timeout).fill(options, names)

@@ -107,6 +107,16 @@ def classify_keys(keys: np.ndarray, level: int, resolution: float, config: BevCo
                          _unique_columns(col[is_floor], presorted))
 
 
+def columns_between(keys: np.ndarray, level: int, resolution: float, low: float,
+                    high: float) -> np.ndarray:
+    """Distinct (ix, iy) voxel columns of packed ``keys`` holding a voxel from ``low`` to
+    ``high`` metres above the floor level ``level`` (both ends included, in whole voxels)."""
+    iz = ((keys >> SHIFT_Z) & AXIS_MASK) - OFFSET
+    lo = level + int(math.ceil(low / resolution - 1e-9))
+    hi = level + int(math.floor(high / resolution + 1e-9))
+    return _unique_columns(keys[(iz >= lo) & (iz <= hi)] >> COLUMN_SHIFT, presorted=False)
+
+
 class ColumnGrid:
     """Occupied/floor flags per voxel column over a grid that grows with the map, updated
     with the columns of new voxels only (the incremental half of the BEV)."""

@@ -480,6 +480,11 @@ class VoxelMap:
         self.flush()
         return self._store.arrays()
 
+    def merged_keys(self) -> np.ndarray:
+        """The sorted packed keys merged so far, without merging the pending frames (the
+        map as of the last :meth:`flush`; reading it changes nothing)."""
+        return self._store.arrays()[0]
+
     def drain_new_keys(self) -> np.ndarray:
         """(voxel, label) keys that entered the map since the last call (unsorted)."""
         self.flush()

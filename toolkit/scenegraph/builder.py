@@ -79,7 +79,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from sgtool.log.frame import Frame
-from sgtool.mapping.bev import ColumnGrid, classify_keys, floor_fans, floor_level
+from sgtool.mapping.bev import (
+    ColumnGrid,
+    classify_keys,
+    columns_between,
+    floor_fans,
+    floor_level,
+)
 from sgtool.mapping.column_update import fresh_extent, reclassify_columns
 from sgtool.mapping.free_space import View
 from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
@@ -416,6 +422,22 @@ class SceneGraphBuilder:
         self._cleared = len(self.trajectory)
         self.cleared_entries += self.voxels.clear_unlabelled_around(
             pts, BODY_RADIUS, level + tol + 1, level + top)
+
+    def columns_between(self, grid: OccupancyGrid, low: float, high: float) -> np.ndarray:
+        """Bool mask over ``grid``'s cells: the voxel columns holding something from ``low``
+        to ``high`` metres above the floor level of the last refresh (what a camera at
+        ``low`` cannot see over); all False before a refresh made the occupancy."""
+        mask = np.zeros(grid.shape, dtype=bool)
+        if self._level is None:
+            return mask
+        res = self.voxels.resolution
+        cols = columns_between(self.voxels.merged_keys(), self._level, res, low, high)
+        if len(cols):
+            r, c = grid.cell_of((cols[:, 0] + 0.5) * res, (cols[:, 1] + 0.5) * res)
+            h, w = grid.shape
+            ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+            mask[r[ok], c[ok]] = True
+        return mask
 
     def _occupancy(self) -> OccupancyGrid:
         cfg = self.config.bev

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from sgtool.mapping.grid import FREE, UNKNOWN, OccupancyGrid
+from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.recorders.sim.motion import drive_while_turning, head_tilts, peek_tilt, sweep
 from sgtool.recorders.sim.navigation import follow_poses, wrap_angle
 
@@ -87,6 +87,28 @@ def test_the_look_around_turns_toward_unknown_space_only() -> None:
     assert 0 < left < math.pi
     # off the map is unknown: a robot at the edge of its map turns toward the outside
     assert sweep(_grid(None), (3.9, 0.0, math.pi), hfov) != 0.0
+
+
+def test_the_look_around_ignores_unknown_space_behind_what_it_cannot_see_over() -> None:
+    hfov = math.radians(90.0)
+    g = np.full((81, 81), FREE, dtype=np.int8)
+    g[:, :30] = UNKNOWN  # the room behind a wall 1 m behind the robot (x < -1 m)
+    g[:, 30] = OCCUPIED
+    grid = OccupancyGrid(g, (-4.05, -4.05), 0.1)
+    wall = g == OCCUPIED
+    # without blockers the unknown room asks for a turn; a wall the camera cannot see
+    # over hides it, so there is nothing to turn for
+    assert sweep(grid, (0.0, 0.0, 0.0), hfov) != 0.0
+    assert sweep(grid, (0.0, 0.0, 0.0), hfov, blockers=wall) == 0.0
+    # the same obstacle low enough to see over (no blocker) hides nothing
+    assert sweep(grid, (0.0, 0.0, 0.0), hfov, blockers=np.zeros_like(wall)) == \
+        sweep(grid, (0.0, 0.0, 0.0), hfov)
+    # a doorway in the wall (|y| < 0.45 m) shows part of the room: turn toward it,
+    # about 180 - 45 degrees either way
+    g[36:45, 30] = FREE
+    wall = g == OCCUPIED
+    a = sweep(OccupancyGrid(g, (-4.05, -4.05), 0.1), (0.0, 0.0, 0.0), hfov, blockers=wall)
+    assert math.radians(110) < abs(a) < math.radians(160)
 
 
 def test_an_action_ends_when_its_navigation_brings_the_target_into_view() -> None:

@@ -206,6 +206,37 @@ def test_look_around_records_where_it_looked() -> None:
     assert skills.looked == [(1.0, 2.0)]
 
 
+def test_look_around_keeps_to_the_sight_lines_only_when_asked() -> None:
+    occ, _ = _map()
+
+    class Turning(_Body):
+        hfov = 1.0
+        fps = 10.0
+        frames = 0
+
+        def drive(self, poses):
+            self.base = poses[-1]
+            self.frames += len(poses)
+            return 0.0, False
+
+    known = SimpleNamespace(index=1, layers=SimpleNamespace(occupancy=occ.grid))
+    asked = []
+
+    def walls(grid):  # the camera sees past nothing: no unknown cell is in sight
+        asked.append(grid)
+        return np.ones(grid.shape, dtype=bool)
+
+    turns = {}
+    for on in (False, True):
+        body = Turning((1.0, 2.0, 0.0), RobotConfig())
+        skills = LiveSkills(body, lambda: known, LiveNavConfig(sight_lines=on), sight=walls)
+        out = skills.look_around()
+        turns[on] = (body.frames, out)
+    assert turns[False][0] > 0  # off: the whole sweep toward the unknown
+    assert turns[True] == (0, ("success", "nothing unknown around", 0.0))
+    assert len(asked) == 1  # consulted once, and only with sight_lines on
+
+
 def test_bump_marks_that_wall_the_robot_in_are_dropped() -> None:
     # contacts all round the robot (at a door frame, a swinging panel): each bump is
     # blocked and grown by the robot's radius, so eight of them ring it in; before, every

@@ -11,6 +11,7 @@ from sgtool.mapping.bev import (
     BevConfig,
     ColumnGrid,
     classify_keys,
+    columns_between,
     estimate_floor_level,
     floor_fans,
     line_of_sight,
@@ -149,3 +150,18 @@ def test_distance_fields_and_inflation() -> None:
     grown = inflate(obstacle, 0.2, 0.1)
     assert grown[5, 7] and grown[6, 7] and grown[6, 6]
     assert not grown[5, 8] and not grown[7, 7]
+
+
+def test_columns_between_keep_the_columns_reaching_into_the_band() -> None:
+    # floor at level 2 (0.1 m voxels): a wall column up to 2.0 m, a table column up to
+    # 0.7 m and a lamp hanging at 1.9-2.0 m over a third column
+    wall = [(0, 0, z) for z in range(2, 23)]
+    table = [(1, 0, z) for z in range(2, 10)]
+    lamp = [(2, 0, 21), (2, 0, 22)]
+    keys = np.sort(pack(*np.array(wall + table + lamp).T, 0))
+    # what reaches from 1.2 m to 1.6 m above the floor: the wall only
+    assert columns_between(keys, 2, 0.1, 1.2, 1.6).tolist() == [[0, 0]]
+    # from 0.5 m: the table too; the lamp is above the band in both
+    assert columns_between(keys, 2, 0.1, 0.5, 1.6).tolist() == [[0, 0], [1, 0]]
+    assert columns_between(keys, 2, 0.1, 1.85, 2.0).tolist() == [[0, 0], [2, 0]]
+    assert columns_between(keys[:0], 2, 0.1, 1.2, 1.6).shape == (0, 2)

@@ -21,6 +21,7 @@ from support.synthetic_world import (
 )
 
 from sgtool.log.frame import CameraIntrinsics, Frame
+from sgtool.mapping.grid import OCCUPIED
 from sgtool.mapping.voxels import VoxelConfig
 from sgtool.planning.candidates import actionable, door_is_entrance
 from sgtool.scenegraph.builder import BuilderConfig, SceneGraphBuilder
@@ -216,3 +217,16 @@ def test_empty_narrow_rooms_are_corridors() -> None:
     assert not corridor_like(room, np.arange(len(room)), CONFIG)
     assert not corridor_like(short, np.arange(len(short)), CONFIG)
     assert not corridor_like(corridor, np.arange(len(corridor)), CONFIG, semantic=False)
+
+
+def test_the_columns_the_camera_cannot_see_over_are_the_walls_not_the_floor() -> None:
+    b, _ = build("closed")
+    grid = b.layers.occupancy  # type: ignore[union-attr]
+    tall = b.columns_between(grid, 1.2, 1.6)
+    assert tall.shape == grid.shape and tall.any()
+    # all of them are obstacles on the map, and the dividing wall (x = 4 m, 2.5 m high)
+    # is among them
+    assert (grid.grid[tall] == OCCUPIED).all()
+    assert any(tall[grid.cell_of(x, 0.5)] for x in (3.98, 4.02))
+    # nothing in the house reaches 5 m above the floor
+    assert not b.columns_between(grid, 5.0, 6.0).any()
