@@ -27,6 +27,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from sgtool.mapping.bev import line_of_sight
 from sgtool.mapping.grid import OccupancyGrid
 from sgtool.recorders.sim.navigation import Pose2, turn_poses, wrap_angle
 
@@ -107,8 +108,10 @@ def sweep(grid: OccupancyGrid, pose: Pose2, hfov: float, radius: float = 3.0,
     unknown = ~inside
     unknown[inside] = grid.grid[rr[inside], cc[inside]] == -1
     sel = near & unknown
-    if blockers is not None and sel.any():
-        sel[sel] = _in_sight(blockers, grid, x, y, cx[sel], cy[sel])
+    if blockers is not None and sel.any():  # the cell itself may hold what blocks
+        ends = np.stack([cx[sel], cy[sel]], axis=1)
+        sel[sel] = line_of_sight(blockers, grid, np.broadcast_to([x, y], ends.shape), ends,
+                                 skip_end=res, outside_blocks=False)
     if not sel.any():
         return 0.0
     bearing = np.arctan2(cy[sel] - y, cx[sel] - x)
@@ -130,25 +133,6 @@ def sweep(grid: OccupancyGrid, pose: Pose2, hfov: float, radius: float = 3.0,
         return 0.0
     best = plus if plus <= minus else -minus
     return max(-two_pi, min(two_pi, best))
-
-
-def _in_sight(blockers: np.ndarray, grid: OccupancyGrid, x: float, y: float,
-              cx: np.ndarray, cy: np.ndarray) -> np.ndarray:
-    """Whether the straight line from (x, y) to each point (cx, cy) crosses no ``blockers``
-    cell of ``grid`` short of the point's own cell (sampled every half cell; off the grid
-    nothing blocks)."""
-    res = grid.resolution
-    reach = float(np.max(np.hypot(cx - x, cy - y)))
-    m = max(2, int(math.ceil(2.0 * reach / res)))
-    t = np.arange(m, dtype=np.float64)[None, :] / m
-    r, c = grid.cell_of(x + t * (cx - x)[:, None], y + t * (cy - y)[:, None])
-    h, w = grid.shape
-    inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
-    blocked = np.zeros(r.shape, dtype=bool)
-    blocked[inside] = blockers[r[inside], c[inside]]
-    own_r, own_c = grid.cell_of(cx, cy)
-    blocked &= ~((r == own_r[:, None]) & (c == own_c[:, None]))
-    return np.asarray(~blocked.any(axis=1), dtype=bool)
 
 
 def peek_tilt(mount_height: float, tilt_deg: float, base_xy: Sequence[float],

@@ -418,10 +418,11 @@ def disk(radius: int) -> np.ndarray:
 
 
 def line_of_sight(blocked: np.ndarray, occ: OccupancyGrid, a: np.ndarray, b: np.ndarray,
-                  skip_end: float = 0.0) -> np.ndarray:
+                  skip_end: float = 0.0, outside_blocks: bool = True) -> np.ndarray:
     """For segments a[i] -> b[i] (world (k, 2)), True when no ``blocked`` cell lies on
     them (sampled every half cell; the last ``skip_end`` metres before b are not checked,
-    so b may sit on an obstacle such as a door panel). Out-of-grid samples block."""
+    so b may sit on an obstacle such as a door panel). Out-of-grid samples block unless
+    ``outside_blocks`` is False (space the map has not reached)."""
     a = np.asarray(a, dtype=np.float64).reshape(-1, 2)
     b = np.asarray(b, dtype=np.float64).reshape(-1, 2)
     k = len(a)
@@ -438,7 +439,7 @@ def line_of_sight(blocked: np.ndarray, occ: OccupancyGrid, a: np.ndarray, b: np.
     unit = vec / np.maximum(length, 1e-12)[:, None]
     r, c = occ.cell_of(a[seg, 0] + unit[seg, 0] * f, a[seg, 1] + unit[seg, 1] * f)
     inside = occ.inside(r, c)
-    hit = np.ones(len(seg), dtype=bool)
+    hit = np.full(len(seg), outside_blocks, dtype=bool)
     hit[inside] = blocked[r[inside], c[inside]]
     out = np.ones(k, dtype=bool)
     out[seg[hit]] = False
