@@ -65,13 +65,15 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
         house = r.house_json()
     x = dict(started.extras) if started is not None else {}
     cam = x.get("camera") or {}
+    nav = x.get("navigation") or {}
+    live = nav.get("mode") == "live"
     ep = [x.get("episode_id"), started.query] if started is not None else None
     return ({"episode": ep, "max_steps": x.get("max_steps"),
              "frame_budget": x.get("frame_budget"),
              "size": [cam.get("width"), cam.get("height")],
              "render_step_m": x.get("render_step_m"),
              "turn_render_deg": x.get("turn_render_deg"),
-             "navigation": (x.get("navigation") or {}).get("mode", "house"),
+             "navigation": nav.get("mode", "house"),
              "noise": x.get("noise"), "seed": x.get("seed"),
              # logs from before each episode drew its planner seed: all drew the run's
              "episode_seeds": "planner_seed" in x,
@@ -81,19 +83,14 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              # logs from before explores went on: an explore ended where it was sent
              "explore_on": x.get("explore_on", 0),
              # logs from before the robot looked into what it opened: it stayed there
-             "look_in": (float((x.get("navigation") or {}).get("look_in", 0.0))
-                         if (x.get("navigation") or {}).get("mode") == "live" else None),
+             "look_in": float(nav.get("look_in", 0.0)) if live else None,
              # logs from before looking in from the side only: after every open
-             "look_in_beyond": (_beyond((x.get("navigation") or {}).get("look_in", 0.0),
-                                        (x.get("navigation") or {}).get("look_in_beyond", 0.0))
-                                if (x.get("navigation") or {}).get("mode") == "live"
-                                else None),
+             "look_in_beyond": (_beyond(nav.get("look_in", 0.0), nav.get("look_in_beyond", 0.0))
+                                if live else None),
              # logs from before the head tilted into containers: it never did
-             "peek": (bool((x.get("navigation") or {}).get("peek", False))
-                      if (x.get("navigation") or {}).get("mode") == "live" else None),
+             "peek": bool(nav.get("peek", False)) if live else None,
              # logs from before the sight lines: every unknown bearing was turned to
-             "sight_lines": (bool((x.get("navigation") or {}).get("sight_lines", False))
-                             if (x.get("navigation") or {}).get("mode") == "live" else None)},
+             "sight_lines": bool(nav.get("sight_lines", False)) if live else None},
             house)
 
 
