@@ -376,6 +376,18 @@ def sight_lines_option() -> Callable[[F], F]:
              "wall, a wardrobe); fewer frames turning, less seen on the way.")
 
 
+def render_turn_option() -> Callable[[F], F]:
+    """``--render-turn DEG`` of the closed-loop commands
+    (:attr:`sgtool.recorders.sim.closed_loop_options.ClosedLoopOptions.turn_render_deg`)."""
+    return click.option(
+        "--render-turn", "render_turn", type=click.FloatRange(0.0, 90.0), default=20.0,
+        show_default=True, metavar="DEG",
+        help="A tick is rendered, mapped and logged once the camera turned DEG degrees "
+             "(or drove 0.25 m, or a share of both) since the last frame; a larger angle "
+             "gives fewer frames on the spot, each still overlapping the last (0 with "
+             "no step: every tick).")
+
+
 def executor_options(what: str) -> Callable[[F], F]:
     """``--executor local|ray``, ``--workers/-w N`` and ``--ray-address`` of the batch
     commands (:func:`sgtool.analysis.executor.make_executor`); ``what`` names the tasks."""

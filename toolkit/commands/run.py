@@ -26,6 +26,7 @@ from sgtool.commands.options import (
     look_in_beyond_option,
     look_in_option,
     peek_option,
+    render_turn_option,
     run_planner_options,
     sight_lines_option,
     success_option,
@@ -83,6 +84,7 @@ if TYPE_CHECKING:
 @look_in_beyond_option()
 @peek_option()
 @sight_lines_option()
+@render_turn_option()
 @click.option("--optimistic", type=float, default=0.25, show_default=True, metavar="M",
               help="live navigation: how far (m) past known free floor a path may run into "
               "unknown space (at frontiers).")
@@ -178,6 +180,7 @@ class RunArgs:
     look_in_beyond: float = 45.0
     peek: bool = True
     sight_lines: bool = False
+    render_turn: float = 20.0
 
 
 def _planner(args: RunArgs) -> tuple[str, dict[str, Any]]:
@@ -237,7 +240,7 @@ def _request(args: RunArgs, out: Path) -> SearchRequest:
         live=LiveNavConfig(optimistic=args.optimistic, look_in=args.look_in,
                            look_in_beyond=args.look_in_beyond, peek=args.peek,
                            sight_lines=args.sight_lines),
-        explore_on=args.explore_on)
+        explore_on=args.explore_on, turn_render_deg=args.render_turn)
     return SearchRequest(house=house, house_id=house_id, episode_index=index, episode=ep,
                          planner=name, output=out, options=opts, planner_options=options,
                          force=args.force, quiet=args.quiet, rerun_to=args.rerun_to)

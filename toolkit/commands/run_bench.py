@@ -23,6 +23,7 @@ from sgtool.commands.options import (
     peek_option,
     planner_names,
     planner_options,
+    render_turn_option,
     sight_lines_option,
     success_option,
 )
@@ -74,6 +75,7 @@ if TYPE_CHECKING:
 @look_in_beyond_option()
 @peek_option()
 @sight_lines_option()
+@render_turn_option()
 @click.option("--navigation", type=click.Choice(["live", "house"]), default="live",
               show_default=True,
               help="live: skills plan on the robot's own map; house: on the ground truth "
@@ -171,6 +173,7 @@ class RunBenchArgs:
     look_in_beyond: float = 45.0
     peek: bool = True
     sight_lines: bool = False
+    render_turn: float = 20.0
 
 
 def _request(args: RunBenchArgs) -> RunBenchRequest:
@@ -221,6 +224,7 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
                              every=args.every, max_steps=args.max_steps, frames=args.frames,
                              navigation=args.navigation, success=args.success,
                              explore_on=args.explore_on,
+                             turn_render_deg=args.render_turn,
                              live=LiveNavConfig(look_in=args.look_in,
                                                 look_in_beyond=args.look_in_beyond,
                                                 peek=args.peek,
