@@ -111,6 +111,7 @@ SMOKE: dict[str, Smoke] = {
         marks=("slow",)),
     "benchmarks/viewers.py": Smoke(("--frames", "3", "-r", "1", "--derived", "{log}")),
     "tools/closed_loop_failures.py": Smoke(("{tmp}", "{tmp}")),
+    "tools/closed_loop_misses.py": Smoke(("{bench}",)),
     "tools/closed_loop_vs_symbolic.py": Smoke(("{bench}", "{bench}")),
     "tools/mutations.py": Smoke(("--list",)),
     "tools/open_reveals.py": Smoke(("{bench}",)),

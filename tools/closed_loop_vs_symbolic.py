@@ -7,7 +7,10 @@ RUN_BENCH_DIR is an ``sgtool run-bench`` output folder (complete or cut short: i
 ``--seeds 1`` over the same houses and episodes. Only the (house, episode) pairs the
 closed loop ran for every planner are compared, and each must hold the same query on both
 sides (else the episodes are not the same and the script says so). Per planner: SR, SPL
-and steps of each benchmark (means over the pairs) and the rank by SR then SPL.
+and steps of each benchmark (means over the pairs) and the rank by SR then SPL; then the
+episodes by where they were solved (both, closed loop only, symbolic only, neither), which
+says whether the closed loop's failures are the planner's (failed symbolically too) or the
+robot's.
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ from __future__ import annotations
 import json
 import statistics
 import sys
-from collections import defaultdict
+from collections import Counter, defaultdict
 from pathlib import Path
 from typing import Any
 
@@ -68,6 +71,14 @@ def main(argv: list[str]) -> int:
         c, s = stats["closed"][p], stats["symbolic"][p]
         print(f"| {p} | {c[0]:.3f} | {s[0]:.3f} | {c[1]:.3f} | {s[1]:.3f} | {c[2]:.1f} | "
               f"{s[2]:.1f} | {rank['closed'][p]} | {rank['symbolic'][p]} |")
+    print()
+    print("| Planner | solved in both | closed loop only | symbolic only | neither |")
+    print("|---|---|---|---|---|")
+    for p in planners:
+        n = Counter((bool(by_pair[k][p]["success"]), bool(sym_by[(k[0], k[1], p)]["success"]))
+                    for k in pairs)
+        print(f"| {p} | {n[(True, True)]} | {n[(True, False)]} | {n[(False, True)]} | "
+              f"{n[(False, False)]} |")
     return 0
 
 
