@@ -70,6 +70,18 @@ category in o's room (checked ones included, as in Z_r),
 so the n together hold C · n^γ: γ = 1 is (B2) unchanged, γ = 0 gives the category one share
 whatever its count, γ = 0.5 grows it with the square root of the count.
 
+**Many openings of one room** (``leading_out_exponent`` δ, 1 = off). On a live map a
+room's border with unknown space is cut into several leading-out frontiers (one opening
+seen past furniture in pieces, long borders split), each of which (B4) would weigh as a
+whole unknown room. With L_r the leading-out frontiers of room r,
+
+    P(leading-out frontier f of r) ∝ R̄ · beyond · L_r^(δ - 1)                         (B9)
+
+so the L_r together hold R̄ · beyond · L_r^δ: δ = 1 is (B4) unchanged, δ = 0 gives the
+space past a room one unknown room's worth. The symbolic environment shows no leading-out
+frontiers (its unknown space is behind doors and unexplored rooms), so (B9) changes only
+the closed loop.
+
 **Bayes update.** A checked place that was empty leaves the candidate set while its C(o)
 stays in Z_r, so renormalising over the remaining candidates,
 
@@ -108,6 +120,8 @@ class BeliefParams:
     region_weight: float = 0.5  # ω of K = ω n̄ C̄, (B2)-(B3) (module doc)
     seen_type_weight: float = 1.0  # η of (B7): weight of a room type per sighting; 1: off
     instance_exponent: float = 1.0  # γ of (B8): mass of n like carriers ∝ n^γ; 1: off
+    # δ of (B9): the L leading-out frontiers of one room hold R̄ · beyond · L^δ; 1: off
+    leading_out_exponent: float = 1.0
 
 
 def known_room_mean(scorer: RelationScorer, query: str, params: BeliefParams) -> float:
@@ -159,6 +173,7 @@ def furniture_masses(graph: SceneGraph, cands: Sequence[Candidate],
     per_room: dict[str, int] = {}
     for f in inner:
         per_room[f.room] = per_room.get(f.room, 0) + 1
+    share = leading_out_shares(graph, params)
     out = np.zeros(len(cands))
     for i, c in enumerate(cands):
         node = nodes.get(c.node_id)
@@ -170,7 +185,7 @@ def furniture_masses(graph: SceneGraph, cands: Sequence[Candidate],
         elif c.kind == "room":
             out[i] = unknown
         else:
-            out[i] = unknown * params.beyond
+            out[i] = unknown * params.beyond * share.get(c.node_id, 1.0)
     return out
 
 
@@ -195,6 +210,17 @@ def place_masses(graph: SceneGraph, cands: Sequence[Candidate], query: str,
         out = out * params.miss ** np.asarray(failures, dtype=float)
     total = float(out.sum())
     return out / total if total > 0 else np.full(len(cands), 1.0 / len(cands))
+
+
+def leading_out_shares(graph: SceneGraph, params: BeliefParams) -> dict[str, float]:
+    """(B9): frontier id -> L_r^(δ - 1) for each leading-out frontier of a room with L_r
+    of them; empty when δ = 1."""
+    if params.leading_out_exponent == 1.0:
+        return {}
+    out = [f for f in graph.regions
+           if f.kind == "frontier" and f.frontier_type == "leading out"]
+    n = Counter(f.room for f in out)
+    return {f.id: float(n[f.room]) ** (params.leading_out_exponent - 1.0) for f in out}
 
 
 def split_instances(carriers: Sequence[ObjectNode], c_of: dict[str, float],
@@ -229,6 +255,7 @@ def _object_masses(graph: SceneGraph, cands: Sequence[Candidate], query: str,
             z[f.room] = z.get(f.room, 0.0) + k_region
     members: tuple[RegionNode | ObjectNode, ...] = (*graph.regions, *graph.objects)
     nodes = {n.id: n for n in members}
+    share = leading_out_shares(graph, params)
     out = np.zeros(len(cands))
     for i, c in enumerate(cands):
         node = nodes.get(c.node_id)
@@ -242,5 +269,5 @@ def _object_masses(graph: SceneGraph, cands: Sequence[Candidate], query: str,
         elif c.kind == "room":
             out[i] = unknown
         else:  # closed door, leading-out frontier: space beyond
-            out[i] = unknown * params.beyond
+            out[i] = unknown * params.beyond * share.get(c.node_id, 1.0)
     return out

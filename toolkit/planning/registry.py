@@ -137,7 +137,8 @@ def _bayes(name: str, o: BayesSearchOptions) -> Planner:
                           seen_type_weight=(BAYES_ROOMS_SEEN_TYPE_WEIGHT
                                             if name == "bayes-rooms" else o.seen_type_weight),
                           instance_exponent=(BAYES_ROOMS_INSTANCE_EXPONENT
-                                             if name == "bayes-rooms" else o.instance_exponent))
+                                             if name == "bayes-rooms" else o.instance_exponent),
+                          leading_out_exponent=o.leading_out_exponent)
     params = SearchParams(step_cost=o.step_cost, open_cost=o.open_cost,
                           reveal_cost=o.reveal_cost, top_k=o.top_k, horizon=o.horizon,
                           step_budget=o.step_budget, belief=belief)

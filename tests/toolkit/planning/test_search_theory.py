@@ -255,3 +255,31 @@ def test_look_ahead_equals_one_sequence_value_per_ordering(seed: int) -> None:
     params = SearchParams(step_budget=0)
     assert best_first(cands, p, (0.0, 0.0), params) == \
         _best_by_loop(cands, p, params, (0.0, 0.0))
+
+
+def test_leading_out_frontiers_of_one_room_share_the_space_beyond() -> None:
+    """(B9): three leading-out frontiers of the kitchen and one closed door. With δ = 1
+    each frontier weighs as the door (a whole unknown room, (B4)); with δ = 0 the three
+    together weigh one door, δ = 0.5 sqrt(3) doors; the carriers' masses relative to each
+    other do not move, and the furniture-level model (B6) splits the same way."""
+    g = kitchen()
+    fronts = tuple(RegionNode(f"frontier:{k}", "room:1", (5.0, float(k)), "frontier",
+                              "leading out") for k in range(1, 4))
+    g = SceneGraph(g.robot, g.rooms, (*g.regions, *fronts), g.objects, g.doors,
+                   {**g.distances, **{f.id: 5.0 for f in fronts}})
+    cands = actionable(g)
+    ids = [c.node_id for c in cands]
+    door, fs = ids.index("door:1"), [ids.index(f.id) for f in fronts]
+    fridge, wardrobe = ids.index("obj:1"), ids.index("obj:2")
+    for furniture in (0.0, 0.9):
+        masses = {d: place_masses(g, cands, "q", SCORER, BeliefParams(leading_out_exponent=d),
+                                  furniture=furniture) for d in (1.0, 0.5, 0.0)}
+        for d, p in masses.items():
+            total = sum(p[i] for i in fs)
+            assert total == pytest.approx(p[door] * 3 ** d)
+            assert p[fs[0]] == pytest.approx(p[fs[1]]) == pytest.approx(p[fs[2]])
+            assert p[fridge] / p[wardrobe] == pytest.approx(
+                masses[1.0][fridge] / masses[1.0][wardrobe])
+        # sharing moves mass from the frontiers to what the kitchen holds
+        assert masses[0.0][fridge] > masses[0.5][fridge] > masses[1.0][fridge]
+    assert BeliefParams().leading_out_exponent == 1.0  # (B4) unchanged by default
