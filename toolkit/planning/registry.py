@@ -155,7 +155,8 @@ def _voi(name: str, o: VoiOptions) -> Planner:
                           sharpness=o.sharpness, object_sharpness=o.object_sharpness,
                           beyond=o.beyond, miss=o.miss, region_weight=o.region_weight,
                           seen_type_weight=o.seen_type_weight,
-                          instance_exponent=o.instance_exponent)
+                          instance_exponent=o.instance_exponent,
+                          leading_out_exponent=o.leading_out_exponent)
     params = VoiParams(step_cost=o.step_cost, open_cost=o.open_cost,
                        follow_steps=o.follow_steps, follow_rule=o.follow_rule,
                        top_k=o.top_k, horizon=o.horizon,

@@ -139,8 +139,8 @@ class EpisodeBelief:
         self._obj_table: tuple[dict[str, tuple[int, str, float]], dict[str, float], float,
                                int] = ({}, {}, 0.5, 0)
         self._regions: tuple[RegionNode, ...] | None = None
-        self._reg_table: tuple[dict[str, tuple[int, str]], list[str], dict[str, int], int] = \
-            ({}, [], {}, 0)
+        self._reg_table: tuple[dict[str, tuple[int, str]], list[str], dict[str, int], int,
+                               dict[str, int]] = ({}, [], {}, 0, {})
         self._rooms: tuple[RoomNode, ...] | None = None
         self._room_table: tuple[dict[str, float], float] = ({}, params.fallback_room)
         self._regions_per_room = 1.0  # m̄ of (V5) for the last regions tuple
@@ -251,13 +251,16 @@ class EpisodeBelief:
         return self._profile
 
     def _frontiers(self, graph: SceneGraph
-                   ) -> tuple[dict[str, tuple[int, str]], list[str], dict[str, int], int]:
+                   ) -> tuple[dict[str, tuple[int, str]], list[str], dict[str, int], int,
+                              dict[str, int]]:
         """Per region id (code, room); the rooms of the inner frontiers in graph order,
-        their count per room; the revealed regions' count."""
+        their count per room; the revealed regions' count; the leading-out frontiers'
+        count per room."""
         if graph.regions is self._regions:
             return self._reg_table
         table: dict[str, tuple[int, str]] = {}
         inner: list[str] = []
+        out: list[str] = []
         revealed = 0
         self._regions_per_room = len(graph.regions) / max(1, len({f.room for f in graph.regions}))
         for f in graph.regions:
@@ -268,9 +271,11 @@ class EpisodeBelief:
                 inner.append(f.room)
                 code = _INNER
             else:
+                out.append(f.room)
                 code = _OUT
             table.setdefault(f.id, (code, f.room))
-        self._regions, self._reg_table = graph.regions, (table, inner, Counter(inner), revealed)
+        self._regions, self._reg_table = graph.regions, (table, inner, Counter(inner), revealed,
+                                                          Counter(out))
         return self._reg_table
 
     # ----- the belief ------------------------------------------------------------------
@@ -284,7 +289,8 @@ class EpisodeBelief:
         p = self.params
         rooms, unknown = self._room_masses(graph)
         objs, zc, mean_c, ncar = self._carriers(graph)
-        regs, inner, per_room, revealed = self._frontiers(graph)
+        regs, inner, per_room, revealed, outs = self._frontiers(graph)
+        delta = p.leading_out_exponent
         per_region = max(1.0, ncar / max(1, revealed))
         k = p.region_weight * per_region * mean_c  # K of (B2)-(B3)
         z = dict(zc)
@@ -315,6 +321,10 @@ class EpisodeBelief:
                     po[i] = rooms.get(room, unknown) * k / (z.get(room) or k)
                     if phi > 0.0:
                         pf[i] = rooms.get(room, unknown) / per_room.get(room, 1)
+                    continue
+                if delta != 1.0 and code == _OUT:  # (B9)
+                    po[i] = pf[i] = beyond * float(outs.get(room, 1)) ** (delta - 1.0)
+                    n_space += 1
                     continue
             n_space += 1
             if kind == "room":

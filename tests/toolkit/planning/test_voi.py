@@ -302,3 +302,24 @@ def test_with_the_shipped_priors_a_search_ends_the_same_way_twice() -> None:
     first = play()
     assert first[-1] is not None and len(first) < 60
     assert first == play()
+
+
+@pytest.mark.parametrize("phi", [0.0, 0.4])
+@pytest.mark.parametrize("delta", [0.0, 0.5])
+def test_belief_shares_leading_out_frontiers_as_place_masses(delta: float, phi: float) -> None:
+    """(B9) in voi's belief: three leading-out frontiers in the living room and one in the
+    bathroom, the same numbers as bayes-search's belief with the same δ."""
+    g = house()
+    more = (RegionNode("frontier:3", "room:3", (13.0, 5.0), "frontier", "leading out", 1.0),
+            RegionNode("frontier:4", "room:3", (14.0, 5.0), "frontier", "leading out", 1.0),
+            RegionNode("frontier:5", "room:2", (6.0, 4.0), "frontier", "leading out", 1.0))
+    g = SceneGraph(g.robot, g.rooms, (*g.regions, *more), g.objects, g.doors,
+                   {**g.distances, **{f.id: 10.0 for f in more}})
+    params = BeliefParams(leading_out_exponent=delta)
+    _compare(g, EpisodeBelief(SCORER, "pan", params, phi), params, phi)
+    off = place_masses(g, actionable(g), "pan", SCORER, BeliefParams(), None, phi)
+    on = place_masses(g, actionable(g), "pan", SCORER, params, None, phi)
+    ids = [c.node_id for c in actionable(g)]
+    assert on[ids.index("frontier:2")] < off[ids.index("frontier:2")]  # shared three ways
+    assert make_planner("voi", leading_out_exponent=delta).inner.params.belief \
+        .leading_out_exponent == delta
