@@ -51,5 +51,6 @@ def test_a_give_up_is_a_miss_of_the_search(tmp_path: Path, capsys: pytest.Captur
     assert miss.frames_showing == miss.most_pixels == 0
     assert tool.main([str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert "1 failed episodes; the target in no frame's pixels in 1" in out
+    assert "1 failed episodes: the target in no frame's pixels in 1 (its holder never " \
+        "opened in 1, opened without the camera seeing in, in 0)" in out
     assert tool.main([str(tmp_path / "absent")]) == 1

@@ -6,9 +6,9 @@ instance tables and its frames' instance images, the ground truth an analysis ma
 where the target is (room type, then ``inside``/``ontop`` of what, with the holder's
 state), how many frames the robot spent in the target's room, whether the holder was
 ever opened, and how many frames showed any pixel of the target (and the most pixels in
-one). A target no frame ever showed was missed by the search (the planner never brought
-the camera to it within its steps); one that frames showed but the map did not keep was
-missed by perception.
+one). A target no frame ever showed behind a holder never opened was missed by the search
+(the planner never brought the camera to it within its steps); behind a holder that was
+opened, by looking in; one that frames showed but the map did not keep, by perception.
 
     .venv/bin/python tools/closed_loop_misses.py RUN_DIR [RUN_DIR ...] [--planner P]
 """
@@ -127,10 +127,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"| {m.planner} | {m.house} | {m.episode} | {m.query} | {m.end} | {m.where} | "
               f"{m.frames} | {m.frames_in_room} | {'yes' if m.holder_opened else 'no'} | "
               f"{m.frames_showing} | {m.most_pixels} |")
-    never = sum(1 for m in rows if m.frames_showing == 0)
-    print(f"\n{len(rows)} failed episodes; the target in no frame's pixels in {never} "
-          "(missed by the search), in some frame's in "
-          f"{len(rows) - never} (seen by the camera, not kept by the map)")
+    seen = sum(1 for m in rows if m.frames_showing > 0)
+    opened = sum(1 for m in rows if m.frames_showing == 0 and m.holder_opened)
+    print(f"\n{len(rows)} failed episodes: the target in no frame's pixels in "
+          f"{len(rows) - seen} (its holder never opened in {len(rows) - seen - opened}, "
+          f"opened without the camera seeing in, in {opened}); in some frame's pixels in "
+          f"{seen} (seen by the camera, not kept by the map)")
     return 0
 
 
