@@ -75,11 +75,11 @@ room's border with unknown space is cut into several leading-out frontiers (one 
 seen past furniture in pieces, long borders split), each of which (B4) would weigh as a
 whole unknown room. With L_r the leading-out frontiers of room r,
 
-    P(leading-out frontier f of r) ∝ R̄ · beyond · L_r^(δ - 1)                         (B9)
+    P(leading-out frontier f of r) ∝ R̄ · beyond · L_r^(δ - 1)                         (B10)
 
 so the L_r together hold R̄ · beyond · L_r^δ: δ = 1 is (B4) unchanged, δ = 0 gives the
 space past a room one unknown room's worth. The symbolic environment shows no leading-out
-frontiers (its unknown space is behind doors and unexplored rooms), so (B9) changes only
+frontiers (its unknown space is behind doors and unexplored rooms), so (B10) changes only
 the closed loop.
 
 **Bayes update.** A checked place that was empty leaves the candidate set while its C(o)
@@ -120,7 +120,7 @@ class BeliefParams:
     region_weight: float = 0.5  # ω of K = ω n̄ C̄, (B2)-(B3) (module doc)
     seen_type_weight: float = 1.0  # η of (B7): weight of a room type per sighting; 1: off
     instance_exponent: float = 1.0  # γ of (B8): mass of n like carriers ∝ n^γ; 1: off
-    # δ of (B9): the L leading-out frontiers of one room hold R̄ · beyond · L^δ; 1: off
+    # δ of (B10): the L leading-out frontiers of one room hold R̄ · beyond · L^δ; 1: off
     leading_out_exponent: float = 1.0
 
 
@@ -213,7 +213,7 @@ def place_masses(graph: SceneGraph, cands: Sequence[Candidate], query: str,
 
 
 def leading_out_shares(graph: SceneGraph, params: BeliefParams) -> dict[str, float]:
-    """(B9): frontier id -> L_r^(δ - 1) for each leading-out frontier of a room with L_r
+    """(B10): frontier id -> L_r^(δ - 1) for each leading-out frontier of a room with L_r
     of them; empty when δ = 1."""
     if params.leading_out_exponent == 1.0:
         return {}

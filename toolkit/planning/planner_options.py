@@ -128,7 +128,7 @@ class BayesSearchOptions(NodeOptions):
         "gamma of (B8): n carriers of one category in a room hold C n^gamma; 1: off",
         "float", lo=0.0, hi=1.0))
     leading_out_exponent: float = field(default=1.0, metadata=option(
-        "delta of (B9): the L leading-out frontiers of one room hold one unknown room's "
+        "delta of (B10): the L leading-out frontiers of one room hold one unknown room's "
         "mass times L^delta; 1: off", "float", lo=0.0, hi=1.0))
     blend: bool = field(default=True, metadata=option(
         "blend the learned scores with the cosine by query novelty", "bool"))
@@ -187,7 +187,7 @@ class VoiOptions(NodeOptions):
         "gamma of (B8): n carriers of one category in a room hold C n^gamma; 1: off",
         "float", lo=0.0, hi=1.0))
     leading_out_exponent: float = field(default=1.0, metadata=option(
-        "delta of (B9): the L leading-out frontiers of one room hold one unknown room's "
+        "delta of (B10): the L leading-out frontiers of one room hold one unknown room's "
         "mass times L^delta; 1: off", "float", lo=0.0, hi=1.0))
     blend: bool = field(default=True, metadata=option(
         "blend the learned scores with the cosine by query novelty", "bool"))

@@ -322,7 +322,7 @@ class EpisodeBelief:
                     if phi > 0.0:
                         pf[i] = rooms.get(room, unknown) / per_room.get(room, 1)
                     continue
-                if delta != 1.0 and code == _OUT:  # (B9)
+                if delta != 1.0 and code == _OUT:  # (B10)
                     po[i] = pf[i] = beyond * float(outs.get(room, 1)) ** (delta - 1.0)
                     n_space += 1
                     continue

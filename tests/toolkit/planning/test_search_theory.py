@@ -258,7 +258,7 @@ def test_look_ahead_equals_one_sequence_value_per_ordering(seed: int) -> None:
 
 
 def test_leading_out_frontiers_of_one_room_share_the_space_beyond() -> None:
-    """(B9): three leading-out frontiers of the kitchen and one closed door. With δ = 1
+    """(B10): three leading-out frontiers of the kitchen and one closed door. With δ = 1
     each frontier weighs as the door (a whole unknown room, (B4)); with δ = 0 the three
     together weigh one door, δ = 0.5 sqrt(3) doors; the carriers' masses relative to each
     other do not move, and the furniture-level model (B6) splits the same way."""

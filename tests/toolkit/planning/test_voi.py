@@ -307,7 +307,7 @@ def test_with_the_shipped_priors_a_search_ends_the_same_way_twice() -> None:
 @pytest.mark.parametrize("phi", [0.0, 0.4])
 @pytest.mark.parametrize("delta", [0.0, 0.5])
 def test_belief_shares_leading_out_frontiers_as_place_masses(delta: float, phi: float) -> None:
-    """(B9) in voi's belief: three leading-out frontiers in the living room and one in the
+    """(B10) in voi's belief: three leading-out frontiers in the living room and one in the
     bathroom, the same numbers as bayes-search's belief with the same δ."""
     g = house()
     more = (RegionNode("frontier:3", "room:3", (13.0, 5.0), "frontier", "leading out", 1.0),
