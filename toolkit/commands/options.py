@@ -384,8 +384,8 @@ def render_turn_option() -> Callable[[F], F]:
         show_default=True, metavar="DEG",
         help="A tick is rendered, mapped and logged once the camera turned DEG degrees "
              "(or drove 0.25 m, or a share of both) since the last frame; a larger angle "
-             "gives fewer frames on the spot, each still overlapping the last (0 with "
-             "no step: every tick).")
+             "gives fewer frames on the spot, each still overlapping the last (0: every "
+             "tick that turns).")
 
 
 def executor_options(what: str) -> Callable[[F], F]:

@@ -322,13 +322,11 @@ class EpisodeBelief:
                     if phi > 0.0:
                         pf[i] = rooms.get(room, unknown) / per_room.get(room, 1)
                     continue
-                if delta != 1.0 and code == _OUT:  # (B10)
-                    po[i] = pf[i] = beyond * float(outs.get(room, 1)) ** (delta - 1.0)
-                    n_space += 1
-                    continue
             n_space += 1
             if kind == "room":
                 po[i] = pf[i] = unknown
+            elif kind == "frontier" and code == _OUT and delta != 1.0:  # (B10)
+                po[i] = pf[i] = beyond * float(outs.get(room, 1)) ** (delta - 1.0)
             else:  # a closed door, a leading-out frontier: space beyond
                 po[i] = pf[i] = beyond
         self.remaining = remaining_actions(n_check, n_region, n_space, per_region,
