@@ -69,7 +69,7 @@ def miss_of(log: Path, result: EpisodeResult) -> Miss:
         targets = [i for i in first.values() if i.category == result.query]
         ids = np.array(sorted(i.id for i in targets), dtype=np.int64)
         holders = {i.parent for i in targets if isinstance(i.parent, int)
-                   and first[i.parent].state == "closed"}
+                   and getattr(first.get(i.parent), "state", None) == "closed"}
         opened = any(i.id in holders and i.state == "open"
                      for t in tables for i in t.instances)
         room_of: dict[str, str] = {}
