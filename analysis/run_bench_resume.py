@@ -46,7 +46,9 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
                                if opts.navigation == "live" else None),
             "peek": bool(opts.live.peek) if opts.navigation == "live" else None,
             "sight_lines": (bool(opts.live.sight_lines) if opts.navigation == "live"
-                            else None)}
+                            else None),
+            "explore_through": (float(opts.live.explore_through)
+                                if opts.navigation == "live" else None)}
 
 
 def _beyond(look_in: float, beyond: float) -> float | None:
@@ -90,7 +92,9 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              # logs from before the head tilted into containers: it never did
              "peek": bool(nav.get("peek", False)) if live else None,
              # logs from before the sight lines: every unknown bearing was turned to
-             "sight_lines": bool(nav.get("sight_lines", False)) if live else None},
+             "sight_lines": bool(nav.get("sight_lines", False)) if live else None,
+             # logs from before explores went through: they stopped at the frontier
+             "explore_through": float(nav.get("explore_through", 0.0)) if live else None},
             house)
 
 
@@ -118,7 +122,7 @@ _LABELS = {"episode": "episode", "max_steps": "max steps", "frame_budget": "fram
            "classifier": "room classifier", "explore_on": "explore on (frontiers)",
            "look_in": "look in (m)",
            "look_in_beyond": "look in beyond (deg)", "peek": "peek into containers",
-           "sight_lines": "sight lines"}
+           "sight_lines": "sight lines", "explore_through": "explore through (m)"}
 
 
 def settings_differences(logged: dict[str, Any], want: dict[str, Any]) -> list[str]:

@@ -65,6 +65,12 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   a floor-standing piece's lower shelves below the view) and back, at its turning
   speed, every tick a frame (an object needs points in two frames); no metres. The
   log's base -> camera transform moves on ``/tf`` while the head is tilted.
+- **Exploring through** (``explore_through`` > 0, off by default). An explore drives to
+  its frontier's nearest reachable cell; past a doorway the look-around from there sees
+  the next room through the door frame only. With ``explore_through`` the robot drives
+  that many metres on, straight on from where the explore set out (to the reachable cell
+  nearest that point, within ``snap``; skipped when it came less than half as far or no
+  such cell is reachable), and looks around there.
 - **Stopping early.** ``stop_when`` (the closed loop's: the target is in the graph) is
   asked at every refresh during a skill; when it says so the skill ends there, a success
   with reason :data:`IN_VIEW`.
@@ -135,6 +141,9 @@ class LiveNavConfig:
     peek: bool = True  # tilt the camera down into an opened container and back
     # look around only toward unknown space the camera can see over to (module doc)
     sight_lines: bool = False
+    # m an explore drives on past the frontier it reached, straight on (module doc;
+    # 0: stops at the frontier)
+    explore_through: float = 0.0
 
     def __post_init__(self) -> None:
         if not 0 <= self.optimistic <= 2.0:
@@ -145,6 +154,9 @@ class LiveNavConfig:
             raise SgtoolError(f"look-in distance {self.look_in} m: must be 0..3")
         if not (0.0 <= self.look_in_beyond <= 180.0):
             raise SgtoolError(f"look-in angle {self.look_in_beyond} degrees: must be 0..180")
+        if not (0.0 <= self.explore_through <= 5.0):
+            raise SgtoolError(f"explore-through distance {self.explore_through} m: must be "
+                              "0..5")
         if self.max_replans < 1 or self.max_contacts < 0:
             raise SgtoolError("max re-plans must be >= 1 and max contacts >= 0")
 
@@ -154,7 +166,7 @@ class LiveNavConfig:
                 "max_replans": self.max_replans, "max_contacts": self.max_contacts,
                 "sealed_m2": self.sealed_m2, "look_in": self.look_in,
                 "look_in_beyond": self.look_in_beyond, "peek": self.peek,
-                "sight_lines": self.sight_lines}
+                "sight_lines": self.sight_lines, "explore_through": self.explore_through}
 
 
 class RobotBody:
@@ -491,11 +503,31 @@ class LiveSkills:
         return "success", (IN_VIEW if found else ""), 0.0
 
     def explore(self, goal: Goal) -> tuple[Outcome, str, float]:
-        """Go to ``goal`` and look around there."""
+        """Go to ``goal``, on through it with ``explore_through`` (module doc), and look
+        around there."""
+        start = _xy(self.body.base)
         o, why, d = self.navigate(goal)
+        if o == "success" and why != IN_VIEW and self.config.explore_through > 0.0:
+            why, d2 = self._through(start)
+            d += d2
         if o == "success" and why != IN_VIEW:
             o, why, _ = self.look_around()
         return o, why, d
+
+    def _through(self, start: tuple[float, float]) -> tuple[str, float]:
+        """After an explore reached its frontier from ``start``: drive ``explore_through``
+        metres on in the direction it came (to the reachable cell nearest that point, within
+        ``snap``): (reason, metres). Nothing when the robot came less than that far or no
+        cell there is reachable; a failed leg is no failure of the explore."""
+        here = _xy(self.body.base)
+        dx, dy = here[0] - start[0], here[1] - start[1]
+        n = math.hypot(dx, dy)
+        m = self.config.explore_through
+        if n < m / 2.0:
+            return "", 0.0
+        at = np.array([[here[0] + dx / n * m, here[1] + dy / n * m]], dtype=np.float64)
+        o, why, d = self.navigate(Goal("past the frontier", "point", at))
+        return (why if o == "success" else ""), d
 
     def look_around(self) -> tuple[Outcome, str, float]:
         """Turn on the spot toward the unknown space around (module doc): the whole way

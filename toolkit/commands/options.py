@@ -376,6 +376,17 @@ def sight_lines_option() -> Callable[[F], F]:
              "wall, a wardrobe); fewer frames turning, less seen on the way.")
 
 
+def explore_through_option() -> Callable[[F], F]:
+    """``--explore-through M`` of the closed-loop commands
+    (:attr:`sgtool.recorders.sim.live_skills.LiveNavConfig.explore_through`)."""
+    return click.option(
+        "--explore-through", type=click.FloatRange(0.0, 5.0), default=0.0,
+        show_default=True, metavar="M",
+        help="live navigation: an explore that reached its frontier drives M metres on, "
+             "straight on from where it set out (through a doorway into the room behind), "
+             "before it looks around (0: it looks around at the frontier).")
+
+
 def render_turn_option() -> Callable[[F], F]:
     """``--render-turn DEG`` of the closed-loop commands
     (:attr:`sgtool.recorders.sim.closed_loop_options.ClosedLoopOptions.turn_render_deg`)."""

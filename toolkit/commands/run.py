@@ -19,6 +19,7 @@ from sgtool.commands.options import (
     LlmEndpoint,
     check_log_output,
     explore_on_option,
+    explore_through_option,
     house_options,
     list_planners_option,
     llm_endpoint_options,
@@ -84,6 +85,7 @@ if TYPE_CHECKING:
 @look_in_beyond_option()
 @peek_option()
 @sight_lines_option()
+@explore_through_option()
 @render_turn_option()
 @click.option("--optimistic", type=float, default=0.25, show_default=True, metavar="M",
               help="live navigation: how far (m) past known free floor a path may run into "
@@ -180,6 +182,7 @@ class RunArgs:
     look_in_beyond: float = 45.0
     peek: bool = True
     sight_lines: bool = False
+    explore_through: float = 0.0
     render_turn: float = 20.0
 
 
@@ -239,7 +242,8 @@ def _request(args: RunArgs, out: Path) -> SearchRequest:
         noise=parse_noise(args.noise),
         live=LiveNavConfig(optimistic=args.optimistic, look_in=args.look_in,
                            look_in_beyond=args.look_in_beyond, peek=args.peek,
-                           sight_lines=args.sight_lines),
+                           sight_lines=args.sight_lines,
+                           explore_through=args.explore_through),
         explore_on=args.explore_on, turn_render_deg=args.render_turn)
     return SearchRequest(house=house, house_id=house_id, episode_index=index, episode=ep,
                          planner=name, output=out, options=opts, planner_options=options,

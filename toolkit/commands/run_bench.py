@@ -14,6 +14,7 @@ from sgtool.commands.options import (
     LlmEndpoint,
     executor_options,
     explore_on_option,
+    explore_through_option,
     list_planners_option,
     llm_endpoint_options,
     look_in_beyond_option,
@@ -75,6 +76,7 @@ if TYPE_CHECKING:
 @look_in_beyond_option()
 @peek_option()
 @sight_lines_option()
+@explore_through_option()
 @render_turn_option()
 @click.option("--navigation", type=click.Choice(["live", "house"]), default="live",
               show_default=True,
@@ -173,6 +175,7 @@ class RunBenchArgs:
     look_in_beyond: float = 45.0
     peek: bool = True
     sight_lines: bool = False
+    explore_through: float = 0.0
     render_turn: float = 20.0
 
 
@@ -228,7 +231,8 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
                              live=LiveNavConfig(look_in=args.look_in,
                                                 look_in_beyond=args.look_in_beyond,
                                                 peek=args.peek,
-                                                sight_lines=args.sight_lines))
+                                                sight_lines=args.sight_lines,
+                                                explore_through=args.explore_through))
     options = planner_options(args.planner_option, names)
     LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
                 args.llm_timeout).fill(options, names)

@@ -371,3 +371,51 @@ def test_examining_an_open_container_peeks_into_it(house, tmp_path) -> None:
     assert all(t == pytest.approx(15.0) for ns, t in tilt if ns <= t0)  # before: none
     assert max(t for ns, t in tilt if t0 < ns <= t1) > 20.0
     assert tilt[-1][1] == pytest.approx(15.0)
+
+
+def _explore_farthest_frontier(g):
+    """Explore the frontier on offer farthest along the floor (the robot sets out toward
+    it, so there is a direction to go on in)."""
+    cands = [c for c in actionable(g) if c.skill == "explore" and
+             c.node_id.startswith("frontier:") and c.node_id in g.distances]
+    if not cands:
+        return Action("done")
+    return Action("explore", max(cands, key=lambda c: (g.distances[c.node_id], c.node_id)
+                                 ).node_id)
+
+
+def test_an_explore_goes_on_through_its_frontier(house, tmp_path) -> None:
+    """With ``explore_through`` the robot drives that far on past the frontier it
+    reached, straight on from where it set out, before it looks around: the same first
+    explore of the same episode travels farther and ends farther from the start than
+    without (by at most the extra metres, snapped to a reachable cell). Episode 1 starts
+    where six frontiers are on offer after the look-around."""
+    idx, ep = pick_episode(house, index=1)
+    runs = {}
+    for through in (0.0, 1.5):
+        p = Scripted([_explore_farthest_frontier, Action("done")])
+        out = tmp_path / f"through-{through}.mcap"
+        live = LiveNavConfig(explore_through=through)
+        run_episode(house, ep, p, out, dataclasses.replace(OPTS, live=live, max_steps=1),
+                    episode_index=idx)
+        fb = p.feedbacks[0]
+        assert (fb.action.skill, fb.outcome) == ("explore", "success")
+        with LogReader(out) as r:
+            started = next(r.records("episode"))[1]
+            first = [m.message for m in r.messages(["/tf"])
+                     if m.message.child_frame_id == S.BASE_FRAME][0]
+        assert started["extra"]["navigation"]["explore_through"] == through
+        t0 = decode_transform(first)
+        x, y, _ = _last_pose(out)
+        runs[through] = (fb.action.target, fb.travelled_m,
+                         math.dist((x, y), (t0[0, 3], t0[1, 3])))
+    (f0, m0, d0), (f1, m1, d1) = runs[0.0], runs[1.5]
+    assert f0 == f1  # the same frontier
+    assert m0 + 0.5 < m1 <= m0 + 1.5 + 1.0 + 0.5  # on by up to 1.5 m (+ snap, + turns)
+    assert d1 > d0 + 0.5
+
+
+def test_an_explore_through_distance_is_checked() -> None:
+    with pytest.raises(SgtoolError, match="must be 0..5"):
+        LiveNavConfig(explore_through=6.0)
+    assert LiveNavConfig(explore_through=1.5).to_dict()["explore_through"] == 1.5
