@@ -140,3 +140,11 @@ def test_a_log_of_other_frame_settings_is_not_resumed(tmp_path: Path) -> None:
         logged, task_settings(dataclasses.replace(
             opts, live=dataclasses.replace(opts.live, sight_lines=True)), "none", ep)) \
         == ["sight lines: false in the log, true now"]
+    # and how far an explore drove on past its frontier (a log from before: 0)
+    through = opts.live.explore_through
+    assert logged["explore_through"] == through
+    assert settings_differences(
+        logged, task_settings(dataclasses.replace(
+            opts, live=dataclasses.replace(opts.live, explore_through=through + 1.0)),
+            "none", ep)) \
+        == [f"explore through (m): {through} in the log, {through + 1.0} now"]
