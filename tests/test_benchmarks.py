@@ -195,3 +195,31 @@ def _sub(arg: str, subs: dict[str, str]) -> str:
     for key, value in subs.items():
         arg = arg.replace(key, value)
     return arg
+
+
+@pytest.mark.parametrize("name", sorted(SMOKE))
+def test_script_explains_itself(name: str, monkeypatch: pytest.MonkeyPatch,
+                                capsys: pytest.CaptureFixture[str]) -> None:
+    """``SCRIPT --help`` prints what it does and exits 0 (no traceback, nothing run)."""
+    smoke = SMOKE[name]
+    if smoke.needs and importlib.util.find_spec(smoke.needs) is None:
+        pytest.skip(f"{smoke.needs} is not installed")
+    script = REPO / name
+    env = {"HF_HUB_OFFLINE": "1", "TRANSFORMERS_OFFLINE": "1", "MPLBACKEND": "Agg",
+           "PYTHONPATH": str(REPO / "tests")}
+    if smoke.subprocess:
+        proc = subprocess.run([sys.executable, str(script), "--help"], cwd=REPO,
+                              env={**os.environ, **env}, capture_output=True, text=True,
+                              timeout=300)
+        assert proc.returncode == 0, proc.stderr[-3000:]
+        assert proc.stdout.strip() and "Traceback" not in proc.stderr
+        return
+    for k, v in env.items():
+        monkeypatch.setenv(k, v)
+    monkeypatch.syspath_prepend(str(script.parent))
+    monkeypatch.setattr(sys, "argv", [str(script), "--help"])
+    try:
+        runpy.run_path(str(script), run_name="__main__")
+    except SystemExit as e:
+        assert e.code in (None, 0), capsys.readouterr().err[-3000:]
+    assert capsys.readouterr().out.strip()

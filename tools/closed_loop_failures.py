@@ -6,6 +6,7 @@ episodes both hold (e.g. ``--navigation house`` before, ``live`` after):
 
 from __future__ import annotations
 
+import argparse
 import collections
 import sys
 from pathlib import Path
@@ -23,7 +24,14 @@ def failed_skills(path: Path) -> collections.Counter[str]:
 
 
 def main(argv: list[str]) -> int:
-    before, after = Path(argv[0]), Path(argv[1])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0].replace("\n", " "))
+    ap.add_argument("before", type=Path, help="a run-bench output folder")
+    ap.add_argument("after", type=Path, help="another one, of the same episodes")
+    args = ap.parse_args(argv)
+    before, after = args.before, args.after
+    for folder in (before, after):
+        if not folder.is_dir():
+            ap.error(f"{folder}: not a folder")
     common = [p.relative_to(before) for p in sorted(before.glob("logs/*/*/*/*.mcap"))
               if (after / p.relative_to(before)).exists()]
     for name, root in ((str(before), before), (str(after), after)):

@@ -15,6 +15,7 @@ robot's.
 
 from __future__ import annotations
 
+import argparse
 import json
 import statistics
 import sys
@@ -39,8 +40,17 @@ def _ranks(stats: dict[str, tuple[float, float, float]]) -> dict[str, int]:
 
 
 def main(argv: list[str]) -> int:
-    closed = _rows(Path(argv[0]) / "episodes.jsonl")
-    sym = _rows(Path(argv[1]) / "episodes.jsonl")
+    ap = argparse.ArgumentParser(
+        description="The closed-loop benchmark next to the symbolic one on the same houses "
+                    "and episodes (module doc).")
+    ap.add_argument("run_bench_dir", type=Path, help="an sgtool run-bench output folder")
+    ap.add_argument("bench_dir", type=Path, help="an sgtool bench output folder (--seeds 1)")
+    args = ap.parse_args(argv)
+    for folder in (args.run_bench_dir, args.bench_dir):
+        if not (folder / "episodes.jsonl").is_file():
+            ap.error(f"{folder}: no episodes.jsonl (not a finished output folder)")
+    closed = _rows(args.run_bench_dir / "episodes.jsonl")
+    sym = _rows(args.bench_dir / "episodes.jsonl")
     planners = list(dict.fromkeys(r["planner"] for r in closed))
     by_pair: dict[tuple[str, int], dict[str, dict[str, Any]]] = defaultdict(dict)
     for r in closed:

@@ -59,9 +59,9 @@ WHAT = {"open": "opens of the target's container showed it",
 
 
 def main(argv: list[str]) -> int:
-    if not argv:
-        print(__doc__.strip().splitlines()[-1].strip(), file=sys.stderr)
-        return 2
+    if not argv or argv[0] in ("-h", "--help"):
+        print(__doc__.strip(), file=sys.stderr if not argv else sys.stdout)
+        return 2 if not argv else 0
     for folder in map(Path, argv):
         path = folder / "episodes.jsonl"
         if not path.is_file():
