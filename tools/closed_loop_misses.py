@@ -9,6 +9,9 @@ ever opened, and how many frames showed any pixel of the target (and the most pi
 one). A target no frame ever showed behind a holder never opened was missed by the search
 (the planner never brought the camera to it within its steps); behind a holder that was
 opened, by looking in; one that frames showed but the map did not keep, by perception.
+Beside it, what the robot's last scene graph named the target's room (the categories of
+its room nodes that stand in it; none: the map has no room there): a room named wrongly
+sends a prior-based planner elsewhere.
 
     .venv/bin/python tools/closed_loop_misses.py RUN_DIR [RUN_DIR ...] [--planner P]
 """
@@ -17,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,7 +29,7 @@ import numpy as np
 
 from sgtool.house.spec import room_at
 from sgtool.log.reader import LogReader
-from sgtool.log.records import InstanceItem, Instances
+from sgtool.log.records import InstanceItem, Instances, SceneGraphRecord
 from sgtool.results import EpisodeResult, read_jsonl
 
 
@@ -38,12 +42,16 @@ class Miss:
     episode: int
     query: str
     end: str
-    where: str  # e.g. "kitchen: inside refrigerator (closed)"; "" when not in the table
+    # e.g. "kitchen: inside refrigerator (closed)", "bathroom: inside bathtub (x3)" for
+    # three instances there; "" when not in the table
+    where: str
     frames: int
     frames_in_room: int  # frames whose base stood in a room holding the target
     holder_opened: bool  # a closed piece holding the target was open in some table
     frames_showing: int  # frames with any pixel of the target
     most_pixels: int
+    named: tuple[str, ...] = ()  # categories the last graph gave rooms in the target's room
+    named_right: bool = False  # one of them is the target's room type
 
 
 def _chain(item: InstanceItem, by_id: dict[int, InstanceItem]) -> str:
@@ -78,6 +86,15 @@ def miss_of(log: Path, result: EpisodeResult) -> Miss:
                 {p.id: p.room for p in spec.furniture}
         categories = {rm.id: rm.category for rm in spec.rooms} if spec is not None else {}
         target_rooms = {room_of.get(str(i.spec_id)) for i in targets} - {None}
+        last = None
+        for _, g in r.records(SceneGraphRecord):
+            last = g
+        named: tuple[str, ...] = ()
+        if last is not None and spec is not None:
+            named = tuple(sorted({rm.category for rm in last.graph().rooms
+                                  if room_at(spec, float(rm.position[0]),
+                                             float(rm.position[1])) in target_rooms}))
+        truth = {categories.get(str(t)) for t in target_rooms}
         n = in_room = showing = most = 0
         for f in r.frames():
             n += 1
@@ -89,10 +106,12 @@ def miss_of(log: Path, result: EpisodeResult) -> Miss:
                 k = int(np.isin(f.ids, ids).sum())
                 showing += k > 0
                 most = max(most, k)
-    where = "; ".join(f"{categories.get(room_of.get(str(i.spec_id), ''), '?')}: "
-                      f"{_chain(i, first)}" for i in targets)
+    places = Counter(f"{categories.get(room_of.get(str(i.spec_id), ''), '?')}: "
+                     f"{_chain(i, first)}" for i in targets)
+    where = "; ".join(p + (f" (x{k})" if k > 1 else "") for p, k in places.items())
     return Miss(result.planner, result.house, result.episode, result.query, result.end,
-                where, n, in_room, opened, showing, most)
+                where, n, in_room, opened, showing, most, named,
+                any(c in truth for c in named))
 
 
 def misses(folder: Path, planners: Sequence[str] = ()) -> list[Miss]:
@@ -120,11 +139,12 @@ def main(argv: list[str] | None = None) -> int:
                   file=sys.stderr)
             return 1
         rows += misses(run, args.planner)
-    print("| planner | house | ep | query | end | where | frames | in its room | holder "
-          "opened | frames showing it | most pixels |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| planner | house | ep | query | end | where | its room on the map | frames | "
+          "in its room | holder opened | frames showing it | most pixels |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for m in rows:
         print(f"| {m.planner} | {m.house} | {m.episode} | {m.query} | {m.end} | {m.where} | "
+              f"{', '.join(m.named) or 'none'} | "
               f"{m.frames} | {m.frames_in_room} | {'yes' if m.holder_opened else 'no'} | "
               f"{m.frames_showing} | {m.most_pixels} |")
     seen = sum(1 for m in rows if m.frames_showing > 0)
@@ -132,7 +152,10 @@ def main(argv: list[str] | None = None) -> int:
     print(f"\n{len(rows)} failed episodes: the target in no frame's pixels in "
           f"{len(rows) - seen} (its holder never opened in {len(rows) - seen - opened}, "
           f"opened without the camera seeing in, in {opened}); in some frame's pixels in "
-          f"{seen} (seen by the camera, not kept by the map)")
+          f"{seen} (seen by the camera, not kept by the map); the target's room named "
+          f"right on the map in {sum(m.named_right for m in rows)}, wrongly in "
+          f"{sum(bool(m.named) and not m.named_right for m in rows)}, no room there in "
+          f"{sum(not m.named for m in rows)}")
     return 0
 
 
