@@ -517,8 +517,8 @@ class LiveSkills:
     def _through(self, start: tuple[float, float]) -> tuple[str, float]:
         """After an explore reached its frontier from ``start``: drive ``explore_through``
         metres on in the direction it came (to the reachable cell nearest that point, within
-        ``snap``): (reason, metres). Nothing when the robot came less than that far or no
-        cell there is reachable; a failed leg is no failure of the explore."""
+        ``snap``): (reason, metres). Nothing when the robot came less than half that far
+        or no cell there is reachable; a failed leg is no failure of the explore."""
         here = _xy(self.body.base)
         dx, dy = here[0] - start[0], here[1] - start[1]
         n = math.hypot(dx, dy)
