@@ -20,7 +20,8 @@ import numpy as np
 
 from sgtool.planning.base import Outcome
 from sgtool.recorders.sim.events import StopSimulation
-from sgtool.recorders.sim.live_skills import IN_VIEW, Goal, LiveSkills, goal_of_node
+from sgtool.recorders.sim.live_goals import Goal, goal_of_node
+from sgtool.recorders.sim.live_skills import IN_VIEW, LiveSkills
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome
 from sgtool.recorders.sim.skill_plan import SkillCall
 from sgtool.scenegraph.graph import ObjectNode

@@ -50,7 +50,8 @@ from sgtool.planning.candidates import Candidate, actionable
 from sgtool.planning.memory import SAME_PLACE_M
 from sgtool.recorders.sim.events import SkillOutcome, StopSimulation
 from sgtool.recorders.sim.frontier_explore import next_frontier
-from sgtool.recorders.sim.live_skills import Goal, LiveSkills
+from sgtool.recorders.sim.live_goals import Goal
+from sgtool.recorders.sim.live_skills import LiveSkills
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.stream import Refresh
 

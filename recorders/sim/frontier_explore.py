@@ -32,7 +32,8 @@ import numpy as np
 
 from sgtool.log.echo import as_logged
 from sgtool.recorders.sim.events import SimObserver, SkillOutcome
-from sgtool.recorders.sim.live_skills import Goal, LiveSkills, frontier_points
+from sgtool.recorders.sim.live_goals import Goal, frontier_points
+from sgtool.recorders.sim.live_skills import LiveSkills
 from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 
 if TYPE_CHECKING:

@@ -8,7 +8,7 @@ spends a step on a skill that fails at once ("unreachable on the robot's map"). 
 live navigation, the closed loop shows the planner a **view** of the graph in force
 (:func:`reachable_view`) in which every actionable node
 (:func:`~sgtool.planning.candidates.actionable`) has been tried the way the skill would
-try it: the goal of the node (:func:`~sgtool.recorders.sim.live_skills.goal_of_node`) and
+try it: the goal of the node (:func:`~sgtool.recorders.sim.live_goals.goal_of_node`) and
 the cell the robot would drive to (:meth:`LiveSkills.select`'s rule, on a window around
 the goal) on the robot's map, from where the robot stands:
 
@@ -50,7 +50,8 @@ from scipy import ndimage
 from sgtool.canonical import canonical_float
 from sgtool.mapping.occupancy import OccupancyMap
 from sgtool.planning.candidates import actionable
-from sgtool.recorders.sim.live_skills import Goal, LiveSkills, goal_of_node
+from sgtool.recorders.sim.live_goals import Goal, goal_of_node
+from sgtool.recorders.sim.live_skills import LiveSkills
 from sgtool.scenegraph.examined import EXAMINE
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.stream import Refresh

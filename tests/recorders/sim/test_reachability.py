@@ -28,7 +28,8 @@ from sgtool.planning.base import Action
 from sgtool.planning.candidates import actionable
 from sgtool.recorders.sim import CameraConfig
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
-from sgtool.recorders.sim.live_skills import Goal, LiveNavConfig, LiveSkills
+from sgtool.recorders.sim.live_goals import Goal
+from sgtool.recorders.sim.live_skills import LiveNavConfig, LiveSkills
 from sgtool.recorders.sim.navigation import RobotConfig
 from sgtool.recorders.sim.reachability import (
     LOOKED,
