@@ -171,24 +171,31 @@ def test_script_runs_with_tiny_arguments(name: str, smoke: Smoke, small_log: Pat
             "{repo}": str(REPO), "{data}": str(data)}
     if "{bench}" in smoke.args:
         subs["{bench}"] = str(_bench_folder(tmp_path / "bench"))
-    args = [_sub(a, subs) for a in smoke.args]
+    _run(name, [_sub(a, subs) for a in smoke.args], tmp_path, monkeypatch, capsys)
+
+
+def _run(name: str, args: list[str], cwd: Path, monkeypatch: pytest.MonkeyPatch,
+         capsys: pytest.CaptureFixture[str]) -> str:
+    """Run script ``name`` with ``args`` in ``cwd`` offline, in this process or (its
+    :class:`Smoke` says so) in a subprocess; it must exit 0. Its standard output."""
     script = REPO / name
     env = {"HF_HUB_OFFLINE": "1", "TRANSFORMERS_OFFLINE": "1", "MPLBACKEND": "Agg"}
-    if smoke.subprocess:
-        proc = subprocess.run([sys.executable, str(script), *args], cwd=tmp_path,
+    if SMOKE[name].subprocess:
+        proc = subprocess.run([sys.executable, str(script), *args], cwd=cwd,
                               env={**os.environ, **env}, capture_output=True, text=True,
                               timeout=1200)
         assert proc.returncode == 0, proc.stderr[-3000:]
-        return
+        return proc.stdout
     for k, v in env.items():
         monkeypatch.setenv(k, v)
     monkeypatch.syspath_prepend(str(script.parent))
     monkeypatch.setattr(sys, "argv", [str(script), *args])
-    monkeypatch.chdir(tmp_path)
+    monkeypatch.chdir(cwd)
     try:
         runpy.run_path(str(script), run_name="__main__")
     except SystemExit as e:
         assert e.code in (None, 0), capsys.readouterr().err[-3000:]
+    return capsys.readouterr().out
 
 
 def _sub(arg: str, subs: dict[str, str]) -> str:
@@ -198,28 +205,9 @@ def _sub(arg: str, subs: dict[str, str]) -> str:
 
 
 @pytest.mark.parametrize("name", sorted(SMOKE))
-def test_script_explains_itself(name: str, monkeypatch: pytest.MonkeyPatch,
+def test_script_explains_itself(name: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                                 capsys: pytest.CaptureFixture[str]) -> None:
     """``SCRIPT --help`` prints what it does and exits 0 (no traceback, nothing run)."""
-    smoke = SMOKE[name]
-    if smoke.needs and importlib.util.find_spec(smoke.needs) is None:
-        pytest.skip(f"{smoke.needs} is not installed")
-    script = REPO / name
-    env = {"HF_HUB_OFFLINE": "1", "TRANSFORMERS_OFFLINE": "1", "MPLBACKEND": "Agg",
-           "PYTHONPATH": str(REPO / "tests")}
-    if smoke.subprocess:
-        proc = subprocess.run([sys.executable, str(script), "--help"], cwd=REPO,
-                              env={**os.environ, **env}, capture_output=True, text=True,
-                              timeout=300)
-        assert proc.returncode == 0, proc.stderr[-3000:]
-        assert proc.stdout.strip() and "Traceback" not in proc.stderr
-        return
-    for k, v in env.items():
-        monkeypatch.setenv(k, v)
-    monkeypatch.syspath_prepend(str(script.parent))
-    monkeypatch.setattr(sys, "argv", [str(script), "--help"])
-    try:
-        runpy.run_path(str(script), run_name="__main__")
-    except SystemExit as e:
-        assert e.code in (None, 0), capsys.readouterr().err[-3000:]
-    assert capsys.readouterr().out.strip()
+    if SMOKE[name].needs and importlib.util.find_spec(SMOKE[name].needs) is None:
+        pytest.skip(f"{SMOKE[name].needs} is not installed")
+    assert _run(name, ["--help"], tmp_path, monkeypatch, capsys).strip()
