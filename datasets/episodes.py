@@ -167,17 +167,19 @@ class EpisodeGeometry:
 def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
                   reach: float = REACH,
                   geometry: EpisodeGeometry | None = None) -> list[Episode]:
-    """Search episodes in ``spec``: one per small-object category (sorted by category)
-    when ``n`` is None, else ``n`` episodes drawn with ``seed`` (categories without
-    replacement while they last, then again with other starts). ``geometry``: the house's
+    """Search episodes in ``spec``: one per small-object category (its
+    :func:`~sgtool.semantics.text.category_text`, so spellings of one name are one query;
+    sorted) when ``n`` is None, else ``n`` episodes drawn with ``seed`` (categories
+    without replacement while they last, then again with other starts). ``geometry``: the house's
     :class:`EpisodeGeometry` with this ``reach``, to share with other listings."""
     if not spec.objects or not spec.starts:
         return []
     by_cat: dict[str, list[str]] = defaultdict(list)
     synset_of: dict[str, str] = {}
-    for o in spec.objects:
-        by_cat[o.category].append(o.id)
-        synset_of.setdefault(o.category, o.synset)
+    for o in spec.objects:  # spellings of one category ("Soap Bar", "soap_bar") are one query
+        text = category_text(o.category)
+        by_cat[text].append(o.id)
+        synset_of.setdefault(text, o.synset)
     cats = sorted(by_cat)
     rng = np.random.default_rng(seed)
     if n is None:
@@ -198,7 +200,7 @@ def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
     out = []
     for i, cat in enumerate(chosen):
         ids = sorted(by_cat[cat], key=spec_id_key)
-        pieces = sorted(furn_by_text.get(category_text(cat), ()), key=spec_id_key)
+        pieces = sorted(furn_by_text.get(cat, ()), key=spec_id_key)
         rooms = tuple(sorted({objs[o].room for o in ids} |
                              {furn[f].room for f in pieces}, key=spec_id_key))
         starts = [s for s in spec.starts if s.room not in rooms] or list(spec.starts)

@@ -90,3 +90,16 @@ def test_two_room_episode_by_hand():
     assert path is not None
     assert path_length(path) == pytest.approx(apple.shortest_path, abs=1e-6)
     assert world_to_cell(geo.occ, *path[-1]) == world_to_cell(geo.occ, *end)
+
+
+def test_spellings_of_one_category_are_one_episode():
+    """"Cup" on the bedroom table and "cup" in a second spelling in the kitchen are one
+    query with both instances as targets (the environments find either), so the start
+    avoids both rooms' instances the way it avoids one."""
+    d = two_rooms()
+    d["objects"][0]["category"] = "Cup"  # the apple in the fridge, renamed
+    d["objects"][1]["category"] = "cup"
+    d["starts"] = [{"x": 1, "y": 1, "yaw": 0, "room": "room_0"}]
+    eps = list_episodes(load_house(d))
+    assert [(e.query, e.targets) for e in eps] == [("cup", ("obj_0", "obj_1"))]
+    assert set(eps[0].target_rooms) == {"room_0", "room_1"}

@@ -77,6 +77,11 @@ def test_category_text() -> None:
     assert category_text("Frying_Pan.n.01") == "frying pan"
     assert category_text("  bottom-cabinet ") == "bottom cabinet"
     assert category_text(category_text("wall_mounted_tv")) == "wall mounted tv"
+    # AI2-THOR's CamelCase types, acronyms included; an upper-case sense suffix
+    assert category_text("CounterTop") == "counter top"
+    assert category_text("TVStand") == category_text("tv_stand") == "tv stand"
+    assert category_text("CD") == "cd" and category_text("Mp3Player") == "mp3 player"
+    assert category_text("Frying_Pan.N.01") == "frying pan"
     assert same_category("frying_pan.n.01", "Frying pan")
     assert not same_category("pan", "frying pan")
 
