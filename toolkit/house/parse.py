@@ -28,7 +28,7 @@ from sgtool.house.consistency import check_consistency
 from sgtool.house.geometry import Point, Vec3, self_crossing, signed_area
 from sgtool.house.migrate import upgrade
 from sgtool.house.names import id_note, id_problem, name_problem
-from sgtool.house.nesting import check_nesting
+from sgtool.house.nesting import check_nesting, with_supporters
 from sgtool.house.spec import (
     AFFORDANCES,
     LIMITS,
@@ -45,6 +45,7 @@ from sgtool.house.spec import (
     StartPose,
     Wall,
 )
+from sgtool.semantics.text import category_text
 
 
 def parse_house(d: Any, limits: SpecLimits = LIMITS) -> HouseSpec:
@@ -72,6 +73,7 @@ def parse_house(d: Any, limits: SpecLimits = LIMITS) -> HouseSpec:
     objects = p.section(d, "objects", p.small_object, limits.objects, "obj_")
     starts = tuple(p.start(f"starts[{i}]", x)
                    for i, x in enumerate(p.entries(d, "starts", limits.starts)))
+    furniture, objects = with_supporters(furniture, objects)
     spec = HouseSpec(seed=seed, rooms=rooms, walls=walls, doors=doors, furniture=furniture,
                      objects=objects, starts=starts, passages=passages, split=split,
                      version=SPEC_VERSION)
@@ -216,6 +218,15 @@ class _Parser:
             raise SpecError(f"{where}: {_short(v)} {problem}")
         return v
 
+    def category(self, where: str, x: Mapping[str, Any]) -> str:
+        """A category name: a name with at least one word in it once read as text
+        (:func:`~sgtool.semantics.text.category_text`: "_" or "-" alone name nothing)."""
+        v = self.string(where, x, "category")
+        if not category_text(v):
+            raise SpecError(f"{where}.category: {_short(v)} has no letters or digits to "
+                            "name a category by")
+        return v
+
     def number(self, where: str, v: Any) -> float:
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             raise SpecError(f"{where}: expected a finite number, got {_short(v)}")
@@ -318,7 +329,7 @@ class _Parser:
         group = x.get("open_plan_group")
         if group is not None:
             self.name(f"{where}.open_plan_group", group)
-        return Room(id=self.string(where, x, "id"), category=self.string(where, x, "category"),
+        return Room(id=self.string(where, x, "id"), category=self.category(where, x),
                     polygon=poly, open_plan_group=group)
 
     def wall(self, where: str, x: Any) -> Wall:
@@ -360,7 +371,7 @@ class _Parser:
         size = self.size(f"{where}.size", _required(where, x, "size"), self.limits.furniture_side)
         aff, state = self.affordances(where, x)
         return Furniture(
-            id=self.string(where, x, "id"), category=self.string(where, x, "category"),
+            id=self.string(where, x, "id"), category=self.category(where, x),
             synset=self.string(where, x, "synset"),
             room=self.room_ref(f"{where}.room", _required(where, x, "room")),
             center=self.vec3(f"{where}.center", _required(where, x, "center")),
@@ -393,7 +404,7 @@ class _Parser:
         aff, state = self.affordances(where, x)
         side = self.limits.object_side
         return SmallObject(
-            id=self.string(where, x, "id"), category=self.string(where, x, "category"),
+            id=self.string(where, x, "id"), category=self.category(where, x),
             synset=self.string(where, x, "synset"), parent=self.string(where, x, "parent"),
             relation=rel, room=self.room_ref(f"{where}.room", _required(where, x, "room")),
             position=self.vec3(f"{where}.position", _required(where, x, "position")),

@@ -36,10 +36,13 @@ Conventions (all of them are checked on load):
   "inside" (its box lies within the parent's box; the parent must be a container) or
   "ontop" (its bottom rests on a support surface of the parent: the parent's top face or
   one of a furniture's ``levels``, within :data:`ONTOP_TOL`; its centre is over the
-  parent's footprint); ``position`` is its box centre and ``size`` its extent along the
-  parent's axes (small objects share their furniture's yaw); its ``room`` is its
-  furniture's; a small object may itself be a container (a bowl) or openable (a lidded
-  box: ``affordances`` and ``state`` as for furniture, version 2);
+  parent's footprint; a parent that is neither a supporter nor a container is read as a
+  supporter, with every piece of its category:
+  :func:`sgtool.house.nesting.with_supporters`); ``position`` is its box centre and
+  ``size`` its extent along the parent's axes (small objects share their furniture's
+  yaw); its ``room`` is its furniture's; a small object may itself be a container (a
+  bowl) or openable (a lidded box: ``affordances`` and ``state`` as for furniture,
+  version 2);
 - ``starts`` are robot start poses (x, y, yaw) on free floor, each in a named room.
 
 **Version 2** (:data:`SPEC_VERSION`) adds nesting, ``levels`` and small-object

@@ -88,6 +88,17 @@ def test_names_with_control_characters_are_refused(where, message) -> None:
     _refused(d, message)
 
 
+@pytest.mark.parametrize("section, index, name", [
+    ("objects", 0, "_"), ("furniture", 1, " - "), ("rooms", 0, "__"),
+])
+def test_a_category_must_name_something(section, index, name) -> None:
+    """A category read as text (underscores and hyphens are spaces) must keep a word:
+    "_" and "-" would all be the one empty query."""
+    d = two_rooms()
+    d[section][index]["category"] = name
+    _refused(d, rf"^{section}\[{index}\]\.category: .* has no letters or digits")
+
+
 def test_id_numbers_are_read_by_isdecimal() -> None:
     assert decimal_int("12") == 12 and decimal_int("١٢") == 12  # Arabic-Indic: int() reads it
     for text in ("²", "1²", "", "+1", " 1", "1_0", "-3", "x"):
@@ -261,3 +272,21 @@ def test_a_path_that_starts_with_a_brace_is_a_path(tmp_path: Path) -> None:
         load_house(bad)
     with pytest.raises(SpecError, match=r"\{missing\}\.json: no such house spec file"):
         load_house(tmp_path / "{missing}.json")
+
+
+def test_a_piece_with_something_on_top_is_read_as_a_supporter() -> None:
+    """The cup lies on the table; a file that leaves the table's affordances empty loads
+    with "supporter" on it and on the other table (by category), not on the chair."""
+    d = two_rooms()
+    table = d["furniture"][1]
+    table["affordances"] = []
+    d["furniture"] += [
+        {**table, "id": "furn_2", "center": [6.0, 1.0, 0.375]},
+        {**table, "id": "furn_3", "category": "chair", "synset": "chair.n.01",
+         "center": [7.2, 2.0, 0.375], "size": [0.5, 0.5, 0.75]},
+    ]
+    spec = load_house(d)
+    aff = {f.id: f.affordances for f in spec.furniture}
+    assert aff == {"furn_0": ("container", "openable"), "furn_1": ("supporter",),
+                   "furn_2": ("supporter",), "furn_3": ()}
+    assert load_house(json.loads(spec.to_json())) == spec  # the completed file is stable
