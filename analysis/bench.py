@@ -518,6 +518,7 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
              f"{len(res.failed)}", *(f"- {line}" for line in res.failed)]
             if res.failed else []),
           *llm_answer_lines(res.results, cfg.planners),
+          *[f"Note on {h.id} ({h.source}): {line}" for h in res.houses for line in h.notes],
           f"Digest of episodes.jsonl without wall-clock fields: {res.digest}",
           f"sgtool {__version__}; relational priors "
           f"{priors_fingerprint(cfg.priors_dir)}; wall-clock figures and the command in "
@@ -539,7 +540,8 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
         "seen_unseen": [asdict(s) for s in seen_unseen(res.results, cfg.planners)],
         "intervals": res.interval_dict(),
         "vocabulary": {"priors": cfg.priors_dir, "training_queries": res.vocabulary_size},
-        "houses": [{"id": h.id, "source": h.source} for h in res.houses],
+        "houses": [{"id": h.id, "source": h.source, **({"notes": list(h.notes)} if h.notes
+                                                       else {})} for h in res.houses],
         "digest": res.digest,
         "failed_tasks": list(res.failed),
         "sgtool_version": __version__,

@@ -29,6 +29,7 @@ from typing import Any
 
 from sgtool.errors import SgtoolError, SpecError
 from sgtool.house.spec import HouseSpec
+from sgtool.semantics.text import category_text
 
 
 class HouseFilesError(SgtoolError):
@@ -43,6 +44,7 @@ class BenchHouse:
     source: str  # the file, or "generated"
     spec: HouseSpec | None = None
     seed: int | None = None
+    notes: tuple[str, ...] = ()  # what a user should know of a given house (walled-off rooms)
 
     def load(self, rooms: tuple[int, int], preset: str = "default") -> HouseSpec:
         """The spec (generated on demand with ``rooms`` and the generator ``preset`` for a
@@ -124,7 +126,8 @@ def load_house_files(paths: Sequence[str | os.PathLike[str]],
         if not spec.objects:
             problems.append(f"{f}: objects: no small objects, nothing to search for")
             continue
-        if bad := symbolic_house_problem(spec, f):
+        house, bad = symbolic_house(spec, f)
+        if bad:
             problems.append(bad)
             continue
         hid = _house_id(spec, f)
@@ -137,24 +140,71 @@ def load_house_files(paths: Sequence[str | os.PathLike[str]],
             problems.append(f"{f}: id: house id {hid!r} is already used by {ids[hid]}")
             continue
         ids[hid] = str(f)
-        houses.append(BenchHouse(hid, str(f), spec=spec))
+        houses.append(BenchHouse(hid, str(f), spec=spec, notes=house_notes(house)))
     if problems:
         raise HouseFilesError("\n".join(problems))
     return tuple(houses)
 
 
+def check_house_files(paths: Sequence[str | os.PathLike[str]]) -> tuple[list[str], bool]:
+    """The checks of a bench run (:func:`load_house_files`) file by file: one line per
+    house file (``ok FILE: id, counts`` and its notes, or the problem) and whether every
+    file passed, ids across files included."""
+    lines: list[str] = []
+    good: list[Path] = []
+    for f, _ in _house_sources(paths):
+        try:
+            (h,) = load_house_files([f])
+        except HouseFilesError as e:
+            lines.extend(f"error {line}" for line in str(e).splitlines())
+            continue
+        spec = h.spec
+        assert spec is not None
+        queries = len({category_text(o.category) for o in spec.objects})
+        counts = ", ".join(f"{n} {word}" for n, word in (
+            (len(spec.rooms), "room(s)"), (len(spec.furniture), "piece(s) of furniture"),
+            (len(spec.objects), "small object(s)"), (queries, "query category(ies)")))
+        lines.append(f"ok {f}: {h.id}: {counts}")
+        lines.extend(f"   note: {n}" for n in h.notes)
+        good.append(f)
+    ok = len(good) == len(_house_sources(paths))
+    if ok and len(good) > 1:
+        try:
+            load_house_files(good)
+        except HouseFilesError as e:  # the same id in two files
+            lines.extend(f"error {line}" for line in str(e).splitlines())
+            ok = False
+    return lines, ok
+
+
 def symbolic_house_problem(spec: HouseSpec, where: str | os.PathLike[str]) -> str | None:
     """Why the benchmark's symbolic house cannot be built from ``spec`` (read from
     ``where``), as one line naming ``where`` and the room (a room without free floor for
-    the robot), or None. The check of :func:`load_house_files`, before any episode."""
+    the robot that no door or passage joins to one with), or None. The check of
+    :func:`load_house_files`, before any episode."""
+    return symbolic_house(spec, where)[1]
+
+
+def symbolic_house(spec: HouseSpec, where: str | os.PathLike[str]) -> tuple[Any, str | None]:
+    """The benchmark's :class:`~sgtool.recorders.symbolic_environment.house.SymbolicHouse`
+    of ``spec`` and None, or None and why it cannot be built
+    (:func:`symbolic_house_problem`)."""
     from sgtool.recorders.symbolic_environment.house import SymbolicHouse
 
     try:
-        SymbolicHouse(spec)
-    except ValueError as e:  # "room room_0 has no free floor"
-        return f"{where}: rooms: {e} (no cell where the robot fits: walls and furniture " \
-               "fill it)"
-    return None
+        return SymbolicHouse(spec), None
+    except ValueError as e:  # "room room_0 has no free floor and no door or passage ..."
+        return None, f"{where}: rooms: {e}"
+
+
+def house_notes(house: Any) -> tuple[str, ...]:
+    """What a user should know of a house that loads: rooms walled off from the rest (their
+    targets are searched from inside, the others' from outside)."""
+    cut = house.isolated_rooms()
+    if not cut:
+        return ()
+    return (f"{', '.join(cut)}: no door or passage leads there from the rest of the house; "
+            "a search for a target inside starts there, any other outside",)
 
 
 MAX_NAME_BYTES = 255  # a file-name component on common file systems (NAME_MAX)

@@ -65,4 +65,7 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
         raise
     for text in (res.table, res.side_by_side, res.seen_table, res.interval_tables()):
         show(text)
+    for h in res.houses:
+        for line in h.notes:
+            show(f"sgtool: note: {h.source}: {line}")
     show(f"wrote {', '.join(str(Path(out_dir) / name) for name in written)}")

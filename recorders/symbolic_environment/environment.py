@@ -3,7 +3,9 @@
 **Roll-out** (SCOUT V.C, Fig. 4), :class:`SymbolicEnv`:
 
 - start: a random region of a random room (rooms holding a target are avoided when others
-  exist), drawn from the episode seed; the start room is explored: the agent sees the
+  exist; only regions from which a target can be reached, so a walled-off room is no
+  start for a target outside it, nor the house outside it for a target in it), drawn
+  from the episode seed; the start room is explored: the agent sees the
   start region with its furniture, the room's other regions as frontiers ("unexplored
   area"), its doors, and the rooms behind its open doors and passages as unexplored rooms
   (``RoomNode(explored=False, category="unknown")``);
@@ -115,10 +117,12 @@ class SymbolicEnv:
         else:
             rng = np.random.default_rng([int(seed), int(self.spec.seed), int(episode_index)])
             avoid = {house.room_index[r] for r in avoid_rooms if r in house.room_index}
-            rooms = [ri for ri in range(len(self.spec.rooms)) if ri not in avoid] or \
+            starts = self._start_regions()
+            ok = [ri for ri, regs in enumerate(starts) if regs] or \
                 list(range(len(self.spec.rooms)))
+            rooms = [ri for ri in ok if ri not in avoid] or ok
             ri = rooms[int(rng.integers(len(rooms)))]
-            regs = house.room_regions[ri]
+            regs = starts[ri] or house.room_regions[ri]
             reg = regs[int(rng.integers(len(regs)))]
         self.start_region = house.regions[reg].id
         self.place = house.regions[reg].place
@@ -127,6 +131,17 @@ class SymbolicEnv:
         self._check_found()
         if self.success:
             self.end_reason = "found"
+
+    def _start_regions(self) -> list[tuple[int, ...]]:
+        """Per room, its regions from which a target can be reached with every door open
+        (all of them in a house without walled-off rooms; none for a query the house
+        lacks)."""
+        h = self.house
+        comp = h.place_component
+        goal = {int(comp[h.furn_place[f]]) for f in self._target_furn}
+        goal |= {int(comp[h.obj_place[j]]) for j in self._target_obj}
+        return [tuple(k for k in regs if int(comp[h.regions[k].place]) in goal)
+                for regs in h.room_regions]
 
     # ----- visibility -----------------------------------------------------------------
     def _enter_room(self, ri: int, region: int) -> None:

@@ -12,7 +12,9 @@ relation "inside"/"ontop"). Rooms are joined by doors (open/closed) and open-pla
 **Travel** (SCOUT Fig. 5 f). Every node the agent can go to has a *place*: the walkable cell
 of its own room nearest to it (walkable: free on the occupancy grid dilated by the robot
 radius, in the room's largest free component), i.e. the closest unoccupied point to the
-goal within the same room. Distances are geodesics on the occupancy grid of
+goal within the same room; in a room too small for the robot (a niche, a closet), the
+nearest walkable cell of the rooms its doors and passages join (it is searched from its
+doorway). Distances are geodesics on the occupancy grid of
 :mod:`sgtool.mapping.occupancy`. To let doors open and close during an episode without
 re-rasterising, they are computed once on the grid with every door closed (each room, or
 open-plan group, its own component) between all places, plus one place each side of every
@@ -25,6 +27,7 @@ parents); a room's is its nearest region's; a door's is its nearer side.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 from typing import TypeVar
@@ -32,7 +35,7 @@ from typing import TypeVar
 import numpy as np
 from scipy import ndimage
 from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
+from scipy.sparse.csgraph import connected_components, dijkstra
 
 from sgtool.house.spec import HouseSpec, enclosed
 from sgtool.mapping.occupancy import (
@@ -201,29 +204,42 @@ class SymbolicHouse:
 
         raster = room_raster(self.spec, self.occ)
         free = ~self.occ.blocked
-        self._snap: list[tuple[tuple[slice, slice], np.ndarray, np.ndarray] | None] = []
+        walks: list[np.ndarray | None] = []
         for ri in range(len(self.spec.rooms)):
-            mask = free & (raster == ri)
             # 4-connected: paths may not cut corners, so cells touching only diagonally
             # are not connected for the robot
-            lab, n = ndimage.label(mask)
-            if n == 0:
-                self._snap.append(None)
-                continue
-            sizes = np.bincount(lab.ravel())[1:]
-            walk = lab == (1 + int(np.argmax(sizes)))
-            rr, cc = np.nonzero(walk)
-            win = (slice(max(rr.min() - 2, 0), rr.max() + 3),
-                   slice(max(cc.min() - 2, 0), cc.max() + 3))
-            sub = walk[win]
-            _, (ir, ic) = ndimage.distance_transform_edt(~sub, return_indices=True)
-            self._snap.append((win, ir, ic))
+            lab, n = ndimage.label(free & (raster == ri))
+            walks.append(lab == (1 + int(np.argmax(np.bincount(lab.ravel())[1:])))
+                         if n else None)
+        self._snap: list[tuple[tuple[slice, slice], np.ndarray, np.ndarray] | None] = []
+        for ri, walk in enumerate(walks):
+            if walk is None:  # a niche the robot does not fit in: seen from the next room
+                near = [w for j in self._neighbours(ri) if (w := walks[j]) is not None]
+                walk = np.logical_or.reduce(near) if near else None
+            self._snap.append(None if walk is None else self._snap_table(walk))
+
+    def _neighbours(self, ri: int) -> list[int]:
+        """Rooms joined to room ``ri`` by a door or passage, ascending."""
+        rid = self.spec.rooms[ri].id
+        links = [d.rooms for d in self.spec.doors] + [p.rooms for p in self.spec.passages]
+        return sorted({self.room_index[r] for pair in links if rid in pair
+                       for r in pair if r != rid})
+
+    @staticmethod
+    def _snap_table(walk: np.ndarray) -> tuple[tuple[slice, slice], np.ndarray, np.ndarray]:
+        """(window, row and column of the nearest walkable cell) over ``walk``'s extent."""
+        rr, cc = np.nonzero(walk)
+        win = (slice(max(rr.min() - 2, 0), rr.max() + 3),
+               slice(max(cc.min() - 2, 0), cc.max() + 3))
+        _, (ir, ic) = ndimage.distance_transform_edt(~walk[win], return_indices=True)
+        return win, ir, ic
 
     def snap(self, x: float, y: float, room: int) -> tuple[int, int]:
         """The walkable cell of ``room`` nearest to (x, y)."""
         s = self._snap[room]
         if s is None:
-            raise ValueError(f"room {self.spec.rooms[room].id} has no free floor")
+            raise ValueError(f"room {self.spec.rooms[room].id} has no free floor (no cell "
+                             "where the robot fits) and no door or passage to a room that has")
         (rs, cs), ir, ic = s
         r, c = world_to_cell(self.occ, x, y)
         lr = min(max(r - rs.start, 0), ir.shape[0] - 1)
@@ -269,6 +285,22 @@ class SymbolicHouse:
             g = csr_matrix((w[src, dst], (src, dst)), shape=w.shape)
             self._graphs[open_doors] = g
         return g
+
+    @functools.cached_property
+    def place_component(self) -> np.ndarray:
+        """Per place, the label of the places it can reach with every door open (places of
+        rooms no door or passage joins to the rest get labels of their own)."""
+        _, labels = connected_components(self._graph(frozenset(range(len(self.spec.doors)))),
+                                         directed=False)
+        return np.asarray(labels)
+
+    def isolated_rooms(self) -> tuple[str, ...]:
+        """Ids of the rooms none of whose places the largest part of the house reaches with
+        every door open (walled off: no door or passage leads in), in spec order."""
+        labels = self.place_component
+        main = int(np.argmax(np.bincount(labels)))
+        return tuple(self.spec.rooms[ri].id for ri, regs in enumerate(self.room_regions)
+                     if all(labels[self.regions[k].place] != main for k in regs))
 
     def distances_from(self, place: int, open_doors: frozenset[int]) -> np.ndarray:
         """Travel distance (m) from ``place`` to every place with these doors open."""

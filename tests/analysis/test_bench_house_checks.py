@@ -62,8 +62,8 @@ def test_run_bench_writes_nothing_for_an_id_that_leaves_the_folder(tmp_path: Pat
 def test_a_room_without_free_floor_is_refused_before_any_episode(tmp_path: Path) -> None:
     f = tmp_path / "tiny.json"
     f.write_text(json.dumps(no_free_floor()))
-    line = (f"{f}: rooms: room room_0 has no free floor (no cell where the robot fits: walls "
-            "and furniture fill it)")
+    line = (f"{f}: rooms: room room_0 has no free floor (no cell where the robot fits) and "
+            "no door or passage to a room that has")
     assert symbolic_house_problem(load_house(f), f) == line
     assert symbolic_house_problem(load_house(cottage()), "cottage") is None
     with pytest.raises(HouseFilesError) as e:

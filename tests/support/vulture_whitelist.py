@@ -26,6 +26,7 @@ _.list_commands  # toolkit/cli.py: click.Group override
 _.get_command  # toolkit/cli.py: click.Group override
 _.format_commands  # toolkit/cli.py: click.Group override
 _.generate_cmd  # toolkit/commands/scenes.py: click sub-command, registered by decorator
+_.check_cmd  # toolkit/commands/scenes.py: click sub-command
 _.show_cmd  # toolkit/commands/scenes.py: click sub-command
 _.stats_cmd  # toolkit/commands/scenes.py: click sub-command
 _.episodes_cmd  # toolkit/commands/scenes.py: click sub-command

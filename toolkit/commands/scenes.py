@@ -1,4 +1,5 @@
-"""``sgtool scenes``: generate houses, draw them, summarise them, list search episodes."""
+"""``sgtool scenes``: generate houses, check house files, draw them, summarise them, list
+search episodes."""
 
 from __future__ import annotations
 
@@ -45,8 +46,8 @@ def _preset_option(f):  # type: ignore[no-untyped-def]
 @click.group("scenes")
 def command() -> None:
     """Houses furnished from BEHAVIOR-1K knowledge (the `bddl` package, read offline):
-    generate them from a seed, draw their floor plans, summarise them in the columns of
-    SCOUT's Table I, list object-search episodes."""
+    generate them from a seed, check house files of your own, draw their floor plans,
+    summarise them in the columns of SCOUT's Table I, list object-search episodes."""
 
 
 @command.command("generate")
@@ -74,6 +75,24 @@ def generate_cmd(seed: int, rooms: tuple[int, int], split: str, preset: str, out
                f"{len(spec.doors)} doors ({closed} closed), {len(spec.passages)} passages, "
                f"{len(spec.furniture)} furniture, {len(spec.objects)} objects "
                f"({inside} inside)", err=True)
+
+
+@command.command("check")
+@click.argument("houses", nargs=-1, required=True, type=click.Path())
+def check_cmd(houses: tuple[str, ...]) -> None:
+    """Check house files (or folders of them) as `sgtool bench --house` does before it runs:
+    the house spec (toolkit/house/spec.py), small objects to search for, free floor for the
+    robot, ids that can name log folders. One line per file: "ok FILE: id, counts" with
+    notes (rooms no door leads into), or "error" and the problem; exit code 2 when any
+    file fails."""
+    from sgtool.analysis.bench_houses import check_house_files
+
+    lines, ok = check_house_files(houses)
+    for line in lines:
+        click.echo(line)
+    if not ok:
+        raise SgtoolError(f"{sum(x.startswith('error') for x in lines)} problem(s) in the "
+                          "house files above")
 
 
 @command.command("show")

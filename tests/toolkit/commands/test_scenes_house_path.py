@@ -49,3 +49,29 @@ def test_episodes_of_a_house_without_free_floor_name_the_room(tmp_path: Path) ->
     assert r.exit_code == 2
     assert f"{p}: rooms: room room_0 has no free floor" in r.output
     assert "no small objects" not in r.output
+
+
+def test_check_names_every_file_with_its_verdict(tmp_path: Path) -> None:
+    """`scenes check` runs the bench's checks file by file (folders too): an ok line with
+    the counts and notes for each good file, an error line for each bad one, exit 2."""
+    from support.datasets_fixtures import walled_off
+
+    (tmp_path / "houses").mkdir()
+    good = _write(tmp_path / "houses" / "a.json", two_rooms())
+    cut = _write(tmp_path / "houses" / "b.json", walled_off(two_rooms(), "door_0"))
+    tiny = _write(tmp_path / "tiny.json", no_free_floor())
+    r = CliRunner().invoke(cli, ["scenes", "check", str(tmp_path / "houses")])
+    assert r.exit_code == 0, r.output
+    lines = r.output.splitlines()
+    assert lines[0] == (f"ok {good}: a: 2 room(s), 2 piece(s) of furniture, 2 small "
+                        "object(s), 2 query category(ies)")
+    assert lines[1].startswith(f"ok {cut}: b: ")
+    assert lines[2].startswith("   note: room_") and len(lines) == 3
+    r = CliRunner().invoke(cli, ["scenes", "check", str(good), str(tiny)])
+    assert r.exit_code == 2
+    assert r.output.splitlines()[1] == (f"error {tiny}: rooms: room room_0 has no free floor "
+                                        "(no cell where the robot fits) and no door or "
+                                        "passage to a room that has")
+    assert r.output.splitlines()[-1] == "sgtool: error: 1 problem(s) in the house files above"
+    r = CliRunner().invoke(cli, ["scenes", "check", str(good), str(good)])  # one id twice
+    assert r.exit_code == 2 and "already used" in r.output
