@@ -23,9 +23,12 @@ whether it sees the driver's output folder itself (same machine, same folder), s
 writes there directly; elsewhere it must send its files back with its value for the
 driver to write (what ``run-bench`` does, :mod:`sgtool.analysis.closed_loop_bench_run`).
 Ctrl-C cancels the tasks not finished yet and re-raises, so a caller that writes its
-outputs from ``on_result`` (atomically) is left with complete outputs only. A SIGTERM to
-the driver (turned into :class:`~sgtool.errors.Terminated` by the CLI) is passed on to the
-pool's workers, whose tasks then clean up as on Ctrl-C, and the driver waits for them.
+outputs from ``on_result`` (atomically) is left with complete outputs only. Pool workers
+ignore SIGINT: the driver stops them, on Ctrl-C (to the terminal's whole process group or
+to the driver alone) as on a SIGTERM to the driver (turned into
+:class:`~sgtool.errors.Terminated` by the CLI), by passing a SIGTERM on to the workers,
+whose running tasks then clean up as on Ctrl-C; the driver waits for them
+(:data:`STOP_GRACE_S`, then kills what is left), so nothing a task writes outlives it.
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ import os
 import signal
 import socket
 import sys
+import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -45,6 +49,7 @@ from sgtool.extras import missing_message
 
 EXECUTORS: tuple[str, ...] = ("local", "ray")
 RETRIES = 1  # a task that raised runs once more before it is reported
+STOP_GRACE_S = 30.0  # how long stopped workers get to clean up before they are killed
 
 
 class ExecutorError(SgtoolError):
@@ -201,11 +206,25 @@ class _Pool:
         return self
 
     def __exit__(self, *exc: object) -> None:
-        killed = isinstance(exc[1], Terminated)
-        if killed:  # kill reached this process only: stop the tasks in flight too
-            _signal_workers(self.pool, signal.SIGTERM)
-        # after a kill, wait for the workers to clean up (their partial outputs)
-        self.pool.shutdown(wait=exc[0] is None or killed, cancel_futures=True)
+        if exc[0] is None:
+            self.pool.shutdown(wait=True)
+            return
+        # Ctrl-C, a kill or an error: no new tasks, stop the running ones (they clean up
+        # their partial outputs), and wait for the workers before the caller removes
+        # anything, so no worker writes into a folder after it is gone
+        procs = list((getattr(self.pool, "_processes", None) or {}).values())
+        self.pool.shutdown(wait=False, cancel_futures=True)
+        for proc in procs:
+            if proc.is_alive():
+                with contextlib.suppress(ProcessLookupError):
+                    os.kill(proc.pid, signal.SIGTERM)
+        deadline = time.monotonic() + STOP_GRACE_S
+        for proc in procs:
+            proc.join(max(0.0, deadline - time.monotonic()))
+        for proc in procs:
+            if proc.is_alive():
+                proc.kill()
+                proc.join()
 
     def submit(self, args: Any) -> Any:
         from concurrent.futures.process import BrokenProcessPool
@@ -231,35 +250,35 @@ class _Pool:
 
 
 _IN_TASK = False  # in a pool worker: a task is running
+_STOPPING = False  # in a pool worker: the driver sent SIGTERM; queued tasks do not start
 
 
 def _worker_setup() -> None:
     """In each pool worker: SIGTERM interrupts a running task as Ctrl-C does (its outputs
     are cleaned up) instead of ending the process mid-write; an idle worker ignores it and
     leaves when the pool shuts down (dying would break the pool, which then kills the
-    other workers mid-cleanup)."""
+    other workers mid-cleanup). SIGINT is ignored: the driver decides (module doc), so a
+    task's clean-up is never cut short by a second signal."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, _worker_sigterm)
 
 
 def _worker_sigterm(signum: int, frame: object) -> None:
+    global _STOPPING
+    _STOPPING = True
     if _IN_TASK:
         raise_terminated(signum, frame)
 
 
 def _call_in_worker(fn: Callable[[Any], Any], args: Any) -> Any:
     global _IN_TASK
+    if _STOPPING:  # a task the pool had queued before the stop: it must not write anything
+        raise Terminated
     _IN_TASK = True
     try:
         return fn(args)
     finally:
         _IN_TASK = False
-
-
-def _signal_workers(pool: Any, sig: int) -> None:
-    for proc in list((getattr(pool, "_processes", None) or {}).values()):
-        if proc.is_alive():
-            with contextlib.suppress(ProcessLookupError):
-                os.kill(proc.pid, sig)
 
 
 class LocalExecutor(_Executor):

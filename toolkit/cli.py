@@ -191,9 +191,9 @@ def main(argv: list[str] | None = None) -> None:
     except SgtoolError as e:
         click.echo(f"sgtool: error: {redact_text(str(e))}", err=True)
         sys.exit(e.exit_code)
-    except click.exceptions.Abort:
+    except click.exceptions.Abort as e:  # click's form of a KeyboardInterrupt (a kill too)
         click.echo("sgtool: interrupted", err=True)
-        sys.exit(130)
+        sys.exit(143 if isinstance(e.__cause__, Terminated) else 130)
     except click.ClickException as e:
         e.show()
         sys.exit(e.exit_code)

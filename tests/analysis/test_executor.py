@@ -184,6 +184,8 @@ if __name__ == "__main__":
         LocalExecutor(2).run(slow, [Task(str(i), i) for i in range(2)])
     except Terminated:
         sys.exit(143)
+    except KeyboardInterrupt:
+        sys.exit(130)
 '''
 
 
@@ -195,7 +197,11 @@ def _gone(pid: int) -> bool:
     return "State:\tZ" in state  # exited, not yet reaped (no init reaps in a container)
 
 
-def test_kill_of_the_driver_stops_the_workers_and_leaves_no_partial_output(tmp_path):
+@pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_kill_of_the_driver_stops_the_workers_and_leaves_no_partial_output(tmp_path, sig,
+                                                                           code):
+    """A kill, or a Ctrl-C sent to the driver alone (the workers ignore SIGINT), stops the
+    tasks mid-write: they clean up, the workers end, and the driver exits after them."""
     script = tmp_path / "driver.py"
     script.write_text(KILLED_DRIVER)
     out = tmp_path / "out"
@@ -207,8 +213,8 @@ def test_kill_of_the_driver_stops_the_workers_and_leaves_no_partial_output(tmp_p
             assert proc.poll() is None and time.monotonic() < deadline
             time.sleep(0.1)
         pids = [int((out / f"pid-{i}").read_text()) for i in range(2)]
-        proc.send_signal(signal.SIGTERM)
-        assert proc.wait(timeout=60) == 143
+        proc.send_signal(sig)
+        assert proc.wait(timeout=60) == code
     finally:
         proc.kill()
     assert sorted(p.name for p in out.iterdir()) == ["pid-0", "pid-1"]  # no partial, no out

@@ -36,7 +36,7 @@ from mcap.summary import Summary
 from mcap.writer import CompressionType, Writer
 from mcap_protobuf.schema import build_file_descriptor_set
 
-from sgtool.errors import SgtoolError
+from sgtool.errors import SgtoolError, Terminated
 from sgtool.files import concerns, output_error, temp_beside
 from sgtool.log import chunk_copy, codec
 from sgtool.log import schemas as S
@@ -76,6 +76,11 @@ class InterruptedWrite(KeyboardInterrupt):
         super().__init__(note)
         self.note = note
         self.partial = partial
+
+
+class TerminatedWrite(InterruptedWrite, Terminated):
+    """:class:`InterruptedWrite` after a kill (SIGTERM): still a
+    :class:`~sgtool.errors.Terminated`, so the command exits as killed."""
 
 
 _COMPRESSION = {
@@ -405,9 +410,11 @@ class LogWriter:
         finally:
             self.partial_path.unlink(missing_ok=True)
 
-    def _keep_partial(self) -> InterruptedWrite:
-        """After Ctrl-C: close the partial file with what it holds (complete chunks), or
-        remove it when it holds no message; the exception to raise says which."""
+    def _keep_partial(self, killed: bool = False) -> InterruptedWrite:
+        """After Ctrl-C (or a kill: ``killed``): close the partial file with what it holds
+        (complete chunks), or remove it when it holds no message; the exception to raise
+        says which."""
+        kind = TerminatedWrite if killed else InterruptedWrite
         self._closed = True
         kept = False
         try:
@@ -421,9 +428,9 @@ class LogWriter:
             if not kept:
                 self.abort()
         if not kept:
-            return InterruptedWrite(f"nothing written to {self.path}", None)
+            return kind(f"nothing written to {self.path}", None)
         p = self.partial_path
-        return InterruptedWrite(
+        return kind(
             f"{self.path} not written; what was recorded is kept in {p} (recover it with: "
             f"sgtool doctor {p} --recover {self.path})", p)
 
@@ -435,7 +442,7 @@ class LogWriter:
         if exc_type is None:
             self.close()
         elif issubclass(exc_type, KeyboardInterrupt) and not self._closed:
-            raise self._keep_partial() from None
+            raise self._keep_partial(issubclass(exc_type, Terminated)) from None
         else:
             self.abort()
             if isinstance(exc, OSError) and concerns(exc, self.partial_path, self.path):
