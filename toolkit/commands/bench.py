@@ -12,6 +12,7 @@ import click
 
 from sgtool.commands.options import (
     PLANNER_OPTION_HELP,
+    PLANNERS_HELP,
     PLUGIN_HELP,
     LlmEndpoint,
     executor_options,
@@ -33,10 +34,7 @@ if TYPE_CHECKING:
 
 @click.command("bench")
 @click.option("--planners", default=None, metavar="LIST",
-              help="Comma-separated planners to compare (random, greedy, sbert, sbert-noroom, "
-                   "scout, scout-noroom, scout-delta0, godhs, esc, bayes-search, moma-llm, "
-                   "unstructured-llm, godhs-llm). Default: all but the LLM planners. "
-                   + PLUGIN_HELP)
+              help=PLANNERS_HELP + PLUGIN_HELP)
 @list_planners_option()
 @click.option("--houses", type=click.IntRange(min=0), default=None,
               help="Number of generated evaluation-split houses (house seeds HOUSE_SEED, +1, "
@@ -46,8 +44,11 @@ if TYPE_CHECKING:
               help="A house spec JSON file, or a folder of them (every *.json there is read "
                    "as a house), to bench (repeatable); named by the spec's id or the file "
                    "name. Generated houses join them only when --houses N is given. Every "
-                   "file is checked first; a bad one stops the run before any episode, "
-                   "naming file and field.")
+                   "file is checked first (`sgtool scenes check` runs the same checks); a "
+                   "bad one stops the run before any episode, naming file and field. "
+                   "Episodes start as SymSearch's do, in a random region of a random room "
+                   "that can reach the target; the file's `starts` are for the closed "
+                   "loop.")
 @click.option("--priors", "priors_dir", default=None, metavar="DIR",
               type=click.Path(file_okay=False, path_type=str),
               help="Relational priors (a folder written by `sgtool distill`, or `blend` for "

@@ -231,6 +231,13 @@ def list_planners_option() -> Callable[[F], F]:
 PLANNER_OPTION_HELP = ("Planner option PLANNER.KEY=VALUE, e.g. scout.delta=0.2 or "
                        "moma-llm.model=gpt-4o-mini (repeatable; --list-planners lists them; "
                        "a plug-in's: mymod:MyPlanner.k=v).")
+# the default of --planners, spelled out for --help (a test keeps it equal to the bench's)
+DEFAULT_PLANNERS_HELP = ("random, greedy, sbert-noroom, sbert, scout-noroom, scout-delta0, "
+                         "scout, godhs, esc, bayes-search")
+PLANNERS_HELP = ("Comma-separated planners to compare; --list-planners shows every one with "
+                 f"its options. Default: {DEFAULT_PLANNERS_HELP} (the papers' planners and "
+                 "their ablations); bayes-rooms, voi and the LLM planners (moma-llm, "
+                 "unstructured-llm, godhs-llm) run when named. ")
 PLUGIN_HELP = ("A planner may be a plug-in: module:Name (a class or factory importable from "
                "PYTHONPATH, called with its -O options; with --executor ray the module must "
                "be importable on every machine) or a name an installed package registers in "

@@ -10,6 +10,7 @@ import click
 
 from sgtool.commands.options import (
     PLANNER_OPTION_HELP,
+    PLANNERS_HELP,
     PLUGIN_HELP,
     LlmEndpoint,
     executor_options,
@@ -38,8 +39,7 @@ if TYPE_CHECKING:
 
 @click.command("run-bench")
 @click.option("--planners", default=None, metavar="LIST",
-              help="Comma-separated planners (as `sgtool bench`). Default: all but the LLM "
-              "planners. " + PLUGIN_HELP)
+              help=PLANNERS_HELP + PLUGIN_HELP)
 @list_planners_option()
 @click.option("--houses", type=click.IntRange(min=0), default=None,
               help="Generated evaluation houses (seeds HOUSE_SEED, +1, ...). [default: 5; "

@@ -285,3 +285,12 @@ def test_moma_llm_transcript_then_replay(tmp_path):
     assert r.exit_code == 0, r.output
     replayed = read_jsonl(tmp_path / "o" / "episodes.jsonl")
     assert results_digest(replayed) == live.digest
+
+
+@pytest.mark.parametrize("command", ["bench", "run-bench"])
+def test_help_names_the_default_planners(command):
+    """--help spells out the default of --planners: the bench's own list, in its order."""
+    from sgtool.analysis.bench import DEFAULT_PLANNERS
+
+    out = CliRunner().invoke(cli, [command, "--help"], terminal_width=400).output
+    assert "Default: " + ", ".join(DEFAULT_PLANNERS) + " (" in " ".join(out.split())
