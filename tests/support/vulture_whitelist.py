@@ -94,3 +94,4 @@ _.CASES  # replayers/golden.py: the golden cases (tests/golden/regenerate.py)
 _.replay_graphs  # replayers/golden.py: public API (sgtool.replay_graphs)
 _.room_check  # toolkit/semantics/everyday_rooms.py: a user scores own priors (module doc)
 _.accuracy  # toolkit/semantics/everyday_rooms.py: RoomCheck property (top-1 share)
+_.get_metavar  # toolkit/commands/options.py: FiniteFloatRange, called by click for --help

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import shlex
 import sys
 from dataclasses import dataclass
@@ -14,6 +13,7 @@ from sgtool.commands.options import (
     PLANNER_OPTION_HELP,
     PLANNERS_HELP,
     PLUGIN_HELP,
+    FiniteFloatRange,
     LlmEndpoint,
     executor_options,
     list_planners_option,
@@ -26,7 +26,6 @@ from sgtool.commands.options import (
     success_option,
 )
 from sgtool.datasets.presets import PRESET_NAMES
-from sgtool.errors import SgtoolError
 
 if TYPE_CHECKING:
     from sgtool.analysis.bench_run import BenchRunRequest
@@ -88,11 +87,11 @@ if TYPE_CHECKING:
 @click.option("--house-seed", default=0, show_default=True, help="Seed of the first house.")
 @click.option("--max-steps", default=50, show_default=True,
               help="High-level actions per episode (SymSearch's N_max).")
-@click.option("--distance-budget", type=click.FloatRange(min=0, min_open=True),
+@click.option("--distance-budget", type=FiniteFloatRange(min=0, min_open=True),
               default=5000.0, show_default=True,
               help="AUC-E distance variant budget max, in low-level steps "
                    "(0.1 m of travel = 1, an open = 30; MoMa-LLM).")
-@click.option("--step-budget", type=click.FloatRange(min=0, min_open=True), default=50.0,
+@click.option("--step-budget", type=FiniteFloatRange(min=0, min_open=True), default=50.0,
               show_default=True,
               help="AUC-E step variant budget max, in high-level steps.")
 @llm_log_options(
@@ -172,10 +171,6 @@ def _request(args: BenchArgs) -> BenchRunRequest:
     from sgtool.analysis.bench_houses import generated_count
     from sgtool.analysis.bench_run import BenchRunRequest
 
-    for flag, value in (("--distance-budget", args.distance_budget),
-                        ("--step-budget", args.step_budget)):
-        if not math.isfinite(value):
-            raise SgtoolError(f"{flag} {value}: must be a finite number > 0")
     names, options = _planners(args)
     cfg = BenchConfig(planners=names, houses=generated_count(args.houses, args.house_files, 10),
                       episodes=args.episodes, seeds=args.seeds,

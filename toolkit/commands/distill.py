@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from sgtool.commands.options import llm_endpoint_options
+from sgtool.commands.options import FiniteFloatRange, llm_endpoint_options
 from sgtool.errors import SgtoolError
 
 if TYPE_CHECKING:
@@ -45,7 +45,7 @@ def _weights_dir() -> Path:
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
 @click.option("--seed", type=int, default=0, show_default=True,
               help="Seed of negative sampling, held-out choice, initialisation, shuffling.")
-@click.option("--holdout", type=click.FloatRange(0.0, 0.9), default=0.0, show_default=True,
+@click.option("--holdout", type=FiniteFloatRange(0.0, 0.9), default=0.0, show_default=True,
               help="Share of training query categories held out of training, reported as "
                    "a second group (the main report group is always the categories unseen "
                    "in training, from the evaluation part).")

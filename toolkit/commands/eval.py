@@ -7,7 +7,6 @@ and prints the result."""
 
 from __future__ import annotations
 
-import math
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,6 +17,7 @@ import click
 from sgtool.commands.options import (
     PLANNER_OPTION_HELP,
     PLUGIN_HELP,
+    FiniteFloatRange,
     LlmEndpoint,
     executor_options,
     list_planners_option,
@@ -45,10 +45,10 @@ if TYPE_CHECKING:
                    "/sgtool/llm channel; repeatable) instead of an endpoint [default: the "
                    "exchanges of the MCAP inputs, when they have any].")
 @success_option(recorded=True)
-@click.option("--distance-budget", type=click.FloatRange(min=0, min_open=True), default=5000.0,
+@click.option("--distance-budget", type=FiniteFloatRange(min=0, min_open=True), default=5000.0,
               show_default=True,
               help="AUC-E distance variant budget max (low-level steps: 0.1 m = 1, open = 30).")
-@click.option("--step-budget", type=click.FloatRange(min=0, min_open=True), default=50.0,
+@click.option("--step-budget", type=FiniteFloatRange(min=0, min_open=True), default=50.0,
               show_default=True, help="AUC-E step variant budget max (high-level steps).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of tables.")
 @click.option("-o", "--out", type=click.Path(dir_okay=False), default=None,
@@ -120,10 +120,6 @@ def _request(inputs: tuple[str, ...], out: str | None, force: bool, args: EvalAr
     from sgtool.commands.options import check_output, planner_names, planner_options
     from sgtool.planning.registry import check_planner_name
 
-    for name, value in (("--distance-budget", args.distance_budget),
-                        ("--step-budget", args.step_budget)):
-        if not math.isfinite(value):
-            raise SgtoolError(f"{name} {value}: must be a finite number > 0")
     runner = make_executor(args.executor, args.workers, args.ray_address)
     files = tuple(map(str, expand_inputs(inputs, (".mcap",), "MCAP logs")))
     if out:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import click
 
+from sgtool.commands.options import FINITE_FLOAT
 from sgtool.errors import SgtoolError
 
 
@@ -40,7 +41,7 @@ def _frames(style: str, pairs: tuple[str, ...]) -> dict[str, str]:
               show_default=True,
               help="ROS 2 distribution whose metadata.yaml layout and types are written "
                    "(a humble bag also plays on jazzy).")
-@click.option("--time-base", "time_base", type=float, default=1.0, show_default=True,
+@click.option("--time-base", "time_base", type=FINITE_FLOAT, default=1.0, show_default=True,
               metavar="SECONDS",
               help="Bag time and header stamps = log time + SECONDS (keeps every message off "
                    "stamp 0).")

@@ -14,7 +14,7 @@ from typing import Any, TypeVar
 
 import click
 
-from sgtool.commands.options import executor_options, option_group
+from sgtool.commands.options import FiniteFloatRange, executor_options, option_group
 from sgtool.errors import SgtoolError
 from sgtool.scenegraph.build_options import CLASSIFIERS
 
@@ -31,7 +31,7 @@ def replay_options(what: str) -> Callable[[F], F]:
                      default=None, help=f"Room classifier [{what}]."),
         click.option("--min-points", type=click.IntRange(min=1), default=None,
                      help=f"Points an instance needs in one frame to count as seen [{what}]."),
-        click.option("--voxel-size", type=click.FloatRange(0.01, 0.5), default=None,
+        click.option("--voxel-size", type=FiniteFloatRange(0.01, 0.5), default=None,
                      help=f"Voxel edge in metres [{what}]."),
         click.option("--max-frames", type=click.IntRange(min=1), default=None,
                      help=f"Stop after this many frames [{what}]."),
@@ -112,7 +112,7 @@ def pin(logs: tuple[str, ...], folder: str, copy: bool, why: str | None, every: 
 @click.option("--log", "names", multiple=True, metavar="NAME",
               help="Check only this pinned log (repeatable).")
 @replay_options("as pinned; given here it overrides the pinned option for every log")
-@click.option("--tolerance", type=click.FloatRange(min=0.0), default=0.0, show_default=True,
+@click.option("--tolerance", type=FiniteFloatRange(min=0.0), default=0.0, show_default=True,
               help="Let differences up to this pass: positions and distances (m), room "
               "areas (m²), category scores (0: the graphs must be byte-identical).")
 @click.option("--update", is_flag=True,

@@ -4,6 +4,7 @@ too."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,6 +17,28 @@ from sgtool.output_check import check_log_output as check_log_output
 from sgtool.output_check import check_output as check_output
 
 F = TypeVar("F", bound=Callable[..., Any])
+
+
+class FiniteFloatRange(click.FloatRange):
+    """:class:`click.FloatRange` that refuses ``nan`` and ``inf`` (a NaN passes every
+    bound check, so ``--tolerance nan`` would read as no tolerance at all); the type of
+    every float option of the commands (:data:`FINITE_FLOAT` without bounds)."""
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        rv = super().convert(value, param, ctx)
+        if not math.isfinite(rv):
+            self.fail(f"{value!r} is not a finite number.", param, ctx)
+        return rv
+
+    def _describe_range(self) -> str:
+        return super()._describe_range() if (self.min, self.max) != (None, None) else ""
+
+    def get_metavar(self, param: click.Parameter, ctx: click.Context | None = None) -> str:
+        return "FLOAT" if (self.min, self.max) == (None, None) else "FLOAT RANGE"
+
+
+FINITE_FLOAT = FiniteFloatRange()
 
 
 def parse_rooms(text: str, option: str = "--rooms", lo_limit: int = 4,
@@ -186,7 +209,7 @@ def llm_endpoint_options(what: str, timeout: float | None = None,
                      "[env SGTOOL_LLM_MODEL]."),
         click.option("--llm-api-key", default=None, help=f"{what}: API key, never written "
                      "to an output [env SGTOOL_LLM_API_KEY]."),
-        click.option("--llm-timeout", type=click.FloatRange(1.0, 3600.0), default=timeout,
+        click.option("--llm-timeout", type=FiniteFloatRange(1.0, 3600.0), default=timeout,
                      show_default=timeout is not None,
                      help=timeout_help or (
                          f"{what}: wall-clock seconds per request (connecting, headers and "
@@ -253,6 +276,11 @@ def planner_names(text: str) -> tuple[str, ...]:
     return tuple(p.lower() if p.lower() in PLANNER_NAMES else p for p in names)
 
 
+def _canonical_planner(name: str) -> str:
+    """A planner name as :func:`planner_names` spells it (a built-in in lower case)."""
+    return planner_names(name)[0] if name.strip() else name
+
+
 def split_planner_key(key: str, planners: Sequence[str] = ()) -> tuple[str, str]:
     """(planner, option) of ``PLANNER.KEY``: the longest planner of ``planners`` the key
     starts with (``mypkg.mod:Cls.k``), else split at the last '.' when the planner is
@@ -278,9 +306,12 @@ def planner_options(items: tuple[str, ...], planners: Sequence[str] | None = Non
     from sgtool.planning.registry import check_planner_name, parse_option
 
     out: dict[str, dict[str, Any]] = {}
+    if planners is not None:  # "-p Scout -O SCOUT.delta=..." is one planner
+        planners = [_canonical_planner(p) for p in planners]
     for item in items:
         key, eq, value = item.partition("=")
         name, opt = split_planner_key(key, planners or ())
+        name = _canonical_planner(name)
         if not eq or not name or not opt.isidentifier():
             raise SgtoolError(f"--planner-option: expected PLANNER.KEY=VALUE, got {item!r}")
         run = planners is None or name in planners
@@ -342,7 +373,7 @@ def look_in_option() -> Callable[[F], F]:
     """``--look-in M`` of the closed-loop commands
     (:attr:`sgtool.recorders.sim.live_skills.LiveNavConfig.look_in`)."""
     return click.option(
-        "--look-in", type=click.FloatRange(0.0, 3.0), default=1.4, show_default=True,
+        "--look-in", type=FiniteFloatRange(0.0, 3.0), default=1.4, show_default=True,
         metavar="M",
         help="live navigation: after opening a container the robot drives to M metres "
              "from it, in front of its opening as its map shows it, and faces it, so the "
@@ -354,7 +385,7 @@ def look_in_beyond_option() -> Callable[[F], F]:
     """``--look-in-beyond DEG`` of the closed-loop commands
     (:attr:`sgtool.recorders.sim.live_skills.LiveNavConfig.look_in_beyond`)."""
     return click.option(
-        "--look-in-beyond", type=click.FloatRange(0.0, 180.0), default=45.0,
+        "--look-in-beyond", type=FiniteFloatRange(0.0, 180.0), default=45.0,
         show_default=True, metavar="DEG",
         help="live navigation: look in (--look-in) only after an open made from more "
              "than DEG degrees off the container's front as the robot's map shows it (the "
@@ -387,7 +418,7 @@ def explore_through_option() -> Callable[[F], F]:
     """``--explore-through M`` of the closed-loop commands
     (:attr:`sgtool.recorders.sim.live_skills.LiveNavConfig.explore_through`)."""
     return click.option(
-        "--explore-through", type=click.FloatRange(0.0, 5.0), default=0.0,
+        "--explore-through", type=FiniteFloatRange(0.0, 5.0), default=0.0,
         show_default=True, metavar="M",
         help="live navigation: an explore that reached its frontier drives M metres on, "
              "straight on from where it set out (through a doorway into the room behind), "
@@ -398,7 +429,7 @@ def render_turn_option() -> Callable[[F], F]:
     """``--render-turn DEG`` of the closed-loop commands
     (:attr:`sgtool.recorders.sim.closed_loop_options.ClosedLoopOptions.turn_render_deg`)."""
     return click.option(
-        "--render-turn", "render_turn", type=click.FloatRange(0.0, 90.0), default=20.0,
+        "--render-turn", "render_turn", type=FiniteFloatRange(0.0, 90.0), default=20.0,
         show_default=True, metavar="DEG",
         help="A tick is rendered, mapped and logged once the camera turned DEG degrees "
              "(or drove 0.25 m, or a share of both) since the last frame; a larger angle "

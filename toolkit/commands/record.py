@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from sgtool.commands.options import check_log_output, house_options
+from sgtool.commands.options import FINITE_FLOAT, check_log_output, house_options
 from sgtool.errors import SgtoolError
 
 if TYPE_CHECKING:
@@ -41,7 +41,7 @@ def _pair(option: str, text: str) -> tuple[float, float]:
 @click.option("--frames", type=int, default=None,
               help="Stop after this many frames. Default: when the scripted exploration has "
               "visited every room.")
-@click.option("--fps", type=float, default=10.0, show_default=True,
+@click.option("--fps", type=FINITE_FLOAT, default=10.0, show_default=True,
               help="Frames per second of log time. The robot drives at --speed, so a higher "
               "rate gives more, closer frames for the same run.")
 @click.option("--noise", default="none", show_default=True,
@@ -50,19 +50,19 @@ def _pair(option: str, text: str) -> tuple[float, float]:
               "at 1 m, grows with z^2), holes (share of depth pixels lost), label_swap, "
               "label_dropout (per visible object and frame), drift_xy (m per m driven), "
               "drift_yaw (rad per m driven and per rad turned).")
-@click.option("--noise-seed", type=int, default=0, show_default=True,
+@click.option("--noise-seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the sensor faults.")
 @click.option("--resolution", default="320x240", show_default=True,
               help="Camera image size WIDTHxHEIGHT.")
-@click.option("--fov", type=float, default=75.0, show_default=True,
+@click.option("--fov", type=FINITE_FLOAT, default=75.0, show_default=True,
               help="Vertical field of view (degrees); square pixels.")
 @click.option("--depth-range", default="0.1,6.0", show_default=True,
               help="Depth sensor range MIN,MAX (m); outside it depth reads 0.")
-@click.option("--camera-height", type=float, default=1.2, show_default=True,
+@click.option("--camera-height", type=FINITE_FLOAT, default=1.2, show_default=True,
               help="Camera height above the floor (m).")
-@click.option("--tilt", type=float, default=15.0, show_default=True,
+@click.option("--tilt", type=FINITE_FLOAT, default=15.0, show_default=True,
               help="Downward tilt of the camera (degrees).")
-@click.option("--speed", type=float, default=0.5, show_default=True,
+@click.option("--speed", type=FINITE_FLOAT, default=0.5, show_default=True,
               help="Driving speed (m/s); turning is 90 deg/s.")
 @click.option("--start", type=int, default=0, show_default=True,
               help="Index of the house's start pose (one per room in generated houses; a "

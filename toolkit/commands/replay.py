@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from sgtool.commands.options import (
+    FINITE_FLOAT,
     check_log_output,
     check_output,
     executor_options,
@@ -59,7 +60,7 @@ if TYPE_CHECKING:
 @click.option("--min-points", type=click.IntRange(min=1), default=None,
               help="Points an instance needs in one frame to count as seen. Default: the "
               "log's, else MoMa-LLM's 50 at 320x240 scaled by the image size.")
-@click.option("--voxel-size", type=float, default=None,
+@click.option("--voxel-size", type=FINITE_FLOAT, default=None,
               help="Voxel edge in metres. Default: the log's, else 0.05.")
 @click.option("--max-frames", type=click.IntRange(min=1), default=None,
               help="Stop after this many frames.")

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from sgtool.commands.options import (
+    FINITE_FLOAT,
     PLUGIN_HELP,
     LlmEndpoint,
     check_log_output,
@@ -62,7 +63,7 @@ if TYPE_CHECKING:
               help="Frame budget of N x the house's room count (excludes --frames).")
 @click.option("--resolution", default="320x240", show_default=True,
               help="Camera image size WIDTHxHEIGHT.")
-@click.option("--fps", type=float, default=10.0, show_default=True,
+@click.option("--fps", type=FINITE_FLOAT, default=10.0, show_default=True,
               help="Frames per second of log time (the robot drives 0.5 m/s, turns 90 deg/s).")
 @click.option("--every", type=click.IntRange(min=1), default=10, show_default=True,
               help="Refresh the scene graph every K frames (and always at every action).")
@@ -87,7 +88,7 @@ if TYPE_CHECKING:
 @sight_lines_option()
 @explore_through_option()
 @render_turn_option()
-@click.option("--optimistic", type=float, default=0.25, show_default=True, metavar="M",
+@click.option("--optimistic", type=FINITE_FLOAT, default=0.25, show_default=True, metavar="M",
               help="live navigation: how far (m) past known free floor a path may run into "
               "unknown space (at frontiers).")
 @click.option("--noise", default="none", show_default=True,

@@ -10,6 +10,7 @@ from typing import Any
 
 import click
 
+from sgtool.commands.options import FiniteFloatRange
 from sgtool.errors import SgtoolError
 
 
@@ -176,7 +177,7 @@ def stats_cmd(houses: int, seed: int, rooms: tuple[int, int], split: str, preset
               help="Number of episodes [default: one per object category].")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of the choice of categories and start poses.")
-@click.option("--reach", type=click.FloatRange(min=0.1), default=1.0, show_default=True,
+@click.option("--reach", type=FiniteFloatRange(min=0.1), default=1.0, show_default=True,
               help="A target counts as reached within this distance (m) of its parent.")
 @_preset_option
 @click.option("--json", "as_json", is_flag=True, help="Print JSON (one list).")

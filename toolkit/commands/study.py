@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from sgtool.commands.options import (
+    FINITE_FLOAT,
     executor_options,
     parse_resolution,
     parse_rooms,
@@ -59,12 +60,12 @@ def command() -> None:
               "Default: mild and strong, unless --factor is given.")
 @click.option("--resolution", default="160x120", show_default=True,
               help="Camera image size WIDTHxHEIGHT of the recordings.")
-@click.option("--fps", default=4.0, show_default=True, type=float,
+@click.option("--fps", default=4.0, show_default=True, type=FINITE_FLOAT,
               help="Frames per second of log time of the recordings.")
 @click.option("--frames", default=None, type=click.IntRange(min=1),
               help="Stop each recording after this many frames. Default: when the scripted "
               "tour has visited every room.")
-@click.option("--noise-seed", default=0, show_default=True, type=int,
+@click.option("--noise-seed", default=0, show_default=True, type=click.IntRange(min=0),
               help="Seed of the sensor faults.")
 @click.option("--cache", "cache_dir", default=None, type=click.Path(file_okay=False),
               help="Folder of recorded logs, keyed by house, noise and recording settings: "

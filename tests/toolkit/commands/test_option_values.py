@@ -50,8 +50,8 @@ def test_bad_planner_options(tmp_path: Path, option: str, expect: str) -> None:
 @pytest.mark.parametrize(("args", "expect"), [
     (["--distance-budget", "0"], "Invalid value for '--distance-budget'"),
     (["--step-budget", "-5"], "Invalid value for '--step-budget'"),
-    (["--distance-budget", "nan"], "--distance-budget nan: must be a finite number > 0"),
-    (["--step-budget", "inf"], "--step-budget inf: must be a finite number > 0"),
+    (["--distance-budget", "nan"], "'--distance-budget': 'nan' is not a finite number"),
+    (["--step-budget", "inf"], "'--step-budget': 'inf' is not a finite number"),
     (["-w", "0"], "Invalid value for '--workers'"),
 ])
 def test_bad_bench_values(tmp_path: Path, args: list[str], expect: str) -> None:
@@ -98,3 +98,35 @@ def test_noise_message_shows_name_value_unredacted() -> None:
     with pytest.raises(SgtoolError) as e:
         parse_noise("bogus")
     assert "NAME=VALUE overrides" in redact_text(str(e.value))
+
+
+@pytest.mark.parametrize("args, flag", [
+    (["record", "--speed", "nan", "--frames", "5"], "--speed"),
+    (["record", "--speed", "inf", "--frames", "5"], "--speed"),
+    (["record", "--noise", "mild", "--noise-seed", "-1", "--frames", "5"], "--noise-seed"),
+    (["scenes", "episodes", "h.json", "--reach", "nan"], "--reach"),
+    (["diff", "a.mcap", "b.mcap", "--tolerance", "nan"], "--tolerance"),
+    (["distill", "--holdout", "nan"], "--holdout"),
+])
+def test_non_finite_and_negative_values_are_usage_errors(tmp_path: Path, args: list[str],
+                                                         flag: str) -> None:
+    """A NaN passes every bound check (--tolerance nan would mean no tolerance): every
+    float option of the commands refuses nan and inf, a seed refuses negatives."""
+    r = CliRunner().invoke(cli, [*args, "-o", str(tmp_path / "out")] if args[0] == "record"
+                           else args)
+    assert r.exit_code == 2, r.output
+    assert f"'{flag}'" in r.output and "Traceback" not in r.output
+    assert not (tmp_path / "out").exists()
+
+
+def test_an_option_reaches_a_planner_spelled_in_another_case() -> None:
+    """`--planners SCOUT -O SCOUT.delta=0.9` sets scout's delta (the run lower-cases a
+    built-in name; the option was a note about a planner not run, and scout ran with its
+    defaults), and a bad value in any spelling is refused."""
+    from sgtool.commands.options import planner_options
+    from sgtool.errors import SgtoolError
+
+    assert planner_options(("SCOUT.delta=0.9",), ("scout",)) == {"scout": {"delta": 0.9}}
+    assert planner_options(("scout.delta=0.9",), ("Scout",)) == {"scout": {"delta": 0.9}}
+    with pytest.raises(SgtoolError, match="must be a number"):
+        planner_options(("Scout.delta=abc",), ("scout",))
