@@ -337,7 +337,7 @@ def make_planner(name: str, **options: Any) -> Planner:
         return planner
     from sgtool.planning.timing import TimedPlanner
 
-    wrapped = TimedPlanner(planner)
+    wrapped = TimedPlanner(planner, plugin=entry is None)
     if entry is None:
         wrapped.name = name
     return wrapped

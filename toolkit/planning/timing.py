@@ -30,20 +30,28 @@ class PlannerContractError(SgtoolError):
 class TimedPlanner:
     """Wraps a planner; ``decide`` returns the action with ``decision_time_s`` filled, and
     raises :class:`PlannerContractError` naming the planner when ``decide`` returns no
-    :class:`~sgtool.planning.base.Action` (a plug-in's mistake, caught where it happens)."""
+    :class:`~sgtool.planning.base.Action` (a plug-in's mistake, caught where it happens),
+    or, for a ``plugin``, when its ``reset``, ``decide`` or ``feedback`` raises."""
 
-    def __init__(self, inner: Planner) -> None:
+    def __init__(self, inner: Planner, plugin: bool = False) -> None:
         self.inner = inner
         self.name = inner.name
         self.decision_times: list[float] = []
+        self.plugin = plugin  # a user's planner: what it raises is one line, not a traceback
 
     def reset(self, query: str, seed: int = 0) -> None:
         self.decision_times = []
-        self.inner.reset(query, seed)
+        try:
+            self.inner.reset(query, seed)
+        except Exception as e:
+            raise self._failed("reset", e) from e
 
     def decide(self, graph: SceneGraph) -> Action:
         t0 = time.perf_counter()
-        action = self.inner.decide(graph)
+        try:
+            action = self.inner.decide(graph)
+        except Exception as e:
+            raise self._failed("decide", e) from e
         dt = time.perf_counter() - t0
         self.decision_times.append(dt)
         if _PLAIN and type(action) is Action:  # dataclasses.replace without its field walk
@@ -63,7 +71,19 @@ class TimedPlanner:
         return getattr(self.inner, "exchanges", None)
 
     def feedback(self, fb: Feedback) -> None:
-        self.inner.feedback(fb)
+        try:
+            self.inner.feedback(fb)
+        except Exception as e:
+            raise self._failed("feedback", e) from e
+
+    def _failed(self, method: str, e: Exception) -> Exception:
+        """What to raise when the wrapped planner's ``method`` raised ``e``: for a plug-in,
+        one :class:`PlannerContractError` line naming it (an :class:`SgtoolError` as it
+        is); for a built-in, ``e`` itself (a bug, with its traceback)."""
+        if not self.plugin or isinstance(e, SgtoolError):
+            return e
+        return PlannerContractError(f"planner {self.name!r}: {method}() raised "
+                                    f"{type(e).__name__}: {e}")
 
     def __getattr__(self, item: str) -> object:
         """Expose the wrapped planner's extras (e.g. ``exchanges`` of moma-llm)."""

@@ -45,6 +45,13 @@ PLUGIN = textwrap.dedent('''
 
     def not_a_planner():
         return "greedy"
+
+
+    class Stumbles(GreedyPlanner):
+        """A planner that breaks on its first decision."""
+
+        def decide(self, graph):
+            raise ZeroDivisionError("no rooms to divide by")
 ''')
 SMALL = ["--houses", "1", "--episodes", "2", "--seeds", "1", "--rooms", "4-5", "--preset",
          "default", "--no-progress"]
@@ -135,6 +142,25 @@ def test_a_failing_plugin_is_one_line_before_any_episode(plugin_dir: Path, tmp_p
     lines = [ln for ln in r.output.splitlines() if ln.strip()]
     assert r.exit_code == 2 and len(lines) == 1 and message in lines[0], r.output
     assert not out.exists()
+
+
+def test_a_plugin_that_raises_in_decide_is_one_line(plugin_dir: Path, tmp_path: Path,
+                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+    """What a user's planner raises while it runs is one line naming it and the method (a
+    built-in's exception stays a traceback: a bug of ours), here in a one-process run."""
+    monkeypatch.syspath_prepend(str(plugin_dir))
+    from sgtool.planning.registry import make_planner
+
+    r = CliRunner().invoke(cli, ["run", "-p", "mymod_cli:Stumbles", "--frames", "40",
+                                 "--max-steps", "2", "-o", str(tmp_path / "r.mcap")])
+    assert r.exit_code == 2, r.output
+    assert r.output.strip() == ("sgtool: error: planner 'mymod_cli:Stumbles': decide() raised "
+                                "ZeroDivisionError: no rooms to divide by")
+    assert not (tmp_path / "r.mcap").exists()
+    greedy = make_planner("greedy")
+    monkeypatch.setattr(greedy.inner, "decide", lambda graph: 1 / 0)
+    with pytest.raises(ZeroDivisionError):
+        greedy.decide(None)
 
 
 def test_log_paths_of_a_plugin_are_safe_and_fixed(monkeypatch: pytest.MonkeyPatch) -> None:
