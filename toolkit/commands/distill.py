@@ -34,7 +34,10 @@ def _weights_dir() -> Path:
 @click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
               default=None,
               help="Folder for the trained weights [default: the weights shipped in the "
-                   "package, sgtool/semantics/weights].")
+                   "package, sgtool/semantics/weights]. A folder that holds weights already "
+                   "is replaced only with --force.")
+@click.option("--force", is_flag=True,
+              help="Replace the weights the --out folder (or the package) holds.")
 @click.option("--report", "report_only", is_flag=True,
               help="Do not train: print the quality report of the weights in --weights: on "
                    "query categories held out of training, ROC-AUC of the learned scores vs "
@@ -85,7 +88,8 @@ def _weights_dir() -> Path:
               help="A small generation: at most ROOMS room types, CATEGORIES object "
                    "categories per room, OBJECTS objects per category [default: 12,8,10].")
 def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, as_json: bool,
-            source: str, llm_slice: str | None = None, **given: Any) -> None:
+            source: str, llm_slice: str | None = None, force: bool = False,
+            **given: Any) -> None:
     """Train the containment and co-occurrence MLPs (SCOUT sec. IV-C) or report on them.
 
     By default the training data come from the training split of the household knowledge
@@ -108,6 +112,11 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
         return
     llm = {k: given.pop(k) for k in list(given) if k.startswith("llm_")}
     target = out_dir or _weights_dir()
+    if (target / "metadata.json").exists() and not force:
+        which = "the weights shipped in the package, every planner's default priors" \
+            if out_dir is None else "trained weights"
+        raise SgtoolError(f"{target} holds {which}; give --out DIR for new ones, or --force "
+                          "to replace them")
     request = DistillRequest(target=target, **given,
                              llm=_llm_source(llm, llm_slice) if source == "llm" else None)
     meta = train_priors(request, note=lambda m: click.echo(m, err=True))

@@ -140,3 +140,20 @@ def test_shipped_weights_are_what_distill_writes(tmp_path) -> None:
         b = load_mlp(WEIGHTS_DIR / f"{rel}.safetensors", rel).pairs(x)
         assert spearmanr(a, b).statistic > 0.9, rel
         assert float(np.abs(a - b).mean()) < 0.05, rel
+
+
+def test_distill_replaces_weights_only_with_force(tmp_path) -> None:
+    """A folder holding weights (the package's own by default) is refused before any
+    training, with the way out in one line; an empty folder is written as before."""
+    from sgtool.cli import cli
+
+    held = tmp_path / "w"
+    held.mkdir()
+    (held / "metadata.json").write_text("{}")
+    r = CliRunner().invoke(cli, ["distill", "--out", str(held), "--epochs-containment", "1"])
+    assert r.exit_code == 2
+    assert r.output.strip() == (f"sgtool: error: {held} holds trained weights; give --out "
+                                "DIR for new ones, or --force to replace them")
+    r = CliRunner().invoke(cli, ["distill", "--epochs-containment", "1"])
+    assert r.exit_code == 2 and "holds the weights shipped in the package" in r.output
+    assert (held / "metadata.json").read_text() == "{}"
