@@ -62,7 +62,9 @@ def command(inputs: tuple[str, ...], out: str | None, force: bool = False,
     """Recompute the benchmark metrics (SR, SPL, steps, decision time, AUC-E with both
     budgets, seen/unseen) from recorded episodes: MCAP logs of closed-loop runs (their
     sgtool.Episode and sgtool.Action records) and/or episodes.jsonl files written by
-    `sgtool bench`. With --planner, replay every logged decision point of the MCAP logs:
+    `sgtool bench`. A folder is read as its episodes.jsonl when it holds one (the output
+    of bench or run-bench), else as every MCAP log in it and its subfolders (a --log-dir
+    of bench or run-bench). With --planner, replay every logged decision point of the MCAP logs:
     the planner decides on the logged scene graph, its choice is compared with the logged
     action, and it is then told what was really done.
 
@@ -121,7 +123,9 @@ def _request(inputs: tuple[str, ...], out: str | None, force: bool, args: EvalAr
     from sgtool.planning.registry import check_planner_name
 
     runner = make_executor(args.executor, args.workers, args.ray_address)
-    files = tuple(map(str, expand_inputs(inputs, (".mcap",), "MCAP logs")))
+    runs = [str(Path(i) / "episodes.jsonl") if (Path(i) / "episodes.jsonl").is_file()
+            else i for i in inputs]  # an output folder: its table, not its logs too
+    files = tuple(map(str, expand_inputs(runs, (".mcap",), "MCAP logs", recursive=True)))
     if out:
         check_output(out, force=force)
         if any(Path(out).resolve() == Path(i).resolve() for i in files):

@@ -121,6 +121,12 @@ def test_eval_asks_a_plugin_and_reads_its_logs(plugin_dir: Path, tmp_path: Path,
     assert set(offline) == {"mymod_cli:MyPlanner", "greedy"}
     assert offline["mymod_cli:MyPlanner"]["same_action"] == 1.0  # it decides as logged
     assert offline["mymod_cli:MyPlanner"]["decisions"] == offline["greedy"]["decisions"] > 0
+    # the folders themselves: --log-dir by its logs in PLANNER/HOUSE/, -o by its table
+    by_logs = CliRunner().invoke(cli, ["eval", str(logs), "--json"])
+    by_out = CliRunner().invoke(cli, ["eval", str(tmp_path / "out"), "--json"])
+    assert by_logs.exit_code == by_out.exit_code == 0, by_logs.output + by_out.output
+    for r in (by_logs, by_out):
+        assert json.loads(r.output)["planners"] == doc["planners"]
 
 
 @pytest.mark.parametrize(("planner", "message"), [
