@@ -60,6 +60,20 @@ def _check_mcap_profile(path: Path) -> None:
     what it is, rather than the bag reader's "Profile is not ros2"."""
     from mcap.reader import make_reader
 
+    from sgtool.log.mcap_records import MAGIC
+
+    with open(path, "rb") as f:
+        head = f.read(len(MAGIC))
+        size = f.seek(0, 2)
+        f.seek(max(size - len(MAGIC), 0))
+        tail = f.read(len(MAGIC))
+    if head != MAGIC:
+        raise SgtoolError(f"{path}: not an MCAP file (it does not start with the MCAP magic "
+                          "bytes)")
+    if size < 2 * len(MAGIC) or tail != MAGIC:
+        raise SgtoolError(f"{path}: the file ends without the MCAP footer (truncated, or "
+                          f"still being written); `sgtool doctor {path} --recover OUT.mcap` "
+                          "copies what is readable into a valid file")
     try:
         with open(path, "rb") as f:
             reader = make_reader(f)

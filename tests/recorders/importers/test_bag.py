@@ -285,6 +285,17 @@ def test_foreign_files_are_named(shared_data_dir, tmp_path):
     with pytest.raises(SgtoolError, match="--depth /topic is a std_msgs/msg/String topic"):
         import_bag(talker, tmp_path / "o.mcap", BagOptions(depth="/topic", info="/topic"))
     assert not (tmp_path / "o.mcap").exists()
+    # a cut copy and an empty file: what they are, and the way to the readable part
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(talker.read_bytes()[:-100])
+    with pytest.raises(SgtoolError, match=r"cut\.mcap: the file ends without the MCAP footer "
+                       r"\(truncated, or still being written\); `sgtool doctor .*--recover"):
+        import_bag(cut, tmp_path / "o.mcap", BagOptions(depth="/topic"))
+    empty = tmp_path / "empty.mcap"
+    empty.write_bytes(b"")
+    with pytest.raises(SgtoolError, match="empty.mcap: not an MCAP file"):
+        import_bag(empty, tmp_path / "o.mcap", BagOptions(depth="/topic"))
+    assert not (tmp_path / "o.mcap").exists()
 
 
 def test_cli_json_report_and_refusal_to_overwrite(tmp_path):
