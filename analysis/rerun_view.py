@@ -24,7 +24,8 @@ Two timelines: ``frame`` (frame index) and ``sim_time`` (log time since the star
 export holds is a function of the log: the recording id is derived from the log's bytes
 (:func:`recording_id`), and every entity, time and value follows from the log. The file's
 bytes are not: Rerun stamps its rows and chunks with ids of its own (time-based, random), so
-two exports of one log differ under ``cmp``; compare what they hold, not their bytes. The robot's path is logged in pieces of :data:`PATH_CHUNK` points
+two exports of one log differ under ``cmp``; compare what they hold, not their bytes. The
+robot's path is logged in pieces of :data:`PATH_CHUNK` points
 (``world/robot/path/K``), each re-logged only while it grows, so the recording grows
 linearly with the number of frames.
 

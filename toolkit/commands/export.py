@@ -6,6 +6,8 @@ the messages written per topic.
 
 from __future__ import annotations
 
+import re
+
 import click
 
 from sgtool.commands.options import FINITE_FLOAT
@@ -17,16 +19,33 @@ def command() -> None:
     """Export sgtool logs to other tools' formats."""
 
 
+_ROS_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_/]*")  # a tf frame id ROS tools accept
+
+
 def _frames(style: str, pairs: tuple[str, ...]) -> dict[str, str]:
-    """The frame renaming of ``--frames STYLE`` and ``--frame OLD=NEW`` pairs."""
+    """The frame renaming of ``--frames STYLE`` and ``--frame OLD=NEW`` pairs: OLD one of
+    the log's frames (sgtool's names), NEW a ROS name, no two frames under one name."""
+    from sgtool.log import schemas as S
     from sgtool.recorders.exporters.bag_export import REP105
 
+    frames = (S.WORLD_FRAME, S.BASE_FRAME, S.CAMERA_FRAME)
     names = dict(REP105) if style == "rep105" else {}
     for pair in pairs:
-        old, sep, new = pair.partition("=")
-        if not sep or not old.strip() or not new.strip():
+        old, sep, new = (x.strip() for x in pair.partition("="))
+        if not sep or not old or not new:
             raise SgtoolError(f"--frame {pair!r}: give OLD=NEW, e.g. camera=camera_link")
-        names[old.strip()] = new.strip()
+        if old not in frames:
+            raise SgtoolError(f"--frame {pair!r}: {old!r} is no frame of an sgtool log "
+                              f"(those are {', '.join(frames)}, before any renaming)")
+        if not _ROS_NAME.fullmatch(new):
+            raise SgtoolError(f"--frame {pair!r}: {new!r} is not a ROS frame name (a letter "
+                              "or '_', then letters, digits, '_' or '/')")
+        names[old] = new
+    final = [names.get(f, f) for f in frames]
+    if len(set(final)) < len(final):
+        twice = sorted({n for n in final if final.count(n) > 1})
+        raise SgtoolError(f"--frame: two frames would be named {', '.join(twice)} (a tf "
+                          "tree needs one name per frame)")
     return names
 
 

@@ -282,6 +282,10 @@ def test_cli_options(tmp_path):
     assert got["/camera/depth/image_raw"][0][1].header.frame_id == "cam"
     assert got["/tf"][0][1].transforms[0].header.frame_id == "world"
     for bad, says in ((["--frame", "camera"], "--frame 'camera': give OLD=NEW"),
+                      (["--frame", "nope=x"], "'nope' is no frame of an sgtool log (those are "
+                       "world, base, camera"),
+                      (["--frame", "world=bad name"], "'bad name' is not a ROS frame name"),
+                      (["--frame", "world=base_link"], "two frames would be named base_link"),
                       (["--topics", ","], "--topics: give at least one topic"),
                       (["--compression", "lz4"], "a ros2 bag takes none, zstd")):
         r = CliRunner().invoke(cli, ["export", "bag", str(log), "-o", str(tmp_path / "x"),
