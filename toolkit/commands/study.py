@@ -163,9 +163,14 @@ def _request(args: NoiseArgs) -> NoiseStudyRequest:
     if cfg.closed_loop.planners:
         from sgtool.analysis.closed_loop_bench import ClosedLoopBenchConfig
 
-        ClosedLoopBenchConfig(planners=cfg.closed_loop.planners, houses=1,
-                              episodes=args.episodes, noise=cfg.closed_loop.noise
-                              ).check()  # names, profiles: before any work
+        try:  # names, profiles: before any work, named by this command's options
+            ClosedLoopBenchConfig(planners=cfg.closed_loop.planners, houses=1,
+                                  episodes=args.episodes, noise=cfg.closed_loop.noise
+                                  ).check()
+        except SgtoolError as e:
+            text = str(e)
+            raise SgtoolError("--closed-loop" + text[len("--planners"):]
+                              if text.startswith("--planners") else text) from None
     cache = Path(args.cache_dir) if args.cache_dir else default_cache()
     if cache.exists() and not cache.is_dir():
         raise SgtoolError(f"--cache {cache}: is a file, not a folder")
@@ -206,7 +211,12 @@ def _closed_loop(args: NoiseArgs) -> Any:
     planners = planner_names(args.closed_loop) if args.closed_loop else ()
     cl_noise = tuple(n.strip() for n in args.closed_loop_noise.split(",") if n.strip())
     for n in cl_noise:
-        parse_noise(n)
+        try:
+            parse_noise(n)
+        except SgtoolError as e:  # its message names `record`'s --noise
+            text = str(e)
+            raise SgtoolError("--closed-loop-noise" + text[len("--noise"):]
+                              if text.startswith("--noise") else text) from None
     if args.closed_loop is not None and not planners:
         raise SgtoolError("--closed-loop: give at least one planner")
     if planners and not cl_noise:

@@ -164,3 +164,15 @@ def test_a_run_that_leaves_its_recorded_transcript_is_an_error(tmp_path):
     assert "holds no (more) responses" in err and "holds the episode up to there" in err
     with LogReader(out) as r:  # the episode so far is a whole log
         assert r.frame_count() > 0
+
+
+@pytest.mark.parametrize("args, line", [
+    (["--closed-loop", "bogus"], "sgtool: error: --closed-loop: unknown planner 'bogus'"),
+    (["--closed-loop", "scout", "--closed-loop-noise", "bogus"],
+     "sgtool: error: --closed-loop-noise bogus: unknown profile 'bogus'"),
+])
+def test_study_names_its_own_closed_loop_options(tmp_path, args, line):
+    """study noise checks its closed-loop planners and profiles with run-bench's and
+    record's rules, but the message names the option the user gave."""
+    r = CliRunner().invoke(cli, ["study", "noise", *args, "-o", str(tmp_path / "s")])
+    assert r.exit_code == 2 and r.output.startswith(line), r.output
