@@ -112,13 +112,13 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
         return
     llm = {k: given.pop(k) for k in list(given) if k.startswith("llm_")}
     target = out_dir or _weights_dir()
-    if (target / "metadata.json").exists() and not force:
+    request = DistillRequest(target=target, **given,
+                             llm=_llm_source(llm, llm_slice) if source == "llm" else None)
+    if (target / "metadata.json").exists() and not force:  # after the options' own checks
         which = "the weights shipped in the package, every planner's default priors" \
             if out_dir is None else "trained weights"
         raise SgtoolError(f"{target} holds {which}; give --out DIR for new ones, or --force "
                           "to replace them")
-    request = DistillRequest(target=target, **given,
-                             llm=_llm_source(llm, llm_slice) if source == "llm" else None)
     meta = train_priors(request, note=lambda m: click.echo(m, err=True))
     if as_json:
         click.echo(json.dumps(meta, indent=1, sort_keys=True))

@@ -14,7 +14,7 @@ from typing import Any
 
 import click
 
-from sgtool.commands.options import FINITE_FLOAT, check_log_output, option_group
+from sgtool.commands.options import check_log_output, option_group
 from sgtool.errors import SgtoolError
 from sgtool.recorders.importers.checks import (
     MAX_DT_S,
@@ -115,10 +115,10 @@ _common_options = option_group([
     click.option("--intrinsics", default=None,
                  help="Camera intrinsics 'fx,fy,cx,cy' in pixels, or a file (Open3D JSON "
                  "or a 3x3 matrix as text); overrides what the source says."),
-    click.option("--depth-scale", type=FINITE_FLOAT, default=None,
+    click.option("--depth-scale", type=float, default=None,
                  help="Raw 16-bit depth units per metre (default: 1000 for bags and "
                  "7-Scenes/Open3D, 5000 for TUM)."),
-    click.option("--max-dt", type=FINITE_FLOAT, default=0.02, show_default=True,
+    click.option("--max-dt", type=float, default=0.02, show_default=True,
                  help="Largest time difference (s, at most 60) when pairing colour (and ids) "
                  "with a depth image. Colour of another size than the depth is resized to it "
                  "when the aspect ratio is the same, and refused when it differs (it would "
@@ -145,7 +145,7 @@ def _odometry_options(estimate_help: str, odometry_help: str,
         click.option("--estimate-poses", is_flag=True, help=estimate_help),
         click.option("--odometry", type=click.Choice(["rgbd+icp", "rgbd", "icp"]),
                      default="rgbd+icp", show_default=True, help=odometry_help),
-        click.option("--depth-max", type=FINITE_FLOAT, default=4.0, show_default=True,
+        click.option("--depth-max", type=float, default=4.0, show_default=True,
                      help=depth_max_help),
     ])
 
@@ -178,9 +178,9 @@ def command() -> None:
               show_default=True,
               help="Image times: the header stamps (checked: distinct, a camera's rate), or the "
               "times the bag recorded the messages.")
-@click.option("--tf-tolerance", type=FINITE_FLOAT, default=0.05, show_default=True,
+@click.option("--tf-tolerance", type=float, default=0.05, show_default=True,
               help="How far (s) before/after a transform's samples a pose may be taken.")
-@click.option("--time-offset", type=FINITE_FLOAT, default=0.0, show_default=True,
+@click.option("--time-offset", type=float, default=0.0, show_default=True,
               help="Seconds added to the image times before they are paired with poses "
               "(a camera clock off from /tf's: image stamps later than the bag recorded them "
               "are an error that names the offset that fits).")
@@ -275,7 +275,7 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None, info: s
               help="Folder layout: TUM RGB-D (rgb.txt, depth.txt, groundtruth.txt), 7-Scenes "
               "(frame-XXXXXX.color/depth/pose), Open3D/Redwood (color|image/, depth/, "
               "*.log, intrinsics JSON).")
-@click.option("--fps", type=FINITE_FLOAT, default=30.0, show_default=True,
+@click.option("--fps", type=float, default=30.0, show_default=True,
               help="Frame rate (0.1-1000) for layouts without time stamps (7-Scenes frame n "
               "is at n/fps, Open3D frame i at i/fps) and for --timestamps index; give the "
               "real spacing of the images when frames were skipped (odometry checks the "

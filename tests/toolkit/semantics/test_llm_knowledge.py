@@ -142,6 +142,6 @@ def test_cli_distills_from_an_llm_and_replays_from_the_cache(tmp_path, monkeypat
     assert LearnedPriors(weights_dir=out).rooms(["kitchen"], "pot").shape == (1,)
     first = (out / "containment.safetensors").read_bytes()
     # no endpoint any more: the complete cache answers every prompt, same weights
-    res = CliRunner().invoke(command, args)
+    res = CliRunner().invoke(command, [*args, "--force"])  # the same folder again
     assert res.exit_code == 0, res.output
     assert (out / "containment.safetensors").read_bytes() == first
