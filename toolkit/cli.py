@@ -16,6 +16,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import logging
+import os
 import signal
 import sys
 from typing import Any
@@ -116,6 +117,9 @@ class LazyGroup(click.Group):
             raise usage_line(e) from e
         except SgtoolError as e:
             raise UserError(str(e)) from e
+        except BrokenPipeError:  # `sgtool ... | head`: the reader has what it wanted
+            _quiet_stdout()
+            raise click.exceptions.Exit(0) from None
         except ModuleNotFoundError as e:  # an optional package (an extra) is not installed
             missing = missing_extra(f"sgtool {ctx.invoked_subcommand}", e)
             if missing is None:
@@ -203,7 +207,19 @@ def main(argv: list[str] | None = None) -> None:
         click.echo("sgtool: interrupted", err=True)
         sys.exit(143 if isinstance(e, Terminated) else 130)
     except BrokenPipeError:
+        _quiet_stdout()
         sys.exit(0)
+
+
+def _quiet_stdout() -> None:
+    """Point stdout at /dev/null, so that the flush at exit does not fail again on the
+    closed pipe (Python's advice for SIGPIPE-free programs)."""
+    try:
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+        os.close(fd)
+    except (OSError, ValueError):  # no real stdout (a test runner's buffer)
+        pass
 
 
 def _terminate_as_interrupt() -> None:

@@ -5,6 +5,8 @@ script's ``main`` and through click's own standalone mode; --help is unchanged."
 
 from __future__ import annotations
 
+import json
+
 import click
 import pytest
 from click.testing import CliRunner
@@ -85,3 +87,24 @@ def test_an_interrupt_is_one_line_with_its_exit_code(capsys, exc, kind, code):
     assert Interrupted.exit_code == 130  # a kill does not change the Ctrl-C code
     e.value.show()
     assert capsys.readouterr().err == "sgtool: interrupted; no output was left half-written\n"
+
+
+def test_a_reader_that_stops_early_is_no_error(tmp_path):
+    """`sgtool scenes episodes HOUSE | head -1`: the closed pipe ends the command with exit
+    code 0 and no error on stderr (click's own handling exits 1)."""
+    import subprocess
+    import sys
+
+    from support.datasets_fixtures import two_rooms
+
+    house = tmp_path / "h.json"
+    house.write_text(json.dumps(two_rooms()))
+    code = "import sys; from sgtool.cli import main; main(sys.argv[1:])"
+    p = subprocess.Popen([sys.executable, "-c", code, "scenes", "episodes", str(house)],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    assert p.stdout is not None and p.stderr is not None
+    p.stdout.readline()
+    p.stdout.close()
+    assert p.wait(timeout=60) == 0
+    err = p.stderr.read().decode()
+    assert "rror" not in err and "Traceback" not in err and "Exception" not in err, err
