@@ -46,7 +46,7 @@ def _weights_dir() -> Path:
                                                           path_type=Path),
               default=None, help="Weights to report on [default: the shipped ones].")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
-@click.option("--seed", type=int, default=0, show_default=True,
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="Seed of negative sampling, held-out choice, initialisation, shuffling.")
 @click.option("--holdout", type=FiniteFloatRange(0.0, 0.9), default=0.0, show_default=True,
               help="Share of training query categories held out of training, reported as "
@@ -79,7 +79,7 @@ def _weights_dir() -> Path:
                    "generation offline) [default: $SGTOOL_CACHE/llm-knowledge].")
 @click.option("--llm-runs", type=click.IntRange(1, 20), default=1, show_default=True,
               help="Repetitions of each generation prompt, for diversity.")
-@click.option("--llm-max-queries", type=int, default=None,
+@click.option("--llm-max-queries", type=click.IntRange(min=1), default=None,
               help="Label at most this many generated objects (cost cap).")
 @click.option("--llm-max-tokens", type=click.IntRange(16, 8192), default=512,
               show_default=True, help="Longest LLM answer, in tokens (a small model that does "

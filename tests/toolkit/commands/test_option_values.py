@@ -107,6 +107,7 @@ def test_noise_message_shows_name_value_unredacted() -> None:
     (["scenes", "episodes", "h.json", "--reach", "nan"], "--reach"),
     (["diff", "a.mcap", "b.mcap", "--tolerance", "nan"], "--tolerance"),
     (["distill", "--holdout", "nan"], "--holdout"),
+    (["distill", "--seed", "-1"], "--seed"),
 ])
 def test_non_finite_and_negative_values_are_usage_errors(tmp_path: Path, args: list[str],
                                                          flag: str) -> None:
