@@ -193,12 +193,19 @@ class BenchConfig:
         lo, hi = self.rooms
         if not 4 <= lo <= hi <= MAX_ROOMS:
             raise BenchError(f"--rooms: need 4 <= MIN <= MAX <= {MAX_ROOMS}, got {lo}-{hi}")
+        if self.reference is not None and self.all_pairs:
+            raise BenchError("--reference and --all-pairs: give one (all pairs compare every "
+                             "planner with every other, the reference among them)")
         if self.reference is not None and self.reference not in self.planners:
             raise BenchError(f"--reference: {self.reference!r} is not one of --planners "
                              f"({', '.join(self.planners)})")
         if self.success not in SUCCESS_RULES:
             raise BenchError(f"--success: one of {', '.join(SUCCESS_RULES)}, got "
                              f"{self.success!r}")
+        llm_files = {"replay", "transcript"} & set(self.planner_options.get("moma-llm", {}))
+        if llm_files and "moma-llm" not in self.planners:
+            raise BenchError("--llm-replay and --llm-transcript are for moma-llm: add it to "
+                             "--planners")
         if "moma-llm" in self.planners:
             opts = self.planner_options.get("moma-llm", {})
             replay = opts.get("replay")

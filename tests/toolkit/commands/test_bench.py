@@ -215,6 +215,10 @@ def test_run_bench_returns_the_tables():
     (["-O", "scout-delta"], "expected PLANNER.KEY=VALUE"),
     (["--planners", "random,greedy", "--reference", "scout"],
      "--reference: 'scout' is not one of --planners"),
+    (["--planners", "random,greedy", "--reference", "random", "--all-pairs"],
+     "--reference and --all-pairs: give one"),
+    (["--planners", "random", "--llm-transcript", "t.jsonl"],
+     "--llm-replay and --llm-transcript are for moma-llm: add it to --planners"),
 ])
 def test_cli_option_errors(tmp_path, args, message):
     r = CliRunner().invoke(cli, ["bench", "-o", str(tmp_path), "--no-progress", *args])
