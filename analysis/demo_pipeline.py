@@ -13,6 +13,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from sgtool.files import quoted
+
 DEMO_PLANNERS = ("random", "greedy", "sbert", "scout")
 
 Echo = Callable[[str], None]
@@ -84,7 +86,7 @@ def run_demo(request: DemoRequest, show: Echo, progress: bool,
     show(f"\n== sgtool replay {log} -o {derived} --rrd {rrd} --score")
     _replay(log, derived, frames, show, progress)
     write_view(derived, rrd, progress)
-    show(f"wrote {rrd}; open it with: rerun {rrd}")
+    show(f"wrote {rrd}; open it with: rerun {quoted(rrd)}")
     show(f"\n== sgtool bench --planners {','.join(DEMO_PLANNERS)} --houses {request.houses} "
          f"--episodes {request.episodes} --seeds {request.seeds} -o {out / 'bench'}")
     show(run_bench(DEMO_PLANNERS, houses=request.houses, episodes=request.episodes,

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from sgtool.errors import SgtoolError
+from sgtool.files import quoted
 
 if TYPE_CHECKING:
     from sgtool.replayers.derived_log import ReplayOptions
@@ -112,7 +113,7 @@ def _show_report(request: ReplayRequest, report: Any, rooms: Any, scores: Any,
         for line in score_lines(scores):
             show(line)
     if rrd:
-        show(f"wrote {rrd}; open it with: rerun {rrd}")
+        show(f"wrote {rrd}; open it with: rerun {quoted(rrd)}")
 
 
 def replay_many(request: BatchReplayRequest, show: Echo) -> None:

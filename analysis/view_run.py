@@ -12,6 +12,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from sgtool.files import quoted
+
 Echo = Callable[[str], None]
 
 
@@ -50,7 +52,7 @@ def view_log(request: ViewRequest, show: Echo, note: Echo) -> None:
                hold=(lambda: _serve_until_interrupted(note))
                if live is not None and live.mode == "serve" else None)
     if request.output:
-        show(f"wrote {request.output}; open it with: rerun {request.output}")
+        show(f"wrote {request.output}; open it with: rerun {quoted(request.output)}")
 
 
 def _voxel_source(request: ViewRequest) -> Callable[[Any], Any] | None:

@@ -26,6 +26,7 @@ import errno
 import fnmatch
 import json
 import os
+import shlex
 import shutil
 import tempfile
 from collections.abc import Iterator, Sequence
@@ -50,6 +51,12 @@ FULL_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO})
 
 class OutputError(SgtoolError):
     """An output could not be written (read-only folder, missing folder, full disk)."""
+
+
+def quoted(path: str | os.PathLike[str]) -> str:
+    """``path`` as a shell word, for a command a message suggests (``rerun 'my run.rrd'``):
+    a path of plain characters as it is, any other quoted so that it pastes whole."""
+    return shlex.quote(str(path))
 
 
 def _umask() -> int:

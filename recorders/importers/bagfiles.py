@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from sgtool.errors import SgtoolError
+from sgtool.files import quoted
 
 IMAGE_TYPES = ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage")
 INFO_TYPES = ("sensor_msgs/msg/CameraInfo",)
@@ -72,8 +73,8 @@ def _check_mcap_profile(path: Path) -> None:
                           "bytes)")
     if size < 2 * len(MAGIC) or tail != MAGIC:
         raise SgtoolError(f"{path}: the file ends without the MCAP footer (truncated, or "
-                          f"still being written); `sgtool doctor {path} --recover OUT.mcap` "
-                          "copies what is readable into a valid file")
+                          f"still being written); `sgtool doctor {quoted(path)} --recover "
+                          "OUT.mcap` copies what is readable into a valid file")
     try:
         with open(path, "rb") as f:
             reader = make_reader(f)

@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 
 from sgtool.errors import SgtoolError
+from sgtool.files import quoted
 from sgtool.log.recover import Diagnosis, recover, scan
 from sgtool.log.writer import partial_files
 
@@ -123,6 +124,6 @@ def command(log: str, out: str | None, force: bool, as_json: bool) -> None:
                        "writer wrote no CRCs over (some of) the messages, so damage inside "
                        "them cannot be detected")
         elif d.status != "complete":
-            click.echo(f"recover with: sgtool doctor {log} --recover OUT.mcap")
+            click.echo(f"recover with: sgtool doctor {quoted(log)} --recover OUT.mcap")
     if d.status not in ("complete", "unverified"):
         raise click.exceptions.Exit(1)

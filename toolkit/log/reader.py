@@ -35,6 +35,7 @@ from sgtool.errors import (
     SgtoolError,
     SpecError,
 )
+from sgtool.files import quoted
 from sgtool.log import chunk_stream as cs
 from sgtool.log import codec, message_check, walk_index
 from sgtool.log import schemas as S
@@ -121,8 +122,8 @@ class LogReader:
             if size < 16 or f.read(8) != _MAGIC:
                 raise LogFormatError(
                     f"{self.path}: the file ends without the MCAP footer (truncated, or still "
-                    f"being written); `sgtool doctor {self.path} --recover OUT.mcap` copies "
-                    "what is readable into a valid log"
+                    f"being written); `sgtool doctor {quoted(self.path)} --recover OUT.mcap` "
+                    "copies what is readable into a valid log"
                 )
         self.size = size
         # reads are clamped to the file: a damaged length cannot allocate gigabytes
@@ -142,13 +143,13 @@ class LogReader:
             self._f.close()
             raise LogFormatError(
                 f"{self.path}: not a readable MCAP file ({type(e).__name__}: {e}); "
-                f"`sgtool doctor {self.path}` says what is wrong"
+                f"`sgtool doctor {quoted(self.path)}` says what is wrong"
             ) from e
         except Exception as e:  # the mcap library raises struct.error etc. on garbage
             self._f.close()
             raise LogFormatError(
                 f"{self.path}: not a readable MCAP file ({type(e).__name__}); "
-                f"`sgtool doctor {self.path}` says what is wrong"
+                f"`sgtool doctor {quoted(self.path)}` says what is wrong"
             ) from e
         # the summary is optional in MCAP, and so is each of its parts: when it does not say
         # everything (no statistics, schemas it lacks, messages outside chunks ...), the
@@ -167,7 +168,7 @@ class LogReader:
             self._f.close()
             if str(e).startswith(str(self.path)):
                 raise
-            raise LogFormatError(f"{self.path}: {e}; `sgtool doctor {self.path}` says what "
+            raise LogFormatError(f"{self.path}: {e}; `sgtool doctor {quoted(self.path)}` says what "
                                  "is readable and --recover copies it") from None
         except Exception as e:  # noqa: BLE001 - the mcap library on damaged records
             self._f.close()
@@ -504,7 +505,7 @@ class LogReader:
             # struct.error, KeyError (a message on an undefined channel), MemoryError ...
             raise LogFormatError(
                 f"{self.path}: damaged data ({type(e).__name__}: {str(e)[:120]}); "
-                f"`sgtool doctor {self.path}` says what is readable and --recover copies it"
+                f"`sgtool doctor {quoted(self.path)}` says what is readable and --recover copies it"
             ) from e
 
     def decode(self, schema: Schema | None, channel: Channel, message: Message) -> Any:
@@ -538,7 +539,7 @@ class LogReader:
                         not ci.message_start_time <= t <= ci.message_end_time for t in found):
                     raise LogFormatError(
                         f"{self.path}: the message index of {topic} at byte {offset} is "
-                        f"damaged; `sgtool doctor {self.path}` says what is readable")
+                        f"damaged; `sgtool doctor {quoted(self.path)}` says what is readable")
                 times.extend(found)
         times.sort()
         return times

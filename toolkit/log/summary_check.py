@@ -18,6 +18,7 @@ from mcap.records import Attachment, AttachmentIndex
 from mcap.summary import Summary
 
 from sgtool.errors import LogFormatError
+from sgtool.files import quoted
 from sgtool.log.mcap_records import FOOTER_RECORD_SIZE, RecordError, footer_at_end, parse_body
 
 
@@ -98,7 +99,7 @@ def read_attachment(f: IO[bytes], ai: AttachmentIndex, where: str) -> Attachment
         a = parse_body(Opcode.ATTACHMENT, data[9:])
     except RecordError as e:
         raise LogFormatError(f"{where}: attachment {ai.name!r} at byte {ai.offset} is "
-                             f"damaged ({e}); `sgtool doctor {where}` says what is "
+                             f"damaged ({e}); `sgtool doctor {quoted(where)}` says what is "
                              "readable") from None
     if a.name != ai.name:
         raise LogFormatError(f"{where}: the attachment at byte {ai.offset} is {a.name!r}, "

@@ -32,6 +32,7 @@ from mcap.records import (
 from mcap.summary import Summary
 
 from sgtool.errors import LogFormatError
+from sgtool.files import quoted
 from sgtool.log.file_walk import ChunkFacts, Layout, walk
 
 Entry = tuple[Schema | None, Channel, Message]
@@ -73,7 +74,7 @@ def walk_log(path: Path, size: int) -> WalkedLog:
         items = list(walk(buf, lay))
     if lay.corrupt or lay.truncated:
         why = lay.problems[0] if lay.problems else "damaged records"
-        raise LogFormatError(f"{path}: {why}; `sgtool doctor {path}` says what is readable "
+        raise LogFormatError(f"{path}: {why}; `sgtool doctor {quoted(path)}` says what is readable "
                              "and --recover copies it")
     schemas: dict[int, Schema] = {}
     channels: dict[int, Channel] = {}
@@ -91,7 +92,7 @@ def walk_log(path: Path, size: int) -> WalkedLog:
         ch = channels.get(m.channel_id)
         if ch is None:
             raise LogFormatError(f"{path}: a message at {m.log_time} ns names channel "
-                                 f"{m.channel_id}, defined nowhere; `sgtool doctor {path}` "
+                                 f"{m.channel_id}, defined nowhere; `sgtool doctor {quoted(path)}` "
                                  "says what is readable")
         messages.append((schemas.get(ch.schema_id), ch, m))
     messages.sort(key=lambda e: int(e[2].log_time))

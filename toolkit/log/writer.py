@@ -37,7 +37,7 @@ from mcap.writer import CompressionType, Writer
 from mcap_protobuf.schema import build_file_descriptor_set
 
 from sgtool.errors import SgtoolError, Terminated
-from sgtool.files import concerns, output_error, temp_beside
+from sgtool.files import concerns, output_error, quoted, temp_beside
 from sgtool.log import chunk_copy, codec
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
@@ -432,7 +432,7 @@ class LogWriter:
         p = self.partial_path
         return kind(
             f"{self.path} not written; what was recorded is kept in {p} (recover it with: "
-            f"sgtool doctor {p} --recover {self.path})", p)
+            f"sgtool doctor {quoted(p)} --recover {quoted(self.path)})", p)
 
     def __enter__(self) -> LogWriter:
         return self

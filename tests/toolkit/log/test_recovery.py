@@ -190,3 +190,16 @@ def test_info_on_a_truncated_log_points_to_doctor(long_log, tmp_path):
     r = CliRunner().invoke(cli, ["info", str(cut)])
     assert r.exit_code == 2
     assert "without the MCAP footer" in r.output and "--recover" in r.output
+
+
+def test_the_suggested_command_pastes_whole(long_log, tmp_path):
+    """A cut log in a folder with a space: the reader's one line names it as it is and
+    suggests `sgtool doctor` with the path quoted, so the command pastes as one word."""
+    folder = tmp_path / "my runs"
+    folder.mkdir()
+    cut = folder / "tour 1.mcap"
+    cut.write_bytes(long_log.read_bytes()[:-40])
+    with pytest.raises(LogFormatError) as e:
+        LogReader(cut)
+    assert str(e.value).startswith(f"{cut}: the file ends without the MCAP footer")
+    assert f"`sgtool doctor '{cut}' --recover OUT.mcap`" in str(e.value)
