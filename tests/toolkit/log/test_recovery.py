@@ -203,3 +203,9 @@ def test_the_suggested_command_pastes_whole(long_log, tmp_path):
         LogReader(cut)
     assert str(e.value).startswith(f"{cut}: the file ends without the MCAP footer")
     assert f"`sgtool doctor '{cut}' --recover OUT.mcap`" in str(e.value)
+
+
+def test_a_recovered_log_is_named_mcap(long_log, tmp_path):
+    r = CliRunner().invoke(cli, ["doctor", str(long_log), "--recover", str(tmp_path / "x.txt")])
+    assert r.exit_code == 2 and "--recover" in r.output and "name it *.mcap" in r.output
+    assert not (tmp_path / "x.txt").exists()
