@@ -112,8 +112,6 @@ def command(log: str, out: str | None, force: bool, as_json: bool) -> None:
         raise SgtoolError(f"{log} does not exist; partial files: "
                           f"{', '.join(map(str, found))} (recover one with: sgtool doctor "
                           f"{quoted(found[0])} --recover {quoted(log)})")
-    if out and Path(out).suffix != ".mcap":  # as replay, import and record name their logs
-        raise SgtoolError(f"--recover {out}: the output is an MCAP log; name it *.mcap")
     d = recover(log, out, overwrite=force) if out else scan(log)
     if as_json:
         click.echo(json.dumps(d.as_dict() | ({"recovered_to": out} if out else {}), indent=2))

@@ -22,7 +22,8 @@ F = TypeVar("F", bound=Callable[..., Any])
 class FiniteFloatRange(click.FloatRange):
     """:class:`click.FloatRange` that refuses ``nan`` and ``inf`` (a NaN passes every
     bound check, so ``--tolerance nan`` would read as no tolerance at all); the type of
-    every float option of the commands (:data:`FINITE_FLOAT` without bounds)."""
+    the commands' float options (:data:`FINITE_FLOAT` without bounds), but for the import
+    commands', which check theirs with messages that say what to give."""
 
     def convert(self, value: Any, param: click.Parameter | None,
                 ctx: click.Context | None) -> Any:

@@ -38,7 +38,7 @@ from sgtool.log.file_walk import Item, Layout, walk
 from sgtool.log.log_file import require_regular_file
 from sgtool.log.mcap_records import MAGIC
 from sgtool.log.message_check import message_problem
-from sgtool.output_check import check_output
+from sgtool.output_check import check_log_output
 
 Status = Literal["complete", "unverified", "truncated", "corrupt"]
 _OUTSIDE_CHUNKS = -1  # the key of messages outside chunks among the per-chunk counts
@@ -334,7 +334,7 @@ def recover(path: str | os.PathLike[str], out: str | os.PathLike[str],
 
     Messages are written in the order they were found; the MCAP index of the new file lets
     readers iterate them in log-time order. ``out`` is written atomically and must not be
-    the input file; it passes the one output check (:func:`sgtool.output_check.check_output`,
+    the input file; it passes the one output check (:func:`sgtool.output_check.check_log_output`,
     its errors naming ``--recover``, the option of ``sgtool doctor`` that gives it) before
     anything is read.
     """
@@ -344,7 +344,7 @@ def recover(path: str | os.PathLike[str], out: str | os.PathLike[str],
     require_regular_file(src)
     if dst.exists() and os.path.samefile(src, dst):
         raise SgtoolError(f"refusing to write the recovered log over its input {src}")
-    check_output(dst, force=overwrite, option="--recover")
+    check_log_output(dst, force=overwrite, option="--recover")
     _require_magic(src)
     diag = Diagnosis(str(src), src.stat().st_size)
     with open(src, "rb") as f, _mapped(f, diag.size) as buf, atomic_open(dst, "wb") as o:
