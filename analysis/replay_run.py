@@ -92,7 +92,12 @@ def replay_one(request: ReplayRequest, show: Echo, note: Echo) -> None:
         live.finish(note)
     scores = _score(request.house, final) if request.house is not None else None
     if request.rrd is not None and request.output is not None:
-        write_view(request.output, Path(request.rrd), request.progress)
+        try:
+            write_view(request.output, Path(request.rrd), request.progress)
+        except KeyboardInterrupt as e:  # the derived log is complete: say so
+            e.note = (f"{request.output} was written; {request.rrd} was not (make it with: "  # type: ignore[attr-defined]
+                      f"sgtool view {quoted(request.output)} -o {quoted(request.rrd)})")
+            raise
     _show_report(request, report, rooms, scores, show)
 
 

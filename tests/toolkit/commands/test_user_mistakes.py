@@ -176,3 +176,22 @@ def test_study_names_its_own_closed_loop_options(tmp_path, args, line):
     record's rules, but the message names the option the user gave."""
     r = CliRunner().invoke(cli, ["study", "noise", *args, "-o", str(tmp_path / "s")])
     assert r.exit_code == 2 and r.output.startswith(line), r.output
+
+
+def test_ctrl_c_while_the_rrd_is_written_says_the_log_is_complete(tmp_path, monkeypatch):
+    """replay -o D.mcap --rrd V.rrd: an interrupt in the .rrd step leaves the complete
+    derived log, and the one line says so, with the command that makes the .rrd."""
+    import sgtool.analysis.replay_run as replay_run
+
+    def interrupted(derived, rrd, show):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(replay_run, "write_view", interrupted)
+    out, rrd = tmp_path / "d.mcap", tmp_path / "v.rrd"
+    r = CliRunner().invoke(cli, ["replay", str(GOLDEN_LOG), "-o", str(out), "--rrd", str(rrd),
+                                 "--no-progress"])
+    assert r.exit_code == 130, r.output
+    assert r.output.strip().splitlines()[-1] == (
+        f"sgtool: interrupted; {out} was written; {rrd} was not (make it with: sgtool view "
+        f"{out} -o {rrd})")
+    assert out.exists() and not rrd.exists()
