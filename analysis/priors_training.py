@@ -10,6 +10,7 @@ notes meant for stderr.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -108,7 +109,10 @@ def train_priors(request: DistillRequest, note: Echo) -> dict[str, Any]:
         eval_sets = evaluation_sets(seed=request.seed)
         if request.room_blend:
             sets = (widened_containment(built.containment, room_types), built.cooccurrence)
+    # the folders this run creates (the target and missing parents) go again on failure
+    made = [d for d in (request.target, *request.target.parents) if not d.exists()]
     tmp = _stage(request.target)
+    done = False
     try:
         meta: dict[str, Any] = distill(tmp, cfg, sets=sets, split_fingerprint=fingerprint,
                                        room_types=room_types, progress=sys.stderr.isatty(),
@@ -128,8 +132,12 @@ def train_priors(request: DistillRequest, note: Echo) -> dict[str, Any]:
 
             for name in (BLEND_FILE, VECTORS_FILE):  # no stale blend
                 (request.target / name).unlink(missing_ok=True)
+        done = True
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+        for d in made if not done else ():
+            with contextlib.suppress(OSError):  # empty unless the moves had begun
+                d.rmdir()
     return meta
 
 

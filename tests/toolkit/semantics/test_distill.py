@@ -157,3 +157,18 @@ def test_distill_replaces_weights_only_with_force(tmp_path) -> None:
     r = CliRunner().invoke(cli, ["distill", "--epochs-containment", "1"])
     assert r.exit_code == 2 and "holds the weights shipped in the package" in r.output
     assert (held / "metadata.json").read_text() == "{}"
+
+
+def test_an_interrupted_distill_leaves_no_folder_it_made(tmp_path, monkeypatch) -> None:
+    """Ctrl-C during training: the folders the run made for --out (and its missing
+    parents) go again, as every other writer leaves nothing behind."""
+    import sgtool.semantics.distill as distill_module
+    from sgtool.cli import cli
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(distill_module, "distill", interrupted)
+    r = CliRunner().invoke(cli, ["distill", "--out", str(tmp_path / "new" / "w")])
+    assert r.exit_code == 130, r.output
+    assert list(tmp_path.iterdir()) == []
