@@ -132,6 +132,11 @@ def check_planner_list(planners: Sequence[str]) -> None:
         raise BenchError("--planners: name at least one planner")
     folders: dict[str, str] = {}
     for p in planners:
+        if not isinstance(p, str):  # a planner object, from Python: runs need its name
+            raise BenchError(f"--planners: a {type(p).__name__} object, not a name; a run "
+                             "builds its planners in each worker by name: give yours as "
+                             "module:Name (a class on sys.path), with its options in "
+                             "planner_options")
         try:
             check_planner_name(p)
         except SgtoolError as e:

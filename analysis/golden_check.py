@@ -33,7 +33,7 @@ from typing import Any, Literal
 
 from sgtool.analysis.executor import Executor, LocalExecutor, Task
 from sgtool.errors import SgtoolError
-from sgtool.files import atomic_output, output_folder, read_manifest
+from sgtool.files import atomic_output, output_folder, quoted, read_manifest
 from sgtool.replayers.derived_log import ReplayOptions
 from sgtool.replayers.golden import describe_mismatch, quality_lines, sha256_file
 from sgtool.replayers.golden_pins import (
@@ -64,7 +64,9 @@ def planner_decisions(log: str | Path, graphs: Sequence[str], refreshes: Sequenc
                       ) -> tuple[str | None, tuple[Decision, ...] | None]:
     """(planner, its decisions) at the decision points of an episode log, on the replayed
     graphs (module doc); (None, None) for a log that is no episode log or whose planner
-    needs an endpoint."""
+    needs an endpoint; an :class:`SgtoolError` when its planner cannot be built here (a
+    plug-in whose module is not on the path: silently leaving the decisions out would pin
+    less than asked, and a check would call the log changed)."""
     from sgtool.analysis.offline import read_log_episodes, replay_decisions
     from sgtool.log.records import given
     from sgtool.planning.registry import is_llm_planner, make_planner
@@ -98,8 +100,10 @@ def planner_decisions(log: str | Path, graphs: Sequence[str], refreshes: Sequenc
         replayed.append(dataclasses.replace(ep, decisions=tuple(ds)))
     try:
         planner = make_planner(name, timed=False)
-    except SgtoolError:
-        return None, None
+    except SgtoolError as e:  # a plug-in not importable here: its decisions cannot be asked
+        raise SgtoolError(f"{log}: its planner cannot be built here ({e}); the decisions of "
+                          "an episode log are pinned and checked by asking its planner again "
+                          "(a plug-in's module on PYTHONPATH)") from None
     report = replay_decisions(planner, replayed, name)
     return name, tuple(Decision(c.episode, c.step, c.chosen[0], c.chosen[1])
                        for c in report.comparisons)
@@ -290,7 +294,8 @@ def _check_task(t: _CheckTask) -> LogCheck:
     try:
         if not log.is_file():
             raise PinError(f"pinned log {log} is missing (moved or deleted? put it back, or "
-                           f"pin it again with `sgtool golden pin {log.name} --dir {folder}`)")
+                           f"pin it again with `sgtool golden pin {quoted(log)} --dir "
+                           f"{quoted(folder)}`)")
         if sha256_file(log) != pin.log_sha256:
             raise PinError(f"{log} is not the pinned log (its sha256 differs); pin it again "
                            "if it was re-recorded on purpose")

@@ -220,6 +220,17 @@ def episode_log(src, dst, planner):
     return dst
 
 
+def test_a_planner_that_cannot_be_built_here_is_an_error(log, tmp_path, capsys):
+    """An episode log of a plug-in whose module is not on the path: pinning says so in one
+    line (it left the decisions out silently), and so does a check of a pin made where the
+    module was (it called the log changed)."""
+    ep = episode_log(log, tmp_path / "episode.mcap", "labmod_not_here:Planner")
+    code, out, err = sgtool(capsys, "golden", "pin", ep, "--dir", tmp_path / "g")
+    assert code == 2 and not (tmp_path / "g").exists()
+    assert "its planner cannot be built here" in err and "PYTHONPATH" in err
+    assert "cannot import module 'labmod_not_here'" in err
+
+
 def test_episode_logs_pin_the_planners_decisions(log, tmp_path, capsys):
     ep = episode_log(log, tmp_path / "episode.mcap", "greedy")
     folder = tmp_path / "g"

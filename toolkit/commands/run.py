@@ -41,9 +41,8 @@ if TYPE_CHECKING:
 
 @click.command("run")
 @click.option("--planner", "-p", required=True,
-              help="The planner: random, greedy, sbert, sbert-noroom, scout, scout-noroom, "
-              "scout-delta0, godhs, esc, bayes-search, moma-llm, unstructured-llm or "
-              "godhs-llm. " + PLUGIN_HELP)
+              help="The planner: a built-in (--list-planners shows them all with their "
+              "options: scout, voi, bayes-search, moma-llm, ...). " + PLUGIN_HELP)
 @list_planners_option()
 @house_options(
     seed_help="Search a generated evaluation house (`sgtool scenes generate`) of this seed "

@@ -242,6 +242,11 @@ def test_all_pairs_compares_every_pair(tmp_path):
 def test_config_check_rejects_duplicates():
     with pytest.raises(BenchError, match="named twice"):
         BenchConfig(planners=("random", "random")).check()
+    from sgtool.planning.registry import make_planner
+
+    with pytest.raises(BenchError, match="a TimedPlanner object, not a name; .* give yours "
+                       "as module:Name"):
+        BenchConfig(planners=(make_planner("random"), "scout")).check()  # type: ignore[arg-type]
 
 
 class ScriptedLlm:
