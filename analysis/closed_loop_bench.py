@@ -227,7 +227,8 @@ def run_task(task: RunTask) -> RunRow:
             rep = run_episode(spec, eps[task.episode],
                               make_planner(task.planner, **dict(task.planner_options)),
                               task.output, opts, house_id=task.house.id,
-                              episode_index=task.episode)
+                              episode_index=task.episode,
+                              planner_options=dict(task.planner_options))
         except KeyboardInterrupt:
             for p in partial_files(task.output):
                 p.unlink(missing_ok=True)
@@ -241,7 +242,8 @@ def _row(task: RunTask, seconds: float | None) -> RunRow:
         spec, eps = house_episodes(task)
         want = [eps[task.episode].id, eps[task.episode].query] \
             if task.episode < len(eps) else None
-        check_resumable(task.output, task_settings(task_options(task), task.noise, want),
+        check_resumable(task.output, task_settings(task_options(task), task.noise, want,
+                                                    dict(task.planner_options)),
                         spec, task.house.source if task.house.spec is not None
                         else task.house.id)
     logged = read_log_episodes(task.output)

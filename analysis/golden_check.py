@@ -98,8 +98,11 @@ def planner_decisions(log: str | Path, graphs: Sequence[str], refreshes: Sequenc
             t = gt if isinstance(gt, int) else d.t_ns
             ds.append(dataclasses.replace(d, graph=graph_at(t) if d.decided else None))
         replayed.append(dataclasses.replace(ep, decisions=tuple(ds)))
+    extra = given(episodes[0].episode.extra) or {}
+    logged = extra.get("planner_options")
+    options = dict(logged) if isinstance(logged, dict) else {}  # as the run built it
     try:
-        planner = make_planner(name, timed=False)
+        planner = make_planner(name, timed=False, **options)
     except SgtoolError as e:  # a plug-in not importable here: its decisions cannot be asked
         raise SgtoolError(f"{log}: its planner cannot be built here ({e}); the decisions of "
                           "an episode log are pinned and checked by asking its planner again "

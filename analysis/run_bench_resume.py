@@ -1,7 +1,7 @@
 """Whether an episode log already in a ``run-bench`` folder may stand for a task: it must
-have been run with the task's settings (episode, steps, frames, resolution, which ticks
-are frames, navigation, noise, seed, success rule, room classifier, how far an explore
-goes on) on the same house.
+have been run with the task's settings (episode, planner options, steps, frames,
+resolution, which ticks are frames, navigation, noise, seed, success rule, room
+classifier, how far an explore goes on) on the same house.
 A log without the frame settings (``render_step_m``, ``turn_render_deg``: older code
 rendered other ticks) is not reused.
 
@@ -15,12 +15,13 @@ naming the log and what differs.
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 from sgtool.errors import SgtoolError, SpecError
 from sgtool.house.spec import HouseSpec
-from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
+from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, recorded_options
 from sgtool.recorders.sim.noise import parse_noise
 
 _FIX = ("give a fresh -o folder, --force to run every episode again, or delete the log to "
@@ -31,10 +32,12 @@ class ResumeError(SgtoolError):
     """An episode log of the output folder was run with other settings or another house."""
 
 
-def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
-                  ) -> dict[str, Any]:
+def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None,
+                  planner_options: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The settings a task's log must have been run with (as :func:`logged_settings`)."""
-    return {"episode": episode, "max_steps": opts.max_steps, "frame_budget": opts.frames,
+    return {"episode": episode,
+            "planner_options": recorded_options(planner_options or {}),
+            "max_steps": opts.max_steps, "frame_budget": opts.frames,
             "size": [opts.camera.width, opts.camera.height],
             "render_step_m": float(opts.render_step_m),
             "turn_render_deg": float(opts.turn_render_deg),
@@ -70,7 +73,10 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
     nav = x.get("navigation") or {}
     live = nav.get("mode") == "live"
     ep = [x.get("episode_id"), started.query] if started is not None else None
-    return ({"episode": ep, "max_steps": x.get("max_steps"),
+    return ({"episode": ep,
+             # logs from before the options were recorded: the planner's defaults
+             "planner_options": x.get("planner_options", {}),
+             "max_steps": x.get("max_steps"),
              "frame_budget": x.get("frame_budget"),
              "size": [cam.get("width"), cam.get("height")],
              "render_step_m": x.get("render_step_m"),
@@ -114,7 +120,8 @@ def same_house(logged: str | None, spec: HouseSpec) -> bool:
 
 
 # the settings by their names in messages
-_LABELS = {"episode": "episode", "max_steps": "max steps", "frame_budget": "frame budget",
+_LABELS = {"episode": "episode", "planner_options": "planner options (-O)",
+           "max_steps": "max steps", "frame_budget": "frame budget",
            "size": "resolution", "render_step_m": "render step (m)",
            "turn_render_deg": "turn render angle (deg)", "navigation": "navigation",
            "noise": "noise", "seed": "seed",

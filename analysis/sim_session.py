@@ -114,7 +114,8 @@ def run_search(request: SearchRequest, show: Echo, note: Echo) -> None:
         report = run_episode(request.house, request.episode, planner, request.output,
                              request.options, house_id=request.house_id,
                              episode_index=request.episode_index, overwrite=request.force,
-                             progress=bar, on_decision=live.decision if live else None)
+                             progress=bar, on_decision=live.decision if live else None,
+                             planner_options=request.planner_options)
     _finish(report, live, request.quiet, show, note)
     miss = getattr(planner, "replay_miss", None)
     if miss:  # as `sgtool replay` says it: the episode left the recorded transcript

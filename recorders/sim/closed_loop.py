@@ -85,7 +85,7 @@ import dataclasses
 import math
 import os
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -440,18 +440,22 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                 output: str | os.PathLike[str], options: ClosedLoopOptions | None = None, *,
                 house_id: str = "", episode_index: int = 0,
                 overwrite: bool = False, progress: Progress | None = None,
-                on_decision: Callable[[SceneGraph, Action], None] | None = None
-                ) -> ClosedLoopReport:
+                on_decision: Callable[[SceneGraph, Action], None] | None = None,
+                planner_options: Mapping[str, Any] | None = None) -> ClosedLoopReport:
     """Run one closed-loop search episode into the log ``output`` (module doc) through
     :func:`sgtool.planning.episode.run_search`.
 
-    ``planner`` is built by the caller (:func:`sgtool.planning.registry.make_planner`) and
+    ``planner`` is built by the caller (:func:`sgtool.planning.registry.make_planner`, with
+    ``planner_options``: recorded in the episode records' ``extra.planner_options``, plain
+    values only and secrets left out, so that the log's planner can be built again) and
     closed here (its ``close()``, when it has one) when the episode ends; its LLM
     exchanges, when it keeps them (``drain_exchanges()``, moma-llm), are logged after each
     decision. ``progress`` is anything with ``update(n)`` (a tqdm bar), advanced per
     frame; ``on_decision`` sees every graph and the action chosen on it.
     """
     opts = options or ClosedLoopOptions()
+    recorded = {"planner_options": recorded_options(planner_options)} if planner_options \
+        else {}
     if opts.max_steps < 1:
         raise SgtoolError(f"--max-steps {opts.max_steps}: must be >= 1")
     if opts.frames is not None and opts.frames < 1:
@@ -480,7 +484,8 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
             writer.attach_house(house.to_json())
             writer.write_record(dataclasses.replace(
                 base, steps=0, travelled_m=0.0, shortest_m=shortest, frames=0,
-                extra=_started_extra(opts, sim, mapping, episode, episode_index)), 0)
+                extra=_started_extra(opts, sim, mapping, episode, episode_index)
+                | recorded), 0)
             rec.write_instances(sim)
             skills = None if opts.navigation == "house" else LiveSkills(
                 RobotBody(sim), lambda: stream.current, opts.live,
@@ -505,7 +510,7 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                        "planner_seed": pseed,
                        "episode": int(episode_index), "episode_id": episode.id,
                        "end": end, "n_open": n_open, "mapping": mapping_record(mapping),
-                       **_withheld(search), **_rule(opts)},
+                       **_withheld(search), **_rule(opts), **recorded},
             ), t_end)
             rec.refreshed(stream.finish(t_end))  # as replay ends: only if anything is new
             travelled, frames, refreshes = sim.travelled_m, rec.frames, rec.refreshes
@@ -542,6 +547,18 @@ def _log_exchanges(agent: Any, writer: LogWriter, t_ns: int) -> None:
         return
     for ex in drain():
         writer.write_record(LlmExchange.from_json(ex), t_ns)
+
+
+def recorded_options(options: Mapping[str, Any]) -> dict[str, Any]:
+    """A planner's options as an episode record keeps them: JSON values only (a Python
+    object set from Python, an encoder, is left out), keys named like secrets left out
+    (:func:`sgtool.redact.is_secret_name`), sorted."""
+    from sgtool.redact import is_secret_name
+
+    plain = (str, int, float, bool, type(None))
+    return {k: v for k, v in sorted(options.items())
+            if not is_secret_name(str(k)) and (isinstance(v, plain) or (
+                isinstance(v, list | tuple) and all(isinstance(x, plain) for x in v)))}
 
 
 def _started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOptions,

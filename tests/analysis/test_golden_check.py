@@ -200,8 +200,10 @@ def test_diff_of_derived_logs(log, tmp_path, capsys):
     assert code == 0, out
 
 
-def episode_log(src, dst, planner):
-    """``src`` with Episode records that make it a search episode of ``planner``."""
+def episode_log(src, dst, planner, options=None):
+    """``src`` with Episode records that make it a search episode of ``planner`` (built
+    with ``options``, as the closed loop records them)."""
+    extra = {"planner_options": options} if options else {}
     with LogReader(src) as r, LogWriter(dst, seed=r.seed) as w:
         w.attach_house(r.house_json())
         ids: dict[int, int] = {}
@@ -216,7 +218,8 @@ def episode_log(src, dst, planner):
                                             dict(ch.metadata))
             w.write_raw(ids[ch.id], m.log_time, bytes(m.data), m.sequence, m.publish_time)
             last = max(last, m.log_time)
-        w.write_record(Episode(kind="search", status="failure", query="mug", planner=planner),
+        w.write_record(Episode(kind="search", status="failure", query="mug", planner=planner,
+                               extra=extra),
                        last)
     return dst
 
@@ -230,6 +233,10 @@ def test_a_planner_that_cannot_be_built_here_is_an_error(log, tmp_path, capsys):
     assert code == 2 and not (tmp_path / "g").exists()
     assert "its planner cannot be built here" in err and "PYTHONPATH" in err
     assert "cannot import module 'labmod_not_here'" in err
+    # the planner is built with the options the log records (here one it refuses)
+    ep = episode_log(log, tmp_path / "opts.mcap", "scout", {"delta": -1})
+    code, _, err = sgtool(capsys, "golden", "pin", ep, "--dir", tmp_path / "g2")
+    assert code == 2 and "option delta=-1: must be >= 0" in err
 
 
 def test_episode_logs_pin_the_planners_decisions(log, tmp_path, capsys):

@@ -452,3 +452,20 @@ def test_eval_pairs_actions_with_graph_time_ns(tmp_path) -> None:
     assert done.graph.robot.position == (3.0, 0.0) and done.decided
     res = ep.result()
     assert res.steps == 2 and res.decisions == 2 and res.decision_s == pytest.approx(0.6)
+
+
+def test_the_log_keeps_the_planners_options(house, tmp_path) -> None:
+    """The options a planner was built with go into both episode records (plain values;
+    secrets and Python objects left out), so golden and resume build the same planner."""
+    from sgtool.recorders.sim.closed_loop import recorded_options
+
+    idx, ep = pick_episode(house, index=0)
+    out = tmp_path / "opts.mcap"
+    run_episode(house, ep, make_planner("greedy", max_failures=3), out,
+                ClosedLoopOptions(camera=OPTS.camera, frames=25, turn_render_deg=0.0),
+                planner_options={"max_failures": 3})
+    with LogReader(out) as r:
+        records = [e for _, e in r.records("episode")]
+    assert [e["extra"]["planner_options"] for e in records] == [{"max_failures": 3}] * 2
+    assert recorded_options({"api_key": "sk-1", "encoder": object(), "delta": 0.2,
+                             "rooms": ["a", "b"]}) == {"delta": 0.2, "rooms": ["a", "b"]}
