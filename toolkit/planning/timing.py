@@ -15,6 +15,7 @@ import time
 from sgtool.errors import SgtoolError
 from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.scenegraph.graph import SceneGraph
+from sgtool.vocabulary import SKILLS
 
 # Action's fields in order, as TimedPlanner.decide builds one (else it uses replace)
 _PLAIN = tuple(f.name for f in dataclasses.fields(Action)) == (
@@ -31,7 +32,8 @@ class TimedPlanner:
     """Wraps a planner; ``decide`` returns the action with ``decision_time_s`` filled, and
     raises :class:`PlannerContractError` naming the planner when ``decide`` returns no
     :class:`~sgtool.planning.base.Action` (a plug-in's mistake, caught where it happens),
-    or, for a ``plugin``, when its ``reset``, ``decide`` or ``feedback`` raises."""
+    or, for a ``plugin``, when its ``reset``, ``decide`` or ``feedback`` raises or its
+    action names no skill (:data:`~sgtool.vocabulary.SKILLS`)."""
 
     def __init__(self, inner: Planner, plugin: bool = False) -> None:
         self.inner = inner
@@ -54,6 +56,10 @@ class TimedPlanner:
             raise self._failed("decide", e) from e
         dt = time.perf_counter() - t0
         self.decision_times.append(dt)
+        if self.plugin and isinstance(action, Action) and action.skill not in SKILLS:
+            raise PlannerContractError(
+                f"planner {self.name!r}: decide() returned an Action with skill "
+                f"{action.skill!r}; the skills are {', '.join(SKILLS)}")
         if _PLAIN and type(action) is Action:  # dataclasses.replace without its field walk
             return Action(action.skill, action.target, action.reason, dt, action.scores,
                           action.outcome, action.travelled_m, action.planner, action.step,

@@ -52,6 +52,15 @@ PLUGIN = textwrap.dedent('''
 
         def decide(self, graph):
             raise ZeroDivisionError("no rooms to divide by")
+
+
+    class Flies(GreedyPlanner):
+        """A planner with a skill of its own."""
+
+        def decide(self, graph):
+            from sgtool.planning.base import Action
+
+            return Action("fly", "room:0")
 ''')
 SMALL = ["--houses", "1", "--episodes", "2", "--seeds", "1", "--rooms", "4-5", "--preset",
          "default", "--no-progress"]
@@ -163,6 +172,9 @@ def test_a_plugin_that_raises_in_decide_is_one_line(plugin_dir: Path, tmp_path: 
     assert r.output.strip() == ("sgtool: error: planner 'mymod_cli:Stumbles': decide() raised "
                                 "ZeroDivisionError: no rooms to divide by")
     assert not (tmp_path / "r.mcap").exists()
+    with pytest.raises(SgtoolError, match="'mymod_cli:Flies': decide\\(\\) returned an Action "
+                       "with skill 'fly'; the skills are navigate, open, close, explore, done"):
+        make_planner("mymod_cli:Flies").decide(None)
     greedy = make_planner("greedy")
     monkeypatch.setattr(greedy.inner, "decide", lambda graph: 1 / 0)
     with pytest.raises(ZeroDivisionError):
