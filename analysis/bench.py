@@ -211,6 +211,9 @@ class BenchConfig:
         if llm_files and "moma-llm" not in self.planners:
             raise BenchError("--llm-replay and --llm-transcript are for moma-llm: add it to "
                              "--planners")
+        for name in sorted(set(self.planner_options) - set(self.planners)):  # a typo
+            raise BenchError(f"planner_options: {name!r} is not one of the planners run "
+                             f"({', '.join(self.planners)})")
         if "moma-llm" in self.planners:
             opts = self.planner_options.get("moma-llm", {})
             replay = opts.get("replay")

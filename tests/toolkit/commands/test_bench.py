@@ -247,6 +247,10 @@ def test_config_check_rejects_duplicates():
     with pytest.raises(BenchError, match="a TimedPlanner object, not a name; .* give yours "
                        "as module:Name"):
         BenchConfig(planners=(make_planner("random"), "scout")).check()  # type: ignore[arg-type]
+    with pytest.raises(BenchError, match="planner_options: 'labplaner:Lab' is not one of the "
+                       "planners run"):  # a typo, from Python: the CLI's -O notes it
+        BenchConfig(planners=("labplanner:Lab",),
+                    planner_options={"labplaner:Lab": {"k": 1}}).check()
 
 
 class ScriptedLlm:
