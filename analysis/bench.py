@@ -66,6 +66,11 @@ from sgtool.analysis.bench_houses import (
     load_house_files,
     output_path,
 )
+from sgtool.analysis.bench_planner_checks import (
+    BenchError,
+    check_planner_list,
+    check_planner_options,
+)
 from sgtool.analysis.bench_priors import (
     planner_options_for,
     priors_fingerprint,
@@ -97,7 +102,6 @@ from sgtool.analysis.report import (
 )
 from sgtool.analysis.search_metrics import CostModel, breakdown, cost_models, seen_unseen, summarize
 from sgtool.canonical import strict_json
-from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write, output_folder
 from sgtool.planning.episode import SUCCESS_RULES
 from sgtool.redact import redact_options, redact_text, secret_values
@@ -115,36 +119,6 @@ BENCH_VERSION = "1.0"
 # SymSearch's; the sparse default houses let random succeed too often to separate planners
 # (the counts and rates: docs/experiments/moved-from-docstrings.md).
 DEFAULT_ROOMS: tuple[int, int] = (12, 16)
-
-
-class BenchError(SgtoolError):
-    """A benchmark option that cannot work (unknown planner, bad range, missing transcript)."""
-
-
-def check_planner_list(planners: Sequence[str]) -> None:
-    """``--planners`` of a benchmark (symbolic or closed loop): at least one, each a
-    built-in planner, a registered plug-in or ``module:Name``
-    (:func:`sgtool.planning.registry.check_planner_name`), no two writing their logs into
-    one folder (:func:`~sgtool.planning.registry.planner_file_name`)."""
-    from sgtool.planning.registry import check_planner_name, planner_file_name
-
-    if not planners:
-        raise BenchError("--planners: name at least one planner")
-    folders: dict[str, str] = {}
-    for p in planners:
-        if not isinstance(p, str):  # a planner object, from Python: runs need its name
-            raise BenchError(f"--planners: a {type(p).__name__} object, not a name; a run "
-                             "builds its planners in each worker by name: give yours as "
-                             "module:Name (a class on sys.path), with its options in "
-                             "planner_options")
-        try:
-            check_planner_name(p)
-        except SgtoolError as e:
-            raise BenchError(f"--planners: {e}") from None
-        other = folders.setdefault(planner_file_name(p), p)
-        if other != p:
-            raise BenchError(f"--planners: {other!r} and {p!r} would share the log folder "
-                             f"{planner_file_name(p)!r}")
 
 
 @dataclass(frozen=True)
@@ -207,21 +181,8 @@ class BenchConfig:
         if self.success not in SUCCESS_RULES:
             raise BenchError(f"--success: one of {', '.join(SUCCESS_RULES)}, got "
                              f"{self.success!r}")
-        llm_files = {"replay", "transcript"} & set(self.planner_options.get("moma-llm", {}))
-        if llm_files and "moma-llm" not in self.planners:
-            raise BenchError("--llm-replay and --llm-transcript are for moma-llm: add it to "
-                             "--planners")
-        for name in sorted(set(self.planner_options) - set(self.planners)):  # a typo
-            raise BenchError(f"planner_options: {name!r} is not one of the planners run "
-                             f"({', '.join(self.planners)})")
-        if "moma-llm" in self.planners:
-            opts = self.planner_options.get("moma-llm", {})
-            replay = opts.get("replay")
-            if replay is not None and not Path(replay).is_file():
-                raise BenchError(f"--llm-replay: no such transcript {replay}")
-            if opts.get("transcript") and (self.workers > 1 or self.executor != "local"):
-                raise BenchError("--llm-transcript needs --workers 1 and the local executor "
-                                 "(one file, one writer)")
+        check_planner_options(self.planners, self.planner_options,
+                              one_writer=self.workers == 1 and self.executor == "local")
 
     def models(self) -> tuple[CostModel, CostModel]:
         return cost_models(self.distance_budget, self.step_budget)

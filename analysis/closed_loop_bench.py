@@ -113,7 +113,7 @@ class ClosedLoopBenchConfig:
     all_pairs: bool = False  # paired comparisons of every pair of planners instead
 
     def check(self) -> None:
-        from sgtool.analysis.bench import check_planner_list
+        from sgtool.analysis.bench_planner_checks import check_planner_list
 
         check_planner_list(self.planners)
         if len(set(self.planners)) != len(self.planners) or \

@@ -21,7 +21,8 @@ from typing import Any
 
 from sgtool.errors import SgtoolError, SpecError
 from sgtool.house.spec import HouseSpec
-from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, recorded_options
+from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
+from sgtool.recorders.sim.episode_extras import recorded_options
 from sgtool.recorders.sim.noise import parse_noise
 
 _FIX = ("give a fresh -o folder, --force to run every episode again, or delete the log to "

@@ -86,7 +86,6 @@ import math
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -114,6 +113,7 @@ from sgtool.recorders.sim.closed_loop_options import (  # noqa: F401 (re-exporte
     ClosedLoopOptions,
 )
 from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport
+from sgtool.recorders.sim.episode_extras import recorded_options, started_extra, success_rule
 from sgtool.recorders.sim.execution import Executed, execute_live, execute_privileged
 from sgtool.recorders.sim.fallback_explore import (
     GAVE_UP,
@@ -140,7 +140,6 @@ from sgtool.recorders.sim.skill_plan import (  # noqa: F401 (re-exported)
     plan_skills,
 )
 from sgtool.scenegraph.build_options import (
-    ResolvedOptions,
     builder_config,
     mapping_record,
 )
@@ -484,7 +483,7 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
             writer.attach_house(house.to_json())
             writer.write_record(dataclasses.replace(
                 base, steps=0, travelled_m=0.0, shortest_m=shortest, frames=0,
-                extra=_started_extra(opts, sim, mapping, episode, episode_index)
+                extra=started_extra(opts, sim, mapping, episode, episode_index)
                 | recorded), 0)
             rec.write_instances(sim)
             skills = None if opts.navigation == "house" else LiveSkills(
@@ -510,7 +509,7 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                        "planner_seed": pseed,
                        "episode": int(episode_index), "episode_id": episode.id,
                        "end": end, "n_open": n_open, "mapping": mapping_record(mapping),
-                       **_withheld(search), **_rule(opts), **recorded},
+                       **_withheld(search), **success_rule(opts), **recorded},
             ), t_end)
             rec.refreshed(stream.finish(t_end))  # as replay ends: only if anything is new
             travelled, frames, refreshes = sim.travelled_m, rec.frames, rec.refreshes
@@ -549,43 +548,6 @@ def _log_exchanges(agent: Any, writer: LogWriter, t_ns: int) -> None:
         writer.write_record(LlmExchange.from_json(ex), t_ns)
 
 
-def recorded_options(options: Mapping[str, Any]) -> dict[str, Any]:
-    """A planner's options as an episode record keeps them: JSON values only (a Python
-    object set from Python, an encoder, is left out), keys named like secrets left out
-    (:func:`sgtool.redact.is_secret_name`), sorted."""
-    from sgtool.redact import is_secret_name
-
-    plain = (str, int, float, bool, type(None))
-    return {k: v for k, v in sorted(options.items())
-            if not is_secret_name(str(k)) and (isinstance(v, plain) or (
-                isinstance(v, list | tuple) and all(isinstance(x, plain) for x in v)))}
-
-
-def _started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOptions,
-                   episode: Episode, index: int) -> dict[str, Any]:
-    k = sim.intrinsics
-    return {
-        "mapping": mapping_record(mapping),
-        "episode": int(index), "episode_id": episode.id,
-        "targets": list(episode.targets), "target_rooms": list(episode.target_rooms),
-        "hidden": episode.hidden, "description": episode.description,
-        "seed": opts.planner_seed,
-        "planner_seed": planner_seed(opts.planner_seed, sim.spec.seed, index),
-        "max_steps": opts.max_steps, "frame_budget": opts.frames, "fps": opts.fps,
-        "start_pose": [round(v, 6) for v in sim.base],
-        "start_room": episode.start.room,
-        "camera": asdict(opts.camera),
-        "intrinsics": {"width": k.width, "height": k.height, "fx": k.fx, "fy": k.fy,
-                       "cx": k.cx, "cy": k.cy},
-        "robot": asdict(opts.robot),
-        "navigation": {"mode": opts.navigation, **opts.live.to_dict()},
-        "noise": opts.noise.to_dict(), "noise_seed": opts.noise_seed,
-        "turn_render_deg": opts.turn_render_deg, "render_step_m": opts.render_step_m,
-        "explore_on": opts.explore_on,
-        **_rule(opts),
-    }
-
-
 def _shown(view: SceneGraph, logged: SceneGraph) -> dict[str, Any]:
     """``{"view_distances": ...}`` when the planner was shown ``view`` with other distances
     than the ``logged`` graph's (the Action record's field: an offline replay shows a planner
@@ -606,9 +568,3 @@ def _withheld(search: _Search) -> dict[str, Any]:
     if search.forgot_bumps:
         out["bumps_forgotten"] = search.forgot_bumps
     return out
-
-
-def _rule(opts: ClosedLoopOptions) -> dict[str, str]:
-    """``{"success": "done"}`` under MoMa-LLM's rule; nothing under the default (logs of
-    the default rule stay as they were)."""
-    return {} if opts.success == "observed" else {"success": opts.success}

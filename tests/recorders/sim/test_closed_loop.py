@@ -457,7 +457,7 @@ def test_eval_pairs_actions_with_graph_time_ns(tmp_path) -> None:
 def test_the_log_keeps_the_planners_options(house, tmp_path) -> None:
     """The options a planner was built with go into both episode records (plain values;
     secrets and Python objects left out), so golden and resume build the same planner."""
-    from sgtool.recorders.sim.closed_loop import recorded_options
+    from sgtool.recorders.sim.episode_extras import recorded_options
 
     idx, ep = pick_episode(house, index=0)
     out = tmp_path / "opts.mcap"

@@ -1,0 +1,63 @@
+"""Checks of a benchmark's planners (symbolic or closed loop) and of the options given
+to them, before any episode runs: one :class:`BenchError` line each.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from sgtool.errors import SgtoolError
+
+
+class BenchError(SgtoolError):
+    """A benchmark option that cannot work (unknown planner, bad range, missing transcript)."""
+
+
+def check_planner_list(planners: Sequence[str]) -> None:
+    """``--planners`` of a benchmark (symbolic or closed loop): at least one, each a
+    built-in planner, a registered plug-in or ``module:Name``
+    (:func:`sgtool.planning.registry.check_planner_name`), no two writing their logs into
+    one folder (:func:`~sgtool.planning.registry.planner_file_name`)."""
+    from sgtool.planning.registry import check_planner_name, planner_file_name
+
+    if not planners:
+        raise BenchError("--planners: name at least one planner")
+    folders: dict[str, str] = {}
+    for p in planners:
+        if not isinstance(p, str):  # a planner object, from Python: runs need its name
+            raise BenchError(f"--planners: a {type(p).__name__} object, not a name; a run "
+                             "builds its planners in each worker by name: give yours as "
+                             "module:Name (a class on sys.path), with its options in "
+                             "planner_options")
+        try:
+            check_planner_name(p)
+        except SgtoolError as e:
+            raise BenchError(f"--planners: {e}") from None
+        other = folders.setdefault(planner_file_name(p), p)
+        if other != p:
+            raise BenchError(f"--planners: {other!r} and {p!r} would share the log folder "
+                             f"{planner_file_name(p)!r}")
+
+
+def check_planner_options(planners: Sequence[str], options: Mapping[str, Mapping[str, Any]],
+                          one_writer: bool) -> None:
+    """Options only for planners run (a typo from Python is otherwise silent), and
+    moma-llm's transcripts: a replayed one that exists, a written one with one writer
+    (``one_writer``: one worker on the local executor)."""
+    llm_files = {"replay", "transcript"} & set(options.get("moma-llm", {}))
+    if llm_files and "moma-llm" not in planners:
+        raise BenchError("--llm-replay and --llm-transcript are for moma-llm: add it to "
+                         "--planners")
+    for name in sorted(set(options) - set(planners)):  # a typo
+        raise BenchError(f"planner_options: {name!r} is not one of the planners run "
+                         f"({', '.join(planners)})")
+    if "moma-llm" in planners:
+        opts = options.get("moma-llm", {})
+        replay = opts.get("replay")
+        if replay is not None and not Path(replay).is_file():
+            raise BenchError(f"--llm-replay: no such transcript {replay}")
+        if opts.get("transcript") and not one_writer:
+            raise BenchError("--llm-transcript needs --workers 1 and the local executor "
+                             "(one file, one writer)")
