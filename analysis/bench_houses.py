@@ -140,7 +140,8 @@ def load_house_files(paths: Sequence[str | os.PathLike[str]],
             problems.append(f"{f}: id: house id {hid!r} is already used by {ids[hid]}")
             continue
         ids[hid] = str(f)
-        houses.append(BenchHouse(hid, str(f), spec=spec, notes=house_notes(house)))
+        notes = house_notes(house) + completion_notes(f, spec)
+        houses.append(BenchHouse(hid, str(f), spec=spec, notes=notes))
     if problems:
         raise HouseFilesError("\n".join(problems))
     return tuple(houses)
@@ -205,6 +206,26 @@ def house_notes(house: Any) -> tuple[str, ...]:
         return ()
     return (f"{', '.join(cut)}: no door or passage leads there from the rest of the house; "
             "a search for a target inside starts there, any other outside",)
+
+
+def completion_notes(path: Path, spec: HouseSpec) -> tuple[str, ...]:
+    """What the loader added to the file at ``path`` (``spec`` is what it loaded): the
+    categories whose pieces it reads as supporters
+    (:func:`sgtool.house.nesting.with_supporters`), found by comparing the two."""
+    try:
+        raw: Any = json.loads(path.read_text(encoding="utf-8"))
+        given = {str(x["id"]): set(x.get("affordances") or ())
+                 for part in ("furniture", "objects") for x in raw.get(part) or ()}
+    except (OSError, ValueError, TypeError, KeyError, AttributeError):
+        return ()
+    pieces = [(f.id, f.category, f.affordances) for f in spec.furniture] + \
+        [(o.id, o.category, o.affordances) for o in spec.objects]
+    added = sorted({cat for pid, cat, aff in pieces
+                    if "supporter" in aff and "supporter" not in given.get(pid, {"supporter"})})
+    if not added:
+        return ()
+    return (f"read as supporters, with something on top and no 'supporter' in the file: "
+            f"{', '.join(added)}",)
 
 
 MAX_NAME_BYTES = 255  # a file-name component on common file systems (NAME_MAX)
