@@ -33,6 +33,7 @@ if TYPE_CHECKING:
 @click.command("eval")
 @click.argument("inputs", nargs=-1, required=True, type=click.Path())
 @click.option("-p", "--planner", "planners", multiple=True, metavar="NAME[,NAME]",
+              is_eager=True,
               help="Also ask these planners at every logged decision point (MCAP logs with "
                    "scene graphs) and compare their choices with what was done (repeatable "
                    "or comma-separated). " + PLUGIN_HELP)

@@ -243,13 +243,19 @@ def list_planners_option() -> Callable[[F], F]:
             return
         from sgtool.planning.registry import describe_planners
 
-        click.echo(describe_planners())
+        given: list[str] = []  # the planners named before --list-planners (eager options)
+        for key in ("planners", "planner"):
+            v = ctx.params.get(key)
+            for text in (v,) if isinstance(v, str) else (v or ()):
+                given += planner_names(text)
+        click.echo(describe_planners(given))
         ctx.exit(0)
 
     return click.option("--list-planners", is_flag=True, expose_value=False, is_eager=True,
                         callback=show,
                         help="List the planners, their options (name, type, default, help) "
-                        "and the installed plug-ins, then exit.")
+                        "and the installed plug-ins, then exit; a module:Name plug-in named "
+                        "before it (--planners mymod:My --list-planners) with its options.")
 
 
 PLANNER_OPTION_HELP = ("Planner option PLANNER.KEY=VALUE, e.g. scout.delta=0.2 or "

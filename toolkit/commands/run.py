@@ -40,7 +40,7 @@ if TYPE_CHECKING:
 
 
 @click.command("run")
-@click.option("--planner", "-p", required=True,
+@click.option("--planner", "-p", required=True, is_eager=True,
               help="The planner: a built-in (--list-planners shows them all with their "
               "options: scout, voi, bayes-search, moma-llm, ...). " + PLUGIN_HELP)
 @list_planners_option()

@@ -38,7 +38,7 @@ if TYPE_CHECKING:
 
 
 @click.command("run-bench")
-@click.option("--planners", default=None, metavar="LIST",
+@click.option("--planners", default=None, metavar="LIST", is_eager=True,
               help=PLANNERS_HELP + PLUGIN_HELP)
 @list_planners_option()
 @click.option("--houses", type=click.IntRange(min=0), default=None,

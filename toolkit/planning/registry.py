@@ -12,7 +12,7 @@ Every planner comes wrapped in :class:`~sgtool.planning.timing.TimedPlanner` (op
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
@@ -362,9 +362,22 @@ def _build(name: str, entry: Entry, options: dict[str, Any]) -> Planner:
             f"not fit ({type(e).__name__}: {e})") from e
 
 
-def describe_planners() -> str:
+def _plugin_lines(name: str) -> list[str]:
+    """A plug-in's line and its options' (from its ``Options`` dataclass), or why not."""
+    try:
+        cls = options_of(name)
+    except SgtoolError as e:
+        return [f"{name}: {e}"]
+    if cls is None:
+        return [f"{name}: a plug-in without an Options dataclass (its -O values are passed "
+                "as int, float, true/false or text)"]
+    return [f"{name}: a plug-in", *(f"    {info.line()}" for info in option_infos(cls))]
+
+
+def describe_planners(plugins_named: Sequence[str] = ()) -> str:
     """Every built-in planner with its summary and options (name, kind, default, help),
-    the options every planner takes, and the plug-ins installed packages register."""
+    the options every planner takes, the plug-ins installed packages register, and the
+    options of the plug-ins in ``plugins_named`` (``module:Name``, imported here)."""
     lines = ["Planners (-O PLANNER.KEY=VALUE sets an option; '(Python only)' options are "
              "for make_planner):", ""]
     for name, entry in REGISTRY.items():
@@ -383,6 +396,8 @@ def describe_planners() -> str:
     for ep_name, ep in sorted(found.items()):
         shadow = " (shadowed by the built-in planner)" if ep_name.lower() in REGISTRY else ""
         lines.append(f"    {ep_name} = {ep.value}{shadow}")
+    for name in dict.fromkeys(n for n in plugins_named if n.lower() not in REGISTRY):
+        lines += ["", *_plugin_lines(name)]
     lines.append("")
     lines.append("module:Name (e.g. mypkg.planners:MyPlanner): a class or factory importable "
                  "here (PYTHONPATH; with Ray, on every machine of the cluster), called with "

@@ -294,3 +294,15 @@ def test_an_api_key_of_the_group_is_never_written(tmp_path: Path,
         if p.suffix in (".md", ".json", ".jsonl"):
             assert key not in p.read_text(), p.name
     assert "--llm-api-key '<redacted>'" in (out / "run.md").read_text()
+
+
+@pytest.mark.parametrize("command", [["bench", "--planners"], ["run", "-p"], ["eval", "-p"]])
+def test_list_planners_describes_a_plugin_named_before_it(
+        plugin_dir: Path, monkeypatch: pytest.MonkeyPatch, command: list[str]) -> None:
+    monkeypatch.syspath_prepend(str(plugin_dir))
+    r = CliRunner().invoke(cli, [*command, "mymod_cli:MyPlanner", "--list-planners"])
+    assert r.exit_code == 0, r.output
+    assert ("mymod_cli:MyPlanner: a plug-in without an Options dataclass (its -O values are "
+            "passed as int, float, true/false or text)") in r.output
+    r = CliRunner().invoke(cli, [*command, "nomod_cli:X", "--list-planners"])
+    assert r.exit_code == 0 and "nomod_cli:X: planner 'nomod_cli:X': cannot import" in r.output
