@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -107,16 +107,18 @@ def folder_note(path: Path, folder: Path) -> str:
 
 
 def load_house_files(paths: Sequence[str | os.PathLike[str]],
-                     taken: Iterable[str] = ()) -> tuple[BenchHouse, ...]:
+                     taken: Iterable[str] | Mapping[str, str] = ()) -> tuple[BenchHouse, ...]:
     """Load and check every house file (module doc); ``taken`` are ids already in the run
-    (the generated houses). Raises :class:`HouseFilesError` listing every problem."""
+    (the generated houses; a mapping: id -> what holds it, as a message names it). Raises
+    :class:`HouseFilesError` listing every problem."""
     from sgtool.house.io import load_house
 
     files = _house_sources(paths)
     problems = [f"{p}: no *.json house files there" for p in map(Path, paths)
                 if p.is_dir() and not folder_houses(p)]
     houses: list[BenchHouse] = []
-    ids = {i: "a generated house" for i in taken}
+    ids = dict(taken) if isinstance(taken, Mapping) else \
+        {i: "a generated house" for i in taken}
     for f, folder in files:
         try:
             spec = load_house(f)
@@ -151,12 +153,15 @@ def check_house_files(paths: Sequence[str | os.PathLike[str]]) -> tuple[list[str
     """The checks of a bench run (:func:`load_house_files`) file by file: one line per
     house file (``ok FILE: id, counts`` and its notes, or the problem) and whether every
     file passed, ids across files included."""
-    lines: list[str] = []
-    good: list[Path] = []
-    for f, _ in _house_sources(paths):
+    empty = [f"error {p}: no *.json house files there" for p in map(Path, paths)
+             if p.is_dir() and not folder_houses(p)]
+    lines = list(empty)
+    ids: dict[str, str] = {}  # the ids of the files that passed, each loaded once
+    sources = _house_sources(paths)
+    for f, _ in sources:
         try:
-            (h,) = load_house_files([f])
-        except HouseFilesError as e:
+            (h,) = load_house_files([f], taken=ids)
+        except HouseFilesError as e:  # its own problem, or an id an earlier file holds
             lines.extend(f"error {line}" for line in str(e).splitlines())
             continue
         spec = h.spec
@@ -167,15 +172,8 @@ def check_house_files(paths: Sequence[str | os.PathLike[str]]) -> tuple[list[str
             (len(spec.objects), "small object(s)"), (queries, "query category(ies)")))
         lines.append(f"ok {f}: {h.id}: {counts}")
         lines.extend(f"   note: {n}" for n in h.notes)
-        good.append(f)
-    ok = len(good) == len(_house_sources(paths))
-    if ok and len(good) > 1:
-        try:
-            load_house_files(good)
-        except HouseFilesError as e:  # the same id in two files
-            lines.extend(f"error {line}" for line in str(e).splitlines())
-            ok = False
-    return lines, ok
+        ids[h.id] = str(f)
+    return lines, len(ids) == len(sources) and not empty
 
 
 def symbolic_house_problem(spec: HouseSpec, where: str | os.PathLike[str]) -> str | None:

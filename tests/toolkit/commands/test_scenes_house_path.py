@@ -75,6 +75,9 @@ def test_check_names_every_file_with_its_verdict(tmp_path: Path) -> None:
     assert r.output.splitlines()[-1] == "sgtool: error: 1 problem(s) in the house files above"
     r = CliRunner().invoke(cli, ["scenes", "check", str(good), str(good)])  # one id twice
     assert r.exit_code == 2 and "already used" in r.output
+    (tmp_path / "none").mkdir()
+    r = CliRunner().invoke(cli, ["scenes", "check", str(tmp_path / "none")])
+    assert r.exit_code == 2 and f"error {tmp_path / 'none'}: no *.json house files" in r.output
     bare = two_rooms()
     bare["furniture"][1]["affordances"] = []  # the table the cup lies on
     bare_file = _write(tmp_path / "bare.json", bare)
