@@ -168,9 +168,7 @@ def _request(args: NoiseArgs) -> NoiseStudyRequest:
                                   episodes=args.episodes, noise=cfg.closed_loop.noise
                                   ).check()
         except SgtoolError as e:
-            text = str(e)
-            raise SgtoolError("--closed-loop" + text[len("--planners"):]
-                              if text.startswith("--planners") else text) from None
+            raise _renamed(e, "--planners", "--closed-loop") from None
     cache = Path(args.cache_dir) if args.cache_dir else default_cache()
     if cache.exists() and not cache.is_dir():
         raise SgtoolError(f"--cache {cache}: is a file, not a folder")
@@ -202,6 +200,13 @@ def _conditions(factors: tuple[str, ...], profiles: tuple[str, ...]) -> Any:
     return conditions_of(chosen, profile_list)
 
 
+def _renamed(e: SgtoolError, theirs: str, ours: str) -> SgtoolError:
+    """``e`` with the option its message starts with (another command's, ``theirs``)
+    named as this command calls it (``ours``)."""
+    text = str(e)
+    return SgtoolError(ours + text[len(theirs):] if text.startswith(theirs) else text)
+
+
 def _closed_loop(args: NoiseArgs) -> Any:
     """The closed-loop settings: ``--closed-loop`` planners under each
     ``--closed-loop-noise`` profile (each parsed)."""
@@ -214,9 +219,7 @@ def _closed_loop(args: NoiseArgs) -> Any:
         try:
             parse_noise(n)
         except SgtoolError as e:  # its message names `record`'s --noise
-            text = str(e)
-            raise SgtoolError("--closed-loop-noise" + text[len("--noise"):]
-                              if text.startswith("--noise") else text) from None
+            raise _renamed(e, "--noise", "--closed-loop-noise") from None
     if args.closed_loop is not None and not planners:
         raise SgtoolError("--closed-loop: give at least one planner")
     if planners and not cl_noise:
