@@ -197,13 +197,26 @@ def symbolic_house(spec: HouseSpec, where: str | os.PathLike[str]) -> tuple[Any,
 
 
 def house_notes(house: Any) -> tuple[str, ...]:
-    """What a user should know of a house that loads: rooms walled off from the rest (their
-    targets are searched from inside, the others' from outside)."""
+    """What a user should know of a house that loads: doors furniture blocks (read as
+    walls), rooms walled off from the rest (their targets are searched from inside, the
+    others' from outside)."""
+    from sgtool.recorders.symbolic_environment.doorways import doorway_pieces
+
+    spec = house.spec
+    notes = []
+    for di in sorted(house.blocked_doors):
+        d = spec.doors[di]
+        near = doorway_pieces(spec, d, 1.0)
+        notes.append(f"{d.id} ({' - '.join(d.rooms)}): the robot (radius "
+                     f"{house.robot_radius:g} m) cannot get through it from one room's free "
+                     "floor to the other's (" + (f"furniture within 1 m: {', '.join(near)}"
+                                                 if near else "too narrow") +
+                     "); read as a wall")
     cut = house.isolated_rooms()
-    if not cut:
-        return ()
-    return (f"{', '.join(cut)}: no door or passage leads there from the rest of the house; "
-            "a search for a target inside starts there, any other outside",)
+    if cut:
+        notes.append(f"{', '.join(cut)}: no door or passage leads there from the rest of "
+                     "the house; a search for a target inside starts there, any other outside")
+    return tuple(notes)
 
 
 def completion_notes(path: Path, spec: HouseSpec) -> tuple[str, ...]:

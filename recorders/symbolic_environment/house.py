@@ -20,6 +20,8 @@ re-rasterising, they are computed once on the grid with every door closed (each 
 open-plan group, its own component) between all places, plus one place each side of every
 door; an open door joins its two side places with an edge of their straight-line length.
 Travel distance is then the shortest path on that place graph for the current door states.
+A door whose doorway furniture blocks (:mod:`~sgtool.recorders.symbolic_environment.doorways`)
+joins nothing: it is read as a wall, and not offered.
 A nested object's place is its furniture's (the piece at the bottom of its chain of
 parents); a room's is its nearest region's; a door's is its nearer side.
 """
@@ -45,6 +47,7 @@ from sgtool.mapping.occupancy import (
     house_occupancy,
     world_to_cell,
 )
+from sgtool.recorders.symbolic_environment.doorways import blocked_doors
 from sgtool.recorders.symbolic_environment.furniture_regions import cluster_regions
 from sgtool.scenegraph.examined import EXAMINE, examinable
 from sgtool.scenegraph.graph import ObjectNode
@@ -91,6 +94,7 @@ class SymbolicHouse:
     def __init__(self, spec: HouseSpec, resolution: float = 0.05, robot_radius: float = 0.2):
         self.spec = spec
         self.resolution = resolution
+        self.robot_radius = robot_radius
         closed = dataclasses.replace(
             spec, doors=tuple(dataclasses.replace(d, state="closed") for d in spec.doors))
         self.occ: OccupancyMap = house_occupancy(closed, resolution=resolution,
@@ -105,7 +109,7 @@ class SymbolicHouse:
         # one position tuple per item, shared by the nodes of its states (so a planner's
         # per-episode object table sees a state change as the same row)
         self._positions: dict[tuple[str, int], tuple[float, float, float]] = {}
-        self._walkable_rooms()
+        self._walkable_rooms()  # sets self.blocked_doors too
         self.places: list[tuple[float, float]] = []
         self.place_room: list[int] = []
         # furniture
@@ -143,6 +147,8 @@ class SymbolicHouse:
         # neighbours: (other room, door index or None for a passage)
         self.links: list[list[tuple[int, int | None]]] = [[] for _ in spec.rooms]
         for di, d in enumerate(spec.doors):
+            if di in self.blocked_doors:  # furniture in the doorway: a wall
+                continue
             a, b = (self.room_index[r] for r in d.rooms)
             self.links[a].append((b, di))
             self.links[b].append((a, di))
@@ -211,6 +217,9 @@ class SymbolicHouse:
             lab, n = ndimage.label(free & (raster == ri))
             walks.append(lab == (1 + int(np.argmax(np.bincount(lab.ravel())[1:])))
                          if n else None)
+        open_occ = house_occupancy(self.spec, resolution=self.resolution,
+                                   robot_radius=self.robot_radius, closed_doors_free=True)
+        self.blocked_doors = frozenset(blocked_doors(self.spec, open_occ, raster, walks))
         self._snap: list[tuple[tuple[slice, slice], np.ndarray, np.ndarray] | None] = []
         for ri, walk in enumerate(walks):
             if walk is None:  # a niche the robot does not fit in: seen from the next room
@@ -221,7 +230,8 @@ class SymbolicHouse:
     def _neighbours(self, ri: int) -> list[int]:
         """Rooms joined to room ``ri`` by a door or passage, ascending."""
         rid = self.spec.rooms[ri].id
-        links = [d.rooms for d in self.spec.doors] + [p.rooms for p in self.spec.passages]
+        links = [d.rooms for di, d in enumerate(self.spec.doors)
+                 if di not in self.blocked_doors] + [p.rooms for p in self.spec.passages]
         return sorted({self.room_index[r] for pair in links if rid in pair
                        for r in pair if r != rid})
 
@@ -277,7 +287,7 @@ class SymbolicHouse:
         if g is None:
             w = self._base.copy()
             np.fill_diagonal(w, np.inf)
-            for di in sorted(open_doors):
+            for di in sorted(open_doors - self.blocked_doors):
                 a, b = self.door_sides[di]
                 d = math.dist(self.places[a], self.places[b])
                 w[a, b] = w[b, a] = min(w[a, b], max(d, 1e-6))
