@@ -61,8 +61,9 @@ at every refresh; a goal its map cannot reach is a failed skill whose reason goe
 planner) and reaches the simulator only through a
 :class:`~sgtool.recorders.sim.live_skills.RobotBody` (motion with contacts, opening and
 closing). When the graph offers the planner nothing actionable (a cluttered start room
-leaves no room, region or frontier node) or the planner gives up while the robot's map
-still has reachable grid frontiers, the robot explores those on its own until the graph
+leaves no room, region or frontier node), or the planner gives up when every goal on offer
+has failed before in the episode, while the robot's map still has reachable grid
+frontiers, the robot explores those on its own until the graph
 offers something new (:mod:`sgtool.recorders.sim.fallback_explore`: ``explore`` actions
 with reason ``fallback: ...``, decided on no graph; their frames and metres count, they
 are no steps). An ``explore`` of the planner that succeeds but leaves no object, door or
@@ -85,7 +86,7 @@ import dataclasses
 import math
 import os
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -183,6 +184,14 @@ def pick_episode(house: HouseSpec, query: str | None = None, index: int | None =
 # ----------------------------------------------------------------------------------------
 # one episode
 # ----------------------------------------------------------------------------------------
+def give_up_handed_over(offered: Iterable[str], failed: Collection[str]) -> bool:
+    """Whether a planner's give-up goes to the robot's own exploration (module doc): every
+    goal on offer when it gave up (``offered``) had failed before in the episode
+    (``failed``), so the give-up is the map's, not the planner's choice; otherwise done()
+    ends the episode."""
+    return all(n in failed for n in offered)
+
+
 class _Search:
     """The closed loop as a :class:`~sgtool.planning.episode.SearchEnvironment` and its
     :class:`~sgtool.planning.episode.SearchRecorder`: the graph in force is observed, an
@@ -213,6 +222,7 @@ class _Search:
         self.withheld: dict[str, int] = {}  # reason -> nodes withheld, summed over decisions
         self.forgot_bumps = 0  # times the bump marks were dropped (they walled off all)
         self._seen: SceneGraph | None = None  # the graph the planner saw last
+        self._failed_ever: set[str] = set()  # goals a skill failed on in this episode
         self._withheld_now: dict[str, str] = {}
         # the robot's own exploration when the graph offers nothing (live navigation only)
         self.fallback = None if skills is None else Fallback(skills, self._log_fallback,
@@ -332,7 +342,7 @@ class _Search:
         cut = False
         o: Outcome
         if plan.done and action.target is None and self.fallback is not None and \
-                self.fallback.can_explore():
+                self._all_failed(self._seen) and self.fallback.can_explore():
             return self._give_up_handed_over(action, self._seen or cur.graph)
         if plan.done:
             o, why, dist, ticks = "success", DONE_MESSAGE, 0.0, 0
@@ -344,6 +354,8 @@ class _Search:
             o, why, dist, ticks, cut = ex.outcome, ex.reason, ex.travelled_m, ex.ticks, ex.cut
             if action.skill == "open" and o == "success":
                 self.n_open += 1
+            if o == "failure" and action.target is not None:
+                self._failed_ever.add(str(action.target))
             if o == "failure" and not cut and action.target is not None:
                 self.failed.failed(action.target)  # not offered again from the same place
             elif o == "success" and not cut and action.skill == "navigate" and \
@@ -395,6 +407,8 @@ class _Search:
                                        ex.travelled_m, ex.ticks), dt,
                 {"graph_time_ns": int(cur.time_ns), **_shown(only, cur.graph)})
             self.agent.feedback(Feedback(action, ex.outcome, ex.reason, ex.travelled_m))
+            if ex.outcome == "failure":
+                self._failed_ever.add(str(action.target))
             if ex.outcome == "failure" and not ex.cut:
                 self.failed.failed(str(action.target))
             self._check(self.rec.stream.current, ex.cut)
@@ -404,6 +418,11 @@ class _Search:
             assert now is not None
             graph = self._view(now)
         return graph
+
+    def _all_failed(self, graph: SceneGraph | None) -> bool:
+        """:func:`give_up_handed_over` of the planner's last view."""
+        offered = () if graph is None else [c.node_id for c in actionable(graph)]
+        return give_up_handed_over(offered, self._failed_ever)
 
     def _give_up_handed_over(self, action: Action, graph: SceneGraph) -> Feedback:
         """The planner gave up but the robot's map has reachable frontiers: the give-up is

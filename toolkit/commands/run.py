@@ -124,7 +124,10 @@ def command(**given: Any) -> None:
     The episode starts with a look around; it succeeds as soon as the scene graph holds an
     object of the query category (as in the symbolic benchmark, no done() needed; with
     `--success done` the planner must then call done() on it), and fails on done(), after
-    --max-steps steps or when the --frames budget is spent.
+    --max-steps steps or when the --frames budget is spent. (When the graph offers
+    nothing, or the planner gives up after every goal on offer failed, the robot explores
+    its map's frontiers on its own, logged as fallback actions, until the graph offers
+    something new.)
 
     Everything goes into one log: sensors, instance tables, the derived map layers and
     scene graphs, every action (outcome, reason, distance, decision time, the graph it was

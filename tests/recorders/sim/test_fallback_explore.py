@@ -6,8 +6,8 @@ condition of a cluttered start room: no room, region or frontier node, reproduce
 emptying the scene graphs built near the start) ends at step 1 without the fallback and
 reaches a room with it, the fallback's actions logged as ``explore`` of grid frontiers
 with reason "fallback: no actionable node", decided on no graph, their frames and metres
-counted; a planner that gives up while the map has reachable frontiers hands over to the
-fallback, which stops as soon as the graph offers a node it did not offer before, and that
+counted; a planner that gives up with goals on offer ends the episode; one that gives up
+after every goal on offer failed (made so) hands over to the fallback, which stops as soon as the graph offers a node it did not offer before, and that
 episode's log replays into the same scene graphs byte for byte; the fallback is
 deterministic and uses the robot's side only (the true map made to raise); with no grid
 frontier it goes to open edges of the robot's map.
@@ -121,7 +121,26 @@ def test_empty_first_graph_reaches_a_room_with_the_fallback(house, tmp_path,
     assert again.steps > 1 and again.end != "gave_up" or again.success
 
 
-def test_giving_up_with_frontiers_left_hands_over(house, tmp_path) -> None:
+def test_giving_up_with_goals_on_offer_ends_the_episode(house, tmp_path) -> None:
+    """done() while the graph offers goals that never failed is the planner's choice: the
+    episode ends (no exploration on the planner's behalf)."""
+    idx, ep = _open_start(house)
+    p = Scripted([lambda g: Action("done")] * 40)
+    out = tmp_path / "gave_up.mcap"
+    rep = run_episode(house, ep, p, out, OPTS, episode_index=idx)
+    assert actionable(p.graphs[0])
+    assert (rep.success, rep.end, rep.steps) == (False, "gave_up", 1)
+    acts = _actions(out)
+    assert acts[-1]["reason"] == cl.DONE_MESSAGE
+    assert not any(is_fallback(a.get("reason")) for a in acts)
+    assert cl.give_up_handed_over(["room:1"], {"room:1", "door:2"})
+    assert not cl.give_up_handed_over(["room:1", "door:2"], {"room:1"})
+
+
+def test_giving_up_after_every_goal_failed_hands_over(house, tmp_path,
+                                                      monkeypatch) -> None:
+    """Every goal on offer failed before (made so here): the give-up is handed over."""
+    monkeypatch.setattr(cl, "give_up_handed_over", lambda offered, failed: True)
     idx, ep = _open_start(house)
     p = Scripted([Action("done")] + [lambda g: Action("done")] * 40)
     out = tmp_path / "gave_up.mcap"
@@ -159,6 +178,8 @@ def test_giving_up_with_frontiers_left_hands_over(house, tmp_path) -> None:
 def test_fallback_uses_the_robot_side_only(house, tmp_path, monkeypatch) -> None:
     """The hand-over runs with the simulator's ground truth made to raise."""
     from sgtool.recorders.sim.simulation import Simulation
+
+    monkeypatch.setattr(cl, "give_up_handed_over", lambda offered, failed: True)
 
     idx, ep = _open_start(house)
 
@@ -294,7 +315,7 @@ def test_bump_marks_that_wall_off_every_goal_are_forgotten(house, tmp_path,
     assert rep.end == "gave_up" and not actionable(p.graphs[1])
     assert "bumps_forgotten" not in extra
     rep, p, extra = ends[True]  # the marks dropped: the goals are on offer again
-    assert rep.end != "gave_up" and actionable(p.graphs[1])
+    assert actionable(p.graphs[1])  # (its done() on them then ends the episode)
     assert extra["bumps_forgotten"] == 1
 
 
@@ -342,6 +363,7 @@ def test_with_no_grid_frontier_the_hand_over_goes_to_open_edges(house, tmp_path,
     from sgtool.recorders.sim import fallback_explore as fe
 
     monkeypatch.setattr(fe, "next_frontier", lambda *a, **k: None)
+    monkeypatch.setattr(cl, "give_up_handed_over", lambda offered, failed: True)
     idx, ep = _open_start(house)
     out = tmp_path / "edges.mcap"
     rep = run_episode(house, ep, Scripted([lambda g: Action("done")] * 40), out, OPTS,
