@@ -237,8 +237,9 @@ def _lens_distortion(idx: BagIndex, opts: BagOptions, k: CameraIntrinsics,
 
 
 def _scale(raw: np.ndarray, scale: float, opts: BagOptions) -> float:
-    """Units per metre of a decoded depth image: --depth-scale for 16-bit images."""
-    return opts.depth_scale if opts.depth_scale and raw.dtype == np.uint16 else scale
+    """Units per metre of a decoded depth image: --depth-scale when given (16-bit or float
+    depth alike), else the encoding's."""
+    return opts.depth_scale if opts.depth_scale else scale
 
 
 def _scale_origin(idx: BagIndex, opts: BagOptions) -> tuple[str, str]:
@@ -247,7 +248,7 @@ def _scale_origin(idx: BagIndex, opts: BagOptions) -> tuple[str, str]:
     if not raws:
         return "-", "no depth"
     raw, scale = raws[0]
-    if opts.depth_scale is not None and raw.dtype == np.uint16:
+    if opts.depth_scale is not None:
         return f"{opts.depth_scale:g} units/m", "flag --depth-scale"
     if raw.dtype == np.uint16:
         return f"{scale:g} units/m", "the image encoding: 16-bit depth is millimetres in ROS"

@@ -85,7 +85,7 @@ def decode_frames(
                     f"topic {c.topic}: a depth image of {raw_d.shape[1]}x{raw_d.shape[0]} "
                     f"pixels; the camera info says {k.width}x{k.height}"
                 )
-            if opts.depth_scale is not None and raw_d.dtype == np.uint16:
+            if opts.depth_scale is not None:
                 scale = opts.depth_scale
             decoded.setdefault(targets, {})["depth"] = (raw_d, scale)
         else:

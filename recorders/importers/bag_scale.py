@@ -46,7 +46,7 @@ def bag_scale_fit(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
         if count in need:
             a, scale = decode_depth_message(reader.deserialize(raw, c.msgtype),
                                             B.normalise_type(c.msgtype), c.topic)
-            s = opts.depth_scale if opts.depth_scale and a.dtype == np.uint16 else scale
+            s = opts.depth_scale if opts.depth_scale else scale
             got[count] = depth_to_metres(a, s)
             if len(got) == len(need):
                 break

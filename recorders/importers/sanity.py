@@ -154,16 +154,17 @@ def fitting_scales(raw: Sequence[np.ndarray], scale: float) -> list[tuple[float,
 
 
 def depth_scale_problem(raw: Sequence[np.ndarray], scale: float, origin: str) -> str | None:
-    """The problem of reading 16-bit ``raw`` depth at ``scale`` units per metre (which came
-    from ``origin``: a flag, a layout default), naming the scales that fit; None when the
-    depth looks indoor or is not 16-bit integers (metres need no scale)."""
-    ints = [a for a in raw if np.asarray(a).dtype.kind in "ui"]
-    if not ints:
+    """The problem of reading ``raw`` depth (16-bit integers, or floats: 32FC1 is metres
+    unless a scale was given) at ``scale`` units per metre (which came from ``origin``: a
+    flag, a layout default, the encoding), naming the scales that fit; None when the depth
+    looks indoor."""
+    raw = [np.asarray(a) for a in raw if np.asarray(a).dtype.kind in "uif"]
+    if not raw:
         return None
-    s = depth_stats(ints, scale)
+    s = depth_stats(raw, scale)
     if s.valid == 0 or depth_plausible(s):
         return None
-    fits = fitting_scales(ints, scale)
+    fits = fitting_scales(raw, scale)
     if fits:
         k, fs = fits[0]
         fix = (f"--depth-scale {k:g} fits (median {fs.median_m:.2f} m); give it, or "

@@ -44,9 +44,11 @@ def write_frames_bag(
     topics: BagTopics | None = None,
     rgb_format: str = "raw",  # raw | jpg | png
     tf: bool = True,
+    depth_units: float | None = None,
 ) -> int:
     """Write sgtool frames as a bag (see the module docstring); returns the frame count.
-    ``tf=False`` leaves the poses out (a camera recorded alone)."""
+    ``tf=False`` leaves the poses out (a camera recorded alone); ``depth_units`` writes the
+    depth as 32FC1 floats in that many units per metre (1: metres; default: 16UC1 mm)."""
     tp = topics or BagTopics()
     n = 0
     with BagWriter(out, fmt) as w:
@@ -57,8 +59,12 @@ def write_frames_bag(
                         w.tf(t, [w.transform_stamped(t, tp.world, tp.camera, fr.pose)]))
             w.write(tp.info, "sensor_msgs/msg/CameraInfo", t,
                     w.camera_info(t, tp.camera, fr.intrinsics))
-            w.write(tp.depth, "sensor_msgs/msg/Image", t,
-                    w.image(t, tp.camera, depth_to_mm(fr.depth), "16UC1"))
+            if depth_units is None:
+                w.write(tp.depth, "sensor_msgs/msg/Image", t,
+                        w.image(t, tp.camera, depth_to_mm(fr.depth), "16UC1"))
+            else:
+                d = depth_to_mm(fr.depth).astype("<f4") * float(depth_units / 1000.0)
+                w.write(tp.depth, "sensor_msgs/msg/Image", t, w.image(t, tp.camera, d, "32FC1"))
             if fr.rgb is not None:
                 if rgb_format == "raw":
                     w.write(tp.rgb, "sensor_msgs/msg/Image", t,

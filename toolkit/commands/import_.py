@@ -116,8 +116,8 @@ _common_options = option_group([
                  help="Camera intrinsics 'fx,fy,cx,cy' in pixels, or a file (Open3D JSON "
                  "or a 3x3 matrix as text); overrides what the source says."),
     click.option("--depth-scale", type=float, default=None,
-                 help="Raw 16-bit depth units per metre (default: 1000 for bags and "
-                 "7-Scenes/Open3D, 5000 for TUM)."),
+                 help="Raw depth units per metre (default: 16-bit depth 1000 for bags "
+                 "and 7-Scenes/Open3D, 5000 for TUM; 32FC1 float depth 1, metres)."),
     click.option("--max-dt", type=float, default=0.02, show_default=True,
                  help="Largest time difference (s, at most 60) when pairing colour (and ids) "
                  "with a depth image. Colour of another size than the depth is resized to it "

@@ -435,3 +435,27 @@ def test_bag_depth_scale_must_be_positive(tmp_path, scale):
     assert r.exit_code == 2 and "Traceback" not in r.output
     assert "give the raw depth units per metre" in r.output, r.output
     assert not out.exists()
+
+
+def test_float_depth_in_millimetres_is_refused_and_scaled(tmp_path):
+    """32FC1 depth is metres in ROS; a bag whose floats are millimetres is refused with the
+    scale that fits (as 16-bit depth of a wrong scale is), and --depth-scale 1000 reads it
+    as the millimetres of the source, bit for bit: never a log of zeroed depth."""
+    src = write_sgtool_log(tmp_path / "src.mcap")
+    mm = bag_path(tmp_path, "ros2-mcap")
+    write_log_as_bag(src, mm, "ros2-mcap", depth_units=1000.0)
+    out = tmp_path / "mm.mcap"
+    with pytest.raises(SgtoolError, match=r"32FC1 depth is metres\) looks wrong.*"
+                                          r"--depth-scale 1000 fits"):
+        import_bag(mm, out, BagOptions(**TOPICS, **KEEP_WORLD))
+    assert not out.exists()
+    rep = import_bag(mm, out, BagOptions(**TOPICS, **KEEP_WORLD, depth_scale=1000.0))
+    assert rep.frames == 8
+    metres = bag_path(tmp_path, "ros2-mcap", "m")
+    write_log_as_bag(src, metres, "ros2-mcap", depth_units=1.0)  # 32FC1 in metres: as is
+    back = tmp_path / "m.mcap"
+    import_bag(metres, back, BagOptions(**TOPICS, **KEEP_WORLD))
+    with LogReader(src) as a, LogReader(out) as b, LogReader(back) as c:
+        for x, y, z in zip(a.frames(), b.frames(), c.frames(), strict=True):
+            assert np.array_equal(x.depth, y.depth) and np.array_equal(x.depth, z.depth)
+            assert np.count_nonzero(y.depth) > 0
