@@ -70,7 +70,7 @@ def _replay(log: Path, derived: Path, frames: int, show: Echo, progress: bool) -
         show(line)
     ref, stream = final["ref"], final["stream"]
     for line in score_lines(score(demo_house(), stream.builder.instances, ref.layers,
-                                  ref.graph)):
+                                  ref.graph, stream.builder.trajectory)):
         show(line)
 
 

@@ -266,7 +266,7 @@ def score_log(log: str | Path) -> tuple[int, dict[str, dict[str, float | int]]]:
         raise SgtoolError(f"{log}: the replay produced no scene graph to score")
     spec = load_house_text(house)
     ref, stream = final["refresh"], final["stream"]
-    q = score(spec, stream.builder.instances, ref.layers, ref.graph)
+    q = score(spec, stream.builder.instances, ref.layers, ref.graph, stream.builder.trajectory)
     out: dict[str, dict[str, float | int]] = {}
     for name, v in q.items():
         d: dict[str, float | int] = dict(asdict(v))

@@ -155,7 +155,8 @@ def _score(spec: Any, final: dict[str, Any]) -> Any:
     ref, stream = final["refresh"], final["stream"]
     if ref.layers is None:
         raise SgtoolError("the last refresh has no map layers to score")
-    return score(spec, stream.builder.instances, ref.layers, ref.graph)
+    return score(spec, stream.builder.instances, ref.layers, ref.graph,
+                 stream.builder.trajectory)
 
 
 def write_view(derived: Path, rrd: Path, show: bool) -> None:

@@ -239,8 +239,9 @@ def capture(log: str | os.PathLike[str], options: ReplayOptions, *,
             from sgtool.replayers.score import score, score_dict
 
             spec = load_house(json.loads(house))
-            figures = score_dict(score(spec, last["stream"].builder.instances, ref.layers,
-                                       ref.graph))
+            builder = last["stream"].builder
+            figures = score_dict(score(spec, builder.instances, ref.layers, ref.graph,
+                                       builder.trajectory))
             figures = {k: {f: canonical_float(v) if isinstance(v, float) else v
                            for f, v in q.items()} for k, q in figures.items()}
     return Capture(graphs, metas, asdict(report.options), figures)

@@ -10,7 +10,7 @@ by a doorless open-plan passage count as one: door-based segmentation cannot spl
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict
 from functools import partial
 
@@ -41,8 +41,11 @@ def passage_groups(spec: HouseSpec) -> dict[str, str]:
 
 
 def score(spec: HouseSpec, instances: Mapping[int, InstanceInfo], layers: MapLayers,
-          graph: SceneGraph) -> dict[str, Quality]:
-    """``{"strict": Quality, "merged": Quality}`` of ``graph`` (module doc)."""
+          graph: SceneGraph, visited: Sequence[tuple[float, float]] = ()
+          ) -> dict[str, Quality]:
+    """``{"strict": Quality, "merged": Quality}`` of ``graph`` (module doc); ``visited``:
+    the camera's (x, y) positions (the builder's ``trajectory``), whose rooms count as
+    seen."""
     rooms_by_spec = ({f.id: f.room for f in spec.furniture}
                      | {o.id: o.room for o in spec.objects})
     object_gt: dict[str, str] = {}
@@ -56,7 +59,7 @@ def score(spec: HouseSpec, instances: Mapping[int, InstanceInfo], layers: MapLay
         room_categories={r.id: r.category for r in graph.rooms if r.explored},
         object_rooms={o.id: o.room for o in graph.objects}, object_gt=object_gt,
         polygons={r.id: r.polygon for r in spec.rooms},
-        gt_categories={r.id: r.category for r in spec.rooms},
+        gt_categories={r.id: r.category for r in spec.rooms}, visited=visited,
     )
     return {"strict": of_graph(), "merged": of_graph(merge=passage_groups(spec))}
 

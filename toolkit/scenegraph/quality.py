@@ -78,7 +78,7 @@ def adjusted_rand_index(a: Sequence[object], b: Sequence[object]) -> float:
 @dataclass(frozen=True)
 class Quality:
     gt_rooms: int  # ground-truth rooms (after merging, for the merged variant)
-    gt_rooms_seen: int  # ground-truth rooms holding at least one Voronoi node
+    gt_rooms_seen: int  # ground-truth rooms holding a Voronoi node or a camera position
     rooms: int  # predicted explored rooms
     room_count_error: int  # rooms - gt_rooms_seen
     purity: float  # share of nodes in the majority ground-truth room of their room
@@ -93,11 +93,15 @@ def evaluate(node_xy: np.ndarray, node_rooms: Sequence[str | None],
              room_categories: Mapping[str, str], object_rooms: Mapping[str, str],
              object_gt: Mapping[str, str], polygons: Mapping[str, Polygon],
              gt_categories: Mapping[str, str],
-             merge: Mapping[str, str] | None = None) -> Quality:
+             merge: Mapping[str, str] | None = None,
+             visited: Sequence[tuple[float, float]] = ()) -> Quality:
     """Scores of one graph (module doc). ``node_xy``/``node_rooms``: Voronoi node positions
     and predicted room ids (None: no room); ``room_categories``: predicted explored room ->
     category; ``object_rooms``/``object_gt``: object id -> predicted / ground-truth room;
-    ``merge``: ground-truth room -> representative (doorless groups), identity if None."""
+    ``merge``: ground-truth room -> representative (doorless groups), identity if None;
+    ``visited``: the camera's (x, y) positions. A room counts as seen when it holds a
+    Voronoi node or the camera stood in it, so a map that lost rooms the robot was in shows
+    a room count error, not a perfect score over what is left of it."""
     rep = dict(merge or {})
 
     def m(r: str | None) -> str | None:
@@ -115,7 +119,8 @@ def evaluate(node_xy: np.ndarray, node_rooms: Sequence[str | None],
     purity = (sum(cnt[majority[p]] for p, cnt in by_room.items()) / len(pairs)) if pairs else 0.0
     ari = adjusted_rand_index([p for p, _ in pairs], [g for _, g in pairs]) if pairs else 0.0
     gt_all = {m(r) for r in polygons}
-    seen = {g for _, g in pairs}
+    stood = gt_rooms_of(np.asarray(visited, dtype=float).reshape(-1, 2), polygons)
+    seen = {g for _, g in pairs} | {r for r in map(m, stood) if r is not None}
     rooms = sorted(room_categories)
     obj_ok = [majority.get(object_rooms[o]) == m(object_gt[o]) for o in sorted(object_rooms)
               if o in object_gt]

@@ -49,3 +49,21 @@ def test_open_plan_under_segmentation_strict_and_merged() -> None:
     assert merged.purity == 1.0 and merged.ari == pytest.approx(1.0)
     assert merged.object_accuracy == 1.0
     assert merged.category_accuracy == 1.0  # "living_room" names a part of the open plan
+
+
+def test_rooms_the_camera_stood_in_count_as_seen() -> None:
+    """A map that lost most of the house (noisy depth: one room's nodes left) scored over
+    what is left would be perfect; the rooms the camera stood in count as seen, so the
+    room count error shows the loss. An empty map with a trajectory: every room it
+    visited is missing."""
+    xy = np.array([[1.0, 2.0], [2.0, 2.0]])
+    rooms = ["room:0", "room:0"]
+    args = dict(object_rooms={}, object_gt={}, polygons=SQUARES, gt_categories=CATS)
+    alone = evaluate(xy, rooms, {"room:0": "kitchen"}, **args)
+    assert (alone.rooms, alone.gt_rooms_seen, alone.room_count_error) == (1, 1, 0)
+    walked = [(1.0, 1.0), (5.0, 1.0), (9.0, 1.0), (13.0, 1.0)]  # the last outside the house
+    q = evaluate(xy, rooms, {"room:0": "kitchen"}, visited=walked, **args)
+    assert (q.rooms, q.gt_rooms_seen, q.room_count_error) == (1, 3, -2)
+    assert q.purity == 1.0  # the nodes left are in the right room
+    empty = evaluate(np.zeros((0, 2)), [], {}, visited=walked[:2], **args)
+    assert (empty.rooms, empty.gt_rooms_seen, empty.room_count_error) == (0, 2, -2)
