@@ -8,9 +8,10 @@ reaches a room with it, the fallback's actions logged as ``explore`` of grid fro
 with reason "fallback: no actionable node", decided on no graph, their frames and metres
 counted; a planner that gives up with goals on offer ends the episode; one that gives up
 after every goal on offer failed (made so) hands over to the fallback, which stops as
-soon as the graph offers a node it did not offer before, and that episode's log replays into the same scene graphs byte for byte; the fallback is
-deterministic and uses the robot's side only (the true map made to raise); with no grid
-frontier it goes to open edges of the robot's map.
+soon as the graph offers a node it did not offer before, and that episode's log replays
+into the same scene graphs byte for byte; the fallback is deterministic and uses the
+robot's side only (the true map made to raise); with no grid frontier it goes to open
+edges of the robot's map.
 """
 
 from __future__ import annotations
