@@ -55,6 +55,8 @@ from sgtool.progress import Progress
 from sgtool.replayers.graph_scene import graph_scene_update
 from sgtool.scenegraph.build_options import (
     CLASSIFIERS,
+    MAX_DEPTH_M,
+    MAX_DEPTH_RANGE,
     MIN_POINTS_320x240,
     ResolvedOptions,
     builder_config,
@@ -79,6 +81,7 @@ class ReplayOptions:
     min_points: int | None = None  # points in one frame for an instance to count as seen
     voxel_size: float | None = None  # m
     max_frames: int | None = None  # stop after this many frames
+    max_depth: float | None = None  # m; depth farther is not mapped
     tf_time: str = "log"  # what pairs /tf with frames: "log" time or header "stamp"
 
 
@@ -106,8 +109,14 @@ def resolve_options(reader: LogReader, options: ReplayOptions) -> ResolvedOption
         raise SgtoolError(f"voxel size {vs} m: must be 0.01..0.5")
     if int(mp) < 1:
         raise SgtoolError(f"min points {mp}: must be >= 1")
+    md = options.max_depth if options.max_depth is not None else float(
+        recorded.get("max_depth", MAX_DEPTH_M))
+    if not MAX_DEPTH_RANGE[0] <= md <= MAX_DEPTH_RANGE[1]:
+        raise SgtoolError(f"max depth {md:g} m: must be {MAX_DEPTH_RANGE[0]:g}.."
+                          f"{MAX_DEPTH_RANGE[1]:g}")
     return ResolvedOptions(every=int(every), classifier=clf, min_points=int(mp),
-                           voxel_size=float(vs), max_frames=options.max_frames)
+                           voxel_size=float(vs), max_frames=options.max_frames,
+                           max_depth=float(md))
 
 
 def replay_metadata(opts: ResolvedOptions, tf_time: str = "log") -> dict[str, str]:
@@ -164,7 +173,8 @@ class ReplayReport:
         out.append(f"{self.frames} frames, {self.refreshes} refreshes (every {o.every} frames "
                    f"and at every action), {self.seconds:.1f} s ({fps:.1f} frames/s); room "
                    f"classifier {o.classifier}, voxels {o.voxel_size} m, seen at "
-                   f">= {o.min_points} points")
+                   f">= {o.min_points} points"
+                   + (f", depth to {o.max_depth:g} m" if o.max_depth != MAX_DEPTH_M else ""))
         if not self.semantic:
             out.append("the log has no instance ids: semantics are absent, so the graph has "
                        "geometry only (occupancy, Voronoi graph, rooms without door cuts, "
@@ -180,6 +190,11 @@ class ReplayReport:
                        f"{len(g.rooms) - len(explored)} unexplored behind closed doors, "
                        f"{len(g.objects)} objects, {len(g.frontiers())} frontiers, "
                        f"{len(g.doors)} doors")
+            if not g.rooms and self.frames >= self.options.every:
+                out.append(f"warning: no room in the final graph after {self.frames} frames: "
+                           "the map found no free floor for its Voronoi graph; noisy depth "
+                           "far from the camera reads as obstacles (try --max-depth "
+                           f"{max(1.0, self.options.max_depth - 2):g})")
         return out + stage_lines(self.stages)
 
 

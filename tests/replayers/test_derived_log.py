@@ -111,6 +111,26 @@ def test_replay_is_byte_identical_and_replaying_a_derived_log_rebuilds_the_same(
     assert messages(c) == messages(a)
 
 
+def test_max_depth_bounds_what_is_mapped_and_is_recorded(tmp_path):
+    """--max-depth leaves farther depth out of the map (the two-room tour seen to 1.5 m
+    maps less floor than to 5 m) and is written to the derived log's replay metadata; the
+    default writes what it wrote before the option."""
+    log = synthetic_log(tmp_path / "two.mcap")
+    near, far = tmp_path / "near.mcap", tmp_path / "far.mcap"
+    a = replay(log, near, ReplayOptions(max_depth=1.5))
+    b = replay(log, far, ReplayOptions())
+    assert a.options.max_depth == 1.5 and b.options.max_depth == 5.0
+
+    def free_cells(rep):
+        return int((rep.last.layers.occupancy.grid == 0).sum())
+
+    assert 0 < free_cells(a) < free_cells(b)
+    with LogReader(near) as r, LogReader(far) as s:
+        assert r.metadata["sgtool.replay"]["max_depth"] == "1.5"
+        assert "max_depth" not in s.metadata["sgtool.replay"]
+    assert any("depth to 1.5 m" in line for line in a.lines())
+
+
 def test_refresh_schedule_every_k_frames_and_at_actions(tmp_path):
     log = synthetic_log(tmp_path / "two.mcap")
     seen = []
@@ -260,6 +280,7 @@ def test_cli_writes_the_derived_log_the_rrd_and_the_score(tmp_path):
     (["{tour}", "-o", "nofolder/out.mcap"], "does not exist"),
     (["{bare}", "--score"], "no house spec"),
     (["{tour}", "--voxel-size", "2"], "--voxel-size"),
+    (["{tour}", "--max-depth", "0.2"], "--max-depth"),
 ])
 def test_cli_user_errors(tmp_path, monkeypatch, args, message):
     monkeypatch.chdir(tmp_path)

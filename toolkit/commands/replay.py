@@ -18,6 +18,7 @@ import click
 
 from sgtool.commands.options import (
     FINITE_FLOAT,
+    FiniteFloatRange,
     check_log_output,
     check_output,
     executor_options,
@@ -62,6 +63,10 @@ if TYPE_CHECKING:
               "log's, else MoMa-LLM's 50 at 320x240 scaled by the image size.")
 @click.option("--voxel-size", type=FINITE_FLOAT, default=None,
               help="Voxel edge in metres. Default: the log's, else 0.05.")
+@click.option("--max-depth", type=FiniteFloatRange(0.5, 20.0), default=None,
+              help="Depth farther than this (m) is not mapped. Default: the log's, else 5 "
+              "(MoMa-LLM's). Lower it for a noisy sensor: far floor seen through depth "
+              "noise reads as obstacles and can leave the map without a room.")
 @click.option("--max-frames", type=click.IntRange(min=1), default=None,
               help="Stop after this many frames.")
 @click.option("--tf-time", type=click.Choice(["log", "stamp"]), default="log",
@@ -162,6 +167,7 @@ class ReplayArgs:
     llm_transcript: str | None = None
     tf_time: str = "log"
     rerun_to: str | None = None
+    max_depth: float | None = None
 
     def llm(self) -> LlmOptions:
         """The ``--llm-*`` options of ``--classifier llm``."""
@@ -182,7 +188,8 @@ def _options(args: ReplayArgs) -> ReplayOptions:
         raise SgtoolError(f"--voxel-size {args.voxel_size}: must be 0.01..0.5 m")
     return ReplayOptions(every=args.every, classifier=args.classifier,
                          min_points=args.min_points, voxel_size=args.voxel_size,
-                         max_frames=args.max_frames, tf_time=args.tf_time)
+                         max_frames=args.max_frames, max_depth=args.max_depth,
+                         tf_time=args.tf_time)
 
 
 def _batch_request(args: ReplayArgs) -> BatchReplayRequest:

@@ -16,6 +16,8 @@ from sgtool.scenegraph.builder import BuilderConfig
 # ``llm`` (MoMa-LLM's room classification) needs a chat client or a transcript from the caller
 CLASSIFIERS = ("containment", "frequency", "llm", "none")
 MIN_POINTS_320x240 = 50  # MoMa-LLM: an object is seen with > 50 points (256x256 camera)
+MAX_DEPTH_M = VoxelConfig().max_range  # depth farther is not mapped (MoMa-LLM: 0-5 m)
+MAX_DEPTH_RANGE = (0.5, 20.0)  # m, what --max-depth accepts
 
 
 @dataclass(frozen=True)
@@ -25,9 +27,13 @@ class ResolvedOptions:
     min_points: int
     voxel_size: float
     max_frames: int | None
+    max_depth: float = MAX_DEPTH_M  # m
 
     def to_metadata(self) -> dict[str, str]:
-        return {k: "" if v is None else str(v) for k, v in asdict(self).items()}
+        """The options as text; ``max_depth`` only when it is not the default (so default
+        replays write what they wrote before it was an option)."""
+        return {k: "" if v is None else str(v) for k, v in asdict(self).items()
+                if k != "max_depth" or v != MAX_DEPTH_M}
 
 
 def default_min_points(width: int, height: int) -> int:
@@ -39,10 +45,12 @@ def mapping_record(options: ResolvedOptions) -> dict[str, Any]:
     """What a live builder writes into its Episode record (``extra.mapping``) so that a
     replay with default options rebuilds its graphs."""
     return {"every": options.every, "classifier": options.classifier,
-            "min_points": options.min_points, "voxel_size": options.voxel_size}
+            "min_points": options.min_points, "voxel_size": options.voxel_size,
+            **({"max_depth": options.max_depth} if options.max_depth != MAX_DEPTH_M else {})}
 
 
 def builder_config(options: ResolvedOptions) -> BuilderConfig:
     return BuilderConfig(voxels=VoxelConfig(resolution=options.voxel_size,
-                                            min_points=options.min_points),
+                                            min_points=options.min_points,
+                                            max_range=options.max_depth),
                          refresh_every=options.every)
