@@ -18,7 +18,8 @@ parents; SCOUT, Fig. 5 f: the closest unoccupied pixel to the goal object within
 room, then A* on the dilated map).
 
 Starts are the house's start poses; an episode prefers a start outside every target room
-(starting next to the target is not a search).
+(starting next to the target is not a search), and, when the start drawn cannot reach a
+target (a room no door leads into, on either side), draws again among the starts that can.
 """
 
 from __future__ import annotations
@@ -205,11 +206,18 @@ def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
                              {furn[f].room for f in pieces}, key=spec_id_key))
         starts = [s for s in spec.starts if s.room not in rooms] or list(spec.starts)
         start = starts[int(rng.integers(len(starts)))]
+        path = geo.shortest_path(start, ids + pieces)
+        if math.isinf(path):  # a walled-off room on one side: a start that reaches one
+            reach = [s for s in spec.starts
+                     if math.isfinite(geo.shortest_path(s, ids + pieces))]
+            if reach:
+                reach = [s for s in reach if s.room not in rooms] or reach
+                start = reach[int(rng.integers(len(reach)))]
+                path = geo.shortest_path(start, ids + pieces)
         hidden = not pieces and all(o in hidden_ids for o in ids)
         out.append(Episode(
             id=f"ep_{i}", query=cat, synset=synset_of[cat], targets=tuple(ids + pieces),
-            target_rooms=rooms, start=start, hidden=hidden,
-            shortest_path=geo.shortest_path(start, ids + pieces),
+            target_rooms=rooms, start=start, hidden=hidden, shortest_path=path,
             description=_describe(spec, ids),
         ))
     return out

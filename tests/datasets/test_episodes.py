@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from support.datasets_fixtures import two_rooms
+from support.datasets_fixtures import two_rooms, walled_off
 from support.path_lengths import path_length
 
 import sgtool.datasets as ds
@@ -103,3 +103,18 @@ def test_spellings_of_one_category_are_one_episode():
     eps = list_episodes(load_house(d))
     assert [(e.query, e.targets) for e in eps] == [("cup", ("obj_0", "obj_1"))]
     assert set(eps[0].target_rooms) == {"room_0", "room_1"}
+
+
+def test_a_start_that_cannot_reach_the_target_is_drawn_again() -> None:
+    """Two rooms and no door between them, a start in each: every episode starts on its
+    target's side (the start outside the target room cannot reach it), with a finite path;
+    a house whose starts all reach keeps its draws."""
+    d = walled_off(two_rooms(), "door_0")
+    d["starts"].append({"x": 7.0, "y": 1.0, "yaw": 0.0, "room": "room_1"})
+    eps = {e.query: e for e in list_episodes(load_house(d), seed=0)}
+    assert eps["apple"].start.room == "room_0" and eps["cup"].start.room == "room_1"
+    assert all(math.isfinite(e.shortest_path) for e in eps.values())
+    open_house = two_rooms()
+    open_house["starts"].append({"x": 7.0, "y": 1.0, "yaw": 0.0, "room": "room_1"})
+    for e in list_episodes(load_house(open_house), seed=0):  # outside its target room
+        assert e.start.room not in e.target_rooms and math.isfinite(e.shortest_path)
