@@ -31,6 +31,7 @@ from sgtool.house.geometry import (
     opening_segment,
     overlap_area,
     point_in_polygon,
+    segment_distance,
     shared_borders,
 )
 from sgtool.house.names import id_note
@@ -96,7 +97,13 @@ def _boxes(boxes: list[tuple[float, float, float, float]]) -> np.ndarray:
 
 
 def _starts_on_free_floor(spec: HouseSpec) -> None:
-    """No start pose inside a piece of furniture's footprint (the robot could not move)."""
+    """No start pose inside a wall's body or a piece of furniture's footprint (the robot
+    could not move, or the simulator pushes it out of the house)."""
+    for i, s in enumerate(spec.starts):
+        for k, w in enumerate(spec.walls):
+            if segment_distance(s.x, s.y, w.a, w.b) <= w.thickness / 2:
+                raise SpecError(f"starts[{i}]: ({s.x}, {s.y}) is inside walls[{k}] ({w.id}); "
+                                "a start pose must be on free floor")
     if not spec.starts or not spec.furniture:
         return
     feet = [f.footprint() for f in spec.furniture]

@@ -207,6 +207,15 @@ def test_a_start_inside_furniture_is_refused() -> None:
     assert len(load_house(d).starts) == 2
 
 
+def test_a_start_inside_a_wall_is_refused() -> None:
+    d = two_rooms()
+    d["starts"].append({"x": 0.02, "y": 2.0, "yaw": 0, "room": "room_0"})  # wall_2, x 0
+    _refused(d, r"^starts\[1\]: \(0\.02, 2\.0\) is inside walls\[2\] \(wall_2\); a start "
+                r"pose must be on free floor$")
+    d["starts"][1]["x"] = 0.3  # off it
+    assert len(load_house(d).starts) == 2
+
+
 def test_a_door_covered_by_a_wall_is_refused() -> None:
     d = two_rooms()
     d["walls"].append({"id": "wall_6", "a": [4, 1.0], "b": [4, 3.0]})
