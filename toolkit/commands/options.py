@@ -4,6 +4,7 @@ too."""
 
 from __future__ import annotations
 
+import difflib
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -309,7 +310,9 @@ def planner_options(items: tuple[str, ...], planners: Sequence[str] | None = Non
     value}}, each value checked and converted against the planner's options dataclass (a
     plug-in without one: int, float, true/false or text). With ``planners`` (the run's), an
     option for a name that is no planner is an error (a typo such as ``sout.delta`` would
-    otherwise run everything with the defaults), one for a planner not run a note."""
+    otherwise run everything with the defaults), and so is one for a planner not run whose
+    name is close to one run (``lab:Labplanner`` for ``lab:LabPlanner``); one for another
+    planner not run is a note."""
     from sgtool.planning.registry import check_planner_name, parse_option
 
     out: dict[str, dict[str, Any]] = {}
@@ -328,6 +331,10 @@ def planner_options(items: tuple[str, ...], planners: Sequence[str] | None = Non
             except SgtoolError:
                 raise SgtoolError(f"--planner-option {item!r}: {name!r} is no planner "
                                   f"(those run: {', '.join(planners or ())})") from None
+            close = difflib.get_close_matches(name, planners or (), n=1, cutoff=0.8)
+            if close:
+                raise SgtoolError(f"--planner-option {item!r}: {name!r} is not run; did you "
+                                  f"mean {close[0]!r}?")
             click.echo(f"sgtool: note: --planner-option {key.strip()}: {name!r} is not "
                        "run; the option is unused", err=True)
         text = value.strip()

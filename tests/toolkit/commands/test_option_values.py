@@ -64,6 +64,18 @@ def test_an_option_of_a_planner_not_run_is_a_note(tmp_path: Path) -> None:
     assert planner_options(("greedy.x=1",), ("random",)) == {"greedy": {"x": 1}}
 
 
+def test_an_option_of_a_name_close_to_a_planner_run_is_an_error() -> None:
+    """``lab:Labplanner.k`` with ``lab:LabPlanner`` run is a typo, not another planner."""
+    from sgtool.commands.options import planner_options
+    from sgtool.errors import SgtoolError
+
+    with pytest.raises(SgtoolError, match=r"'lab:Labplanner' is not run; did you mean "
+                                          r"'lab:LabPlanner'\?"):
+        planner_options(("lab:Labplanner.k=2",), ("lab:LabPlanner",))
+    assert planner_options(("other:Planner.k=2",), ("lab:LabPlanner",)) == \
+        {"other:Planner": {"k": 2}}  # another planner not run: a note, as before
+
+
 def test_run_bench_workers_must_be_positive(tmp_path: Path) -> None:
     _one_line_error(["run-bench", "--planners", "random", "--houses", "1", "--episodes", "1",
                      "-w", "-1"], tmp_path, "Invalid value for '--workers'")
