@@ -157,6 +157,11 @@ def beyond_packing(what: str, camera: np.ndarray | None, resolution: float, limi
         who = "world points (or NaN) reach"
     else:
         t = np.asarray(camera, dtype=np.float64)
+        if np.all(np.isnan(t)):  # what a log reader gives a frame /tf does not pose
+            return MapRangeError(f"{what}: no camera pose: /tf has no chain from the frame "
+                                 "'world' to the depth image's frame (sgtool's logs name "
+                                 "them 'world' and 'camera') at this time; the frame cannot "
+                                 "be mapped")
         if not np.all(np.isfinite(t)):
             return MapRangeError(f"{what}: the camera pose is not finite; the frame cannot "
                                  "be mapped")

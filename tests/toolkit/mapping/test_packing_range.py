@@ -53,6 +53,15 @@ def test_a_pose_that_is_not_finite_is_refused() -> None:
         VoxelMap().integrate(f)
 
 
+def test_a_frame_tf_does_not_pose_names_the_missing_chain() -> None:
+    """A log reader poses a frame /tf has no chain for with NaN: the error says so."""
+    f = flat_frame(0.0)
+    f.pose[:] = np.nan
+    with pytest.raises(MapRangeError, match="frame 0 at 0.000 s: no camera pose: /tf has no "
+                                            "chain from the frame 'world'"):
+        VoxelMap().integrate(f)
+
+
 def test_world_points_beyond_the_packing_are_refused() -> None:
     vm = VoxelMap()
     pts = np.array([[0.0, 0.0, 0.0], [0.0, -5000.0, 1.0]])
