@@ -240,7 +240,7 @@ def replay(
                 extra = {k: v for k, v in meta.items()
                          if k not in ("sgtool_version", "log_schema_version", "seed")}
                 with LogWriter(dst, seed=reader.seed, compression=compression,
-                               metadata=extra) as writer:
+                               metadata=extra, keep_partial=False) as writer:
                     for name, data in sorted(reader.metadata.items()):
                         if name not in (S.METADATA_NAME, REPLAY_METADATA):
                             writer.add_metadata(name, data)

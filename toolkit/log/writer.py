@@ -12,7 +12,8 @@ The writer is crash tolerant and atomic:
   :class:`~sgtool.files.OutputError` and leaves nothing behind;
 - Ctrl-C (:class:`KeyboardInterrupt`) keeps the partial file when it holds messages, and
   re-raises as :class:`InterruptedWrite`, whose text names the file and the
-  ``sgtool doctor`` line that recovers it;
+  ``sgtool doctor`` line that recovers it; a writer of output that can be made again
+  (``keep_partial=False``: a replay's derived log) removes it instead;
 - it closes and flushes a chunk to the operating system at least every
   ``flush_interval_ns`` of log time (1 s by default) and whenever a chunk exceeds
   ``chunk_size``; a process killed with SIGKILL leaves ``OUT.XXXXXXXX.partial`` whose
@@ -110,6 +111,7 @@ class LogWriter:
         flush_interval_ns: int = 1_000_000_000,
         metadata: dict[str, str] | None = None,
         overwrite: bool = True,
+        keep_partial: bool = True,
     ) -> None:
         if compression not in _COMPRESSION:
             raise SgtoolError(f"unknown compression {compression!r} (zstd, lz4, none)")
@@ -127,6 +129,7 @@ class LogWriter:
         self._stream: IO[bytes] = os.fdopen(fd, "wb")
         self._compression = "" if compression == "none" else compression
         self._closed = False
+        self._keep_on_interrupt = keep_partial
         self._checked_items: set[str] = set()  # instance-table items checked (JSON texts)
         self.message_count = 0
         try:
@@ -441,7 +444,8 @@ class LogWriter:
                  tb: TracebackType | None) -> None:
         if exc_type is None:
             self.close()
-        elif issubclass(exc_type, KeyboardInterrupt) and not self._closed:
+        elif issubclass(exc_type, KeyboardInterrupt) and not self._closed and \
+                self._keep_on_interrupt:
             raise self._keep_partial(issubclass(exc_type, Terminated)) from None
         else:
             self.abort()

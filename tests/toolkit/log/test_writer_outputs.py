@@ -107,6 +107,17 @@ def test_ctrl_c_before_any_message_leaves_nothing(tmp_path):
     assert leftovers(tmp_path) == []
 
 
+def test_ctrl_c_of_output_that_can_be_made_again_leaves_nothing(tmp_path):
+    """``keep_partial=False`` (a replay's derived log): Ctrl-C removes the partial file,
+    however much it holds, and the interrupt goes on as it came."""
+    out = tmp_path / "derived.mcap"
+    with pytest.raises(KeyboardInterrupt) as info, LogWriter(out, keep_partial=False) as w:
+        frames(w, 25)
+        raise KeyboardInterrupt
+    assert not isinstance(info.value, InterruptedWrite)
+    assert leftovers(tmp_path) == []
+
+
 class FullDisk:
     """A file whose writes fail with ENOSPC after ``room`` bytes, like a full disk."""
 
@@ -265,7 +276,9 @@ def test_view_stops_before_rerun_hangs_on_a_full_disk(tmp_path, monkeypatch):
     assert leftovers(tmp_path) == ["run.mcap"]
 
 
-def test_replay_ctrl_c_keeps_the_partial_log_and_names_it(tmp_path, monkeypatch):
+def test_replay_ctrl_c_leaves_no_partial_log(tmp_path, monkeypatch):
+    """A derived log can be made again: Ctrl-C removes its partial file (partial files of
+    interrupted replays used to pile up beside the output, each as big as the log)."""
     calls = {"n": 0}
     real = LogWriter._add  # every message but those of input chunks copied as they are
 
@@ -280,11 +293,8 @@ def test_replay_ctrl_c_keeps_the_partial_log_and_names_it(tmp_path, monkeypatch)
     r = CliRunner().invoke(cli, ["replay", str(GOLDEN / "house6-tour.mcap"), "-o", str(out),
                                  "--no-progress"])
     assert r.exit_code == 130, r.output
-    (partial,) = partial_files(out)
-    assert r.output.strip() == (
-        f"sgtool: interrupted; {out} not written; what was recorded is kept in {partial} "
-        f"(recover it with: sgtool doctor {partial} --recover {out})")
-    assert not out.exists()
+    assert r.output.strip() == "sgtool: interrupted; no output was left half-written"
+    assert partial_files(out) == [] and not out.exists()
 
 
 def test_main_ignores_ctrl_c_once_the_command_is_done(tmp_path):
