@@ -162,7 +162,8 @@ def _success(r: EpisodeResult) -> float:
 def format_agreement(matched: int, total: int, rows: Sequence[RankAgreement],
                      source: str) -> str:
     what = (f"{matched} symbolic episodes of the same (house, episode, query)" if matched
-            else f"all {total} symbolic episodes (none of the same house, episode and query)")
+            else f"all {total} symbolic episodes (none of the same house, episode and query: "
+                 "run the bench with the same --episodes)")
     lines = [f"Agreement with the symbolic order ({source}; {what}): Kendall tau-b over the "
              "planners"]
     for r in rows:

@@ -55,7 +55,8 @@ if TYPE_CHECKING:
 @click.option("--preset", type=click.Choice(list(PRESET_NAMES)), default="symsearch",
               show_default=True, help="Generator preset of the generated houses.")
 @click.option("--episodes", default=6, show_default=True,
-              help="Episodes per house: the first ones of `sgtool bench`'s episodes.")
+              help="Episodes per house: those `sgtool bench --episodes N` draws with the "
+              "same N (the draw depends on N: a bench folder for --symbolic needs it).")
 @click.option("--noise", "noise", multiple=True, metavar="PROFILE",
               help="Sensor noise profile (none, mild, strong, with overrides as `sgtool "
               "record --noise`); repeatable: every profile is a run. Default: none.")
