@@ -113,6 +113,18 @@ class EvalArgs:
     llm_timeout: float | None = None
 
 
+def _read_once(files: tuple[str, ...]) -> tuple[str, ...]:
+    """``files`` without the logs inside a folder whose episodes.jsonl is read too (``eval
+    run/ run/logs`` would count each episode twice), with a note."""
+    tables = [Path(f).resolve().parent for f in files if Path(f).name == "episodes.jsonl"]
+    dup = [f for f in files if f.endswith(".mcap") and
+           any(Path(f).resolve().is_relative_to(t) for t in tables)]
+    if dup:
+        click.echo(f"sgtool: note: {len(dup)} log(s) are episodes of an episodes.jsonl also "
+                   "given; each episode is read once, from the table", err=True)
+    return tuple(f for f in files if f not in dup)
+
+
 def _request(inputs: tuple[str, ...], out: str | None, force: bool, args: EvalArgs
              ) -> EvalRequest:
     """The option, output and input checks: finite budgets, the executor, the inputs (MCAP
@@ -126,7 +138,8 @@ def _request(inputs: tuple[str, ...], out: str | None, force: bool, args: EvalAr
     runner = make_executor(args.executor, args.workers, args.ray_address)
     runs = [str(Path(i) / "episodes.jsonl") if (Path(i) / "episodes.jsonl").is_file()
             else i for i in inputs]  # an output folder: its table, not its logs too
-    files = tuple(map(str, expand_inputs(runs, (".mcap",), "MCAP logs", recursive=True)))
+    files = _read_once(tuple(map(str, expand_inputs(runs, (".mcap",), "MCAP logs",
+                                                    recursive=True))))
     if out:
         check_output(out, force=force)
         if any(Path(out).resolve() == Path(i).resolve() for i in files):

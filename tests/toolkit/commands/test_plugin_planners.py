@@ -136,6 +136,13 @@ def test_eval_asks_a_plugin_and_reads_its_logs(plugin_dir: Path, tmp_path: Path,
     assert by_logs.exit_code == by_out.exit_code == 0, by_logs.output + by_out.output
     for r in (by_logs, by_out):
         assert json.loads(r.output)["planners"] == doc["planners"]
+    # a run folder and its own logs given together (as run-bench writes them): once each
+    logs.rename(tmp_path / "out" / "logs")
+    both = CliRunner().invoke(cli, ["eval", str(tmp_path / "out"), str(tmp_path / "out" /
+                                                                        "logs"), "--json"])
+    assert both.exit_code == 0, both.output
+    assert "each episode is read once" in both.stderr
+    assert json.loads(both.stdout) == json.loads(by_out.output)
 
 
 @pytest.mark.parametrize(("planner", "message"), [
