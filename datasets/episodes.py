@@ -208,11 +208,11 @@ def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
         start = starts[int(rng.integers(len(starts)))]
         path = geo.shortest_path(start, ids + pieces)
         if math.isinf(path):  # a walled-off room on one side: a start that reaches one
-            reach = [s for s in spec.starts
-                     if math.isfinite(geo.shortest_path(s, ids + pieces))]
-            if reach:
-                reach = [s for s in reach if s.room not in rooms] or reach
-                start = reach[int(rng.integers(len(reach)))]
+            able = [s for s in spec.starts
+                    if math.isfinite(geo.shortest_path(s, ids + pieces))]
+            if able:
+                able = [s for s in able if s.room not in rooms] or able
+                start = able[int(rng.integers(len(able)))]
                 path = geo.shortest_path(start, ids + pieces)
         hidden = not pieces and all(o in hidden_ids for o in ids)
         out.append(Episode(

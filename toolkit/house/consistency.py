@@ -100,9 +100,9 @@ def _starts_on_free_floor(spec: HouseSpec) -> None:
     """No start pose inside a wall's body or a piece of furniture's footprint (the robot
     could not move, or the simulator pushes it out of the house)."""
     for i, s in enumerate(spec.starts):
-        for k, w in enumerate(spec.walls):
+        for j, w in enumerate(spec.walls):
             if segment_distance(s.x, s.y, w.a, w.b) <= w.thickness / 2:
-                raise SpecError(f"starts[{i}]: ({s.x}, {s.y}) is inside walls[{k}] ({w.id}); "
+                raise SpecError(f"starts[{i}]: ({s.x}, {s.y}) is inside walls[{j}] ({w.id}); "
                                 "a start pose must be on free floor")
     if not spec.starts or not spec.furniture:
         return
