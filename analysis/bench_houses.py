@@ -198,8 +198,8 @@ def symbolic_house(spec: HouseSpec, where: str | os.PathLike[str]) -> tuple[Any,
 
 def house_notes(house: Any) -> tuple[str, ...]:
     """What a user should know of a house that loads: doors furniture blocks (read as
-    walls), rooms walled off from the rest (their targets are searched from inside, the
-    others' from outside)."""
+    walls), no start poses (the bench adds its own), rooms walled off from the rest (their
+    targets are searched from inside, the others' from outside)."""
     from sgtool.recorders.symbolic_environment.doorways import doorway_pieces
 
     spec = house.spec
@@ -212,6 +212,9 @@ def house_notes(house: Any) -> tuple[str, ...]:
                      "floor to the other's (" + (f"furniture within 1 m: {', '.join(near)}"
                                                  if near else "too narrow") +
                      "); read as a wall")
+    if not spec.starts:
+        notes.append("no start poses: the bench and the closed loop add their own "
+                     "(sgtool.datasets.start_poses)")
     cut = house.isolated_rooms()
     if cut:
         notes.append(f"{', '.join(cut)}: no door or passage leads there from the rest of "

@@ -171,6 +171,24 @@ def stats_cmd(houses: int, seed: int, rooms: tuple[int, int], split: str, preset
                "from the paper, not measured here.")
 
 
+def _episodes(spec: Any, count: int | None, seed: int, reach: float, preset: str
+              ) -> list[Any]:
+    """The episodes ``scenes episodes`` lists; a house without start poses gets those the
+    bench and the closed loop add (with a note), so the lists agree."""
+    from sgtool.datasets.episode_mix import symsearch_episodes
+    from sgtool.datasets.episodes import list_episodes
+    from sgtool.datasets.start_poses import with_start_poses
+
+    if not spec.starts and spec.objects:
+        spec = with_start_poses(spec, spec.seed)
+        click.echo("sgtool: note: the house has no start poses; those the bench and "
+                   "`sgtool run` add are used", err=True)
+    if preset == "symsearch":
+        n = count or len({o.category for o in spec.objects}) or len(spec.furniture)
+        return list(symsearch_episodes(spec, n, seed=seed, reach=reach))
+    return list_episodes(spec, n=count, seed=seed, reach=reach)
+
+
 @command.command("episodes")
 @click.argument("house", type=click.Path(dir_okay=False))
 @click.option("-n", "--count", type=click.IntRange(min=1), default=None,
@@ -190,16 +208,10 @@ def episodes_cmd(house: str, count: int | None, seed: int, reach: float, preset:
     non-interactive targets); COUNT defaults to the number of small-object categories."""
     from pathlib import Path
 
-    from sgtool.datasets.episode_mix import symsearch_episodes
-    from sgtool.datasets.episodes import list_episodes
     from sgtool.house.io import load_house
 
     spec = load_house(Path(house))  # a path, even one that starts with "{"
-    if preset == "symsearch":
-        n = count or len({o.category for o in spec.objects}) or len(spec.furniture)
-        eps = symsearch_episodes(spec, n, seed=seed, reach=reach)
-    else:
-        eps = list_episodes(spec, n=count, seed=seed, reach=reach)
+    eps = _episodes(spec, count, seed, reach, preset)
     if as_json:
         click.echo(json.dumps([e.to_dict() for e in eps], indent=1, sort_keys=True))
         return
@@ -208,7 +220,7 @@ def episodes_cmd(house: str, count: int | None, seed: int, reach: float, preset:
 
         if bad := symbolic_house_problem(spec, house):  # e.g. a room without free floor
             raise SgtoolError(bad)
-        click.echo("no episodes: the house has no small objects or no start poses")
+        click.echo("no episodes: the house has no small objects")
         return
     w = max(len(e.query) for e in eps)
     click.echo(f"{'id':<6} {'query':<{w}}  {'start':>18}  {'hidden':<6} {'path m':>7}  "

@@ -82,6 +82,27 @@ def test_episodes_and_knowledge(tmp_path):
     assert k["train"]["activities"] + k["eval"]["activities"] == 1016
 
 
+def test_a_house_without_start_poses_lists_the_episodes_the_bench_runs(tmp_path):
+    """No start poses: `scenes episodes` adds those the bench and `sgtool run` add (with a
+    note) instead of listing nothing, and `scenes check` notes it."""
+    from sgtool.analysis.bench_houses import bench_episodes
+
+    doc = json.loads((generate_house(1, rooms=(5, 5)).to_json()))
+    doc["starts"] = []
+    house = tmp_path / "nostarts.json"
+    house.write_text(json.dumps(doc))
+    r = CliRunner().invoke(cli, ["scenes", "episodes", str(house), "--json", "-n", "4",
+                                 "--seed", str(doc["seed"])])  # the bench's draw
+    assert r.exit_code == 0, r.output
+    assert "no start poses" in r.stderr
+    listed = json.loads(r.stdout)
+    ran = bench_episodes(load_house(house), 4)
+    assert [(e["query"], e["start"]) for e in listed] == \
+        [(e.query, e.to_dict()["start"]) for e in ran]
+    r = CliRunner().invoke(cli, ["scenes", "check", str(house)])
+    assert r.exit_code == 0 and "note: no start poses" in r.output
+
+
 def test_user_errors_name_the_problem(tmp_path):
     bad = tmp_path / "bad.json"
     spec = json.loads(generate_house(0, rooms=(4, 4)).to_json())
