@@ -87,7 +87,7 @@ def test_a_house_without_start_poses_lists_the_episodes_the_bench_runs(tmp_path)
     note) instead of listing nothing, and `scenes check` notes it."""
     from sgtool.analysis.bench_houses import bench_episodes
 
-    doc = json.loads((generate_house(1, rooms=(5, 5)).to_json()))
+    doc = json.loads(generate_house(1, rooms=(5, 5)).to_json())
     doc["starts"] = []
     house = tmp_path / "nostarts.json"
     house.write_text(json.dumps(doc))
