@@ -24,7 +24,8 @@ _ROS_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_/]*")  # a tf frame id ROS tools ac
 
 def _frames(style: str, pairs: tuple[str, ...]) -> dict[str, str]:
     """The frame renaming of ``--frames STYLE`` and ``--frame OLD=NEW`` pairs: OLD one of
-    the log's frames (sgtool's names), NEW a ROS name, no two frames under one name."""
+    the log's frames by sgtool's name or by the name ``--frames`` gives it (``map`` with
+    rep105), NEW a ROS name, no two frames under one name."""
     from sgtool.log import schemas as S
     from sgtool.recorders.exporters.bag_export import REP105
 
@@ -34,9 +35,12 @@ def _frames(style: str, pairs: tuple[str, ...]) -> dict[str, str]:
         old, sep, new = (x.strip() for x in pair.partition("="))
         if not sep or not old or not new:
             raise SgtoolError(f"--frame {pair!r}: give OLD=NEW, e.g. camera=camera_link")
+        styled = {n: f for f, n in REP105.items()} if style == "rep105" else {}
+        old = styled.get(old, old)  # the --frames name of a frame: the same frame
         if old not in frames:
+            shown = ", ".join(f"{f} ({REP105[f]})" if styled else f for f in frames)
             raise SgtoolError(f"--frame {pair!r}: {old!r} is no frame of an sgtool log "
-                              f"(those are {', '.join(frames)}, before any renaming)")
+                              f"(those are {shown})")
         if not _ROS_NAME.fullmatch(new):
             raise SgtoolError(f"--frame {pair!r}: {new!r} is not a ROS frame name (a letter "
                               "or '_', then letters, digits, '_' or '/')")
@@ -69,7 +73,9 @@ def _frames(style: str, pairs: tuple[str, ...]) -> dict[str, str]:
               help="Frame names: REP-105 (map, base_link, camera_optical_frame) or sgtool's "
                    "(world, base, camera).")
 @click.option("--frame", "frame_pairs", multiple=True, metavar="OLD=NEW",
-              help="Rename one frame (repeatable), after --frames.")
+              help="Rename one frame (repeatable), named as sgtool names it (world, base, "
+              "camera) or as --frames does (map, base_link, camera_optical_frame), e.g. "
+              "--frame map=odom.")
 @click.option("--compression", type=click.Choice(["zstd", "lz4", "bz2", "none"]),
               default=None,
               help="Chunk compression [default: zstd for ros2, lz4 for ros1; ros2 takes zstd "

@@ -283,7 +283,7 @@ def test_cli_options(tmp_path):
     assert got["/tf"][0][1].transforms[0].header.frame_id == "world"
     for bad, says in ((["--frame", "camera"], "--frame 'camera': give OLD=NEW"),
                       (["--frame", "nope=x"], "'nope' is no frame of an sgtool log (those are "
-                       "world, base, camera"),
+                       "world (map), base (base_link), camera (camera_optical_frame))"),
                       (["--frame", "world=bad name"], "'bad name' is not a ROS frame name"),
                       (["--frame", "world=base_link"], "two frames would be named base_link"),
                       (["--topics", ","], "--topics: give at least one topic"),
@@ -291,3 +291,9 @@ def test_cli_options(tmp_path):
         r = CliRunner().invoke(cli, ["export", "bag", str(log), "-o", str(tmp_path / "x"),
                                      *bad])
         assert r.exit_code == 2 and says in r.output, r.output
+    # a frame by its REP-105 name (the default --frames): map is the world frame
+    odom = tmp_path / "odom"
+    r = CliRunner().invoke(cli, ["export", "bag", str(log), "-o", str(odom), "--frame",
+                                 "map=odom", "--topics", "/tf", "--no-progress"])
+    assert r.exit_code == 0, r.output
+    assert read_bag(odom)["/tf"][0][1].transforms[0].header.frame_id == "odom"
