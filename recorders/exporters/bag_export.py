@@ -106,6 +106,7 @@ class ExportReport:
     derived: bool  # the log had derived layers
     time_base_s: float = DEFAULT_TIME_BASE_S
     compression: str = "none"
+    others: tuple[str, ...] = ()  # channels of the log that are none of sgtool's: not exported
 
     def lines(self) -> list[str]:
         total = sum(n for _, _, n in self.counts)
@@ -113,6 +114,9 @@ class ExportReport:
                f"stamps = log time + {self.time_base_s:g} s"]
         w = max((len(t) for t, _, _ in self.counts), default=5)
         out.extend(f"  {t:<{w}}  {ty}  {n}" for t, ty, n in self.counts)
+        if self.others:
+            out.append(f"note: not exported, channels sgtool does not know: "
+                       f"{', '.join(self.others)}")
         if not self.derived:
             out.append("note: the log has no derived layers (occupancy, Voronoi graph, rooms, "
                        "scene graph): export the output of `sgtool replay LOG -o DERIVED.mcap`")
@@ -197,6 +201,9 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
                               f"pass {_MAX_STAMP_S} s, the largest a ROS time holds (a signed "
                               "32-bit count of seconds)")
         derived = r.has(GRAPH_TOPIC) or r.has(S.OCCUPANCY)
+        records = {k.topic for k in S.RECORDS.values()}
+        others = tuple(sorted(t for t in r.topics() if t not in OUTPUTS_ORDER
+                              and t not in records and t != S.GRAPH_SCENE))
         names = frames if frames is not None else REP105
 
         def writer(path: Path) -> BagWriter:
@@ -218,7 +225,7 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
                 for entry in os.listdir(inner):
                     os.replace(inner / entry, stage / entry)
                 shutil.rmtree(inner)
-    return ExportReport(out, fmt, tuple(counts), derived, time_base_s, compression)
+    return ExportReport(out, fmt, tuple(counts), derived, time_base_s, compression, others)
 
 
 def _check_ros1_target(out: Path, force: bool) -> None:
@@ -238,10 +245,14 @@ def _check_ros1_target(out: Path, force: bool) -> None:
                           "not replacing it")
 
 
+STATIC_TOL = 1e-9  # m, and rotation-matrix entries: a link this still is static
+
+
 def _static_links(r: LogReader) -> tuple[dict[tuple[str, str], np.ndarray], int]:
     """The (parent, child) links whose transform is the same in every ``/tf`` message of
-    the log, and every link of its ``/tf_static``, with their transform; and the log time
-    of the earliest of their messages."""
+    the log (to :data:`STATIC_TOL`: a log of schema 1.0 composes base -> camera per frame,
+    equal to the last bits), and every link of its ``/tf_static``, with their transform
+    (the first); and the log time of the earliest of their messages."""
     seen: dict[tuple[str, str], np.ndarray] = {}
     first: dict[tuple[str, str], int] = {}
     moving: set[tuple[str, str]] = set()
@@ -249,7 +260,8 @@ def _static_links(r: LogReader) -> tuple[dict[tuple[str, str], np.ndarray], int]
     for d in r.messages(topics):
         key = (d.message.parent_frame_id, d.message.child_frame_id)
         T = codec.decode_transform(d.message)  # noqa: N806
-        if key in seen and d.topic == S.TF and not np.array_equal(seen[key], T):
+        if key in seen and d.topic == S.TF and \
+                not np.allclose(seen[key], T, rtol=0.0, atol=STATIC_TOL):
             moving.add(key)
         seen.setdefault(key, T)
         first.setdefault(key, d.log_time_ns)

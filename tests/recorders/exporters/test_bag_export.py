@@ -297,3 +297,29 @@ def test_cli_options(tmp_path):
                                  "map=odom", "--topics", "/tf", "--no-progress"])
     assert r.exit_code == 0, r.output
     assert read_bag(odom)["/tf"][0][1].transforms[0].header.frame_id == "odom"
+
+
+def test_a_link_still_to_the_last_bits_is_static_and_foreign_channels_are_named(tmp_path):
+    """A log of schema 1.0 composes base -> camera per frame, equal to the last bits: it
+    goes once to /tf_static; channels sgtool does not know are not exported, and said so."""
+    src = tmp_path / "jitter.mcap"
+    with LogWriter(src, seed=7) as w:
+        for i in range(4):
+            k, _, depth, _, pose, base = synthetic_frame(i)
+            if i == 0:
+                w.write_calibration(0, k)
+            w.write_transform(i * DT, S.WORLD_FRAME, S.BASE_FRAME, base)
+            link = np.linalg.inv(base) @ pose
+            link[0, 3] += i * 1e-16  # float noise of a composition
+            w.write_transform(i * DT, S.BASE_FRAME, S.CAMERA_FRAME, link)
+            w.write_depth(i * DT, depth)
+        cid = w.copy_channel("/chatter", "", "", b"", "json")
+        w.write_raw(cid, 0, b'{"data": "hi"}')
+    rep = export_bag(src, tmp_path / "out")
+    got = read_bag(tmp_path / "out")
+    assert len(got["/tf_static"]) == 1
+    (msg,) = (m for _, m in got["/tf_static"])
+    assert [t.child_frame_id for t in msg.transforms] == ["camera_optical_frame"]
+    assert {t.child_frame_id for _, m in got["/tf"] for t in m.transforms} == {"base_link"}
+    assert rep.others == ("/chatter",)
+    assert "note: not exported, channels sgtool does not know: /chatter" in rep.lines()
