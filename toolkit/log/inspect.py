@@ -149,6 +149,11 @@ def foreign_log_problem(path: str | os.PathLike[str]) -> str | None:
     enc = f"{', '.join(encodings) or 'no'} messages on {len(channels)} topics"
     if profile in ("ros1", "ros2") or encodings in (["cdr"], ["ros1"]):
         return f"{p} is {what} with {enc}, not an sgtool log; {_import_hint(p, channels)}"
+    if profile == S.PROFILE:
+        return (f"{p} has the MCAP profile 'sgtool' but no '{S.METADATA_NAME}' metadata "
+                "record (version, schema version, seed): not an sgtool log as written, or "
+                "one a tool rewrote without its metadata; copy the original's metadata "
+                "record into it, or record or import it again")
     return (f"{p} is {what} with {enc}, not an sgtool log (profile 'sgtool'); sgtool imports "
             "ROS 1/2 bags (`sgtool import bag`) and RGB-D folders (`sgtool import rgbd`)")
 

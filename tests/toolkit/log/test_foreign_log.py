@@ -57,3 +57,31 @@ def test_sgtool_logs_and_other_files_are_not_flagged(tmp_path):
     text.write_text("hello")
     assert foreign_log_problem(text) is None  # the reader's own error says what is wrong
     assert foreign_log_problem(tmp_path / "missing.mcap") is None
+
+
+def test_an_sgtool_profile_without_its_metadata_record_says_so(tmp_path):
+    """A log a tool rewrote without the 'sgtool' metadata record: the message says what is
+    missing (it said "profile 'sgtool' ... not an sgtool log (profile 'sgtool')")."""
+    from mcap.reader import make_reader
+    from mcap.writer import Writer
+
+    log = write_log(tmp_path / "log.mcap", n=2)
+    out = tmp_path / "bare.mcap"
+    with open(log, "rb") as f, open(out, "wb") as g:
+        r = make_reader(f)
+        w = Writer(g)
+        w.start(profile="sgtool", library="a tool")
+        ids: dict[int, int] = {}
+        for schema, channel, message in r.iter_messages():
+            if channel.id not in ids:
+                sid = w.register_schema(schema.name, schema.encoding, schema.data) \
+                    if schema else 0
+                ids[channel.id] = w.register_channel(channel.topic, channel.message_encoding,
+                                                     sid, channel.metadata)
+            w.add_message(ids[channel.id], message.log_time, message.data,
+                          message.publish_time)
+        w.finish()
+    msg = foreign_log_problem(out)
+    assert msg is not None and "has the MCAP profile 'sgtool' but no 'sgtool' metadata" in msg
+    r2 = CliRunner().invoke(cli, ["replay", str(out)])
+    assert r2.exit_code == 2 and "no 'sgtool' metadata record" in r2.output
