@@ -167,6 +167,10 @@ def _after_damage(buf: FileBytes, pos: int, end: int, lay: Layout, why: str
         return None
     opcode, length = h
     runs_past = length > end - pos - 9
+    if found is not None and runs_past and lay.footer is None and opcode == Opcode.CHUNK:
+        ch = chunk_prefix(buf, pos, end)
+        if ch is not None and not ch.compression:
+            found = None  # the records of the cut chunk's own uncompressed body: a cut
     if found is None and runs_past and lay.footer is None:
         lay.truncated = True
         lay.problems.append(f"file ends inside a record (opcode 0x{opcode:02x}, {length} "

@@ -75,6 +75,24 @@ def test_truncation_every_two_percent_recovers_a_growing_prefix(long_log, tmp_pa
     assert frames_seen[0] < frames_seen[-1]
 
 
+def test_a_cut_inside_an_uncompressed_chunk_is_a_truncation(tmp_path):
+    """An uncompressed chunk holds whole records in its body: a file cut inside one is
+    truncated, not corrupt (the records of the cut chunk are no resumption after damage;
+    a ROS 2 bag of a review helper, cut at 10 MB, was called corrupt)."""
+    path = tmp_path / "plain.mcap"
+    with LogWriter(path, seed=1, compression="none") as w:
+        for i in range(3 * FPS):
+            k, rgb, depth, ids, pose, base = synthetic_frame(i)
+            w.write_frame(i * DT, rgb=rgb, depth=depth, ids=ids, pose=pose, intrinsics=k)
+    data = path.read_bytes()
+    for pct in (15, 40, 55, 70, 85):
+        cut = tmp_path / "cut.mcap"
+        cut.write_bytes(data[: len(data) * pct // 100])
+        d = scan(cut)
+        assert d.status == "truncated", (pct, d.problems)
+        assert d.readable_messages > 0
+
+
 def test_corrupt_chunk_is_reported_and_skipped(long_log, tmp_path):
     data = bytearray(long_log.read_bytes())
     data[len(data) // 2] ^= 0xFF
