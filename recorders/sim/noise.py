@@ -38,6 +38,11 @@ from sgtool.log.frame import Frame
 from sgtool.recorders.sim.camera import LINK_TOL, se2_matrix
 
 
+# the largest strengths taken: 1 m of depth std at 1 m, 1 m of drift per metre driven, 1 rad
+# of yaw drift per metre (the strong profile is 0.006, 0.02, 0.02)
+LIMITS = {"depth_sigma": 1.0, "drift_xy": 1.0, "drift_yaw": 1.0}
+
+
 @dataclass(frozen=True)
 class NoiseProfile:
     """Fault strengths (all 0 = a perfect sensor)."""
@@ -62,6 +67,9 @@ class NoiseProfile:
         for p in ("holes", "label_swap", "label_dropout"):
             if getattr(self, p) > 1:
                 raise SgtoolError(f"noise {p}: a probability, at most 1")
+        for p, most in LIMITS.items():  # beyond these, no sensor: overflow, not noise
+            if getattr(self, p) > most:
+                raise SgtoolError(f"noise {p}: at most {most:g}, got {getattr(self, p):g}")
 
     @property
     def is_clean(self) -> bool:
