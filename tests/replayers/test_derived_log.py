@@ -131,6 +131,25 @@ def test_max_depth_bounds_what_is_mapped_and_is_recorded(tmp_path):
     assert any("depth to 1.5 m" in line for line in a.lines())
 
 
+def test_the_report_warns_of_doors_joining_one_room_and_of_no_room(tmp_path):
+    """Rooms merged across their doors (every door lists one room) and a map without a
+    room are said in the report; the clean two-room tour says neither."""
+    import dataclasses
+
+    rep = replay(synthetic_log(tmp_path / "two.mcap"), None, ReplayOptions())
+    assert not [line for line in rep.lines() if line.startswith("warning:")]
+    g = rep.last.graph
+    assert g.doors and all(len(set(d.rooms)) == 2 for d in g.doors)
+    merged = dataclasses.replace(g, doors=tuple(dataclasses.replace(d, rooms=d.rooms[:1])
+                                                for d in g.doors))
+    rep.last = dataclasses.replace(rep.last, graph=merged)
+    assert any(line.startswith(f"warning: {len(g.doors)} of {len(g.doors)} doors join one "
+                               "room only") for line in rep.lines())
+    rep.last = dataclasses.replace(rep.last, graph=dataclasses.replace(g, rooms=(), doors=()))
+    assert any(line.startswith("warning: no room in the final graph") and
+               "--max-depth 3" in line for line in rep.lines())
+
+
 def test_refresh_schedule_every_k_frames_and_at_actions(tmp_path):
     log = synthetic_log(tmp_path / "two.mcap")
     seen = []
