@@ -37,7 +37,6 @@ from sgtool.errors import SgtoolError
 from sgtool.log.frame import Frame
 from sgtool.recorders.sim.camera import LINK_TOL, se2_matrix
 
-
 # the largest strengths taken: 1 m of depth std at 1 m, 1 m of drift per metre driven, 1 rad
 # of yaw drift per metre (the strong profile is 0.006, 0.02, 0.02)
 LIMITS = {"depth_sigma": 1.0, "drift_xy": 1.0, "drift_yaw": 1.0}
