@@ -172,6 +172,9 @@ def check_house_files(paths: Sequence[str | os.PathLike[str]]) -> tuple[list[str
             (len(spec.objects), "small object(s)"), (queries, "query category(ies)")))
         lines.append(f"ok {f}: {h.id}: {counts}")
         lines.extend(f"   note: {n}" for n in h.notes)
+        if not spec.starts:  # (the symbolic bench draws its own starts: no note there)
+            lines.append("   note: no start poses: the closed loop (run, run-bench) adds "
+                         "its own (sgtool.datasets.start_poses)")
         ids[h.id] = str(f)
     return lines, len(ids) == len(sources) and not empty
 
@@ -198,8 +201,8 @@ def symbolic_house(spec: HouseSpec, where: str | os.PathLike[str]) -> tuple[Any,
 
 def house_notes(house: Any) -> tuple[str, ...]:
     """What a user should know of a house that loads: doors furniture blocks (read as
-    walls), no start poses (the bench adds its own), rooms walled off from the rest (their
-    targets are searched from inside, the others' from outside)."""
+    walls), rooms walled off from the rest (their targets are searched from inside, the
+    others' from outside)."""
     from sgtool.recorders.symbolic_environment.doorways import doorway_pieces
 
     spec = house.spec
@@ -212,9 +215,6 @@ def house_notes(house: Any) -> tuple[str, ...]:
                      "floor to the other's (" + (f"furniture within 1 m: {', '.join(near)}"
                                                  if near else "too narrow") +
                      "); read as a wall")
-    if not spec.starts:
-        notes.append("no start poses: the bench and the closed loop add their own "
-                     "(sgtool.datasets.start_poses)")
     cut = house.isolated_rooms()
     if cut:
         notes.append(f"{', '.join(cut)}: no door or passage leads there from the rest of "

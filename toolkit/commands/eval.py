@@ -7,6 +7,7 @@ and prints the result."""
 
 from __future__ import annotations
 
+import json
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -114,11 +115,21 @@ class EvalArgs:
 
 
 def _read_once(files: tuple[str, ...]) -> tuple[str, ...]:
-    """``files`` without the logs inside a folder whose episodes.jsonl is read too (``eval
-    run/ run/logs`` would count each episode twice), with a note."""
-    tables = [Path(f).resolve().parent for f in files if Path(f).name == "episodes.jsonl"]
-    dup = [f for f in files if f.endswith(".mcap") and
-           any(Path(f).resolve().is_relative_to(t) for t in tables)]
+    """``files`` without the logs an episodes.jsonl also read holds (a row's ``source``, or
+    a log under its folder's ``logs/``, as run-bench writes them: ``eval run/ run/logs``
+    would count each episode twice), with a note."""
+    tables = [Path(f) for f in files if Path(f).name == "episodes.jsonl"]
+    sources: set[Path] = set()
+    for t in tables:
+        try:
+            rows = [json.loads(line) for line in t.read_text(encoding="utf-8").splitlines()
+                    if line.strip()]
+        except (OSError, ValueError):
+            continue  # the reader's own error says what is wrong with it
+        sources |= {Path(r["source"]).resolve() for r in rows
+                    if isinstance(r, dict) and isinstance(r.get("source"), str)}
+    dup = [f for f in files if f.endswith(".mcap") and (Path(f).resolve() in sources or any(
+        Path(f).resolve().is_relative_to(t.resolve().parent / "logs") for t in tables))]
     if dup:
         click.echo(f"sgtool: note: {len(dup)} log(s) are episodes of an episodes.jsonl also "
                    "given; each episode is read once, from the table", err=True)
