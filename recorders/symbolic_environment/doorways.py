@@ -1,4 +1,5 @@
-"""Doors the robot cannot pass: furniture stands in the doorway.
+"""Doors the robot cannot get through: furniture in the doorway, or beyond it cutting the
+doorway's side off from the rest of its room.
 
 A door joins its two rooms in the symbolic house by an edge between one place on each side
 (:mod:`sgtool.recorders.symbolic_environment.house`); the places are snapped to the nearest
@@ -64,7 +65,7 @@ def blocked_doors(spec: HouseSpec, open_occ: OccupancyMap, rooms: np.ndarray,
         labels, _ = ndimage.label(free[win] & inside)
         through = sorted({int(labels[r - win[0].start, c - win[1].start]) for r, c in cells})
         if not any(all(bool((labels[s[win]] == k).any()) for s in sides if s is not None)
-                   for k in through):
+                   for k in through):  # (no side is None here: niches were skipped)
             out.append(di)
     return tuple(out)
 
