@@ -360,6 +360,8 @@ def run_task(args: tuple[BenchConfig, BenchHouse, tuple[str, ...]]) -> list[Epis
 
 def _task_episodes(cfg: BenchConfig, ref: BenchHouse,
                    names: tuple[str, ...]) -> list[EpisodeResult]:
+    from sgtool.errors import SgtoolError
+    from sgtool.planning.moma.planner import replay_miss_of
     from sgtool.planning.registry import planner_file_name
     from sgtool.recorders.symbolic_environment.rollout import run_episode
     from sgtool.semantics.text import category_text
@@ -376,14 +378,17 @@ def _task_episodes(cfg: BenchConfig, ref: BenchHouse,
                           house_id=ref.id, planner_name=name, success=cfg.success)
                 if cfg.log_dir is None:
                     out.append(run_episode(house, planner, ep.query, ep.targets, **kw))
-                    continue
-                from sgtool.log.writer import LogWriter
+                else:
+                    from sgtool.log.writer import LogWriter
 
-                path = output_path(cfg.log_dir, planner_file_name(name), ref.id,
-                                   f"seed{seed}-ep{i}.mcap")
-                path.parent.mkdir(parents=True, exist_ok=True)
-                with LogWriter(path, seed=seed) as log:
-                    out.append(run_episode(house, planner, ep.query, ep.targets, log=log, **kw))
+                    path = output_path(cfg.log_dir, planner_file_name(name), ref.id,
+                                       f"seed{seed}-ep{i}.mcap")
+                    path.parent.mkdir(parents=True, exist_ok=True)
+                    with LogWriter(path, seed=seed) as log:
+                        out.append(run_episode(house, planner, ep.query, ep.targets, log=log,
+                                               **kw))
+                if miss := replay_miss_of(planner):  # --llm-replay of another run
+                    raise SgtoolError(f"{name}: {miss} ({ref.id}, episode {i}, seed {seed})")
     return out
 
 

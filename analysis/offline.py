@@ -357,7 +357,10 @@ def replay_decisions(planner: Planner, episodes: Sequence[LoggedEpisode],
                      name: str | None = None) -> OfflineReport:
     """Ask ``planner`` at every logged decision point of ``episodes`` (module doc: it
     decides on the logged graph, then is told the logged outcome) and compare its choices
-    with the logged actions; ``name`` labels the report (default: the planner's name)."""
+    with the logged actions; ``name`` labels the report (default: the planner's name). An
+    LLM planner that leaves its recorded transcript (another run's) is an error."""
+    from sgtool.planning.moma.planner import replay_miss_of
+
     out: list[DecisionComparison] = []
     skipped = 0
     for ep in episodes:
@@ -377,6 +380,9 @@ def replay_decisions(planner: Planner, episodes: Sequence[LoggedEpisode],
                 t0 = time.perf_counter()
                 chosen = planner.decide(logged.shown(d.graph))
                 dt = time.perf_counter() - t0
+                if miss := replay_miss_of(planner):  # --llm-replay of other logs
+                    raise SgtoolError(f"{name or getattr(planner, 'name', 'planner')}: {miss} "
+                                      f"({ep.source}, decision {step})")
                 valid = chosen.skill == "done" or chosen.target in d.graph.node_ids()
                 lr = node_rooms(d.graph, logged.target)
                 same_room = bool(lr & node_rooms(d.graph, chosen.target)) or (

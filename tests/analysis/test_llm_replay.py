@@ -104,6 +104,22 @@ def test_eval_cli_replays_from_the_mcap_and_reports_answers(llm_log) -> None:
     assert doc["llm_answers"]["invalid"] == 1
 
 
+def test_eval_with_another_runs_transcript_is_an_error(llm_log, tmp_path) -> None:
+    """A transcript that does not hold the logs' prompts is no replay of them: one error
+    line naming the log and the decision, not a table of give-ups."""
+    path, _ = llm_log
+    other = tmp_path / "other.jsonl"
+    _, rec = log_exchanges([path])[0]
+    rec = {**rec, "messages": [{"role": "user", "content": "another run's prompt"}]}
+    rec.pop("prompt_sha256", None)
+    other.write_text(json.dumps(rec) + "\n")
+    r = CliRunner().invoke(cli, ["eval", str(path), "-p", "moma-llm", "--llm-replay",
+                                 str(other)])
+    assert r.exit_code == 2, r.output
+    assert "holds no (more) responses for this prompt" in r.output
+    assert f"({path}, decision 0)" in r.output
+
+
 def test_success_rules_in_eval(llm_log) -> None:
     path, res = llm_log
     (r,) = load_results([path])[0]

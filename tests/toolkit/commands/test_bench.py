@@ -298,6 +298,15 @@ def test_moma_llm_transcript_then_replay(tmp_path):
     assert r.exit_code == 0, r.output
     replayed = read_jsonl(tmp_path / "o" / "episodes.jsonl")
     assert results_digest(replayed) == live.digest
+    # the transcript of another house is no replay of this run: an error, nothing written
+    r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
+                                 "--house-seed", "5", "--episodes", "2", "--seeds", "1",
+                                 "--no-progress", "--llm-replay", str(transcript), "-o",
+                                 str(tmp_path / "other")])
+    assert r.exit_code == 2, r.output
+    assert "holds no (more) responses for this prompt" in r.output
+    assert "(house-5, episode 0, seed 0)" in r.output
+    assert not (tmp_path / "other" / "episodes.jsonl").exists()
 
 
 @pytest.mark.parametrize("command", ["bench", "run-bench"])

@@ -321,3 +321,13 @@ class MomaLlmPlanner:
     def close(self) -> None:
         if self._transcript is not None:
             self._transcript.close()
+
+
+def replay_miss_of(planner: object) -> str | None:
+    """What made ``planner`` (or the planner a wrapper holds as ``inner``) leave its
+    recorded transcript in the episode just run (``--llm-replay`` of another run), or
+    None; a run that meets one is no replay and must say so, not score a give-up."""
+    inner = getattr(planner, "inner", planner)
+    miss = getattr(inner, "replay_miss", None)
+    return miss if isinstance(miss, str) else None
+
