@@ -58,6 +58,11 @@ def check_planner_options(planners: Sequence[str], options: Mapping[str, Mapping
         replay = opts.get("replay")
         if replay is not None and not Path(replay).is_file():
             raise BenchError(f"--llm-replay: no such transcript {replay}")
+        written = opts.get("transcript")
+        read = [replay] if isinstance(replay, str | Path) else list(replay or ())
+        if written and any(Path(r).resolve() == Path(written).resolve() for r in read):
+            raise BenchError(f"--llm-transcript {written}: it is the --llm-replay transcript "
+                             "(a run's transcript is emptied when it starts)")
         if opts.get("transcript") and not one_writer:
             raise BenchError("--llm-transcript needs --workers 1 and the local executor "
                              "(one file, one writer)")

@@ -41,6 +41,7 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     error line and nothing is written; Ctrl-C leaves both folders as they were."""
     from sgtool.analysis.bench import OUTPUT_NAMES, run_benchmark, write_outputs
     from sgtool.files import output_folder
+    from sgtool.llm.recorded import start_transcript
 
     out_dir, log_dir = request.out_dir, request.config.log_dir
     try:
@@ -52,6 +53,7 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
                     stack.enter_context(output_folder(log_dir, force=request.force,
                                                       command="bench", option="--log-dir"))
             cfg = replace(request.config, log_dir=None if logs is None else str(logs))
+            start_transcript(cfg.planner_options.get("moma-llm", {}).get("transcript"))
             res = run_benchmark(cfg, progress=request.progress)
             if res.failed:  # tables without some houses' episodes would pass for a result
                 raise SgtoolError(f"{len(res.failed)} task(s) failed after a retry, nothing "

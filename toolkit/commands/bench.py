@@ -95,7 +95,8 @@ if TYPE_CHECKING:
               show_default=True,
               help="AUC-E step variant budget max, in high-level steps.")
 @llm_log_options(
-    transcript_help="moma-llm: append every LLM exchange to this JSONL transcript "
+    transcript_help="moma-llm: write every LLM exchange to this JSONL transcript, emptied "
+    "when the run starts "
     "(needs --workers 1).")
 @llm_endpoint_options("LLM planners")
 @click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",

@@ -104,7 +104,8 @@ if TYPE_CHECKING:
                    "planner draws from a seed made of it, the house seed and the episode "
                    "index, as in `sgtool bench`.")
 @llm_log_options(
-    transcript_help="moma-llm: append every LLM exchange to this JSONL transcript (replay it "
+    transcript_help="moma-llm: write every LLM exchange to this JSONL transcript, emptied "
+    "when the run starts (replay it "
     "later with --llm-replay).")
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
               help="The episode log to write (OUT.mcap).")
@@ -213,6 +214,11 @@ def _planner(args: RunArgs) -> tuple[str, dict[str, Any]]:
             raise SgtoolError(f"--llm-replay {args.llm_replay}: no such file")
         options["replay"] = args.llm_replay
     if args.llm_transcript:
+        if args.llm_replay and Path(args.llm_replay).resolve() == \
+                Path(args.llm_transcript).resolve():
+            raise SgtoolError(f"--llm-transcript {args.llm_transcript}: it is the "
+                              "--llm-replay transcript (a run's transcript is emptied when "
+                              "it starts)")
         options["transcript"] = args.llm_transcript
     return name, options
 

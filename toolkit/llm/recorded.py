@@ -39,6 +39,21 @@ class ReplayMiss(LlmTransportError):
     """The transcript has no (more) responses for this prompt."""
 
 
+def start_transcript(path: str | Path | None) -> None:
+    """Empty the transcript at ``path`` (created) when a command's run starts: a transcript
+    holds one run, so that a replay of it cannot serve an earlier run's answers to the same
+    prompts first (the planner's writer then appends the run's exchanges)."""
+    if path is None:
+        return
+    p = Path(path)
+    try:
+        p.parent.mkdir(parents=True, exist_ok=True)
+        with open(p, "w", encoding="utf-8"):
+            pass
+    except OSError as e:
+        raise output_error(e, p) from None
+
+
 class TranscriptWriter:
     """Writes records as JSON lines, one ``write`` + flush per record.
 

@@ -298,6 +298,22 @@ def test_moma_llm_transcript_then_replay(tmp_path):
     assert r.exit_code == 0, r.output
     replayed = read_jsonl(tmp_path / "o" / "episodes.jsonl")
     assert results_digest(replayed) == live.digest
+    # a run's transcript holds that run only (an earlier run's answers would be served
+    # first by a replay of it), and cannot be the transcript it replays
+    again = tmp_path / "again.jsonl"
+    again.write_text('{"an": "earlier run"}\n')
+    r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
+                                 "--episodes", "2", "--seeds", "1", "--no-progress",
+                                 "--llm-replay", str(transcript), "--llm-transcript",
+                                 str(again), "-o", str(tmp_path / "o2")])
+    assert r.exit_code == 0, r.output
+    assert "earlier run" not in again.read_text()
+    assert len(again.read_text().splitlines()) == len(transcript.read_text().splitlines())
+    r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
+                                 "--episodes", "2", "--seeds", "1", "--no-progress",
+                                 "--llm-replay", str(again), "--llm-transcript", str(again),
+                                 "-o", str(tmp_path / "o3")])
+    assert r.exit_code == 2 and "it is the --llm-replay transcript" in r.output
     # the transcript of another house is no replay of this run: an error, nothing written
     r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
                                  "--house-seed", "5", "--episodes", "2", "--seeds", "1",
