@@ -40,6 +40,7 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     then show the tables and the files written; a task that failed after a retry is one
     error line and nothing is written; Ctrl-C leaves both folders as they were."""
     from sgtool.analysis.bench import OUTPUT_NAMES, run_benchmark, write_outputs
+    from sgtool.analysis.report import llm_answer_totals
     from sgtool.files import output_folder
     from sgtool.llm.recorded import start_transcript
 
@@ -70,4 +71,9 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     for h in res.houses:
         for line in h.notes:
             show(f"sgtool: note: {h.source}: {line}")
+    for planner, t in llm_answer_totals(res.results, res.config.planners).items():
+        if not t["valid"] and t["faults"]:  # a wrong endpoint that answers, with garbage
+            show(f"sgtool: warning: {planner}: none of its {t['requests']} LLM requests got a "
+                 f"valid answer ({t['faults']} faults); check the endpoint with `sgtool llm "
+                 "check`")
     show(f"wrote {', '.join(str(Path(out_dir) / name) for name in written)}")

@@ -145,6 +145,12 @@ class LlmSettings:
         return cls(base_url, model, api_key, timeout, temperature, max_tokens)
 
 
+# HTTP statuses of a first request that say the setup is wrong (key, path, model, method;
+# 501: a server that takes no POST), not that the server is busy or failing (408, 429 and
+# the other 5xx stay faults to retry around)
+SETUP_STATUS = frozenset({401, 403, 404, 405, 501})
+
+
 class OpenAIChatClient:
     """One chat-completion request per :meth:`complete` call."""
 
@@ -165,6 +171,7 @@ class OpenAIChatClient:
         )
         self._client = self._new_client()
         self.replies = 0  # HTTP replies received (any status): the endpoint exists
+        self.answers = 0  # replies with a usable answer
 
     @property
     def where(self) -> str:
@@ -196,6 +203,12 @@ class OpenAIChatClient:
                 f"{self.where}: no reply within {timeout:.3g} s") from e
         except openai.APIStatusError as e:
             self.replies += 1
+            if not self.answers and e.status_code in SETUP_STATUS:
+                # before any answer: a wrong key, path or model, not a fault to retry around
+                raise LlmConfigError(
+                    f"the LLM endpoint {self.where} refused the first request: HTTP "
+                    f"{e.status_code}: {self._short(e)}; check the API key, the base URL "
+                    f"and the model ({self.model}) with `sgtool llm check`") from e
             raise LlmTransportError(
                 f"{self.where}: HTTP {e.status_code}: {self._short(e)}") from e
         except openai.APIConnectionError as e:
@@ -213,6 +226,7 @@ class OpenAIChatClient:
         latency = time.perf_counter() - t0
         self.replies += 1
         text = reply_text(resp, self.where)
+        self.answers += 1
         text, full = cut_reply(text)
         usage = _field(resp, "usage")
         return ChatResult(

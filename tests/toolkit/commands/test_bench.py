@@ -332,3 +332,25 @@ def test_help_names_the_default_planners(command):
 
     out = CliRunner().invoke(cli, [command, "--help"], terminal_width=400).output
     assert "Default: " + ", ".join(DEFAULT_PLANNERS) + " (" in " ".join(out.split())
+
+
+def test_an_endpoint_that_never_answers_is_warned_about(tmp_path):
+    """Every request fails (HTTP 500 from the start: a busy or broken server, no setup
+    mistake the first request could name): the run completes and says that no answer came."""
+    from support.semantics_fixtures import ChatServer
+
+    with ChatServer() as srv:  # HTTP 500 to every request
+        r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
+                                     "--episodes", "1", "--seeds", "1", "--max-steps", "2",
+                                     "--no-progress", "--llm-base-url", srv.base_url,
+                                     "--llm-model", "m", "-o", str(tmp_path / "o")])
+    assert r.exit_code == 0, r.output
+    assert "sgtool: warning: moma-llm: none of its" in r.output
+    assert "check the endpoint with `sgtool llm check`" in r.output
+    with ChatServer(responder=lambda req: {"status": 401}) as srv:  # a wrong key: stop
+        r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
+                                     "--episodes", "1", "--seeds", "1", "--no-progress",
+                                     "--llm-base-url", srv.base_url, "--llm-model", "m",
+                                     "-o", str(tmp_path / "o2")])
+    assert r.exit_code == 2 and "refused the first request: HTTP 401" in r.output
+    assert not (tmp_path / "o2" / "episodes.jsonl").exists()

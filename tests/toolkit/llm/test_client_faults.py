@@ -13,6 +13,7 @@ from support.semantics_fixtures import ChatServer, answer, house
 from sgtool.llm.client import (
     MAX_REPLY_CHARS,
     ChatResult,
+    LlmConfigError,
     LlmSettings,
     LlmTransportError,
     OpenAIChatClient,
@@ -53,6 +54,28 @@ def test_malformed_replies_are_retryable_one_line_faults(reply, reason):
             client(srv).complete([{"role": "user", "content": "x"}])
     msg = str(info.value)
     assert reason in msg and "\n" not in msg and KEY not in msg
+
+
+@pytest.mark.parametrize(("first", "says"), [
+    ({"status": 401}, "refused the first request: HTTP 401"),
+    ({"status": 404}, "refused the first request: HTTP 404"),
+    ({"status": 501}, "refused the first request: HTTP 501"),
+])
+def test_a_wrong_setup_stops_at_the_first_request(first, says):
+    """A wrong key, path or model, or a server that is no chat endpoint, refuses the first
+    request: a one-line user error (the run stops), not a fault every decision retries;
+    the same status once answers came is a fault, and a 500 is one from the start."""
+    with ChatServer([first]) as srv:
+        with pytest.raises(LlmConfigError) as info:
+            client(srv).complete([{"role": "user", "content": "x"}])
+    assert says in str(info.value) and "\n" not in str(info.value)
+    with ChatServer([{"text": "fine"}, first, {"status": 500}]) as srv:
+        c = client(srv)
+        c.complete([{"role": "user", "content": "x"}])
+        with pytest.raises(LlmTransportError):
+            c.complete([{"role": "user", "content": "x"}])
+    with ChatServer([{"status": 500}]) as srv, pytest.raises(LlmTransportError):
+        client(srv).complete([{"role": "user", "content": "x"}])
 
 
 def test_bad_token_counts_are_dropped_not_fatal():
