@@ -128,18 +128,21 @@ def server_root(base_url: str) -> str:
     return u[:-3] if u.endswith("/v1") else u
 
 
-def detect_kind(base_url: str | None, timeout_s: float = 3.0) -> str:
+def detect_kind(base_url: str | None, timeout_s: float = 3.0,
+                api_key: str | None = None) -> str:
     """``grammar`` for a llama.cpp server, ``json_schema`` for api.openai.com (no base URL),
-    else ``none`` (module doc). Never raises: an endpoint that does not answer gets
+    else ``none`` (module doc); ``api_key`` goes with the request (a server started with a
+    key answers nothing without it). Never raises: an endpoint that does not answer gets
     ``none`` and the planner parses plain answers."""
     if not base_url:
         return "json_schema"
     host = urllib.parse.urlsplit(base_url).hostname or ""
     if host == "api.openai.com":
         return "json_schema"
+    req = urllib.request.Request(server_root(base_url) + "/props", headers={
+        "Authorization": f"Bearer {api_key}"} if api_key else {})
     try:
-        with urllib.request.urlopen(server_root(base_url) + "/props",  # noqa: S310
-                                    timeout=timeout_s) as resp:
+        with urllib.request.urlopen(req, timeout=timeout_s) as resp:  # noqa: S310
             props = json.loads(resp.read(1 << 20))
     except Exception:  # noqa: BLE001 - not llama.cpp, or not reachable: plain parsing
         return "none"

@@ -122,7 +122,9 @@ class LlmRoomClassifier:
             raise ValueError("no room types to choose from")
         kind = check_kind(constraint)
         if kind == "auto":
-            kind = detect_kind(getattr(getattr(client, "settings", None), "base_url", None)) \
+            settings = getattr(client, "settings", None)
+            kind = detect_kind(getattr(settings, "base_url", None),
+                               api_key=getattr(settings, "api_key", None)) \
                 if getattr(client, "takes_constraint", False) else "none"
         self.constraint = kind
         self.fallback = fallback

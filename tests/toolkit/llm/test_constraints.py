@@ -81,6 +81,35 @@ def test_kinds_and_detection() -> None:
         assert detect_kind(srv.base_url) == "none"
 
 
+def test_detection_sends_the_api_key() -> None:
+    """A llama.cpp server started with a key answers GET /props only with it: without the
+    key the planner lost its grammar (a review helper's server, 0 valid answers of 10)."""
+    import threading
+    from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+
+    class Props(BaseHTTPRequestHandler):
+        def log_message(self, *args: object) -> None:
+            pass
+
+        def do_GET(self) -> None:  # noqa: N802
+            ok = self.headers.get("Authorization") == "Bearer lab-key"
+            body = json.dumps({"default_generation_settings": {}}).encode() if ok else b"{}"
+            self.send_response(200 if ok else 401)
+            self.send_header("Content-Length", str(len(body)))
+            self.end_headers()
+            self.wfile.write(body)
+
+    srv = ThreadingHTTPServer(("127.0.0.1", 0), Props)
+    threading.Thread(target=srv.serve_forever, daemon=True).start()
+    try:
+        url = f"http://127.0.0.1:{srv.server_address[1]}/v1"
+        assert detect_kind(url) == "none"
+        assert detect_kind(url, api_key="lab-key") == "grammar"
+    finally:
+        srv.shutdown()
+        srv.server_close()
+
+
 def test_json_answer_parses_with_its_sections() -> None:
     cmd = parse_response(json.dumps({"analysis": "milk is cold", "reasoning": "fridge",
                                      "command": "go_to_and_open(kitchen, fridge)"}))

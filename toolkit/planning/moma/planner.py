@@ -125,8 +125,9 @@ class MomaLlmPlanner:
         self.decision_timeout_s = float(decision_timeout_s)
         self.constraint = check_kind(constraint)
         if self.constraint == "auto":
-            self.constraint = detect_kind(getattr(getattr(client, "settings", None),
-                                                  "base_url", None)) \
+            settings = getattr(client, "settings", None)
+            self.constraint = detect_kind(getattr(settings, "base_url", None),
+                                          api_key=getattr(settings, "api_key", None)) \
                 if getattr(client, "takes_constraint", False) else "none"
         self.reason_chars = int(reason_chars)
         self.invalid_commands = 0  # answers rejected (unparsable or not groundable)
