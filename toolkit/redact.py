@@ -33,13 +33,21 @@ def is_secret_name(name: str) -> bool:
 
 def redact_options(options: Any) -> Any:
     """A copy of ``options`` (mappings, lists, tuples of plain values) with the value of
-    every key named like a secret replaced by :data:`REDACTED`."""
+    every key named like a secret replaced by :data:`REDACTED`, and the password of a URL
+    in any text value (``http://user:PASS@host``) too."""
     if isinstance(options, Mapping):
         return {k: (REDACTED if is_secret_name(str(k)) and v is not None
                     else redact_options(v)) for k, v in options.items()}
     if isinstance(options, list | tuple):
         return type(options)(redact_options(v) for v in options)
+    if isinstance(options, str):
+        return redact_url(options)
     return options
+
+
+def redact_url(text: str) -> str:
+    """``text`` with the password of every URL in it (``user:PASS@host``) redacted."""
+    return _URL_PASSWORD.sub(rf"\g<1>{REDACTED}@", text)
 
 
 def secret_values(options: object) -> list[str]:
@@ -66,4 +74,4 @@ def redact_text(text: str, secrets: Iterable[str | None] = ()) -> str:
     text = _ASSIGNMENT.sub(
         lambda m: m.group(1) + REDACTED if is_secret_name(m.group(1).split(".")[-1][:-1])
         else m.group(0), text)
-    return _URL_PASSWORD.sub(rf"\g<1>{REDACTED}@", text)
+    return redact_url(text)

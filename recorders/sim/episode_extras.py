@@ -20,11 +20,11 @@ from sgtool.scenegraph.build_options import ResolvedOptions, mapping_record
 def recorded_options(options: Mapping[str, Any]) -> dict[str, Any]:
     """A planner's options as an episode record keeps them: JSON values only (a Python
     object set from Python, an encoder, is left out), keys named like secrets left out
-    (:func:`sgtool.redact.is_secret_name`), sorted."""
-    from sgtool.redact import is_secret_name
+    (:func:`sgtool.redact.is_secret_name`) and URL passwords redacted, sorted."""
+    from sgtool.redact import is_secret_name, redact_options
 
     plain = (str, int, float, bool, type(None))
-    return {k: v for k, v in sorted(options.items())
+    return {k: redact_options(v) for k, v in sorted(options.items())
             if not is_secret_name(str(k)) and (isinstance(v, plain) or (
                 isinstance(v, list | tuple) and all(isinstance(x, plain) for x in v)))}
 

@@ -31,6 +31,18 @@ def test_options_are_redacted_at_any_depth_and_not_changed_in_place():
     assert secret_values(opts) == ["sk-1", "t-2"]
 
 
+def test_url_passwords_in_option_values_are_redacted():
+    """A password in a base URL reached summary.json and the episode records (a review
+    helper's "http://labuser:SECRETPW@host/v1")."""
+    from sgtool.recorders.sim.episode_extras import recorded_options
+
+    opts = {"base_url": "http://labuser:SECRETPW@127.0.0.1:8080/v1", "model": "m"}
+    assert redact_options(opts)["base_url"] == f"http://labuser:{REDACTED}@127.0.0.1:8080/v1"
+    assert "SECRETPW" not in str(recorded_options(opts))
+    assert redact_options({"base_url": "http://127.0.0.1:8080/v1"}) == \
+        {"base_url": "http://127.0.0.1:8080/v1"}
+
+
 def test_text_loses_known_secrets_and_url_passwords():
     text = "sgtool bench -O moma-llm.api_key=sk-abcdef -O x.base_url=http://u:hunter2@h:1/v1"
     assert redact_text(text, ["sk-abcdef", None, "ab"]) == (
