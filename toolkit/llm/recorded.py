@@ -118,15 +118,19 @@ class TranscriptWriter:
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 
 
+def _is_mcap(path: Path) -> bool:
+    with open(path, "rb") as fh:
+        return fh.read(len(MCAP_MAGIC)) == MCAP_MAGIC
+
+
 def read_transcript(path: str | Path) -> list[dict[str, Any]]:
     """The exchange records of a JSONL transcript, or of the ``/sgtool/llm`` channel of an
     MCAP log (a closed-loop log, a bench ``--log-dir`` log), in recorded order."""
     path = Path(path)
     if not path.is_file():
         raise TranscriptError(f"LLM transcript not found: {path}")
-    with open(path, "rb") as fh:
-        if fh.read(len(MCAP_MAGIC)) == MCAP_MAGIC:
-            return _log_exchanges(path)
+    if _is_mcap(path):
+        return _log_exchanges(path)
     out = []
     with open(path, encoding="utf-8") as fh:
         lines = fh.readlines()
@@ -170,7 +174,15 @@ class ReplayChatClient:
                  ) -> None:
         paths = [Path(path)] if isinstance(path, str | Path) else [Path(p) for p in path]
         self.path = paths[0] if len(paths) == 1 else Path(f"{paths[0]} (+{len(paths) - 1})")
-        records = [rec for p in paths for rec in read_transcript(p)]
+        records = []
+        for p in paths:
+            got = read_transcript(p)
+            if not got and _is_mcap(p):
+                raise TranscriptError(
+                    f"{p} holds no LLM exchanges (/sgtool/llm): the derived log of `replay "
+                    "--classifier llm` does not log them; give the --llm-transcript that "
+                    "replay wrote, or a log of an LLM planner's run")
+            records += got
         self.model = model or (records[0]["model"] if records else "replay")
         self._queues: dict[str, deque[dict[str, Any]]] = {}
         for rec in records:

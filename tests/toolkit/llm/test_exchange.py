@@ -90,3 +90,8 @@ def test_transcript_errors_and_interrupted_last_line(tmp_path) -> None:
     mid.write_text(line[:20] + "\n" + line + "\n")
     with pytest.raises(TranscriptError, match=":1: not a JSON line"):
         ReplayChatClient(mid)
+    from support.paths import TESTS
+
+    tour = TESTS / "golden" / "house6-tour.mcap"  # an MCAP log without /sgtool/llm
+    with pytest.raises(TranscriptError, match=r"holds no LLM exchanges \(/sgtool/llm\)"):
+        ReplayChatClient(tour)
