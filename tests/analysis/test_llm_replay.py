@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import math
 
 import pytest
 from click.testing import CliRunner
@@ -84,6 +85,12 @@ def test_the_log_holds_the_exchanges_and_the_executor_messages(llm_log) -> None:
     stats = answer_stats(ex)
     assert stats.invalid == 1 and stats.valid == len(ep.decisions)
     assert stats.requests == len(ep.decisions) + 1 and stats.decisions == len(ep.decisions)
+    # the same records as a replay serves them: counted alike, but a replay's latency (the
+    # time to look an answer up) is no generation speed
+    replayed = answer_stats((src, {**r, "source": "replay"}) for src, r in ex)
+    assert (replayed.requests, replayed.valid, replayed.invalid) == \
+        (stats.requests, stats.valid, stats.invalid)
+    assert replayed.latency_s == 0.0 and math.isnan(replayed.tokens_per_s)
 
 
 def test_every_decision_replays_from_the_log(llm_log) -> None:

@@ -25,7 +25,7 @@ class AnswerStats:
     unknown: int  # answers without a verdict
     decisions: int
     completion_tokens: int
-    latency_s: float  # summed over requests
+    latency_s: float  # summed over requests to an endpoint (a replay's are no speed)
 
     @property
     def invalid_rate(self) -> float:
@@ -52,11 +52,12 @@ def answer_stats(records: Iterable[tuple[str, Mapping[str, Any]]]) -> AnswerStat
     for source, r in records:
         requests += 1
         decisions.add((source, r.get("query"), r.get("step")))
-        latency += float(r.get("latency_s") or 0.0)
+        live = r.get("source", "endpoint") != "replay"  # a replay's latency is no speed
+        latency += float(r.get("latency_s") or 0.0) if live else 0.0
         if r.get("error") or r.get("response") is None:
             faults += 1
             continue
-        tokens += int(r.get("completion_tokens") or 0)
+        tokens += int(r.get("completion_tokens") or 0) if live else 0
         verdict = str(r.get("verdict") or "")
         if verdict == "ok":
             valid += 1
