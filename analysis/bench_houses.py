@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -149,20 +149,30 @@ def load_house_files(paths: Sequence[str | os.PathLike[str]],
     return tuple(houses)
 
 
-def check_house_files(paths: Sequence[str | os.PathLike[str]]) -> tuple[list[str], bool]:
+def check_house_files(paths: Sequence[str | os.PathLike[str]],
+                      emit: Callable[[str], None] | None = None) -> tuple[list[str], bool]:
     """The checks of a bench run (:func:`load_house_files`) file by file: one line per
     house file (``ok FILE: id, counts`` and its notes, or the problem) and whether every
-    file passed, ids across files included."""
-    empty = [f"error {p}: no *.json house files there" for p in map(Path, paths)
-             if p.is_dir() and not folder_houses(p)]
-    lines = list(empty)
+    file passed, ids across files included; ``emit`` gets each file's lines as soon as it
+    is checked (a folder of big houses takes minutes)."""
+    lines: list[str] = []
+
+    def add(new: Iterable[str]) -> None:  # kept, and to ``emit`` at once
+        for line in new:
+            lines.append(line)
+            if emit is not None:
+                emit(line)
+
+    add(f"error {p}: no *.json house files there" for p in map(Path, paths)
+        if p.is_dir() and not folder_houses(p))
+    empty = bool(lines)
     ids: dict[str, str] = {}  # the ids of the files that passed, each loaded once
     sources = _house_sources(paths)
     for f, _ in sources:
         try:
             (h,) = load_house_files([f], taken=ids)
         except HouseFilesError as e:  # its own problem, or an id an earlier file holds
-            lines.extend(f"error {line}" for line in str(e).splitlines())
+            add(f"error {line}" for line in str(e).splitlines())
             continue
         spec = h.spec
         assert spec is not None
@@ -170,11 +180,10 @@ def check_house_files(paths: Sequence[str | os.PathLike[str]]) -> tuple[list[str
         counts = ", ".join(f"{n} {word}" for n, word in (
             (len(spec.rooms), "room(s)"), (len(spec.furniture), "piece(s) of furniture"),
             (len(spec.objects), "small object(s)"), (queries, "query category(ies)")))
-        lines.append(f"ok {f}: {h.id}: {counts}")
-        lines.extend(f"   note: {n}" for n in h.notes)
+        add([f"ok {f}: {h.id}: {counts}", *(f"   note: {n}" for n in h.notes)])
         if not spec.starts:  # (the symbolic bench draws its own starts: no note there)
-            lines.append("   note: no start poses: the closed loop (run, run-bench) adds "
-                         "its own (sgtool.datasets.start_poses)")
+            add(["   note: no start poses: the closed loop (run, run-bench) adds its own "
+                 "(sgtool.datasets.start_poses)"])
         ids[h.id] = str(f)
     return lines, len(ids) == len(sources) and not empty
 

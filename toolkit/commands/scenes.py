@@ -88,9 +88,7 @@ def check_cmd(houses: tuple[str, ...]) -> None:
     file fails."""
     from sgtool.analysis.bench_houses import check_house_files
 
-    lines, ok = check_house_files(houses)
-    for line in lines:
-        click.echo(line)
+    lines, ok = check_house_files(houses, emit=click.echo)  # each file's lines at once
     if not ok:
         raise SgtoolError(f"{sum(x.startswith('error') for x in lines)} problem(s) in the "
                           "house files above")

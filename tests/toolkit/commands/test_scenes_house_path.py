@@ -6,8 +6,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
 from click.testing import CliRunner
-from support.datasets_fixtures import no_free_floor, two_rooms
+from support.datasets_fixtures import no_free_floor, two_rooms, walled_off
 
 from sgtool.cli import cli
 from sgtool.commands.options import house_from_options
@@ -85,3 +86,25 @@ def test_check_names_every_file_with_its_verdict(tmp_path: Path) -> None:
     assert r.exit_code == 0 and r.output.splitlines()[1] == (
         "   note: read as supporters, with something on top and no 'supporter' in the file: "
         "table")
+
+
+def test_check_gives_each_files_lines_as_it_is_checked(tmp_path: Path,
+                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    """A folder of big houses takes minutes: each file's lines go out when it is done, not
+    all at the end (the second file is loaded after the first's line was emitted)."""
+    from sgtool.analysis import bench_houses
+
+    good = _write(tmp_path / "a.json", two_rooms())
+    other = _write(tmp_path / "b.json", walled_off(two_rooms(), "door_0"))
+    emitted: list[str] = []
+    seen: list[str] = []
+    real = bench_houses.load_house_files
+
+    def load(paths, taken=()):  # noqa: ANN001, ANN202 - the loader, watched
+        seen.append(f"load {Path(paths[0]).name} after {len(emitted)} line(s)")
+        return real(paths, taken)
+
+    monkeypatch.setattr(bench_houses, "load_house_files", load)
+    lines, ok = bench_houses.check_house_files([good, other], emit=emitted.append)
+    assert ok and emitted == lines
+    assert seen == ["load a.json after 0 line(s)", "load b.json after 1 line(s)"]
