@@ -21,6 +21,7 @@ import numpy as np
 
 from sgtool.datasets.episodes import REACH, Episode, EpisodeGeometry, list_episodes
 from sgtool.house.spec import Furniture, HouseSpec, spec_id_key
+from sgtool.semantics.text import category_text
 
 FURNITURE_SHARE = 1 / 3  # SymSearch: about a third of the episodes ask for furniture
 
@@ -32,11 +33,13 @@ def furniture_episodes(spec: HouseSpec, n: int, seed: int = 0, reach: float = RE
     ``geometry``: the house's :class:`EpisodeGeometry` with this ``reach``, to share."""
     if n <= 0 or not spec.starts:
         return []
-    small = {o.category for o in spec.objects}
+    # spellings of one category ("Refrigerator", "refrigerator") are one query, as the
+    # environments count any piece whose name reads the same as found
+    small = {category_text(o.category) for o in spec.objects}
     by_cat: dict[str, list[Furniture]] = defaultdict(list)
     for f in spec.furniture:
-        if f.category not in small:
-            by_cat[f.category].append(f)
+        if category_text(f.category) not in small:
+            by_cat[category_text(f.category)].append(f)
     geo = geometry or EpisodeGeometry(spec, reach=reach)
     near = {f.id: geo.near(f) for fs in by_cat.values() for f in fs}
     cats = sorted(c for c, fs in by_cat.items() if any(near[f.id] is not None for f in fs))

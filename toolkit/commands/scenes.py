@@ -176,13 +176,15 @@ def _episodes(spec: Any, count: int | None, seed: int, reach: float, preset: str
     from sgtool.datasets.episode_mix import symsearch_episodes
     from sgtool.datasets.episodes import list_episodes
     from sgtool.datasets.start_poses import with_start_poses
+    from sgtool.semantics.text import category_text
 
     if not spec.starts and spec.objects:
         spec = with_start_poses(spec, spec.seed)
         click.echo("sgtool: note: the house has no start poses; those the bench and "
                    "`sgtool run` add are used", err=True)
     if preset == "symsearch":
-        n = count or len({o.category for o in spec.objects}) or len(spec.furniture)
+        n = count or len({category_text(o.category) for o in spec.objects}) or \
+            len(spec.furniture)
         return list(symsearch_episodes(spec, n, seed=seed, reach=reach))
     return list_episodes(spec, n=count, seed=seed, reach=reach)
 
@@ -191,13 +193,14 @@ def _episodes(spec: Any, count: int | None, seed: int, reach: float, preset: str
 @click.argument("house", type=click.Path(dir_okay=False))
 @click.option("-n", "--count", type=click.IntRange(min=1), default=None,
               help="Number of episodes [default: one per object category].")
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
-              help="Seed of the choice of categories and start poses.")
+@click.option("--seed", type=click.IntRange(min=0), default=None,
+              help="Seed of the choice of categories and start poses [default: the house "
+              "file's seed, the one `sgtool bench` and `run-bench` draw with].")
 @click.option("--reach", type=FiniteFloatRange(min=0.1), default=1.0, show_default=True,
               help="A target counts as reached within this distance (m) of its parent.")
 @_preset_option
 @click.option("--json", "as_json", is_flag=True, help="Print JSON (one list).")
-def episodes_cmd(house: str, count: int | None, seed: int, reach: float, preset: str,
+def episodes_cmd(house: str, count: int | None, seed: int | None, reach: float, preset: str,
                  as_json: bool) -> None:
     """List object-search episodes of HOUSE: query category, target instances, start pose,
     whether every target is hidden in a closed container, and the shortest path (m) from
@@ -209,7 +212,7 @@ def episodes_cmd(house: str, count: int | None, seed: int, reach: float, preset:
     from sgtool.house.io import load_house
 
     spec = load_house(Path(house))  # a path, even one that starts with "{"
-    eps = _episodes(spec, count, seed, reach, preset)
+    eps = _episodes(spec, count, spec.seed if seed is None else seed, reach, preset)
     if as_json:
         click.echo(json.dumps([e.to_dict() for e in eps], indent=1, sort_keys=True))
         return

@@ -157,3 +157,28 @@ def test_symsearch_preset_generate_stats_episodes(tmp_path):
     furn = [e for e in eps if e["targets"][0].startswith("furn_")]
     assert len(eps) == 6 and len(furn) == 2  # a third ask for furniture
     assert all(e["shortest_path"] is not None and not e["hidden"] for e in furn)
+
+
+def test_episodes_draw_as_the_bench_and_spellings_are_one_furniture_query(tmp_path):
+    """By default `scenes episodes` draws with the house file's seed, as the bench does; two
+    spellings of one furniture category are one query with both pieces as targets."""
+    from sgtool.analysis.bench_houses import bench_episodes
+
+    doc = json.loads(generate_house(3, rooms=(5, 5)).to_json())
+    cats = sorted({f["category"] for f in doc["furniture"]})
+    same = [f for f in doc["furniture"] if f["category"] == cats[0]]
+    other = next(f for f in doc["furniture"] if f["category"] != cats[0])
+    other["category"] = cats[0].upper()  # another spelling of the first category
+    house = tmp_path / "h.json"
+    house.write_text(json.dumps(doc))
+    r = CliRunner().invoke(cli, ["scenes", "episodes", str(house), "--json", "-n", "4"])
+    assert r.exit_code == 0, r.output
+    assert [e["query"] for e in json.loads(r.stdout)] == \
+        [e.query for e in bench_episodes(load_house(house), 4)]
+    r = CliRunner().invoke(cli, ["scenes", "episodes", str(house), "--json", "--preset",
+                                 "symsearch", "-n", "60"])
+    eps = json.loads(r.stdout)
+    assert cats[0].upper() not in {e["query"] for e in eps}
+    targets = {tuple(e["targets"]) for e in eps if e["query"] == cats[0]}
+    assert targets == {tuple(sorted([*(f["id"] for f in same), other["id"]],
+                                    key=lambda i: int(i.split("_")[-1])))}
