@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from pathlib import Path
 
 from sgtool.files import atomic_output
@@ -118,8 +119,11 @@ def draw_house(spec: HouseSpec, path: str | os.PathLike[str], dpi: int = 120,
               frameon=False)
     fig.tight_layout()
     try:
-        with atomic_output(path, suffix=path.suffix) as tmp:
-            fig.savefig(tmp, dpi=dpi,
+        with atomic_output(path, suffix=path.suffix) as tmp, warnings.catch_warnings():
+            # a name in a script the font lacks (emoji, CJK) draws as boxes: no warning
+            # with source lines for each glyph
+            warnings.filterwarnings("ignore", message=r"Glyph \d+ .*missing from")
+            fig.savefig(tmp, dpi=dpi, bbox_inches="tight",  # the legend beside the plan
                         metadata={"Software": None} if path.suffix == ".png" else None)
     finally:
         plt.close(fig)
