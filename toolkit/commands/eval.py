@@ -7,7 +7,6 @@ and prints the result."""
 
 from __future__ import annotations
 
-import json
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -118,16 +117,15 @@ def _read_once(files: tuple[str, ...]) -> tuple[str, ...]:
     """``files`` without the logs an episodes.jsonl also read holds (a row's ``source``, or
     a log under its folder's ``logs/``, as run-bench writes them: ``eval run/ run/logs``
     would count each episode twice), with a note."""
+    from sgtool.results import ResultsFormatError, read_jsonl
+
     tables = [Path(f) for f in files if Path(f).name == "episodes.jsonl"]
     sources: set[Path] = set()
     for t in tables:
         try:
-            rows = [json.loads(line) for line in t.read_text(encoding="utf-8").splitlines()
-                    if line.strip()]
-        except (OSError, ValueError):
-            continue  # the reader's own error says what is wrong with it
-        sources |= {Path(r["source"]).resolve() for r in rows
-                    if isinstance(r, dict) and isinstance(r.get("source"), str)}
+            sources |= {Path(r.source).resolve() for r in read_jsonl(t) if r.source}
+        except ResultsFormatError:
+            continue  # the evaluation's own read of it says what is wrong
     dup = [f for f in files if f.endswith(".mcap") and (Path(f).resolve() in sources or any(
         Path(f).resolve().is_relative_to(t.resolve().parent / "logs") for t in tables))]
     if dup:
