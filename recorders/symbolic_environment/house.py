@@ -37,7 +37,7 @@ from typing import TypeVar
 import numpy as np
 from scipy import ndimage
 from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import connected_components, dijkstra
+from scipy.sparse.csgraph import dijkstra
 
 from sgtool.house.spec import HouseSpec, enclosed
 from sgtool.mapping.occupancy import (
@@ -173,7 +173,6 @@ class SymbolicHouse:
                                 bool(self.nested[i]) for i, f in enumerate(spec.furniture))
         roots = spec.root_furniture()
         self.obj_furn = tuple(self.furn_index[roots[o.id]] for o in spec.objects)
-        self._base = self._base_distances()
         self._graphs: dict[frozenset[int], csr_matrix] = {}
         self._rows: dict[tuple[frozenset[int], int], np.ndarray] = {}
         self._lookups()
@@ -267,8 +266,11 @@ class SymbolicHouse:
         self.place_room.append(room)
         return len(self.places) - 1
 
-    def _base_distances(self) -> np.ndarray:
-        """Geodesics between all places with every door closed (inf across doors)."""
+    @functools.cached_property
+    def _base(self) -> np.ndarray:
+        """Geodesics between all places with every door closed (inf across doors): the
+        costly part of a house, computed at its first travel question (a check of the house
+        file asks none)."""
         n = len(self.places)
         cells = [world_to_cell(self.occ, x, y) for x, y in self.places]
         rows = np.array([c[0] for c in cells])
@@ -299,10 +301,27 @@ class SymbolicHouse:
     @functools.cached_property
     def place_component(self) -> np.ndarray:
         """Per place, the label of the places it can reach with every door open (places of
-        rooms no door or passage joins to the rest get labels of their own)."""
-        _, labels = connected_components(self._graph(frozenset(range(len(self.spec.doors)))),
-                                         directed=False)
-        return np.asarray(labels)
+        rooms no door or passage joins to the rest get labels of their own), labels in the
+        order of each part's first place. Without geodesics: the free cells' 4-connected
+        parts (the 8-connected moves that cut no corner join no more) joined through the
+        doors that are not blocked, which is what the place graph with every door open
+        joins."""
+        parts, _ = ndimage.label(~self.occ.blocked)
+        raw = [int(parts[world_to_cell(self.occ, x, y)]) for x, y in self.places]
+        parent: dict[int, int] = {}
+
+        def find(a: int) -> int:
+            while parent.get(a, a) != a:
+                a = parent[a]
+            return a
+
+        for di, (a, b) in enumerate(self.door_sides):
+            if di not in self.blocked_doors:
+                ra, rb = find(raw[a]), find(raw[b])
+                if ra != rb:
+                    parent[max(ra, rb)] = min(ra, rb)
+        first: dict[int, int] = {}
+        return np.asarray([first.setdefault(find(r), len(first)) for r in raw])
 
     def isolated_rooms(self) -> tuple[str, ...]:
         """Ids of the rooms none of whose places the largest part of the house reaches with

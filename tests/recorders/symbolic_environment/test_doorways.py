@@ -9,6 +9,7 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 from support.datasets_fixtures import two_rooms
 
 from sgtool.analysis.bench_houses import load_house_files
@@ -68,3 +69,29 @@ def test_a_clear_doorway_is_a_door(tmp_path: Path) -> None:
     assert "door:0" in {n.id for n in env.observe().doors}
     assert env.step(Action("explore", "room:1")).feedback.outcome == "success"
     assert load_house_files([f])[0].notes == ()
+
+
+def test_a_check_computes_no_geodesics_and_finds_the_same_parts(tmp_path: Path,
+                                                                monkeypatch) -> None:
+    """Checking a house file asks no travel question (the per-place geodesics are the
+    costly part, computed at the first one), and the parts it finds are those of the
+    place graph with every door open."""
+    from sgtool.recorders.symbolic_environment import house as symbolic
+
+    d = _with_piece(two_rooms(), "furn_9", [4.25, 1.95, 0.9], [0.4, 1.2, 1.8])
+    f = tmp_path / "blocked.json"
+    f.write_text(json.dumps(d))
+
+    def refuse(*a, **k):
+        raise AssertionError("a geodesic during the check")
+
+    with monkeypatch.context() as m:
+        m.setattr(symbolic, "geodesic_distances", refuse)
+        (h,) = load_house_files([f])
+        assert "read as a wall" in h.notes[0]
+    house = SymbolicHouse(load_house(f))
+    labels = house.place_component
+    for i in range(len(house.places)):  # same part <=> a finite walk with every door open
+        reach = np.isfinite(house.distances_from(i, house.all_doors()))
+        assert (reach == (labels == labels[i])).all()
+    assert len(set(labels.tolist())) == 2  # the blocked door leaves two parts
