@@ -337,6 +337,13 @@ def cached_planner(name: str, options: Mapping[str, Any]) -> Any:
     return p
 
 
+def forget_replaying_planners() -> None:
+    """Drop the cached planners that answer from a recorded transcript (their answers are
+    served once, in order, over a run): the next run builds them again, from the start."""
+    for key in [k for k in _PLANNERS if '"replay":' in k[1]]:
+        del _PLANNERS[key]
+
+
 def run_task(args: tuple[BenchConfig, BenchHouse, tuple[str, ...]]) -> list[EpisodeResult]:
     """Every episode and seed of one house for each of the given planners (the ``args`` of a
     :func:`bench_tasks` task), in planner, seed, episode order. The results depend on the
@@ -409,6 +416,7 @@ def run_benchmark(cfg: BenchConfig, progress: bool | None = None) -> BenchResult
     a one-line :class:`~sgtool.errors.SgtoolError` (:class:`BenchError`, a planner option)
     before any episode runs."""
     cfg.check()
+    forget_replaying_planners()  # a transcript serves one run: a new run starts it again
     executor = make_executor(cfg.executor, cfg.workers, cfg.ray_address)
     houses = prepare_houses(cfg)
     vocabulary = training_vocabulary(cfg.priors_dir)  # a bad --priors fails before any episode

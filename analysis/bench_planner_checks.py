@@ -56,10 +56,11 @@ def check_planner_options(planners: Sequence[str], options: Mapping[str, Mapping
     if "moma-llm" in planners:
         opts = options.get("moma-llm", {})
         replay = opts.get("replay")
-        if replay is not None and not Path(replay).is_file():
-            raise BenchError(f"--llm-replay: no such transcript {replay}")
-        written = opts.get("transcript")
         read = [replay] if isinstance(replay, str | Path) else list(replay or ())
+        for r in read:
+            if not Path(r).is_file():
+                raise BenchError(f"--llm-replay: no such transcript {r}")
+        written = opts.get("transcript")
         if written and any(Path(r).resolve() == Path(written).resolve() for r in read):
             raise BenchError(f"--llm-transcript {written}: it is the --llm-replay transcript "
                              "(a run's transcript is emptied when it starts)")

@@ -45,6 +45,7 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     from sgtool.llm.recorded import start_transcript
 
     out_dir, log_dir = request.out_dir, request.config.log_dir
+    request.config.check()  # before anything is emptied or written (the transcript)
     try:
         with output_folder(out_dir, force=request.force, command="bench",
                            known=OUTPUT_NAMES) as stage, contextlib.ExitStack() as stack:

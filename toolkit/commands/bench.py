@@ -22,6 +22,7 @@ from sgtool.commands.options import (
     parse_rooms,
     planner_names,
     planner_options,
+    replay_files,
     shown_command,
     success_option,
 )
@@ -97,7 +98,7 @@ if TYPE_CHECKING:
 @llm_log_options(
     transcript_help="moma-llm: write every LLM exchange to this JSONL transcript, emptied "
     "when the run starts "
-    "(needs --workers 1).")
+    "(needs --workers 1).", many=True)
 @llm_endpoint_options("LLM planners")
 @click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
               help=PLANNER_OPTION_HELP)
@@ -149,7 +150,7 @@ class BenchArgs:
     max_steps: int
     distance_budget: float
     step_budget: float
-    llm_replay: str | None
+    llm_replay: tuple[str, ...]
     llm_transcript: str | None
     planner_option: tuple[str, ...]
     log_dir: str | None
@@ -201,7 +202,7 @@ def _planners(args: BenchArgs) -> tuple[tuple[str, ...], dict[str, dict[str, Any
     if args.llm_replay or args.llm_transcript:
         moma = options.setdefault("moma-llm", {})
         if args.llm_replay:
-            moma["replay"] = args.llm_replay
+            moma["replay"] = replay_files(args.llm_replay)
         if args.llm_transcript:
             moma["transcript"] = args.llm_transcript
     return names, options

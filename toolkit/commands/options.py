@@ -148,15 +148,41 @@ def house_options(seed_help: str, rooms_help: str) -> Callable[[F], F]:
     ])
 
 
-def llm_log_options(transcript_help: str) -> Callable[[F], F]:
-    """``--llm-replay`` and ``--llm-transcript`` of the moma-llm planner."""
+def llm_log_options(transcript_help: str, many: bool = False) -> Callable[[F], F]:
+    """``--llm-replay`` and ``--llm-transcript`` of the moma-llm planner; ``many``: the
+    replay option is repeatable and takes folders (of a bench's ``--log-dir`` logs)."""
+    replay = click.option(
+        "--llm-replay", type=click.Path(), multiple=True,
+        help="moma-llm: serve answers from these transcripts (JSONL, or MCAP logs' "
+        "/sgtool/llm; repeatable; a folder: its *.mcap logs and *.jsonl transcripts, as "
+        "`--log-dir` writes them) instead of an endpoint.") if many else click.option(
+        "--llm-replay", type=click.Path(dir_okay=False), default=None,
+        help="moma-llm: serve answers from this JSONL transcript instead of an endpoint.")
     return option_group([
-        click.option("--llm-replay", type=click.Path(dir_okay=False), default=None,
-                     help="moma-llm: serve answers from this JSONL transcript instead of an "
-                     "endpoint."),
+        replay,
         click.option("--llm-transcript", type=click.Path(dir_okay=False), default=None,
                      help=transcript_help),
     ])
+
+
+def replay_files(given: Sequence[str]) -> str | list[str]:
+    """The transcripts of a repeatable ``--llm-replay``: files as given, a folder's
+    ``*.mcap`` and ``*.jsonl`` (recursively, sorted); one file as itself. A path that is
+    neither, or a folder without one, is a one-line error."""
+    out: list[str] = []
+    for g in given:
+        p = Path(g)
+        if p.is_dir():
+            found = sorted(str(f) for f in p.rglob("*") if f.suffix in (".mcap", ".jsonl")
+                           and f.is_file())
+            if not found:
+                raise SgtoolError(f"--llm-replay {g}: no *.mcap or *.jsonl transcripts there")
+            out += found
+        elif p.is_file():
+            out.append(str(p))
+        else:
+            raise SgtoolError(f"--llm-replay: no such transcript {g}")
+    return out[0] if len(out) == 1 else out
 
 
 @dataclass(frozen=True)

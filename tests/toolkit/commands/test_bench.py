@@ -298,6 +298,20 @@ def test_moma_llm_transcript_then_replay(tmp_path):
     assert r.exit_code == 0, r.output
     replayed = read_jsonl(tmp_path / "o" / "episodes.jsonl")
     assert results_digest(replayed) == live.digest
+    # several transcripts (repeated, or a folder of them) serve as one
+    lines = transcript.read_text().splitlines(keepends=True)
+    parts = tmp_path / "parts"
+    parts.mkdir()
+    (parts / "a.jsonl").write_text("".join(lines[:len(lines) // 2]))
+    (parts / "b.jsonl").write_text("".join(lines[len(lines) // 2:]))
+    for given in ([str(parts / "a.jsonl"), str(parts / "b.jsonl")], [str(parts)]):
+        out = tmp_path / f"parts{len(given)}"
+        r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
+                                     "--episodes", "2", "--seeds", "1", "--no-progress",
+                                     *(x for g in given for x in ("--llm-replay", g)),
+                                     "-o", str(out)])
+        assert r.exit_code == 0, r.output
+        assert results_digest(read_jsonl(out / "episodes.jsonl")) == live.digest
     # a run's transcript holds that run only (an earlier run's answers would be served
     # first by a replay of it), and cannot be the transcript it replays
     again = tmp_path / "again.jsonl"
@@ -314,6 +328,7 @@ def test_moma_llm_transcript_then_replay(tmp_path):
                                  "--llm-replay", str(again), "--llm-transcript", str(again),
                                  "-o", str(tmp_path / "o3")])
     assert r.exit_code == 2 and "it is the --llm-replay transcript" in r.output
+    assert again.read_text() and "earlier run" not in again.read_text()  # not emptied
     # the transcript of another house is no replay of this run: an error, nothing written
     r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
                                  "--house-seed", "5", "--episodes", "2", "--seeds", "1",
