@@ -341,15 +341,12 @@ def with_success_rule(r: EpisodeResult, rule: str | None) -> EpisodeResult:
 def log_exchanges(paths: Iterable[str | os.PathLike[str]]) -> list[tuple[str, dict[str, Any]]]:
     """(file, exchange record) of the ``/sgtool/llm`` channels of the MCAP logs among
     ``paths``, file by file in log-time order."""
-    from sgtool.llm.recorded import MCAP_MAGIC, read_transcript
+    from sgtool.llm.recorded import is_mcap_file, read_transcript
 
     out: list[tuple[str, dict[str, Any]]] = []
-    for path in paths:
-        p = Path(path)
-        with open(p, "rb") as f:
-            if f.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
-                continue
-        out.extend((str(p), rec) for rec in read_transcript(p))
+    for path in map(Path, paths):
+        if is_mcap_file(path):
+            out.extend((str(path), rec) for rec in read_transcript(path))
     return out
 
 

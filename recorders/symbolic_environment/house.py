@@ -37,7 +37,7 @@ from typing import TypeVar
 import numpy as np
 from scipy import ndimage
 from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
+from scipy.sparse.csgraph import connected_components, dijkstra
 
 from sgtool.house.spec import HouseSpec, enclosed
 from sgtool.mapping.occupancy import (
@@ -306,22 +306,15 @@ class SymbolicHouse:
         parts (the 8-connected moves that cut no corner join no more) joined through the
         doors that are not blocked, which is what the place graph with every door open
         joins."""
-        parts, _ = ndimage.label(~self.occ.blocked)
+        parts, n = ndimage.label(~self.occ.blocked)
         raw = [int(parts[world_to_cell(self.occ, x, y)]) for x, y in self.places]
-        parent: dict[int, int] = {}
-
-        def find(a: int) -> int:
-            while parent.get(a, a) != a:
-                a = parent[a]
-            return a
-
-        for di, (a, b) in enumerate(self.door_sides):
-            if di not in self.blocked_doors:
-                ra, rb = find(raw[a]), find(raw[b])
-                if ra != rb:
-                    parent[max(ra, rb)] = min(ra, rb)
+        doors = [(raw[a], raw[b]) for di, (a, b) in enumerate(self.door_sides)
+                 if di not in self.blocked_doors]
+        links = csr_matrix((np.ones(len(doors)), ([a for a, _ in doors], [b for _, b in doors])),
+                           shape=(n + 1, n + 1))
+        _, joined = connected_components(links, directed=False)
         first: dict[int, int] = {}
-        return np.asarray([first.setdefault(find(r), len(first)) for r in raw])
+        return np.asarray([first.setdefault(int(joined[r]), len(first)) for r in raw])
 
     def isolated_rooms(self) -> tuple[str, ...]:
         """Ids of the rooms none of whose places the largest part of the house reaches with

@@ -118,7 +118,8 @@ class TranscriptWriter:
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 
 
-def _is_mcap(path: Path) -> bool:
+def is_mcap_file(path: str | Path) -> bool:
+    """``path`` starts with the MCAP magic (a log, not a JSONL transcript)."""
     with open(path, "rb") as fh:
         return fh.read(len(MCAP_MAGIC)) == MCAP_MAGIC
 
@@ -129,7 +130,7 @@ def read_transcript(path: str | Path) -> list[dict[str, Any]]:
     path = Path(path)
     if not path.is_file():
         raise TranscriptError(f"LLM transcript not found: {path}")
-    if _is_mcap(path):
+    if is_mcap_file(path):
         return _log_exchanges(path)
     out = []
     with open(path, encoding="utf-8") as fh:
@@ -177,7 +178,7 @@ class ReplayChatClient:
         records = []
         for p in paths:
             got = read_transcript(p)
-            if not got and _is_mcap(p):
+            if not got and is_mcap_file(p):
                 raise TranscriptError(
                     f"{p} holds no LLM exchanges (/sgtool/llm): the derived log of `replay "
                     "--classifier llm` does not log them; give the --llm-transcript that "
