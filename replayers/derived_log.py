@@ -20,8 +20,11 @@ Options default to what the log says it was built with: a closed-loop log record
 mapping options in its ``sgtool.Episode`` record (``extra.mapping``), so replaying it with
 the defaults rebuilds the same graphs it decided on. Otherwise: a refresh every 10 frames
 and at every action, the frequency room classifier (the containment model for a room none
-of whose categories it knows), and MoMa-LLM's "seen" threshold of 50
-points per frame scaled by the image size (``50 * W * H / 320 / 240``, at least 5).
+of whose categories it knows), MoMa-LLM's "seen" threshold of 50
+points per frame scaled by the image size (``50 * W * H / 320 / 240``, at least 5), and
+depth mapped to MoMa-LLM's 5 m, or less where the log's own depth noise would read far
+floor as obstacles (measured on its first frames, :mod:`sgtool.replayers.depth_range`;
+the report says so and the ``sgtool.replay`` metadata records the depth).
 
 Logs without instance ids (imported real data) replay to geometry only: voxels,
 occupancy, Voronoi graph, rooms without door cuts, frontiers; the report says that the
@@ -50,8 +53,10 @@ from sgtool.log.frame_assembly import FRAME_TOPICS, FrameAssembler
 from sgtool.log.reader import LogReader
 from sgtool.log.records import Episode, Instances
 from sgtool.log.writer import LogWriter
+from sgtool.mapping.depth_noise import DepthNoise
 from sgtool.mapping.voxels import VoxelConfig
 from sgtool.progress import Progress
+from sgtool.replayers.depth_range import measured_depth
 from sgtool.replayers.graph_scene import graph_scene_update
 from sgtool.scenegraph.build_options import (
     CLASSIFIERS,
@@ -86,12 +91,23 @@ class ReplayOptions:
 
 
 def resolve_options(reader: LogReader, options: ReplayOptions) -> ResolvedOptions:
-    """Fill the unset options from the log's Episode record, else the defaults."""
+    """Fill the unset options from the log's Episode record, else the defaults
+    (:func:`resolve_options_measured` without what it measured)."""
+    return resolve_options_measured(reader, options)[0]
+
+
+def resolve_options_measured(reader: LogReader, options: ReplayOptions
+                             ) -> tuple[ResolvedOptions, DepthNoise | None]:
+    """Fill the unset options from the log's Episode record, else the defaults; the depth
+    to map to, unless given or recorded (a live map's log records its own), is lowered to
+    where the log's depth noise reaches the floor tolerance
+    (:func:`~sgtool.replayers.depth_range.measured_depth`), returned with the options."""
     recorded: dict[str, Any] = {}
+    found = False
     for _, rec in reader.records(Episode):
         m = rec.extras.get("mapping")
         if isinstance(m, dict):
-            recorded = m
+            recorded, found = m, True
             break
     size = _image_size(reader)
     every = options.every if options.every is not None else int(recorded.get("every", 10))
@@ -111,12 +127,17 @@ def resolve_options(reader: LogReader, options: ReplayOptions) -> ResolvedOption
         raise SgtoolError(f"min points {mp}: must be >= 1")
     md = options.max_depth if options.max_depth is not None else float(
         recorded.get("max_depth", MAX_DEPTH_M))
+    noise = None
+    if options.max_depth is None and not found:
+        noise = measured_depth(reader, md, options.tf_time)
+        if noise is not None and noise.max_depth is not None:
+            md = max(MAX_DEPTH_RANGE[0], noise.max_depth)
     if not MAX_DEPTH_RANGE[0] <= md <= MAX_DEPTH_RANGE[1]:
         raise SgtoolError(f"max depth {md:g} m: must be {MAX_DEPTH_RANGE[0]:g}.."
                           f"{MAX_DEPTH_RANGE[1]:g}")
     return ResolvedOptions(every=int(every), classifier=clf, min_points=int(mp),
                            voxel_size=float(vs), max_frames=options.max_frames,
-                           max_depth=float(md))
+                           max_depth=float(md)), noise
 
 
 def replay_metadata(opts: ResolvedOptions, tf_time: str = "log") -> dict[str, str]:
@@ -163,6 +184,7 @@ class ReplayReport:
     seconds: float = 0.0  # wall clock of the run (reported, never written)
     truncated: bool = False  # stopped at max_frames
     warnings: list[str] = field(default_factory=list)  # one line each (/tf stamps)
+    notes: list[str] = field(default_factory=list)  # one line each (the depth measured)
 
     def lines(self) -> list[str]:
         out = []
@@ -175,6 +197,7 @@ class ReplayReport:
                    f"classifier {o.classifier}, voxels {o.voxel_size} m, seen at "
                    f">= {o.min_points} points"
                    + (f", depth to {o.max_depth:g} m" if o.max_depth != MAX_DEPTH_M else ""))
+        out.extend(self.notes)
         if not self.semantic:
             out.append("the log has no instance ids: semantics are absent, so the graph has "
                        "geometry only (occupancy, Voronoi graph, rooms without door cuts, "
@@ -232,8 +255,10 @@ def replay(
     with LogReader(src, verify=verify or dst is not None) as reader, single_blas_thread():
         reader.require(S.DEPTH, why="replay builds the map from depth images")
         tf_time = (options or ReplayOptions()).tf_time
-        opts = resolve_options(reader, options or ReplayOptions())
+        opts, noise = resolve_options_measured(reader, options or ReplayOptions())
         report = ReplayReport(src, dst, opts, semantic=reader.has(S.IDS))
+        if noise is not None and noise.max_depth is not None:
+            report.notes.append(noise.describe())
         stream = SceneGraphStream(None, (room_classifier or make_classifier)(opts.classifier),
                                   builder_config(opts))
         with frozen_heap(), small_pages():  # no full-collection or huge-page stalls

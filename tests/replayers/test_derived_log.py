@@ -47,10 +47,13 @@ def messages(path: Path) -> dict[str, list[tuple[int, bytes]]]:
     return out
 
 
-def synthetic_log(path: Path, with_ids: bool = True, opening: str = "open") -> Path:
+def synthetic_log(path: Path, with_ids: bool = True, opening: str = "open",
+                  noise: float = 0.0) -> Path:
     """The two-room house seen by a robot looking around in the kitchen, walking to the
-    bedroom and looking around there; an action record after each part."""
+    bedroom and looking around there; an action record after each part. ``noise``: depth
+    noise of std ``noise`` z^2 (seeded)."""
     hw = world_of_house(two_room_house(opening))
+    rng = np.random.default_rng(5)
     parts = [look_around(2.0, 1.5, 0.0, 12), walk([(2.0, 1.5), (6.0, 1.5)], 0.25),
              look_around(6.0, 1.0, 0.0, 12)]
     with LogWriter(path, seed=3) as w:
@@ -61,7 +64,9 @@ def synthetic_log(path: Path, with_ids: bool = True, opening: str = "open") -> P
         for n, poses in enumerate(parts):
             for x, y, yaw in poses:
                 f = make_frame(hw.world, x, y, yaw, K, index=i, pitch=0.3, with_ids=with_ids)
-                w.write_frame(i * 100_000_000, depth=f.depth, pose=f.pose, intrinsics=K,
+                d = f.depth + (noise * f.depth ** 2 * rng.standard_normal(f.depth.shape)
+                               ).astype(np.float32) if noise else f.depth
+                w.write_frame(i * 100_000_000, depth=d, pose=f.pose, intrinsics=K,
                               ids=f.ids, base_pose=f.base_pose)
                 i += 1
             w.write_record("action", (i - 1) * 100_000_000, {
@@ -129,6 +134,32 @@ def test_max_depth_bounds_what_is_mapped_and_is_recorded(tmp_path):
         assert r.metadata["sgtool.replay"]["max_depth"] == "1.5"
         assert "max_depth" not in s.metadata["sgtool.replay"]
     assert any("depth to 1.5 m" in line for line in a.lines())
+
+
+def test_noisy_depth_is_mapped_only_as_far_as_the_floor_stays_floor(tmp_path):
+    """A log without a depth of its own whose floor points scatter with depth (noise 0.02
+    z^2) is mapped to where 4 sigma of the floor's heights reach the floor tolerance
+    (said in the report and the derived log's metadata): far floor no longer reads as
+    obstacles, and the rooms on the door's two sides stay apart; a clean log keeps 5 m."""
+    noisy = synthetic_log(tmp_path / "noisy.mcap", noise=0.02)
+    auto = replay(noisy, tmp_path / "auto.mcap", ReplayOptions())
+    fixed = replay(noisy, None, ReplayOptions(max_depth=5.0))
+    assert 1.0 <= auto.options.max_depth < 2.0
+    assert any(line.startswith("depth noise: floor points scatter") and
+               f"depth mapped to {auto.options.max_depth:g} m" in line for line in auto.lines())
+    with LogReader(tmp_path / "auto.mcap") as r:
+        assert r.metadata["sgtool.replay"]["max_depth"] == f"{auto.options.max_depth}"
+
+    def obstacles(rep):
+        return int((rep.last.layers.occupancy.grid == 100).sum())
+
+    assert obstacles(auto) < obstacles(fixed) / 2
+    # the door joins its two rooms; at 5 m phantom obstacles cut the kitchen's floor
+    # from its side of the door, and the door lists one room only
+    assert [len(set(d.rooms)) for d in auto.last.graph.doors] == [2]
+    assert [len(set(d.rooms)) for d in fixed.last.graph.doors] == [1]
+    clean = replay(synthetic_log(tmp_path / "clean.mcap"), None, ReplayOptions())
+    assert clean.options.max_depth == 5.0 and not any("depth noise" in x for x in clean.lines())
 
 
 def test_the_report_warns_of_doors_joining_one_room_and_of_no_room(tmp_path):

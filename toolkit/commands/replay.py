@@ -64,9 +64,11 @@ if TYPE_CHECKING:
 @click.option("--voxel-size", type=FINITE_FLOAT, default=None,
               help="Voxel edge in metres. Default: the log's, else 0.05.")
 @click.option("--max-depth", type=FiniteFloatRange(0.5, 20.0), default=None,
-              help="Depth farther than this (m) is not mapped. Default: the log's, else 5 "
-              "(MoMa-LLM's). Lower it for a noisy sensor: far floor seen through depth "
-              "noise reads as obstacles and can leave the map without a room.")
+              help="Depth farther than this (m) is not mapped. Default: the log's (a "
+              "closed-loop log records its live map's), else 5 (MoMa-LLM's), lowered to "
+              "where the log's depth noise would read far floor as obstacles (measured on "
+              "its first 60 frames from the points below the floor; the report says so). "
+              "Give it to map to a depth of your own.")
 @click.option("--max-frames", type=click.IntRange(min=1), default=None,
               help="Stop after this many frames.")
 @click.option("--tf-time", type=click.Choice(["log", "stamp"]), default="log",

@@ -420,9 +420,10 @@ class LogReader:
 
     # ----- frames -----------------------------------------------------------------------
     def frames(
-        self, *, start_ns: int | None = None, end_ns: int | None = None
+        self, *, start_ns: int | None = None, end_ns: int | None = None, tf_time: str = "log"
     ) -> Iterator[Frame]:
-        """Frames in log-time order (see the module docstring)."""
+        """Frames in log-time order (see the module docstring); ``tf_time`` pairs ``/tf``
+        with frames (:class:`~sgtool.log.frame_assembly.FrameAssembler`)."""
         self.require(S.DEPTH, why="frames need depth images")
         for _, ch in sorted(self.summary.channels.items()):
             if ch.topic in FRAME_TOPICS:
@@ -434,7 +435,7 @@ class LogReader:
                      else (TransformBuffer(), None))
         index = self._frame_index_before(start_ns) if start_ns is not None else 0
         asm = FrameAssembler(index=index, transforms=tf, calibration=calib,
-                             where=str(self.path))
+                             where=str(self.path), tf_time=tf_time)
         for d in self._messages(FRAME_TOPICS, start_ns=start_ns, end_ns=end_ns, views=True):
             fr = asm.push(d.topic, d.log_time_ns, d.message)
             if fr is not None:

@@ -1,0 +1,72 @@
+"""The depth a noisy log can be mapped to, from its points below the floor.
+
+Frames of the two-room house from the numpy ray-caster, a camera 1.2 m up pitched down,
+with depth noise sigma_d = c z^2 added (seeded). A floor point at depth z moves along its
+ray when its depth errs by e: its height changes by H e / z (H the camera's height above
+the floor), so the vertical noise is sigma_v(z) = H c z, and 4 sigma_v reaches the 0.1 m
+floor tolerance at z = 0.1 / (4 H c): 3.47 m for c = 0.006, 2.08 m for c = 0.01, 1.39 m
+for c = 0.015.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from support.synthetic_world import make_frame, two_room_house, world_of_house
+
+from sgtool.log.frame import CameraIntrinsics
+from sgtool.mapping.depth_noise import BIN, MIN_DEPTH, estimate, floor_height, frame_heights
+
+K = CameraIntrinsics.from_fov(160, 120, 60)
+H = 1.2
+
+
+def samples(c: float, seed: int = 0):
+    """(depth, height) of frames looking around the kitchen and the bedroom, with noise
+    ``c z^2``."""
+    hw = world_of_house(two_room_house())
+    rng = np.random.default_rng(seed)
+    out = []
+    for x, y in ((2.0, 1.5), (6.0, 1.5)):
+        for i in range(12):
+            f = make_frame(hw.world, x, y, 2 * math.pi * i / 12, K, height=H, pitch=0.5)
+            d = f.depth.astype(np.float64)
+            d = d + c * d * d * rng.standard_normal(d.shape)
+            out.append(frame_heights(d, f.pose, K.fx, K.fy, K.cx, K.cy))
+    return out
+
+
+def test_a_clean_log_keeps_its_depth():
+    est = estimate(samples(0.0), 0.1)
+    assert est is not None and abs(est.floor) < 0.005
+    assert est.max_depth is None and max(est.sigma) < 0.005
+
+
+def test_noisy_depth_is_cut_where_four_sigma_reach_the_floor_tolerance():
+    for c in (0.006, 0.01, 0.015):
+        est = estimate(samples(c), 0.1)
+        cut = 0.1 / (4 * H * c)  # module doc
+        assert est is not None and abs(est.floor) < 0.01
+        assert cut - BIN <= est.max_depth <= cut, (c, est)  # the bin the cut falls in
+        # the measured noise follows H c z within a fifth up to a metre past the cut
+        for z, s in zip(est.depths, est.sigma, strict=True):
+            if z < est.max_depth + 1.0:
+                assert abs(s / (H * c * (z + BIN / 2)) - 1) < 0.2, (c, z, s)
+
+
+def test_a_cut_beyond_the_ceiling_changes_nothing():
+    est = estimate(samples(0.004), 0.1, ceiling=4.0)  # cut near 5.2 m
+    assert est is not None and est.max_depth is None
+
+
+def test_very_noisy_depth_keeps_what_surrounds_the_robot():
+    # noise 0.05 z^2: 4 sigma_v is past the tolerance where the floor is seen nearest
+    est = estimate(samples(0.05), 0.1)
+    assert est is not None and est.max_depth == MIN_DEPTH
+
+
+def test_no_estimate_without_a_floor_at_height_zero():
+    assert estimate([], 0.1) is None
+    assert floor_height(np.zeros(100)) is None  # too few points to find a floor
+    assert floor_height(np.full(10_000, 0.7)) is None  # no floor at height 0
