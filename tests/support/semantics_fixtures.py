@@ -133,6 +133,7 @@ class ChatServer:
 
         self.script = list(script or [])
         self.requests: list[dict] = []
+        self.auth: list[str] = []  # each request's Authorization header
         self.model = model
         self.responder = responder
         self.errors: list[str] = []
@@ -156,6 +157,7 @@ class ChatServer:
                 n = int(self.headers.get("Content-Length", "0"))
                 req = json.loads(self.rfile.read(n) or b"{}")
                 server.requests.append(req)
+                server.auth.append(self.headers.get("Authorization", ""))
                 if server.script:
                     item = server.script.pop(0)
                 elif server.responder is not None:

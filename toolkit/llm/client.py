@@ -128,6 +128,15 @@ class LlmSettings:
         base_url = base_url or env.get("SGTOOL_LLM_BASE_URL") or env.get("OPENAI_BASE_URL")
         model = model or env.get("SGTOOL_LLM_MODEL") or DEFAULT_MODEL
         api_key = api_key or env.get("SGTOOL_LLM_API_KEY") or env.get("OPENAI_API_KEY")
+        # a key or URL read from a file keeps its newline ("$(cat key)" does not, a .env
+        # file or KEY=$'...\n' does); an HTTP header cannot hold one, and the request
+        # would fail as if the server were unreachable
+        base_url = base_url.strip() if base_url else base_url
+        model = model.strip()
+        api_key = api_key.strip() if api_key else api_key
+        if api_key and any(c.isspace() for c in api_key):
+            raise LlmConfigError("the LLM API key holds white space (a key is one word): "
+                                 "check SGTOOL_LLM_API_KEY / OPENAI_API_KEY or api_key")
         if not base_url and not api_key:
             raise LlmConfigError(
                 "no LLM endpoint configured: set SGTOOL_LLM_BASE_URL (and SGTOOL_LLM_API_KEY "

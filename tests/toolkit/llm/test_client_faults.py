@@ -158,6 +158,19 @@ def test_the_deadline_bounds_a_real_request():
     assert elapsed < 2.5  # not a speed target: the server answers only after 3 s
 
 
+def test_a_key_read_with_its_newline_still_works():
+    """A key or URL from a file keeps its line end; it goes out without it (an HTTP header
+    cannot hold one), and a key with white space inside is a one-line setup error."""
+    with ChatServer([{"text": "hi"}]) as srv:
+        c = OpenAIChatClient(LlmSettings.resolve(base_url=f" {srv.base_url}\n", model="m\r\n",
+                                                 api_key=f"{KEY}\r\n", timeout_s=5))
+        assert c.complete([{"role": "user", "content": "x"}]).text == "hi"
+        assert srv.auth == [f"Bearer {KEY}"] and srv.requests[0]["model"] == "m"
+    with pytest.raises(LlmConfigError, match="white space") as info:
+        LlmSettings.resolve(base_url="http://127.0.0.1:9/v1", api_key="sk-a b")
+    assert "sk-a" not in str(info.value)
+
+
 def test_the_api_key_is_not_in_error_messages(monkeypatch):
     c = OpenAIChatClient(LlmSettings.resolve(base_url="http://user:pw-XYZ1@127.0.0.1:9/v1",
                                              api_key=KEY))
