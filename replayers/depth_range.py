@@ -1,34 +1,57 @@
-"""The depth a replay maps to when neither the user nor the log chose one.
+"""What a replay reads off a log's first frames before it maps them.
 
 A recording made without sgtool's live map says nothing about how far its depth can be
 trusted; a noisy camera's far floor then fills the map with phantom obstacles
-(:mod:`sgtool.mapping.depth_noise`). :func:`measured_depth` reads the first
-:data:`FRAMES` frames of the log, measures the vertical noise of the floor against depth
-and returns the depth at which it reaches the bird's-eye map's floor tolerance, or None
-when the default is fine (or nothing could be measured). The same log gives the same
-answer: the frames read and the pixels sampled are fixed.
+(:mod:`sgtool.mapping.depth_noise`). :func:`first_frames` reads the first :data:`FRAMES`
+frames of the log once and returns
+
+- ``noise``: the vertical noise of the floor against depth and the depth at which it
+  reaches the bird's-eye map's floor tolerance (None when nothing could be measured);
+- ``up_note``: a line when the camera's image "down" axis is not downward in the world in
+  most of those frames (median world z of that axis above :data:`UPRIGHT`): sgtool maps
+  heights along z, so a world written y-up maps side-on without any other sign.
+
+The same log gives the same answer: the frames read and the pixels sampled are fixed.
 """
 
 from __future__ import annotations
 
 import itertools
+from dataclasses import dataclass
+
+import numpy as np
 
 from sgtool.log.reader import LogReader
 from sgtool.mapping.bev import BevConfig
-from sgtool.mapping.depth_noise import DepthNoise, estimate, frame_heights
+from sgtool.mapping.depth_noise import DepthNoise, estimate, frame_points
 
 FRAMES = 60  # the first frames of the log that are measured
 STRIDE = 2  # every STRIDE-th pixel in each direction
+UPRIGHT = -0.3  # median world z of the camera's image-down axis above this: not z-up
 
 
-def measured_depth(reader: LogReader, ceiling: float, tf_time: str = "log",
-                   tolerance: float | None = None) -> DepthNoise | None:
+@dataclass(frozen=True)
+class FirstFrames:
+    """What :func:`first_frames` found (module doc)."""
+
+    noise: DepthNoise | None
+    up_note: str | None
+
+
+def first_frames(reader: LogReader, ceiling: float, tf_time: str = "log",
+                 tolerance: float | None = None) -> FirstFrames:
     """The depth noise of the log's first :data:`FRAMES` frames (:func:`estimate`, with
-    the default bird's-eye ``floor_tolerance`` unless ``tolerance`` is given);
-    ``max_depth`` None when the log can be mapped to ``ceiling``."""
+    the default bird's-eye ``floor_tolerance`` unless ``tolerance`` is given;
+    ``max_depth`` None when the log can be mapped to ``ceiling``) and the z-up check."""
     tol = BevConfig().floor_tolerance if tolerance is None else tolerance
-    samples = []
+    samples, down_z = [], []
     for fr in itertools.islice(reader.frames(tf_time=tf_time), FRAMES):
         k = fr.intrinsics
-        samples.append(frame_heights(fr.depth, fr.pose, k.fx, k.fy, k.cx, k.cy, STRIDE))
-    return estimate(samples, tol, ceiling=ceiling)
+        samples.append(frame_points(fr.depth, fr.pose, k.fx, k.fy, k.cx, k.cy, STRIDE))
+        down_z.append(float(np.asarray(fr.pose)[2, 1]))
+    note = None
+    if down_z and float(np.median(down_z)) > UPRIGHT:
+        note = (f"the camera's image 'down' axis points {float(np.median(down_z)):+.2f} along "
+                "the world's z in the median of the first frames: sgtool maps heights along "
+                "z (z up), so a world written y-up maps side-on; check the poses' convention")
+    return FirstFrames(estimate(samples, tol, ceiling=ceiling), note)

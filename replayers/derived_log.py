@@ -53,10 +53,9 @@ from sgtool.log.frame_assembly import FRAME_TOPICS, FrameAssembler
 from sgtool.log.reader import LogReader
 from sgtool.log.records import Episode, Instances
 from sgtool.log.writer import LogWriter
-from sgtool.mapping.depth_noise import DepthNoise
 from sgtool.mapping.voxels import VoxelConfig
 from sgtool.progress import Progress
-from sgtool.replayers.depth_range import measured_depth
+from sgtool.replayers.depth_range import FirstFrames, first_frames
 from sgtool.replayers.graph_scene import graph_scene_update
 from sgtool.scenegraph.build_options import (
     CLASSIFIERS,
@@ -97,11 +96,11 @@ def resolve_options(reader: LogReader, options: ReplayOptions) -> ResolvedOption
 
 
 def resolve_options_measured(reader: LogReader, options: ReplayOptions
-                             ) -> tuple[ResolvedOptions, DepthNoise | None]:
+                             ) -> tuple[ResolvedOptions, FirstFrames | None]:
     """Fill the unset options from the log's Episode record, else the defaults; the depth
     to map to, unless given or recorded (a live map's log records its own), is lowered to
     where the log's depth noise reaches the floor tolerance
-    (:func:`~sgtool.replayers.depth_range.measured_depth`), returned with the options."""
+    (:func:`~sgtool.replayers.depth_range.first_frames`, returned with the options)."""
     recorded: dict[str, Any] = {}
     found = False
     for _, rec in reader.records(Episode):
@@ -127,17 +126,17 @@ def resolve_options_measured(reader: LogReader, options: ReplayOptions
         raise SgtoolError(f"min points {mp}: must be >= 1")
     md = options.max_depth if options.max_depth is not None else float(
         recorded.get("max_depth", MAX_DEPTH_M))
-    noise = None
+    first = None
     if options.max_depth is None and not found:
-        noise = measured_depth(reader, md, options.tf_time)
-        if noise is not None and noise.max_depth is not None:
-            md = max(MAX_DEPTH_RANGE[0], noise.max_depth)
+        first = first_frames(reader, md, options.tf_time)
+        if first.noise is not None and first.noise.max_depth is not None:
+            md = max(MAX_DEPTH_RANGE[0], first.noise.max_depth)
     if not MAX_DEPTH_RANGE[0] <= md <= MAX_DEPTH_RANGE[1]:
         raise SgtoolError(f"max depth {md:g} m: must be {MAX_DEPTH_RANGE[0]:g}.."
                           f"{MAX_DEPTH_RANGE[1]:g}")
     return ResolvedOptions(every=int(every), classifier=clf, min_points=int(mp),
                            voxel_size=float(vs), max_frames=options.max_frames,
-                           max_depth=float(md)), noise
+                           max_depth=float(md)), first
 
 
 def replay_metadata(opts: ResolvedOptions, tf_time: str = "log") -> dict[str, str]:
@@ -255,10 +254,12 @@ def replay(
     with LogReader(src, verify=verify or dst is not None) as reader, single_blas_thread():
         reader.require(S.DEPTH, why="replay builds the map from depth images")
         tf_time = (options or ReplayOptions()).tf_time
-        opts, noise = resolve_options_measured(reader, options or ReplayOptions())
+        opts, first = resolve_options_measured(reader, options or ReplayOptions())
         report = ReplayReport(src, dst, opts, semantic=reader.has(S.IDS))
-        if noise is not None and noise.max_depth is not None:
-            report.notes.append(noise.describe())
+        if first is not None and first.noise is not None and first.noise.max_depth is not None:
+            report.notes.append(first.noise.describe())
+        if first is not None and first.up_note is not None:
+            report.warnings.append(first.up_note)
         stream = SceneGraphStream(None, (room_classifier or make_classifier)(opts.classifier),
                                   builder_config(opts))
         with frozen_heap(), small_pages():  # no full-collection or huge-page stalls

@@ -48,10 +48,11 @@ def messages(path: Path) -> dict[str, list[tuple[int, bytes]]]:
 
 
 def synthetic_log(path: Path, with_ids: bool = True, opening: str = "open",
-                  noise: float = 0.0) -> Path:
+                  noise: float = 0.0, world: np.ndarray | None = None) -> Path:
     """The two-room house seen by a robot looking around in the kitchen, walking to the
     bedroom and looking around there; an action record after each part. ``noise``: depth
-    noise of std ``noise`` z^2 (seeded)."""
+    noise of std ``noise`` z^2 (seeded); ``world``: a 4x4 transform applied to every pose
+    (another world convention)."""
     hw = world_of_house(two_room_house(opening))
     rng = np.random.default_rng(5)
     parts = [look_around(2.0, 1.5, 0.0, 12), walk([(2.0, 1.5), (6.0, 1.5)], 0.25),
@@ -66,7 +67,8 @@ def synthetic_log(path: Path, with_ids: bool = True, opening: str = "open",
                 f = make_frame(hw.world, x, y, yaw, K, index=i, pitch=0.3, with_ids=with_ids)
                 d = f.depth + (noise * f.depth ** 2 * rng.standard_normal(f.depth.shape)
                                ).astype(np.float32) if noise else f.depth
-                w.write_frame(i * 100_000_000, depth=d, pose=f.pose, intrinsics=K,
+                pose = f.pose if world is None else world @ f.pose
+                w.write_frame(i * 100_000_000, depth=d, pose=pose, intrinsics=K,
                               ids=f.ids, base_pose=f.base_pose)
                 i += 1
             w.write_record("action", (i - 1) * 100_000_000, {
@@ -160,6 +162,15 @@ def test_noisy_depth_is_mapped_only_as_far_as_the_floor_stays_floor(tmp_path):
     assert [len(set(d.rooms)) for d in fixed.last.graph.doors] == [1]
     clean = replay(synthetic_log(tmp_path / "clean.mcap"), None, ReplayOptions())
     assert clean.options.max_depth == 5.0 and not any("depth noise" in x for x in clean.lines())
+
+
+def test_a_world_written_y_up_is_warned_of(tmp_path):
+    """Poses of a y-up world (the house turned a quarter about x) map side-on; the report
+    says the camera's "down" is not down in the world. The z-up log says nothing."""
+    y_up = np.array([[1.0, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]])
+    rep = replay(synthetic_log(tmp_path / "yup.mcap", world=y_up), None, ReplayOptions())
+    assert any(line.startswith("warning: the camera's image 'down' axis points") and
+               "y-up" in line for line in rep.lines())
 
 
 def test_the_report_warns_of_doors_joining_one_room_and_of_no_room(tmp_path):

@@ -13,19 +13,20 @@ a frame below the floor are floor points moved down by noise: with the floor at 
 
     sigma_v(z) = sqrt(mean((f - h)^2 over the points with h < f at depth z))      (N1)
 
-(the pixels are grouped by the depth at which their rays meet the floor, which does not
-move with their depth errors, not by their measured depth, which does).
-
-(obstacles only add points above the floor, so they do not bias it). The usable depth is
+(obstacles only add points above the floor, so they do not bias it; the pixels are grouped
+by the depth at which their rays meet the floor, which does not move with their depth
+errors, not by their measured depth, which does). The usable depth is
 where ``k`` sigma_v stays within the floor tolerance:
 
     z_max = the lower edge of the first depth bin with k sigma_v(z) > tolerance   (N2)
 
-The floor ``f`` is where sgtool's logs put it, at height 0 (recorded in simulation, or
-imported: the importers level the world and move the floor there), refined to the median
-height of the points within ``PEAK`` of 0; a log with too few points there (a floor
-elsewhere, or hardly seen) is not measured. It is also not measured when too few points fall below
-the floor. The depth kept is at least ``MIN_DEPTH`` (what surrounds the robot is always
+The floor ``f`` is found as the bird's-eye map finds it (the lowest height level holding
+at least half as many points as the fullest one) and measured only when it is where
+sgtool's logs put it, at height 0 (recorded in simulation, or imported: the importers
+level the world and move the floor there); then it is the median height of the points
+within ``PEAK`` of 0. A log whose floor is elsewhere (written by other software with its
+own conventions) or hardly seen is not measured, nor one with too few points below the
+floor. The depth kept is at least ``MIN_DEPTH`` (what surrounds the robot is always
 mapped). A floor that is not level in the world frame scatters too and is cut the same
 way: far from the camera it would read as obstacles as well.
 """
@@ -37,7 +38,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+LEVEL = 0.05  # m; height levels of the floor search (a voxel)
 PEAK = 0.1  # m; points this close to height 0 find the floor
+MAX_BINS = 400  # depth bins (100 m): farther floor depths share the last
 BIN = 0.25  # m; depth bins of (N1)
 MIN_BELOW = 50  # points below the floor for a depth bin to count
 MIN_FLOOR = 500  # points near height 0 for a floor
@@ -68,52 +71,81 @@ class DepthNoise:
                 "(--max-depth to choose)")
 
 
-def frame_heights(depth: np.ndarray, pose: np.ndarray, fx: float, fy: float, cx: float,
-                  cy: float, stride: int = 2) -> tuple[np.ndarray, np.ndarray]:
-    """(floor depth, world height) of every ``stride``-th pixel in each direction with a
-    finite positive depth, ``pose`` world_T_camera (OpenCV camera axes). The floor depth
-    of a pixel is the depth at which its ray meets height 0 (inf for rays that do not
-    descend): unlike the measured depth it does not move with the pixel's depth error,
-    so binning by it does not sort the errors (a bin of measured depth keeps the floor
-    points that erred into it)."""
+@dataclass(frozen=True)
+class FramePoints:
+    """What (N1) needs of one frame: the world heights ``h`` of its sampled pixels, the
+    height each pixel's ray gains per metre of depth (``slope``), and the camera's height
+    ``camera_z``."""
+
+    h: np.ndarray
+    slope: np.ndarray
+    camera_z: float
+
+    def floor_depths(self, floor: float) -> np.ndarray:
+        """The depth at which each pixel's ray meets the height ``floor`` (inf for rays
+        that do not descend to it): unlike the measured depth it does not move with the
+        pixel's depth error, so binning by it does not sort the errors (a bin of measured
+        depth keeps the floor points that erred into it)."""
+        drop = floor - self.camera_z
+        if drop >= 0:
+            return np.full(self.h.shape, np.inf)
+        with np.errstate(divide="ignore"):
+            return np.where(self.slope < 0, drop / np.minimum(self.slope, -1e-12), np.inf)
+
+
+def frame_points(depth: np.ndarray, pose: np.ndarray, fx: float, fy: float, cx: float,
+                 cy: float, stride: int = 2) -> FramePoints:
+    """The :class:`FramePoints` of every ``stride``-th pixel in each direction with a
+    finite positive depth, ``pose`` world_T_camera (OpenCV camera axes)."""
     d = np.asarray(depth)[::stride, ::stride].astype(np.float64)
     v, u = np.mgrid[0:depth.shape[0]:stride, 0:depth.shape[1]:stride]
     ok = np.isfinite(d) & (d > 0)
-    z = d[ok]
     T = np.asarray(pose, dtype=np.float64)  # noqa: N806
     slope = T[2, 0] * (u[ok] - cx) / fx + T[2, 1] * (v[ok] - cy) / fy + T[2, 2]
-    h = T[2, 3] + slope * z
-    with np.errstate(divide="ignore"):
-        zf = np.where(slope < 0, -T[2, 3] / np.minimum(slope, -1e-12), np.inf)
-    return zf, h
+    return FramePoints(T[2, 3] + slope * d[ok], slope, float(T[2, 3]))
 
 
 def floor_height(h: np.ndarray) -> float | None:
-    """The floor: the median of the heights within ``PEAK`` m of 0 (module doc); None
-    with fewer than ``MIN_FLOOR`` such points."""
-    near = h[np.abs(h) <= PEAK]
-    return float(np.median(near)) if near.size >= MIN_FLOOR else None
-
-
-def estimate(samples: Iterable[tuple[np.ndarray, np.ndarray]], tolerance: float,
-             *, sigmas: float = SIGMAS, ceiling: float | None = None) -> DepthNoise | None:
-    """(N1)-(N2) over (floor depth, height) samples (:func:`frame_heights`); ``ceiling``: a
-    ``max_depth`` at or beyond it is reported as None (nothing to lower). None when the
-    floor cannot be found or is not sharp near the camera (module doc)."""
-    pairs = [(np.asarray(z, dtype=np.float64), np.asarray(h, dtype=np.float64))
-             for z, h in samples]
-    if not pairs:
+    """The floor, when it is at height 0 (module doc): the lowest ``LEVEL`` level of the
+    heights holding at least half as many points as the fullest one, as the bird's-eye map
+    finds it; if that level lies within ``PEAK`` of 0, the median of the heights within
+    ``PEAK`` of 0, else None (a floor elsewhere); None with fewer than ``MIN_FLOOR``
+    points there."""
+    h = h[np.isfinite(h)]
+    if h.size < MIN_FLOOR:
         return None
-    z = np.concatenate([p[0] for p in pairs])
-    h = np.concatenate([p[1] for p in pairs])
-    f = floor_height(h)
+    lv = np.floor(h / LEVEL).astype(np.int64)
+    lo = int(lv.min())
+    counts = np.bincount(lv - lo)
+    level = (lo + int(np.flatnonzero(counts >= 0.5 * counts.max())[0]) + 0.5) * LEVEL
+    near = h[np.abs(h) <= PEAK]
+    if abs(level) > PEAK or near.size < MIN_FLOOR:
+        return None
+    return float(np.median(near))
+
+
+def estimate(samples: Iterable[FramePoints], tolerance: float,
+             *, sigmas: float = SIGMAS, ceiling: float | None = None) -> DepthNoise | None:
+    """(N1)-(N2) over frames (:func:`frame_points`); ``ceiling``: a ``max_depth`` at or
+    beyond it is reported as None (nothing to lower). None when the floor is not at
+    height 0 or too few points lie below it (module doc)."""
+    frames = list(samples)
+    if not frames:
+        return None
+    f = floor_height(np.concatenate([fp.h for fp in frames]))
     if f is None:
         return None
-    below = (h < f) & (h > f - BELOW_LIMIT)
-    zb, db = z[below], f - h[below]
-    bins = np.floor(zb / BIN).astype(np.int64)
-    if bins.size == 0:
+    zb_parts, db_parts = [], []
+    for fp in frames:
+        below = (fp.h < f) & (fp.h > f - BELOW_LIMIT)
+        zf = fp.floor_depths(f)[below]
+        good = np.isfinite(zf)
+        zb_parts.append(zf[good])
+        db_parts.append(f - fp.h[below][good])
+    zb, db = np.concatenate(zb_parts), np.concatenate(db_parts)
+    if zb.size == 0:
         return None
+    bins = np.floor(np.minimum(zb, MAX_BINS * BIN) / BIN).astype(np.int64)
     n = np.bincount(bins)
     ss = np.bincount(bins, weights=db * db)
     keep = np.flatnonzero(n >= MIN_BELOW)

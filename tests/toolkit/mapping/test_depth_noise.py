@@ -16,15 +16,15 @@ import numpy as np
 from support.synthetic_world import make_frame, two_room_house, world_of_house
 
 from sgtool.log.frame import CameraIntrinsics
-from sgtool.mapping.depth_noise import BIN, MIN_DEPTH, estimate, floor_height, frame_heights
+from sgtool.mapping.depth_noise import BIN, MIN_DEPTH, estimate, floor_height, frame_points
 
 K = CameraIntrinsics.from_fov(160, 120, 60)
 H = 1.2
 
 
-def samples(c: float, seed: int = 0):
-    """(depth, height) of frames looking around the kitchen and the bedroom, with noise
-    ``c z^2``."""
+def samples(c: float, seed: int = 0, floor: float = 0.0):
+    """The frames looking around the kitchen and the bedroom, with noise ``c z^2``, in a
+    world whose floor is at height ``floor``."""
     hw = world_of_house(two_room_house())
     rng = np.random.default_rng(seed)
     out = []
@@ -33,7 +33,9 @@ def samples(c: float, seed: int = 0):
             f = make_frame(hw.world, x, y, 2 * math.pi * i / 12, K, height=H, pitch=0.5)
             d = f.depth.astype(np.float64)
             d = d + c * d * d * rng.standard_normal(d.shape)
-            out.append(frame_heights(d, f.pose, K.fx, K.fy, K.cx, K.cy))
+            pose = f.pose.copy()
+            pose[2, 3] += floor
+            out.append(frame_points(d, pose, K.fx, K.fy, K.cx, K.cy))
     return out
 
 
@@ -67,6 +69,9 @@ def test_very_noisy_depth_keeps_what_surrounds_the_robot():
 
 
 def test_no_estimate_without_a_floor_at_height_zero():
+    # a world written with the floor elsewhere (walls cross height 0 there): not measured
+    for floor in (-1.2, -2.0, 0.8):
+        assert estimate(samples(0.01, floor=floor), 0.1) is None, floor
     assert estimate([], 0.1) is None
     assert floor_height(np.zeros(100)) is None  # too few points to find a floor
     assert floor_height(np.full(10_000, 0.7)) is None  # no floor at height 0
