@@ -43,6 +43,7 @@ from sgtool.errors import SgtoolError
 GRPC_PORT = 9876
 WEB_PORT = 9090
 DEFAULT_CONNECT = f"rerun+http://127.0.0.1:{GRPC_PORT}/proxy"
+FLUSH_S = 30.0  # the longest a finished command waits for its stream to reach the viewer
 
 
 @dataclass(frozen=True)
@@ -76,16 +77,43 @@ def parse_target(text: str, option: str = "--rerun") -> LiveTarget:
                               grpc_port=int(ports[1]) if len(ports) == 2 else GRPC_PORT)
         raise SgtoolError(f"{option} {text}: give serve:WEB_PORT or serve:WEB_PORT:GRPC_PORT "
                           "with port numbers 1..65535")
-    raise SgtoolError(f"{option} {text!r}: give spawn, connect[:URL] or serve[:WEB_PORT]")
+    raise SgtoolError(f"{option} {text!r}: give spawn, connect[:URL] or "
+                      "serve[:WEB_PORT[:GRPC_PORT]]")
 
 
 def has_display() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
-def check_target(target: LiveTarget, option: str = "--rerun") -> None:
+def viewer_address(url: str) -> tuple[str, int]:
+    """(host, port) of a viewer URL (``rerun+http://HOST:PORT/proxy``, ``rerun://...``;
+    the port :data:`GRPC_PORT` when it names none)."""
+    from urllib.parse import urlsplit
+
+    parts = urlsplit(url.replace("rerun+", "", 1))
+    try:
+        port = parts.port
+    except ValueError:
+        port = None
+    return parts.hostname or "127.0.0.1", port or GRPC_PORT
+
+
+def check_target(target: LiveTarget, option: str = "--rerun", probe_s: float = 2.0) -> None:
     """Refuse in one line what cannot work here: spawning without a display or without
-    the ``rerun`` viewer on PATH (naming ``serve`` for a headless machine)."""
+    the ``rerun`` viewer on PATH (naming ``serve`` for a headless machine), connecting to
+    a viewer that does not answer on its port within ``probe_s`` seconds (the stream
+    would fail, or wait without end, only after the work)."""
+    if target.mode == "connect":
+        import socket
+
+        host, port = viewer_address(target.url)
+        try:
+            socket.create_connection((host, port), timeout=probe_s).close()
+        except OSError:
+            raise SgtoolError(f"{option} connect: no Rerun viewer answers at {target.url}; "
+                              f"start `rerun` there first, or use {option} serve or write a "
+                              "file") from None
+        return
     if target.mode != "spawn":
         return
     if not has_display():
@@ -268,4 +296,12 @@ class LiveReplay:
                                                     colors=[(230, 80, 40)]))
 
     def close(self) -> None:
-        self.rec.flush()
+        """Flush the stream: a viewer lost on the way is one line, and a flush that cannot
+        finish stops waiting after :data:`FLUSH_S` seconds."""
+        try:
+            self.rec.flush(timeout_sec=FLUSH_S)
+        except RuntimeError as e:
+            where = self.target.url if self.target is not None else "the viewer"
+            raise SgtoolError(f"--rerun: lost the Rerun viewer at {where} "
+                              f"({str(e).splitlines()[0] if str(e) else type(e).__name__})"
+                              ) from None

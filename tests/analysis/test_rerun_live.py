@@ -16,7 +16,7 @@ import pytest
 from click.testing import CliRunner
 from support.paths import GOLDEN
 
-from sgtool.analysis.rerun_live import DEFAULT_CONNECT, LiveTarget, parse_target
+from sgtool.analysis.rerun_live import DEFAULT_CONNECT, LiveTarget, parse_target, viewer_address
 from sgtool.cli import cli
 from sgtool.errors import SgtoolError
 
@@ -32,6 +32,8 @@ def test_parse_target():
     for bad in ("show", "serve:http", "serve:70000", "spawn:now"):
         with pytest.raises(SgtoolError, match="--rerun"):
             parse_target(bad)
+    assert viewer_address(url) == ("10.0.0.2", 9876)
+    assert viewer_address("rerun+http://example.org/proxy") == ("example.org", 9876)
 
 
 def test_headless_view_names_serve(tmp_path, monkeypatch):
@@ -50,6 +52,22 @@ def free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
+
+
+@pytest.mark.parametrize("command", [["view", "{log}"], ["replay", "{log}"],
+                                     ["record", "-o", "{out}", "--frames", "5"]])
+def test_connect_without_a_viewer_is_refused_before_any_work(tmp_path, command):
+    """No viewer on the port: one line and exit 2 before the work starts (no traceback
+    after it, no recording left waiting for a viewer), and no output file."""
+    from support.logfixtures import write_log
+
+    log = write_log(tmp_path / "run.mcap", n=2)
+    url = f"rerun+http://127.0.0.1:{free_port()}/proxy"
+    args = [a.format(log=log, out=tmp_path / "rec.mcap") for a in command]
+    r = CliRunner().invoke(cli, [*args, "--rerun", f"connect:{url}"])
+    assert r.exit_code == 2, r.output
+    assert f"no Rerun viewer answers at {url}" in r.output and "Traceback" not in r.output
+    assert not (tmp_path / "rec.mcap").exists()
 
 
 def test_replay_serves_a_web_viewer_while_it_runs(tmp_path):

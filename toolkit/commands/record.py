@@ -79,7 +79,8 @@ def _pair(option: str, text: str) -> tuple[float, float]:
               show_default=True, help="MCAP chunk compression.")
 @click.option("--force", is_flag=True, help="Overwrite the output log.")
 @click.option("--quiet", is_flag=True, help="No progress bar, no report.")
-@click.option("--rerun", "rerun_to", default=None, metavar="spawn|connect[:URL]|serve[:PORT]",
+@click.option("--rerun", "rerun_to", default=None,
+              metavar="spawn|connect[:URL]|serve[:WEB_PORT[:GRPC_PORT]]",
               help="Stream every frame (camera images, robot, path) to Rerun while recording: "
               "spawn a viewer, connect to one, or serve a web viewer (headless machines; "
               "waits for Ctrl-C at the end).")

@@ -80,7 +80,8 @@ if TYPE_CHECKING:
               "more than 1 s refused.")
 @click.option("--rrd", type=click.Path(dir_okay=False),
               help="Also write a Rerun recording of the derived log (needs -o).")
-@click.option("--rerun", "rerun_to", default=None, metavar="spawn|connect[:URL]|serve[:PORT]",
+@click.option("--rerun", "rerun_to", default=None,
+              metavar="spawn|connect[:URL]|serve[:WEB_PORT[:GRPC_PORT]]",
               help="Stream every refresh (maps, scene graph, robot) to Rerun while replaying: "
               "spawn a viewer, connect to one, or serve a web viewer (headless machines; "
               "waits for Ctrl-C at the end).")

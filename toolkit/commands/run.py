@@ -111,7 +111,8 @@ if TYPE_CHECKING:
               help="The episode log to write (OUT.mcap).")
 @click.option("--force", is_flag=True, help="Overwrite the output log.")
 @click.option("--quiet", is_flag=True, help="No progress bar, no report.")
-@click.option("--rerun", "rerun_to", default=None, metavar="spawn|connect[:URL]|serve[:PORT]",
+@click.option("--rerun", "rerun_to", default=None,
+              metavar="spawn|connect[:URL]|serve[:WEB_PORT[:GRPC_PORT]]",
               help="Stream every decision (scene graph, robot, action) to Rerun while the "
               "episode runs: spawn a viewer, connect to one, or serve a web viewer (headless "
               "machines; waits for Ctrl-C at the end).")

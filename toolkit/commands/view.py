@@ -24,7 +24,8 @@ from sgtool.errors import SgtoolError
               help="Stop after this many camera frames.")
 @click.option("--voxels/--no-voxels", default=True, show_default=True,
               help="Rebuild and show the semantic voxel map (needs the mapping pipeline).")
-@click.option("--rerun", "rerun_to", default=None, metavar="spawn|connect[:URL]|serve[:PORT]",
+@click.option("--rerun", "rerun_to", default=None,
+              metavar="spawn|connect[:URL]|serve[:WEB_PORT[:GRPC_PORT]]",
               help="Where to stream instead of -o: spawn a viewer (the default without -o), "
               "connect to a running one, or serve a web viewer from here (headless "
               "machines; waits for Ctrl-C).")
