@@ -57,6 +57,7 @@ from sgtool.mapping.voxels import VoxelConfig
 from sgtool.progress import Progress
 from sgtool.replayers.depth_range import FirstFrames, first_frames
 from sgtool.replayers.graph_scene import graph_scene_update
+from sgtool.replayers.instance_notes import instance_notes
 from sgtool.scenegraph.build_options import (
     CLASSIFIERS,
     MAX_DEPTH_M,
@@ -282,6 +283,10 @@ def replay(
                          tf_time=tf_time)
         report.seconds = time.perf_counter() - t0
         report.stages = stream.builder.stage_summary()
+        if report.semantic:
+            rooms = len(report.last.graph.rooms) if report.last is not None else 0
+            report.warnings.extend(instance_notes(stream.builder.voxels.label_ids(),
+                                                  stream.builder.instances, rooms))
     return report
 
 

@@ -65,13 +65,18 @@ def score(spec: HouseSpec, instances: Mapping[int, InstanceInfo], layers: MapLay
 
 
 def score_lines(scores: Mapping[str, Quality]) -> list[str]:
+    """One line per scoring; objects none of which could be scored (no instance of the
+    graph's objects names an element of the spec: ``spec_id`` in the instance table) are
+    said so, not scored as 0 %."""
     out = []
     for name, v in scores.items():
+        objects = (f"objects in the right room {v.object_accuracy:.1%} of {v.objects}"
+                   if v.objects else "objects not scored (no object's instance names a "
+                   "spec element: spec_id in the instance table)")
         out.append(
             f"quality ({name}): rooms {v.rooms} vs {v.gt_rooms_seen} seen of {v.gt_rooms} "
             f"(error {v.room_count_error:+d}); Voronoi nodes in the right room: purity "
-            f"{v.purity:.3f}, ARI {v.ari:.3f}; objects in the right room "
-            f"{v.object_accuracy:.1%} of {v.objects}; room categories right "
+            f"{v.purity:.3f}, ARI {v.ari:.3f}; {objects}; room categories right "
             f"{v.category_accuracy:.1%} of {v.rooms} ({v.categorised} categorised)")
     return out
 

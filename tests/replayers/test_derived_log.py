@@ -48,11 +48,13 @@ def messages(path: Path) -> dict[str, list[tuple[int, bytes]]]:
 
 
 def synthetic_log(path: Path, with_ids: bool = True, opening: str = "open",
-                  noise: float = 0.0, world: np.ndarray | None = None) -> Path:
+                  noise: float = 0.0, world: np.ndarray | None = None,
+                  table_without: str | None = None) -> Path:
     """The two-room house seen by a robot looking around in the kitchen, walking to the
     bedroom and looking around there; an action record after each part. ``noise``: depth
     noise of std ``noise`` z^2 (seeded); ``world``: a 4x4 transform applied to every pose
-    (another world convention)."""
+    (another world convention); ``table_without``: an instance kind left out of the
+    instance table (its ids stay in the images)."""
     hw = world_of_house(two_room_house(opening))
     rng = np.random.default_rng(5)
     parts = [look_around(2.0, 1.5, 0.0, 12), walk([(2.0, 1.5), (6.0, 1.5)], 0.25),
@@ -60,7 +62,7 @@ def synthetic_log(path: Path, with_ids: bool = True, opening: str = "open",
     with LogWriter(path, seed=3) as w:
         if with_ids:
             w.write_record("instances", 0, {"instances": [
-                v.to_record() for v in hw.instances.values()]})
+                v.to_record() for v in hw.instances.values() if v.kind != table_without]})
         i = 0
         for n, poses in enumerate(parts):
             for x, y, yaw in poses:
@@ -162,6 +164,21 @@ def test_noisy_depth_is_mapped_only_as_far_as_the_floor_stays_floor(tmp_path):
     assert [len(set(d.rooms)) for d in fixed.last.graph.doors] == [1]
     clean = replay(synthetic_log(tmp_path / "clean.mcap"), None, ReplayOptions())
     assert clean.options.max_depth == 5.0 and not any("depth noise" in x for x in clean.lines())
+
+
+def test_ids_the_table_lacks_and_a_table_without_doors_are_said(tmp_path):
+    """The door left out of the instance table: its id in the images is ignored (said,
+    with the id), and with no door the two rooms are one (said)."""
+    rep = replay(synthetic_log(tmp_path / "nodoor.mcap", table_without="door"), None,
+                 ReplayOptions())
+    door_ids = [i for i, v in world_of_house(two_room_house()).instances.items()
+                if v.kind == "door"]
+    lines = rep.lines()
+    assert len(rep.last.graph.rooms) == 1 and not rep.last.graph.doors
+    assert any(f"{len(door_ids)} of" in x and "no entry in the instance table" in x and
+               str(door_ids[0]) in x for x in lines)
+    assert any(x.startswith("warning: one room: the instance table names no door")
+               for x in lines)
 
 
 def test_a_world_written_y_up_is_warned_of(tmp_path):
