@@ -57,8 +57,13 @@ INTEGER_ENCODINGS = frozenset({"mono8", "8UC1", "mono16", "16UC1", "32SC1"})
 def encode_ids(t_ns: int, ids: np.ndarray, frame_id: str) -> RawImage:
     """An instance-id image as a ``RawImage`` in an encoding Foxglove's Image panel shows:
     ``16UC1`` (exact ids, 0 = none) when every id fits in 0..65535, else ``32SC1`` (exact,
-    not drawn by Foxglove; sgtool's readers take both)."""
-    fits = ids.size == 0 or (int(ids.min()) >= 0 and int(ids.max()) <= S.IDS_MAX_16)
+    not drawn by Foxglove; sgtool's readers take both); ids outside int32 are a
+    ``ValueError`` (they would wrap)."""
+    lo, hi = (int(ids.min()), int(ids.max())) if ids.size else (0, 0)
+    if lo < -(2 ** 31) or hi > 2 ** 31 - 1:
+        raise ValueError(f"instance ids {lo}..{hi}: ids must fit int32 (the instance table "
+                         "takes no others)")
+    fits = ids.size == 0 or (lo >= 0 and hi <= S.IDS_MAX_16)
     return encode_image(t_ns, ids, S.IDS_ENCODING_16 if fits else S.IDS_ENCODING, frame_id)
 
 

@@ -60,6 +60,7 @@ IDS_ENCODING = "32SC1"  # instance ids, little endian int32, 0 = none
 IDS_ENCODING_16 = "16UC1"  # instance ids that fit 0..IDS_MAX_16 (Foxglove shows it)
 IDS_MAX_16 = 65535
 DEPTH_SCALE = 1000.0  # depth units per metre
+DEPTH_MAX_M = 65535 / DEPTH_SCALE  # m; the farthest depth uint16 millimetres hold
 
 
 @dataclass(frozen=True)

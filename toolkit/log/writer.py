@@ -156,6 +156,7 @@ class LogWriter:
         self._channels: dict[str, int] = {}
         self._sequence: dict[int, int] = {}
         self._last_calibration: CameraIntrinsics | None = None
+        self._last_frame_t: int | None = None  # write_frame's last time
 
     # ----- channels ---------------------------------------------------------------------
     def _proto_channel(self, topic: str, message_class: Any) -> int:
@@ -333,7 +334,21 @@ class LogWriter:
         self.write_proto(S.RGB, t_ns, codec.encode_image(t_ns, rgb, S.RGB_ENCODING, frame_id))
 
     def write_depth(self, t_ns: int, depth_m: np.ndarray, frame_id: str = S.CAMERA_FRAME) -> None:
-        """Metric depth (float metres) or already uint16 millimetres."""
+        """Metric depth (float metres) or already uint16 millimetres. Other integer types,
+        and float depth most of whose valid pixels lie beyond what uint16 millimetres hold
+        (65.535 m: millimetres given as float), are a ``ValueError``: written, they would
+        read back as no depth at all."""
+        if depth_m.dtype != np.uint16 and depth_m.dtype.kind in "iub":
+            raise ValueError(f"depth as {depth_m.dtype}: give float metres or uint16 "
+                             "millimetres")
+        if depth_m.dtype != np.uint16:
+            d = np.asarray(depth_m, dtype=np.float32)
+            valid = int(np.count_nonzero(np.isfinite(d) & (d > 0)))
+            far = int(np.count_nonzero(np.isfinite(d) & (d > S.DEPTH_MAX_M)))
+            if valid and far > valid // 2:
+                raise ValueError(f"depth beyond {S.DEPTH_MAX_M:g} m in {far} of {valid} valid "
+                                 "pixels: give float metres (millimetres / 1000) or uint16 "
+                                 "millimetres")
         mm = depth_m if depth_m.dtype == np.uint16 else codec.depth_to_mm(depth_m)
         self.write_proto(S.DEPTH, t_ns, codec.encode_image(t_ns, mm, S.DEPTH_ENCODING, frame_id))
 
@@ -365,7 +380,12 @@ class LogWriter:
     ) -> None:
         """One time step. ``pose`` is world_T_camera; with ``base_pose`` (world_T_base) the
         transforms are written as the chain world -> base -> camera, else world -> camera.
-        Calibration is written on the first frame and whenever it changes."""
+        Calibration is written on the first frame and whenever it changes. Frame times
+        must increase (a ``ValueError`` otherwise: a replay pairs messages by time)."""
+        if self._last_frame_t is not None and t_ns <= self._last_frame_t:
+            raise ValueError(f"frame at t_ns={t_ns}: frame times must increase (the previous "
+                             f"frame is at {self._last_frame_t})")
+        self._last_frame_t = int(t_ns)
         if intrinsics != self._last_calibration:
             self.write_calibration(t_ns, intrinsics)
         if base_pose is not None:

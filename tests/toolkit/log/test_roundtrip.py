@@ -135,3 +135,27 @@ def test_not_an_mcap_file(tmp_path):
     p.write_text("hello")
     with pytest.raises(LogFormatError, match="not an MCAP file"):
         LogReader(p)
+
+
+def test_input_that_would_read_back_wrong_is_refused(tmp_path):
+    """What the writer would store as something else is a ValueError naming it: depth
+    in an integer type other than uint16 or in millimetres as float (it would read back
+    as no depth), ids beyond int32 (they would wrap), frames at a time not after the last
+    (a replay pairs by time); uint16 millimetres, float metres and ids that fit pass."""
+    k, rgb, depth, ids, pose, _ = synthetic_frame(0)
+    with LogWriter(tmp_path / "run.mcap", seed=1) as w:
+        w.write_frame(2 * DT, depth=depth, pose=pose, intrinsics=k, ids=ids)
+        for bad, says in (((depth * 1000).astype(np.int32), "depth as int32"),
+                          (depth * 1000.0, "depth beyond 65.535 m")):
+            with pytest.raises(ValueError, match=says):
+                w.write_depth(DT, bad)
+        with pytest.raises(ValueError, match="ids must fit int32"):
+            w.write_ids(DT, ids.astype(np.int64) + 2**31)
+        for t in (2 * DT, DT):  # the same time, an earlier one
+            with pytest.raises(ValueError, match="frame times must increase"):
+                w.write_frame(t, depth=depth, pose=pose, intrinsics=k)
+        w.write_frame(3 * DT, depth=np.rint(depth * 1000).astype(np.uint16), pose=pose,
+                      intrinsics=k)  # uint16 millimetres: as given
+    with LogReader(tmp_path / "run.mcap") as r:
+        a, b = r.frames()
+        np.testing.assert_allclose(b.depth, a.depth, atol=1e-3)
