@@ -37,7 +37,7 @@ if TYPE_CHECKING:
               help="Also ask these planners at every logged decision point (MCAP logs with "
                    "scene graphs) and compare their choices with what was done (repeatable "
                    "or comma-separated). " + PLUGIN_HELP)
-@list_planners_option()
+@list_planners_option("--planner")
 @click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
               help=PLANNER_OPTION_HELP)
 @llm_endpoint_options("LLM planners (-p)")

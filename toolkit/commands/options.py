@@ -167,16 +167,27 @@ def llm_log_options(transcript_help: str, many: bool = False) -> Callable[[F], F
 
 def replay_files(given: Sequence[str]) -> str | list[str]:
     """The transcripts of a repeatable ``--llm-replay``: files as given, a folder's
-    ``*.mcap`` and ``*.jsonl`` (recursively, sorted); one file as itself. A path that is
-    neither, or a folder without one, is a one-line error."""
+    ``*.jsonl`` and the ``*.mcap`` logs that hold LLM exchanges (recursively, sorted: a
+    ``--log-dir`` of a run that mixed LLM and other planners); one file as itself. A path
+    that is neither, or a folder without one, is a one-line error."""
+    from sgtool.log import schemas as S
+    from sgtool.log.reader import LogReader
+
+    def exchanges(f: Path) -> bool:
+        if f.suffix != ".mcap":
+            return True
+        with LogReader(f) as r:
+            return r.has(S.RECORDS["llm_exchange"].topic)
+
     out: list[str] = []
     for g in given:
         p = Path(g)
         if p.is_dir():
             found = sorted(str(f) for f in p.rglob("*") if f.suffix in (".mcap", ".jsonl")
-                           and f.is_file())
+                           and f.is_file() and exchanges(f))
             if not found:
-                raise SgtoolError(f"--llm-replay {g}: no *.mcap or *.jsonl transcripts there")
+                raise SgtoolError(f"--llm-replay {g}: no transcripts there (*.jsonl, or *.mcap "
+                                  "logs holding LLM exchanges)")
             out += found
         elif p.is_file():
             out.append(str(p))
@@ -262,9 +273,10 @@ def shown_command(argv: Sequence[str]) -> list[str]:
     return out
 
 
-def list_planners_option() -> Callable[[F], F]:
+def list_planners_option(named_by: str = "--planners") -> Callable[[F], F]:
     """``--list-planners``: print every planner with its summary and options (from their
-    dataclasses) and the installed plug-ins, then exit."""
+    dataclasses) and the installed plug-ins, then exit; ``named_by``: the command's option
+    that names planners (for the help's example)."""
     def show(ctx: click.Context, param: click.Parameter, value: bool) -> None:
         if not value or ctx.resilient_parsing:
             return
@@ -282,7 +294,7 @@ def list_planners_option() -> Callable[[F], F]:
                         callback=show,
                         help="List the planners, their options (name, type, default, help) "
                         "and the installed plug-ins, then exit; a module:Name plug-in named "
-                        "before it (--planners mymod:My --list-planners) with its options.")
+                        f"before it ({named_by} mymod:My --list-planners) with its options.")
 
 
 PLANNER_OPTION_HELP = ("Planner option PLANNER.KEY=VALUE, e.g. scout.delta=0.2 or "

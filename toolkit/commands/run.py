@@ -43,7 +43,7 @@ if TYPE_CHECKING:
 @click.option("--planner", "-p", required=True, is_eager=True,
               help="The planner: a built-in (--list-planners shows them all with their "
               "options: scout, voi, bayes-search, moma-llm, ...). " + PLUGIN_HELP)
-@list_planners_option()
+@list_planners_option("--planner")
 @house_options(
     seed_help="Search a generated evaluation house (`sgtool scenes generate`) of this seed "
     "instead of --house.",

@@ -369,3 +369,23 @@ def test_an_endpoint_that_never_answers_is_warned_about(tmp_path):
                                      "-o", str(tmp_path / "o2")])
     assert r.exit_code == 2 and "refused the first request: HTTP 401" in r.output
     assert not (tmp_path / "o2" / "episodes.jsonl").exists()
+
+
+def test_a_replay_folder_skips_logs_without_exchanges(tmp_path):
+    """A --log-dir folder of a run that mixed moma-llm with other planners: the other
+    planners' logs hold no LLM exchanges and are not transcripts; a folder with none is
+    one line."""
+    from support.logfixtures import synthetic_frame
+
+    from sgtool.commands.options import replay_files
+    from sgtool.errors import SgtoolError
+    from sgtool.log import LogWriter
+
+    (tmp_path / "scout").mkdir()
+    k, _, depth, _, pose, _ = synthetic_frame(0)
+    with LogWriter(tmp_path / "scout" / "seed0-ep0.mcap", seed=1) as w:
+        w.write_frame(0, depth=depth, pose=pose, intrinsics=k)
+    with pytest.raises(SgtoolError, match="no transcripts there"):
+        replay_files([str(tmp_path)])
+    (tmp_path / "moma.jsonl").write_text("")
+    assert replay_files([str(tmp_path)]) == str(tmp_path / "moma.jsonl")
