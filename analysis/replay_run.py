@@ -72,6 +72,10 @@ def replay_one(request: ReplayRequest, show: Echo, note: Echo) -> None:
     from sgtool.replayers.derived_log import replay
 
     final: dict[str, Any] = {}
+    if request.rrd is not None or request.rerun_to is not None:
+        from sgtool.extras import require
+
+        require("rerun")  # before the work: a missing viewer is one line, not a late one
 
     def keep(ref: Any, stream: Any) -> None:
         final["refresh"], final["stream"] = ref, stream

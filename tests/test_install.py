@@ -197,6 +197,13 @@ def test_the_cli_names_the_extra_of_a_command(monkeypatch, tmp_path):
     assert r.output.splitlines() == [
         "sgtool: error: sgtool view needs Rerun: pip install 'sgtool[view]'"]
     assert not (tmp_path / "v.rrd").exists()
+    # replay --rrd says so before the replay: no derived log left to refuse the next try
+    r = CliRunner().invoke(cli, ["replay", str(GOLDEN / "house10-start.mcap"), "-o",
+                                 str(tmp_path / "d.mcap"), "--rrd", str(tmp_path / "v.rrd")],
+                           prog_name="sgtool")
+    assert r.exit_code == 2 and r.output.splitlines() == [
+        "sgtool: error: sgtool replay needs Rerun: pip install 'sgtool[view]'"]
+    assert not (tmp_path / "d.mcap").exists()
 
 
 # ----- the core alone, from the wheel, in a fresh venv -----------------------------------
