@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from sgtool.errors import SgtoolError
+from sgtool.log.codec import rigid_problem
 from sgtool.recorders.importers.poses import pose_from_tq
 
 
@@ -87,29 +88,6 @@ def read_tum_trajectory(path: Path) -> list[tuple[int, np.ndarray]]:
             raise SgtoolError(f"{path}:{n}: not a valid pose (NaN or zero quaternion)")
         out.append((t, pose_from_tq(v[:3], v[3:])))
     return sorted(out, key=lambda tp: tp[0])
-
-
-RIGID_TOL = 5e-3  # |R^T R - I|, |det R - 1| and the last row (7-Scenes: up to 5e-4)
-
-
-def rigid_problem(m: np.ndarray) -> tuple[int, str] | None:
-    """Why a finite 4x4 matrix is not a rigid pose, with the matrix row (0-3) to name:
-    the last row is not 0 0 0 1, or the rotation is not orthonormal with det +1 (within
-    :data:`RIGID_TOL`); None when it is rigid."""
-    last = m[3]
-    if np.abs(last - (0.0, 0.0, 0.0, 1.0)).max() > RIGID_TOL:
-        return 3, f"the last row is {' '.join(f'{v:g}' for v in last)}, not 0 0 0 1"
-    r = m[:3, :3]
-    big = float(np.abs(r).max())
-    if big > 1e100:  # (r.T @ r would overflow; a rotation's entries are within +-1)
-        return 0, (f"the rotation is not orthonormal with det +1 (an entry of magnitude "
-                   f"{big:.4g}): not a rigid camera pose (scaled or sheared)")
-    ortho = float(np.abs(r.T @ r - np.eye(3)).max())
-    det = float(np.linalg.det(r))
-    if ortho > RIGID_TOL or abs(det - 1.0) > RIGID_TOL:
-        return 0, (f"the rotation is not orthonormal with det +1 (|R^T R - I| = {ortho:.3g}, "
-                   f"det {det:.4g}): not a rigid camera pose (scaled or sheared)")
-    return None
 
 
 def pose_matrix(path: Path, rows: list[tuple[int, list[str]]]) -> np.ndarray:

@@ -193,8 +193,17 @@ def matrix_from_quat(x: float, y: float, z: float, w: float) -> np.ndarray:
 
 
 def encode_transform(t_ns: int, parent: str, child: str, T: np.ndarray) -> FrameTransform:  # noqa: N803
-    """``T`` is parent_T_child (4x4): the pose of ``child`` in ``parent``."""
+    """``T`` is parent_T_child (4x4): the pose of ``child`` in ``parent``. A matrix that
+    is not a rigid transform (not 4x4 and finite, or :func:`rigid_problem`) is a
+    ``ValueError``: its quaternion would be another pose."""
     T = np.asarray(T, dtype=np.float64)  # noqa: N806
+    if T.shape != (4, 4) or not np.isfinite(T).all():
+        raise ValueError(f"transform {parent} -> {child}: a finite 4x4 matrix is needed, not "
+                         f"{'x'.join(str(n) for n in T.shape)}"
+                         + ("" if T.shape != (4, 4) else " with values that are not finite"))
+    problem = rigid_problem(T)
+    if problem is not None:
+        raise ValueError(f"transform {parent} -> {child}: {problem[1]}")
     qx, qy, qz, qw = quat_from_matrix(T[:3, :3])
     msg = FrameTransform(timestamp=timestamp(t_ns), parent_frame_id=parent, child_frame_id=child)
     msg.translation.x, msg.translation.y, msg.translation.z = (float(v) for v in T[:3, 3])
@@ -203,6 +212,27 @@ def encode_transform(t_ns: int, parent: str, child: str, T: np.ndarray) -> Frame
 
 
 MAX_TRANSLATION_M = 1e9  # beyond any map: a transform this far is damage, not a pose
+RIGID_TOL = 5e-3  # |R^T R - I|, |det R - 1| and the last row (7-Scenes: up to 5e-4)
+
+
+def rigid_problem(m: np.ndarray) -> tuple[int, str] | None:
+    """Why a finite 4x4 matrix is not a rigid pose, with the matrix row (0-3) to name:
+    the last row is not 0 0 0 1, or the rotation is not orthonormal with det +1 (within
+    :data:`RIGID_TOL`); None when it is rigid."""
+    last = m[3]
+    if np.abs(last - (0.0, 0.0, 0.0, 1.0)).max() > RIGID_TOL:
+        return 3, f"the last row is {' '.join(f'{v:g}' for v in last)}, not 0 0 0 1"
+    r = m[:3, :3]
+    big = float(np.abs(r).max())
+    if big > 1e100:  # (r.T @ r would overflow; a rotation's entries are within +-1)
+        return 0, (f"the rotation is not orthonormal with det +1 (an entry of magnitude "
+                   f"{big:.4g}): not a rigid camera pose (scaled or sheared)")
+    ortho = float(np.abs(r.T @ r - np.eye(3)).max())
+    det = float(np.linalg.det(r))
+    if ortho > RIGID_TOL or abs(det - 1.0) > RIGID_TOL:
+        return 0, (f"the rotation is not orthonormal with det +1 (|R^T R - I| = {ortho:.3g}, "
+                   f"det {det:.4g}): not a rigid camera pose (scaled or sheared)")
+    return None
 
 
 def _numbers(*values: float) -> str:

@@ -347,7 +347,8 @@ def test_huge_pose_entries_and_intrinsics_sizes_are_one_line(tmp_path, recwarn) 
     import pytest
 
     from sgtool.errors import SgtoolError
-    from sgtool.recorders.importers.textformats import read_intrinsics_file, rigid_problem
+    from sgtool.log.codec import rigid_problem
+    from sgtool.recorders.importers.textformats import read_intrinsics_file
 
     m = np.eye(4)
     m[0, 0] = 1e200

@@ -140,7 +140,8 @@ def test_not_an_mcap_file(tmp_path):
 def test_input_that_would_read_back_wrong_is_refused(tmp_path):
     """What the writer would store as something else is a ValueError naming it: depth
     in an integer type other than uint16 or in millimetres as float (it would read back
-    as no depth), ids beyond int32 (they would wrap), frames at a time not after the last
+    as no depth), ids beyond int32 (they would wrap), a pose that is not a rigid 4x4
+    transform (its quaternion would be another pose), frames at a time not after the last
     (a replay pairs by time); uint16 millimetres, float metres and ids that fit pass."""
     k, rgb, depth, ids, pose, _ = synthetic_frame(0)
     with LogWriter(tmp_path / "run.mcap", seed=1) as w:
@@ -151,6 +152,12 @@ def test_input_that_would_read_back_wrong_is_refused(tmp_path):
                 w.write_depth(DT, bad)
         with pytest.raises(ValueError, match="ids must fit int32"):
             w.write_ids(DT, ids.astype(np.int64) + 2**31)
+        scaled = pose.copy()
+        scaled[:3, :3] *= 2
+        for bad_pose, says in ((pose[:3], "4x4 matrix is needed, not 3x4"),
+                               (scaled, "not orthonormal")):
+            with pytest.raises(ValueError, match=says):
+                w.write_transform(2 * DT, "world", "camera", bad_pose)
         for t in (2 * DT, DT):  # the same time, an earlier one
             with pytest.raises(ValueError, match="frame times must increase"):
                 w.write_frame(t, depth=depth, pose=pose, intrinsics=k)
