@@ -17,6 +17,7 @@ The same log gives the same answer: the frames read and the pixels sampled are f
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,7 +27,7 @@ from sgtool.mapping.bev import BevConfig
 from sgtool.mapping.depth_noise import DepthNoise, estimate, frame_points
 
 FRAMES = 60  # the first frames of the log that are measured
-STRIDE = 2  # every STRIDE-th pixel in each direction
+PIXELS = 20_000  # about this many pixels of each frame are measured (a fixed stride)
 UPRIGHT = -0.3  # median world z of the camera's image-down axis above this: not z-up
 
 
@@ -47,7 +48,8 @@ def first_frames(reader: LogReader, ceiling: float, tf_time: str = "log",
     samples, down_z = [], []
     for fr in itertools.islice(reader.frames(tf_time=tf_time), FRAMES):
         k = fr.intrinsics
-        samples.append(frame_points(fr.depth, fr.pose, k.fx, k.fy, k.cx, k.cy, STRIDE))
+        stride = max(1, round(math.sqrt(k.width * k.height / PIXELS)))
+        samples.append(frame_points(fr.depth, fr.pose, k.fx, k.fy, k.cx, k.cy, stride))
         down_z.append(float(np.asarray(fr.pose)[2, 1]))
     note = None
     if down_z and float(np.median(down_z)) > UPRIGHT:
