@@ -204,6 +204,8 @@ def replay_dict(report: Any, scores: Any, rrd: str | None) -> dict[str, Any]:
     }
     if report.warnings:
         out["warnings"] = list(report.warnings)
+    if report.notes:
+        out["notes"] = list(report.notes)
     if scores is not None:
         out["score"] = score_dict(scores)
     return out

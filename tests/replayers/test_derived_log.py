@@ -164,6 +164,10 @@ def test_noisy_depth_is_mapped_only_as_far_as_the_floor_stays_floor(tmp_path):
     assert [len(set(d.rooms)) for d in fixed.last.graph.doors] == [1]
     clean = replay(synthetic_log(tmp_path / "clean.mcap"), None, ReplayOptions())
     assert clean.options.max_depth == 5.0 and not any("depth noise" in x for x in clean.lines())
+    r = CliRunner().invoke(cli, ["replay", str(noisy), "--json"])
+    doc = json.loads(r.output.splitlines()[-1])
+    assert r.exit_code == 0 and doc["options"]["max_depth"] == auto.options.max_depth
+    assert doc["notes"] == [x for x in auto.lines() if x.startswith("depth noise")]
 
 
 def test_ids_the_table_lacks_and_a_table_without_doors_are_said(tmp_path):
