@@ -65,6 +65,7 @@ SMOKE: dict[str, Smoke] = {
         ("--base", "{repo}", "--rounds", "1", "--rooms", "4-4", "--seed", "0", "--episode",
          "0", "--frames", "10", "--resolution", "32x24"), marks=("slow",)),
     "benchmarks/decide.py": Smoke(("--episodes", "1"), subprocess=True, marks=("slow",)),
+    "benchmarks/depth_measure.py": Smoke(("{log}", "--rounds", "1", "--json", "{tmp}/o.json")),
     "benchmarks/density.py": Smoke(
         ("--houses", "1", "--episodes", "1", "--seeds", "1", "--presets", "default",
          "--planners", "random", "--rooms", "4-5")),
