@@ -151,6 +151,11 @@ class BenchConfig:
     reference: str | None = None  # paired comparisons against it (None: scout, else first)
     all_pairs: bool = False  # paired comparisons of every pair of planners instead
 
+    def __post_init__(self) -> None:
+        # a copy: the caller's dict changed for the next run must not change this one's
+        object.__setattr__(self, "planner_options",
+                           {str(k): dict(v) for k, v in self.planner_options.items()})
+
     def check(self) -> None:
         check_planner_list(self.planners)
         if len(set(self.planners)) != len(self.planners):
@@ -301,6 +306,7 @@ class BenchResult:
 # depends on how many episodes are drawn, so N episodes are not the first N of a larger draw
 _HOUSES: OrderedDict[tuple[str, str, tuple[int, int], str, int], Any] = OrderedDict()
 _PLANNERS: dict[tuple[str, str], Any] = {}
+_PLANNERS_RUN: list[str] = [""]  # the run the cached planners were built for
 
 
 def _house(ref: BenchHouse, rooms: tuple[int, int], episodes: int,
@@ -323,13 +329,20 @@ def _house(ref: BenchHouse, rooms: tuple[int, int], episodes: int,
     return entry
 
 
-def cached_planner(name: str, options: Mapping[str, Any]) -> Any:
-    """The planner ``make_planner(name, **options)`` builds, built once per process for each
-    name and options (compared by their text) and handed out again after; a bad name or
-    option raises as :func:`~sgtool.planning.registry.make_planner` does."""
+def cached_planner(name: str, options: Mapping[str, Any], run: str = "") -> Any:
+    """The planner ``make_planner(name, **options)`` builds, built once per run (``run``:
+    the run's token; the planners of another run are dropped first, so a plug-in class
+    redefined or reloaded between runs, or a plug-in's own state, never carries into the
+    next) for each name and options (compared by type and repr) and handed out again
+    after; a bad name or option raises as
+    :func:`~sgtool.planning.registry.make_planner` does."""
     from sgtool.planning.registry import make_planner
 
-    key = (name, json.dumps({k: str(v) for k, v in sorted(options.items())}))
+    if run != _PLANNERS_RUN[0]:
+        _PLANNERS.clear()
+        _PLANNERS_RUN[0] = run
+    key = (name, json.dumps({k: [type(v).__name__, repr(v)] for k, v in
+                             sorted(options.items())}))
     p = _PLANNERS.get(key)
     if p is None:
         p = make_planner(name, **dict(options))
@@ -337,22 +350,18 @@ def cached_planner(name: str, options: Mapping[str, Any]) -> Any:
     return p
 
 
-def forget_replaying_planners() -> None:
-    """Drop the cached planners that answer from a recorded transcript (their answers are
-    served once, in order, over a run): the next run builds them again, from the start."""
-    for key in [k for k in _PLANNERS if '"replay":' in k[1]]:
-        del _PLANNERS[key]
-
-
-def run_task(args: tuple[BenchConfig, BenchHouse, tuple[str, ...]]) -> list[EpisodeResult]:
+def run_task(args: tuple[BenchConfig, BenchHouse, tuple[str, ...]]
+             | tuple[BenchConfig, BenchHouse, tuple[str, ...], str]) -> list[EpisodeResult]:
     """Every episode and seed of one house for each of the given planners (the ``args`` of a
-    :func:`bench_tasks` task), in planner, seed, episode order. The results depend on the
-    task alone: not on what the process ran before, nor on the machine's core count."""
+    :func:`bench_tasks` task, with the run's token), in planner, seed, episode order. The
+    results depend on the task alone: not on what the process ran before, nor on the
+    machine's core count."""
     from sgtool.blas import single_blas_thread
     from sgtool.heap import frozen_heap
     from sgtool.semantics.priors import forget_default_scores
 
-    cfg, ref, names = args
+    cfg, ref, names = args[:3]
+    run = str(args[3]) if len(args) > 3 else ""
     # A task's results depend on the task alone, not on what its worker ran before nor on
     # the machine's core count: the shared priors start from an empty score memo (their
     # batches, and so the last bits of their scores, are the task's own), and the small
@@ -362,11 +371,11 @@ def run_task(args: tuple[BenchConfig, BenchHouse, tuple[str, ...]]) -> list[Epis
     # scans (sgtool.heap.frozen_heap).
     forget_default_scores()
     with single_blas_thread(), frozen_heap():
-        return _task_episodes(cfg, ref, names)
+        return _task_episodes(cfg, ref, names, run)
 
 
-def _task_episodes(cfg: BenchConfig, ref: BenchHouse,
-                   names: tuple[str, ...]) -> list[EpisodeResult]:
+def _task_episodes(cfg: BenchConfig, ref: BenchHouse, names: tuple[str, ...],
+                   run: str = "") -> list[EpisodeResult]:
     from sgtool.errors import SgtoolError
     from sgtool.planning.moma.planner import replay_miss_of
     from sgtool.planning.registry import planner_file_name
@@ -377,7 +386,7 @@ def _task_episodes(cfg: BenchConfig, ref: BenchHouse,
     vocabulary = training_vocabulary(cfg.priors_dir)
     out = []
     for name in names:
-        planner = cached_planner(name, planner_options_for(cfg, name))
+        planner = cached_planner(name, planner_options_for(cfg, name), run)
         for seed in range(cfg.seeds):
             for i, ep in enumerate(episodes):
                 kw = dict(seed=seed, episode_index=i, avoid_rooms=ep.target_rooms,
@@ -399,33 +408,44 @@ def _task_episodes(cfg: BenchConfig, ref: BenchHouse,
     return out
 
 
-def bench_tasks(cfg: BenchConfig, houses: Sequence[BenchHouse]) -> list[Task]:
+def bench_tasks(cfg: BenchConfig, houses: Sequence[BenchHouse], run: str = "") -> list[Task]:
     """The run's tasks, grouped by house: all planners of a house in one task, or, when
-    there are fewer houses than workers, the house's planners cut into that many runs."""
+    there are fewer houses than workers, the house's planners cut into that many runs;
+    ``run``: the run's token (:func:`cached_planner`)."""
     groups = -(-cfg.workers // max(1, len(houses)))  # ceil(workers / houses)
-    return [Task(f"{h.id}/{'+'.join(names)}", (cfg, h, names))
+    return [Task(f"{h.id}/{'+'.join(names)}", (cfg, h, names, run))
             for h in houses for names in chunks(cfg.planners, groups)]
 
 
 # ----------------------------------------------------------------------------------------
 # the run
 # ----------------------------------------------------------------------------------------
-def run_benchmark(cfg: BenchConfig, progress: bool | None = None) -> BenchResult:
+def run_benchmark(cfg: BenchConfig, progress: bool | None = None,
+                  partial: bool = False) -> BenchResult:
     """Run every planner on every episode (module doc) and return the results and their
     tables; nothing is written (:func:`write_outputs` does). A setting that cannot work is
     a one-line :class:`~sgtool.errors.SgtoolError` (:class:`BenchError`, a planner option)
-    before any episode runs."""
+    before any episode runs. A task (one house's planners) that failed twice (a plug-in
+    that raises) is a :class:`BenchError` naming the first failure, unless ``partial``:
+    then the result holds the other tasks' episodes and says which failed (``failed``)."""
+    import uuid
+
     cfg.check()
-    forget_replaying_planners()  # a transcript serves one run: a new run starts it again
+    run = uuid.uuid4().hex  # planners are built afresh for each run (cached_planner)
     executor = make_executor(cfg.executor, cfg.workers, cfg.ray_address)
     houses = prepare_houses(cfg)
     vocabulary = training_vocabulary(cfg.priors_dir)  # a bad --priors fails before any episode
     for name in cfg.planners:  # and so does a bad planner option (built here, kept)
-        cached_planner(name, planner_options_for(cfg, name))
+        cached_planner(name, planner_options_for(cfg, name), run)
     show = sys.stderr.isatty() if progress is None else progress
     t0 = time.perf_counter()
-    outcomes = executor.run(run_task, bench_tasks(cfg, houses), progress=show, desc="bench")
+    outcomes = executor.run(run_task, bench_tasks(cfg, houses, run), progress=show,
+                            desc="bench")
     chunks = [o.value for o in outcomes if o.ok]
+    failed = failure_lines(outcomes)
+    if failed and not partial:  # tables without some houses' episodes would pass for a result
+        raise BenchError(f"{len(failed)} of {len(outcomes)} bench task(s) failed after a "
+                         f"retry; the first: {failed[0]}")
     wall = time.perf_counter() - t0
     order = {p: i for i, p in enumerate(cfg.planners)}
     # through the JSONL form, so the summary is exactly what `sgtool eval` recomputes from
@@ -448,7 +468,7 @@ def run_benchmark(cfg: BenchConfig, progress: bool | None = None) -> BenchResult
               f"one of the {len(vocabulary)} training queries of {priors}")
     return BenchResult(cfg, tuple(results), throughput, table, seen_table,
                        results_digest(results), wall, houses, len(vocabulary),
-                       tuple(failure_lines(outcomes)))
+                       tuple(failed))
 
 
 def prepare_houses(cfg: BenchConfig) -> tuple[BenchHouse, ...]:

@@ -112,6 +112,11 @@ class ClosedLoopBenchConfig:
     reference: str | None = None  # paired comparisons against it (None: scout, else first)
     all_pairs: bool = False  # paired comparisons of every pair of planners instead
 
+    def __post_init__(self) -> None:
+        # a copy: the caller's dict changed for the next run must not change this one's
+        object.__setattr__(self, "planner_options",
+                           {str(k): dict(v) for k, v in self.planner_options.items()})
+
     def check(self) -> None:
         from sgtool.analysis.bench_planner_checks import check_planner_list
 
@@ -483,7 +488,4 @@ def run_symbolic(cfg: ClosedLoopBenchConfig) -> tuple[EpisodeResult, ...]:
                         house_seed=cfg.house_seed, max_steps=cfg.options.max_steps,
                         planner_options=cfg.planner_options, house_files=cfg.house_files,
                         success=cfg.options.success)
-    res = run_benchmark(bench, progress=False)
-    if res.failed:
-        raise SgtoolError(f"the symbolic bench failed: {res.failed[0]}")
-    return res.results
+    return run_benchmark(bench, progress=False).results  # a failed task raises

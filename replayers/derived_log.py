@@ -179,8 +179,8 @@ class ReplayReport:
     frames: int = 0
     refreshes: int = 0
     semantic: bool = True  # the log has instance ids
-    last: Refresh | None = None
-    stages: dict[str, tuple[float, float, int]] = field(default_factory=dict)
+    last: Refresh | None = field(default=None, repr=False)  # graph and map layers
+    stages: dict[str, tuple[float, float, int]] = field(default_factory=dict, repr=False)
     seconds: float = 0.0  # wall clock of the run (reported, never written)
     truncated: bool = False  # stopped at max_frames
     warnings: list[str] = field(default_factory=list)  # one line each (/tf stamps)

@@ -80,8 +80,8 @@ class LogDiff:
     """:func:`diff_logs`' result: ``lines`` (the first refresh that differs, layer by
     layer; empty when the sequences agree), quality lines, the first action that differs."""
 
-    a: LogGraphs
-    b: LogGraphs
+    a: LogGraphs = field(repr=False)  # whole graph sequences: report() sums them up
+    b: LogGraphs = field(repr=False)
     lines: list[str]
     quality: list[str]
     action: str | None

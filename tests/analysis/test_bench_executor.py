@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import sys
 
 import pytest
 from click.testing import CliRunner
@@ -49,7 +50,12 @@ def house_one_breaks(monkeypatch):
 
 
 def test_a_failing_task_is_retried_once_then_listed(house_one_breaks, tmp_path):
-    res = run_benchmark(BenchConfig(**SMALL))
+    # from Python a failed task is an error, not a result without that house
+    with pytest.raises(SgtoolError, match=r"1 of 2 bench task\(s\) failed after a retry; "
+                       "the first: house-1/random\\+greedy: RuntimeError: the house fell"):
+        run_benchmark(BenchConfig(**SMALL))
+    house_one_breaks.clear()
+    res = run_benchmark(BenchConfig(**SMALL), partial=True)  # the others' episodes
     assert house_one_breaks == ["house-0", "house-1", "house-1"]  # one retry
     assert res.failed == ("house-1/random+greedy: RuntimeError: the house fell down "
                           "(after 2 attempts)",)
@@ -117,3 +123,37 @@ def test_a_task_gives_the_same_episodes_after_a_larger_draw_of_the_same_house():
     fresh = run_task(task.args)
     run_task(larger.args)
     assert results_digest(run_task(task.args)) == results_digest(fresh)
+
+
+def test_a_plug_in_redefined_between_runs_runs_anew(monkeypatch):
+    """A notebook redefines its plug-in between two runs in one process: the second run
+    uses the new definition (planners are built per run, not per process), as a fresh
+    process would."""
+    import types
+
+    from sgtool.analysis.bench import run_benchmark
+    from sgtool.planning.registry import make_planner
+
+    mod = types.ModuleType("lab_planners")
+    monkeypatch.setitem(sys.modules, "lab_planners", mod)
+    cfg = BenchConfig(planners=("lab_planners:Lab",), houses=1, episodes=3, seeds=1,
+                      rooms=(4, 5), preset="default")
+    mod.Lab = lambda **o: make_planner("random", **o)
+    first = run_benchmark(cfg, progress=False).digest
+    mod.Lab = lambda **o: make_planner("greedy", **o)
+    second = run_benchmark(cfg, progress=False).digest
+    greedy = run_benchmark(BenchConfig(planners=("greedy",), houses=1, episodes=3, seeds=1,
+                                       rooms=(4, 5), preset="default"), progress=False)
+    assert first != second
+    assert [(r.success, r.steps) for r in run_benchmark(cfg, progress=False).results] == \
+        [(r.success, r.steps) for r in greedy.results]
+
+
+def test_the_config_keeps_its_own_options():
+    """A sweep that changes its options dict for the next point leaves the finished
+    run's configuration (and summary) as it ran."""
+    opts = {"scout": {"delta": 0.2}}
+    cfg = BenchConfig(planners=("scout",), planner_options=opts)
+    opts["scout"]["delta"] = 0.9
+    opts["greedy"] = {}
+    assert cfg.planner_options == {"scout": {"delta": 0.2}}

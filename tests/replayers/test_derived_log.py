@@ -185,6 +185,32 @@ def test_ids_the_table_lacks_and_a_table_without_doors_are_said(tmp_path):
                for x in lines)
 
 
+def test_reports_print_short(tmp_path):
+    """What a notebook shows of a replay's report and of a diff is a summary, not the map
+    layers or whole graph sequences (lines() and report() say the rest)."""
+    from sgtool.replayers.golden_diff import diff_logs
+
+    rep = replay(TOUR, None, ReplayOptions(max_frames=30))
+    assert len(repr(rep)) < 2000 and "layers" not in repr(rep.last)
+    assert len(repr(diff_logs(TOUR, TOUR))) < 2000
+
+
+def test_the_voronoi_arrays_handed_out_are_read_only(tmp_path):
+    """A refresh's Voronoi graph may be reused by the next refresh: a caller cannot edit
+    its arrays (it would change later graphs)."""
+    seen = []
+
+    def look(ref, stream):
+        v = ref.layers.voronoi
+        seen.append(len(v))
+        for a in (v.positions, v.clearance, v.cells, v.edges, v.lengths, v.ridge):
+            with pytest.raises(ValueError, match="read-only"):
+                a[...] = 0
+
+    replay(synthetic_log(tmp_path / "two.mcap"), None, ReplayOptions(), on_refresh=look)
+    assert seen and max(seen) > 0
+
+
 def test_a_world_written_y_up_is_warned_of(tmp_path):
     """Poses of a y-up world (the house turned a quarter about x) map side-on; the report
     says the camera's "down" is not down in the world. The z-up log says nothing."""

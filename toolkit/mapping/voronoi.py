@@ -91,6 +91,13 @@ class VoronoiGraph:
     ridge: np.ndarray = field(repr=False)  # bool grid: thinned ridge (all components)
     shape: tuple[int, int] = (0, 0)
 
+    def __post_init__(self) -> None:
+        # read-only: a refresh hands these out and the next refresh may reuse them, so a
+        # caller's edit would otherwise reach later graphs
+        for a in (self.positions, self.clearance, self.cells, self.edges, self.lengths,
+                  self.ridge, *self.edge_cells):
+            a.setflags(write=False)
+
     def __len__(self) -> int:
         return len(self.positions)
 

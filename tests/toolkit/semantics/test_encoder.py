@@ -91,3 +91,15 @@ def test_cosine_separates_synonyms_from_unrelated() -> None:
     v = encoder().encode(["sponge", "scrubber", "bookshelf", "bookcase", "tv", "plant"])
     assert v[0] @ v[1] > v[4] @ v[5]
     assert v[2] @ v[3] > v[4] @ v[5]
+
+
+def test_loading_the_model_leaves_the_environment_as_it_was(monkeypatch) -> None:
+    """The Hugging Face variables are set only while the model loads: a notebook's later
+    downloads (and its child processes) are not made offline behind its back."""
+    import os
+
+    for name in ("HF_HUB_OFFLINE", "TRANSFORMERS_OFFLINE"):
+        monkeypatch.delenv(name, raising=False)
+    e = SentenceEncoder(cache=False)
+    assert e.encode(["mug"]).shape == (1, 384) and e.model_loads == 1
+    assert "HF_HUB_OFFLINE" not in os.environ and "TRANSFORMERS_OFFLINE" not in os.environ
