@@ -112,6 +112,7 @@ SMOKE: dict[str, Smoke] = {
         marks=("slow",)),
     "benchmarks/viewers.py": Smoke(("--frames", "3", "-r", "1", "--derived", "{log}")),
     "tools/closed_loop_failures.py": Smoke(("{tmp}", "{tmp}")),
+    "tools/bench_misses.py": Smoke(("{symbolic}", "--list")),
     "tools/closed_loop_misses.py": Smoke(("{bench}",)),
     "tools/closed_loop_vs_symbolic.py": Smoke(("{bench}", "{bench}")),
     "tools/mutations.py": Smoke(("--list",)),
@@ -172,7 +173,22 @@ def test_script_runs_with_tiny_arguments(name: str, smoke: Smoke, small_log: Pat
             "{repo}": str(REPO), "{data}": str(data)}
     if "{bench}" in smoke.args:
         subs["{bench}"] = str(_bench_folder(tmp_path / "bench"))
-    _run(name, [_sub(a, subs) for a in smoke.args], tmp_path, monkeypatch, capsys)
+    if "{symbolic}" in smoke.args:
+        subs["{symbolic}"] = str(_symbolic_folder(tmp_path / "symbolic"))
+    out = _run(name, [_sub(a, subs) for a in smoke.args], tmp_path, monkeypatch, capsys)
+    if name == "tools/bench_misses.py":  # the tiny run fails most episodes in 2 steps
+        assert "failed episodes" in out and "random:" in out, out
+
+
+def _symbolic_folder(folder: Path) -> Path:
+    """The outputs of a tiny real ``sgtool bench`` run (random, 2 steps an episode)."""
+    from sgtool.analysis.bench import BenchConfig, run_benchmark, write_outputs
+
+    res = run_benchmark(BenchConfig(planners=("random",), houses=1, episodes=4, seeds=1,
+                                    rooms=(4, 5), preset="default", max_steps=2),
+                        progress=False)
+    write_outputs(res, folder)
+    return folder
 
 
 def _run(name: str, args: list[str], cwd: Path, monkeypatch: pytest.MonkeyPatch,
