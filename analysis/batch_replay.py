@@ -32,7 +32,7 @@ from dataclasses import replace as replace_field
 from pathlib import Path
 
 from sgtool.analysis.executor import Executor, Outcome, Task
-from sgtool.errors import LogFormatError, SgtoolError
+from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write, output_folder
 from sgtool.log.reader import LogReader
 from sgtool.replayers.derived_log import (
@@ -129,7 +129,7 @@ def is_complete(job: ReplayJob) -> bool:
             meta = done.metadata.get(REPLAY_METADATA)
         with LogReader(job.input) as src:
             wanted = replay_metadata(resolve_options(src, job.options), job.options.tf_time)
-    except (LogFormatError, OSError):
+    except (SgtoolError, OSError):  # the input's frames unreadable: the job says why
         return False
     return meta == wanted
 

@@ -41,8 +41,9 @@ workers, a house's planners are split over several tasks. The tasks run on
 :mod:`sgtool.analysis.executor`'s local executor (``workers`` spawned processes, each keeping
 its last houses and its planners) or on Ray (``executor="ray"``, ``ray_address``); results
 are put back in the fixed order, so the output does not depend on the executor or N. A task
-that still fails after one retry is listed in the summary (``failed_tasks``) with its
-error; its episodes are missing from every table.
+that still fails after one retry stops the run with a :class:`BenchError` naming it; with
+``partial`` the run goes on, the task is listed in the summary (``failed_tasks``) with its
+error, and its episodes are missing from every table.
 """
 
 from __future__ import annotations

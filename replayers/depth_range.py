@@ -40,13 +40,17 @@ class FirstFrames:
 
 
 def first_frames(reader: LogReader, ceiling: float, tf_time: str = "log",
-                 tolerance: float | None = None) -> FirstFrames:
-    """The depth noise of the log's first :data:`FRAMES` frames (:func:`estimate`, with
-    the default bird's-eye ``floor_tolerance`` unless ``tolerance`` is given;
-    ``max_depth`` None when the log can be mapped to ``ceiling``) and the z-up check."""
+                 tolerance: float | None = None, max_frames: int | None = None
+                 ) -> FirstFrames:
+    """The depth noise of the log's first :data:`FRAMES` frames, or of its first
+    ``max_frames`` when fewer (a replay cut short reads no frame it would not map;
+    :func:`estimate`, with the default bird's-eye ``floor_tolerance`` unless ``tolerance``
+    is given; ``max_depth`` None when the log can be mapped to ``ceiling``) and the z-up
+    check."""
     tol = BevConfig().floor_tolerance if tolerance is None else tolerance
     samples, down_z = [], []
-    for fr in itertools.islice(reader.frames(tf_time=tf_time), FRAMES):
+    count = FRAMES if max_frames is None else min(FRAMES, max_frames)
+    for fr in itertools.islice(reader.frames(tf_time=tf_time), count):
         k = fr.intrinsics
         stride = max(1, round(math.sqrt(k.width * k.height / PIXELS)))
         samples.append(frame_points(fr.depth, fr.pose, k.fx, k.fy, k.cx, k.cy, stride))

@@ -129,7 +129,7 @@ def resolve_options_measured(reader: LogReader, options: ReplayOptions
         recorded.get("max_depth", MAX_DEPTH_M))
     first = None
     if options.max_depth is None and not found:
-        first = first_frames(reader, md, options.tf_time)
+        first = first_frames(reader, md, options.tf_time, max_frames=options.max_frames)
         if first.noise is not None and first.noise.max_depth is not None:
             md = max(MAX_DEPTH_RANGE[0], first.noise.max_depth)
     if not MAX_DEPTH_RANGE[0] <= md <= MAX_DEPTH_RANGE[1]:

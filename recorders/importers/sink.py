@@ -143,8 +143,12 @@ def write_log(
                     w.write_record(Episode(kind="import", status="started",
                                            source=meta.get("source", ""), frames=0),
                                    fr.time_ns)
-                w.write_frame(fr.time_ns, depth=fr.depth, pose=A @ fr.pose,
-                              intrinsics=fr.intrinsics, rgb=fr.rgb, ids=fr.ids)
+                try:
+                    w.write_frame(fr.time_ns, depth=fr.depth, pose=A @ fr.pose,
+                                  intrinsics=fr.intrinsics, rgb=fr.rgb, ids=fr.ids)
+                except ValueError as e:  # what the log would hold wrong (a depth scale)
+                    raise SgtoolError(f"frame {n} (t = {fr.time_ns} ns): {e}; nothing "
+                                      "written") from None
                 has_rgb |= fr.rgb is not None
                 has_ids |= fr.ids is not None
                 last_t = fr.time_ns

@@ -107,6 +107,25 @@ def _pixels(msg: RawImage | RawImageView) -> np.ndarray:
     return a
 
 
+def encode_depth(t_ns: int, depth_m: np.ndarray, frame_id: str) -> RawImage:
+    """A depth image (float metres, or already uint16 millimetres) as the ``16UC1``
+    millimetre ``RawImage`` of the log. Other integer types, and float depth most of whose
+    valid pixels lie beyond what uint16 millimetres hold (65.535 m: millimetres given as
+    float), are a ``ValueError``: written, they would read back as no depth at all."""
+    if depth_m.dtype != np.uint16 and depth_m.dtype.kind in "iub":
+        raise ValueError(f"depth as {depth_m.dtype}: give float metres or uint16 millimetres")
+    if depth_m.dtype != np.uint16:
+        d = np.asarray(depth_m, dtype=np.float32)
+        valid = int(np.count_nonzero(np.isfinite(d) & (d > 0)))
+        far = int(np.count_nonzero(np.isfinite(d) & (d > S.DEPTH_MAX_M)))
+        if valid and far > valid // 2:
+            raise ValueError(f"depth beyond {S.DEPTH_MAX_M:g} m in {far} of {valid} valid "
+                             "pixels: give float metres (millimetres / 1000) or uint16 "
+                             "millimetres")
+    mm = depth_m if depth_m.dtype == np.uint16 else depth_to_mm(depth_m)
+    return encode_image(t_ns, mm, S.DEPTH_ENCODING, frame_id)
+
+
 def depth_to_mm(depth_m: np.ndarray) -> np.ndarray:
     """Metric depth (float, NaN/inf/<=0 = no return) -> uint16 millimetres (0 = none)."""
     d = np.nan_to_num(np.asarray(depth_m, dtype=np.float32), nan=0.0, posinf=0.0, neginf=0.0)

@@ -334,23 +334,9 @@ class LogWriter:
         self.write_proto(S.RGB, t_ns, codec.encode_image(t_ns, rgb, S.RGB_ENCODING, frame_id))
 
     def write_depth(self, t_ns: int, depth_m: np.ndarray, frame_id: str = S.CAMERA_FRAME) -> None:
-        """Metric depth (float metres) or already uint16 millimetres. Other integer types,
-        and float depth most of whose valid pixels lie beyond what uint16 millimetres hold
-        (65.535 m: millimetres given as float), are a ``ValueError``: written, they would
-        read back as no depth at all."""
-        if depth_m.dtype != np.uint16 and depth_m.dtype.kind in "iub":
-            raise ValueError(f"depth as {depth_m.dtype}: give float metres or uint16 "
-                             "millimetres")
-        if depth_m.dtype != np.uint16:
-            d = np.asarray(depth_m, dtype=np.float32)
-            valid = int(np.count_nonzero(np.isfinite(d) & (d > 0)))
-            far = int(np.count_nonzero(np.isfinite(d) & (d > S.DEPTH_MAX_M)))
-            if valid and far > valid // 2:
-                raise ValueError(f"depth beyond {S.DEPTH_MAX_M:g} m in {far} of {valid} valid "
-                                 "pixels: give float metres (millimetres / 1000) or uint16 "
-                                 "millimetres")
-        mm = depth_m if depth_m.dtype == np.uint16 else codec.depth_to_mm(depth_m)
-        self.write_proto(S.DEPTH, t_ns, codec.encode_image(t_ns, mm, S.DEPTH_ENCODING, frame_id))
+        """Metric depth (float metres) or already uint16 millimetres; what would read back
+        as no depth is a ``ValueError`` (:func:`~sgtool.log.codec.encode_depth`)."""
+        self.write_proto(S.DEPTH, t_ns, codec.encode_depth(t_ns, depth_m, frame_id))
 
     def write_ids(self, t_ns: int, ids: np.ndarray, frame_id: str = S.CAMERA_FRAME) -> None:
         """Instance ids as :func:`~sgtool.log.codec.encode_ids` writes them (16UC1 when they
@@ -385,20 +371,30 @@ class LogWriter:
         if self._last_frame_t is not None and t_ns <= self._last_frame_t:
             raise ValueError(f"frame at t_ns={t_ns}: frame times must increase (the previous "
                              f"frame is at {self._last_frame_t})")
-        self._last_frame_t = int(t_ns)
+        # every message encoded (and so checked) before the first is written: a refused
+        # frame leaves nothing of itself in the log, and the same frame mended goes in
+        out: list[tuple[str, Any]] = []
         if intrinsics != self._last_calibration:
-            self.write_calibration(t_ns, intrinsics)
+            out.append((S.CALIBRATION, codec.encode_calibration(t_ns, intrinsics,
+                                                                S.CAMERA_FRAME)))
         if base_pose is not None:
-            self.write_transform(t_ns, S.WORLD_FRAME, S.BASE_FRAME, base_pose)
             base_T_cam = np.linalg.inv(base_pose) @ pose  # noqa: N806
-            self.write_transform(t_ns, S.BASE_FRAME, S.CAMERA_FRAME, base_T_cam)
+            out += [(S.TF, codec.encode_transform(t_ns, S.WORLD_FRAME, S.BASE_FRAME,
+                                                  base_pose)),
+                    (S.TF, codec.encode_transform(t_ns, S.BASE_FRAME, S.CAMERA_FRAME,
+                                                  base_T_cam))]
         else:
-            self.write_transform(t_ns, S.WORLD_FRAME, S.CAMERA_FRAME, pose)
+            out.append((S.TF, codec.encode_transform(t_ns, S.WORLD_FRAME, S.CAMERA_FRAME,
+                                                     pose)))
         if rgb is not None:
-            self.write_rgb(t_ns, rgb)
-        self.write_depth(t_ns, depth)
+            out.append((S.RGB, codec.encode_image(t_ns, rgb, S.RGB_ENCODING, S.CAMERA_FRAME)))
+        out.append((S.DEPTH, codec.encode_depth(t_ns, depth, S.CAMERA_FRAME)))
         if ids is not None:
-            self.write_ids(t_ns, ids)
+            out.append((S.IDS, codec.encode_ids(t_ns, ids, S.CAMERA_FRAME)))
+        for topic, msg in out:
+            self.write_proto(topic, t_ns, msg)
+        self._last_calibration = intrinsics
+        self._last_frame_t = int(t_ns)
 
     # ----- end --------------------------------------------------------------------------
     def flush(self) -> None:

@@ -40,6 +40,7 @@ import numpy as np
 
 LEVEL = 0.05  # m; height levels of the floor search (a voxel)
 PEAK = 0.1  # m; points this close to height 0 find the floor
+WINDOW = 10.0  # m; heights the floor search looks at, either side of 0
 MAX_BINS = 400  # depth bins (100 m): farther floor depths share the last
 BIN = 0.25  # m; depth bins of (N1)
 MIN_BELOW = 50  # points below the floor for a depth bin to count
@@ -107,11 +108,11 @@ def frame_points(depth: np.ndarray, pose: np.ndarray, fx: float, fy: float, cx: 
 
 def floor_height(h: np.ndarray) -> float | None:
     """The floor, when it is at height 0 (module doc): the lowest ``LEVEL`` level of the
-    heights holding at least half as many points as the fullest one, as the bird's-eye map
-    finds it; if that level lies within ``PEAK`` of 0, the median of the heights within
-    ``PEAK`` of 0, else None (a floor elsewhere); None with fewer than ``MIN_FLOOR``
-    points there."""
-    h = h[np.isfinite(h)]
+    heights within ``WINDOW`` of 0 holding at least half as many points as the fullest
+    one, as the bird's-eye map finds it; if that level lies within ``PEAK`` of 0, the
+    median of the heights within ``PEAK`` of 0, else None (a floor elsewhere); None with
+    fewer than ``MIN_FLOOR`` points there."""
+    h = h[np.isfinite(h) & (np.abs(h) <= WINDOW)]  # (a stray pose: no huge histogram)
     if h.size < MIN_FLOOR:
         return None
     lv = np.floor(h / LEVEL).astype(np.int64)

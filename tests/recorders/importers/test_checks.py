@@ -103,6 +103,13 @@ def test_millimetre_depth_at_the_tum_default_fails_and_names_1000(tmp_path):
     rep = import_rgbd(root, tmp_path / "c.mcap", opts(depth_scale=5000.0, warn=seen.append,
                                                       floor=None, floor_auto=False))
     assert len(seen) == 1 and "looks wrong" in seen[0] and rep.warnings == tuple(seen)
+    # a scale so wrong that the depth leaves what the log holds: one line, nothing written
+    seen.clear()
+    with pytest.raises(SgtoolError, match=r"^frame 0 \(t = \d+ ns\): depth beyond 65.535 m "
+                       r".*; nothing written$"):
+        import_rgbd(root, tmp_path / "d.mcap", opts(depth_scale=1.0, warn=seen.append,
+                                                     floor=None, floor_auto=False))
+    assert len(seen) == 1 and not (tmp_path / "d.mcap").exists()
 
 
 def test_table_taken_for_the_floor_fails_and_names_floor(tmp_path):

@@ -163,6 +163,14 @@ def test_input_that_would_read_back_wrong_is_refused(tmp_path):
                 w.write_frame(t, depth=depth, pose=pose, intrinsics=k)
         w.write_frame(3 * DT, depth=np.rint(depth * 1000).astype(np.uint16), pose=pose,
                       intrinsics=k)  # uint16 millimetres: as given
+        # a refused frame leaves nothing of itself, and the same frame mended goes in
+        with pytest.raises(ValueError, match="depth as int32"):
+            w.write_frame(4 * DT, depth=(depth * 1000).astype(np.int32), pose=pose,
+                          intrinsics=synthetic_frame(1)[0], rgb=rgb)
+        w.write_frame(4 * DT, depth=depth, pose=pose, intrinsics=k, rgb=rgb)
     with LogReader(tmp_path / "run.mcap") as r:
-        a, b = r.frames()
+        a, b, c = r.frames()
         np.testing.assert_allclose(b.depth, a.depth, atol=1e-3)
+        assert c.time_ns == 4 * DT and c.intrinsics == k
+        counts = {t: sum(1 for _ in r.messages([t])) for t in (S.TF, S.RGB, S.CALIBRATION)}
+    assert counts == {S.TF: 3, S.RGB: 1, S.CALIBRATION: 1}

@@ -75,3 +75,13 @@ def test_no_estimate_without_a_floor_at_height_zero():
     assert estimate([], 0.1) is None
     assert floor_height(np.zeros(100)) is None  # too few points to find a floor
     assert floor_height(np.full(10_000, 0.7)) is None  # no floor at height 0
+
+
+def test_a_stray_point_far_away_costs_nothing():
+    """A pose error that puts one frame's points 500 km up: the floor search looks near
+    height 0 only (no histogram over the distance), and the rest is measured as before."""
+    frames = samples(0.01)
+    far = frames[0]
+    frames[0] = type(far)(far.h + 5e8, far.slope, far.camera_z + 5e8)
+    est = estimate(frames, 0.1)
+    assert est is not None and est.max_depth == estimate(samples(0.01), 0.1).max_depth
