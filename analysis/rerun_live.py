@@ -300,8 +300,10 @@ class LiveReplay:
         finish stops waiting after :data:`FLUSH_S` seconds."""
         try:
             self.rec.flush(timeout_sec=FLUSH_S)
-        except RuntimeError as e:
+        except Exception as e:  # noqa: BLE001 - Rerun's own error types (a lost viewer,
+            # a timeout) are not part of its API; each is one line here
             where = self.target.url if self.target is not None else "the viewer"
-            raise SgtoolError(f"--rerun: lost the Rerun viewer at {where} "
+            raise SgtoolError(f"--rerun: the stream to {where} did not finish within "
+                              f"{FLUSH_S:g} s or lost its viewer "
                               f"({str(e).splitlines()[0] if str(e) else type(e).__name__})"
                               ) from None

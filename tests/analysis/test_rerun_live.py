@@ -157,3 +157,26 @@ def test_live_frames_of_a_recording_in_strict_mode(tmp_path):
         rr.set_strict_mode(False)
     assert len(shown) == rep.frames == 12 and shown == sorted(set(shown))
     assert len(live.path.points) == 12
+
+
+def test_a_stream_that_cannot_finish_is_one_line():
+    """The final flush waits at most FLUSH_S and any error of Rerun's (a lost viewer, the
+    timeout) is one line naming the viewer, not a traceback."""
+    from sgtool.analysis.rerun_live import FLUSH_S, LiveReplay
+
+    class Stuck:
+        waited: float | None = None
+
+        def log(self, *a, **k) -> None:
+            pass
+
+        def flush(self, timeout_sec: float) -> None:
+            Stuck.waited = timeout_sec
+            raise TimeoutError("flush timed out\nmore detail")
+
+    live = LiveReplay(Stuck(), LiveTarget("connect", url="rerun+http://10.0.0.9:9876/proxy"))
+    with pytest.raises(SgtoolError) as e:
+        live.finish(print)
+    assert Stuck.waited == FLUSH_S
+    assert str(e.value) == ("--rerun: the stream to rerun+http://10.0.0.9:9876/proxy did not "
+                            f"finish within {FLUSH_S:g} s or lost its viewer (flush timed out)")
