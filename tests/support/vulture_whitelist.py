@@ -77,6 +77,7 @@ _.containers  # toolkit/house/spec.py: HouseSpec method, public API
 _.children  # toolkit/scenegraph/graph.py: SceneGraph method, public API
 _.offered  # toolkit/planning/memory.py: EpisodeMemory method
 _.frame_at  # toolkit/log/reader.py: LogReader method, public API
+_.write_ids  # toolkit/log/writer.py: LogWriter method, public API (write_frame encodes its own)
 _.to_record  # toolkit/scenegraph/instances.py: Instance -> log record
 _.excludes  # analysis/intervals.py: Interval method
 _.goal_mask  # datasets/episodes.py: EpisodeGeometry method
