@@ -38,6 +38,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sgtool.mapping.bev import estimate_floor_level
+
 LEVEL = 0.05  # m; height levels of the floor search (a voxel)
 PEAK = 0.1  # m; points this close to height 0 find the floor
 WINDOW = 10.0  # m; heights the floor search looks at, either side of 0
@@ -117,10 +119,9 @@ def floor_height(h: np.ndarray) -> float | None:
         return None
     lv = np.floor(h / LEVEL).astype(np.int64)
     lo = int(lv.min())
-    counts = np.bincount(lv - lo)
-    level = (lo + int(np.flatnonzero(counts >= 0.5 * counts.max())[0]) + 0.5) * LEVEL
+    found = estimate_floor_level(lo, np.bincount(lv - lo))
     near = h[np.abs(h) <= PEAK]
-    if abs(level) > PEAK or near.size < MIN_FLOOR:
+    if found is None or abs((found + 0.5) * LEVEL) > PEAK or near.size < MIN_FLOOR:
         return None
     return float(np.median(near))
 
