@@ -77,6 +77,10 @@ def summarize(path: str | os.PathLike[str]) -> dict[str, Any]:
         if not out["readable"]:
             return out
         out["frames"] = r.frame_count()
+        if out["frames"]:
+            times = r.frame_times()
+            if len(set(times)) < len(times):  # (only said when there are: replay refuses)
+                out["repeated_frame_times"] = len(times) - len(set(times))
         if out["frames"] and r.has(S.CALIBRATION):
             for d in r.messages([S.CALIBRATION]):
                 k = decoded(str(p), d.topic, d.log_time_ns, codec.decode_calibration,
@@ -193,6 +197,9 @@ def format_summary(s: dict[str, Any]) -> str:
             f"instance ids {'yes' if s['has_instance_ids'] else 'no'}; "
             f"instances {s['instances']}, actions {s['actions']}, scene graphs {s['scene_graphs']}"
         )
+        if s.get("repeated_frame_times"):
+            lines.append(f"warning: {s['repeated_frame_times']} depth image(s) share a log time "
+                         "with another: replay refuses such a log (one frame per time)")
         ep = s.get("episode")
         if ep:
             keys = ["kind", "status", "source", "house_id", "query", "planner", "steps",

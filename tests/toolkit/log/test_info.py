@@ -75,3 +75,24 @@ def test_info_and_doctor_on_real_ros2_mcap(shared_data_dir, tmp_path, name):
     assert d["readable_messages"] == sum(counts.values())
     j2 = json.loads(CliRunner().invoke(cli, ["info", "--json", str(tmp_path / "out.mcap")]).output)
     assert {c["topic"]: c["messages"] for c in j2["channels"]} == counts
+
+
+def test_info_warns_of_frames_that_share_a_time(tmp_path):
+    """Depth images at one log time (written below write_frame, which refuses them): info
+    says so, since replay refuses such a log; a log without them says nothing."""
+    from support.logfixtures import synthetic_frame
+
+    from sgtool.log import LogWriter
+
+    k, _, depth, _, pose, _ = synthetic_frame(0)
+    with LogWriter(tmp_path / "dup.mcap", seed=1) as w:
+        w.write_frame(0, depth=depth, pose=pose, intrinsics=k)
+        w.write_depth(0, depth)
+        w.write_frame(10**8, depth=depth, pose=pose, intrinsics=k)
+    r = CliRunner().invoke(cli, ["info", str(tmp_path / "dup.mcap")])
+    assert r.exit_code == 0 and ("warning: 1 depth image(s) share a log time with another: "
+                                 "replay refuses such a log") in r.output
+    r = CliRunner().invoke(cli, ["info", str(tmp_path / "dup.mcap"), "--json"])
+    assert json.loads(r.output)["repeated_frame_times"] == 1
+    r = CliRunner().invoke(cli, ["info", str(write_log(tmp_path / "ok.mcap"))])
+    assert "share a log time" not in r.output
