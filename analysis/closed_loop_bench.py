@@ -65,7 +65,7 @@ from sgtool.log.writer import partial_files
 from sgtool.recorders.sim.closed_loop import WENT_ON, ClosedLoopOptions, run_episode
 from sgtool.recorders.sim.fallback_explore import is_fallback
 from sgtool.recorders.sim.frame_budget import frame_budget
-from sgtool.recorders.sim.noise import parse_noise
+from sgtool.recorders.sim.noise import names_file, parse_noise
 from sgtool.results import EpisodeResult, write_jsonl
 
 # failed-skill reasons, by the first pattern their text matches
@@ -132,11 +132,18 @@ class ClosedLoopBenchConfig:
         if self.houses < 0 or (self.houses == 0 and not self.house_files):
             raise SgtoolError(f"--houses: must be >= 1, or >= 0 with --house, got "
                               f"{self.houses}")
+        folders: dict[str, str] = {}
         for n in self.noise:
             parse_noise(n)
-            if not re.fullmatch(r"[A-Za-z0-9_.=,+-]+", n):
-                raise SgtoolError(f"--noise {n!r}: a profile name with overrides "
-                                  "(letters, digits, _ . = , + -) names a log folder")
+            folder = noise_folder(n)
+            if not re.fullmatch(r"[A-Za-z0-9_.=,+-]+", folder):
+                what = "the profile's name" if names_file(n) else "a profile name with overrides"
+                raise SgtoolError(f"--noise {n!r}: {what} (letters, digits, _ . = , + -) "
+                                  f"names a log folder, not {folder!r}")
+            if folder in folders:
+                raise SgtoolError(f"--noise {folders[folder]!r} and {n!r}: both name the log "
+                                  f"folder {folder!r}")
+            folders[folder] = n
         self.options.mapping()
         frame_budget(self.options.frames, self.frames_per_room, 1)
 
@@ -175,14 +182,21 @@ class RunRow:
     went_on: int = 0
 
 
+def noise_folder(noise: str) -> str:
+    """The log folder of a ``--noise`` profile: its text, or for a JSON file the profile's
+    name (its ``name`` field, else the file's stem)."""
+    return parse_noise(noise).name if names_file(noise) else noise
+
+
 def log_path(root: Path, noise: str, planner: str, house: str, episode: int) -> Path:
-    """``root/NOISE/PLANNER/HOUSE/ep-K.mcap`` (a plug-in ``module:Name`` as
-    ``module__Name``: :func:`sgtool.planning.registry.planner_file_name`); a name that
-    would leave ``root`` (or is no file name) is refused
+    """``root/NOISE/PLANNER/HOUSE/ep-K.mcap`` (NOISE: :func:`noise_folder`; a plug-in
+    ``module:Name`` as ``module__Name``: :func:`sgtool.planning.registry.planner_file_name`);
+    a name that would leave ``root`` (or is no file name) is refused
     (:func:`~sgtool.analysis.bench_houses.output_path`)."""
     from sgtool.planning.registry import planner_file_name
 
-    return output_path(root, noise, planner_file_name(planner), house, f"ep-{episode:03d}.mcap")
+    return output_path(root, noise_folder(noise), planner_file_name(planner), house,
+                       f"ep-{episode:03d}.mcap")
 
 
 # the house and its episodes per house and draw, per process: houses a worker keeps (a

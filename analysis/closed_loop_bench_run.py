@@ -25,7 +25,12 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from sgtool.analysis.closed_loop_bench import ClosedLoopBenchConfig, RunRow, RunTask
+from sgtool.analysis.closed_loop_bench import (
+    ClosedLoopBenchConfig,
+    RunRow,
+    RunTask,
+    noise_folder,
+)
 from sgtool.analysis.executor import Executor, FolderMark
 
 Echo = Callable[[str], None]
@@ -83,6 +88,11 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
             raise  # (with --force, output_folder says OUT is as it was instead)
         finally:
             bar.close()
+        if request.report_only:
+            for folder in unreported(root / "logs", request.config):
+                print(f"sgtool: note: {folder} holds episode logs this report leaves out "
+                      "(give the --noise profiles and --planners that ran them)",
+                      file=sys.stderr)
         res = _with_symbolic(request, res)
         written = [p.name for p in write_tables(res, root)]
         if not request.report_only:
@@ -90,6 +100,25 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
                 res.rows, root, runner, request.executor)).name)
     show(res.table())
     show(f"wrote {', '.join(str(Path(request.out_dir) / name) for name in written)}")
+
+
+def unreported(logs: Path, config: ClosedLoopBenchConfig) -> list[Path]:
+    """The folders ``logs/NOISE`` and ``logs/NOISE/PLANNER`` of a run-bench folder that
+    ``config`` does not name (its noise profiles, :func:`noise_folder`, and planners),
+    sorted."""
+    from sgtool.planning.registry import planner_file_name
+
+    noises = {noise_folder(n) for n in config.noise}
+    planners = {planner_file_name(p) for p in config.planners}
+    out = []
+    for d in sorted(logs.iterdir()) if logs.is_dir() else []:
+        if not d.is_dir():
+            continue
+        if d.name not in noises:
+            out.append(d)
+            continue
+        out.extend(p for p in sorted(d.iterdir()) if p.is_dir() and p.name not in planners)
+    return out
 
 
 def _executor(request: RunBenchRequest) -> tuple[Executor | None, bool]:

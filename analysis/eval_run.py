@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -21,6 +21,7 @@ from sgtool.errors import SgtoolError
 
 if TYPE_CHECKING:
     from sgtool.analysis.executor import Executor
+    from sgtool.results import EpisodeResult
 
 Echo = Callable[[str], None]
 
@@ -62,6 +63,11 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
     results, logged, notes, unread = load_many([Path(i) for i in request.inputs], request.runner,
                                                progress=request.progress)
     results = [with_success_rule(r, request.success) for r in results]
+    results, profiles = per_noise(results)
+    if profiles:
+        notes = [*notes, f"the episodes ran under {len(profiles)} sensor noise profiles "
+                 f"({', '.join(profiles)}): each planner is scored per profile, as "
+                 "PLANNER [NOISE]"]
     for text in notes:
         note(f"sgtool: note: {text}")
     if not results:
@@ -75,6 +81,18 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
     text = render(request, results, notes, models, summarize(results, models), reports,
                   exchanges)
     return EvalOutcome(text=text, unread=list(unread))
+
+
+def per_noise(results: Sequence[EpisodeResult]) -> tuple[list[EpisodeResult], list[str]]:
+    """``results`` with each planner named ``PLANNER [NOISE]`` when they ran under more
+    than one sensor noise profile (:attr:`EpisodeResult.noise`; ``unknown`` when not
+    recorded), and those profiles in order of appearance (empty: one profile, names
+    kept): episodes of different sensors are not pooled."""
+    profiles = list(dict.fromkeys(r.noise or "unknown" for r in results))
+    if len(profiles) < 2:
+        return list(results), []
+    return [replace(r, planner=f"{r.planner} [{r.noise or 'unknown'}]") for r in results], \
+        profiles
 
 
 def _replays(request: EvalRequest, logged: Sequence[Any], exchanges: Sequence[Any]

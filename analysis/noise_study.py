@@ -407,7 +407,7 @@ def run_closed_loop(cfg: StudyConfig, specs: Mapping[str, str], out_dir: Path,
         files.append(str(atomic_write(out_dir / "houses" / f"{hid}.json", specs[hid])))
     s = cfg.settings
     opts = ClosedLoopOptions(camera=CameraConfig(width=s.width, height=s.height),
-                             max_steps=cl.max_steps)
+                             max_steps=cl.max_steps, noise_seed=s.noise_seed)
     bench = ClosedLoopBenchConfig(planners=cl.planners, houses=0, house_files=tuple(files),
                                   episodes=cl.episodes, rooms=cfg.rooms, noise=cl.noise,
                                   options=opts, frames_per_room=cl.frames_per_room)

@@ -106,10 +106,10 @@ def _signed(x: float) -> str:
 
 
 def cell_text(c: Cell) -> str:
-    """``found/true purity objects%``: ``6/6 1.000 100.0%``."""
+    """``found/true purity objects% of n``: ``6/6 1.000 100.0% of 38``."""
     m = c.merged
     return (f"{m['rooms']}/{m['gt_rooms']} {_f3(float(m['purity']))} "
-            f"{_pct(float(m['object_accuracy']))}")
+            f"{_pct(float(m['object_accuracy']))} of {m['objects']}")
 
 
 def condition_label(c: Condition) -> str:
@@ -142,18 +142,23 @@ def condition_row(res: StudyResult, cond: Condition, first: str) -> list[str]:
         d = [x for x in d if math.isfinite(x)]
         return statistics.median(d) if d else math.nan
 
+    def kept() -> list[float]:  # objects in the graph, share of the noise-free graph's
+        return [float(c.merged["objects"]) / float(base[c.house].merged["objects"])
+                for c in cells if c.house in base and base[c.house].merged["objects"]]
+
     found = " ".join(f"{c.merged['rooms']}/{c.merged['gt_rooms']}" for c in cells)
     return [first, found,
             _median_range(vals("room_error_vs_true"), lambda x: f"{x:+g}"),
             _median_range(vals("purity"), _f3),
             _median_range(vals("object_accuracy"), _pct),
+            _median_range(kept(), _pct),
             _median_range(vals("ari"), _f3),
             _signed(delta("purity")), _signed(delta("object_accuracy"))]
 
 
 FACTOR_HEADER = ["level", "rooms found/true per house", "room error vs true",
-                 "purity", "objects right", "ARI", "purity vs none (pts)",
-                 "objects vs none (pts)"]
+                 "purity", "objects right", "objects kept vs none", "ARI",
+                 "purity vs none (pts)", "objects vs none (pts)"]
 
 
 def summary_md(res: StudyResult) -> str:
@@ -172,9 +177,12 @@ def summary_md(res: StudyResult) -> str:
             "final graph, merged (rooms joined by a doorless passage count as one).", "",
             "Medians over houses, [min, max] after them; 'rooms found/true': explored rooms "
             "of the graph vs every true room of the house; 'vs none': median over houses of "
-            "the difference to the house's noise-free cell, in points.", ""]
+            "the difference to the house's noise-free cell, in points; 'objects kept vs "
+            "none': the objects in the graph, as a share of those in the house's noise-free "
+            "graph (objects right counts only those kept).", ""]
     out += ["## Every house and condition", "",
-            "Cell: rooms found/true, Voronoi purity, objects in the right room.", ""]
+            "Cell: rooms found/true, Voronoi purity, objects in the right room of the "
+            "objects in the graph.", ""]
     rows = []
     for cond in cfg.conditions:
         by_house = {c.house: c for c in _cells_of(res, cond)}

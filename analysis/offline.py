@@ -101,6 +101,9 @@ class LoggedEpisode:
                 "decisions": float(len(decided))})
         if "episode" not in self.episode.extras:
             r = _replace(r, episode=self.index)
+        noise = self.episode.extras.get("noise")
+        if isinstance(noise, dict) and isinstance(noise.get("name"), str):
+            r = _replace(r, noise=noise["name"])
         return r
 
 

@@ -119,7 +119,8 @@ def _show_report(request: ReplayRequest, report: Any, rooms: Any, scores: Any,
     if scores is not None:
         from sgtool.replayers.score import score_lines
 
-        for line in score_lines(scores):
+        last = report.last
+        for line in score_lines(scores, None if last is None else len(last.graph.objects)):
             show(line)
     if rrd:
         show(f"wrote {rrd}; open it with: rerun {quoted(rrd)}")

@@ -1,7 +1,7 @@
 """Whether an episode log already in a ``run-bench`` folder may stand for a task: it must
 have been run with the task's settings (episode, planner options, steps, frames,
-resolution, which ticks are frames, navigation, noise, seed, success rule, room
-classifier, how far an explore goes on) on the same house.
+resolution, which ticks are frames, navigation, noise and its seed, seed, success rule, room
+classifier, depth mapped, how far an explore goes on) on the same house.
 A log without the frame settings (``render_step_m``, ``turn_render_deg``: older code
 rendered other ticks) is not reused.
 
@@ -14,6 +14,7 @@ naming the log and what differs.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from collections.abc import Mapping
 from pathlib import Path
@@ -24,6 +25,7 @@ from sgtool.house.spec import HouseSpec
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
 from sgtool.recorders.sim.episode_extras import recorded_options
 from sgtool.recorders.sim.noise import parse_noise
+from sgtool.scenegraph.build_options import MAX_DEPTH_M
 
 _FIX = ("give a fresh -o folder, --force to run every episode again, or delete the log to "
         "run the episode again")
@@ -43,8 +45,10 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
             "render_step_m": float(opts.render_step_m),
             "turn_render_deg": float(opts.turn_render_deg),
             "navigation": opts.navigation, "noise": parse_noise(noise).to_dict(),
+            "noise_seed": opts.noise_seed,
             "seed": opts.planner_seed, "episode_seeds": True, "success": opts.success,
             "classifier": opts.classifier, "explore_on": opts.explore_on,
+            "max_depth": dataclasses.replace(opts, noise=parse_noise(noise)).depth_mapped(),
             "look_in": float(opts.live.look_in) if opts.navigation == "live" else None,
             "look_in_beyond": (_beyond(opts.live.look_in, opts.live.look_in_beyond)
                                if opts.navigation == "live" else None),
@@ -83,12 +87,15 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              "render_step_m": x.get("render_step_m"),
              "turn_render_deg": x.get("turn_render_deg"),
              "navigation": nav.get("mode", "house"),
-             "noise": x.get("noise"), "seed": x.get("seed"),
+             "noise": x.get("noise"), "noise_seed": x.get("noise_seed", 0),
+             "seed": x.get("seed"),
              # logs from before each episode drew its planner seed: all drew the run's
              "episode_seeds": "planner_seed" in x,
              "success": x.get("success", "observed"),
              # logs from before the default changed recorded no other classifier
              "classifier": (x.get("mapping") or {}).get("classifier", "containment"),
+             # the depth the live map kept (recorded when not the default)
+             "max_depth": float((x.get("mapping") or {}).get("max_depth", MAX_DEPTH_M)),
              # logs from before explores went on: an explore ended where it was sent
              "explore_on": x.get("explore_on", 0),
              # logs from before the robot looked into what it opened: it stayed there
@@ -125,10 +132,10 @@ _LABELS = {"episode": "episode", "planner_options": "planner options (-O)",
            "max_steps": "max steps", "frame_budget": "frame budget",
            "size": "resolution", "render_step_m": "render step (m)",
            "turn_render_deg": "turn render angle (deg)", "navigation": "navigation",
-           "noise": "noise", "seed": "seed",
+           "noise": "noise", "noise_seed": "noise seed", "seed": "seed",
            "episode_seeds": "planner seed per episode", "success": "success rule",
            "classifier": "room classifier", "explore_on": "explore on (frontiers)",
-           "look_in": "look in (m)",
+           "max_depth": "depth mapped (m)", "look_in": "look in (m)",
            "look_in_beyond": "look in beyond (deg)", "peek": "peek into containers",
            "sight_lines": "sight lines", "explore_through": "explore through (m)"}
 

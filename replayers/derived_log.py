@@ -220,9 +220,10 @@ class ReplayReport:
                            f"{max(1.0, self.options.max_depth - 2):g})")
             lone = sum(len(set(d.rooms)) < 2 for d in g.doors)
             if lone and g.rooms:
-                out.append(f"warning: {lone} of {len(g.doors)} doors join one room only: the "
-                           "rooms on their two sides merged (pose drift or jumps, or a door "
-                           "unlabelled in most frames, are usual causes)")
+                out.append(f"warning: {lone} of {len(g.doors)} doors join one room only: "
+                           "the floor behind them was not mapped, or the rooms on their two "
+                           "sides merged (pose drift or jumps, or a door unlabelled in most "
+                           "frames)")
         return out + stage_lines(self.stages)
 
 

@@ -366,6 +366,11 @@ QUALITY_FIGURES = (("purity", "purity", ".3f"), ("ari", "ARI", ".3f"), ("rooms",
                    ("object_accuracy", "objects in the right room", ".1%"))
 
 
+def _figure(x: Any, spec: str) -> str:
+    """A figure as printed; ``-`` for one over nothing (None)."""
+    return "-" if x is None else format(x, spec)
+
+
 def quality_lines(before: dict[str, Any] | None, after: dict[str, Any] | None,
                   changed_only: bool = False) -> list[str]:
     """``quality (merged): purity 0.950 -> 0.910, ARI 0.900 (same), ...``: the figures
@@ -377,7 +382,7 @@ def quality_lines(before: dict[str, Any] | None, after: dict[str, Any] | None,
     out = []
     for variant in sorted(before.keys() & after.keys()):
         b, a = before[variant], after[variant]
-        pairs = [(label, format(b[k], spec), format(a[k], spec))
+        pairs = [(label, _figure(b[k], spec), _figure(a[k], spec))
                  for k, label, spec in QUALITY_FIGURES if k in b and k in a]
         if changed_only and all(x == y for _, x, y in pairs):
             continue

@@ -100,7 +100,7 @@ class Capture:
     graphs: list[str]
     refreshes: list[RefreshMeta]
     resolved: dict[str, Any]
-    quality: dict[str, dict[str, float | int]] | None = None
+    quality: dict[str, dict[str, float | int | None]] | None = None
     planner: str | None = None
     decisions: tuple[Decision, ...] | None = None
 
@@ -118,7 +118,7 @@ class Pinned:
     options: ReplayOptions = field(default_factory=ReplayOptions)
     log_bytes: int | None = None
     resolved: dict[str, Any] | None = None
-    quality: dict[str, dict[str, float | int]] | None = None
+    quality: dict[str, dict[str, float | int | None]] | None = None
     planner: str | None = None
     decisions: tuple[Decision, ...] | None = None
     why: str | None = None

@@ -64,15 +64,17 @@ def score(spec: HouseSpec, instances: Mapping[int, InstanceInfo], layers: MapLay
     return {"strict": of_graph(), "merged": of_graph(merge=passage_groups(spec))}
 
 
-def score_lines(scores: Mapping[str, Quality]) -> list[str]:
+def score_lines(scores: Mapping[str, Quality], graph_objects: int | None = None) -> list[str]:
     """One line per scoring; objects none of which could be scored (no instance of the
     graph's objects names an element of the spec: ``spec_id`` in the instance table) are
-    said so, not scored as 0 %."""
+    said so, not scored as 0 %, as is a graph without objects (``graph_objects``: how many
+    the graph holds, 0 says so; None: not known)."""
     out = []
     for name, v in scores.items():
         objects = (f"objects in the right room {v.object_accuracy:.1%} of {v.objects}"
-                   if v.objects else "objects not scored (no object's instance names a "
-                   "spec element: spec_id in the instance table)")
+                   if v.objects else "no object in the graph to score" if graph_objects == 0
+                   else "objects not scored (no object's instance names a spec element: "
+                   "spec_id in the instance table)")
         out.append(
             f"quality ({name}): rooms {v.rooms} vs {v.gt_rooms_seen} seen of {v.gt_rooms} "
             f"(error {v.room_count_error:+d}); Voronoi nodes in the right room: purity "
@@ -81,5 +83,15 @@ def score_lines(scores: Mapping[str, Quality]) -> list[str]:
     return out
 
 
-def score_dict(scores: Mapping[str, Quality]) -> dict[str, dict[str, float | int]]:
-    return {k: asdict(v) for k, v in scores.items()}
+def score_dict(scores: Mapping[str, Quality]) -> dict[str, dict[str, float | int | None]]:
+    """The figures of each scoring; an accuracy over nothing (no object scored, no
+    explored room) is None, not 0."""
+    def figures(v: Quality) -> dict[str, float | int | None]:
+        d: dict[str, float | int | None] = dict(asdict(v))
+        if not v.objects:
+            d["object_accuracy"] = None
+        if not v.rooms:
+            d["category_accuracy"] = None
+        return d
+
+    return {k: figures(v) for k, v in scores.items()}

@@ -61,7 +61,10 @@ class EpisodeResult:
       ``episode_s``), the only non-deterministic part;
     - ``llm_answers``: an LLM planner's answer counts (:func:`sgtool.llm.stats.answer_counts`:
       requests, valid, invalid (rejected), faults, unknown); empty, and absent from the
-      record, for other planners, so their records are as before.
+      record, for other planners, so their records are as before;
+    - ``noise``: the sensor noise profile of a closed-loop episode (its name: ``none``,
+      ``strong``, ``mild,holes=0.05``, ...; empty, and absent from the record, when not
+      known, as in the symbolic bench).
     """
 
     planner: str
@@ -82,6 +85,7 @@ class EpisodeResult:
     trace: tuple[Step, ...] = ()
     wall: Mapping[str, float] = field(default_factory=dict)
     llm_answers: Mapping[str, int] = field(default_factory=dict)
+    noise: str = ""
 
     @property
     def decision_s(self) -> float:
@@ -118,6 +122,7 @@ class EpisodeResult:
             "wall": {k: round(float(v), 6) for k, v in sorted(self.wall.items())},
             **({"llm_answers": {k: int(v) for k, v in sorted(self.llm_answers.items())}}
                if self.llm_answers else {}),
+            **({"noise": self.noise} if self.noise else {}),
         }
 
     def to_json(self) -> str:
@@ -155,6 +160,7 @@ class EpisodeResult:
                         for s in d.get("trace", [])),
             wall=dict(d.get("wall", {})),
             llm_answers={str(k): int(v) for k, v in (d.get("llm_answers") or {}).items()},
+            noise=str(d.get("noise") or ""),
         )
 
 

@@ -113,7 +113,7 @@ from sgtool.recorders.sim.closed_loop_options import (  # noqa: F401 (re-exporte
     NAVIGATION,
     ClosedLoopOptions,
 )
-from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport
+from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport, episode_notes
 from sgtool.recorders.sim.episode_extras import recorded_options, started_extra, success_rule
 from sgtool.recorders.sim.execution import Executed, execute_live, execute_privileged
 from sgtool.recorders.sim.fallback_explore import (
@@ -140,10 +140,7 @@ from sgtool.recorders.sim.skill_plan import (  # noqa: F401 (re-exported)
     SkillPlan,
     plan_skills,
 )
-from sgtool.scenegraph.build_options import (
-    builder_config,
-    mapping_record,
-)
+from sgtool.scenegraph.build_options import MAX_DEPTH_M, builder_config, mapping_record
 from sgtool.scenegraph.categories import RoomClassifier
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.stream import Refresh, SceneGraphStream
@@ -532,6 +529,9 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
             ), t_end)
             rec.refreshed(stream.finish(t_end))  # as replay ends: only if anything is new
             travelled, frames, refreshes = sim.travelled_m, rec.frames, rec.refreshes
+            last = stream.current
+            notes = episode_notes(mapping.max_depth, MAX_DEPTH_M, opts.noise.depth_sigma,
+                                  None if last is None else len(last.graph.rooms))
     finally:
         closer = getattr(planner, "close", None)
         if callable(closer):
@@ -540,7 +540,8 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
         output=Path(output), house_id=hid, planner=name, query=query, episode=episode.id,
         success=success, end=end, steps=steps, travelled_m=travelled, shortest_m=shortest,
         frames=frames, refreshes=refreshes, n_open=n_open,
-        decision_times=tuple(search.decision_times), seconds=time.perf_counter() - t_wall)
+        decision_times=tuple(search.decision_times), seconds=time.perf_counter() - t_wall,
+        notes=notes)
 
 
 # the room classifiers of this process by name: loading one (weights, room-type vectors)

@@ -11,13 +11,21 @@ import math
 from dataclasses import dataclass, field
 
 from sgtool.errors import SgtoolError
+from sgtool.mapping.bev import BevConfig
+from sgtool.mapping.depth_noise import sensor_max_depth
 from sgtool.planning.episode import check_success_rule
 from sgtool.recorders.sim.camera import CameraConfig
 from sgtool.recorders.sim.keyframes import KeyframeRule
 from sgtool.recorders.sim.live_skills import LiveNavConfig
 from sgtool.recorders.sim.navigation import RobotConfig
 from sgtool.recorders.sim.noise import PROFILES, NoiseProfile
-from sgtool.scenegraph.build_options import CLASSIFIERS, ResolvedOptions, default_min_points
+from sgtool.scenegraph.build_options import (
+    CLASSIFIERS,
+    MAX_DEPTH_M,
+    MAX_DEPTH_RANGE,
+    ResolvedOptions,
+    default_min_points,
+)
 
 N_MAX = 50  # high-level steps per episode (SymSearch's N_max)
 NAVIGATION = ("live", "house")
@@ -28,10 +36,11 @@ class ClosedLoopOptions:
     """How a closed-loop episode runs
     (:func:`~sgtool.recorders.sim.closed_loop.run_episode`): frame rate, camera, robot,
     sensor ``noise``; the mapping (a refresh every ``every`` frames, room ``classifier``,
-    ``min_points``, ``voxel_size``: recorded in the log, so ``sgtool replay`` rebuilds the
-    same graphs); ``max_steps`` high-level steps and a ``frames`` budget; ``navigation``
-    ``live`` (the robot's own map) or ``house`` (ground truth); the ``success`` rule;
-    ``explore_on``, how many frontiers an explore that showed nothing new goes on to.
+    ``min_points``, ``voxel_size``, ``max_depth``: recorded in the log, so ``sgtool
+    replay`` rebuilds the same graphs); ``max_steps`` high-level steps and a ``frames``
+    budget; ``navigation`` ``live`` (the robot's own map) or ``house`` (ground truth);
+    the ``success`` rule; ``explore_on``, how many frontiers an explore that showed nothing
+    new goes on to.
     :meth:`mapping` checks them (a one-line :class:`~sgtool.errors.SgtoolError`)."""
 
     fps: float = 10.0
@@ -43,6 +52,10 @@ class ClosedLoopOptions:
     classifier: str = "frequency"
     min_points: int | None = None  # None: MoMa-LLM's 50 at 320x240, scaled
     voxel_size: float = 0.05
+    # m; depth farther is not mapped. None: the default, lowered to where the depth noise
+    # of the sensor (``noise.depth_sigma``, known to the robot as a datasheet figure)
+    # reaches the floor tolerance (:func:`~sgtool.mapping.depth_noise.sensor_max_depth`)
+    max_depth: float | None = None
     max_steps: int = N_MAX
     frames: int | None = None  # frame budget (None: none)
     planner_seed: int = 0
@@ -85,4 +98,15 @@ class ClosedLoopOptions:
             raise SgtoolError(f"min points {mp}: must be >= 1")
         return ResolvedOptions(every=int(self.every), classifier=self.classifier,
                                min_points=int(mp), voxel_size=float(self.voxel_size),
-                               max_frames=None)
+                               max_frames=None, max_depth=self.depth_mapped())
+
+    def depth_mapped(self) -> float:
+        """``max_depth``, checked, or the default cut to the sensor's depth noise."""
+        lo, hi = MAX_DEPTH_RANGE
+        if self.max_depth is not None:
+            if not (math.isfinite(self.max_depth) and lo <= self.max_depth <= hi):
+                raise SgtoolError(f"--max-depth {self.max_depth:g} m: must be {lo:g}..{hi:g}")
+            return float(self.max_depth)
+        cut = sensor_max_depth(self.noise.depth_sigma, self.camera.mount_height,
+                               BevConfig().floor_tolerance, ceiling=MAX_DEPTH_M)
+        return MAX_DEPTH_M if cut is None else max(lo, cut)

@@ -12,9 +12,9 @@ class ClosedLoopReport:
     """What one closed-loop episode did
     (:func:`sgtool.recorders.sim.closed_loop.run_episode`): its log ``output``, house,
     planner, query and episode id, ``success`` and why it ended, steps, metres travelled,
-    the shortest path (None when unknown), frames, refreshes, opens, and the wall-clock
-    decision times and run seconds (reported, never logged); :meth:`lines` is what
-    ``sgtool run`` prints."""
+    the shortest path (None when unknown), frames, refreshes, opens, the wall-clock
+    decision times and run seconds (reported, never logged) and ``notes``
+    (:func:`episode_notes`); :meth:`lines` is what ``sgtool run`` prints."""
 
     output: Path
     house_id: str
@@ -31,6 +31,7 @@ class ClosedLoopReport:
     n_open: int
     decision_times: tuple[float, ...]  # wall clock per decision (reported and logged)
     seconds: float  # wall clock of the run (reported, never logged)
+    notes: tuple[str, ...] = ()  # what the user should know about the run (episode_notes)
 
     @property
     def spl(self) -> float | None:
@@ -62,4 +63,21 @@ class ClosedLoopReport:
         mx = f"{max(dt):.4f} s" if dt else "-"
         out.append(f"{self.seconds:.1f} s ({self.frames_per_s:.1f} frames/s); decision "
                    f"time median {med}, max {mx}")
-        return out
+        return out + [f"note: {n}" for n in self.notes]
+
+
+def episode_notes(max_depth: float, default_depth: float, depth_sigma: float,
+                  rooms: int | None) -> tuple[str, ...]:
+    """The notes of an episode whose live map kept depth to ``max_depth`` (the default
+    ``default_depth`` lowered for the sensor's ``depth_sigma``, or chosen) and whose last
+    scene graph has ``rooms`` rooms (None: no graph)."""
+    notes = []
+    if max_depth < default_depth and depth_sigma > 0:
+        notes.append(f"the sensor's depth noise ({depth_sigma:g} z^2 m) would read far floor "
+                     f"as obstacles: the live map kept depth to {max_depth:g} m "
+                     "(--max-depth to choose)")
+    if not rooms:
+        notes.append("the live map ended without a room (no free floor for its Voronoi "
+                     "graph): the planner had little to decide on; with sensor faults, see "
+                     "`sgtool replay LOG --score` and --max-depth")
+    return tuple(notes)

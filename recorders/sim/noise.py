@@ -93,10 +93,13 @@ def parse_noise(text: str | None) -> NoiseProfile:
     """A profile from ``none``/``mild``/``strong``, optionally followed by overrides
     (``mild,holes=0.05,drift_xy=0``), only overrides (``holes=0.05``, starting from none),
     or a JSON file holding an object of fields."""
-    if text is None or not text.strip():
+    if text is None:
         return PROFILES["none"]
     t = text.strip()
-    if t.endswith(".json") or Path(t).is_file():
+    if not t:
+        raise SgtoolError("--noise: empty; give a profile (none, mild, strong), overrides "
+                          "(holes=0.05) or a .json file")
+    if names_file(t):
         p = Path(t)
         try:
             d = json.loads(p.read_text(encoding="utf-8"))
@@ -130,6 +133,13 @@ def parse_noise(text: str | None) -> NoiseProfile:
     return _override(base, items, t, default_name=t)
 
 
+def names_file(text: str) -> bool:
+    """Whether the ``--noise`` text names a JSON file (:func:`parse_noise`), not a
+    profile with overrides."""
+    t = text.strip()
+    return t.endswith(".json") or Path(t).is_file()
+
+
 def _override(base: NoiseProfile, items: Iterable[tuple[str, Any]], where: str,
               default_name: str) -> NoiseProfile:
     names = {f.name for f in fields(NoiseProfile)} - {"name"}
@@ -141,6 +151,8 @@ def _override(base: NoiseProfile, items: Iterable[tuple[str, Any]], where: str,
         if k not in names:
             raise SgtoolError(f"--noise {where}: unknown field {k!r} (fields: "
                               f"{', '.join(sorted(names))})")
+        if k in kw:
+            raise SgtoolError(f"--noise {where}: {k} is given twice")
         kw[k] = v
     if not kw:
         return base

@@ -64,7 +64,10 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
     assert "| random " in again.output  # frames/s "-": nothing was run
     only = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
                                     "--planners", "random", "--report-only"])
-    assert only.exit_code == 0 and "| random " in only.output and "greedy" not in only.output
+    assert only.exit_code == 0 and "| random " in only.output and "| greedy" not in only.output
+    # ... and says which logs it left out
+    assert f"note: {out / 'logs' / 'none' / 'greedy'} holds episode logs this report " \
+        "leaves out" in only.output
     # other settings do not mix with the logs there
     other = [*ARGS, "--house", str(house_file), "-o", str(out)]
     other[other.index("--max-steps") + 1] = "3"
@@ -252,3 +255,34 @@ def test_a_worker_builds_each_house_once_when_tasks_cycle_through_houses(monkeyp
     for t in tasks:  # episode 0 of both houses, then episode 1 of both
         assert _episodes(t) == ["ep", "ep"]
     assert built == ["house-0", "house-1"]
+
+
+def test_noise_profiles_are_kept_apart(house_file, tmp_path) -> None:
+    """A profile from a JSON file in another folder runs into logs/NAME (its name); every
+    episode row names its profile, so `sgtool eval` scores them apart; the noise seed is a
+    setting of the logs; a report of one profile says which logs it left out."""
+    (tmp_path / "nj").mkdir()
+    prof = tmp_path / "nj" / "my.json"
+    prof.write_text(json.dumps({"profile": "none", "holes": 0.05}))
+    out = tmp_path / "rb"
+    args = [*ARGS, "--planners", "random", "--house", str(house_file), "-o", str(out)]
+    res = CliRunner().invoke(cli, [*args, "--noise", "none", "--noise", str(prof)])
+    assert res.exit_code == 0, res.output
+    logs = sorted(p.relative_to(out).as_posix() for p in out.rglob("*.mcap"))
+    assert logs == ["logs/my/random/small/ep-000.mcap", "logs/none/random/small/ep-000.mcap"]
+    rows = [json.loads(s) for s in (out / "episodes.jsonl").read_text().splitlines()]
+    assert [r["noise"] for r in rows] == ["none", "my"]
+    ev = CliRunner().invoke(cli, ["eval", str(out / "episodes.jsonl")])
+    assert ev.exit_code == 0, ev.output
+    assert "random [none]" in ev.output and "random [my]" in ev.output
+    assert "2 sensor noise profiles (none, my)" in ev.output
+    res = CliRunner().invoke(cli, [*args, "--noise", "none", "--noise-seed", "1"])
+    assert res.exit_code == 2 and "noise seed: 0 in the log, 1 now" in res.output
+    only = CliRunner().invoke(cli, [*args, "--report-only"])
+    assert only.exit_code == 0, only.output
+    assert f"note: {out / 'logs' / 'my'} holds episode logs" in only.output
+    # two files of one profile name would share a folder
+    (tmp_path / "my.json").write_text(json.dumps({"holes": 0.1}))
+    res = CliRunner().invoke(cli, [*args, "--noise", str(prof), "--noise",
+                                   str(tmp_path / "my.json")])
+    assert res.exit_code == 2 and "both name the log folder 'my'" in res.output

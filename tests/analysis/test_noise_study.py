@@ -82,7 +82,16 @@ def test_tables_list_every_condition_once(study: dict[str, Path]) -> None:
         assert int(r["merged_rooms"]) == c["merged"]["rooms"]
     text = (out / "summary.md").read_text()
     assert "## label_dropout (per object and frame)" in text
-    assert re.search(r"^\| label_dropout=0\.2 +\| 2/2 \d\.\d{3} \d+\.\d%", text, re.M)
+    cell = re.search(r"^\| label_dropout=0\.2 +\| 2/2 \d\.\d{3} \d+\.\d% of (\d+)", text,
+                     re.M)
+    assert cell is not None  # "of N": the objects the accuracy is over
+    row = next(r for r in rows if r["level"] == "0.2")
+    assert int(cell.group(1)) == int(row["merged_objects"])
+    # the objects a level kept, against the noise-free graph's (a lost object is no error
+    # of "objects right")
+    base = next(r for r in rows if r["factor"] == "none")
+    kept = 100 * int(row["merged_objects"]) / int(base["merged_objects"])
+    assert "| objects kept vs none |" in text and f"| {kept:.1f}% " in text
     assert "Houses: small (file " in text
     assert (out / "plots" / "label_dropout.png").read_bytes()[:4] == b"\x89PNG"
 

@@ -37,7 +37,7 @@ def test_no_door_is_said_only_when_the_graph_is_one_room():
 
 def test_a_score_without_scorable_objects_says_so():
     """Objects none of which name a spec element are "not scored", not 0 % of 0."""
-    from sgtool.replayers.score import score_lines
+    from sgtool.replayers.score import score_dict, score_lines
     from sgtool.scenegraph.quality import Quality
 
     def q(objects: int) -> Quality:
@@ -48,3 +48,9 @@ def test_a_score_without_scorable_objects_says_so():
     none, some = score_lines({"strict": q(0), "merged": q(9)})
     assert "objects not scored (no object's instance names a spec element" in none
     assert "objects in the right room 100.0% of 9" in some
+    # a graph without objects has nothing to score, for no fault of the instance table
+    empty, _ = score_lines({"strict": q(0), "merged": q(9)}, graph_objects=0)
+    assert "no object in the graph to score" in empty and "spec_id" not in empty
+    # --json: an accuracy over nothing is null, not 0
+    d = score_dict({"strict": q(0), "merged": q(9)})
+    assert d["strict"]["object_accuracy"] is None and d["merged"]["object_accuracy"] == 1.0

@@ -489,6 +489,18 @@ def render_turn_option() -> Callable[[F], F]:
              "tick that turns).")
 
 
+def live_max_depth_option() -> Callable[[F], F]:
+    """``--max-depth M`` of the closed-loop commands
+    (:attr:`sgtool.recorders.sim.closed_loop_options.ClosedLoopOptions.max_depth`)."""
+    return click.option(
+        "--max-depth", "max_depth", type=FiniteFloatRange(0.5, 20.0), default=None,
+        metavar="M",
+        help="Depth farther than this (m) is not mapped by the live map (recorded in the "
+             "log: replay maps the same). Default: 5 (MoMa-LLM's), lowered to where the "
+             "sensor's depth noise (--noise depth_sigma, known to the robot like a "
+             "datasheet figure) would read far floor as obstacles, as replay does.")
+
+
 def executor_options(what: str) -> Callable[[F], F]:
     """``--executor local|ray``, ``--workers/-w N`` and ``--ray-address`` of the batch
     commands (:func:`sgtool.analysis.executor.make_executor`); ``what`` names the tasks."""

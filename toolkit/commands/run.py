@@ -23,6 +23,7 @@ from sgtool.commands.options import (
     explore_through_option,
     house_options,
     list_planners_option,
+    live_max_depth_option,
     llm_endpoint_options,
     llm_log_options,
     look_in_beyond_option,
@@ -87,11 +88,14 @@ if TYPE_CHECKING:
 @sight_lines_option()
 @explore_through_option()
 @render_turn_option()
+@live_max_depth_option()
 @click.option("--optimistic", type=FINITE_FLOAT, default=0.25, show_default=True, metavar="M",
               help="live navigation: how far (m) past known free floor a path may run into "
               "unknown space (at frontiers).")
 @click.option("--noise", default="none", show_default=True,
               help="Sensor faults, as `sgtool record --noise` (none, mild, strong, overrides).")
+@click.option("--noise-seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Seed of the sensor faults (--noise).")
 @click.option("-O", "--planner-option", "planner_option", multiple=True,
               metavar="P.KEY=VALUE",
               help="Planner option, e.g. -O scout.delta=0.2 or -O moma-llm.model=gpt-4o-mini "
@@ -189,6 +193,8 @@ class RunArgs:
     sight_lines: bool = False
     explore_through: float = 0.0
     render_turn: float = 20.0
+    max_depth: float | None = None
+    noise_seed: int = 0
 
 
 def _planner(args: RunArgs) -> tuple[str, dict[str, Any]]:
@@ -249,12 +255,13 @@ def _request(args: RunArgs, out: Path) -> SearchRequest:
         classifier=args.classifier, min_points=args.min_points, max_steps=args.max_steps,
         frames=frame_budget(args.frames, args.frames_per_room, len(house.rooms)),
         planner_seed=args.planner_seed, navigation=args.navigation, success=args.success,
-        noise=parse_noise(args.noise),
+        noise=parse_noise(args.noise), noise_seed=args.noise_seed,
         live=LiveNavConfig(optimistic=args.optimistic, look_in=args.look_in,
                            look_in_beyond=args.look_in_beyond, peek=args.peek,
                            sight_lines=args.sight_lines,
                            explore_through=args.explore_through),
-        explore_on=args.explore_on, turn_render_deg=args.render_turn)
+        explore_on=args.explore_on, turn_render_deg=args.render_turn,
+        max_depth=args.max_depth)
     return SearchRequest(house=house, house_id=house_id, episode_index=index, episode=ep,
                          planner=name, output=out, options=opts, planner_options=options,
                          force=args.force, quiet=args.quiet, rerun_to=args.rerun_to)

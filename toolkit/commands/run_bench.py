@@ -17,6 +17,7 @@ from sgtool.commands.options import (
     explore_on_option,
     explore_through_option,
     list_planners_option,
+    live_max_depth_option,
     llm_endpoint_options,
     look_in_beyond_option,
     look_in_option,
@@ -58,8 +59,12 @@ if TYPE_CHECKING:
               help="Episodes per house: those `sgtool bench --episodes N` draws with the "
               "same N (the draw depends on N: a bench folder for --symbolic needs it).")
 @click.option("--noise", "noise", multiple=True, metavar="PROFILE",
-              help="Sensor noise profile (none, mild, strong, with overrides as `sgtool "
-              "record --noise`); repeatable: every profile is a run. Default: none.")
+              help="Sensor noise profile (none, mild, strong, with overrides, or a .json "
+              "file, as `sgtool record --noise`); repeatable: every profile is a run, its "
+              "logs in logs/NOISE/ (NOISE: the text given, or a file's profile name). "
+              "Default: none.")
+@click.option("--noise-seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Seed of the sensor faults (--noise).")
 @click.option("--max-steps", default=50, show_default=True,
               help="High-level planner steps per episode.")
 @click.option("--frames", type=click.IntRange(min=1), default=None,
@@ -79,6 +84,7 @@ if TYPE_CHECKING:
 @sight_lines_option()
 @explore_through_option()
 @render_turn_option()
+@live_max_depth_option()
 @click.option("--navigation", type=click.Choice(["live", "house"]), default="live",
               show_default=True,
               help="live: skills plan on the robot's own map; house: on the ground truth "
@@ -178,6 +184,8 @@ class RunBenchArgs:
     sight_lines: bool = False
     explore_through: float = 0.0
     render_turn: float = 20.0
+    max_depth: float | None = None
+    noise_seed: int = 0
 
 
 def _request(args: RunBenchArgs) -> RunBenchRequest:
@@ -229,6 +237,7 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
                              navigation=args.navigation, success=args.success,
                              explore_on=args.explore_on,
                              turn_render_deg=args.render_turn,
+                             max_depth=args.max_depth, noise_seed=args.noise_seed,
                              live=LiveNavConfig(look_in=args.look_in,
                                                 look_in_beyond=args.look_in_beyond,
                                                 peek=args.peek,

@@ -277,9 +277,11 @@ class Episode(LogRecord):
 
     def merged(self, later: Episode) -> Episode:
         """This record with the fields ``later`` holds replaced by its values (a closing
-        record over its opening one)."""
+        record over its opening one); ``extra`` is merged the same way, key by key."""
         d = self.to_json()
         d.update(later.to_json())
+        if self.extras and later.extras:
+            d["extra"] = {**self.extras, **later.extras}
         return Episode._build(d)
 
 

@@ -155,9 +155,34 @@ def estimate(samples: Iterable[FramePoints], tolerance: float,
         return None
     sigma = np.sqrt(ss[keep] / n[keep])
     edges = keep * BIN
-    over = sigmas * sigma > tolerance
-    max_depth = max(MIN_DEPTH, float(edges[np.flatnonzero(over)[0]])) if over.any() else None
-    if max_depth is not None and ceiling is not None and max_depth >= ceiling:
-        max_depth = None
     return DepthNoise(floor=round(f, 4), depths=tuple(float(e) for e in edges),
-                      sigma=tuple(round(float(s), 4) for s in sigma), max_depth=max_depth)
+                      sigma=tuple(round(float(s), 4) for s in sigma),
+                      max_depth=cut_depth(edges, sigma, tolerance, sigmas, ceiling))
+
+
+def cut_depth(edges: np.ndarray, sigma: np.ndarray, tolerance: float,
+              sigmas: float = SIGMAS, ceiling: float | None = None) -> float | None:
+    """(N2): the lower edge ``edges`` of the first depth bin whose vertical noise ``sigma``
+    times ``sigmas`` passes ``tolerance``, at least ``MIN_DEPTH``; None when no bin does
+    or the cut lies at or beyond ``ceiling``."""
+    over = np.flatnonzero(sigmas * np.asarray(sigma) > tolerance)
+    if over.size == 0:
+        return None
+    max_depth = max(MIN_DEPTH, float(np.asarray(edges)[over[0]]))
+    return None if ceiling is not None and max_depth >= ceiling else max_depth
+
+
+def sensor_max_depth(depth_sigma: float, camera_height: float, tolerance: float,
+                     *, sigmas: float = SIGMAS, ceiling: float | None = None) -> float | None:
+    """(N2) for a camera whose depth error has the std ``depth_sigma * z^2`` (a datasheet
+    figure, or :class:`sgtool.recorders.sim.noise.NoiseProfile`), mounted
+    ``camera_height`` above a level floor: a depth error ``e`` moves a floor point seen at
+    depth ``z`` by ``e * camera_height / z`` vertically, whatever the camera's tilt, so
+    the vertical noise is ``sigma_v(z) = depth_sigma * camera_height * z``, taken at the
+    far edge of each bin of (N1) (so the cut is the bin edge at or before the exact one).
+    None as :func:`cut_depth` (no noise: None)."""
+    if depth_sigma <= 0:
+        return None
+    edges = np.arange(MAX_BINS) * BIN
+    return cut_depth(edges, depth_sigma * camera_height * (edges + BIN), tolerance,
+                     sigmas, ceiling)

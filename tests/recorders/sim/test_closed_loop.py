@@ -40,6 +40,8 @@ from sgtool.recorders.sim.closed_loop import (
     plan_skills,
     run_episode,
 )
+from sgtool.recorders.sim.closed_loop_report import episode_notes
+from sgtool.recorders.sim.noise import PROFILES
 from sgtool.scenegraph.derived_layers import DERIVED_TOPICS
 from sgtool.scenegraph.examined import EXAMINE, close_views
 from sgtool.scenegraph.graph import (
@@ -469,3 +471,42 @@ def test_the_log_keeps_the_planners_options(house, tmp_path) -> None:
     assert [e["extra"]["planner_options"] for e in records] == [{"max_failures": 3}] * 2
     assert recorded_options({"api_key": "sk-1", "encoder": object(), "delta": 0.2,
                              "rooms": ["a", "b"]}) == {"delta": 0.2, "rooms": ["a", "b"]}
+
+
+def test_a_noisy_sensor_maps_as_far_as_its_noise_allows(house, tmp_path) -> None:
+    # depth noise 0.01 z^2 from a camera 1.2 m up: 4 sigma of the floor reach its 0.1 m
+    # tolerance at 2.08 m (sgtool.mapping.depth_noise.sensor_max_depth), so the live map
+    # keeps depth to 2 m, says so, records it, and a replay maps the same
+    idx, ep = pick_episode(house, index=0)
+    out = tmp_path / "noisy.mcap"
+    r = CliRunner().invoke(cli, ["run", "--planner", "scout", "--seed", str(SEED), "--rooms",
+                                 ROOMS, "--episode", "0", "--resolution", "160x120",
+                                 "--max-steps", "2", "--noise", "none,depth_sigma=0.01",
+                                 "--noise-seed", "3", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "the live map kept depth to 2 m" in r.output
+    (logged,) = read_log_episodes(out)
+    assert logged.episode.extras["mapping"]["max_depth"] == 2.0
+    assert logged.episode.extras["noise_seed"] == 3
+    assert logged.result().noise == "none,depth_sigma=0.01"
+    derived = tmp_path / "replayed.mcap"
+    r = CliRunner().invoke(cli, ["replay", str(out), "-o", str(derived)])
+    assert r.exit_code == 0, r.output
+    assert messages(out, [GRAPH]) == messages(derived, [GRAPH])
+    # a depth of the user's own, checked like replay's
+    opts = dataclasses.replace(OPTS, noise=PROFILES["strong"])
+    assert opts.mapping().max_depth == 3.25  # 0.1 / (4 x 1.2 x 0.006) = 3.47: bin 3.25
+    assert dataclasses.replace(opts, max_depth=4.5).mapping().max_depth == 4.5
+    with pytest.raises(SgtoolError, match="--max-depth 0.2 m: must be 0.5..20"):
+        dataclasses.replace(opts, max_depth=0.2).mapping()
+    assert OPTS.mapping().max_depth == 5.0  # a perfect sensor: MoMa-LLM's 5 m
+
+
+def test_episode_notes() -> None:
+    assert episode_notes(5.0, 5.0, 0.0, 3) == ()
+    (depth,) = episode_notes(1.0, 5.0, 0.02, 2)
+    assert "kept depth to 1 m" in depth and "0.02 z^2" in depth
+    assert episode_notes(4.0, 5.0, 0.0, 2) == ()  # a depth the user chose: no note
+    (_, empty) = episode_notes(1.0, 5.0, 0.02, 0)
+    assert "ended without a room" in empty
+    assert "ended without a room" in episode_notes(5.0, 5.0, 0.0, None)[0]

@@ -14,7 +14,13 @@ import pytest
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.recorders.sim.camera import base_T_camera, se2_matrix
-from sgtool.recorders.sim.noise import PROFILES, NoiseProfile, SensorFaults, parse_noise
+from sgtool.recorders.sim.noise import (
+    PROFILES,
+    NoiseProfile,
+    SensorFaults,
+    names_file,
+    parse_noise,
+)
 
 K = CameraIntrinsics.from_fov(200, 100, 60.0)
 CAM = base_T_camera(1.2, 15.0)
@@ -141,3 +147,9 @@ def test_parse_noise(tmp_path: Path) -> None:
     (tmp_path / "bad.json").write_text("[1, 2]")
     with pytest.raises(SgtoolError, match="JSON object"):
         parse_noise(str(tmp_path / "bad.json"))
+    with pytest.raises(SgtoolError, match="holes is given twice"):
+        parse_noise("mild,holes=0.1,holes=0.2")  # not the last one silently
+    for empty in ("", "  "):  # an empty --noise is a mistake, not a perfect sensor
+        with pytest.raises(SgtoolError, match="empty"):
+            parse_noise(empty)
+    assert names_file(str(f)) and names_file("nj/my.json") and not names_file("mild,holes=1")

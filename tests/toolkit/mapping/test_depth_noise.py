@@ -16,7 +16,14 @@ import numpy as np
 from support.synthetic_world import make_frame, two_room_house, world_of_house
 
 from sgtool.log.frame import CameraIntrinsics
-from sgtool.mapping.depth_noise import BIN, MIN_DEPTH, estimate, floor_height, frame_points
+from sgtool.mapping.depth_noise import (
+    BIN,
+    MIN_DEPTH,
+    estimate,
+    floor_height,
+    frame_points,
+    sensor_max_depth,
+)
 
 K = CameraIntrinsics.from_fov(160, 120, 60)
 H = 1.2
@@ -85,3 +92,21 @@ def test_a_stray_point_far_away_costs_nothing():
     frames[0] = type(far)(far.h + 5e8, far.slope, far.camera_z + 5e8)
     est = estimate(frames, 0.1)
     assert est is not None and est.max_depth == estimate(samples(0.01), 0.1).max_depth
+
+
+def test_a_sensor_model_is_cut_where_the_measurement_cuts_it():
+    # sigma_v(z) = H c z (module doc of the test): the model cuts in the bin the cut
+    # falls in, the measurement there or one bin nearer (its noise near the cut)
+    for c in (0.006, 0.01, 0.015):
+        est = estimate(samples(c), 0.1)
+        model = sensor_max_depth(c, H, 0.1)
+        assert est is not None and est.max_depth is not None and model is not None
+        cut = 0.1 / (4 * H * c)
+        assert cut - BIN <= model <= cut, c
+        assert est.max_depth in (model, model - BIN), (c, model, est.max_depth)
+    assert sensor_max_depth(0.01, H, 0.1) == 2.0  # 0.1 / (4 x 1.2 x 0.01) = 2.08: bin 2.0
+    assert sensor_max_depth(0.0, H, 0.1) is None  # no noise: nothing to cut
+    assert sensor_max_depth(0.05, H, 0.1) == MIN_DEPTH  # the robot keeps its surroundings
+    assert sensor_max_depth(0.004, H, 0.1, ceiling=5.0) is None  # the cut lies at 5.0 m
+    # a camera mounted higher sees the floor's noise larger: cut nearer
+    assert sensor_max_depth(0.01, 2 * H, 0.1) == 1.0
