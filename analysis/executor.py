@@ -80,11 +80,15 @@ class Outcome:
 
 
 def error_line(e: BaseException) -> str:
-    """``Type: first line of the message`` (a Ray task error is unwrapped to its cause)."""
+    """``Type: first line of the message`` (a Ray task error is unwrapped to its cause);
+    the message alone for an :class:`~sgtool.errors.SgtoolError`, which is written for
+    the user."""
     cause = getattr(e, "cause", None)
     if isinstance(cause, BaseException):
         e = cause
     text = str(e).strip().splitlines()
+    if text and isinstance(e, SgtoolError):
+        return text[0]
     return f"{type(e).__name__}: {text[0]}" if text else type(e).__name__
 
 

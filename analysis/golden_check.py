@@ -189,6 +189,11 @@ def pin_logs(logs: Sequence[str | Path], folder: str | Path,
     failed = [o for o in outcomes if not o.ok]
     if failed:
         raise SgtoolError(f"{failed[0].id}: could not be replayed: {failed[0].error}")
+    empty = [p for p, o in zip(paths, outcomes, strict=True)
+             if not o.value.refreshes or o.value.refreshes[-1].frames == 0]
+    if empty:
+        raise SgtoolError(f"{empty[0]}: its replay mapped no camera frame (no depth "
+                          "image?): a pin of it would check nothing")
     logs_now = dict(old)
     with pin_folder(root) as out:
         staged = PinSet(out, logs_now, sgtool_version=__version__)

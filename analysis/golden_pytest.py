@@ -10,7 +10,10 @@ an environment where sgtool is installed; it does nothing unless asked).
 - The fixture ``sgtool_golden`` checks logs from a lab's own tests, snapshot style:
   ``sgtool_golden.check(log, folder, **replay_options)`` pins the log into ``folder`` on
   first use (the test then fails once, saying so: commit the pin), and afterwards fails
-  with the report when its replay changed (re-pins under ``--sgtool-golden-update``).
+  with the report when its replay changed (re-pins under ``--sgtool-golden-update``), or
+  when the log given is not the one pinned under its name; options given override the
+  pinned ones for the check (as ``sgtool golden check --voxel-size``), the others are as
+  pinned.
 
 The module imports only pytest and the standard library at load time: sgtool's replay
 code is imported when a golden test runs.
@@ -95,8 +98,12 @@ class GoldenLog(pytest.Item):
     def repr_failure(self, excinfo: pytest.ExceptionInfo[BaseException],
                      style: Any = None) -> str:
         if isinstance(excinfo.value, GoldenFailure):
+            from sgtool.files import quoted
+
             return str(excinfo.value) + ("\n(deliberate? `sgtool golden check --dir "
-                                         f"{self.path.parent} --update`)")
+                                         f"{quoted(self.path.parent)} --log "
+                                         f"{quoted(self.name)} --update`, or pytest "
+                                         "--sgtool-golden-update)")
         return str(super().repr_failure(excinfo))
 
     def reportinfo(self) -> tuple[Path, int | None, str]:
@@ -111,19 +118,30 @@ class GoldenFixture:
         self.tolerance = tolerance
 
     def check(self, log: str | Path, folder: str | Path, **options: Any) -> None:
-        """Pin ``log`` into ``folder`` on first use, else check it (module doc);
-        ``options``: replay options (``every``, ``voxel_size``, ...)."""
+        """Pin ``log`` into ``folder`` on first use (with the replay ``options``: ``every``,
+        ``voxel_size``, ...), else check it: options given override the pinned ones for
+        this check, as ``sgtool golden check --voxel-size`` does, the others are as pinned.
+        A ``log`` that is not the log pinned under its name fails (re-pinned under
+        ``--sgtool-golden-update``)."""
         from sgtool.analysis.golden_check import check_pins, pin_logs, pin_name, update_pins
         from sgtool.replayers.derived_log import ReplayOptions
         from sgtool.replayers.golden_pins import INDEX, read_pins
 
         log, folder = Path(log), Path(folder)
         name = pin_name(log)
-        known = (folder / INDEX).is_file() and name in read_pins(folder).logs
-        if not known:
+        pin = read_pins(folder).logs.get(name) if (folder / INDEX).is_file() else None
+        if pin is None:
             pin_logs([log], folder, ReplayOptions(**options))
             pytest.fail(f"pinned {log} into {folder} (first run); commit the pin and run "
                         "again", pytrace=False)
+        if pin.log_path(folder).resolve() != log.resolve():
+            if not self.update:
+                pytest.fail(f"{log} is not the log pinned as {name!r} in {folder} "
+                            f"({pin.log_path(folder)}): pins are named by file name, give "
+                            "each log its own name or folder (or re-pin with pytest "
+                            "--sgtool-golden-update)", pytrace=False)
+            pin_logs([log], folder, pin.options, why=pin.why)
+            return
         report = check_pins(folder, ReplayOptions(**options) if options else None,
                             tolerance=self.tolerance, names=[name], keep=self.update)
         c = report.logs[0]

@@ -33,7 +33,7 @@ from typing import Any
 
 from sgtool.canonical import canonical_float
 from sgtool.errors import SgtoolError
-from sgtool.files import atomic_write
+from sgtool.files import atomic_write, quoted
 from sgtool.replayers.derived_log import ReplayOptions, replay
 from sgtool.replayers.golden import (
     EXPECTED,
@@ -126,7 +126,7 @@ class Pinned:
 
     def log_path(self, folder: Path) -> Path:
         p = Path(self.log)
-        return p if p.is_absolute() else folder / p
+        return p if p.is_absolute() else Path(os.path.normpath(folder / p))
 
     def to_dict(self) -> dict[str, Any]:
         d: dict[str, Any] = {
@@ -260,10 +260,10 @@ def read_pins(folder: str | os.PathLike[str]) -> PinSet:
     path = root / INDEX
     if not root.is_dir():
         raise PinError(f"{root}: no such pin folder (make one with `sgtool golden pin LOG "
-                       f"--dir {root}`)")
+                       f"--dir {quoted(root)}`)")
     if not path.is_file():
         raise PinError(f"{root}: no {INDEX}, so nothing is pinned there (pin logs with "
-                       f"`sgtool golden pin LOG --dir {root}`)")
+                       f"`sgtool golden pin LOG --dir {quoted(root)}`)")
     try:
         doc = json.loads(path.read_bytes())
     except (ValueError, UnicodeDecodeError) as e:
@@ -279,11 +279,20 @@ def read_pins(folder: str | os.PathLike[str]) -> PinSet:
     common = doc.get("replay", {}) if fmt == 1 else {}
     logs: dict[str, Pinned] = {}
     for name, entry in sorted(doc["cases"].items()):
+        if not valid_name(name):
+            raise _damaged(path, f"entry {name!r}: a pin name is a file name (no path)")
         try:
             logs[name] = _entry(name, entry, common, fmt, path)
         except (KeyError, TypeError, ValueError) as err:
             raise _damaged(path, f"entry {name!r}: {err}") from None
     return PinSet(root, logs, fmt, str(doc.get("sgtool_version", "")))
+
+
+def valid_name(name: str) -> bool:
+    """Whether ``name`` can name a pin: a plain file name, so that its files stay in the
+    pin folder."""
+    return bool(name) and name not in (".", "..") and "/" not in name and "\\" not in name \
+        and "\0" not in name
 
 
 def _entry(name: str, e: Mapping[str, Any], common: Mapping[str, Any], fmt: int,
@@ -345,12 +354,18 @@ def load_expected(pins: PinSet, name: str) -> tuple[list[str], list[RefreshMeta]
 
 
 def stored_path(log: Path, folder: Path) -> str:
-    """How the index names ``log``: relative to ``folder`` when it lies below it, else
-    absolute."""
+    """How the index names ``log``: relative to ``folder`` (``../../logs/run.mcap``) when
+    the two share a directory other than the filesystem root, so that a repository
+    holding both checks out anywhere; else absolute."""
+    a, f = log.resolve(), folder.resolve()
     try:
-        return str(log.resolve().relative_to(folder.resolve()))
+        return a.relative_to(f).as_posix()
     except ValueError:
-        return str(log.resolve())
+        pass
+    common = Path(os.path.commonpath([a, f]))
+    if common == Path(common.anchor):
+        return str(a)
+    return Path(os.path.relpath(a, f)).as_posix()
 
 
 def pinned_entry(name: str, log: Path, stored: str, options: ReplayOptions, cap: Capture,

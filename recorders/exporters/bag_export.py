@@ -17,8 +17,10 @@ Topics (sgtool topic -> ROS topic, type):
   ``/tf_static``, are latched: transient-local QoS in ROS 2, latching in ROS 1.
 
 Time base: a message's bag time and header stamp are its log time plus ``time_base_s``
-seconds (default 1 s), so no message falls on stamp 0 (ROS 1's ``rosbag play`` starts at
-``TIME_MIN`` and drops what is at zero; ``tf2`` treats stamp 0 as "latest").
+seconds, so no message falls on stamp 0 (ROS 1's ``rosbag play`` starts at ``TIME_MIN``
+and drops what is at zero; ``tf2`` treats stamp 0 as "latest"). By default 1 s for a log
+whose time starts within a second of 0 (recorded in simulation), else 0: a recording
+imported from a bag keeps its own stamps, and plays beside the original.
 
 Frames are renamed to REP-105's by default (``world`` -> ``map``, ``base`` ->
 ``base_link``, ``camera`` -> ``camera_optical_frame``: sgtool's camera frame is an optical
@@ -157,15 +159,15 @@ _MAX_STAMP_S = 2**31 - 1  # ROS time: int32 seconds (builtin_interfaces/Time)
 
 
 def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
-               force: bool = False, *, time_base_s: float = DEFAULT_TIME_BASE_S,
+               force: bool = False, *, time_base_s: float | None = None,
                frames: Mapping[str, str] | None = None, distro: str = "humble",
                compression: str | None = None, topics: Iterable[str] | None = None,
                progress: Progress | None = None) -> ExportReport:
     """Write the sgtool log ``log`` (best a derived one) as a ROS bag at ``out`` (module
     doc): ``fmt`` ros1 or ros2 (None: from ``out``'s name), stamps at log time +
-    ``time_base_s`` seconds, frames renamed by ``frames`` (None: REP-105), ``compression``
-    (None: zstd for ros2, lz4 for ros1), only the ROS or sgtool ``topics`` given (None:
-    all). The bag appears under its name only when complete."""
+    ``time_base_s`` seconds (None: as the module doc says), frames renamed by ``frames``
+    (None: REP-105), ``compression`` (None: zstd for ros2, lz4 for ros1), only the ROS or
+    sgtool ``topics`` given (None: all). The bag appears under its name only when complete."""
     log, out = Path(log), Path(out)
     fmt = format_for(out, fmt)
     compression = compression or DEFAULT_COMPRESSION[fmt]
@@ -174,7 +176,7 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
                           f"{', '.join(COMPRESSIONS[FORMATS[fmt]])}")
     if distro not in DISTROS:
         raise SgtoolError(f"--distro {distro!r}: give {' or '.join(DISTROS)}")
-    if not np.isfinite(time_base_s) or time_base_s < 0:
+    if time_base_s is not None and (not np.isfinite(time_base_s) or time_base_s < 0):
         raise SgtoolError(f"--time-base {time_base_s}: give seconds >= 0")
     chosen = select_outputs(topics)
     if not log.is_file():
@@ -187,12 +189,14 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
         raise SgtoolError(f"-o {out}: folder {out.parent} does not exist")
     elif out.exists() and not out.is_dir():
         raise SgtoolError(f"-o {out} is a file; a ROS 2 bag is a folder (not replacing it)")
-    base_ns = int(round(time_base_s * 1e9))
     with LogReader(log) as r:
         if not r.is_sgtool:
             raise SgtoolError(f"{log} is not an sgtool log (`sgtool info {log}` says what it "
                               "is); export works on sgtool logs and their replays")
         tr = r.time_range()
+        if time_base_s is None:
+            time_base_s = DEFAULT_TIME_BASE_S if tr is None or tr[0] < 1_000_000_000 else 0.0
+        base_ns = int(round(time_base_s * 1e9))
         if tr is not None and tr[0] + base_ns <= 0:
             raise SgtoolError(f"--time-base {time_base_s:g}: the first message would be at "
                               "stamp 0; give a time base > 0")

@@ -65,7 +65,7 @@ def test_a_log_that_fails_is_reported_and_the_others_are_written(logs, tmp_path)
     assert r.exit_code == 2
     lines = r.stdout.splitlines()
     assert lines[0] == f"wrote {out / 'run6.mcap'}: 6 frames, 2 refreshes"
-    assert lines[1].startswith(f"failed {bad}: ") and "Error" in lines[1]
+    assert lines[1].startswith(f"failed {bad}: ") and "ends without the MCAP" in lines[1]
     assert lines[2] == f"wrote {out / 'run8.mcap'}: 8 frames, 2 refreshes"
     assert lines[3].startswith("2 replayed, 0 skipped, 1 failed in ")
     assert r.stderr.startswith(f"sgtool: error: 1 of 3 log(s) failed to replay (after a "

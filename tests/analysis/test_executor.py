@@ -25,6 +25,7 @@ from sgtool.analysis.executor import (
     failure_lines,
     make_executor,
 )
+from sgtool.errors import SgtoolError
 
 CALLS: list[int] = []
 
@@ -95,6 +96,9 @@ def test_error_line_unwraps_a_cause_and_keeps_the_first_line():
     assert error_line(Wrapped("x")) == "KeyError: 'k'"
     assert error_line(RuntimeError("one\ntwo")) == "RuntimeError: one"
     assert error_line(RuntimeError()) == "RuntimeError"
+    # a message written for the user goes without its class name
+    assert error_line(SgtoolError("x.mcap has no channel /camera/depth\nmore")) == \
+        "x.mcap has no channel /camera/depth"
 
 
 def test_ray_not_installed_says_how_to_install_it(monkeypatch):

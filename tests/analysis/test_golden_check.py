@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import gzip
 import json
+import shlex
 import shutil
 import signal
 
@@ -137,7 +138,8 @@ def test_a_moved_log_is_one_line_naming_it(log, tmp_path, capsys):
     shutil.copyfile(log, mine)
     folder = tmp_path / "g"
     assert sgtool(capsys, "golden", "pin", mine, "--dir", folder, *FRAMES)[0] == 0
-    assert read_pins(folder).logs["small"].log == str(mine.resolve())  # not below DIR
+    # not below DIR: relative to it all the same (they share tmp_path)
+    assert read_pins(folder).logs["small"].log == "../runs/small.mcap"
     mine.rename(tmp_path / "elsewhere.mcap")
     code, out, err = sgtool(capsys, "golden", "check", "--dir", folder)
     assert code == 2
@@ -295,3 +297,70 @@ def test_pins_are_added_in_place_and_a_foreign_folder_is_refused(log, tmp_path, 
     code, _, err = sgtool(capsys, "golden", "pin", log, "--dir", mine, *FRAMES)
     assert code == 2 and "holds files but no pins" in err
     assert [p.name for p in mine.iterdir()] == ["notes.txt"]
+
+
+def test_a_repository_of_logs_and_pins_checks_out_anywhere(log, tmp_path, capsys):
+    """Logs beside the pin folder (logs/, tests/golden/) are stored relative to it: a
+    clone elsewhere checks its own copy; the hint to accept a change repeats the options
+    and logs checked, quoted."""
+    repo = tmp_path / "lab repo"
+    (repo / "logs").mkdir(parents=True)
+    shutil.copyfile(log, repo / "logs" / "small.mcap")
+    pins = repo / "tests" / "golden"
+    assert sgtool(capsys, "golden", "pin", repo / "logs" / "small.mcap", "--dir", pins,
+                  *FRAMES)[0] == 0
+    assert read_pins(pins).logs["small"].log == "../../logs/small.mcap"
+    clone = tmp_path / "clone"
+    shutil.copytree(repo, clone)
+    shutil.rmtree(repo)
+    code, out, _ = sgtool(capsys, "golden", "check", "--dir", clone / "tests" / "golden")
+    assert code == 0, out
+    code, _, err = sgtool(capsys, "golden", "check", "--dir", clone / "tests" / "golden",
+                          "--log", "small", "--voxel-size", "0.08")
+    assert code == 1
+    folder = shlex.quote(str(clone / "tests" / "golden"))
+    assert (f"accept it with: sgtool golden check --dir {folder} --log small --voxel-size "
+            "0.08 --update") in err
+    code, out, _ = sgtool(capsys, "golden", "check", "--dir", clone / "tests" / "golden",
+                          "--update")
+    assert code == 0 and "nothing to accept" in out
+
+
+def _without(src, dst, topic):
+    """``src`` with every message of ``topic`` left out (its channel kept)."""
+    from mcap.reader import make_reader
+    from mcap.writer import Writer
+
+    with open(src, "rb") as f, open(dst, "wb") as g:
+        r, w = make_reader(f), Writer(g)
+        head, summary = r.get_header(), r.get_summary()
+        w.start(head.profile, head.library)
+        for sc in summary.schemas.values():
+            w.register_schema(sc.name, sc.encoding, sc.data)
+        ids = {cid: w.register_channel(c.topic, c.message_encoding, c.schema_id, c.metadata)
+               for cid, c in summary.channels.items()}
+        for a in r.iter_attachments():
+            w.add_attachment(a.create_time, a.log_time, a.name, a.media_type, a.data)
+        for _, c, m in r.iter_messages():
+            if c.topic != topic:
+                w.add_message(ids[c.id], m.log_time, m.data, m.publish_time, m.sequence)
+        w.finish()
+    return dst
+
+
+def test_a_log_without_camera_frames_is_not_pinned(log, tmp_path, capsys):
+    """Its replay maps nothing (a refresh at each action record, of an empty map): a pin
+    of it would pass whatever the mapping code did."""
+    empty = _without(log, tmp_path / "no depth.mcap", "/camera/depth")
+    code, _, err = sgtool(capsys, "golden", "pin", empty, "--dir", tmp_path / "g")
+    assert code == 2 and "mapped no camera frame" in err and err.count("\n") == 1
+    assert not (tmp_path / "g").exists()
+
+
+def test_a_pin_name_must_stay_in_its_folder(pinned, tmp_path, capsys):
+    index = json.loads((pinned / "expected.json").read_text())
+    index["cases"]["../escape/small"] = index["cases"].pop("small")
+    (pinned / "expected.json").write_text(json.dumps(index))
+    code, _, err = sgtool(capsys, "golden", "check", "--dir", pinned, "--update")
+    assert code == 2 and "a pin name is a file name" in err
+    assert not (tmp_path / "escape").exists()

@@ -70,3 +70,28 @@ def test_the_example_test_runs_with_the_fixture(tmp_path, monkeypatch):
     code, out = pytest_run(REPO / "examples" / "test_golden_logs.py", cwd=REPO)
     assert code == 0, out
     assert "2 passed" in out
+
+
+def test_the_fixture_refuses_another_log_of_the_pinned_name(tmp_path, monkeypatch):
+    """Pins are named by file name: v2/run.mcap is not v1/run.mcap, pinned as "run", so the
+    fixture fails instead of checking v1's log (and re-pins under --sgtool-golden-update)."""
+    for v in ("v1", "v2"):
+        (tmp_path / v).mkdir()
+    shutil.copyfile(GOLDEN / "house10-start.mcap", tmp_path / "v1" / "run.mcap")
+    shutil.copyfile(GOLDEN / "house6-tour.mcap", tmp_path / "v2" / "run.mcap")
+    pin_logs([tmp_path / "v1" / "run.mcap"], tmp_path / "pins", ReplayOptions(max_frames=20))
+    (tmp_path / "test_lab.py").write_text(
+        "import os\nfrom pathlib import Path\nHERE = Path(__file__).parent\n\n"
+        "def test_run(sgtool_golden):\n"
+        "    sgtool_golden.check(HERE / os.environ['WHICH'] / 'run.mcap', HERE / 'pins')\n")
+    monkeypatch.setenv("WHICH", "v1")
+    code, out = pytest_run("test_lab.py", cwd=tmp_path)
+    assert code == 0, out
+    monkeypatch.setenv("WHICH", "v2")
+    code, out = pytest_run("test_lab.py", cwd=tmp_path)
+    assert code == 1 and "is not the log pinned as 'run'" in out, out
+    code, out = pytest_run("test_lab.py", "--sgtool-golden-update", cwd=tmp_path)
+    assert code == 0, out
+    index = json.loads((tmp_path / "pins" / "expected.json").read_text())
+    assert index["cases"]["run"]["log"] == "../v2/run.mcap"
+    assert index["cases"]["run"]["options"] == {"max_frames": 20}  # kept as pinned

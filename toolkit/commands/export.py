@@ -64,10 +64,12 @@ def _frames(style: str, pairs: tuple[str, ...]) -> dict[str, str]:
               show_default=True,
               help="ROS 2 distribution whose metadata.yaml layout and types are written "
                    "(a humble bag also plays on jazzy).")
-@click.option("--time-base", "time_base", type=FINITE_FLOAT, default=1.0, show_default=True,
+@click.option("--time-base", "time_base", type=FINITE_FLOAT, default=None,
               metavar="SECONDS",
               help="Bag time and header stamps = log time + SECONDS (keeps every message off "
-                   "stamp 0).")
+                   "stamp 0). Default: 1 for a log whose time starts within a second of 0 "
+                   "(recorded in simulation), else 0 (an imported recording keeps its own "
+                   "stamps and plays beside the original).")
 @click.option("--frames", "frame_style", type=click.Choice(["rep105", "sgtool"]),
               default="rep105", show_default=True,
               help="Frame names: REP-105 (map, base_link, camera_optical_frame) or sgtool's "
@@ -88,7 +90,7 @@ def _frames(style: str, pairs: tuple[str, ...]) -> dict[str, str]:
 @click.option("--force", is_flag=True,
               help="Replace an existing OUT: a ROS 1 bag, or the files sgtool wrote in a ROS "
                    "2 bag folder (other files there stay).")
-def bag(log: str, output: str, fmt: str | None, distro: str, time_base: float,
+def bag(log: str, output: str, fmt: str | None, distro: str, time_base: float | None,
         frame_style: str, frame_pairs: tuple[str, ...], compression: str | None,
         topics: str | None, progress: bool, force: bool) -> None:
     """Write LOG (a derived log of `sgtool replay`, or any sgtool log) as a ROS bag that
@@ -124,20 +126,28 @@ def bag(log: str, output: str, fmt: str | None, distro: str, time_base: float,
 @command.command("foxglove-layout")
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
               help="Where to write the layout (JSON).")
+@click.option("--follow", default="base", show_default=True, metavar="FRAME",
+              help="The frame the 3D panel follows: base (the robot of a simulated or "
+              "closed-loop log) or camera (an imported recording, which has no base frame).")
 @click.option("--force", is_flag=True, help="Overwrite OUT.")
-def foxglove_layout(output: str, force: bool) -> None:
+def foxglove_layout(output: str, follow: str, force: bool) -> None:
     """Write the Foxglove layout shipped with sgtool: a 3D panel with the maps and the
     scene graph (/map/occupancy, /map/voronoi, /map/rooms, /map/graph) following the
     robot, the RGB, depth and instance images, and the scene graph and action records.
     Import it in Foxglove with Layouts > Import from file, then open a log or a derived
     log."""
+    import json
     from importlib.resources import files
 
     from sgtool.commands.options import check_output
     from sgtool.files import atomic_write
 
+    if follow not in ("base", "camera", "world"):
+        raise SgtoolError(f"--follow {follow!r}: one of base, camera, world (sgtool's frames)")
     check_output(output, force=force, suffixes=(".json",), what="layout")
-    atomic_write(output, files("sgtool").joinpath(LAYOUT).read_text(encoding="utf-8"))
+    layout = json.loads(files("sgtool").joinpath(LAYOUT).read_text(encoding="utf-8"))
+    layout["configById"]["3D!sgtool"]["followTf"] = follow
+    atomic_write(output, json.dumps(layout, indent=2) + "\n")
     click.echo(f"wrote {output}; import it in Foxglove: Layouts > Import from file")
 
 

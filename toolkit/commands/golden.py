@@ -7,6 +7,7 @@ options and prints or writes the reports (:mod:`sgtool.analysis.golden_report`).
 
 from __future__ import annotations
 
+import shlex
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -16,6 +17,7 @@ import click
 
 from sgtool.commands.options import FiniteFloatRange, executor_options, option_group
 from sgtool.errors import SgtoolError
+from sgtool.files import quoted
 from sgtool.scenegraph.build_options import CLASSIFIERS
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -103,7 +105,7 @@ def pin(logs: tuple[str, ...], folder: str, copy: bool, why: str | None, every: 
         extra += f", {len(e.decisions)} {e.planner} decisions" if e.decisions else ""
         click.echo(f"pinned {e.name}: {e.refreshes} refreshes{extra} ({e.log})")
     click.echo(f"wrote {Path(folder) / 'expected.json'}; check with: sgtool golden check "
-               f"--dir {folder}")
+               f"--dir {quoted(folder)}")
 
 
 @command.command("check")
@@ -151,7 +153,7 @@ def check(folder: str, names: tuple[str, ...], every: int | None, classifier: st
     _write_report_files(report, report_md, junit)
     code = report.exit_code
     if update:
-        for line in update_pins(report):
+        for line in update_pins(report) or ["nothing to accept: no pinned log changed"]:
             click.echo(line)
         code = 2 if code == 2 else 0
     if code == 2:
@@ -159,9 +161,19 @@ def check(folder: str, names: tuple[str, ...], every: int | None, classifier: st
         raise SgtoolError(f"{report.counts()['error']} pinned log(s) could not be checked; "
                           f"the first: {first.name}: {first.error}")
     if code:
-        click.echo("changed on purpose? accept it with: sgtool golden check --dir "
-                   f"{folder} --update", err=True)
+        again = _same_check(folder, names, every=every, classifier=classifier,
+                            min_points=min_points, voxel_size=voxel_size,
+                            max_frames=max_frames, tolerance=tolerance or None)
+        click.echo(f"changed on purpose? accept it with: sgtool golden check {again} "
+                   "--update", err=True)
         raise click.exceptions.Exit(code)
+
+
+def _same_check(folder: str, names: tuple[str, ...], **given: Any) -> str:
+    """The options of this check as shell words: the folder, the logs, the options set."""
+    return shlex.join(["--dir", folder, *(a for n in names for a in ("--log", n)),
+                       *(a for k, v in given.items() if v is not None
+                         for a in ("--" + k.replace("_", "-"), str(v)))])
 
 
 def _check_report_files(report_md: str | None, junit: str | None) -> None:

@@ -323,3 +323,21 @@ def test_a_link_still_to_the_last_bits_is_static_and_foreign_channels_are_named(
     assert {t.child_frame_id for _, m in got["/tf"] for t in m.transforms} == {"base_link"}
     assert rep.others == ("/chatter",)
     assert "note: not exported, channels sgtool does not know: /chatter" in rep.lines()
+
+
+def test_a_recording_off_time_zero_keeps_its_stamps(tmp_path):
+    """A log whose time starts at 900 s (a recording imported from a bag) exports at its
+    own stamps, to play beside the original; one starting at 0 (simulation) is moved 1 s
+    off stamp 0."""
+    from support.crafted_logs import frame_messages
+
+    log = tmp_path / "imported.mcap"
+    with LogWriter(log, seed=1) as w:
+        for topic, t, msg in frame_messages():
+            w.write_proto(topic, t + 900_000_000_000, msg)
+    rep = export_bag(log, tmp_path / "o.bag", topics=["/camera/depth"])
+    stamps = [t for t, _ in read_bag(tmp_path / "o.bag")["/camera/depth/image_raw"]]
+    assert stamps[0] == 900_000_000_000 and rep.time_base_s == 0.0
+    at_zero = log_with_rooms(tmp_path / "d.mcap")
+    rep = export_bag(at_zero, tmp_path / "z.bag", topics=["/camera/depth"])
+    assert rep.time_base_s == 1.0

@@ -37,3 +37,17 @@ def test_layout_names_topics_of_a_derived_log(tmp_path):
     assert "/map/graph" in panel_topics(layout)
     r = CliRunner().invoke(cli, ["export", "foxglove-layout", "-o", str(out)])
     assert r.exit_code == 2 and "--force" in r.output
+
+
+def test_the_3d_panel_follows_a_frame_the_log_has(tmp_path):
+    """base by default (simulated and closed-loop logs); camera for an imported recording,
+    whose /tf has world -> camera only."""
+    out = tmp_path / "layout.json"
+    for args, frame in (([], "base"), (["--follow", "camera"], "camera")):
+        r = CliRunner().invoke(cli, ["export", "foxglove-layout", "-o", str(out), "--force",
+                                     *args])
+        assert r.exit_code == 0, r.output
+        assert json.loads(out.read_text())["configById"]["3D!sgtool"]["followTf"] == frame
+    r = CliRunner().invoke(cli, ["export", "foxglove-layout", "-o", str(out), "--force",
+                                 "--follow", "base_link"])
+    assert r.exit_code == 2 and "--follow 'base_link': one of base, camera, world" in r.output
