@@ -54,15 +54,14 @@ import math
 import os
 import sys
 import time
-from collections import OrderedDict
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from sgtool.analysis.bench_cache import cached_house, cached_planner
 from sgtool.analysis.bench_houses import (
     BenchHouse,
-    bench_episodes,
     generated_houses,
     load_house_files,
     output_path,
@@ -303,54 +302,6 @@ class BenchResult:
 # ----------------------------------------------------------------------------------------
 # one worker task: one house, one planner, every seed and episode
 # ----------------------------------------------------------------------------------------
-# a house and its episodes, by everything they depend on: the draw of ``bench_episodes``
-# depends on how many episodes are drawn, so N episodes are not the first N of a larger draw
-_HOUSES: OrderedDict[tuple[str, str, tuple[int, int], str, int], Any] = OrderedDict()
-_PLANNERS: dict[tuple[str, str], Any] = {}
-_PLANNERS_RUN: list[str] = [""]  # the run the cached planners were built for
-
-
-def _house(ref: BenchHouse, rooms: tuple[int, int], episodes: int,
-           preset: str = "default") -> tuple[Any, list[Any]]:
-    from sgtool.recorders.symbolic_environment.house import SymbolicHouse
-
-    key = (ref.id, ref.source, rooms, preset, episodes)
-    hit = _HOUSES.get(key)
-    if hit is not None:
-        _HOUSES.move_to_end(key)
-        return hit
-    spec = ref.load(rooms, preset)
-    # the preset's episode mix (furniture-level targets) is for generated houses; a given
-    # house file is searched for its small objects, as list_episodes lists them
-    mix = preset if ref.spec is None else "default"
-    entry = (SymbolicHouse(spec), bench_episodes(spec, episodes, mix))
-    _HOUSES[key] = entry
-    while len(_HOUSES) > 3:
-        _HOUSES.popitem(last=False)
-    return entry
-
-
-def cached_planner(name: str, options: Mapping[str, Any], run: str = "") -> Any:
-    """The planner ``make_planner(name, **options)`` builds, built once per run (``run``:
-    the run's token; the planners of another run are dropped first, so a plug-in class
-    redefined or reloaded between runs, or a plug-in's own state, never carries into the
-    next) for each name and options (compared by type and repr) and handed out again
-    after; a bad name or option raises as
-    :func:`~sgtool.planning.registry.make_planner` does."""
-    from sgtool.planning.registry import make_planner
-
-    if run != _PLANNERS_RUN[0]:
-        _PLANNERS.clear()
-        _PLANNERS_RUN[0] = run
-    key = (name, json.dumps({k: [type(v).__name__, repr(v)] for k, v in
-                             sorted(options.items())}))
-    p = _PLANNERS.get(key)
-    if p is None:
-        p = make_planner(name, **dict(options))
-        _PLANNERS[key] = p
-    return p
-
-
 def run_task(args: tuple[BenchConfig, BenchHouse, tuple[str, ...]]
              | tuple[BenchConfig, BenchHouse, tuple[str, ...], str]) -> list[EpisodeResult]:
     """Every episode and seed of one house for each of the given planners (the ``args`` of a
@@ -383,7 +334,7 @@ def _task_episodes(cfg: BenchConfig, ref: BenchHouse, names: tuple[str, ...],
     from sgtool.recorders.symbolic_environment.rollout import run_episode
     from sgtool.semantics.text import category_text
 
-    house, episodes = _house(ref, cfg.rooms, cfg.episodes, cfg.preset)
+    house, episodes = cached_house(ref, cfg.rooms, cfg.episodes, cfg.preset)
     vocabulary = training_vocabulary(cfg.priors_dir)
     out = []
     for name in names:
@@ -412,7 +363,7 @@ def _task_episodes(cfg: BenchConfig, ref: BenchHouse, names: tuple[str, ...],
 def bench_tasks(cfg: BenchConfig, houses: Sequence[BenchHouse], run: str = "") -> list[Task]:
     """The run's tasks, grouped by house: all planners of a house in one task, or, when
     there are fewer houses than workers, the house's planners cut into that many runs;
-    ``run``: the run's token (:func:`cached_planner`)."""
+    ``run``: the run's token (:func:`~sgtool.analysis.bench_cache.cached_planner`)."""
     groups = -(-cfg.workers // max(1, len(houses)))  # ceil(workers / houses)
     return [Task(f"{h.id}/{'+'.join(names)}", (cfg, h, names, run))
             for h in houses for names in chunks(cfg.planners, groups)]

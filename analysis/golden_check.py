@@ -206,6 +206,11 @@ def pin_logs(logs: Sequence[str | Path], folder: str | Path,
                         shutil.copyfile(p, tmp)
             pin = pinned_entry(name, p, stored, opts, o.value, why)
             write_capture(staged, pin, o.value)
+            was = old.get(name)
+            copied = out / f"{name}.mcap"  # a copy pinned before, not the log pinned now
+            if was is not None and was.log == copied.name and stored != copied.name and \
+                    copied.is_file() and copied.resolve() != p.resolve():
+                copied.unlink()
             logs_now[name] = pin
         write_index(staged)
     return PinSet(root, logs_now, sgtool_version=__version__)

@@ -36,7 +36,7 @@ def test_tasks_are_grouped_by_house_and_split_when_workers_outnumber_houses():
 
 @pytest.fixture
 def house_one_breaks(monkeypatch):
-    real = bench._house
+    real = bench.cached_house
     calls: list[str] = []
 
     def flaky(ref, *a, **kw):
@@ -45,7 +45,7 @@ def house_one_breaks(monkeypatch):
             raise RuntimeError("the house fell down")
         return real(ref, *a, **kw)
 
-    monkeypatch.setattr(bench, "_house", flaky)
+    monkeypatch.setattr(bench, "cached_house", flaky)
     return calls
 
 

@@ -364,3 +364,14 @@ def test_a_pin_name_must_stay_in_its_folder(pinned, tmp_path, capsys):
     code, _, err = sgtool(capsys, "golden", "check", "--dir", pinned, "--update")
     assert code == 2 and "a pin name is a file name" in err
     assert not (tmp_path / "escape").exists()
+
+
+def test_pinning_elsewhere_drops_the_copy_pinned_before(pinned, log, tmp_path, capsys):
+    """A log pinned with --copy, then pinned again from outside the folder: the old copy
+    goes, and the pin names the log given."""
+    assert (pinned / "small.mcap").is_file()
+    assert sgtool(capsys, "golden", "pin", log, "--dir", pinned, *FRAMES)[0] == 0
+    assert not (pinned / "small.mcap").exists()
+    assert (pinned / read_pins(pinned).logs["small"].log).resolve() == log.resolve()
+    code, out, _ = sgtool(capsys, "golden", "check", "--dir", pinned)
+    assert code == 0, out

@@ -1,0 +1,31 @@
+"""The caches of a bench worker: planners per run, also for runs in two threads."""
+
+from __future__ import annotations
+
+import threading
+
+from sgtool.analysis.bench_cache import cached_planner
+
+
+def test_a_run_builds_each_planner_once_and_the_next_run_afresh():
+    a = cached_planner("scout", {}, "run-a")
+    assert cached_planner("scout", {}, "run-a") is a
+    assert cached_planner("scout", {"delta": 0.2}, "run-a") is not a
+    assert cached_planner("scout", {}, "run-b") is not a
+
+
+def test_runs_in_two_threads_keep_their_own_planners():
+    seen: dict[str, list[object]] = {"x": [], "y": []}
+
+    def work(run: str) -> None:
+        for _ in range(50):
+            seen[run].append(cached_planner("greedy", {}, run))
+
+    threads = [threading.Thread(target=work, args=(r,)) for r in ("x", "y")]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    # each run saw one planner throughout, and not the other run's
+    assert len({id(p) for p in seen["x"]}) == 1 and len({id(p) for p in seen["y"]}) == 1
+    assert seen["x"][0] is not seen["y"][0]
