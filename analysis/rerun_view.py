@@ -232,7 +232,11 @@ class RobotPath:
     def add(self, fr: Frame) -> tuple[float, float, float] | None:
         """The frame's base position (the camera's without a base pose), appended to the
         path; None when /tf does not give it."""
-        base = fr.base_pose if fr.base_pose is not None else fr.pose
+        return self.add_pose(fr.base_pose if fr.base_pose is not None else fr.pose)
+
+    def add_pose(self, base: np.ndarray) -> tuple[float, float, float] | None:
+        """The position of the pose ``base`` (world_T_frame), appended to the path; None
+        when it is not finite."""
         if not np.all(np.isfinite(base)):
             return None
         here = (float(base[0, 3]), float(base[1, 3]), 0.02)
@@ -306,6 +310,11 @@ def _export(
             stamp(fr.index, fr.time_ns)
             log_camera(rec, fr)
             path.log(rec, here)
+    elif r.has(S.TF):  # a trajectory without frames (`sgtool import bag` without --depth)
+        for d in r.messages([S.TF]):
+            if d.message.parent_frame_id == S.WORLD_FRAME:
+                stamp(None, d.log_time_ns)
+                path.log(rec, path.add_pose(codec.decode_transform(d.message)))
     # voxel map over time (computed by the caller)
     if voxels is not None:
         for idx, t_ns, centres, cols, size in voxels(r):

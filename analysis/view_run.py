@@ -66,6 +66,8 @@ def _voxel_source(request: ViewRequest) -> Callable[[Any], Any] | None:
         return None
 
     def voxel_source(reader: Any) -> Any:
+        if not reader.has("/camera/depth"):  # a trajectory: nothing to map
+            return iter(())
         return voxel_snapshots(reader, every=max(request.every, 10),
                                max_frames=request.max_frames)
     return voxel_source

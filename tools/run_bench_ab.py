@@ -15,6 +15,9 @@ Episode record, the rooms of the house from the log's ``house.json`` attachment.
         --preset symsearch --resolution 96x72 -o A --explore-on 0
     sgtool run-bench ... -o B --explore-on 3
     .venv/bin/python tools/run_bench_ab.py A B --budgets 50,80 --reference random
+
+Folders of several noise profiles are compared one profile at a time (``--noise NAME``,
+the profile's name as the episode rows record it).
 """
 
 from __future__ import annotations
@@ -46,14 +49,24 @@ def _frames_per_room(r: EpisodeResult) -> float | None:
     return frames / rooms
 
 
-def load(folder: Path) -> tuple[list[EpisodeResult],
-                                dict[tuple[str, int, str, int], float] | None]:
-    """The episodes of a run-bench folder and their frames per room (by result key; None
-    when some episode's log is not there)."""
+def load(folder: Path, noise: str | None = None
+         ) -> tuple[list[EpisodeResult], dict[tuple[str, int, str, int], float] | None]:
+    """The episodes of a run-bench folder (those of the noise profile ``noise`` when
+    given; a folder of several profiles needs it) and their frames per room (by result
+    key; None when some episode's log is not there)."""
     path = folder / "episodes.jsonl"
     if not path.is_file():
         raise SgtoolError(f"{folder}: no episodes.jsonl (not a finished run-bench folder)")
     results = list(read_jsonl(path))
+    profiles = sorted({r.noise for r in results})
+    if noise is not None:
+        results = [r for r in results if r.noise == noise]
+        if not results:
+            raise SgtoolError(f"{folder}: no episode of noise {noise!r} (it has "
+                              f"{', '.join(map(repr, profiles))})")
+    elif len(profiles) > 1:
+        raise SgtoolError(f"{folder}: episodes of several noise profiles "
+                          f"({', '.join(map(repr, profiles))}): give --noise")
     frames = {r.key(): _frames_per_room(r) for r in results}
     if any(v is None for v in frames.values()):
         return results, None
@@ -76,10 +89,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--reference", default="random",
                     help="planner the others are compared with within each run")
     ap.add_argument("--json", type=Path, help="also write the figures here")
+    ap.add_argument("--noise", default=None,
+                    help="the noise profile compared, when the folders ran several")
     args = ap.parse_args(argv)
     try:
         budgets = [float(x) for x in args.budgets.split(",") if x.strip()]
-        (ra, fa), (rb, fb) = load(args.a), load(args.b)
+        (ra, fa), (rb, fb) = load(args.a, args.noise), load(args.b, args.noise)
     except (SgtoolError, ValueError) as e:
         print(f"run_bench_ab: {e}", file=sys.stderr)
         return 2

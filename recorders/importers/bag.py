@@ -83,6 +83,7 @@ from sgtool.recorders.importers.sanity import (
     floor_problem,
     timestamp_problem,
 )
+from sgtool.recorders.importers.scale_check import pose_motion_problem
 from sgtool.recorders.importers.sink import (
     IMPORT_METADATA,
     ImportReport,
@@ -151,6 +152,9 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
             fit = bag_scale_fit(reader, idx, opts, src, k)
             if fit is not None:
                 checks.append(("depth scale against the poses", fit.describe()))
+            motion = pose_motion_problem(fit, src.describe)
+            if motion is not None:
+                findings.problem(motion[0], given=estimate or not motion[1])
             findings.problem(bag_scale_problem(fit, opts, src, _scale_origin(idx, opts)[1]),
                              given=opts.depth_scale is not None)
         plan, notes = plan_frames(idx, src, opts, keep_unposed=estimate)

@@ -39,6 +39,7 @@ class BagIndex:
     tf: TfTree = field(default_factory=TfTree)
     pose_samples: list[tuple[int, np.ndarray]] = field(default_factory=list)
     pose_frame: str = ""
+    pose_child: str = ""  # the frame a --pose topic's messages give the pose of ("": unsaid)
     info: tuple[int, int, float, float, float, float] | None = None
     distortion: tuple[str, tuple[float, ...]] | None = None  # of the first CameraInfo
     info_changes: int = 0
@@ -86,6 +87,8 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
                 t, parent, T = pose_of_message(msg, mt, c.topic)  # noqa: N806
                 idx.pose_samples.append((t, T))
                 idx.pose_frame = idx.pose_frame or parent
+                idx.pose_child = idx.pose_child or frame_name(
+                    str(getattr(msg, "child_frame_id", "") or ""))
                 continue
             if c.topic == opts.info:
                 k = intrinsics_of_info(msg)

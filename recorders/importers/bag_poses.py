@@ -19,19 +19,27 @@ from sgtool.recorders.importers.tftree import TfTree, frame_name
 
 @dataclass(frozen=True)
 class PoseSource:
-    """world_T_camera at a time, from the tf ``tree`` or a pose ``track`` (one of them)."""
+    """world_T_camera at a time, from the tf ``tree`` or a pose ``track`` (one of them), or
+    a track of the frame ``mounted_on`` (a robot's odometry) carried to the camera by the
+    tree."""
 
     world: str  # frame name
-    camera: str  # frame name ("camera" for a pose topic)
+    camera: str  # frame name ("camera" for a pose topic of the camera itself)
     describe: str  # for notes, errors and the log metadata
     tree: TfTree | None = None
     track: PoseTrack | None = None
+    mounted_on: str = ""  # the frame the track gives the pose of, when not the camera's
 
     def at(self, t_ns: int, camera: str | None = None) -> np.ndarray | None:
         """The pose at ``t_ns`` (of frame ``camera`` instead of the source's, in a tree);
         None where it cannot be resolved."""
         if self.track is not None:
-            return self.track.at(t_ns)
+            pose = self.track.at(t_ns)
+            if pose is None or not self.mounted_on:
+                return pose
+            assert self.tree is not None
+            mount = self.tree.lookup(self.mounted_on, camera or self.camera, t_ns)
+            return None if mount is None else pose @ mount
         assert self.tree is not None
         return self.tree.lookup(self.world, camera or self.camera, t_ns)
 
@@ -42,8 +50,19 @@ def pose_source_of(path: Path, idx: BagIndex, opts: BagOptions) -> PoseSource:
             raise SgtoolError(f"{path}: --pose {opts.pose} has no messages")
         track = PoseTrack.from_samples(idx.pose_samples, max_gap_ns=opts.tf_max_gap_ns,
                                        tolerance_ns=opts.tf_tolerance_ns)
-        return PoseSource(idx.pose_frame or "world", "camera",
-                           f"topic {opts.pose} ({len(track)} poses)", track=track)
+        what = f"topic {opts.pose} ({len(track)} poses)"
+        child, cam = idx.pose_child, (idx.depth.frames[0] if idx.depth.frames else "")
+        if not child or not cam or child == cam:
+            return PoseSource(idx.pose_frame or "world", "camera", what, track=track)
+        if child not in idx.tf.frames() or cam not in idx.tf.frames() or \
+                idx.tf.path(child, cam) is None:
+            raise SgtoolError(
+                f"{path}: --pose {opts.pose} gives the pose of frame {child!r}, the depth "
+                f"images are in frame {cam!r}, and /tf does not link the two; give "
+                f"--tf-frames WORLD:{cam} to take the camera's pose from /tf, or a pose "
+                "topic of the camera")
+        return PoseSource(idx.pose_frame or "world", cam, f"{what}, of {child} -> {cam} "
+                          "by /tf", tree=idx.tf, track=track, mounted_on=child)
     tree = idx.tf
     if not tree.links:
         raise SgtoolError(f"{path}: no transforms on /tf or /tf_static; give --pose TOPIC")

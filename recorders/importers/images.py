@@ -107,6 +107,12 @@ def read_depth_file(path: Path) -> np.ndarray:
     """A 16-bit depth image file (PNG/TIFF) -> its raw uint16 values (units per the
     dataset's depth scale)."""
     a = _read_image(path)
+    if a.ndim == 2 and a.dtype.kind == "f":
+        raise SgtoolError(
+            f"{path}: a depth image file must be single-channel 16-bit, this one is "
+            f"{a.dtype} (depth in metres?); write it as 16-bit millimetres "
+            "(uint16(round(depth_m * 1000))) and give --depth-scale 1000 (float depth is "
+            "read from bags, 32FC1)")
     if a.ndim != 2 or a.dtype != np.uint16:
         raise SgtoolError(
             f"{path}: a depth image must be single-channel 16-bit, this one is "

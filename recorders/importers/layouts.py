@@ -217,7 +217,7 @@ def read_sequence(
         seq = _read_tum(root, max_dt_ns, trajectory, keep_unposed, timestamps, fps,
                         skip_missing)
     elif layout == "7scenes":
-        seq = _read_7scenes(root, fps, trajectory, skip_missing)
+        seq = _read_7scenes(root, fps, trajectory, skip_missing, keep_unposed)
     elif layout == "open3d":
         seq = _read_open3d(root, fps, trajectory)
     else:  # pragma: no cover - missing_for_layout refuses unknown layouts
@@ -279,7 +279,15 @@ def _read_tum(
         what = str(root / name)
         problem = (time_range_problem([t for t, _ in rows], what)
                    or timestamp_problem([t for t, _ in rows], what))
-        if problem:
+        in_order = sorted(rows)
+        if problem and in_order != rows and not timestamp_problem([t for t, _ in in_order],
+                                                                  what):
+            # times of frames listed out of order: TUM associates by time, so sort them
+            back = sum(b[0] < a[0] for a, b in zip(rows, rows[1:], strict=False))
+            notes.append(f"{name} lists its images out of time order ({back} step"
+                         f"{'s' if back > 1 else ''} back): read in time order")
+            rows[:] = in_order
+        elif problem:
             raise SgtoolError(problem)
     gt_path = trajectory or (root / "groundtruth.txt")
     if trajectory is not None and is_open3d_log(trajectory):
@@ -391,7 +399,10 @@ def _seven_missing(root: Path, by_id: dict[int, dict[str, Path]],
 
 
 def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
-                  skip_missing: bool = False) -> FolderSequence:
+                  skip_missing: bool = False, keep_unposed: bool = False) -> FolderSequence:
+    """Frames ``frame-XXXXXX.*`` in id order; frames without a pose.txt (when others have
+    one) are kept to be estimated (``keep_unposed``) or left out and counted as dropped,
+    as a TUM ground truth that does not cover them."""
     by_id: dict[int, dict[str, Path]] = {}
     for p in root.iterdir():
         m = _SEVEN.match(p.name)
@@ -413,10 +424,17 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
         intr = replace(read_intrinsics_file(root / "camera-intrinsics.txt"),
                        source="file camera-intrinsics.txt")
     posed = sum(f.pose is not None for f in frames)
+    dropped = 0
     if 0 < posed < len(frames):
-        raise SgtoolError(f"{root}: {len(frames) - posed} of {len(frames)} frames have no pose.txt")
+        first = next(f.depth_path.name for f in frames if f.pose is None)
+        notes.append(f"{len(frames) - posed} of {len(frames)} frames have no pose.txt "
+                     f"(first: {first})")
+        if not keep_unposed:
+            dropped = len(frames) - posed
+            frames = [f for f in frames if f.pose is not None]
     kind = "trajectory" if trajectory else ("ground truth" if posed else "none")
-    return FolderSequence("7scenes", root, tuple(frames), intr, 1000.0, kind, tuple(notes))
+    return FolderSequence("7scenes", root, tuple(frames), intr, 1000.0, kind, tuple(notes),
+                          dropped=dropped)
 
 
 def _external_poses(trajectory: Path | None, count: int,
@@ -450,10 +468,18 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None) -> FolderSeque
     depths = _images(root / "depth")
     colors = _images(cdir) if cdir is not None else []
     by_stem = {p.stem: p for p in colors}
-    if all(d.stem in by_stem for d in depths):
-        pairs = [(d, by_stem[d.stem]) for d in depths]
+    pairs: list[tuple[Path, Path | None]]
+    notes: list[str] = []
+    matched = sum(d.stem in by_stem for d in depths)
+    if matched or not colors:  # one naming scheme: by name, a depth image may lack colour
+        pairs = [(d, by_stem.get(d.stem)) for d in depths]
+        if matched < len(depths):
+            first = next(d for d in depths if d.stem not in by_stem)
+            notes.append(f"{len(depths) - matched} depth images have no colour image of "
+                         f"their name (first: {first.relative_to(root)})")
     elif len(colors) == len(depths):
         pairs = list(zip(depths, colors, strict=True))
+        notes.append("depth and colour images paired in order (their names differ)")
     else:
         raise SgtoolError(
             f"{root}: {len(depths)} depth and {len(colors)} colour images with different "
@@ -489,5 +515,5 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None) -> FolderSeque
     return FolderSequence(
         "open3d", root, frames, intr or PRIMESENSE_INTRINSICS, 1000.0,
         "trajectory" if poses is not None else "none",
-        (f"poses from {traj.name}",) if traj is not None else (),
+        ((f"poses from {traj.name}",) if traj is not None else ()) + tuple(notes),
     )

@@ -76,6 +76,7 @@ from sgtool.recorders.importers.scale_check import (
     fit_scale,
     geometric_scale_problem,
     pair_indices,
+    pose_motion_problem,
 )
 from sgtool.recorders.importers.sink import (
     ImportFrame,
@@ -243,14 +244,19 @@ def run_odometry(
 
 def check_scale_by_geometry(frames: list[FolderFrame], k: CameraIntrinsics, scale: float,
                             origin: str, pose_source: str, findings: Findings,
-                            given: bool) -> ScaleFit | None:
-    """The depth scale against the metric poses (:mod:`.scale_check`), on a few pairs of
-    nearby frames, before any heavy work; the fit (None without a usable pair)."""
+                            given: bool, estimate: bool = False) -> ScaleFit | None:
+    r"""The depth scale against the metric poses (:mod:`.scale_check`), on a few pairs of
+    nearby frames, before any heavy work; the fit (None without a usable pair). Poses
+    the depth does not follow are an error when clear, else a warning (a warning only
+    when the poses are to be ``estimate``\ d anyway)."""
     poses = [np.asarray(f.pose) for f in frames]
     pairs = [(depth_to_metres(read_depth_file(frames[i].depth_path), scale),
               depth_to_metres(read_depth_file(frames[j].depth_path), scale), poses[i], poses[j])
              for i, j in pair_indices(poses)]
     fit = fit_scale(pairs, k)
+    motion = pose_motion_problem(fit, pose_source)
+    if motion is not None:
+        findings.problem(motion[0], given=estimate or not motion[1])
     findings.problem(geometric_scale_problem(fit, scale, origin, pose_source), given=given)
     return fit
 
@@ -292,7 +298,8 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     checks: list[tuple[str, str]] = []
     if seq.pose_source != "none" and all(f.pose is not None for f in frames):
         fit = check_scale_by_geometry(frames, k, scale, scale_origin, seq.pose_source,
-                                      findings, given=opts.depth_scale is not None)
+                                      findings, given=opts.depth_scale is not None,
+                                      estimate=opts.estimate_poses)
         checks.append(("depth scale against the poses",
                        fit.describe() if fit else "no verdict: no frame pair pins the motion down"))
     intr_origin = "flag --intrinsics" if opts.intrinsics is not None else \

@@ -113,11 +113,11 @@ def fit_scale(pairs: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarr
     """The fit over ``(depth_i, depth_j, pose_i, pose_j)`` (depth in metres at the scale
     checked; world_T_camera poses): :func:`translation_scale` per pair, pairs matched under
     :data:`MIN_MATCHED` or moving under :data:`MIN_ALONG_M` along the surfaces' normals
-    left out, the rest combined weighted by that motion; None without a usable pair."""
+    (or of one depth image twice) left out, the rest combined weighted by that motion; None without a usable pair."""
     ratios, weights = [], []
     for d0, d1, p0, p1 in pairs:
         rel = np.linalg.inv(p0) @ p1  # camera j in camera i
-        if float(np.linalg.norm(rel[:3, 3])) < MIN_STEP_M:
+        if float(np.linalg.norm(rel[:3, 3])) < MIN_STEP_M or _same_image(d0, d1):
             continue
         got = translation_scale(d0, d1, k, rel)
         if got is None or got[1] < MIN_MATCHED or got[2] < MIN_ALONG_M:
@@ -129,6 +129,12 @@ def fit_scale(pairs: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarr
     r = float(np.average(ratios, weights=weights))
     spread = max(abs(x / r - 1.0) for x in ratios) if r > 0 else float("inf")
     return ScaleFit(r, len(ratios), spread)
+
+
+def _same_image(d0: np.ndarray, d1: np.ndarray) -> bool:
+    """Whether two depth images are one image (a sensor that repeats its frame, a test's
+    fixture): their motion says nothing about the poses'."""
+    return d0.shape == d1.shape and bool(np.array_equal(d0, d1))
 
 
 def snap_scale(value: float) -> float:
@@ -152,3 +158,26 @@ def geometric_scale_problem(fit: ScaleFit | None, scale: float, origin: str,
             f"between {fit.pairs} pairs of nearby frames the depth geometry moves "
             f"{fit.ratio:.2f}x as far as the poses (the poses' translation fitted to the depth); "
             f"--depth-scale {fits:g} fits; give it, or --depth-scale {scale:g} to keep this one")
+
+
+MIN_RATIO = 0.2  # a depth that moves less than this far (either way) gives no verdict
+
+
+def pose_motion_problem(fit: ScaleFit | None, pose_source: str) -> tuple[str, bool] | None:
+    """When the depth does not move as the poses (``pose_source``) say, at any one scale,
+    over two or more pairs: it moves against them (a ratio below -:data:`MIN_RATIO`: clear)
+    or the pairs' ratios spread beyond 35 % (likely). The text and whether it is clear;
+    None otherwise: a depth that hardly moves (a scene that does not pin the motion down)
+    gives no verdict, and a ratio of 20 or more is the depth scale's problem."""
+    if fit is None or fit.pairs < 2 or fit.consistent() or fit.ratio >= 20.0 or \
+            abs(fit.ratio) <= MIN_RATIO:
+        return None
+    clear = fit.ratio < 0
+    how = (f"moves {fit.ratio:.2f}x as far as the poses" if clear else
+           f"moves {fit.ratio:.2f}x as far as the poses, pair by pair up to "
+           f"{fit.spread:.0%} apart")
+    return (f"the poses ({pose_source}) do not move as the depth does: between {fit.pairs} "
+            f"pairs of nearby frames the depth {how}; poses in another convention are the "
+            "usual cause (world-to-camera instead of camera-to-world, a quaternion order "
+            "other than x y z w, the pose of a frame other than the camera's optical one): "
+            "fix them, or give --estimate-poses to estimate the poses from the depth"), clear

@@ -178,3 +178,25 @@ def test_path_pieces_with_every(tmp_path, monkeypatch):
     assert sorted(xs) == [f"world/robot/path/{k}" for k in range(4)]
     assert xs["world/robot/path/0"] == [0.0, 0.05, 0.1, 0.15]
     assert xs["world/robot/path/2"] == [0.3, 0.35, 0.4, 0.45]
+
+
+def test_view_of_a_trajectory_without_frames_draws_its_path(tmp_path):
+    """`sgtool import bag` without --depth writes /tf world -> camera only: the view draws
+    the path (no voxel map to build, no camera images)."""
+    from sgtool.log import LogWriter, codec
+    from sgtool.log import schemas as S
+
+    log = tmp_path / "trajectory.mcap"
+    with LogWriter(log, seed=1) as w:
+        for i in range(5):
+            pose = np.eye(4)
+            pose[0, 3] = 0.5 * i
+            t = i * 100_000_000
+            w.write_proto(S.TF, t, codec.encode_transform(t, S.WORLD_FRAME, S.CAMERA_FRAME,
+                                                          pose))
+    out = tmp_path / "t.rrd"
+    r = CliRunner().invoke(cli, ["view", str(log), "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    rrd_verify(out)
+    printed = rrd_print(out)
+    assert "world/robot/path/0" in printed and "world/robot " in printed.replace("\n", " ")

@@ -117,7 +117,8 @@ _common_options = option_group([
                  "or a 3x3 matrix as text); overrides what the source says."),
     click.option("--depth-scale", type=float, default=None,
                  help="Raw depth units per metre (default: 16-bit depth 1000 for bags "
-                 "and 7-Scenes/Open3D, 5000 for TUM; 32FC1 float depth 1, metres)."),
+                 "and 7-Scenes/Open3D, 5000 for TUM; a bag's 32FC1 float depth 1, metres; "
+                 "depth image files are 16-bit)."),
     click.option("--max-dt", type=float, default=0.02, show_default=True,
                  help="Largest time difference (s, at most 60) when pairing colour (and ids) "
                  "with a depth image. Colour of another size than the depth is resized to it "
@@ -173,7 +174,8 @@ def command() -> None:
               "import the trajectory of CAMERA in WORLD.")
 @click.option("--pose", help="Pose topic (PoseStamped, PoseWithCovarianceStamped, "
               "TransformStamped, Odometry) giving the camera's optical frame in the world, "
-              "instead of tf.")
+              "instead of tf; a topic whose messages name another child frame (an "
+              "odometry's base_link) is carried to the depth images' frame by /tf.")
 @click.option("--timestamps", type=click.Choice(["header", "bag"]), default="header",
               show_default=True,
               help="Image times: the header stamps (checked: distinct, a camera's rate), or the "

@@ -342,6 +342,50 @@ def test_pose_topic_instead_of_tf_with_every_and_limit(tmp_path):
         assert np.array_equal(g.depth, f.depth)
 
 
+def test_a_pose_topic_of_the_robot_base_is_carried_to_the_camera(tmp_path):
+    """A robot's odometry (map -> base_link, TransformStamped) as --pose, the camera
+    mounted on the base by /tf_static: the camera's pose is the base's times the mount,
+    not the base's; without the mount in /tf the import refuses in one line."""
+    src = write_sgtool_log(tmp_path / "src.mcap", n=6)
+    mount = pose_from_tq(np.array([0.1, 0.0, 1.0]), np.array([-0.5, 0.5, -0.5, 0.5]))
+    with LogReader(src) as r:
+        frames = list(r.frames())
+    k = frames[0].intrinsics
+    from sgtool.recorders.importers.textformats import PinholeParams
+
+    opts = dict(depth=TOPICS["depth"], pose="/odom",
+                intrinsics=PinholeParams(k.fx, k.fy, k.cx, k.cy), **KEEP_WORLD)
+    for static in (True, False):
+        bag = bag_path(tmp_path, "ros2-sqlite3", f"b{static}")
+        with BagWriter(bag, "ros2-sqlite3") as w:
+            t0 = frames[0].time_ns
+            if static:
+                w.write("/tf_static", "tf2_msgs/msg/TFMessage", t0,
+                        w.tf(t0, [w.transform_stamped(t0, "base_link", "cam", mount)]))
+            for f in frames:
+                t = f.time_ns
+                w.write("/odom", "geometry_msgs/msg/TransformStamped", t,
+                        w.transform_stamped(t, "map", "base_link",
+                                            f.pose @ np.linalg.inv(mount)))
+                w.write(TOPICS["depth"], "sensor_msgs/msg/Image", t,
+                        w.image(t, "cam", (f.depth * 1000).round().astype(np.uint16), "16UC1"))
+        out = tmp_path / f"o{static}.mcap"
+        if not static:
+            with pytest.raises(SgtoolError, match=r"--pose /odom gives the pose of frame "
+                               r"'base_link', the depth images are in frame 'cam', and /tf "
+                               r"does not link the two; give --tf-frames WORLD:cam"):
+                import_bag(bag, out, BagOptions(**opts))
+            assert not out.exists()
+            continue
+        rep = import_bag(bag, out, BagOptions(**opts))
+        assert rep.pose_source == "topic /odom (6 poses), of base_link -> cam by /tf"
+        with LogReader(out) as r:
+            got = list(r.frames())
+        assert len(got) == 6
+        for g, f in zip(got, frames, strict=True):
+            assert pose_difference(g.pose, f.pose)[0] < 1e-6
+
+
 def test_bag_poses_estimated_by_odometry(shared_data_dir, tmp_path):
     """Six real ICL-NUIM frames as a ROS 2 bag: with tf and --estimate-poses the drift
     against the bag's tf is reported; without tf (a camera recorded alone) the poses are

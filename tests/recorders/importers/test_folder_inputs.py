@@ -373,3 +373,49 @@ def test_a_trajectory_file_is_read_by_its_content_not_only_its_suffix(tmp_path) 
     tum.write_text("# timestamp tx ty tz qx qy qz qw\n1.0 0 0 0 0 0 0 1\n")
     assert is_open3d_log(o3d) and not is_open3d_log(tum)
     assert not is_open3d_log(tmp_path / "traj.txt") and not is_open3d_log(tmp_path / "x.log")
+
+
+def test_open3d_pairs_by_name_when_one_name_has_no_partner(tmp_path):
+    """A lab that dropped bad frames: depth 00020 and colour 00040 gone; each depth image
+    keeps the colour image of its name (not its neighbour's by list position), the one
+    without a colour image is said."""
+    names = [f"{i:05d}" for i in range(0, 60, 10)]
+    root = open3d_folder(tmp_path / "f", names)
+    (root / "depth" / "00020.png").unlink()
+    (root / "image" / "00040.jpg").unlink()
+    write_open3d_log(root / "traj.log", [_pose(float(i)) for i in range(5)])
+    seq = read_sequence(root)
+    assert [(f.depth_path.stem, f.color_path.stem if f.color_path else None)
+            for f in seq.frames] == [("00000", "00000"), ("00010", "00010"),
+                                     ("00030", "00030"), ("00040", None), ("00050", "00050")]
+    assert "1 depth images have no colour image of their name (first: depth/00040.png)" \
+        in seq.notes
+    # names of two schemes: paired in order, and said
+    root = open3d_folder(tmp_path / "g", ["00000", "00001"])
+    for i, p in enumerate(sorted((root / "image").iterdir())):
+        p.rename(root / "image" / f"rgb_{i}.jpg")
+    seq = read_sequence(root)
+    assert [f.color_path.name for f in seq.frames] == ["rgb_0.jpg", "rgb_1.jpg"]
+    assert "depth and colour images paired in order (their names differ)" in seq.notes
+
+
+def test_seven_scenes_frames_without_a_pose_are_named_and_dropped_or_estimated(tmp_path):
+    root = seven_folder(tmp_path / "s", n=4)
+    (root / "frame-000002.pose.txt").unlink()
+    seq = read_sequence(root)
+    assert [f.depth_path.name[:12] for f in seq.frames] == [
+        "frame-000000", "frame-000001", "frame-000003"]
+    assert seq.dropped == 1 and "1 of 4 frames have no pose.txt (first: " \
+        "frame-000002.depth.png)" in seq.notes
+    kept = read_sequence(root, keep_unposed=True)  # --estimate-poses
+    assert len(kept.frames) == 4 and kept.dropped == 0 and kept.frames[2].pose is None
+
+
+def test_float_depth_files_say_how_to_convert_them(tmp_path):
+    from sgtool.recorders.importers.images import read_depth_file
+
+    p = tmp_path / "d.tiff"
+    cv2.imwrite(str(p), np.full((H, W), 1.5, np.float32))
+    with pytest.raises(SgtoolError, match=r"float32 \(depth in metres\?\); write it as 16-bit "
+                       r"millimetres .* --depth-scale 1000"):
+        read_depth_file(p)

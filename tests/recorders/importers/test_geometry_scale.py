@@ -115,3 +115,53 @@ def test_real_icl_pixels_in_tenth_millimetres_name_10000(shared_data_dir, tmp_pa
     rep = import_rgbd(root, tmp_path / "b.mcap", RgbdOptions(intrinsics=k, progress=False,
                                                              depth_scale=10000.0))
     assert rep.frames == 40 and rep.warnings == ()
+
+
+def _rewrite_ground_truth(root, change):
+    lines = (root / "groundtruth.txt").read_text().splitlines()
+    out = [lines[0]]
+    for line in lines[1:]:
+        t, *v = line.split()
+        out.append(" ".join([t, *change([float(x) for x in v])]))
+    (root / "groundtruth.txt").write_text("\n".join(out) + "\n")
+
+
+def test_poses_in_another_convention_are_caught(tmp_path):
+    """A ground truth written world-to-camera: between nearby frames the depth moves
+    against the poses (the scale check's fit is negative), so the import refuses in one
+    line naming the usual causes; with --estimate-poses (the ground truth only measures
+    the drift) it is a warning."""
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    def inverted(v):
+        m = np.eye(4)
+        m[:3, :3] = Rotation.from_quat(v[3:]).as_matrix()
+        m[:3, 3] = v[:3]
+        inv = np.linalg.inv(m)
+        return [f"{x:.9f}" for x in (*inv[:3, 3], *Rotation.from_matrix(inv[:3, :3]).as_quat())]
+
+    root = make_scene_folder(tmp_path / "inv", room(), POSES, units_per_m=5000.0)
+    _rewrite_ground_truth(root, inverted)
+    with pytest.raises(SgtoolError, match=r"the poses \(ground truth\) do not move as the "
+                       r"depth does: between 6 pairs .* moves -1\.\d\dx as far as the poses; "
+                       r".*world-to-camera instead of camera-to-world.*--estimate-poses"):
+        import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
+    assert not (tmp_path / "a.mcap").exists()
+    rep = import_rgbd(root, tmp_path / "est.mcap",
+                      RgbdOptions(intrinsics=K, progress=False, estimate_poses=True))
+    assert rep.frames == 20 and any("do not move as the depth does" in w for w in rep.warnings)
+
+
+def test_pose_motion_problem_needs_a_clear_disagreement():
+    from sgtool.recorders.importers.scale_check import pose_motion_problem
+
+    assert pose_motion_problem(None, "gt") is None
+    assert pose_motion_problem(ScaleFit(1.0, 6, 0.05), "gt") is None  # they agree
+    assert pose_motion_problem(ScaleFit(-0.4, 1, float("inf")), "gt") is None  # one pair
+    assert pose_motion_problem(ScaleFit(2.0, 6, 0.1), "gt") is None  # the scale's problem
+    assert pose_motion_problem(ScaleFit(40.0, 6, 0.1), "gt") is None  # the scale's, too
+    text, clear = pose_motion_problem(ScaleFit(-0.4, 5, float("inf")), "gt")
+    assert clear and "-0.40x" in text
+    text, clear = pose_motion_problem(ScaleFit(1.07, 5, 0.65), "gt")
+    assert not clear and "up to 65% apart" in text
