@@ -113,7 +113,8 @@ def fit_scale(pairs: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarr
     """The fit over ``(depth_i, depth_j, pose_i, pose_j)`` (depth in metres at the scale
     checked; world_T_camera poses): :func:`translation_scale` per pair, pairs matched under
     :data:`MIN_MATCHED` or moving under :data:`MIN_ALONG_M` along the surfaces' normals
-    (or of one depth image twice) left out, the rest combined weighted by that motion; None without a usable pair."""
+    (or of one depth image twice) left out, the rest combined weighted by that motion;
+    None without a usable pair."""
     ratios, weights = [], []
     for d0, d1, p0, p1 in pairs:
         rel = np.linalg.inv(p0) @ p1  # camera j in camera i
