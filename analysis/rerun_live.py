@@ -31,12 +31,12 @@ from typing import Any
 import numpy as np
 
 from sgtool.analysis.rerun_view import (
-    APP_ID,
     RobotPath,
     _log_scene_graph,
     _scene_update_strips,
     blueprint,
     log_camera,
+    new_stream,
 )
 from sgtool.errors import SgtoolError
 
@@ -131,7 +131,7 @@ def open_stream(target: LiveTarget, recording_id: str) -> tuple[Any, str | None]
     import rerun as rr
 
     check_target(target)
-    rec = rr.RecordingStream(APP_ID, recording_id=recording_id, send_properties=False)
+    rec = new_stream(recording_id)
     bp = blueprint()
     where = None
     if target.mode == "spawn":

@@ -9,18 +9,26 @@ nothing of sgtool's JSON records; so sgtool logs everything natively with the Re
 - ``world/map/occupancy``: the BEV occupancy grid (``GridMap``);
 - ``world/map/voronoi``: the Voronoi graph coloured by room (``LineStrips3D``);
 - ``world/map/voxels``: the semantic voxel map when the caller passes one per refresh;
-- ``world/graph/rooms|objects|frontiers``: scene-graph nodes with labels;
+- ``world/graph/rooms|objects|doors|frontiers``: scene-graph nodes with labels (doors
+  green when open, red when closed), cleared when a graph has none;
 - ``graph``: the scene graph as ``GraphNodes``/``GraphEdges`` (rooms, regions, frontiers,
   objects and doors; edges object -> parent, region -> room, door -> rooms, room ->
   neighbour), for Rerun's graph view;
-- ``actions``: the actions with their outcomes (``TextLog``).
+- ``actions``: the actions with their outcomes (``TextLog``);
+- ``episode``: the Episode records (query, planner, status, steps, how it ended), as
+  Markdown (``TextDocument``).
+
+A log of a trajectory only (``sgtool import bag`` without ``--depth``) shows the path of
+its world-parented ``/tf`` transforms. Segmentation class ids are the instance ids, or,
+when a table holds ids past 65535, their ranks (:func:`class_ids`).
 
 Every recording carries a default blueprint (:func:`blueprint`): the 3D map with the
 robot and the graph, a bird's-eye view of the occupancy grid with the Voronoi graph and
 rooms, the camera's RGB, depth and segmentation, the scene graph's graph view and the
 action log.
 
-Two timelines: ``frame`` (frame index) and ``sim_time`` (log time since the start). What an
+Two timelines: ``frame`` (frame index) and ``sim_time`` (log time since the start; Rerun's
+wall-clock ``log_time`` is turned off, :func:`new_stream`). What an
 export holds is a function of the log: the recording id is derived from the log's bytes
 (:func:`recording_id`), and every entity, time and value follows from the log. The file's
 bytes are not: Rerun stamps its rows and chunks with ids of its own (time-based, random), so
@@ -42,7 +50,7 @@ import contextlib
 import errno
 import hashlib
 import os
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -89,6 +97,7 @@ def blueprint() -> Any:
             ),
             rrb.GraphView(name="Scene graph", origin="graph"),
             rrb.TextLogView(name="Actions", origin="actions"),
+            rrb.TextDocumentView(name="Episode", origin="episode"),
         ),
         column_shares=[3, 2],
     ), collapse_panels=False)
@@ -160,7 +169,6 @@ def export(
     voxel centres (N,3), colours (N,3) uint8, voxel size) to draw the semantic voxel map
     over time. ``warn``, when given, receives one-line notes about the log (frames without
     a camera pose)."""
-    import rerun as rr
 
     log_path = Path(log_path)
     rid = recording_id(log_path)
@@ -178,7 +186,7 @@ def export(
             if where is not None and warn is not None:
                 warn(f"web viewer at {where}")
         else:
-            rec = rr.RecordingStream(APP_ID, recording_id=rid, send_properties=False)
+            rec = new_stream(rid)
         if out is not None and tmp is not None:
             require_space(out)
             rec.save(tmp, default_blueprint=blueprint())
@@ -186,6 +194,11 @@ def export(
         with LogReader(log_path, verify=True) as r:  # a damaged chunk: one line, no .rrd
             unposed, framed = _export(rec, r, every=every, max_frames=max_frames,
                                       progress=progress, voxels=voxels)
+            drawn = {S.TF, S.OCCUPANCY, S.VORONOI, S.ROOMS,
+                     *(k.topic for n, k in S.RECORDS.items() if n != "instances")}
+            if not framed and not r.topics() & drawn and warn is not None:
+                warn(f"{log_path} holds nothing sgtool draws (no camera frames, /tf, maps "
+                     "or records): the recording is empty")
         if unposed and warn is not None:
             warn(f"{unposed} of {framed} frames have no camera pose: {S.TF} has no chain "
                  f"{S.WORLD_FRAME} -> {S.CAMERA_FRAME} at their time (a missing link or a "
@@ -199,7 +212,37 @@ def export(
     return out
 
 
-def log_camera(rec: Any, fr: Frame) -> None:
+def new_stream(rid: str) -> Any:
+    """A Rerun recording stream of id ``rid`` on sgtool's timelines only (Rerun's own
+    ``log_time``, the wall clock of the export, is left out: it would differ from export to
+    export and squeeze the log's time into the export's)."""
+    import rerun as rr
+
+    rec = rr.RecordingStream(APP_ID, recording_id=rid, send_properties=False)
+    rec.set_log_time_enabled(False)
+    return rec
+
+
+def class_ids(instance_ids: Iterable[int]) -> np.ndarray | None:
+    """How instance ids become Rerun's 16-bit class ids: None when every id fits (an id is
+    its class id), else the sorted ids, whose position + 1 is the class id (ids of a table
+    past 65535, as ``32SC1`` images hold them: never wrapped onto another's)."""
+    ids = np.unique(np.asarray(list(instance_ids), dtype=np.int64))
+    return None if ids.size == 0 or int(ids.max()) <= 65535 else ids
+
+
+def segmentation(ids: np.ndarray, dense: np.ndarray | None) -> np.ndarray:
+    """A frame's instance ids as class ids (:func:`class_ids`); an id without a class is
+    0 (none)."""
+    a = ids.astype(np.int64)
+    if dense is None:
+        return np.where((a > 0) & (a <= 65535), a, 0).astype(np.uint16)
+    pos = np.searchsorted(dense, a)
+    ok = (pos < dense.size) & (dense[np.minimum(pos, dense.size - 1)] == a) & (a > 0)
+    return np.where(ok, pos + 1, 0).astype(np.uint16)
+
+
+def log_camera(rec: Any, fr: Frame, dense: np.ndarray | None = None) -> None:
     """A frame's camera at the current time: its pose (when /tf gives one), pinhole, RGB,
     depth and instance segmentation."""
     import rerun as rr
@@ -217,7 +260,7 @@ def log_camera(rec: Any, fr: Frame) -> None:
     rec.log("world/camera/image/depth", rr.DepthImage(fr.depth, meter=1.0))
     if fr.ids is not None:
         rec.log("world/camera/image/segmentation",
-                rr.SegmentationImage(fr.ids.astype(np.uint16)))
+                rr.SegmentationImage(segmentation(fr.ids, dense)))
 
 
 class RobotPath:
@@ -287,10 +330,13 @@ def _export(
     rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
     instances = r.last_record("instances")
     labels: dict[int, str] = {}
+    dense = None
     if instances:
         labels = {int(i["id"]): i["category"] for i in instances["instances"]}
+        dense = class_ids(labels)
         ctx = [(0, "none", (0, 0, 0))] + [
-            (iid, f"{cat} #{iid}", color_for(iid)) for iid, cat in sorted(labels.items())
+            (iid if dense is None else k + 1, f"{cat} #{iid}", color_for(iid))
+            for k, (iid, cat) in enumerate(sorted(labels.items()))
         ]
         rec.log("world/camera/image", rr.AnnotationContext(ctx), static=True)
     # camera frames
@@ -308,7 +354,7 @@ def _export(
             if fr.index % every:
                 continue
             stamp(fr.index, fr.time_ns)
-            log_camera(rec, fr)
+            log_camera(rec, fr, dense)
             path.log(rec, here)
     elif r.has(S.TF):  # a trajectory without frames (`sgtool import bag` without --depth)
         for d in r.messages([S.TF]):
@@ -354,6 +400,9 @@ def _export(
     for t, g in r.records("scene_graph"):
         stamp(frame_of(t), t)
         _log_scene_graph(rec, g)
+    for t, e in r.records("episode"):
+        stamp(frame_of(t), t)
+        rec.log("episode", rr.TextDocument(episode_text(e), media_type="text/markdown"))
     for t, a in r.records("action"):
         stamp(frame_of(t), t)
         level = "INFO" if a.get("outcome") == "success" else "WARN"
@@ -364,6 +413,18 @@ def _export(
             text += f" [{a['travelled_m']:.2f} m]"
         rec.log("actions", rr.TextLog(text, level=level))
     return unposed, framed
+
+
+def episode_text(e: dict[str, Any]) -> str:
+    """An Episode record as Markdown: what was searched for (or recorded) and how it
+    ended."""
+    keys = ("kind", "status", "query", "planner", "house_id", "steps", "travelled_m",
+            "shortest_m", "frames")
+    lines = [f"- **{k}**: {e[k]}" for k in keys if e.get(k) is not None]
+    end = (e.get("extra") or {}).get("end")
+    if end:
+        lines.append(f"- **end**: {end}")
+    return "\n".join(lines)
 
 
 def graph_nodes_edges(g: dict[str, Any]) -> tuple[list[str], list[str], list[tuple[float, float]],
@@ -421,18 +482,25 @@ def _log_scene_graph(rec: Any, g: dict[str, Any]) -> None:
         rec.log("graph", rr.Clear(recursive=False))
 
     rooms = g.get("rooms", [])
-    if rooms:
-        rec.log("world/graph/rooms", rr.Points3D(
-            [(*rm["position"][:2], 1.5) for rm in rooms],
-            labels=[f"{rm['id']}: {rm['category']}" for rm in rooms],
-            colors=[color_for(rm["id"]) for rm in rooms], radii=0.12))
+    rec.log("world/graph/rooms", rr.Points3D(
+        [(*rm["position"][:2], 1.5) for rm in rooms],
+        labels=[f"{rm['id']}: {rm['category']}" for rm in rooms],
+        colors=[color_for(rm["id"]) for rm in rooms], radii=0.12)
+        if rooms else rr.Clear(recursive=False))
     objs = g.get("objects", [])
-    if objs:
-        rec.log("world/graph/objects", rr.Points3D(
-            [o["position"] for o in objs],
-            labels=[o["category"] + (f" ({o['state']})" if o.get("state") else "")
-                    for o in objs],
-            colors=[color_for(o["room"]) for o in objs], radii=0.05))
+    rec.log("world/graph/objects", rr.Points3D(
+        [o["position"] for o in objs],
+        labels=[o["category"] + (f" ({o['state']})" if o.get("state") else "")
+                for o in objs],
+        colors=[color_for(o["room"]) for o in objs], radii=0.05)
+        if objs else rr.Clear(recursive=False))
+    doors = g.get("doors", [])
+    rec.log("world/graph/doors", rr.Points3D(
+        [(*d["position"][:2], 1.0) for d in doors],
+        labels=[f"door ({d.get('state') or '?'})" for d in doors],
+        colors=[(50, 200, 50) if d.get("state") == "open" else (220, 50, 50)
+                for d in doors], radii=0.1)
+        if doors else rr.Clear(recursive=False))
     fr = [x for x in g.get("regions", []) if x.get("kind") == "frontier"]
     if fr:
         rec.log("world/graph/frontiers", rr.Points3D(

@@ -200,3 +200,49 @@ def test_view_of_a_trajectory_without_frames_draws_its_path(tmp_path):
     rrd_verify(out)
     printed = rrd_print(out)
     assert "world/robot/path/0" in printed and "world/robot " in printed.replace("\n", " ")
+
+
+def test_class_ids_past_16_bits_keep_their_labels():
+    """Instance ids past 65535 (32SC1 images) become their ranks, never another id's
+    class by wrapping; ids that fit are their own class ids."""
+    from sgtool.analysis.rerun_view import class_ids, segmentation
+
+    assert class_ids([5, 7, 65535]) is None
+    ids = np.array([[5, 65541], [0, 99]], dtype=np.int32)
+    assert segmentation(ids, None).tolist() == [[5, 0], [0, 99]]  # no wrap onto id 5
+    dense = class_ids([65541, 5])
+    assert dense is not None and dense.tolist() == [5, 65541]
+    assert segmentation(ids, dense).tolist() == [[1, 2], [0, 0]]  # 99: no class
+
+
+def test_episode_doors_and_empty_graphs_are_drawn(tmp_path):
+    """The episode record (query and outcome) is a document; doors are points coloured by
+    state; a graph without rooms or objects clears the last ones; no wall-clock timeline."""
+    from sgtool.analysis.rerun_view import episode_text
+    from sgtool.log import LogWriter
+
+    text = episode_text({"kind": "search", "status": "success", "query": "bowl",
+                         "steps": 4, "extra": {"end": "found"}})
+    assert "- **query**: bowl" in text and "- **end**: found" in text
+    from sgtool.scenegraph.graph import DoorNode, ObjectNode, RobotState, RoomNode, SceneGraph
+
+    full = SceneGraph(
+        robot=RobotState((0.0, 0.0)), rooms=(RoomNode("room:0", "kitchen", (1.0, 1.0)),),
+        objects=(ObjectNode("obj:1", "bowl", "room:0", "room:0", (1.0, 1.0, 0.8)),),
+        doors=(DoorNode("door:2", (2.0, 1.0), "open", ("room:0",)),)).to_dict()
+    empty = SceneGraph(robot=RobotState((0.0, 0.0))).to_dict()
+    derived = tmp_path / "graphs.mcap"
+    with LogWriter(derived, seed=1) as w:
+        w.write_record("scene_graph", 1, full)
+        w.write_record("scene_graph", 2, empty)
+        w.write_record("episode", 3, {"kind": "search", "status": "success",
+                                      "query": "bowl"})
+    out = tmp_path / "g.rrd"
+    r = CliRunner().invoke(cli, ["view", str(derived), "-o", str(out), "--no-voxels"])
+    assert r.exit_code == 0, r.output
+    printed = rrd_print(out)
+    for entity in ("/world/graph/doors", "/world/graph/objects", "/episode"):
+        assert entity in printed, entity
+    for entity in ("/world/graph/objects", "/world/graph/rooms", "/world/graph/doors"):
+        assert f"{entity} - data columns: [Clear:is_recursive]" in printed, entity
+    assert "log_time" not in printed

@@ -37,7 +37,8 @@ if TYPE_CHECKING:
 @click.argument("logs", metavar="LOG...", nargs=-1, required=True, type=click.Path())
 @click.option("-o", "--output", type=click.Path(dir_okay=False),
               help="Derived log to write: a copy of LOG's messages plus /map/occupancy, "
-              "/map/voronoi, /map/rooms and /sgtool/scene_graph at every refresh. Without "
+              "/map/voronoi, /map/rooms, /map/graph and /sgtool/scene_graph at every "
+              "refresh. Without "
               "it nothing is written (use with --score or --json).")
 @click.option("--every", type=click.IntRange(min=1), default=None,
               help="Refresh the graph every K frames (and always at every action). "

@@ -23,7 +23,8 @@ from sgtool.errors import SgtoolError
 @click.option("--max-frames", type=click.IntRange(min=1), default=None,
               help="Stop after this many camera frames.")
 @click.option("--voxels/--no-voxels", default=True, show_default=True,
-              help="Rebuild and show the semantic voxel map (needs the mapping pipeline).")
+              help="Rebuild and show the semantic voxel map (needs the mapping pipeline and "
+              "depth images; a log without them is shown without it).")
 @click.option("--rerun", "rerun_to", default=None,
               metavar="spawn|connect[:URL]|serve[:WEB_PORT[:GRPC_PORT]]",
               help="Where to stream instead of -o: spawn a viewer (the default without -o), "
@@ -32,9 +33,9 @@ from sgtool.errors import SgtoolError
 def command(log: str, out: str | None, every: int, max_frames: int | None,
             voxels: bool, force: bool = False, rerun_to: str | None = None) -> None:
     """Show LOG in Rerun: camera with RGB, depth and segmentation, the voxel map, BEV
-    occupancy, the Voronoi graph coloured by room, room labels, objects, frontiers, the
-    robot's path and its actions, on a frame timeline. Derived layers appear when LOG is
-    the output of `sgtool replay`.
+    occupancy, the Voronoi graph coloured by room, room labels, objects, doors, frontiers,
+    the robot's path, its actions and the episode (query, outcome), on a frame timeline.
+    Derived layers appear when LOG is the output of `sgtool replay`.
 
     Without -o the Rerun viewer is spawned (it needs a display); with -o the recording is
     written to a file that `rerun view.rrd` opens later (`rerun rrd verify` checks it); on
