@@ -8,8 +8,9 @@ frames of the log once and returns
 - ``noise``: the vertical noise of the floor against depth and the depth at which it
   reaches the bird's-eye map's floor tolerance (None when nothing could be measured);
 - ``up_note``: a line when the camera's image "down" axis is not downward in the world in
-  most of those frames (median world z of that axis above :data:`UPRIGHT`): sgtool maps
-  heights along z, so a world written y-up maps side-on without any other sign.
+  most of those frames (median world z of that axis above :data:`UPRIGHT`) and no floor
+  is found at height 0 (a camera looking straight down is upright): sgtool maps heights
+  along z, so a world written y-up maps side-on without any other sign.
 
 The same log gives the same answer: the frames read and the pixels sampled are fixed.
 """
@@ -24,7 +25,7 @@ import numpy as np
 
 from sgtool.log.reader import LogReader
 from sgtool.mapping.bev import BevConfig
-from sgtool.mapping.depth_noise import DepthNoise, estimate, frame_points
+from sgtool.mapping.depth_noise import DepthNoise, estimate, floor_height, frame_points
 
 FRAMES = 60  # the first frames of the log that are measured
 PIXELS = 20_000  # about this many pixels of each frame are measured (a fixed stride)
@@ -56,7 +57,10 @@ def first_frames(reader: LogReader, ceiling: float, tf_time: str = "log",
         samples.append(frame_points(fr.depth, fr.pose, k.fx, k.fy, k.cx, k.cy, stride))
         down_z.append(float(np.asarray(fr.pose)[2, 1]))
     note = None
-    if down_z and float(np.median(down_z)) > UPRIGHT:
+    # a camera looking straight down has its image "down" level; a floor found at height
+    # 0 shows the world is z-up all the same
+    floor = floor_height(np.concatenate([fp.h for fp in samples])) if samples else None
+    if down_z and float(np.median(down_z)) > UPRIGHT and floor is None:
         note = (f"the camera's image 'down' axis points {float(np.median(down_z)):+.2f} along "
                 "the world's z in the median of the first frames: sgtool maps heights along "
                 "z (z up), so a world written y-up maps side-on; check the poses' convention")

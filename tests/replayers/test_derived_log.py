@@ -49,12 +49,12 @@ def messages(path: Path) -> dict[str, list[tuple[int, bytes]]]:
 
 def synthetic_log(path: Path, with_ids: bool = True, opening: str = "open",
                   noise: float = 0.0, world: np.ndarray | None = None,
-                  table_without: str | None = None) -> Path:
+                  table_without: str | None = None, pitch: float = 0.3) -> Path:
     """The two-room house seen by a robot looking around in the kitchen, walking to the
     bedroom and looking around there; an action record after each part. ``noise``: depth
     noise of std ``noise`` z^2 (seeded); ``world``: a 4x4 transform applied to every pose
     (another world convention); ``table_without``: an instance kind left out of the
-    instance table (its ids stay in the images)."""
+    instance table (its ids stay in the images); ``pitch``: the camera's, down (rad)."""
     hw = world_of_house(two_room_house(opening))
     rng = np.random.default_rng(5)
     parts = [look_around(2.0, 1.5, 0.0, 12), walk([(2.0, 1.5), (6.0, 1.5)], 0.25),
@@ -66,7 +66,7 @@ def synthetic_log(path: Path, with_ids: bool = True, opening: str = "open",
         i = 0
         for n, poses in enumerate(parts):
             for x, y, yaw in poses:
-                f = make_frame(hw.world, x, y, yaw, K, index=i, pitch=0.3, with_ids=with_ids)
+                f = make_frame(hw.world, x, y, yaw, K, index=i, pitch=pitch, with_ids=with_ids)
                 d = f.depth + (noise * f.depth ** 2 * rng.standard_normal(f.depth.shape)
                                ).astype(np.float32) if noise else f.depth
                 pose = f.pose if world is None else world @ f.pose
@@ -218,6 +218,10 @@ def test_a_world_written_y_up_is_warned_of(tmp_path):
     rep = replay(synthetic_log(tmp_path / "yup.mcap", world=y_up), None, ReplayOptions())
     assert any(line.startswith("warning: the camera's image 'down' axis points") and
                "y-up" in line for line in rep.lines())
+    # a camera looking straight down has its image "down" level, but sees the floor at
+    # height 0: upright, nothing said
+    rep = replay(synthetic_log(tmp_path / "down.mcap", pitch=1.5), None, ReplayOptions())
+    assert not any("'down' axis" in line for line in rep.lines())
 
 
 def test_the_report_warns_of_doors_joining_one_room_and_of_no_room(tmp_path):
