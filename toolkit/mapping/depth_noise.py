@@ -9,11 +9,15 @@ left for its Voronoi graph.
 The noise can be read off the log itself. Nothing stands below the floor, so the points of
 a frame below the floor are floor points moved down by noise: with the floor at height
 ``f``, the heights ``h < f`` of the floor points whose pixel rays meet the floor at depth
-``z`` scatter as a half-normal whose second moment is the vertical noise at that depth,
+``z`` scatter as a half-normal whose median is 0.6745 times the vertical noise at that
+depth,
 
-    sigma_v(z) = sqrt(mean((f - h)^2 over the points with h < f at depth z))      (N1)
+    sigma_v(z) = median(f - h over the points with h < f at depth z) / 0.6745      (N1)
 
-(obstacles only add points above the floor, so they do not bias it; the pixels are grouped
+(obstacles only add points above the floor, so they do not bias it; the median, not the
+RMS, so that points below the floor that are no noise, a sunken area, a step down, a floor
+seen through a glass table, move it little while they are a minority of the points below
+the floor at that depth, which under noise hold half the floor's; the pixels are grouped
 by the depth at which their rays meet the floor, which does not move with their depth
 errors, not by their measured depth, which does). The usable depth is
 where ``k`` sigma_v stays within the floor tolerance:
@@ -48,6 +52,7 @@ BIN = 0.25  # m; depth bins of (N1)
 MIN_BELOW = 50  # points below the floor for a depth bin to count
 MIN_FLOOR = 500  # points near height 0 for a floor
 SIGMAS = 4.0  # k of (N2)
+HALF_NORMAL_MEDIAN = 0.6745  # the median of |N(0, 1)|
 BELOW_LIMIT = 1.0  # m; points further below the floor are not floor (stairs, reflections)
 MIN_DEPTH = 1.0  # m; the least depth kept: what is around the robot is always mapped
 
@@ -137,6 +142,21 @@ def estimate(samples: Iterable[FramePoints], tolerance: float,
     f = floor_height(np.concatenate([fp.h for fp in frames]))
     if f is None:
         return None
+    below = _below_floor(frames, f)
+    if below is None:
+        return None
+    keep, sigma = below
+    edges = keep * BIN
+    return DepthNoise(floor=round(f, 4), depths=tuple(float(e) for e in edges),
+                      sigma=tuple(round(float(s), 4) for s in sigma),
+                      max_depth=cut_depth(edges, sigma, tolerance, sigmas, ceiling))
+
+
+def _below_floor(frames: list[FramePoints], f: float
+                 ) -> tuple[np.ndarray, np.ndarray] | None:
+    """(N1) below the floor ``f`` (within ``BELOW_LIMIT``): the depth bins with at least
+    ``MIN_BELOW`` points and their median depth below the floor over the half-normal's
+    median; None without."""
     zb_parts, db_parts = [], []
     for fp in frames:
         below = (fp.h < f) & (fp.h > f - BELOW_LIMIT)
@@ -149,15 +169,13 @@ def estimate(samples: Iterable[FramePoints], tolerance: float,
         return None
     bins = np.floor(np.minimum(zb, MAX_BINS * BIN) / BIN).astype(np.int64)
     n = np.bincount(bins)
-    ss = np.bincount(bins, weights=db * db)
     keep = np.flatnonzero(n >= MIN_BELOW)
     if keep.size == 0:
         return None
-    sigma = np.sqrt(ss[keep] / n[keep])
-    edges = keep * BIN
-    return DepthNoise(floor=round(f, 4), depths=tuple(float(e) for e in edges),
-                      sigma=tuple(round(float(s), 4) for s in sigma),
-                      max_depth=cut_depth(edges, sigma, tolerance, sigmas, ceiling))
+    order = np.lexsort((db, bins))  # by bin, then by depth below the floor
+    starts = np.concatenate([[0], np.cumsum(n)])[keep]
+    lo, hi = db[order][starts + (n[keep] - 1) // 2], db[order][starts + n[keep] // 2]
+    return keep, (lo + hi) / 2 / HALF_NORMAL_MEDIAN
 
 
 def cut_depth(edges: np.ndarray, sigma: np.ndarray, tolerance: float,

@@ -57,11 +57,12 @@ def test_noisy_depth_is_cut_where_four_sigma_reach_the_floor_tolerance():
         est = estimate(samples(c), 0.1)
         cut = 0.1 / (4 * H * c)  # module doc
         assert est is not None and abs(est.floor) < 0.01
-        assert cut - BIN <= est.max_depth <= cut, (c, est)  # the bin the cut falls in
-        # the measured noise follows H c z within a fifth up to a metre past the cut
+        # the bin the cut falls in, or the next (the measurement's noise near the cut)
+        assert cut - BIN <= est.max_depth <= cut + BIN, (c, est)
+        # the measured noise follows H c z within a quarter up to a metre past the cut
         for z, s in zip(est.depths, est.sigma, strict=True):
             if z < est.max_depth + 1.0:
-                assert abs(s / (H * c * (z + BIN / 2)) - 1) < 0.2, (c, z, s)
+                assert abs(s / (H * c * (z + BIN / 2)) - 1) < 0.25, (c, z, s)
 
 
 def test_a_cut_beyond_the_ceiling_changes_nothing():
@@ -96,17 +97,40 @@ def test_a_stray_point_far_away_costs_nothing():
 
 def test_a_sensor_model_is_cut_where_the_measurement_cuts_it():
     # sigma_v(z) = H c z (module doc of the test): the model cuts in the bin the cut
-    # falls in, the measurement there or one bin nearer (its noise near the cut)
+    # falls in, the measurement there or one bin either side (its noise near the cut)
     for c in (0.006, 0.01, 0.015):
         est = estimate(samples(c), 0.1)
         model = sensor_max_depth(c, H, 0.1)
         assert est is not None and est.max_depth is not None and model is not None
         cut = 0.1 / (4 * H * c)
         assert cut - BIN <= model <= cut, c
-        assert est.max_depth in (model, model - BIN), (c, model, est.max_depth)
+        assert abs(est.max_depth - model) <= BIN, (c, model, est.max_depth)
     assert sensor_max_depth(0.01, H, 0.1) == 2.0  # 0.1 / (4 x 1.2 x 0.01) = 2.08: bin 2.0
     assert sensor_max_depth(0.0, H, 0.1) is None  # no noise: nothing to cut
     assert sensor_max_depth(0.05, H, 0.1) == MIN_DEPTH  # the robot keeps its surroundings
     assert sensor_max_depth(0.004, H, 0.1, ceiling=5.0) is None  # the cut lies at 5.0 m
     # a camera mounted higher sees the floor's noise larger: cut nearer
     assert sensor_max_depth(0.01, 2 * H, 0.1) == 1.0
+
+
+def test_a_sunken_floor_is_no_noise():
+    """A fifth of the floor seen between 1 and 3 m lies 0.15 m lower (a sunken area, a step
+    down): points below the floor that are no noise. (N1) takes the median, so a minority
+    of them does not read as noise (their RMS would: 0.15 m x sqrt(0.2 / 0.6) is 0.087 m,
+    4 sigma 0.35 m): a good sensor's log is not cut; a noisy one's is, more conservatively
+    (the sunken points are a third of those below the floor there)."""
+    from sgtool.mapping.depth_noise import FramePoints
+
+    def sunken(fp: FramePoints) -> FramePoints:
+        zf = fp.floor_depths(0.0)
+        floor = np.flatnonzero((np.abs(fp.h) < 0.2) & (zf > 1.0) & (zf < 3.0))
+        h = fp.h.copy()
+        h[floor[::5]] -= 0.15
+        return FramePoints(h, fp.slope, fp.camera_z)
+
+    # a good sensor (0.002 z^2: 4 sigma reach the tolerance at 10 m): nothing cut
+    clean = estimate([sunken(fp) for fp in samples(0.002)], 0.1, ceiling=5.0)
+    assert clean is not None and clean.max_depth is None
+    noisy = estimate([sunken(fp) for fp in samples(0.01)], 0.1)
+    assert noisy is not None and noisy.max_depth is not None
+    assert noisy.max_depth <= 2.0  # cut, at 2 m without the sunken area, nearer with it
