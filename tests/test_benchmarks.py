@@ -112,6 +112,7 @@ SMOKE: dict[str, Smoke] = {
         marks=("slow",)),
     "benchmarks/viewers.py": Smoke(("--frames", "3", "-r", "1", "--derived", "{log}")),
     "tools/closed_loop_failures.py": Smoke(("{tmp}", "{tmp}")),
+    "tools/depth_cuts.py": Smoke(("{log}",)),
     "tools/bench_misses.py": Smoke(("{symbolic}", "--list")),
     "tools/closed_loop_misses.py": Smoke(("{bench}",)),
     "tools/closed_loop_vs_symbolic.py": Smoke(("{bench}", "{bench}")),
