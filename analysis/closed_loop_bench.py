@@ -368,7 +368,8 @@ class ClosedLoopBenchResult:
             rows = [r for r in self.rows if r.task.noise == noise]
             parts.append(format_table(summarize([r.result for r in rows], models,
                                                 cfg.planners), models=models,
-                                      title=f"## Closed loop, noise {noise!r}{rule}"))
+                                      title=f"## Closed loop, noise "
+                                            f"{noise_folder(noise)!r}{rule}"))
             parts.append(_run_table(rows, cfg.planners))
             parts.append(self.statistics(noise)[0])
         return "\n".join(parts)
@@ -376,7 +377,7 @@ class ClosedLoopBenchResult:
     def summary(self) -> dict[str, Any]:
         """summary.json: per noise profile the statistics of :meth:`statistics`."""
         return {"planners": list(self.config.planners),
-                "noise": {n: self.statistics(n)[1] for n in self.config.noise}}
+                "noise": {noise_folder(n): self.statistics(n)[1] for n in self.config.noise}}
 
 
 def _run_table(rows: Sequence[RunRow], planners: Sequence[str]) -> str:
@@ -470,7 +471,8 @@ def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]
         for model in (*cost_models(cfg.distance_budget, cfg.step_budget),
                       res.frames_model(noise)):
             paths.append(plot_efficiency(by_planner, model,
-                                         out / f"efficiency_{noise}_{model.name}.png"))
+                                         out / f"efficiency_{noise_folder(noise)}_"
+                                         f"{model.name}.png"))
     paths.append(atomic_write(out / "summary.md", res.table()))
     paths.append(atomic_write(out / "summary.json", json.dumps(
         strict_json(res.summary()), indent=1, sort_keys=True, allow_nan=False) + "\n"))

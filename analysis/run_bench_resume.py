@@ -153,7 +153,11 @@ def check_resumable(path: Path, want: dict[str, Any], spec: HouseSpec, house: st
     settings, logged_house = logged_settings(path)
     diff = settings_differences(settings, want)
     if diff:
-        raise ResumeError(f"{path} was run with other settings ({'; '.join(diff)}); {_FIX}")
+        depth = settings.get("max_depth")
+        fix = (f"--max-depth {depth:g} maps as that log did, or {_FIX}"
+               if settings.get("max_depth") != want.get("max_depth") and depth is not None
+               else _FIX)
+        raise ResumeError(f"{path} was run with other settings ({'; '.join(diff)}); {fix}")
     if not same_house(logged_house, spec):
         raise ResumeError(f"{path} was run on another house: the house of {house} changed "
                           f"since; {_FIX}")

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from sgtool.files import quoted
+from sgtool.log.schemas import DEPTH
 
 Echo = Callable[[str], None]
 
@@ -40,7 +41,7 @@ def view_log(request: ViewRequest, show: Echo, note: Echo) -> None:
     from sgtool.log import LogReader
 
     with LogReader(request.log) as r:
-        total = r.frame_count() if r.has("/camera/depth") else 0
+        total = r.frame_count() if r.has(DEPTH) else 0
     if request.max_frames is not None:
         total = min(total, request.max_frames)
     live = request.live
@@ -66,7 +67,7 @@ def _voxel_source(request: ViewRequest) -> Callable[[Any], Any] | None:
         return None
 
     def voxel_source(reader: Any) -> Any:
-        if not reader.has("/camera/depth"):  # a trajectory: nothing to map
+        if not reader.has(DEPTH):  # a trajectory: nothing to map
             return iter(())
         return voxel_snapshots(reader, every=max(request.every, 10),
                                max_frames=request.max_frames)

@@ -125,8 +125,11 @@ class Pinned:
     sgtool_version: str | None = None
 
     def log_path(self, folder: Path) -> Path:
+        """The log's path: as stored, or joined to ``folder``, resolved as
+        :func:`stored_path` made it (``..`` through a symlinked folder goes to the link's
+        target's parent)."""
         p = Path(self.log)
-        return p if p.is_absolute() else Path(os.path.normpath(folder / p))
+        return p if p.is_absolute() else Path(os.path.normpath(folder.resolve() / p))
 
     def to_dict(self) -> dict[str, Any]:
         d: dict[str, Any] = {

@@ -277,11 +277,11 @@ def _read_tum(
         return _read_tum_by_index(root, rgb, depth, fps, notes)
     for name, rows in (("depth.txt", depth), ("rgb.txt", rgb)):
         what = str(root / name)
-        problem = (time_range_problem([t for t, _ in rows], what)
-                   or timestamp_problem([t for t, _ in rows], what))
+        in_range = time_range_problem([t for t, _ in rows], what)
+        problem = in_range or timestamp_problem([t for t, _ in rows], what)
         in_order = sorted(rows)
-        if problem and in_order != rows and not timestamp_problem([t for t, _ in in_order],
-                                                                  what):
+        if problem and not in_range and in_order != rows and \
+                not timestamp_problem([t for t, _ in in_order], what):
             # times of frames listed out of order: TUM associates by time, so sort them
             back = sum(b[0] < a[0] for a, b in zip(rows, rows[1:], strict=False))
             notes.append(f"{name} lists its images out of time order ({back} step"
@@ -428,7 +428,7 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
     if 0 < posed < len(frames):
         first = next(f.depth_path.name for f in frames if f.pose is None)
         notes.append(f"{len(frames) - posed} of {len(frames)} frames have no pose.txt "
-                     f"(first: {first})")
+                     f"(first: {first})" + ("" if keep_unposed else ": left out"))
         if not keep_unposed:
             dropped = len(frames) - posed
             frames = [f for f in frames if f.pose is not None]

@@ -272,12 +272,19 @@ def test_noise_profiles_are_kept_apart(house_file, tmp_path) -> None:
     assert logs == ["logs/my/random/small/ep-000.mcap", "logs/none/random/small/ep-000.mcap"]
     rows = [json.loads(s) for s in (out / "episodes.jsonl").read_text().splitlines()]
     assert [r["noise"] for r in rows] == ["none", "my"]
+    # the tables and plots name the profile as its logs do
+    assert (out / "efficiency_my_steps.png").is_file() and "noise 'my'" in \
+        (out / "summary.md").read_text()
+    assert set(json.loads((out / "summary.json").read_text())["noise"]) == {"none", "my"}
     ev = CliRunner().invoke(cli, ["eval", str(out / "episodes.jsonl")])
     assert ev.exit_code == 0, ev.output
     assert "random [none]" in ev.output and "random [my]" in ev.output
     assert "2 sensor noise profiles (none, my)" in ev.output
     res = CliRunner().invoke(cli, [*args, "--noise", "none", "--noise-seed", "1"])
     assert res.exit_code == 2 and "noise seed: 0 in the log, 1 now" in res.output
+    res = CliRunner().invoke(cli, [*args, "--noise", "none", "--max-depth", "3"])
+    assert res.exit_code == 2 and "depth mapped (m): 5.0 in the log, 3.0 now" in res.output
+    assert "--max-depth 5 maps as that log did" in res.output
     only = CliRunner().invoke(cli, [*args, "--report-only"])
     assert only.exit_code == 0, only.output
     assert f"note: {out / 'logs' / 'my'} holds episode logs" in only.output

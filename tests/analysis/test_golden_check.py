@@ -375,3 +375,17 @@ def test_pinning_elsewhere_drops_the_copy_pinned_before(pinned, log, tmp_path, c
     assert (pinned / read_pins(pinned).logs["small"].log).resolve() == log.resolve()
     code, out, _ = sgtool(capsys, "golden", "check", "--dir", pinned)
     assert code == 0, out
+
+
+def test_a_pin_folder_reached_through_a_symlink(log, tmp_path, capsys):
+    """The folder is a link into another tree; the log lies beside the link: the stored
+    path is relative to where the folder really is, and the check finds the log."""
+    (tmp_path / "R" / "a" / "b" / "store").mkdir(parents=True)  # deeper than the link
+    (tmp_path / "L" / "logs").mkdir(parents=True)
+    shutil.copyfile(log, tmp_path / "L" / "logs" / "run.mcap")
+    (tmp_path / "L" / "golden").symlink_to(tmp_path / "R" / "a" / "b" / "store")
+    folder = tmp_path / "L" / "golden" / "g"
+    assert sgtool(capsys, "golden", "pin", tmp_path / "L" / "logs" / "run.mcap", "--dir",
+                  folder, *FRAMES)[0] == 0
+    code, out, err = sgtool(capsys, "golden", "check", "--dir", folder)
+    assert code == 0, out + err

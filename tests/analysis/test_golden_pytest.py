@@ -95,3 +95,8 @@ def test_the_fixture_refuses_another_log_of_the_pinned_name(tmp_path, monkeypatc
     index = json.loads((tmp_path / "pins" / "expected.json").read_text())
     assert index["cases"]["run"]["log"] == "../v2/run.mcap"
     assert index["cases"]["run"]["options"] == {"max_frames": 20}  # kept as pinned
+    # a --copy pin of the log given holds the same bytes: it is that log
+    pin_logs([tmp_path / "v2" / "run.mcap"], tmp_path / "pins", ReplayOptions(max_frames=20),
+             copy=True)
+    code, out = pytest_run("test_lab.py", cwd=tmp_path)
+    assert code == 0, out

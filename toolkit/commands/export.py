@@ -126,9 +126,11 @@ def bag(log: str, output: str, fmt: str | None, distro: str, time_base: float | 
 @command.command("foxglove-layout")
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
               help="Where to write the layout (JSON).")
-@click.option("--follow", default="base", show_default=True, metavar="FRAME",
+@click.option("--follow", type=click.Choice(["base", "camera", "world"]), default="base",
+              show_default=True,
               help="The frame the 3D panel follows: base (the robot of a simulated or "
-              "closed-loop log) or camera (an imported recording, which has no base frame).")
+              "closed-loop log), camera (an imported recording, which has no base frame) or "
+              "world (a fixed view).")
 @click.option("--force", is_flag=True, help="Overwrite OUT.")
 def foxglove_layout(output: str, follow: str, force: bool) -> None:
     """Write the Foxglove layout shipped with sgtool: a 3D panel with the maps and the
@@ -142,8 +144,6 @@ def foxglove_layout(output: str, follow: str, force: bool) -> None:
     from sgtool.commands.options import check_output
     from sgtool.files import atomic_write
 
-    if follow not in ("base", "camera", "world"):
-        raise SgtoolError(f"--follow {follow!r}: one of base, camera, world (sgtool's frames)")
     check_output(output, force=force, suffixes=(".json",), what="layout")
     layout = json.loads(files("sgtool").joinpath(LAYOUT).read_text(encoding="utf-8"))
     layout["configById"]["3D!sgtool"]["followTf"] = follow

@@ -9,10 +9,11 @@ left for its Voronoi graph.
 The noise can be read off the log itself. Nothing stands below the floor, so the points of
 a frame below the floor are floor points moved down by noise: with the floor at height
 ``f``, the heights ``h < f`` of the floor points whose pixel rays meet the floor at depth
-``z`` scatter as a half-normal whose median is 0.6745 times the vertical noise at that
-depth,
+``z`` scatter as a half-normal whose median is ``HALF_NORMAL_MEDIAN`` (the median of
+``|N(0, 1)|``) times the vertical noise at that depth,
 
-    sigma_v(z) = median(f - h over the points with h < f at depth z) / 0.6745      (N1)
+    sigma_v(z) = median(f - h over the points with h < f at depth z) / HALF_NORMAL_MEDIAN
+                                                                                  (N1)
 
 (obstacles only add points above the floor, so they do not bias it; the median, not the
 RMS, so that points below the floor that are no noise, a sunken area, a step down, a floor

@@ -50,4 +50,4 @@ def test_the_3d_panel_follows_a_frame_the_log_has(tmp_path):
         assert json.loads(out.read_text())["configById"]["3D!sgtool"]["followTf"] == frame
     r = CliRunner().invoke(cli, ["export", "foxglove-layout", "-o", str(out), "--force",
                                  "--follow", "base_link"])
-    assert r.exit_code == 2 and "--follow 'base_link': one of base, camera, world" in r.output
+    assert r.exit_code == 2 and "'base_link' is not one of 'base', 'camera', 'world'" in r.output

@@ -174,6 +174,10 @@ def test_duplicated_and_backward_times_fail(tmp_path):
     with LogReader(tmp_path / "b.mcap") as r:
         stamps = r.frame_times()
     assert stamps == sorted(stamps) and len(stamps) == len(times)
+    # out of order and out of a log's range (negative): the range is the problem named
+    root = make_tum_folder(tmp_path / "negative", [t - 1e6 for t in times])
+    with pytest.raises(SgtoolError, match=r"negative"):
+        import_rgbd(root, tmp_path / "n.mcap", opts())
     # stamps that are not times even in order stay refused
     times = [0.001 * (i % 3) for i in range(12)]
     root = make_tum_folder(tmp_path / "intervals", times)

@@ -406,7 +406,7 @@ def test_seven_scenes_frames_without_a_pose_are_named_and_dropped_or_estimated(t
     assert [f.depth_path.name[:12] for f in seq.frames] == [
         "frame-000000", "frame-000001", "frame-000003"]
     assert seq.dropped == 1 and "1 of 4 frames have no pose.txt (first: " \
-        "frame-000002.depth.png)" in seq.notes
+        "frame-000002.depth.png): left out" in seq.notes
     kept = read_sequence(root, keep_unposed=True)  # --estimate-poses
     assert len(kept.frames) == 4 and kept.dropped == 0 and kept.frames[2].pose is None
 
