@@ -155,6 +155,10 @@ class BenchConfig:
         # a copy: the caller's dict changed for the next run must not change this one's
         object.__setattr__(self, "planner_options",
                            {str(k): dict(v) for k, v in self.planner_options.items()})
+        for name in ("planners", "house_files"):  # one name is a list of one, not of letters
+            v = getattr(self, name)
+            object.__setattr__(self, name, (v,) if isinstance(v, str) else tuple(v))
+        object.__setattr__(self, "rooms", tuple(self.rooms))  # (a list from a JSON file)
 
     def check(self) -> None:
         check_planner_list(self.planners)
@@ -188,6 +192,11 @@ class BenchConfig:
                              f"{self.success!r}")
         check_planner_options(self.planners, self.planner_options,
                               one_writer=self.workers == 1 and self.executor == "local")
+        here = [p for p in self.planners if p.startswith("__main__:")]
+        if here and (self.workers > 1 or self.executor != "local"):
+            raise BenchError(f"planner {here[0]!r} is defined in __main__ (a notebook or "
+                             "script), which worker processes cannot import: run it with "
+                             "workers=1, or put it in a module on sys.path")
 
     def models(self) -> tuple[CostModel, CostModel]:
         return cost_models(self.distance_budget, self.step_budget)

@@ -5,6 +5,7 @@ each once.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import threading
 from collections import OrderedDict
@@ -15,7 +16,7 @@ from sgtool.analysis.bench_houses import BenchHouse, bench_episodes
 
 # a house and its episodes, by everything they depend on: the draw of ``bench_episodes``
 # depends on how many episodes are drawn, so N episodes are not the first N of a larger draw
-_HOUSES: OrderedDict[tuple[str, str, tuple[int, int], str, int], Any] = OrderedDict()
+_HOUSES: OrderedDict[tuple[str, str, str, tuple[int, int], str, int], Any] = OrderedDict()
 # the planners of the latest runs, by run token (runs in two threads keep their own)
 _PLANNERS: OrderedDict[str, dict[tuple[str, str], Any]] = OrderedDict()
 _PLANNERS_LOCK = threading.Lock()
@@ -27,7 +28,11 @@ def cached_house(ref: BenchHouse, rooms: tuple[int, int], episodes: int,
     process for the last three houses asked for."""
     from sgtool.recorders.symbolic_environment.house import SymbolicHouse
 
-    key = (ref.id, ref.source, rooms, preset, episodes)
+    # a given house by its content: a file rewritten between two runs of one process is
+    # another house
+    what = ref.seed if ref.spec is None else hashlib.sha256(
+        ref.spec.to_json().encode()).hexdigest()
+    key = (ref.id, ref.source, str(what), (int(rooms[0]), int(rooms[1])), preset, episodes)
     hit = _HOUSES.get(key)
     if hit is not None:
         _HOUSES.move_to_end(key)

@@ -25,6 +25,7 @@ from __future__ import annotations
 import bisect
 import contextlib
 import dataclasses
+import os
 import shutil
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -160,7 +161,7 @@ def pin_folder(root: Path) -> Iterator[Path]:
         yield out
 
 
-def pin_logs(logs: Sequence[str | Path], folder: str | Path,
+def pin_logs(logs: Sequence[str | Path] | str | Path, folder: str | Path,
              options: ReplayOptions | None = None, *, copy: bool = False,
              executor: Executor | None = None, progress: bool = False,
              why: str | None = None) -> PinSet:
@@ -170,7 +171,7 @@ def pin_logs(logs: Sequence[str | Path], folder: str | Path,
     (the pin then refers to the copy)."""
     root = Path(folder)
     opts = options or ReplayOptions()
-    paths = [Path(p) for p in logs]
+    paths = [Path(logs)] if isinstance(logs, (str, os.PathLike)) else [Path(p) for p in logs]
     names = [pin_name(p) for p in paths]
     for p in paths:
         if not p.is_file():

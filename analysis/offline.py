@@ -197,6 +197,8 @@ def load_results(paths: Iterable[str | os.PathLike[str]], notes: list[str] | Non
     results: list[EpisodeResult] = []
     logged: list[LoggedEpisode] = []
     notes = [] if notes is None else notes
+    if isinstance(paths, (str, os.PathLike)):  # one path, not a list of its letters
+        paths = [paths]
     for path in paths:
         p = Path(path)
         if not p.exists():
@@ -353,13 +355,20 @@ def log_exchanges(paths: Iterable[str | os.PathLike[str]]) -> list[tuple[str, di
     return out
 
 
-def replay_decisions(planner: Planner, episodes: Sequence[LoggedEpisode],
+def replay_decisions(planner: Planner | str, episodes: Sequence[LoggedEpisode],
                      name: str | None = None) -> OfflineReport:
-    """Ask ``planner`` at every logged decision point of ``episodes`` (module doc: it
-    decides on the logged graph, then is told the logged outcome) and compare its choices
-    with the logged actions; ``name`` labels the report (default: the planner's name). An
-    LLM planner that leaves its recorded transcript (another run's) is an error."""
+    """Ask ``planner`` (or the planner of that name, with its default options) at every
+    logged decision point of ``episodes`` (module doc: it decides on the logged graph,
+    then is told the logged outcome) and compare its choices with the logged actions;
+    ``name`` labels the report (default: the planner's name). An LLM planner that leaves
+    its recorded transcript (another run's) is an error."""
     from sgtool.planning.moma.planner import replay_miss_of
+
+    if isinstance(planner, str):
+        from sgtool.planning.registry import make_planner
+
+        name = name or planner
+        planner = make_planner(planner)
 
     out: list[DecisionComparison] = []
     skipped = 0

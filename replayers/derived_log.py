@@ -251,6 +251,8 @@ def replay(
     message by message (recompressed)."""
     src = Path(log)
     dst = Path(output) if output is not None else None
+    if options is not None and not isinstance(options, ReplayOptions):
+        raise SgtoolError(f"options: expected a ReplayOptions, got {type(options).__name__}")
     if dst is not None and dst.exists() and src.exists() and dst.resolve() == src.resolve():
         raise SgtoolError("the output must not be the input log")
     with LogReader(src, verify=verify or dst is not None) as reader, single_blas_thread():

@@ -217,3 +217,34 @@ def test_a_log_round_trip_through_the_public_names(tmp_path: Path) -> None:
         [(t, back)] = list(log.records(sgtool.ActionRecord))
     assert t == 1_000_000_000 and back.target == "room:1"
     assert back.travelled_m == 1.2346  # distances are rounded to 0.1 mm by the record
+
+
+def test_api_mistakes_are_one_line_errors(tmp_path) -> None:
+    """What a notebook gets wrong most: one name where a list goes, a list where a tuple
+    goes, a profile by name, options of another type, a planner returning nothing."""
+    import sgtool
+
+    cfg = sgtool.BenchConfig(planners="scout", houses=1, episodes=1, seeds=1, rooms=[4, 5])
+    assert cfg.planners == ("scout",) and cfg.rooms == (4, 5)
+    with pytest.raises(sgtool.SgtoolError, match=r"missing\.mcap: no such file"):
+        sgtool.load_results(str(tmp_path / "missing.mcap"))  # one path, not its letters
+    with pytest.raises(sgtool.SgtoolError, match=r"missing\.mcap: no such log"):
+        sgtool.pin_logs(str(tmp_path / "missing.mcap"), tmp_path / "g")
+    assert sgtool.ClosedLoopOptions(noise="strong").noise == sgtool.parse_noise("strong")
+    with pytest.raises(sgtool.SgtoolError, match="noise: expected a NoiseProfile"):
+        sgtool.ClosedLoopOptions(noise=3)  # type: ignore[arg-type]
+    with pytest.raises(sgtool.SgtoolError, match="options: expected a ReplayOptions"):
+        sgtool.replay("any.mcap", options="every=5")  # type: ignore[arg-type]
+    with pytest.raises(sgtool.SgtoolError, match=r"__main__.*workers=1"):
+        sgtool.BenchConfig(planners=("__main__:Mine",), workers=2).check()
+
+    class Nothing:
+        name = "nothing"
+
+        def reset(self, query: str, seed: int = 0) -> None: ...
+        def decide(self, graph: object) -> None: ...
+        def feedback(self, fb: object) -> None: ...
+
+    house = sgtool.generate_house(3, rooms=(4, 5))
+    with pytest.raises(sgtool.SgtoolError, match=r"'nothing': decide\(\) returned NoneType"):
+        sgtool.run_one(house, Nothing(), sgtool.list_episodes(house)[0].query)

@@ -32,13 +32,16 @@ symbolic benchmark     :func:`run_one` (one episode), :class:`SymbolicHouse`,
                        :class:`BenchResult`, :func:`write_bench_outputs`
 closed loop            :func:`run_closed_loop` (one PyBullet episode into a log),
                        :class:`ClosedLoopOptions`, :class:`ClosedLoopReport`,
-                       :func:`pick_episode`
+                       :func:`pick_episode`, :class:`NoiseProfile` (sensor faults, from
+                       :func:`parse_noise`: ``"strong"``, ``"mild,holes=0.05"``)
 metrics                :func:`success_rate`, :func:`spl`, :func:`episode_spl`,
                        :func:`mean_steps`, :func:`mean_decision_time`, :func:`auc_e`,
                        :func:`efficiency_curve`, :class:`CostModel`, :func:`cost_models`,
                        :func:`metrics_of`, :func:`summarize`, :class:`PlannerSummary`,
                        :class:`Stat`, :func:`format_table`, :func:`read_results`,
-                       :func:`write_results`
+                       :func:`write_results`, :func:`planner_intervals`,
+                       :func:`paired_comparison` (bootstrap :class:`Interval` s over houses:
+                       :class:`PlannerIntervals`, :class:`PairedComparison`)
 logged decisions       :func:`load_results`, :func:`read_log_episodes`,
                        :class:`LoggedEpisode`, :func:`replay_decisions`,
                        :class:`OfflineReport`, :func:`format_offline`

@@ -68,7 +68,14 @@ from sgtool.recorders.sim.closed_loop import run_episode as run_closed_loop
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions as ClosedLoopOptions
 from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport as ClosedLoopReport
 from sgtool.recorders.sim.closed_loop import pick_episode as pick_episode
+from sgtool.recorders.sim.noise import NoiseProfile as NoiseProfile
+from sgtool.recorders.sim.noise import parse_noise as parse_noise
 # metrics
+from sgtool.analysis.intervals import Interval as Interval
+from sgtool.analysis.intervals import PairedComparison as PairedComparison
+from sgtool.analysis.intervals import PlannerIntervals as PlannerIntervals
+from sgtool.analysis.intervals import paired_comparison as paired_comparison
+from sgtool.analysis.intervals import planner_intervals as planner_intervals
 from sgtool.analysis.search_metrics import success_rate as success_rate
 from sgtool.analysis.search_metrics import spl as spl
 from sgtool.analysis.search_metrics import episode_spl as episode_spl
@@ -129,7 +136,9 @@ __all__ = [
     "load_house_text", "save_house", "generate_house", "SearchEpisode", "list_episodes",
     "run_one", "SymbolicHouse", "EpisodeResult", "BenchConfig", "BenchResult", "run_benchmark",
     "write_bench_outputs", "run_closed_loop", "ClosedLoopOptions", "ClosedLoopReport",
-    "pick_episode", "success_rate", "spl", "episode_spl", "mean_steps", "mean_decision_time",
+    "pick_episode", "NoiseProfile", "parse_noise", "Interval", "PairedComparison",
+    "PlannerIntervals", "paired_comparison", "planner_intervals", "success_rate", "spl",
+    "episode_spl", "mean_steps", "mean_decision_time",
     "auc_e", "efficiency_curve", "CostModel", "cost_models", "metrics_of", "summarize",
     "PlannerSummary", "Stat", "format_table", "read_results", "write_results", "load_results",
     "read_log_episodes", "LoggedEpisode", "replay_decisions", "OfflineReport", "format_offline",

@@ -18,7 +18,7 @@ from sgtool.recorders.sim.camera import CameraConfig
 from sgtool.recorders.sim.keyframes import KeyframeRule
 from sgtool.recorders.sim.live_skills import LiveNavConfig
 from sgtool.recorders.sim.navigation import RobotConfig
-from sgtool.recorders.sim.noise import PROFILES, NoiseProfile
+from sgtool.recorders.sim.noise import PROFILES, NoiseProfile, parse_noise
 from sgtool.scenegraph.build_options import (
     CLASSIFIERS,
     MAX_DEPTH_M,
@@ -46,7 +46,7 @@ class ClosedLoopOptions:
     fps: float = 10.0
     camera: CameraConfig = field(default_factory=CameraConfig)
     robot: RobotConfig = field(default_factory=RobotConfig)
-    noise: NoiseProfile = field(default_factory=lambda: PROFILES["none"])
+    noise: NoiseProfile = field(default_factory=lambda: PROFILES["none"])  # or its text
     noise_seed: int = 0
     every: int = 10  # frames between graph refreshes (and one at every action)
     classifier: str = "frequency"
@@ -71,6 +71,14 @@ class ClosedLoopOptions:
     # an explore that showed no new object, door or room goes on to up to this many
     # frontiers the planner chooses, no steps (live navigation; 0: it does not)
     explore_on: int = 0
+
+    def __post_init__(self) -> None:
+        # a profile by name or text ("strong", "mild,holes=0.05"), as the CLI takes it
+        if isinstance(self.noise, str):
+            object.__setattr__(self, "noise", parse_noise(self.noise))
+        elif not isinstance(self.noise, NoiseProfile):
+            raise SgtoolError(f"noise: expected a NoiseProfile or a profile's text, got "
+                              f"{type(self.noise).__name__}")
 
     def keyframes(self) -> KeyframeRule:
         """Which ticks are frames (a one-line :class:`~sgtool.errors.SgtoolError` when

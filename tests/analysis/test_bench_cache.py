@@ -29,3 +29,16 @@ def test_runs_in_two_threads_keep_their_own_planners():
     # each run saw one planner throughout, and not the other run's
     assert len({id(p) for p in seen["x"]}) == 1 and len({id(p) for p in seen["y"]}) == 1
     assert seen["x"][0] is not seen["y"][0]
+
+
+def test_a_house_file_rewritten_between_runs_is_another_house():
+    """A notebook that edits its house file and runs again benches the new house."""
+    from sgtool.analysis.bench_cache import cached_house
+    from sgtool.analysis.bench_houses import BenchHouse
+    from sgtool.datasets.generator import generate_house
+
+    old = BenchHouse("myhouse", "hh/myhouse.json", spec=generate_house(1, rooms=(4, 6)))
+    new = BenchHouse("myhouse", "hh/myhouse.json", spec=generate_house(7, rooms=(5, 6)))
+    a, b = cached_house(old, (4, 16), 3), cached_house(new, (4, 16), 3)
+    assert [e.query for e in a[1]] != [e.query for e in b[1]]
+    assert cached_house(old, (4, 16), 3) is a  # the same content: built once

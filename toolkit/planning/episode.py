@@ -147,6 +147,9 @@ def _step(planner: Planner, graph: SceneGraph, index: int, recorder: SearchRecor
     t0 = time.perf_counter()
     action = planner.decide(graph)
     dt = time.perf_counter() - t0
+    if not isinstance(action, Action):
+        raise SgtoolError(f"planner {getattr(planner, 'name', type(planner).__name__)!r}: "
+                          f"decide() returned {type(action).__name__}, not an Action")
     kept = getattr(planner, "exchanges", None)
     exchanges = tuple(kept[n0:]) if isinstance(kept, list) else ()
     if recorder is not None:
