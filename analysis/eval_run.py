@@ -85,14 +85,28 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
 
 def per_noise(results: Sequence[EpisodeResult]) -> tuple[list[EpisodeResult], list[str]]:
     """``results`` with each planner named ``PLANNER [NOISE]`` when they ran under more
-    than one sensor noise profile (:attr:`EpisodeResult.noise`; ``unknown`` when not
-    recorded), and those profiles in order of appearance (empty: one profile, names
-    kept): episodes of different sensors are not pooled."""
+    than one sensor noise profile (:attr:`EpisodeResult.noise`, or the run-bench folder
+    an older row's log lies in; ``unknown`` when neither says), and those profiles in
+    order of appearance (empty: one profile, names kept): episodes of different sensors
+    are not pooled."""
+    results = [r if r.noise else replace(r, noise=_run_bench_noise(r)) for r in results]
     profiles = list(dict.fromkeys(r.noise or "unknown" for r in results))
     if len(profiles) < 2:
         return list(results), []
     return [replace(r, planner=f"{r.planner} [{r.noise or 'unknown'}]") for r in results], \
         profiles
+
+
+def _run_bench_noise(r: EpisodeResult) -> str:
+    """The noise profile of a row written before rows named it, from its log's place in a
+    run-bench folder (``.../logs/NOISE/PLANNER/HOUSE/ep-K.mcap``); "" when it is not."""
+    from sgtool.planning.registry import planner_file_name
+
+    parts = Path(r.source).parts
+    if len(parts) >= 5 and parts[-5] == "logs" and parts[-3] == planner_file_name(r.planner) \
+            and parts[-2] == r.house and parts[-1].startswith("ep-"):
+        return parts[-4]
+    return ""
 
 
 def _replays(request: EvalRequest, logged: Sequence[Any], exchanges: Sequence[Any]
