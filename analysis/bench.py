@@ -157,7 +157,13 @@ class BenchConfig:
                            {str(k): dict(v) for k, v in self.planner_options.items()})
         for name in ("planners", "house_files"):  # one name is a list of one, not of letters
             v = getattr(self, name)
-            object.__setattr__(self, name, (v,) if isinstance(v, str) else tuple(v))
+            if isinstance(v, (set, frozenset)):  # no order: tables and digests would vary
+                raise BenchError(f"{name}: give a list or tuple (a set has no order)")
+            v = (v,) if isinstance(v, (str, os.PathLike)) else tuple(v)
+            object.__setattr__(self, name, tuple(str(x) if name == "house_files" else x
+                                                 for x in v))
+        if isinstance(self.rooms, (str, int)) or len(tuple(self.rooms)) != 2:
+            raise BenchError(f"rooms: give (MIN, MAX), got {self.rooms!r}")
         object.__setattr__(self, "rooms", tuple(self.rooms))  # (a list from a JSON file)
 
     def check(self) -> None:

@@ -129,6 +129,8 @@ class GoldenFixture:
         from sgtool.replayers.golden_pins import INDEX, read_pins
 
         log, folder = Path(log), Path(folder)
+        if not log.is_file():
+            pytest.fail(f"{log}: no such log", pytrace=False)
         name = pin_name(log)
         pin = read_pins(folder).logs.get(name) if (folder / INDEX).is_file() else None
         if pin is None:

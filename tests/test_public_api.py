@@ -248,3 +248,17 @@ def test_api_mistakes_are_one_line_errors(tmp_path) -> None:
     house = sgtool.generate_house(3, rooms=(4, 5))
     with pytest.raises(sgtool.SgtoolError, match=r"'nothing': decide\(\) returned NoneType"):
         sgtool.run_one(house, Nothing(), sgtool.list_episodes(house)[0].query)
+
+
+def test_bench_config_shapes(tmp_path) -> None:
+    """A set has no order (digests would vary with the hash seed); a path is a list of
+    one; rooms are a pair."""
+    import sgtool
+
+    with pytest.raises(sgtool.SgtoolError, match="a set has no order"):
+        sgtool.BenchConfig(planners={"scout", "random"})
+    cfg = sgtool.BenchConfig(planners=("scout",), house_files=tmp_path / "h.json")
+    assert cfg.house_files == (str(tmp_path / "h.json"),)
+    for rooms in (5, (12, 16, 3)):
+        with pytest.raises(sgtool.SgtoolError, match="rooms: give"):
+            sgtool.BenchConfig(planners=("scout",), rooms=rooms)  # type: ignore[arg-type]

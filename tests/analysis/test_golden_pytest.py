@@ -87,6 +87,9 @@ def test_the_fixture_refuses_another_log_of_the_pinned_name(tmp_path, monkeypatc
     monkeypatch.setenv("WHICH", "v1")
     code, out = pytest_run("test_lab.py", cwd=tmp_path)
     assert code == 0, out
+    monkeypatch.setenv("WHICH", "v3")  # no such log: one line, no traceback
+    code, out = pytest_run("test_lab.py", cwd=tmp_path)
+    assert code == 1 and "v3/run.mcap: no such log" in out and "Traceback" not in out, out
     monkeypatch.setenv("WHICH", "v2")
     code, out = pytest_run("test_lab.py", cwd=tmp_path)
     assert code == 1 and "is not the log pinned as 'run'" in out, out

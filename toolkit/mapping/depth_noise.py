@@ -25,6 +25,12 @@ where ``k`` sigma_v stays within the floor tolerance:
 
     z_max = the lower edge of the first depth bin with k sigma_v(z) > tolerance   (N2)
 
+Noise moves about half the floor's points below it; a depth bin whose points below the
+floor are far fewer than that holds no noise to measure, only a sunken area or a step
+down seen there, and is left out:
+
+    points below the floor >= BELOW_SHARE x points within PEAK of it, per bin     (N3)
+
 The floor ``f`` is found as the bird's-eye map finds it (the lowest height level holding
 at least half as many points as the fullest one) and measured only when it is where
 sgtool's logs put it, at height 0 (recorded in simulation, or imported: the importers
@@ -54,6 +60,7 @@ MIN_BELOW = 50  # points below the floor for a depth bin to count
 MIN_FLOOR = 500  # points near height 0 for a floor
 SIGMAS = 4.0  # k of (N2)
 HALF_NORMAL_MEDIAN = 0.6745  # the median of |N(0, 1)|
+BELOW_SHARE = 0.3  # (N3): least points below the floor per point at it (noise: about 0.5)
 BELOW_LIMIT = 1.0  # m; points further below the floor are not floor (stairs, reflections)
 MIN_DEPTH = 1.0  # m; the least depth kept: what is around the robot is always mapped
 
@@ -158,19 +165,25 @@ def _below_floor(frames: list[FramePoints], f: float
     """(N1) below the floor ``f`` (within ``BELOW_LIMIT``): the depth bins with at least
     ``MIN_BELOW`` points and their median depth below the floor over the half-normal's
     median; None without."""
-    zb_parts, db_parts = [], []
+    zb_parts, db_parts, za_parts = [], [], []
     for fp in frames:
         below = (fp.h < f) & (fp.h > f - BELOW_LIMIT)
-        zf = fp.floor_depths(f)[below]
-        good = np.isfinite(zf)
-        zb_parts.append(zf[good])
+        zf = fp.floor_depths(f)
+        good = np.isfinite(zf[below])
+        zb_parts.append(zf[below][good])
         db_parts.append(f - fp.h[below][good])
+        at = (np.abs(fp.h - f) <= PEAK) & np.isfinite(zf)  # the floor at that depth
+        za_parts.append(zf[at])
     zb, db = np.concatenate(zb_parts), np.concatenate(db_parts)
     if zb.size == 0:
         return None
     bins = np.floor(np.minimum(zb, MAX_BINS * BIN) / BIN).astype(np.int64)
     n = np.bincount(bins)
-    keep = np.flatnonzero(n >= MIN_BELOW)
+    za = np.concatenate(za_parts)
+    at_floor = np.bincount(np.floor(np.minimum(za, MAX_BINS * BIN) / BIN).astype(np.int64),
+                           minlength=n.size)[:n.size]
+    # (N3) under noise about half the floor's points lie below it; far fewer: no noise
+    keep = np.flatnonzero((n >= MIN_BELOW) & (n >= BELOW_SHARE * at_floor))
     if keep.size == 0:
         return None
     order = np.lexsort((db, bins))  # by bin, then by depth below the floor

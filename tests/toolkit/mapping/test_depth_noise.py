@@ -117,8 +117,9 @@ def test_a_sunken_floor_is_no_noise():
     """A fifth of the floor seen between 1 and 3 m lies 0.15 m lower (a sunken area, a step
     down): points below the floor that are no noise. (N1) takes the median, so a minority
     of them does not read as noise (their RMS would: 0.15 m x sqrt(0.2 / 0.6) is 0.087 m,
-    4 sigma 0.35 m): a good sensor's log is not cut; a noisy one's is, more conservatively
-    (the sunken points are a third of those below the floor there)."""
+    4 sigma 0.35 m), and (N3) leaves out depths where they are all there is: a good
+    sensor's log is not cut; a noisy one's is, more conservatively (the sunken points are
+    a third of those below the floor there)."""
     from sgtool.mapping.depth_noise import FramePoints
 
     def sunken(fp: FramePoints) -> FramePoints:
@@ -131,6 +132,18 @@ def test_a_sunken_floor_is_no_noise():
     # a good sensor (0.002 z^2: 4 sigma reach the tolerance at 10 m): nothing cut
     clean = estimate([sunken(fp) for fp in samples(0.002)], 0.1, ceiling=5.0)
     assert clean is not None and clean.max_depth is None
+    # no noise at all and a twentieth of the floor lower: the points below the floor are
+    # the sunken ones (and a few a rounding error below), far fewer than half the
+    # floor's there ((N3)): nothing cut either
+    def lower_20th(fp: FramePoints) -> FramePoints:
+        zf = fp.floor_depths(0.0)
+        floor = np.flatnonzero((np.abs(fp.h) < 0.2) & (zf > 1.0) & (zf < 3.0))
+        h = fp.h.copy()
+        h[floor[::20]] -= 0.15
+        return FramePoints(h, fp.slope, fp.camera_z)
+
+    exact = estimate([lower_20th(fp) for fp in samples(0.0)], 0.1)
+    assert exact is None or exact.max_depth is None
     noisy = estimate([sunken(fp) for fp in samples(0.01)], 0.1)
     assert noisy is not None and noisy.max_depth is not None
     assert noisy.max_depth <= 2.0  # cut, at 2 m without the sunken area, nearer with it
