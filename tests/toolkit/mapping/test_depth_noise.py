@@ -122,11 +122,11 @@ def test_a_sunken_floor_is_no_noise():
     a third of those below the floor there)."""
     from sgtool.mapping.depth_noise import FramePoints
 
-    def sunken(fp: FramePoints) -> FramePoints:
+    def sunken(fp: FramePoints, every: int = 5) -> FramePoints:
         zf = fp.floor_depths(0.0)
         floor = np.flatnonzero((np.abs(fp.h) < 0.2) & (zf > 1.0) & (zf < 3.0))
         h = fp.h.copy()
-        h[floor[::5]] -= 0.15
+        h[floor[::every]] -= 0.15
         return FramePoints(h, fp.slope, fp.camera_z)
 
     # a good sensor (0.002 z^2: 4 sigma reach the tolerance at 10 m): nothing cut
@@ -135,14 +135,7 @@ def test_a_sunken_floor_is_no_noise():
     # no noise at all and a twentieth of the floor lower: the points below the floor are
     # the sunken ones (and a few a rounding error below), far fewer than half the
     # floor's there ((N3)): nothing cut either
-    def lower_20th(fp: FramePoints) -> FramePoints:
-        zf = fp.floor_depths(0.0)
-        floor = np.flatnonzero((np.abs(fp.h) < 0.2) & (zf > 1.0) & (zf < 3.0))
-        h = fp.h.copy()
-        h[floor[::20]] -= 0.15
-        return FramePoints(h, fp.slope, fp.camera_z)
-
-    exact = estimate([lower_20th(fp) for fp in samples(0.0)], 0.1)
+    exact = estimate([sunken(fp, 20) for fp in samples(0.0)], 0.1)
     assert exact is None or exact.max_depth is None
     noisy = estimate([sunken(fp) for fp in samples(0.01)], 0.1)
     assert noisy is not None and noisy.max_depth is not None
