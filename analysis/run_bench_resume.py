@@ -156,7 +156,7 @@ def check_resumable(path: Path, want: dict[str, Any], spec: HouseSpec, house: st
         depth = settings.get("max_depth")
         fix = (f"--max-depth {depth:g} maps as that log did, or {_FIX}"
                if settings.get("max_depth") != want.get("max_depth") and depth is not None
-               else _FIX)
+               and settings.get("noise") == want.get("noise") else _FIX)
         raise ResumeError(f"{path} was run with other settings ({'; '.join(diff)}); {fix}")
     if not same_house(logged_house, spec):
         raise ResumeError(f"{path} was run on another house: the house of {house} changed "
