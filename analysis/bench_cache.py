@@ -41,7 +41,9 @@ def cached_house(ref: BenchHouse, rooms: tuple[int, int], episodes: int,
     # the preset's episode mix (furniture-level targets) is for generated houses; a given
     # house file is searched for its small objects, as list_episodes lists them
     mix = preset if ref.spec is None else "default"
-    entry = (SymbolicHouse(spec), bench_episodes(spec, episodes, mix))
+    house = SymbolicHouse(spec)
+    house.prepare()  # its geodesics now, not in the first planner's first (timed) episode
+    entry = (house, bench_episodes(spec, episodes, mix))
     _HOUSES[key] = entry
     while len(_HOUSES) > 3:
         _HOUSES.popitem(last=False)

@@ -228,7 +228,32 @@ def house_notes(house: Any) -> tuple[str, ...]:
     if cut:
         notes.append(f"{', '.join(cut)}: no door or passage leads there from the rest of "
                      "the house; a search for a target inside starts there, any other outside")
+    unlinked = [r for r in unlinked_rooms(house) if r not in cut]
+    if unlinked:
+        notes.append(f"{', '.join(unlinked)}: joined to the rest by open floor (no wall) but "
+                     "by no door or passage, so the scene graph never leads there: give the "
+                     "opening a passage (or a door), or a wall")
     return tuple(notes)
+
+
+def unlinked_rooms(house: Any) -> list[str]:
+    """Ids of the rooms outside the largest group of rooms joined by doors and passages
+    (the scene graph's links), in spec order."""
+    n = len(house.spec.rooms)
+    group = [-1] * n
+    for start in range(n):
+        if group[start] >= 0:
+            continue
+        group[start], todo = start, [start]
+        while todo:
+            a = todo.pop()
+            for b, _ in house.links[a]:
+                if group[b] < 0:
+                    group[b] = start
+                    todo.append(b)
+    sizes = {g: group.count(g) for g in set(group)}
+    main = max(sorted(sizes), key=lambda g: sizes[g])
+    return [house.spec.rooms[i].id for i in range(n) if group[i] != main]
 
 
 def completion_notes(path: Path, spec: HouseSpec) -> tuple[str, ...]:

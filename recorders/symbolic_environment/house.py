@@ -284,6 +284,12 @@ class SymbolicHouse:
             out[i] = done[cell]
         return np.minimum(out, out.T)  # exact symmetry despite float summation order
 
+    def prepare(self) -> None:
+        """Compute the geodesics between places now (the first travel question does it
+        otherwise): a caller that times episodes calls it first, so the house's cost is
+        not counted in its first episode."""
+        self._base  # noqa: B018 (the cached property is the work)
+
     def _graph(self, open_doors: frozenset[int]) -> csr_matrix:
         g = self._graphs.get(open_doors)
         if g is None:

@@ -42,3 +42,22 @@ def test_a_house_file_rewritten_between_runs_is_another_house():
     a, b = cached_house(old, (4, 16), 3), cached_house(new, (4, 16), 3)
     assert [e.query for e in a[1]] != [e.query for e in b[1]]
     assert cached_house(old, (4, 16), 3) is a  # the same content: built once
+
+
+def test_rooms_joined_by_open_floor_alone_are_said():
+    """Two rooms that touch with no wall between them and no door or passage: the grid
+    joins them, the scene graph never does, so a search there fails; the house's notes say
+    so (and a house built by the generator says nothing)."""
+    import dataclasses
+
+    from sgtool.analysis.bench_houses import house_notes, unlinked_rooms
+    from sgtool.datasets.generator import generate_house
+    from sgtool.recorders.symbolic_environment.house import SymbolicHouse
+
+    spec = generate_house(2, rooms=(4, 5))
+    assert unlinked_rooms(SymbolicHouse(spec)) == []
+    bare = dataclasses.replace(spec, walls=(), doors=(), passages=())
+    house = SymbolicHouse(bare)
+    assert len(unlinked_rooms(house)) == len(spec.rooms) - 1
+    assert any("by no door or passage, so the scene graph never leads there" in n
+               for n in house_notes(house))
