@@ -29,6 +29,7 @@ noise profile (distance, steps and frames per room).
 
 from __future__ import annotations
 
+import functools
 import json
 import re
 import statistics
@@ -182,9 +183,11 @@ class RunRow:
     went_on: int = 0
 
 
+@functools.lru_cache(maxsize=64)
 def noise_folder(noise: str) -> str:
     """The log folder of a ``--noise`` profile: its text, or for a JSON file the profile's
-    name (its ``name`` field, else the file's stem)."""
+    name (its ``name`` field, else the file's stem; the file read once per process, so a
+    run's folders and tables keep one name however long it runs)."""
     return parse_noise(noise).name if names_file(noise) else noise
 
 
