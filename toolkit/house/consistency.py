@@ -67,6 +67,15 @@ def check_consistency(spec: HouseSpec, limits: SpecLimits) -> None:
                                     f"{off:.2f} m from its room {rid} (more than "
                                     f"{limits.opening_offset:g} m)"
                                     f"{id_note(key, i, d.id)}")
+                # the opening runs along the border (yaw: the wall's direction), so both
+                # its ends lie at each of its rooms, not one end inside the other room
+                for tip in opening_segment(d.center, d.width, d.yaw):
+                    off = distance_to_polygon(tip[0], tip[1], by_room[rid].polygon)
+                    if off > limits.opening_offset:
+                        raise SpecError(f"{key}[{i}].yaw: {d.yaw:g} rad sets the opening "
+                                        f"across the border of {rid}, not along it (an end "
+                                        f"{off:.2f} m from the room; yaw is the direction "
+                                        f"of the wall it sits in){id_note(key, i, d.id)}")
     for i, f in enumerate(spec.furniture):
         room = by_room[f.room]
         if not room.contains(f.center[0], f.center[1]):

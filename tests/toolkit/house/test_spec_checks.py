@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import copy
 import json
+import math
 from pathlib import Path
 
 import pytest
@@ -299,3 +300,12 @@ def test_a_piece_with_something_on_top_is_read_as_a_supporter() -> None:
     assert aff == {"furn_0": ("container", "openable"), "furn_1": ("supporter",),
                    "furn_2": ("supporter",), "furn_3": ()}
     assert load_house(json.loads(spec.to_json())) == spec  # the completed file is stable
+
+
+def test_a_door_set_across_its_wall_is_refused() -> None:
+    """A door's yaw is the direction of the wall it sits in: turned a quarter, its panel
+    would stick into both rooms and leave the wall's gap open."""
+    d = two_rooms()
+    d["doors"][0]["yaw"] = d["doors"][0].get("yaw", 0.0) + math.pi / 2
+    _refused(d, r"^doors\[0\]\.yaw: .* rad sets the opening across the border of room_\d, "
+                r"not along it")
