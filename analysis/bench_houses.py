@@ -222,7 +222,8 @@ def house_notes(house: Any) -> tuple[str, ...]:
         notes.append(f"{d.id} ({' - '.join(d.rooms)}): the robot (radius "
                      f"{house.robot_radius:g} m) cannot get through it from one room's free "
                      "floor to the other's (" + (f"furniture within 1 m: {', '.join(near)}"
-                                                 if near else "too narrow") +
+                                                 if near else "too narrow, or furniture "
+                                                 "farther in cuts the door's side off") +
                      "); read as a wall")
     cut = house.isolated_rooms()
     if cut:
