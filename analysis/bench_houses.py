@@ -240,20 +240,16 @@ def house_notes(house: Any) -> tuple[str, ...]:
 def unlinked_rooms(house: Any) -> list[str]:
     """Ids of the rooms outside the largest group of rooms joined by doors and passages
     (the scene graph's links), in spec order."""
+    import numpy as np
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import connected_components
+
     n = len(house.spec.rooms)
-    group = [-1] * n
-    for start in range(n):
-        if group[start] >= 0:
-            continue
-        group[start], todo = start, [start]
-        while todo:
-            a = todo.pop()
-            for b, _ in house.links[a]:
-                if group[b] < 0:
-                    group[b] = start
-                    todo.append(b)
-    sizes = {g: group.count(g) for g in set(group)}
-    main = max(sorted(sizes), key=lambda g: sizes[g])
+    pairs = [(a, b) for a in range(n) for b, _ in house.links[a]]
+    links = csr_matrix((np.ones(len(pairs)), ([a for a, _ in pairs], [b for _, b in pairs])),
+                       shape=(n, n))
+    _, group = connected_components(links, directed=False)
+    main = int(np.argmax(np.bincount(group)))  # the largest group (the first of equals)
     return [house.spec.rooms[i].id for i in range(n) if group[i] != main]
 
 

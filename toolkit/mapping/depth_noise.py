@@ -48,6 +48,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import ndimage
 
 from sgtool.mapping.bev import estimate_floor_level
 
@@ -186,10 +187,8 @@ def _below_floor(frames: list[FramePoints], f: float
     keep = np.flatnonzero((n >= MIN_BELOW) & (n >= BELOW_SHARE * at_floor))
     if keep.size == 0:
         return None
-    order = np.lexsort((db, bins))  # by bin, then by depth below the floor
-    starts = np.concatenate([[0], np.cumsum(n)])[keep]
-    lo, hi = db[order][starts + (n[keep] - 1) // 2], db[order][starts + n[keep] // 2]
-    return keep, (lo + hi) / 2 / HALF_NORMAL_MEDIAN
+    medians = ndimage.median(db, labels=bins, index=keep)
+    return keep, np.asarray(medians, dtype=np.float64) / HALF_NORMAL_MEDIAN
 
 
 def cut_depth(edges: np.ndarray, sigma: np.ndarray, tolerance: float,
