@@ -43,8 +43,9 @@ from sgtool.house.spec import HouseSpec, enclosed
 from sgtool.mapping.occupancy import (
     OccupancyMap,
     cell_to_world,
-    geodesic_distances,
+    free_cell_graph,
     house_occupancy,
+    nearest_free_cell,
     world_to_cell,
 )
 from sgtool.recorders.symbolic_environment.doorways import blocked_doors
@@ -55,6 +56,9 @@ from sgtool.semantics.text import category_text
 from sgtool.vocabulary import OPEN_STATES, RELATIONS, OpenState, Relation
 
 _V = TypeVar("_V", bound=str)
+# geodesics between places are searched in batches of starts whose result arrays hold
+# at most this many cells together (bounded memory on a large open floor)
+_GEODESIC_BATCH_CELLS = 8_000_000
 
 
 def _member(value: str, allowed: tuple[_V, ...]) -> _V:
@@ -270,18 +274,37 @@ class SymbolicHouse:
     def _base(self) -> np.ndarray:
         """Geodesics between all places with every door closed (inf across doors): the
         costly part of a house, computed at its first travel question (a check of the house
-        file asks none)."""
+        file asks none). The same distances as :func:`~sgtool.mapping.occupancy.
+        geodesic_distances` from each place to the others' cells, searched only within the
+        free space each place can reach (a room, or rooms joined by passages), so a house
+        of many rooms costs its rooms, not its rooms times its whole grid."""
         n = len(self.places)
-        cells = [world_to_cell(self.occ, x, y) for x, y in self.places]
-        rows = np.array([c[0] for c in cells])
-        cols = np.array([c[1] for c in cells])
         out = np.full((n, n), np.inf)
-        done: dict[tuple[int, int], np.ndarray] = {}
-        for i, cell in enumerate(cells):
-            if cell not in done:
-                grid = geodesic_distances(self.occ, self.places[i], max_snap=0.0)
-                done[cell] = grid[rows, cols]
-            out[i] = done[cell]
+        g, index, _ = free_cell_graph(self.occ)
+        if g.shape[0] == 0:
+            return out
+        _, part = connected_components(g, directed=False)
+        targets = np.array([index[world_to_cell(self.occ, x, y)] for x, y in self.places])
+        sources = np.array([-1 if c is None else index[c] for c in
+                            (nearest_free_cell(self.occ, x, y, 0.0) for x, y in self.places)])
+        for label in sorted({int(part[s]) for s in sources if s >= 0}):
+            nodes = np.flatnonzero(part == label)  # ascending: the whole graph's order
+            local = np.full(g.shape[0], -1, np.int64)
+            local[nodes] = np.arange(nodes.size)
+            sub = g[nodes][:, nodes]
+            rows = [i for i in range(n) if sources[i] >= 0 and part[sources[i]] == label]
+            cols = [j for j in range(n) if targets[j] >= 0 and part[targets[j]] == label]
+            starts = sorted({int(local[sources[i]]) for i in rows})
+            # bounded memory: each batch of starts returns a (batch, cells) array
+            batch = max(1, _GEODESIC_BATCH_CELLS // nodes.size)
+            found: dict[int, np.ndarray] = {}
+            for k in range(0, len(starts), batch):
+                chunk = starts[k:k + batch]
+                d = dijkstra(sub, directed=True, indices=chunk)
+                for s, row in zip(chunk, np.atleast_2d(d), strict=True):
+                    found[s] = row[local[targets[cols]]]
+            for i in rows:
+                out[i, cols] = found[int(local[sources[i]])]
         return np.minimum(out, out.T)  # exact symmetry despite float summation order
 
     def prepare(self) -> None:

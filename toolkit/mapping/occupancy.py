@@ -149,8 +149,10 @@ def inflate(occupied: np.ndarray, radius: float, resolution: float) -> np.ndarra
 # ----------------------------------------------------------------------------------------
 # graph search
 # ----------------------------------------------------------------------------------------
-def _graph(occ: OccupancyMap) -> tuple[csr_matrix, np.ndarray, np.ndarray]:
-    """CSR adjacency over free cells (cached on the map): (graph, index grid, flat cells)."""
+def free_cell_graph(occ: OccupancyMap) -> tuple[csr_matrix, np.ndarray, np.ndarray]:
+    """The 8-connected moves between free cells that cut no corner, as a CSR adjacency
+    (weights in metres; cached on the map): (graph, index grid of each cell's node or -1
+    when blocked, flat grid index of each node)."""
     cached = occ._cache.get("graph")
     if cached is not None:
         return cached
@@ -215,7 +217,7 @@ def geodesic_distances(occ: OccupancyMap, start_xy: Sequence[float] | Iterable[S
     nearest of them). A start in a blocked cell is moved to the nearest free cell within
     ``max_snap`` m; with none there, everything is ``inf``."""
     starts = _as_points(start_xy)
-    g, index, flat = _graph(occ)
+    g, index, flat = free_cell_graph(occ)
     src = []
     for x, y in starts:
         cell = nearest_free_cell(occ, x, y, max_snap)
@@ -241,7 +243,7 @@ def astar(occ: OccupancyMap, start_xy: Sequence[float], goal_xy: Sequence[float]
     cg = nearest_free_cell(occ, goal_xy[0], goal_xy[1], max_snap)
     if cs is None or cg is None:
         return None
-    g, index, flat = _graph(occ)
+    g, index, flat = free_cell_graph(occ)
     s, t = int(index[cs]), int(index[cg])
     cols = occ.shape[1]
     indptr, indices, weights = g.indptr, g.indices, g.data

@@ -86,7 +86,7 @@ def test_a_check_computes_no_geodesics_and_finds_the_same_parts(tmp_path: Path,
         raise AssertionError("a geodesic during the check")
 
     with monkeypatch.context() as m:
-        m.setattr(symbolic, "geodesic_distances", refuse)
+        m.setattr(symbolic, "dijkstra", refuse)
         (h,) = load_house_files([f])
         assert "read as a wall" in h.notes[0]
     house = SymbolicHouse(load_house(f))

@@ -7,10 +7,12 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 from support.datasets_fixtures import two_rooms, walled_off, with_closet
 
 from sgtool.analysis.bench_houses import load_house_files
 from sgtool.house.io import load_house
+from sgtool.mapping.occupancy import geodesic_distances, world_to_cell
 from sgtool.planning.base import Action
 from sgtool.recorders.symbolic_environment import SymbolicEnv, SymbolicHouse
 
@@ -53,3 +55,18 @@ def test_the_bench_names_a_walled_off_room(tmp_path: Path) -> None:
     g = tmp_path / "closet.json"
     g.write_text(json.dumps(with_closet()))
     assert load_house_files([g])[0].notes == ()
+
+
+def test_place_distances_are_the_grid_geodesics_of_each_place() -> None:
+    """Distances between places with every door closed, searched part by part of the free
+    space, are the whole-grid geodesics from each place (inf into parts it cannot reach)."""
+    house = SymbolicHouse(load_house(walled_off(with_closet(), "door_0")))
+    cells = tuple(zip(*(world_to_cell(house.occ, x, y) for x, y in house.places), strict=True))
+    whole = np.array([geodesic_distances(house.occ, xy, max_snap=0.0)[cells]
+                      for xy in house.places])
+    whole = np.minimum(whole, whole.T)
+    got = np.array([house.distances_from(i, frozenset()) for i in range(len(house.places))])
+    assert np.array_equal(np.isfinite(got), np.isfinite(whole))
+    assert np.allclose(got[np.isfinite(got)], whole[np.isfinite(whole)], rtol=0, atol=1e-9)
+    # some places reach others, and the walled-off room's do not reach the rest
+    assert len(house.places) < int(np.isfinite(got).sum()) < len(house.places) ** 2
