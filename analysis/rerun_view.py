@@ -57,8 +57,10 @@ from typing import Any
 import numpy as np
 
 from sgtool.colors import color_for
+from sgtool.errors import SgtoolError
 from sgtool.files import atomic_output, output_error
 from sgtool.log import LogReader, codec
+from sgtool.log.inspect import foreign_log_problem
 from sgtool.log import schemas as S
 from sgtool.log.frame import Frame
 
@@ -168,9 +170,12 @@ def export(
     ``voxels``, when given, is called with the open reader and yields (frame index, t_ns,
     voxel centres (N,3), colours (N,3) uint8, voxel size) to draw the semantic voxel map
     over time. ``warn``, when given, receives one-line notes about the log (frames without
-    a camera pose)."""
+    a camera pose). A recording that is not an sgtool log (a ROS bag, another tool's MCAP)
+    is refused with :class:`~sgtool.errors.SgtoolError` naming the import that fits it."""
 
     log_path = Path(log_path)
+    if (foreign := foreign_log_problem(log_path)) is not None:
+        raise SgtoolError(foreign)
     rid = recording_id(log_path)
     if spawn and live is None:
         from sgtool.analysis.rerun_live import LiveTarget

@@ -85,3 +85,15 @@ def test_an_sgtool_profile_without_its_metadata_record_says_so(tmp_path):
     assert msg is not None and "has the MCAP profile 'sgtool' but no 'sgtool' metadata" in msg
     r2 = CliRunner().invoke(cli, ["replay", str(out)])
     assert r2.exit_code == 2 and "no 'sgtool' metadata record" in r2.output
+
+
+def test_view_refuses_a_foreign_recording_in_one_line(tmp_path):
+    """`sgtool view` of a ROS 2 MCAP (its /tf is CDR, not sgtool's) says what it is, as
+    replay does, and writes no recording."""
+    bag = tmp_path / "poses"
+    write_frames_bag(frames(), bag, "ros2-mcap")
+    r = CliRunner().invoke(cli, ["view", str(bag / "poses.mcap"), "-o", str(tmp_path / "v.rrd")])
+    assert r.exit_code == 2 and "Traceback" not in r.output
+    assert len(r.output.strip().splitlines()) == 1
+    assert "is a ROS 2 recording" in r.output and "sgtool import bag" in r.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["poses"]
