@@ -4,7 +4,8 @@ intrinsics from ``--info`` or ``--intrinsics``, checked against the depth images
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+import bisect
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -58,6 +59,8 @@ def decode_frames(
         return ("depth" in d and (p.k_rgb is None or "rgb" in d)
                 and (p.k_ids is None or "ids" in d))
 
+    calibration = intrinsics_in_effect(idx, opts, k)
+
     def build(i: int) -> ImportFrame:
         d = decoded.pop(i)
         raw, scale = d["depth"]
@@ -67,7 +70,8 @@ def decode_frames(
                if "ids" in d else None)
         planned = plan[i]
         pose = planned.pose if planned.pose is not None else np.eye(4)
-        return ImportFrame(planned.t_ns, depth_for_log(raw, scale), pose, k, rgb=rgb, ids=ids)
+        return ImportFrame(planned.t_ns, depth_for_log(raw, scale), pose,
+                           calibration(planned.t_ns), rgb=rgb, ids=ids)
 
     for c, _, raw in reader.messages(connections=conns):
         kind = topic_kind[c.topic]
@@ -119,6 +123,28 @@ def camera_of(path: Path, idx: BagIndex, opts: BagOptions,
                                                  _intrinsics_origin(opts)),
                          given=opts.intrinsics is not None)
     return k
+
+
+def intrinsics_in_effect(idx: BagIndex, opts: BagOptions,
+                         k: CameraIntrinsics) -> Callable[[int], CameraIntrinsics]:
+    """The intrinsics of an image at time t: ``k`` (of :func:`camera_of`) until the
+    CameraInfo changes, then the latest one at or before t (a zoom, a recalibration);
+    ``k`` throughout with ``--intrinsics``. A change of image size is an error: the depth
+    images keep theirs."""
+    samples = [] if opts.intrinsics is not None else idx.info_samples[1:]
+    for _, (iw, ih, fx, fy, *_rest) in samples:
+        if (iw, ih) != (k.width, k.height) or fx <= 0 or fy <= 0:
+            raise SgtoolError(f"--info {opts.info} changes to {iw}x{ih} images (focal length "
+                              f"{fx:g}, {fy:g}) part-way through; the depth images are "
+                              f"{k.width}x{k.height} (a log holds one image size)")
+    times = [t for t, _ in samples]
+    cams = [CameraIntrinsics(k.width, k.height, *info[2:]) for _, info in samples]
+
+    def at(t: int) -> CameraIntrinsics:
+        j = bisect.bisect_right(times, t)
+        return k if j == 0 else cams[j - 1]
+
+    return at
 
 
 def _intrinsics_origin(opts: BagOptions) -> str:

@@ -42,21 +42,35 @@ class BagIndex:
     pose_child: str = ""  # the frame a --pose topic's messages give the pose of ("": unsaid)
     info: tuple[int, int, float, float, float, float] | None = None
     distortion: tuple[str, tuple[float, ...]] | None = None  # of the first CameraInfo
-    info_changes: int = 0
+    info_changes: int = 0  # how many times a CameraInfo's K differs from the one before
+    # (time, K) of the first CameraInfo and of each one whose K differs from the one before
+    info_samples: list[tuple[int, tuple[int, int, float, float, float, float]]] = field(
+        default_factory=list)
     samples: dict[int, tuple[np.ndarray, float]] = field(default_factory=dict)  # depth k ->
     zero_stamps: int = 0
     # record time minus header stamp of each dynamic /tf transform (ns)
     tf_latency_ns: list[int] = field(default_factory=list)
 
 
-def _stamp_or_bagtime(header: Any, bag_t: int, idx: BagIndex, use_bag: bool = False) -> int:
-    if use_bag:
-        return int(bag_t)
-    t = stamp_ns(header)
-    if t == 0:
+# a zero header stamp next to stamps within this of zero is a clock that starts at 0 (a
+# simulator's), not an unset stamp
+_SIM_CLOCK_NS = 60 * 10**9
+
+
+def _resolve_zero_stamps(ii: ImageIndex, idx: BagIndex) -> None:
+    """Replace the unset (zero) header stamps of one image topic by the bag's record times.
+    A zero is unset unless the nearest non-zero stamp of the topic (in message order) is
+    within ``_SIM_CLOCK_NS`` of it: a simulator's clock starts at 0, and its first image
+    keeps its stamp."""
+    stamps = np.asarray(ii.stamps, np.int64)
+    nonzero = np.flatnonzero(stamps != 0)
+    for i in np.flatnonzero(stamps == 0):
+        if nonzero.size:
+            near = nonzero[np.argmin(np.abs(nonzero - i))]
+            if stamps[near] <= _SIM_CLOCK_NS:
+                continue
+        ii.stamps[i] = ii.received[i]
         idx.zero_stamps += 1
-        return int(bag_t)
-    return t
 
 
 def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIndex:
@@ -95,13 +109,14 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
                 if idx.info is None:
                     idx.info = k
                     idx.distortion = distortion_of_info(msg)
-                elif k != idx.info:
-                    idx.info_changes += 1
+                if not idx.info_samples or k != idx.info_samples[-1][1]:
+                    t = int(bag_t) if opts.timestamps == "bag" else stamp_ns(msg.header)
+                    idx.info_samples.append((t or int(bag_t), k))
+                    idx.info_changes = len(idx.info_samples) - 1
                 continue
             for topic, ii in ((opts.depth, idx.depth), (opts.rgb, idx.rgb), (opts.ids, idx.ids)):
                 if topic is not None and c.topic == topic:
-                    t = _stamp_or_bagtime(msg.header, bag_t, idx, opts.timestamps == "bag")
-                    t += opts.time_offset_ns
+                    t = int(bag_t) if opts.timestamps == "bag" else stamp_ns(msg.header)
                     if topic == opts.depth and len(ii.stamps) in keep:
                         idx.samples[len(ii.stamps)] = decode_depth_message(msg, mt, topic)
                     ii.stamps.append(t)
@@ -109,5 +124,9 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
                     ii.frames.append(frame_name(msg.header.frame_id))
     finally:
         bar.close()
+    for ii in (idx.depth, idx.rgb, idx.ids):
+        _resolve_zero_stamps(ii, idx)
+        ii.stamps = [t + opts.time_offset_ns for t in ii.stamps]
+    idx.info_samples = sorted((t + opts.time_offset_ns, k) for t, k in idx.info_samples)
     idx.tf.freeze()
     return idx

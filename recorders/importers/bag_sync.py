@@ -114,7 +114,8 @@ def plan_frames(
     if idx.zero_stamps:
         notes.append(f"{idx.zero_stamps} images had a zero header stamp (bag time used)")
     if idx.info_changes:
-        notes.append(f"the camera info changed {idx.info_changes} times; the first is used")
+        notes.append(f"the camera info changed {idx.info_changes} time(s); each image has the "
+                     "one in effect at its time (the world alignment and checks use the first)")
     plan = plan[:: opts.every]
     if opts.limit is not None:
         plan = plan[: opts.limit]

@@ -45,35 +45,39 @@ def write_frames_bag(
     rgb_format: str = "raw",  # raw | jpg | png
     tf: bool = True,
     depth_units: float | None = None,
+    record_offset_ns: int = 0,
 ) -> int:
     """Write sgtool frames as a bag (see the module docstring); returns the frame count.
     ``tf=False`` leaves the poses out (a camera recorded alone); ``depth_units`` writes the
-    depth as 32FC1 floats in that many units per metre (1: metres; default: 16UC1 mm)."""
+    depth as 32FC1 floats in that many units per metre (1: metres; default: 16UC1 mm);
+    ``record_offset_ns`` records each message that much after its header stamp (a bag
+    recorded on the wall clock of a simulation whose clock starts at 0)."""
     tp = topics or BagTopics()
     n = 0
     with BagWriter(out, fmt) as w:
         for fr in frames:
             t = fr.time_ns
+            rt = t + record_offset_ns
             if tf:
-                w.write(tp.tf, "tf2_msgs/msg/TFMessage", t,
+                w.write(tp.tf, "tf2_msgs/msg/TFMessage", rt,
                         w.tf(t, [w.transform_stamped(t, tp.world, tp.camera, fr.pose)]))
-            w.write(tp.info, "sensor_msgs/msg/CameraInfo", t,
+            w.write(tp.info, "sensor_msgs/msg/CameraInfo", rt,
                     w.camera_info(t, tp.camera, fr.intrinsics))
             if depth_units is None:
-                w.write(tp.depth, "sensor_msgs/msg/Image", t,
+                w.write(tp.depth, "sensor_msgs/msg/Image", rt,
                         w.image(t, tp.camera, depth_to_mm(fr.depth), "16UC1"))
             else:
                 d = depth_to_mm(fr.depth).astype("<f4") * float(depth_units / 1000.0)
-                w.write(tp.depth, "sensor_msgs/msg/Image", t, w.image(t, tp.camera, d, "32FC1"))
+                w.write(tp.depth, "sensor_msgs/msg/Image", rt, w.image(t, tp.camera, d, "32FC1"))
             if fr.rgb is not None:
                 if rgb_format == "raw":
-                    w.write(tp.rgb, "sensor_msgs/msg/Image", t,
+                    w.write(tp.rgb, "sensor_msgs/msg/Image", rt,
                             w.image(t, tp.camera, fr.rgb, "rgb8"))
                 else:
-                    w.write(tp.rgb, "sensor_msgs/msg/CompressedImage", t,
+                    w.write(tp.rgb, "sensor_msgs/msg/CompressedImage", rt,
                             w.compressed(t, tp.camera, fr.rgb, rgb_format))
             if fr.ids is not None:
-                w.write(tp.ids, "sensor_msgs/msg/Image", t,
+                w.write(tp.ids, "sensor_msgs/msg/Image", rt,
                         w.image(t, tp.camera, fr.ids.astype("<i4"), "32SC1"))
             n += 1
     return n

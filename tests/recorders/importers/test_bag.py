@@ -10,12 +10,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from support.bag_export import BagWriter, write_log_as_bag
+from support.bag_export import BagWriter, write_frames_bag, write_log_as_bag
 from support.logfixtures import synthetic_frame
 
 from sgtool.cli import cli
 from sgtool.errors import SgtoolError
 from sgtool.log import LogReader, LogWriter
+from sgtool.log.frame import Frame
 from sgtool.recorders.importers.bag import BagOptions, import_bag, read_trajectory
 from sgtool.recorders.importers.poses import pose_difference, pose_from_tq
 from sgtool.recorders.importers.sink import IMPORT_METADATA
@@ -503,3 +504,52 @@ def test_float_depth_in_millimetres_is_refused_and_scaled(tmp_path):
         for x, y, z in zip(a.frames(), b.frames(), c.frames(), strict=True):
             assert np.array_equal(x.depth, y.depth) and np.array_equal(x.depth, z.depth)
             assert np.count_nonzero(y.depth) > 0
+
+
+def test_a_simulator_clock_starting_at_zero_keeps_its_first_frame(tmp_path):
+    """Header stamps from a clock that starts at 0 (a simulation) in a bag recorded on the
+    wall clock: the first image's stamp of 0 is a time, not an unset stamp, so its pose is
+    found and every frame is imported at its header time."""
+    frames = []
+    for i in range(5):
+        k, rgb, depth, ids, pose, _ = synthetic_frame(i)
+        frames.append(Frame(index=i, time_ns=i * 33_000_000, rgb=rgb, depth=depth, ids=ids,
+                            pose=pose, intrinsics=k))
+    bag = tmp_path / "sim"
+    write_frames_bag(frames, bag, "ros2-mcap", record_offset_ns=1_733_000_000 * 10**9)
+    out = tmp_path / "o.mcap"
+    rep = import_bag(bag, out, BagOptions(**TOPICS, **KEEP_WORLD))
+    assert rep.frames == 5 and not any("zero header stamp" in n for n in rep.notes)
+    with LogReader(out) as r:
+        assert [f.time_ns for f in r.frames()] == [f.time_ns for f in frames]
+
+
+def test_a_camera_info_that_changes_part_way_is_followed(tmp_path):
+    """A CameraInfo whose focal length changes at the fourth image (a zoom): each imported
+    frame has the intrinsics in effect at its time, and the note counts one change."""
+    import dataclasses
+
+    frames = []
+    for i in range(6):
+        k, rgb, depth, ids, pose, _ = synthetic_frame(i)
+        if i >= 3:
+            k = dataclasses.replace(k, fx=k.fx * 1.02, fy=k.fy * 1.02)
+        frames.append(Frame(index=i, time_ns=10**9 + i * 33_000_000, rgb=rgb, depth=depth,
+                            ids=ids, pose=pose, intrinsics=k))
+    bag = tmp_path / "zoom"
+    write_frames_bag(frames, bag, "ros2-mcap")
+    out = tmp_path / "o.mcap"
+    rep = import_bag(bag, out, BagOptions(**TOPICS, **KEEP_WORLD))
+    assert [n for n in rep.notes if "camera info changed" in n] == [
+        "the camera info changed 1 time(s); each image has the one in effect at its time "
+        "(the world alignment and checks use the first)"]
+    with LogReader(out) as r:
+        got = [f.intrinsics.fx for f in r.frames()]
+    assert got == pytest.approx([f.intrinsics.fx for f in frames], abs=1e-9)
+    # a CameraInfo for another image size part-way is refused in one line
+    sized = [dataclasses.replace(f, intrinsics=dataclasses.replace(
+        f.intrinsics, width=2 * f.intrinsics.width)) if f.index >= 3 else f for f in frames]
+    write_frames_bag(sized, tmp_path / "sized", "ros2-mcap")
+    with pytest.raises(SgtoolError, match="changes to .* images .* part-way through"):
+        import_bag(tmp_path / "sized", tmp_path / "s.mcap", BagOptions(**TOPICS, **KEEP_WORLD))
+    assert not (tmp_path / "s.mcap").exists()
