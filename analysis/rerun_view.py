@@ -60,9 +60,9 @@ from sgtool.colors import color_for
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_output, output_error
 from sgtool.log import LogReader, codec
-from sgtool.log.inspect import foreign_log_problem
 from sgtool.log import schemas as S
 from sgtool.log.frame import Frame
+from sgtool.log.inspect import foreign_log_problem
 
 APP_ID = "sgtool"
 FREE_MARGIN = 16 * 1024 * 1024  # bytes that must stay free beside the .rrd while writing

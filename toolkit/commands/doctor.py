@@ -33,8 +33,8 @@ def _report(d: Diagnosis) -> str:
         lines.append(f"  of which {d.unverified_messages} no CRC covers: each was decoded and "
                      "checked against its schema (where sgtool can decode its encoding)")
     if d.dropped_messages:
-        lines.append(f"dropped: {d.dropped_messages} messages that no CRC covers and that fail "
-                     "their check (not readable, not copied)")
+        lines.append(f"dropped: {d.dropped_messages} messages that fail their check (damaged "
+                     "where no CRC covers them, or written malformed; not copied)")
     checks = ", ".join(f"{k} {v}" for k, v in d.checks.items())
     if checks:
         lines.append(f"CRCs: {checks}")
@@ -96,10 +96,10 @@ def command(log: str, out: str | None, force: bool, as_json: bool) -> None:
     summary copies agree with the records. With --recover OUT, copy what is readable into
     a new log: damaged records are skipped up to the next valid one, channels whose
     definition is damaged are read with their summary copy, and the readable prefix of a
-    cut or damaged compressed chunk is decoded. A message that no CRC covers (its chunk
-    has none, or is damaged) is decoded and checked against its schema first: one that
-    fails is dropped and counted; the others are copied into chunks written without a CRC,
-    so the copy is "unverified", never "complete", when it holds them.
+    cut or damaged compressed chunk is decoded. Every message is checked against its
+    schema as replay reads it: one that fails is dropped (a file written with one is
+    corrupt); those no CRC covers are copied into chunks without a CRC, so the copy is
+    "unverified", never "complete", when it holds them.
 
     A file whose writer wrote no CRCs over its messages (many ROS 2 recordings) is at best
     "unverified": nothing is found wrong, but damage inside a message cannot be seen.

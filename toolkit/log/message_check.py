@@ -13,8 +13,8 @@ as they would: an image must decode to the size its width, height, step and enco
 advertise, a transform must be finite and its quaternion normalisable, a calibration must
 have a 3x3 K with positive focal lengths, a record must be JSON that fits its record type
 (:mod:`sgtool.log.records`, instance tables included), other protobuf messages must parse
-with their schema, JSON messages must parse. Recovery (:mod:`sgtool.log.recover`) runs it
-on every message whose bytes no CRC covers before copying it. Encodings sgtool cannot
+with their schema, JSON messages must parse. Diagnosis and recovery (:mod:`sgtool.log.recover`)
+run it on every message (one that fails is not copied). Encodings sgtool cannot
 decode (CDR, ROS 1, flatbuffer ...) are not checked: :func:`checkable` says which are.
 """
 

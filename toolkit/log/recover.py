@@ -62,7 +62,7 @@ class Diagnosis:
     # readable messages no CRC covers (damaged chunks, chunks without a CRC, outside
     # chunks without a data-section CRC): each decoded and checked (message_check) first
     unverified_messages: int = 0
-    dropped_messages: int = 0  # no CRC covers them and they fail their check: not copied
+    dropped_messages: int = 0  # they fail their check (damaged, or written malformed): not copied
     lost_messages: int = 0  # that the indexes or statistics know of
     lost_unknown: bool = False  # some damaged or cut data had no index: more may be lost
     lost: dict[str, dict[str, int | None]] = field(default_factory=dict)  # per topic
@@ -193,16 +193,19 @@ def _consume(items: Iterator[Item], diag: Diagnosis, writer: _Copier | None) -> 
 
     dropped: Counter[str] = Counter()
     first_drop: dict[str, str] = {}
+    malformed: Counter[str] = Counter()  # intact bytes that fail their check as written
+    first_malformed: dict[str, str] = {}
 
     def take(it: Item, ch: Channel) -> None:
         r = it.record
         schema = schemas.get(ch.schema_id) or spare_schemas.get(ch.schema_id)
+        problem = message_problem(schema, ch, r.data)
+        if problem is not None:
+            count, first = (malformed, first_malformed) if it.covered else (dropped, first_drop)
+            count[ch.topic] += 1
+            first.setdefault(ch.topic, f"at {int(r.log_time)} ns: {problem}")
+            return
         if not it.covered:
-            problem = message_problem(schema, ch, r.data)
-            if problem is not None:
-                dropped[ch.topic] += 1
-                first_drop.setdefault(ch.topic, f"at {int(r.log_time)} ns: {problem}")
-                return
             diag.unverified_messages += 1
         seen_channels.add(ch.id)
         diag.readable_messages += 1
@@ -250,7 +253,11 @@ def _consume(items: Iterator[Item], diag: Diagnosis, writer: _Copier | None) -> 
     for topic, n in sorted(dropped.items()):
         diag.problems.append(f"{n} messages of {topic[:80]} that no CRC covers dropped: they "
                              f"fail their check (the first {first_drop[topic]})")
-    diag.dropped_messages = sum(dropped.values())
+    for topic, n in sorted(malformed.items()):
+        diag.problems.append(f"{n} messages of {topic[:80]} were written malformed (their CRC "
+                             f"holds, their content fails its check: the first "
+                             f"{first_malformed[topic]}); --recover leaves them out")
+    diag.dropped_messages = sum(dropped.values()) + sum(malformed.values())
     if writer is not None:  # channels without messages are kept too
         for _, ch in sorted({**spare_channels, **channels}.items()):
             writer.channel(schemas.get(ch.schema_id) or spare_schemas.get(ch.schema_id), ch)

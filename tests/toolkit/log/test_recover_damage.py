@@ -166,3 +166,31 @@ def test_ros2_mcap_cut_inside_its_only_chunk_gives_the_prefix(shared_data_dir, t
     assert len(got) == d.readable_messages
     # what comes back is exactly the first messages of the original, in file order
     assert sorted(got) == sorted(_mcap_messages(src)[: len(got)])
+
+
+def test_a_record_written_malformed_is_found_and_left_out(tmp_path):
+    """A log whose CRCs all hold but whose writer wrote one empty episode record: doctor
+    calls it corrupt (replay would refuse it) and --recover copies everything else, so the
+    copy replays."""
+    from support.logfixtures import synthetic_frame
+
+    from sgtool.log import LogWriter
+
+    log = tmp_path / "bad.mcap"
+    kind = S.RECORDS["episode"]
+    with LogWriter(log, seed=1) as w:
+        for i in range(3):
+            k, rgb, depth, ids, pose, _ = synthetic_frame(i)
+            w.write_frame(i * 100_000_000, depth=depth, pose=pose, intrinsics=k, rgb=rgb)
+        c = w.copy_channel(kind.topic, kind.schema_name, "jsonschema", kind.schema_bytes(),
+                           "json")
+        w.write_raw(c, 250_000_000, b"")
+    d = scan(log)
+    assert d.status == "corrupt" and d.dropped_messages == 1
+    assert any("/sgtool/episode were written malformed" in p for p in d.problems)
+    out = tmp_path / "fixed.mcap"
+    r = recover(log, out)
+    assert r.readable_messages == d.readable_messages and r.dropped_messages == 1
+    with LogReader(out) as rd:
+        assert rd.frame_count() == 3 and list(rd.records("episode")) == []
+    assert scan(out).status == "complete"
