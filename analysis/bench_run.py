@@ -73,8 +73,8 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
         for line in h.notes:
             show(f"sgtool: note: {h.source}: {line}")
     for planner, t in llm_answer_totals(res.results, res.config.planners).items():
-        if not t["valid"] and t["faults"]:  # a wrong endpoint that answers, with garbage
+        if t["requests"] and not t["valid"]:  # a wrong endpoint, or one answering garbage
             show(f"sgtool: warning: {planner}: none of its {t['requests']} LLM requests got a "
-                 f"valid answer ({t['faults']} faults); check the endpoint with `sgtool llm "
-                 "check`")
+                 f"valid answer ({t['invalid']} rejected, {t['faults']} faults); check the "
+                 "endpoint and model with `sgtool llm check`")
     show(f"wrote {', '.join(str(Path(out_dir) / name) for name in written)}")

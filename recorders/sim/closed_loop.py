@@ -95,6 +95,7 @@ from sgtool.datasets.episodes import Episode, list_episodes
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
 from sgtool.house.spec import HouseSpec
+from sgtool.llm.stats import answer_counts
 from sgtool.log.records import Episode as LoggedEpisode
 from sgtool.log.records import LlmExchange
 from sgtool.log.writer import LogWriter
@@ -209,6 +210,7 @@ class _Search:
         self.steps = self.n_open = self.last_t = 0
         self.end = ""
         self.decision_times: list[float] = []
+        self.exchanges: list[dict[str, Any]] = []  # the planner's LLM exchanges, as logged
         self._graph_time_ns = 0
         self._shown: dict[str, Any] = {}  # the view's distances for the log (decided())
         self._decision_s = 0.0
@@ -328,7 +330,7 @@ class _Search:
         self._confirming = bool(self.end)  # asked once more after the end: not a step
         if not self._confirming:
             self.steps += 1
-        _log_exchanges(self.agent, self.rec.writer, self.rec.last_time_ns)
+        self.exchanges += _log_exchanges(self.agent, self.rec.writer, self.rec.last_time_ns)
         if self.on_decision is not None:
             self.on_decision(graph, action)
 
@@ -392,7 +394,8 @@ class _Search:
             action = self.agent.decide(only)
             dt = time.perf_counter() - t0
             self.decision_times.append(dt)
-            _log_exchanges(self.agent, self.rec.writer, self.rec.last_time_ns)
+            self.exchanges += _log_exchanges(self.agent, self.rec.writer,
+                                             self.rec.last_time_ns)
             if self.on_decision is not None:
                 self.on_decision(only, action)
             if action.skill != "explore" or action.target not in fronts:
@@ -531,7 +534,8 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
             travelled, frames, refreshes = sim.travelled_m, rec.frames, rec.refreshes
             last = stream.current
             notes = episode_notes(mapping.max_depth, MAX_DEPTH_M, opts.noise.depth_sigma,
-                                  None if last is None else len(last.graph.rooms))
+                                  None if last is None else len(last.graph.rooms),
+                                  answer_counts(search.exchanges))
     finally:
         closer = getattr(planner, "close", None)
         if callable(closer):
@@ -560,12 +564,12 @@ def _found(refresh: Refresh | None, query: str) -> bool:
     return refresh is not None and find_target(refresh.graph, query) is not None
 
 
-def _log_exchanges(agent: Any, writer: LogWriter, t_ns: int) -> None:
+def _log_exchanges(agent: Any, writer: LogWriter, t_ns: int) -> list[dict[str, Any]]:
     drain = getattr(agent, "drain_exchanges", None)
-    if not callable(drain):
-        return
-    for ex in drain():
+    done = list(drain()) if callable(drain) else []
+    for ex in done:
         writer.write_record(LlmExchange.from_json(ex), t_ns)
+    return done
 
 
 def _shown(view: SceneGraph, logged: SceneGraph) -> dict[str, Any]:

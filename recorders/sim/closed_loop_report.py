@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import statistics
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -67,11 +68,19 @@ class ClosedLoopReport:
 
 
 def episode_notes(max_depth: float, default_depth: float, depth_sigma: float,
-                  rooms: int | None) -> tuple[str, ...]:
+                  rooms: int | None, llm_answers: Mapping[str, int] | None = None
+                  ) -> tuple[str, ...]:
     """The notes of an episode whose live map kept depth to ``max_depth`` (the default
-    ``default_depth`` lowered for the sensor's ``depth_sigma``, or chosen) and whose last
-    scene graph has ``rooms`` rooms (None: no graph)."""
+    ``default_depth`` lowered for the sensor's ``depth_sigma``, or chosen), whose last
+    scene graph has ``rooms`` rooms (None: no graph) and whose planner's LLM answers are
+    counted in ``llm_answers`` (:func:`~sgtool.llm.stats.answer_counts`; empty: it asked
+    none)."""
     notes = []
+    llm = llm_answers or {}
+    if llm.get("requests") and not llm.get("valid"):
+        notes.append(f"none of the planner's {llm['requests']} LLM requests got a valid answer "
+                     f"({llm.get('invalid', 0)} rejected, {llm.get('faults', 0)} faults): check "
+                     "the endpoint and model with `sgtool llm check`")
     if max_depth < default_depth and depth_sigma > 0:
         notes.append(f"the sensor's depth noise ({depth_sigma:g} z^2 m) would read far floor "
                      f"as obstacles: the live map kept depth to {max_depth:g} m "

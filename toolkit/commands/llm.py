@@ -106,9 +106,12 @@ def check(base_url: str | None, model_name: str | None, gguf: Path | None, threa
           llm_api_key: str | None = None, llm_timeout: float = 300.0) -> None:
     """Print tokens/s of an endpoint and whether one scene decision parsed.
 
-    --llm-timeout is the deadline of the whole check (the speed request and the decision
-    together, wall-clock, a slow or trickled reply included): at the deadline the check
-    stops with one line saying so (exit 2)."""
+    Exit 0 when the decision parsed and named something in the scene, 1 when it did not
+    (the endpoint answers, but not with a usable command: a wrong model, a completion-only
+    one, no grammar), 2 when the endpoint cannot be used at all. --llm-timeout is the
+    deadline of the whole check (the speed request and the decision together, wall-clock,
+    a slow or trickled reply included): at the deadline the check stops with one line
+    saying so (exit 2)."""
     from sgtool.analysis.llm_check_run import LlmCheckRequest, run_check
 
     result = run_check(LlmCheckRequest(
@@ -117,6 +120,8 @@ def check(base_url: str | None, model_name: str | None, gguf: Path | None, threa
         max_tokens=max_tokens, constraint=constraint, reason_chars=reason_chars))
     if as_json:
         click.echo(json.dumps(result.figures, sort_keys=True))
-        return
-    for line in result.lines:
-        click.echo(line)
+    else:
+        for line in result.lines:
+            click.echo(line)
+    if not result.figures["decision_parsed"]:
+        raise click.exceptions.Exit(1)

@@ -137,6 +137,11 @@ class LlmSettings:
         if api_key and any(c.isspace() for c in api_key):
             raise LlmConfigError("the LLM API key holds white space (a key is one word): "
                                  "check SGTOOL_LLM_API_KEY / OPENAI_API_KEY or api_key")
+        if base_url and not base_url.lower().startswith(("http://", "https://")):
+            raise LlmConfigError(
+                f"the LLM base URL {redact_text(base_url)!r} must start with http:// or "
+                "https:// (an OpenAI-compatible API, e.g. http://127.0.0.1:8080/v1 for "
+                "`sgtool llm serve`): check SGTOOL_LLM_BASE_URL / --llm-base-url / base_url")
         if not base_url and not api_key:
             raise LlmConfigError(
                 "no LLM endpoint configured: set SGTOOL_LLM_BASE_URL (and SGTOOL_LLM_API_KEY "

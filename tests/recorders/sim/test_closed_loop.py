@@ -392,6 +392,23 @@ def test_moma_llm_episode_and_its_replay(house, tmp_path) -> None:
     assert [{k: v for k, v in a.items() if k != "decision_time_s"} for a in acts2] == strip
 
 
+def test_an_endpoint_without_one_valid_answer_is_named(house, tmp_path) -> None:
+    """An endpoint that answers, but never with a command (a wrong model, a completion-only
+    one): the episode gives up, and the report says why rather than a bare 'not found'."""
+    idx, ep = pick_episode(house, index=4)
+    with ChatServer(responder=lambda request: {"text": "<html>not a chat model</html>"}) \
+            as srv:
+        moma = make_planner("moma-llm", base_url=srv.base_url, model="scripted",
+                            api_key="test", timeout_s=10.0)
+        rep = run_episode(house, ep, moma, tmp_path / "g.mcap",
+                          ClosedLoopOptions(camera=OPTS.camera, max_steps=2), episode_index=idx)
+    assert not rep.success
+    (note,) = [n for n in rep.notes if "LLM requests" in n]
+    assert note.startswith("none of the planner's ") and "rejected" in note
+    assert "sgtool llm check" in note
+    assert episode_notes(5.0, 5.0, 0.0, 3, {"requests": 4, "valid": 1}) == ()
+
+
 # ----- user errors --------------------------------------------------------------------
 @pytest.mark.parametrize("args,message", [
     (["--planner", "nope"], "unknown planner 'nope'"),

@@ -361,7 +361,15 @@ def test_an_endpoint_that_never_answers_is_warned_about(tmp_path):
                                      "--llm-model", "m", "-o", str(tmp_path / "o")])
     assert r.exit_code == 0, r.output
     assert "sgtool: warning: moma-llm: none of its" in r.output
-    assert "check the endpoint with `sgtool llm check`" in r.output
+    assert "check the endpoint and model with `sgtool llm check`" in r.output
+    # an endpoint that answers every request, never with a command: warned about too
+    with ChatServer(responder=lambda req: {"text": "<html>a web page</html>"}) as srv:
+        r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
+                                     "--episodes", "1", "--seeds", "1", "--max-steps", "2",
+                                     "--no-progress", "--llm-base-url", srv.base_url,
+                                     "--llm-model", "m", "-o", str(tmp_path / "o3")])
+    assert r.exit_code == 0, r.output
+    assert "rejected, 0 faults); check the endpoint and model" in r.output
     with ChatServer(responder=lambda req: {"status": 401}) as srv:  # a wrong key: stop
         r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
                                      "--episodes", "1", "--seeds", "1", "--no-progress",

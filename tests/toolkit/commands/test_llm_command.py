@@ -43,7 +43,7 @@ def test_check_against_a_scripted_endpoint() -> None:
                      answer(first)]) as srv:
         r = CliRunner().invoke(cli, ["llm", "check", "--base-url", srv.base_url,
                                      "--model-name", "m", "--json"])
-        assert r.exit_code == 0, r.output
+        assert r.exit_code == 1, r.output  # answers, but no usable command: a failed check
         d = json.loads(r.output)
         # one failed answer, no retry (max one request): not parsed
         assert d["completion_tokens"] == 4 and d["tokens_per_s"] > 0

@@ -198,3 +198,13 @@ def test_a_fresh_transcript_uses_a_unique_temporary_name(tmp_path):
         w.write({"model": "m", "messages": []})
         raise RuntimeError("boom")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.jsonl"]
+
+
+@pytest.mark.parametrize("url", ["127.0.0.1:8080/v1", "ftp://127.0.0.1:8080/v1",
+                                 "localhost:8080"])
+def test_a_base_url_without_http_is_a_setup_error(url):
+    """A URL without its scheme is no unreachable server: it is refused before any request,
+    naming what it must start with."""
+    with pytest.raises(LlmConfigError, match="must start with http:// or https://"):
+        LlmSettings.resolve(base_url=url, model="m")
+    assert LlmSettings.resolve(base_url="HTTPS://example.org/v1").base_url
