@@ -31,7 +31,7 @@ from sgtool.planning.candidates import (
     natural_key,
     object_skill,
 )
-from sgtool.planning.moma.scene_text import EncodedScene, singular
+from sgtool.planning.moma.scene_text import EncodedScene, same_name
 from sgtool.scenegraph.graph import DoorNode, ObjectNode, RegionNode, SceneGraph
 from sgtool.semantics.text import category_text
 
@@ -120,7 +120,7 @@ def _norm(s: str) -> str:
 
 
 def _strip_object_words(name: str) -> tuple[str, str | None]:
-    """"the 2 closed cabinets" -> ("cabinet", "closed")."""
+    """"the 2 closed cabinets" -> ("cabinets", "closed")."""
     words = _norm(name).split()
     state = None
     kept = []
@@ -133,7 +133,7 @@ def _strip_object_words(name: str) -> tuple[str, str | None]:
             continue
         else:
             kept.append(w)
-    return singular(" ".join(kept)), state
+    return " ".join(kept), state
 
 
 def resolve_room(name: str, scene: EncodedScene) -> str:
@@ -176,7 +176,7 @@ def resolve_object(graph: SceneGraph, room_id: str, name: str, skill: str,
     """Node id of the object (or door) ``name`` in room ``room_id`` for ``skill``."""
     wanted, state = _strip_object_words(name)
     room_name = scene.name_by_room.get(room_id, room_id)
-    if wanted in _DOOR_WORDS or wanted == "door":
+    if wanted in _DOOR_WORDS:
         doors: list[DoorNode] = [d for d in graph.doors if room_id in d.rooms]
         if state is not None:
             doors = [d for d in doors if d.state == state] or doors
@@ -187,7 +187,7 @@ def resolve_object(graph: SceneGraph, room_id: str, name: str, skill: str,
         return _pick(graph, doors, lambda d: door_is_entrance(graph, d))
     objs: list[ObjectNode] = [
         o for o in graph.objects_in(room_id)
-        if singular(category_text(o.category)) == wanted or category_text(o.category) == wanted
+        if same_name(wanted, category_text(o.category))
     ]
     if not objs:
         raise InvalidCommand(

@@ -44,28 +44,73 @@ def distance_adjective(d: float | None) -> str:
     return "distant"
 
 
+# English plurals that the suffix rules get wrong, and names that are their own plural
+_IRREGULAR = {
+    "shelf": "shelves", "knife": "knives", "leaf": "leaves", "loaf": "loaves",
+    "half": "halves", "scarf": "scarves", "wolf": "wolves", "calf": "calves",
+    "life": "lives", "wife": "wives", "thief": "thieves", "foot": "feet", "tooth": "teeth",
+    "mouse": "mice", "goose": "geese", "person": "people", "child": "children", "man": "men",
+    "woman": "women", "potato": "potatoes", "tomato": "tomatoes", "mango": "mangoes",
+    "cactus": "cacti", "fungus": "fungi",
+}
+_SINGULAR = {p: s for s, p in _IRREGULAR.items()}
+_OWN_PLURAL = frozenset({
+    "shears", "tights", "scissors", "pants", "jeans", "shorts", "trousers", "pliers", "tongs",
+    "tweezers", "headphones", "earphones", "binoculars", "pajamas", "clothes", "sheep",
+    "fish", "deer", "series", "species", "drawers", "stairs", "supplies", "groceries",
+})
+
+
+def _split_of(noun: str) -> tuple[str, str]:
+    """("chest", " of drawers") for "chest of drawers": the head noun of an "X of Y" name
+    is the word that takes the number; ("coffee table", "") otherwise."""
+    head, of, rest = noun.partition(" of ")
+    return (head, of + rest) if of and head else (noun, "")
+
+
 def plural(noun: str) -> str:
-    """English plural of the last word (good enough for category names)."""
+    """English plural of a category name: its head noun's ("chests of drawers",
+    "coffee tables"), irregular ones ("shelves", "knives") and names that are their own
+    plural ("shears") included."""
+    noun, tail = _split_of(noun)
     head, _, last = noun.rpartition(" ")
-    if last.endswith(("s", "x", "z", "ch", "sh")):
+    if last in _IRREGULAR:
+        last = _IRREGULAR[last]
+    elif last in _OWN_PLURAL:
+        pass
+    elif last.endswith(("s", "x", "z", "ch", "sh")):
         last += "es"
     elif last.endswith("y") and len(last) > 1 and last[-2] not in "aeiou":
         last = last[:-1] + "ies"
     else:
         last += "s"
-    return f"{head} {last}" if head else last
+    return (f"{head} {last}" if head else last) + tail
 
 
 def singular(word: str) -> str:
-    """Inverse of :func:`plural` for matching model output ("chairs" -> "chair")."""
+    """Inverse of :func:`plural` for matching model output ("chairs" -> "chair", "chests of
+    drawers" -> "chest of drawers", "shelves" -> "shelf")."""
+    word, tail = _split_of(word)
     head, _, last = word.rpartition(" ")
-    if last.endswith("ies") and len(last) > 3:
+    if last in _SINGULAR:
+        last = _SINGULAR[last]
+    elif last in _OWN_PLURAL:
+        pass
+    elif last.endswith("ies") and len(last) > 3:
         last = last[:-3] + "y"
     elif last.endswith(("ches", "shes", "sses", "xes", "zes")):
         last = last[:-2]
-    elif last.endswith("s") and not last.endswith("ss") and len(last) > 1:
+    elif last.endswith("s") and not last.endswith(("ss", "us")) and len(last) > 1:
         last = last[:-1]
-    return f"{head} {last}" if head else last
+    return (f"{head} {last}" if head else last) + tail
+
+
+def same_name(text: str, category: str) -> bool:
+    """Whether ``text`` (a model's words, articles, counts and states removed) names
+    ``category`` in words: the name itself, its plural as a prompt shows it, or a plural a
+    model writes for it."""
+    return text in (category, plural(category)) or singular(text) in (category,
+                                                                       singular(category))
 
 
 def object_label(o: ObjectNode) -> str:
@@ -224,6 +269,7 @@ __all__ = [
     "plural",
     "room_names",
     "room_of",
+    "same_name",
     "singular",
     "summarise",
 ]

@@ -13,6 +13,7 @@ from sgtool.planning.moma.scene_text import (
     encode_scene,
     plural,
     room_names,
+    same_name,
     singular,
     summarise,
 )
@@ -28,9 +29,16 @@ def test_distance_adjectives_follow_moma_bins() -> None:
 def test_plural_singular_and_counts() -> None:
     for s, p in [("chair", "chairs"), ("glass", "glasses"), ("box", "boxes"),
                  ("bench", "benches"), ("toy", "toys"), ("battery", "batteries"),
-                 ("coffee table", "coffee tables")]:
+                 ("coffee table", "coffee tables"), ("shelf", "shelves"),
+                 ("butter knife", "butter knives"), ("chest of drawers", "chests of drawers"),
+                 ("bottle of olive oil", "bottles of olive oil"), ("shears", "shears"),
+                 ("tomato", "tomatoes"), ("house", "houses"), ("cactus", "cacti")]:
         assert plural(s) == p
         assert singular(p) == s
+        # what the prompt shows and what a model may write name the category
+        assert same_name(p, s) and same_name(s, s) and same_name(singular(p), s)
+    assert not same_name("chair", "armchair") and not same_name("shelve", "shelf")
+    assert same_name("buses", "bus")  # the plural a prompt shows names it either way
     assert summarise(["chair", "closed fridge", "chair"]) == ["2 chairs", "closed fridge"]
 
 
