@@ -36,7 +36,7 @@ def valid_commands(graph: SceneGraph, scene: EncodedScene, query: str) -> tuple[
     cands += [f"explore({scene.name_by_room[r]})" for r in rooms]
     for r in rooms:
         words = sorted({category_text(o.category) for o in graph.objects_in(r)})
-        if any(r in d.rooms for d in graph.doors):
+        if r in scene.door_rooms:
             words.append("door")
         for skill in OBJECT_SKILLS:
             cands += [f"{skill}({scene.name_by_room[r]}, {w})" for w in words]

@@ -177,11 +177,11 @@ def resolve_object(graph: SceneGraph, room_id: str, name: str, skill: str,
     wanted, state = _strip_object_words(name)
     room_name = scene.name_by_room.get(room_id, room_id)
     if wanted in _DOOR_WORDS:
-        doors: list[DoorNode] = [d for d in graph.doors if room_id in d.rooms]
-        if state is not None:
-            doors = [d for d in doors if d.state == state] or doors
+        # the doors the text shows: a room's closed doors, listed when it is explored
+        doors: list[DoorNode] = [d for d in graph.doors if room_id in d.rooms
+                                 and d.state == "closed" and room_id in scene.door_rooms]
         if not doors:
-            raise InvalidCommand(f"there is no door in the {room_name}")
+            raise InvalidCommand(f"there is no closed door in the {room_name}")
         if skill == "close":
             return _pick(graph, doors, lambda d: d.state == "open")
         return _pick(graph, doors, lambda d: door_is_entrance(graph, d))

@@ -132,6 +132,8 @@ class EncodedScene:
     name_by_room: dict[str, str]
     unexplored_rooms: tuple[str, ...] = ()
     notes: dict[str, str] = field(default_factory=dict)
+    # rooms the text lists with closed doors: the only rooms whose "door" a command names
+    door_rooms: frozenset[str] = frozenset()
 
 
 def room_names(graph: SceneGraph) -> dict[str, str]:
@@ -223,6 +225,7 @@ def encode_scene(graph: SceneGraph) -> EncodedScene:
         room_by_name={v: k for k, v in names.items()},
         name_by_room=names,
         unexplored_rooms=tuple(r.id for r in unexplored),
+        door_rooms=frozenset(door_rooms),
     )
 
 

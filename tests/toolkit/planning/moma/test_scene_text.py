@@ -135,3 +135,24 @@ def test_the_prompt_names_the_query_with_the_right_article():
     assert with_article("short pants") == "some short pants"
     assert with_article("wineglass") == "a wineglass"
     assert "find some short pants." in system_prompt("short pants")
+
+
+def test_a_door_is_named_only_where_the_text_shows_one() -> None:
+    """The living room's door is closed: the text lists it, and `go_to_and_open(living room,
+    door)` grounds; once the door is open the text shows no door, and a command naming one
+    is refused (and not among the valid commands a grammar allows)."""
+    from sgtool.planning.moma.choices import valid_commands
+
+    g = house()
+    scene = encode_scene(g)
+    assert "Rooms with closed doors: living room." in scene.text
+    cmd = "go_to_and_open(living room, door)"
+    assert ground(parse_response(f"Command: {cmd}"), g, scene, "mug").target == "door:1"
+    assert cmd in valid_commands(g, scene, "mug")
+    opened = dataclasses.replace(g, doors=tuple(dataclasses.replace(d, state="open")
+                                                for d in g.doors))
+    scene = encode_scene(opened)
+    assert "closed door" not in scene.text
+    with pytest.raises(InvalidCommand, match="no closed door in the living room"):
+        ground(parse_response("Command: navigate(living room, door)"), opened, scene, "mug")
+    assert not any("door" in c for c in valid_commands(opened, scene, "mug"))
