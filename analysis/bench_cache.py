@@ -56,9 +56,13 @@ def cached_planner(name: str, options: Mapping[str, Any], run: str = "") -> Any:
     redefined or reloaded between runs, or a plug-in's own state, never carries into the
     next) for each name and options (compared by type and repr) and handed out again
     after; a bad name or option raises as
-    :func:`~sgtool.planning.registry.make_planner` does."""
-    from sgtool.planning.registry import make_planner
+    :func:`~sgtool.planning.registry.make_planner` does. A plug-in is built afresh at each
+    call (each task of a house): what it keeps between episodes stays within the task, so
+    its results do not depend on how tasks share workers, nor on a failed attempt."""
+    from sgtool.planning.registry import REGISTRY, make_planner
 
+    if name.strip().lower() not in REGISTRY:
+        return make_planner(name, **dict(options))
     key = (name, json.dumps({k: [type(v).__name__, repr(v)] for k, v in
                              sorted(options.items())}))
     with _PLANNERS_LOCK:

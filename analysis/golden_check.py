@@ -102,8 +102,9 @@ def planner_decisions(log: str | Path, graphs: Sequence[str], refreshes: Sequenc
     extra = given(episodes[0].episode.extra) or {}
     logged = extra.get("planner_options")
     options = dict(logged) if isinstance(logged, dict) else {}  # as the run built it
+    options["timed"] = False  # asked again, not timed (whatever the run chose)
     try:
-        planner = make_planner(name, timed=False, **options)
+        planner = make_planner(name, **options)
     except SgtoolError as e:  # a plug-in not importable here: its decisions cannot be asked
         raise SgtoolError(f"{log}: its planner cannot be built here ({e}); the decisions of "
                           "an episode log are pinned and checked by asking its planner again "

@@ -61,3 +61,16 @@ def test_rooms_joined_by_open_floor_alone_are_said():
     assert len(unlinked_rooms(house)) == len(spec.rooms) - 1
     assert any("by no door or passage, so the scene graph never leads there" in n
                for n in house_notes(house))
+
+
+def test_a_plugin_is_built_afresh_for_each_task(tmp_path, monkeypatch):
+    """What a plug-in keeps between episodes stays in one task (a house's episodes): it is
+    not handed to the next task the worker runs, so results do not depend on -w."""
+    (tmp_path / "keeps_state.py").write_text(
+        "from sgtool.planning.planners import GreedyPlanner\n"
+        "class Keeps(GreedyPlanner):\n"
+        "    seen = 0\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    a = cached_planner("keeps_state:Keeps", {}, "run-p")
+    b = cached_planner("keeps_state:Keeps", {}, "run-p")
+    assert a is not b and a.name == b.name == "keeps_state:Keeps"

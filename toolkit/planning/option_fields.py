@@ -101,13 +101,33 @@ class OptionInfo:
                 + (f" [{rng}]" if rng else ""))
 
 
+_PLAIN_KINDS = (("bool", bool), ("int", int), ("float", float), ("str", str))
+
+
+def _plain_meta(f: dataclasses.Field[Any]) -> OptionMeta:
+    """The metadata of a field without :func:`option` (a plug-in's plain config dataclass):
+    its kind from its default's type, else from its annotation's words (``int``,
+    ``float``, ``bool``, ``str``, ``Path``), else a Python object; None is a value when the
+    default is None or the annotation allows it."""
+    default = f.default if f.default is not dataclasses.MISSING else None
+    note = str(getattr(f.type, "__name__", f.type))
+    optional = default is None or "None" in note or "Optional" in note
+    kind = next((k for k, t in _PLAIN_KINDS if type(default) is t), None)
+    if kind is None:
+        words = set(note.replace("|", " ").replace("[", " ").replace("]", " ").split())
+        kind = next((k for k, _ in _PLAIN_KINDS if k in words), None)
+        if kind is None and words & {"Path", "PathLike", "os.PathLike", "pathlib.Path"}:
+            kind = "path"
+    return OptionMeta(f"a field of {note}", kind or "object", optional=optional)
+
+
 def option_infos(cls: type) -> tuple[OptionInfo, ...]:
-    """The options of an options dataclass, in field order."""
+    """The options of an options dataclass, in field order; a field without
+    :func:`option` metadata takes the kind of its default or annotation
+    (:func:`_plain_meta`)."""
     out = []
     for f in dataclasses.fields(cls):
-        meta = f.metadata.get(_META)
-        if meta is None:
-            raise TypeError(f"{cls.__name__}.{f.name}: no option() metadata")
+        meta = f.metadata.get(_META) or _plain_meta(f)
         default = f.default if f.default is not dataclasses.MISSING else None
         out.append(OptionInfo(f.name, meta.kind, default, meta))
     return tuple(out)

@@ -98,10 +98,7 @@ def plugin_options(name: str, factory: Callable[..., Any], given: Mapping[str, A
     cls = options_class(factory)
     if cls is None:
         return dict(given)
-    try:
-        return convert_options(name, cls, given, from_cli=from_cli)
-    except TypeError as e:  # an Options field without option() metadata
-        raise PluginError(f"planner {name!r}: its Options dataclass: {e}") from None
+    return convert_options(name, cls, given, from_cli=from_cli)
 
 
 def build_plugin(name: str, factory: Callable[..., Any], options: Mapping[str, Any]) -> Planner:

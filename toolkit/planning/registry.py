@@ -324,8 +324,10 @@ def make_planner(name: str, **options: Any) -> Planner:
     """A fresh planner by name (a built-in of :data:`REGISTRY` or a plug-in), built from
     ``options`` (checked against its options dataclass: one line for an unknown key, a
     value of the wrong type or out of range), wrapped in
-    :class:`~sgtool.planning.timing.TimedPlanner` unless ``timed=False``. A plug-in's
-    wrapper carries ``name`` as its name, so tables and logs list it as it was named."""
+    :class:`~sgtool.planning.timing.TimedPlanner` unless ``timed=False`` (a plug-in is
+    wrapped either way, its decision time measured only when timed). A plug-in's wrapper
+    checks its contract and carries ``name`` as its name, so tables and logs list it as it
+    was named."""
     timed = convert_value(name, "timed", TIMED, options.pop("timed", True))
     key = name.strip().lower()
     entry = REGISTRY.get(key)
@@ -333,11 +335,12 @@ def make_planner(name: str, **options: Any) -> Planner:
         planner = plugins.build_plugin(name, _factory(name), options)
     else:
         planner = _build(key, entry, options)
-    if not timed:
+    if not timed and entry is not None:
         return planner
     from sgtool.planning.timing import TimedPlanner
 
-    wrapped = TimedPlanner(planner, plugin=entry is None)
+    # a plug-in is always wrapped: its contract is checked and its name is the one given
+    wrapped = TimedPlanner(planner, plugin=entry is None, measure=timed)
     if entry is None:
         wrapped.name = name
     return wrapped

@@ -33,13 +33,15 @@ class TimedPlanner:
     raises :class:`PlannerContractError` naming the planner when ``decide`` returns no
     :class:`~sgtool.planning.base.Action` (a plug-in's mistake, caught where it happens),
     or, for a ``plugin``, when its ``reset``, ``decide`` or ``feedback`` raises or its
-    action names no skill (:data:`~sgtool.vocabulary.SKILLS`)."""
+    action names no skill (:data:`~sgtool.vocabulary.SKILLS`). Without ``measure`` the
+    checks stay and the action keeps the decision time the planner gave it."""
 
-    def __init__(self, inner: Planner, plugin: bool = False) -> None:
+    def __init__(self, inner: Planner, plugin: bool = False, measure: bool = True) -> None:
         self.inner = inner
         self.name = inner.name
         self.decision_times: list[float] = []
         self.plugin = plugin  # a user's planner: what it raises is one line, not a traceback
+        self.measure = measure
 
     def reset(self, query: str, seed: int = 0) -> None:
         self.decision_times = []
@@ -60,6 +62,8 @@ class TimedPlanner:
             raise PlannerContractError(
                 f"planner {self.name!r}: decide() returned an Action with skill "
                 f"{action.skill!r}; the skills are {', '.join(SKILLS)}")
+        if not self.measure and isinstance(action, Action):
+            return action
         if _PLAIN and type(action) is Action:  # dataclasses.replace without its field walk
             return Action(action.skill, action.target, action.reason, dt, action.scores,
                           action.outcome, action.travelled_m, action.planner, action.step,

@@ -24,6 +24,7 @@ from sgtool.commands.options import (
     split_planner_key,
 )
 from sgtool.errors import SgtoolError
+from sgtool.log import LogReader
 
 PLUGIN = textwrap.dedent('''
     from sgtool.planning.planners import GreedyPlanner
@@ -188,6 +189,13 @@ def test_a_plugin_that_raises_in_decide_is_one_line(plugin_dir: Path, tmp_path: 
     monkeypatch.setattr(greedy.inner, "decide", lambda graph: 1 / 0)
     with pytest.raises(ZeroDivisionError):
         greedy.decide(None)
+    # untimed, the same: one line, and the contract still checked
+    r = CliRunner().invoke(cli, ["run", "-p", "mymod_cli:Stumbles", "-O",
+                                 "mymod_cli:Stumbles.timed=false", "--frames", "40",
+                                 "--max-steps", "2", "-o", str(tmp_path / "u.mcap")])
+    assert r.exit_code == 2 and "decide() raised ZeroDivisionError" in r.output, r.output
+    with pytest.raises(SgtoolError, match="returned an Action with skill 'fly'"):
+        make_planner("mymod_cli:Flies", timed=False).decide(None)
 
 
 def test_log_paths_of_a_plugin_are_safe_and_fixed(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -315,3 +323,25 @@ def test_list_planners_describes_a_plugin_named_before_it(
             "passed as int, float, true/false or text)") in r.output
     r = CliRunner().invoke(cli, [*command, "nomod_cli:X", "--list-planners"])
     assert r.exit_code == 0 and "nomod_cli:X: planner 'nomod_cli:X': cannot import" in r.output
+
+
+def test_an_untimed_plugin_keeps_its_name_in_the_closed_loop(plugin_dir: Path, tmp_path: Path,
+                                                             monkeypatch: pytest.MonkeyPatch
+                                                             ) -> None:
+    """`-O P.timed=false` on a plug-in: the log names the planner as given (not the name
+    its class sets), and the log, which records timed among the options, pins."""
+    monkeypatch.syspath_prepend(str(plugin_dir))
+    log = tmp_path / "u.mcap"
+    r = CliRunner().invoke(cli, ["run", "-p", "mymod_cli:MyPlanner", "-O",
+                                 "mymod_cli:MyPlanner.k=3", "-O",
+                                 "mymod_cli:MyPlanner.timed=false", "--frames", "40",
+                                 "--max-steps", "2", "--quiet", "-o", str(log)])
+    assert r.exit_code == 0, r.output
+    with LogReader(log) as rd:
+        acts = [a for _, a in rd.records("action")]
+        (ep,) = [e for _, e in rd.records("episode") if e["status"] != "started"]
+    assert ep["planner"] == "mymod_cli:MyPlanner"
+    assert {a["planner"] for a in acts if a.get("planner")} == {"mymod_cli:MyPlanner"}
+    r = CliRunner().invoke(cli, ["golden", "pin", str(log), "--dir", str(tmp_path / "g"),
+                                 "--max-frames", "20"])
+    assert r.exit_code == 0, r.output

@@ -46,6 +46,19 @@ PLUGIN = textwrap.dedent('''
             self.k = k
 
 
+    class Plain(GreedyPlanner):
+        @dataclass
+        class Options:  # a lab's own config class, no sgtool metadata
+            radius: float = 2.0
+            steps: int = 3
+            greedy: bool = False
+            tag: str = "a"
+
+        def __init__(self, radius=2.0, steps=3, greedy=False, tag="a"):
+            super().__init__()
+            self.radius, self.steps, self.greedy, self.tag = radius, steps, greedy, tag
+
+
     def factory(**kw):
         return MyPlanner(**kw)
 
@@ -88,8 +101,24 @@ def test_a_class_gets_its_options_and_carries_its_given_name(plugin_dir: Path) -
     assert p.name == "mymod_plug:MyPlanner"  # as named: the label of tables and logs
     assert type(p).__name__ == "TimedPlanner"
     assert (p.inner.k, p.inner.label) == (3, "y")  # type: ignore[attr-defined]
+    # untimed, a plug-in still carries the name as given (its rows and logs are its own)
+    # and its contract is still checked; only the decision time is not measured
     raw = make_planner("mymod_plug:factory", timed=False)
-    assert raw.name == "mine" and raw.k == 1  # type: ignore[attr-defined]
+    assert raw.name == "mymod_plug:factory" and raw.inner.name == "mine"  # type: ignore[attr-defined]
+    assert raw.k == 1  # type: ignore[attr-defined]
+
+
+def test_a_plain_options_dataclass_checks_by_its_fields_types(plugin_dir: Path) -> None:
+    """An Options dataclass without option() metadata: values are checked and converted
+    by each field's default type, unknown keys named, and the options listed."""
+    p = make_planner("mymod_plug:Plain", radius="1.5", steps="4", greedy="yes")
+    assert (p.inner.radius, p.inner.steps, p.inner.greedy) == (1.5, 4, True)  # type: ignore[attr-defined]
+    assert parse_option("mymod_plug:Plain", "tag", "b") == "b"
+    with pytest.raises(PlannerOptionError, match="option steps=1.5: must be an integer"):
+        make_planner("mymod_plug:Plain", steps="1.5")
+    with pytest.raises(UnknownPlannerError, match="did you mean 'radius'"):
+        make_planner("mymod_plug:Plain", radios=1.0)
+    assert "radius (float, default 2.0)" in describe_planners(["mymod_plug:Plain"])
 
 
 def test_an_options_dataclass_checks_like_the_built_ins(plugin_dir: Path) -> None:
