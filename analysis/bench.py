@@ -358,7 +358,8 @@ def _task_episodes(cfg: BenchConfig, ref: BenchHouse, names: tuple[str, ...],
             for i, ep in enumerate(episodes):
                 kw = dict(seed=seed, episode_index=i, avoid_rooms=ep.target_rooms,
                           max_steps=cfg.max_steps, seen=category_text(ep.query) in vocabulary,
-                          house_id=ref.id, planner_name=name, success=cfg.success)
+                          house_id=ref.id, planner_name=name, success=cfg.success,
+                          planner_options=planner_options_for(cfg, name))
                 if cfg.log_dir is None:
                     out.append(run_episode(house, planner, ep.query, ep.targets, **kw))
                 else:

@@ -75,3 +75,13 @@ def redact_text(text: str, secrets: Iterable[str | None] = ()) -> str:
         lambda m: m.group(1) + REDACTED if is_secret_name(m.group(1).split(".")[-1][:-1])
         else m.group(0), text)
     return redact_url(text)
+
+
+def recorded_options(options: Mapping[str, Any]) -> dict[str, Any]:
+    """A planner's options as an episode record keeps them: JSON values only (a Python
+    object set from Python, an encoder, is left out), keys named like secrets left out
+    (:func:`sgtool.redact.is_secret_name`) and URL passwords redacted, sorted."""
+    plain = (str, int, float, bool, type(None))
+    return {k: redact_options(v) for k, v in sorted(options.items())
+            if not is_secret_name(str(k)) and (isinstance(v, plain) or (
+                isinstance(v, list | tuple) and all(isinstance(x, plain) for x in v)))}

@@ -6,7 +6,6 @@ was built with.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import asdict
 from typing import Any
 
@@ -14,19 +13,8 @@ from sgtool.datasets.episodes import Episode
 from sgtool.planning.episode import planner_seed
 from sgtool.recorders.sim.closed_loop_options import ClosedLoopOptions
 from sgtool.recorders.sim.simulation import Simulation
+from sgtool.redact import recorded_options  # noqa: F401 (re-exported)
 from sgtool.scenegraph.build_options import ResolvedOptions, mapping_record
-
-
-def recorded_options(options: Mapping[str, Any]) -> dict[str, Any]:
-    """A planner's options as an episode record keeps them: JSON values only (a Python
-    object set from Python, an encoder, is left out), keys named like secrets left out
-    (:func:`sgtool.redact.is_secret_name`) and URL passwords redacted, sorted."""
-    from sgtool.redact import is_secret_name, redact_options
-
-    plain = (str, int, float, bool, type(None))
-    return {k: redact_options(v) for k, v in sorted(options.items())
-            if not is_secret_name(str(k)) and (isinstance(v, plain) or (
-                isinstance(v, list | tuple) and all(isinstance(x, plain) for x in v)))}
 
 
 def started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOptions,

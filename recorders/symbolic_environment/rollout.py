@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 from sgtool.errors import SgtoolError
 from sgtool.house.spec import HouseSpec, StartPose
@@ -29,6 +30,7 @@ from sgtool.planning.episode import (
 )
 from sgtool.recorders.symbolic_environment.environment import N_MAX, SymbolicEnv
 from sgtool.recorders.symbolic_environment.house import SymbolicHouse
+from sgtool.redact import recorded_options
 from sgtool.results import EpisodeResult, Step
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.semantics.text import category_text
@@ -82,7 +84,8 @@ def run_episode(house: SymbolicHouse, planner: Planner, query: str, targets: Seq
                 seed: int = 0, episode_index: int = 0, avoid_rooms: Sequence[str] = (),
                 max_steps: int = N_MAX, seen: bool | None = None, house_id: str = "",
                 planner_name: str | None = None, log: LogWriter | None = None,
-                start_region: str | None = None, success: str = "observed") -> EpisodeResult:
+                start_region: str | None = None, success: str = "observed",
+                planner_options: Mapping[str, Any] | None = None) -> EpisodeResult:
     """Roll out one episode: observe, decide, act, feed back, until it ends.
 
     ``targets`` (spec ids of the query's instances) only serve the shortest path of SPL;
@@ -128,7 +131,9 @@ def run_episode(house: SymbolicHouse, planner: Planner, query: str, targets: Seq
         recorder.close(len(steps), env, shortest, {
             "seed": int(seed), "planner_seed": pseed, "episode": int(episode_index),
             "seen": seen, "end": end, "n_open": env.n_open,
-            "start_region": env.start_region}, success=ok)
+            "start_region": env.start_region,
+            **({"planner_options": recorded_options(planner_options)} if planner_options
+               else {})}, success=ok)
     return result
 
 

@@ -397,3 +397,22 @@ def test_a_replay_folder_skips_logs_without_exchanges(tmp_path):
         replay_files([str(tmp_path)])
     (tmp_path / "moma.jsonl").write_text("")
     assert replay_files([str(tmp_path)]) == str(tmp_path / "moma.jsonl")
+
+
+def test_episode_logs_record_the_planner_options(tmp_path):
+    """A bench's episode logs keep the options each planner was built with (as closed-loop
+    logs do), so `sgtool golden` asks the same planner again."""
+    from sgtool.log import LogReader
+
+    r = CliRunner().invoke(cli, ["bench", "--planners", "scout,greedy", "--houses", "1",
+                                 "--episodes", "1", "--seeds", "1", "--max-steps", "3",
+                                 "--no-progress", "-O", "scout.delta=0.3", "--log-dir",
+                                 str(tmp_path / "logs"), "-o", str(tmp_path / "o")])
+    assert r.exit_code == 0, r.output
+    extras = {}
+    for log in sorted((tmp_path / "logs").rglob("*.mcap")):
+        with LogReader(log) as rd:
+            (end,) = [e for _, e in rd.records("episode") if e["status"] != "started"]
+        extras[end["planner"]] = end["extra"]
+    assert extras["scout"]["planner_options"] == {"delta": 0.3}
+    assert "planner_options" not in extras["greedy"]  # built with its defaults
