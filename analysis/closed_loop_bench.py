@@ -18,12 +18,13 @@ spread tasks over processes or machines (:func:`run_closed_loop_bench` takes a `
 
 The outputs (:func:`write_outputs`): ``episodes.jsonl`` (the
 :class:`~sgtool.results.EpisodeResult` of every run), ``summary.md`` (per noise profile:
-SR / SPL / steps / decision time / AUC-E as the symbolic bench, then frames per second and
-failed skills per episode by reason; then the statistics that separate planners,
-:mod:`sgtool.analysis.closed_loop_tables`: SR and SPL with bootstrap intervals over houses,
+SR / SPL / steps / AUC-E as the symbolic bench, then failed skills per episode by reason;
+then the statistics that separate planners, :mod:`sgtool.analysis.closed_loop_tables`: SR
+and SPL with bootstrap intervals over houses,
 paired comparisons over houses and per house, SR against the frame budget per room with
 AUC-E on frames, and, with symbolic bench results, Kendall's tau between the two planner
-orders), ``summary.json`` (the same statistics as numbers) and the efficiency curves per
+orders), ``summary.json`` (the same statistics as numbers), ``run.md`` (the wall-clock
+figures: decision time, frames per second) and the efficiency curves per
 noise profile (distance, steps and frames per room).
 """
 
@@ -362,7 +363,8 @@ class ClosedLoopBenchResult:
         return "\n".join(parts), data
 
     def table(self) -> str:
-        """Per noise profile: the bench table, then frames/s and failed skills by reason."""
+        """summary.md, per noise profile: the bench table, failed skills by reason and the
+        statistics that separate planners; no wall-clock figure (:meth:`timings`)."""
         cfg = self.config
         models = cost_models(cfg.distance_budget, cfg.step_budget)
         parts = []
@@ -370,11 +372,25 @@ class ClosedLoopBenchResult:
         for noise in cfg.noise:
             rows = [r for r in self.rows if r.task.noise == noise]
             parts.append(format_table(summarize([r.result for r in rows], models,
-                                                cfg.planners), models=models,
+                                                cfg.planners), models=models, timing=False,
                                       title=f"## Closed loop, noise "
                                             f"{noise_folder(noise)!r}{rule}"))
             parts.append(_run_table(rows, cfg.planners))
             parts.append(self.statistics(noise)[0])
+        return "\n".join(parts)
+
+    def timings(self) -> str:
+        """run.md, per noise profile: the wall-clock figures of the episodes run now
+        (decision time, frames per second), which differ between two runs."""
+        cfg = self.config
+        models = cost_models(cfg.distance_budget, cfg.step_budget)
+        parts = []
+        for noise in cfg.noise:
+            rows = [r for r in self.rows if r.task.noise == noise]
+            parts.append(format_table(summarize([r.result for r in rows], models,
+                                                cfg.planners), models=models,
+                                      title=f"## Closed loop, noise {noise_folder(noise)!r}"))
+            parts.append(_frame_rates(rows, cfg.planners))
         return "\n".join(parts)
 
     def summary(self) -> dict[str, Any]:
@@ -385,29 +401,38 @@ class ClosedLoopBenchResult:
 
 def _run_table(rows: Sequence[RunRow], planners: Sequence[str]) -> str:
     classes = sorted({k for r in rows for k in r.failures})
-    header = ["Planner", "Episodes", "Frames/ep", "Frames/s", "Ended", "Fallback/ep",
-              "Went on/ep", "Failed skills/ep", *classes]
+    header = ["Planner", "Episodes", "Frames/ep", "Ended", "Fallback/ep", "Went on/ep",
+              "Failed skills/ep", *classes]
     table = []
     for p in planners:
         rs = [r for r in rows if r.task.planner == p]
         if not rs:
             continue
         n = len(rs)
-        timed = [r for r in rs if r.seconds]
-        fps = (f"{sum(r.frames for r in timed) / sum(r.seconds or 0 for r in timed):.1f}"
-               if timed else "-")
         ends = Counter(r.result.end for r in rs)
         total = sum(sum(r.failures.values()) for r in rs)
-        table.append([p, str(n), f"{statistics.mean(r.frames for r in rs):.0f}", fps,
+        table.append([p, str(n), f"{statistics.mean(r.frames for r in rs):.0f}",
                       ", ".join(f"{k} {v}" for k, v in sorted(ends.items())),
                       f"{sum(r.fallbacks for r in rs) / n:.2f}",
                       f"{sum(r.went_on for r in rs) / n:.2f}", f"{total / n:.2f}",
                       *(f"{sum(r.failures.get(c, 0) for r in rs) / n:.2f}" for c in classes)])
-    return (pipe_table(header, table) + "\nFrames/s: wall clock of the episodes run now "
-            "(resumed ones excluded); Fallback/ep: goals per episode of the robot's own "
+    return (pipe_table(header, table) + "\nFallback/ep: goals per episode of the robot's own "
             "exploration when the graph offered the planner nothing; Went on/ep: frontiers "
             "per episode an explore that showed no new object, door or room went on to; "
             "failed skills per episode by reason.\n")
+
+
+def _frame_rates(rows: Sequence[RunRow], planners: Sequence[str]) -> str:
+    table = []
+    for p in planners:
+        if not any(r.task.planner == p for r in rows):
+            continue
+        timed = [r for r in rows if r.task.planner == p and r.seconds]
+        seconds = sum(r.seconds or 0 for r in timed)
+        fps = f"{sum(r.frames for r in timed) / seconds:.1f}" if timed else "-"
+        table.append([p, str(len(timed)), fps])
+    return (pipe_table(["Planner", "Episodes run now", "Frames/s"], table)
+            + "\nFrames/s: wall clock of the episodes run now (resumed ones excluded).\n")
 
 
 def iter_rows(tasks: Iterable[RunTask],
@@ -456,12 +481,14 @@ def report_order(cfg: ClosedLoopBenchConfig,
 # the names of a run-bench folder's entries (what ``--force`` may replace, and what marks a
 # folder without a manifest as a run-bench folder: :func:`sgtool.files.output_folder`)
 OUTPUT_NAMES: tuple[str, ...] = ("logs", "episodes.jsonl", "summary.md", "summary.json",
-                                 "efficiency_*.png")
+                                 "run.md", "efficiency_*.png")
 
 
 def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]:
-    """episodes.jsonl, summary.md, summary.json and the efficiency curves (per noise
-    profile: distance, steps, frames per room), each written atomically into ``out_dir``."""
+    """episodes.jsonl, summary.md, summary.json (no wall-clock figure: two runs give the
+    same bytes), run.md (decision times, frames per second) and the efficiency curves (per
+    noise profile: distance, steps, frames per room), each written atomically into
+    ``out_dir``."""
     from sgtool.analysis.curves import plot_efficiency
 
     out = Path(out_dir)
@@ -477,6 +504,7 @@ def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]
                                          out / f"efficiency_{noise_folder(noise)}_"
                                          f"{model.name}.png"))
     paths.append(atomic_write(out / "summary.md", res.table()))
+    paths.append(atomic_write(out / "run.md", res.timings()))
     paths.append(atomic_write(out / "summary.json", json.dumps(
         strict_json(res.summary()), indent=1, sort_keys=True, allow_nan=False) + "\n"))
     return paths

@@ -95,7 +95,8 @@ if TYPE_CHECKING:
 @click.option("-o", "--out", "out_dir", default="run-bench", show_default=True,
               type=click.Path(file_okay=False),
               help="Output folder: logs/NOISE/PLANNER/HOUSE/ep-K.mcap, episodes.jsonl, "
-              "summary.md, efficiency curves. A run-bench folder is resumed; another "
+              "summary.md/.json, run.md (wall-clock figures), efficiency curves. A run-bench "
+              "folder is resumed; another "
               "non-empty folder is refused unless --force.")
 @click.option("--force", is_flag=True,
               help="Start afresh: the run is built beside OUT and moved in complete, "
