@@ -95,7 +95,8 @@ def format_table(summaries: Sequence[PlannerSummary],
         row = [s.planner, *(fmt_stat(s.stats.get(k), spec) for k, _, spec in columns),
                f"{s.episodes} ({len(s.seeds)} seeds)"]
         if throughput is not None:
-            row.append(_fmt(throughput.get(s.planner, math.nan), ".1f"))
+            rate = throughput.get(s.planner, math.nan)  # an LLM planner's is below 0.1
+            row.append(_fmt(rate, ".1f" if not rate < 1 else ".2g"))
         rows.append(row)
     parts = []
     if title:

@@ -92,6 +92,10 @@ def test_tables_and_summary_dict():
     assert lines[1].startswith("| Planner") and "AUC-E dist" in lines[1]
     row = next(ln for ln in lines if ln.startswith("| scout"))
     assert "1.000 ± 0.000" in row and "12.0" in row
+    # an LLM planner's few episodes a second keep their digits (not "0.0")
+    slow = format_table(sums, throughput={"scout": 0.0333}, models=COST_MODELS)
+    assert next(ln for ln in slow.splitlines() if ln.startswith("| scout")).split("|")[-2].strip() \
+        == "0.033"
     assert "budget max 5000" in text and "budget max 50" in text
     split = format_seen_unseen(seen_unseen(rs))
     assert "| scout" in split and "Unseen SR" in split
