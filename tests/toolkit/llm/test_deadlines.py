@@ -136,6 +136,9 @@ def test_a_server_answering_after_the_request_timeout_ends_at_the_decision_deadl
     assert a.reason == ("llm failure: no valid command after 2 attempts: the decision "
                         "deadline of 1.5 s is spent")
     assert len(p.exchanges) == 2 and all(e["response"] is None for e in p.exchanges)
+    # each failed request logs the time it took until it was cut (1 s, then what was left)
+    first, second = (e["latency_s"] for e in p.exchanges)
+    assert first >= 0.9 and second >= 0.3  # not 0: a timeout took its time
 
 
 def test_llm_check_has_one_deadline_and_says_so_in_one_line():

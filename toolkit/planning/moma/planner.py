@@ -181,14 +181,16 @@ class MomaLlmPlanner:
                                 "is spent")
                 break
             attempts += 1
+            t_ask = time.perf_counter()
             try:
                 result = complete_within(self.client, messages, left, constraint)
             except ReplayMiss as e:
                 self._log(messages, None, 0.0, None, None, str(e), attempt)
                 self.replay_miss = str(e)
                 return Action("done", None, reason=f"llm failure: {e}")
-            except LlmTransportError as e:
-                self._log(messages, None, 0.0, None, None, str(e), attempt)
+            except LlmTransportError as e:  # its latency: the time spent until it failed
+                self._log(messages, None, time.perf_counter() - t_ask, None, None, str(e),
+                          attempt)
                 problems.append(str(e))
                 continue
             cmd = None
