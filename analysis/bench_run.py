@@ -42,7 +42,7 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     from sgtool.analysis.bench import OUTPUT_NAMES, run_benchmark, write_outputs
     from sgtool.analysis.report import llm_answer_totals
     from sgtool.files import output_folder
-    from sgtool.llm.recorded import start_transcript
+    from sgtool.llm.recorded import transcript_run
 
     out_dir, log_dir = request.out_dir, request.config.log_dir
     request.config.check()  # before anything is emptied or written (the transcript)
@@ -55,7 +55,8 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
                     stack.enter_context(output_folder(log_dir, force=request.force,
                                                       command="bench", option="--log-dir"))
             cfg = replace(request.config, log_dir=None if logs is None else str(logs))
-            start_transcript(cfg.planner_options.get("moma-llm", {}).get("transcript"))
+            stack.enter_context(transcript_run(
+                cfg.planner_options.get("moma-llm", {}).get("transcript")))
             res = run_benchmark(cfg, progress=request.progress, partial=True)
             if res.failed:  # tables without some houses' episodes would pass for a result
                 raise SgtoolError(f"{len(res.failed)} task(s) failed after a retry, nothing "

@@ -103,13 +103,13 @@ def record_tour(request: RecordRequest, show: Echo, note: Echo) -> None:
 def run_search(request: SearchRequest, show: Echo, note: Echo) -> None:
     """Run the request's episode in closed loop with its planner into its log; the
     report's lines go to ``show`` unless quiet."""
-    from sgtool.llm.recorded import start_transcript
+    from sgtool.llm.recorded import transcript_run
     from sgtool.planning.registry import make_planner
     from sgtool.recorders.sim.closed_loop import run_episode
 
     name = request.planner
-    with _progress(request.options.frames, f"run {name}", request.quiet) as bar:
-        start_transcript(request.planner_options.get("transcript"))
+    with _progress(request.options.frames, f"run {name}", request.quiet) as bar, \
+            transcript_run(request.planner_options.get("transcript")):
         planner = make_planner(name, **request.planner_options)
         live = _live(request.rerun_to, f"run {request.house_id} {request.episode_index} "
                      f"{name} {request.output}", note)

@@ -97,8 +97,8 @@ if TYPE_CHECKING:
               help="AUC-E step variant budget max, in high-level steps.")
 @llm_log_options(
     transcript_help="moma-llm: write every LLM exchange to this JSONL transcript, emptied "
-    "when the run starts "
-    "(needs --workers 1).", many=True)
+    "when the run starts (an interrupted run puts the previous one back; "
+    "needs --workers 1).", many=True)
 @llm_endpoint_options("LLM planners")
 @click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
               help=PLANNER_OPTION_HELP)

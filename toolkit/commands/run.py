@@ -109,8 +109,8 @@ if TYPE_CHECKING:
                    "index, as in `sgtool bench`.")
 @llm_log_options(
     transcript_help="moma-llm: write every LLM exchange to this JSONL transcript, emptied "
-    "when the run starts (replay it "
-    "later with --llm-replay).")
+    "when the run starts (an interrupted run puts the previous one back; replay "
+    "it later with --llm-replay).")
 @click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
               help="The episode log to write (OUT.mcap).")
 @click.option("--force", is_flag=True, help="Overwrite the output log.")

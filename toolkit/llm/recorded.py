@@ -18,7 +18,7 @@ import logging
 import os
 import time
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -39,19 +39,43 @@ class ReplayMiss(LlmTransportError):
     """The transcript has no (more) responses for this prompt."""
 
 
-def start_transcript(path: str | Path | None) -> None:
-    """Empty the transcript at ``path`` (created) when a command's run starts: a transcript
-    holds one run, so that a replay of it cannot serve an earlier run's answers to the same
-    prompts first (the planner's writer then appends the run's exchanges)."""
+@contextlib.contextmanager
+def transcript_run(path: str | Path | None) -> Iterator[None]:
+    """A command's run writing the transcript at ``path``: emptied (created) when the run
+    starts, since a transcript holds one run, so that a replay of it cannot serve an
+    earlier run's answers to the same prompts first (the planner's writer then appends the
+    run's exchanges). An interrupted run (Ctrl-C, SIGTERM) puts the transcript that was
+    there back, as the run's other outputs are left as they were; a run that ends, or
+    fails, keeps its own."""
     if path is None:
+        yield
         return
     p = Path(path)
+    previous: Path | None = None
     try:
         p.parent.mkdir(parents=True, exist_ok=True)
+        if p.exists():
+            fd, previous = temp_beside(p)
+            os.close(fd)
+            os.replace(p, previous)
         with open(p, "w", encoding="utf-8"):
             pass
     except OSError as e:
         raise output_error(e, p) from None
+    interrupted = False
+    try:
+        yield
+    except KeyboardInterrupt:
+        interrupted = True
+        raise
+    finally:
+        with contextlib.suppress(OSError):
+            if interrupted and previous is not None:
+                os.replace(previous, p)
+            elif interrupted:
+                p.unlink()
+            elif previous is not None:
+                previous.unlink()
 
 
 class TranscriptWriter:

@@ -1,0 +1,47 @@
+"""A command's transcript: emptied when a run starts, kept when it ends, and put back as it
+was when the run is interrupted (the run's other outputs are left as they were too)."""
+
+from __future__ import annotations
+
+import pytest
+
+from sgtool.llm.recorded import TranscriptWriter, transcript_run
+
+
+def test_a_finished_run_keeps_its_own_transcript(tmp_path):
+    t = tmp_path / "t.jsonl"
+    t.write_text('{"old": 1}\n')
+    with transcript_run(t):
+        assert t.read_text() == ""  # one run per transcript
+        w = TranscriptWriter(t)
+        w.write({"new": 1})
+        w.close()
+    assert t.read_text() == '{"new": 1}\n'
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.jsonl"]
+
+
+def test_an_interrupted_run_puts_the_previous_transcript_back(tmp_path):
+    t = tmp_path / "t.jsonl"
+    t.write_text('{"old": 1}\n')
+    with pytest.raises(KeyboardInterrupt), transcript_run(t):
+        TranscriptWriter(t).write({"new": 1})
+        raise KeyboardInterrupt
+    assert t.read_text() == '{"old": 1}\n'
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.jsonl"]
+    fresh = tmp_path / "fresh.jsonl"  # none before: none after
+    with pytest.raises(KeyboardInterrupt), transcript_run(fresh):
+        raise KeyboardInterrupt
+    assert not fresh.exists()
+
+
+def test_a_failed_run_keeps_what_it_asked(tmp_path):
+    """An error (not an interrupt) keeps the run's exchanges: they say what went wrong."""
+    t = tmp_path / "t.jsonl"
+    t.write_text('{"old": 1}\n')
+    with pytest.raises(ValueError), transcript_run(t):
+        w = TranscriptWriter(t)
+        w.write({"new": 1})
+        w.close()
+        raise ValueError("the planner failed")
+    assert t.read_text() == '{"new": 1}\n'
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.jsonl"]
