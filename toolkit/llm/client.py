@@ -209,6 +209,11 @@ class OpenAIChatClient:
             kwargs["max_tokens"] = self.settings.max_tokens
         if constraint is not None:
             kwargs.update(constraint.request_fields())
+            if constraint.kind == "grammar" and self.settings.temperature == 0:
+                # llama.cpp (the grammar's server) answers a prompt that reuses an earlier
+                # one's cache with other text: computed whole, the same request gets the
+                # same answer
+                kwargs["extra_body"] = {**kwargs["extra_body"], "cache_prompt": False}
         t0 = time.perf_counter()
         try:
             resp = self._create_within(kwargs, timeout)

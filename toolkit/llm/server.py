@@ -115,6 +115,10 @@ class LocalServer:
         p.n_ctx = int(config.ctx)
         p.n_parallel = 1
         p.cache_ram_mib = int(config.cache_mib)
+        # a request that reuses the cached part of an earlier prompt is computed in other
+        # batches, and at temperature 0 answers other text: every prompt is computed
+        # whole, so the same request gets the same answer (determinism over speed)
+        p.cache_prompt = False
         p.cpuparams.n_threads = int(config.threads)
         p.cpuparams_batch.n_threads = int(config.threads)
         p.endpoint_props = True

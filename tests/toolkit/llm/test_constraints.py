@@ -139,6 +139,14 @@ def test_planner_sends_the_grammar_of_the_scene_and_logs_the_verdict() -> None:
     assert p.invalid_commands == 1
     p.reset("milk")
     assert p.invalid_commands == 0
+    assert all("cache_prompt" not in r for r in srv.requests)  # the server's default
+    # at temperature 0 a llama.cpp request is computed whole: the same answer again
+    with ChatServer([answer("go_to_and_open(kitchen, fridge)")]) as srv:
+        p = make_planner("moma-llm", base_url=srv.base_url, model="m", api_key="k",
+                         timeout_s=5.0, constraint="grammar", temperature=0.0, timed=False)
+        p.reset("milk")
+        p.decide(house())
+    assert srv.requests[0]["cache_prompt"] is False and srv.requests[0]["temperature"] == 0
 
 
 def test_planner_sends_a_json_schema_and_reads_the_json_answer() -> None:

@@ -89,3 +89,22 @@ def test_room_classification_is_one_of_the_types(server) -> None:
     (got,) = c.classify(["toilet", "shower", "sink"])
     assert got[0] in ("bathroom", "kitchen", "living_room") and got[1] == 1.0
     assert c.exchanges[0]["verdict"] == "ok"
+
+
+def test_the_same_request_gets_the_same_answer_at_temperature_0(server) -> None:
+    """A prompt asked again right after another that begins it (an answer and a retry
+    message appended, as an invalid command's retry sends; llama.cpp's prompt cache would
+    reuse the shorter one's part) gets the same text: sgtool's server computes every prompt
+    whole."""
+    g = house()
+    c = client(server, 40)
+    short = MomaLlmPlanner(c, max_attempts=1, constraint="none")
+    short.reset("milk")
+    short.decide(g)
+    base = list(short.exchanges[0]["messages"])
+    long = [*base, {"role": "assistant", "content": "Command: explore(attic)"},
+            {"role": "user", "content": "Your command could not be executed: invalid "
+             "argument: there is no attic. Answer again in the same format."}]
+    alone = c.complete(long).text
+    c.complete(base)
+    assert c.complete(long).text == alone
