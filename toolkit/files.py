@@ -232,6 +232,19 @@ def _folder_target(target: str | os.PathLike[str], option: str) -> Path:
     return path
 
 
+def leftover_stages(target: str | os.PathLike[str]) -> list[Path]:
+    """The hidden staging folders of :func:`output_folder` beside ``target``
+    (``.NAME.XXXXXXXX.partial``) that no run removed: a run killed outright (SIGKILL, a
+    power cut) leaves one; sorted by name."""
+    path = Path(target)
+    head, tail = f".{path.name}.", ".partial"
+    if not path.parent.is_dir():
+        return []
+    return sorted(p for p in path.parent.iterdir()
+                  if p.name.startswith(head) and p.name.endswith(tail) and p.is_dir()
+                  and len(p.name) == len(head) + 8 + len(tail))
+
+
 @contextlib.contextmanager
 def output_folder(target: str | os.PathLike[str], *, force: bool, command: str = "sgtool",
                   option: str = "-o", known: Sequence[str] = (),

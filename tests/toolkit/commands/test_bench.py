@@ -416,3 +416,17 @@ def test_episode_logs_record_the_planner_options(tmp_path):
         extras[end["planner"]] = end["extra"]
     assert extras["scout"]["planner_options"] == {"delta": 0.3}
     assert "planner_options" not in extras["greedy"]  # built with its defaults
+
+
+def test_a_killed_runs_staging_folder_is_named(tmp_path):
+    """A run killed outright leaves its hidden staging folder beside OUT; the next run
+    that writes OUT names it (it never removes another run's folder)."""
+    stale = tmp_path / ".o.k1ll3d00.partial"
+    stale.mkdir()
+    r = CliRunner().invoke(cli, ["bench", "--planners", "greedy", "--houses", "1",
+                                 "--episodes", "1", "--seeds", "1", "--max-steps", "2",
+                                 "--no-progress", "-o", str(tmp_path / "o")])
+    assert r.exit_code == 0, r.output
+    assert f"sgtool: note: {stale} is the unfinished output of a run that was killed" \
+        in r.output
+    assert stale.is_dir()
