@@ -43,7 +43,7 @@ from sgtool.log.chunk_copy import RawChunk, raw_chunk
 from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.log.frame_assembly import FRAME_TOPICS, FrameAssembler, TransformBuffer, decoded
 from sgtool.log.image_wire import parse_raw_image
-from sgtool.log.log_file import require_regular_file
+from sgtool.log.log_file import require_regular_file, unended_problem
 from sgtool.log.records import RECORD_TYPES, LogRecord
 from sgtool.log.summary_check import BoundedReader as _BoundedReader
 from sgtool.log.summary_check import check_summary, read_attachment
@@ -120,11 +120,7 @@ class LogReader:
             size = f.tell()
             f.seek(max(size - 8, 0))
             if size < 16 or f.read(8) != _MAGIC:
-                raise LogFormatError(
-                    f"{self.path}: the file ends without the MCAP footer (truncated, or still "
-                    f"being written); `sgtool doctor {quoted(self.path)} --recover OUT.mcap` "
-                    "copies what is readable into a valid log"
-                )
+                raise LogFormatError(unended_problem(self.path, size))
         self.size = size
         # reads are clamped to the file: a damaged length cannot allocate gigabytes
         self._f: IO[bytes] = _BoundedReader(io.FileIO(self.path, "rb"), size)

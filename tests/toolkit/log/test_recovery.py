@@ -227,3 +227,21 @@ def test_a_recovered_log_is_named_mcap(long_log, tmp_path):
     r = CliRunner().invoke(cli, ["doctor", str(long_log), "--recover", str(tmp_path / "x.txt")])
     assert r.exit_code == 2 and "--recover" in r.output and "name it *.mcap" in r.output
     assert not (tmp_path / "x.txt").exists()
+
+
+def test_bytes_appended_to_a_complete_log_are_not_called_a_cut(long_log, tmp_path):
+    """A complete log with bytes appended (a second copy written over a first, a transfer
+    that added a line end): the reader says where the log ends, not that it was cut."""
+    data = long_log.read_bytes()
+    padded = tmp_path / "padded.mcap"
+    padded.write_bytes(data + b"\n")
+    with pytest.raises(LogFormatError) as e:
+        LogReader(padded)
+    assert str(e.value).startswith(
+        f"{padded}: 1 byte after the end of the MCAP file (its footer and closing magic end "
+        f"at byte {len(data)}): bytes appended to a complete log;")
+    recovered = tmp_path / "fixed.mcap"
+    r = CliRunner().invoke(cli, ["doctor", str(padded), "--recover", str(recovered)])
+    assert r.exit_code == 1 and recovered.is_file()
+    with LogReader(recovered) as a, LogReader(long_log) as b:
+        assert a.message_count() == b.message_count()
