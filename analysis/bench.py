@@ -70,6 +70,8 @@ from sgtool.analysis.bench_planner_checks import (
     BenchError,
     check_planner_list,
     check_planner_options,
+    config_names,
+    config_rooms,
 )
 from sgtool.analysis.bench_priors import (
     planner_options_for,
@@ -155,16 +157,10 @@ class BenchConfig:
         # a copy: the caller's dict changed for the next run must not change this one's
         object.__setattr__(self, "planner_options",
                            {str(k): dict(v) for k, v in self.planner_options.items()})
-        for name in ("planners", "house_files"):  # one name is a list of one, not of letters
-            v = getattr(self, name)
-            if isinstance(v, (set, frozenset)):  # no order: tables and digests would vary
-                raise BenchError(f"{name}: give a list or tuple (a set has no order)")
-            v = (v,) if isinstance(v, (str, os.PathLike)) else tuple(v)
-            object.__setattr__(self, name, tuple(str(x) if name == "house_files" else x
-                                                 for x in v))
-        if isinstance(self.rooms, (str, int)) or len(tuple(self.rooms)) != 2:
-            raise BenchError(f"rooms: give (MIN, MAX), got {self.rooms!r}")
-        object.__setattr__(self, "rooms", tuple(self.rooms))  # (a list from a JSON file)
+        object.__setattr__(self, "planners", config_names(self.planners, "planners"))
+        object.__setattr__(self, "house_files",
+                           config_names(self.house_files, "house_files", paths=True))
+        object.__setattr__(self, "rooms", config_rooms(self.rooms))
 
     def check(self) -> None:
         check_planner_list(self.planners)

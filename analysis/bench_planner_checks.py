@@ -15,6 +15,26 @@ class BenchError(SgtoolError):
     """A benchmark option that cannot work (unknown planner, bad range, missing transcript)."""
 
 
+def config_names(value: Any, field: str, paths: bool = False) -> tuple[Any, ...]:
+    """A config's list field as a tuple: one name (a string, a path) is a list of one, not
+    of letters; a set is refused (no order: tables and digests would vary); ``paths``:
+    each item as text."""
+    import os
+
+    if isinstance(value, set | frozenset):
+        raise BenchError(f"{field}: give a list or tuple (a set has no order)")
+    items = (value,) if isinstance(value, str | os.PathLike) else tuple(value)
+    return tuple(str(x) for x in items) if paths else items
+
+
+def config_rooms(value: Any) -> tuple[int, int]:
+    """A config's ``rooms``: (MIN, MAX), a list from a JSON file taken as a pair."""
+    if isinstance(value, str | int) or len(tuple(value)) != 2:
+        raise BenchError(f"rooms: give (MIN, MAX), got {value!r}")
+    lo, hi = tuple(value)
+    return lo, hi
+
+
 def check_planner_list(planners: Sequence[str]) -> None:
     """``--planners`` of a benchmark (symbolic or closed loop): at least one, each a
     built-in planner, a registered plug-in or ``module:Name``

@@ -47,6 +47,7 @@ from sgtool.analysis.bench_houses import (
     load_house_files,
     output_path,
 )
+from sgtool.analysis.bench_planner_checks import config_names, config_rooms
 from sgtool.analysis.closed_loop_tables import (
     budget_comparisons,
     format_agreement,
@@ -64,6 +65,7 @@ from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write
 from sgtool.log.writer import partial_files
+from sgtool.progress import Progress
 from sgtool.recorders.sim.closed_loop import WENT_ON, ClosedLoopOptions, run_episode
 from sgtool.recorders.sim.fallback_explore import is_fallback
 from sgtool.recorders.sim.frame_budget import frame_budget
@@ -96,8 +98,21 @@ def reason_class(reason: str) -> str:
     return "other"
 
 
+# what maps run_task over the tasks: map (in order, here) or an executor's runner
+Runner = Callable[[Callable[["RunTask"], "RunRow"], Iterable["RunTask"]], Iterable["RunRow"]]
+
+
 @dataclass(frozen=True)
 class ClosedLoopBenchConfig:
+    """What ``sgtool run-bench`` runs: ``episodes`` per house of ``planners`` in closed loop
+    (PyBullet), on ``houses`` generated houses (seeds from ``house_seed``, ``rooms`` (MIN,
+    MAX), ``preset``) and the ``house_files`` after them, once per sensor ``noise`` profile,
+    each with the closed-loop ``options`` and its ``planner_options``; the tables price
+    ``frames_per_room`` (None: the most any episode used), ``distance_budget`` and
+    ``step_budget``, and compare planners against ``reference`` (or every pair). A planner
+    name, a house file or a noise profile given alone is a list of one; :meth:`check` says
+    in one line what cannot work."""
+
     planners: tuple[str, ...]
     houses: int = 5  # generated houses, seeds house_seed, +1, ...
     house_seed: int = 0
@@ -118,6 +133,11 @@ class ClosedLoopBenchConfig:
         # a copy: the caller's dict changed for the next run must not change this one's
         object.__setattr__(self, "planner_options",
                            {str(k): dict(v) for k, v in self.planner_options.items()})
+        for name in ("planners", "noise"):
+            object.__setattr__(self, name, config_names(getattr(self, name), name))
+        object.__setattr__(self, "house_files",
+                           config_names(self.house_files, "house_files", paths=True))
+        object.__setattr__(self, "rooms", config_rooms(self.rooms))
 
     def check(self) -> None:
         from sgtool.analysis.bench_planner_checks import check_planner_list
@@ -435,18 +455,18 @@ def _frame_rates(rows: Sequence[RunRow], planners: Sequence[str]) -> str:
             + "\nFrames/s: wall clock of the episodes run now (resumed ones excluded).\n")
 
 
-def iter_rows(tasks: Iterable[RunTask],
-              runner: Callable[[Callable[[RunTask], RunRow], Iterable[RunTask]],
-                               Iterable[RunRow]] = map) -> Iterator[RunRow]:
+def iter_rows(tasks: Iterable[RunTask], runner: Runner = map) -> Iterator[RunRow]:
     return iter(runner(run_task, tasks))
 
 
 def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
-                          progress: Any = None, runner: Any = map,
+                          progress: Progress | None = None, runner: Runner = map,
                           report_only: bool = False) -> ClosedLoopBenchResult:
-    """Run (or resume) the benchmark into ``out_dir``/logs; ``progress`` is anything with
-    ``update(n)`` and ``total`` (a tqdm bar), advanced per episode. ``report_only``: run
-    nothing, read back the episodes whose logs are there (a run in progress, cut short)."""
+    """Run (or resume) the benchmark into ``out_dir``/logs; ``progress`` is advanced per
+    episode (a tqdm bar's ``total`` is set to the episodes). ``runner`` maps
+    :func:`run_task` over the tasks (``map``: one after the other, here). ``report_only``:
+    run nothing, read back the episodes whose logs are there (a run in progress, cut
+    short)."""
     cfg.check()
     logs = Path(out_dir) / "logs"
     tasks = tasks_of(cfg, logs)
@@ -454,7 +474,7 @@ def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
         tasks = [t for t in tasks if t.output.exists()]
         if not tasks:
             raise SgtoolError(f"no episode log of this run in {logs}")
-    if progress is not None:
+    if progress is not None and hasattr(progress, "total"):
         progress.total = len(tasks)
     rows = []
     for row in iter_rows(tasks, runner):

@@ -8,8 +8,10 @@ builds the request; ``show`` receives the result line (stdout), ``note`` the not
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from sgtool.files import quoted
@@ -54,6 +56,35 @@ def view_log(request: ViewRequest, show: Echo, note: Echo) -> None:
                if live is not None and live.mode == "serve" else None)
     if request.output:
         show(f"wrote {request.output}; open it with: rerun {quoted(request.output)}")
+
+
+def write_rerun(log: str | os.PathLike[str], output: str | os.PathLike[str], *,
+                every: int = 1, max_frames: int | None = None, voxels: bool = True,
+                overwrite: bool = False, progress: Callable[[int], None] | None = None,
+                warn: Callable[[str], None] | None = None) -> Path:
+    """Write ``log`` as a Rerun recording ``output`` (``.rrd``, atomically), as ``sgtool
+    view LOG -o OUTPUT`` does: camera images, the voxel map (unless not ``voxels``), the
+    maps, graphs, rooms, objects, doors, frontiers, path, actions and episode of a derived
+    log, on a frame timeline; one camera frame in ``every``, at most ``max_frames``.
+    ``progress`` is called with the frames drawn, ``warn`` with one-line notes about the
+    log. An existing ``output`` is refused unless ``overwrite``; a foreign recording, a
+    damaged log or an output that is the log is one :class:`~sgtool.errors.SgtoolError`
+    line. Returns the path written."""
+    from sgtool.analysis.rerun_view import export
+    from sgtool.errors import SgtoolError
+    from sgtool.output_check import check_output
+
+    if every < 1 or (max_frames is not None and max_frames < 1):
+        raise SgtoolError(f"every={every}, max_frames={max_frames}: each must be >= 1")
+    if Path(output).resolve() == Path(log).resolve():
+        raise SgtoolError("the output must not be the input log")
+    check_output(Path(output), force=overwrite, suffixes=(".rrd",), what="Rerun recording")
+    request = ViewRequest(log=os.fspath(log), output=os.fspath(output), every=every,
+                          max_frames=max_frames, voxels=voxels)
+    written = export(log, output, every=every, max_frames=max_frames, progress=progress,
+                     voxels=_voxel_source(request), warn=warn)
+    assert written is not None  # a file was asked for
+    return written
 
 
 def _voxel_source(request: ViewRequest) -> Callable[[Any], Any] | None:

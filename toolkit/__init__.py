@@ -33,7 +33,12 @@ symbolic benchmark     :func:`run_one` (one episode), :class:`SymbolicHouse`,
 closed loop            :func:`run_closed_loop` (one PyBullet episode into a log),
                        :class:`ClosedLoopOptions`, :class:`ClosedLoopReport`,
                        :func:`pick_episode`, :class:`NoiseProfile` (sensor faults, from
-                       :func:`parse_noise`: ``"strong"``, ``"mild,holes=0.05"``)
+                       :func:`parse_noise`: ``"strong"``, ``"mild,holes=0.05"``); the
+                       closed-loop benchmark: :class:`ClosedLoopBenchConfig`,
+                       :func:`run_closed_loop_bench` (runs or resumes into a folder),
+                       :class:`ClosedLoopBenchResult`,
+                       :func:`write_closed_loop_bench_outputs`
+viewers                :func:`write_rerun` (a log as a Rerun recording)
 metrics                :func:`success_rate`, :func:`spl`, :func:`episode_spl`,
                        :func:`mean_steps`, :func:`mean_decision_time`, :func:`auc_e`,
                        :func:`efficiency_curve`, :class:`CostModel`, :func:`cost_models`,
@@ -62,7 +67,8 @@ A few names differ from their defining module's to stay unambiguous at the top l
 ``Action`` (:class:`ActionRecord` is the planner's :class:`Action`: one type),
 :class:`SearchEpisode` is ``sgtool.datasets.episodes.Episode``, :func:`run_closed_loop` is
 ``sgtool.recorders.sim.closed_loop.run_episode``, :func:`write_bench_outputs` is
-``sgtool.analysis.bench.write_outputs``, :func:`read_results`/:func:`write_results` are
+``sgtool.analysis.bench.write_outputs``, :func:`write_closed_loop_bench_outputs` is
+``sgtool.analysis.closed_loop_bench.write_outputs``, :func:`read_results`/:func:`write_results` are
 ``sgtool.results.read_jsonl``/``write_jsonl``.
 """
 

@@ -70,6 +70,12 @@ from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport as ClosedLo
 from sgtool.recorders.sim.closed_loop import pick_episode as pick_episode
 from sgtool.recorders.sim.noise import NoiseProfile as NoiseProfile
 from sgtool.recorders.sim.noise import parse_noise as parse_noise
+from sgtool.analysis.closed_loop_bench import ClosedLoopBenchConfig as ClosedLoopBenchConfig
+from sgtool.analysis.closed_loop_bench import ClosedLoopBenchResult as ClosedLoopBenchResult
+from sgtool.analysis.closed_loop_bench import run_closed_loop_bench as run_closed_loop_bench
+from sgtool.analysis.closed_loop_bench import write_outputs as write_closed_loop_bench_outputs
+# viewers
+from sgtool.analysis.view_run import write_rerun as write_rerun
 # metrics
 from sgtool.analysis.intervals import Interval as Interval
 from sgtool.analysis.intervals import PairedComparison as PairedComparison
@@ -136,7 +142,9 @@ __all__ = [
     "load_house_text", "save_house", "generate_house", "SearchEpisode", "list_episodes",
     "run_one", "SymbolicHouse", "EpisodeResult", "BenchConfig", "BenchResult", "run_benchmark",
     "write_bench_outputs", "run_closed_loop", "ClosedLoopOptions", "ClosedLoopReport",
-    "pick_episode", "NoiseProfile", "parse_noise", "Interval", "PairedComparison",
+    "pick_episode", "NoiseProfile", "parse_noise", "ClosedLoopBenchConfig",
+    "ClosedLoopBenchResult", "run_closed_loop_bench", "write_closed_loop_bench_outputs",
+    "write_rerun", "Interval", "PairedComparison",
     "PlannerIntervals", "paired_comparison", "planner_intervals", "success_rate", "spl",
     "episode_spl", "mean_steps", "mean_decision_time",
     "auc_e", "efficiency_curve", "CostModel", "cost_models", "metrics_of", "summarize",
