@@ -89,7 +89,7 @@ def _house_sources(paths: Iterable[str | os.PathLike[str]]) -> list[tuple[Path, 
 def _not_a_house(path: Path) -> bool:
     """A file that holds no house spec at all (not a JSON object with ``rooms``)."""
     try:
-        raw: Any = json.loads(path.read_text(encoding="utf-8"))
+        raw: Any = json.loads(path.read_text(encoding="utf-8-sig"))
     except (OSError, ValueError, RecursionError):
         return True
     return not (isinstance(raw, dict) and "rooms" in raw)
@@ -258,7 +258,7 @@ def completion_notes(path: Path, spec: HouseSpec) -> tuple[str, ...]:
     categories whose pieces it reads as supporters
     (:func:`sgtool.house.nesting.with_supporters`), found by comparing the two."""
     try:
-        raw: Any = json.loads(path.read_text(encoding="utf-8"))
+        raw: Any = json.loads(path.read_text(encoding="utf-8-sig"))
         given = {str(x["id"]): set(x.get("affordances") or ())
                  for part in ("furniture", "objects") for x in raw.get(part) or ()}
     except (OSError, ValueError, TypeError, KeyError, AttributeError):
@@ -304,7 +304,7 @@ def _house_id(spec: HouseSpec, path: Path) -> str:
     own = getattr(spec, "id", None)
     if not own:
         try:
-            raw: Any = json.loads(path.read_text(encoding="utf-8"))
+            raw: Any = json.loads(path.read_text(encoding="utf-8-sig"))
             own = raw.get("id") if isinstance(raw, dict) else None
         except (OSError, ValueError):
             own = None

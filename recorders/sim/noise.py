@@ -102,7 +102,7 @@ def parse_noise(text: str | None) -> NoiseProfile:
     if names_file(t):
         p = Path(t)
         try:
-            d = json.loads(p.read_text(encoding="utf-8"))
+            d = json.loads(p.read_text(encoding="utf-8-sig"))
         except (OSError, UnicodeDecodeError) as e:
             raise SgtoolError(f"--noise {t}: cannot read: {e}") from None
         except json.JSONDecodeError as e:

@@ -46,7 +46,7 @@ def load_house(source: str | os.PathLike[str] | Mapping[str, Any],
         if p.is_file() and p.stat().st_size > MAX_FILE_BYTES:
             raise SpecError(f"{p}: {p.stat().st_size} bytes, more than the limit of "
                             f"{MAX_FILE_BYTES} for a house spec")
-        raw = p.read_text(encoding="utf-8")
+        raw = p.read_text(encoding="utf-8-sig")  # a byte-order mark (Windows editors) is no text
     except FileNotFoundError:
         raise SpecError(f"{p}: no such house spec file") from None
     except (OSError, UnicodeDecodeError) as e:

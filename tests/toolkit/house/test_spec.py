@@ -99,6 +99,13 @@ def test_validation_names_the_field(mutate, message):
     assert str(e.value).startswith(message), str(e.value)
 
 
+def test_a_file_with_a_byte_order_mark_loads(tmp_path):
+    """Editors on Windows save UTF-8 with a byte-order mark; it is no part of the JSON."""
+    p = tmp_path / "bom.json"
+    p.write_bytes(b"\xef\xbb\xbf" + json.dumps(two_rooms()).encode())
+    assert load_house(p) == load_house(two_rooms())
+
+
 def test_file_errors_name_the_file(tmp_path):
     bad = tmp_path / "bad.json"
     bad.write_text("{not json")
