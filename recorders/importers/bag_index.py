@@ -83,6 +83,7 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
     conns = [c for c in reader.connections if c.topic in wanted]
     n_depth = sum(t.count for t in topics if t.topic == opts.depth)
     keep = set(sample_indices(n_depth))  # depth images kept for the world alignment
+    info_received: list[int] = []  # the bag's record times of idx.info_samples
     total = sum(int(c.msgcount) for c in conns)
     bar = tqdm(total=total, unit="msg", desc="index", file=sys.stderr,
                disable=None if opts.progress else True, leave=False)
@@ -111,7 +112,8 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
                     idx.distortion = distortion_of_info(msg)
                 if not idx.info_samples or k != idx.info_samples[-1][1]:
                     t = int(bag_t) if opts.timestamps == "bag" else stamp_ns(msg.header)
-                    idx.info_samples.append((t or int(bag_t), k))
+                    idx.info_samples.append((t, k))
+                    info_received.append(int(bag_t))
                     idx.info_changes = len(idx.info_samples) - 1
                 continue
             for topic, ii in ((opts.depth, idx.depth), (opts.rgb, idx.rgb), (opts.ids, idx.ids)):
@@ -126,7 +128,14 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
         bar.close()
     for ii in (idx.depth, idx.rgb, idx.ids):
         _resolve_zero_stamps(ii, idx)
+    # a zero CameraInfo stamp is a time when the images' clock starts near 0 (a simulator's)
+    sim_clock = any(0 < t <= _SIM_CLOCK_NS for t in idx.depth.stamps)
+    for ii in (idx.depth, idx.rgb, idx.ids):
         ii.stamps = [t + opts.time_offset_ns for t in ii.stamps]
-    idx.info_samples = sorted((t + opts.time_offset_ns, k) for t, k in idx.info_samples)
+    timed = [(t if t or sim_clock else r, k)
+             for (t, k), r in zip(idx.info_samples, info_received, strict=True)]
+    # the first CameraInfo is the camera's until a change; the changes in time order
+    idx.info_samples = timed[:1] + sorted(timed[1:])
+    idx.info_samples = [(t + opts.time_offset_ns, k) for t, k in idx.info_samples]
     idx.tf.freeze()
     return idx

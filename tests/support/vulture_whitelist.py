@@ -42,6 +42,7 @@ _.cache_ram_mib  # toolkit/llm/server.py: xllamacpp CommonParams field
 _.n_threads  # toolkit/llm/server.py: xllamacpp CpuParams field
 _.endpoint_props  # toolkit/llm/server.py: xllamacpp CommonParams field
 _.verbosity  # toolkit/llm/server.py: xllamacpp CommonParams field
+_.cache_prompt  # toolkit/llm/server.py: xllamacpp CommonParams field (the server default)
 _.model_alias  # toolkit/llm/server.py: xllamacpp CommonParams field
 _._server  # toolkit/llm/server.py: keeps the llama.cpp server object alive
 _.holds  # analysis/validity.py: Rule field, rendered into the docs of the rules
@@ -93,6 +94,7 @@ _.RECORD_NAMES  # toolkit/vocabulary.py: vocabulary table (tests/toolkit/test_vo
 _.LOGGED_SKILLS  # toolkit/vocabulary.py: vocabulary table
 _.CASES  # replayers/golden.py: the golden cases (tests/golden/regenerate.py)
 _.replay_graphs  # replayers/golden.py: public API (sgtool.replay_graphs)
+_.write_rerun  # analysis/view_run.py: public API (sgtool.write_rerun)
 _.room_check  # toolkit/semantics/everyday_rooms.py: a user scores own priors (module doc)
 _.accuracy  # toolkit/semantics/everyday_rooms.py: RoomCheck property (top-1 share)
 _.get_metavar  # toolkit/commands/options.py: FiniteFloatRange, called by click for --help

@@ -44,9 +44,10 @@ def transcript_run(path: str | Path | None) -> Iterator[None]:
     """A command's run writing the transcript at ``path``: emptied (created) when the run
     starts, since a transcript holds one run, so that a replay of it cannot serve an
     earlier run's answers to the same prompts first (the planner's writer then appends the
-    run's exchanges). An interrupted run (Ctrl-C, SIGTERM) puts the transcript that was
-    there back, as the run's other outputs are left as they were; a run that ends, or
-    fails, keeps its own."""
+    run's exchanges). The transcript that was there is put back when the run is
+    interrupted (Ctrl-C, SIGTERM: the run's other outputs are left as they were too) or
+    fails before its first exchange (a setup mistake); a run that ends, or fails after
+    asking, keeps its own."""
     if path is None:
         yield
         return
@@ -62,17 +63,20 @@ def transcript_run(path: str | Path | None) -> Iterator[None]:
             pass
     except OSError as e:
         raise output_error(e, p) from None
-    interrupted = False
+    restore = False
     try:
         yield
     except KeyboardInterrupt:
-        interrupted = True
+        restore = True
+        raise
+    except BaseException:
+        restore = not p.exists() or p.stat().st_size == 0
         raise
     finally:
         with contextlib.suppress(OSError):
-            if interrupted and previous is not None:
+            if restore and previous is not None:
                 os.replace(previous, p)
-            elif interrupted:
+            elif restore:
                 p.unlink()
             elif previous is not None:
                 previous.unlink()

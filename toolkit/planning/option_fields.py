@@ -101,33 +101,58 @@ class OptionInfo:
                 + (f" [{rng}]" if rng else ""))
 
 
-_PLAIN_KINDS = (("bool", bool), ("int", int), ("float", float), ("str", str))
+_PLAIN_KINDS = {bool: "bool", int: "int", float: "float", str: "str"}
 
 
-def _plain_meta(f: dataclasses.Field[Any]) -> OptionMeta:
-    """The metadata of a field without :func:`option` (a plug-in's plain config dataclass):
-    its kind from its default's type, else from its annotation's words (``int``,
-    ``float``, ``bool``, ``str``, ``Path``), else a Python object; None is a value when the
-    default is None or the annotation allows it."""
-    default = f.default if f.default is not dataclasses.MISSING else None
-    note = str(getattr(f.type, "__name__", f.type))
-    optional = default is None or "None" in note or "Optional" in note
-    kind = next((k for k, t in _PLAIN_KINDS if type(default) is t), None)
-    if kind is None:
-        words = set(note.replace("|", " ").replace("[", " ").replace("]", " ").split())
-        kind = next((k for k, _ in _PLAIN_KINDS if k in words), None)
-        if kind is None and words & {"Path", "PathLike", "os.PathLike", "pathlib.Path"}:
-            kind = "path"
-    return OptionMeta(f"a field of {note}", kind or "object", optional=optional)
+def _plain_meta(f: dataclasses.Field[Any], hint: Any) -> OptionMeta:
+    """The metadata of a field without :func:`option` (a plug-in's plain config dataclass),
+    from its type ``hint`` (resolved by :func:`typing.get_type_hints`): ``int``, ``float``,
+    ``bool``, ``str`` or a path, each alone or ``| None`` (then None is a value); anything
+    else (a list, a dict, a class) is a Python object, settable from Python only."""
+    import pathlib
+    import types
+    import typing
+
+    args: tuple[Any, ...] = (hint,)
+    if typing.get_origin(hint) in (typing.Union, types.UnionType):
+        args = typing.get_args(hint)
+    optional = type(None) in args
+    plain = [a for a in args if a is not type(None)]
+    kind = "object"
+    if len(plain) == 1:
+        t = plain[0]
+        kind = _PLAIN_KINDS.get(t) or ("path" if t in (pathlib.Path, os.PathLike) else "object")
+    note = hint.__name__ if isinstance(hint, type) else str(hint).replace("typing.", "")
+    return OptionMeta(f"a field of {note}", kind, optional=optional)
+
+
+def _type_hints(cls: type) -> dict[str, Any]:
+    """The resolved annotation of each field of ``cls`` (text under ``from __future__
+    import annotations``, evaluated in its module); a field whose annotation names what
+    cannot be resolved there is left out (it is then a Python object)."""
+    import sys
+
+    namespace = dict(vars(sys.modules.get(cls.__module__, sys)))
+    out: dict[str, Any] = {}
+    for f in dataclasses.fields(cls):
+        hint = f.type
+        if isinstance(hint, str):
+            try:
+                hint = eval(hint, namespace, {})  # noqa: S307 - the plug-in's own annotation
+            except Exception:  # noqa: BLE001 - a name not importable there: a Python object
+                continue
+        out[f.name] = hint
+    return out
 
 
 def option_infos(cls: type) -> tuple[OptionInfo, ...]:
     """The options of an options dataclass, in field order; a field without
-    :func:`option` metadata takes the kind of its default or annotation
+    :func:`option` metadata takes the kind of its type annotation
     (:func:`_plain_meta`)."""
     out = []
+    hints = _type_hints(cls)
     for f in dataclasses.fields(cls):
-        meta = f.metadata.get(_META) or _plain_meta(f)
+        meta = f.metadata.get(_META) or _plain_meta(f, hints.get(f.name, f.type))
         default = f.default if f.default is not dataclasses.MISSING else None
         out.append(OptionInfo(f.name, meta.kind, default, meta))
     return tuple(out)

@@ -546,6 +546,14 @@ def test_a_camera_info_that_changes_part_way_is_followed(tmp_path):
     with LogReader(out) as r:
         got = [f.intrinsics.fx for f in r.frames()]
     assert got == pytest.approx([f.intrinsics.fx for f in frames], abs=1e-9)
+    # the same on a simulator's clock (stamps from 0) in a wall-clock bag
+    sim = [dataclasses.replace(f, time_ns=f.time_ns - 10**9) for f in frames]
+    write_frames_bag(sim, tmp_path / "zoom_sim", "ros2-mcap",
+                     record_offset_ns=1_733_000_000 * 10**9)
+    import_bag(tmp_path / "zoom_sim", tmp_path / "o2.mcap", BagOptions(**TOPICS, **KEEP_WORLD))
+    with LogReader(tmp_path / "o2.mcap") as r:
+        got = [f.intrinsics.fx for f in r.frames()]
+    assert got == pytest.approx([f.intrinsics.fx for f in frames], abs=1e-9)
     # a CameraInfo for another image size part-way is refused in one line
     sized = [dataclasses.replace(f, intrinsics=dataclasses.replace(
         f.intrinsics, width=2 * f.intrinsics.width)) if f.index >= 3 else f for f in frames]

@@ -45,3 +45,14 @@ def test_a_failed_run_keeps_what_it_asked(tmp_path):
         raise ValueError("the planner failed")
     assert t.read_text() == '{"new": 1}\n'
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.jsonl"]
+
+
+def test_a_run_that_fails_before_asking_puts_the_previous_one_back(tmp_path):
+    """A setup mistake (a bad option, a URL without http://) fails before the first
+    exchange: the earlier run's transcript is not lost to an empty file."""
+    t = tmp_path / "t.jsonl"
+    t.write_text('{"old": 1}\n')
+    with pytest.raises(ValueError), transcript_run(t):
+        raise ValueError("a bad option")
+    assert t.read_text() == '{"old": 1}\n'
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.jsonl"]

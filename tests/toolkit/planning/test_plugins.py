@@ -121,6 +121,41 @@ def test_a_plain_options_dataclass_checks_by_its_fields_types(plugin_dir: Path) 
     assert "radius (float, default 2.0)" in describe_planners(["mymod_plug:Plain"])
 
 
+def test_plain_fields_are_typed_by_their_annotations(tmp_path: Path, monkeypatch) -> None:
+    """Annotations as text (``from __future__ import annotations``) are resolved in the
+    plug-in's module: ``X | None`` takes None, a list or a dict is a Python object (not
+    set by -O), a name that does not resolve is a Python object too."""
+    (tmp_path / "future_plug.py").write_text(textwrap.dedent('''
+        from __future__ import annotations
+
+        from dataclasses import dataclass, field
+        from typing import Optional
+
+        from sgtool.planning.planners import GreedyPlanner
+
+
+        class P(GreedyPlanner):
+            @dataclass
+            class Options:
+                tags: list[str] = field(default_factory=list)
+                limit: Optional[int] = None
+                cap: int | None = None
+                mode: Unknowable = "a"
+
+            def __init__(self, **kw):
+                super().__init__()
+                self.kw = kw
+    '''))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert parse_option("future_plug:P", "limit", "5") == 5
+    assert make_planner("future_plug:P", cap=None).inner.kw == {"cap": None}  # type: ignore[attr-defined]
+    for key in ("tags", "mode"):
+        with pytest.raises(PlannerOptionError, match="a Python object, set from Python only"):
+            parse_option("future_plug:P", key, "1.5")
+    with pytest.raises(PlannerOptionError, match="must be an integer"):
+        parse_option("future_plug:P", "cap", "x")
+
+
 def test_an_options_dataclass_checks_like_the_built_ins(plugin_dir: Path) -> None:
     assert make_planner("mymod_plug:Typed", k="4").inner.k == 4  # type: ignore[attr-defined]
     assert parse_option("mymod_plug:Typed", "k", "5") == 5
