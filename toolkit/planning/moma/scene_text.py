@@ -54,44 +54,57 @@ _IRREGULAR = {
     "cactus": "cacti", "fungus": "fungi",
 }
 _SINGULAR = {p: s for s, p in _IRREGULAR.items()}
-_OWN_PLURAL = frozenset({
-    "shears", "tights", "scissors", "pants", "jeans", "shorts", "trousers", "pliers", "tongs",
-    "tweezers", "headphones", "earphones", "binoculars", "pajamas", "clothes", "sheep",
-    "fish", "deer", "series", "species", "drawers", "stairs", "supplies", "groceries",
+_OWN_PLURAL = frozenset({"sheep", "fish", "deer", "series", "species"})
+# the partitive nouns of "X of Y" names, which take the number ("bottles of olive oil");
+# in other "X of Y" names the last word does ("cream of tartar shakers")
+_PARTITIVES = frozenset({
+    "bag", "bar", "basket", "bottle", "bowl", "box", "bucket", "bunch", "can", "carton",
+    "case", "chest", "container", "crate", "cup", "glass", "jar", "jug", "loaf", "mug",
+    "pack", "packet", "pair", "piece", "plate", "pot", "roll", "sack", "scoop", "set",
+    "sheet", "slice", "stack", "stick", "tin", "tray", "tub", "tube",
 })
 
 
-def _split_of(noun: str) -> tuple[str, str]:
-    """("chest", " of drawers") for "chest of drawers": the head noun of an "X of Y" name
-    is the word that takes the number; ("coffee table", "") otherwise."""
-    head, of, rest = noun.partition(" of ")
-    return (head, of + rest) if of and head else (noun, "")
+def _parts(noun: str) -> tuple[str, str, str]:
+    """(before, the word that takes the number, after) of a category name in words."""
+    first, of, rest = noun.partition(" of ")
+    if of and first and " " not in first and (first in _PARTITIVES
+                                             or first.removesuffix("s") in _PARTITIVES
+                                             or first in _SINGULAR):
+        return "", first, of + rest
+    head, _, last = noun.rpartition(" ")
+    return (head + " " if head else ""), last, ""
+
+
+def _plural_look(word: str) -> bool:
+    """A word that already reads as a plural ("sunglasses", "fries", "drawers"): -es, or
+    -s after a consonant; not -ss, -us, -is, -as, -os ("glass", "bus")."""
+    return word.endswith("es") or (word.endswith("s") and len(word) > 2
+                                   and word[-2] not in "aeiosu")
 
 
 def plural(noun: str) -> str:
-    """English plural of a category name: its head noun's ("chests of drawers",
-    "coffee tables"), irregular ones ("shelves", "knives") and names that are their own
-    plural ("shears") included."""
-    noun, tail = _split_of(noun)
-    head, _, last = noun.rpartition(" ")
-    if last in _IRREGULAR:
-        last = _IRREGULAR[last]
-    elif last in _OWN_PLURAL:
+    """English plural of a category name: its head noun's ("chests of drawers", "coffee
+    tables", "cream of tartar shakers"), irregular ones ("shelves", "knives"), and a name
+    that already reads as a plural as it is ("sunglasses", "shears")."""
+    before, word, after = _parts(noun)
+    if word in _IRREGULAR:
+        word = _IRREGULAR[word]
+    elif word in _OWN_PLURAL or _plural_look(word):
         pass
-    elif last.endswith(("s", "x", "z", "ch", "sh")):
-        last += "es"
-    elif last.endswith("y") and len(last) > 1 and last[-2] not in "aeiou":
-        last = last[:-1] + "ies"
+    elif word.endswith(("s", "x", "z", "ch", "sh")):
+        word += "es"
+    elif word.endswith("y") and len(word) > 1 and word[-2] not in "aeiou":
+        word = word[:-1] + "ies"
     else:
-        last += "s"
-    return (f"{head} {last}" if head else last) + tail
+        word += "s"
+    return before + word + after
 
 
 def singular(word: str) -> str:
     """Inverse of :func:`plural` for matching model output ("chairs" -> "chair", "chests of
     drawers" -> "chest of drawers", "shelves" -> "shelf")."""
-    word, tail = _split_of(word)
-    head, _, last = word.rpartition(" ")
+    before, last, after = _parts(word)
     if last in _SINGULAR:
         last = _SINGULAR[last]
     elif last in _OWN_PLURAL:
@@ -102,15 +115,16 @@ def singular(word: str) -> str:
         last = last[:-2]
     elif last.endswith("s") and not last.endswith(("ss", "us")) and len(last) > 1:
         last = last[:-1]
-    return (f"{head} {last}" if head else last) + tail
+    return before + last + after
 
 
 def same_name(text: str, category: str) -> bool:
     """Whether ``text`` (a model's words, articles, counts and states removed) names
-    ``category`` in words: the name itself, its plural as a prompt shows it, or a plural a
-    model writes for it."""
-    return text in (category, plural(category)) or singular(text) in (category,
-                                                                       singular(category))
+    ``category`` in words: the name itself, its plural as a prompt shows it, or a singular
+    or plural a model writes for it ("drawer" for "drawers", "shelves" for "shelf")."""
+    if text in (category, plural(category)):
+        return True
+    return bool({text, singular(text)} & {category, singular(category)})
 
 
 def object_label(o: ObjectNode) -> str:
