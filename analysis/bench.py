@@ -399,7 +399,7 @@ def run_benchmark(cfg: BenchConfig, progress: bool | None = None,
     executor = make_executor(cfg.executor, cfg.workers, cfg.ray_address)
     houses = prepare_houses(cfg)
     vocabulary = training_vocabulary(cfg.priors_dir)  # a bad --priors fails before any episode
-    for name in cfg.planners:  # and so does a bad planner option (built here, kept)
+    for name in cfg.planners:  # and so does a bad planner option (built-ins kept for the tasks)
         cached_planner(name, planner_options_for(cfg, name), run)
     show = sys.stderr.isatty() if progress is None else progress
     t0 = time.perf_counter()
@@ -527,7 +527,7 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
         json.dumps(strict_json(summary), indent=1, sort_keys=True, allow_nan=False) + "\n"))
     run = {"wall": {"seconds": round(res.wall_s, 3), "workers": cfg.workers,
                     "executor": cfg.executor,
-                    "episodes_per_s": {k: round(v, 3) for k, v in res.throughput.items()},
+                    "episodes_per_s": {k: float(f"{v:.3g}") for k, v in res.throughput.items()},
                     "decision_s": {p: d["decision_s"]
                                    for p, d in summary_dict(sums).items()}},
            "command": shown}

@@ -40,7 +40,7 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     then show the tables and the files written; a task that failed after a retry is one
     error line and nothing is written; Ctrl-C leaves both folders as they were."""
     from sgtool.analysis.bench import OUTPUT_NAMES, run_benchmark, write_outputs
-    from sgtool.analysis.report import llm_answer_totals
+    from sgtool.analysis.report import llm_warnings
     from sgtool.files import leftover_stages, output_folder
     from sgtool.llm.recorded import transcript_run
 
@@ -73,11 +73,8 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     for h in res.houses:
         for line in h.notes:
             show(f"sgtool: note: {h.source}: {line}")
-    for planner, t in llm_answer_totals(res.results, res.config.planners).items():
-        if t["requests"] and not t["valid"]:  # a wrong endpoint, or one answering garbage
-            show(f"sgtool: warning: {planner}: none of its {t['requests']} LLM requests got a "
-                 f"valid answer ({t['invalid']} rejected, {t['faults']} faults); check the "
-                 "endpoint and model with `sgtool llm check`")
+    for line in llm_warnings(res.results, res.config.planners):
+        show(line)
     show(f"wrote {', '.join(str(Path(out_dir) / name) for name in written)}")
     for folder in (out_dir, *([log_dir] if log_dir is not None else [])):
         for stale in leftover_stages(folder):

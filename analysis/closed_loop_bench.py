@@ -57,13 +57,14 @@ from sgtool.analysis.closed_loop_tables import (
     interval_tables,
     symbolic_agreement,
 )
-from sgtool.analysis.offline import read_log_episodes
+from sgtool.analysis.offline import log_exchanges, read_log_episodes
 from sgtool.analysis.report import format_table, pipe_table
 from sgtool.analysis.run_bench_resume import check_resumable, task_settings
 from sgtool.analysis.search_metrics import CostModel, cost_models, summarize
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write
+from sgtool.llm.stats import answer_counts
 from sgtool.log.writer import partial_files
 from sgtool.progress import Progress
 from sgtool.recorders.sim.closed_loop import WENT_ON, ClosedLoopOptions, run_episode
@@ -294,7 +295,8 @@ def _row(task: RunTask, seconds: float | None) -> RunRow:
         raise SgtoolError(f"{task.output}: holds {len(logged)} episodes, not one; remove it "
                           "to run the episode again")
     ep = logged[0]
-    res = replace(ep.result(), seed=task.options.planner_seed)
+    res = replace(ep.result(), seed=task.options.planner_seed,
+                  llm_answers=answer_counts(rec for _, rec in log_exchanges([task.output])))
     fails = Counter(reason_class(d.action.reason or "") for d in ep.decisions
                     if d.action.outcome == "failure")
     reasons = [d.action.reason or "" for d in ep.decisions]
@@ -400,8 +402,9 @@ class ClosedLoopBenchResult:
         return "\n".join(parts)
 
     def timings(self) -> str:
-        """run.md, per noise profile: the wall-clock figures of the episodes run now
-        (decision time, frames per second), which differ between two runs."""
+        """run.md, per noise profile: the wall-clock figures, which differ between two
+        runs: the decision times as the logs recorded them, and the frames per second of
+        the episodes run now."""
         cfg = self.config
         models = cost_models(cfg.distance_budget, cfg.step_budget)
         parts = []

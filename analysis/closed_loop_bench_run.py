@@ -99,6 +99,10 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
             written.append(atomic_write(root / RUN_FILE, run_record(
                 res.rows, root, runner, request.executor)).name)
     show(res.table())
+    from sgtool.analysis.report import llm_warnings
+
+    for line in llm_warnings(res.results(), request.config.planners):
+        show(line)
     show(f"wrote {', '.join(str(Path(request.out_dir) / name) for name in written)}")
 
 

@@ -48,6 +48,16 @@ def _fmt(x: float, spec: str) -> str:
     return "-" if x is None or math.isnan(x) else format(x, spec)
 
 
+def _rate_text(rate: float) -> str:
+    """A rate with one decimal, or two significant digits below 1 (an LLM planner's 0.033
+    episodes a second), never in exponent notation; "-" when unknown."""
+    if rate is None or not math.isfinite(rate):
+        return "-"
+    if rate >= 0.95 or rate <= 0:
+        return f"{rate:.1f}"
+    return f"{rate:.{1 - math.floor(math.log10(rate))}f}"
+
+
 def fmt_stat(s: Stat | None, spec: str) -> str:
     if s is None or math.isnan(s.mean):
         return "-"
@@ -95,8 +105,7 @@ def format_table(summaries: Sequence[PlannerSummary],
         row = [s.planner, *(fmt_stat(s.stats.get(k), spec) for k, _, spec in columns),
                f"{s.episodes} ({len(s.seeds)} seeds)"]
         if throughput is not None:
-            rate = throughput.get(s.planner, math.nan)  # an LLM planner's is below 0.1
-            row.append(_fmt(rate, ".1f" if not rate < 1 else ".2g"))
+            row.append(_rate_text(throughput.get(s.planner, math.nan)))
         rows.append(row)
     parts = []
     if title:
@@ -247,6 +256,15 @@ def llm_answer_totals(results: Sequence[EpisodeResult], planners: Sequence[str]
         if tot["requests"]:
             out[p] = tot
     return out
+
+
+def llm_warnings(results: Sequence[EpisodeResult], planners: Sequence[str]) -> list[str]:
+    """A warning line per planner that asked an LLM and got no valid answer at all (a
+    wrong endpoint or model, one answering garbage)."""
+    return [f"sgtool: warning: {p}: none of its {t['requests']} LLM requests got a valid "
+            f"answer ({t['invalid']} rejected, {t['faults']} faults); check the endpoint "
+            "and model with `sgtool llm check`"
+            for p, t in llm_answer_totals(results, planners).items() if not t["valid"]]
 
 
 def llm_answer_lines(results: Sequence[EpisodeResult], planners: Sequence[str]) -> list[str]:

@@ -299,3 +299,21 @@ def test_noise_profiles_are_kept_apart(house_file, tmp_path) -> None:
     res = CliRunner().invoke(cli, [*args, "--noise", str(prof), "--noise",
                                    str(tmp_path / "my.json")])
     assert res.exit_code == 2 and "both name the log folder 'my'" in res.output
+
+
+def test_run_bench_warns_of_an_llm_that_never_answered_usefully(tmp_path) -> None:
+    """moma-llm against an endpoint answering every request with a web page: run-bench
+    counts its answers per episode (episodes.jsonl) and warns, as bench does."""
+    from support.semantics_fixtures import ChatServer
+
+    out = tmp_path / "rb"
+    with ChatServer(responder=lambda req: {"text": "<html>a web page</html>"}) as srv:
+        r = CliRunner().invoke(cli, ["run-bench", "--planners", "moma-llm", "--houses", "1",
+                                     "--episodes", "1", "--resolution", "64x48",
+                                     "--max-steps", "2", "--frames", "120", "--no-progress",
+                                     "--llm-base-url", srv.base_url, "--llm-model", "m",
+                                     "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "sgtool: warning: moma-llm: none of its" in r.output
+    (row,) = [json.loads(s) for s in (out / "episodes.jsonl").read_text().splitlines()]
+    assert row["llm_answers"]["requests"] > 0 and row["llm_answers"]["valid"] == 0

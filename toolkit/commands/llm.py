@@ -49,8 +49,9 @@ def _model_option(f: F) -> F:
 @click.option("--ctx", type=click.IntRange(512, 131072), default=4096, show_default=True,
               help="Context length in tokens.")
 @click.option("--cache-mib", type=click.IntRange(0, 65536), default=256, show_default=True,
-              help="Cap of llama.cpp's prompt cache in MiB (its 8 GiB default let the "
-                   "server grow to several GB).")
+              help="Cap of llama.cpp's host-memory prompt cache in MiB (its 8 GiB default "
+                   "let the server grow to several GB); a request never reuses a cached "
+                   "prompt part (the same request, the same answer at temperature 0).")
 def serve(gguf: Path | None, threads: int, port: int, ctx: int, cache_mib: int) -> None:
     """Serve a GGUF model on 127.0.0.1 with an OpenAI-compatible API until Ctrl-C."""
     from sgtool.llm.server import model_size_mib, start_server

@@ -127,8 +127,8 @@ def command(**given: Any) -> None:
     """Run closed-loop search episodes in PyBullet for every planner on generated and given
     houses (the houses and episodes of `sgtool bench`), under each noise profile: one
     episode log per run (what `sgtool run` writes), then the table of the symbolic bench
-    (SR, SPL, steps, decision time, AUC-E) with frames per second and failed skills per
-    episode by reason, and the efficiency curves.
+    (SR, SPL, steps, AUC-E) with failed skills per episode by reason, and the efficiency
+    curves; the wall-clock figures (decision time, frames per second) go to run.md.
 
     Resumable: an episode whose log exists is read back instead of run again (a log is
     only there once complete). Ctrl-C stops the run and leaves only complete logs (with

@@ -3,8 +3,10 @@
 :func:`start_server` loads a GGUF model into llama.cpp's own HTTP server (OpenAI-compatible
 ``/v1/chat/completions``, plus llama.cpp's ``/props`` and per-request ``grammar``) bound to
 127.0.0.1 only. The defaults suit a small shared machine: one thread (more threads
-contend with the other work), one slot, a 4096-token context and a prompt cache capped at
-:data:`CACHE_RAM_MIB` (llama.cpp's 8 GiB default lets the server grow by gigabytes); the
+contend with the other work), one slot, a 4096-token context, a host-memory prompt cache
+capped at :data:`CACHE_RAM_MIB` (llama.cpp's 8 GiB default lets the server grow by
+gigabytes) and no reuse of a cached prompt part by a request (``cache_prompt`` off: at
+temperature 0 the same request then gets the same answer, whatever came before); the
 runs behind them are in ``docs/experiments/moved-from-docstrings.md``. :class:`LocalServer`
 is a context manager; closing it stops the server (llama.cpp's destructor joins its threads).
 
