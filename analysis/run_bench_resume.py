@@ -1,7 +1,8 @@
 """Whether an episode log already in a ``run-bench`` folder may stand for a task: it must
 have been run with the task's settings (episode, planner options, steps, frames,
 resolution, which ticks are frames, navigation, noise and its seed, seed, success rule, room
-classifier, depth mapped, how far an explore goes on) on the same house.
+classifier, depth mapped, graph refreshes, voxel size and points, how far an explore goes
+on) on the same house.
 A log without the frame settings (``render_step_m``, ``turn_render_deg``: older code
 rendered other ticks) is not reused.
 
@@ -25,7 +26,7 @@ from sgtool.house.spec import HouseSpec
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
 from sgtool.recorders.sim.episode_extras import recorded_options
 from sgtool.recorders.sim.noise import parse_noise
-from sgtool.scenegraph.build_options import MAX_DEPTH_M
+from sgtool.scenegraph.build_options import MAX_DEPTH_M, ResolvedOptions, default_min_points
 
 _FIX = ("give a fresh -o folder, --force to run every episode again, or delete the log to "
         "run the episode again")
@@ -49,6 +50,7 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
             "seed": opts.planner_seed, "episode_seeds": True, "success": opts.success,
             "classifier": opts.classifier, "explore_on": opts.explore_on,
             "max_depth": dataclasses.replace(opts, noise=parse_noise(noise)).depth_mapped(),
+            **_map_settings(dataclasses.replace(opts, noise=parse_noise(noise)).mapping()),
             "look_in": float(opts.live.look_in) if opts.navigation == "live" else None,
             "look_in_beyond": (_beyond(opts.live.look_in, opts.live.look_in_beyond)
                                if opts.navigation == "live" else None),
@@ -57,6 +59,12 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
                             else None),
             "explore_through": (float(opts.live.explore_through)
                                 if opts.navigation == "live" else None)}
+
+
+def _map_settings(m: ResolvedOptions) -> dict[str, Any]:
+    """The mapping settings a log must share: refreshes, voxel size, points per voxel."""
+    return {"every": int(m.every), "voxel_size": float(m.voxel_size),
+            "min_points": int(m.min_points)}
 
 
 def _beyond(look_in: float, beyond: float) -> float | None:
@@ -96,6 +104,12 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              "classifier": (x.get("mapping") or {}).get("classifier", "containment"),
              # the depth the live map kept (recorded when not the default)
              "max_depth": float((x.get("mapping") or {}).get("max_depth", MAX_DEPTH_M)),
+             # how often the graph was refreshed and what its voxels kept (logs from
+             # before the mapping was recorded: the defaults)
+             "every": int((x.get("mapping") or {}).get("every", 10)),
+             "voxel_size": float((x.get("mapping") or {}).get("voxel_size", 0.05)),
+             "min_points": int((x.get("mapping") or {}).get("min_points") or default_min_points(
+                 int(cam.get("width") or 0) or 160, int(cam.get("height") or 0) or 120)),
              # logs from before explores went on: an explore ended where it was sent
              "explore_on": x.get("explore_on", 0),
              # logs from before the robot looked into what it opened: it stayed there
@@ -135,7 +149,9 @@ _LABELS = {"episode": "episode", "planner_options": "planner options (-O)",
            "noise": "noise", "noise_seed": "noise seed", "seed": "seed",
            "episode_seeds": "planner seed per episode", "success": "success rule",
            "classifier": "room classifier", "explore_on": "explore on (frontiers)",
-           "max_depth": "depth mapped (m)", "look_in": "look in (m)",
+           "max_depth": "depth mapped (m)", "every": "graph refresh (--every frames)",
+           "voxel_size": "voxel size (m)", "min_points": "points per voxel",
+           "look_in": "look in (m)",
            "look_in_beyond": "look in beyond (deg)", "peek": "peek into containers",
            "sight_lines": "sight lines", "explore_through": "explore through (m)"}
 

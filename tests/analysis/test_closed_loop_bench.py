@@ -79,6 +79,10 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
     other[other.index("--max-steps") + 1] = "3"
     res = CliRunner().invoke(cli, other)
     assert res.exit_code == 2 and "was run with other settings" in res.output
+    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                   "--every", "5"])
+    assert res.exit_code == 2 and "graph refresh (--every frames): 10 in the log, 5 now" \
+        in res.output
     # nor does another success rule (MoMa-LLM's done rule)
     res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
                                    "--success", "done"])
