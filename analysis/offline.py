@@ -213,6 +213,10 @@ def load_results(paths: Iterable[str | os.PathLike[str]], notes: list[str] | Non
                 raise EvalInputError(foreign)
             for e in _search_episodes(p, read_log_episodes(p), notes):
                 r = _with_seen(e.result())
+                if isinstance(e.episode.steps, Absent):  # no closing record: cut short
+                    notes.append(f"{p}: episode {e.index} has no closing record (the run was "
+                                 "interrupted or killed): scored from the actions logged "
+                                 f"until it stopped{'' if r.success else ', as a failure'}")
                 if _accepted(r, f"{p}: episode {e.index}", notes):
                     logged.append(e)
                     results.append(r)

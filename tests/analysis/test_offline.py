@@ -87,6 +87,12 @@ def test_multi_episode_and_unfinished_logs(tmp_path, house):
     assert (rb.query, rb.success, rb.steps, rb.travelled_m, rb.n_invalid, rb.end) == (
         "mug", False, 2, 3.0, 1, "ended")
     assert (ra.episode, rb.episode) == (0, 1)
+    # eval says that the second was cut short, not only that it failed
+    notes: list[str] = []
+    load_results([path], notes)
+    assert notes == [f"{path}: episode 1 has no closing record (the run was interrupted or "
+                     "killed): scored from the actions logged until it stopped, as a "
+                     "failure"]
     # no scene graphs: a planner has nothing to decide on
     rep = replay_decisions(make_planner("greedy"), [a, b])
     assert rep.decisions == 0 and rep.skipped == 3
