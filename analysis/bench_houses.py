@@ -211,7 +211,9 @@ def symbolic_house(spec: HouseSpec, where: str | os.PathLike[str]) -> tuple[Any,
 def house_notes(house: Any) -> tuple[str, ...]:
     """What a user should know of a house that loads: doors furniture blocks (read as
     walls), rooms walled off from the rest (their targets are searched from inside, the
-    others' from outside)."""
+    others' from outside), containers whose front is blocked and starts nearer to walls
+    or furniture than the robot's radius (:mod:`sgtool.house.clearance`)."""
+    from sgtool.house.clearance import FRONT_CLEAR, blocked_fronts, cramped_starts
     from sgtool.recorders.symbolic_environment.doorways import doorway_pieces
 
     spec = house.spec
@@ -229,6 +231,16 @@ def house_notes(house: Any) -> tuple[str, ...]:
     if cut:
         notes.append(f"{', '.join(cut)}: no door or passage leads there from the rest of "
                      "the house; a search for a target inside starts there, any other outside")
+    for k, what in blocked_fronts(spec):
+        f = spec.furniture[k]
+        notes.append(f"furniture[{k}] ({f.id}, {f.category}): {what} is within "
+                     f"{FRONT_CLEAR:g} m of its front (its local +y face, where it opens); the "
+                     "closed loop cannot look into it (turn it to face the room: yaw + pi)")
+    for i, gap in cramped_starts(spec, house.robot_radius):
+        s = spec.starts[i]
+        notes.append(f"starts[{i}] ({s.x:g}, {s.y:g}): {gap:.2f} m from a wall or a piece, "
+                     f"less than the robot's radius ({house.robot_radius:g} m): the closed loop "
+                     "starts it overlapping one")
     unlinked = [r for r in unlinked_rooms(house) if r not in cut]
     if unlinked:
         notes.append(f"{', '.join(unlinked)}: joined to the rest by open floor (no wall) but "

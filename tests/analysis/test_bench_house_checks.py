@@ -90,3 +90,28 @@ def test_folders_empty_among_others_and_upper_case_suffixes(tmp_path: Path) -> N
     houses = load_house_files([tmp_path / "upper"])
     assert [(h.id, h.source) for h in houses] == [("HOUSE", str(upper)),
                                                   ("other", str(tmp_path / "upper/b.Json"))]
+
+
+def test_a_container_facing_a_wall_and_a_cramped_start_are_noted(tmp_path: Path) -> None:
+    """A fridge set with its front (local +y) to the wall, as a yaw of 0 does for a piece
+    against a north wall, and a start 0.07 m from a wall: `scenes check` says both (the
+    symbolic bench finds what is inside; the closed loop could not look in)."""
+    from support.datasets_fixtures import two_rooms
+
+    d = two_rooms()
+    d["furniture"][0]["yaw"] = 0.0  # the fridge at the north wall, its front to the wall
+    d["starts"][0].update(x=0.12, y=1.0)  # the west wall's face is at x = 0.05
+    f = tmp_path / "h.json"
+    f.write_text(json.dumps(d))
+    r = CliRunner().invoke(cli, ["scenes", "check", str(f)])
+    assert r.exit_code == 0, r.output
+    assert ("furniture[0] (furn_0, refrigerator): the room's border is within 0.3 m of its "
+            "front (its local +y face, where it opens); the closed loop cannot look into it "
+            "(turn it to face the room: yaw + pi)") in r.output
+    assert "starts[0] (0.12, 1): 0.07 m from a wall or a piece, less than the robot's radius "\
+        "(0.2 m)" in r.output
+    d["furniture"][0]["yaw"] = 3.14159  # facing the room: nothing to say
+    d["starts"][0].update(x=1.0)
+    f.write_text(json.dumps(d))
+    r = CliRunner().invoke(cli, ["scenes", "check", str(f)])
+    assert r.exit_code == 0 and "note:" not in r.output, r.output

@@ -26,8 +26,9 @@ def two_rooms(door_state: str = "open") -> dict:
                    "state": door_state, "rooms": ["room_0", "room_1"]}],
         "furniture": [
             {"id": "furn_0", "category": "refrigerator", "synset": "electric_refrigerator.n.01",
-             "room": "room_0", "center": [0.5, 3.5, 0.9], "size": [0.8, 0.7, 1.8], "yaw": 0,
-             "affordances": ["openable", "container"], "state": "closed"},
+             "room": "room_0", "center": [0.5, 3.5, 0.9], "size": [0.8, 0.7, 1.8],
+             "yaw": math.pi, "affordances": ["openable", "container"],  # its front faces the room
+             "state": "closed"},
             {"id": "furn_1", "category": "table", "synset": "table.n.02", "room": "room_1",
              "center": [6.0, 3.4, 0.375], "size": [1.2, 0.8, 0.75], "yaw": 0,
              "affordances": ["supporter"], "state": None},

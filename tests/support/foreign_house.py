@@ -6,6 +6,7 @@ start poses (the benchmark gives it some)."""
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -39,11 +40,13 @@ def cottage() -> dict[str, Any]:
              "state": "closed", "rooms": ["room_hall", "room_bed"]},
         ],
         "furniture": [
-            _furniture("fridge", "room_kitchen", (0.5, 3.4, 0.9), (0.8, 0.7, 1.8), "closed"),
+            _furniture("fridge", "room_kitchen", (0.5, 3.4, 0.9), (0.8, 0.7, 1.8), "closed",
+                       yaw=math.pi),  # against the north wall, facing south
             _furniture("counter", "room_kitchen", (2.0, 0.4, 0.45), (1.6, 0.6, 0.9)),
             _furniture("bench", "room_hall", (5.0, 3.6, 0.25), (1.2, 0.4, 0.5)),
             _furniture("bed", "room_bed", (8.5, 2.0, 0.3), (2.0, 1.6, 0.6)),
-            _furniture("wardrobe", "room_bed", (9.6, 3.5, 1.0), (0.6, 0.8, 2.0), "closed"),
+            _furniture("wardrobe", "room_bed", (9.6, 3.5, 1.0), (0.8, 0.6, 2.0), "closed",
+                       yaw=math.pi / 2),  # against the east wall, facing west
         ],
         "objects": [
             _object("milk", "fridge", "inside", "room_kitchen", (0.5, 3.4, 0.9), 0.2),
@@ -57,10 +60,13 @@ def cottage() -> dict[str, Any]:
 
 
 def _furniture(name: str, room: str, center: tuple[float, float, float],
-               size: tuple[float, float, float], state: str | None = None) -> dict[str, Any]:
+               size: tuple[float, float, float], state: str | None = None,
+               yaw: float = 0.0) -> dict[str, Any]:
+    """A piece; a container's front (local +y) faces the room: yaw = its direction - pi/2."""
     aff = ["container", "openable"] if state else ["supporter"]
     return {"id": f"furn_{name}", "category": name, "synset": f"{name}.n.01", "room": room,
-            "center": list(center), "size": list(size), "affordances": aff, "state": state}
+            "center": list(center), "size": list(size), "yaw": yaw, "affordances": aff,
+            "state": state}
 
 
 def _object(name: str, parent: str, relation: str, room: str,
