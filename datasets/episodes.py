@@ -19,7 +19,10 @@ room, then A* on the dilated map).
 
 Starts are the house's start poses; an episode prefers a start outside every target room
 (starting next to the target is not a search), and, when the start drawn cannot reach a
-target (a room no door leads into, on either side), draws again among the starts that can.
+target (a room no door leads into, on either side), draws again among the starts that can;
+when none can, it starts inside a target's room (the reachable cell nearest its centroid,
+:func:`sgtool.datasets.start_poses.reachability`), as the symbolic bench searches a
+walled-off room from inside.
 """
 
 from __future__ import annotations
@@ -165,6 +168,19 @@ class EpisodeGeometry:
         return best
 
 
+def _start_inside(spec: HouseSpec, geo: EpisodeGeometry, rooms: tuple[str, ...],
+                  targets: list[str], seed: int) -> tuple[StartPose, float] | None:
+    """A start in one of the target ``rooms`` (in order) that reaches a target, with its
+    path; None when there is none."""
+    from sgtool.datasets.start_poses import reachability
+
+    for room in rooms:
+        for s in reachability(spec, seed, origin_room=room).starts:
+            if s.room == room and math.isfinite(path := geo.shortest_path(s, targets)):
+                return s, path
+    return None
+
+
 def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
                   reach: float = REACH,
                   geometry: EpisodeGeometry | None = None) -> list[Episode]:
@@ -214,6 +230,9 @@ def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
                 able = [s for s in able if s.room not in rooms] or able
                 start = able[int(rng.integers(len(able)))]
                 path = geo.shortest_path(start, ids + pieces)
+            else:  # no start of the file reaches one: search from inside, as the bench does
+                start, path = _start_inside(spec, geo, rooms, ids + pieces, seed) or (start,
+                                                                                       path)
         hidden = not pieces and all(o in hidden_ids for o in ids)
         out.append(Episode(
             id=f"ep_{i}", query=cat, synset=synset_of[cat], targets=tuple(ids + pieces),

@@ -118,3 +118,14 @@ def test_a_start_that_cannot_reach_the_target_is_drawn_again() -> None:
     open_house["starts"].append({"x": 7.0, "y": 1.0, "yaw": 0.0, "room": "room_1"})
     for e in list_episodes(load_house(open_house), seed=0):  # outside its target room
         assert e.start.room not in e.target_rooms and math.isfinite(e.shortest_path)
+
+
+def test_with_no_start_that_reaches_it_a_search_starts_inside() -> None:
+    """Two rooms and no door between them, the only start in the kitchen: the cup's search
+    (in the bedroom) starts inside the bedroom, on its reachable floor, with a finite path,
+    as the symbolic bench searches a walled-off room from inside."""
+    eps = {e.query: e for e in list_episodes(load_house(walled_off(two_rooms(), "door_0")))}
+    cup = eps["cup"]
+    assert cup.start.room == "room_1" and math.isfinite(cup.shortest_path)
+    assert 4.0 < cup.start.x < 8.0 and 0.0 < cup.start.y < 4.0
+    assert eps["apple"].start.room == "room_0"  # the file's start reaches the apple
