@@ -236,6 +236,13 @@ def house_notes(house: Any) -> tuple[str, ...]:
         notes.append(f"furniture[{k}] ({f.id}, {f.category}): {what} is within "
                      f"{FRONT_CLEAR:g} m of its front (its local +y face, where it opens); the "
                      "closed loop cannot look into it (turn it to face the room: yaw + pi)")
+    lidded = [o for o in spec.objects if o.is_openable and o.state == "closed"
+              and any(x.parent == o.id for x in spec.objects)]
+    if lidded:
+        notes.append(f"{', '.join(f'{o.id} ({o.category})' for o in lidded)}: closed small "
+                     "object(s) holding others; the symbolic bench opens them, the closed "
+                     "loop cannot (it opens furniture only): what is inside is not found "
+                     "there")
     for i, gap in cramped_starts(spec, house.robot_radius):
         s = spec.starts[i]
         notes.append(f"starts[{i}] ({s.x:g}, {s.y:g}): {gap:.2f} m from a wall or a piece, "

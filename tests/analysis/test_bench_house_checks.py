@@ -115,3 +115,16 @@ def test_a_container_facing_a_wall_and_a_cramped_start_are_noted(tmp_path: Path)
     f.write_text(json.dumps(d))
     r = CliRunner().invoke(cli, ["scenes", "check", str(f)])
     assert r.exit_code == 0 and "note:" not in r.output, r.output
+
+
+def test_a_closed_box_holding_things_is_noted(tmp_path: Path) -> None:
+    """A closed lidded box with a tin inside: the symbolic bench opens it, the closed loop
+    (which opens furniture only) cannot, and `scenes check` says so."""
+    from support.nested_house import nested_house
+
+    f = tmp_path / "nested.json"
+    f.write_text(json.dumps(nested_house()))
+    r = CliRunner().invoke(cli, ["scenes", "check", str(f)])
+    assert r.exit_code == 0, r.output
+    assert "obj_box (" in r.output and "the closed loop cannot (it opens furniture only)" \
+        in r.output
