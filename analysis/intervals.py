@@ -340,8 +340,9 @@ def kendall_tau_interval(a: Sequence[EpisodeResult], b: Sequence[EpisodeResult],
     ``a`` and over ``b``: the clusters (houses) of ``a`` and ``b`` together are resampled,
     the same draw for both sides, and tau taken on each resample (tau-b = Σ s_x s_y /
     sqrt(Σ s_x² Σ s_y²) over the pairs of planners, s the sign of a pair's difference, as
-    scipy's; resamples where it is undefined are left out); (NaN, NaN) with fewer than two
-    clusters or planners."""
+    scipy's; resamples where it is undefined are left out; an episode whose ``value`` is
+    NaN, an SPL without a known shortest path, is left out as the point tau leaves it);
+    (NaN, NaN) with fewer than two clusters or planners."""
     keys = _cluster_keys([*a, *b], cluster)
     names = list(dict.fromkeys(planners))
     if len(keys) < 2 or len(names) < 2:
@@ -354,9 +355,10 @@ def kendall_tau_interval(a: Sequence[EpisodeResult], b: Sequence[EpisodeResult],
         counts = np.zeros((len(keys), len(names)))
         for r in results:
             j = col.get(r.planner)
-            if j is not None:
+            v = value(r) if j is not None else math.nan
+            if j is not None and not math.isnan(v):  # an SPL without a shortest path: out
                 i = row[cluster(r)]
-                sums[i, j] += value(r)
+                sums[i, j] += v
                 counts[i, j] += 1
         sides.append((sums, counts))
     idx = resample_indices(len(keys), boot)

@@ -59,9 +59,10 @@ def _rate_text(rate: float) -> str:
 
 
 def fmt_stat(s: Stat | None, spec: str) -> str:
+    """``mean ± std``; ``mean ± -`` over one seed (no spread measured); "-" for none."""
     if s is None or math.isnan(s.mean):
         return "-"
-    return f"{format(s.mean, spec)} ± {format(s.std, spec)}"
+    return f"{format(s.mean, spec)} ± {'-' if math.isnan(s.std) else format(s.std, spec)}"
 
 
 # a line break of any kind (those str.splitlines knows) inside a table cell

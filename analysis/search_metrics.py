@@ -6,13 +6,18 @@
   to the target and p the path length travelled; averaged over all episodes. An episode
   with ``l = p = 0`` (target seen from the start) scores S.
 - High-level steps: mean number of actions per episode, failures included (SCOUT Table VII
-  "N Steps"; a failed episode counts its full budget).
+  "N Steps"; a failed episode counts the steps it spent: its full budget when it ran out,
+  fewer when it gave up).
 - Decision time: mean wall time of one planner decision (total decision seconds over total
   decisions), SCOUT's "Inference Time".
 - AUC-E (MoMa-LLM, "Area Under the Efficiency Curve"): sort the episodes by cost; y(b) is
   the share of ALL episodes solved with cost <= b; the curve starts at (0, 0), is clipped
   at the budget maximum and its last value extended to it; the trapezoid area divided by
-  the maximum lies in [0, 1]. Two cost models (:data:`DISTANCE_COST`, :data:`STEP_COST`):
+  the maximum lies in [0, 1]. This is MoMa-LLM's computation (the trapezoid over the sorted
+  points, so the curve rises linearly from one solved episode to the next): its figures
+  compare with the paper's; the step function y(b) itself has a smaller area, by at most
+  c / (2 n B) for the last solved cost c of n episodes and budget B. Two cost models
+  (:data:`DISTANCE_COST`, :data:`STEP_COST`):
 
   * distance-plus-open cost, MoMa-LLM's low-level variant: low-level steps of 0.1 m
     (travelled / 0.1) plus 30 per open interaction, budget 5000;
@@ -21,8 +26,8 @@
 
 Aggregation over seeds (SCOUT: "averaged across 5 different seeds"): every metric is
 computed per seed on that seed's episodes, then reported as mean +- sample standard
-deviation (ddof = 1; 0 with one seed) over seeds. Efficiency curves pool all seeds (the
-same as the mean curve when every seed has the same episodes).
+deviation (ddof = 1; none, "-", with one seed) over seeds. Efficiency curves pool all seeds
+(the same as the mean curve when every seed has the same episodes).
 """
 
 from __future__ import annotations
@@ -49,10 +54,10 @@ def episode_spl(success: bool, shortest: float | None, travelled: float) -> floa
         raise ValueError(f"SPL: travelled {travelled} m is not a finite number >= 0")
     if shortest is not None and shortest < 0.0:
         raise ValueError(f"SPL: shortest path {shortest} m is negative")
+    if shortest is None or not math.isfinite(shortest):
+        return math.nan  # failed or not: an episode whose l is unknown is left out
     if not success:
         return 0.0
-    if shortest is None or not math.isfinite(shortest):
-        return math.nan
     denom = max(float(shortest), float(travelled))
     if denom <= 0.0:
         return 1.0
@@ -192,7 +197,8 @@ def curve_of(results: Sequence[EpisodeResult], model: CostModel
 # ----------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Stat:
-    """A metric over seeds: mean, sample std (ddof=1, 0 for one seed), per-seed values."""
+    """A metric over seeds: mean, sample std (ddof=1; NaN for one seed: no spread is
+    measured), per-seed values."""
 
     mean: float
     std: float
@@ -203,7 +209,7 @@ class Stat:
         vals = [float(v) for v in values if not math.isnan(float(v))]
         if not vals:
             return cls(math.nan, math.nan, tuple(float(v) for v in values))
-        std = float(np.std(vals, ddof=1)) if len(vals) > 1 else 0.0
+        std = float(np.std(vals, ddof=1)) if len(vals) > 1 else math.nan
         return cls(float(np.mean(vals)), std, tuple(float(v) for v in values))
 
 

@@ -174,6 +174,20 @@ def test_kendall_tau_interval_of_an_order_every_house_agrees_on() -> None:
     assert kendall_tau_interval(a, b, ["a", "b", "c"], _spl, boot=SMALL) == (-1.0, -1.0)
     assert all(math.isnan(x) for x in kendall_tau_interval(a[:3], a[:3], ["a", "b", "c"],
                                                             _spl, boot=SMALL))  # one house
+    # one episode without a shortest path (its SPL NaN) is left out, as the point tau does:
+    # the other episodes of its house still count, so the interval stays (1, 1)
+    from sgtool.analysis.search_metrics import episode_spl
+
+    def spl(r: EpisodeResult) -> float:
+        return episode_spl(r.success, r.shortest_m, r.travelled_m)
+
+    # the other side orders b > a > c: tau 1/3 in every resample (dropping a's pairs in
+    # the resamples holding h0 would give 1 there)
+    swapped = [ep(p, f"h{h}", 0, p != "c", travelled=t) for h in range(4)
+               for p, t in (("a", 20.0), ("b", 10.0), ("c", 10.0))]
+    extra = [*a, ep("a", "h0", 1, False, shortest=None)]
+    lo, hi = kendall_tau_interval(extra, swapped, ["a", "b", "c"], spl, boot=SMALL)
+    assert lo == pytest.approx(1 / 3) and hi == pytest.approx(1 / 3)
 
 
 def test_kendall_tau_interval_is_scipys_tau_b_on_each_resample() -> None:

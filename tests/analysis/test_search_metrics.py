@@ -97,7 +97,7 @@ def test_summary_mean_std_over_seeds():
     assert sr.mean == pytest.approx(0.75)
     assert sr.std == pytest.approx(math.sqrt(0.125))  # sample std of (0.5, 1.0)
     assert sums[0].episodes == 4 and sums[0].seeds == (0, 1)
-    assert sums[1].stats["sr"].std == 0.0  # one seed
+    assert math.isnan(sums[1].stats["sr"].std)  # one seed: no spread measured
     assert set(sums[0].stats) >= {"sr", "spl", "steps", "decision_s", "auc_e_distance",
                                   "auc_e_steps"}
     assert Stat.of([math.nan, 1.0]).mean == 1.0
@@ -110,3 +110,11 @@ def test_seen_unseen_breakdown():
     assert (row.seen_n, row.unseen_n) == (2, 1)
     assert row.seen_sr == 0.5 and row.unseen_sr == 1.0
     assert row.seen_spl == pytest.approx(0.25) and row.unseen_spl == pytest.approx(1.0)
+
+
+def test_an_episode_without_a_shortest_path_is_out_of_spl_either_way() -> None:
+    """SPL leaves out an episode whose shortest path is unknown, failed or not (a failure
+    kept as 0 beside successes left out pulled the mean towards 0)."""
+    assert math.isnan(episode_spl(False, None, 3.0))
+    assert math.isnan(episode_spl(True, math.nan, 3.0))
+    assert episode_spl(False, 2.0, 3.0) == 0.0

@@ -91,7 +91,7 @@ def test_tables_and_summary_dict():
     assert lines[0] == "T"
     assert lines[1].startswith("| Planner") and "AUC-E dist" in lines[1]
     row = next(ln for ln in lines if ln.startswith("| scout"))
-    assert "1.000 ± 0.000" in row and "12.0" in row
+    assert "1.000 ± -" in row and "12.0" in row  # one seed: no spread
     # an LLM planner's few episodes a second keep their digits (not "0.0")
     slow = format_table(sums, throughput={"scout": 0.0333}, models=COST_MODELS)
     assert next(ln for ln in slow.splitlines() if ln.startswith("| scout")).split("|")[-2].strip() \
