@@ -68,6 +68,8 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
         notes = [*notes, f"the episodes ran under {len(profiles)} sensor noise profiles "
                  f"({', '.join(profiles)}): each planner is scored per profile, as "
                  "PLANNER [NOISE]"]
+    if (other := _unlike_episodes(results)) is not None:
+        notes = [*notes, other]
     for text in notes:
         note(f"sgtool: note: {text}")
     if not results:
@@ -95,6 +97,21 @@ def per_noise(results: Sequence[EpisodeResult]) -> tuple[list[EpisodeResult], li
         return list(results), []
     return [replace(r, planner=f"{r.planner} [{r.noise or 'unknown'}]") for r in results], \
         profiles
+
+
+def _unlike_episodes(results: Sequence[EpisodeResult]) -> str | None:
+    """A note when the planners were not run on the same episodes (house, episode, seed):
+    their rows are then not comparable as they stand (the paired tables are)."""
+    sets: dict[str, set[tuple[str, int, int]]] = {}
+    for r in results:
+        sets.setdefault(r.planner, set()).add((r.house, r.episode, r.seed))
+    if len(sets) < 2 or len({frozenset(s) for s in sets.values()}) == 1:
+        return None
+    common = set.intersection(*sets.values())
+    counts = ", ".join(f"{p} {len(s)}" for p, s in sorted(sets.items()))
+    return (f"the planners ran on different episodes ({counts}; {len(common)} in common): "
+            "their rows are not comparable as they stand; compare them on the same episodes "
+            "(give the runs' logs of one episode list)")
 
 
 def _run_bench_noise(r: EpisodeResult) -> str:

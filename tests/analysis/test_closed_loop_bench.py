@@ -67,6 +67,11 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
     assert (out / "episodes.jsonl").read_text().splitlines() == lines
     assert "| random " in again.output
     assert (out / "summary.md").read_text() == summary  # the same run, the same bytes
+    # the AUC-E budgets are the report's: a report of the same logs on 8 steps
+    only8 = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                     "--report-only", "--step-budget", "8"])
+    assert only8.exit_code == 0 and "steps: high-level steps, budget max 8" in \
+        (out / "summary.md").read_text()
     assert "| random  | 0 " in (out / "run.md").read_text()  # nothing was run now
     only = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
                                     "--planners", "random", "--report-only"])

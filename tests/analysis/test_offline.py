@@ -179,3 +179,21 @@ def test_a_ros2_mcap_with_sgtool_topic_names_is_called_foreign(tmp_path):
         w.finish()
     with pytest.raises(EvalInputError, match=r"is a ROS 2 recording .*not an sgtool log"):
         load_results([path])
+
+
+def test_eval_says_when_planners_ran_on_different_episodes(tmp_path):
+    """Rows of planners run on different episodes are not comparable as they stand: eval
+    says so, with the counts."""
+    from sgtool.results import EpisodeResult, write_jsonl
+
+    rows = [EpisodeResult(planner=p, seed=0, house="h", episode=e, query="mug",
+                          success=True, steps=2, travelled_m=3.0, shortest_m=2.0)
+            for p, eps in (("a", (0, 1, 2)), ("b", (0, 1))) for e in eps]
+    f = tmp_path / "episodes.jsonl"
+    write_jsonl(rows, f)
+    r = CliRunner().invoke(cli, ["eval", str(f)])
+    assert r.exit_code == 0, r.output
+    assert "sgtool: note: the planners ran on different episodes (a 3, b 2; 2 in common)" \
+        in r.output
+    write_jsonl(rows[:2] + rows[3:], f)  # the same two episodes each: nothing to say
+    assert "different episodes" not in CliRunner().invoke(cli, ["eval", str(f)]).output

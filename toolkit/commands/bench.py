@@ -13,8 +13,8 @@ from sgtool.commands.options import (
     PLANNER_OPTION_HELP,
     PLANNERS_HELP,
     PLUGIN_HELP,
-    FiniteFloatRange,
     LlmEndpoint,
+    budget_options,
     executor_options,
     list_planners_option,
     llm_endpoint_options,
@@ -88,13 +88,7 @@ if TYPE_CHECKING:
 @click.option("--house-seed", default=0, show_default=True, help="Seed of the first house.")
 @click.option("--max-steps", default=50, show_default=True,
               help="High-level actions per episode (SymSearch's N_max).")
-@click.option("--distance-budget", type=FiniteFloatRange(min=0, min_open=True),
-              default=5000.0, show_default=True,
-              help="AUC-E distance variant budget max, in low-level steps "
-                   "(0.1 m of travel = 1, an open = 30; MoMa-LLM).")
-@click.option("--step-budget", type=FiniteFloatRange(min=0, min_open=True), default=50.0,
-              show_default=True,
-              help="AUC-E step variant budget max, in high-level steps.")
+@budget_options()
 @llm_log_options(
     transcript_help="moma-llm: write every LLM exchange to this JSONL transcript, emptied "
     "when the run starts (an interrupted run puts the previous one back; "

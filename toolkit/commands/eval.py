@@ -17,8 +17,8 @@ import click
 from sgtool.commands.options import (
     PLANNER_OPTION_HELP,
     PLUGIN_HELP,
-    FiniteFloatRange,
     LlmEndpoint,
+    budget_options,
     executor_options,
     list_planners_option,
     llm_endpoint_options,
@@ -46,11 +46,7 @@ if TYPE_CHECKING:
                    "/sgtool/llm channel; repeatable) instead of an endpoint [default: the "
                    "exchanges of the MCAP inputs, when they have any].")
 @success_option(recorded=True)
-@click.option("--distance-budget", type=FiniteFloatRange(min=0, min_open=True), default=5000.0,
-              show_default=True,
-              help="AUC-E distance variant budget max (low-level steps: 0.1 m = 1, open = 30).")
-@click.option("--step-budget", type=FiniteFloatRange(min=0, min_open=True), default=50.0,
-              show_default=True, help="AUC-E step variant budget max (high-level steps).")
+@budget_options()
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of tables.")
 @click.option("-o", "--out", type=click.Path(dir_okay=False), default=None,
               help="Also write the output to this file (JSON if it ends in .json).")

@@ -409,6 +409,22 @@ def success_option(recorded: bool = False) -> Callable[[F], F]:
              + (" [default: as recorded]." if recorded else "."))
 
 
+def budget_options() -> Callable[[F], F]:
+    """``--distance-budget`` and ``--step-budget``: the budget maxima of the two AUC-E
+    variants (MoMa-LLM's; :func:`sgtool.analysis.search_metrics.cost_models`)."""
+    distance = click.option(
+        "--distance-budget", type=FiniteFloatRange(min=0, min_open=True), default=5000.0,
+        show_default=True, help="AUC-E distance variant budget max, in low-level steps "
+        "(0.1 m of travel = 1, an open = 30; MoMa-LLM).")
+    steps = click.option(
+        "--step-budget", type=FiniteFloatRange(min=0, min_open=True), default=50.0,
+        show_default=True, help="AUC-E step variant budget max, in high-level steps.")
+
+    def wrap(f: F) -> F:
+        return distance(steps(f))
+    return wrap
+
+
 def explore_on_option() -> Callable[[F], F]:
     """``--explore-on N`` of the closed-loop commands
     (:attr:`sgtool.recorders.sim.closed_loop.ClosedLoopOptions.explore_on`)."""

@@ -13,6 +13,7 @@ from sgtool.commands.options import (
     PLANNERS_HELP,
     PLUGIN_HELP,
     LlmEndpoint,
+    budget_options,
     executor_options,
     explore_on_option,
     explore_through_option,
@@ -122,6 +123,7 @@ if TYPE_CHECKING:
               help="Run the symbolic bench (one seed) on the same houses and episodes for "
               "that Kendall tau (seconds to minutes; excludes --symbolic).")
 @success_option()
+@budget_options()
 @executor_options("episodes (one closed-loop run each)")
 def command(**given: Any) -> None:
     """Run closed-loop search episodes in PyBullet for every planner on generated and given
@@ -187,6 +189,8 @@ class RunBenchArgs:
     render_turn: float = 20.0
     max_depth: float | None = None
     noise_seed: int = 0
+    distance_budget: float = 5000.0
+    step_budget: float = 50.0
 
 
 def _request(args: RunBenchArgs) -> RunBenchRequest:
@@ -253,4 +257,5 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
         rooms=parse_rooms(args.rooms), preset=args.preset,
         noise=tuple(args.noise) or ("none",), options=opts, planner_options=options,
         frames_per_room=args.frames_per_room, reference=args.reference,
-        all_pairs=args.all_pairs)
+        all_pairs=args.all_pairs, distance_budget=args.distance_budget,
+        step_budget=args.step_budget)
