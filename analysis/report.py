@@ -340,15 +340,15 @@ def format_paired_split(seen: Sequence[PairedComparison], unseen: Sequence[Paire
     """The paired comparisons on seen and on unseen queries side by side (the same pairs in
     the same order): paired episodes, SPL ratio and SR difference of each half."""
     level = f"{boot.level * 100:g} %"
-    header = ["Planner", "Reference", "Seen n", f"Seen SPL ratio [{level} CI]",
-              f"Seen SR diff [{level} CI]", "Unseen n", f"Unseen SPL ratio [{level} CI]",
-              f"Unseen SR diff [{level} CI]"]
-    body = [[s.planner, s.reference, str(s.episodes), fmt_interval(s.spl_ratio),
-             fmt_interval(s.sr_diff, signed=True), str(u.episodes), fmt_interval(u.spl_ratio),
-             fmt_interval(u.sr_diff, signed=True)]
+    header = ["Planner", "Reference", "Seen n (houses)", f"Seen SPL ratio [{level} CI]",
+              f"Seen SR diff [{level} CI]", "Unseen n (houses)",
+              f"Unseen SPL ratio [{level} CI]", f"Unseen SR diff [{level} CI]"]
+    body = [[s.planner, s.reference, f"{s.episodes} ({s.clusters})", fmt_interval(s.spl_ratio),
+             fmt_interval(s.sr_diff, signed=True), f"{u.episodes} ({u.clusters})",
+             fmt_interval(u.spl_ratio), fmt_interval(u.sr_diff, signed=True)]
             for s, u in zip(seen, unseen, strict=True)]
     parts = [title] if title else []
     parts.append(pipe_table(header, body))
     parts.append("Seen / unseen: the query is / is not a training query of the priors; "
-                 "intervals over houses as above.")
+                 "intervals over the houses holding such episodes (in brackets), as above.")
     return "\n".join(parts) + "\n"
