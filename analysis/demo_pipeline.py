@@ -77,7 +77,10 @@ def _replay(log: Path, derived: Path, frames: int, show: Echo, progress: bool) -
 def run_demo(request: DemoRequest, show: Echo, progress: bool,
              write_view: Callable[[Path, Path, bool], None]) -> None:
     """Run the demo into ``request.out``: ``demo.mcap``, ``derived.mcap``, ``view.rrd``
-    (made by ``write_view(derived, rrd, progress)``) and ``bench/``."""
+    (made by ``write_view(derived, rrd, progress)``; left out, with a note, when Rerun is
+    not installed) and ``bench/``."""
+    import importlib.util
+
     from sgtool.analysis.bench import run_bench
 
     out = request.out
@@ -85,8 +88,11 @@ def run_demo(request: DemoRequest, show: Echo, progress: bool,
     frames = _record(request, log, show, progress)
     show(f"\n== sgtool replay {log} -o {derived} --rrd {rrd} --score")
     _replay(log, derived, frames, show, progress)
-    write_view(derived, rrd, progress)
-    show(f"wrote {rrd}; open it with: rerun {quoted(rrd)}")
+    if importlib.util.find_spec("rerun") is None:
+        show("note: no Rerun recording: Rerun is not installed (pip install 'sgtool[view]')")
+    else:
+        write_view(derived, rrd, progress)
+        show(f"wrote {rrd}; open it with: rerun {quoted(rrd)}")
     show(f"\n== sgtool bench --planners {','.join(DEMO_PLANNERS)} --houses {request.houses} "
          f"--episodes {request.episodes} --seeds {request.seeds} -o {out / 'bench'}")
     show(run_bench(DEMO_PLANNERS, houses=request.houses, episodes=request.episodes,

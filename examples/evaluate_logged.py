@@ -4,7 +4,7 @@ Run::
 
     sgtool bench --planners greedy --houses 1 --episodes 3 --seeds 1 -o bench/ \\
         --log-dir bench/logs
-    python examples/evaluate_logged.py bench/logs/*.mcap --planner greedy --planner scout
+    python examples/evaluate_logged.py bench/logs/*/*/*.mcap --planner greedy --planner scout
 
 First the metrics of the logged episodes (SR, SPL, steps, AUC-E: what ``sgtool eval LOGS``
 prints), then, per ``--planner``, how its choices compare with what was done: at every

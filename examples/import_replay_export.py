@@ -2,7 +2,7 @@
 
 Run::
 
-    python examples/import_replay_export.py rgbd_dataset_freiburg1_xyz -o out/ \
+    python examples/import_replay_export.py rgbd_dataset_freiburg1_xyz -o out/ \\
         --intrinsics 517.3,516.5,318.6,255.3
     python examples/import_replay_export.py 7scenes/redkitchen/seq-01 -o out/ --limit 100 \\
         --format ros1

@@ -6,7 +6,7 @@ Pin your logs once and commit the folder::
 
 Then either run every pinned log as a test case (the report is the failure message)::
 
-    pytest --sgtool-golden tests/golden-logs
+    pytest --sgtool-golden=tests/golden-logs tests/golden-logs
 
 or check chosen logs from your tests with the ``sgtool_golden`` fixture, as this file does
 with sgtool's own golden logs (``tests/golden``, pinned by the same command)::

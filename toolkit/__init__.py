@@ -59,7 +59,7 @@ golden logs            :func:`pin_logs`, :func:`check_pins` (a :class:`CheckRepo
                        (:class:`LogDiff`), :func:`diff_graphs`, :func:`describe_mismatch`,
                        :func:`replay_graphs`
 errors                 :class:`SgtoolError` (every failure a user can cause),
-                       :class:`LogFormatError`, :class:`SpecError`
+                       :class:`LogFormatError`, :class:`SpecError`, :class:`BenchError`
 =====================  =====================================================================
 
 A few names differ from their defining module's to stay unambiguous at the top level:

@@ -13,6 +13,7 @@ from sgtool.version import __version__ as __version__
 from sgtool.errors import SgtoolError as SgtoolError
 from sgtool.errors import LogFormatError as LogFormatError
 from sgtool.errors import SpecError as SpecError
+from sgtool.analysis.bench_planner_checks import BenchError as BenchError
 # logs and their typed records
 from sgtool.log.reader import LogReader as LogReader
 from sgtool.log.writer import LogWriter as LogWriter
@@ -133,7 +134,8 @@ def planner_names() -> tuple[str, ...]: ...
 def __dir__() -> list[str]: ...
 
 __all__ = [
-    "planner_names", "SgtoolError", "LogFormatError", "SpecError", "LogReader", "LogWriter",
+    "planner_names", "SgtoolError", "LogFormatError", "SpecError", "BenchError", "LogReader",
+    "LogWriter",
     "Frame", "CameraIntrinsics", "LogRecord", "EpisodeRecord", "ActionRecord", "Instances",
     "InstanceItem", "SceneGraphRecord", "LlmExchange", "replay", "ReplayOptions",
     "ReplayReport", "Progress", "SceneGraphStream", "Refresh", "SceneGraph", "RoomNode",

@@ -81,7 +81,7 @@ def _recovered(d: Diagnosis, out: str) -> str:
 @click.command("doctor")
 @click.argument("log", type=click.Path(dir_okay=False))
 @click.option(
-    "--recover", "out", type=click.Path(dir_okay=False),
+    "--recover", "out", type=click.Path(dir_okay=False), metavar="OUT",
     help="Write every readable message to OUT as a valid, indexed MCAP file "
     "(never the input file).",
 )

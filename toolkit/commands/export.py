@@ -85,8 +85,8 @@ def _frames(style: str, pairs: tuple[str, ...]) -> dict[str, str]:
 @click.option("--topics", "topics", default=None, metavar="T1,T2,...",
               help="Only these topics (ROS or sgtool names, comma-separated); an sgtool "
                    "topic selects every ROS topic made from it.")
-@click.option("--progress/--no-progress", default=True, show_default=True,
-              help="Show a progress bar.")
+@click.option("--progress/--no-progress", default=True,
+              help="Show a progress bar [default: when stderr is a terminal].")
 @click.option("--force", is_flag=True,
               help="Replace an existing OUT: a ROS 1 bag, or the files sgtool wrote in a ROS "
                    "2 bag folder (other files there stay).")

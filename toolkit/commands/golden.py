@@ -64,7 +64,7 @@ def command() -> None:
     sgtool golden check --dir golden/ --voxel-size 0.08   # what would this change?
     sgtool golden check --dir golden/ --update            # accept it
 
-    The pin format is documented in docs/golden.md; `pytest --sgtool-golden DIR` runs one
+    The pin format is documented in docs/golden.md; `pytest --sgtool-golden=DIR DIR` runs one
     test per pinned log."""
 
 

@@ -280,13 +280,15 @@ def list_planners_option(named_by: str = "--planners") -> Callable[[F], F]:
     def show(ctx: click.Context, param: click.Parameter, value: bool) -> None:
         if not value or ctx.resilient_parsing:
             return
-        from sgtool.planning.registry import describe_planners
+        from sgtool.planning.registry import check_planner_name, describe_planners
 
         given: list[str] = []  # the planners named before --list-planners (eager options)
         for key in ("planners", "planner"):
             v = ctx.params.get(key)
             for text in (v,) if isinstance(v, str) else (v or ()):
                 given += planner_names(text)
+        for name in given:  # a misspelt name is said, as without --list-planners
+            check_planner_name(name)
         click.echo(describe_planners(given))
         ctx.exit(0)
 

@@ -89,14 +89,16 @@ if TYPE_CHECKING:
 @click.option("--navigation", type=click.Choice(["live", "house"]), default="live",
               show_default=True,
               help="live: skills plan on the robot's own map; house: on the ground truth "
-              "(the privileged behaviour before issue 17, for comparison).")
+              "(privileged, the closed loop's behaviour before live navigation; for "
+              "comparison).")
 @click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
               help=PLANNER_OPTION_HELP)
 @llm_endpoint_options("LLM planners")
 @click.option("-o", "--out", "out_dir", default="run-bench", show_default=True,
               type=click.Path(file_okay=False),
               help="Output folder: logs/NOISE/PLANNER/HOUSE/ep-K.mcap, episodes.jsonl, "
-              "summary.md/.json, run.md (wall-clock figures), efficiency curves. A run-bench "
+              "summary.md/.json, run.md (wall-clock figures), run.json (where and how long "
+              "each episode ran), efficiency curves. A run-bench "
               "folder is resumed; another "
               "non-empty folder is refused unless --force.")
 @click.option("--force", is_flag=True,

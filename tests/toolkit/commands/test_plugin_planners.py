@@ -260,6 +260,10 @@ def test_list_planners(command: list[str]) -> None:
     assert r.output.startswith("Planners (-O PLANNER.KEY=VALUE")
     assert "\nbayes-search: " in r.output and "    horizon (int, default 3): " in r.output
     assert "Plug-ins registered in the entry-point group sgtool.planners" in r.output
+    # a misspelt name before it is said, as without --list-planners
+    opt = "--planner" if command in (["run"], ["eval"]) else "--planners"
+    r = CliRunner().invoke(cli, [*command, opt, "scoutt", "--list-planners"])
+    assert r.exit_code == 2 and "unknown planner 'scoutt'" in r.output
 
 
 @pytest.mark.parametrize("command", [["bench"], ["run"], ["run-bench"], ["eval"], ["replay"],
