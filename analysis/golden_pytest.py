@@ -5,8 +5,8 @@ an environment where sgtool is installed; it does nothing unless asked).
   pinned in ``DIR`` (by ``sgtool golden pin``), named ``DIR::NAME``: it replays the log
   with the current code and fails with the layer-by-layer report when anything changed, or
   with the one-line error when the log cannot be checked. ``--sgtool-golden-tolerance X``
-  lets differences up to X pass (as ``sgtool golden check --tolerance``); ``--sgtool-
-  golden-update`` re-pins changed logs instead of failing.
+  lets differences up to X pass (as ``sgtool golden check --tolerance``);
+  ``--sgtool-golden-update`` re-pins changed logs instead of failing.
 - The fixture ``sgtool_golden`` checks logs from a lab's own tests, snapshot style:
   ``sgtool_golden.check(log, folder, **replay_options)`` pins the log into ``folder`` on
   first use (the test then fails once, saying so: commit the pin), and afterwards fails
