@@ -4,6 +4,7 @@ wall-clock fields, whatever the worker count), option errors."""
 from __future__ import annotations
 
 import json
+from typing import Any
 
 import pytest
 from click.testing import CliRunner
@@ -354,20 +355,20 @@ def test_an_endpoint_that_never_answers_is_warned_about(tmp_path):
     mistake the first request could name): the run completes and says that no answer came."""
     from support.semantics_fixtures import ChatServer
 
+    def bench_against(srv: ChatServer, out: str) -> Any:
+        return CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
+                                        "--episodes", "1", "--seeds", "1", "--max-steps",
+                                        "2", "--no-progress", "--llm-base-url", srv.base_url,
+                                        "--llm-model", "m", "-o", str(tmp_path / out)])
+
     with ChatServer() as srv:  # HTTP 500 to every request
-        r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
-                                     "--episodes", "1", "--seeds", "1", "--max-steps", "2",
-                                     "--no-progress", "--llm-base-url", srv.base_url,
-                                     "--llm-model", "m", "-o", str(tmp_path / "o")])
+        r = bench_against(srv, "o")
     assert r.exit_code == 0, r.output
     assert "sgtool: warning: moma-llm: none of its" in r.output
     assert "check the endpoint and model with `sgtool llm check`" in r.output
     # an endpoint that answers every request, never with a command: warned about too
     with ChatServer(responder=lambda req: {"text": "<html>a web page</html>"}) as srv:
-        r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
-                                     "--episodes", "1", "--seeds", "1", "--max-steps", "2",
-                                     "--no-progress", "--llm-base-url", srv.base_url,
-                                     "--llm-model", "m", "-o", str(tmp_path / "o3")])
+        r = bench_against(srv, "o3")
     assert r.exit_code == 0, r.output
     assert "rejected, 0 faults); check the endpoint and model" in r.output
     with ChatServer(responder=lambda req: {"status": 401}) as srv:  # a wrong key: stop
