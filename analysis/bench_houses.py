@@ -21,6 +21,7 @@ reachable room first (:func:`sgtool.datasets.start_poses.with_start_poses`).
 from __future__ import annotations
 
 import json
+import math
 import os
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -236,8 +237,16 @@ def house_notes(house: Any) -> tuple[str, ...]:
         notes.append(f"furniture[{k}] ({f.id}, {f.category}): {what} is within "
                      f"{FRONT_CLEAR:g} m of its front (its local +y face, where it opens); the "
                      "closed loop cannot look into it (turn it to face the room: yaw + pi)")
+    turned = [f"{kind}[{i}] ({x.yaw:g})" for kind, items in (("furniture", spec.furniture),
+                                                             ("starts", spec.starts))
+              for i, x in enumerate(items) if abs(x.yaw) > 2 * math.pi + 1e-9]
+    if turned:
+        notes.append(f"yaw beyond 2 pi: {', '.join(turned[:5])}"
+                     f"{f' and {len(turned) - 5} more' if len(turned) > 5 else ''}; yaws "
+                     "are radians (degrees given by mistake turn a piece the wrong way)")
+    parents = {x.parent for x in spec.objects}
     lidded = [o for o in spec.objects if o.is_openable and o.state == "closed"
-              and any(x.parent == o.id for x in spec.objects)]
+              and o.id in parents]
     if lidded:
         notes.append(f"{', '.join(f'{o.id} ({o.category})' for o in lidded)}: closed small "
                      "object(s) holding others; the symbolic bench opens them, the closed "

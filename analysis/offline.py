@@ -90,6 +90,7 @@ class LoggedEpisode:
     index: int  # episode number within its log
     episode: Episode  # the closing Episode record (synthesised when missing)
     decisions: tuple[Decision, ...]
+    closed: bool = True  # False: the log has no closing record (a run cut short)
 
     def result(self) -> EpisodeResult:
         r = result_from_log_records(self.episode, [d.action for d in self.decisions],
@@ -136,9 +137,10 @@ def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
     opened: Episode | None = None
     decisions: list[Decision] = []
 
-    def close(record: Episode) -> None:
+    def close(record: Episode, closed: bool = True) -> None:
         nonlocal decisions, opened
-        episodes.append(LoggedEpisode(str(p), len(episodes), record, tuple(decisions)))
+        episodes.append(LoggedEpisode(str(p), len(episodes), record, tuple(decisions),
+                                      closed))
         decisions = []
         opened = None
 
@@ -154,7 +156,7 @@ def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
         elif isinstance(rec, Episode):
             if rec.status == "started":
                 if opened is not None or decisions:
-                    close(_ended(opened))
+                    close(_ended(opened), closed=False)
                 opened = rec
             elif rec.status in _TERMINAL:
                 close(rec if opened is None else opened.merged(rec))
@@ -162,7 +164,7 @@ def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
             assert isinstance(rec, Action)
             decisions.append(Decision(t, _decided_on(rec, graph, graph_times, graphs), rec))
     if opened is not None or decisions:
-        close(_ended(opened))
+        close(_ended(opened), closed=False)
     return episodes
 
 
@@ -213,7 +215,7 @@ def load_results(paths: Iterable[str | os.PathLike[str]], notes: list[str] | Non
                 raise EvalInputError(foreign)
             for e in _search_episodes(p, read_log_episodes(p), notes):
                 r = _with_seen(e.result())
-                if isinstance(e.episode.steps, Absent):  # no closing record: cut short
+                if not e.closed:  # no closing record: cut short
                     notes.append(f"{p}: episode {e.index} has no closing record (the run was "
                                  "interrupted or killed): scored from the actions logged "
                                  f"until it stopped{'' if r.success else ', as a failure'}")

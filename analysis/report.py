@@ -49,11 +49,13 @@ def _fmt(x: float, spec: str) -> str:
 
 
 def _rate_text(rate: float) -> str:
-    """A rate with one decimal, or two significant digits below 1 (an LLM planner's 0.033
+    """A rate with one decimal, or two significant digits below 1 (an LLM planner's few
     episodes a second), never in exponent notation; "-" when unknown."""
     if rate is None or not math.isfinite(rate):
         return "-"
-    if rate >= 0.95 or rate <= 0:
+    if rate > 0:
+        rate = float(f"{rate:.2g}")  # two significant digits first, then the decimals
+    if rate >= 1 or rate <= 0:
         return f"{rate:.1f}"
     return f"{rate:.{1 - math.floor(math.log10(rate))}f}"
 

@@ -111,8 +111,17 @@ def _paired(base: list[dict[str, Any]], this: list[dict[str, Any]]) -> dict[str,
             [s["cpu_s"] for s, _ in pairs], [t["cpu_s"] for _, t in pairs]),
         "sr_difference": ratio_interval([float(t["success"]) - float(s["success"])
                                          for s, t in pairs], ones),
-        "spl_difference": ratio_interval([t["spl"] - s["spl"] for s, t in pairs], ones),
+        # an episode without a shortest path has no SPL (NaN): its pair is left out
+        "spl_difference": ratio_interval(
+            [t["spl"] - s["spl"] for s, t in pairs if math.isfinite(t["spl"] - s["spl"])],
+            [1.0 for s, t in pairs if math.isfinite(t["spl"] - s["spl"])]),
     }
+
+
+def _mean_finite(values: Any) -> float:
+    """The mean of the finite values (SPL leaves out episodes without a shortest path)."""
+    kept = [v for v in values if math.isfinite(v)]
+    return statistics.mean(kept) if kept else math.nan
 
 
 def _median_runs(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -212,7 +221,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{name:<6} {n:>8} {statistics.mean(e['frames'] for e in eps):>10.0f} "
               f"{statistics.mean(e['cpu_s'] for e in eps):>9.1f} "
               f"{statistics.mean(e['success'] for e in eps):>5.2f} "
-              f"{statistics.mean(e['spl'] for e in eps):>6.3f}")
+              f"{_mean_finite(e['spl'] for e in eps):>6.3f}")
     doc: dict[str, Any] = {"episodes": per}
     if "base" in per:
         paired = _paired(per["base"], per["this"])

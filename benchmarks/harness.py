@@ -191,8 +191,11 @@ def emit(doc: Mapping[str, Any], path: str | None) -> None:
     with the script's context: the command line and the load average."""
     if path is None:
         return
+    from sgtool.canonical import strict_json
+
     full = {"argv": sys.argv[1:], "load_1min": round(os.getloadavg()[0], 2), **doc}
-    text = json.dumps(full, indent=1, sort_keys=True, default=_plain) + "\n"
+    # NaN (an SPL without a shortest path) as null
+    text = json.dumps(strict_json(full), indent=1, sort_keys=True, default=_plain) + "\n"
     if path == "-":
         sys.stdout.write(text)
     else:

@@ -5,21 +5,28 @@ SymSearch (SCOUT sec. VI) also asks for non-interactive targets, furniture-level
 the small-object episodes from :func:`sgtool.datasets.episodes.list_episodes` and adds
 furniture-target episodes: the query is a furniture category of the house (one that no
 small object shares), the targets are all its pieces (seeing any one succeeds), the start
-is a start pose outside every target room when there is one, the target is never hidden,
-and the shortest path runs from the start to the nearest free cell of a target's room
-within ``reach`` of the piece's footprint (the rule of :mod:`sgtool.datasets.episodes`,
-with the piece itself as the parent). A category no start can reach is not drawn.
+is drawn as a small object's (:func:`sgtool.datasets.episodes.draw_start`: outside every
+target room when it can be, inside one when no start reaches a piece), the target is never
+hidden, and the shortest path runs from the start to the nearest free cell of a target's
+room within ``reach`` of the piece's footprint (the rule of :mod:`sgtool.datasets.episodes`,
+with the piece itself as the parent). A category none of whose pieces has free floor
+within ``reach`` is not drawn.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections import defaultdict
 
 import numpy as np
 
-from sgtool.datasets.episodes import REACH, Episode, EpisodeGeometry, list_episodes
+from sgtool.datasets.episodes import (
+    REACH,
+    Episode,
+    EpisodeGeometry,
+    draw_start,
+    list_episodes,
+)
 from sgtool.house.spec import Furniture, HouseSpec, spec_id_key
 from sgtool.semantics.text import category_text
 
@@ -52,11 +59,7 @@ def furniture_episodes(spec: HouseSpec, n: int, seed: int = 0, reach: float = RE
         for ci in sorted(rng.choice(len(cats), size=take, replace=False).tolist()):
             pieces = sorted(by_cat[cats[ci]], key=lambda f: spec_id_key(f.id))
             rooms = tuple(sorted({f.room for f in pieces}, key=spec_id_key))
-            starts = [s for s in spec.starts if s.room not in rooms] or list(spec.starts)
-            start = starts[int(rng.integers(len(starts)))]
-            d = geo.distances(start)
-            reached = [nf for nf in (near[f.id] for f in pieces) if nf is not None]
-            best = min((float(d[w][m].min()) for w, m in reached), default=math.inf)
+            start, best = draw_start(spec, geo, rooms, [f.id for f in pieces], rng, seed)
             first = pieces[0]
             room = spec.room(first.room).category.replace("_", " ")
             more = f" (+{len(pieces) - 1} more)" if len(pieces) > 1 else ""

@@ -168,6 +168,26 @@ class EpisodeGeometry:
         return best
 
 
+def draw_start(spec: HouseSpec, geo: EpisodeGeometry, rooms: tuple[str, ...],
+               targets: list[str], rng: np.random.Generator,
+               seed: int) -> tuple[StartPose, float]:
+    """An episode's start and shortest path (module doc): drawn with ``rng`` among the
+    starts outside the target ``rooms`` (all, when none is); when it reaches no target,
+    drawn again among the starts that do; when none does, inside a target room."""
+    starts = [s for s in spec.starts if s.room not in rooms] or list(spec.starts)
+    start = starts[int(rng.integers(len(starts)))]
+    path = geo.shortest_path(start, targets)
+    if math.isinf(path):  # a walled-off room on one side: a start that reaches one
+        able = [s for s in spec.starts if math.isfinite(geo.shortest_path(s, targets))]
+        if able:
+            able = [s for s in able if s.room not in rooms] or able
+            start = able[int(rng.integers(len(able)))]
+            path = geo.shortest_path(start, targets)
+        else:  # no start of the file reaches one: search from inside, as the bench does
+            start, path = _start_inside(spec, geo, rooms, targets, seed) or (start, path)
+    return start, path
+
+
 def _start_inside(spec: HouseSpec, geo: EpisodeGeometry, rooms: tuple[str, ...],
                   targets: list[str], seed: int) -> tuple[StartPose, float] | None:
     """A start in one of the target ``rooms`` (in order) that reaches a target, with its
@@ -220,19 +240,7 @@ def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
         pieces = sorted(furn_by_text.get(cat, ()), key=spec_id_key)
         rooms = tuple(sorted({objs[o].room for o in ids} |
                              {furn[f].room for f in pieces}, key=spec_id_key))
-        starts = [s for s in spec.starts if s.room not in rooms] or list(spec.starts)
-        start = starts[int(rng.integers(len(starts)))]
-        path = geo.shortest_path(start, ids + pieces)
-        if math.isinf(path):  # a walled-off room on one side: a start that reaches one
-            able = [s for s in spec.starts
-                    if math.isfinite(geo.shortest_path(s, ids + pieces))]
-            if able:
-                able = [s for s in able if s.room not in rooms] or able
-                start = able[int(rng.integers(len(able)))]
-                path = geo.shortest_path(start, ids + pieces)
-            else:  # no start of the file reaches one: search from inside, as the bench does
-                start, path = _start_inside(spec, geo, rooms, ids + pieces, seed) or (start,
-                                                                                       path)
+        start, path = draw_start(spec, geo, rooms, ids + pieces, rng, seed)
         hidden = not pieces and all(o in hidden_ids for o in ids)
         out.append(Episode(
             id=f"ep_{i}", query=cat, synset=synset_of[cat], targets=tuple(ids + pieces),

@@ -57,6 +57,16 @@ class BagIndex:
 _SIM_CLOCK_NS = 60 * 10**9
 
 
+def _info_time(depth: ImageIndex, stamp: int, received: int) -> int:
+    """The time a CameraInfo change takes effect: its header stamp, or, when it has none
+    (0), the stamp of the first depth image the bag recorded at or after it (on the
+    images' clock, whatever it is; after the last image: past it)."""
+    if stamp:
+        return stamp
+    later = [t for t, r in zip(depth.stamps, depth.received, strict=True) if r >= received]
+    return min(later) if later else max(depth.stamps, default=0) + 1
+
+
 def _resolve_zero_stamps(ii: ImageIndex, idx: BagIndex) -> None:
     """Replace the unset (zero) header stamps of one image topic by the bag's record times.
     A zero is unset unless the nearest non-zero stamp of the topic (in message order) is
@@ -128,14 +138,12 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
         bar.close()
     for ii in (idx.depth, idx.rgb, idx.ids):
         _resolve_zero_stamps(ii, idx)
-    # a zero CameraInfo stamp is a time when the images' clock starts near 0 (a simulator's)
-    sim_clock = any(0 < t <= _SIM_CLOCK_NS for t in idx.depth.stamps)
+    # the first CameraInfo is the camera's until a change; the changes in time order
+    timed = [(t, k) for t, k in idx.info_samples[:1]] + sorted(
+        (_info_time(idx.depth, t, r), k)
+        for (t, k), r in zip(idx.info_samples[1:], info_received[1:], strict=True))
     for ii in (idx.depth, idx.rgb, idx.ids):
         ii.stamps = [t + opts.time_offset_ns for t in ii.stamps]
-    timed = [(t if t or sim_clock else r, k)
-             for (t, k), r in zip(idx.info_samples, info_received, strict=True)]
-    # the first CameraInfo is the camera's until a change; the changes in time order
-    idx.info_samples = timed[:1] + sorted(timed[1:])
-    idx.info_samples = [(t + opts.time_offset_ns, k) for t, k in idx.info_samples]
+    idx.info_samples = [(t + opts.time_offset_ns, k) for t, k in timed]
     idx.tf.freeze()
     return idx

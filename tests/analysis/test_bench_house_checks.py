@@ -115,6 +115,10 @@ def test_a_container_facing_a_wall_and_a_cramped_start_are_noted(tmp_path: Path)
     f.write_text(json.dumps(d))
     r = CliRunner().invoke(cli, ["scenes", "check", str(f)])
     assert r.exit_code == 0 and "note:" not in r.output, r.output
+    d["furniture"][0]["yaw"] = 180  # degrees by mistake
+    f.write_text(json.dumps(d))
+    r = CliRunner().invoke(cli, ["scenes", "check", str(f)])
+    assert "yaw beyond 2 pi: furniture[0] (180); yaws are radians" in r.output
 
 
 def test_a_closed_box_holding_things_is_noted(tmp_path: Path) -> None:

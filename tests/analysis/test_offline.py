@@ -197,3 +197,18 @@ def test_eval_says_when_planners_ran_on_different_episodes(tmp_path):
         in r.output
     write_jsonl(rows[:2] + rows[3:], f)  # the same two episodes each: nothing to say
     assert "different episodes" not in CliRunner().invoke(cli, ["eval", str(f)]).output
+
+
+def test_a_closing_record_without_steps_is_no_cut_short_episode(tmp_path):
+    """``steps`` is optional in a closing record: an episode closed by one is complete
+    (eval says nothing), only a missing closing record is a run cut short."""
+    path = tmp_path / "one.mcap"
+    with LogWriter(path) as log:
+        log.write_record("episode", 0, {"kind": "search", "status": "started", "query": "cup",
+                                        "planner": "x"})
+        log.write_record("action", 1, {"skill": "navigate", "target": "obj:1",
+                                       "outcome": "success", "travelled_m": 2.0})
+        log.write_record("episode", 2, {"kind": "search", "status": "success"})
+    notes: list[str] = []
+    (r,), (e,) = load_results([path], notes)
+    assert notes == [] and e.closed and r.success

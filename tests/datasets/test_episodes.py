@@ -129,3 +129,14 @@ def test_with_no_start_that_reaches_it_a_search_starts_inside() -> None:
     assert cup.start.room == "room_1" and math.isfinite(cup.shortest_path)
     assert 4.0 < cup.start.x < 8.0 and 0.0 < cup.start.y < 4.0
     assert eps["apple"].start.room == "room_0"  # the file's start reaches the apple
+
+
+def test_a_furniture_target_no_start_reaches_is_searched_from_inside() -> None:
+    """The SymSearch mix's furniture episodes draw their start as the small objects' do:
+    the table behind the walled-off door is searched from inside its room."""
+    from sgtool.datasets.episode_mix import furniture_episodes
+
+    house = load_house(walled_off(two_rooms(), "door_0"))
+    eps = {e.query: e for e in furniture_episodes(house, 4, seed=0)}
+    assert eps["table"].start.room == "room_1" and math.isfinite(eps["table"].shortest_path)
+    assert all(math.isfinite(e.shortest_path) for e in eps.values())

@@ -29,8 +29,8 @@ Conventions (all of them are checked on load):
   of the box centre; a floor-standing piece has z = sz / 2), ``size`` (sx, sy, sz along the
   box's own axes before rotation), ``yaw``; a container's front (where it opens, and what
   the robot looks in through; also a shelf's open side) is the box's local +y face, so a
-  piece against a wall faces away from it: ``yaw`` = the direction of its front minus 90
-  degrees; ``affordances`` is a sorted tuple from
+  piece against a wall faces away from it: ``yaw`` (radians, as every angle of the spec) =
+  the direction of its front minus pi/2; ``affordances`` is a sorted tuple from
   {"container", "openable", "supporter"}; ``state`` is "open"/"closed" for openable
   pieces and None otherwise; ``levels`` (version 2) are the heights above the box's bottom
   of its lower support surfaces (shelves), ascending, each inside the box;

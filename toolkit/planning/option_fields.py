@@ -106,9 +106,12 @@ _PLAIN_KINDS = {bool: "bool", int: "int", float: "float", str: "str"}
 
 def _plain_meta(f: dataclasses.Field[Any], hint: Any) -> OptionMeta:
     """The metadata of a field without :func:`option` (a plug-in's plain config dataclass),
-    from its type ``hint`` (resolved by :func:`typing.get_type_hints`): ``int``, ``float``,
-    ``bool``, ``str`` or a path, each alone or ``| None`` (then None is a value); anything
-    else (a list, a dict, a class) is a Python object, settable from Python only."""
+    from its type ``hint`` (the annotation as :func:`_type_hints` resolves it): ``int``,
+    ``float``, ``bool`` or ``str`` alone; a ``Literal`` of strings is a choice; a path
+    (``Path``, ``os.PathLike``, alone or with ``str``) a path; each of these with ``| None``
+    takes None too. Another annotation (``Any``, one that does not resolve) takes the kind
+    of a plain default (3: int); anything else (a list, a dict, a class) is a Python
+    object, settable from Python only."""
     import pathlib
     import types
     import typing
@@ -118,29 +121,40 @@ def _plain_meta(f: dataclasses.Field[Any], hint: Any) -> OptionMeta:
         args = typing.get_args(hint)
     optional = type(None) in args
     plain = [a for a in args if a is not type(None)]
-    kind = "object"
-    if len(plain) == 1:
-        t = plain[0]
-        kind = _PLAIN_KINDS.get(t) or ("path" if t in (pathlib.Path, os.PathLike) else "object")
+    bare = [typing.get_origin(a) or a for a in plain]
+    paths = (pathlib.Path, os.PathLike)
+    kind, choices = "object", ()
+    if len(plain) == 1 and plain[0] in _PLAIN_KINDS:
+        kind = _PLAIN_KINDS[plain[0]]
+    elif len(plain) == 1 and typing.get_origin(plain[0]) is typing.Literal and all(
+            isinstance(c, str) for c in typing.get_args(plain[0])):
+        kind, choices = "choice", tuple(typing.get_args(plain[0]))
+    elif bare and all(b in paths or b is str for b in bare) and any(b in paths for b in bare):
+        kind = "path"
+    elif not plain or plain[0] is Any or isinstance(plain[0], str):
+        default = f.default if f.default is not dataclasses.MISSING else None
+        kind = _PLAIN_KINDS.get(type(default), "object")
     note = hint.__name__ if isinstance(hint, type) else str(hint).replace("typing.", "")
-    return OptionMeta(f"a field of {note}", kind, optional=optional)
+    return OptionMeta(f"a field of {note}", kind, choices=choices, optional=optional)
 
 
 def _type_hints(cls: type) -> dict[str, Any]:
     """The resolved annotation of each field of ``cls`` (text under ``from __future__
-    import annotations``, evaluated in its module); a field whose annotation names what
-    cannot be resolved there is left out (it is then a Python object)."""
+    import annotations``, evaluated in its module); an annotation naming what cannot be
+    resolved there is kept as its text."""
     import sys
 
     namespace = dict(vars(sys.modules.get(cls.__module__, sys)))
     out: dict[str, Any] = {}
     for f in dataclasses.fields(cls):
         hint = f.type
-        if isinstance(hint, str):
+        for _ in range(2):  # "'int'" under postponed annotations is text twice
+            if not isinstance(hint, str):
+                break
             try:
                 hint = eval(hint, namespace, {})  # noqa: S307 - the plug-in's own annotation
-            except Exception:  # noqa: BLE001 - a name not importable there: a Python object
-                continue
+            except Exception:  # noqa: BLE001 - a name not importable there
+                break
         out[f.name] = hint
     return out
 

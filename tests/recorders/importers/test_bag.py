@@ -554,6 +554,14 @@ def test_a_camera_info_that_changes_part_way_is_followed(tmp_path):
     with LogReader(tmp_path / "o2.mcap") as r:
         got = [f.intrinsics.fx for f in r.frames()]
     assert got == pytest.approx([f.intrinsics.fx for f in frames], abs=1e-9)
+    # and with CameraInfo never stamped: a change takes effect at the next image recorded
+    write_frames_bag(sim, tmp_path / "zoom_unstamped", "ros2-mcap",
+                     record_offset_ns=1_733_000_000 * 10**9, info_stamped=False)
+    import_bag(tmp_path / "zoom_unstamped", tmp_path / "o3.mcap",
+               BagOptions(**TOPICS, **KEEP_WORLD))
+    with LogReader(tmp_path / "o3.mcap") as r:
+        got = [f.intrinsics.fx for f in r.frames()]
+    assert got == pytest.approx([f.intrinsics.fx for f in frames], abs=1e-9)
     # a CameraInfo for another image size part-way is refused in one line
     sized = [dataclasses.replace(f, intrinsics=dataclasses.replace(
         f.intrinsics, width=2 * f.intrinsics.width)) if f.index >= 3 else f for f in frames]

@@ -123,13 +123,15 @@ def test_a_plain_options_dataclass_checks_by_its_fields_types(plugin_dir: Path) 
 
 def test_plain_fields_are_typed_by_their_annotations(tmp_path: Path, monkeypatch) -> None:
     """Annotations as text (``from __future__ import annotations``) are resolved in the
-    plug-in's module: ``X | None`` takes None, a list or a dict is a Python object (not
-    set by -O), a name that does not resolve is a Python object too."""
+    plug-in's module: ``X | None`` takes None, a ``Literal`` of strings is a choice, a path
+    or ``str | Path`` a path, a list or a dict is a Python object (not set by -O); a name
+    that does not resolve takes its default's type."""
     (tmp_path / "future_plug.py").write_text(textwrap.dedent('''
         from __future__ import annotations
 
         from dataclasses import dataclass, field
-        from typing import Optional
+        from pathlib import Path
+        from typing import Literal, Optional
 
         from sgtool.planning.planners import GreedyPlanner
 
@@ -141,6 +143,8 @@ def test_plain_fields_are_typed_by_their_annotations(tmp_path: Path, monkeypatch
                 limit: Optional[int] = None
                 cap: int | None = None
                 mode: Unknowable = "a"
+                speed: Literal["fast", "slow"] = "fast"
+                where: str | Path = "x"
 
             def __init__(self, **kw):
                 super().__init__()
@@ -149,9 +153,13 @@ def test_plain_fields_are_typed_by_their_annotations(tmp_path: Path, monkeypatch
     monkeypatch.syspath_prepend(str(tmp_path))
     assert parse_option("future_plug:P", "limit", "5") == 5
     assert make_planner("future_plug:P", cap=None).inner.kw == {"cap": None}  # type: ignore[attr-defined]
-    for key in ("tags", "mode"):
-        with pytest.raises(PlannerOptionError, match="a Python object, set from Python only"):
-            parse_option("future_plug:P", key, "1.5")
+    with pytest.raises(PlannerOptionError, match="a Python object, set from Python only"):
+        parse_option("future_plug:P", "tags", "1.5")
+    assert parse_option("future_plug:P", "mode", "b") == "b"
+    assert parse_option("future_plug:P", "speed", "slow") == "slow"
+    with pytest.raises(PlannerOptionError, match="must be one of fast, slow"):
+        parse_option("future_plug:P", "speed", "medium")
+    assert parse_option("future_plug:P", "where", "/tmp/x") == "/tmp/x"
     with pytest.raises(PlannerOptionError, match="must be an integer"):
         parse_option("future_plug:P", "cap", "x")
 

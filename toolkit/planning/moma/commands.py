@@ -180,10 +180,12 @@ def resolve_object(graph: SceneGraph, room_id: str, name: str, skill: str,
         # the doors the text shows: a room's closed doors, listed when it is explored
         doors: list[DoorNode] = [d for d in graph.doors if room_id in d.rooms
                                  and d.state == "closed" and room_id in scene.door_rooms]
-        if not doors or state == "open" or skill == "close":
-            raise InvalidCommand(f"the scene shows no {'open' if skill == 'close' else 'closed'}"
-                                 f" door in the {room_name}; it lists only closed doors, under "
-                                 "'Rooms with closed doors'")
+        if not doors:
+            raise InvalidCommand(f"the scene shows no closed door in the {room_name}; it lists "
+                                 "only closed doors, under 'Rooms with closed doors'")
+        if state == "open" or skill == "close":
+            raise InvalidCommand(f"the scene shows no open door in the {room_name}, only "
+                                 "closed ones: open one with go_to_and_open(ROOM, door)")
         return _pick(graph, doors, lambda d: door_is_entrance(graph, d))
     objs: list[ObjectNode] = [
         o for o in graph.objects_in(room_id)

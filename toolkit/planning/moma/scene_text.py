@@ -68,9 +68,7 @@ _PARTITIVES = frozenset({
 def _parts(noun: str) -> tuple[str, str, str]:
     """(before, the word that takes the number, after) of a category name in words."""
     first, of, rest = noun.partition(" of ")
-    if of and first and " " not in first and (first in _PARTITIVES
-                                             or first.removesuffix("s") in _PARTITIVES
-                                             or first in _SINGULAR):
+    if of and first and " " not in first and _singular_word(first) in _PARTITIVES:
         return "", first, of + rest
     head, _, last = noun.rpartition(" ")
     return (head + " " if head else ""), last, ""
@@ -102,20 +100,26 @@ def plural(noun: str) -> str:
 
 
 def singular(word: str) -> str:
-    """Inverse of :func:`plural` for matching model output ("chairs" -> "chair", "chests of
-    drawers" -> "chest of drawers", "shelves" -> "shelf")."""
+    """A plural read back by :func:`plural`'s rules, for matching model output ("chairs" ->
+    "chair", "chests of drawers" -> "chest of drawers", "shelves" -> "shelf"). Not an exact
+    inverse ("pies" -> "py"): :func:`same_name` also compares the category's own plural."""
     before, last, after = _parts(word)
+    return before + _singular_word(last) + after
+
+
+def _singular_word(last: str) -> str:
+    """One word's singular by :func:`plural`'s rules, read backwards."""
     if last in _SINGULAR:
-        last = _SINGULAR[last]
-    elif last in _OWN_PLURAL:
-        pass
-    elif last.endswith("ies") and len(last) > 3:
-        last = last[:-3] + "y"
-    elif last.endswith(("ches", "shes", "sses", "xes", "zes")):
-        last = last[:-2]
-    elif last.endswith("s") and not last.endswith(("ss", "us")) and len(last) > 1:
-        last = last[:-1]
-    return before + last + after
+        return _SINGULAR[last]
+    if last in _OWN_PLURAL:
+        return last
+    if last.endswith("ies") and len(last) > 3:
+        return last[:-3] + "y"
+    if last.endswith(("ches", "shes", "sses", "xes", "zes")):
+        return last[:-2]
+    if last.endswith("s") and not last.endswith(("ss", "us")) and len(last) > 1:
+        return last[:-1]
+    return last
 
 
 def same_name(text: str, category: str) -> bool:
