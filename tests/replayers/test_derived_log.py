@@ -412,3 +412,13 @@ def test_cli_on_a_file_that_is_not_a_log(tmp_path):
     r = CliRunner().invoke(cli, ["replay", str(p), "-o", str(tmp_path / "o.mcap")])
     assert r.exit_code == 2 and "not an MCAP file" in r.output
     assert not (tmp_path / "o.mcap").exists()
+
+
+@pytest.mark.parametrize("voxel", [0.2, 0.3])
+def test_a_coarse_voxel_still_maps_the_floor(voxel: float) -> None:
+    """A voxel coarser than twice the floor tolerance (0.1 m) once counted no level as
+    floor (0.1 / 0.2 rounded to 0), so a clean log replayed into no room at all; every
+    voxel size the CLI accepts keeps at least one level of floor."""
+    rep = replay(GOLDEN / "house6-tour.mcap", None, ReplayOptions(voxel_size=voxel))
+    g = rep.last.graph
+    assert len(g.rooms) >= 2 and len(g.objects) >= 5

@@ -93,13 +93,20 @@ def _unique_columns(col: np.ndarray, presorted: bool) -> np.ndarray:
     return np.stack([ix, iy], axis=1)
 
 
+def floor_levels(config: BevConfig, resolution: float) -> int:
+    """Voxel levels above the floor's own that still count as floor: the floor tolerance
+    in voxels, at least one (a floor seen from a tilted camera straddles two levels, so a
+    voxel coarser than twice the tolerance would map no floor at all)."""
+    return max(1, int(round(config.floor_tolerance / resolution)))
+
+
 def classify_keys(keys: np.ndarray, level: int, resolution: float, config: BevConfig,
                   presorted: bool = False) -> ColumnClasses:
     """Occupied and floor columns of packed voxel keys (:mod:`sgtool.mapping.voxels`;
     sorted keys, as the map stores them, skip a sort)."""
     iz = ((keys >> SHIFT_Z) & AXIS_MASK) - OFFSET
     col = keys >> COLUMN_SHIFT
-    tol = int(round(config.floor_tolerance / resolution))
+    tol = floor_levels(config, resolution)
     top = int(round(config.band_top / resolution))
     is_floor = iz <= level + tol
     in_band = (iz > level + tol) & (iz <= level + top)
@@ -189,7 +196,7 @@ class ColumnGrid:
         if len(fans) == 0:
             return
         res = self.resolution
-        tol = int(round(self.config.floor_tolerance / res))
+        tol = floor_levels(self.config, res)
         ez = np.floor(fans[:, 4] / res).astype(np.int64)
         f = fans[ez <= level + tol]
         if len(f) == 0:

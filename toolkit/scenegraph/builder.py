@@ -85,6 +85,7 @@ from sgtool.mapping.bev import (
     columns_between,
     floor_fans,
     floor_level,
+    floor_levels,
 )
 from sgtool.mapping.column_update import fresh_extent, reclassify_columns
 from sgtool.mapping.free_space import View
@@ -410,7 +411,7 @@ class SceneGraphBuilder:
         res = self.voxels.resolution
         lo, hist = self.voxels.level_histogram()
         level = floor_level(cfg, res, lo, hist)
-        tol = int(round(cfg.floor_tolerance / res))
+        tol = floor_levels(cfg, res)
         top = int(round(cfg.band_top / res))
         if self._views:
             views, self._views = self._views, []
