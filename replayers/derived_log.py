@@ -218,6 +218,12 @@ class ReplayReport:
                            "the map found no free floor for its Voronoi graph; noisy depth "
                            "far from the camera reads as obstacles (try --max-depth "
                            f"{max(1.0, self.options.max_depth - 2):g})")
+            if self.semantic and not g.objects and not g.doors \
+                    and self.frames >= self.options.every:
+                out.append(f"warning: the log has instance ids, but no object or door was "
+                           f"seen in {self.frames} frames (ids on floor and walls only, a "
+                           "segmenter that failed, or ids its instance table does not name): "
+                           "the graph has geometry only")
             lone = sum(len(set(d.rooms)) < 2 for d in g.doors)
             if lone and g.rooms:
                 out.append(f"warning: {lone} of {len(g.doors)} doors join one room only: "

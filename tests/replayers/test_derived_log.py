@@ -422,3 +422,21 @@ def test_a_coarse_voxel_still_maps_the_floor(voxel: float) -> None:
     rep = replay(GOLDEN / "house6-tour.mcap", None, ReplayOptions(voxel_size=voxel))
     g = rep.last.graph
     assert len(g.rooms) >= 2 and len(g.objects) >= 5
+
+
+def test_ids_that_name_nothing_are_warned_about(tmp_path: Path) -> None:
+    """A log whose instance-id images hold no object or door (every pixel 0: a segmenter
+    that failed) replays to geometry only, and the report says why, as it does for a log
+    without ids."""
+    from support.logfixtures import synthetic_frame
+
+    log = tmp_path / "blank.mcap"
+    with LogWriter(log, seed=1) as w:
+        for i in range(12):
+            k, rgb, depth, ids, pose, _ = synthetic_frame(i)
+            w.write_frame(i * 100_000_000, depth=depth, pose=pose, intrinsics=k, rgb=rgb,
+                          ids=np.zeros_like(ids))
+    rep = replay(log, None, ReplayOptions(every=5))
+    assert rep.semantic and not rep.last.graph.objects
+    assert any(line.startswith("warning: the log has instance ids, but no object or door "
+                               "was seen in 12 frames") for line in rep.lines())
