@@ -72,7 +72,8 @@ def parse_house(d: Any, limits: SpecLimits = LIMITS) -> HouseSpec:
     furniture = p.section(d, "furniture", p.furniture, limits.furniture, "furn_")
     objects = p.section(d, "objects", p.small_object, limits.objects, "obj_")
     starts = tuple(p.start(f"starts[{i}]", x)
-                   for i, x in enumerate(p.entries(d, "starts", limits.starts)))
+                   for i, x in enumerate(p.entries(d, "starts", limits.starts,
+                                                   required=False)))
     furniture, objects = with_supporters(furniture, objects)
     spec = HouseSpec(seed=seed, rooms=rooms, walls=walls, doors=doors, furniture=furniture,
                      objects=objects, starts=starts, passages=passages, split=split,

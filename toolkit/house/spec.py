@@ -46,7 +46,8 @@ Conventions (all of them are checked on load):
   yaw); its ``room`` is its furniture's; a small object may itself be a container (a
   bowl) or openable (a lidded box: ``affordances`` and ``state`` as for furniture,
   version 2);
-- ``starts`` are robot start poses (x, y, yaw) on free floor, each in a named room.
+- ``starts`` are robot start poses (x, y, yaw) on free floor, each in a named room; the
+  key may be left out (no starts: the commands that need them add one per reachable room).
 
 **Version 2** (:data:`SPEC_VERSION`) adds nesting, ``levels`` and small-object
 affordances; a version-1 file is a version-2 file without them and loads as one

@@ -179,3 +179,10 @@ def test_geodesics_by_hand():
     # a start inside furniture snaps to the nearest free cell; far outside gives inf
     assert np.isfinite(geodesic_distances(occ, (0.5, 3.5), max_snap=1.0)).any()
     assert np.isinf(geodesic_distances(occ, (20.0, 20.0))).all()
+
+
+def test_a_house_without_a_starts_key_loads_with_none():
+    """``starts`` may be left out, as the commands that need starts add their own."""
+    d = two_rooms()
+    del d["starts"]
+    assert load_house(d).starts == ()
