@@ -78,7 +78,8 @@ def score_lines(scores: Mapping[str, Quality], graph_objects: int | None = None)
         out.append(
             f"quality ({name}): rooms {v.rooms} vs {v.gt_rooms_seen} seen of {v.gt_rooms} "
             f"(error {v.room_count_error:+d}); Voronoi nodes in the right room: purity "
-            f"{v.purity:.3f}, ARI {v.ari:.3f}; {objects}; room categories right "
+            f"{v.purity:.3f}, ARI {v.ari:.3f} (nodes in {v.gt_rooms_with_nodes} of the "
+            f"{v.gt_rooms_seen} seen rooms); {objects}; room categories right "
             f"{v.category_accuracy:.1%} of {v.rooms} ({v.categorised} categorised)")
     return out
 

@@ -87,6 +87,9 @@ class Quality:
     object_accuracy: float  # objects whose room stands for their ground-truth room
     categorised: int  # predicted rooms with a category other than "unknown"
     category_accuracy: float  # predicted rooms whose category is their gt room's category
+    # seen ground-truth rooms holding a Voronoi node that some predicted room holds: purity
+    # and ARI say how those nodes are split, this how much of the house they cover
+    gt_rooms_with_nodes: int = 0
 
 
 def evaluate(node_xy: np.ndarray, node_rooms: Sequence[str | None],
@@ -135,4 +138,5 @@ def evaluate(node_xy: np.ndarray, node_rooms: Sequence[str | None],
         objects=len(obj_ok), object_accuracy=float(np.mean(obj_ok)) if obj_ok else 0.0,
         categorised=sum(room_categories[r] != "unknown" for r in rooms),
         category_accuracy=float(np.mean(cat_ok)) if cat_ok else 0.0,
+        gt_rooms_with_nodes=len({g for _, g in pairs}),
     )

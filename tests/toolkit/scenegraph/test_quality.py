@@ -64,6 +64,7 @@ def test_rooms_the_camera_stood_in_count_as_seen() -> None:
     walked = [(1.0, 1.0), (5.0, 1.0), (9.0, 1.0), (13.0, 1.0)]  # the last outside the house
     q = evaluate(xy, rooms, {"room:0": "kitchen"}, visited=walked, **args)
     assert (q.rooms, q.gt_rooms_seen, q.room_count_error) == (1, 3, -2)
-    assert q.purity == 1.0  # the nodes left are in the right room
+    assert q.purity == 1.0  # the nodes left are in the right room...
+    assert q.gt_rooms_with_nodes == 1  # ...but they cover one of the three rooms seen
     empty = evaluate(np.zeros((0, 2)), [], {}, visited=walked[:2], **args)
     assert (empty.rooms, empty.gt_rooms_seen, empty.room_count_error) == (0, 2, -2)
