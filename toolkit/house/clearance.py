@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from sgtool.house.geometry import distance_to_polygon, point_in_polygon, segment_distance
 from sgtool.house.spec import Furniture, HouseSpec
 
@@ -26,20 +28,53 @@ def front_point(f: Furniture, clear: float = FRONT_CLEAR) -> tuple[float, float]
     return (f.center[0] - math.sin(f.yaw) * d, f.center[1] + math.cos(f.yaw) * d)
 
 
-def _covered(spec: HouseSpec, x: float, y: float, skip: int = -1) -> str | None:
-    """What covers the floor point (x, y): a wall's id, a piece's id, or None."""
-    for w in spec.walls:
-        if segment_distance(x, y, w.a, w.b) <= w.thickness / 2.0:
-            return w.id
-    for k, g in enumerate(spec.furniture):
-        if k != skip and point_in_polygon(x, y, g.footprint()):
-            return g.id
-    return None
+class _Covers:
+    """What covers floor points of one house: walls' bodies and pieces' footprints, found
+    through their bounding boxes first (numpy), then exactly."""
+
+    def __init__(self, spec: HouseSpec) -> None:
+        self.spec = spec
+        self.feet = [f.footprint() for f in spec.furniture]
+        self.fbox = np.array([(min(p[0] for p in c), min(p[1] for p in c),
+                               max(p[0] for p in c), max(p[1] for p in c))
+                              for c in self.feet], dtype=float).reshape(-1, 4)
+        self.wbox = np.array([(min(w.a[0], w.b[0]) - w.thickness / 2,
+                               min(w.a[1], w.b[1]) - w.thickness / 2,
+                               max(w.a[0], w.b[0]) + w.thickness / 2,
+                               max(w.a[1], w.b[1]) + w.thickness / 2)
+                              for w in spec.walls], dtype=float).reshape(-1, 4)
+
+    @staticmethod
+    def _near(box: np.ndarray, x: float, y: float, pad: float = 0.0) -> np.ndarray:
+        return np.flatnonzero((box[:, 0] - pad <= x) & (x <= box[:, 2] + pad)
+                              & (box[:, 1] - pad <= y) & (y <= box[:, 3] + pad))
+
+    def at(self, x: float, y: float, skip: int = -1) -> str | None:
+        """What covers the floor point (x, y): a wall's id, a piece's id, or None."""
+        for j in self._near(self.wbox, x, y):
+            w = self.spec.walls[j]
+            if segment_distance(x, y, w.a, w.b) <= w.thickness / 2.0:
+                return w.id
+        for k in self._near(self.fbox, x, y):
+            if k != skip and point_in_polygon(x, y, self.feet[k]):
+                return self.spec.furniture[k].id
+        return None
+
+    def gap(self, x: float, y: float, radius: float) -> float:
+        """Distance from (x, y) to the nearest wall body or footprint, ``radius`` when none
+        is nearer."""
+        walls = self.spec.walls
+        gaps = [segment_distance(x, y, walls[j].a, walls[j].b) - walls[j].thickness / 2.0
+                for j in self._near(self.wbox, x, y, radius)]
+        gaps += [distance_to_polygon(x, y, self.feet[k])
+                 for k in self._near(self.fbox, x, y, radius)]
+        return min(gaps, default=radius)
 
 
 def blocked_fronts(spec: HouseSpec) -> list[tuple[int, str]]:
     """(furniture index, what covers it: a wall's or piece's id, or "the room's border")
     for each container or shelved piece whose front is blocked (module doc), spec order."""
+    covers = _Covers(spec)
     out = []
     for k, f in enumerate(spec.furniture):
         if not (f.is_container or f.levels):
@@ -47,7 +82,7 @@ def blocked_fronts(spec: HouseSpec) -> list[tuple[int, str]]:
         x, y = front_point(f)
         if not point_in_polygon(x, y, spec.room(f.room).polygon):
             out.append((k, "the room's border"))
-        elif (what := _covered(spec, x, y, skip=k)) is not None:
+        elif (what := covers.at(x, y, skip=k)) is not None:
             out.append((k, what))
     return out
 
@@ -55,12 +90,10 @@ def blocked_fronts(spec: HouseSpec) -> list[tuple[int, str]]:
 def cramped_starts(spec: HouseSpec, radius: float) -> list[tuple[int, float]]:
     """(start index, clearance in m) of the starts whose robot disc of ``radius`` overlaps
     a wall's body or a piece's footprint, in spec order."""
+    covers = _Covers(spec)
     out = []
     for i, s in enumerate(spec.starts):
-        gaps = [segment_distance(s.x, s.y, w.a, w.b) - w.thickness / 2.0 for w in spec.walls]
-        gaps += [distance_to_polygon(s.x, s.y, f.footprint()) for f in spec.furniture]
-        gap = min(gaps, default=math.inf)
+        gap = covers.gap(s.x, s.y, radius)
         if gap < radius:
             out.append((i, max(gap, 0.0)))
     return out
-
