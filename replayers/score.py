@@ -5,20 +5,24 @@ its ``sgtool.Instances`` table names the spec element it stands for (``spec_id``
 ground truth of every figure of :mod:`sgtool.scenegraph.quality` is in the log: room
 polygons and categories, and the room of every piece of furniture and every small object.
 Figures are given ``strict`` (against the polygons as they are) and ``merged`` (rooms joined
-by a doorless open-plan passage count as one: door-based segmentation cannot split them).
+by a doorless open-plan passage count as one: door-based segmentation need not split them;
+a group the graph does split, each of its predicted rooms mostly in another of the group's
+rooms, is scored as its rooms, so either form is right).
 """
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict
 from functools import partial
+from typing import Any
 
 from sgtool.house.spec import HouseSpec
 from sgtool.scenegraph.builder import MapLayers
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.instances import InstanceInfo
-from sgtool.scenegraph.quality import Quality, evaluate
+from sgtool.scenegraph.quality import Quality, evaluate, gt_rooms_of
 
 
 def passage_groups(spec: HouseSpec) -> dict[str, str]:
@@ -61,7 +65,41 @@ def score(spec: HouseSpec, instances: Mapping[int, InstanceInfo], layers: MapLay
         polygons={r.id: r.polygon for r in spec.rooms},
         gt_categories={r.id: r.category for r in spec.rooms}, visited=visited,
     )
-    return {"strict": of_graph(), "merged": of_graph(merge=passage_groups(spec))}
+    merge = split_groups_kept_apart(passage_groups(spec), layers.voronoi.positions,
+                                    layers.node_rooms, {r.id: r.polygon for r in spec.rooms})
+    return {"strict": of_graph(), "merged": of_graph(merge=merge)}
+
+
+def split_groups_kept_apart(merge: Mapping[str, str], node_xy: Any,
+                            node_rooms: Sequence[str | None],
+                            polygons: Mapping[str, Any]) -> dict[str, str]:
+    """``merge`` (room -> its passage group's representative) as the graph splits each
+    group: rooms of a group whose Voronoi nodes lie mostly in one predicted room stay
+    merged, rooms the graph gives predicted rooms of their own are scored apart; a room
+    without nodes stays with its group's representative, as before."""
+    import numpy as np
+
+    gt = gt_rooms_of(np.asarray(node_xy, dtype=float).reshape(-1, 2), polygons)
+    of_gt: dict[str, Counter[str]] = {}  # ground-truth room -> its nodes' predicted rooms
+    for p, g in zip(node_rooms, gt, strict=True):
+        if p is not None and g is not None and g in merge:
+            of_gt.setdefault(g, Counter())[p] += 1
+    # the key a room is grouped by: its group and where the graph put most of it
+    key = {r: (merge[r], min(of_gt[r].items(), key=lambda kv: (-kv[1], kv[0]))[0]
+               if r in of_gt else None) for r in merge}
+    out: dict[str, str] = {}
+    for group in sorted(set(merge.values())):
+        members = sorted(r for r in merge if merge[r] == group)
+        placed = sorted({p for r in members if (p := key[r][1]) is not None})
+        for p in placed:  # the members the graph put in one predicted room: one room
+            same = [r for r in members if key[r][1] == p]
+            if len(placed) == 1:  # not split: the whole group, rooms without nodes too
+                same = members
+            if len(same) > 1:
+                out.update({r: min(same) for r in same})
+        if not placed and len(members) > 1:
+            out.update({r: group for r in members})
+    return out
 
 
 def score_lines(scores: Mapping[str, Quality], graph_objects: int | None = None) -> list[str]:
