@@ -109,6 +109,11 @@ def os_error_text(e: OSError) -> str:
     return f"{reason}: {e.filename}" if e.filename is not None else reason
 
 
+# commands whose exit code is their verdict (diff: 1 when the logs differ; golden check,
+# doctor, llm check): a closed pipe ends them with 141 (as SIGPIPE would), never a false 0
+VERDICT_COMMANDS = frozenset({"diff", "golden", "doctor", "llm"})
+
+
 class LazyGroup(click.Group):
     def invoke(self, ctx: click.Context) -> object:
         try:
@@ -119,7 +124,9 @@ class LazyGroup(click.Group):
             raise UserError(str(e)) from e
         except BrokenPipeError:  # `sgtool ... | head`: the reader has what it wanted
             _quiet_stdout()
-            raise click.exceptions.Exit(0) from None
+            # but a command whose exit code is its verdict has not given it: 128 + SIGPIPE
+            verdict = ctx.invoked_subcommand in VERDICT_COMMANDS
+            raise click.exceptions.Exit(141 if verdict else 0) from None
         except ModuleNotFoundError as e:  # an optional package (an extra) is not installed
             missing = missing_extra(f"sgtool {ctx.invoked_subcommand}", e)
             if missing is None:
@@ -206,9 +213,11 @@ def main(argv: list[str] | None = None) -> None:
     except KeyboardInterrupt as e:
         click.echo("sgtool: interrupted", err=True)
         sys.exit(143 if isinstance(e, Terminated) else 130)
-    except BrokenPipeError:
+    except BrokenPipeError:  # the closed pipe found at the last flush
         _quiet_stdout()
-        sys.exit(0)
+        args = sys.argv[1:] if argv is None else argv
+        command = next((a for a in args if not a.startswith("-")), None)
+        sys.exit(141 if command in VERDICT_COMMANDS else 0)
 
 
 def _quiet_stdout() -> None:

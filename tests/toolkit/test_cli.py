@@ -108,3 +108,22 @@ def test_a_reader_that_stops_early_is_no_error(tmp_path):
     assert p.wait(timeout=60) == 0
     err = p.stderr.read().decode()
     assert "rror" not in err and "Traceback" not in err and "Exception" not in err, err
+
+
+def test_a_verdict_is_never_zero_when_the_reader_stops_early():
+    """`sgtool diff A B | head -1` on logs that differ: the closed pipe may cut the report,
+    but the exit code is never 0 ("the same"): 1, or 141 (128 + SIGPIPE) when the pipe
+    closed first."""
+    import subprocess
+    import sys
+
+    from support.paths import GOLDEN
+
+    code = "import sys; from sgtool.cli import main; main(sys.argv[1:])"
+    p = subprocess.Popen([sys.executable, "-c", code, "diff", str(GOLDEN / "house6-tour.mcap"),
+                          str(GOLDEN / "house10-start.mcap")],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    assert p.stdout is not None and p.stderr is not None
+    p.stdout.close()
+    assert p.wait(timeout=120) in (1, 141)
+    assert "Traceback" not in p.stderr.read().decode()
