@@ -125,7 +125,13 @@ def first_action_change(a: list[tuple[str, str | None]], b: list[tuple[str, str 
 def diff_logs(a: str | os.PathLike[str], b: str | os.PathLike[str],
               options: ReplayOptions | None = None, tolerance: float = 0.0) -> LogDiff:
     """What differs between the scene graphs of ``a`` and ``b`` (module doc); ``options``
-    replay the logs that hold no graphs; ``tolerance`` as in ``sgtool golden check``."""
+    replay the logs that hold no graphs; ``tolerance`` as in ``sgtool golden check``. A
+    recording that is not an sgtool log is refused in one line naming what it is."""
+    from sgtool.log.inspect import foreign_log_problem
+
+    for log in (a, b):
+        if (foreign := foreign_log_problem(log)) is not None:
+            raise SgtoolError(foreign)
     ga, gb = log_graphs(a, options), log_graphs(b, options)
     layers = [(x.layers, y.layers) for x, y in zip(ga.refreshes, gb.refreshes, strict=False)]
     lines = describe_mismatch(ga.graphs, list(zip(gb.refreshes, gb.graphs, strict=True)),

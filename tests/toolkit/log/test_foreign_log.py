@@ -97,3 +97,14 @@ def test_view_refuses_a_foreign_recording_in_one_line(tmp_path):
     assert len(r.output.strip().splitlines()) == 1
     assert "is a ROS 2 recording" in r.output and "sgtool import bag" in r.output
     assert sorted(p.name for p in tmp_path.iterdir()) == ["poses"]
+
+
+def test_diff_refuses_a_foreign_recording_in_one_line(tmp_path):
+    """`sgtool diff` of an exported ROS 2 bag and a log says what the bag is (it read the
+    bag's std_msgs/String /sgtool/scene_graph topic as a record before)."""
+    bag = tmp_path / "cam"
+    write_frames_bag(frames(), bag, "ros2-mcap")
+    log = write_log(tmp_path / "log.mcap", n=2)
+    r = CliRunner().invoke(cli, ["diff", str(bag / "cam.mcap"), str(log)])
+    assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1
+    assert "is a ROS 2 recording" in r.output
