@@ -271,6 +271,14 @@ def score_log(log: str | Path) -> tuple[int, dict[str, dict[str, float | int]]]:
     for name, v in q.items():
         d: dict[str, float | int] = dict(asdict(v))
         d["room_error_vs_true"] = v.rooms - v.gt_rooms
+        # a share over nothing is no figure (NaN: "-" in the tables, null in the JSON),
+        # not a 0 % that would enter the medians and plots
+        if not v.objects:
+            d["object_accuracy"] = math.nan
+        if not v.rooms:
+            d["category_accuracy"] = math.nan
+        if not v.gt_rooms_with_nodes:
+            d["purity"] = d["ari"] = math.nan
         out[name] = d
     return report.frames, out
 

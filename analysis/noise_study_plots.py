@@ -10,6 +10,7 @@ matplotlib's Agg backend; the PNGs carry no timestamp.
 from __future__ import annotations
 
 import io
+import math
 import statistics
 from collections.abc import Sequence
 from pathlib import Path
@@ -57,7 +58,8 @@ def plot_factor(res: StudyResult, factor: str, conds: Sequence[Condition],
         med = []
         for c in conds:
             vals = [float(cell.merged[key]) * scale for h in houses
-                    if (cell := res.cell(h, c.noise)) is not None]
+                    if (cell := res.cell(h, c.noise)) is not None
+                    and math.isfinite(float(cell.merged[key]))]
             med.append(statistics.median(vals) if vals else float("nan"))
         ax.plot(xs, med, color="black", linewidth=1.6, marker="_", markersize=12,
                 label="median")

@@ -204,3 +204,17 @@ def test_closed_loop_episodes_run_as_run_bench_runs_them(study: dict[str, Path],
     for p in seen:
         assert p.parts[-6:-4] == ("closed_loop", "logs") and p.name == "ep-000.mcap"
         assert out.joinpath(*p.parts[-6:]).exists()
+
+
+def test_a_share_over_nothing_is_no_zero(study: dict[str, Path]) -> None:
+    """A recording too short to see an object scores no object accuracy ("-", null), not
+    0 %, so it cannot pull a median or plot down."""
+    out = study["root"] / "short"
+    r = CliRunner().invoke(cli, [
+        "study", "noise", "--houses", "0", "--house", str(study["house"]),
+        "--resolution", "64x48", "--frames", "1", "--factor", "holes=0.1",
+        "--cache", str(study["root"] / "cache-short"), "-o", str(out), "--no-progress"])
+    assert r.exit_code == 0, r.output
+    cells = json.loads((out / "results.json").read_text())["cells"]
+    assert all(c["merged"]["objects"] == 0 for c in cells)
+    assert all(c["merged"]["object_accuracy"] is None for c in cells)
