@@ -72,8 +72,10 @@ def study_into(request: NoiseStudyRequest, show: Echo) -> None:
         plot_study(res, out / "plots")
         summary = summary_md(res)
     show(summary.removesuffix("\n"))  # summary_md ends in one newline; show adds it
-    show(f"{len(res.cells)} cells ({res.recorded} log(s) recorded now, the others from "
-         f"{request.cache}); wrote {request.out_dir}/summary.md, results.json, results.csv, "
+    cached = len(res.cells) - res.recorded
+    show(f"{len(res.cells)} cells ({res.recorded} log(s) recorded now"
+         + (f", {cached} from {request.cache}" if cached else "")
+         + f"); wrote {request.out_dir}/summary.md, results.json, results.csv, "
          "plots/")
 
 

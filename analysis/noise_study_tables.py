@@ -103,7 +103,7 @@ def _median_range(xs: Sequence[float], fmt: Callable[[float], str]) -> str:
 
 
 def _signed(x: float) -> str:
-    return "-" if not math.isfinite(x) else f"{x:+.1f}"
+    return "-" if not math.isfinite(x) else f"{x + 0.0:+.1f}".replace("-0.0", "+0.0")
 
 
 def cell_text(c: Cell) -> str:
