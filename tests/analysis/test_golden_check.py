@@ -189,6 +189,8 @@ def test_diff_of_derived_logs(log, tmp_path, capsys):
     assert sgtool(capsys, "replay", log, "-o", d2, "--voxel-size", "0.06", *FRAMES)[0] == 0
     code, out, _ = sgtool(capsys, "diff", d1, d1)
     assert code == 0 and "the same scene graphs" in out
+    code, out, err = sgtool(capsys, "diff", d1, d1, "--voxel-size", "0.3")  # nothing to replay
+    assert code == 0 and "the replay options given were not used" in err
     code, out, _ = sgtool(capsys, "diff", d1, d2)
     assert code == 1 and "they differ" in out
     assert "refresh 0 at 3.000 s (after 10 frames, logged) differs:" in out

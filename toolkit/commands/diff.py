@@ -34,8 +34,12 @@ def command(a: str, b: str, every: int | None, classifier: str | None,
     0.06; sgtool diff d1.mcap d2.mcap`."""
     from sgtool.replayers.golden_diff import diff_logs
 
+    given = any(x is not None for x in (every, classifier, min_points, voxel_size, max_frames))
     d = diff_logs(a, b, make_options(every, classifier, min_points, voxel_size, max_frames),
                   tolerance)
+    if given and d.a.source == "logged" and d.b.source == "logged":
+        click.echo("sgtool: note: both logs hold their scene graphs, compared as they are: "
+                   "the replay options given were not used", err=True)
     if as_json:
         click.echo(json.dumps(d.to_dict(), sort_keys=True))
     else:
