@@ -64,23 +64,28 @@ def test_planner_against_its_own_log_agrees(greedy_log):
     assert 0.0 <= other.rate("agree") <= other.rate("target") <= 1.0
 
 
-def test_multi_episode_and_unfinished_logs(tmp_path, house):
-    path = tmp_path / "two.mcap"
+def records_log(path, records):  # type: ignore[no-untyped-def]
+    """A log of sgtool records only, one per nanosecond in the order given."""
     with LogWriter(path) as log:
-        log.write_record("episode", 0, {"kind": "search", "status": "started", "query": "cup",
-                                        "planner": "x"})
-        log.write_record("action", 1, {"skill": "open", "target": "door:0",
-                                       "outcome": "success", "travelled_m": 2.0})
-        log.write_record("episode", 2, {"kind": "search", "status": "success", "steps": 1,
-                                        "travelled_m": 2.0, "shortest_m": 1.0})
-        log.write_record("episode", 3, {"kind": "search", "status": "started", "query": "mug",
-                                        "planner": "x", "steps": 0, "travelled_m": 0.0,
-                                        "frames": 0})  # as the closed loop opens one
-        log.write_record("action", 4, {"skill": "explore", "target": "room:1",
-                                       "outcome": "success", "travelled_m": 3.0})
-        log.write_record("action", 5, {"skill": "open", "target": "obj:1",
-                                       "outcome": "invalid", "travelled_m": 0.0})
-        # the run was killed: no closing record
+        for t, (kind, data) in enumerate(records):
+            log.write_record(kind, t, data)
+    return path
+
+
+def test_multi_episode_and_unfinished_logs(tmp_path, house):
+    path = records_log(tmp_path / "two.mcap", [
+        ("episode", {"kind": "search", "status": "started", "query": "cup", "planner": "x"}),
+        ("action", {"skill": "open", "target": "door:0", "outcome": "success",
+                    "travelled_m": 2.0}),
+        ("episode", {"kind": "search", "status": "success", "steps": 1, "travelled_m": 2.0,
+                     "shortest_m": 1.0}),
+        ("episode", {"kind": "search", "status": "started", "query": "mug", "planner": "x",
+                     "steps": 0, "travelled_m": 0.0, "frames": 0}),  # as the closed loop
+        ("action", {"skill": "explore", "target": "room:1", "outcome": "success",
+                    "travelled_m": 3.0}),
+        ("action", {"skill": "open", "target": "obj:1", "outcome": "invalid",
+                    "travelled_m": 0.0}),
+    ])  # the run was killed: no closing record
     a, b = read_log_episodes(path)
     ra, rb = a.result(), b.result()
     assert (ra.query, ra.success, ra.steps, ra.n_open, ra.shortest_m) == ("cup", True, 1, 1, 1.0)
@@ -202,13 +207,12 @@ def test_eval_says_when_planners_ran_on_different_episodes(tmp_path):
 def test_a_closing_record_without_steps_is_no_cut_short_episode(tmp_path):
     """``steps`` is optional in a closing record: an episode closed by one is complete
     (eval says nothing), only a missing closing record is a run cut short."""
-    path = tmp_path / "one.mcap"
-    with LogWriter(path) as log:
-        log.write_record("episode", 0, {"kind": "search", "status": "started", "query": "cup",
-                                        "planner": "x"})
-        log.write_record("action", 1, {"skill": "navigate", "target": "obj:1",
-                                       "outcome": "success", "travelled_m": 2.0})
-        log.write_record("episode", 2, {"kind": "search", "status": "success"})
+    path = records_log(tmp_path / "one.mcap", [
+        ("episode", {"kind": "search", "status": "started", "query": "cup", "planner": "x"}),
+        ("action", {"skill": "navigate", "target": "obj:1", "outcome": "success",
+                    "travelled_m": 2.0}),
+        ("episode", {"kind": "search", "status": "success"}),
+    ])
     notes: list[str] = []
     (r,), (e,) = load_results([path], notes)
     assert notes == [] and e.closed and r.success
