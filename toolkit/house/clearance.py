@@ -28,7 +28,7 @@ def front_point(f: Furniture, clear: float = FRONT_CLEAR) -> tuple[float, float]
     return (f.center[0] - math.sin(f.yaw) * d, f.center[1] + math.cos(f.yaw) * d)
 
 
-class _Covers:
+class Covers:
     """What covers floor points of one house: walls' bodies and pieces' footprints, found
     through their bounding boxes first (numpy), then exactly."""
 
@@ -49,15 +49,17 @@ class _Covers:
         return np.flatnonzero((box[:, 0] - pad <= x) & (x <= box[:, 2] + pad)
                               & (box[:, 1] - pad <= y) & (y <= box[:, 3] + pad))
 
-    def at(self, x: float, y: float, skip: int = -1) -> str | None:
-        """What covers the floor point (x, y): a wall's id, a piece's id, or None."""
+    def at(self, x: float, y: float, skip: int = -1) -> tuple[str, int] | None:
+        """What covers the floor point (x, y): ("walls", index) of a wall whose body holds
+        it, else ("furniture", index) of a piece whose footprint does (not ``skip``), else
+        None."""
         for j in self._near(self.wbox, x, y):
             w = self.spec.walls[j]
             if segment_distance(x, y, w.a, w.b) <= w.thickness / 2.0:
-                return w.id
+                return "walls", int(j)
         for k in self._near(self.fbox, x, y):
             if k != skip and point_in_polygon(x, y, self.feet[k]):
-                return self.spec.furniture[k].id
+                return "furniture", int(k)
         return None
 
     def gap(self, x: float, y: float, radius: float) -> float:
@@ -74,7 +76,7 @@ class _Covers:
 def blocked_fronts(spec: HouseSpec) -> list[tuple[int, str]]:
     """(furniture index, what covers it: a wall's or piece's id, or "the room's border")
     for each container or shelved piece whose front is blocked (module doc), spec order."""
-    covers = _Covers(spec)
+    covers = Covers(spec)
     out = []
     for k, f in enumerate(spec.furniture):
         if not (f.is_container or f.levels):
@@ -83,14 +85,15 @@ def blocked_fronts(spec: HouseSpec) -> list[tuple[int, str]]:
         if not point_in_polygon(x, y, spec.room(f.room).polygon):
             out.append((k, "the room's border"))
         elif (what := covers.at(x, y, skip=k)) is not None:
-            out.append((k, what))
+            kind, i = what
+            out.append((k, spec.walls[i].id if kind == "walls" else spec.furniture[i].id))
     return out
 
 
 def cramped_starts(spec: HouseSpec, radius: float) -> list[tuple[int, float]]:
     """(start index, clearance in m) of the starts whose robot disc of ``radius`` overlaps
     a wall's body or a piece's footprint, in spec order."""
-    covers = _Covers(spec)
+    covers = Covers(spec)
     out = []
     for i, s in enumerate(spec.starts):
         gap = covers.gap(s.x, s.y, radius)

@@ -30,8 +30,6 @@ from sgtool.house.geometry import (
     longest_uncovered,
     opening_segment,
     overlap_area,
-    point_in_polygon,
-    segment_distance,
     shared_borders,
 )
 from sgtool.house.names import id_note
@@ -108,24 +106,21 @@ def _boxes(boxes: list[tuple[float, float, float, float]]) -> np.ndarray:
 def _starts_on_free_floor(spec: HouseSpec) -> None:
     """No start pose inside a wall's body or a piece of furniture's footprint (the robot
     could not move, or the simulator pushes it out of the house)."""
-    for i, s in enumerate(spec.starts):
-        for j, w in enumerate(spec.walls):
-            if segment_distance(s.x, s.y, w.a, w.b) <= w.thickness / 2:
-                raise SpecError(f"starts[{i}]: ({s.x}, {s.y}) is inside walls[{j}] ({w.id}); "
-                                "a start pose must be on free floor")
-    if not spec.starts or not spec.furniture:
+    from sgtool.house.clearance import Covers
+
+    if not spec.starts:
         return
-    feet = [f.footprint() for f in spec.furniture]
-    boxes = _boxes([(min(p[0] for p in c), min(p[1] for p in c),
-                     max(p[0] for p in c), max(p[1] for p in c)) for c in feet])
+    covers = Covers(spec)
     for i, s in enumerate(spec.starts):
-        near = np.flatnonzero((boxes[:, 0] <= s.x) & (s.x <= boxes[:, 2])
-                              & (boxes[:, 1] <= s.y) & (s.y <= boxes[:, 3]))
-        for k in near:
-            if point_in_polygon(s.x, s.y, feet[k]):
-                f = spec.furniture[k]
-                raise SpecError(f"starts[{i}]: ({s.x}, {s.y}) is inside furniture[{k}] "
-                                f"({f.id}, {f.category}); a start pose must be on free floor")
+        what = covers.at(s.x, s.y)
+        if what is not None and what[0] == "walls":
+            w = spec.walls[what[1]]
+            raise SpecError(f"starts[{i}]: ({s.x}, {s.y}) is inside walls[{what[1]}] ({w.id}); "
+                            "a start pose must be on free floor")
+        if what is not None:
+            f = spec.furniture[what[1]]
+            raise SpecError(f"starts[{i}]: ({s.x}, {s.y}) is inside furniture[{what[1]}] "
+                            f"({f.id}, {f.category}); a start pose must be on free floor")
 
 
 def _openings_clear(spec: HouseSpec) -> None:
