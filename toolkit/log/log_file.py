@@ -8,6 +8,7 @@ inside the MCAP reader.
 
 from __future__ import annotations
 
+import mmap
 import os
 import stat
 import struct
@@ -15,33 +16,43 @@ from pathlib import Path
 
 from sgtool.errors import LogFormatError
 from sgtool.files import quoted
-from sgtool.log.mcap_records import MAGIC
+from sgtool.log.mcap_records import MAGIC, FileBytes
 
 _FOOTER = struct.Struct("<BQQQI")  # opcode 0x02, record length 20, two offsets and a CRC
 _TAIL = 1 << 20  # how far from the end a footer followed by bytes is looked for
 
 
-def unended_problem(path: Path, size: int) -> str:
-    """The one line for a file of ``size`` bytes that does not end with the MCAP magic:
-    bytes appended after a complete log's footer (the magic found within the last MiB,
-    after a footer record), or a file cut short or still being written; both name the
-    recovery."""
-    recover = (f"`sgtool doctor {quoted(path)} --recover OUT.mcap` copies what is readable "
-               "into a valid log")
-    with open(path, "rb") as f:
-        start = max(size - _TAIL, 0)
-        f.seek(start)
-        tail = f.read()
+def appended_end(buf: FileBytes, size: int) -> int | None:
+    """Where a complete log ends in a file of ``size`` bytes that does not end with the
+    MCAP magic but holds, within its last MiB, a footer record followed by the closing
+    magic (bytes appended to a closed log): the offset just after that magic, else None.
+    Only the pattern is checked; the caller decides whether the log before it reads."""
+    if size >= len(MAGIC) and bytes(buf[size - len(MAGIC):size]) == MAGIC:
+        return None
+    start = max(size - _TAIL, 0)
+    tail = bytes(buf[start:size])
     at = tail.rfind(MAGIC)
     while at >= _FOOTER.size:
         opcode, length, *_ = _FOOTER.unpack_from(tail, at - _FOOTER.size)
         if opcode == 0x02 and length == 20:
-            extra = len(tail) - at - len(MAGIC)
-            end = start + at + len(MAGIC)
-            return (f"{path}: {extra} byte{'' if extra == 1 else 's'} after the end of the "
-                    f"MCAP file (its footer and closing magic end at byte {end}): bytes "
-                    f"appended to a complete log; {recover}")
+            return start + at + len(MAGIC)
         at = tail.rfind(MAGIC, 0, at)
+    return None
+
+
+def unended_problem(path: Path, size: int) -> str:
+    """The one line for a file of ``size`` bytes that does not end with the MCAP magic:
+    bytes appended after a complete log's footer (:func:`appended_end`), or a file cut
+    short or still being written; both name the recovery."""
+    recover = (f"`sgtool doctor {quoted(path)} --recover OUT.mcap` copies what is readable "
+               "into a valid log")
+    with open(path, "rb") as f, mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as buf:
+        end = appended_end(buf, size)
+    if end is not None:
+        extra = size - end
+        return (f"{path}: {extra} byte{'' if extra == 1 else 's'} after the end of the "
+                f"MCAP file (its footer and closing magic end at byte {end}): bytes "
+                f"appended to a complete log; {recover}")
     return (f"{path}: the file ends without the MCAP footer (truncated, or still being "
             f"written); {recover}")
 

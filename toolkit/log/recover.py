@@ -35,7 +35,7 @@ from sgtool.errors import LogFormatError, SgtoolError
 from sgtool.files import atomic_open
 from sgtool.log.file_check import SummaryState, check, expected_messages, summary_state
 from sgtool.log.file_walk import Item, Layout, walk
-from sgtool.log.log_file import require_regular_file
+from sgtool.log.log_file import appended_end, require_regular_file
 from sgtool.log.mcap_records import MAGIC
 from sgtool.log.message_check import message_problem
 from sgtool.output_check import check_log_output
@@ -77,8 +77,17 @@ def _mapped(f: io.BufferedReader, size: int) -> mmap.mmap:
 
 
 def _diagnose(buf: mmap.mmap, diag: Diagnosis, writer: _Copier | None) -> None:
-    """Walk ``buf``, copy what is readable to ``writer``, fill ``diag``."""
-    lay = Layout(diag.size)
+    """Walk ``buf``, copy what is readable to ``writer``, fill ``diag``. Bytes appended
+    after a complete log (:func:`~sgtool.log.log_file.appended_end`) are the only problem
+    named when the log before them reads without damage; else the whole file is walked."""
+    end = appended_end(buf, diag.size)
+    if end is not None:
+        before = Layout(end)
+        for _ in walk(buf, before):
+            pass
+        if before.corrupt or before.truncated or before.problems:
+            end = None
+    lay = Layout(diag.size if end is None else end)
     if writer is not None:
         writer.layout = lay
     unknown = _consume(walk(buf, lay), diag, writer)
@@ -88,6 +97,10 @@ def _diagnose(buf: mmap.mmap, diag: Diagnosis, writer: _Copier | None) -> None:
     state = summary_state(buf, lay)
     diag.checks = _checks(lay, state)
     problems = list(lay.problems) + diag.problems
+    if end is not None:
+        extra = diag.size - end
+        problems.insert(0, f"{extra} byte{'' if extra == 1 else 's'} after the closing magic "
+                        f"at byte {end}: appended to a closed log (its footer and magic end there)")
     if not lay.corrupt and not lay.truncated:
         problems += check(buf, lay, state)
     diag.problems = problems

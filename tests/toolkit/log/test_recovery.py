@@ -245,3 +245,25 @@ def test_bytes_appended_to_a_complete_log_are_not_called_a_cut(long_log, tmp_pat
     assert r.exit_code == 1 and recovered.is_file()
     with LogReader(recovered) as a, LogReader(long_log) as b:
         assert a.message_count() == b.message_count()
+
+
+def test_doctor_names_bytes_appended_to_a_complete_log(long_log, tmp_path):
+    """The diagnosis of a closed log followed by junk reads the log up to its closing magic
+    (summary and CRCs checked, nothing lost) and names the appended bytes as its only
+    problem; junk that itself holds a footer and magic is not taken for the end of a log
+    unless the log before it reads without damage."""
+    data = long_log.read_bytes()
+    padded = tmp_path / "padded.mcap"
+    padded.write_bytes(data + b"junk")
+    d = scan(padded)
+    whole = scan(long_log)
+    assert d.status == "corrupt" and d.lost_messages == 0 and not d.lost_unknown
+    assert d.problems == [f"4 bytes after the closing magic at byte {len(data)}: appended "
+                          "to a closed log (its footer and magic end there)"]
+    assert d.readable_messages == whole.readable_messages and d.checks == whole.checks
+    # a file cut inside its data whose tail happens to hold a footer and magic: no "end"
+    fake = tmp_path / "fake.mcap"
+    fake.write_bytes(data[:len(data) // 2] + data[-37:] + b"x")
+    f = scan(fake)
+    assert f.status in ("corrupt", "truncated")
+    assert not any("appended to a closed log" in p for p in f.problems)
