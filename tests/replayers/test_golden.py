@@ -11,10 +11,12 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 
 import pytest
 from support.paths import GOLDEN
 
+from sgtool import LogReader
 from sgtool.analysis.golden_check import check_pins
 from sgtool.replayers.golden import (
     CASES,
@@ -60,6 +62,21 @@ def test_the_golden_cases_cover_what_they_claim():
     assert any(o.relation == "inside" for o in tour.objects)  # contents of opened containers
     start = final["house10-start"]
     assert start.frontiers()  # stopped early: unexplored space remains
+
+
+def test_the_golden_graphs_doors_stand_in_their_doorways():
+    """Every door of the final graphs stands within 0.1 m of a doorway of the house (the
+    swung panel's centroid stands about 0.6 m off it) and joins two rooms."""
+    for c in CASES:
+        with LogReader(GOLDEN / f"{c.name}.mcap") as r:
+            spec = r.house_spec()
+        assert spec is not None
+        g = SceneGraph.from_json(read_graphs(GOLDEN / f"{c.name}.graphs.jsonl.gz")[-1])
+        assert g.doors
+        for d in g.doors:
+            off = min(math.dist(d.position, s.center) for s in spec.doors)
+            assert off < 0.1, (c.name, d.id, off)
+            assert len(set(d.rooms)) == 2, (c.name, d.id, d.rooms)
 
 
 def test_diff_names_what_changed():

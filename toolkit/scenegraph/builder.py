@@ -31,9 +31,10 @@ caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
 5. regions (:mod:`sgtool.scenegraph.regions`) and frontiers
    (:mod:`sgtool.scenegraph.frontiers`), frontier ids kept by proximity
    (:mod:`sgtool.scenegraph.frontier_ids`);
-6. doors (:mod:`sgtool.scenegraph.door_evidence`): rooms on either side from visible nodes
-   nearby; a closed door with only one explored side leads to an unexplored room node
-   (SCOUT sec. IV-A), placed ``unexplored_offset`` beyond the door;
+6. doors (:mod:`sgtool.scenegraph.door_evidence`), an open one at its doorway (the
+   centre of its cells of stage 3): rooms on either side from visible nodes nearby; a
+   closed door with only one explored side leads to an unexplored room node (SCOUT sec.
+   IV-A), placed ``unexplored_offset`` beyond the door;
 7. room categories (:mod:`sgtool.scenegraph.room_nodes`) from the contained furniture (all
    objects when a room has none) with the configured
    :class:`~sgtool.scenegraph.categories.RoomClassifier`; a room with no object at all
@@ -104,7 +105,7 @@ from sgtool.scenegraph.builder_config import BuilderConfig
 from sgtool.scenegraph.categories import RoomClassifier
 from sgtool.scenegraph.door_evidence import (
     DoorObservation,
-    door_cells_of,
+    doorways,
     observe_doors,
     open_doors,
 )
@@ -185,6 +186,7 @@ class _Rooms:
     density: np.ndarray
     seg: RoomSegmentation
     room_ids: list[str]
+    doorways: dict[int, tuple[float, float]]  # open door id -> centre of its door cells
 
 
 class SceneGraphBuilder:
@@ -366,7 +368,7 @@ class SceneGraphBuilder:
         tick("regions")
         doors, unexplored_pos = observe_doors(
             [s for s in seen if s[0].kind == "door"], vg, node_room, rooms.room_ids, occ,
-            blocked, self._rooms, cfg.door_radius, cfg.unexplored_offset)
+            blocked, self._rooms, cfg.door_radius, cfg.unexplored_offset, rooms.doorways)
         tick("doors")
         frontiers, frontier_ids, f_nodes = self._frontier_stage(occ, vg, robot_xy, node_room,
                                                                 blocked)
@@ -532,7 +534,7 @@ class SceneGraphBuilder:
                                     self.voxels.frame_counts, DOOR_MIN_FRAMES)
         reach = DOOR_REACH / self.voxels.resolution
         won = {iid: near_median(ijk, reach) for iid, ijk in won.items()}
-        cells = door_cells_of(occ, won, self._panel_memo)
+        cells, centres = doorways(occ, won, self._panel_memo)
         cells.setflags(write=False)  # kept to recognise the same cells next time
         got = self._density
         if got is None or got[0] != occ.resolution or not np.array_equal(got[1], cells):
@@ -544,7 +546,7 @@ class SceneGraphBuilder:
         density = got[2]
         seg = segment_rooms(vg, density, cfg, self._centre_memo)
         numbers = self._rooms.assign([vg.positions[r] for r in seg.rooms], cfg.match_radius)
-        return _Rooms(cells, density, seg, [f"room:{n}" for n in numbers])
+        return _Rooms(cells, density, seg, [f"room:{n}" for n in numbers], centres)
 
     def _frontier_stage(self, occ: OccupancyGrid, vg: VoronoiGraph,
                         robot_xy: tuple[float, float] | None, node_room: np.ndarray,

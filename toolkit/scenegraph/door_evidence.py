@@ -51,15 +51,25 @@ def open_doors(instances: Mapping[int, InstanceInfo]) -> list[int]:
 
 def door_cells_of(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
                   panel_memo: dict[bytes, object]) -> np.ndarray:
+    """Bool grid of the door evidence (module doc): :func:`doorways`' cells."""
+    return doorways(occ, door_voxels, panel_memo)[0]
+
+
+def doorways(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
+             panel_memo: dict[bytes, object]
+             ) -> tuple[np.ndarray, dict[int, tuple[float, float]]]:
     """Bool grid of the door evidence (module doc) from the voxels (ijk) of each open door,
-    in any order (e.g. from :class:`sgtool.scenegraph.door_voxels.DoorVoxels`);
-    ``panel_memo`` caches the openings found from swung panels across calls. The cells of
-    every door are looked up at once; only a door with too few passable cells (a swung
-    panel) is looked at on its own."""
+    in any order (e.g. from :class:`sgtool.scenegraph.door_voxels.DoorVoxels`), and the
+    centre (x, y in m) of each door's cells in it: its doorway, where a swung panel's
+    centroid stands beside it. ``panel_memo`` caches the openings found from swung panels
+    across calls. The cells of every door are looked up at once; only a door with too few
+    passable cells (a swung panel) is looked at on its own."""
     cells = np.zeros(occ.shape, dtype=bool)
-    parts = [ijk for _, ijk in sorted(door_voxels.items()) if len(ijk)]
+    centres: dict[int, tuple[float, float]] = {}
+    ids = [iid for iid, ijk in sorted(door_voxels.items()) if len(ijk)]
+    parts = [door_voxels[iid] for iid in ids]
     if not parts:
-        return cells
+        return cells, centres
     ix0 = int(round(occ.origin[0] / occ.resolution))
     iy0 = int(round(occ.origin[1] / occ.resolution))
     door = np.repeat(np.arange(len(parts)), [len(p) for p in parts])
@@ -77,6 +87,9 @@ def door_cells_of(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
     open_door = n_pass >= np.maximum(PASSABLE_SHARE * n_cells, 1)
     use = passable & open_door[door]
     cells[r[use], c[use]] = True  # the passable cells of a door with an opening
+    for i in np.flatnonzero(open_door).tolist():
+        mine = use & (door == i)
+        centres[ids[i]] = _centre(occ, r[mine], c[mine])
     occupied: np.ndarray | None = None
     for i in np.flatnonzero(~open_door).tolist():  # doors seen as their panel (mostly)
         mine = door == i
@@ -93,19 +106,32 @@ def door_cells_of(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
         if got is not None:
             pr, pc = got
         cells[pr, pc] = True  # the panel's doorway, else all its cells
-    return cells
+        centres[ids[i]] = _centre(occ, np.asarray(pr), np.asarray(pc))
+    return cells, centres
+
+
+def _centre(occ: OccupancyGrid, rows: np.ndarray, cols: np.ndarray) -> tuple[float, float]:
+    """The mean of the centres of the cells (``rows``, ``cols``) of ``occ`` (each cell
+    once)."""
+    key = np.unique(rows.astype(np.int64) * (occ.shape[1] + 1) + cols.astype(np.int64))
+    rr, cc = np.divmod(key, occ.shape[1] + 1)
+    x, y = occ.center_of(rr, cc)
+    return float(np.mean(x)), float(np.mean(y))
 
 
 def observe_doors(
     seen: list[SeenInstance], vg: VoronoiGraph, node_room: np.ndarray, room_ids: list[str],
     occ: OccupancyGrid, blocked: np.ndarray, tracker: RoomTracker, door_radius: float,
-    unexplored_offset: float,
+    unexplored_offset: float, doorways: Mapping[int, tuple[float, float]] | None = None,
 ) -> tuple[list[DoorObservation], dict[str, tuple[float, float]]]:
     """The seen doors with their rooms (module doc), and the position of every unexplored
-    room node behind them (``tracker`` names those rooms)."""
+    room node behind them (``tracker`` names those rooms). A door stands at its doorway
+    when ``doorways`` (door id -> x, y from :func:`doorways`) has it, else at the centroid
+    of its voxels (a closed panel fills its doorway)."""
     out = []
     unexplored_pos: dict[str, tuple[float, float]] = {}
-    points = [(float(c[0]), float(c[1])) for _, c, _ in seen]
+    at = doorways or {}
+    points = [at.get(info.id, (float(c[0]), float(c[1]))) for info, c, _ in seen]
     visible = visible_labelled_nodes(points, vg, node_room, occ, blocked, door_radius)
     for (info, _c, _vp), pos, near in zip(seen, points, visible, strict=True):
         rooms: list[str] = []

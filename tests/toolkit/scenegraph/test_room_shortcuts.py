@@ -11,7 +11,12 @@ from sgtool.mapping.bev import line_of_sight
 from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph
 from sgtool.scenegraph import room_segmentation
-from sgtool.scenegraph.door_evidence import PASSABLE_SHARE, door_cells_of, visible_labelled_nodes
+from sgtool.scenegraph.door_evidence import (
+    PASSABLE_SHARE,
+    door_cells_of,
+    doorways,
+    visible_labelled_nodes,
+)
 from sgtool.scenegraph.room_segmentation import opening_from_panel, ray_shares, room_overlaps
 
 
@@ -244,3 +249,26 @@ def test_thin_columns_beside_a_panel_are_not_part_of_it():
     alone = door_cells_of(occ, {1: panel.astype(np.int64)}, {})
     both = door_cells_of(occ, {1: np.concatenate([panel, smear]).astype(np.int64)}, {})
     assert alone.any() and np.array_equal(both, alone)
+
+
+def test_an_open_door_stands_at_its_doorway_not_at_its_swung_panel():
+    """A door swung into a room, seen with its lintel (a fair share of passable columns) or
+    as its panel alone: either way its place is the centre of the doorway (columns 10-25 of
+    row 20, x = 0.9 m, y = 1.025 m at 5 cm cells), where the centroid of its voxels stands
+    0.4 m inside the room."""
+    g = np.full((60, 60), FREE, dtype=np.int8)
+    g[20, :10] = OCCUPIED
+    g[20, 26:] = OCCUPIED
+    rows = 20 + np.arange(1, 16)
+    g[rows, 10] = OCCUPIED
+    panel = np.stack([np.full(15, 10), rows, np.zeros(15, np.int64)], axis=1)
+    lintel = np.stack([np.arange(10, 26), np.full(16, 20), np.full(16, 44)], axis=1)
+    occ = OccupancyGrid(g, (0.0, 0.0), 0.05)
+    cells, at = doorways(occ, {7: np.concatenate([panel, lintel]).astype(np.int64)}, {})
+    assert np.array_equal(cells, door_cells_of(
+        occ, {7: np.concatenate([panel, lintel]).astype(np.int64)}, {}))
+    assert at[7] == pytest.approx((0.9, 1.025))
+    cells, at = doorways(occ, {7: panel.astype(np.int64), 8: np.zeros((0, 3), np.int64)}, {})
+    assert set(at) == {7}  # a door without voxels has no doorway
+    x, y = at[7]
+    assert abs(y - 1.025) < 0.051 and 0.5 <= x <= 1.3  # in the gap (a cell), not in the room
