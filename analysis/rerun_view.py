@@ -166,7 +166,9 @@ def export(
     :class:`~sgtool.analysis.rerun_live.LiveTarget`: spawn, connect, serve; the web
     viewer's address goes to ``warn``). ``hold``, when given, is called after everything is
     sent and before the stream closes (a served recording lives until it returns).
-    ``every`` logs one camera frame in K (maps, graphs and actions are always logged).
+    ``every`` logs one camera frame in K (maps, graphs and actions are always logged);
+    ``max_frames`` stops after that many camera frames, and leaves out the maps, graphs and
+    actions logged after them.
     ``voxels``, when given, is called with the open reader and yields (frame index, t_ns,
     voxel centres (N,3), colours (N,3) uint8, voxel size) to draw the semantic voxel map
     over time. ``warn``, when given, receives one-line notes about the log (frames without
@@ -375,6 +377,9 @@ def _export(
                 half_sizes=np.full((len(centres), 3), size / 2, np.float32),
                 colors=cols, fill_mode="solid"))
     frame_times = r.frame_times() if r.has(S.DEPTH) else []
+    # with max_frames, what was logged after the last frame shown is left out too
+    end = (frame_times[max_frames] if max_frames is not None and max_frames < len(frame_times)
+           else None)
 
     def frame_of(t: int) -> int | None:
         import bisect
@@ -385,7 +390,7 @@ def _export(
 
     # derived layers
     if r.has(S.OCCUPANCY):
-        for d in r.messages([S.OCCUPANCY]):
+        for d in r.messages([S.OCCUPANCY], end_ns=end):
             cells, origin, res = codec.decode_grid(d.message)
             stamp(frame_of(d.log_time_ns), d.log_time_ns)
             h, w = cells.shape
@@ -397,18 +402,18 @@ def _export(
                 colormap=rr.components.Colormap.RvizMap))
     for topic, entity in ((S.VORONOI, "world/map/voronoi"), (S.ROOMS, "world/map/rooms")):
         if r.has(topic):
-            for d in r.messages([topic]):
+            for d in r.messages([topic], end_ns=end):
                 strips, colors = _scene_update_strips(d.message)
                 stamp(frame_of(d.log_time_ns), d.log_time_ns)
                 rec.log(entity, rr.LineStrips3D(strips, colors=colors, radii=0.02)
                         if strips else rr.Clear(recursive=False))
-    for t, g in r.records("scene_graph"):
+    for t, g in r.records("scene_graph", end_ns=end):
         stamp(frame_of(t), t)
         _log_scene_graph(rec, g)
-    for t, e in r.records("episode"):
+    for t, e in r.records("episode", end_ns=end):
         stamp(frame_of(t), t)
         rec.log("episode", rr.TextDocument(episode_text(e), media_type="text/markdown"))
-    for t, a in r.records("action"):
+    for t, a in r.records("action", end_ns=end):
         stamp(frame_of(t), t)
         level = "INFO" if a.get("outcome") == "success" else "WARN"
         text = f"{a.get('skill')}({a.get('target') or ''}) -> {a.get('outcome')}"

@@ -25,6 +25,9 @@ imported from a bag keeps its own stamps, and plays beside the original.
 Frames are renamed to REP-105's by default (``world`` -> ``map``, ``base`` ->
 ``base_link``, ``camera`` -> ``camera_optical_frame``: sgtool's camera frame is an optical
 one, x right, y down, z forward); ``frames`` gives another mapping (``{}`` keeps sgtool's).
+A trajectory imported from a bag's /tf (``sgtool import bag --tf-frames odom:base_link``
+without images) is the pose of the frame it names, not of an optical frame: its frames keep
+the source's names where the mapping gives the REP-105 ones (:func:`trajectory_frames`).
 
 The format follows ``out``'s name unless given: ``NAME.bag`` is ROS 1, anything else a
 ROS 2 bag folder. Compression: zstd chunks in the ROS 2 MCAP file, lz4 (or bz2) chunks in
@@ -57,6 +60,7 @@ from sgtool.log.reader import LogReader
 from sgtool.output_check import check_output
 from sgtool.recorders.exporters import ros_maps
 from sgtool.recorders.exporters.bagwriter import COMPRESSIONS, DISTROS, BagWriter
+from sgtool.recorders.importers.sink import IMPORT_METADATA
 
 FORMATS = {"ros1": "ros1", "ros2": "ros2-mcap"}
 DEFAULT_COMPRESSION = {"ros1": "lz4", "ros2": "zstd"}
@@ -208,7 +212,8 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
         records = {k.topic for k in S.RECORDS.values()}
         others = tuple(sorted(t for t in r.topics() if t not in OUTPUTS_ORDER
                               and t not in records and t != S.GRAPH_SCENE))
-        names = frames if frames is not None else REP105
+        names = trajectory_frames(r.metadata.get(IMPORT_METADATA, {}),
+                                  frames if frames is not None else REP105)
 
         def writer(path: Path) -> BagWriter:
             return BagWriter(path, FORMATS[fmt], frames=names, compression=compression,
@@ -230,6 +235,25 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
                     os.replace(inner / entry, stage / entry)
                 shutil.rmtree(inner)
     return ExportReport(out, fmt, tuple(counts), derived, time_base_s, compression, others)
+
+
+def trajectory_frames(meta: Mapping[str, str], names: Mapping[str, str]) -> dict[str, str]:
+    """``names`` (sgtool frame -> bag frame) for a log whose import ``meta`` (the
+    ``sgtool.import`` metadata) says it is a trajectory read from /tf: its world and camera
+    frames, where ``names`` gives them their REP-105 names, take the source's frame names
+    (``odom``, ``base_link``: a robot base's pose is not an optical frame's). Other logs,
+    and frames renamed otherwise, keep ``names``."""
+    out = dict(names)
+    if meta.get("content") != "trajectory":
+        return out
+    for frame, key in ((S.CAMERA_FRAME, "pose_frame"), (S.WORLD_FRAME, "world_frame")):
+        source = meta.get(key, "")
+        if source and out.get(frame) == REP105[frame]:
+            out[frame] = source
+    taken = (out.get(S.CAMERA_FRAME), out.get(S.WORLD_FRAME))
+    if S.BASE_FRAME in out and out[S.BASE_FRAME] in taken:
+        out.pop(S.BASE_FRAME)  # a trajectory has no base frame: no clash of names
+    return out
 
 
 def _check_ros1_target(out: Path, force: bool) -> None:

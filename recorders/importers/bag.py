@@ -325,6 +325,11 @@ def _import_trajectory(
     else:
         alignment = WorldAlignment.identity()
     meta = {**meta, **alignment.metadata(), "content": "trajectory"}
+    if src.tree is not None and src.track is None:  # /tf: the pose of a named frame
+        # the frames export names it by (the world's only when the import kept it)
+        meta["pose_frame"] = src.camera
+        if np.array_equal(alignment.matrix, np.eye(4)):
+            meta["world_frame"] = src.world
     A = alignment.matrix  # noqa: N806
     with LogWriter(out, compression=opts.compression) as w:
         w.add_metadata(IMPORT_METADATA, meta)

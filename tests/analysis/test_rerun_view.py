@@ -246,3 +246,34 @@ def test_episode_doors_and_empty_graphs_are_drawn(tmp_path):
     for entity in ("/world/graph/objects", "/world/graph/rooms", "/world/graph/doors"):
         assert f"{entity} - data columns: [Clear:is_recursive]" in printed, entity
     assert "log_time" not in printed
+
+
+def test_max_frames_leaves_out_what_was_logged_after_the_last_frame(tmp_path):
+    """`view --max-frames 10` of a 40-frame replay: the camera stops at frame 9, and so do
+    the maps and graphs (they were logged until frame 39), on the frame timeline."""
+    import collections
+
+    import rerun.chunk as rc
+
+    from sgtool.replayers.derived_log import ReplayOptions, replay
+
+    derived = tmp_path / "derived.mcap"
+    replay(GOLDEN / "house10-start.mcap", derived, ReplayOptions(max_frames=40))
+    last: dict[str, int] = collections.defaultdict(int)
+    for n in (10, None):
+        out = tmp_path / f"v{n}.rrd"
+        args = ["view", str(derived), "-o", str(out), "--no-voxels"]
+        r = CliRunner().invoke(cli, args + (["--max-frames", str(n)] if n else []))
+        assert r.exit_code == 0, r.output
+        last.clear()
+        for chunk in rc.RrdReader(str(out)).store().stream().to_chunks():
+            batch = chunk.to_record_batch()
+            if "frame" in batch.schema.names:
+                frames = [f for f in batch.column("frame").to_pylist() if f is not None]
+                if frames:
+                    last[str(chunk.entity_path)] = max(last[str(chunk.entity_path)],
+                                                       max(frames))
+        if n:
+            assert last["/world/camera/image/depth"] == 9
+            assert last["/world/map/occupancy"] <= 9 and last["/graph"] <= 9
+    assert last["/graph"] > 9 and last["/world/camera/image/depth"] == 39

@@ -73,7 +73,8 @@ def _frames(style: str, pairs: tuple[str, ...]) -> dict[str, str]:
 @click.option("--frames", "frame_style", type=click.Choice(["rep105", "sgtool"]),
               default="rep105", show_default=True,
               help="Frame names: REP-105 (map, base_link, camera_optical_frame) or sgtool's "
-                   "(world, base, camera).")
+                   "(world, base, camera). A trajectory imported from a bag keeps its "
+                   "source's frame names under rep105 (e.g. odom -> base_link).")
 @click.option("--frame", "frame_pairs", multiple=True, metavar="OLD=NEW",
               help="Rename one frame (repeatable), named as sgtool names it (world, base, "
               "camera) or as --frames does (map, base_link, camera_optical_frame), e.g. "
@@ -84,7 +85,8 @@ def _frames(style: str, pairs: tuple[str, ...]) -> dict[str, str]:
                    "or none, ros1 lz4, bz2 or none].")
 @click.option("--topics", "topics", default=None, metavar="T1,T2,...",
               help="Only these topics (ROS or sgtool names, comma-separated); an sgtool "
-                   "topic selects every ROS topic made from it.")
+                   "topic selects every ROS topic made from it (/tf: /tf and /tf_static, "
+                   "the links that never move).")
 @click.option("--progress/--no-progress", default=True,
               help="Show a progress bar [default: when stderr is a terminal].")
 @click.option("--force", is_flag=True,

@@ -21,7 +21,8 @@ from sgtool.errors import SgtoolError
 @click.option("--every", type=click.IntRange(min=1), default=1, show_default=True,
               help="Log one camera frame in K (maps, graphs and actions are always logged).")
 @click.option("--max-frames", type=click.IntRange(min=1), default=None,
-              help="Stop after this many camera frames.")
+              help="Stop after this many camera frames (the maps, graphs and actions "
+                   "logged after them are left out too).")
 @click.option("--voxels/--no-voxels", default=True, show_default=True,
               help="Rebuild and show the semantic voxel map (needs the mapping pipeline and "
               "depth images; a log without them is shown without it).")

@@ -28,7 +28,7 @@ from sgtool.cli import cli
 from sgtool.errors import SgtoolError
 from sgtool.log import LogReader, LogWriter, codec
 from sgtool.log import schemas as S
-from sgtool.recorders.exporters.bag_export import export_bag
+from sgtool.recorders.exporters.bag_export import REP105, export_bag, trajectory_frames
 from sgtool.recorders.exporters.ros_maps import DELETEALL, LINE_LIST, LINE_STRIP, TEXT
 
 GOLDEN = Path(__file__).resolve().parents[2] / "golden" / "house6-tour.mcap"
@@ -341,3 +341,34 @@ def test_a_recording_off_time_zero_keeps_its_stamps(tmp_path):
     at_zero = log_with_rooms(tmp_path / "d.mcap")
     rep = export_bag(at_zero, tmp_path / "z.bag", topics=["/camera/depth"])
     assert rep.time_base_s == 1.0
+
+
+def test_a_tf_trajectory_keeps_its_frame_names_in_the_bag(shared_data_dir, tmp_path):
+    """evo's odom -> base_link trajectory, imported and exported: the bag's /tf names the
+    robot base base_link under odom, as the source did (not camera_optical_frame under
+    map: a base's axes are not an optical frame's); --frames sgtool and --frame renames
+    still win."""
+    from sgtool.recorders.importers.bag import import_bag
+    from sgtool.recorders.importers.bag_options import BagOptions
+
+    log = tmp_path / "traj.mcap"
+    import_bag(shared_data_dir / "logs" / "evo" / "tf_example.bag", log,
+               BagOptions(tf_frames=("odom", "base_link"), progress=False))
+    export_bag(log, tmp_path / "b")
+    tf = read_bag(tmp_path / "b")["/tf"]
+    assert len(tf) == 517
+    assert {(m.transforms[0].header.frame_id, m.transforms[0].child_frame_id)
+            for _, m in tf} == {("odom", "base_link")}
+    export_bag(log, tmp_path / "s", frames={})
+    m = read_bag(tmp_path / "s")["/tf"][0][1]
+    assert (m.transforms[0].header.frame_id, m.transforms[0].child_frame_id) == ("world", "camera")
+    export_bag(log, tmp_path / "r", frames={**REP105, S.CAMERA_FRAME: "robot"})
+    m = read_bag(tmp_path / "r")["/tf"][0][1]
+    assert (m.transforms[0].header.frame_id, m.transforms[0].child_frame_id) == ("odom", "robot")
+
+
+def test_trajectory_frames_leave_other_logs_alone():
+    assert trajectory_frames({}, REP105) == REP105
+    assert trajectory_frames({"content": "frames", "pose_frame": "x"}, REP105) == REP105
+    got = trajectory_frames({"content": "trajectory", "pose_frame": "base_link"}, REP105)
+    assert got == {S.WORLD_FRAME: "map", S.CAMERA_FRAME: "base_link"}  # no clash with base
