@@ -370,7 +370,7 @@ def check_pins(folder: str | Path, options: ReplayOptions | None = None, *,
     (m, m², scores): differences up to it pass (0: byte-exact graphs); ``keep``: keep the
     new replay of changed logs for :func:`update_pins`."""
     pins = read_pins(folder)
-    chosen = sorted(pins.logs) if names is None else list(names)
+    chosen = sorted(pins.logs) if names is None else list(dict.fromkeys(names))  # each once
     for n in chosen:
         if n not in pins.logs:
             raise PinError(f"{pins.folder}: no pinned log named {n!r} (pinned: "

@@ -75,7 +75,13 @@ class GoldenFolder(pytest.File):
 
 
 class GoldenFailure(Exception):
-    """A changed or unusable golden log: the report is the failure message."""
+    """A changed or unusable golden log: the report is the failure message; ``changed``:
+    its replay changed (what ``--sgtool-golden-update`` accepts), else it could not be
+    checked."""
+
+    def __init__(self, report: str, changed: bool) -> None:
+        super().__init__(report)
+        self.changed = changed
 
 
 class GoldenLog(pytest.Item):
@@ -93,10 +99,12 @@ class GoldenLog(pytest.Item):
             update_pins(report)
             return
         if c.status != "unchanged":
-            raise GoldenFailure("\n".join(c.report()))
+            raise GoldenFailure("\n".join(c.report()), changed=c.status == "changed")
 
     def repr_failure(self, excinfo: pytest.ExceptionInfo[BaseException],
                      style: Any = None) -> str:
+        if isinstance(excinfo.value, GoldenFailure) and not excinfo.value.changed:
+            return str(excinfo.value)  # the one line of a log that could not be checked
         if isinstance(excinfo.value, GoldenFailure):
             from sgtool.files import quoted
 
@@ -122,7 +130,8 @@ class GoldenFixture:
         ``voxel_size``, ...), else check it: options given override the pinned ones for
         this check, as ``sgtool golden check --voxel-size`` does, the others are as pinned.
         A ``log`` that is not the log pinned under its name (another path and other bytes)
-        fails (re-pinned under ``--sgtool-golden-update``)."""
+        fails, one re-recorded in its place fails as ``golden check`` says; both are
+        re-pinned under ``--sgtool-golden-update``."""
         from sgtool.analysis.golden_check import check_pins, pin_logs, pin_name, update_pins
         from sgtool.replayers.derived_log import ReplayOptions
         from sgtool.replayers.golden import sha256_file
@@ -137,15 +146,15 @@ class GoldenFixture:
             pin_logs([log], folder, ReplayOptions(**options))
             pytest.fail(f"pinned {log} into {folder} (first run); commit the pin and run "
                         "again", pytrace=False)
-        if pin.log_path(folder).resolve() != log.resolve() and \
-                sha256_file(log) != pin.log_sha256:  # (a --copy pin holds the same bytes)
-            if not self.update:
+        if sha256_file(log) != pin.log_sha256:  # (a --copy pin holds the same bytes)
+            if self.update:  # another log under the name, or this one re-recorded
+                pin_logs([log], folder, pin.options, why=pin.why)
+                return
+            if pin.log_path(folder).resolve() != log.resolve():
                 pytest.fail(f"{log} is not the log pinned as {name!r} in {folder} "
                             f"({pin.log_path(folder)}): pins are named by file name, give "
                             "each log its own name or folder (or re-pin with pytest "
                             "--sgtool-golden-update)", pytrace=False)
-            pin_logs([log], folder, pin.options, why=pin.why)
-            return
         report = check_pins(folder, ReplayOptions(**options) if options else None,
                             tolerance=self.tolerance, names=[name], keep=self.update)
         c = report.logs[0]

@@ -132,9 +132,31 @@ def _added_removed(layer: str, expected: dict[str, Any], actual: dict[str, Any],
             for k in sorted(expected.keys() ^ actual.keys())]
 
 
+def _beyond(d: float, tol: float) -> bool:
+    """``d`` is more than ``tol``: a difference of exactly ``tol`` between values rounded to
+    the canonical JSON's 4 decimals passes, whatever float subtraction makes of it."""
+    return d > tol + 1e-9
+
+
 def _moved(a: Any, b: Any, tol: float) -> float | None:
     d = math.dist(a.position, b.position)
-    return d if d > tol else None
+    return d if _beyond(d, tol) else None
+
+
+def _m(x: float) -> str:
+    """A length as a report prints it: 3 decimals, or 2 significant digits below 1 mm (a
+    change of 0.0001 m does not read as 0.000)."""
+    return f"{x:.3f}" if abs(x) >= 0.001 or x == 0 else f"{x:.2g}"
+
+
+def _pair(a: float, b: float, least: int = 2) -> tuple[str, str]:
+    """``a`` and ``b`` with ``least`` decimals or as many more (up to 6) as they need to
+    read differently."""
+    for k in range(least, 7):
+        x, y = f"{a:.{k}f}", f"{b:.{k}f}"
+        if x != y:
+            break
+    return x, y
 
 
 def _room_changes(a: Any, b: Any, tol: float) -> list[str]:
@@ -142,7 +164,7 @@ def _room_changes(a: Any, b: Any, tol: float) -> list[str]:
     if a.category != b.category:
         out.append(f"rooms: {a.id} category {a.category} -> {b.category}")
     sa, sb = dict(a.category_scores), dict(b.category_scores)
-    if sa.keys() != sb.keys() or any(abs(sa[k] - sb[k]) > tol for k in sa):
+    if sa.keys() != sb.keys() or any(_beyond(abs(sa[k] - sb[k]), tol) for k in sa):
         out.append(f"rooms: {a.id} category scores {_scores(a)} -> {_scores(b)}")
     if a.explored != b.explored:
         out.append(f"rooms: {a.id} explored {a.explored} -> {b.explored}")
@@ -150,16 +172,17 @@ def _room_changes(a: Any, b: Any, tol: float) -> list[str]:
         out.append(f"edges: {a.id} neighbours {_fmt_list(sorted(a.neighbours))} -> "
                    f"{_fmt_list(sorted(b.neighbours))}")
     if (d := _moved(a, b, tol)) is not None:
-        out.append(f"rooms: {a.id} moved {d:.2f} m")
+        out.append(f"rooms: {a.id} moved {_m(d)} m")
     return out
 
 
 def _object_changes(a: Any, b: Any, tol: float) -> list[str]:
     out = [f"objects: {a.id} {a.category} {attr} {getattr(a, attr)} -> {getattr(b, attr)}"
-           for attr in ("room", "parent", "relation", "state", "explored", "category")
+           for attr in ("room", "parent", "relation", "state", "explored", "category",
+                        "instance", "affordances")
            if getattr(a, attr) != getattr(b, attr)]
     if (d := _moved(a, b, tol)) is not None:
-        out.append(f"objects: {a.id} {a.category} moved {d:.3f} m")
+        out.append(f"objects: {a.id} {a.category} moved {_m(d)} m")
     return out
 
 
@@ -170,6 +193,10 @@ def _door_changes(a: Any, b: Any, tol: float) -> list[str]:
     if sorted(a.rooms) != sorted(b.rooms):
         out.append(f"edges: {a.id} joins {_fmt_list(sorted(a.rooms))} -> "
                    f"{_fmt_list(sorted(b.rooms))}")
+    if a.instance != b.instance:
+        out.append(f"doors: {a.id} instance {a.instance} -> {b.instance}")
+    if (d := _moved(a, b, tol)) is not None:
+        out.append(f"doors: {a.id} moved {_m(d)} m")
     return out
 
 
@@ -180,9 +207,10 @@ def _region_changes(a: Any, b: Any, tol: float) -> list[str]:
                 f"{_region_kind(b)} in {b.room}"]
     out = []
     if (d := _moved(a, b, tol)) is not None:
-        out.append(f"{layer}: {a.id} moved {d:.2f} m")
-    if abs(a.size - b.size) > tol:
-        out.append(f"{layer}: {a.id} length {a.size:.2f} -> {b.size:.2f} m")
+        out.append(f"{layer}: {a.id} moved {_m(d)} m")
+    if _beyond(abs(a.size - b.size), tol):
+        x, y = _pair(a.size, b.size)
+        out.append(f"{layer}: {a.id} length {x} -> {y} m")
     return out
 
 
@@ -212,12 +240,12 @@ def _distance_changes(expected: SceneGraph, actual: SceneGraph, tol: float) -> l
         a, b = expected.distances.get(k), actual.distances.get(k)
         if a is None or b is None:
             gone += 1
-        elif abs(a - b) > tol:
+        elif _beyond(abs(a - b), tol):
             n += 1
             worst = max(worst, (abs(a - b), k))
     if not n and not gone:
         return []
-    parts = [f"{n} differ" + (f", largest {worst[0]:.3f} m ({worst[1]})" if n else "")]
+    parts = [f"{n} differ" + (f", largest {_m(worst[0])} m ({worst[1]})" if n else "")]
     if gone:
         parts.append(f"{gone} new or gone")
     return ["distances: " + "; ".join(parts)]
@@ -275,8 +303,8 @@ def _area_changes(expected: SceneGraph,
     out = []
     for r in expected.rooms:
         x, y = se.area(r.id), sa.area(r.id)
-        if x is not None and y is not None and abs(x - y) > tol:
-            out.append(f"rooms: {r.id} area {x:.2f} -> {y:.2f} m²")
+        if x is not None and y is not None and _beyond(abs(x - y), tol):
+            out.append("rooms: {} area {} -> {} m²".format(r.id, *_pair(x, y)))
     return out
 
 
@@ -296,8 +324,10 @@ def diff_graphs(expected: SceneGraph, actual: SceneGraph, tol: float = 1e-4,
     (empty when they are equal up to ``tol`` in positions (m), distances (m), category
     scores and room areas (m²)): rooms removed, added, merged or split (with their areas
     when ``layers``, the two refreshes' :class:`LayerSummary`, give them), categories,
-    objects moved or assigned to another room, doors, edges, regions and frontiers, the
-    robot, distances and the Voronoi graph size. Equal up to ``tol`` but not byte-equal:
+    objects moved, assigned to another room or otherwise changed, doors (moved, state,
+    rooms), edges, regions and frontiers, the robot (room, position, yaw), the graph's time
+    and version, distances and the Voronoi graph size (every field of the graph is
+    compared). Equal up to ``tol`` but not byte-equal:
     the one line :data:`ROUNDING`."""
     out: list[str] = _room_set_changes(expected, actual, layers)
     for layer, nodes, describe, changes in _LAYERS:
@@ -312,6 +342,14 @@ def diff_graphs(expected: SceneGraph, actual: SceneGraph, tol: float = 1e-4,
     er, ar = expected.robot, actual.robot
     if (er.room, er.region) != (ar.room, ar.region):
         out.append(f"robot: in {er.room}/{er.region} -> {ar.room}/{ar.region}")
+    if (d := _moved(er, ar, tol)) is not None:
+        out.append(f"robot: moved {_m(d)} m")
+    turn = abs(math.remainder(er.yaw - ar.yaw, math.tau))
+    if _beyond(turn, tol):
+        out.append(f"robot: yaw {er.yaw:.4f} -> {ar.yaw:.4f} rad")
+    if expected.time_ns != actual.time_ns or expected.version != actual.version:
+        out.append(f"graph: time {expected.time_ns} -> {actual.time_ns} ns, version "
+                   f"{expected.version} -> {actual.version}")
     out += _distance_changes(expected, actual, tol)
     if not out and expected.to_json() != actual.to_json():
         out.append(ROUNDING)

@@ -274,7 +274,7 @@ def read_pins(folder: str | os.PathLike[str]) -> PinSet:
     if not isinstance(doc, dict) or not isinstance(doc.get("cases"), dict):
         raise _damaged(path, "no 'cases' object")
     fmt = doc.get("format")
-    if not isinstance(fmt, int) or fmt < 1:
+    if not isinstance(fmt, int) or isinstance(fmt, bool) or fmt < 1:
         raise _damaged(path, f"format {fmt!r} is no version number")
     if fmt > PIN_FORMAT:
         raise PinError(f"{path}: pin format {fmt} is newer than this sgtool reads (format "
@@ -307,6 +307,11 @@ def _entry(name: str, e: Mapping[str, Any], common: Mapping[str, Any], fmt: int,
         if e.get(key) is not None and not isinstance(e[key], kinds):
             raise TypeError(f"{key!r} is {_json_kind(e[key])}, expected "
                             f"{' or '.join(_json_kind(t()) for t in kinds)}")
+    for variant, figures in (e.get("quality") or {}).items():
+        if not isinstance(figures, dict) or not all(
+                v is None or (isinstance(v, int | float) and not isinstance(v, bool))
+                for v in figures.values()):
+            raise TypeError(f"'quality' {variant!r} must map figures to numbers or null")
     options = options_from(common if fmt == 1 else e.get("options", {}), f"{path}: {name}")
     decisions = None
     if e.get("decisions") is not None:
@@ -359,7 +364,15 @@ def load_expected(pins: PinSet, name: str) -> tuple[list[str], list[RefreshMeta]
 def stored_path(log: Path, folder: Path) -> str:
     """How the index names ``log``: relative to ``folder`` (``../../logs/run.mcap``) when
     the two share a directory other than the filesystem root, so that a repository
-    holding both checks out anywhere; else absolute."""
+    holding both checks out anywhere; else absolute. The path as given is kept when it
+    leads to the same file from ``folder`` (a symlinked data folder of the repository
+    stays a link in the index, not its target's place on this machine)."""
+    la, fa = os.path.abspath(log), os.path.abspath(folder)
+    if os.path.commonpath([la, fa]) != os.path.abspath(os.sep):
+        lexical = Path(os.path.relpath(la, fa))
+        target = Path(os.path.normpath(folder.resolve() / lexical))
+        if target.exists() and os.path.samefile(target, log):
+            return lexical.as_posix()
     a, f = log.resolve(), folder.resolve()
     try:
         return a.relative_to(f).as_posix()

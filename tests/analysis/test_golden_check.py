@@ -168,6 +168,22 @@ def test_a_damaged_pin_file_is_one_line_naming_it(pinned, capsys, damage):
     assert str(target) in err and "damaged pin file" in err
 
 
+@pytest.mark.parametrize("edit", ["quality", "format"])
+def test_a_mistyped_pin_entry_is_one_line_naming_the_file(pinned, capsys, edit):
+    """A quality figure set that is not an object, a format that is a boolean: the damaged
+    pin file named in one line, not a TypeError from deep inside the check."""
+    index = pinned / "expected.json"
+    doc = json.loads(index.read_text())
+    if edit == "quality":
+        doc["cases"]["small"]["quality"] = {"strict": 5}
+    else:
+        doc["format"] = True
+    index.write_text(json.dumps(doc))
+    code, _, err = sgtool(capsys, "golden", "check", "--dir", pinned)
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err, err
+    assert str(index) in err and "damaged pin file" in err, err
+
+
 def test_a_newer_pin_format_is_refused_naming_both_versions(pinned, capsys):
     index = json.loads((pinned / "expected.json").read_text())
     index["format"] = PIN_FORMAT + 1
@@ -326,6 +342,30 @@ def test_a_repository_of_logs_and_pins_checks_out_anywhere(log, tmp_path, capsys
     code, out, _ = sgtool(capsys, "golden", "check", "--dir", clone / "tests" / "golden",
                           "--update")
     assert code == 0 and "nothing to accept" in out
+
+
+def test_a_symlinked_data_folder_stays_a_link_in_the_index(log, tmp_path, capsys):
+    """A repository whose data/ is a symlink to a shared drive: the index names the log
+    through the link (../data/small.mcap), so the link pointed at another copy of the same
+    log still checks; a second --log of the same name is checked once."""
+    first, second = tmp_path / "drive1", tmp_path / "drive2"
+    for d in (first, second):
+        d.mkdir()
+        shutil.copyfile(log, d / "small.mcap")
+    repo = tmp_path / "repo"
+    repo.mkdir()
+    (repo / "data").symlink_to(first)
+    pins = repo / "pins"
+    assert sgtool(capsys, "golden", "pin", repo / "data" / "small.mcap", "--dir", pins,
+                  *FRAMES)[0] == 0
+    assert read_pins(pins).logs["small"].log == "../data/small.mcap"
+    (repo / "data").unlink()
+    (repo / "data").symlink_to(second)
+    shutil.rmtree(first)
+    code, out, err = sgtool(capsys, "golden", "check", "--dir", pins, "--log", "small",
+                            "--log", "small")
+    assert code == 0, out + err
+    assert summary_row(out, "small")
 
 
 def _without(src, dst, topic):

@@ -103,3 +103,33 @@ def test_the_fixture_refuses_another_log_of_the_pinned_name(tmp_path, monkeypatc
              copy=True)
     code, out = pytest_run("test_lab.py", cwd=tmp_path)
     assert code == 0, out
+
+
+def test_a_log_that_cannot_be_checked_fails_in_one_line_without_the_update_hint(tmp_path):
+    """A pinned log deleted: its test fails with the one line naming it; --update cannot
+    mend it, so it is not suggested."""
+    log = tmp_path / "a.mcap"
+    shutil.copyfile(GOLDEN / "house10-start.mcap", log)
+    pin_logs([log], tmp_path / "pins", ReplayOptions(max_frames=20))
+    log.unlink()
+    code, out = pytest_run("--sgtool-golden", tmp_path / "pins", "-rf", cwd=tmp_path)
+    assert code == 1 and "a.mcap" in out, out
+    assert "--update" not in out and "Traceback" not in out, out
+
+
+def test_the_fixture_re_pins_a_log_re_recorded_in_its_place_under_update(tmp_path):
+    """run.mcap pinned, then recorded again at the same path: the check fails (not the
+    pinned log); with --sgtool-golden-update the fixture re-pins it, and it passes after."""
+    shutil.copyfile(GOLDEN / "house10-start.mcap", tmp_path / "run.mcap")
+    pin_logs([tmp_path / "run.mcap"], tmp_path / "pins", ReplayOptions(max_frames=20))
+    (tmp_path / "test_lab.py").write_text(
+        "from pathlib import Path\nHERE = Path(__file__).parent\n\n"
+        "def test_run(sgtool_golden):\n"
+        "    sgtool_golden.check(HERE / 'run.mcap', HERE / 'pins')\n")
+    shutil.copyfile(GOLDEN / "house6-tour.mcap", tmp_path / "run.mcap")
+    code, out = pytest_run("test_lab.py", cwd=tmp_path)
+    assert code == 1, out
+    code, out = pytest_run("test_lab.py", "--sgtool-golden-update", cwd=tmp_path)
+    assert code == 0, out
+    code, out = pytest_run("test_lab.py", cwd=tmp_path)
+    assert code == 0, out

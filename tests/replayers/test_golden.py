@@ -154,6 +154,71 @@ def test_tolerance_and_exactness_of_describe_mismatch():
         "2 refreshes where 3 were expected; the first 2 agree"]
 
 
+def _changed(value):
+    """A value of the same type that reads differently in the canonical JSON."""
+    if isinstance(value, bool):
+        return not value
+    if isinstance(value, int):
+        return value + 1
+    if isinstance(value, float):
+        return value + 0.5
+    if isinstance(value, str):
+        return value + "x"
+    if isinstance(value, tuple) and value and all(isinstance(v, float) for v in value):
+        return (value[0] + 0.5, *value[1:])
+    if isinstance(value, tuple):
+        return (*value, ("kitchen", 0.5)) if value and isinstance(value[0], tuple) else \
+            (*value, "x")
+    if isinstance(value, dict):
+        return {**value, "x": 1.0}
+    return "x" if value is None else None
+
+
+def test_every_field_of_a_graph_is_compared():
+    """A change to any one field of any node, of the robot or of the graph (a door moved
+    0.5 m, a robot turned, another instance) reads as a difference naming it, never as
+    rounding: a real change must not pass a check run with a tolerance."""
+    g = SceneGraph.from_json(read_graphs(GOLDEN / "house6-tour.graphs.jsonl.gz")[-1])
+    assert g.rooms and g.objects and g.doors and g.regions
+    tried = 0
+    for layer in ("rooms", "objects", "doors", "regions"):
+        node = getattr(g, layer)[0]
+        for f in dataclasses.fields(node):
+            if f.name == "id":
+                continue
+            other = dataclasses.replace(node, **{f.name: _changed(getattr(node, f.name))})
+            changed = dataclasses.replace(g, **{layer: (other, *getattr(g, layer)[1:])})
+            lines = diff_graphs(g, changed, tol=0.01)
+            assert lines and ROUNDING not in lines, (layer, f.name, lines)
+            tried += 1
+    for f in dataclasses.fields(g.robot):
+        robot = dataclasses.replace(g.robot, **{f.name: _changed(getattr(g.robot, f.name))})
+        lines = diff_graphs(g, dataclasses.replace(g, robot=robot), tol=0.01)
+        assert lines and ROUNDING not in lines, ("robot", f.name, lines)
+    for name in ("time_ns", "version", "distances"):
+        lines = diff_graphs(g, dataclasses.replace(g, **{name: _changed(getattr(g, name))}),
+                            tol=0.01)
+        assert lines and ROUNDING not in lines, (name, lines)
+    assert tried >= 20
+
+
+def test_a_difference_of_exactly_the_tolerance_passes_and_small_ones_read():
+    """Values the canonical JSON rounds to 4 decimals that differ by exactly the tolerance
+    pass, in every layer; below 1 mm a report prints the change with its digits."""
+    g = SceneGraph.from_json(read_graphs(GOLDEN / "house6-tour.graphs.jsonl.gz")[-1])
+    o, r = g.objects[0], g.rooms[0]
+    for tol in (0.0001, 0.001, 0.01):
+        moved = dataclasses.replace(g, objects=(dataclasses.replace(
+            o, position=(round(o.position[0] + tol, 4), *o.position[1:])),) + g.objects[1:],
+            rooms=(dataclasses.replace(r, position=(round(r.position[0] + tol, 4),
+                                                    r.position[1])),) + g.rooms[1:],
+            distances={k: round(v + tol, 4) for k, v in g.distances.items()})
+        assert diff_graphs(g, moved, tol=tol) == [ROUNDING], tol
+    tiny = dataclasses.replace(g, objects=(dataclasses.replace(
+        o, position=(o.position[0] + 0.0002, *o.position[1:])),) + g.objects[1:])
+    assert diff_graphs(g, tiny, tol=0.0) == [f"objects: {o.id} {o.category} moved 0.0002 m"]
+
+
 def test_format_1_pin_folders_are_still_read(tmp_path):
     for f in GOLDEN.glob("house10-start.*"):
         (tmp_path / f.name).symlink_to(f)

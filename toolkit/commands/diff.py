@@ -17,7 +17,8 @@ from sgtool.commands.options import FiniteFloatRange
 @replay_options("for a log without scene graphs: the log's, else the replay default")
 @click.option("--tolerance", type=FiniteFloatRange(min=0.0), default=0.0, show_default=True,
               help="Let differences up to this pass: positions and distances (m), room "
-              "areas (m²), category scores (0: the graphs must be byte-identical).")
+              "areas (m²), category scores, the robot's yaw (rad) (0: the graphs must be "
+              "byte-identical).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of text.")
 def command(a: str, b: str, every: int | None, classifier: str | None,
             min_points: int | None, voxel_size: float | None, max_frames: int | None,

@@ -116,7 +116,8 @@ def pin(logs: tuple[str, ...], folder: str, copy: bool, why: str | None, every: 
 @replay_options("as pinned; given here it overrides the pinned option for every log")
 @click.option("--tolerance", type=FiniteFloatRange(min=0.0), default=0.0, show_default=True,
               help="Let differences up to this pass: positions and distances (m), room "
-              "areas (m²), category scores (0: the graphs must be byte-identical).")
+              "areas (m²), category scores, the robot's yaw (rad) (0: the graphs must be "
+              "byte-identical).")
 @click.option("--update", is_flag=True,
               help="Re-pin the changed logs (with the options checked) and print what was "
               "accepted; exit 0 then.")
