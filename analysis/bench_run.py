@@ -41,7 +41,7 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     error line and nothing is written; Ctrl-C leaves both folders as they were."""
     from sgtool.analysis.bench import OUTPUT_NAMES, run_benchmark, write_outputs
     from sgtool.analysis.report import llm_warnings
-    from sgtool.files import leftover_stages, output_folder
+    from sgtool.files import leftover_notes, output_folder
     from sgtool.llm.recorded import transcript_run
 
     out_dir, log_dir = request.out_dir, request.config.log_dir
@@ -77,6 +77,5 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
         show(line)
     show(f"wrote {', '.join(str(Path(out_dir) / name) for name in written)}")
     for folder in (out_dir, *([log_dir] if log_dir is not None else [])):
-        for stale in leftover_stages(folder):
-            show(f"sgtool: note: {stale} is the unfinished output of a run that was killed "
-                 "(or one still running); remove it when none is")
+        for line in leftover_notes(folder):
+            show(line)

@@ -17,7 +17,8 @@ spread tasks over processes or machines (:func:`run_closed_loop_bench` takes a `
 ``map`` by default, that maps ``run_task`` over the tasks in order).
 
 The outputs (:func:`write_outputs`): ``episodes.jsonl`` (the
-:class:`~sgtool.results.EpisodeResult` of every run), ``summary.md`` (per noise profile:
+:class:`~sgtool.results.EpisodeResult` of every run, its ``source`` the log relative to
+the folder: :func:`log_source`), ``summary.md`` (per noise profile:
 SR / SPL / steps / AUC-E as the symbolic bench, then failed skills per episode by reason;
 then the statistics that separate planners, :mod:`sgtool.analysis.closed_loop_tables`: SR
 and SPL with bootstrap intervals over houses,
@@ -59,7 +60,11 @@ from sgtool.analysis.closed_loop_tables import (
 )
 from sgtool.analysis.offline import log_exchanges, read_log_episodes
 from sgtool.analysis.report import format_table, pipe_table
-from sgtool.analysis.run_bench_resume import check_resumable, task_settings
+from sgtool.analysis.run_bench_resume import (
+    check_resumable,
+    episode_identity,
+    task_settings,
+)
 from sgtool.analysis.search_metrics import CostModel, cost_models, summarize
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
@@ -213,6 +218,13 @@ def noise_folder(noise: str) -> str:
     return parse_noise(noise).name if names_file(noise) else noise
 
 
+def log_source(log: Path) -> str:
+    """How a row names its log (``logs/NOISE/PLANNER/HOUSE/ep-K.mcap`` of
+    :func:`log_path`): relative to the run's folder, which holds ``episodes.jsonl``, so two
+    runs (in a staging folder, elsewhere, on another machine) name their logs alike."""
+    return Path(*log.parts[-5:]).as_posix()
+
+
 def log_path(root: Path, noise: str, planner: str, house: str, episode: int) -> Path:
     """``root/NOISE/PLANNER/HOUSE/ep-K.mcap`` (NOISE: :func:`noise_folder`; a plug-in
     ``module:Name`` as ``module__Name``: :func:`sgtool.planning.registry.planner_file_name`);
@@ -284,8 +296,7 @@ def run_task(task: RunTask) -> RunRow:
 def _row(task: RunTask, seconds: float | None) -> RunRow:
     if seconds is None:  # a log that was there: run with these settings, on this house?
         spec, eps = house_episodes(task)
-        want = [eps[task.episode].id, eps[task.episode].query] \
-            if task.episode < len(eps) else None
+        want = episode_identity(eps[task.episode]) if task.episode < len(eps) else None
         check_resumable(task.output, task_settings(task_options(task), task.noise, want,
                                                     dict(task.planner_options)),
                         spec, task.house.source if task.house.spec is not None
@@ -295,7 +306,7 @@ def _row(task: RunTask, seconds: float | None) -> RunRow:
         raise SgtoolError(f"{task.output}: holds {len(logged)} episodes, not one; remove it "
                           "to run the episode again")
     ep = logged[0]
-    res = replace(ep.result(), seed=task.options.planner_seed,
+    res = replace(ep.result(), seed=task.options.planner_seed, source=log_source(task.output),
                   llm_answers=answer_counts(rec for _, rec in log_exchanges([task.output])))
     fails = Counter(reason_class(d.action.reason or "") for d in ep.decisions
                     if d.action.outcome == "failure")

@@ -29,6 +29,7 @@ from sgtool.analysis.closed_loop_bench import (
     ClosedLoopBenchConfig,
     RunRow,
     RunTask,
+    log_source,
     noise_folder,
 )
 from sgtool.analysis.executor import Executor, FolderMark
@@ -70,7 +71,7 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
 
     from sgtool.analysis.closed_loop_bench import OUTPUT_NAMES, run_closed_loop_bench
     from sgtool.analysis.closed_loop_bench import write_outputs as write_tables
-    from sgtool.files import atomic_write, output_folder
+    from sgtool.files import atomic_write, leftover_notes, output_folder
 
     executor, bars = _executor(request)
     with output_folder(request.out_dir, force=request.force, command="run-bench",
@@ -104,6 +105,8 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
     for line in llm_warnings(res.results(), request.config.planners):
         show(line)
     show(f"wrote {', '.join(str(Path(request.out_dir) / name) for name in written)}")
+    for line in leftover_notes(request.out_dir):
+        show(line)
 
 
 def unreported(logs: Path, config: ClosedLoopBenchConfig) -> list[Path]:
@@ -149,14 +152,15 @@ class Shipped:
 def run_task_on(fn: RunFn, folder: FolderMark, task: RunTask) -> RunRow | Shipped:
     """``fn(task)`` on a worker: into the output folder when the worker sees it
     (:meth:`FolderMark.here`), else into a temporary folder of its own, the log sent back
-    (:class:`Shipped`; the row names ``task.output`` as a run in the folder would)."""
+    (:class:`Shipped`; its row names the log as a run in the folder would:
+    :func:`~sgtool.analysis.closed_loop_bench.log_source`)."""
     if folder.here():
         return fn(task)
     with tempfile.TemporaryDirectory(prefix="sgtool-run-bench-") as tmp:
         local = replace(task, output=Path(tmp) / task.output.name)
         row = fn(local)
         data = local.output.read_bytes()
-    result = replace(row.result, source=str(task.output))
+    result = replace(row.result, source=log_source(task.output))
     return Shipped(replace(row, task=task, result=result), data)
 
 
@@ -168,9 +172,10 @@ class EpisodeRunner:
     folder is read back here (a worker elsewhere would not see the log) and every other
     task runs on the executor (:func:`run_task_on`); a log sent back is written
     (atomically) as its task finishes; a task that failed after its retry stops the run
-    with one line once all have run (the finished logs stay). :attr:`nodes` maps each log
-    run now to the Ray node that ran it (``""``: this machine); :attr:`sent` holds the
-    logs sent back."""
+    with one line once all have run (the finished logs stay); Ctrl-C removes the partial
+    logs of the tasks not finished (a Ray worker cancelled by force cannot).
+    :attr:`nodes` maps each log run now to the Ray node that ran it (``""``: this
+    machine); :attr:`sent` holds the logs sent back."""
 
     def __init__(self, executor: Executor | None, root: Path, *,
                  progress: bool = False) -> None:
@@ -212,10 +217,16 @@ class EpisodeRunner:
             if out.ok:
                 self.nodes[Path(out.id)] = out.node
 
-        outcomes = executor.run(
-            partial(run_task_on, fn, FolderMark.of(self.root)),
-            [Task(str(tasks[i].output), tasks[i]) for i in todo],
-            progress=self.progress, desc="run-bench", on_result=arrived)
+        try:
+            outcomes = executor.run(
+                partial(run_task_on, fn, FolderMark.of(self.root)),
+                [Task(str(tasks[i].output), tasks[i]) for i in todo],
+                progress=self.progress, desc="run-bench", on_result=arrived)
+        except KeyboardInterrupt:  # workers killed outright (Ray) leave their partial logs
+            for i in todo:
+                if not tasks[i].output.exists():
+                    _remove_partials(tasks[i])
+            raise
         failed = failure_lines(outcomes)
         if failed:
             raise ExecutorError(f"{len(failed)} of {len(todo)} episode(s) failed; the first: "

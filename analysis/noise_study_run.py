@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from sgtool.analysis.noise_study import StudyConfig
@@ -63,7 +63,6 @@ def study_into(request: NoiseStudyRequest, show: Echo) -> None:
             cl = run_closed_loop(cfg, res.specs, out / "closed_loop",
                                  runner=EpisodeRunner(runner, out / "closed_loop",
                                                       progress=show_bars))
-            cl = _sources_in(cl, out, Path(request.out_dir))
             write_outputs(cl, out / "closed_loop")
             res = replace(res, closed_loop=cl)
         atomic_write(out / "summary.md", summary_md(res))
@@ -79,15 +78,4 @@ def study_into(request: NoiseStudyRequest, show: Echo) -> None:
          "plots/")
 
 
-def _sources_in(cl: Any, stage: Path, final: Path) -> Any:
-    """``cl`` with each episode's ``source`` (its log) named where the log will be once the
-    staging folder ``stage`` becomes ``final``, not in the folder that then is gone."""
-    rows = []
-    for row in cl.rows:
-        src = Path(row.result.source)
-        if src.is_relative_to(stage):
-            row = replace(row, result=replace(row.result,
-                                              source=str(final / src.relative_to(stage))))
-        rows.append(row)
-    return replace(cl, rows=tuple(rows))
 

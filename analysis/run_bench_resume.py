@@ -21,6 +21,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from sgtool.datasets.episodes import Episode
 from sgtool.errors import SgtoolError, SpecError
 from sgtool.house.spec import HouseSpec
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
@@ -34,6 +35,14 @@ _FIX = ("give a fresh -o folder, --force to run every episode again, or delete t
 
 class ResumeError(SgtoolError):
     """An episode log of the output folder was run with other settings or another house."""
+
+
+def episode_identity(ep: Episode) -> list[Any]:
+    """What tells an episode from another drawn under the same id (the draw depends on how
+    many episodes a house gets): id, query, targets, their rooms, the start room and pose
+    (as :func:`logged_settings` reads them from a log)."""
+    return [ep.id, ep.query, list(ep.targets), list(ep.target_rooms), ep.start.room,
+            [round(float(v), 4) for v in (ep.start.x, ep.start.y, ep.start.yaw)]]
 
 
 def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None,
@@ -85,7 +94,12 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
     cam = x.get("camera") or {}
     nav = x.get("navigation") or {}
     live = nav.get("mode") == "live"
-    ep = [x.get("episode_id"), started.query] if started is not None else None
+    ep = None
+    if started is not None:
+        pose = x.get("start_pose") or [None] * 3
+        ep = [x.get("episode_id"), started.query, list(x.get("targets") or []),
+              list(x.get("target_rooms") or []), x.get("start_room"),
+              [None if v is None else round(float(v), 4) for v in pose]]
     return ({"episode": ep,
              # logs from before the options were recorded: the planner's defaults
              "planner_options": x.get("planner_options", {}),

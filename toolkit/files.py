@@ -245,6 +245,13 @@ def leftover_stages(target: str | os.PathLike[str]) -> list[Path]:
                   and len(p.name) == len(head) + 8 + len(tail))
 
 
+def leftover_notes(target: str | os.PathLike[str]) -> list[str]:
+    """One note per :func:`leftover_stages` folder beside ``target``, for a command to
+    show after its run."""
+    return [f"sgtool: note: {stale} is the unfinished output of a run that was killed (or "
+            "one still running); remove it when none is" for stale in leftover_stages(target)]
+
+
 @contextlib.contextmanager
 def output_folder(target: str | os.PathLike[str], *, force: bool, command: str = "sgtool",
                   option: str = "-o", known: Sequence[str] = (),

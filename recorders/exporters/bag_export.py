@@ -60,7 +60,6 @@ from sgtool.log.reader import LogReader
 from sgtool.output_check import check_output
 from sgtool.recorders.exporters import ros_maps
 from sgtool.recorders.exporters.bagwriter import COMPRESSIONS, DISTROS, BagWriter
-from sgtool.recorders.importers.sink import IMPORT_METADATA
 
 FORMATS = {"ros1": "ros1", "ros2": "ros2-mcap"}
 DEFAULT_COMPRESSION = {"ros1": "lz4", "ros2": "zstd"}
@@ -212,7 +211,7 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
         records = {k.topic for k in S.RECORDS.values()}
         others = tuple(sorted(t for t in r.topics() if t not in OUTPUTS_ORDER
                               and t not in records and t != S.GRAPH_SCENE))
-        names = trajectory_frames(r.metadata.get(IMPORT_METADATA, {}),
+        names = trajectory_frames(r.metadata.get(S.IMPORT_METADATA_NAME, {}),
                                   frames if frames is not None else REP105)
 
         def writer(path: Path) -> BagWriter:

@@ -29,12 +29,13 @@ import numpy as np
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.records import Episode
+from sgtool.log.schemas import IMPORT_METADATA_NAME
 from sgtool.log.writer import LogWriter
 from sgtool.recorders.importers.images import ResizeLog
 from sgtool.recorders.importers.odometry import DriftReport, OdometryResult
 from sgtool.recorders.importers.upright import WorldAlignment
 
-IMPORT_METADATA = "sgtool.import"
+IMPORT_METADATA = IMPORT_METADATA_NAME
 
 
 @dataclass(frozen=True, eq=False)

@@ -33,8 +33,11 @@ def house_file(tmp_path_factory) -> Path:
 
 def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkeypatch) -> None:
     out = tmp_path / "rb"
+    stale = tmp_path / ".rb.k1ll3d00.partial"  # a killed --force run's staging folder
+    stale.mkdir()
     res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
     assert res.exit_code == 0, res.output
+    assert f"sgtool: note: {stale} is the unfinished output of a run" in res.output
     logs = sorted(p.relative_to(out).as_posix() for p in out.rglob("*.mcap"))
     assert logs == ["logs/none/greedy/small/ep-000.mcap",
                     "logs/none/random/small/ep-000.mcap"]
@@ -181,7 +184,8 @@ def test_run_bench_on_two_worker_processes_writes_the_same_logs(house_file, tmp_
         assert res.exit_code == 0, res.output
         recs = [json.loads(s) for s in (out / "episodes.jsonl").read_text().splitlines()]
         for r in recs:
-            r.pop("wall"), r.pop("source")  # wall clock; the log's own path
+            r.pop("wall")  # wall clock
+            assert (out / r["source"]).is_file() and not Path(r["source"]).is_absolute()
         logs = {p.relative_to(out).as_posix(): _messages(p) for p in out.rglob("*.mcap")}
         runs[name] = (recs, logs)
     assert runs["one"][0] == runs["two"][0] and len(runs["one"][0]) == 2

@@ -148,3 +148,23 @@ def test_a_log_of_other_frame_settings_is_not_resumed(tmp_path: Path) -> None:
             opts, live=dataclasses.replace(opts.live, explore_through=through + 1.0)),
             "none", ep)) \
         == [f"explore through (m): {through} in the log, {through + 1.0} now"]
+
+
+def test_an_episode_drawn_otherwise_under_the_same_id_is_not_resumed(tmp_path: Path) -> None:
+    """Which episodes a house gets depends on --episodes: house 1's ep-000 (4 rooms, the
+    default mix) has the same id and query for 1 and 2 episodes but another start. A folder
+    run with --episodes 1 does not lend that log to a run with --episodes 2: it is refused
+    in one line naming the log (it was reused, and the summary differed from a fresh run)."""
+    from sgtool.analysis.run_bench_resume import logged_settings
+
+    args = ["run-bench", "--planners", "random", "--houses", "1", "--house-seed", "1",
+            "--rooms", "4-4", "--preset", "default", "--resolution", "64x48",
+            "--max-steps", "2", "--frames", "60", "--no-progress", "-o", str(tmp_path / "rb")]
+    res = CliRunner().invoke(cli, [*args, "--episodes", "1"])
+    assert res.exit_code == 0, res.output
+    log = next((tmp_path / "rb" / "logs").rglob("ep-000.mcap"))
+    ep_id, query, targets, rooms, start_room, pose = logged_settings(log)[0]["episode"]
+    assert ep_id and query and targets and rooms and start_room and len(pose) == 3
+    res = CliRunner().invoke(cli, [*args, "--episodes", "2"])
+    assert res.exit_code != 0 and "ep-000.mcap was run with other settings" in res.output
+    assert "Traceback" not in res.output

@@ -91,8 +91,32 @@ def test_a_worker_that_does_not_see_the_folder_sends_its_log_back(
         assert _messages(away / rel) == _messages(here / rel)
     for a, b in zip(shipped.rows, direct.rows, strict=True):
         assert a.task.output == away / b.task.output.relative_to(here)
-        assert a.result.source == str(a.task.output)  # the folder's log, not the worker's
+        # the folder's log, relative to it (not the worker's)
+        assert away / a.result.source == a.task.output
         assert replace(a.result, wall={}, source="") == replace(b.result, wall={}, source="")
         assert (a.frames, a.failures) == (b.frames, b.failures)
     assert runner.nodes == {r.task.output: "" for r in shipped.rows}
     assert runner.sent == {r.task.output for r in shipped.rows}
+
+
+def test_ctrl_c_on_an_executor_removes_the_partial_logs_of_unfinished_tasks(tmp_path) -> None:
+    """A Ray worker cancelled by force cannot remove its partial log: on Ctrl-C the driver
+    removes those of the tasks not finished."""
+    from sgtool.analysis.closed_loop_bench import tasks_of
+
+    cfg = ClosedLoopBenchConfig(planners=("random",), houses=1, episodes=1,
+                                options=ClosedLoopOptions(max_steps=2))
+    (task,) = tasks_of(cfg, tmp_path / "logs")
+    task.output.parent.mkdir(parents=True)
+
+    class Killed:
+        """An executor whose worker was writing when Ctrl-C came."""
+
+        def run(self, fn, items, **kw):
+            (task.output.parent / f"{task.output.name}.abcd1234.partial").write_bytes(b"x")
+            raise KeyboardInterrupt
+
+    runner = EpisodeRunner(Killed(), tmp_path)  # type: ignore[arg-type]
+    with pytest.raises(KeyboardInterrupt):
+        runner(lambda t: t, [task])
+    assert not list(task.output.parent.glob("*.partial"))

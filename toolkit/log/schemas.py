@@ -35,6 +35,7 @@ from sgtool.vocabulary import (
 LOG_SCHEMA_VERSION: tuple[int, int] = (1, 2)
 PROFILE = "sgtool"
 METADATA_NAME = "sgtool"
+IMPORT_METADATA_NAME = "sgtool.import"  # where an import came from (sgtool import ...)
 HOUSE_ATTACHMENT = "house.json"
 
 WORLD_FRAME = "world"

@@ -1,7 +1,7 @@
 """Doors in the scene graph: the grid cells that say "doorway" to the room segmentation,
 and each seen door's rooms.
 
-- :func:`door_cells_of`: from the voxels of the open (or state-unknown) doors
+- :func:`doorways`: from the voxels of the open (or state-unknown) doors
   (:func:`open_doors`), the *passable* columns of each door -- its
   opening under the lintel, not the swung panel, whose cells would cut the room it stands
   in (when they are at least ``PASSABLE_SHARE`` of its columns: a panel smeared by depth
@@ -47,12 +47,6 @@ class DoorObservation:
 def open_doors(instances: Mapping[int, InstanceInfo]) -> list[int]:
     """The door instances that are open or of unknown state."""
     return [iid for iid, v in instances.items() if v.kind == "door" and v.state != "closed"]
-
-
-def door_cells_of(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
-                  panel_memo: dict[bytes, object]) -> np.ndarray:
-    """Bool grid of the door evidence (module doc): :func:`doorways`' cells."""
-    return doorways(occ, door_voxels, panel_memo)[0]
 
 
 def doorways(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],

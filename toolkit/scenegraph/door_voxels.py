@@ -1,6 +1,6 @@
 """The voxels of the door instances, kept up to date from the keys entering the voxel map.
 
-The door evidence of every refresh (:func:`sgtool.scenegraph.door_evidence.door_cells_of`)
+The door evidence of every refresh (:func:`sgtool.scenegraph.door_evidence.doorways`)
 needs each door's voxels; asking the map (:meth:`~sgtool.mapping.voxels.VoxelMap.voxels_of`)
 scans every (voxel, label) key of the house at every refresh. :class:`DoorVoxels` keeps
 the door keys instead: the builder hands it the keys new since the last refresh (the ones
