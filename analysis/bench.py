@@ -104,7 +104,7 @@ from sgtool.analysis.report import (
 )
 from sgtool.analysis.search_metrics import CostModel, breakdown, cost_models, seen_unseen, summarize
 from sgtool.canonical import strict_json
-from sgtool.files import atomic_write, output_folder
+from sgtool.files import atomic_write, output_dir, output_folder
 from sgtool.planning.episode import SUCCESS_RULES
 from sgtool.redact import redact_options, redact_text, secret_values
 from sgtool.results import EpisodeResult, results_digest, write_jsonl
@@ -132,7 +132,7 @@ class BenchConfig:
     :meth:`check` raises a one-line :class:`BenchError` for a setting that cannot work;
     :meth:`settings` are the ones that can change results (written to summary.json)."""
 
-    planners: tuple[str, ...] = DEFAULT_PLANNERS
+    planners: tuple[str, ...] | str = DEFAULT_PLANNERS  # a tuple once made (a name alone: one)
     houses: int = 10
     episodes: int = 20  # per house
     seeds: int = 5
@@ -145,7 +145,7 @@ class BenchConfig:
     step_budget: float = 50.0  # MoMa-LLM high-level budget
     planner_options: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     log_dir: str | None = None  # also record every episode as an MCAP log here
-    house_files: tuple[str, ...] = ()  # house spec files or folders, after the generated
+    house_files: tuple[str, ...] | str = ()  # house spec files or folders, after the generated
     priors_dir: str | None = None  # relational priors (vocabulary, scout weights)
     success: str = "observed"  # success rule: observed | done (sgtool.planning.episode)
     executor: str = "local"  # local | ray (sgtool.analysis.executor)
@@ -472,8 +472,7 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
     so that the set appears complete."""
     from sgtool.analysis.curves import plot_efficiency
 
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_dir(out_dir)
     cfg = res.config
     paths = [write_jsonl(res.results, out / "episodes.jsonl")]
     by_planner = [(p, [r for r in res.results if r.planner == p]) for p in cfg.planners]

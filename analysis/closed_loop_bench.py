@@ -68,7 +68,8 @@ from sgtool.analysis.run_bench_resume import (
 from sgtool.analysis.search_metrics import CostModel, cost_models, summarize
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
-from sgtool.files import atomic_write
+from sgtool.extras import require
+from sgtool.files import atomic_write, output_dir
 from sgtool.llm.stats import answer_counts
 from sgtool.log.writer import partial_files
 from sgtool.progress import Progress
@@ -119,14 +120,14 @@ class ClosedLoopBenchConfig:
     name, a house file or a noise profile given alone is a list of one; :meth:`check` says
     in one line what cannot work."""
 
-    planners: tuple[str, ...]
+    planners: tuple[str, ...] | str  # a tuple once made (a name alone: a list of one)
     houses: int = 5  # generated houses, seeds house_seed, +1, ...
     house_seed: int = 0
-    house_files: tuple[str, ...] = ()
+    house_files: tuple[str, ...] | str = ()
     episodes: int = 6  # per house
     rooms: tuple[int, int] = (12, 16)
     preset: str = "symsearch"
-    noise: tuple[str, ...] = ("none",)  # noise profiles (`sgtool record --noise` syntax)
+    noise: tuple[str, ...] | str = ("none",)  # noise profiles (`sgtool record --noise` syntax)
     options: ClosedLoopOptions = field(default_factory=ClosedLoopOptions)
     planner_options: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     frames_per_room: int | None = None  # frame budget per room (excludes options.frames)
@@ -482,7 +483,9 @@ def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
     run nothing, read back the episodes whose logs are there (a run in progress, cut
     short)."""
     cfg.check()
-    logs = Path(out_dir) / "logs"
+    if not report_only:  # one line on a core install, before any folder is made
+        require("pybullet", api="sgtool.run_closed_loop_bench")
+    logs = (Path(out_dir) if report_only else output_dir(out_dir)) / "logs"
     tasks = tasks_of(cfg, logs)
     if report_only:
         tasks = [t for t in tasks if t.output.exists()]
@@ -525,8 +528,7 @@ def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]
     ``out_dir``."""
     from sgtool.analysis.curves import plot_efficiency
 
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_dir(out_dir)
     cfg = res.config
     paths = [write_jsonl(res.results(), out / "episodes.jsonl")]
     for noise in cfg.noise:

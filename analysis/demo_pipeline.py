@@ -78,13 +78,19 @@ def run_demo(request: DemoRequest, show: Echo, progress: bool,
              write_view: Callable[[Path, Path, bool], None]) -> None:
     """Run the demo into ``request.out``: ``demo.mcap``, ``derived.mcap``, ``view.rrd``
     (made by ``write_view(derived, rrd, progress)``; left out, with a note, when Rerun is
-    not installed) and ``bench/``."""
+    not installed) and ``bench/``. A previous demo's outputs there go first, so that a run
+    cut short leaves its own outputs only (each written whole), not a mix of two runs."""
     import importlib.util
 
-    from sgtool.analysis.bench import run_bench
+    from sgtool.analysis.bench import OUTPUT_NAMES, run_bench
+    from sgtool.files import sgtool_entries
 
     out = request.out
     log, derived, rrd = out / "demo.mcap", out / "derived.mcap", out / "view.rrd"
+    for old in (log, derived, rrd, *(out / "bench" / n for n in sgtool_entries(
+            out / "bench", OUTPUT_NAMES))):  # the bench's own files (a user's stay)
+        if not old.is_dir():
+            old.unlink(missing_ok=True)
     frames = _record(request, log, show, progress)
     show(f"\n== sgtool replay {log} -o {derived} --rrd {rrd} --score")
     _replay(log, derived, frames, show, progress)

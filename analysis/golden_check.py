@@ -34,7 +34,13 @@ from typing import Any, Literal
 
 from sgtool.analysis.executor import Executor, LocalExecutor, Task
 from sgtool.errors import SgtoolError
-from sgtool.files import atomic_output, output_folder, quoted, read_manifest
+from sgtool.files import (
+    atomic_output,
+    deferred_interrupts,
+    output_folder,
+    quoted,
+    read_manifest,
+)
 from sgtool.replayers.derived_log import ReplayOptions
 from sgtool.replayers.golden import describe_mismatch, quality_lines, sha256_file
 from sgtool.replayers.golden_pins import (
@@ -197,7 +203,8 @@ def pin_logs(logs: Sequence[str | Path] | str | Path, folder: str | Path,
         raise SgtoolError(f"{empty[0]}: its replay mapped no camera frame (no depth "
                           "image?): a pin of it would check nothing")
     logs_now = dict(old)
-    with pin_folder(root) as out:
+    with pin_folder(root) as out, \
+            deferred_interrupts() if out == root else contextlib.nullcontext():
         staged = PinSet(out, logs_now, sgtool_version=__version__)
         for p, name, o in zip(paths, names, outcomes, strict=True):
             stored = stored_path(p, root)
@@ -393,7 +400,8 @@ def update_pins(report: CheckReport) -> list[str]:
     changed = [c for c in report.logs if c.status == "changed" and c.capture is not None]
     if not changed:
         return []
-    with pin_folder(pins.folder) as out:
+    with pin_folder(pins.folder) as out, \
+            deferred_interrupts() if out == pins.folder else contextlib.nullcontext():
         staged = PinSet(out, pins.logs, sgtool_version=__version__)
         for c in changed:
             assert c.capture is not None

@@ -154,8 +154,10 @@ class RecordingSettings:
     def check(self) -> None:
         if self.width < 16 or self.height < 16:
             raise SgtoolError(f"--resolution {self.width}x{self.height}: at least 16x16")
-        if not (math.isfinite(self.fps) and self.fps > 0):
-            raise SgtoolError(f"--fps {self.fps}: must be > 0")
+        from sgtool.recorders.sim.simulation import FPS_RANGE
+
+        if not (math.isfinite(self.fps) and FPS_RANGE[0] <= self.fps <= FPS_RANGE[1]):
+            raise SgtoolError(f"--fps {self.fps}: must be {FPS_RANGE[0]:g}..{FPS_RANGE[1]:g}")
         if self.frames is not None and self.frames < 1:
             raise SgtoolError(f"--frames {self.frames}: must be >= 1")
 

@@ -72,8 +72,10 @@ def write_rerun(log: str | os.PathLike[str], output: str | os.PathLike[str], *,
     line. Returns the path written."""
     from sgtool.analysis.rerun_view import export
     from sgtool.errors import SgtoolError
+    from sgtool.extras import require
     from sgtool.output_check import check_output
 
+    require("rerun", api="sgtool.write_rerun")  # one line on a core install
     if every < 1 or (max_frames is not None and max_frames < 1):
         raise SgtoolError(f"every={every}, max_frames={max_frames}: each must be >= 1")
     if Path(output).resolve() == Path(log).resolve():

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sgtool.datasets.footprint_reach import Window, full_mask, near_footprint
+from sgtool.errors import SgtoolError
 from sgtool.house.spec import (
     Furniture,
     HouseSpec,
@@ -115,6 +116,10 @@ class EpisodeGeometry:
 
     def __init__(self, spec: HouseSpec, reach: float = REACH, resolution: float = 0.05,
                  robot_radius: float = 0.2):
+        if reach < robot_radius + 2 * resolution - 1e-9:
+            raise SgtoolError(f"reach {reach:g} m: at least {robot_radius + 2 * resolution:g} m "
+                              f"(the robot's centre stays {robot_radius:g} m from furniture, "
+                              "so nothing nearer is reached)")
         self.spec = spec
         self.reach = reach
         self.occ = house_occupancy(spec, resolution=resolution, robot_radius=robot_radius,

@@ -53,6 +53,7 @@ def main() -> None:
         planner_options={MINE: {"max_failures": args.max_failures}})
     result = sgtool.run_benchmark(config, progress=False)
     print(result.results_table)
+    print(result.interval_tables())  # SR/SPL intervals over houses, paired comparisons
     if args.out:
         sgtool.write_bench_outputs(result, args.out)
         print(f"wrote {args.out}/summary.md and the other outputs")

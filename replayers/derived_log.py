@@ -102,6 +102,11 @@ def resolve_options_measured(reader: LogReader, options: ReplayOptions
     to map to, unless given or recorded (a live map's log records its own), is lowered to
     where the log's depth noise reaches the floor tolerance
     (:func:`~sgtool.replayers.depth_range.first_frames`, returned with the options)."""
+    if options.max_frames is not None and options.max_frames < 1:
+        raise SgtoolError(f"max frames {options.max_frames}: must be >= 1")
+    if options.tf_time not in ("log", "stamp"):
+        raise SgtoolError(f"tf time {options.tf_time!r}: \"log\" (pair /tf with frames by "
+                          "log time) or \"stamp\" (by header stamp)")
     recorded: dict[str, Any] = {}
     found = False
     for _, rec in reader.records(Episode):
@@ -120,7 +125,7 @@ def resolve_options_measured(reader: LogReader, options: ReplayOptions
     vs = options.voxel_size if options.voxel_size is not None else float(
         recorded.get("voxel_size", VoxelConfig().resolution))
     if every < 1:
-        raise SgtoolError(f"--every {every}: must be >= 1")
+        raise SgtoolError(f"every {every} (--every): must be >= 1")
     if not 0.01 <= vs <= 0.5:
         raise SgtoolError(f"voxel size {vs} m: must be 0.01..0.5")
     if int(mp) < 1:

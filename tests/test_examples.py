@@ -32,12 +32,13 @@ def run(script: str, *args: str | Path, cwd: Path = REPO) -> str:
 
 
 def table_rows(text: str) -> dict[str, list[str]]:
-    """Markdown table rows of ``text``: first cell -> the other cells."""
-    rows = {}
+    """Markdown table rows of ``text``: first cell -> the other cells (of its first row:
+    the results table, not the interval tables after it)."""
+    rows: dict[str, list[str]] = {}
     for line in text.splitlines():
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
         if line.startswith("|") and not set(cells[0]) <= {"-"}:
-            rows[cells[0]] = cells[1:]
+            rows.setdefault(cells[0], cells[1:])
     return rows
 
 
@@ -134,6 +135,7 @@ def test_benchmark_my_planner_rows_beside_scout(tmp_path: Path) -> None:
     assert len(mine) == 6 and len(results) == 12
     assert rows["my_planner:MyPlanner"][0] == f"{sgtool.success_rate(mine):.3f} ± -"
     assert "my_planner:MyPlanner" in (tmp_path / "bench" / "summary.md").read_text()
+    assert "Paired comparisons on the same episodes" in out  # and the intervals
 
 
 def test_my_planner_script_runs_one_episode() -> None:

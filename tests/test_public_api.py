@@ -139,6 +139,37 @@ def test_a_name_whose_extra_is_missing_is_one_line(monkeypatch: pytest.MonkeyPat
     assert "probe_sim" not in vars(sgtool) and "probe_bug" not in vars(sgtool)
 
 
+def test_a_call_whose_extra_is_missing_is_one_line(monkeypatch: pytest.MonkeyPatch,
+                                                    tmp_path) -> None:
+    """Public functions whose stage imports an extra on call (the closed loop, the Rerun
+    view, an RGB-D import) say which, in one SgtoolError line naming the function, before
+    they write anything; their types and options still load (a core install's
+    ``from sgtool import *`` works)."""
+    for module in ("pybullet", "rerun", "cv2"):
+        monkeypatch.setitem(sys.modules, module, None)
+    house = sgtool.generate_house(0, rooms=(4, 4))
+    _, episode = sgtool.pick_episode(house)
+    calls = {
+        "sgtool.run_closed_loop needs PyBullet": lambda: sgtool.run_closed_loop(
+            house, episode, sgtool.make_planner("greedy"), tmp_path / "ep.mcap"),
+        "sgtool.run_closed_loop_bench needs PyBullet": lambda: sgtool.run_closed_loop_bench(
+            sgtool.ClosedLoopBenchConfig(planners=("random",), houses=1, episodes=1),
+            tmp_path / "rb"),
+        "sgtool.write_rerun needs Rerun": lambda: sgtool.write_rerun(
+            tmp_path / "a.mcap", tmp_path / "a.rrd"),
+        "sgtool.import_rgbd needs OpenCV": lambda: sgtool.import_rgbd(
+            tmp_path, tmp_path / "b.mcap", sgtool.RgbdOptions()),
+    }
+    for said, call in calls.items():
+        with pytest.raises(sgtool.SgtoolError) as e:
+            call()
+        assert str(e.value).startswith(said + ": pip install"), str(e.value)
+    assert not list(tmp_path.iterdir())
+    namespace: dict[str, object] = {}
+    exec("from sgtool import *", namespace)  # noqa: S102
+    assert "RgbdOptions" in namespace and "ImportReport" in namespace
+
+
 def test_version_is_one_string() -> None:
     from sgtool.version import __version__
 

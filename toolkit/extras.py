@@ -75,22 +75,23 @@ def missing_extra(who: str, error: ModuleNotFoundError) -> MissingExtraError | N
     return MissingExtraError(missing_message(who, top))
 
 
-def require(module: str, who: str | None = None) -> ModuleType:
+def require(module: str, who: str | None = None, *, api: str = "sgtool") -> ModuleType:
     """Import ``module`` (whose top-level package is in :data:`OPTIONAL`), or raise
     :class:`MissingExtraError` naming ``who`` (a command or a feature; by default the running
-    ``sgtool`` command, else ``sgtool``) and the command that installs it."""
+    ``sgtool`` command, else ``api``: the public function called, ``sgtool.write_rerun``)
+    and the command that installs it."""
     try:
         return importlib.import_module(module)
     except ModuleNotFoundError as e:
-        err = missing_extra(who or _running_command(), e)
+        err = missing_extra(who or _running_command(api), e)
         if err is None:
             raise
         raise err from None
 
 
-def _running_command() -> str:
-    """``sgtool replay`` while the CLI runs a command in this thread, else ``sgtool``."""
+def _running_command(default: str = "sgtool") -> str:
+    """``sgtool replay`` while the CLI runs a command in this thread, else ``default``."""
     import click
 
     ctx = click.get_current_context(silent=True)
-    return ctx.command_path if ctx is not None and ctx.command_path else "sgtool"
+    return ctx.command_path if ctx is not None and ctx.command_path else default

@@ -28,7 +28,9 @@ import json
 import os
 import shlex
 import shutil
+import signal
 import tempfile
+import threading
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import IO
@@ -223,6 +225,19 @@ def _is_own(folder: Path, command: str, known: Sequence[str]) -> bool:
     return all(_matches(n, known) for n in present)
 
 
+def output_dir(path: str | os.PathLike[str]) -> Path:
+    """The folder ``path``, made (with its parents) when missing; a file there, or on the
+    way, or a folder that cannot be made is one :class:`OutputError` line."""
+    out = Path(path)
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"cannot write into {path}: it is a file, not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise output_error(e, out) from None
+    return out
+
+
 def _folder_target(target: str | os.PathLike[str], option: str) -> Path:
     path = Path(os.path.abspath(target))  # "." has a name and a parent to build beside
     if path.is_symlink() and path.is_dir():  # a link to a folder: the folder is the target
@@ -243,6 +258,28 @@ def leftover_stages(target: str | os.PathLike[str]) -> list[Path]:
     return sorted(p for p in path.parent.iterdir()
                   if p.name.startswith(head) and p.name.endswith(tail) and p.is_dir()
                   and len(p.name) == len(head) + 8 + len(tail))
+
+
+@contextlib.contextmanager
+def deferred_interrupts() -> Iterator[None]:
+    """Ctrl-C (and SIGTERM) during the block take effect when it ends: for a commit of
+    files that must change together (a pin folder's graphs and its index), which an
+    interrupt between two of them would leave out of step. Outside the main thread (no
+    signal handlers there) the block runs as it is."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    got: list[int] = []
+    old = {int(s): signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    for s in old:
+        signal.signal(s, lambda signum, _frame: got.append(signum))
+    try:
+        yield
+    finally:
+        for s, handler in old.items():
+            signal.signal(s, handler)
+    if got and callable(handler := old[got[0]]):  # Python's Ctrl-C handler raises
+        handler(got[0], None)
 
 
 def leftover_notes(target: str | os.PathLike[str]) -> list[str]:

@@ -44,6 +44,13 @@ class PoseSource:
         return self.tree.lookup(self.world, camera or self.camera, t_ns)
 
 
+def _links(tree: TfTree, most: int = 12) -> str:
+    """The tree's links on one line (the first ``most``, then how many more)."""
+    links = tree.describe()
+    more = f"; and {len(links) - most} more" if len(links) > most else ""
+    return "; ".join(links[:most]) + more
+
+
 def pose_source_of(path: Path, idx: BagIndex, opts: BagOptions) -> PoseSource:
     if opts.pose is not None:
         if not idx.pose_samples:
@@ -80,12 +87,12 @@ def pose_source_of(path: Path, idx: BagIndex, opts: BagOptions) -> PoseSource:
     for f in (world, camera):
         if f not in tree.frames():
             raise SgtoolError(
-                f"{path}: --tf-frames: frame {f!r} is not in the tf tree; its links are:\n  "
-                + "\n  ".join(tree.describe())
+                f"{path}: --tf-frames: frame {f!r} is not in the tf tree; its links: "
+                + _links(tree)
             )
     if tree.path(world, camera) is None:
         raise SgtoolError(
             f"{path}: frames {world!r} and {camera!r} are not connected in the tf tree "
-            f"(roots: {', '.join(tree.roots())}); links:\n  " + "\n  ".join(tree.describe())
+            f"(roots: {', '.join(tree.roots())}); links: " + _links(tree)
         )
     return PoseSource(world, camera, f"tf {world} -> {camera}", tree=tree)

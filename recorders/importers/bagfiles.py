@@ -95,7 +95,7 @@ def _check_mcap_profile(path: Path) -> None:
 @contextlib.contextmanager
 def open_bag(path: str | Path) -> Iterator[Any]:
     """An open ``rosbags`` AnyReader over the bag at ``path`` (see the module docstring)."""
-    from rosbags.highlevel import AnyReader, AnyReaderError
+    from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
 
     path = Path(path)
@@ -118,10 +118,10 @@ def open_bag(path: str | Path) -> Iterator[Any]:
         try:
             reader = AnyReader([target], default_typestore=get_typestore(Stores.LATEST))
             stack.enter_context(reader)
-        except (AnyReaderError, FileNotFoundError, ValueError, KeyError) as e:
-            raise SgtoolError(f"{path}: not a readable ROS bag ({type(e).__name__}: {e})") from e
         except Exception as e:  # the bag readers raise assorted errors on garbage
-            raise SgtoolError(f"{path}: not a readable ROS bag ({type(e).__name__}: {e})") from e
+            first = (str(e).strip().splitlines() or [""])[0][:200]  # one line (YAML's are many)
+            raise SgtoolError(f"{path}: not a readable ROS bag ({type(e).__name__}: {first})"
+                              ) from e
         try:
             yield reader
         except Exception as e:

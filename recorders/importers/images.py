@@ -17,15 +17,22 @@ import struct
 from pathlib import Path
 from typing import Any
 
-import cv2
 import numpy as np
 
 from sgtool.errors import SgtoolError
+from sgtool.extras import require
 
 INVALID_U16 = 65535
 
 
+def _cv2() -> Any:
+    """OpenCV, imported on first use: the module's types (the options and reports of an
+    import) load on a core install; decoding an image needs the ``import`` extra."""
+    return require("cv2")
+
+
 def _read_image(path: Path) -> np.ndarray:
+    cv2 = _cv2()
     if not Path(path).is_file():
         raise SgtoolError(f"{path}: no such image file")
     # decoded from the bytes: cv2.imread takes the name as UTF-8 text and crashes on a
@@ -122,6 +129,7 @@ def read_depth_file(path: Path) -> np.ndarray:
 
 
 def _to_rgb(a: np.ndarray, what: str) -> np.ndarray:
+    cv2 = _cv2()
     if a.dtype == np.uint16:
         a = (a >> 8).astype(np.uint8)
     if a.dtype != np.uint8:
@@ -172,11 +180,11 @@ _RAW = {
 }
 # OpenCV names a Bayer pattern by the second row's second and third pixels: ROS's
 # bayer_rggb is OpenCV's BayerBG (as cv_bridge maps them)
-_BAYER = {"rggb": cv2.COLOR_BayerBG2RGB, "bggr": cv2.COLOR_BayerRG2RGB,
-          "gbrg": cv2.COLOR_BayerGR2RGB, "grbg": cv2.COLOR_BayerGB2RGB}
+_BAYER = {"rggb": "COLOR_BayerBG2RGB", "bggr": "COLOR_BayerRG2RGB",
+          "gbrg": "COLOR_BayerGR2RGB", "grbg": "COLOR_BayerGB2RGB"}  # OpenCV's names
 # ROS's "yuv422" is UYVY (cv_bridge); "yuv422_yuy2" is YUYV
-_YUV = {"yuv422": cv2.COLOR_YUV2RGB_UYVY, "uyvy": cv2.COLOR_YUV2RGB_UYVY,
-        "yuv422_yuy2": cv2.COLOR_YUV2RGB_YUY2, "yuyv": cv2.COLOR_YUV2RGB_YUY2}
+_YUV = {"yuv422": "COLOR_YUV2RGB_UYVY", "uyvy": "COLOR_YUV2RGB_UYVY",
+        "yuv422_yuy2": "COLOR_YUV2RGB_YUY2", "yuyv": "COLOR_YUV2RGB_YUY2"}
 COLOUR_ENCODINGS = ("rgb8", "bgr8", "rgba8", "bgra8", "mono8", "8UC1", "8UC3", "mono16",
                     *(e for e in _RAW if e.startswith("bayer_")), *_YUV)
 DEPTH_ENCODINGS = ("16UC1", "mono16", "32FC1")
@@ -230,7 +238,8 @@ def _convert(a: np.ndarray, enc: str, topic: str) -> np.ndarray:
     if enc in _YUV and a.shape[1] % 2:
         raise SgtoolError(f"topic {topic}: a {enc} image needs an even width (two pixels "
                           f"share U and V); this one is {a.shape[1]} pixels wide")
-    code = _YUV[enc] if enc in _YUV else _BAYER[enc[6:10]]
+    cv2 = _cv2()
+    code = getattr(cv2, _YUV[enc] if enc in _YUV else _BAYER[enc[6:10]])
     try:
         rgb: np.ndarray = cv2.cvtColor(np.ascontiguousarray(a), code)
     except cv2.error as e:
@@ -242,6 +251,7 @@ def _convert(a: np.ndarray, enc: str, topic: str) -> np.ndarray:
 
 def decode_color_message(msg: Any, msgtype: str, topic: str) -> np.ndarray:
     """``Image`` or ``CompressedImage`` -> (H, W, 3) uint8 RGB."""
+    cv2 = _cv2()
     if msgtype.endswith("CompressedImage"):
         a = cv2.imdecode(np.asarray(msg.data, dtype=np.uint8), cv2.IMREAD_UNCHANGED)
         if a is None:
@@ -254,6 +264,7 @@ def decode_color_message(msg: Any, msgtype: str, topic: str) -> np.ndarray:
 def decode_depth_message(msg: Any, msgtype: str, topic: str) -> tuple[np.ndarray, float]:
     """``Image`` (16UC1/mono16 millimetres, 32FC1 metres) or ``CompressedImage`` (PNG, or
     image_transport's ``compressedDepth``) -> (raw array, units per metre)."""
+    cv2 = _cv2()
     if msgtype.endswith("CompressedImage"):
         fmt = str(msg.format)
         data = bytes(np.asarray(msg.data, dtype=np.uint8).tobytes())
@@ -280,6 +291,7 @@ def _decode_compressed_depth(data: bytes, fmt: str, topic: str) -> tuple[np.ndar
     """image_transport ``compressedDepth``: a 12-byte header (int32 format, float
     depthQuantA, float depthQuantB) then a PNG. 16UC1 stores millimetres; 32FC1 stores
     quantised inverse depth, depth = A / (v - B) for v != 0."""
+    cv2 = _cv2()
     if len(data) < 12:
         raise SgtoolError(f"topic {topic}: compressedDepth message shorter than its header")
     _, qa, qb = struct.unpack("<iff", data[:12])
@@ -323,6 +335,7 @@ def _decode_rvl_payload(payload: bytes, topic: str) -> np.ndarray:
 
 def decode_ids_message(msg: Any, msgtype: str, topic: str) -> np.ndarray:
     """Instance-id image (8/16/32-bit integer) -> int32."""
+    cv2 = _cv2()
     if msgtype.endswith("CompressedImage"):
         a = cv2.imdecode(np.asarray(msg.data, dtype=np.uint8), cv2.IMREAD_UNCHANGED)
         if a is None or a.ndim != 2:
@@ -367,6 +380,7 @@ def resize_to(a: np.ndarray, width: int, height: int, what: str = "a colour or i
     another aspect ratio (640x360 colour for 640x480 depth) would no longer be registered to
     the depth when stretched: a user error naming ``what``. Each resize is counted in
     ``log`` under ``stream``."""
+    cv2 = _cv2()
     if a.shape[1] == width and a.shape[0] == height:
         return a
     if abs(a.shape[1] * height / (a.shape[0] * width) - 1.0) > ASPECT_TOL:

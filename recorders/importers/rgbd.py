@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from sgtool.errors import SgtoolError
+from sgtool.extras import require
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.recorders.importers.checks import (
     FPS_RANGE,
@@ -265,6 +266,7 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     """Import the RGB-D folder ``root`` into the log ``out`` (module doc) and return what
     was written; options and the folder's files are checked before any work, each problem
     a one-line :class:`~sgtool.errors.SgtoolError`."""
+    require("cv2", api="sgtool.import_rgbd")  # before any work
     opts = opts or RgbdOptions()
     root, out = Path(root), Path(out)
     check_options(opts)

@@ -94,6 +94,7 @@ from sgtool.canonical import canonical_float
 from sgtool.datasets.episodes import Episode, list_episodes
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
+from sgtool.extras import require
 from sgtool.house.spec import HouseSpec
 from sgtool.llm.stats import answer_counts
 from sgtool.log.records import Episode as LoggedEpisode
@@ -471,6 +472,7 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
     decision. ``progress`` is anything with ``update(n)`` (a tqdm bar), advanced per
     frame; ``on_decision`` sees every graph and the action chosen on it.
     """
+    require("pybullet", api="sgtool.run_closed_loop")  # one line on a core install
     opts = options or ClosedLoopOptions()
     recorded = {"planner_options": recorded_options(planner_options)} if planner_options \
         else {}

@@ -62,6 +62,9 @@ __all__ = ["LIGHT_DIRECTION", "SimObserver", "Simulation", "SkillOutcome", "Stop
 LIGHT_DIRECTION = (0.4, 0.25, 1.0)
 
 
+FPS_RANGE = (0.1, 1000.0)  # frames per second of log time a simulation runs at
+
+
 class Simulation(Skills):
     """A house in PyBullet with a kinematic camera robot. Use as a context manager or call
     :meth:`disconnect` when done (each instance owns one PyBullet DIRECT client)."""
@@ -69,8 +72,8 @@ class Simulation(Skills):
     def __init__(self, house: HouseSpec, *, camera: CameraConfig | None = None,
                  robot: RobotConfig | None = None, fps: float = 10.0,
                  start: int | Pose2 | StartPose = 0, cull: bool = True) -> None:
-        if not 0.1 <= fps <= 1000:
-            raise SgtoolError(f"fps {fps}: must be 0.1..1000")
+        if not FPS_RANGE[0] <= fps <= FPS_RANGE[1]:
+            raise SgtoolError(f"fps {fps}: must be {FPS_RANGE[0]:g}..{FPS_RANGE[1]:g}")
         self.spec = house
         self.camera = camera or CameraConfig()
         self.robot = robot or RobotConfig()

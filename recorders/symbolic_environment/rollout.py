@@ -155,11 +155,13 @@ def run_one(house: HouseSpec | SymbolicHouse, planner: Planner | str, query: str
     outside the target rooms, as the benchmark does; a region id fixes it; a
     :class:`~sgtool.house.spec.StartPose` (e.g. from
     :func:`sgtool.datasets.start_poses.start_poses`) starts in the region of its room
-    nearest to it. Raises :class:`RunOneError` for a query with no instance in the house
-    or a start that is not in it.
+    nearest to it. Raises :class:`RunOneError` for a query with no instance in the house,
+    a start that is not in it, or ``max_steps`` below 1.
     """
     from sgtool.planning.registry import make_planner
 
+    if max_steps < 1:
+        raise RunOneError(f"max_steps {max_steps}: must be >= 1")
     h = house if isinstance(house, SymbolicHouse) else SymbolicHouse(house)
     spec = h.spec
     text = category_text(query)

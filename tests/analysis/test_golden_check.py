@@ -149,6 +149,31 @@ def test_a_moved_log_is_one_line_naming_it(log, tmp_path, capsys):
     assert "small: error:" in out
 
 
+def test_ctrl_c_while_update_writes_leaves_the_pin_folder_whole(pinned, capsys,
+                                                                 monkeypatch):
+    """Ctrl-C arriving after a graph file is rewritten and before the index (the moment
+    that left them out of step): the update finishes its files first, then stops, so the
+    folder checks against its index."""
+    import os
+    import signal
+
+    import sgtool.analysis.golden_check as gc
+
+    real = gc.write_capture
+
+    def interrupted(*args, **kwargs):
+        real(*args, **kwargs)
+        os.kill(os.getpid(), signal.SIGINT)
+
+    monkeypatch.setattr(gc, "write_capture", interrupted)
+    code, _, _ = sgtool(capsys, "golden", "check", "--dir", pinned, "--update",
+                        "--voxel-size", "0.08")
+    assert code == 130
+    monkeypatch.undo()
+    code, out, err = sgtool(capsys, "golden", "check", "--dir", pinned, "--voxel-size", "0.08")
+    assert code == 0, out + err
+
+
 def test_a_changed_log_is_refused(pinned, capsys):
     p = pinned / "small.mcap"
     data = bytearray(p.read_bytes())

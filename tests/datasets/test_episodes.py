@@ -10,6 +10,7 @@ import pytest
 from support.datasets_fixtures import two_rooms, walled_off
 from support.path_lengths import path_length
 
+import sgtool
 import sgtool.datasets as ds
 from sgtool.datasets.episodes import EpisodeGeometry, list_episodes
 from sgtool.house.io import load_house
@@ -140,3 +141,14 @@ def test_a_furniture_target_no_start_reaches_is_searched_from_inside() -> None:
     eps = {e.query: e for e in furniture_episodes(house, 4, seed=0)}
     assert eps["table"].start.room == "room_1" and math.isfinite(eps["table"].shortest_path)
     assert all(math.isfinite(e.shortest_path) for e in eps.values())
+
+
+def test_a_reach_the_robot_cannot_stand_within_is_refused() -> None:
+    """The robot's centre stays 0.2 m from furniture: a reach under 0.3 m made every
+    episode unreachable without a word; it is one line now."""
+    from sgtool.errors import SgtoolError
+
+    spec = sgtool.generate_house(3, rooms=(4, 4))
+    with pytest.raises(SgtoolError, match="reach 0.2 m: at least 0.3 m"):
+        list_episodes(spec, 2, reach=0.2)
+    assert all(math.isfinite(e.shortest_path) for e in list_episodes(spec, 3, reach=0.3))

@@ -213,3 +213,23 @@ def test_the_current_folder_is_built_beside_it(tmp_path: Path,
         _write(stage, **{"a.txt": "1"})
     assert sorted(os.listdir(out)) == [MANIFEST, "a.txt", "mine.txt"]
     assert os.listdir(tmp_path) == ["res"]
+
+
+def test_deferred_interrupts_hold_ctrl_c_until_the_block_ends() -> None:
+    """A Ctrl-C inside the block lets the block finish (every file of a commit written),
+    then raises as usual; without one nothing is raised, and the handlers are restored."""
+    import os
+    import signal
+
+    from sgtool.files import deferred_interrupts
+
+    before = signal.getsignal(signal.SIGINT)
+    done = []
+    with pytest.raises(KeyboardInterrupt):
+        with deferred_interrupts():
+            os.kill(os.getpid(), signal.SIGINT)
+            done.append("after the signal")
+    assert done == ["after the signal"]
+    with deferred_interrupts():
+        done.append("quiet")
+    assert signal.getsignal(signal.SIGINT) is before

@@ -107,6 +107,9 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
     if llm_slice is not None and source != "llm":
         raise SgtoolError("--llm-slice is for --source llm")
     if report_only:
+        if out_dir is not None:
+            raise SgtoolError(f"--report trains nothing, so --out {out_dir} has nothing to "
+                              "go there; to report on weights give --weights DIR")
         rep = weights_report(weights_dir or _weights_dir())
         click.echo(json.dumps(rep, indent=1, sort_keys=True) if as_json else format_report(rep))
         return

@@ -243,8 +243,10 @@ def _request(args: RunArgs, out: Path) -> SearchRequest:
     frame_budget(args.frames, args.frames_per_room, 1)  # both given: before the house
     if args.query is not None and args.episode is not None:
         raise SgtoolError("give either --query or --episode, not both")
-    if not 0.1 <= args.fps <= 1000:
-        raise SgtoolError(f"--fps {args.fps}: must be 0.1..1000")
+    from sgtool.recorders.sim.simulation import FPS_RANGE
+
+    if not FPS_RANGE[0] <= args.fps <= FPS_RANGE[1]:
+        raise SgtoolError(f"--fps {args.fps}: must be {FPS_RANGE[0]:g}..{FPS_RANGE[1]:g}")
     name, options = _planner(args)
     width, height = parse_resolution(args.resolution)
     house, house_id = house_from_options(args.house_path, args.seed, args.rooms)

@@ -120,8 +120,8 @@ def show_cmd(house: str, output: str | None, dpi: int, no_objects: bool, force: 
 
 
 @command.command("stats")
-@click.option("-n", "--houses", type=click.IntRange(min=1), default=20, show_default=True,
-              help="Number of houses to generate (seeds SEED .. SEED+N-1).")
+@click.option("-n", "--houses", type=click.IntRange(min=1, max=1_000_000), default=20,
+              show_default=True, help="Number of houses to generate (seeds SEED .. SEED+N-1).")
 @click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
               help="First seed.")
 @_rooms_option
@@ -196,8 +196,9 @@ def _episodes(spec: Any, count: int | None, seed: int, reach: float, preset: str
 @click.option("--seed", type=click.IntRange(min=0), default=None,
               help="Seed of the choice of categories and start poses [default: the house "
               "file's seed, the one `sgtool bench` and `run-bench` draw with].")
-@click.option("--reach", type=FiniteFloatRange(min=0.1), default=1.0, show_default=True,
-              help="A target counts as reached within this distance (m) of its parent.")
+@click.option("--reach", type=FiniteFloatRange(min=0.3), default=1.0, show_default=True,
+              help="A target counts as reached within this distance (m) of its parent (at "
+              "least 0.3: the robot's centre stays 0.2 m from furniture).")
 @_preset_option
 @click.option("--json", "as_json", is_flag=True, help="Print JSON (one list).")
 def episodes_cmd(house: str, count: int | None, seed: int | None, reach: float, preset: str,

@@ -40,8 +40,20 @@ def timestamp(t_ns: int) -> Timestamp:
 
 
 def encode_image(t_ns: int, arr: np.ndarray, encoding: str, frame_id: str) -> RawImage:
+    """``arr`` as a ``RawImage`` of ``encoding``; values the encoding's integer type cannot
+    hold as they are (floats, values out of its range) are a ``ValueError``: cast, they
+    would read back as other values (0.8 as 0, 300 as 44)."""
     dtype, channels = _DTYPES[encoding]
-    a = np.ascontiguousarray(arr, dtype=dtype)
+    src = np.asarray(arr)
+    if np.issubdtype(dtype, np.integer) and src.dtype != dtype:
+        if src.dtype.kind not in "iub":
+            raise ValueError(f"a {encoding} image as {src.dtype}: give integers ({dtype}), "
+                             "e.g. colours as uint8 0..255")
+        info = np.iinfo(dtype)
+        if src.size and (int(src.min()) < info.min or int(src.max()) > info.max):
+            raise ValueError(f"a {encoding} image with values {int(src.min())}.."
+                             f"{int(src.max())}: {dtype} holds {info.min}..{info.max}")
+    a = np.ascontiguousarray(src, dtype=dtype)
     h, w = a.shape[:2]
     if (channels == 1 and a.ndim != 2) or (channels > 1 and a.shape[2:] != (channels,)):
         raise ValueError(f"image of shape {a.shape} does not fit encoding {encoding}")

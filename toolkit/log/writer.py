@@ -37,7 +37,7 @@ from mcap.summary import Summary
 from mcap.writer import CompressionType, Writer
 from mcap_protobuf.schema import build_file_descriptor_set
 
-from sgtool.errors import SgtoolError, Terminated
+from sgtool.errors import LogFormatError, SgtoolError, Terminated
 from sgtool.files import concerns, output_error, quoted, temp_beside
 from sgtool.log import chunk_copy, codec
 from sgtool.log import schemas as S
@@ -89,6 +89,27 @@ _COMPRESSION = {
     "lz4": CompressionType.LZ4,
     "none": CompressionType.NONE,
 }
+
+
+def _check_frame(k: CameraIntrinsics, depth: np.ndarray, rgb: np.ndarray | None,
+                 ids: np.ndarray | None) -> None:
+    """``ValueError`` unless the frame would read back as written: intrinsics a reader
+    takes (positive focal lengths and size), depth of the intrinsics' size, rgb (H, W, 3)
+    and ids (H, W) of the depth's."""
+    try:
+        codec.decode_calibration(codec.encode_calibration(0, k, S.CAMERA_FRAME))
+    except LogFormatError as e:
+        raise ValueError(f"intrinsics {k}: {e}") from None
+    size = (k.height, k.width)
+    if np.shape(depth) != size:
+        raise ValueError(f"depth of shape {np.shape(depth)}: the intrinsics say {k.width}x"
+                         f"{k.height}, so ({k.height}, {k.width})")
+    if rgb is not None and np.shape(rgb) != (*size, 3):
+        raise ValueError(f"rgb of shape {np.shape(rgb)}: give ({k.height}, {k.width}, 3), "
+                         "the depth's size")
+    if ids is not None and np.shape(ids) != size:
+        raise ValueError(f"ids of shape {np.shape(ids)}: give ({k.height}, {k.width}), the "
+                         "depth's size")
 
 
 class LogWriter:
@@ -371,6 +392,7 @@ class LogWriter:
         if self._last_frame_t is not None and t_ns <= self._last_frame_t:
             raise ValueError(f"frame at t_ns={t_ns}: frame times must increase (the previous "
                              f"frame is at {self._last_frame_t})")
+        _check_frame(intrinsics, depth, rgb, ids)
         # every message encoded (and so checked) before the first is written: a refused
         # frame leaves nothing of itself in the log, and the same frame mended goes in
         out: list[tuple[str, Any]] = []

@@ -271,6 +271,7 @@ def test_wrong_topic_types_name_topic_and_type(tmp_path):
                     "--tf-frames", "map:camera_optical_frame"])
     assert "frame 'map' is not in the tf tree" in r.output
     assert "world -> camera_optical_frame" in r.output
+    assert r.output.count("\n") == 1  # one line, the links in it
     assert not out.exists() and not Path(str(out) + ".partial").exists()
     assert all("Traceback" not in x for x in [r.output])
 
@@ -569,3 +570,15 @@ def test_a_camera_info_that_changes_part_way_is_followed(tmp_path):
     with pytest.raises(SgtoolError, match="changes to .* images .* part-way through"):
         import_bag(tmp_path / "sized", tmp_path / "s.mcap", BagOptions(**TOPICS, **KEEP_WORLD))
     assert not (tmp_path / "s.mcap").exists()
+
+
+def test_a_bag_folder_with_damaged_metadata_is_one_line(tmp_path):
+    """A ROS 2 bag folder whose metadata.yaml does not parse: the YAML parser's
+    multi-line message is cut to its first line."""
+    bag = tmp_path / "bag"
+    bag.mkdir()
+    (bag / "metadata.yaml").write_text("garbage: [\n")
+    r = CliRunner().invoke(cli, ["import", "bag", str(bag), "--list"])
+    assert r.exit_code == 2, r.output
+    assert r.output.startswith(f"sgtool: error: {bag}: not a readable ROS bag")
+    assert r.output.count("\n") == 1 and "Traceback" not in r.output

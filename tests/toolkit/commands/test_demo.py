@@ -30,3 +30,29 @@ def test_demo_refuses_a_file_as_its_folder(tmp_path):
     f.write_text("x")
     r = CliRunner().invoke(cli, ["demo", "-o", str(f)])
     assert r.exit_code == 2 and "is a file" in r.output and "Traceback" not in r.output
+
+
+def test_a_demo_cut_short_leaves_no_outputs_of_the_run_before(tmp_path, monkeypatch):
+    """A demo run again into its folder and stopped in its first stage: the previous run's
+    log, replay, view and bench tables are gone (not left to pass for this run's), a
+    user's own file in the folder stays."""
+    import json
+
+    import sgtool.recorders.sim as sim
+
+    out = tmp_path / "demo"
+    (out / "bench").mkdir(parents=True)
+    for name in ("demo.mcap", "derived.mcap", "view.rrd", "bench/summary.md", "mine.txt",
+                 "bench/notes.txt"):
+        (out / name).write_text("old")
+    (out / "bench" / ".sgtool-output").write_text(json.dumps(
+        {"command": "bench", "files": ["summary.md"]}))
+
+    def stopped(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sim, "record_house", stopped)
+    r = CliRunner().invoke(cli, ["demo", "-o", str(out), "--frames", "5"])
+    assert r.exit_code != 0
+    left = sorted(p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file())
+    assert left == ["bench/notes.txt", "mine.txt"]

@@ -117,6 +117,8 @@ def test_noise_message_shows_name_value_unredacted() -> None:
     (["record", "--speed", "inf", "--frames", "5"], "--speed"),
     (["record", "--noise", "mild", "--noise-seed", "-1", "--frames", "5"], "--noise-seed"),
     (["scenes", "episodes", "h.json", "--reach", "nan"], "--reach"),
+    (["scenes", "episodes", "h.json", "--reach", "0.2"], "--reach"),  # nothing reachable
+    (["scenes", "stats", "-n", "99999999999999999999"], "-n"),  # (an OverflowError)
     (["diff", "a.mcap", "b.mcap", "--tolerance", "nan"], "--tolerance"),
     (["distill", "--holdout", "nan"], "--holdout"),
     (["distill", "--seed", "-1"], "--seed"),
@@ -143,3 +145,17 @@ def test_an_option_reaches_a_planner_spelled_in_another_case() -> None:
     assert planner_options(("scout.delta=0.9",), ("Scout",)) == {"scout": {"delta": 0.9}}
     with pytest.raises(SgtoolError, match="must be a number"):
         planner_options(("Scout.delta=abc",), ("scout",))
+
+
+@pytest.mark.parametrize("args, says", [
+    (["study", "noise", "--fps", "1e9", "--houses", "1"], "--fps 1000000000.0: must be 0.1..1000"),
+    (["distill", "--report", "--out", "w1"], "--report trains nothing"),
+])
+def test_options_refused_before_any_work(tmp_path: Path, args: list[str], says: str) -> None:
+    """A frame rate no simulation runs at (it was retried per recording first), --out with
+    --report (it was ignored): one line at once, nothing written."""
+    r = CliRunner().invoke(cli, [*args, "-o", str(tmp_path / "out")] if args[0] == "study"
+                           else args)
+    assert r.exit_code == 2, r.output
+    assert says in r.output and "Traceback" not in r.output
+    assert not (tmp_path / "out").exists() and not Path("w1").exists()

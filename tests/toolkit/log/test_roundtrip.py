@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 
@@ -168,6 +169,22 @@ def test_input_that_would_read_back_wrong_is_refused(tmp_path):
             w.write_frame(4 * DT, depth=(depth * 1000).astype(np.int32), pose=pose,
                           intrinsics=synthetic_frame(1)[0], rgb=rgb)
         w.write_frame(4 * DT, depth=depth, pose=pose, intrinsics=k, rgb=rgb)
+        # images of another size than the intrinsics', colours as float or beyond uint8,
+        # ids as float, intrinsics a reader refuses: each would read back as damage or as
+        # other values (0.8 as black, 300 as 44)
+        h, w_ = depth.shape
+        for frame, says in (
+                (dict(depth=depth[: h // 2]), r"depth of shape \("),
+                (dict(depth=depth, rgb=rgb[:, : w_ // 2]), r"rgb of shape \("),
+                (dict(depth=depth, ids=ids[:-1]), r"ids of shape \("),
+                (dict(depth=depth, rgb=rgb / 255.0), "rgb8 image as float64"),
+                (dict(depth=depth, rgb=rgb.astype(np.int64) + 200),
+                 "uint8 holds 0..255"),
+                (dict(depth=depth, ids=ids.astype(np.float64) + 0.6), "image as float64"),
+                (dict(depth=depth, intrinsics=dataclasses.replace(k, fx=0.0)),
+                 "focal")):
+            with pytest.raises(ValueError, match=says):
+                w.write_frame(5 * DT, pose=pose, **{"intrinsics": k, **frame})
     with LogReader(tmp_path / "run.mcap") as r:
         a, b, c = r.frames()
         np.testing.assert_allclose(b.depth, a.depth, atol=1e-3)
