@@ -67,6 +67,7 @@ from sgtool.analysis.bench import write_outputs as write_bench_outputs
 # the closed loop (PyBullet: sgtool[sim])
 from sgtool.recorders.sim.closed_loop import run_episode as run_closed_loop
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions as ClosedLoopOptions
+from sgtool.recorders.sim.camera import CameraConfig as CameraConfig
 from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport as ClosedLoopReport
 from sgtool.recorders.sim.closed_loop import pick_episode as pick_episode
 from sgtool.recorders.sim.noise import NoiseProfile as NoiseProfile
@@ -143,7 +144,8 @@ __all__ = [
     "make_planner", "actionable", "Candidate", "find_target", "HouseSpec", "load_house",
     "load_house_text", "save_house", "generate_house", "SearchEpisode", "list_episodes",
     "run_one", "SymbolicHouse", "EpisodeResult", "BenchConfig", "BenchResult", "run_benchmark",
-    "write_bench_outputs", "run_closed_loop", "ClosedLoopOptions", "ClosedLoopReport",
+    "write_bench_outputs", "run_closed_loop", "ClosedLoopOptions", "CameraConfig",
+    "ClosedLoopReport",
     "pick_episode", "NoiseProfile", "parse_noise", "ClosedLoopBenchConfig",
     "ClosedLoopBenchResult", "run_closed_loop_bench", "write_closed_loop_bench_outputs",
     "write_rerun", "Interval", "PairedComparison",
