@@ -58,7 +58,7 @@ from sgtool.analysis.closed_loop_tables import (
     interval_tables,
     symbolic_agreement,
 )
-from sgtool.analysis.offline import log_exchanges, read_log_episodes
+from sgtool.analysis.offline import log_exchanges, read_log_episodes, with_seen
 from sgtool.analysis.report import format_table, pipe_table
 from sgtool.analysis.run_bench_resume import (
     check_resumable,
@@ -307,7 +307,8 @@ def _row(task: RunTask, seconds: float | None) -> RunRow:
         raise SgtoolError(f"{task.output}: holds {len(logged)} episodes, not one; remove it "
                           "to run the episode again")
     ep = logged[0]
-    res = replace(ep.result(), seed=task.options.planner_seed, source=log_source(task.output),
+    res = replace(with_seen(ep.result()), seed=task.options.planner_seed,
+                  source=log_source(task.output),
                   llm_answers=answer_counts(rec for _, rec in log_exchanges([task.output])))
     fails = Counter(reason_class(d.action.reason or "") for d in ep.decisions
                     if d.action.outcome == "failure")

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
+from sgtool.semantics.text import category_text
 
 if TYPE_CHECKING:
     from sgtool.analysis.executor import Executor
@@ -57,12 +58,14 @@ class EvalOutcome:
 def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
     """Score the request's episodes and replay its planners on the logged decisions."""
     from sgtool.analysis.batch_eval import load_many
-    from sgtool.analysis.offline import log_exchanges, with_success_rule
+    from sgtool.analysis.offline import log_exchanges, with_seen, with_success_rule
     from sgtool.analysis.search_metrics import cost_models, summarize
 
     results, logged, notes, unread = load_many([Path(i) for i in request.inputs], request.runner,
                                                progress=request.progress)
-    results = [with_success_rule(r, request.success) for r in results]
+    results = [with_seen(with_success_rule(r, request.success)) for r in results]
+    results, twice = once_each(results)
+    notes = [*notes, *twice]
     results, profiles = per_noise(results)
     if profiles:
         notes = [*notes, f"the episodes ran under {len(profiles)} sensor noise profiles "
@@ -99,12 +102,53 @@ def per_noise(results: Sequence[EpisodeResult]) -> tuple[list[EpisodeResult], li
         profiles
 
 
-def _unlike_episodes(results: Sequence[EpisodeResult]) -> str | None:
-    """A note when the planners were not run on the same episodes (house, episode, seed):
-    their rows are then not comparable as they stand (the paired tables are)."""
-    sets: dict[str, set[tuple[str, int, int]]] = {}
+def _episode_key(r: EpisodeResult) -> tuple[str, str, int, int, str, str]:
+    """What names one run of a planner: planner, house, episode, seed, query (generated
+    houses of other sizes share their names, house-0, but not their queries) and noise."""
+    return (r.planner, r.house, r.episode, r.seed, category_text(r.query), r.noise or "")
+
+
+def once_each(results: Sequence[EpisodeResult]) -> tuple[list[EpisodeResult], list[str]]:
+    """``results`` with each run read once: a run given twice (a copy of a log, a log and
+    the table that lists it) keeps its first reading; and notes saying how many were left
+    out, and when one name (planner, house, episode, seed) holds runs that differ (the
+    same house name for other houses): those are kept, pooled, and named."""
+    seen: dict[tuple[str, str, int, int, str, str], EpisodeResult] = {}
+    out, dropped, clash = [], 0, set()
     for r in results:
-        sets.setdefault(r.planner, set()).add((r.house, r.episode, r.seed))
+        key = _episode_key(r)
+        first = seen.get(key)
+        if first is None:
+            seen[key] = r
+            out.append(r)
+        elif _outcome(first) == _outcome(r):
+            dropped += 1
+        else:
+            clash.add(key)
+            out.append(r)
+    notes = []
+    if dropped:
+        notes.append(f"{dropped} episode(s) were given twice (a copy of a log, or a log and "
+                     "a table that lists it): each is scored once")
+    if clash:
+        names = sorted({f"{k[0]} on {k[1]}" for k in clash})
+        notes.append(f"{len(clash)} run(s) of one name (planner, house, episode, seed, "
+                     f"query) ended differently in two inputs ({', '.join(names[:3])}): "
+                     "runs of other houses or settings under one name are pooled; score "
+                     "them separately")
+    return out, notes
+
+
+def _outcome(r: EpisodeResult) -> tuple[object, ...]:
+    return (r.success, r.steps, round(r.travelled_m, 3), r.end)
+
+
+def _unlike_episodes(results: Sequence[EpisodeResult]) -> str | None:
+    """A note when the planners were not run on the same episodes (house, episode, seed,
+    query): their rows are then not comparable as they stand (the paired tables are)."""
+    sets: dict[str, set[tuple[str, int, int, str, str]]] = {}
+    for r in results:
+        sets.setdefault(r.planner, set()).add(_episode_key(r)[1:])
     if len(sets) < 2 or len({frozenset(s) for s in sets.values()}) == 1:
         return None
     common = set.intersection(*sets.values())

@@ -168,6 +168,11 @@ def pin_folder(root: Path) -> Iterator[Path]:
         yield out
 
 
+def _same_place(out: Path, root: Path) -> bool:
+    """Whether :func:`pin_folder` gave ``root`` itself (in place), however it is spelt."""
+    return out.resolve() == root.resolve()
+
+
 def pin_logs(logs: Sequence[str | Path] | str | Path, folder: str | Path,
              options: ReplayOptions | None = None, *, copy: bool = False,
              executor: Executor | None = None, progress: bool = False,
@@ -204,7 +209,7 @@ def pin_logs(logs: Sequence[str | Path] | str | Path, folder: str | Path,
                           "image?): a pin of it would check nothing")
     logs_now = dict(old)
     with pin_folder(root) as out, \
-            deferred_interrupts() if out == root else contextlib.nullcontext():
+            deferred_interrupts() if _same_place(out, root) else contextlib.nullcontext():
         staged = PinSet(out, logs_now, sgtool_version=__version__)
         for p, name, o in zip(paths, names, outcomes, strict=True):
             stored = stored_path(p, root)
@@ -401,7 +406,7 @@ def update_pins(report: CheckReport) -> list[str]:
     if not changed:
         return []
     with pin_folder(pins.folder) as out, \
-            deferred_interrupts() if out == pins.folder else contextlib.nullcontext():
+            deferred_interrupts() if _same_place(out, pins.folder) else contextlib.nullcontext():
         staged = PinSet(out, pins.logs, sgtool_version=__version__)
         for c in changed:
             assert c.capture is not None

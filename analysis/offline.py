@@ -214,7 +214,7 @@ def load_results(paths: Iterable[str | os.PathLike[str]], notes: list[str] | Non
             if foreign is not None:
                 raise EvalInputError(foreign)
             for e in _search_episodes(p, read_log_episodes(p), notes):
-                r = _with_seen(e.result())
+                r = with_seen(e.result())
                 if not e.closed:  # no closing record: cut short
                     notes.append(f"{p}: episode {e.index} has no closing record (the run was "
                                  "interrupted or killed): scored from the actions logged "
@@ -248,7 +248,7 @@ def _accepted(r: EpisodeResult, where: str, notes: list[str]) -> bool:
     return problem is None
 
 
-def _with_seen(r: EpisodeResult) -> EpisodeResult:
+def with_seen(r: EpisodeResult) -> EpisodeResult:
     """A log that does not say whether its query is seen: decide it from the split (the
     query is unseen when it is one of :func:`sgtool.datasets.split.unseen_queries`)."""
     if r.seen is not None or not r.query:

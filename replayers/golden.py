@@ -179,8 +179,11 @@ def _room_changes(a: Any, b: Any, tol: float) -> list[str]:
 def _object_changes(a: Any, b: Any, tol: float) -> list[str]:
     out = [f"objects: {a.id} {a.category} {attr} {getattr(a, attr)} -> {getattr(b, attr)}"
            for attr in ("room", "parent", "relation", "state", "explored", "category",
-                        "instance", "affordances")
+                        "instance")
            if getattr(a, attr) != getattr(b, attr)]
+    if sorted(a.affordances) != sorted(b.affordances):  # a set (the JSON sorts it)
+        out.append(f"objects: {a.id} {a.category} affordances {sorted(a.affordances)} -> "
+                   f"{sorted(b.affordances)}")
     if (d := _moved(a, b, tol)) is not None:
         out.append(f"objects: {a.id} {a.category} moved {_m(d)} m")
     return out

@@ -278,8 +278,13 @@ def deferred_interrupts() -> Iterator[None]:
     finally:
         for s, handler in old.items():
             signal.signal(s, handler)
-    if got and callable(handler := old[got[0]]):  # Python's Ctrl-C handler raises
+    if not got:
+        return
+    handler = old[got[0]]
+    if callable(handler):  # Python's Ctrl-C handler raises KeyboardInterrupt
         handler(got[0], None)
+    elif handler == signal.SIG_DFL:  # the default action (SIGTERM: the process ends)
+        signal.raise_signal(got[0])
 
 
 def leftover_notes(target: str | os.PathLike[str]) -> list[str]:

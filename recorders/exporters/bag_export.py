@@ -26,8 +26,8 @@ Frames are renamed to REP-105's by default (``world`` -> ``map``, ``base`` ->
 ``base_link``, ``camera`` -> ``camera_optical_frame``: sgtool's camera frame is an optical
 one, x right, y down, z forward); ``frames`` gives another mapping (``{}`` keeps sgtool's).
 A trajectory imported from a bag's /tf (``sgtool import bag --tf-frames odom:base_link``
-without images) is the pose of the frame it names, not of an optical frame: its frames keep
-the source's names where the mapping gives the REP-105 ones (:func:`trajectory_frames`).
+without images) is the pose of the frame it names, not of an optical frame: by default
+(``frames`` None) its frames keep the source's names (:func:`default_frames`).
 
 The format follows ``out``'s name unless given: ``NAME.bag`` is ROS 1, anything else a
 ROS 2 bag folder. Compression: zstd chunks in the ROS 2 MCAP file, lz4 (or bz2) chunks in
@@ -169,8 +169,9 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
     """Write the sgtool log ``log`` (best a derived one) as a ROS bag at ``out`` (module
     doc): ``fmt`` ros1 or ros2 (None: from ``out``'s name), stamps at log time +
     ``time_base_s`` seconds (None: as the module doc says), frames renamed by ``frames``
-    (None: REP-105), ``compression`` (None: zstd for ros2, lz4 for ros1), only the ROS or
-    sgtool ``topics`` given (None: all). The bag appears under its name only when complete."""
+    (None: :func:`default_frames`), ``compression`` (None: zstd for ros2, lz4 for ros1),
+    only the ROS or sgtool ``topics`` given (None: all). The bag appears under its name only
+    when complete."""
     log, out = Path(log), Path(out)
     fmt = format_for(out, fmt)
     compression = compression or DEFAULT_COMPRESSION[fmt]
@@ -211,8 +212,8 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
         records = {k.topic for k in S.RECORDS.values()}
         others = tuple(sorted(t for t in r.topics() if t not in OUTPUTS_ORDER
                               and t not in records and t != S.GRAPH_SCENE))
-        names = trajectory_frames(r.metadata.get(S.IMPORT_METADATA_NAME, {}),
-                                  frames if frames is not None else REP105)
+        names = dict(frames) if frames is not None else trajectory_frames(
+            r.metadata.get(S.IMPORT_METADATA_NAME, {}), REP105)
 
         def writer(path: Path) -> BagWriter:
             return BagWriter(path, FORMATS[fmt], frames=names, compression=compression,
@@ -234,6 +235,18 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
                     os.replace(inner / entry, stage / entry)
                 shutil.rmtree(inner)
     return ExportReport(out, fmt, tuple(counts), derived, time_base_s, compression, others)
+
+
+def default_frames(log: str | Path) -> dict[str, str]:
+    """The frame names :func:`export_bag` gives ``log`` by default (REP-105, a /tf
+    trajectory's source names: :func:`trajectory_frames`); REP-105 when the log cannot be
+    read (export says why)."""
+    try:
+        with LogReader(log) as r:
+            meta = r.metadata.get(S.IMPORT_METADATA_NAME, {})
+    except (SgtoolError, OSError):
+        return dict(REP105)
+    return trajectory_frames(meta, REP105)
 
 
 def trajectory_frames(meta: Mapping[str, str], names: Mapping[str, str]) -> dict[str, str]:

@@ -166,7 +166,8 @@ def test_ctrl_c_while_update_writes_leaves_the_pin_folder_whole(pinned, capsys,
         os.kill(os.getpid(), signal.SIGINT)
 
     monkeypatch.setattr(gc, "write_capture", interrupted)
-    code, _, _ = sgtool(capsys, "golden", "check", "--dir", pinned, "--update",
+    monkeypatch.chdir(pinned.parent)  # --dir as the help shows it: relative
+    code, _, _ = sgtool(capsys, "golden", "check", "--dir", pinned.name, "--update",
                         "--voxel-size", "0.08")
     assert code == 130
     monkeypatch.undo()

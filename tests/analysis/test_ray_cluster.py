@@ -190,7 +190,7 @@ def _records(out: Path) -> list[dict[str, object]]:
     recs = [json.loads(s) for s in (out / "episodes.jsonl").read_text().splitlines()]
     for r in recs:
         r.pop("wall")  # wall clock
-        r["source"] = Path(str(r["source"])).relative_to(out).as_posix()
+        assert (out / str(r["source"])).is_file()  # named relative to the run folder
     return recs
 
 

@@ -233,3 +233,22 @@ def test_deferred_interrupts_hold_ctrl_c_until_the_block_ends() -> None:
     with deferred_interrupts():
         done.append("quiet")
     assert signal.getsignal(signal.SIGINT) is before
+
+
+def test_deferred_sigterm_with_the_default_handler_still_ends_the_process(tmp_path) -> None:
+    """A library caller keeps Python's default SIGTERM action: a SIGTERM inside the block
+    ends the process when the block ends (it was dropped)."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "term.py"
+    script.write_text(
+        "import os, signal\n"
+        "from sgtool.files import deferred_interrupts\n"
+        "with deferred_interrupts():\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)\n"
+        "    print('block done', flush=True)\n"
+        "print('after the block')\n")
+    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                         timeout=60)
+    assert run.returncode == -15 and run.stdout == "block done\n", (run.returncode, run.stdout)

@@ -21,6 +21,16 @@ if TYPE_CHECKING:
     from sgtool.analysis.priors_training import LlmSource
 
 
+def _check_modes(out_dir: Path | None, report_only: bool, source: str,
+                 llm_slice: str | None) -> None:
+    """Options that do not go together, one line each."""
+    if llm_slice is not None and source != "llm":
+        raise SgtoolError("--llm-slice is for --source llm")
+    if report_only and out_dir is not None:
+        raise SgtoolError(f"--report trains nothing, so --out {out_dir} has nothing to go "
+                          "there; to report on weights give --weights DIR")
+
+
 def _weights_dir() -> Path:
     from sgtool.semantics.priors import WEIGHTS_DIR
 
@@ -104,12 +114,8 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
     )
     from sgtool.semantics.distill import format_report
 
-    if llm_slice is not None and source != "llm":
-        raise SgtoolError("--llm-slice is for --source llm")
+    _check_modes(out_dir, report_only, source, llm_slice)
     if report_only:
-        if out_dir is not None:
-            raise SgtoolError(f"--report trains nothing, so --out {out_dir} has nothing to "
-                              "go there; to report on weights give --weights DIR")
         rep = weights_report(weights_dir or _weights_dir())
         click.echo(json.dumps(rep, indent=1, sort_keys=True) if as_json else format_report(rep))
         return

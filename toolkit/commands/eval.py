@@ -109,27 +109,6 @@ class EvalArgs:
     llm_timeout: float | None = None
 
 
-def _read_once(files: tuple[str, ...]) -> tuple[str, ...]:
-    """``files`` without the logs an episodes.jsonl also read holds (a row's ``source``, or
-    a log under its folder's ``logs/``, as run-bench writes them: ``eval run/ run/logs``
-    would count each episode twice), with a note."""
-    from sgtool.results import ResultsFormatError, read_jsonl
-
-    tables = [Path(f) for f in files if Path(f).name == "episodes.jsonl"]
-    sources: set[Path] = set()
-    for t in tables:
-        try:
-            sources |= {Path(r.source).resolve() for r in read_jsonl(t) if r.source}
-        except ResultsFormatError:
-            continue  # the evaluation's own read of it says what is wrong
-    dup = [f for f in files if f.endswith(".mcap") and (Path(f).resolve() in sources or any(
-        Path(f).resolve().is_relative_to(t.resolve().parent / "logs") for t in tables))]
-    if dup:
-        click.echo(f"sgtool: note: {len(dup)} log(s) are episodes of an episodes.jsonl also "
-                   "given; each episode is read once, from the table", err=True)
-    return tuple(f for f in files if f not in dup)
-
-
 def _request(inputs: tuple[str, ...], out: str | None, force: bool, args: EvalArgs
              ) -> EvalRequest:
     """The option, output and input checks: finite budgets, the executor, the inputs (MCAP
@@ -143,8 +122,8 @@ def _request(inputs: tuple[str, ...], out: str | None, force: bool, args: EvalAr
     runner = make_executor(args.executor, args.workers, args.ray_address)
     runs = [str(Path(i) / "episodes.jsonl") if (Path(i) / "episodes.jsonl").is_file()
             else i for i in inputs]  # an output folder: its table, not its logs too
-    files = _read_once(tuple(map(str, expand_inputs(runs, (".mcap",), "MCAP logs",
-                                                    recursive=True))))
+    # a run given twice (a table and its logs) is scored once: eval_run.once_each
+    files = tuple(map(str, expand_inputs(runs, (".mcap",), "MCAP logs", recursive=True)))
     if out:
         check_output(out, force=force)
         if any(Path(out).resolve() == Path(i).resolve() for i in files):

@@ -22,23 +22,24 @@ def command() -> None:
 _ROS_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_/]*")  # a tf frame id ROS tools accept
 
 
-def _frames(style: str, pairs: tuple[str, ...]) -> dict[str, str]:
+def _frames(style: str, pairs: tuple[str, ...], log: str) -> dict[str, str]:
     """The frame renaming of ``--frames STYLE`` and ``--frame OLD=NEW`` pairs: OLD one of
-    the log's frames by sgtool's name or by the name ``--frames`` gives it (``map`` with
-    rep105), NEW a ROS name, no two frames under one name."""
+    the log's frames by sgtool's name or by the name ``--frames`` gives it in this log
+    (``map`` with rep105; ``base_link`` for a trajectory of a robot base), NEW a ROS name,
+    no two frames under one name."""
     from sgtool.log import schemas as S
-    from sgtool.recorders.exporters.bag_export import REP105
+    from sgtool.recorders.exporters.bag_export import default_frames
 
     frames = (S.WORLD_FRAME, S.BASE_FRAME, S.CAMERA_FRAME)
-    names = dict(REP105) if style == "rep105" else {}
+    names = default_frames(log) if style == "rep105" else {}
+    styled = {n: f for f, n in names.items()}
     for pair in pairs:
         old, sep, new = (x.strip() for x in pair.partition("="))
         if not sep or not old or not new:
             raise SgtoolError(f"--frame {pair!r}: give OLD=NEW, e.g. camera=camera_link")
-        styled = {n: f for f, n in REP105.items()} if style == "rep105" else {}
         old = styled.get(old, old)  # the --frames name of a frame: the same frame
         if old not in frames:
-            shown = ", ".join(f"{f} ({REP105[f]})" if styled else f for f in frames)
+            shown = ", ".join(f"{f} ({names[f]})" if f in names else f for f in frames)
             raise SgtoolError(f"--frame {pair!r}: {old!r} is no frame of an sgtool log "
                               f"(those are {shown})")
         if not _ROS_NAME.fullmatch(new):
@@ -119,7 +120,7 @@ def bag(log: str, output: str, fmt: str | None, distro: str, time_base: float | 
     with tqdm(unit="msg", desc="export", disable=None if progress else True,
               leave=False) as bar:
         report = export_bag(log, output, fmt, force, time_base_s=time_base,
-                            frames=_frames(frame_style, frame_pairs), distro=distro,
+                            frames=_frames(frame_style, frame_pairs, log), distro=distro,
                             compression=compression, topics=names, progress=bar)
     for line in report.lines():
         click.echo(line)

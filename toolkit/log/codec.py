@@ -71,6 +71,9 @@ def encode_ids(t_ns: int, ids: np.ndarray, frame_id: str) -> RawImage:
     ``16UC1`` (exact ids, 0 = none) when every id fits in 0..65535, else ``32SC1`` (exact,
     not drawn by Foxglove; sgtool's readers take both); ids outside int32 are a
     ``ValueError`` (they would wrap)."""
+    if np.asarray(ids).dtype.kind not in "iub":
+        raise ValueError(f"instance ids as {np.asarray(ids).dtype}: give an integer array "
+                         "(an id per pixel, 0 = none)")
     lo, hi = (int(ids.min()), int(ids.max())) if ids.size else (0, 0)
     if lo < -(2 ** 31) or hi > 2 ** 31 - 1:
         raise ValueError(f"instance ids {lo}..{hi}: ids must fit int32 (the instance table "

@@ -388,7 +388,10 @@ class LogWriter:
         """One time step. ``pose`` is world_T_camera; with ``base_pose`` (world_T_base) the
         transforms are written as the chain world -> base -> camera, else world -> camera.
         Calibration is written on the first frame and whenever it changes. Frame times
-        must increase (a ``ValueError`` otherwise: a replay pairs messages by time)."""
+        must increase (a ``ValueError`` otherwise: a replay pairs messages by time), and so
+        is anything that would read back as something else: images of another size than
+        the intrinsics' (depth (H, W), rgb (H, W, 3), ids (H, W)), intrinsics a reader
+        refuses, colours as float or beyond 0..255, ids as float."""
         if self._last_frame_t is not None and t_ns <= self._last_frame_t:
             raise ValueError(f"frame at t_ns={t_ns}: frame times must increase (the previous "
                              f"frame is at {self._last_frame_t})")

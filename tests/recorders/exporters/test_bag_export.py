@@ -346,8 +346,8 @@ def test_a_recording_off_time_zero_keeps_its_stamps(tmp_path):
 def test_a_tf_trajectory_keeps_its_frame_names_in_the_bag(shared_data_dir, tmp_path):
     """evo's odom -> base_link trajectory, imported and exported: the bag's /tf names the
     robot base base_link under odom, as the source did (not camera_optical_frame under
-    map: a base's axes are not an optical frame's); --frames sgtool and --frame renames
-    still win."""
+    map: a base's axes are not an optical frame's); --frames sgtool, names given to the
+    API and --frame renames (by the name shown) still win."""
     from sgtool.recorders.importers.bag import import_bag
     from sgtool.recorders.importers.bag_options import BagOptions
 
@@ -363,7 +363,13 @@ def test_a_tf_trajectory_keeps_its_frame_names_in_the_bag(shared_data_dir, tmp_p
     m = read_bag(tmp_path / "s")["/tf"][0][1]
     assert (m.transforms[0].header.frame_id, m.transforms[0].child_frame_id) == ("world", "camera")
     export_bag(log, tmp_path / "r", frames={**REP105, S.CAMERA_FRAME: "robot"})
-    m = read_bag(tmp_path / "r")["/tf"][0][1]
+    m = read_bag(tmp_path / "r")["/tf"][0][1]  # the names given are the names written
+    assert (m.transforms[0].header.frame_id, m.transforms[0].child_frame_id) == ("map", "robot")
+    # the CLI renames a frame by the name the bag shows for it (base_link here)
+    r = CliRunner().invoke(cli, ["export", "bag", str(log), "-o", str(tmp_path / "c"),
+                                 "--frame", "base_link=robot", "--no-progress"])
+    assert r.exit_code == 0, r.output
+    m = read_bag(tmp_path / "c")["/tf"][0][1]
     assert (m.transforms[0].header.frame_id, m.transforms[0].child_frame_id) == ("odom", "robot")
 
 

@@ -142,7 +142,7 @@ def test_eval_asks_a_plugin_and_reads_its_logs(plugin_dir: Path, tmp_path: Path,
     both = CliRunner().invoke(cli, ["eval", str(tmp_path / "out"), str(tmp_path / "out" /
                                                                         "logs"), "--json"])
     assert both.exit_code == 0, both.output
-    assert "each episode is read once" in both.stderr
+    assert "episode(s) were given twice" in both.stderr and "each is scored once" in both.stderr
     got, want = json.loads(both.stdout)["planners"], json.loads(by_out.output)["planners"]
     assert {p: v["episodes"] for p, v in got.items()} == \
         {p: v["episodes"] for p, v in want.items()} == {"mymod_cli:MyPlanner": 2}

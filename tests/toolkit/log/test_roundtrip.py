@@ -180,7 +180,8 @@ def test_input_that_would_read_back_wrong_is_refused(tmp_path):
                 (dict(depth=depth, rgb=rgb / 255.0), "rgb8 image as float64"),
                 (dict(depth=depth, rgb=rgb.astype(np.int64) + 200),
                  "uint8 holds 0..255"),
-                (dict(depth=depth, ids=ids.astype(np.float64) + 0.6), "image as float64"),
+                (dict(depth=depth, ids=ids.astype(np.float64) + 0.6),
+                 "instance ids as float64: give an integer array"),
                 (dict(depth=depth, intrinsics=dataclasses.replace(k, fx=0.0)),
                  "focal")):
             with pytest.raises(ValueError, match=says):

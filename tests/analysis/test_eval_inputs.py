@@ -1,0 +1,56 @@
+"""`sgtool eval` scores every run once and says when its inputs do not add up: a run given
+twice (a copy of a log, a table and its logs) counts once; runs of one name that ended
+otherwise (other houses under the generated name house-0) are kept, pooled and named;
+planners run on other queries under the same (house, episode, seed) are not comparable;
+a run-bench table without seen/unseen flags gets them as its logs do
+(sgtool.analysis.eval_run.once_each)."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+from click.testing import CliRunner
+
+from sgtool.analysis.eval_run import once_each
+from sgtool.cli import cli
+from sgtool.results import EpisodeResult, write_jsonl
+
+RUN = EpisodeResult("greedy", 0, "house-0", 0, "mug", True, steps=4, travelled_m=10.0,
+                    shortest_m=9.48, source="logs/a.mcap")
+
+
+def test_a_run_given_twice_counts_once() -> None:
+    copy = dataclasses.replace(RUN, source="copy.mcap", wall={"decision_s": 0.1})
+    kept, notes = once_each([RUN, copy])
+    assert kept == [RUN]
+    assert notes == ["1 episode(s) were given twice (a copy of a log, or a log and a table "
+                     "that lists it): each is scored once"]
+
+
+def test_runs_of_one_name_that_ended_otherwise_are_kept_and_named() -> None:
+    other = dataclasses.replace(RUN, success=False, steps=50)
+    kept, notes = once_each([RUN, other])
+    assert kept == [RUN, other]
+    assert len(notes) == 1 and "greedy on house-0" in notes[0] and "pooled" in notes[0]
+    # another query under the same (house, episode, seed) is another episode: no note
+    assert once_each([RUN, dataclasses.replace(RUN, query="bowl")])[1] == []
+
+
+def test_eval_notes_planners_run_on_other_queries_and_fills_seen(tmp_path) -> None:
+    """Two tables of house-0 episode 0 with other queries (houses of other sizes): the
+    planners' rows are not comparable, and eval says so; rows without seen/unseen get it
+    from the query split, as logs do."""
+    a, b = tmp_path / "a" / "episodes.jsonl", tmp_path / "b" / "episodes.jsonl"
+    a.parent.mkdir()
+    b.parent.mkdir()
+    write_jsonl([dataclasses.replace(RUN, planner="random", seen=None)], a)
+    write_jsonl([dataclasses.replace(RUN, query="bowl", seen=None)], b)
+    r = CliRunner().invoke(cli, ["eval", str(a.parent), str(b.parent), "--json"])
+    assert r.exit_code == 0, r.output
+    assert "the planners ran on different episodes (greedy 1, random 1; 0 in common)" \
+        in r.stderr
+    doc = json.loads(r.stdout)
+    assert {p: v["episodes"] for p, v in doc["planners"].items()} == {"greedy": 1, "random": 1}
+    assert {(s["planner"], s["seen_n"] + s["unseen_n"]) for s in doc["seen_unseen"]} == \
+        {("greedy", 1), ("random", 1)}  # (a row without the flag was in neither)
