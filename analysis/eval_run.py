@@ -184,8 +184,12 @@ def _replays(request: EvalRequest, logged: Sequence[Any], exchanges: Sequence[An
     if replay and "moma-llm" in names and (request.llm_replay or not moma.get("base_url")):
         options.setdefault("moma-llm", {}).setdefault("replay", replay)
     if names and not any(d.graph is not None for e in logged for d in e.decisions):
-        raise SgtoolError("--planner needs MCAP logs with sgtool.SceneGraph records; "
-                          "the inputs have none")
+        decisions = sum(len(e.decisions) for e in logged)
+        raise SgtoolError(
+            "--planner needs logged decisions made on a scene graph (sgtool.Action records "
+            "of MCAP logs, each after an sgtool.SceneGraph record); " + (
+                "the inputs' logs hold no decision" if not decisions else
+                f"none of the inputs' {decisions} decisions has a graph before it"))
     return [replay_decisions(make_planner(n, **options.get(n, {})), logged, name=n)
             for n in names]
 

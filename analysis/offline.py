@@ -270,7 +270,7 @@ class DecisionComparison:
     step: int
     logged: tuple[str, str | None]
     chosen: tuple[str, str | None]
-    valid: bool  # the chosen target is a node of the graph (or done)
+    valid: bool  # the chosen target is a node of the graph (or a done without one)
     same_room: bool
     decision_s: float
 
@@ -398,7 +398,9 @@ def replay_decisions(planner: Planner | str, episodes: Sequence[LoggedEpisode],
                 if miss := replay_miss_of(planner):  # --llm-replay of other logs
                     raise SgtoolError(f"{name or getattr(planner, 'name', 'planner')}: {miss} "
                                       f"({ep.source}, decision {step})")
-                valid = chosen.skill == "done" or chosen.target in d.graph.node_ids()
+                # done without a target gives up; with one it names a node, as the others
+                valid = chosen.target in d.graph.node_ids() if chosen.target is not None \
+                    else chosen.skill == "done"
                 lr = node_rooms(d.graph, logged.target)
                 same_room = bool(lr & node_rooms(d.graph, chosen.target)) or (
                     chosen.skill == logged.skill == "done")

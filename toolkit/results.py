@@ -24,7 +24,7 @@ from typing import Any
 from sgtool.canonical import canonical_float
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write
-from sgtool.log.records import Action, Episode, given
+from sgtool.log.records import WENT_ON, Action, Episode, given
 
 RESULT_VERSION = "1.0"
 
@@ -218,6 +218,17 @@ def results_digest(results: Sequence[EpisodeResult]) -> str:
 # ----------------------------------------------------------------------------------------
 # from log records
 # ----------------------------------------------------------------------------------------
+def planner_steps(actions: Sequence[Action]) -> int:
+    """The planner steps among ``actions``: those a planner decided (the closed loop's
+    opening look-around and fallback explores name none), but explores that went on after
+    one (reason :data:`~sgtool.log.records.WENT_ON`); every action when none names a
+    planner (a log of its own kind)."""
+    decided = [a for a in actions if given(a.planner)]
+    if not decided:
+        return len(actions)
+    return sum(1 for a in decided if not str(a.reason or "").startswith(WENT_ON))
+
+
 def result_from_log_records(episode: Episode, actions: Sequence[Action],
                             source: str = "log") -> EpisodeResult:
     """An :class:`EpisodeResult` from the records of one episode of a log.
@@ -229,8 +240,9 @@ def result_from_log_records(episode: Episode, actions: Sequence[Action],
     (int), ``episode`` (int), ``seen`` (bool), ``end`` (str), ``n_open`` (int).
 
     Derived when absent: ``n_open`` = actions with skill "open" and outcome "success";
-    ``n_invalid`` / ``n_failure`` = actions with that outcome; ``steps`` = number of
-    actions; ``travelled_m`` = sum over actions.
+    ``n_invalid`` / ``n_failure`` = actions with that outcome; ``steps`` = the actions a
+    planner decided (:func:`planner_steps`: a closed-loop log cut short counts its steps as
+    its closing record would); ``travelled_m`` = sum over actions.
     """
     extra = episode.extras
     trace = tuple(
@@ -253,7 +265,7 @@ def result_from_log_records(episode: Episode, actions: Sequence[Action],
         query=str(given(episode.query, "")),
         seen=None if seen is None else bool(seen),
         success=status == "success",
-        steps=int(given(episode.steps, len(trace))),
+        steps=int(given(episode.steps, planner_steps(actions))),
         travelled_m=float(given(episode.travelled_m, sum(s.travelled_m for s in trace))),
         shortest_m=None if shortest is None else float(shortest),
         n_open=int(n_open),

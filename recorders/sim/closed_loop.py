@@ -97,8 +97,8 @@ from sgtool.errors import SgtoolError
 from sgtool.extras import require
 from sgtool.house.spec import HouseSpec
 from sgtool.llm.stats import answer_counts
+from sgtool.log.records import WENT_ON, LlmExchange  # WENT_ON: the reason of a go-on explore
 from sgtool.log.records import Episode as LoggedEpisode
-from sgtool.log.records import LlmExchange
 from sgtool.log.writer import LogWriter
 from sgtool.planning.base import Action, Feedback, Outcome, Planner
 from sgtool.planning.candidates import Candidate, actionable, find_target
@@ -147,9 +147,6 @@ from sgtool.scenegraph.categories import RoomClassifier
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 from sgtool.semantics.text import category_text
-
-# the reason of an explore that goes on (:meth:`_Search.go_on`): no step
-WENT_ON = "went on: the last explore showed no new object, door or room"
 
 
 # ----------------------------------------------------------------------------------------

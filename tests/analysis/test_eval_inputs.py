@@ -54,3 +54,11 @@ def test_eval_notes_planners_run_on_other_queries_and_fills_seen(tmp_path) -> No
     assert {p: v["episodes"] for p, v in doc["planners"].items()} == {"greedy": 1, "random": 1}
     assert {(s["planner"], s["seen_n"] + s["unseen_n"]) for s in doc["seen_unseen"]} == \
         {("greedy", 1), ("random", 1)}  # (a row without the flag was in neither)
+
+
+def test_p_without_logged_decisions_says_so(tmp_path) -> None:
+    """-p on a table (no MCAP log): the error says there is no logged decision, not that
+    the logs lack scene graphs."""
+    write_jsonl([RUN], tmp_path / "episodes.jsonl")
+    r = CliRunner().invoke(cli, ["eval", str(tmp_path), "-p", "greedy"])
+    assert r.exit_code == 2 and "the inputs' logs hold no decision" in r.output, r.output

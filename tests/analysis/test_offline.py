@@ -64,6 +64,30 @@ def test_planner_against_its_own_log_agrees(greedy_log):
     assert 0.0 <= other.rate("agree") <= other.rate("target") <= 1.0
 
 
+def test_done_naming_no_node_of_the_graph_is_not_in_graph(greedy_log):
+    """A planner answering done(obj:99999) names no node, as navigate(obj:99999) would:
+    both count as "not in graph"; a done without a target (giving up) does not."""
+    from sgtool.planning.base import Action
+
+    class Says:
+        def __init__(self, skill, target):
+            self.name, self.skill, self.target = "says", skill, target
+
+        def reset(self, query, seed=0):
+            pass
+
+        def decide(self, graph):
+            return Action(self.skill, self.target)
+
+        def feedback(self, fb):
+            pass
+
+    eps = read_log_episodes(greedy_log[0])
+    for skill, target, invalid in (("done", "obj:99999", 1.0), ("navigate", "obj:99999", 1.0),
+                                   ("done", None, 0.0)):
+        assert replay_decisions(Says(skill, target), eps).rate("invalid") == invalid
+
+
 def records_log(path, records):  # type: ignore[no-untyped-def]
     """A log of sgtool records only, one per nanosecond in the order given."""
     with LogWriter(path) as log:
@@ -135,7 +159,7 @@ def test_eval_cli_on_logs_and_bench_output(tmp_path, greedy_log):
             assert got["planners"][p][k]["mean"] == want[p][k]["mean"]
     assert json.loads((tmp_path / "e.json").read_text()) == got
     r = runner.invoke(cli, ["eval", str(tmp_path / "b" / "episodes.jsonl"), "-p", "greedy"])
-    assert r.exit_code == 2 and "needs MCAP logs" in r.output
+    assert r.exit_code == 2 and "needs logged decisions" in r.output
 
 
 def test_bench_logs_round_trip_through_eval(tmp_path):

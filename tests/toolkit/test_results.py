@@ -83,6 +83,26 @@ def test_result_from_log_records_derives_counts():
     assert r2.shortest_m is None and r2.planner == "unknown"
 
 
+def test_a_closed_loop_log_cut_short_counts_planner_steps_only():
+    """No closing record (a killed run, recovered): steps are the actions a planner
+    decided, not the opening look-around or the fallback explores (planner null), nor the
+    explores that went on after one, as the closing record of a whole run counts them."""
+    from sgtool.log.records import WENT_ON
+
+    def act(skill, planner, reason=""):
+        return Action.from_json({"skill": skill, "target": "frontier:1", "outcome": "success",
+                                 "planner": planner, "reason": reason})
+
+    actions = [act("look_around", None), act("explore", "greedy"), act("navigate", "greedy"),
+               act("explore", "greedy", WENT_ON), act("explore", None, "fallback: gave up"),
+               act("open", "greedy")]
+    cut = result_from_log_records(Episode(kind="search", status="started"), actions)
+    assert cut.steps == 3 and cut.decisions == 6
+    closed = result_from_log_records(Episode(kind="search", status="failure", steps=3),
+                                     actions)
+    assert closed.steps == 3
+
+
 def test_tables_and_summary_dict():
     rs = [_result(), _result(success=False, planner="random")]
     sums = summarize(rs)

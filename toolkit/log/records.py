@@ -285,6 +285,10 @@ class Episode(LogRecord):
         return Episode._build(d)
 
 
+# the reason of a closed-loop explore that goes on after a planner's (no step of its own)
+WENT_ON = "went on: the last explore showed no new object, door or room"
+
+
 @dataclass(frozen=True)
 class Action(LogRecord):
     """``sgtool.Action``: a high-level action on a scene-graph node, as a planner decides it
