@@ -55,7 +55,14 @@ PRIMESENSE_INTRINSICS = PinholeParams(525.0, 525.0, 319.5, 239.5,
                                       source="dataset default: PrimeSense, as Open3D assumes")
 
 _IMAGE_EXT = (".png", ".jpg", ".jpeg", ".ppm", ".bmp", ".tif", ".tiff")
-_SEVEN = re.compile(r"^frame-(\d+)\.(color|depth|pose)\.(png|jpg|jpeg|txt)$")
+# (any case: "frame-000100.depth.PNG" as copied from a camera or another file system)
+_SEVEN = re.compile(r"^frame-(\d+)\.(color|depth|pose)\.(png|jpg|jpeg|txt)$", re.IGNORECASE)
+
+
+def _seven_depth(name: str) -> bool:
+    """Whether ``name`` is a 7-Scenes depth image."""
+    m = _SEVEN.match(name)
+    return m is not None and m.group(2).lower() == "depth"
 
 
 @dataclass(frozen=True)
@@ -91,7 +98,7 @@ def looks_like(root: Path) -> str | None:
     names = {p.name for p in root.iterdir()}
     if "rgb.txt" in names and "depth.txt" in names:
         return "tum"
-    if any(_SEVEN.match(n) and ".depth." in n for n in names):
+    if any(_seven_depth(n) for n in names):
         return "7scenes"
     if "depth" in names and (root / "depth").is_dir() and _color_dir(root) is not None:
         return "open3d"
@@ -120,7 +127,7 @@ def missing_for_layout(root: Path, layout: str) -> str | None:
         absent = [n for n in ("rgb.txt", "depth.txt") if not (root / n).is_file()]
         return f"no {' and no '.join(absent)}" if absent else None
     if layout == "7scenes":
-        if not any(_SEVEN.match(p.name) and ".depth." in p.name for p in root.iterdir()):
+        if not any(_seven_depth(p.name) for p in root.iterdir()):
             return "no frame-XXXXXX.depth.png files"
         return None
     if layout == "open3d":
@@ -407,7 +414,7 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
     for p in root.iterdir():
         m = _SEVEN.match(p.name)
         if m:
-            by_id.setdefault(int(m.group(1)), {})[m.group(2)] = p
+            by_id.setdefault(int(m.group(1)), {})[m.group(2).lower()] = p
     ids, notes = _seven_missing(root, by_id, skip_missing)
     ext_poses = _external_poses(trajectory, len(ids))
     frames = []

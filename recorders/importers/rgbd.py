@@ -295,16 +295,17 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     picks = sample_indices(len(frames))
     raws = [read_depth_file(frames[i].depth_path) for i in picks]
     findings.problem(no_depth_problem(raws, str(root)), given=False)
-    findings.problem(depth_scale_problem(raws, scale, scale_origin),
-                     given=opts.depth_scale is not None)
     k = camera_for(seq, opts, raws[0].shape[1], raws[0].shape[0], findings)
     checks: list[tuple[str, str]] = []
     if seq.pose_source != "none" and all(f.pose is not None for f in frames):
+        # first: metric poses name the scale that fits better than a usual median does
         fit = check_scale_by_geometry(frames, k, scale, scale_origin, seq.pose_source,
                                       findings, given=opts.depth_scale is not None,
                                       estimate=opts.estimate_poses)
         checks.append(("depth scale against the poses",
                        fit.describe() if fit else "no verdict: no frame pair pins the motion down"))
+    findings.problem(depth_scale_problem(raws, scale, scale_origin),
+                     given=opts.depth_scale is not None)
     intr_origin = "flag --intrinsics" if opts.intrinsics is not None else \
         (seq.intrinsics.source if seq.intrinsics is not None else "given")
     if opts.intrinsics is None and intr_origin.startswith("folder-name default"):

@@ -194,8 +194,9 @@ def floor_problem(poses: Sequence[np.ndarray], alignment_matrix: np.ndarray, flo
     example = cam - 1.3
     return (f"the camera is {h:.2f} m above the floor ({origin}; at {floor:.3f} m in the "
             f"source), outside --camera-height {band[0]:g}:{band[1]:g}"
-            + (": the floor is probably not in view and a table or counter was taken for it"
-               if h < band[0] else "")
+            + (": a table or counter was taken for the floor (not in view), or the camera "
+               f"is mounted that low (a robot's: then give --camera-height "
+               f"{max(0.1, round(h - 0.1, 1)):g}:{band[1]:g})" if h < band[0] else "")
             + f"; give the floor's height with --floor (e.g. --floor {example:.2f} puts the "
             "camera at 1.3 m), or a wider --camera-height")
 

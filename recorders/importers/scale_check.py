@@ -161,20 +161,26 @@ def geometric_scale_problem(fit: ScaleFit | None, scale: float, origin: str,
             f"--depth-scale {fits:g} fits; give it, or --depth-scale {scale:g} to keep this one")
 
 
-MIN_RATIO = 0.2  # a depth that moves less than this far (either way) gives no verdict
+MIN_RATIO = 0.2  # a depth that moves less than this far (either way) stands still
+STILL_PAIRS = 3  # pairs over which depth standing still while the poses move is clear
 
 
 def pose_motion_problem(fit: ScaleFit | None, pose_source: str) -> tuple[str, bool] | None:
     """When the depth does not move as the poses (``pose_source``) say, at any one scale,
-    over two or more pairs: it moves against them (a ratio below -:data:`MIN_RATIO`: clear)
-    or the pairs' ratios spread beyond 35 % (likely). The text and whether it is clear;
-    None otherwise: a depth that hardly moves (a scene that does not pin the motion down)
-    gives no verdict, and a ratio of 20 or more is the depth scale's problem."""
-    if fit is None or fit.pairs < 2 or fit.consistent() or fit.ratio >= 20.0 or \
-            abs(fit.ratio) <= MIN_RATIO:
+    over two or more pairs: it moves against them (a ratio below -:data:`MIN_RATIO`: clear),
+    it stands still while every pair's poses moved, the pairs disagreeing (a ratio within
+    :data:`MIN_RATIO` of 0 spread beyond 35 %: clear over :data:`STILL_PAIRS` pairs or
+    more, as with world-to-camera poses, else likely), or the pairs' ratios spread beyond
+    35 % (likely). The text and whether it is clear; None otherwise (a ratio of 20 or more,
+    or a tiny one the pairs agree on, is the depth scale's problem)."""
+    if fit is None or fit.pairs < 2 or fit.consistent() or fit.ratio >= 20.0:
         return None
-    clear = fit.ratio < 0
-    how = (f"moves {fit.ratio:.2f}x as far as the poses" if clear else
+    if abs(fit.ratio) <= MIN_RATIO and fit.spread <= 0.35:
+        return None  # the pairs agree on a tiny ratio: the depth scale's problem
+    still = abs(fit.ratio) <= MIN_RATIO
+    clear = fit.ratio < -MIN_RATIO or (still and fit.pairs >= STILL_PAIRS)
+    how = (f"hardly moves ({fit.ratio:.2f}x as far as the poses) while they move"
+           if still else f"moves {fit.ratio:.2f}x as far as the poses" if clear else
            f"moves {fit.ratio:.2f}x as far as the poses, pair by pair up to "
            f"{fit.spread:.0%} apart")
     return (f"the poses ({pose_source}) do not move as the depth does: between {fit.pairs} "

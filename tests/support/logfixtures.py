@@ -16,10 +16,12 @@ from sgtool.log import schemas as S
 
 
 def synthetic_frame(i: int, width: int = 64, height: int = 48):
-    """Frame ``i``: a floor, a wall and a box whose position moves with ``i``."""
+    """Frame ``i``: a floor, a wall and a box whose position moves with ``i``. The camera
+    drives 0.05 m a frame towards the wall, which comes as near in the depth (down to
+    0.5 m): depth and poses agree, as the imports' pose check asks."""
     k = CameraIntrinsics.from_fov(width, height, 60.0)
     v, u = np.mgrid[0:height, 0:width]
-    depth = np.full((height, width), 3.0, np.float32)
+    depth = np.full((height, width), max(3.0 - 0.05 * i, 0.5), np.float32)
     ids = np.full((height, width), 2, np.int32)  # wall
     floor = v > height * 0.6
     depth[floor] = (1.2 * k.fy / np.maximum(v[floor] - k.cy, 1)).astype(np.float32)

@@ -414,3 +414,67 @@ def test_tum_estimate_reports_ground_truth(shared_data_dir, tmp_path):
                                   up=np.array([0.0, 0.0, 1.0]), **QUIET))
     assert rep.drift is not None and rep.drift_reference == "ground truth"
     assert any(line.startswith("drift against ground truth: ") for line in rep.lines())
+
+
+def test_7scenes_names_in_upper_case_are_read(rgbd_data, tmp_path):
+    """frame-XXXXXX.depth.PNG (a camera's or another file system's spelling) is the same
+    layout: detected, and each frame's files found whatever their case."""
+    import shutil
+
+    src = rgbd_data / "7scenes-redkitchen-every10"
+    folder = tmp_path / "upper"
+    folder.mkdir()
+    shutil.copy(src / "camera-intrinsics.txt", folder)
+    for n in range(0, 100, 10):
+        for kind, ext in (("color", "jpg"), ("depth", "png"), ("pose", "txt")):
+            name = f"frame-{n:06d}.{kind}.{ext}"
+            shutil.copy(src / name, folder / (name.upper().replace("FRAME", "frame")
+                                              if kind == "depth" else name))
+    assert detect_layout(folder) == "7scenes"
+    rep = import_rgbd(folder, tmp_path / "u.mcap", RgbdOptions(**QUIET))
+    assert rep.frames == 10
+
+
+def test_world_to_camera_poses_are_refused_for_what_they_are(rgbd_data, tmp_path):
+    """The ICL sequence with its trajectory inverted (world-to-camera): the depth hardly
+    moves while the poses do, over every pair checked. The import says the poses are
+    wrong, before the floor they would misplace (it blamed the floor, whose advice gave a
+    wrong map)."""
+    import shutil
+
+    src = rgbd_data / "icl-livingroom1-micro"
+    folder = tmp_path / "inverted"
+    shutil.copytree(src, folder)
+    lines = (src / "open3d_estimated_trajectory.log").read_text().split("\n")
+    out = []
+    for i in range(0, len(lines) - 4, 5):
+        if not lines[i].strip():
+            break
+        pose = np.array([[float(x) for x in lines[i + k].split()] for k in range(1, 5)])
+        out += [lines[i], *(" ".join(f"{x:.8f}" for x in row) for row in np.linalg.inv(pose))]
+    (folder / "open3d_estimated_trajectory.log").write_text("\n".join(out) + "\n")
+    with pytest.raises(SgtoolError, match=r"do not move as the depth does: .* hardly moves"):
+        import_rgbd(folder, tmp_path / "i.mcap", RgbdOptions(**QUIET, every=3))
+    assert not (tmp_path / "i.mcap").exists()
+
+
+def test_depth_at_another_scale_is_named_by_the_poses(rgbd_data, tmp_path):
+    """7-Scenes depth written at 5000 units/m (TUM's) instead of its 1000: the error names
+    5000, which the metric poses fit, not the usual scale whose median depth is nearest
+    2 m (4000, which imported with a map 21 % too large)."""
+    import shutil
+
+    import cv2
+
+    src = rgbd_data / "7scenes-redkitchen-every10"
+    folder = tmp_path / "k5000"
+    folder.mkdir()
+    shutil.copy(src / "camera-intrinsics.txt", folder)
+    for n in range(0, 300, 10):
+        for kind, ext in (("color", "jpg"), ("pose", "txt")):
+            shutil.copy(src / f"frame-{n:06d}.{kind}.{ext}", folder)
+        d = cv2.imread(str(src / f"frame-{n:06d}.depth.png"), cv2.IMREAD_UNCHANGED)
+        d = np.where(d == 65535, 65535, np.minimum(d.astype(np.int64) * 5, 65534))
+        cv2.imwrite(str(folder / f"frame-{n:06d}.depth.png"), d.astype(np.uint16))
+    with pytest.raises(SgtoolError, match=r"--depth-scale 5000 fits"):
+        import_rgbd(folder, tmp_path / "k.mcap", RgbdOptions(**QUIET))
