@@ -21,6 +21,7 @@
 from __future__ import annotations
 
 import re
+from collections import Counter
 from dataclasses import dataclass, replace
 from decimal import Decimal
 from pathlib import Path
@@ -185,7 +186,8 @@ def _images(folder: Path) -> list[Path]:
     """The image files of ``folder`` in natural order (names numbered without zero padding
     sort by value); names whose numbers tie ("1.png" and "01.png", "2.5.png" and "2.50.png")
     are an error."""
-    found = sorted((p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_EXT),
+    found = sorted((p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_EXT
+                    and not p.name.startswith(".")),  # hidden (macOS "._0001.png")
                    key=lambda p: (natural_key(p.name), p.name))
     for a, b in zip(found, found[1:], strict=False):
         if natural_key(a.name) == natural_key(b.name):
@@ -470,13 +472,31 @@ def _is_intrinsics_json(path: Path) -> bool:
         raise SgtoolError(f"{path}: cannot read ({e.strerror})") from e
 
 
+def _depth_images(folder: Path, notes: list[str]) -> list[Path]:
+    """The depth images of ``folder``: those of its most common image type (a stray
+    preview.jpg beside PNG depth is no frame), the others left out with a note."""
+    found = _images(folder)
+    kinds = Counter(p.suffix.lower() for p in found)
+    if len(kinds) < 2:
+        return found
+    main = max(sorted(kinds), key=lambda k: kinds[k])
+    stray = [p for p in found if p.suffix.lower() != main]
+    notes.append(f"{len(stray)} file(s) in {folder.name}/ are not {main} images as the "
+                 f"{kinds[main]} depth images are, and were left out (first: {stray[0].name})")
+    return [p for p in found if p.suffix.lower() == main]
+
+
 def _read_open3d(root: Path, fps: float, trajectory: Path | None) -> FolderSequence:
+    """Depth images of ``depth/`` and colour images of the colour folder, paired by name
+    (else in order when every name differs); a depth image without a colour image of its
+    name (a lab that dropped bad colour frames) is a frame without colour, with a note:
+    nothing lists the files, so none is missing."""
+    notes: list[str] = []
     cdir = _color_dir(root)
-    depths = _images(root / "depth")
+    depths = _depth_images(root / "depth", notes)
     colors = _images(cdir) if cdir is not None else []
     by_stem = {p.stem: p for p in colors}
     pairs: list[tuple[Path, Path | None]]
-    notes: list[str] = []
     matched = sum(d.stem in by_stem for d in depths)
     if matched or not colors:  # one naming scheme: by name, a depth image may lack colour
         pairs = [(d, by_stem.get(d.stem)) for d in depths]

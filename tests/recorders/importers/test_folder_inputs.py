@@ -399,6 +399,20 @@ def test_open3d_pairs_by_name_when_one_name_has_no_partner(tmp_path):
     assert "depth and colour images paired in order (their names differ)" in seq.notes
 
 
+def test_stray_and_hidden_files_in_depth_are_no_frames(tmp_path):
+    """A preview.jpg beside the PNG depth images and macOS's ._00000.png files: no frames
+    (the trajectory's 5 poses fit the 5 depth images), the stray file named in a note."""
+    names = [f"{i:05d}" for i in range(5)]
+    root = open3d_folder(tmp_path / "f", names)
+    write_open3d_log(root / "traj.log", [_pose(float(i)) for i in range(5)])
+    (root / "depth" / "preview.jpg").write_bytes((root / "image" / "00000.jpg").read_bytes())
+    (root / "depth" / "._00000.png").write_bytes(b"\0\5\x16\x07")
+    seq = read_sequence(root)
+    assert [f.depth_path.name for f in seq.frames] == [f"{n}.png" for n in names]
+    assert any("1 file(s) in depth/ are not .png images" in n and "preview.jpg" in n
+               for n in seq.notes)
+
+
 def test_seven_scenes_frames_without_a_pose_are_named_and_dropped_or_estimated(tmp_path):
     root = seven_folder(tmp_path / "s", n=4)
     (root / "frame-000002.pose.txt").unlink()
