@@ -94,8 +94,14 @@ def test_a_cut_inside_an_uncompressed_chunk_is_a_truncation(tmp_path):
 
 
 def test_corrupt_chunk_is_reported_and_skipped(long_log, tmp_path):
+    from mcap.reader import make_reader
+
+    with open(long_log, "rb") as f:
+        summary = make_reader(f).get_summary()
+    assert summary is not None
+    middle = summary.chunk_indexes[len(summary.chunk_indexes) // 2]
     data = bytearray(long_log.read_bytes())
-    data[len(data) // 2] ^= 0xFF
+    data[middle.chunk_start_offset + middle.chunk_length // 2] ^= 0xFF  # inside one chunk
     bad = tmp_path / "bad.mcap"
     bad.write_bytes(bytes(data))
     d = recover(bad, tmp_path / "ok.mcap")
