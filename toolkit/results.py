@@ -204,6 +204,16 @@ def read_jsonl(path: str | os.PathLike[str]) -> list[EpisodeResult]:
     return out
 
 
+def source_log(result: EpisodeResult, table: str | os.PathLike[str]) -> Path | None:
+    """The log a row of the table ``table`` (an ``episodes.jsonl``) names: its ``source``
+    as it is, or relative to the table's folder (run-bench names its logs so); None when
+    neither is a file (a symbolic episode, a log moved away)."""
+    for p in (Path(result.source), Path(table).parent / result.source):
+        if p.is_file():
+            return p
+    return None
+
+
 def results_digest(results: Sequence[EpisodeResult]) -> str:
     """SHA-256 over the canonical records without their ``wall`` figures."""
     h = hashlib.sha256()

@@ -30,7 +30,7 @@ import numpy as np
 from sgtool.house.spec import room_at
 from sgtool.log.reader import LogReader
 from sgtool.log.records import InstanceItem, Instances, SceneGraphRecord
-from sgtool.results import EpisodeResult, read_jsonl
+from sgtool.results import EpisodeResult, read_jsonl, source_log
 
 
 @dataclass(frozen=True)
@@ -120,8 +120,8 @@ def misses(folder: Path, planners: Sequence[str] = ()) -> list[Miss]:
     for r in read_jsonl(folder / "episodes.jsonl"):
         if r.success or (planners and r.planner not in planners):
             continue
-        log = Path(r.source)
-        if log.is_file():
+        log = source_log(r, folder / "episodes.jsonl")
+        if log is not None:
             out.append(miss_of(log, r))
     return out
 

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from sgtool.log.reader import LogReader
 from sgtool.log.records import Instances
-from sgtool.results import EpisodeResult, read_jsonl
+from sgtool.results import EpisodeResult, read_jsonl, source_log
 
 
 def target_holders(log: Path, query: str) -> set[int]:
@@ -36,13 +36,14 @@ def target_holders(log: Path, query: str) -> set[int]:
             if i.kind == "object" and i.category == query and isinstance(i.parent, int)}
 
 
-def reveals(result: EpisodeResult) -> dict[str, tuple[int, int]]:
+def reveals(result: EpisodeResult, table: Path) -> dict[str, tuple[int, int]]:
     """Per skill (``open``, ``navigate``: walking up to a piece examines it), the actions
     on a piece holding the target in one episode and those that ended it found."""
     out = {"open": (0, 0), "navigate": (0, 0)}
-    if not Path(result.source).is_file():
+    log = source_log(result, table)
+    if log is None:
         return out
-    holders = target_holders(Path(result.source), result.query)
+    holders = target_holders(log, result.query)
     for k, step in enumerate(result.trace):
         node = step.target
         if step.skill not in out or not node or not node.startswith("obj:"):
@@ -71,7 +72,7 @@ def main(argv: list[str]) -> int:
         acts: collections.Counter[tuple[str, str]] = collections.Counter()
         shown: collections.Counter[tuple[str, str]] = collections.Counter()
         for r in read_jsonl(path):
-            for skill, (n, s) in reveals(r).items():
+            for skill, (n, s) in reveals(r, path).items():
                 acts[r.planner, skill] += n
                 shown[r.planner, skill] += s
         for planner, skill in sorted(acts):

@@ -34,14 +34,16 @@ from sgtool.analysis.report import fmt_interval
 from sgtool.analysis.search_metrics import CostModel
 from sgtool.errors import SgtoolError
 from sgtool.log.reader import LogReader
-from sgtool.results import EpisodeResult, read_jsonl
+from sgtool.results import EpisodeResult, read_jsonl, source_log
 
 
-def _frames_per_room(r: EpisodeResult) -> float | None:
-    """Frames per room of the house of ``r``'s log; None without a readable log."""
-    if not Path(r.source).is_file():
+def _frames_per_room(r: EpisodeResult, table: Path) -> float | None:
+    """Frames per room of the house of ``r``'s log (a row of ``table``); None without a
+    readable log."""
+    log_path = source_log(r, table)
+    if log_path is None:
         return None
-    with LogReader(r.source) as log:
+    with LogReader(log_path) as log:
         ep = log.last_record("episode")
         spec = log.house_spec()
     frames = float((ep or {}).get("frames") or 0)
@@ -67,7 +69,7 @@ def load(folder: Path, noise: str | None = None
     elif len(profiles) > 1:
         raise SgtoolError(f"{folder}: episodes of several noise profiles "
                           f"({', '.join(map(repr, profiles))}): give --noise")
-    frames = {r.key(): _frames_per_room(r) for r in results}
+    frames = {r.key(): _frames_per_room(r, path) for r in results}
     if any(v is None for v in frames.values()):
         return results, None
     return results, {k: v for k, v in frames.items() if v is not None}

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import pytest
@@ -132,3 +133,19 @@ def test_plot_writes_png(tmp_path):
     assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     img = mpimg.imread(p)
     assert img.shape[0] > 100 and img.shape[1] > 100
+
+
+def test_source_log_finds_a_row_s_log_beside_its_table(tmp_path):
+    """run-bench rows name their logs relative to the run folder: found from anywhere;
+    a symbolic row, or a log moved away, has none."""
+    from sgtool.results import source_log
+
+    log = tmp_path / "run" / "logs" / "ep-000.mcap"
+    log.parent.mkdir(parents=True)
+    log.write_bytes(b"")
+    def row(source: str) -> EpisodeResult:
+        return dataclasses.replace(_result(), source=source)
+
+    assert source_log(row("logs/ep-000.mcap"), tmp_path / "run" / "episodes.jsonl") == log
+    assert source_log(row(str(log)), tmp_path / "x.jsonl") == log
+    assert source_log(row("symbolic"), tmp_path / "run" / "episodes.jsonl") is None
