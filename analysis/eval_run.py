@@ -64,9 +64,9 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
     results, logged, notes, unread = load_many([Path(i) for i in request.inputs], request.runner,
                                                progress=request.progress)
     results = [with_seen(with_success_rule(r, request.success)) for r in results]
+    results, profiles = per_noise(results)  # (fills the noise a row's folder names)
     results, twice = once_each(results)
     notes = [*notes, *twice]
-    results, profiles = per_noise(results)
     if profiles:
         notes = [*notes, f"the episodes ran under {len(profiles)} sensor noise profiles "
                  f"({', '.join(profiles)}): each planner is scored per profile, as "
@@ -146,9 +146,9 @@ def _outcome(r: EpisodeResult) -> tuple[object, ...]:
 def _unlike_episodes(results: Sequence[EpisodeResult]) -> str | None:
     """A note when the planners were not run on the same episodes (house, episode, seed,
     query): their rows are then not comparable as they stand (the paired tables are)."""
-    sets: dict[str, set[tuple[str, int, int, str, str]]] = {}
-    for r in results:
-        sets.setdefault(r.planner, set()).add(_episode_key(r)[1:])
+    sets: dict[str, set[tuple[str, int, int, str]]] = {}
+    for r in results:  # (the noise profile is in the planner's name when there are several)
+        sets.setdefault(r.planner, set()).add(_episode_key(r)[1:5])
     if len(sets) < 2 or len({frozenset(s) for s in sets.values()}) == 1:
         return None
     common = set.intersection(*sets.values())

@@ -206,9 +206,9 @@ def read_jsonl(path: str | os.PathLike[str]) -> list[EpisodeResult]:
 
 def source_log(result: EpisodeResult, table: str | os.PathLike[str]) -> Path | None:
     """The log a row of the table ``table`` (an ``episodes.jsonl``) names: its ``source``
-    as it is, or relative to the table's folder (run-bench names its logs so); None when
+    relative to the table's folder (run-bench names its logs so), else as it is; None when
     neither is a file (a symbolic episode, a log moved away)."""
-    for p in (Path(result.source), Path(table).parent / result.source):
+    for p in (Path(table).parent / result.source, Path(result.source)):
         if p.is_file():
             return p
     return None

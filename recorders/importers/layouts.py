@@ -473,17 +473,23 @@ def _is_intrinsics_json(path: Path) -> bool:
 
 
 def _depth_images(folder: Path, notes: list[str]) -> list[Path]:
-    """The depth images of ``folder``: those of its most common image type (a stray
-    preview.jpg beside PNG depth is no frame), the others left out with a note."""
+    """The depth images of ``folder``: those of its most common lossless image type (JPEG
+    never holds depth: previews beside PNG depth are no frames, however many), the others
+    left out with a note; .tif/.tiff and .jpg/.jpeg are one type."""
     found = _images(folder)
-    kinds = Counter(p.suffix.lower() for p in found)
+
+    def kind(p: Path) -> str:
+        s = p.suffix.lower()
+        return {".tiff": ".tif", ".jpeg": ".jpg"}.get(s, s)
+
+    kinds = Counter(kind(p) for p in found)
     if len(kinds) < 2:
         return found
-    main = max(sorted(kinds), key=lambda k: kinds[k])
-    stray = [p for p in found if p.suffix.lower() != main]
+    main = max(sorted(kinds), key=lambda k: (k != ".jpg", kinds[k]))
+    stray = [p for p in found if kind(p) != main]
     notes.append(f"{len(stray)} file(s) in {folder.name}/ are not {main} images as the "
                  f"{kinds[main]} depth images are, and were left out (first: {stray[0].name})")
-    return [p for p in found if p.suffix.lower() == main]
+    return [p for p in found if kind(p) == main]
 
 
 def _read_open3d(root: Path, fps: float, trajectory: Path | None) -> FolderSequence:

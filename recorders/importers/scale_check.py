@@ -38,6 +38,8 @@ class ScaleFit:
     ratio: float
     pairs: int
     spread: float
+    step_m: float = 0.0  # the median pose translation of the pairs (m)
+    matched: float = 1.0  # the median share of a pair's points matched
 
     def describe(self) -> str:
         return (f"depth moves {self.ratio:.2f}x as far as the poses over {self.pairs} frame "
@@ -115,21 +117,24 @@ def fit_scale(pairs: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarr
     :data:`MIN_MATCHED` or moving under :data:`MIN_ALONG_M` along the surfaces' normals
     (or of one depth image twice) left out, the rest combined weighted by that motion;
     None without a usable pair."""
-    ratios, weights = [], []
+    ratios, weights, steps, shares = [], [], [], []
     for d0, d1, p0, p1 in pairs:
         rel = np.linalg.inv(p0) @ p1  # camera j in camera i
-        if float(np.linalg.norm(rel[:3, 3])) < MIN_STEP_M or _same_image(d0, d1):
+        step = float(np.linalg.norm(rel[:3, 3]))
+        if step < MIN_STEP_M or _same_image(d0, d1):
             continue
         got = translation_scale(d0, d1, k, rel)
         if got is None or got[1] < MIN_MATCHED or got[2] < MIN_ALONG_M:
             continue
         ratios.append(got[0])
         weights.append(got[2] ** 2)
+        steps.append(step)
+        shares.append(got[1])
     if not ratios:
         return None
     r = float(np.average(ratios, weights=weights))
     spread = max(abs(x / r - 1.0) for x in ratios) if r > 0 else float("inf")
-    return ScaleFit(r, len(ratios), spread)
+    return ScaleFit(r, len(ratios), spread, float(np.median(steps)), float(np.median(shares)))
 
 
 def _same_image(d0: np.ndarray, d1: np.ndarray) -> bool:
@@ -162,7 +167,8 @@ def geometric_scale_problem(fit: ScaleFit | None, scale: float, origin: str,
 
 
 MIN_RATIO = 0.2  # a depth that moves less than this far (either way) stands still
-STILL_PAIRS = 3  # pairs over which depth standing still while the poses move is clear
+STILL_PAIRS = 3  # pairs over which depth standing still while the poses move is clear,
+STILL_STEP_M = 0.05  # when the pairs' poses move this far (median): well beyond depth noise
 
 
 def pose_motion_problem(fit: ScaleFit | None, pose_source: str) -> tuple[str, bool] | None:
@@ -170,7 +176,9 @@ def pose_motion_problem(fit: ScaleFit | None, pose_source: str) -> tuple[str, bo
     over two or more pairs: it moves against them (a ratio below -:data:`MIN_RATIO`: clear),
     it stands still while every pair's poses moved, the pairs disagreeing (a ratio within
     :data:`MIN_RATIO` of 0 spread beyond 35 %: clear over :data:`STILL_PAIRS` pairs or
-    more, as with world-to-camera poses, else likely), or the pairs' ratios spread beyond
+    more whose poses moved :data:`STILL_STEP_M` or more, as with world-to-camera poses;
+    else likely: a camera panning on a tripod moves a few cm a pair, which depth noise
+    hides), or the pairs' ratios spread beyond
     35 % (likely). The text and whether it is clear; None otherwise (a ratio of 20 or more,
     or a tiny one the pairs agree on, is the depth scale's problem)."""
     if fit is None or fit.pairs < 2 or fit.consistent() or fit.ratio >= 20.0:
@@ -178,7 +186,8 @@ def pose_motion_problem(fit: ScaleFit | None, pose_source: str) -> tuple[str, bo
     if abs(fit.ratio) <= MIN_RATIO and fit.spread <= 0.35:
         return None  # the pairs agree on a tiny ratio: the depth scale's problem
     still = abs(fit.ratio) <= MIN_RATIO
-    clear = fit.ratio < -MIN_RATIO or (still and fit.pairs >= STILL_PAIRS)
+    clear = fit.ratio < -MIN_RATIO or (still and fit.pairs >= STILL_PAIRS
+                                       and fit.step_m >= STILL_STEP_M)
     how = (f"hardly moves ({fit.ratio:.2f}x as far as the poses) while they move"
            if still else f"moves {fit.ratio:.2f}x as far as the poses" if clear else
            f"moves {fit.ratio:.2f}x as far as the poses, pair by pair up to "

@@ -62,3 +62,18 @@ def test_p_without_logged_decisions_says_so(tmp_path) -> None:
     write_jsonl([RUN], tmp_path / "episodes.jsonl")
     r = CliRunner().invoke(cli, ["eval", str(tmp_path), "-p", "greedy"])
     assert r.exit_code == 2 and "the inputs' logs hold no decision" in r.output, r.output
+
+
+def test_one_episode_under_two_noise_profiles_is_two_runs(tmp_path) -> None:
+    """An older run-bench table (rows without a noise field; the profile is the folder of
+    each log) where an episode ended alike under two profiles: two runs, one per
+    profile, not one given twice."""
+    rows = [dataclasses.replace(RUN, noise="", source=f"logs/{noise}/greedy/house-0/ep-000.mcap")
+            for noise in ("none", "strong")]
+    write_jsonl(rows, tmp_path / "episodes.jsonl")
+    r = CliRunner().invoke(cli, ["eval", str(tmp_path), "--json"])
+    assert r.exit_code == 0, r.output
+    assert "given twice" not in r.stderr and "different episodes" not in r.stderr, r.stderr
+    doc = json.loads(r.stdout)
+    assert {p: v["episodes"] for p, v in doc["planners"].items()} == \
+        {"greedy [none]": 1, "greedy [strong]": 1}

@@ -149,3 +149,16 @@ def test_source_log_finds_a_row_s_log_beside_its_table(tmp_path):
     assert source_log(row("logs/ep-000.mcap"), tmp_path / "run" / "episodes.jsonl") == log
     assert source_log(row(str(log)), tmp_path / "x.jsonl") == log
     assert source_log(row("symbolic"), tmp_path / "run" / "episodes.jsonl") is None
+    # beside the table first: another run's logs of the same names in the working
+    # directory are not this row's
+    other = tmp_path / "logs" / "ep-000.mcap"
+    other.parent.mkdir()
+    other.write_bytes(b"")
+    import os
+
+    here = os.getcwd()
+    try:
+        os.chdir(tmp_path)
+        assert source_log(row("logs/ep-000.mcap"), tmp_path / "run" / "episodes.jsonl") == log
+    finally:
+        os.chdir(here)

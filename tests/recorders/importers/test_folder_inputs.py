@@ -411,6 +411,17 @@ def test_stray_and_hidden_files_in_depth_are_no_frames(tmp_path):
     assert [f.depth_path.name for f in seq.frames] == [f"{n}.png" for n in names]
     assert any("1 file(s) in depth/ are not .png images" in n and "preview.jpg" in n
                for n in seq.notes)
+    # a JPEG preview beside every PNG (a tie): the PNGs are the depth, JPEG holds none
+    for n in names:
+        (root / "depth" / f"{n}.jpg").write_bytes(b"")
+    assert [f.depth_path.name for f in read_sequence(root).frames] == \
+        [f"{n}.png" for n in names]
+    # .tif and .tiff are one type
+    tif = open3d_folder(tmp_path / "t", names)
+    write_open3d_log(tif / "traj.log", [_pose(float(i)) for i in range(5)])
+    for i, n in enumerate(names):
+        (tif / "depth" / f"{n}.png").rename(tif / "depth" / f"{n}.{'tif' if i % 2 else 'tiff'}")
+    assert len(read_sequence(tif).frames) == 5
 
 
 def test_seven_scenes_frames_without_a_pose_are_named_and_dropped_or_estimated(tmp_path):
