@@ -203,8 +203,9 @@ def replay_dict(report: Any, scores: Any, rrd: str | None) -> dict[str, Any]:
         },
         "rrd": rrd,
     }
-    if report.warnings:
-        out["warnings"] = list(report.warnings)
+    warnings = [*report.warnings, *report.graph_warnings()]
+    if warnings:
+        out["warnings"] = warnings
     if report.notes:
         out["notes"] = list(report.notes)
     if scores is not None:

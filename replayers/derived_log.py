@@ -218,24 +218,32 @@ class ReplayReport:
                        f"{len(g.rooms) - len(explored)} unexplored behind closed doors, "
                        f"{len(g.objects)} objects, {len(g.frontiers())} frontiers, "
                        f"{len(g.doors)} doors")
-            if not g.rooms and self.frames >= self.options.every:
-                out.append(f"warning: no room in the final graph after {self.frames} frames: "
-                           "the map found no free floor for its Voronoi graph; noisy depth "
-                           "far from the camera reads as obstacles (try --max-depth "
-                           f"{max(1.0, self.options.max_depth - 2):g})")
-            if self.semantic and not g.objects and not g.doors \
-                    and self.frames >= self.options.every:
-                out.append(f"warning: the log has instance ids, but no object or door was "
-                           f"seen in {self.frames} frames (ids on floor and walls only, a "
-                           "segmenter that failed, or ids its instance table does not name): "
-                           "the graph has geometry only")
-            lone = sum(len(set(d.rooms)) < 2 for d in g.doors)
-            if lone and g.rooms:
-                out.append(f"warning: {lone} of {len(g.doors)} doors join one room only: "
-                           "the floor behind them was not mapped, or the rooms on their two "
-                           "sides merged (pose drift or jumps, or a door unlabelled in most "
-                           "frames)")
+            out.extend(f"warning: {w}" for w in self.graph_warnings())
         return out + stage_lines(self.stages)
+
+    def graph_warnings(self) -> list[str]:
+        """What the final graph says went wrong (no room, no object or door of a log with
+        ids, doors joining one room), for the report and ``--json``."""
+        if self.last is None:
+            return []
+        g, out = self.last.graph, []
+        if not g.rooms and self.frames >= self.options.every:
+            out.append(f"no room in the final graph after {self.frames} frames: the map "
+                       "found no free floor for its Voronoi graph; noisy depth far from the "
+                       "camera reads as obstacles (try --max-depth "
+                       f"{max(1.0, self.options.max_depth - 2):g})")
+        if self.semantic and not g.objects and not g.doors \
+                and self.frames >= self.options.every:
+            out.append(f"the log has instance ids, but no object or door was seen in "
+                       f"{self.frames} frames (ids on floor and walls only, a segmenter that "
+                       "failed, or ids its instance table does not name): the graph has "
+                       "geometry only")
+        lone = sum(len(set(d.rooms)) < 2 for d in g.doors)
+        if lone and g.rooms:
+            out.append(f"{lone} of {len(g.doors)} doors join one room only: the floor behind "
+                       "them was not mapped, or the rooms on their two sides merged (pose "
+                       "drift or jumps, or a door unlabelled in most frames)")
+        return out
 
 
 def replay(

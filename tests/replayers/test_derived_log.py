@@ -440,3 +440,8 @@ def test_ids_that_name_nothing_are_warned_about(tmp_path: Path) -> None:
     assert rep.semantic and not rep.last.graph.objects
     assert any(line.startswith("warning: the log has instance ids, but no object or door "
                                "was seen in 12 frames") for line in rep.lines())
+    # and --json says it too (scripted studies read the JSON only)
+    r = CliRunner().invoke(cli, ["replay", str(log), "--every", "5", "--json"])
+    assert r.exit_code == 0, r.output
+    assert any(w.startswith("the log has instance ids, but no object or door was seen")
+               for w in json.loads(r.stdout)["warnings"])
