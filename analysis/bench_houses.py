@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from sgtool.errors import SgtoolError, SpecError
+from sgtool.house.io import house_file_id
 from sgtool.house.spec import HouseSpec
 from sgtool.semantics.text import category_text
 
@@ -133,7 +134,7 @@ def load_house_files(paths: Sequence[str | os.PathLike[str]],
         if bad:
             problems.append(bad)
             continue
-        hid = _house_id(spec, f)
+        hid = house_file_id(f)
         bad = folder_name_problem(hid)
         if bad:
             problems.append(f"{f}: id: the house id {hid!r} (its \"id\", else the file "
@@ -326,17 +327,6 @@ def output_path(root: str | os.PathLike[str], *names: str) -> Path:
             raise SgtoolError(f"{n!r} cannot name a folder or file inside {root}: "
                               f"{bad}")
     return Path(root).joinpath(*names)
-
-
-def _house_id(spec: HouseSpec, path: Path) -> str:
-    own = getattr(spec, "id", None)
-    if not own:
-        try:
-            raw: Any = json.loads(path.read_text(encoding="utf-8-sig"))
-            own = raw.get("id") if isinstance(raw, dict) else None
-        except (OSError, ValueError):
-            own = None
-    return own if isinstance(own, str) and own.strip() else path.stem
 
 
 def bench_episodes(spec: HouseSpec, count: int, preset: str = "default") -> list[Any]:

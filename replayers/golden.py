@@ -350,9 +350,10 @@ def diff_graphs(expected: SceneGraph, actual: SceneGraph, tol: float = 1e-4,
     turn = abs(math.remainder(er.yaw - ar.yaw, math.tau))
     if _beyond(turn, tol):
         out.append(f"robot: yaw {er.yaw:.4f} -> {ar.yaw:.4f} rad")
-    if expected.time_ns != actual.time_ns or expected.version != actual.version:
-        out.append(f"graph: time {expected.time_ns} -> {actual.time_ns} ns, version "
-                   f"{expected.version} -> {actual.version}")
+    if expected.time_ns != actual.time_ns:
+        out.append(f"graph: time {expected.time_ns} -> {actual.time_ns} ns")
+    if expected.version != actual.version:
+        out.append(f"graph: version {expected.version} -> {actual.version}")
     out += _distance_changes(expected, actual, tol)
     if not out and expected.to_json() != actual.to_json():
         out.append(ROUNDING)

@@ -200,6 +200,9 @@ def test_every_field_of_a_graph_is_compared():
                             tol=0.01)
         assert lines and ROUNDING not in lines, (name, lines)
     assert tried >= 20
+    # each line names what changed: the time alone is no change of version
+    later = dataclasses.replace(g, time_ns=g.time_ns + 1)
+    assert diff_graphs(g, later) == [f"graph: time {g.time_ns} -> {g.time_ns + 1} ns"]
     # affordances are a set (the JSON sorts them): their order is no change
     obj = next(o for o in g.objects if len(o.affordances) > 1)
     turned = dataclasses.replace(obj, affordances=tuple(reversed(obj.affordances)))

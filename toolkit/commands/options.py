@@ -98,9 +98,10 @@ def house_from_options(path: str | None, seed: int | None, rooms: str) -> tuple[
         raise SgtoolError(f"--rooms {rooms}: the room count of a house generated with --seed; "
                           "give --seed N as well")
     if path is not None:
-        from sgtool.house.io import load_house
+        from sgtool.house.io import house_file_id, load_house
 
-        return load_house(Path(path)), Path(path).stem  # a path, even one starting with "{"
+        # a path, even one starting with "{"; named as bench names it (its "id", else stem)
+        return load_house(Path(path)), house_file_id(path)
     if seed is not None:
         from sgtool.datasets.generator import generate_house
 
@@ -309,10 +310,11 @@ PLANNERS_HELP = ("Comma-separated planners to compare; --list-planners shows eve
                  f"its options. Default: {DEFAULT_PLANNERS_HELP} (the papers' planners and "
                  "their ablations); bayes-rooms, voi and the LLM planners (moma-llm, "
                  "unstructured-llm, godhs-llm) run when named. ")
-PLUGIN_HELP = ("A planner may be a plug-in: module:Name (a class or factory importable from "
-               "PYTHONPATH, called with its -O options; with --executor ray the module must "
-               "be importable on every machine) or a name an installed package registers in "
-               "the entry-point group sgtool.planners.")
+PLUGIN_HELP_ONE = ("A planner may be a plug-in: module:Name (a class or factory importable "
+                   "from PYTHONPATH, called with its -O options) or a name an installed "
+                   "package registers in the entry-point group sgtool.planners.")
+PLUGIN_HELP = PLUGIN_HELP_ONE + (" With --executor ray a plug-in's module must be importable "
+                                 "on every machine.")
 
 
 def planner_names(text: str) -> tuple[str, ...]:

@@ -16,7 +16,7 @@ import click
 
 from sgtool.commands.options import (
     FINITE_FLOAT,
-    PLUGIN_HELP,
+    PLUGIN_HELP_ONE,
     LlmEndpoint,
     check_log_output,
     explore_on_option,
@@ -43,7 +43,7 @@ if TYPE_CHECKING:
 @click.command("run")
 @click.option("--planner", "-p", required=True, is_eager=True,
               help="The planner: a built-in (--list-planners shows them all with their "
-              "options: scout, voi, bayes-search, moma-llm, ...). " + PLUGIN_HELP)
+              "options: scout, voi, bayes-search, moma-llm, ...). " + PLUGIN_HELP_ONE)
 @list_planners_option("--planner")
 @house_options(
     seed_help="Search a generated evaluation house (`sgtool scenes generate`) of this seed "

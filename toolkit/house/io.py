@@ -71,6 +71,18 @@ def load_house_text(text: str, limits: SpecLimits = LIMITS) -> HouseSpec:
     return parse_house(data, limits)
 
 
+def house_file_id(path: str | os.PathLike[str]) -> str:
+    """The id a house file goes by: its ``"id"`` (checked on load), else its file name
+    without the suffix; ``sgtool bench``, ``record`` and ``run`` name logs and rows by it."""
+    p = Path(path)
+    try:
+        raw: Any = json.loads(p.read_text(encoding="utf-8-sig"))
+    except (OSError, ValueError):
+        raw = None
+    own = raw.get("id") if isinstance(raw, dict) else None
+    return own if isinstance(own, str) and own.strip() else p.stem
+
+
 def _is_file(name: str) -> bool:
     try:
         return len(name) < 4096 and "\0" not in name and Path(name).is_file()

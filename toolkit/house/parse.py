@@ -89,6 +89,7 @@ _ROOM_KEYS = frozenset({"id", "category", "polygon", "open_plan_group"})
 _WALL_KEYS = frozenset({"id", "a", "b", "thickness", "height"})
 _PASSAGE_KEYS = frozenset({"id", "center", "width", "yaw", "rooms"})
 _DOOR_KEYS = _PASSAGE_KEYS | {"state", "height", "thickness"}
+FLOOR_SLACK_M = 0.01  # a box's bottom may sit this far under the floor (rounding)
 _FURNITURE_KEYS = frozenset({"id", "category", "synset", "room", "center", "size", "yaw",
                              "affordances", "state", "levels"})
 _OBJECT_KEYS = frozenset({"id", "category", "synset", "parent", "relation", "room", "position",
@@ -371,11 +372,17 @@ class _Parser:
         x = _json_object(where, x, _FURNITURE_KEYS)
         size = self.size(f"{where}.size", _required(where, x, "size"), self.limits.furniture_side)
         aff, state = self.affordances(where, x)
+        center = self.vec3(f"{where}.center", _required(where, x, "center"))
+        if center[2] - size[2] / 2 < -FLOOR_SLACK_M:
+            raise SpecError(f"{where}.center: the box's bottom is at z = "
+                            f"{center[2] - size[2] / 2:g} m, under the floor (z is the box "
+                            f"centre's height: a piece standing on the floor has z = "
+                            f"{size[2] / 2:g})")
         return Furniture(
             id=self.string(where, x, "id"), category=self.category(where, x),
             synset=self.string(where, x, "synset"),
             room=self.room_ref(f"{where}.room", _required(where, x, "room")),
-            center=self.vec3(f"{where}.center", _required(where, x, "center")),
+            center=center,
             size=size,
             yaw=self.number(f"{where}.yaw", x.get("yaw", 0.0)),
             affordances=aff, state=state, levels=self.levels(f"{where}.levels", x, size[2]),

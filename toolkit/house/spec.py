@@ -6,7 +6,8 @@ is a frozen contract, validated on load (:func:`sgtool.house.io.load_house`, rul
 :mod:`sgtool.house.parse` and :mod:`sgtool.house.consistency`) with messages that name the
 offending field (``rooms[2].polygon: needs at least 3 points``).
 
-Conventions (all of them are checked on load):
+Conventions (checked on load, all but one: rooms a passage joins need not share an
+``open_plan_group``; the scores then count them as two rooms):
 
 - metres, z up, yaw counter-clockwise from +x in radians;
 - ids are strings with a kind prefix, usually followed by a running number: ``room_0``,

@@ -159,3 +159,9 @@ def test_options_refused_before_any_work(tmp_path: Path, args: list[str], says: 
     assert r.exit_code == 2, r.output
     assert says in r.output and "Traceback" not in r.output
     assert not (tmp_path / "out").exists() and not Path("w1").exists()
+
+
+def test_run_help_names_no_option_it_lacks() -> None:
+    """`run` has no --executor: its planner help does not send plug-ins to Ray."""
+    r = CliRunner().invoke(cli, ["run", "-h"])
+    assert r.exit_code == 0 and "--executor" not in r.output
