@@ -98,4 +98,4 @@ _.write_rerun  # analysis/view_run.py: public API (sgtool.write_rerun)
 _.room_check  # toolkit/semantics/everyday_rooms.py: a user scores own priors (module doc)
 _.accuracy  # toolkit/semantics/everyday_rooms.py: RoomCheck property (top-1 share)
 _.get_metavar  # toolkit/commands/options.py: FiniteFloatRange, called by click for --help
-_.source_log  # toolkit/results.py: a run-bench row's log (tools/run_bench_ab.py, closed_loop_misses.py, open_reveals.py)
+_.source_log  # toolkit/results.py: a run-bench row's log (tools/run_bench_ab.py and others)

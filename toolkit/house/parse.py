@@ -89,7 +89,6 @@ _ROOM_KEYS = frozenset({"id", "category", "polygon", "open_plan_group"})
 _WALL_KEYS = frozenset({"id", "a", "b", "thickness", "height"})
 _PASSAGE_KEYS = frozenset({"id", "center", "width", "yaw", "rooms"})
 _DOOR_KEYS = _PASSAGE_KEYS | {"state", "height", "thickness"}
-FLOOR_SLACK_M = 0.01  # a box's bottom may sit this far under the floor (rounding)
 _FURNITURE_KEYS = frozenset({"id", "category", "synset", "room", "center", "size", "yaw",
                              "affordances", "state", "levels"})
 _OBJECT_KEYS = frozenset({"id", "category", "synset", "parent", "relation", "room", "position",
@@ -373,11 +372,6 @@ class _Parser:
         size = self.size(f"{where}.size", _required(where, x, "size"), self.limits.furniture_side)
         aff, state = self.affordances(where, x)
         center = self.vec3(f"{where}.center", _required(where, x, "center"))
-        if center[2] - size[2] / 2 < -FLOOR_SLACK_M:
-            raise SpecError(f"{where}.center: the box's bottom is at z = "
-                            f"{center[2] - size[2] / 2:g} m, under the floor (z is the box "
-                            f"centre's height: a piece standing on the floor has z = "
-                            f"{size[2] / 2:g})")
         return Furniture(
             id=self.string(where, x, "id"), category=self.category(where, x),
             synset=self.string(where, x, "synset"),
