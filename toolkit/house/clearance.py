@@ -7,7 +7,8 @@ another piece or the room's border covers: the point :data:`FRONT_CLEAR` in fron
 middle of the front face is outside the piece's room, within a wall's body or inside
 another piece's footprint (a cabinet set with its back to the room). :func:`cramped_starts`
 finds the start poses nearer to a wall or a piece than the robot's radius (the simulator
-then starts the robot overlapping it).
+then starts the robot overlapping it). :func:`hidden_pieces` finds the pieces no camera
+can see: a box whose top lies under the floor, or one inside another piece's box.
 """
 
 from __future__ import annotations
@@ -99,4 +100,27 @@ def cramped_starts(spec: HouseSpec, radius: float) -> list[tuple[int, float]]:
         gap = covers.gap(s.x, s.y, radius)
         if gap < radius:
             out.append((i, max(gap, 0.0)))
+    return out
+
+
+def hidden_pieces(spec: HouseSpec) -> list[tuple[int, str]]:
+    """(furniture index, why) of the pieces the simulator shows nothing of, in spec order:
+    a box whose top lies under the floor, or one inside another piece's box (its footprint
+    within the other's, its height within the other's). What they hold is never seen in
+    a recording, while the symbolic bench, which reads the spec, finds it."""
+    covers = Covers(spec)
+    out = []
+    for k, f in enumerate(spec.furniture):
+        if f.top <= 0.0:
+            out.append((k, f"its box lies under the floor (top at z = {f.top:g} m)"))
+            continue
+        box = covers.fbox[k]
+        near = np.flatnonzero((covers.fbox[:, 0] <= box[0]) & (covers.fbox[:, 1] <= box[1])
+                              & (covers.fbox[:, 2] >= box[2]) & (covers.fbox[:, 3] >= box[3]))
+        for j in near.tolist():
+            g = spec.furniture[j]
+            if j != k and g.bottom <= f.bottom + 1e-6 and f.top <= g.top + 1e-6 and all(
+                    point_in_polygon(x, y, covers.feet[j]) for x, y in covers.feet[k]):
+                out.append((k, f"its box lies inside furniture[{j}] ({g.id}, {g.category})"))
+                break
     return out
