@@ -71,14 +71,19 @@ def weights_report(weights: Path) -> dict[str, Any]:
     out of training with the seed their metadata records)."""
     from sgtool.datasets.relational import evaluation_sets, training_sets
     from sgtool.semantics.distill import quality_report
+    from sgtool.semantics.priors import LearnedPriors
 
     if not (weights / "metadata.json").is_file():
         raise SgtoolError(f"{weights}: no metadata.json; not a folder of distilled weights")
     try:
-        seed = int(json.loads((weights / "metadata.json").read_text())["config"]["seed"])
-    except (ValueError, KeyError, TypeError) as e:  # (JSONDecodeError is a ValueError)
+        meta = json.loads((weights / "metadata.json").read_text())
+        seed = int(meta["config"]["seed"])
+        if not isinstance(meta["heldout_queries"], list):
+            raise TypeError("heldout_queries is not a list")
+    except (ValueError, KeyError, TypeError, UnicodeDecodeError) as e:  # (JSON errors too)
         raise SgtoolError(f"{weights / 'metadata.json'}: not the metadata `sgtool distill` "
                           f"writes ({type(e).__name__}: {e})") from e
+    LearnedPriors(weights_dir=weights)  # the planners' own checks: files, sizes, encoder
     built = training_sets(seed=seed)
     return quality_report(weights, (built.containment, built.cooccurrence),
                           eval_sets=evaluation_sets(seed=seed))

@@ -21,14 +21,33 @@ if TYPE_CHECKING:
     from sgtool.analysis.priors_training import LlmSource
 
 
+# the options of training, which --report (no training) does not take
+_TRAINING = ("seed", "holdout", "epochs_containment", "epochs_cooccurrence", "keep", "threads",
+             "room_blend", "source", "force")
+
+
 def _check_modes(out_dir: Path | None, report_only: bool, source: str,
-                 llm_slice: str | None) -> None:
-    """Options that do not go together, one line each."""
+                 llm_slice: str | None, weights_dir: Path | None = None) -> None:
+    """Options that do not go together, one line each: training options with --report,
+    --weights (what --report reads) without it."""
+    from click.core import ParameterSource
+
     if llm_slice is not None and source != "llm":
         raise SgtoolError("--llm-slice is for --source llm")
     if report_only and out_dir is not None:
         raise SgtoolError(f"--report trains nothing, so --out {out_dir} has nothing to go "
                           "there; to report on weights give --weights DIR")
+    ctx = click.get_current_context(silent=True)
+    if ctx is None:
+        return
+    given = [f"--{n.replace('_', '-')}" for n in _TRAINING
+             if ctx.get_parameter_source(n) is ParameterSource.COMMANDLINE]
+    if report_only and given:
+        raise SgtoolError(f"--report trains nothing: {', '.join(given)} would do nothing "
+                          "(the report uses the seed the weights were trained with)")
+    if not report_only and weights_dir is not None:
+        raise SgtoolError(f"--weights {weights_dir} is the folder --report reads; training "
+                          "starts afresh and writes --out")
 
 
 def _weights_dir() -> Path:
@@ -71,8 +90,8 @@ def _weights_dir() -> Path:
               help="Keep the final weights, or those of the epoch with the lowest "
                    "validation loss.")
 @click.option("--threads", type=click.IntRange(1, 64), default=1, show_default=True,
-              help="Torch CPU threads (1 keeps the weights bit-identical across machines "
-                   "with the same libraries).")
+              help="Torch CPU threads (1 gives bit-identical weights run after run on one "
+                   "machine; processors of other kinds may round differently).")
 @click.option("--room-blend", is_flag=True,
               help="Train on the widened room knowledge (room types a house lacks folded "
                    "into the most alike household type; ProcTHOR's room annotations) and "
@@ -114,7 +133,7 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
     )
     from sgtool.semantics.distill import format_report
 
-    _check_modes(out_dir, report_only, source, llm_slice)
+    _check_modes(out_dir, report_only, source, llm_slice, weights_dir)
     if report_only:
         rep = weights_report(weights_dir or _weights_dir())
         click.echo(json.dumps(rep, indent=1, sort_keys=True) if as_json else format_report(rep))

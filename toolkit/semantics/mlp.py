@@ -108,12 +108,16 @@ def load_mlp(path: str | Path, relation: str | None = None) -> RelationMLP:
     except Exception as e:  # noqa: BLE001 - safetensors' own error types: a damaged file
         raise SgtoolError(f"{path}: not readable relational model weights "
                           f"({type(e).__name__}: {e}); `sgtool distill` writes them") from e
-    return RelationMLP(
-        relation=relation or meta.get("relation", path.stem),
-        weights=tuple(ws),
-        biases=tuple(bs),
-        metadata=meta,
-    )
+    try:
+        return RelationMLP(
+            relation=relation or meta.get("relation", path.stem),
+            weights=tuple(ws),
+            biases=tuple(bs),
+            metadata=meta,
+        )
+    except ValueError as e:  # layer sizes of another model: not these weights
+        raise SgtoolError(f"{path}: {e}; `sgtool distill` writes the weights sgtool "
+                          "loads") from None
 
 
 def save_mlp(

@@ -150,6 +150,8 @@ def test_an_option_reaches_a_planner_spelled_in_another_case() -> None:
 @pytest.mark.parametrize("args, says", [
     (["study", "noise", "--fps", "1e9", "--houses", "1"], "--fps 1000000000.0: must be 0.1..1000"),
     (["distill", "--report", "--out", "w1"], "--report trains nothing"),
+    (["distill", "--report", "--seed", "5"], "--report trains nothing: --seed would do"),
+    (["distill", "--weights", ".", "--out", "w1"], "--weights . is the folder --report reads"),
 ])
 def test_options_refused_before_any_work(tmp_path: Path, args: list[str], says: str) -> None:
     """A frame rate no simulation runs at (it was retried per recording first), --out with
@@ -165,3 +167,33 @@ def test_run_help_names_no_option_it_lacks() -> None:
     """`run` has no --executor: its planner help does not send plug-ins to Ray."""
     r = CliRunner().invoke(cli, ["run", "-h"])
     assert r.exit_code == 0 and "--executor" not in r.output
+
+
+def test_distill_report_refuses_weights_it_cannot_score(tmp_path: Path) -> None:
+    """Weights of another layer size (a traceback before), metadata without its held-out
+    list (a KeyError traceback): one line each, naming the file."""
+    import json
+    import shutil
+
+    import numpy as np
+
+    from sgtool.semantics.mlp import save_mlp
+    from sgtool.semantics.priors import WEIGHTS_DIR
+
+    meta = tmp_path / "meta"
+    shutil.copytree(WEIGHTS_DIR, meta)
+    doc = json.loads((meta / "metadata.json").read_text())
+    del doc["heldout_queries"]
+    (meta / "metadata.json").write_text(json.dumps(doc))
+    r = CliRunner().invoke(cli, ["distill", "--report", "--weights", str(meta)])
+    assert r.exit_code == 2 and "not the metadata `sgtool distill` writes" in r.output
+    assert "Traceback" not in r.output
+    wide = tmp_path / "wide"
+    shutil.copytree(WEIGHTS_DIR, wide)
+    sizes = [1024, 512, 256, 128, 1]
+    save_mlp(wide / "containment.safetensors",
+             [np.zeros((b, a), np.float32) for a, b in zip(sizes[:-1], sizes[1:], strict=True)],
+             [np.zeros(b, np.float32) for b in sizes[1:]], {"relation": "containment"})
+    r = CliRunner().invoke(cli, ["distill", "--report", "--weights", str(wide)])
+    assert r.exit_code == 2 and "containment.safetensors: containment: layer sizes" in r.output
+    assert "Traceback" not in r.output
