@@ -23,6 +23,14 @@ _PALETTE = [
 ]
 
 
+
+# per image format, the metadata matplotlib would stamp with the date or its version
+_STABLE_METADATA: dict[str, dict[str, None]] = {
+    ".png": {"Software": None},
+    ".svg": {"Date": None, "Creator": None},
+    ".pdf": {"CreationDate": None, "Creator": None, "Producer": None},
+}
+
 def room_colours(spec: HouseSpec) -> dict[str, str]:
     """Category -> colour, stable for a given set of categories (sorted order)."""
     cats = sorted({r.category for r in spec.rooms})
@@ -123,8 +131,10 @@ def draw_house(spec: HouseSpec, path: str | os.PathLike[str], dpi: int = 120,
             # a name in a script the font lacks (emoji, CJK) draws as boxes: no warning
             # with source lines for each glyph
             warnings.filterwarnings("ignore", message=r"Glyph \d+ .*missing from")
-            fig.savefig(tmp, dpi=dpi, bbox_inches="tight",  # the legend beside the plan
-                        metadata={"Software": None} if path.suffix == ".png" else None)
+            # no date, program or random ids in the file: the same house, the same bytes
+            with plt.rc_context({"svg.hashsalt": "sgtool"}):
+                fig.savefig(tmp, dpi=dpi, bbox_inches="tight",  # the legend beside the plan
+                            metadata=_STABLE_METADATA.get(path.suffix.lower()))
     finally:
         plt.close(fig)
     return path

@@ -110,7 +110,7 @@ def parse_noise(text: str | None) -> NoiseProfile:
         if not isinstance(d, dict):
             raise SgtoolError(f"--noise {t}: expected a JSON object of noise fields")
         prof = d.pop("profile", "none")
-        if prof not in PROFILES:
+        if not isinstance(prof, str) or prof not in PROFILES:
             raise SgtoolError(f"--noise {t}: unknown profile {prof!r} (one of "
                               f"{', '.join(PROFILES)})")
         return _override(PROFILES[prof], d.items(), t, default_name=p.stem)

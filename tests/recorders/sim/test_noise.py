@@ -128,6 +128,10 @@ def test_fault_streams_are_independent() -> None:
 
 def test_parse_noise(tmp_path: Path) -> None:
     assert parse_noise(None) == PROFILES["none"] == parse_noise("none")
+    odd = tmp_path / "odd.json"  # a profile that is no name: one line, not a TypeError
+    odd.write_text('{"profile": ["mild"]}')
+    with pytest.raises(SgtoolError, match="unknown profile"):
+        parse_noise(str(odd))
     assert parse_noise("mild") == PROFILES["mild"]
     p = parse_noise("strong,holes=0.2,drift_xy=0")
     assert (p.holes, p.drift_xy, p.label_swap) == (0.2, 0.0, PROFILES["strong"].label_swap)

@@ -46,6 +46,15 @@ def test_show_writes_a_png(tmp_path):
     assert r.exit_code == 0 and (tmp_path / "h.png").is_file()
     r = CliRunner().invoke(cli, ["scenes", "show", str(house), "-o", str(tmp_path / "p.gif")])
     assert r.exit_code == 2
+    # svg and pdf carry no date, program or random ids: the same house, the same bytes
+    for ext in ("svg", "pdf"):
+        made = []
+        for name in ("a", "b"):
+            out = tmp_path / f"{name}.{ext}"
+            r = CliRunner().invoke(cli, ["scenes", "show", str(house), "-o", str(out)])
+            assert r.exit_code == 0, r.output
+            made.append(out.read_bytes())
+        assert made[0] == made[1], ext
 
 
 def test_stats_json_matches_the_library():
