@@ -111,7 +111,7 @@ def _episode_key(r: EpisodeResult) -> tuple[str, str, int, int, str, str]:
 def once_each(results: Sequence[EpisodeResult]) -> tuple[list[EpisodeResult], list[str]]:
     """``results`` with each run read once: a run given twice (a copy of a log, a log and
     the table that lists it) keeps its first reading; and notes saying how many were left
-    out, and when one name (planner, house, episode, seed) holds runs that differ (the
+    out, and when one name (:func:`_episode_key`) holds runs that ended otherwise (the
     same house name for other houses): those are kept, pooled, and named."""
     seen: dict[tuple[str, str, int, int, str, str], EpisodeResult] = {}
     out, dropped, clash = [], 0, set()
