@@ -93,13 +93,9 @@ _COMPRESSION = {
 
 def _check_frame(k: CameraIntrinsics, depth: np.ndarray, rgb: np.ndarray | None,
                  ids: np.ndarray | None) -> None:
-    """``ValueError`` unless the frame would read back as written: intrinsics a reader
-    takes (positive focal lengths and size), depth of the intrinsics' size, rgb (H, W, 3)
-    and ids (H, W) of the depth's."""
-    try:
-        codec.decode_calibration(codec.encode_calibration(0, k, S.CAMERA_FRAME))
-    except LogFormatError as e:
-        raise ValueError(f"intrinsics {k}: {e}") from None
+    """``ValueError`` unless the frame's images would read back as written: depth of the
+    intrinsics' size, rgb (H, W, 3) and ids (H, W) of the depth's (the intrinsics
+    themselves are checked where their calibration message is made, when they change)."""
     size = (k.height, k.width)
     if np.shape(depth) != size:
         raise ValueError(f"depth of shape {np.shape(depth)}: the intrinsics say {k.width}x"
@@ -399,9 +395,13 @@ class LogWriter:
         # every message encoded (and so checked) before the first is written: a refused
         # frame leaves nothing of itself in the log, and the same frame mended goes in
         out: list[tuple[str, Any]] = []
-        if intrinsics != self._last_calibration:
-            out.append((S.CALIBRATION, codec.encode_calibration(t_ns, intrinsics,
-                                                                S.CAMERA_FRAME)))
+        if intrinsics != self._last_calibration:  # written, so checked, when it changes
+            calibration = codec.encode_calibration(t_ns, intrinsics, S.CAMERA_FRAME)
+            try:
+                codec.decode_calibration(calibration)  # what a reader takes
+            except LogFormatError as e:
+                raise ValueError(f"intrinsics {intrinsics}: {e}") from None
+            out.append((S.CALIBRATION, calibration))
         if base_pose is not None:
             base_T_cam = np.linalg.inv(base_pose) @ pose  # noqa: N806
             out += [(S.TF, codec.encode_transform(t_ns, S.WORLD_FRAME, S.BASE_FRAME,
