@@ -6,9 +6,10 @@ and each seen door's rooms.
   opening under the lintel, not the swung panel, whose cells would cut the room it stands
   in (when they are at least ``PASSABLE_SHARE`` of its columns: a panel smeared by depth
   noise or drift reaches a few passable columns) -- else the panel's closed position
-  (from its core columns, those with at least ``CORE_SHARE`` of its fullest column's
-  voxels)
-  (:func:`~sgtool.scenegraph.room_segmentation.opening_from_panel`), else all its columns.
+  (:func:`~sgtool.scenegraph.door_panel.opening_from_panel`) found from its core columns
+  (those with at least ``CORE_SHARE`` of its fullest column's voxels), else from its line
+  (the core continued by the thinner columns in line with it: :func:`panel_cells`), else
+  its core columns.
 - :func:`observe_doors`: the rooms on either side of a door from the visible Voronoi nodes
   within ``door_radius``; a closed door with only one explored side leads to an unexplored
   room node (SCOUT sec. IV-A), placed ``unexplored_offset`` beyond the door.
@@ -23,15 +24,18 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from sgtool.mapping.bev import line_of_sight
-from sgtool.mapping.grid import OCCUPIED, OccupancyGrid
+from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph
+from sgtool.scenegraph.door_panel import grid_at, opening_from_panel
 from sgtool.scenegraph.instances import InstanceInfo
 from sgtool.scenegraph.object_placement import SeenInstance
-from sgtool.scenegraph.room_segmentation import RoomTracker, opening_from_panel
+from sgtool.scenegraph.room_segmentation import RoomTracker
 from sgtool.vocabulary import OpenState
 
 PASSABLE_SHARE = 0.25  # passable share of a door's columns that makes them its opening
 CORE_SHARE = 0.5  # a panel's column holds at least this share of its fullest column's voxels
+LINE_SLACK = 0.9  # cells across a panel's line that are on it (a slanted line's cells: <0.71)
+LINE_GAP = 2  # cells a panel's line may miss between cells that continue it
 
 
 @dataclass(frozen=True, eq=False)
@@ -85,23 +89,64 @@ def doorways(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
         mine = use & (door == i)
         centres[ids[i]] = _centre(occ, r[mine], c[mine])
     occupied: np.ndarray | None = None
+    free: np.ndarray | None = None
     for i in np.flatnonzero(~open_door).tolist():  # doors seen as their panel (mostly)
         mine = door == i
         if not mine.any():
             continue
         cell, count = np.unique(r[mine] * (occ.shape[1] + 1) + c[mine], return_counts=True)
-        # the panel's core: columns holding at least half the most voxels any column holds
-        # (a panel smeared by depth noise or drift grows thin columns beside it)
-        cell = cell[count >= CORE_SHARE * count.max()]
+        if occupied is None or free is None:
+            occupied, free = occ.grid == OCCUPIED, occ.grid == FREE
         pr, pc = np.divmod(cell, occ.shape[1] + 1)
-        if occupied is None:
-            occupied = occ.grid == OCCUPIED
-        got = opening_from_panel(pr, pc, occupied, int(0.4 / occ.resolution), memo=panel_memo)
-        if got is not None:
-            pr, pc = got
-        cells[pr, pc] = True  # the panel's doorway, else all its cells
+        core, line = panel_cells(pr, pc, count, occupied)
+        got = None
+        for panel in (core, line) if len(line[0]) > len(core[0]) else (core,):
+            got = opening_from_panel(*panel, occupied, int(0.4 / occ.resolution),
+                                     memo=panel_memo, free=free)
+            if got is not None:
+                break
+        pr, pc = core if got is None else got
+        cells[pr, pc] = True  # the panel's doorway, else its core cells
         centres[ids[i]] = _centre(occ, np.asarray(pr), np.asarray(pc))
     return cells, centres
+
+
+_Cells = tuple[np.ndarray, np.ndarray]
+
+
+def panel_cells(rows: np.ndarray, cols: np.ndarray, counts: np.ndarray,
+                occupied: np.ndarray) -> tuple[_Cells, _Cells]:
+    """The (rows, cols) of a door seen as its swung panel, from its cells (``rows``,
+    ``cols``) and the voxels each holds: its core (cells holding at least ``CORE_SHARE``
+    of the most voxels any cell holds; a panel smeared by depth noise or drift grows thin
+    columns beside it), and its line: the core and the cells on the core's line (within
+    ``LINE_SLACK`` cells across it) that continue it with gaps of at most ``LINE_GAP``
+    cells (a panel seen only in part near its hinge, where it stands in the corner, holds
+    fewer voxels there). A cell with an ``occupied`` cell on both sides across the line
+    is in a wall and continues nothing."""
+    core = counts >= CORE_SHARE * counts.max(initial=0)
+    if core.sum() < 2:
+        return (rows[core], cols[core]), (rows[core], cols[core])
+    pts = np.stack([cols, rows], axis=1).astype(np.float64)
+    mean = pts[core].mean(axis=0)
+    cen = pts - mean
+    evals, evecs = np.linalg.eigh(cen[core].T @ cen[core])
+    a = evecs[:, int(np.argmax(evals))]
+    t = np.array([-a[1], a[0]])
+    along, across = cen @ a, np.abs(cen @ t)
+    lo, hi = float(along[core].min()), float(along[core].max())
+    walled = grid_at(pts + t, occupied) & grid_at(pts - t, occupied)
+    on_line = np.sort(along[~core & ~walled & (across <= LINE_SLACK)])
+    for x in on_line[on_line > hi]:  # continue the core past each end, gap by gap
+        if x - hi > LINE_GAP + 1:
+            break
+        hi = float(x)
+    for x in on_line[on_line < lo][::-1]:
+        if lo - x > LINE_GAP + 1:
+            break
+        lo = float(x)
+    keep = core | (~walled & (across <= LINE_SLACK) & (along >= lo) & (along <= hi))
+    return (rows[core], cols[core]), (rows[keep], cols[keep])
 
 
 def _centre(occ: OccupancyGrid, rows: np.ndarray, cols: np.ndarray) -> tuple[float, float]:

@@ -15,7 +15,8 @@ What we do, and why it differs:
   swung panel misses the opening by half a door width): the grid cells of an open (or
   state-unknown) door instance that are passable (its lintel above the free opening),
   or, for a door seen only as its swung panel, the panel's closed position
-  (:func:`opening_from_panel`), or else all its cells. Closed doors are walls already
+  (:func:`sgtool.scenegraph.door_panel.opening_from_panel`), or else all its cells.
+  Closed doors are walls already
   (the graph never crosses them) and would only cut corridors running past them.
 - **Density without the 1/N_D factor**: ``gaussian_filter(door_cells, sigma=0.15 m)`` is
   ``sum_i K_H(x - x_i) * cell_area``, the kernel mass of door cells near x. With the 1/N_D
@@ -41,7 +42,6 @@ from __future__ import annotations
 import hashlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -66,159 +66,6 @@ def door_density(door_cells: np.ndarray, resolution: float, bandwidth: float) ->
         return np.zeros(door_cells.shape, dtype=np.float64)
     return ndimage.gaussian_filter(door_cells.astype(np.float64), sigma=bandwidth / resolution,
                                    mode="constant", truncate=4.0)
-
-
-def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
-                       min_width: int = 8, memo: dict[bytes, Any] | None = None
-                       ) -> tuple[np.ndarray, np.ndarray] | None:
-    """The doorway of a door seen only as its swung-open panel: the panel's closed
-    position, found by turning it by 90 degrees about its hinge.
-
-    For each end of the panel (along its principal axis) and each side across it, score
-    how much the surroundings look like a doorway seen from the hinge: wall running away
-    on one side (share of occupied cells 0.1-0.45 panel widths along it), a clear opening
-    on the other (share of occupied cells along the panel's closed position, which must be
-    low) and the far jamb just beyond it; the score is wall + jamb - 2 opening. The best
-    hinge and side must score well and clearly beat every alternative. When none does (a
-    free end whose far-jamb ray hits furniture can come close to a hinge whose opening
-    ray, for a panel smeared longer than its doorway, reaches the far wall), they are
-    scored again by the wall line alone: the lesser of the wall and jamb shares minus the
-    opening's (at least ``LINE_LEAST``, ``LINE_MARGIN`` ahead of every alternative).
-    Otherwise None (the caller then uses the panel's own cells), as for cells that are not
-    one panel at least ``min_width`` cells long."""
-    if len(rows) < 2:
-        return None
-    # work in a window around the panel (everything looked at is within 1.3 widths)
-    span = int(max(rows.max() - rows.min(), cols.max() - cols.min())) + 1
-    pad = int(1.5 * span) + 6
-    r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
-    r1 = min(int(rows.max()) + pad + 1, occupied.shape[0])
-    c1 = min(int(cols.max()) + pad + 1, occupied.shape[1])
-    window = occupied[r0:r1, c0:c1]
-    key = None
-    if memo is not None:  # the same panel cells in the same surroundings: the same answer
-        h = hashlib.blake2b(digest_size=16)
-        for a in (rows - r0, cols - c0, np.ascontiguousarray(window)):
-            h.update(np.ascontiguousarray(a).tobytes())
-        h.update(repr((window.shape, min_width, r0, c0, rows.dtype.str)).encode())
-        key = h.digest()
-        if key in memo:
-            return memo[key]
-    got = _opening(rows - r0, cols - c0, window, min_width)
-    out = None if got is None else (got[0] + r0, got[1] + c0)
-    if memo is not None and key is not None:
-        if len(memo) > 256:
-            memo.clear()
-        memo[key] = out
-    return out
-
-
-def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray, min_width: int
-             ) -> tuple[np.ndarray, np.ndarray] | None:
-    pts = np.stack([cols, rows], axis=1).astype(np.float64)
-    mean = pts.mean(axis=0)
-    cen = pts - mean
-    evals, evecs = np.linalg.eigh(cen.T @ cen)
-    a = evecs[:, int(np.argmax(evals))]
-    proj = cen @ a
-    s0, s1 = float(proj.min()), float(proj.max())
-    width = s1 - s0 + 1.0
-    if width < min_width:
-        return None
-    t = np.array([-a[1], a[0]])
-    h, w = occupied.shape
-    grown = ndimage.binary_dilation(occupied, structure=np.ones((3, 3), dtype=bool))
-
-    # every (end, side, offset) of the panel: the shares of occupied cells along the wall
-    # side, the opening and the far jamb, sampled at once (:func:`ray_shares`)
-    rays = []
-    for s, out in ((s0, -a), (s1, a)):
-        for sign in (1.0, -1.0):
-            d = sign * t
-            for off in range(4):  # the wall line may lie a few cells beyond the panel's end
-                end = mean + a * s + out * off
-                rays += [(end, -d, 0.1 * width, 0.45 * width, True),
-                         (end, d, 0.15 * width, 0.85 * width, False),
-                         (end, d, 1.05 * width, 1.3 * width, True)]
-    shares = ray_shares(rays, occupied, grown)
-    best = _clear_best(shares, s0, s1, a, _sum_score, 1.0, 0.5)
-    if best is None:  # ambiguous: ask for the wall line on both sides of the opening
-        best = _clear_best(shares, s0, s1, a, _line_score, LINE_LEAST, LINE_MARGIN)
-    if best is None:
-        return None
-    _, s_end, sign, off, out = best
-    end, d = mean + a * s_end + out * off, sign * t
-    f = np.linspace(0.0, width, int(np.ceil(2 * width)) + 1)[:, None]
-    p = end[None, :] + d[None, :] * f
-    c = np.round(p[:, 0]).astype(np.int64)
-    r = np.round(p[:, 1]).astype(np.int64)
-    ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
-    return r[ok], c[ok]
-
-
-LINE_LEAST = 0.5  # the wall-line score a hinge needs (0 to 1: wall on both sides, clear)
-LINE_MARGIN = 0.25  # and its lead over every other hinge and side
-
-
-def _sum_score(wall: float, opening: float, jamb: float) -> float:
-    """Wall on one side, far jamb on the other, a clear opening between."""
-    return wall + jamb - 2.0 * opening
-
-
-def _line_score(wall: float, opening: float, jamb: float) -> float:
-    """The wall line on *both* sides of a clear opening: a panel's free end, whose far-jamb
-    ray can hit any obstacle in the room, has no wall beside it."""
-    return min(wall, jamb) - opening
-
-
-def _clear_best(shares: list[float], s0: float, s1: float, a: np.ndarray,
-                score: Callable[[float, float, float], float], least: float, margin: float
-                ) -> tuple[float, float, float, int, np.ndarray] | None:
-    """The (score, end, side sign, offset, outward axis) of the best hinge and side under
-    ``score`` of the (wall, opening, jamb) shares, when it scores at least ``least`` and
-    beats every other hinge and side by ``margin``; else None."""
-    scored: list[tuple[float, float, float, int, np.ndarray]] = []
-    at = 0
-    for s, out in ((s0, -a), (s1, a)):
-        for sign in (1.0, -1.0):
-            side: tuple[float, int] | None = None  # (score, offset) of the best offset
-            for off in range(4):
-                cand = (score(*shares[at:at + 3]), off)
-                at += 3
-                if side is None or cand[0] > side[0]:
-                    side = cand
-            assert side is not None
-            scored.append((side[0], s, sign, side[1], out))
-    scored.sort(key=lambda x: -x[0])
-    best, second = scored[0], scored[1]
-    if best[0] < least or best[0] - second[0] < margin:
-        return None
-    return best
-
-
-def ray_shares(rays: list[tuple[np.ndarray, np.ndarray, float, float, bool]],
-               occupied: np.ndarray, grown: np.ndarray) -> list[float]:
-    """Per ray (start, direction, from, to, on the grown grid; in (column, row) cells of
-    ``occupied``, ``grown`` being that grid dilated): the share of occupied cells at the
-    points sampled every half cell from ``start + from * direction`` to
-    ``start + to * direction``, rounded to cells (points off the grid skipped; 0.0 with
-    none on it). The points of every ray are computed as one ray at a time would, the
-    shares counted for all at once."""
-    fs = [np.linspace(lo, hi, max(2, int(np.ceil(2 * (hi - lo))))) for _, _, lo, hi, _ in rays]
-    sizes = np.fromiter((len(f) for f in fs), dtype=np.int64, count=len(rays))
-    ray = np.repeat(np.arange(len(rays)), sizes)
-    p0 = np.stack([r[0] for r in rays])[ray]
-    direction = np.stack([r[1] for r in rays])[ray]
-    p = p0 + direction * np.concatenate(fs)[:, None]
-    c, r = np.round(p[:, 0]).astype(np.int64), np.round(p[:, 1]).astype(np.int64)
-    h, w = occupied.shape
-    ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
-    on_grown = np.fromiter((g for *_, g in rays), dtype=bool, count=len(rays))[ray[ok]]
-    hit = np.where(on_grown, grown[r[ok], c[ok]], occupied[r[ok], c[ok]])
-    count = np.bincount(ray[ok], minlength=len(rays))
-    total = np.bincount(ray[ok], weights=hit.astype(np.float64), minlength=len(rays))
-    return [float(x / n) if n else 0.0 for x, n in zip(total.tolist(), count.tolist(),
-                                                        strict=True)]
 
 
 @dataclass(frozen=True, eq=False)

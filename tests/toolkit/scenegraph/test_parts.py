@@ -11,12 +11,13 @@ from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.voronoi import voronoi_graph
 from sgtool.scenegraph.assign import AssignConfig, assign_objects
 from sgtool.scenegraph.categories import FrequencyRoomClassifier, RoomClassifier
+from sgtool.scenegraph.door_evidence import panel_cells
+from sgtool.scenegraph.door_panel import opening_from_panel
 from sgtool.scenegraph.frontiers import FrontierConfig, find_frontiers
 from sgtool.scenegraph.regions import cluster_room
 from sgtool.scenegraph.room_segmentation import (
     RoomTracker,
     door_density,
-    opening_from_panel,
     room_neighbours,
     segment_rooms,
 )
@@ -114,6 +115,72 @@ def test_smeared_panel_beside_a_cupboard_still_gives_its_doorway() -> None:
     r, c = got
     assert np.all((r >= 14) & (r <= 20))  # along the wall ...
     assert c.min() <= 41 and c.max() >= 57  # ... across the whole doorway
+
+def _wall_with_doorway() -> tuple[np.ndarray, np.ndarray]:
+    """A wall along x at row 20 with an 18-cell doorway (columns 40-57); floor seen free
+    everywhere else."""
+    occupied = np.zeros((70, 100), dtype=bool)
+    occupied[20, :] = True
+    occupied[20, 40:58] = False
+    return occupied, ~occupied
+
+
+def test_panel_seen_only_far_from_its_hinge_still_gives_its_doorway() -> None:
+    """Near its hinge a swung panel stands in the corner and may go unseen: the seen part
+    (rows 27-38) ends 7 cells short of the wall, unseen cells between. The wall line is
+    looked for that far out, and the doorway spans the whole door (panel and unseen
+    part); floor seen free in that gap says the panel ends there: no doorway."""
+    occupied, free = _wall_with_doorway()
+    rows = np.arange(27, 39)  # hinged at (20, 40), swung into +row
+    cols = np.full(len(rows), 40)
+    occupied[rows, cols], free[rows, cols] = True, False
+    free[21:27, 39:42] = False  # never seen
+    got = opening_from_panel(rows, cols, occupied, min_width=8, free=free)
+    assert got is not None
+    r, c = got
+    assert np.all(np.abs(r - 20) <= 1)
+    assert c.min() <= 41 and 56 <= c.max() <= 59
+    free[21:27, 39:42] = True  # floor seen where the panel would have to be
+    assert opening_from_panel(rows, cols, occupied, min_width=8, free=free) is None
+
+
+def test_counter_past_a_panels_free_end_is_no_wall_line() -> None:
+    """A counter 3 cells past a whole panel's free end, floor seen between, looks like a
+    wall line with the panel's gap in it (wall and jamb rays both hit it), as close as
+    the true hinge: without what was seen free neither wins; with it the free end's line
+    is ruled out and the doorway is found at the hinge."""
+    occupied, _ = _wall_with_doorway()
+    rows = np.arange(21, 39)  # hinged at (20, 57), swung into +row
+    cols = np.full(len(rows), 57)
+    occupied[rows, cols] = True
+    occupied[42:50, 30:75] = True  # the counter
+    occupied[22:34, 64:80] = True  # a cupboard beside the hinge
+    assert opening_from_panel(rows, cols, occupied, min_width=8) is None
+    got = opening_from_panel(rows, cols, occupied, min_width=8, free=~occupied)
+    assert got is not None
+    r, c = got
+    assert np.all(np.abs(r - 20) <= 1)
+    assert c.max() >= 56 and 39 <= c.min() <= 41
+
+
+def test_panel_line_takes_thin_columns_in_line_not_beside_or_in_the_wall() -> None:
+    """Core columns (10 voxels) at rows 30-38; thin columns (2 voxels) continue it down to
+    row 25 with a 1-row gap, stand beside it (column 41), lie beyond a 4-row gap (rows
+    10-14), and sit in the wall's row 23 beside occupied cells on both sides."""
+    occupied = np.zeros((60, 60), dtype=bool)
+    occupied[23, :] = True
+    core_rows = np.arange(30, 39)
+    thin_rows = np.array([25, 26, 27, 29])
+    rows = np.concatenate([core_rows, thin_rows, [33, 34], [10, 11, 12, 13, 14], [23]])
+    cols = np.concatenate([np.full(len(core_rows) + len(thin_rows), 40), [41, 41],
+                           np.full(5, 40), [40]])
+    counts = np.concatenate([np.full(len(core_rows), 10), np.full(len(rows) - 9, 2)])
+    (cr, cc), (lr, lc) = panel_cells(rows, cols, counts, occupied)
+    assert sorted(zip(cr.tolist(), cc.tolist(), strict=True)) == [(r, 40) for r in range(30, 39)]
+    assert sorted(zip(lr.tolist(), lc.tolist(), strict=True)) == [
+        (r, 40) for r in (25, 26, 27, 29)] + [
+        (r, 40) for r in range(30, 39)]
+
 
 # ----- assignment -----------------------------------------------------------------------
 def test_assignment_goes_around_the_wall_not_through_it() -> None:

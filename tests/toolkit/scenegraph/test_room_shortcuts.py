@@ -10,13 +10,15 @@ from scipy.spatial import cKDTree
 from sgtool.mapping.bev import line_of_sight
 from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph
-from sgtool.scenegraph import room_segmentation
+from sgtool.scenegraph import door_panel
 from sgtool.scenegraph.door_evidence import (
     PASSABLE_SHARE,
     doorways,
+    panel_cells,
     visible_labelled_nodes,
 )
-from sgtool.scenegraph.room_segmentation import opening_from_panel, ray_shares, room_overlaps
+from sgtool.scenegraph.door_panel import opening_from_panel, ray_shares
+from sgtool.scenegraph.room_segmentation import room_overlaps
 
 
 def door_cells_of(occ, door_voxels, memo):
@@ -74,7 +76,7 @@ def test_panel_openings_equal_the_ray_by_ray_search(seed, monkeypatch):
     occupied[rows, cols] = True
     occupied |= rng.random(occupied.shape) < 0.03
     got = opening_from_panel(rows, cols, occupied, min_width=8)
-    monkeypatch.setattr(room_segmentation, "ray_shares", _reference_shares)
+    monkeypatch.setattr(door_panel, "ray_shares", _reference_shares)
     want = opening_from_panel(rows, cols, occupied, min_width=8)
     assert (got is None) == (want is None)
     if want is not None:
@@ -100,13 +102,18 @@ def _door_cells_one_by_one(occ, door_voxels, panel_memo):  # noqa: ANN001, ANN20
         if n_pass and n_pass >= PASSABLE_SHARE * n_cells:
             r, c = r[passable], c[passable]
         else:
-            cell = np.unique(r * (occ.shape[1] + 1) + c)
+            cell, count = np.unique(r * (occ.shape[1] + 1) + c, return_counts=True)
             r, c = np.divmod(cell, occ.shape[1] + 1)
             if occupied is None:
                 occupied = occ.grid == OCCUPIED
-            got = opening_from_panel(r, c, occupied, int(0.4 / occ.resolution), memo=panel_memo)
-            if got is not None:
-                r, c = got
+            core, line = panel_cells(r, c, count, occupied)
+            r, c = core
+            for panel in (core, line):  # the core, else the line
+                got = opening_from_panel(*panel, occupied, int(0.4 / occ.resolution),
+                                         memo=panel_memo, free=occ.grid == FREE)
+                if got is not None:
+                    r, c = got
+                    break
         cells[r, c] = True
     return cells
 
@@ -134,6 +141,9 @@ def test_door_cells_of_all_doors_at_once_equal_one_door_at_a_time(seed):
             rows = r0 + np.arange(1, width)
             cols = np.full(len(rows), c0)
             g[rows, cols] = OCCUPIED
+            seen = int(rng.integers(0, width // 2))  # near the hinge seen thinly
+            rows = np.concatenate([rows, np.repeat(rows[seen:], 2)])
+            cols = np.full(len(rows), c0)
         else:
             rows = np.full(width, r0)
             cols = c0 + np.arange(width)

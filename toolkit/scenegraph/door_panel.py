@@ -1,0 +1,221 @@
+"""The doorway of a door seen only as its swung-open panel (:func:`opening_from_panel`).
+
+A panel swung open stands at right angles to its wall, hinged at one end of its doorway;
+turned back by 90 degrees about that hinge it covers the doorway, the cells the room
+segmentation needs as door evidence. Which end is the hinge, and which side the doorway
+lies on, is read from the surroundings: the wall running away from the hinge, a clear
+opening across the doorway and the far jamb beyond it.
+
+The hinge need not touch the panel's seen end: near the hinge the panel stands in the
+corner between wall and door and is often seen only in part, so the wall line may lie
+beyond the seen end, up to the seen panel's own length. A hinge that far is believed only
+where nothing was seen free between the panel's end and the wall line: a door is hinged
+to its wall, so floor seen there says the panel ends before it (as beyond a panel's free
+end, where a counter along the room's wall can look like a wall line with a gap).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from scipy import ndimage
+
+LINE_LEAST = 0.5  # the wall-line score a hinge needs (0 to 1: wall on both sides, clear)
+LINE_MARGIN = 0.25  # and its lead over every other hinge and side
+MIN_REACH = 3  # cells past a panel's end the wall line is looked for, at least
+OFFSET_SLACK = 0.1  # a wall line this close to the best score of its hinge and side is as good
+
+_Candidate = tuple[float, float, float, int, np.ndarray]  # score, end, side, offset, out
+
+
+def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
+                       min_width: int = 8, memo: dict[bytes, Any] | None = None,
+                       free: np.ndarray | None = None
+                       ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The doorway (rows, cols) of a door seen only as its swung-open panel (cells
+    ``rows``, ``cols`` of the bool grid ``occupied``): the panel's closed position, found
+    by turning it by 90 degrees about its hinge (module doc).
+
+    For each end of the panel (along its principal axis), each side across it and each
+    offset of the wall line past that end (0 to ``MIN_REACH`` cells, and only when no
+    hinge among those is found, up to the panel's length; beyond 1, only when no cell on
+    the panel's line between its end and the wall line is surely free: a cell of
+    ``free`` whose eight neighbours are ``free`` too), score how
+    much the surroundings look like a doorway seen from the hinge, for a door as long as
+    the panel plus the offset: wall running away on one side (share of occupied cells
+    0.1-0.45 door widths along it), a clear opening on the other (share of occupied cells
+    along the closed position, which must be low) and the far jamb just beyond it; the
+    score is wall + jamb - 2 opening. The best hinge and side must score well and clearly
+    beat every alternative. When none does (a free end whose far-jamb ray hits furniture
+    can come close to a hinge whose opening ray, for a panel smeared longer than its
+    doorway, reaches the far wall), they are scored again by the wall line alone: the
+    lesser of the wall and jamb shares minus the opening's (at least ``LINE_LEAST``,
+    ``LINE_MARGIN`` ahead of every alternative). Otherwise None (the caller then uses the
+    panel's own cells), as for cells that are not one panel at least ``min_width`` cells
+    long. ``free`` (bool, the shape of ``occupied``; None: no cell known free) is the
+    grid's cells seen free; ``memo`` caches answers by panel and surroundings."""
+    if len(rows) < 2:
+        return None
+    # work in a window around the panel (everything looked at is within 2.7 lengths)
+    span = int(max(rows.max() - rows.min(), cols.max() - cols.min())) + 1
+    pad = 3 * span + 8
+    r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
+    r1 = min(int(rows.max()) + pad + 1, occupied.shape[0])
+    c1 = min(int(cols.max()) + pad + 1, occupied.shape[1])
+    window = occupied[r0:r1, c0:c1]
+    free_window = None if free is None else free[r0:r1, c0:c1]
+    key = None
+    if memo is not None:  # the same panel cells in the same surroundings: the same answer
+        h = hashlib.blake2b(digest_size=16)
+        for a in (rows - r0, cols - c0, window, free_window):
+            h.update(b"-" if a is None else np.ascontiguousarray(a).tobytes())
+        h.update(repr((window.shape, min_width, r0, c0, rows.dtype.str)).encode())
+        key = h.digest()
+        if key in memo:
+            return memo[key]
+    got = _opening(rows - r0, cols - c0, window, free_window, min_width)
+    out = None if got is None else (got[0] + r0, got[1] + c0)
+    if memo is not None and key is not None:
+        if len(memo) > 256:
+            memo.clear()
+        memo[key] = out
+    return out
+
+
+def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
+             free: np.ndarray | None, min_width: int
+             ) -> tuple[np.ndarray, np.ndarray] | None:
+    pts = np.stack([cols, rows], axis=1).astype(np.float64)
+    mean = pts.mean(axis=0)
+    cen = pts - mean
+    evals, evecs = np.linalg.eigh(cen.T @ cen)
+    a = evecs[:, int(np.argmax(evals))]
+    proj = cen @ a
+    s0, s1 = float(proj.min()), float(proj.max())
+    width = s1 - s0 + 1.0
+    if width < min_width:
+        return None
+    t = np.array([-a[1], a[0]])
+    grown = ndimage.binary_dilation(occupied, structure=np.ones((3, 3), dtype=bool))
+    surely_free = None if free is None else ndimage.binary_erosion(
+        free, structure=np.ones((3, 3), dtype=bool), border_value=0)
+    reach = max(MIN_REACH, int(width))
+
+    # every (end, side, offset) of the panel whose gap to the wall line may be panel:
+    # the shares of occupied cells along the wall side, the opening and the far jamb,
+    # sampled at once (:func:`ray_shares`)
+    rays = []
+    places: list[tuple[float, float, int, np.ndarray]] = []  # end, side, offset, out
+    for s, out in ((s0, -a), (s1, a)):
+        for off in range(reach + 1):
+            if off > 1 and surely_free is not None and _seen_free(
+                    mean + a * s, out, off, surely_free):
+                break  # floor seen between the panel's end and here: no hinge further out
+            end, w = mean + a * s + out * off, width + off
+            for sign in (1.0, -1.0):
+                d = sign * t
+                rays += [(end, -d, 0.1 * w, 0.45 * w, True),
+                         (end, d, 0.15 * w, 0.85 * w, False),
+                         (end, d, 1.05 * w, 1.3 * w, True)]
+                places.append((s, sign, off, out))
+    shares = ray_shares(rays, occupied, grown)
+    best = None
+    for most in (MIN_REACH, reach):  # the nearest wall lines first
+        best = _clear_best(shares, places, most, _sum_score, 1.0, 0.5)
+        if best is None:  # ambiguous: ask for the wall line on both sides of the opening
+            best = _clear_best(shares, places, most, _line_score, LINE_LEAST, LINE_MARGIN)
+        if best is not None:
+            break
+    if best is None:
+        return None
+    _, s_end, sign, off, out = best
+    end, d, w = mean + a * s_end + out * off, sign * t, width + off
+    f = np.linspace(0.0, w, int(np.ceil(2 * w)) + 1)[:, None]
+    p = end[None, :] + d[None, :] * f
+    c = np.round(p[:, 0]).astype(np.int64)
+    r = np.round(p[:, 1]).astype(np.int64)
+    h, w_ = occupied.shape
+    ok = (r >= 0) & (r < h) & (c >= 0) & (c < w_)
+    return r[ok], c[ok]
+
+
+def _seen_free(end: np.ndarray, out: np.ndarray, off: int, surely_free: np.ndarray) -> bool:
+    """Whether the cell ``off - 1`` cells past ``end`` along ``out`` (the last of the
+    panel's line before a wall line ``off`` cells out) is surely free."""
+    return bool(grid_at((end + out * (off - 1))[None, :], surely_free)[0])
+
+
+def grid_at(points: np.ndarray, grid: np.ndarray) -> np.ndarray:
+    """Per (column, row) point (N, 2; rounded to its cell): the bool ``grid``'s cell
+    (False off the grid)."""
+    c, r = np.round(points[:, 0]).astype(np.int64), np.round(points[:, 1]).astype(np.int64)
+    h, w = grid.shape
+    ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+    out = np.zeros(len(points), dtype=bool)
+    out[ok] = grid[r[ok], c[ok]]
+    return out
+
+
+def _sum_score(wall: float, opening: float, jamb: float) -> float:
+    """Wall on one side, far jamb on the other, a clear opening between."""
+    return wall + jamb - 2.0 * opening
+
+
+def _line_score(wall: float, opening: float, jamb: float) -> float:
+    """The wall line on *both* sides of a clear opening: a panel's free end, whose far-jamb
+    ray can hit any obstacle in the room, has no wall beside it."""
+    return min(wall, jamb) - opening
+
+
+def _clear_best(shares: list[float], places: list[tuple[float, float, int, np.ndarray]],
+                most: int, score: Callable[[float, float, float], float], least: float,
+                margin: float) -> _Candidate | None:
+    """The (score, end, side sign, offset, outward axis) of the best hinge and side under
+    ``score`` of the (wall, opening, jamb) shares of each place (end, side, offset,
+    outward axis; three shares each, in order) at most ``most`` cells out, each hinge and
+    side at the nearest offset within ``OFFSET_SLACK`` of its best score, when it scores
+    at least ``least`` and beats every other hinge and side by ``margin``; else None."""
+    of_side: dict[tuple[float, float], list[_Candidate]] = {}
+    for i, (s, sign, off, out) in enumerate(places):
+        if off <= most:
+            value = score(*shares[3 * i:3 * i + 3])
+            of_side.setdefault((s, sign), []).append((value, s, sign, off, out))
+    scored = []
+    for cands in of_side.values():  # in order of offset
+        top = max(c[0] for c in cands)
+        scored.append(next(c for c in cands if c[0] >= top - OFFSET_SLACK))
+    scored.sort(key=lambda x: -x[0])
+    if len(scored) < 2:
+        return None
+    best, second = scored[0], scored[1]
+    if best[0] < least or best[0] - second[0] < margin:
+        return None
+    return best
+
+
+def ray_shares(rays: list[tuple[np.ndarray, np.ndarray, float, float, bool]],
+               occupied: np.ndarray, grown: np.ndarray) -> list[float]:
+    """Per ray (start, direction, from, to, on the grown grid; in (column, row) cells of
+    ``occupied``, ``grown`` being that grid dilated): the share of occupied cells at the
+    points sampled every half cell from ``start + from * direction`` to
+    ``start + to * direction``, rounded to cells (points off the grid skipped; 0.0 with
+    none on it). The points of every ray are computed as one ray at a time would, the
+    shares counted for all at once."""
+    fs = [np.linspace(lo, hi, max(2, int(np.ceil(2 * (hi - lo))))) for _, _, lo, hi, _ in rays]
+    sizes = np.fromiter((len(f) for f in fs), dtype=np.int64, count=len(rays))
+    ray = np.repeat(np.arange(len(rays)), sizes)
+    p0 = np.stack([r[0] for r in rays])[ray]
+    direction = np.stack([r[1] for r in rays])[ray]
+    p = p0 + direction * np.concatenate(fs)[:, None]
+    c, r = np.round(p[:, 0]).astype(np.int64), np.round(p[:, 1]).astype(np.int64)
+    h, w = occupied.shape
+    ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+    on_grown = np.fromiter((g for *_, g in rays), dtype=bool, count=len(rays))[ray[ok]]
+    hit = np.where(on_grown, grown[r[ok], c[ok]], occupied[r[ok], c[ok]])
+    count = np.bincount(ray[ok], minlength=len(rays))
+    total = np.bincount(ray[ok], weights=hit.astype(np.float64), minlength=len(rays))
+    return [float(x / n) if n else 0.0 for x, n in zip(total.tolist(), count.tolist(),
+                                                        strict=True)]
