@@ -135,7 +135,7 @@ def format_for(out: Path, fmt: str | None) -> str:
     if fmt is None:
         return "ros1" if is_bag else "ros2"
     if fmt not in FORMATS:
-        raise SgtoolError(f"--format {fmt!r}: give ros1 or ros2")
+        raise SgtoolError(f"--format (fmt=) {fmt!r}: give ros1 or ros2")
     if fmt == "ros2" and is_bag:
         raise SgtoolError(f"-o {out}: a .bag name is a ROS 1 bag file, but --format ros2 "
                           "writes a bag folder; drop .bag or use --format ros1")

@@ -162,8 +162,8 @@ def pick_episode(house: HouseSpec, query: str | None = None, index: int | None =
                           "start poses)")
     if query is not None:
         if index is not None:
-            raise SgtoolError("give either a query (--query) or an episode index (--episode), "
-                              "not both")
+            raise SgtoolError("give either a query (--query, query=) or an episode index "
+                              "(--episode, index=), not both")
         want = category_text(query)
         for i, e in enumerate(eps):
             if category_text(e.query) == want:

@@ -258,7 +258,7 @@ def test_a_replayed_log_round_trips_grid_for_grid(tmp_path):
 
 def test_not_an_sgtool_log_and_bad_format(tmp_path):
     log = log_with_rooms(tmp_path / "d.mcap")
-    with pytest.raises(SgtoolError, match="--format 'ros3': give ros1 or ros2"):
+    with pytest.raises(SgtoolError, match=r"--format \(fmt=\) 'ros3': give ros1 or ros2"):
         export_bag(log, tmp_path / "o", "ros3")
     with pytest.raises(SgtoolError, match="--distro 'iron'"):
         export_bag(log, tmp_path / "o", distro="iron")
