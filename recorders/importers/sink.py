@@ -82,7 +82,9 @@ class ImportReport:
     # the import's checks before the heavy work: (check, verdict) lines
     checks: tuple[tuple[str, str], ...] = ()
 
-    def lines(self) -> list[str]:
+    def lines(self, warnings_shown: bool = False) -> list[str]:
+        """The report, a line per fact; ``warnings_shown``: the warnings were shown
+        already where these lines go (a terminal), so they are counted, not repeated."""
         a = self.alignment
         ux, uy, uz = a.up
         out = [
@@ -103,7 +105,11 @@ class ImportReport:
         out.extend(f"check: {name}: {verdict}" for name, verdict in self.checks)
         out.extend(f"resized: {r}" for r in self.resizes)
         out.extend(f"note: {n}" for n in self.notes)
-        out.extend(f"warning: {w}" for w in self.warnings)
+        if warnings_shown and self.warnings:
+            n = len(self.warnings)
+            out.append(f"{n} warning{'s' if n > 1 else ''}, shown above")
+        elif not warnings_shown:
+            out.extend(f"warning: {w}" for w in self.warnings)
         return out
 
 

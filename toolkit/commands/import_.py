@@ -7,6 +7,7 @@ prints the import report (or JSON with ``--json``).
 from __future__ import annotations
 
 import json
+import sys
 from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
@@ -76,8 +77,9 @@ def _print_report(report, as_json: bool) -> None:  # type: ignore[no-untyped-def
             "checks": {name: verdict for name, verdict in report.checks},
         }
         click.echo(json.dumps(d, indent=2, sort_keys=True))
-    else:
-        for line in report.lines():
+    else:  # on one terminal the warnings stand above already (:func:`_warn`)
+        shown = sys.stdout.isatty() and sys.stderr.isatty()
+        for line in report.lines(warnings_shown=shown):
             click.echo(line)
 
 

@@ -7,6 +7,7 @@ a pose."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import struct
 from pathlib import Path
@@ -240,3 +241,15 @@ def test_tf_at_a_low_rate_dropping_frames_is_an_error_naming_the_flags(tmp_path)
                                  "--up", "z"])
     assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1
     assert "--allow-drop" in r.output
+
+
+def test_warnings_shown_above_are_counted_not_repeated(tmp_path):
+    """On a terminal each warning is on stderr as it is found; the report then counts them
+    instead of printing them again (a redirected report keeps them)."""
+    rep = import_rgbd(make_tum_folder(tmp_path / "f", TIMES), tmp_path / "a.mcap", opts())
+    rep = dataclasses.replace(rep, warnings=("first thing", "second thing"))
+    assert rep.lines()[-2:] == ["warning: first thing", "warning: second thing"]
+    shown = rep.lines(warnings_shown=True)
+    assert shown[-1] == "2 warnings, shown above"
+    assert not any("thing" in line for line in shown)
+    assert rep.lines(warnings_shown=True)[:-1] == rep.lines()[:-2]
