@@ -238,12 +238,18 @@ def top1(held: Sequence[Any], rooms: Sequence[str],
 
 def training_lines(meta: dict[str, Any]) -> list[str]:
     """One line per model of a training's metadata: pairs, queries, the epoch kept and
-    its validation loss."""
+    its validation loss; with queries held out of training, the pairs trained on (and
+    validated on) of all, and the queries held out."""
     lines = []
+    held = len(meta.get("heldout_queries", ()))
     for rel in ("containment", "cooccurrence"):
         m = meta["models"][rel]
-        lines.append(f"{rel}: {m['data']['pairs']} pairs ({m['data']['positives']} positive), "
-                     f"{m['data']['queries']} queries, kept epoch {m['best_epoch']}, "
+        d = m["data"]
+        data = f"{d['pairs']} pairs ({d['positives']} positive), {d['queries']} queries"
+        if held:
+            data = (f"{m['train_pairs'] + m['val_pairs']} of {d['pairs']} pairs trained "
+                    f"on ({held} {'query' if held == 1 else 'queries'} held out of training)")
+        lines.append(f"{rel}: {data}, kept epoch {m['best_epoch']}, "
                      f"val loss {m['history'][m['best_epoch'] - 1]['val_loss']:.4f}")
     return lines
 

@@ -11,6 +11,7 @@ from click.testing import CliRunner
 from support.semantics_fixtures import encoder
 from support.tiny_knowledge import tiny
 
+from sgtool.analysis.priors_training import training_lines
 from sgtool.datasets.relational import containment_set, cooccurrence_set
 from sgtool.semantics.distill import DistillConfig, distill, quality_report
 from sgtool.semantics.priors import LearnedPriors
@@ -55,6 +56,11 @@ def test_distill_is_byte_identical_and_loadable(tmp_path) -> None:
         # held-out queries never reach training
         assert m["train_pairs"] + m["val_pairs"] + held[rel].get("pairs", 0) == \
             m["data"]["pairs"]
+    # the summary names the pairs trained on, not the whole set's
+    for line, rel in zip(training_lines(meta), ("containment", "cooccurrence"), strict=True):
+        m = meta["models"][rel]
+        assert line.startswith(f"{rel}: {m['train_pairs'] + m['val_pairs']} of "
+                               f"{m['data']['pairs']} pairs trained on (1 query held out")
     p = LearnedPriors(encoder(), weights_dir=a)
     s = p.rooms(["kitchen"], "plate")
     assert 0.0 <= s[0] <= 1.0
