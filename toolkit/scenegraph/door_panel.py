@@ -9,9 +9,11 @@ opening across the doorway and the far jamb beyond it.
 The hinge need not touch the panel's seen end: near the hinge the panel stands in the
 corner between wall and door and is often seen only in part, so the wall line may lie
 beyond the seen end, up to the seen panel's own length. A hinge that far is believed only
-where nothing was seen free between the panel's end and the wall line: a door is hinged
-to its wall, so floor seen there says the panel ends before it (as beyond a panel's free
-end, where a counter along the room's wall can look like a wall line with a gap).
+where the panel's line up to the wall line may be panel: no floor seen on it (a door is
+hinged to its wall, so floor seen there says the panel ends before it, as past a panel's
+free end, where a counter along the room's wall can look like a wall line with a gap),
+and no wall crossed on the way (the line of a door standing partly open runs on through
+its doorway's wall).
 """
 
 from __future__ import annotations
@@ -40,12 +42,16 @@ def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
     by turning it by 90 degrees about its hinge (module doc).
 
     For each end of the panel (along its principal axis), each side across it and each
-    offset of the wall line past that end (0 to ``MIN_REACH`` cells, and only when no
-    hinge among those is found, up to the panel's length; beyond 1, only when no cell on
-    the panel's line between its end and the wall line is surely free: a cell of
-    ``free`` whose eight neighbours are ``free`` too), score how
-    much the surroundings look like a doorway seen from the hinge, for a door as long as
-    the panel plus the offset: wall running away on one side (share of occupied cells
+    offset of the wall line past that end, score how much the surroundings look like a
+    doorway seen from the hinge. The offsets: 0 to ``MIN_REACH`` cells, the door as long
+    as the panel; beyond 1 only while no cell on the panel's line before the wall line
+    was seen free together with its two neighbours across the line. When no hinge among
+    those is found and ``free`` is given, offsets up to the panel's length, the door as
+    long as the panel plus the offset, where the panel's line before the wall line holds
+    occupied cells (the panel's thin columns) and then unseen ones (its unseen part), no
+    free cell, no cell occupied with its two neighbours across the line (a wall it would
+    run through), no occupied cell past an unseen one. The
+    score: wall running away on one side (share of occupied cells
     0.1-0.45 door widths along it), a clear opening on the other (share of occupied cells
     along the closed position, which must be low) and the far jamb just beyond it; the
     score is wall + jamb - 2 opening. The best hinge and side must score well and clearly
@@ -59,9 +65,11 @@ def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
     grid's cells seen free; ``memo`` caches answers by panel and surroundings."""
     if len(rows) < 2:
         return None
-    # work in a window around the panel (everything looked at is within 2.7 lengths)
-    span = int(max(rows.max() - rows.min(), cols.max() - cols.min())) + 1
-    pad = 3 * span + 8
+    # work in a window around the panel: every ray starts at most a panel length past its
+    # end and reaches 2.6 lengths across (under 2.8 lengths in all), the panel no longer
+    # than its box's diagonal
+    diag = float(np.hypot(rows.max() - rows.min(), cols.max() - cols.min())) + 1.0
+    pad = int(np.ceil(3.0 * diag)) + 8
     r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
     r1 = min(int(rows.max()) + pad + 1, occupied.shape[0])
     c1 = min(int(cols.max()) + pad + 1, occupied.shape[1])
@@ -76,8 +84,8 @@ def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
         key = h.digest()
         if key in memo:
             return memo[key]
-    got = _opening(rows - r0, cols - c0, window, free_window, min_width)
-    out = None if got is None else (got[0] + r0, got[1] + c0)
+    # in the grid's own cells (rounding sees the same coordinates whatever the window)
+    out = _opening(rows, cols, window, free_window, min_width, (r0, c0))
     if memo is not None and key is not None:
         if len(memo) > 256:
             memo.clear()
@@ -86,8 +94,11 @@ def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
 
 
 def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
-             free: np.ndarray | None, min_width: int
+             free: np.ndarray | None, min_width: int, origin: tuple[int, int]
              ) -> tuple[np.ndarray, np.ndarray] | None:
+    """:func:`opening_from_panel` on the window ``occupied`` / ``free`` of the grid whose
+    cell (0, 0) is the grid's cell ``origin`` (row, col); ``rows``, ``cols`` and the
+    answer in the grid's cells."""
     pts = np.stack([cols, rows], axis=1).astype(np.float64)
     mean = pts.mean(axis=0)
     cen = pts - mean
@@ -100,9 +111,8 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
         return None
     t = np.array([-a[1], a[0]])
     grown = ndimage.binary_dilation(occupied, structure=np.ones((3, 3), dtype=bool))
-    surely_free = None if free is None else ndimage.binary_erosion(
-        free, structure=np.ones((3, 3), dtype=bool), border_value=0)
-    reach = max(MIN_REACH, int(width))
+    # far wall lines only where what was seen free is known
+    reach = MIN_REACH if free is None else max(MIN_REACH, int(width))
 
     # every (end, side, offset) of the panel whose gap to the wall line may be panel:
     # the shares of occupied cells along the wall side, the opening and the far jamb,
@@ -110,10 +120,22 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
     rays = []
     places: list[tuple[float, float, int, np.ndarray]] = []  # end, side, offset, out
     for s, out in ((s0, -a), (s1, a)):
+        far_ok, unseen_run = free is not None, False
         for off in range(reach + 1):
-            if off > 1 and surely_free is not None and _seen_free(
-                    mean + a * s, out, off, surely_free):
-                break  # floor seen between the panel's end and here: no hinge further out
+            if off > 1 and free is not None:
+                gap = mean + a * s + out * (off - 1)  # the panel's line before the wall line
+                across = np.stack([gap, gap + t, gap - t])
+                if grid_at(across, free, origin).all():
+                    break  # floor seen across the panel's line here: it ends before
+                # far out, the line holds the panel's thin columns, then its unseen part:
+                # no floor, no wall across it, nothing occupied past an unseen cell
+                is_free = bool(grid_at(gap[None, :], free, origin)[0])
+                taken = grid_at(across, occupied, origin)
+                far_ok = far_ok and not is_free and not taken.all() and not (
+                    unseen_run and taken[0])
+                unseen_run = unseen_run or not taken[0]
+            if off > MIN_REACH and not far_ok:
+                break
             end, w = mean + a * s + out * off, width + off
             for sign in (1.0, -1.0):
                 d = sign * t
@@ -121,7 +143,7 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
                          (end, d, 0.15 * w, 0.85 * w, False),
                          (end, d, 1.05 * w, 1.3 * w, True)]
                 places.append((s, sign, off, out))
-    shares = ray_shares(rays, occupied, grown)
+    shares = ray_shares(rays, occupied, grown, origin)
     best = None
     for most in (MIN_REACH, reach):  # the nearest wall lines first
         best = _clear_best(shares, places, most, _sum_score, 1.0, 0.5)
@@ -138,20 +160,16 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
     c = np.round(p[:, 0]).astype(np.int64)
     r = np.round(p[:, 1]).astype(np.int64)
     h, w_ = occupied.shape
-    ok = (r >= 0) & (r < h) & (c >= 0) & (c < w_)
+    ok = (r >= origin[0]) & (r < origin[0] + h) & (c >= origin[1]) & (c < origin[1] + w_)
     return r[ok], c[ok]
 
 
-def _seen_free(end: np.ndarray, out: np.ndarray, off: int, surely_free: np.ndarray) -> bool:
-    """Whether the cell ``off - 1`` cells past ``end`` along ``out`` (the last of the
-    panel's line before a wall line ``off`` cells out) is surely free."""
-    return bool(grid_at((end + out * (off - 1))[None, :], surely_free)[0])
-
-
-def grid_at(points: np.ndarray, grid: np.ndarray) -> np.ndarray:
+def grid_at(points: np.ndarray, grid: np.ndarray, origin: tuple[int, int] = (0, 0)
+            ) -> np.ndarray:
     """Per (column, row) point (N, 2; rounded to its cell): the bool ``grid``'s cell
-    (False off the grid)."""
-    c, r = np.round(points[:, 0]).astype(np.int64), np.round(points[:, 1]).astype(np.int64)
+    (False off the grid), ``grid``'s cell (0, 0) being cell ``origin`` (row, col)."""
+    c = np.round(points[:, 0]).astype(np.int64) - origin[1]
+    r = np.round(points[:, 1]).astype(np.int64) - origin[0]
     h, w = grid.shape
     ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
     out = np.zeros(len(points), dtype=bool)
@@ -197,9 +215,11 @@ def _clear_best(shares: list[float], places: list[tuple[float, float, int, np.nd
 
 
 def ray_shares(rays: list[tuple[np.ndarray, np.ndarray, float, float, bool]],
-               occupied: np.ndarray, grown: np.ndarray) -> list[float]:
+               occupied: np.ndarray, grown: np.ndarray, origin: tuple[int, int] = (0, 0)
+               ) -> list[float]:
     """Per ray (start, direction, from, to, on the grown grid; in (column, row) cells of
-    ``occupied``, ``grown`` being that grid dilated): the share of occupied cells at the
+    the grid whose cell ``origin`` (row, col) is ``occupied``'s cell (0, 0), ``grown``
+    being ``occupied`` dilated): the share of occupied cells at the
     points sampled every half cell from ``start + from * direction`` to
     ``start + to * direction``, rounded to cells (points off the grid skipped; 0.0 with
     none on it). The points of every ray are computed as one ray at a time would, the
@@ -210,7 +230,8 @@ def ray_shares(rays: list[tuple[np.ndarray, np.ndarray, float, float, bool]],
     p0 = np.stack([r[0] for r in rays])[ray]
     direction = np.stack([r[1] for r in rays])[ray]
     p = p0 + direction * np.concatenate(fs)[:, None]
-    c, r = np.round(p[:, 0]).astype(np.int64), np.round(p[:, 1]).astype(np.int64)
+    c = np.round(p[:, 0]).astype(np.int64) - origin[1]
+    r = np.round(p[:, 1]).astype(np.int64) - origin[0]
     h, w = occupied.shape
     ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
     on_grown = np.fromiter((g for *_, g in rays), dtype=bool, count=len(rays))[ray[ok]]

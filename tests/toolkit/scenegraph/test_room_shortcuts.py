@@ -27,18 +27,20 @@ def door_cells_of(occ, door_voxels, memo):
 
 
 def _share(p0: np.ndarray, direction: np.ndarray, lo: float, hi: float,
-           grid: np.ndarray) -> float:
+           grid: np.ndarray, origin: tuple[int, int] = (0, 0)) -> float:
     """One ray at a time, as ``_opening`` sampled before its rays were batched."""
     h, w = grid.shape
     f = np.linspace(lo, hi, max(2, int(np.ceil(2 * (hi - lo)))))
     p = p0[None, :] + direction[None, :] * f[:, None]
-    c, r = np.round(p[:, 0]).astype(np.int64), np.round(p[:, 1]).astype(np.int64)
+    c = np.round(p[:, 0]).astype(np.int64) - origin[1]
+    r = np.round(p[:, 1]).astype(np.int64) - origin[0]
     ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
     return float(grid[r[ok], c[ok]].mean()) if ok.any() else 0.0
 
 
-def _reference_shares(rays, occupied, grown):  # noqa: ANN001, ANN202
-    return [_share(p0, d, lo, hi, grown if g else occupied) for p0, d, lo, hi, g in rays]
+def _reference_shares(rays, occupied, grown, origin=(0, 0)):  # noqa: ANN001, ANN202
+    return [_share(p0, d, lo, hi, grown if g else occupied, origin)
+            for p0, d, lo, hi, g in rays]
 
 
 @pytest.mark.parametrize("seed", range(10))
@@ -284,3 +286,39 @@ def test_an_open_door_stands_at_its_doorway_not_at_its_swung_panel():
     assert set(at) == {7}  # a door without voxels has no doorway
     x, y = at[7]
     assert abs(y - 1.025) < 0.051 and 0.5 <= x <= 1.3  # in the gap (a cell), not in the room
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_panel_opening_moves_with_the_grid(seed):
+    """A diagonal wall with a doorway, its panel swung open and clutter: the same scene
+    one, two or three cells further from the grid's corner gives a doorway (or none)
+    likewise, that much further, to a cell (the search works in the grid's own cells; a
+    point half-way between two cells may round the other way once moved)."""
+    rng = np.random.default_rng(700 + seed)
+    width = int(rng.integers(14, 30))
+    d = np.array([1.0, 1.0]) / np.sqrt(2)
+    t = np.array([-d[1], d[0]])
+    occupied = np.zeros((200, 200), dtype=bool)
+    hinge = np.array([100.0, 100.0])
+    for s in np.arange(-90.0, 90.0, 0.25):
+        if not 0 <= s <= width:
+            c, r = np.round(hinge + t * s).astype(int)
+            occupied[r, c] = True
+    occupied |= rng.random(occupied.shape) < rng.uniform(0.0, 0.1)
+    p = hinge[None, :] + d[None, :] * np.arange(1.0, width, 0.25)[:, None]
+    cell = np.unique(np.round(p[:, ::-1]).astype(np.int64), axis=0)
+    rows, cols = cell[:, 0], cell[:, 1]
+    occupied[rows, cols] = True
+    free = ~occupied
+    want = opening_from_panel(rows, cols, occupied, min_width=8, free=free)
+    for k in (1, 2, 3):
+        moved = np.zeros((200 + k, 200 + k), dtype=bool)
+        moved[k:, k:] = occupied
+        got = opening_from_panel(rows + k, cols + k, moved, min_width=8, free=np.pad(
+            free, ((k, 0), (k, 0))))
+        assert (got is None) == (want is None)
+        if want is not None and got is not None:
+            a = np.stack([want[0], want[1]], axis=1)
+            b = np.stack([got[0] - k, got[1] - k], axis=1)
+            assert len(a) == len(b)
+            assert np.abs(a[:, None, :] - b[None, :, :]).max(axis=2).min(axis=1).max() <= 1
