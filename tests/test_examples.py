@@ -204,7 +204,7 @@ def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     minute; tests/recorders/sim covers run_episode)."""
     guide = (REPO / "docs" / "api.md").read_text()
     blocks = re.findall(r"```python\n(.*?)```", guide, re.DOTALL)
-    assert len(blocks) == 14
+    assert len(blocks) == 15
     runnable = [b for b in blocks if "run_closed_loop(" not in b]
     assert len(runnable) == len(blocks) - 1
     for name in ("tests", "examples"):
@@ -223,6 +223,10 @@ def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     assert "| scout " in (tmp_path / "run-bench" / "run.md").read_text()
     with sgtool.LogReader(tmp_path / "my.mcap") as log:
         assert [r.skill for _, r in log.records(sgtool.ActionRecord)] == ["navigate"]
+    recorded = namespace["recorded"]  # the recording block
+    assert isinstance(recorded, sgtool.RecordReport) and recorded.frames == 40
+    with sgtool.LogReader(tmp_path / "house.mcap") as log:
+        assert log.frame_count() == 40
     report = namespace["report"]
     assert isinstance(report, sgtool.OfflineReport) and report.decisions > 0
     checked, what_if = namespace["checked"], namespace["what_if"]  # the golden-logs block

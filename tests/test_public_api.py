@@ -37,6 +37,7 @@ REQUIRED = {
     "symbolic episode": ("run_one", "EpisodeResult"),
     "benchmark": ("BenchConfig", "run_benchmark", "BenchResult"),
     "closed loop": ("run_closed_loop", "ClosedLoopOptions"),
+    "recording": ("record_house", "RecordOptions", "RecordReport"),
     "metrics": ("success_rate", "spl", "auc_e", "summarize"),
     "houses": ("HouseSpec", "load_house"),
     "errors": ("SgtoolError",),
@@ -152,6 +153,8 @@ def test_a_call_whose_extra_is_missing_is_one_line(monkeypatch: pytest.MonkeyPat
     calls = {
         "sgtool.run_closed_loop needs PyBullet": lambda: sgtool.run_closed_loop(
             house, episode, sgtool.make_planner("greedy"), tmp_path / "ep.mcap"),
+        "sgtool.record_house needs PyBullet": lambda: sgtool.record_house(
+            house, tmp_path / "rec.mcap", sgtool.RecordOptions(frames=3)),
         "sgtool.run_closed_loop_bench needs PyBullet": lambda: sgtool.run_closed_loop_bench(
             sgtool.ClosedLoopBenchConfig(planners=("random",), houses=1, episodes=1),
             tmp_path / "rb"),
@@ -276,6 +279,10 @@ def test_api_mistakes_are_one_line_errors(tmp_path) -> None:
         def decide(self, graph: object) -> None: ...
         def feedback(self, fb: object) -> None: ...
 
+    with pytest.raises(sgtool.SgtoolError, match=r"explore 'walk' \(--explore\): one of"):
+        sgtool.RecordOptions(explore="walk")
+    with pytest.raises(sgtool.SgtoolError, match=r"frames 0 \(--frames\): must be >= 1"):
+        sgtool.RecordOptions(frames=0)
     house = sgtool.generate_house(3, rooms=(4, 5))
     with pytest.raises(sgtool.SgtoolError, match=r"'nothing': decide\(\) returned NoneType"):
         sgtool.run_one(house, Nothing(), sgtool.list_episodes(house)[0].query)

@@ -65,6 +65,9 @@ from sgtool.analysis.bench import BenchResult as BenchResult
 from sgtool.analysis.bench import run_benchmark as run_benchmark
 from sgtool.analysis.bench import write_outputs as write_bench_outputs
 # the closed loop (PyBullet: sgtool[sim])
+from sgtool.recorders.sim.recording import record_house as record_house
+from sgtool.recorders.sim.recording import RecordOptions as RecordOptions
+from sgtool.recorders.sim.recording import RecordReport as RecordReport
 from sgtool.recorders.sim.closed_loop import run_episode as run_closed_loop
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions as ClosedLoopOptions
 from sgtool.recorders.sim.camera import CameraConfig as CameraConfig
@@ -144,7 +147,8 @@ __all__ = [
     "make_planner", "actionable", "Candidate", "find_target", "HouseSpec", "load_house",
     "load_house_text", "save_house", "generate_house", "SearchEpisode", "list_episodes",
     "run_one", "SymbolicHouse", "EpisodeResult", "BenchConfig", "BenchResult", "run_benchmark",
-    "write_bench_outputs", "run_closed_loop", "ClosedLoopOptions", "CameraConfig",
+    "write_bench_outputs", "record_house", "RecordOptions", "RecordReport",
+    "run_closed_loop", "ClosedLoopOptions", "CameraConfig",
     "ClosedLoopReport",
     "pick_episode", "NoiseProfile", "parse_noise", "ClosedLoopBenchConfig",
     "ClosedLoopBenchResult", "run_closed_loop_bench", "write_closed_loop_bench_outputs",

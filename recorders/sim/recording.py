@@ -39,6 +39,7 @@ from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.log.records import Action, Episode, Instances
 from sgtool.log.writer import LogWriter
+from sgtool.progress import Progress
 from sgtool.recorders.sim.body_instances import STRUCTURE
 from sgtool.recorders.sim.camera import LINK_TOL, CameraConfig, base_T_camera
 from sgtool.recorders.sim.explore import ExplorationReport, ScriptOptions, explore_house
@@ -68,7 +69,7 @@ class LogRecorder(SimObserver):
     def __init__(self, writer: LogWriter, sim: Simulation, *,
                  noise: NoiseProfile | None = None, seed: int = 0,
                  max_frames: int | None = None, planner: str | None = None,
-                 progress: Any = None, log_actions: bool = True) -> None:
+                 progress: Progress | None = None, log_actions: bool = True) -> None:
         self.writer = writer
         self.max_frames = max_frames
         self.planner = planner
@@ -181,8 +182,20 @@ def instance_image(t_ns: int, ids: np.ndarray) -> Any:
     return codec.encode_ids(t_ns, ids, S.CAMERA_FRAME)
 
 
+EXPLORE = ("script", "frontier")
+
+
 @dataclass(frozen=True)
 class RecordOptions:
+    """How :func:`record_house` records (``sgtool record``'s options): ``fps`` frames per
+    second of log time, ``frames`` a budget (None: until the exploration ends), the
+    camera, the robot base, sensor ``noise`` (:func:`sgtool.parse_noise`) seeded by
+    ``seed``, the house's ``start`` pose, the scripted tour's ``script`` options, the
+    log's ``compression`` (zstd, lz4, none), and ``explore``: "script" (the scripted tour
+    of every room, with the house's knowledge) or "frontier" (frontier exploration on the
+    robot's own map, refreshed every ``every`` frames). A bad value is one
+    :class:`~sgtool.errors.SgtoolError` line."""
+
     fps: float = 10.0
     frames: int | None = None  # stop after this many frames (None: when the script ends)
     camera: CameraConfig = field(default_factory=CameraConfig)
@@ -195,9 +208,28 @@ class RecordOptions:
     explore: str = "script"  # or "frontier": frontier exploration on the robot's own map
     every: int = 10  # frontier: frames between refreshes of the robot's map
 
+    def __post_init__(self) -> None:
+        from sgtool.errors import SgtoolError
+
+        if self.frames is not None and self.frames < 1:
+            raise SgtoolError(f"frames {self.frames} (--frames): must be >= 1")
+        if self.explore not in EXPLORE:
+            raise SgtoolError(f"explore {self.explore!r} (--explore): one of "
+                              f"{', '.join(EXPLORE)}")
+        if self.every < 1:
+            raise SgtoolError(f"every {self.every}: must be >= 1")
+        if self.seed < 0:
+            raise SgtoolError(f"seed {self.seed} (--noise-seed): must be >= 0")
+
 
 @dataclass(frozen=True)
 class RecordReport:
+    """What :func:`record_house` wrote: the log, its frames and actions, the metres
+    driven, the rooms (or frontier goals) visited and those missed with why, the pieces
+    opened, whether the frame budget cut the tour short, the wall-clock seconds, and for
+    a frontier exploration the share of the house's floor seen over time. ``lines()``
+    is ``sgtool record``'s report."""
+
     output: Path
     house_id: str
     frames: int
@@ -245,15 +277,18 @@ def coverage_at(samples: Sequence[tuple[float, float]], t: float) -> float:
 
 def record_house(house: HouseSpec, output: str | os.PathLike[str],
                  options: RecordOptions | None = None, *, house_id: str = "",
-                 progress: Any = None, observers: Sequence[SimObserver] = ()) -> RecordReport:
-    """Record the scripted exploration of ``house`` into the log ``output``. ``observers``
-    also watch the simulation (after the recorder, so they see each frame once it is
-    written)."""
-    opts = options or RecordOptions()
-    if opts.frames is not None and opts.frames < 1:
-        from sgtool.errors import SgtoolError
+                 progress: Progress | None = None, observers: Sequence[SimObserver] = ()
+                 ) -> RecordReport:
+    """Record the exploration of ``house`` (``sgtool record``) into the log ``output``
+    (an MCAP file, replaced when it exists; written to a temporary name and renamed at the
+    end, so an error leaves nothing). ``house_id`` names the house in the log (default
+    ``house-SEED``); ``progress`` advances by one per frame; ``observers`` also watch the
+    simulation (after the recorder, so they see each frame once it is written). Needs
+    PyBullet (``pip install 'sgtool[sim]'``)."""
+    from sgtool.extras import require
 
-        raise SgtoolError(f"frames {opts.frames}: must be >= 1")
+    require("pybullet", api="sgtool.record_house")  # one line on a core install
+    opts = options or RecordOptions()
     hid = house_id or f"house-{house.seed}"
     t_wall = time.perf_counter()
     rep = ExplorationReport()
