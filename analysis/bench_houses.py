@@ -213,14 +213,16 @@ def symbolic_house(spec: HouseSpec, where: str | os.PathLike[str]) -> tuple[Any,
 def house_notes(house: Any) -> tuple[str, ...]:
     """What a user should know of a house that loads: doors furniture blocks (read as
     walls), rooms walled off from the rest (their targets are searched from inside, the
-    others' from outside), containers whose front is blocked, pieces no camera sees and
-    starts nearer to walls or furniture than the robot's radius
+    others' from outside), containers whose front is blocked, pieces no camera sees,
+    pieces reaching into a wall and starts nearer to walls or furniture than the robot's
+    radius
     (:mod:`sgtool.house.clearance`)."""
     from sgtool.house.clearance import (
         FRONT_CLEAR,
         blocked_fronts,
         cramped_starts,
         hidden_pieces,
+        pieces_in_walls,
     )
     from sgtool.recorders.symbolic_environment.doorways import doorway_pieces
 
@@ -249,6 +251,11 @@ def house_notes(house: Any) -> tuple[str, ...]:
         notes.append(f"furniture[{k}] ({f.id}, {f.category}): {why}: no camera sees it or "
                      "what it holds, which the symbolic bench finds all the same (furniture "
                      "centres are at half their height above the floor)")
+    for k, wall, area in pieces_in_walls(spec):
+        f = spec.furniture[k]
+        notes.append(f"furniture[{k}] ({f.id}, {f.category}): {area:.2f} m² of its "
+                     f"footprint lies inside {wall}'s body: it reaches through the wall (the "
+                     "simulator shows it on both sides; set it against the wall's face)")
     turned = [f"{kind}[{i}] ({x.yaw:g})" for kind, items in (("furniture", spec.furniture),
                                                              ("starts", spec.starts))
               for i, x in enumerate(items) if abs(x.yaw) > 2 * math.pi + 1e-9]

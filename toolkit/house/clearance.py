@@ -9,6 +9,8 @@ another piece's footprint (a cabinet set with its back to the room). :func:`cram
 finds the start poses nearer to a wall or a piece than the robot's radius (the simulator
 then starts the robot overlapping it). :func:`hidden_pieces` finds the pieces no camera
 can see: a box whose top lies under the floor, or one inside another piece's box.
+:func:`pieces_in_walls` finds the pieces whose footprint reaches into a wall's body (a
+piece through a wall stands in two rooms; set against a wall, it touches its face only).
 """
 
 from __future__ import annotations
@@ -17,10 +19,17 @@ import math
 
 import numpy as np
 
-from sgtool.house.geometry import distance_to_polygon, point_in_polygon, segment_distance
+from sgtool.house.geometry import (
+    box_corners,
+    distance_to_polygon,
+    overlap_area,
+    point_in_polygon,
+    segment_distance,
+)
 from sgtool.house.spec import Furniture, HouseSpec
 
 FRONT_CLEAR = 0.3  # m in front of a front face that must be open floor
+IN_WALL_AREA = 0.01  # m^2 of a footprint inside a wall's body that is more than touching
 
 
 def front_point(f: Furniture, clear: float = FRONT_CLEAR) -> tuple[float, float]:
@@ -123,4 +132,24 @@ def hidden_pieces(spec: HouseSpec) -> list[tuple[int, str]]:
                     point_in_polygon(x, y, covers.feet[j]) for x, y in covers.feet[k]):
                 out.append((k, f"its box lies inside furniture[{j}] ({g.id}, {g.category})"))
                 break
+    return out
+
+
+def pieces_in_walls(spec: HouseSpec) -> list[tuple[int, str, float]]:
+    """(furniture index, wall id, m^2 of its footprint inside the wall's body) for each
+    piece and wall they share at least ``IN_WALL_AREA`` of, in spec order (the wall's body:
+    its segment, ``thickness`` wide)."""
+    covers = Covers(spec)
+    out = []
+    for k, feet in enumerate(covers.feet):
+        b = covers.fbox[k]
+        near = np.flatnonzero((covers.wbox[:, 0] < b[2]) & (b[0] < covers.wbox[:, 2])
+                              & (covers.wbox[:, 1] < b[3]) & (b[1] < covers.wbox[:, 3]))
+        for j in near.tolist():
+            w = spec.walls[j]
+            body = box_corners(((w.a[0] + w.b[0]) / 2, (w.a[1] + w.b[1]) / 2),
+                               (w.length, w.thickness), w.yaw)
+            area = overlap_area(feet, body)
+            if area >= IN_WALL_AREA:
+                out.append((k, w.id, area))
     return out

@@ -8,7 +8,7 @@ import copy
 
 from support.datasets_fixtures import two_rooms
 
-from sgtool.house.clearance import hidden_pieces
+from sgtool.house.clearance import hidden_pieces, pieces_in_walls
 from sgtool.house.io import load_house
 
 
@@ -52,3 +52,34 @@ def test_scenes_check_names_a_hidden_piece(tmp_path) -> None:
     r = CliRunner().invoke(cli, ["scenes", "check", str(f)])
     assert r.exit_code == 0, r.output
     assert "furniture[1] (furn_1, table): its box lies under the floor" in r.output
+
+
+def test_a_piece_through_a_wall_is_named_and_one_against_it_is_not(tmp_path) -> None:
+    """The refrigerator (0.8 x 0.7 m) pushed through the 0.1 m wall at x = 0 (to x =
+    -0.08, within the 0.1 m a piece may stand outside its room) shares 0.1 x 0.7 = 0.07 m^2
+    of its footprint with the wall's body; set against its face (x from 0.05) it shares
+    nothing."""
+    import json
+
+    from click.testing import CliRunner
+
+    from sgtool.cli import cli
+
+    d = two_rooms()
+    assert pieces_in_walls(load_house(d)) == []
+    against = copy.deepcopy(d)
+    against["furniture"][0]["center"][0] = 0.45
+    assert pieces_in_walls(load_house(against)) == []
+    through = copy.deepcopy(d)
+    through["furniture"][0]["center"][0] = 0.32
+    for o in through["objects"]:
+        if o["parent"] == "furn_0":
+            o["position"][0] -= 0.18
+    (k, wall, area), = pieces_in_walls(load_house(through))
+    assert (k, wall) == (0, "wall_2") and abs(area - 0.07) < 1e-9
+    f = tmp_path / "through.json"
+    f.write_text(json.dumps(through))
+    r = CliRunner().invoke(cli, ["scenes", "check", str(f)])
+    assert r.exit_code == 0, r.output
+    assert "furniture[0] (furn_0, refrigerator): 0.07 m² of its footprint lies inside " \
+        "wall_2's body" in r.output
