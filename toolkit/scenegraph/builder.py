@@ -18,8 +18,9 @@ caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
    doors win (:mod:`sgtool.scenegraph.door_evidence`,
    :meth:`sgtool.scenegraph.door_voxels.DoorVoxels.won`), within ``DOOR_REACH`` of
    their median (:func:`sgtool.scenegraph.door_voxels.near_median`), in columns where at
-   least ``DOOR_MIN_FRAMES`` frames gave the door a voxel, cut the graph, ids
-   are kept stable by overlap with the previous refresh;
+   least ``DOOR_MIN_FRAMES`` frames gave the door a voxel, and the lintels over
+   doorways no door leaf was seen in (:mod:`sgtool.scenegraph.lintels`) cut the graph;
+   ids are kept stable by overlap with the previous refresh;
 4. objects (:mod:`sgtool.scenegraph.object_placement`, :mod:`sgtool.scenegraph.assign`):
    instances seen with enough points in a frame, given points by at least
    ``OBJECT_EVIDENCE.min_frames`` frames and winning a voxel
@@ -121,6 +122,7 @@ from sgtool.scenegraph.frontier_ids import FrontierTracker
 from sgtool.scenegraph.frontiers import Frontier, find_frontiers
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.instances import InstanceInfo
+from sgtool.scenegraph.lintels import LINTEL_BAND, lintel_doorways
 from sgtool.scenegraph.object_evidence import EvidenceRule
 from sgtool.scenegraph.object_placement import (
     OBJECT_KINDS,
@@ -535,6 +537,7 @@ class SceneGraphBuilder:
         reach = DOOR_REACH / self.voxels.resolution
         won = {iid: near_median(ijk, reach) for iid, ijk in won.items()}
         cells, centres = doorways(occ, won, self._panel_memo)
+        cells |= lintel_doorways(occ, self.columns_between(occ, *LINTEL_BAND))  # no leaf seen
         cells.setflags(write=False)  # kept to recognise the same cells next time
         got = self._density
         if got is None or got[0] != occ.resolution or not np.array_equal(got[1], cells):

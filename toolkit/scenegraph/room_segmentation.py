@@ -15,8 +15,9 @@ What we do, and why it differs:
   swung panel misses the opening by half a door width): the grid cells of an open (or
   state-unknown) door instance that are passable (its lintel above the free opening),
   or, for a door seen only as its swung panel, the panel's closed position
-  (:func:`sgtool.scenegraph.door_panel.opening_from_panel`), or else all its cells.
-  Closed doors are walls already
+  (:func:`sgtool.scenegraph.door_panel.opening_from_panel`), or else all its cells; and
+  the cells under a lintel seen over a gap in a wall, where no door leaf was seen
+  (:mod:`sgtool.scenegraph.lintels`). Closed doors are walls already
   (the graph never crosses them) and would only cut corridors running past them.
 - **Density without the 1/N_D factor**: ``gaussian_filter(door_cells, sigma=0.15 m)`` is
   ``sum_i K_H(x - x_i) * cell_area``, the kernel mass of door cells near x. With the 1/N_D

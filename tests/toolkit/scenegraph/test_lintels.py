@@ -1,0 +1,62 @@
+"""Doorways seen by their lintel (sgtool.scenegraph.lintels) on hand-made grids: a beam over
+a gap in a wall, with floor seen under it and on both sides, is a doorway; a wall whose
+foot is hidden, a shelf along a wall, a beam across a room and a lamp are not."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from sgtool.scenegraph.lintels import lintel_doorways
+
+RES = 0.05
+
+
+def two_rooms() -> tuple[np.ndarray, np.ndarray]:
+    """A 3 x 6 m floor seen free, split at x = 3 m (columns 60-61) by a wall with an
+    18-cell gap (rows 20-37, 0.9 m); and the overhead mask of the gap's lintel."""
+    g = np.full((60, 120), FREE, dtype=np.int8)
+    g[[0, -1], :] = OCCUPIED
+    g[:, [0, -1]] = OCCUPIED
+    g[:, 60:62] = OCCUPIED
+    g[20:38, 60:62] = FREE
+    overhead = np.zeros(g.shape, dtype=bool)
+    overhead[20:38, 60:62] = True
+    return g, overhead
+
+
+def grid(g: np.ndarray) -> OccupancyGrid:
+    return OccupancyGrid(g, (0.0, 0.0), RES)
+
+
+def test_a_beam_over_a_gap_in_a_wall_is_a_doorway() -> None:
+    g, overhead = two_rooms()
+    got = lintel_doorways(grid(g), overhead)
+    assert np.array_equal(got, overhead)
+    # the ceiling-height band of a wall seen whole is no lintel: its cells are occupied
+    overhead[:, 60:62] = True
+    assert np.array_equal(lintel_doorways(grid(g), overhead), got)
+
+
+def test_no_doorway_without_floor_under_it_and_on_both_sides() -> None:
+    g, overhead = two_rooms()
+    hidden = g.copy()
+    hidden[20:38, 60:62] = UNKNOWN  # the wall's foot hidden by furniture: no floor seen
+    assert not lintel_doorways(grid(hidden), overhead).any()
+    one_side = g.copy()
+    one_side[15:43, 62:66] = OCCUPIED  # a cupboard filling one side of the gap
+    assert not lintel_doorways(grid(one_side), overhead).any()
+
+
+def test_shelf_beam_and_lamp_are_no_doorways() -> None:
+    g, _ = two_rooms()
+    g[20:38, 60:62] = OCCUPIED  # a wall without a gap
+    shelf = np.zeros(g.shape, dtype=bool)
+    shelf[10:30, 62:68] = True  # 1 m along the wall, 0.3 m deep, above the floor
+    assert not lintel_doorways(grid(g), shelf).any()
+    beam = np.zeros(g.shape, dtype=bool)
+    beam[1:59, 30:32] = True  # 2.9 m across the room, wall to wall: longer than a door
+    assert not lintel_doorways(grid(g), beam).any()
+    lamp = np.zeros(g.shape, dtype=bool)
+    lamp[28:32, 28:34] = True  # over the middle of the room, no wall at either end
+    assert not lintel_doorways(grid(g), lamp).any()
