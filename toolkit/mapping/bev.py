@@ -115,13 +115,14 @@ def classify_keys(keys: np.ndarray, level: int, resolution: float, config: BevCo
 
 
 def columns_between(keys: np.ndarray, level: int, resolution: float, low: float,
-                    high: float) -> np.ndarray:
+                    high: float, presorted: bool = False) -> np.ndarray:
     """Distinct (ix, iy) voxel columns of packed ``keys`` holding a voxel from ``low`` to
-    ``high`` metres above the floor level ``level`` (both ends included, in whole voxels)."""
+    ``high`` metres above the floor level ``level`` (both ends included, in whole voxels);
+    sorted keys, as the map stores them, skip a sort."""
     iz = ((keys >> SHIFT_Z) & AXIS_MASK) - OFFSET
     lo = level + int(math.ceil(low / resolution - 1e-9))
     hi = level + int(math.floor(high / resolution + 1e-9))
-    return _unique_columns(keys[(iz >= lo) & (iz <= hi)] >> COLUMN_SHIFT, presorted=False)
+    return _unique_columns(keys[(iz >= lo) & (iz <= hi)] >> COLUMN_SHIFT, presorted)
 
 
 class ColumnGrid:

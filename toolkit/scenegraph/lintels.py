@@ -23,6 +23,9 @@ bar between walls.
 
 from __future__ import annotations
 
+import hashlib
+from typing import Any
+
 import numpy as np
 from scipy import ndimage
 
@@ -37,20 +40,42 @@ SIDE_GAP = 2.0  # cells off a bar's long side where the floor of a room must be 
 SIDE_SHARE = 0.7  # of the points along each long side
 
 
-def lintel_doorways(occ: OccupancyGrid, overhead: np.ndarray) -> np.ndarray:
+def lintel_doorways(occ: OccupancyGrid, overhead: np.ndarray,
+                    memo: dict[bytes, Any] | None = None) -> np.ndarray:
     """Bool grid over ``occ``: the cells of the lintels (module doc), from ``overhead``
     (bool, ``occ``'s shape: the cells whose voxel column holds something in
-    ``LINTEL_BAND``)."""
-    out = np.zeros(occ.shape, dtype=bool)
+    ``LINTEL_BAND``). ``memo`` keeps answers by grid and overhead cells (the same
+    inputs, the same answer; a read-only array)."""
     free = occ.grid == FREE
     bar = overhead & free
     if not bar.any():
-        return out
+        return np.zeros(occ.shape, dtype=bool)
+    key = None
+    if memo is not None:
+        h = hashlib.blake2b(b"lintels", digest_size=16)
+        for a in (occ.grid, bar):
+            h.update(np.ascontiguousarray(a).tobytes())
+        h.update(repr((occ.shape, occ.resolution)).encode())
+        key = h.digest()
+        if key in memo:
+            return memo[key]
+    out = _lintels(occ, bar, free)
+    if memo is not None and key is not None:
+        out.setflags(write=False)
+        if len(memo) > 256:
+            memo.clear()
+        memo[key] = out
+    return out
+
+
+def _lintels(occ: OccupancyGrid, bar: np.ndarray, free: np.ndarray) -> np.ndarray:
+    out = np.zeros(occ.shape, dtype=bool)
     labels, n = ndimage.label(bar, structure=np.ones((3, 3), dtype=bool))
     occupied = occ.grid == OCCUPIED
     res = occ.resolution
+    big = np.bincount(labels.ravel(), minlength=n + 1) >= LINTEL_LENGTH[0] / res
     for i, piece in enumerate(ndimage.find_objects(labels), start=1):
-        if piece is None:
+        if piece is None or not big[i]:  # too few cells to be a doorway's length
             continue
         rr, cc = np.nonzero(labels[piece] == i)
         rows, cols = rr + piece[0].start, cc + piece[1].start

@@ -60,3 +60,14 @@ def test_shelf_beam_and_lamp_are_no_doorways() -> None:
     lamp = np.zeros(g.shape, dtype=bool)
     lamp[28:32, 28:34] = True  # over the middle of the room, no wall at either end
     assert not lintel_doorways(grid(g), lamp).any()
+
+
+def test_the_memo_gives_the_same_answer_for_the_same_inputs_only() -> None:
+    g, overhead = two_rooms()
+    memo: dict[bytes, object] = {}
+    first = lintel_doorways(grid(g), overhead, memo)
+    assert lintel_doorways(grid(g), overhead, memo) is first and not first.flags.writeable
+    assert np.array_equal(first, lintel_doorways(grid(g), overhead))
+    closed = g.copy()
+    closed[20:38, 60:62] = OCCUPIED  # the doorway shut: no free cell under the beam
+    assert not lintel_doorways(grid(closed), overhead, memo).any()
