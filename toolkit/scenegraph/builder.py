@@ -231,7 +231,7 @@ class SceneGraphBuilder:
         self._rooms = RoomTracker()
         self._frontiers = FrontierTracker()
         self._class_memo: dict[tuple[str, ...], list[tuple[str, float]]] = {}
-        self._panel_memo: dict[bytes, object] = {}  # door openings from swung panels, lintels
+        self._panel_memo: dict[bytes, object] = {}  # door openings from swung panels
         # door density of these cells: (resolution, door cells, density)
         self._density: tuple[float, np.ndarray, np.ndarray] | None = None
         self._centre_memo: dict[bytes, int] = {}  # room centres by their sub-graph
@@ -537,7 +537,7 @@ class SceneGraphBuilder:
         reach = DOOR_REACH / self.voxels.resolution
         won = {iid: near_median(ijk, reach) for iid, ijk in won.items()}
         cells, centres = doorways(occ, won, self._panel_memo)
-        cells |= lintel_doorways(occ, self.columns_between(occ, *LINTEL_BAND), self._panel_memo)
+        cells |= lintel_doorways(occ, self.columns_between(occ, *LINTEL_BAND))  # no leaf seen
         cells.setflags(write=False)  # kept to recognise the same cells next time
         got = self._density
         if got is None or got[0] != occ.resolution or not np.array_equal(got[1], cells):

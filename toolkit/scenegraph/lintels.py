@@ -11,20 +11,19 @@ above the obstacle band, below a ceiling's usual height) over seen floor:
 - grouped into 8-connected pieces; a piece is a lintel when it is a thin bar
   (``LINTEL_LENGTH`` long along its principal axis, at most ``LINTEL_DEPTH`` across) whose
   line runs into occupied cells past both of its ends (the wall it bridges: the jambs),
-  with walkable floor off both long sides (the two places it joins);
+  each jamb thin across the line (not a wall running across it, as at a corridor's side
+  under a duct, nor a column), with walkable floor off both long sides (the two places
+  it joins);
 - the bar's cells are door evidence for the room segmentation
   (:mod:`sgtool.scenegraph.room_segmentation`), as a door's opening is.
 
 What passes for a lintel otherwise is ruled out by these: a wall whose lower part a
 piece of furniture hides has no floor seen under it; a shelf along a wall has free floor
-past its ends and the wall on one side; a ceiling is higher than the band; a lamp is no
-bar between walls.
+past its ends and the wall on one side; a duct or beam across a corridor ends at walls
+running across it; a ceiling is higher than the band; a lamp is no bar between walls.
 """
 
 from __future__ import annotations
-
-import hashlib
-from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -34,52 +33,32 @@ from sgtool.scenegraph.door_panel import grid_at
 
 LINTEL_BAND = (1.75, 2.3)  # m above the floor: over a walking robot, under most ceilings
 LINTEL_LENGTH = (0.5, 1.6)  # m: a doorway's width
-LINTEL_DEPTH = 0.35  # m: a wall's thickness, at most
+LINTEL_DEPTH = 0.6  # m: a wall's thickness, at most (a noisy map smears a lintel deeper)
 JAMB_REACH = 2  # cells past a bar's end its wall must start
 SIDE_GAP = 2.0  # cells off a bar's long side where the floor of a room must be seen
 SIDE_SHARE = 0.7  # of the points along each long side
 
 
-def lintel_doorways(occ: OccupancyGrid, overhead: np.ndarray,
-                    memo: dict[bytes, Any] | None = None) -> np.ndarray:
+def lintel_doorways(occ: OccupancyGrid, overhead: np.ndarray) -> np.ndarray:
     """Bool grid over ``occ``: the cells of the lintels (module doc), from ``overhead``
     (bool, ``occ``'s shape: the cells whose voxel column holds something in
-    ``LINTEL_BAND``). ``memo`` keeps answers by grid and overhead cells (the same
-    inputs, the same answer; a read-only array)."""
+    ``LINTEL_BAND``)."""
+    out = np.zeros(occ.shape, dtype=bool)
     free = occ.grid == FREE
     bar = overhead & free
     if not bar.any():
-        return np.zeros(occ.shape, dtype=bool)
-    key = None
-    if memo is not None:
-        h = hashlib.blake2b(b"lintels", digest_size=16)
-        for a in (occ.grid, bar):
-            h.update(np.ascontiguousarray(a).tobytes())
-        h.update(repr((occ.shape, occ.resolution)).encode())
-        key = h.digest()
-        if key in memo:
-            return memo[key]
-    out = _lintels(occ, bar, free)
-    if memo is not None and key is not None:
-        out.setflags(write=False)
-        if len(memo) > 256:
-            memo.clear()
-        memo[key] = out
-    return out
-
-
-def _lintels(occ: OccupancyGrid, bar: np.ndarray, free: np.ndarray) -> np.ndarray:
-    out = np.zeros(occ.shape, dtype=bool)
+        return out
     labels, n = ndimage.label(bar, structure=np.ones((3, 3), dtype=bool))
     occupied = occ.grid == OCCUPIED
     res = occ.resolution
-    big = np.bincount(labels.ravel(), minlength=n + 1) >= LINTEL_LENGTH[0] / res
+    size = np.bincount(labels.ravel(), minlength=n + 1)
+    most = (LINTEL_LENGTH[1] / res + 2) * (LINTEL_DEPTH / res + 2)  # cells of the largest bar
     for i, piece in enumerate(ndimage.find_objects(labels), start=1):
-        if piece is None or not big[i]:  # too few cells to be a doorway's length
-            continue
+        if piece is None or not LINTEL_LENGTH[0] / res <= size[i] <= most:
+            continue  # too few or too many cells for a doorway's bar
         rr, cc = np.nonzero(labels[piece] == i)
         rows, cols = rr + piece[0].start, cc + piece[1].start
-        if len(rows) >= 2 and _is_lintel(rows, cols, occupied, free, res):
+        if _is_lintel(rows, cols, occupied, free, res):
             out[rows, cols] = True
     return out
 
@@ -87,8 +66,10 @@ def _lintels(occ: OccupancyGrid, bar: np.ndarray, free: np.ndarray) -> np.ndarra
 def _is_lintel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray, free: np.ndarray,
                res: float) -> bool:
     """Whether the cells (``rows``, ``cols``) are a thin bar of a doorway's length whose
-    line runs into ``occupied`` cells within ``JAMB_REACH`` cells past both ends, with
-    ``free`` floor ``SIDE_GAP`` cells off both of its long sides along most of it."""
+    line runs into ``occupied`` cells within ``JAMB_REACH`` cells past both ends, each of
+    those not ``occupied`` on both sides across the line ``SIDE_GAP`` cells past the bar's
+    half depth, with ``free`` floor ``SIDE_GAP`` cells off both of its long sides along
+    most of it."""
     pts = np.stack([cols, rows], axis=1).astype(np.float64)
     mean = pts.mean(axis=0)
     cen = pts - mean
@@ -100,9 +81,16 @@ def _is_lintel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray, free: n
     depth = (float(across.max() - across.min()) + 1.0) * res
     if not (LINTEL_LENGTH[0] <= length <= LINTEL_LENGTH[1] and depth <= LINTEL_DEPTH):
         return False
+    half = (float(across.max() - across.min()) + 1.0) / 2.0 + SIDE_GAP
     for end, out in ((float(along.min()), -a), (float(along.max()), a)):
         past = mean + a * end + out * np.arange(1, JAMB_REACH + 1)[:, None]
-        if not grid_at(past, occupied).any():
+        hit = grid_at(past, occupied)
+        if not hit.any():
+            return False
+        # the jamb is the wall the bar lies in: thin across, not a wall (or a column)
+        # running across the bar's line, as at a corridor's side under a duct
+        jamb = past[int(np.argmax(hit))]
+        if grid_at(np.stack([jamb + t * half, jamb - t * half]), occupied).all():
             return False
     # walkable floor on both sides, over most of the bar's length: it joins two places
     span = np.linspace(float(along.min()), float(along.max()), 9)[1:-1, None]

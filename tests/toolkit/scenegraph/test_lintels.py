@@ -1,6 +1,7 @@
 """Doorways seen by their lintel (sgtool.scenegraph.lintels) on hand-made grids: a beam over
 a gap in a wall, with floor seen under it and on both sides, is a doorway; a wall whose
-foot is hidden, a shelf along a wall, a beam across a room and a lamp are not."""
+foot is hidden, a shelf along a wall, a beam across a room, a duct across a corridor and
+a lamp are not."""
 
 from __future__ import annotations
 
@@ -62,12 +63,19 @@ def test_shelf_beam_and_lamp_are_no_doorways() -> None:
     assert not lintel_doorways(grid(g), lamp).any()
 
 
-def test_the_memo_gives_the_same_answer_for_the_same_inputs_only() -> None:
-    g, overhead = two_rooms()
-    memo: dict[bytes, object] = {}
-    first = lintel_doorways(grid(g), overhead, memo)
-    assert lintel_doorways(grid(g), overhead, memo) is first and not first.flags.writeable
-    assert np.array_equal(first, lintel_doorways(grid(g), overhead))
-    closed = g.copy()
-    closed[20:38, 60:62] = OCCUPIED  # the doorway shut: no free cell under the beam
-    assert not lintel_doorways(grid(closed), overhead, memo).any()
+def test_a_duct_across_a_corridor_is_no_doorway() -> None:
+    """A 1.2 m corridor (rows 20-43) between walls along it; a duct overhead across it
+    (columns 30-31) runs into the walls past both ends, with floor on both sides, as a
+    lintel does, but those walls run across its line: they are no jambs. A wider bar
+    smeared by noise (0.5 m deep) in a doorway is still its lintel."""
+    g = np.full((64, 120), FREE, dtype=np.int8)
+    g[[0, 19, 44, 63], :] = OCCUPIED
+    duct = np.zeros(g.shape, dtype=bool)
+    duct[20:44, 30:32] = True
+    assert not lintel_doorways(grid(g), duct).any()
+    d, overhead = two_rooms()
+    d[20:38, 56:66] = FREE
+    overhead[20:38, 56:66] = True  # 10 cells deep: the doorway's lintel, smeared
+    d[:20, 56:60] = d[38:, 56:60] = OCCUPIED  # the wall smeared as deep
+    d[:20, 62:66] = d[38:, 62:66] = OCCUPIED
+    assert np.array_equal(lintel_doorways(grid(d), overhead), overhead)
