@@ -254,8 +254,8 @@ def house_notes(house: Any) -> tuple[str, ...]:
     for k, wall, area in pieces_in_walls(spec):
         f = spec.furniture[k]
         notes.append(f"furniture[{k}] ({f.id}, {f.category}): {area:.2f} m² of its "
-                     f"footprint lies inside {wall}'s body: it reaches through the wall (the "
-                     "simulator shows it on both sides; set it against the wall's face)")
+                     f"footprint lies past {wall}'s far face: it reaches through the wall "
+                     "(the simulator shows it on both sides; set it against the wall's face)")
     turned = [f"{kind}[{i}] ({x.yaw:g})" for kind, items in (("furniture", spec.furniture),
                                                              ("starts", spec.starts))
               for i, x in enumerate(items) if abs(x.yaw) > 2 * math.pi + 1e-9]

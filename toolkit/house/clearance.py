@@ -9,8 +9,9 @@ another piece's footprint (a cabinet set with its back to the room). :func:`cram
 finds the start poses nearer to a wall or a piece than the robot's radius (the simulator
 then starts the robot overlapping it). :func:`hidden_pieces` finds the pieces no camera
 can see: a box whose top lies under the floor, or one inside another piece's box.
-:func:`pieces_in_walls` finds the pieces whose footprint reaches into a wall's body (a
-piece through a wall stands in two rooms; set against a wall, it touches its face only).
+:func:`pieces_in_walls` finds the pieces whose footprint reaches through a wall, past its
+far face (a piece through a wall stands in two rooms; set against a wall, or into its
+body up to the middle line that is a room's border, it does not).
 """
 
 from __future__ import annotations
@@ -29,7 +30,8 @@ from sgtool.house.geometry import (
 from sgtool.house.spec import Furniture, HouseSpec
 
 FRONT_CLEAR = 0.3  # m in front of a front face that must be open floor
-IN_WALL_AREA = 0.01  # m^2 of a footprint inside a wall's body that is more than touching
+IN_WALL_AREA = 0.01  # m^2 of a footprint past a wall's far face that is more than touching
+THROUGH_STRIP = 0.5  # m beyond a wall's far face looked at for a piece reaching through
 
 
 def front_point(f: Furniture, clear: float = FRONT_CLEAR) -> tuple[float, float]:
@@ -136,20 +138,27 @@ def hidden_pieces(spec: HouseSpec) -> list[tuple[int, str]]:
 
 
 def pieces_in_walls(spec: HouseSpec) -> list[tuple[int, str, float]]:
-    """(furniture index, wall id, m^2 of its footprint inside the wall's body) for each
-    piece and wall they share at least ``IN_WALL_AREA`` of, in spec order (the wall's body:
-    its segment, ``thickness`` wide)."""
+    """(furniture index, wall id, m^2 of its footprint past the wall's far face) for each
+    piece that reaches through a wall: at least ``IN_WALL_AREA`` of its footprint lies in
+    the strip ``THROUGH_STRIP`` m deep beyond the face of the wall's body away from the
+    piece's centre; in spec order. A piece set against a wall, or into its body up to its
+    middle line (a room's border), reaches nothing there."""
     covers = Covers(spec)
     out = []
     for k, feet in enumerate(covers.feet):
         b = covers.fbox[k]
         near = np.flatnonzero((covers.wbox[:, 0] < b[2]) & (b[0] < covers.wbox[:, 2])
                               & (covers.wbox[:, 1] < b[3]) & (b[1] < covers.wbox[:, 3]))
+        f = spec.furniture[k]
         for j in near.tolist():
             w = spec.walls[j]
-            body = box_corners(((w.a[0] + w.b[0]) / 2, (w.a[1] + w.b[1]) / 2),
-                               (w.length, w.thickness), w.yaw)
-            area = overlap_area(feet, body)
+            nx, ny = -math.sin(w.yaw), math.cos(w.yaw)  # the wall's normal
+            mx, my = (w.a[0] + w.b[0]) / 2, (w.a[1] + w.b[1]) / 2
+            side = 1.0 if (f.center[0] - mx) * nx + (f.center[1] - my) * ny > 0 else -1.0
+            shift = -side * (w.thickness + THROUGH_STRIP) / 2
+            strip = box_corners((mx + nx * shift, my + ny * shift), (w.length, THROUGH_STRIP),
+                                w.yaw)
+            area = overlap_area(feet, strip)
             if area >= IN_WALL_AREA:
                 out.append((k, w.id, area))
     return out

@@ -56,9 +56,9 @@ def test_scenes_check_names_a_hidden_piece(tmp_path) -> None:
 
 def test_a_piece_through_a_wall_is_named_and_one_against_it_is_not(tmp_path) -> None:
     """The refrigerator (0.8 x 0.7 m) pushed through the 0.1 m wall at x = 0 (to x =
-    -0.08, within the 0.1 m a piece may stand outside its room) shares 0.1 x 0.7 = 0.07 m^2
-    of its footprint with the wall's body; set against its face (x from 0.05) it shares
-    nothing."""
+    -0.08, within the 0.1 m a piece may stand outside its room) has 0.03 x 0.7 = 0.021
+    m^2 of its footprint past the wall's far face (x < -0.05); set against its face (x
+    from 0.05) or into its body up to the room's border (x from 0) it has none."""
     import json
 
     from click.testing import CliRunner
@@ -68,18 +68,19 @@ def test_a_piece_through_a_wall_is_named_and_one_against_it_is_not(tmp_path) -> 
     d = two_rooms()
     assert pieces_in_walls(load_house(d)) == []
     against = copy.deepcopy(d)
-    against["furniture"][0]["center"][0] = 0.45
-    assert pieces_in_walls(load_house(against)) == []
+    for x in (0.45, 0.4):
+        against["furniture"][0]["center"][0] = x
+        assert pieces_in_walls(load_house(against)) == []
     through = copy.deepcopy(d)
     through["furniture"][0]["center"][0] = 0.32
     for o in through["objects"]:
         if o["parent"] == "furn_0":
             o["position"][0] -= 0.18
     (k, wall, area), = pieces_in_walls(load_house(through))
-    assert (k, wall) == (0, "wall_2") and abs(area - 0.07) < 1e-9
+    assert (k, wall) == (0, "wall_2") and abs(area - 0.021) < 1e-9
     f = tmp_path / "through.json"
     f.write_text(json.dumps(through))
     r = CliRunner().invoke(cli, ["scenes", "check", str(f)])
     assert r.exit_code == 0, r.output
-    assert "furniture[0] (furn_0, refrigerator): 0.07 m² of its footprint lies inside " \
-        "wall_2's body" in r.output
+    assert "furniture[0] (furn_0, refrigerator): 0.02 m² of its footprint lies past " \
+        "wall_2's far face" in r.output
