@@ -43,18 +43,17 @@ def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
 
     For each end of the panel (along its principal axis), each side across it and each
     offset of the wall line past that end, score how much the surroundings look like a
-    doorway seen from the hinge. The offsets: 0 to ``MIN_REACH`` cells, the door as long
-    as the panel; beyond 1 only while no cell on the panel's line before the wall line
-    was seen free together with its two neighbours across the line. When no hinge among
-    those is found and ``free`` is given, offsets up to the panel's length, the door as
-    long as the panel plus the offset, where the panel's line before the wall line holds
-    occupied cells (the panel's thin columns) and then unseen ones (its unseen part), no
-    free cell, no cell occupied with its two neighbours across the line (a wall it would
-    run through), no occupied cell past an unseen one. The
-    score: wall running away on one side (share of occupied cells
-    0.1-0.45 door widths along it), a clear opening on the other (share of occupied cells
-    along the closed position, which must be low) and the far jamb just beyond it; the
-    score is wall + jamb - 2 opening. The best hinge and side must score well and clearly
+    doorway seen from the hinge, for a door as long as the panel plus the offset. The
+    offsets: 0 to ``MIN_REACH`` cells, beyond 1 only while no cell on the panel's line
+    before the wall line was seen free together with its two neighbours across the line;
+    when no hinge among those is found and ``free`` is given, up to the panel's length,
+    where the panel's line before the wall line holds occupied cells (the panel's thin
+    columns) and then unseen ones (its unseen part): no free cell, no cell occupied with
+    its two neighbours across the line (a wall it would run through), no occupied cell
+    past an unseen one. The score: wall running away on one side (share of occupied
+    cells 0.1-0.45 door widths along it), a clear opening on the other (share of occupied
+    cells along the closed position, which must be low) and the far jamb just beyond it,
+    wall + jamb - 2 opening. The best hinge and side must score well and clearly
     beat every alternative. When none does (a free end whose far-jamb ray hits furniture
     can come close to a hinge whose opening ray, for a panel smeared longer than its
     doorway, reaches the far wall), they are scored again by the wall line alone: the
