@@ -214,8 +214,8 @@ def house_notes(house: Any) -> tuple[str, ...]:
     """What a user should know of a house that loads: doors furniture blocks (read as
     walls), rooms walled off from the rest (their targets are searched from inside, the
     others' from outside), containers whose front is blocked, pieces no camera sees,
-    pieces reaching into a wall and starts nearer to walls or furniture than the robot's
-    radius
+    pieces reaching through a wall, walls through a room's inside and starts nearer to
+    walls or furniture than the robot's radius
     (:mod:`sgtool.house.clearance`)."""
     from sgtool.house.clearance import (
         FRONT_CLEAR,
@@ -223,6 +223,7 @@ def house_notes(house: Any) -> tuple[str, ...]:
         cramped_starts,
         hidden_pieces,
         pieces_in_walls,
+        walls_in_rooms,
     )
     from sgtool.recorders.symbolic_environment.doorways import doorway_pieces
 
@@ -256,6 +257,10 @@ def house_notes(house: Any) -> tuple[str, ...]:
         notes.append(f"furniture[{k}] ({f.id}, {f.category}): {area:.2f} m² of its "
                      f"footprint lies past {wall}'s far face: it reaches through the wall "
                      "(the simulator shows it on both sides; set it against the wall's face)")
+    for i, room, inside in walls_in_rooms(spec):
+        notes.append(f"walls[{i}] ({spec.walls[i].id}) runs {inside:.1f} m through {room}'s "
+                     "inside, not along its border: the room is cut by it (give each part its "
+                     "own room) or has a wall standing in it")
     turned = [f"{kind}[{i}] ({x.yaw:g})" for kind, items in (("furniture", spec.furniture),
                                                              ("starts", spec.starts))
               for i, x in enumerate(items) if abs(x.yaw) > 2 * math.pi + 1e-9]

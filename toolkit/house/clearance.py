@@ -11,7 +11,8 @@ then starts the robot overlapping it). :func:`hidden_pieces` finds the pieces no
 can see: a box whose top lies under the floor, or one inside another piece's box.
 :func:`pieces_in_walls` finds the pieces whose footprint reaches through a wall, past its
 far face (a piece through a wall stands in two rooms; set against a wall, or into its
-body up to the middle line that is a room's border, it does not).
+body up to the middle line that is a room's border, it does not). :func:`walls_in_rooms`
+finds the walls that run through a room's inside rather than along its border.
 """
 
 from __future__ import annotations
@@ -32,6 +33,8 @@ from sgtool.house.spec import Furniture, HouseSpec
 FRONT_CLEAR = 0.3  # m in front of a front face that must be open floor
 IN_WALL_AREA = 0.01  # m^2 of a footprint past a wall's far face that is more than touching
 THROUGH_STRIP = 0.5  # m beyond a wall's far face looked at for a piece reaching through
+INSIDE_CLEAR = 0.15  # m from a room's border where a wall is inside the room
+INSIDE_LEAST = 0.3  # m of a wall inside a room that is more than a corner's overlap
 
 
 def front_point(f: Furniture, clear: float = FRONT_CLEAR) -> tuple[float, float]:
@@ -161,4 +164,30 @@ def pieces_in_walls(spec: HouseSpec) -> list[tuple[int, str, float]]:
             area = overlap_area(feet, strip)
             if area >= IN_WALL_AREA:
                 out.append((k, w.id, area))
+    return out
+
+
+def walls_in_rooms(spec: HouseSpec, step: float = 0.05) -> list[tuple[int, str, float]]:
+    """(wall index, room id, metres of the wall inside the room) for each wall running at
+    least ``INSIDE_LEAST`` m through a room's inside, farther than ``INSIDE_CLEAR`` from
+    its border (the middles of pieces about ``step`` m long), in spec order: a wall that
+    cuts a room in two, or stands in its middle, where walls run along rooms' borders."""
+    out = []
+    for i, w in enumerate(spec.walls):
+        n = max(1, int(round(w.length / step)))
+        t = (np.arange(n) + 0.5) / n  # the middles of n equal pieces
+        xs = w.a[0] + (w.b[0] - w.a[0]) * t
+        ys = w.a[1] + (w.b[1] - w.a[1]) * t
+        for r in spec.rooms:
+            poly = r.polygon
+            px, py = [p[0] for p in poly], [p[1] for p in poly]
+            if xs.max() < min(px) or xs.min() > max(px) or ys.max() < min(py) or \
+                    ys.min() > max(py):
+                continue
+            inside = sum(point_in_polygon(x, y, poly) and min(
+                segment_distance(x, y, poly[k], poly[(k + 1) % len(poly)])
+                for k in range(len(poly))) > INSIDE_CLEAR
+                for x, y in zip(xs.tolist(), ys.tolist(), strict=True))
+            if inside * w.length / n >= INSIDE_LEAST:
+                out.append((i, r.id, inside * w.length / n))
     return out

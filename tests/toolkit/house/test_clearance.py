@@ -8,7 +8,7 @@ import copy
 
 from support.datasets_fixtures import two_rooms
 
-from sgtool.house.clearance import hidden_pieces, pieces_in_walls
+from sgtool.house.clearance import hidden_pieces, pieces_in_walls, walls_in_rooms
 from sgtool.house.io import load_house
 
 
@@ -84,3 +84,25 @@ def test_a_piece_through_a_wall_is_named_and_one_against_it_is_not(tmp_path) -> 
     assert r.exit_code == 0, r.output
     assert "furniture[0] (furn_0, refrigerator): 0.02 m² of its footprint lies past " \
         "wall_2's far face" in r.output
+
+
+def test_a_wall_through_a_rooms_inside_is_named(tmp_path) -> None:
+    """Walls run along rooms' borders; one from (5, 1) to (5, 3) stands 1 m inside room_1
+    (x 4-8): 2.0 m of it farther than 0.15 m from the border."""
+    import json
+
+    from click.testing import CliRunner
+
+    from sgtool.cli import cli
+
+    d = two_rooms()
+    assert walls_in_rooms(load_house(d)) == []
+    d["walls"].append({"id": "wall_9", "a": [5.0, 1.0], "b": [5.0, 3.0], "thickness": 0.1,
+                       "height": 2.5})
+    (i, room, inside), = walls_in_rooms(load_house(d))
+    assert (i, room) == (6, "room_1") and abs(inside - 2.0) < 1e-9
+    f = tmp_path / "cut.json"
+    f.write_text(json.dumps(d))
+    r = CliRunner().invoke(cli, ["scenes", "check", str(f)])
+    assert r.exit_code == 0, r.output
+    assert "walls[6] (wall_9) runs 2.0 m through room_1's inside" in r.output
