@@ -257,10 +257,12 @@ def house_notes(house: Any) -> tuple[str, ...]:
         notes.append(f"furniture[{k}] ({f.id}, {f.category}): {area:.2f} m² of its "
                      f"footprint lies past {wall}'s far face: it reaches through the wall "
                      "(the simulator shows it on both sides; set it against the wall's face)")
-    for i, room, inside in walls_in_rooms(spec):
-        notes.append(f"walls[{i}] ({spec.walls[i].id}) runs {inside:.1f} m through {room}'s "
-                     "inside, not along its border: the room is cut by it (give each part its "
-                     "own room) or has a wall standing in it")
+    for room, walls, inside in walls_in_rooms(spec):
+        names = ", ".join(f"walls[{i}] ({spec.walls[i].id})" for i in walls[:4])
+        more = f" and {len(walls) - 4} more" if len(walls) > 4 else ""
+        notes.append(f"{names}{more} run {inside:.1f} m through {room}'s inside, not along "
+                     "its border: the room is cut by them (give each part its own room) or "
+                     "has a wall standing in it")
     turned = [f"{kind}[{i}] ({x.yaw:g})" for kind, items in (("furniture", spec.furniture),
                                                              ("starts", spec.starts))
               for i, x in enumerate(items) if abs(x.yaw) > 2 * math.pi + 1e-9]

@@ -192,9 +192,9 @@ def pin_logs(logs: Sequence[str | Path] | str | Path, folder: str | Path,
     if dup:
         raise SgtoolError(f"two logs are named {dup[0]}.mcap; pin them into separate folders")
     if root.exists() and not root.is_dir():
-        raise SgtoolError(f"--dir {root} is a file; give a folder")
+        raise SgtoolError(f"--dir (folder=) {root} is a file; give a folder")
     if root.is_dir() and not (root / INDEX).is_file() and any(root.iterdir()):
-        raise SgtoolError(f"--dir {root}: the folder holds files but no pins "
+        raise SgtoolError(f"--dir (folder=) {root}: the folder holds files but no pins "
                           f"({INDEX}); pin into a new or empty folder")
     old = read_pins(root).logs if (root / INDEX).is_file() else {}
     outcomes = _run(executor, _pin_task,

@@ -283,6 +283,19 @@ def test_api_mistakes_are_one_line_errors(tmp_path) -> None:
         sgtool.RecordOptions(explore="walk")
     with pytest.raises(sgtool.SgtoolError, match=r"frames 0 \(--frames\): must be >= 1"):
         sgtool.RecordOptions(frames=0)
+    assert sgtool.RecordOptions(noise="mild").noise == sgtool.parse_noise("mild")
+    for bad, said in ((dict(noise=None), "noise: expected a NoiseProfile, got NoneType"),
+                      (dict(fps="4"), "fps '4' (--fps): must be a number 0.1..1000"),
+                      (dict(frames=2.5), "frames: expected a whole number, got 2.5"),
+                      (dict(camera=None), "camera: expected a CameraConfig, got NoneType"),
+                      (dict(compression="gzip"), "compression 'gzip' (--compression): one of "
+                                                 "zstd, lz4, none")):
+        with pytest.raises(sgtool.SgtoolError) as e:
+            sgtool.RecordOptions(**bad)  # type: ignore[arg-type]
+        assert str(e.value) == said
+    with pytest.raises(sgtool.SgtoolError, match=r"out\.txt: the output is an MCAP log"):
+        sgtool.record_house(sgtool.generate_house(3, rooms=(4, 4)), tmp_path / "out.txt")
+    assert not list(tmp_path.iterdir())
     house = sgtool.generate_house(3, rooms=(4, 5))
     with pytest.raises(sgtool.SgtoolError, match=r"'nothing': decide\(\) returned NoneType"):
         sgtool.run_one(house, Nothing(), sgtool.list_episodes(house)[0].query)

@@ -210,7 +210,26 @@ class RecordOptions:
 
     def __post_init__(self) -> None:
         from sgtool.errors import SgtoolError
+        from sgtool.log.writer import COMPRESSIONS
+        from sgtool.recorders.sim.noise import parse_noise
+        from sgtool.recorders.sim.simulation import FPS_RANGE
 
+        if isinstance(self.noise, str):  # a profile's text, as --noise takes it
+            object.__setattr__(self, "noise", parse_noise(self.noise))
+        for name, kind in (("noise", NoiseProfile), ("camera", CameraConfig),
+                           ("robot", RobotConfig), ("script", ScriptOptions)):
+            if not isinstance(getattr(self, name), kind):
+                raise SgtoolError(f"{name}: expected a {kind.__name__}, got "
+                                  f"{type(getattr(self, name)).__name__}")
+        for name in ("frames", "every", "seed", "start"):
+            v = getattr(self, name)
+            if not (isinstance(v, int) and not isinstance(v, bool)) and not (
+                    name == "frames" and v is None):
+                raise SgtoolError(f"{name}: expected a whole number, got {v!r}")
+        if isinstance(self.fps, bool) or not isinstance(self.fps, (int, float)) or \
+                not FPS_RANGE[0] <= self.fps <= FPS_RANGE[1]:
+            raise SgtoolError(f"fps {self.fps!r} (--fps): must be a number "
+                              f"{FPS_RANGE[0]:g}..{FPS_RANGE[1]:g}")
         if self.frames is not None and self.frames < 1:
             raise SgtoolError(f"frames {self.frames} (--frames): must be >= 1")
         if self.explore not in EXPLORE:
@@ -218,8 +237,12 @@ class RecordOptions:
                               f"{', '.join(EXPLORE)}")
         if self.every < 1:
             raise SgtoolError(f"every {self.every}: must be >= 1")
-        if self.seed < 0:
-            raise SgtoolError(f"seed {self.seed} (--noise-seed): must be >= 0")
+        if self.seed < 0 or self.start < 0:
+            raise SgtoolError(f"seed {self.seed} (--noise-seed) and start {self.start} "
+                              "(--start): must be >= 0")
+        if self.compression not in COMPRESSIONS:
+            raise SgtoolError(f"compression {self.compression!r} (--compression): one of "
+                              f"{', '.join(COMPRESSIONS)}")
 
 
 @dataclass(frozen=True)
@@ -280,14 +303,20 @@ def record_house(house: HouseSpec, output: str | os.PathLike[str],
                  progress: Progress | None = None, observers: Sequence[SimObserver] = ()
                  ) -> RecordReport:
     """Record the exploration of ``house`` (``sgtool record``) into the log ``output``
-    (an MCAP file, replaced when it exists; written to a temporary name and renamed at the
-    end, so an error leaves nothing). ``house_id`` names the house in the log (default
-    ``house-SEED``); ``progress`` advances by one per frame; ``observers`` also watch the
-    simulation (after the recorder, so they see each frame once it is written). Needs
-    PyBullet (``pip install 'sgtool[sim]'``)."""
+    (``*.mcap``, replaced when it exists; written to a temporary name and renamed at the
+    end, so an error leaves nothing, and an interrupt its ``.partial`` file:
+    :mod:`sgtool.log.writer`). A house without start poses needs them first
+    (:func:`sgtool.datasets.start_poses.with_start_poses`, as ``sgtool record`` does).
+    ``house_id`` names the house in the log (default ``house-SEED``); ``progress``
+    advances by one per frame; ``observers`` also watch the simulation (after the
+    recorder, so they see each frame once it is written). Needs PyBullet (``pip install
+    'sgtool[sim]'``)."""
+    from sgtool.errors import SgtoolError
     from sgtool.extras import require
 
     require("pybullet", api="sgtool.record_house")  # one line on a core install
+    if Path(output).suffix != ".mcap":
+        raise SgtoolError(f"{output}: the output is an MCAP log; name it *.mcap")
     opts = options or RecordOptions()
     hid = house_id or f"house-{house.seed}"
     t_wall = time.perf_counter()

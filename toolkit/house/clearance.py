@@ -144,7 +144,8 @@ def pieces_in_walls(spec: HouseSpec) -> list[tuple[int, str, float]]:
     """(furniture index, wall id, m^2 of its footprint past the wall's far face) for each
     piece that reaches through a wall: at least ``IN_WALL_AREA`` of its footprint lies in
     the strip ``THROUGH_STRIP`` m deep beyond the face of the wall's body away from the
-    piece's centre; in spec order. A piece set against a wall, or into its body up to its
+    piece's centre (along the wall but a thickness from either end, where it may meet
+    another wall); in spec order. A piece set against a wall, or into its body up to its
     middle line (a room's border), reaches nothing there."""
     covers = Covers(spec)
     out = []
@@ -159,7 +160,11 @@ def pieces_in_walls(spec: HouseSpec) -> list[tuple[int, str, float]]:
             mx, my = (w.a[0] + w.b[0]) / 2, (w.a[1] + w.b[1]) / 2
             side = 1.0 if (f.center[0] - mx) * nx + (f.center[1] - my) * ny > 0 else -1.0
             shift = -side * (w.thickness + THROUGH_STRIP) / 2
-            strip = box_corners((mx + nx * shift, my + ny * shift), (w.length, THROUGH_STRIP),
+            # not the ends, where the wall may meet another (a T), whose body it enters
+            inner = w.length - 2.0 * w.thickness
+            if inner <= 0.0:
+                continue
+            strip = box_corners((mx + nx * shift, my + ny * shift), (inner, THROUGH_STRIP),
                                 w.yaw)
             area = overlap_area(feet, strip)
             if area >= IN_WALL_AREA:
@@ -167,20 +172,23 @@ def pieces_in_walls(spec: HouseSpec) -> list[tuple[int, str, float]]:
     return out
 
 
-def walls_in_rooms(spec: HouseSpec, step: float = 0.05) -> list[tuple[int, str, float]]:
-    """(wall index, room id, metres of the wall inside the room) for each wall running at
-    least ``INSIDE_LEAST`` m through a room's inside, farther than ``INSIDE_CLEAR`` from
-    its border (the middles of pieces about ``step`` m long), in spec order: a wall that
-    cuts a room in two, or stands in its middle, where walls run along rooms' borders."""
+def walls_in_rooms(spec: HouseSpec, step: float = 0.05
+                   ) -> list[tuple[str, tuple[int, ...], float]]:
+    """(room id, wall indices, metres of those walls inside the room) for each room that
+    walls run through, at least ``INSIDE_LEAST`` m of them in all (a wall drawn as short
+    pieces counts whole) farther than ``INSIDE_CLEAR`` from its border (the middles of
+    pieces about ``step`` m long), in room order: walls that cut a room in two, or stand
+    in its middle, where walls run along rooms' borders."""
     out = []
-    for i, w in enumerate(spec.walls):
-        n = max(1, int(round(w.length / step)))
-        t = (np.arange(n) + 0.5) / n  # the middles of n equal pieces
-        xs = w.a[0] + (w.b[0] - w.a[0]) * t
-        ys = w.a[1] + (w.b[1] - w.a[1]) * t
-        for r in spec.rooms:
-            poly = r.polygon
-            px, py = [p[0] for p in poly], [p[1] for p in poly]
+    for r in spec.rooms:
+        poly = r.polygon
+        px, py = [p[0] for p in poly], [p[1] for p in poly]
+        walls, total = [], 0.0
+        for i, w in enumerate(spec.walls):
+            n = max(1, int(round(w.length / step)))
+            t = (np.arange(n) + 0.5) / n  # the middles of n equal pieces
+            xs = w.a[0] + (w.b[0] - w.a[0]) * t
+            ys = w.a[1] + (w.b[1] - w.a[1]) * t
             if xs.max() < min(px) or xs.min() > max(px) or ys.max() < min(py) or \
                     ys.min() > max(py):
                 continue
@@ -188,6 +196,9 @@ def walls_in_rooms(spec: HouseSpec, step: float = 0.05) -> list[tuple[int, str, 
                 segment_distance(x, y, poly[k], poly[(k + 1) % len(poly)])
                 for k in range(len(poly))) > INSIDE_CLEAR
                 for x, y in zip(xs.tolist(), ys.tolist(), strict=True))
-            if inside * w.length / n >= INSIDE_LEAST:
-                out.append((i, r.id, inside * w.length / n))
+            if inside:
+                walls.append(i)
+                total += inside * w.length / n
+        if total >= INSIDE_LEAST:
+            out.append((r.id, tuple(walls), total))
     return out

@@ -89,6 +89,8 @@ _COMPRESSION = {
     "lz4": CompressionType.LZ4,
     "none": CompressionType.NONE,
 }
+COMPRESSIONS: tuple[str, ...] = tuple(_COMPRESSION)  # the names a log may be written with
+
 
 
 def _check_frame(k: CameraIntrinsics, depth: np.ndarray, rgb: np.ndarray | None,

@@ -99,10 +99,16 @@ def test_a_wall_through_a_rooms_inside_is_named(tmp_path) -> None:
     assert walls_in_rooms(load_house(d)) == []
     d["walls"].append({"id": "wall_9", "a": [5.0, 1.0], "b": [5.0, 3.0], "thickness": 0.1,
                        "height": 2.5})
-    (i, room, inside), = walls_in_rooms(load_house(d))
-    assert (i, room) == (6, "room_1") and abs(inside - 2.0) < 1e-9
+    (room, walls, inside), = walls_in_rooms(load_house(d))
+    assert (room, walls) == ("room_1", (6,)) and abs(inside - 2.0) < 1e-9
+    pieces = copy.deepcopy(d)  # the same wall drawn as eight 0.25 m pieces
+    pieces["walls"][6:] = [{"id": f"wall_{9 + k}", "a": [5.0, 1.0 + 0.25 * k],
+                            "b": [5.0, 1.25 + 0.25 * k], "thickness": 0.1, "height": 2.5}
+                           for k in range(8)]
+    (room, walls, inside), = walls_in_rooms(load_house(pieces))
+    assert (room, walls) == ("room_1", tuple(range(6, 14))) and abs(inside - 2.0) < 1e-9
     f = tmp_path / "cut.json"
     f.write_text(json.dumps(d))
     r = CliRunner().invoke(cli, ["scenes", "check", str(f)])
     assert r.exit_code == 0, r.output
-    assert "walls[6] (wall_9) runs 2.0 m through room_1's inside" in r.output
+    assert "walls[6] (wall_9) run 2.0 m through room_1's inside" in r.output
