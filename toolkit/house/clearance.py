@@ -23,6 +23,7 @@ import numpy as np
 
 from sgtool.house.geometry import (
     box_corners,
+    distance_to_border,
     distance_to_polygon,
     overlap_area,
     point_in_polygon,
@@ -192,10 +193,9 @@ def walls_in_rooms(spec: HouseSpec, step: float = 0.05
             if xs.max() < min(px) or xs.min() > max(px) or ys.max() < min(py) or \
                     ys.min() > max(py):
                 continue
-            inside = sum(point_in_polygon(x, y, poly) and min(
-                segment_distance(x, y, poly[k], poly[(k + 1) % len(poly)])
-                for k in range(len(poly))) > INSIDE_CLEAR
-                for x, y in zip(xs.tolist(), ys.tolist(), strict=True))
+            inside = sum(point_in_polygon(x, y, poly) and
+                         distance_to_border(x, y, poly) > INSIDE_CLEAR
+                         for x, y in zip(xs.tolist(), ys.tolist(), strict=True))
             if inside:
                 walls.append(i)
                 total += inside * w.length / n

@@ -89,6 +89,11 @@ def distance_to_polygon(x: float, y: float, poly: Sequence[Point]) -> float:
     """0 inside (or on the border of) ``poly``, else the distance to its border."""
     if point_in_polygon(x, y, poly):
         return 0.0
+    return distance_to_border(x, y, poly)
+
+
+def distance_to_border(x: float, y: float, poly: Sequence[Point]) -> float:
+    """Distance from (x, y), inside or outside, to the border of ``poly``."""
     n = len(poly)
     return min(segment_distance(x, y, poly[i], poly[(i + 1) % n]) for i in range(n))
 

@@ -5,7 +5,8 @@ corner at ``origin`` (world x, y) and cells are ``resolution`` metres wide, so t
 cell (r, c) is ``origin + ((c + 0.5) * resolution, (r + 0.5) * resolution)``. Values follow
 ROS and Foxglove occupancy grids: 0 free, 100 occupied, -1 unknown. The bird's-eye map of a
 voxel map (:mod:`sgtool.mapping.bev`) and the rasterised house a simulator or the symbolic
-benchmark plans on (:mod:`sgtool.mapping.occupancy`) are both this type.
+benchmark plans on (:mod:`sgtool.mapping.occupancy`) are both this type. :func:`grid_at`
+reads a bool grid (a mask of one) at points given in cells.
 """
 
 from __future__ import annotations
@@ -67,3 +68,16 @@ class OccupancyGrid:
         if not self.inside(r, c):
             return int(UNKNOWN)
         return int(self.grid[r, c])
+
+
+def grid_at(points: np.ndarray, grid: np.ndarray, origin: tuple[int, int] = (0, 0)
+            ) -> np.ndarray:
+    """Per (column, row) point (N, 2; rounded to its cell): the bool ``grid``'s cell
+    (False off the grid), ``grid``'s cell (0, 0) being cell ``origin`` (row, col)."""
+    c = np.round(points[:, 0]).astype(np.int64) - origin[1]
+    r = np.round(points[:, 1]).astype(np.int64) - origin[0]
+    h, w = grid.shape
+    ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+    out = np.zeros(len(points), dtype=bool)
+    out[ok] = grid[r[ok], c[ok]]
+    return out

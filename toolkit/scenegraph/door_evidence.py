@@ -24,9 +24,9 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from sgtool.mapping.bev import line_of_sight
-from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
+from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid, grid_at
 from sgtool.mapping.voronoi import VoronoiGraph
-from sgtool.scenegraph.door_panel import grid_at, opening_from_panel
+from sgtool.scenegraph.door_panel import opening_from_panel
 from sgtool.scenegraph.instances import InstanceInfo
 from sgtool.scenegraph.object_placement import SeenInstance
 from sgtool.scenegraph.room_segmentation import RoomTracker

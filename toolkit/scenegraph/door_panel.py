@@ -25,6 +25,8 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
+from sgtool.mapping.grid import grid_at
+
 LINE_LEAST = 0.5  # the wall-line score a hinge needs (0 to 1: wall on both sides, clear)
 LINE_MARGIN = 0.25  # and its lead over every other hinge and side
 MIN_REACH = 3  # cells past a panel's end the wall line is looked for, at least
@@ -161,19 +163,6 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
     h, w_ = occupied.shape
     ok = (r >= origin[0]) & (r < origin[0] + h) & (c >= origin[1]) & (c < origin[1] + w_)
     return r[ok], c[ok]
-
-
-def grid_at(points: np.ndarray, grid: np.ndarray, origin: tuple[int, int] = (0, 0)
-            ) -> np.ndarray:
-    """Per (column, row) point (N, 2; rounded to its cell): the bool ``grid``'s cell
-    (False off the grid), ``grid``'s cell (0, 0) being cell ``origin`` (row, col)."""
-    c = np.round(points[:, 0]).astype(np.int64) - origin[1]
-    r = np.round(points[:, 1]).astype(np.int64) - origin[0]
-    h, w = grid.shape
-    ok = (r >= 0) & (r < h) & (c >= 0) & (c < w)
-    out = np.zeros(len(points), dtype=bool)
-    out[ok] = grid[r[ok], c[ok]]
-    return out
 
 
 def _sum_score(wall: float, opening: float, jamb: float) -> float:

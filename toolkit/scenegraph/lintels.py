@@ -28,8 +28,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
-from sgtool.scenegraph.door_panel import grid_at
+from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid, grid_at
 
 LINTEL_BAND = (1.75, 2.3)  # m above the floor: over a walking robot, under most ceilings
 LINTEL_LENGTH = (0.5, 1.6)  # m: a doorway's width
