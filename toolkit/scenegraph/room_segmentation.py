@@ -31,6 +31,14 @@ What we do, and why it differs:
   with edge length and node spacing).
 - **Tiny components**: fewer than ``min_room_length`` metres of edges (isolated nodes
   have none). Dropped nodes keep no room label.
+- **A door separates its two sides, nothing more**: given the free cells, components
+  whose nodes lie in one connected part of the free space outside the cut zone (cells
+  below the threshold, 4-connected) are one room. The cut zone is a disc-like region
+  around the door cells, so it also cuts a corridor whose graph runs close past a
+  doorway (a door panel swung into the corridor leaves the ridge only the gap beside
+  the doorway); the floor on that side still joins up past the zone. Pieces of one room
+  that the graph does not join (free space it does not cover, a phantom obstacle on
+  the ridge) join the same way. A merged room's centre is taken on its largest piece.
 
 Room ids stay stable across refreshes (:class:`RoomTracker`): new rooms take the id of the
 previous room whose nodes they overlap most (greedy, largest overlap first), so a planner's
@@ -87,10 +95,13 @@ class RoomSegmentation:
 
 def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
                   config: RoomConfig | None = None,
-                  centre_memo: dict[bytes, int] | None = None) -> RoomSegmentation:
+                  centre_memo: dict[bytes, int] | None = None,
+                  free: np.ndarray | None = None) -> RoomSegmentation:
     """Cut ``vg`` where the door density reaches the threshold; components are rooms.
     ``centre_memo`` keeps each room's centre across calls, keyed by its sub-graph (a room
-    whose sub-graph is unchanged has the same centre: the same arrays, the same Dijkstra)."""
+    whose sub-graph is unchanged has the same centre: the same arrays, the same Dijkstra).
+    ``free``: the grid's free cells (``vg.shape``); components sharing free space outside
+    the cut zone are then one room (module doc)."""
     cfg = config or RoomConfig()
     n, m = len(vg.positions), len(vg.edges)
     cut_e = np.zeros(m, dtype=bool)
@@ -124,12 +135,43 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
             continue
         labels[nodes] = len(rooms)
         rooms.append(nodes)
+    if free is not None and len(rooms) > 1:
+        rooms = _join_by_free_space(vg, rooms, free, density, cfg.door_threshold)
+        for i, nodes in enumerate(rooms):
+            labels[nodes] = i
     where = np.full(n, -1, dtype=np.int64)
     keys = _room_keys(vg, keep, labels, rooms) if centre_memo is not None else None
     centres = tuple(_graph_centre(graph, nodes, where, centre_memo,
                                   None if keys is None else keys[i])
                     for i, nodes in enumerate(rooms))
     return RoomSegmentation(labels, cut_e, cut_n, tuple(rooms), centres)
+
+
+def _join_by_free_space(vg: VoronoiGraph, rooms: list[np.ndarray], free: np.ndarray,
+                        density: np.ndarray | None, threshold: float) -> list[np.ndarray]:
+    """``rooms`` with those whose nodes share a 4-connected part of ``free`` outside the
+    cut zone (``density`` >= ``threshold``) joined; numbered by their lowest node."""
+    open_floor = free if density is None else free & (density < threshold)
+    part, _ = ndimage.label(open_floor)
+    parent = list(range(len(rooms)))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    owner: dict[int, int] = {}
+    for i, nodes in enumerate(rooms):
+        for p in np.unique(part[vg.cells[nodes, 0], vg.cells[nodes, 1]]).tolist():
+            if p == 0:  # a node on no open floor (it cannot be, but never join through it)
+                continue
+            a, b = root(owner.setdefault(p, i)), root(i)
+            parent[max(a, b)] = min(a, b)
+    groups: dict[int, list[np.ndarray]] = {}
+    for i, nodes in enumerate(rooms):  # rooms come by lowest node: so do the groups
+        groups.setdefault(root(i), []).append(nodes)
+    return [np.sort(np.concatenate(g)) if len(g) > 1 else g[0] for g in groups.values()]
 
 
 def _room_keys(vg: VoronoiGraph, keep: np.ndarray, labels: np.ndarray,
@@ -167,7 +209,10 @@ def _graph_centre(graph: csr_matrix, nodes: np.ndarray, where: np.ndarray,
     if memo is not None and key is not None and key in memo:
         return int(nodes[memo[key]])
     d = dijkstra(submatrix(graph, nodes, where), directed=False)
-    ecc = d.max(axis=1)
+    reach = np.isfinite(d)
+    count = reach.sum(axis=1)
+    # a room of pieces (joined by free space): the centre of its largest piece
+    ecc = np.where(count == count.max(), np.where(reach, d, 0.0).max(axis=1), np.inf)
     best = int(np.argmin(ecc))
     if memo is not None and key is not None:
         if len(memo) > 1024:

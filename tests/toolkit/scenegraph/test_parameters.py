@@ -115,6 +115,47 @@ def test_a_door_in_the_passage_cuts_whatever_the_parameters() -> None:
         assert segment_rooms(vg, dens, cfg).count == 2
 
 
+def test_a_corridor_cut_beside_a_door_is_joined_by_its_floor() -> None:
+    """NEAR's graph is cut beside the door (two rooms), but the door's cut zone reaches
+    only 0.3 m into the 0.5 m corridor: its floor joins up past the zone, so with the
+    free cells it is one room. The doorway across the corridor still makes two (its cut
+    zone spans the floor), at every threshold of the test above."""
+    g = walled(NEAR[0], 100)
+    vg, door = corridor_past_door(*NEAR)
+    dens = door_density(door, RES, ROOMS.door_bandwidth)
+    assert segment_rooms(vg, dens, ROOMS).count == 2
+    joined = segment_rooms(vg, dens, ROOMS, free=g == FREE)
+    assert joined.count == 1
+    assert joined.rooms[0].tolist() == np.flatnonzero(joined.labels == 0).tolist()
+    assert joined.centres[0] in joined.rooms[0]
+    across = np.zeros(g.shape, dtype=bool)
+    across[4:4 + NEAR[0], 4 + 49:4 + 51] = True
+    for f in (0.5, 1.0, 2.0):
+        cfg = dataclasses.replace(ROOMS, door_threshold=f * ROOMS.door_threshold)
+        assert segment_rooms(vg, door_density(across, RES, ROOMS.door_bandwidth), cfg,
+                             free=g == FREE).count == 2
+
+
+def test_pieces_of_one_floor_are_one_room_centred_on_the_larger() -> None:
+    """Two pieces of graph, 7 nodes (2.4 m of edges) and 5 (1.2 m), with no door between
+    them: apart they are two rooms; on one free floor they are one, whose centre is the
+    larger piece's (node 3 of its 0..6 chain; the smaller's middle node is nearer its
+    ends), and two floors keep them apart."""
+    a_pts, a_e = chain(0.0, 0.0, 6, 0.4)
+    b_pts, b_e = chain(0.0, 3.0, 4, 0.3)
+    k = len(a_pts)
+    vg = hand_graph(a_pts + b_pts, a_e + [(i + k, j + k) for i, j in b_e])
+    assert segment_rooms(vg, None).count == 2
+    one_floor = np.ones(vg.shape, dtype=bool)
+    seg = segment_rooms(vg, None, free=one_floor)
+    assert seg.count == 1 and seg.rooms[0].tolist() == list(range(k + 5))
+    assert seg.centres == (3,)
+    two_floors = one_floor.copy()
+    two_floors[0, k] = False  # hand_graph's node n sits in cell (0, n): cells 0..k-1
+    # hold the first piece, k+1.. the rest of the second (node k stands on no floor)
+    assert segment_rooms(vg, None, free=two_floors).count == 2
+
+
 # ----- hand-made Voronoi graphs ----------------------------------------------------------
 def hand_graph(positions: list[tuple[float, float]], edges: list[tuple[int, int]],
                lengths: list[float] | None = None) -> VoronoiGraph:
