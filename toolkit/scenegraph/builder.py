@@ -547,7 +547,7 @@ class SceneGraphBuilder:
             got[2].setflags(write=False)
             self._density = got
         density = got[2]
-        seg = segment_rooms(vg, density, cfg, self._centre_memo, occ.free)
+        seg = segment_rooms(vg, density, cfg, self._centre_memo, occ)
         numbers = self._rooms.assign([vg.positions[r] for r in seg.rooms], cfg.match_radius)
         return _Rooms(cells, density, seg, [f"room:{n}" for n in numbers], centres)
 

@@ -30,8 +30,8 @@ What we do, and why it differs:
 - **Cut on the maximum** density along an edge's ridge cells (not the sum, which grows
   with edge length and node spacing).
 - **Tiny components**: fewer than ``min_room_length`` metres of edges (isolated nodes
-  have none). Dropped nodes keep no room label.
-- **A door separates its two sides, nothing more**: given the free cells, components
+  have none), unless on floor of their own (below). Dropped nodes keep no room label.
+- **A door separates its two sides, nothing more**: given the grid, components
   whose nodes lie in one connected part of the free space outside the cut zone (cells
   below the threshold, 4-connected) are one room. The cut zone is a disc-like region
   around the door cells, so it also cuts a corridor whose graph runs close past a
@@ -39,6 +39,9 @@ What we do, and why it differs:
   the doorway); the floor on that side still joins up past the zone. Pieces of one room
   that the graph does not join (free space it does not cover, a phantom obstacle on
   the ridge) join the same way. A merged room's centre is taken on its largest piece.
+  A component shorter than ``min_room_length`` is a room when it stands on floor of its
+  own (no longer component's nodes on it) of at least ``min_room_length`` squared: a room
+  glimpsed through a doorway has little graph but floor that belongs to no other room.
 
 Room ids stay stable across refreshes (:class:`RoomTracker`): new rooms take the id of the
 previous room whose nodes they overlap most (greedy, largest overlap first), so a planner's
@@ -58,6 +61,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components, dijkstra
 from scipy.spatial import cKDTree
 
+from sgtool.mapping.grid import OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph, submatrix
 
 
@@ -96,12 +100,12 @@ class RoomSegmentation:
 def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
                   config: RoomConfig | None = None,
                   centre_memo: dict[bytes, int] | None = None,
-                  free: np.ndarray | None = None) -> RoomSegmentation:
+                  occ: OccupancyGrid | None = None) -> RoomSegmentation:
     """Cut ``vg`` where the door density reaches the threshold; components are rooms.
     ``centre_memo`` keeps each room's centre across calls, keyed by its sub-graph (a room
     whose sub-graph is unchanged has the same centre: the same arrays, the same Dijkstra).
-    ``free``: the grid's free cells (``vg.shape``); components sharing free space outside
-    the cut zone are then one room (module doc)."""
+    ``occ``: the grid of ``vg``; with it, components sharing free space outside the cut
+    zone are one room, and a short one on floor of its own is a room (module doc)."""
     cfg = config or RoomConfig()
     n, m = len(vg.positions), len(vg.edges)
     cut_e = np.zeros(m, dtype=bool)
@@ -127,18 +131,18 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
     rooms: list[np.ndarray] = []
     by_comp = np.argsort(comp, kind="stable")  # nodes grouped by component, ascending
     bounds = np.searchsorted(comp[by_comp], np.arange(ncomp + 1))
-    for c in np.flatnonzero(comp_len >= cfg.min_room_length).tolist():
-        # components are numbered by their lowest node already
+    short: list[np.ndarray] = []
+    for c in range(ncomp):  # components are numbered by their lowest node already
+        if comp_len[c] < cfg.min_room_length and occ is None:
+            continue
         nodes = by_comp[bounds[c]:bounds[c + 1]]
         nodes = nodes[~cut_n[nodes]]
-        if len(nodes) == 0:
-            continue
-        labels[nodes] = len(rooms)
-        rooms.append(nodes)
-    if free is not None and len(rooms) > 1:
-        rooms = _join_by_free_space(vg, rooms, free, density, cfg.door_threshold)
-        for i, nodes in enumerate(rooms):
-            labels[nodes] = i
+        if len(nodes):
+            (rooms if comp_len[c] >= cfg.min_room_length else short).append(nodes)
+    if occ is not None:
+        rooms = _rooms_by_floor(vg, rooms, short, occ, density, cfg)
+    for i, nodes in enumerate(rooms):
+        labels[nodes] = i
     where = np.full(n, -1, dtype=np.int64)
     keys = _room_keys(vg, keep, labels, rooms) if centre_memo is not None else None
     centres = tuple(_graph_centre(graph, nodes, where, centre_memo,
@@ -147,12 +151,27 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
     return RoomSegmentation(labels, cut_e, cut_n, tuple(rooms), centres)
 
 
-def _join_by_free_space(vg: VoronoiGraph, rooms: list[np.ndarray], free: np.ndarray,
-                        density: np.ndarray | None, threshold: float) -> list[np.ndarray]:
-    """``rooms`` with those whose nodes share a 4-connected part of ``free`` outside the
-    cut zone (``density`` >= ``threshold``) joined; numbered by their lowest node."""
-    open_floor = free if density is None else free & (density < threshold)
-    part, _ = ndimage.label(open_floor)
+def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.ndarray],
+                    occ: OccupancyGrid, density: np.ndarray | None,
+                    cfg: RoomConfig) -> list[np.ndarray]:
+    """``rooms`` (components long enough) joined where their nodes share a 4-connected part
+    of the free cells outside the cut zone, plus the ``short`` components whose parts no
+    such room touches and hold at least ``min_room_length`` squared of floor; numbered by
+    their lowest node."""
+    open_floor = occ.free if density is None else occ.free & (density < cfg.door_threshold)
+    part, count = ndimage.label(open_floor)
+
+    def parts(nodes: np.ndarray) -> list[int]:
+        p = np.unique(part[vg.cells[nodes, 0], vg.cells[nodes, 1]])
+        return p[p > 0].tolist()  # a node on no open floor never joins through it
+
+    taken = {p for nodes in rooms for p in parts(nodes)}
+    if short:
+        area = np.bincount(part.ravel(), minlength=count + 1) * occ.resolution ** 2
+        rooms = rooms + [nodes for nodes in short if parts(nodes)
+                         and not taken.intersection(parts(nodes))
+                         and area[parts(nodes)].sum() >= cfg.min_room_length ** 2]
+        rooms.sort(key=lambda nodes: int(nodes[0]))
     parent = list(range(len(rooms)))
 
     def root(i: int) -> int:
@@ -163,9 +182,7 @@ def _join_by_free_space(vg: VoronoiGraph, rooms: list[np.ndarray], free: np.ndar
 
     owner: dict[int, int] = {}
     for i, nodes in enumerate(rooms):
-        for p in np.unique(part[vg.cells[nodes, 0], vg.cells[nodes, 1]]).tolist():
-            if p == 0:  # a node on no open floor (it cannot be, but never join through it)
-                continue
+        for p in parts(nodes):
             a, b = root(owner.setdefault(p, i)), root(i)
             parent[max(a, b)] = min(a, b)
     groups: dict[int, list[np.ndarray]] = {}

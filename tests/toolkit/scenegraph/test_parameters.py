@@ -124,7 +124,8 @@ def test_a_corridor_cut_beside_a_door_is_joined_by_its_floor() -> None:
     vg, door = corridor_past_door(*NEAR)
     dens = door_density(door, RES, ROOMS.door_bandwidth)
     assert segment_rooms(vg, dens, ROOMS).count == 2
-    joined = segment_rooms(vg, dens, ROOMS, free=g == FREE)
+    occ = OccupancyGrid(g, (0.0, 0.0), RES)
+    joined = segment_rooms(vg, dens, ROOMS, occ=occ)
     assert joined.count == 1
     assert joined.rooms[0].tolist() == np.flatnonzero(joined.labels == 0).tolist()
     assert joined.centres[0] in joined.rooms[0]
@@ -133,7 +134,12 @@ def test_a_corridor_cut_beside_a_door_is_joined_by_its_floor() -> None:
     for f in (0.5, 1.0, 2.0):
         cfg = dataclasses.replace(ROOMS, door_threshold=f * ROOMS.door_threshold)
         assert segment_rooms(vg, door_density(across, RES, ROOMS.door_bandwidth), cfg,
-                             free=g == FREE).count == 2
+                             occ=occ).count == 2
+
+
+def floor(free: np.ndarray) -> OccupancyGrid:
+    """A grid of ``free`` cells (else occupied), 5 cm cells, for a hand-made graph."""
+    return OccupancyGrid(np.where(free, FREE, OCCUPIED).astype(np.int8), (0.0, 0.0), RES)
 
 
 def test_pieces_of_one_floor_are_one_room_centred_on_the_larger() -> None:
@@ -147,13 +153,44 @@ def test_pieces_of_one_floor_are_one_room_centred_on_the_larger() -> None:
     vg = hand_graph(a_pts + b_pts, a_e + [(i + k, j + k) for i, j in b_e])
     assert segment_rooms(vg, None).count == 2
     one_floor = np.ones(vg.shape, dtype=bool)
-    seg = segment_rooms(vg, None, free=one_floor)
+    seg = segment_rooms(vg, None, occ=floor(one_floor))
     assert seg.count == 1 and seg.rooms[0].tolist() == list(range(k + 5))
     assert seg.centres == (3,)
     two_floors = one_floor.copy()
     two_floors[0, k] = False  # hand_graph's node n sits in cell (0, n): cells 0..k-1
     # hold the first piece, k+1.. the rest of the second (node k stands on no floor)
-    assert segment_rooms(vg, None, free=two_floors).count == 2
+    assert segment_rooms(vg, None, occ=floor(two_floors)).count == 2
+
+
+def test_a_short_piece_on_floor_of_its_own_is_a_room() -> None:
+    """A room glimpsed through a door: its graph is a 0.6 m piece (under min_room_length),
+    dropped on its own. On floor of its own of at least min_room_length squared (1 m^2 =
+    400 cells of 5 cm) it is a room; on less floor, or on floor a long piece stands on,
+    it is none (its nodes keep no room, as before)."""
+    a_pts, a_e = chain(0.0, 0.0, 6, 0.4)  # 2.4 m: a room
+    b_pts, b_e = chain(0.0, 3.0, 3, 0.2)  # 0.6 m: short
+    k = len(a_pts)
+    vg = hand_graph(a_pts + b_pts, a_e + [(i + k, j + k) for i, j in b_e])
+    assert segment_rooms(vg, None).count == 1
+
+    def grid(own_cells: int) -> OccupancyGrid:
+        free = np.zeros((30, 60), dtype=bool)
+        free[0, :k] = True  # the long piece's floor (its nodes sit in cells (0, n))
+        free[0, k + 1:k + 4] = True  # the short piece's floor, one cell apart ...
+        free[1:, k + 1:] = False
+        rows, cols = np.divmod(np.arange(own_cells), 60 - k - 1)
+        free[1 + rows, k + 1 + cols] = True  # ... with this many more cells of floor
+        return OccupancyGrid(np.where(free, FREE, OCCUPIED).astype(np.int8),
+                             (0.0, 0.0), RES)
+
+    big = segment_rooms(vg, None, occ=grid(400))
+    assert big.count == 2 and big.rooms[1].tolist() == list(range(k, k + 4))
+    assert big.labels[k:].tolist() == [1] * 4
+    assert segment_rooms(vg, None, occ=grid(390)).count == 1  # under 1 m^2
+    joined = np.zeros((1, 60), dtype=bool)
+    joined[0, :k + 4] = True  # one floor for both
+    seg = segment_rooms(vg, None, occ=floor(joined))
+    assert seg.count == 1 and seg.rooms[0].tolist() == list(range(k))
 
 
 # ----- hand-made Voronoi graphs ----------------------------------------------------------
