@@ -48,9 +48,9 @@ def study_into(request: NoiseStudyRequest, show: Echo) -> None:
     from sgtool.analysis.closed_loop_bench_run import EpisodeRunner
     from sgtool.analysis.executor import make_executor
     from sgtool.analysis.noise_study import run_closed_loop, run_study
-    from sgtool.analysis.noise_study_plots import plot_study
-    from sgtool.analysis.noise_study_tables import results_csv, results_json, summary_md
-    from sgtool.files import atomic_write, output_folder
+    from sgtool.analysis.noise_study_api import write_noise_study_outputs
+    from sgtool.analysis.noise_study_tables import summary_md
+    from sgtool.files import output_folder
 
     cfg, show_bars = request.config, request.progress
     runner = make_executor(request.executor, request.workers, request.ray_address)
@@ -65,10 +65,7 @@ def study_into(request: NoiseStudyRequest, show: Echo) -> None:
                                                       progress=show_bars))
             write_outputs(cl, out / "closed_loop")
             res = replace(res, closed_loop=cl)
-        atomic_write(out / "summary.md", summary_md(res))
-        atomic_write(out / "results.json", results_json(res))
-        atomic_write(out / "results.csv", results_csv(res))
-        plot_study(res, out / "plots")
+        write_noise_study_outputs(res, out)
         summary = summary_md(res)
     show(summary.removesuffix("\n"))  # summary_md ends in one newline; show adds it
     cached = len(res.cells) - res.recorded

@@ -204,7 +204,7 @@ def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     minute; tests/recorders/sim covers run_episode)."""
     guide = (REPO / "docs" / "api.md").read_text()
     blocks = re.findall(r"```python\n(.*?)```", guide, re.DOTALL)
-    assert len(blocks) == 15
+    assert len(blocks) == 16
     runnable = [b for b in blocks if "run_closed_loop(" not in b]
     assert len(runnable) == len(blocks) - 1
     for name in ("tests", "examples"):
@@ -227,6 +227,11 @@ def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     assert isinstance(recorded, sgtool.RecordReport) and recorded.frames == 40
     with sgtool.LogReader(tmp_path / "house.mcap") as log:
         assert log.frame_count() == 40
+    cells = namespace["cells"]  # the noise-study block: none, then label_swap 0.05
+    assert isinstance(cells, sgtool.NoiseStudyResult)
+    assert [c.condition.noise for c in cells.cells] == ["none", "none,label_swap=0.05"]
+    assert (tmp_path / "noise-study" / "results.csv").is_file()
+    assert len(list((tmp_path / "noise-cache").rglob("*.mcap"))) == 2
     report = namespace["report"]
     assert isinstance(report, sgtool.OfflineReport) and report.decisions > 0
     checked, what_if = namespace["checked"], namespace["what_if"]  # the golden-logs block

@@ -38,6 +38,10 @@ closed loop            :func:`run_closed_loop` (one PyBullet episode into a log)
                        :func:`run_closed_loop_bench` (runs or resumes into a folder),
                        :class:`ClosedLoopBenchResult`,
                        :func:`write_closed_loop_bench_outputs`
+noise study            :func:`noise_study_config` (a :class:`NoiseStudyConfig`),
+                       :func:`run_noise_study` (records into a cache, scores each final
+                       graph: a :class:`NoiseStudyResult`),
+                       :func:`write_noise_study_outputs`
 viewers                :func:`write_rerun` (a log as a Rerun recording)
 metrics                :func:`success_rate`, :func:`spl`, :func:`episode_spl`,
                        :func:`mean_steps`, :func:`mean_decision_time`, :func:`auc_e`,
@@ -68,7 +72,9 @@ A few names differ from their defining module's to stay unambiguous at the top l
 :class:`SearchEpisode` is ``sgtool.datasets.episodes.Episode``, :func:`run_closed_loop` is
 ``sgtool.recorders.sim.closed_loop.run_episode``, :func:`write_bench_outputs` is
 ``sgtool.analysis.bench.write_outputs``, :func:`write_closed_loop_bench_outputs` is
-``sgtool.analysis.closed_loop_bench.write_outputs``, :func:`read_results`/:func:`write_results` are
+``sgtool.analysis.closed_loop_bench.write_outputs``, :class:`NoiseStudyConfig` and
+:class:`NoiseStudyResult` are ``sgtool.analysis.noise_study.StudyConfig`` and
+``StudyResult``, :func:`read_results`/:func:`write_results` are
 ``sgtool.results.read_jsonl``/``write_jsonl``.
 """
 

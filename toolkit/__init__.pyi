@@ -79,6 +79,12 @@ from sgtool.analysis.closed_loop_bench import ClosedLoopBenchConfig as ClosedLoo
 from sgtool.analysis.closed_loop_bench import ClosedLoopBenchResult as ClosedLoopBenchResult
 from sgtool.analysis.closed_loop_bench import run_closed_loop_bench as run_closed_loop_bench
 from sgtool.analysis.closed_loop_bench import write_outputs as write_closed_loop_bench_outputs
+# the noise study (recording: PyBullet, sgtool[sim])
+from sgtool.analysis.noise_study import StudyConfig as NoiseStudyConfig
+from sgtool.analysis.noise_study import StudyResult as NoiseStudyResult
+from sgtool.analysis.noise_study_api import noise_study_config as noise_study_config
+from sgtool.analysis.noise_study_api import run_noise_study as run_noise_study
+from sgtool.analysis.noise_study_api import write_noise_study_outputs as write_noise_study_outputs
 # viewers
 from sgtool.analysis.view_run import write_rerun as write_rerun
 # metrics
@@ -152,6 +158,8 @@ __all__ = [
     "ClosedLoopReport",
     "pick_episode", "NoiseProfile", "parse_noise", "ClosedLoopBenchConfig",
     "ClosedLoopBenchResult", "run_closed_loop_bench", "write_closed_loop_bench_outputs",
+    "NoiseStudyConfig", "NoiseStudyResult", "noise_study_config", "run_noise_study",
+    "write_noise_study_outputs",
     "write_rerun", "Interval", "PairedComparison",
     "PlannerIntervals", "paired_comparison", "planner_intervals", "success_rate", "spl",
     "episode_spl", "mean_steps", "mean_decision_time",

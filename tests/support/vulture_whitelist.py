@@ -95,6 +95,8 @@ _.LOGGED_SKILLS  # toolkit/vocabulary.py: vocabulary table
 _.CASES  # replayers/golden.py: the golden cases (tests/golden/regenerate.py)
 _.replay_graphs  # replayers/golden.py: public API (sgtool.replay_graphs)
 _.write_rerun  # analysis/view_run.py: public API (sgtool.write_rerun)
+_.noise_study_config  # analysis/noise_study_api.py: public API (sgtool.noise_study_config)
+_.run_noise_study  # analysis/noise_study_api.py: public API (sgtool.run_noise_study)
 _.room_check  # toolkit/semantics/everyday_rooms.py: a user scores own priors (module doc)
 _.accuracy  # toolkit/semantics/everyday_rooms.py: RoomCheck property (top-1 share)
 _.get_metavar  # toolkit/commands/options.py: FiniteFloatRange, called by click for --help
