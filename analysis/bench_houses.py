@@ -252,11 +252,12 @@ def house_notes(house: Any) -> tuple[str, ...]:
         notes.append(f"furniture[{k}] ({f.id}, {f.category}): {why}: no camera sees it or "
                      "what it holds, which the symbolic bench finds all the same (furniture "
                      "centres are at half their height above the floor)")
-    for k, wall, area in pieces_in_walls(spec):
+    for k, wall, area, depth in pieces_in_walls(spec):
         f = spec.furniture[k]
         notes.append(f"furniture[{k}] ({f.id}, {f.category}): {area:.2f} m² of its "
-                     f"footprint lies past {wall}'s far face: it reaches through the wall "
-                     "(the simulator shows it on both sides; set it against the wall's face)")
+                     f"footprint lies past {wall}'s far face, up to {depth:.2f} m: it "
+                     "reaches through the wall (the simulator shows it on both sides; set it "
+                     "against the wall's face)")
     for room, walls, inside in walls_in_rooms(spec):
         names = ", ".join(f"walls[{i}] ({spec.walls[i].id})" for i in walls[:4])
         more = f" and {len(walls) - 4} more" if len(walls) > 4 else ""

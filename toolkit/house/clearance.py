@@ -33,6 +33,7 @@ from sgtool.house.spec import Furniture, HouseSpec
 
 FRONT_CLEAR = 0.3  # m in front of a front face that must be open floor
 IN_WALL_AREA = 0.01  # m^2 of a footprint past a wall's far face that is more than touching
+IN_WALL_DEPTH = 0.05  # m a footprint's corner past a wall's far face that is more than touching
 THROUGH_STRIP = 0.5  # m beyond a wall's far face looked at for a piece reaching through
 INSIDE_CLEAR = 0.15  # m from a room's border where a wall is inside the room
 INSIDE_LEAST = 0.3  # m of a wall inside a room that is more than a corner's overlap
@@ -141,13 +142,15 @@ def hidden_pieces(spec: HouseSpec) -> list[tuple[int, str]]:
     return out
 
 
-def pieces_in_walls(spec: HouseSpec) -> list[tuple[int, str, float]]:
-    """(furniture index, wall id, m^2 of its footprint past the wall's far face) for each
-    piece that reaches through a wall: at least ``IN_WALL_AREA`` of its footprint lies in
-    the strip ``THROUGH_STRIP`` m deep beyond the face of the wall's body away from the
-    piece's centre (along the wall but a thickness from either end, where it may meet
-    another wall); in spec order. A piece set against a wall, or into its body up to its
-    middle line (a room's border), reaches nothing there."""
+def pieces_in_walls(spec: HouseSpec) -> list[tuple[int, str, float, float]]:
+    """(furniture index, wall id, m^2 of its footprint past the wall's far face, m its
+    farthest corner there lies past it) for each piece that reaches through a wall: at
+    least ``IN_WALL_AREA`` of its footprint, or a corner ``IN_WALL_DEPTH`` deep (a piece
+    turned against the wall pokes a small corner through), lies in the strip
+    ``THROUGH_STRIP`` m deep beyond the face of the wall's body away from the piece's
+    centre (along the wall but a thickness from either end, where it may meet another
+    wall); in spec order. A piece set against a wall, or into its body up to its middle
+    line (a room's border), reaches nothing there."""
     covers = Covers(spec)
     out = []
     for k, feet in enumerate(covers.feet):
@@ -168,8 +171,13 @@ def pieces_in_walls(spec: HouseSpec) -> list[tuple[int, str, float]]:
             strip = box_corners((mx + nx * shift, my + ny * shift), (inner, THROUGH_STRIP),
                                 w.yaw)
             area = overlap_area(feet, strip)
-            if area >= IN_WALL_AREA:
-                out.append((k, w.id, area))
+            if area <= 0.0:
+                continue
+            # how far past the far face the corners inside the strip lie
+            depth = max((-side * ((x - mx) * nx + (y - my) * ny) - w.thickness / 2
+                         for x, y in feet if point_in_polygon(x, y, strip)), default=0.0)
+            if area >= IN_WALL_AREA or depth >= IN_WALL_DEPTH:
+                out.append((k, w.id, area, depth))
     return out
 
 

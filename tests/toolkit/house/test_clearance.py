@@ -5,6 +5,7 @@ inside another piece's box; what they hold is found by the symbolic bench only, 
 from __future__ import annotations
 
 import copy
+import math
 
 from support.datasets_fixtures import two_rooms
 
@@ -76,14 +77,41 @@ def test_a_piece_through_a_wall_is_named_and_one_against_it_is_not(tmp_path) -> 
     for o in through["objects"]:
         if o["parent"] == "furn_0":
             o["position"][0] -= 0.18
-    (k, wall, area), = pieces_in_walls(load_house(through))
+    (k, wall, area, depth), = pieces_in_walls(load_house(through))
     assert (k, wall) == (0, "wall_2") and abs(area - 0.021) < 1e-9
+    assert abs(depth - 0.03) < 1e-5  # yaw pi: corners within float noise
     f = tmp_path / "through.json"
     f.write_text(json.dumps(through))
     r = CliRunner().invoke(cli, ["scenes", "check", str(f)])
     assert r.exit_code == 0, r.output
     assert "furniture[0] (furn_0, refrigerator): 0.02 m² of its footprint lies past " \
-        "wall_2's far face" in r.output
+        "wall_2's far face, up to 0.03 m" in r.output
+
+
+def test_a_corner_turned_through_a_thin_wall_is_named() -> None:
+    """The refrigerator turned 45 degrees (its half-extent along x (0.8 + 0.7) / 2 /
+    sqrt(2) = 0.530 m) at x = 0.435 pokes one corner to x = -0.095 through a 2 cm wall at
+    x = 0 (far face x = -0.01): 0.085 m deep but only 0.085^2 = 0.0072 m^2 past the face,
+    under the area rule; the depth rule names it. Turned the other way round against the
+    face (x = 0.54, corner at x = 0.01) it reaches nothing."""
+    d = two_rooms()
+    next(w for w in d["walls"] if w["id"] == "wall_2")["thickness"] = 0.02
+    turned = copy.deepcopy(d)
+    fridge = turned["furniture"][0]
+    fridge["yaw"] = math.pi / 4
+    fridge["center"][0] = 0.435
+    for o in turned["objects"]:
+        if o["parent"] == "furn_0":
+            o["position"][0] = 0.435
+            o["position"][1] = fridge["center"][1]
+    (k, wall, area, depth), = pieces_in_walls(load_house(turned))
+    assert (k, wall) == (0, "wall_2")
+    assert abs(depth - 0.085) < 1e-3 and abs(area - 0.085 ** 2) < 1e-3 < 0.01
+    fridge["center"][0] = 0.54
+    for o in turned["objects"]:
+        if o["parent"] == "furn_0":
+            o["position"][0] = 0.54
+    assert pieces_in_walls(load_house(turned)) == []
 
 
 def test_a_wall_through_a_rooms_inside_is_named(tmp_path) -> None:
