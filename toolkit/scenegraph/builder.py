@@ -536,7 +536,7 @@ class SceneGraphBuilder:
                                     self.voxels.frame_counts, DOOR_MIN_FRAMES)
         reach = DOOR_REACH / self.voxels.resolution
         won = {iid: near_median(ijk, reach) for iid, ijk in won.items()}
-        cells, centres = doorways(occ, won, self._panel_memo)
+        cells, centres, unsure = doorways(occ, won, self._panel_memo)
         cells |= lintel_doorways(occ, self.columns_between(occ, *LINTEL_BAND))  # no leaf seen
         cells.setflags(write=False)  # kept to recognise the same cells next time
         got = self._density
@@ -547,7 +547,7 @@ class SceneGraphBuilder:
             got[2].setflags(write=False)
             self._density = got
         density = got[2]
-        seg = segment_rooms(vg, density, cfg, self._centre_memo, occ)
+        seg = segment_rooms(vg, density, cfg, self._centre_memo, occ, unsure | cells)
         numbers = self._rooms.assign([vg.positions[r] for r in seg.rooms], cfg.match_radius)
         return _Rooms(cells, density, seg, [f"room:{n}" for n in numbers], centres)
 

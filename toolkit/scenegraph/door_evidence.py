@@ -9,7 +9,10 @@ and each seen door's rooms.
   (:func:`~sgtool.scenegraph.door_panel.opening_from_panel`) found from its core columns
   (those with at least ``CORE_SHARE`` of its fullest column's voxels), else from its line
   (the core continued by the thinner columns in line with it: :func:`panel_cells`), else
-  its core columns.
+  its core columns. A door seen as a panel whose doorway was not found (a door standing
+  partly open, as a rule) also marks the floor within ``UNSURE_REACH`` (or its panel's
+  length, when longer) of its core as *unsure*: its doorway lies somewhere there, so the
+  room segmentation joins no floor through it.
 - :func:`observe_doors`: the rooms on either side of a door from the visible Voronoi nodes
   within ``door_radius``; a closed door with only one explored side leads to an unexplored
   room node (SCOUT sec. IV-A), placed ``unexplored_offset`` beyond the door.
@@ -17,10 +20,12 @@ and each seen door's rooms.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from sgtool.mapping.bev import line_of_sight
@@ -36,6 +41,7 @@ PASSABLE_SHARE = 0.25  # passable share of a door's columns that makes them its 
 CORE_SHARE = 0.5  # a panel's column holds at least this share of its fullest column's voxels
 LINE_SLACK = 0.9  # cells across a panel's line that are on it (a slanted line's cells: <0.71)
 LINE_GAP = 2  # cells a panel's line may miss between cells that continue it
+UNSURE_REACH = 0.9  # m: a door leaf's width (interior doors 0.7-0.9 m), at least
 
 
 @dataclass(frozen=True, eq=False)
@@ -55,19 +61,21 @@ def open_doors(instances: Mapping[int, InstanceInfo]) -> list[int]:
 
 def doorways(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
              panel_memo: dict[bytes, object]
-             ) -> tuple[np.ndarray, dict[int, tuple[float, float]]]:
+             ) -> tuple[np.ndarray, dict[int, tuple[float, float]], np.ndarray]:
     """Bool grid of the door evidence (module doc) from the voxels (ijk) of each open door,
-    in any order (e.g. from :class:`sgtool.scenegraph.door_voxels.DoorVoxels`), and the
+    in any order (e.g. from :class:`sgtool.scenegraph.door_voxels.DoorVoxels`), the
     centre (x, y in m) of each door's cells in it: its doorway, where a swung panel's
-    centroid stands beside it. ``panel_memo`` caches the openings found from swung panels
-    across calls. The cells of every door are looked up at once; only a door with too few
-    passable cells (a swung panel) is looked at on its own."""
+    centroid stands beside it; and the bool grid of unsure floor (module doc).
+    ``panel_memo`` caches the openings found from swung panels across calls. The cells of
+    every door are looked up at once; only a door with too few passable cells (a swung
+    panel) is looked at on its own."""
     cells = np.zeros(occ.shape, dtype=bool)
+    unsure = np.zeros(occ.shape, dtype=bool)
     centres: dict[int, tuple[float, float]] = {}
     ids = [iid for iid, ijk in sorted(door_voxels.items()) if len(ijk)]
     parts = [door_voxels[iid] for iid in ids]
     if not parts:
-        return cells, centres
+        return cells, centres, unsure
     ix0 = int(round(occ.origin[0] / occ.resolution))
     iy0 = int(round(occ.origin[1] / occ.resolution))
     door = np.repeat(np.arange(len(parts)), [len(p) for p in parts])
@@ -108,7 +116,26 @@ def doorways(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
         pr, pc = core if got is None else got
         cells[pr, pc] = True  # the panel's doorway, else its core cells
         centres[ids[i]] = _centre(occ, np.asarray(pr), np.asarray(pc))
-    return cells, centres
+        if got is None:
+            _near_panel(unsure, np.asarray(pr), np.asarray(pc), occ.resolution)
+    return cells, centres, unsure
+
+
+def _near_panel(unsure: np.ndarray, rows: np.ndarray, cols: np.ndarray,
+                resolution: float) -> None:
+    """Mark in ``unsure`` the cells within the reach of a panel's cells: its length (the
+    longer side of their bounding box, diagonal included), at least ``UNSURE_REACH``."""
+    if len(rows) == 0:
+        return
+    span = math.hypot(int(rows.max() - rows.min()), int(cols.max() - cols.min())) + 1
+    reach = max(span, UNSURE_REACH / resolution)
+    pad = int(math.ceil(reach))
+    r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
+    r1 = min(int(rows.max()) + pad + 1, unsure.shape[0])
+    c1 = min(int(cols.max()) + pad + 1, unsure.shape[1])
+    away = np.ones((r1 - r0, c1 - c0), dtype=bool)
+    away[rows - r0, cols - c0] = False
+    unsure[r0:r1, c0:c1] |= ndimage.distance_transform_edt(away) <= reach
 
 
 _Cells = tuple[np.ndarray, np.ndarray]

@@ -38,7 +38,12 @@ What we do, and why it differs:
   doorway (a door panel swung into the corridor leaves the ridge only the gap beside
   the doorway); the floor on that side still joins up past the zone. Pieces of one room
   that the graph does not join (free space it does not cover, a phantom obstacle on
-  the ridge) join the same way. A merged room's centre is taken on its largest piece.
+  the ridge) join the same way. Joining floor keeps ``JOIN_SEAL`` (0.3 m) from door
+  evidence (the cut zone reaches about 0.1 m past the end of a line of door cells, so a
+  doorway whose cells cover part of it would leak) and from the floor near a door whose
+  doorway was not found (a door standing partly open, whose cells need not span its
+  opening), and needs passages ``JOIN_WIDTH`` wide (a slit beside a closed leaf, a gap
+  at a wall's end join nothing). A merged room's centre is taken on its largest piece.
   A component shorter than ``min_room_length`` is a room when it stands on floor of its
   own (no longer component's nodes on it) of at least ``min_room_length`` squared: a room
   glimpsed through a doorway has little graph but floor that belongs to no other room.
@@ -52,6 +57,7 @@ passes its id to the explored room found beyond that door later.
 from __future__ import annotations
 
 import hashlib
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
@@ -63,6 +69,9 @@ from scipy.spatial import cKDTree
 
 from sgtool.mapping.grid import OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph, submatrix
+
+JOIN_WIDTH = 0.15  # m: the narrowest passage of open floor that joins two rooms
+JOIN_SEAL = 0.3  # m around door evidence (and unsure floor) where floor joins nothing
 
 
 @dataclass(frozen=True)
@@ -100,12 +109,15 @@ class RoomSegmentation:
 def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
                   config: RoomConfig | None = None,
                   centre_memo: dict[bytes, int] | None = None,
-                  occ: OccupancyGrid | None = None) -> RoomSegmentation:
+                  occ: OccupancyGrid | None = None,
+                  unsure: np.ndarray | None = None) -> RoomSegmentation:
     """Cut ``vg`` where the door density reaches the threshold; components are rooms.
     ``centre_memo`` keeps each room's centre across calls, keyed by its sub-graph (a room
     whose sub-graph is unchanged has the same centre: the same arrays, the same Dijkstra).
     ``occ``: the grid of ``vg``; with it, components sharing free space outside the cut
-    zone are one room, and a short one on floor of its own is a room (module doc)."""
+    zone are one room, and a short one on floor of its own is a room (module doc);
+    ``unsure``: the door evidence and the cells near a door whose doorway is not known
+    (bool, ``vg.shape``): floor within ``JOIN_SEAL`` of them joins nothing."""
     cfg = config or RoomConfig()
     n, m = len(vg.positions), len(vg.edges)
     cut_e = np.zeros(m, dtype=bool)
@@ -140,7 +152,7 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
         if len(nodes):
             (rooms if comp_len[c] >= cfg.min_room_length else short).append(nodes)
     if occ is not None:
-        rooms = _rooms_by_floor(vg, rooms, short, occ, density, cfg)
+        rooms = _rooms_by_floor(vg, rooms, short, occ, density, cfg, unsure)
     for i, nodes in enumerate(rooms):
         labels[nodes] = i
     where = np.full(n, -1, dtype=np.int64)
@@ -153,25 +165,36 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
 
 def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.ndarray],
                     occ: OccupancyGrid, density: np.ndarray | None,
-                    cfg: RoomConfig) -> list[np.ndarray]:
+                    cfg: RoomConfig, unsure: np.ndarray | None = None) -> list[np.ndarray]:
     """``rooms`` (components long enough) joined where their nodes share a 4-connected part
-    of the free cells outside the cut zone, plus the ``short`` components whose parts no
-    such room touches and hold at least ``min_room_length`` squared of floor; numbered by
-    their lowest node."""
+    of the open floor (free, outside the cut zone and ``unsure``) that passages at least
+    ``JOIN_WIDTH`` wide hold together, plus the ``short`` components whose parts of the
+    open floor no such room touches and hold at least ``min_room_length`` squared;
+    numbered by their lowest node."""
     open_floor = occ.free if density is None else occ.free & (density < cfg.door_threshold)
-    part, count = ndimage.label(open_floor)
-
-    def parts(nodes: np.ndarray) -> list[int]:
-        p = np.unique(part[vg.cells[nodes, 0], vg.cells[nodes, 1]])
-        return p[p > 0].tolist()  # a node on no open floor never joins through it
-
-    taken = {p for nodes in rooms for p in parts(nodes)}
+    if unsure is not None and unsure.any():  # and what lies within JOIN_SEAL of it
+        reach = JOIN_SEAL / occ.resolution
+        pad = int(math.ceil(reach))
+        rows, cols = np.nonzero(unsure)
+        r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
+        window = ~unsure[r0:int(rows.max()) + pad + 1, c0:int(cols.max()) + pad + 1]
+        near = ndimage.distance_transform_edt(window) <= reach
+        open_floor = open_floor.copy()
+        open_floor[r0:r0 + near.shape[0], c0:c0 + near.shape[1]] &= ~near
     if short:
+        part, count = ndimage.label(open_floor)
         area = np.bincount(part.ravel(), minlength=count + 1) * occ.resolution ** 2
-        rooms = rooms + [nodes for nodes in short if parts(nodes)
-                         and not taken.intersection(parts(nodes))
-                         and area[parts(nodes)].sum() >= cfg.min_room_length ** 2]
+        taken = {p for nodes in rooms for p in _parts(vg, part, nodes)}
+        rooms = rooms + [nodes for nodes in short if (mine := _parts(vg, part, nodes))
+                         and not taken.intersection(mine)
+                         and area[mine].sum() >= cfg.min_room_length ** 2]
         rooms.sort(key=lambda nodes: int(nodes[0]))
+    # a passage narrower than JOIN_WIDTH (a gap at a wall's end, beside a closed leaf)
+    # joins nothing: one erosion step per pair of cells it takes
+    steps = (int(round(JOIN_WIDTH / occ.resolution)) - 1) // 2
+    if steps > 0:  # (the grid's edge is no wall)
+        open_floor = ndimage.binary_erosion(open_floor, iterations=steps, border_value=1)
+    part, _ = ndimage.label(open_floor)
     parent = list(range(len(rooms)))
 
     def root(i: int) -> int:
@@ -182,13 +205,19 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
 
     owner: dict[int, int] = {}
     for i, nodes in enumerate(rooms):
-        for p in parts(nodes):
+        for p in _parts(vg, part, nodes):
             a, b = root(owner.setdefault(p, i)), root(i)
             parent[max(a, b)] = min(a, b)
     groups: dict[int, list[np.ndarray]] = {}
     for i, nodes in enumerate(rooms):  # rooms come by lowest node: so do the groups
         groups.setdefault(root(i), []).append(nodes)
     return [np.sort(np.concatenate(g)) if len(g) > 1 else g[0] for g in groups.values()]
+
+
+def _parts(vg: VoronoiGraph, part: np.ndarray, nodes: np.ndarray) -> list[int]:
+    """The labelled parts of floor the ``nodes`` stand on (a node on none joins nothing)."""
+    p = np.unique(part[vg.cells[nodes, 0], vg.cells[nodes, 1]])
+    return p[p > 0].tolist()
 
 
 def _room_keys(vg: VoronoiGraph, keep: np.ndarray, labels: np.ndarray,

@@ -14,12 +14,14 @@ import dataclasses
 import networkx as nx
 import numpy as np
 import pytest
+from scipy import ndimage
 from scipy.sparse import csr_matrix
 from support.grids import walled
 
 from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph, voronoi_graph
 from sgtool.scenegraph.assign import AssignConfig, assign_objects
+from sgtool.scenegraph.door_evidence import UNSURE_REACH
 from sgtool.scenegraph.frontiers import FrontierConfig, find_frontiers
 from sgtool.scenegraph.room_segmentation import RoomConfig, door_density, segment_rooms
 
@@ -138,7 +140,8 @@ def test_a_corridor_cut_beside_a_door_is_joined_by_its_floor() -> None:
 
 
 def floor(free: np.ndarray) -> OccupancyGrid:
-    """A grid of ``free`` cells (else occupied), 5 cm cells, for a hand-made graph."""
+    """A grid of ``free`` cells (else occupied), 5 cm cells, for a hand-made graph (whose
+    node n sits in cell (0, n))."""
     return OccupancyGrid(np.where(free, FREE, OCCUPIED).astype(np.int8), (0.0, 0.0), RES)
 
 
@@ -146,50 +149,50 @@ def test_pieces_of_one_floor_are_one_room_centred_on_the_larger() -> None:
     """Two pieces of graph, 7 nodes (2.4 m of edges) and 5 (1.2 m), with no door between
     them: apart they are two rooms; on one free floor they are one, whose centre is the
     larger piece's (node 3 of its 0..6 chain; the smaller's middle node is nearer its
-    ends), and two floors keep them apart."""
+    ends). A wall of one cell between their floors keeps them apart, and so does a gap
+    in that wall narrower than JOIN_WIDTH (0.15 m: 3 cells); a gap of 3 cells joins."""
     a_pts, a_e = chain(0.0, 0.0, 6, 0.4)
     b_pts, b_e = chain(0.0, 3.0, 4, 0.3)
     k = len(a_pts)
     vg = hand_graph(a_pts + b_pts, a_e + [(i + k, j + k) for i, j in b_e])
     assert segment_rooms(vg, None).count == 2
-    one_floor = np.ones(vg.shape, dtype=bool)
+    one_floor = np.ones((12, k + 5), dtype=bool)
     seg = segment_rooms(vg, None, occ=floor(one_floor))
     assert seg.count == 1 and seg.rooms[0].tolist() == list(range(k + 5))
     assert seg.centres == (3,)
-    two_floors = one_floor.copy()
-    two_floors[0, k] = False  # hand_graph's node n sits in cell (0, n): cells 0..k-1
-    # hold the first piece, k+1.. the rest of the second (node k stands on no floor)
-    assert segment_rooms(vg, None, occ=floor(two_floors)).count == 2
+    walled = one_floor.copy()
+    walled[:, k] = False  # node k stands in the wall; the pieces' floors either side
+    assert segment_rooms(vg, None, occ=floor(walled)).count == 2
+    for gap, rooms in ((1, 2), (2, 2), (3, 1)):
+        gapped = walled.copy()
+        gapped[6:6 + gap, k] = True
+        assert segment_rooms(vg, None, occ=floor(gapped)).count == rooms, gap
 
 
 def test_a_short_piece_on_floor_of_its_own_is_a_room() -> None:
     """A room glimpsed through a door: its graph is a 0.6 m piece (under min_room_length),
-    dropped on its own. On floor of its own of at least min_room_length squared (1 m^2 =
+    dropped on its own. On floor of its own of at least min_room_length squared (1 m^2:
     400 cells of 5 cm) it is a room; on less floor, or on floor a long piece stands on,
-    it is none (its nodes keep no room, as before)."""
+    it is none (its nodes keep no room)."""
     a_pts, a_e = chain(0.0, 0.0, 6, 0.4)  # 2.4 m: a room
     b_pts, b_e = chain(0.0, 3.0, 3, 0.2)  # 0.6 m: short
     k = len(a_pts)
     vg = hand_graph(a_pts + b_pts, a_e + [(i + k, j + k) for i, j in b_e])
     assert segment_rooms(vg, None).count == 1
 
-    def grid(own_cells: int) -> OccupancyGrid:
-        free = np.zeros((30, 60), dtype=bool)
-        free[0, :k] = True  # the long piece's floor (its nodes sit in cells (0, n))
-        free[0, k + 1:k + 4] = True  # the short piece's floor, one cell apart ...
-        free[1:, k + 1:] = False
-        rows, cols = np.divmod(np.arange(own_cells), 60 - k - 1)
-        free[1 + rows, k + 1 + cols] = True  # ... with this many more cells of floor
-        return OccupancyGrid(np.where(free, FREE, OCCUPIED).astype(np.int8),
-                             (0.0, 0.0), RES)
+    def grid(rows: int, wall: bool = True) -> OccupancyGrid:
+        free = np.zeros((rows, 40), dtype=bool)
+        free[:3, :k] = True  # the long piece's floor
+        free[:, k + 1:] = True  # the short piece's floor: rows x 40 - k - 1 cells ...
+        free[:, k] = not wall  # ... behind a wall of one cell
+        return floor(free)
 
-    big = segment_rooms(vg, None, occ=grid(400))
+    assert 32 * 12 < 400 <= 32 * 13  # 40 - 7 - 1 = 32 columns
+    big = segment_rooms(vg, None, occ=grid(13))
     assert big.count == 2 and big.rooms[1].tolist() == list(range(k, k + 4))
     assert big.labels[k:].tolist() == [1] * 4
-    assert segment_rooms(vg, None, occ=grid(390)).count == 1  # under 1 m^2
-    joined = np.zeros((1, 60), dtype=bool)
-    joined[0, :k + 4] = True  # one floor for both
-    seg = segment_rooms(vg, None, occ=floor(joined))
+    assert segment_rooms(vg, None, occ=grid(12)).count == 1  # under 1 m^2
+    seg = segment_rooms(vg, None, occ=grid(13, wall=False))  # one floor for both
     assert seg.count == 1 and seg.rooms[0].tolist() == list(range(k))
 
 
@@ -418,3 +421,46 @@ def test_candidate_radius_decides_which_nodes_may_take_the_object() -> None:
     assert room_of(cfg) == 0
     assert room_of(dataclasses.replace(cfg, candidate_radius=1.2 * cfg.candidate_radius)) == 2
     assert room_of(dataclasses.replace(cfg, candidate_radius=0.8 * cfg.candidate_radius)) == 1
+
+
+def partly_open_door(degrees: float) -> tuple[OccupancyGrid, np.ndarray]:
+    """Two rooms either side of a 2-cell wall at row 60 with an 18-cell (0.9 m) doorway
+    at columns 70-87, its leaf hinged at (62, 70) and standing ``degrees`` open into the
+    lower room; the leaf's cells are the door evidence (its doorway not found)."""
+    g = walled(112, 152)
+    g[60:62, 4:-4] = OCCUPIED
+    g[60:62, 70:88] = FREE
+    door = np.zeros(g.shape, dtype=bool)
+    a = np.radians(degrees)
+    for t in np.linspace(0.0, 17.0, 72):
+        r, c = int(round(62 + t * np.sin(a))), int(round(70 + t * np.cos(a)))
+        g[r, c] = OCCUPIED
+        door[r, c] = True
+    return OccupancyGrid(g, (0.0, 0.0), RES), door
+
+
+def test_floor_near_unsure_door_evidence_joins_nothing() -> None:
+    """A leaf standing 30 degrees open cuts the doorway's ridge (two rooms), but its cut
+    zone leaves the far part of the opening open: the floor joins the rooms there, even
+    0.3 m (JOIN_SEAL) from the leaf. The floor within a leaf's width (UNSURE_REACH, what
+    door_evidence marks unsure around a leaf whose doorway it did not find) joins
+    nothing, so they stay two. Doorway cells covering 60 % of an opening from one jamb
+    leave a gap narrower than JOIN_SEAL and JOIN_WIDTH together: two rooms as well."""
+    occ, door = partly_open_door(30)
+    vg = voronoi_graph(occ)
+    dens = door_density(door, RES, ROOMS.door_bandwidth)
+    assert segment_rooms(vg, dens, ROOMS).count == 2
+    assert segment_rooms(vg, dens, ROOMS, occ=occ).count == 1  # the leak
+    assert segment_rooms(vg, dens, ROOMS, occ=occ, unsure=door).count == 1
+    unsure = ndimage.distance_transform_edt(~door) <= UNSURE_REACH / RES
+    assert segment_rooms(vg, dens, ROOMS, occ=occ, unsure=unsure).count == 2
+    g = walled(60, 120)
+    g[30:32, 4:-4] = OCCUPIED
+    g[30:32, 60:78] = FREE
+    part = np.zeros(g.shape, dtype=bool)
+    part[30:32, 60:71] = True  # 11 of the 18 cells, from one jamb
+    grid = OccupancyGrid(g, (0.0, 0.0), RES)
+    vg = voronoi_graph(grid)
+    dens = door_density(part, RES, ROOMS.door_bandwidth)
+    assert segment_rooms(vg, dens, ROOMS, occ=grid).count == 1  # without the seal
+    assert segment_rooms(vg, dens, ROOMS, occ=grid, unsure=part).count == 2

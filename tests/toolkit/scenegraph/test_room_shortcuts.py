@@ -280,12 +280,41 @@ def test_an_open_door_stands_at_its_doorway_not_at_its_swung_panel():
     panel = np.stack([np.full(15, 10), rows, np.zeros(15, np.int64)], axis=1)
     lintel = np.stack([np.arange(10, 26), np.full(16, 20), np.full(16, 44)], axis=1)
     occ = OccupancyGrid(g, (0.0, 0.0), 0.05)
-    cells, at = doorways(occ, {7: np.concatenate([panel, lintel]).astype(np.int64)}, {})
+    cells, at, _ = doorways(occ, {7: np.concatenate([panel, lintel]).astype(np.int64)}, {})
     assert at[7] == pytest.approx((0.9, 1.025))
-    cells, at = doorways(occ, {7: panel.astype(np.int64), 8: np.zeros((0, 3), np.int64)}, {})
+    cells, at, _ = doorways(occ, {7: panel.astype(np.int64), 8: np.zeros((0, 3), np.int64)}, {})
     assert set(at) == {7}  # a door without voxels has no doorway
     x, y = at[7]
     assert abs(y - 1.025) < 0.051 and 0.5 <= x <= 1.3  # in the gap (a cell), not in the room
+
+
+def test_a_leaf_whose_doorway_is_not_found_marks_the_floor_around_it_unsure():
+    """A leaf standing 45 degrees open from its hinge (no wall line continues it: no
+    doorway is found) is its own door evidence, and the floor within UNSURE_REACH (0.9 m:
+    18 cells) of it is unsure, as far as its 0.75 m length when that is longer; a leaf
+    whose doorway is found (the same leaf closed into its wall's gap) marks none."""
+    g = np.full((80, 80), FREE, dtype=np.int8)
+    t = np.arange(15)
+    rows, cols = 30 + t, 30 + t  # 45 degrees, 15 cells: 1.05 m along its diagonal
+    g[rows, cols] = OCCUPIED
+    panel = np.stack([cols, rows, np.zeros(15, np.int64)], axis=1).astype(np.int64)
+    occ = OccupancyGrid(g, (0.0, 0.0), 0.05)
+    cells, _, unsure = doorways(occ, {7: panel}, {})
+    assert cells[rows, cols].all()  # the leaf's own cells
+    dist = ndimage.distance_transform_edt(~cells)
+    assert unsure[dist <= 18].all()
+    reach = np.hypot(14, 14) + 1  # the leaf's span, longer than 18 cells
+    assert unsure[(dist > 19) & (dist <= reach - 0.5)].all()
+    assert not unsure[dist > reach + 1].any()
+    closed = np.full((60, 60), FREE, dtype=np.int8)
+    closed[20, :10] = OCCUPIED
+    closed[20, 26:] = OCCUPIED
+    leaf = 20 + np.arange(1, 16)
+    closed[leaf, 10] = OCCUPIED
+    swung = np.stack([np.full(15, 10), leaf, np.zeros(15, np.int64)], axis=1)
+    _, _, none = doorways(OccupancyGrid(closed, (0.0, 0.0), 0.05),
+                          {7: swung.astype(np.int64)}, {})
+    assert not none.any()
 
 
 @pytest.mark.parametrize("seed", range(12))
