@@ -267,19 +267,25 @@ def test_thin_columns_beside_a_panel_are_not_part_of_it():
     assert alone.any() and np.array_equal(both, alone)
 
 
-def test_an_open_door_stands_at_its_doorway_not_at_its_swung_panel():
-    """A door swung into a room, seen with its lintel (a fair share of passable columns) or
-    as its panel alone: either way its place is the centre of the doorway (columns 10-25 of
-    row 20, x = 0.9 m, y = 1.025 m at 5 cm cells), where the centroid of its voxels stands
-    0.4 m inside the room."""
+def swung_door() -> tuple[OccupancyGrid, np.ndarray]:
+    """A wall along row 20 with a doorway at columns 10-25 and a door swung into the room
+    below it, hinged at column 10; and the panel's voxels (i, j, k)."""
     g = np.full((60, 60), FREE, dtype=np.int8)
     g[20, :10] = OCCUPIED
     g[20, 26:] = OCCUPIED
     rows = 20 + np.arange(1, 16)
     g[rows, 10] = OCCUPIED
     panel = np.stack([np.full(15, 10), rows, np.zeros(15, np.int64)], axis=1)
+    return OccupancyGrid(g, (0.0, 0.0), 0.05), panel.astype(np.int64)
+
+
+def test_an_open_door_stands_at_its_doorway_not_at_its_swung_panel():
+    """A door swung into a room, seen with its lintel (a fair share of passable columns) or
+    as its panel alone: either way its place is the centre of the doorway (columns 10-25 of
+    row 20, x = 0.9 m, y = 1.025 m at 5 cm cells), where the centroid of its voxels stands
+    0.4 m inside the room."""
+    occ, panel = swung_door()
     lintel = np.stack([np.arange(10, 26), np.full(16, 20), np.full(16, 44)], axis=1)
-    occ = OccupancyGrid(g, (0.0, 0.0), 0.05)
     cells, at, _ = doorways(occ, {7: np.concatenate([panel, lintel]).astype(np.int64)}, {})
     assert at[7] == pytest.approx((0.9, 1.025))
     cells, at, _ = doorways(occ, {7: panel.astype(np.int64), 8: np.zeros((0, 3), np.int64)}, {})
@@ -289,13 +295,13 @@ def test_an_open_door_stands_at_its_doorway_not_at_its_swung_panel():
 
 
 def test_a_leaf_whose_doorway_is_not_found_marks_the_floor_around_it_unsure():
-    """A leaf standing 45 degrees open from its hinge (no wall line continues it: no
-    doorway is found) is its own door evidence, and the floor within UNSURE_REACH (0.9 m:
-    18 cells) of it is unsure, as far as its 0.75 m length when that is longer; a leaf
-    whose doorway is found (the same leaf closed into its wall's gap) marks none."""
+    """A leaf standing diagonally on open floor (no wall: no doorway is found) is its own
+    door evidence, and the floor within UNSURE_REACH (0.9 m: 18 cells) of it is unsure,
+    as far as its span (20.8 cells, 1.04 m) since that is longer; a door whose doorway
+    is found (swung_door's) marks none."""
     g = np.full((80, 80), FREE, dtype=np.int8)
     t = np.arange(15)
-    rows, cols = 30 + t, 30 + t  # 45 degrees, 15 cells: 1.05 m along its diagonal
+    rows, cols = 30 + t, 30 + t  # 45 degrees, 15 cells
     g[rows, cols] = OCCUPIED
     panel = np.stack([cols, rows, np.zeros(15, np.int64)], axis=1).astype(np.int64)
     occ = OccupancyGrid(g, (0.0, 0.0), 0.05)
@@ -306,14 +312,8 @@ def test_a_leaf_whose_doorway_is_not_found_marks_the_floor_around_it_unsure():
     reach = np.hypot(14, 14) + 1  # the leaf's span, longer than 18 cells
     assert unsure[(dist > 19) & (dist <= reach - 0.5)].all()
     assert not unsure[dist > reach + 1].any()
-    closed = np.full((60, 60), FREE, dtype=np.int8)
-    closed[20, :10] = OCCUPIED
-    closed[20, 26:] = OCCUPIED
-    leaf = 20 + np.arange(1, 16)
-    closed[leaf, 10] = OCCUPIED
-    swung = np.stack([np.full(15, 10), leaf, np.zeros(15, np.int64)], axis=1)
-    _, _, none = doorways(OccupancyGrid(closed, (0.0, 0.0), 0.05),
-                          {7: swung.astype(np.int64)}, {})
+    swung_occ, swung = swung_door()
+    _, _, none = doorways(swung_occ, {7: swung}, {})
     assert not none.any()
 
 
