@@ -34,11 +34,14 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sgtool.analysis.bench_houses import BenchHouse
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write
+
+if TYPE_CHECKING:
+    from sgtool.analysis.closed_loop_bench import ClosedLoopBenchResult
 
 # the factors of the study: the noise profile's fields, in the order tables list them
 FACTORS: tuple[str, ...] = ("depth_sigma", "holes", "label_swap", "label_dropout",
@@ -308,6 +311,12 @@ class ClosedLoopSettings:
 
 @dataclass(frozen=True)
 class StudyConfig:
+    """A noise study: ``houses`` (generated or from files), each recorded once per noise
+    setting of ``conditions`` (generated ones with ``rooms`` (MIN, MAX) rooms) with the
+    recording ``settings``; ``closed_loop``: the closed-loop runs under noise (none by
+    default). :func:`sgtool.noise_study_config` builds one from plain values; :meth:`check`
+    says in one line what cannot work."""
+
     houses: tuple[BenchHouse, ...]
     conditions: tuple[Condition, ...]
     rooms: tuple[int, int] = (8, 8)
@@ -362,11 +371,16 @@ class Cell:
 
 @dataclass(frozen=True)
 class StudyResult:
+    """What a noise study found: per house and condition a :class:`Cell` (the final
+    graph's scores, merged and strict, as ``sgtool replay --score`` gives them), how many
+    logs this run recorded, the houses' specs and, when the study ran them, the
+    closed-loop runs' result."""
+
     config: StudyConfig
     cells: tuple[Cell, ...]  # houses outer, conditions in config order
     recorded: int  # logs recorded by this run (the others came from the cache)
     specs: Mapping[str, str] = field(default_factory=dict)  # house id -> spec JSON
-    closed_loop: Any = None  # a ClosedLoopBenchResult, or None
+    closed_loop: ClosedLoopBenchResult | None = None
 
     def cell(self, house: str, noise: str) -> Cell | None:
         for c in self.cells:

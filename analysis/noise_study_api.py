@@ -32,50 +32,109 @@ from sgtool.extras import require
 
 
 def noise_study_config(houses: int = 4, *, house_seed: int = 0,
-                       house_files: Sequence[str | os.PathLike[str]] = (),
+                       house_files: str | os.PathLike[str]
+                       | Sequence[str | os.PathLike[str]] = (),
                        rooms: tuple[int, int] = (8, 8),
                        factors: Mapping[str, Sequence[float]] | None = None,
-                       profiles: Sequence[str] | None = None,
+                       profiles: str | Sequence[str] | None = None,
                        camera: tuple[int, int] = (160, 120), fps: float = 4.0,
                        frames: int | None = None, noise_seed: int = 0) -> StudyConfig:
     """A study of ``houses`` generated houses (seeds ``house_seed``, +1, ...; ``rooms``
-    (MIN, MAX) rooms each) and the ``house_files`` after them, under no noise, each
-    factor of ``factors`` at each of its levels (name -> levels, names of
-    :data:`~sgtool.analysis.noise_study.FACTORS`; None: the command's default levels) and
-    each whole profile of ``profiles`` (None: ``mild`` and ``strong`` unless factors are
-    given); recorded at ``camera`` (width, height) and ``fps``, ``frames`` at most (None:
-    the whole scripted tour). Checked: a one-line :class:`SgtoolError` names what cannot
-    work."""
+    (MIN, MAX) rooms each) and the ``house_files`` after them (one path or several), under
+    no noise, each factor of ``factors`` at each of its levels (name -> levels, names of
+    :data:`~sgtool.analysis.noise_study.FACTORS`; None or empty: the command's default
+    levels) and each whole profile of ``profiles`` (None: ``mild`` and ``strong`` unless
+    factors are given); recorded at ``camera`` (width, height) and ``fps``, ``frames`` at
+    most (None: the whole scripted tour). Every value is checked here: a one-line
+    :class:`SgtoolError` names the parameter."""
     from sgtool.analysis.bench_houses import generated_houses, load_house_files
-    from sgtool.analysis.noise_study import FACTORS
 
-    if isinstance(houses, bool) or not isinstance(houses, int) or houses < 0:
-        raise SgtoolError(f"houses={houses!r}: a count, >= 0")
-    chosen = dict(DEFAULT_LEVELS) if factors is None else dict(factors)
-    unknown = sorted(set(chosen) - set(FACTORS))
-    if unknown:
-        raise SgtoolError(f"factors: {unknown[0]!r} is not a noise factor (one of "
-                          f"{', '.join(FACTORS)})")
-    for name, levels in chosen.items():
-        if isinstance(levels, (str, bytes)) or not all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) and v >= 0
-                for v in levels):
-            raise SgtoolError(f"factors[{name!r}]: a list of levels >= 0, got {levels!r}")
-    if profiles is None:
-        profiles = () if factors else DEFAULT_PROFILES
-    if isinstance(profiles, str):
-        profiles = (profiles,)
-    conditions = conditions_of(chosen, tuple(profiles))
-    settings = RecordingSettings(int(camera[0]), int(camera[1]), float(fps), frames,
-                                 noise_seed)
-    settings.check()
-    gen = generated_houses(houses, house_seed)
+    _count("houses", houses, 0)
+    _count("house_seed", house_seed, 0)
+    _count("noise_seed", noise_seed, 0)
+    lo, hi = _pair("rooms", rooms, 1)
+    from sgtool.datasets.generator import MAX_ROOMS
+
+    if not 4 <= lo <= hi <= MAX_ROOMS:
+        raise SgtoolError(f"rooms={rooms!r}: need 4 <= MIN <= MAX <= {MAX_ROOMS}")
+    width, height = _pair("camera", camera, 16)
+    if isinstance(fps, bool) or not isinstance(fps, (int, float)):
+        raise SgtoolError(f"fps={fps!r}: a number of frames per second")
+    if frames is not None:
+        _count("frames", frames, 1)
+    try:
+        conditions = conditions_of(_levels(factors), _profiles(profiles, factors))
+    except SgtoolError as e:  # the command's words: --profile 'x' -> profiles: 'x'
+        raise SgtoolError(str(e).replace("--profile ", "profiles: ")) from None
+    settings = RecordingSettings(width, height, float(fps), frames, noise_seed)
+    try:
+        settings.check()
+    except SgtoolError as e:  # the command's words: --fps 999 -> fps=999
+        raise SgtoolError(str(e).replace("--fps ", "fps=")) from None
+    if house_files is None:
+        house_files = ()
+    elif isinstance(house_files, (str, os.PathLike)):
+        house_files = (house_files,)
+    elif not isinstance(house_files, Sequence):
+        raise SgtoolError(f"house_files={house_files!r}: a path or a list of paths")
     files = [str(p) for p in house_files]
+    gen = generated_houses(houses, house_seed)
     given = load_house_files(files, taken=[h.id for h in gen]) if files else ()
-    cfg = StudyConfig(gen + tuple(given), conditions, (int(rooms[0]), int(rooms[1])),
-                      settings)
+    cfg = StudyConfig(gen + tuple(given), conditions, (lo, hi), settings)
     cfg.check()
     return cfg
+
+
+def _count(name: str, value: object, least: int) -> int:
+    """``value`` as a whole number >= ``least``, else one line naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, int) or value < least:
+        raise SgtoolError(f"{name}={value!r}: a whole number >= {least}")
+    return value
+
+
+def _pair(name: str, value: object, least: int) -> tuple[int, int]:
+    """``value`` as two whole numbers >= ``least`` (a tuple or list), else one line."""
+    if isinstance(value, (str, bytes)) or not isinstance(value, Sequence) or len(value) != 2:
+        raise SgtoolError(f"{name}={value!r}: give two whole numbers, e.g. ({least}, {least})")
+    a, b = value
+    return _count(name, a, least), _count(name, b, least)
+
+
+def _levels(factors: Mapping[str, Sequence[float]] | None) -> dict[str, tuple[float, ...]]:
+    """The factors' levels, each checked as ``--factor`` checks it (a known factor, numbers
+    the profile accepts); None or empty: the default levels."""
+    from sgtool.analysis.noise_study import FACTORS, parse_factor
+
+    if not factors:
+        return dict(DEFAULT_LEVELS)
+    if not isinstance(factors, Mapping):
+        raise SgtoolError(f"factors={factors!r}: a mapping of factor name -> levels")
+    out: dict[str, tuple[float, ...]] = {}
+    for name, levels in factors.items():
+        if name not in FACTORS:
+            raise SgtoolError(f"factors: {name!r} is not a noise factor (one of "
+                              f"{', '.join(FACTORS)})")
+        if isinstance(levels, (str, bytes)) or not isinstance(levels, Sequence) or not levels \
+                or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                           for v in levels):
+            raise SgtoolError(f"factors[{name!r}]: a list of numbers, got {levels!r}")
+        try:
+            out[name] = parse_factor(f"{name}=" + ",".join(repr(float(v)) for v in levels))[1]
+        except SgtoolError as e:
+            raise SgtoolError(f"factors[{name!r}]: " + str(e).partition(": ")[2]) from None
+    return out
+
+
+def _profiles(profiles: str | Sequence[str] | None,
+              factors: Mapping[str, Sequence[float]] | None) -> tuple[str, ...]:
+    """The whole profiles studied (None: the defaults unless factors are given)."""
+    if profiles is None:
+        return () if factors else DEFAULT_PROFILES
+    if isinstance(profiles, str):
+        return (profiles,)
+    if not isinstance(profiles, Sequence) or not all(isinstance(p, str) for p in profiles):
+        raise SgtoolError(f"profiles={profiles!r}: a profile name or a list of them")
+    return tuple(profiles)
 
 
 def run_noise_study(config: StudyConfig, cache: str | os.PathLike[str], *,

@@ -227,9 +227,9 @@ def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     assert isinstance(recorded, sgtool.RecordReport) and recorded.frames == 40
     with sgtool.LogReader(tmp_path / "house.mcap") as log:
         assert log.frame_count() == 40
-    cells = namespace["cells"]  # the noise-study block: none, then label_swap 0.05
-    assert isinstance(cells, sgtool.NoiseStudyResult)
-    assert [c.condition.noise for c in cells.cells] == ["none", "none,label_swap=0.05"]
+    found = namespace["found"]  # the noise-study block: none, then label_swap 0.05
+    assert isinstance(found, sgtool.NoiseStudyResult)
+    assert [c.condition.noise for c in found.cells] == ["none", "none,label_swap=0.05"]
     assert (tmp_path / "noise-study" / "results.csv").is_file()
     assert len(list((tmp_path / "noise-cache").rglob("*.mcap"))) == 2
     report = namespace["report"]

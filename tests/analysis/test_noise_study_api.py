@@ -28,11 +28,23 @@ def test_the_config_lists_conditions_as_the_command_does() -> None:
 
 @pytest.mark.parametrize(("kwargs", "message"), [
     ({"factors": {"blur": [0.1]}}, "'blur' is not a noise factor"),
-    ({"factors": {"holes": "0.1"}}, "factors['holes']: a list of levels"),
-    ({"factors": {"holes": [-0.1]}}, "factors['holes']: a list of levels"),
-    ({"profiles": ["loud"]}, "'loud': unknown profile"),
-    ({"camera": (8, 8)}, "at least 16x16"),
-    ({"frames": 0}, "must be >= 1"),
+    ({"factors": {"holes": "0.1"}}, "factors['holes']: a list of numbers"),
+    ({"factors": {"holes": None}}, "factors['holes']: a list of numbers"),
+    ({"factors": {"holes": [-0.1]}}, "factors['holes']: level -0.1"),
+    ({"factors": {"label_swap": [2.0]}}, "a probability, at most 1"),
+    ({"factors": "holes"}, "factors='holes': a mapping"),
+    ({"profiles": ["loud"]}, "profiles: 'loud': unknown profile"),
+    ({"profiles": 5}, "profiles=5: a profile name"),
+    ({"camera": (8, 8)}, "camera=8: a whole number >= 16"),
+    ({"camera": "160x120"}, "camera='160x120': give two whole numbers"),
+    ({"camera": (96.7, 72)}, "camera=96.7"),
+    ({"rooms": (5, 3)}, "rooms=(5, 3): need 4 <= MIN <= MAX"),
+    ({"rooms": "4-5"}, "rooms='4-5': give two whole numbers"),
+    ({"frames": 0}, "frames=0: a whole number >= 1"),
+    ({"frames": 2.5}, "frames=2.5"),
+    ({"fps": "4"}, "fps='4': a number"),
+    ({"noise_seed": -1}, "noise_seed=-1"),
+    ({"house_files": 5}, "house_files=5: a path or a list of paths"),
 ])
 def test_a_bad_config_value_is_one_line(kwargs: dict, message: str) -> None:
     with pytest.raises(sgtool.SgtoolError) as e:
@@ -44,6 +56,13 @@ def test_a_bad_config_value_is_one_line(kwargs: dict, message: str) -> None:
 def test_houses_is_a_count(houses: object) -> None:
     with pytest.raises(sgtool.SgtoolError, match="houses="):
         sgtool.noise_study_config(houses)  # type: ignore[arg-type]
+
+
+def test_one_house_file_is_a_path_not_a_list_of_characters(tmp_path: Path) -> None:
+    missing = tmp_path / "mine.json"
+    with pytest.raises(sgtool.SgtoolError) as e:
+        sgtool.noise_study_config(0, house_files=str(missing))
+    assert str(missing) in str(e.value) and "\n" not in str(e.value)
 
 
 def test_run_refuses_bad_workers_and_a_file_as_cache(tmp_path: Path) -> None:

@@ -23,11 +23,13 @@ import numpy as np
 
 from sgtool.house.geometry import (
     box_corners,
+    clip_convex,
     distance_to_border,
     distance_to_polygon,
     overlap_area,
     point_in_polygon,
     segment_distance,
+    signed_area,
 )
 from sgtool.house.spec import Furniture, HouseSpec
 
@@ -173,9 +175,10 @@ def pieces_in_walls(spec: HouseSpec) -> list[tuple[int, str, float, float]]:
             area = overlap_area(feet, strip)
             if area <= 0.0:
                 continue
-            # how far past the far face the corners inside the strip lie
+            # how far past the far face the footprint reaches within the strip
+            ccw = strip if signed_area(strip) > 0 else strip[::-1]
             depth = max((-side * ((x - mx) * nx + (y - my) * ny) - w.thickness / 2
-                         for x, y in feet if point_in_polygon(x, y, strip)), default=0.0)
+                         for x, y in clip_convex(feet, ccw)), default=0.0)
             if area >= IN_WALL_AREA or depth >= IN_WALL_DEPTH:
                 out.append((k, w.id, area, depth))
     return out

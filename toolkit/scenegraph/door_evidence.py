@@ -123,12 +123,12 @@ def doorways(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
 
 def _near_panel(unsure: np.ndarray, rows: np.ndarray, cols: np.ndarray,
                 resolution: float) -> None:
-    """Mark in ``unsure`` the cells within the reach of a panel's cells: its length (the
-    longer side of their bounding box, diagonal included), at least ``UNSURE_REACH``."""
+    """Mark in ``unsure`` the cells within the reach of a panel's cells: its span (the
+    diagonal of their bounding box, plus a cell), at least ``UNSURE_REACH``."""
     if len(rows) == 0:
         return
     span = math.hypot(int(rows.max() - rows.min()), int(cols.max() - cols.min())) + 1
-    reach = max(span, UNSURE_REACH / resolution)
+    reach = max(span, UNSURE_REACH / resolution) + 1e-9  # (cells exactly that far)
     pad = int(math.ceil(reach))
     r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
     r1 = min(int(rows.max()) + pad + 1, unsure.shape[0])

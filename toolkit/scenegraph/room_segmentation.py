@@ -43,7 +43,9 @@ What we do, and why it differs:
   doorway whose cells cover part of it would leak) and from the floor near a door whose
   doorway was not found (a door standing partly open, whose cells need not span its
   opening), and needs passages ``JOIN_WIDTH`` wide (a slit beside a closed leaf, a gap
-  at a wall's end join nothing). A merged room's centre is taken on its largest piece.
+  at a wall's end join nothing): the floor is eroded k cells, which keeps passages of
+  2k + 1 cells, k the fewest steps that make those at least ``JOIN_WIDTH`` (3 cells at
+  5 cm). A merged room's centre is taken on its largest piece.
   A component shorter than ``min_room_length`` is a room when it stands on floor of its
   own (no longer component's nodes on it) of at least ``min_room_length`` squared: a room
   glimpsed through a doorway has little graph but floor that belongs to no other room.
@@ -70,7 +72,7 @@ from scipy.spatial import cKDTree
 from sgtool.mapping.grid import OccupancyGrid
 from sgtool.mapping.voronoi import VoronoiGraph, submatrix
 
-JOIN_WIDTH = 0.15  # m: the narrowest passage of open floor that joins two rooms
+JOIN_WIDTH = 0.15  # m: passages of open floor narrower than this join no rooms (module doc)
 JOIN_SEAL = 0.3  # m around door evidence (and unsure floor) where floor joins nothing
 
 
@@ -173,7 +175,7 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
     numbered by their lowest node."""
     open_floor = occ.free if density is None else occ.free & (density < cfg.door_threshold)
     if unsure is not None and unsure.any():  # and what lies within JOIN_SEAL of it
-        reach = JOIN_SEAL / occ.resolution
+        reach = JOIN_SEAL / occ.resolution + 1e-9  # (0.3 / 0.05 is 5.999...)
         pad = int(math.ceil(reach))
         rows, cols = np.nonzero(unsure)
         r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
@@ -190,8 +192,8 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
                          and area[mine].sum() >= cfg.min_room_length ** 2]
         rooms.sort(key=lambda nodes: int(nodes[0]))
     # a passage narrower than JOIN_WIDTH (a gap at a wall's end, beside a closed leaf)
-    # joins nothing: one erosion step per pair of cells it takes
-    steps = (int(round(JOIN_WIDTH / occ.resolution)) - 1) // 2
+    # joins nothing: k erosion steps keep passages of 2k + 1 cells and more
+    steps = max(0, math.ceil((JOIN_WIDTH / occ.resolution - 1) / 2 - 1e-9))
     if steps > 0:  # (the grid's edge is no wall)
         open_floor = ndimage.binary_erosion(open_floor, iterations=steps, border_value=1)
     part, _ = ndimage.label(open_floor)

@@ -169,6 +169,34 @@ def test_pieces_of_one_floor_are_one_room_centred_on_the_larger() -> None:
         assert segment_rooms(vg, None, occ=floor(gapped)).count == rooms, gap
 
 
+@pytest.mark.parametrize(("resolution", "joins_from"), [(0.1, 3), (0.05, 3), (0.04, 5),
+                                                       (0.025, 7), (0.02, 9)])
+def test_a_passage_joins_from_join_width_at_any_cell_size(resolution: float,
+                                                          joins_from: int) -> None:
+    """Two pieces of graph on floors either side of a one-cell wall with a gap: the gap
+    joins them from the fewest odd number of cells at least JOIN_WIDTH (0.15 m) wide
+    (erosion keeps passages of 2k + 1 cells), a cell narrower it does not, even where
+    that is 0.15 m or more (4 cells of 4 cm; at 0.1 m cells 3 cells, 0.3 m)."""
+    a_pts, a_e = chain(0.0, 0.0, 6, 0.4)
+    b_pts, b_e = chain(0.0, 3.0, 4, 0.3)
+    k = len(a_pts)
+    vg = hand_graph(a_pts + b_pts, a_e + [(i + k, j + k) for i, j in b_e])
+    # the nodes on row 20, away from the wall at column 30: the first piece at columns
+    # 5-11, the second at 45-49
+    cells = np.stack([np.full(k + 5, 20), np.r_[np.arange(5, 5 + k), np.arange(45, 50)]],
+                     axis=1)
+    vg = dataclasses.replace(vg, cells=cells, shape=(40, 60))
+    assert joins_from % 2 == 1
+    assert (joins_from - 2) * resolution < 0.15 <= joins_from * resolution + 1e-9
+    for gap, rooms in ((joins_from - 1, 2), (joins_from, 1)):
+        free = np.ones((40, 60), dtype=bool)
+        free[:, 30] = False
+        free[15:15 + gap, 30] = True
+        occ = OccupancyGrid(np.where(free, FREE, OCCUPIED).astype(np.int8), (0.0, 0.0),
+                            resolution)
+        assert segment_rooms(vg, None, occ=occ).count == rooms, gap
+
+
 def test_a_short_piece_on_floor_of_its_own_is_a_room() -> None:
     """A room glimpsed through a door: its graph is a 0.6 m piece (under min_room_length),
     dropped on its own. On floor of its own of at least min_room_length squared (1 m^2:
