@@ -146,6 +146,23 @@ def inflate(occupied: np.ndarray, radius: float, resolution: float) -> np.ndarra
     return dist < radius + resolution / 2.0 - _TOL
 
 
+def within_cells(mask: np.ndarray, reach: float) -> np.ndarray:
+    """Cells whose centre is at most ``reach`` cells from a ``mask`` cell's centre (a
+    reach of whole cells included: 0.3 m / 0.05 m is 5.999...); the distance transform
+    runs on the mask's bounding box grown by ``reach`` only."""
+    out = np.zeros(mask.shape, dtype=bool)
+    if not mask.any():
+        return out
+    reach += 1e-9
+    pad = int(math.ceil(reach))
+    rows, cols = np.nonzero(mask)
+    r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
+    r1 = min(int(rows.max()) + pad + 1, mask.shape[0])
+    c1 = min(int(cols.max()) + pad + 1, mask.shape[1])
+    out[r0:r1, c0:c1] = ndimage.distance_transform_edt(~mask[r0:r1, c0:c1]) <= reach
+    return out
+
+
 # ----------------------------------------------------------------------------------------
 # graph search
 # ----------------------------------------------------------------------------------------

@@ -25,11 +25,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from sgtool.mapping.bev import line_of_sight
 from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid, grid_at
+from sgtool.mapping.occupancy import within_cells
 from sgtool.mapping.voronoi import VoronoiGraph
 from sgtool.scenegraph.door_panel import opening_from_panel
 from sgtool.scenegraph.instances import InstanceInfo
@@ -128,14 +128,9 @@ def _near_panel(unsure: np.ndarray, rows: np.ndarray, cols: np.ndarray,
     if len(rows) == 0:
         return
     span = math.hypot(int(rows.max() - rows.min()), int(cols.max() - cols.min())) + 1
-    reach = max(span, UNSURE_REACH / resolution) + 1e-9  # (cells exactly that far)
-    pad = int(math.ceil(reach))
-    r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
-    r1 = min(int(rows.max()) + pad + 1, unsure.shape[0])
-    c1 = min(int(cols.max()) + pad + 1, unsure.shape[1])
-    away = np.ones((r1 - r0, c1 - c0), dtype=bool)
-    away[rows - r0, cols - c0] = False
-    unsure[r0:r1, c0:c1] |= ndimage.distance_transform_edt(away) <= reach
+    panel = np.zeros(unsure.shape, dtype=bool)
+    panel[rows, cols] = True
+    unsure |= within_cells(panel, max(span, UNSURE_REACH / resolution))
 
 
 _Cells = tuple[np.ndarray, np.ndarray]

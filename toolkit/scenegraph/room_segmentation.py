@@ -70,6 +70,7 @@ from scipy.sparse.csgraph import connected_components, dijkstra
 from scipy.spatial import cKDTree
 
 from sgtool.mapping.grid import OccupancyGrid
+from sgtool.mapping.occupancy import within_cells
 from sgtool.mapping.voronoi import VoronoiGraph, submatrix
 
 JOIN_WIDTH = 0.15  # m: passages of open floor narrower than this join no rooms (module doc)
@@ -174,15 +175,8 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
     open floor no such room touches and hold at least ``min_room_length`` squared;
     numbered by their lowest node."""
     open_floor = occ.free if density is None else occ.free & (density < cfg.door_threshold)
-    if unsure is not None and unsure.any():  # and what lies within JOIN_SEAL of it
-        reach = JOIN_SEAL / occ.resolution + 1e-9  # (0.3 / 0.05 is 5.999...)
-        pad = int(math.ceil(reach))
-        rows, cols = np.nonzero(unsure)
-        r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
-        window = ~unsure[r0:int(rows.max()) + pad + 1, c0:int(cols.max()) + pad + 1]
-        near = ndimage.distance_transform_edt(window) <= reach
-        open_floor = open_floor.copy()
-        open_floor[r0:r0 + near.shape[0], c0:c0 + near.shape[1]] &= ~near
+    if unsure is not None:  # and what lies within JOIN_SEAL of it
+        open_floor = open_floor & ~within_cells(unsure, JOIN_SEAL / occ.resolution)
     if short:
         part, count = ndimage.label(open_floor)
         area = np.bincount(part.ravel(), minlength=count + 1) * occ.resolution ** 2
@@ -196,23 +190,16 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
     steps = max(0, math.ceil((JOIN_WIDTH / occ.resolution - 1) / 2 - 1e-9))
     if steps > 0:  # (the grid's edge is no wall)
         open_floor = ndimage.binary_erosion(open_floor, iterations=steps, border_value=1)
-    part, _ = ndimage.label(open_floor)
-    parent = list(range(len(rooms)))
-
-    def root(i: int) -> int:
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    owner: dict[int, int] = {}
-    for i, nodes in enumerate(rooms):
-        for p in _parts(vg, part, nodes):
-            a, b = root(owner.setdefault(p, i)), root(i)
-            parent[max(a, b)] = min(a, b)
+    part, count = ndimage.label(open_floor)
+    # rooms and parts of floor as one graph: a room linked to each part it stands on
+    links = [(i, len(rooms) + p) for i, nodes in enumerate(rooms) for p in _parts(vg, part, nodes)]
+    size = len(rooms) + count + 1
+    a, b = np.array(links, dtype=np.int64).reshape(-1, 2).T
+    _, joined = connected_components(csr_matrix((np.ones(len(a)), (a, b)), shape=(size, size)),
+                                     directed=False)
     groups: dict[int, list[np.ndarray]] = {}
     for i, nodes in enumerate(rooms):  # rooms come by lowest node: so do the groups
-        groups.setdefault(root(i), []).append(nodes)
+        groups.setdefault(int(joined[i]), []).append(nodes)
     return [np.sort(np.concatenate(g)) if len(g) > 1 else g[0] for g in groups.values()]
 
 
