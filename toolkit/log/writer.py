@@ -92,7 +92,6 @@ _COMPRESSION = {
 COMPRESSIONS: tuple[str, ...] = tuple(_COMPRESSION)  # the names a log may be written with
 
 
-
 def _check_frame(k: CameraIntrinsics, depth: np.ndarray, rgb: np.ndarray | None,
                  ids: np.ndarray | None) -> None:
     """``ValueError`` unless the frame's images would read back as written: depth of the
