@@ -22,6 +22,7 @@ from sgtool.semantics.text import category_text
 
 if TYPE_CHECKING:
     from sgtool.analysis.executor import Executor
+    from sgtool.analysis.interval_report import IntervalReport
     from sgtool.results import EpisodeResult
 
 Echo = Callable[[str], None]
@@ -33,7 +34,8 @@ class EvalRequest:
     replay with their checked options, transcripts answering moma-llm (empty: the logs'
     own exchanges), the success rule (None: as recorded), the AUC-E budgets (distance in
     low-level steps, high-level steps), JSON or tables, the executor of the reads and
-    whether to show progress (stderr)."""
+    whether to show progress (stderr), and the paired comparisons' reference (None: scout when
+    scored, else the first planner) or every pair."""
 
     inputs: tuple[str, ...]
     runner: Executor
@@ -45,6 +47,8 @@ class EvalRequest:
     step_budget: float = 50.0
     as_json: bool = False
     progress: bool = False
+    reference: str | None = None  # paired comparisons against it (None: scout, else first)
+    all_pairs: bool = False  # paired comparisons of every pair of planners instead
 
 
 @dataclass(frozen=True)
@@ -59,7 +63,7 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
     """Score the request's episodes and replay its planners on the logged decisions."""
     from sgtool.analysis.batch_eval import load_many
     from sgtool.analysis.offline import log_exchanges, with_seen, with_success_rule
-    from sgtool.analysis.search_metrics import cost_models, summarize
+    from sgtool.analysis.search_metrics import cost_models, planner_order, summarize
 
     results, logged, notes, unread = load_many([Path(i) for i in request.inputs], request.runner,
                                                progress=request.progress)
@@ -79,6 +83,9 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
         why = f" ({len(notes)} skipped or refused, see the notes)" if notes else ""
         raise SgtoolError("no search episodes to score in "
                           + ", ".join(request.inputs) + why)
+    if request.reference is not None and request.reference not in planner_order(results):
+        raise SgtoolError(f"--reference {request.reference}: no episode of that planner in "
+                          f"the inputs (planners: {', '.join(planner_order(results))})")
     models = cost_models(request.distance_budget, request.step_budget)
     exchanges = log_exchanges(request.inputs)
     reports = _replays(request, logged, exchanges)
@@ -207,6 +214,7 @@ def _as_json(request: EvalRequest, results: Sequence[Any], notes: Sequence[str],
         "budgets": {m.name: {"max": m.max_cost, "cost": m.label} for m in models},
         "planners": summary_dict(sums),
         "seen_unseen": [asdict(s) for s in seen_unseen(results)],
+        "intervals": _intervals(request, results).to_dict(),
         "offline": {r.planner: {"decisions": r.decisions, "same_action": r.rate("agree"),
                                 "same_target": r.rate("target"), "same_room": r.rate("room"),
                                 "not_in_graph": r.rate("invalid"), "skipped": r.skipped,
@@ -231,8 +239,18 @@ def _as_tables(request: EvalRequest, results: Sequence[Any], notes: Sequence[str
                                 f"{len(request.inputs)} file(s)")]
     if any(r.seen is not None for r in results):
         parts.append(format_seen_unseen(seen_unseen(results), title="Seen vs unseen queries"))
+    parts.append(_intervals(request, results).text())
     if reports:
         parts.append(format_offline(reports))
     if exchanges:
         parts.append(format_stats(answer_stats(exchanges), "the logs") + "\n")
     return "\n".join(parts)
+
+
+def _intervals(request: EvalRequest, results: Sequence[EpisodeResult]) -> IntervalReport:
+    """SR and SPL with intervals over houses and the paired comparisons of the request."""
+    from sgtool.analysis.interval_report import interval_report
+    from sgtool.analysis.search_metrics import planner_order
+
+    return interval_report(results, planner_order(results), request.reference,
+                           request.all_pairs)

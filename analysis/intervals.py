@@ -17,9 +17,10 @@ clusters sees the same resamples (the comparisons of a table share their draws).
 fewer than two clusters there is nothing to resample: the interval is NaN (shown "-").
 A resample whose denominator is 0 is left out (0/0) or counts as +inf (x/0, x > 0).
 
-Pairing: two planners' episodes are matched on (house, episode, seed); only episodes both
-ran count. Wins / losses / ties are counted per cluster on the paired mean SPL (SR where
-no episode of the cluster has a known shortest path), equal within 1e-9.
+Pairing: two planners' episodes are matched on (house, episode, seed, query); only episodes
+both ran count (the query keeps apart runs of other houses under one name, as two runs'
+files given together may hold). Wins / losses / ties are counted per cluster on the paired
+mean SPL (SR where no episode of the cluster has a known shortest path), equal within 1e-9.
 
 Kendall's tau (:func:`kendall_tau`) compares two orders of the same planners (e.g. the
 closed loop's and the symbolic bench's) by a metric: tau-b of ``scipy.stats.kendalltau``.
@@ -234,15 +235,15 @@ class PairedComparison:
                 "losses": self.losses, "ties": self.ties}
 
 
-def _pair_key(r: EpisodeResult) -> tuple[str, int, int]:
-    return (r.house, r.episode, r.seed)
+def _pair_key(r: EpisodeResult) -> tuple[str, int, int, str]:
+    return (r.house, r.episode, r.seed, r.query)
 
 
 def paired_comparison(results: Sequence[EpisodeResult], planner: str, reference: str,
                       cluster: Cluster = by_house,
                       boot: Bootstrap = DEFAULT_BOOTSTRAP) -> PairedComparison:
-    """``planner`` against ``reference`` on their common (house, episode, seed) episodes
-    of ``results`` (module doc)."""
+    """``planner`` against ``reference`` on their common (house, episode, seed, query)
+    episodes of ``results`` (module doc)."""
     mine = {_pair_key(r): r for r in results if r.planner == planner}
     ref = {_pair_key(r): r for r in results if r.planner == reference}
     common = sorted(mine.keys() & ref.keys())

@@ -47,6 +47,16 @@ if TYPE_CHECKING:
                    "exchanges of the MCAP inputs, when they have any].")
 @success_option(recorded=True)
 @budget_options()
+@click.option("--reference", default=None, metavar="PLANNER",
+              help="Paired comparisons of every other planner against this one on the same "
+                   "(house, episode, seed, query) episodes, pooled over the inputs (a run "
+                   "of your planner against a stored run of the baselines): SPL ratio, SR "
+                   "and SPL differences with bootstrap intervals over houses, wins/losses/"
+                   "ties per house; all, seen and unseen queries. [default: scout when "
+                   "scored, else the first planner]")
+@click.option("--all-pairs", is_flag=True,
+              help="Paired comparisons of every pair of planners instead of against "
+                   "--reference.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of tables.")
 @click.option("-o", "--out", type=click.Path(dir_okay=False), default=None,
               help="Also write the output to this file (JSON if it ends in .json).")
@@ -57,13 +67,14 @@ if TYPE_CHECKING:
 def command(inputs: tuple[str, ...], out: str | None, force: bool = False,
             **given: Any) -> None:
     """Recompute the benchmark metrics (SR, SPL, steps, decision time, AUC-E with both
-    budgets, seen/unseen) from recorded episodes: MCAP logs of closed-loop runs (their
-    sgtool.Episode and sgtool.Action records) and/or episodes.jsonl files written by
-    `sgtool bench`. A folder is read as its episodes.jsonl when it holds one (the output
-    of bench or run-bench), else as every MCAP log in it and its subfolders (a --log-dir
-    of bench or run-bench). With --planner, replay every logged decision point of the MCAP logs:
-    the planner decides on the logged scene graph, its choice is compared with the logged
-    action, and it is then told what was really done.
+    budgets, seen/unseen, SR and SPL with bootstrap intervals over houses, paired
+    comparisons of planners on the same episodes) from recorded episodes: MCAP logs of
+    closed-loop runs (their sgtool.Episode and sgtool.Action records) and/or
+    episodes.jsonl files written by `sgtool bench`. A folder is read as its episodes.jsonl
+    when it holds one (the output of bench or run-bench), else as every MCAP log in it and
+    its subfolders (a --log-dir of bench or run-bench). With --planner, replay every logged
+    decision point of the MCAP logs: the planner decides on the logged scene graph, its
+    choice is compared with the logged action, and it is then told what was really done.
 
     Only search episodes are scored: logs of recordings and imports are skipped with a note.
     An episode whose figures cannot be true, or contradict each other, is refused: it is
@@ -107,6 +118,8 @@ class EvalArgs:
     llm_model: str | None = None
     llm_api_key: str | None = None
     llm_timeout: float | None = None
+    reference: str | None = None
+    all_pairs: bool = False
 
 
 def _request(inputs: tuple[str, ...], out: str | None, force: bool, args: EvalArgs
@@ -119,6 +132,9 @@ def _request(inputs: tuple[str, ...], out: str | None, force: bool, args: EvalAr
     from sgtool.commands.options import check_output, planner_names, planner_options
     from sgtool.planning.registry import check_planner_name
 
+    if args.reference is not None and args.all_pairs:
+        raise SgtoolError("--reference and --all-pairs: give one (all pairs compare every "
+                          "planner with every other, the reference among them)")
     runner = make_executor(args.executor, args.workers, args.ray_address)
     runs = [str(Path(i) / "episodes.jsonl") if (Path(i) / "episodes.jsonl").is_file()
             else i for i in inputs]  # an output folder: its table, not its logs too
@@ -137,7 +153,8 @@ def _request(inputs: tuple[str, ...], out: str | None, force: bool, args: EvalAr
     return EvalRequest(inputs=files, runner=runner, planners=tuple(names),
                        planner_options=options, llm_replay=args.llm_replay,
                        success=args.success, distance_budget=args.distance_budget,
-                       step_budget=args.step_budget,
+                       step_budget=args.step_budget, reference=args.reference,
+                       all_pairs=args.all_pairs,
                        as_json=args.as_json or bool(out and out.endswith(".json")),
                        progress=args.progress if args.progress is not None
                        else sys.stderr.isatty())

@@ -1,0 +1,70 @@
+"""`sgtool eval` prints the bench's intervals and paired comparisons, pooled over its
+inputs: a run of one planner compared with a stored run of another on the same episodes
+gives the figures of one bench run of both; episodes under one (house, episode, seed) with
+other queries (houses of other sizes) are not paired."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+
+from click.testing import CliRunner
+
+from sgtool.cli import cli
+from sgtool.results import EpisodeResult, write_jsonl
+
+BENCH = ["bench", "--houses", "2", "--episodes", "3", "--rooms", "4-5", "--seeds", "1",
+         "--no-progress"]
+
+
+def _bench(out: Path, planners: str) -> dict:
+    r = CliRunner().invoke(cli, [*BENCH, "--planners", planners, "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    return json.loads((out / "summary.json").read_text())
+
+
+def test_two_runs_compared_as_one_bench_compares_them(tmp_path: Path) -> None:
+    both = _bench(tmp_path / "both", "scout,greedy")["intervals"]
+    _bench(tmp_path / "a", "scout")
+    _bench(tmp_path / "b", "greedy")
+    r = CliRunner().invoke(cli, ["eval", str(tmp_path / "a"), str(tmp_path / "b"),
+                                 "--reference", "scout", "--json"])
+    assert r.exit_code == 0, r.output
+    got = json.loads(r.stdout)["intervals"]
+    assert got["paired"] == both["paired"]  # greedy against scout, 6 episodes, 2 houses
+    assert got["paired"][0]["episodes"] == 6 and got["paired"][0]["clusters"] == 2
+    assert got["planners"] == both["planners"]
+    assert got["paired_seen"] == both["paired_seen"]
+    text = CliRunner().invoke(cli, ["eval", str(tmp_path / "a"), str(tmp_path / "b"),
+                                    "--reference", "greedy"]).stdout
+    paired = text.split("Paired comparisons on the same episodes\n", 1)[1]
+    row = next(line for line in paired.splitlines() if line.startswith("| scout "))
+    assert row.split("|")[2].strip() == "greedy"  # scout against the reference given
+
+
+RUN = EpisodeResult("greedy", 0, "house-0", 0, "mug", True, steps=4, travelled_m=10.0,
+                    shortest_m=9.48)
+
+
+def test_other_queries_under_one_name_are_not_paired(tmp_path: Path) -> None:
+    a, b = tmp_path / "a.jsonl", tmp_path / "b.jsonl"
+    write_jsonl([RUN, dataclasses.replace(RUN, episode=1, query="bowl")], a)
+    write_jsonl([dataclasses.replace(RUN, planner="random"),
+                 dataclasses.replace(RUN, planner="random", episode=1, query="cup")], b)
+    r = CliRunner().invoke(cli, ["eval", str(a), str(b), "--all-pairs", "--json"])
+    assert r.exit_code == 0, r.output
+    (pair,) = json.loads(r.stdout)["intervals"]["paired"]
+    assert (pair["planner"], pair["reference"], pair["episodes"]) == ("random", "greedy", 1)
+
+
+def test_reference_mistakes_are_one_line(tmp_path: Path) -> None:
+    a = tmp_path / "a.jsonl"
+    write_jsonl([RUN], a)
+    r = CliRunner().invoke(cli, ["eval", str(a), "--reference", "voi"])
+    assert r.exit_code == 2
+    assert r.stderr.strip().splitlines()[-1] == \
+        "sgtool: error: --reference voi: no episode of that planner in the inputs " \
+        "(planners: greedy)"
+    r = CliRunner().invoke(cli, ["eval", str(a), "--reference", "greedy", "--all-pairs"])
+    assert r.exit_code == 2 and "give one" in r.stderr and "Traceback" not in r.output
