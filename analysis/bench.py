@@ -79,25 +79,15 @@ from sgtool.analysis.bench_priors import (
     training_vocabulary,
 )
 from sgtool.analysis.executor import Task, chunks, failure_lines, make_executor
-from sgtool.analysis.intervals import (
-    DEFAULT_BOOTSTRAP,
-    Bootstrap,
-    PairedComparison,
-    PlannerIntervals,
-    comparison_pairs,
-    paired_comparison,
-    planner_intervals,
-)
+from sgtool.analysis.interval_report import IntervalReport, interval_report
 from sgtool.analysis.paper_tables import TABLE_IX_SYMSEARCH
 from sgtool.analysis.report import (
     breakdown_records,
     format_breakdown,
-    format_intervals,
-    format_paired,
-    format_paired_split,
     format_seen_unseen,
     format_side_by_side,
     format_table,
+    invalid_action_notes,
     llm_answer_lines,
     llm_answer_totals,
     summary_dict,
@@ -259,48 +249,20 @@ class BenchResult:
             title="Ours next to SCOUT Table VII (SymSearch rows quoted from the paper)",
             timing=timing)
 
-    def intervals(self, boot: Bootstrap = DEFAULT_BOOTSTRAP) -> list[PlannerIntervals]:
-        """SR and SPL per planner with cluster-bootstrap intervals over houses."""
-        return [planner_intervals(self.results, p, boot=boot) for p in self.config.planners]
-
-    def comparisons(self, boot: Bootstrap = DEFAULT_BOOTSTRAP,
-                    seen: bool | None = None) -> list[PairedComparison]:
-        """The paired comparisons of the config's pairs (:func:`~sgtool.analysis.
-        intervals.comparison_pairs`), intervals over houses; ``seen`` True / False: on
-        the episodes of seen / unseen queries only."""
-        pairs = comparison_pairs(self.config.planners, self.config.reference,
-                                 self.config.all_pairs)
-        results = self.results if seen is None else \
-            [r for r in self.results if r.seen is seen]
-        return [paired_comparison(results, a, b, boot=boot) for a, b in pairs]
-
     @functools.cached_property
-    def statistics(self) -> tuple[list[PlannerIntervals], list[PairedComparison],
-                                  list[PairedComparison], list[PairedComparison]]:
-        """With the default bootstrap, computed once: :meth:`intervals`, then
-        :meth:`comparisons` on all, seen and unseen queries."""
-        return (self.intervals(), self.comparisons(), self.comparisons(seen=True),
-                self.comparisons(seen=False))
+    def intervals(self) -> IntervalReport:
+        """SR and SPL per planner with bootstrap intervals over houses, and the paired
+        comparisons of the config's pairs on all, seen and unseen queries (computed once)."""
+        cfg = self.config
+        return interval_report(self.results, cfg.planners, cfg.reference, cfg.all_pairs)
 
     def interval_tables(self) -> str:
         """The intervals per planner, then the paired comparisons (text)."""
-        ivs, pairs, seen, unseen = self.statistics
-        boot = DEFAULT_BOOTSTRAP
-        return "\n".join([
-            format_intervals(ivs, boot, title="SR and SPL with bootstrap intervals over "
-                                              "houses, episodes pooled over seeds"),
-            format_paired(pairs, boot, title="Paired comparisons on the same episodes"),
-            format_paired_split(seen, unseen, boot,
-                                title="Paired comparisons on seen and on unseen queries")])
+        return self.intervals.text()
 
     def interval_dict(self) -> dict[str, Any]:
         """The same as :meth:`interval_tables`, JSON-ready (summary.json)."""
-        ivs, pairs, seen, unseen = self.statistics
-        return {"bootstrap": DEFAULT_BOOTSTRAP.to_dict(), "cluster": "house",
-                "planners": {r.planner: r.to_dict() for r in ivs},
-                "paired": [c.to_dict() for c in pairs],
-                "paired_seen": [c.to_dict() for c in seen],
-                "paired_unseen": [c.to_dict() for c in unseen]}
+        return self.intervals.to_dict()
 
     def breakdown_table(self, by: str) -> str:
         rows = breakdown(self.results, by, self.config.planners)
@@ -490,6 +452,8 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
              f"{len(res.failed)}", *(f"- {line}" for line in res.failed)]
             if res.failed else []),
           *llm_answer_lines(res.results, cfg.planners),
+          *(line.removeprefix("sgtool: note: ")
+            for line in invalid_action_notes(res.results, cfg.planners)),
           *[f"Note on {h.id} ({h.source}): {line}" for h in res.houses for line in h.notes],
           f"Digest of episodes.jsonl without wall-clock fields: {res.digest}",
           f"sgtool {__version__}; relational priors "

@@ -40,7 +40,7 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     then show the tables and the files written; a task that failed after a retry is one
     error line and nothing is written; Ctrl-C leaves both folders as they were."""
     from sgtool.analysis.bench import OUTPUT_NAMES, run_benchmark, write_outputs
-    from sgtool.analysis.report import llm_warnings
+    from sgtool.analysis.report import invalid_action_notes, llm_warnings
     from sgtool.files import leftover_notes, output_folder
     from sgtool.llm.recorded import transcript_run
 
@@ -73,7 +73,8 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     for h in res.houses:
         for line in h.notes:
             show(f"sgtool: note: {h.source}: {line}")
-    for line in llm_warnings(res.results, res.config.planners):
+    for line in (*llm_warnings(res.results, res.config.planners),
+                 *invalid_action_notes(res.results, res.config.planners)):
         show(line)
     show(f"wrote {', '.join(str(Path(out_dir) / name) for name in written)}")
     for folder in (out_dir, *([log_dir] if log_dir is not None else [])):

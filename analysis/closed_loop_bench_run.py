@@ -100,9 +100,10 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
             written.append(atomic_write(root / RUN_FILE, run_record(
                 res.rows, root, runner, request.executor)).name)
     show(res.table())
-    from sgtool.analysis.report import llm_warnings
+    from sgtool.analysis.report import invalid_action_notes, llm_warnings
 
-    for line in llm_warnings(res.results(), request.config.planners):
+    results, planners = res.results(), request.config.planners
+    for line in (*llm_warnings(results, planners), *invalid_action_notes(results, planners)):
         show(line)
     show(f"wrote {', '.join(str(Path(request.out_dir) / name) for name in written)}")
     for line in leftover_notes(request.out_dir):

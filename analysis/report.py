@@ -270,6 +270,25 @@ def llm_warnings(results: Sequence[EpisodeResult], planners: Sequence[str]) -> l
             for p, t in llm_answer_totals(results, planners).items() if not t["valid"]]
 
 
+def invalid_action_notes(results: Sequence[EpisodeResult], planners: Sequence[str]
+                         ) -> list[str]:
+    """A note per planner some of whose actions were invalid (a target that is no node of
+    the scene graph it was given, a skill its node does not offer): each spent a step and
+    did nothing, so a planner that names nodes wrongly looks like one that searches badly
+    unless told."""
+    out = []
+    for p in planners:
+        rs = [r for r in results if r.planner == p]
+        bad = sum(r.n_invalid for r in rs)
+        if bad:
+            out.append(f"sgtool: note: {p}: {bad} of its {sum(r.steps for r in rs)} actions "
+                       f"(in {sum(1 for r in rs if r.n_invalid)} of {len(rs)} episodes) were "
+                       "invalid, a target that is no node of the scene graph it was given or "
+                       "a skill the node does not offer, and spent a step each (n_invalid in "
+                       "episodes.jsonl)")
+    return out
+
+
 def llm_answer_lines(results: Sequence[EpisodeResult], planners: Sequence[str]) -> list[str]:
     """One line per planner that asked an LLM: its requests, valid and rejected answers (the
     invalid-answer rate) and transport faults."""
@@ -330,7 +349,7 @@ def format_paired(rows: Sequence[PairedComparison], boot: Bootstrap, cluster: st
         body = [[label, *row] for label, row in zip(labels, body, strict=True)]
     parts = [title] if title else []
     parts.append(pipe_table(header, body))
-    parts.append(f"Same (house, episode, seed) episodes for both planners. SPL ratio = the "
+    parts.append(f"Same (house, episode, seed, query) episodes for both planners. SPL ratio = the "
                  f"planner's mean SPL / the reference's; diff = planner - reference; W/L/T "
                  f"= {cluster}s where the planner's paired SPL is higher / lower / equal. "
                  + boot.statement(cluster) + ".")

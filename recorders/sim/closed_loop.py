@@ -209,6 +209,7 @@ class _Search:
         self.steps = self.n_open = self.last_t = 0
         self.end = ""
         self.decision_times: list[float] = []
+        self.invalid: list[str] = []  # why each invalid action was (episode_notes)
         self.exchanges: list[dict[str, Any]] = []  # the planner's LLM exchanges, as logged
         self._graph_time_ns = 0
         self._shown: dict[str, Any] = {}  # the view's distances for the log (decided())
@@ -347,6 +348,7 @@ class _Search:
             self.end = "gave_up" if action.target is None else "wrong_done"
         elif plan.invalid is not None:
             o, why, dist, ticks = "invalid", plan.invalid, 0.0, 0
+            self.invalid.append(plan.invalid)
         else:
             ex = self._run(plan.calls)
             o, why, dist, ticks, cut = ex.outcome, ex.reason, ex.travelled_m, ex.ticks, ex.cut
@@ -535,7 +537,7 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
             last = stream.current
             notes = episode_notes(mapping.max_depth, MAX_DEPTH_M, opts.noise.depth_sigma,
                                   None if last is None else len(last.graph.rooms),
-                                  answer_counts(search.exchanges))
+                                  answer_counts(search.exchanges), search.invalid)
     finally:
         closer = getattr(planner, "close", None)
         if callable(closer):

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import statistics
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -68,14 +68,17 @@ class ClosedLoopReport:
 
 
 def episode_notes(max_depth: float, default_depth: float, depth_sigma: float,
-                  rooms: int | None, llm_answers: Mapping[str, int] | None = None
-                  ) -> tuple[str, ...]:
+                  rooms: int | None, llm_answers: Mapping[str, int] | None = None,
+                  invalid: Sequence[str] = ()) -> tuple[str, ...]:
     """The notes of an episode whose live map kept depth to ``max_depth`` (the default
     ``default_depth`` lowered for the sensor's ``depth_sigma``, or chosen), whose last
     scene graph has ``rooms`` rooms (None: no graph) and whose planner's LLM answers are
     counted in ``llm_answers`` (:func:`~sgtool.llm.stats.answer_counts`; empty: it asked
-    none)."""
+    none), and why each of the planner's ``invalid`` actions was."""
     notes = []
+    if invalid:
+        notes.append(f"{len(invalid)} of the planner's actions were invalid and spent a step "
+                     f"each (the first: {invalid[0]})")
     llm = llm_answers or {}
     if llm.get("requests") and not llm.get("valid"):
         notes.append(f"none of the planner's {llm['requests']} LLM requests got a valid answer "

@@ -156,9 +156,13 @@ def run_one(house: HouseSpec | SymbolicHouse, planner: Planner | str, query: str
     :class:`~sgtool.house.spec.StartPose` (e.g. from
     :func:`sgtool.datasets.start_poses.start_poses`) starts in the region of its room
     nearest to it. Raises :class:`RunOneError` for a query with no instance in the house,
-    a start that is not in it, or ``max_steps`` below 1.
+    a start that is not in it, or ``max_steps`` below 1; a planner object is held to the
+    contract a plug-in is (:class:`~sgtool.planning.timing.TimedPlanner`: what its methods
+    raise, an action with no skill or a target that is no node id, is one
+    :class:`~sgtool.planning.timing.PlannerContractError` naming it).
     """
     from sgtool.planning.registry import make_planner
+    from sgtool.planning.timing import TimedPlanner
 
     if max_steps < 1:
         raise RunOneError(f"max_steps {max_steps}: must be >= 1")
@@ -169,7 +173,10 @@ def run_one(house: HouseSpec | SymbolicHouse, planner: Planner | str, query: str
         [f.id for f in spec.furniture if category_text(f.category) == text]
     if not targets:
         raise RunOneError(f"query {query!r}: no object of that category in the house")
-    p = make_planner(planner) if isinstance(planner, str) else planner
+    # a planner object is checked as a plug-in is (its mistakes are one line)
+    p = make_planner(planner) if isinstance(planner, str) else \
+        planner if isinstance(planner, TimedPlanner) else \
+        TimedPlanner(planner, plugin=True, measure=False)
     name = planner if isinstance(planner, str) else None
     rooms = sorted({o.room for o in spec.objects if o.id in targets} |
                    {f.room for f in spec.furniture if f.id in targets})

@@ -33,7 +33,8 @@ class TimedPlanner:
     raises :class:`PlannerContractError` naming the planner when ``decide`` returns no
     :class:`~sgtool.planning.base.Action` (a plug-in's mistake, caught where it happens),
     or, for a ``plugin``, when its ``reset``, ``decide`` or ``feedback`` raises or its
-    action names no skill (:data:`~sgtool.vocabulary.SKILLS`). Without ``measure`` the
+    action names no skill (:data:`~sgtool.vocabulary.SKILLS`) or a target that is no
+    node id (text) or None. Without ``measure`` the
     checks stay and the action keeps the decision time the planner gave it."""
 
     def __init__(self, inner: Planner, plugin: bool = False, measure: bool = True) -> None:
@@ -58,10 +59,8 @@ class TimedPlanner:
             raise self._failed("decide", e) from e
         dt = time.perf_counter() - t0
         self.decision_times.append(dt)
-        if self.plugin and isinstance(action, Action) and action.skill not in SKILLS:
-            raise PlannerContractError(
-                f"planner {self.name!r}: decide() returned an Action with skill "
-                f"{action.skill!r}; the skills are {', '.join(SKILLS)}")
+        if self.plugin and isinstance(action, Action):
+            self._check(action)
         if not self.measure and isinstance(action, Action):
             return action
         if _PLAIN and type(action) is Action:  # dataclasses.replace without its field walk
@@ -73,6 +72,18 @@ class TimedPlanner:
                 f"planner {self.name!r}: decide() returned a {type(action).__name__}, not an "
                 "sgtool.Action (e.g. Action('navigate', node_id))")
         return dataclasses.replace(action, decision_time_s=dt)
+
+    def _check(self, action: Action) -> None:
+        """A plug-in's action names a skill and a node id (text) or no target."""
+        if action.skill not in SKILLS:
+            raise PlannerContractError(
+                f"planner {self.name!r}: decide() returned an Action with skill "
+                f"{action.skill!r}; the skills are {', '.join(SKILLS)}")
+        if action.target is not None and not isinstance(action.target, str):
+            raise PlannerContractError(
+                f"planner {self.name!r}: decide() returned an Action whose target is "
+                f"{action.target!r} ({type(action.target).__name__}); a target is a node id "
+                "(text, e.g. a candidate's node_id) or None")
 
     @property
     def exchanges(self) -> object:

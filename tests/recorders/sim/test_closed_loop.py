@@ -527,3 +527,6 @@ def test_episode_notes() -> None:
     (_, empty) = episode_notes(1.0, 5.0, 0.02, 0)
     assert "ended without a room" in empty
     assert "ended without a room" in episode_notes(5.0, 5.0, 0.0, None)[0]
+    (invalid,) = episode_notes(5.0, 5.0, 0.0, 3, None, ["'room:9' is not a node", "x"])
+    assert invalid == ("2 of the planner's actions were invalid and spent a step each (the "
+                       "first: 'room:9' is not a node)")

@@ -62,6 +62,24 @@ PLUGIN = textwrap.dedent('''
             from sgtool.planning.base import Action
 
             return Action("fly", "room:0")
+
+
+    class NamesNothing(GreedyPlanner):
+        """A planner whose target is no node of any graph."""
+
+        def decide(self, graph):
+            from sgtool.planning.base import Action
+
+            return Action("navigate", "room:999")
+
+
+    class CountsRooms(GreedyPlanner):
+        """A planner whose target is a number."""
+
+        def decide(self, graph):
+            from sgtool.planning.base import Action
+
+            return Action("navigate", 5)
 ''')
 SMALL = ["--houses", "1", "--episodes", "2", "--seeds", "1", "--rooms", "4-5", "--preset",
          "default", "--no-progress"]
@@ -349,3 +367,37 @@ def test_an_untimed_plugin_keeps_its_name_in_the_closed_loop(plugin_dir: Path, t
     r = CliRunner().invoke(cli, ["golden", "pin", str(log), "--dir", str(tmp_path / "g"),
                                  "--max-frames", "20"])
     assert r.exit_code == 0, r.output
+
+
+def test_invalid_actions_are_told_and_a_target_must_be_a_node_id(
+        plugin_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A plug-in naming nodes that are not there runs (an LLM planner may), but the bench
+    says so on stderr and in summary.md; a target that is no text is one line; a planner
+    object given to run_one is held to the same contract."""
+    monkeypatch.syspath_prepend(str(plugin_dir))
+    out = tmp_path / "out"
+    r = CliRunner().invoke(cli, ["bench", "--planners", "greedy,mymod_cli:NamesNothing",
+                                 *SMALL, "--max-steps", "5", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    note = ("mymod_cli:NamesNothing: 10 of its 10 actions (in 2 of 2 episodes) were invalid, "
+            "a target that is no node of the scene graph it was given or a skill the node "
+            "does not offer, and spent a step each (n_invalid in episodes.jsonl)")
+    assert f"sgtool: note: {note}" in r.stdout
+    assert note in (out / "summary.md").read_text()
+    assert "note: greedy:" not in r.stdout  # greedy's actions were all valid
+    from sgtool.planning.registry import make_planner
+
+    with pytest.raises(SgtoolError, match="'mymod_cli:CountsRooms': decide\\(\\) returned an "
+                       "Action whose target is 5 \\(int\\); a target is a node id"):
+        make_planner("mymod_cli:CountsRooms").decide(None)
+    import mymod_cli
+
+    import sgtool
+    from sgtool.datasets.generator import generate_house
+
+    house = generate_house(0, rooms=(4, 5))
+    query = house.objects[0].category
+    with pytest.raises(SgtoolError, match="skill 'fly'"):
+        sgtool.run_one(house, mymod_cli.Flies(), query)
+    with pytest.raises(SgtoolError, match="target is 5"):
+        sgtool.run_one(house, mymod_cli.CountsRooms(), query)
