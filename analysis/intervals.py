@@ -95,6 +95,23 @@ class Interval:
     low: float
     high: float
 
+    def format(self, spec: str = ".3f", signed: bool = False) -> str:
+        """``value [low, high]``; ``value [-]`` without an interval, ``-`` without a value;
+        ``signed`` prints a + before positive numbers (differences). ``str()`` is this."""
+        def num(x: float) -> str:
+            if math.isinf(x):
+                return "inf" if x > 0 else "-inf"
+            return format(x, ("+" if signed else "") + spec)
+
+        if math.isnan(self.value):
+            return "-"
+        if math.isnan(self.low) or math.isnan(self.high):
+            return f"{num(self.value)} [-]"
+        return f"{num(self.value)} [{num(self.low)}, {num(self.high)}]"
+
+    def __str__(self) -> str:
+        return self.format()
+
     def excludes(self, x: float) -> bool:
         """Whether ``x`` lies outside the interval (False when there is no interval)."""
         return bool(self.low > x or self.high < x)

@@ -300,18 +300,8 @@ def llm_answer_lines(results: Sequence[EpisodeResult], planners: Sequence[str]) 
 
 
 def fmt_interval(iv: Interval, spec: str = ".3f", signed: bool = False) -> str:
-    """``value [low, high]``; ``value [-]`` without an interval, ``-`` without a value;
-    ``signed`` prints a + before positive numbers (differences)."""
-    def num(x: float) -> str:
-        if math.isinf(x):
-            return "inf" if x > 0 else "-inf"
-        return format(x, ("+" if signed else "") + spec)
-
-    if math.isnan(iv.value):
-        return "-"
-    if math.isnan(iv.low) or math.isnan(iv.high):
-        return f"{num(iv.value)} [-]"
-    return f"{num(iv.value)} [{num(iv.low)}, {num(iv.high)}]"
+    """:meth:`Interval.format <sgtool.analysis.intervals.Interval.format>`."""
+    return iv.format(spec, signed)
 
 
 def format_intervals(rows: Sequence[PlannerIntervals], boot: Bootstrap,

@@ -214,3 +214,13 @@ def test_kendall_tau_interval_is_scipys_tau_b_on_each_resample() -> None:
         if len(set(x)) > 1 and len(set(y)) > 1:
             taus.append(kendalltau(x, y).statistic)
     assert (low, high) == pytest.approx((np.quantile(taus, 0.025), np.quantile(taus, 0.975)))
+
+
+def test_an_interval_prints_as_the_tables_show_it() -> None:
+    from sgtool.analysis.intervals import Interval
+
+    nan = float("nan")
+    assert str(Interval(1.0878, 1.0078, 1.1756)) == "1.088 [1.008, 1.176]"
+    assert Interval(0.02, -0.02, 0.055).format(signed=True) == "+0.020 [-0.020, +0.055]"
+    assert str(Interval(0.5, nan, nan)) == "0.500 [-]" and str(Interval(nan, nan, nan)) == "-"
+    assert str(Interval(2.0, 1.0, float("inf"))) == "2.000 [1.000, inf]"
