@@ -80,6 +80,12 @@ from sgtool.analysis.bench_priors import (
 )
 from sgtool.analysis.executor import Task, chunks, failure_lines, make_executor
 from sgtool.analysis.interval_report import IntervalReport, interval_report
+from sgtool.analysis.intervals import (
+    DEFAULT_BOOTSTRAP,
+    Bootstrap,
+    PairedComparison,
+    PlannerIntervals,
+)
 from sgtool.analysis.paper_tables import TABLE_IX_SYMSEARCH
 from sgtool.analysis.report import (
     breakdown_records,
@@ -249,20 +255,40 @@ class BenchResult:
             title="Ours next to SCOUT Table VII (SymSearch rows quoted from the paper)",
             timing=timing)
 
-    @functools.cached_property
-    def intervals(self) -> IntervalReport:
+    def interval_report(self, boot: Bootstrap = DEFAULT_BOOTSTRAP) -> IntervalReport:
         """SR and SPL per planner with bootstrap intervals over houses, and the paired
-        comparisons of the config's pairs on all, seen and unseen queries (computed once)."""
+        comparisons of the config's pairs (:func:`~sgtool.analysis.intervals.
+        comparison_pairs`) on all, seen and unseen queries (with the default bootstrap,
+        computed once)."""
+        if boot == DEFAULT_BOOTSTRAP:
+            return self._default_report
+        cfg = self.config
+        return interval_report(self.results, cfg.planners, cfg.reference, cfg.all_pairs, boot)
+
+    @functools.cached_property
+    def _default_report(self) -> IntervalReport:
         cfg = self.config
         return interval_report(self.results, cfg.planners, cfg.reference, cfg.all_pairs)
 
+    def intervals(self, boot: Bootstrap = DEFAULT_BOOTSTRAP) -> list[PlannerIntervals]:
+        """SR and SPL per planner with cluster-bootstrap intervals over houses."""
+        return list(self.interval_report(boot).planners)
+
+    def comparisons(self, boot: Bootstrap = DEFAULT_BOOTSTRAP,
+                    seen: bool | None = None) -> list[PairedComparison]:
+        """The paired comparisons of the config's pairs, intervals over houses; ``seen``
+        True / False: on the episodes of seen / unseen queries only."""
+        rep = self.interval_report(boot)
+        return list(rep.paired if seen is None else rep.paired_seen if seen
+                    else rep.paired_unseen)
+
     def interval_tables(self) -> str:
         """The intervals per planner, then the paired comparisons (text)."""
-        return self.intervals.text()
+        return self.interval_report().text()
 
     def interval_dict(self) -> dict[str, Any]:
         """The same as :meth:`interval_tables`, JSON-ready (summary.json)."""
-        return self.intervals.to_dict()
+        return self.interval_report().to_dict()
 
     def breakdown_table(self, by: str) -> str:
         rows = breakdown(self.results, by, self.config.planners)

@@ -63,7 +63,7 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
     """Score the request's episodes and replay its planners on the logged decisions."""
     from sgtool.analysis.batch_eval import load_many
     from sgtool.analysis.offline import log_exchanges, with_seen, with_success_rule
-    from sgtool.analysis.search_metrics import cost_models, planner_order, summarize
+    from sgtool.analysis.search_metrics import cost_models, summarize
 
     results, logged, notes, unread = load_many([Path(i) for i in request.inputs], request.runner,
                                                progress=request.progress)
@@ -83,9 +83,10 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
         why = f" ({len(notes)} skipped or refused, see the notes)" if notes else ""
         raise SgtoolError("no search episodes to score in "
                           + ", ".join(request.inputs) + why)
-    if request.reference is not None and request.reference not in planner_order(results):
+    bases = list(dict.fromkeys(base for _, base in _profile_names(results).values()))
+    if request.reference is not None and request.reference not in bases:
         raise SgtoolError(f"--reference {request.reference}: no episode of that planner in "
-                          f"the inputs (planners: {', '.join(planner_order(results))})")
+                          f"the inputs (planners: {', '.join(bases)})")
     models = cost_models(request.distance_budget, request.step_budget)
     exchanges = log_exchanges(request.inputs)
     reports = _replays(request, logged, exchanges)
@@ -248,9 +249,33 @@ def _as_tables(request: EvalRequest, results: Sequence[Any], notes: Sequence[str
 
 
 def _intervals(request: EvalRequest, results: Sequence[EpisodeResult]) -> IntervalReport:
-    """SR and SPL with intervals over houses and the paired comparisons of the request."""
+    """SR and SPL with intervals over houses and the paired comparisons of the request:
+    planners compared under one sensor noise profile at a time (their names PLANNER
+    [NOISE] when there are several), the reference named without the profile."""
     from sgtool.analysis.interval_report import interval_report
-    from sgtool.analysis.search_metrics import planner_order
+    from sgtool.analysis.intervals import comparison_pairs
 
-    return interval_report(results, planner_order(results), request.reference,
-                           request.all_pairs)
+    names = _profile_names(results)
+    groups: dict[str, list[str]] = {}
+    for planner, (noise, _) in names.items():
+        groups.setdefault(noise, []).append(planner)
+    pairs: list[tuple[str, str]] = []
+    for planners in groups.values():
+        base = {names[p][1]: p for p in planners}
+        ref = base.get(request.reference or "scout") if not request.all_pairs else None
+        if request.reference is not None and ref is None:
+            continue  # the reference did not run under this profile: nothing to pair
+        pairs += comparison_pairs(planners, ref, request.all_pairs)
+    return interval_report(results, list(names), pairs=pairs)
+
+
+def _profile_names(results: Sequence[EpisodeResult]) -> dict[str, tuple[str, str]]:
+    """Each planner name in order of appearance: (its noise profile, its name without the
+    `` [NOISE]`` that :func:`per_noise` adds when there are several profiles)."""
+    out: dict[str, tuple[str, str]] = {}
+    for r in results:
+        if r.planner not in out:
+            noise = r.noise or "unknown"
+            tail = f" [{noise}]"
+            out[r.planner] = (noise, r.planner.removesuffix(tail))
+    return out

@@ -35,12 +35,17 @@ class IntervalReport:
     boot: Bootstrap = DEFAULT_BOOTSTRAP
 
     def text(self) -> str:
-        """The three tables, as summary.md has them."""
+        """The three tables, as summary.md has them (the intervals only, with one line
+        saying so, when there is no pair to compare)."""
         boot = self.boot
+        ivs = format_intervals(self.planners, boot, title="SR and SPL with bootstrap "
+                                                          "intervals over houses, episodes "
+                                                          "pooled over seeds")
+        if not self.paired:
+            return ivs + "\nPaired comparisons: no two planners to pair.\n"
         return "\n".join([
-            format_intervals(self.planners, boot, title="SR and SPL with bootstrap intervals "
-                                                        "over houses, episodes pooled over seeds"),
-            format_paired(self.paired, boot, title="Paired comparisons on the same episodes"),
+            ivs, format_paired(self.paired, boot, title="Paired comparisons on the same "
+                                                        "episodes"),
             format_paired_split(self.paired_seen, self.paired_unseen, boot,
                                 title="Paired comparisons on seen and on unseen queries")])
 
@@ -55,12 +60,15 @@ class IntervalReport:
 
 def interval_report(results: Sequence[EpisodeResult], planners: Sequence[str],
                     reference: str | None = None, all_pairs: bool = False,
-                    boot: Bootstrap = DEFAULT_BOOTSTRAP) -> IntervalReport:
+                    boot: Bootstrap = DEFAULT_BOOTSTRAP,
+                    pairs: Sequence[tuple[str, str]] | None = None) -> IntervalReport:
     """The report of ``planners`` (in this order) over ``results``: every other planner
     against ``reference`` (default: scout when among them, else the first), or every pair
     with ``all_pairs`` (:func:`~sgtool.analysis.intervals.comparison_pairs`; a reference
-    not among ``planners`` raises ValueError)."""
-    pairs = comparison_pairs(planners, reference, all_pairs)
+    not among ``planners`` raises ValueError); ``pairs`` (planner, reference) instead of
+    both."""
+    if pairs is None:
+        pairs = comparison_pairs(planners, reference, all_pairs)
 
     def compare(rows: Sequence[EpisodeResult]) -> tuple[PairedComparison, ...]:
         return tuple(paired_comparison(rows, a, b, boot=boot) for a, b in pairs)

@@ -17,10 +17,11 @@ clusters sees the same resamples (the comparisons of a table share their draws).
 fewer than two clusters there is nothing to resample: the interval is NaN (shown "-").
 A resample whose denominator is 0 is left out (0/0) or counts as +inf (x/0, x > 0).
 
-Pairing: two planners' episodes are matched on (house, episode, seed, query); only episodes
-both ran count (the query keeps apart runs of other houses under one name, as two runs'
-files given together may hold). Wins / losses / ties are counted per cluster on the paired
-mean SPL (SR where no episode of the cluster has a known shortest path), equal within 1e-9.
+Pairing: two planners' episodes are matched on (house, episode, seed, query, shortest path);
+only episodes both ran count (the query and the shortest path keep apart runs of other
+houses under one generated name, as two runs' files given together may hold). Wins /
+losses / ties are counted per cluster on the paired mean SPL (SR where no episode of the
+cluster has a known shortest path), equal within 1e-9.
 
 Kendall's tau (:func:`kendall_tau`) compares two orders of the same planners (e.g. the
 closed loop's and the symbolic bench's) by a metric: tau-b of ``scipy.stats.kendalltau``.
@@ -37,6 +38,7 @@ import numpy as np
 
 from sgtool.analysis.search_metrics import episode_spl
 from sgtool.results import EpisodeResult
+from sgtool.semantics.text import category_text
 
 RESAMPLES = 10_000  # bootstrap resamples of every interval
 BOOTSTRAP_SEED = 0
@@ -252,15 +254,19 @@ class PairedComparison:
                 "losses": self.losses, "ties": self.ties}
 
 
-def _pair_key(r: EpisodeResult) -> tuple[str, int, int, str]:
-    return (r.house, r.episode, r.seed, r.query)
+def _pair_key(r: EpisodeResult) -> tuple[str, int, int, str, float | None]:
+    """(house, episode, seed, query, shortest path to 1 cm): the shortest path keeps apart
+    two houses under one name that drew the same query."""
+    short = r.shortest_m
+    return (r.house, r.episode, r.seed, category_text(r.query),
+            round(short, 2) if short is not None and math.isfinite(short) else None)
 
 
 def paired_comparison(results: Sequence[EpisodeResult], planner: str, reference: str,
                       cluster: Cluster = by_house,
                       boot: Bootstrap = DEFAULT_BOOTSTRAP) -> PairedComparison:
-    """``planner`` against ``reference`` on their common (house, episode, seed, query)
-    episodes of ``results`` (module doc)."""
+    """``planner`` against ``reference`` on their common episodes of ``results`` (house,
+    episode, seed, query, shortest path: module doc)."""
     mine = {_pair_key(r): r for r in results if r.planner == planner}
     ref = {_pair_key(r): r for r in results if r.planner == reference}
     common = sorted(mine.keys() & ref.keys())

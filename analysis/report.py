@@ -339,9 +339,10 @@ def format_paired(rows: Sequence[PairedComparison], boot: Bootstrap, cluster: st
         body = [[label, *row] for label, row in zip(labels, body, strict=True)]
     parts = [title] if title else []
     parts.append(pipe_table(header, body))
-    parts.append(f"Same (house, episode, seed, query) episodes for both planners. SPL ratio = the "
-                 f"planner's mean SPL / the reference's; diff = planner - reference; W/L/T "
-                 f"= {cluster}s where the planner's paired SPL is higher / lower / equal. "
+    parts.append(f"Same episodes (house, episode, seed, query, shortest path) for both "
+                 f"planners. SPL ratio = the planner's mean SPL / the reference's; diff = "
+                 f"planner - reference; W/L/T = {cluster}s where the planner's paired SPL "
+                 "is higher / lower / equal. "
                  + boot.statement(cluster) + ".")
     return "\n".join(parts) + "\n"
 

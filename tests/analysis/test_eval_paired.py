@@ -47,15 +47,50 @@ RUN = EpisodeResult("greedy", 0, "house-0", 0, "mug", True, steps=4, travelled_m
                     shortest_m=9.48)
 
 
-def test_other_queries_under_one_name_are_not_paired(tmp_path: Path) -> None:
+def test_other_houses_under_one_name_are_not_paired(tmp_path: Path) -> None:
+    """house-0 of another size: another query, or the same query at another distance."""
     a, b = tmp_path / "a.jsonl", tmp_path / "b.jsonl"
-    write_jsonl([RUN, dataclasses.replace(RUN, episode=1, query="bowl")], a)
+    write_jsonl([RUN, dataclasses.replace(RUN, episode=1, query="bowl"),
+                 dataclasses.replace(RUN, episode=2)], a)
     write_jsonl([dataclasses.replace(RUN, planner="random"),
-                 dataclasses.replace(RUN, planner="random", episode=1, query="cup")], b)
+                 dataclasses.replace(RUN, planner="random", episode=1, query="cup"),
+                 dataclasses.replace(RUN, planner="random", episode=2, shortest_m=5.61)], b)
     r = CliRunner().invoke(cli, ["eval", str(a), str(b), "--all-pairs", "--json"])
     assert r.exit_code == 0, r.output
     (pair,) = json.loads(r.stdout)["intervals"]["paired"]
     assert (pair["planner"], pair["reference"], pair["episodes"]) == ("random", "greedy", 1)
+
+
+def test_planners_pair_under_one_noise_profile_at_a_time(tmp_path: Path) -> None:
+    """A run-bench under two profiles: each planner is PLANNER [NOISE]; scout is the
+    reference under each profile, by its plain name too; nothing pairs across profiles."""
+    rows = [dataclasses.replace(RUN, planner=p, noise=n, episode=e, success=(e + i) % 2 == 0)
+            for i, p in enumerate(("greedy", "scout")) for n in ("none", "mild")
+            for e in range(3)]
+    a = tmp_path / "a.jsonl"
+    write_jsonl(rows, a)
+    for extra in ([], ["--reference", "scout"]):
+        r = CliRunner().invoke(cli, ["eval", str(a), "--json", *extra])
+        assert r.exit_code == 0, r.output
+        pairs = {(p["planner"], p["reference"], p["episodes"])
+                 for p in json.loads(r.stdout)["intervals"]["paired"]}
+        assert pairs == {("greedy [none]", "scout [none]", 3),
+                         ("greedy [mild]", "scout [mild]", 3)}
+    r = CliRunner().invoke(cli, ["eval", str(a), "--json", "--all-pairs"])
+    assert len(json.loads(r.stdout)["intervals"]["paired"]) == 2
+    text = CliRunner().invoke(cli, ["eval", str(a), "--reference", "greedy"]).stdout
+    paired = text.split("Paired comparisons on the same episodes\n", 1)[1].split("\n\n")[0]
+    cells = [[c.strip() for c in line.split("|")[1:3]] for line in paired.splitlines()[2:]
+             if line.startswith("|")]
+    assert cells == [["scout [none]", "greedy [none]"], ["scout [mild]", "greedy [mild]"]]
+
+
+def test_one_planner_has_intervals_and_no_pairs(tmp_path: Path) -> None:
+    a = tmp_path / "a.jsonl"
+    write_jsonl([RUN, dataclasses.replace(RUN, house="house-1")], a)
+    text = CliRunner().invoke(cli, ["eval", str(a)]).stdout
+    assert "| greedy " in text.split("SR and SPL with bootstrap intervals", 1)[1]
+    assert "Paired comparisons: no two planners to pair." in text
 
 
 def test_reference_mistakes_are_one_line(tmp_path: Path) -> None:
@@ -68,3 +103,22 @@ def test_reference_mistakes_are_one_line(tmp_path: Path) -> None:
         "(planners: greedy)"
     r = CliRunner().invoke(cli, ["eval", str(a), "--reference", "greedy", "--all-pairs"])
     assert r.exit_code == 2 and "give one" in r.stderr and "Traceback" not in r.output
+
+
+def test_bench_result_keeps_its_interval_methods() -> None:
+    """BenchResult.intervals() / comparisons() as before the shared report."""
+    import sgtool
+
+    res = sgtool.run_benchmark(sgtool.BenchConfig(planners=("scout", "greedy"), houses=2,
+                                                  episodes=3, seeds=1, rooms=(4, 5)),
+                               progress=False)
+    report = res.interval_report()
+    assert res.intervals() == list(report.planners) and len(res.intervals()) == 2
+    (pair,) = res.comparisons()
+    assert (pair.planner, pair.reference, pair.episodes) == ("greedy", "scout", 6)
+    assert res.comparisons(seen=True) == list(report.paired_seen)
+    assert res.comparisons(seen=False) == list(report.paired_unseen)
+    from sgtool.analysis.intervals import Bootstrap
+
+    few = res.intervals(Bootstrap(resamples=100))  # the same figures, other intervals
+    assert [r.sr.value for r in few] == [r.sr.value for r in res.intervals()]

@@ -49,11 +49,12 @@ if TYPE_CHECKING:
 @budget_options()
 @click.option("--reference", default=None, metavar="PLANNER",
               help="Paired comparisons of every other planner against this one on the same "
-                   "(house, episode, seed, query) episodes, pooled over the inputs (a run "
-                   "of your planner against a stored run of the baselines): SPL ratio, SR "
-                   "and SPL differences with bootstrap intervals over houses, wins/losses/"
-                   "ties per house; all, seen and unseen queries. [default: scout when "
-                   "scored, else the first planner]")
+                   "episodes (house, episode, seed, query, shortest path), pooled over the "
+                   "inputs (a run of your planner against a stored run of the baselines) "
+                   "and under one noise profile at a time: SPL ratio, SR and SPL "
+                   "differences with bootstrap intervals over houses, wins/losses/ties per "
+                   "house; all, seen and unseen queries. [default: scout when scored, else "
+                   "the first planner]")
 @click.option("--all-pairs", is_flag=True,
               help="Paired comparisons of every pair of planners instead of against "
                    "--reference.")

@@ -108,12 +108,18 @@ def build_plugin(name: str, factory: Callable[..., Any], options: Mapping[str, A
         planner = factory(**kw)
     except Exception as e:  # noqa: BLE001 - a user's planner failing is one line
         raise PluginError(f"planner {name!r}: raised {type(e).__name__}: {e}") from None
-    missing = [p for p in PLANNER_PARTS if not hasattr(planner, p)
-               or (p != "name" and not callable(getattr(planner, p)))]
+    missing = missing_parts(planner)
     if missing:
         raise PluginError(f"planner {name!r}: returned a {type(planner).__name__}, not a "
                           f"Planner (it lacks {', '.join(missing)})")
     return planner
+
+
+def missing_parts(planner: object, parts: tuple[str, ...] = PLANNER_PARTS) -> list[str]:
+    """The members of the Planner protocol (``parts`` of :data:`PLANNER_PARTS`) that
+    ``planner`` lacks: an attribute for ``name``, a method for the others."""
+    return [p for p in parts if not hasattr(planner, p)
+            or (p != "name" and not callable(getattr(planner, p)))]
 
 
 def file_name(name: str) -> str:

@@ -39,7 +39,7 @@ class TimedPlanner:
 
     def __init__(self, inner: Planner, plugin: bool = False, measure: bool = True) -> None:
         self.inner = inner
-        self.name = inner.name
+        self.name = getattr(inner, "name", "planner")  # (run_one takes a planner without)
         self.decision_times: list[float] = []
         self.plugin = plugin  # a user's planner: what it raises is one line, not a traceback
         self.measure = measure
