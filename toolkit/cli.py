@@ -23,6 +23,7 @@ from typing import Any
 
 import click
 
+from sgtool.commands.options import COMMAND_ARGS
 from sgtool.errors import SgtoolError, Terminated, raise_terminated
 from sgtool.extras import missing_extra
 from sgtool.files import is_environment_error
@@ -115,6 +116,12 @@ VERDICT_COMMANDS = frozenset({"diff", "golden", "doctor", "llm"})
 
 
 class LazyGroup(click.Group):
+    def resolve_command(self, ctx: click.Context, args: list[str]
+                        ) -> tuple[str | None, click.Command | None, list[str]]:
+        name, cmd, rest = super().resolve_command(ctx, args)
+        ctx.meta[COMMAND_ARGS] = tuple(rest)  # the subcommand's words, as given (eager options)
+        return name, cmd, rest
+
     def invoke(self, ctx: click.Context) -> object:
         try:
             return super().invoke(ctx)

@@ -283,10 +283,13 @@ def list_planners_option(named_by: str = "--planners") -> Callable[[F], F]:
             return
         from sgtool.planning.registry import check_planner_name, describe_planners
 
-        given: list[str] = []  # the planners named before --list-planners (eager options)
+        given: list[str] = []  # the planners named (eager options: before, or as given)
         for key in ("planners", "planner"):
             v = ctx.params.get(key)
             for text in (v,) if isinstance(v, str) else (v or ()):
+                given += planner_names(text)
+        if not given:  # named after --list-planners: not processed yet, so read as given
+            for text in _option_values(ctx, ("planners", "planner")):
                 given += planner_names(text)
         for name in given:  # a misspelt name is said, as without --list-planners
             check_planner_name(name)
@@ -297,7 +300,30 @@ def list_planners_option(named_by: str = "--planners") -> Callable[[F], F]:
                         callback=show,
                         help="List the planners, their options (name, type, default, help) "
                         "and the installed plug-ins, then exit; a module:Name plug-in named "
-                        f"before it ({named_by} mymod:My --list-planners) with its options.")
+                        f"with it ({named_by} mymod:My --list-planners) with its options.")
+
+
+# ctx.meta key of the words given to the subcommand (sgtool.cli.LazyGroup)
+COMMAND_ARGS = "sgtool.command_args"
+
+
+def _option_values(ctx: click.Context, names: Sequence[str]) -> list[str]:
+    """The values given on the command line to the options of ``ctx``'s command named
+    ``names`` (``--opt V``, ``--opt=V``, ``-oV``), from the words the group kept."""
+    words = list(ctx.meta.get(COMMAND_ARGS, ()))
+    flags = [o for p in ctx.command.params if p.name in names for o in p.opts]
+    out = []
+    for i, word in enumerate(words):
+        if word == "--":
+            break
+        for flag in flags:
+            if word == flag and i + 1 < len(words):
+                out.append(words[i + 1])
+            elif word.startswith(flag + "=") or (len(flag) == 2 and word.startswith(flag)
+                                                   and len(word) > 2 and word[2] != "="):
+                out.append(word.split("=", 1)[1] if word.startswith(flag + "=")
+                           else word[2:])
+    return out
 
 
 PLANNER_OPTION_HELP = ("Planner option PLANNER.KEY=VALUE, e.g. scout.delta=0.2 or "

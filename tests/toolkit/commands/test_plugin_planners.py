@@ -336,13 +336,19 @@ def test_an_api_key_of_the_group_is_never_written(tmp_path: Path,
 
 
 @pytest.mark.parametrize("command", [["bench", "--planners"], ["run", "-p"], ["eval", "-p"]])
-def test_list_planners_describes_a_plugin_named_before_it(
+def test_list_planners_describes_a_plugin_named_with_it(
         plugin_dir: Path, monkeypatch: pytest.MonkeyPatch, command: list[str]) -> None:
     monkeypatch.syspath_prepend(str(plugin_dir))
+    said = ("mymod_cli:MyPlanner: a plug-in without an Options dataclass (its -O values are "
+            "passed as int, float, true/false or text)")
     r = CliRunner().invoke(cli, [*command, "mymod_cli:MyPlanner", "--list-planners"])
-    assert r.exit_code == 0, r.output
-    assert ("mymod_cli:MyPlanner: a plug-in without an Options dataclass (its -O values are "
-            "passed as int, float, true/false or text)") in r.output
+    assert r.exit_code == 0 and said in r.output, r.output
+    # named after it, or as --opt=VALUE: the same
+    flag = command[-1]
+    for words in (["--list-planners", flag, "mymod_cli:MyPlanner"],
+                  ["--list-planners", f"{flag}=mymod_cli:MyPlanner"]):
+        r = CliRunner().invoke(cli, [*command[:-1], *words])
+        assert r.exit_code == 0 and said in r.output, (words, r.output)
     r = CliRunner().invoke(cli, [*command, "nomod_cli:X", "--list-planners"])
     assert r.exit_code == 0 and "nomod_cli:X: planner 'nomod_cli:X': cannot import" in r.output
 
