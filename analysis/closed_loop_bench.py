@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import functools
 import json
+import math
 import re
 import statistics
 from collections import Counter
@@ -135,6 +136,9 @@ class ClosedLoopBenchConfig:
     step_budget: float = 50.0
     reference: str | None = None  # paired comparisons against it (None: scout, else first)
     all_pairs: bool = False  # paired comparisons of every pair of planners instead
+    # frames per room of the SR-within-budget tables (a report setting; empty: quarters of
+    # the most an episode used)
+    budgets: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         # a copy: the caller's dict changed for the next run must not change this one's
@@ -142,6 +146,11 @@ class ClosedLoopBenchConfig:
                            {str(k): dict(v) for k, v in self.planner_options.items()})
         for name in ("planners", "noise"):
             object.__setattr__(self, name, config_names(getattr(self, name), name))
+        try:  # (a list from Python, numbers as text)
+            object.__setattr__(self, "budgets", tuple(float(b) for b in self.budgets))
+        except (TypeError, ValueError):
+            raise SgtoolError(f"budgets: frames per room, numbers; got {self.budgets!r}"
+                              ) from None
         object.__setattr__(self, "house_files",
                            config_names(self.house_files, "house_files", paths=True))
         object.__setattr__(self, "rooms", config_rooms(self.rooms))
@@ -153,6 +162,8 @@ class ClosedLoopBenchConfig:
         if len(set(self.planners)) != len(self.planners) or \
                 len(set(self.noise)) != len(self.noise):
             raise SgtoolError("--planners/--noise: a name is given twice")
+        if any(not (math.isfinite(b) and b > 0) for b in self.budgets):
+            raise SgtoolError(f"--budgets: frames per room > 0, got {list(self.budgets)}")
         if self.reference is not None and self.reference not in self.planners:
             raise SgtoolError(f"--reference: {self.reference!r} is not one of --planners "
                               f"({', '.join(self.planners)})")
@@ -376,11 +387,12 @@ class ClosedLoopBenchResult:
         results = self.results(noise)
         text, data = interval_tables(results, cfg.planners, cfg.reference, cfg.all_pairs)
         model = self.frames_model(noise)
-        budgets, curves = frame_curves(results, cfg.planners, model)
+        budgets, curves = frame_curves(results, cfg.planners, model, sorted(cfg.budgets))
         within, within_data = budget_comparisons(results, cfg.planners, model, budgets,
                                                  cfg.reference, cfg.all_pairs)
         parts = [text, format_frame_curves(
-            budgets, curves, title="SR against the frame budget (frames per room)"), within]
+            budgets, curves, title="SR against the frame budget (frames per room)",
+            max_cost=model.max_cost), within]
         data["frames"] = {"max_per_room": model.max_cost,
                           "budgets_per_room": list(budgets),
                           "planners": {c.planner: {"auc_e": round(c.auc_e, 6),

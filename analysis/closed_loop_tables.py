@@ -63,12 +63,14 @@ class FrameCurveRow:
 
 
 def frame_curves(results: Sequence[EpisodeResult], planners: Sequence[str],
-                 model: CostModel) -> tuple[tuple[float, ...], list[FrameCurveRow]]:
-    """The budgets (:data:`BUDGET_FRACTIONS` of the model's max, rounded up to whole
-    frames per room) and per planner its AUC-E and SR within each budget: the share of
-    its episodes that succeeded at a cost of at most the budget (the curve's value at
-    its steps, not between them)."""
-    budgets = tuple(float(math.ceil(model.max_cost * f)) for f in BUDGET_FRACTIONS)
+                 model: CostModel, budgets: Sequence[float] = ()
+                 ) -> tuple[tuple[float, ...], list[FrameCurveRow]]:
+    """The budgets (``budgets`` in frames per room, else :data:`BUDGET_FRACTIONS` of the
+    model's max, rounded up to whole frames per room) and per planner its AUC-E (over the
+    model's max) and SR within each budget: the share of its episodes that succeeded at a
+    cost of at most the budget (the curve's value at its steps, not between them)."""
+    budgets = tuple(map(float, budgets)) or \
+        tuple(float(math.ceil(model.max_cost * f)) for f in BUDGET_FRACTIONS)
     rows = []
     for p in planners:
         rs = [r for r in results if r.planner == p]
@@ -82,7 +84,10 @@ def frame_curves(results: Sequence[EpisodeResult], planners: Sequence[str],
 
 
 def format_frame_curves(budgets: Sequence[float], rows: Sequence[FrameCurveRow],
-                        title: str = "") -> str:
+                        title: str = "", max_cost: float | None = None) -> str:
+    """The SR-within-budget table; ``max_cost``: the AUC-E's upper end (default: the last
+    budget, as :func:`frame_curves` chooses them)."""
+    top = budgets[-1] if max_cost is None else max_cost
     header = ["Planner", "Episodes", "AUC-E frames ↑",
               *(f"SR ≤ {b:.0f} f/room" for b in budgets)]
     body = [[r.planner, str(r.episodes), f"{r.auc_e:.3f}",
@@ -90,8 +95,8 @@ def format_frame_curves(budgets: Sequence[float], rows: Sequence[FrameCurveRow],
     parts = [title] if title else []
     parts.append(pipe_table(header, body))
     parts.append("SR ≤ b: share of all episodes solved within b frames per room of the "
-                 "house; AUC-E frames: area under that curve over [0, "
-                 f"{budgets[-1]:.0f}] / {budgets[-1]:.0f}.")
+                 f"house; AUC-E frames: area under that curve over [0, {top:.0f}] / "
+                 f"{top:.0f}.")
     return "\n".join(parts) + "\n"
 
 

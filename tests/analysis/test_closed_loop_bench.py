@@ -76,6 +76,14 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
     assert only8.exit_code == 0 and "steps: high-level steps, budget max 8" in \
         (out / "summary.md").read_text()
     assert "| random  | 0 " in (out / "run.md").read_text()  # nothing was run now
+    # so are the frame budgets of the SR tables
+    at = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                  "--report-only", "--budgets", "7,14"])
+    assert at.exit_code == 0 and "| SR ≤ 7 f/room | SR ≤ 14 f/room |" in at.output, at.output
+    bad = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                   "--report-only", "--budgets", "7,all"])
+    assert bad.exit_code == 2 and bad.output.strip() == \
+        "sgtool: error: --budgets 7,all: comma-separated frames per room, e.g. 90,100"
     only = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
                                     "--planners", "random", "--report-only"])
     assert only.exit_code == 0 and "| random " in only.output and "| greedy" not in only.output

@@ -47,6 +47,12 @@ def test_frame_curves_count_the_episodes_solved_within_each_budget() -> None:
     assert fast.auc_e == pytest.approx(0.875) and slow.auc_e == pytest.approx(0.275)
     text = format_frame_curves(budgets, curves)
     assert "| SR ≤ 25 f/room" in text and "| fast " in text and "absent" not in text
+    # budgets of the report's choosing: the same counts there, the same AUC-E
+    chosen, again = frame_curves(rows, ["fast", "slow"], model, [20, 95])
+    assert chosen == (20.0, 95.0)
+    assert again[0].sr_within == (0.5, 1.0) and again[1].sr_within == (0.0, 0.5)
+    assert again[0].auc_e == fast.auc_e
+    assert "over [0, 100] / 100" in format_frame_curves(chosen, again, max_cost=100.0)
 
 
 def test_symbolic_agreement_uses_the_same_episodes_when_there_are() -> None:

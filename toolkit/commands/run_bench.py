@@ -116,6 +116,10 @@ if TYPE_CHECKING:
 @click.option("--all-pairs", is_flag=True,
               help="Paired comparisons of every pair of planners instead of against "
               "--reference.")
+@click.option("--budgets", default=None, metavar="F1,F2,...",
+              help="Frames per room of the SR-within-budget tables (e.g. 90,100): a report "
+              "setting, so --report-only re-tables a finished run at other budgets. "
+              "[default: quarters of the most frames per room an episode used]")
 @click.option("--symbolic", "symbolic_dir", default=None, metavar="DIR",
               type=click.Path(path_type=str),
               help="A `sgtool bench` output folder (or its episodes.jsonl): the table adds "
@@ -180,6 +184,7 @@ class RunBenchArgs:
     llm_timeout: float | None = None
     reference: str | None = None
     all_pairs: bool = False
+    budgets: str | None = None
     symbolic_dir: str | None = None
     with_symbolic: bool = False
     explore_on: int = 0
@@ -260,4 +265,15 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
         noise=tuple(args.noise) or ("none",), options=opts, planner_options=options,
         frames_per_room=args.frames_per_room, reference=args.reference,
         all_pairs=args.all_pairs, distance_budget=args.distance_budget,
-        step_budget=args.step_budget)
+        step_budget=args.step_budget, budgets=_budgets(args.budgets))
+
+
+def _budgets(text: str | None) -> tuple[float, ...]:
+    """--budgets F1,F2,...: frames per room, one line for what is not a number."""
+    if not text:
+        return ()
+    try:
+        return tuple(float(part) for part in text.split(","))
+    except ValueError:
+        raise SgtoolError(f"--budgets {text}: comma-separated frames per room, e.g. 90,100"
+                          ) from None
