@@ -319,10 +319,10 @@ def _option_values(ctx: click.Context, names: Sequence[str]) -> list[str]:
         for flag in flags:
             if word == flag and i + 1 < len(words):
                 out.append(words[i + 1])
-            elif word.startswith(flag + "=") or (len(flag) == 2 and word.startswith(flag)
-                                                   and len(word) > 2 and word[2] != "="):
-                out.append(word.split("=", 1)[1] if word.startswith(flag + "=")
-                           else word[2:])
+            elif word.startswith(flag + "="):
+                out.append(word[len(flag) + 1:])
+            elif len(flag) == 2 and word.startswith(flag) and len(word) > 2:  # -pNAME
+                out.append(word[2:])
     return out
 
 
