@@ -1,0 +1,30 @@
+"""The hand-made apartments shipped in datasets/data/handmade load and pass the house
+validator, and hold what their README says: four rooms of the four kinds, dense kitchens,
+small objects on surfaces and inside closed containers."""
+
+from __future__ import annotations
+
+from collections import Counter
+from pathlib import Path
+
+from sgtool.house.io import load_house
+from sgtool.house.spec import hidden_objects
+
+DATA = Path(__file__).resolve().parents[2] / "datasets" / "data" / "handmade"
+
+
+def test_shipped_apartments_pass_the_validator() -> None:
+    files = sorted(DATA.glob("hm_*.json"))
+    assert [p.stem for p in files] == [f"hm_{i}" for i in range(6)]
+    specs = [load_house(p) for p in files]
+    for s in specs:
+        assert sorted(r.category for r in s.rooms) == \
+            ["bathroom", "bedroom", "kitchen", "living_room"]
+        kitchen = next(r.id for r in s.rooms if r.category == "kitchen")
+        kinds = Counter(f.category for f in s.furniture if f.room == kitchen)
+        assert sum(n for k, n in kinds.items() if "cabinet" in k or "pantry" in k) >= 9
+        assert kinds["drawer"] >= 6 and 37 <= len(s.objects) <= 45
+        inside = len(hidden_objects(s))
+        assert 0.25 <= inside / len(s.objects) <= 0.4, (s.id, inside)
+    assert sum(len(s.furniture) for s in specs) == 261
+    assert sum(len(s.objects) for s in specs) == 251
