@@ -478,8 +478,7 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
              f"{len(res.failed)}", *(f"- {line}" for line in res.failed)]
             if res.failed else []),
           *llm_answer_lines(res.results, cfg.planners),
-          *(line.removeprefix("sgtool: note: ")
-            for line in invalid_action_notes(res.results, cfg.planners)),
+          *invalid_action_notes(res.results, cfg.planners),
           *[f"Note on {h.id} ({h.source}): {line}" for h in res.houses for line in h.notes],
           f"Digest of episodes.jsonl without wall-clock fields: {res.digest}",
           f"sgtool {__version__}; relational priors "

@@ -73,9 +73,10 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     for h in res.houses:
         for line in h.notes:
             show(f"sgtool: note: {h.source}: {line}")
-    for line in (*llm_warnings(res.results, res.config.planners),
-                 *invalid_action_notes(res.results, res.config.planners)):
+    for line in llm_warnings(res.results, res.config.planners):
         show(line)
+    for line in invalid_action_notes(res.results, res.config.planners):
+        show(f"sgtool: note: {line}")
     show(f"wrote {', '.join(str(Path(out_dir) / name) for name in written)}")
     for folder in (out_dir, *([log_dir] if log_dir is not None else [])):
         for line in leftover_notes(folder):

@@ -103,8 +103,10 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
     from sgtool.analysis.report import invalid_action_notes, llm_warnings
 
     results, planners = res.results(), request.config.planners
-    for line in (*llm_warnings(results, planners), *invalid_action_notes(results, planners)):
+    for line in llm_warnings(results, planners):
         show(line)
+    for line in invalid_action_notes(results, planners):
+        show(f"sgtool: note: {line}")
     show(f"wrote {', '.join(str(Path(request.out_dir) / name) for name in written)}")
     for line in leftover_notes(request.out_dir):
         show(line)

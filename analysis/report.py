@@ -275,13 +275,13 @@ def invalid_action_notes(results: Sequence[EpisodeResult], planners: Sequence[st
     """A note per planner some of whose actions were invalid (a target that is no node of
     the scene graph it was given, a skill its node does not offer): each spent a step and
     did nothing, so a planner that names nodes wrongly looks like one that searches badly
-    unless told."""
+    unless told (summary.md's lines; the commands show them as notes)."""
     out = []
     for p in planners:
         rs = [r for r in results if r.planner == p]
         bad = sum(r.n_invalid for r in rs)
         if bad:
-            out.append(f"sgtool: note: {p}: {bad} of its {sum(r.steps for r in rs)} actions "
+            out.append(f"{p}: {bad} of its {sum(r.steps for r in rs)} actions "
                        f"(in {sum(1 for r in rs if r.n_invalid)} of {len(rs)} episodes) were "
                        "invalid, a target that is no node of the scene graph it was given or "
                        "a skill the node does not offer, and spent a step each (n_invalid in "

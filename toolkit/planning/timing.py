@@ -33,9 +33,9 @@ class TimedPlanner:
     raises :class:`PlannerContractError` naming the planner when ``decide`` returns no
     :class:`~sgtool.planning.base.Action` (a plug-in's mistake, caught where it happens),
     or, for a ``plugin``, when its ``reset``, ``decide`` or ``feedback`` raises or its
-    action names no skill (:data:`~sgtool.vocabulary.SKILLS`) or a target that is no
-    node id (text) or None. Without ``measure`` the
-    checks stay and the action keeps the decision time the planner gave it."""
+    action names no skill (:data:`~sgtool.vocabulary.SKILLS`) or a target that is no node
+    id (text) or None. Without ``measure`` the checks stay and the action keeps the
+    decision time the planner gave it."""
 
     def __init__(self, inner: Planner, plugin: bool = False, measure: bool = True) -> None:
         self.inner = inner
