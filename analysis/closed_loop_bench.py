@@ -70,7 +70,7 @@ from sgtool.analysis.search_metrics import CostModel, cost_models, summarize
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
 from sgtool.extras import require
-from sgtool.files import atomic_write, output_dir
+from sgtool.files import atomic_write, output_dir, remove_empty_folders
 from sgtool.llm.stats import answer_counts
 from sgtool.log.writer import partial_files
 from sgtool.progress import Progress
@@ -507,10 +507,15 @@ def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
     if progress is not None and hasattr(progress, "total"):
         progress.total = len(tasks)
     rows = []
-    for row in iter_rows(tasks, runner):
-        rows.append(row)
-        if progress is not None:
-            progress.update(1)
+    try:
+        for row in iter_rows(tasks, runner):
+            rows.append(row)
+            if progress is not None:
+                progress.update(1)
+    except BaseException:
+        if not report_only:  # the folders of logs never written (a planner that raised)
+            remove_empty_folders(logs)
+        raise
     return ClosedLoopBenchResult(cfg, tuple(sorted(rows, key=report_order(cfg, tasks))))
 
 

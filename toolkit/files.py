@@ -389,6 +389,18 @@ def _remove_empty(folders: list[Path]) -> None:
             return
 
 
+def remove_empty_folders(root: str | os.PathLike[str]) -> None:
+    """Remove every folder under ``root`` (``root`` included) that holds no file, innermost
+    first: what a run that failed before writing leaves of its folder tree. A folder that
+    cannot be removed (it filled meanwhile, no permission) stays."""
+    top = Path(root)
+    if not top.is_dir():
+        return
+    for folder, _, _ in sorted(os.walk(top), key=lambda entry: -len(Path(entry[0]).parts)):
+        with contextlib.suppress(OSError):
+            os.rmdir(folder)
+
+
 def _commit(stage: Path, target: Path, old: set[str]) -> None:
     """Move the entries of ``stage`` into ``target`` (module doc of :func:`output_folder`);
     ``old`` are the entries of ``target`` that sgtool wrote."""

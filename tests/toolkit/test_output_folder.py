@@ -11,7 +11,7 @@ import pytest
 from support.read_only import make_read_only
 
 from sgtool.errors import SgtoolError
-from sgtool.files import MANIFEST, OutputError, output_folder, read_manifest
+from sgtool.files import MANIFEST, OutputError, output_folder, read_manifest, remove_empty_folders
 
 
 def _tree(folder: Path) -> dict[str, str]:
@@ -252,3 +252,16 @@ def test_deferred_sigterm_with_the_default_handler_still_ends_the_process(tmp_pa
     run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
                          timeout=60)
     assert run.returncode == -15 and run.stdout == "block done\n", (run.returncode, run.stdout)
+
+
+def test_remove_empty_folders_keeps_every_file(tmp_path: Path) -> None:
+    for d in ("run/logs/a/house-0", "run/logs/b/house-1/deep", "run/keep"):
+        (tmp_path / d).mkdir(parents=True)
+    (tmp_path / "run/keep/ep.mcap").write_bytes(b"x")
+    remove_empty_folders(tmp_path / "run")
+    assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*")) == [
+        "run", "run/keep", "run/keep/ep.mcap"]
+    (tmp_path / "run/keep/ep.mcap").unlink()
+    remove_empty_folders(tmp_path / "run")
+    remove_empty_folders(tmp_path / "missing")  # nothing there: nothing to do
+    assert list(tmp_path.iterdir()) == []

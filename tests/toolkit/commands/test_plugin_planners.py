@@ -216,6 +216,30 @@ def test_a_plugin_that_raises_in_decide_is_one_line(plugin_dir: Path, tmp_path: 
         make_planner("mymod_cli:Flies", timed=False).decide(None)
 
 
+def test_a_plugin_that_raises_in_a_run_bench_leaves_no_folders(
+        plugin_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """run-bench stops on a plug-in that raises with one line and leaves no folder of logs
+    never written: a fresh output folder is gone, a resumed one holds what it held."""
+    monkeypatch.syspath_prepend(str(plugin_dir))
+    out = tmp_path / "rb"
+
+    def run_bench(planners: str) -> list[str]:
+        r = CliRunner().invoke(cli, [
+            "run-bench", "--planners", planners, "--houses", "1", "--rooms", "4-4",
+            "--episodes", "1", "--frames", "40", "--max-steps", "2", "-w", "1",
+            "--no-progress", "-o", str(out)])
+        assert r.exit_code == (2 if "Stumbles" in planners else 0), r.output
+        if "Stumbles" in planners:
+            assert "decide() raised ZeroDivisionError" in r.output, r.output
+        return sorted(p.relative_to(out).as_posix() for p in out.rglob("*.mcap"))
+
+    assert run_bench("mymod_cli:Stumbles") == [] and not out.exists()
+    logs = run_bench("greedy")
+    assert logs == ["logs/none/greedy/house-0/ep-000.mcap"]
+    assert run_bench("greedy,mymod_cli:Stumbles") == logs
+    assert sorted(p.name for p in (out / "logs" / "none").iterdir()) == ["greedy"]
+
+
 def test_log_paths_of_a_plugin_are_safe_and_fixed(monkeypatch: pytest.MonkeyPatch) -> None:
     from sgtool.analysis.bench import BenchError, check_planner_list
     from sgtool.analysis.closed_loop_bench import log_path
