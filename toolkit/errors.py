@@ -33,3 +33,15 @@ class Terminated(KeyboardInterrupt):
 def raise_terminated(signum: int, frame: object) -> None:
     """A SIGTERM handler: raise :class:`Terminated` in the main thread."""
     raise Terminated
+
+
+def raised_text(e: BaseException) -> str:
+    """One line for what a user's code raised, for a message that names the code: ``Type:
+    first line of the message`` (`` ...`` when it went on), ``exited (SystemExit: CODE)``
+    for a ``sys.exit`` or an argument parser giving up."""
+    if isinstance(e, SystemExit):
+        return f"exited (SystemExit: {e.code})"
+    lines = str(e).strip().splitlines()
+    text = lines[0] if lines else ""
+    more = " ..." if len(lines) > 1 else ""
+    return f"{type(e).__name__}: {text}{more}" if text else type(e).__name__

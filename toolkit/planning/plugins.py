@@ -22,6 +22,7 @@ from collections.abc import Callable, Mapping
 from importlib import metadata
 from typing import Any
 
+from sgtool.errors import raised_text
 from sgtool.planning.base import Planner
 from sgtool.planning.option_fields import PlannerOptionError, convert_options
 
@@ -65,17 +66,16 @@ def load_factory(name: str, entry: metadata.EntryPoint | None = None) -> Callabl
         where = f"entry point {entry.value!r} of {GROUP}"
         try:
             obj = entry.load()
-        except Exception as e:  # noqa: BLE001 - any import failure of user code is one line
-            raise PluginError(f"planner {name!r}: cannot load {where} "
-                              f"({type(e).__name__}: {e})") from None
+        except (Exception, SystemExit) as e:  # noqa: BLE001 - user code failing: one line
+            raise PluginError(f"planner {name!r}: cannot load {where} ({raised_text(e)})"
+                              ) from None
     else:
         module, attr = check_spec(name)
         try:
             obj = importlib.import_module(module)
-        except Exception as e:  # noqa: BLE001
+        except (Exception, SystemExit) as e:  # noqa: BLE001
             raise PluginError(f"planner {name!r}: cannot import module {module!r} "
-                              f"({type(e).__name__}: {e}); is its folder on PYTHONPATH?"
-                              ) from None
+                              f"({raised_text(e)}); is its folder on PYTHONPATH?") from None
         for part in attr.split("."):
             if not hasattr(obj, part):
                 raise PluginError(f"planner {name!r}: {module!r} has no {attr!r}")
@@ -106,8 +106,9 @@ def build_plugin(name: str, factory: Callable[..., Any], options: Mapping[str, A
     kw = plugin_options(name, factory, options)
     try:
         planner = factory(**kw)
-    except Exception as e:  # noqa: BLE001 - a user's planner failing is one line
-        raise PluginError(f"planner {name!r}: raised {type(e).__name__}: {e}") from None
+    except (Exception, SystemExit) as e:  # noqa: BLE001 - a user's planner failing: one line
+        raise PluginError(f"planner {name!r}: {raised_text(e)}" if isinstance(e, SystemExit)
+                          else f"planner {name!r}: raised {raised_text(e)}") from None
     missing = missing_parts(planner)
     if missing:
         raise PluginError(f"planner {name!r}: returned a {type(planner).__name__}, not a "

@@ -12,7 +12,7 @@ from __future__ import annotations
 import dataclasses
 import time
 
-from sgtool.errors import SgtoolError
+from sgtool.errors import SgtoolError, raised_text
 from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.vocabulary import SKILLS
@@ -48,14 +48,14 @@ class TimedPlanner:
         self.decision_times = []
         try:
             self.inner.reset(query, seed)
-        except Exception as e:
+        except (Exception, SystemExit) as e:
             raise self._failed("reset", e) from e
 
     def decide(self, graph: SceneGraph) -> Action:
         t0 = time.perf_counter()
         try:
             action = self.inner.decide(graph)
-        except Exception as e:
+        except (Exception, SystemExit) as e:
             raise self._failed("decide", e) from e
         dt = time.perf_counter() - t0
         self.decision_times.append(dt)
@@ -94,17 +94,20 @@ class TimedPlanner:
     def feedback(self, fb: Feedback) -> None:
         try:
             self.inner.feedback(fb)
-        except Exception as e:
+        except (Exception, SystemExit) as e:
             raise self._failed("feedback", e) from e
 
-    def _failed(self, method: str, e: Exception) -> Exception:
+    def _failed(self, method: str, e: BaseException) -> BaseException:
         """What to raise when the wrapped planner's ``method`` raised ``e``: for a plug-in,
         one :class:`PlannerContractError` line naming it (an :class:`SgtoolError` as it
         is); for a built-in, ``e`` itself (a bug, with its traceback)."""
         if not self.plugin or isinstance(e, SgtoolError):
             return e
+        if isinstance(e, SystemExit):
+            return PlannerContractError(f"planner {self.name!r}: {method}() "
+                                        f"{raised_text(e)}")
         return PlannerContractError(f"planner {self.name!r}: {method}() raised "
-                                    f"{type(e).__name__}: {e}")
+                                    f"{raised_text(e)}")
 
     def __getattr__(self, item: str) -> object:
         """Expose the wrapped planner's extras (e.g. ``exchanges`` of moma-llm)."""

@@ -48,6 +48,17 @@ PLUGIN = textwrap.dedent('''
         return "greedy"
 
 
+    def exits():
+        raise SystemExit(3)
+
+
+    class Verbose(GreedyPlanner):
+        """A planner whose exception tells a story."""
+
+        def decide(self, graph):
+            raise ValueError("line one\\nline two\\nline three")
+
+
     class Stumbles(GreedyPlanner):
         """A planner that breaks on its first decision."""
 
@@ -90,6 +101,7 @@ def plugin_dir(tmp_path: Path) -> Path:
     d = tmp_path / "plugins"
     d.mkdir()
     (d / "mymod_cli.py").write_text(PLUGIN)
+    (d / "script_cli.py").write_text("raise SystemExit(2)  # a script parsing its arguments\n")
     return d
 
 
@@ -174,6 +186,9 @@ def test_eval_asks_a_plugin_and_reads_its_logs(plugin_dir: Path, tmp_path: Path,
     ("mymod_cli:MyPlanner", "planner 'mymod_cli:MyPlanner': raised ValueError: k=1, "
      "expected 3"),
     ("mymod_cli", "unknown planner 'mymod_cli'"),
+    ("script_cli:P", "planner 'script_cli:P': cannot import module 'script_cli' (exited "
+     "(SystemExit: 2))"),
+    ("mymod_cli:exits", "planner 'mymod_cli:exits': exited (SystemExit: 3)"),
 ])
 def test_a_failing_plugin_is_one_line_before_any_episode(plugin_dir: Path, tmp_path: Path,
                                                          monkeypatch: pytest.MonkeyPatch,
@@ -214,6 +229,10 @@ def test_a_plugin_that_raises_in_decide_is_one_line(plugin_dir: Path, tmp_path: 
     assert r.exit_code == 2 and "decide() raised ZeroDivisionError" in r.output, r.output
     with pytest.raises(SgtoolError, match="returned an Action with skill 'fly'"):
         make_planner("mymod_cli:Flies", timed=False).decide(None)
+    with pytest.raises(SgtoolError) as err:  # a message of many lines: its first
+        make_planner("mymod_cli:Verbose").decide(None)
+    assert str(err.value) == ("planner 'mymod_cli:Verbose': decide() raised ValueError: "
+                              "line one ...")
 
 
 def test_a_plugin_that_raises_in_a_run_bench_leaves_no_folders(
