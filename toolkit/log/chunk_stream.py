@@ -240,6 +240,40 @@ def ordered_messages(f: IO[bytes], summary: Summary, topics: list[str] | None = 
         del pending[:cut]
 
 
+def reversed_messages(f: IO[bytes], summary: Summary, topics: list[str] | None = None, *,
+                      start_ns: int | None = None, end_ns: int | None = None,
+                      verify: bool = False) -> Iterator[Item]:
+    """The messages of :func:`ordered_messages` in exactly the reverse order, read chunk by
+    chunk from the chunk that ends last (the ``mcap`` reader's reverse read parses a chunk
+    with a record parser of its own, which loses the messages after a schema or channel
+    record that a newer writer extended)."""
+    wanted = None if topics is None else {
+        cid for cid, ch in summary.channels.items() if ch.topic in set(topics)}
+    chunks = sorted(
+        (ci for ci in summary.chunk_indexes
+         if (wanted is None or not ci.message_index_offsets
+             or wanted & ci.message_index_offsets.keys())
+         and (start_ns is None or ci.message_end_time >= start_ns)
+         and (end_ns is None or ci.message_start_time < end_ns)),
+        key=lambda ci: (ci.message_end_time, ci.chunk_start_offset), reverse=True)
+    pending: list[tuple[_Key, Item]] = []
+    for j, ci in enumerate(chunks):
+        data = chunk_records(f, ci, verify, None)
+        pending.extend(_messages_of(data, ci.chunk_start_offset, summary, wanted, start_ns,
+                                    end_ns))
+        pending.sort(key=lambda e: e[0], reverse=True)
+        cut = len(pending)
+        if j + 1 < len(chunks):  # what a chunk still to be read may hold comes after
+            nxt = chunks[j + 1]
+            bound = (nxt.message_end_time, nxt.chunk_start_offset, sys.maxsize)
+            cut = 0
+            while cut < len(pending) and pending[cut][0] > bound:
+                cut += 1
+        for _, item in pending[:cut]:
+            yield item
+        del pending[:cut]
+
+
 def chunk_messages(data: bytes | memoryview, ci: ChunkIndex, summary: Summary, views: bool = False
                    ) -> list[Item]:
     """(schema, channel, message) of every message of one chunk (``data``: its

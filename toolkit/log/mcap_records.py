@@ -4,8 +4,9 @@ Every length is checked against the bytes that are really there before anything 
 allocated; a record parses only when its body holds one whole record of its type (no bytes
 missing, the attachment CRC right). Bytes after the last field are allowed where the MCAP
 specification allows them (fields a newer writer appends: every record but a message, a
-chunk, whose records fill it, and the fixed-size data end and footer);
-:func:`trailing_is_damage` tells them from a length field grown by damage.
+chunk, whose records fill it, and the fixed-size footer); :func:`trailing_is_damage` tells
+them from a length field grown by damage. A record of an application's own opcode
+(0x80-0xFF, which the specification reserves for extensions) is skipped by its length.
 :func:`next_record_start` finds the next plausible record after damaged bytes
 (resynchronisation), and :func:`decompress` gives the readable prefix of a truncated or
 damaged compressed chunk (zstd and lz4 are decoded as streams, so everything before the
@@ -59,8 +60,9 @@ _CLASSES: dict[int, Any] = {
     Opcode.SUMMARY_OFFSET: SummaryOffset, Opcode.DATA_END: DataEnd,
 }
 KNOWN_OPCODES = frozenset(_CLASSES) | {Opcode.MESSAGE, Opcode.CHUNK}
+EXTENSION_OPCODES = frozenset(range(0x80, 0x100))  # the specification's, for applications
 # records whose size the specification fixes (no fields can be appended)
-_FIXED_SIZE = frozenset({Opcode.DATA_END, Opcode.FOOTER})
+_FIXED_SIZE = frozenset({Opcode.FOOTER})
 CHUNK_OPCODES = frozenset({Opcode.SCHEMA, Opcode.CHANNEL, Opcode.MESSAGE})
 _ZSTD_STEP = 16 * 1024  # compressed bytes fed per call: the granularity of a salvage
 
@@ -177,10 +179,12 @@ def read_record(buf: FileBytes, pos: int, end: int) -> Raw:
     if h is None:
         raise RecordError(f"{end - pos} bytes left: a record needs at least 9")
     opcode, length = h
-    if opcode not in KNOWN_OPCODES:
+    if opcode not in KNOWN_OPCODES and opcode not in EXTENSION_OPCODES:
         raise RecordError(f"unknown opcode 0x{opcode:02x}")
     if length > end - pos - 9:
         raise RecordError(f"record of {length} bytes runs past the end ({end - pos - 9} left)")
+    if opcode in EXTENSION_OPCODES:  # an application's record: skipped by its length
+        return Raw(pos, opcode, length, None)
     rec, used = _parse(opcode, buf[pos + 9:pos + 9 + length])
     return Raw(pos, opcode, length, rec, length - used)
 
@@ -202,7 +206,8 @@ def _plausible_next(buf: FileBytes, pos: int, end: int, opcodes: frozenset[int]
     if pos == end or bytes(buf[pos:pos + 8]) == MAGIC:
         return True
     h = head(buf, pos, end)
-    return h is not None and h[0] in opcodes and h[1] <= end - pos - 9
+    return (h is not None and (h[0] in opcodes or h[0] in EXTENSION_OPCODES)
+            and h[1] <= end - pos - 9)
 
 
 def next_record_start(buf: FileBytes, start: int, end: int,

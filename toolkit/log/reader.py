@@ -154,7 +154,8 @@ class LogReader:
         try:
             if summary is not None:
                 check_summary(self._f, size, summary)
-            if walk_index.needs_walk(summary):
+            if walk_index.needs_walk(summary) or (
+                    summary is not None and walk_index.loose_messages(self._f, size, summary)):
                 walked = walk_index.walk_log(self.path, size)
                 summary, self._walked = walked.summary, walked.messages
                 self.metadata: dict[str, dict[str, str]] = walked.metadata
@@ -467,12 +468,15 @@ class LogReader:
     def _iter(self, topics: list[str] | None, *, start_ns: int | None = None,
               end_ns: int | None = None, reverse: bool = False, views: bool = False
               ) -> Iterator[tuple[Schema | None, Channel, Message]]:
-        """Messages in log-time order (ties in file order): chunk by chunk
-        (:mod:`sgtool.log.chunk_stream`) when the file is chunked and read forwards, else
-        through the ``mcap`` reader."""
+        """Messages in log-time order (ties in file order), or its reverse: chunk by chunk
+        (:mod:`sgtool.log.chunk_stream`) when the file is chunked, else through the
+        ``mcap`` reader."""
         if self._walked is not None:
             return self._from_walk(topics, start_ns, end_ns, reverse)
-        if self.summary.chunk_indexes and not reverse:
+        if self.summary.chunk_indexes and reverse:
+            return cs.reversed_messages(self._f, self.summary, topics, start_ns=start_ns,
+                                        end_ns=end_ns, verify=self.verify)
+        if self.summary.chunk_indexes:
             return cs.ordered_messages(self._f, self.summary, topics, start_ns=start_ns,
                                     end_ns=end_ns, verify=self.verify, views=views,
                                     buffers=self._buffers)

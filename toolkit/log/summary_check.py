@@ -14,7 +14,7 @@ import zlib
 from typing import IO
 
 from mcap.opcode import Opcode
-from mcap.records import Attachment, AttachmentIndex
+from mcap.records import Attachment, AttachmentIndex, Footer
 from mcap.summary import Summary
 
 from sgtool.errors import LogFormatError
@@ -43,13 +43,18 @@ def _tail(f: IO[bytes], size: int) -> bytes:
     return b"\0" * (16 + FOOTER_RECORD_SIZE - n) + f.read(n)
 
 
+def read_footer(f: IO[bytes], size: int) -> Footer | None:
+    """The footer record at the end of the file, None when there is none."""
+    tail = _tail(f, size)
+    found = footer_at_end(tail, len(tail))
+    return None if found is None else found[1]
+
+
 def check_summary(f: IO[bytes], size: int, summary: Summary) -> None:
     """:class:`LogFormatError` when the summary CRC is wrong or an index points outside
     the file or contradicts the others."""
-    tail = _tail(f, size)
-    found = footer_at_end(tail, len(tail))
-    if found is not None and found[1].summary_crc and found[1].summary_start:
-        footer = found[1]
+    footer = read_footer(f, size)
+    if footer is not None and footer.summary_crc and footer.summary_start:
         start = int(footer.summary_start)
         end = size - 8 - FOOTER_RECORD_SIZE + 9 + 16
         if not 8 <= start <= end:

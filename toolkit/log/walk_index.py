@@ -17,6 +17,7 @@ from __future__ import annotations
 import mmap
 from dataclasses import dataclass
 from pathlib import Path
+from typing import IO
 
 from mcap.opcode import Opcode
 from mcap.records import (
@@ -34,6 +35,8 @@ from mcap.summary import Summary
 from sgtool.errors import LogFormatError
 from sgtool.files import quoted
 from sgtool.log.file_walk import ChunkFacts, Layout, walk
+from sgtool.log.mcap_records import head
+from sgtool.log.summary_check import read_footer
 
 Entry = tuple[Schema | None, Channel, Message]
 
@@ -65,6 +68,34 @@ def needs_walk(summary: Summary | None) -> bool:
             or (st.message_count > 0 and not summary.chunk_indexes)
             or st.attachment_count != len(summary.attachment_indexes)
             or st.metadata_count != len(summary.metadata_indexes))
+
+
+def loose_messages(f: IO[bytes], size: int, summary: Summary) -> bool:
+    """True when the data section holds a message (or bytes that are no record) outside
+    what ``summary`` indexes: its chunks with the message indexes after them, attachments
+    and metadata. Statistics count such messages, no index points to them, so a reader
+    going by the indexes alone would lose them. Only the bytes between indexed records are
+    read (the header, definitions outside chunks, the data end, as a rule)."""
+    footer = read_footer(f, size)
+    if footer is None or not footer.summary_start:
+        return True
+    spans = sorted([(int(c.chunk_start_offset), int(c.chunk_start_offset + c.chunk_length
+                                                    + c.message_index_length))
+                    for c in summary.chunk_indexes]
+                   + [(int(a.offset), int(a.offset + a.length))
+                      for a in summary.attachment_indexes]
+                   + [(int(m.offset), int(m.offset + m.length))
+                      for m in summary.metadata_indexes])
+    pos, end = 8, int(footer.summary_start)
+    for start, stop in [*spans, (end, end)]:
+        while pos < start:  # the records of a gap, read one by one
+            f.seek(pos)
+            h = head(f.read(9), 0, 9)
+            if h is None or h[0] == Opcode.MESSAGE or pos + 9 + h[1] > start:
+                return True
+            pos += 9 + h[1]
+        pos = max(pos, stop)
+    return False
 
 
 def walk_log(path: Path, size: int) -> WalkedLog:
