@@ -43,7 +43,7 @@ class ReplayRequest:
     rerun_to: str | None = None
     as_json: bool = False
     progress: bool = False
-    verify: bool = False
+    verify: bool = True
 
 
 @dataclass(frozen=True)

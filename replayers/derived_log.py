@@ -254,15 +254,15 @@ def replay(
     on_refresh: Callable[[Refresh, SceneGraphStream], None] | None = None,
     progress: Progress | None = None,
     compression: str = "zstd",
-    verify: bool = False,
+    verify: bool = True,
     room_classifier: Callable[[str], Any] | None = None,
     copy_chunks: bool = True,
 ) -> ReplayReport:
     """Replay ``log`` (module doc). ``on_refresh`` sees every refresh as it happens;
     ``progress`` is anything with ``update(n)`` (a tqdm bar), advanced per frame;
-    ``verify`` checks every chunk CRC of the input as it is read, always on with an
-    ``output`` (module doc; ``sgtool doctor`` checks everything; without it damage still
-    gives a one-line error, or a frame);
+    ``verify`` (the default) checks every chunk CRC of the input as it is read, always on
+    with an ``output`` (module doc; ``sgtool doctor`` checks everything; without it damage
+    still gives a one-line error, or a frame read from damaged bytes);
     ``room_classifier`` builds the classifier from the resolved name instead of
     :func:`~sgtool.datasets.room_evidence.make_classifier` (``llm`` with a chat client);
     ``copy_chunks`` copies the input's chunks into the derived log as they are where that

@@ -92,10 +92,11 @@ if TYPE_CHECKING:
               "category accuracy, strict and with open-plan rooms merged.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of text.")
 @click.option("--force", is_flag=True, help="Overwrite the output files.")
-@click.option("--verify", is_flag=True,
-              help="Check every chunk CRC of LOG as it is read (always on with -o or "
-              "--out-dir: a damaged chunk is never copied into a derived log; `sgtool doctor "
-              "LOG` checks a whole log without replaying it).")
+@click.option("--verify/--no-verify", default=True, show_default=True,
+              help="Check every chunk CRC of LOG as it is read: a damaged chunk is an "
+              "error, never replayed or copied into a derived log (--no-verify: without "
+              "-o or --out-dir, replay what the chunks hold; `sgtool doctor LOG` checks a "
+              "whole log without replaying it).")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
 @click.option("--out-dir", type=click.Path(file_okay=False), default=None,
@@ -161,7 +162,7 @@ class ReplayArgs:
     executor: str = "local"
     workers: int = 1
     ray_address: str | None = None
-    verify: bool = False
+    verify: bool = True
     llm_base_url: str | None = None
     llm_model: str | None = None
     llm_api_key: str | None = None

@@ -9,8 +9,9 @@ chunk) at a fraction of the cost: chunks are visited by (start time, offset) and
 messages read so far are handed out, sorted, as soon as no chunk still to be read can hold
 an earlier one (a single sort of an already sorted list when chunks do not overlap).
 
-Chunk CRCs are checked only with ``verify=True`` (``sgtool replay --verify``; ``sgtool
-doctor`` always checks every CRC through :mod:`sgtool.log.file_check`). Lengths are
+Chunk CRCs are checked only with ``verify=True`` (every ``sgtool replay`` unless
+``--no-verify``; ``sgtool doctor`` always checks every CRC through
+:mod:`sgtool.log.file_check`). Lengths are
 checked against the chunk before they are used; any damage raises an exception that the
 reader (``LogReader._checked``) turns into its one-line
 :class:`~sgtool.errors.LogFormatError` pointing to ``sgtool doctor``.

@@ -73,9 +73,10 @@ def test_crc_is_checked_only_when_asked(tmp_path):
         list(r.frames())
 
 
-def test_replay_verify_flag_refuses_a_damaged_chunk(tmp_path):
-    """`sgtool replay --verify` checks the input's CRCs: one line naming `sgtool doctor`, no
-    output written (without the flag the damage surfaces later, if at all)."""
+def test_replay_refuses_a_damaged_chunk(tmp_path):
+    """`sgtool replay` checks the input's CRCs (also without an output, and so does
+    `golden pin`): one line naming `sgtool doctor`, no output written; `--no-verify`
+    reads what the chunks hold."""
     from click.testing import CliRunner
 
     from sgtool.cli import cli
@@ -92,6 +93,13 @@ def test_replay_verify_flag_refuses_a_damaged_chunk(tmp_path):
     assert res.exit_code == 2 and "Traceback" not in res.output and "doctor" in res.output
     assert len(res.output.strip().splitlines()) == 1 and "CRC" in res.output
     assert not out.exists() and not list(tmp_path.glob("d.mcap*"))
+    for args in (["replay", str(bad)], ["golden", "pin", str(bad), "--dir", str(tmp_path / "g")]):
+        res = CliRunner().invoke(cli, args)
+        assert res.exit_code == 2 and "CRC" in res.output and "doctor" in res.output, res.output
+    assert not (tmp_path / "g").exists()
+    res = CliRunner().invoke(cli, ["replay", str(bad), "--no-verify", "--json"])
+    assert "CRC" not in res.output  # here the flipped byte is in the episode's JSON
+    assert res.exit_code == 2 and "is not JSON" in res.output, res.output
 
 
 def test_buffers_are_reused_only_when_no_view_of_them_lives():
