@@ -189,6 +189,8 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
         raise SgtoolError(f"-o {out}: the output must not be the input log")
     if fmt == "ros1":
         _check_ros1_target(out, force)
+    elif out.parent.exists() and not out.parent.is_dir():
+        raise SgtoolError(f"-o {out}: {out.parent} is a file, not a folder")
     elif not out.parent.is_dir():
         raise SgtoolError(f"-o {out}: folder {out.parent} does not exist")
     elif out.exists() and not out.is_dir():

@@ -120,8 +120,12 @@ def open_bag(path: str | Path) -> Iterator[Any]:
             stack.enter_context(reader)
         except Exception as e:  # the bag readers raise assorted errors on garbage
             first = (str(e).strip().splitlines() or [""])[0][:200]  # one line (YAML's are many)
+            mcaps = [path] if path.suffix == ".mcap" else sorted(path.glob("*.mcap")) \
+                if path.is_dir() else []
+            hint = (f"; if it was cut short, `sgtool doctor {quoted(mcaps[0])} --recover "
+                    "OUT.mcap` copies what is readable" if mcaps else "")
             raise SgtoolError(f"{path}: not a readable ROS bag ({type(e).__name__}: {first})"
-                              ) from e
+                              f"{hint}") from e
         try:
             yield reader
         except Exception as e:

@@ -192,8 +192,9 @@ def read_intrinsics_file(path: Path) -> PinholeParams:
                                height=size[1], source=str(path.name))
     try:
         m = np.loadtxt(path, dtype=np.float64)
-    except ValueError as e:
-        raise SgtoolError(f"{path}: expected a 3x3 camera matrix ({e})") from e
+    except ValueError:
+        raise SgtoolError(f"{path}: expected a 3x3 camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]] "
+                          "(three rows of three numbers), or Open3D intrinsics JSON") from None
     if m.shape != (3, 3) or abs(m[2, 2] - 1.0) > 1e-6 or m[0, 0] <= 0 or m[1, 1] <= 0:
         raise SgtoolError(f"{path}: expected a 3x3 camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]]")
     return checked_pinhole(m[0, 0], m[1, 1], m[0, 2], m[1, 2], str(path),

@@ -52,8 +52,10 @@ class RobotConfig:
     resolution: float = 0.05  # occupancy cell (m)
 
     def __post_init__(self) -> None:
-        if self.speed <= 0 or self.turn_speed <= 0 or self.open_time <= 0:
-            raise SgtoolError("robot speed, turn speed and open time must be > 0")
+        for flag, value in (("--speed", self.speed), ("turn_speed", self.turn_speed),
+                            ("open_time", self.open_time)):
+            if not value > 0:
+                raise SgtoolError(f"{flag} {value:g}: must be > 0")
         if not 0 < self.approach[0] < self.approach[1] <= self.reach:
             raise SgtoolError(f"robot approach range {self.approach}: need 0 < min < max "
                               f"<= reach ({self.reach} m)")

@@ -237,9 +237,10 @@ class RecordOptions:
                               f"{', '.join(EXPLORE)}")
         if self.every < 1:
             raise SgtoolError(f"every {self.every}: must be >= 1")
-        if self.seed < 0 or self.start < 0:
-            raise SgtoolError(f"seed {self.seed} (--noise-seed) and start {self.start} "
-                              "(--start): must be >= 0")
+        if self.seed < 0:
+            raise SgtoolError(f"--noise-seed {self.seed}: must be >= 0")
+        if self.start < 0:
+            raise SgtoolError(f"--start {self.start}: must be >= 0")
         if self.compression not in COMPRESSIONS:
             raise SgtoolError(f"compression {self.compression!r} (--compression): one of "
                               f"{', '.join(COMPRESSIONS)}")

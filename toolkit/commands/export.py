@@ -33,6 +33,7 @@ def _frames(style: str, pairs: tuple[str, ...], log: str) -> dict[str, str]:
     frames = (S.WORLD_FRAME, S.BASE_FRAME, S.CAMERA_FRAME)
     names = default_frames(log) if style == "rep105" else {}
     styled = {n: f for f, n in names.items()}
+    given: dict[str, str] = {}  # frame -> the pair that renamed it
     for pair in pairs:
         old, sep, new = (x.strip() for x in pair.partition("="))
         if not sep or not old or not new:
@@ -45,6 +46,10 @@ def _frames(style: str, pairs: tuple[str, ...], log: str) -> dict[str, str]:
         if not _ROS_NAME.fullmatch(new):
             raise SgtoolError(f"--frame {pair!r}: {new!r} is not a ROS frame name (a letter "
                               "or '_', then letters, digits, '_' or '/')")
+        if old in given:
+            raise SgtoolError(f"--frame {pair!r} and --frame {given[old]!r} rename the same "
+                              f"frame ({old}); give one")
+        given[old] = pair
         names[old] = new
     final = [names.get(f, f) for f in frames]
     if len(set(final)) < len(final):

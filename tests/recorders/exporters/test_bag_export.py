@@ -286,6 +286,10 @@ def test_cli_options(tmp_path):
                        "world (map), base (base_link), camera (camera_optical_frame))"),
                       (["--frame", "world=bad name"], "'bad name' is not a ROS frame name"),
                       (["--frame", "world=base_link"], "two frames would be named base_link"),
+                      (["--frame", "map=odom", "--frame", "world=x"], "--frame 'world=x' and "
+                       "--frame 'map=odom' rename the same frame (world); give one"),
+                      (["-o", str(log / "out")], f"-o {log / 'out'}: {log} is a file, not a "
+                       "folder"),
                       (["--topics", ","], "--topics: give at least one topic"),
                       (["--compression", "lz4"], "a ros2 bag takes none, zstd")):
         r = CliRunner().invoke(cli, ["export", "bag", str(log), "-o", str(tmp_path / "x"),

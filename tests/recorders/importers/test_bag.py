@@ -582,3 +582,15 @@ def test_a_bag_folder_with_damaged_metadata_is_one_line(tmp_path):
     assert r.exit_code == 2, r.output
     assert r.output.startswith(f"sgtool: error: {bag}: not a readable ROS bag")
     assert r.output.count("\n") == 1 and "Traceback" not in r.output
+
+
+def test_a_cut_ros2_mcap_points_to_doctor(tmp_path):
+    """A ROS 2 bag whose .mcap was cut short (a recorder killed): the one line says how to
+    copy what is readable."""
+    bag = bag_path(tmp_path, "ros2-mcap")
+    write_log_as_bag(write_sgtool_log(tmp_path / "src.mcap"), bag, "ros2-mcap")
+    (part,) = sorted(bag.glob("*.mcap"))
+    part.write_bytes(part.read_bytes()[: part.stat().st_size // 2])
+    r = CliRunner().invoke(cli, ["import", "bag", str(bag), "--list"])
+    assert r.exit_code == 2 and r.output.count("\n") == 1, r.output
+    assert f"`sgtool doctor {part} --recover OUT.mcap` copies what is readable" in r.output

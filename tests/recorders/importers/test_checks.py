@@ -27,7 +27,7 @@ from sgtool.recorders.importers.sanity import (
     timestamp_problem,
 )
 from sgtool.recorders.importers.sink import IMPORT_METADATA
-from sgtool.recorders.importers.textformats import PinholeParams
+from sgtool.recorders.importers.textformats import PinholeParams, read_intrinsics_file
 
 K = PinholeParams(60.0, 60.0, 39.5, 29.5)
 GOOD_TIMES = [100.0 + i / 30 for i in range(12)]
@@ -220,3 +220,15 @@ def test_json_report_carries_sources_and_warnings(tmp_path):
     # the camera is 1.4 - 1.2 = 0.2 m above the given floor: a warning, in the JSON too
     assert len(d["warnings"]) == 1 and "camera is 0.20 m above the floor" in d["warnings"][0]
     assert r.output.startswith("sgtool: warning: the camera is 0.20 m above the floor")
+
+
+def test_an_intrinsics_file_of_another_shape_says_what_it_should_hold(tmp_path):
+    """A pose trajectory given as --intrinsics: the message shows the matrix to give, not
+    numpy's advice about its own arguments."""
+    bad = tmp_path / "k.txt"
+    bad.write_text("0 0 1\n1 0 0 0\n0 1 0 0\n")
+    with pytest.raises(SgtoolError) as err:
+        read_intrinsics_file(bad)
+    assert str(err.value) == (f"{bad}: expected a 3x3 camera matrix [[fx 0 cx] [0 fy cy] "
+                              "[0 0 1]] (three rows of three numbers), or Open3D intrinsics "
+                              "JSON")

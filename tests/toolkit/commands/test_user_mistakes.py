@@ -119,6 +119,11 @@ def test_rooms_without_seed_and_a_negative_depth_range_are_refused(tmp_path):
     assert "need 4 <= MIN <= MAX" in _refusal(["record", "--rooms", "5-2", "-o", str(out)])
     assert "need 0 < MIN < MAX" in _refusal(["record", "--depth-range", "-1,0", "-o",
                                              str(out)])
+    # each message names the option given, and only that one
+    assert _refusal(["record", "--start", "-1", "-o", str(out)]).endswith(
+        "--start -1: must be >= 0")
+    assert _refusal(["record", "--speed", "0", "-o", str(out)]).endswith(
+        "--speed 0: must be > 0")
     assert not list(tmp_path.iterdir())
 
 
