@@ -281,7 +281,11 @@ def list_planners_option(named_by: str = "--planners") -> Callable[[F], F]:
     def show(ctx: click.Context, param: click.Parameter, value: bool) -> None:
         if not value or ctx.resilient_parsing:
             return
-        from sgtool.planning.registry import check_planner_name, describe_planners
+        from sgtool.planning.registry import (
+            check_planner_name,
+            describe_planners,
+            plugin_problem,
+        )
 
         given: list[str] = []  # the planners named (eager options: before, or as given)
         for key in ("planners", "planner"):
@@ -294,6 +298,9 @@ def list_planners_option(named_by: str = "--planners") -> Callable[[F], F]:
         for name in given:  # a misspelt name is said, as without --list-planners
             check_planner_name(name)
         click.echo(describe_planners(given))
+        problem = plugin_problem(given)
+        if problem is not None:  # listed with the rest, and the exit says it
+            raise SgtoolError(problem)
         ctx.exit(0)
 
     return click.option("--list-planners", is_flag=True, expose_value=False, is_eager=True,

@@ -16,6 +16,7 @@ import dataclasses
 import difflib
 import math
 import os
+import pathlib
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -41,7 +42,8 @@ class OptionMeta:
     """What a field accepts: ``kind`` (:data:`KINDS`), ``lo``/``hi`` bounds of numbers
     (``lo_open``: strictly above ``lo``), ``choices`` of a ``choice``, ``optional``: None
     is a value (the default: "not set"), ``objects``: a ``path`` also takes Python objects
-    (a mapping, a list of paths) as they are."""
+    (a mapping, a list of paths) as they are; ``path_object``: a ``path`` arrives as a
+    ``pathlib.Path`` (a plain field annotated ``Path``), else as text."""
 
     help: str
     kind: str
@@ -51,6 +53,7 @@ class OptionMeta:
     choices: tuple[str, ...] = ()
     optional: bool = False
     objects: bool = False
+    path_object: bool = False
 
     @property
     def cli(self) -> bool:
@@ -112,7 +115,6 @@ def _plain_meta(f: dataclasses.Field[Any], hint: Any) -> OptionMeta:
     takes None too. Another annotation (``Any``, one that does not resolve) takes the kind
     of a plain default (3: int); anything else (a list, a dict, a class) is a Python
     object, settable from Python only."""
-    import pathlib
     import types
     import typing
 
@@ -123,19 +125,20 @@ def _plain_meta(f: dataclasses.Field[Any], hint: Any) -> OptionMeta:
     plain = [a for a in args if a is not type(None)]
     bare = [typing.get_origin(a) or a for a in plain]
     paths = (pathlib.Path, os.PathLike)
-    kind, choices = "object", ()
+    kind, choices, as_path = "object", (), False
     if len(plain) == 1 and plain[0] in _PLAIN_KINDS:
         kind = _PLAIN_KINDS[plain[0]]
     elif len(plain) == 1 and typing.get_origin(plain[0]) is typing.Literal and all(
             isinstance(c, str) for c in typing.get_args(plain[0])):
         kind, choices = "choice", tuple(typing.get_args(plain[0]))
     elif bare and all(b in paths or b is str for b in bare) and any(b in paths for b in bare):
-        kind = "path"
+        kind, as_path = "path", str not in bare  # Path alone: a Path; str | Path: text
     elif not plain or plain[0] is Any or isinstance(plain[0], str):
         default = f.default if f.default is not dataclasses.MISSING else None
         kind = _PLAIN_KINDS.get(type(default), "object")
     note = hint.__name__ if isinstance(hint, type) else str(hint).replace("typing.", "")
-    return OptionMeta(f"a field of {note}", kind, choices=choices, optional=optional)
+    return OptionMeta(f"a field of {note}", kind, choices=choices, optional=optional,
+                      path_object=as_path)
 
 
 def _type_hints(cls: type) -> dict[str, Any]:
@@ -253,7 +256,7 @@ def convert_value(planner: str, key: str, meta: OptionMeta, value: Any,
         return text
     elif meta.kind == "path":
         if isinstance(value, str | os.PathLike):
-            return os.fspath(value)
+            return pathlib.Path(value) if meta.path_object else os.fspath(value)
         if meta.objects and not from_cli:
             return value
         raise fail("must be a path")

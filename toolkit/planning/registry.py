@@ -377,6 +377,20 @@ def _plugin_lines(name: str) -> list[str]:
     return [f"{name}: a plug-in", *(f"    {info.line()}" for info in option_infos(cls))]
 
 
+def plugin_problem(names: Sequence[str]) -> str | None:
+    """Why the first plug-in of ``names`` (built-in names are skipped) cannot be used as a
+    planner (it does not import, names nothing callable, its options class is broken);
+    None when all can."""
+    for name in names:
+        if name.lower() in REGISTRY:
+            continue
+        try:
+            options_of(name)
+        except SgtoolError as e:
+            return str(e)
+    return None
+
+
 def describe_planners(plugins_named: Sequence[str] = ()) -> str:
     """Every built-in planner with its summary and options (name, kind, default, help),
     the options every planner takes, the plug-ins installed packages register, and the

@@ -392,8 +392,11 @@ def test_list_planners_describes_a_plugin_named_with_it(
                   ["--list-planners", f"{flag}=mymod_cli:MyPlanner"]):
         r = CliRunner().invoke(cli, [*command[:-1], *words])
         assert r.exit_code == 0 and said in r.output, (words, r.output)
+    # one that cannot be imported: listed with why, and the exit says so
     r = CliRunner().invoke(cli, [*command, "nomod_cli:X", "--list-planners"])
-    assert r.exit_code == 0 and "nomod_cli:X: planner 'nomod_cli:X': cannot import" in r.output
+    assert r.exit_code == 2 and "nomod_cli:X: planner 'nomod_cli:X': cannot import" in r.output
+    assert r.output.splitlines()[-1].startswith(
+        "sgtool: error: planner 'nomod_cli:X': cannot import"), r.output
 
 
 def test_an_untimed_plugin_keeps_its_name_in_the_closed_loop(plugin_dir: Path, tmp_path: Path,

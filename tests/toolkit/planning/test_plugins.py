@@ -123,9 +123,10 @@ def test_a_plain_options_dataclass_checks_by_its_fields_types(plugin_dir: Path) 
 
 def test_plain_fields_are_typed_by_their_annotations(tmp_path: Path, monkeypatch) -> None:
     """Annotations as text (``from __future__ import annotations``) are resolved in the
-    plug-in's module: ``X | None`` takes None, a ``Literal`` of strings is a choice, a path
-    or ``str | Path`` a path, a list or a dict is a Python object (not set by -O); a name
-    that does not resolve takes its default's type."""
+    plug-in's module: ``X | None`` takes None, a ``Literal`` of strings is a choice, a
+    ``Path`` a path that arrives as a Path, ``str | Path`` one that arrives as text, a list
+    or a dict is a Python object (not set by -O); a name that does not resolve takes its
+    default's type."""
     (tmp_path / "future_plug.py").write_text(textwrap.dedent('''
         from __future__ import annotations
 
@@ -145,6 +146,7 @@ def test_plain_fields_are_typed_by_their_annotations(tmp_path: Path, monkeypatch
                 mode: Unknowable = "a"
                 speed: Literal["fast", "slow"] = "fast"
                 where: str | Path = "x"
+                folder: Path = Path(".")
 
             def __init__(self, **kw):
                 super().__init__()
@@ -160,6 +162,7 @@ def test_plain_fields_are_typed_by_their_annotations(tmp_path: Path, monkeypatch
     with pytest.raises(PlannerOptionError, match="must be one of fast, slow"):
         parse_option("future_plug:P", "speed", "medium")
     assert parse_option("future_plug:P", "where", "/tmp/x") == "/tmp/x"
+    assert parse_option("future_plug:P", "folder", "/tmp/x") == Path("/tmp/x")  # as annotated
     with pytest.raises(PlannerOptionError, match="must be an integer"):
         parse_option("future_plug:P", "cap", "x")
 
