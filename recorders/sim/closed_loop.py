@@ -109,6 +109,7 @@ from sgtool.planning.episode import (
     run_search,
     search_success,
 )
+from sgtool.planning.plugins import held_to_contract
 from sgtool.progress import Progress
 from sgtool.recorders.sim.closed_loop_options import (  # noqa: F401 (re-exported)
     N_MAX,
@@ -469,10 +470,13 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
     values only and secrets left out, so that the log's planner can be built again) and
     closed here (its ``close()``, when it has one) when the episode ends; its LLM
     exchanges, when it keeps them (``drain_exchanges()``, moma-llm), are logged after each
-    decision. ``progress`` is anything with ``update(n)`` (a tqdm bar), advanced per
-    frame; ``on_decision`` sees every graph and the action chosen on it.
+    decision. A planner object of the user's is held to the contract a plug-in is
+    (:func:`sgtool.planning.plugins.held_to_contract`). ``progress`` is anything with
+    ``update(n)`` (a tqdm bar), advanced per frame; ``on_decision`` sees every graph and
+    the action chosen on it.
     """
     require("pybullet", api="sgtool.run_closed_loop")  # one line on a core install
+    planner = held_to_contract(planner)  # a user's planner object: one line for its faults
     opts = options or ClosedLoopOptions()
     recorded = {"planner_options": recorded_options(planner_options)} if planner_options \
         else {}

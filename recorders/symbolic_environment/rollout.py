@@ -161,6 +161,7 @@ def run_one(house: HouseSpec | SymbolicHouse, planner: Planner | str, query: str
     raise, an action with no skill or a target that is no node id, is one
     :class:`~sgtool.planning.timing.PlannerContractError` naming it).
     """
+    from sgtool.planning.plugins import held_to_contract
     from sgtool.planning.registry import make_planner
 
     if max_steps < 1:
@@ -172,7 +173,7 @@ def run_one(house: HouseSpec | SymbolicHouse, planner: Planner | str, query: str
         [f.id for f in spec.furniture if category_text(f.category) == text]
     if not targets:
         raise RunOneError(f"query {query!r}: no object of that category in the house")
-    p = make_planner(planner) if isinstance(planner, str) else _checked(planner)
+    p = make_planner(planner) if isinstance(planner, str) else held_to_contract(planner)
     name = planner if isinstance(planner, str) else None
     rooms = sorted({o.room for o in spec.objects if o.id in targets} |
                    {f.room for f in spec.furniture if f.id in targets})
@@ -180,21 +181,6 @@ def run_one(house: HouseSpec | SymbolicHouse, planner: Planner | str, query: str
                        avoid_rooms=rooms, max_steps=max_steps, seen=seen,
                        house_id=house_id, planner_name=name, log=log,
                        start_region=_start_region(h, start))
-
-
-def _checked(planner: Planner) -> Planner:
-    """A user's planner object held to the contract a plug-in is (what it lacks, raises or
-    returns wrongly is one line); sgtool's own planners as they are (their exceptions are
-    bugs, with their tracebacks)."""
-    from sgtool.planning.plugins import PLANNER_PARTS, missing_parts
-    from sgtool.planning.timing import PlannerContractError, TimedPlanner
-
-    if isinstance(planner, TimedPlanner) or type(planner).__module__.startswith("sgtool."):
-        return planner
-    if missing := missing_parts(planner, PLANNER_PARTS[1:]):
-        raise PlannerContractError(f"planner: a {type(planner).__name__} is not a Planner "
-                                   f"(it lacks {', '.join(missing)})")
-    return TimedPlanner(planner, plugin=True, measure=False)
 
 
 def _start_region(h: SymbolicHouse, start: str | StartPose | None) -> str | None:

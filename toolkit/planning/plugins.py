@@ -116,6 +116,21 @@ def build_plugin(name: str, factory: Callable[..., Any], options: Mapping[str, A
     return planner
 
 
+def held_to_contract(planner: Planner) -> Planner:
+    """A user's planner object held to the contract a plug-in is (what it lacks, raises or
+    returns wrongly is one line: :class:`~sgtool.planning.timing.TimedPlanner`, its
+    decision time not measured); sgtool's own planners as they are (their exceptions are
+    bugs, with their tracebacks)."""
+    from sgtool.planning.timing import PlannerContractError, TimedPlanner
+
+    if isinstance(planner, TimedPlanner) or type(planner).__module__.startswith("sgtool."):
+        return planner
+    if missing := missing_parts(planner, PLANNER_PARTS[1:]):
+        raise PlannerContractError(f"planner: a {type(planner).__name__} is not a Planner "
+                                   f"(it lacks {', '.join(missing)})")
+    return TimedPlanner(planner, plugin=True, measure=False)
+
+
 def missing_parts(planner: object, parts: tuple[str, ...] = PLANNER_PARTS) -> list[str]:
     """The members of the Planner protocol (``parts`` of :data:`PLANNER_PARTS`) that
     ``planner`` lacks: an attribute for ``name``, a method for the others."""

@@ -425,8 +425,8 @@ def test_invalid_actions_are_told_and_a_target_must_be_a_node_id(
         plugin_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A plug-in naming nodes that are not there runs (an LLM planner may), but the bench
     says so (with its tables, on stdout) and in summary.md; a target that is no text is one
-    line; a user's planner object given to run_one is held to the same contract, sgtool's
-    own is not (its bug keeps its traceback)."""
+    line; a user's planner object given to run_one or run_closed_loop is held to the same
+    contract, sgtool's own is not (its bug keeps its traceback)."""
     monkeypatch.syspath_prepend(str(plugin_dir))
     out = tmp_path / "out"
     r = CliRunner().invoke(cli, ["bench", "--planners", "greedy,mymod_cli:NamesNothing",
@@ -469,3 +469,11 @@ def test_invalid_actions_are_told_and_a_target_must_be_a_node_id(
     monkeypatch.setattr(greedy, "decide", lambda graph: {}["no such key"])
     with pytest.raises(KeyError):
         sgtool.run_one(house, greedy, query)
+    # the closed loop holds a planner object to the same contract, and leaves no log
+    _, ep = sgtool.pick_episode(house)
+    out = tmp_path / "cl.mcap"
+    with pytest.raises(SgtoolError, match=r"^planner 'greedy': decide\(\) raised "
+                       r"ZeroDivisionError: no rooms to divide by$"):
+        sgtool.run_closed_loop(house, ep, mymod_cli.Stumbles(), out, sgtool.ClosedLoopOptions(
+            max_steps=2, frames=40, camera=sgtool.CameraConfig(width=64, height=48)))
+    assert not list(tmp_path.glob("cl.mcap*"))
