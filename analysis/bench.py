@@ -71,6 +71,7 @@ from sgtool.analysis.bench_planner_checks import (
     check_planner_list,
     check_planner_options,
     config_names,
+    config_planner_options,
     config_rooms,
 )
 from sgtool.analysis.bench_priors import (
@@ -150,9 +151,8 @@ class BenchConfig:
     all_pairs: bool = False  # paired comparisons of every pair of planners instead
 
     def __post_init__(self) -> None:
-        # a copy: the caller's dict changed for the next run must not change this one's
         object.__setattr__(self, "planner_options",
-                           {str(k): dict(v) for k, v in self.planner_options.items()})
+                           config_planner_options(self.planner_options))
         object.__setattr__(self, "planners", config_names(self.planners, "planners"))
         object.__setattr__(self, "house_files",
                            config_names(self.house_files, "house_files", paths=True))

@@ -27,6 +27,21 @@ def config_names(value: Any, field: str, paths: bool = False) -> tuple[Any, ...]
     return tuple(str(x) for x in items) if paths else items
 
 
+def config_planner_options(value: Any) -> dict[str, dict[str, Any]]:
+    """A config's ``planner_options`` copied (a caller's dict changed for the next run must
+    not change this one's): planner name -> {option: value}; anything else one line."""
+    if not isinstance(value, Mapping):
+        raise BenchError(f"planner_options: give {{planner: {{option: value}}}}, got a "
+                         f"{type(value).__name__}")
+    out: dict[str, dict[str, Any]] = {}
+    for k, v in value.items():
+        if not isinstance(v, Mapping):
+            raise BenchError(f"planner_options[{k!r}]: give {{option: value}}, got "
+                             f"{v!r}")
+        out[str(k)] = dict(v)
+    return out
+
+
 def config_rooms(value: Any) -> tuple[int, int]:
     """A config's ``rooms``: (MIN, MAX), a list from a JSON file taken as a pair."""
     if isinstance(value, str | int) or len(tuple(value)) != 2:

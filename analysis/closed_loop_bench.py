@@ -49,7 +49,11 @@ from sgtool.analysis.bench_houses import (
     load_house_files,
     output_path,
 )
-from sgtool.analysis.bench_planner_checks import config_names, config_rooms
+from sgtool.analysis.bench_planner_checks import (
+    config_names,
+    config_planner_options,
+    config_rooms,
+)
 from sgtool.analysis.closed_loop_tables import (
     budget_comparisons,
     format_agreement,
@@ -141,9 +145,8 @@ class ClosedLoopBenchConfig:
     budgets: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
-        # a copy: the caller's dict changed for the next run must not change this one's
         object.__setattr__(self, "planner_options",
-                           {str(k): dict(v) for k, v in self.planner_options.items()})
+                           config_planner_options(self.planner_options))
         for name in ("planners", "noise"):
             object.__setattr__(self, name, config_names(getattr(self, name), name))
         try:  # (a list from Python, numbers as text)

@@ -11,6 +11,7 @@ query, and optionally a start.
 from __future__ import annotations
 
 import dataclasses
+import os
 import time
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -141,16 +142,18 @@ class RunOneError(SgtoolError):
     """A query or a start that does not fit the house of :func:`run_one`."""
 
 
-def run_one(house: HouseSpec | SymbolicHouse, planner: Planner | str, query: str, *,
+def run_one(house: HouseSpec | SymbolicHouse | str | os.PathLike[str], planner: Planner | str,
+            query: str, *,
             start: str | StartPose | None = None, seed: int = 0, episode_index: int = 0,
             max_steps: int = N_MAX, house_id: str = "", seen: bool | None = None,
             log: LogWriter | None = None) -> EpisodeResult:
     """One SymSearch episode on any house with one planner, for scripting your own runs.
 
-    ``house`` is a spec (prepared here; pass a :class:`SymbolicHouse` to reuse one for
-    many episodes) and ``planner`` a planner or a registry name
-    (:func:`sgtool.planning.registry.make_planner`). Every instance of ``query`` in the
-    house (furniture or small object, by :func:`~sgtool.semantics.text.category_text`) is a
+    ``house`` is a spec, or the path of a spec file (prepared here; pass a
+    :class:`SymbolicHouse` to reuse one for many episodes) and ``planner`` a planner or a
+    registry name (:func:`sgtool.planning.registry.make_planner`). Every instance of
+    ``query`` in the house (furniture or small object, by
+    :func:`~sgtool.semantics.text.category_text`) is a
     target. ``start``: None draws a start region from (seed, house seed, episode index)
     outside the target rooms, as the benchmark does; a region id fixes it; a
     :class:`~sgtool.house.spec.StartPose` (e.g. from
@@ -166,6 +169,10 @@ def run_one(house: HouseSpec | SymbolicHouse, planner: Planner | str, query: str
 
     if max_steps < 1:
         raise RunOneError(f"max_steps {max_steps}: must be >= 1")
+    if isinstance(house, str | os.PathLike):
+        from sgtool.house.io import load_house
+
+        house = load_house(house)
     h = house if isinstance(house, SymbolicHouse) else SymbolicHouse(house)
     spec = h.spec
     text = category_text(query)

@@ -157,3 +157,6 @@ def test_the_config_keeps_its_own_options():
     opts["scout"]["delta"] = 0.9
     opts["greedy"] = {}
     assert cfg.planner_options == {"scout": {"delta": 0.2}}
+    with pytest.raises(SgtoolError, match=r"^planner_options\['scout'\]: give \{option: "
+                       r"value\}, got 0.2$"):
+        BenchConfig(planners=("scout",), planner_options={"scout": 0.2})

@@ -3,6 +3,8 @@ episodes of a hand-made house; one episode run from a script."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 from support.foreign_house import QUERIES, cottage, write_cottage
 
@@ -60,7 +62,7 @@ def test_episodes_of_a_hand_made_house() -> None:
     assert len(bench_episodes(spec, 7)) == 7  # more than categories: again, other starts
 
 
-def test_run_one_on_a_hand_made_house() -> None:
+def test_run_one_on_a_hand_made_house(tmp_path: Path) -> None:
     spec = load_house(cottage())
     house = SymbolicHouse(spec)
     # start in the bedroom, look for the milk in the closed fridge of the kitchen
@@ -70,6 +72,9 @@ def test_run_one_on_a_hand_made_house() -> None:
     assert r.travelled_m >= r.shortest_m > 4.0
     again = run_one(spec, "greedy", "milk", start="region:2.0", seed=1, house_id="cottage")
     assert again.trace == r.trace  # the same from a spec
+    path = write_cottage(tmp_path)
+    from_file = run_one(path, "greedy", "milk", start="region:2.0", seed=1, house_id="cottage")
+    assert from_file.trace == r.trace  # and from its file
     from sgtool.datasets.start_poses import start_poses
 
     bedroom = start_poses(spec)[2]
