@@ -11,6 +11,7 @@ line). ``note`` receives the notes meant for stderr, one per skipped or refused 
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
@@ -62,6 +63,7 @@ class EvalOutcome:
 def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
     """Score the request's episodes and replay its planners on the logged decisions."""
     from sgtool.analysis.batch_eval import load_many
+    from sgtool.analysis.eval_settings import settings_notes
     from sgtool.analysis.offline import log_exchanges, with_seen, with_success_rule
     from sgtool.analysis.search_metrics import cost_models, summarize
 
@@ -77,6 +79,12 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
                  "PLANNER [NOISE]"]
     if (other := _unlike_episodes(results)) is not None:
         notes = [*notes, other]
+    notes = [*notes, *settings_notes(request.inputs)]
+    if unknown := sum(1 for r in results if r.shortest_m is None
+                      or not math.isfinite(r.shortest_m)):
+        notes = [*notes, f"{unknown} episode(s) have no shortest path (none was logged, or "
+                 "the target cannot be reached on the house's geometry): SPL leaves them "
+                 "out, SR counts them"]
     for text in notes:
         note(f"sgtool: note: {text}")
     if not results:

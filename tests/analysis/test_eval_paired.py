@@ -41,6 +41,23 @@ def test_two_runs_compared_as_one_bench_compares_them(tmp_path: Path) -> None:
     paired = text.split("Paired comparisons on the same episodes\n", 1)[1]
     row = next(line for line in paired.splitlines() if line.startswith("| scout "))
     assert row.split("|")[2].strip() == "greedy"  # scout against the reference given
+    assert "sgtool: note" not in r.stderr  # the same settings: nothing to say
+
+
+def test_runs_made_apart_under_other_settings_are_named(tmp_path: Path) -> None:
+    """A baseline stored with another step budget, a planner run with other options: eval
+    pairs them as asked and says what differs."""
+    _bench(tmp_path / "a", "scout")
+    r = CliRunner().invoke(cli, [*BENCH, "--planners", "greedy,scout", "--max-steps", "10",
+                                 "-O", "scout.delta=0.9", "-o", str(tmp_path / "b")])
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(cli, ["eval", str(tmp_path / "a"), str(tmp_path / "b")])
+    assert r.exit_code == 0, r.output
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert (f"sgtool: note: the runs given ran with different max_steps (50 in {a}, 10 in "
+            f"{b}): their rows and paired comparisons mix them") in r.stderr
+    assert (f'sgtool: note: scout ran with other options in the runs given ({{}} in {a}, '
+            f'{{"delta": "0.9"}} in {b}): its rows pool them') in r.stderr
 
 
 RUN = EpisodeResult("greedy", 0, "house-0", 0, "mug", True, steps=4, travelled_m=10.0,
@@ -122,3 +139,16 @@ def test_bench_result_keeps_its_interval_methods() -> None:
 
     few = res.intervals(Bootstrap(resamples=100))  # the same figures, other intervals
     assert [r.sr.value for r in few] == [r.sr.value for r in res.intervals()]
+
+
+def test_episodes_without_a_shortest_path_are_named(tmp_path: Path) -> None:
+    """SR counts an episode whose shortest path is unknown, SPL leaves it out: eval says so,
+    as the case where SPL (over fewer episodes) can stand above SR."""
+    rows = tmp_path / "episodes.jsonl"
+    write_jsonl([RUN, dataclasses.replace(RUN, episode=1, success=False, steps=50,
+                                          shortest_m=None)], rows)
+    r = CliRunner().invoke(cli, ["eval", str(rows)])
+    assert r.exit_code == 0, r.output
+    assert ("sgtool: note: 1 episode(s) have no shortest path (none was logged, or the target "
+            "cannot be reached on the house's geometry): SPL leaves them out, SR counts them"
+            ) in r.stderr

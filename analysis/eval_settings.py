@@ -1,0 +1,53 @@
+"""What the inputs of ``sgtool eval`` say about the settings they ran under: runs made
+apart (a lab's planner, a stored run of the baselines) are paired on their episodes, so a
+step budget or a planner's options that differ between them would decide a comparison
+without a word. :func:`settings_notes` reads the ``summary.json`` beside each
+``episodes.jsonl`` input (``sgtool bench`` writes both) and names what differs.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+COMPARED = ("max_steps", "priors_dir")  # bench settings that change what an episode scores
+
+
+def _settings(summary: Path) -> dict[str, Any] | None:
+    try:
+        doc = json.loads(summary.read_text())
+    except (OSError, ValueError):
+        return None
+    settings = doc.get("settings") if isinstance(doc, dict) else None
+    return settings if isinstance(settings, dict) else None
+
+
+def settings_notes(files: Sequence[str]) -> list[str]:
+    """One note per setting of :data:`COMPARED` whose value differs between the bench
+    runs among ``files``, and one per planner that ran with other options in two runs."""
+    runs: dict[str, dict[str, Any]] = {}
+    for f in files:
+        p = Path(f)
+        if p.name == "episodes.jsonl" and (s := _settings(p.parent / "summary.json")):
+            runs[str(p.parent)] = s
+    notes = []
+    for key in COMPARED:
+        values = {run: s[key] for run, s in runs.items() if key in s}
+        if len({json.dumps(v) for v in values.values()}) > 1:
+            shown = ", ".join(f"{v} in {run}" for run, v in values.items())
+            notes.append(f"the runs given ran with different {key} ({shown}): their rows and "
+                         "paired comparisons mix them")
+    options: dict[str, dict[str, str]] = {}
+    for run, s in runs.items():
+        given = s.get("planner_options") or {}
+        for planner in s.get("planners") or ():
+            options.setdefault(planner, {})[run] = json.dumps(given.get(planner, {}),
+                                                              sort_keys=True)
+    for planner, per in options.items():
+        if len(set(per.values())) > 1:
+            shown = ", ".join(f"{opts} in {run}" for run, opts in per.items())
+            notes.append(f"{planner} ran with other options in the runs given ({shown}): its "
+                         "rows pool them; run each under its own name to compare them")
+    return notes
