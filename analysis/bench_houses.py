@@ -284,12 +284,35 @@ def house_notes(house: Any) -> tuple[str, ...]:
         notes.append(f"starts[{i}] ({s.x:g}, {s.y:g}): {gap:.2f} m from a wall or a piece, "
                      f"less than the robot's radius ({house.robot_radius:g} m): the closed loop "
                      "starts it overlapping one")
+    notes += unreachable_notes(spec)
     unlinked = [r for r in unlinked_rooms(house) if r not in cut]
     if unlinked:
         notes.append(f"{', '.join(unlinked)}: joined to the rest by open floor (no wall) but "
                      "by no door or passage, so the scene graph never leads there: give the "
                      "opening a passage (or a door), or a wall")
     return tuple(notes)
+
+
+def unreachable_notes(spec: HouseSpec) -> list[str]:
+    """A note per piece holding small objects that the robot cannot get within reach of
+    from the house's start poses (:meth:`~sgtool.datasets.episodes.EpisodeGeometry.
+    unreachable_holders`; none without start poses)."""
+    from sgtool.datasets.episodes import REACH, EpisodeGeometry
+
+    if not spec.starts or not spec.objects:
+        return []
+    index = {f.id: k for k, f in enumerate(spec.furniture)}
+    by_id = spec.object_by_id()
+    notes = []
+    for piece, ids in EpisodeGeometry(spec).unreachable_holders():
+        held = ", ".join(f"{i} ({by_id[i].category})" for i in ids[:4])
+        more = f" and {len(ids) - 4} more" if len(ids) > 4 else ""
+        notes.append(f"furniture[{index[piece.id]}] ({piece.id}, {piece.category}) holds "
+                     f"{held}{more}, but the robot cannot get within {REACH:g} m of it from "
+                     "any start (furniture around it closes the way): the closed loop finds "
+                     "what it holds by sight only and cannot open it (leave the robot a way "
+                     "in); the symbolic bench reaches it all the same")
+    return notes
 
 
 def unlinked_rooms(house: Any) -> list[str]:

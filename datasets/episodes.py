@@ -162,6 +162,24 @@ class EpisodeGeometry:
             self._dist[key] = geodesic_distances(self.occ, key, max_snap=1.0)
         return self._dist[key]
 
+    def unreachable_holders(self) -> list[tuple[Furniture, list[str]]]:
+        """The pieces at the bottom of small objects' chains of parents that the robot
+        cannot get within ``reach`` of from any start pose of the house (furniture around
+        them closes the way: their targets are found by sight in the closed loop, never
+        opened), each with the ids of the objects it holds; spec order."""
+        held: dict[str, list[str]] = defaultdict(list)
+        for o in self.spec.objects:
+            held[self._piece(o.id).id].append(o.id)
+        out = []
+        for piece in self.spec.furniture:
+            if piece.id not in held:
+                continue
+            near = self.near(piece)
+            if near is None or not any(np.isfinite(self.distances(s)[near[0]][near[1]]).any()
+                                       for s in self.spec.starts):
+                out.append((piece, held[piece.id]))
+        return out
+
     def shortest_path(self, start: StartPose, target_ids: list[str]) -> float:
         """Geodesic to the nearest target (small object or furniture ids)."""
         d = self.distances(start)
