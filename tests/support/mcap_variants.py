@@ -14,22 +14,11 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import mcap.records as R
 import zstandard
 from mcap.data_stream import RecordBuilder
 from mcap.opcode import Opcode
 from mcap.reader import make_reader
-from mcap.records import (
-    AttachmentIndex,
-    ChunkIndex,
-    DataEnd,
-    Footer,
-    Header,
-    Message,
-    MessageIndex,
-    MetadataIndex,
-    Statistics,
-    SummaryOffset,
-)
 
 MAGIC = bytes([137, 77, 67, 65, 80, 48, 13, 10])
 EXTENSION = struct.pack("<BQ", 0xFF, 7) + b"\x00" * 7  # a record of an application's opcode
@@ -47,7 +36,7 @@ class Variant:
     extension: str = ""
     extend: int = 0
     chunk_messages: int = 50
-    order: Callable[[list[Message]], list[Message]] | None = None
+    order: Callable[[list[R.Message]], list[R.Message]] | None = None
 
 
 def _bytes(rec: object, extend: int = 0) -> bytes:
@@ -69,7 +58,7 @@ class _Writer:
     index: dict[int, list[tuple[int, int]]] = field(default_factory=dict)
     times: list[int] = field(default_factory=list)
     defined: set[tuple[str, int]] = field(default_factory=set)
-    chunk_indexes: list[ChunkIndex] = field(default_factory=list)
+    chunk_indexes: list[R.ChunkIndex] = field(default_factory=list)
 
     def top(self, rec_bytes: bytes) -> int:
         at = len(self.out)
@@ -97,9 +86,9 @@ class _Writer:
         offsets, mi = {}, bytearray()
         for cid, entries in sorted(self.index.items()):
             offsets[cid] = len(self.out) + len(mi)
-            mi += _bytes(MessageIndex(channel_id=cid, records=entries))
+            mi += _bytes(R.MessageIndex(channel_id=cid, records=entries))
         self.out += mi
-        self.chunk_indexes.append(ChunkIndex(
+        self.chunk_indexes.append(R.ChunkIndex(
             message_start_time=min(self.times), message_end_time=max(self.times),
             chunk_start_offset=start, chunk_length=len(rec), message_index_offsets=offsets,
             message_index_length=len(mi), compression="zstd", compressed_size=len(packed),
@@ -108,9 +97,7 @@ class _Writer:
 
 
 def _chunk(start: int, end: int, data: bytes, packed: bytes) -> object:
-    from mcap.records import Chunk
-
-    return Chunk(message_start_time=start, message_end_time=end,
+    return R.Chunk(message_start_time=start, message_end_time=end,
                  uncompressed_size=len(data), uncompressed_crc=zlib.crc32(data),
                  compression="zstd", data=packed)
 
@@ -130,8 +117,8 @@ def rewrite(src: Path, dst: Path, v: Variant) -> Path:
         messages = v.order(messages)
     w = _Writer(dst, v)
     w.out += MAGIC
-    w.top(_bytes(Header(profile=header.profile, library=header.library)))
-    stats = Statistics(message_count=0, schema_count=len(schemas), channel_count=len(channels),
+    w.top(_bytes(R.Header(profile=header.profile, library=header.library)))
+    stats = R.Statistics(message_count=0, schema_count=len(schemas), channel_count=len(channels),
                        attachment_count=len(attachments), metadata_count=len(metadata),
                        chunk_count=0, message_start_time=min(m.log_time for m in messages),
                        message_end_time=max(m.log_time for m in messages),
@@ -158,16 +145,16 @@ def rewrite(src: Path, dst: Path, v: Variant) -> Path:
     att_idx = []
     for a in attachments:
         rec = _bytes(a)
-        att_idx.append(AttachmentIndex(offset=w.top(rec), length=len(rec),
+        att_idx.append(R.AttachmentIndex(offset=w.top(rec), length=len(rec),
                                        log_time=a.log_time, create_time=a.create_time,
                                        data_size=len(a.data), name=a.name,
                                        media_type=a.media_type))
     meta_idx = []
     for md in metadata:
         rec = _bytes(md)
-        meta_idx.append(MetadataIndex(offset=w.top(rec), length=len(rec), name=md.name))
+        meta_idx.append(R.MetadataIndex(offset=w.top(rec), length=len(rec), name=md.name))
     stats.chunk_count = len(w.chunk_indexes)
-    w.out += _bytes(DataEnd(data_section_crc=0), v.extend)
+    w.out += _bytes(R.DataEnd(data_section_crc=0), v.extend)
     start = len(w.out)
     groups: list[tuple[int, Iterable[object]]] = [
         (Opcode.SCHEMA, schemas.values()), (Opcode.CHANNEL, channels.values()),
@@ -179,12 +166,12 @@ def rewrite(src: Path, dst: Path, v: Variant) -> Path:
         for rec in recs:
             w.out += _bytes(rec)
         if len(w.out) > at:
-            offsets.append(SummaryOffset(group_opcode=opcode, group_start=at,
+            offsets.append(R.SummaryOffset(group_opcode=opcode, group_start=at,
                                          group_length=len(w.out) - at))
     offset_start = len(w.out)
     for so in offsets:
         w.out += _bytes(so)
-    w.out += _bytes(Footer(summary_start=start, summary_offset_start=offset_start,
+    w.out += _bytes(R.Footer(summary_start=start, summary_offset_start=offset_start,
                            summary_crc=0))
     w.out += MAGIC
     dst.write_bytes(bytes(w.out))

@@ -203,6 +203,19 @@ def _messages_of(data: bytes | memoryview, offset: int, summary: Summary, wanted
     return out
 
 
+def _chunks_of(summary: Summary, topics: list[str] | None, start_ns: int | None,
+               end_ns: int | None) -> tuple[set[int] | None, list[ChunkIndex]]:
+    """(the channel ids of ``topics``, None for all; the chunks that may hold their
+    messages with ``start_ns <= log time < end_ns``), in index order."""
+    wanted = None if topics is None else {
+        cid for cid, ch in summary.channels.items() if ch.topic in set(topics)}
+    return wanted, [ci for ci in summary.chunk_indexes
+                    if (wanted is None or not ci.message_index_offsets
+                        or wanted & ci.message_index_offsets.keys())
+                    and (start_ns is None or ci.message_end_time >= start_ns)
+                    and (end_ns is None or ci.message_start_time < end_ns)]
+
+
 def ordered_messages(f: IO[bytes], summary: Summary, topics: list[str] | None = None, *,
                      start_ns: int | None = None, end_ns: int | None = None,
                      verify: bool = False, views: bool = False,
@@ -213,15 +226,8 @@ def ordered_messages(f: IO[bytes], summary: Summary, topics: list[str] | None = 
     ``data`` is a read-only ``memoryview`` into its chunk instead of a copy (for callers
     that parse it at once: an image is then copied once, by the parser, not twice), and
     with ``buffers`` too the chunks are decompressed into reused buffers."""
-    wanted = None if topics is None else {
-        cid for cid, ch in summary.channels.items() if ch.topic in set(topics)}
-    chunks = sorted(
-        (ci for ci in summary.chunk_indexes
-         if (wanted is None or not ci.message_index_offsets
-             or wanted & ci.message_index_offsets.keys())
-         and (start_ns is None or ci.message_end_time >= start_ns)
-         and (end_ns is None or ci.message_start_time < end_ns)),
-        key=lambda ci: (ci.message_start_time, ci.chunk_start_offset))
+    wanted, chunks = _chunks_of(summary, topics, start_ns, end_ns)
+    chunks.sort(key=lambda ci: (ci.message_start_time, ci.chunk_start_offset))
     pending: list[tuple[_Key, Item]] = []
     for j, ci in enumerate(chunks):
         data = chunk_records(f, ci, verify, buffers if views else None)
@@ -248,15 +254,8 @@ def reversed_messages(f: IO[bytes], summary: Summary, topics: list[str] | None =
     chunk from the chunk that ends last (the ``mcap`` reader's reverse read parses a chunk
     with a record parser of its own, which loses the messages after a schema or channel
     record that a newer writer extended)."""
-    wanted = None if topics is None else {
-        cid for cid, ch in summary.channels.items() if ch.topic in set(topics)}
-    chunks = sorted(
-        (ci for ci in summary.chunk_indexes
-         if (wanted is None or not ci.message_index_offsets
-             or wanted & ci.message_index_offsets.keys())
-         and (start_ns is None or ci.message_end_time >= start_ns)
-         and (end_ns is None or ci.message_start_time < end_ns)),
-        key=lambda ci: (ci.message_end_time, ci.chunk_start_offset), reverse=True)
+    wanted, chunks = _chunks_of(summary, topics, start_ns, end_ns)
+    chunks.sort(key=lambda ci: (ci.message_end_time, ci.chunk_start_offset), reverse=True)
     pending: list[tuple[_Key, Item]] = []
     for j, ci in enumerate(chunks):
         data = chunk_records(f, ci, verify, None)
