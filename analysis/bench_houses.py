@@ -295,8 +295,9 @@ def house_notes(house: Any) -> tuple[str, ...]:
 
 def unreachable_notes(spec: HouseSpec) -> list[str]:
     """A note per piece holding small objects that the robot cannot get within reach of
-    from the house's start poses (:meth:`~sgtool.datasets.episodes.EpisodeGeometry.
-    unreachable_holders`; none without start poses)."""
+    from the house's start poses, in a room it does enter
+    (:meth:`~sgtool.datasets.episodes.EpisodeGeometry.unreachable_holders`; none without
+    start poses)."""
     from sgtool.datasets.episodes import REACH, EpisodeGeometry
 
     if not spec.starts or not spec.objects:

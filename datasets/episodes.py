@@ -164,19 +164,24 @@ class EpisodeGeometry:
 
     def unreachable_holders(self) -> list[tuple[Furniture, list[str]]]:
         """The pieces at the bottom of small objects' chains of parents that the robot
-        cannot get within ``reach`` of from any start pose of the house (furniture around
-        them closes the way: their targets are found by sight in the closed loop, never
-        opened), each with the ids of the objects it holds; spec order."""
+        cannot get within ``reach`` of from any start pose of the house, in a room whose
+        floor it does reach elsewhere (furniture around them closes the way: their targets
+        are found by sight in the closed loop, never opened), each with the ids of the
+        objects it holds; spec order. A room the robot cannot enter at all (too narrow, or
+        walled off) is not these pieces' fault and is left out."""
         held: dict[str, list[str]] = defaultdict(list)
         for o in self.spec.objects:
             held[self._piece(o.id).id].append(o.id)
+        reached = np.zeros(self.occ.shape, dtype=bool)
+        for s in self.spec.starts:
+            reached |= np.isfinite(self.distances(s))
         out = []
         for piece in self.spec.furniture:
-            if piece.id not in held:
+            if piece.id not in held or not reached[
+                    self.rooms == self._room_index[piece.room]].any():
                 continue
             near = self.near(piece)
-            if near is None or not any(np.isfinite(self.distances(s)[near[0]][near[1]]).any()
-                                       for s in self.spec.starts):
+            if near is None or not reached[near[0]][near[1]].any():
                 out.append((piece, held[piece.id]))
         return out
 
