@@ -7,7 +7,7 @@ action records. With an output it also writes the derived log: a copy of every i
 message (same bytes, same channels and schemas, same order), the input's attachments and
 its ``sgtool`` metadata, and after the message that caused each refresh the derived
 channels of :mod:`sgtool.scenegraph.derived_layers` and the scene graph as a Foxglove
-``SceneUpdate`` (:mod:`sgtool.replayers.graph_scene`, ``/map/graph``) at the refresh time.
+``SceneUpdate`` (:mod:`sgtool.scenegraph.graph_scene`, ``/map/graph``) at the refresh time.
 Derived channels of the input (a log that was already replayed, or a closed-loop log) are
 not copied: they are rebuilt. A metadata record ``sgtool.replay`` holds the options. Input
 chunks go into the derived log as they are, not recompressed (:mod:`sgtool.log.chunk_copy`),
@@ -56,7 +56,6 @@ from sgtool.log.writer import LogWriter
 from sgtool.mapping.voxels import VoxelConfig
 from sgtool.progress import Progress
 from sgtool.replayers.depth_range import FirstFrames, first_frames
-from sgtool.replayers.graph_scene import graph_scene_update
 from sgtool.replayers.instance_notes import instance_notes
 from sgtool.scenegraph.build_options import (
     CLASSIFIERS,
@@ -380,8 +379,6 @@ class _Feed:
         self.report.last = r
         if self.writer is not None:
             write_refresh(self.writer, r)
-            self.writer.write_proto(S.GRAPH_SCENE, r.time_ns,
-                                    graph_scene_update(r.time_ns, r.graph.to_dict()))
         if self.on_refresh is not None:
             self.on_refresh(r, self.stream)
 

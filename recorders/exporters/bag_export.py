@@ -10,7 +10,11 @@ Topics (sgtool topic -> ROS topic, type):
   of the same stamp and frame, as ``image_proc``/``depth_image_proc`` pair them;
 - ``/tf`` -> ``/tf`` (``tf2_msgs/TFMessage``) for the links that move, and one latched
   ``/tf_static`` message, at the first stamp, holding every link whose transform never
-  changes in the log (``/tf_static`` of the log is taken as fixed too);
+  changes in the log (``/tf_static`` of the log is taken as fixed too). A link that moves
+  only at times (a closed loop's head tilted to look into a container, its mounting on
+  the log's ``/tf_static``) goes to ``/tf`` from its first sample on, again at each image
+  stamp while it holds still, so that ``tf2`` (which neither extrapolates nor keeps
+  samples older than its cache) resolves every image's frame;
 - ``/map/occupancy`` -> ``nav_msgs/OccupancyGrid``; ``/map/voronoi``, ``/map/rooms`` ->
   ``visualization_msgs/MarkerArray``; ``/sgtool/scene_graph`` -> ``std_msgs/String`` (its
   JSON) and ``/map/objects`` (``MarkerArray`` of the graph's objects). These, and
@@ -339,21 +343,26 @@ def _write(r: LogReader, w: BagWriter, chosen: list[str], base_ns: int,
                 latched=True)
         calib: CameraIntrinsics | None = None
         converters = _converters(w)
+        held: dict[tuple[str, str], tuple[np.ndarray, int]] = {}  # moving: value, its stamp
         for d in r.messages(topics):
             if progress is not None:
                 progress.update(1)
             t = d.log_time_ns + base_ns
             if d.topic == S.CALIBRATION:
                 calib = codec.decode_calibration(d.message)
-            elif d.topic == TF_STATIC:
-                continue  # in the one /tf_static message above
-            elif d.topic == S.TF:
+            elif d.topic in (S.TF, TF_STATIC):
                 key = (d.message.parent_frame_id, d.message.child_frame_id)
-                if key not in static and S.TF in want:
-                    w.write(S.TF, TF_TYPE, t, w.tf(t, [w.transform_stamped(
-                        t, key[0], key[1], codec.decode_transform(d.message))]))
+                if key in static or S.TF not in want:
+                    continue  # in the one /tf_static message above
+                T = codec.decode_transform(d.message)  # noqa: N806
+                held[key] = (T, t)
+                w.write(S.TF, TF_TYPE, t, w.tf(t, [w.transform_stamped(t, *key, T)]))
             elif d.topic in IMAGE_TOPICS:
                 ns = IMAGE_TOPICS[d.topic]
+                for key, (T, since) in list(held.items()):  # noqa: N806
+                    if since < t:  # a moving link, still: again at the image's stamp
+                        held[key] = (T, t)
+                        w.write(S.TF, TF_TYPE, t, w.tf(t, [w.transform_stamped(t, *key, T)]))
                 if f"{ns}/image_raw" in want:
                     w.write(f"{ns}/image_raw", IMAGE, t, _image(w, t, d.message))
                 if f"{ns}/camera_info" in want and calib is not None:

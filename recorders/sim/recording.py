@@ -83,6 +83,7 @@ class LogRecorder(SimObserver):
         self._calibration: CameraIntrinsics | None = None  # the last one written
         self._static: np.ndarray | None = None  # base_T_camera as on /tf_static
         self._link_moved = False  # the last base -> camera on /tf is not the static one
+        self._level_ns: int | None = None  # the last frame's time, while at the mounting
         profile = noise or PROFILES["none"]
         structure = [i.id for i in sim.instances if i.kind == STRUCTURE]
         self.faults = None if profile.is_clean else SensorFaults(
@@ -120,9 +121,11 @@ class LogRecorder(SimObserver):
         it changes, transforms, RGB, depth, ids), with two differences: the base -> camera
         link, which does not move, goes once to ``/tf_static`` (again on ``/tf`` only at a
         frame where it differs by more than :data:`STATIC_TOL`, e.g. under pose noise),
-        and the ids are :func:`instance_image`'s. A link that moved (a tilted head) is
-        written on ``/tf`` again at the first frame it is back at the mounting, since a
-        reader takes the latest ``/tf`` link at or before a frame."""
+        and the ids are :func:`instance_image`'s. A link that moves (a tilted head) is also
+        written on ``/tf`` at the mounting at the last frame before (a viewer that
+        interpolates between samples, as Foxglove does, then tilts the camera between two
+        frames, not over the whole run before) and again at the first frame it is back,
+        since a reader takes the latest ``/tf`` link at or before a frame."""
         w, t = self.writer, f.time_ns
         if f.intrinsics != self._calibration:
             w.write_calibration(t, f.intrinsics)
@@ -137,11 +140,16 @@ class LogRecorder(SimObserver):
                 w.write_proto(S.TF_STATIC, t, codec.encode_transform(
                     t, S.BASE_FRAME, S.CAMERA_FRAME, base_T_cam))
             elif not np.allclose(base_T_cam, self._static, rtol=0.0, atol=STATIC_TOL):
+                if self._level_ns is not None:  # still at the mounting one frame ago
+                    w.write_transform(self._level_ns, S.BASE_FRAME, S.CAMERA_FRAME,
+                                      self._static)
                 w.write_transform(t, S.BASE_FRAME, S.CAMERA_FRAME, base_T_cam)
-                self._link_moved = True
+                self._link_moved, self._level_ns = True, None
             elif self._link_moved:  # back to the mounting: /tf says so, as readers use it
                 w.write_transform(t, S.BASE_FRAME, S.CAMERA_FRAME, self._static)
                 self._link_moved = False
+            if not self._link_moved:
+                self._level_ns = t
         if f.rgb is not None:
             w.write_rgb(t, f.rgb)
         w.write_depth(t, f.depth)

@@ -37,6 +37,7 @@ from sgtool.log import schemas as S
 from sgtool.log.records import SceneGraphRecord
 from sgtool.log.writer import LogWriter
 from sgtool.scenegraph import scene_wire as sw
+from sgtool.scenegraph.graph_scene import graph_scene_update
 from sgtool.scenegraph.stream import Refresh
 
 GRAPH_Z = 0.05  # m: height of the drawn graph above the floor
@@ -187,7 +188,8 @@ def rooms_message(refresh: Refresh) -> SceneUpdate | None:
 
 def write_refresh(writer: LogWriter, refresh: Refresh) -> None:
     """Write the derived channels of ``refresh`` at its time: occupancy, Voronoi graph,
-    rooms (when map layers exist) and the scene graph."""
+    rooms (when map layers exist), the scene graph and its ``SceneUpdate`` (``/map/graph``,
+    :mod:`sgtool.scenegraph.graph_scene`)."""
     t = refresh.time_ns
     for topic, make in ((S.OCCUPANCY, occupancy_message), (S.VORONOI, voronoi_message),
                         (S.ROOMS, rooms_message)):
@@ -195,3 +197,4 @@ def write_refresh(writer: LogWriter, refresh: Refresh) -> None:
         if msg is not None:
             writer.write_proto(topic, t, msg)
     writer.write_record(SceneGraphRecord.of_graph(refresh.graph), t)
+    writer.write_proto(S.GRAPH_SCENE, t, graph_scene_update(t, refresh.graph.to_dict()))

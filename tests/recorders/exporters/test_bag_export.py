@@ -22,6 +22,7 @@ from foxglove_schemas_protobuf.SceneEntity_pb2 import SceneEntity
 from foxglove_schemas_protobuf.SceneEntityDeletion_pb2 import SceneEntityDeletion
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
 from foxglove_schemas_protobuf.TextPrimitive_pb2 import TextPrimitive
+from support.bag_read import read_bag, stamp_ns
 from support.logfixtures import DT, synthetic_frame
 
 from sgtool.cli import cli
@@ -32,26 +33,6 @@ from sgtool.recorders.exporters.bag_export import REP105, export_bag, trajectory
 from sgtool.recorders.exporters.ros_maps import DELETEALL, LINE_LIST, LINE_STRIP, TEXT
 
 GOLDEN = Path(__file__).resolve().parents[2] / "golden" / "house6-tour.mcap"
-
-
-def read_bag(path: Path, types: dict[str, str] | None = None
-             ) -> dict[str, list[tuple[int, object]]]:
-    """Every message of the bag by topic, deserialised; ``types`` gets topic -> type."""
-    from rosbags.highlevel import AnyReader
-    from rosbags.typesys import Stores, get_typestore
-
-    out: dict[str, list[tuple[int, object]]] = {}
-    with AnyReader([path], default_typestore=get_typestore(Stores.LATEST)) as r:
-        for c, t, raw in r.messages():
-            out.setdefault(c.topic, []).append((t, r.deserialize(raw, c.msgtype)))
-            if types is not None:
-                types[c.topic] = c.msgtype
-    return out
-
-
-def stamp_ns(msg: object) -> int:
-    st = msg.header.stamp  # type: ignore[attr-defined]
-    return int(st.sec) * 1_000_000_000 + int(st.nanosec)
 
 
 def log_with_rooms(path: Path, n: int = 4) -> Path:

@@ -261,6 +261,8 @@ def test_a_replay_shows_the_planner_the_graph_it_was_shown(house, tmp_path) -> N
     (logged,) = read_log_episodes(out)
     decided = [d for d in logged.decisions if d.decided]
     assert len(decided) == len(given) >= 2
+    with LogReader(out) as r:  # Foxglove's view of each graph, as a replay writes it
+        assert r.message_count(S.GRAPH_SCENE) == r.message_count(GRAPH) >= 2
     assert any(d.action.view_distances for d in decided)
     for d, g in zip(decided, given, strict=True):
         assert d.graph is not None

@@ -19,6 +19,7 @@ import math
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from support.bag_read import read_bag
 from support.scripted_planner import Scripted
 
 from sgtool.cli import cli
@@ -313,10 +314,37 @@ def test_after_opening_a_container_the_robot_peeks_in_and_back(house, tmp_path) 
     assert len(low) == 2 * len(head_tilts(15.0, goal, 9.0)) - 1
     assert len(frames1) == len(frames0) + len(low) + 1
     assert all(np.array_equal(frames1[i].base_pose, stand) for i in low)
+    # the link on /tf: at the mounting at the last frame before the tilt (a viewer that
+    # interpolates tilts the camera between two frames only), tilted, and back after
+    with LogReader(out) as r:
+        links = [(d.log_time_ns, _tilt(decode_transform(d.message)))
+                 for d in r.messages([S.TF]) if d.message.child_frame_id == S.CAMERA_FRAME]
+    before, after = frames1[low[0] - 1].time_ns, frames1[low[-1] + 1].time_ns
+    assert links[0] == (before, pytest.approx(15.0)) and links[-1] == (after,
+                                                                       pytest.approx(15.0))
+    assert [t for t, _ in links[1:-1]] == [frames1[i].time_ns for i in low]
     derived = tmp_path / "peek-replayed.mcap"
     r = CliRunner().invoke(cli, ["replay", str(out), "-o", str(derived)])
     assert r.exit_code == 0, r.output
     assert _graphs(out) == _graphs(derived) and len(_graphs(out)) >= 2
+    # as a ROS bag: every image has the camera's link on /tf at its stamp (tf2 neither
+    # extrapolates nor keeps old samples), tilted where the log's is
+    bag = tmp_path / "peek_bag"
+    r = CliRunner().invoke(cli, ["export", "bag", str(out), "-o", str(bag), "--no-progress"])
+    assert r.exit_code == 0, r.output
+    got = read_bag(bag)
+    stamps = {_stamp(m.header.stamp) for _, m in got["/camera/depth/image_raw"]}
+    links_at = {_stamp(tr.header.stamp): tr for _, m in got["/tf"] for tr in m.transforms
+                if tr.child_frame_id == "camera_optical_frame"}
+    assert stamps and stamps <= set(links_at)
+    assert all(tr.child_frame_id != "camera_optical_frame"
+               for _, m in got.get("/tf_static", []) for tr in m.transforms)
+    tilted = [tr for tr in links_at.values() if abs(tr.transform.rotation.x) > 0.0]
+    assert len({round(tr.transform.rotation.x, 6) for tr in tilted}) == len(low) // 2 + 2
+
+
+def _stamp(stamp) -> int:
+    return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
 
 
 def _graphs(path) -> list[bytes]:

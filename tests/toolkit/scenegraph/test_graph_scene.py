@@ -15,7 +15,7 @@ from sgtool.log import LogReader, codec
 from sgtool.log import schemas as S
 from sgtool.recorders.sim.recording import instance_image
 from sgtool.replayers.derived_log import ReplayOptions, replay
-from sgtool.replayers.graph_scene import graph_scene_update
+from sgtool.scenegraph.graph_scene import graph_scene_update
 
 
 def test_derived_log_has_graph_entities_with_metadata(tmp_path):
