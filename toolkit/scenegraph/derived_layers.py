@@ -25,6 +25,8 @@ from foxglove_schemas_protobuf.Color_pb2 import Color
 from foxglove_schemas_protobuf.Grid_pb2 import Grid
 from foxglove_schemas_protobuf.LinePrimitive_pb2 import LinePrimitive
 from foxglove_schemas_protobuf.Point3_pb2 import Point3
+from foxglove_schemas_protobuf.Pose_pb2 import Pose
+from foxglove_schemas_protobuf.Quaternion_pb2 import Quaternion
 from foxglove_schemas_protobuf.SceneEntity_pb2 import SceneEntity
 from foxglove_schemas_protobuf.SceneEntityDeletion_pb2 import SceneEntityDeletion
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
@@ -97,7 +99,7 @@ def voronoi_message(refresh: Refresh) -> SceneUpdate | None:
         ends = xy[edges.reshape(-1)]  # u, v of every edge
         col = rgba[np.repeat(np.where(cu == cv, cu, 0), 2)]
         m = len(ends)
-        line = LinePrimitive(type=LinePrimitive.LINE_LIST, thickness=0.03,
+        line = LinePrimitive(type=LinePrimitive.LINE_LIST, pose=_identity(), thickness=0.03,
                              color=room_color(None))
         line.MergeFromString(
             sw.records(_LINE_POINT, {"x": ends[:, 0], "y": ends[:, 1], "z": GRAPH_Z}, m)
@@ -170,7 +172,8 @@ def rooms_message(refresh: Refresh) -> SceneUpdate | None:
             np.ascontiguousarray(vg.positions[nodes], dtype=np.float64).tobytes(), ROOM_MARGIN)
         ent = SceneEntity(timestamp=stamp, frame_id=S.WORLD_FRAME, id=rid)
         ent.lines.append(LinePrimitive(
-            type=LinePrimitive.LINE_LOOP, thickness=0.05, color=room_color(rid),
+            type=LinePrimitive.LINE_LOOP, pose=_identity(), thickness=0.05,
+            color=room_color(rid),
             points=[Point3(x=float(x), y=float(y), z=GRAPH_Z) for x, y in hull.tolist()]))
         cx, cy = (float(v) for v in vg.positions[nodes].mean(axis=0))
         room = refresh.graph.room(rid)
@@ -184,6 +187,12 @@ def rooms_message(refresh: Refresh) -> SceneUpdate | None:
         ent.texts.append(t)
         upd.entities.append(ent)
     return upd
+
+
+def _identity() -> Pose:
+    """The pose of a primitive given in world coordinates (a pose left out is a zero
+    quaternion on the wire, which a viewer may not read as no rotation)."""
+    return Pose(orientation=Quaternion(w=1.0))
 
 
 def write_refresh(writer: LogWriter, refresh: Refresh) -> None:

@@ -40,8 +40,10 @@ def _one_by_one(refresh: SimpleNamespace) -> SceneUpdate:
             c = room_color(rooms[u] if rooms[u] == rooms[v] else None)
             pts += (points[u], points[v])
             cols += (c, c)
-        ent.lines.append(LinePrimitive(type=LinePrimitive.LINE_LIST, thickness=0.03,
-                                       points=pts, colors=cols, color=room_color(None)))
+        line = LinePrimitive(type=LinePrimitive.LINE_LIST, thickness=0.03,
+                             points=pts, colors=cols, color=room_color(None))
+        line.pose.orientation.w = 1.0  # the world frame as it is, no zero quaternion
+        ent.lines.append(line)
     for n, (x, y) in enumerate(xy):
         s = ent.spheres.add()
         s.pose.position.x, s.pose.position.y, s.pose.position.z = float(x), float(y), GRAPH_Z
