@@ -46,14 +46,18 @@ def training_vocabulary(priors_dir: str | None) -> frozenset[str]:
 
 def priors_fingerprint(weights_dir: str | os.PathLike[str] | None = None) -> str:
     """SHA-256 (first 16 hex digits) of the relational-prior weights the scout planners load
-    (the shipped ones by default), so a table can be traced to the priors behind it."""
+    (the shipped ones by default): the models, their metadata and the room blend when the
+    folder has one (:mod:`sgtool.semantics.room_blend`), so a table can be traced to the
+    priors behind it."""
     import hashlib
 
     from sgtool.semantics.priors import weights_folder
+    from sgtool.semantics.room_blend import BLEND_FILE, VECTORS_FILE
 
     h = hashlib.sha256()
     for p in sorted(weights_folder(weights_dir).glob("*")):
-        if p.is_file() and (p.suffix == ".safetensors" or p.name == "metadata.json"):
+        if p.is_file() and (p.suffix == ".safetensors"
+                            or p.name in ("metadata.json", BLEND_FILE, VECTORS_FILE)):
             h.update(p.name.encode())
             h.update(p.read_bytes())
     return h.hexdigest()[:16]

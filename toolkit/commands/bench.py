@@ -193,6 +193,14 @@ def _planners(args: BenchArgs) -> tuple[tuple[str, ...], dict[str, dict[str, Any
                if k in names}  # those of planners not run: a note said they are unused
     LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
                 args.llm_timeout).fill(options, names)
+    for name, given in options.items():  # priors of their own: the tables do not say so
+        if "weights_dir" in given and str(given["weights_dir"]) != str(args.priors_dir):
+            bench_priors = f"--priors {args.priors_dir}" if args.priors_dir else \
+                "the shipped priors"
+            click.echo(f"sgtool: note: -O {name}.weights_dir={given['weights_dir']}: {name} "
+                       "loads those priors, but the summary's priors id and seen/unseen "
+                       f"split are those of {bench_priors}; give --priors DIR to label the "
+                       "tables by the priors the planners load", err=True)
     if args.llm_replay or args.llm_transcript:
         moma = options.setdefault("moma-llm", {})
         if args.llm_replay:

@@ -196,9 +196,11 @@ def _episodes(spec: Any, count: int | None, seed: int, reach: float, preset: str
 @click.option("--seed", type=click.IntRange(min=0), default=None,
               help="Seed of the choice of categories and start poses [default: the house "
               "file's seed, the one `sgtool bench` and `run-bench` draw with].")
-@click.option("--reach", type=FiniteFloatRange(min=0.3), default=1.0, show_default=True,
+@click.option("--reach", type=FiniteFloatRange(min=0.3, max=100.0), default=1.0,
+              show_default=True,
               help="A target counts as reached within this distance (m) of its parent (at "
-              "least 0.3: the robot's centre stays 0.2 m from furniture).")
+              "least 0.3: the robot's centre stays 0.2 m from furniture; at most 100, a "
+              "house's largest extent).")
 @_preset_option
 @click.option("--json", "as_json", is_flag=True, help="Print JSON (one list).")
 def episodes_cmd(house: str, count: int | None, seed: int | None, reach: float, preset: str,

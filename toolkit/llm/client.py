@@ -142,6 +142,11 @@ class LlmSettings:
                 f"the LLM base URL {redact_text(base_url)!r} must start with http:// or "
                 "https:// (an OpenAI-compatible API, e.g. http://127.0.0.1:8080/v1 for "
                 "`sgtool llm serve`): check SGTOOL_LLM_BASE_URL / --llm-base-url / base_url")
+        if base_url and (problem := _url_problem(base_url)):
+            raise LlmConfigError(
+                f"the LLM base URL {redact_text(base_url)!r}: {problem} (e.g. "
+                "http://127.0.0.1:8080/v1): check SGTOOL_LLM_BASE_URL / --llm-base-url / "
+                "base_url")
         if not base_url and not api_key:
             raise LlmConfigError(
                 "no LLM endpoint configured: set SGTOOL_LLM_BASE_URL (and SGTOOL_LLM_API_KEY "
@@ -157,6 +162,23 @@ class LlmSettings:
         if not timeout > 0:
             raise LlmConfigError(f"LLM timeout must be > 0 s, got {timeout_s}")
         return cls(base_url, model, api_key, timeout, temperature, max_tokens)
+
+
+def _url_problem(url: str) -> str | None:
+    """What makes ``url`` (http or https) no URL an HTTP client can use: a port that is no
+    number from 1 to 65535, no host, a bracket left open; None when it is one."""
+    from urllib.parse import urlsplit
+
+    try:
+        parts = urlsplit(url)
+        port = parts.port  # ValueError: a port that is no number, or out of range
+    except ValueError as e:
+        return f"not a valid URL ({e})"
+    if not parts.hostname:
+        return "no host in it"
+    if port == 0:
+        return "port 0 is no port"
+    return None
 
 
 # HTTP statuses of a first request that say the setup is wrong (key, path, model, method;

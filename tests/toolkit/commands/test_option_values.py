@@ -64,6 +64,28 @@ def test_an_option_of_a_planner_not_run_is_a_note(tmp_path: Path) -> None:
     assert planner_options(("greedy.x=1",), ("random",)) == {"greedy": {"x": 1}}
 
 
+def test_priors_of_a_planners_own_are_noted_and_fingerprinted(tmp_path: Path) -> None:
+    """-O scout.weights_dir=DIR loads other priors than the bench's --priors: the tables'
+    priors id and seen/unseen split are --priors', so a note says so; the id covers a
+    folder's room blend (its episodes differ with it)."""
+    from sgtool.analysis.bench_priors import priors_fingerprint
+    from sgtool.semantics.priors import weights_folder
+
+    r = CliRunner().invoke(cli, [*BENCH, "--planners", "scout", "-O",
+                                 "scout.weights_dir=blend", "--no-progress", "-o",
+                                 str(tmp_path / "b")])
+    assert r.exit_code == 0, r.output
+    assert ("sgtool: note: -O scout.weights_dir=blend: scout loads those priors, but the "
+            "summary's priors id and seen/unseen split are those of the shipped priors"
+            ) in r.stderr
+    bare = tmp_path / "bare"
+    shutil.copytree(weights_folder("blend"), bare)
+    for name in ("room_blend.json", "room_blend_vectors.npy"):
+        (bare / name).unlink()
+    assert priors_fingerprint("blend") != priors_fingerprint(bare)
+    assert priors_fingerprint(None) == priors_fingerprint(WEIGHTS_DIR)
+
+
 def test_an_option_of_a_name_close_to_a_planner_run_is_an_error() -> None:
     """``lab:Labplanner.k`` with ``lab:LabPlanner`` run is a typo, not another planner."""
     from sgtool.commands.options import planner_options

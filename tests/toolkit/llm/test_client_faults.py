@@ -5,6 +5,7 @@ the API key is written nowhere."""
 from __future__ import annotations
 
 import json
+import re
 import time
 
 import pytest
@@ -208,3 +209,17 @@ def test_a_base_url_without_http_is_a_setup_error(url):
     with pytest.raises(LlmConfigError, match="must start with http:// or https://"):
         LlmSettings.resolve(base_url=url, model="m")
     assert LlmSettings.resolve(base_url="HTTPS://example.org/v1").base_url
+
+
+@pytest.mark.parametrize(("url", "says"), [
+    ("http://127.0.0.1:80a/v1", "not a valid URL (Port could not be cast"),
+    ("http://[::1", "not a valid URL (Invalid IPv6 URL)"),
+    ("http://127.0.0.1:99999/v1", "not a valid URL (Port out of range"),
+    ("http:///v1", "no host in it"),
+])
+def test_a_mistyped_base_url_is_a_setup_error(url, says):
+    """A typo in the port or host is refused in one line before any client is built (the
+    HTTP client raised its own exception from inside)."""
+    with pytest.raises(LlmConfigError, match=re.escape(says)):
+        LlmSettings.resolve(base_url=url, model="m")
+    assert LlmSettings.resolve(base_url="http://[::1]:8080/v1").base_url
