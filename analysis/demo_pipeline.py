@@ -70,7 +70,8 @@ def _replay(log: Path, derived: Path, frames: int, show: Echo, progress: bool) -
         show(line)
     ref, stream = final["ref"], final["stream"]
     for line in score_lines(score(demo_house(), stream.builder.instances, ref.layers,
-                                  ref.graph, stream.builder.trajectory)):
+                                  ref.graph, stream.builder.trajectory),
+                            len(ref.graph.objects)):
         show(line)
 
 

@@ -155,8 +155,9 @@ class RecordingSettings:
     noise_seed: int = 0
 
     def check(self) -> None:
-        if self.width < 16 or self.height < 16:
-            raise SgtoolError(f"--resolution {self.width}x{self.height}: at least 16x16")
+        if not (16 <= self.width <= 4096 and 16 <= self.height <= 4096):
+            raise SgtoolError(f"--resolution {self.width}x{self.height}: each side 16..4096 "
+                              "pixels")
         from sgtool.recorders.sim.simulation import FPS_RANGE
 
         if not (math.isfinite(self.fps) and FPS_RANGE[0] <= self.fps <= FPS_RANGE[1]):

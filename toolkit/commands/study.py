@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import sys
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -169,9 +170,9 @@ def _request(args: NoiseArgs) -> NoiseStudyRequest:
                                   ).check()
         except SgtoolError as e:
             raise _renamed(e, "--planners", "--closed-loop") from None
+        _check_llm_planners(cfg.closed_loop.planners)
     cache = Path(args.cache_dir) if args.cache_dir else default_cache()
-    if cache.exists() and not cache.is_dir():
-        raise SgtoolError(f"--cache {cache}: is a file, not a folder")
+    _check_cache(cache)
     return NoiseStudyRequest(
         config=cfg, cache=cache, out_dir=args.out_dir, force=args.force,
         progress=sys.stderr.isatty() if args.progress is None else args.progress,
@@ -202,9 +203,39 @@ def _conditions(factors: tuple[str, ...], profiles: tuple[str, ...]) -> Any:
 
 def _renamed(e: SgtoolError, theirs: str, ours: str) -> SgtoolError:
     """``e`` with the option its message starts with (another command's, ``theirs``)
-    named as this command calls it (``ours``)."""
+    named as this command calls it (``ours``; run-bench's ``--noise`` is
+    ``--closed-loop-noise`` here)."""
     text = str(e)
-    return SgtoolError(ours + text[len(theirs):] if text.startswith(theirs) else text)
+    text = ours + text[len(theirs):] if text.startswith(theirs) else text
+    return SgtoolError(text.replace(f"{ours}/--noise", f"{ours}/--closed-loop-noise", 1))
+
+
+def _check_llm_planners(planners: Sequence[str]) -> None:
+    """An LLM planner of the closed-loop part needs an endpoint before any recording (the
+    study takes it from SGTOOL_LLM_BASE_URL; it has no option for one)."""
+    from sgtool.planning.registry import is_llm_planner, make_planner
+
+    for name in planners:
+        if is_llm_planner(name):
+            try:
+                make_planner(name)
+            except SgtoolError as e:
+                why = str(e)
+                if why.startswith("no LLM endpoint configured"):
+                    why = ("no LLM endpoint configured: set SGTOOL_LLM_BASE_URL (and "
+                           "SGTOOL_LLM_API_KEY if it needs one); study noise has no option "
+                           "for it")
+                raise SgtoolError(f"--closed-loop {name}: {why}") from None
+
+
+def _check_cache(cache: Path) -> None:
+    """``--cache`` is a folder, or can be made one (its nearest existing ancestor is a
+    folder), before any work."""
+    near = next((p for p in (cache, *cache.parents) if p.exists()), None)
+    if near is not None and not near.is_dir():
+        what = "is a file, not a folder" if near == cache else \
+            f"lies under {near}, which is no folder"
+        raise SgtoolError(f"--cache {cache}: {what}")
 
 
 def _closed_loop(args: NoiseArgs) -> Any:

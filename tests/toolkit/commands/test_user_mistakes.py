@@ -175,12 +175,29 @@ def test_a_run_that_leaves_its_recorded_transcript_is_an_error(tmp_path):
     (["--closed-loop", "bogus"], "sgtool: error: --closed-loop: unknown planner 'bogus'"),
     (["--closed-loop", "scout", "--closed-loop-noise", "bogus"],
      "sgtool: error: --closed-loop-noise bogus: unknown profile 'bogus'"),
+    (["--closed-loop", "scout", "--closed-loop-noise", "none,none"],
+     "sgtool: error: --closed-loop/--closed-loop-noise: a name is given twice"),
+    (["--closed-loop", "moma-llm"], "sgtool: error: --closed-loop moma-llm: no LLM endpoint "
+     "configured: set SGTOOL_LLM_BASE_URL (and SGTOOL_LLM_API_KEY if it needs one); study "
+     "noise has no option for it"),
+    (["--resolution", "4097x120"], "sgtool: error: --resolution 4097x120: each side "
+     "16..4096 pixels"),
+    (["--cache", "{tmp}/f/x"], "sgtool: error: --cache {tmp}/f/x: lies under {tmp}/f, which "
+     "is no folder"),
 ])
-def test_study_names_its_own_closed_loop_options(tmp_path, args, line):
+def test_study_names_its_own_closed_loop_options(tmp_path, monkeypatch, args, line):
     """study noise checks its closed-loop planners and profiles with run-bench's and
-    record's rules, but the message names the option the user gave."""
+    record's rules, its LLM planners' endpoint, resolution and cache before any recording,
+    and the message names the option the user gave."""
+    for key in ("SGTOOL_LLM_BASE_URL", "OPENAI_BASE_URL", "SGTOOL_LLM_API_KEY",
+                "OPENAI_API_KEY"):
+        monkeypatch.delenv(key, raising=False)
+    (tmp_path / "f").write_text("a file")
+    args = [a.replace("{tmp}", str(tmp_path)) for a in args]
     r = CliRunner().invoke(cli, ["study", "noise", *args, "-o", str(tmp_path / "s")])
-    assert r.exit_code == 2 and r.output.startswith(line), r.output
+    assert r.exit_code == 2 and r.output.startswith(line.replace("{tmp}", str(tmp_path))), \
+        r.output
+    assert not (tmp_path / "s").exists()
 
 
 def test_ctrl_c_while_the_rrd_is_written_says_the_log_is_complete(tmp_path, monkeypatch):
