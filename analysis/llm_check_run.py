@@ -86,11 +86,11 @@ def run_check(request: LlmCheckRequest) -> LlmCheckResult:
         "decision_s": round(dec.decision_s, 3), "constraint": dec.constraint,
         "query": query,
     }
-    tps = "unknown (no token count)" if speed.tokens_per_s is None \
-        else f"{speed.tokens_per_s:.1f}"
+    generation = (f"{speed.completion_tokens} tokens in {speed.latency_s:.2f} s = "
+                  f"{speed.tokens_per_s:.1f} tokens/s" if speed.tokens_per_s is not None
+                  else f"{speed.latency_s:.2f} s (the reply counted no tokens: no speed)")
     lines = [f"endpoint {figures['endpoint']}, model {settings.model}",
-             f"generation: {speed.completion_tokens} tokens in {speed.latency_s:.2f} s "
-             f"= {tps} tokens/s",
+             f"generation: {generation}",
              f"scene decision (find {query}, constraint {dec.constraint}): "
              f"{'parsed' if dec.parsed else 'NOT parsed'}: {dec.action} "
              f"({dec.decision_s:.2f} s)"]

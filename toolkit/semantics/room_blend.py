@@ -156,12 +156,16 @@ def load_room_blend(folder: Path, encoder: SentenceEncoder) -> RoomBlend | None:
     path = Path(folder) / BLEND_FILE
     if not path.is_file():
         return None
+    vec_path = Path(folder) / VECTORS_FILE
+    try:
+        vectors = np.load(vec_path, allow_pickle=False) if vec_path.is_file() else None
+    except (OSError, ValueError, EOFError) as e:
+        raise SgtoolError(f"{vec_path}: not the room blend's name vectors (an .npy array; "
+                          f"{type(e).__name__})") from None
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
         names = {f.name for f in fields(RoomBlendParams)}
         params = RoomBlendParams(**{k: v for k, v in doc["params"].items() if k in names})
-        vec_path = Path(folder) / VECTORS_FILE
-        vectors = np.load(vec_path, allow_pickle=False) if vec_path.is_file() else None
         return RoomBlend(doc["table"], doc["training_names"], params, encoder, vectors)
     except (OSError, KeyError, TypeError, ValueError, AttributeError) as e:
         raise SgtoolError(f"{path}: not a room blend ({type(e).__name__}: {e})") from None

@@ -117,6 +117,10 @@ def test_save_and_load_room_blend(tmp_path) -> None:
         RoomBlend({"kitchen": ["pot"]}, ["pan"], RoomBlendParams(), enc)
     with pytest.raises(ValueError, match="vectors for"):
         RoomBlend(TABLE, ["soap", "pan"], RoomBlendParams(), enc, np.zeros((1, 3)))
+    (tmp_path / VECTORS_FILE).write_bytes(b"not an array")  # the file at fault is named
+    with pytest.raises(SgtoolError, match=f"{VECTORS_FILE}: not the room blend's name vectors"):
+        load_room_blend(tmp_path, enc)
+    (tmp_path / VECTORS_FILE).unlink()
     (tmp_path / BLEND_FILE).write_text('{"params": {"neighbours": 0}}')
     with pytest.raises(SgtoolError, match="not a room blend"):
         load_room_blend(tmp_path, enc)
