@@ -143,6 +143,10 @@ def train_priors(request: DistillRequest, note: Echo) -> dict[str, Any]:
         for d in made if not done else ():
             with contextlib.suppress(OSError):  # empty unless the moves had begun
                 d.rmdir()
+    for stale in sorted(request.target.glob(".distill-*")):  # a run killed outright
+        if stale.is_dir():
+            note(f"sgtool: note: {stale} is the unfinished output of a distill that was "
+                 "killed (or one still running); remove it when none is")
     return meta
 
 

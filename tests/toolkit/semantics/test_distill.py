@@ -178,3 +178,27 @@ def test_an_interrupted_distill_leaves_no_folder_it_made(tmp_path, monkeypatch) 
     r = CliRunner().invoke(cli, ["distill", "--out", str(tmp_path / "new" / "w")])
     assert r.exit_code == 130, r.output
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_killed_distill_is_named_by_the_next_run(tmp_path, monkeypatch) -> None:
+    """A distill killed outright (SIGKILL) leaves its hidden staging folder in --out; the
+    next run there says so in a note (it may be a run still going, so it is not removed)."""
+    import sgtool.semantics.distill as distill_module
+    from sgtool.cli import cli
+    from sgtool.semantics.priors import WEIGHTS_DIR
+
+    def fast(tmp, *args, **kwargs):  # the shipped weights, as if trained
+        for p in WEIGHTS_DIR.glob("*"):
+            if p.suffix in (".safetensors", ".json"):
+                (tmp / p.name).write_bytes(p.read_bytes())
+        return json.loads((WEIGHTS_DIR / "metadata.json").read_text())
+
+    monkeypatch.setattr(distill_module, "distill", fast)
+    out = tmp_path / "w"
+    (out / ".distill-k1ll3d").mkdir(parents=True)
+    r = CliRunner().invoke(cli, ["distill", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    assert (f"sgtool: note: {out / '.distill-k1ll3d'} is the unfinished output of a distill "
+            "that was killed") in r.output
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
+        "containment.safetensors", "cooccurrence.safetensors", "metadata.json"]
