@@ -24,6 +24,22 @@ def _settings(summary: Path) -> dict[str, Any] | None:
     return settings if isinstance(settings, dict) else None
 
 
+def _effective(planner: str, given: dict[str, Any]) -> dict[str, Any]:
+    """``given`` options of ``planner`` as the planner takes them, those at its default left
+    out (``-O scout.delta=0.10`` runs as no option at all); as given when the planner
+    cannot be asked (a plug-in not importable here)."""
+    from sgtool.planning.option_fields import option_infos
+    from sgtool.planning.registry import options_of, parse_option
+
+    try:
+        cls = options_of(planner)
+        defaults = {} if cls is None else {i.name: i.default for i in option_infos(cls)}
+        values = {k: parse_option(planner, k, str(v)) for k, v in given.items()}
+    except Exception:  # noqa: BLE001 - a planner this process cannot build: compare as given
+        return dict(given)
+    return {k: v for k, v in values.items() if k not in defaults or v != defaults[k]}
+
+
 def settings_notes(files: Sequence[str]) -> list[str]:
     """One note per setting of :data:`COMPARED` whose value differs between the bench
     runs among ``files``, and one per planner that ran with other options in two runs."""
@@ -43,8 +59,8 @@ def settings_notes(files: Sequence[str]) -> list[str]:
     for run, s in runs.items():
         given = s.get("planner_options") or {}
         for planner in s.get("planners") or ():
-            options.setdefault(planner, {})[run] = json.dumps(given.get(planner, {}),
-                                                              sort_keys=True)
+            options.setdefault(planner, {})[run] = json.dumps(
+                _effective(planner, given.get(planner) or {}), sort_keys=True, default=str)
     for planner, per in options.items():
         if len(set(per.values())) > 1:
             shown = ", ".join(f"{opts} in {run}" for run, opts in per.items())

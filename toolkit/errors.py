@@ -39,9 +39,9 @@ def raised_text(e: BaseException) -> str:
     """One line for what a user's code raised, for a message that names the code: ``Type:
     first line of the message`` (`` ...`` when it went on), ``exited (SystemExit: CODE)``
     for a ``sys.exit`` or an argument parser giving up."""
+    code = e.code if isinstance(e, SystemExit) else e
+    lines = str(code).strip().splitlines()
+    text = (lines[0] if lines else "") + (" ..." if len(lines) > 1 else "")
     if isinstance(e, SystemExit):
-        return f"exited (SystemExit: {e.code})"
-    lines = str(e).strip().splitlines()
-    text = lines[0] if lines else ""
-    more = " ..." if len(lines) > 1 else ""
-    return f"{type(e).__name__}: {text}{more}" if text else type(e).__name__
+        return f"exited (SystemExit: {text})"
+    return f"{type(e).__name__}: {text}" if text else type(e).__name__

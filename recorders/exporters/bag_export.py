@@ -10,11 +10,12 @@ Topics (sgtool topic -> ROS topic, type):
   of the same stamp and frame, as ``image_proc``/``depth_image_proc`` pair them;
 - ``/tf`` -> ``/tf`` (``tf2_msgs/TFMessage``) for the links that move, and one latched
   ``/tf_static`` message, at the first stamp, holding every link whose transform never
-  changes in the log (``/tf_static`` of the log is taken as fixed too). A link that moves
-  only at times (a closed loop's head tilted to look into a container, its mounting on
-  the log's ``/tf_static``) goes to ``/tf`` from its first sample on, again at each image
-  stamp while it holds still, so that ``tf2`` (which neither extrapolates nor keeps
-  samples older than its cache) resolves every image's frame;
+  changes in the log (``/tf_static`` of the log is taken as fixed too). A link of the
+  log's ``/tf_static`` that moves at times (a closed loop's head tilted to look into a
+  container) goes to ``/tf`` from its first sample on, its latest value again at each
+  image stamp without a sample of its own, so that ``tf2`` (which neither extrapolates
+  nor keeps samples older than its cache) resolves every image's frame; a link only ever
+  on ``/tf`` is written as logged;
 - ``/map/occupancy`` -> ``nav_msgs/OccupancyGrid``; ``/map/voronoi``, ``/map/rooms`` ->
   ``visualization_msgs/MarkerArray``; ``/sgtool/scene_graph`` -> ``std_msgs/String`` (its
   JSON) and ``/map/objects`` (``MarkerArray`` of the graph's objects). These, and
@@ -343,7 +344,9 @@ def _write(r: LogReader, w: BagWriter, chosen: list[str], base_ns: int,
                 latched=True)
         calib: CameraIntrinsics | None = None
         converters = _converters(w)
-        held: dict[tuple[str, str], tuple[np.ndarray, int]] = {}  # moving: value, its stamp
+        # a mounting that moves at times (on the log's /tf_static, then on /tf): its
+        # latest value and the stamp it was last written at
+        held: dict[tuple[str, str], tuple[np.ndarray, int]] = {}
         for d in r.messages(topics):
             if progress is not None:
                 progress.update(1)
@@ -355,12 +358,16 @@ def _write(r: LogReader, w: BagWriter, chosen: list[str], base_ns: int,
                 if key in static or S.TF not in want:
                     continue  # in the one /tf_static message above
                 T = codec.decode_transform(d.message)  # noqa: N806
-                held[key] = (T, t)
+                last = held.get(key)
+                if d.topic == TF_STATIC or key in held:
+                    held[key] = (T, t)
+                if last is not None and last[1] == t and np.array_equal(last[0], T):
+                    continue  # written at this stamp already (held for an image)
                 w.write(S.TF, TF_TYPE, t, w.tf(t, [w.transform_stamped(t, *key, T)]))
             elif d.topic in IMAGE_TOPICS:
                 ns = IMAGE_TOPICS[d.topic]
                 for key, (T, since) in list(held.items()):  # noqa: N806
-                    if since < t:  # a moving link, still: again at the image's stamp
+                    if since < t:  # the mounting, holding still: again at the image's stamp
                         held[key] = (T, t)
                         w.write(S.TF, TF_TYPE, t, w.tf(t, [w.transform_stamped(t, *key, T)]))
                 if f"{ns}/image_raw" in want:

@@ -57,7 +57,13 @@ def test_runs_made_apart_under_other_settings_are_named(tmp_path: Path) -> None:
     assert (f"sgtool: note: the runs given ran with different max_steps (50 in {a}, 10 in "
             f"{b}): their rows and paired comparisons mix them") in r.stderr
     assert (f'sgtool: note: scout ran with other options in the runs given ({{}} in {a}, '
-            f'{{"delta": "0.9"}} in {b}): its rows pool them') in r.stderr
+            f'{{"delta": 0.9}} in {b}): its rows pool them') in r.stderr
+    # an option given at its default is no other option
+    r = CliRunner().invoke(cli, [*BENCH, "--planners", "scout", "-O", "scout.delta=0.10",
+                                 "-o", str(tmp_path / "c")])
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(cli, ["eval", str(a), str(tmp_path / "c")])
+    assert r.exit_code == 0 and "other options" not in r.stderr, r.stderr
 
 
 RUN = EpisodeResult("greedy", 0, "house-0", 0, "mug", True, steps=4, travelled_m=10.0,

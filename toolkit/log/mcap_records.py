@@ -184,9 +184,26 @@ def read_record(buf: FileBytes, pos: int, end: int) -> Raw:
     if length > end - pos - 9:
         raise RecordError(f"record of {length} bytes runs past the end ({end - pos - 9} left)")
     if opcode in EXTENSION_OPCODES:  # an application's record: skipped by its length
+        _check_extension(opcode, buf[pos + 9:pos + 9 + length])
         return Raw(pos, opcode, length, None)
     rec, used = _parse(opcode, buf[pos + 9:pos + 9 + length])
     return Raw(pos, opcode, length, rec, length - used)
+
+
+def _check_extension(opcode: int, body: bytes | memoryview) -> None:
+    """:class:`RecordError` when the record of application opcode ``opcode`` is rather a
+    record of sgtool's kind whose opcode lost its top bit to damage (0x86: a chunk): its
+    body parses whole as the record of ``opcode & 0x7f``. (A message's body parses as
+    almost anything, so 0x85 is taken as the application's.)"""
+    known = opcode & 0x7F
+    if known not in KNOWN_OPCODES or known == Opcode.MESSAGE:
+        return
+    try:
+        _parse(known, body)
+    except RecordError:
+        return
+    raise RecordError(f"opcode 0x{opcode:02x} holds a whole record of opcode 0x{known:02x} "
+                      "(a damaged opcode)")
 
 
 def trailing_is_damage(buf: FileBytes, raw: Raw, end: int) -> bool:

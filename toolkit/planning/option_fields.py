@@ -255,6 +255,8 @@ def convert_value(planner: str, key: str, meta: OptionMeta, value: Any,
             raise fail(f"must be one of {', '.join(meta.choices)}")
         return text
     elif meta.kind == "path":
+        if isinstance(value, str) and not value.strip():  # empty: not set, as before
+            return None if meta.optional else value
         if isinstance(value, str | os.PathLike):
             return pathlib.Path(value) if meta.path_object else os.fspath(value)
         if meta.objects and not from_cli:

@@ -52,6 +52,10 @@ PLUGIN = textwrap.dedent('''
         raise SystemExit(3)
 
 
+    def exits_loud():  # as a script's argument handling does
+        raise SystemExit("usage: lab [-h] --k K\\nlab: error: --k is required")
+
+
     class Verbose(GreedyPlanner):
         """A planner whose exception tells a story."""
 
@@ -189,6 +193,8 @@ def test_eval_asks_a_plugin_and_reads_its_logs(plugin_dir: Path, tmp_path: Path,
     ("script_cli:P", "planner 'script_cli:P': cannot import module 'script_cli' (exited "
      "(SystemExit: 2))"),
     ("mymod_cli:exits", "planner 'mymod_cli:exits': exited (SystemExit: 3)"),
+    ("mymod_cli:exits_loud", "planner 'mymod_cli:exits_loud': exited (SystemExit: usage: lab "
+     "[-h] --k K ...)"),
 ])
 def test_a_failing_plugin_is_one_line_before_any_episode(plugin_dir: Path, tmp_path: Path,
                                                          monkeypatch: pytest.MonkeyPatch,

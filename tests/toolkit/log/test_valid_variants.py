@@ -83,3 +83,19 @@ def test_backwards_is_forwards_reversed(source: Path, tmp_path: Path) -> None:
         want = key(ordered_messages(f, summary, ["/camera/depth"], start_ns=lo, end_ns=hi))
     assert back == fwd[::-1] == lib
     assert window == want[::-1] and len(window) > 3
+
+
+def test_a_chunk_whose_opcode_lost_a_bit_is_damage_not_an_extension(source: Path,
+                                                                      tmp_path: Path) -> None:
+    """0x06 -> 0x86 (one flipped bit) looks like an application's record; its body is a
+    whole chunk, so doctor calls it damage instead of skipping it without a word."""
+    with LogReader(source) as r:
+        ci = sorted(r.summary.chunk_indexes, key=lambda c: c.chunk_start_offset)[1]
+    data = bytearray(source.read_bytes())
+    assert data[ci.chunk_start_offset] == 0x06
+    data[ci.chunk_start_offset] = 0x86
+    bad = tmp_path / "flipped.mcap"
+    bad.write_bytes(bytes(data))
+    d = scan(bad)
+    assert d.status == "corrupt", (d.status, d.problems)
+    assert any("a damaged opcode" in p for p in d.problems), d.problems

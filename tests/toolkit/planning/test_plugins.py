@@ -147,6 +147,7 @@ def test_plain_fields_are_typed_by_their_annotations(tmp_path: Path, monkeypatch
                 speed: Literal["fast", "slow"] = "fast"
                 where: str | Path = "x"
                 folder: Path = Path(".")
+                cache: Path | None = None
 
             def __init__(self, **kw):
                 super().__init__()
@@ -163,6 +164,7 @@ def test_plain_fields_are_typed_by_their_annotations(tmp_path: Path, monkeypatch
         parse_option("future_plug:P", "speed", "medium")
     assert parse_option("future_plug:P", "where", "/tmp/x") == "/tmp/x"
     assert parse_option("future_plug:P", "folder", "/tmp/x") == Path("/tmp/x")  # as annotated
+    assert parse_option("future_plug:P", "cache", "") is None  # empty: not set, not "."
     with pytest.raises(PlannerOptionError, match="must be an integer"):
         parse_option("future_plug:P", "cap", "x")
 
