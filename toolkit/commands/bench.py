@@ -187,6 +187,7 @@ def _planners(args: BenchArgs) -> tuple[tuple[str, ...], dict[str, dict[str, Any
     """The planners run and their checked options (``-O``, the LLM endpoint, the
     moma-llm transcripts)."""
     from sgtool.analysis.bench import DEFAULT_PLANNERS
+    from sgtool.semantics.priors import weights_folder
 
     names = planner_names(args.planners) if args.planners else DEFAULT_PLANNERS
     options = {k: v for k, v in planner_options(args.planner_option, names).items()
@@ -194,7 +195,8 @@ def _planners(args: BenchArgs) -> tuple[tuple[str, ...], dict[str, dict[str, Any
     LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
                 args.llm_timeout).fill(options, names)
     for name, given in options.items():  # priors of their own: the tables do not say so
-        if "weights_dir" in given and str(given["weights_dir"]) != str(args.priors_dir):
+        if "weights_dir" in given and str(given["weights_dir"]) != str(args.priors_dir) \
+                and weights_folder(given["weights_dir"]).is_dir():  # (else: an error)
             bench_priors = f"--priors {args.priors_dir}" if args.priors_dir else \
                 "the shipped priors"
             click.echo(f"sgtool: note: -O {name}.weights_dir={given['weights_dir']}: {name} "
