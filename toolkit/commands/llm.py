@@ -18,6 +18,7 @@ from pathlib import Path
 import click
 
 from sgtool.commands.options import F, llm_endpoint_options
+from sgtool.errors import SgtoolError
 
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
@@ -115,6 +116,9 @@ def check(base_url: str | None, model_name: str | None, gguf: Path | None, threa
     saying so (exit 2)."""
     from sgtool.analysis.llm_check_run import LlmCheckRequest, run_check
 
+    if gguf is not None and (llm_base_url or base_url):
+        raise SgtoolError("--model and --llm-base-url: give one (--model starts a local "
+                          "server for the check, --llm-base-url checks a running endpoint)")
     result = run_check(LlmCheckRequest(
         base_url=llm_base_url or base_url, model=llm_model or model_name,
         api_key=llm_api_key, timeout_s=llm_timeout, gguf=gguf, threads=threads,

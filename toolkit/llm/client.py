@@ -150,9 +150,9 @@ class LlmSettings:
         if not base_url and not api_key:
             raise LlmConfigError(
                 "no LLM endpoint configured: set SGTOOL_LLM_BASE_URL (and SGTOOL_LLM_API_KEY "
-                "if it needs one), give --llm-base-url URL (every command that talks to an "
-                "LLM) or -O PLANNER.base_url=URL, or replay a recorded transcript with "
-                "--llm-replay FILE"
+                "if it needs one) or give --llm-base-url URL; an LLM planner also takes -O "
+                "PLANNER.base_url=URL, or a recorded transcript (--llm-replay FILE of bench, "
+                "run and eval)"
             )
         try:
             timeout = float(timeout_s)
@@ -257,7 +257,8 @@ class OpenAIChatClient:
                 # never reached at all: a wrong address, not a fault to retry around
                 raise LlmUnreachableError(
                     f"cannot reach the LLM endpoint {self.where}: {self._short(e)}; check "
-                    "SGTOOL_LLM_BASE_URL / base_url, or replay a transcript with --llm-replay"
+                    "SGTOOL_LLM_BASE_URL / --llm-base-url / base_url (an LLM planner also "
+                    "replays a recorded transcript: --llm-replay FILE of bench, run and eval)"
                 ) from e
             raise LlmTransportError(f"{self.where}: connection failed: {self._short(e)}") from e
         except Exception as e:  # noqa: BLE001 - any malformed reply is a retryable fault

@@ -392,6 +392,10 @@ class LogWriter:
         if self._last_frame_t is not None and t_ns <= self._last_frame_t:
             raise ValueError(f"frame at t_ns={t_ns}: frame times must increase (the previous "
                              f"frame is at {self._last_frame_t})")
+        # nested lists (as a pose may be given) are arrays here
+        depth, pose = np.asarray(depth), np.asarray(pose, dtype=np.float64)
+        rgb = None if rgb is None else np.asarray(rgb)
+        ids = None if ids is None else np.asarray(ids)
         _check_frame(intrinsics, depth, rgb, ids)
         # every message encoded (and so checked) before the first is written: a refused
         # frame leaves nothing of itself in the log, and the same frame mended goes in

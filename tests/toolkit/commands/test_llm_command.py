@@ -33,6 +33,12 @@ def test_a_model_that_is_no_gguf_is_one_line(tmp_path) -> None:
                                "needs GGUF)"
     r = CliRunner().invoke(cli, ["llm", "serve", "--model", str(tmp_path / "none.gguf")])
     assert r.exit_code == 2 and "model file not found" in r.output
+    # a model to serve and an endpoint to check: one is ignored, so both are refused
+    r = CliRunner().invoke(cli, ["llm", "check", "--model", str(bad), "--llm-base-url",
+                                 "http://127.0.0.1:9/v1"])
+    assert r.exit_code == 2 and r.output.strip() == (
+        "sgtool: error: --model and --llm-base-url: give one (--model starts a local server "
+        "for the check, --llm-base-url checks a running endpoint)")
 
 
 def test_check_against_a_scripted_endpoint() -> None:

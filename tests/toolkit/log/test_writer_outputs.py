@@ -333,3 +333,21 @@ def test_eval_and_view_never_overwrite_without_force(tmp_path):
     r = CliRunner().invoke(cli, ["view", str(log), "-o", str(other), "--no-voxels"])
     assert r.exit_code == 2 and "exists; not overwriting it (use --force)" in r.output
     assert other.read_bytes() == log.read_bytes()
+
+
+def test_a_frame_of_nested_lists_is_written_as_its_arrays(tmp_path):
+    """Images and a pose given as nested lists (as a pose already could be) are written as
+    the arrays they stand for, not an AttributeError from inside the encoder."""
+    from sgtool.log import LogReader, LogWriter
+
+    k, rgb, depth, ids, pose, _ = synthetic_frame(0)
+    frames = []
+    for name, conv in (("arrays", lambda a: a), ("lists", lambda a: a.tolist())):
+        with LogWriter(tmp_path / f"{name}.mcap", seed=1) as w:
+            w.write_frame(0, depth=conv(depth), pose=conv(pose), intrinsics=k,
+                          rgb=conv(rgb), ids=conv(ids))
+        with LogReader(tmp_path / f"{name}.mcap") as r:
+            frames += list(r.frames())
+    a, b = frames
+    assert (a.depth == b.depth).all() and (a.rgb == b.rgb).all() and (a.ids == b.ids).all()
+    assert (a.pose == b.pose).all()
