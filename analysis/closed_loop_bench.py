@@ -315,7 +315,7 @@ def _row(task: RunTask, seconds: float | None) -> RunRow:
         check_resumable(task.output, task_settings(task_options(task), task.noise, want,
                                                     dict(task.planner_options)),
                         spec, task.house.source if task.house.spec is not None
-                        else task.house.id)
+                        else task.house.id, task.planner)
     logged = read_log_episodes(task.output)
     if len(logged) != 1:
         raise SgtoolError(f"{task.output}: holds {len(logged)} episodes, not one; remove it "
@@ -381,7 +381,10 @@ class ClosedLoopBenchResult:
             if r.task.house.id not in rooms:
                 rooms[r.task.house.id] = max(1, len(house_episodes(r.task)[0].rooms))
             per_room[r.result.key()] = r.frames / rooms[r.task.house.id]
-        budget = self.config.frames_per_room
+        budget: float | None = self.config.frames_per_room
+        frames = self.config.options.frames
+        if budget is None and frames is not None and rooms:  # --frames F: F / rooms at most
+            budget = max(frames / n for n in rooms.values())
         return frames_model(per_room, None if budget is None else float(budget))
 
     def statistics(self, noise: str) -> tuple[str, dict[str, Any]]:

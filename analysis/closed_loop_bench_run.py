@@ -17,6 +17,7 @@ its log was sent back.
 
 from __future__ import annotations
 
+import itertools
 import json
 import sys
 import tempfile
@@ -30,7 +31,6 @@ from sgtool.analysis.closed_loop_bench import (
     RunRow,
     RunTask,
     log_source,
-    noise_folder,
 )
 from sgtool.analysis.executor import Executor, FolderMark
 
@@ -89,11 +89,13 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
             raise  # (with --force, output_folder says OUT is as it was instead)
         finally:
             bar.close()
-        if request.report_only:
-            for folder in unreported(root / "logs", request.config):
-                print(f"sgtool: note: {folder} holds episode logs this report leaves out "
-                      "(give the --noise profiles and --planners that ran them)",
-                      file=sys.stderr)
+        left = unreported(root / "logs", {row.task.output for row in res.rows})
+        if left:
+            shown = ", ".join(str(p.relative_to(root)) for p in left[:2])
+            more = f" and {len(left) - 2} more" if len(left) > 2 else ""
+            print(f"sgtool: note: {len(left)} episode log(s) in {request.out_dir}/logs are left "
+                  f"out of this report ({shown}{more}): give the --noise profiles, --planners, "
+                  "houses and --episodes that ran them to report them", file=sys.stderr)
         res = _with_symbolic(request, res)
         written = [p.name for p in write_tables(res, root)]
         if not request.report_only:
@@ -112,23 +114,12 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
         show(line)
 
 
-def unreported(logs: Path, config: ClosedLoopBenchConfig) -> list[Path]:
-    """The folders ``logs/NOISE`` and ``logs/NOISE/PLANNER`` of a run-bench folder that
-    ``config`` does not name (its noise profiles, :func:`noise_folder`, and planners),
+def unreported(logs: Path, reported: set[Path]) -> list[Path]:
+    """The episode logs under ``logs`` (a run-bench folder's) that are not ``reported``:
+    runs of noise profiles, planners, houses or episodes the report does not name;
     sorted."""
-    from sgtool.planning.registry import planner_file_name
-
-    noises = {noise_folder(n) for n in config.noise}
-    planners = {planner_file_name(p) for p in config.planners}
-    out = []
-    for d in sorted(logs.iterdir()) if logs.is_dir() else []:
-        if not d.is_dir():
-            continue
-        if d.name not in noises:
-            out.append(d)
-            continue
-        out.extend(p for p in sorted(d.iterdir()) if p.is_dir() and p.name not in planners)
-    return out
+    return sorted(p for p in logs.rglob("ep-*.mcap") if p not in reported) \
+        if logs.is_dir() else []
 
 
 def _executor(request: RunBenchRequest) -> tuple[Executor | None, bool]:
@@ -189,9 +180,14 @@ class EpisodeRunner:
         self.sent: set[Path] = set()
 
     def __call__(self, fn: RunFn, items: Iterable[RunTask]) -> Iterator[RunRow]:
-        if self.executor is None:
-            return (self._here(fn, t) for t in items)
-        return iter(self._on_executor(self.executor, fn, list(items)))
+        tasks = list(items)
+        if self.executor is None:  # the logs there first: a resume refused runs nothing
+            logged = [t.output.exists() for t in tasks]
+            there = [fn(t) for t, done in zip(tasks, logged, strict=True) if done]
+            return itertools.chain(there, (self._here(fn, t)
+                                           for t, done in zip(tasks, logged, strict=True)
+                                           if not done))
+        return iter(self._on_executor(self.executor, fn, tasks))
 
     def _here(self, fn: RunFn, task: RunTask) -> RunRow:
         if not task.output.exists():

@@ -89,7 +89,7 @@ def format_frame_curves(budgets: Sequence[float], rows: Sequence[FrameCurveRow],
     budget, as :func:`frame_curves` chooses them)."""
     top = budgets[-1] if max_cost is None else max_cost
     header = ["Planner", "Episodes", "AUC-E frames ↑",
-              *(f"SR ≤ {b:.0f} f/room" for b in budgets)]
+              *(f"SR ≤ {b:g} f/room" for b in budgets)]
     body = [[r.planner, str(r.episodes), f"{r.auc_e:.3f}",
              *(f"{v:.3f}" for v in r.sr_within)] for r in rows]
     parts = [title] if title else []
@@ -126,7 +126,7 @@ def budget_comparisons(results: Sequence[EpisodeResult], planners: Sequence[str]
         body.append([a, b, *(fmt_interval(d, signed=True) for d in diffs)])
         data.append({"planner": a, "reference": b,
                      "sr_diff_within": [d.to_dict() for d in diffs]})
-    header = ["Planner", "Reference", *(f"SR diff ≤ {x:.0f} f/room" for x in budgets)]
+    header = ["Planner", "Reference", *(f"SR diff ≤ {x:g} f/room" for x in budgets)]
     text = "\n".join([
         "Paired SR difference within each frame budget (planner - reference)",
         pipe_table(header, body),

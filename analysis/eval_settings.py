@@ -12,6 +12,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from sgtool.planning.registry import effective_options
+
 COMPARED = ("max_steps", "priors_dir")  # bench settings that change what an episode scores
 
 
@@ -22,22 +24,6 @@ def _settings(summary: Path) -> dict[str, Any] | None:
         return None
     settings = doc.get("settings") if isinstance(doc, dict) else None
     return settings if isinstance(settings, dict) else None
-
-
-def _effective(planner: str, given: dict[str, Any]) -> dict[str, Any]:
-    """``given`` options of ``planner`` as the planner takes them, those at its default left
-    out (``-O scout.delta=0.10`` runs as no option at all); as given when the planner
-    cannot be asked (a plug-in not importable here)."""
-    from sgtool.planning.option_fields import option_infos
-    from sgtool.planning.registry import options_of, parse_option
-
-    try:
-        cls = options_of(planner)
-        defaults = {} if cls is None else {i.name: i.default for i in option_infos(cls)}
-        values = {k: parse_option(planner, k, str(v)) for k, v in given.items()}
-    except Exception:  # noqa: BLE001 - a planner this process cannot build: compare as given
-        return dict(given)
-    return {k: v for k, v in values.items() if k not in defaults or v != defaults[k]}
 
 
 def settings_notes(files: Sequence[str]) -> list[str]:
@@ -60,7 +46,8 @@ def settings_notes(files: Sequence[str]) -> list[str]:
         given = s.get("planner_options") or {}
         for planner in s.get("planners") or ():
             options.setdefault(planner, {})[run] = json.dumps(
-                _effective(planner, given.get(planner) or {}), sort_keys=True, default=str)
+                effective_options(planner, given.get(planner) or {}), sort_keys=True,
+                default=str)
     for planner, per in options.items():
         if len(set(per.values())) > 1:
             shown = ", ".join(f"{opts} in {run}" for run, opts in per.items())

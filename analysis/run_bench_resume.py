@@ -176,11 +176,20 @@ def settings_differences(logged: dict[str, Any], want: dict[str, Any]) -> list[s
             for k, v in want.items() if logged.get(k) != v]
 
 
-def check_resumable(path: Path, want: dict[str, Any], spec: HouseSpec, house: str) -> None:
+def check_resumable(path: Path, want: dict[str, Any], spec: HouseSpec, house: str,
+                    planner: str = "") -> None:
     """Raise :class:`ResumeError` unless the log ``path`` was run with the settings ``want``
     (:func:`task_settings`) on the house ``spec`` (``house`` names it: a file, or a
-    generated house's id)."""
+    generated house's id); ``planner``'s options compared as it takes them (an option at
+    its default is no other option: :func:`~sgtool.planning.registry.effective_options`)."""
+    from sgtool.planning.registry import effective_options
+
     settings, logged_house = logged_settings(path)
+    if planner:
+        want = {**want, "planner_options": effective_options(planner,
+                                                             want["planner_options"])}
+        settings["planner_options"] = effective_options(planner,
+                                                        settings["planner_options"] or {})
     diff = settings_differences(settings, want)
     if diff:
         depth = settings.get("max_depth")

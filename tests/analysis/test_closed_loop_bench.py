@@ -12,7 +12,7 @@ from click.testing import CliRunner
 from sgtool.analysis import closed_loop_bench as clb
 from sgtool.cli import cli
 from sgtool.datasets.generator import generate_house
-from sgtool.house.io import save_house
+from sgtool.house.io import load_house, save_house
 from sgtool.log.writer import partial_files
 
 ARGS = ["run-bench", "--planners", "random,greedy", "--houses", "0", "--episodes", "1",
@@ -80,6 +80,16 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
     at = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
                                   "--report-only", "--budgets", "7,14"])
     assert at.exit_code == 0 and "| SR ≤ 7 f/room | SR ≤ 14 f/room |" in at.output, at.output
+    at = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                  "--report-only", "--budgets", "18.7,18.8"])  # as given
+    assert at.exit_code == 0 and "| SR ≤ 18.7 f/room | SR ≤ 18.8 f/room |" in at.output
+    # eval asks a planner on the run's decisions from the folder itself (its logs)
+    asked = CliRunner().invoke(cli, ["eval", str(out), "-p", "greedy", "--json"])
+    assert asked.exit_code == 0, asked.output
+    assert json.loads(asked.stdout)["offline"]["greedy"]["decisions"] > 0
+    # by default, quarters of the budget per room: --frames 120 over the house's rooms
+    rooms = len(load_house(house_file).rooms)
+    assert f"| SR ≤ {120 / rooms:g} f/room |" in summary, summary
     bad = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
                                    "--report-only", "--budgets", "7,all"])
     assert bad.exit_code == 2 and bad.output.strip() == \
@@ -88,8 +98,8 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
                                     "--planners", "random", "--report-only"])
     assert only.exit_code == 0 and "| random " in only.output and "| greedy" not in only.output
     # ... and says which logs it left out
-    assert f"note: {out / 'logs' / 'none' / 'greedy'} holds episode logs this report " \
-        "leaves out" in only.output
+    assert (f"sgtool: note: 1 episode log(s) in {out}/logs are left out of this report "
+            "(logs/none/greedy/small/ep-000.mcap)") in only.output
     # other settings do not mix with the logs there
     other = [*ARGS, "--house", str(house_file), "-o", str(out)]
     other[other.index("--max-steps") + 1] = "3"
@@ -314,7 +324,8 @@ def test_noise_profiles_are_kept_apart(house_file, tmp_path) -> None:
     assert "--max-depth 5 maps as that log did" in res.output
     only = CliRunner().invoke(cli, [*args, "--report-only"])
     assert only.exit_code == 0, only.output
-    assert f"note: {out / 'logs' / 'my'} holds episode logs" in only.output
+    assert f"episode log(s) in {out}/logs are left out of this report (logs/my/" \
+        in only.output
     # two files of one profile name would share a folder
     (tmp_path / "my.json").write_text(json.dumps({"holes": 0.1}))
     res = CliRunner().invoke(cli, [*args, "--noise", str(prof), "--noise",

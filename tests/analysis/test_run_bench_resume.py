@@ -168,3 +168,29 @@ def test_an_episode_drawn_otherwise_under_the_same_id_is_not_resumed(tmp_path: P
     res = CliRunner().invoke(cli, [*args, "--episodes", "2"])
     assert res.exit_code != 0 and "ep-000.mcap was run with other settings" in res.output
     assert "Traceback" not in res.output
+
+
+def test_a_refused_resume_runs_nothing_and_defaults_are_no_change(tmp_path: Path) -> None:
+    """A resume with a changed setting is refused before any new episode runs (a planner
+    named first used to run into the folder under the new setting); an option given at its
+    default resumes; a run naming fewer planners says which logs its report leaves out."""
+    spec = generate_house(6, rooms=(4, 4))
+    house = tmp_path / "myhouse.json"
+    save_house(spec, house)
+    out = tmp_path / "rb"
+    base = [*ARGS, "--house", str(house), "-o", str(out)]
+    r = CliRunner().invoke(cli, base)
+    assert r.exit_code == 0, r.output
+    changed = [a if a != "random" else "greedy,random" for a in base]
+    changed[changed.index("--max-steps") + 1] = "3"
+    r = CliRunner().invoke(cli, changed)
+    assert r.exit_code == 2 and "max steps: 2 in the log, 3 now" in r.output, r.output
+    assert not (out / "logs/none/greedy").exists()  # nothing ran under the new setting
+    r = CliRunner().invoke(cli, [*base, "-O", "random.max_failures=2"])  # its default
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(cli, [a if a != "random" else "greedy,random" for a in base])
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(cli, [a if a != "random" else "greedy" for a in base])
+    assert r.exit_code == 0, r.output
+    assert (f"sgtool: note: 1 episode log(s) in {out}/logs are left out of this report "
+            "(logs/none/random/myhouse/ep-000.mcap)") in r.stderr

@@ -85,7 +85,8 @@ if TYPE_CHECKING:
                    "objects) and makes about a third of the episodes furniture-level "
                    "(non-interactive) targets; 'default' is the sparse generator of "
                    "`sgtool scenes generate` (random reaches SR ~0.85 there).")
-@click.option("--house-seed", default=0, show_default=True, help="Seed of the first house.")
+@click.option("--house-seed", default=0, show_default=True, type=click.IntRange(min=0, max=2**62),
+              help="Seed of the first house.")
 @click.option("--max-steps", default=50, show_default=True,
               help="High-level actions per episode (SymSearch's N_max).")
 @budget_options()

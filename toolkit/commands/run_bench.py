@@ -51,7 +51,8 @@ if TYPE_CHECKING:
               help="A house spec JSON file or a folder of them (every *.json there is read as "
               "a house; repeatable), checked first. Generated houses join them only when "
               "--houses N is given.")
-@click.option("--house-seed", default=0, show_default=True, help="Seed of the first house.")
+@click.option("--house-seed", default=0, show_default=True, type=click.IntRange(min=0, max=2**62),
+              help="Seed of the first house.")
 @click.option("--rooms", default="12-16", show_default=True, metavar="MIN-MAX",
               help="Room count range of the generated houses.")
 @click.option("--preset", type=click.Choice(list(PRESET_NAMES)), default="symsearch",
@@ -119,7 +120,9 @@ if TYPE_CHECKING:
 @click.option("--budgets", default=None, metavar="F1,F2,...",
               help="Frames per room of the SR-within-budget tables (e.g. 90,100): a report "
               "setting, so --report-only re-tables a finished run at other budgets. "
-              "[default: quarters of the most frames per room an episode used]")
+              "[default: quarters of the frame budget per room (--frames-per-room, or "
+              "--frames over the fewest rooms of a house), else of the most frames per room "
+              "an episode used]")
 @click.option("--symbolic", "symbolic_dir", default=None, metavar="DIR",
               type=click.Path(path_type=str),
               help="A `sgtool bench` output folder (or its episodes.jsonl): the table adds "

@@ -301,6 +301,21 @@ def options_of(name: str) -> type | None:
     return plugins.options_class(_factory(name))
 
 
+def effective_options(name: str, given: Mapping[str, Any]) -> dict[str, Any]:
+    """``given`` options of planner ``name`` as it takes them (each value parsed as ``-O``
+    text is), those at the planner's default left out: ``-O scout.delta=0.10`` runs as no
+    option at all. As given when the planner cannot be asked here (a plug-in that does not
+    import in this process)."""
+    try:
+        cls = options_of(name)
+        defaults = {} if cls is None else {i.name: i.default for i in option_infos(cls)}
+        values = {k: parse_option(name, k, str(v)) if isinstance(v, str | int | float | bool)
+                  else v for k, v in given.items()}
+    except Exception:  # noqa: BLE001 - a plug-in that fails here: compare as given
+        return dict(given)
+    return {k: v for k, v in sorted(values.items()) if k not in defaults or v != defaults[k]}
+
+
 def parse_option(name: str, key: str, text: str) -> Any:
     """The value of ``-O NAME.KEY=TEXT``: checked against the planner's field (built-in,
     or a plug-in's ``Options``), else the text parsed as int, float, true/false or text."""
