@@ -83,6 +83,13 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
     at = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
                                   "--report-only", "--budgets", "18.7,18.8"])  # as given
     assert at.exit_code == 0 and "| SR ≤ 18.7 f/room | SR ≤ 18.8 f/room |" in at.output
+    # --report-only on another command's folder says so (and does not advise --force)
+    (tmp_path / "sym").mkdir()
+    (tmp_path / "sym" / ".sgtool-output").write_text('{"command": "bench", "files": []}')
+    other = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o",
+                                     str(tmp_path / "sym"), "--report-only"])
+    assert other.exit_code == 2 and "a folder of `sgtool bench`, not of run-bench" in \
+        other.output, other.output
     # eval asks a planner on the run's decisions from the folder itself (its logs)
     asked = CliRunner().invoke(cli, ["eval", str(out), "-p", "greedy", "--json"])
     assert asked.exit_code == 0, asked.output

@@ -231,6 +231,13 @@ def _check_folder(args: RunBenchArgs) -> None:
         raise SgtoolError("--report-only reads the run in OUT as it is; leave out --force")
     if args.report_only and not Path(out_dir).is_dir():
         raise SgtoolError(f"no episode log of this run in {Path(out_dir) / 'logs'}")
+    if args.report_only:
+        from sgtool.files import read_manifest
+
+        owner, _ = read_manifest(out_dir)
+        if owner not in (None, "run-bench"):
+            raise SgtoolError(f"--report-only -o {out_dir}: a folder of `sgtool {owner}`, not "
+                              "of run-bench: nothing to report there")
 
 
 def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
