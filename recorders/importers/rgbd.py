@@ -331,6 +331,9 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         pose_source = f"estimated by {odo.method} odometry"
         if seq.pose_source != "none":
             pose_source += f" (the dataset's {seq.pose_source} kept for the drift)"
+        # the dataset's pose file measures the drift only: not where the poses come from
+        notes = [f"{n[len('poses from '):]} kept to measure the odometry's drift"
+                 if n.startswith("poses from ") else n for n in notes]
     else:
         poses = [np.asarray(p) for p in source_poses]
         pose_source = (f"trajectory {opts.trajectory} (--trajectory)" if opts.trajectory

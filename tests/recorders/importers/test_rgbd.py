@@ -256,6 +256,15 @@ def test_cli_rgbd(rgbd_data, tmp_path):
     rep = json.loads(r.output)
     assert rep["frames"] == 5 and rep["alignment"]["up_method"] == "given"
     assert rep["kind"] == "rgbd/open3d" and rep["drift"] is None
+    assert "poses from trajectory.log" in rep["notes"]
+    # poses estimated: the trajectory only measures the drift, and the notes say so
+    r = CliRunner().invoke(cli, ["import", "rgbd", str(rgbd_data / "open3d-testdata"), "-o",
+                                 str(tmp_path / "e.mcap"), "--json", "--quiet", "--up", "y",
+                                 "--estimate-poses"])
+    assert r.exit_code == 0, r.output
+    notes = json.loads(r.output)["notes"]
+    assert "trajectory.log kept to measure the odometry's drift" in notes
+    assert not any(n.startswith("poses from") for n in notes)
     r = CliRunner().invoke(cli, ["import", "rgbd", str(rgbd_data / "open3d-testdata"), "-o",
                                  str(tmp_path / "p.mcap"), "--layout", "7scenes"])
     assert r.exit_code == 2 and "not a 7-Scenes folder" in r.output
