@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import bisect
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -122,6 +123,24 @@ def first_action_change(a: list[tuple[str, str | None]], b: list[tuple[str, str 
     return None
 
 
+def paired_refreshes(ta: Sequence[int], tb: Sequence[int]
+                     ) -> tuple[list[int], list[int], str | None]:
+    """The refreshes of two logs to compare, by index into each: all of them, in order,
+    when both refresh at the same times; else those at a time both refresh at, and the
+    last of each (the final graphs), with a note saying so (two replays at other
+    ``--every`` compared refresh by refresh would set a graph at 3 s against one at 33 s)."""
+    if list(ta) == list(tb):
+        return list(range(len(ta))), list(range(len(tb))), None
+    where_b = {t: j for j, t in enumerate(tb)}
+    pairs = [(i, where_b[t]) for i, t in enumerate(ta) if t in where_b]
+    if ta and tb and (not pairs or pairs[-1] != (len(ta) - 1, len(tb) - 1)):
+        pairs.append((len(ta) - 1, len(tb) - 1))
+    common = sum(1 for i, j in pairs if ta[i] == tb[j])
+    note = (f"the logs refresh at other times ({len(ta)} and {len(tb)} refreshes, {common} "
+            "at the same time): compared where both refresh, and the final graphs")
+    return [i for i, _ in pairs], [j for _, j in pairs], note
+
+
 def diff_logs(a: str | os.PathLike[str], b: str | os.PathLike[str],
               options: ReplayOptions | None = None, tolerance: float = 0.0) -> LogDiff:
     """What differs between the scene graphs of ``a`` and ``b`` (module doc); ``options``
@@ -133,9 +152,15 @@ def diff_logs(a: str | os.PathLike[str], b: str | os.PathLike[str],
         if (foreign := foreign_log_problem(log)) is not None:
             raise SgtoolError(foreign)
     ga, gb = log_graphs(a, options), log_graphs(b, options)
-    layers = [(x.layers, y.layers) for x, y in zip(ga.refreshes, gb.refreshes, strict=False)]
-    lines = describe_mismatch(ga.graphs, list(zip(gb.refreshes, gb.graphs, strict=True)),
+    ia, ib, note = paired_refreshes([r.time_ns for r in ga.refreshes],
+                                    [r.time_ns for r in gb.refreshes])
+    layers = [(ga.refreshes[i].layers, gb.refreshes[j].layers) for i, j in zip(ia, ib,
+                                                                                strict=True)]
+    lines = describe_mismatch([ga.graphs[i] for i in ia],
+                              [(gb.refreshes[j], gb.graphs[j]) for j in ib],
                               tol=tolerance, exact=tolerance <= 0, layers=layers)
+    if note and (lines or len(ga.graphs) != len(gb.graphs)):
+        lines = [note, *(x for x in lines if "refreshes where" not in x)]
     return LogDiff(ga, gb, lines, quality_lines(ga.quality, gb.quality),
                    first_action_change(ga.actions, gb.actions),
                    bool(quality_lines(ga.quality, gb.quality, changed_only=True)))

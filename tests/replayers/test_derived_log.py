@@ -445,3 +445,21 @@ def test_ids_that_name_nothing_are_warned_about(tmp_path: Path) -> None:
     assert r.exit_code == 0, r.output
     assert any(w.startswith("the log has instance ids, but no object or door was seen")
                for w in json.loads(r.stdout)["warnings"])
+
+
+def test_diff_pairs_refreshes_by_time(tmp_path):
+    """Two replays of one log at other --every refresh at other times: diff compares the
+    refreshes both logs have at one time, and the final graphs, and says so (pairing by
+    position set the graph at 0.3 s against the one at 0.03 s)."""
+    from sgtool.replayers.golden_diff import diff_logs, paired_refreshes
+
+    assert paired_refreshes([1, 2, 3], [1, 2, 3]) == ([0, 1, 2], [0, 1, 2], None)
+    ia, ib, note = paired_refreshes([10, 20, 30, 40, 45], [20, 40, 50])
+    assert (ia, ib) == ([1, 3, 4], [0, 1, 2]) and note is not None
+    assert note.startswith("the logs refresh at other times (5 and 3 refreshes, 2 at the "
+                           "same time)")
+    a, b = tmp_path / "a.mcap", tmp_path / "b.mcap"
+    replay(TOUR, a, ReplayOptions(max_frames=40, every=10))
+    replay(TOUR, b, ReplayOptions(max_frames=40, every=20))
+    lines = diff_logs(a, b).lines
+    assert lines and lines[0].startswith("the logs refresh at other times"), lines
