@@ -97,22 +97,17 @@ def resolve_options(reader: LogReader, options: ReplayOptions) -> ResolvedOption
 
 def resolve_options_measured(reader: LogReader, options: ReplayOptions
                              ) -> tuple[ResolvedOptions, FirstFrames | None]:
-    """Fill the unset options from the log's Episode record, else the defaults; the depth
-    to map to, unless given or recorded (a live map's log records its own), is lowered to
-    where the log's depth noise reaches the floor tolerance
+    """Fill the unset options from the log's Episode record (a live map's), else the
+    options a derived log was built with (its ``sgtool.replay`` metadata), else the
+    defaults; the depth to map to, unless given or recorded, is lowered to where the log's
+    depth noise reaches the floor tolerance
     (:func:`~sgtool.replayers.depth_range.first_frames`, returned with the options)."""
     if options.max_frames is not None and options.max_frames < 1:
         raise SgtoolError(f"max frames {options.max_frames}: must be >= 1")
     if options.tf_time not in ("log", "stamp"):
         raise SgtoolError(f"tf time {options.tf_time!r}: \"log\" (pair /tf with frames by "
                           "log time) or \"stamp\" (by header stamp)")
-    recorded: dict[str, Any] = {}
-    found = False
-    for _, rec in reader.records(Episode):
-        m = rec.extras.get("mapping")
-        if isinstance(m, dict):
-            recorded, found = m, True
-            break
+    recorded, found = _recorded_mapping(reader)
     size = _image_size(reader)
     every = options.every if options.every is not None else int(recorded.get("every", 10))
     clf = options.classifier or str(recorded.get("classifier", "frequency"))
@@ -142,6 +137,29 @@ def resolve_options_measured(reader: LogReader, options: ReplayOptions
     return ResolvedOptions(every=int(every), classifier=clf, min_points=int(mp),
                            voxel_size=float(vs), max_frames=options.max_frames,
                            max_depth=float(md)), first
+
+
+def _recorded_mapping(reader: LogReader) -> tuple[dict[str, Any], bool]:
+    """The mapping options ``reader``'s log was built with, and whether it says: a live
+    map's Episode record (``extra.mapping``), else a derived log's ``sgtool.replay``
+    metadata (text; ``max_depth`` there only when it was not the default)."""
+    for _, rec in reader.records(Episode):
+        m = rec.extras.get("mapping")
+        if isinstance(m, dict):
+            return m, True
+    meta = reader.metadata.get(REPLAY_METADATA)
+    if not meta:
+        return {}, False
+    out: dict[str, Any] = {"max_depth": MAX_DEPTH_M}
+    try:
+        for key, kind in (("every", int), ("classifier", str), ("min_points", int),
+                          ("voxel_size", float), ("max_depth", float)):
+            if meta.get(key):
+                out[key] = kind(meta[key])
+    except ValueError:
+        raise SgtoolError(f"{reader.path}: its sgtool.replay metadata is damaged "
+                          f"({dict(meta)}); give the replay options") from None
+    return out, True
 
 
 def replay_metadata(opts: ResolvedOptions, tf_time: str = "log") -> dict[str, str]:

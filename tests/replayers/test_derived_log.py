@@ -463,3 +463,17 @@ def test_diff_pairs_refreshes_by_time(tmp_path):
     replay(TOUR, b, ReplayOptions(max_frames=40, every=20))
     lines = diff_logs(a, b).lines
     assert lines and lines[0].startswith("the logs refresh at other times"), lines
+
+
+def test_a_derived_log_replays_with_the_options_it_was_built_with(tmp_path):
+    """Re-replaying a derived log without options rebuilds it as it was built (its
+    sgtool.replay metadata), as -h says; options given still win."""
+    from sgtool.replayers.golden_diff import diff_logs
+
+    first, again = tmp_path / "a.mcap", tmp_path / "b.mcap"
+    rep = replay(TOUR, first, ReplayOptions(max_frames=40, every=20, voxel_size=0.08))
+    assert rep.options.every == 20
+    rep2 = replay(first, again)
+    assert (rep2.options.every, rep2.options.voxel_size) == (20, 0.08)
+    assert diff_logs(first, again).same
+    assert replay(first, None, ReplayOptions(every=10)).options.every == 10
