@@ -46,9 +46,9 @@ caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
    frontier: their node plus the straight last leg);
 9. assembly of the nodes into the graph (:mod:`sgtool.scenegraph.assembly`).
 
-Before the stages, the robot's body is free-space evidence: the voxels in the BEV height
-band within ``BODY_RADIUS`` of the trajectory points new since the last refresh that never
-had an instance's label are dropped
+Before the stages, a robot's body is free-space evidence: the voxels in the BEV height band
+within ``BODY_RADIUS`` of the base's positions (frames with a base pose: a hand-held camera
+has no body below it) new since the last refresh that never had an instance's label are dropped
 (:meth:`~sgtool.mapping.voxels.VoxelMap.clear_unlabelled_around`); a later frame that sees
 something there puts it back. Depth is free-space evidence too: every ``VIEW_STRIDE``-th
 frame since the last refresh counts a miss on each weak voxel of the band it saw through
@@ -212,7 +212,8 @@ class SceneGraphBuilder:
         self._pieces: dict[int, PieceView] = {}  # what close frames showed of carriers
         self.robot: tuple[float, float, float] | None = None
         self.frames_since_refresh = 0
-        self._cleared = 0  # trajectory points whose body cleared the voxels around them
+        self._body: list[tuple[float, float]] = []  # where a robot's base stood, per frame
+        self._cleared = 0  # points of _body whose body cleared the voxels around them
         self._views: list[View] = []  # depth frames not yet used as free-space evidence
         self.seen_through_entries = 0  # voxel entries dropped as seen through by depth
         self.cleared_entries = 0  # voxel entries dropped by the robot's body
@@ -289,6 +290,7 @@ class SceneGraphBuilder:
                                      k.fy, k.cx, k.cy, min_range=vc.min_range,
                                      max_range=vc.max_range))
         self.trajectory.append((x, y))
+        self._body += [(x, y)] if frame.base_pose is not None else []  # hand-held: no body
         self.robot = (x, y, yaw)
         self.frames_since_refresh += 1
         self.timings["integrate"].append((self.clock() - t0) * 1e3)
@@ -409,7 +411,7 @@ class SceneGraphBuilder:
         """The robot's body is free-space evidence (module doc): drop the unlabelled voxels
         of the BEV height band within ``BODY_RADIUS`` of the trajectory points new since
         the last refresh."""
-        if self._cleared >= len(self.trajectory) and not self._views:
+        if self._cleared >= len(self._body) and not self._views:
             return
         cfg = self.config.bev
         res = self.voxels.resolution
@@ -421,10 +423,10 @@ class SceneGraphBuilder:
             views, self._views = self._views, []
             self.seen_through_entries += self.voxels.clear_seen_through(
                 views, level + tol + 1, level + top, self.config.free_space)
-        if self._cleared >= len(self.trajectory):
+        if self._cleared >= len(self._body):
             return
-        pts = np.asarray(self.trajectory[self._cleared:], dtype=np.float64)
-        self._cleared = len(self.trajectory)
+        pts = np.asarray(self._body[self._cleared:], dtype=np.float64)
+        self._cleared = len(self._body)
         self.cleared_entries += self.voxels.clear_unlabelled_around(
             pts, BODY_RADIUS, level + tol + 1, level + top)
 
