@@ -44,7 +44,9 @@ def test_settings_differences_name_the_setting() -> None:
         == ["max steps: 2 in the log, 3 now"]
 
 
-def test_a_changed_house_file_is_not_resumed(tmp_path: Path, monkeypatch) -> None:
+def _first_run(tmp_path: Path) -> tuple[object, Path, Path, list[str]]:
+    """A house file, a finished one-episode run of random on it: (spec, house file,
+    output folder, the command)."""
     spec = generate_house(6, rooms=(4, 4))
     house = tmp_path / "myhouse.json"
     save_house(spec, house)
@@ -52,6 +54,11 @@ def test_a_changed_house_file_is_not_resumed(tmp_path: Path, monkeypatch) -> Non
     cmd = [*ARGS, "--house", str(house), "-o", str(out)]
     first = CliRunner().invoke(cli, cmd)
     assert first.exit_code == 0, first.output
+    return spec, house, out, cmd
+
+
+def test_a_changed_house_file_is_not_resumed(tmp_path: Path, monkeypatch) -> None:
+    spec, house, out, cmd = _first_run(tmp_path)
     log = out / "logs/none/random/myhouse/ep-000.mcap"
     monkeypatch.setattr(clb, "run_episode", lambda *a, **k: pytest.fail("ran again"))
     # the same house in another text form (as an older writer might attach it): resumed
@@ -174,13 +181,7 @@ def test_a_refused_resume_runs_nothing_and_defaults_are_no_change(tmp_path: Path
     """A resume with a changed setting is refused before any new episode runs (a planner
     named first used to run into the folder under the new setting); an option given at its
     default resumes; a run naming fewer planners says which logs its report leaves out."""
-    spec = generate_house(6, rooms=(4, 4))
-    house = tmp_path / "myhouse.json"
-    save_house(spec, house)
-    out = tmp_path / "rb"
-    base = [*ARGS, "--house", str(house), "-o", str(out)]
-    r = CliRunner().invoke(cli, base)
-    assert r.exit_code == 0, r.output
+    _, _, out, base = _first_run(tmp_path)
     changed = [a if a != "random" else "greedy,random" for a in base]
     changed[changed.index("--max-steps") + 1] = "3"
     r = CliRunner().invoke(cli, changed)
