@@ -201,9 +201,13 @@ def _replays(request: EvalRequest, logged: Sequence[Any], exchanges: Sequence[An
         options.setdefault("moma-llm", {}).setdefault("replay", replay)
     if names and not any(d.graph is not None for e in logged for d in e.decisions):
         decisions = sum(len(e.decisions) for e in logged)
+        tables = [Path(i).parent for i in request.inputs if Path(i).name == "episodes.jsonl"
+                  and (Path(i).parent / "logs").is_dir()]
         raise SgtoolError(
             "--planner needs logged decisions made on a scene graph (sgtool.Action records "
             "of MCAP logs, each after an sgtool.SceneGraph record); " + (
+                f"a folder is read as its table: give {tables[0] / 'logs'} for its logs"
+                if tables and not decisions else
                 "the inputs' logs hold no decision" if not decisions else
                 f"none of the inputs' {decisions} decisions has a graph before it"))
     return [replay_decisions(make_planner(n, **options.get(n, {})), logged, name=n)

@@ -140,15 +140,16 @@ def resolve_options_measured(reader: LogReader, options: ReplayOptions
 
 
 def _recorded_mapping(reader: LogReader) -> tuple[dict[str, Any], bool]:
-    """The mapping options ``reader``'s log was built with, and whether it says: a live
-    map's Episode record (``extra.mapping``), else a derived log's ``sgtool.replay``
-    metadata (text; ``max_depth`` there only when it was not the default)."""
-    for _, rec in reader.records(Episode):
-        m = rec.extras.get("mapping")
-        if isinstance(m, dict):
-            return m, True
+    """The mapping options ``reader``'s log was built with, and whether it says: a derived
+    log's ``sgtool.replay`` metadata (text; ``max_depth`` there only when it was not the
+    default), else a live map's Episode record (``extra.mapping``; a derived log of a
+    closed-loop log copies it, so the metadata of its own build comes first)."""
     meta = reader.metadata.get(REPLAY_METADATA)
     if not meta:
+        for _, rec in reader.records(Episode):
+            m = rec.extras.get("mapping")
+            if isinstance(m, dict):
+                return m, True
         return {}, False
     out: dict[str, Any] = {"max_depth": MAX_DEPTH_M}
     try:

@@ -379,12 +379,13 @@ def refresh_head(i: int, ref: RefreshInfo) -> str:
 
 def describe_mismatch(expected: Sequence[str], actual: Sequence[tuple[RefreshInfo, str]],
                       limit: int = 40, tol: float = 1e-4, exact: bool = True,
-                      layers: Sequence[tuple[LayerSummary | None, LayerSummary | None]] = ()
-                      ) -> list[str]:
+                      layers: Sequence[tuple[LayerSummary | None, LayerSummary | None]] = (),
+                      numbers: Sequence[int] = ()) -> list[str]:
     """The first refresh whose graph differs, with :func:`diff_graphs` of it; empty when
     none does. ``exact``: any byte of difference counts (below ``tol`` it reads
     :data:`ROUNDING`); else only differences beyond ``tol``. ``layers``: per refresh, the
-    expected and actual :class:`LayerSummary` (areas, Voronoi graph size)."""
+    expected and actual :class:`LayerSummary` (areas, Voronoi graph size); ``numbers``:
+    the actual refreshes' numbers in their log when they are not 0, 1, ... (a selection)."""
     for i, (exp, (ref, got)) in enumerate(zip(expected, actual, strict=False)):
         if exp == got and not (i < len(layers) and layers[i][0] != layers[i][1]):
             continue
@@ -394,7 +395,7 @@ def describe_mismatch(expected: Sequence[str], actual: Sequence[tuple[RefreshInf
             lines = [x for x in lines if x != ROUNDING]
         if not lines:
             continue
-        head = refresh_head(i, ref) + " differs:"
+        head = refresh_head(numbers[i] if i < len(numbers) else i, ref) + " differs:"
         more = [f"  ... and {len(lines) - limit} more"] if len(lines) > limit else []
         return [head] + ["  " + x for x in lines[:limit]] + more
     if len(expected) != len(actual):

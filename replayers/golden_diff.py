@@ -158,7 +158,8 @@ def diff_logs(a: str | os.PathLike[str], b: str | os.PathLike[str],
                                                                                 strict=True)]
     lines = describe_mismatch([ga.graphs[i] for i in ia],
                               [(gb.refreshes[j], gb.graphs[j]) for j in ib],
-                              tol=tolerance, exact=tolerance <= 0, layers=layers)
+                              tol=tolerance, exact=tolerance <= 0, layers=layers,
+                              numbers=ib)
     if note and (lines or len(ga.graphs) != len(gb.graphs)):
         lines = [note, *(x for x in lines if "refreshes where" not in x)]
     return LogDiff(ga, gb, lines, quality_lines(ga.quality, gb.quality),

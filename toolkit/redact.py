@@ -11,6 +11,7 @@ such as an error message that quotes a request.
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Iterable, Mapping
 from typing import Any
@@ -78,10 +79,13 @@ def redact_text(text: str, secrets: Iterable[str | None] = ()) -> str:
 
 
 def recorded_options(options: Mapping[str, Any]) -> dict[str, Any]:
-    """A planner's options as an episode record keeps them: JSON values only (a Python
-    object set from Python, an encoder, is left out), keys named like secrets left out
-    (:func:`sgtool.redact.is_secret_name`) and URL passwords redacted, sorted."""
+    """A planner's options as an episode record keeps them: JSON values only (a path as
+    its text; a Python object set from Python, an encoder, is left out), keys named like
+    secrets left out (:func:`sgtool.redact.is_secret_name`) and URL passwords redacted,
+    sorted."""
     plain = (str, int, float, bool, type(None))
+    options = {k: os.fspath(v) if isinstance(v, os.PathLike) else v
+               for k, v in options.items()}
     return {k: redact_options(v) for k, v in sorted(options.items())
             if not is_secret_name(str(k)) and (isinstance(v, plain) or (
                 isinstance(v, list | tuple) and all(isinstance(x, plain) for x in v)))}

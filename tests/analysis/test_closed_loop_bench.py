@@ -90,8 +90,11 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
                                      str(tmp_path / "sym"), "--report-only"])
     assert other.exit_code == 2 and "a folder of `sgtool bench`, not of run-bench" in \
         other.output, other.output
-    # eval asks a planner on the run's decisions from the folder itself (its logs)
+    # eval reads a folder as its table; to ask a planner on the run's decisions it says
+    # to give the folder's logs, which it then reads
     asked = CliRunner().invoke(cli, ["eval", str(out), "-p", "greedy", "--json"])
+    assert asked.exit_code == 2 and f"give {out / 'logs'} for its logs" in asked.output
+    asked = CliRunner().invoke(cli, ["eval", str(out / "logs"), "-p", "greedy", "--json"])
     assert asked.exit_code == 0, asked.output
     assert json.loads(asked.stdout)["offline"]["greedy"]["decisions"] > 0
     # by default, quarters of the budget per room: --frames 120 over the house's rooms

@@ -463,6 +463,10 @@ def test_diff_pairs_refreshes_by_time(tmp_path):
     replay(TOUR, b, ReplayOptions(max_frames=40, every=20))
     lines = diff_logs(a, b).lines
     assert lines and lines[0].startswith("the logs refresh at other times"), lines
+    # a refresh is named by its number in its own log: the last of a's five, of b's three
+    for x, y, last in ((b, a, 4), (a, b, 2)):
+        head = next(h for h in diff_logs(x, y).lines if h.startswith("refresh "))
+        assert head.startswith(f"refresh {last} at 19.500 s"), head
 
 
 def test_a_derived_log_replays_with_the_options_it_was_built_with(tmp_path):

@@ -21,7 +21,9 @@ from mcap.opcode import Opcode
 from mcap.reader import make_reader
 
 MAGIC = bytes([137, 77, 67, 65, 80, 48, 13, 10])
-EXTENSION = struct.pack("<BQ", 0xFF, 7) + b"\x00" * 7  # a record of an application's opcode
+def extension(opcode: int) -> bytes:
+    """A record of an application's ``opcode`` (0x80-0xFF): 7 bytes of its own."""
+    return struct.pack("<BQ", opcode, 7) + b"\x07" * 7
 
 
 @dataclass
@@ -34,6 +36,7 @@ class Variant:
 
     loose: frozenset[str] = frozenset()
     extension: str = ""
+    extension_opcode: int = 0xFF
     extend: int = 0
     chunk_messages: int = 50
     order: Callable[[list[R.Message]], list[R.Message]] | None = None
@@ -64,7 +67,7 @@ class _Writer:
         at = len(self.out)
         self.out += rec_bytes
         if self.v.extension == "data":
-            self.out += EXTENSION
+            self.out += extension(self.v.extension_opcode)
         return at
 
     def define(self, schemas: dict, ch: object, sink: Callable[[bytes], object]) -> None:
@@ -134,7 +137,7 @@ def rewrite(src: Path, dst: Path, v: Variant) -> Path:
             continue
         w.define(schemas, ch, w.chunk.append)
         if v.extension == "chunk":
-            w.chunk.append(EXTENSION)
+            w.chunk.append(extension(v.extension_opcode))
         at = sum(len(b) for b in w.chunk)
         w.index.setdefault(m.channel_id, []).append((m.log_time, at))
         w.chunk.append(_bytes(m))

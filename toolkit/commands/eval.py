@@ -137,10 +137,8 @@ def _request(inputs: tuple[str, ...], out: str | None, force: bool, args: EvalAr
         raise SgtoolError("--reference and --all-pairs: give one (all pairs compare every "
                           "planner with every other, the reference among them)")
     runner = make_executor(args.executor, args.workers, args.ray_address)
-    # an output folder: its table, not its logs too; its logs when planners are to decide
-    # on their decisions (-p) and it holds them (run-bench's logs/)
     runs = [str(Path(i) / "episodes.jsonl") if (Path(i) / "episodes.jsonl").is_file()
-            and not (args.planners and (Path(i) / "logs").is_dir()) else i for i in inputs]
+            else i for i in inputs]  # an output folder: its table, not its logs too
     # a run given twice (a table and its logs) is scored once: eval_run.once_each
     files = tuple(map(str, expand_inputs(runs, (".mcap",), "MCAP logs", recursive=True)))
     if out:

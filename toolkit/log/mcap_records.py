@@ -64,6 +64,9 @@ EXTENSION_OPCODES = frozenset(range(0x80, 0x100))  # the specification's, for ap
 # records whose size the specification fixes (no fields can be appended)
 _FIXED_SIZE = frozenset({Opcode.FOOTER})
 CHUNK_OPCODES = frozenset({Opcode.SCHEMA, Opcode.CHANNEL, Opcode.MESSAGE})
+# records an extension opcode with its top bit lost is checked against (_check_extension)
+_WHOLE_CHECKED = frozenset({Opcode.CHUNK, Opcode.SCHEMA, Opcode.CHANNEL, Opcode.ATTACHMENT,
+                            Opcode.METADATA})
 _ZSTD_STEP = 16 * 1024  # compressed bytes fed per call: the granularity of a salvage
 
 
@@ -192,15 +195,18 @@ def read_record(buf: FileBytes, pos: int, end: int) -> Raw:
 
 def _check_extension(opcode: int, body: bytes | memoryview) -> None:
     """:class:`RecordError` when the record of application opcode ``opcode`` is rather a
-    record of sgtool's kind whose opcode lost its top bit to damage (0x86: a chunk): its
-    body parses whole as the record of ``opcode & 0x7f``. (A message's body parses as
-    almost anything, so 0x85 is taken as the application's.)"""
+    record whose opcode lost its top bit to damage (0x86: a chunk): its body parses whole,
+    not a byte left, as the record of ``opcode & 0x7f``, one of :data:`_WHOLE_CHECKED`
+    (records of length-prefixed fields, which a body of other bytes does not fill by
+    chance; a message, a data end or an index parses from almost anything)."""
     known = opcode & 0x7F
-    if known not in KNOWN_OPCODES or known == Opcode.MESSAGE:
+    if known not in _WHOLE_CHECKED:
         return
     try:
-        _parse(known, body)
+        _, used = _parse(known, body)
     except RecordError:
+        return
+    if used != len(body):  # not a whole record of that kind: the application's own
         return
     raise RecordError(f"opcode 0x{opcode:02x} holds a whole record of opcode 0x{known:02x} "
                       "(a damaged opcode)")

@@ -12,6 +12,7 @@ Every planner comes wrapped in :class:`~sgtool.planning.timing.TimedPlanner` (op
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -308,11 +309,17 @@ def effective_options(name: str, given: Mapping[str, Any]) -> dict[str, Any]:
     import in this process)."""
     try:
         cls = options_of(name)
-        defaults = {} if cls is None else {i.name: i.default for i in option_infos(cls)}
-        values = {k: parse_option(name, k, str(v)) if isinstance(v, str | int | float | bool)
-                  else v for k, v in given.items()}
     except Exception:  # noqa: BLE001 - a plug-in that fails here: compare as given
-        return dict(given)
+        return dict(sorted(given.items()))
+    defaults = {"timed": True, **({} if cls is None else
+                                  {i.name: i.default for i in option_infos(cls)})}
+    values = {}
+    for k, v in given.items():
+        try:
+            values[k] = parse_option(name, k, str(v)) if isinstance(
+                v, str | int | float | bool | os.PathLike) else v
+        except Exception:  # noqa: BLE001 - a key it does not take: compared as given
+            values[k] = v
     return {k: v for k, v in sorted(values.items()) if k not in defaults or v != defaults[k]}
 
 

@@ -42,6 +42,7 @@ from sgtool.recorders.sim.closed_loop import (
 )
 from sgtool.recorders.sim.closed_loop_report import episode_notes
 from sgtool.recorders.sim.noise import PROFILES
+from sgtool.replayers.derived_log import ReplayOptions, replay
 from sgtool.scenegraph.derived_layers import DERIVED_TOPICS
 from sgtool.scenegraph.examined import EXAMINE, close_views
 from sgtool.scenegraph.graph import (
@@ -263,6 +264,11 @@ def test_a_replay_shows_the_planner_the_graph_it_was_shown(house, tmp_path) -> N
     assert len(decided) == len(given) >= 2
     with LogReader(out) as r:  # Foxglove's view of each graph, as a replay writes it
         assert r.message_count(S.GRAPH_SCENE) == r.message_count(GRAPH) >= 2
+    # a derived log of it replays with the options of its own build, not the live map's
+    derived = tmp_path / "derived.mcap"
+    replay(out, derived, ReplayOptions(every=3, voxel_size=0.08))
+    again = replay(derived, None).options
+    assert (again.every, again.voxel_size) == (3, 0.08)
     assert any(d.action.view_distances for d in decided)
     for d, g in zip(decided, given, strict=True):
         assert d.graph is not None

@@ -32,6 +32,10 @@ VARIANTS = {
     "frames outside chunks": Variant(loose=frozenset({"/camera/depth", "/tf"})),
     "extension records between records": Variant(extension="data"),
     "extension records in chunks": Variant(extension="chunk"),
+    # opcodes whose low bits name a record of the specification's (0x0f: data end, 0x01:
+    # header): an application's all the same, read past
+    "extension records at 0x8f": Variant(extension="data", extension_opcode=0x8F),
+    "extension records at 0x81 in chunks": Variant(extension="chunk", extension_opcode=0x81),
     "extended schemas, channels, data end": Variant(extend=8),
     "shuffled into small chunks": Variant(order=_shuffled, chunk_messages=5),
 }

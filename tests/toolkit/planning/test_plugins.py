@@ -248,3 +248,18 @@ def test_a_decision_that_is_no_action_is_one_line_naming_the_plugin(plugin_dir: 
         planner.decide(graph)
     assert str(e.value) == ("planner 'mymod_plug:Candidates': decide() returned a Candidate, "
                             "not an sgtool.Action (e.g. Action('navigate', node_id))")
+
+
+def test_options_compared_as_the_planner_takes_them(plugin_dir: Path) -> None:
+    """effective_options: text and numbers alike, an option at its default (timed too) is
+    no option, a key the planner does not take is kept as given, a path is a path; and a
+    path option is recorded in a log as its text (so a resume compares it)."""
+    from sgtool.planning.registry import effective_options
+    from sgtool.redact import recorded_options
+
+    assert effective_options("scout", {"delta": "0.10", "timed": True}) == {}
+    assert effective_options("scout", {"delta": 0.2, "bogus": 1}) == {"delta": 0.2,
+                                                                      "bogus": 1}
+    assert effective_options("nomod_plug:X", {"k": "1"}) == {"k": "1"}  # cannot be asked
+    assert recorded_options({"folder": Path("/tmp/x"), "obj": object()}) == {
+        "folder": "/tmp/x"}
