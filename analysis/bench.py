@@ -70,6 +70,7 @@ from sgtool.analysis.bench_planner_checks import (
     BenchError,
     check_planner_list,
     check_planner_options,
+    check_reference,
     config_names,
     config_planner_options,
     config_rooms,
@@ -179,12 +180,7 @@ class BenchConfig:
         lo, hi = self.rooms
         if not 4 <= lo <= hi <= MAX_ROOMS:
             raise BenchError(f"--rooms: need 4 <= MIN <= MAX <= {MAX_ROOMS}, got {lo}-{hi}")
-        if self.reference is not None and self.all_pairs:
-            raise BenchError("--reference and --all-pairs: give one (all pairs compare every "
-                             "planner with every other, the reference among them)")
-        if self.reference is not None and self.reference not in self.planners:
-            raise BenchError(f"--reference: {self.reference!r} is not one of --planners "
-                             f"({', '.join(self.planners)})")
+        check_reference(self.reference, self.all_pairs, self.planners)
         if self.success not in SUCCESS_RULES:
             raise BenchError(f"--success: one of {', '.join(SUCCESS_RULES)}, got "
                              f"{self.success!r}")

@@ -42,6 +42,17 @@ def config_planner_options(value: Any) -> dict[str, dict[str, Any]]:
     return out
 
 
+def check_reference(reference: str | None, all_pairs: bool, planners: Sequence[str]) -> None:
+    """``--reference`` and ``--all-pairs`` of a benchmark: one of them, and a reference
+    that is one of ``planners``."""
+    if reference is not None and all_pairs:
+        raise BenchError("--reference and --all-pairs: give one (all pairs compare every "
+                         "planner with every other, the reference among them)")
+    if reference is not None and reference not in planners:
+        raise BenchError(f"--reference: {reference!r} is not one of --planners "
+                         f"({', '.join(planners)})")
+
+
 def config_rooms(value: Any) -> tuple[int, int]:
     """A config's ``rooms``: (MIN, MAX), a list from a JSON file taken as a pair."""
     if isinstance(value, str | int) or len(tuple(value)) != 2:

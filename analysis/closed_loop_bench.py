@@ -159,7 +159,7 @@ class ClosedLoopBenchConfig:
         object.__setattr__(self, "rooms", config_rooms(self.rooms))
 
     def check(self) -> None:
-        from sgtool.analysis.bench_planner_checks import check_planner_list
+        from sgtool.analysis.bench_planner_checks import check_planner_list, check_reference
 
         check_planner_list(self.planners)
         if len(set(self.planners)) != len(self.planners) or \
@@ -167,9 +167,7 @@ class ClosedLoopBenchConfig:
             raise SgtoolError("--planners/--noise: a name is given twice")
         if any(not (math.isfinite(b) and b > 0) for b in self.budgets):
             raise SgtoolError(f"--budgets: frames per room > 0, got {list(self.budgets)}")
-        if self.reference is not None and self.reference not in self.planners:
-            raise SgtoolError(f"--reference: {self.reference!r} is not one of --planners "
-                              f"({', '.join(self.planners)})")
+        check_reference(self.reference, self.all_pairs, self.planners)
         if self.episodes < 1:
             raise SgtoolError(f"--episodes: must be >= 1, got {self.episodes}")
         if self.houses < 0 or (self.houses == 0 and not self.house_files):

@@ -145,7 +145,9 @@ def test_kendall_tau_against_a_symbolic_bench(house_file, tmp_path) -> None:
     assert [k["metric"] for k in agreement["kendall"]] == ["spl", "sr"]
     for args, msg in ((["--symbolic", str(tmp_path / "none")], "no episodes.jsonl"),
                       (["--symbolic", str(sym), "--with-symbolic"], "give one of them"),
-                      (["--reference", "scout"], "--reference: 'scout' is not one of")):
+                      (["--reference", "scout"], "--reference: 'scout' is not one of"),
+                      (["--reference", "random", "--all-pairs"],
+                       "--reference and --all-pairs: give one")):
         bad = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
                                        "--report-only", *args])
         assert bad.exit_code == 2 and msg in bad.output and bad.output.count("\n") == 1, \
