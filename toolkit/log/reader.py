@@ -46,7 +46,7 @@ from sgtool.log.image_wire import parse_raw_image
 from sgtool.log.log_file import require_regular_file, unended_problem
 from sgtool.log.records import RECORD_TYPES, LogRecord
 from sgtool.log.summary_check import BoundedReader as _BoundedReader
-from sgtool.log.summary_check import check_summary, read_attachment
+from sgtool.log.summary_check import check_summary, read_attachment, read_footer
 from sgtool.vocabulary import RecordName
 
 if TYPE_CHECKING:
@@ -152,10 +152,12 @@ class LogReader:
         # file is read once and indexed from its records (:mod:`sgtool.log.walk_index`)
         self._walked: list[walk_index.Entry] | None = None
         try:
-            if summary is not None:
-                check_summary(self._f, size, summary)
-            if walk_index.needs_walk(summary) or (
-                    summary is not None and walk_index.loose_messages(self._f, size, summary)):
+            walk = walk_index.needs_walk(summary)
+            if summary is not None:  # the footer read once for both checks
+                footer = read_footer(self._f, size)
+                check_summary(self._f, size, summary, footer)
+                walk = walk or walk_index.loose_messages(self._f, size, summary, footer)
+            if walk:
                 walked = walk_index.walk_log(self.path, size)
                 summary, self._walked = walked.summary, walked.messages
                 self.metadata: dict[str, dict[str, str]] = walked.metadata

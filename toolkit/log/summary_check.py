@@ -50,10 +50,11 @@ def read_footer(f: IO[bytes], size: int) -> Footer | None:
     return None if found is None else found[1]
 
 
-def check_summary(f: IO[bytes], size: int, summary: Summary) -> None:
+def check_summary(f: IO[bytes], size: int, summary: Summary,
+                  footer: Footer | None = None) -> None:
     """:class:`LogFormatError` when the summary CRC is wrong or an index points outside
-    the file or contradicts the others."""
-    footer = read_footer(f, size)
+    the file or contradicts the others; ``footer``: the file's, when read already."""
+    footer = footer or read_footer(f, size)
     if footer is not None and footer.summary_crc and footer.summary_start:
         start = int(footer.summary_start)
         end = size - 8 - FOOTER_RECORD_SIZE + 9 + 16

@@ -24,6 +24,7 @@ from mcap.records import (
     AttachmentIndex,
     Channel,
     ChunkIndex,
+    Footer,
     Message,
     Metadata,
     MetadataIndex,
@@ -70,13 +71,15 @@ def needs_walk(summary: Summary | None) -> bool:
             or st.metadata_count != len(summary.metadata_indexes))
 
 
-def loose_messages(f: IO[bytes], size: int, summary: Summary) -> bool:
+def loose_messages(f: IO[bytes], size: int, summary: Summary,
+                   footer: Footer | None = None) -> bool:
     """True when the data section holds a message (or bytes that are no record) outside
     what ``summary`` indexes: its chunks with the message indexes after them, attachments
     and metadata. Statistics count such messages, no index points to them, so a reader
     going by the indexes alone would lose them. Only the bytes between indexed records are
-    read (the header, definitions outside chunks, the data end, as a rule)."""
-    footer = read_footer(f, size)
+    read (the header, definitions outside chunks, the data end, as a rule); ``footer``:
+    the file's, when read already."""
+    footer = footer or read_footer(f, size)
     if footer is None or not footer.summary_start:
         return True
     spans = sorted([(int(c.chunk_start_offset), int(c.chunk_start_offset + c.chunk_length
