@@ -8,7 +8,7 @@ compares them with what a log recorded.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 from sgtool.errors import SgtoolError
 from sgtool.mapping.bev import BevConfig
@@ -29,6 +29,10 @@ from sgtool.scenegraph.build_options import (
 
 N_MAX = 50  # high-level steps per episode (SymSearch's N_max)
 NAVIGATION = ("live", "house")
+# the CLI's names of the LiveNavConfig fields it sets (``peek``'s default is on)
+_LIVE_FLAGS = {"optimistic": "--optimistic", "look_in": "--look-in",
+               "look_in_beyond": "--look-in-beyond", "peek": "--no-peek",
+               "sight_lines": "--sight-lines", "explore_through": "--explore-through"}
 
 
 @dataclass(frozen=True)
@@ -98,6 +102,7 @@ class ClosedLoopOptions:
         self.keyframes()
         if self.explore_on < 0:
             raise SgtoolError(f"--explore-on {self.explore_on}: must be >= 0")
+        self._check_live_only()
         if not 0.01 <= self.voxel_size <= 0.5:
             raise SgtoolError(f"voxel size {self.voxel_size} m: must be 0.01..0.5")
         mp = self.min_points if self.min_points is not None else default_min_points(
@@ -107,6 +112,21 @@ class ClosedLoopOptions:
         return ResolvedOptions(every=int(self.every), classifier=self.classifier,
                                min_points=int(mp), voxel_size=float(self.voxel_size),
                                max_frames=None, max_depth=self.depth_mapped())
+
+    def _check_live_only(self) -> None:
+        """Options of the robot's own navigation are refused with ``navigation="house"``,
+        which does not use them (one line naming them as the CLI does)."""
+        if self.navigation != "house":
+            return
+        default = LiveNavConfig()
+        changed = [_LIVE_FLAGS.get(f.name, f.name) for f in fields(LiveNavConfig)
+                   if getattr(self.live, f.name) != getattr(default, f.name)]
+        if self.explore_on:
+            changed.append("--explore-on")
+        if changed:
+            raise SgtoolError(f"{', '.join(changed)}: for --navigation live (the robot's own "
+                              "navigation); --navigation house does not use "
+                              f"{'them' if len(changed) > 1 else 'it'}")
 
     def depth_mapped(self) -> float:
         """``max_depth``, checked, or the default cut to the sensor's depth noise."""

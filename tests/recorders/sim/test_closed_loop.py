@@ -538,3 +538,18 @@ def test_episode_notes() -> None:
     (invalid,) = episode_notes(5.0, 5.0, 0.0, 3, None, ["'room:9' is not a node", "x"])
     assert invalid == ("2 of the planner's actions were invalid and spent a step each (the "
                        "first: 'room:9' is not a node)")
+
+
+def test_live_only_options_refused_with_house_navigation(tmp_path: Path) -> None:
+    house_nav = dataclasses.replace(OPTS, navigation="house")
+    assert house_nav.mapping().every == 10  # the defaults of live navigation pass
+    live = dataclasses.replace(OPTS.live, peek=False, look_in=0.5)
+    with pytest.raises(SgtoolError, match="^--look-in, --no-peek: for --navigation live"):
+        dataclasses.replace(house_nav, live=live).mapping()
+    with pytest.raises(SgtoolError, match="^--explore-on: .* does not use it$"):
+        dataclasses.replace(house_nav, explore_on=2).mapping()
+    assert dataclasses.replace(OPTS, live=live, explore_on=2).mapping().every == 10
+    r = CliRunner().invoke(cli, ["run", "--navigation", "house", "--sight-lines", "--seed",
+                                 "3", "--rooms", "4-4", "-p", "random", "-o",
+                                 str(tmp_path / "x.mcap")])
+    assert r.exit_code == 2 and "--sight-lines: for --navigation live" in r.output
