@@ -183,11 +183,22 @@ class EpisodeRunner:
         tasks = list(items)
         if self.executor is None:  # the logs there first: a resume refused runs nothing
             logged = [t.output.exists() for t in tasks]
-            there = [fn(t) for t, done in zip(tasks, logged, strict=True) if done]
+            there = list(self._read_back(fn, [t for t, done in zip(tasks, logged, strict=True)
+                                              if done]).values())
             return itertools.chain(there, (self._here(fn, t)
                                            for t, done in zip(tasks, logged, strict=True)
                                            if not done))
         return iter(self._on_executor(self.executor, fn, tasks))
+
+    def _read_back(self, fn: RunFn, tasks: list[RunTask]) -> dict[Path, RunRow]:
+        """The rows of the logs already there, in order, each checked against its task
+        (a bar while they are read, with ``progress``: a large folder takes a while)."""
+        from tqdm import tqdm
+
+        with tqdm(tasks, desc="checking logs there", unit="log", file=sys.stderr,
+                  leave=False, disable=not self.progress or not tasks,
+                  dynamic_ncols=True) as bar:
+            return {t.output: fn(t) for t in bar}
 
     def _here(self, fn: RunFn, task: RunTask) -> RunRow:
         if not task.output.exists():
@@ -202,7 +213,9 @@ class EpisodeRunner:
         from sgtool.analysis.executor import ExecutorError, Outcome, Task, failure_lines
         from sgtool.files import atomic_write
 
-        rows: dict[int, RunRow] = {i: fn(t) for i, t in enumerate(tasks) if t.output.exists()}
+        there = [i for i, t in enumerate(tasks) if t.output.exists()]
+        read = self._read_back(fn, [tasks[i] for i in there])
+        rows: dict[int, RunRow] = {i: read[tasks[i].output] for i in there}
         todo = [i for i in range(len(tasks)) if i not in rows]
         for i in todo:
             _remove_partials(tasks[i])

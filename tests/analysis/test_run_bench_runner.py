@@ -66,7 +66,7 @@ def test_a_partial_log_of_a_killed_run_is_removed_and_run_json_says_what_ran(
 
 
 def test_a_worker_that_does_not_see_the_folder_sends_its_log_back(
-        house_file, tmp_path, monkeypatch) -> None:
+        house_file, tmp_path, monkeypatch, capsys) -> None:
     cfg = ClosedLoopBenchConfig(
         planners=("random", "greedy"), houses=0, house_files=(str(house_file),), episodes=1,
         options=ClosedLoopOptions(camera=CameraConfig(width=64, height=48), max_steps=2,
@@ -74,6 +74,11 @@ def test_a_worker_that_does_not_see_the_folder_sends_its_log_back(
     here = tmp_path / "here"
     here.mkdir()
     direct = run_closed_loop_bench(cfg, here, runner=EpisodeRunner(None, here))
+    capsys.readouterr()
+    again = run_closed_loop_bench(cfg, here, runner=EpisodeRunner(None, here, progress=True))
+    # read back, not run, with a bar while the logs are checked
+    assert [(r.task, r.seconds) for r in again.rows] == [(r.task, None) for r in direct.rows]
+    assert "checking logs there" in capsys.readouterr().err
     away = tmp_path / "away"
     away.mkdir()
     stale = away / "logs/none/greedy/small/ep-000.mcap.k1lled00.partial"
