@@ -66,6 +66,7 @@ from sgtool.analysis.closed_loop_tables import (
 from sgtool.analysis.offline import log_exchanges, read_log_episodes, with_seen
 from sgtool.analysis.report import format_table, pipe_table
 from sgtool.analysis.run_bench_resume import (
+    ResumeError,
     check_resumable,
     episode_identity,
     task_settings,
@@ -497,8 +498,7 @@ def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
     """Run (or resume) the benchmark into ``out_dir``/logs; ``progress`` is advanced per
     episode (a tqdm bar's ``total`` is set to the episodes). ``runner`` maps
     :func:`run_task` over the tasks (``map``: one after the other, here). ``report_only``:
-    run nothing, read back the episodes whose logs are there (a run in progress, cut
-    short)."""
+    run nothing, read back the episodes whose logs are there (a run cut short too)."""
     cfg.check()
     if not report_only:  # one line on a core install, before any folder is made
         require("pybullet", api="sgtool.run_closed_loop_bench")
@@ -507,7 +507,8 @@ def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
     if report_only:
         tasks = [t for t in tasks if t.output.exists()]
         if not tasks:
-            raise SgtoolError(f"no episode log of this run in {logs}")
+            raise SgtoolError(f"no episode log of these planners, houses and episodes in "
+                              f"{logs}: give the options the run was made with")
     if progress is not None and hasattr(progress, "total"):
         progress.total = len(tasks)
     rows = []
@@ -516,7 +517,10 @@ def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
             rows.append(row)
             if progress is not None:
                 progress.update(1)
-    except BaseException:
+    except BaseException as e:
+        if report_only and isinstance(e, ResumeError):  # nothing to run again
+            raise ResumeError(f"{e.problem}; --report-only: give the options the run was "
+                              "made with") from None
         if not report_only:  # the folders of logs never written (a planner that raised)
             remove_empty_folders(logs)
         raise

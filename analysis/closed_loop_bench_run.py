@@ -40,6 +40,7 @@ RunFn = Callable[[RunTask], RunRow]
 # run.json: where and how long each episode of the last run ran (not in summary.*: wall
 # clock and placement differ from run to run)
 RUN_FILE = "run.json"
+RUN_OPTIONS_FILE = "run-options.json"  # the options the run was made with
 
 
 @dataclass(frozen=True)
@@ -61,6 +62,7 @@ class RunBenchRequest:
     symbolic_dir: str | None = None
     symbolic: Sequence[Any] = ()
     with_symbolic: bool = False
+    options_text: str | None = None  # RUN_OPTIONS_FILE's text (None: not written)
 
 
 def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
@@ -75,8 +77,12 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
 
     executor, bars = _executor(request)
     with output_folder(request.out_dir, force=request.force, command="run-bench",
-                       known=(*OUTPUT_NAMES, RUN_FILE), resume=True) as root:
+                       known=(*OUTPUT_NAMES, RUN_FILE, RUN_OPTIONS_FILE),
+                       resume=True) as root:
         runner = EpisodeRunner(executor, root, progress=bars)
+        if request.options_text is not None and not request.report_only:
+            text = request.options_text  # once the logs there agree with the options
+            runner.checked = lambda: atomic_write(root / RUN_OPTIONS_FILE, text)
         show_bar = bars and executor is None
         bar = tqdm(total=None, unit="episode", desc="run-bench", file=sys.stderr,
                    disable=not show_bar, dynamic_ncols=True)
@@ -169,7 +175,8 @@ class EpisodeRunner:
     with one line once all have run (the finished logs stay); Ctrl-C removes the partial
     logs of the tasks not finished (a Ray worker cancelled by force cannot).
     :attr:`nodes` maps each log run now to the Ray node that ran it (``""``: this
-    machine); :attr:`sent` holds the logs sent back."""
+    machine); :attr:`sent` holds the logs sent back; :attr:`checked` is called once the
+    logs there are read back and agree with their tasks, before any task runs."""
 
     def __init__(self, executor: Executor | None, root: Path, *,
                  progress: bool = False) -> None:
@@ -178,6 +185,7 @@ class EpisodeRunner:
         self.progress = progress
         self.nodes: dict[Path, str] = {}
         self.sent: set[Path] = set()
+        self.checked: Callable[[], object] | None = None
 
     def __call__(self, fn: RunFn, items: Iterable[RunTask]) -> Iterator[RunRow]:
         tasks = list(items)
@@ -198,7 +206,10 @@ class EpisodeRunner:
         with tqdm(tasks, desc="checking logs there", unit="log", file=sys.stderr,
                   leave=False, disable=not self.progress or not tasks,
                   dynamic_ncols=True) as bar:
-            return {t.output: fn(t) for t in bar}
+            rows = {t.output: fn(t) for t in bar}
+        if self.checked is not None:
+            self.checked()
+        return rows
 
     def _here(self, fn: RunFn, task: RunTask) -> RunRow:
         if not task.output.exists():

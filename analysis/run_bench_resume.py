@@ -34,7 +34,16 @@ _FIX = ("give a fresh -o folder, --force to run every episode again, or delete t
 
 
 class ResumeError(SgtoolError):
-    """An episode log of the output folder was run with other settings or another house."""
+    """An episode log of the output folder was run with other settings or another house:
+    :attr:`problem` says what differs, the message adds what to do."""
+
+    problem: str = ""
+
+
+def _refused(problem: str, fix: str) -> ResumeError:
+    e = ResumeError(f"{problem}; {fix}")
+    e.problem = problem
+    return e
 
 
 def episode_identity(ep: Episode) -> list[Any]:
@@ -196,7 +205,7 @@ def check_resumable(path: Path, want: dict[str, Any], spec: HouseSpec, house: st
         fix = (f"--max-depth {depth:g} maps as that log did, or {_FIX}"
                if settings.get("max_depth") != want.get("max_depth") and depth is not None
                and settings.get("noise") == want.get("noise") else _FIX)
-        raise ResumeError(f"{path} was run with other settings ({'; '.join(diff)}); {fix}")
+        raise _refused(f"{path} was run with other settings ({'; '.join(diff)})", fix)
     if not same_house(logged_house, spec):
-        raise ResumeError(f"{path} was run on another house: the house of {house} changed "
-                          f"since; {_FIX}")
+        raise _refused(f"{path} was run on another house: the house of {house} changed "
+                       "since", _FIX)

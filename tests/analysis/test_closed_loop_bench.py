@@ -334,7 +334,9 @@ def test_noise_profiles_are_kept_apart(house_file, tmp_path) -> None:
     res = CliRunner().invoke(cli, [*args, "--noise", "none", "--max-depth", "3"])
     assert res.exit_code == 2 and "depth mapped (m): 5.0 in the log, 3.0 now" in res.output
     assert "--max-depth 5 maps as that log did" in res.output
-    only = CliRunner().invoke(cli, [*args, "--report-only"])
+    both = CliRunner().invoke(cli, [*args, "--report-only"])  # as the run was made
+    assert both.exit_code == 0 and "noise 'my'" in both.output, both.output
+    only = CliRunner().invoke(cli, [*args, "--report-only", "--noise", "none"])
     assert only.exit_code == 0, only.output
     assert f"episode log(s) in {out}/logs are left out of this report (logs/my/" \
         in only.output

@@ -187,6 +187,8 @@ def test_a_refused_resume_runs_nothing_and_defaults_are_no_change(tmp_path: Path
     r = CliRunner().invoke(cli, changed)
     assert r.exit_code == 2 and "max steps: 2 in the log, 3 now" in r.output, r.output
     assert not (out / "logs/none/greedy").exists()  # nothing ran under the new setting
+    recorded = json.loads((out / "run-options.json").read_text())["options"]
+    assert recorded["max_steps"] == 2 and recorded["planners"] == "random"  # kept
     r = CliRunner().invoke(cli, [*base, "-O", "random.max_failures=2"])  # its default
     assert r.exit_code == 0, r.output
     r = CliRunner().invoke(cli, [a if a != "random" else "greedy,random" for a in base])
@@ -195,3 +197,32 @@ def test_a_refused_resume_runs_nothing_and_defaults_are_no_change(tmp_path: Path
     assert r.exit_code == 0, r.output
     assert (f"sgtool: note: 1 episode log(s) in {out}/logs are left out of this report "
             "(logs/none/random/myhouse/ep-000.mcap)") in r.stderr
+
+
+def test_report_only_tables_the_run_as_it_was_made(tmp_path: Path) -> None:
+    """--report-only needs none of the run's options again (run-options.json has them);
+    one given is the user's (a setting the logs were not run with is refused); the report
+    settings are the command's."""
+    _, _, out, _ = _first_run(tmp_path)
+    summary = (out / "summary.md").read_text()
+    r = CliRunner().invoke(cli, ["run-bench", "-o", str(out), "--report-only",
+                                 "--no-progress"])
+    assert r.exit_code == 0, r.output
+    assert (out / "summary.md").read_text() == summary
+    r = CliRunner().invoke(cli, ["run-bench", "-o", str(out), "--report-only", "--budgets",
+                                 "7", "--max-steps", "2", "--no-progress"])
+    assert r.exit_code == 0, r.output
+    assert "7 f/room" in (out / "summary.md").read_text()
+    r = CliRunner().invoke(cli, ["run-bench", "-o", str(out), "--report-only",
+                                 "--max-steps", "3"])  # given: not the run's, refused
+    assert r.exit_code == 2 and "max steps: 2 in the log, 3 now); --report-only: give the " \
+        "options the run was made with" in r.output, r.output
+    (out / "run-options.json").unlink()  # a folder of an older sgtool: give the options
+    r = CliRunner().invoke(cli, ["run-bench", "-o", str(out), "--report-only"])
+    assert r.exit_code == 2 and "give the options the run was made with" in r.output
+    r = CliRunner().invoke(cli, ["run-bench", "-o", str(out), "--report-only", "--planners",
+                                 "random", "--house", str(tmp_path / "myhouse.json"),
+                                 "--episodes", "1"])
+    assert r.exit_code == 2
+    assert "max steps: 2 in the log, 50 now" in r.output
+    assert r.output.strip().endswith("; --report-only: give the options the run was made with")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -106,7 +106,10 @@ if TYPE_CHECKING:
               help="Start afresh: the run is built beside OUT and moved in complete, "
               "replacing what sgtool wrote there (earlier logs included); other files stay.")
 @click.option("--report-only", is_flag=True,
-              help="Run nothing: the tables of the episodes whose logs are there already.")
+              help="Run nothing: the tables of the episodes whose logs are there already, "
+              "run as OUT/run-options.json records (the options that decide the run need "
+              "not be given again; the report settings --reference, --all-pairs, "
+              "--budgets, --symbolic and the budgets of AUC-E are this command's).")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
 @click.option("--reference", default=None, metavar="PLANNER",
@@ -149,9 +152,14 @@ def command(**given: Any) -> None:
     Example: `sgtool run-bench --planners random,scout --houses 2 --episodes 3
     --resolution 160x120 -o rb`.
     """
-    from sgtool.analysis.closed_loop_bench_run import run_bench_into
+    from sgtool.analysis.closed_loop_bench_run import RUN_OPTIONS_FILE, run_bench_into
+    from sgtool.commands.run_bench_recorded import as_recorded, options_text
 
-    run_bench_into(_request(RunBenchArgs(**given)), show=click.echo)
+    args = RunBenchArgs(**given)
+    if args.report_only:  # the run as it was made, whatever the defaults now
+        args = as_recorded(args, Path(args.out_dir) / RUN_OPTIONS_FILE)
+    request = _request(args)
+    run_bench_into(replace(request, options_text=options_text(args)), show=click.echo)
 
 
 @dataclass(frozen=True)
