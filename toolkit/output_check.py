@@ -12,12 +12,14 @@ from sgtool.errors import SgtoolError
 
 
 def check_output(path: str | Path, *, force: bool = False, option: str = "-o",
-                 suffixes: Sequence[str] = (), what: str = "output") -> Path:
+                 suffixes: Sequence[str] = (), what: str = "output",
+                 force_flag: str = "--force") -> Path:
     """The one check of an output file name a command may write, before any work: it is
     not a folder, it has one of ``suffixes`` (when given), its folder exists and takes a new
     file (a probe file is made there and removed), and it does not exist unless ``force``
     (and is never a device, FIFO or socket, which the atomic rename would replace).
-    Each failure is one :class:`SgtoolError` line; nothing is left behind."""
+    Each failure is one :class:`SgtoolError` line (``force_flag`` names how to
+    overwrite); nothing is left behind."""
     p = Path(path)
     if p.is_dir():
         raise SgtoolError(f"{option} {p} is a folder; give a file name")
@@ -26,7 +28,7 @@ def check_output(path: str | Path, *, force: bool = False, option: str = "-o",
     if not p.parent.exists():
         raise SgtoolError(f"{option} {p}: folder {p.parent} does not exist")
     if p.exists() and not force:
-        raise SgtoolError(f"{p} exists; not overwriting it (use --force)")
+        raise SgtoolError(f"{p} exists; not overwriting it (use {force_flag})")
     if p.exists() and not p.is_file():  # a device, FIFO or socket: a rename would replace it
         raise SgtoolError(f"{option} {p} is not a regular file; not replacing it, even with "
                           "--force")

@@ -29,7 +29,7 @@ def test_write_rerun_refuses_in_one_line(tmp_path) -> None:
         sgtool.write_rerun(log, log)
     out = tmp_path / "x.rrd"
     out.write_bytes(b"old")
-    with pytest.raises(sgtool.SgtoolError, match="exists"):
+    with pytest.raises(sgtool.SgtoolError, match=r"exists; .*\(use --force \(overwrite=\)\)"):
         sgtool.write_rerun(log, out)
     with pytest.raises(sgtool.SgtoolError, match="every=0"):
         sgtool.write_rerun(log, tmp_path / "y.rrd", every=0)

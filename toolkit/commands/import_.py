@@ -205,7 +205,8 @@ def bag(path: str, list_only: bool, output: str | None, force: bool, as_json: bo
 
     Each depth image becomes a frame at its header time, with the colour (and id) image of
     nearest time within --max-dt and the camera pose from tf interpolated at that time.
-    Without flags, lists the topics and suggests them.
+    Without flags, it stops (exit 2) naming the bag's topics and the flags to give for
+    them; --list only lists the topics.
 
     \b
     Example:
