@@ -200,7 +200,7 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
         raise SgtoolError(f"-o {out}: folder {out.parent} does not exist")
     elif out.exists() and not out.is_dir():
         raise SgtoolError(f"-o {out} is a file; a ROS 2 bag is a folder (not replacing it)")
-    with LogReader(log) as r:
+    with LogReader(log, verify=True) as r:  # a damaged chunk: one line, no bag
         if not r.is_sgtool:
             raise SgtoolError(f"{log} is not an sgtool log (`sgtool info {log}` says what it "
                               "is); export works on sgtool logs and their replays")

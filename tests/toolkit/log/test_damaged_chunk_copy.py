@@ -84,3 +84,15 @@ def test_view_refuses_a_damaged_chunk_in_one_line_and_writes_no_rrd(tmp_path, ca
     err = _one_line_refusal(["view", str(path), "-o", str(rrd)], capsys)
     assert f"chunk at byte {offset}: CRC mismatch" in err
     assert not rrd.exists() and not list(tmp_path.glob("*.rrd*"))
+
+
+@pytest.mark.parametrize("fmt", ["ros2", "ros1"])
+def test_export_bag_refuses_a_damaged_chunk_in_one_line_and_writes_no_bag(
+        tmp_path, capsys, fmt):
+    pytest.importorskip("rosbags")
+    path, offset = damaged_log(tmp_path)
+    out = tmp_path / ("flip.bag" if fmt == "ros1" else "flip_bag")
+    err = _one_line_refusal(["export", "bag", str(path), "-o", str(out), "--format", fmt],
+                            capsys)
+    assert f"chunk at byte {offset}: CRC mismatch" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["flip.mcap"]  # no bag at all
