@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -140,28 +141,72 @@ class EpisodeResult:
                 f"(reads {RESULT_VERSION.split('.')[0]}.x)"
             )
         shortest = d.get("shortest_m")
+        trace = d.get("trace", [])
+        if not isinstance(trace, list):
+            raise ResultsFormatError("trace: expected a list")
         return cls(
-            planner=str(d["planner"]),
-            seed=int(d.get("seed", 0)),
-            house=str(d.get("house", "")),
-            episode=int(d.get("episode", 0)),
-            query=str(d.get("query", "")),
-            seen=d.get("seen"),
-            success=bool(d["success"]),
-            steps=int(d["steps"]),
-            travelled_m=float(d["travelled_m"]),
-            shortest_m=None if shortest is None else float(shortest),
-            n_open=int(d.get("n_open", 0)),
-            n_invalid=int(d.get("n_invalid", 0)),
-            n_failure=int(d.get("n_failure", 0)),
-            end=str(d.get("end", "")),
-            source=str(d.get("source", "symbolic")),
-            trace=tuple(Step(str(s[0]), s[1], str(s[2]), float(s[3]))
-                        for s in d.get("trace", [])),
+            planner=_text(d, "planner"),
+            seed=_whole(d, "seed", 0),
+            house=_text(d, "house", ""),
+            episode=_whole(d, "episode", 0),
+            query=_text(d, "query", ""),
+            seen=None if d.get("seen") is None else _flag(d, "seen"),
+            success=_flag(d, "success"),
+            steps=_whole(d, "steps"),
+            travelled_m=_number(d, "travelled_m"),
+            shortest_m=None if shortest is None else _number(d, "shortest_m"),
+            n_open=_whole(d, "n_open", 0),
+            n_invalid=_whole(d, "n_invalid", 0),
+            n_failure=_whole(d, "n_failure", 0),
+            end=_text(d, "end", ""),
+            source=_text(d, "source", "symbolic"),
+            trace=tuple(Step(str(s[0]), s[1], str(s[2]), float(s[3])) for s in trace),
             wall=dict(d.get("wall", {})),
             llm_answers={str(k): int(v) for k, v in (d.get("llm_answers") or {}).items()},
             noise=str(d.get("noise") or ""),
         )
+
+
+_ABSENT = object()
+
+
+def _field(d: Mapping[str, Any], key: str, default: Any) -> Any:
+    value = d.get(key, default)
+    if value is _ABSENT:
+        raise ResultsFormatError(f"episode record lacks field(s): {key}")
+    return value
+
+
+def _flag(d: Mapping[str, Any], key: str, default: Any = _ABSENT) -> bool:
+    """A JSON true/false (not "false", not 0)."""
+    value = _field(d, key, default)
+    if not isinstance(value, bool):
+        raise ResultsFormatError(f"{key}: expected true or false, got {json.dumps(value)}")
+    return value
+
+
+def _whole(d: Mapping[str, Any], key: str, default: Any = _ABSENT) -> int:
+    """A JSON integer (not 3.5, not a string, not a boolean)."""
+    value = _field(d, key, default)
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ResultsFormatError(f"{key}: expected a whole number, got {json.dumps(value)}")
+    return value
+
+
+def _number(d: Mapping[str, Any], key: str, default: Any = _ABSENT) -> float:
+    """A finite JSON number."""
+    value = _field(d, key, default)
+    if isinstance(value, bool) or not isinstance(value, int | float) or \
+            not math.isfinite(value):
+        raise ResultsFormatError(f"{key}: expected a finite number, got {json.dumps(value)}")
+    return float(value)
+
+
+def _text(d: Mapping[str, Any], key: str, default: Any = _ABSENT) -> str:
+    value = _field(d, key, default)
+    if not isinstance(value, str):
+        raise ResultsFormatError(f"{key}: expected text, got {json.dumps(value)}")
+    return value
 
 
 # ----------------------------------------------------------------------------------------

@@ -62,6 +62,30 @@ def test_read_errors_name_the_line(tmp_path):
         read_jsonl(tmp_path / "missing.jsonl")
 
 
+@pytest.mark.parametrize(("key", "value", "message"), [
+    ("success", "false", 'success: expected true or false, got "false"'),
+    ("success", 1, "success: expected true or false, got 1"),
+    ("steps", 3.5, "steps: expected a whole number, got 3.5"),
+    ("steps", 1e30, "steps: expected a whole number, got 1e+30"),
+    ("steps", True, "steps: expected a whole number, got true"),
+    ("travelled_m", "7", 'travelled_m: expected a finite number, got "7"'),
+    ("planner", 5, "planner: expected text, got 5"),
+    ("house", None, "house: expected text, got null"),
+    ("seen", "no", 'seen: expected true or false, got "no"'),
+    ("trace", "x", "trace: expected a list"),
+])
+def test_a_field_of_the_wrong_type_is_refused_not_coerced(tmp_path, key, value, message):
+    """A record is read as written, never coerced: "false" is no success, 3.5 steps are
+    not 3 (eval would score them)."""
+    p = tmp_path / "e.jsonl"
+    p.write_text(json.dumps({**_result().to_dict(), key: value}) + "\n")
+    with pytest.raises(ResultsFormatError) as e:
+        read_jsonl(p)
+    assert str(e.value) == f"{p}:1: {message}"
+    p.write_text(json.dumps({**_result().to_dict(), "seen": None, "shortest_m": None}) + "\n")
+    assert read_jsonl(p)[0].seen is None and read_jsonl(p)[0].shortest_m is None
+
+
 def test_result_from_log_records_derives_counts():
     episode = {"kind": "search", "status": "success", "query": "cup", "planner": "scout",
                "house_id": "house-1", "steps": 3, "travelled_m": 6.5, "shortest_m": 5.0,
