@@ -190,7 +190,7 @@ def _planners(args: BenchArgs) -> tuple[tuple[str, ...], dict[str, dict[str, Any
     from sgtool.analysis.bench import DEFAULT_PLANNERS
     from sgtool.semantics.priors import weights_folder
 
-    names = planner_names(args.planners) if args.planners else DEFAULT_PLANNERS
+    names = planner_names(args.planners) if args.planners is not None else DEFAULT_PLANNERS
     options = {k: v for k, v in planner_options(args.planner_option, names).items()
                if k in names}  # those of planners not run: a note said they are unused
     LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,

@@ -258,7 +258,7 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
     from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
     from sgtool.recorders.sim.live_skills import LiveNavConfig
 
-    names = planner_names(args.planners) if args.planners else DEFAULT_PLANNERS
+    names = planner_names(args.planners) if args.planners is not None else DEFAULT_PLANNERS
     if args.max_steps < 1:
         raise SgtoolError(f"--max-steps: must be >= 1, got {args.max_steps}")
     width, height = parse_resolution(args.resolution)
@@ -288,10 +288,10 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
 
 def _budgets(text: str | None) -> tuple[float, ...]:
     """--budgets F1,F2,...: frames per room, one line for what is not a number."""
-    if not text:
+    if text is None:
         return ()
     try:
         return tuple(float(part) for part in text.split(","))
     except ValueError:
-        raise SgtoolError(f"--budgets {text}: comma-separated frames per room, e.g. 90,100"
-                          ) from None
+        raise SgtoolError(f"--budgets {text or repr(text)}: comma-separated frames per "
+                          "room, e.g. 90,100") from None

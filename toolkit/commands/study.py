@@ -197,8 +197,30 @@ def _conditions(factors: tuple[str, ...], profiles: tuple[str, ...]) -> Any:
         chosen[name] = levels
     if not factors:
         chosen = dict(DEFAULT_LEVELS)
+    twice = sorted({p for p in profiles if profiles.count(p) > 1})
+    if twice:
+        raise SgtoolError(f"--profile {twice[0]}: given twice")
     profile_list = tuple(profiles) if profiles else (() if factors else DEFAULT_PROFILES)
     return conditions_of(chosen, profile_list)
+
+
+_CLOSED_LOOP_ONLY = ("closed_loop_noise", "episodes", "closed_loop_houses",
+                     "frames_per_room", "max_steps")
+
+
+def _refuse_closed_loop_options() -> None:
+    """The options of the closed-loop part, given without --closed-loop, are refused
+    (they would do nothing)."""
+    from click.core import ParameterSource
+
+    ctx = click.get_current_context(silent=True)
+    if ctx is None:
+        return
+    given = [f"--{n.replace('_', '-')}" for n in _CLOSED_LOOP_ONLY
+             if ctx.get_parameter_source(n) is ParameterSource.COMMANDLINE]
+    if given:
+        raise SgtoolError(f"{', '.join(given)}: for the closed-loop part; give "
+                          "--closed-loop PLANNERS too")
 
 
 def _renamed(e: SgtoolError, theirs: str, ours: str) -> SgtoolError:
@@ -253,6 +275,8 @@ def _closed_loop(args: NoiseArgs) -> Any:
             raise _renamed(e, "--noise", "--closed-loop-noise") from None
     if args.closed_loop is not None and not planners:
         raise SgtoolError("--closed-loop: give at least one planner")
+    if args.closed_loop is None:
+        _refuse_closed_loop_options()
     if planners and not cl_noise:
         raise SgtoolError("--closed-loop-noise: give at least one profile")
     return ClosedLoopSettings(planners, cl_noise, args.episodes, args.closed_loop_houses,

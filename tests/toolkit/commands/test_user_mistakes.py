@@ -184,6 +184,10 @@ def test_a_run_that_leaves_its_recorded_transcript_is_an_error(tmp_path):
      "16..4096 pixels"),
     (["--cache", "{tmp}/f/x"], "sgtool: error: --cache {tmp}/f/x: lies under {tmp}/f, which "
      "is no folder"),
+    (["--closed-loop-noise", "mild", "--closed-loop-houses", "2"], "sgtool: error: "
+     "--closed-loop-noise, --closed-loop-houses: for the closed-loop part; give "
+     "--closed-loop PLANNERS too"),
+    (["--profile", "mild", "--profile", "mild"], "sgtool: error: --profile mild: given twice"),
 ])
 def test_study_names_its_own_closed_loop_options(tmp_path, monkeypatch, args, line):
     """study noise checks its closed-loop planners and profiles with run-bench's and
@@ -217,3 +221,15 @@ def test_ctrl_c_while_the_rrd_is_written_says_the_log_is_complete(tmp_path, monk
         f"sgtool: interrupted; {out} was written; {rrd} was not (make it with: sgtool view "
         f"{out} -o {rrd})")
     assert out.exists() and not rrd.exists()
+
+
+@pytest.mark.parametrize("args, line", [
+    (["bench", "--planners", ""], "sgtool: error: --planners: name at least one planner"),
+    (["run-bench", "--planners", ""], "sgtool: error: --planners: name at least one planner"),
+    (["run-bench", "--budgets", ""], "sgtool: error: --budgets '': comma-separated frames per "
+     "room, e.g. 90,100"),
+])
+def test_an_empty_list_is_not_the_defaults(tmp_path, args, line):
+    r = CliRunner().invoke(cli, [*args, "-o", str(tmp_path / "out")])
+    assert r.exit_code == 2 and r.output.strip() == line, r.output
+    assert not (tmp_path / "out").exists()
