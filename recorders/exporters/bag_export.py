@@ -65,13 +65,13 @@ from sgtool.log.reader import LogReader
 from sgtool.output_check import check_output
 from sgtool.recorders.exporters import ros_maps
 from sgtool.recorders.exporters.bagwriter import COMPRESSIONS, DISTROS, BagWriter
+from sgtool.recorders.importers.bagfiles import ROS1_MAGIC
 
 FORMATS = {"ros1": "ros1", "ros2": "ros2-mcap"}
 DEFAULT_COMPRESSION = {"ros1": "lz4", "ros2": "zstd"}
 DEFAULT_TIME_BASE_S = 1.0
 REP105 = {S.WORLD_FRAME: "map", S.BASE_FRAME: "base_link",
           S.CAMERA_FRAME: "camera_optical_frame"}
-ROS1_MAGIC = b"#ROSBAG V2.0\n"
 TF_STATIC = "/tf_static"
 GRAPH_TOPIC = S.RECORDS["scene_graph"].topic
 IMAGE_TOPICS = {S.DEPTH: "/camera/depth", S.RGB: "/camera/rgb", S.IDS: "/camera/instances"}

@@ -15,6 +15,7 @@ Failures become :class:`SgtoolError` messages that name the file and what it is 
 from __future__ import annotations
 
 import contextlib
+import tempfile
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,6 +24,7 @@ from typing import Any
 from sgtool.errors import SgtoolError
 from sgtool.files import quoted
 
+ROS1_MAGIC = b"#ROSBAG V2.0\n"  # the first bytes of a ROS 1 bag
 IMAGE_TYPES = ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage")
 INFO_TYPES = ("sensor_msgs/msg/CameraInfo",)
 TF_TYPES = ("tf2_msgs/msg/TFMessage", "tf/msg/tfMessage")
@@ -48,10 +50,11 @@ def normalise_type(t: str) -> str:
 
 
 def bag_kind(path: Path) -> str:
-    """``ros1`` or ``ros2`` (folder, or bare storage file)."""
+    """``ros1`` (a .bag file, or a file starting as one) or ``ros2`` (folder, or bare
+    storage file)."""
     if path.is_dir():
         return "ros2"
-    if path.suffix == ".bag":
+    if path.suffix == ".bag" or _starts_with(path, ROS1_MAGIC):
         return "ros1"
     return "ros2"
 
@@ -92,6 +95,14 @@ def _check_mcap_profile(path: Path) -> None:
         )
 
 
+def _starts_with(path: Path, magic: bytes) -> bool:
+    try:
+        with open(path, "rb") as fh:
+            return fh.read(len(magic)) == magic
+    except OSError:
+        return False
+
+
 @contextlib.contextmanager
 def open_bag(path: str | Path) -> Iterator[Any]:
     """An open ``rosbags`` AnyReader over the bag at ``path`` (see the module docstring)."""
@@ -111,10 +122,13 @@ def open_bag(path: str | Path) -> Iterator[Any]:
         elif path.is_dir() and not (path / "metadata.yaml").is_file():
             raise SgtoolError(f"{path}: a folder without metadata.yaml is not a ROS 2 bag")
         elif path.is_file() and path.suffix != ".bag":
-            raise SgtoolError(
-                f"{path}: not a ROS bag (expected a ROS 1 .bag file, a ROS 2 bag folder, or a "
-                "ROS 2 .mcap/.db3 file)"
-            )
+            if not _starts_with(path, ROS1_MAGIC):
+                raise SgtoolError(
+                    f"{path}: not a ROS bag (expected a ROS 1 .bag file, a ROS 2 bag folder, "
+                    "or a ROS 2 .mcap/.db3 file)")
+            # a ROS 1 bag by another name: the reader goes by the name, so give it one
+            target = Path(stack.enter_context(tempfile.TemporaryDirectory())) / "bag.bag"
+            target.symlink_to(path.resolve())
         try:
             reader = AnyReader([target], default_typestore=get_typestore(Stores.LATEST))
             stack.enter_context(reader)

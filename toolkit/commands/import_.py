@@ -240,6 +240,9 @@ def _tf_frames(text: str | None) -> tuple[str, str] | None:
     parts = text.split(":")
     if len(parts) != 2 or not all(parts):
         raise SgtoolError(f"--tf-frames {text!r}: give WORLD:CAMERA, e.g. map:camera")
+    if parts[0] == parts[1]:
+        raise SgtoolError(f"--tf-frames {text!r}: the world and the camera are one frame "
+                          "(every pose would be the identity); give two frames")
     return parts[0], parts[1]
 
 

@@ -66,6 +66,20 @@ def test_round_trip_sgtool_log_through_a_bag(tmp_path, fmt):
         assert b.last_record("episode")["kind"] == "import"
 
 
+def test_a_ros1_bag_by_another_name_is_read(tmp_path):
+    """ROS 1 bags are known by their first bytes, not their name (export bag -o NAME
+    --format ros1 writes one without .bag)."""
+    src = write_sgtool_log(tmp_path / "src.mcap", n=3)
+    bag = bag_path(tmp_path, "ros1")
+    assert write_log_as_bag(src, bag, "ros1") == 3
+    renamed = bag.rename(tmp_path / "recording")
+    rep = import_bag(renamed, tmp_path / "back.mcap", BagOptions(**TOPICS, **KEEP_WORLD))
+    assert rep.frames == 3
+    with LogReader(tmp_path / "back.mcap") as r:
+        assert r.metadata[IMPORT_METADATA]["source_kind"] == "bag/ros1"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["back.mcap", "recording", "src.mcap"]
+
+
 def test_round_trip_with_png_colour_and_automatic_world(tmp_path):
     """CompressedImage colour decodes losslessly (PNG); the automatic alignment of the
     synthetic scene (camera 1.2 m above a floor at z = 0, world already z-up) is the
@@ -272,6 +286,9 @@ def test_wrong_topic_types_name_topic_and_type(tmp_path):
     assert "frame 'map' is not in the tf tree" in r.output
     assert "world -> camera_optical_frame" in r.output
     assert r.output.count("\n") == 1  # one line, the links in it
+    r = run(base + ["--depth", TOPICS["depth"], "--tf-frames", "map:map"])
+    assert r.exit_code == 2 and "--tf-frames 'map:map': the world and the camera are one " \
+        "frame" in r.output
     assert not out.exists() and not Path(str(out) + ".partial").exists()
     assert all("Traceback" not in x for x in [r.output])
 
