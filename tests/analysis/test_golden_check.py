@@ -98,6 +98,10 @@ def test_a_coarser_voxel_size_is_reported_layer_by_layer(pinned, tmp_path, capsy
     assert "## small: changed" in md.read_text()
     junit = xml.read_text()
     assert 'tests="1" failures="1" errors="0"' in junit and "<failure" in junit
+    code, _, err = sgtool(capsys, "golden", "check", "--dir", pinned, "--report", md,
+                          "--junit", md)
+    assert code == 2 and f"--report {md} and --junit {md}: one file" in err
+    assert "## small: changed" in md.read_text()  # untouched
 
 
 def test_tolerance_lets_float_level_changes_pass(pinned, capsys):

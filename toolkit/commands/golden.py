@@ -185,6 +185,9 @@ def _check_report_files(report_md: str | None, junit: str | None) -> None:
     for path, option in ((report_md, "--report"), (junit, "--junit")):
         if path:
             check_output(path, force=True, option=option)
+    if report_md and junit and Path(report_md).resolve() == Path(junit).resolve():
+        raise SgtoolError(f"--report {report_md} and --junit {junit}: one file; give two "
+                          "(the second would replace the first)")
 
 
 def _write_report_files(report: Any, report_md: str | None, junit: str | None) -> None:

@@ -42,9 +42,14 @@ def _offset_ns(seconds: float) -> int:
     """``--time-offset`` in seconds (finite) -> integer nanoseconds."""
     import math
 
+    from sgtool.recorders.importers.bag_options import MAX_TIME_OFFSET_S
+
     if not math.isfinite(seconds):
         raise SgtoolError(f"--time-offset {seconds!r}: give a number of seconds")
-    return round(seconds * 1e9) if abs(seconds) < 1e6 else int(math.copysign(1e15, seconds))
+    if abs(seconds) > MAX_TIME_OFFSET_S:  # the value given, not one cut to fit nanoseconds
+        raise SgtoolError(f"--time-offset {seconds:g}: must be within "
+                          f"+-{MAX_TIME_OFFSET_S:g} seconds")
+    return round(seconds * 1e9)
 
 
 def _output(output: str | None, force: bool) -> Path:

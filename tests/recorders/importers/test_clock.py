@@ -58,6 +58,11 @@ def test_images_stamped_after_their_tf_are_refused_naming_the_fixes(tmp_path):
                                  "-o", str(tmp_path / "c.mcap"), "--quiet", "--up", "z",
                                  "--floor", "none", "--time-offset", "-0.25"])
     assert r.exit_code == 0, r.output
+    for given in ("1e7", "-1e9", "5000"):  # named as given
+        r = CliRunner().invoke(cli, ["import", "bag", str(bag), "--depth", DEPTH,
+                                     "--time-offset", given, "-o", str(tmp_path / "d.mcap")])
+        assert r.exit_code == 2 and r.output.strip() == (
+            f"sgtool: error: --time-offset {float(given):g}: must be within +-3600 seconds")
 
 
 def test_camera_latency_is_not_a_clock_error(tmp_path):
