@@ -81,12 +81,42 @@ def require(module: str, who: str | None = None, *, api: str = "sgtool") -> Modu
     ``sgtool`` command, else ``api``: the public function called, ``sgtool.write_rerun``)
     and the command that installs it."""
     try:
-        return importlib.import_module(module)
+        return quiet_import(module) if module in BANNERS else importlib.import_module(module)
     except ModuleNotFoundError as e:
         err = missing_extra(who or _running_command(api), e)
         if err is None:
             raise
         raise err from None
+
+
+BANNERS = frozenset({"pybullet"})  # modules that print a banner on stderr at import
+
+
+def quiet_import(module: str) -> ModuleType:
+    """Import ``module`` with the C-level stderr silenced while it loads (PyBullet prints
+    its build time there), so command output stays one line; as
+    :func:`importlib.import_module` where there is no real stderr to silence."""
+    import contextlib
+    import ctypes
+    import os
+    import sys
+
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError, AttributeError):  # no real stderr (embedded, captured)
+        return importlib.import_module(module)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 2)
+        mod = importlib.import_module(module)
+        with contextlib.suppress(Exception):  # flush C stdio while it still goes nowhere
+            ctypes.CDLL(None).fflush(None)
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(devnull)
+    return mod
 
 
 def _running_command(default: str = "sgtool") -> str:

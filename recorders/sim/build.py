@@ -19,18 +19,15 @@ renders are byte-identical across runs and machines.
 
 from __future__ import annotations
 
-import contextlib
-import ctypes
 import hashlib
 import math
-import os
-import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from types import ModuleType
 
 import numpy as np
 
+from sgtool.extras import quiet_import
 from sgtool.house.spec import Furniture, HouseSpec
 from sgtool.recorders.sim import articulation as art
 from sgtool.recorders.sim.body_instances import Instance, initial_states, instance_table
@@ -50,28 +47,8 @@ def pybullet() -> ModuleType:
     on the C-level stderr at import) silenced, so command output stays clean."""
     global _pybullet
     if _pybullet is None:
-        _pybullet = _quiet_import()
+        _pybullet = quiet_import("pybullet")
     return _pybullet
-
-
-def _quiet_import() -> ModuleType:
-    try:
-        sys.stderr.flush()
-        saved = os.dup(2)
-    except (OSError, ValueError, AttributeError):  # no real stderr (embedded, captured)
-        import pybullet as pb
-        return pb
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    try:
-        os.dup2(devnull, 2)
-        import pybullet as pb
-        with contextlib.suppress(Exception):  # flush C stdio while it still goes nowhere
-            ctypes.CDLL(None).fflush(None)
-    finally:
-        os.dup2(saved, 2)
-        os.close(saved)
-        os.close(devnull)
-    return pb
 
 
 def category_rgb(category: str) -> tuple[float, float, float]:

@@ -4,6 +4,7 @@ reaching the log, and user errors that leave no file behind."""
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import pytest
@@ -127,3 +128,17 @@ def test_same_bytes_in_a_fresh_process(tmp_path: Path) -> None:
                    env={"PYTHONHASHSEED": "77", "PATH": "/usr/bin:/bin",
                         **{k: v for k, v in os.environ.items() if k.startswith("OPENBLAS_")}})
     assert hashlib.sha256(a.read_bytes()).digest() == hashlib.sha256(b.read_bytes()).digest()
+
+
+def test_a_mistake_is_one_line_in_a_fresh_process(tmp_path: Path) -> None:
+    """PyBullet prints its build time on the C-level stderr when imported; the import that
+    checks it is installed silences that too, so a refusal stays one line."""
+    import subprocess
+
+    r = subprocess.run([sys.executable, "-c", "from sgtool.cli import main; main()",
+                        "record", "--seed", "3", "--rooms", "4-4", "--start", "999", "-o",
+                        str(tmp_path / "x.mcap")],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2
+    assert r.stderr == "sgtool: error: start 999: the house has 4 start poses (0..3)\n"
+    assert r.stdout == ""
