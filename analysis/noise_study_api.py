@@ -27,6 +27,7 @@ from sgtool.analysis.noise_study import (
     conditions_of,
     run_study,
 )
+from sgtool.arg_checks import whole
 from sgtool.errors import SgtoolError
 from sgtool.extras import require
 
@@ -87,9 +88,7 @@ def noise_study_config(houses: int = 4, *, house_seed: int = 0,
 
 def _count(name: str, value: object, least: int) -> int:
     """``value`` as a whole number >= ``least``, else one line naming ``name``."""
-    if isinstance(value, bool) or not isinstance(value, int) or value < least:
-        raise SgtoolError(f"{name}={value!r}: a whole number >= {least}")
-    return value
+    return int(whole(name, value, least))  # type: ignore[arg-type]
 
 
 def _pair(name: str, value: object, least: int) -> tuple[int, int]:

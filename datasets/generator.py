@@ -164,7 +164,15 @@ def generate_house(seed: int, rooms: tuple[int, int] = (4, 12), split: str = "ev
     of the room count, corridors included (inclusive, 4..30); ``preset`` names a
     :mod:`sgtool.datasets.presets` entry ("default": as documented here; "symsearch":
     InteriorGS-dense houses with long-tail small objects)."""
-    lo, hi = int(rooms[0]), int(rooms[1])
+    try:
+        lo, hi = rooms
+        if not all(isinstance(r, int | np.integer) and not isinstance(r, bool)
+                   for r in (lo, hi)):
+            raise TypeError
+    except (TypeError, ValueError):
+        raise SgtoolError(f"rooms={rooms!r}: give (MIN, MAX), two whole numbers, e.g. "
+                          "(4, 12)") from None
+    lo, hi = int(lo), int(hi)
     if not 4 <= lo <= hi <= MAX_ROOMS:
         raise SgtoolError(f"rooms: need 4 <= min <= max <= {MAX_ROOMS}, got {lo}-{hi}")
     if split not in ("eval", "train"):

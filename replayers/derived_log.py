@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from sgtool.arg_checks import number, whole
 from sgtool.blas import single_blas_thread
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
@@ -87,6 +88,14 @@ class ReplayOptions:
     max_frames: int | None = None  # stop after this many frames
     max_depth: float | None = None  # m; depth farther is not mapped
     tf_time: str = "log"  # what pairs /tf with frames: "log" time or header "stamp"
+
+    def __post_init__(self) -> None:  # a caller's wrong type: one line, here
+        for name in ("every", "min_points", "max_frames"):
+            whole(name, getattr(self, name), 1, optional=True)
+        for name in ("voxel_size", "max_depth"):
+            number(name, getattr(self, name), optional=True)
+        if self.classifier is not None and not isinstance(self.classifier, str):
+            raise SgtoolError(f"classifier={self.classifier!r}: a classifier's name")
 
 
 def resolve_options(reader: LogReader, options: ReplayOptions) -> ResolvedOptions:

@@ -307,11 +307,12 @@ def coverage_at(samples: Sequence[tuple[float, float]], t: float) -> float:
     return best
 
 
-def record_house(house: HouseSpec, output: str | os.PathLike[str],
+def record_house(house: HouseSpec | str | os.PathLike[str], output: str | os.PathLike[str],
                  options: RecordOptions | None = None, *, house_id: str = "",
                  progress: Progress | None = None, observers: Sequence[SimObserver] = ()
                  ) -> RecordReport:
-    """Record the exploration of ``house`` (``sgtool record``) into the log ``output``
+    """Record the exploration of ``house`` (a spec, or a spec file's path; ``sgtool
+    record``) into the log ``output``
     (``*.mcap``, replaced when it exists; written to a temporary name and renamed at the
     end, so an error leaves nothing, and an interrupt its ``.partial`` file:
     :mod:`sgtool.log.writer`). A house without start poses needs them first
@@ -324,6 +325,13 @@ def record_house(house: HouseSpec, output: str | os.PathLike[str],
     from sgtool.extras import require
 
     require("pybullet", api="sgtool.record_house")  # one line on a core install
+    if isinstance(house, str | os.PathLike):  # a house spec file, as run_one takes
+        from sgtool.house.io import load_house
+
+        house = load_house(house)
+    elif not isinstance(house, HouseSpec):
+        raise SgtoolError(f"house: a HouseSpec or a house spec file, got "
+                          f"{type(house).__name__}")
     if Path(output).suffix != ".mcap":
         raise SgtoolError(f"{output}: the output is an MCAP log; name it *.mcap")
     opts = options or RecordOptions()

@@ -39,3 +39,47 @@ def test_write_rerun_refuses_in_one_line(tmp_path) -> None:
         sgtool.write_rerun(text, tmp_path / "z.rrd")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt", "x.rrd"]
     assert out.read_bytes() == b"old"
+
+
+def test_arguments_of_the_wrong_type_are_one_line(tmp_path) -> None:
+    """The mistakes a caller of the API makes are one SgtoolError line naming the
+    parameter, not an error deep inside a stage (a review hit each of these)."""
+    with pytest.raises(sgtool.SgtoolError, match=r"^rooms=5: give \(MIN, MAX\)"):
+        sgtool.generate_house(0, rooms=5)
+    with pytest.raises(sgtool.SgtoolError, match=r"^rooms=\(4.5, 6\): give \(MIN, MAX\)"):
+        sgtool.generate_house(0, rooms=(4.5, 6))
+    with pytest.raises(sgtool.SgtoolError, match="^every='x': a whole number >= 1, or None$"):
+        sgtool.ReplayOptions(every="x")
+    with pytest.raises(sgtool.SgtoolError, match="^max_frames=2.5: a whole number >= 1"):
+        sgtool.ReplayOptions(max_frames=2.5)
+    with pytest.raises(sgtool.SgtoolError, match="^max_depth=nan: a finite number"):
+        sgtool.ReplayOptions(max_depth=float("nan"))
+    with sgtool.LogReader(LOG) as r:
+        with pytest.raises(sgtool.SgtoolError, match="^record kind 'nosuch': one of action, "):
+            list(r.records("nosuch"))
+        with pytest.raises(sgtool.SgtoolError, match="^record kind 5: one of"):
+            list(r.records(5))
+        assert r.last_record("episode") is not None
+    for seed in ("x", -1, True):
+        with pytest.raises(sgtool.SgtoolError, match=f"^seed={seed!r}: a whole number >= 0"):
+            sgtool.LogWriter(tmp_path / "w.mcap", seed=seed)
+    assert not list(tmp_path.iterdir())
+    with sgtool.LogWriter(tmp_path / "w.mcap") as w, \
+            pytest.raises(ValueError, match="^intrinsics: a CameraIntrinsics, got NoneType$"):
+        w.write_frame(0, depth=[[1.0]], pose=[[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0],
+                                             [0, 0, 0, 1]], intrinsics=None)
+
+
+def test_record_house_takes_a_house_file(tmp_path) -> None:
+    pytest.importorskip("pybullet")
+    from sgtool.datasets.start_poses import with_start_poses
+    from sgtool.recorders.sim import CameraConfig
+
+    house = tmp_path / "h.json"
+    sgtool.save_house(with_start_poses(sgtool.generate_house(6, rooms=(4, 4))), house)
+    opts = sgtool.RecordOptions(frames=2, camera=CameraConfig(width=32, height=24))
+    rep = sgtool.record_house(str(house), tmp_path / "r.mcap", opts)
+    assert rep.frames == 2
+    with pytest.raises(sgtool.SgtoolError, match="^house: a HouseSpec or a house spec file, "
+                       "got int$"):
+        sgtool.record_house(5, tmp_path / "x.mcap", opts)  # type: ignore[arg-type]

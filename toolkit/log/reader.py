@@ -44,7 +44,7 @@ from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.log.frame_assembly import FRAME_TOPICS, FrameAssembler, TransformBuffer, decoded
 from sgtool.log.image_wire import parse_raw_image
 from sgtool.log.log_file import require_regular_file, unended_problem
-from sgtool.log.records import RECORD_TYPES, LogRecord
+from sgtool.log.records import LogRecord, record_type
 from sgtool.log.summary_check import BoundedReader as _BoundedReader
 from sgtool.log.summary_check import check_summary, read_attachment, read_footer
 from sgtool.vocabulary import RecordName
@@ -392,7 +392,7 @@ class LogReader:
         record type (``Episode``) gives typed records; a kind name (``"episode"``) gives
         the checked JSON dicts. ``start_ns``, ``end_ns``, ``reverse``: as in
         :meth:`messages`."""
-        rtype = RECORD_TYPES[kind] if isinstance(kind, str) else kind
+        rtype = record_type(kind)
         if not self.has(rtype.channel().topic):
             return
         for i, d in enumerate(self.messages([rtype.channel().topic], start_ns=start_ns,

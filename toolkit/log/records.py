@@ -41,7 +41,7 @@ from dataclasses import dataclass, field, fields, replace
 from typing import TYPE_CHECKING, Any, ClassVar, Final, Literal, TypeVar, overload
 
 from sgtool.canonical import canonical_float
-from sgtool.errors import LogFormatError
+from sgtool.errors import LogFormatError, SgtoolError
 from sgtool.log import schemas as S
 from sgtool.vocabulary import (
     EpisodeKind,
@@ -568,3 +568,14 @@ class LlmExchange(LogRecord):
 RECORD_TYPES: dict[RecordName, type[LogRecord]] = {
     c.KIND: c for c in (Episode, Instances, Action, SceneGraphRecord, LlmExchange)
 }
+
+
+def record_type(kind: type[LogRecord] | str) -> type[LogRecord]:
+    """The record type of ``kind`` (a type, or its channel's name: ``"episode"``); anything
+    else is one :class:`~sgtool.errors.SgtoolError` line naming the kinds there are."""
+    if isinstance(kind, str) and kind in RECORD_TYPES:
+        return RECORD_TYPES[kind]
+    if isinstance(kind, type) and issubclass(kind, LogRecord):
+        return kind
+    raise SgtoolError(f"record kind {kind!r}: one of {', '.join(sorted(RECORD_TYPES))} "
+                      "(or its record type)")

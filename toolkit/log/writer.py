@@ -37,6 +37,7 @@ from mcap.summary import Summary
 from mcap.writer import CompressionType, Writer
 from mcap_protobuf.schema import build_file_descriptor_set
 
+from sgtool.arg_checks import whole
 from sgtool.errors import LogFormatError, SgtoolError, Terminated
 from sgtool.files import concerns, output_error, quoted, temp_beside
 from sgtool.log import chunk_copy, codec
@@ -97,6 +98,8 @@ def _check_frame(k: CameraIntrinsics, depth: np.ndarray, rgb: np.ndarray | None,
     """``ValueError`` unless the frame's images would read back as written: depth of the
     intrinsics' size, rgb (H, W, 3) and ids (H, W) of the depth's (the intrinsics
     themselves are checked where their calibration message is made, when they change)."""
+    if not isinstance(k, CameraIntrinsics):
+        raise ValueError(f"intrinsics: a CameraIntrinsics, got {type(k).__name__}")
     size = (k.height, k.width)
     if np.shape(depth) != size:
         raise ValueError(f"depth of shape {np.shape(depth)}: the intrinsics say {k.width}x"
@@ -133,6 +136,7 @@ class LogWriter:
     ) -> None:
         if compression not in _COMPRESSION:
             raise SgtoolError(f"unknown compression {compression!r} (zstd, lz4, none)")
+        whole("seed", seed, 0, optional=True)
         self.path = Path(path)
         if self.path.exists() and not overwrite:
             raise SgtoolError(f"{self.path} exists; not overwriting it")

@@ -1,0 +1,41 @@
+"""Checks of the arguments a Python caller gives the API: a value of the wrong type or range
+is one :class:`~sgtool.errors.SgtoolError` line naming the parameter (``every='x': a whole
+number >= 1``), not an error deep inside a stage."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from sgtool.errors import SgtoolError
+
+
+def whole(name: str, value: Any, least: int | None = None, *, optional: bool = False
+          ) -> int | None:
+    """``value`` as an int (an int or numpy integer, not a bool), at least ``least``; None
+    passes when ``optional``."""
+    if value is None and optional:
+        return None
+    ok = isinstance(value, int | np.integer) and not isinstance(value, bool)
+    if not ok or (least is not None and value < least):
+        bound = "" if least is None else f" >= {least}"
+        raise SgtoolError(f"{name}={value!r}: a whole number{bound}"
+                          + (", or None" if optional else ""))
+    return int(value)
+
+
+def number(name: str, value: Any, least: float | None = None, *, optional: bool = False
+           ) -> float | None:
+    """``value`` as a finite float (an int or float, not a bool), at least ``least``; None
+    passes when ``optional``."""
+    if value is None and optional:
+        return None
+    ok = isinstance(value, int | float | np.integer | np.floating) and \
+        not isinstance(value, bool) and math.isfinite(value)
+    if not ok or (least is not None and value < least):
+        bound = "" if least is None else f" >= {least:g}"
+        raise SgtoolError(f"{name}={value!r}: a finite number{bound}"
+                          + (", or None" if optional else ""))
+    return float(value)
