@@ -185,6 +185,8 @@ def pin_logs(logs: Sequence[str | Path] | str | Path, folder: str | Path,
     opts = options or ReplayOptions()
     paths = [Path(logs)] if isinstance(logs, (str, os.PathLike)) else [Path(p) for p in logs]
     names = [pin_name(p) for p in paths]
+    if not paths:
+        raise SgtoolError("logs: give at least one log to pin")
     for p in paths:
         if not p.is_file():
             raise SgtoolError(f"{p}: no such log")

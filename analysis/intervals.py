@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sgtool.analysis.search_metrics import episode_spl
+from sgtool.errors import SgtoolError
 from sgtool.results import EpisodeResult
 from sgtool.semantics.text import category_text
 
@@ -205,11 +206,24 @@ def _cluster_keys(results: Sequence[EpisodeResult], cluster: Cluster) -> list[Ha
     return sorted(keys, key=lambda k: (str(k), repr(k)))
 
 
+def _check_planners(results: Sequence[EpisodeResult], *planners: str) -> None:
+    """One line for a planner with no episode in ``results`` (a typo gave NaN intervals)."""
+    there = sorted({r.planner for r in results})
+    for name in planners:
+        if name not in there:
+            raise SgtoolError(f"planner {name!r} has no episode in the results (there: "
+                              f"{', '.join(there) or 'none'})")
+
+
 def planner_intervals(results: Sequence[EpisodeResult], planner: str,
                       cluster: Cluster = by_house,
-                      boot: Bootstrap = DEFAULT_BOOTSTRAP) -> PlannerIntervals:
+                      boot: Bootstrap = DEFAULT_BOOTSTRAP, *,
+                      check: bool = True) -> PlannerIntervals:
     """SR and SPL of ``planner``'s episodes in ``results`` (pooled over seeds, as the
-    per-house tables) with cluster-bootstrap intervals."""
+    per-house tables) with cluster-bootstrap intervals; ``check``: a planner without an
+    episode there is one :class:`~sgtool.errors.SgtoolError` line (else NaN figures)."""
+    if check:
+        _check_planners(results, planner)
     rs = [r for r in results if r.planner == planner]
     keys = _cluster_keys(rs, cluster)
     pos = {k: i for i, k in enumerate(keys)}
@@ -264,9 +278,13 @@ def _pair_key(r: EpisodeResult) -> tuple[str, int, int, str, float | None]:
 
 def paired_comparison(results: Sequence[EpisodeResult], planner: str, reference: str,
                       cluster: Cluster = by_house,
-                      boot: Bootstrap = DEFAULT_BOOTSTRAP) -> PairedComparison:
+                      boot: Bootstrap = DEFAULT_BOOTSTRAP, *,
+                      check: bool = True) -> PairedComparison:
     """``planner`` against ``reference`` on their common episodes of ``results`` (house,
-    episode, seed, query, shortest path: module doc)."""
+    episode, seed, query, shortest path: module doc); ``check`` as in
+    :func:`planner_intervals`."""
+    if check:
+        _check_planners(results, planner, reference)
     mine = {_pair_key(r): r for r in results if r.planner == planner}
     ref = {_pair_key(r): r for r in results if r.planner == reference}
     common = sorted(mine.keys() & ref.keys())

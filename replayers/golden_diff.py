@@ -146,8 +146,10 @@ def diff_logs(a: str | os.PathLike[str], b: str | os.PathLike[str],
     """What differs between the scene graphs of ``a`` and ``b`` (module doc); ``options``
     replay the logs that hold no graphs; ``tolerance`` as in ``sgtool golden check``. A
     recording that is not an sgtool log is refused in one line naming what it is."""
+    from sgtool.arg_checks import number
     from sgtool.log.inspect import foreign_log_problem
 
+    number("tolerance", tolerance, 0.0)
     for log in (a, b):
         if (foreign := foreign_log_problem(log)) is not None:
             raise SgtoolError(foreign)

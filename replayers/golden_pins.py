@@ -261,6 +261,9 @@ def read_pins(folder: str | os.PathLike[str]) -> PinSet:
     or its index is missing or damaged, or the format is newer than :data:`PIN_FORMAT`."""
     root = Path(folder)
     path = root / INDEX
+    if root.is_file():
+        raise PinError(f"{root} is a file, not a pin folder (give the folder `sgtool golden "
+                       "pin` wrote)")
     if not root.is_dir():
         raise PinError(f"{root}: no such pin folder (make one with `sgtool golden pin LOG "
                        f"--dir {quoted(root)}`)")

@@ -83,3 +83,26 @@ def test_record_house_takes_a_house_file(tmp_path) -> None:
     with pytest.raises(sgtool.SgtoolError, match="^house: a HouseSpec or a house spec file, "
                        "got int$"):
         sgtool.record_house(5, tmp_path / "x.mcap", opts)  # type: ignore[arg-type]
+
+
+def test_what_the_cli_refuses_the_api_refuses(tmp_path) -> None:
+    """A typo'd planner gave NaN intervals, a negative tolerance 'no difference', an empty
+    list an empty pin folder, a file 'no such pin folder'; each is one line now."""
+    r = sgtool.EpisodeResult(planner="scout", seed=0, house="h", episode=0, query="cup",
+                             success=True, steps=2, travelled_m=3.0, shortest_m=2.0)
+    assert sgtool.planner_intervals([r], "scout").episodes == 1
+    with pytest.raises(sgtool.SgtoolError, match=r"^planner 'scuot' has no episode in the "
+                       r"results \(there: scout\)$"):
+        sgtool.planner_intervals([r], "scuot")
+    with pytest.raises(sgtool.SgtoolError, match="^planner 'random' has no episode"):
+        sgtool.paired_comparison([r], "scout", "random")
+    for tol in (-1.0, float("nan")):
+        with pytest.raises(sgtool.SgtoolError, match="^tolerance=.*: a finite number >= 0$"):
+            sgtool.diff_logs(LOG, LOG, tolerance=tol)
+    with pytest.raises(sgtool.SgtoolError, match="^logs: give at least one log to pin$"):
+        sgtool.pin_logs([], tmp_path / "pins")
+    assert not (tmp_path / "pins").exists()
+    text = tmp_path / "text.mcap"
+    text.write_text("x")
+    with pytest.raises(sgtool.SgtoolError, match="text.mcap is a file, not a pin folder"):
+        sgtool.check_pins(text)
