@@ -38,13 +38,14 @@ import os
 import signal
 import socket
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sgtool.errors import SgtoolError, Terminated, raise_terminated
+from sgtool.errors import STOP_SIGNALS, SgtoolError, Terminated, raise_terminated
 from sgtool.extras import missing_message
 
 EXECUTORS: tuple[str, ...] = ("local", "ray")
@@ -264,7 +265,8 @@ def _worker_setup() -> None:
     other workers mid-cleanup). SIGINT is ignored: the driver decides (module doc), so a
     task's clean-up is never cut short by a second signal."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, _worker_sigterm)
+    for sig in STOP_SIGNALS:  # a closed terminal reaches the workers too
+        signal.signal(sig, _worker_sigterm)
 
 
 def _worker_sigterm(signum: int, frame: object) -> None:
@@ -390,6 +392,10 @@ class _RaySession:
 
 def import_ray() -> Any:
     """The ``ray`` module, or one line saying how to install it."""
+    # Ray's native handler turns SIGTERM into an abort with stack dumps (exit 134, partial
+    # outputs left); without it sgtool's own handler cleans up as for Ctrl-C. Ray reads
+    # this when it is first imported.
+    os.environ.setdefault("RAY_DISABLE_FAILURE_SIGNAL_HANDLER", "1")
     try:
         import ray
     except ImportError:
@@ -416,6 +422,18 @@ def check_reachable(address: str, timeout_s: float = 3.0) -> None:
                             "--ray-address and RAY_ADDRESS to start a local Ray") from None
 
 
+@contextlib.contextmanager
+def _sigterm_kept() -> Iterator[None]:
+    """``ray.init`` sets a SIGTERM handler of its own (``sys.exit(15)``, which skips the
+    cleanup and the one-line message of sgtool's); the handler there before is put back."""
+    before = signal.getsignal(signal.SIGTERM)
+    try:
+        yield
+    finally:
+        if before is not None and threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGTERM, before)
+
+
 class RayExecutor(_Executor):
     """Tasks as Ray tasks (one CPU each) on a cluster or a local Ray instance."""
 
@@ -434,12 +452,13 @@ class RayExecutor(_Executor):
             return False
         os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
         common = dict(log_to_driver=False, configure_logging=False, include_dashboard=False)
-        if self.address:
-            check_reachable(self.address)
-            ray.init(address=self.address, **common)
-            self.workers = max(self.workers, int(ray.cluster_resources().get("CPU", 1)))
-        else:
-            ray.init(address="local", num_cpus=self.workers, **common)
+        with _sigterm_kept():
+            if self.address:
+                check_reachable(self.address)
+                ray.init(address=self.address, **common)
+                self.workers = max(self.workers, int(ray.cluster_resources().get("CPU", 1)))
+            else:
+                ray.init(address="local", num_cpus=self.workers, **common)
         return True
 
     def _session(self, fn: Callable[[Any], Any]) -> Any:

@@ -24,7 +24,13 @@ from typing import Any
 import click
 
 from sgtool.commands.options import COMMAND_ARGS
-from sgtool.errors import SgtoolError, Terminated, raise_terminated
+from sgtool.errors import (
+    STOP_SIGNALS,
+    SgtoolError,
+    forget_stop_signals,
+    raise_terminated,
+    stop_exit_code,
+)
 from sgtool.extras import missing_extra
 from sgtool.files import is_environment_error
 from sgtool.redact import redact_text
@@ -104,6 +110,13 @@ class Killed(Interrupted):
     exit_code = 143
 
 
+class HungUp(Killed):
+    """SIGHUP (the terminal or ssh session closed) during a command: as :class:`Killed`,
+    exit code 129."""
+
+    exit_code = 129
+
+
 def os_error_text(e: OSError) -> str:
     """One line for an :class:`OSError`: ``Read-only file system: /data/out.mcap``."""
     reason = e.strerror or type(e).__name__
@@ -123,6 +136,7 @@ class LazyGroup(click.Group):
         return name, cmd, rest
 
     def invoke(self, ctx: click.Context) -> object:
+        forget_stop_signals()  # this command's signals decide its exit code
         try:
             return super().invoke(ctx)
         except click.UsageError as e:  # a subcommand's arguments, or an unknown command
@@ -145,8 +159,9 @@ class LazyGroup(click.Group):
             raise UserError(os_error_text(e)) from e
         except KeyboardInterrupt as e:
             # not click's Abort (a blank line and "Aborted!"): one line, what was kept
-            kind = Killed if isinstance(e, Terminated) else Interrupted
-            raise kind(getattr(e, "note", "") or "no output was left half-written") from e
+            note = getattr(e, "note", "") or "no output was left half-written"
+            kind = {130: Interrupted, 129: HungUp}.get(stop_exit_code(e), Killed)
+            raise kind(note) from e
 
     def make_context(self, info_name: str | None, args: list[str],
                      parent: click.Context | None = None, **extra: Any) -> click.Context:
@@ -211,15 +226,19 @@ def main(argv: list[str] | None = None) -> None:
         sys.exit(e.exit_code)
     except click.exceptions.Abort as e:  # click's form of a KeyboardInterrupt (a kill too)
         click.echo("sgtool: interrupted", err=True)
-        sys.exit(143 if isinstance(e.__cause__, Terminated) else 130)
+        _finished()  # a second Ctrl-C must not break the exit's clean-up with a traceback
+        sys.exit(stop_exit_code(e.__cause__ or e))
     except click.ClickException as e:
         e.show()
+        if isinstance(e, Interrupted):
+            _finished()
         sys.exit(e.exit_code)
     except click.exceptions.Exit as e:
         sys.exit(e.exit_code)
     except KeyboardInterrupt as e:
         click.echo("sgtool: interrupted", err=True)
-        sys.exit(143 if isinstance(e, Terminated) else 130)
+        _finished()
+        sys.exit(stop_exit_code(e))
     except BrokenPipeError:  # the closed pipe found at the last flush
         _quiet_stdout()
         args = sys.argv[1:] if argv is None else argv
@@ -239,20 +258,25 @@ def _quiet_stdout() -> None:
 
 
 def _terminate_as_interrupt() -> None:
-    """``kill`` (SIGTERM) cleans up as Ctrl-C does: partial outputs are removed and worker
-    processes stopped, instead of the process vanishing mid-write."""
+    """``kill`` (SIGTERM) and a closed terminal (SIGHUP) clean up as Ctrl-C does: partial
+    outputs are removed and worker processes stopped, instead of the process vanishing
+    mid-write."""
+    forget_stop_signals()
     try:
-        signal.signal(signal.SIGTERM, raise_terminated)
+        for sig in STOP_SIGNALS:
+            signal.signal(sig, raise_terminated)
     except ValueError:  # not the main thread (sgtool called from a thread of another tool)
         pass
 
 
 def _finished() -> None:
-    """The command is done and its outputs are in place: a Ctrl-C during the exit (a
-    library's shutdown hooks) must not turn a complete run into a killed one."""
+    """The command is done and its outputs are in place (or, interrupted, cleaned up): a
+    Ctrl-C during the exit (a library's shutdown hooks, a worker pool's) must not turn a
+    complete run into a killed one, nor print a traceback."""
     try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        for sig in STOP_SIGNALS:
+            signal.signal(sig, signal.SIG_DFL)
     except ValueError:  # not the main thread
         pass
 

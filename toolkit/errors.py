@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import signal
+
 
 class SgtoolError(Exception):
     """Base for every error caused by input a user gave (a file, an option, a log)."""
@@ -30,9 +32,32 @@ class Terminated(KeyboardInterrupt):
     no half-written output is left, worker processes are stopped too."""
 
 
+# the signals that stop a command as Ctrl-C does, turned into Terminated by the CLI: a
+# kill and a closed terminal (or ssh session)
+STOP_SIGNALS: tuple[signal.Signals, ...] = tuple(
+    getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name))
+_received: list[int] = []  # the stop signals the handler got during this command
+
+
 def raise_terminated(signum: int, frame: object) -> None:
-    """A SIGTERM handler: raise :class:`Terminated` in the main thread."""
+    """A SIGTERM (SIGHUP) handler: raise :class:`Terminated` in the main thread."""
+    _received.append(int(signum))
     raise Terminated
+
+
+def forget_stop_signals() -> None:
+    """A command starts: no stop signal received yet."""
+    _received.clear()
+
+
+def stop_exit_code(e: BaseException) -> int:
+    """The exit code of a command stopped by ``e``: 128 + the stop signal received (143 a
+    kill, 129 a closed terminal), as a shell reports it; 130 for Ctrl-C. A library (Ray's
+    wait) may raise a plain KeyboardInterrupt in place of the :class:`Terminated` the
+    handler raised, so the signal received decides."""
+    if _received:
+        return 128 + _received[-1]
+    return 143 if isinstance(e, Terminated) else 130
 
 
 def raised_text(e: BaseException) -> str:

@@ -35,7 +35,7 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import IO
 
-from sgtool.errors import SgtoolError
+from sgtool.errors import STOP_SIGNALS, SgtoolError
 
 # OSError numbers that a user's environment causes (a destination that is read-only,
 # missing, full, not writable): reported as one line, never as a traceback
@@ -262,7 +262,7 @@ def leftover_stages(target: str | os.PathLike[str]) -> list[Path]:
 
 @contextlib.contextmanager
 def deferred_interrupts() -> Iterator[None]:
-    """Ctrl-C (and SIGTERM) during the block take effect when it ends: for a commit of
+    """Ctrl-C (and SIGTERM, SIGHUP) during the block take effect when it ends: for a commit of
     files that must change together (a pin folder's graphs and its index), which an
     interrupt between two of them would leave out of step. Outside the main thread (no
     signal handlers there) the block runs as it is."""
@@ -270,7 +270,7 @@ def deferred_interrupts() -> Iterator[None]:
         yield
         return
     got: list[int] = []
-    old = {int(s): signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    old = {int(s): signal.getsignal(s) for s in (signal.SIGINT, *STOP_SIGNALS)}
     for s in old:
         signal.signal(s, lambda signum, _frame: got.append(signum))
     try:

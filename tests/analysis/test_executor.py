@@ -171,7 +171,7 @@ import os, sys, time
 from pathlib import Path
 from sgtool.analysis.executor import LocalExecutor, Task
 from sgtool.cli import _terminate_as_interrupt
-from sgtool.errors import Terminated
+from sgtool.errors import stop_exit_code
 from sgtool.files import atomic_output
 
 OUT = Path(sys.argv[1])
@@ -186,10 +186,8 @@ if __name__ == "__main__":
     _terminate_as_interrupt()
     try:
         LocalExecutor(2).run(slow, [Task(str(i), i) for i in range(2)])
-    except Terminated:
-        sys.exit(143)
-    except KeyboardInterrupt:
-        sys.exit(130)
+    except KeyboardInterrupt as e:
+        sys.exit(stop_exit_code(e))
 '''
 
 
@@ -201,11 +199,13 @@ def _gone(pid: int) -> bool:
     return "State:\tZ" in state  # exited, not yet reaped (no init reaps in a container)
 
 
-@pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+@pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130),
+                                       (signal.SIGHUP, 129)])
 def test_kill_of_the_driver_stops_the_workers_and_leaves_no_partial_output(tmp_path, sig,
                                                                            code):
-    """A kill, or a Ctrl-C sent to the driver alone (the workers ignore SIGINT), stops the
-    tasks mid-write: they clean up, the workers end, and the driver exits after them."""
+    """A kill, a closed terminal, or a Ctrl-C sent to the driver alone (the workers ignore
+    SIGINT), stops the tasks mid-write: they clean up, the workers end, and the driver
+    exits after them, with 128 + the signal."""
     script = tmp_path / "driver.py"
     script.write_text(KILLED_DRIVER)
     out = tmp_path / "out"

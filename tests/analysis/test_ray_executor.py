@@ -63,3 +63,51 @@ def test_batch_replay_on_ray_equals_one_by_one_and_reports_a_failing_log(local_r
     # the local executor gives the same report, but for the wall clock
     local = replay_many(jobs, LocalExecutor(1), force=True)
     assert local.logs == report.logs
+
+
+KILLED_RAY_DRIVER = '''
+import signal, sys, time
+from pathlib import Path
+from sgtool.analysis.executor import RayExecutor, Task
+from sgtool.errors import raise_terminated, stop_exit_code
+
+OUT = Path(sys.argv[1])
+
+def slow(i):
+    (OUT / "started").write_text("1")
+    time.sleep(120)
+
+if __name__ == "__main__":
+    signal.signal(signal.SIGTERM, raise_terminated)  # as the CLI does
+    try:
+        RayExecutor(1).run(slow, [Task("0", 0)])
+    except KeyboardInterrupt as e:
+        print("stopped", file=sys.stderr)
+        sys.exit(stop_exit_code(e))
+'''
+
+
+def test_a_kill_of_a_ray_driver_ends_as_sgtool_s_own(tmp_path):
+    """ray.init sets a SIGTERM handler of its own (sys.exit(15), no clean-up) and Ray's
+    native failure handler turns SIGTERM into an abort with stack dumps (exit 134); the
+    executor keeps the caller's handler and disables Ray's, so a kill is an interrupt."""
+    import subprocess
+    import sys
+    import time
+
+    script = tmp_path / "driver.py"
+    script.write_text(KILLED_RAY_DRIVER)
+    env = {k: v for k, v in os.environ.items() if k != "RAY_ADDRESS"}
+    proc = subprocess.Popen([sys.executable, str(script), str(tmp_path)], env=env,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while not (tmp_path / "started").exists():
+            assert proc.poll() is None and time.monotonic() < deadline
+            time.sleep(0.2)
+        proc.terminate()
+        assert proc.wait(timeout=120) == 143
+        err = proc.stderr.read() if proc.stderr else ""
+    finally:
+        proc.kill()
+    assert "stopped" in err and "SIGTERM received" not in err, err
