@@ -73,8 +73,14 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
 
     from sgtool.analysis.closed_loop_bench import OUTPUT_NAMES, run_closed_loop_bench
     from sgtool.analysis.closed_loop_bench import write_outputs as write_tables
-    from sgtool.files import atomic_write, leftover_notes, output_folder
+    from sgtool.files import (
+        atomic_write,
+        leftover_notes,
+        output_folder,
+        refuse_inputs_inside,
+    )
 
+    refuse_inputs_inside(request.out_dir, request.config.house_files, what="--house input")
     executor, bars = _executor(request)
     with output_folder(request.out_dir, force=request.force, command="run-bench",
                        known=(*OUTPUT_NAMES, RUN_FILE, RUN_OPTIONS_FILE),

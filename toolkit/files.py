@@ -31,7 +31,7 @@ import shutil
 import signal
 import tempfile
 import threading
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import IO
 
@@ -295,6 +295,19 @@ def leftover_notes(target: str | os.PathLike[str]) -> list[str]:
 
 
 @contextlib.contextmanager
+def refuse_inputs_inside(target: str | os.PathLike[str],
+                         inputs: Iterable[str | os.PathLike[str]], *, option: str = "-o",
+                         what: str = "input") -> None:
+    """One :class:`~sgtool.errors.SgtoolError` line when an input file lies in the output
+    folder ``target`` (with ``--force`` the run would write its outputs among them, and
+    the next run would read those as inputs)."""
+    folder = Path(target).resolve()
+    for p in inputs:  # a file, or a folder of inputs
+        if Path(p).resolve() == folder or folder in Path(p).resolve().parents:
+            raise SgtoolError(f"{option} {target} holds the {what} {p}; write the outputs to "
+                              "another folder")
+
+
 def output_folder(target: str | os.PathLike[str], *, force: bool, command: str = "sgtool",
                   option: str = "-o", known: Sequence[str] = (),
                   resume: bool = False) -> Iterator[Path]:

@@ -233,3 +233,24 @@ def test_an_empty_list_is_not_the_defaults(tmp_path, args, line):
     r = CliRunner().invoke(cli, [*args, "-o", str(tmp_path / "out")])
     assert r.exit_code == 2 and r.output.strip() == line, r.output
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("command", [["bench", "--seeds", "1"], ["run-bench"],
+                                     ["study", "noise"]])
+def test_an_output_folder_holding_the_house_inputs_is_refused(tmp_path, command):
+    """With --force the run would write its tables among the house specs, and the next run
+    would read summary.json as a house."""
+    from sgtool.datasets.generator import generate_house
+    from sgtool.house.io import save_house
+
+    houses = tmp_path / "houses"
+    houses.mkdir()
+    save_house(generate_house(3, rooms=(4, 4)), houses / "h.json")
+    for given in (houses, houses / "h.json"):
+        r = CliRunner().invoke(cli, [*command, "--house", str(given), "-o", str(houses),
+                                     "--force"])
+        line = r.output.strip()  # (study names the file its folder gave)
+        assert r.exit_code == 2 and line.startswith(
+            f"sgtool: error: -o {houses} holds the --house input {houses}") and \
+            line.endswith("; write the outputs to another folder"), r.output
+    assert sorted(p.name for p in houses.iterdir()) == ["h.json"]
