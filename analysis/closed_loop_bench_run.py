@@ -86,9 +86,8 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
                        known=(*OUTPUT_NAMES, RUN_FILE, RUN_OPTIONS_FILE),
                        resume=True) as root:
         runner = EpisodeRunner(executor, root, progress=bars)
-        if request.options_text is not None and not request.report_only:
-            text = request.options_text  # once the logs there agree with the options
-            runner.checked = lambda: atomic_write(root / RUN_OPTIONS_FILE, text)
+        agreed: list[bool] = []  # the logs there agree with this run's options
+        runner.checked = lambda: agreed.append(True)
         show_bar = bars and executor is None
         bar = tqdm(total=None, unit="episode", desc="run-bench", file=sys.stderr,
                    disable=not show_bar, dynamic_ncols=True)
@@ -101,6 +100,8 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
             raise  # (with --force, output_folder says OUT is as it was instead)
         finally:
             bar.close()
+            if agreed and not request.report_only:
+                _record_options(root, request.options_text)
         left = unreported(root / "logs", {row.task.output for row in res.rows})
         if left:
             shown = ", ".join(str(p.relative_to(root)) for p in left[:2])
@@ -263,6 +264,20 @@ class EpisodeRunner:
         for i, out in zip(todo, outcomes, strict=True):
             rows[i] = out.value.row if isinstance(out.value, Shipped) else out.value
         return [rows[i] for i in range(len(tasks))]
+
+
+def _record_options(root: Path, text: str | None) -> None:
+    """Write :data:`RUN_OPTIONS_FILE` once a run that agreed with the logs there has logs
+    of its own to show for it (a run that wrote nothing, a full disk, leaves no file that
+    makes its folder look like a run); best effort while an error is on its way."""
+    import contextlib
+
+    from sgtool.files import atomic_write
+
+    if text is None or not any((root / "logs").rglob("*.mcap")):
+        return
+    with contextlib.suppress(OSError):
+        atomic_write(root / RUN_OPTIONS_FILE, text)
 
 
 def _remove_partials(task: RunTask) -> None:

@@ -294,7 +294,6 @@ def leftover_notes(target: str | os.PathLike[str]) -> list[str]:
             "one still running); remove it when none is" for stale in leftover_stages(target)]
 
 
-@contextlib.contextmanager
 def refuse_inputs_inside(target: str | os.PathLike[str],
                          inputs: Iterable[str | os.PathLike[str]], *, option: str = "-o",
                          what: str = "input") -> None:
@@ -308,6 +307,7 @@ def refuse_inputs_inside(target: str | os.PathLike[str],
                               "another folder")
 
 
+@contextlib.contextmanager
 def output_folder(target: str | os.PathLike[str], *, force: bool, command: str = "sgtool",
                   option: str = "-o", known: Sequence[str] = (),
                   resume: bool = False) -> Iterator[Path]:
