@@ -41,12 +41,12 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     error line and nothing is written; Ctrl-C leaves both folders as they were."""
     from sgtool.analysis.bench import OUTPUT_NAMES, run_benchmark, write_outputs
     from sgtool.analysis.report import invalid_action_notes, llm_warnings
-    from sgtool.files import leftover_notes, output_folder, refuse_inputs_inside
+    from sgtool.files import leftover_notes, output_folder, refuse_input_folder
     from sgtool.llm.recorded import transcript_run
 
     out_dir, log_dir = request.out_dir, request.config.log_dir
     request.config.check()  # before anything is emptied or written (the transcript)
-    refuse_inputs_inside(out_dir, request.config.house_files, what="--house input")
+    refuse_input_folder(out_dir, request.config.house_files, what="--house")
     try:
         with output_folder(out_dir, force=request.force, command="bench",
                            known=OUTPUT_NAMES) as stage, contextlib.ExitStack() as stack:

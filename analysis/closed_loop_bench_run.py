@@ -77,10 +77,10 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
         atomic_write,
         leftover_notes,
         output_folder,
-        refuse_inputs_inside,
+        refuse_input_folder,
     )
 
-    refuse_inputs_inside(request.out_dir, request.config.house_files, what="--house input")
+    refuse_input_folder(request.out_dir, request.config.house_files, what="--house")
     executor, bars = _executor(request)
     with output_folder(request.out_dir, force=request.force, command="run-bench",
                        known=(*OUTPUT_NAMES, RUN_FILE, RUN_OPTIONS_FILE),
@@ -101,7 +101,7 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
         finally:
             bar.close()
             if agreed and not request.report_only:
-                _record_options(root, request.options_text)
+                _record_options(root, request.options_text, ran=bool(runner.nodes))
         left = unreported(root / "logs", {row.task.output for row in res.rows})
         if left:
             shown = ", ".join(str(p.relative_to(root)) for p in left[:2])
@@ -266,15 +266,18 @@ class EpisodeRunner:
         return [rows[i] for i in range(len(tasks))]
 
 
-def _record_options(root: Path, text: str | None) -> None:
+def _record_options(root: Path, text: str | None, *, ran: bool) -> None:
     """Write :data:`RUN_OPTIONS_FILE` once a run that agreed with the logs there has logs
-    of its own to show for it (a run that wrote nothing, a full disk, leaves no file that
-    makes its folder look like a run); best effort while an error is on its way."""
+    to show (a run that wrote nothing, a full disk, leaves no file that makes its folder
+    look like a run), and either ``ran`` episodes now or finds no such file (a resume
+    naming fewer planners reads back and keeps the run's options); best effort while an
+    error is on its way."""
     import contextlib
 
     from sgtool.files import atomic_write
 
-    if text is None or not any((root / "logs").rglob("*.mcap")):
+    if text is None or not any((root / "logs").rglob("*.mcap")) or \
+            (not ran and (root / RUN_OPTIONS_FILE).is_file()):
         return
     with contextlib.suppress(OSError):
         atomic_write(root / RUN_OPTIONS_FILE, text)

@@ -265,8 +265,9 @@ def _worker_setup() -> None:
     other workers mid-cleanup). SIGINT is ignored: the driver decides (module doc), so a
     task's clean-up is never cut short by a second signal."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    for sig in STOP_SIGNALS:  # a closed terminal reaches the workers too
-        signal.signal(sig, _worker_sigterm)
+    for sig in STOP_SIGNALS:  # a closed terminal reaches the workers too (unless nohup)
+        if signal.getsignal(sig) is not signal.SIG_IGN:
+            signal.signal(sig, _worker_sigterm)
 
 
 def _worker_sigterm(signum: int, frame: object) -> None:
@@ -425,13 +426,16 @@ def check_reachable(address: str, timeout_s: float = 3.0) -> None:
 @contextlib.contextmanager
 def _sigterm_kept() -> Iterator[None]:
     """``ray.init`` sets a SIGTERM handler of its own (``sys.exit(15)``, which skips the
-    cleanup and the one-line message of sgtool's); the handler there before is put back."""
-    before = signal.getsignal(signal.SIGTERM)
+    cleanup and the one-line message of sgtool's); the handlers of the stop signals there
+    before are put back."""
+    before = {sig: signal.getsignal(sig) for sig in STOP_SIGNALS}
     try:
         yield
     finally:
-        if before is not None and threading.current_thread() is threading.main_thread():
-            signal.signal(signal.SIGTERM, before)
+        if threading.current_thread() is threading.main_thread():
+            for sig, handler in before.items():
+                if handler is not None:
+                    signal.signal(sig, handler)
 
 
 class RayExecutor(_Executor):

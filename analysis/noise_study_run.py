@@ -50,11 +50,9 @@ def study_into(request: NoiseStudyRequest, show: Echo) -> None:
     from sgtool.analysis.noise_study import run_closed_loop, run_study
     from sgtool.analysis.noise_study_api import write_noise_study_outputs
     from sgtool.analysis.noise_study_tables import summary_md
-    from sgtool.files import output_folder, refuse_inputs_inside
+    from sgtool.files import output_folder
 
     cfg, show_bars = request.config, request.progress
-    refuse_inputs_inside(request.out_dir, [h.source for h in cfg.houses
-                                           if h.source != "generated"], what="--house input")
     runner = make_executor(request.executor, request.workers, request.ray_address)
     with output_folder(request.out_dir, force=request.force, command="study noise",
                        known=OUTPUTS) as out:

@@ -89,9 +89,9 @@ class ReplayOptions:
     max_depth: float | None = None  # m; depth farther is not mapped
     tf_time: str = "log"  # what pairs /tf with frames: "log" time or header "stamp"
 
-    def __post_init__(self) -> None:  # a caller's wrong type: one line, here
-        for name in ("every", "min_points", "max_frames"):
-            whole(name, getattr(self, name), 1, optional=True)
+    def __post_init__(self) -> None:  # a caller's wrong type: one line, here (the ranges
+        for name in ("every", "min_points", "max_frames"):  # when resolved, named as flags)
+            whole(name, getattr(self, name), optional=True)
         for name in ("voxel_size", "max_depth"):
             number(name, getattr(self, name), optional=True)
         if self.classifier is not None and not isinstance(self.classifier, str):

@@ -198,7 +198,10 @@ def options_from(d: Mapping[str, Any], where: str) -> ReplayOptions:
         if v is not None and (isinstance(v, bool) or not isinstance(v, kinds)):
             raise PinError(f"{where}: replay option {k!r} is {_json_kind(v)} {v!r}; expected "
                            f"{' or '.join(t.__name__ for t in kinds)}")
-    return ReplayOptions(**{k: v for k, v in d.items() if k in known})
+    try:
+        return ReplayOptions(**{k: v for k, v in d.items() if k in known})
+    except SgtoolError as e:
+        raise PinError(f"{where}: {e}") from None
 
 
 def _json_kind(v: Any) -> str:

@@ -264,7 +264,8 @@ def _terminate_as_interrupt() -> None:
     forget_stop_signals()
     try:
         for sig in STOP_SIGNALS:
-            signal.signal(sig, raise_terminated)
+            if signal.getsignal(sig) is not signal.SIG_IGN:  # `nohup sgtool ...` stays so
+                signal.signal(sig, raise_terminated)
     except ValueError:  # not the main thread (sgtool called from a thread of another tool)
         pass
 
@@ -276,7 +277,8 @@ def _finished() -> None:
     try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         for sig in STOP_SIGNALS:
-            signal.signal(sig, signal.SIG_DFL)
+            if signal.getsignal(sig) is not signal.SIG_IGN:
+                signal.signal(sig, signal.SIG_DFL)
     except ValueError:  # not the main thread
         pass
 

@@ -294,17 +294,18 @@ def leftover_notes(target: str | os.PathLike[str]) -> list[str]:
             "one still running); remove it when none is" for stale in leftover_stages(target)]
 
 
-def refuse_inputs_inside(target: str | os.PathLike[str],
-                         inputs: Iterable[str | os.PathLike[str]], *, option: str = "-o",
-                         what: str = "input") -> None:
-    """One :class:`~sgtool.errors.SgtoolError` line when an input file lies in the output
-    folder ``target`` (with ``--force`` the run would write its outputs among them, and
-    the next run would read those as inputs)."""
+def refuse_input_folder(target: str | os.PathLike[str],
+                        inputs: Iterable[str | os.PathLike[str]], *, option: str = "-o",
+                        what: str = "input") -> None:
+    """One :class:`~sgtool.errors.SgtoolError` line when an input folder (whose files are
+    all read as inputs) is the output folder ``target``: with ``--force`` the run would
+    write its outputs among them, and the next run would read those as inputs. A single
+    input file in the output folder is no problem (``--force`` keeps a user's files)."""
     folder = Path(target).resolve()
-    for p in inputs:  # a file, or a folder of inputs
-        if Path(p).resolve() == folder or folder in Path(p).resolve().parents:
-            raise SgtoolError(f"{option} {target} holds the {what} {p}; write the outputs to "
-                              "another folder")
+    for p in inputs:
+        if Path(p).is_dir() and Path(p).resolve() == folder:
+            raise SgtoolError(f"{option} {target} is the {what} folder {p}, whose files are "
+                              "read as inputs; write the outputs to another folder")
 
 
 @contextlib.contextmanager

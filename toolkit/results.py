@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -194,11 +193,11 @@ def _whole(d: Mapping[str, Any], key: str, default: Any = _ABSENT) -> int:
 
 
 def _number(d: Mapping[str, Any], key: str, default: Any = _ABSENT) -> float:
-    """A finite JSON number."""
+    """A JSON number (a non-finite one is read: the validity rules refuse that record
+    alone, with a note, :mod:`sgtool.analysis.validity`)."""
     value = _field(d, key, default)
-    if isinstance(value, bool) or not isinstance(value, int | float) or \
-            not math.isfinite(value):
-        raise ResultsFormatError(f"{key}: expected a finite number, got {json.dumps(value)}")
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ResultsFormatError(f"{key}: expected a number, got {json.dumps(value)}")
     return float(value)
 
 

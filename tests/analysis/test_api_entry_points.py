@@ -48,9 +48,9 @@ def test_arguments_of_the_wrong_type_are_one_line(tmp_path) -> None:
         sgtool.generate_house(0, rooms=5)
     with pytest.raises(sgtool.SgtoolError, match=r"^rooms=\(4.5, 6\): give \(MIN, MAX\)"):
         sgtool.generate_house(0, rooms=(4.5, 6))
-    with pytest.raises(sgtool.SgtoolError, match="^every='x': a whole number >= 1, or None$"):
+    with pytest.raises(sgtool.SgtoolError, match="^every='x': a whole number, or None$"):
         sgtool.ReplayOptions(every="x")
-    with pytest.raises(sgtool.SgtoolError, match="^max_frames=2.5: a whole number >= 1"):
+    with pytest.raises(sgtool.SgtoolError, match="^max_frames=2.5: a whole number"):
         sgtool.ReplayOptions(max_frames=2.5)
     with pytest.raises(sgtool.SgtoolError, match="^max_depth=nan: a finite number"):
         sgtool.ReplayOptions(max_depth=float("nan"))
@@ -60,8 +60,8 @@ def test_arguments_of_the_wrong_type_are_one_line(tmp_path) -> None:
         with pytest.raises(sgtool.SgtoolError, match="^record kind 5: one of"):
             list(r.records(5))
         assert r.last_record("episode") is not None
-    for seed in ("x", -1, True):
-        with pytest.raises(sgtool.SgtoolError, match=f"^seed={seed!r}: a whole number >= 0"):
+    for seed in ("x", 1.5, True):
+        with pytest.raises(sgtool.SgtoolError, match=f"^seed={seed!r}: a whole number, or"):
             sgtool.LogWriter(tmp_path / "w.mcap", seed=seed)
     assert not list(tmp_path.iterdir())
     with sgtool.LogWriter(tmp_path / "w.mcap") as w, \

@@ -461,3 +461,22 @@ def test_a_pin_folder_reached_through_a_symlink(log, tmp_path, capsys):
                   folder, *FRAMES)[0] == 0
     code, out, err = sgtool(capsys, "golden", "check", "--dir", folder)
     assert code == 0, out + err
+
+
+@pytest.mark.parametrize(("value", "verdict"), [(0, "error"), ("x", None)])
+def test_a_pinned_option_out_of_range_is_that_case_s_error(pinned, capsys, tmp_path, value,
+                                                           verdict):
+    """every 0 in the index is that case's error row (the report and JUnit still written),
+    as a replay names it; a value of the wrong type is a damaged pin file, one line."""
+    index = pinned / "expected.json"
+    doc = json.loads(index.read_text())
+    doc["cases"]["small"]["options"]["every"] = value
+    index.write_text(json.dumps(doc))
+    junit = tmp_path / "j.xml"
+    code, out, err = sgtool(capsys, "golden", "check", "--dir", pinned, "--junit", junit)
+    if verdict == "error":
+        assert code == 2 and summary_row(out, "small")[1] == "error", out
+        assert "every 0 (--every): must be >= 1" in out and junit.is_file()
+    else:
+        assert code == 2 and err.count("\n") == 1 and str(index) in err, err
+        assert "'every' is a string" in err

@@ -195,11 +195,13 @@ def test_a_refused_resume_runs_nothing_and_defaults_are_no_change(tmp_path: Path
     assert r.exit_code == 0, r.output
     r = CliRunner().invoke(cli, [a if a != "random" else "greedy" for a in base])
     assert r.exit_code == 0, r.output
+    recorded = json.loads((out / "run-options.json").read_text())["options"]
+    assert recorded["planners"] == "greedy,random"  # read back only: the run's options kept
     assert (f"sgtool: note: 1 episode log(s) in {out}/logs are left out of this report "
             "(logs/none/random/myhouse/ep-000.mcap)") in r.stderr
 
 
-def test_report_only_tables_the_run_as_it_was_made(tmp_path: Path) -> None:
+def test_report_only_tables_the_run_as_it_was_made(tmp_path: Path, monkeypatch) -> None:
     """--report-only needs none of the run's options again (run-options.json has them);
     one given is the user's (a setting the logs were not run with is refused); the report
     settings are the command's."""
@@ -213,6 +215,23 @@ def test_report_only_tables_the_run_as_it_was_made(tmp_path: Path) -> None:
                                  "7", "--max-steps", "2", "--no-progress"])
     assert r.exit_code == 0, r.output
     assert "7 f/room" in (out / "summary.md").read_text()
+    # the house file by its absolute path: a report from another folder finds it
+    options = json.loads((out / "run-options.json").read_text())["options"]
+    assert options["house_files"] == [str((tmp_path / "myhouse.json").resolve())]
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    r = CliRunner().invoke(cli, ["run-bench", "-o", str(out), "--report-only",
+                                 "--no-progress"])
+    assert r.exit_code == 0, r.output
+    edited = out / "run-options.json"  # a value of the wrong type, by hand: one line
+    text = edited.read_text()
+    edited.write_text(text.replace('"max_steps": 2', '"max_steps": "2"'))
+    r = CliRunner().invoke(cli, ["run-bench", "-o", str(out), "--report-only"])
+    assert r.exit_code == 2 and r.output.strip() == (
+        f'sgtool: error: {edited}: max_steps is "2", not a value of that option; delete the '
+        "file and give the options the run was made with"), r.output
+    edited.write_text(text)
     r = CliRunner().invoke(cli, ["run-bench", "-o", str(out), "--report-only",
                                  "--max-steps", "3"])  # given: not the run's, refused
     assert r.exit_code == 2 and "max steps: 2 in the log, 3 now); --report-only: give the " \

@@ -127,3 +127,30 @@ def test_a_verdict_is_never_zero_when_the_reader_stops_early():
     p.stdout.close()
     assert p.wait(timeout=120) in (1, 141)
     assert "Traceback" not in p.stderr.read().decode()
+
+
+def test_nohup_keeps_a_command_running_through_a_hang_up(tmp_path):
+    """SIGHUP stops a command as a kill does, unless it is ignored (`nohup sgtool ...`):
+    then the command keeps it ignored and finishes."""
+    import signal
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    log = Path(__file__).resolve().parents[1] / "golden" / "house6-tour.mcap"
+    code = ("import signal, sys; signal.signal(signal.SIGHUP, signal.SIG_IGN); "
+            "from sgtool.cli import main; main(sys.argv[1:])")
+    out = tmp_path / "d.mcap"
+    p = subprocess.Popen([sys.executable, "-c", code, "replay", str(log), "-o", str(out)],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while not list(tmp_path.glob("d.mcap*")) and p.poll() is None:
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        p.send_signal(signal.SIGHUP)
+        assert p.wait(timeout=120) == 0, p.stderr.read() if p.stderr else ""
+    finally:
+        p.kill()
+    assert out.is_file() and not list(tmp_path.glob("*.partial"))

@@ -265,3 +265,16 @@ def test_remove_empty_folders_keeps_every_file(tmp_path: Path) -> None:
     remove_empty_folders(tmp_path / "run")
     remove_empty_folders(tmp_path / "missing")  # nothing there: nothing to do
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_input_folder_that_is_the_output_folder_is_refused(tmp_path: Path) -> None:
+    from sgtool.errors import SgtoolError
+    from sgtool.files import refuse_input_folder
+
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "h.json").write_text("{}")
+    refuse_input_folder(run, [run / "h.json"])  # a file kept in the run folder: fine
+    refuse_input_folder(run / "out", [run])  # outputs in a folder under the inputs: fine
+    with pytest.raises(SgtoolError, match="is the input folder"):
+        refuse_input_folder(tmp_path / "run" / ".." / "run", [run])

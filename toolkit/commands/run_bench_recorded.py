@@ -13,7 +13,8 @@ import json
 from collections.abc import Mapping
 from dataclasses import fields, replace
 from pathlib import Path
-from typing import Any, TypeVar
+from types import UnionType
+from typing import Any, TypeVar, Union, get_args, get_origin, get_type_hints
 
 import click
 from click.core import ParameterSource
@@ -31,9 +32,12 @@ A = TypeVar("A")
 
 def recorded_options(args: Any) -> dict[str, Any]:
     """The run-defining options of ``args`` (a dataclass of the command's parameters), as
-    JSON values."""
-    return {f.name: _json(getattr(args, f.name)) for f in fields(args)
-            if f.name not in REPORT | EXECUTION}
+    JSON values; house files as absolute paths (a report may run from another folder)."""
+    out = {f.name: _json(getattr(args, f.name)) for f in fields(args)
+           if f.name not in REPORT | EXECUTION}
+    if isinstance(out.get("house_files"), list):
+        out["house_files"] = [str(Path(p).resolve()) for p in out["house_files"]]
+    return out
 
 
 def options_text(args: Any) -> str:
@@ -57,6 +61,7 @@ def as_recorded(args: A, path: Path) -> A:
     except (OSError, ValueError, KeyError, TypeError):
         raise SgtoolError(f"{path}: not the run options sgtool writes; delete it and give "
                           "the options the run was made with") from None
+    _check_types(type(args), saved, path)
     ctx = click.get_current_context(silent=True)
     now = {f.name: getattr(args, f.name) for f in fields(args)}  # type: ignore[arg-type]
     changes = {n: tuple(v) if isinstance(now[n], tuple) and isinstance(v, list) else v
@@ -64,6 +69,24 @@ def as_recorded(args: A, path: Path) -> A:
                and (ctx is None or ctx.get_parameter_source(n) is not
                     ParameterSource.COMMANDLINE)}
     return replace(args, **changes)  # type: ignore[type-var]
+
+
+def _check_types(kind: type, saved: Mapping[str, Any], path: Path) -> None:
+    """Each recorded value is of its option's type (a file edited by hand: one line)."""
+    hints = get_type_hints(kind)
+    for name, value in saved.items():
+        if name not in hints:
+            continue
+        allowed = get_args(hints[name]) if get_origin(hints[name]) in (Union, UnionType) \
+            else (hints[name],)
+        kinds = tuple(list if get_origin(t) is tuple else (get_origin(t) or t)
+                      for t in allowed)
+        kinds += (int,) if float in kinds else ()
+        ok = isinstance(value, kinds) and not (isinstance(value, bool) and bool not in kinds)
+        if not ok:
+            raise SgtoolError(f"{path}: {name} is {json.dumps(value)}, not a value of that "
+                              "option; delete the file and give the options the run was "
+                              "made with")
 
 
 def _json(value: Any) -> Any:

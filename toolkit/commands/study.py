@@ -150,7 +150,9 @@ def _request(args: NoiseArgs) -> NoiseStudyRequest:
     from sgtool.analysis.bench_houses import generated_houses, load_house_files
     from sgtool.analysis.noise_study import RecordingSettings, StudyConfig
     from sgtool.analysis.noise_study_run import NoiseStudyRequest
+    from sgtool.files import refuse_input_folder
 
+    refuse_input_folder(args.out_dir, args.house_files, what="--house")
     conditions = _conditions(args.factors, args.profiles)
     width, height = parse_resolution(args.resolution)
     settings = RecordingSettings(width, height, args.fps, args.frames, args.noise_seed)

@@ -136,7 +136,7 @@ class LogWriter:
     ) -> None:
         if compression not in _COMPRESSION:
             raise SgtoolError(f"unknown compression {compression!r} (zstd, lz4, none)")
-        whole("seed", seed, 0, optional=True)
+        whole("seed", seed, optional=True)  # (a log's own seed is copied as it is)
         self.path = Path(path)
         if self.path.exists() and not overwrite:
             raise SgtoolError(f"{self.path} exists; not overwriting it")
