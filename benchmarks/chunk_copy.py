@@ -17,7 +17,7 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-from harness import add_output_options, alternate, emit
+from harness import add_output_options, alternate, emit, log_given
 
 from sgtool.blas import single_blas_thread
 from sgtool.log import LogReader
@@ -46,6 +46,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("log", type=Path, nargs="?", default=DEFAULT)
     ap.add_argument("--rounds", type=int, default=3)
     a = add_output_options(ap).parse_args(argv)
+    log_given(ap, a.log)
     out = Path(tempfile.mkdtemp(prefix="sgtool-chunk-copy-"))
     frames: dict[bool, int] = {}
 

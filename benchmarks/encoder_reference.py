@@ -2,7 +2,8 @@
 
 Prints the reference values embedded in tests/toolkit/semantics/test_encoder.py (first components
 and pairwise cosines computed by sentence-transformers) and the largest deviation of the
-numpy encoder over a few hundred household names, plus load and encode times side by side.
+numpy encoder over a couple of dozen household names and phrases, plus load and encode
+times side by side.
 
     .venv/bin/python benchmarks/encoder_reference.py
 """

@@ -179,6 +179,15 @@ def alternate_trees(script: Path, args: Sequence[str], against: Path | None, rou
     return out
 
 
+def log_given(ap: argparse.ArgumentParser, log: Path) -> Path:
+    """``log``, or the parser's one-line usage error when it is not a file (the default of
+    a script reading a recording is the one ``benchmarks/replay.py`` caches)."""
+    if not log.is_file():
+        ap.error(f"{log}: no such log (give LOG, or run benchmarks/replay.py first: it "
+                 "caches the default recording)")
+    return log
+
+
 def add_output_options(ap: argparse.ArgumentParser) -> argparse.ArgumentParser:
     """``--json PATH``: also write the figures as JSON (``-``: stdout)."""
     ap.add_argument("--json", dest="json_out", default=None, metavar="PATH",

@@ -39,6 +39,9 @@ def main() -> None:
         t = best_of(lambda d=doc, k=n: parse_house(d, SpecLimits(objects=k)), 3).wall_s
         print(f"{n:>9} {t:>8.3f} {t / n * 1e6:>10.1f}")
 
+    doc = copy.deepcopy(base)  # one object past the default limit, whatever --max
+    doc["objects"] = [dict(one, id=f"obj_{k}") for k in range(LIMITS.objects + 1)]
+
     def refuse() -> None:
         try:
             parse_house(doc)

@@ -29,7 +29,7 @@ from pathlib import Path
 from foxglove_schemas_protobuf.CameraCalibration_pb2 import CameraCalibration
 from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
 from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
-from harness import add_output_options, alternate, emit
+from harness import add_output_options, alternate, emit, log_given
 from mcap.reader import make_reader
 
 from sgtool.log import LogReader
@@ -73,6 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("log", type=Path, nargs="?", default=DEFAULT)
     ap.add_argument("--rounds", type=int, default=5)
     a = add_output_options(ap).parse_args(argv)
+    log_given(ap, a.log)
     readers: dict[str, Callable[[Path], int]] = {
         "mcap raw": mcap_raw,
         "mcap + protobuf": mcap_protobuf,

@@ -38,3 +38,22 @@ def test_fuzz_cli_without_the_support_modules_says_how_to_run_it(tmp_path: Path)
     assert proc.stderr.strip().splitlines() == [
         "fuzz_cli: the test support modules are not importable: run it as "
         "PYTHONPATH=tests .venv/bin/python tools/fuzz_cli.py (from the repository root)"]
+
+
+def test_every_mutation_of_tools_mutations_still_applies() -> None:
+    """Each mutation's text is in its file exactly once (a refactor that moves it would
+    make the tool report the mutation as not applied)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("tool_mutations", REPO / "tools" /
+                                                  "mutations.py")
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules["tool_mutations"] = mod  # (dataclasses look their module up)
+    try:
+        spec.loader.exec_module(mod)
+        stale = [(m.parameter, m.label) for m in mod.MUTATIONS
+                 if (REPO / "toolkit" / m.file).read_text().count(m.old) != 1]
+    finally:
+        del sys.modules["tool_mutations"]
+    assert not stale

@@ -34,7 +34,12 @@ from pathlib import Path
 try:
     from support.crafted_logs import CRAFTS
     from support.log_fuzz import campaign as prepare
-    from support.log_fuzz import crafted_expectation, crafted_logs, message_count
+    from support.log_fuzz import (
+        crafted_expectation,
+        crafted_logs,
+        crafted_report_problem,
+        message_count,
+    )
     from support.logfixtures import write_log
 except ModuleNotFoundError as e:  # run without tests/ on the path
     if e.name != "support":
@@ -132,9 +137,11 @@ def crafted_campaign(commands: list[str], work: Path, names: set[str]
                 outcome, text = "wrong", f"{outcome}, expected {want[cmd]}: {text[:200]}"
             elif cmd in ("doctor", "recover") and outcome == "clean":
                 d = json.loads(text)
-                if d["status"] != "complete" or (
-                        cmd == "recover" and d["readable_messages"] != message_count(log)):
-                    outcome, text = "wrong", f"{d['status']}, {d['readable_messages']} messages"
+                wrong = crafted_report_problem(
+                    name, cmd, d["status"], d.get("problems", []), d["readable_messages"],
+                    d.get("dropped_messages", 0), message_count(log))
+                if wrong:
+                    outcome, text = "wrong", wrong
             _tally(table, failures, cmd, outcome, f"crafted {name} {cmd}: {text}")
         print(".", end="", flush=True, file=sys.stderr)
     print(file=sys.stderr)

@@ -68,7 +68,7 @@ MUTATIONS: list[Mutation] = [
     *scaled("door KDE bandwidth", RS, "door_bandwidth: float = 0.15", "0.15", UP_DOWN),
     *scaled("min room size", RS, "min_room_length: float = 1.0", "1.0", UP_DOWN),
     Mutation("room centre rule", "min eccentricity -> medoid (min summed distance)", RS,
-             "ecc = d.max(axis=1)", "ecc = d.sum(axis=1)"),
+             "np.where(reach, d, 0.0).max(axis=1)", "np.where(reach, d, 0.0).sum(axis=1)"),
     *scaled("Voronoi min clearance", VO, "min_clearance: float = 0.2", "0.2", UP_DOWN),
     *scaled("sparsification node spacing", VO, "node_spacing: float = 0.6", "0.6", UP_DOWN),
     *scaled("assignment exponent", AS, "exponent: float = 1.3", "1.3", UP_DOWN),
@@ -174,7 +174,12 @@ def main() -> None:
     for p, lab, c in rows:
         print(f"{p:<{w0}} | {lab:<{w1}} | {c}")
     survived = sum(r[2].startswith("--") for r in rows)
-    print(f"{len(rows) - survived} of {len(rows)} mutations caught")
+    stale = sum(r[2].startswith("NOT APPLIED") for r in rows)
+    print(f"{len(rows) - survived - stale} of {len(rows) - stale} mutations caught"
+          + (f"; {stale} not applied (the code they change moved: update them)"
+             if stale else ""))
+    if stale:
+        sys.exit(1)
 
 
 if __name__ == "__main__":

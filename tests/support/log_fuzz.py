@@ -145,6 +145,21 @@ def crafted_expectation(name: str) -> dict[str, str]:
             "score": "clean" if name in _SCORED else "error"}
 
 
+def crafted_report_problem(name: str, cmd: str, status: str, problems: list[str],
+                           readable: int, dropped: int, total: int) -> str | None:
+    """What is wrong with doctor's (``cmd`` "doctor") or recovery's ("recover") report on
+    the crafted log ``name`` of ``total`` messages, None when it is right: doctor calls a
+    valid file complete, or corrupt when every problem is a message written malformed (a
+    log replay refuses); recovery accounts for every message, kept or dropped."""
+    if cmd == "doctor" and status != "complete" and not (
+            status == "corrupt" and crafted_expectation(name)["replay"] == "error"
+            and all("were written malformed" in p for p in problems)):
+        return f"{status} {problems[:2]}"
+    if cmd == "recover" and readable + dropped != total:
+        return f"{readable} messages kept, {dropped} dropped of {total}"
+    return None
+
+
 def crafted_logs(work: Path) -> list[tuple[str, Path]]:
     """Every crafted log of :data:`support.crafted_logs.CRAFTS`, written under ``work``."""
     from support.crafted_logs import CRAFTS

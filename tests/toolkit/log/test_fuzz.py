@@ -20,7 +20,12 @@ from typing import Any
 
 import pytest
 from support.log_fuzz import campaign as prepare
-from support.log_fuzz import crafted_expectation, crafted_logs, message_count
+from support.log_fuzz import (
+    crafted_expectation,
+    crafted_logs,
+    crafted_report_problem,
+    message_count,
+)
 from support.logfixtures import write_log
 
 from sgtool.errors import SgtoolError
@@ -161,14 +166,10 @@ def test_fuzz_crafted_logs(tmp_path):
             elif cmd in want and outcome != want[cmd]:
                 failures.append(f"{name} {cmd}: {outcome}, expected {want[cmd]}: {value}")
                 outcome = "wrong"
-            elif cmd == "doctor" and value.status != "complete" and not (
-                    value.status == "corrupt" and want["replay"] == "error"
-                    and all("were written malformed" in p for p in value.problems)):
-                failures.append(f"{name} doctor: {value.status} {value.problems[:2]}")
-                outcome = "wrong"
-            elif cmd == "recover" and (value.readable_messages + value.dropped_messages
-                                       != message_count(path)):
-                failures.append(f"{name} recover: {value.readable_messages} messages kept")
+            elif cmd in ("doctor", "recover") and (wrong := crafted_report_problem(
+                    name, cmd, value.status, value.problems, value.readable_messages,
+                    value.dropped_messages, message_count(path))):
+                failures.append(f"{name} {cmd}: {wrong}")
                 outcome = "wrong"
             table[cmd, outcome] += 1
     cmds = ["info", "doctor", "recover", "replay", "score", "frames", "eval"]
