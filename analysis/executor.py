@@ -404,15 +404,17 @@ def import_ray() -> Any:
     return ray
 
 
-def check_reachable(address: str, timeout_s: float = 3.0) -> None:
-    """Refuse an address where nothing listens (one line), rather than let Ray wait for
-    minutes. ``auto`` and ``local`` are Ray's own and are passed on unchecked."""
+def check_reachable(address: str, timeout_s: float = 3.0, given_as: str = "--ray-address"
+                    ) -> None:
+    """Refuse an address where nothing listens (one line naming where it was ``given_as``),
+    rather than let Ray wait for minutes. ``auto`` and ``local`` are Ray's own and are
+    passed on unchecked."""
     if address in ("auto", "local"):
         return
     hostport = address.split("://", 1)[-1].rstrip("/")
     host, sep, port = hostport.rpartition(":")
     if not sep or not port.isdecimal() or not host:
-        raise ExecutorError(f"--ray-address {address!r}: give HOST:PORT (the head node's "
+        raise ExecutorError(f"{given_as} {address!r}: give HOST:PORT (the head node's "
                             "GCS address, e.g. 10.0.0.5:6379) or ray://HOST:PORT")
     try:
         with socket.create_connection((host, int(port)), timeout=timeout_s):
@@ -446,6 +448,7 @@ class RayExecutor(_Executor):
     def __init__(self, workers: int = 1, address: str | None = None) -> None:
         super().__init__(workers)
         self.address = address or os.environ.get("RAY_ADDRESS") or None
+        self.given_as = "--ray-address" if address else "RAY_ADDRESS"
         import_ray()  # fail before any work when Ray is missing
 
     def connect(self) -> bool:
@@ -458,7 +461,7 @@ class RayExecutor(_Executor):
         common = dict(log_to_driver=False, configure_logging=False, include_dashboard=False)
         with _sigterm_kept():
             if self.address:
-                check_reachable(self.address)
+                check_reachable(self.address, given_as=self.given_as)
                 ray.init(address=self.address, **common)
                 self.workers = max(self.workers, int(ray.cluster_resources().get("CPU", 1)))
             else:

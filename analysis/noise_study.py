@@ -100,7 +100,8 @@ def parse_factor(text: str) -> tuple[str, tuple[float, ...]]:
         try:
             replace(PROFILES[NONE], **kw)  # the profile's own checks (>= 0, finite, <= 1)
         except SgtoolError as e:
-            raise SgtoolError(f"--factor {text!r}: level {p}: {e}") from None
+            why = str(e).split(": ", 1)[-1]  # (the profile's message names --noise)
+            raise SgtoolError(f"--factor {text!r}: level {p}: {why}") from None
         if v not in levels:
             levels.append(v)
     return name, tuple(levels)

@@ -80,7 +80,7 @@ def write_rerun(log: str | os.PathLike[str], output: str | os.PathLike[str], *,
         raise SgtoolError(f"every={every}, max_frames={max_frames}: each must be >= 1")
     if Path(output).resolve() == Path(log).resolve():
         raise SgtoolError("the output must not be the input log")
-    check_output(Path(output), force=overwrite, suffixes=(".rrd",), what="Rerun recording",
+    check_output(output, force=overwrite, suffixes=(".rrd",), what="Rerun recording",
                  force_flag="--force (overwrite=)")
     request = ViewRequest(log=os.fspath(log), output=os.fspath(output), every=every,
                           max_frames=max_frames, voxels=voxels)

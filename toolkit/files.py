@@ -239,6 +239,8 @@ def output_dir(path: str | os.PathLike[str]) -> Path:
 
 
 def _folder_target(target: str | os.PathLike[str], option: str) -> Path:
+    if not os.fspath(target):  # ("" would be the working folder)
+        raise SgtoolError(f"{option} '': an empty path; give a folder")
     path = Path(os.path.abspath(target))  # "." has a name and a parent to build beside
     if path.is_symlink() and path.is_dir():  # a link to a folder: the folder is the target
         path = Path(os.path.realpath(path))

@@ -5,13 +5,14 @@ line naming the option; nothing is left behind."""
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from pathlib import Path
 
 from sgtool.errors import SgtoolError
 
 
-def check_output(path: str | Path, *, force: bool = False, option: str = "-o",
+def check_output(path: str | os.PathLike[str], *, force: bool = False, option: str = "-o",
                  suffixes: Sequence[str] = (), what: str = "output",
                  force_flag: str = "--force") -> Path:
     """The one check of an output file name a command may write, before any work: it is
@@ -20,6 +21,8 @@ def check_output(path: str | Path, *, force: bool = False, option: str = "-o",
     (and is never a device, FIFO or socket, which the atomic rename would replace).
     Each failure is one :class:`SgtoolError` line (``force_flag`` names how to
     overwrite); nothing is left behind."""
+    if not os.fspath(path):  # ("" would be the working folder)
+        raise SgtoolError(f"{option} '': an empty path; give a file name")
     p = Path(path)
     if p.is_dir():
         raise SgtoolError(f"{option} {p} is a folder; give a file name")
@@ -36,7 +39,8 @@ def check_output(path: str | Path, *, force: bool = False, option: str = "-o",
     return p
 
 
-def check_log_output(path: str | Path, *, force: bool = False, option: str = "-o") -> Path:
+def check_log_output(path: str | os.PathLike[str], *, force: bool = False,
+                     option: str = "-o") -> Path:
     """:func:`check_output` of an MCAP log to write (``*.mcap``)."""
     if Path(path).suffix != ".mcap" and not Path(path).is_dir():
         raise SgtoolError(f"{option} {path}: the output is an MCAP log; name it *.mcap")

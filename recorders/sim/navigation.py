@@ -32,6 +32,9 @@ from sgtool.recorders.sim.articulation import Box2
 Pose2 = tuple[float, float, float]  # x, y, yaw
 
 
+MAX_SPEED = 5.0  # m/s: --speed of a mobile base
+
+
 @dataclass(frozen=True)
 class RobotConfig:
     """The kinematic mobile base.
@@ -56,6 +59,9 @@ class RobotConfig:
                             ("open_time", self.open_time)):
             if not value > 0:
                 raise SgtoolError(f"{flag} {value:g}: must be > 0")
+        if self.speed > MAX_SPEED:
+            raise SgtoolError(f"--speed {self.speed:g}: at most {MAX_SPEED:g} m/s (a mobile "
+                              "robot's base)")
         if not 0 < self.approach[0] < self.approach[1] <= self.reach:
             raise SgtoolError(f"robot approach range {self.approach}: need 0 < min < max "
                               f"<= reach ({self.reach} m)")

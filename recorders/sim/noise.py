@@ -60,15 +60,15 @@ class NoiseProfile:
                 continue
             v = getattr(self, f.name)
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-                raise SgtoolError(f"noise {f.name}: expected a number, got {v!r}")
+                raise SgtoolError(f"--noise {f.name}={v!r}: expected a number")
             if v < 0:
-                raise SgtoolError(f"noise {f.name}: must be >= 0, got {v}")
+                raise SgtoolError(f"--noise {f.name}={v:g}: must be >= 0")
         for p in ("holes", "label_swap", "label_dropout"):
             if getattr(self, p) > 1:
-                raise SgtoolError(f"noise {p}: a probability, at most 1")
+                raise SgtoolError(f"--noise {p}={getattr(self, p):g}: a probability, at most 1")
         for p, most in LIMITS.items():  # beyond these, no sensor: overflow, not noise
             if getattr(self, p) > most:
-                raise SgtoolError(f"noise {p}: at most {most:g}, got {getattr(self, p):g}")
+                raise SgtoolError(f"--noise {p}={getattr(self, p):g}: at most {most:g}")
 
     @property
     def is_clean(self) -> bool:

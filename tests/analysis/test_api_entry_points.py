@@ -106,3 +106,14 @@ def test_what_the_cli_refuses_the_api_refuses(tmp_path) -> None:
     text.write_text("x")
     with pytest.raises(sgtool.SgtoolError, match="text.mcap is a file, not a pin folder"):
         sgtool.check_pins(text)
+
+
+def test_an_empty_path_is_no_working_folder(tmp_path, monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(sgtool.SgtoolError, match="^an empty path: no such file$"):
+        sgtool.LogReader("")
+    with pytest.raises(sgtool.SgtoolError, match="^an empty path: give a house spec file$"):
+        sgtool.load_house("")
+    with pytest.raises(sgtool.SgtoolError, match="^-o '': an empty path; give a file name$"):
+        sgtool.write_rerun(LOG, "")
+    assert list(tmp_path.iterdir()) == []

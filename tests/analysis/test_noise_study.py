@@ -116,7 +116,7 @@ def test_a_non_empty_output_folder_is_refused_without_force(study: dict[str, Pat
     (("--factor", "holes=0.1,lots"), "level 'lots' is not a number"),
     (("--factor", "holes=-0.1"), "must be >= 0"),
     (("--factor", "label_swap=2"), "a probability, at most 1"),
-    (("--factor", "depth_sigma=1e300"), "noise depth_sigma: at most 1, got 1e+300"),
+    (("--factor", "depth_sigma=1e300"), "'depth_sigma=1e300': level 1e300: at most 1"),
     (("--factor", "holes"), "give NAME=L1,L2"),
     (("--profile", "awful"), "unknown profile"),
 ])

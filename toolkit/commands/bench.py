@@ -14,6 +14,7 @@ from sgtool.commands.options import (
     PLANNERS_HELP,
     PLUGIN_HELP,
     LlmEndpoint,
+    PathParam,
     budget_options,
     executor_options,
     list_planners_option,
@@ -40,7 +41,7 @@ if TYPE_CHECKING:
               help="Number of generated evaluation-split houses (house seeds HOUSE_SEED, +1, "
                    "...). [default: 10; with --house: 0, the given houses only]")
 @click.option("--house", "house_files", multiple=True, metavar="PATH",
-              type=click.Path(path_type=str),
+              type=PathParam(path_type=str),
               help="A house spec JSON file, or a folder of them (every *.json there is read "
                    "as a house), to bench (repeatable); named by the spec's id or the file "
                    "name. Generated houses join them only when --houses N is given. Every "
@@ -50,7 +51,7 @@ if TYPE_CHECKING:
                    "that can reach the target; the file's `starts` are for the closed "
                    "loop.")
 @click.option("--priors", "priors_dir", default=None, metavar="DIR",
-              type=click.Path(file_okay=False, path_type=str),
+              type=PathParam(file_okay=False, path_type=str),
               help="Relational priors (a folder written by `sgtool distill`, or `blend` for "
                    "the shipped priors with the room blend): the planners "
                    "of the learned priors (scout*, godhs, esc, bayes-search) load them, and a "
@@ -63,7 +64,7 @@ if TYPE_CHECKING:
                    "metrics are reported as mean ± std over seeds.")
 @executor_options("tasks (one house, its planners)")
 @click.option("-o", "--out", "out_dir", default="results", show_default=True,
-              type=click.Path(file_okay=False),
+              type=PathParam(file_okay=False),
               help="Output folder: episodes.jsonl, summary.md, summary.json (the same bytes "
                    "on any executor and worker count), run.md, run.json (wall-clock figures "
                    "and the command), per_house.md, "
@@ -97,7 +98,7 @@ if TYPE_CHECKING:
 @llm_endpoint_options("LLM planners")
 @click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
               help=PLANNER_OPTION_HELP)
-@click.option("--log-dir", type=click.Path(file_okay=False), default=None,
+@click.option("--log-dir", type=PathParam(file_okay=False), default=None,
               help="Also record every episode as an MCAP log (scene graph and action per "
                    "step) under LOG_DIR/PLANNER/HOUSE/, readable by `sgtool eval`; built "
                    "beside LOG_DIR and moved in complete, as OUT (--force likewise).")

@@ -20,11 +20,12 @@ from pathlib import Path
 
 import click
 
+from sgtool.commands.options import PathParam
 from sgtool.errors import SgtoolError
 
 
 @click.command("demo")
-@click.option("-o", "--out", "out_dir", type=click.Path(file_okay=False), default="demo-out",
+@click.option("-o", "--out", "out_dir", type=PathParam(file_okay=False), default="demo-out",
               show_default=True, help="Folder for the demo's logs and results.")
 @click.option("--frames", type=click.IntRange(min=1), default=None,
               help="Stop the recording after this many frames (default: the whole tour).")

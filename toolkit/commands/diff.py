@@ -8,12 +8,12 @@ import json
 import click
 
 from sgtool.commands.golden import make_options, replay_options
-from sgtool.commands.options import FiniteFloatRange
+from sgtool.commands.options import FiniteFloatRange, PathParam
 
 
 @click.command("diff")
-@click.argument("a", type=click.Path(dir_okay=False))
-@click.argument("b", type=click.Path(dir_okay=False))
+@click.argument("a", type=PathParam(dir_okay=False))
+@click.argument("b", type=PathParam(dir_okay=False))
 @replay_options("for a log without scene graphs: the log's, else the replay default")
 @click.option("--tolerance", type=FiniteFloatRange(min=0.0), default=0.0, show_default=True,
               help="Let differences up to this pass: positions and distances (m), room "

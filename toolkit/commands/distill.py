@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from sgtool.commands.options import FiniteFloatRange, llm_endpoint_options
+from sgtool.commands.options import FiniteFloatRange, PathParam, llm_endpoint_options
 from sgtool.errors import SgtoolError
 
 if TYPE_CHECKING:
@@ -60,7 +60,7 @@ def _weights_dir() -> Path:
     "distill",
     context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100},
 )
-@click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
+@click.option("--out", "out_dir", type=PathParam(file_okay=False, path_type=Path),
               default=None,
               help="Folder for the trained weights [default: the weights shipped in the "
                    "package, sgtool/semantics/weights]. A folder that holds weights already "
@@ -71,7 +71,7 @@ def _weights_dir() -> Path:
               help="Do not train: print the quality report of the weights in --weights: on "
                    "query categories held out of training, ROC-AUC of the learned scores vs "
                    "raw SBERT cosine similarity, for containment and co-occurrence.")
-@click.option("--weights", "weights_dir", type=click.Path(file_okay=False, exists=True,
+@click.option("--weights", "weights_dir", type=PathParam(file_okay=False, exists=True,
                                                           path_type=Path),
               default=None, help="Weights to report on [default: the shipped ones].")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
@@ -103,7 +103,7 @@ def _weights_dir() -> Path:
               help="knowledge: the training split of the BEHAVIOR-1K knowledge (offline). "
                    "llm: SCOUT's procedural generation and labelling by an LLM.")
 @llm_endpoint_options("--source llm", timeout=30.0)
-@click.option("--llm-cache", type=click.Path(file_okay=False, path_type=Path), default=None,
+@click.option("--llm-cache", type=PathParam(file_okay=False, path_type=Path), default=None,
               help="Folder caching every LLM answer (resumable; a complete cache replays the "
                    "generation offline) [default: $SGTOOL_CACHE/llm-knowledge].")
 @click.option("--llm-runs", type=click.IntRange(1, 20), default=1, show_default=True,

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import click
 
+from sgtool.commands.options import PathParam
 from sgtool.errors import SgtoolError
 from sgtool.files import quoted
 from sgtool.log.recover import Diagnosis, recover, scan
@@ -79,9 +80,9 @@ def _recovered(d: Diagnosis, out: str) -> str:
 
 
 @click.command("doctor")
-@click.argument("log", type=click.Path(dir_okay=False))
+@click.argument("log", type=PathParam(dir_okay=False))
 @click.option(
-    "--recover", "out", type=click.Path(dir_okay=False), metavar="OUT",
+    "--recover", "out", type=PathParam(dir_okay=False), metavar="OUT",
     help="Write every readable message to OUT as a valid, indexed MCAP file "
     "(never the input file).",
 )

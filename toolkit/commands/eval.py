@@ -18,6 +18,7 @@ from sgtool.commands.options import (
     PLANNER_OPTION_HELP,
     PLUGIN_HELP,
     LlmEndpoint,
+    PathParam,
     budget_options,
     executor_options,
     list_planners_option,
@@ -31,7 +32,7 @@ if TYPE_CHECKING:
 
 
 @click.command("eval")
-@click.argument("inputs", nargs=-1, required=True, type=click.Path())
+@click.argument("inputs", nargs=-1, required=True, type=PathParam())
 @click.option("-p", "--planner", "planners", multiple=True, metavar="NAME[,NAME]",
               is_eager=True,
               help="Also ask these planners at every logged decision point (MCAP logs with "
@@ -41,7 +42,7 @@ if TYPE_CHECKING:
 @click.option("-O", "--planner-option", "planner_option", multiple=True, metavar="P.KEY=VALUE",
               help=PLANNER_OPTION_HELP)
 @llm_endpoint_options("LLM planners (-p)")
-@click.option("--llm-replay", type=click.Path(dir_okay=False), multiple=True,
+@click.option("--llm-replay", type=PathParam(dir_okay=False), multiple=True,
               help="moma-llm: answer from this transcript (JSONL, or an MCAP log's "
                    "/sgtool/llm channel; repeatable) instead of an endpoint [default: the "
                    "exchanges of the MCAP inputs, when they have any].")
@@ -59,7 +60,7 @@ if TYPE_CHECKING:
               help="Paired comparisons of every pair of planners instead of against "
                    "--reference.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of tables.")
-@click.option("-o", "--out", type=click.Path(dir_okay=False), default=None,
+@click.option("-o", "--out", type=PathParam(dir_okay=False), default=None,
               help="Also write the output to this file (JSON if it ends in .json).")
 @click.option("--force", is_flag=True, help="Overwrite the -o file.")
 @executor_options("file reads (one per input)")

@@ -10,7 +10,7 @@ import re
 
 import click
 
-from sgtool.commands.options import FINITE_FLOAT
+from sgtool.commands.options import FINITE_FLOAT, PathParam
 from sgtool.errors import SgtoolError
 
 
@@ -60,8 +60,8 @@ def _frames(style: str, pairs: tuple[str, ...], log: str) -> dict[str, str]:
 
 
 @command.command("bag")
-@click.argument("log", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", required=True, type=click.Path(),
+@click.argument("log", type=PathParam(dir_okay=False))
+@click.option("-o", "--output", required=True, type=PathParam(),
               help="The bag to write: NAME.bag is a ROS 1 bag file, any other name a ROS 2 "
                    "bag folder (MCAP storage).")
 @click.option("--format", "fmt", type=click.Choice(["ros1", "ros2"]), default=None,
@@ -132,7 +132,7 @@ def bag(log: str, output: str, fmt: str | None, distro: str, time_base: float | 
 
 
 @command.command("foxglove-layout")
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
+@click.option("-o", "--output", required=True, type=PathParam(dir_okay=False),
               help="Where to write the layout (JSON).")
 @click.option("--follow", type=click.Choice(["base", "camera", "world"]), default="base",
               show_default=True,

@@ -15,7 +15,7 @@ from typing import Any, TypeVar
 
 import click
 
-from sgtool.commands.options import FiniteFloatRange, executor_options, option_group
+from sgtool.commands.options import FiniteFloatRange, PathParam, executor_options, option_group
 from sgtool.errors import SgtoolError
 from sgtool.files import quoted
 from sgtool.scenegraph.build_options import CLASSIFIERS
@@ -69,8 +69,8 @@ def command() -> None:
 
 
 @command.command("pin")
-@click.argument("logs", metavar="LOG...", nargs=-1, required=True, type=click.Path())
-@click.option("--dir", "folder", required=True, type=click.Path(file_okay=False),
+@click.argument("logs", metavar="LOG...", nargs=-1, required=True, type=PathParam())
+@click.option("--dir", "folder", required=True, type=PathParam(file_okay=False),
               help="Pin folder (created when missing; logs pinned there before under other "
               "names are kept).")
 @click.option("--copy", is_flag=True,
@@ -109,7 +109,7 @@ def pin(logs: tuple[str, ...], folder: str, copy: bool, why: str | None, every: 
 
 
 @command.command("check")
-@click.option("--dir", "folder", required=True, type=click.Path(file_okay=False),
+@click.option("--dir", "folder", required=True, type=PathParam(file_okay=False),
               help="Pin folder written by `sgtool golden pin`.")
 @click.option("--log", "names", multiple=True, metavar="NAME",
               help="Check only this pinned log (repeatable).")
@@ -121,9 +121,9 @@ def pin(logs: tuple[str, ...], folder: str, copy: bool, why: str | None, every: 
 @click.option("--update", is_flag=True,
               help="Re-pin the changed logs (with the options checked) and print what was "
               "accepted; exit 0 then.")
-@click.option("--report", "report_md", type=click.Path(dir_okay=False), default=None,
+@click.option("--report", "report_md", type=PathParam(dir_okay=False), default=None,
               help="Also write the report as Markdown to this file.")
-@click.option("--junit", type=click.Path(dir_okay=False), default=None,
+@click.option("--junit", type=PathParam(dir_okay=False), default=None,
               help="Also write a JUnit XML file (one test case per log) for CI.")
 @executor_options("checks (one per log)")
 @click.option("--progress/--no-progress", default=None,

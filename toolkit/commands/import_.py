@@ -15,7 +15,7 @@ from typing import Any
 
 import click
 
-from sgtool.commands.options import check_log_output, option_group
+from sgtool.commands.options import PathParam, check_log_output, option_group
 from sgtool.errors import SgtoolError
 from sgtool.recorders.importers.checks import (
     MAX_DT_S,
@@ -117,7 +117,7 @@ def _world_options(f):  # type: ignore[no-untyped-def]
 
 
 _common_options = option_group([
-    click.option("-o", "--output", type=click.Path(dir_okay=False),
+    click.option("-o", "--output", type=PathParam(dir_okay=False),
                  help="The sgtool log to write (OUT.mcap)."),
     click.option("--intrinsics", default=None,
                  help="Camera intrinsics 'fx,fy,cx,cy' in pixels, or a file (Open3D JSON "
@@ -170,7 +170,7 @@ def command() -> None:
 
 
 @command.command("bag")
-@click.argument("path", type=click.Path(exists=True))
+@click.argument("path", type=PathParam(exists=True))
 @click.option("--depth", help="Depth image topic (sensor_msgs/Image 16UC1 or 32FC1, or "
               "CompressedImage PNG/compressedDepth): one frame per depth image.")
 @click.option("--rgb", help="Colour image topic (Image or CompressedImage).")
@@ -282,7 +282,7 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None, info: s
 
 
 @command.command("rgbd")
-@click.argument("folder", type=click.Path(exists=True, file_okay=False))
+@click.argument("folder", type=PathParam(exists=True, file_okay=False))
 @click.option("--layout", type=click.Choice(["auto", "tum", "7scenes", "open3d"]),
               default="auto", show_default=True,
               help="Folder layout: TUM RGB-D (rgb.txt, depth.txt, groundtruth.txt), 7-Scenes "
@@ -301,7 +301,7 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None, info: s
 @click.option("--skip-missing", is_flag=True,
               help="Import the frames whose files exist when rgb.txt/depth.txt list missing "
               "ones (without it, missing files are an error before anything is read).")
-@click.option("--trajectory", type=click.Path(dir_okay=False, exists=True),
+@click.option("--trajectory", type=PathParam(dir_okay=False, exists=True),
               help="Poses to use instead of the dataset's: an Open3D .log or a TUM file.")
 @_odometry_options(
     estimate_help="Estimate the poses by RGB-D odometry even when the dataset has them (their "

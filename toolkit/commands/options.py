@@ -43,6 +43,18 @@ class FiniteFloatRange(click.FloatRange):
 FINITE_FLOAT = FiniteFloatRange()
 
 
+class PathParam(click.Path):
+    """:class:`click.Path` that refuses an empty value (``Path("")`` is the working folder,
+    so ``-o ''`` would write there and ``info ''`` would read it); the type of every path
+    option and argument of the commands."""
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        if isinstance(value, str) and value == "":
+            self.fail("an empty path.", param, ctx)
+        return super().convert(value, param, ctx)
+
+
 def parse_rooms(text: str, option: str = "--rooms", lo_limit: int = 4,
                 hi_limit: int | None = None) -> tuple[int, int]:
     """A room-count range: ``N``, ``MIN-MAX`` or ``MIN,MAX`` (at most the generator's
@@ -139,10 +151,11 @@ def house_options(seed_help: str, rooms_help: str) -> Callable[[F], F]:
     """``--house``, ``--seed`` and ``--rooms`` (for :func:`house_from_options`); the help of
     ``--seed`` and ``--rooms`` says what the command does with the house."""
     return option_group([
-        click.option("--house", "house_path", type=click.Path(dir_okay=False),
+        click.option("--house", "house_path", type=PathParam(dir_okay=False),
                      help="House spec (JSON, see `sgtool scenes`). Default: the demo house "
                      "shipped with sgtool, unless --seed is given."),
-        click.option("--seed", type=int, default=None, help=seed_help),
+        click.option("--seed", type=click.IntRange(min=0, max=2**62), default=None,
+                     help=seed_help),
         click.option("--rooms", default=DEFAULT_ROOMS_TEXT, show_default=True,
                      metavar="MIN-MAX",
                      help=rooms_help),
@@ -153,15 +166,15 @@ def llm_log_options(transcript_help: str, many: bool = False) -> Callable[[F], F
     """``--llm-replay`` and ``--llm-transcript`` of the moma-llm planner; ``many``: the
     replay option is repeatable and takes folders (of a bench's ``--log-dir`` logs)."""
     replay = click.option(
-        "--llm-replay", type=click.Path(), multiple=True,
+        "--llm-replay", type=PathParam(), multiple=True,
         help="moma-llm: serve answers from these transcripts (JSONL, or MCAP logs' "
         "/sgtool/llm; repeatable; a folder: its *.mcap logs and *.jsonl transcripts, as "
         "`--log-dir` writes them) instead of an endpoint.") if many else click.option(
-        "--llm-replay", type=click.Path(dir_okay=False), default=None,
+        "--llm-replay", type=PathParam(dir_okay=False), default=None,
         help="moma-llm: serve answers from this JSONL transcript instead of an endpoint.")
     return option_group([
         replay,
-        click.option("--llm-transcript", type=click.Path(dir_okay=False), default=None,
+        click.option("--llm-transcript", type=PathParam(dir_okay=False), default=None,
                      help=transcript_help),
     ])
 

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from sgtool.commands.options import FINITE_FLOAT, check_log_output, house_options
+from sgtool.commands.options import FINITE_FLOAT, PathParam, check_log_output, house_options
 from sgtool.errors import SgtoolError
 
 if TYPE_CHECKING:
@@ -36,7 +36,7 @@ def _pair(option: str, text: str) -> tuple[float, float]:
     seed_help="Generate the house for this seed (`sgtool scenes generate`) instead of "
     "reading --house.",
     rooms_help="Room count range for a house generated with --seed (N, MIN-MAX).")
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
+@click.option("-o", "--output", required=True, type=PathParam(dir_okay=False),
               help="The log to write (OUT.mcap).")
 @click.option("--frames", type=int, default=None,
               help="Stop after this many frames. Default: when the scripted exploration has "
@@ -50,7 +50,7 @@ def _pair(option: str, text: str) -> tuple[float, float]:
               "at 1 m, grows with z^2), holes (share of depth pixels lost), label_swap, "
               "label_dropout (per visible object and frame), drift_xy (m per m driven), "
               "drift_yaw (rad per m driven and per rad turned).")
-@click.option("--noise-seed", type=click.IntRange(min=0), default=0, show_default=True,
+@click.option("--noise-seed", type=click.IntRange(min=0, max=2**62), default=0, show_default=True,
               help="Seed of the sensor faults.")
 @click.option("--resolution", default="320x240", show_default=True,
               help="Camera image size WIDTHxHEIGHT.")
@@ -63,7 +63,7 @@ def _pair(option: str, text: str) -> tuple[float, float]:
 @click.option("--tilt", type=FINITE_FLOAT, default=15.0, show_default=True,
               help="Downward tilt of the camera (degrees).")
 @click.option("--speed", type=FINITE_FLOAT, default=0.5, show_default=True,
-              help="Driving speed (m/s); turning is 90 deg/s.")
+              help="Driving speed (m/s, at most 5); turning is 90 deg/s.")
 @click.option("--start", type=int, default=0, show_default=True,
               help="Index of the house's start pose (one per room in generated houses; a "
               "house file without \"starts\" gets one per reachable room, as in `sgtool "

@@ -19,6 +19,7 @@ import click
 from sgtool.commands.options import (
     FINITE_FLOAT,
     FiniteFloatRange,
+    PathParam,
     check_log_output,
     check_output,
     executor_options,
@@ -34,8 +35,8 @@ if TYPE_CHECKING:
 
 
 @click.command("replay")
-@click.argument("logs", metavar="LOG...", nargs=-1, required=True, type=click.Path())
-@click.option("-o", "--output", type=click.Path(dir_okay=False),
+@click.argument("logs", metavar="LOG...", nargs=-1, required=True, type=PathParam())
+@click.option("-o", "--output", type=PathParam(dir_okay=False),
               help="Derived log to write: a copy of LOG's messages plus /map/occupancy, "
               "/map/voronoi, /map/rooms, /map/graph and /sgtool/scene_graph at every "
               "refresh. Without "
@@ -53,10 +54,10 @@ if TYPE_CHECKING:
               default="auto", show_default=True,
               help="--classifier llm: answers constrained to the room types by a llama.cpp "
               "grammar or a JSON schema (auto: detected per endpoint), or parsed.")
-@click.option("--llm-replay", type=click.Path(dir_okay=False), multiple=True,
+@click.option("--llm-replay", type=PathParam(dir_okay=False), multiple=True,
               help="--classifier llm: answer from this transcript (JSONL, or an MCAP log's "
               "/sgtool/llm; repeatable) instead of an endpoint: offline, same output bytes.")
-@click.option("--llm-transcript", type=click.Path(dir_okay=False), default=None,
+@click.option("--llm-transcript", type=PathParam(dir_okay=False), default=None,
               help="--classifier llm: write every exchange to this JSONL transcript (for "
               "--llm-replay); the report counts valid and rejected answers.")
 @click.option("--min-points", type=click.IntRange(min=1), default=None,
@@ -79,7 +80,7 @@ if TYPE_CHECKING:
               "stamp every message with its log time). Pairing by log time, /tf stamps more "
               "than 0.05 s from their log times are warned about (the largest offset named), "
               "more than 1 s refused.")
-@click.option("--rrd", type=click.Path(dir_okay=False),
+@click.option("--rrd", type=PathParam(dir_okay=False),
               help="Also write a Rerun recording of the derived log (needs -o).")
 @click.option("--rerun", "rerun_to", default=None,
               metavar="spawn|connect[:URL]|serve[:WEB_PORT[:GRPC_PORT]]",
@@ -99,7 +100,7 @@ if TYPE_CHECKING:
               "whole log without replaying it).")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
-@click.option("--out-dir", type=click.Path(file_okay=False), default=None,
+@click.option("--out-dir", type=PathParam(file_okay=False), default=None,
               help="Replay many logs (files, folders of *.mcap, quoted glob patterns) into "
               "this folder, one DIR/NAME.mcap per LOG, byte-identical to one-by-one "
               "replays; outputs that are complete already are kept unless --force. A "

@@ -18,6 +18,7 @@ from sgtool.commands.options import (
     FINITE_FLOAT,
     PLUGIN_HELP_ONE,
     LlmEndpoint,
+    PathParam,
     check_log_output,
     explore_on_option,
     explore_through_option,
@@ -94,7 +95,7 @@ if TYPE_CHECKING:
               "unknown space (at frontiers).")
 @click.option("--noise", default="none", show_default=True,
               help="Sensor faults, as `sgtool record --noise` (none, mild, strong, overrides).")
-@click.option("--noise-seed", type=click.IntRange(min=0), default=0, show_default=True,
+@click.option("--noise-seed", type=click.IntRange(min=0, max=2**62), default=0, show_default=True,
               help="Seed of the sensor faults (--noise).")
 @click.option("-O", "--planner-option", "planner_option", multiple=True,
               metavar="P.KEY=VALUE",
@@ -111,7 +112,7 @@ if TYPE_CHECKING:
     transcript_help="moma-llm: write every LLM exchange to this JSONL transcript, emptied "
     "when the run starts (an interrupted run puts the previous one back; replay "
     "it later with --llm-replay).")
-@click.option("-o", "--output", required=True, type=click.Path(dir_okay=False),
+@click.option("-o", "--output", required=True, type=PathParam(dir_okay=False),
               help="The episode log to write (OUT.mcap).")
 @click.option("--force", is_flag=True, help="Overwrite the output log.")
 @click.option("--quiet", is_flag=True, help="No progress bar, no report.")

@@ -13,6 +13,7 @@ from sgtool.commands.options import (
     PLANNERS_HELP,
     PLUGIN_HELP,
     LlmEndpoint,
+    PathParam,
     budget_options,
     executor_options,
     explore_on_option,
@@ -47,7 +48,7 @@ if TYPE_CHECKING:
               help="Generated evaluation houses (seeds HOUSE_SEED, +1, ...). [default: 5; "
               "with --house: 0, the given houses only]")
 @click.option("--house", "house_files", multiple=True, metavar="PATH",
-              type=click.Path(path_type=str),
+              type=PathParam(path_type=str),
               help="A house spec JSON file or a folder of them (every *.json there is read as "
               "a house; repeatable), checked first. Generated houses join them only when "
               "--houses N is given.")
@@ -65,7 +66,7 @@ if TYPE_CHECKING:
               "file, as `sgtool record --noise`); repeatable: every profile is a run, its "
               "logs in logs/NOISE/ (NOISE: the text given, or a file's profile name). "
               "Default: none.")
-@click.option("--noise-seed", type=click.IntRange(min=0), default=0, show_default=True,
+@click.option("--noise-seed", type=click.IntRange(min=0, max=2**62), default=0, show_default=True,
               help="Seed of the sensor faults (--noise).")
 @click.option("--max-steps", default=50, show_default=True,
               help="High-level planner steps per episode.")
@@ -96,7 +97,7 @@ if TYPE_CHECKING:
               help=PLANNER_OPTION_HELP)
 @llm_endpoint_options("LLM planners")
 @click.option("-o", "--out", "out_dir", default="run-bench", show_default=True,
-              type=click.Path(file_okay=False),
+              type=PathParam(file_okay=False),
               help="Output folder: logs/NOISE/PLANNER/HOUSE/ep-K.mcap, episodes.jsonl, "
               "summary.md/.json, run.md (wall-clock figures), run.json (where and how long "
               "each episode ran), efficiency curves. A run-bench "
@@ -127,7 +128,7 @@ if TYPE_CHECKING:
               "--frames over the fewest rooms of a house), else of the most frames per room "
               "an episode used]")
 @click.option("--symbolic", "symbolic_dir", default=None, metavar="DIR",
-              type=click.Path(path_type=str),
+              type=PathParam(path_type=str),
               help="A `sgtool bench` output folder (or its episodes.jsonl): the table adds "
               "Kendall's tau between its planner order and the closed loop's, on the "
               "episodes of the same house, episode and query when there are any.")

@@ -10,7 +10,7 @@ from typing import Any
 
 import click
 
-from sgtool.commands.options import FiniteFloatRange
+from sgtool.commands.options import FiniteFloatRange, PathParam
 from sgtool.errors import SgtoolError
 
 
@@ -57,7 +57,7 @@ def command() -> None:
 @_rooms_option
 @_split_option
 @_preset_option
-@click.option("-o", "--output", type=click.Path(dir_okay=False), required=True,
+@click.option("-o", "--output", type=PathParam(dir_okay=False), required=True,
               help="House spec JSON to write (atomically).")
 @click.option("--force", is_flag=True, help="Overwrite the output file.")
 def generate_cmd(seed: int, rooms: tuple[int, int], split: str, preset: str, output: str,
@@ -79,7 +79,7 @@ def generate_cmd(seed: int, rooms: tuple[int, int], split: str, preset: str, out
 
 
 @command.command("check")
-@click.argument("houses", nargs=-1, required=True, type=click.Path())
+@click.argument("houses", nargs=-1, required=True, type=PathParam())
 def check_cmd(houses: tuple[str, ...]) -> None:
     """Check house files (or folders of them) as `sgtool bench --house` does before it runs:
     the house spec (toolkit/house/spec.py), small objects to search for, free floor for the
@@ -95,8 +95,8 @@ def check_cmd(houses: tuple[str, ...]) -> None:
 
 
 @command.command("show")
-@click.argument("house", type=click.Path(dir_okay=False))
-@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
+@click.argument("house", type=PathParam(dir_okay=False))
+@click.option("-o", "--output", type=PathParam(dir_okay=False), default=None,
               help="Image to write (.png, .svg or .pdf) [default: HOUSE with .png].")
 @click.option("--dpi", type=click.IntRange(min=30, max=600), default=120, show_default=True,
               help="Resolution of raster images.")
@@ -190,7 +190,7 @@ def _episodes(spec: Any, count: int | None, seed: int, reach: float, preset: str
 
 
 @command.command("episodes")
-@click.argument("house", type=click.Path(dir_okay=False))
+@click.argument("house", type=PathParam(dir_okay=False))
 @click.option("-n", "--count", type=click.IntRange(min=1), default=None,
               help="Number of episodes [default: one per object category].")
 @click.option("--seed", type=click.IntRange(min=0, max=2**62), default=None,

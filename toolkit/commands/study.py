@@ -14,6 +14,7 @@ import click
 
 from sgtool.commands.options import (
     FINITE_FLOAT,
+    PathParam,
     executor_options,
     parse_resolution,
     parse_rooms,
@@ -46,7 +47,7 @@ def command() -> None:
 @click.option("--house-seed", default=0, show_default=True, type=click.IntRange(min=0),
               help="Seed of the first generated house.")
 @click.option("--house", "house_files", multiple=True, metavar="FILE",
-              type=click.Path(path_type=str),
+              type=PathParam(path_type=str),
               help="A house spec JSON file or a folder of them (repeatable), studied after "
               "the generated houses.")
 @click.option("--rooms", default="8-8", show_default=True, metavar="MIN-MAX",
@@ -66,9 +67,10 @@ def command() -> None:
 @click.option("--frames", default=None, type=click.IntRange(min=1),
               help="Stop each recording after this many frames. Default: when the scripted "
               "tour has visited every room.")
-@click.option("--noise-seed", default=0, show_default=True, type=click.IntRange(min=0),
+@click.option("--noise-seed", default=0, show_default=True,
+              type=click.IntRange(min=0, max=2**62),
               help="Seed of the sensor faults.")
-@click.option("--cache", "cache_dir", default=None, type=click.Path(file_okay=False),
+@click.option("--cache", "cache_dir", default=None, type=PathParam(file_okay=False),
               help="Folder of recorded logs, keyed by house, noise and recording settings: "
               "a log recorded once is reused by every later study [default: "
               "$XDG_CACHE_HOME/sgtool/study-noise, else ~/.cache/sgtool/study-noise].")
@@ -87,7 +89,7 @@ def command() -> None:
               help="Closed-loop frame budget per episode: N x the house's room count.")
 @click.option("--max-steps", default=50, show_default=True, type=click.IntRange(min=1),
               help="Closed-loop high-level planner steps per episode.")
-@click.option("-o", "--out", "out_dir", required=True, type=click.Path(file_okay=False),
+@click.option("-o", "--out", "out_dir", required=True, type=PathParam(file_okay=False),
               help="Output folder: summary.md, results.json, results.csv (one row per "
               "house x condition), plots/FACTOR.png, closed_loop/ (episode logs and tables).")
 @click.option("--force", is_flag=True,

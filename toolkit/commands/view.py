@@ -9,13 +9,13 @@ from typing import Any
 
 import click
 
-from sgtool.commands.options import check_output
+from sgtool.commands.options import PathParam, check_output
 from sgtool.errors import SgtoolError
 
 
 @click.command("view")
-@click.argument("log", type=click.Path(dir_okay=False))
-@click.option("-o", "--out", type=click.Path(dir_okay=False),
+@click.argument("log", type=PathParam(dir_okay=False))
+@click.option("-o", "--out", type=PathParam(dir_okay=False),
               help="Write a Rerun recording (.rrd) instead of opening the viewer.")
 @click.option("--force", is_flag=True, help="Overwrite the -o file.")
 @click.option("--every", type=click.IntRange(min=1), default=1, show_default=True,

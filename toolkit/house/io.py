@@ -41,6 +41,8 @@ def load_house(source: str | os.PathLike[str] | Mapping[str, Any],
     if isinstance(source, str) and source.lstrip().startswith("{") \
             and not _is_file(source):
         return load_house_text(source, limits)
+    if not os.fspath(source):  # ("" would be the folder ".")
+        raise SpecError("an empty path: give a house spec file")
     p = Path(os.fspath(source))
     try:
         if p.is_file() and p.stat().st_size > MAX_FILE_BYTES:

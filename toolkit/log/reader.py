@@ -106,8 +106,8 @@ class LogReader:
                  verify: bool = False) -> None:
         self.path = Path(path)
         self.verify = verify
-        if not self.path.exists():
-            raise LogFormatError(f"{self.path}: no such file")
+        if not os.fspath(path) or not self.path.exists():  # ("" would be the folder ".")
+            raise LogFormatError(f"{os.fspath(path) or 'an empty path'}: no such file")
         if self.path.is_dir():
             raise LogFormatError(f"{self.path} is a folder; expected an MCAP file")
         require_regular_file(self.path)

@@ -253,3 +253,32 @@ def test_an_output_folder_that_is_the_house_folder_is_refused(tmp_path, command)
         f"sgtool: error: -o {houses} is the --house folder {houses}, whose files are read "
         "as inputs; write the outputs to another folder"), r.output
     assert sorted(p.name for p in houses.iterdir()) == ["h.json"]
+
+
+@pytest.mark.parametrize("args, says", [
+    (["info", ""], "Invalid value for 'LOG': an empty path."),
+    (["record", "--house", "", "-o", "x.mcap"], "Invalid value for '--house': an empty path."),
+    (["bench", "-o", ""], "Invalid value for '-o' / '--out': an empty path."),
+    (["scenes", "generate", "-o", ""], "Invalid value for '-o' / '--output': an empty path."),
+    (["record", "--speed", "1e9", "-o", "x.mcap"], "--speed 1e+09: at most 5 m/s"),
+    (["record", "--noise", "mild,holes=2", "-o", "x.mcap"],
+     "--noise holes=2: a probability, at most 1"),
+    (["record", "--seed", "-1", "-o", "x.mcap"], "Invalid value for '--seed': -1 is not in"),
+])
+def test_an_empty_path_and_out_of_range_values_are_one_line(tmp_path, monkeypatch, args,
+                                                            says):
+    """An empty path is not the working folder (Path('') is '.'); the message names the
+    option the user gave."""
+    monkeypatch.chdir(tmp_path)
+    r = CliRunner().invoke(cli, args)
+    assert r.exit_code == 2 and r.output.count("\n") == 1 and says in r.output, r.output
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_ray_address_from_the_environment_is_named_so(monkeypatch, tmp_path):
+    pytest.importorskip("ray")
+    monkeypatch.setenv("RAY_ADDRESS", "junk")
+    r = CliRunner().invoke(cli, ["bench", "--executor", "ray", "--houses", "1", "-o",
+                                 str(tmp_path / "b")])
+    assert r.exit_code == 2 and r.output.startswith("sgtool: error: RAY_ADDRESS 'junk': give "
+                                                    "HOST:PORT"), r.output
