@@ -101,6 +101,7 @@ from sgtool.analysis.report import (
     summary_dict,
 )
 from sgtool.analysis.search_metrics import CostModel, breakdown, cost_models, seen_unseen, summarize
+from sgtool.arg_checks import of_type
 from sgtool.canonical import strict_json
 from sgtool.files import atomic_write, output_dir, output_folder
 from sgtool.planning.episode import SUCCESS_RULES
@@ -378,6 +379,7 @@ def run_benchmark(cfg: BenchConfig, progress: bool | None = None,
     then the result holds the other tasks' episodes and says which failed (``failed``)."""
     import uuid
 
+    of_type("cfg", cfg, BenchConfig, "a BenchConfig")
     cfg.check()
     run = uuid.uuid4().hex  # planners are built afresh for each run (cached_planner)
     executor = make_executor(cfg.executor, cfg.workers, cfg.ray_address)
@@ -456,6 +458,7 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
     so that the set appears complete."""
     from sgtool.analysis.curves import plot_efficiency
 
+    of_type("res", res, BenchResult, "a BenchResult (of run_benchmark)")
     out = output_dir(out_dir)
     cfg = res.config
     paths = [write_jsonl(res.results, out / "episodes.jsonl")]

@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from sgtool.analysis.executor import Executor, LocalExecutor, Task
+from sgtool.arg_checks import of_type
 from sgtool.errors import SgtoolError
 from sgtool.files import (
     atomic_output,
@@ -402,6 +403,7 @@ def update_pins(report: CheckReport) -> list[str]:
     """Re-pin the changed logs of ``report`` (checked with ``keep``) with the options they
     were checked with (in place: :func:`pin_folder`); what was accepted, one line per
     log."""
+    of_type("report", report, CheckReport, "a CheckReport (of check_pins(..., keep=True))")
     pins = report.pins
     accepted = []
     changed = [c for c in report.logs if c.status == "changed" and c.capture is not None]

@@ -153,8 +153,10 @@ def efficiency_curve(costs: Sequence[float], successes: Sequence[bool], max_cost
     """
     if len(costs) != len(successes):
         raise ValueError("costs and successes differ in length")
-    if max_cost <= 0:
+    if not max_cost > 0:
         raise ValueError("max_cost must be > 0")
+    if any(math.isnan(float(c)) for c in costs):
+        raise ValueError("costs: a NaN cost has no place on the curve")
     n = len(costs)
     if n == 0:
         return np.array([0.0, float(max_cost)]), np.array([0.0, 0.0])

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sgtool.arg_checks import of_type
 from sgtool.datasets.footprint_reach import Window, full_mask, near_footprint
 from sgtool.errors import SgtoolError
 from sgtool.house.spec import (
@@ -237,6 +238,7 @@ def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
     sorted) when ``n`` is None, else ``n`` episodes drawn with ``seed`` (categories
     without replacement while they last, then again with other starts). ``geometry``: the house's
     :class:`EpisodeGeometry` with this ``reach``, to share with other listings."""
+    of_type("spec", spec, HouseSpec, "a HouseSpec (sgtool.load_house(path))")
     if not spec.objects or not spec.starts:
         return []
     by_cat: dict[str, list[str]] = defaultdict(list)
@@ -277,3 +279,29 @@ def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
         ))
     return out
 
+
+def pick_episode(house: HouseSpec, query: str | None = None, index: int | None = None
+                 ) -> tuple[int, Episode]:
+    """(index, episode) of ``house``'s search episodes (``sgtool scenes episodes``, one per
+    small-object category): the one of category ``query``, else number ``index`` (0)."""
+    of_type("house", house, HouseSpec, "a HouseSpec (sgtool.load_house(path))")
+    eps = list_episodes(house)
+    if not eps:
+        raise SgtoolError("the house has no search episodes (it needs small objects and "
+                          "start poses)")
+    if query is not None:
+        if index is not None:
+            raise SgtoolError("give either a query (--query, query=) or an episode index "
+                              "(--episode, index=), not both")
+        want = category_text(query)
+        for i, e in enumerate(eps):
+            if category_text(e.query) == want:
+                return i, e
+        cats = ", ".join(e.query for e in eps)
+        raise SgtoolError(f"no object of category {query!r} in the house; its small-object "
+                          f"categories are: {cats}")
+    k = 0 if index is None else int(index)
+    if not 0 <= k < len(eps):
+        raise SgtoolError(f"episode {k}: the house has {len(eps)} episodes "
+                          f"(0..{len(eps) - 1}; see `sgtool scenes episodes`)")
+    return k, eps[k]

@@ -299,6 +299,11 @@ def replay(
     dst = Path(output) if output is not None else None
     if options is not None and not isinstance(options, ReplayOptions):
         raise SgtoolError(f"options: expected a ReplayOptions, got {type(options).__name__}")
+    for name, fn in (("on_refresh", on_refresh), ("room_classifier", room_classifier)):
+        if fn is not None and not callable(fn):
+            raise SgtoolError(f"{name}: a function, got {type(fn).__name__}")
+    if dst is not None and dst.suffix != ".mcap":
+        raise SgtoolError(f"{output}: the derived log is an MCAP log; name it *.mcap")
     if dst is not None and dst.exists() and src.exists() and dst.resolve() == src.resolve():
         raise SgtoolError("the output must not be the input log")
     with LogReader(src, verify=verify or dst is not None) as reader, single_blas_thread():

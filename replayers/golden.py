@@ -32,6 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
+from sgtool.arg_checks import of_type
 from sgtool.files import atomic_write
 from sgtool.replayers.derived_log import ReplayOptions, replay
 from sgtool.replayers.golden_layers import LayerSummary
@@ -332,6 +333,8 @@ def diff_graphs(expected: SceneGraph, actual: SceneGraph, tol: float = 1e-4,
     and version, distances and the Voronoi graph size (every field of the graph is
     compared). Equal up to ``tol`` but not byte-equal:
     the one line :data:`ROUNDING`."""
+    for name, graph in (("expected", expected), ("actual", actual)):
+        of_type(name, graph, SceneGraph, "a SceneGraph")
     out: list[str] = _room_set_changes(expected, actual, layers)
     for layer, nodes, describe, changes in _LAYERS:
         e, a = _by_id(nodes(expected)), _by_id(nodes(actual))

@@ -39,3 +39,11 @@ def number(name: str, value: Any, least: float | None = None, *, optional: bool 
         raise SgtoolError(f"{name}={value!r}: a finite number{bound}"
                           + (", or None" if optional else ""))
     return float(value)
+
+
+def of_type(name: str, value: Any, kind: type | tuple[type, ...], what: str) -> Any:
+    """``value`` when it is a ``kind``, else one line: ``{name}: {what}, got {type}``
+    (``what`` says what to give, e.g. "a HouseSpec (sgtool.load_house(path))")."""
+    if not isinstance(value, kind):
+        raise SgtoolError(f"{name}: {what}, got {type(value).__name__}")
+    return value

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sgtool.arg_checks import number, whole
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
 
@@ -56,6 +57,10 @@ class CameraConfig:
     near: float = 0.05
 
     def __post_init__(self) -> None:
+        whole("width", self.width)
+        whole("height", self.height)
+        for name in ("vfov_deg", "mount_height", "tilt_deg", "depth_min", "depth_max", "near"):
+            number(name, getattr(self, name))
         if not (8 <= self.width <= 4096 and 8 <= self.height <= 4096):
             raise SgtoolError(f"camera resolution {self.width}x{self.height}: each side must "
                               "be 8..4096 pixels")

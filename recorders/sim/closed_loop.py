@@ -90,8 +90,10 @@ from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from sgtool.arg_checks import of_type
 from sgtool.canonical import canonical_float
-from sgtool.datasets.episodes import Episode, list_episodes
+from sgtool.datasets.episodes import Episode
+from sgtool.datasets.episodes import pick_episode as pick_episode  # (its home before)
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
 from sgtool.extras import require
@@ -147,36 +149,6 @@ from sgtool.scenegraph.build_options import MAX_DEPTH_M, builder_config, mapping
 from sgtool.scenegraph.categories import RoomClassifier
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.stream import Refresh, SceneGraphStream
-from sgtool.semantics.text import category_text
-
-
-# ----------------------------------------------------------------------------------------
-# episodes, report
-# ----------------------------------------------------------------------------------------
-def pick_episode(house: HouseSpec, query: str | None = None, index: int | None = None
-                 ) -> tuple[int, Episode]:
-    """(index, episode) of ``house``'s search episodes (``sgtool scenes episodes``, one per
-    small-object category): the one of category ``query``, else number ``index`` (0)."""
-    eps = list_episodes(house)
-    if not eps:
-        raise SgtoolError("the house has no search episodes (it needs small objects and "
-                          "start poses)")
-    if query is not None:
-        if index is not None:
-            raise SgtoolError("give either a query (--query, query=) or an episode index "
-                              "(--episode, index=), not both")
-        want = category_text(query)
-        for i, e in enumerate(eps):
-            if category_text(e.query) == want:
-                return i, e
-        cats = ", ".join(e.query for e in eps)
-        raise SgtoolError(f"no object of category {query!r} in the house; its small-object "
-                          f"categories are: {cats}")
-    k = 0 if index is None else int(index)
-    if not 0 <= k < len(eps):
-        raise SgtoolError(f"episode {k}: the house has {len(eps)} episodes "
-                          f"(0..{len(eps) - 1}; see `sgtool scenes episodes`)")
-    return k, eps[k]
 
 
 # ----------------------------------------------------------------------------------------
@@ -477,6 +449,10 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
     """
     require("pybullet", api="sgtool.run_closed_loop")  # one line on a core install
     planner = held_to_contract(planner)  # a user's planner object: one line for its faults
+    of_type("house", house, HouseSpec, "a HouseSpec (sgtool.load_house(path))")
+    of_type("episode", episode, Episode, "an Episode (sgtool.pick_episode(house))")
+    if on_decision is not None and not callable(on_decision):
+        raise SgtoolError(f"on_decision: a function, got {type(on_decision).__name__}")
     opts = options or ClosedLoopOptions()
     recorded = {"planner_options": recorded_options(planner_options)} if planner_options \
         else {}

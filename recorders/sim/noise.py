@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from sgtool.arg_checks import of_type
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import Frame
 from sgtool.recorders.sim.camera import LINK_TOL, se2_matrix
@@ -95,6 +96,8 @@ def parse_noise(text: str | None) -> NoiseProfile:
     or a JSON file holding an object of fields."""
     if text is None:
         return PROFILES["none"]
+    of_type("--noise", text, str, "a profile's text (none, mild, strong, overrides) or a "
+            "JSON file's path")
     t = text.strip()
     if not t:
         raise SgtoolError("--noise: empty; give a profile (none, mild, strong), overrides "

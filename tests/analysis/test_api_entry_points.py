@@ -117,3 +117,40 @@ def test_an_empty_path_is_no_working_folder(tmp_path, monkeypatch) -> None:
     with pytest.raises(sgtool.SgtoolError, match="^-o '': an empty path; give a file name$"):
         sgtool.write_rerun(LOG, "")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_first_argument_of_the_wrong_kind_is_one_line(tmp_path) -> None:
+    """What a caller passes in the wrong place (a path for a house, a name for an
+    episode, None for a result) is named in one line, not an AttributeError deep inside."""
+    from sgtool.recorders.sim import CameraConfig
+
+    house = sgtool.generate_house(6, rooms=(4, 4))
+    cases = [
+        (lambda: sgtool.list_episodes("h.json"), "^spec: a HouseSpec .*, got str$"),
+        (lambda: sgtool.pick_episode("h.json"), "^house: a HouseSpec .*, got str$"),
+        (lambda: sgtool.make_planner(5), "^planner name: a planner's name .*, got int$"),
+        (lambda: sgtool.parse_noise(5), "^--noise: a profile's text .*, got int$"),
+        (lambda: CameraConfig(width="x"), "^width='x': a whole number$"),
+        (lambda: sgtool.run_benchmark("x"), "^cfg: a BenchConfig, got str$"),
+        (lambda: sgtool.write_bench_outputs(None, tmp_path / "b"),
+         r"^res: a BenchResult \(of run_benchmark\), got NoneType$"),
+        (lambda: sgtool.update_pins(None), "^report: a CheckReport .*, got NoneType$"),
+        (lambda: sgtool.diff_graphs(None, None), "^expected: a SceneGraph, got NoneType$"),
+        (lambda: sgtool.replay(LOG, on_refresh=5), "^on_refresh: a function, got int$"),
+        (lambda: sgtool.replay(LOG, tmp_path / "out.txt"), "name it \\*.mcap$"),
+    ]
+    for call, message in cases:
+        with pytest.raises(sgtool.SgtoolError, match=message):
+            call()
+    assert sgtool.pick_episode(house)[0] == 0
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(ValueError, match="NaN cost"):
+        sgtool.auc_e([float("nan")], [True], 10.0)
+
+
+def test_run_closed_loop_names_a_wrong_episode() -> None:
+    pytest.importorskip("pybullet")
+    house = sgtool.generate_house(6, rooms=(4, 4))
+    with pytest.raises(sgtool.SgtoolError, match=r"^episode: an Episode \(sgtool.pick_episode"
+                       r"\(house\)\), got str$"):
+        sgtool.run_closed_loop(house, "mug", sgtool.make_planner("random"), "x.mcap")

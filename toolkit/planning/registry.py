@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
+from sgtool.arg_checks import of_type
 from sgtool.errors import SgtoolError
 from sgtool.planning import plugins
 from sgtool.planning.base import Planner
@@ -350,6 +351,7 @@ def make_planner(name: str, **options: Any) -> Planner:
     wrapped either way, its decision time measured only when timed). A plug-in's wrapper
     checks its contract and carries ``name`` as its name, so tables and logs list it as it
     was named."""
+    of_type("planner name", name, str, "a planner's name (--list-planners) or module:Name")
     timed = convert_value(name, "timed", TIMED, options.pop("timed", True))
     key = name.strip().lower()
     entry = REGISTRY.get(key)

@@ -25,6 +25,7 @@ from click.testing import CliRunner
 from support.scripted_planner import Scripted
 
 from sgtool.cli import cli
+from sgtool.datasets.episodes import list_episodes
 from sgtool.datasets.generator import generate_house
 from sgtool.log import LogReader
 from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
@@ -58,7 +59,7 @@ def house():
 
 def _open_start(house) -> tuple[int, object]:
     """An episode whose start room has a way out (episode 0's door is closed)."""
-    for k in range(len(cl.list_episodes(house))):
+    for k in range(len(list_episodes(house))):
         idx, ep = pick_episode(house, index=k)
         if ep.start.room != pick_episode(house, index=0)[1].start.room:
             return idx, ep

@@ -23,6 +23,7 @@ from support.bag_read import read_bag
 from support.scripted_planner import Scripted
 
 from sgtool.cli import cli
+from sgtool.datasets.episodes import list_episodes
 from sgtool.datasets.generator import generate_house
 from sgtool.errors import SgtoolError
 from sgtool.log import LogReader
@@ -32,12 +33,7 @@ from sgtool.planning.base import Action
 from sgtool.planning.candidates import actionable
 from sgtool.planning.registry import make_planner
 from sgtool.recorders.sim import CameraConfig, Simulation
-from sgtool.recorders.sim.closed_loop import (
-    ClosedLoopOptions,
-    list_episodes,
-    pick_episode,
-    run_episode,
-)
+from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
 from sgtool.recorders.sim.live_skills import (
     LiveNavConfig,
     PrivilegedAccess,
