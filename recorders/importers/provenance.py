@@ -57,12 +57,16 @@ class Findings:
     warnings: list[str] = field(default_factory=list)
 
     def problem(self, text: str | None, *, given: bool) -> None:
-        """A problem of a value the user ``given`` is a warning; of a default or an
-        estimate, an error (one line)."""
+        """A problem of a value the user ``given`` is a warning (its advice to give the
+        value to keep it becomes that it is kept); of a default or an estimate, an error
+        (one line)."""
         if text is None:
             return
         if not given:
             raise SgtoolError(text)
+        head, sep, tail = text.rpartition("; give it, or ")
+        if sep and tail.endswith("to keep this one"):  # the value given is what is kept
+            text = f"{head}; the value given is kept"
         self.warning(text)
 
     def warning(self, text: str) -> None:

@@ -444,3 +444,24 @@ def test_float_depth_files_say_how_to_convert_them(tmp_path):
     with pytest.raises(SgtoolError, match=r"float32 \(depth in metres\?\); write it as 16-bit "
                        r"millimetres .* --depth-scale 1000"):
         read_depth_file(p)
+
+
+def test_a_trajectory_without_poses_says_so(tmp_path) -> None:
+    from support.rgbd_folders import make_tum_folder
+
+    root = make_tum_folder(tmp_path / "tum", [1.0, 1.1, 1.2])
+    (root / "groundtruth.txt").write_text("# timestamp tx ty tz qx qy qz qw\n")
+    with pytest.raises(SgtoolError, match=r"groundtruth.txt: holds no poses \(TUM lines"):
+        read_sequence(root)
+
+
+def test_a_problem_of_a_value_given_keeps_it_and_says_so() -> None:
+    told: list[str] = []
+    findings = Findings(warn=told.append)
+    text = ("depth scale 1 units/m (flag --depth-scale) looks wrong: ...; --depth-scale 1000 "
+            "fits (median 2.10 m); give it, or --depth-scale 1 to keep this one")
+    findings.problem(text, given=True)
+    assert told == ["depth scale 1 units/m (flag --depth-scale) looks wrong: ...; "
+                    "--depth-scale 1000 fits (median 2.10 m); the value given is kept"]
+    with pytest.raises(SgtoolError, match="to keep this one$"):
+        findings.problem(text, given=False)
