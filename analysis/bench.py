@@ -169,7 +169,8 @@ class BenchConfig:
             if value < 1:
                 raise BenchError(f"{name}: must be >= 1, got {value}")
         if self.houses < 0 or (self.houses == 0 and not self.house_files):
-            raise BenchError(f"--houses: must be >= 1, or >= 0 with --house, got {self.houses}")
+            raise BenchError(f"--houses: must be >= 1, or >= 0 with --house (house_files=), got "
+                             f"{self.houses}")
         if self.house_seed < 0:
             raise BenchError(f"--house-seed: must be >= 0, got {self.house_seed}")
         from sgtool.datasets.presets import PRESET_NAMES

@@ -172,7 +172,7 @@ class ClosedLoopBenchConfig:
         if self.episodes < 1:
             raise SgtoolError(f"--episodes: must be >= 1, got {self.episodes}")
         if self.houses < 0 or (self.houses == 0 and not self.house_files):
-            raise SgtoolError(f"--houses: must be >= 1, or >= 0 with --house, got "
+            raise SgtoolError(f"--houses: must be >= 1, or >= 0 with --house (house_files=), got "
                               f"{self.houses}")
         folders: dict[str, str] = {}
         for n in self.noise:

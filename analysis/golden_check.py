@@ -406,6 +406,9 @@ def update_pins(report: CheckReport) -> list[str]:
     of_type("report", report, CheckReport, "a CheckReport (of check_pins(..., keep=True))")
     pins = report.pins
     accepted = []
+    if any(c.status == "changed" and c.capture is None for c in report.logs):
+        raise SgtoolError("report: its changed logs kept no replay to pin; check with "
+                          "check_pins(..., keep=True) to update them")
     changed = [c for c in report.logs if c.status == "changed" and c.capture is not None]
     if not changed:
         return []

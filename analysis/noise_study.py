@@ -328,7 +328,7 @@ class StudyConfig:
     def check(self) -> None:
         self.settings.check()
         if not self.houses:
-            raise SgtoolError("no houses: give --houses N or --house FILE")
+            raise SgtoolError("no houses: give --houses N or --house FILE (houses=, house_files=)")
         cl = self.closed_loop
         if cl.planners:
             if cl.episodes < 1:

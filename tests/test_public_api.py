@@ -114,6 +114,14 @@ def test_every_public_name_is_documented() -> None:
     assert not foreign, f"public names defined outside sgtool: {foreign}"
 
 
+def test_help_lists_every_public_name_by_topic() -> None:
+    """help(sgtool)'s topic table names every public name and no other."""
+    import re
+
+    named = set(re.findall(r":(?:func|class):`([A-Za-z_]+)`", sgtool.__doc__ or ""))
+    assert named == set(sgtool.__all__)
+
+
 def test_dir_and_unknown_names() -> None:
     assert set(sgtool.__all__) <= set(dir(sgtool))
     assert "__version__" in dir(sgtool)

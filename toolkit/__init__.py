@@ -30,7 +30,10 @@ houses                 :class:`HouseSpec`, :func:`load_house`, :func:`load_house
 symbolic benchmark     :func:`run_one` (one episode), :class:`SymbolicHouse`,
                        :class:`EpisodeResult`, :class:`BenchConfig`, :func:`run_benchmark`,
                        :class:`BenchResult`, :func:`write_bench_outputs`
-closed loop            :func:`run_closed_loop` (one PyBullet episode into a log),
+closed loop            :func:`record_house` (a scripted tour into a log, with
+                       :class:`RecordOptions`, :class:`CameraConfig`: a
+                       :class:`RecordReport`), :func:`run_closed_loop` (one PyBullet
+                       episode into a log),
                        :class:`ClosedLoopOptions`, :class:`ClosedLoopReport`,
                        :func:`pick_episode`, :class:`NoiseProfile` (sensor faults, from
                        :func:`parse_noise`: ``"strong"``, ``"mild,holes=0.05"``); the

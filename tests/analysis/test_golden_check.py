@@ -480,3 +480,18 @@ def test_a_pinned_option_out_of_range_is_that_case_s_error(pinned, capsys, tmp_p
     else:
         assert code == 2 and err.count("\n") == 1 and str(index) in err, err
         assert "'every' is a string" in err
+
+
+def test_update_pins_needs_a_report_that_kept_its_replays(pinned) -> None:
+    """A report made without keep=True has nothing to pin: one line, not a silent []."""
+    from sgtool.analysis.golden_check import check_pins, update_pins
+    from sgtool.errors import SgtoolError
+    from sgtool.replayers.derived_log import ReplayOptions
+
+    coarse = ReplayOptions(voxel_size=0.08)
+    report = check_pins(pinned, coarse)
+    assert report.exit_code == 1
+    with pytest.raises(SgtoolError, match=r"check_pins\(\.\.\., keep=True\)"):
+        update_pins(report)
+    assert update_pins(check_pins(pinned, coarse, keep=True)) != []
+    assert check_pins(pinned, coarse).exit_code == 0  # accepted
