@@ -182,6 +182,8 @@ def pin_logs(logs: Sequence[str | Path] | str | Path, folder: str | Path,
     other names are kept, the same name is replaced): replay each with ``options``, write
     its graphs and refresh files and the index. ``copy``: copy each log into the folder
     (the pin then refers to the copy)."""
+    if not os.fspath(folder):
+        raise SgtoolError("--dir (folder=) '': an empty path; give a folder")
     root = Path(folder)
     opts = options or ReplayOptions()
     paths = [Path(logs)] if isinstance(logs, (str, os.PathLike)) else [Path(p) for p in logs]

@@ -43,7 +43,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from sgtool.arg_checks import number, whole
+from sgtool.arg_checks import function, number, of_type, whole
 from sgtool.blas import single_blas_thread
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
@@ -295,13 +295,14 @@ def replay(
     ``copy_chunks`` copies the input's chunks into the derived log as they are where that
     gives the same messages in the same order (:func:`_can_copy`), instead of writing them
     message by message (recompressed)."""
+    if options is not None:
+        of_type("options", options, ReplayOptions, "a ReplayOptions")
+    function("on_refresh", on_refresh)
+    function("room_classifier", room_classifier)
+    if output is not None and not os.fspath(output):
+        raise SgtoolError("output: an empty path; give the derived log's name (*.mcap)")
     src = Path(log)
     dst = Path(output) if output is not None else None
-    if options is not None and not isinstance(options, ReplayOptions):
-        raise SgtoolError(f"options: expected a ReplayOptions, got {type(options).__name__}")
-    for name, fn in (("on_refresh", on_refresh), ("room_classifier", room_classifier)):
-        if fn is not None and not callable(fn):
-            raise SgtoolError(f"{name}: a function, got {type(fn).__name__}")
     if dst is not None and dst.suffix != ".mcap":
         raise SgtoolError(f"{output}: the derived log is an MCAP log; name it *.mcap")
     if dst is not None and dst.exists() and src.exists() and dst.resolve() == src.resolve():

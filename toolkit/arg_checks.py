@@ -47,3 +47,11 @@ def of_type(name: str, value: Any, kind: type | tuple[type, ...], what: str) -> 
     if not isinstance(value, kind):
         raise SgtoolError(f"{name}: {what}, got {type(value).__name__}")
     return value
+
+
+def function(name: str, value: Any) -> Any:
+    """``value`` when it is None or callable, else one line: ``{name}: a function, got
+    {type}``."""
+    if value is not None and not callable(value):
+        raise SgtoolError(f"{name}: a function, got {type(value).__name__}")
+    return value

@@ -227,7 +227,10 @@ def _is_own(folder: Path, command: str, known: Sequence[str]) -> bool:
 
 def output_dir(path: str | os.PathLike[str]) -> Path:
     """The folder ``path``, made (with its parents) when missing; a file there, or on the
-    way, or a folder that cannot be made is one :class:`OutputError` line."""
+    way, or a folder that cannot be made is one :class:`OutputError` line (an empty
+    ``path`` too: it is no name for the working folder)."""
+    if not os.fspath(path):
+        raise OutputError("an empty path: give a folder")
     out = Path(path)
     if out.exists() and not out.is_dir():
         raise OutputError(f"cannot write into {path}: it is a file, not a folder")

@@ -42,6 +42,8 @@ def check_output(path: str | os.PathLike[str], *, force: bool = False, option: s
 def check_log_output(path: str | os.PathLike[str], *, force: bool = False,
                      option: str = "-o") -> Path:
     """:func:`check_output` of an MCAP log to write (``*.mcap``)."""
+    if not os.fspath(path):  # ("" would be the working folder)
+        raise SgtoolError(f"{option} '': an empty path; give a file name")
     if Path(path).suffix != ".mcap" and not Path(path).is_dir():
         raise SgtoolError(f"{option} {path}: the output is an MCAP log; name it *.mcap")
     return check_output(path, force=force, option=option)

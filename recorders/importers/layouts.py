@@ -306,11 +306,11 @@ def _read_tum(
         # ground truth at ~100 Hz: interpolate over gaps up to 0.1 s, no extrapolation
         # beyond 10 ms (the motion-capture system loses markers now and then)
         samples = read_tum_trajectory(gt_path)
-        if not samples:
+        if not samples and not keep_unposed:
             raise SgtoolError(f"{gt_path}: holds no poses (TUM lines: time tx ty tz qx qy qz "
                               "qw); give a trajectory, or --estimate-poses")
         track = PoseTrack.from_samples(samples, max_gap_ns=100_000_000,
-                                       tolerance_ns=10_000_000)
+                                       tolerance_ns=10_000_000) if samples else None
     frames = []
     no_rgb = no_pose = 0
     for t, name in depth:

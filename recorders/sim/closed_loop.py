@@ -90,9 +90,10 @@ from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from sgtool.arg_checks import of_type
+from sgtool.arg_checks import function, of_type
 from sgtool.canonical import canonical_float
 from sgtool.datasets.episodes import Episode
+from sgtool.datasets.episodes import list_episodes as list_episodes  # (imported from here)
 from sgtool.datasets.episodes import pick_episode as pick_episode  # (its home before)
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
@@ -447,12 +448,11 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
     ``update(n)`` (a tqdm bar), advanced per frame; ``on_decision`` sees every graph and
     the action chosen on it.
     """
-    require("pybullet", api="sgtool.run_closed_loop")  # one line on a core install
-    planner = held_to_contract(planner)  # a user's planner object: one line for its faults
     of_type("house", house, HouseSpec, "a HouseSpec (sgtool.load_house(path))")
     of_type("episode", episode, Episode, "an Episode (sgtool.pick_episode(house))")
-    if on_decision is not None and not callable(on_decision):
-        raise SgtoolError(f"on_decision: a function, got {type(on_decision).__name__}")
+    function("on_decision", on_decision)
+    require("pybullet", api="sgtool.run_closed_loop")  # one line on a core install
+    planner = held_to_contract(planner)  # a user's planner object: one line for its faults
     opts = options or ClosedLoopOptions()
     recorded = {"planner_options": recorded_options(planner_options)} if planner_options \
         else {}

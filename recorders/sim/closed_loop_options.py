@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, fields
 
+from sgtool.arg_checks import of_type
 from sgtool.errors import SgtoolError
 from sgtool.mapping.bev import BevConfig
 from sgtool.mapping.depth_noise import sensor_max_depth
@@ -80,9 +81,8 @@ class ClosedLoopOptions:
         # a profile by name or text ("strong", "mild,holes=0.05"), as the CLI takes it
         if isinstance(self.noise, str):
             object.__setattr__(self, "noise", parse_noise(self.noise))
-        elif not isinstance(self.noise, NoiseProfile):
-            raise SgtoolError(f"noise: expected a NoiseProfile or a profile's text, got "
-                              f"{type(self.noise).__name__}")
+        else:
+            of_type("noise", self.noise, NoiseProfile, "a NoiseProfile or a profile's text")
 
     def keyframes(self) -> KeyframeRule:
         """Which ticks are frames (a one-line :class:`~sgtool.errors.SgtoolError` when

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from sgtool.arg_checks import of_type, whole
 from sgtool.house.spec import HouseSpec
 from sgtool.log import codec
 from sgtool.log import schemas as S
@@ -226,14 +227,9 @@ class RecordOptions:
             object.__setattr__(self, "noise", parse_noise(self.noise))
         for name, kind in (("noise", NoiseProfile), ("camera", CameraConfig),
                            ("robot", RobotConfig), ("script", ScriptOptions)):
-            if not isinstance(getattr(self, name), kind):
-                raise SgtoolError(f"{name}: expected a {kind.__name__}, got "
-                                  f"{type(getattr(self, name)).__name__}")
+            of_type(name, getattr(self, name), kind, f"a {kind.__name__}")
         for name in ("frames", "every", "seed", "start"):
-            v = getattr(self, name)
-            if not (isinstance(v, int) and not isinstance(v, bool)) and not (
-                    name == "frames" and v is None):
-                raise SgtoolError(f"{name}: expected a whole number, got {v!r}")
+            whole(name, getattr(self, name), optional=name == "frames")
         if isinstance(self.fps, bool) or not isinstance(self.fps, (int, float)) or \
                 not FPS_RANGE[0] <= self.fps <= FPS_RANGE[1]:
             raise SgtoolError(f"fps {self.fps!r} (--fps): must be a number "

@@ -116,6 +116,12 @@ def test_an_empty_path_is_no_working_folder(tmp_path, monkeypatch) -> None:
         sgtool.load_house("")
     with pytest.raises(sgtool.SgtoolError, match="^-o '': an empty path; give a file name$"):
         sgtool.write_rerun(LOG, "")
+    with pytest.raises(sgtool.SgtoolError, match="^output: an empty path; give the derived"):
+        sgtool.replay(LOG, "")
+    with pytest.raises(sgtool.SgtoolError, match=r"^--dir \(folder=\) '': an empty path"):
+        sgtool.pin_logs([LOG], "")
+    with pytest.raises(sgtool.SgtoolError, match="^an empty path: give a folder$"):
+        sgtool.files.output_dir("")
     assert list(tmp_path.iterdir()) == []
 
 

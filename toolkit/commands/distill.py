@@ -75,7 +75,7 @@ def _weights_dir() -> Path:
                                                           path_type=Path),
               default=None, help="Weights to report on [default: the shipped ones].")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+@click.option("--seed", type=click.IntRange(min=0, max=2**62), default=0, show_default=True,
               help="Seed of negative sampling, held-out choice, initialisation, shuffling.")
 @click.option("--holdout", type=FiniteFloatRange(0.0, 0.9), default=0.0, show_default=True,
               help="Share of training query categories held out of training, reported as "

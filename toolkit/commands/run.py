@@ -104,7 +104,8 @@ if TYPE_CHECKING:
               "sets the planner's option, with a note that it is deprecated.")
 @llm_endpoint_options("LLM planners")
 @success_option()
-@click.option("--planner-seed", type=click.IntRange(min=0), default=0, show_default=True,
+@click.option("--planner-seed", type=click.IntRange(min=0, max=2**62), default=0,
+              show_default=True,
               help="Seed of the planner's randomness (the random planner): the episode's "
                    "planner draws from a seed made of it, the house seed and the episode "
                    "index, as in `sgtool bench`.")

@@ -44,7 +44,8 @@ def command() -> None:
 @click.option("--houses", default=5, show_default=True, type=click.IntRange(min=0),
               help="Generated houses (seeds HOUSE_SEED, +1, ...; the houses of `sgtool "
               "record --seed`); 0 with --house studies the given houses only.")
-@click.option("--house-seed", default=0, show_default=True, type=click.IntRange(min=0),
+@click.option("--house-seed", default=0, show_default=True,
+              type=click.IntRange(min=0, max=2**62),
               help="Seed of the first generated house.")
 @click.option("--house", "house_files", multiple=True, metavar="FILE",
               type=PathParam(path_type=str),

@@ -453,6 +453,8 @@ def test_a_trajectory_without_poses_says_so(tmp_path) -> None:
     (root / "groundtruth.txt").write_text("# timestamp tx ty tz qx qy qz qw\n")
     with pytest.raises(SgtoolError, match=r"groundtruth.txt: holds no poses \(TUM lines"):
         read_sequence(root)
+    # poses to be estimated: the frames are kept, as without the file
+    assert len(read_sequence(root, keep_unposed=True).frames) == 3
 
 
 def test_a_problem_of_a_value_given_keeps_it_and_says_so() -> None:
