@@ -13,6 +13,7 @@ from sgtool.commands.options import (
     PLANNER_OPTION_HELP,
     PLANNERS_HELP,
     PLUGIN_HELP,
+    SEED,
     LlmEndpoint,
     PathParam,
     budget_options,
@@ -86,7 +87,7 @@ if TYPE_CHECKING:
                    "objects) and makes about a third of the episodes furniture-level "
                    "(non-interactive) targets; 'default' is the sparse generator of "
                    "`sgtool scenes generate` (random reaches SR ~0.85 there).")
-@click.option("--house-seed", default=0, show_default=True, type=click.IntRange(min=0, max=2**62),
+@click.option("--house-seed", default=0, show_default=True, type=SEED,
               help="Seed of the first house.")
 @click.option("--max-steps", default=50, show_default=True,
               help="High-level actions per episode (SymSearch's N_max).")

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from sgtool.commands.options import FiniteFloatRange, PathParam, llm_endpoint_options
+from sgtool.commands.options import SEED, FiniteFloatRange, PathParam, llm_endpoint_options
 from sgtool.errors import SgtoolError
 
 if TYPE_CHECKING:
@@ -75,7 +75,7 @@ def _weights_dir() -> Path:
                                                           path_type=Path),
               default=None, help="Weights to report on [default: the shipped ones].")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
-@click.option("--seed", type=click.IntRange(min=0, max=2**62), default=0, show_default=True,
+@click.option("--seed", type=SEED, default=0, show_default=True,
               help="Seed of negative sampling, held-out choice, initialisation, shuffling.")
 @click.option("--holdout", type=FiniteFloatRange(0.0, 0.9), default=0.0, show_default=True,
               help="Share of training query categories held out of training, reported as "

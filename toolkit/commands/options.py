@@ -41,6 +41,8 @@ class FiniteFloatRange(click.FloatRange):
 
 
 FINITE_FLOAT = FiniteFloatRange()
+# the type of every seed option: a house seed and its offsets stay within numpy's int64
+SEED = click.IntRange(min=0, max=2**62)
 
 
 class PathParam(click.Path):
@@ -154,7 +156,7 @@ def house_options(seed_help: str, rooms_help: str) -> Callable[[F], F]:
         click.option("--house", "house_path", type=PathParam(dir_okay=False),
                      help="House spec (JSON, see `sgtool scenes`). Default: the demo house "
                      "shipped with sgtool, unless --seed is given."),
-        click.option("--seed", type=click.IntRange(min=0, max=2**62), default=None,
+        click.option("--seed", type=SEED, default=None,
                      help=seed_help),
         click.option("--rooms", default=DEFAULT_ROOMS_TEXT, show_default=True,
                      metavar="MIN-MAX",

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from sgtool.commands.options import FINITE_FLOAT, PathParam, check_log_output, house_options
+from sgtool.commands.options import FINITE_FLOAT, SEED, PathParam, check_log_output, house_options
 from sgtool.errors import SgtoolError
 
 if TYPE_CHECKING:
@@ -50,7 +50,7 @@ def _pair(option: str, text: str) -> tuple[float, float]:
               "at 1 m, grows with z^2), holes (share of depth pixels lost), label_swap, "
               "label_dropout (per visible object and frame), drift_xy (m per m driven), "
               "drift_yaw (rad per m driven and per rad turned).")
-@click.option("--noise-seed", type=click.IntRange(min=0, max=2**62), default=0, show_default=True,
+@click.option("--noise-seed", type=SEED, default=0, show_default=True,
               help="Seed of the sensor faults.")
 @click.option("--resolution", default="320x240", show_default=True,
               help="Camera image size WIDTHxHEIGHT.")

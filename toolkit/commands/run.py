@@ -17,6 +17,7 @@ import click
 from sgtool.commands.options import (
     FINITE_FLOAT,
     PLUGIN_HELP_ONE,
+    SEED,
     LlmEndpoint,
     PathParam,
     check_log_output,
@@ -95,7 +96,7 @@ if TYPE_CHECKING:
               "unknown space (at frontiers).")
 @click.option("--noise", default="none", show_default=True,
               help="Sensor faults, as `sgtool record --noise` (none, mild, strong, overrides).")
-@click.option("--noise-seed", type=click.IntRange(min=0, max=2**62), default=0, show_default=True,
+@click.option("--noise-seed", type=SEED, default=0, show_default=True,
               help="Seed of the sensor faults (--noise).")
 @click.option("-O", "--planner-option", "planner_option", multiple=True,
               metavar="P.KEY=VALUE",
@@ -104,7 +105,7 @@ if TYPE_CHECKING:
               "sets the planner's option, with a note that it is deprecated.")
 @llm_endpoint_options("LLM planners")
 @success_option()
-@click.option("--planner-seed", type=click.IntRange(min=0, max=2**62), default=0,
+@click.option("--planner-seed", type=SEED, default=0,
               show_default=True,
               help="Seed of the planner's randomness (the random planner): the episode's "
                    "planner draws from a seed made of it, the house seed and the episode "

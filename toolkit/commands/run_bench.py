@@ -12,6 +12,7 @@ from sgtool.commands.options import (
     PLANNER_OPTION_HELP,
     PLANNERS_HELP,
     PLUGIN_HELP,
+    SEED,
     LlmEndpoint,
     PathParam,
     budget_options,
@@ -52,7 +53,7 @@ if TYPE_CHECKING:
               help="A house spec JSON file or a folder of them (every *.json there is read as "
               "a house; repeatable), checked first. Generated houses join them only when "
               "--houses N is given.")
-@click.option("--house-seed", default=0, show_default=True, type=click.IntRange(min=0, max=2**62),
+@click.option("--house-seed", default=0, show_default=True, type=SEED,
               help="Seed of the first house.")
 @click.option("--rooms", default="12-16", show_default=True, metavar="MIN-MAX",
               help="Room count range of the generated houses.")
@@ -66,7 +67,7 @@ if TYPE_CHECKING:
               "file, as `sgtool record --noise`); repeatable: every profile is a run, its "
               "logs in logs/NOISE/ (NOISE: the text given, or a file's profile name). "
               "Default: none.")
-@click.option("--noise-seed", type=click.IntRange(min=0, max=2**62), default=0, show_default=True,
+@click.option("--noise-seed", type=SEED, default=0, show_default=True,
               help="Seed of the sensor faults (--noise).")
 @click.option("--max-steps", default=50, show_default=True,
               help="High-level planner steps per episode.")

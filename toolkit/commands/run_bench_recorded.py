@@ -64,8 +64,9 @@ def as_recorded(args: A, path: Path) -> A:
     _check_types(type(args), saved, path)
     ctx = click.get_current_context(silent=True)
     now = {f.name: getattr(args, f.name) for f in fields(args)}  # type: ignore[arg-type]
+    recorded = recorded_options(args).keys()
     changes = {n: tuple(v) if isinstance(now[n], tuple) and isinstance(v, list) else v
-               for n, v in saved.items() if n in recorded_options(args)
+               for n, v in saved.items() if n in recorded
                and (ctx is None or ctx.get_parameter_source(n) is not
                     ParameterSource.COMMANDLINE)}
     return replace(args, **changes)  # type: ignore[type-var]

@@ -10,7 +10,7 @@ from typing import Any
 
 import click
 
-from sgtool.commands.options import FiniteFloatRange, PathParam
+from sgtool.commands.options import SEED, FiniteFloatRange, PathParam
 from sgtool.errors import SgtoolError
 
 
@@ -52,7 +52,7 @@ def command() -> None:
 
 
 @command.command("generate")
-@click.option("--seed", type=click.IntRange(min=0, max=2**62), default=0, show_default=True,
+@click.option("--seed", type=SEED, default=0, show_default=True,
               help="Random seed; the same seed gives the same bytes.")
 @_rooms_option
 @_split_option
@@ -122,7 +122,7 @@ def show_cmd(house: str, output: str | None, dpi: int, no_objects: bool, force: 
 @command.command("stats")
 @click.option("-n", "--houses", type=click.IntRange(min=1, max=1_000_000), default=20,
               show_default=True, help="Number of houses to generate (seeds SEED .. SEED+N-1).")
-@click.option("--seed", type=click.IntRange(min=0, max=2**62), default=0, show_default=True,
+@click.option("--seed", type=SEED, default=0, show_default=True,
               help="First seed.")
 @_rooms_option
 @_split_option
@@ -193,7 +193,7 @@ def _episodes(spec: Any, count: int | None, seed: int, reach: float, preset: str
 @click.argument("house", type=PathParam(dir_okay=False))
 @click.option("-n", "--count", type=click.IntRange(min=1), default=None,
               help="Number of episodes [default: one per object category].")
-@click.option("--seed", type=click.IntRange(min=0, max=2**62), default=None,
+@click.option("--seed", type=SEED, default=None,
               help="Seed of the choice of categories and start poses [default: the house "
               "file's seed, the one `sgtool bench` and `run-bench` draw with].")
 @click.option("--reach", type=FiniteFloatRange(min=0.3, max=100.0), default=1.0,

@@ -14,6 +14,7 @@ import click
 
 from sgtool.commands.options import (
     FINITE_FLOAT,
+    SEED,
     PathParam,
     executor_options,
     parse_resolution,
@@ -45,7 +46,7 @@ def command() -> None:
               help="Generated houses (seeds HOUSE_SEED, +1, ...; the houses of `sgtool "
               "record --seed`); 0 with --house studies the given houses only.")
 @click.option("--house-seed", default=0, show_default=True,
-              type=click.IntRange(min=0, max=2**62),
+              type=SEED,
               help="Seed of the first generated house.")
 @click.option("--house", "house_files", multiple=True, metavar="FILE",
               type=PathParam(path_type=str),
@@ -69,7 +70,7 @@ def command() -> None:
               help="Stop each recording after this many frames. Default: when the scripted "
               "tour has visited every room.")
 @click.option("--noise-seed", default=0, show_default=True,
-              type=click.IntRange(min=0, max=2**62),
+              type=SEED,
               help="Seed of the sensor faults.")
 @click.option("--cache", "cache_dir", default=None, type=PathParam(file_okay=False),
               help="Folder of recorded logs, keyed by house, noise and recording settings: "
