@@ -111,6 +111,7 @@ SMOKE: dict[str, Smoke] = {
         ("--base", "{repo}", "--rounds", "1", "--no-compile", "--", "info", "{log}"),
         marks=("slow",)),
     "benchmarks/viewers.py": Smoke(("--frames", "3", "-r", "1", "--derived", "{log}")),
+    "tools/api_reference.py": Smoke(()),
     "tools/closed_loop_failures.py": Smoke(("{tmp}", "{tmp}")),
     "tools/depth_cuts.py": Smoke(("{log}",)),
     "tools/bench_misses.py": Smoke(("{symbolic}", "--list")),

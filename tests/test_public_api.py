@@ -122,6 +122,20 @@ def test_help_lists_every_public_name_by_topic() -> None:
     assert named == set(sgtool.__all__)
 
 
+def test_docs_api_lists_every_public_name() -> None:
+    """docs/api.md's "Every public name" section is what tools/api_reference.py prints
+    (run it with --write after changing the public names or their first sentences)."""
+    import importlib.util
+
+    tool = Path(__file__).resolve().parents[1] / "tools" / "api_reference.py"
+    spec = importlib.util.spec_from_file_location("api_reference", tool)
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert mod.section() in mod.DOC.read_text(encoding="utf-8")
+    assert sorted(n for _, names in mod.topics() for n in names) == sorted(sgtool.__all__)
+
+
 def test_dir_and_unknown_names() -> None:
     assert set(sgtool.__all__) <= set(dir(sgtool))
     assert "__version__" in dir(sgtool)
