@@ -386,8 +386,21 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
                       "were discarded")
         shutil.rmtree(stage, ignore_errors=True)
         _remove_empty(made)  # the folders made for the target, when still empty
+        _name_target(e, stage, path)
         raise
     shutil.rmtree(stage, ignore_errors=True)  # emptied by the moves, or moved in whole
+
+
+def _name_target(e: BaseException, stage: Path, target: Path) -> None:
+    """A failure to write into the hidden ``stage`` names the file in ``target`` instead
+    (the stage is gone, and the user never gave its name); a full disk met by a buffered
+    write, which names no file, names ``target``."""
+    if isinstance(e, SgtoolError) and len(e.args) == 1 and str(stage) in str(e.args[0]):
+        e.args = (str(e.args[0]).replace(str(stage), str(target)),)
+    elif isinstance(e, OSError) and e.filename is not None and str(stage) in str(e.filename):
+        e.filename = str(e.filename).replace(str(stage), str(target))
+    elif isinstance(e, OSError) and e.filename is None and e.errno in FULL_ERRNOS:
+        e.filename = str(target)  # a buffered write: the disk the outputs went to
 
 
 def _make_folders(folder: Path) -> list[Path]:

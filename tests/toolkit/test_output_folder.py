@@ -278,3 +278,25 @@ def test_an_input_folder_that_is_the_output_folder_is_refused(tmp_path: Path) ->
     refuse_input_folder(run / "out", [run])  # outputs in a folder under the inputs: fine
     with pytest.raises(SgtoolError, match="is the input folder"):
         refuse_input_folder(tmp_path / "run" / ".." / "run", [run])
+
+
+def test_a_write_error_in_the_staging_folder_names_the_target(tmp_path: Path) -> None:
+    """The hidden staging folder is gone when the error is shown; the message names the
+    file as the user will look for it."""
+    import errno
+
+    from sgtool.files import output_error
+
+    out = tmp_path / "run"
+    with pytest.raises(OutputError) as e, output_folder(out, force=False) as stage:
+        raise output_error(OSError(errno.ENOSPC, "No space left on device"),
+                           stage / "summary.md")
+    assert str(e.value) == (f"cannot write {out}/summary.md: No space left on device "
+                            "(nothing was written)")
+    with pytest.raises(OSError) as raw, output_folder(out, force=False) as stage:
+        raise OSError(errno.EIO, "Input/output error", str(stage / "a.png"))
+    assert raw.value.filename == str(out / "a.png")
+    with pytest.raises(OSError) as full, output_folder(out, force=False):
+        raise OSError(errno.ENOSPC, "No space left on device")  # a buffered write's
+    assert full.value.filename == str(out)
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
