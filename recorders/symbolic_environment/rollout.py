@@ -161,8 +161,9 @@ def run_one(house: HouseSpec | SymbolicHouse | str | os.PathLike[str], planner: 
     nearest to it. Raises :class:`RunOneError` for a query with no instance in the house,
     a start that is not in it, or ``max_steps`` below 1; a planner object is held to the
     contract a plug-in is (:class:`~sgtool.planning.timing.TimedPlanner`: what its methods
-    raise, an action with no skill or a target that is no node id, is one
-    :class:`~sgtool.planning.timing.PlannerContractError` naming it).
+    raise, an action with no skill or a target that is not text, is one
+    :class:`~sgtool.planning.timing.PlannerContractError` naming it; a text target that
+    names no node of the graph is an invalid action and spends a step, as in the bench).
     """
     from sgtool.planning.plugins import held_to_contract
     from sgtool.planning.registry import make_planner
