@@ -45,7 +45,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sgtool.errors import STOP_SIGNALS, SgtoolError, Terminated, raise_terminated
+from sgtool.errors import (
+    STOP_SIGNALS,
+    SgtoolError,
+    Terminated,
+    raise_terminated,
+    set_stop_handlers,
+)
 from sgtool.extras import missing_message
 
 EXECUTORS: tuple[str, ...] = ("local", "ray")
@@ -265,9 +271,7 @@ def _worker_setup() -> None:
     other workers mid-cleanup). SIGINT is ignored: the driver decides (module doc), so a
     task's clean-up is never cut short by a second signal."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    for sig in STOP_SIGNALS:  # a closed terminal reaches the workers too (unless nohup)
-        if signal.getsignal(sig) is not signal.SIG_IGN:
-            signal.signal(sig, _worker_sigterm)
+    set_stop_handlers(_worker_sigterm)  # a closed terminal reaches the workers too
 
 
 def _worker_sigterm(signum: int, frame: object) -> None:

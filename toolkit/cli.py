@@ -25,10 +25,10 @@ import click
 
 from sgtool.commands.options import COMMAND_ARGS
 from sgtool.errors import (
-    STOP_SIGNALS,
     SgtoolError,
     forget_stop_signals,
     raise_terminated,
+    set_stop_handlers,
     stop_exit_code,
 )
 from sgtool.extras import missing_extra
@@ -263,9 +263,7 @@ def _terminate_as_interrupt() -> None:
     mid-write."""
     forget_stop_signals()
     try:
-        for sig in STOP_SIGNALS:
-            if signal.getsignal(sig) is not signal.SIG_IGN:  # `nohup sgtool ...` stays so
-                signal.signal(sig, raise_terminated)
+        set_stop_handlers(raise_terminated)
     except ValueError:  # not the main thread (sgtool called from a thread of another tool)
         pass
 
@@ -276,9 +274,7 @@ def _finished() -> None:
     complete run into a killed one, nor print a traceback."""
     try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
-        for sig in STOP_SIGNALS:
-            if signal.getsignal(sig) is not signal.SIG_IGN:
-                signal.signal(sig, signal.SIG_DFL)
+        set_stop_handlers(signal.SIG_DFL)
     except ValueError:  # not the main thread
         pass
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import signal
+from typing import Any
 
 
 class SgtoolError(Exception):
@@ -43,6 +44,15 @@ def raise_terminated(signum: int, frame: object) -> None:
     """A SIGTERM (SIGHUP) handler: raise :class:`Terminated` in the main thread."""
     _received.append(int(signum))
     raise Terminated
+
+
+def set_stop_handlers(handler: Any) -> None:
+    """Every stop signal to ``handler`` (a function, ``signal.SIG_DFL``), but for one that
+    is ignored (``nohup sgtool ...``: a hang-up must not stop it). Main thread only
+    (``ValueError`` elsewhere, as :func:`signal.signal`)."""
+    for sig in STOP_SIGNALS:
+        if signal.getsignal(sig) is not signal.SIG_IGN:
+            signal.signal(sig, handler)
 
 
 def forget_stop_signals() -> None:
