@@ -15,16 +15,19 @@ and a live view of a replay's refreshes.
 :class:`LiveReplay` logs each refresh of a replay (occupancy, Voronoi graph, rooms, the
 scene graph as points and as a graph view, the robot's position), each decision of a
 closed-loop run (the graph, the robot, the action) or each frame of a recording (camera
-images, robot, path), on the ``frame`` (refresh, decision or frame count) and ``sim_time``
-timelines, with the default blueprint of
-:mod:`sgtool.analysis.rerun_view`.
+images, robot, path), on the ``frame`` and ``sim_time`` timelines, with the default
+blueprint of :mod:`sgtool.analysis.rerun_view`. A replay of a log is shown on the
+timelines ``sgtool view`` gives that log (it shares their recording id): ``frame`` the
+index of the last camera frame a refresh integrated, ``sim_time`` log time since the
+log's first message. A recording's frames carry their own index and time; a closed-loop
+run's decisions are counted on ``frame``.
 """
 
 from __future__ import annotations
 
 import os
 import shutil
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -35,7 +38,9 @@ from sgtool.analysis.rerun_view import (
     _log_scene_graph,
     _scene_update_strips,
     blueprint,
+    frame_at,
     log_camera,
+    log_labels,
     new_stream,
 )
 from sgtool.errors import SgtoolError
@@ -44,6 +49,17 @@ GRPC_PORT = 9876
 WEB_PORT = 9090
 DEFAULT_CONNECT = f"rerun+http://127.0.0.1:{GRPC_PORT}/proxy"
 FLUSH_S = 30.0  # the longest a finished command waits for its stream to reach the viewer
+
+
+def log_clock(log: Any) -> tuple[list[int], int]:
+    """(camera frame times, first message's time) of the log at ``log``: what puts a live
+    replay's refreshes on the timelines ``sgtool view`` gives that log."""
+    from sgtool.log import LogReader
+    from sgtool.log import schemas as S
+
+    with LogReader(log) as r:
+        tr = r.time_range()
+        return (r.frame_times() if r.has(S.DEPTH) else []), (tr[0] if tr else 0)
 
 
 @dataclass(frozen=True)
@@ -149,13 +165,21 @@ class LiveReplay:
     """Logs a replay's refreshes to a live recording (module doc): pass :meth:`refresh`
     (or :meth:`chain`) as ``replay``'s ``on_refresh``, then call :meth:`finish`."""
 
-    def __init__(self, rec: Any, target: LiveTarget | None = None) -> None:
+    def __init__(self, rec: Any, target: LiveTarget | None = None,
+                 frame_times: Sequence[int] = (), start_ns: int = 0) -> None:
+        """``frame_times`` and ``start_ns``: the camera frames' times and the first
+        message's time of the log being replayed (none: refreshes are counted on
+        ``frame`` and ``sim_time`` is their time)."""
         import rerun as rr
 
         self.rec = rec
         self.target = target
+        self.frame_times = list(frame_times)
+        self.start_ns = int(start_ns)
         self.refreshes = 0
         self.path = RobotPath()
+        self._instances: Any = None  # the instance table the segmentation is labelled by
+        self._dense: np.ndarray | None = None
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
 
     @classmethod
@@ -171,10 +195,11 @@ class LiveReplay:
         target = parse_target(text)
         rid = (recording_id(Path(source)) if Path(str(source)).is_file()
                else hashlib.sha256(str(source).encode()).hexdigest()[:32])
+        clock = log_clock(Path(source)) if Path(str(source)).is_file() else ([], 0)
         rec, where = open_stream(target, rid)
         if where is not None:
             echo(f"rerun: web viewer at {where} (gRPC port {target.grpc_port})")
-        return cls(rec, target)
+        return cls(rec, target, *clock)
 
     def chain(self, other: Callable[[Any, Any], None] | None) -> Callable[[Any, Any], None]:
         """An ``on_refresh`` that logs the refresh and then calls ``other`` (if any)."""
@@ -214,8 +239,11 @@ class LiveReplay:
         )
 
         rec = self.rec
-        rr.set_time("frame", sequence=self.refreshes, recording=rec)
-        rr.set_time("sim_time", duration=np.timedelta64(int(ref.time_ns), "ns"), recording=rec)
+        frame = frame_at(self.frame_times, int(ref.time_ns))
+        rr.set_time("frame", sequence=self.refreshes if frame is None else frame,
+                    recording=rec)
+        rr.set_time("sim_time", duration=np.timedelta64(int(ref.time_ns) - self.start_ns, "ns"),
+                    recording=rec)
         self.refreshes += 1
         grid = occupancy_message(ref)
         if grid is not None:
@@ -237,15 +265,21 @@ class LiveReplay:
         _log_scene_graph(rec, g)
         self._robot(g)
 
-    def frame(self, fr: Any) -> None:
+    def frame(self, fr: Any, instances: Any = None) -> None:
         """A recorded frame: the camera (pose, pinhole, RGB, depth, segmentation) and the
-        robot with its path, at the frame's index and time."""
+        robot with its path, at the frame's index and time. ``instances``: the instance
+        table in force (an ``sgtool.Instances``), whose categories label the segmentation
+        when it changes."""
         import rerun as rr
 
+        if instances is not None and instances is not self._instances:
+            self._instances = instances
+            self._dense = log_labels(self.rec, {int(i.id): i.category
+                                                for i in instances.instances})
         rr.set_time("frame", sequence=int(fr.index), recording=self.rec)
         rr.set_time("sim_time", duration=np.timedelta64(int(fr.time_ns), "ns"),
                     recording=self.rec)
-        log_camera(self.rec, fr)
+        log_camera(self.rec, fr, self._dense)
         self.path.log(self.rec, self.path.add(fr))
 
     def observer(self) -> Any:
@@ -265,7 +299,7 @@ class LiveReplay:
                 fr = rec.last_frame if rec is not None else None
                 if fr is not None and fr is not self.last:
                     self.last = fr
-                    live.frame(fr)
+                    live.frame(fr, rec.last_instances if rec is not None else None)
 
         return Frames()
 

@@ -46,11 +46,12 @@ destination itself and stops with an :class:`~sgtool.files.OutputError` when les
 
 from __future__ import annotations
 
+import bisect
 import contextlib
 import errno
 import hashlib
 import os
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -114,6 +115,15 @@ def recording_id(log_path: Path) -> str:
             return hashlib.file_digest(fh, "sha256").hexdigest()[:32]
     except OSError:
         return hashlib.sha256(str(log_path).encode()).hexdigest()[:32]  # the reader says why
+
+
+def frame_at(frame_times: Sequence[int], t_ns: int) -> int | None:
+    """The ``frame`` a layer logged at ``t_ns`` is shown at: the index of the last camera
+    frame at or before it (the first frame for an earlier time); None for a log without
+    frames (``frame_times`` empty)."""
+    if not frame_times:
+        return None
+    return max(bisect.bisect_right(frame_times, t_ns) - 1, 0)
 
 
 def _time(rec: Any, frame: int | None, t_ns: int) -> None:
@@ -238,6 +248,21 @@ def class_ids(instance_ids: Iterable[int]) -> np.ndarray | None:
     return None if ids.size == 0 or int(ids.max()) <= 65535 else ids
 
 
+def log_labels(rec: Any, labels: Mapping[int, str]) -> np.ndarray | None:
+    """The segmentation images' labels (instance id -> category) as the camera's static
+    annotation context, "category #id" in the id's colour; returns the class ids of
+    :func:`class_ids` that :func:`segmentation` takes."""
+    import rerun as rr
+
+    dense = class_ids(labels)
+    ctx = [(0, "none", (0, 0, 0))] + [
+        (iid if dense is None else k + 1, f"{cat} #{iid}", color_for(iid))
+        for k, (iid, cat) in enumerate(sorted(labels.items()))
+    ]
+    rec.log("world/camera/image", rr.AnnotationContext(ctx), static=True)
+    return dense
+
+
 def segmentation(ids: np.ndarray, dense: np.ndarray | None) -> np.ndarray:
     """A frame's instance ids as class ids (:func:`class_ids`); an id without a class is
     0 (none)."""
@@ -336,16 +361,8 @@ def _export(
 
     rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
     instances = r.last_record("instances")
-    labels: dict[int, str] = {}
-    dense = None
-    if instances:
-        labels = {int(i["id"]): i["category"] for i in instances["instances"]}
-        dense = class_ids(labels)
-        ctx = [(0, "none", (0, 0, 0))] + [
-            (iid if dense is None else k + 1, f"{cat} #{iid}", color_for(iid))
-            for k, (iid, cat) in enumerate(sorted(labels.items()))
-        ]
-        rec.log("world/camera/image", rr.AnnotationContext(ctx), static=True)
+    dense = log_labels(rec, {int(i["id"]): i["category"] for i in instances["instances"]}
+                       ) if instances else None
     # camera frames
     path = RobotPath()
     unposed = framed = 0  # frames whose camera pose /tf does not give (a missing link, a cycle)
@@ -382,11 +399,7 @@ def _export(
            else None)
 
     def frame_of(t: int) -> int | None:
-        import bisect
-
-        if not frame_times:
-            return None
-        return max(bisect.bisect_right(frame_times, t) - 1, 0)
+        return frame_at(frame_times, t)
 
     # derived layers
     if r.has(S.OCCUPANCY):

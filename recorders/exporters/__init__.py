@@ -6,5 +6,5 @@
   graph, rooms, objects, scene graph) as ``nav_msgs``, ``visualization_msgs`` and
   ``std_msgs`` messages;
 - :mod:`sgtool.recorders.exporters.bag_export`: ``sgtool export bag``, a derived log as a bag
-  that ROS tools (RViz, rosbag, Rerun's ROS importers) understand.
+  that ROS tools (RViz, rosbag) understand.
 """

@@ -1,6 +1,7 @@
 """``sgtool export bag``: an sgtool log (typically a derived log of ``sgtool replay``) as a
 ROS 1 ``.bag`` or a ROS 2 bag folder (MCAP storage), written with ``rosbags`` so that RViz,
-``ros2 bag``, ``image_proc``, Foxglove and Rerun's ROS importers use it.
+``ros2 bag``, ``image_proc`` and Foxglove use it (Rerun's ROS importer reads its maps,
+images and /tf, not its markers).
 
 Topics (sgtool topic -> ROS topic, type):
 
@@ -16,10 +17,11 @@ Topics (sgtool topic -> ROS topic, type):
   image stamp without a sample of its own, so that ``tf2`` (which neither extrapolates
   nor keeps samples older than its cache) resolves every image's frame; a link only ever
   on ``/tf`` is written as logged;
-- ``/map/occupancy`` -> ``nav_msgs/OccupancyGrid``; ``/map/voronoi``, ``/map/rooms`` ->
-  ``visualization_msgs/MarkerArray``; ``/sgtool/scene_graph`` -> ``std_msgs/String`` (its
-  JSON) and ``/map/objects`` (``MarkerArray`` of the graph's objects). These, and
-  ``/tf_static``, are latched: transient-local QoS in ROS 2, latching in ROS 1.
+- ``/map/occupancy`` -> ``nav_msgs/OccupancyGrid``; ``/map/voronoi``, ``/map/rooms`` and
+  ``/map/graph`` (objects, doors, frontiers, edges) -> ``visualization_msgs/MarkerArray``;
+  ``/sgtool/scene_graph`` -> ``std_msgs/String`` (its JSON) and ``/map/objects``
+  (``MarkerArray`` of the graph's objects). These, and ``/tf_static``, are latched:
+  transient-local QoS in ROS 2, latching in ROS 1.
 
 Time base: a message's bag time and header stamp are its log time plus ``time_base_s``
 seconds, so no message falls on stamp 0 (ROS 1's ``rosbag play`` starts at ``TIME_MIN``
@@ -89,6 +91,7 @@ OUTPUTS: dict[str, tuple[str, str, bool]] = {
     S.OCCUPANCY: (S.OCCUPANCY, "nav_msgs/msg/OccupancyGrid", True),
     S.VORONOI: (S.VORONOI, MARKERS, True),
     S.ROOMS: (S.ROOMS, MARKERS, True),
+    S.GRAPH_SCENE: (S.GRAPH_SCENE, MARKERS, True),
     GRAPH_TOPIC: (GRAPH_TOPIC, STRING, True),
     OBJECTS_TOPIC: (GRAPH_TOPIC, MARKERS, True),
 }
@@ -124,6 +127,9 @@ class ExportReport:
                f"stamps = log time + {self.time_base_s:g} s"]
         w = max((len(t) for t, _, _ in self.counts), default=5)
         out.extend(f"  {t:<{w}}  {ty}  {n}" for t, ty, n in self.counts)
+        if not total:
+            out.append("note: the log holds nothing for the topics chosen (/tf_static holds "
+                       "only the links that never move)")
         if self.others:
             out.append(f"note: not exported, channels sgtool does not know: "
                        f"{', '.join(self.others)}")
@@ -218,7 +224,7 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
         derived = r.has(GRAPH_TOPIC) or r.has(S.OCCUPANCY)
         records = {k.topic for k in S.RECORDS.values()}
         others = tuple(sorted(t for t in r.topics() if t not in OUTPUTS_ORDER
-                              and t not in records and t != S.GRAPH_SCENE))
+                              and t not in records))
         names = dict(frames) if frames is not None else trajectory_frames(
             r.metadata.get(S.IMPORT_METADATA_NAME, {}), REP105)
 
@@ -384,7 +390,7 @@ def _write(r: LogReader, w: BagWriter, chosen: list[str], base_ns: int,
 
 
 OUTPUTS_ORDER = (S.CALIBRATION, S.TF, TF_STATIC, *IMAGE_TOPICS, S.OCCUPANCY, S.VORONOI,
-                 S.ROOMS, GRAPH_TOPIC)
+                 S.ROOMS, S.GRAPH_SCENE, GRAPH_TOPIC)
 
 
 def _converters(w: BagWriter) -> dict[str, list[tuple[str, Callable[[int, Any], Any]]]]:
@@ -393,6 +399,7 @@ def _converters(w: BagWriter) -> dict[str, list[tuple[str, Callable[[int, Any], 
         S.OCCUPANCY: [(S.OCCUPANCY, lambda t, m: ros_maps.occupancy_grid(w, t, m))],
         S.VORONOI: [(S.VORONOI, lambda t, m: ros_maps.marker_array(w, t, m))],
         S.ROOMS: [(S.ROOMS, lambda t, m: ros_maps.marker_array(w, t, m))],
+        S.GRAPH_SCENE: [(S.GRAPH_SCENE, lambda t, m: ros_maps.marker_array(w, t, m))],
         GRAPH_TOPIC: [(GRAPH_TOPIC, lambda t, m: ros_maps.graph_string(w, m)),
                       (OBJECTS_TOPIC, lambda t, m: ros_maps.object_markers(w, t, m))],
     }

@@ -3,10 +3,12 @@
 
 - occupancy (Foxglove ``Grid``, int8 -1/0/100, rows along +y) -> ``nav_msgs/OccupancyGrid``
   with the same cells, origin and resolution (the ROS convention is the same);
-- Voronoi graph and rooms (Foxglove ``SceneUpdate``) -> ``visualization_msgs/MarkerArray``:
-  a ``DELETEALL`` marker when the update deletes everything, then per entity its lines
-  (``LINE_LIST``; ``LINE_LOOP`` as a closed ``LINE_STRIP``), its spheres as one
-  ``SPHERE_LIST`` and its texts as ``TEXT_VIEW_FACING``; colours per vertex kept;
+- Voronoi graph, rooms and the scene graph's scene (Foxglove ``SceneUpdate``: objects,
+  doors, frontiers, edges) -> ``visualization_msgs/MarkerArray``: a ``DELETEALL`` marker
+  when the update deletes everything, then per entity its lines (``LINE_LIST``;
+  ``LINE_LOOP`` as a closed ``LINE_STRIP``), its spheres as one ``SPHERE_LIST``, each cube
+  as a ``CUBE`` and each cylinder as a ``CYLINDER`` (pose and size kept), and its texts as
+  ``TEXT_VIEW_FACING``; colours per vertex kept;
 - objects of the scene graph -> ``MarkerArray`` of a sphere and a label per object,
   coloured by room as ``sgtool view`` does;
 - the scene graph record -> ``std_msgs/String`` holding its canonical JSON.
@@ -27,7 +29,7 @@ from sgtool.recorders.exporters.bagwriter import BagWriter
 
 MARKER = "visualization_msgs/msg/Marker"
 # visualization_msgs/Marker types and actions
-LINE_STRIP, LINE_LIST, SPHERE_LIST, SPHERE, TEXT = 4, 5, 7, 2, 9
+LINE_STRIP, LINE_LIST, SPHERE_LIST, SPHERE, TEXT, CUBE, CYLINDER = 4, 5, 7, 2, 9, 1, 3
 DELETEALL = 3
 TEXT_HEIGHT = 0.3  # m: Foxglove texts are sized in pixels; RViz's in metres
 OBJECT_SIZE = 0.15  # m
@@ -51,6 +53,16 @@ def _colour(w: BagWriter, c: Any) -> Any:
 def _rgba(w: BagWriter, rgb: tuple[int, int, int], a: float = 1.0) -> Any:
     return w.make("std_msgs/msg/ColorRGBA", r=rgb[0] / 255.0, g=rgb[1] / 255.0,
                   b=rgb[2] / 255.0, a=a)
+
+
+def _solid_pose(w: BagWriter, pose: Any) -> Any:
+    """A Foxglove ``Pose`` (position and orientation) as ``geometry_msgs/Pose``; an unset
+    orientation (all zero) is the identity."""
+    g, q = "geometry_msgs/msg/", pose.orientation
+    quat = (q.x, q.y, q.z, q.w) if (q.x, q.y, q.z, q.w) != (0, 0, 0, 0) else (0, 0, 0, 1)
+    return w.make(g + "Pose", position=_point(w, pose.position),
+                  orientation=w.make(g + "Quaternion", x=float(quat[0]), y=float(quat[1]),
+                                     z=float(quat[2]), w=float(quat[3])))
 
 
 def _point(w: BagWriter, p: Any) -> Any:
@@ -99,6 +111,14 @@ def marker_array(w: BagWriter, t_ns: int, update: Any) -> Any:
                 points=[_point(w, s.pose.position) for s in ent.spheres],
                 colors=[_colour(w, s.color) for s in ent.spheres], color=_colour(w, s0.color),
                 scale=w.make(g, x=float(s0.size.x), y=float(s0.size.y), z=float(s0.size.z))))
+        for kind, solids in ((CUBE, ent.cubes), (CYLINDER, ent.cylinders)):
+            for solid in solids:
+                markers.append(_marker(w, t_ns, frame, ns, len(markers), type=kind,
+                                       pose=_solid_pose(w, solid.pose),
+                                       color=_colour(w, solid.color),
+                                       scale=w.make(g, x=float(solid.size.x),
+                                                    y=float(solid.size.y),
+                                                    z=float(solid.size.z))))
         for text in ent.texts:
             p = text.pose.position
             markers.append(_marker(w, t_ns, frame, ns, len(markers), type=TEXT,

@@ -131,7 +131,8 @@ def test_live_replay_logs_refreshes_and_decisions_in_strict_mode():
 
 def test_live_frames_of_a_recording_in_strict_mode(tmp_path):
     """record --rerun: the observer shows every frame the recorder wrote, once, with valid
-    archetypes (strict mode), into a memory recording."""
+    archetypes (strict mode), and labels the segmentation by the instance table (the
+    camera's annotation context, as `sgtool view` gives it)."""
     import rerun as rr
     from support.small_house import small_house
 
@@ -142,21 +143,30 @@ def test_live_frames_of_a_recording_in_strict_mode(tmp_path):
     rr.set_strict_mode(True)
     try:
         rec = rr.RecordingStream("test")
-        rec.memory_recording()
+        rec.save(str(tmp_path / "live.rrd"))
         live = LiveReplay(rec)
         frame = live.frame
 
-        def count(fr):
+        def count(fr, instances=None):
             shown.append(fr.index)
-            frame(fr)
+            assert instances is not None and len(instances.instances) > 0
+            frame(fr, instances)
 
         live.frame = count  # type: ignore[method-assign]
         rep = record_house(small_house(), tmp_path / "rec.mcap", RecordOptions(
             camera=CameraConfig(width=80, height=60), frames=12), observers=[live.observer()])
+        live.close()
+        rec.disconnect()
     finally:
         rr.set_strict_mode(False)
     assert len(shown) == rep.frames == 12 and shown == sorted(set(shown))
     assert len(live.path.points) == 12
+    import rerun.chunk as chunk
+
+    labelled = [ch for ch in chunk.RrdReader(tmp_path / "live.rrd").stream()
+                if ch.is_static and ch.entity_path == "/world/camera/image"
+                and any("AnnotationContext" in str(c) for c in ch.to_record_batch().schema.names)]
+    assert labelled
 
 
 def test_a_stream_that_cannot_finish_is_one_line():
@@ -180,3 +190,42 @@ def test_a_stream_that_cannot_finish_is_one_line():
     assert Stuck.waited == FLUSH_S
     assert str(e.value) == ("--rerun: the stream to rerun+http://10.0.0.9:9876/proxy did not "
                             f"finish within {FLUSH_S:g} s or lost its viewer (flush timed out)")
+
+
+def _times(rrd: Path, entity: str) -> list[tuple[int, int]]:
+    """(frame, sim_time in ns) of every row of ``entity`` in an .rrd file."""
+    import rerun.chunk as chunk
+
+    got = []
+    for ch in chunk.RrdReader(rrd).stream():
+        if ch.is_static or ch.entity_path != entity:
+            continue
+        batch = ch.to_record_batch()
+        frames = batch.column("frame").to_pylist()
+        times = batch.column("sim_time").cast("int64").to_pylist()  # ns
+        got += list(zip(frames, times, strict=True))
+    return sorted(got)
+
+
+def test_a_live_replay_shares_the_timelines_of_view(tmp_path):
+    """replay --rerun shares the recording id of `sgtool view` of the same log, so its
+    refreshes sit at the frame and time `view` shows them at: the maps of both on the same
+    (frame, sim_time) pairs, not one on refresh counts or absolute time."""
+    from sgtool.analysis.rerun_live import LiveReplay, log_clock
+    from sgtool.analysis.rerun_view import new_stream, recording_id
+    from sgtool.analysis.view_run import write_rerun
+    from sgtool.replayers.derived_log import ReplayOptions, replay
+
+    log = GOLDEN / "house10-start.mcap"
+    derived = tmp_path / "derived.mcap"
+    replay(log, derived, ReplayOptions(max_frames=30))
+    write_rerun(derived, tmp_path / "view.rrd", voxels=False)
+    rec = new_stream(recording_id(log))
+    rec.save(str(tmp_path / "live.rrd"))
+    live = LiveReplay(rec, None, *log_clock(log))
+    replay(log, None, ReplayOptions(max_frames=30), on_refresh=live.refresh)
+    live.close()
+    rec.disconnect()
+    view = _times(tmp_path / "view.rrd", "/world/map/occupancy")
+    assert len(view) >= 3 and view[0][0] > 0
+    assert _times(tmp_path / "live.rrd", "/world/map/occupancy") == view

@@ -101,9 +101,10 @@ def _frames(style: str, pairs: tuple[str, ...], log: str) -> dict[str, str]:
 def bag(log: str, output: str, fmt: str | None, distro: str, time_base: float | None,
         frame_style: str, frame_pairs: tuple[str, ...], compression: str | None,
         topics: str | None, progress: bool, force: bool) -> None:
-    """Write LOG (a derived log of `sgtool replay`, or any sgtool log) as a ROS bag that
-    RViz, `ros2 bag`, image_proc, Foxglove and Rerun's ROS importers understand: the
-    occupancy as nav_msgs/OccupancyGrid, the Voronoi graph, rooms and objects as
+    """Write LOG (a derived log of `sgtool replay`, or any sgtool log) as a ROS bag for
+    RViz, `ros2 bag`, image_proc and Foxglove (Rerun's ROS importer reads its maps, images
+    and /tf, not its markers): the occupancy as nav_msgs/OccupancyGrid, the Voronoi graph,
+    rooms, scene graph (objects, doors, frontiers, edges) and objects as
     visualization_msgs/MarkerArray, the scene graph as std_msgs/String JSON, the camera
     images each with a CameraInfo of the same stamp, /tf and a latched /tf_static for the
     fixed transforms. Maps and /tf_static are latched (transient-local QoS in ROS 2).

@@ -30,7 +30,16 @@ from sgtool.errors import SgtoolError
 from sgtool.log import LogReader, LogWriter, codec
 from sgtool.log import schemas as S
 from sgtool.recorders.exporters.bag_export import REP105, export_bag, trajectory_frames
-from sgtool.recorders.exporters.ros_maps import DELETEALL, LINE_LIST, LINE_STRIP, TEXT
+from sgtool.recorders.exporters.ros_maps import (
+    CUBE,
+    CYLINDER,
+    DELETEALL,
+    LINE_LIST,
+    LINE_STRIP,
+    SPHERE_LIST,
+    TEXT,
+)
+from sgtool.scenegraph.graph_scene import DOOR_SIZE, graph_scene_update
 
 GOLDEN = Path(__file__).resolve().parents[2] / "golden" / "house6-tour.mcap"
 
@@ -58,11 +67,18 @@ def log_with_rooms(path: Path, n: int = 4) -> Path:
         ent.texts.append(TextPrimitive(text="room:1 kitchen", color=Color(a=1)))
         w.write_proto(S.ROOMS, t, SceneUpdate(deletions=[SceneEntityDeletion(
             type=SceneEntityDeletion.ALL)], entities=[ent]))
-        w.write_record("scene_graph", t, {"version": "1.0", "rooms": [], "objects": [
+        graph = {"version": "1.0", "rooms": [{"id": "room:1", "position": [1.0, 1.0]}],
+                 "objects": [
             {"id": "obj:3", "category": "cabinet", "parent": "region:0", "room": "room:1",
              "position": [1.0, 2.0, 0.5]},
             {"id": "obj:4", "category": "apple", "parent": "obj:3", "room": "room:1",
-             "position": [1.1, 2.0, 0.9]}]})
+             "position": [1.1, 2.0, 0.9]}],
+                 "doors": [{"id": "door:1", "position": [2.0, 0.5], "state": "closed",
+                            "rooms": ["room:1"]}],
+                 "regions": [{"id": "frontier:0", "kind": "frontier", "room": "room:1",
+                              "frontier_type": "leading out", "position": [3.0, 3.0]}]}
+        w.write_record("scene_graph", t, graph)
+        w.write_proto(S.GRAPH_SCENE, t, graph_scene_update(t, graph))
     return path
 
 
@@ -70,7 +86,7 @@ ALL_TOPICS = {
     "/camera/depth/image_raw", "/camera/rgb/image_raw", "/camera/instances/image_raw",
     "/camera/depth/camera_info", "/camera/rgb/camera_info", "/camera/instances/camera_info",
     "/tf", "/tf_static", "/map/occupancy", "/map/voronoi", "/map/rooms", "/map/objects",
-    "/sgtool/scene_graph"}
+    "/map/graph", "/sgtool/scene_graph"}
 
 
 @pytest.mark.parametrize("fmt", ["ros1", "ros2"])
@@ -129,6 +145,17 @@ def test_every_channel_round_trips_through_rosbags(tmp_path, fmt):
     assert labels == ["obj:3 cabinet", "obj:4 apple"]
     _, graph = got["/sgtool/scene_graph"][0]
     assert json.loads(graph.data)["objects"][1]["category"] == "apple"
+    # /map/graph: a cube per object, a cylinder per door, the frontier, the edges
+    _, scene = got["/map/graph"][0]
+    shapes = [(m.ns, m.type) for m in scene.markers if m.type != TEXT and m.action != DELETEALL]
+    assert shapes == [("obj:3", CUBE), ("obj:4", CUBE), ("door:1", CYLINDER),
+                      ("frontier:0", SPHERE_LIST), ("edges", LINE_LIST)]
+    door = next(m for m in scene.markers if m.type == CYLINDER)
+    assert (door.pose.position.x, door.pose.position.y, door.pose.orientation.w) == (2, 0.5, 1)
+    assert (door.scale.x, door.scale.y, door.scale.z) == DOOR_SIZE
+    edges = next(m for m in scene.markers if m.ns == "edges").points
+    assert len(edges) == 2 * 3  # obj:4 - obj:3, frontier - room, door - room
+    assert "door:1 closed" in [m.text for m in scene.markers if m.type == TEXT]
 
 
 def test_ros2_metadata_qos_distro_and_compression(tmp_path):
