@@ -9,13 +9,22 @@ runs with one BLAS thread, limited by ``threadpoolctl`` (a dependency).
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Iterator
+from collections.abc import Callable
+
+from sgtool.heap import ProcessWide
 
 
-@contextlib.contextmanager
-def single_blas_thread() -> Iterator[None]:
-    """Limit BLAS libraries to one thread inside the block (module doc)."""
+def _one_thread() -> Callable[[], object]:
     from threadpoolctl import threadpool_limits
 
-    with threadpool_limits(limits=1, user_api="blas"):
-        yield
+    return threadpool_limits(limits=1, user_api="blas").restore_original_limits
+
+
+_ONE_THREAD = ProcessWide(_one_thread)
+
+
+def single_blas_thread() -> contextlib.AbstractContextManager[None]:
+    """Limit BLAS libraries to one thread inside the block (module doc). The limit is one
+    per process (:class:`~sgtool.heap.ProcessWide`): blocks in several threads may overlap
+    in any order, and the last to leave restores the process's own setting."""
+    return _ONE_THREAD()

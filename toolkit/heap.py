@@ -30,18 +30,50 @@ from collections.abc import Callable, Iterator
 
 @contextlib.contextmanager
 def frozen_heap() -> Iterator[None]:
-    """Exempt the objects alive now from full collections inside the block (module doc)."""
+    """Exempt the objects alive now from full collections inside the block (module doc).
+    The heap is unfrozen however the block ends, a Ctrl-C during its start included."""
     if gc.get_freeze_count():  # frozen already (an enclosing block, or the host process)
         yield
         return
     # garbage left by earlier work goes now: frozen, it would outlive the block (a worker
     # running task after task would pile it up, frozen again before any full collection)
     gc.collect()
-    gc.freeze()
     try:
+        gc.freeze()
         yield
     finally:
         gc.unfreeze()
+
+
+class ProcessWide:
+    """A setting that is one per process, shared by blocks that may overlap in several
+    threads in any order: the first block to enter applies it (``apply`` returns what
+    undoes it), the last to leave undoes it, so the process gets back the setting it had
+    before the first. Use an instance as ``with setting():``."""
+
+    def __init__(self, apply: Callable[[], Callable[[], object]]) -> None:
+        self._apply = apply
+        self._lock = threading.Lock()
+        self._depth = 0
+        self._undo: Callable[[], object] | None = None
+
+    @contextlib.contextmanager
+    def __call__(self) -> Iterator[None]:
+        entered = False
+        try:
+            with self._lock:
+                if self._depth == 0:
+                    self._undo = self._apply()
+                self._depth += 1
+                entered = True
+            yield
+        finally:
+            if entered:
+                with self._lock:
+                    self._depth -= 1
+                    if self._depth == 0 and self._undo is not None:
+                        undo, self._undo = self._undo, None
+                        undo()
 
 
 def hugepage_setter() -> Callable[[bool], bool] | None:
@@ -57,27 +89,19 @@ def hugepage_setter() -> Callable[[bool], bool] | None:
     return None
 
 
-_PAGES_LOCK = threading.Lock()
-_pages_depth = [0, True]  # blocks inside small_pages now, numpy's setting before the first
-
-
-@contextlib.contextmanager
-def small_pages() -> Iterator[None]:
-    """numpy arrays allocated inside the block do not ask for huge pages (module doc).
-    numpy's switch is one per process: the first block to enter turns it off, the last to
-    leave restores it (blocks in several threads may overlap in any order)."""
+def _no_hugepages() -> Callable[[], object]:
     setter = hugepage_setter()
     if setter is None:
-        yield
-        return
-    with _PAGES_LOCK:
-        if _pages_depth[0] == 0:
-            _pages_depth[1] = setter(False)
-        _pages_depth[0] += 1
-    try:
-        yield
-    finally:
-        with _PAGES_LOCK:
-            _pages_depth[0] -= 1
-            if _pages_depth[0] == 0:
-                setter(bool(_pages_depth[1]))
+        return lambda: None
+    old = setter(False)
+    return lambda: setter(bool(old))
+
+
+_SMALL_PAGES = ProcessWide(_no_hugepages)
+
+
+def small_pages() -> contextlib.AbstractContextManager[None]:
+    """numpy arrays allocated inside the block do not ask for huge pages (module doc).
+    numpy's switch is one per process (:class:`ProcessWide`): blocks in several threads
+    may overlap in any order."""
+    return _SMALL_PAGES()

@@ -107,3 +107,44 @@ def test_garbage_from_before_the_block_does_not_outlive_it() -> None:
         del a, b  # cyclic garbage, not yet collected
         with frozen_heap():
             assert dead() is None  # collected on entry, not frozen
+
+
+def test_a_ctrl_c_as_the_heap_freezes_leaves_it_unfrozen(monkeypatch) -> None:
+    """A KeyboardInterrupt raised just after gc.freeze (it arrives while the collection
+    before it runs) must not leave the heap frozen for the rest of the process."""
+    freeze = gc.freeze
+
+    def freeze_then_interrupt() -> None:
+        freeze()
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(gc, "freeze", freeze_then_interrupt)
+    with pytest.raises(KeyboardInterrupt), frozen_heap():
+        pass
+    assert gc.get_freeze_count() == 0
+
+
+def test_one_blas_thread_in_overlapping_blocks_restores_the_process_setting() -> None:
+    """Two replays in threads whose blocks overlap out of order: the BLAS limit is back at
+    the process's own setting after both, not at the 1 the second block saw on entry."""
+    from threadpoolctl import threadpool_info
+
+    from sgtool.blas import single_blas_thread
+
+    def limits() -> list[int]:
+        return [p["num_threads"] for p in threadpool_info() if p["user_api"] == "blas"]
+
+    import numpy  # noqa: F401  (loads OpenBLAS)
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=2, user_api="blas"):  # the process's own setting
+        before = limits()
+        assert before and set(before) == {2}
+        first, second = single_blas_thread(), single_blas_thread()
+        first.__enter__()
+        assert set(limits()) == {1}
+        second.__enter__()
+        first.__exit__(None, None, None)  # the first leaves while the second is inside
+        assert set(limits()) == {1}
+        second.__exit__(None, None, None)
+        assert limits() == before
