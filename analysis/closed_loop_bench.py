@@ -49,11 +49,7 @@ from sgtool.analysis.bench_houses import (
     load_house_files,
     output_path,
 )
-from sgtool.analysis.bench_planner_checks import (
-    config_names,
-    config_planner_options,
-    config_rooms,
-)
+from sgtool.analysis.bench_planner_checks import config_names, config_planner_options, config_rooms
 from sgtool.analysis.closed_loop_tables import (
     budget_comparisons,
     format_agreement,
@@ -72,6 +68,7 @@ from sgtool.analysis.run_bench_resume import (
     task_settings,
 )
 from sgtool.analysis.search_metrics import CostModel, cost_models, summarize
+from sgtool.arg_checks import progress as check_progress
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
 from sgtool.extras import require
@@ -500,6 +497,7 @@ def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
     :func:`run_task` over the tasks (``map``: one after the other, here). ``report_only``:
     run nothing, read back the episodes whose logs are there (a run cut short too)."""
     cfg.check()
+    progress = check_progress("progress", progress)
     if not report_only:  # one line on a core install, before any folder is made
         require("pybullet", api="sgtool.run_closed_loop_bench")
     logs = (Path(out_dir) if report_only else output_dir(out_dir)) / "logs"

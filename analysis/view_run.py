@@ -71,10 +71,14 @@ def write_rerun(log: str | os.PathLike[str], output: str | os.PathLike[str], *,
     damaged log or an output that is the log is one :class:`~sgtool.errors.SgtoolError`
     line. Returns the path written."""
     from sgtool.analysis.rerun_view import export
+    from sgtool.arg_checks import function
+    from sgtool.arg_checks import progress as check_progress
     from sgtool.errors import SgtoolError
     from sgtool.extras import require
     from sgtool.output_check import check_output
 
+    progress = check_progress("progress", progress, method="")
+    function("warn", warn)
     require("rerun", api="sgtool.write_rerun")  # one line on a core install
     if every < 1 or (max_frames is not None and max_frames < 1):
         raise SgtoolError(f"every={every}, max_frames={max_frames}: each must be >= 1")

@@ -44,6 +44,7 @@ from pathlib import Path
 from typing import Any
 
 from sgtool.arg_checks import function, number, of_type, whole
+from sgtool.arg_checks import progress as check_progress
 from sgtool.blas import single_blas_thread
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import SgtoolError
@@ -298,6 +299,7 @@ def replay(
     if options is not None:
         of_type("options", options, ReplayOptions, "a ReplayOptions")
     function("on_refresh", on_refresh)
+    progress = check_progress("progress", progress)
     function("room_classifier", room_classifier)
     if output is not None and not os.fspath(output):
         raise SgtoolError("output: an empty path; give the derived log's name (*.mcap)")

@@ -55,3 +55,16 @@ def function(name: str, value: Any) -> Any:
     if value is not None and not callable(value):
         raise SgtoolError(f"{name}: a function, got {type(value).__name__}")
     return value
+
+
+def progress(name: str, value: Any, *, method: str = "update") -> Any:
+    """A progress argument that takes an object with ``update(n)`` (a tqdm bar) or, with
+    ``method=""``, a function: the value itself, None for None or False (no progress), else
+    one line saying what to give (True has no bar of its own here: pass ``tqdm()``)."""
+    if value is None or value is False:
+        return None
+    ok = callable(value) if not method else callable(getattr(value, method, None))
+    if value is True or not ok:
+        what = f"an object with {method}(n) such as a tqdm bar" if method else "a function"
+        raise SgtoolError(f"{name}={value!r}: {what}, or None")
+    return value

@@ -183,6 +183,9 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
     (None: :func:`default_frames`), ``compression`` (None: zstd for ros2, lz4 for ros1),
     only the ROS or sgtool ``topics`` given (None: all). The bag appears under its name only
     when complete."""
+    from sgtool.arg_checks import progress as check_progress
+
+    progress = check_progress("progress", progress)
     log, out = Path(log), Path(out)
     fmt = format_for(out, fmt)
     compression = compression or DEFAULT_COMPRESSION[fmt]

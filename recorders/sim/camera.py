@@ -60,7 +60,8 @@ class CameraConfig:
         whole("width", self.width)
         whole("height", self.height)
         for name in ("vfov_deg", "mount_height", "tilt_deg", "depth_min", "depth_max", "near"):
-            number(name, getattr(self, name))
+            # kept as a float: vfov_deg=75 logs as the CLI's 75.0 does
+            object.__setattr__(self, name, number(name, getattr(self, name)))
         if not (8 <= self.width <= 4096 and 8 <= self.height <= 4096):
             raise SgtoolError(f"camera resolution {self.width}x{self.height}: each side must "
                               "be 8..4096 pixels")

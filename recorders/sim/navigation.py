@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
+from sgtool.arg_checks import number
 from sgtool.errors import SgtoolError
 from sgtool.house.spec import HouseSpec, Room
 from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
@@ -55,6 +56,13 @@ class RobotConfig:
     resolution: float = 0.05  # occupancy cell (m)
 
     def __post_init__(self) -> None:
+        for name in ("radius", "reach", "speed", "turn_speed", "open_time", "resolution"):
+            # kept as a float: speed=1 logs as the CLI's --speed 1 (1.0) does
+            object.__setattr__(self, name, number(name, getattr(self, name)))
+        if not (isinstance(self.approach, tuple | list) and len(self.approach) == 2):
+            raise SgtoolError(f"approach={self.approach!r}: a (min, max) pair of metres")
+        object.__setattr__(self, "approach", tuple(number("approach", v)
+                                                   for v in self.approach))
         for flag, value in (("--speed", self.speed), ("turn_speed", self.turn_speed),
                             ("open_time", self.open_time)):
             if not value > 0:

@@ -234,6 +234,7 @@ class RecordOptions:
                 not FPS_RANGE[0] <= self.fps <= FPS_RANGE[1]:
             raise SgtoolError(f"fps {self.fps!r} (--fps): must be a number "
                               f"{FPS_RANGE[0]:g}..{FPS_RANGE[1]:g}")
+        object.__setattr__(self, "fps", float(self.fps))  # fps=4 logs as --fps 4 does
         if self.frames is not None and self.frames < 1:
             raise SgtoolError(f"frames {self.frames} (--frames): must be >= 1")
         if self.explore not in EXPLORE:
@@ -317,9 +318,11 @@ def record_house(house: HouseSpec | str | os.PathLike[str], output: str | os.Pat
     advances by one per frame; ``observers`` also watch the simulation (after the
     recorder, so they see each frame once it is written). Needs PyBullet (``pip install
     'sgtool[sim]'``)."""
+    from sgtool.arg_checks import progress as check_progress
     from sgtool.errors import SgtoolError
     from sgtool.extras import require
 
+    progress = check_progress("progress", progress)
     require("pybullet", api="sgtool.record_house")  # one line on a core install
     if isinstance(house, str | os.PathLike):  # a house spec file, as run_one takes
         from sgtool.house.io import load_house

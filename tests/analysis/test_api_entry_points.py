@@ -160,3 +160,31 @@ def test_run_closed_loop_names_a_wrong_episode() -> None:
     with pytest.raises(sgtool.SgtoolError, match=r"^episode: an Episode \(sgtool.pick_episode"
                        r"\(house\)\), got str$"):
         sgtool.run_closed_loop(house, "mug", sgtool.make_planner("random"), "x.mcap")
+
+
+def test_progress_takes_false_as_none_and_refuses_true_in_one_line(tmp_path) -> None:
+    """progress=False means no progress, as it does for run_benchmark and pin_logs; True
+    (no bar of its own there) and an object without update(n) are one line before any
+    work, not an AttributeError after an episode."""
+    rep = sgtool.replay(LOG, None, sgtool.ReplayOptions(max_frames=5), progress=False)
+    assert rep.frames == 5
+    with pytest.raises(sgtool.SgtoolError, match=r"^progress=True: an object with update"):
+        sgtool.replay(LOG, None, progress=True)
+    with pytest.raises(sgtool.SgtoolError, match=r"^progress=5: an object with update"):
+        sgtool.export_bag(LOG, tmp_path / "b.bag", progress=5)
+    with pytest.raises(sgtool.SgtoolError, match=r"^progress=True: a function, or None"):
+        sgtool.write_rerun(LOG, tmp_path / "v.rrd", progress=True)
+    with pytest.raises(sgtool.SgtoolError, match=r"^progress=True: an object with update"):
+        sgtool.run_closed_loop_bench(sgtool.ClosedLoopBenchConfig("random"), tmp_path / "cl",
+                                     progress=True)
+    assert not list(tmp_path.iterdir())
+
+
+def test_float_options_given_as_ints_log_as_floats() -> None:
+    """fps=4 and vfov_deg=75 log as the CLI's --fps 4 (4.0) does: the same bytes."""
+    from sgtool.recorders.sim import CameraConfig, RecordOptions
+
+    opts = RecordOptions(fps=4, camera=CameraConfig(vfov_deg=75))
+    assert isinstance(opts.fps, float) and isinstance(opts.camera.vfov_deg, float)
+    with pytest.raises(sgtool.SgtoolError, match="^speed='x': a finite number"):
+        sgtool.recorders.sim.RobotConfig(speed="x")

@@ -20,7 +20,7 @@ import os
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any, TypeVar, overload
+from typing import TYPE_CHECKING, Any, TypeVar, overload
 
 from mcap.data_stream import ReadDataStream
 from mcap.exceptions import InvalidMagic, McapError
@@ -45,8 +45,7 @@ from sgtool.log.frame_assembly import FRAME_TOPICS, FrameAssembler, TransformBuf
 from sgtool.log.image_wire import parse_raw_image
 from sgtool.log.log_file import require_regular_file, unended_problem
 from sgtool.log.records import LogRecord, record_type
-from sgtool.log.summary_check import BoundedReader as _BoundedReader
-from sgtool.log.summary_check import check_summary, read_attachment, read_footer
+from sgtool.log.summary_check import BoundedReader, check_summary, read_attachment, read_footer
 from sgtool.vocabulary import RecordName
 
 if TYPE_CHECKING:
@@ -123,7 +122,7 @@ class LogReader:
                 raise LogFormatError(unended_problem(self.path, size))
         self.size = size
         # reads are clamped to the file: a damaged length cannot allocate gigabytes
-        self._f: IO[bytes] = _BoundedReader(io.FileIO(self.path, "rb"), size)
+        self._f = BoundedReader(io.FileIO(self.path, "rb"), size)
         try:
             # chunk CRCs are checked as chunks are read when asked (``verify``; `sgtool
             # doctor` checks them all): damaged bytes give a clear error either way
@@ -501,11 +500,12 @@ class LogReader:
         """``it``, with damaged chunks (bad CRC, bad compression, bad records) turned into a
         :class:`LogFormatError` that points to ``sgtool doctor``."""
         try:
-            yield from it
+            for item in it:
+                self._f.check_open()  # an iterator made in the `with` block, read after it
+                yield item
         except SgtoolError:
             raise
-        except Exception as e:  # noqa: BLE001 - McapError, CRC, zstd, lz4 (RuntimeError),
-            # struct.error, KeyError (a message on an undefined channel), MemoryError ...
+        except Exception as e:  # noqa: BLE001 - McapError, CRC, zstd, lz4, struct, MemoryError
             raise LogFormatError(
                 f"{self.path}: damaged data ({type(e).__name__}: {str(e)[:120]}); "
                 f"`sgtool doctor {quoted(self.path)}` says what is readable and --recover copies it"

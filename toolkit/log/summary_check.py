@@ -17,7 +17,7 @@ from mcap.opcode import Opcode
 from mcap.records import Attachment, AttachmentIndex, Footer
 from mcap.summary import Summary
 
-from sgtool.errors import LogFormatError
+from sgtool.errors import LogFormatError, SgtoolError
 from sgtool.files import quoted
 from sgtool.log.mcap_records import FOOTER_RECORD_SIZE, RecordError, footer_at_end, parse_body
 
@@ -29,8 +29,21 @@ class BoundedReader(io.BufferedReader):
     def __init__(self, raw: io.FileIO, size: int) -> None:
         super().__init__(raw)
         self._size = size
+        self._path = raw.name
+
+    def check_open(self) -> None:
+        """A read after :meth:`close` (a LogReader used after its ``with`` block) is one
+        line saying so, not a damaged-data error."""
+        if self.closed:
+            raise SgtoolError(f"{self._path}: read after its LogReader was closed (read "
+                              "inside its `with` block)")
+
+    def seek(self, pos: int, whence: int = 0) -> int:
+        self.check_open()
+        return super().seek(pos, whence)
 
     def read(self, n: int | None = -1) -> bytes:
+        self.check_open()
         if n is None or n < 0:
             return super().read()
         return super().read(max(0, min(n, self._size - self.tell())))

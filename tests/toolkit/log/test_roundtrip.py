@@ -192,3 +192,19 @@ def test_input_that_would_read_back_wrong_is_refused(tmp_path):
         assert c.time_ns == 4 * DT and c.intrinsics == k
         counts = {t: sum(1 for _ in r.messages([t])) for t in (S.TF, S.RGB, S.CALIBRATION)}
     assert counts == {S.TF: 3, S.RGB: 1, S.CALIBRATION: 1}
+
+
+def test_a_read_after_close_says_so_not_damaged(tmp_path):
+    """A reader used after its `with` block: one line saying it was closed, never "damaged
+    data" pointing to `sgtool doctor` (the file is fine)."""
+    from sgtool.errors import SgtoolError
+
+    log = write_log(tmp_path / "a.mcap", n=4)
+    with LogReader(log) as r:
+        frames = r.frames()
+        next(frames)
+    for read in (lambda: list(frames), lambda: list(r.messages([S.DEPTH])),
+                 lambda: r.last_record("episode")):
+        with pytest.raises(SgtoolError, match="read after its LogReader was closed") as e:
+            read()
+        assert not isinstance(e.value, LogFormatError)
