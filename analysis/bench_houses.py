@@ -282,8 +282,8 @@ def house_notes(house: Any) -> tuple[str, ...]:
     for i, gap in cramped_starts(spec, house.robot_radius):
         s = spec.starts[i]
         notes.append(f"starts[{i}] ({s.x:g}, {s.y:g}): {gap:.2f} m from a wall or a piece, "
-                     f"less than the robot's radius ({house.robot_radius:g} m): the closed loop "
-                     "starts it overlapping one")
+                     f"less than the robot's radius ({house.robot_radius:g} m): the simulator "
+                     "starts the robot at the nearest place clear of it")
     notes += unreachable_notes(spec)
     unlinked = [r for r in unlinked_rooms(house) if r not in cut]
     if unlinked:

@@ -39,31 +39,12 @@ from typing import TypeVar
 
 import numpy as np
 
-from sgtool.results import EpisodeResult
+from sgtool.results import EpisodeResult, episode_spl
 
 
 # ----------------------------------------------------------------------------------------
 # per-episode quantities
 # ----------------------------------------------------------------------------------------
-def episode_spl(success: bool, shortest: float | None, travelled: float) -> float:
-    """S * l / max(l, p); NaN when l is unknown (None or NaN: the episode is left out of
-    SPL). A ``travelled`` p that is no finite number >= 0, or a negative ``shortest`` l,
-    raises ValueError: such figures would score SPL 1 (``sgtool eval`` refuses them first,
-    :mod:`sgtool.analysis.validity`)."""
-    if not (math.isfinite(travelled) and travelled >= 0.0):
-        raise ValueError(f"SPL: travelled {travelled} m is not a finite number >= 0")
-    if shortest is not None and shortest < 0.0:
-        raise ValueError(f"SPL: shortest path {shortest} m is negative")
-    if shortest is None or not math.isfinite(shortest):
-        return math.nan  # failed or not: an episode whose l is unknown is left out
-    if not success:
-        return 0.0
-    denom = max(float(shortest), float(travelled))
-    if denom <= 0.0:
-        return 1.0
-    return float(shortest) / denom
-
-
 @dataclass(frozen=True)
 class CostModel:
     """How an episode's cost is measured for an efficiency curve, and the budget maximum."""

@@ -230,15 +230,18 @@ def _start_inside(spec: HouseSpec, geo: EpisodeGeometry, rooms: tuple[str, ...],
     return None
 
 
-def list_episodes(spec: HouseSpec, n: int | None = None, seed: int = 0,
+def list_episodes(spec: HouseSpec, n: int | None = None, seed: int | None = None,
                   reach: float = REACH,
                   geometry: EpisodeGeometry | None = None) -> list[Episode]:
     """Search episodes in ``spec``: one per small-object category (its
     :func:`~sgtool.semantics.text.category_text`, so spellings of one name are one query;
     sorted) when ``n`` is None, else ``n`` episodes drawn with ``seed`` (categories
-    without replacement while they last, then again with other starts). ``geometry``: the house's
+    without replacement while they last, then again with other starts). ``seed`` (the
+    start poses' draw too) defaults to the house's own, as ``sgtool scenes episodes``,
+    ``bench``, ``run-bench`` and ``run --episode`` draw them. ``geometry``: the house's
     :class:`EpisodeGeometry` with this ``reach``, to share with other listings."""
     of_type("spec", spec, HouseSpec, "a HouseSpec (sgtool.load_house(path))")
+    seed = spec.seed if seed is None else seed
     if not spec.objects or not spec.starts:
         return []
     by_cat: dict[str, list[str]] = defaultdict(list)

@@ -7,6 +7,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from sgtool.results import episode_spl
+
 
 @dataclass(frozen=True)
 class ClosedLoopReport:
@@ -38,9 +40,7 @@ class ClosedLoopReport:
     def spl(self) -> float | None:
         if self.shortest_m is None:
             return None
-        if not self.success:
-            return 0.0
-        return self.shortest_m / max(self.shortest_m, self.travelled_m, 1e-9)
+        return episode_spl(self.success, self.shortest_m, self.travelled_m)  # as eval scores
 
     @property
     def frames_per_s(self) -> float:

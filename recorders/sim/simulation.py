@@ -122,6 +122,16 @@ class Simulation(Skills):
         self.disconnect()
 
     def _start_pose(self, start: int | Pose2 | StartPose) -> Pose2:
+        """The pose the robot starts at: ``start`` (an index of the house's start poses, a
+        StartPose or (x, y, yaw)) moved to the nearest place where the robot's disc
+        overlaps no wall or piece (:func:`~sgtool.house.clearance.clear_start`), so the
+        camera never starts inside a wall."""
+        from sgtool.house.clearance import clear_start
+
+        x, y, yaw = self._given_start(start)
+        return (*clear_start(self.spec, x, y, self.robot.radius), yaw)
+
+    def _given_start(self, start: int | Pose2 | StartPose) -> Pose2:
         if isinstance(start, StartPose):
             return (start.x, start.y, start.yaw)
         if isinstance(start, int):

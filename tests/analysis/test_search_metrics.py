@@ -118,3 +118,24 @@ def test_an_episode_without_a_shortest_path_is_out_of_spl_either_way() -> None:
     assert math.isnan(episode_spl(False, None, 3.0))
     assert math.isnan(episode_spl(True, math.nan, 3.0))
     assert episode_spl(False, 2.0, 3.0) == 0.0
+
+
+def test_run_prints_the_spl_eval_scores() -> None:
+    """`sgtool run`'s report and `sgtool eval` share one SPL: an episode that starts in
+    the target's room (shortest path 0) and finds it without moving scores 1 in both."""
+    from pathlib import Path
+
+    from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport
+    from sgtool.results import episode_spl
+
+    def report(success: bool, shortest: float | None, travelled: float) -> ClosedLoopReport:
+        return ClosedLoopReport(Path("x.mcap"), "h", "scout", "mug", "ep_0", success,
+                                "found" if success else "budget", 0, travelled, shortest,
+                                1, 1, 0, (), 0.0)
+
+    for success, shortest, travelled in ((True, 0.0, 0.0), (True, 2.0, 4.0),
+                                         (False, 2.0, 1.0), (True, 0.0, 3.0)):
+        assert report(success, shortest, travelled).spl == \
+            episode_spl(success, shortest, travelled)
+    assert report(True, 0.0, 0.0).spl == 1.0
+    assert report(True, None, 1.0).spl is None

@@ -152,3 +152,17 @@ def test_a_reach_the_robot_cannot_stand_within_is_refused() -> None:
     with pytest.raises(SgtoolError, match="reach 0.2 m: at least 0.3 m"):
         list_episodes(spec, 2, reach=0.2)
     assert all(math.isfinite(e.shortest_path) for e in list_episodes(spec, 3, reach=0.3))
+
+
+def test_run_episode_k_is_the_listings_k() -> None:
+    """`sgtool run --episode K` (pick_episode) draws the start poses the listing of
+    `sgtool scenes episodes`, bench and run-bench draw: with the house's own seed."""
+    from sgtool.datasets.episodes import pick_episode
+
+    spec = sgtool.generate_house(7, rooms=(5, 6))
+    assert spec.seed == 7
+    listed = list_episodes(spec, seed=spec.seed)
+    assert listed != list_episodes(spec, seed=0)  # the seed moves the starts
+    for k, ep in enumerate(listed):
+        assert pick_episode(spec, index=k) == (k, ep)
+        assert pick_episode(spec, query=ep.query) == (k, ep)

@@ -6,9 +6,10 @@ A container opens, and is looked into, through its front: the box's local +y fac
 another piece or the room's border covers: the point :data:`FRONT_CLEAR` in front of the
 middle of the front face is outside the piece's room, within a wall's body or inside
 another piece's footprint (a cabinet set with its back to the room). :func:`cramped_starts`
-finds the start poses nearer to a wall or a piece than the robot's radius (the simulator
-then starts the robot overlapping it). :func:`hidden_pieces` finds the pieces no camera
-can see: a box whose top lies under the floor, or one inside another piece's box.
+finds the start poses nearer to a wall or a piece than the robot's radius, and
+:func:`clear_start` the nearest place clear of them, where the simulator puts the robot.
+:func:`hidden_pieces` finds the pieces no camera can see: a box whose top lies under the
+floor, or one inside another piece's box.
 :func:`pieces_in_walls` finds the pieces whose footprint reaches through a wall, past its
 far face (a piece through a wall stands in two rooms; set against a wall, or into its
 body up to the middle line that is a room's border, it does not). :func:`walls_in_rooms`
@@ -39,6 +40,7 @@ IN_WALL_DEPTH = 0.05  # m a footprint's corner past a wall's far face that is mo
 THROUGH_STRIP = 0.5  # m beyond a wall's far face looked at for a piece reaching through
 INSIDE_CLEAR = 0.15  # m from a room's border where a wall is inside the room
 INSIDE_LEAST = 0.3  # m of a wall inside a room that is more than a corner's overlap
+CLEAR_SEARCH = 1.0  # m around a cramped start searched for a clear place (clear_start)
 
 
 def front_point(f: Furniture, clear: float = FRONT_CLEAR) -> tuple[float, float]:
@@ -119,6 +121,27 @@ def cramped_starts(spec: HouseSpec, radius: float) -> list[tuple[int, float]]:
         if gap < radius:
             out.append((i, max(gap, 0.0)))
     return out
+
+
+def clear_start(spec: HouseSpec, x: float, y: float, radius: float,
+                search: float = CLEAR_SEARCH) -> tuple[float, float]:
+    """Where the robot disc of ``radius`` at (x, y) overlaps no wall body or footprint:
+    (x, y) itself when it does not, else the nearest such point within ``search`` metres
+    (rings 1 cm apart, 64 directions from +x counter-clockwise: the first found) in the
+    room holding (x, y), if any; (x, y) when there is none. A start set against a wall
+    would put the camera's near plane past the wall (it would see through it)."""
+    covers = Covers(spec)
+    if covers.gap(x, y, radius) >= radius:
+        return x, y
+    room = next((r.polygon for r in spec.rooms if point_in_polygon(x, y, r.polygon)), None)
+    angles = np.arange(64) * (2.0 * math.pi / 64)
+    for d in np.arange(1, int(round(search / 0.01)) + 1) * 0.01:
+        for a in angles:
+            px, py = x + d * math.cos(a), y + d * math.sin(a)
+            if (room is None or point_in_polygon(px, py, room)) and \
+                    covers.gap(px, py, radius) >= radius:
+                return float(px), float(py)
+    return x, y
 
 
 def hidden_pieces(spec: HouseSpec) -> list[tuple[int, str]]:

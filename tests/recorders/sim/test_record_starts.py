@@ -59,3 +59,22 @@ def test_run_on_a_house_without_starts_starts_where_bench_would(tmp_path: Path) 
     with LogReader(out) as r:
         logged = load_house(json.loads(r.house_json() or "{}"))
     assert logged.starts == with_start_poses(spec, spec.seed).starts
+
+
+def test_a_start_against_a_wall_is_recorded_from_clear_of_it(tmp_path: Path) -> None:
+    """A start pose 0.02 m from a wall would put the camera's near plane past the wall: the
+    robot starts at the nearest place clear of it, and the log says where."""
+    from support.datasets_fixtures import two_rooms
+
+    from sgtool.house.clearance import Covers
+
+    d = two_rooms()
+    d["starts"] = [{"x": 3.93, "y": 3.0, "yaw": 0.0, "room": "room_0"}]
+    house = tmp_path / "h.json"
+    house.write_text(json.dumps(d))
+    out = tmp_path / "h.mcap"
+    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house), "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    with LogReader(out) as r:
+        x, y, _ = next(iter(r.records("episode")))[1]["extra"]["start_pose"]
+    assert x < 3.93 and Covers(load_house(d)).gap(x, y, 0.2) >= 0.2

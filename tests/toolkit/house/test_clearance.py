@@ -140,3 +140,20 @@ def test_a_wall_through_a_rooms_inside_is_named(tmp_path) -> None:
     r = CliRunner().invoke(cli, ["scenes", "check", str(f)])
     assert r.exit_code == 0, r.output
     assert "walls[6] (wall_9) run 2.0 m through room_1's inside" in r.output
+
+
+def test_a_start_against_a_wall_is_moved_clear_in_its_own_room() -> None:
+    """A start 0.02 m from the shared wall (x = 4, 0.05 m thick each side) moves straight
+    away from it, to where the robot's 0.2 m disc touches nothing, staying in its room; a
+    clear start stays where it is."""
+    from sgtool.house.clearance import Covers, clear_start, cramped_starts
+
+    spec = load_house(two_rooms())
+    x, y = clear_start(spec, 3.93, 3.0, 0.2)  # the wall's face at x = 3.95
+    assert (x, y) != (3.93, 3.0) and x < 4.0  # still in room_0
+    assert Covers(spec).gap(x, y, 0.2) >= 0.2
+    assert abs(y - 3.0) < 0.05 and 3.70 <= x <= 3.76  # the nearest place: 0.2 m off the face
+    assert clear_start(spec, 2.0, 2.0, 0.2) == (2.0, 2.0)
+    d = two_rooms()
+    d["starts"] = [{"x": 3.93, "y": 3.0, "yaw": 0.0, "room": "room_0"}]
+    assert [i for i, _ in cramped_starts(load_house(d), 0.2)] == [0]
