@@ -233,6 +233,9 @@ def convert_value(planner: str, key: str, meta: OptionMeta, value: Any,
         return value
     if value is None and (meta.optional or meta.objects):
         return None
+    if from_cli and meta.optional and meta.kind in ("int", "float", "choice") and \
+            isinstance(value, str) and not value.strip():
+        return None  # `-O NAME.k=` sets an optional number or choice to None
     if meta.kind == "int":
         out: Any = _to_int(value)
         if out is None:
@@ -250,10 +253,11 @@ def convert_value(planner: str, key: str, meta: OptionMeta, value: Any,
             raise fail("must be true or false")
         return out
     elif meta.kind == "choice":
-        text = str(value).strip().lower() if isinstance(value, str) else None
-        if text not in meta.choices:
+        text = value.strip().lower() if isinstance(value, str) else None
+        match = next((c for c in meta.choices if c.lower() == text), None)
+        if match is None:  # any case given, the choice as declared returned
             raise fail(f"must be one of {', '.join(meta.choices)}")
-        return text
+        return match
     elif meta.kind == "path":
         if isinstance(value, str) and not value.strip():  # empty: not set, as before
             return None if meta.optional else value

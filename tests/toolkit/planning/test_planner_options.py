@@ -5,6 +5,7 @@ through the table are those built by hand, and ``describe_planners`` lists the o
 from __future__ import annotations
 
 import dataclasses
+from typing import Literal
 
 import pytest
 
@@ -182,3 +183,21 @@ def test_describe_lists_every_planner_and_its_options() -> None:
     assert "    top_k (int, default 5): " in text and "[>= 1]" in text
     assert "Every planner: timed (bool, default true)" in text
     assert "entry-point group sgtool.planners" in text
+
+
+def test_a_plug_ins_choices_keep_their_case_and_an_empty_optional_is_none() -> None:
+    """A Literal["Fast", "Slow"] option takes either spelling from -O and gives the choice
+    as declared; `-O NAME.k=` sets an Optional[int] to None, as an empty path does."""
+    @dataclasses.dataclass(frozen=True)
+    class Opts:
+        mode: Literal["Fast", "Slow"] = "Fast"
+        n: int | None = 3
+
+    for given in ("Fast", "fast", " SLOW "):
+        got = convert_options("lab:P", Opts, {"mode": given}, from_cli=True)
+        assert got == {"mode": given.strip().capitalize()}
+    with pytest.raises(PlannerOptionError, match="mode=Medium: must be one of Fast, Slow"):
+        convert_options("lab:P", Opts, {"mode": "Medium"}, from_cli=True)
+    assert convert_options("lab:P", Opts, {"n": ""}, from_cli=True) == {"n": None}
+    with pytest.raises(PlannerOptionError, match="must be an integer"):
+        convert_options("lab:P", Opts, {"n": "x"}, from_cli=True)
