@@ -46,7 +46,10 @@ class Planner(Protocol):
     name: str
 
     def reset(self, query: str, seed: int = 0) -> None:
-        """Start a new episode searching for ``query`` (an object category, free text)."""
+        """Start a new episode searching for ``query`` (an object category, free text).
+        Draw any randomness from ``seed`` (e.g. ``numpy.random.default_rng(seed)``): the
+        same episode then decides the same in any run. (A plug-in's Python ``random`` and
+        numpy global generator are seeded from it too: :mod:`sgtool.planning.timing`.)"""
 
     def decide(self, graph: SceneGraph) -> Action:
         """Choose the next action on ``graph``."""

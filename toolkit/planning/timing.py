@@ -5,12 +5,24 @@ same way: wall time of ``decide`` (monotonic ``perf_counter``), including LLM ro
 for ``moma-llm``. The value is written into ``Action.decision_time_s`` so it travels with
 the action into the log (``sgtool.Action.decision_time_s``). It is a measurement, not
 derived data, so it is the one field of an action that differs between two runs.
+
+A plug-in that draws from Python's ``random`` or numpy's global generator instead of the
+``seed`` its ``reset`` gets would make a bench differ from run to run. The wrapper gives a
+plug-in's calls generators of its own, seeded by that ``seed`` at every ``reset`` and
+swapped in around each call (the caller's global generators are left as they were), so
+the same episode draws the same numbers in any process and order.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import random
 import time
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
 
 from sgtool.errors import SgtoolError, raised_text
 from sgtool.planning.base import Action, Feedback, Planner
@@ -43,18 +55,40 @@ class TimedPlanner:
         self.decision_times: list[float] = []
         self.plugin = plugin  # a user's planner: what it raises is one line, not a traceback
         self.measure = measure
+        self._globals: tuple[Any, Any] | None = None  # a plug-in's random, numpy states
+
+    @contextlib.contextmanager
+    def _own_randomness(self) -> Iterator[None]:
+        """A plug-in's global generators swapped in for the call (module doc)."""
+        if self._globals is None:
+            yield
+            return
+        outer = random.getstate(), np.random.get_state()
+        random.setstate(self._globals[0])
+        np.random.set_state(self._globals[1])
+        try:
+            yield
+        finally:
+            self._globals = random.getstate(), np.random.get_state()
+            random.setstate(outer[0])
+            np.random.set_state(outer[1])
 
     def reset(self, query: str, seed: int = 0) -> None:
         self.decision_times = []
+        if self.plugin:
+            self._globals = (random.Random(seed).getstate(),
+                             np.random.RandomState(seed % 2**32).get_state())
         try:
-            self.inner.reset(query, seed)
+            with self._own_randomness():
+                self.inner.reset(query, seed)
         except (Exception, SystemExit) as e:
             raise self._failed("reset", e) from e
 
     def decide(self, graph: SceneGraph) -> Action:
         t0 = time.perf_counter()
         try:
-            action = self.inner.decide(graph)
+            with self._own_randomness():
+                action = self.inner.decide(graph)
         except (Exception, SystemExit) as e:
             raise self._failed("decide", e) from e
         dt = time.perf_counter() - t0
@@ -84,6 +118,10 @@ class TimedPlanner:
                 f"planner {self.name!r}: decide() returned an Action whose target is "
                 f"{action.target!r} ({type(action.target).__name__}); a target is a node id "
                 "(text, e.g. a candidate's node_id) or None")
+        if not isinstance(action.reason, str):
+            raise PlannerContractError(
+                f"planner {self.name!r}: decide() returned an Action whose reason is "
+                f"{action.reason!r} ({type(action.reason).__name__}); a reason is text")
 
     @property
     def exchanges(self) -> object:
@@ -93,7 +131,8 @@ class TimedPlanner:
 
     def feedback(self, fb: Feedback) -> None:
         try:
-            self.inner.feedback(fb)
+            with self._own_randomness():
+                self.inner.feedback(fb)
         except (Exception, SystemExit) as e:
             raise self._failed("feedback", e) from e
 

@@ -80,6 +80,28 @@ PLUGIN = textwrap.dedent('''
             return actionable(graph)[0]
 
 
+    class GlobalRandom(GreedyPlanner):
+        """Draws from Python's and numpy's global generators, not from its seed."""
+
+        def decide(self, graph):
+            import random
+
+            import numpy as np
+            from sgtool.planning.base import Action
+            from sgtool.planning.candidates import actionable
+
+            cands = actionable(graph)
+            k = (random.randrange(len(cands)) + int(np.random.randint(len(cands)))) % len(cands)
+            return Action("navigate", cands[k].node_id, reason="random")
+
+
+    class OddReason(GreedyPlanner):
+        def decide(self, graph):
+            from dataclasses import replace
+
+            return replace(super().decide(graph), reason=3)
+
+
     class Half:
         name = "half"
 
@@ -263,3 +285,44 @@ def test_options_compared_as_the_planner_takes_them(plugin_dir: Path) -> None:
     assert effective_options("nomod_plug:X", {"k": "1"}) == {"k": "1"}  # cannot be asked
     assert recorded_options({"folder": Path("/tmp/x"), "obj": object()}) == {
         "folder": "/tmp/x"}
+
+
+def test_a_plug_ins_global_randomness_follows_the_episode_seed(plugin_dir: Path) -> None:
+    """A plug-in drawing from random/np.random decides the same for the same episode
+    seed whatever ran before, and leaves the caller's global generators as they were."""
+    import random
+
+    import numpy as np
+    from support.planning_world import World
+
+    graph = World(0).graph()
+
+    def targets(seed: int) -> list[str | None]:
+        planner = make_planner("mymod_plug:GlobalRandom")
+        planner.reset("mug", seed)
+        return [planner.decide(graph).target for _ in range(6)]
+
+    random.seed(1)
+    np.random.seed(1)
+    first = targets(5)
+    after = random.random(), float(np.random.random_sample())
+    random.seed(99)
+    np.random.seed(99)  # other global states before the same episode
+    assert targets(5) == first
+    random.seed(1)
+    np.random.seed(1)
+    targets(5)
+    assert (random.random(), float(np.random.random_sample())) == after  # untouched
+    assert any(targets(s) != first for s in range(6, 12))  # another seed, other draws
+
+
+def test_an_action_whose_reason_is_no_text_is_one_line(plugin_dir: Path) -> None:
+    from support.planning_world import World
+
+    from sgtool.planning.timing import PlannerContractError
+
+    planner = make_planner("mymod_plug:OddReason")
+    planner.reset("mug")
+    with pytest.raises(PlannerContractError, match="an Action whose reason is 3 .int.; a "
+                                                   "reason is text"):
+        planner.decide(World(0).graph())
