@@ -113,3 +113,15 @@ def check_planner_options(planners: Sequence[str], options: Mapping[str, Mapping
         if opts.get("transcript") and not one_writer:
             raise BenchError("--llm-transcript needs --workers 1 and the local executor "
                              "(one file, one writer)")
+
+
+def check_plugins_build(planners: Sequence[str], options: Mapping[str, Mapping[str, Any]]
+                        ) -> None:
+    """Build each plug-in planner once with its options, so one that cannot be imported
+    or built is one line before any episode runs (the built-ins' options are checked by
+    their fields, and built where they run)."""
+    from sgtool.planning.registry import PLANNER_NAMES, make_planner
+
+    for name in planners:
+        if name.strip().lower() not in PLANNER_NAMES:
+            make_planner(name, **options.get(name, {}))

@@ -49,7 +49,13 @@ from sgtool.analysis.bench_houses import (
     load_house_files,
     output_path,
 )
-from sgtool.analysis.bench_planner_checks import config_names, config_planner_options, config_rooms
+from sgtool.analysis.bench_planner_checks import (
+    check_planner_options,
+    check_plugins_build,
+    config_names,
+    config_planner_options,
+    config_rooms,
+)
 from sgtool.analysis.closed_loop_tables import (
     budget_comparisons,
     format_agreement,
@@ -57,6 +63,7 @@ from sgtool.analysis.closed_loop_tables import (
     frame_curves,
     frames_model,
     interval_tables,
+    reason_class,
     symbolic_agreement,
 )
 from sgtool.analysis.offline import log_exchanges, read_log_episodes, with_seen
@@ -81,32 +88,6 @@ from sgtool.recorders.sim.fallback_explore import is_fallback
 from sgtool.recorders.sim.frame_budget import frame_budget
 from sgtool.recorders.sim.noise import names_file, parse_noise
 from sgtool.results import EpisodeResult, write_jsonl
-
-# failed-skill reasons, by the first pattern their text matches
-REASONS: tuple[tuple[str, str], ...] = (
-    ("unreachable on the robot's map", "unreachable on the map"),
-    ("no map yet", "unreachable on the map"),
-    ("stands on no free cell", "unreachable on the map"),
-    ("blocked by an obstacle", "contact"),
-    ("re-plans", "no progress"),
-    ("out of reach", "out of reach"),
-    ("not on free floor", "not on free floor"),
-    ("behind closed door", "behind closed doors"),
-    ("no collision-free path", "no path"),
-    ("already", "already open/closed"),
-    ("cannot be opened", "not openable"),
-    ("stands in the way", "robot in the way"),
-    ("stopped:", "frame budget"),
-)
-
-
-def reason_class(reason: str) -> str:
-    """The class of a failed skill's reason (:data:`REASONS`; "other" when none fits)."""
-    for pattern, name in REASONS:
-        if pattern in reason:
-            return name
-    return "other"
-
 
 # what maps run_task over the tasks: map (in order, here) or an executor's runner
 Runner = Callable[[Callable[["RunTask"], "RunRow"], Iterable["RunTask"]], Iterable["RunRow"]]
@@ -166,6 +147,7 @@ class ClosedLoopBenchConfig:
         if any(not (math.isfinite(b) and b > 0) for b in self.budgets):
             raise SgtoolError(f"--budgets: frames per room > 0, got {list(self.budgets)}")
         check_reference(self.reference, self.all_pairs, self.planners)
+        check_planner_options(self.planners, self.planner_options, one_writer=True)
         if self.episodes < 1:
             raise SgtoolError(f"--episodes: must be >= 1, got {self.episodes}")
         if self.houses < 0 or (self.houses == 0 and not self.house_files):
@@ -500,6 +482,7 @@ def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
     progress = check_progress("progress", progress)
     if not report_only:  # one line on a core install, before any folder is made
         require("pybullet", api="sgtool.run_closed_loop_bench")
+        check_plugins_build(cfg.planners, cfg.planner_options)
     logs = (Path(out_dir) if report_only else output_dir(out_dir)) / "logs"
     tasks = tasks_of(cfg, logs)
     if report_only:

@@ -205,3 +205,29 @@ def interval_tables(results: Sequence[EpisodeResult], planners: Sequence[str],
         "paired": [c.to_dict() for c in overall],
         "paired_per_house": [{"house": h, **c.to_dict()} for h, c in per_house]}
     return text, data
+
+
+# failed-skill reasons, by the first pattern their text matches
+REASONS: tuple[tuple[str, str], ...] = (
+    ("unreachable on the robot's map", "unreachable on the map"),
+    ("no map yet", "unreachable on the map"),
+    ("stands on no free cell", "unreachable on the map"),
+    ("blocked by an obstacle", "contact"),
+    ("re-plans", "no progress"),
+    ("out of reach", "out of reach"),
+    ("not on free floor", "not on free floor"),
+    ("behind closed door", "behind closed doors"),
+    ("no collision-free path", "no path"),
+    ("already", "already open/closed"),
+    ("cannot be opened", "not openable"),
+    ("stands in the way", "robot in the way"),
+    ("stopped:", "frame budget"),
+)
+
+
+def reason_class(reason: str) -> str:
+    """The class of a failed skill's reason (:data:`REASONS`; "other" when none fits)."""
+    for pattern, name in REASONS:
+        if pattern in reason:
+            return name
+    return "other"

@@ -188,3 +188,16 @@ def test_float_options_given_as_ints_log_as_floats() -> None:
     assert isinstance(opts.fps, float) and isinstance(opts.camera.vfov_deg, float)
     with pytest.raises(sgtool.SgtoolError, match="^speed='x': a finite number"):
         sgtool.recorders.sim.RobotConfig(speed="x")
+
+
+def test_run_closed_loop_bench_refuses_before_any_folder(tmp_path) -> None:
+    """Options for a planner not run (a typo) and a plug-in that cannot be built are one
+    line before any episode, and leave no output folder (as the symbolic bench does)."""
+    out = tmp_path / "cl"
+    with pytest.raises(sgtool.SgtoolError, match="'Greedy' is not one of the planners run"):
+        sgtool.run_closed_loop_bench(sgtool.ClosedLoopBenchConfig(
+            "greedy", planner_options={"Greedy": {"max_failures": 2}}), out)
+    with pytest.raises(sgtool.SgtoolError, match="cannot import module 'no_such_module_x'"):
+        sgtool.run_closed_loop_bench(sgtool.ClosedLoopBenchConfig(
+            ("greedy", "no_such_module_x:Planner")), out)
+    assert not out.exists()

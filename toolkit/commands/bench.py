@@ -24,6 +24,7 @@ from sgtool.commands.options import (
     parse_rooms,
     planner_names,
     planner_options,
+    reference_planner,
     replay_files,
     shown_command,
     success_option,
@@ -105,7 +106,7 @@ if TYPE_CHECKING:
                    "beside LOG_DIR and moved in complete, as OUT (--force likewise).")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
-@click.option("--reference", default=None, metavar="PLANNER",
+@click.option("--reference", default=None, metavar="PLANNER", callback=reference_planner,
               help="Paired comparisons (summary.md, summary.json) of every other planner "
                    "against this one on the same episodes: SPL ratio, SR and SPL "
                    "differences with bootstrap intervals over houses, wins/losses/ties per "

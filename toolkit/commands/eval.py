@@ -23,6 +23,7 @@ from sgtool.commands.options import (
     executor_options,
     list_planners_option,
     llm_endpoint_options,
+    reference_planner,
     success_option,
 )
 from sgtool.errors import SgtoolError
@@ -48,7 +49,7 @@ if TYPE_CHECKING:
                    "exchanges of the MCAP inputs, when they have any].")
 @success_option(recorded=True)
 @budget_options()
-@click.option("--reference", default=None, metavar="PLANNER",
+@click.option("--reference", default=None, metavar="PLANNER", callback=reference_planner,
               help="Paired comparisons of every other planner against this one on the same "
                    "episodes (house, episode, seed, query, shortest path), pooled over the "
                    "inputs (a run of your planner against a stored run of the baselines) "

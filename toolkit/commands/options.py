@@ -379,6 +379,13 @@ def _canonical_planner(name: str) -> str:
     return planner_names(name)[0] if name.strip() else name
 
 
+def reference_planner(ctx: click.Context, param: click.Parameter, value: str | None
+                      ) -> str | None:
+    """``--reference PLANNER`` spelt as :func:`planner_names` spells ``--planners`` (a
+    built-in in any case), so ``--planners SCOUT --reference Scout`` agree."""
+    return None if value is None else _canonical_planner(value)
+
+
 def split_planner_key(key: str, planners: Sequence[str] = ()) -> tuple[str, str]:
     """(planner, option) of ``PLANNER.KEY``: the longest planner of ``planners`` the key
     starts with (``mypkg.mod:Cls.k``), else split at the last '.' when the planner is

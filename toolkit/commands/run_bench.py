@@ -29,6 +29,7 @@ from sgtool.commands.options import (
     peek_option,
     planner_names,
     planner_options,
+    reference_planner,
     render_turn_option,
     sight_lines_option,
     success_option,
@@ -114,7 +115,7 @@ if TYPE_CHECKING:
               "--budgets, --symbolic and the budgets of AUC-E are this command's).")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
-@click.option("--reference", default=None, metavar="PLANNER",
+@click.option("--reference", default=None, metavar="PLANNER", callback=reference_planner,
               help="Paired comparisons of every other planner against this one on the same "
               "episodes, over houses and per house (SPL ratio, SR and SPL differences with "
               "bootstrap intervals, wins/losses/ties). [default: scout when run, else the "
