@@ -30,11 +30,15 @@ MINE = "my_planner:MyPlanner"
 
 
 def main() -> None:
+    sys.path.insert(0, str(HERE))  # my_planner.py is importable (workers inherit sys.path)
+    from my_planner import room_range
+
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--houses", type=int, default=2, help="generated houses")
     parser.add_argument("--episodes", type=int, default=4, help="search episodes per house")
     parser.add_argument("--seeds", type=int, default=1, help="benchmark seeds")
-    parser.add_argument("--rooms", default="4-6", help="room count range of the houses, MIN-MAX")
+    parser.add_argument("--rooms", type=room_range, default="4-6",
+                        help="room count range of the houses, MIN-MAX")
     parser.add_argument("--max-steps", type=int, default=50, help="actions per episode")
     parser.add_argument("--max-failures", type=int, default=2,
                         help="MyPlanner: failed attempts before a node is dropped")
@@ -43,12 +47,10 @@ def main() -> None:
     parser.add_argument("-o", "--out", default=None, help="also write the bench outputs here")
     args = parser.parse_args()
 
-    sys.path.insert(0, str(HERE))  # my_planner.py is importable (workers inherit sys.path)
-    lo, _, hi = args.rooms.partition("-")
     others = tuple(p.strip() for p in args.against.split(",") if p.strip())
     config = sgtool.BenchConfig(
         planners=(MINE, *others), houses=args.houses, episodes=args.episodes,
-        seeds=args.seeds, rooms=(int(lo), int(hi or lo)), preset="default",
+        seeds=args.seeds, rooms=args.rooms, preset="default",
         max_steps=args.max_steps,
         planner_options={MINE: {"max_failures": args.max_failures}})
     result = sgtool.run_benchmark(config, progress=False)

@@ -82,14 +82,24 @@ class MyPlanner:
             self.failures[fb.action.target] += 1
 
 
+def room_range(text: str) -> tuple[int, int]:
+    """``--rooms MIN-MAX`` (or one count) as (MIN, MAX); anything else is argparse's one
+    line."""
+    lo, _, hi = text.partition("-")
+    try:
+        return int(lo), int(hi or lo)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: give MIN-MAX, e.g. 4-6") from None
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description="One symbolic episode with MyPlanner.")
     parser.add_argument("--seed", type=int, default=0, help="house seed")
-    parser.add_argument("--rooms", default="4-6", help="room count range MIN-MAX")
+    parser.add_argument("--rooms", type=room_range, default="4-6",
+                        help="room count range MIN-MAX")
     parser.add_argument("--episode", type=int, default=0, help="which search episode")
     args = parser.parse_args()
-    lo, _, hi = args.rooms.partition("-")
-    house = sgtool.generate_house(args.seed, rooms=(int(lo), int(hi or lo)))
+    house = sgtool.generate_house(args.seed, rooms=args.rooms)
     episodes = sgtool.list_episodes(house)
     if not 0 <= args.episode < len(episodes):
         raise SystemExit(f"my_planner: --episode: the house has {len(episodes)} episodes")
