@@ -26,12 +26,28 @@ def _priors_planners() -> tuple[str, ...]:
 PRIORS_PLANNERS = _priors_planners()
 
 
+def takes_priors(name: str) -> bool:
+    """Whether planner ``name`` loads a folder of priors: a built-in of
+    :data:`PRIORS_PLANNERS`, or a plug-in whose options have a ``weights_dir`` field (one
+    that cannot be imported here: no)."""
+    from sgtool.planning.option_fields import option_infos
+    from sgtool.planning.registry import REGISTRY, options_of
+
+    if name in PRIORS_PLANNERS or name.strip().lower() in REGISTRY:
+        return name in PRIORS_PLANNERS
+    try:
+        cls = options_of(name)
+    except Exception:  # noqa: BLE001 - its own build says why, where it runs
+        return False
+    return cls is not None and any(i.name == "weights_dir" for i in option_infos(cls))
+
+
 def planner_options_for(cfg: BenchConfig, name: str) -> dict[str, Any]:
     """The options ``name`` is built with: the configured ones, and for the planners that
-    use the learned priors (:data:`PRIORS_PLANNERS`) the weights of ``cfg.priors_dir``
-    unless an option names other weights."""
+    load priors (:func:`takes_priors`, a plug-in's ``weights_dir`` too) the weights of
+    ``cfg.priors_dir`` unless an option names other weights."""
     opts = dict(cfg.planner_options.get(name, {}))
-    if cfg.priors_dir is not None and name in PRIORS_PLANNERS:
+    if cfg.priors_dir is not None and takes_priors(name):
         opts.setdefault("weights_dir", cfg.priors_dir)
     return opts
 

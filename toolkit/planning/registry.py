@@ -49,8 +49,9 @@ __all__ = ["REGISTRY", "PLANNER_NAMES", "Entry", "UnknownPlannerError", "Planner
            "make_planner", "options_of", "parse_option", "describe_planners", "is_llm_planner",
            "check_planner_name", "planner_file_name"]
 
-TIMED = OptionMeta("wrap the planner in TimedPlanner: every action carries its decision "
-                   "time", "bool")
+TIMED = OptionMeta("fill each action's decision_time_s as make_planner returns it (off: the "
+                   "planner's own value; bench, run and their logs time every decision "
+                   "either way)", "bool")
 
 
 @dataclass(frozen=True)

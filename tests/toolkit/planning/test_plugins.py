@@ -95,6 +95,16 @@ PLUGIN = textwrap.dedent('''
             return Action("navigate", cands[k].node_id, reason="random")
 
 
+    class Priored(GreedyPlanner):
+        @dataclass(frozen=True)
+        class Options:
+            weights_dir: str = ""
+
+        def __init__(self, weights_dir=""):
+            super().__init__()
+            self.weights_dir = weights_dir
+
+
     class OddReason(GreedyPlanner):
         def decide(self, graph):
             from dataclasses import replace
@@ -326,3 +336,19 @@ def test_an_action_whose_reason_is_no_text_is_one_line(plugin_dir: Path) -> None
     with pytest.raises(PlannerContractError, match="an Action whose reason is 3 .int.; a "
                                                    "reason is text"):
         planner.decide(World(0).graph())
+
+
+def test_priors_reach_a_plug_in_whose_options_name_weights(plugin_dir: Path) -> None:
+    """bench --priors DIR reaches a plug-in with a weights_dir option as it reaches scout
+    (it kept the shipped priors, with the tables labelled by DIR); -O still wins."""
+    from sgtool.analysis.bench import BenchConfig
+    from sgtool.analysis.bench_priors import planner_options_for
+
+    cfg = BenchConfig(planners=("scout", "mymod_plug:Priored", "mymod_plug:Typed"),
+                      priors_dir="blend")
+    assert planner_options_for(cfg, "scout") == {"weights_dir": "blend"}
+    assert planner_options_for(cfg, "mymod_plug:Priored") == {"weights_dir": "blend"}
+    assert planner_options_for(cfg, "mymod_plug:Typed") == {}
+    given = BenchConfig(planners=("mymod_plug:Priored",), priors_dir="blend",
+                        planner_options={"mymod_plug:Priored": {"weights_dir": "mine"}})
+    assert planner_options_for(given, "mymod_plug:Priored") == {"weights_dir": "mine"}
