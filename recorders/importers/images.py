@@ -31,8 +31,22 @@ def _cv2() -> Any:
     return require("cv2")
 
 
-def _read_image(path: Path) -> np.ndarray:
+def _imdecode(data: Any) -> np.ndarray | None:
+    """``cv2.imdecode`` of image file bytes, unchanged depth and channels; None for bytes
+    that are no image, none at all included (OpenCV asserts on an empty buffer)."""
     cv2 = _cv2()
+    buf = np.frombuffer(bytes(data), np.uint8) if not isinstance(data, np.ndarray) else \
+        np.ascontiguousarray(data, np.uint8).ravel()
+    if not buf.size:
+        return None
+    try:
+        a: np.ndarray | None = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED)
+    except cv2.error:
+        return None
+    return a
+
+
+def _read_image(path: Path) -> np.ndarray:
     if not Path(path).is_file():
         raise SgtoolError(f"{path}: no such image file")
     # decoded from the bytes: cv2.imread takes the name as UTF-8 text and crashes on a
@@ -41,7 +55,7 @@ def _read_image(path: Path) -> np.ndarray:
         data = np.fromfile(path, dtype=np.uint8)
     except OSError as e:
         raise SgtoolError(f"{path}: cannot read ({e.strerror or e})") from None
-    a = cv2.imdecode(data, cv2.IMREAD_UNCHANGED) if data.size else None
+    a = _imdecode(data)
     if a is None:
         raise SgtoolError(f"{path}: OpenCV cannot read this image")
     return a
@@ -251,11 +265,12 @@ def _convert(a: np.ndarray, enc: str, topic: str) -> np.ndarray:
 
 def decode_color_message(msg: Any, msgtype: str, topic: str) -> np.ndarray:
     """``Image`` or ``CompressedImage`` -> (H, W, 3) uint8 RGB."""
-    cv2 = _cv2()
     if msgtype.endswith("CompressedImage"):
-        a = cv2.imdecode(np.asarray(msg.data, dtype=np.uint8), cv2.IMREAD_UNCHANGED)
+        a = _imdecode(np.asarray(msg.data, dtype=np.uint8))
         if a is None:
-            raise SgtoolError(f"topic {topic}: OpenCV cannot decode a {msg.format!r} image")
+            raise SgtoolError(f"topic {topic}: OpenCV cannot decode a {msg.format!r} image"
+                              + (" (the message holds no image data)" if not len(msg.data)
+                                 else ""))
         return _to_rgb(a, f"topic {topic}")
     a, enc = decode_raw_image(msg, topic)
     return color_from_raw(a, enc, topic)
@@ -264,13 +279,12 @@ def decode_color_message(msg: Any, msgtype: str, topic: str) -> np.ndarray:
 def decode_depth_message(msg: Any, msgtype: str, topic: str) -> tuple[np.ndarray, float]:
     """``Image`` (16UC1/mono16 millimetres, 32FC1 metres) or ``CompressedImage`` (PNG, or
     image_transport's ``compressedDepth``) -> (raw array, units per metre)."""
-    cv2 = _cv2()
     if msgtype.endswith("CompressedImage"):
         fmt = str(msg.format)
         data = bytes(np.asarray(msg.data, dtype=np.uint8).tobytes())
         if "compresseddepth" in fmt.lower().replace(" ", ""):
             return _decode_compressed_depth(data, fmt, topic)
-        a = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED)
+        a = _imdecode(data)
         if a is None or a.ndim != 2 or a.dtype != np.uint16:
             raise SgtoolError(
                 f"topic {topic}: compressed depth format {fmt!r} did not decode to a "
@@ -291,7 +305,6 @@ def _decode_compressed_depth(data: bytes, fmt: str, topic: str) -> tuple[np.ndar
     """image_transport ``compressedDepth``: a 12-byte header (int32 format, float
     depthQuantA, float depthQuantB) then a PNG. 16UC1 stores millimetres; 32FC1 stores
     quantised inverse depth, depth = A / (v - B) for v != 0."""
-    cv2 = _cv2()
     if len(data) < 12:
         raise SgtoolError(f"topic {topic}: compressedDepth message shorter than its header")
     _, qa, qb = struct.unpack("<iff", data[:12])
@@ -300,7 +313,7 @@ def _decode_compressed_depth(data: bytes, fmt: str, topic: str) -> tuple[np.ndar
     if "rvl" in fmt.lower() and not payload.startswith(_PNG_MAGIC):
         a = _decode_rvl_payload(payload, topic)
     else:
-        png = cv2.imdecode(np.frombuffer(payload, np.uint8), cv2.IMREAD_UNCHANGED)
+        png = _imdecode(payload)
         if png is None or png.dtype != np.uint16 or png.ndim != 2:
             what = ("a PNG that is not single-channel 16-bit" if png is not None else
                     "a PNG that OpenCV cannot decode" if payload.startswith(_PNG_MAGIC) else
@@ -335,9 +348,8 @@ def _decode_rvl_payload(payload: bytes, topic: str) -> np.ndarray:
 
 def decode_ids_message(msg: Any, msgtype: str, topic: str) -> np.ndarray:
     """Instance-id image (8/16/32-bit integer) -> int32."""
-    cv2 = _cv2()
     if msgtype.endswith("CompressedImage"):
-        a = cv2.imdecode(np.asarray(msg.data, dtype=np.uint8), cv2.IMREAD_UNCHANGED)
+        a = _imdecode(np.asarray(msg.data, dtype=np.uint8))
         if a is None or a.ndim != 2:
             raise SgtoolError(f"topic {topic}: instance ids must decode to one channel")
         return a.astype(np.int32)

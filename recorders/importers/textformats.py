@@ -16,6 +16,7 @@ Parsing errors are user errors naming the file and the line.
 from __future__ import annotations
 
 import json
+import math
 import re
 from dataclasses import dataclass
 from decimal import Decimal, InvalidOperation
@@ -125,21 +126,36 @@ def read_pose_file(path: Path) -> np.ndarray:
 
 
 def read_open3d_log(path: Path) -> list[np.ndarray]:
-    """Camera-to-world 4x4 poses of an Open3D / Redwood ``.log`` trajectory, in order,
-    each checked rigid."""
+    """Camera-to-world 4x4 poses of an Open3D / Redwood ``.log`` trajectory, each checked
+    rigid, in the order of the frame ids of their block headers ``i j n`` (Open3D writes
+    ``i i i+1`` for frame i): blocks out of order are put in order; a frame id given twice
+    is refused (unless every block has the same one: ids that say nothing, file order)."""
     rows = _data_lines(path)
     if len(rows) % 5:
         raise SgtoolError(
             f"{path}: an Open3D .log trajectory has 5 lines per pose (\"i j n\" and 4 matrix "
             f"rows); {len(rows)} lines is not a multiple of 5"
         )
-    poses = []
+    poses: list[tuple[float, np.ndarray]] = []
+    seen: dict[float, int] = {}
     for b in range(0, len(rows), 5):
         n0, head = rows[b]
-        if len(head) != 3:
-            raise SgtoolError(f"{path}:{n0}: expected the block header 'i j n'")
-        poses.append(pose_matrix(path, rows[b + 1:b + 5]))
-    return poses
+        try:
+            frame = float(head[0]) if len(head) == 3 else math.nan
+        except ValueError:
+            frame = math.nan
+        if not math.isfinite(frame):
+            raise SgtoolError(f"{path}:{n0}: expected the block header 'i j n' (numbers)")
+        poses.append((frame, pose_matrix(path, rows[b + 1:b + 5])))
+        seen.setdefault(frame, n0)
+    if 1 < len(seen) < len(poses):
+        twice = next(i for i, (k, _) in enumerate(poses) if seen[k] != rows[5 * i][0])
+        raise SgtoolError(f"{path}:{rows[5 * twice][0]}: frame id {poses[twice][0]:g} is "
+                          f"given twice (first on line {seen[poses[twice][0]]}); each pose "
+                          "block's header 'i j n' names its frame i")
+    if len(seen) == len(poses):
+        poses.sort(key=lambda p: p[0])
+    return [m for _, m in poses]
 
 
 @dataclass(frozen=True)

@@ -195,3 +195,17 @@ def test_suggestions_follow_the_encodings():
     sugg = suggest_flags(topics, encodings={"/a/image": "bayer_rggb8", "/b/image_color": "rgb8"})
     # the native rgb8 topic over the Bayer one that comes first by name
     assert "--depth /a/image" not in sugg and sugg[0] == "--rgb /b/image_color"
+
+
+@pytest.mark.parametrize("kind, fmt", [("color", "jpeg"), ("depth", "png"), ("ids", "png"),
+                                       ("depth", "16UC1; compressedDepth png")])
+def test_an_empty_compressed_image_is_one_line(kind, fmt):
+    """A CompressedImage with no bytes (a dropped frame some drivers still publish):
+    one SgtoolError naming the topic, not OpenCV's assertion from an empty buffer."""
+    from sgtool.errors import SgtoolError
+
+    msg = SimpleNamespace(format=fmt, data=np.zeros(0, np.uint8))
+    decode = {"color": images.decode_color_message, "depth": images.decode_depth_message,
+              "ids": images.decode_ids_message}[kind]
+    with pytest.raises(SgtoolError, match="^topic /cam: "):
+        decode(msg, "sensor_msgs/msg/CompressedImage", "/cam")

@@ -251,3 +251,33 @@ def test_depth_for_log_keeps_millimetres_and_clears_65535():
     assert out.dtype == np.uint16 and out.tolist() == [[0, 1234, 0]]
     tum = images.depth_for_log(np.array([[5000, 0]], np.uint16), 5000.0)
     assert tum.dtype == np.float32 and tum.tolist() == [[1.0, 0.0]]
+
+
+def test_open3d_log_blocks_go_to_the_frames_their_headers_name(tmp_path: Path):
+    """Each block's header 'i j n' names its frame: blocks written out of order are put in
+    order, a frame given twice is refused, and headers that all say the same keep the
+    file's order."""
+    poses = [trans(0.1 * i, 0, 0) for i in range(4)]
+    p = tmp_path / "traj.log"
+
+    def write(ids: list[int], order: list[int]) -> None:
+        blocks = []
+        for i, k in zip(ids, order, strict=True):
+            rows = "\n".join(" ".join(f"{v:.6f}" for v in r) for r in poses[k])
+            blocks.append(f"{i} {i} {i + 1}\n{rows}\n")
+        p.write_text("".join(blocks))
+
+    write([2, 0, 3, 1], [2, 0, 3, 1])  # reversed and shuffled, each with its own id
+    assert [float(m[0, 3]) for m in textformats.read_open3d_log(p)] == \
+        pytest.approx([0.0, 0.1, 0.2, 0.3])
+    write([0, 1, 1, 3], [0, 1, 2, 3])
+    with pytest.raises(SgtoolError, match=r"traj\.log:11: frame id 1 is given twice "
+                                          r"\(first on line 6\)"):
+        textformats.read_open3d_log(p)
+    write([0, 0, 0, 0], [0, 1, 2, 3])  # ids that say nothing: the file's order
+    assert [float(m[0, 3]) for m in textformats.read_open3d_log(p)] == \
+        pytest.approx([0.0, 0.1, 0.2, 0.3])
+    p.write_text("a b c\n" + "1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n")
+    with pytest.raises(SgtoolError, match=r"traj\.log:1: expected the block header 'i j n' "
+                                          r"\(numbers\)"):
+        textformats.read_open3d_log(p)
