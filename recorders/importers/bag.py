@@ -81,6 +81,7 @@ from sgtool.recorders.importers.sanity import (
     clock_problem,
     depth_scale_problem,
     floor_problem,
+    no_depth_problem,
     timestamp_problem,
 )
 from sgtool.recorders.importers.scale_check import pose_motion_problem
@@ -137,7 +138,7 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         findings.problem(timestamp_problem(
             sorted(idx.depth.stamps), f"{path}: --depth {opts.depth} ({opts.timestamps} times)",
             BAG_TIME_FIX), given=opts.timestamps != "header")
-        check_depth_samples(idx, opts, findings)
+        check_depth_samples(idx, opts, findings, f"{path}: --depth {opts.depth}")
         checks: list[tuple[str, str]] = []
         if opts.timestamps == "header" and src is not None and src.tree is not None:
             offset = clock_offset_s([r - t for r, t in zip(idx.depth.received,
@@ -259,14 +260,17 @@ def _scale_origin(idx: BagIndex, opts: BagOptions) -> tuple[str, str]:
     return "metres", "the image encoding: 32FC1 depth is metres"
 
 
-def check_depth_samples(idx: BagIndex, opts: BagOptions, findings: Findings) -> None:
-    """The depth scale against the sampled depth images, before the frames are decoded."""
+def check_depth_samples(idx: BagIndex, opts: BagOptions, findings: Findings,
+                        what: str) -> None:
+    """The sampled depth images (``what`` names their topic): some valid pixel, and the
+    depth scale against them, before the frames are decoded."""
     if not idx.samples:
         return
+    raws = [raw for raw, _ in idx.samples.values()]
+    findings.problem(no_depth_problem(raws, what), given=False)
     raw0, scale0 = next(iter(idx.samples.values()))
     _, origin = _scale_origin(idx, opts)
-    findings.problem(depth_scale_problem([raw for raw, _ in idx.samples.values()],
-                                         _scale(raw0, scale0, opts), origin),
+    findings.problem(depth_scale_problem(raws, _scale(raw0, scale0, opts), origin),
                      given=opts.depth_scale is not None)
 
 

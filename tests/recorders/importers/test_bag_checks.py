@@ -32,9 +32,11 @@ Edit = Callable[[int, Any], None]  # (frame index, message) -> change the messag
 
 
 def write_bag(path: Path, n: int = 5, *, tf_edit: Edit | None = None,
-              pose_edit: Edit | None = None, info_edit: Edit | None = None) -> Path:
+              pose_edit: Edit | None = None, info_edit: Edit | None = None,
+              no_return: bool = False) -> Path:
     """``n`` synthetic frames as a ROS 1 bag: /tf world -> cam, a PoseStamped topic with the
-    same poses, CameraInfo and 16UC1 depth; each ``*_edit`` may spoil a message."""
+    same poses, CameraInfo and 16UC1 depth (all 0 with ``no_return``); each ``*_edit`` may
+    spoil a message."""
     with BagWriter(path, "ros1") as w:
         for i in range(n):
             k, _, depth, _, pose, _ = synthetic_frame(i)
@@ -52,7 +54,8 @@ def write_bag(path: Path, n: int = 5, *, tf_edit: Edit | None = None,
                 info_edit(i, info)
             w.write(INFO, "sensor_msgs/msg/CameraInfo", t, info)
             w.write(DEPTH, "sensor_msgs/msg/Image", t,
-                    w.image(t, "cam", (depth * 1000).round().astype(np.uint16), "16UC1"))
+                    w.image(t, "cam", (depth * 1000 * (not no_return)).round().astype(np.uint16),
+                            "16UC1"))
     return path
 
 
@@ -188,3 +191,14 @@ def test_camera_info_with_distortion_is_reported(tmp_path):
     clean = write_bag(tmp_path / "c.bag")
     rep = import_bag(clean, tmp_path / "c.mcap", opts)
     assert not rep.warnings and not any("distortion" in n for n in rep.notes)
+
+
+def test_depth_without_a_return_is_refused_as_the_folder_importer_does(tmp_path):
+    """A bag whose depth images hold no valid pixel imported with exit 0 into a log of no
+    map (the RGB-D folder importer refused it): one line naming the bag and the topic."""
+    bag = write_bag(tmp_path / "b.bag", no_return=True)
+    out = tmp_path / "o.mcap"
+    with pytest.raises(SgtoolError, match=rf"b\.bag: --depth {DEPTH}: none of the 5 sampled "
+                                          "depth images has a valid pixel"):
+        import_bag(bag, out, BagOptions(depth=DEPTH, info=INFO, **KEEP_WORLD))
+    assert not out.exists()
