@@ -113,6 +113,24 @@ class ImportReport:
         return out
 
 
+def far_camera_problem(pose: np.ndarray, what: str) -> str | None:
+    """The problem of a camera so far from the world origin that replay's voxel map (at
+    its default voxel size, seeing as far as its default range) cannot hold what it sees:
+    replay would refuse the log, so the import does; None when it is within reach."""
+    from sgtool.mapping.voxel_keys import OFFSET
+    from sgtool.mapping.voxels import VoxelConfig
+
+    cfg = VoxelConfig()
+    reach = (OFFSET - 2) * cfg.resolution - cfg.max_range
+    t = np.asarray(pose, dtype=np.float64)[:3, 3]
+    if np.all(np.abs(t) < reach):
+        return None
+    return (f"{what}: the camera at ({', '.join(f'{v:.1f}' for v in t)}) m is beyond "
+            f"+-{reach:.0f} m of the world origin, past what replay's voxel map holds; "
+            "recentre the trajectory near the origin (subtract e.g. the first pose's "
+            "position from every pose) and import it again; nothing written")
+
+
 def write_log(
     out: Path,
     frames: Iterable[ImportFrame],
@@ -150,8 +168,12 @@ def write_log(
                     w.write_record(Episode(kind="import", status="started",
                                            source=meta.get("source", ""), frames=0),
                                    fr.time_ns)
+                pose = A @ fr.pose
+                far = far_camera_problem(pose, f"frame {n} (t = {fr.time_ns} ns)")
+                if far is not None:
+                    raise SgtoolError(far)
                 try:
-                    w.write_frame(fr.time_ns, depth=fr.depth, pose=A @ fr.pose,
+                    w.write_frame(fr.time_ns, depth=fr.depth, pose=pose,
                                   intrinsics=fr.intrinsics, rgb=fr.rgb, ids=fr.ids)
                 except ValueError as e:  # what the log would hold wrong (a depth scale)
                     raise SgtoolError(f"frame {n} (t = {fr.time_ns} ns): {e}; nothing "

@@ -202,3 +202,17 @@ def test_depth_without_a_return_is_refused_as_the_folder_importer_does(tmp_path)
                                           "depth images has a valid pixel"):
         import_bag(bag, out, BagOptions(depth=DEPTH, info=INFO, **KEEP_WORLD))
     assert not out.exists()
+
+
+def test_a_trajectory_far_from_the_origin_is_refused_at_import(tmp_path):
+    """A camera 1e6 m from the origin imported with exit 0 into a log that replay then
+    refused: the import refuses it, with replay's advice, and writes nothing."""
+    def far(i, tr):
+        tr.transform.translation.x += 1e6
+
+    bag = write_bag(tmp_path / "b.bag", tf_edit=far)
+    out = tmp_path / "o.mcap"
+    with pytest.raises(SgtoolError, match=r"^frame 0 .*: the camera at \(1000000.*\) m is "
+                                          r"beyond .* recentre the trajectory"):
+        import_bag(bag, out, BagOptions(depth=DEPTH, info=INFO, **KEEP_WORLD))
+    assert not out.exists()
