@@ -44,6 +44,7 @@ from sgtool.files import (
 )
 from sgtool.replayers.derived_log import ReplayOptions
 from sgtool.replayers.golden import describe_mismatch, quality_lines, sha256_file
+from sgtool.replayers.golden_diff import paired_refreshes
 from sgtool.replayers.golden_pins import (
     INDEX,
     Capture,
@@ -160,13 +161,34 @@ def pin_folder(root: Path) -> Iterator[Path]:
     new or empty ``root`` is built beside and moved in complete (a non-empty folder that
     holds no pins is refused); a pin folder sgtool made is written in place, file by file
     atomically, the index last; a pin folder without sgtool's manifest (one kept with a
-    project's tests) likewise, as it is."""
-    if (root / INDEX).is_file() and read_manifest(root)[0] != PIN_COMMAND:
-        yield root
-        return
-    with output_folder(root, force=False, command=PIN_COMMAND, option="--dir",
-                       known=PIN_FILES, resume=(root / INDEX).is_file()) as out:
-        yield out
+    project's tests) likewise, as it is. The block holds :func:`pins_locked`: read the
+    index inside it, so that writers in several processes (``pytest -n``) keep each
+    other's pins."""
+    with pins_locked(root):
+        if (root / INDEX).is_file() and read_manifest(root)[0] != PIN_COMMAND:
+            yield root
+            return
+        with output_folder(root, force=False, command=PIN_COMMAND, option="--dir",
+                           known=PIN_FILES, resume=(root / INDEX).is_file()) as out:
+            yield out
+
+
+@contextlib.contextmanager
+def pins_locked(root: Path) -> Iterator[None]:
+    """Hold the lock of the pin folder ``root`` (an advisory lock on a file in the system's
+    temporary folder named after ``root``'s resolved path; nothing is added to ``root``):
+    one process at a time reads, changes and writes its index."""
+    import fcntl
+    import hashlib
+    import tempfile
+
+    key = hashlib.sha256(str(root.resolve()).encode()).hexdigest()[:20]
+    with open(Path(tempfile.gettempdir()) / f"sgtool-pins-{key}.lock", "a+b") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
 
 
 def _same_place(out: Path, root: Path) -> bool:
@@ -201,7 +223,6 @@ def pin_logs(logs: Sequence[str | Path] | str | Path, folder: str | Path,
     if root.is_dir() and not (root / INDEX).is_file() and any(root.iterdir()):
         raise SgtoolError(f"--dir (folder=) {root}: the folder holds files but no pins "
                           f"({INDEX}); pin into a new or empty folder")
-    old = read_pins(root).logs if (root / INDEX).is_file() else {}
     outcomes = _run(executor, _pin_task,
                     [Task(str(p), _PinTask(str(p), opts)) for p in paths], "pin", progress)
     failed = [o for o in outcomes if not o.ok]
@@ -212,9 +233,10 @@ def pin_logs(logs: Sequence[str | Path] | str | Path, folder: str | Path,
     if empty:
         raise SgtoolError(f"{empty[0]}: its replay mapped no camera frame (no depth "
                           "image?): a pin of it would check nothing")
-    logs_now = dict(old)
     with pin_folder(root) as out, \
             deferred_interrupts() if _same_place(out, root) else contextlib.nullcontext():
+        old = read_pins(root).logs if (root / INDEX).is_file() else {}  # (under the lock)
+        logs_now = dict(old)
         staged = PinSet(out, logs_now, sgtool_version=__version__)
         for p, name, o in zip(paths, names, outcomes, strict=True):
             stored = stored_path(p, root)
@@ -292,7 +314,7 @@ def _layer_counts(lines: Sequence[str]) -> dict[str, int]:
     out: dict[str, int] = {}
     for x in lines[1:]:
         layer = x.strip().split(":", 1)[0]
-        if layer.startswith("..."):
+        if layer.startswith(("...", "(")):  # "... and 5 more", a note
             continue
         out[layer] = out.get(layer, 0) + 1
     return out
@@ -337,16 +359,26 @@ def _check_task(t: _CheckTask) -> LogCheck:
         return dataclasses.replace(base, error=str(e).splitlines()[0])
     exact = t.tolerance <= 0
     actual = list(zip(cap.refreshes, cap.graphs, strict=True))
-    layers = ([(m.layers, c.layers) for m, c in zip(metas, cap.refreshes, strict=False)]
+    pinned, numbers, note = expected, list(range(len(actual))), None
+    if metas is not None:  # replayed at other times (--every): compared at the same times
+        ia, numbers, note = paired_refreshes([m.time_ns for m in metas],
+                                             [r.time_ns for r in cap.refreshes])
+        pinned, metas, actual = ([expected[i] for i in ia], [metas[i] for i in ia],
+                                 [actual[j] for j in numbers])
+    layers = ([(m.layers, c.layers) for m, (c, _) in zip(metas, actual, strict=False)]
               if metas is not None else [])
-    lines = describe_mismatch(expected, actual, tol=t.tolerance, exact=exact, layers=layers)
+    lines = describe_mismatch(pinned, actual, tol=t.tolerance, exact=exact, layers=layers,
+                              numbers=numbers)
+    if note is not None:
+        lines = (lines or [f"{len(cap.graphs)} refreshes where {len(expected)} were pinned; "
+                           "the graphs agree where both refresh"]) + [f"  ({note})"]
     decision = first_decision_change(pin.decisions, cap.decisions, cap.planner or pin.planner)
     quality = (pin.quality, cap.quality)
     q_changed = bool(quality_lines(*quality, changed_only=True)) and (exact or bool(lines))
     changed = bool(lines) or decision is not None or q_changed
     first = lines[0].removesuffix(" differs:") if lines else None
-    differing = sum(e != g for e, g in zip(expected, cap.graphs, strict=False)) + \
-        abs(len(expected) - len(cap.graphs))
+    differing = sum(e != g for e, (_, g) in zip(pinned, actual, strict=False)) + \
+        max(len(expected), len(cap.graphs)) - min(len(pinned), len(actual))
     return dataclasses.replace(
         base, status="changed" if changed else "unchanged",
         refreshes=(pin.refreshes, len(cap.graphs)), first=first, lines=tuple(lines),
@@ -416,7 +448,8 @@ def update_pins(report: CheckReport) -> list[str]:
         return []
     with pin_folder(pins.folder) as out, \
             deferred_interrupts() if _same_place(out, pins.folder) else contextlib.nullcontext():
-        staged = PinSet(out, pins.logs, sgtool_version=__version__)
+        now = read_pins(pins.folder).logs  # as other writers left it (under the lock)
+        staged = PinSet(out, now, sgtool_version=__version__)
         for c in changed:
             assert c.capture is not None
             old = pins.logs[c.name]
@@ -424,7 +457,7 @@ def update_pins(report: CheckReport) -> list[str]:
             pin = pinned_entry(c.name, old.log_path(pins.folder), old.log, opts, c.capture,
                                old.why)
             write_capture(staged, pin, c.capture)
-            pins.logs[c.name] = pin
+            pins.logs[c.name] = now[c.name] = pin
             what = c.first or "planner decisions or quality figures"
             accepted.append(f"updated {c.name}: accepted the change from {what} "
                             f"({sum(c.layers.values())} differences in it)")

@@ -28,12 +28,26 @@ from typing import Any
 import pytest
 
 
+def _tolerance(text: str) -> float:
+    """``--sgtool-golden-tolerance X``: a finite number >= 0, as ``golden check`` takes."""
+    import argparse
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value >= 0):
+        raise argparse.ArgumentTypeError(f"{text!r}: give a finite number >= 0")
+    return value
+
+
 def pytest_addoption(parser: pytest.Parser) -> None:
     group = parser.getgroup("sgtool-golden", "sgtool golden logs")
     group.addoption("--sgtool-golden", action="append", default=[], metavar="DIR",
                     help="Add one test per log pinned in DIR (`sgtool golden pin`); "
                     "repeatable.")
-    group.addoption("--sgtool-golden-tolerance", type=float, default=0.0, metavar="X",
+    group.addoption("--sgtool-golden-tolerance", type=_tolerance, default=0.0, metavar="X",
                     help="Golden logs: let differences up to X pass (m, m², scores).")
     group.addoption("--sgtool-golden-update", action="store_true",
                     help="Golden logs: re-pin changed logs instead of failing.")
@@ -128,22 +142,34 @@ class GoldenFixture:
     def check(self, log: str | Path, folder: str | Path, **options: Any) -> None:
         """Pin ``log`` into ``folder`` on first use (with the replay ``options``: ``every``,
         ``voxel_size``, ...), else check it: options given override the pinned ones for
-        this check, as ``sgtool golden check --voxel-size`` does, the others are as pinned.
-        A ``log`` that is not the log pinned under its name (another path and other bytes)
-        fails, one re-recorded in its place fails as ``golden check`` says; both are
-        re-pinned under ``--sgtool-golden-update``."""
-        from sgtool.analysis.golden_check import check_pins, pin_logs, pin_name, update_pins
+        this check, as ``sgtool golden check --voxel-size`` does, the others are as pinned;
+        such a what-if check is never re-pinned. A ``log`` that is not the log pinned under
+        its name (another path and other bytes) fails, one re-recorded in its place fails as
+        ``golden check`` says; both are re-pinned under ``--sgtool-golden-update``. A
+        mistake in the call (an unknown option, a damaged pin folder) fails in one line."""
+        from sgtool.errors import SgtoolError
         from sgtool.replayers.derived_log import ReplayOptions
-        from sgtool.replayers.golden import sha256_file
-        from sgtool.replayers.golden_pins import INDEX, read_pins
 
-        log, folder = Path(log), Path(folder)
+        try:  # a mistake in the call (an unknown option, a damaged pin folder): one line
+            given = ReplayOptions(**options) if options else None
+        except (SgtoolError, TypeError) as e:
+            pytest.fail(f"sgtool_golden.check({log}): {e}", pytrace=False)
+        try:
+            self._check(Path(log), Path(folder), given)
+        except SgtoolError as e:
+            pytest.fail(f"sgtool_golden.check({log}): {e}", pytrace=False)
+
+    def _check(self, log: Path, folder: Path, given: Any) -> None:
+        from sgtool.analysis.golden_check import check_pins, pin_logs, pin_name, update_pins
+        from sgtool.replayers.golden import sha256_file
+        from sgtool.replayers.golden_pins import INDEX, overridden, read_pins
+
         if not log.is_file():
             pytest.fail(f"{log}: no such log", pytrace=False)
         name = pin_name(log)
         pin = read_pins(folder).logs.get(name) if (folder / INDEX).is_file() else None
         if pin is None:
-            pin_logs([log], folder, ReplayOptions(**options))
+            pin_logs([log], folder, given)
             pytest.fail(f"pinned {log} into {folder} (first run); commit the pin and run "
                         "again", pytrace=False)
         if sha256_file(log) != pin.log_sha256:  # (a --copy pin holds the same bytes)
@@ -155,10 +181,12 @@ class GoldenFixture:
                             f"({pin.log_path(folder)}): pins are named by file name, give "
                             "each log its own name or folder (or re-pin with pytest "
                             "--sgtool-golden-update)", pytrace=False)
-        report = check_pins(folder, ReplayOptions(**options) if options else None,
-                            tolerance=self.tolerance, names=[name], keep=self.update)
+        # options that change the pinned ones ask "what would this do": never re-pinned
+        what_if = given is not None and overridden(pin.options, given) != pin.options
+        report = check_pins(folder, given, tolerance=self.tolerance, names=[name],
+                            keep=self.update and not what_if)
         c = report.logs[0]
-        if c.status == "changed" and self.update:
+        if c.status == "changed" and self.update and not what_if:
             update_pins(report)
             return
         if c.status != "unchanged":

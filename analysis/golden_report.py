@@ -61,30 +61,53 @@ def text_report(report: CheckReport) -> list[str]:
     return out
 
 
-def markdown_report(report: CheckReport) -> str:
-    """``--report FILE.md``: the per-log reports as sections, then the summary table."""
+def markdown_report(report: CheckReport, accepted: Sequence[str] = ()) -> str:
+    """``--report FILE.md``: the per-log reports as sections, then the summary table;
+    ``accepted``: what ``--update`` accepted (one line per log), as its last section."""
     parts = [f"# Golden check of {report.pins.folder}", "", summary_line(report), ""]
     for c in report.logs:
         lines = c.report()
         parts += [f"## {c.name}: {c.status}", "", "```", *lines, "```", ""]
     parts += ["## Summary", "", pipe_table(HEADER, summary_rows(report.logs)), ""]
+    if accepted:
+        parts += ["## Accepted (--update)", "", *(f"- {x}" for x in accepted), ""]
     return "\n".join(parts)
 
 
-def junit_report(report: CheckReport) -> str:
-    """``--junit FILE.xml``: one ``testcase`` per log (JUnit XML as CI systems read it)."""
-    n = report.counts()
+def junit_report(report: CheckReport, accepted: Sequence[str] = ()) -> str:
+    """``--junit FILE.xml``: one ``testcase`` per log (JUnit XML as CI systems read it); a
+    changed log whose change ``--update`` accepted (``accepted`` names it) passes, with
+    the acceptance as its output."""
+    done = {line.split(":", 1)[0].removeprefix("updated ") for line in accepted}
     cases = []
+    failures = errors = 0
     for c in report.logs:
         body = ""
         text = escape("\n".join(c.report()))
-        if c.status == "changed":
+        if c.status == "changed" and c.name in done:
+            body = f"<system-out>{text}</system-out>"
+        elif c.status == "changed":
+            failures += 1
             body = f"<failure message={quoteattr(c.first or 'changed')}>{text}</failure>"
         elif c.status == "error":
+            errors += 1
             body = f"<error message={quoteattr(c.error or 'error')}>{text}</error>"
         cases.append(f'  <testcase classname="sgtool.golden" name={quoteattr(c.name)}>'
                      f"{body}</testcase>")
     return ("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
             f"<testsuite name=\"sgtool golden\" tests=\"{len(report.logs)}\" "
-            f"failures=\"{n['changed']}\" errors=\"{n['error']}\">\n"
+            f"failures=\"{failures}\" errors=\"{errors}\">\n"
             + "\n".join(cases) + "\n</testsuite>\n")
+
+
+def error_reports(folder: str, error: str) -> tuple[str, str]:
+    """(Markdown, JUnit XML) of a check that could not start (a damaged or missing pin
+    folder): one error, so a report left by an earlier check is never taken for this
+    one."""
+    md = f"# Golden check of {folder}\n\nerror: {error}\n"
+    xml = ("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
+           "<testsuite name=\"sgtool golden\" tests=\"1\" failures=\"0\" errors=\"1\">\n"
+           f'  <testcase classname="sgtool.golden" name={quoteattr(folder)}>'
+           f"<error message={quoteattr(error)}>{escape(error)}</error></testcase>\n"
+           "</testsuite>\n")
+    return md, xml

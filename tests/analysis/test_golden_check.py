@@ -495,3 +495,38 @@ def test_update_pins_needs_a_report_that_kept_its_replays(pinned) -> None:
         update_pins(report)
     assert update_pins(check_pins(pinned, coarse, keep=True)) != []
     assert check_pins(pinned, coarse).exit_code == 0  # accepted
+
+
+def test_another_every_is_compared_at_the_times_both_refresh(pinned, capsys):
+    """--every 5 against a pin of every 10: refreshes are paired by time (the pinned 3 s
+    graph with the new 3 s graph, not with the new refresh 0 at 1.5 s), and the report
+    says so."""
+    code, out, _ = sgtool(capsys, "golden", "check", "--dir", pinned, "--every", "5")
+    assert code == 1
+    assert "small: changed" in out and "compared where both refresh" in out
+    assert "refresh 0 at 1.500 s" not in out  # no graph at 1.5 s was pinned
+    heads = [x for x in out.splitlines() if " differs:" in x]
+    for head in heads:  # a refresh of the new replay that the pin has a graph for too
+        assert any(f"at {t:.3f} s" in head for t in (3.0, 6.0, 9.0)) or "refreshes where" \
+            in head, head
+
+
+def test_reports_say_what_this_check_did(pinned, tmp_path, capsys):
+    """--update's accepted change passes in the JUnit file (exit 0 agrees), and a check
+    that cannot start (a damaged index) replaces an earlier all-green report with its
+    error instead of leaving it."""
+    md, xml = tmp_path / "r.md", tmp_path / "j.xml"
+    code, out, _ = sgtool(capsys, "golden", "check", "--dir", pinned, "--voxel-size", "0.08",
+                          "--update", "--report", md, "--junit", xml)
+    assert code == 0 and "updated small: accepted" in out
+    assert 'failures="0" errors="0"' in xml.read_text() and "<system-out>" in xml.read_text()
+    assert "## Accepted (--update)" in md.read_text()
+    code, _, _ = sgtool(capsys, "golden", "check", "--dir", pinned, "--report", md,
+                        "--junit", xml)
+    assert code == 0 and 'tests="1" failures="0" errors="0"' in xml.read_text()
+    (pinned / "expected.json").write_text("{damaged")
+    code, _, err = sgtool(capsys, "golden", "check", "--dir", pinned, "--report", md,
+                          "--junit", xml)
+    assert code == 2 and "damaged pin file" in err
+    assert 'errors="1"' in xml.read_text() and "damaged pin file" in xml.read_text()
+    assert "error: " in md.read_text() and "unchanged" not in md.read_text()

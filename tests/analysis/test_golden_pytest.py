@@ -70,6 +70,12 @@ def test_the_example_test_runs_with_the_fixture(tmp_path, monkeypatch):
     code, out = pytest_run(REPO / "examples" / "test_golden_logs.py", cwd=REPO)
     assert code == 0, out
     assert "2 passed" in out
+    # its what-if check (a coarser map) is never re-pinned, even under update
+    index = (pins / "expected.json").read_bytes()
+    code, out = pytest_run(REPO / "examples" / "test_golden_logs.py", "--sgtool-golden-update",
+                           cwd=REPO)
+    assert code == 0 and "2 passed" in out, out
+    assert (pins / "expected.json").read_bytes() == index
 
 
 def test_the_fixture_refuses_another_log_of_the_pinned_name(tmp_path, monkeypatch):
@@ -133,3 +139,38 @@ def test_the_fixture_re_pins_a_log_re_recorded_in_its_place_under_update(tmp_pat
     assert code == 0, out
     code, out = pytest_run("test_lab.py", cwd=tmp_path)
     assert code == 0, out
+
+
+def test_updates_from_parallel_workers_keep_each_others_pins(tmp_path):
+    """pytest -n 2 --sgtool-golden-update: each worker re-pins its log under the folder's
+    lock and re-reads the index there, so neither drops the other's entry."""
+    logs = []
+    for name in ("a", "b"):
+        logs.append(tmp_path / f"{name}.mcap")
+        shutil.copyfile(GOLDEN / "house10-start.mcap", logs[-1])
+    folder = tmp_path / "pins"
+    pin_logs(logs, folder, ReplayOptions(max_frames=20, voxel_size=0.08), copy=True)
+    index = json.loads((folder / "expected.json").read_text())
+    for name in ("a", "b"):  # pins of 8 cm voxels that say 5 cm: both changed
+        del index["cases"][name]["options"]["voxel_size"]
+    (folder / "expected.json").write_text(json.dumps(index))
+    code, out = pytest_run("--sgtool-golden", folder, "--sgtool-golden-update", "-n", "2",
+                           cwd=tmp_path)
+    assert code == 0 and "2 passed" in out, out
+    code, out = pytest_run("--sgtool-golden", folder, cwd=tmp_path)
+    assert code == 0 and "2 passed" in out, out
+
+
+def test_fixture_mistakes_and_a_bad_tolerance_are_one_line(tmp_path):
+    shutil.copyfile(GOLDEN / "house10-start.mcap", tmp_path / "run.mcap")
+    pin_logs([tmp_path / "run.mcap"], tmp_path / "pins", ReplayOptions(max_frames=20))
+    (tmp_path / "test_lab.py").write_text(
+        "from pathlib import Path\nHERE = Path(__file__).parent\n\n"
+        "def test_run(sgtool_golden):\n"
+        "    sgtool_golden.check(HERE / 'run.mcap', HERE / 'pins', voxel=0.08)\n")
+    code, out = pytest_run("test_lab.py", cwd=tmp_path)
+    assert code == 1 and "sgtool_golden.check(" in out and "voxel" in out, out
+    assert "Traceback" not in out and "golden_pytest.py" not in out, out
+    code, out = pytest_run("--sgtool-golden", tmp_path / "pins", "--sgtool-golden-tolerance",
+                           "nan", cwd=tmp_path)
+    assert code == 4 and "'nan': give a finite number >= 0" in out, out

@@ -7,9 +7,10 @@ options and prints or writes the reports (:mod:`sgtool.analysis.golden_report`).
 
 from __future__ import annotations
 
+import contextlib
 import shlex
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -145,18 +146,18 @@ def check(folder: str, names: tuple[str, ...], every: int | None, classifier: st
 
     _check_report_files(report_md, junit)
     runner = make_executor(executor, workers, ray_address)
-    report = check_pins(Path(folder),
-                        make_options(every, classifier, min_points, voxel_size, max_frames),
-                        tolerance=tolerance, executor=runner, names=names or None,
-                        keep=update, progress=_show(progress))
+    with _reported_error(folder, report_md, junit):
+        report = check_pins(Path(folder),
+                            make_options(every, classifier, min_points, voxel_size, max_frames),
+                            tolerance=tolerance, executor=runner, names=names or None,
+                            keep=update, progress=_show(progress))
     for line in text_report(report):
         click.echo(line)
-    _write_report_files(report, report_md, junit)
-    code = report.exit_code
-    if update:
-        for line in update_pins(report) or ["nothing to accept: no pinned log changed"]:
-            click.echo(line)
-        code = 2 if code == 2 else 0
+    accepted = update_pins(report) if update else []
+    _write_report_files(report, report_md, junit, accepted)
+    for line in (accepted or ["nothing to accept: no pinned log changed"]) if update else ():
+        click.echo(line)
+    code = 2 if report.exit_code == 2 else 0 if update else report.exit_code
     if code == 2:
         first = next(c for c in report.logs if c.status == "error")
         raise SgtoolError(f"{report.counts()['error']} pinned log(s) could not be checked; "
@@ -190,12 +191,29 @@ def _check_report_files(report_md: str | None, junit: str | None) -> None:
                           "(the second would replace the first)")
 
 
-def _write_report_files(report: Any, report_md: str | None, junit: str | None) -> None:
-    """The Markdown report and the JUnit XML of a check, each written atomically."""
-    from sgtool.analysis.golden_report import junit_report, markdown_report
+@contextlib.contextmanager
+def _reported_error(folder: str, report_md: str | None, junit: str | None) -> Iterator[None]:
+    """A check that cannot start (a damaged pin folder): the report files say so, so one
+    left by an earlier check is never read as this one's."""
+    try:
+        yield
+    except SgtoolError as e:
+        _write_report_files(None, report_md, junit, error=(folder, str(e)))
+        raise
+
+
+def _write_report_files(report: Any, report_md: str | None, junit: str | None,
+                        accepted: Sequence[str] = (),
+                        error: tuple[str, str] | None = None) -> None:
+    """The Markdown report and the JUnit XML of a check (with what ``--update``
+    ``accepted``), or of the ``error`` (folder, message) that stopped it, each written
+    atomically."""
+    from sgtool.analysis.golden_report import error_reports, junit_report, markdown_report
     from sgtool.files import atomic_write
 
+    md, xml = error_reports(*error) if error is not None else (
+        markdown_report(report, accepted), junit_report(report, accepted))
     if report_md:
-        atomic_write(report_md, markdown_report(report))
+        atomic_write(report_md, md)
     if junit:
-        atomic_write(junit, junit_report(report))
+        atomic_write(junit, xml)
