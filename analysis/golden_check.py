@@ -39,7 +39,6 @@ from sgtool.files import (
     atomic_output,
     deferred_interrupts,
     output_folder,
-    quoted,
     read_manifest,
 )
 from sgtool.replayers.derived_log import ReplayOptions
@@ -340,6 +339,19 @@ def first_decision_change(pinned: Sequence[Decision] | None, now: Sequence[Decis
     return None
 
 
+def pin_command(pin: Pinned, log: Path, folder: Path) -> str:
+    """The ``sgtool golden pin`` command that pins ``log`` again as ``pin`` was pinned:
+    its replay options and its note (a bare command would reset them)."""
+    import shlex
+
+    words = ["sgtool", "golden", "pin", str(log), "--dir", str(folder)]
+    for k, v in sorted(options_dict(pin.options).items()):
+        words += ["--" + k.replace("_", "-"), str(v)]
+    if pin.why:
+        words += ["--why", pin.why]
+    return shlex.join(words)
+
+
 def _check_task(t: _CheckTask) -> LogCheck:
     folder, pin = Path(t.folder), t.pin
     pins = PinSet(folder, {pin.name: pin})
@@ -348,11 +360,11 @@ def _check_task(t: _CheckTask) -> LogCheck:
     try:
         if not log.is_file():
             raise PinError(f"pinned log {log} is missing (moved or deleted? put it back, or "
-                           f"pin it again with `sgtool golden pin {quoted(log)} --dir "
-                           f"{quoted(folder)}`)")
+                           f"pin it again with `{pin_command(pin, log, folder)}`)")
         if sha256_file(log) != pin.log_sha256:
-            raise PinError(f"{log} is not the pinned log (its sha256 differs); pin it again "
-                           "if it was re-recorded on purpose")
+            raise PinError(f"{log} is not the pinned log (its sha256 differs); if it was "
+                           "re-recorded on purpose, pin it again with its settings: "
+                           f"`{pin_command(pin, log, folder)}`")
         expected, metas = load_expected(pins, pin.name)
         cap = capture_log(log, t.options)
     except SgtoolError as e:
@@ -419,6 +431,9 @@ def check_pins(folder: str | Path, options: ReplayOptions | None = None, *,
     (m, m², scores): differences up to it pass (0: byte-exact graphs); ``keep``: keep the
     new replay of changed logs for :func:`update_pins`."""
     pins = read_pins(folder)
+    if not pins.logs:  # a check of nothing would pass a CI job whose pins were lost
+        raise PinError(f"{pins.folder}: its index pins no log; pin some with `sgtool golden "
+                       "pin LOG --dir DIR`")
     chosen = sorted(pins.logs) if names is None else list(dict.fromkeys(names))  # each once
     for n in chosen:
         if n not in pins.logs:

@@ -530,3 +530,25 @@ def test_reports_say_what_this_check_did(pinned, tmp_path, capsys):
     assert code == 2 and "damaged pin file" in err
     assert 'errors="1"' in xml.read_text() and "damaged pin file" in xml.read_text()
     assert "error: " in md.read_text() and "unchanged" not in md.read_text()
+
+
+def test_a_re_recorded_log_is_told_how_to_pin_it_with_its_settings(log, tmp_path, capsys):
+    """The hint of a log whose bytes changed gives the pin command with the pinned options
+    and note (a bare `golden pin` would reset them); an index of no pins is refused."""
+    mine = tmp_path / "small.mcap"
+    shutil.copyfile(log, mine)
+    folder = tmp_path / "g"
+    code, _, _ = sgtool(capsys, "golden", "pin", mine, "--dir", folder, "--every", "5",
+                        "--max-frames", "20", "--why", "the lab's kitchen")
+    assert code == 0
+    shutil.copyfile(GOLDEN / "house6-tour.mcap", mine)  # re-recorded in its place
+    code, out, err = sgtool(capsys, "golden", "check", "--dir", folder)
+    assert code == 2
+    hint = f"sgtool golden pin {mine} --dir {folder} --every 5 --max-frames 20 --why " \
+        "'the lab'\"'\"'s kitchen'"
+    assert hint in out + err, out + err
+    index = json.loads((folder / "expected.json").read_text())
+    index["cases"] = {}
+    (folder / "expected.json").write_text(json.dumps(index))
+    code, _, err = sgtool(capsys, "golden", "check", "--dir", folder)
+    assert code == 2 and "its index pins no log" in err
