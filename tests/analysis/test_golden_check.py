@@ -149,7 +149,8 @@ def test_a_moved_log_is_one_line_naming_it(log, tmp_path, capsys):
     assert code == 2
     assert err.count("\n") == 1 and "Traceback" not in err
     assert str(mine) in err and "missing" in err
-    assert f"`sgtool golden pin {mine.resolve()} --dir {folder}`" in err  # pastes as it is
+    # pastes as it is, with the pin's settings
+    assert f"`sgtool golden pin {mine.resolve()} --dir {folder} --max-frames 30`" in err
     assert "small: error:" in out
 
 
