@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 from support.scripted_planner import Scripted
+from support.seed0_episodes import seed0_episode
 
 from sgtool.datasets.generator import generate_house
 from sgtool.house.spec import room_at
@@ -17,7 +18,7 @@ from sgtool.log import LogReader
 from sgtool.log.records import SceneGraphRecord
 from sgtool.planning.base import Action
 from sgtool.recorders.sim import CameraConfig
-from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
+from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, run_episode
 from sgtool.results import EpisodeResult, write_jsonl
 
 TOOL = Path(__file__).resolve().parents[1] / "tools" / "closed_loop_misses.py"
@@ -44,7 +45,7 @@ def test_a_give_up_is_a_miss_of_the_search(tmp_path: Path, capsys: pytest.Captur
     (tmp_path / "logs").mkdir()
     # the first episode whose target is not in view but whose room the map holds
     for index in range(len(house.objects)):
-        idx, ep = pick_episode(house, index=index)
+        idx, ep = seed0_episode(house, index)
         log = tmp_path / "logs" / f"ep-{idx}.mcap"
         rep = run_episode(house, ep, Scripted([Action("done")]), log, opts,
                           house_id="house-0", episode_index=idx)

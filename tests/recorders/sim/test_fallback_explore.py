@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 from support.scripted_planner import Scripted
+from support.seed0_episodes import seed0_episode
 
 from sgtool.cli import cli
 from sgtool.datasets.episodes import list_episodes
@@ -36,7 +37,7 @@ from sgtool.planning.candidates import actionable
 from sgtool.planning.registry import make_planner
 from sgtool.recorders.sim import CameraConfig
 from sgtool.recorders.sim import closed_loop as cl
-from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
+from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, run_episode
 from sgtool.recorders.sim.fallback_explore import (
     FallbackOptions,
     FallbackRun,
@@ -59,9 +60,9 @@ def house():
 
 def _open_start(house) -> tuple[int, object]:
     """An episode whose start room has a way out (episode 0's door is closed)."""
-    for k in range(len(list_episodes(house))):
-        idx, ep = pick_episode(house, index=k)
-        if ep.start.room != pick_episode(house, index=0)[1].start.room:
+    for k in range(len(list_episodes(house, seed=0))):
+        idx, ep = seed0_episode(house, k)
+        if ep.start.room != seed0_episode(house, 0)[1].start.room:
             return idx, ep
     raise AssertionError("no episode starts in another room")
 

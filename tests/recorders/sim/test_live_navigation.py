@@ -21,6 +21,7 @@ import pytest
 from click.testing import CliRunner
 from support.bag_read import read_bag
 from support.scripted_planner import Scripted
+from support.seed0_episodes import seed0_episode
 
 from sgtool.cli import cli
 from sgtool.datasets.episodes import list_episodes
@@ -33,7 +34,7 @@ from sgtool.planning.base import Action
 from sgtool.planning.candidates import actionable
 from sgtool.planning.registry import make_planner
 from sgtool.recorders.sim import CameraConfig, Simulation
-from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
+from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, run_episode
 from sgtool.recorders.sim.live_skills import (
     LiveNavConfig,
     PrivilegedAccess,
@@ -59,7 +60,7 @@ def _unexplored_room(g):
 def test_unreachable_goal_fails_with_its_reason_in_the_log(house, tmp_path) -> None:
     # episode 0 starts in a room whose only door to room:1 is closed: after the look
     # around the graph knows room:1 through that door, but the map holds no way there
-    idx, ep = pick_episode(house, index=0)
+    idx, ep = seed0_episode(house, 0)
     p = Scripted([_unexplored_room] + [Action("done")] * 20)  # give-ups may hand over
     out = tmp_path / "unreachable.mcap"
     run_episode(house, ep, p, out, OPTS, episode_index=idx)
@@ -86,7 +87,7 @@ def test_the_robot_side_never_reads_the_house(house, tmp_path, monkeypatch) -> N
 
     for name in ("occupancy", "navigate", "explore", "closed_doors_on_way", "room_of_base"):
         monkeypatch.setattr(Simulation, name, forbidden)
-    idx, ep = pick_episode(house, index=3)
+    idx, ep = seed0_episode(house, 3)
     rep = run_episode(house, ep, make_planner("random"), tmp_path / "guarded.mcap",
                       ClosedLoopOptions(camera=OPTS.camera, max_steps=3, frames=300),
                       episode_index=idx)
@@ -121,8 +122,8 @@ def _open_first_container(g):
 def _first_open(house, opts, stem):
     """(episode index, log, planner, feedback) of the first episode of ``house`` whose
     first action opens a container successfully (logs ``STEM-K.mcap``)."""
-    for k in range(len(list_episodes(house))):
-        idx, ep = pick_episode(house, index=k)
+    for k in range(len(list_episodes(house, seed=0))):
+        idx, ep = seed0_episode(house, k)
         p = Scripted([_open_first_container, Action("done")])
         out = stem.with_name(f"{stem.name}-{k}.mcap")
         run_episode(house, ep, p, out, opts, episode_index=idx)
@@ -173,7 +174,7 @@ def test_a_container_is_opened_from_in_front_of_it(tmp_path) -> None:
     of 4 rooms, episode 1) the nearest stand within reach is 64 degrees off the front,
     where the side board hides the inside; the front stand is 31 degrees off."""
     house = generate_house(1, rooms=(4, 4))
-    idx, ep = pick_episode(house, index=1)
+    idx, ep = seed0_episode(house, 1)
     p = Scripted([_open_first_container, Action("done")])
     out = tmp_path / "front.mcap"
     run_episode(house, ep, p, out,
@@ -198,7 +199,7 @@ def test_looking_in_only_after_an_open_from_the_side(tmp_path, beyond) -> None:
     of the test above) it opens from 31 degrees off the piece's front: within 60 degrees
     it stays where it opened, beyond 10 degrees it backs off to 1.4 m in front."""
     house = generate_house(1, rooms=(4, 4))
-    idx, ep = pick_episode(house, index=1)
+    idx, ep = seed0_episode(house, 1)
     p = Scripted([_open_first_container, Action("done")])
     out = tmp_path / "side.mcap"
     live = LiveNavConfig(peek=False, look_in=1.4, look_in_beyond=beyond)
@@ -378,7 +379,7 @@ def test_examining_an_open_container_peeks_into_it(house, tmp_path) -> None:
     """A navigate to a container that stands open (a bookcase, a sink) examines it; with
     ``peek`` the head then tilts into it and back, as after an open; driving elsewhere
     or opening a door does not tilt it."""
-    idx, ep = pick_episode(house, index=3)  # its fifth action examines a bookcase
+    idx, ep = seed0_episode(house, 3)  # its fifth action examines a bookcase
     p = Scripted([_examine_or_explore] * 8)
     out = tmp_path / "examine.mcap"
     opts = dataclasses.replace(OPTS, live=LiveNavConfig(peek=True), max_steps=8)
@@ -416,7 +417,7 @@ def test_an_explore_goes_on_through_its_frontier(house, tmp_path) -> None:
     explore of the same episode travels farther and ends farther from the start than
     without (by at most the extra metres, snapped to a reachable cell). Episode 1 starts
     where six frontiers are on offer after the look-around."""
-    idx, ep = pick_episode(house, index=1)
+    idx, ep = seed0_episode(house, 1)
     runs = {}
     for through in (0.0, 1.5):
         p = Scripted([_explore_farthest_frontier, Action("done")])

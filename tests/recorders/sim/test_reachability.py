@@ -18,6 +18,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 from support.scripted_planner import Scripted
+from support.seed0_episodes import seed0_episode
 
 from sgtool.datasets.generator import generate_house
 from sgtool.log import LogReader
@@ -27,7 +28,7 @@ from sgtool.mapping.occupancy import geodesic_distances
 from sgtool.planning.base import Action
 from sgtool.planning.candidates import actionable
 from sgtool.recorders.sim import CameraConfig
-from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, pick_episode, run_episode
+from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, run_episode
 from sgtool.recorders.sim.live_goals import Goal
 from sgtool.recorders.sim.live_skills import LiveNavConfig, LiveSkills
 from sgtool.recorders.sim.navigation import RobotConfig
@@ -108,7 +109,7 @@ def house():
 def test_the_planner_is_not_offered_a_room_its_map_cannot_reach(house, tmp_path) -> None:
     # episode 0 starts in a room whose only door to room:1 is closed (test_live_navigation):
     # the scene graph knows room:1, the robot's map holds no way there
-    idx, ep = pick_episode(house, index=0)
+    idx, ep = seed0_episode(house, 0)
     p = Scripted([Action("done")])
     out = tmp_path / "view.mcap"
     run_episode(house, ep, p, out,
