@@ -127,9 +127,11 @@ class _Executor:
         if not tasks:  # nothing to do: no pool, no Ray start-up
             return []
         done: dict[int, Outcome] = {}
+        # no bar object at all without progress: tqdm makes a multiprocessing lock even
+        # when disabled, which fixes the process's start method for its caller
         with self._session(fn) as backend, tqdm(
-                total=len(tasks), desc=desc, unit="task", disable=not progress,
-                file=sys.stderr, dynamic_ncols=True) as bar:
+                total=len(tasks), desc=desc, unit="task", file=sys.stderr,
+                dynamic_ncols=True) if progress else contextlib.nullcontext(_NoBar()) as bar:
             queue = list(range(len(tasks)))[::-1]
             attempts = [0] * len(tasks)
             flight: dict[Any, int] = {}
@@ -162,6 +164,13 @@ class _Executor:
 
     def _session(self, fn: Callable[[Any], Any]) -> Any:
         raise NotImplementedError
+
+
+class _NoBar:
+    """What a run counts its tasks on when no progress bar is shown."""
+
+    def update(self, n: int = 1) -> None:
+        pass
 
 
 class _Inline:

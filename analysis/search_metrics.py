@@ -32,6 +32,7 @@ deviation (ddof = 1; none, "-", with one seed) over seeds. Efficiency curves poo
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
@@ -88,7 +89,8 @@ def cost_models(distance_budget: float = DISTANCE_BUDGET, step_budget: float = S
     """The two cost models with other budgets or unit costs."""
     dist = CostModel(
         "distance", f"travelled / {step_m:g} m + {open_cost:g} per open (low-level steps)",
-        float(distance_budget), lambda r: distance_cost(r, step_m, open_cost),
+        float(distance_budget), functools.partial(distance_cost, step_m=step_m,
+                                                  open_cost=open_cost),
     )
     return dist, CostModel("steps", "high-level steps", float(step_budget), step_cost)
 

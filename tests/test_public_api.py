@@ -336,3 +336,26 @@ def test_bench_config_shapes(tmp_path) -> None:
     for rooms in (5, (12, 16, 3)):
         with pytest.raises(sgtool.SgtoolError, match="rooms: give"):
             sgtool.BenchConfig(planners=("scout",), rooms=rooms)  # type: ignore[arg-type]
+
+
+def test_results_a_user_sends_to_a_pool_pickle(tmp_path) -> None:
+    """A cost model, an interrupted write and the embedding cache survive pickling (a
+    pool's arguments and results): the cache's copy opens its own connection."""
+    import pickle
+
+    import numpy as np
+
+    from sgtool.log.writer import InterruptedWrite
+    from sgtool.results import EpisodeResult
+    from sgtool.semantics.cache import EmbeddingCache
+
+    dist, steps = sgtool.cost_models(step_m=0.5)
+    r = EpisodeResult("greedy", 0, "h", 0, "mug", True, 3, 2.0, 1.0, n_open=1)
+    assert pickle.loads(pickle.dumps(dist)).cost(r) == dist.cost(r)
+    assert pickle.loads(pickle.dumps(steps)).cost(r) == 3.0
+    back = pickle.loads(pickle.dumps(InterruptedWrite("kept x.partial", Path("x.partial"))))
+    assert (str(back), back.partial) == ("kept x.partial", Path("x.partial"))
+    cache = EmbeddingCache(tmp_path / "e.sqlite")
+    cache.put_many("m", [("mug", np.ones(3, np.float32))])
+    copy = pickle.loads(pickle.dumps(cache))
+    assert list(copy.get_many("m", ["mug"])["mug"]) == [1.0, 1.0, 1.0]

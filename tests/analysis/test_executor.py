@@ -257,3 +257,19 @@ def test_sgtool_machine_id_makes_a_process_another_machine(tmp_path, monkeypatch
 def test_a_task_on_this_machine_names_no_node():
     outs = LocalExecutor(1).run(abs, [Task("a", -2)])
     assert outs == [Outcome("a", 2, None, 1, "")]
+
+
+def test_a_run_without_progress_leaves_the_start_method_unset() -> None:
+    """run_benchmark(progress=False) in a user's process: no progress bar object is made,
+    so multiprocessing's start method stays the caller's to set (tqdm made a lock that
+    fixed it, and set_start_method("spawn") then failed)."""
+    import subprocess
+    import sys
+
+    code = ("import multiprocessing as mp\n"
+            "from sgtool.analysis.executor import LocalExecutor, Task\n"
+            "LocalExecutor(1).run(abs, [Task('a', -1)])\n"
+            "mp.set_start_method('spawn')\nprint('ok')\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120)
+    assert done.stdout.strip() == "ok", done.stderr

@@ -79,6 +79,9 @@ class InterruptedWrite(KeyboardInterrupt):
         self.note = note
         self.partial = partial
 
+    def __reduce__(self) -> tuple[Any, ...]:  # pickles (from a worker process) as built
+        return type(self), (self.note, self.partial)
+
 
 class TerminatedWrite(InterruptedWrite, Terminated):
     """:class:`InterruptedWrite` after a kill (SIGTERM): still a

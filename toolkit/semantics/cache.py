@@ -19,6 +19,7 @@ import sqlite3
 import threading
 from collections.abc import Iterable, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -51,6 +52,15 @@ class EmbeddingCache:
         self._conn: sqlite3.Connection | None = None
         self._lock = threading.Lock()
         self._broken = False
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The path and whether it failed: a copy (in another process) opens its own
+        connection when first used."""
+        return {"path": self.path, "broken": self._broken}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__(state["path"])  # type: ignore[misc]
+        self._broken = state["broken"]
 
     def _connect(self) -> sqlite3.Connection | None:
         if self._broken:
