@@ -101,7 +101,7 @@ from sgtool.analysis.report import (
     summary_dict,
 )
 from sgtool.analysis.search_metrics import CostModel, breakdown, cost_models, seen_unseen, summarize
-from sgtool.arg_checks import of_type
+from sgtool.arg_checks import of_type, whole
 from sgtool.canonical import strict_json
 from sgtool.files import atomic_write, output_dir, output_folder
 from sgtool.planning.episode import SUCCESS_RULES
@@ -161,6 +161,8 @@ class BenchConfig:
         object.__setattr__(self, "rooms", config_rooms(self.rooms))
 
     def check(self) -> None:
+        for name in ("houses", "episodes", "seeds", "max_steps", "workers"):
+            whole(name, getattr(self, name))  # "2" or 2.5 from Python: one line
         check_planner_list(self.planners)
         if len(set(self.planners)) != len(self.planners):
             raise BenchError("--planners: a planner is named twice")

@@ -76,6 +76,7 @@ from sgtool.analysis.run_bench_resume import (
 )
 from sgtool.analysis.search_metrics import CostModel, cost_models, summarize
 from sgtool.arg_checks import progress as check_progress
+from sgtool.arg_checks import whole
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
 from sgtool.extras import require
@@ -140,6 +141,8 @@ class ClosedLoopBenchConfig:
     def check(self) -> None:
         from sgtool.analysis.bench_planner_checks import check_planner_list, check_reference
 
+        for name in ("houses", "episodes"):
+            whole(name, getattr(self, name))  # "2" or 2.5 from Python: one line
         check_planner_list(self.planners)
         if len(set(self.planners)) != len(self.planners) or \
                 len(set(self.noise)) != len(self.noise):

@@ -40,6 +40,7 @@ from typing import TypeVar
 
 import numpy as np
 
+from sgtool.errors import ArgumentError
 from sgtool.results import EpisodeResult, episode_spl
 
 
@@ -135,11 +136,11 @@ def efficiency_curve(costs: Sequence[float], successes: Sequence[bool], max_cost
     y). Costs are clipped below at 0.
     """
     if len(costs) != len(successes):
-        raise ValueError("costs and successes differ in length")
+        raise ArgumentError("costs and successes differ in length")
     if not max_cost > 0:
-        raise ValueError("max_cost must be > 0")
+        raise ArgumentError("max_cost must be > 0")
     if any(math.isnan(float(c)) for c in costs):
-        raise ValueError("costs: a NaN cost has no place on the curve")
+        raise ArgumentError("costs: a NaN cost has no place on the curve")
     n = len(costs)
     if n == 0:
         return np.array([0.0, float(max_cost)]), np.array([0.0, 0.0])
@@ -313,7 +314,7 @@ def breakdown(results: Sequence[EpisodeResult], by: str,
     """SR, SPL and mean steps per (house or query, planner), ``by`` = "house" or "query";
     rows sorted by key (plain string order), then by planner in ``planners`` order."""
     if by not in ("house", "query"):
-        raise ValueError(f"by must be 'house' or 'query', got {by!r}")
+        raise ArgumentError(f"by must be 'house' or 'query', got {by!r}")
     order = list(planners) if planners is not None else planner_order(results)
     groups = group_by(results, lambda r: (r.house if by == "house" else r.query, r.planner))
     out = []

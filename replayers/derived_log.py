@@ -296,6 +296,7 @@ def replay(
     ``copy_chunks`` copies the input's chunks into the derived log as they are where that
     gives the same messages in the same order (:func:`_can_copy`), instead of writing them
     message by message (recompressed)."""
+    of_type("log", log, (str, os.PathLike), "a log's path")
     if options is not None:
         of_type("options", options, ReplayOptions, "a ReplayOptions")
     function("on_refresh", on_refresh)

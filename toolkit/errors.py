@@ -12,6 +12,11 @@ class SgtoolError(Exception):
     exit_code = 2
 
 
+class ArgumentError(SgtoolError, ValueError):
+    """An API function given an argument it cannot take: an :class:`SgtoolError` (one
+    line), and a ``ValueError`` as such mistakes are in Python."""
+
+
 class LogFormatError(SgtoolError):
     """A file is not an sgtool/MCAP log, is truncated or corrupt where it must not be."""
 

@@ -201,3 +201,18 @@ def test_run_closed_loop_bench_refuses_before_any_folder(tmp_path) -> None:
         sgtool.run_closed_loop_bench(sgtool.ClosedLoopBenchConfig(
             ("greedy", "no_such_module_x:Planner")), out)
     assert not out.exists()
+
+
+def test_more_wrong_arguments_are_one_line() -> None:
+    """A bench config's counts as text or fractions, replay of no log, and AUC-E given
+    mismatched lists are SgtoolError lines (AUC-E's also a ValueError, as before)."""
+    for field, value in (("houses", "2"), ("episodes", 2.5), ("seeds", "1")):
+        with pytest.raises(sgtool.SgtoolError, match=f"^{field}={value!r}: a whole number"):
+            sgtool.run_benchmark(sgtool.BenchConfig(**{field: value}))
+    with pytest.raises(sgtool.SgtoolError, match="^houses='2': a whole number"):
+        sgtool.ClosedLoopBenchConfig("greedy", houses="2").check()
+    with pytest.raises(sgtool.SgtoolError, match="^log: a log's path, got NoneType$"):
+        sgtool.replay(None)
+    with pytest.raises(sgtool.SgtoolError, match="differ in length") as e:
+        sgtool.auc_e([1.0], [True, False], 10.0)
+    assert isinstance(e.value, ValueError)
