@@ -84,6 +84,15 @@ class CameraConfig:
         """The renderer's far plane: the sensor's maximum range."""
         return self.depth_max
 
+    def nearest_floor_depth(self) -> float | None:
+        """The depth (along the optical axis) of the nearest floor the camera sees at its
+        mounting: where the bottom row's middle ray meets the floor; None when it looks
+        above the floor."""
+        down = math.radians(self.tilt_deg + self.vfov_deg / 2.0)
+        if down <= 0.0:
+            return None
+        return self.mount_height / math.sin(down) * math.cos(math.radians(self.vfov_deg / 2.0))
+
     def intrinsics(self) -> CameraIntrinsics:
         return CameraIntrinsics.from_fov(self.width, self.height, self.vfov_deg)
 

@@ -134,6 +134,12 @@ class ClosedLoopOptions:
         if self.max_depth is not None:
             if not (math.isfinite(self.max_depth) and lo <= self.max_depth <= hi):
                 raise SgtoolError(f"--max-depth {self.max_depth:g} m: must be {lo:g}..{hi:g}")
+            floor = self.camera.nearest_floor_depth()
+            if floor is not None and self.max_depth <= floor:
+                raise SgtoolError(
+                    f"--max-depth {self.max_depth:g} m: the camera ({self.camera.mount_height:g}"
+                    f" m high, tilted {self.camera.tilt_deg:g} deg) sees no floor nearer than "
+                    f"{floor:.2f} m, so the live map would hold no floor; give more")
             return float(self.max_depth)
         cut = sensor_max_depth(self.noise.depth_sigma, self.camera.mount_height,
                                BevConfig().floor_tolerance, ceiling=MAX_DEPTH_M)

@@ -524,6 +524,11 @@ def test_a_noisy_sensor_maps_as_far_as_its_noise_allows(house, tmp_path) -> None
     assert dataclasses.replace(opts, max_depth=4.5).mapping().max_depth == 4.5
     with pytest.raises(SgtoolError, match="--max-depth 0.2 m: must be 0.5..20"):
         dataclasses.replace(opts, max_depth=0.2).mapping()
+    # the camera at 1.2 m, tilted 15 deg, 75 deg field: its nearest floor is 1.2 m deep
+    with pytest.raises(SgtoolError, match="--max-depth 1 m: .* sees no floor nearer than "
+                                          "1.20 m"):
+        dataclasses.replace(opts, max_depth=1.0).mapping()
+    assert dataclasses.replace(opts, max_depth=1.3).mapping().max_depth == 1.3
     assert OPTS.mapping().max_depth == 5.0  # a perfect sensor: MoMa-LLM's 5 m
 
 
