@@ -169,6 +169,7 @@ def _camera_of(path: Path, idx: BagIndex, opts: BagOptions) -> CameraIntrinsics:
             f"{path}: --info {opts.info} is for {iw}x{ih} images but the depth images on "
             f"{opts.depth} are {w}x{h}; give the depth camera's CameraInfo topic"
         )
-    if fx <= 0 or fy <= 0:
-        raise SgtoolError(f"{path}: --info {opts.info} has no focal length (K is zero)")
+    if not (fx > 0 and fy > 0):
+        raise SgtoolError(f"{path}: --info {opts.info} has no usable focal length (K gives "
+                          f"fx {fx:g}, fy {fy:g}; each must be > 0)")
     return CameraIntrinsics(w, h, fx, fy, cx, cy)

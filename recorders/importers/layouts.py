@@ -20,6 +20,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 from collections import Counter
 from dataclasses import dataclass, replace
@@ -233,6 +234,12 @@ def read_sequence(
         raise SgtoolError(f"unknown layout {layout!r} ({', '.join(LAYOUTS)})")
     if not seq.frames:
         raise SgtoolError(f"{root}: no frames found in the {LAYOUT_NAMES[layout]} layout")
+    unused = [flag for flag, on, layouts in (
+        ("--timestamps index", timestamps != "file", ("tum",)),
+        ("--skip-missing", skip_missing, ("tum", "7scenes"))) if on and layout not in layouts]
+    if unused:  # said, not silently ignored
+        seq = replace(seq, notes=(*seq.notes, f"{' and '.join(unused)}: not used by the "
+                                  f"{LAYOUT_NAMES[layout]} layout"))
     seen = looks_like(root)
     if given is not None and seen is not None and seen != given:
         seq = replace(seq, notes=(*seq.notes, f"read as {LAYOUT_NAMES[given]} as asked; the "
@@ -467,12 +474,22 @@ def _external_poses(trajectory: Path | None, count: int,
 
 
 def _is_intrinsics_json(path: Path) -> bool:
-    """Whether a JSON file means to be intrinsics (names 'intrinsic_matrix'): other JSON
-    files of a folder are not read as intrinsics; a malformed intrinsics file is an error."""
+    """Whether a JSON file means to be intrinsics (names 'intrinsic_matrix', or is named
+    for a camera or its intrinsics and is no JSON at all: one cut short): other JSON
+    files of a folder are not read as intrinsics; a malformed intrinsics file is an
+    error."""
     try:
-        return "intrinsic_matrix" in path.read_text(errors="replace")
+        text = path.read_text(errors="replace")
     except OSError as e:
         raise SgtoolError(f"{path}: cannot read ({e.strerror})") from e
+    if "intrinsic_matrix" in text:
+        return True
+    if any(w in path.name.lower() for w in ("intrinsic", "camera")):
+        try:
+            json.loads(text)
+        except ValueError:
+            return True
+    return False
 
 
 def _depth_images(folder: Path, notes: list[str]) -> list[Path]:

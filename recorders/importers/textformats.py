@@ -85,8 +85,10 @@ def read_tum_trajectory(path: Path) -> list[tuple[int, np.ndarray]]:
         if abs(t) > MAX_TIME_NS:
             raise SgtoolError(f"{path}:{n}: time stamp {parts[0]} is beyond year 2262 in "
                               "seconds: TUM files give seconds (not ms or us)")
-        if not np.all(np.isfinite(v)) or np.linalg.norm(v[3:]) < 1e-6:
-            raise SgtoolError(f"{path}:{n}: not a valid pose (NaN or zero quaternion)")
+        if not np.all(np.isfinite(v)):
+            raise SgtoolError(f"{path}:{n}: not a valid pose (a number is NaN or infinite)")
+        if np.linalg.norm(v[3:]) < 1e-6:
+            raise SgtoolError(f"{path}:{n}: not a valid pose (the quaternion is zero)")
         out.append((t, pose_from_tq(v[:3], v[3:])))
     return sorted(out, key=lambda tp: tp[0])
 
@@ -229,9 +231,12 @@ def parse_intrinsics(text: str) -> PinholeParams:
             return checked_pinhole(fx, fy, cx, cy, f"--intrinsics {text!r}", source="given")
     path = Path(text)
     if not path.is_file():
+        looks_like_file = len(parts) == 1 and (path.suffix or "/" in text)
         raise SgtoolError(
-            f"--intrinsics {text!r}: give 'fx,fy,cx,cy' in pixels or an intrinsics file "
-            "(Open3D JSON, or a 3x3 matrix as text)"
+            f"--intrinsics {text!r}: " + ("no such file; give " if looks_like_file else
+                                          "give ")
+            + "'fx,fy,cx,cy' in pixels or an intrinsics file (Open3D JSON, or a 3x3 matrix "
+            "as text)"
         )
     return read_intrinsics_file(path)
 

@@ -161,8 +161,14 @@ def test_a_malformed_intrinsics_json_is_an_error(tmp_path):
     (root / "camera.json").write_text('{"intrinsic_matrix": [600, 0, 0, 0, 600, 0, 320, 240]}')
     with pytest.raises(SgtoolError, match=r"camera.json: expected Open3D intrinsics JSON"):
         read_sequence(root)
+    (root / "camera.json").write_text('{"width": 640,')  # cut short: no default instead
+    with pytest.raises(SgtoolError, match=r"camera.json: expected Open3D intrinsics JSON"):
+        read_sequence(root)
     (root / "camera.json").write_text('{"other": 1}')  # not an intrinsics file: ignored
     assert read_sequence(root).intrinsics.source.startswith("dataset default")
+    seq = read_sequence(root, timestamps="index", skip_missing=True)  # TUM's options
+    assert any("--timestamps index and --skip-missing: not used by the Open3D" in n
+               for n in seq.notes)
 
 
 @pytest.mark.parametrize("text", ["nan,525,319.5,239.5", "inf,525,319.5,239.5",
