@@ -39,6 +39,7 @@ time) and :mod:`.bag_frames` (pass 2: decoding).
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -139,6 +140,11 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
             sorted(idx.depth.stamps), f"{path}: --depth {opts.depth} ({opts.timestamps} times)",
             BAG_TIME_FIX), given=opts.timestamps != "header")
         check_depth_samples(idx, opts, findings, f"{path}: --depth {opts.depth}")
+        back = sum(b < a for a, b in itertools.pairwise(idx.depth.stamps))
+        if back and opts.timestamps == "header":  # each image is posed at its own stamp
+            findings.warning(f"{path}: --depth {opts.depth}: {back} image(s) stamped earlier "
+                             "than the image recorded before; each is posed at its own stamp "
+                             "(--timestamps bag takes the recording times)")
         checks: list[tuple[str, str]] = []
         if opts.timestamps == "header" and src is not None and src.tree is not None:
             offset = clock_offset_s([r - t for r, t in zip(idx.depth.received,

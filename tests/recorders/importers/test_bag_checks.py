@@ -33,7 +33,7 @@ Edit = Callable[[int, Any], None]  # (frame index, message) -> change the messag
 
 def write_bag(path: Path, n: int = 5, *, tf_edit: Edit | None = None,
               pose_edit: Edit | None = None, info_edit: Edit | None = None,
-              no_return: bool = False) -> Path:
+              no_return: bool = False, depth_edit: Edit | None = None) -> Path:
     """``n`` synthetic frames as a ROS 1 bag: /tf world -> cam, a PoseStamped topic with the
     same poses, CameraInfo and 16UC1 depth (all 0 with ``no_return``); each ``*_edit`` may
     spoil a message."""
@@ -53,9 +53,11 @@ def write_bag(path: Path, n: int = 5, *, tf_edit: Edit | None = None,
             if info_edit is not None:
                 info_edit(i, info)
             w.write(INFO, "sensor_msgs/msg/CameraInfo", t, info)
-            w.write(DEPTH, "sensor_msgs/msg/Image", t,
-                    w.image(t, "cam", (depth * 1000 * (not no_return)).round().astype(np.uint16),
-                            "16UC1"))
+            img = w.image(t, "cam", (depth * 1000 * (not no_return)).round().astype(np.uint16),
+                          "16UC1")
+            if depth_edit is not None:
+                depth_edit(i, img)
+            w.write(DEPTH, "sensor_msgs/msg/Image", t, img)
     return path
 
 
@@ -216,3 +218,20 @@ def test_a_trajectory_far_from_the_origin_is_refused_at_import(tmp_path):
                                           r"beyond .* recentre the trajectory"):
         import_bag(bag, out, BagOptions(depth=DEPTH, info=INFO, **KEEP_WORLD))
     assert not out.exists()
+
+
+def test_images_stamped_out_of_their_recording_order_are_told(tmp_path):
+    """Two depth images whose header stamps run backwards against the bag's order: the
+    import says so (each is posed at its own stamp; --timestamps bag takes the order)."""
+    def swap(i, msg):
+        if i in (2, 3):
+            t = T0 + (5 - i) * DT
+            msg.header.stamp.sec, msg.header.stamp.nanosec = t // 10**9, t % 10**9
+
+    bag = tmp_path / "b.bag"
+    write_bag(bag, depth_edit=swap)
+    warned: list[str] = []
+    import_bag(bag, tmp_path / "o.mcap", BagOptions(depth=DEPTH, info=INFO, warn=warned.append,
+                                                    **KEEP_WORLD))
+    assert any("1 image(s) stamped earlier than the image recorded before" in w
+               for w in warned), warned
