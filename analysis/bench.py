@@ -80,7 +80,7 @@ from sgtool.analysis.bench_priors import (
     priors_fingerprint,
     training_vocabulary,
 )
-from sgtool.analysis.executor import Task, chunks, failure_lines, make_executor
+from sgtool.analysis.executor import Task, chunks, failure_lines, make_executor, retry_lines
 from sgtool.analysis.interval_report import IntervalReport, interval_report
 from sgtool.analysis.intervals import (
     DEFAULT_BOOTSTRAP,
@@ -233,6 +233,7 @@ class BenchResult:
     houses: tuple[BenchHouse, ...] = ()
     vocabulary_size: int = 0  # training queries of the priors
     failed: tuple[str, ...] = ()  # one line per task that failed after its retry
+    retried: tuple[str, ...] = ()  # one line per task that succeeded after an error
 
     @property
     def side_by_side(self) -> str:
@@ -396,6 +397,7 @@ def run_benchmark(cfg: BenchConfig, progress: bool | None = None,
                             desc="bench")
     chunks = [o.value for o in outcomes if o.ok]
     failed = failure_lines(outcomes)
+    retried = retry_lines(outcomes)
     if failed and not partial:  # tables without some houses' episodes would pass for a result
         raise BenchError(f"{len(failed)} of {len(outcomes)} bench task(s) failed after a "
                          f"retry; the first: {failed[0]}")
@@ -421,7 +423,7 @@ def run_benchmark(cfg: BenchConfig, progress: bool | None = None,
               f"one of the {len(vocabulary)} training queries of {priors}")
     return BenchResult(cfg, tuple(results), throughput, table, seen_table,
                        results_digest(results), wall, houses, len(vocabulary),
-                       tuple(failed))
+                       tuple(failed), tuple(retried))
 
 
 def prepare_houses(cfg: BenchConfig) -> tuple[BenchHouse, ...]:
@@ -492,7 +494,10 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
     run_md = [res.table,
               f"Episodes per second: one core, episode roll-outs only (house preparation "
               f"excluded); whole run {res.wall_s:.1f} s with {cfg.workers} worker(s) on the "
-              f"{cfg.executor} executor.", *([f"Command: `{shown}`"] if shown else [])]
+              f"{cfg.executor} executor.", *([f"Command: `{shown}`"] if shown else []),
+              *([f"Tasks that succeeded after an error (retried; their episodes are in the "
+                 f"tables): {len(res.retried)}", *(f"- {line}" for line in res.retried)]
+                if res.retried else [])]
     paths.append(atomic_write(out / "run.md", "\n".join(run_md) + "\n"))
     sums = summarize(res.results, cfg.models(), cfg.planners)
     summary = {
@@ -520,7 +525,7 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
                     "episodes_per_s": {k: float(f"{v:.3g}") for k, v in res.throughput.items()},
                     "decision_s": {p: d["decision_s"]
                                    for p, d in summary_dict(sums).items()}},
-           "command": shown}
+           "command": shown, "retried_tasks": list(res.retried)}
     paths.append(atomic_write(
         out / "run.json",
         json.dumps(strict_json(run), indent=1, sort_keys=True, allow_nan=False) + "\n"))

@@ -78,6 +78,8 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
         show(line)
     for line in invalid_action_notes(res.results, res.config.planners):
         show(f"sgtool: note: {line}")
+    for line in res.retried:  # a planner that raises now and then, a worker lost
+        show(f"sgtool: note: task retried after an error: {line}")
     show(f"wrote {', '.join(str(Path(out_dir) / name) for name in written)}")
     for folder in (out_dir, *([log_dir] if log_dir is not None else [])):
         for line in leftover_notes(folder):

@@ -80,6 +80,7 @@ class Outcome:
     error: str | None = None
     attempts: int = 1
     node: str = ""  # the Ray node (hex id) of the last attempt; "" on this machine
+    retried: str | None = None  # the first attempt's error, when a later attempt ran
 
     @property
     def ok(self) -> bool:
@@ -102,6 +103,13 @@ def error_line(e: BaseException) -> str:
 def failure_lines(outcomes: Sequence[Outcome]) -> list[str]:
     """One line per failed task: ``ID: Type: message (after N attempts)``."""
     return [f"{o.id}: {o.error} (after {o.attempts} attempts)" for o in outcomes if not o.ok]
+
+
+def retry_lines(outcomes: Sequence[Outcome]) -> list[str]:
+    """One line per task that succeeded after an error: ``ID: Type: message (succeeded on
+    attempt N)`` (a worker lost, or a planner that raises now and then)."""
+    return [f"{o.id}: {o.retried} (succeeded on attempt {o.attempts})" for o in outcomes
+            if o.ok and o.retried is not None]
 
 
 class _Executor:
@@ -134,6 +142,7 @@ class _Executor:
                 dynamic_ncols=True) if progress else contextlib.nullcontext(_NoBar()) as bar:
             queue = list(range(len(tasks)))[::-1]
             attempts = [0] * len(tasks)
+            first_error: dict[int, str] = {}
             flight: dict[Any, int] = {}
             try:
                 while queue or flight:
@@ -146,13 +155,14 @@ class _Executor:
                     if isinstance(err, KeyboardInterrupt):  # a worker was killed or Ctrl-C'd
                         raise err  # stop the run, as in process
                     if err is not None and attempts[i] <= RETRIES:
+                        first_error.setdefault(i, error_line(err))
                         queue.append(i)
                         continue
                     node = ""
                     if isinstance(value, _Placed):
                         node, value = value.node, value.value
                     out = Outcome(tasks[i].id, value, None if err is None else error_line(err),
-                                  attempts[i], node)
+                                  attempts[i], node, first_error.get(i))
                     done[i] = out
                     if on_result is not None:
                         on_result(out)

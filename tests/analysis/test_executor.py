@@ -5,6 +5,7 @@ missing or unreachable too (no Ray started here: see test_ray_executor.py)."""
 
 from __future__ import annotations
 
+import os
 import signal
 import socket
 import subprocess
@@ -24,6 +25,7 @@ from sgtool.analysis.executor import (
     error_line,
     failure_lines,
     make_executor,
+    retry_lines,
 )
 from sgtool.errors import SgtoolError
 
@@ -273,3 +275,23 @@ def test_a_run_without_progress_leaves_the_start_method_unset() -> None:
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           timeout=120)
     assert done.stdout.strip() == "ok", done.stderr
+
+
+def fails_once(arg: tuple[int, str]) -> int:
+    """Raises the first time it is called for 1 (a marker file says it was), then works."""
+    x, marker = arg
+    if x == 1 and not os.path.exists(marker):
+        open(marker, "w").close()
+        raise RuntimeError("flaky")
+    return x
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_task_that_succeeds_on_its_retry_is_told(workers, tmp_path):
+    """The retry of a task that raised once is no silent event: its outcome keeps the
+    first error, and retry_lines names it (bench prints and writes it in run.md)."""
+    marker = str(tmp_path / "failed-once")
+    outs = LocalExecutor(workers).run(fails_once, [Task(f"t{i}", (i, marker))
+                                                    for i in range(3)])
+    assert [o.value for o in outs] == [0, 1, 2] and all(o.ok for o in outs)
+    assert retry_lines(outs) == ["t1: RuntimeError: flaky (succeeded on attempt 2)"]
