@@ -315,6 +315,8 @@ def effective_options(name: str, given: Mapping[str, Any]) -> dict[str, Any]:
         return dict(sorted(given.items()))
     defaults = {"timed": True, **({} if cls is None else
                                   {i.name: i.default for i in option_infos(cls)})}
+    if cls is None and name.strip().lower() not in REGISTRY:  # a plug-in's own defaults
+        defaults |= _signature_defaults(_factory(name))
     values = {}
     for k, v in given.items():
         try:
@@ -323,6 +325,18 @@ def effective_options(name: str, given: Mapping[str, Any]) -> dict[str, Any]:
         except Exception:  # noqa: BLE001 - a key it does not take: compared as given
             values[k] = v
     return {k: v for k, v in sorted(values.items()) if k not in defaults or v != defaults[k]}
+
+
+def _signature_defaults(factory: Any) -> dict[str, Any]:
+    """The keyword defaults of a plug-in without an ``Options`` class: its factory's (its
+    ``__init__``'s, for a class); none when Python cannot tell."""
+    import inspect
+
+    try:
+        params = inspect.signature(factory).parameters.values()
+    except (TypeError, ValueError):
+        return {}
+    return {p.name: p.default for p in params if p.default is not inspect.Parameter.empty}
 
 
 def parse_option(name: str, key: str, text: str) -> Any:

@@ -293,6 +293,9 @@ def test_options_compared_as_the_planner_takes_them(plugin_dir: Path) -> None:
     assert effective_options("scout", {"delta": 0.2, "bogus": 1}) == {"delta": 0.2,
                                                                       "bogus": 1}
     assert effective_options("nomod_plug:X", {"k": "1"}) == {"k": "1"}  # cannot be asked
+    # a plug-in without an Options class: its __init__'s defaults are its defaults
+    assert effective_options("mymod_plug:MyPlanner", {"k": "1", "label": "y"}) == {
+        "label": "y"}
     assert recorded_options({"folder": Path("/tmp/x"), "obj": object()}) == {
         "folder": "/tmp/x"}
 
