@@ -151,6 +151,8 @@ def _run(executor: Executor | None, fn: Callable[[Any], Any], tasks: list[Task],
 
 
 PIN_COMMAND = "sgtool golden"
+# the replay options `sgtool golden pin` takes as flags (the others are set from Python)
+PIN_CLI_OPTIONS = ("every", "classifier", "min_points", "voxel_size", "max_frames")
 PIN_FILES = (INDEX, "*.graphs.jsonl.gz", "*.refreshes.jsonl.gz", "*.mcap")
 
 
@@ -174,15 +176,21 @@ def pin_folder(root: Path) -> Iterator[Path]:
 
 @contextlib.contextmanager
 def pins_locked(root: Path) -> Iterator[None]:
-    """Hold the lock of the pin folder ``root`` (an advisory lock on a file in the system's
-    temporary folder named after ``root``'s resolved path; nothing is added to ``root``):
-    one process at a time reads, changes and writes its index."""
-    import fcntl
+    """Hold the lock of the pin folder ``root`` (an advisory lock on a file of this user's
+    in the system's temporary folder, named after ``root``'s resolved path; nothing is
+    added to ``root``): one process at a time reads, changes and writes its index. Where
+    there are no advisory locks (not POSIX), nothing is held."""
     import hashlib
     import tempfile
 
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        yield
+        return
     key = hashlib.sha256(str(root.resolve()).encode()).hexdigest()[:20]
-    with open(Path(tempfile.gettempdir()) / f"sgtool-pins-{key}.lock", "a+b") as fh:
+    user = os.getuid() if hasattr(os, "getuid") else 0
+    with open(Path(tempfile.gettempdir()) / f"sgtool-pins-{user}-{key}.lock", "a+b") as fh:
         fcntl.flock(fh, fcntl.LOCK_EX)
         try:
             yield
@@ -341,15 +349,20 @@ def first_decision_change(pinned: Sequence[Decision] | None, now: Sequence[Decis
 
 def pin_command(pin: Pinned, log: Path, folder: Path) -> str:
     """The ``sgtool golden pin`` command that pins ``log`` again as ``pin`` was pinned:
-    its replay options and its note (a bare command would reset them)."""
+    its replay options and its note (a bare command would reset them); options the
+    command does not take (set from Python) are named after it."""
     import shlex
 
     words = ["sgtool", "golden", "pin", str(log), "--dir", str(folder)]
+    others = []
     for k, v in sorted(options_dict(pin.options).items()):
-        words += ["--" + k.replace("_", "-"), str(v)]
+        if k in PIN_CLI_OPTIONS:
+            words += ["--" + k.replace("_", "-"), str(v)]
+        else:
+            others.append(f"{k}={v!r}")
     if pin.why:
         words += ["--why", pin.why]
-    return shlex.join(words)
+    return shlex.join(words) + (f" (and from Python: {', '.join(others)})" if others else "")
 
 
 def _check_task(t: _CheckTask) -> LogCheck:

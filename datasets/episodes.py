@@ -237,8 +237,9 @@ def list_episodes(spec: HouseSpec, n: int | None = None, seed: int | None = None
     :func:`~sgtool.semantics.text.category_text`, so spellings of one name are one query;
     sorted) when ``n`` is None, else ``n`` episodes drawn with ``seed`` (categories
     without replacement while they last, then again with other starts). ``seed`` (the
-    start poses' draw too) defaults to the house's own, as ``sgtool scenes episodes``,
-    ``bench``, ``run-bench`` and ``run --episode`` draw them. ``geometry``: the house's
+    start poses' draw too) defaults to the house's own, the seed ``bench`` and
+    ``run-bench`` draw with, so ``run --episode K`` is episode K of ``sgtool scenes
+    episodes``. ``geometry``: the house's
     :class:`EpisodeGeometry` with this ``reach``, to share with other listings."""
     of_type("spec", spec, HouseSpec, "a HouseSpec (sgtool.load_house(path))")
     seed = spec.seed if seed is None else seed

@@ -47,23 +47,24 @@ def frozen_heap() -> Iterator[None]:
 
 class ProcessWide:
     """A setting that is one per process, shared by blocks that may overlap in several
-    threads in any order: the first block to enter applies it (``apply`` returns what
-    undoes it), the last to leave undoes it, so the process gets back the setting it had
-    before the first. Use an instance as ``with setting():``."""
+    threads in any order: every block entering applies it (``apply`` returns what undoes
+    it; applying again covers what was loaded since, a BLAS library imported inside the
+    first block), and the last block to leave undoes them all, the latest first, so the
+    process gets back the setting it had before the first. Use an instance as ``with
+    setting():``."""
 
     def __init__(self, apply: Callable[[], Callable[[], object]]) -> None:
         self._apply = apply
         self._lock = threading.Lock()
         self._depth = 0
-        self._undo: Callable[[], object] | None = None
+        self._undo: list[Callable[[], object]] = []
 
     @contextlib.contextmanager
     def __call__(self) -> Iterator[None]:
         entered = False
         try:
             with self._lock:
-                if self._depth == 0:
-                    self._undo = self._apply()
+                self._undo.append(self._apply())
                 self._depth += 1
                 entered = True
             yield
@@ -71,9 +72,10 @@ class ProcessWide:
             if entered:
                 with self._lock:
                     self._depth -= 1
-                    if self._depth == 0 and self._undo is not None:
-                        undo, self._undo = self._undo, None
-                        undo()
+                    if self._depth == 0:
+                        undo, self._undo = self._undo, []
+                        for step in reversed(undo):
+                            step()
 
 
 def hugepage_setter() -> Callable[[bool], bool] | None:

@@ -553,3 +553,16 @@ def test_a_re_recorded_log_is_told_how_to_pin_it_with_its_settings(log, tmp_path
     (folder / "expected.json").write_text(json.dumps(index))
     code, _, err = sgtool(capsys, "golden", "check", "--dir", folder)
     assert code == 2 and "its index pins no log" in err
+
+
+def test_the_re_pin_hint_runs_as_given(log, tmp_path) -> None:
+    """A pin made from Python with an option `golden pin` has no flag for (max_depth):
+    the hint's command keeps to the flags it takes and names the rest."""
+    from sgtool.analysis.golden_check import pin_command, pin_logs
+    from sgtool.replayers.derived_log import ReplayOptions
+
+    pin_logs([log], tmp_path / "g", ReplayOptions(max_frames=20, max_depth=3.0))
+    pin = read_pins(tmp_path / "g").logs["small"]
+    text = pin_command(pin, log, tmp_path / "g")
+    assert text == (f"sgtool golden pin {log} --dir {tmp_path / 'g'} --max-frames 20 "
+                    "(and from Python: max_depth=3.0)")

@@ -141,7 +141,7 @@ def check(folder: str, names: tuple[str, ...], every: int | None, classifier: st
     after, the first planner decision that differs; then a summary table. Exit 0 when
     nothing changed, 1 when something did, 2 when a log could not be checked."""
     from sgtool.analysis.executor import make_executor
-    from sgtool.analysis.golden_check import check_pins, update_pins
+    from sgtool.analysis.golden_check import check_pins
     from sgtool.analysis.golden_report import text_report
 
     _check_report_files(report_md, junit)
@@ -153,10 +153,7 @@ def check(folder: str, names: tuple[str, ...], every: int | None, classifier: st
                             keep=update, progress=_show(progress))
     for line in text_report(report):
         click.echo(line)
-    accepted = update_pins(report) if update else []
-    _write_report_files(report, report_md, junit, accepted)
-    for line in (accepted or ["nothing to accept: no pinned log changed"]) if update else ():
-        click.echo(line)
+    _reports_and_update(report, update, report_md, junit)
     code = 2 if report.exit_code == 2 else 0 if update else report.exit_code
     if code == 2:
         first = next(c for c in report.logs if c.status == "error")
@@ -191,6 +188,23 @@ def _check_report_files(report_md: str | None, junit: str | None) -> None:
                           "(the second would replace the first)")
 
 
+def _reports_and_update(report: Any, update: bool, report_md: str | None,
+                        junit: str | None) -> None:
+    """Write the check's report files, then with ``update`` re-pin the changed logs, say
+    what was accepted and write the files again with it (they keep the check's if the
+    update fails)."""
+    from sgtool.analysis.golden_check import update_pins
+
+    _write_report_files(report, report_md, junit)
+    if not update:
+        return
+    accepted = update_pins(report)
+    if accepted:
+        _write_report_files(report, report_md, junit, accepted)
+    for line in accepted or ["nothing to accept: no pinned log changed"]:
+        click.echo(line)
+
+
 @contextlib.contextmanager
 def _reported_error(folder: str, report_md: str | None, junit: str | None) -> Iterator[None]:
     """A check that cannot start (a damaged pin folder): the report files say so, so one
@@ -211,8 +225,9 @@ def _write_report_files(report: Any, report_md: str | None, junit: str | None,
     from sgtool.analysis.golden_report import error_reports, junit_report, markdown_report
     from sgtool.files import atomic_write
 
+    names = [c.name for c in report.logs if c.status == "changed"] if accepted else []
     md, xml = error_reports(*error) if error is not None else (
-        markdown_report(report, accepted), junit_report(report, accepted))
+        markdown_report(report, accepted), junit_report(report, names))
     if report_md:
         atomic_write(report_md, md)
     if junit:

@@ -35,6 +35,7 @@ import numpy as np
 
 from sgtool.errors import SgtoolError
 from sgtool.planning.base import Action, Feedback, Planner
+from sgtool.planning.timing import decision_time
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.semantics.text import same_category
 
@@ -150,6 +151,7 @@ def _step(planner: Planner, graph: SceneGraph, index: int, recorder: SearchRecor
     if not isinstance(action, Action):
         raise SgtoolError(f"planner {getattr(planner, 'name', type(planner).__name__)!r}: "
                           f"decide() returned {type(action).__name__}, not an Action")
+    dt = decision_time(planner, action, dt)
     kept = getattr(planner, "exchanges", None)
     exchanges = tuple(kept[n0:]) if isinstance(kept, list) else ()
     if recorder is not None:

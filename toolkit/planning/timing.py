@@ -18,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import random
+import threading
 import time
 from collections.abc import Iterator
 from typing import Any
@@ -33,6 +34,20 @@ from sgtool.vocabulary import SKILLS
 _PLAIN = tuple(f.name for f in dataclasses.fields(Action)) == (
     "unknown", "skill", "target", "reason", "decision_time_s", "scores", "outcome", "travelled_m",
     "planner", "step", "graph_time_ns", "absent")
+
+
+# a process has one set of global generators: a plug-in's swap holds them for its call
+_GLOBALS_LOCK = threading.RLock()
+
+
+def decision_time(planner: Planner, action: Action, outer_s: float) -> float:
+    """The time ``planner`` took for ``action``: a measuring :class:`TimedPlanner`'s own
+    figure (the inner call alone, without a plug-in's generator swap), else ``outer_s``,
+    the caller's measure around ``decide``."""
+    if isinstance(planner, TimedPlanner) and planner.measure and \
+            isinstance(action.decision_time_s, float):
+        return action.decision_time_s
+    return outer_s
 
 
 class PlannerContractError(SgtoolError):
@@ -63,15 +78,16 @@ class TimedPlanner:
         if self._globals is None:
             yield
             return
-        outer = random.getstate(), np.random.get_state()
-        random.setstate(self._globals[0])
-        np.random.set_state(self._globals[1])
-        try:
-            yield
-        finally:
-            self._globals = random.getstate(), np.random.get_state()
-            random.setstate(outer[0])
-            np.random.set_state(outer[1])
+        with _GLOBALS_LOCK:  # one process's generators: one plug-in call at a time holds them
+            outer = random.getstate(), np.random.get_state()
+            random.setstate(self._globals[0])
+            np.random.set_state(self._globals[1])
+            try:
+                yield
+            finally:
+                self._globals = random.getstate(), np.random.get_state()
+                random.setstate(outer[0])
+                np.random.set_state(outer[1])
 
     def reset(self, query: str, seed: int = 0) -> None:
         self.decision_times = []
@@ -85,13 +101,13 @@ class TimedPlanner:
             raise self._failed("reset", e) from e
 
     def decide(self, graph: SceneGraph) -> Action:
-        t0 = time.perf_counter()
         try:
-            with self._own_randomness():
+            with self._own_randomness():  # (its swap is no part of the decision's time)
+                t0 = time.perf_counter()
                 action = self.inner.decide(graph)
+                dt = time.perf_counter() - t0
         except (Exception, SystemExit) as e:
             raise self._failed("decide", e) from e
-        dt = time.perf_counter() - t0
         self.decision_times.append(dt)
         if self.plugin and isinstance(action, Action):
             self._check(action)

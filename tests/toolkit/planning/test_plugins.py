@@ -327,6 +327,17 @@ def test_a_plug_ins_global_randomness_follows_the_episode_seed(plugin_dir: Path)
     targets(5)
     assert (random.random(), float(np.random.random_sample())) == after  # untouched
     assert any(targets(s) != first for s in range(6, 12))  # another seed, other draws
+    # two threads deciding at once: each draws as alone, the caller's state untouched
+    import threading
+
+    random.seed(1)
+    got: list[list[str | None]] = []
+    runs = [threading.Thread(target=lambda: got.append(targets(5))) for _ in range(2)]
+    for t in runs:
+        t.start()
+    for t in runs:
+        t.join()
+    assert got == [first, first] and random.random() == after[0]
 
 
 def test_an_action_whose_reason_is_no_text_is_one_line(plugin_dir: Path) -> None:
