@@ -113,15 +113,18 @@ class ImportReport:
         return out
 
 
+COARSEST_VOXEL_M = 0.5  # m: the largest voxel edge a replay of an import is asked for
+
+
 def far_camera_problem(pose: np.ndarray, what: str) -> str | None:
-    """The problem of a camera so far from the world origin that replay's voxel map (at
-    its default voxel size, seeing as far as its default range) cannot hold what it sees:
-    replay would refuse the log, so the import does; None when it is within reach."""
+    """The problem of a camera so far from the world origin that replay's voxel map cannot
+    hold what it sees at any voxel size (up to :data:`COARSEST_VOXEL_M`, seeing as far as
+    its default range): every replay would refuse the log, so the import does; None when
+    some replay can (one at the default voxel size may still refuse it, saying so)."""
     from sgtool.mapping.voxel_keys import OFFSET
     from sgtool.mapping.voxels import VoxelConfig
 
-    cfg = VoxelConfig()
-    reach = (OFFSET - 2) * cfg.resolution - cfg.max_range
+    reach = (OFFSET - 2) * COARSEST_VOXEL_M - VoxelConfig().max_range
     t = np.asarray(pose, dtype=np.float64)[:3, 3]
     if np.all(np.abs(t) < reach):
         return None
