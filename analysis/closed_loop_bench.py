@@ -141,8 +141,8 @@ class ClosedLoopBenchConfig:
     def check(self) -> None:
         from sgtool.analysis.bench_planner_checks import check_planner_list, check_reference
 
-        for name in ("houses", "episodes"):
-            whole(name, getattr(self, name))  # "2" or 2.5 from Python: one line
+        for name in ("houses", "episodes", "frames_per_room"):  # "2" or 2.5: one line
+            whole(name, getattr(self, name), optional=name == "frames_per_room")
         check_planner_list(self.planners)
         if len(set(self.planners)) != len(self.planners) or \
                 len(set(self.noise)) != len(self.noise):

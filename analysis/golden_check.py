@@ -39,6 +39,7 @@ from sgtool.files import (
     atomic_output,
     deferred_interrupts,
     output_folder,
+    quoted,
     read_manifest,
 )
 from sgtool.replayers.derived_log import ReplayOptions
@@ -374,8 +375,12 @@ def _check_task(t: _CheckTask) -> LogCheck:
         if not log.is_file():
             raise PinError(f"pinned log {log} is missing (moved or deleted? put it back, or "
                            f"pin it again with `{pin_command(pin, log, folder)}`)")
-        if sha256_file(log) != pin.log_sha256:
-            raise PinError(f"{log} is not the pinned log (its sha256 differs); if it was "
+        size = log.stat().st_size
+        if (pin.log_bytes is not None and size != pin.log_bytes) or \
+                sha256_file(log) != pin.log_sha256:
+            what = (f"{size} bytes, {pin.log_bytes} pinned" if pin.log_bytes not in (None, size)
+                    else "its sha256 differs")
+            raise PinError(f"{log} is not the pinned log ({what}); if it was "
                            "re-recorded on purpose, pin it again with its settings: "
                            f"`{pin_command(pin, log, folder)}`")
         expected, metas = load_expected(pins, pin.name)
@@ -446,7 +451,7 @@ def check_pins(folder: str | Path, options: ReplayOptions | None = None, *,
     pins = read_pins(folder)
     if not pins.logs:  # a check of nothing would pass a CI job whose pins were lost
         raise PinError(f"{pins.folder}: its index pins no log; pin some with `sgtool golden "
-                       "pin LOG --dir DIR`")
+                       f"pin LOG --dir {quoted(pins.folder)}`")
     chosen = sorted(pins.logs) if names is None else list(dict.fromkeys(names))  # each once
     for n in chosen:
         if n not in pins.logs:

@@ -82,6 +82,8 @@ class GoldenFolder(pytest.File):
             pins = read_pins(self.path.parent)
         except SgtoolError as e:
             raise self.CollectError(str(e)) from None
+        if not pins.logs:  # a run of no checks would pass a CI job whose pins were lost
+            raise self.CollectError(f"{pins.folder}: its index pins no log")
         for name in sorted(pins.logs):
             item = GoldenLog.from_parent(self, name=name)
             item.add_marker("sgtool_golden")
@@ -162,7 +164,7 @@ class GoldenFixture:
     def _check(self, log: Path, folder: Path, given: Any) -> None:
         from sgtool.analysis.golden_check import check_pins, pin_logs, pin_name, update_pins
         from sgtool.replayers.golden import sha256_file
-        from sgtool.replayers.golden_pins import INDEX, overridden, read_pins
+        from sgtool.replayers.golden_pins import INDEX, options_dict, overridden, read_pins
 
         if not log.is_file():
             pytest.fail(f"{log}: no such log", pytrace=False)
@@ -170,8 +172,10 @@ class GoldenFixture:
         pin = read_pins(folder).logs.get(name) if (folder / INDEX).is_file() else None
         if pin is None:
             pin_logs([log], folder, given)
-            pytest.fail(f"pinned {log} into {folder} (first run); commit the pin and run "
-                        "again", pytrace=False)
+            opts = "" if given is None else " with " + ", ".join(
+                f"{k}={v!r}" for k, v in sorted(options_dict(given).items()))
+            pytest.fail(f"pinned {log} into {folder}{opts} (first run); commit the pin and "
+                        "run again", pytrace=False)
         if sha256_file(log) != pin.log_sha256:  # (a --copy pin holds the same bytes)
             if self.update:  # another log under the name, or this one re-recorded
                 pin_logs([log], folder, pin.options, why=pin.why)

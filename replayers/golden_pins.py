@@ -24,6 +24,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import typing
 import zlib
 from collections.abc import Mapping
@@ -318,6 +319,16 @@ def _entry(name: str, e: Mapping[str, Any], common: Mapping[str, Any], fmt: int,
                 v is None or (isinstance(v, int | float) and not isinstance(v, bool))
                 for v in figures.values()):
             raise TypeError(f"'quality' {variant!r} must map figures to numbers or null")
+    for key in ("log_sha256", "final_sha256", "sequence_sha256"):
+        if key not in e:
+            raise KeyError(f"{key!r} is missing")
+        if not (isinstance(e[key], str) and re.fullmatch(r"[0-9a-f]{64}", e[key])):
+            raise ValueError(f"{key!r} is {e[key]!r}, not a SHA-256 (64 hex digits)")
+    for key, least in (("refreshes", 1), ("log_bytes", 0)):
+        v = e.get(key)
+        if (v is not None or key == "refreshes") and not (
+                isinstance(v, int) and not isinstance(v, bool) and v >= least):
+            raise ValueError(f"{key!r} is {v!r}, not a whole number >= {least}")
     options = options_from(common if fmt == 1 else e.get("options", {}), f"{path}: {name}")
     decisions = None
     if e.get("decisions") is not None:

@@ -120,6 +120,7 @@ class ExportReport:
     time_base_s: float = DEFAULT_TIME_BASE_S
     compression: str = "none"
     others: tuple[str, ...] = ()  # channels of the log that are none of sgtool's: not exported
+    chosen: tuple[str, ...] = ()  # the ROS topics asked for
 
     def lines(self) -> list[str]:
         total = sum(n for _, _, n in self.counts)
@@ -128,8 +129,9 @@ class ExportReport:
         w = max((len(t) for t, _, _ in self.counts), default=5)
         out.extend(f"  {t:<{w}}  {ty}  {n}" for t, ty, n in self.counts)
         if not total:
-            out.append("note: the log holds nothing for the topics chosen (/tf_static holds "
-                       "only the links that never move)")
+            out.append("note: the log holds nothing for the topics chosen"
+                       + (" (/tf_static holds only the links that never move)"
+                          if TF_STATIC in self.chosen else ""))
         if self.others:
             out.append(f"note: not exported, channels sgtool does not know: "
                        f"{', '.join(self.others)}")
@@ -250,7 +252,8 @@ def export_bag(log: str | Path, out: str | Path, fmt: str | None = None,
                 for entry in os.listdir(inner):
                     os.replace(inner / entry, stage / entry)
                 shutil.rmtree(inner)
-    return ExportReport(out, fmt, tuple(counts), derived, time_base_s, compression, others)
+    return ExportReport(out, fmt, tuple(counts), derived, time_base_s, compression, others,
+                        tuple(chosen))
 
 
 def default_frames(log: str | Path) -> dict[str, str]:

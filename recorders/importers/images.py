@@ -285,6 +285,8 @@ def decode_depth_message(msg: Any, msgtype: str, topic: str) -> tuple[np.ndarray
         if "compresseddepth" in fmt.lower().replace(" ", ""):
             return _decode_compressed_depth(data, fmt, topic)
         a = _imdecode(data)
+        if not data:
+            raise SgtoolError(f"topic {topic}: a compressed depth message holds no image data")
         if a is None or a.ndim != 2 or a.dtype != np.uint16:
             raise SgtoolError(
                 f"topic {topic}: compressed depth format {fmt!r} did not decode to a "
@@ -350,6 +352,8 @@ def decode_ids_message(msg: Any, msgtype: str, topic: str) -> np.ndarray:
     """Instance-id image (8/16/32-bit integer) -> int32."""
     if msgtype.endswith("CompressedImage"):
         a = _imdecode(np.asarray(msg.data, dtype=np.uint8))
+        if not len(msg.data):
+            raise SgtoolError(f"topic {topic}: a compressed ids message holds no image data")
         if a is None or a.ndim != 2:
             raise SgtoolError(f"topic {topic}: instance ids must decode to one channel")
         return a.astype(np.int32)

@@ -130,8 +130,9 @@ def read_pose_file(path: Path) -> np.ndarray:
 def read_open3d_log(path: Path) -> list[np.ndarray]:
     """Camera-to-world 4x4 poses of an Open3D / Redwood ``.log`` trajectory, each checked
     rigid, in the order of the frame ids of their block headers ``i j n`` (Open3D writes
-    ``i i i+1`` for frame i): blocks out of order are put in order; a frame id given twice
-    is refused (unless every block has the same one: ids that say nothing, file order)."""
+    ``i i i+1`` for frame i): blocks out of order are put in order; a frame id given twice,
+    or ids with a gap (a pose for a frame the folder may not have), are refused (unless
+    every block has the same one: ids that say nothing, file order)."""
     rows = _data_lines(path)
     if len(rows) % 5:
         raise SgtoolError(
@@ -157,6 +158,12 @@ def read_open3d_log(path: Path) -> list[np.ndarray]:
                           "block's header 'i j n' names its frame i")
     if len(seen) == len(poses):
         poses.sort(key=lambda p: p[0])
+        ids = [k for k, _ in poses]
+        if ids != [ids[0] + i for i in range(len(ids))]:
+            gap = next(i for i in range(1, len(ids)) if ids[i] != ids[i - 1] + 1)
+            raise SgtoolError(f"{path}: the frame ids of its pose blocks jump from "
+                              f"{ids[gap - 1]:g} to {ids[gap]:g}; each block's header 'i j n' "
+                              "names its frame, one pose per frame in order")
     return [m for _, m in poses]
 
 

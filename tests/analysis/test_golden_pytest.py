@@ -57,6 +57,10 @@ def test_a_damaged_pin_folder_is_a_collection_error_naming_it(tmp_path):
     code, out = pytest_run("--sgtool-golden", folder, cwd=tmp_path)
     assert code != 0
     assert f"{folder / 'expected.json'}: damaged pin file" in out
+    (folder / "expected.json").write_text('{"format": 2, "cases": {}}')  # pins lost
+    (tmp_path / "test_other.py").write_text("def test_ok():\n    pass\n")
+    code, out = pytest_run("--sgtool-golden", folder, "test_other.py", cwd=tmp_path)
+    assert code != 0 and "its index pins no log" in out, out
 
 
 def test_the_example_test_runs_with_the_fixture(tmp_path, monkeypatch):

@@ -56,7 +56,8 @@ if TYPE_CHECKING:
               type=PathParam(file_okay=False, path_type=str),
               help="Relational priors (a folder written by `sgtool distill`, or `blend` for "
                    "the shipped priors with the room blend): the planners "
-                   "of the learned priors (scout*, godhs, esc, bayes-search) load them, and a "
+                   "of the learned priors (scout*, godhs, esc, bayes-search, and a plug-in "
+                   "whose options have weights_dir) load them, and a "
                    "query is 'seen' when it is one of their training queries [default: the "
                    "shipped priors].")
 @click.option("--episodes", default=20, show_default=True,

@@ -350,7 +350,8 @@ def _option_values(ctx: click.Context, names: Sequence[str]) -> list[str]:
 
 PLANNER_OPTION_HELP = ("Planner option PLANNER.KEY=VALUE, e.g. scout.delta=0.2 or "
                        "moma-llm.model=gpt-4o-mini (repeatable; --list-planners lists them; "
-                       "a plug-in's: mymod:MyPlanner.k=v).")
+                       "a plug-in's: mymod:MyPlanner.k=v; an empty VALUE sets an optional "
+                       "number or choice to none).")
 # the default of --planners, spelled out for --help (a test keeps it equal to the bench's)
 DEFAULT_PLANNERS_HELP = ("random, greedy, sbert-noroom, sbert, scout-noroom, scout-delta0, "
                          "scout, godhs, esc, bayes-search")
@@ -571,7 +572,8 @@ def live_max_depth_option() -> Callable[[F], F]:
         "--max-depth", "max_depth", type=FiniteFloatRange(0.5, 20.0), default=None,
         metavar="M",
         help="Depth farther than this (m) is not mapped by the live map (recorded in the "
-             "log: replay maps the same). Default: 5 (MoMa-LLM's), lowered to where the "
+             "log: replay maps the same); more than the depth of the nearest floor the camera "
+             "sees (1.2 m at its default mounting). Default: 5 (MoMa-LLM's), lowered to where the "
              "sensor's depth noise (--noise depth_sigma, known to the robot like a "
              "datasheet figure) would read far floor as obstacles, as replay does.")
 

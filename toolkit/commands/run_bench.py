@@ -276,7 +276,8 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
                                                 peek=args.peek,
                                                 sight_lines=args.sight_lines,
                                                 explore_through=args.explore_through))
-    options = planner_options(args.planner_option, names)
+    options = {k: v for k, v in planner_options(args.planner_option, names).items()
+               if k in names}  # those of planners not run: a note said they are unused
     LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
                 args.llm_timeout).fill(options, names)
     return ClosedLoopBenchConfig(

@@ -207,5 +207,6 @@ def test_an_empty_compressed_image_is_one_line(kind, fmt):
     msg = SimpleNamespace(format=fmt, data=np.zeros(0, np.uint8))
     decode = {"color": images.decode_color_message, "depth": images.decode_depth_message,
               "ids": images.decode_ids_message}[kind]
-    with pytest.raises(SgtoolError, match="^topic /cam: "):
+    with pytest.raises(SgtoolError, match="^topic /cam: .*(holds no image data|shorter than "
+                                          "its header)"):
         decode(msg, "sensor_msgs/msg/CompressedImage", "/cam")

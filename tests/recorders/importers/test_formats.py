@@ -274,6 +274,10 @@ def test_open3d_log_blocks_go_to_the_frames_their_headers_name(tmp_path: Path):
     with pytest.raises(SgtoolError, match=r"traj\.log:11: frame id 1 is given twice "
                                           r"\(first on line 6\)"):
         textformats.read_open3d_log(p)
+    write([0, 1, 2, 7], [0, 1, 2, 3])  # a pose for frame 7 where the fourth is 3
+    with pytest.raises(SgtoolError, match=r"traj\.log: the frame ids of its pose blocks jump "
+                                          r"from 2 to 7"):
+        textformats.read_open3d_log(p)
     write([0, 0, 0, 0], [0, 1, 2, 3])  # ids that say nothing: the file's order
     assert [float(m[0, 3]) for m in textformats.read_open3d_log(p)] == \
         pytest.approx([0.0, 0.1, 0.2, 0.3])
