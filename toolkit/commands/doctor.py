@@ -10,6 +10,7 @@ import click
 from sgtool.commands.options import PathParam
 from sgtool.errors import SgtoolError
 from sgtool.files import quoted
+from sgtool.log.inspect import bag_problem
 from sgtool.log.recover import Diagnosis, recover, scan
 from sgtool.log.writer import partial_files
 
@@ -67,6 +68,18 @@ def _lost_lines(d: Diagnosis) -> list[str]:
     return lines
 
 
+def _refuse_no_log(log: str) -> None:
+    """One line for a LOG that is not there but its partial files are (a killed writer
+    leaves LOG.XXXXXXXX.partial, never LOG), or that is a bag sgtool imports."""
+    found = [] if Path(log).exists() else partial_files(log)
+    if found:
+        raise SgtoolError(f"{log} does not exist; partial files: "
+                          f"{', '.join(map(str, found))} (recover one with: sgtool doctor "
+                          f"{quoted(found[0])} --recover {quoted(log)})")
+    if (bag := bag_problem(log)) is not None:
+        raise SgtoolError(bag)
+
+
 def _recovered(d: Diagnosis, out: str) -> str:
     """The copy's verdict: what it holds, what of it no CRC vouched for, what was dropped."""
     line = f"recovered {d.readable_messages} messages into {out}"
@@ -108,11 +121,7 @@ def command(log: str, out: str | None, force: bool, as_json: bool) -> None:
     Exit code 0 for a complete or unverified file, 1 for a truncated or corrupt one (also
     after a successful recovery), 2 for a usage error.
     """
-    found = [] if Path(log).exists() else partial_files(log)
-    if found:  # a killed writer leaves LOG.XXXXXXXX.partial, never LOG
-        raise SgtoolError(f"{log} does not exist; partial files: "
-                          f"{', '.join(map(str, found))} (recover one with: sgtool doctor "
-                          f"{quoted(found[0])} --recover {quoted(log)})")
+    _refuse_no_log(log)
     d = recover(log, out, overwrite=force) if out else scan(log)
     if as_json:
         click.echo(json.dumps(d.as_dict() | ({"recovered_to": out} if out else {}), indent=2))

@@ -7,7 +7,8 @@ import json
 import click
 
 from sgtool.commands.options import PathParam
-from sgtool.log.inspect import format_summary, summarize
+from sgtool.errors import SgtoolError
+from sgtool.log.inspect import bag_problem, format_summary, summarize
 
 
 @click.command("info")
@@ -18,6 +19,8 @@ def command(log: str, as_json: bool) -> None:
     schema version and the episode summary. Works on foreign MCAP files too (lists their
     topics, schemas and counts). A truncated file gives an error that points to
     `sgtool doctor`."""
+    if (bag := bag_problem(log)) is not None:  # a recording sgtool imports: say how
+        raise SgtoolError(bag)
     s = summarize(log)
     if as_json:
         click.echo(json.dumps(s, indent=2, sort_keys=True))

@@ -115,6 +115,9 @@ def show_cmd(house: str, output: str | None, dpi: int, no_objects: bool, force: 
     spec = load_house(Path(house))  # a path, even one that starts with "{"
     out = check_output(output or Path(house).with_suffix(".png"), force=force,
                        suffixes=(".png", ".svg", ".pdf"), what="image")
+    if Path(out).resolve() == Path(house).resolve():
+        raise SgtoolError(f"{out}: the image would replace the house file it draws; give "
+                          "-o another name")
     draw_house(spec, out, dpi=dpi, show_objects=not no_objects)
     click.echo(f"wrote {out}", err=True)
 

@@ -119,6 +119,19 @@ def _import_hint(path: Path, channels: list[tuple[str, str]]) -> str:
     return f"it has no image or pose topic sgtool can import ({listing})"
 
 
+def bag_problem(path: str | os.PathLike[str]) -> str | None:
+    """:func:`foreign_log_problem` for a file that is no MCAP file (a ROS 1 bag, a ROS 2
+    bag's SQLite storage), with the import command; None for anything else."""
+    p = Path(path)
+    try:
+        with open(p, "rb") as f:
+            if f.read(5) == b"\x89MCAP":
+                return None
+    except OSError:
+        return None
+    return foreign_log_problem(p)
+
+
 def foreign_log_problem(path: str | os.PathLike[str]) -> str | None:
     """One line saying what ``path`` is when it is a recording but not an sgtool log, and the
     import command that turns it into one; None for an sgtool log, or for anything else (the

@@ -96,3 +96,26 @@ def test_info_warns_of_frames_that_share_a_time(tmp_path):
     assert json.loads(r.output)["repeated_frame_times"] == 1
     r = CliRunner().invoke(cli, ["info", str(write_log(tmp_path / "ok.mcap"))])
     assert "share a log time" not in r.output
+
+
+@pytest.mark.parametrize("command", ["info", "doctor"])
+def test_a_bag_is_told_how_to_import(tmp_path, command):
+    """info and doctor on a ROS 1 bag say what it is and the import command, as replay
+    does, not only "not an MCAP file"."""
+    bag = tmp_path / "run.bag"
+    bag.write_bytes(b"#ROSBAG V2.0\n" + bytes(64))
+    r = CliRunner().invoke(cli, [command, str(bag)])
+    assert r.exit_code == 2
+    assert "is a ROS 1 bag, not an sgtool log" in r.output and "sgtool import bag" in r.output
+
+
+def test_scenes_show_never_draws_over_its_house(tmp_path):
+    from sgtool.datasets.generator import generate_house
+    from sgtool.house.io import save_house
+
+    house = tmp_path / "h.png"  # a house file under an image's name
+    save_house(generate_house(3, rooms=(4, 4)), house)
+    before = house.read_bytes()
+    r = CliRunner().invoke(cli, ["scenes", "show", str(house), "--force"])
+    assert r.exit_code == 2 and "would replace the house file" in r.output
+    assert house.read_bytes() == before
