@@ -14,7 +14,22 @@ from typing import Any
 
 from sgtool.planning.registry import effective_options
 
-COMPARED = ("max_steps", "priors_dir")  # bench settings that change what an episode scores
+COMPARED = ("max_steps", "priors_dir",  # bench settings that change what an episode scores
+            "distance_budget", "step_budget")  # and the AUC-E curves
+
+
+def recorded_budgets(files: Sequence[str]) -> tuple[float | None, float | None]:
+    """(distance, step) AUC-E budgets the bench runs among ``files`` were made with, each
+    None when no run records it or the runs differ (a note says so)."""
+    found: dict[str, set[float]] = {"distance_budget": set(), "step_budget": set()}
+    for f in files:
+        p = Path(f)
+        if p.name == "episodes.jsonl" and (s := _settings(p.parent / "summary.json")):
+            for key, seen in found.items():
+                if isinstance(s.get(key), int | float) and not isinstance(s[key], bool):
+                    seen.add(float(s[key]))
+    dist, steps = (next(iter(v)) if len(v) == 1 else None for v in found.values())
+    return dist, steps
 
 
 def _settings(summary: Path) -> dict[str, Any] | None:

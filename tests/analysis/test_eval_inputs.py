@@ -77,3 +77,24 @@ def test_one_episode_under_two_noise_profiles_is_two_runs(tmp_path) -> None:
     doc = json.loads(r.stdout)
     assert {p: v["episodes"] for p, v in doc["planners"].items()} == \
         {"greedy [none]": 1, "greedy [strong]": 1}
+
+
+def test_eval_takes_the_auc_e_budgets_the_run_was_made_with(tmp_path) -> None:
+    """A bench run made with --step-budget 30 --distance-budget 1000 is re-scored with
+    them (its summary.json records them), unless eval is given others."""
+    run = tmp_path / "run"
+    run.mkdir()
+    write_jsonl([RUN, dataclasses.replace(RUN, episode=1, success=False, steps=50)],
+                run / "episodes.jsonl")
+    (run / "summary.json").write_text(json.dumps(
+        {"settings": {"distance_budget": 1000.0, "step_budget": 30.0}}))
+
+    def budgets(*args: str) -> dict[str, float]:
+        r = CliRunner().invoke(cli, ["eval", str(run), "--json", *args])
+        assert r.exit_code == 0, r.output
+        return {k: v["max"] for k, v in json.loads(r.output)["budgets"].items()}
+
+    assert budgets() == {"distance": 1000.0, "steps": 30.0}
+    assert budgets("--step-budget", "40") == {"distance": 1000.0, "steps": 40.0}
+    (run / "summary.json").unlink()  # nothing recorded: MoMa-LLM's
+    assert budgets() == {"distance": 5000.0, "steps": 50.0}

@@ -8,6 +8,7 @@ and prints the result."""
 from __future__ import annotations
 
 import sys
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -48,7 +49,7 @@ if TYPE_CHECKING:
                    "/sgtool/llm channel; repeatable) instead of an endpoint [default: the "
                    "exchanges of the MCAP inputs, when they have any].")
 @success_option(recorded=True)
-@budget_options()
+@budget_options(recorded=True)
 @click.option("--reference", default=None, metavar="PLANNER", callback=reference_planner,
               help="Paired comparisons of every other planner against this one on the same "
                    "episodes (house, episode, seed, query, shortest path), pooled over the "
@@ -109,8 +110,8 @@ class EvalArgs:
     planners: tuple[str, ...]
     planner_option: tuple[str, ...]
     llm_replay: tuple[str, ...]
-    distance_budget: float
-    step_budget: float
+    distance_budget: float | None
+    step_budget: float | None
     as_json: bool
     success: str | None = None
     executor: str = "local"
@@ -153,11 +154,23 @@ def _request(inputs: tuple[str, ...], out: str | None, force: bool, args: EvalAr
     options = planner_options(args.planner_option, names)
     LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
                 args.llm_timeout).fill(options, names)
+    dist, steps = _budgets(args, files)
     return EvalRequest(inputs=files, runner=runner, planners=tuple(names),
                        planner_options=options, llm_replay=args.llm_replay,
-                       success=args.success, distance_budget=args.distance_budget,
-                       step_budget=args.step_budget, reference=args.reference,
+                       success=args.success, distance_budget=dist, step_budget=steps,
+                       reference=args.reference,
                        all_pairs=args.all_pairs,
                        as_json=args.as_json or bool(out and out.endswith(".json")),
                        progress=args.progress if args.progress is not None
                        else sys.stderr.isatty())
+
+
+def _budgets(args: EvalArgs, files: Sequence[str]) -> tuple[float, float]:
+    """The AUC-E budgets: as given, else as the runs read were made (bench records them),
+    else the defaults (MoMa-LLM's)."""
+    from sgtool.analysis.eval_settings import recorded_budgets
+    from sgtool.analysis.search_metrics import DISTANCE_BUDGET, STEP_BUDGET
+
+    dist, steps = recorded_budgets(files)
+    return (args.distance_budget or dist or DISTANCE_BUDGET,
+            args.step_budget or steps or STEP_BUDGET)

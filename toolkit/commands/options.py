@@ -469,16 +469,21 @@ def success_option(recorded: bool = False) -> Callable[[F], F]:
              + (" [default: as recorded]." if recorded else "."))
 
 
-def budget_options() -> Callable[[F], F]:
+def budget_options(recorded: bool = False) -> Callable[[F], F]:
     """``--distance-budget`` and ``--step-budget``: the budget maxima of the two AUC-E
-    variants (MoMa-LLM's; :func:`sgtool.analysis.search_metrics.cost_models`)."""
+    variants (MoMa-LLM's; :func:`sgtool.analysis.search_metrics.cost_models`); with
+    ``recorded`` (eval) their default is None: the budgets the runs read recorded."""
+    tail = (" [default: as the runs read were made (bench records it), else {}]" if recorded
+            else "")
     distance = click.option(
-        "--distance-budget", type=FiniteFloatRange(min=0, min_open=True), default=5000.0,
-        show_default=True, help="AUC-E distance variant budget max, in low-level steps "
-        "(0.1 m of travel = 1, an open = 30; MoMa-LLM).")
+        "--distance-budget", type=FiniteFloatRange(min=0, min_open=True),
+        default=None if recorded else 5000.0, show_default=not recorded,
+        help="AUC-E distance variant budget max, in low-level steps (0.1 m of travel = 1, "
+        "an open = 30; MoMa-LLM)." + tail.format(5000))
     steps = click.option(
-        "--step-budget", type=FiniteFloatRange(min=0, min_open=True), default=50.0,
-        show_default=True, help="AUC-E step variant budget max, in high-level steps.")
+        "--step-budget", type=FiniteFloatRange(min=0, min_open=True),
+        default=None if recorded else 50.0, show_default=not recorded,
+        help="AUC-E step variant budget max, in high-level steps." + tail.format(50))
 
     def wrap(f: F) -> F:
         return distance(steps(f))
