@@ -40,6 +40,11 @@ def _check_modes(out_dir: Path | None, report_only: bool, source: str,
     ctx = click.get_current_context(silent=True)
     if ctx is None:
         return
+    llm_given = [f"--{n.replace('_', '-')}" for n in ctx.params if n.startswith("llm_")
+                 and ctx.get_parameter_source(n) is ParameterSource.COMMANDLINE]
+    if llm_given and (source != "llm" or report_only):
+        raise SgtoolError(f"{', '.join(llm_given)}: for --source llm (training from an "
+                          "LLM's answers), which this run does not use")
     given = [f"--{n.replace('_', '-')}" for n in _TRAINING
              if ctx.get_parameter_source(n) is ParameterSource.COMMANDLINE]
     if report_only and given:

@@ -121,6 +121,12 @@ def test_distill_llm_slice_needs_the_llm_source(tmp_path: Path) -> None:
     r = CliRunner().invoke(cli, ["distill", "--out", str(tmp_path / "w"), "--llm-slice",
                                  "a,b,c"])
     assert r.exit_code == 2 and "--llm-slice is for --source llm" in r.output
+    # the other LLM options did nothing without it, and said nothing
+    for args in (["--out", str(tmp_path / "w"), "--llm-runs", "5"], ["--report", "--llm-runs",
+                                                                      "3"]):
+        r = CliRunner().invoke(cli, ["distill", *args])
+        assert r.exit_code == 2 and "--llm-runs: for --source llm" in r.output, r.output
+    assert not (tmp_path / "w").exists()
     assert not (tmp_path / "w").exists()
 
 
