@@ -69,10 +69,16 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
 
     results, logged, notes, unread = load_many([Path(i) for i in request.inputs], request.runner,
                                                progress=request.progress)
-    results = [with_seen(with_success_rule(r, request.success)) for r in results]
-    results, profiles = per_noise(results)  # (fills the noise a row's folder names)
+    judged = [with_seen(with_success_rule(r, request.success)) for r in results]
+    unconfirmed = sorted({r.planner for r, j in zip(results, judged, strict=True)
+                          if r.success and not j.success})
+    results, profiles = per_noise(judged)  # (fills the noise a row's folder names)
     results, twice = once_each(results)
     notes = [*notes, *twice]
+    if unconfirmed:  # runs made under "observed": their planners never had to call done
+        notes = [*notes, f"--success {request.success}: successes of {', '.join(unconfirmed)} "
+                 "that end without done() naming an object count as failures (a run made "
+                 "under the observed rule never asked its planners for done)"]
     if profiles:
         notes = [*notes, f"the episodes ran under {len(profiles)} sensor noise profiles "
                  f"({', '.join(profiles)}): each planner is scored per profile, as "

@@ -98,3 +98,14 @@ def test_eval_takes_the_auc_e_budgets_the_run_was_made_with(tmp_path) -> None:
     assert budgets("--step-budget", "40") == {"distance": 1000.0, "steps": 40.0}
     (run / "summary.json").unlink()  # nothing recorded: MoMa-LLM's
     assert budgets() == {"distance": 5000.0, "steps": 50.0}
+
+
+def test_a_stricter_success_rule_says_what_it_turned(tmp_path) -> None:
+    """--success done on episodes recorded under observed (no done() at the end): their
+    successes become failures, and a note says why instead of an SR of 0 alone."""
+    write_jsonl([RUN], tmp_path / "episodes.jsonl")
+    r = CliRunner().invoke(cli, ["eval", str(tmp_path / "episodes.jsonl"), "--success",
+                                 "done"])
+    assert r.exit_code == 0, r.output
+    assert "--success done: successes of greedy that end without done() naming an object " \
+        "count as failures" in r.output
