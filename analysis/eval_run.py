@@ -102,7 +102,9 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
         raise SgtoolError(f"--reference {request.reference}: no episode of that planner in "
                           f"the inputs (planners: {', '.join(bases)})")
     models = cost_models(request.distance_budget, request.step_budget)
-    exchanges = log_exchanges(request.inputs)
+    # a file that could not be read (a note said so) is left out of the rest too
+    bad = {u.split(": not read (", 1)[0] for u in unread}
+    exchanges = log_exchanges([i for i in request.inputs if i not in bad])
     reports = _replays(request, logged, exchanges)
     render = _as_json if request.as_json else _as_tables
     text = render(request, results, notes, models, summarize(results, models), reports,

@@ -109,3 +109,18 @@ def test_a_stricter_success_rule_says_what_it_turned(tmp_path) -> None:
     assert r.exit_code == 0, r.output
     assert "--success done: successes of greedy that end without done() naming an object " \
         "count as failures" in r.output
+
+
+def test_a_truncated_log_among_the_inputs_is_left_out_not_fatal(tmp_path) -> None:
+    """One cut-off MCAP beside a readable table: the metrics of what was read are printed,
+    then the one line saying the log was left out (exit 2), as for an unreadable table."""
+    from support.paths import GOLDEN
+
+    write_jsonl([RUN], tmp_path / "episodes.jsonl")
+    data = (GOLDEN / "house6-tour.mcap").read_bytes()
+    (tmp_path / "half.mcap").write_bytes(data[: len(data) // 2])
+    r = CliRunner().invoke(cli, ["eval", str(tmp_path / "episodes.jsonl"),
+                                 str(tmp_path / "half.mcap")])
+    assert r.exit_code == 2
+    assert "| greedy" in r.output  # the metrics of the table
+    assert "1 of 2 input(s) could not be read and are left out" in r.output
