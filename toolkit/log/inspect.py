@@ -180,8 +180,8 @@ def format_summary(s: dict[str, Any]) -> str:
     if s["sgtool_log"]:
         lines.append(
             f"sgtool log, schema version {s.get('log_schema_version')}, "
-            f"written by sgtool {s['metadata'].get('sgtool', {}).get('sgtool_version', '?')}, "
-            f"seed {s.get('seed')}"
+            f"written by sgtool {s['metadata'].get('sgtool', {}).get('sgtool_version', '?')}"
+            + (f", seed {s['seed']}" if s.get("seed") is not None else "")
             + (f", house seed {s['house_seed']}" if s.get("house_seed") is not None else "")
         )
         if not s.get("readable", True):

@@ -119,3 +119,15 @@ def test_scenes_show_never_draws_over_its_house(tmp_path):
     r = CliRunner().invoke(cli, ["scenes", "show", str(house), "--force"])
     assert r.exit_code == 2 and "would replace the house file" in r.output
     assert house.read_bytes() == before
+
+
+def test_info_leaves_out_a_seed_the_log_has_none_of(tmp_path):
+    """An imported log has no seed: info says nothing of one, never "seed None"."""
+    from sgtool.log import LogWriter
+
+    out = tmp_path / "imported.mcap"
+    with LogWriter(out) as w:
+        w.write_record("episode", 0, {"kind": "import", "status": "started", "frames": 0})
+    r = CliRunner().invoke(cli, ["info", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "None" not in r.output
