@@ -23,6 +23,17 @@ def pytest_run(*args, cwd):
     return done.returncode, done.stdout + done.stderr
 
 
+def lab_test(tmp_path, arguments):
+    """run.mcap (house10-start) pinned into tmp_path/pins, and a lab's test_lab.py that
+    calls ``sgtool_golden.check(ARGUMENTS)`` (HERE: its folder)."""
+    shutil.copyfile(GOLDEN / "house10-start.mcap", tmp_path / "run.mcap")
+    pin_logs([tmp_path / "run.mcap"], tmp_path / "pins", ReplayOptions(max_frames=20))
+    (tmp_path / "test_lab.py").write_text(
+        "from pathlib import Path\nHERE = Path(__file__).parent\n\n"
+        "def test_run(sgtool_golden):\n"
+        f"    sgtool_golden.check({arguments})\n")
+
+
 def test_one_test_per_pinned_log_and_the_report_as_failure(tmp_path):
     logs = []
     for name in ("a", "b"):
@@ -130,12 +141,7 @@ def test_a_log_that_cannot_be_checked_fails_in_one_line_without_the_update_hint(
 def test_the_fixture_re_pins_a_log_re_recorded_in_its_place_under_update(tmp_path):
     """run.mcap pinned, then recorded again at the same path: the check fails (not the
     pinned log); with --sgtool-golden-update the fixture re-pins it, and it passes after."""
-    shutil.copyfile(GOLDEN / "house10-start.mcap", tmp_path / "run.mcap")
-    pin_logs([tmp_path / "run.mcap"], tmp_path / "pins", ReplayOptions(max_frames=20))
-    (tmp_path / "test_lab.py").write_text(
-        "from pathlib import Path\nHERE = Path(__file__).parent\n\n"
-        "def test_run(sgtool_golden):\n"
-        "    sgtool_golden.check(HERE / 'run.mcap', HERE / 'pins')\n")
+    lab_test(tmp_path, "HERE / 'run.mcap', HERE / 'pins'")
     shutil.copyfile(GOLDEN / "house6-tour.mcap", tmp_path / "run.mcap")
     code, out = pytest_run("test_lab.py", cwd=tmp_path)
     assert code == 1, out
@@ -166,12 +172,7 @@ def test_updates_from_parallel_workers_keep_each_others_pins(tmp_path):
 
 
 def test_fixture_mistakes_and_a_bad_tolerance_are_one_line(tmp_path):
-    shutil.copyfile(GOLDEN / "house10-start.mcap", tmp_path / "run.mcap")
-    pin_logs([tmp_path / "run.mcap"], tmp_path / "pins", ReplayOptions(max_frames=20))
-    (tmp_path / "test_lab.py").write_text(
-        "from pathlib import Path\nHERE = Path(__file__).parent\n\n"
-        "def test_run(sgtool_golden):\n"
-        "    sgtool_golden.check(HERE / 'run.mcap', HERE / 'pins', voxel=0.08)\n")
+    lab_test(tmp_path, "HERE / 'run.mcap', HERE / 'pins', voxel=0.08")
     code, out = pytest_run("test_lab.py", cwd=tmp_path)
     assert code == 1 and "sgtool_golden.check(" in out and "voxel" in out, out
     assert "Traceback" not in out and "golden_pytest.py" not in out, out

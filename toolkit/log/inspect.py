@@ -123,6 +123,8 @@ def bag_problem(path: str | os.PathLike[str]) -> str | None:
     """:func:`foreign_log_problem` for a file that is no MCAP file (a ROS 1 bag, a ROS 2
     bag's SQLite storage), with the import command; None for anything else."""
     p = Path(path)
+    if not p.is_file():  # (a pipe would block the open; the reader refuses it)
+        return None
     try:
         with open(p, "rb") as f:
             if f.read(5) == b"\x89MCAP":
