@@ -473,8 +473,7 @@ def budget_options(recorded: bool = False) -> Callable[[F], F]:
     """``--distance-budget`` and ``--step-budget``: the budget maxima of the two AUC-E
     variants (MoMa-LLM's; :func:`sgtool.analysis.search_metrics.cost_models`); with
     ``recorded`` (eval) their default is None: the budgets the runs read recorded."""
-    tail = (" [default: as the runs read were made (bench records it), else {}]" if recorded
-            else "")
+    tail = " [default: as the runs read were made (bench records it), else {}]" * recorded
     distance = click.option(
         "--distance-budget", type=FiniteFloatRange(min=0, min_open=True),
         default=None if recorded else 5000.0, show_default=not recorded,
@@ -484,10 +483,7 @@ def budget_options(recorded: bool = False) -> Callable[[F], F]:
         "--step-budget", type=FiniteFloatRange(min=0, min_open=True),
         default=None if recorded else 50.0, show_default=not recorded,
         help="AUC-E step variant budget max, in high-level steps." + tail.format(50))
-
-    def wrap(f: F) -> F:
-        return distance(steps(f))
-    return wrap
+    return lambda f: distance(steps(f))
 
 
 def explore_on_option() -> Callable[[F], F]:
