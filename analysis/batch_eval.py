@@ -27,6 +27,14 @@ def load_one(path: str) -> tuple[list[Any], list[Any], list[str]]:
     return results, logged, notes
 
 
+NOT_READ = ": not read ("  # a failed file's note: "PATH: not read (WHY)"
+
+
+def unread_path(note: str) -> str:
+    """The file a failure note of :func:`load_many` names."""
+    return note.split(NOT_READ, 1)[0]
+
+
 def load_many(paths: Sequence[Path], executor: Executor, *, progress: bool = False
               ) -> tuple[list[Any], list[Any], list[str], list[str]]:
     """(results, logged episodes, notes, the notes of the files that failed) of every
@@ -38,7 +46,7 @@ def load_many(paths: Sequence[Path], executor: Executor, *, progress: bool = Fal
     failed: list[str] = []
     for o in executor.run(load_one, tasks, progress=progress, desc="eval"):
         if not o.ok:
-            notes.append(f"{o.id}: not read ({o.error})")
+            notes.append(f"{o.id}{NOT_READ}{o.error})")
             failed.append(notes[-1])
             continue
         r, lg, n = o.value

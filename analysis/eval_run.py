@@ -62,7 +62,7 @@ class EvalOutcome:
 
 def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
     """Score the request's episodes and replay its planners on the logged decisions."""
-    from sgtool.analysis.batch_eval import load_many
+    from sgtool.analysis.batch_eval import load_many, unread_path
     from sgtool.analysis.eval_settings import settings_notes
     from sgtool.analysis.offline import log_exchanges, with_seen, with_success_rule
     from sgtool.analysis.search_metrics import cost_models, summarize
@@ -103,7 +103,7 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
                           f"the inputs (planners: {', '.join(bases)})")
     models = cost_models(request.distance_budget, request.step_budget)
     # a file that could not be read (a note said so) is left out of the rest too
-    bad = {u.split(": not read (", 1)[0] for u in unread}
+    bad = {unread_path(u) for u in unread}
     exchanges = log_exchanges([i for i in request.inputs if i not in bad])
     reports = _replays(request, logged, exchanges)
     render = _as_json if request.as_json else _as_tables
