@@ -7,9 +7,9 @@ chunk record byte for byte, then the input's message index records (their offset
 relative to the chunk, so they stay valid), and adds a chunk index pointing at the new
 place, and the chunk's messages to the statistics. The ``mcap`` package's writer has no
 such call, so this module writes those records beside it, into the same stream, and updates
-the writer's chunk index list and statistics (its private state: :func:`writer_supported`
-checks that it is there and that the writer keeps no data-section CRC, which the copied
-bytes would miss; otherwise replay writes message by message.
+the writer's chunk index list, statistics and running data-section CRC (its private state:
+:func:`writer_supported` checks that it is there; otherwise replay writes message by
+message).
 ``tests/toolkit/log/test_chunk_copy.py`` reads every copy back and through ``sgtool
 doctor``'s checks).
 
@@ -26,6 +26,7 @@ points to ``sgtool doctor``, whatever ``verify`` says.
 from __future__ import annotations
 
 import struct
+import zlib
 from dataclasses import dataclass
 from typing import IO, Any
 
@@ -108,17 +109,19 @@ def in_sequence(chunks: list[ChunkIndex]) -> bool:
 
 def writer_supported(writer: Writer) -> bool:
     """``writer`` (an ``mcap`` package writer) has the private state :func:`append_chunk`
-    updates, and computes no data-section CRC (module doc)."""
+    updates (module doc)."""
     private: Any = writer
     return (isinstance(getattr(private, "_Writer__chunk_indices", None), list)
             and hasattr(private, "_Writer__statistics")
-            and getattr(private, "_Writer__enable_data_crcs", None) is False)
+            and isinstance(getattr(private, "_Writer__enable_data_crcs", None), bool)
+            and isinstance(getattr(private, "_Writer__data_section_crc", None), int))
 
 
 def append_chunk(writer: Writer, stream: IO[bytes], chunk: RawChunk) -> None:
     """Write ``chunk`` (record and message indexes) at the end of ``writer``'s output
     ``stream``, after finishing the writer's own chunk in progress; index it and count its
-    messages in the writer's statistics (module doc)."""
+    messages in the writer's statistics and its bytes in the data-section CRC (module
+    doc)."""
     writer.flush()
     start = stream.tell()
     stream.write(chunk.record)
@@ -127,6 +130,9 @@ def append_chunk(writer: Writer, stream: IO[bytes], chunk: RawChunk) -> None:
     ci = chunk.index
     shift = index_start - (ci.chunk_start_offset + ci.chunk_length)
     private: Any = writer
+    if private._Writer__enable_data_crcs:
+        private._Writer__data_section_crc = zlib.crc32(
+            chunk.message_indexes, zlib.crc32(chunk.record, private._Writer__data_section_crc))
     private._Writer__chunk_indices.append(ChunkIndex(
         message_start_time=ci.message_start_time, message_end_time=ci.message_end_time,
         chunk_start_offset=start, chunk_length=ci.chunk_length,

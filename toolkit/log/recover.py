@@ -22,6 +22,7 @@ from __future__ import annotations
 import io
 import mmap
 import os
+import zlib
 from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -95,7 +96,7 @@ def _diagnose(buf: mmap.mmap, diag: Diagnosis, writer: _Copier | None) -> None:
             for c in lay.chunks}
     read[_OUTSIDE_CHUNKS] = Counter((cid, t) for cid, t, _ in lay.loose if cid not in unknown)
     state = summary_state(buf, lay)
-    diag.checks = _checks(lay, state)
+    diag.checks = _checks(buf, lay, state)
     problems = list(lay.problems) + diag.problems
     if end is not None:
         extra = diag.size - end
@@ -122,14 +123,16 @@ def _verified(lay: Layout) -> Status:
     return "complete" if covered else "unverified"
 
 
-def _checks(lay: Layout, state: SummaryState) -> dict[str, str]:
+def _checks(buf: mmap.mmap, lay: Layout, state: SummaryState) -> dict[str, str]:
     chunks = [c for c in lay.chunks if c.header.uncompressed_crc]
     out = {"chunks": f"{sum(c.intact for c in chunks)} of {len(lay.chunks)} verified"
            if chunks else "no CRCs written" if lay.chunks else "no chunks"}
     out["summary"] = ("absent" if not state.present else "not written"
                       if not state.crc_checked else "ok" if state.crc_ok else "mismatch")
     if lay.data_end is not None:
-        out["data"] = "written" if lay.data_end.record.data_section_crc else "not written"
+        crc = lay.data_end.record.data_section_crc
+        out["data"] = ("not written" if not crc else "ok" if zlib.crc32(
+            memoryview(buf)[:lay.data_end.offset]) == crc else "mismatch")
     return out
 
 

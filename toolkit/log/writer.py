@@ -20,7 +20,8 @@ The writer is crash tolerant and atomic:
   complete chunks ``sgtool doctor OUT.XXXXXXXX.partial --recover OUT`` turns into a valid
   log, losing at most that last interval.
 
-Output is deterministic: the same calls give the same bytes (no wall clock is written).
+Every chunk and the data section carry CRCs (``sgtool doctor`` checks them). Output is
+deterministic: the same calls give the same bytes (no wall clock is written).
 """
 
 from __future__ import annotations
@@ -159,8 +160,8 @@ class LogWriter:
         self.message_count = 0
         try:
             self._mcap = Writer(
-                self._stream, chunk_size=chunk_size, compression=_COMPRESSION[compression]
-            )
+                self._stream, chunk_size=chunk_size, compression=_COMPRESSION[compression],
+                enable_data_crcs=True)
             self._mcap.start(profile=S.PROFILE, library=f"sgtool {__version__}")
             meta = {
                 "sgtool_version": __version__,

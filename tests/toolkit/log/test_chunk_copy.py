@@ -70,6 +70,7 @@ def test_copied_chunks_read_back_the_same_and_pass_doctor(tmp_path):
     for log in (src, dst):  # no attachments: an empty summary group is no damage
         d = scan(log)
         assert d.status == "complete", d.problems
+        assert d.checks["data"] == "ok"  # the copied bytes are in the data-section CRC
     with LogReader(dst, verify=True) as r:
         st = r.summary.statistics
         assert st.message_count == 12 + 4 + 3 and st.chunk_count == 6
@@ -108,21 +109,53 @@ def test_damaged_message_indexes_are_not_copied(tmp_path):
         assert raw_chunk(r._f, ci, bad_length) is None
 
 
-def test_no_copy_into_a_writer_without_the_state_it_updates_or_with_data_crcs(tmp_path):
-    """Copying writes into the mcap writer's private state: a writer that has it not, or
-    that keeps a data-section CRC the copied bytes would miss, takes no copies (replay
-    then writes message by message)."""
+def test_no_copy_into_a_writer_without_the_state_it_updates(tmp_path):
+    """Copying writes into the mcap writer's private state (chunk indexes, statistics,
+    the running data-section CRC): a writer that has it not takes no copies (replay then
+    writes message by message)."""
     src = source_log(tmp_path / "in.mcap")
     with LogReader(src) as r:
         with LogWriter(tmp_path / "ok.mcap") as w:
             assert writer_supported(w._mcap)
         with LogWriter(tmp_path / "crc.mcap") as w:
-            w._mcap._Writer__enable_data_crcs = True
+            crc = w._mcap.__dict__.pop("_Writer__data_section_crc")
             assert not writer_supported(w._mcap) and not w.copy_channels(r.summary)
+            w._mcap._Writer__data_section_crc = crc  # let it close
         with LogWriter(tmp_path / "renamed.mcap") as w:
             w._mcap._renamed = w._mcap.__dict__.pop("_Writer__chunk_indices")
             assert not writer_supported(w._mcap) and not w.copy_channels(r.summary)
             w._mcap._Writer__chunk_indices = w._mcap._renamed  # let it close
+
+
+def test_a_copy_into_a_writer_without_data_crcs_writes_none(tmp_path):
+    """A writer that keeps no data-section CRC (as ``mcap``'s default) takes copies and
+    writes a CRC of 0 ("not written"), never one that misses the copied bytes."""
+    src = source_log(tmp_path / "in.mcap")
+    dst = tmp_path / "out.mcap"
+    with LogReader(src) as r, LogWriter(dst) as w:
+        w._mcap._Writer__enable_data_crcs = False  # as if made so: no CRC of the start
+        w._mcap._Writer__data_section_crc = 0
+        assert w.copy_channels(r.summary)
+        for ci in r.summary.chunk_indexes:
+            assert w.copy_chunk(raw_chunk(r._f, ci, read_chunk(r._f, ci)))
+    d = scan(dst)
+    assert d.status == "complete" and d.checks["data"] == "not written"
+    assert all_messages(dst) == all_messages(src)
+
+
+def test_a_flipped_byte_outside_every_chunk_is_found(tmp_path):
+    """Metadata and attachments sit outside chunks: the data-section CRC that sgtool
+    writes is what shows a byte of them changed (the chunk CRCs cannot)."""
+    log = source_log(tmp_path / "in.mcap")
+    data = bytearray(log.read_bytes())
+    at = data.index(b"sgtool_version")  # in the metadata record, before every chunk
+    data[at] ^= 0x20
+    bad = tmp_path / "bad.mcap"
+    bad.write_bytes(bytes(data))
+    assert scan(log).checks["data"] == "ok"
+    d = scan(bad)
+    assert d.checks["data"] == "mismatch" and d.status == "corrupt"
+    assert any("data section CRC" in p for p in d.problems)
 
 
 def summary(schemas, channels, chunks):
