@@ -105,7 +105,7 @@ from sgtool.arg_checks import of_type, whole
 from sgtool.canonical import strict_json
 from sgtool.files import atomic_write, output_dir, output_folder
 from sgtool.planning.episode import SUCCESS_RULES
-from sgtool.redact import redact_options, redact_text, secret_values
+from sgtool.redact import options_as_text, redact_text, secret_values
 from sgtool.results import EpisodeResult, results_digest, write_jsonl
 from sgtool.version import __version__
 
@@ -203,8 +203,7 @@ class BenchConfig:
         d = asdict(self)
         d["planners"] = list(self.planners)
         d["rooms"] = list(self.rooms)
-        d["planner_options"] = {k: {kk: str(vv) for kk, vv in redact_options(v).items()}
-                                for k, v in sorted(self.planner_options.items())}
+        d["planner_options"] = options_as_text(self.planner_options)
         for key in ("workers", "executor", "ray_address",  # do not change the results
                     "reference", "all_pairs"):
             d.pop(key)

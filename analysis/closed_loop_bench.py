@@ -88,6 +88,7 @@ from sgtool.recorders.sim.closed_loop import WENT_ON, ClosedLoopOptions, run_epi
 from sgtool.recorders.sim.fallback_explore import is_fallback
 from sgtool.recorders.sim.frame_budget import frame_budget
 from sgtool.recorders.sim.noise import names_file, parse_noise
+from sgtool.redact import options_as_text
 from sgtool.results import EpisodeResult, write_jsonl
 
 # what maps run_task over the tasks: map (in order, here) or an executor's runner
@@ -429,9 +430,14 @@ class ClosedLoopBenchResult:
         return "\n".join(parts)
 
     def summary(self) -> dict[str, Any]:
-        """summary.json: per noise profile the statistics of :meth:`statistics`."""
-        return {"planners": list(self.config.planners),
-                "noise": {noise_folder(n): self.statistics(n)[1] for n in self.config.noise}}
+        """summary.json: per noise profile the statistics of :meth:`statistics`, and the
+        settings ``sgtool eval`` re-scores and compares runs by (:mod:`.eval_settings`)."""
+        cfg = self.config
+        settings = {"planners": list(cfg.planners), "max_steps": cfg.options.max_steps,
+                    "distance_budget": cfg.distance_budget, "step_budget": cfg.step_budget,
+                    "planner_options": options_as_text(cfg.planner_options)}
+        return {"planners": list(cfg.planners), "settings": settings,
+                "noise": {noise_folder(n): self.statistics(n)[1] for n in cfg.noise}}
 
 
 def _run_table(rows: Sequence[RunRow], planners: Sequence[str]) -> str:

@@ -78,6 +78,14 @@ def redact_text(text: str, secrets: Iterable[str | None] = ()) -> str:
     return redact_url(text)
 
 
+def options_as_text(planner_options: Mapping[str, Mapping[str, Any]]
+                    ) -> dict[str, dict[str, str]]:
+    """Planners' options as a run's settings record them: per planner (sorted) each value
+    redacted (:func:`redact_options`) and as its text."""
+    return {planner: {k: str(v) for k, v in redact_options(opts).items()}
+            for planner, opts in sorted(planner_options.items())}
+
+
 def recorded_options(options: Mapping[str, Any]) -> dict[str, Any]:
     """A planner's options as an episode record keeps them: JSON values only (a path as
     its text; a Python object set from Python, an encoder, is left out), keys named like

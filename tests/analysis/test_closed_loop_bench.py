@@ -35,7 +35,8 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
     out = tmp_path / "rb"
     stale = tmp_path / ".rb.k1ll3d00.partial"  # a killed --force run's staging folder
     stale.mkdir()
-    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
+    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                   "--step-budget", "30"])
     assert res.exit_code == 0, res.output
     assert f"sgtool: note: {stale} is the unfinished output of a run" in res.output
     logs = sorted(p.relative_to(out).as_posix() for p in out.rglob("*.mcap"))
@@ -63,9 +64,18 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
     assert stats["paired_per_house"][0]["house"] == "small"
     # the most frames per room an episode used: at most --frames 120 over 4 rooms
     assert 0 < stats["frames"]["max_per_room"] <= 30.0
+    # the settings eval re-scores the run by (AUC-E budgets) and compares runs by
+    settings = json.loads((out / "summary.json").read_text())["settings"]
+    assert settings == {"planners": ["random", "greedy"], "max_steps": 2,
+                        "distance_budget": 5000.0, "step_budget": 30.0,
+                        "planner_options": {}}
+    scored = CliRunner().invoke(cli, ["eval", str(out), "--json"])
+    assert scored.exit_code == 0, scored.output
+    assert json.loads(scored.stdout)["budgets"]["steps"]["max"] == 30.0
     # a second run reads the logs back instead of running anything
     monkeypatch.setattr(clb, "run_episode", lambda *a, **k: pytest.fail("ran again"))
-    again = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
+    again = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                     "--step-budget", "30"])
     assert again.exit_code == 0, again.output
     assert (out / "episodes.jsonl").read_text().splitlines() == lines
     assert "| random " in again.output
