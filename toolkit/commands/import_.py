@@ -59,7 +59,21 @@ def _output(output: str | None, force: bool) -> Path:
     return check_log_output(output, force=force)
 
 
+def _unused_odometry_note(report) -> None:  # type: ignore[no-untyped-def]
+    """A note when --odometry or --depth-max was given but no pose was estimated."""
+    ctx = click.get_current_context(silent=True)
+    if ctx is None or report.odometry_failures is not None:
+        return
+    given = [f"--{n.replace('_', '-')}" for n in ("odometry", "depth_max")
+             if ctx.get_parameter_source(n) == click.core.ParameterSource.COMMANDLINE]
+    if given:
+        click.echo(f"sgtool: note: {' and '.join(given)} did nothing: no pose was estimated "
+                   f"(poses: {report.pose_source}); --estimate-poses estimates them",
+                   err=True)
+
+
 def _print_report(report, as_json: bool) -> None:  # type: ignore[no-untyped-def]
+    _unused_odometry_note(report)
     if as_json:
         a = report.alignment
         d = {

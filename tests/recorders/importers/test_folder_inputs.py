@@ -473,3 +473,17 @@ def test_a_problem_of_a_value_given_keeps_it_and_says_so() -> None:
                     "--depth-scale 1000 fits (median 2.10 m); the value given is kept"]
     with pytest.raises(SgtoolError, match="to keep this one$"):
         findings.problem(text, given=False)
+
+
+def test_odometry_options_without_estimated_poses_are_a_note(tmp_path) -> None:
+    """--odometry and --depth-max shape estimated poses only: beside the dataset's own
+    poses they did nothing, and a note says so (the import goes on)."""
+    root = open3d_folder(tmp_path / "f", ["0", "1", "2"])
+    args = ["import", "rgbd", str(root), "--quiet", "--up", "y", "--floor", "none",
+            "--intrinsics", "30,30,15.5,11.5"]
+    r = CliRunner().invoke(cli, [*args, "-o", str(tmp_path / "a.mcap"), "--odometry", "icp",
+                                 "--depth-max", "3"])
+    assert r.exit_code == 0, r.output
+    assert "note: --odometry and --depth-max did nothing: no pose was estimated" in r.stderr
+    r = CliRunner().invoke(cli, [*args, "-o", str(tmp_path / "b.mcap")])
+    assert r.exit_code == 0 and "did nothing" not in r.stderr, r.output
