@@ -531,6 +531,12 @@ def test_reports_say_what_this_check_did(pinned, tmp_path, capsys):
     assert code == 2 and "damaged pin file" in err
     assert 'errors="1"' in xml.read_text() and "damaged pin file" in xml.read_text()
     assert "error: " in md.read_text() and "unchanged" not in md.read_text()
+    # a value click refuses before the check runs replaces the reports too
+    code, _, _ = sgtool(capsys, "golden", "check", "--dir", pinned, "--report", md,
+                        "--junit", xml, "--tolerance", "-1")
+    assert code == 2
+    assert 'errors="1"' in xml.read_text() and "--tolerance" in xml.read_text()
+    assert "damaged pin file" not in md.read_text() and "--tolerance" in md.read_text()
 
 
 def test_a_re_recorded_log_is_told_how_to_pin_it_with_its_settings(log, tmp_path, capsys):

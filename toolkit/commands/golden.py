@@ -109,7 +109,37 @@ def pin(logs: tuple[str, ...], folder: str, copy: bool, why: str | None, every: 
                f"--dir {quoted(folder)}")
 
 
-@command.command("check")
+class _ReportingCommand(click.Command):
+    """A command whose refused arguments (click's usage errors: ``--every 0``) still
+    replace ``--report``/``--junit`` with the error, so an earlier check's green report is
+    never read as this one's."""
+
+    def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
+        given = list(args)
+        try:
+            return super().parse_args(ctx, args)
+        except click.UsageError as e:
+            report_md, junit = (_given_value(given, o) for o in ("--report", "--junit"))
+            if report_md or junit:
+                with contextlib.suppress(Exception):  # the usage error is the one said
+                    _write_report_files(None, report_md, junit, error=(
+                        _given_value(given, "--dir") or "(no --dir)", e.format_message()))
+            raise
+
+
+def _given_value(args: Sequence[str], option: str) -> str | None:
+    """The last value of ``option`` in raw command-line ``args`` (``--x V`` or
+    ``--x=V``), or None."""
+    found = None
+    for i, a in enumerate(args):
+        if a == option and i + 1 < len(args):
+            found = args[i + 1]
+        elif a.startswith(option + "="):
+            found = a.split("=", 1)[1]
+    return found
+
+
+@command.command("check", cls=_ReportingCommand)
 @click.option("--dir", "folder", required=True, type=PathParam(file_okay=False),
               help="Pin folder written by `sgtool golden pin`.")
 @click.option("--log", "names", multiple=True, metavar="NAME",
