@@ -356,6 +356,8 @@ def _run(reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
     feed = _Feed(reader, stream, writer, opts, report, on_refresh, progress, tf_time)
     if copy_chunks and writer is not None and _can_copy(reader, writer, opts):
         for chunk, items in reader.chunks(views=True):
+            if chunk is not None and _copyable(chunk, items):
+                feed.settle_before(int(chunk.index.message_start_time))
             copied = chunk is not None and _copyable(chunk, items) and writer.copy_chunk(chunk)
             for schema, channel, message in items:
                 feed.message(schema, channel, message, write=not copied)
@@ -408,6 +410,9 @@ class _Feed:
         self.copied: dict[int, int] = {}  # input channel id -> output channel id
         self.asm = FrameAssembler(where=str(reader.path), tf_time=tf_time)
         self.last_t = 0
+        # instance tables and actions of one log time, held until that time's messages
+        # are all in (:meth:`settle`): MCAP orders no messages of one time
+        self.held: list[tuple[int, Instances | None]] = []
 
     def refreshed(self, r: Refresh | None) -> None:
         if r is None:
@@ -438,6 +443,8 @@ class _Feed:
         when the frame budget is spent (the message is then not taken)."""
         topic = channel.topic
         t = int(message.log_time)
+        if self.held and self.held[0][0] != t and not self.settle():
+            return False
         if topic in self.needed:
             decoded = self.reader.decode(schema, channel, message)
             if topic in self.frame_topics:
@@ -448,13 +455,11 @@ class _Feed:
                     self.report.truncated = True  # a frame past the budget: not copied
                     return False
             else:
-                if not self.take_frame(self.asm.flush()):
-                    return False
-                if topic == _INSTANCES:
-                    self.stream.instances(t, Instances.from_json(
-                        decoded, where=f"{self.reader.path}: {Instances.describe(t_ns=t)}"))
-                else:
-                    self.refreshed(self.stream.action(t))
+                if self.asm.time != t and not self.take_frame(self.asm.flush()):
+                    return False  # (the frame of an earlier time comes before the record)
+                self.held.append((t, Instances.from_json(
+                    decoded, where=f"{self.reader.path}: {Instances.describe(t_ns=t)}")
+                    if topic == _INSTANCES else None))
         if write and self.writer is not None and topic not in REBUILT_TOPICS:
             self._write(schema, channel, message, t)
         self.last_t = max(self.last_t, t)
@@ -476,6 +481,27 @@ class _Feed:
     def end(self) -> None:
         """After the last message taken: the last frame (unless the budget is spent), the
         last refresh."""
-        if not self.report.truncated:
+        if not self.report.truncated and self.settle():
             self.take_frame(self.asm.flush())
         self.refreshed(self.stream.finish(self.last_t if not self.report.truncated else None))
+
+    def settle(self) -> bool:
+        """Take the records held at one log time in the order sgtool writes them, whatever
+        the file's order among messages of that time: its instance tables, then its frame,
+        then its actions (each a refresh). False when the frame budget is spent."""
+        held, self.held = self.held, []
+        for t, table in held:
+            if table is not None:
+                self.stream.instances(t, table)
+        if not self.take_frame(self.asm.flush()):
+            return False
+        for t, table in held:
+            if table is None:
+                self.refreshed(self.stream.action(t))
+        return True
+
+    def settle_before(self, t_ns: int) -> None:
+        """Settle the held records when they are older than ``t_ns`` (a copied chunk's
+        first log time: their refreshes go before it, as they were written)."""
+        if self.held and self.held[0][0] < t_ns:
+            self.settle()

@@ -1,9 +1,10 @@
 """Rewrite an MCAP file into valid variants the specification allows and sgtool's own
-writer never makes: messages of some channels outside chunks (with a full summary),
-records of an application's opcode (0x80-0xFF) between records and inside chunks, schema,
-channel and data-end records with fields a newer writer appends, small chunks, messages
-in another order. Every variant holds the same schemas, channels, messages, attachments
-and metadata as its source."""
+writer never makes: messages of some channels (or the last ones) outside chunks (with a
+full summary), records of an application's opcode (0x80-0xFF) between records and inside
+chunks, schema, channel and data-end records with fields a newer writer appends, small
+chunks, an empty chunk, definitions outside chunks, chunk indexes without message
+indexes, statistics without counts per channel, messages in another order. Every variant
+holds the same schemas, channels, messages, attachments and metadata as its source."""
 
 from __future__ import annotations
 
@@ -32,9 +33,18 @@ class Variant:
     application's record after every data-section record (``"data"``) or before every
     message in a chunk (``"chunk"``); ``extend`` appends bytes to every schema, channel
     and data-end record; ``chunk_messages`` messages per chunk; ``order`` reorders the
-    messages before they are written."""
+    messages before they are written; ``loose_last`` writes that many last messages
+    outside chunks; ``empty_chunk`` writes a chunk of no message (times 0) first;
+    ``outside`` writes schema and channel records outside chunks; ``message_indexes``
+    False writes chunk indexes without them; ``channel_counts`` False leaves the
+    statistics' counts per channel empty ("not available")."""
 
     loose: frozenset[str] = frozenset()
+    loose_last: int = 0
+    empty_chunk: bool = False
+    outside: bool = False
+    message_indexes: bool = True
+    channel_counts: bool = True
     extension: str = ""
     extension_opcode: int = 0xFF
     extend: int = 0
@@ -87,7 +97,7 @@ class _Writer:
         rec = _bytes(_chunk(min(self.times), max(self.times), data, packed))
         start = self.top(rec)
         offsets, mi = {}, bytearray()
-        for cid, entries in sorted(self.index.items()):
+        for cid, entries in sorted(self.index.items()) if self.v.message_indexes else ():
             offsets[cid] = len(self.out) + len(mi)
             mi += _bytes(R.MessageIndex(channel_id=cid, records=entries))
         self.out += mi
@@ -121,21 +131,28 @@ def rewrite(src: Path, dst: Path, v: Variant) -> Path:
     w = _Writer(dst, v)
     w.out += MAGIC
     w.top(_bytes(R.Header(profile=header.profile, library=header.library)))
+    if v.empty_chunk:
+        packed = zstandard.ZstdCompressor().compress(b"")
+        rec = _bytes(_chunk(0, 0, b"", packed))
+        w.chunk_indexes.append(R.ChunkIndex(
+            message_start_time=0, message_end_time=0, chunk_start_offset=w.top(rec),
+            chunk_length=len(rec), message_index_offsets={}, message_index_length=0,
+            compression="zstd", compressed_size=len(packed), uncompressed_size=0))
     stats = R.Statistics(message_count=0, schema_count=len(schemas), channel_count=len(channels),
                        attachment_count=len(attachments), metadata_count=len(metadata),
                        chunk_count=0, message_start_time=min(m.log_time for m in messages),
                        message_end_time=max(m.log_time for m in messages),
                        channel_message_counts=defaultdict(int))
-    for m in messages:
+    for i, m in enumerate(messages):
         ch = channels[m.channel_id]
         stats.message_count += 1
         stats.channel_message_counts[m.channel_id] += 1
-        if ch.topic in v.loose:
+        if ch.topic in v.loose or i >= len(messages) - v.loose_last:
             w.flush()
             w.define(schemas, ch, w.top)
             w.top(_bytes(m))
             continue
-        w.define(schemas, ch, w.chunk.append)
+        w.define(schemas, ch, w.top if v.outside else w.chunk.append)
         if v.extension == "chunk":
             w.chunk.append(extension(v.extension_opcode))
         at = sum(len(b) for b in w.chunk)
@@ -157,6 +174,8 @@ def rewrite(src: Path, dst: Path, v: Variant) -> Path:
         rec = _bytes(md)
         meta_idx.append(R.MetadataIndex(offset=w.top(rec), length=len(rec), name=md.name))
     stats.chunk_count = len(w.chunk_indexes)
+    if not v.channel_counts:
+        stats.channel_message_counts = {}
     w.out += _bytes(R.DataEnd(data_section_crc=0), v.extend)
     start = len(w.out)
     groups: list[tuple[int, Iterable[object]]] = [

@@ -25,8 +25,10 @@ points to ``sgtool doctor``, whatever ``verify`` says.
 
 from __future__ import annotations
 
+import contextlib
 import struct
 import zlib
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import IO, Any
 
@@ -112,9 +114,28 @@ def writer_supported(writer: Writer) -> bool:
     updates (module doc)."""
     private: Any = writer
     return (isinstance(getattr(private, "_Writer__chunk_indices", None), list)
+            and hasattr(private, "_Writer__chunk_builder")
+            and callable(getattr(private, "_Writer__flush", None))
             and hasattr(private, "_Writer__statistics")
             and isinstance(getattr(private, "_Writer__enable_data_crcs", None), bool)
             and isinstance(getattr(private, "_Writer__data_section_crc", None), int))
+
+
+@contextlib.contextmanager
+def outside_chunks(writer: Writer) -> Iterator[None]:
+    """Within the block, ``writer`` writes schema and channel records into the data
+    section, outside chunks, at once: a copied chunk may need them (its input defined
+    them outside its chunks), and the writer's chunk in progress, which holds no message
+    yet, is written only after a copied chunk (the MCAP specification wants a channel
+    before its first message)."""
+    private: Any = writer
+    builder = private._Writer__chunk_builder
+    private._Writer__chunk_builder = None
+    try:
+        yield
+    finally:
+        private._Writer__chunk_builder = builder
+        private._Writer__flush()
 
 
 def append_chunk(writer: Writer, stream: IO[bytes], chunk: RawChunk) -> None:

@@ -164,7 +164,8 @@ def _statistics(lay: Layout, summary: list) -> list[str]:
     }
     out = [f"statistics: {k} is {getattr(st, k)}, the file holds {v}"
            for k, v in want.items() if getattr(st, k) != v]
-    if {k: v for k, v in st.channel_message_counts.items() if v} != dict(counts):
+    if st.channel_message_counts and \
+            {k: v for k, v in st.channel_message_counts.items() if v} != dict(counts):
         out.append("statistics: message counts per channel differ from the file")
     if msgs and (st.message_start_time, st.message_end_time) != (
             min(t for _, t in msgs), max(t for _, t in msgs)):

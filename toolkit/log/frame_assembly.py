@@ -177,6 +177,11 @@ class FrameAssembler:
                 f"{o.worst_ns / 1e9:+.3f} s, at log time {o.worst_at_ns} ns); frames were "
                 f"paired with {S.TF} by log time ({TF_TIME_OPTION} pairs them by stamps)")
 
+    @property
+    def time(self) -> int | None:
+        """The log time of the frame being assembled (None before the first message)."""
+        return self._t
+
     def push(self, topic: str, t_ns: int, message: Any) -> Frame | None:
         out = None
         if self._t is not None and t_ns != self._t:

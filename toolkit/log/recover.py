@@ -119,7 +119,8 @@ def _verified(lay: Layout) -> Status:
     seen."""
     if lay.data_end is not None and lay.data_end.record.data_section_crc:
         return "complete"
-    covered = all(c.header.uncompressed_crc for c in lay.chunks) and not lay.loose
+    covered = all(c.header.uncompressed_crc or not c.messages for c in lay.chunks) \
+        and not lay.loose
     return "complete" if covered else "unverified"
 
 

@@ -14,7 +14,7 @@ import zlib
 from typing import IO
 
 from mcap.opcode import Opcode
-from mcap.records import Attachment, AttachmentIndex, Footer
+from mcap.records import Attachment, AttachmentIndex, ChunkIndex, Footer
 from mcap.summary import Summary
 
 from sgtool.errors import LogFormatError, SgtoolError
@@ -98,13 +98,21 @@ def check_summary(f: IO[bytes], size: int, summary: Summary,
         if mi.offset + mi.length > size:
             raise LogFormatError(f"the metadata index of {mi.name!r} does not fit the file")
     st = summary.statistics
-    if st is not None and st.message_count and summary.chunk_indexes:
-        span = (min(c.message_start_time for c in summary.chunk_indexes),
-                max(c.message_end_time for c in summary.chunk_indexes))
-        if (st.message_start_time, st.message_end_time) != span:
+    chunks = [c for c in summary.chunk_indexes if not maybe_empty(c)]
+    if st is not None and st.message_count and chunks:
+        span = (min(c.message_start_time for c in chunks),
+                max(c.message_end_time for c in chunks))
+        # messages outside chunks may widen the statistics' range, never narrow it
+        if st.message_start_time > span[0] or st.message_end_time < span[1]:
             raise LogFormatError(f"the statistics say messages from {st.message_start_time} "
                                  f"to {st.message_end_time} ns, the chunk indexes "
                                  f"{span[0]} to {span[1]} ns")
+
+
+def maybe_empty(ci: ChunkIndex) -> bool:
+    """The chunk ``ci`` indexes may hold no message: the MCAP specification gives such a
+    chunk the times 0 and 0, and it has no message index."""
+    return not ci.message_index_offsets and ci.message_start_time == ci.message_end_time == 0
 
 
 def read_attachment(f: IO[bytes], ai: AttachmentIndex, where: str) -> Attachment:

@@ -37,7 +37,7 @@ from sgtool.errors import LogFormatError
 from sgtool.files import quoted
 from sgtool.log.file_walk import ChunkFacts, Layout, walk
 from sgtool.log.mcap_records import head
-from sgtool.log.summary_check import read_footer
+from sgtool.log.summary_check import maybe_empty, read_footer
 
 Entry = tuple[Schema | None, Channel, Message]
 
@@ -54,12 +54,18 @@ class WalkedLog:
 
 def needs_walk(summary: Summary | None) -> bool:
     """True when ``summary`` cannot answer for the file alone: it is absent, has no
-    statistics, names schemas it lacks, counts messages on channels it lacks, or counts
-    more chunks, attachments or metadata records than it indexes (so messages outside
-    chunks, or records no index points to, exist)."""
+    statistics or no message counts per channel (an empty map: "not available"), names
+    schemas it lacks, counts messages on channels it lacks, indexes a chunk without
+    message indexes, or counts more chunks, attachments or metadata records than it
+    indexes (so messages outside chunks, or records no index points to, exist)."""
     if summary is None or summary.statistics is None:
         return True
     st = summary.statistics
+    if st.message_count and not any(st.channel_message_counts.values()):
+        return True
+    if st.message_count and any(not c.message_index_offsets and not maybe_empty(c)
+                                for c in summary.chunk_indexes):
+        return True
     if any(c.schema_id and c.schema_id not in summary.schemas
            for c in summary.channels.values()):
         return True

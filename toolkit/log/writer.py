@@ -275,13 +275,14 @@ class LogWriter:
                 or chunk_copy.ids_problem(summary)
                 or not chunk_copy.writer_supported(self._mcap)):
             return False
-        for sid, schema in sorted(summary.schemas.items()):
-            self._schemas[f"copied\0{sid}"] = self._mcap.register_schema(
-                name=schema.name, encoding=schema.encoding, data=bytes(schema.data))
-        for _, ch in sorted(summary.channels.items()):
-            self._channels[ch.topic] = self._mcap.register_channel(
-                topic=ch.topic, message_encoding=ch.message_encoding, schema_id=ch.schema_id,
-                metadata=dict(ch.metadata))
+        with chunk_copy.outside_chunks(self._mcap):  # before any chunk copied after them
+            for sid, schema in sorted(summary.schemas.items()):
+                self._schemas[f"copied\0{sid}"] = self._mcap.register_schema(
+                    name=schema.name, encoding=schema.encoding, data=bytes(schema.data))
+            for _, ch in sorted(summary.channels.items()):
+                self._channels[ch.topic] = self._mcap.register_channel(
+                    topic=ch.topic, message_encoding=ch.message_encoding,
+                    schema_id=ch.schema_id, metadata=dict(ch.metadata))
         return True
 
     def copy_chunk(self, chunk: chunk_copy.RawChunk) -> bool:
