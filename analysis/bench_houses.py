@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from sgtool.errors import SgtoolError, SpecError
+from sgtool.files import quoted
 from sgtool.house.io import house_file_id
 from sgtool.house.spec import HouseSpec
 from sgtool.semantics.text import category_text
@@ -84,7 +85,13 @@ def _house_sources(paths: Iterable[str | os.PathLike[str]]) -> list[tuple[Path, 
     loading it reports it."""
     out: list[tuple[Path, Path | None]] = []
     for p in map(Path, paths):
-        out.extend([(f, p) for f in folder_houses(p)] if p.is_dir() else [(p, None)])
+        try:
+            is_dir = p.is_dir()
+        except (OSError, ValueError) as e:  # a name too long, a NUL in it
+            raise SgtoolError(f"{quoted(str(p))[:120]}: not a house file or folder "
+                              f"({type(e).__name__}: {getattr(e, 'strerror', None) or e})"
+                              ) from None
+        out.extend([(f, p) for f in folder_houses(p)] if is_dir else [(p, None)])
     return out
 
 
@@ -357,11 +364,11 @@ MAX_NAME_BYTES = 255  # a file-name component on common file systems (NAME_MAX)
 
 def folder_name_problem(name: str) -> str | None:
     """Why ``name`` cannot be one folder name of an output (a house id in a log path), or
-    None: the rules of an id (:func:`sgtool.house.names.id_problem`) and the byte limit of
-    a file-name component."""
-    from sgtool.house.names import id_problem
+    None: the rules of a house id (:func:`sgtool.house.names.folder_id_problem`) and the
+    byte limit of a file-name component."""
+    from sgtool.house.names import folder_id_problem
 
-    bad = id_problem(name)
+    bad = folder_id_problem(name)
     if bad is None and len(name.encode("utf-8", "surrogatepass")) > MAX_NAME_BYTES:
         bad = f"more than {MAX_NAME_BYTES} bytes as a file name"
     return bad

@@ -24,7 +24,15 @@ def config_names(value: Any, field: str, paths: bool = False) -> tuple[Any, ...]
     if isinstance(value, set | frozenset):
         raise BenchError(f"{field}: give a list or tuple (a set has no order)")
     items = (value,) if isinstance(value, str | os.PathLike) else tuple(value)
-    return tuple(str(x) for x in items) if paths else items
+    if not paths:
+        return items
+    for x in items:
+        if not isinstance(x, str | os.PathLike):
+            hint = " (save it with sgtool.save_house and give the file)" \
+                if type(x).__name__ == "HouseSpec" else ""
+            raise BenchError(f"{field}: give paths of house files or folders, got a "
+                             f"{type(x).__name__}{hint}")
+    return tuple(os.fspath(x) for x in items)
 
 
 def config_planner_options(value: Any) -> dict[str, dict[str, Any]]:

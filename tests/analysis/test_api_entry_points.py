@@ -216,3 +216,16 @@ def test_more_wrong_arguments_are_one_line() -> None:
     with pytest.raises(sgtool.SgtoolError, match="differ in length") as e:
         sgtool.auc_e([1.0], [True, False], 10.0)
     assert isinstance(e.value, ValueError)
+
+
+def test_house_files_that_are_no_paths_are_one_line() -> None:
+    """A HouseSpec (run_one takes one, bench takes files) or a name too long for the file
+    system: a one-line SgtoolError, not an OSError showing the spec."""
+    spec = sgtool.load_house(Path(__file__).parents[2] / "datasets/data/demo_house.json")
+    with pytest.raises(sgtool.SgtoolError, match="got a HouseSpec .save it with "
+                       "sgtool.save_house"):
+        sgtool.BenchConfig(planners=("greedy",), houses=0, house_files=(spec,))
+    config = sgtool.BenchConfig(planners=("greedy",), houses=0, episodes=1, seeds=1,
+                                house_files=("x" * 300 + ".json",))
+    with pytest.raises(sgtool.SgtoolError, match="not a house file or folder .OSError"):
+        sgtool.run_benchmark(config)

@@ -32,6 +32,17 @@ def name_problem(text: str) -> str | None:
     return f"contains the control character {bad}" if bad else None
 
 
+def folder_id_problem(text: str) -> str | None:
+    """Why ``text`` cannot be the id of a house, which names a folder of logs, or None:
+    :func:`id_problem`'s rules, and no leading ``.`` (a hidden folder, which listings and
+    ``sgtool eval`` pass over)."""
+    bad = id_problem(text)
+    if bad is None and text.startswith("."):
+        bad = "starts with '.' (a house id names a folder of logs, and a hidden one is " \
+            "passed over)"
+    return bad
+
+
 def id_problem(text: str) -> str | None:
     """Why ``text`` cannot be an id, or None. An id must be usable as one file-name
     component and one table cell: not empty, at most :data:`MAX_ID_LENGTH` characters,

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import unicodedata
 from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
@@ -27,7 +28,7 @@ from sgtool.errors import SpecError
 from sgtool.house.consistency import check_consistency
 from sgtool.house.geometry import Point, Vec3, self_crossing, signed_area
 from sgtool.house.migrate import upgrade
-from sgtool.house.names import id_note, id_problem, name_problem
+from sgtool.house.names import folder_id_problem, id_note, id_problem, name_problem
 from sgtool.house.nesting import check_nesting, with_supporters
 from sgtool.house.spec import (
     AFFORDANCES,
@@ -55,8 +56,7 @@ def parse_house(d: Any, limits: SpecLimits = LIMITS) -> HouseSpec:
     of entries (rooms are compared pairwise, at most ``limits.rooms`` of them)."""
     doc, d = d, upgrade(d)
     _known_keys("top level", doc, _TOP_KEYS)  # the document as read (its repeated keys)
-    if "id" in d:
-        _house_id(d["id"])
+    own_id = _house_id(d["id"]) if "id" in d else None
     seed = d.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 63:
         raise SpecError("seed: expected an integer in [0, 2^63)")
@@ -77,7 +77,7 @@ def parse_house(d: Any, limits: SpecLimits = LIMITS) -> HouseSpec:
     furniture, objects = with_supporters(furniture, objects)
     spec = HouseSpec(seed=seed, rooms=rooms, walls=walls, doors=doors, furniture=furniture,
                      objects=objects, starts=starts, passages=passages, split=split,
-                     version=SPEC_VERSION)
+                     version=SPEC_VERSION, id=own_id)
     check_consistency(spec, limits)
     check_nesting(furniture, objects, limits.depth)
     return spec
@@ -144,7 +144,7 @@ def _field(where: str, key: Any) -> str:
 def _house_id(v: Any) -> str:
     if not isinstance(v, str):
         raise SpecError(f"id: expected a string, got {_short(v)}")
-    problem = id_problem(v)
+    problem = folder_id_problem(v)
     if problem:
         raise SpecError(f"id: {_short(v)} {problem}")
     return v
@@ -217,7 +217,7 @@ class _Parser:
         problem = name_problem(v)
         if problem:
             raise SpecError(f"{where}: {_short(v)} {problem}")
-        return v
+        return unicodedata.normalize("NFC", v)  # "café" typed or stored decomposed: one name
 
     def category(self, where: str, x: Mapping[str, Any]) -> str:
         """A category name: a name with at least one word in it once read as text

@@ -303,7 +303,7 @@ class HouseSpec:
     objects and start poses; immutable, checked when loaded
     (:func:`sgtool.house.io.load_house`), written as canonical JSON by ``to_json()``.
     ``seed`` is the generator's seed (or the file's), ``split`` the knowledge split that
-    furnished it."""
+    furnished it, ``id`` the file's own id (None: the file name names the house)."""
 
     seed: int
     rooms: tuple[Room, ...]
@@ -315,6 +315,7 @@ class HouseSpec:
     passages: tuple[Passage, ...] = ()
     split: str = "eval"
     version: str = SPEC_VERSION
+    id: str | None = None
 
     # ----- look-ups -------------------------------------------------------------------
     def room(self, room_id: str) -> Room:
@@ -369,7 +370,9 @@ class HouseSpec:
 
     # ----- canonical form -------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
+        own_id = {} if self.id is None else {"id": self.id}
         return {
+            **own_id,
             "version": self.version,
             "seed": int(self.seed),
             "split": self.split,

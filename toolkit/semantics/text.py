@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import re
+import unicodedata
 
 _SENSE = re.compile(r"\.[a-zA-Z]\.\d+$")  # WordNet sense suffix: ".n.01"
 _SPACES = re.compile(r"\s+")
@@ -23,8 +24,8 @@ _CAMEL = re.compile(r"(?<=[a-z0-9])(?=[A-Z])|(?<=[A-Z])(?=[A-Z][a-z])")
 @functools.lru_cache(maxsize=65536)
 def category_text(name: str) -> str:
     """``"Frying_Pan.n.01"`` -> ``"frying pan"``; ``"bottom-cabinet"`` -> ``"bottom cabinet"``;
-    ``"TVStand"`` -> ``"tv stand"``."""
-    s = _SENSE.sub("", name.strip())
+    ``"TVStand"`` -> ``"tv stand"``; Unicode in its composed form (NFC)."""
+    s = _SENSE.sub("", unicodedata.normalize("NFC", name).strip())
     s = _CAMEL.sub(" ", s).lower()
     s = s.replace("_", " ").replace("-", " ")
     return _SPACES.sub(" ", s).strip()

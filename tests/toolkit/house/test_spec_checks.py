@@ -37,6 +37,7 @@ def _refused(d: dict, message: str) -> None:
     ("x" * (MAX_ID_LENGTH + 1), rf"^id: .* {MAX_ID_LENGTH + 1} characters, more than the limit"),
     ("..", r"^id: '\.\.' is not allowed as an id"),
     (".", r"^id: '\.' is not allowed as an id"),
+    (".hidden", r"^id: '\.hidden' starts with '\.' \(a house id names a folder of logs"),
     ("", r"^id: '' is empty"),
     (7, r"^id: expected a string, got 7"),
 ])
@@ -73,6 +74,27 @@ def test_safe_ids_and_names_load() -> None:
     assert len(d["id"]) <= MAX_ID_LENGTH and id_problem(d["id"]) is None
     spec = load_house(d)
     assert spec.objects[0].category == "café au lait"
+
+
+def test_a_house_keeps_its_id_and_one_spelling_of_a_name(tmp_path) -> None:
+    """The file's id survives a load and save (bench names logs by it); a name stored
+    decomposed (NFD, as some editors write it) is one name with the composed one, and a
+    query typed either way finds it."""
+    from sgtool.house.io import house_file_id, save_house
+    from sgtool.semantics.text import category_text
+
+    d = two_rooms()
+    d["id"] = "maison_é"
+    d["objects"][0]["category"] = "cafe\u0301 cup"  # NFD: e + combining acute
+    d["objects"][1]["category"] = "café cup"
+    spec = load_house(d)
+    assert spec.id == "maison_é"
+    assert spec.objects[0].category == spec.objects[1].category == "café cup"
+    save_house(spec, tmp_path / "copy.json")
+    assert house_file_id(tmp_path / "copy.json") == "maison_é"
+    assert load_house(tmp_path / "copy.json") == spec
+    assert category_text("Cafe\u0301_Cup") == category_text("café cup") == "café cup"
+    assert "id" not in load_house(two_rooms()).to_dict()  # no id given: none written
 
 
 @pytest.mark.parametrize("where, message", [
