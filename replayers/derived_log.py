@@ -43,11 +43,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from sgtool.arg_checks import function, number, of_type, whole
 from sgtool.arg_checks import progress as check_progress
 from sgtool.blas import single_blas_thread
 from sgtool.datasets.room_evidence import make_classifier
-from sgtool.errors import SgtoolError
+from sgtool.errors import LogFormatError, SgtoolError
 from sgtool.heap import frozen_heap, small_pages
 from sgtool.log import schemas as S
 from sgtool.log.chunk_copy import RawChunk, in_sequence
@@ -366,9 +368,21 @@ def _run(reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
             if not feed.message(schema, channel, message, write=writer is not None):
                 break
     feed.end()
-    note = feed.asm.tf_stamp_note()
-    if note is not None:
-        report.warnings.append(note)
+    for note in (feed.asm.tf_stamp_note(), feed.asm.stale.note(), unposed_note(feed)):
+        if note is not None:
+            report.warnings.append(note)
+
+
+def unposed_note(feed: _Feed) -> str | None:
+    """One line for the frames left out without a camera pose (before the first /tf, a
+    chain broken); an error when no frame had one."""
+    if not feed.unposed:
+        return None
+    why = (f"{S.TF} has no chain from '{S.WORLD_FRAME}' to the depth image's frame (sgtool's "
+           f"logs name them '{S.WORLD_FRAME}' and '{S.CAMERA_FRAME}') at their time")
+    if not feed.report.frames and not feed.report.truncated:
+        raise LogFormatError(f"{feed.reader.path}: no frame has a camera pose: {why}")
+    return f"{feed.unposed} frame(s) without a camera pose left out: {why}"
 
 
 def _can_copy(reader: LogReader, writer: LogWriter, opts: ResolvedOptions) -> bool:
@@ -413,6 +427,7 @@ class _Feed:
         # instance tables and actions of one log time, held until that time's messages
         # are all in (:meth:`settle`): MCAP orders no messages of one time
         self.held: list[tuple[int, Instances | None]] = []
+        self.unposed = 0  # frames without a camera pose, left out
 
     def refreshed(self, r: Refresh | None) -> None:
         if r is None:
@@ -424,18 +439,21 @@ class _Feed:
         if self.on_refresh is not None:
             self.on_refresh(r, self.stream)
 
-    def take_frame(self, fr: Any) -> bool:
-        """Integrate a finished frame; False when the frame budget is spent."""
-        if fr is None:
-            return True
+    def take_frame(self, frames: list[Any]) -> bool:
+        """Integrate finished frames (a frame /tf did not pose is left out and counted);
+        False when the frame budget is spent."""
         report = self.report
-        if self.opts.max_frames is not None and report.frames >= self.opts.max_frames:
-            report.truncated = True
-            return False
-        report.frames += 1
-        if self.progress is not None:
-            self.progress.update(1)
-        self.refreshed(self.stream.frame(fr))
+        for fr in frames:
+            if not np.isfinite(fr.pose).all():
+                self.unposed += 1
+                continue
+            if self.opts.max_frames is not None and report.frames >= self.opts.max_frames:
+                report.truncated = True
+                return False
+            report.frames += 1
+            if self.progress is not None:
+                self.progress.update(1)
+            self.refreshed(self.stream.frame(fr))
         return True
 
     def message(self, schema: Any, channel: Any, message: Any, write: bool) -> bool:
@@ -482,7 +500,7 @@ class _Feed:
         """After the last message taken: the last frame (unless the budget is spent), the
         last refresh."""
         if not self.report.truncated and self.settle():
-            self.take_frame(self.asm.flush())
+            self.take_frame(self.asm.finish())
         self.refreshed(self.stream.finish(self.last_t if not self.report.truncated else None))
 
     def settle(self) -> bool:

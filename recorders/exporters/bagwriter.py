@@ -30,7 +30,7 @@ import numpy as np
 
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
-from sgtool.recorders.importers.poses import tq_from_pose
+from sgtool.log.poses import tq_from_pose
 
 FORMATS = ("ros1", "ros2-sqlite3", "ros2-mcap")
 DISTROS = ("humble", "jazzy")

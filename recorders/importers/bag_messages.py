@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from sgtool.errors import SgtoolError
-from sgtool.recorders.importers.poses import pose_from_tq
+from sgtool.log.poses import pose_from_tq
 from sgtool.recorders.importers.tftree import TfTree, frame_name
 
 MIN_QUATERNION_NORM = 1e-6  # shorter quaternions cannot be normalised (replay's limit too)

@@ -11,9 +11,9 @@ from pathlib import Path
 import numpy as np
 
 from sgtool.errors import SgtoolError
+from sgtool.log.poses import PoseTrack
 from sgtool.recorders.importers.bag_index import BagIndex
 from sgtool.recorders.importers.bag_options import BagOptions
-from sgtool.recorders.importers.poses import PoseTrack
 from sgtool.recorders.importers.tftree import TfTree, frame_name
 
 

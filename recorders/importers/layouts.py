@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from sgtool.errors import SgtoolError
-from sgtool.recorders.importers.poses import PoseTrack
+from sgtool.log.poses import PoseTrack
 from sgtool.recorders.importers.sanity import time_range_problem, timestamp_problem
 from sgtool.recorders.importers.textformats import (
     PinholeParams,

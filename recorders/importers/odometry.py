@@ -60,7 +60,7 @@ import numpy as np
 
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
-from sgtool.recorders.importers.poses import pose_difference, rotation_angle_deg
+from sgtool.log.poses import pose_difference, rotation_angle_deg
 
 METHODS = ("rgbd+icp", "rgbd", "icp")
 

@@ -26,7 +26,7 @@ import numpy as np
 
 from sgtool.errors import SgtoolError
 from sgtool.log.codec import rigid_problem
-from sgtool.recorders.importers.poses import pose_from_tq
+from sgtool.log.poses import pose_from_tq
 
 
 def seconds_to_ns(text: str) -> int:

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sgtool.recorders.importers.poses import PoseTrack
+from sgtool.log.poses import PoseTrack
 
 
 def frame_name(name: str) -> str:

@@ -12,7 +12,7 @@ import cv2
 import numpy as np
 
 from sgtool.log.frame import CameraIntrinsics
-from sgtool.recorders.importers.poses import tq_from_pose
+from sgtool.log.poses import tq_from_pose
 
 K = CameraIntrinsics(80, 60, 60.0, 60.0, 39.5, 29.5)
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sgtool.recorders.importers.poses import tq_from_pose
+from sgtool.log.poses import tq_from_pose
 
 
 def ns_to_seconds_text(t_ns: int) -> str:

@@ -22,6 +22,7 @@ not checked. A stamp of 0 (unset) counts as the log time.
 from __future__ import annotations
 
 import bisect
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, TypeVar
@@ -32,20 +33,29 @@ from sgtool.errors import LogFormatError
 from sgtool.log import codec
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics, Frame
+from sgtool.log.poses import interpolate
 
 T = TypeVar("T")
 
 
 class TransformBuffer:
-    """Transforms by (parent, child) over time; lookup of the latest at or before t."""
+    """Transforms by (parent, child) over time. A link's value at time t is its sample at
+    t, else interpolated between the samples around t (linear in translation, slerp in
+    rotation, as ``tf2`` does) when they are at most :data:`MAX_GAP_NS` apart, else the
+    latest before t; before a link's first sample, that sample when it is at most
+    :data:`NEAR_NS` away. A ``static`` link (``/tf_static``) holds at every time."""
 
     def __init__(self) -> None:
         self._parent: dict[str, str] = {}
         self._times: dict[str, list[int]] = {}
         self._values: dict[str, list[np.ndarray]] = {}
+        self._static: set[str] = set()
 
-    def add(self, t_ns: int, parent: str, child: str, T: np.ndarray) -> None:  # noqa: N803
+    def add(self, t_ns: int, parent: str, child: str, T: np.ndarray,  # noqa: N803
+            static: bool = False) -> None:
         self._parent[child] = parent
+        if static:
+            self._static.add(child)
         times = self._times.setdefault(child, [])
         vals = self._values.setdefault(child, [])
         if times and t_ns < times[-1]:
@@ -56,23 +66,70 @@ class TransformBuffer:
             times.append(t_ns)
             vals.append(T)
 
-    def lookup(self, t_ns: int, target: str, root: str = S.WORLD_FRAME) -> np.ndarray | None:
-        """root_T_target at ``t_ns``, or None when the chain is not known yet."""
-        T = None  # noqa: N806 - the identity until the first link
+    def _chain(self, target: str, root: str) -> list[str] | None:
+        """The children of the links from ``target`` up to ``root``; None when unknown."""
+        out: list[str] = []
         frame = target
         for _ in range(32):
             if frame == root:
-                return np.eye(4) if T is None else T
+                return out
             if frame not in self._parent:
                 return None
-            times = self._times[frame]
-            i = bisect.bisect_right(times, t_ns) - 1
-            if i < 0:
-                return None
-            link = self._values[frame][i]
-            T = link.copy() if T is None else link @ T  # noqa: N806
+            out.append(frame)
             frame = self._parent[frame]
         return None
+
+    def covers(self, t_ns: int, target: str, root: str = S.WORLD_FRAME) -> bool:
+        """Every moving link from ``root`` to ``target`` has a sample at or after ``t_ns``
+        (so no later transform can change the pose at ``t_ns``)."""
+        chain = self._chain(target, root)
+        return chain is not None and all(
+            c in self._static or self._times[c][-1] >= t_ns for c in chain)
+
+    def _link(self, child: str, t_ns: int) -> tuple[np.ndarray, int] | None:
+        """The link's value at ``t_ns`` (class doc) and how far its sample lies from
+        ``t_ns`` when it was not interpolated (0 when it was, or the link is static)."""
+        times, vals = self._times[child], self._values[child]
+        i = bisect.bisect_right(times, t_ns) - 1
+        if child in self._static:
+            return vals[max(i, 0)], 0
+        if i >= 0 and times[i] == t_ns:
+            return vals[i], 0
+        if i < 0:
+            return (vals[0], times[0] - t_ns) if times[0] - t_ns <= NEAR_NS else None
+        if i + 1 < len(times) and times[i + 1] - times[i] <= MAX_GAP_NS:
+            a = (t_ns - times[i]) / (times[i + 1] - times[i])
+            return interpolate(vals[i], vals[i + 1], a), 0
+        return vals[i], t_ns - times[i]
+
+    def lookup(self, t_ns: int, target: str, root: str = S.WORLD_FRAME) -> np.ndarray | None:
+        """root_T_target at ``t_ns``, or None when the chain is not known yet."""
+        found = self.lookup_aged(t_ns, target, root)
+        return None if found is None else found[0]
+
+    def lookup_aged(self, t_ns: int, target: str, root: str = S.WORLD_FRAME
+                    ) -> tuple[np.ndarray, int] | None:
+        """:meth:`lookup` and the largest distance in time of a sample taken as it is
+        (not interpolated) from ``t_ns`` (ns; 0: every moving link was exact or
+        interpolated)."""
+        chain = self._chain(target, root)
+        if chain is None:
+            return None
+        T, age = None, 0  # noqa: N806 - the identity until the first link
+        for child in chain:
+            link = self._link(child, t_ns)
+            if link is None:
+                return None
+            T = link[0].copy() if T is None else link[0] @ T  # noqa: N806
+            age = max(age, link[1])
+        return (np.eye(4) if T is None else T), age
+
+
+MAX_GAP_NS = 1_000_000_000  # /tf samples further apart: a dropout, not interpolated
+NEAR_NS = 50_000_000  # a link's first sample counts this far before it
+HOLD_NS = 500_000_000  # a frame waits this long (log time) for a later /tf
+MAX_HELD = 64  # frames held at most (a /tf that stopped)
+STALE_NS = 50_000_000  # a pose from /tf older than this is noted
 
 
 FRAME_TOPICS = (S.RGB, S.DEPTH, S.IDS, S.CALIBRATION, S.TF, S.TF_STATIC)
@@ -112,6 +169,34 @@ class TfStampOffsets:
             self.beyond += 1
         if abs(offset_ns) > abs(self.worst_ns):
             self.worst_ns, self.worst_at_ns = offset_ns, log_ns
+@dataclass
+class StalePoses:
+    """Frames posed from a ``/tf`` sample older than :data:`STALE_NS` (no later sample
+    came while they were held): how many, the largest age (ns) and the log time of its
+    frame."""
+
+    count: int = 0
+    worst_ns: int = 0
+    worst_at_ns: int = 0
+
+    def add(self, age_ns: int, t_ns: int) -> None:
+        if age_ns <= STALE_NS:
+            return
+        self.count += 1
+        if age_ns > self.worst_ns:
+            self.worst_ns, self.worst_at_ns = age_ns, t_ns
+
+    def note(self, where: str = "") -> str | None:
+        """One line when any frame was posed from a stale ``/tf``, else None."""
+        if not self.count:
+            return None
+        prefix = f"{where}: " if where else ""
+        return (f"{prefix}{self.count} frame(s) took a camera pose from a {S.TF} sample "
+                f"older than the image (up to {self.worst_ns / 1e9:.3f} s, at log time "
+                f"{self.worst_at_ns} ns; no later {S.TF} came within "
+                f"{HOLD_NS / 1e9:g} s): where the camera moved, their points are misplaced")
+
+
 _IMAGES = {S.DEPTH: "depth", S.RGB: "rgb", S.IDS: "ids"}
 
 
@@ -135,9 +220,16 @@ class FrameAssembler:
     image of one log time with the RGB and id images of the same time, the calibration in
     force and the camera pose from the transforms in force (module doc).
 
-    :meth:`push` returns the previous frame when a message of a new log time arrives;
-    :meth:`flush` returns the frame being assembled (when it has its depth image), so a
-    caller that meets another record of the same time can take the frame first.
+    :meth:`push` returns the frames finished by a message: the previous log time's when a
+    message of a new log time arrives; :meth:`flush` the frame being assembled (when it
+    has its depth image), so a caller that meets another record of the same time can take
+    the frame first; :meth:`finish`, at the end, every frame still held. A frame is held
+    (in order) until every moving ``/tf`` link of its pose has a sample at or after its
+    time, so that a transform stamped a moment after the image still poses it (interpolated,
+    :class:`TransformBuffer`), for at most :data:`HOLD_NS` of log time or
+    :data:`MAX_HELD` frames; then it takes the latest transforms read when it was
+    assembled, and :attr:`stale` counts the frames posed from one older than
+    :data:`STALE_NS`.
 
     Inconsistent sensor data is refused with a :class:`LogFormatError` naming ``where``
     (the log), the channel, the log time and the field: a transform that is not finite or
@@ -163,6 +255,11 @@ class FrameAssembler:
         self.tf_offsets = TfStampOffsets()
         self._pending: dict[str, Any] = {}
         self._t: int | None = None
+        # frames waiting for /tf: the frame, its pose's time, the camera's frame id and the
+        # (pose, age, base pose) of the transforms read when it was assembled
+        self._held: list[tuple[Frame, int, str, tuple[np.ndarray, int, np.ndarray | None]
+                               | None]] = []
+        self.stale = StalePoses()
 
     def tf_stamp_note(self) -> str | None:
         """One line when ``/tf`` stamps disagreed with their log times beyond
@@ -182,16 +279,18 @@ class FrameAssembler:
         """The log time of the frame being assembled (None before the first message)."""
         return self._t
 
-    def push(self, topic: str, t_ns: int, message: Any) -> Frame | None:
-        out = None
+    def push(self, topic: str, t_ns: int, message: Any) -> list[Frame]:
+        out: list[Frame] = []
         if self._t is not None and t_ns != self._t:
             out = self.flush()
             self._pending = {}
         self._t = t_ns
         if topic in (S.TF, S.TF_STATIC):  # /tf_static: links written once
             T = decoded(self.where, topic, t_ns, codec.decode_transform, message)  # noqa: N806
-            self.transforms.add(self._tf_key(t_ns, message), message.parent_frame_id,
-                                message.child_frame_id, T)
+            tf_t = self._tf_key(t_ns, message)
+            self.transforms.add(tf_t, message.parent_frame_id, message.child_frame_id, T,
+                                static=topic == S.TF_STATIC)
+            out += self._release()
         elif topic == S.CALIBRATION:
             self.calibration = decoded(self.where, topic, t_ns, codec.decode_calibration,
                                        message)
@@ -201,6 +300,34 @@ class FrameAssembler:
                 self._fail(topic, t_ns, "a second image of this channel at the same log "
                            "time (each frame needs its own log time)")
             self._pending[key] = message
+        return out
+
+    def finish(self) -> list[Frame]:
+        """After the last message: the frame being assembled and every frame held."""
+        return self.flush() + self._release(final=True)
+
+    def _release(self, final: bool = False) -> list[Frame]:
+        """The held frames, in order, whose pose no later ``/tf`` can change, or that waited
+        long enough (class doc); every one when ``final``. A frame that waited in vain
+        takes the pose it had when it was assembled (the latest transforms read then)."""
+        out: list[Frame] = []
+        while self._held:
+            fr, at, camera, fallback = self._held[0]
+            covered = self.transforms.covers(at, camera)
+            if not (covered or final or len(self._held) > MAX_HELD
+                    or (self._t is not None and self._t - fr.time_ns > HOLD_NS)):
+                break
+            self._held.pop(0)
+            if covered:
+                now = self.transforms.lookup_aged(at, camera)
+                fallback = None if now is None else (
+                    *now, self.transforms.lookup(at, S.BASE_FRAME))
+            if fallback is None:
+                out.append(fr)  # (its pose is NaN: no chain at its time)
+                continue
+            pose, age, base = fallback
+            self.stale.add(age, fr.time_ns)
+            out.append(dataclasses.replace(fr, pose=pose, base_pose=base))
         return out
 
     def _tf_key(self, t_ns: int, message: Any) -> int:
@@ -224,12 +351,13 @@ class FrameAssembler:
         prefix = f"{self.where}: " if self.where else ""
         raise LogFormatError(f"{prefix}{topic} message at {t_ns} ns: {why}")
 
-    def flush(self) -> Frame | None:
+    def flush(self) -> list[Frame]:
         """The frame of the current log time, if its depth image has arrived (it is then
-        handed out once); None otherwise."""
+        handed out once, now or, held for a later ``/tf``, by a later call), after the
+        frames held before it that can go."""
         pending, t = self._pending, self._t
         if "depth" not in pending or t is None:
-            return None
+            return self._release()
         self._pending = {}
         depth_msg = pending["depth"]
         k = self.calibration
@@ -255,10 +383,11 @@ class FrameAssembler:
         at = t
         if self.tf_time == "stamp":
             at = stamp_ns(depth_msg) or t
-        pose = self.transforms.lookup(at, depth_msg.frame_id or S.CAMERA_FRAME)
-        if pose is None:
-            pose = np.full((4, 4), np.nan)
-        fr = Frame(index=self.index, time_ns=t, rgb=rgb, depth=depth, ids=ids, pose=pose,
-                   intrinsics=k, base_pose=self.transforms.lookup(at, S.BASE_FRAME))
+        fr = Frame(index=self.index, time_ns=t, rgb=rgb, depth=depth, ids=ids,
+                   pose=np.full((4, 4), np.nan), intrinsics=k)
         self.index += 1
-        return fr
+        camera = depth_msg.frame_id or S.CAMERA_FRAME
+        now = self.transforms.lookup_aged(at, camera)
+        fallback = None if now is None else (*now, self.transforms.lookup(at, S.BASE_FRAME))
+        self._held.append((fr, at, camera, fallback))
+        return self._release()

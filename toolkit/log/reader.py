@@ -38,6 +38,7 @@ from sgtool.errors import (
 from sgtool.files import quoted
 from sgtool.log import chunk_stream as cs
 from sgtool.log import codec, message_check, walk_index
+from sgtool.log import frame_assembly as assembly
 from sgtool.log import schemas as S
 from sgtool.log.chunk_copy import RawChunk, raw_chunk
 from sgtool.log.frame import CameraIntrinsics, Frame
@@ -435,12 +436,8 @@ class LogReader:
         asm = FrameAssembler(index=index, transforms=tf, calibration=calib,
                              where=str(self.path), tf_time=tf_time)
         for d in self._messages(FRAME_TOPICS, start_ns=start_ns, end_ns=end_ns, views=True):
-            fr = asm.push(d.topic, d.log_time_ns, d.message)
-            if fr is not None:
-                yield fr
-        fr = asm.flush()
-        if fr is not None:
-            yield fr
+            yield from asm.push(d.topic, d.log_time_ns, d.message)
+        yield from asm.finish()
 
     def raw_messages(self, topics: Iterable[str] | None = None
                      ) -> Iterator[tuple[Schema | None, Channel, Message]]:
@@ -549,14 +546,15 @@ class LogReader:
 
     def frame_at(self, t_ns: int) -> Frame | None:
         """The frame at or before ``t_ns`` (None before the first frame), found through the
-        MCAP chunk index without reading the log from the start."""
+        MCAP chunk index without reading the log from the start (posed as replay poses it:
+        a ``/tf`` up to :data:`~sgtool.log.frame_assembly.HOLD_NS` later counts)."""
         self.require(S.DEPTH, why="frames need depth images")
         times = self.frame_times()
         i = bisect.bisect_right(times, int(t_ns)) - 1
         t_frame = times[i] if i >= 0 else None
         if t_frame is None:
             return None
-        for fr in self.frames(start_ns=t_frame, end_ns=t_frame + 1):
+        for fr in self.frames(start_ns=t_frame, end_ns=t_frame + assembly.HOLD_NS + 1):
             return fr
         return None
 
@@ -573,7 +571,7 @@ class LogReader:
             for d in self.messages([S.TF_STATIC], end_ns=t_ns):
                 tf.add(d.log_time_ns, d.message.parent_frame_id, d.message.child_frame_id,
                        decoded(str(self.path), d.topic, d.log_time_ns,
-                               codec.decode_transform, d.message))
+                               codec.decode_transform, d.message), static=True)
         seen: set[str] = set()
         for d in self.messages([S.TF], end_ns=t_ns, reverse=True):
             child = d.message.child_frame_id

@@ -17,8 +17,8 @@ from sgtool.cli import cli
 from sgtool.errors import SgtoolError
 from sgtool.log import LogReader, LogWriter
 from sgtool.log.frame import Frame
+from sgtool.log.poses import pose_difference, pose_from_tq
 from sgtool.recorders.importers.bag import BagOptions, import_bag, read_trajectory
-from sgtool.recorders.importers.poses import pose_difference, pose_from_tq
 from sgtool.recorders.importers.sink import IMPORT_METADATA
 from sgtool.recorders.importers.textformats import read_tum_trajectory, seconds_to_ns
 

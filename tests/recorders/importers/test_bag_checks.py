@@ -20,9 +20,9 @@ from sgtool.cli import cli
 from sgtool.errors import SgtoolError
 from sgtool.log import LogReader
 from sgtool.log.frame import CameraIntrinsics
+from sgtool.log.poses import pose_difference
 from sgtool.recorders.importers.bag import BagOptions, check_options, import_bag
 from sgtool.recorders.importers.distortion import distortion_finding, distortion_shift_px
-from sgtool.recorders.importers.poses import pose_difference
 
 T0 = 1_700_000_000_000_000_000
 DT = 100_000_000

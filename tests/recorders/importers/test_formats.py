@@ -19,13 +19,13 @@ from support.trajectory_files import (
 
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
-from sgtool.recorders.importers import images, textformats
-from sgtool.recorders.importers.poses import (
+from sgtool.log.poses import (
     PoseTrack,
     interpolate,
     pose_difference,
     rotation_angle_deg,
 )
+from sgtool.recorders.importers import images, textformats
 from sgtool.recorders.importers.tftree import TfTree
 from sgtool.recorders.importers.upright import (
     DepthSample,

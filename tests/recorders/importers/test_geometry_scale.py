@@ -87,7 +87,7 @@ def test_real_icl_pixels_in_tenth_millimetres_name_10000(shared_data_dir, tmp_pa
     import cv2
     import numpy as np
 
-    from sgtool.recorders.importers.poses import tq_from_pose
+    from sgtool.log.poses import tq_from_pose
     from sgtool.recorders.importers.textformats import read_open3d_log
 
     icl = shared_data_dir / "rgbd" / "icl-livingroom1-micro"

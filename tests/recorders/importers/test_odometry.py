@@ -16,13 +16,13 @@ from click.testing import CliRunner
 from sgtool.cli import cli
 from sgtool.log import LogReader
 from sgtool.log.frame import CameraIntrinsics
+from sgtool.log.poses import rotation_angle_deg
 from sgtool.recorders.importers.odometry import (
     MotionLimits,
     drift_against,
     estimate_trajectory,
     implausible_motion,
 )
-from sgtool.recorders.importers.poses import rotation_angle_deg
 
 
 def wall_frames(n: int = 4, step_m: float = 0.03):

@@ -19,9 +19,9 @@ from support.trajectory_files import ns_to_seconds_text
 from sgtool.cli import cli
 from sgtool.errors import SgtoolError
 from sgtool.log import LogReader
+from sgtool.log.poses import pose_difference
 from sgtool.recorders.importers.layouts import detect_layout, read_sequence
 from sgtool.recorders.importers.odometry import drift_against
-from sgtool.recorders.importers.poses import pose_difference
 from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
 from sgtool.recorders.importers.sink import IMPORT_METADATA
 from sgtool.recorders.importers.textformats import (

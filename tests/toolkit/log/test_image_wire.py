@@ -80,11 +80,8 @@ def test_frames_read_through_views_equal_frames_from_protobuf_messages():
         slow = []
         for d in r.messages(FRAME_TOPICS):  # protobuf classes, copied bytes
             assert not isinstance(d.message, memoryview)
-            fr = asm.push(d.topic, d.log_time_ns, d.message)
-            if fr is not None:
-                slow.append(fr)
-        fr = asm.flush()
-        slow.append(fr)
+            slow += asm.push(d.topic, d.log_time_ns, d.message)
+        slow += asm.finish()
     assert len(fast) == len(slow) > 10
     for a, b in zip(fast, slow, strict=True):
         assert a.time_ns == b.time_ns and a.index == b.index

@@ -53,12 +53,8 @@ def assembled(path, tf_time: str = "log"):
     xs = []
     with LogReader(path) as r:
         for d in r.messages(FRAME_TOPICS):
-            fr = asm.push(d.topic, d.log_time_ns, d.message)
-            if fr is not None:
-                xs.append(fr.pose[0, 3])
-    fr = asm.flush()
-    if fr is not None:
-        xs.append(fr.pose[0, 3])
+            xs += [fr.pose[0, 3] for fr in asm.push(d.topic, d.log_time_ns, d.message)]
+    xs += [fr.pose[0, 3] for fr in asm.finish()]
     return xs, asm.tf_stamp_note()
 
 
@@ -80,13 +76,14 @@ def test_stamps_a_quarter_second_off_are_noted_with_the_offset_and_the_option(tm
                     "with /tf by log time (--tf-time stamp pairs them by stamps)")
 
 
-def test_pairing_by_stamps_uses_the_transform_stamped_at_or_before_the_frame(tmp_path):
+def test_pairing_by_stamps_interpolates_between_the_transforms_around_the_frame(tmp_path):
     log = tf_log(tmp_path / "late.mcap", 0.25)
     xs, note = assembled(log, tf_time="stamp")
-    # frame i (stamp 0.1 i s) takes the transform stamped at or before it: the one of
-    # frame j with 0.1 j + 0.25 <= 0.1 i, i.e. j <= i - 2.5; none for frames 0..2
-    assert np.isnan(xs[:3]).all()
-    assert xs[3:] == [0.0, 1.0, 2.0]
+    # frame i (stamp 0.1 i s) lies between the transforms of frames j and j + 1 (stamped
+    # 0.1 j + 0.25, camera at x = j): x = i - 2.5 for frames 3..5; frame 2 is 0.05 s
+    # before the first transform, near enough to take it; frames 0 and 1 have no pose
+    assert np.isnan(xs[:2]).all()
+    assert xs[2:] == pytest.approx([0.0, 0.5, 1.5, 2.5])
     assert note is None
 
 
@@ -126,7 +123,10 @@ def test_replay_warns_refuses_and_takes_the_choice(tmp_path):
     out = tmp_path / "derived.mcap"
     r = CliRunner().invoke(cli, ["replay", str(early), "--tf-time", "stamp", "-o", str(out)])
     assert r.exit_code == 0, r.output
-    assert "warning" not in r.output
+    assert "header stamps" not in r.output  # the user's choice: no offset warning, but
+    # each frame's pose comes from a transform stamped 2 s before its image, and is told
+    assert "6 frame(s) took a camera pose from a /tf sample older than the image (up to " \
+        "2.000 s" in r.output
     with LogReader(out) as d:
         assert d.metadata["sgtool.replay"]["tf_time"] == "stamp"
 
