@@ -36,6 +36,7 @@ no path names), so replaying a log twice gives byte-identical files.
 
 from __future__ import annotations
 
+import collections
 import os
 import time
 from collections.abc import Callable
@@ -397,10 +398,9 @@ def _can_copy(reader: LogReader, writer: LogWriter, opts: ResolvedOptions) -> bo
 def _copyable(chunk: RawChunk, items: list[Any]) -> bool:
     """The messages of ``chunk`` (``items``, in log-time order) can be written as the
     chunk: its indexes count them, and it holds no instance table or action record. A
-    refresh is written before the message that caused it; a frame's refresh is caused by
-    the first message of a later log time, so the copy, which puts the refresh after the
-    chunk, keeps the log-time order; an instance table or action record can cause a
-    refresh at its own log time, which must stay before it."""
+    frame's refresh is made when a message of a later log time arrives, and may go after
+    the chunk; an action record's refresh belongs right after the messages of its log
+    time, before what follows it in its chunk."""
     counts: dict[int, int] = {}
     for _, channel, _ in items:
         if channel.topic in (_INSTANCES, _ACTION):
@@ -427,6 +427,8 @@ class _Feed:
         # instance tables and actions of one log time, held until that time's messages
         # are all in (:meth:`settle`): MCAP orders no messages of one time
         self.held: list[tuple[int, Instances | None]] = []
+        # records of earlier times waiting for their frames (held for a later /tf)
+        self.queue: collections.deque[tuple[int, Instances | None]] = collections.deque()
         self.unposed = 0  # frames without a camera pose, left out
 
     def refreshed(self, r: Refresh | None) -> None:
@@ -440,21 +442,38 @@ class _Feed:
             self.on_refresh(r, self.stream)
 
     def take_frame(self, frames: list[Any]) -> bool:
-        """Integrate finished frames (a frame /tf did not pose is left out and counted);
-        False when the frame budget is spent."""
+        """Integrate finished frames, each after the records that come before it (a frame
+        /tf did not pose is left out and counted), then the records whose frames are all
+        in; False when the frame budget is spent."""
         report = self.report
         for fr in frames:
+            self._records(before=fr.time_ns)
             if not np.isfinite(fr.pose).all():
                 self.unposed += 1
                 continue
-            if self.opts.max_frames is not None and report.frames >= self.opts.max_frames:
-                report.truncated = True
+            if self.opts.max_frames is not None and fr.index >= self.opts.max_frames:
+                report.truncated = True  # (frames are numbered from 0 as they are read)
                 return False
             report.frames += 1
             if self.progress is not None:
                 self.progress.update(1)
             self.refreshed(self.stream.frame(fr))
+        if not self.asm.holding:
+            self._records(before=None)
         return True
+
+    def _records(self, before: int | None) -> None:
+        """Take the queued records that come before a frame at log time ``before`` (every
+        one: None): instance tables of that time or earlier, actions of earlier times."""
+        while self.queue:
+            t, table = self.queue[0]
+            if before is not None and (t > before or (t == before and table is None)):
+                return
+            self.queue.popleft()
+            if table is not None:
+                self.stream.instances(t, table)
+            else:
+                self.refreshed(self.stream.action(t))
 
     def message(self, schema: Any, channel: Any, message: Any, write: bool) -> bool:
         """Take one input message (``write``: also copy it into the derived log); False
@@ -469,7 +488,7 @@ class _Feed:
                 if not self.take_frame(self.asm.push(topic, t, decoded)):
                     return False
                 if self.opts.max_frames is not None and \
-                        self.report.frames >= self.opts.max_frames:
+                        self.asm.index >= self.opts.max_frames:
                     self.report.truncated = True  # a frame past the budget: not copied
                     return False
             else:
@@ -497,26 +516,21 @@ class _Feed:
         writer.write_raw(cid, t, bytes(message.data), message.sequence, message.publish_time)
 
     def end(self) -> None:
-        """After the last message taken: the last frame (unless the budget is spent), the
-        last refresh."""
-        if not self.report.truncated and self.settle():
+        """After the last message taken: the frames and records still held (within the
+        frame budget), the last refresh."""
+        if self.settle():
             self.take_frame(self.asm.finish())
+            self._records(before=None)
         self.refreshed(self.stream.finish(self.last_t if not self.report.truncated else None))
 
     def settle(self) -> bool:
-        """Take the records held at one log time in the order sgtool writes them, whatever
-        the file's order among messages of that time: its instance tables, then its frame,
-        then its actions (each a refresh). False when the frame budget is spent."""
+        """Queue the records held at one log time in the order sgtool writes them, whatever
+        the file's order among messages of that time: its instance tables before its
+        frame, its actions (each a refresh) after it (:meth:`take_frame` takes them in
+        turn with the frames). False when the frame budget is spent."""
         held, self.held = self.held, []
-        for t, table in held:
-            if table is not None:
-                self.stream.instances(t, table)
-        if not self.take_frame(self.asm.flush()):
-            return False
-        for t, table in held:
-            if table is None:
-                self.refreshed(self.stream.action(t))
-        return True
+        self.queue.extend(sorted(held, key=lambda r: r[1] is None))  # tables first (stable)
+        return self.take_frame(self.asm.flush())
 
     def settle_before(self, t_ns: int) -> None:
         """Settle the held records when they are older than ``t_ns`` (a copied chunk's

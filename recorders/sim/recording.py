@@ -126,7 +126,8 @@ class LogRecorder(SimObserver):
         written on ``/tf`` at the mounting at the last frame before (a viewer that
         interpolates between samples, as Foxglove does, then tilts the camera between two
         frames, not over the whole run before) and again at the first frame it is back,
-        since a reader takes the latest ``/tf`` link at or before a frame."""
+        since a reader takes a link also sent on ``/tf_static`` as fixed: its latest
+        sample at or before a frame, not interpolated."""
         w, t = self.writer, f.time_ns
         if f.intrinsics != self._calibration:
             w.write_calibration(t, f.intrinsics)

@@ -14,9 +14,10 @@ their log times is checked, since pairing by one time or the other builds anothe
 an offset beyond :data:`TF_STAMP_WARN_S` is noted (:meth:`FrameAssembler.tf_stamp_note`,
 naming the largest offset and ``--tf-time``), one beyond :data:`TF_STAMP_REFUSE_S` is
 refused (:class:`LogFormatError`). With ``tf_time="stamp"`` transforms are keyed by their
-header stamps and a frame's pose is looked up at its depth image's header stamp (a
-transform still counts only once it has been read, in log order); the offsets are then
-not checked. A stamp of 0 (unset) counts as the log time.
+header stamps and a frame's pose is looked up at its depth image's header stamp; the
+offsets are then not checked. A stamp of 0 (unset) counts as the log time. Either way a
+frame waits, for a while, for the transforms after its time (:class:`FrameAssembler`):
+a pose is interpolated between the samples around it, as ``tf2`` does.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.log.poses import interpolate
 
 T = TypeVar("T")
+_Snapshot = dict[str, tuple[np.ndarray, int]] | None
 
 
 class TransformBuffer:
@@ -43,17 +45,20 @@ class TransformBuffer:
     t, else interpolated between the samples around t (linear in translation, slerp in
     rotation, as ``tf2`` does) when they are at most :data:`MAX_GAP_NS` apart, else the
     latest before t; before a link's first sample, that sample when it is at most
-    :data:`NEAR_NS` away. A ``static`` link (``/tf_static``) holds at every time."""
+    :data:`NEAR_NS` away. A ``static`` link (``/tf_static``) holds at every time, a link
+    sent once on ``/tf`` (:meth:`_fixed`) from its time on."""
 
     def __init__(self) -> None:
         self._parent: dict[str, str] = {}
         self._times: dict[str, list[int]] = {}
         self._values: dict[str, list[np.ndarray]] = {}
         self._static: set[str] = set()
+        self._latest = -(2**63)  # the latest sample time of any link
 
     def add(self, t_ns: int, parent: str, child: str, T: np.ndarray,  # noqa: N803
             static: bool = False) -> None:
         self._parent[child] = parent
+        self._latest = max(self._latest, t_ns)
         if static:
             self._static.add(child)
         times = self._times.setdefault(child, [])
@@ -79,19 +84,26 @@ class TransformBuffer:
             frame = self._parent[frame]
         return None
 
+    def _fixed(self, child: str) -> bool:
+        """A link that does not move: from ``/tf_static``, or sent once on ``/tf`` (no
+        second sample came within :data:`HOLD_NS` of later transforms)."""
+        times = self._times[child]
+        return child in self._static or (len(times) == 1 and
+                                         self._latest - times[0] > HOLD_NS)
+
     def covers(self, t_ns: int, target: str, root: str = S.WORLD_FRAME) -> bool:
         """Every moving link from ``root`` to ``target`` has a sample at or after ``t_ns``
         (so no later transform can change the pose at ``t_ns``)."""
         chain = self._chain(target, root)
         return chain is not None and all(
-            c in self._static or self._times[c][-1] >= t_ns for c in chain)
+            self._fixed(c) or self._times[c][-1] >= t_ns for c in chain)
 
     def _link(self, child: str, t_ns: int) -> tuple[np.ndarray, int] | None:
         """The link's value at ``t_ns`` (class doc) and how far its sample lies from
-        ``t_ns`` when it was not interpolated (0 when it was, or the link is static)."""
+        ``t_ns`` when it was not interpolated (0 when it was, or the link is fixed)."""
         times, vals = self._times[child], self._values[child]
         i = bisect.bisect_right(times, t_ns) - 1
-        if child in self._static:
+        if self._fixed(child) and (i >= 0 or child in self._static):
             return vals[max(i, 0)], 0
         if i >= 0 and times[i] == t_ns:
             return vals[i], 0
@@ -102,32 +114,51 @@ class TransformBuffer:
             return interpolate(vals[i], vals[i + 1], a), 0
         return vals[i], t_ns - times[i]
 
-    def lookup(self, t_ns: int, target: str, root: str = S.WORLD_FRAME) -> np.ndarray | None:
-        """root_T_target at ``t_ns``, or None when the chain is not known yet."""
-        found = self.lookup_aged(t_ns, target, root)
-        return None if found is None else found[0]
+    def snapshot(self, t_ns: int, target: str, root: str = S.WORLD_FRAME
+                 ) -> dict[str, tuple[np.ndarray, int]] | None:
+        """Each link's value at ``t_ns`` from the samples read so far (:meth:`resolve`
+        falls back on it); None when the chain is not known."""
+        chain = self._chain(target, root)
+        if chain is None:
+            return None
+        out = {}
+        for child in chain:
+            link = self._link(child, t_ns)
+            if link is not None:
+                out[child] = link
+        return out
 
-    def lookup_aged(self, t_ns: int, target: str, root: str = S.WORLD_FRAME
-                    ) -> tuple[np.ndarray, int] | None:
-        """:meth:`lookup` and the largest distance in time of a sample taken as it is
-        (not interpolated) from ``t_ns`` (ns; 0: every moving link was exact or
-        interpolated)."""
+    def resolve(self, t_ns: int, target: str, root: str = S.WORLD_FRAME,
+                snapshot: dict[str, tuple[np.ndarray, int]] | None = None
+                ) -> tuple[np.ndarray, int] | None:
+        """root_T_target at ``t_ns`` and the largest distance in time of a sample taken as
+        it is (not interpolated; 0 when every moving link was exact or interpolated), or
+        None when the chain is not known. A moving link with no sample at or after
+        ``t_ns`` takes its value from ``snapshot`` when it has one (what was read when
+        the frame was assembled)."""
         chain = self._chain(target, root)
         if chain is None:
             return None
         T, age = None, 0  # noqa: N806 - the identity until the first link
         for child in chain:
-            link = self._link(child, t_ns)
+            later = self._fixed(child) or self._times[child][-1] >= t_ns
+            link = (snapshot.get(child) if snapshot is not None and not later else None) \
+                or self._link(child, t_ns)
             if link is None:
                 return None
             T = link[0].copy() if T is None else link[0] @ T  # noqa: N806
             age = max(age, link[1])
         return (np.eye(4) if T is None else T), age
 
+    def lookup(self, t_ns: int, target: str, root: str = S.WORLD_FRAME) -> np.ndarray | None:
+        """root_T_target at ``t_ns``, or None when the chain is not known yet."""
+        found = self.resolve(t_ns, target, root)
+        return None if found is None else found[0]
+
 
 MAX_GAP_NS = 1_000_000_000  # /tf samples further apart: a dropout, not interpolated
 NEAR_NS = 50_000_000  # a link's first sample counts this far before it
-HOLD_NS = 500_000_000  # a frame waits this long (log time) for a later /tf
+HOLD_NS = 1_000_000_000  # a frame waits this long (log time) for a later /tf
 MAX_HELD = 64  # frames held at most (a /tf that stopped)
 STALE_NS = 50_000_000  # a pose from /tf older than this is noted
 
@@ -227,9 +258,9 @@ class FrameAssembler:
     (in order) until every moving ``/tf`` link of its pose has a sample at or after its
     time, so that a transform stamped a moment after the image still poses it (interpolated,
     :class:`TransformBuffer`), for at most :data:`HOLD_NS` of log time or
-    :data:`MAX_HELD` frames; then it takes the latest transforms read when it was
-    assembled, and :attr:`stale` counts the frames posed from one older than
-    :data:`STALE_NS`.
+    :data:`MAX_HELD` frames; then a link with no later sample keeps the value read when
+    the frame was assembled, and :attr:`stale` counts the frames posed from a sample older
+    than :data:`STALE_NS`.
 
     Inconsistent sensor data is refused with a :class:`LogFormatError` naming ``where``
     (the log), the channel, the log time and the field: a transform that is not finite or
@@ -256,9 +287,8 @@ class FrameAssembler:
         self._pending: dict[str, Any] = {}
         self._t: int | None = None
         # frames waiting for /tf: the frame, its pose's time, the camera's frame id and the
-        # (pose, age, base pose) of the transforms read when it was assembled
-        self._held: list[tuple[Frame, int, str, tuple[np.ndarray, int, np.ndarray | None]
-                               | None]] = []
+        # links of its camera and base chains as read when it was assembled
+        self._held: list[tuple[Frame, int, str, tuple[_Snapshot, _Snapshot]]] = []
         self.stale = StalePoses()
 
     def tf_stamp_note(self) -> str | None:
@@ -306,28 +336,31 @@ class FrameAssembler:
         """After the last message: the frame being assembled and every frame held."""
         return self.flush() + self._release(final=True)
 
+    @property
+    def holding(self) -> bool:
+        """Frames are held for a later ``/tf`` (class doc)."""
+        return bool(self._held)
+
     def _release(self, final: bool = False) -> list[Frame]:
         """The held frames, in order, whose pose no later ``/tf`` can change, or that waited
-        long enough (class doc); every one when ``final``. A frame that waited in vain
-        takes the pose it had when it was assembled (the latest transforms read then)."""
+        long enough (class doc); every one when ``final``. A link of a frame that waited
+        in vain keeps the value it had when the frame was assembled."""
         out: list[Frame] = []
         while self._held:
-            fr, at, camera, fallback = self._held[0]
-            covered = self.transforms.covers(at, camera)
-            if not (covered or final or len(self._held) > MAX_HELD
+            fr, at, camera, snaps = self._held[0]
+            if not (final or len(self._held) > MAX_HELD
+                    or self.transforms.covers(at, camera)
                     or (self._t is not None and self._t - fr.time_ns > HOLD_NS)):
                 break
             self._held.pop(0)
-            if covered:
-                now = self.transforms.lookup_aged(at, camera)
-                fallback = None if now is None else (
-                    *now, self.transforms.lookup(at, S.BASE_FRAME))
-            if fallback is None:
+            found = self.transforms.resolve(at, camera, snapshot=snaps[0])
+            if found is None:
                 out.append(fr)  # (its pose is NaN: no chain at its time)
                 continue
-            pose, age, base = fallback
-            self.stale.add(age, fr.time_ns)
-            out.append(dataclasses.replace(fr, pose=pose, base_pose=base))
+            self.stale.add(found[1], fr.time_ns)
+            base = self.transforms.resolve(at, S.BASE_FRAME, snapshot=snaps[1])
+            out.append(dataclasses.replace(fr, pose=found[0],
+                                           base_pose=None if base is None else base[0]))
         return out
 
     def _tf_key(self, t_ns: int, message: Any) -> int:
@@ -387,7 +420,6 @@ class FrameAssembler:
                    pose=np.full((4, 4), np.nan), intrinsics=k)
         self.index += 1
         camera = depth_msg.frame_id or S.CAMERA_FRAME
-        now = self.transforms.lookup_aged(at, camera)
-        fallback = None if now is None else (*now, self.transforms.lookup(at, S.BASE_FRAME))
-        self._held.append((fr, at, camera, fallback))
+        self._held.append((fr, at, camera, (self.transforms.snapshot(at, camera),
+                                            self.transforms.snapshot(at, S.BASE_FRAME))))
         return self._release()

@@ -422,7 +422,8 @@ class LogReader:
         self, *, start_ns: int | None = None, end_ns: int | None = None, tf_time: str = "log"
     ) -> Iterator[Frame]:
         """Frames in log-time order (see the module docstring); ``tf_time`` pairs ``/tf``
-        with frames (:class:`~sgtool.log.frame_assembly.FrameAssembler`)."""
+        with frames (:class:`~sgtool.log.frame_assembly.FrameAssembler`); a frame near
+        ``end_ns`` is posed from the transforms before ``end_ns``."""
         self.require(S.DEPTH, why="frames need depth images")
         for _, ch in sorted(self.summary.channels.items()):
             if ch.topic in FRAME_TOPICS:

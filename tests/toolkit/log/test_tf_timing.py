@@ -16,7 +16,7 @@ from sgtool.errors import LogFormatError
 from sgtool.log import LogReader
 from sgtool.log import schemas as S
 from sgtool.log.poses import pose_difference
-from sgtool.replayers.derived_log import replay
+from sgtool.replayers.derived_log import ReplayOptions, replay
 
 START = GOLDEN / "house10-start.mcap"
 IMAGES = {S.DEPTH, S.RGB, S.IDS}
@@ -97,3 +97,79 @@ def test_a_transform_that_stops_gives_stale_poses_and_says_so(tmp_path):
     assert report.frames == 110
     (note,) = [w for w in report.warnings if "older than the image" in w]
     assert note.split(" frame(s)")[0].isdigit()
+
+
+TOUR = GOLDEN / "house6-tour.mcap"
+
+
+def tf_later(path, by_ns: int, once: str | None = None):
+    """An order of ``path``'s messages with every /tf ``by_ns`` after its frame's images;
+    with ``once``, the transforms of that child frame sent only the first time."""
+    with LogReader(path) as r:
+        topics = {cid: ch.topic for cid, ch in r.summary.channels.items()}
+    children: dict[bytes, str] = {}
+
+    def order(messages):
+        out, seen = [], set()
+        for m in messages:
+            if topics[m.channel_id] != S.TF:
+                out.append(m)
+                continue
+            child = children.setdefault(m.data, _child(m))
+            if once is not None and child == once and child in seen:
+                continue
+            seen.add(child)
+            out.append(dataclasses.replace(m, log_time=m.log_time + by_ns))
+        return sorted(out, key=lambda m: m.log_time)
+    return order
+
+
+def _child(message) -> str:
+    from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
+
+    msg = FrameTransform()
+    msg.ParseFromString(bytes(message.data))
+    return msg.child_frame_id
+
+
+def refreshes(path, **kw):
+    got = []
+    report = replay(path, None, on_refresh=lambda r, _s: got.append(
+        (r.reason, r.time_ns, r.frames)), **kw)
+    return report, got
+
+
+def test_an_action_refreshes_after_the_frame_of_its_time_held_for_its_transform(tmp_path):
+    """/tf 1 ms after the images and action record of its time: each action's refresh
+    still holds the frame of its time (the record waits with the frame)."""
+    log = rewrite(TOUR, tmp_path / "later.mcap", Variant(order=tf_later(TOUR, 10**6)))
+    clean, skewed = refreshes(TOUR), refreshes(log)
+    assert skewed[1] == clean[1] and len(clean[1]) == 31
+    assert sum(reason == "action" for reason, _, _ in clean[1]) == 20
+    assert not skewed[0].warnings
+
+
+def test_a_link_sent_once_on_tf_waits_for_no_later_sample(tmp_path):
+    """The camera's mount sent once on /tf (not /tf_static) and the base's /tf 1 ms late:
+    the mount counts as fixed once no second sample comes, the base is interpolated, and
+    no pose is called stale."""
+    log = rewrite(START, tmp_path / "once.mcap",
+                  Variant(order=tf_later(START, 10**6, once=S.CAMERA_FRAME)))
+    clean, moved = poses(START), poses(log)
+    worst = np.max([pose_difference(a, b) for a, b in zip(clean, moved, strict=True)], axis=0)
+    assert worst[0] < 0.01 and worst[1] < 1.0, worst
+    assert not replay(log, None).warnings
+
+
+def test_the_frame_budget_counts_frames_held_for_their_transform(tmp_path):
+    """--max-frames 40 on a log whose /tf stops at 10 s (frames held, then posed from the
+    last transforms): 40 frames integrated and 40 depth images in the derived log."""
+    topics = _topics()
+    log = rewrite(START, tmp_path / "stops.mcap", Variant(
+        order=lambda ms: [m for m in ms if not (topics[m.channel_id] == S.TF
+                                                and m.log_time > 10 * 10**9)]))
+    out = tmp_path / "derived.mcap"
+    report = replay(log, out, ReplayOptions(max_frames=40))
+    assert report.frames == 40 and report.truncated
+    with LogReader(out) as r:
+        assert r.message_count(S.DEPTH) == 40
