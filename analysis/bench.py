@@ -220,7 +220,8 @@ class BenchResult:
     second per planner (wall clock), the ``table`` and ``seen_table`` text, the
     ``digest`` of the results without wall-clock figures, the run's ``wall_s``, its
     houses, the number of training queries of the priors and one line per task that
-    ``failed``; :func:`write_outputs` writes it into a folder."""
+    ``failed``; :func:`write_outputs` (``sgtool.write_bench_outputs``) writes it into a
+    folder."""
 
     config: BenchConfig
     results: tuple[EpisodeResult, ...]
@@ -375,7 +376,8 @@ def bench_tasks(cfg: BenchConfig, houses: Sequence[BenchHouse], run: str = "") -
 def run_benchmark(cfg: BenchConfig, progress: bool | None = None,
                   partial: bool = False) -> BenchResult:
     """Run every planner on every episode (module doc) and return the results and their
-    tables; nothing is written (:func:`write_outputs` does). A setting that cannot work is
+    tables; nothing is written (:func:`write_outputs`, ``sgtool.write_bench_outputs``,
+    does). A setting that cannot work is
     a one-line :class:`~sgtool.errors.SgtoolError` (:class:`BenchError`, a planner option)
     before any episode runs. A task (one house's planners) that failed twice (a plug-in
     that raises) is a :class:`BenchError` naming the first failure, unless ``partial``:

@@ -29,8 +29,8 @@ from sgtool.recorders.sim.episode_extras import recorded_options
 from sgtool.recorders.sim.noise import parse_noise
 from sgtool.scenegraph.build_options import MAX_DEPTH_M, ResolvedOptions, default_min_points
 
-_FIX = ("give a fresh -o folder (out_dir=), --force to run every episode again, or delete "
-        "the log to run the episode again")
+_FIX = ("give a fresh -o folder (out_dir=), --force to run every episode again (from "
+        "Python: a fresh out_dir), or delete the log to run the episode again")
 
 
 class ResumeError(SgtoolError):

@@ -220,7 +220,8 @@ def metrics_of(results: Sequence[EpisodeResult],
 @dataclass(frozen=True)
 class PlannerSummary:
     """One planner's metrics (:func:`summarize`): its ``episodes`` over all seeds, the
-    ``seeds``, and per metric name (:data:`METRICS`) a :class:`Stat` over the seeds."""
+    ``seeds``, and per metric name (``sr``, ``spl``, ``steps``, ``decision_s``, one
+    ``auc_e_NAME`` per cost model: :data:`METRICS`) a :class:`Stat` over the seeds."""
 
     planner: str
     episodes: int  # all episodes over all seeds

@@ -204,7 +204,7 @@ def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     minute; tests/recorders/sim covers run_episode)."""
     guide = (REPO / "docs" / "api.md").read_text()
     blocks = re.findall(r"```python\n(.*?)```", guide, re.DOTALL)
-    assert len(blocks) == 16
+    assert len(blocks) == 17
     runnable = [b for b in blocks if "run_closed_loop(" not in b]
     assert len(runnable) == len(blocks) - 1
     for name in ("tests", "examples"):
@@ -221,6 +221,8 @@ def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     assert (tmp_path / "derived.rrd").stat().st_size > 0
     assert (tmp_path / "run-bench" / "summary.md").is_file()
     assert "| scout " in (tmp_path / "run-bench" / "run.md").read_text()
+    again = namespace["again"]  # the tables at other budgets, read back (nothing run)
+    assert again.results() == namespace["result"].results()  # type: ignore[attr-defined]
     with sgtool.LogReader(tmp_path / "my.mcap") as log:
         assert [r.skill for _, r in log.records(sgtool.ActionRecord)] == ["navigate"]
     recorded = namespace["recorded"]  # the recording block

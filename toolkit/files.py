@@ -361,7 +361,8 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
         return
     if busy and not force:
         raise SgtoolError(f"{option} {target}: the folder is not empty; not writing into it "
-                          "(--force replaces what sgtool wrote there and keeps other files)")
+                          "(--force, force=True from Python, replaces what sgtool wrote "
+                          "there and keeps other files)")
     parent = path.parent
     made: list[Path] = []
     try:

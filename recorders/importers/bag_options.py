@@ -13,6 +13,7 @@ from sgtool.recorders.importers.checks import (
     check_counts,
     check_depth_scale,
     check_height_band,
+    check_intrinsics,
     check_non_negative,
     check_positive,
 )
@@ -59,6 +60,7 @@ def check_options(opts: BagOptions) -> None:
     check_counts(opts.every, opts.limit)
     check_depth_scale(opts.depth_scale)
     check_height_band(opts.camera_height)
+    check_intrinsics(opts.intrinsics)
     if opts.timestamps not in ("header", "bag"):
         raise SgtoolError(f"--timestamps {opts.timestamps!r}: give header or bag")
     check_positive(opts.depth_max, "--depth-max", "metres")

@@ -114,3 +114,14 @@ def parse_height_band(text: str) -> tuple[float, float]:
         raise SgtoolError(f"--camera-height {text!r}: give MIN:MAX in metres, e.g. "
                           "0.45:2.2") from e
     return check_height_band(band)
+
+
+def check_intrinsics(value: object) -> None:
+    """``intrinsics`` set from Python: None or a
+    :class:`~sgtool.recorders.importers.textformats.PinholeParams` (a string is a one-line
+    error naming the parser, not an AttributeError while frames are read)."""
+    from sgtool.recorders.importers.textformats import PinholeParams
+
+    if value is not None and not isinstance(value, PinholeParams):
+        raise SgtoolError(f"intrinsics: give a PinholeParams (sgtool.parse_intrinsics reads "
+                          f"'fx,fy,cx,cy' or a file), got a {type(value).__name__}")

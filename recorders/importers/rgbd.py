@@ -35,6 +35,7 @@ from sgtool.recorders.importers.checks import (
     check_depth_scale,
     check_floor,
     check_height_band,
+    check_intrinsics,
     check_positive,
     check_range,
 )
@@ -134,6 +135,7 @@ def check_options(opts: RgbdOptions) -> None:
     check_positive(opts.depth_max, "--depth-max", "metres")
     check_range(opts.max_dt_ns / 1e9, "--max-dt", 0.0, MAX_DT_S, "seconds")
     check_floor(opts.floor)
+    check_intrinsics(opts.intrinsics)
 
 
 def drift_reference(seq: FolderSequence, trajectory: Path | None) -> str:

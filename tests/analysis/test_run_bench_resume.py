@@ -70,8 +70,8 @@ def test_a_changed_house_file_is_not_resumed(tmp_path: Path, monkeypatch) -> Non
     assert res.exit_code == 2 and "Traceback" not in res.output
     assert res.output.strip().splitlines() == [
         f"sgtool: error: {log} was run on another house: the house of {house} changed "
-        "since; give a fresh -o folder (out_dir=), --force to run every episode again, or "
-        "delete the log to run the episode again"]
+        "since; give a fresh -o folder (out_dir=), --force to run every episode again "
+        "(from Python: a fresh out_dir), or delete the log to run the episode again"]
     # other settings: the message names them
     save_house(spec, house)
     other = list(cmd)

@@ -143,7 +143,8 @@ class LogWriter:
         whole("seed", seed, optional=True)  # (a log's own seed is copied as it is)
         self.path = Path(path)
         if self.path.exists() and not overwrite:
-            raise SgtoolError(f"{self.path} exists; not overwriting it")
+            raise SgtoolError(f"{self.path} exists; not overwriting it (use --force, "
+                              "overwrite=True)")
         if self.path.is_dir():
             raise SgtoolError(f"{self.path} is a folder, not a file name")
         if not self.path.parent.exists():

@@ -487,3 +487,13 @@ def test_odometry_options_without_estimated_poses_are_a_note(tmp_path) -> None:
     assert "note: --odometry and --depth-max did nothing: no pose was estimated" in r.stderr
     r = CliRunner().invoke(cli, [*args, "-o", str(tmp_path / "b.mcap")])
     assert r.exit_code == 0 and "did nothing" not in r.stderr, r.output
+
+
+def test_intrinsics_given_as_text_from_python_are_one_line(tmp_path) -> None:
+    """RgbdOptions(intrinsics="fx,fy,cx,cy") from Python: a one-line error naming the
+    parser, before anything is read (it was an AttributeError while frames were read)."""
+    root = open3d_folder(tmp_path / "f", ["0", "1"])
+    with pytest.raises(SgtoolError, match=r"^intrinsics: give a PinholeParams "
+                       r"\(sgtool.parse_intrinsics reads 'fx,fy,cx,cy' or a file\), got a str$"):
+        import_rgbd(root, tmp_path / "x.mcap", RgbdOptions(intrinsics="30,30,15.5,11.5"))
+    assert not (tmp_path / "x.mcap").exists()
