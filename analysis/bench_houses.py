@@ -292,11 +292,10 @@ def house_notes(house: Any) -> tuple[str, ...]:
                      f"less than the robot's radius ({house.robot_radius:g} m): the simulator "
                      "starts the robot at the nearest place clear of it")
     notes += unreachable_notes(spec)
-    unlinked = [r for r in unlinked_rooms(house) if r not in cut]
-    if unlinked:
-        notes.append(f"{', '.join(unlinked)}: joined to the rest by open floor (no wall) but "
-                     "by no door or passage, so the scene graph never leads there: give the "
-                     "opening a passage (or a door), or a wall")
+    for a, b in house.open_floor:
+        notes.append(f"{spec.rooms[a].id} and {spec.rooms[b].id} share open floor (no wall) "
+                     "but no door or passage: read as a passage (give the opening a passage "
+                     "or a door, or the border a wall)")
     return tuple(notes)
 
 
@@ -321,22 +320,6 @@ def unreachable_notes(spec: HouseSpec) -> list[str]:
                      "what it holds by sight only and cannot open it (leave the robot a way "
                      "in); the symbolic bench reaches it all the same")
     return notes
-
-
-def unlinked_rooms(house: Any) -> list[str]:
-    """Ids of the rooms outside the largest group of rooms joined by doors and passages
-    (the scene graph's links), in spec order."""
-    import numpy as np
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    n = len(house.spec.rooms)
-    pairs = [(a, b) for a in range(n) for b, _ in house.links[a]]
-    links = csr_matrix((np.ones(len(pairs)), ([a for a, _ in pairs], [b for _, b in pairs])),
-                       shape=(n, n))
-    _, group = connected_components(links, directed=False)
-    main = int(np.argmax(np.bincount(group)))  # the largest group (the first of equals)
-    return [house.spec.rooms[i].id for i in range(n) if group[i] != main]
 
 
 def completion_notes(path: Path, spec: HouseSpec) -> tuple[str, ...]:

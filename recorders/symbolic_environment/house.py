@@ -31,6 +31,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TypeVar
 
@@ -160,6 +161,12 @@ class SymbolicHouse:
             a, b = (self.room_index[r] for r in p.rooms)
             self.links[a].append((b, None))
             self.links[b].append((a, None))
+        # rooms whose free floor meets where the file has no wall, door or passage: open
+        # plan, joined as by a passage (the robot drives across; so does the planner)
+        self.open_floor = open_floor_pairs(self._raster, self.occ.blocked, self.links)
+        for a, b in self.open_floor:
+            self.links[a].append((b, None))
+            self.links[b].append((a, None))
         # small objects: children of each piece and of each object, the piece at the root
         # of each object's chain, whether a closed parent hides it (spec.enclosed)
         self.obj_index = {o.id: j for j, o in enumerate(spec.objects)}
@@ -211,7 +218,7 @@ class SymbolicHouse:
     def _walkable_rooms(self) -> None:
         from sgtool.datasets.episodes import room_raster
 
-        raster = room_raster(self.spec, self.occ)
+        raster = self._raster = room_raster(self.spec, self.occ)
         free = ~self.occ.blocked
         walks: list[np.ndarray | None] = []
         for ri in range(len(self.spec.rooms)):
@@ -428,3 +435,19 @@ class SymbolicHouse:
 
     def initially_open(self) -> frozenset[int]:
         return frozenset(i for i, d in enumerate(self.spec.doors) if d.state == "open")
+
+
+def open_floor_pairs(raster: np.ndarray, blocked: np.ndarray,
+                     links: Sequence[Sequence[tuple[int, int | None]]]
+                     ) -> list[tuple[int, int]]:
+    """Pairs (a, b), a < b, of rooms (``raster``: a room index per cell, -1 outside) whose
+    free cells (not ``blocked``: walls, closed doors, the robot's margin) touch side by
+    side, that ``links`` (per room, (other room, door or None)) does not join yet."""
+    lab = np.where(blocked, -1, raster)
+    found: set[tuple[int, int]] = set()
+    for a, b in ((lab[:, :-1], lab[:, 1:]), (lab[:-1, :], lab[1:, :])):
+        meet = (a >= 0) & (b >= 0) & (a != b)
+        found.update(zip(np.minimum(a, b)[meet].tolist(), np.maximum(a, b)[meet].tolist(),
+                         strict=True))
+    joined = {(min(a, o), max(a, o)) for a, ls in enumerate(links) for o, _ in ls}
+    return sorted(found - joined)
