@@ -292,6 +292,12 @@ def house_notes(house: Any) -> tuple[str, ...]:
                      f"less than the robot's radius ({house.robot_radius:g} m): the simulator "
                      "starts the robot at the nearest place clear of it")
     notes += unreachable_notes(spec)
+    if not spec.walls:
+        from sgtool.house.outline import outline_walls
+
+        notes.append(f"no walls: the closed loop stands {len(outline_walls(spec))} along the "
+                     "house's outer outline (gaps at its doors); inside, rooms meet on open "
+                     "floor (the symbolic bench needs no walls)")
     for a, b in house.open_floor:
         notes.append(f"{spec.rooms[a].id} and {spec.rooms[b].id} share open floor (no wall) "
                      "but no door or passage: read as a passage (give the opening a passage "

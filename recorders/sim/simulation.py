@@ -21,6 +21,7 @@ outcomes and observer callbacks in :mod:`.events`.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import replace
@@ -30,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from sgtool.errors import SgtoolError
+from sgtool.house.outline import outline_walls
 from sgtool.house.spec import HouseSpec, StartPose, room_at, spec_id_key
 from sgtool.log.frame import Frame
 from sgtool.mapping.occupancy import OccupancyMap
@@ -74,6 +76,8 @@ class Simulation(Skills):
                  start: int | Pose2 | StartPose = 0, cull: bool = True) -> None:
         if not FPS_RANGE[0] <= fps <= FPS_RANGE[1]:
             raise SgtoolError(f"fps {fps}: must be {FPS_RANGE[0]:g}..{FPS_RANGE[1]:g}")
+        if not house.walls:  # (a house file may give none: its outer outline gets walls)
+            house = dataclasses.replace(house, walls=outline_walls(house))
         self.spec = house
         self.camera = camera or CameraConfig()
         self.robot = robot or RobotConfig()
