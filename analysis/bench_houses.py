@@ -30,6 +30,7 @@ from typing import Any
 
 from sgtool.errors import SgtoolError, SpecError
 from sgtool.files import quoted
+from sgtool.house.geometry import distance_to_polygon
 from sgtool.house.io import house_file_id
 from sgtool.house.spec import HouseSpec
 from sgtool.semantics.text import category_text
@@ -217,6 +218,9 @@ def symbolic_house(spec: HouseSpec, where: str | os.PathLike[str]) -> tuple[Any,
         return None, f"{where}: rooms: {e}"
 
 
+DOOR_GAP = 0.3  # m between a door's two rooms (across its wall) past which no floor joins
+
+
 def house_notes(house: Any) -> tuple[str, ...]:
     """What a user should know of a house that loads: doors furniture blocks (read as
     walls), rooms walled off from the rest (their targets are searched from inside, the
@@ -238,6 +242,13 @@ def house_notes(house: Any) -> tuple[str, ...]:
     notes = []
     for di in sorted(house.blocked_doors):
         d = spec.doors[di]
+        gap = sum(distance_to_polygon(d.center[0], d.center[1], spec.room(r).polygon)
+                  for r in d.rooms)
+        if gap > DOOR_GAP:
+            notes.append(f"{d.id} ({' - '.join(d.rooms)}): the rooms are {gap:.2f} m apart at "
+                         "the door: no floor joins them through it; read as a wall (move a "
+                         "room's border to the door, or the door to where they meet)")
+            continue
         near = doorway_pieces(spec, d, 1.0)
         notes.append(f"{d.id} ({' - '.join(d.rooms)}): the robot (radius "
                      f"{house.robot_radius:g} m) cannot get through it from one room's free "
@@ -292,6 +303,10 @@ def house_notes(house: Any) -> tuple[str, ...]:
                      f"less than the robot's radius ({house.robot_radius:g} m): the simulator "
                      "starts the robot at the nearest place clear of it")
     notes += unreachable_notes(spec)
+    for ri in house.niches:
+        notes.append(f"{spec.rooms[ri].id}: no free floor the robot (radius "
+                     f"{house.robot_radius:g} m) fits on: the symbolic bench searches it from "
+                     "the rooms next to it, the closed loop only sees into it from there")
     if not spec.walls:
         from sgtool.house.outline import outline_walls
 

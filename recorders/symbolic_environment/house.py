@@ -231,6 +231,8 @@ class SymbolicHouse:
                                    robot_radius=self.robot_radius, closed_doors_free=True)
         self.blocked_doors = frozenset(blocked_doors(self.spec, open_occ, raster, walks))
         self._snap: list[tuple[tuple[slice, slice], np.ndarray, np.ndarray] | None] = []
+        # rooms without free floor for the robot (searched from the rooms next to them)
+        self.niches = tuple(ri for ri, walk in enumerate(walks) if walk is None)
         for ri, walk in enumerate(walks):
             if walk is None:  # a niche the robot does not fit in: seen from the next room
                 near = [w for j in self._neighbours(ri) if (w := walks[j]) is not None]

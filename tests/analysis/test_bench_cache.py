@@ -79,3 +79,45 @@ def test_a_plugin_is_built_afresh_for_each_task(tmp_path, monkeypatch):
     a = cached_planner("keeps_state:Keeps", {}, "run-p")
     b = cached_planner("keeps_state:Keeps", {}, "run-p")
     assert a is not b and a.name == b.name == "keeps_state:Keeps"
+
+
+def test_a_room_the_robot_cannot_stand_in_is_said():
+    """A table filling a 4 m x 4 m bedroom: the symbolic bench searches the room from
+    the kitchen next to it, the closed loop cannot enter it; the notes say so (they said
+    nothing of it)."""
+    from support.datasets_fixtures import two_rooms
+
+    from sgtool.analysis.bench_houses import house_notes
+    from sgtool.house.io import load_house
+    from sgtool.recorders.symbolic_environment.house import SymbolicHouse
+
+    d = two_rooms()
+    table = d["furniture"][1]
+    table.update(center=[6.0, 2.0, 0.375], size=[3.9, 3.9, 0.75])  # a table as big
+    d["objects"][1]["position"][:2] = [6.0, 2.0]
+    house = SymbolicHouse(load_house(d))
+    assert house.niches == (1,)
+    assert any(n.startswith("room_1: no free floor the robot (radius 0.2 m) fits on")
+               for n in house_notes(house))
+    assert SymbolicHouse(load_house(two_rooms())).niches == ()
+
+
+def test_a_door_between_rooms_that_do_not_meet_says_so():
+    """Rooms 0.4 m apart with the door in the gap: the note says no floor joins them
+    there (it blamed a cabinet 0.9 m away)."""
+    from support.datasets_fixtures import two_rooms
+
+    from sgtool.analysis.bench_houses import house_notes
+    from sgtool.house.io import load_house
+    from sgtool.recorders.symbolic_environment.house import SymbolicHouse
+
+    d = two_rooms()
+    d["rooms"][1]["polygon"] = [[4.4, 0], [8.4, 0], [8.4, 4], [4.4, 4]]
+    d["walls"] = [w for w in d["walls"] if w["a"][0] != 4]
+    d["doors"][0]["center"] = [4.2, 1.95]
+    for x in (*d["furniture"], *d["objects"]):
+        if x["room"] == "room_1":
+            x["center" if "center" in x else "position"][0] += 0.4
+    notes = house_notes(SymbolicHouse(load_house(d)))
+    assert "door_0 (room_0 - room_1): the rooms are 0.40 m apart at the door: no floor " \
+        "joins them through it; read as a wall" in " ".join(notes)
