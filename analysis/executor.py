@@ -499,7 +499,9 @@ Executor = LocalExecutor | RayExecutor
 
 
 def make_executor(name: str, workers: int = 1, address: str | None = None) -> Executor:
-    """The executor of ``--executor NAME`` (``--ray-address`` only with ``ray``)."""
+    """The executor of ``--executor NAME`` (``--ray-address`` only with ``ray``): "local"
+    (``workers`` processes; 1: in this process) or "ray"; the ``executor=`` of
+    :func:`~sgtool.pin_logs` and :func:`~sgtool.check_pins`."""
     if name == "local":
         if address:
             raise ExecutorError("--ray-address needs --executor ray")

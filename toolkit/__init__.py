@@ -61,7 +61,8 @@ import and export      :func:`import_rgbd`, :class:`RgbdOptions` (:class:`Pinhol
                        from :func:`parse_intrinsics`), :class:`ImportReport`,
                        :func:`export_bag`, :class:`ExportReport`
 golden logs            :func:`pin_logs`, :func:`check_pins` (a :class:`CheckReport` of
-                       :class:`LogCheck` s), :func:`update_pins`, :func:`read_pins`
+                       :class:`LogCheck` s; ``executor=``:func:`make_executor` runs
+                       logs in parallel), :func:`update_pins`, :func:`read_pins`
                        (:class:`PinSet` of :class:`Pinned`), :func:`diff_logs`
                        (:class:`LogDiff`), :func:`diff_graphs`, :func:`describe_mismatch`,
                        :func:`replay_graphs`

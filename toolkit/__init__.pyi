@@ -130,6 +130,7 @@ from sgtool.analysis.golden_check import check_pins as check_pins
 from sgtool.analysis.golden_check import update_pins as update_pins
 from sgtool.analysis.golden_check import CheckReport as CheckReport
 from sgtool.analysis.golden_check import LogCheck as LogCheck
+from sgtool.analysis.executor import make_executor as make_executor
 from sgtool.replayers.golden_pins import read_pins as read_pins
 from sgtool.replayers.golden_pins import PinSet as PinSet
 from sgtool.replayers.golden_pins import Pinned as Pinned
@@ -168,6 +169,6 @@ __all__ = [
     "read_log_episodes", "LoggedEpisode", "replay_decisions", "OfflineReport", "format_offline",
     "import_rgbd", "RgbdOptions", "PinholeParams", "parse_intrinsics", "ImportReport",
     "export_bag", "ExportReport", "pin_logs", "check_pins", "update_pins", "CheckReport",
-    "LogCheck", "read_pins", "PinSet", "Pinned", "diff_logs", "LogDiff", "replay_graphs",
-    "diff_graphs", "describe_mismatch",
+    "LogCheck", "make_executor", "read_pins", "PinSet", "Pinned", "diff_logs", "LogDiff",
+    "replay_graphs", "diff_graphs", "describe_mismatch",
 ]

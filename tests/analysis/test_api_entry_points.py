@@ -229,3 +229,14 @@ def test_house_files_that_are_no_paths_are_one_line() -> None:
                                 house_files=("x" * 300 + ".json",))
     with pytest.raises(sgtool.SgtoolError, match="not a house file or folder .OSError"):
         sgtool.run_benchmark(config)
+
+
+def test_a_golden_check_runs_on_the_executor_sgtool_exports(tmp_path) -> None:
+    """check_pins(executor=sgtool.make_executor(...)): the public way to check logs as
+    `golden check -w N` does; a wrong name is one line."""
+    log = Path(__file__).parents[1] / "golden" / "house10-start.mcap"
+    sgtool.pin_logs([log], tmp_path / "g", sgtool.ReplayOptions(max_frames=20))
+    checked = sgtool.check_pins(tmp_path / "g", executor=sgtool.make_executor("local", 1))
+    assert checked.exit_code == 0 and [c.status for c in checked.logs] == ["unchanged"]
+    with pytest.raises(sgtool.SgtoolError, match="--executor: one of"):
+        sgtool.make_executor("cluster")
