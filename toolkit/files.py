@@ -215,6 +215,22 @@ def sgtool_entries(folder: Path, known: Sequence[str] = ()) -> set[str]:
     return ours
 
 
+def _refuse_unlisted(folder: Path, target: str | os.PathLike[str], option: str,
+                     known: Sequence[str]) -> None:
+    """``--force`` into ``folder`` that has no :data:`MANIFEST` but entries named as the
+    command's outputs: sgtool did not write them (or an sgtool before manifests did), and
+    a user's files there would be replaced; one line naming them."""
+    owner, _ = read_manifest(folder)
+    if owner is not None:
+        return
+    clash = sorted(n for n in os.listdir(folder) if _matches(n, known))
+    if clash:
+        shown = ", ".join(clash[:4]) + (f" and {len(clash) - 4} more" if len(clash) > 4 else "")
+        raise SgtoolError(f"{option} {target}: holds {shown}, named as this command's "
+                          f"outputs but not listed as sgtool's ({MANIFEST} is missing); not "
+                          "replacing them: move them away, or give another folder")
+
+
 def _is_own(folder: Path, command: str, known: Sequence[str]) -> bool:
     """A folder ``command`` wrote (its manifest says so; without one, every entry matches
     ``known``), or an empty one."""
@@ -329,8 +345,9 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
       ``force`` the entries sgtool wrote there before (:func:`sgtool_entries`: the
       :data:`MANIFEST`'s list, names matching ``known``) and the entries of the same name
       as a new output are moved aside, the new entries moved in, and the moved-aside ones
-      deleted; any other entry (a user's file) stays. A failure or Ctrl-C while moving
-      puts every entry back where it was.
+      deleted; any other entry (a user's file) stays. A folder without a manifest that
+      holds entries named as outputs is refused (:func:`_refuse_unlisted`: they may be a
+      user's). A failure or Ctrl-C while moving puts every entry back where it was.
 
     The new :data:`MANIFEST` lists the top-level entries of the yielded folder, for the
     next ``--force``. On any exception (Ctrl-C included) the yielded folder is removed and
@@ -363,6 +380,8 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
         raise SgtoolError(f"{option} {target}: the folder is not empty; not writing into it "
                           "(--force, force=True from Python, replaces what sgtool wrote "
                           "there and keeps other files)")
+    if busy:
+        _refuse_unlisted(path, target, option, known)
     parent = path.parent
     made: list[Path] = []
     try:

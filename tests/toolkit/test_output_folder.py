@@ -80,11 +80,22 @@ def test_force_replaces_what_sgtool_wrote_and_keeps_the_users_files(tmp_path: Pa
     assert not [n for n in os.listdir(out) if n.startswith(".sgtool-previous")]
 
 
-def test_force_without_a_manifest_replaces_the_known_names_only(tmp_path: Path) -> None:
+def test_force_without_a_manifest_replaces_nothing_named_as_an_output(tmp_path: Path) -> None:
+    """No manifest: entries named as the outputs may be a user's (a review lost a `logs/`
+    folder of its own data to `run-bench --force`): refused, naming them; other files
+    alone are no obstacle."""
     out = tmp_path / "res"
     out.mkdir()
     _write(out, **{"episodes.jsonl": "old", "efficiency_x.png": "old", "mine.txt": "mine"})
-    with output_folder(out, force=True, known=("episodes.jsonl", "efficiency_*.png")) as s:
+    known = ("episodes.jsonl", "efficiency_*.png")
+    with pytest.raises(SgtoolError, match=r"holds efficiency_x.png, episodes.jsonl, named as "
+                       r"this command's outputs but not listed as sgtool's"):
+        with output_folder(out, force=True, known=known) as s:
+            _write(s, **{"episodes.jsonl": "new"})
+    assert _tree(out) == {"episodes.jsonl": "old", "efficiency_x.png": "old", "mine.txt": "mine"}
+    (out / "episodes.jsonl").unlink()
+    (out / "efficiency_x.png").unlink()
+    with output_folder(out, force=True, known=known) as s:
         _write(s, **{"episodes.jsonl": "new"})
     files = _tree(out)
     del files[MANIFEST]

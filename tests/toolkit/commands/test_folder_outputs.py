@@ -60,9 +60,12 @@ def test_bench_refuses_a_non_empty_folder_and_force_keeps_the_users_files(tmp_pa
     assert "not empty" in msg and "--force" in msg
     assert _tree(out) == {"summary.md": b"mine\n"}
     assert sorted(os.listdir(tmp_path)) == ["d", "fresh"]
-    # an earlier bench's file (no manifest: a bench output name) and the user's notes
+    # a file named as an output, no manifest: it may be the user's, so --force refuses
+    msg = _one_line_error(*_run([*BENCH, "-o", out, "--force"]))
+    assert "holds summary.md, named as this command's outputs but not listed" in msg
+    assert _tree(out) == {"summary.md": b"mine\n"}
+    # the user's notes alone are no obstacle
     (out / "summary.md").unlink()
-    (out / "episodes.jsonl").write_text("an earlier bench\n")
     (out / "notes.txt").write_text("mine\n")
     code, output = _run([*BENCH, "-o", out, "--force"])
     assert code == 0, output
