@@ -40,10 +40,16 @@ def check_output(path: str | os.PathLike[str], *, force: bool = False, option: s
 
 
 def check_log_output(path: str | os.PathLike[str], *, force: bool = False,
-                     option: str = "-o") -> Path:
-    """:func:`check_output` of an MCAP log to write (``*.mcap``)."""
+                     option: str = "-o",
+                     inputs: Sequence[str | os.PathLike[str] | None] = ()) -> Path:
+    """:func:`check_output` of an MCAP log to write (``*.mcap``), which must not be one of
+    the command's ``inputs`` (files it reads; None: not given)."""
     if not os.fspath(path):  # ("" would be the working folder)
         raise SgtoolError(f"{option} '': an empty path; give a file name")
+    for given in inputs:
+        if given and Path(given).is_file() and Path(given).resolve() == Path(path).resolve():
+            raise SgtoolError(f"{option} {path}: the output must not be an input "
+                              f"({given})")
     if Path(path).suffix != ".mcap" and not Path(path).is_dir():
         raise SgtoolError(f"{option} {path}: the output is an MCAP log; name it *.mcap")
     return check_output(path, force=force, option=option)

@@ -35,6 +35,7 @@ import numpy as np
 
 from sgtool.arg_checks import of_type
 from sgtool.errors import SgtoolError
+from sgtool.house.parse import JsonObject, json_object_pairs
 from sgtool.log.frame import Frame
 from sgtool.recorders.sim.camera import LINK_TOL, se2_matrix
 
@@ -105,13 +106,16 @@ def parse_noise(text: str | None) -> NoiseProfile:
     if names_file(t):
         p = Path(t)
         try:
-            d = json.loads(p.read_text(encoding="utf-8-sig"))
+            d = json.loads(p.read_text(encoding="utf-8-sig"),
+                           object_pairs_hook=json_object_pairs)
         except (OSError, UnicodeDecodeError) as e:
             raise SgtoolError(f"--noise {t}: cannot read: {e}") from None
         except json.JSONDecodeError as e:
             raise SgtoolError(f"--noise {t}: not valid JSON ({e.msg})") from None
         if not isinstance(d, dict):
             raise SgtoolError(f"--noise {t}: expected a JSON object of noise fields")
+        if isinstance(d, JsonObject) and d.duplicates:  # (json keeps the last silently)
+            raise SgtoolError(f"--noise {t}: {', '.join(d.duplicates)} is given twice")
         prof = d.pop("profile", "none")
         if not isinstance(prof, str) or prof not in PROFILES:
             raise SgtoolError(f"--noise {t}: unknown profile {prof!r} (one of "

@@ -97,7 +97,7 @@ def command(**given: Any) -> None:
     from sgtool.analysis.sim_session import record_tour
 
     args = RecordArgs(**given)
-    out = check_log_output(args.output, force=args.force)
+    out = check_log_output(args.output, force=args.force, inputs=(args.house_path, args.noise))
     request = _request(args, out)
     record_tour(request, show=click.echo, note=lambda m: click.echo(m, err=True))
 

@@ -150,7 +150,7 @@ def command(**given: Any) -> None:
     from sgtool.analysis.sim_session import run_search
 
     args = RunArgs(**given)
-    out = check_log_output(args.output, force=args.force)
+    out = check_log_output(args.output, force=args.force, inputs=(args.house_path, args.noise))
     request = _request(args, out)
     run_search(request, show=click.echo, note=lambda m: click.echo(m, err=True))
 

@@ -429,6 +429,9 @@ def test_an_endpoint_without_one_valid_answer_is_named(house, tmp_path) -> None:
     (["--planner", "scout", "-o", "{exists}"], "exists; not overwriting it (use --force)"),
     (["--planner", "scout", "--optimistic", "5"], "optimistic margin 5.0 m: must be 0..2"),
     (["--planner", "scout", "--noise", "loud"], "unknown profile 'loud'"),
+    # a house saved as .mcap given as the output too: it was replaced by the log
+    (["--planner", "scout", "--house", "{exists}", "-o", "{exists}", "--force"],
+     "the output must not be an input"),
 ])
 def test_user_errors(tmp_path, args, message) -> None:
     (tmp_path / "bad.json").write_text("{not json")

@@ -153,6 +153,9 @@ def test_parse_noise(tmp_path: Path) -> None:
         parse_noise(str(tmp_path / "bad.json"))
     with pytest.raises(SgtoolError, match="holes is given twice"):
         parse_noise("mild,holes=0.1,holes=0.2")  # not the last one silently
+    (tmp_path / "twice.json").write_text('{"holes": 0.1, "holes": 0.9}')
+    with pytest.raises(SgtoolError, match=r"twice.json: holes is given twice"):
+        parse_noise(str(tmp_path / "twice.json"))  # a file as the text: the same rule
     for empty in ("", "  "):  # an empty --noise is a mistake, not a perfect sensor
         with pytest.raises(SgtoolError, match="empty"):
             parse_noise(empty)
