@@ -218,7 +218,7 @@ def symbolic_house(spec: HouseSpec, where: str | os.PathLike[str]) -> tuple[Any,
         return None, f"{where}: rooms: {e}"
 
 
-DOOR_GAP = 0.3  # m between a door's two rooms (across its wall) past which no floor joins
+DOOR_GAP = 0.02  # m between a door's two rooms: any gap is floor of neither (rounding)
 
 
 def house_notes(house: Any) -> tuple[str, ...]:

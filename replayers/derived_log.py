@@ -447,13 +447,13 @@ class _Feed:
         in; False when the frame budget is spent."""
         report = self.report
         for fr in frames:
+            if self.opts.max_frames is not None and fr.index >= self.opts.max_frames:
+                report.truncated = True  # (frames are numbered from 0 as they are read)
+                return False
             self._records(before=fr.time_ns)
             if not np.isfinite(fr.pose).all():
                 self.unposed += 1
                 continue
-            if self.opts.max_frames is not None and fr.index >= self.opts.max_frames:
-                report.truncated = True  # (frames are numbered from 0 as they are read)
-                return False
             report.frames += 1
             if self.progress is not None:
                 self.progress.update(1)
@@ -482,18 +482,24 @@ class _Feed:
         t = int(message.log_time)
         if self.held and self.held[0][0] != t and not self.settle():
             return False
+        if self.budget_read():  # the budget's frames are read: only /tf that poses them
+            self.take_frame(self.asm.push(topic, t, self.reader.decode(
+                schema, channel, message)) if topic in (S.TF, S.TF_STATIC)
+                else self.asm.tick(t))
+            self.report.truncated |= topic == S.DEPTH  # a frame past the budget
+            return self.budget_waits()
         if topic in self.needed:
             decoded = self.reader.decode(schema, channel, message)
             if topic in self.frame_topics:
                 if not self.take_frame(self.asm.push(topic, t, decoded)):
                     return False
-                if self.opts.max_frames is not None and \
-                        self.asm.index >= self.opts.max_frames:
-                    self.report.truncated = True  # a frame past the budget: not copied
-                    return False
+                if self.budget_read():  # (this message is past the budget: not copied)
+                    return self.budget_waits()
             else:
                 if self.asm.time != t and not self.take_frame(self.asm.flush()):
                     return False  # (the frame of an earlier time comes before the record)
+                if self.budget_read():  # (a record past the budget: neither taken nor copied)
+                    return self.budget_waits()
                 self.held.append((t, Instances.from_json(
                     decoded, where=f"{self.reader.path}: {Instances.describe(t_ns=t)}")
                     if topic == _INSTANCES else None))
@@ -501,6 +507,20 @@ class _Feed:
             self._write(schema, channel, message, t)
         self.last_t = max(self.last_t, t)
         return True
+
+    def budget_read(self) -> bool:
+        """The ``max_frames`` frames are all read (assembled; some may wait for /tf)."""
+        return self.opts.max_frames is not None and self.asm.index >= self.opts.max_frames
+
+    def budget_waits(self) -> bool:
+        """Past the frame budget: True while a frame within it waits for its /tf (read
+        on, copying nothing), else False (the replay stops there)."""
+        first = self.asm.first_held
+        if first is not None and self.opts.max_frames is not None and \
+                first < self.opts.max_frames:
+            return True
+        self.report.truncated = True
+        return False
 
     def _write(self, schema: Any, channel: Any, message: Any, t: int) -> None:
         writer = self.writer

@@ -36,9 +36,9 @@ def outline_walls(spec: HouseSpec) -> tuple[Wall, ...]:
             ux, uy = (q[0] - p[0]) / length, (q[1] - p[1]) / length
             nx, ny = turn * uy, -turn * ux
             for s0, s1 in _outer_runs(spec, room, p, (ux, uy), (nx, ny), length):
-                half = THICKNESS / 2
-                a = (p[0] + ux * (s0 - half) + nx * half, p[1] + uy * (s0 - half) + ny * half)
-                b = (p[0] + ux * (s1 + half) + nx * half, p[1] + uy * (s1 + half) + ny * half)
+                half = THICKNESS / 2  # the inner face on the border: no floor is covered
+                a = (p[0] + ux * s0 + nx * half, p[1] + uy * s0 + ny * half)
+                b = (p[0] + ux * s1 + nx * half, p[1] + uy * s1 + ny * half)
                 walls.append(Wall(f"outline_{len(walls)}", a, b, THICKNESS, HEIGHT))
     return tuple(walls)
 

@@ -286,6 +286,7 @@ class FrameAssembler:
         self.tf_offsets = TfStampOffsets()
         self._pending: dict[str, Any] = {}
         self._t: int | None = None
+        self._now: int | None = None  # the latest log time pushed or ticked
         # frames waiting for /tf: the frame, its pose's time, the camera's frame id and the
         # links of its camera and base chains as read when it was assembled
         self._held: list[tuple[Frame, int, str, tuple[_Snapshot, _Snapshot]]] = []
@@ -315,6 +316,7 @@ class FrameAssembler:
             out = self.flush()
             self._pending = {}
         self._t = t_ns
+        self._now = t_ns if self._now is None else max(self._now, t_ns)
         if topic in (S.TF, S.TF_STATIC):  # /tf_static: links written once
             T = decoded(self.where, topic, t_ns, codec.decode_transform, message)  # noqa: N806
             tf_t = self._tf_key(t_ns, message)
@@ -332,6 +334,12 @@ class FrameAssembler:
             self._pending[key] = message
         return out
 
+    def tick(self, t_ns: int) -> list[Frame]:
+        """Log time ``t_ns`` has come (a message the caller does not push): the held frames
+        that waited long enough."""
+        self._now = t_ns if self._now is None else max(self._now, t_ns)
+        return self._release()
+
     def finish(self) -> list[Frame]:
         """After the last message: the frame being assembled and every frame held."""
         return self.flush() + self._release(final=True)
@@ -340,6 +348,11 @@ class FrameAssembler:
     def holding(self) -> bool:
         """Frames are held for a later ``/tf`` (class doc)."""
         return bool(self._held)
+
+    @property
+    def first_held(self) -> int | None:
+        """The index of the first frame held for a later ``/tf``; None when none is."""
+        return self._held[0][0].index if self._held else None
 
     def _release(self, final: bool = False) -> list[Frame]:
         """The held frames, in order, whose pose no later ``/tf`` can change, or that waited
@@ -350,7 +363,7 @@ class FrameAssembler:
             fr, at, camera, snaps = self._held[0]
             if not (final or len(self._held) > MAX_HELD
                     or self.transforms.covers(at, camera)
-                    or (self._t is not None and self._t - fr.time_ns > HOLD_NS)):
+                    or (self._now is not None and self._now - fr.time_ns > HOLD_NS)):
                 break
             self._held.pop(0)
             found = self.transforms.resolve(at, camera, snapshot=snaps[0])

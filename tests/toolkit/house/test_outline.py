@@ -26,11 +26,26 @@ def test_two_rooms_get_six_walls_outside_and_none_between() -> None:
     d = two_rooms()
     d["walls"], d["doors"] = [], []
     walls = outline_walls(load_house(d))
-    # each room's three outer sides, 0.05 m outside the floor and 0.05 m past the corners
+    # each room's three outer sides, their inner faces on the border (no floor covered)
     assert len(walls) == 6 and all(w.thickness == 0.1 for w in walls)
     assert not any(abs(w.a[0] - 4) < 0.2 and abs(w.b[0] - 4) < 0.2 for w in walls)
-    assert sum(math.dist(w.a, w.b) for w in walls) == pytest.approx(3 * 4.1 * 2, abs=1e-6)
-    assert ((-0.05, -0.05), (4.05, -0.05)) in _ends(walls)
+    assert sum(math.dist(w.a, w.b) for w in walls) == pytest.approx(3 * 4 * 2, abs=1e-6)
+    assert ((0.0, -0.05), (4.0, -0.05)) in _ends(walls)
+
+
+def test_an_l_shaped_room_gets_no_wall_on_its_floor() -> None:
+    """A room with a reflex corner, either winding: every wall lies outside the floor."""
+    from sgtool.house.spec import HouseSpec, Room
+
+    ell = ((0.0, 0.0), (4.0, 0.0), (4.0, 2.0), (2.0, 2.0), (2.0, 4.0), (0.0, 4.0))
+    for poly in (ell, ell[::-1]):
+        spec = HouseSpec(seed=0, rooms=(Room("room_0", "kitchen", poly),), walls=(),
+                         doors=(), furniture=(), objects=(), starts=())
+        walls = outline_walls(spec)
+        assert len(walls) == 6
+        for w in walls:
+            mid = ((w.a[0] + w.b[0]) / 2, (w.a[1] + w.b[1]) / 2)
+            assert not spec.rooms[0].contains(*mid)
 
 
 ONE_ROOM = {  # a kitchen without walls, a bowl in a closed cabinet (a review's house)

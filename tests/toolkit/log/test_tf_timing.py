@@ -173,3 +173,34 @@ def test_the_frame_budget_counts_frames_held_for_their_transform(tmp_path):
     assert report.frames == 40 and report.truncated
     with LogReader(out) as r:
         assert r.message_count(S.DEPTH) == 40
+
+
+@pytest.mark.parametrize("budget", [7, 20])
+def test_the_last_frame_of_the_budget_waits_for_its_transform(tmp_path, budget):
+    """--max-frames with /tf 1 ms after the images: the budget's last frame is posed by
+    the /tf read past the budget (nothing past it is taken or copied), as without the
+    skew; no stale pose is claimed."""
+    log = rewrite(START, tmp_path / "later.mcap", Variant(order=tf_later(START, 10**6)))
+    clean = refreshes(START, options=ReplayOptions(max_frames=budget))
+    skewed = refreshes(log, options=ReplayOptions(max_frames=budget))
+    assert skewed[1] == clean[1] and skewed[0].frames == budget
+    assert not skewed[0].warnings and skewed[0].truncated
+
+
+def test_a_record_past_the_budget_is_not_taken_whatever_its_order(tmp_path):
+    """An action record first among the messages of the first time past --max-frames 8:
+    not taken (it gave a refresh of its own), as in the file's own order."""
+    topics = _topics_of(TOUR)
+
+    def action_first(messages):
+        return sorted(messages, key=lambda m: (m.log_time, topics[m.channel_id] != S.RECORDS[
+            "action"].topic))
+    log = rewrite(TOUR, tmp_path / "first.mcap", Variant(order=action_first))
+    want = refreshes(TOUR, options=ReplayOptions(max_frames=8))
+    got = refreshes(log, options=ReplayOptions(max_frames=8))
+    assert got[1] == want[1] and want[1][-1][0] == "end"
+
+
+def _topics_of(path):
+    with LogReader(path) as r:
+        return {cid: ch.topic for cid, ch in r.summary.channels.items()}
