@@ -133,3 +133,14 @@ def check_plugins_build(planners: Sequence[str], options: Mapping[str, Mapping[s
     for name in planners:
         if name.strip().lower() not in PLANNER_NAMES:
             make_planner(name, **options.get(name, {}))
+
+
+MAX_SEED = 2**62  # the largest seed `sgtool run --seed` and `scenes generate --seed` take
+
+
+def check_house_seeds(house_seed: int, houses: int) -> None:
+    """Generated houses take seeds ``house_seed`` .. ``house_seed + houses - 1``: each must
+    be one `sgtool run --seed` takes again (one line otherwise)."""
+    if houses > 0 and not 0 <= house_seed <= MAX_SEED - houses + 1:
+        raise BenchError(f"--house-seed {house_seed} with --houses {houses}: the houses' seeds "
+                         f"must lie in 0..{MAX_SEED} (the seeds `sgtool run --seed` takes)")

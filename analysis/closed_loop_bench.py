@@ -50,6 +50,7 @@ from sgtool.analysis.bench_houses import (
     output_path,
 )
 from sgtool.analysis.bench_planner_checks import (
+    check_house_seeds,
     check_planner_options,
     check_plugins_build,
     config_names,
@@ -157,6 +158,7 @@ class ClosedLoopBenchConfig:
         if self.houses < 0 or (self.houses == 0 and not self.house_files):
             raise SgtoolError(f"--houses: must be >= 1, or >= 0 with --house (house_files=), got "
                               f"{self.houses}")
+        check_house_seeds(self.house_seed, self.houses)
         folders: dict[str, str] = {}
         for n in self.noise:
             parse_noise(n)

@@ -240,3 +240,14 @@ def test_a_golden_check_runs_on_the_executor_sgtool_exports(tmp_path) -> None:
     assert checked.exit_code == 0 and [c.status for c in checked.logs] == ["unchanged"]
     with pytest.raises(sgtool.SgtoolError, match="--executor: one of"):
         sgtool.make_executor("cluster")
+
+
+def test_generated_house_seeds_stay_ones_run_takes_again() -> None:
+    """--house-seed near the top with --houses 2: the second house's seed is beyond what
+    `sgtool run --seed` takes (its episodes could not be rerun); one line, both benches."""
+    top = 2**62
+    for config in (sgtool.BenchConfig, sgtool.ClosedLoopBenchConfig):
+        with pytest.raises(sgtool.SgtoolError, match=r"--house-seed 4611686018427387904 with "
+                           r"--houses 2: the houses' seeds must lie in 0\.\.4611686018427387904"):
+            config(planners=("greedy",), houses=2, house_seed=top).check()
+        config(planners=("greedy",), houses=1, house_seed=top).check()
