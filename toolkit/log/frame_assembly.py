@@ -200,6 +200,8 @@ class TfStampOffsets:
             self.beyond += 1
         if abs(offset_ns) > abs(self.worst_ns):
             self.worst_ns, self.worst_at_ns = offset_ns, log_ns
+
+
 @dataclass
 class StalePoses:
     """Frames posed from a ``/tf`` sample older than :data:`STALE_NS` (no later sample
