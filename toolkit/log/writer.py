@@ -489,9 +489,10 @@ class LogWriter:
         if not kept:
             return kind(f"nothing written to {self.path}", None)
         p = self.partial_path
+        force = " --force" if self.path.exists() else ""  # (an earlier log stays there)
         return kind(
             f"{self.path} not written; what was recorded is kept in {p} (recover it with: "
-            f"sgtool doctor {quoted(p)} --recover {quoted(self.path)})", p)
+            f"sgtool doctor {quoted(p)} --recover {quoted(self.path)}{force})", p)
 
     def __enter__(self) -> LogWriter:
         return self

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import errno
 import os
+import shlex
 import signal
 import tempfile
 
@@ -98,6 +99,24 @@ def test_ctrl_c_keeps_a_recoverable_partial_file_and_says_where(tmp_path):
     assert d.status == "truncated"
     with LogReader(tmp_path / "r.mcap") as r:
         assert r.frame_count() == 25  # the open chunk was flushed on the way out
+    assert not info.value.note.endswith("--force)")
+
+
+def test_the_recover_hint_of_an_overwrite_runs_as_given(tmp_path):
+    """Ctrl-C while replacing a log (--force): the earlier log stays, so the hint's
+    recover command needs --force too; it runs as printed."""
+    out = tmp_path / "run.mcap"
+    with LogWriter(out, seed=3) as w:
+        frames(w, 3)
+    with pytest.raises(InterruptedWrite) as info, LogWriter(out, seed=3, overwrite=True) as w:
+        frames(w, 25)
+        raise KeyboardInterrupt
+    hint = info.value.note.split("recover it with: ")[1].rstrip(")")
+    assert hint.endswith(" --force")
+    r = CliRunner().invoke(cli, shlex.split(hint)[1:])
+    assert r.exit_code in (0, 1), r.output  # 1: a truncated log, recovered
+    with LogReader(out) as log:
+        assert log.frame_count() == 25
 
 
 def test_ctrl_c_before_any_message_leaves_nothing(tmp_path):
