@@ -95,8 +95,10 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
             res = run_closed_loop_bench(request.config, root, progress=bar,
                                         report_only=request.report_only, runner=runner)
         except KeyboardInterrupt as e:  # the CLI prints the note; exit 130 (143: killed)
+            kept = any((root / "logs").rglob("*.mcap")) if (root / "logs").is_dir() else False
             e.note = (f"the complete episode logs are kept in {request.out_dir}/logs "  # type: ignore[attr-defined]
-                      "(run the same command again to resume)")
+                      "(run the same command again to resume)" if kept else
+                      "no episode had finished: no log was kept")
             raise  # (with --force, output_folder says OUT is as it was instead)
         finally:
             bar.close()
@@ -109,11 +111,17 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
             print(f"sgtool: note: {len(left)} episode log(s) in {request.out_dir}/logs are left "
                   f"out of this report ({shown}{more}): give the --noise profiles, --planners, "
                   "houses and --episodes that ran them to report them", file=sys.stderr)
-        res = _with_symbolic(request, res)
-        written = [p.name for p in write_tables(res, root)]
-        if not request.report_only:
-            written.append(atomic_write(root / RUN_FILE, run_record(
-                res.rows, root, runner, request.executor)).name)
+        try:
+            res = _with_symbolic(request, res)
+            written = [p.name for p in write_tables(res, root)]
+            if not request.report_only:
+                written.append(atomic_write(root / RUN_FILE, run_record(
+                    res.rows, root, runner, request.executor)).name)
+        except KeyboardInterrupt as e:
+            e.note = (f"interrupted while writing the report: the report files in "  # type: ignore[attr-defined]
+                      f"{request.out_dir} may mix this run's and an earlier one's; the "
+                      "same command again rewrites them from the logs (nothing runs again)")
+            raise
     show(res.table())
     from sgtool.analysis.report import invalid_action_notes, llm_warnings
 

@@ -175,9 +175,29 @@ def test_ctrl_c_leaves_only_complete_logs(house_file, tmp_path, monkeypatch) -> 
     res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
     assert res.exit_code == 130  # as any interrupted command (143 when killed)
     assert res.output.count("\n") == 1 and "interrupted" in res.output
-    assert "complete episode logs are kept" in res.output
+    assert "no episode had finished: no log was kept" in res.output  # (it named OUT/logs)
     first = out / "logs/none/random/small/ep-000.mcap"
     assert not first.exists() and partial_files(first) == []
+
+
+def test_ctrl_c_while_the_report_is_written_says_how_to_finish_it(house_file, tmp_path,
+                                                                  monkeypatch) -> None:
+    """Every episode logged, Ctrl-C in the tables: the note says the report may be mixed
+    and that the same command rewrites it from the logs (it said nothing was
+    half-written)."""
+    out = tmp_path / "rb"
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(clb, "write_outputs", interrupted)
+    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
+    assert res.exit_code == 130
+    assert "interrupted while writing the report" in res.output
+    assert "rewrites them from the logs (nothing runs again)" in res.output
+    monkeypatch.undo()
+    again = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
+    assert again.exit_code == 0 and (out / "summary.md").is_file()
 
 
 def test_user_errors(tmp_path) -> None:
