@@ -163,7 +163,7 @@ class ClosedLoopBenchConfig:
         for n in self.noise:
             parse_noise(n)
             folder = noise_folder(n)
-            if not re.fullmatch(r"[A-Za-z0-9_.=,+-]+", folder):
+            if not re.fullmatch(r"[A-Za-z0-9_.=,+-]+", folder) or set(folder) == {"."}:
                 what = "the profile's name" if names_file(n) else "a profile name with overrides"
                 raise SgtoolError(f"--noise {n!r}: {what} (letters, digits, _ . = , + -) "
                                   f"names a log folder, not {folder!r}")
@@ -214,7 +214,8 @@ def noise_folder(noise: str) -> str:
     """The log folder of a ``--noise`` profile: its text, or for a JSON file the profile's
     name (its ``name`` field, else the file's stem; the file read once per process, so a
     run's folders and tables keep one name however long it runs)."""
-    return parse_noise(noise).name if names_file(noise) else noise
+    return parse_noise(noise).name if names_file(noise) else \
+        re.sub(r"\s*([,=])\s*", r"\1", noise.strip())  # "mild, holes=0.05" as record reads it
 
 
 def log_source(log: Path) -> str:

@@ -12,6 +12,7 @@ from click.testing import CliRunner
 from sgtool.analysis import closed_loop_bench as clb
 from sgtool.cli import cli
 from sgtool.datasets.generator import generate_house
+from sgtool.errors import SgtoolError
 from sgtool.house.io import load_house, save_house
 from sgtool.log.writer import partial_files
 
@@ -393,3 +394,13 @@ def test_run_bench_warns_of_an_llm_that_never_answered_usefully(tmp_path) -> Non
     assert "sgtool: warning: moma-llm: none of its" in r.output
     (row,) = [json.loads(s) for s in (out / "episodes.jsonl").read_text().splitlines()]
     assert row["llm_answers"]["requests"] > 0 and row["llm_answers"]["valid"] == 0
+
+
+def test_a_noise_profile_spelled_with_spaces_is_the_same_profile() -> None:
+    """`--noise "mild, holes=0.05"` (record and run take it) names the folder of
+    "mild,holes=0.05"; given both, they are one profile given twice."""
+    assert clb.noise_folder("mild, holes = 0.05") == "mild,holes=0.05"
+    clb.ClosedLoopBenchConfig("greedy", houses=1, noise="mild, holes=0.05").check()
+    with pytest.raises(SgtoolError, match="both name the log folder 'mild,holes=0.05'"):
+        clb.ClosedLoopBenchConfig("greedy", houses=1,
+                                  noise=("mild,holes=0.05", "mild, holes=0.05")).check()
