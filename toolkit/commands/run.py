@@ -66,7 +66,9 @@ if TYPE_CHECKING:
 @click.option("--resolution", default="320x240", show_default=True,
               help="Camera image size WIDTHxHEIGHT.")
 @click.option("--fps", type=FINITE_FLOAT, default=10.0, show_default=True,
-              help="Frames per second of log time (the robot drives 0.5 m/s, turns 90 deg/s).")
+              help="Simulator ticks per second of log time (the robot drives 0.5 m/s, turns "
+              "90 deg/s); a tick becomes a frame once the camera turned --render-turn "
+              "degrees or drove 0.25 m, so the log holds fewer frames than ticks.")
 @click.option("--every", type=click.IntRange(min=1), default=10, show_default=True,
               help="Refresh the scene graph every K frames (and always at every action).")
 @click.option("--classifier", type=click.Choice(["containment", "frequency", "none"]),
