@@ -25,7 +25,7 @@ from mcap.records import (
     SummaryOffset,
 )
 
-from sgtool.log.file_walk import ChunkFacts, Layout, message_index_at
+from sgtool.log.file_walk import ChunkFacts, Layout, data_crc_matches, message_index_at
 from sgtool.log.mcap_records import FileBytes
 
 
@@ -63,8 +63,8 @@ def check(buf: FileBytes, lay: Layout, state: SummaryState) -> list[str]:
         out.append("no readable header record")
     if lay.data_end is None:
         out.append("no data end record")
-    elif lay.data_end.record.data_section_crc and zlib.crc32(
-            bytes(buf[:lay.data_end.offset])) != lay.data_end.record.data_section_crc:
+    elif lay.data_end.record.data_section_crc and not data_crc_matches(
+            buf, lay, lay.data_end.offset, lay.data_end.record.data_section_crc):
         out.append("the data section CRC does not match its bytes")
     if lay.footer is not None and lay.footer[1].summary_start and not state.present:
         out.append(f"the footer's summary start {lay.footer[1].summary_start} is not in "

@@ -76,6 +76,9 @@ class Layout:
     truncated: bool = False
     last_good_offset: int = 8
     trusted_summary_start: int | None = None
+    # data-section CRCs checked: the offset of the data end record -> its CRC matched
+    # (one pass over the bytes per offset, whoever asks: :func:`data_crc_matches`)
+    data_crcs: dict[int, bool] = field(default_factory=dict)
 
     def define(self, rec: Schema | Channel) -> None:
         """Note a schema or channel of the data section (the first definition of an id)."""
@@ -124,7 +127,7 @@ def walk(buf: FileBytes, lay: Layout) -> Iterator[Item]:
         if 8 <= f.summary_start <= end and f.summary_crc and f.summary_crc == zlib.crc32(
                 bytes(buf[f.summary_start:end + 9 + 16])):
             lay.trusted_summary_start = int(f.summary_start)
-    loose_covered = data_section_verified(buf, lay.footer)
+    loose_covered = data_section_verified(buf, lay)
     pos = 8
     while pos < end:
         if pos == size - 8 and bytes(buf[pos:size]) == MAGIC:
@@ -204,19 +207,27 @@ def _after_damage(buf: FileBytes, pos: int, end: int, lay: Layout, why: str
     return found
 
 
-def data_section_verified(buf: FileBytes, footer: tuple[int, Footer] | None) -> bool:
+def data_section_verified(buf: FileBytes, lay: Layout) -> bool:
     """The data end record (right before the summary section, or before the footer when
     there is none) holds a data-section CRC, and the bytes before it match it: every
     record of the data section, messages outside chunks included, is as written."""
-    if footer is None:
+    if lay.footer is None:
         return False
-    foff, f = footer
+    foff, f = lay.footer
     pos = (int(f.summary_start) if f.summary_start else foff) - 13  # opcode, length, crc
     if pos < 8 or pos + 13 > foff or buf[pos] != Opcode.DATA_END or int.from_bytes(
             bytes(buf[pos + 1:pos + 9]), "little") != 4:
         return False
     crc = int.from_bytes(bytes(buf[pos + 9:pos + 13]), "little")
-    return crc != 0 and zlib.crc32(memoryview(buf)[:pos]) == crc
+    return crc != 0 and data_crc_matches(buf, lay, pos, crc)
+
+
+def data_crc_matches(buf: FileBytes, lay: Layout, end: int, crc: int) -> bool:
+    """The bytes before ``end`` (a data end record's offset) match the data-section CRC
+    ``crc``; computed once per offset and kept in ``lay``."""
+    if end not in lay.data_crcs:
+        lay.data_crcs[end] = zlib.crc32(memoryview(buf)[:end]) == crc
+    return lay.data_crcs[end]
 
 
 def _top(raw: Raw, lay: Layout, loose_covered: bool = False) -> Iterator[Item]:

@@ -22,7 +22,6 @@ from __future__ import annotations
 import io
 import mmap
 import os
-import zlib
 from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -35,7 +34,7 @@ from mcap.writer import CompressionType, Writer
 from sgtool.errors import LogFormatError, SgtoolError
 from sgtool.files import atomic_open
 from sgtool.log.file_check import SummaryState, check, expected_messages, summary_state
-from sgtool.log.file_walk import Item, Layout, walk
+from sgtool.log.file_walk import Item, Layout, data_crc_matches, walk
 from sgtool.log.log_file import appended_end, require_regular_file
 from sgtool.log.mcap_records import MAGIC
 from sgtool.log.message_check import message_problem
@@ -132,8 +131,8 @@ def _checks(buf: mmap.mmap, lay: Layout, state: SummaryState) -> dict[str, str]:
                       if not state.crc_checked else "ok" if state.crc_ok else "mismatch")
     if lay.data_end is not None:
         crc = lay.data_end.record.data_section_crc
-        out["data"] = ("not written" if not crc else "ok" if zlib.crc32(
-            memoryview(buf)[:lay.data_end.offset]) == crc else "mismatch")
+        out["data"] = ("not written" if not crc else "ok" if data_crc_matches(
+            buf, lay, lay.data_end.offset, crc) else "mismatch")
     return out
 
 
