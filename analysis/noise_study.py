@@ -45,11 +45,12 @@ if TYPE_CHECKING:
 
 # the factors of the study: the noise profile's fields, in the order tables list them
 FACTORS: tuple[str, ...] = ("depth_sigma", "holes", "label_swap", "label_dropout",
-                            "drift_xy", "drift_yaw")
+                            "drift_xy", "drift_yaw", "flying")
 FACTOR_UNITS: Mapping[str, str] = {
     "depth_sigma": "m of std at 1 m", "holes": "share of depth pixels",
     "label_swap": "per object and frame", "label_dropout": "per object and frame",
     "drift_xy": "m per m driven", "drift_yaw": "rad per m and per rad",
+    "flying": "share of depth-edge pixels",
 }
 # levels of each factor when none are chosen: mild's and strong's values, and the
 # label-fault levels of the issue that found the one-room collapse
@@ -60,6 +61,7 @@ DEFAULT_LEVELS: Mapping[str, tuple[float, ...]] = {
     "label_dropout": (0.01, 0.05, 0.1),
     "drift_xy": (0.005, 0.02),
     "drift_yaw": (0.005, 0.02),
+    "flying": (0.1, 0.5),
 }
 DEFAULT_PROFILES: tuple[str, ...] = ("mild", "strong")
 NONE = "none"

@@ -7,6 +7,12 @@ the robot still drives where it drives and the instances table stays the truth.
 - depth noise: ``z + N(0, (sigma * z^2)^2)``, the quadratic growth of structured-light
   and stereo depth error with distance (Khoshelham & Elberink 2012 for the Kinect);
 - depth holes: each pixel independently reads 0 (no return) with probability ``holes``;
+- mixed ("flying") pixels: a pixel on a depth edge (a 4-neighbour farther or nearer by
+  more than ``EDGE_REL`` of the nearer depth and ``EDGE_ABS``) reads, with probability
+  ``flying``, a depth drawn uniformly between its own and that of the neighbour across
+  the largest jump: the mixed returns of time-of-flight cameras and the edge smear of
+  stereo ones, points floating in free space between a foreground edge and what lies
+  behind it. Applied before the depth noise; the pixel keeps its label;
 - label swaps: per frame, each visible non-structure instance is, with probability
   ``label_swap``, paired with another visible one and their ids exchanged in that frame
   (the confusions of a per-frame instance segmenter);
@@ -42,6 +48,8 @@ from sgtool.recorders.sim.camera import LINK_TOL, se2_matrix
 # the largest strengths taken: 1 m of depth std at 1 m, 1 m of drift per metre driven, 1 rad
 # of yaw drift per metre (the strong profile is 0.006, 0.02, 0.02)
 LIMITS = {"depth_sigma": 1.0, "drift_xy": 1.0, "drift_yaw": 1.0}
+EDGE_REL = 0.1  # a depth edge: neighbouring depths differ by this share of the nearer one
+EDGE_ABS = 0.1  # m; and by at least this much
 
 
 @dataclass(frozen=True)
@@ -55,6 +63,7 @@ class NoiseProfile:
     label_dropout: float = 0.0  # per visible instance and frame
     drift_xy: float = 0.0  # std (m) per metre driven, per axis
     drift_yaw: float = 0.0  # std (rad) per metre driven + per radian turned
+    flying: float = 0.0  # probability a depth-edge pixel reads between the two surfaces
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -65,7 +74,7 @@ class NoiseProfile:
                 raise SgtoolError(f"--noise {f.name}={v!r}: expected a number")
             if v < 0:
                 raise SgtoolError(f"--noise {f.name}={v:g}: must be >= 0")
-        for p in ("holes", "label_swap", "label_dropout"):
+        for p in ("holes", "label_swap", "label_dropout", "flying"):
             if getattr(self, p) > 1:
                 raise SgtoolError(f"--noise {p}={getattr(self, p):g}: a probability, at most 1")
         for p, most in LIMITS.items():  # beyond these, no sensor: overflow, not noise
@@ -176,9 +185,10 @@ class SensorFaults:
     def __init__(self, profile: NoiseProfile, seed: int, structure_ids: Iterable[int] = (),
                  base_T_camera: np.ndarray | None = None) -> None:
         self.profile = profile
-        ss = np.random.SeedSequence([int(seed), 0x5EED])
-        self._depth_rng, self._label_rng, self._pose_rng = (
-            np.random.default_rng(s) for s in ss.spawn(3))
+        ss = np.random.SeedSequence([int(seed), 0x5EED])  # (children keep their draws
+        # whatever the number spawned: a fault added later leaves the others' unchanged)
+        self._depth_rng, self._label_rng, self._pose_rng, self._edge_rng = (
+            np.random.default_rng(s) for s in ss.spawn(4))
         self._structure = frozenset(int(i) for i in structure_ids)
         self._base_T_cam = base_T_camera
         self._true_prev: tuple[float, float, float] | None = None
@@ -189,6 +199,8 @@ class SensorFaults:
         if p.is_clean:
             return frame
         depth, ids = frame.depth, frame.ids
+        if p.flying > 0:
+            depth = mixed_edges(depth, p.flying, self._edge_rng)
         if p.depth_sigma > 0 or p.holes > 0:
             depth = self._depth(depth)
         if ids is not None and (p.label_swap > 0 or p.label_dropout > 0):
@@ -271,3 +283,27 @@ class SensorFaults:
                                                         rtol=0.0, atol=LINK_TOL):
             base_T_cam = self._base_T_cam  # the mounting as given (not rounded again)
         return est_base @ base_T_cam, est_base
+
+
+def mixed_edges(depth: np.ndarray, share: float, rng: np.random.Generator) -> np.ndarray:
+    """A copy of ``depth`` (m, 0 = no return) whose depth-edge pixels (module doc) each
+    read, with probability ``share``, a depth uniform between their own and that of the
+    4-neighbour across their largest jump."""
+    d = np.asarray(depth, dtype=np.float32)
+    h, w = d.shape
+    best = np.zeros((h, w), dtype=np.float32)  # the largest jump to a valid neighbour
+    other = d.copy()  # that neighbour's depth
+    pad = np.pad(d, 1)
+    for dy, dx in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+        n = pad[1 + dy:1 + dy + h, 1 + dx:1 + dx + w]
+        jump = np.abs(n - d)
+        edge = ((d > 0) & (n > 0) & (jump > EDGE_ABS)
+                & (jump > np.float32(EDGE_REL) * np.minimum(d, n)) & (jump > best))
+        best[edge] = jump[edge]
+        other[edge] = n[edge]
+    u = rng.random((h, w), dtype=np.float32)
+    t = rng.random((h, w), dtype=np.float32)
+    hit = (best > 0) & (u < np.float32(share))
+    out = d.copy()
+    out[hit] = d[hit] + t[hit] * (other[hit] - d[hit])
+    return out

@@ -138,7 +138,7 @@ def test_factor_levels_and_conditions() -> None:
         ("holes", "0.01", "none,holes=0.01"), ("holes", "0.05", "none,holes=0.05"),
         (PROFILE, "strong", "strong")]
     assert set(FACTORS) == {"depth_sigma", "holes", "label_swap", "label_dropout",
-                            "drift_xy", "drift_yaw"}
+                            "drift_xy", "drift_yaw", "flying"}
     with pytest.raises(SgtoolError, match="unknown factor"):
         parse_factor("name=1")
 

@@ -23,7 +23,7 @@ def test_the_config_lists_conditions_as_the_command_does() -> None:
     # no factors given: the command's default levels and both profiles
     default = sgtool.noise_study_config(1)
     assert [c.noise for c in default.conditions][-2:] == ["mild", "strong"]
-    assert len(default.conditions) == 1 + 13 + 2
+    assert len(default.conditions) == 1 + 15 + 2  # 15 levels of 7 factors
 
 
 @pytest.mark.parametrize(("kwargs", "message"), [

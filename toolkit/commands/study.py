@@ -56,7 +56,7 @@ def command() -> None:
               help="Room count range of the generated houses.")
 @click.option("--factor", "factors", multiple=True, metavar="NAME=L1,L2,...",
               help="A noise factor and its levels (repeatable): depth_sigma, holes, "
-              "label_swap, label_dropout, drift_xy, drift_yaw (fields and units of `sgtool "
+              "label_swap, label_dropout, drift_xy, drift_yaw, flying (fields and units of `sgtool "
               "record --noise`); each level is recorded with that fault alone. Default: "
               "every factor at levels including mild's and strong's values.")
 @click.option("--profile", "profiles", multiple=True, metavar="NAME",

@@ -160,3 +160,40 @@ def test_parse_noise(tmp_path: Path) -> None:
         with pytest.raises(SgtoolError, match="empty"):
             parse_noise(empty)
     assert names_file(str(f)) and names_file("nj/my.json") and not names_file("mild,holes=1")
+
+
+def test_flying_pixels_mix_the_two_sides_of_depth_edges() -> None:
+    f = _frame(z=4.0)
+    depth = f.depth.copy()
+    depth[20:80, 60:120] = 2.0  # a box 2 m away before a wall at 4 m
+    f = replace(f, depth=depth)
+    p = NoiseProfile("t", flying=0.5)
+    g = SensorFaults(p, 5).apply(f)
+    changed = g.depth != depth
+    edge = np.zeros_like(changed)
+    edge[19:81, 59:121] = True
+    edge[21:79, 61:119] = False  # the pixels either side of the box's outline
+    edge[:, :11] = False  # the no-return band's edge is no depth edge
+    assert not (changed & ~edge).any()  # only edge pixels, and about half of them
+    assert abs(changed[edge].mean() - 0.5) < 0.08
+    assert np.all((g.depth[changed] > 2.0) & (g.depth[changed] < 4.0))  # between the two
+    assert np.array_equal(SensorFaults(p, 5).apply(f).depth, g.depth)  # seeded
+    assert parse_noise("flying=0.5") == replace(p, name="flying=0.5")
+    with pytest.raises(SgtoolError, match="flying=1.5: a probability"):
+        parse_noise("flying=1.5")
+
+
+def test_flying_pixels_leave_the_other_faults_as_they_were() -> None:
+    """Adding mixed pixels moves only edge pixels: the depth noise elsewhere and the
+    holes are the same draws."""
+    p1 = NoiseProfile("a", depth_sigma=0.004, holes=0.1)
+    p2 = replace(p1, flying=1.0)
+    f = _frame(z=3.0)
+    depth = f.depth.copy()
+    depth[40:60, 100:140] = 1.5
+    f = replace(f, depth=depth)
+    a, b = SensorFaults(p1, 2).apply(f).depth, SensorFaults(p2, 2).apply(f).depth
+    inner = np.zeros(a.shape, dtype=bool)
+    inner[:, 12:] = True
+    inner[38:62, 98:142] = False
+    assert np.array_equal(a[inner], b[inner]) and not np.array_equal(a, b)
