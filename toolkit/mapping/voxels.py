@@ -17,7 +17,9 @@ distinct instances share the overflow label 4,095 (geometry stays right, their s
 are merged).
 
 Integration (:meth:`VoxelMap.integrate`): valid depth in ``[min_range, max_range)``
-(MoMa-LLM: 0-5 m) is back-projected with the intrinsics, moved to the world by the pose,
+(MoMa-LLM: 0-5 m), less the mixed pixels between two surfaces
+(:mod:`sgtool.mapping.mixed_pixels`, unless ``mixed_pixels`` is off), is back-projected
+with the intrinsics, moved to the world by the pose,
 quantised and packed (a frame with points beyond the packing's range, or not finite, is
 refused with :class:`~sgtool.mapping.backproject.MapRangeError`: never dropped silently;
 the per-frame bound on the pose, :func:`~sgtool.mapping.backproject.within_packing`,
@@ -63,6 +65,7 @@ from sgtool.mapping.backproject import Scratch, beyond_packing, within_packing, 
 from sgtool.mapping.free_space import FreeSpaceConfig, View, seen_through
 from sgtool.mapping.key_count import count_keys
 from sgtool.mapping.label_stats import InstanceObservation, LabelStats, update_frame
+from sgtool.mapping.mixed_pixels import mixed_pixels
 from sgtool.mapping.vote_store import VoteStore, drain_keys, sorted_unique, spans
 from sgtool.mapping.voxel_keys import (  # the key layout (callers import it from here too)
     AXIS_BITS,
@@ -93,6 +96,7 @@ class VoxelConfig:
     max_range: float = 5.0  # m; farther depth is ignored (MoMa-LLM: 0-5 m)
     min_points: int = 50  # an instance counts as seen with this many points in one frame
     flush_keys: int = 150_000  # merge pending frame keys into the map beyond this many
+    mixed_pixels: bool = True  # leave out depth pixels between two surfaces (mixed_pixels)
 
 
 class VoxelMap:
@@ -185,6 +189,8 @@ class VoxelMap:
         cfg = self.config
         with np.errstate(invalid="ignore"):
             valid = (d >= cfg.min_range) & (d < cfg.max_range)
+        if cfg.mixed_pixels:
+            valid &= ~mixed_pixels(depth).reshape(-1)
         if viewpoint is None:
             src = frame.base_pose if frame.base_pose is not None else frame.pose
             viewpoint = (float(src[0, 3]), float(src[1, 3]))

@@ -9,6 +9,7 @@ from support.synthetic_world import Box, BoxWorld, make_frame
 
 import sgtool.mapping.voxels as vx
 from sgtool.log.frame import CameraIntrinsics, Frame
+from sgtool.mapping.mixed_pixels import mixed_pixels
 from sgtool.mapping.voxels import VoxelConfig, VoxelMap
 
 K = CameraIntrinsics.from_fov(48, 36, 70)
@@ -65,11 +66,12 @@ def test_dense_path_gives_the_same_map(seed: int, monkeypatch: pytest.MonkeyPatc
     assert calls["dense"] == n_dense
     assert n_dense >= 1  # the test covers the dense path
     assert used_a == used_b
-    # the points used: the valid pixels (no NaN, inf, too near or too far)
+    # the points used: the valid pixels (no NaN, inf, too near or too far, not mixed)
     for f, n in zip(frames, used_a, strict=True):
         d = f.depth
         with np.errstate(invalid="ignore"):
-            assert n == int(((d >= cfg.min_range) & (d < cfg.max_range)).sum())
+            ok = (d >= cfg.min_range) & (d < cfg.max_range) & ~mixed_pixels(d)
+        assert n == int(ok.sum())
     for a, b in zip(_state(dense), _state(gather), strict=True):
         np.testing.assert_array_equal(a, b)  # bit for bit; NaNs in the same places
     # ids seen only on invalid pixels got no label

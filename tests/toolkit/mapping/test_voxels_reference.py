@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from sgtool.log import LogReader
+from sgtool.mapping.mixed_pixels import mixed_pixels
 from sgtool.mapping.voxels import OFFSET, VoxelConfig, VoxelMap, pack
 
 GOLDEN = Path(__file__).resolve().parents[2] / "golden" / "house6-tour.mcap"
@@ -24,7 +25,7 @@ def reference(frames: list, cfg: VoxelConfig) -> tuple[dict[int, int], dict[int,
         h, w = fr.depth.shape
         v, u = np.mgrid[0:h, 0:w]
         z = fr.depth.astype(np.float64).ravel()
-        ok = (z >= cfg.min_range) & (z < cfg.max_range)
+        ok = (z >= cfg.min_range) & (z < cfg.max_range) & ~mixed_pixels(fr.depth).ravel()
         k = fr.intrinsics
         xc = (u.ravel()[ok] - k.cx) / k.fx * z[ok]
         yc = (v.ravel()[ok] - k.cy) / k.fy * z[ok]
