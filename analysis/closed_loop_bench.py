@@ -88,7 +88,7 @@ from sgtool.progress import Progress
 from sgtool.recorders.sim.closed_loop import WENT_ON, ClosedLoopOptions, run_episode
 from sgtool.recorders.sim.fallback_explore import is_fallback
 from sgtool.recorders.sim.frame_budget import frame_budget
-from sgtool.recorders.sim.noise import names_file, parse_noise
+from sgtool.recorders.sim.noise import NoiseProfile, names_file, parse_noise
 from sgtool.redact import options_as_text
 from sgtool.results import EpisodeResult, write_jsonl
 
@@ -160,8 +160,9 @@ class ClosedLoopBenchConfig:
                               f"{self.houses}")
         check_house_seeds(self.house_seed, self.houses)
         folders: dict[str, str] = {}
+        faults: dict[NoiseProfile, str] = {}
         for n in self.noise:
-            parse_noise(n)
+            profile = replace(parse_noise(n), name="")
             folder = noise_folder(n)
             if not re.fullmatch(r"[A-Za-z0-9_.=,+-]+", folder) or set(folder) == {"."}:
                 what = "the profile's name" if names_file(n) else "a profile name with overrides"
@@ -171,6 +172,9 @@ class ClosedLoopBenchConfig:
                 raise SgtoolError(f"--noise {folders[folder]!r} and {n!r}: both name the log "
                                   f"folder {folder!r}")
             folders[folder] = n
+            same = faults.setdefault(profile, n)
+            if same != n:  # two spellings of one profile would run it twice, apart
+                raise SgtoolError(f"--noise {same!r} and {n!r}: the same faults; give one")
         self.options.mapping()
         frame_budget(self.options.frames, self.frames_per_room, 1)
 

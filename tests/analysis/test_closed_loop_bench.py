@@ -404,3 +404,10 @@ def test_a_noise_profile_spelled_with_spaces_is_the_same_profile() -> None:
     with pytest.raises(SgtoolError, match="both name the log folder 'mild,holes=0.05'"):
         clb.ClosedLoopBenchConfig("greedy", houses=1,
                                   noise=("mild,holes=0.05", "mild, holes=0.05")).check()
+    # spelled otherwise (another number form, another order): the same faults, refused
+    with pytest.raises(SgtoolError, match="'mild,holes=0.05' and 'mild,holes=5e-2': the same"):
+        clb.ClosedLoopBenchConfig("greedy", houses=1,
+                                  noise=("mild,holes=0.05", "mild,holes=5e-2")).check()
+    with pytest.raises(SgtoolError, match="the same faults"):
+        clb.ClosedLoopBenchConfig("greedy", houses=1, noise=(
+            "none,holes=0.05,label_swap=0.1", "label_swap=0.1,holes=0.05")).check()
