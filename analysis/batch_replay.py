@@ -31,7 +31,9 @@ from dataclasses import dataclass
 from dataclasses import replace as replace_field
 from pathlib import Path
 
-from sgtool.analysis.executor import Executor, Outcome, Task
+from sgtool.analysis.batch_inputs import expand_inputs
+from sgtool.analysis.executor import Executor, LocalExecutor, Outcome, Task
+from sgtool.arg_checks import of_type
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write, output_folder
 from sgtool.log.reader import LogReader
@@ -84,6 +86,9 @@ class LogResult:
 
 @dataclass(frozen=True)
 class BatchReport:
+    """What a batch replay did: one :class:`LogResult` per input, in input order, and
+    the run's wall-clock seconds; :meth:`lines` says it as the command prints it."""
+
     logs: tuple[LogResult, ...]
     seconds: float  # wall clock of the run (reported, never written)
 
@@ -192,6 +197,31 @@ def replay_into(jobs: Sequence[ReplayJob], out_dir: str | os.PathLike[str],
     final = {s.output: j.output for s, j in zip(staged, jobs, strict=True)}
     return BatchReport(tuple(replace_field(r, output=final[r.output]) for r in report.logs),
                        report.seconds)
+
+
+def replay_logs(logs: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
+                out_dir: str | os.PathLike[str], options: ReplayOptions | None = None, *,
+                executor: Executor | None = None, force: bool = False,
+                progress: bool = False, verify: bool = False) -> BatchReport:
+    """Replay logs into the folder ``out_dir``, as ``sgtool replay LOG... --out-dir DIR``
+    (module doc): ``logs`` is a log, a folder of logs or a glob pattern, or a list of
+    them; every ``NAME.mcap`` gives ``out_dir/NAME.mcap``, outputs already complete are
+    kept (unless ``force``), and a folder sgtool did not write is refused unless
+    ``force``. ``executor``: :func:`~sgtool.make_executor` (default: in this process);
+    ``verify`` checks the inputs' chunk CRCs. A log that fails twice is a ``failed``
+    entry of the report (the others are written all the same), not an exception."""
+    items = [logs] if isinstance(logs, (str, os.PathLike)) else logs
+    if not isinstance(items, Sequence) or not items or \
+            not all(isinstance(i, (str, os.PathLike)) for i in items):
+        raise SgtoolError(f"logs: a log's path, a folder or a list of them, got {logs!r}")
+    of_type("options", options or ReplayOptions(), ReplayOptions, "a ReplayOptions")
+    if executor is not None and not callable(getattr(executor, "run", None)):
+        raise SgtoolError(f"executor: one of sgtool.make_executor, got "
+                          f"{type(executor).__name__}")
+    inputs = expand_inputs(items, (".mcap",))
+    jobs = plan_jobs(inputs, out_folder(out_dir), options or ReplayOptions(), verify=verify)
+    return replay_into(jobs, out_dir, executor or LocalExecutor(1), force=force,
+                       progress=progress)
 
 
 def out_folder(path: str | os.PathLike[str]) -> Path:

@@ -130,16 +130,13 @@ def replay_many(request: BatchReplayRequest, show: Echo) -> None:
     """``--out-dir``: every log replayed on the executor
     (:func:`sgtool.analysis.batch_replay.replay_into`); a log that failed twice is one
     error line after the others are written."""
-    from sgtool.analysis.batch_inputs import expand_inputs
-    from sgtool.analysis.batch_replay import out_folder, plan_jobs, replay_into
+    from sgtool.analysis.batch_replay import replay_logs
     from sgtool.analysis.executor import make_executor
 
     runner = make_executor(request.executor, request.workers, request.ray_address)
-    inputs = expand_inputs(request.logs, (".mcap",))
-    jobs = plan_jobs(inputs, out_folder(request.out_dir), request.options,
-                     verify=request.verify)
-    report = replay_into(jobs, request.out_dir, runner, force=request.force,
-                         progress=request.progress)
+    report = replay_logs(request.logs, request.out_dir, request.options, executor=runner,
+                         force=request.force, progress=request.progress,
+                         verify=request.verify)
     if request.as_json:
         show(json.dumps({"logs": [asdict(r) for r in report.logs],
                          "seconds": report.seconds}, sort_keys=True))

@@ -204,7 +204,7 @@ def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     minute; tests/recorders/sim covers run_episode)."""
     guide = (REPO / "docs" / "api.md").read_text()
     blocks = re.findall(r"```python\n(.*?)```", guide, re.DOTALL)
-    assert len(blocks) == 17
+    assert len(blocks) == 18
     runnable = [b for b in blocks if "run_closed_loop(" not in b]
     assert len(runnable) == len(blocks) - 1
     for name in ("tests", "examples"):
@@ -218,6 +218,8 @@ def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     assert "my_planner:MyPlanner" in out and "| scout" in out  # the benchmark table
     assert (tmp_path / "results" / "summary.md").is_file()
     assert (tmp_path / "derived_bag").is_dir()
+    assert sorted(p.name for p in (tmp_path / "derived_logs").iterdir()) == [
+        ".sgtool-output", "house10-start.mcap", "house6-tour.mcap"]
     assert (tmp_path / "derived.rrd").stat().st_size > 0
     assert (tmp_path / "run-bench" / "summary.md").is_file()
     assert "| scout " in (tmp_path / "run-bench" / "run.md").read_text()

@@ -17,7 +17,9 @@ logs                   :class:`LogReader`, :class:`LogWriter`, :class:`Frame`,
                        :class:`SceneGraphRecord`, :class:`LlmExchange`, :class:`LogRecord`
 replay                 :func:`replay` (a callback per refresh), :class:`ReplayOptions`,
                        :class:`ReplayReport`, :class:`SceneGraphStream`, :class:`Refresh`,
-                       :class:`Progress` (what ``progress=`` takes: a tqdm bar)
+                       :class:`Progress` (what ``progress=`` takes: a tqdm bar);
+                       :func:`replay_logs` (many logs into a folder, on an executor: a
+                       :class:`BatchReport` of :class:`LogResult` s)
 scene graph            :class:`SceneGraph`, :class:`RoomNode`, :class:`RegionNode`,
                        :class:`ObjectNode`, :class:`DoorNode`, :class:`RobotState`
 planners               the :class:`Planner` protocol, :class:`Action`, :class:`Feedback`,

@@ -30,6 +30,9 @@ from sgtool.log.records import LlmExchange as LlmExchange
 from sgtool.replayers.derived_log import replay as replay
 from sgtool.replayers.derived_log import ReplayOptions as ReplayOptions
 from sgtool.replayers.derived_log import ReplayReport as ReplayReport
+from sgtool.analysis.batch_replay import replay_logs as replay_logs
+from sgtool.analysis.batch_replay import BatchReport as BatchReport
+from sgtool.analysis.batch_replay import LogResult as LogResult
 from sgtool.progress import Progress as Progress
 from sgtool.scenegraph.stream import SceneGraphStream as SceneGraphStream
 from sgtool.scenegraph.stream import Refresh as Refresh
@@ -149,7 +152,8 @@ __all__ = [
     "LogWriter",
     "Frame", "CameraIntrinsics", "LogRecord", "EpisodeRecord", "ActionRecord", "Instances",
     "InstanceItem", "SceneGraphRecord", "LlmExchange", "replay", "ReplayOptions",
-    "ReplayReport", "Progress", "SceneGraphStream", "Refresh", "SceneGraph", "RoomNode",
+    "ReplayReport", "replay_logs", "BatchReport", "LogResult", "Progress", "SceneGraphStream",
+    "Refresh", "SceneGraph", "RoomNode",
     "RegionNode", "ObjectNode", "DoorNode", "RobotState", "Planner", "Action", "Feedback",
     "make_planner", "actionable", "Candidate", "find_target", "HouseSpec", "load_house",
     "load_house_text", "save_house", "generate_house", "SearchEpisode", "list_episodes",

@@ -131,3 +131,37 @@ def test_eval_over_a_folder_equals_eval_of_each_file(tmp_path):
     assert results == load_results([a, b])[0] and [r.planner for r in results] == \
         ["greedy", "greedy", "random"]
     assert logged == [] and notes == [] and failed == []
+
+
+def test_replay_logs_from_python(logs, tmp_path):
+    """``sgtool.replay_logs``: a folder of logs into a folder, as the command writes it;
+    a log that fails is in the report, not raised; wrong arguments are one line."""
+    import sgtool
+
+    src = tmp_path / "in"
+    src.mkdir()
+    for p in logs[:2]:
+        (src / p.name).write_bytes(p.read_bytes())
+    (src / "cut.mcap").write_bytes(logs[2].read_bytes()[:3000])
+    out = tmp_path / "out"
+    report = sgtool.replay_logs(src, out, OPTS, executor=sgtool.make_executor("local", 2))
+    assert [(r.status, r.frames) for r in report.logs] == [
+        ("failed", 0), ("replayed", 6), ("replayed", 8)]  # cut, run6, run8: sorted
+    assert report.logs[0].error
+    cli_out = tmp_path / "cli"
+    r = CliRunner().invoke(cli, ["replay", str(src / "run6.mcap"), str(src / "run8.mcap"),
+                                 "--out-dir", str(cli_out), "--every", "4",
+                                 "--voxel-size", "0.1"])
+    assert r.exit_code == 0, r.output
+    for name in ("run6.mcap", "run8.mcap"):
+        assert (out / name).read_bytes() == (cli_out / name).read_bytes()
+    assert not (out / "cut.mcap").exists()
+    again = sgtool.replay_logs([src / "run6.mcap"], out, OPTS)  # complete: kept
+    assert [r.status for r in again.logs] == ["skipped"]
+    for kwargs, message in (({"logs": None}, "logs: a log's path, a folder or a list"),
+                            ({"logs": []}, "logs: a log's path"),
+                            ({"options": "every=4"}, "options: a ReplayOptions, got str"),
+                            ({"executor": 2}, "executor: one of sgtool.make_executor")):
+        args = {"logs": src, **kwargs}
+        with pytest.raises(SgtoolError, match=message):
+            sgtool.replay_logs(args.pop("logs"), tmp_path / "x", **args)
