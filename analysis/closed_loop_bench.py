@@ -548,7 +548,7 @@ def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]
     """episodes.jsonl, summary.md, summary.json (no wall-clock figure: two runs give the
     same bytes), run.md (decision times, frames per second) and the efficiency curves (per
     noise profile: distance, steps, frames per room), each written atomically into
-    ``out_dir``."""
+    ``out_dir``; curves of other profiles there (an earlier run's) are removed."""
     from sgtool.analysis.curves import plot_efficiency
 
     out = output_dir(out_dir)
@@ -562,6 +562,8 @@ def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]
             paths.append(plot_efficiency(by_planner, model,
                                          out / f"efficiency_{noise_folder(noise)}_"
                                          f"{model.name}.png"))
+    for stale in sorted(set(out.glob("efficiency_*.png")) - set(paths)):
+        stale.unlink()  # curves of a profile this run's tables do not hold (a resumed run)
     paths.append(atomic_write(out / "summary.md", res.table()))
     paths.append(atomic_write(out / "run.md", res.timings()))
     paths.append(atomic_write(out / "summary.json", json.dumps(
