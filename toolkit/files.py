@@ -93,14 +93,39 @@ def output_error(e: OSError, path: str | os.PathLike[str] | None = None,
     return OutputError(f"cannot write {where}: {reason}" + (f" ({note})" if note else ""))
 
 
+NAME_MAX = 255  # bytes of one name in a folder (ext4, xfs, btrfs, tmpfs, APFS, NTFS: 255)
+TEMP_RANDOM = 8  # the characters tempfile.mkstemp and mkdtemp put between prefix and suffix
+
+
+def temp_prefix(name: str, suffix: str, hidden: bool = True) -> str:
+    """The prefix of a temporary name beside ``name``: ``.NAME.`` (``NAME.`` when not
+    ``hidden``), ``NAME`` cut at a character so that the whole temporary name (the prefix,
+    tempfile's 8 random characters, ``suffix``) stays within :data:`NAME_MAX` bytes: an
+    output whose own name fits gets a temporary name that fits."""
+    lead = "." if hidden else ""
+    room = NAME_MAX - len(lead) - 1 - TEMP_RANDOM - len(os.fsencode(suffix))
+    raw = os.fsencode(name)
+    if len(raw) > room:
+        cut = raw[:max(room, 1)]
+        for end in range(len(cut), max(len(cut) - 4, 0), -1):  # a UTF-8 character: <= 4
+            try:
+                cut[:end].decode("utf-8")
+            except UnicodeDecodeError:
+                continue
+            cut = cut[:end]
+            break
+        name = os.fsdecode(cut)
+    return f"{lead}{name}."
+
+
 def temp_beside(path: str | os.PathLike[str], suffix: str = ".partial",
                 hidden: bool = True) -> tuple[int, Path]:
     """A new, uniquely named, empty file in the folder of ``path`` (``.NAME.XXXXXXXX`` +
-    ``suffix``, or ``NAME.XXXXXXXX`` + ``suffix`` when not ``hidden``) with the mode a
-    plain ``open`` would give; returns its open descriptor and path. Two callers never get
-    the same name."""
+    ``suffix``, or ``NAME.XXXXXXXX`` + ``suffix`` when not ``hidden``; a long ``NAME``
+    cut: :func:`temp_prefix`) with the mode a plain ``open`` would give; returns its open
+    descriptor and path. Two callers never get the same name."""
     path = Path(path)
-    prefix = f".{path.name}." if hidden else f"{path.name}."
+    prefix = temp_prefix(path.name, suffix, hidden)
     fd, name = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=path.parent)
     try:
         os.fchmod(fd, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual mode
@@ -273,7 +298,7 @@ def leftover_stages(target: str | os.PathLike[str]) -> list[Path]:
     (``.NAME.XXXXXXXX.partial``) that no run removed: a run killed outright (SIGKILL, a
     power cut) leaves one; sorted by name."""
     path = Path(target)
-    head, tail = f".{path.name}.", ".partial"
+    head, tail = temp_prefix(path.name, ".partial"), ".partial"
     if not path.parent.is_dir():
         return []
     return sorted(p for p in path.parent.iterdir()
@@ -386,7 +411,8 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
     made: list[Path] = []
     try:
         made = _make_folders(parent)
-        stage = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".partial", dir=parent))
+        stage = Path(tempfile.mkdtemp(prefix=temp_prefix(path.name, ".partial"),
+                                      suffix=".partial", dir=parent))
         os.chmod(stage, 0o777 & ~_umask())  # mkdtemp makes 0700; give the usual mode
     except OSError as e:
         _remove_empty(made)

@@ -40,7 +40,7 @@ from mcap_protobuf.schema import build_file_descriptor_set
 
 from sgtool.arg_checks import whole
 from sgtool.errors import LogFormatError, SgtoolError, Terminated
-from sgtool.files import concerns, output_error, quoted, temp_beside
+from sgtool.files import concerns, output_error, quoted, temp_beside, temp_prefix
 from sgtool.log import chunk_copy, codec
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
@@ -61,7 +61,8 @@ def partial_files(path: str | os.PathLike[str]) -> list[Path]:
     path = Path(path)
     if not path.parent.is_dir():
         return []
-    found = [p for p in path.parent.glob(f"{glob_escape(path.name)}.????????{PARTIAL_SUFFIX}")
+    head = temp_prefix(path.name, PARTIAL_SUFFIX, hidden=False)  # a long name is cut
+    found = [p for p in path.parent.glob(f"{glob_escape(head)}????????{PARTIAL_SUFFIX}")
              if p.is_file()]
     return sorted(found, key=lambda p: (p.stat().st_mtime_ns, p.name), reverse=True)
 

@@ -280,3 +280,18 @@ def test_replay_out_dir_under_a_read_only_parent_is_one_line(
     finally:
         parent.chmod(0o755)
     assert "Permission denied" in msg and os.listdir(parent) == []
+
+
+def test_a_folder_name_near_the_limit_is_staged_beside_it(tmp_path: Path) -> None:
+    """An output folder named with 250 bytes: its hidden staging folder
+    (``.NAME.XXXXXXXX.partial``, 18 bytes longer) is cut to fit, and a stage a killed run
+    left beside it is found."""
+    from sgtool.files import leftover_stages, output_folder
+
+    target = tmp_path / ("d" * 250)
+    with output_folder(target, force=False, command="bench") as root:
+        assert len(os.fsencode(root.name)) <= 255
+        (root / "summary.md").write_text("x")
+        stages = leftover_stages(target)
+        assert stages == [root]  # while it is being built, it is the stage beside
+    assert (target / "summary.md").read_text() == "x" and leftover_stages(target) == []

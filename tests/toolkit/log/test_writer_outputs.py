@@ -370,3 +370,21 @@ def test_a_frame_of_nested_lists_is_written_as_its_arrays(tmp_path):
     a, b = frames
     assert (a.depth == b.depth).all() and (a.rgb == b.rgb).all() and (a.ids == b.ids).all()
     assert (a.pose == b.pose).all()
+
+
+@pytest.mark.parametrize("stem", ["a" * 245, "é" * 121])  # 250 and 247 bytes with ".mcap"
+def test_an_output_name_near_the_limit_gets_a_temporary_name_that_fits(tmp_path, stem):
+    """A name of up to 255 bytes is a name the file system takes: its temporary name
+    (``NAME.XXXXXXXX.partial``, 18 bytes longer) is cut to fit, at a character, and is
+    still found as the output's partial file."""
+    out = tmp_path / f"{stem}.mcap"
+    assert len(os.fsencode(out.name)) <= 255
+    w = LogWriter(out)
+    assert len(os.fsencode(w.partial_path.name)) <= 255
+    w.partial_path.name.encode("utf-8")  # cut at a character, not inside one
+    assert partial_files(out) == [w.partial_path]
+    frames(w, 2)
+    w.close()
+    assert LogReader(out).frame_count() == 2 and leftovers(tmp_path) == [out.name]
+    atomic_write(tmp_path / f"{stem}.json", "{}")
+    assert (tmp_path / f"{stem}.json").read_text() == "{}"
