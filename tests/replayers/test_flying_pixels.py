@@ -69,9 +69,8 @@ def test_flying_pixels_add_no_phantom_obstacles(logs: dict[str, Path]) -> None:
 
 
 def test_the_clean_map_keeps_its_obstacles(logs: dict[str, Path]) -> None:
-    """Surfaces have next to no mixed pixels (a few two-pixel stubs where a top face
-    meets the front one in the image): the clean log maps to the same cells within a
-    few of its ~1,700 either way."""
+    """Surfaces have next to no mixed pixels (the odd pixel where a face steps in the
+    image): the clean log maps to the same cells within a few of its ~1,700 either way."""
     on, off = _obstacles(logs["none"], True), _obstacles(logs["none"], False)
     a = {tuple(p) for p in np.round(on / 0.05).astype(int).tolist()}
     b = {tuple(p) for p in np.round(off / 0.05).astype(int).tolist()}

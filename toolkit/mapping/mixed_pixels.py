@@ -21,19 +21,19 @@ pixel beyond ``A`` (the same for ``B``) and ``k`` the distance of ``A`` from the
 
 and it is no part of a surface along the edge:
 
-    alone:      it is in no line of three pixels (along an image direction, it at the
-                middle or an end) each within TOL q_p of the next                      (M4)
+    alone:      along no image direction in which (M1)-(M3) do not hold is it in a line
+                of three pixels (it the middle or an end) whose inverse depths step by
+                at most TOL q_p, or are affine within LINE q_p                           (M4)
 
 A pixel on a plane continues its own surface (M3), whether it stands at an occlusion edge
 or the plane is seen at a grazing angle; a thin thing nearer than both sides is not
-between them (M1); a thin thing between two surfaces, one pixel across (a cloth on a
-shelf's edge seen from afar), continues itself along its length (M4), its ends too,
-where the depths of mixed pixels differ from pixel to pixel (they mix the two surfaces in
-varying parts; mixed pixels of one depth all along an edge pass for such a strip). What
-is lost on clean surfaces is the odd stub of two pixels where a top face meets a front
-face in the image. Pixels without depth (0, not finite) take no part. The test is per
-frame and pure; the voxel map leaves mixed pixels out
-(:attr:`~sgtool.mapping.voxels.VoxelConfig.mixed_pixels`).
+between them (M1); a strip of surface between two others, one or two pixels across (a
+cloth on a shelf's edge seen from afar, a box's side face seen nearly edge-on, the rim of
+a sphere) continues itself along its length (M4), its ends too, where the depths of mixed
+pixels differ from pixel to pixel (they mix the two surfaces in varying parts; mixed
+pixels whose depths run evenly all along an edge pass for such a strip). Pixels without
+depth (0, not finite) take no part. The test is per frame and pure; the voxel map leaves
+mixed pixels out (:attr:`~sgtool.mapping.voxels.VoxelConfig.mixed_pixels`).
 """
 
 from __future__ import annotations
@@ -41,6 +41,7 @@ from __future__ import annotations
 import numpy as np
 
 TOL = 0.03  # (M1), (M3): a share of the pixel's inverse depth (3 cm at 1 m)
+LINE = 0.01  # (M4): a share of the pixel's inverse depth (a plane's strip is affine)
 JUMP = 0.1  # (M2): the two sides differ by this share of the pixel's inverse depth
 DIRECTIONS = ((0, 1), (1, 0), (1, 1), (1, -1))  # (row, column) steps of the four lines
 REACH = 3  # pixels the test looks along a line: a neighbour two away and the one beyond
@@ -79,9 +80,10 @@ def mixed_pixels(depth: np.ndarray, tol: float = TOL, jump: float = JUMP) -> np.
     qp = flat[at0]
     t = np.float32(tol) * qp
     big = np.float32(jump) * qp
-    hit = np.zeros(len(at0), dtype=bool)
+    hits = []  # per image direction: (M1)-(M3) along it
     with np.errstate(invalid="ignore"):
         for sy, sx in DIRECTIONS:
+            hit = np.zeros(len(at0), dtype=bool)
             for ka, kb in PAIRS:
                 qa, qa2 = at(-ka * sy, -ka * sx), at(-(ka + 1) * sy, -(ka + 1) * sx)
                 qb, qb2 = at(kb * sy, kb * sx), at((kb + 1) * sy, (kb + 1) * sx)
@@ -89,14 +91,20 @@ def mixed_pixels(depth: np.ndarray, tol: float = TOL, jump: float = JUMP) -> np.
                 hit |= ((qp - lo1 > t) & (hi1 - qp > t) & (hi1 - lo1 > big)  # (M1), (M2)
                         & (np.abs(qp - (qa + ka * (qa - qa2))) > t)  # (M3)
                         & (np.abs(qp - (qb + kb * (qb - qb2))) > t))
+            hits.append(hit)
+        hit = np.logical_or.reduce(hits)
         if not hit.any():
             return out
         line = np.zeros(len(at0), dtype=bool)  # (M4): in a line of three on its surface
-        for sy, sx in DIRECTIONS:
+        u = np.float32(LINE / tol) * t
+        for (sy, sx), across in zip(DIRECTIONS, hits, strict=True):
             f1, b1 = at(sy, sx), at(-sy, -sx)
-            fwd, back = np.abs(f1 - qp) <= t, np.abs(b1 - qp) <= t
-            line |= (fwd & (back | (np.abs(at(2 * sy, 2 * sx) - f1) <= t))
-                     | back & (np.abs(at(-2 * sy, -2 * sx) - b1) <= t))
+            f2, b2 = at(2 * sy, 2 * sx), at(-2 * sy, -2 * sx)
+            fwd, back = np.abs(f1 - qp) <= t, np.abs(b1 - qp) <= t  # level steps
+            level = fwd & (back | (np.abs(f2 - f1) <= t)) | back & (np.abs(b2 - b1) <= t)
+            even = ((np.abs(f1 + b1 - 2 * qp) <= u)  # affine: the middle of three
+                    | (np.abs(qp + f2 - 2 * f1) <= u) | (np.abs(qp + b2 - 2 * b1) <= u))
+            line |= ~across & (level | even)
     keep = at0[hit & ~line]
     out[keep // pw - REACH, keep % pw - REACH] = True
     return out

@@ -46,12 +46,13 @@ def test_surfaces_have_no_mixed_pixels() -> None:
 def test_pixels_between_the_two_sides_of_an_edge_are_mixed() -> None:
     d = _box_before_wall()
     d[30:70, 89] = np.resize([2.5, 3.0, 3.5], 40)  # a column of mixed pixels on the box's
-    d[40:50, 39] = np.linspace(2.3, 3.7, 10)  # right edge, ten on its left: each its own mix
-    m = mixed_pixels(d)
+    d[40:50, 39] = [2.3, 3.6, 2.9, 3.4, 2.5, 3.7, 2.7, 3.2, 2.4, 3.5]  # right edge, ten on
+    m = mixed_pixels(d)  # its left: each its own mix
     assert m[30:70, 89].all() and m[40:50, 39].all()
     assert m.sum() == 50  # and nothing else
     same = _box_before_wall()
-    same[30:70, 89] = 3.0  # mixed pixels of one depth down the edge read as a strip (M4)
+    same[30:70, 89] = 3.0  # mixed pixels of one depth down the edge read as a strip (M4),
+    same[30:70, 39] = 1 / np.linspace(1 / 2.2, 1 / 3.8, 40)  # as do ones that run evenly
     assert not mixed_pixels(same).any()
     two = _box_before_wall()  # a run of two across the edge, in either order
     two[30:70:2, 90], two[30:70:2, 91] = 2.6, 3.4
@@ -66,6 +67,18 @@ def test_a_one_pixel_strip_between_two_surfaces_is_kept() -> None:
     d = np.full((H, W), 1.05, np.float32)  # a shelf's back, 1.05 m
     d[50:, :] = 0.45  # the shelf's front edge below, 0.45 m
     d[49, 20:60] = 0.95  # the cloth: one row, 40 pixels
+    assert not mixed_pixels(d).any()
+
+
+def test_a_side_face_seen_nearly_edge_on_is_kept() -> None:
+    """A box's side face two pixels wide between its front face (2 m) and the wall behind
+    (4 m): in the row the two pixels sit between the surfaces and continue neither
+    (M1)-(M3); down the column each continues its surface, whose depth changes by 4 % a
+    row (more than a level step of (M4)) evenly (inverse depth nearly affine)."""
+    d = _box_before_wall()
+    grow = 1.04 ** np.arange(13, dtype=np.float32)
+    d[30:43, 90] = 1 / (0.30 * grow)  # 3.3 m, and nearer by 4 % a row
+    d[30:43, 91] = 1 / (0.27 * grow)  # 3.7 m ...
     assert not mixed_pixels(d).any()
 
 
@@ -100,7 +113,7 @@ def _frame(depth: np.ndarray) -> Frame:
 
 def test_the_voxel_map_leaves_mixed_pixels_out() -> None:
     d = _box_before_wall()
-    d[30:70, 89] = np.resize([2.8, 3.0, 3.2], 40)  # points 1 m behind the box's face
+    d[30:70, 89] = np.resize([2.6, 3.3, 2.9, 3.1], 40)  # points 1 m behind the box's face
     for on, floating in ((True, 0), (False, 38)):
         vm = VoxelMap(VoxelConfig(mixed_pixels=on))
         vm.integrate(_frame(d))
