@@ -26,7 +26,7 @@ from sgtool.errors import SgtoolError, SpecError
 from sgtool.house.spec import HouseSpec
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
 from sgtool.recorders.sim.episode_extras import recorded_options
-from sgtool.recorders.sim.noise import parse_noise
+from sgtool.recorders.sim.noise import NoiseProfile, parse_noise
 from sgtool.scenegraph.build_options import MAX_DEPTH_M, ResolvedOptions, default_min_points
 
 _FIX = ("give a fresh -o folder (out_dir=), --force to run every episode again (from "
@@ -118,7 +118,8 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              "render_step_m": x.get("render_step_m"),
              "turn_render_deg": x.get("turn_render_deg"),
              "navigation": nav.get("mode", "house"),
-             "noise": x.get("noise"), "noise_seed": x.get("noise_seed", 0),
+             # a fault added since (flying) was off in logs that do not name it
+             "noise": _with_new_faults(x.get("noise")), "noise_seed": x.get("noise_seed", 0),
              "seed": x.get("seed"),
              # logs from before each episode drew its planner seed: all drew the run's
              "episode_seeds": "planner_seed" in x,
@@ -209,3 +210,11 @@ def check_resumable(path: Path, want: dict[str, Any], spec: HouseSpec, house: st
     if not same_house(logged_house, spec):
         raise _refused(f"{path} was run on another house: the house of {house} changed "
                        "since", _FIX)
+
+
+def _with_new_faults(noise: Any) -> Any:
+    """A log's recorded noise profile with the faults it does not name at 0 (off): the
+    faults :class:`~sgtool.recorders.sim.noise.NoiseProfile` gained after it was written."""
+    if not isinstance(noise, dict):
+        return noise
+    return {**{k: v for k, v in NoiseProfile().to_dict().items() if k != "name"}, **noise}

@@ -245,3 +245,19 @@ def test_report_only_tables_the_run_as_it_was_made(tmp_path: Path, monkeypatch) 
     assert r.exit_code == 2
     assert "max steps: 2 in the log, 50 now" in r.output
     assert r.output.strip().endswith("; --report-only: give the options the run was made with")
+
+
+def test_logs_from_before_a_fault_was_added_resume(tmp_path: Path,
+                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    """Logs written before the noise profile gained ``flying`` record no such field; a
+    fault they do not name was off, so the same command resumes their folder."""
+    from sgtool.recorders.sim.noise import NoiseProfile
+
+    full = NoiseProfile.to_dict
+    monkeypatch.setattr(NoiseProfile, "to_dict",  # as sgtool wrote it before the field
+                        lambda self: {k: v for k, v in full(self).items() if k != "flying"})
+    _, _, out, cmd = _first_run(tmp_path)
+    monkeypatch.setattr(NoiseProfile, "to_dict", full)
+    monkeypatch.setattr(clb, "run_episode", lambda *a, **k: pytest.fail("ran again"))
+    again = CliRunner().invoke(cli, cmd)
+    assert again.exit_code == 0, again.output
