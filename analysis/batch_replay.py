@@ -32,7 +32,7 @@ from dataclasses import replace as replace_field
 from pathlib import Path
 
 from sgtool.analysis.batch_inputs import expand_inputs
-from sgtool.analysis.executor import Executor, LocalExecutor, Outcome, Task
+from sgtool.analysis.executor import Executor, LocalExecutor, Outcome, RayExecutor, Task
 from sgtool.arg_checks import of_type
 from sgtool.errors import SgtoolError
 from sgtool.files import atomic_write, output_folder
@@ -203,21 +203,27 @@ def replay_logs(logs: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
                 out_dir: str | os.PathLike[str], options: ReplayOptions | None = None, *,
                 executor: Executor | None = None, force: bool = False,
                 progress: bool = False, verify: bool = False) -> BatchReport:
-    """Replay logs into the folder ``out_dir``, as ``sgtool replay LOG... --out-dir DIR``
-    (module doc): ``logs`` is a log, a folder of logs or a glob pattern, or a list of
-    them; every ``NAME.mcap`` gives ``out_dir/NAME.mcap``, outputs already complete are
-    kept (unless ``force``), and a folder sgtool did not write is refused unless
-    ``force``. ``executor``: :func:`~sgtool.make_executor` (default: in this process);
-    ``verify`` checks the inputs' chunk CRCs. A log that fails twice is a ``failed``
-    entry of the report (the others are written all the same), not an exception."""
+    """Replay many logs into the folder ``out_dir`` on an executor, as ``sgtool replay
+    --out-dir`` does (module doc): ``logs`` is a log, a folder
+    of logs or a glob pattern, or a list of them; every ``NAME.mcap`` gives
+    ``out_dir/NAME.mcap``, outputs already complete are kept (unless ``force``), and a
+    folder sgtool did not write is refused unless ``force``. ``executor``:
+    :func:`~sgtool.make_executor` (default: in this process); ``verify`` checks the
+    inputs' chunk CRCs. A log that fails twice is a ``failed`` entry of the report (the
+    others are written all the same), not an exception."""
     items = [logs] if isinstance(logs, (str, os.PathLike)) else logs
     if not isinstance(items, Sequence) or not items or \
-            not all(isinstance(i, (str, os.PathLike)) for i in items):
+            not all(isinstance(i, (str, os.PathLike)) and os.fspath(i) for i in items):
         raise SgtoolError(f"logs: a log's path, a folder or a list of them, got {logs!r}")
-    of_type("options", options or ReplayOptions(), ReplayOptions, "a ReplayOptions")
-    if executor is not None and not callable(getattr(executor, "run", None)):
-        raise SgtoolError(f"executor: one of sgtool.make_executor, got "
-                          f"{type(executor).__name__}")
+    if not isinstance(out_dir, (str, os.PathLike)) or not os.fspath(out_dir):
+        raise SgtoolError(f"out_dir: a folder's path, got {out_dir!r}")
+    if options is not None:
+        of_type("options", options, ReplayOptions, "a ReplayOptions")
+    for name, flag in (("force", force), ("progress", progress), ("verify", verify)):
+        of_type(name, flag, bool, "True or False")
+    if executor is not None:
+        of_type("executor", executor, (LocalExecutor, RayExecutor),
+                "one of sgtool.make_executor")
     inputs = expand_inputs(items, (".mcap",))
     jobs = plan_jobs(inputs, out_folder(out_dir), options or ReplayOptions(), verify=verify)
     return replay_into(jobs, out_dir, executor or LocalExecutor(1), force=force,

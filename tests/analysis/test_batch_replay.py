@@ -160,8 +160,15 @@ def test_replay_logs_from_python(logs, tmp_path):
     assert [r.status for r in again.logs] == ["skipped"]
     for kwargs, message in (({"logs": None}, "logs: a log's path, a folder or a list"),
                             ({"logs": []}, "logs: a log's path"),
+                            ({"logs": ""}, "logs: a log's path"),
+                            ({"out_dir": None}, "out_dir: a folder's path, got None"),
+                            ({"out_dir": ""}, "out_dir: a folder's path, got ''"),
                             ({"options": "every=4"}, "options: a ReplayOptions, got str"),
-                            ({"executor": 2}, "executor: one of sgtool.make_executor")):
-        args = {"logs": src, **kwargs}
+                            ({"options": {}}, "options: a ReplayOptions, got dict"),
+                            ({"force": "no"}, "force: True or False, got str"),
+                            ({"executor": 2}, "executor: one of sgtool.make_executor"),
+                            ({"executor": type("E", (), {"run": 1})()}, "executor: one of")):
+        args = {"logs": src, "out_dir": tmp_path / "x", **kwargs}
         with pytest.raises(SgtoolError, match=message):
-            sgtool.replay_logs(args.pop("logs"), tmp_path / "x", **args)
+            sgtool.replay_logs(args.pop("logs"), args.pop("out_dir"), **args)
+    assert not (tmp_path / "x").exists()
