@@ -96,7 +96,7 @@ def mixed_pixels(depth: np.ndarray, tol: float = TOL, jump: float = JUMP) -> np.
         if not hit.any():
             return out
         line = np.zeros(len(at0), dtype=bool)  # (M4): in a line of three on its surface
-        u = np.float32(LINE / tol) * t
+        u = np.float32(LINE) * qp
         for (sy, sx), across in zip(DIRECTIONS, hits, strict=True):
             f1, b1 = at(sy, sx), at(-sy, -sx)
             f2, b2 = at(2 * sy, 2 * sx), at(-2 * sy, -2 * sx)
