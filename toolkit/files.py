@@ -24,6 +24,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import fnmatch
+import hashlib
 import json
 import os
 import shlex
@@ -99,22 +100,19 @@ TEMP_RANDOM = 8  # the characters tempfile.mkstemp and mkdtemp put between prefi
 
 def temp_prefix(name: str, suffix: str, hidden: bool = True) -> str:
     """The prefix of a temporary name beside ``name``: ``.NAME.`` (``NAME.`` when not
-    ``hidden``), ``NAME`` cut at a character so that the whole temporary name (the prefix,
-    tempfile's 8 random characters, ``suffix``) stays within :data:`NAME_MAX` bytes: an
-    output whose own name fits gets a temporary name that fits."""
+    ``hidden``). When the whole temporary name (the prefix, tempfile's 8 random
+    characters, ``suffix``) would pass :data:`NAME_MAX` bytes, ``NAME`` is cut before a
+    character and followed by ``~`` and 8 hex digits of a hash of the whole name, so that
+    two long names that begin alike keep apart."""
     lead = "." if hidden else ""
     room = NAME_MAX - len(lead) - 1 - TEMP_RANDOM - len(os.fsencode(suffix))
     raw = os.fsencode(name)
     if len(raw) > room:
-        cut = raw[:max(room, 1)]
-        for end in range(len(cut), max(len(cut) - 4, 0), -1):  # a UTF-8 character: <= 4
-            try:
-                cut[:end].decode("utf-8")
-            except UnicodeDecodeError:
-                continue
-            cut = cut[:end]
-            break
-        name = os.fsdecode(cut)
+        end = max(room - 1 - TEMP_RANDOM, 1)
+        while end > 1 and raw[end] & 0xC0 == 0x80:  # not inside a UTF-8 character
+            end -= 1
+        tag = hashlib.blake2b(raw, digest_size=TEMP_RANDOM // 2).hexdigest()
+        name = f"{os.fsdecode(raw[:end])}~{tag}"
     return f"{lead}{name}."
 
 

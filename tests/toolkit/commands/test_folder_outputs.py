@@ -295,3 +295,6 @@ def test_a_folder_name_near_the_limit_is_staged_beside_it(tmp_path: Path) -> Non
         stages = leftover_stages(target)
         assert stages == [root]  # while it is being built, it is the stage beside
     assert (target / "summary.md").read_text() == "x" and leftover_stages(target) == []
+    other = tmp_path / ("d" * 249 + "e")  # the same first 249 bytes: not its stage
+    with output_folder(other, force=False, command="bench") as root:
+        assert leftover_stages(other) == [root] and leftover_stages(target) == []

@@ -388,3 +388,15 @@ def test_an_output_name_near_the_limit_gets_a_temporary_name_that_fits(tmp_path,
     assert LogReader(out).frame_count() == 2 and leftovers(tmp_path) == [out.name]
     atomic_write(tmp_path / f"{stem}.json", "{}")
     assert (tmp_path / f"{stem}.json").read_text() == "{}"
+
+
+def test_two_long_names_that_begin_alike_keep_their_partial_files_apart(tmp_path):
+    """Cut to fit, two names differing only past the cut still name their own partial
+    files (the cut name carries a hash of the whole one)."""
+    a, b = (tmp_path / f"run_{'x' * 236}_{c}.mcap" for c in "AB")
+    wa, wb = LogWriter(a), LogWriter(b)
+    assert wa.partial_path.name != wb.partial_path.name
+    assert partial_files(a) == [wa.partial_path] and partial_files(b) == [wb.partial_path]
+    wb.abort()
+    assert partial_files(a) == [wa.partial_path] and partial_files(b) == []
+    wa.abort()
