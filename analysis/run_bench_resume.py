@@ -24,6 +24,7 @@ from typing import Any
 from sgtool.datasets.episodes import Episode
 from sgtool.errors import SgtoolError, SpecError
 from sgtool.house.spec import HouseSpec
+from sgtool.mapping.voxels import VoxelConfig
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
 from sgtool.recorders.sim.episode_extras import recorded_options
 from sgtool.recorders.sim.noise import NoiseProfile, parse_noise
@@ -80,9 +81,10 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
 
 
 def _map_settings(m: ResolvedOptions) -> dict[str, Any]:
-    """The mapping settings a log must share: refreshes, voxel size, points per voxel."""
+    """The mapping settings a log must share: refreshes, voxel size, points per voxel,
+    whether mixed depth pixels were left out."""
     return {"every": int(m.every), "voxel_size": float(m.voxel_size),
-            "min_points": int(m.min_points)}
+            "min_points": int(m.min_points), "mixed_pixels": VoxelConfig().mixed_pixels}
 
 
 def _beyond(look_in: float, beyond: float) -> float | None:
@@ -134,6 +136,8 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              "voxel_size": float((x.get("mapping") or {}).get("voxel_size", 0.05)),
              "min_points": int((x.get("mapping") or {}).get("min_points") or default_min_points(
                  int(cam.get("width") or 0) or 160, int(cam.get("height") or 0) or 120)),
+             # logs from before the live map left mixed depth pixels out: it kept them
+             "mixed_pixels": bool((x.get("mapping") or {}).get("mixed_pixels", False)),
              # logs from before explores went on: an explore ended where it was sent
              "explore_on": x.get("explore_on", 0),
              # logs from before the robot looked into what it opened: it stayed there
@@ -175,6 +179,7 @@ _LABELS = {"episode": "episode", "planner_options": "planner options (-O)",
            "classifier": "room classifier", "explore_on": "explore on (frontiers)",
            "max_depth": "depth mapped (m)", "every": "graph refresh (--every frames)",
            "voxel_size": "voxel size (m)", "min_points": "points per voxel",
+           "mixed_pixels": "mixed depth pixels left out",
            "look_in": "look in (m)",
            "look_in_beyond": "look in beyond (deg)", "peek": "peek into containers",
            "sight_lines": "sight lines", "explore_through": "explore through (m)"}

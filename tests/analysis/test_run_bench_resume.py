@@ -247,17 +247,28 @@ def test_report_only_tables_the_run_as_it_was_made(tmp_path: Path, monkeypatch) 
     assert r.output.strip().endswith("; --report-only: give the options the run was made with")
 
 
-def test_logs_from_before_a_fault_was_added_resume(tmp_path: Path,
-                                                   monkeypatch: pytest.MonkeyPatch) -> None:
-    """Logs written before the noise profile gained ``flying`` record no such field; a
-    fault they do not name was off, so the same command resumes their folder."""
+def test_logs_from_before_mixed_pixels_were_left_out_say_so(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Logs written before the live map left mixed depth pixels out record neither that
+    nor the ``flying`` fault: their folder is refused naming the map's change (their
+    episodes were mapped otherwise), not the noise, which did not change (a fault a log
+    does not name was off)."""
+    from sgtool.recorders.sim import closed_loop, episode_extras
     from sgtool.recorders.sim.noise import NoiseProfile
 
-    full = NoiseProfile.to_dict
-    monkeypatch.setattr(NoiseProfile, "to_dict",  # as sgtool wrote it before the field
+    full, record = NoiseProfile.to_dict, episode_extras.mapping_record
+
+    def older(options):  # type: ignore[no-untyped-def]
+        return {k: v for k, v in record(options).items() if k != "mixed_pixels"}
+
+    monkeypatch.setattr(NoiseProfile, "to_dict",  # as sgtool wrote them before both
                         lambda self: {k: v for k, v in full(self).items() if k != "flying"})
+    monkeypatch.setattr(episode_extras, "mapping_record", older)
+    monkeypatch.setattr(closed_loop, "mapping_record", older)
     _, _, out, cmd = _first_run(tmp_path)
-    monkeypatch.setattr(NoiseProfile, "to_dict", full)
+    monkeypatch.undo()
     monkeypatch.setattr(clb, "run_episode", lambda *a, **k: pytest.fail("ran again"))
     again = CliRunner().invoke(cli, cmd)
-    assert again.exit_code == 0, again.output
+    assert again.exit_code == 2, again.output
+    assert "mixed depth pixels left out: false in the log, true now" in again.output
+    assert "noise:" not in again.output

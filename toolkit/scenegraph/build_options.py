@@ -46,7 +46,9 @@ def mapping_record(options: ResolvedOptions) -> dict[str, Any]:
     replay with default options rebuilds its graphs."""
     return {"every": options.every, "classifier": options.classifier,
             "min_points": options.min_points, "voxel_size": options.voxel_size,
-            **({"max_depth": options.max_depth} if options.max_depth != MAX_DEPTH_M else {})}
+            **({"max_depth": options.max_depth} if options.max_depth != MAX_DEPTH_M else {}),
+            # the voxel map left mixed depth pixels out (logs without the key kept them)
+            "mixed_pixels": VoxelConfig().mixed_pixels}
 
 
 def builder_config(options: ResolvedOptions) -> BuilderConfig:
