@@ -546,9 +546,9 @@ OUTPUT_NAMES: tuple[str, ...] = ("logs", "episodes.jsonl", "summary.md", "summar
 
 def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]:
     """episodes.jsonl, summary.md, summary.json (no wall-clock figure: two runs give the
-    same bytes), run.md (decision times, frames per second) and the efficiency curves (per
-    noise profile: distance, steps, frames per room), each written atomically into
-    ``out_dir``; curves of other profiles there (an earlier run's) are removed."""
+    same bytes), run.md (decision times, frames/s), the efficiency curves per noise profile
+    (distance, steps, frames per room; those of other profiles, an earlier run's, are
+    removed), each written atomically into ``out_dir``."""
     from sgtool.analysis.curves import plot_efficiency
 
     out = output_dir(out_dir)
@@ -562,8 +562,10 @@ def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]
             paths.append(plot_efficiency(by_planner, model,
                                          out / f"efficiency_{noise_folder(noise)}_"
                                          f"{model.name}.png"))
-    for stale in sorted(set(out.glob("efficiency_*.png")) - set(paths)):
-        stale.unlink()  # curves of a profile this run's tables do not hold (a resumed run)
+    models = {m.name for m in cost_models(cfg.distance_budget, cfg.step_budget)} | {"frames"}
+    for stale in sorted(p for p in set(out.glob("efficiency_*_*.png")) - set(paths)
+                        if p.stem.rpartition("_")[2] in models):  # another profile's
+        stale.unlink()
     paths.append(atomic_write(out / "summary.md", res.table()))
     paths.append(atomic_write(out / "run.md", res.timings()))
     paths.append(atomic_write(out / "summary.json", json.dumps(
@@ -592,8 +594,7 @@ def run_symbolic(cfg: ClosedLoopBenchConfig) -> tuple[EpisodeResult, ...]:
     from sgtool.analysis.bench import BenchConfig, run_benchmark
 
     bench = BenchConfig(planners=cfg.planners, houses=cfg.houses, episodes=cfg.episodes,
-                        seeds=1, rooms=cfg.rooms, preset=cfg.preset,
-                        house_seed=cfg.house_seed, max_steps=cfg.options.max_steps,
-                        planner_options=cfg.planner_options, house_files=cfg.house_files,
-                        success=cfg.options.success)
+                        seeds=1, rooms=cfg.rooms, preset=cfg.preset, house_seed=cfg.house_seed,
+                        max_steps=cfg.options.max_steps, planner_options=cfg.planner_options,
+                        house_files=cfg.house_files, success=cfg.options.success)
     return run_benchmark(bench, progress=False).results  # a failed task raises

@@ -90,11 +90,12 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
     # so are the frame budgets of the SR tables; curves of a profile the tables no longer
     # hold (an earlier run's, here made up) go with the report that leaves it out
     (out / "efficiency_mild_steps.png").write_bytes(b"stale")
+    (out / "efficiency_steps.png").write_bytes(b"a bench's")  # no profile: not a curve here
     at = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
                                   "--report-only", "--budgets", "7,14"])
     assert sorted(p.name for p in out.glob("efficiency_*")) == [
         "efficiency_none_distance.png", "efficiency_none_frames.png",
-        "efficiency_none_steps.png"]
+        "efficiency_none_steps.png", "efficiency_steps.png"]
     assert at.exit_code == 0 and "| SR ≤ 7 f/room | SR ≤ 14 f/room |" in at.output, at.output
     at = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
                                   "--report-only", "--budgets", "18.7,18.8"])  # as given
