@@ -156,7 +156,8 @@ def test_scout_episode_log(scout_log, house) -> None:
         started, ended = [rec for _, rec in r.records("episode")]
         assert started["status"] == "started" and started["query"] == ep.query
         assert started["extra"]["mapping"] == {"every": 10, "classifier": "frequency",
-                                               "min_points": 12, "voxel_size": 0.05}
+                                               "min_points": 12, "voxel_size": 0.05,
+                                               "mixed_pixels": True}
         assert ended["status"] == "success" and ended["planner"] == "scout"
         assert ended["shortest_m"] == pytest.approx(ep.shortest_path, abs=1e-3)
         assert ended["extra"]["end"] == "found" and ended["extra"]["query"] == ep.query
