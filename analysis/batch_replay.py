@@ -204,10 +204,10 @@ def replay_logs(logs: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
                 executor: Executor | None = None, force: bool = False,
                 progress: bool = False, verify: bool = False) -> BatchReport:
     """Replay many logs into the folder ``out_dir`` on an executor, as ``sgtool replay
-    --out-dir`` does (module doc): ``logs`` is a log, a folder
-    of logs or a glob pattern, or a list of them; every ``NAME.mcap`` gives
-    ``out_dir/NAME.mcap``, outputs already complete are kept (unless ``force``), and a
-    folder sgtool did not write is refused unless ``force``. ``executor``:
+    --out-dir`` does (module doc): ``logs`` is a log, a folder of logs or a glob pattern,
+    or a list of them; every ``NAME.mcap`` gives ``out_dir/NAME.mcap``, outputs already
+    complete are kept (unless ``force``), and a folder sgtool did not write is refused
+    unless ``force``. ``executor``:
     :func:`~sgtool.make_executor` (default: in this process); ``verify`` checks the
     inputs' chunk CRCs. A log that fails twice is a ``failed`` entry of the report (the
     others are written all the same), not an exception."""

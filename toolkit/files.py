@@ -96,6 +96,7 @@ def output_error(e: OSError, path: str | os.PathLike[str] | None = None,
 
 NAME_MAX = 255  # bytes of one name in a folder (ext4, xfs, btrfs, tmpfs, APFS, NTFS: 255)
 TEMP_RANDOM = 8  # the characters tempfile.mkstemp and mkdtemp put between prefix and suffix
+NAME_TAG = 8  # hex digits of the whole name's hash that a cut temporary name ends in
 
 
 def temp_prefix(name: str, suffix: str, hidden: bool = True) -> str:
@@ -108,10 +109,10 @@ def temp_prefix(name: str, suffix: str, hidden: bool = True) -> str:
     room = NAME_MAX - len(lead) - 1 - TEMP_RANDOM - len(os.fsencode(suffix))
     raw = os.fsencode(name)
     if len(raw) > room:
-        end = max(room - 1 - TEMP_RANDOM, 1)
+        end = max(room - 1 - NAME_TAG, 1)
         while end > 1 and raw[end] & 0xC0 == 0x80:  # not inside a UTF-8 character
             end -= 1
-        tag = hashlib.blake2b(raw, digest_size=TEMP_RANDOM // 2).hexdigest()
+        tag = hashlib.blake2b(raw, digest_size=NAME_TAG // 2).hexdigest()
         name = f"{os.fsdecode(raw[:end])}~{tag}"
     return f"{lead}{name}."
 
