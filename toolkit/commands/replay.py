@@ -248,6 +248,11 @@ def _outputs(args: ReplayArgs, src: Path) -> Path | None:
     for given, opt in ((args.output, "-o"), (args.rrd, "--rrd")):
         if given and Path(given).resolve() == src.resolve():
             raise SgtoolError(f"{opt} {given}: the output must not be the input log")
+    for given, what in ((str(src), "the input log"), (args.output, "the output log (-o)"),
+                        (args.rrd, "the --rrd output")):
+        if args.llm_transcript and given and \
+                Path(args.llm_transcript).resolve() == Path(given).resolve():
+            raise SgtoolError(f"--llm-transcript {args.llm_transcript}: it is {what}")
     dst = check_log_output(args.output, force=args.force) if args.output else None
     if args.rrd:
         check_output(args.rrd, force=args.force, option="--rrd", suffixes=(".rrd",),

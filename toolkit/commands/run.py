@@ -232,6 +232,9 @@ def _planner(args: RunArgs) -> tuple[str, dict[str, Any]]:
                               "--llm-replay transcript (a run's transcript is emptied when "
                               "it starts)")
         options["transcript"] = args.llm_transcript
+    t = options.get("transcript")
+    if t and Path(str(t)).resolve() == Path(args.output).resolve():
+        raise SgtoolError(f"transcript {t}: it is the output log (-o)")
     return name, options
 
 

@@ -31,6 +31,9 @@ from sgtool.log.records import LlmExchange
 log = logging.getLogger(__name__)
 
 
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
 class TranscriptError(SgtoolError):
     """A transcript file is missing or malformed."""
 
@@ -52,6 +55,7 @@ def transcript_run(path: str | Path | None) -> Iterator[None]:
         yield
         return
     p = Path(path)
+    not_a_transcript(p)
     previous: Path | None = None
     try:
         p.parent.mkdir(parents=True, exist_ok=True)
@@ -82,6 +86,31 @@ def transcript_run(path: str | Path | None) -> Iterator[None]:
                 previous.unlink()
 
 
+def not_a_transcript(path: Path) -> None:
+    """Refuse (one line) to write a transcript over a file that is not one: an MCAP log,
+    or a file whose first line is not a JSON object."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(1 << 16)
+    except FileNotFoundError:
+        return
+    except OSError as e:
+        raise output_error(e, path) from None
+    if head.startswith(MCAP_MAGIC):
+        raise TranscriptError(f"transcript {path}: an MCAP log, not a JSONL transcript; "
+                              "not writing over it")
+    first = head.split(b"\n", 1)[0].strip()
+    if not first:
+        return
+    try:
+        ok = isinstance(json.loads(first), dict)
+    except ValueError:
+        ok = False
+    if not ok:
+        raise TranscriptError(f"transcript {path}: exists and is not a JSONL transcript; "
+                              "not writing over it")
+
+
 class TranscriptWriter:
     """Writes records as JSON lines, one ``write`` + flush per record.
 
@@ -96,6 +125,7 @@ class TranscriptWriter:
     def __init__(self, path: str | Path, append: bool = True) -> None:
         self.path = Path(path)
         self.append = append
+        not_a_transcript(self.path)  # a log or another file is never written over
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             if append:
@@ -141,9 +171,6 @@ class TranscriptWriter:
             self.close()
         else:
             self.abort()
-
-
-MCAP_MAGIC = b"\x89MCAP0\r\n"
 
 
 def is_mcap_file(path: str | Path) -> bool:

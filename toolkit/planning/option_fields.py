@@ -99,7 +99,7 @@ class OptionInfo:
             return f"{self.name} (Python only): {self.meta.help}"
         rng = self.meta.range_text()
         default = "" if self.default is None and "[default:" in self.meta.help else \
-            ", default " + ("none" if self.default is None else _text(self.default))
+            ", default " + ("unset" if self.default is None else _text(self.default))
         return (f"{self.name} ({self.kind}{default}): {self.meta.help}"
                 + (f" [{rng}]" if rng else ""))
 

@@ -223,7 +223,8 @@ class LlmEndpointOptions:
         "answer from this transcript (JSONL or an MCAP log's /sgtool/llm) instead of an "
         "endpoint", "path", objects=True))
     transcript: str | None = field(default=None, metadata=option(
-        "append every exchange to this JSONL transcript", "path", optional=True))
+        "write every exchange to this JSONL transcript (appended to; a command's run "
+        "empties it first)", "path", optional=True))
     client: Any = field(default=None, metadata=option(
         "a chat client (``model``, ``complete(messages)``) instead of an endpoint", "object"))
 

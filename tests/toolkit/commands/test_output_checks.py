@@ -95,3 +95,19 @@ def test_golden_check_reports_are_checked_before_any_replay(option: str,
     assert len(r.output.strip().splitlines()) == 1 and "Traceback" not in r.output
     assert f"{option} {out}: folder {out.parent} does not exist" in r.output
     assert list(tmp_path.iterdir()) == []  # nothing made: no pin folder, no report folder
+
+
+@pytest.mark.parametrize("given", [["--llm-transcript", "{out}"],
+                                   ["-O", "moma-llm.transcript={out}"]])
+def test_a_run_s_transcript_is_not_its_output_log(tmp_path, given) -> None:
+    """`run -o X.mcap` with the transcript at X.mcap (either spelling) is one line naming
+    both, before anything is written (it was a false "X exists")."""
+    out = tmp_path / "ep.mcap"
+    answers = tmp_path / "answers.jsonl"
+    answers.write_text("")
+    r = CliRunner().invoke(cli, ["run", "--planner", "moma-llm", "--frames", "1",
+                                 "--llm-replay", str(answers), "-o", str(out),
+                                 *(g.format(out=out) for g in given)])
+    assert r.exit_code == 2 and f"transcript {out}: it is the output log (-o)" in r.output, \
+        r.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["answers.jsonl"]

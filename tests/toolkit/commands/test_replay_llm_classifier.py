@@ -96,3 +96,22 @@ def test_misuse_is_one_line(args, says, tmp_path, monkeypatch) -> None:
     r = CliRunner().invoke(cli, ["replay", str(LOG), "--max-frames", "2", *args])
     assert r.exit_code == 2, r.output
     assert says in r.output and len(r.output.strip().splitlines()) == 1
+
+
+def test_the_transcript_is_never_the_input_the_output_or_a_user_file(live, tmp_path) -> None:
+    """--llm-transcript naming the input log, the output log or another file is refused in
+    one line before anything runs, and every file stays as it was."""
+    d, _, _ = live
+    log = tmp_path / "in.mcap"
+    log.write_bytes(LOG.read_bytes())
+    notes = tmp_path / "notes.txt"
+    notes.write_text("mine\n")
+    out = tmp_path / "out.mcap"
+    for transcript, why in ((log, "it is the input log"), (out, "it is the output log (-o)"),
+                            (notes, "exists and is not a JSONL transcript")):
+        r = CliRunner().invoke(cli, [
+            "replay", str(log), "-o", str(out), "--max-frames", FRAMES, "--classifier",
+            "llm", "--llm-replay", str(d / "rooms.jsonl"), "--llm-transcript", str(transcript)])
+        assert r.exit_code == 2 and why in r.output, r.output
+    assert log.read_bytes() == LOG.read_bytes() and notes.read_text() == "mine\n"
+    assert not out.exists()

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pytest
 
+from sgtool.errors import SgtoolError
 from sgtool.llm.recorded import TranscriptWriter, transcript_run
 
 
@@ -56,3 +57,28 @@ def test_a_run_that_fails_before_asking_puts_the_previous_one_back(tmp_path):
         raise ValueError("a bad option")
     assert t.read_text() == '{"old": 1}\n'
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.jsonl"]
+
+
+def test_a_transcript_is_never_written_over_a_log_or_another_file(tmp_path):
+    """A transcript path that names an MCAP log (the input, a recording) or a file that is
+    not a JSONL transcript is refused in one line and the file is left as it was."""
+    log = tmp_path / "run.mcap"
+    log.write_bytes(b"\x89MCAP0\r\n" + b"\0" * 64)
+    notes = tmp_path / "notes.txt"
+    notes.write_text("my notes\n")
+    for path, why in ((log, "an MCAP log, not a JSONL transcript"),
+                      (notes, "exists and is not a JSONL transcript")):
+        before = path.read_bytes()
+        with pytest.raises(SgtoolError, match=why):
+            with transcript_run(path):
+                pass
+        with pytest.raises(SgtoolError, match=why):
+            TranscriptWriter(path)
+        with pytest.raises(SgtoolError, match=why):
+            TranscriptWriter(path, append=False)
+        assert path.read_bytes() == before
+    t = tmp_path / "t.jsonl"  # a transcript (or an empty file) is appended to
+    t.write_text('{"old": 1}\n')
+    with TranscriptWriter(t) as w:
+        w.write({"new": 1})
+    assert t.read_text() == '{"old": 1}\n{"new": 1}\n'
