@@ -572,3 +572,24 @@ def test_the_re_pin_hint_runs_as_given(log, tmp_path) -> None:
     text = pin_command(pin, log, tmp_path / "g")
     assert text == (f"sgtool golden pin {log} --dir {tmp_path / 'g'} --max-frames 20 "
                     "(and from Python: max_depth=3.0)")
+
+
+def test_a_report_is_never_written_over_a_pinned_log_or_a_pin_file(pinned, tmp_path, capsys):
+    """--report/--junit replace an earlier report of their kind, never the pinned copy of a
+    log, expected.json or a file of the user's (they took the pins with them before)."""
+    before = {p.name: p.read_bytes() for p in pinned.iterdir()}
+    notes = tmp_path / "notes.txt"
+    notes.write_text("mine\n")
+    for option, target in (("--junit", pinned / "small.mcap"),
+                           ("--report", pinned / "expected.json"), ("--junit", notes)):
+        code, _, err = sgtool(capsys, "golden", "check", "--dir", pinned, option, target)
+        assert code == 2 and f"{option} {target}: exists and is not a golden check report" \
+            in err, err
+    assert {p.name: p.read_bytes() for p in pinned.iterdir()} == before
+    assert notes.read_text() == "mine\n"
+    md, xml = tmp_path / "r.md", tmp_path / "r.xml"
+    for _ in range(2):  # a report of the last check is replaced
+        code, _, err = sgtool(capsys, "golden", "check", "--dir", pinned, "--report", md,
+                              "--junit", xml)
+        assert code == 0, err
+    assert md.read_text().startswith("# Golden check of ") and "<testsuite" in xml.read_text()

@@ -207,15 +207,30 @@ def _same_check(folder: str, names: tuple[str, ...], **given: Any) -> str:
 
 def _check_report_files(report_md: str | None, junit: str | None) -> None:
     """``--report`` and ``--junit`` through the one output check before any replay (each
-    is replaced when it exists: a report of the last check)."""
+    is replaced when it is a report of an earlier check, any other file refused)."""
     from sgtool.commands.options import check_output
 
-    for path, option in ((report_md, "--report"), (junit, "--junit")):
-        if path:
-            check_output(path, force=True, option=option)
     if report_md and junit and Path(report_md).resolve() == Path(junit).resolve():
         raise SgtoolError(f"--report {report_md} and --junit {junit}: one file; give two "
                           "(the second would replace the first)")
+    for path, option in ((report_md, "--report"), (junit, "--junit")):
+        if path:
+            check_output(path, force=True, option=option)
+            _only_a_report(path, option)
+
+
+_REPORT_HEADS = {"--report": (b"# Golden check of ",), "--junit": (b"<?xml", b"<testsuite")}
+
+
+def _only_a_report(path: str, option: str) -> None:
+    """A report replaces only an earlier report of its kind (or an empty file): never a
+    pinned log, a pin file or any other file (one line)."""
+    with contextlib.suppress(OSError):
+        with open(path, "rb") as fh:
+            head = fh.read(64).lstrip()
+        if head and not head.startswith(_REPORT_HEADS[option]):
+            raise SgtoolError(f"{option} {path}: exists and is not a golden check report; "
+                              "not writing over it")
 
 
 def _reports_and_update(report: Any, update: bool, report_md: str | None,
@@ -258,6 +273,9 @@ def _write_report_files(report: Any, report_md: str | None, junit: str | None,
     names = [c.name for c in report.logs if c.status == "changed"] if accepted else []
     md, xml = error_reports(*error) if error is not None else (
         markdown_report(report, accepted), junit_report(report, names))
+    for path, option in ((report_md, "--report"), (junit, "--junit")):
+        if path:
+            _only_a_report(path, option)
     if report_md:
         atomic_write(report_md, md)
     if junit:
