@@ -35,7 +35,7 @@ from sgtool.analysis.batch_inputs import expand_inputs
 from sgtool.analysis.executor import Executor, LocalExecutor, Outcome, RayExecutor, Task
 from sgtool.arg_checks import of_type
 from sgtool.errors import SgtoolError
-from sgtool.files import atomic_write, output_folder
+from sgtool.files import atomic_write, output_folder, sha256_file
 from sgtool.log.reader import LogReader
 from sgtool.replayers.derived_log import (
     REPLAY_METADATA,
@@ -124,8 +124,8 @@ def plan_jobs(inputs: Sequence[Path], out_dir: Path, options: ReplayOptions, *,
 
 
 def is_complete(job: ReplayJob) -> bool:
-    """The output exists, opens as a log, and was replayed with the options this job
-    would use."""
+    """The output exists, opens as a log, and was replayed from this input (its sha256)
+    with the options this job would use."""
     dst = Path(job.output)
     if not dst.is_file():
         return False
@@ -133,7 +133,8 @@ def is_complete(job: ReplayJob) -> bool:
         with LogReader(dst) as done:
             meta = done.metadata.get(REPLAY_METADATA)
         with LogReader(job.input) as src:
-            wanted = replay_metadata(resolve_options(src, job.options), job.options.tf_time)
+            wanted = replay_metadata(resolve_options(src, job.options), job.options.tf_time,
+                                     sha256_file(job.input))
     except (SgtoolError, OSError):  # the input's frames unreadable: the job says why
         return False
     return meta == wanted

@@ -41,9 +41,10 @@ from sgtool.files import (
     output_folder,
     quoted,
     read_manifest,
+    sha256_file,
 )
 from sgtool.replayers.derived_log import ReplayOptions
-from sgtool.replayers.golden import describe_mismatch, quality_lines, sha256_file
+from sgtool.replayers.golden import describe_mismatch, quality_lines
 from sgtool.replayers.golden_diff import paired_refreshes
 from sgtool.replayers.golden_pins import (
     INDEX,

@@ -163,7 +163,7 @@ class GoldenFixture:
 
     def _check(self, log: Path, folder: Path, given: Any) -> None:
         from sgtool.analysis.golden_check import check_pins, pin_logs, pin_name, update_pins
-        from sgtool.replayers.golden import sha256_file
+        from sgtool.files import sha256_file
         from sgtool.replayers.golden_pins import INDEX, options_dict, overridden, read_pins
 
         if not log.is_file():

@@ -51,6 +51,7 @@ from sgtool.arg_checks import progress as check_progress
 from sgtool.blas import single_blas_thread
 from sgtool.datasets.room_evidence import make_classifier
 from sgtool.errors import LogFormatError, SgtoolError
+from sgtool.files import sha256_file
 from sgtool.heap import frozen_heap, small_pages
 from sgtool.log import schemas as S
 from sgtool.log.chunk_copy import RawChunk, in_sequence
@@ -176,10 +177,14 @@ def _recorded_mapping(reader: LogReader) -> tuple[dict[str, Any], bool]:
     return out, True
 
 
-def replay_metadata(opts: ResolvedOptions, tf_time: str = "log") -> dict[str, str]:
-    """The ``sgtool.replay`` metadata of a derived log: the resolved options, and
-    ``tf_time`` when it is not the default "log" (default replays stay as they were)."""
-    return {**opts.to_metadata(), **({"tf_time": tf_time} if tf_time != "log" else {})}
+def replay_metadata(opts: ResolvedOptions, tf_time: str = "log",
+                    input_sha256: str | None = None) -> dict[str, str]:
+    """The ``sgtool.replay`` metadata of a derived log: the resolved options, ``tf_time``
+    when it is not the default "log" (default replays stay as they were), and the sha256
+    of the input log's bytes (what a derived log was made from: a folder replay keeps a
+    derived log only while its input is the same)."""
+    return {**opts.to_metadata(), **({"tf_time": tf_time} if tf_time != "log" else {}),
+            **({"input_sha256": input_sha256} if input_sha256 else {})}
 
 
 def _image_size(reader: LogReader) -> tuple[int, int] | None:
@@ -337,7 +342,8 @@ def replay(
                     for name, data in sorted(reader.metadata.items()):
                         if name not in (S.METADATA_NAME, REPLAY_METADATA):
                             writer.add_metadata(name, data)
-                    writer.add_metadata(REPLAY_METADATA, replay_metadata(opts, tf_time))
+                    writer.add_metadata(REPLAY_METADATA, replay_metadata(
+                        opts, tf_time, sha256_file(src)))
                     for a in reader.iter_attachments():
                         writer.attach(a.name, a.data, a.media_type, a.log_time)
                     _run(reader, stream, writer, opts, report, on_refresh, progress, copy_chunks,

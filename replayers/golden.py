@@ -66,14 +66,6 @@ CASES: tuple[GoldenCase, ...] = (
 
 
 # ----- digests and files ---------------------------------------------------------------
-def sha256_file(path: str | os.PathLike[str]) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
 def sequence_digest(graphs: Sequence[str]) -> str:
     """sha256 over the graphs' own sha256 digests, in order."""
     h = hashlib.sha256()

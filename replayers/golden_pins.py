@@ -34,13 +34,12 @@ from typing import Any
 
 from sgtool.canonical import canonical_float
 from sgtool.errors import SgtoolError
-from sgtool.files import atomic_write, quoted
+from sgtool.files import atomic_write, quoted, sha256_file
 from sgtool.replayers.derived_log import ReplayOptions, replay
 from sgtool.replayers.golden import (
     EXPECTED,
     read_graphs,
     sequence_digest,
-    sha256_file,
     write_graphs,
 )
 from sgtool.replayers.golden_layers import LayerSummary, layer_summary

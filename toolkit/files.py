@@ -536,3 +536,12 @@ def _in_place(target: Path, command: str, known: Sequence[str]) -> Iterator[Path
                 mark()
         raise
     mark()
+
+
+def sha256_file(path: str | os.PathLike[str]) -> str:
+    """The sha256 of a file's bytes, hex."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()

@@ -172,3 +172,20 @@ def test_replay_logs_from_python(logs, tmp_path):
         with pytest.raises(SgtoolError, match=message):
             sgtool.replay_logs(args.pop("logs"), args.pop("out_dir"), **args)
     assert not (tmp_path / "x").exists()
+
+
+def test_an_output_of_another_input_with_that_name_is_replayed_again(tmp_path):
+    """A log recorded again under its name is not the input its derived log was made from:
+    the derived log records its input's sha256, and a folder replay compares it."""
+    src = write_log(tmp_path / "run.mcap", n=6)
+    out = tmp_path / "out"
+    out.mkdir()
+    jobs = plan_jobs([src], out, OPTS)
+    assert [r.status for r in replay_many(jobs, LocalExecutor(1)).logs] == ["replayed"]
+    assert [r.status for r in replay_many(jobs, LocalExecutor(1)).logs] == ["skipped"]
+    write_log(src, n=8)  # the same name, another recording
+    assert not is_complete(jobs[0])
+    assert [r.status for r in replay_many(jobs, LocalExecutor(1)).logs] == ["replayed"]
+    fresh = tmp_path / "fresh.mcap"
+    replay(src, fresh, OPTS)
+    assert (out / "run.mcap").read_bytes() == fresh.read_bytes()
