@@ -151,9 +151,10 @@ def parse_noise(text: str | None) -> NoiseProfile:
 
 def names_file(text: str) -> bool:
     """Whether the ``--noise`` text names a JSON file (:func:`parse_noise`), not a
-    profile with overrides."""
+    profile with overrides: a profile's name is always the profile (a file of that name
+    is ``./NAME``)."""
     t = text.strip()
-    return t.endswith(".json") or Path(t).is_file()
+    return t.endswith(".json") or (t not in PROFILES and Path(t).is_file())
 
 
 def _override(base: NoiseProfile, items: Iterable[tuple[str, Any]], where: str,

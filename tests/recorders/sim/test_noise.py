@@ -197,3 +197,19 @@ def test_flying_pixels_leave_the_other_faults_as_they_were() -> None:
     inner[:, 12:] = True
     inner[38:62, 98:142] = False
     assert np.array_equal(a[inner], b[inner]) and not np.array_equal(a, b)
+
+
+def test_a_file_named_like_a_profile_does_not_take_its_place(tmp_path: Path,
+                                                               monkeypatch) -> None:
+    """A file called none, mild or strong in the current folder (notes, a transcript
+    written as `transcript=none`) leaves the profile of that name as it is; ./NAME reads
+    the file."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "none").write_text("some notes\n")
+    (tmp_path / "mild").write_text("{}")
+    assert parse_noise("none") == PROFILES["none"] and parse_noise(None) == PROFILES["none"]
+    assert parse_noise("mild") == PROFILES["mild"]
+    assert not names_file("mild") and names_file("./mild")
+    assert parse_noise("./mild").holes == 0.0  # the file: no fault given
+    with pytest.raises(SgtoolError, match="not valid JSON"):
+        parse_noise("./none")
