@@ -44,6 +44,9 @@ _COLUMNS: tuple[tuple[str, str, str], ...] = (
 )
 
 
+_SHORT = {"distance": "dist"}  # cost model names shortened in column headers
+
+
 def _fmt(x: float, spec: str) -> str:
     return "-" if x is None or math.isnan(x) else format(x, spec)
 
@@ -96,10 +99,15 @@ def format_table(summaries: Sequence[PlannerSummary],
                  throughput: Mapping[str, float] | None = None,
                  models: Sequence[CostModel] = (), title: str = "",
                  timing: bool = True) -> str:
-    """Table VII's SymSearch columns plus AUC-E (both cost models) and, when given, the
-    measured throughput (episodes per second, a wall-clock figure). ``timing=False`` leaves
-    out the decision time (wall clock), so the table depends on the results alone."""
+    """Table VII's SymSearch columns plus AUC-E (a column per cost model of ``models``;
+    none given: the distance and step models) and, when given, the measured throughput
+    (episodes per second, a wall-clock figure). ``timing=False`` leaves out the decision
+    time (wall clock), so the table depends on the results alone."""
     columns = [c for c in _COLUMNS if timing or c[0] != "decision_s"]
+    if models:
+        columns = [c for c in columns if not c[0].startswith("auc_e_")] + [
+            (f"auc_e_{m.name}", f"AUC-E {_SHORT.get(m.name, m.name)} ↑", ".3f")
+            for m in models]
     header = ["Planner", *(h for _, h, _ in columns), "Episodes"]
     if throughput is not None:
         header.append("Episodes/s")

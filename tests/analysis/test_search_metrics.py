@@ -139,3 +139,25 @@ def test_run_prints_the_spl_eval_scores() -> None:
             episode_spl(success, shortest, travelled)
     assert report(True, 0.0, 0.0).spl == 1.0
     assert report(True, None, 1.0).spl is None
+
+
+def test_the_table_has_a_column_per_cost_model_it_is_given():
+    """A user's cost model (opens) gets its AUC-E column; without models the table keeps
+    the distance and step columns."""
+    from sgtool.analysis.report import format_table
+    from sgtool.analysis.search_metrics import CostModel
+
+    opens = CostModel("opens", "containers and doors opened", 10.0, lambda r: float(r.n_open))
+    runs = [ep(True, n_open=2, seed=0), ep(True, n_open=4, seed=1), ep(False, seed=2)]
+    header = format_table(summarize(runs, [opens]), models=[opens]).splitlines()[0]
+    assert "AUC-E opens" in header and "AUC-E dist" not in header
+    both = [*cost_models(5000.0, 50.0), opens]
+    header = format_table(summarize(runs, both), models=both).splitlines()[0]
+    assert [h.strip() for h in header.split("|") if "AUC-E" in h] == \
+        ["AUC-E dist ↑", "AUC-E steps ↑", "AUC-E opens ↑"]
+    plain = format_table(summarize(runs)).splitlines()[0]
+    assert [h.strip() for h in plain.split("|") if "AUC-E" in h] == \
+        ["AUC-E dist ↑", "AUC-E steps ↑"]
+    lines = format_table(summarize(runs, [opens]), models=[opens]).splitlines()
+    col = [h.strip() for h in lines[0].split("|")].index("AUC-E opens ↑")
+    assert lines[2].split("|")[col].strip() not in ("", "-")  # the column holds a figure
