@@ -130,6 +130,31 @@ def test_a_wrong_type_is_refused_on_write(tmp_path, record, field) -> None:
         w.write_record(record, 5)
 
 
+@pytest.mark.parametrize("record, field, why", [
+    (Action(skill="navigate", outcome="success", travelled_m=float("nan")), "travelled_m",
+     "NaN and infinity are no JSON numbers"),
+    (Episode(kind="search", status="success", travelled_m=float("inf")), "travelled_m",
+     "NaN and infinity"),
+    (Episode(kind="search", status="success", travelled_m=-1.0), "travelled_m",
+     "a distance is never negative"),
+    (Episode(kind="search", status="success", shortest_m=-2.0), "shortest_m", "negative"),
+    (Episode(kind="search", status="started", extra={"score": float("nan")}), "extra.score",
+     "NaN"),
+])
+def test_a_number_the_reader_would_refuse_is_refused_on_write(tmp_path, record, field,
+                                                              why) -> None:
+    """What a log must not hold (NaN or infinity is no JSON; a negative distance is read
+    as a broken episode and dropped) is refused when written, naming the field, and the
+    log written so far stays readable."""
+    path = tmp_path / "x.mcap"
+    with LogWriter(path) as w:
+        with pytest.raises(LogFormatError, match=re.escape(f"'{field}'") + ".*" + why):
+            w.write_record(record, 5)
+        w.write_record(Episode(kind="search", status="started"), 6)
+    with LogReader(path) as r:
+        assert [e.status for _, e in r.records(Episode)] == ["started"]
+
+
 def test_a_missing_field_is_refused_on_write(tmp_path) -> None:
     with LogWriter(tmp_path / "x.mcap") as w, pytest.raises(LogFormatError, match="'status'"):
         w.write_record("episode", 0, {"kind": "search"})
