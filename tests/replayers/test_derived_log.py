@@ -481,3 +481,36 @@ def test_a_derived_log_replays_with_the_options_it_was_built_with(tmp_path):
     assert (rep2.options.every, rep2.options.voxel_size) == (20, 0.08)
     assert diff_logs(first, again).same
     assert replay(first, None, ReplayOptions(every=10)).options.every == 10
+
+
+class _OwnClassifier:
+    """A user's room classifier answering ``answer`` for every room."""
+
+    def __init__(self, answer) -> None:
+        self.answer = answer
+
+    def classify(self, object_categories):
+        return self.answer
+
+
+@pytest.mark.parametrize("answer, why", [
+    ([("kitchen", float("nan"))], "scored 'kitchen' nan: a score is a number in"),
+    ([("kitchen", 7.0)], "scored 'kitchen' 7.0"),
+    (None, "returned NoneType, not \\(category, score\\) pairs"),
+    ("kitchen", "returned str"),
+    ([("", 0.5)], "named a category ''"),
+])
+def test_a_classifier_of_ones_own_is_checked_before_its_answer_enters_the_graph(
+        tmp_path, answer, why) -> None:
+    """replay(room_classifier=...) writes the classifier's scores into the graph: a score
+    that is not a number in [0, 1] (NaN would be written as a token no JSON reader takes)
+    or an answer that is no list of pairs is one line naming the classifier, and no
+    derived log is left."""
+    from sgtool.errors import SgtoolError
+
+    out = tmp_path / "d.mcap"
+    with pytest.raises(SgtoolError, match="room classifier _OwnClassifier: classify\\(\\) "
+                       + why):
+        replay(GOLDEN / "house6-tour.mcap", out, ReplayOptions(max_frames=30),
+               room_classifier=lambda name: _OwnClassifier(answer))
+    assert not list(tmp_path.iterdir())

@@ -11,11 +11,14 @@ through a closed door are unexplored room nodes.
 from __future__ import annotations
 
 import hashlib
+import math
 from collections import defaultdict
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
+from sgtool.errors import SgtoolError
 from sgtool.mapping.voronoi import VoronoiGraph
 from sgtool.scenegraph.builder_config import BuilderConfig
 from sgtool.scenegraph.categories import RoomClassifier
@@ -124,8 +127,8 @@ def room_nodes(
             if evidence:
                 got = class_memo.get(evidence)
                 if got is None:
-                    got = list(classifier.classify(list(evidence)))
-                    class_memo[evidence] = got
+                    got = class_memo[evidence] = checked_scores(
+                        classifier, classifier.classify(list(evidence)))
                 scores = got[: config.max_scores]
             elif corridor_like(vg, seg.rooms[i], config, semantic=bool(instances)):
                 scores = [(str(config.corridor), 1.0)]
@@ -141,6 +144,26 @@ def room_nodes(
         out.append(RoomNode(id=d.unexplored_room, position=unexplored_pos[d.unexplored_room],
                             explored=False, neighbours=tuple(sorted(d.rooms))))
     return out
+
+
+def checked_scores(classifier: RoomClassifier, got: Any) -> list[tuple[str, float]]:
+    """A classifier's answer as (category, score) pairs, each a non-empty name and a
+    finite score in [0, 1]; anything else is one line naming the classifier (a user's
+    classifier, given to ``replay(room_classifier=...)``, writes into the graph)."""
+    def fail(why: str) -> SgtoolError:
+        return SgtoolError(f"room classifier {type(classifier).__name__}: classify() {why}")
+
+    try:
+        pairs = [(r, p) for r, p in got]
+    except (TypeError, ValueError):
+        raise fail(f"returned {type(got).__name__}, not (category, score) pairs") from None
+    for r, p in pairs:
+        if not isinstance(r, str) or not r:
+            raise fail(f"named a category {r!r}, not a room type's name")
+        ok = isinstance(p, int | float | np.integer | np.floating) and not isinstance(p, bool)
+        if not (ok and math.isfinite(p) and 0.0 <= p <= 1.0):
+            raise fail(f"scored {r!r} {p!r}: a score is a number in [0, 1]")
+    return [(r, float(p)) for r, p in pairs]
 
 
 def corridor_like(vg: VoronoiGraph, nodes: np.ndarray, config: BuilderConfig,
