@@ -103,9 +103,12 @@ def plugin_options(name: str, factory: Callable[..., Any], given: Mapping[str, A
 
 def build_plugin(name: str, factory: Callable[..., Any], options: Mapping[str, Any]) -> Planner:
     """``factory(**options)``, checked to be a Planner; every failure one line."""
+    from sgtool.planning.timing import seeded_globals
+
     kw = plugin_options(name, factory, options)
     try:
-        planner = factory(**kw)
+        with seeded_globals():  # a constructor drawing from random: the same in any run
+            planner = factory(**kw)
     except (Exception, SystemExit) as e:  # noqa: BLE001 - a user's planner failing: one line
         raise PluginError(f"planner {name!r}: {raised_text(e)}" if isinstance(e, SystemExit)
                           else f"planner {name!r}: raised {raised_text(e)}") from None

@@ -10,7 +10,9 @@ A plug-in that draws from Python's ``random`` or numpy's global generator instea
 ``seed`` its ``reset`` gets would make a bench differ from run to run. The wrapper gives a
 plug-in's calls generators of its own, seeded by that ``seed`` at every ``reset`` and
 swapped in around each call (the caller's global generators are left as they were), so
-the same episode draws the same numbers in any process and order.
+the same episode draws the same numbers in any process and order; a plug-in's constructor
+runs with them seeded by 0 (:func:`seeded_globals`, from
+:func:`~sgtool.planning.plugins.build_plugin`).
 """
 
 from __future__ import annotations
@@ -48,6 +50,22 @@ def decision_time(planner: Planner, action: Action, outer_s: float) -> float:
             isinstance(action.decision_time_s, float):
         return action.decision_time_s
     return outer_s
+
+
+@contextlib.contextmanager
+def seeded_globals(seed: int = 0) -> Iterator[None]:
+    """Python's and numpy's global generators seeded with ``seed`` inside the block, the
+    caller's put back after: a plug-in's constructor that draws from them draws the same
+    numbers in any process and order (module doc)."""
+    with _GLOBALS_LOCK:
+        outer = random.getstate(), np.random.get_state()
+        random.seed(seed)
+        np.random.seed(seed % 2**32)
+        try:
+            yield
+        finally:
+            random.setstate(outer[0])
+            np.random.set_state(outer[1])
 
 
 class PlannerContractError(SgtoolError):

@@ -366,3 +366,39 @@ def test_priors_reach_a_plug_in_whose_options_name_weights(plugin_dir: Path) -> 
     given = BenchConfig(planners=("mymod_plug:Priored",), priors_dir="blend",
                         planner_options={"mymod_plug:Priored": {"weights_dir": "mine"}})
     assert planner_options_for(given, "mymod_plug:Priored") == {"weights_dir": "mine"}
+
+
+def test_a_plug_in_constructor_drawing_from_random_draws_the_same_every_run(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A plug-in that seeds itself from the global generators in its constructor (a
+    common pattern) is built with them seeded, so a bench of it is the same in every run
+    and process; the caller's generators are left as they were."""
+    import random
+
+    import numpy as np
+
+    (tmp_path / "initrand_plug.py").write_text(textwrap.dedent('''
+        import random
+
+        import numpy as np
+
+        from sgtool.planning.planners import GreedyPlanner
+
+
+        class Drawn(GreedyPlanner):
+            def __init__(self):
+                super().__init__()
+                self.drawn = (random.random(), float(np.random.random_sample()))
+    '''))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    random.seed(1)
+    np.random.seed(1)
+    first = make_planner("initrand_plug:Drawn").drawn
+    after = random.random(), float(np.random.random_sample())
+    random.seed(2)
+    np.random.seed(2)
+    assert make_planner("initrand_plug:Drawn").drawn == first
+    random.seed(1)
+    np.random.seed(1)
+    make_planner("initrand_plug:Drawn")
+    assert (random.random(), float(np.random.random_sample())) == after  # untouched
