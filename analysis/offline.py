@@ -375,6 +375,10 @@ def replay_decisions(planner: Planner | str, episodes: Sequence[LoggedEpisode],
 
         name = name or planner
         planner = make_planner(planner)
+    else:  # a user's object: what it returns wrongly or raises is one line, as run_one's
+        from sgtool.planning.plugins import held_to_contract
+
+        planner = held_to_contract(planner)
 
     out: list[DecisionComparison] = []
     skipped = 0
