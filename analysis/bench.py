@@ -68,6 +68,7 @@ from sgtool.analysis.bench_houses import (
 )
 from sgtool.analysis.bench_planner_checks import (
     BenchError,
+    check_budgets,
     check_house_seeds,
     check_planner_list,
     check_planner_options,
@@ -175,6 +176,7 @@ class BenchConfig:
             raise BenchError(f"--houses: must be >= 1, or >= 0 with --house (house_files=), got "
                              f"{self.houses}")
         check_house_seeds(self.house_seed, self.houses)
+        check_budgets(self.distance_budget, self.step_budget)
         if self.house_seed < 0:
             raise BenchError(f"--house-seed: must be >= 0, got {self.house_seed}")
         from sgtool.datasets.presets import PRESET_NAMES

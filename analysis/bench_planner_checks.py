@@ -8,6 +8,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from sgtool.arg_checks import number, whole
 from sgtool.errors import SgtoolError
 
 
@@ -141,6 +142,16 @@ MAX_SEED = 2**62  # the largest seed `sgtool run --seed` and `scenes generate --
 def check_house_seeds(house_seed: int, houses: int) -> None:
     """Generated houses take seeds ``house_seed`` .. ``house_seed + houses - 1``: each must
     be one `sgtool run --seed` takes again (one line otherwise)."""
+    whole("house_seed", house_seed)
     if houses > 0 and not 0 <= house_seed <= MAX_SEED - houses + 1:
         raise BenchError(f"--house-seed {house_seed} with --houses {houses}: the houses' seeds "
                          f"must lie in 0..{MAX_SEED} (the seeds `sgtool run --seed` takes)")
+
+
+def check_budgets(distance_budget: Any, step_budget: Any) -> None:
+    """The AUC-E budgets: finite numbers above 0 (one line naming the flag)."""
+    for flag, name, value in (("--distance-budget", "distance_budget", distance_budget),
+                              ("--step-budget", "step_budget", step_budget)):
+        checked = number(name, value)  # (a wrong type or NaN: number's line)
+        if checked is None or checked <= 0:
+            raise BenchError(f"{flag} ({name}=): must be > 0, got {value:g}")

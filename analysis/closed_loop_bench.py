@@ -50,6 +50,7 @@ from sgtool.analysis.bench_houses import (
     output_path,
 )
 from sgtool.analysis.bench_planner_checks import (
+    check_budgets,
     check_house_seeds,
     check_planner_options,
     check_plugins_build,
@@ -76,8 +77,8 @@ from sgtool.analysis.run_bench_resume import (
     task_settings,
 )
 from sgtool.analysis.search_metrics import CostModel, cost_models, summarize
+from sgtool.arg_checks import of_type, whole
 from sgtool.arg_checks import progress as check_progress
-from sgtool.arg_checks import whole
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
 from sgtool.extras import require
@@ -122,9 +123,7 @@ class ClosedLoopBenchConfig:
     step_budget: float = 50.0
     reference: str | None = None  # paired comparisons against it (None: scout, else first)
     all_pairs: bool = False  # paired comparisons of every pair of planners instead
-    # frames per room of the SR-within-budget tables (a report setting; empty: quarters of
-    # the most an episode used)
-    budgets: tuple[float, ...] = ()
+    budgets: tuple[float, ...] = ()  # f/room of the SR tables (empty: quarters of the most used)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "planner_options",
@@ -134,8 +133,7 @@ class ClosedLoopBenchConfig:
         try:  # (a list from Python, numbers as text)
             object.__setattr__(self, "budgets", tuple(float(b) for b in self.budgets))
         except (TypeError, ValueError):
-            raise SgtoolError(f"budgets: frames per room, numbers; got {self.budgets!r}"
-                              ) from None
+            raise SgtoolError(f"budgets: frames per room, numbers; got {self.budgets!r}") from None
         object.__setattr__(self, "house_files",
                            config_names(self.house_files, "house_files", paths=True))
         object.__setattr__(self, "rooms", config_rooms(self.rooms))
@@ -159,6 +157,8 @@ class ClosedLoopBenchConfig:
             raise SgtoolError(f"--houses: must be >= 1, or >= 0 with --house (house_files=), got "
                               f"{self.houses}")
         check_house_seeds(self.house_seed, self.houses)
+        check_budgets(self.distance_budget, self.step_budget)
+        of_type("options", self.options, ClosedLoopOptions, "a ClosedLoopOptions")
         folders: dict[str, str] = {}
         faults: dict[NoiseProfile, str] = {}
         for n in self.noise:

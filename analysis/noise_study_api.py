@@ -27,7 +27,7 @@ from sgtool.analysis.noise_study import (
     conditions_of,
     run_study,
 )
-from sgtool.arg_checks import whole
+from sgtool.arg_checks import of_type, whole
 from sgtool.errors import SgtoolError
 from sgtool.extras import require
 
@@ -142,6 +142,7 @@ def run_noise_study(config: StudyConfig, cache: str | os.PathLike[str], *,
     ``config`` with ``workers`` local processes; the cells in house x condition order."""
     from sgtool.analysis.executor import make_executor
 
+    of_type("config", config, StudyConfig, "a StudyConfig")
     if config.closed_loop.planners:
         raise SgtoolError("run_noise_study: the closed-loop part is `sgtool study noise "
                           "--closed-loop`'s; leave config.closed_loop.planners empty")

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sgtool.arg_checks import of_type
+from sgtool.arg_checks import of_type, whole
 from sgtool.datasets.footprint_reach import Window, full_mask, near_footprint
 from sgtool.errors import SgtoolError
 from sgtool.house.spec import (
@@ -242,6 +242,8 @@ def list_episodes(spec: HouseSpec, n: int | None = None, seed: int | None = None
     episodes``. ``geometry``: the house's
     :class:`EpisodeGeometry` with this ``reach``, to share with other listings."""
     of_type("spec", spec, HouseSpec, "a HouseSpec (sgtool.load_house(path))")
+    whole("n", n, 0, optional=True)
+    whole("seed", seed, optional=True)
     seed = spec.seed if seed is None else seed
     if not spec.objects or not spec.starts:
         return []

@@ -4,7 +4,10 @@ number >= 1``), not an error deep inside a stage."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import types
+import typing
 from typing import Any
 
 import numpy as np
@@ -68,3 +71,32 @@ def progress(name: str, value: Any, *, method: str = "update") -> Any:
         what = f"an object with {method}(n) such as a tqdm bar" if method else "a function"
         raise SgtoolError(f"{name}={value!r}: {what}, or None")
     return value
+
+
+def typed_fields(obj: Any) -> None:
+    """Every field of the dataclass ``obj`` annotated with one type (``int``, ``float``,
+    ``bool``, ``str`` or a class, or that type ``| None``) holds a value of it: one line
+    naming the field otherwise (an int passes for a float). Fields of other annotations
+    are the class's own to check."""
+    try:
+        hints = typing.get_type_hints(type(obj))
+    except (NameError, TypeError):  # an annotation only a type checker resolves
+        return
+    for f in dataclasses.fields(obj):
+        t = hints.get(f.name)
+        union = typing.get_origin(t) in (typing.Union, types.UnionType)
+        args = typing.get_args(t) if union else (t,)
+        optional = type(None) in args
+        kinds = [a for a in args if a is not type(None)]
+        value = getattr(obj, f.name)
+        if len(kinds) != 1 or (value is None and optional):
+            continue
+        kind = kinds[0]
+        if kind is int:
+            whole(f.name, value, optional=optional)
+        elif kind is float:
+            number(f.name, value, optional=optional)
+        elif isinstance(kind, type) and typing.get_origin(kind) is None and \
+                not isinstance(value, kind):
+            raise SgtoolError(f"{f.name}={value!r}: a {kind.__name__}"
+                              + (", or None" if optional else ""))

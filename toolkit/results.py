@@ -214,7 +214,16 @@ def _text(d: Mapping[str, Any], key: str, default: Any = _ABSENT) -> str:
 # ----------------------------------------------------------------------------------------
 def write_jsonl(results: Iterable[EpisodeResult], path: str | os.PathLike[str]) -> Path:
     """One record per line, written to a temp file beside ``path`` and renamed at the end."""
-    return atomic_write(path, "".join(r.to_json() + "\n" for r in results))
+    from sgtool.arg_checks import of_type
+
+    of_type("path", path, (str, os.PathLike), "a file's path (write_results(results, path))")
+    if isinstance(results, str | bytes | os.PathLike):
+        raise SgtoolError("results: give the EpisodeResults, then the path "
+                          "(write_results(results, path))")
+    rows = list(results)
+    for r in rows:
+        of_type("results", r, EpisodeResult, "EpisodeResults")
+    return atomic_write(path, "".join(r.to_json() + "\n" for r in rows))
 
 
 

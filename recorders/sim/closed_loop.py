@@ -452,6 +452,8 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
     of_type("episode", episode, Episode, "an Episode (sgtool.pick_episode(house))")
     function("on_decision", on_decision)
     require("pybullet", api="sgtool.run_closed_loop")  # one line on a core install
+    if options is not None:
+        of_type("options", options, ClosedLoopOptions, "a ClosedLoopOptions")
     planner = held_to_contract(planner)  # a user's planner object: one line for its faults
     opts = options or ClosedLoopOptions()
     recorded = {"planner_options": recorded_options(planner_options)} if planner_options \

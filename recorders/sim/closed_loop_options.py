@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, fields
 
-from sgtool.arg_checks import of_type
+from sgtool.arg_checks import of_type, typed_fields
 from sgtool.errors import SgtoolError
 from sgtool.mapping.bev import BevConfig
 from sgtool.mapping.depth_noise import sensor_max_depth
@@ -83,6 +83,7 @@ class ClosedLoopOptions:
             object.__setattr__(self, "noise", parse_noise(self.noise))
         else:
             of_type("noise", self.noise, NoiseProfile, "a NoiseProfile or a profile's text")
+        typed_fields(self)  # max_steps="3", camera=(96, 72): one line here
 
     def keyframes(self) -> KeyframeRule:
         """Which ticks are frames (a one-line :class:`~sgtool.errors.SgtoolError` when

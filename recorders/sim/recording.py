@@ -319,11 +319,14 @@ def record_house(house: HouseSpec | str | os.PathLike[str], output: str | os.Pat
     advances by one per frame; ``observers`` also watch the simulation (after the
     recorder, so they see each frame once it is written). Needs PyBullet (``pip install
     'sgtool[sim]'``)."""
+    from sgtool.arg_checks import of_type
     from sgtool.arg_checks import progress as check_progress
     from sgtool.errors import SgtoolError
     from sgtool.extras import require
 
     progress = check_progress("progress", progress)
+    if options is not None:
+        of_type("options", options, RecordOptions, "a RecordOptions")
     require("pybullet", api="sgtool.record_house")  # one line on a core install
     if isinstance(house, str | os.PathLike):  # a house spec file, as run_one takes
         from sgtool.house.io import load_house

@@ -40,6 +40,7 @@ from scipy import ndimage
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components, dijkstra
 
+from sgtool.arg_checks import of_type
 from sgtool.house.spec import HouseSpec, enclosed
 from sgtool.mapping.occupancy import (
     OccupancyMap,
@@ -97,6 +98,7 @@ class SymbolicHouse:
     """
 
     def __init__(self, spec: HouseSpec, resolution: float = 0.05, robot_radius: float = 0.2):
+        of_type("spec", spec, HouseSpec, "a HouseSpec (sgtool.load_house(path) reads a file)")
         self.spec = spec
         self.resolution = resolution
         self.robot_radius = robot_radius

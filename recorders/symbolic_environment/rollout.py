@@ -165,9 +165,20 @@ def run_one(house: HouseSpec | SymbolicHouse | str | os.PathLike[str], planner: 
     :class:`~sgtool.planning.timing.PlannerContractError` naming it; a text target that
     names no node of the graph is an invalid action and spends a step, as in the bench).
     """
+    from sgtool.arg_checks import of_type, whole
     from sgtool.planning.plugins import held_to_contract
     from sgtool.planning.registry import make_planner
 
+    of_type("house", house, (HouseSpec, SymbolicHouse, str, os.PathLike),
+            "a HouseSpec, a SymbolicHouse or a house spec file's path")
+    of_type("query", query, str, "the target's category name (text)")
+    for arg, value in (("max_steps", max_steps), ("seed", seed),
+                       ("episode_index", episode_index)):
+        whole(arg, value)
+    if start is not None:
+        of_type("start", start, (str, StartPose), "a region id or a StartPose")
+    if log is not None:
+        of_type("log", log, LogWriter, "an open sgtool.LogWriter")
     if max_steps < 1:
         raise RunOneError(f"max_steps {max_steps}: must be >= 1")
     if isinstance(house, str | os.PathLike):

@@ -251,3 +251,52 @@ def test_generated_house_seeds_stay_ones_run_takes_again() -> None:
                            r"--houses 2: the houses' seeds must lie in 0\.\.4611686018427387904"):
             config(planners=("greedy",), houses=2, house_seed=top).check()
         config(planners=("greedy",), houses=1, house_seed=top).check()
+
+
+def test_a_third_review_s_wrong_arguments_are_one_line(tmp_path) -> None:
+    """Wrong types and swapped arguments at the API's entry points are one SgtoolError
+    line naming the parameter (a review of the documented API hit each of these)."""
+    from support.symbolic_fixtures import three_rooms
+
+    house = sgtool.load_house(three_rooms())
+    cases = [
+        (lambda: sgtool.BenchConfig(planners=("random",), distance_budget=0).check(),
+         r"^--distance-budget \(distance_budget=\): must be > 0"),
+        (lambda: sgtool.BenchConfig(planners=("random",), step_budget=float("nan")).check(),
+         "^step_budget=nan: a finite number"),
+        (lambda: sgtool.BenchConfig(planners=("random",), distance_budget="5k").check(),
+         "^distance_budget='5k': a finite number"),
+        (lambda: sgtool.BenchConfig(planners=("random",), house_seed="1").check(),
+         "^house_seed='1': a whole number"),
+        (lambda: sgtool.ClosedLoopBenchConfig("greedy", step_budget=-1).check(),
+         r"^--step-budget \(step_budget=\): must be > 0"),
+        (lambda: sgtool.ClosedLoopBenchConfig("greedy", options={"max_steps": 3}).check(),
+         "^options: a ClosedLoopOptions, got dict"),
+        (lambda: sgtool.ClosedLoopOptions(max_steps="3"), "^max_steps='3': a whole number"),
+        (lambda: sgtool.ClosedLoopOptions(camera=(96, 72)), r"^camera=\(96, 72\): a CameraConfig"),
+        (lambda: sgtool.run_one(house, "greedy", 3), "^query: the target's category name"),
+        (lambda: sgtool.run_one(house, "greedy", "sweater", max_steps="5"),
+         "^max_steps='5': a whole number"),
+        (lambda: sgtool.run_one(house, "greedy", "sweater", start=3), "^start: a region id"),
+        (lambda: sgtool.run_one(house, "greedy", "sweater", log="ep.mcap"),
+         "^log: an open sgtool.LogWriter"),
+        (lambda: sgtool.SymbolicHouse("h.json"), "^spec: a HouseSpec"),
+        (lambda: sgtool.load_house(3), "^source: a house spec file's path"),
+        (lambda: sgtool.save_house(tmp_path / "h.json", house), "^spec: a HouseSpec"),
+        (lambda: sgtool.write_results(tmp_path / "r.jsonl", []), "^path: a file's path"),
+        (lambda: sgtool.write_results(str(tmp_path / "r.jsonl"), str(tmp_path / "x")),
+         "^results: give the EpisodeResults, then the path"),
+        (lambda: sgtool.list_episodes(house, n=-1), "^n=-1: a whole number >= 0"),
+        (lambda: sgtool.LogReader(3), "^path: a log's path, got int"),
+        (lambda: sgtool.actionable(None), "^graph: a SceneGraph, got NoneType"),
+        (lambda: sgtool.run_closed_loop(house, sgtool.list_episodes(house, n=1)[0],
+                                        sgtool.make_planner("greedy"), tmp_path / "e.mcap",
+                                        {"max_steps": 3}),
+         "^options: a ClosedLoopOptions, got dict"),
+        (lambda: sgtool.record_house(house, tmp_path / "r.mcap", {"fps": 4}),
+         "^options: a RecordOptions, got dict"),
+    ]
+    for call, message in cases:
+        with pytest.raises(sgtool.SgtoolError, match=message):
+            call()
+    assert not list(tmp_path.iterdir())

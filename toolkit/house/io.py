@@ -13,6 +13,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from sgtool.arg_checks import of_type
 from sgtool.errors import SpecError
 from sgtool.files import atomic_write
 from sgtool.house.parse import json_object_pairs, parse_house
@@ -23,6 +24,8 @@ MAX_FILE_BYTES = 64 * 1024 * 1024  # a house at every limit of SpecLimits is far
 
 def save_house(spec: HouseSpec, path: str | os.PathLike[str]) -> Path:
     """Write the canonical JSON atomically (temp file beside ``path``, then rename)."""
+    of_type("spec", spec, HouseSpec, "a HouseSpec (save_house(spec, path): the house first)")
+    of_type("path", path, (str, os.PathLike), "a file's path")
     return atomic_write(path, spec.to_json())
 
 
@@ -36,6 +39,8 @@ def load_house(source: str | os.PathLike[str] | Mapping[str, Any],
     with the file and the offending field (``h.json: furniture[3].size: every side must
     be > 0``).
     """
+    of_type("source", source, (str, os.PathLike, Mapping),
+            "a house spec file's path or a parsed JSON object")
     if isinstance(source, Mapping):
         return parse_house(source, limits)
     if isinstance(source, str) and source.lstrip().startswith("{") \

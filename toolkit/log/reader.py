@@ -28,6 +28,7 @@ from mcap.reader import SeekingReader
 from mcap.records import Attachment, Channel, Message, MessageIndex, Schema
 from mcap.summary import Summary
 
+from sgtool.arg_checks import of_type
 from sgtool.errors import (
     LogFormatError,
     MissingChannelError,
@@ -104,7 +105,7 @@ class LogReader:
 
     def __init__(self, path: str | os.PathLike[str], *, check_version: bool = True,
                  verify: bool = False) -> None:
-        self.path = Path(path)
+        self.path = Path(of_type("path", path, (str, os.PathLike), "a log's path"))
         self.verify = verify
         if not os.fspath(path) or not self.path.exists():  # ("" would be the folder ".")
             raise LogFormatError(f"{os.fspath(path) or 'an empty path'}: no such file")

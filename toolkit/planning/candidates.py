@@ -39,6 +39,7 @@ from typing import Literal
 
 import numpy as np
 
+from sgtool.arg_checks import of_type
 from sgtool.planning.base import Skill
 from sgtool.scenegraph.graph import (
     DoorNode,
@@ -419,6 +420,7 @@ def actionable(graph: SceneGraph) -> list[Candidate]:
     """The nodes a planner may act on (SCOUT's N_a; the module doc's table says which
     skill acts on which node), each a :class:`Candidate` with its travel distance, in
     natural id order; unreachable nodes are left out."""
+    of_type("graph", graph, SceneGraph, "a SceneGraph")
     if not graph.distances:
         return _actionable_without_distances(graph)
     return actionable_columns(graph).candidates()
@@ -448,6 +450,8 @@ def _actionable_without_distances(graph: SceneGraph) -> list[Candidate]:
 
 def find_target(graph: SceneGraph, query: str) -> ObjectNode | None:
     """The nearest observed object of the query category (exact name match), or None."""
+    of_type("graph", graph, SceneGraph, "a SceneGraph")
+    of_type("query", query, str, "the target's category name (text)")
     best: tuple[float, str, ObjectNode] | None = None
     for o in _of_query(graph.objects, query):
         d = distance_to(graph, o)
