@@ -232,9 +232,12 @@ def _planner(args: RunArgs) -> tuple[str, dict[str, Any]]:
                               "--llm-replay transcript (a run's transcript is emptied when "
                               "it starts)")
         options["transcript"] = args.llm_transcript
-    t = options.get("transcript")
+    t, r = options.get("transcript"), options.get("replay")
     if t and Path(str(t)).resolve() == Path(args.output).resolve():
         raise SgtoolError(f"transcript {t}: it is the output log (-o)")
+    if t and r and Path(str(t)).resolve() == Path(str(r)).resolve():
+        raise SgtoolError(f"transcript {t}: it is the replay transcript (a run's transcript "
+                          "is emptied when it starts)")
     return name, options
 
 

@@ -16,6 +16,7 @@ import contextlib
 import json
 import logging
 import os
+import stat
 import time
 from collections import deque
 from collections.abc import Iterator, Sequence
@@ -32,6 +33,7 @@ log = logging.getLogger(__name__)
 
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
+FIRST_LINE_MAX = 64 << 20  # bytes of a transcript's first line read to judge it
 
 
 class TranscriptError(SgtoolError):
@@ -87,28 +89,35 @@ def transcript_run(path: str | Path | None) -> Iterator[None]:
 
 
 def not_a_transcript(path: Path) -> None:
-    """Refuse (one line) to write a transcript over a file that is not one: an MCAP log,
-    or a file whose first line is not a JSON object."""
+    """Refuse (one line) to write a transcript over a regular file that is not one: an
+    MCAP log, or a file whose first non-blank line is no exchange record (a JSON object
+    with ``model`` and ``messages``; a file of blank lines is empty). A missing file, or
+    one that is no regular file (a FIFO, ``/dev/stdout``), is never read here."""
     try:
+        if not stat.S_ISREG(path.stat().st_mode):
+            return
         with open(path, "rb") as fh:
-            head = fh.read(1 << 16)
+            if fh.read(len(MCAP_MAGIC)) == MCAP_MAGIC:
+                raise TranscriptError(f"transcript {path}: an MCAP log, not a JSONL "
+                                      "transcript; not writing over it")
+            fh.seek(0)
+            first = b""
+            while not first and (line := fh.readline(FIRST_LINE_MAX)):
+                first = line.strip()
     except FileNotFoundError:
         return
     except OSError as e:
         raise output_error(e, path) from None
-    if head.startswith(MCAP_MAGIC):
-        raise TranscriptError(f"transcript {path}: an MCAP log, not a JSONL transcript; "
-                              "not writing over it")
-    first = head.split(b"\n", 1)[0].strip()
     if not first:
         return
     try:
-        ok = isinstance(json.loads(first), dict)
-    except ValueError:
+        d = json.loads(first)
+        ok = isinstance(d, dict) and "model" in d and "messages" in d
+    except ValueError:  # (a first line cut at FIRST_LINE_MAX is no transcript's either)
         ok = False
     if not ok:
-        raise TranscriptError(f"transcript {path}: exists and is not a JSONL transcript; "
-                              "not writing over it")
+        raise TranscriptError(f"transcript {path}: exists and is not a JSONL transcript "
+                              "of LLM exchanges; not writing over it")
 
 
 class TranscriptWriter:

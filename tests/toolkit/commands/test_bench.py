@@ -316,7 +316,7 @@ def test_moma_llm_transcript_then_replay(tmp_path):
     # a run's transcript holds that run only (an earlier run's answers would be served
     # first by a replay of it), and cannot be the transcript it replays
     again = tmp_path / "again.jsonl"
-    again.write_text('{"an": "earlier run"}\n')
+    again.write_text('{"messages": [], "model": "an earlier run"}\n')
     r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
                                  "--episodes", "2", "--seeds", "1", "--no-progress",
                                  "--llm-replay", str(transcript), "--llm-transcript",

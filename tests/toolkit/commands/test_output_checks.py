@@ -111,3 +111,20 @@ def test_a_run_s_transcript_is_not_its_output_log(tmp_path, given) -> None:
     assert r.exit_code == 2 and f"transcript {out}: it is the output log (-o)" in r.output, \
         r.output
     assert sorted(p.name for p in tmp_path.iterdir()) == ["answers.jsonl"]
+
+
+@pytest.mark.parametrize("given", [
+    ["--llm-replay", "{a}", "-O", "moma-llm.transcript={a}"],
+    ["-O", "moma-llm.replay={a}", "--llm-transcript", "{a}"],
+])
+def test_a_run_s_transcript_is_not_the_transcript_it_replays(tmp_path, given) -> None:
+    """The replayed transcript given again as the transcript (either through -O) would be
+    emptied before it is read: one line, and the file keeps its bytes."""
+    answers = tmp_path / "answers.jsonl"
+    answers.write_text('{"messages": [], "model": "m"}\n')
+    r = CliRunner().invoke(cli, ["run", "--planner", "moma-llm", "--frames", "1", "-o",
+                                 str(tmp_path / "ep.mcap"),
+                                 *(g.format(a=answers) for g in given)])
+    assert r.exit_code == 2 and "it is the replay transcript" in r.output, r.output
+    assert answers.read_text() == '{"messages": [], "model": "m"}\n'
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["answers.jsonl"]
