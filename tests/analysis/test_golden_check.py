@@ -580,13 +580,18 @@ def test_a_report_is_never_written_over_a_pinned_log_or_a_pin_file(pinned, tmp_p
     before = {p.name: p.read_bytes() for p in pinned.iterdir()}
     notes = tmp_path / "notes.txt"
     notes.write_text("mine\n")
+    pom = tmp_path / "pom.xml"  # XML, and another tool's JUnit file: not this check's
+    pom.write_text('<?xml version="1.0"?>\n<project/>\n')
+    other = tmp_path / "pytest.xml"
+    other.write_text('<?xml version="1.0"?><testsuites><testsuite name="pytest"/></testsuites>')
     for option, target in (("--junit", pinned / "small.mcap"),
-                           ("--report", pinned / "expected.json"), ("--junit", notes)):
+                           ("--report", pinned / "expected.json"), ("--junit", notes),
+                           ("--junit", pom), ("--junit", other)):
         code, _, err = sgtool(capsys, "golden", "check", "--dir", pinned, option, target)
         assert code == 2 and f"{option} {target}: exists and is not a golden check report" \
             in err, err
     assert {p.name: p.read_bytes() for p in pinned.iterdir()} == before
-    assert notes.read_text() == "mine\n"
+    assert notes.read_text() == "mine\n" and pom.read_text().endswith("<project/>\n")
     md, xml = tmp_path / "r.md", tmp_path / "r.xml"
     for _ in range(2):  # a report of the last check is replaced
         code, _, err = sgtool(capsys, "golden", "check", "--dir", pinned, "--report", md,
