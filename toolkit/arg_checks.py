@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 import types
 import typing
 from typing import Any
@@ -80,8 +81,8 @@ def typed_fields(obj: Any) -> None:
     are the class's own to check."""
     try:
         hints = typing.get_type_hints(type(obj))
-    except (NameError, TypeError):  # an annotation only a type checker resolves
-        return
+    except (NameError, TypeError):  # an annotation only a type checker resolves: the others
+        hints = _field_hints(obj)
     for f in dataclasses.fields(obj):
         t = hints.get(f.name)
         union = typing.get_origin(t) in (typing.Union, types.UnionType)
@@ -97,6 +98,29 @@ def typed_fields(obj: Any) -> None:
         elif kind is float:
             number(f.name, value, optional=optional)
         elif isinstance(kind, type) and typing.get_origin(kind) is None and \
-                not isinstance(value, kind):
+                not _instance(value, kind):
             raise SgtoolError(f"{f.name}={value!r}: a {kind.__name__}"
                               + (", or None" if optional else ""))
+
+
+def _instance(value: Any, kind: type) -> bool:
+    """``isinstance``, true for what it cannot check (``Any``, a Protocol that is not
+    runtime-checkable: the class's own to check)."""
+    try:
+        return isinstance(value, kind)
+    except TypeError:
+        return True
+
+
+def _field_hints(obj: Any) -> dict[str, Any]:
+    """The annotations of ``obj``'s fields that resolve one by one in its module (a class
+    defined in a function, an import only a type checker sees: those fields are left)."""
+    module = sys.modules.get(type(obj).__module__)
+    names = dict(vars(module)) if module is not None else {}
+    out = {}
+    for f in dataclasses.fields(obj):
+        try:
+            out[f.name] = eval(f.type, names) if isinstance(f.type, str) else f.type  # noqa: S307
+        except Exception:  # noqa: BLE001 - an annotation that does not resolve: not checked
+            continue
+    return out

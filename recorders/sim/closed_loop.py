@@ -451,13 +451,19 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
     of_type("house", house, HouseSpec, "a HouseSpec (sgtool.load_house(path))")
     of_type("episode", episode, Episode, "an Episode (sgtool.pick_episode(house))")
     function("on_decision", on_decision)
-    require("pybullet", api="sgtool.run_closed_loop")  # one line on a core install
     if options is not None:
         of_type("options", options, ClosedLoopOptions, "a ClosedLoopOptions")
+    if Path(output).suffix != ".mcap":
+        raise SgtoolError(f"{output}: the output is an MCAP log; name it *.mcap")
+    require("pybullet", api="sgtool.run_closed_loop")  # one line on a core install
     planner = held_to_contract(planner)  # a user's planner object: one line for its faults
     opts = options or ClosedLoopOptions()
     recorded = {"planner_options": recorded_options(planner_options)} if planner_options \
         else {}
+    for k, v in recorded.get("planner_options", {}).items():  # logged: found now, not at
+        if isinstance(v, float) and not math.isfinite(v):  # the episode's end
+            raise SgtoolError(f"planner option {k}={v}: a finite number (the episode's log "
+                              "records it)")
     if opts.max_steps < 1:
         raise SgtoolError(f"--max-steps {opts.max_steps}: must be >= 1")
     if opts.frames is not None and opts.frames < 1:

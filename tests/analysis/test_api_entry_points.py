@@ -3,7 +3,9 @@ name alone is a list of one, a set is refused, and every mistake is one SgtoolEr
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, Protocol
 
 import pytest
 
@@ -300,3 +302,49 @@ def test_a_third_review_s_wrong_arguments_are_one_line(tmp_path) -> None:
         with pytest.raises(sgtool.SgtoolError, match=message):
             call()
     assert not list(tmp_path.iterdir())
+
+
+def test_a_closed_loop_run_refuses_what_it_could_not_log_before_it_runs(tmp_path) -> None:
+    """An output not named *.mcap, and a planner option the log cannot hold (infinity), are
+    one line before the simulation starts, and nothing is written."""
+    pytest.importorskip("pybullet")
+    from support.symbolic_fixtures import three_rooms
+
+    house = sgtool.load_house(three_rooms())
+    ep = sgtool.list_episodes(house, n=1)[0]
+    with pytest.raises(sgtool.SgtoolError, match="e.txt: the output is an MCAP log"):
+        sgtool.run_closed_loop(house, ep, sgtool.make_planner("greedy"), tmp_path / "e.txt")
+    with pytest.raises(sgtool.SgtoolError, match="^planner option radius=inf: a finite"):
+        sgtool.run_closed_loop(house, ep, sgtool.make_planner("greedy"), tmp_path / "e.mcap",
+                               planner_options={"radius": float("inf")})
+    assert not list(tmp_path.iterdir())
+
+
+class _Shape(Protocol):
+    def area(self) -> float: ...
+
+
+@dataclass
+class _Mine:
+    anything: Any = None
+    shape: _Shape | None = None
+    count: int = 1
+
+
+def test_typed_fields_leaves_what_isinstance_cannot_check() -> None:
+    """A field annotated Any (or a Protocol that is not runtime-checkable) is the class's
+    own to check: typed_fields passes it, and still checks its other fields, also of a
+    class whose other annotations do not resolve."""
+    from sgtool.arg_checks import typed_fields
+
+    typed_fields(_Mine(anything=object(), shape="not checked"))
+    with pytest.raises(sgtool.SgtoolError, match="^count='2': a whole number"):
+        typed_fields(_Mine(count="2"))
+
+    @dataclass
+    class Local:  # "_Local" does not resolve in the module: count is still checked
+        inner: _Local | None = None  # noqa: F821
+        count: int = 1
+
+    with pytest.raises(sgtool.SgtoolError, match="^count=2.5: a whole number"):
+        typed_fields(Local(count=2.5))
