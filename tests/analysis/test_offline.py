@@ -242,28 +242,16 @@ def test_a_closing_record_without_steps_is_no_cut_short_episode(tmp_path):
     assert notes == [] and e.closed and r.success
 
 
-class _Mine:
-    """A user's planner object (not a plug-in name) with one mistake, chosen by ``how``."""
+def _mistake(how: str):
+    """A decision with one mistake: it raises, returns None or names no skill."""
+    from sgtool.planning.base import Action
 
-    name = "mine"
-
-    def __init__(self, how: str) -> None:
-        self.how = how
-
-    def reset(self, query: str, seed: int = 0) -> None:
-        pass
-
-    def decide(self, graph):
-        from sgtool.planning.base import Action
-
-        if self.how == "raises":
+    def decide(graph):
+        if how == "raises":
             raise RuntimeError("bug in my planner")
-        if self.how == "none":
-            return None
-        return Action("fly", None)
+        return None if how == "none" else Action("fly", None)
 
-    def feedback(self, fb) -> None:
-        pass
+    return decide
 
 
 @pytest.mark.parametrize("how, why", [
@@ -275,8 +263,11 @@ def test_a_planner_object_is_held_to_the_plug_in_contract(greedy_log, how, why):
     """replay_decisions holds a user's object to what run_one holds it to: a wrong return,
     an unknown skill or an exception is one line naming the planner, not a traceback or
     a disagreement scored."""
+    from support.scripted_planner import Scripted
+
     from sgtool.errors import SgtoolError
 
-    eps = read_log_episodes(greedy_log[0])
+    mine = Scripted([_mistake(how)])  # a user's planner object, not a plug-in name
+    mine.name = "mine"
     with pytest.raises(SgtoolError, match=f"planner 'mine': {why}"):
-        replay_decisions(_Mine(how), eps)
+        replay_decisions(mine, read_log_episodes(greedy_log[0]))
