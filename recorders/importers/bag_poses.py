@@ -84,6 +84,16 @@ def pose_source_of(path: Path, idx: BagIndex, opts: BagOptions) -> PoseSource:
                 f"tree (frames: {frames_list}); give --tf-frames WORLD:CAMERA"
             )
         world = tree.root_of(camera)
+        if world == camera:  # the tree is stored from the camera out: no world above it
+            others = world_candidates(tree, camera)
+            raise SgtoolError(
+                f"{path}: the depth images' frame {camera!r} is the root of its tf tree "
+                "(its transforms are stored from the camera to the world), so no pose of "
+                "the camera can be read from it by default; give --tf-frames WORLD:CAMERA"
+                + (f", e.g. --tf-frames {others[0]}:{camera}" if others else ""))
+    if world == camera:
+        raise SgtoolError(f"{path}: --tf-frames {world}:{camera}: the world and the camera "
+                          "are one frame (every pose would be the identity)")
     for f in (world, camera):
         if f not in tree.frames():
             raise SgtoolError(
@@ -96,3 +106,14 @@ def pose_source_of(path: Path, idx: BagIndex, opts: BagOptions) -> PoseSource:
             f"(roots: {', '.join(tree.roots())}); links: " + _links(tree)
         )
     return PoseSource(world, camera, f"tf {world} -> {camera}", tree=tree)
+
+
+WORLD_NAMES = ("world", "map", "odom")  # frame names a world frame goes by, likeliest first
+
+
+def world_candidates(tree: TfTree, camera: str) -> list[str]:
+    """The frames linked with ``camera`` that could be its world: those named like one
+    (:data:`WORLD_NAMES`) first, then the others in name order."""
+    linked = [f for f in tree.frames() if f != camera and tree.path(f, camera) is not None]
+    named = [f for n in WORLD_NAMES for f in linked if f.lstrip("/") == n]
+    return named + [f for f in linked if f not in named]

@@ -184,12 +184,28 @@ def peek_tf(reader: Any, topics: list[B.TopicInfo], max_messages: int = 500) -> 
 
 
 def tf_suggestions(tree: TfTree) -> list[str]:
-    """``--tf-frames ROOT:LEAF`` for every leaf frame of the tree."""
+    """``--tf-frames WORLD:CAMERA`` for the frames that look like cameras (any frame with
+    "optical", else "camera" in its name; else every leaf), each with its root as the
+    world, or for a camera at the root of its tree (stored from the camera out) the frame
+    most like a world it links to; a leaf named like a world (world, map, odom) under a
+    root that is not is that root's world (the tree stored from the camera out)."""
+    from sgtool.recorders.importers.bag_poses import WORLD_NAMES, world_candidates
+
     parents = {link.parent for link in tree.links.values()}
     leaves = sorted(f for f in tree.links if f not in parents)
-    cams = [f for f in leaves if "optical" in f] or [f for f in leaves if "camera" in f]
+    frames = tree.frames()
+    cams = [f for f in frames if "optical" in f] or [f for f in frames if "camera" in f]
     picks = cams or leaves
-    out = [f"--tf-frames {tree.root_of(f)}:{f}" for f in picks[:6]]
+    out = []
+    for f in picks[:6]:
+        world = tree.root_of(f)
+        if world == f:
+            world = next(iter(world_candidates(tree, f)), "")
+        elif not cams and f.lstrip("/") in WORLD_NAMES and \
+                world.lstrip("/") not in WORLD_NAMES:
+            world, f = f, world
+        if world:
+            out.append(f"--tf-frames {world}:{f}")
     if len(picks) > 6:
         out.append(f"... ({len(picks) - 6} more)")
     return out

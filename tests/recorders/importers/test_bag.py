@@ -611,3 +611,43 @@ def test_a_cut_ros2_mcap_points_to_doctor(tmp_path):
     r = CliRunner().invoke(cli, ["import", "bag", str(bag), "--list"])
     assert r.exit_code == 2 and r.output.count("\n") == 1, r.output
     assert f"`sgtool doctor {part} --recover OUT.mcap` copies what is readable" in r.output
+
+
+@pytest.mark.parametrize("parent, child, image_frame", [("cam", "world", "cam"),
+                                                      ("world", "cam", "world")])
+def test_a_camera_at_the_root_of_its_tf_tree_is_refused_naming_the_flag(tmp_path, parent,
+                                                                         child, image_frame):
+    """A tf tree stored from the camera out (cam -> world, legal tf), or images whose frame
+    is the tree's root, gave every frame the identity pose and an import that succeeded.
+    Now one line names --tf-frames with the world it would take; with it the import reads
+    the camera's poses through the inverted links."""
+    src = write_sgtool_log(tmp_path / "src.mcap", n=6)
+    bag = bag_path(tmp_path, "ros2-sqlite3")
+    with LogReader(src) as r, BagWriter(bag, "ros2-sqlite3") as w:
+        frames = list(r.frames())
+        for f in frames:
+            t = f.time_ns
+            pose = f.pose if parent == "world" else np.linalg.inv(f.pose)
+            w.write("/tf", "tf2_msgs/msg/TFMessage", t,
+                    w.tf(t, [w.transform_stamped(t, parent, child, pose)]))
+            w.write(TOPICS["depth"], "sensor_msgs/msg/Image", t,
+                    w.image(t, image_frame, (f.depth * 1000).round().astype(np.uint16),
+                            "16UC1"))
+    k = frames[0].intrinsics
+    from sgtool.recorders.importers.textformats import PinholeParams
+
+    opts = dict(depth=TOPICS["depth"], intrinsics=PinholeParams(k.fx, k.fy, k.cx, k.cy),
+                **KEEP_WORLD)
+    out = tmp_path / "o.mcap"
+    other = "world" if image_frame == "cam" else "cam"
+    with pytest.raises(SgtoolError, match=f"the depth images' frame '{image_frame}' is the "
+                       f"root of its tf tree.*e.g. --tf-frames {other}:{image_frame}"):
+        import_bag(bag, out, BagOptions(**opts))
+    assert not out.exists()
+    rep = import_bag(bag, out, BagOptions(tf_frames=("world", "cam"), **opts))
+    assert rep.frames == 6
+    with LogReader(out) as r:
+        for g, f in zip([g.pose for g in r.frames()], frames, strict=True):
+            assert np.allclose(g, f.pose, atol=1e-6)
+    r = CliRunner().invoke(cli, ["import", "bag", str(bag), "--list"])
+    assert "camera / trajectory frames: --tf-frames world:cam" in r.output, r.output
