@@ -5,7 +5,8 @@ argument is a file (kept as given), a folder (its files with one of the wanted s
 sorted by name; with ``recursive``, as ``sgtool eval`` reads the ``PLANNER/HOUSE/`` folders
 that ``bench --log-dir`` and ``run-bench`` write, those of its subfolders too, sorted by
 path, hidden folders left out) or a glob pattern (``runs/*/log.mcap``, quoted so that the
-shell leaves it alone; matches sorted). Writers' partial files (``*.partial``) are never
+shell leaves it alone; ``**`` matches any depth of folders, as in a shell with globstar;
+matches sorted). Writers' partial files (``*.partial``) are never
 inputs. A file named twice is kept once, at its first place.
 """
 
@@ -39,7 +40,8 @@ def expand_inputs(items: Sequence[str | os.PathLike[str]], suffixes: Sequence[st
                 raise SgtoolError(f"{p}: no {what} there ({' or '.join(suffixes)} files"
                                   f"{', in it or its subfolders' if recursive else ''})")
         elif not p.exists() and _GLOB_CHARS & set(text):
-            found = sorted(Path(m) for m in glob.glob(text) if Path(m).is_file())
+            found = sorted(Path(m) for m in glob.glob(text, recursive=True)
+                           if Path(m).is_file())
             found = [f for f in found if not f.name.endswith(".partial")]
             if not found:
                 raise SgtoolError(f"{text}: the pattern matches no file")

@@ -189,3 +189,15 @@ def test_an_output_of_another_input_with_that_name_is_replayed_again(tmp_path):
     fresh = tmp_path / "fresh.mcap"
     replay(src, fresh, OPTS)
     assert (out / "run.mcap").read_bytes() == fresh.read_bytes()
+
+
+def test_a_double_star_pattern_matches_any_depth(tmp_path):
+    """A quoted ``**`` pattern finds the logs of every subfolder (run-bench writes
+    logs/NOISE/PLANNER/HOUSE/), as a shell with globstar does, instead of one level."""
+    for sub in ("a", "a/b/c", "a/b"):
+        (tmp_path / sub).mkdir(parents=True, exist_ok=True)
+        (tmp_path / sub / "x.mcap").write_bytes(b"")
+    got = expand_inputs([str(tmp_path / "**" / "*.mcap")], (".mcap",))
+    assert got == sorted(tmp_path / s / "x.mcap" for s in ("a", "a/b", "a/b/c"))
+    assert expand_inputs([str(tmp_path / "a" / "b" / "**" / "*.mcap")], (".mcap",)) == \
+        sorted([tmp_path / "a/b/c/x.mcap", tmp_path / "a/b/x.mcap"])
