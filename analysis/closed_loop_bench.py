@@ -573,21 +573,6 @@ def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]
     return paths
 
 
-def load_symbolic(path: str | Path) -> tuple[EpisodeResult, ...]:
-    """The episodes of a symbolic bench (``sgtool bench``): its output folder or its
-    ``episodes.jsonl``; a one-line :class:`~sgtool.errors.SgtoolError` when there are none."""
-    from sgtool.results import read_jsonl
-
-    p = Path(path)
-    file = p / "episodes.jsonl" if p.is_dir() else p
-    if not file.is_file():
-        raise SgtoolError(f"--symbolic {path}: no episodes.jsonl of a `sgtool bench` there")
-    results = tuple(read_jsonl(file))
-    if not results:
-        raise SgtoolError(f"--symbolic {path}: holds no episode")
-    return results
-
-
 def run_symbolic(cfg: ClosedLoopBenchConfig) -> tuple[EpisodeResult, ...]:
     """The symbolic bench (one seed) on the run's houses and episodes, with its planners,
     step budget and success rule: the symbolic order on the same episodes."""

@@ -33,6 +33,8 @@ from sgtool.analysis.closed_loop_bench import (
     log_source,
 )
 from sgtool.analysis.executor import Executor, FolderMark
+from sgtool.errors import SgtoolError
+from sgtool.results import EpisodeResult
 
 Echo = Callable[[str], None]
 RunFn = Callable[[RunTask], RunRow]
@@ -327,3 +329,22 @@ def _with_symbolic(request: RunBenchRequest, res: Any) -> Any:
         return replace(res, symbolic=request.symbolic,
                        symbolic_source=f"--symbolic {request.symbolic_dir}")
     return res
+
+
+def load_symbolic(path: str | Path) -> tuple[EpisodeResult, ...]:
+    """The episodes of a symbolic bench (``sgtool bench``): its output folder or its
+    ``episodes.jsonl``; a one-line :class:`~sgtool.errors.SgtoolError` when there are none
+    or they are a closed loop's (a run-bench folder: its own order, tau 1)."""
+    from sgtool.results import read_jsonl
+
+    p = Path(path)
+    file = p / "episodes.jsonl" if p.is_dir() else p
+    if not file.is_file():
+        raise SgtoolError(f"--symbolic {path}: no episodes.jsonl of a `sgtool bench` there")
+    results = tuple(read_jsonl(file))
+    if not results:
+        raise SgtoolError(f"--symbolic {path}: holds no episode")
+    if other := next((r.source for r in results if r.source != "symbolic"), None):
+        raise SgtoolError(f"--symbolic {path}: closed-loop episodes (source {other}), a "
+                          "`sgtool run-bench` folder; give a `sgtool bench` folder")
+    return results

@@ -4,6 +4,7 @@ agreement with a symbolic order, the interval tables over houses and per house."
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import pytest
 
@@ -116,3 +117,23 @@ def test_within_a_budget_the_slow_planner_fails() -> None:
     assert pair["sr_diff_within"] == [{"value": 1.0, "low": 1.0, "high": 1.0},
                                       {"value": 0.0, "low": 0.0, "high": 0.0}]
     assert "| SR diff ≤ 50 f/room" in text and "+1.000 [+1.000, +1.000]" in text
+
+
+def test_symbolic_rows_must_come_from_a_symbolic_bench(tmp_path):
+    """--symbolic given a run-bench folder compared the closed loop with itself (tau 1): its
+    episodes are refused in one line naming their source; a bench's are read."""
+    from sgtool.analysis.closed_loop_bench_run import load_symbolic
+    from sgtool.errors import SgtoolError
+    from sgtool.results import write_jsonl
+
+    row = EpisodeResult(planner="scout", seed=0, house="h", episode=0, query="cup",
+                        success=True, steps=3, travelled_m=2.0, shortest_m=1.0)
+    (tmp_path / "bench").mkdir()
+    write_jsonl([row], tmp_path / "bench" / "episodes.jsonl")
+    assert load_symbolic(tmp_path / "bench") == (row,)
+    (tmp_path / "rb").mkdir()
+    write_jsonl([replace(row, source="logs/none/scout/h/ep-000.mcap")],
+                tmp_path / "rb" / "episodes.jsonl")
+    with pytest.raises(SgtoolError, match=r"^--symbolic .*rb: closed-loop episodes \(source "
+                       r"logs/none/scout/h/ep-000.mcap\), a `sgtool run-bench` folder"):
+        load_symbolic(tmp_path / "rb")

@@ -217,8 +217,7 @@ class RunBenchArgs:
 def _request(args: RunBenchArgs) -> RunBenchRequest:
     """The checks: the options and the output folder's mode, then the run's configuration
     (:meth:`ClosedLoopBenchConfig.check`) and the symbolic results to show beside it."""
-    from sgtool.analysis.closed_loop_bench import load_symbolic
-    from sgtool.analysis.closed_loop_bench_run import RunBenchRequest
+    from sgtool.analysis.closed_loop_bench_run import RunBenchRequest, load_symbolic
 
     _check_folder(args)
     cfg = _config(args)
