@@ -174,7 +174,12 @@ def _override(base: NoiseProfile, items: Iterable[tuple[str, Any]], where: str,
     if not kw:
         return base
     kw.setdefault("name", default_name)
-    return replace(base, **kw)
+    out = replace(base, **kw)
+    same = PROFILES.get(out.name)
+    if same is not None and replace(out, name=same.name) != same:  # labelled, pooled as it
+        raise SgtoolError(f"--noise {where}: named {out.name!r}, a built-in profile, with "
+                          "other faults; give it a name of its own")
+    return out
 
 
 class SensorFaults:

@@ -213,3 +213,18 @@ def test_a_file_named_like_a_profile_does_not_take_its_place(tmp_path: Path,
     assert parse_noise("./mild").holes == 0.0  # the file: no fault given
     with pytest.raises(SgtoolError, match="not valid JSON"):
         parse_noise("./none")
+
+
+def test_a_profile_of_ones_own_cannot_take_a_built_in_name(tmp_path: Path) -> None:
+    """A JSON profile named (or whose file is named) mild with other faults would be
+    labelled and pooled as mild: one line; the same faults under the name pass."""
+    for text, name in (('{"name": "mild", "holes": 0.3}', "x.json"),
+                       ('{"holes": 0.3}', "strong.json")):
+        f = tmp_path / name
+        f.write_text(text)
+        with pytest.raises(SgtoolError, match="a built-in profile, with other faults"):
+            parse_noise(str(f))
+    same = tmp_path / "same.json"
+    same.write_text(json.dumps({"profile": "mild", "name": "mild",
+                                "holes": PROFILES["mild"].holes}))
+    assert parse_noise(str(same)) == PROFILES["mild"]
