@@ -121,6 +121,11 @@ def open_bag(path: str | Path) -> Iterator[Any]:
                 _check_mcap_profile(path)
         elif path.is_dir() and not (path / "metadata.yaml").is_file():
             raise SgtoolError(f"{path}: a folder without metadata.yaml is not a ROS 2 bag")
+        elif path.is_dir() and path.suffix == ".bag":
+            # a ROS 2 bag folder named *.bag (`ros2 bag record -o run.bag`): the reader
+            # takes that name for a ROS 1 file, so give it another
+            target = Path(stack.enter_context(tempfile.TemporaryDirectory())) / "bag"
+            target.symlink_to(path.resolve(), target_is_directory=True)
         elif path.is_file() and path.suffix != ".bag":
             if not _starts_with(path, ROS1_MAGIC):
                 raise SgtoolError(

@@ -651,3 +651,22 @@ def test_a_camera_at_the_root_of_its_tf_tree_is_refused_naming_the_flag(tmp_path
             assert np.allclose(g, f.pose, atol=1e-6)
     r = CliRunner().invoke(cli, ["import", "bag", str(bag), "--list"])
     assert "camera / trajectory frames: --tf-frames world:cam" in r.output, r.output
+
+
+@pytest.mark.parametrize("fmt", ["ros2-sqlite3", "ros2-mcap"])
+def test_a_ros2_bag_folder_named_dot_bag_is_read_as_ros2(tmp_path, fmt):
+    """`ros2 bag record -o run.bag` makes a folder named run.bag, which the bag reader took
+    for a ROS 1 file (and, for MCAP storage, suggested recovering an undamaged file)."""
+    src = write_sgtool_log(tmp_path / "src.mcap", n=4)
+    bag = tmp_path / "run.bag"
+    write_log_as_bag(src, bag, fmt)
+    assert bag.is_dir()
+    r = CliRunner().invoke(cli, ["import", "bag", str(bag), "--list"])
+    assert r.exit_code == 0 and r.output.startswith(f"{bag} (ros2): topics"), r.output
+    out = tmp_path / "o.mcap"
+    r = CliRunner().invoke(cli, ["import", "bag", str(bag), "-o", str(out), "--quiet",
+                                 "--depth", TOPICS["depth"], "--info", TOPICS["info"],
+                                 "--up", "z", "--floor", "none"])
+    assert r.exit_code == 0, r.output
+    with LogReader(out) as log:
+        assert sum(1 for _ in log.frames()) == 4
