@@ -40,6 +40,7 @@ from sgtool.recorders.importers.textformats import (
     read_pose_file,
     read_tum_list,
     read_tum_trajectory,
+    untracked_pose,
 )
 
 LAYOUTS = ("tum", "7scenes", "open3d")
@@ -435,7 +436,7 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
         pose = None
         if ext_poses is not None:
             pose = ext_poses[n]
-        elif "pose" in files:
+        elif "pose" in files and not untracked_pose(files["pose"]):
             pose = read_pose_file(files["pose"])
         frames.append(FolderFrame(round(i * 1e9 / fps), files["depth"], files.get("color"), pose))
     intr = SEVEN_SCENES_INTRINSICS
@@ -446,8 +447,9 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
     dropped = 0
     if 0 < posed < len(frames):
         first = next(f.depth_path.name for f in frames if f.pose is None)
-        notes.append(f"{len(frames) - posed} of {len(frames)} frames have no pose.txt "
-                     f"(first: {first})" + ("" if keep_unposed else ": left out"))
+        notes.append(f"{len(frames) - posed} of {len(frames)} frames have no pose.txt, or "
+                     f"one of non-finite numbers (untracked) (first: {first})"
+                     + ("" if keep_unposed else ": left out"))
         if not keep_unposed:
             dropped = len(frames) - posed
             frames = [f for f in frames if f.pose is not None]

@@ -117,6 +117,16 @@ def pose_matrix(path: Path, rows: list[tuple[int, list[str]]]) -> np.ndarray:
     return m
 
 
+def untracked_pose(path: Path) -> bool:
+    """A pose file of numbers some of which are not finite: a frame its tracker lost
+    (ScanNet writes ``-inf`` rows), no pose rather than a damaged file."""
+    try:
+        vals = [float(x) for x in path.read_text(encoding="utf-8").split()]
+    except (OSError, UnicodeDecodeError, ValueError):
+        return False
+    return bool(vals) and not all(math.isfinite(v) for v in vals)
+
+
 def read_pose_file(path: Path) -> np.ndarray:
     """A 4x4 camera-to-world pose as text (7-Scenes ``frame-XXXXXX.pose.txt``), checked
     rigid."""

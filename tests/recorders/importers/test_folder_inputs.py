@@ -436,10 +436,26 @@ def test_seven_scenes_frames_without_a_pose_are_named_and_dropped_or_estimated(t
     seq = read_sequence(root)
     assert [f.depth_path.name[:12] for f in seq.frames] == [
         "frame-000000", "frame-000001", "frame-000003"]
-    assert seq.dropped == 1 and "1 of 4 frames have no pose.txt (first: " \
-        "frame-000002.depth.png): left out" in seq.notes
+    assert seq.dropped == 1 and "1 of 4 frames have no pose.txt, or one of non-finite " \
+        "numbers (untracked) (first: frame-000002.depth.png): left out" in seq.notes
     kept = read_sequence(root, keep_unposed=True)  # --estimate-poses
     assert len(kept.frames) == 4 and kept.dropped == 0 and kept.frames[2].pose is None
+
+
+def test_a_seven_scenes_pose_of_non_finite_numbers_is_an_untracked_frame(tmp_path):
+    """ScanNet-style -inf rows mark a frame the tracker lost: it has no pose (left out, or
+    estimated with --estimate-poses), rather than stopping the import."""
+    root = seven_folder(tmp_path / "s", n=4)
+    (root / "frame-000001.pose.txt").write_text("-inf -inf -inf -inf\n" * 4)
+    seq = read_sequence(root)
+    assert [f.depth_path.name[:12] for f in seq.frames] == [
+        "frame-000000", "frame-000002", "frame-000003"]
+    assert seq.dropped == 1
+    kept = read_sequence(root, keep_unposed=True)
+    assert len(kept.frames) == 4 and kept.frames[1].pose is None
+    (root / "frame-000002.pose.txt").write_text("1 0 0 x\n" * 4)  # damaged: still an error
+    with pytest.raises(SgtoolError, match="frame-000002.pose.txt:1"):
+        read_sequence(root)
 
 
 def test_float_depth_files_say_how_to_convert_them(tmp_path):
