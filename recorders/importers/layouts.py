@@ -99,8 +99,8 @@ LAYOUT_FILES = {
 def looks_like(root: Path) -> str | None:
     """The layout a folder's names suggest (see :func:`detect_layout`), or None."""
     names = {p.name for p in root.iterdir()}
-    if "rgb.txt" in names and "depth.txt" in names:
-        return "tum"
+    if "depth.txt" in names or ("rgb.txt" in names and "groundtruth.txt" in names):
+        return "tum"  # (one list missing: TUM's reader says which, not another layout)
     if any(_seven_depth(n) for n in names):
         return "7scenes"
     if "depth" in names and (root / "depth").is_dir() and _color_dir(root) is not None:

@@ -513,3 +513,15 @@ def test_intrinsics_given_as_text_from_python_are_one_line(tmp_path) -> None:
                        r"\(sgtool.parse_intrinsics reads 'fx,fy,cx,cy' or a file\), got a str$"):
         import_rgbd(root, tmp_path / "x.mcap", RgbdOptions(intrinsics="30,30,15.5,11.5"))
     assert not (tmp_path / "x.mcap").exists()
+
+
+def test_a_tum_folder_missing_a_list_is_named_not_read_as_another_layout(tmp_path):
+    """A TUM folder without rgb.txt (depth.txt and groundtruth.txt there, colour and depth
+    folders beside them) was read as an Open3D folder: its time stamps and ground truth
+    silently ignored. It is a TUM folder that lacks rgb.txt."""
+    from support.rgbd_folders import make_tum_folder
+
+    root = make_tum_folder(tmp_path / "tum", [0.0, 0.1, 0.2])
+    (root / "rgb.txt").unlink()
+    with pytest.raises(SgtoolError, match="not a TUM RGB-D folder .*: no rgb.txt"):
+        read_sequence(root)
