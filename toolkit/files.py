@@ -366,7 +366,9 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
     - a missing or empty ``target`` is replaced by it in one rename;
     - a non-empty ``target`` is refused in one line (:class:`~sgtool.errors.SgtoolError`
       naming ``option`` and ``--force``) before the block runs, unless ``force``; with
-      ``force`` the entries sgtool wrote there before (:func:`sgtool_entries`: the
+      ``force`` (of the command that wrote it: another command's folder is refused, its
+      results are not this command's to delete) the entries sgtool wrote there before
+      (:func:`sgtool_entries`: the
       :data:`MANIFEST`'s list, names matching ``known``) and the entries of the same name
       as a new output are moved aside, the new entries moved in, and the moved-aside ones
       deleted; any other entry (a user's file) stays. A folder without a manifest that
@@ -389,9 +391,9 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
     partial file): an interruption then leaves complete files only, which the next run
     takes up. On exit, clean or not, the manifest lists what it listed plus the entries
     that appeared; an exception before any entry appeared leaves ``target`` as it was
-    (a folder created for the run is removed again). With ``force``, or for another
-    command's folder (refused without ``force``), it builds as above: a fresh run that
-    replaces what sgtool wrote.
+    (a folder created for the run is removed again). With ``force`` it builds as above: a
+    fresh run that replaces what sgtool wrote; another command's folder is refused, with
+    or without ``force``.
     """
     path = _folder_target(target, option)
     exists = path.is_dir()
@@ -400,10 +402,16 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
         with _in_place(path, command, known) as out:
             yield out
         return
+    owner = read_manifest(path)[0] if busy else None
     if busy and not force:
-        raise SgtoolError(f"{option} {target}: the folder is not empty; not writing into it "
-                          "(--force, force=True from Python, replaces what sgtool wrote "
-                          "there and keeps other files)")
+        raise SgtoolError(f"{option} {target}: the folder is not empty"
+                          + (f" (a `sgtool {owner}` folder)" if owner else "")
+                          + "; not writing into it (--force, force=True from Python, "
+                          "replaces what sgtool wrote there and keeps other files)")
+    if busy and owner is not None and owner != command:
+        raise SgtoolError(f"{option} {target}: a `sgtool {owner}` folder; --force of "
+                          f"`sgtool {command}` would delete its results: give another "
+                          "folder, or remove that one first")
     if busy:
         _refuse_unlisted(path, target, option, known)
     parent = path.parent

@@ -311,3 +311,19 @@ def test_a_write_error_in_the_staging_folder_names_the_target(tmp_path: Path) ->
         raise OSError(errno.ENOSPC, "No space left on device")  # a buffered write's
     assert full.value.filename == str(out)
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_force_of_another_command_leaves_a_folder_s_results(tmp_path: Path) -> None:
+    """`bench --force` into a run-bench folder deleted its episode logs: the refusal names
+    the folder's command, and --force of another command is refused too."""
+    out = tmp_path / "rb"
+    with output_folder(out, force=False, command="run-bench", resume=True) as folder:
+        _write(folder, **{"ep-0.log": "done"})
+    for force in (False, True):
+        with pytest.raises(SgtoolError, match="a `sgtool run-bench` folder"), \
+                output_folder(out, force=force, command="bench"):
+            raise AssertionError("the block must not run")
+    assert (out / "ep-0.log").read_text() == "done"
+    with output_folder(out, force=True, command="run-bench") as folder:  # its own: replaced
+        _write(folder, **{"ep-0.log": "again"})
+    assert (out / "ep-0.log").read_text() == "again"
