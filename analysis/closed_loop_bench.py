@@ -349,12 +349,14 @@ def tasks_of(cfg: ClosedLoopBenchConfig, logs: Path) -> list[RunTask]:
 @dataclass(frozen=True)
 class ClosedLoopBenchResult:
     """The rows of a run, and optionally the episodes of a symbolic bench to compare the
-    planner order with (``symbolic``, from ``symbolic_source``)."""
+    planner order with (``symbolic``, from ``symbolic_source``); ``missing``: the episodes
+    of the config without a log (a report of a run cut short)."""
 
     config: ClosedLoopBenchConfig
     rows: tuple[RunRow, ...]
     symbolic: tuple[EpisodeResult, ...] = ()
     symbolic_source: str = ""
+    missing: int = 0
 
     def results(self, noise: str | None = None) -> list[EpisodeResult]:
         return [r.result for r in self.rows if noise is None or r.task.noise == noise]
@@ -411,6 +413,11 @@ class ClosedLoopBenchResult:
         models = cost_models(cfg.distance_budget, cfg.step_budget)
         parts = []
         rule = "; success only on done() (MoMa-LLM)" if cfg.options.success == "done" else ""
+        if self.missing:
+            parts.append(f"**Incomplete: {self.missing} of {self.missing + len(self.rows)} "
+                         "episodes have no log** (a run cut short?): the planners' rows may "
+                         "cover different episodes; `sgtool run-bench` with the same options "
+                         "finishes the run.\n")
         for noise in cfg.noise:
             rows = [r for r in self.rows if r.task.noise == noise]
             parts.append(format_table(summarize([r.result for r in rows], models,
@@ -444,7 +451,8 @@ class ClosedLoopBenchResult:
                     "distance_budget": cfg.distance_budget, "step_budget": cfg.step_budget,
                     "planner_options": options_as_text(cfg.planner_options)}
         return {"planners": list(cfg.planners), "settings": settings,
-                "noise": {noise_folder(n): self.statistics(n)[1] for n in cfg.noise}}
+                "noise": {noise_folder(n): self.statistics(n)[1] for n in cfg.noise},
+                **({"missing_episodes": self.missing} if self.missing else {})}
 
 
 def _run_table(rows: Sequence[RunRow], planners: Sequence[str]) -> str:
@@ -501,6 +509,7 @@ def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
         check_plugins_build(cfg.planners, cfg.planner_options)
     logs = (Path(out_dir) if report_only else output_dir(out_dir)) / "logs"
     tasks = tasks_of(cfg, logs)
+    expected = len(tasks)
     if report_only:
         tasks = [t for t in tasks if t.output.exists()]
         if not tasks:
@@ -521,7 +530,8 @@ def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
         if not report_only:  # the folders of logs never written (a planner that raised)
             remove_empty_folders(logs)
         raise
-    return ClosedLoopBenchResult(cfg, tuple(sorted(rows, key=report_order(cfg, tasks))))
+    return ClosedLoopBenchResult(cfg, tuple(sorted(rows, key=report_order(cfg, tasks))),
+                                 missing=expected - len(rows))
 
 
 def report_order(cfg: ClosedLoopBenchConfig,

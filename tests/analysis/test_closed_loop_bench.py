@@ -140,6 +140,13 @@ def test_run_bench_writes_a_log_per_run_and_resumes(house_file, tmp_path, monkey
     res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
                                    "--success", "done"])
     assert res.exit_code == 2 and "success rule" in res.output
+    # a report of a run cut short says so, in the table and in summary.json
+    (out / "logs/none/greedy/small/ep-000.mcap").unlink()
+    cut = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                   "--report-only"])
+    assert cut.exit_code == 0 and "**Incomplete: 1 of 2 episodes have no log**" in \
+        (out / "summary.md").read_text(), cut.output
+    assert json.loads((out / "summary.json").read_text())["missing_episodes"] == 1
 
 
 def test_kendall_tau_against_a_symbolic_bench(house_file, tmp_path) -> None:
