@@ -104,9 +104,10 @@ def _boxes(boxes: list[tuple[float, float, float, float]]) -> np.ndarray:
 
 
 def _starts_on_free_floor(spec: HouseSpec) -> None:
-    """No start pose inside a wall's body or a piece of furniture's footprint (the robot
-    could not move, or the simulator pushes it out of the house)."""
+    """No start pose inside a wall's body, a closed door's leaf or a piece of furniture's
+    footprint (the robot could not move, or the simulator pushes it out of the house)."""
     from sgtool.house.clearance import Covers
+    from sgtool.house.geometry import segment_distance
 
     if not spec.starts:
         return
@@ -121,6 +122,10 @@ def _starts_on_free_floor(spec: HouseSpec) -> None:
             f = spec.furniture[what[1]]
             raise SpecError(f"starts[{i}]: ({s.x}, {s.y}) is inside furniture[{what[1]}] "
                             f"({f.id}, {f.category}); a start pose must be on free floor")
+        for j, d in enumerate(spec.doors):
+            if not d.is_open and segment_distance(s.x, s.y, *d.segment) <= d.thickness / 2:
+                raise SpecError(f"starts[{i}]: ({s.x}, {s.y}) is inside doors[{j}] ({d.id}, "
+                                "closed); a start pose must be on free floor")
 
 
 def _openings_clear(spec: HouseSpec) -> None:

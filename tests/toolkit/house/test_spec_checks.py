@@ -230,6 +230,16 @@ def test_a_start_inside_furniture_is_refused() -> None:
     assert len(load_house(d).starts) == 2
 
 
+def test_a_start_inside_a_closed_door_is_refused() -> None:
+    """A start in a closed door's leaf (the door at x 4, y 1.5..2.4) put the robot inside
+    it; an open door's opening is floor."""
+    d = two_rooms("closed")
+    d["starts"].append({"x": 4.0, "y": 2.0, "yaw": 0, "room": "room_0"})
+    _refused(d, r"^starts\[1\]: \(4\.0, 2\.0\) is inside doors\[0\] \(door_0, closed\); a "
+                r"start pose must be on free floor$")
+    assert len(load_house(two_rooms("open") | {"starts": d["starts"]}).starts) == 2
+
+
 def test_a_start_inside_a_wall_is_refused() -> None:
     d = two_rooms()
     d["starts"].append({"x": 0.02, "y": 2.0, "yaw": 0, "room": "room_0"})  # wall_2, x 0
