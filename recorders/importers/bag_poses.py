@@ -84,13 +84,8 @@ def pose_source_of(path: Path, idx: BagIndex, opts: BagOptions) -> PoseSource:
                 f"tree (frames: {frames_list}); give --tf-frames WORLD:CAMERA"
             )
         world = tree.root_of(camera)
-        if world == camera:  # the tree is stored from the camera out: no world above it
-            others = world_candidates(tree, camera)
-            raise SgtoolError(
-                f"{path}: the depth images' frame {camera!r} is the root of its tf tree "
-                "(its transforms are stored from the camera to the world), so no pose of "
-                "the camera can be read from it by default; give --tf-frames WORLD:CAMERA"
-                + (f", e.g. --tf-frames {others[0]}:{camera}" if others else ""))
+        if world == camera or outward_worlds(tree, camera):
+            raise SgtoolError(f"{path}: {stored_outwards(tree, camera)}")
     if world == camera:
         raise SgtoolError(f"{path}: --tf-frames {world}:{camera}: the world and the camera "
                           "are one frame (every pose would be the identity)")
@@ -111,9 +106,45 @@ def pose_source_of(path: Path, idx: BagIndex, opts: BagOptions) -> PoseSource:
 WORLD_NAMES = ("world", "map", "odom")  # frame names a world frame goes by, likeliest first
 
 
+def is_world_name(frame: str) -> bool:
+    return frame.lstrip("/") in WORLD_NAMES
+
+
 def world_candidates(tree: TfTree, camera: str) -> list[str]:
-    """The frames linked with ``camera`` that could be its world: those named like one
-    (:data:`WORLD_NAMES`) first, then the others in name order."""
+    """The frames linked with ``camera`` named like a world (:data:`WORLD_NAMES`, in that
+    order), ``camera`` itself left out."""
     linked = [f for f in tree.frames() if f != camera and tree.path(f, camera) is not None]
-    named = [f for n in WORLD_NAMES for f in linked if f.lstrip("/") == n]
-    return named + [f for f in linked if f not in named]
+    return [f for n in WORLD_NAMES for f in linked if f.lstrip("/") == n]
+
+
+def outward_worlds(tree: TfTree, camera: str) -> list[str]:
+    """The world-named frames linked with ``camera`` off its way to the root, when none is
+    on it: a tree stored from the camera out (camera_link -> world); empty otherwise."""
+    up = tree.ancestors(camera)
+    if any(is_world_name(f) for f in up):
+        return []
+    return [f for f in world_candidates(tree, camera) if f not in up]
+
+
+def stored_outwards(tree: TfTree, camera: str) -> str:
+    """Why no default pose is read for ``camera`` (one line, no path): the tree stored
+    from the camera out, with the pair to give; the images in a world frame, with the
+    camera-like frames; or no world frame at all, with --estimate-poses."""
+    root = tree.root_of(camera)
+    where = "is the root of its tf tree" if root == camera else \
+        f"hangs under {root!r}, the root of its tf tree"
+    if is_world_name(camera):
+        others = [f for f in tree.frames() if f != camera]
+        cams = [f for f in others if "optical" in f or "camera" in f] or \
+            [f for f in others if f not in {link.parent for link in tree.links.values()}]
+        return (f"the depth images are in frame {camera!r}, the root of its tf tree: a world, "
+                "not a camera; give --tf-frames WORLD:CAMERA with the camera's frame"
+                + (f", e.g. --tf-frames {camera}:{cams[0]}" if cams else ""))
+    named = outward_worlds(tree, camera) or world_candidates(tree, camera)
+    if named:
+        return (f"the depth images' frame {camera!r} {where}, and {named[0]!r} below it: the "
+                "transforms are stored from the camera out, so no pose of the camera can be "
+                f"read by default; give --tf-frames {named[0]}:{camera}")
+    return (f"the depth images' frame {camera!r} {where} and no frame named like a world "
+            f"({', '.join(WORLD_NAMES)}) is linked to it: the bag holds no camera "
+            "trajectory; give --tf-frames WORLD:CAMERA, or --estimate-poses")

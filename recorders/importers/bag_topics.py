@@ -186,10 +186,14 @@ def peek_tf(reader: Any, topics: list[B.TopicInfo], max_messages: int = 500) -> 
 def tf_suggestions(tree: TfTree) -> list[str]:
     """``--tf-frames WORLD:CAMERA`` for the frames that look like cameras (any frame with
     "optical", else "camera" in its name; else every leaf), each with its root as the
-    world, or for a camera at the root of its tree (stored from the camera out) the frame
-    most like a world it links to; a leaf named like a world (world, map, odom) under a
-    root that is not is that root's world (the tree stored from the camera out)."""
-    from sgtool.recorders.importers.bag_poses import WORLD_NAMES, world_candidates
+    world, unless the tree is stored from the camera out
+    (:func:`~sgtool.recorders.importers.bag_poses.outward_worlds`): then the world-named
+    frame below it; a camera with no world at all gets none."""
+    from sgtool.recorders.importers.bag_poses import (
+        is_world_name,
+        outward_worlds,
+        world_candidates,
+    )
 
     parents = {link.parent for link in tree.links.values()}
     leaves = sorted(f for f in tree.links if f not in parents)
@@ -198,12 +202,13 @@ def tf_suggestions(tree: TfTree) -> list[str]:
     picks = cams or leaves
     out = []
     for f in picks[:6]:
-        world = tree.root_of(f)
-        if world == f:
-            world = next(iter(world_candidates(tree, f)), "")
-        elif not cams and f.lstrip("/") in WORLD_NAMES and \
-                world.lstrip("/") not in WORLD_NAMES:
-            world, f = f, world
+        root = tree.root_of(f)
+        if is_world_name(f):  # a world leaf under the camera's root (stored outwards)
+            if not cams and not is_world_name(root):
+                out.append(f"--tf-frames {f}:{root}")
+            continue
+        world = next(iter(outward_worlds(tree, f)), "") or (
+            root if root != f else next(iter(world_candidates(tree, f)), ""))
         if world:
             out.append(f"--tf-frames {world}:{f}")
     if len(picks) > 6:

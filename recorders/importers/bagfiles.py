@@ -121,11 +121,7 @@ def open_bag(path: str | Path) -> Iterator[Any]:
                 _check_mcap_profile(path)
         elif path.is_dir() and not (path / "metadata.yaml").is_file():
             raise SgtoolError(f"{path}: a folder without metadata.yaml is not a ROS 2 bag")
-        elif path.is_dir() and path.suffix == ".bag":
-            # a ROS 2 bag folder named *.bag (`ros2 bag record -o run.bag`): the reader
-            # takes that name for a ROS 1 file, so give it another
-            target = Path(stack.enter_context(tempfile.TemporaryDirectory())) / "bag"
-            target.symlink_to(path.resolve(), target_is_directory=True)
+
         elif path.is_file() and path.suffix != ".bag":
             if not _starts_with(path, ROS1_MAGIC):
                 raise SgtoolError(
@@ -134,6 +130,12 @@ def open_bag(path: str | Path) -> Iterator[Any]:
             # a ROS 1 bag by another name: the reader goes by the name, so give it one
             target = Path(stack.enter_context(tempfile.TemporaryDirectory())) / "bag.bag"
             target.symlink_to(path.resolve())
+        if target.is_dir() and target.suffix == ".bag":
+            # a ROS 2 bag folder named *.bag (`ros2 bag record -o run.bag`), given or found
+            # above its storage file: the reader takes the name for a ROS 1 file
+            link = Path(stack.enter_context(tempfile.TemporaryDirectory())) / "bag"
+            link.symlink_to(target.resolve(), target_is_directory=True)
+            target = link
         try:
             reader = AnyReader([target], default_typestore=get_typestore(Stores.LATEST))
             stack.enter_context(reader)

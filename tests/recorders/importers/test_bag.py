@@ -613,23 +613,29 @@ def test_a_cut_ros2_mcap_points_to_doctor(tmp_path):
     assert f"`sgtool doctor {part} --recover OUT.mcap` copies what is readable" in r.output
 
 
-@pytest.mark.parametrize("parent, child, image_frame", [("cam", "world", "cam"),
-                                                      ("world", "cam", "world")])
-def test_a_camera_at_the_root_of_its_tf_tree_is_refused_naming_the_flag(tmp_path, parent,
-                                                                         child, image_frame):
-    """A tf tree stored from the camera out (cam -> world, legal tf), or images whose frame
-    is the tree's root, gave every frame the identity pose and an import that succeeded.
-    Now one line names --tf-frames with the world it would take; with it the import reads
-    the camera's poses through the inverted links."""
+_ROOT_CASES = {  # name: (links of a frame's pose P as (parent, child, transform), image frame)
+    "camera at the root": (lambda P: [("cam", "world", np.linalg.inv(P))], "cam"),
+    "camera under a root link": (lambda P: [("cam_link", "world", np.linalg.inv(P)),
+                                            ("cam_link", "cam", np.eye(4))], "cam"),
+    "images in the world frame": (lambda P: [("world", "cam", P)], "world"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(_ROOT_CASES))
+def test_a_tf_tree_stored_from_the_camera_out_is_refused_naming_the_flag(tmp_path, case):
+    """A tf tree stored from the camera out (cam -> world, legal tf; or cam_link -> world
+    with the optical frame under cam_link), or images in the world frame, gave every frame
+    one pose and an import that succeeded. Now one line names the --tf-frames pair to
+    give, --list suggests it, and with it the poses come through the inverted links."""
+    links, image_frame = _ROOT_CASES[case]
     src = write_sgtool_log(tmp_path / "src.mcap", n=6)
     bag = bag_path(tmp_path, "ros2-sqlite3")
     with LogReader(src) as r, BagWriter(bag, "ros2-sqlite3") as w:
         frames = list(r.frames())
         for f in frames:
             t = f.time_ns
-            pose = f.pose if parent == "world" else np.linalg.inv(f.pose)
             w.write("/tf", "tf2_msgs/msg/TFMessage", t,
-                    w.tf(t, [w.transform_stamped(t, parent, child, pose)]))
+                    w.tf(t, [w.transform_stamped(t, a, b, T) for a, b, T in links(f.pose)]))
             w.write(TOPICS["depth"], "sensor_msgs/msg/Image", t,
                     w.image(t, image_frame, (f.depth * 1000).round().astype(np.uint16),
                             "16UC1"))
@@ -639,18 +645,40 @@ def test_a_camera_at_the_root_of_its_tf_tree_is_refused_naming_the_flag(tmp_path
     opts = dict(depth=TOPICS["depth"], intrinsics=PinholeParams(k.fx, k.fy, k.cx, k.cy),
                 **KEEP_WORLD)
     out = tmp_path / "o.mcap"
-    other = "world" if image_frame == "cam" else "cam"
-    with pytest.raises(SgtoolError, match=f"the depth images' frame '{image_frame}' is the "
-                       f"root of its tf tree.*e.g. --tf-frames {other}:{image_frame}"):
+    with pytest.raises(SgtoolError, match=r"--tf-frames (WORLD:CAMERA with the camera's "
+                       r"frame, e.g. --tf-frames )?world:cam$"):
         import_bag(bag, out, BagOptions(**opts))
     assert not out.exists()
+    r = CliRunner().invoke(cli, ["import", "bag", str(bag), "--list"])
+    line = next(x for x in r.output.splitlines() if x.startswith("camera / trajectory"))
+    assert "--tf-frames world:cam" in line.split(": ", 1)[1].split(" | "), r.output
     rep = import_bag(bag, out, BagOptions(tf_frames=("world", "cam"), **opts))
     assert rep.frames == 6
     with LogReader(out) as r:
         for g, f in zip([g.pose for g in r.frames()], frames, strict=True):
             assert np.allclose(g, f.pose, atol=1e-6)
-    r = CliRunner().invoke(cli, ["import", "bag", str(bag), "--list"])
-    assert "camera / trajectory frames: --tf-frames world:cam" in r.output, r.output
+
+
+def test_a_camera_with_no_world_in_its_tree_is_told_to_estimate_poses(tmp_path):
+    """Only a static link from the camera to another sensor: no trajectory in the bag."""
+    from sgtool.recorders.importers.textformats import PinholeParams
+
+    src = write_sgtool_log(tmp_path / "src.mcap", n=4)
+    bag = bag_path(tmp_path, "ros2-sqlite3")
+    with LogReader(src) as r, BagWriter(bag, "ros2-sqlite3") as w:
+        for i, f in enumerate(r.frames()):
+            k = f.intrinsics
+            t = f.time_ns
+            if i == 0:
+                w.write("/tf_static", "tf2_msgs/msg/TFMessage", t,
+                        w.tf(t, [w.transform_stamped(t, "cam", "imu", np.eye(4))]))
+            w.write(TOPICS["depth"], "sensor_msgs/msg/Image", t,
+                    w.image(t, "cam", (f.depth * 1000).round().astype(np.uint16), "16UC1"))
+    with pytest.raises(SgtoolError, match="no frame named like a world .* the bag holds no "
+                       "camera trajectory; give --tf-frames WORLD:CAMERA, or --estimate-poses"):
+        import_bag(bag, tmp_path / "o.mcap", BagOptions(
+            depth=TOPICS["depth"], intrinsics=PinholeParams(k.fx, k.fy, k.cx, k.cy),
+            **KEEP_WORLD))
 
 
 @pytest.mark.parametrize("fmt", ["ros2-sqlite3", "ros2-mcap"])
@@ -663,6 +691,9 @@ def test_a_ros2_bag_folder_named_dot_bag_is_read_as_ros2(tmp_path, fmt):
     assert bag.is_dir()
     r = CliRunner().invoke(cli, ["import", "bag", str(bag), "--list"])
     assert r.exit_code == 0 and r.output.startswith(f"{bag} (ros2): topics"), r.output
+    (storage,) = [p for p in bag.iterdir() if p.suffix in (".mcap", ".db3")]
+    r = CliRunner().invoke(cli, ["import", "bag", str(storage), "--list"])  # its file
+    assert r.exit_code == 0 and "(ros2): topics" in r.output, r.output
     out = tmp_path / "o.mcap"
     r = CliRunner().invoke(cli, ["import", "bag", str(bag), "-o", str(out), "--quiet",
                                  "--depth", TOPICS["depth"], "--info", TOPICS["info"],
