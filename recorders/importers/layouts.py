@@ -99,7 +99,7 @@ LAYOUT_FILES = {
 def looks_like(root: Path) -> str | None:
     """The layout a folder's names suggest (see :func:`detect_layout`), or None."""
     names = {p.name for p in root.iterdir()}
-    if "depth.txt" in names or ("rgb.txt" in names and "groundtruth.txt" in names):
+    if "depth.txt" in names or "rgb.txt" in names:
         return "tum"  # (one list missing: TUM's reader says which, not another layout)
     if any(_seven_depth(n) for n in names):
         return "7scenes"

@@ -283,7 +283,8 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     if not opts.allow_drop:
         problem = dropped_problem(
             seq.dropped, len(seq.frames) + seq.dropped,
-            ("they have no pose.txt" if seq.layout == "7scenes" else
+            ("they have no pose.txt, or one of non-finite numbers (untracked)"
+             if seq.layout == "7scenes" else
              f"the {seq.pose_source} of {root.name} does not cover their time"),
             "give --estimate-poses to estimate the poses of all frames, or --allow-drop to "
             "import only the covered ones")

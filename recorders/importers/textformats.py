@@ -118,13 +118,15 @@ def pose_matrix(path: Path, rows: list[tuple[int, list[str]]]) -> np.ndarray:
 
 
 def untracked_pose(path: Path) -> bool:
-    """A pose file of numbers some of which are not finite: a frame its tracker lost
-    (ScanNet writes ``-inf`` rows), no pose rather than a damaged file."""
+    """A 4x4 pose file (as :func:`read_pose_file` reads it) of which no number is finite:
+    a frame its tracker lost (ScanNet writes ``-inf`` rows), no pose rather than a damaged
+    file (a partly non-finite or malformed one is :func:`read_pose_file`'s error)."""
     try:
-        vals = [float(x) for x in path.read_text(encoding="utf-8").split()]
-    except (OSError, UnicodeDecodeError, ValueError):
+        rows = _data_lines(path)
+        vals = [float(x) for _, parts in rows for x in parts]
+    except (OSError, SgtoolError, ValueError):
         return False
-    return bool(vals) and not all(math.isfinite(v) for v in vals)
+    return len(rows) == 4 and len(vals) == 16 and not any(math.isfinite(v) for v in vals)
 
 
 def read_pose_file(path: Path) -> np.ndarray:

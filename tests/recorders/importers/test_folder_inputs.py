@@ -453,9 +453,12 @@ def test_a_seven_scenes_pose_of_non_finite_numbers_is_an_untracked_frame(tmp_pat
     assert seq.dropped == 1
     kept = read_sequence(root, keep_unposed=True)
     assert len(kept.frames) == 4 and kept.frames[1].pose is None
-    (root / "frame-000002.pose.txt").write_text("1 0 0 x\n" * 4)  # damaged: still an error
-    with pytest.raises(SgtoolError, match="frame-000002.pose.txt:1"):
-        read_sequence(root)
+    (root / "frame-000001.pose.txt").write_text("# lost\n" + "-inf,-inf,-inf,-inf\n" * 4)
+    assert read_sequence(root).dropped == 1  # commas and comments, as read_pose_file reads
+    for damaged in ("1 0 0 x\n" * 4, "1 0 0 0\n0 1 0 inf\n", "nan\n"):  # still errors
+        (root / "frame-000002.pose.txt").write_text(damaged)
+        with pytest.raises(SgtoolError, match="frame-000002.pose.txt"):
+            read_sequence(root)
 
 
 def test_float_depth_files_say_how_to_convert_them(tmp_path):
@@ -525,3 +528,7 @@ def test_a_tum_folder_missing_a_list_is_named_not_read_as_another_layout(tmp_pat
     (root / "rgb.txt").unlink()
     with pytest.raises(SgtoolError, match="not a TUM RGB-D folder .*: no rgb.txt"):
         read_sequence(root)
+    other = make_tum_folder(tmp_path / "tum2", [0.0, 0.1, 0.2], ground_truth=False)
+    (other / "depth.txt").unlink()  # rgb.txt alone (a validation sequence): TUM too
+    with pytest.raises(SgtoolError, match="not a TUM RGB-D folder .*: no depth.txt"):
+        read_sequence(other)
