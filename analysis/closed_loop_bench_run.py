@@ -345,6 +345,6 @@ def load_symbolic(path: str | Path) -> tuple[EpisodeResult, ...]:
     if not results:
         raise SgtoolError(f"--symbolic {path}: holds no episode")
     if other := next((r.source for r in results if r.source != "symbolic"), None):
-        raise SgtoolError(f"--symbolic {path}: closed-loop episodes (source {other}), a "
-                          "`sgtool run-bench` folder; give a `sgtool bench` folder")
+        raise SgtoolError(f"--symbolic {path}: episodes of logs (source {other}), not of a "
+                          "`sgtool bench` (a run-bench's or an eval's); give a bench's folder")
     return results

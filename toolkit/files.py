@@ -403,15 +403,17 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
             yield out
         return
     owner = read_manifest(path)[0] if busy else None
+    if owner is not None:  # (a command may be named with its program: "sgtool golden")
+        owner = owner.removeprefix("sgtool ")
     if busy and not force:
         raise SgtoolError(f"{option} {target}: the folder is not empty"
                           + (f" (a `sgtool {owner}` folder)" if owner else "")
                           + "; not writing into it (--force, force=True from Python, "
                           "replaces what sgtool wrote there and keeps other files)")
-    if busy and owner is not None and owner != command:
+    if busy and owner is not None and owner != command.removeprefix("sgtool "):
         raise SgtoolError(f"{option} {target}: a `sgtool {owner}` folder; --force of "
-                          f"`sgtool {command}` would delete its results: give another "
-                          "folder, or remove that one first")
+                          f"`sgtool {command.removeprefix('sgtool ')}` would delete its "
+                          "results: give another folder, or remove that one first")
     if busy:
         _refuse_unlisted(path, target, option, known)
     parent = path.parent

@@ -173,12 +173,13 @@ def _override(base: NoiseProfile, items: Iterable[tuple[str, Any]], where: str,
         kw[k] = v
     if not kw:
         return base
+    how = "its \"name\"" if "name" in kw else "the file's name"
     kw.setdefault("name", default_name)
     out = replace(base, **kw)
-    same = PROFILES.get(out.name)
+    same = PROFILES.get(out.name.strip())
     if same is not None and replace(out, name=same.name) != same:  # labelled, pooled as it
-        raise SgtoolError(f"--noise {where}: named {out.name!r}, a built-in profile, with "
-                          "other faults; give it a name of its own")
+        raise SgtoolError(f"--noise {where}: named {out.name.strip()!r} ({how}), a built-in "
+                          "profile, with other faults; give it a name of its own")
     return out
 
 

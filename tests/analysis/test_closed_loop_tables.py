@@ -134,6 +134,6 @@ def test_symbolic_rows_must_come_from_a_symbolic_bench(tmp_path):
     (tmp_path / "rb").mkdir()
     write_jsonl([replace(row, source="logs/none/scout/h/ep-000.mcap")],
                 tmp_path / "rb" / "episodes.jsonl")
-    with pytest.raises(SgtoolError, match=r"^--symbolic .*rb: closed-loop episodes \(source "
-                       r"logs/none/scout/h/ep-000.mcap\), a `sgtool run-bench` folder"):
+    with pytest.raises(SgtoolError, match=r"^--symbolic .*rb: episodes of logs \(source "
+                       r"logs/none/scout/h/ep-000.mcap\), not of a `sgtool bench`"):
         load_symbolic(tmp_path / "rb")

@@ -327,3 +327,9 @@ def test_force_of_another_command_leaves_a_folder_s_results(tmp_path: Path) -> N
     with output_folder(out, force=True, command="run-bench") as folder:  # its own: replaced
         _write(folder, **{"ep-0.log": "again"})
     assert (out / "ep-0.log").read_text() == "again"
+    pins = tmp_path / "pins"  # a command named with its program is named once
+    with output_folder(pins, force=False, command="sgtool golden") as folder:
+        _write(folder, **{"expected.json": "{}"})
+    with pytest.raises(SgtoolError, match="^-o .*pins: a `sgtool golden` folder; --force of "
+                       "`sgtool bench`"), output_folder(pins, force=True, command="bench"):
+        raise AssertionError("the block must not run")
