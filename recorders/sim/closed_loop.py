@@ -102,7 +102,7 @@ from sgtool.house.spec import HouseSpec
 from sgtool.llm.stats import answer_counts
 from sgtool.log.records import WENT_ON, LlmExchange  # WENT_ON: the reason of a go-on explore
 from sgtool.log.records import Episode as LoggedEpisode
-from sgtool.log.writer import LogWriter
+from sgtool.log.writer import LogWriter, refused_number
 from sgtool.planning.base import Action, Feedback, Outcome, Planner
 from sgtool.planning.candidates import Candidate, actionable, find_target
 from sgtool.planning.episode import (
@@ -460,10 +460,9 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
     opts = options or ClosedLoopOptions()
     recorded = {"planner_options": recorded_options(planner_options)} if planner_options \
         else {}
-    for k, v in recorded.get("planner_options", {}).items():  # logged: found now, not at
-        if isinstance(v, float) and not math.isfinite(v):  # the episode's end
-            raise SgtoolError(f"planner option {k}={v}: a finite number (the episode's log "
-                              "records it)")
+    if bad := refused_number(recorded.get("planner_options", {})):  # now, not at the end
+        raise SgtoolError(f"planner option {bad[0]}={bad[1]}: a finite number (the "
+                          "episode's log records it)")
     if opts.max_steps < 1:
         raise SgtoolError(f"--max-steps {opts.max_steps}: must be >= 1")
     if opts.frames is not None and opts.frames < 1:

@@ -341,7 +341,7 @@ class LogWriter:
             record.check_since(d, where, self._checked_items)
         else:
             d = record.checked_json(where)
-        if (bad := _refused_number(d)) is not None:
+        if (bad := refused_number(d)) is not None:
             raise LogFormatError(f"{where}: field {bad[0]!r} is {bad[1]!r}: "
                                  + ("a distance is never negative" if bad[1] < 0 else
                                     "NaN and infinity are no JSON numbers"))
@@ -529,7 +529,7 @@ def _utf8(text: str) -> str:
 DISTANCES = ("travelled_m", "shortest_m")  # record fields in metres: never negative
 
 
-def _refused_number(d: Any, path: str = "") -> tuple[str, float] | None:
+def refused_number(d: Any, path: str = "") -> tuple[str, float] | None:
     """The path and value of the first number of a record's JSON form that the log must
     not hold: NaN or infinite anywhere, negative in a top-level :data:`DISTANCES` field."""
     if isinstance(d, float) and not math.isfinite(d):
@@ -538,10 +538,10 @@ def _refused_number(d: Any, path: str = "") -> tuple[str, float] | None:
         for k, v in d.items():
             if not path and k in DISTANCES and isinstance(v, int | float) and v < 0:
                 return k, float(v)
-            if (bad := _refused_number(v, f"{path}.{k}" if path else str(k))) is not None:
+            if (bad := refused_number(v, f"{path}.{k}" if path else str(k))) is not None:
                 return bad
     elif isinstance(d, list | tuple):
         for i, v in enumerate(d):
-            if (bad := _refused_number(v, f"{path}[{i}]")) is not None:
+            if (bad := refused_number(v, f"{path}[{i}]")) is not None:
                 return bad
     return None
