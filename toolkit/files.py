@@ -368,8 +368,8 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
       naming ``option`` and ``--force``) before the block runs, unless ``force``; with
       ``force`` (of the command that wrote it: another command's folder is refused, its
       results are not this command's to delete) the entries sgtool wrote there before
-      (:func:`sgtool_entries`: the
-      :data:`MANIFEST`'s list, names matching ``known``) and the entries of the same name
+      (:func:`sgtool_entries`: the :data:`MANIFEST`'s list, names matching ``known``)
+      and the entries of the same name
       as a new output are moved aside, the new entries moved in, and the moved-aside ones
       deleted; any other entry (a user's file) stays. A folder without a manifest that
       holds entries named as outputs is refused (:func:`_refuse_unlisted`: they may be a
@@ -403,17 +403,17 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
             yield out
         return
     owner = read_manifest(path)[0] if busy else None
-    if owner is not None:  # (a command may be named with its program: "sgtool golden")
-        owner = owner.removeprefix("sgtool ")
+    owner, me = (None if c is None else c.removeprefix("sgtool ")  # ("sgtool golden")
+                 for c in (owner, command))
     if busy and not force:
         raise SgtoolError(f"{option} {target}: the folder is not empty"
                           + (f" (a `sgtool {owner}` folder)" if owner else "")
                           + "; not writing into it (--force, force=True from Python, "
                           "replaces what sgtool wrote there and keeps other files)")
-    if busy and owner is not None and owner != command.removeprefix("sgtool "):
+    if busy and owner is not None and owner != me:
         raise SgtoolError(f"{option} {target}: a `sgtool {owner}` folder; --force of "
-                          f"`sgtool {command.removeprefix('sgtool ')}` would delete its "
-                          "results: give another folder, or remove that one first")
+                          f"`sgtool {me}` would delete its results: give another folder, "
+                          "or remove that one first")
     if busy:
         _refuse_unlisted(path, target, option, known)
     parent = path.parent
