@@ -110,6 +110,15 @@ def is_world_name(frame: str) -> bool:
     return frame.lstrip("/") in WORLD_NAMES
 
 
+def camera_like(tree: TfTree) -> list[str]:
+    """The frames that look like cameras: those with "optical" in the name, else with
+    "camera", else the leaves of the tree."""
+    frames = tree.frames()
+    parents = {link.parent for link in tree.links.values()}
+    return [f for f in frames if "optical" in f] or [f for f in frames if "camera" in f] \
+        or sorted(f for f in tree.links if f not in parents)
+
+
 def world_candidates(tree: TfTree, camera: str) -> list[str]:
     """The frames linked with ``camera`` named like a world (:data:`WORLD_NAMES`, in that
     order), ``camera`` itself left out."""
@@ -134,9 +143,7 @@ def stored_outwards(tree: TfTree, camera: str) -> str:
     where = "is the root of its tf tree" if root == camera else \
         f"hangs under {root!r}, the root of its tf tree"
     if is_world_name(camera):
-        others = [f for f in tree.frames() if f != camera]
-        cams = [f for f in others if "optical" in f or "camera" in f] or \
-            [f for f in others if f not in {link.parent for link in tree.links.values()}]
+        cams = [f for f in camera_like(tree) if f != camera]
         return (f"the depth images are in frame {camera!r}, the root of its tf tree: a world, "
                 "not a camera; give --tf-frames WORLD:CAMERA with the camera's frame"
                 + (f", e.g. --tf-frames {camera}:{cams[0]}" if cams else ""))

@@ -184,27 +184,25 @@ def peek_tf(reader: Any, topics: list[B.TopicInfo], max_messages: int = 500) -> 
 
 
 def tf_suggestions(tree: TfTree) -> list[str]:
-    """``--tf-frames WORLD:CAMERA`` for the frames that look like cameras (any frame with
-    "optical", else "camera" in its name; else every leaf), each with its root as the
-    world, unless the tree is stored from the camera out
+    """``--tf-frames WORLD:CAMERA`` for the frames that look like cameras
+    (:func:`~sgtool.recorders.importers.bag_poses.camera_like`), each with its root as
+    the world, unless the tree is stored from the camera out
     (:func:`~sgtool.recorders.importers.bag_poses.outward_worlds`): then the world-named
     frame below it; a camera with no world at all gets none."""
     from sgtool.recorders.importers.bag_poses import (
+        camera_like,
         is_world_name,
         outward_worlds,
         world_candidates,
     )
 
-    parents = {link.parent for link in tree.links.values()}
-    leaves = sorted(f for f in tree.links if f not in parents)
-    frames = tree.frames()
-    cams = [f for f in frames if "optical" in f] or [f for f in frames if "camera" in f]
-    picks = cams or leaves
+    picks = camera_like(tree)
+    named = any("optical" in f or "camera" in f for f in picks)
     out = []
     for f in picks[:6]:
         root = tree.root_of(f)
         if is_world_name(f):  # a world leaf under the camera's root (stored outwards)
-            if not cams and not is_world_name(root):
+            if not named and not is_world_name(root):
                 out.append(f"--tf-frames {f}:{root}")
             continue
         world = next(iter(outward_worlds(tree, f)), "") or (
