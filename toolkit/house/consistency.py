@@ -21,6 +21,8 @@ everything else is linear in the number of entries times the polygon sizes.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from sgtool.errors import SpecError
@@ -67,13 +69,22 @@ def check_consistency(spec: HouseSpec, limits: SpecLimits) -> None:
                                     f"{id_note(key, i, d.id)}")
                 # the opening runs along the border (yaw: the wall's direction), so both
                 # its ends lie at each of its rooms, not one end inside the other room
+                poly = by_room[rid].polygon
                 for tip in opening_segment(d.center, d.width, d.yaw):
-                    off = distance_to_polygon(tip[0], tip[1], by_room[rid].polygon)
-                    if off > limits.opening_offset:
+                    off = distance_to_polygon(tip[0], tip[1], poly)
+                    if off <= limits.opening_offset:
+                        continue
+                    turned = opening_segment(d.center, d.width, d.yaw + math.pi / 2)
+                    if max(distance_to_polygon(x, y, poly) for x, y in turned) <= \
+                            limits.opening_offset:  # the other direction fits: the yaw
                         raise SpecError(f"{key}[{i}].yaw: {d.yaw:g} rad sets the opening "
                                         f"across the border of {rid}, not along it (an end "
                                         f"{off:.2f} m from the room; yaw is the direction "
                                         f"of the wall it sits in){id_note(key, i, d.id)}")
+                    raise SpecError(f"{key}[{i}].center: the opening runs {off:.2f} m past "
+                                    f"the room {rid} (a corner, or the end of its border): "
+                                    f"move its center along the wall"
+                                    f"{id_note(key, i, d.id)}")
     for i, f in enumerate(spec.furniture):
         room = by_room[f.room]
         if not room.contains(f.center[0], f.center[1]):

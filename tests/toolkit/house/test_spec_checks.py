@@ -343,6 +343,17 @@ def test_a_door_set_across_its_wall_is_refused() -> None:
                 r"not along it")
 
 
+def test_a_door_past_the_end_of_its_border_names_its_center_not_its_yaw() -> None:
+    """A door at a room's corner runs past the border whatever its yaw: the message said to
+    change the yaw, which could not help; it names the center to move."""
+    d = two_rooms()
+    d["doors"][0]["center"] = [4, 0]  # the corner of both rooms
+    for yaw in (math.pi / 2, 0.0):
+        d["doors"][0]["yaw"] = yaw
+        _refused(d, r"^doors\[0\]\.center: the opening runs 0\.45 m past the room room_\d "
+                    r"\(a corner, or the end of its border\): move its center along the wall")
+
+
 def test_a_house_file_goes_by_its_id_in_every_command(tmp_path: Path) -> None:
     """bench named a house file by its "id", record and run by its file name: one house
     under two file names gave two logs. Every command names it as house_file_id does."""
