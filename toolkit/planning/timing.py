@@ -52,20 +52,39 @@ def decision_time(planner: Planner, action: Action, outer_s: float) -> float:
     return outer_s
 
 
+_Globals = tuple[Any, Any]  # Python's and numpy's global generator states
+
+
+def seeded_state(seed: int) -> _Globals:
+    """The global generators' states right after seeding both with ``seed``."""
+    return random.Random(seed).getstate(), np.random.RandomState(seed % 2**32).get_state()
+
+
+@contextlib.contextmanager
+def swapped_globals(inner: _Globals) -> Iterator[list[_Globals]]:
+    """The global generators set to ``inner`` inside the block (one block at a time in a
+    process), the caller's put back after; the block's list holds their states at its
+    end."""
+    with _GLOBALS_LOCK:
+        outer = random.getstate(), np.random.get_state()
+        random.setstate(inner[0])
+        np.random.set_state(inner[1])
+        after = [inner]
+        try:
+            yield after
+        finally:
+            after[0] = random.getstate(), np.random.get_state()
+            random.setstate(outer[0])
+            np.random.set_state(outer[1])
+
+
 @contextlib.contextmanager
 def seeded_globals(seed: int = 0) -> Iterator[None]:
     """Python's and numpy's global generators seeded with ``seed`` inside the block, the
     caller's put back after: a plug-in's constructor that draws from them draws the same
     numbers in any process and order (module doc)."""
-    with _GLOBALS_LOCK:
-        outer = random.getstate(), np.random.get_state()
-        random.seed(seed)
-        np.random.seed(seed % 2**32)
-        try:
-            yield
-        finally:
-            random.setstate(outer[0])
-            np.random.set_state(outer[1])
+    with swapped_globals(seeded_state(seed)):
+        yield
 
 
 class PlannerContractError(SgtoolError):
@@ -96,22 +115,18 @@ class TimedPlanner:
         if self._globals is None:
             yield
             return
-        with _GLOBALS_LOCK:  # one process's generators: one plug-in call at a time holds them
-            outer = random.getstate(), np.random.get_state()
-            random.setstate(self._globals[0])
-            np.random.set_state(self._globals[1])
-            try:
+        after: list[_Globals] = []
+        try:
+            with swapped_globals(self._globals) as after:
                 yield
-            finally:
-                self._globals = random.getstate(), np.random.get_state()
-                random.setstate(outer[0])
-                np.random.set_state(outer[1])
+        finally:  # (a call that raised keeps what it drew, as one that returned)
+            if after:
+                self._globals = after[0]
 
     def reset(self, query: str, seed: int = 0) -> None:
         self.decision_times = []
         if self.plugin:
-            self._globals = (random.Random(seed).getstate(),
-                             np.random.RandomState(seed % 2**32).get_state())
+            self._globals = seeded_state(seed)
         try:
             with self._own_randomness():
                 self.inner.reset(query, seed)
