@@ -215,11 +215,11 @@ class RunRow:
 
 @functools.lru_cache(maxsize=64)
 def noise_folder(noise: str) -> str:
-    """The log folder of a ``--noise`` profile: its text, or for a JSON file the profile's
-    name (its ``name`` field, else the file's stem; the file read once per process, so a
+    """The log folder of a ``--noise`` profile: its name (a built-in profile's; with
+    overrides, one spelling of them, so ``mild, holes=0.050`` is ``mild,holes=0.05``; a
+    JSON file's ``name`` field, else the file's stem; the file read once per process, so a
     run's folders and tables keep one name however long it runs)."""
-    return parse_noise(noise).name if names_file(noise) else \
-        re.sub(r"\s*([,=])\s*", r"\1", noise.strip())  # "mild, holes=0.05" as record reads it
+    return parse_noise(noise).name
 
 
 def log_source(log: Path) -> str:

@@ -146,7 +146,21 @@ def parse_noise(text: str | None) -> NoiseProfile:
             items.append((k.strip(), float(v)))
         except ValueError:
             raise SgtoolError(f"--noise {t}: {k.strip()}={v!r} is not a number") from None
-    return _override(base, items, t, default_name=t)
+    return _override(base, items, t, default_name=_spelled(base.name, items))
+
+
+def _spelled(base: str, items: Iterable[tuple[str, float]]) -> str:
+    """One spelling of a profile given with overrides, its name and log folder: the
+    base profile named unless it is ``none``, the overrides in the order of
+    :class:`NoiseProfile`'s fields with numbers in Python's shortest form (``none,
+    label_swap=0.1, holes=0.050`` and ``holes=5e-2,label_swap=0.1`` are
+    ``holes=0.05,label_swap=0.1``; ``drift_xy=1.0`` is ``drift_xy=1``)."""
+    def number(v: float) -> str:
+        r = repr(float(v))
+        return r[:-2] if r.endswith(".0") else r
+    order = [f.name for f in fields(NoiseProfile)]
+    given = sorted(items, key=lambda kv: order.index(kv[0]) if kv[0] in order else len(order))
+    return ",".join(([base] if base != "none" else []) + [f"{k}={number(v)}" for k, v in given])
 
 
 def names_file(text: str) -> bool:

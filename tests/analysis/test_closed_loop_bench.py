@@ -417,10 +417,25 @@ def test_a_noise_profile_spelled_with_spaces_is_the_same_profile() -> None:
     with pytest.raises(SgtoolError, match="both name the log folder 'mild,holes=0.05'"):
         clb.ClosedLoopBenchConfig("greedy", houses=1,
                                   noise=("mild,holes=0.05", "mild, holes=0.05")).check()
-    # spelled otherwise (another number form, another order): the same faults, refused
-    with pytest.raises(SgtoolError, match="'mild,holes=0.05' and 'mild,holes=5e-2': the same"):
+    # spelled otherwise (another number form, another order): one folder, refused
+    with pytest.raises(SgtoolError, match="'mild,holes=0.05' and 'mild,holes=5e-2': both"):
         clb.ClosedLoopBenchConfig("greedy", houses=1,
                                   noise=("mild,holes=0.05", "mild,holes=5e-2")).check()
-    with pytest.raises(SgtoolError, match="the same faults"):
+    with pytest.raises(SgtoolError, match="both name the log folder 'holes=0.05,label_swap"):
         clb.ClosedLoopBenchConfig("greedy", houses=1, noise=(
             "none,holes=0.05,label_swap=0.1", "label_swap=0.1,holes=0.05")).check()
+
+
+def test_one_profile_spelled_two_ways_resumes_into_one_folder(tmp_path: Path) -> None:
+    """A resume that spells the profile otherwise (`holes=0.050`, `none, holes=5e-2`)
+    finds the first run's logs: one folder and equal settings, name included."""
+    from sgtool.analysis.run_bench_resume import task_settings
+    from sgtool.recorders.sim import ClosedLoopOptions
+
+    spellings = ("holes=0.05", "holes=0.050", "none, holes=5e-2", " holes = .05 ")
+    assert {clb.noise_folder(s) for s in spellings} == {"holes=0.05"}
+    opts = ClosedLoopOptions()
+    assert len({json.dumps(task_settings(opts, s, None), sort_keys=True)
+                for s in spellings}) == 1
+    assert clb.noise_folder("mild,drift_xy=1.0,label_swap=0.1") == \
+        "mild,label_swap=0.1,drift_xy=1"
