@@ -100,7 +100,7 @@ def parse_factor(text: str) -> tuple[str, tuple[float, ...]]:
             raise SgtoolError(f"--factor {text!r}: level {p!r} is not a number") from None
         kw: dict[str, Any] = {name: v}
         try:
-            replace(PROFILES[NONE], **kw)  # the profile's own checks (>= 0, finite, <= 1)
+            replace(PROFILES[NONE], name="", **kw)  # its checks: >= 0, finite, <= 1
         except SgtoolError as e:
             why = str(e).split(": ", 1)[-1]  # (the profile's message names --noise)
             raise SgtoolError(f"--factor {text!r}: level {p}: {why}") from None

@@ -54,7 +54,9 @@ EDGE_ABS = 0.1  # m; and by at least this much
 
 @dataclass(frozen=True)
 class NoiseProfile:
-    """Fault strengths (all 0 = a perfect sensor)."""
+    """Fault strengths (all 0 = a perfect sensor). ``name`` labels and pools the
+    profile's runs; a built-in profile's name (:data:`PROFILES`) is taken only with that
+    profile's faults."""
 
     name: str = "none"
     depth_sigma: float = 0.0  # m of std at 1 m; grows with z^2
@@ -80,6 +82,12 @@ class NoiseProfile:
         for p, most in LIMITS.items():  # beyond these, no sensor: overflow, not noise
             if getattr(self, p) > most:
                 raise SgtoolError(f"--noise {p}={getattr(self, p):g}: at most {most:g}")
+        of_type("NoiseProfile name", self.name, str, "a text")
+        same = globals().get("PROFILES", {}).get(self.name.strip())
+        if same is not None and any(getattr(self, f.name) != getattr(same, f.name)
+                                    for f in fields(self) if f.name != "name"):
+            raise SgtoolError(f"NoiseProfile({self.name!r}, ...): a built-in profile's name "
+                              "with other faults; give it a name of its own")
 
     @property
     def is_clean(self) -> bool:
@@ -188,13 +196,13 @@ def _override(base: NoiseProfile, items: Iterable[tuple[str, Any]], where: str,
     if not kw:
         return base
     how = "its \"name\"" if "name" in kw else "the file's name"
-    kw.setdefault("name", default_name)
-    out = replace(base, **kw)
-    same = PROFILES.get(out.name.strip())
-    if same is not None and replace(out, name=same.name) != same:  # labelled, pooled as it
-        raise SgtoolError(f"--noise {where}: named {out.name.strip()!r} ({how}), a built-in "
+    name = str(kw.pop("name", default_name))
+    out = replace(base, **kw, name="")
+    same = PROFILES.get(name.strip())
+    if same is not None and replace(out, name="") != replace(same, name=""):  # pooled as it
+        raise SgtoolError(f"--noise {where}: named {name.strip()!r} ({how}), a built-in "
                           "profile, with other faults; give it a name of its own")
-    return out
+    return replace(out, name=name)
 
 
 class SensorFaults:

@@ -229,3 +229,17 @@ def test_a_profile_of_ones_own_cannot_take_a_built_in_name(tmp_path: Path) -> No
     same.write_text(json.dumps({"profile": "mild", "name": "mild",
                                 "holes": PROFILES["mild"].holes}))
     assert parse_noise(str(same)) == PROFILES["mild"]
+
+
+def test_a_profile_made_in_python_cannot_take_a_built_in_name() -> None:
+    """`NoiseProfile("mild", holes=0.3)` would be labelled and pooled as mild: one line;
+    the built-in faults under the name, or another name, pass."""
+    with pytest.raises(SgtoolError, match=r"NoiseProfile\('mild', ...\): a built-in"):
+        NoiseProfile("mild", holes=0.3)
+    with pytest.raises(SgtoolError, match="a built-in profile's name"):
+        NoiseProfile(" none ", holes=0.01)
+    with pytest.raises(SgtoolError, match="NoiseProfile name"):
+        NoiseProfile(3)  # type: ignore[arg-type]
+    assert NoiseProfile("mild", **{k: v for k, v in PROFILES["mild"].to_dict().items()
+                                   if k != "name"}) == PROFILES["mild"]
+    assert NoiseProfile("mine", holes=0.3).holes == 0.3
