@@ -19,8 +19,10 @@ class BenchError(SgtoolError):
 def config_names(value: Any, field: str, paths: bool = False) -> tuple[Any, ...]:
     """A config's list field as a tuple: one name (a string, a path) is a list of one, not
     of letters; a set is refused (no order: tables and digests would vary); ``paths``:
-    each item as text."""
+    each item as text in one spelling (:func:`sgtool.files.path_text`)."""
     import os
+
+    from sgtool.files import path_text
 
     if isinstance(value, set | frozenset):
         raise BenchError(f"{field}: give a list or tuple (a set has no order)")
@@ -33,7 +35,7 @@ def config_names(value: Any, field: str, paths: bool = False) -> tuple[Any, ...]
                 if type(x).__name__ == "HouseSpec" else ""
             raise BenchError(f"{field}: give paths of house files or folders, got a "
                              f"{type(x).__name__}{hint}")
-    return tuple(os.fspath(x) for x in items)
+    return tuple(path_text(x) for x in items)
 
 
 def config_planner_options(value: Any) -> dict[str, dict[str, Any]]:

@@ -555,3 +555,18 @@ def sha256_file(path: str | os.PathLike[str]) -> str:
         for block in iter(lambda: f.read(1 << 20), b""):
             h.update(block)
     return h.hexdigest()
+
+
+def path_text(path: str | os.PathLike[str]) -> str:
+    """A path as results record it, one spelling however it was typed: normalised
+    (``./hs/`` is ``hs``), and relative to the working folder when it lies inside it
+    (``$PWD/hs`` is ``hs``); symbolic links are left as given, an empty path empty."""
+    text = os.fspath(path)
+    if not text:
+        return text
+    text = os.path.normpath(text)
+    if os.path.isabs(text):
+        rel = os.path.relpath(text)
+        if rel != ".." and not rel.startswith(".." + os.sep):
+            return rel
+    return text

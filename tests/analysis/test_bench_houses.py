@@ -86,3 +86,19 @@ def test_run_one_on_a_hand_made_house(tmp_path: Path) -> None:
         run_one(house, "greedy", "piano")
     with pytest.raises(RunOneError, match="no region 'region:9.0'"):
         run_one(house, "greedy", "milk", start="region:9.0")
+
+
+def test_a_house_path_typed_three_ways_is_recorded_one_way(tmp_path, monkeypatch) -> None:
+    """`--house ./hs/`, `--house $PWD/hs` and `--house hs` run the same houses: the
+    settings and house sources a summary records are the same text."""
+    from sgtool.analysis.bench import BenchConfig, run_benchmark
+
+    write_cottage(tmp_path / "hs")
+    monkeypatch.chdir(tmp_path)
+    runs = [run_benchmark(BenchConfig(planners=("greedy",), houses=0, episodes=1, seeds=1,
+                                      house_files=(given,)), progress=False)
+            for given in ("./hs/", str(tmp_path / "hs"), "hs")]
+    assert {tuple(r.config.settings()["house_files"]) for r in runs} == {("hs",)}
+    assert {tuple(h.source for h in r.houses) for r in runs} == {("hs/cottage.json",)}
+    outside = BenchConfig(planners=("greedy",), houses=0, house_files=(str(tmp_path.parent),))
+    assert outside.house_files == (str(tmp_path.parent),)  # outside the working folder: as is
