@@ -44,6 +44,7 @@ from typing import Any
 
 from sgtool.analysis.bench_houses import (
     BenchHouse,
+    HouseFilesError,
     bench_episodes,
     generated_houses,
     load_house_files,
@@ -508,7 +509,13 @@ def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
         require("pybullet", api="sgtool.run_closed_loop_bench")
         check_plugins_build(cfg.planners, cfg.planner_options)
     logs = (Path(out_dir) if report_only else output_dir(out_dir)) / "logs"
-    tasks = tasks_of(cfg, logs)
+    try:
+        tasks = tasks_of(cfg, logs)
+    except HouseFilesError as e:
+        if not report_only or all(Path(p).exists() for p in cfg.house_files):
+            raise
+        raise HouseFilesError(f"{e}\n--report-only: the run's house files are not where "
+                              "it read them; give --house with their place now") from None
     expected = len(tasks)
     if report_only:
         tasks = [t for t in tasks if t.output.exists()]

@@ -439,3 +439,16 @@ def test_one_profile_spelled_two_ways_resumes_into_one_folder(tmp_path: Path) ->
                 for s in spellings}) == 1
     assert clb.noise_folder("mild,drift_xy=1.0,label_swap=0.1") == \
         "mild,label_swap=0.1,drift_xy=1"
+
+
+def test_report_only_says_where_the_house_files_went(tmp_path: Path) -> None:
+    """A run's house files moved after it ran: --report-only names them and says to give
+    --house (a run, not a report, only names them)."""
+    cfg = clb.ClosedLoopBenchConfig("greedy", houses=0,
+                                    house_files=(str(tmp_path / "gone" / "h.json"),))
+    with pytest.raises(SgtoolError, match="no such house spec file\n--report-only: the run's "
+                                          "house files are not where it read them; give "
+                                          "--house"):
+        clb.run_closed_loop_bench(cfg, tmp_path, report_only=True)
+    with pytest.raises(SgtoolError, match="no such house spec file$"):
+        clb.tasks_of(cfg, tmp_path / "logs")
