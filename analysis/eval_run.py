@@ -115,10 +115,12 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
 def per_noise(results: Sequence[EpisodeResult]) -> tuple[list[EpisodeResult], list[str]]:
     """``results`` with each planner named ``PLANNER [NOISE]`` when they ran under more
     than one sensor noise profile (:attr:`EpisodeResult.noise`, or the run-bench folder
-    an older row's log lies in; ``unknown`` when neither says), and those profiles in
-    order of appearance (empty: one profile, names kept): episodes of different sensors
-    are not pooled."""
-    results = [r if r.noise else replace(r, noise=_run_bench_noise(r)) for r in results]
+    an older row's log lies in; ``symbolic`` for a symbolic bench's rows, which had no
+    sensor; ``unknown`` when none of these says), and those profiles in order of
+    appearance (empty: one profile, names kept): episodes of different sensors are not
+    pooled."""
+    results = [r if r.noise else replace(r, noise=_run_bench_noise(r) or (
+        "symbolic" if r.source == "symbolic" else "")) for r in results]
     profiles = list(dict.fromkeys(r.noise or "unknown" for r in results))
     if len(profiles) < 2:
         return list(results), []

@@ -28,3 +28,12 @@ def test_older_rows_name_their_profile_by_their_log_folder():
         _row("scout", source="/elsewhere/run.mcap")])
     assert profiles == ["strong", "none", "unknown"]
     assert rows[2].planner == "scout [unknown]"
+
+
+def test_a_symbolic_benchs_rows_are_named_symbolic_beside_a_closed_loop():
+    """A symbolic bench (no sensor) beside closed-loop logs: its rows are `[symbolic]`,
+    not `[unknown]`."""
+    rows, profiles = per_noise([_row("scout", source="symbolic"),
+                                _row("scout", "none", "logs/none/scout/house-0/ep-000.mcap")])
+    assert profiles == ["symbolic", "none"]
+    assert [r.planner for r in rows] == ["scout [symbolic]", "scout [none]"]
