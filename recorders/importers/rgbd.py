@@ -76,6 +76,7 @@ from sgtool.recorders.importers.sanity import (
 from sgtool.recorders.importers.scale_check import (
     ScaleFit,
     fit_scale,
+    frozen_poses_problem,
     geometric_scale_problem,
     pair_indices,
     pose_motion_problem,
@@ -307,6 +308,11 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
                                       estimate=opts.estimate_poses)
         checks.append(("depth scale against the poses",
                        fit.describe() if fit else "no verdict: no frame pair pins the motion down"))
+        frozen = frozen_poses_problem([np.asarray(f.pose) for f in frames],
+                                      [depth_to_metres(r, scale) for r in raws],
+                                      seq.pose_source)
+        if frozen is not None and not opts.estimate_poses:
+            findings.problem(frozen[0], given=not frozen[1])
     findings.problem(depth_scale_problem(raws, scale, scale_origin),
                      given=opts.depth_scale is not None)
     intr_origin = "flag --intrinsics" if opts.intrinsics is not None else \

@@ -197,3 +197,49 @@ def pose_motion_problem(fit: ScaleFit | None, pose_source: str) -> tuple[str, bo
             "usual cause (world-to-camera instead of camera-to-world, a quaternion order "
             "other than x y z w, the pose of a frame other than the camera's optical one): "
             "fix them, or give --estimate-poses to estimate the poses from the depth"), clear
+
+
+FROZEN_M = 0.001  # poses this close (translation, m) and
+FROZEN_RAD = 0.002  # this close (rotation, rad) to the first stand still
+MOVED_M = 0.05  # a pixel whose depth changes this much (or MOVED_REL of it) moved
+MOVED_REL = 0.05
+FROZEN_CLEAR = 0.5  # share of the pixels that moved between sampled frames: clear
+FROZEN_LIKELY = 0.2  # likely (a still camera seeing people walk stays below)
+
+
+def frozen_poses_problem(poses: Sequence[np.ndarray], depths_m: Sequence[np.ndarray],
+                         pose_source: str) -> tuple[str, bool] | None:
+    """When all ``poses`` (three or more) stand still while the depth changes: the median,
+    over consecutive ``depths_m`` (metres, frames sampled over the sequence, 0 = no
+    reading), of the share of pixels read in both whose depth changed by :data:`MOVED_M`
+    or :data:`MOVED_REL` is :data:`FROZEN_LIKELY` or more (clear at
+    :data:`FROZEN_CLEAR`: a moving camera, where a still one seeing people walk changes a
+    few pixels). The text and whether it is clear; None otherwise."""
+    if len(poses) < 3 or len(depths_m) < 2:
+        return None
+    first = np.asarray(poses[0], float)
+    for p in poses[1:]:
+        p = np.asarray(p, float)
+        cos = (np.trace(first[:3, :3].T @ p[:3, :3]) - 1.0) / 2.0
+        if np.linalg.norm(p[:3, 3] - first[:3, 3]) > FROZEN_M or \
+                np.arccos(np.clip(cos, -1.0, 1.0)) > FROZEN_RAD:
+            return None
+    shares = []
+    for a, b in zip(depths_m[:-1], depths_m[1:], strict=True):
+        if a.shape != b.shape:
+            continue
+        both = (a > 0) & (b > 0) & np.isfinite(a) & np.isfinite(b)
+        if both.sum() < 100:
+            continue
+        d = np.abs(a[both] - b[both])
+        shares.append(float(np.mean(d > np.maximum(MOVED_M, MOVED_REL * np.minimum(
+            a[both], b[both])))))
+    if not shares or float(np.median(shares)) < FROZEN_LIKELY:
+        return None
+    share = float(np.median(shares))
+    return (f"the poses ({pose_source}) stand still over all {len(poses)} frames while the "
+            f"depth changes ({share:.0%} of the pixels move more than {MOVED_M * 100:g} cm "
+            "between frames sampled over the sequence): one pose repeated for every frame is "
+            "the usual cause (a pose file of the first pose only, poses of a fixed frame); "
+            "fix them, or give --estimate-poses to estimate the poses from the depth"), \
+        share >= FROZEN_CLEAR

@@ -467,6 +467,50 @@ def test_world_to_camera_poses_are_refused_for_what_they_are(rgbd_data, tmp_path
     assert not (tmp_path / "i.mcap").exists()
 
 
+def test_one_pose_for_every_frame_is_refused_while_the_depth_moves(rgbd_data, tmp_path):
+    """The ICL sequence with its first pose repeated for every frame (a trajectory that
+    never moves): the depth changes over the sequence, so the import says the poses stand
+    still (it imported every view at one place, exit 0); --estimate-poses takes it."""
+    src = rgbd_data / "icl-livingroom1-micro"
+    folder = tmp_path / "frozen"
+    shutil.copytree(src, folder)
+    lines = (src / "open3d_estimated_trajectory.log").read_text().split("\n")
+    out = []
+    for i in range(0, len(lines) - 4, 5):
+        if not lines[i].strip():
+            break
+        out += [lines[i], *lines[1:5]]
+    (folder / "open3d_estimated_trajectory.log").write_text("\n".join(out) + "\n")
+    with pytest.raises(SgtoolError, match=r"the poses \(trajectory\) stand still over all 71 "
+                                          r"frames while the depth changes \(\d+% of the"):
+        import_rgbd(folder, tmp_path / "f.mcap", RgbdOptions(**QUIET, every=3))
+    assert not (tmp_path / "f.mcap").exists()
+    rep = import_rgbd(folder, tmp_path / "e.mcap",
+                      RgbdOptions(**QUIET, every=3, limit=12, estimate_poses=True))
+    assert rep.frames == 12
+
+
+def test_a_still_camera_is_not_taken_for_frozen_poses() -> None:
+    """Poses that stand still over depth that hardly changes (a camera on a tripod, a
+    person walking through a corner of the view) pass; so do poses that move."""
+    from sgtool.recorders.importers.scale_check import frozen_poses_problem
+
+    rng = np.random.default_rng(0)
+    room = rng.uniform(1.0, 4.0, (48, 64))
+    still = [room + rng.normal(0, 0.005, room.shape) for _ in range(5)]
+    for k, d in enumerate(still):
+        d[10:30, 5 * k:5 * k + 8] = 0.8  # someone walking: 5 % of the pixels
+    eye = [np.eye(4)] * 5
+    assert frozen_poses_problem(eye, still, "trajectory") is None
+    moved = [np.roll(room, 7 * k, axis=1) for k in range(5)]
+    text, clear = frozen_poses_problem(eye, moved, "trajectory")
+    assert clear and "stand still over all 5 frames" in text
+    steps = [np.eye(4) for _ in range(5)]
+    for k, p in enumerate(steps):
+        p[0, 3] = 0.1 * k
+    assert frozen_poses_problem(steps, moved, "trajectory") is None
+
+
 def test_depth_at_another_scale_is_named_by_the_poses(rgbd_data, tmp_path):
     """7-Scenes depth written at 5000 units/m (TUM's) instead of its 1000: the error names
     5000, which the metric poses fit, not the usual scale whose median depth is nearest
