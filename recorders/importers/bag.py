@@ -94,7 +94,12 @@ from sgtool.recorders.importers.sink import (
     odometry_report_fields,
     write_log,
 )
-from sgtool.recorders.importers.upright import DepthSample, WorldAlignment, estimate_alignment
+from sgtool.recorders.importers.upright import (
+    DepthSample,
+    WorldAlignment,
+    estimate_alignment,
+    given_up_problem,
+)
 
 __all__ = ["BagOptions", "check_flags", "check_options", "describe_bag", "import_bag",
            "read_trajectory"]
@@ -197,6 +202,7 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         ]
         alignment = estimate_alignment(poses, samples, up=opts.up,
                                        floor=opts.floor, floor_auto=opts.floor_auto)
+        findings.problem(given_up_problem(alignment), given=True)
         findings.problem(floor_confidence_problem(
             alignment.floor, alignment.floor_confidence, alignment.floor_method,
             alignment.floor_detail, float(np.median(camera_heights(poses, alignment.matrix))),

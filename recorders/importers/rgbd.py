@@ -90,7 +90,12 @@ from sgtool.recorders.importers.sink import (
     write_log,
 )
 from sgtool.recorders.importers.textformats import PinholeParams
-from sgtool.recorders.importers.upright import DepthSample, estimate_alignment, sample_indices
+from sgtool.recorders.importers.upright import (
+    DepthSample,
+    estimate_alignment,
+    given_up_problem,
+    sample_indices,
+)
 
 
 @dataclass(frozen=True)
@@ -352,6 +357,7 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
                for raw, i in zip(raws, picks, strict=True)]
     alignment = estimate_alignment(poses, samples, up=opts.up, floor=opts.floor,
                                    floor_auto=opts.floor_auto)
+    findings.problem(given_up_problem(alignment), given=True)
     findings.problem(floor_confidence_problem(
         alignment.floor, alignment.floor_confidence, alignment.floor_method,
         alignment.floor_detail, float(np.median(camera_heights(poses, alignment.matrix))),

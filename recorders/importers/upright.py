@@ -88,6 +88,7 @@ class WorldAlignment:
     floor_method: str  # "given", "none", "no-depth", "horizontal-plane", "all-points"
     floor_confidence: float = 1.0  # of an estimated floor (:mod:`.floor`); 1 when given
     floor_detail: str = ""  # what the estimate is made of (:meth:`.FloorEstimate.describe`)
+    surfaces_up: tuple[float, float, float] | None = None  # a given up: the surfaces' normal
 
     @classmethod
     def identity(cls) -> WorldAlignment:
@@ -198,21 +199,19 @@ def estimate_alignment(
     pts = np.concatenate(pts_list) if pts_list else np.zeros((0, 3))
     nrm = np.concatenate(nrm_list) if nrm_list else np.zeros((0, 3))
 
+    surfaces: tuple[float, float, float] | None = None
     if up is not None:
         u = np.asarray(up, dtype=np.float64) / np.linalg.norm(up)
         up_method = "given"
+        seen = _horizontal_normal(nrm, u)
+        if seen is not None:
+            surfaces = (float(seen[0]), float(seen[1]), float(seen[2]))
     else:
         u = camera_up(poses)
         up_method = "camera-up"
-        for cos_min in np.cos(np.radians([30.0, 15.0, 8.0])):
-            d = nrm @ u
-            sel = np.abs(d) > cos_min
-            if sel.sum() < max(200, 0.02 * len(nrm)):
-                break
-            oriented = nrm[sel] * np.sign(d[sel])[:, None]
-            m = oriented.mean(axis=0)
-            u = m / np.linalg.norm(m)
-            up_method = "horizontal-normals"
+        seen = _horizontal_normal(nrm, u)
+        if seen is not None:
+            u, up_method = seen, "horizontal-normals"
 
     R = rotation_to_z(u)  # noqa: N806
     if floor is not None:
@@ -226,5 +225,40 @@ def estimate_alignment(
         est = estimate_floor(samples, u)
         assert est is not None  # there are points
         return WorldAlignment(R, est.height, (float(u[0]), float(u[1]), float(u[2])), up_method,
-                              est.method, est.confidence, est.describe())
-    return WorldAlignment(R, fl, (float(u[0]), float(u[1]), float(u[2])), up_method, floor_method)
+                              est.method, est.confidence, est.describe(), surfaces)
+    return WorldAlignment(R, fl, (float(u[0]), float(u[1]), float(u[2])), up_method, floor_method,
+                          surfaces_up=surfaces)
+
+
+def _horizontal_normal(nrm: np.ndarray, u: np.ndarray) -> np.ndarray | None:
+    """The mean normal of the surfaces within 30, then 15, then 8 degrees of ``u``
+    (module doc), oriented along ``u``; None when too few normals lie within 30."""
+    found = None
+    for cos_min in np.cos(np.radians([30.0, 15.0, 8.0])):
+        d = nrm @ u
+        sel = np.abs(d) > cos_min
+        if sel.sum() < max(200, 0.02 * len(nrm)):
+            break
+        m = (nrm[sel] * np.sign(d[sel])[:, None]).mean(axis=0)
+        u = found = m / np.linalg.norm(m)
+    return found
+
+
+UP_TOLERANCE_DEG = 10.0  # a given up this far from the horizontal surfaces is doubted
+
+
+def given_up_problem(alignment: WorldAlignment) -> str | None:
+    """A given ``--up`` more than :data:`UP_TOLERANCE_DEG` from the normal of the
+    horizontal surfaces (floor, table tops) seen near it: heights would tilt across the
+    map. None when the up was not given or no such surfaces were seen."""
+    if alignment.up_method != "given" or alignment.surfaces_up is None:
+        return None
+    given, seen = np.asarray(alignment.up), np.asarray(alignment.surfaces_up)
+    off = float(np.degrees(np.arccos(np.clip(given @ seen, -1.0, 1.0))))
+    if off <= UP_TOLERANCE_DEG:
+        return None
+    shown = ",".join(f"{x:.3f}" for x in seen)
+    return (f"--up {','.join(f'{x:.3f}' for x in alignment.up)} is {off:.0f} degrees off the "
+            f"horizontal surfaces seen (floor, table tops: up {shown}); heights tilt by "
+            f"{np.tan(np.radians(off)):.2f} m per metre across the map; give --up {shown} "
+            "or --up auto")

@@ -490,6 +490,22 @@ def test_one_pose_for_every_frame_is_refused_while_the_depth_moves(rgbd_data, tm
     assert rep.frames == 12
 
 
+def test_an_up_far_off_the_horizontal_surfaces_is_doubted(rgbd_data, tmp_path):
+    """ICL's up is -y; a given up 27 degrees off it (a tilted world every height would
+    follow) is kept with a warning naming the surfaces' up; -y itself passes quietly."""
+    src = rgbd_data / "icl-livingroom1-micro"
+    tilt = np.radians(27.0)
+    off = np.array([0.0, -np.cos(tilt), np.sin(tilt)])
+    rep = import_rgbd(src, tmp_path / "t.mcap",
+                      RgbdOptions(**QUIET, every=10, up=off, floor=-0.45))
+    (warn,) = [w for w in rep.warnings if "degrees off the horizontal" in w]
+    assert warn.startswith("--up 0.000,-0.891,0.454 is 2")  # 27-29: the surfaces' own tilt
+    assert "give --up -0.0" in warn
+    rep = import_rgbd(src, tmp_path / "y.mcap",
+                      RgbdOptions(**QUIET, every=10, up=np.array([0.0, -1.0, 0.0])))
+    assert not [w for w in rep.warnings if "degrees off" in w]
+
+
 def test_a_still_camera_is_not_taken_for_frozen_poses() -> None:
     """Poses that stand still over depth that hardly changes (a camera on a tripod, a
     person walking through a corner of the view) pass; so do poses that move."""
