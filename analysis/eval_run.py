@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -72,7 +72,8 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
     judged = [with_seen(with_success_rule(r, request.success)) for r in results]
     unconfirmed = sorted({r.planner for r, j in zip(results, judged, strict=True)
                           if r.success and not j.success})
-    results, profiles = per_noise(judged)  # (fills the noise a row's folder names)
+    symbolic = {lg.source for lg in logged if lg.episode.source == "symbolic"}
+    results, profiles = per_noise(judged, symbolic)  # (fills the noise a row's folder names)
     results, twice = once_each(results)
     notes = [*notes, *twice]
     if unconfirmed:  # runs made under "observed": their planners never had to call done
@@ -112,15 +113,17 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
     return EvalOutcome(text=text, unread=list(unread))
 
 
-def per_noise(results: Sequence[EpisodeResult]) -> tuple[list[EpisodeResult], list[str]]:
+def per_noise(results: Sequence[EpisodeResult], symbolic_logs: Collection[str] = ()
+              ) -> tuple[list[EpisodeResult], list[str]]:
     """``results`` with each planner named ``PLANNER [NOISE]`` when they ran under more
     than one sensor noise profile (:attr:`EpisodeResult.noise`, or the run-bench folder
-    an older row's log lies in; ``symbolic`` for a symbolic bench's rows, which had no
-    sensor; ``unknown`` when none of these says), and those profiles in order of
-    appearance (empty: one profile, names kept): episodes of different sensors are not
-    pooled."""
+    an older row's log lies in; ``symbolic`` for a symbolic bench's rows and the rows of
+    its logs (``symbolic_logs``: their sources), which had no sensor; ``unknown`` when none
+    of these says), and those profiles in order of appearance (empty: one profile, names
+    kept): episodes of different sensors are not pooled."""
     results = [r if r.noise else replace(r, noise=_run_bench_noise(r) or (
-        "symbolic" if r.source == "symbolic" else "")) for r in results]
+        "symbolic" if r.source == "symbolic" or r.source in symbolic_logs else ""))
+        for r in results]
     profiles = list(dict.fromkeys(r.noise or "unknown" for r in results))
     if len(profiles) < 2:
         return list(results), []

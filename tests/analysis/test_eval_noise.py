@@ -37,3 +37,8 @@ def test_a_symbolic_benchs_rows_are_named_symbolic_beside_a_closed_loop():
                                 _row("scout", "none", "logs/none/scout/house-0/ep-000.mcap")])
     assert profiles == ["symbolic", "none"]
     assert [r.planner for r in rows] == ["scout [symbolic]", "scout [none]"]
+    # the bench's own logs (--log-dir) are symbolic too: one profile with its table rows
+    log = "/x/b/logs/scout/house-0/ep-000-s0.mcap"
+    rows, profiles = per_noise([_row("scout", source="symbolic"), _row("scout", source=log)],
+                               symbolic_logs={log})
+    assert profiles == [] and [r.planner for r in rows] == ["scout", "scout"]

@@ -50,13 +50,39 @@ def check_spec(name: str) -> tuple[str, str]:
     return m.group(1), m.group(2)
 
 
-def entry_points() -> dict[str, metadata.EntryPoint]:
-    """The planners installed packages register (group :data:`GROUP`), by name; the first
-    of two distributions registering one name wins (``importlib.metadata``'s order)."""
-    out: dict[str, metadata.EntryPoint] = {}
+def registered() -> dict[str, list[metadata.EntryPoint]]:
+    """The planners installed packages register (group :data:`GROUP`), by name: the
+    distinct ``module:Name`` values registered under it, in ``importlib.metadata``'s
+    order (two when two packages register one name)."""
+    out: dict[str, list[metadata.EntryPoint]] = {}
     for ep in metadata.entry_points(group=GROUP):
-        out.setdefault(ep.name, ep)
+        same = out.setdefault(ep.name, [])
+        if all(e.value != ep.value for e in same):
+            same.append(ep)
     return out
+
+
+def entry_points() -> dict[str, metadata.EntryPoint]:
+    """The first entry point registered under each name (:func:`registered`); a name two
+    packages register is refused where it is used (:func:`clash_problem`)."""
+    return {name: eps[0] for name, eps in registered().items()}
+
+
+def clash_problem(name: str) -> str | None:
+    """When two installed packages register planner ``name`` as different things: one
+    line naming both (which one an entry-point lookup finds depends on the install order,
+    so neither is taken); None otherwise."""
+    eps = registered().get(name, [])
+    if len(eps) < 2:
+        return None
+    shown = ", ".join(f"{e.value} (package {_package(e)})" for e in eps)
+    return (f"planner {name!r}: two installed packages register it in {GROUP} ({shown}); "
+            "name the one meant as module:Name, or uninstall the other")
+
+
+def _package(ep: metadata.EntryPoint) -> str:
+    dist = getattr(ep, "dist", None)
+    return f"{dist.name} {dist.version}" if dist is not None else "unknown"
 
 
 def load_factory(name: str, entry: metadata.EntryPoint | None = None) -> Callable[..., Any]:

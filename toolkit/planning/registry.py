@@ -292,6 +292,8 @@ def _factory(name: str) -> Callable[..., Any]:
     entry = plugins.entry_points().get(name)
     if entry is None and not plugins.is_spec(name):
         raise _unknown(name)
+    if (clash := plugins.clash_problem(name)) is not None:
+        raise plugins.PluginError(clash)
     return plugins.load_factory(name, entry)
 
 
@@ -449,9 +451,10 @@ def describe_planners(plugins_named: Sequence[str] = ()) -> str:
     found = plugins.entry_points()
     lines.append(f"Plug-ins registered in the entry-point group {plugins.GROUP}: "
                  + ("none" if not found else ""))
-    for ep_name, ep in sorted(found.items()):
-        shadow = " (shadowed by the built-in planner)" if ep_name.lower() in REGISTRY else ""
-        lines.append(f"    {ep_name} = {ep.value}{shadow}")
+    for ep_name, eps in sorted(plugins.registered().items()):
+        shadow = " (shadowed by the built-in planner)" if ep_name.lower() in REGISTRY else \
+            " (registered by two packages: name one as module:Name)" if len(eps) > 1 else ""
+        lines.append(f"    {ep_name} = {' | '.join(e.value for e in eps)}{shadow}")
     for name in dict.fromkeys(n for n in plugins_named if n.lower() not in REGISTRY):
         lines += ["", *_plugin_lines(name)]
     lines.append("")

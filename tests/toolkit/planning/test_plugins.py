@@ -402,3 +402,22 @@ def test_a_plug_in_constructor_drawing_from_random_draws_the_same_every_run(
     np.random.seed(1)
     make_planner("initrand_plug:Drawn")
     assert (random.random(), float(np.random.random_sample())) == after  # untouched
+
+
+def test_a_name_two_packages_register_is_refused_naming_both(plugin_dir: Path) -> None:
+    """Two installed packages register `fake-twice` as different classes: which one a
+    lookup finds depends on the install order, so neither is taken (it was the first,
+    silently); the listing shows both. The same value registered twice is one."""
+    for pkg, value in (("alpha", "mymod_plug:MyPlanner"), ("beta", "mymod_plug:Half")):
+        dist = plugin_dir / f"sgtool_{pkg}-1.0.dist-info"
+        dist.mkdir()
+        (dist / "METADATA").write_text(f"Metadata-Version: 2.1\nName: sgtool-{pkg}\n"
+                                       "Version: 1.0\n")
+        (dist / "entry_points.txt").write_text(
+            f"[{GROUP}]\nfake-twice = {value}\nfake-once = mymod_plug:MyPlanner\n")
+    with pytest.raises(PluginError, match=r"planner 'fake-twice': two installed packages "
+                                          r"register it in sgtool.planners \(mymod_plug:"):
+        make_planner("fake-twice")
+    assert make_planner("fake-once").name == "fake-once"
+    assert "fake-twice = mymod_plug:" in describe_planners()
+    assert "(registered by two packages: name one as module:Name)" in describe_planners()
