@@ -102,6 +102,26 @@ class RobotState:
     region: str | None = None
 
 
+class Distances(dict[str, float]):
+    """A read-only dict: a scene graph's ``distances``. A planner is handed the graph that
+    is logged and handed to the next planner, so changing it in place would change both;
+    every method that would change it raises :class:`TypeError` (copy it with
+    ``dict(graph.distances)``). Compares, pickles and serialises as a dict."""
+
+    def _read_only(self, *args: Any, **kwargs: Any) -> Any:
+        raise TypeError("SceneGraph.distances is read-only (the graph is logged and shared): "
+                        "change a copy, dict(graph.distances)")
+
+    __setitem__ = __delitem__ = __ior__ = _read_only
+    clear = pop = popitem = setdefault = update = _read_only
+
+    def __reduce__(self) -> tuple[type, tuple[dict[str, float]]]:
+        return (type(self), (dict(self),))
+
+    def copy(self) -> dict[str, float]:
+        return dict(self)
+
+
 @dataclass(frozen=True)
 class SceneGraph:
     """One observation of the world at ``time_ns`` (log time; 0 in the symbolic benchmark).
@@ -109,7 +129,8 @@ class SceneGraph:
     ``distances`` holds the travel distance in metres from the robot to every node it could
     act on (rooms, regions, frontiers, objects, doors), as computed by whoever built the
     graph (Voronoi graph paths in the replayer, geodesics on the occupancy grid in the
-    symbolic benchmark). A node missing from it is unreachable.
+    symbolic benchmark). A node missing from it is unreachable. It is read-only
+    (:class:`Distances`: a mapping given is copied into one).
     """
 
     robot: RobotState
@@ -117,9 +138,13 @@ class SceneGraph:
     regions: tuple[RegionNode, ...] = ()
     objects: tuple[ObjectNode, ...] = ()
     doors: tuple[DoorNode, ...] = ()
-    distances: dict[str, float] = field(default_factory=dict)
+    distances: dict[str, float] = field(default_factory=Distances)
     time_ns: int = 0
     version: str = SCENE_GRAPH_VERSION
+
+    def __post_init__(self) -> None:
+        if type(self.distances) is not Distances:
+            object.__setattr__(self, "distances", Distances(self.distances))
 
     # ----- look-ups -------------------------------------------------------------------
     def node(self, node_id: str) -> RoomNode | RegionNode | ObjectNode | DoorNode | None:
