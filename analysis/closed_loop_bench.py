@@ -69,7 +69,12 @@ from sgtool.analysis.closed_loop_tables import (
     reason_class,
     symbolic_agreement,
 )
-from sgtool.analysis.offline import log_exchanges, read_log_episodes, with_seen
+from sgtool.analysis.offline import (
+    executor_message,
+    log_exchanges,
+    read_log_episodes,
+    with_seen,
+)
 from sgtool.analysis.report import format_table, pipe_table
 from sgtool.analysis.run_bench_resume import (
     ResumeError,
@@ -314,7 +319,7 @@ def _row(task: RunTask, seconds: float | None) -> RunRow:
     res = replace(with_seen(ep.result()), seed=task.options.planner_seed,
                   source=log_source(task.output),
                   llm_answers=answer_counts(rec for _, rec in log_exchanges([task.output])))
-    fails = Counter(reason_class(d.action.reason or "") for d in ep.decisions
+    fails = Counter(reason_class(executor_message(d.action)) for d in ep.decisions
                     if d.action.outcome == "failure")
     reasons = [d.action.reason or "" for d in ep.decisions]
     went_on = sum(1 for r in reasons if r.startswith(WENT_ON))

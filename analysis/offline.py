@@ -326,9 +326,9 @@ def node_rooms(graph: SceneGraph, node_id: str | None) -> frozenset[str]:
 
 
 def executor_message(action: Action) -> str:
-    """What the executor told the planner about ``action``: the ``message`` a symbolic log
-    records beside the planner's ``reason``; a closed-loop log's ``reason`` is the
-    simulator's own."""
+    """What the executor told the planner about ``action``: the ``message`` a log records
+    beside the planner's ``reason``; without one (the robot's own actions, closed-loop
+    logs written before they kept the planner's reason) the ``reason``, the robot's."""
     msg = action.unknown.get("message")
     return str(msg) if isinstance(msg, str) else str(given(action.reason, ""))
 

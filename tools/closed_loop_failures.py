@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 
 from sgtool.analysis.closed_loop_bench import reason_class
+from sgtool.analysis.offline import executor_message
 from sgtool.log.reader import LogReader
 from sgtool.log.records import Action
 
@@ -19,7 +20,7 @@ from sgtool.log.records import Action
 def failed_skills(path: Path) -> collections.Counter[str]:
     """Failed skills of one closed-loop log by reason class."""
     with LogReader(path) as r:
-        return collections.Counter(reason_class(a.reason) for _, a in r.records(Action)
+        return collections.Counter(reason_class(executor_message(a)) for _, a in r.records(Action)
                                    if a.outcome == "failure")
 
 

@@ -338,7 +338,7 @@ class _Search:
                 self.failed.failed(str(action.target))
         outcome = SkillOutcome(action.skill, action.target, o, why, dist, ticks)
         self.last_t = self.rec.act(self.sim, outcome, self._decision_s,
-                                   {"graph_time_ns": self._graph_time_ns, **self._shown})
+                                   self._decided_fields(action, why))
         self._check(self.rec.stream.current, cut)  # found overrides a done
         if self.explore_on and self.skills is not None and action.skill == "explore" and \
                 o == "success" and why != IN_VIEW and self._seen is not None:
@@ -406,7 +406,7 @@ class _Search:
         why = f"{GAVE_UP}: the robot explores them (fallback)"
         outcome = SkillOutcome("done", None, "success", why, 0.0, 0)
         self.last_t = self.rec.act(self.sim, outcome, self._decision_s,
-                                   {"graph_time_ns": self._graph_time_ns, **self._shown})
+                                   self._decided_fields(action, why))
         self._check(self.rec.stream.current, False)
         if not self.end:
             self._hand_over(GAVE_UP, actionable(graph))
@@ -421,7 +421,15 @@ class _Search:
         outcome = SkillOutcome(step.action.skill, step.action.target, fb.outcome,
                                fb.message, 0.0, 0)
         self.last_t = self.rec.act(self.sim, outcome, self._decision_s,
-                                   {"graph_time_ns": self._graph_time_ns, **self._shown})
+                                   self._decided_fields(step.action, fb.message))
+
+    def _decided_fields(self, action: Action, message: str) -> dict[str, Any]:
+        """The record fields of an action the planner decided: the graph it decided on and
+        the view it was shown, its own ``reason``, and the executor's ``message`` beside it
+        (as the symbolic environment logs them; the robot's own actions carry the robot's
+        reason and no message)."""
+        return {"graph_time_ns": self._graph_time_ns, **self._shown,
+                "reason": action.reason, "unknown": {"message": message}}
 
     def _run(self, calls: tuple[SkillCall, ...]) -> Executed:
         if self.skills is None:

@@ -173,6 +173,9 @@ def test_scout_episode_log(scout_log, house) -> None:
             assert a["graph_time_ns"] in graphs and a["graph_time_ns"] <= t
             # a refresh at every action that took frames
             assert t in graphs or a["outcome"] == "invalid" or a["skill"] == "done"
+            # the planner's reason, and the executor's message beside it
+            assert isinstance(a["message"], str) and a["message"] != a["reason"]
+        assert "message" not in look  # the robot's own action: its reason only
         # every logged distance is rounded to 0.1 mm (the records' canonical rounding)
         assert ended["travelled_m"] == pytest.approx(sum(a["travelled_m"] for a in decided),
                                                      abs=5e-5 * (len(decided) + 1))

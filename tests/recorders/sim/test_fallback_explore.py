@@ -134,7 +134,7 @@ def test_giving_up_with_goals_on_offer_ends_the_episode(house, tmp_path) -> None
     assert actionable(p.graphs[0])
     assert (rep.success, rep.end, rep.steps) == (False, "gave_up", 1)
     acts = _actions(out)
-    assert acts[-1]["reason"] == cl.DONE_MESSAGE
+    assert acts[-1]["message"] == cl.DONE_MESSAGE  # the executor's, beside the planner's reason
     assert not any(is_fallback(a.get("reason")) for a in acts)
     assert cl.give_up_handed_over(["room:1"], {"room:1", "door:2"})
     assert not cl.give_up_handed_over(["room:1", "door:2"], {"room:1"})
@@ -150,8 +150,8 @@ def test_giving_up_after_every_goal_failed_hands_over(house, tmp_path,
     rep = run_episode(house, ep, p, out, OPTS, episode_index=idx)
     acts = _actions(out)
     assert (acts[1]["skill"], acts[1]["outcome"]) == ("done", "success")
-    assert "gave up while the robot's map has reachable frontiers" in acts[1]["reason"]
-    assert p.feedbacks[0].message == acts[1]["reason"]
+    assert "gave up while the robot's map has reachable frontiers" in acts[1]["message"]
+    assert p.feedbacks[0].message == acts[1]["message"]
     handed = [a for a in acts[2:] if is_fallback(a.get("reason"))]
     assert handed and handed[0]["reason"].startswith("fallback: the planner gave up")
     assert handed[0]["travelled_m"] > 0 and handed[0]["graph_time_ns"] is None
@@ -161,7 +161,7 @@ def test_giving_up_after_every_goal_failed_hands_over(house, tmp_path,
     # the episode ends: found, out of frames, or a give-up with no frontier left
     assert rep.end in ("found", "frames", "gave_up")
     if rep.end == "gave_up":
-        assert acts[-1]["reason"] == cl.DONE_MESSAGE
+        assert acts[-1]["message"] == cl.DONE_MESSAGE
     # replay rebuilds the live scene graphs byte for byte
     derived = tmp_path / "replayed.mcap"
     r = CliRunner().invoke(cli, ["replay", str(out), "-o", str(derived)])

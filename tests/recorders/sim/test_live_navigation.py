@@ -72,7 +72,7 @@ def test_unreachable_goal_fails_with_its_reason_in_the_log(house, tmp_path) -> N
         started = r.records("episode").__next__()[1]
     assert (acts[1]["skill"], acts[1]["target"], acts[1]["outcome"]) == (
         "navigate", "room:1", "failure")
-    assert acts[1]["reason"] == fb.message
+    assert acts[1]["message"] == fb.message  # the planner's own reason beside it
     assert started["extra"]["navigation"]["mode"] == "live"
     # the privileged simulator planned on the whole house and knew why
     p2 = Scripted([_unexplored_room] + [Action("done")] * 20)

@@ -86,7 +86,7 @@ def test_done_rule_confirmed(runs) -> None:
     acts = _actions(path)
     assert len(acts) == len(_actions(runs["observed"][0])) + 1
     last = acts[-1]
-    assert (last["skill"], last["outcome"], last["reason"]) == ("done", "success", CONFIRMED)
+    assert (last["skill"], last["outcome"], last["message"]) == ("done", "success", CONFIRMED)
     assert last["target"].startswith("obj:") and last["travelled_m"] == 0.0
     started, ended = _episodes(path)
     assert started["extra"]["success"] == ended["extra"]["success"] == "done"
@@ -103,7 +103,7 @@ def test_done_rule_unconfirmed(runs) -> None:
     path, rep = runs["unconfirmed"]
     assert (rep.success, rep.end) == (False, NOT_CONFIRMED)
     last = _actions(path)[-1]
-    assert last["outcome"] == "failure" and "did not call done()" in last["reason"]
+    assert last["outcome"] == "failure" and "did not call done()" in last["message"]
     ended = _episodes(path)[-1]
     assert (ended["status"], ended["extra"]["end"]) == ("failure", NOT_CONFIRMED)
     # judged by the observed rule the same log is a find
