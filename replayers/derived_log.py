@@ -345,7 +345,8 @@ def replay(
                     writer.add_metadata(REPLAY_METADATA, replay_metadata(
                         opts, tf_time, sha256_file(src)))
                     for a in reader.iter_attachments():
-                        writer.attach(a.name, a.data, a.media_type, a.log_time)
+                        writer.attach(a.name, a.data, a.media_type, a.log_time,
+                                      create_time_ns=a.create_time)
                     _run(reader, stream, writer, opts, report, on_refresh, progress, copy_chunks,
                          tf_time=tf_time)
         report.seconds = time.perf_counter() - t0

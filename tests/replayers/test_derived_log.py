@@ -49,17 +49,23 @@ def messages(path: Path) -> dict[str, list[tuple[int, bytes]]]:
 
 def synthetic_log(path: Path, with_ids: bool = True, opening: str = "open",
                   noise: float = 0.0, world: np.ndarray | None = None,
-                  table_without: str | None = None, pitch: float = 0.3) -> Path:
+                  table_without: str | None = None, pitch: float = 0.3,
+                  calibration: bool = False) -> Path:
     """The two-room house seen by a robot looking around in the kitchen, walking to the
     bedroom and looking around there; an action record after each part. ``noise``: depth
     noise of std ``noise`` z^2 (seeded); ``world``: a 4x4 transform applied to every pose
     (another world convention); ``table_without``: an instance kind left out of the
-    instance table (its ids stay in the images); ``pitch``: the camera's, down (rad)."""
+    instance table (its ids stay in the images); ``pitch``: the camera's, down (rad);
+    ``calibration``: an attachment created long before its log time, as a user's tool
+    attaches a calibration file."""
     hw = world_of_house(two_room_house(opening))
     rng = np.random.default_rng(5)
     parts = [look_around(2.0, 1.5, 0.0, 12), walk([(2.0, 1.5), (6.0, 1.5)], 0.25),
              look_around(6.0, 1.0, 0.0, 12)]
     with LogWriter(path, seed=3) as w:
+        if calibration:
+            w.attach("calib.yaml", b"fx: 525\n", "application/yaml", 5,
+                     create_time_ns=1_600_000_000_000_000_000)
         if with_ids:
             w.write_record("instances", 0, {"instances": [
                 v.to_record() for v in hw.instances.values() if v.kind != table_without]})
@@ -514,3 +520,17 @@ def test_a_classifier_of_ones_own_is_checked_before_its_answer_enters_the_graph(
         replay(GOLDEN / "house6-tour.mcap", out, ReplayOptions(max_frames=30),
                room_classifier=lambda name: _OwnClassifier(answer))
     assert not list(tmp_path.iterdir())
+
+
+def test_an_attachment_is_copied_with_its_own_create_time(tmp_path):
+    """A replay copies attachments unchanged: the create time too (it became the log
+    time)."""
+    src = synthetic_log(tmp_path / "cal.mcap", calibration=True)
+    out = tmp_path / "derived.mcap"
+    replay(src, out, ReplayOptions())
+    with LogReader(src) as a, LogReader(out) as b:
+        was, now = ([(x.name, x.log_time, x.create_time, x.media_type, x.data)
+                     for x in r.iter_attachments()] for r in (a, b))
+    assert ("calib.yaml", 5, 1_600_000_000_000_000_000, "application/yaml",
+            b"fx: 525\n") in was
+    assert now == was

@@ -349,9 +349,13 @@ class LogWriter:
         self._add(cid, t_ns, json.dumps(d, sort_keys=True, separators=(",", ":")).encode())
         return d
 
-    def attach(self, name: str, data: bytes, media_type: str, t_ns: int = 0) -> None:
+    def attach(self, name: str, data: bytes, media_type: str, t_ns: int = 0,
+               create_time_ns: int | None = None) -> None:
+        """An attachment at log time ``t_ns``, created at ``create_time_ns`` (None: then
+        too; a copied attachment keeps its own)."""
         self._mcap.add_attachment(
-            create_time=t_ns, log_time=t_ns, name=name, media_type=media_type, data=data
+            create_time=t_ns if create_time_ns is None else create_time_ns, log_time=t_ns,
+            name=name, media_type=media_type, data=data
         )
 
     def attach_house(self, house_json: str | bytes) -> None:
