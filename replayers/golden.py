@@ -388,6 +388,8 @@ def describe_mismatch(expected: Sequence[str], actual: Sequence[tuple[RefreshInf
         lines = diff_graphs(SceneGraph.from_json(exp), SceneGraph.from_json(got), tol, pair)
         if not exact:
             lines = [x for x in lines if x != ROUNDING]
+        elif not lines and exp != got:  # bytes differ where the graph reads nothing
+            lines = json_changes(exp, got)
         if not lines:
             continue
         head = refresh_head(numbers[i] if i < len(numbers) else i, ref) + " differs:"
@@ -397,6 +399,38 @@ def describe_mismatch(expected: Sequence[str], actual: Sequence[tuple[RefreshInf
         return [f"{len(actual)} refreshes where {len(expected)} were expected; the first "
                 f"{min(len(expected), len(actual))} agree"]
     return []
+
+
+def json_changes(expected: str, actual: str, limit: int = 10) -> list[str]:
+    """Where two graph JSON texts differ that :func:`diff_graphs` does not see (keys the
+    scene graph does not read, added or removed, and their values; else the text's form):
+    one line per difference, ``json: PATH: ...``."""
+    import json
+
+    out: list[str] = []
+
+    def walk(a: Any, b: Any, path: str) -> None:
+        if len(out) >= limit:
+            return
+        if isinstance(a, dict) and isinstance(b, dict):
+            for k in sorted(a.keys() - b.keys()):
+                out.append(f"json: {path}{k}: key removed")
+            for k in sorted(b.keys() - a.keys()):
+                out.append(f"json: {path}{k}: key added")
+            for k in sorted(a.keys() & b.keys()):
+                walk(a[k], b[k], f"{path}{k}.")
+        elif isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+            for i, (x, y) in enumerate(zip(a, b, strict=True)):
+                walk(x, y, f"{path.removesuffix('.')}[{i}].")
+        elif a != b or type(a) is not type(b):
+            out.append(f"json: {path.removesuffix('.')}: {a!r} -> {b!r}")
+
+    try:
+        walk(json.loads(expected), json.loads(actual), "")
+    except ValueError:
+        return ["json: the text is not JSON"]
+    return out[:limit] or ["json: the same fields and values, written otherwise (key order, "
+                           "spacing or number form)"]
 
 
 # quality figure, how a report names it, its format

@@ -156,6 +156,31 @@ def test_tolerance_and_exactness_of_describe_mismatch():
         "2 refreshes where 3 were expected; the first 2 agree"]
 
 
+def test_a_graph_key_added_or_removed_is_a_difference_at_tolerance_0():
+    """Keys the scene graph does not read (a key renamed, added, removed) leave the graphs
+    it parses equal: at tolerance 0 (byte-identical graphs wanted) the check still says
+    where the JSON differs; with a tolerance they pass."""
+    import json
+
+    graphs = read_graphs(GOLDEN / "house10-start.graphs.jsonl.gz")[:2]
+    d = json.loads(graphs[1])
+    d["objects"][0]["confidence"] = 0.9
+    d["objects"][0].pop("relation", None)
+
+    class Ref:
+        time_ns, frames, reason = 2_500_000_000, 20, "every"
+
+    actual = [(Ref, graphs[0]), (Ref, json.dumps(d, sort_keys=True, separators=(",", ":")))]
+    lines = describe_mismatch(graphs, actual, tol=0.0)
+    assert lines[0] == "refresh 1 at 2.500 s (after 20 frames, every) differs:"
+    assert "  json: objects[0].confidence: key added" in lines
+    assert describe_mismatch(graphs, actual, tol=0.01, exact=False) == []
+    spaced = [(Ref, graphs[0]), (Ref, json.dumps(json.loads(graphs[1]), indent=1))]
+    assert describe_mismatch(graphs, spaced, tol=0.0)[1:] == [
+        "  json: the same fields and values, written otherwise (key order, spacing or "
+        "number form)"]
+
+
 def _changed(value):
     """A value of the same type that reads differently in the canonical JSON."""
     if isinstance(value, bool):
