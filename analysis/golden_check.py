@@ -61,6 +61,7 @@ from sgtool.replayers.golden_pins import (
     pinned_entry,
     read_pins,
     stored_path,
+    valid_name,
     write_capture,
     write_index,
 )
@@ -159,16 +160,18 @@ PIN_FILES = (INDEX, "*.graphs.jsonl.gz", "*.refreshes.jsonl.gz", "*.mcap")
 
 
 @contextlib.contextmanager
-def pin_folder(root: Path) -> Iterator[Path]:
+def pin_folder(root: Path, logs: Sequence[Path] = ()) -> Iterator[Path]:
     """The folder to write pins of ``root`` into (:func:`sgtool.files.output_folder`): a
     new or empty ``root`` is built beside and moved in complete (a non-empty folder that
-    holds no pins is refused); a pin folder sgtool made is written in place, file by file
-    atomically, the index last; a pin folder without sgtool's manifest (one kept with a
-    project's tests) likewise, as it is. The block holds :func:`pins_locked`: read the
-    index inside it, so that writers in several processes (``pytest -n``) keep each
-    other's pins."""
+    holds no pins is refused, unless it holds only ``logs``, the logs pinned now: then in
+    place); a pin folder sgtool made is written in place, file by file atomically, the
+    index last; a pin folder without sgtool's manifest (one kept with a project's tests)
+    likewise, as it is. The block holds :func:`pins_locked`: read the index inside it, so
+    that writers in several processes (``pytest -n``) keep each other's pins."""
     with pins_locked(root):
-        if (root / INDEX).is_file() and read_manifest(root)[0] != PIN_COMMAND:
+        if ((root / INDEX).is_file() and read_manifest(root)[0] != PIN_COMMAND) or (
+                root.is_dir() and not (root / INDEX).is_file() and any(root.iterdir())
+                and _only_these_logs(root, logs)):
             yield root
             return
         with output_folder(root, force=False, command=PIN_COMMAND, option="--dir",
@@ -227,11 +230,17 @@ def pin_logs(logs: Sequence[str | Path] | str | Path, folder: str | Path,
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise SgtoolError(f"two logs are named {dup[0]}.mcap; pin them into separate folders")
+    for p, n in zip(paths, names, strict=True):
+        if not valid_name(n):
+            raise SgtoolError(f"{p}: a pin is named after its log's file name, and {n!r} "
+                              "cannot name one (its files would leave the folder); rename "
+                              "the log")
     if root.exists() and not root.is_dir():
         raise SgtoolError(f"--dir (folder=) {root} is a file; give a folder")
-    if root.is_dir() and not (root / INDEX).is_file() and any(root.iterdir()):
+    if root.is_dir() and not (root / INDEX).is_file() and not _only_these_logs(root, paths):
         raise SgtoolError(f"--dir (folder=) {root}: the folder holds files but no pins "
-                          f"({INDEX}); pin into a new or empty folder")
+                          f"({INDEX}); pin into a new or empty folder (or one holding only "
+                          "the logs pinned now)")
     outcomes = _run(executor, _pin_task,
                     [Task(str(p), _PinTask(str(p), opts)) for p in paths], "pin", progress)
     failed = [o for o in outcomes if not o.ok]
@@ -242,28 +251,71 @@ def pin_logs(logs: Sequence[str | Path] | str | Path, folder: str | Path,
     if empty:
         raise SgtoolError(f"{empty[0]}: its replay mapped no camera frame (no depth "
                           "image?): a pin of it would check nothing")
-    with pin_folder(root) as out, \
+    with pin_folder(root, paths) as out, \
             deferred_interrupts() if _same_place(out, root) else contextlib.nullcontext():
         old = read_pins(root).logs if (root / INDEX).is_file() else {}  # (under the lock)
+        copies = {name: _copy_action(p, root / f"{name}.mcap", old.get(name))
+                  for p, name in zip(paths, names, strict=True)} if copy else {}
         logs_now = dict(old)
         staged = PinSet(out, logs_now, sgtool_version=__version__)
         for p, name, o in zip(paths, names, outcomes, strict=True):
-            stored = stored_path(p, root)
-            if copy:
-                stored = f"{name}.mcap"
-                if not (root / stored).exists() or (root / stored).resolve() != p.resolve():
-                    with atomic_output(out / stored) as tmp:
-                        shutil.copyfile(p, tmp)
-            pin = pinned_entry(name, p, stored, opts, o.value, why)
-            write_capture(staged, pin, o.value)
+            stored = f"{name}.mcap" if copy else stored_path(p, root)
+            if copies.get(name) == "copy":
+                with atomic_output(out / stored) as tmp:
+                    shutil.copyfile(p, tmp)
             was = old.get(name)
-            copied = out / f"{name}.mcap"  # a copy pinned before, not the log pinned now
-            if was is not None and was.log == copied.name and stored != copied.name and \
-                    copied.is_file() and copied.resolve() != p.resolve():
+            ours = copies.get(name) == "copy" or (copies.get(name) == "keep" and
+                                                   was is not None and bool(was.copied))
+            pin = pinned_entry(name, p, stored, opts, o.value, why, copied=ours)
+            write_capture(staged, pin, o.value)
+            copied = out / f"{name}.mcap"  # a copy sgtool made before, not the log pinned now
+            if was is not None and was.copied and was.log == copied.name and \
+                    stored != copied.name and copied.is_file() and copied.resolve() != p.resolve():
                 copied.unlink()
             logs_now[name] = pin
         write_index(staged)
     return PinSet(root, logs_now, sgtool_version=__version__)
+
+
+def _not_a_whole_log(log: Path) -> str | None:
+    """What ``log`` is when it is no whole MCAP file (a Git LFS pointer never fetched,
+    another file, one cut short), with what to do; None for a whole one."""
+    from sgtool.log.mcap_records import MAGIC
+
+    with open(log, "rb") as f:
+        head = f.read(64)
+        f.seek(max(0, log.stat().st_size - len(MAGIC)))
+        tail = f.read()
+    if head.startswith(b"version https://git-lfs"):
+        return "it is a Git LFS pointer, not the log: fetch it (`git lfs pull`)"
+    if not head.startswith(MAGIC):
+        return "it is not an MCAP file; put the pinned log back"
+    if tail != MAGIC:
+        return ("it ends without the MCAP footer (cut short, or still being written); put "
+                "the pinned log back")
+    return None
+
+
+def _only_these_logs(root: Path, logs: Sequence[Path]) -> bool:
+    """Whether every entry of ``root`` is one of ``logs`` (a folder of logs pinned in
+    place on the first run, as a project's test folder is laid out)."""
+    mine = {p.resolve() for p in logs}
+    return all(e.resolve() in mine for e in root.iterdir())
+
+
+def _copy_action(log: Path, dest: Path, was: Pinned | None) -> str:
+    """What ``--copy`` does at ``dest``: "copy" (nothing there, or sgtool's own earlier
+    copy), "keep" (the log itself, or the same bytes already there); a file of the user's
+    with other bytes is refused, never replaced."""
+    if not dest.exists():
+        return "copy"
+    if dest.resolve() == log.resolve() or (dest.is_file()
+                                           and sha256_file(dest) == sha256_file(log)):
+        return "keep"
+    if was is not None and was.copied and was.log == dest.name:
+        return "copy"
+    raise SgtoolError(f"--copy: {dest} is a file sgtool did not copy there; not replacing it "
+                      "(move it away, or pin without --copy)")
 
 
 # ----- check --------------------------------------------------------------------------------
@@ -381,6 +433,8 @@ def _check_task(t: _CheckTask) -> LogCheck:
                 sha256_file(log) != pin.log_sha256:
             what = (f"{size} bytes, {pin.log_bytes} pinned" if pin.log_bytes not in (None, size)
                     else "its sha256 differs")
+            if (damage := _not_a_whole_log(log)) is not None:
+                raise PinError(f"{log} is not the pinned log ({what}): {damage}")
             raise PinError(f"{log} is not the pinned log ({what}); if it was "
                            "re-recorded on purpose, pin it again with its settings: "
                            f"`{pin_command(pin, log, folder)}`")

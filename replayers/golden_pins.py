@@ -123,6 +123,7 @@ class Pinned:
     decisions: tuple[Decision, ...] | None = None
     why: str | None = None
     sgtool_version: str | None = None
+    copied: bool | None = None  # True: sgtool copied the log in (--copy); it may replace it
 
     def log_path(self, folder: Path) -> Path:
         """The log's path: as stored, or joined to ``folder``, resolved as
@@ -141,6 +142,8 @@ class Pinned:
                      ("why", self.why), ("sgtool_version", self.sgtool_version)):
             if v is not None:
                 d[k] = v
+        if self.copied:
+            d["copied"] = True
         if self.decisions is not None:
             d["decisions"] = [[x.episode, x.step, x.skill, x.target] for x in self.decisions]
         return d
@@ -309,7 +312,8 @@ def _entry(name: str, e: Mapping[str, Any], common: Mapping[str, Any], fmt: int,
     if not isinstance(e, Mapping):
         raise TypeError(f"must be an object, not {_json_kind(e)}")
     for key, kinds in (("log", (str,)), ("quality", (dict,)), ("resolved", (dict,)),
-                       ("planner", (str,)), ("why", (str,)), ("decisions", (list,))):
+                       ("planner", (str,)), ("why", (str,)), ("decisions", (list,)),
+                       ("copied", (bool,))):
         if e.get(key) is not None and not isinstance(e[key], kinds):
             raise TypeError(f"{key!r} is {_json_kind(e[key])}, expected "
                             f"{' or '.join(_json_kind(t()) for t in kinds)}")
@@ -339,7 +343,8 @@ def _entry(name: str, e: Mapping[str, Any], common: Mapping[str, Any], fmt: int,
         sequence_sha256=str(e["sequence_sha256"]), options=options,
         log_bytes=None if e.get("log_bytes") is None else int(e["log_bytes"]),
         resolved=e.get("resolved"), quality=e.get("quality"), planner=e.get("planner"),
-        decisions=decisions, why=e.get("why"), sgtool_version=e.get("sgtool_version"))
+        decisions=decisions, why=e.get("why"), sgtool_version=e.get("sgtool_version"),
+        copied=e.get("copied"))
 
 
 def write_index(pins: PinSet) -> Path:
@@ -401,16 +406,18 @@ def stored_path(log: Path, folder: Path) -> str:
 
 
 def pinned_entry(name: str, log: Path, stored: str, options: ReplayOptions, cap: Capture,
-                 why: str | None = None) -> Pinned:
+                 why: str | None = None, copied: bool = False) -> Pinned:
     """The index entry of ``cap``, a capture of ``log`` (its bytes are digested; the index
-    names it ``stored``: :func:`stored_path`) with ``options``."""
+    names it ``stored``: :func:`stored_path`) with ``options``; ``copied``: ``stored`` is
+    a copy sgtool made."""
     graphs = cap.graphs
     return Pinned(
         name=name, log=stored, log_sha256=sha256_file(log), refreshes=len(graphs),
         final_sha256=hashlib.sha256(graphs[-1].encode()).hexdigest() if graphs else "",
         sequence_sha256=sequence_digest(graphs), options=options,
         log_bytes=log.stat().st_size, resolved=cap.resolved, quality=cap.quality,
-        planner=cap.planner, decisions=cap.decisions, why=why, sgtool_version=__version__)
+        planner=cap.planner, decisions=cap.decisions, why=why, sgtool_version=__version__,
+        copied=copied or None)
 
 
 def write_capture(pins: PinSet, pin: Pinned, cap: Capture) -> None:

@@ -598,3 +598,67 @@ def test_a_report_is_never_written_over_a_pinned_log_or_a_pin_file(pinned, tmp_p
                               "--junit", xml)
         assert code == 0, err
     assert md.read_text().startswith("# Golden check of ") and "<testsuite" in xml.read_text()
+
+
+def test_a_users_log_in_the_pin_folder_is_never_deleted_or_replaced(log, tmp_path, capsys):
+    """A log pinned in place in the pin folder (not a copy sgtool made), then a log of the
+    same name pinned from elsewhere: the user's log stays (it was taken for an earlier
+    copy and deleted). With --copy a file of the user's there is refused, unchanged."""
+    folder = tmp_path / "G"
+    other = tmp_path / "b.mcap"
+    shutil.copyfile(log, other)
+    assert sgtool(capsys, "golden", "pin", other, "--dir", folder, *FRAMES)[0] == 0
+    mine = folder / "small.mcap"
+    shutil.copyfile(log, mine)
+    assert sgtool(capsys, "golden", "pin", mine, "--dir", folder, *FRAMES)[0] == 0
+    assert read_pins(folder).logs["small"].copied is None
+    assert sgtool(capsys, "golden", "pin", log, "--dir", folder, *FRAMES)[0] == 0
+    assert mine.read_bytes() == log.read_bytes()  # kept
+    # --copy over a file of the user's with other bytes: refused, the file as it was
+    user = tmp_path / "H"
+    user.mkdir()
+    assert sgtool(capsys, "golden", "pin", other, "--dir", user, *FRAMES)[0] == 0
+    (user / "small.mcap").write_bytes(b"my own notes, not a log")
+    code, _, err = sgtool(capsys, "golden", "pin", log, "--dir", user, "--copy", *FRAMES)
+    assert code == 2 and "is a file sgtool did not copy there; not replacing it" in err
+    assert (user / "small.mcap").read_bytes() == b"my own notes, not a log"
+    assert "small" not in read_pins(user).logs
+
+
+def test_logs_pinned_in_place_in_a_folder_of_their_own(log, tmp_path, capsys):
+    """A folder holding only the logs to pin (the example fixture's layout, first run):
+    pinned in place, the logs named as they lie; another file there is still refused."""
+    folder = tmp_path / "golden-logs"
+    folder.mkdir()
+    shutil.copyfile(log, folder / "x.mcap")
+    code, out, err = sgtool(capsys, "golden", "pin", folder / "x.mcap", "--dir", folder,
+                            *FRAMES)
+    assert code == 0, out + err
+    assert read_pins(folder).logs["x"].log == "x.mcap" and (folder / "x.mcap").is_file()
+    assert sgtool(capsys, "golden", "check", "--dir", folder)[0] == 0
+
+
+@pytest.mark.parametrize("name", ["..mcap", ".mcap", "x\\y.mcap"])
+def test_a_log_whose_name_cannot_name_a_pin_is_refused(log, tmp_path, capsys, name):
+    odd = tmp_path / "odd"
+    odd.mkdir()
+    shutil.copyfile(log, odd / name)
+    code, _, err = sgtool(capsys, "golden", "pin", odd / name, "--dir", tmp_path / "Q", *FRAMES)
+    assert code == 2 and "cannot name one" in err and "rename the log" in err
+    assert not (tmp_path / "Q").exists()
+
+
+@pytest.mark.parametrize(("damage", "said"), [
+    ("lfs", "it is a Git LFS pointer, not the log: fetch it (`git lfs pull`)"),
+    ("cut", "it ends without the MCAP footer (cut short"),
+    ("other", "it is not an MCAP file")])
+def test_a_pinned_log_that_is_no_whole_log_says_what_it_is(pinned, capsys, damage, said):
+    """An LFS pointer never fetched, or a log cut short, is not 're-recorded': the check
+    says what the file is, not to pin it again."""
+    log = pinned / "small.mcap"
+    data = log.read_bytes()
+    log.write_bytes({"lfs": b"version https://git-lfs.github.com/spec/v1\noid sha256:" +
+                            b"0" * 64 + b"\nsize 1460047\n",
+                     "cut": data[: len(data) - 100], "other": b"PK\x03\x04 a zip"}[damage])
+    code, out, err = sgtool(capsys, "golden", "check", "--dir", pinned)
+    assert code != 0 and said in out + err and "pin it again" not in out + err

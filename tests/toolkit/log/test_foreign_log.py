@@ -34,7 +34,8 @@ def test_ros2_mcap_with_camera_topics_points_to_import_bag(tmp_path):
     write_frames_bag(frames(), bag, "ros2-mcap")
     storage = bag / "cam.mcap"
     out = replay_error(storage)
-    assert "is a ROS 2 recording (MCAP, profile 'ros2') with cdr messages on 5 topics" in out
+    assert ("is a ROS 2 recording (MCAP, profile 'ros2') with 5 topic(s) of messages "
+            "encoded 'cdr'") in out
     assert f"sgtool import bag {storage} -o OUT.mcap --depth /camera/depth/image_raw" in out
     assert "--list` shows its topics" in out
 
