@@ -89,6 +89,7 @@ class WorldAlignment:
     floor_confidence: float = 1.0  # of an estimated floor (:mod:`.floor`); 1 when given
     floor_detail: str = ""  # what the estimate is made of (:meth:`.FloorEstimate.describe`)
     surfaces_up: tuple[float, float, float] | None = None  # a given up: the surfaces' normal
+    image_up: tuple[float, float, float] | None = None  # a given up: the cameras' image up
 
     @classmethod
     def identity(cls) -> WorldAlignment:
@@ -200,12 +201,17 @@ def estimate_alignment(
     nrm = np.concatenate(nrm_list) if nrm_list else np.zeros((0, 3))
 
     surfaces: tuple[float, float, float] | None = None
+    image: tuple[float, float, float] | None = None
     if up is not None:
         u = np.asarray(up, dtype=np.float64) / np.linalg.norm(up)
         up_method = "given"
         seen = _horizontal_normal(nrm, u)
         if seen is not None:
             surfaces = (float(seen[0]), float(seen[1]), float(seen[2]))
+        mean_up = np.mean([-np.asarray(T)[:3, 1] for T in poses], axis=0) if len(poses) else None
+        if mean_up is not None and np.linalg.norm(mean_up) > 0.5:  # cameras held alike
+            m = mean_up / np.linalg.norm(mean_up)
+            image = (float(m[0]), float(m[1]), float(m[2]))
     else:
         u = camera_up(poses)
         up_method = "camera-up"
@@ -225,9 +231,9 @@ def estimate_alignment(
         est = estimate_floor(samples, u)
         assert est is not None  # there are points
         return WorldAlignment(R, est.height, (float(u[0]), float(u[1]), float(u[2])), up_method,
-                              est.method, est.confidence, est.describe(), surfaces)
+                              est.method, est.confidence, est.describe(), surfaces, image)
     return WorldAlignment(R, fl, (float(u[0]), float(u[1]), float(u[2])), up_method, floor_method,
-                          surfaces_up=surfaces)
+                          surfaces_up=surfaces, image_up=image)
 
 
 def _horizontal_normal(nrm: np.ndarray, u: np.ndarray) -> np.ndarray | None:
@@ -248,12 +254,21 @@ UP_TOLERANCE_DEG = 10.0  # a given up this far from the horizontal surfaces is d
 
 
 def given_up_problem(alignment: WorldAlignment) -> str | None:
-    """A given ``--up`` more than :data:`UP_TOLERANCE_DEG` from the normal of the
+    """A given ``--up`` against the cameras' image up (over 120 degrees from their mean:
+    an upside-down world), or more than :data:`UP_TOLERANCE_DEG` from the normal of the
     horizontal surfaces (floor, table tops) seen near it: heights would tilt across the
-    map. None when the up was not given or no such surfaces were seen."""
-    if alignment.up_method != "given" or alignment.surfaces_up is None:
+    map. None when the up was not given or nothing says otherwise."""
+    if alignment.up_method != "given":
         return None
-    given, seen = np.asarray(alignment.up), np.asarray(alignment.surfaces_up)
+    given = np.asarray(alignment.up)
+    if alignment.image_up is not None and float(given @ np.asarray(alignment.image_up)) < -0.5:
+        shown = ",".join(f"{-x + 0.0:.3f}" for x in given)  # (no -0.000)
+        return (f"--up {','.join(f'{x:.3f}' for x in given)} points the way the cameras' "
+                f"images point down: the world would be upside down (floor above, ceiling "
+                f"below); give --up {shown} or --up auto")
+    if alignment.surfaces_up is None:
+        return None
+    seen = np.asarray(alignment.surfaces_up)
     off = float(np.degrees(np.arccos(np.clip(given @ seen, -1.0, 1.0))))
     if off <= UP_TOLERANCE_DEG:
         return None

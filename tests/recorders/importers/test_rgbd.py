@@ -503,7 +503,14 @@ def test_an_up_far_off_the_horizontal_surfaces_is_doubted(rgbd_data, tmp_path):
     assert "give --up -0.0" in warn
     rep = import_rgbd(src, tmp_path / "y.mcap",
                       RgbdOptions(**QUIET, every=10, up=np.array([0.0, -1.0, 0.0])))
-    assert not [w for w in rep.warnings if "degrees off" in w]
+    assert not [w for w in rep.warnings if "degrees off" in w or "upside down" in w]
+    # +y: the surfaces agree (their normal is found along it), the cameras do not
+    rep = import_rgbd(src, tmp_path / "f.mcap",
+                      RgbdOptions(**QUIET, every=10, up=np.array([0.0, 1.0, 0.0]),
+                                  floor=1.41))
+    (warn,) = [w for w in rep.warnings if "upside down" in w]
+    assert warn.startswith("--up 0.000,1.000,0.000 points the way the cameras' images point "
+                           "down") and "give --up 0.000,-1.000,0.000 or --up auto" in warn
 
 
 def test_a_still_camera_is_not_taken_for_frozen_poses() -> None:
