@@ -396,11 +396,12 @@ def test_drift_against_a_reconstructed_reference_is_not_called_ground_truth(rgbd
                                                                            tmp_path):
     """The Open3D layout's .log (ICL-NUIM's trajectory in the Open3D data) is Open3D's
     reconstruction: the report, JSON and metadata say so; 7-Scenes and TUM keep
-    "ground truth" (test_odometry_drift_on_7scenes, test_tum_estimate_reports_ground_truth)."""
+    "ground truth" (test_odometry_drift_on_7scenes, test_tum_estimate_reports_ground_truth).
+    (The Open3D test data's world has its up along +y: --up y, as auto finds.)"""
     out = tmp_path / "o.mcap"
     r = CliRunner().invoke(cli, ["import", "rgbd", str(rgbd_data / "open3d-testdata"), "-o",
                                  str(out), "--estimate-poses", "--odometry", "icp", "--quiet",
-                                 "--up", "-y", "--floor", "none"])
+                                 "--up", "y", "--floor", "none"])
     assert r.exit_code == 0, r.output
     ref = "the reference trajectory (reconstructed, not ground truth)"
     assert f"drift against {ref}: 5 frames" in r.output
@@ -409,7 +410,7 @@ def test_drift_against_a_reconstructed_reference_is_not_called_ground_truth(rgbd
         assert log.metadata[IMPORT_METADATA]["odometry_drift_reference"] == ref
     r = CliRunner().invoke(cli, ["import", "rgbd", str(rgbd_data / "open3d-testdata"), "-o",
                                  str(out), "--estimate-poses", "--odometry", "icp", "--quiet",
-                                 "--up", "-y", "--floor", "none", "--force", "--json"])
+                                 "--up", "y", "--floor", "none", "--force", "--json"])
     rep = json.loads(r.output)
     assert rep["drift_reference"] == ref and rep["odometry_failures"] == 0
     assert rep["odometry_failure_reasons"] == {"reported": 0, "matches": 0, "motion": 0}
