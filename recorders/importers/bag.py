@@ -167,7 +167,7 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
             motion = pose_motion_problem(fit, src.describe)
             if motion is not None:
                 findings.problem(motion[0], given=estimate or not motion[1])
-            findings.problem(bag_scale_problem(fit, opts, src, _scale_origin(idx, opts)[1]),
+            findings.problem(bag_scale_problem(fit, idx, opts, src, _scale_origin(idx, opts)[1]),
                              given=opts.depth_scale is not None)
         plan, notes = plan_frames(idx, src, opts, keep_unposed=estimate)
         if not plan:

@@ -1,7 +1,8 @@
 """The depth scale of a bag checked against its metric poses (``/tf`` or ``--pose``) before
-the frames are written: a few pairs of nearby 16-bit depth images are decoded (one pass over
-the depth topic, deserialising only those) and their ICP motion compared with the poses'
-(:mod:`.scale_check`)."""
+the frames are written: a few pairs of nearby depth images are decoded (one pass over the
+depth topic, deserialising only those) and their ICP motion compared with the poses'
+(:mod:`.scale_check`). The fit says whether the poses move as the depth does, whatever the
+depth's encoding; only 16-bit depth has a scale to name."""
 
 from __future__ import annotations
 
@@ -25,10 +26,9 @@ from sgtool.recorders.importers.scale_check import (
 
 def bag_scale_fit(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
                   k: CameraIntrinsics) -> ScaleFit | None:
-    """How far the 16-bit depth's geometry moves against the poses of ``src``
-    (:func:`~.scale_check.fit_scale`); None without a usable pair or for depth that is not
-    16-bit (metres need no scale)."""
-    if not idx.samples or next(iter(idx.samples.values()))[0].dtype != np.uint16:
+    """How far the depth's geometry moves against the poses of ``src``
+    (:func:`~.scale_check.fit_scale`); None without a usable pair."""
+    if not idx.samples:
         return None
     explicit = opts.tf_frames is not None or opts.pose is not None
     posed: list[tuple[int, np.ndarray]] = []
@@ -57,7 +57,11 @@ def bag_scale_fit(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
     return fit_scale(quads, k)
 
 
-def bag_scale_problem(fit: ScaleFit | None, opts: BagOptions, src: PoseSource,
-                      origin: str) -> str | None:
-    """The problem of the fit (naming the ``--depth-scale`` that fits), or None."""
+def bag_scale_problem(fit: ScaleFit | None, idx: BagIndex, opts: BagOptions,
+                      src: PoseSource, origin: str) -> str | None:
+    """The problem of the fit (naming the ``--depth-scale`` that fits), or None; None for
+    depth that is not 16-bit (metres have no scale to name: :func:`bag_scale_fit`'s other
+    use, the poses' motion, is :func:`~.scale_check.pose_motion_problem`'s)."""
+    if not idx.samples or next(iter(idx.samples.values()))[0].dtype != np.uint16:
+        return None
     return geometric_scale_problem(fit, opts.depth_scale or 1000.0, origin, src.describe)

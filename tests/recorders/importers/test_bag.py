@@ -633,3 +633,31 @@ def test_a_ros2_bag_folder_named_dot_bag_is_read_as_ros2(tmp_path, fmt):
     assert r.exit_code == 0, r.output
     with LogReader(out) as log:
         assert sum(1 for _ in log.frames()) == 4
+
+
+def test_poses_of_float_depth_are_checked_against_it_too(shared_data_dir, tmp_path):
+    """Depth in metres (32FC1) has no scale to check, but its poses still must move as it
+    does: world-to-camera poses were imported, exit 0, when the depth was float (the
+    motion check rode on the 16-bit scale fit); right poses pass with the check shown."""
+    import dataclasses
+
+    from support.bag_export import write_frames_bag
+
+    from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
+
+    icl = tmp_path / "icl.mcap"
+    import_rgbd(shared_data_dir / "rgbd" / "icl-livingroom1-micro", icl,
+                RgbdOptions(every=3, limit=20, progress=False))
+    with LogReader(icl) as r:
+        frames = list(r.frames())
+    inverted = [dataclasses.replace(f, pose=np.linalg.inv(f.pose)) for f in frames]
+    good, bad = tmp_path / "good", tmp_path / "bad"
+    write_frames_bag(frames, good, "ros2-mcap", depth_units=1.0)
+    write_frames_bag(inverted, bad, "ros2-mcap", depth_units=1.0)
+    flags = dict(depth=TOPICS["depth"], rgb=TOPICS["rgb"], info=TOPICS["info"], **KEEP_WORLD)
+    with pytest.raises(SgtoolError, match="do not move as the depth does"):
+        import_bag(bad, tmp_path / "b.mcap", BagOptions(**flags))
+    assert not (tmp_path / "b.mcap").exists()
+    rep = import_bag(good, tmp_path / "g.mcap", BagOptions(**flags))
+    assert rep.frames == 20
+    assert dict(rep.checks)["depth scale against the poses"].startswith("depth moves 1.0")
