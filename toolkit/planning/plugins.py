@@ -100,8 +100,13 @@ def load_factory(name: str, entry: metadata.EntryPoint | None = None) -> Callabl
         try:
             obj = importlib.import_module(module)
         except (Exception, SystemExit) as e:  # noqa: BLE001
+            missing = isinstance(e, ModuleNotFoundError) and e.name is not None and (
+                module == e.name or module.startswith(e.name + "."))
+            hint = ("is its folder on PYTHONPATH?" if missing else
+                    "the module was found and failed while importing: fix it, or install "
+                    "what it imports")
             raise PluginError(f"planner {name!r}: cannot import module {module!r} "
-                              f"({raised_text(e)}); is its folder on PYTHONPATH?") from None
+                              f"({raised_text(e)}); {hint}") from None
         for part in attr.split("."):
             if not hasattr(obj, part):
                 raise PluginError(f"planner {name!r}: {module!r} has no {attr!r}")

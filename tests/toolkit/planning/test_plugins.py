@@ -217,7 +217,8 @@ def test_an_options_dataclass_checks_like_the_built_ins(plugin_dir: Path) -> Non
     ("nosuchmod_plug:X", "planner 'nosuchmod_plug:X': cannot import module 'nosuchmod_plug' "
      "(ModuleNotFoundError: No module named 'nosuchmod_plug'); is its folder on PYTHONPATH?"),
     ("broken_plug:X", "planner 'broken_plug:X': cannot import module 'broken_plug' "
-     "(ModuleNotFoundError: No module named 'not_installed_anywhere')"),
+     "(ModuleNotFoundError: No module named 'not_installed_anywhere'); the module was "
+     "found and failed while importing: fix it, or install what it imports"),
     ("mymod_plug:Nope", "planner 'mymod_plug:Nope': 'mymod_plug' has no 'Nope'"),
     ("mymod_plug:raises", "planner 'mymod_plug:raises': raised ValueError: no GPU here"),
     ("mymod_plug:not_a_planner", "planner 'mymod_plug:not_a_planner': returned a int, not a "
