@@ -7,6 +7,8 @@ and prints the result."""
 
 from __future__ import annotations
 
+import contextlib
+import os
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -93,7 +95,8 @@ def command(inputs: tuple[str, ...], out: str | None, force: bool = False,
     from sgtool.files import atomic_write
 
     request = _request(inputs, out, force, EvalArgs(**given))
-    outcome = evaluate(request, note=lambda m: click.echo(m, err=True))
+    with stdout_to_stderr() if request.as_json and not out else contextlib.nullcontext():
+        outcome = evaluate(request, note=lambda m: click.echo(m, err=True))
     if out:
         atomic_write(out, outcome.text)
     click.echo(outcome.text, nl=False)
@@ -174,3 +177,25 @@ def _budgets(args: EvalArgs, files: Sequence[str]) -> tuple[float, float]:
     dist, steps = recorded_budgets(files)
     return (args.distance_budget or dist or DISTANCE_BUDGET,
             args.step_budget or steps or STEP_BUDGET)
+
+
+@contextlib.contextmanager
+def stdout_to_stderr() -> Any:
+    """Whatever a plug-in planner prints while eval runs goes to stderr, so that the JSON
+    printed on stdout stays one JSON object: ``sys.stdout`` and, where it is a real file,
+    file descriptor 1 (the worker processes started meanwhile inherit it)."""
+    try:
+        out_fd, err_fd = sys.stdout.fileno(), sys.stderr.fileno()
+    except (AttributeError, OSError, ValueError):  # (a test runner's buffers)
+        out_fd = err_fd = -1
+    sys.stdout.flush()
+    saved = os.dup(out_fd) if out_fd >= 0 else -1
+    try:
+        if saved >= 0:
+            os.dup2(err_fd, out_fd)
+        with contextlib.redirect_stdout(sys.stderr):
+            yield
+    finally:
+        if saved >= 0:
+            os.dup2(saved, out_fd)
+            os.close(saved)

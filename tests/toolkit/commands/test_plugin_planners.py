@@ -44,6 +44,14 @@ PLUGIN = textwrap.dedent('''
         raise RuntimeError("out of coffee")
 
 
+    class Talker(GreedyPlanner):
+        """Greedy that prints what it does, as research code does."""
+
+        def decide(self, graph):
+            print("deciding on", len(graph.objects), "objects")
+            return super().decide(graph)
+
+
     def not_a_planner():
         return "greedy"
 
@@ -483,3 +491,21 @@ def test_invalid_actions_are_told_and_a_target_must_be_a_node_id(
         sgtool.run_closed_loop(house, ep, mymod_cli.Stumbles(), out, sgtool.ClosedLoopOptions(
             max_steps=2, frames=40, camera=sgtool.CameraConfig(width=64, height=48)))
     assert not list(tmp_path.glob("cl.mcap*"))
+
+
+def test_eval_json_stays_json_when_a_plug_in_prints(plugin_dir: Path, tmp_path: Path) -> None:
+    """`sgtool eval LOGS -p mod:Talker --json | jq`: what the plug-in prints goes to stderr
+    (it broke the JSON on stdout), in the process and in its workers."""
+    env = {**os.environ, "PYTHONPATH": str(plugin_dir), "HF_HUB_OFFLINE": "1",
+           "TRANSFORMERS_OFFLINE": "1", "MPLBACKEND": "Agg"}
+    logs = tmp_path / "logs"
+    bench = [sys.executable, "-m", "sgtool.cli", "bench", "--planners", "greedy", *SMALL,
+             "--log-dir", str(logs), "-o", str(tmp_path / "out")]
+    assert subprocess.run(bench, env=env, capture_output=True, timeout=600).returncode == 0
+    for workers in ("1", "2"):
+        r = subprocess.run([sys.executable, "-m", "sgtool.cli", "eval", str(logs), "-p",
+                            "mymod_cli:Talker", "--json", "-w", workers], env=env,
+                           capture_output=True, text=True, timeout=600)
+        assert r.returncode == 0, r.stderr
+        assert "mymod_cli:Talker" in json.loads(r.stdout)["offline"]
+        assert "deciding on" in r.stderr
