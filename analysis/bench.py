@@ -105,7 +105,7 @@ from sgtool.analysis.report import (
 from sgtool.analysis.search_metrics import CostModel, breakdown, cost_models, seen_unseen, summarize
 from sgtool.arg_checks import of_type, whole
 from sgtool.canonical import strict_json
-from sgtool.files import atomic_write, output_dir, output_folder
+from sgtool.files import atomic_write, note_written, output_dir, output_folder
 from sgtool.planning.episode import SUCCESS_RULES
 from sgtool.redact import options_as_text, redact_text, secret_values
 from sgtool.results import EpisodeResult, results_digest, write_jsonl
@@ -464,8 +464,9 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
     """episodes.jsonl, summary.md, summary.json (no wall-clock figure), run.md, run.json
     (timing, command), per_house.md/.jsonl, per_query.md/.jsonl and the two efficiency
     PNGs (:data:`OUTPUT_NAMES`), each written atomically into ``out_dir`` (created when
-    missing); the commands write into the folder of :func:`sgtool.files.output_folder`,
-    so that the set appears complete."""
+    missing) and listed in its manifest as ``sgtool bench``'s (:func:`sgtool.files.
+    note_written`); the commands write into the folder of
+    :func:`sgtool.files.output_folder`, so that the set appears complete."""
     from sgtool.analysis.curves import plot_efficiency
 
     of_type("res", res, BenchResult, "a BenchResult (of run_benchmark)")
@@ -534,6 +535,7 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
     paths.append(atomic_write(
         out / "run.json",
         json.dumps(strict_json(run), indent=1, sort_keys=True, allow_nan=False) + "\n"))
+    note_written(out, "bench", [p.name for p in paths])  # (sgtool's, for --force later)
     return paths
 
 

@@ -221,6 +221,17 @@ def manifest_text(command: str, names: Sequence[str]) -> str:
     return json.dumps({"command": command, "files": files}, indent=1, sort_keys=True) + "\n"
 
 
+def note_written(folder: str | os.PathLike[str], command: str, names: Iterable[str]) -> None:
+    """List ``names`` (entries ``command`` just wrote into ``folder``) in its
+    :data:`MANIFEST`, as a command's own output folder lists them, so that the command
+    later replaces them (``--force``) as its own; a folder of another command keeps its
+    manifest as it is."""
+    owner, listed = read_manifest(folder)
+    if owner not in (None, command):
+        return
+    atomic_write(Path(folder) / MANIFEST, manifest_text(command, sorted(listed | set(names))))
+
+
 def _matches(name: str, known: Sequence[str]) -> bool:
     return any(fnmatch.fnmatchcase(name, pattern) for pattern in known)
 

@@ -348,3 +348,24 @@ def test_typed_fields_leaves_what_isinstance_cannot_check() -> None:
 
     with pytest.raises(sgtool.SgtoolError, match="^count=2.5: a whole number"):
         typed_fields(Local(count=2.5))
+
+
+def test_outputs_written_from_python_are_sgtools_for_the_shell(tmp_path) -> None:
+    """api.md's walk-through: write_bench_outputs into a folder, then the same bench from
+    the shell with --force into it: it replaces them (it refused them as not sgtool's,
+    the folder having no manifest); a user's file there is kept."""
+    from click.testing import CliRunner
+
+    from sgtool.cli import cli
+
+    cfg = sgtool.BenchConfig(planners=("greedy",), houses=1, episodes=1, seeds=1,
+                             rooms=(4, 5), preset="default")
+    out = tmp_path / "results"
+    sgtool.write_bench_outputs(sgtool.run_benchmark(cfg), out)
+    (out / "notes.txt").write_text("mine")
+    r = CliRunner().invoke(cli, ["bench", "--planners", "greedy", "--houses", "1",
+                                 "--episodes", "1", "--seeds", "1", "--rooms", "4-5",
+                                 "--preset", "default", "--no-progress", "-o", str(out),
+                                 "--force"])
+    assert r.exit_code == 0, r.output
+    assert (out / "notes.txt").read_text() == "mine" and (out / "summary.md").is_file()
