@@ -92,13 +92,16 @@ class OptionInfo:
     kind: str
     default: Any
     meta: OptionMeta
+    required: bool = False  # a field without a default: the planner cannot be made without it
 
     def line(self) -> str:
         """``name  kind  default  help [range]``; a Python object shows no default."""
         if not self.meta.cli:
-            return f"{self.name} (Python only): {self.meta.help}"
+            return f"{self.name} (Python only{', required' if self.required else ''}): " \
+                f"{self.meta.help}"
         rng = self.meta.range_text()
-        default = "" if self.default is None and "[default:" in self.meta.help else \
+        default = ", required" if self.required else \
+            "" if self.default is None and "[default:" in self.meta.help else \
             ", default " + ("unset" if self.default is None else _text(self.default))
         return (f"{self.name} ({self.kind}{default}): {self.meta.help}"
                 + (f" [{rng}]" if rng else ""))
@@ -171,7 +174,9 @@ def option_infos(cls: type) -> tuple[OptionInfo, ...]:
     for f in dataclasses.fields(cls):
         meta = f.metadata.get(_META) or _plain_meta(f, hints.get(f.name, f.type))
         default = f.default if f.default is not dataclasses.MISSING else None
-        out.append(OptionInfo(f.name, meta.kind, default, meta))
+        required = f.default is dataclasses.MISSING and \
+            f.default_factory is dataclasses.MISSING
+        out.append(OptionInfo(f.name, meta.kind, default, meta, required))
     return tuple(out)
 
 
@@ -213,6 +218,12 @@ def convert_options(planner: str, cls: type, given: Mapping[str, Any],
     unknown = [k for k in given if k not in infos]
     if unknown:
         raise unknown_keys_error(planner, unknown, infos)
+    missing = [n for n, i in infos.items() if i.required and n not in given]
+    if missing:
+        how = ", ".join(f"-O {planner}.{n}=..." if infos[n].meta.cli else f"{n}= from Python"
+                        for n in missing)
+        raise PlannerOptionError(f"planner {planner!r}: option {', '.join(missing)} is "
+                                 f"required ({how})")
     return {k: convert_value(planner, k, infos[k].meta, v, from_cli) for k, v in given.items()}
 
 

@@ -422,3 +422,34 @@ def test_a_name_two_packages_register_is_refused_naming_both(plugin_dir: Path) -
     assert make_planner("fake-once").name == "fake-once"
     assert "fake-twice = mymod_plug:" in describe_planners()
     assert "(registered by two packages: name one as module:Name)" in describe_planners()
+
+
+def test_a_required_option_of_a_plug_in_is_named_when_left_out(tmp_path: Path,
+                                                              monkeypatch) -> None:
+    """An Options field without a default: --list-planners says it is required, and
+    leaving it out is one line naming it (it was the constructor's TypeError)."""
+    (tmp_path / "req_plug.py").write_text(textwrap.dedent('''
+        from dataclasses import dataclass
+
+        from sgtool.planning.planners import GreedyPlanner
+
+
+        class Needs(GreedyPlanner):
+            @dataclass
+            class Options:
+                model_path: str
+                k: int = 2
+
+            def __init__(self, model_path, k=2):
+                super().__init__()
+                self.model_path = model_path
+    '''))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    from sgtool.planning.option_fields import PlannerOptionError
+
+    with pytest.raises(PlannerOptionError, match=r"planner 'req_plug:Needs': option model_path is "
+                                          r"required \(-O req_plug:Needs.model_path=\.\.\.\)"):
+        make_planner("req_plug:Needs")
+    made = make_planner("req_plug:Needs", model_path="m.gguf")
+    assert made.inner.model_path == "m.gguf"  # type: ignore[attr-defined]
+    assert "model_path (str, required)" in describe_planners(["req_plug:Needs"])
