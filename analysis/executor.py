@@ -291,6 +291,26 @@ def _worker_setup() -> None:
     task's clean-up is never cut short by a second signal."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     set_stop_handlers(_worker_sigterm)  # a closed terminal reaches the workers too
+    threading.Thread(target=_leave_with_the_driver, args=(os.getppid(),), daemon=True,
+                     name="sgtool-driver-watch").start()
+
+
+ORPHAN_GRACE_S = 30.0  # a running task's clean-up time once the driver is gone
+
+
+def _leave_with_the_driver(driver: int) -> None:
+    """A worker whose driver died without shutting the pool down (SIGKILL, a crash) would
+    wait for tasks forever, deaf to SIGTERM while idle: once its parent is another process,
+    a running task is stopped as SIGTERM stops it (its outputs cleaned up), and the worker
+    leaves."""
+    while os.getppid() == driver:
+        time.sleep(1.0)
+    if _IN_TASK:
+        os.kill(os.getpid(), signal.SIGTERM)
+        end = time.monotonic() + ORPHAN_GRACE_S
+        while _IN_TASK and time.monotonic() < end:
+            time.sleep(0.1)
+    os._exit(1)
 
 
 def _worker_sigterm(signum: int, frame: object) -> None:

@@ -295,3 +295,29 @@ def test_a_task_that_succeeds_on_its_retry_is_told(workers, tmp_path):
                                                     for i in range(3)])
     assert [o.value for o in outs] == [0, 1, 2] and all(o.ok for o in outs)
     assert retry_lines(outs) == ["t1: RuntimeError: flaky (succeeded on attempt 2)"]
+
+
+def test_workers_of_a_driver_killed_outright_leave_and_clean_up(tmp_path):
+    """SIGKILL of the driver alone (no shutdown of the pool): the workers, mid-task, stop
+    their tasks as SIGTERM does (no partial output left) and leave; they waited for the
+    next task forever, deaf to SIGTERM."""
+    script = tmp_path / "driver.py"
+    script.write_text(KILLED_DRIVER)
+    out = tmp_path / "out"
+    out.mkdir()
+    proc = subprocess.Popen([sys.executable, str(script), str(out)])
+    try:
+        deadline = time.monotonic() + 120
+        while len(list(out.glob("*.partial"))) < 2:
+            assert proc.poll() is None and time.monotonic() < deadline
+            time.sleep(0.1)
+        pids = [int((out / f"pid-{i}").read_text()) for i in range(2)]
+        proc.kill()
+        proc.wait(timeout=60)
+    finally:
+        proc.kill()
+    deadline = time.monotonic() + 30
+    while not all(_gone(p) for p in pids) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert all(_gone(p) for p in pids)
+    assert sorted(p.name for p in out.iterdir()) == ["pid-0", "pid-1"]
