@@ -85,7 +85,11 @@ from sgtool.recorders.importers.sanity import (
     no_depth_problem,
     timestamp_problem,
 )
-from sgtool.recorders.importers.scale_check import pose_motion_problem
+from sgtool.recorders.importers.scale_check import (
+    TOLERANCE,
+    inverted_poses_problem,
+    pose_motion_problem,
+)
 from sgtool.recorders.importers.sink import (
     IMPORT_METADATA,
     ImportReport,
@@ -164,6 +168,10 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
             fit = bag_scale_fit(reader, idx, opts, src, k)
             if fit is not None:
                 checks.append(("depth scale against the poses", fit.describe()))
+            if fit is None or not fit.consistent() or abs(fit.ratio - 1.0) > TOLERANCE:
+                findings.problem(inverted_poses_problem(
+                    fit, bag_scale_fit(reader, idx, opts, src, k, invert=True), src.describe),
+                    given=estimate)
             motion = pose_motion_problem(fit, src.describe)
             if motion is not None:
                 findings.problem(motion[0], given=estimate or not motion[1])

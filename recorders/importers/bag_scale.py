@@ -25,9 +25,10 @@ from sgtool.recorders.importers.scale_check import (
 
 
 def bag_scale_fit(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
-                  k: CameraIntrinsics) -> ScaleFit | None:
+                  k: CameraIntrinsics, invert: bool = False) -> ScaleFit | None:
     """How far the depth's geometry moves against the poses of ``src``
-    (:func:`~.scale_check.fit_scale`); None without a usable pair."""
+    (:func:`~.scale_check.fit_scale`; ``invert``: against their inverses, as
+    :func:`~.scale_check.inverted_poses_problem` asks); None without a usable pair."""
     if not idx.samples:
         return None
     explicit = opts.tf_frames is not None or opts.pose is not None
@@ -51,7 +52,8 @@ def bag_scale_fit(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
             if len(got) == len(need):
                 break
         count += 1
-    quads = [(got[posed[i][0]], got[posed[j][0]], posed[i][1], posed[j][1])
+    pose = np.linalg.inv if invert else np.asarray
+    quads = [(got[posed[i][0]], got[posed[j][0]], pose(posed[i][1]), pose(posed[j][1]))
              for i, j in pairs if posed[i][0] in got and posed[j][0] in got
              and got[posed[i][0]].shape == (k.height, k.width)]
     return fit_scale(quads, k)

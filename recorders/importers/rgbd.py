@@ -74,10 +74,12 @@ from sgtool.recorders.importers.sanity import (
     principal_point_problem,
 )
 from sgtool.recorders.importers.scale_check import (
+    TOLERANCE,
     ScaleFit,
     fit_scale,
     frozen_poses_problem,
     geometric_scale_problem,
+    inverted_poses_problem,
     pair_indices,
     pose_motion_problem,
 )
@@ -263,6 +265,10 @@ def check_scale_by_geometry(frames: list[FolderFrame], k: CameraIntrinsics, scal
               depth_to_metres(read_depth_file(frames[j].depth_path), scale), poses[i], poses[j])
              for i, j in pair_indices(poses)]
     fit = fit_scale(pairs, k)
+    if fit is None or not fit.consistent() or abs(fit.ratio - 1.0) > TOLERANCE:
+        inverted = fit_scale([(a, b, np.linalg.inv(p), np.linalg.inv(q))
+                              for a, b, p, q in pairs], k)
+        findings.problem(inverted_poses_problem(fit, inverted, pose_source), given=estimate)
     motion = pose_motion_problem(fit, pose_source)
     if motion is not None:
         findings.problem(motion[0], given=estimate or not motion[1])

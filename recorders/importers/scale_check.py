@@ -166,6 +166,26 @@ def geometric_scale_problem(fit: ScaleFit | None, scale: float, origin: str,
             f"--depth-scale {fits:g} fits; give it, or --depth-scale {scale:g} to keep this one")
 
 
+def inverted_poses_problem(given: ScaleFit | None, inverted: ScaleFit | None,
+                           pose_source: str) -> str | None:
+    """When the poses' inverses move as the depth does (a consistent fit within
+    :data:`TOLERANCE` of 1) and the poses themselves do not: world-to-camera poses, which
+    the depth-scale and motion checks would otherwise take for a wrong scale (a few
+    centimetres a pair, a small turn: the inverses' error is systematic, so it fits a
+    consistent wrong ratio). The text; None otherwise."""
+    if inverted is None or not inverted.consistent() or abs(inverted.ratio - 1.0) > TOLERANCE:
+        return None
+    if given is not None and given.consistent() and abs(given.ratio - 1.0) <= TOLERANCE:
+        return None
+    how = ("no consistent factor" if given is None else f"{given.ratio:.2f}x"
+           if given.consistent() else f"{given.ratio:.2f}x on average, the pairs disagreeing,")
+    return (f"the poses ({pose_source}) look world-to-camera: between {inverted.pairs} pairs "
+            f"of nearby frames the depth moves {how} as far as the poses, and "
+            f"{inverted.ratio:.2f}x as far as their inverses; camera-to-world poses are "
+            "expected: invert them, or give --estimate-poses to estimate the poses from the "
+            "depth")
+
+
 MIN_RATIO = 0.2  # a depth that moves less than this far (either way) stands still
 STILL_PAIRS = 3  # pairs over which depth standing still while the poses move is clear,
 STILL_STEP_M = 0.05  # when the pairs' poses move this far (median): well beyond depth noise

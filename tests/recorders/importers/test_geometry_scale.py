@@ -143,9 +143,10 @@ def test_poses_in_another_convention_are_caught(tmp_path):
 
     root = make_scene_folder(tmp_path / "inv", room(), POSES, units_per_m=5000.0)
     _rewrite_ground_truth(root, inverted)
-    with pytest.raises(SgtoolError, match=r"the poses \(ground truth\) do not move as the "
-                       r"depth does: between 6 pairs .* moves -1\.\d\dx as far as the poses; "
-                       r".*world-to-camera instead of camera-to-world.*--estimate-poses"):
+    with pytest.raises(SgtoolError, match=r"the poses \(ground truth\) look world-to-camera: "
+                       r"between 6 pairs .* moves -1\.\d\dx on average, the pairs "
+                       r"disagreeing, as far as the poses, and 1\.0\dx as far as their "
+                       r"inverses; .*invert them, or give --estimate-poses"):
         import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
     assert not (tmp_path / "a.mcap").exists()
     rep = import_rgbd(root, tmp_path / "est.mcap",
