@@ -186,6 +186,23 @@ def inverted_poses_problem(given: ScaleFit | None, inverted: ScaleFit | None,
             "depth")
 
 
+POSE_UNITS = ((0.01, "centimetres"), (0.001, "millimetres"))
+
+
+def pose_units_problem(fits: Sequence[tuple[str, ScaleFit | None]],
+                       pose_source: str) -> str | None:
+    """When the poses' translations, read as one of the units of :data:`POSE_UNITS`
+    (``fits``: the unit's name and the fit of the poses with their translations scaled
+    to metres from it), move as the depth does: the text naming the unit; else None."""
+    for unit, fit in fits:
+        if fit is not None and fit.consistent() and abs(fit.ratio - 1.0) <= TOLERANCE:
+            return (f"the poses' translations ({pose_source}) look in {unit}: between "
+                    f"{fit.pairs} pairs of nearby frames the depth moves {fit.ratio:.2f}x as "
+                    f"far as the poses read in {unit}; sgtool reads metres: convert them, or "
+                    "give --estimate-poses to estimate the poses from the depth")
+    return None
+
+
 MIN_RATIO = 0.2  # a depth that moves less than this far (either way) stands still
 STILL_PAIRS = 3  # pairs over which depth standing still while the poses move is clear,
 STILL_STEP_M = 0.05  # when the pairs' poses move this far (median): well beyond depth noise

@@ -521,6 +521,28 @@ def test_an_up_far_off_the_horizontal_surfaces_is_doubted(rgbd_data, tmp_path):
                            "down") and "give --up 0.000,-1.000,0.000 or --up auto" in warn
 
 
+@pytest.mark.parametrize(("factor", "unit"), [(100.0, "centimetres"), (1000.0, "millimetres")])
+def test_poses_in_centimetres_are_named_so(rgbd_data, tmp_path, factor, unit):
+    """A trajectory written in cm or mm: no frame pair matched at metres, so the check had
+    no verdict and the floor was blamed (52 m under the camera; the --floor it advised
+    gave a map of views 69 m apart, exit 0). The translations read in the unit fit."""
+    src = rgbd_data / "icl-livingroom1-micro"
+    folder = tmp_path / "units"
+    shutil.copytree(src, folder)
+    lines = (src / "open3d_estimated_trajectory.log").read_text().split("\n")
+    out = []
+    for i in range(0, len(lines) - 4, 5):
+        if not lines[i].strip():
+            break
+        pose = np.array([[float(x) for x in lines[i + k].split()] for k in range(1, 5)])
+        pose[:3, 3] *= factor
+        out += [lines[i], *(" ".join(f"{x:.8f}" for x in row) for row in pose)]
+    (folder / "open3d_estimated_trajectory.log").write_text("\n".join(out) + "\n")
+    with pytest.raises(SgtoolError, match=rf"the poses' translations \(trajectory\) look in "
+                                          rf"{unit}: .* 1\.0\dx as far as the poses read in"):
+        import_rgbd(folder, tmp_path / "u.mcap", RgbdOptions(**QUIET, limit=60))
+
+
 def test_a_still_camera_is_not_taken_for_frozen_poses() -> None:
     """Poses that stand still over depth that hardly changes (a camera on a tripod, a
     person walking through a corner of the view) pass; so do poses that move."""
