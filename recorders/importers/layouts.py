@@ -230,14 +230,15 @@ def read_sequence(
     elif layout == "7scenes":
         seq = _read_7scenes(root, fps, trajectory, skip_missing, keep_unposed)
     elif layout == "open3d":
-        seq = _read_open3d(root, fps, trajectory)
+        seq = _read_open3d(root, fps, trajectory, skip_missing)
     else:  # pragma: no cover - missing_for_layout refuses unknown layouts
         raise SgtoolError(f"unknown layout {layout!r} ({', '.join(LAYOUTS)})")
     if not seq.frames:
         raise SgtoolError(f"{root}: no frames found in the {LAYOUT_NAMES[layout]} layout")
     unused = [flag for flag, on, layouts in (
         ("--timestamps index", timestamps != "file", ("tum",)),
-        ("--skip-missing", skip_missing, ("tum", "7scenes"))) if on and layout not in layouts]
+        ("--skip-missing", skip_missing, ("tum", "7scenes", "open3d")))
+              if on and layout not in layouts]
     if unused:  # said, not silently ignored
         seq = replace(seq, notes=(*seq.notes, f"{' and '.join(unused)}: not used by the "
                                   f"{LAYOUT_NAMES[layout]} layout"))
@@ -514,11 +515,15 @@ def _depth_images(folder: Path, notes: list[str]) -> list[Path]:
     return [p for p in found if kind(p) == main]
 
 
-def _read_open3d(root: Path, fps: float, trajectory: Path | None) -> FolderSequence:
+def _read_open3d(root: Path, fps: float, trajectory: Path | None,
+                 skip_missing: bool = False) -> FolderSequence:
     """Depth images of ``depth/`` and colour images of the colour folder, paired by name
     (else in order when every name differs); a depth image without a colour image of its
     name (a lab that dropped bad colour frames) is a frame without colour, with a note:
-    nothing lists the files, so none is missing."""
+    nothing lists the files, so none is missing. A colour image without a depth image
+    makes the trajectory one pose longer than the frames: ``skip_missing`` takes the
+    poses as those of every image name, depth or colour (in natural order), and leaves
+    the frames without depth out with their poses."""
     notes: list[str] = []
     cdir = _color_dir(root)
     depths = _depth_images(root / "depth", notes)
@@ -555,9 +560,18 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None) -> FolderSeque
             )
     unpaired = sorted({c.stem for c in colors} - {d.stem for d in depths}, key=natural_key)
     hint = (f" ({len(unpaired)} colour images have no depth image; first: depth/{unpaired[0]}.*"
-            f" for {by_stem[unpaired[0]].relative_to(root)})"
-            if unpaired and len(pairs) < len(colors) else "")
-    poses = _external_poses(traj, len(pairs), hint) if traj is not None else None
+            f" for {by_stem[unpaired[0]].relative_to(root)}; --skip-missing leaves them out "
+            "with their poses)" if unpaired and len(pairs) < len(colors) else "")
+    if traj is not None and skip_missing and unpaired and matched:
+        stems = sorted({d.stem for d in depths} | set(by_stem), key=natural_key)
+        every = _external_poses(traj, len(stems), hint)  # one pose per frame recorded
+        assert every is not None
+        pose_of = dict(zip(stems, every, strict=True))
+        poses: list[np.ndarray] | None = [pose_of[d.stem] for d, _ in pairs]
+        notes.append(f"--skip-missing: {len(unpaired)} colour image(s) without a depth image "
+                     f"left out with their poses (first: {by_stem[unpaired[0]].relative_to(root)})")
+    else:
+        poses = _external_poses(traj, len(pairs), hint) if traj is not None else None
     intr = None
     for p in sorted(root.glob("*.json")):
         if _is_intrinsics_json(p):

@@ -543,6 +543,35 @@ def test_poses_in_centimetres_are_named_so(rgbd_data, tmp_path, factor, unit):
         import_rgbd(folder, tmp_path / "u.mcap", RgbdOptions(**QUIET, limit=60))
 
 
+def test_a_colour_frame_without_depth_is_skipped_with_its_pose(rgbd_data, tmp_path):
+    """An Open3D folder whose depth image 00005 is missing: the trajectory has a pose more
+    than the frames (refused, naming --skip-missing); with --skip-missing the frame goes
+    with its pose and every other frame keeps its own."""
+    src = rgbd_data / "icl-livingroom1-micro"
+    folder = tmp_path / "gap"
+    (folder / "depth").mkdir(parents=True)
+    (folder / "image").mkdir()
+    for i in range(12):
+        shutil.copy(src / "depth" / f"{i:05d}.png", folder / "depth")
+        shutil.copy(src / "image" / f"{i:05d}.jpg", folder / "image")
+    shutil.copy(src / "camera_primesense.json", folder)
+    lines = (src / "open3d_estimated_trajectory.log").read_text().split("\n")
+    (folder / "traj.log").write_text("\n".join(lines[:60]) + "\n")
+    (folder / "depth" / "00005.png").unlink()
+    with pytest.raises(SgtoolError, match=r"has 12 poses for 11 frames .*--skip-missing leaves "
+                                          r"them out with their poses"):
+        import_rgbd(folder, tmp_path / "a.mcap", RgbdOptions(**QUIET))
+    rep = import_rgbd(folder, tmp_path / "b.mcap", RgbdOptions(**QUIET, skip_missing=True,
+                                                               floor_auto=False))
+    assert rep.frames == 11
+    want = [np.array([[float(x) for x in lines[5 * i + k].split()] for k in range(1, 5)])
+            for i in range(12) if i != 5]
+    with LogReader(tmp_path / "b.mcap") as r:
+        got = [f.pose for f in r.frames()]
+    back = want[0] @ np.linalg.inv(got[0])  # undoes the import's world alignment (A @ pose)
+    assert all(pose_difference(back @ g, w)[0] < 1e-5 for g, w in zip(got, want, strict=True))
+
+
 def test_a_still_camera_is_not_taken_for_frozen_poses() -> None:
     """Poses that stand still over depth that hardly changes (a camera on a tripod, a
     person walking through a corner of the view) pass; so do poses that move."""
