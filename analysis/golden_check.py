@@ -180,11 +180,13 @@ def pin_folder(root: Path, logs: Sequence[Path] = ()) -> Iterator[Path]:
 
 
 @contextlib.contextmanager
-def pins_locked(root: Path) -> Iterator[None]:
+def pins_locked(root: Path, shared: bool = False) -> Iterator[None]:
     """Hold the lock of the pin folder ``root`` (an advisory lock on a file of this user's
     in the system's temporary folder, named after ``root``'s resolved path; nothing is
-    added to ``root``): one process at a time reads, changes and writes its index. Where
-    there are no advisory locks (not POSIX), nothing is held."""
+    added to ``root``): one process at a time reads, changes and writes its index;
+    ``shared``: a reader's lock (checks read the index and the graphs it names together,
+    never half of a pin being written). Where there are no advisory locks (not POSIX),
+    nothing is held."""
     import hashlib
     import tempfile
 
@@ -196,7 +198,7 @@ def pins_locked(root: Path) -> Iterator[None]:
     key = hashlib.sha256(str(root.resolve()).encode()).hexdigest()[:20]
     user = os.getuid() if hasattr(os, "getuid") else 0
     with open(Path(tempfile.gettempdir()) / f"sgtool-pins-{user}-{key}.lock", "a+b") as fh:
-        fcntl.flock(fh, fcntl.LOCK_EX)
+        fcntl.flock(fh, fcntl.LOCK_SH if shared else fcntl.LOCK_EX)
         try:
             yield
         finally:
@@ -275,6 +277,13 @@ def pin_logs(logs: Sequence[str | Path] | str | Path, folder: str | Path,
             logs_now[name] = pin
         write_index(staged)
     return PinSet(root, logs_now, sgtool_version=__version__)
+
+
+def _graph_times(graphs: Sequence[str]) -> list[int]:
+    """The ``time_ns`` of each graph's JSON (0 where it is missing)."""
+    import json
+
+    return [int(json.loads(g).get("time_ns") or 0) for g in graphs]
 
 
 def _not_a_whole_log(log: Path) -> str | None:
@@ -420,8 +429,16 @@ def pin_command(pin: Pinned, log: Path, folder: Path) -> str:
 
 
 def _check_task(t: _CheckTask) -> LogCheck:
-    folder, pin = Path(t.folder), t.pin
-    pins = PinSet(folder, {pin.name: pin})
+    folder = Path(t.folder)
+    with pins_locked(folder, shared=True):  # the index and its graphs of one moment
+        pin = read_pins(folder).logs.get(t.pin.name, t.pin) if (folder / INDEX).is_file() \
+            else t.pin  # (re-pinned since the index was read: the new pin)
+        pins = PinSet(folder, {pin.name: pin})
+        try:
+            loaded: tuple[list[str], list[RefreshMeta] | None] | SgtoolError = \
+                load_expected(pins, pin.name)
+        except SgtoolError as e:
+            loaded = e
     log = pin.log_path(folder)
     base = LogCheck(pin.name, "error", str(log), options_dict(t.options))
     try:
@@ -438,7 +455,9 @@ def _check_task(t: _CheckTask) -> LogCheck:
             raise PinError(f"{log} is not the pinned log ({what}); if it was "
                            "re-recorded on purpose, pin it again with its settings: "
                            f"`{pin_command(pin, log, folder)}`")
-        expected, metas = load_expected(pins, pin.name)
+        if isinstance(loaded, SgtoolError):
+            raise loaded
+        expected, metas = loaded
         cap = capture_log(log, t.options)
     except SgtoolError as e:
         return dataclasses.replace(base, error=str(e).splitlines()[0])
@@ -450,6 +469,11 @@ def _check_task(t: _CheckTask) -> LogCheck:
                                              [r.time_ns for r in cap.refreshes])
         pinned, metas, actual = ([expected[i] for i in ia], [metas[i] for i in ia],
                                  [actual[j] for j in numbers])
+    elif (times := _graph_times(expected)) != [r.time_ns for r in cap.refreshes] and \
+            len(set(times)) == len(times) == len(expected):
+        # no refresh file (an older pin): the graphs' own distinct times pair them
+        ia, numbers, note = paired_refreshes(times, [r.time_ns for r in cap.refreshes])
+        pinned, actual = [expected[i] for i in ia], [actual[j] for j in numbers]
     layers = ([(m.layers, c.layers) for m, (c, _) in zip(metas, actual, strict=False)]
               if metas is not None else [])
     lines = describe_mismatch(pinned, actual, tol=t.tolerance, exact=exact, layers=layers,

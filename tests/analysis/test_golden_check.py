@@ -662,3 +662,35 @@ def test_a_pinned_log_that_is_no_whole_log_says_what_it_is(pinned, capsys, damag
                      "cut": data[: len(data) - 100], "other": b"PK\x03\x04 a zip"}[damage])
     code, out, err = sgtool(capsys, "golden", "check", "--dir", pinned)
     assert code != 0 and said in out + err and "pin it again" not in out + err
+
+
+def test_without_a_refresh_file_other_refreshes_pair_by_the_graphs_times(pinned, capsys,
+                                                                          tmp_path):
+    """An older pin holds no refresh file (optional): `--every 5` compared the refreshes
+    by position, a graph at 1.5 s against one at 3 s. The graphs' own times pair them, as
+    the refresh file's do: the same refreshes compared either way."""
+    def heads(folder):
+        out = sgtool(capsys, "golden", "check", "--dir", folder, "--every", "5")[1]
+        return [x.strip() for x in out.splitlines() if x.strip().startswith("refresh ")]
+
+    with_file = heads(pinned)
+    (pinned / "small.refreshes.jsonl.gz").unlink()
+    assert heads(pinned) == with_file != []
+
+
+def test_a_check_waits_for_a_pin_being_written(pinned, capsys):
+    """A pin of the same folder in progress holds its lock: a check reading the index and
+    its graphs waits for it (it read a new graphs file against the old index: 'damaged')."""
+    import threading
+
+    from sgtool.analysis.golden_check import check_pins, pins_locked
+
+    done: list[str] = []
+    with pins_locked(pinned):
+        t = threading.Thread(target=lambda: done.append(
+            check_pins(pinned).logs[0].status))
+        t.start()
+        t.join(timeout=3)
+        assert t.is_alive() and not done  # waiting for the writer
+    t.join(timeout=120)
+    assert done == ["unchanged"]
