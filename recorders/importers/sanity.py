@@ -82,6 +82,13 @@ def timestamp_problem(times_ns: Sequence[int], what: str,
     looks = ""
     if s.backwards and s.span_s * MAX_FPS < s.frames:  # small values up and down
         looks = f"; {s.frames} frames in {s.span_s:.3g} s: they look like per-frame intervals"
+    elif not s.backwards and not s.duplicates and s.fps < MIN_FPS:
+        for factor, unit in ((1e3, "milliseconds"), (1e6, "microseconds")):
+            if MIN_FPS <= s.fps * factor <= MAX_FPS:
+                looks = (f"; read as {unit}, {s.fps * factor:.3g} fps: they look like "
+                         f"{unit} where the format gives seconds (convert the lists and any "
+                         "trajectory of the same clock to seconds to keep its poses)")
+                break
     return f"{what}: the time stamps are not times of frames ({'; '.join(found)}{looks}); {fix}"
 
 

@@ -232,3 +232,17 @@ def test_an_intrinsics_file_of_another_shape_says_what_it_should_hold(tmp_path):
     assert str(err.value) == (f"{bad}: expected a 3x3 camera matrix [[fx 0 cx] [0 fy cy] "
                               "[0 0 1]] (three rows of three numbers), or Open3D intrinsics "
                               "JSON")
+
+
+def test_time_stamps_in_milliseconds_are_named_so():
+    """TUM lists written in ms (10 frames over 300 "s"): the refusal says they read as
+    30 fps in milliseconds, and how to keep the ground truth's poses."""
+    from sgtool.recorders.importers.sanity import timestamp_problem
+
+    ms = [int(t * 1e9) for t in (100.0 * 1000 + 33.3 * i for i in range(10))]
+    text = timestamp_problem(ms, "depth.txt")
+    assert text is not None and "read as milliseconds, 30 fps" in text
+    assert "to keep its poses" in text
+    assert timestamp_problem([int(i * 1e9 / 30) for i in range(10)], "depth.txt") is None
+    slow = timestamp_problem([int(i * 300e9) for i in range(10)], "depth.txt")  # 1 per 5 min
+    assert slow is not None and "milliseconds" not in slow
