@@ -84,7 +84,7 @@ def timestamp_problem(times_ns: Sequence[int], what: str,
         looks = f"; {s.frames} frames in {s.span_s:.3g} s: they look like per-frame intervals"
     elif not s.backwards and not s.duplicates and s.fps < MIN_FPS:
         for factor, unit in ((1e3, "milliseconds"), (1e6, "microseconds")):
-            if MIN_FPS <= s.fps * factor <= MAX_FPS:
+            if 5.0 <= s.fps * factor <= 120.0:  # a camera's usual rates
                 looks = (f"; read as {unit}, {s.fps * factor:.3g} fps: they look like "
                          f"{unit} where the format gives seconds (convert the lists and any "
                          "trajectory of the same clock to seconds to keep its poses)")
