@@ -230,7 +230,7 @@ def read_sequence(
     elif layout == "7scenes":
         seq = _read_7scenes(root, fps, trajectory, skip_missing, keep_unposed)
     elif layout == "open3d":
-        seq = _read_open3d(root, fps, trajectory, skip_missing)
+        seq = _read_open3d(root, fps, trajectory, skip_missing, keep_unposed)
     else:  # pragma: no cover - missing_for_layout refuses unknown layouts
         raise SgtoolError(f"unknown layout {layout!r} ({', '.join(LAYOUTS)})")
     if not seq.frames:
@@ -459,10 +459,11 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
                           dropped=dropped)
 
 
-def _external_poses(trajectory: Path | None, count: int,
-                    hint: str = "") -> list[np.ndarray] | None:
+def _external_poses(trajectory: Path | None, count: int, hint: str = "",
+                    shorter: bool = False) -> list[np.ndarray] | None:
     """Poses from a --trajectory file for frames in order (Open3D .log, or a TUM file whose
-    lines are taken in order); ``hint`` says why the counts may differ."""
+    lines are taken in order); ``hint`` says why the counts may differ; ``shorter``: a
+    trajectory that ends before the frames is taken (the first frames' poses)."""
     if trajectory is None:
         return None
     if not trajectory.is_file():
@@ -471,7 +472,7 @@ def _external_poses(trajectory: Path | None, count: int,
         poses = read_open3d_log(trajectory)
     else:
         poses = [T for _, T in read_tum_trajectory(trajectory)]
-    if len(poses) != count:
+    if len(poses) != count and not (shorter and 0 < len(poses) < count):
         raise SgtoolError(f"{trajectory} has {len(poses)} poses for {count} frames{hint}")
     return poses
 
@@ -516,7 +517,7 @@ def _depth_images(folder: Path, notes: list[str]) -> list[Path]:
 
 
 def _read_open3d(root: Path, fps: float, trajectory: Path | None,
-                 skip_missing: bool = False) -> FolderSequence:
+                 skip_missing: bool = False, keep_unposed: bool = False) -> FolderSequence:
     """Depth images of ``depth/`` and colour images of the colour folder, paired by name
     (else in order when every name differs); a depth image without a colour image of its
     name (a lab that dropped bad colour frames) is a frame without colour, with a note:
@@ -567,11 +568,24 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
         every = _external_poses(traj, len(stems), hint)  # one pose per frame recorded
         assert every is not None
         pose_of = dict(zip(stems, every, strict=True))
-        poses: list[np.ndarray] | None = [pose_of[d.stem] for d, _ in pairs]
+        poses: list[np.ndarray | None] | None = [pose_of[d.stem] for d, _ in pairs]
         notes.append(f"--skip-missing: {len(unpaired)} colour image(s) without a depth image "
                      f"left out with their poses (first: {by_stem[unpaired[0]].relative_to(root)})")
     else:
-        poses = _external_poses(traj, len(pairs), hint) if traj is not None else None
+        read = _external_poses(traj, len(pairs), hint, shorter=True) \
+            if traj is not None else None
+        poses = None if read is None else list(read)
+    dropped = 0
+    if poses is not None and len(poses) < len(pairs):  # a reconstruction that stopped early
+        assert traj is not None
+        late = len(pairs) - len(poses)
+        notes.append(f"{late} of {len(pairs)} frames come after the last pose of {traj.name} "
+                     f"(first: {pairs[len(poses)][0].relative_to(root)})"
+                     + ("" if keep_unposed else ": left out"))
+        if keep_unposed:
+            poses = [*poses, *([None] * late)]
+        else:
+            dropped, pairs = late, pairs[:len(poses)]
     intr = None
     for p in sorted(root.glob("*.json")):
         if _is_intrinsics_json(p):
@@ -585,4 +599,5 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
         "open3d", root, frames, intr or PRIMESENSE_INTRINSICS, 1000.0,
         "trajectory" if poses is not None else "none",
         ((f"poses from {traj.name}",) if traj is not None else ()) + tuple(notes),
+        dropped=dropped,
     )

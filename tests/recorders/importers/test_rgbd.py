@@ -572,6 +572,27 @@ def test_a_colour_frame_without_depth_is_skipped_with_its_pose(rgbd_data, tmp_pa
     assert all(pose_difference(back @ g, w)[0] < 1e-5 for g, w in zip(got, want, strict=True))
 
 
+def test_a_trajectory_that_stops_early_leaves_the_later_frames_out(rgbd_data, tmp_path):
+    """An Open3D .log shorter than the frames (a reconstruction that stopped early; it was
+    refused, --allow-drop and --limit no way past): the frames after its last pose are
+    dropped frames, up to a tenth with a note, more refused without --allow-drop."""
+    src = rgbd_data / "icl-livingroom1-micro"
+    folder = tmp_path / "short"
+    shutil.copytree(src, folder)
+    lines = (src / "open3d_estimated_trajectory.log").read_text().split("\n")
+    log = folder / "open3d_estimated_trajectory.log"
+    log.write_text("\n".join(lines[:5 * 150]) + "\n")
+    with pytest.raises(SgtoolError, match=r"61 of 211 frames \(29 %.*--allow-drop"):
+        import_rgbd(folder, tmp_path / "a.mcap", RgbdOptions(**QUIET))
+    rep = import_rgbd(folder, tmp_path / "b.mcap", RgbdOptions(**QUIET, allow_drop=True,
+                                                               every=10))
+    assert rep.frames == 15  # frames 0, 10, ..., 140 of the 150 posed
+    assert any("61 of 211 frames come after the last pose" in n for n in rep.notes)
+    log.write_text("\n".join(lines[:5 * 200]) + "\n")  # 11 short: a note only
+    rep = import_rgbd(folder, tmp_path / "c.mcap", RgbdOptions(**QUIET, every=10))
+    assert rep.frames == 20 and any("11 of 211 frames come after" in n for n in rep.notes)
+
+
 def test_a_still_camera_is_not_taken_for_frozen_poses() -> None:
     """Poses that stand still over depth that hardly changes (a camera on a tripod, a
     person walking through a corner of the view) pass; so do poses that move."""
