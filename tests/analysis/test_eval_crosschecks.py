@@ -45,6 +45,9 @@ GOOD = EpisodeResult("greedy", 0, "h", 0, "mug", True, steps=4, travelled_m=10.0
     ({"steps": 0, "travelled_m": 3.0, "success": False},
      "steps 0 but travelled_m 3 m: no step, no travel"),
     ({"n_open": 5}, "n_open 5 is more than steps 4: every open is a step"),
+    ({"noise": "symbolic", "steps": 0, "travelled_m": 1.0},  # eval's label, no sensor
+     "steps 0 but travelled_m 1 m: no step, no travel"),
+    ({"noise": "none", "n_open": 5}, "n_open 5 is more than steps 4: every open is a step"),
 ])
 def test_contradicting_figures_are_refused_naming_them(change, problem):
     assert episode_problem(dataclasses.replace(GOOD, **change)) == problem
@@ -59,6 +62,12 @@ def test_contradicting_figures_are_refused_naming_them(change, problem):
     {"steps": 0, "travelled_m": 0.0, "shortest_m": 5.9},  # in sight from the start
     {"travelled_m": 0.0, "shortest_m": None},  # no shortest path known: nothing to check
     {"n_open": 4},
+    # closed loop: the robot's own exploration drives without a step, and its camera sees
+    # the target over a counter the path goes round (it was refused, while run-bench
+    # counted it a success)
+    {"noise": "none", "steps": 0, "travelled_m": 0.81},
+    {"noise": "mild", "steps": 0, "travelled_m": 0.0, "shortest_m": 6.31},
+    {"noise": "none", "steps": 3, "travelled_m": 1.0},
 ])
 def test_consistent_figures_pass(change):
     assert episode_problem(dataclasses.replace(GOOD, **change)) is None

@@ -86,11 +86,13 @@ def command(inputs: tuple[str, ...], out: str | None, force: bool = False,
     An episode whose figures cannot be true, or contradict each other, is refused: it is
     left out of every metric and a one-line note on stderr names the file, the episode and
     the contradiction (the JSON output lists the notes too). Refused: negative steps or
-    counts; a negative or non-finite travelled_m or shortest_m; travel without a step
-    (steps 0, travelled_m > 0); more opens than steps; a success that travelled less than
-    its shortest path by more than 5.5 m + 10% of it (the path ends 1 m from the target, a
-    camera sees it from up to 6 m: a success with 0 m travelled towards a target 9.48 m
-    away is refused). A shortest_m of 0 is accepted: the target is seen from the start."""
+    counts; a negative or non-finite travelled_m or shortest_m; more opens than steps; and
+    in symbolic episodes travel without a step (steps 0, travelled_m > 0) and a success
+    that travelled less than its shortest path by more than 5.5 m + 10% of it (the path
+    ends 1 m from the target, a camera sees it from up to 6 m: a success with 0 m
+    travelled towards a target 9.48 m away is refused; a closed-loop robot drives on its
+    own between steps and sees over furniture its path goes round). A shortest_m of 0 is
+    accepted: the target is seen from the start."""
     from sgtool.analysis.eval_run import evaluate
     from sgtool.files import atomic_write
 
