@@ -432,8 +432,12 @@ class _Search:
                 "reason": action.reason, "unknown": {"message": message}}
 
     def _run(self, calls: tuple[SkillCall, ...]) -> Executed:
-        if self.skills is None:
-            return execute_privileged(self.sim, calls)
+        if self.skills is None:  # the skill ends at a refresh that holds the target
+            self.rec.stop_when = lambda: _found(self.rec.stream.current, self.query)
+            try:
+                return execute_privileged(self.sim, calls)
+            finally:
+                self.rec.stop_when = None
         return execute_live(self.sim, self.skills, calls, self.rec.stream.current)
 
 

@@ -16,6 +16,12 @@ class StopSimulation(Exception):  # noqa: N818 (a control-flow signal, not an er
     """Raised by an observer to end the current run (frame budget reached)."""
 
 
+class TargetInView(Exception):  # noqa: N818 (a control-flow signal, not an error)
+    """Raised by the closed loop's recorder at a refresh whose graph holds the target,
+    to end the skill running (the ground-truth skills of ``navigation="house"``; the live
+    skills ask at every refresh themselves)."""
+
+
 @dataclass(frozen=True)
 class SkillOutcome:
     """What a skill did: the log's ``sgtool.Action`` fields."""

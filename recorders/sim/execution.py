@@ -6,9 +6,10 @@
 - :func:`execute_privileged` (``navigation="house"``, privileged, kept for comparison): the
   simulator's skills plan on the house's ground-truth occupancy.
 
-Both run the calls until one does not succeed (live: or ends because the target came
-into view, :data:`~sgtool.recorders.sim.live_skills.IN_VIEW`) and return an
-:class:`Executed`.
+Both run the calls until one does not succeed or the target came into view
+(:data:`~sgtool.recorders.sim.live_skills.IN_VIEW`: live, the skills ask at every
+refresh; privileged, the recorder raises :class:`~.events.TargetInView` at one) and
+return an :class:`Executed`.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sgtool.planning.base import Outcome
-from sgtool.recorders.sim.events import StopSimulation
+from sgtool.recorders.sim.events import StopSimulation, TargetInView
 from sgtool.recorders.sim.live_goals import Goal, goal_of_node
 from sgtool.recorders.sim.live_skills import IN_VIEW, LiveSkills
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome
@@ -50,6 +51,8 @@ def execute_privileged(sim: Simulation, calls: Sequence[SkillCall]) -> Executed:
     except StopSimulation as e:
         return Executed("failure", f"stopped: {e}", sim.travelled_m - d0,
                         sim.tick_index - t0, True)
+    except TargetInView:  # the recorder's graph holds the target: the rest is moot
+        return Executed("success", IN_VIEW, sim.travelled_m - d0, sim.tick_index - t0, False)
     assert out is not None
     return Executed(out.outcome, out.reason, sim.travelled_m - d0, sim.tick_index - t0, False)
 

@@ -19,11 +19,12 @@ within the frame budget), so the refresh at the action sees where the robot stan
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from sgtool.log.echo import as_logged
 from sgtool.log.writer import LogWriter
+from sgtool.recorders.sim.events import TargetInView
 from sgtool.recorders.sim.keyframes import KeyframeRule
 from sgtool.recorders.sim.recording import LogRecorder
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome
@@ -49,6 +50,8 @@ class LiveRecorder(LogRecorder):
         self._tilt: float | None = None  # the head's tilt at the last frame (degrees)
         self._changed = False  # a door or container changed since the last frame
         self._pending: int | None = None  # the last tick, when it was no frame
+        # asked at each refresh a frame makes: True ends the skill (TargetInView)
+        self.stop_when: Callable[[], bool] | None = None
 
     def write_instances(self, sim: Simulation) -> dict[str, Any]:
         """Write the instance table (as :class:`LogRecorder` does) and hand the stream the
@@ -77,7 +80,10 @@ class LiveRecorder(LogRecorder):
         self._changed = False
         self._pending = None
         assert self.last_frame is not None
-        self.refreshed(self.stream.frame(as_logged(self.last_frame)))
+        r = self.stream.frame(as_logged(self.last_frame))
+        self.refreshed(r)
+        if r is not None and self.stop_when is not None and self.stop_when():
+            raise TargetInView
 
     def _tilted(self, sim: Simulation) -> float:
         """Degrees the head tilted since the last frame (0 before the first)."""

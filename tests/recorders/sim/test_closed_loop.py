@@ -565,3 +565,24 @@ def test_live_only_options_refused_with_house_navigation(tmp_path: Path) -> None
                                  "3", "--rooms", "4-4", "-p", "random", "-o",
                                  str(tmp_path / "x.mcap")])
     assert r.exit_code == 2 and "--sight-lines: for --navigation live" in r.output
+
+
+def test_house_navigation_ends_the_skill_when_the_target_is_in_the_graph(tmp_path) -> None:
+    """`--navigation house`: the episode ends at the refresh whose graph holds the target,
+    as live navigation does; it drove on to the next cabinet first (16 frames, 2.1 m
+    more, counted in SPL and frames per room)."""
+    from sgtool.house.io import save_house
+    from sgtool.recorders.sim.live_skills import IN_VIEW
+
+    house = tmp_path / "h.json"
+    save_house(generate_house(3, rooms=(4, 5)), house)
+    out = tmp_path / "pie.mcap"
+    r = CliRunner().invoke(cli, ["run", "--planner", "scout", "--house", str(house), "--query",
+                                 "apple pie", "--resolution", "96x72", "--max-steps", "10",
+                                 "--navigation", "house", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    with LogReader(out) as log:
+        graphs = [(t, SceneGraph.from_dict(g)) for t, g in log.records("scene_graph")]
+        (t_last, last), *_ = reversed(list(log.records("action")))
+    first = next(t for t, g in graphs if any(o.category == "apple pie" for o in g.objects))
+    assert t_last == first and last["message"] == IN_VIEW and last["outcome"] == "success"
