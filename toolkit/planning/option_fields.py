@@ -174,7 +174,7 @@ def option_infos(cls: type) -> tuple[OptionInfo, ...]:
     for f in dataclasses.fields(cls):
         meta = f.metadata.get(_META) or _plain_meta(f, hints.get(f.name, f.type))
         default = f.default if f.default is not dataclasses.MISSING else None
-        required = f.default is dataclasses.MISSING and \
+        required = f.init and f.default is dataclasses.MISSING and \
             f.default_factory is dataclasses.MISSING
         out.append(OptionInfo(f.name, meta.kind, default, meta, required))
     return tuple(out)
@@ -218,17 +218,24 @@ def convert_options(planner: str, cls: type, given: Mapping[str, Any],
     unknown = [k for k in given if k not in infos]
     if unknown:
         raise unknown_keys_error(planner, unknown, infos)
+    return {k: convert_value(planner, k, infos[k].meta, v, from_cli) for k, v in given.items()}
+
+
+def check_required(planner: str, cls: type, given: Mapping[str, Any]) -> None:
+    """Every option of ``cls`` without a default is in ``given`` (the whole set the
+    planner is built with), else one :class:`PlannerOptionError` line naming them."""
+    infos = {i.name: i for i in option_infos(cls)}
     missing = [n for n, i in infos.items() if i.required and n not in given]
     if missing:
         how = ", ".join(f"-O {planner}.{n}=..." if infos[n].meta.cli else f"{n}= from Python"
                         for n in missing)
         raise PlannerOptionError(f"planner {planner!r}: option {', '.join(missing)} is "
                                  f"required ({how})")
-    return {k: convert_value(planner, k, infos[k].meta, v, from_cli) for k, v in given.items()}
 
 
 def build_options(planner: str, cls: type, given: Mapping[str, Any]) -> Any:
     """An instance of ``cls`` from ``given`` (checked, converted), defaults elsewhere."""
+    check_required(planner, cls, given)
     return cls(**convert_options(planner, cls, given))
 
 

@@ -24,7 +24,7 @@ from typing import Any
 
 from sgtool.errors import raised_text
 from sgtool.planning.base import Planner
-from sgtool.planning.option_fields import PlannerOptionError, convert_options
+from sgtool.planning.option_fields import PlannerOptionError, check_required, convert_options
 
 GROUP = "sgtool.planners"
 _DOTTED = r"[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*"
@@ -137,6 +137,8 @@ def build_plugin(name: str, factory: Callable[..., Any], options: Mapping[str, A
     from sgtool.planning.timing import seeded_globals
 
     kw = plugin_options(name, factory, options)
+    if (cls := options_class(factory)) is not None:
+        check_required(name, cls, kw)
     try:
         with seeded_globals():  # a constructor drawing from random: the same in any run
             planner = factory(**kw)

@@ -453,3 +453,7 @@ def test_a_required_option_of_a_plug_in_is_named_when_left_out(tmp_path: Path,
     made = make_planner("req_plug:Needs", model_path="m.gguf")
     assert made.inner.model_path == "m.gguf"  # type: ignore[attr-defined]
     assert "model_path (str, required)" in describe_planners(["req_plug:Needs"])
+    # -O converts one option at a time: another one given alone is no missing option
+    from sgtool.planning.registry import parse_option
+
+    assert parse_option("req_plug:Needs", "k", "3") == 3
