@@ -460,10 +460,12 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
 
 
 def _external_poses(trajectory: Path | None, count: int, hint: str = "",
-                    shorter: bool = False) -> list[np.ndarray] | None:
+                    shorter: bool = False, also: int | None = None
+                    ) -> list[np.ndarray] | None:
     """Poses from a --trajectory file for frames in order (Open3D .log, or a TUM file whose
     lines are taken in order); ``hint`` says why the counts may differ; ``shorter``: a
-    trajectory that ends before the frames is taken (the first frames' poses)."""
+    trajectory that ends before the frames is taken (the first frames' poses); ``also``:
+    another count taken."""
     if trajectory is None:
         return None
     if not trajectory.is_file():
@@ -472,7 +474,7 @@ def _external_poses(trajectory: Path | None, count: int, hint: str = "",
         poses = read_open3d_log(trajectory)
     else:
         poses = [T for _, T in read_tum_trajectory(trajectory)]
-    if len(poses) != count and not (shorter and 0 < len(poses) < count):
+    if len(poses) not in (count, also) and not (shorter and 0 < len(poses) < count):
         raise SgtoolError(f"{trajectory} has {len(poses)} poses for {count} frames{hint}")
     return poses
 
@@ -561,16 +563,20 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
             )
     unpaired = sorted({c.stem for c in colors} - {d.stem for d in depths}, key=natural_key)
     hint = (f" ({len(unpaired)} colour images have no depth image; first: depth/{unpaired[0]}.*"
-            f" for {by_stem[unpaired[0]].relative_to(root)}; --skip-missing leaves them out "
-            "with their poses)" if unpaired and len(pairs) < len(colors) else "")
+            f" for {by_stem[unpaired[0]].relative_to(root)}"
+            + ("" if skip_missing else "; --skip-missing leaves them out with their poses")
+            + ")" if unpaired and len(pairs) < len(colors) else "")
     if traj is not None and skip_missing and unpaired and matched:
         stems = sorted({d.stem for d in depths} | set(by_stem), key=natural_key)
-        every = _external_poses(traj, len(stems), hint)  # one pose per frame recorded
+        every = _external_poses(traj, len(stems), hint, also=len(pairs))
         assert every is not None
-        pose_of = dict(zip(stems, every, strict=True))
-        poses: list[np.ndarray | None] | None = [pose_of[d.stem] for d, _ in pairs]
-        notes.append(f"--skip-missing: {len(unpaired)} colour image(s) without a depth image "
-                     f"left out with their poses (first: {by_stem[unpaired[0]].relative_to(root)})")
+        poses: list[np.ndarray | None] | None = list(every)  # one pose per RGB-D pair
+        if len(every) == len(stems) != len(pairs):  # one per image name: those of the pairs
+            pose_of = dict(zip(stems, every, strict=True))
+            poses = [pose_of[d.stem] for d, _ in pairs]
+            notes.append(f"--skip-missing: {len(unpaired)} colour image(s) without a depth "
+                         "image left out with their poses (first: "
+                         f"{by_stem[unpaired[0]].relative_to(root)})")
     else:
         read = _external_poses(traj, len(pairs), hint, shorter=True) \
             if traj is not None else None

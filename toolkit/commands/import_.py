@@ -313,8 +313,10 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None, info: s
               "distinct, a camera's rate), 'index' puts frame n at n/--fps in the listed "
               "order and pairs colour n with depth n (the ground truth is then not used).")
 @click.option("--skip-missing", is_flag=True,
-              help="Import the frames whose files exist when rgb.txt/depth.txt list missing "
-              "ones (without it, missing files are an error before anything is read).")
+              help="Import the frames whose files exist when some are missing: files "
+              "rgb.txt/depth.txt list (TUM), a 7-Scenes frame's depth, an Open3D colour image "
+              "without its depth image (its pose left out with it); without it, missing "
+              "files are an error before anything is read.")
 @click.option("--trajectory", type=PathParam(dir_okay=False, exists=True),
               help="Poses to use instead of the dataset's: an Open3D .log or a TUM file.")
 @_odometry_options(

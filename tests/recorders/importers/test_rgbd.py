@@ -570,6 +570,17 @@ def test_a_colour_frame_without_depth_is_skipped_with_its_pose(rgbd_data, tmp_pa
         got = [f.pose for f in r.frames()]
     back = want[0] @ np.linalg.inv(got[0])  # undoes the import's world alignment (A @ pose)
     assert all(pose_difference(back @ g, w)[0] < 1e-5 for g, w in zip(got, want, strict=True))
+    # a trajectory of one pose per RGB-D pair (as Open3D's reconstruction writes) is taken
+    # as it is with the flag too (it was refused, the hint naming the flag given)
+    kept = [i for i in range(12) if i != 5]
+    (folder / "traj.log").write_text("\n".join(
+        line for k, i in enumerate(kept)
+        for line in (f"{k} {k} {k + 1}", *lines[5 * i + 1:5 * i + 5])) + "\n")
+    rep = import_rgbd(folder, tmp_path / "c.mcap", RgbdOptions(**QUIET, skip_missing=True,
+                                                               floor_auto=False))
+    with LogReader(tmp_path / "c.mcap") as r:
+        again = [f.pose for f in r.frames()]
+    assert rep.frames == 11 and all(np.allclose(a, g) for a, g in zip(again, got, strict=True))
 
 
 def test_a_trajectory_that_stops_early_leaves_the_later_frames_out(rgbd_data, tmp_path):
