@@ -314,15 +314,17 @@ def _only_these_logs(root: Path, logs: Sequence[Path]) -> bool:
 
 def _copy_action(log: Path, dest: Path, was: Pinned | None) -> str:
     """What ``--copy`` does at ``dest``: "copy" (nothing there, or sgtool's own earlier
-    copy), "keep" (the log itself, or the same bytes already there); a file of the user's
-    with other bytes is refused, never replaced."""
+    copy; for a pin written before pins recorded ``copied``, the very file it pinned),
+    "keep" (the log itself, or the same bytes already there); a file of the user's with
+    other bytes is refused, never replaced."""
     if not dest.exists():
         return "copy"
     if dest.resolve() == log.resolve() or (dest.is_file()
                                            and sha256_file(dest) == sha256_file(log)):
         return "keep"
-    if was is not None and was.copied and was.log == dest.name:
-        return "copy"
+    if was is not None and was.log == dest.name and (
+            was.copied or (was.copied is None and sha256_file(dest) == was.log_sha256)):
+        return "copy"  # sgtool's copy; or a pin written before pins said (the file pinned)
     raise SgtoolError(f"--copy: {dest} is a file sgtool did not copy there; not replacing it "
                       "(move it away, or pin without --copy)")
 

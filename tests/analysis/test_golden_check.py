@@ -694,3 +694,19 @@ def test_a_check_waits_for_a_pin_being_written(pinned, capsys):
         assert t.is_alive() and not done  # waiting for the writer
     t.join(timeout=120)
     assert done == ["unchanged"]
+
+
+def test_a_copy_pinned_before_pins_said_so_is_replaced_by_a_new_copy(pinned, log, tmp_path,
+                                                                   capsys):
+    """An index written before pins recorded 'copied': its copy (the very file it pinned)
+    is replaced by --copy of a re-recorded log, as before (it was refused as the user's)."""
+    index = json.loads((pinned / "expected.json").read_text())
+    assert index["cases"]["small"].pop("copied") is True
+    (pinned / "expected.json").write_text(json.dumps(index))
+    again = tmp_path / "again" / "small.mcap"  # re-recorded: another log of that name
+    again.parent.mkdir()
+    shutil.copyfile(GOLDEN / "house6-tour.mcap", again)
+    code, _, err = sgtool(capsys, "golden", "pin", again, "--dir", pinned, "--copy", *FRAMES)
+    assert code == 0, err
+    assert (pinned / "small.mcap").read_bytes() == again.read_bytes()
+    assert read_pins(pinned).logs["small"].copied is True
