@@ -31,7 +31,6 @@ noise profile (distance, steps and frames per room).
 
 from __future__ import annotations
 
-import functools
 import json
 import math
 import re
@@ -48,7 +47,6 @@ from sgtool.analysis.bench_houses import (
     bench_episodes,
     generated_houses,
     load_house_files,
-    output_path,
 )
 from sgtool.analysis.bench_planner_checks import (
     check_budgets,
@@ -76,6 +74,7 @@ from sgtool.analysis.offline import (
     with_seen,
 )
 from sgtool.analysis.report import format_table, pipe_table
+from sgtool.analysis.run_bench_paths import log_path, log_source, noise_folder
 from sgtool.analysis.run_bench_resume import (
     ResumeError,
     check_resumable,
@@ -217,33 +216,6 @@ class RunRow:
     failures: Mapping[str, int]
     fallbacks: int = 0
     went_on: int = 0
-
-
-@functools.lru_cache(maxsize=64)
-def noise_folder(noise: str) -> str:
-    """The log folder of a ``--noise`` profile: its name (a built-in profile's; with
-    overrides, one spelling of them, so ``mild, holes=0.050`` is ``mild,holes=0.05``; a
-    JSON file's ``name`` field, else the file's stem; the file read once per process, so a
-    run's folders and tables keep one name however long it runs)."""
-    return parse_noise(noise).name
-
-
-def log_source(log: Path) -> str:
-    """How a row names its log (``logs/NOISE/PLANNER/HOUSE/ep-K.mcap`` of
-    :func:`log_path`): relative to the run's folder, which holds ``episodes.jsonl``, so two
-    runs (in a staging folder, elsewhere, on another machine) name their logs alike."""
-    return Path(*log.parts[-5:]).as_posix()
-
-
-def log_path(root: Path, noise: str, planner: str, house: str, episode: int) -> Path:
-    """``root/NOISE/PLANNER/HOUSE/ep-K.mcap`` (NOISE: :func:`noise_folder`; a plug-in
-    ``module:Name`` as ``module__Name``: :func:`sgtool.planning.registry.planner_file_name`);
-    a name that would leave ``root`` (or is no file name) is refused
-    (:func:`~sgtool.analysis.bench_houses.output_path`)."""
-    from sgtool.planning.registry import planner_file_name
-
-    return output_path(root, noise_folder(noise), planner_file_name(planner), house,
-                       f"ep-{episode:03d}.mcap")
 
 
 # the house and its episodes per house and draw, per process: houses a worker keeps (a

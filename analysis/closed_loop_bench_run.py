@@ -170,7 +170,7 @@ def run_task_on(fn: RunFn, folder: FolderMark, task: RunTask) -> RunRow | Shippe
     """``fn(task)`` on a worker: into the output folder when the worker sees it
     (:meth:`FolderMark.here`), else into a temporary folder of its own, the log sent back
     (:class:`Shipped`; its row names the log as a run in the folder would:
-    :func:`~sgtool.analysis.closed_loop_bench.log_source`)."""
+    :func:`~sgtool.analysis.run_bench_paths.log_source`)."""
     if folder.here():
         return fn(task)
     with tempfile.TemporaryDirectory(prefix="sgtool-run-bench-") as tmp:

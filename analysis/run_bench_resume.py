@@ -64,7 +64,7 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
             "size": [opts.camera.width, opts.camera.height],
             "render_step_m": float(opts.render_step_m),
             "turn_render_deg": float(opts.turn_render_deg),
-            "navigation": opts.navigation, "noise": parse_noise(noise).to_dict(),
+            "navigation": opts.navigation, "noise": _faults(parse_noise(noise).to_dict()),
             "noise_seed": opts.noise_seed,
             "seed": opts.planner_seed, "episode_seeds": True, "success": opts.success,
             "classifier": opts.classifier, "explore_on": opts.explore_on,
@@ -219,7 +219,14 @@ def check_resumable(path: Path, want: dict[str, Any], spec: HouseSpec, house: st
 
 def _with_new_faults(noise: Any) -> Any:
     """A log's recorded noise profile with the faults it does not name at 0 (off): the
-    faults :class:`~sgtool.recorders.sim.noise.NoiseProfile` gained after it was written."""
+    faults :class:`~sgtool.recorders.sim.noise.NoiseProfile` gained after it was written;
+    its faults only (:func:`_faults`)."""
     if not isinstance(noise, dict):
         return noise
-    return {**{k: v for k, v in NoiseProfile().to_dict().items() if k != "name"}, **noise}
+    return _faults({**NoiseProfile().to_dict(), **noise})
+
+
+def _faults(noise: dict[str, Any]) -> dict[str, Any]:
+    """A profile's faults without its name: a log is taken up by faults, however the
+    profile was spelled when it ran (an older spelling of the same overrides)."""
+    return {k: v for k, v in noise.items() if k != "name"}

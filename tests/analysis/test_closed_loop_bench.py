@@ -452,3 +452,23 @@ def test_report_only_says_where_the_house_files_went(tmp_path: Path) -> None:
         clb.run_closed_loop_bench(cfg, tmp_path, report_only=True)
     with pytest.raises(SgtoolError, match="no such house spec file$"):
         clb.tasks_of(cfg, tmp_path / "logs")
+
+
+def test_a_run_made_before_one_spelling_is_found_where_its_logs_are(tmp_path: Path) -> None:
+    """A run-bench folder of an earlier sgtool keeps its logs under the profile as typed
+    (`none,holes=0.05`): a resume or --report-only finds them there (it looked in
+    `holes=0.05` only and ran every episode again), and its logs' recorded profile name
+    does not refuse them (faults are compared, not names)."""
+    from sgtool.analysis.run_bench_resume import _with_new_faults, task_settings
+    from sgtool.recorders.sim import ClosedLoopOptions
+
+    logs = tmp_path / "logs"
+    (logs / "none,holes=0.05" / "greedy").mkdir(parents=True)
+    assert clb.log_path(logs, "none, holes=0.05", "greedy", "house-0", 2) == \
+        logs / "none,holes=0.05" / "greedy" / "house-0" / "ep-002.mcap"
+    assert clb.log_path(logs, "holes=0.05", "greedy", "house-0", 2).parts[-4] == "holes=0.05"
+    from sgtool.recorders.sim.noise import PROFILES
+
+    logged = {**PROFILES["none"].to_dict(), "name": "none,holes=0.05", "holes": 0.05}
+    want = task_settings(ClosedLoopOptions(), "holes=0.05", None)["noise"]
+    assert _with_new_faults(logged) == want
