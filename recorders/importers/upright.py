@@ -253,23 +253,37 @@ def _horizontal_normal(nrm: np.ndarray, u: np.ndarray) -> np.ndarray | None:
 UP_TOLERANCE_DEG = 10.0  # a given up this far from the horizontal surfaces is doubted
 
 
+def _degrees(a: np.ndarray, b: np.ndarray) -> float:
+    """The angle between unit vectors ``a`` and ``b``, in degrees."""
+    return float(np.degrees(np.arccos(np.clip(float(a @ b), -1.0, 1.0))))
+
+
 def given_up_problem(alignment: WorldAlignment) -> str | None:
     """A given ``--up`` against the cameras' image up (over 120 degrees from their mean:
-    an upside-down world), or more than :data:`UP_TOLERANCE_DEG` from the normal of the
-    horizontal surfaces (floor, table tops) seen near it: heights would tilt across the
-    map. None when the up was not given or nothing says otherwise."""
+    an upside-down world; over 45: another axis), or more than :data:`UP_TOLERANCE_DEG`
+    from the normal of the horizontal surfaces (floor, table tops) seen near it, when
+    those agree with the image up: heights would tilt across the map. None when the up
+    was not given or nothing says otherwise."""
     if alignment.up_method != "given":
         return None
     given = np.asarray(alignment.up)
-    if alignment.image_up is not None and float(given @ np.asarray(alignment.image_up)) < -0.5:
+    image = None if alignment.image_up is None else np.asarray(alignment.image_up)
+    if image is not None and float(given @ image) < -0.5:
         shown = ",".join(f"{-x + 0.0:.3f}" for x in given)  # (no -0.000)
         return (f"--up {','.join(f'{x:.3f}' for x in given)} points the way the cameras' "
                 f"images point down: the world would be upside down (floor above, ceiling "
                 f"below); give --up {shown} or --up auto")
+    if image is not None and _degrees(given, image) > 45.0:  # another axis altogether
+        return (f"--up {','.join(f'{x:.3f}' for x in given)} is "
+                f"{_degrees(given, image):.0f} degrees from the cameras' image up "
+                f"({','.join(f'{x:.3f}' for x in image)}): heights would run along the "
+                "walls; give --up auto, or the axis nearest the image up")
     if alignment.surfaces_up is None:
         return None
     seen = np.asarray(alignment.surfaces_up)
-    off = float(np.degrees(np.arccos(np.clip(given @ seen, -1.0, 1.0))))
+    if image is not None and _degrees(seen, image) > 45.0:
+        return None  # the surfaces near the given up are walls: they say nothing of it
+    off = _degrees(given, seen)
     if off <= UP_TOLERANCE_DEG:
         return None
     shown = ",".join(f"{x:.3f}" for x in seen)

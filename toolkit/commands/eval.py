@@ -97,7 +97,7 @@ def command(inputs: tuple[str, ...], out: str | None, force: bool = False,
     from sgtool.files import atomic_write
 
     request = _request(inputs, out, force, EvalArgs(**given))
-    with stdout_to_stderr() if request.as_json and not out else contextlib.nullcontext():
+    with stdout_to_stderr() if request.as_json else contextlib.nullcontext():
         outcome = evaluate(request, note=lambda m: click.echo(m, err=True))
     if out:
         atomic_write(out, outcome.text)

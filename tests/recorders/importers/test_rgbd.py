@@ -502,6 +502,7 @@ def test_an_up_far_off_the_horizontal_surfaces_is_doubted(rgbd_data, tmp_path):
     """ICL's up is -y; a given up 27 degrees off it (a tilted world every height would
     follow) is kept with a warning naming the surfaces' up; -y itself passes quietly."""
     src = rgbd_data / "icl-livingroom1-micro"
+    said: list[str] = []
     tilt = np.radians(27.0)
     off = np.array([0.0, -np.cos(tilt), np.sin(tilt)])
     rep = import_rgbd(src, tmp_path / "t.mcap",
@@ -519,6 +520,13 @@ def test_an_up_far_off_the_horizontal_surfaces_is_doubted(rgbd_data, tmp_path):
     (warn,) = [w for w in rep.warnings if "upside down" in w]
     assert warn.startswith("--up 0.000,1.000,0.000 points the way the cameras' images point "
                            "down") and "give --up 0.000,-1.000,0.000 or --up auto" in warn
+    # z, another axis: said so (it advised the normal of the walls near z as the up)
+    with pytest.raises(SgtoolError):  # (the floor check then fails: no floor along z)
+        import_rgbd(src, tmp_path / "z.mcap", RgbdOptions(
+            every=10, up=np.array([0.0, 0.0, 1.0]), progress=False,
+            warn=lambda w: said.append(w)))
+    assert [w for w in said if "degrees from the cameras' image up" in w]
+    assert not [w for w in said if "off the horizontal surfaces" in w]
 
 
 @pytest.mark.parametrize(("factor", "unit"), [(100.0, "centimetres"), (1000.0, "millimetres")])
