@@ -56,7 +56,7 @@ from sgtool.recorders.importers.bag_frames import camera_of, decode_frames
 from sgtool.recorders.importers.bag_index import BagIndex, index_bag
 from sgtool.recorders.importers.bag_options import BagOptions, check_options
 from sgtool.recorders.importers.bag_poses import PoseSource, pose_source_of
-from sgtool.recorders.importers.bag_scale import bag_scale_fit, bag_scale_problem
+from sgtool.recorders.importers.bag_scale import bag_scale_pairs, bag_scale_problem
 from sgtool.recorders.importers.bag_sync import PlannedFrame, plan_frames, planned_poses
 from sgtool.recorders.importers.bag_topics import check_flags, describe_bag, with_only_info
 from sgtool.recorders.importers.distortion import distortion_finding
@@ -86,8 +86,8 @@ from sgtool.recorders.importers.sanity import (
     timestamp_problem,
 )
 from sgtool.recorders.importers.scale_check import (
-    TOLERANCE,
-    inverted_poses_problem,
+    convention_problems,
+    fit_scale,
     pose_motion_problem,
 )
 from sgtool.recorders.importers.sink import (
@@ -165,13 +165,12 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
             findings.problem(clock_problem(offset, f"{path}: --depth {opts.depth}"),
                              given=opts.time_offset_ns != 0)
         if src is not None:
-            fit = bag_scale_fit(reader, idx, opts, src, k)
+            pairs = bag_scale_pairs(reader, idx, opts, src, k)
+            fit = fit_scale(pairs, k)
             if fit is not None:
                 checks.append(("depth scale against the poses", fit.describe()))
-            if fit is None or not fit.consistent() or abs(fit.ratio - 1.0) > TOLERANCE:
-                findings.problem(inverted_poses_problem(
-                    fit, bag_scale_fit(reader, idx, opts, src, k, invert=True), src.describe),
-                    given=estimate)
+            for problem in convention_problems(pairs, k, fit, src.describe):
+                findings.problem(problem, given=estimate)
             motion = pose_motion_problem(fit, src.describe)
             if motion is not None:
                 findings.problem(motion[0], given=estimate or not motion[1])

@@ -18,19 +18,19 @@ from sgtool.recorders.importers.bag_poses import PoseSource
 from sgtool.recorders.importers.images import decode_depth_message, depth_to_metres
 from sgtool.recorders.importers.scale_check import (
     ScaleFit,
-    fit_scale,
     geometric_scale_problem,
     pair_indices,
 )
 
 
-def bag_scale_fit(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
-                  k: CameraIntrinsics, invert: bool = False) -> ScaleFit | None:
-    """How far the depth's geometry moves against the poses of ``src``
-    (:func:`~.scale_check.fit_scale`; ``invert``: against their inverses, as
-    :func:`~.scale_check.inverted_poses_problem` asks); None without a usable pair."""
+def bag_scale_pairs(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
+                    k: CameraIntrinsics) -> list[tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                       np.ndarray]]:
+    """Pairs of nearby depth images in metres with their poses from ``src``, as
+    :func:`~.scale_check.fit_scale` and :func:`~.scale_check.convention_problems` take
+    them (one pass over the depth topic); empty without a usable pair."""
     if not idx.samples:
-        return None
+        return []
     explicit = opts.tf_frames is not None or opts.pose is not None
     posed: list[tuple[int, np.ndarray]] = []
     for kk in sorted(range(len(idx.depth.stamps)), key=lambda i: idx.depth.stamps[i]):
@@ -39,7 +39,7 @@ def bag_scale_fit(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
             posed.append((kk, T))
     pairs = pair_indices([T for _, T in posed])
     if not pairs:
-        return None
+        return []
     need = {posed[i][0] for p in pairs for i in p}
     got: dict[int, np.ndarray] = {}
     count = 0
@@ -52,17 +52,15 @@ def bag_scale_fit(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
             if len(got) == len(need):
                 break
         count += 1
-    pose = np.linalg.inv if invert else np.asarray
-    quads = [(got[posed[i][0]], got[posed[j][0]], pose(posed[i][1]), pose(posed[j][1]))
-             for i, j in pairs if posed[i][0] in got and posed[j][0] in got
-             and got[posed[i][0]].shape == (k.height, k.width)]
-    return fit_scale(quads, k)
+    return [(got[posed[i][0]], got[posed[j][0]], posed[i][1], posed[j][1])
+            for i, j in pairs if posed[i][0] in got and posed[j][0] in got
+            and got[posed[i][0]].shape == (k.height, k.width)]
 
 
 def bag_scale_problem(fit: ScaleFit | None, idx: BagIndex, opts: BagOptions,
                       src: PoseSource, origin: str) -> str | None:
     """The problem of the fit (naming the ``--depth-scale`` that fits), or None; None for
-    depth that is not 16-bit (metres have no scale to name: :func:`bag_scale_fit`'s other
+    depth that is not 16-bit (metres have no scale to name: :func:`bag_scale_pairs`' other
     use, the poses' motion, is :func:`~.scale_check.pose_motion_problem`'s)."""
     if not idx.samples or next(iter(idx.samples.values()))[0].dtype != np.uint16:
         return None

@@ -74,16 +74,13 @@ from sgtool.recorders.importers.sanity import (
     principal_point_problem,
 )
 from sgtool.recorders.importers.scale_check import (
-    POSE_UNITS,
-    TOLERANCE,
     ScaleFit,
+    convention_problems,
     fit_scale,
     frozen_poses_problem,
     geometric_scale_problem,
-    inverted_poses_problem,
     pair_indices,
     pose_motion_problem,
-    pose_units_problem,
 )
 from sgtool.recorders.importers.sink import (
     ImportFrame,
@@ -267,26 +264,13 @@ def check_scale_by_geometry(frames: list[FolderFrame], k: CameraIntrinsics, scal
               depth_to_metres(read_depth_file(frames[j].depth_path), scale), poses[i], poses[j])
              for i, j in pair_indices(poses)]
     fit = fit_scale(pairs, k)
-    if fit is None or not fit.consistent() or abs(fit.ratio - 1.0) > TOLERANCE:
-        inverted = fit_scale([(a, b, np.linalg.inv(p), np.linalg.inv(q))
-                              for a, b, p, q in pairs], k)
-        findings.problem(inverted_poses_problem(fit, inverted, pose_source), given=estimate)
-        findings.problem(pose_units_problem(
-            [(unit, fit_scale([(a, b, _in_metres(p, f), _in_metres(q, f))
-                               for a, b, p, q in pairs], k)) for f, unit in POSE_UNITS],
-            pose_source), given=estimate)
+    for problem in convention_problems(pairs, k, fit, pose_source):
+        findings.problem(problem, given=estimate)
     motion = pose_motion_problem(fit, pose_source)
     if motion is not None:
         findings.problem(motion[0], given=estimate or not motion[1])
     findings.problem(geometric_scale_problem(fit, scale, origin, pose_source), given=given)
     return fit
-
-
-def _in_metres(pose: np.ndarray, unit_m: float) -> np.ndarray:
-    """``pose`` with its translation read in units of ``unit_m`` metres."""
-    out = np.array(pose, dtype=float)
-    out[:3, 3] *= unit_m
-    return out
 
 
 def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = None) -> ImportReport:

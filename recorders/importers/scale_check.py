@@ -188,6 +188,32 @@ def inverted_poses_problem(given: ScaleFit | None, inverted: ScaleFit | None,
 
 POSE_UNITS = ((0.01, "centimetres"), (0.001, "millimetres"))
 
+Pairs = Sequence[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
+
+
+def convention_problems(pairs: Pairs, k: CameraIntrinsics, fit: ScaleFit | None,
+                        pose_source: str) -> list[str]:
+    """When the poses do not fit the depth (``fit``, of ``pairs`` as :func:`fit_scale`
+    takes them): the problems of the poses' inverses or their translations in another
+    unit fitting it (:func:`inverted_poses_problem`, :func:`pose_units_problem`); empty
+    when the poses fit, or neither does."""
+    if fit is not None and fit.consistent() and abs(fit.ratio - 1.0) <= TOLERANCE:
+        return []
+    inverted = fit_scale([(a, b, np.linalg.inv(p), np.linalg.inv(q)) for a, b, p, q in pairs],
+                         k)
+    units = [(unit, fit_scale([(a, b, _in_metres(p, f), _in_metres(q, f))
+                               for a, b, p, q in pairs], k)) for f, unit in POSE_UNITS]
+    found = (inverted_poses_problem(fit, inverted, pose_source),
+             pose_units_problem(units, pose_source))
+    return [x for x in found if x is not None]
+
+
+def _in_metres(pose: np.ndarray, unit_m: float) -> np.ndarray:
+    """``pose`` with its translation read in units of ``unit_m`` metres."""
+    out = np.array(pose, dtype=float)
+    out[:3, 3] *= unit_m
+    return out
+
 
 def pose_units_problem(fits: Sequence[tuple[str, ScaleFit | None]],
                        pose_source: str) -> str | None:
