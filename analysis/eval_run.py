@@ -82,8 +82,9 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
                  "under the observed rule never asked its planners for done)"]
     if profiles:
         notes = [*notes, f"the episodes ran under {len(profiles)} sensor noise profiles "
-                 f"({', '.join(profiles)}): each planner is scored per profile, as "
-                 "PLANNER [NOISE]"]
+                 f"({', '.join(profiles)}"
+                 + ("; symbolic: the symbolic bench, no sensor" if "symbolic" in profiles
+                    else "") + "): each planner is scored per profile, as PLANNER [NOISE]"]
     if (other := _unlike_episodes(results)) is not None:
         notes = [*notes, other]
     notes = [*notes, *settings_notes(request.inputs)]
