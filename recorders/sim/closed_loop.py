@@ -226,6 +226,8 @@ class _Search:
 
     @property
     def ended(self) -> bool:
+        if not self.end and self.rec.budget_spent:  # an action took the last frame: no
+            self.end = "frames"  # step is asked for that could not render one
         if not self.end and self.steps >= self.max_steps:
             self.end = "max_steps"
         return bool(self.end)

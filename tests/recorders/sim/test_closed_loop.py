@@ -586,3 +586,22 @@ def test_house_navigation_ends_the_skill_when_the_target_is_in_the_graph(tmp_pat
         (t_last, last), *_ = reversed(list(log.records("action")))
     first = next(t for t, g in graphs if any(o.category == "apple pie" for o in g.objects))
     assert t_last == first and last["message"] == IN_VIEW and last["outcome"] == "success"
+
+
+def test_no_step_is_asked_for_once_an_action_took_the_last_frame(tmp_path) -> None:
+    """The frame budget spent exactly as an action ends: the episode ends on frames; the
+    planner was asked once more and that step (failed at once, 0 m) was counted."""
+    from sgtool.house.io import save_house
+
+    house = tmp_path / "h.json"
+    save_house(generate_house(3, rooms=(4, 5)), house)
+    out = tmp_path / "fpr.mcap"
+    r = CliRunner().invoke(cli, ["run", "--planner", "scout", "--house", str(house), "--query",
+                                 "carving knife", "--resolution", "64x48", "--max-steps", "20",
+                                 "--frames-per-room", "8", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    (logged,) = read_log_episodes(out)
+    res = logged.result()
+    assert res.end == "frames" and logged.episode.frames == 40  # 8 frames x 5 rooms
+    assert not [d for d in logged.decisions if "frame budget" in str(d.action.reason) + str(
+        d.action.unknown.get("message"))]
