@@ -30,6 +30,7 @@ from sgtool.house.geometry import (
     distance_to_polygon,
     length_in_strip,
     longest_uncovered,
+    nearest_edge_direction,
     opening_segment,
     overlap_area,
     shared_borders,
@@ -42,6 +43,7 @@ _OPENING_EDGE = 0.05  # m at each end of an opening a wall may reach into (round
 _COVERED = 1e-6  # m of an opening inside a wall's body that count as covered
 _BORDER_TOL = 0.05  # m two room edges may lie apart and still be one border
 _MIN_GAP = 0.3  # m of a border without a wall that connect two rooms (the robot is 0.4 m wide)
+_MAX_SKEW_DEG = 10.0  # degrees an opening may lie off the border it sits on
 
 
 def check_consistency(spec: HouseSpec, limits: SpecLimits) -> None:
@@ -84,6 +86,15 @@ def check_consistency(spec: HouseSpec, limits: SpecLimits) -> None:
                     raise SpecError(f"{key}[{i}].center: the opening runs {off:.2f} m past "
                                     f"the room {rid} (a corner, or the end of its border): "
                                     f"move its center along the wall"
+                                    f"{id_note(key, i, d.id)}")
+                wall = nearest_edge_direction(d.center[0], d.center[1], poly)
+                skew = abs(math.remainder(d.yaw - wall, math.pi))
+                if math.degrees(skew) > _MAX_SKEW_DEG:
+                    raise SpecError(f"{key}[{i}].yaw: {d.yaw:g} rad lies "
+                                    f"{math.degrees(skew):.0f} degrees off the border of "
+                                    f"{rid} it sits on ({wall:.4g} rad); yaw is the "
+                                    f"direction of its wall, in radians"
+                                    f"{' (degrees given?)' if abs(d.yaw) > 2 * math.pi else ''}"
                                     f"{id_note(key, i, d.id)}")
     for i, f in enumerate(spec.furniture):
         room = by_room[f.room]

@@ -98,6 +98,14 @@ def distance_to_border(x: float, y: float, poly: Sequence[Point]) -> float:
     return min(segment_distance(x, y, poly[i], poly[(i + 1) % n]) for i in range(n))
 
 
+def nearest_edge_direction(x: float, y: float, poly: Sequence[Point]) -> float:
+    """The direction (radians, in [0, pi)) of the edge of ``poly`` nearest (x, y)."""
+    n = len(poly)
+    i = min(range(n), key=lambda k: segment_distance(x, y, poly[k], poly[(k + 1) % n]))
+    (ax, ay), (bx, by) = poly[i], poly[(i + 1) % n]
+    return math.atan2(by - ay, bx - ax) % math.pi
+
+
 def triangulate(poly: Sequence[Point]) -> list[tuple[Point, Point, Point]]:
     """Counter-clockwise triangles covering a simple polygon (ear clipping, O(n^2))."""
     pts = list(poly) if signed_area(poly) > 0 else list(reversed(poly))

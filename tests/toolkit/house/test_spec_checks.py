@@ -9,6 +9,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+import re
 from pathlib import Path
 
 import pytest
@@ -341,6 +342,19 @@ def test_a_door_set_across_its_wall_is_refused() -> None:
     d["doors"][0]["yaw"] = d["doors"][0].get("yaw", 0.0) + math.pi / 2
     _refused(d, r"^doors\[0\]\.yaw: .* rad sets the opening across the border of room_\d, "
                 r"not along it")
+
+
+@pytest.mark.parametrize(("yaw", "degrees", "note"), [(90.0, 27, " (degrees given?)"),
+                                                    (math.pi / 2 + 0.7, 40, "")])
+def test_a_door_skewed_off_its_wall_is_refused(yaw, degrees, note) -> None:
+    """A door's yaw given in degrees (90 rad lies 27 degrees off a wall along y) or 40
+    degrees off its wall: both ends still lay within the rooms' tolerance, so the check
+    passed and the replay merged the rooms."""
+    d = two_rooms()
+    d["doors"][0]["yaw"] = yaw
+    _refused(d, rf"^doors\[0\]\.yaw: {yaw:g} rad lies {degrees} degrees off the border of "
+                rf"room_\d it sits on \(1\.571 rad\); yaw is the direction of its wall, in "
+                rf"radians{re.escape(note)}")
 
 
 def test_a_door_past_the_end_of_its_border_names_its_center_not_its_yaw() -> None:
