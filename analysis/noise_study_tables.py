@@ -35,7 +35,7 @@ from sgtool.analysis.report import pipe_table
 SCORE_FIELDS: tuple[str, ...] = ("gt_rooms", "gt_rooms_seen", "rooms", "room_count_error",
                                  "room_error_vs_true", "purity", "ari", "objects",
                                  "object_accuracy", "categorised", "category_accuracy",
-                                 "gt_rooms_with_nodes")
+                                 "gt_rooms_with_nodes", "house_objects", "objects_seen")
 
 
 def _num(x: float | int) -> float | int | None:

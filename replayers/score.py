@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from functools import partial
 from typing import Any
 
@@ -67,7 +67,11 @@ def score(spec: HouseSpec, instances: Mapping[int, InstanceInfo], layers: MapLay
     )
     merge = split_groups_kept_apart(passage_groups(spec), layers.voronoi.positions,
                                     layers.node_rooms, {r.id: r.polygon for r in spec.rooms})
-    return {"strict": of_graph(), "merged": of_graph(merge=merge)}
+    seen = {info.spec_id for o in graph.objects
+            if (info := instances.get(o.instance)) is not None and info.spec_id in rooms_by_spec}
+    cover = {"house_objects": len(rooms_by_spec), "objects_seen": len(seen)}
+    return {"strict": replace(of_graph(), **cover),
+            "merged": replace(of_graph(merge=merge), **cover)}
 
 
 def split_groups_kept_apart(merge: Mapping[str, str], node_xy: Any,
@@ -113,6 +117,8 @@ def score_lines(scores: Mapping[str, Quality], graph_objects: int | None = None)
                    if v.objects else "no object in the graph to score" if graph_objects == 0
                    else "objects not scored (no object's instance names a spec element: "
                    "spec_id in the instance table)")
+        if v.house_objects and v.objects:
+            objects += f" ({v.objects_seen} of the house's {v.house_objects} pieces seen)"
         out.append(
             f"quality ({name}): rooms {v.rooms} vs {v.gt_rooms_seen} seen of {v.gt_rooms} "
             f"(error {v.room_count_error:+d}); Voronoi nodes in the right room: purity "

@@ -3,6 +3,8 @@ entry, a table without doors, objects that name no spec element (scoring)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from sgtool.replayers.instance_notes import instance_notes
@@ -54,3 +56,22 @@ def test_a_score_without_scorable_objects_says_so():
     # --json: an accuracy over nothing is null, not 0
     d = score_dict({"strict": q(0), "merged": q(9)})
     assert d["strict"]["object_accuracy"] is None and d["merged"]["object_accuracy"] == 1.0
+
+
+def test_a_score_says_how_much_of_the_house_the_graph_saw(tmp_path):
+    """A tour that never reached half the house scored its objects 100 % over what it saw,
+    saying nothing of the rest: the score names the pieces of the house the graph holds."""
+    import json
+
+    from click.testing import CliRunner
+
+    from sgtool.cli import cli
+
+    log = Path(__file__).resolve().parents[1] / "golden" / "house6-tour.mcap"
+    r = CliRunner().invoke(cli, ["replay", str(log), "--score", "--json", "--max-frames", "40"])
+    assert r.exit_code == 0, r.output
+    merged = json.loads(r.output)["score"]["merged"]
+    assert 0 < merged["objects_seen"] < merged["house_objects"]
+    r = CliRunner().invoke(cli, ["replay", str(log), "--score", "--max-frames", "40"])
+    assert (f"({merged['objects_seen']} of the house's {merged['house_objects']} pieces "
+            "seen)") in r.output

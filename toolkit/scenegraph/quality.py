@@ -90,6 +90,10 @@ class Quality:
     # seen ground-truth rooms holding a Voronoi node that some predicted room holds: purity
     # and ARI say how those nodes are split, this how much of the house they cover
     gt_rooms_with_nodes: int = 0
+    # pieces of the house (furniture and small objects) and how many of them the graph
+    # holds: a map that never saw half the house scores its objects over what it saw
+    house_objects: int = 0
+    objects_seen: int = 0
 
 
 def evaluate(node_xy: np.ndarray, node_rooms: Sequence[str | None],
