@@ -149,7 +149,11 @@ def load_house_files(paths: Sequence[str | os.PathLike[str]],
                             f"name) cannot name a log folder: {bad}")
             continue
         if hid in ids:
-            problems.append(f"{f}: id: house id {hid!r} is already used by {ids[hid]}")
+            again = ids[hid] == str(f) or (Path(ids[hid]).exists() and f.exists()
+                                           and Path(ids[hid]).samefile(f))
+            problems.append(f"{f}: given twice (a --house named it, or a folder holding it, "
+                            "more than once): give it once" if again else
+                            f"{f}: id: house id {hid!r} is already used by {ids[hid]}")
             continue
         ids[hid] = str(f)
         notes = house_notes(house) + completion_notes(f, spec)

@@ -153,7 +153,11 @@ class ClosedLoopBenchConfig:
                 len(set(self.noise)) != len(self.noise):
             raise SgtoolError("--planners/--noise: a name is given twice")
         if any(not (math.isfinite(b) and b > 0) for b in self.budgets):
-            raise SgtoolError(f"--budgets: frames per room > 0, got {list(self.budgets)}")
+            raise SgtoolError(f"--budgets: frames per room, finite numbers > 0, got "
+                              f"{', '.join(f'{b:g}' for b in self.budgets)}")
+        if len(set(self.budgets)) != len(self.budgets):
+            raise SgtoolError(f"--budgets: a budget is given twice "
+                              f"({', '.join(f'{b:g}' for b in self.budgets)})")
         check_reference(self.reference, self.all_pairs, self.planners)
         check_planner_options(self.planners, self.planner_options, one_writer=True)
         if self.episodes < 1:

@@ -102,3 +102,12 @@ def test_a_house_path_typed_three_ways_is_recorded_one_way(tmp_path, monkeypatch
     assert {tuple(h.source for h in r.houses) for r in runs} == {("hs/cottage.json",)}
     outside = BenchConfig(planners=("greedy",), houses=0, house_files=(str(tmp_path.parent),))
     assert outside.house_files == (str(tmp_path.parent),)  # outside the working folder: as is
+
+
+def test_a_house_file_given_twice_is_named_so(tmp_path) -> None:
+    """`--house d/h.json --house d/h.json` (or the file and its folder): it said the file's
+    id was already used by the file itself."""
+    f = write_cottage(tmp_path / "d")
+    for paths in ([f, f], [f, tmp_path / "d"], [f, tmp_path / "d" / ".." / "d" / f.name]):
+        with pytest.raises(HouseFilesError, match=r"given twice .*: give it once$"):
+            load_house_files(paths)

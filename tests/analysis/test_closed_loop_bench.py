@@ -4,6 +4,7 @@ two steps per episode: logs per run, the table, resuming, Ctrl-C, the reason cla
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import pytest
@@ -472,3 +473,13 @@ def test_a_run_made_before_one_spelling_is_found_where_its_logs_are(tmp_path: Pa
     logged = {**PROFILES["none"].to_dict(), "name": "none,holes=0.05", "holes": 0.05}
     want = task_settings(ClosedLoopOptions(), "holes=0.05", None)["noise"]
     assert _with_new_faults(logged) == want
+
+
+@pytest.mark.parametrize(("budgets", "message"), [
+    ((10.0, 10.0), r"--budgets: a budget is given twice \(10, 10\)"),
+    ((math.inf,), r"--budgets: frames per room, finite numbers > 0, got inf"),
+])
+def test_budgets_given_twice_or_infinite_are_one_line(budgets, message) -> None:
+    """Two equal budgets printed two identical columns; inf was 'frames per room > 0'."""
+    with pytest.raises(SgtoolError, match=message):
+        clb.ClosedLoopBenchConfig("greedy", houses=1, budgets=budgets).check()

@@ -33,6 +33,9 @@ def upgrade(d: object) -> Mapping[str, Any]:
     version = d.get("version")
     if version is None:
         raise SpecError("version: missing")
+    if not isinstance(version, str) and f"{version}" in KNOWN_VERSIONS:
+        raise SpecError(f"version: {version!r} is a number; give it as text: "
+                        f"\"{version}\"")
     if not isinstance(version, str) or version not in KNOWN_VERSIONS:
         shown = repr(version) if len(repr(version)) <= 40 else repr(version)[:37] + "..."
         raise SpecError(f"version: {shown} is not supported (this sgtool reads "

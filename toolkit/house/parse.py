@@ -223,9 +223,12 @@ class _Parser:
         """A category name: a name with at least one word in it once read as text
         (:func:`~sgtool.semantics.text.category_text`: "_" or "-" alone name nothing)."""
         v = self.string(where, x, "category")
-        if not category_text(v):
+        if not category_text(v) or not any(c.isalnum() for c in v):
             raise SpecError(f"{where}.category: {_short(v)} has no letters or digits to "
                             "name a category by")
+        if any(unicodedata.category(c) == "Cf" for c in v):  # a zero-width space, ...
+            raise SpecError(f"{where}.category: {_short(v)} holds an invisible character "
+                            "(it would not match the category typed): remove it")
         return v
 
     def number(self, where: str, v: Any) -> float:
