@@ -7,7 +7,8 @@ is a frozen contract, validated on load (:func:`sgtool.house.io.load_house`, rul
 offending field (``rooms[2].polygon: needs at least 3 points``).
 
 Conventions (checked on load, all but one: rooms a passage joins need not share an
-``open_plan_group``; the scores then count them as two rooms):
+``open_plan_group``, which labels and draws them only: the merged scores join the rooms
+passages join, group or not, and keep rooms a door parts apart):
 
 - metres, z up, yaw counter-clockwise from +x in radians;
 - ids are strings with a kind prefix, usually followed by a running number: ``room_0``,
