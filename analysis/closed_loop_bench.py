@@ -542,9 +542,11 @@ OUTPUT_NAMES: tuple[str, ...] = ("logs", "episodes.jsonl", "summary.md", "summar
                                  "run.md", "efficiency_*.png")
 
 
-def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]:
+def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path,
+                  timings: bool = True) -> list[Path]:
     """episodes.jsonl, summary.md, summary.json (no wall-clock figure: two runs give the
-    same bytes), run.md (decision times, frames/s), the efficiency curves per noise profile
+    same bytes), run.md (decision times, frames/s; not with ``timings`` False: a report
+    of logs run earlier keeps the run's own), the efficiency curves per noise profile
     (distance, steps, frames per room; those of other profiles, an earlier run's, are
     removed), each written atomically into ``out_dir``."""
     from sgtool.analysis.curves import plot_efficiency
@@ -565,7 +567,8 @@ def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path) -> list[Path]
                         if p.stem.rpartition("_")[2] in models):  # another profile's
         stale.unlink()
     paths.append(atomic_write(out / "summary.md", res.table()))
-    paths.append(atomic_write(out / "run.md", res.timings()))
+    if timings:
+        paths.append(atomic_write(out / "run.md", res.timings()))
     paths.append(atomic_write(out / "summary.json", json.dumps(
         strict_json(res.summary()), indent=1, sort_keys=True, allow_nan=False) + "\n"))
     return paths

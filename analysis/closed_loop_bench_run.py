@@ -115,7 +115,8 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
                   "houses and --episodes that ran them to report them", file=sys.stderr)
         try:
             res = _with_symbolic(request, res)
-            written = [p.name for p in write_tables(res, root)]
+            written = [p.name for p in write_tables(  # (a report keeps the run's run.md)
+                res, root, timings=not (request.report_only and (root / "run.md").is_file()))]
             if not request.report_only:
                 written.append(atomic_write(root / RUN_FILE, run_record(
                     res.rows, root, runner, request.executor)).name)

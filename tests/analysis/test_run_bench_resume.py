@@ -206,11 +206,12 @@ def test_report_only_tables_the_run_as_it_was_made(tmp_path: Path, monkeypatch) 
     one given is the user's (a setting the logs were not run with is refused); the report
     settings are the command's."""
     _, _, out, _ = _first_run(tmp_path)
-    summary = (out / "summary.md").read_text()
+    summary, timings = (out / "summary.md").read_text(), (out / "run.md").read_text()
     r = CliRunner().invoke(cli, ["run-bench", "-o", str(out), "--report-only",
                                  "--no-progress"])
     assert r.exit_code == 0, r.output
     assert (out / "summary.md").read_text() == summary
+    assert (out / "run.md").read_text() == timings  # the run's wall clock, not "run now 0"
     r = CliRunner().invoke(cli, ["run-bench", "-o", str(out), "--report-only", "--budgets",
                                  "7", "--max-steps", "2", "--no-progress"])
     assert r.exit_code == 0, r.output

@@ -74,8 +74,8 @@ def test_check_names_every_file_with_its_verdict(tmp_path: Path) -> None:
                                         "(no cell where the robot fits) and no door or "
                                         "passage to a room that has")
     assert r.output.splitlines()[-1] == "sgtool: error: 1 problem(s) in the house files above"
-    r = CliRunner().invoke(cli, ["scenes", "check", str(good), str(good)])  # one id twice
-    assert r.exit_code == 2 and "already used" in r.output
+    r = CliRunner().invoke(cli, ["scenes", "check", str(good), str(good)])  # one file twice
+    assert r.exit_code == 2 and "given twice" in r.output
     (tmp_path / "none").mkdir()
     r = CliRunner().invoke(cli, ["scenes", "check", str(tmp_path / "none")])
     assert r.exit_code == 2 and f"error {tmp_path / 'none'}: no *.json house files" in r.output
