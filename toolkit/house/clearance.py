@@ -27,6 +27,7 @@ from sgtool.house.geometry import (
     clip_convex,
     distance_to_border,
     distance_to_polygon,
+    opening_segment,
     overlap_area,
     point_in_polygon,
     segment_distance,
@@ -41,6 +42,7 @@ THROUGH_STRIP = 0.5  # m beyond a wall's far face looked at for a piece reaching
 INSIDE_CLEAR = 0.15  # m from a room's border where a wall is inside the room
 INSIDE_LEAST = 0.3  # m of a wall inside a room that is more than a corner's overlap
 CLEAR_SEARCH = 1.0  # m around a cramped start searched for a clear place (clear_start)
+CORNER_WALL = 0.1  # m of wall a door needs beside it at a room's corner (doors_at_corners)
 
 
 def front_point(f: Furniture, clear: float = FRONT_CLEAR) -> tuple[float, float]:
@@ -235,4 +237,21 @@ def walls_in_rooms(spec: HouseSpec, step: float = 0.05
                 total += inside * w.length / n
         if total >= INSIDE_LEAST:
             out.append((r.id, tuple(walls), total))
+    return out
+
+
+def doors_at_corners(spec: HouseSpec) -> list[tuple[int, str, float]]:
+    """(door index, room, metres of wall left) of each door whose opening ends within
+    :data:`CORNER_WALL` of a corner of one of its rooms: its swung panel lies along the
+    side wall, and the replay's door finding (a gap between two wall ends) has no wall end
+    there to find; the two rooms merge in the scene graph."""
+    out = []
+    for i, d in enumerate(spec.doors):
+        for rid in d.rooms:
+            corners = spec.room(rid).polygon
+            left = min(math.dist(tip, c) for tip in opening_segment(d.center, d.width, d.yaw)
+                       for c in corners)
+            if left < CORNER_WALL - 1e-6:  # (0.1 m of wall, read as 0.0999...)
+                out.append((i, rid, left))
+                break
     return out
