@@ -125,11 +125,13 @@ def draw_house(spec: HouseSpec, path: str | os.PathLike[str], dpi: int = 120,
     ]
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=6,
               frameon=False)
-    fig.tight_layout()
     try:
-        with atomic_output(path, suffix=path.suffix) as tmp, warnings.catch_warnings():
+        with warnings.catch_warnings():
             # a name in a script the font lacks (emoji, CJK) draws as boxes: no warning
-            # with source lines for each glyph
+            # with source lines for each glyph (laying out draws the text too)
+            warnings.filterwarnings("ignore", message=r"Glyph \d+ .*missing from")
+            fig.tight_layout()
+        with atomic_output(path, suffix=path.suffix) as tmp, warnings.catch_warnings():
             warnings.filterwarnings("ignore", message=r"Glyph \d+ .*missing from")
             # no date, program or random ids in the file: the same house, the same bytes
             with plt.rc_context({"svg.hashsalt": "sgtool"}):

@@ -191,3 +191,23 @@ def test_episodes_draw_as_the_bench_and_spellings_are_one_furniture_query(tmp_pa
     targets = {tuple(e["targets"]) for e in eps if e["query"] == cats[0]}
     assert targets == {tuple(sorted([*(f["id"] for f in same), other["id"]],
                                     key=lambda i: int(i.split("_")[-1])))}
+
+
+def test_show_of_names_the_font_lacks_prints_no_warnings(tmp_path):
+    """CJK room names (the font draws boxes): no matplotlib warning with source lines per
+    glyph (laying the plan out warned before it was saved)."""
+    import json
+    import warnings
+
+    from support.datasets_fixtures import two_rooms
+
+    from sgtool.datasets.draw import draw_house
+    from sgtool.house.io import load_house
+
+    d = two_rooms()
+    d["rooms"][0]["category"] = "\u5bdd\u5ba4"
+    spec = load_house(json.loads(json.dumps(d)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        draw_house(spec, tmp_path / "u.png")
+    assert (tmp_path / "u.png").stat().st_size > 0
