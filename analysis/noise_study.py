@@ -131,7 +131,7 @@ def conditions_of(factors: Mapping[str, Sequence[float]],
                   profiles: Sequence[str]) -> tuple[Condition, ...]:
     """``none`` first, then each factor's levels (factors in :data:`FACTORS` order, levels
     ascending; a level 0 is ``none``), then the profiles as given."""
-    from sgtool.recorders.sim.noise import PROFILES
+    from sgtool.recorders.sim.noise import PROFILES, names_file, parse_noise
 
     out = [Condition(NONE, "0", NONE)]
     for f in FACTORS:
@@ -139,11 +139,12 @@ def conditions_of(factors: Mapping[str, Sequence[float]],
             if v != 0:
                 out.append(Condition(f, level_text(v), f"none,{f}={level_text(v)}"))
     for p in profiles:
-        if p not in PROFILES:
+        if p not in PROFILES and not names_file(p):
             raise SgtoolError(f"--profile {p!r}: unknown profile (one of "
-                              f"{', '.join(PROFILES)})")
-        if p != NONE and all(c.noise != p for c in out):
-            out.append(Condition(PROFILE, p, p))
+                              f"{', '.join(PROFILES)}, or a JSON profile's file)")
+        label = p if p in PROFILES else parse_noise(p).name  # a file: its profile's name
+        if p != NONE and all(c.noise != p and c.level != label for c in out):
+            out.append(Condition(PROFILE, label, p))
     return tuple(out)
 
 
@@ -204,7 +205,11 @@ def house_key(house: BenchHouse, spec_text: str, rooms: tuple[int, int]) -> dict
 
 def cache_key(house: Mapping[str, Any], noise: str, settings: RecordingSettings) -> str:
     """The hex sha256 (first 20 digits) of everything a recording depends on."""
-    doc = {"format": CACHE_FORMAT, "house": dict(house), "noise": noise,
+    from sgtool.recorders.sim.noise import names_file, parse_noise
+
+    # a JSON profile's file by what it holds (an edited file records anew), a text as it is
+    key = parse_noise(noise).to_dict() if names_file(noise) else noise
+    doc = {"format": CACHE_FORMAT, "house": dict(house), "noise": key,
            "settings": asdict(settings)}
     text = json.dumps(doc, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:20]

@@ -156,6 +156,23 @@ def test_cache_key_changes_with_every_recording_input() -> None:
     assert base not in others and len(others) == 6
 
 
+def test_a_json_profile_of_ones_own_is_studied_by_its_name(tmp_path: Path) -> None:
+    """`--profile my.json` (record --noise and --closed-loop-noise take it) was refused as
+    an unknown profile; it is a condition labelled by its name, recorded anew when the
+    file's faults change."""
+    mine = tmp_path / "my.json"
+    mine.write_text('{"name": "cheap-camera", "holes": 0.03}')
+    conds = conditions_of({}, ("mild", str(mine)))
+    assert [(c.factor, c.level, c.noise) for c in conds][-2:] == [
+        (PROFILE, "mild", "mild"), (PROFILE, "cheap-camera", str(mine))]
+    house = {"generated": 3, "rooms": [8, 8]}
+    before = cache_key(house, str(mine), RecordingSettings())
+    mine.write_text('{"name": "cheap-camera", "holes": 0.05}')
+    assert cache_key(house, str(mine), RecordingSettings()) != before
+    with pytest.raises(SgtoolError, match="unknown profile .*or a JSON profile's file"):
+        conditions_of({}, ("extreme",))
+
+
 def test_closed_loop_rows_are_the_run_bench_episodes(study: dict[str, Path]) -> None:
     out = study["root"] / "closed"
     r = _study(study["house"], study["cache"], out, "--closed-loop", "scout",

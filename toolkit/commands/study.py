@@ -60,8 +60,9 @@ def command() -> None:
               "record --noise`); each level is recorded with that fault alone. Default: "
               "every factor at levels including mild's and strong's values.")
 @click.option("--profile", "profiles", multiple=True, metavar="NAME",
-              help="A whole noise profile to study as well (repeatable; mild, strong). "
-              "Default: mild and strong, unless --factor is given.")
+              help="A whole noise profile to study as well (repeatable; mild, strong, or a "
+              "JSON profile's file as `record --noise` takes it). Default: mild and strong, "
+              "unless --factor is given.")
 @click.option("--resolution", default="160x120", show_default=True,
               help="Camera image size WIDTHxHEIGHT of the recordings.")
 @click.option("--fps", default=4.0, show_default=True, type=FINITE_FLOAT,
