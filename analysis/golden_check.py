@@ -182,8 +182,8 @@ def pin_folder(root: Path, logs: Sequence[Path] = ()) -> Iterator[Path]:
 @contextlib.contextmanager
 def pins_locked(root: Path, shared: bool = False) -> Iterator[None]:
     """Hold the lock of the pin folder ``root`` (an advisory lock on a file of this user's
-    in the system's temporary folder, named after ``root``'s resolved path; nothing is
-    added to ``root``): one process at a time reads, changes and writes its index;
+    in a folder of them in the system's temporary folder, named after ``root``'s resolved
+    path; nothing is added to ``root``): one process at a time reads, changes and writes its index;
     ``shared``: a reader's lock (checks read the index and the graphs it names together,
     never half of a pin being written). Where there are no advisory locks (not POSIX),
     nothing is held."""
@@ -197,7 +197,9 @@ def pins_locked(root: Path, shared: bool = False) -> Iterator[None]:
         return
     key = hashlib.sha256(str(root.resolve()).encode()).hexdigest()[:20]
     user = os.getuid() if hasattr(os, "getuid") else 0
-    with open(Path(tempfile.gettempdir()) / f"sgtool-pins-{user}-{key}.lock", "a+b") as fh:
+    locks = Path(tempfile.gettempdir()) / f"sgtool-pin-locks-{user}"  # one folder of them,
+    locks.mkdir(mode=0o700, exist_ok=True)  # not a file per pin folder in the temp folder
+    with open(locks / f"{key}.lock", "a+b") as fh:
         fcntl.flock(fh, fcntl.LOCK_SH if shared else fcntl.LOCK_EX)
         try:
             yield
