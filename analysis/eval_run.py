@@ -87,7 +87,7 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
                     else "") + "): each planner is scored per profile, as PLANNER [NOISE]"]
     if (other := _unlike_episodes(results)) is not None:
         notes = [*notes, other]
-    notes = [*notes, *settings_notes(request.inputs)]
+    notes = [*notes, *settings_notes(request.inputs), *_logged_step_notes(logged)]
     if unknown := sum(1 for r in results if r.shortest_m is None
                       or not math.isfinite(r.shortest_m)):
         notes = [*notes, f"{unknown} episode(s) have no shortest path (none was logged, or "
@@ -112,6 +112,22 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
     text = render(request, results, notes, models, summarize(results, models), reports,
                   exchanges)
     return EvalOutcome(text=text, unread=list(unread))
+
+
+def _logged_step_notes(logged: Sequence[Any]) -> list[str]:
+    """A note when the episode logs given ran with different step budgets (their
+    ``max_steps``), as :func:`~sgtool.analysis.eval_settings.settings_notes` says of
+    bench runs: their rows would mix them silently."""
+    budgets: dict[int, int] = {}
+    for lg in logged:
+        v = lg.episode.extras.get("max_steps")
+        if isinstance(v, int) and not isinstance(v, bool):
+            budgets[v] = budgets.get(v, 0) + 1
+    if len(budgets) < 2:
+        return []
+    shown = ", ".join(f"{k} ({n} episode(s))" for k, n in sorted(budgets.items()))
+    return [f"the logs given ran with different max_steps ({shown}): their rows and paired "
+            "comparisons mix them"]
 
 
 def per_noise(results: Sequence[EpisodeResult], symbolic_logs: Collection[str] = ()

@@ -605,3 +605,20 @@ def test_no_step_is_asked_for_once_an_action_took_the_last_frame(tmp_path) -> No
     assert res.end == "frames" and logged.episode.frames == 40  # 8 frames x 5 rooms
     assert not [d for d in logged.decisions if "frame budget" in str(d.action.reason) + str(
         d.action.unknown.get("message"))]
+
+
+def test_eval_of_logs_run_with_other_step_budgets_says_so(house, tmp_path) -> None:
+    """Episode logs of --max-steps 2 and 3 given together: eval said so of bench folders
+    only and pooled the logs silently."""
+    logs = []
+    for steps in ("2", "3"):
+        out = tmp_path / f"s{steps}.mcap"
+        r = CliRunner().invoke(cli, ["run", "--planner", "greedy", "--seed", str(SEED),
+                                     "--rooms", ROOMS, "--episode", "0", "--resolution",
+                                     "64x48", "--max-steps", steps, "-o", str(out)])
+        assert r.exit_code == 0, r.output
+        logs.append(str(out))
+    r = CliRunner().invoke(cli, ["eval", *logs])
+    assert r.exit_code == 0, r.output
+    assert "the logs given ran with different max_steps (2 (1 episode(s)), 3 (1 " \
+        "episode(s)))" in r.stderr
