@@ -235,6 +235,7 @@ def house_notes(house: Any) -> tuple[str, ...]:
     from sgtool.house.clearance import (
         CORNER_WALL,
         FRONT_CLEAR,
+        back_is_clear,
         blocked_fronts,
         cramped_starts,
         doors_at_corners,
@@ -274,9 +275,12 @@ def house_notes(house: Any) -> tuple[str, ...]:
                      "the house; a search for a target inside starts there, any other outside")
     for k, what in blocked_fronts(spec):
         f = spec.furniture[k]
+        fix = ("turn it to face the room: yaw + pi" if back_is_clear(spec, k) else
+               f"move {what} away from it" if what != "the room's border" else
+               "turn it to face the room")
         notes.append(f"furniture[{k}] ({f.id}, {f.category}): {what} is within "
                      f"{FRONT_CLEAR:g} m of its front (its local +y face, where it opens); the "
-                     "closed loop cannot look into it (turn it to face the room: yaw + pi)")
+                     f"closed loop cannot look into it ({fix})")
     for k, why in hidden_pieces(spec):
         f = spec.furniture[k]
         notes.append(f"furniture[{k}] ({f.id}, {f.category}): {why}: no camera sees it or "

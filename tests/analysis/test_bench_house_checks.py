@@ -155,3 +155,16 @@ def test_a_door_with_no_wall_beside_it_at_a_corner_gets_a_note() -> None:
         assert bad is None
         said = [n for n in house_notes(house) if "from a corner of" in n]
         assert bool(said) == noted, said
+
+
+def test_a_front_blocked_by_a_piece_of_a_corner_says_to_move_that_piece() -> None:
+    """A cabinet backed against the wall whose front an L-shaped corner piece blocks (the
+    generator's own kitchens): turning it (yaw + pi) would face the wall; the note says to
+    move the piece in front of it instead."""
+    import sgtool
+    from sgtool.analysis.bench_houses import house_notes, symbolic_house
+
+    house, bad = symbolic_house(sgtool.generate_house(0, rooms=(4, 8)), "h.json")
+    fronts = [n for n in house_notes(house) if "cannot look into it" in n]
+    assert bad is None and fronts
+    assert all("(move furn_" in n and "yaw + pi" not in n for n in fronts)

@@ -19,6 +19,7 @@ finds the walls that run through a room's inside rather than along its border.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -94,6 +95,15 @@ class Covers:
         gaps += [distance_to_polygon(x, y, self.feet[k])
                  for k in self._near(self.fbox, x, y, radius)]
         return min(gaps, default=radius)
+
+
+def back_is_clear(spec: HouseSpec, k: int) -> bool:
+    """Whether piece ``k`` turned about (yaw + pi) would face open floor of its room: the
+    advice for a blocked front, which a piece backed against a wall cannot take."""
+    f = spec.furniture[k]
+    x, y = front_point(replace(f, yaw=f.yaw + math.pi))
+    return point_in_polygon(x, y, spec.room(f.room).polygon) and \
+        Covers(spec).at(x, y, skip=k) is None
 
 
 def blocked_fronts(spec: HouseSpec) -> list[tuple[int, str]]:
