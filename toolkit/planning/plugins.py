@@ -87,18 +87,23 @@ def _package(ep: metadata.EntryPoint) -> str:
 
 def load_factory(name: str, entry: metadata.EntryPoint | None = None) -> Callable[..., Any]:
     """The class or factory of plug-in ``name``: ``entry`` loaded, else ``module:Name``
-    imported."""
+    imported, with the global generators seeded (a module that draws from them at import
+    draws the same numbers in the driver and in every worker)."""
+    from sgtool.planning.timing import seeded_globals
+
     if entry is not None:
         where = f"entry point {entry.value!r} of {GROUP}"
         try:
-            obj = entry.load()
+            with seeded_globals():  # a module drawing at import: the same in any process
+                obj = entry.load()
         except (Exception, SystemExit) as e:  # noqa: BLE001 - user code failing: one line
             raise PluginError(f"planner {name!r}: cannot load {where} ({raised_text(e)})"
                               ) from None
     else:
         module, attr = check_spec(name)
         try:
-            obj = importlib.import_module(module)
+            with seeded_globals():  # (as above)
+                obj = importlib.import_module(module)
         except (Exception, SystemExit) as e:  # noqa: BLE001
             missing = isinstance(e, ModuleNotFoundError) and e.name is not None and (
                 module == e.name or module.startswith(e.name + "."))

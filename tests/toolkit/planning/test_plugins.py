@@ -457,3 +457,36 @@ def test_a_required_option_of_a_plug_in_is_named_when_left_out(tmp_path: Path,
     from sgtool.planning.registry import parse_option
 
     assert parse_option("req_plug:Needs", "k", "3") == 3
+
+
+def test_a_plug_in_module_drawing_at_import_draws_the_same_in_any_process(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A module that draws from the global generators at import (a table of random
+    features) drew other numbers in the driver and in each worker: it is imported with
+    them seeded, the caller's put back."""
+    import importlib
+    import random
+    import sys
+
+    (tmp_path / "importrand_plug.py").write_text(textwrap.dedent('''
+        import random
+
+        from sgtool.planning.planners import GreedyPlanner
+
+        TABLE = [random.random() for _ in range(3)]
+
+
+        class Drawn(GreedyPlanner):
+            pass
+    '''))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    tables = []
+    for seed in (1, 2):
+        sys.modules.pop("importrand_plug", None)  # a fresh process imports it anew
+        random.seed(seed)
+        make_planner("importrand_plug:Drawn")
+        after = random.random()
+        random.seed(seed)
+        assert after == random.random()  # the caller's stream as if nothing was imported
+        tables.append(importlib.import_module("importrand_plug").TABLE)
+    assert tables[0] == tables[1]
