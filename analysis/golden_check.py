@@ -316,17 +316,21 @@ def _only_these_logs(root: Path, logs: Sequence[Path]) -> bool:
 
 def _copy_action(log: Path, dest: Path, was: Pinned | None) -> str:
     """What ``--copy`` does at ``dest``: "copy" (nothing there, or sgtool's own earlier
-    copy; for a pin written before pins recorded ``copied``, the very file it pinned),
-    "keep" (the log itself, or the same bytes already there); a file of the user's with
-    other bytes is refused, never replaced."""
+    copy), "keep" (the log itself, or the same bytes already there); a file of the user's
+    with other bytes is refused, never replaced, and so is one an older index pinned
+    without saying whether sgtool copied it."""
     if not dest.exists():
         return "copy"
     if dest.resolve() == log.resolve() or (dest.is_file()
                                            and sha256_file(dest) == sha256_file(log)):
         return "keep"
-    if was is not None and was.log == dest.name and (
-            was.copied or (was.copied is None and sha256_file(dest) == was.log_sha256)):
-        return "copy"  # sgtool's copy; or a pin written before pins said (the file pinned)
+    if was is not None and was.log == dest.name and was.copied:
+        return "copy"  # sgtool's own copy
+    if was is not None and was.log == dest.name and was.copied is None:
+        raise SgtoolError(f"--copy: {dest} was pinned by an sgtool that did not record "
+                          "whether it copied the log there or found it there; not replacing "
+                          "it: move it away (a copy of its own is made), or pin without "
+                          "--copy")
     raise SgtoolError(f"--copy: {dest} is a file sgtool did not copy there; not replacing it "
                       "(move it away, or pin without --copy)")
 

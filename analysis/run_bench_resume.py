@@ -121,7 +121,7 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              "turn_render_deg": x.get("turn_render_deg"),
              "navigation": nav.get("mode", "house"),
              # a fault added since (flying) was off in logs that do not name it
-             "noise": _with_new_faults(x.get("noise")), "noise_seed": x.get("noise_seed", 0),
+             "noise": with_new_faults(x.get("noise")), "noise_seed": x.get("noise_seed", 0),
              "seed": x.get("seed"),
              # logs from before each episode drew its planner seed: all drew the run's
              "episode_seeds": "planner_seed" in x,
@@ -217,7 +217,7 @@ def check_resumable(path: Path, want: dict[str, Any], spec: HouseSpec, house: st
                        "since", _FIX)
 
 
-def _with_new_faults(noise: Any) -> Any:
+def with_new_faults(noise: Any) -> Any:
     """A log's recorded noise profile with the faults it does not name at 0 (off): the
     faults :class:`~sgtool.recorders.sim.noise.NoiseProfile` gained after it was written;
     its faults only (:func:`_faults`)."""

@@ -123,7 +123,8 @@ class Pinned:
     decisions: tuple[Decision, ...] | None = None
     why: str | None = None
     sgtool_version: str | None = None
-    copied: bool | None = None  # True: sgtool copied the log in (--copy); it may replace it
+    copied: bool | None = None  # True: sgtool copied the log in (--copy), and may replace
+    # it; False: the log is the user's; None: an index written before pins said
 
     def log_path(self, folder: Path) -> Path:
         """The log's path: as stored, or joined to ``folder``, resolved as
@@ -142,8 +143,8 @@ class Pinned:
                      ("why", self.why), ("sgtool_version", self.sgtool_version)):
             if v is not None:
                 d[k] = v
-        if self.copied:
-            d["copied"] = True
+        if self.copied is not None:  # (absent: an index written before pins said)
+            d["copied"] = self.copied
         if self.decisions is not None:
             d["decisions"] = [[x.episode, x.step, x.skill, x.target] for x in self.decisions]
         return d
@@ -417,7 +418,7 @@ def pinned_entry(name: str, log: Path, stored: str, options: ReplayOptions, cap:
         sequence_sha256=sequence_digest(graphs), options=options,
         log_bytes=log.stat().st_size, resolved=cap.resolved, quality=cap.quality,
         planner=cap.planner, decisions=cap.decisions, why=why, sgtool_version=__version__,
-        copied=copied or None)
+        copied=copied)
 
 
 def write_capture(pins: PinSet, pin: Pinned, cap: Capture) -> None:

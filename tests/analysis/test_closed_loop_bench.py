@@ -460,7 +460,7 @@ def test_a_run_made_before_one_spelling_is_found_where_its_logs_are(tmp_path: Pa
     (`none,holes=0.05`): a resume or --report-only finds them there (it looked in
     `holes=0.05` only and ran every episode again), and its logs' recorded profile name
     does not refuse them (faults are compared, not names)."""
-    from sgtool.analysis.run_bench_resume import _with_new_faults, task_settings
+    from sgtool.analysis.run_bench_resume import with_new_faults, task_settings
     from sgtool.recorders.sim import ClosedLoopOptions
 
     logs = tmp_path / "logs"
@@ -472,7 +472,7 @@ def test_a_run_made_before_one_spelling_is_found_where_its_logs_are(tmp_path: Pa
 
     logged = {**PROFILES["none"].to_dict(), "name": "none,holes=0.05", "holes": 0.05}
     want = task_settings(ClosedLoopOptions(), "holes=0.05", None)["noise"]
-    assert _with_new_faults(logged) == want
+    assert with_new_faults(logged) == want
 
 
 @pytest.mark.parametrize(("budgets", "message"), [

@@ -611,7 +611,7 @@ def test_a_users_log_in_the_pin_folder_is_never_deleted_or_replaced(log, tmp_pat
     mine = folder / "small.mcap"
     shutil.copyfile(log, mine)
     assert sgtool(capsys, "golden", "pin", mine, "--dir", folder, *FRAMES)[0] == 0
-    assert read_pins(folder).logs["small"].copied is None
+    assert read_pins(folder).logs["small"].copied is False
     assert sgtool(capsys, "golden", "pin", log, "--dir", folder, *FRAMES)[0] == 0
     assert mine.read_bytes() == log.read_bytes()  # kept
     # --copy over a file of the user's with other bytes: refused, the file as it was
@@ -696,17 +696,24 @@ def test_a_check_waits_for_a_pin_being_written(pinned, capsys):
     assert done == ["unchanged"]
 
 
-def test_a_copy_pinned_before_pins_said_so_is_replaced_by_a_new_copy(pinned, log, tmp_path,
-                                                                   capsys):
-    """An index written before pins recorded 'copied': its copy (the very file it pinned)
-    is replaced by --copy of a re-recorded log, as before (it was refused as the user's)."""
+def test_a_file_an_older_index_pinned_is_not_replaced_by_a_copy(pinned, log, tmp_path,
+                                                              capsys):
+    """An index written before pins recorded 'copied' cannot tell sgtool's copy from a
+    log the user pinned in place: --copy of another log of that name is refused with
+    the reason (it overwrote a user's log pinned in place), the file as it was; new pins
+    say copied true or false."""
     index = json.loads((pinned / "expected.json").read_text())
     assert index["cases"]["small"].pop("copied") is True
     (pinned / "expected.json").write_text(json.dumps(index))
     again = tmp_path / "again" / "small.mcap"  # re-recorded: another log of that name
     again.parent.mkdir()
     shutil.copyfile(GOLDEN / "house6-tour.mcap", again)
+    before = (pinned / "small.mcap").read_bytes()
     code, _, err = sgtool(capsys, "golden", "pin", again, "--dir", pinned, "--copy", *FRAMES)
-    assert code == 0, err
-    assert (pinned / "small.mcap").read_bytes() == again.read_bytes()
-    assert read_pins(pinned).logs["small"].copied is True
+    assert code == 2 and "did not record whether it copied the log there" in err
+    assert (pinned / "small.mcap").read_bytes() == before
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    shutil.copyfile(log, mine / "small.mcap")
+    assert sgtool(capsys, "golden", "pin", mine / "small.mcap", "--dir", mine, *FRAMES)[0] == 0
+    assert json.loads((mine / "expected.json").read_text())["cases"]["small"]["copied"] is False
