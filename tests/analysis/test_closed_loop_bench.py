@@ -460,7 +460,7 @@ def test_a_run_made_before_one_spelling_is_found_where_its_logs_are(tmp_path: Pa
     (`none,holes=0.05`): a resume or --report-only finds them there (it looked in
     `holes=0.05` only and ran every episode again), and its logs' recorded profile name
     does not refuse them (faults are compared, not names)."""
-    from sgtool.analysis.run_bench_resume import with_new_faults, task_settings
+    from sgtool.analysis.run_bench_resume import task_settings, with_new_faults
     from sgtool.recorders.sim import ClosedLoopOptions
 
     logs = tmp_path / "logs"
