@@ -326,10 +326,12 @@ class _Search:
             o, why, dist, ticks = "invalid", plan.invalid, 0.0, 0
             self.invalid.append(plan.invalid)
         else:
+            before = self.sim.states
             ex = self._run(plan.calls)
             o, why, dist, ticks, cut = ex.outcome, ex.reason, ex.travelled_m, ex.ticks, ex.cut
-            if action.skill == "open" and o == "success":
-                self.n_open += 1
+            if action.skill == "open" and o == "success" and any(
+                    v == "open" and before.get(k) != "open" for k, v in self.sim.states.items()):
+                self.n_open += 1  # (not when the target came into view on the way to it)
             if o == "failure" and action.target is not None:
                 self._failed_ever.add(str(action.target))
             if o == "failure" and not cut and action.target is not None:

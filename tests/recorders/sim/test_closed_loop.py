@@ -622,3 +622,21 @@ def test_eval_of_logs_run_with_other_step_budgets_says_so(house, tmp_path) -> No
     assert r.exit_code == 0, r.output
     assert "the logs given ran with different max_steps (2 (1 episode(s)), 3 (1 " \
         "episode(s)))" in r.stderr
+
+
+def test_an_open_cut_short_by_the_target_in_view_is_no_open(tmp_path) -> None:
+    """`--navigation house`: the target came into view while the robot drove to a cabinet
+    to open it: the cabinet never opened, and n_open counted it (6 where the simulator
+    opened 5)."""
+    out = tmp_path / "o2.mcap"
+    r = CliRunner().invoke(cli, ["run", "--planner", "scout", "--navigation", "house",
+                                 "--success", "done", "--resolution", "80x60", "--episode",
+                                 "2", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    with LogReader(out) as log:
+        instances = [rec for _, rec in log.records("instances")]
+        (_, ended), *_ = reversed(list(log.records("episode")))
+    opened = {i["spec_id"] for rec in instances for i in rec["instances"]
+              if i.get("state") == "open"}  # doors and furniture the robot opened
+    shut = {i["spec_id"] for i in instances[0]["instances"] if i.get("state") == "closed"}
+    assert ended["extra"]["n_open"] == len(opened & shut)
