@@ -26,6 +26,7 @@ The transform and how it was found are recorded in the log metadata (``sgtool.im
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -90,6 +91,7 @@ class WorldAlignment:
     floor_detail: str = ""  # what the estimate is made of (:meth:`.FloorEstimate.describe`)
     surfaces_up: tuple[float, float, float] | None = None  # a given up: the surfaces' normal
     image_up: tuple[float, float, float] | None = None  # a given up: the cameras' image up
+    image_right: tuple[float, float, float] | None = None  # and their image right (x)
 
     @classmethod
     def identity(cls) -> WorldAlignment:
@@ -202,6 +204,7 @@ def estimate_alignment(
 
     surfaces: tuple[float, float, float] | None = None
     image: tuple[float, float, float] | None = None
+    right: tuple[float, float, float] | None = None
     if up is not None:
         u = np.asarray(up, dtype=np.float64) / np.linalg.norm(up)
         up_method = "given"
@@ -212,6 +215,10 @@ def estimate_alignment(
         if mean_up is not None and np.linalg.norm(mean_up) > 0.5:  # cameras held alike
             m = mean_up / np.linalg.norm(mean_up)
             image = (float(m[0]), float(m[1]), float(m[2]))
+        mean_x = np.mean([np.asarray(T)[:3, 0] for T in poses], axis=0) if len(poses) else None
+        if mean_x is not None and np.linalg.norm(mean_x) > 0.5:
+            m = mean_x / np.linalg.norm(mean_x)
+            right = (float(m[0]), float(m[1]), float(m[2]))
     else:
         u = camera_up(poses)
         up_method = "camera-up"
@@ -231,9 +238,10 @@ def estimate_alignment(
         est = estimate_floor(samples, u)
         assert est is not None  # there are points
         return WorldAlignment(R, est.height, (float(u[0]), float(u[1]), float(u[2])), up_method,
-                              est.method, est.confidence, est.describe(), surfaces, image)
+                              est.method, est.confidence, est.describe(), surfaces, image,
+                              right)
     return WorldAlignment(R, fl, (float(u[0]), float(u[1]), float(u[2])), up_method, floor_method,
-                          surfaces_up=surfaces, image_up=image)
+                          surfaces_up=surfaces, image_up=image, image_right=right)
 
 
 def _horizontal_normal(nrm: np.ndarray, u: np.ndarray) -> np.ndarray | None:
@@ -260,7 +268,9 @@ def _degrees(a: np.ndarray, b: np.ndarray) -> float:
 
 def given_up_problem(alignment: WorldAlignment) -> str | None:
     """A given ``--up`` against the cameras' image up (over 120 degrees from their mean:
-    an upside-down world; over 45: another axis), or more than :data:`UP_TOLERANCE_DEG`
+    an upside-down world; over 75: another axis unless they look straight down) or image x
+    axis (within 45 degrees of it: another axis; x stays level however the cameras
+    pitch), or more than :data:`UP_TOLERANCE_DEG`
     from the normal of the horizontal surfaces (floor, table tops) seen near it, when
     those agree with the image up: heights would tilt across the map. None when the up
     was not given or nothing says otherwise."""
@@ -273,11 +283,20 @@ def given_up_problem(alignment: WorldAlignment) -> str | None:
         return (f"--up {','.join(f'{x:.3f}' for x in given)} points the way the cameras' "
                 f"images point down: the world would be upside down (floor above, ceiling "
                 f"below); give --up {shown} or --up auto")
-    if image is not None and _degrees(given, image) > 45.0:  # another axis altogether
+    right = None if alignment.image_right is None else np.asarray(alignment.image_right)
+    if right is not None and abs(float(given @ right)) > math.sin(math.radians(45.0)):
+        # the cameras' x stays level however they pitch (no roll): an up along it is
+        # another axis altogether
+        off = min(_degrees(given, right), 180.0 - _degrees(given, right))
+        return (f"--up {','.join(f'{x:.3f}' for x in given)} lies within {off:.0f} degrees "
+                f"of the cameras' image x axis ({','.join(f'{x:.3f}' for x in right)}, level "
+                "however they pitch): heights would run along the walls; give --up auto")
+    if image is not None and _degrees(given, image) > 75.0:  # along the view: a camera
+        # pitched this far down is a top-down scan, rare enough to be asked about
         return (f"--up {','.join(f'{x:.3f}' for x in given)} is "
                 f"{_degrees(given, image):.0f} degrees from the cameras' image up "
-                f"({','.join(f'{x:.3f}' for x in image)}): heights would run along the "
-                "walls; give --up auto, or the axis nearest the image up")
+                f"({','.join(f'{x:.3f}' for x in image)}): unless they look almost straight "
+                "down, heights would run along the walls; give --up auto")
     if alignment.surfaces_up is None:
         return None
     seen = np.asarray(alignment.surfaces_up)

@@ -671,3 +671,21 @@ def test_a_hand_held_camera_clears_no_body(rgbd_data, tmp_path):
         grids.append(rep.last.layers.occupancy.grid.tobytes())
     assert cleared and not any(cleared) and grids[0] == grids[1]
 
+
+
+def test_cameras_looking_down_keep_their_up_and_an_up_along_their_x_is_named() -> None:
+    """A tabletop scan pitched 55 degrees down: the right up (z) is no 'other axis' (its
+    image up is 55 degrees off it); an up along the cameras' level x axis is named so."""
+    from scipy.spatial.transform import Rotation
+
+    from sgtool.recorders.importers.upright import estimate_alignment, given_up_problem
+
+    level = np.column_stack([[0, -1, 0], [0, 0, -1], [1, 0, 0]]).astype(float)  # looks +x
+    pose = np.eye(4)
+    pose[:3, :3] = Rotation.from_euler("y", 55, degrees=True).as_matrix() @ level
+    pose[2, 3] = 1.2
+    def said(up):
+        return given_up_problem(estimate_alignment([pose] * 5, [], up=np.array(up)))
+    assert said([0.0, 0.0, 1.0]) is None
+    text = said([0.0, 1.0, 0.0])
+    assert text is not None and "lies within 0 degrees of the cameras' image x axis" in text
