@@ -276,8 +276,8 @@ def house_notes(house: Any) -> tuple[str, ...]:
     for k, what in blocked_fronts(spec):
         f = spec.furniture[k]
         fix = ("turn it to face the room: yaw + pi" if back_is_clear(spec, k) else
-               f"move {what} away from it" if what != "the room's border" else
-               "turn it to face the room")
+               f"move {what} away from it" if what.startswith("furn") else
+               "move it away from the wall, or turn it to face open floor")
         notes.append(f"furniture[{k}] ({f.id}, {f.category}): {what} is within "
                      f"{FRONT_CLEAR:g} m of its front (its local +y face, where it opens); the "
                      f"closed loop cannot look into it ({fix})")

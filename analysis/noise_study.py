@@ -143,6 +143,11 @@ def conditions_of(factors: Mapping[str, Sequence[float]],
             raise SgtoolError(f"--profile {p!r}: unknown profile (one of "
                               f"{', '.join(PROFILES)}, or a JSON profile's file)")
         label = p if p in PROFILES else parse_noise(p).name  # a file: its profile's name
+        same = next((c for c in out if c.factor == PROFILE and c.level == label), None)
+        if same is not None and same.noise != p and \
+                parse_noise(same.noise).to_dict() != parse_noise(p).to_dict():
+            raise SgtoolError(f"--profile {p}: named {label!r} as {same.noise} is, with other "
+                              "faults; give each profile a name of its own")
         if p != NONE and all(c.noise != p and c.level != label for c in out):
             out.append(Condition(PROFILE, label, p))
     return tuple(out)

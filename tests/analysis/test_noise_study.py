@@ -171,6 +171,10 @@ def test_a_json_profile_of_ones_own_is_studied_by_its_name(tmp_path: Path) -> No
     assert cache_key(house, str(mine), RecordingSettings()) != before
     with pytest.raises(SgtoolError, match="unknown profile .*or a JSON profile's file"):
         conditions_of({}, ("extreme",))
+    other = tmp_path / "other.json"  # another file of that name and other faults: refused
+    other.write_text('{"name": "cheap-camera", "holes": 0.2}')
+    with pytest.raises(SgtoolError, match="named 'cheap-camera' as .* is, with other faults"):
+        conditions_of({}, (str(mine), str(other)))
 
 
 def test_closed_loop_rows_are_the_run_bench_episodes(study: dict[str, Path]) -> None:
