@@ -201,6 +201,23 @@ def _gone(pid: int) -> bool:
     return "State:\tZ" in state  # exited, not yet reaped (no init reaps in a container)
 
 
+def _driver_mid_write(tmp_path: Path) -> tuple[subprocess.Popen, Path]:
+    """The KILLED_DRIVER script started, once both its tasks are mid-write (their partial
+    outputs there): the process and its output folder."""
+    script = tmp_path / "driver.py"
+    script.write_text(KILLED_DRIVER)
+    out = tmp_path / "out"
+    out.mkdir()
+    proc = subprocess.Popen([sys.executable, str(script), str(out)])
+    deadline = time.monotonic() + 120
+    while len(list(out.glob("*.partial"))) < 2:  # both tasks are mid-write
+        if proc.poll() is not None or time.monotonic() > deadline:
+            proc.kill()
+            raise AssertionError("the driver's tasks never got to write")
+        time.sleep(0.1)
+    return proc, out
+
+
 @pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130),
                                        (signal.SIGHUP, 129)])
 def test_kill_of_the_driver_stops_the_workers_and_leaves_no_partial_output(tmp_path, sig,
@@ -208,16 +225,8 @@ def test_kill_of_the_driver_stops_the_workers_and_leaves_no_partial_output(tmp_p
     """A kill, a closed terminal, or a Ctrl-C sent to the driver alone (the workers ignore
     SIGINT), stops the tasks mid-write: they clean up, the workers end, and the driver
     exits after them, with 128 + the signal."""
-    script = tmp_path / "driver.py"
-    script.write_text(KILLED_DRIVER)
-    out = tmp_path / "out"
-    out.mkdir()
-    proc = subprocess.Popen([sys.executable, str(script), str(out)])
+    proc, out = _driver_mid_write(tmp_path)
     try:
-        deadline = time.monotonic() + 120
-        while len(list(out.glob("*.partial"))) < 2:  # both tasks are mid-write
-            assert proc.poll() is None and time.monotonic() < deadline
-            time.sleep(0.1)
         pids = [int((out / f"pid-{i}").read_text()) for i in range(2)]
         proc.send_signal(sig)
         assert proc.wait(timeout=60) == code
@@ -301,16 +310,8 @@ def test_workers_of_a_driver_killed_outright_leave_and_clean_up(tmp_path):
     """SIGKILL of the driver alone (no shutdown of the pool): the workers, mid-task, stop
     their tasks as SIGTERM does (no partial output left) and leave; they waited for the
     next task forever, deaf to SIGTERM."""
-    script = tmp_path / "driver.py"
-    script.write_text(KILLED_DRIVER)
-    out = tmp_path / "out"
-    out.mkdir()
-    proc = subprocess.Popen([sys.executable, str(script), str(out)])
+    proc, out = _driver_mid_write(tmp_path)
     try:
-        deadline = time.monotonic() + 120
-        while len(list(out.glob("*.partial"))) < 2:
-            assert proc.poll() is None and time.monotonic() < deadline
-            time.sleep(0.1)
         pids = [int((out / f"pid-{i}").read_text()) for i in range(2)]
         proc.kill()
         proc.wait(timeout=60)

@@ -445,15 +445,10 @@ def test_7scenes_names_in_upper_case_are_read(rgbd_data, tmp_path):
     assert rep.frames == 10
 
 
-def test_world_to_camera_poses_are_refused_for_what_they_are(rgbd_data, tmp_path):
-    """The ICL sequence with its trajectory inverted (world-to-camera): the depth hardly
-    moves while the poses do, over every pair checked. The import says the poses are
-    wrong, before the floor they would misplace (it blamed the floor, whose advice gave a
-    wrong map)."""
-    import shutil
-
+def icl_with_poses(rgbd_data: Path, folder: Path, change) -> Path:
+    """A copy of the ICL micro folder in ``folder`` whose trajectory's every pose is
+    ``change(pose)`` (a convention or a unit another tool writes)."""
     src = rgbd_data / "icl-livingroom1-micro"
-    folder = tmp_path / "inverted"
     shutil.copytree(src, folder)
     lines = (src / "open3d_estimated_trajectory.log").read_text().split("\n")
     out = []
@@ -461,8 +456,17 @@ def test_world_to_camera_poses_are_refused_for_what_they_are(rgbd_data, tmp_path
         if not lines[i].strip():
             break
         pose = np.array([[float(x) for x in lines[i + k].split()] for k in range(1, 5)])
-        out += [lines[i], *(" ".join(f"{x:.8f}" for x in row) for row in np.linalg.inv(pose))]
+        out += [lines[i], *(" ".join(f"{x:.8f}" for x in row) for row in change(pose))]
     (folder / "open3d_estimated_trajectory.log").write_text("\n".join(out) + "\n")
+    return folder
+
+
+def test_world_to_camera_poses_are_refused_for_what_they_are(rgbd_data, tmp_path):
+    """The ICL sequence with its trajectory inverted (world-to-camera): the depth hardly
+    moves while the poses do, over every pair checked. The import says the poses are
+    wrong, before the floor they would misplace (it blamed the floor, whose advice gave a
+    wrong map)."""
+    folder = icl_with_poses(rgbd_data, tmp_path / "inverted", np.linalg.inv)
     with pytest.raises(SgtoolError, match=r"look world-to-camera: .* 1\.0\dx as far as "
                                           r"their inverses"):
         import_rgbd(folder, tmp_path / "i.mcap", RgbdOptions(**QUIET, every=3))
@@ -534,18 +538,12 @@ def test_poses_in_centimetres_are_named_so(rgbd_data, tmp_path, factor, unit):
     """A trajectory written in cm or mm: no frame pair matched at metres, so the check had
     no verdict and the floor was blamed (52 m under the camera; the --floor it advised
     gave a map of views 69 m apart, exit 0). The translations read in the unit fit."""
-    src = rgbd_data / "icl-livingroom1-micro"
-    folder = tmp_path / "units"
-    shutil.copytree(src, folder)
-    lines = (src / "open3d_estimated_trajectory.log").read_text().split("\n")
-    out = []
-    for i in range(0, len(lines) - 4, 5):
-        if not lines[i].strip():
-            break
-        pose = np.array([[float(x) for x in lines[i + k].split()] for k in range(1, 5)])
-        pose[:3, 3] *= factor
-        out += [lines[i], *(" ".join(f"{x:.8f}" for x in row) for row in pose)]
-    (folder / "open3d_estimated_trajectory.log").write_text("\n".join(out) + "\n")
+    def scaled(pose: np.ndarray) -> np.ndarray:
+        out = pose.copy()
+        out[:3, 3] *= factor
+        return out
+
+    folder = icl_with_poses(rgbd_data, tmp_path / "units", scaled)
     with pytest.raises(SgtoolError, match=rf"the poses' translations \(trajectory\) look in "
                                           rf"{unit}: .* 1\.0\dx as far as the poses read in"):
         import_rgbd(folder, tmp_path / "u.mcap", RgbdOptions(**QUIET, limit=60))

@@ -567,20 +567,28 @@ def test_live_only_options_refused_with_house_navigation(tmp_path: Path) -> None
     assert r.exit_code == 2 and "--sight-lines: for --navigation live" in r.output
 
 
+def _scout_in_house_3(tmp_path: Path, query: str, *args: str) -> Path:
+    """`sgtool run --planner scout` in generated house 3 (4-5 rooms) searching ``query``
+    with ``args``; the log's path."""
+    from sgtool.house.io import save_house
+
+    house = tmp_path / "h.json"
+    save_house(generate_house(3, rooms=(4, 5)), house)
+    out = tmp_path / "run.mcap"
+    r = CliRunner().invoke(cli, ["run", "--planner", "scout", "--house", str(house), "--query",
+                                 query, *args, "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    return out
+
+
 def test_house_navigation_ends_the_skill_when_the_target_is_in_the_graph(tmp_path) -> None:
     """`--navigation house`: the episode ends at the refresh whose graph holds the target,
     as live navigation does; it drove on to the next cabinet first (16 frames, 2.1 m
     more, counted in SPL and frames per room)."""
-    from sgtool.house.io import save_house
     from sgtool.recorders.sim.live_skills import IN_VIEW
 
-    house = tmp_path / "h.json"
-    save_house(generate_house(3, rooms=(4, 5)), house)
-    out = tmp_path / "pie.mcap"
-    r = CliRunner().invoke(cli, ["run", "--planner", "scout", "--house", str(house), "--query",
-                                 "apple pie", "--resolution", "96x72", "--max-steps", "10",
-                                 "--navigation", "house", "-o", str(out)])
-    assert r.exit_code == 0, r.output
+    out = _scout_in_house_3(tmp_path, "apple pie", "--resolution", "96x72", "--max-steps",
+                            "10", "--navigation", "house")
     with LogReader(out) as log:
         graphs = [(t, SceneGraph.from_dict(g)) for t, g in log.records("scene_graph")]
         (t_last, last), *_ = reversed(list(log.records("action")))
@@ -591,15 +599,8 @@ def test_house_navigation_ends_the_skill_when_the_target_is_in_the_graph(tmp_pat
 def test_no_step_is_asked_for_once_an_action_took_the_last_frame(tmp_path) -> None:
     """The frame budget spent exactly as an action ends: the episode ends on frames; the
     planner was asked once more and that step (failed at once, 0 m) was counted."""
-    from sgtool.house.io import save_house
-
-    house = tmp_path / "h.json"
-    save_house(generate_house(3, rooms=(4, 5)), house)
-    out = tmp_path / "fpr.mcap"
-    r = CliRunner().invoke(cli, ["run", "--planner", "scout", "--house", str(house), "--query",
-                                 "carving knife", "--resolution", "64x48", "--max-steps", "20",
-                                 "--frames-per-room", "8", "-o", str(out)])
-    assert r.exit_code == 0, r.output
+    out = _scout_in_house_3(tmp_path, "carving knife", "--resolution", "64x48",
+                            "--max-steps", "20", "--frames-per-room", "8")
     (logged,) = read_log_episodes(out)
     res = logged.result()
     assert res.end == "frames" and logged.episode.frames == 40  # 8 frames x 5 rooms
