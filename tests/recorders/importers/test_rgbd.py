@@ -483,16 +483,13 @@ def test_one_pose_for_every_frame_is_refused_while_the_depth_moves(rgbd_data, tm
     """The ICL sequence with its first pose repeated for every frame (a trajectory that
     never moves): the depth changes over the sequence, so the import says the poses stand
     still (it imported every view at one place, exit 0); --estimate-poses takes it."""
-    src = rgbd_data / "icl-livingroom1-micro"
-    folder = tmp_path / "frozen"
-    shutil.copytree(src, folder)
-    lines = (src / "open3d_estimated_trajectory.log").read_text().split("\n")
-    out = []
-    for i in range(0, len(lines) - 4, 5):
-        if not lines[i].strip():
-            break
-        out += [lines[i], *lines[1:5]]
-    (folder / "open3d_estimated_trajectory.log").write_text("\n".join(out) + "\n")
+    seen: list[np.ndarray] = []
+
+    def first(pose: np.ndarray) -> np.ndarray:
+        seen.append(pose)
+        return seen[0]
+
+    folder = icl_with_poses(rgbd_data, tmp_path / "frozen", first)
     with pytest.raises(SgtoolError, match=r"the poses \(trajectory\) stand still over all 71 "
                                           r"frames while the depth changes \(\d+% of the"):
         import_rgbd(folder, tmp_path / "f.mcap", RgbdOptions(**QUIET, every=3))
