@@ -36,10 +36,10 @@ from sgtool.recorders.importers.textformats import (
     PinholeParams,
     is_open3d_log,
     read_intrinsics_file,
-    read_open3d_log,
     read_pose_file,
     read_tum_list,
     read_tum_trajectory,
+    trajectory_poses,
     untracked_pose,
 )
 
@@ -358,7 +358,7 @@ def _read_tum_log_poses(root: Path, rgb: list[tuple[int, str]], depth: list[tupl
                         max_dt_ns: int, trajectory: Path, notes: list[str]) -> FolderSequence:
     """``--trajectory X.log`` for a TUM folder: an Open3D .log has no times, so its poses go
     to the depth images in the listed order."""
-    poses = _external_poses(trajectory, len(depth))
+    poses = trajectory_poses(trajectory, len(depth))
     assert poses is not None
     frames = [FolderFrame(t, root / name, _colour_near(root, rgb, t, max_dt_ns), poses[i])
               for i, (t, name) in enumerate(depth)]
@@ -430,7 +430,7 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
         if m:
             by_id.setdefault(int(m.group(1)), {})[m.group(2).lower()] = p
     ids, notes = _seven_missing(root, by_id, skip_missing)
-    ext_poses = _external_poses(trajectory, len(ids))
+    ext_poses = trajectory_poses(trajectory, len(ids))
     frames = []
     for n, i in enumerate(ids):
         files = by_id[i]
@@ -457,26 +457,6 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
     kind = "trajectory" if trajectory else ("ground truth" if posed else "none")
     return FolderSequence("7scenes", root, tuple(frames), intr, 1000.0, kind, tuple(notes),
                           dropped=dropped)
-
-
-def _external_poses(trajectory: Path | None, count: int, hint: str = "",
-                    shorter: bool = False, also: int | None = None
-                    ) -> list[np.ndarray] | None:
-    """Poses from a --trajectory file for frames in order (Open3D .log, or a TUM file whose
-    lines are taken in order); ``hint`` says why the counts may differ; ``shorter``: a
-    trajectory that ends before the frames is taken (the first frames' poses); ``also``:
-    another count taken."""
-    if trajectory is None:
-        return None
-    if not trajectory.is_file():
-        raise SgtoolError(f"--trajectory {trajectory}: no such file")
-    if is_open3d_log(trajectory):
-        poses = read_open3d_log(trajectory)
-    else:
-        poses = [T for _, T in read_tum_trajectory(trajectory)]
-    if len(poses) not in (count, also) and not (shorter and 0 < len(poses) < count):
-        raise SgtoolError(f"{trajectory} has {len(poses)} poses for {count} frames{hint}")
-    return poses
 
 
 def _is_intrinsics_json(path: Path) -> bool:
@@ -568,7 +548,7 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
             + ")" if unpaired and len(pairs) < len(colors) else "")
     if traj is not None and skip_missing and unpaired and matched:
         stems = sorted({d.stem for d in depths} | set(by_stem), key=natural_key)
-        every = _external_poses(traj, len(stems), hint, also=len(pairs))
+        every = trajectory_poses(traj, len(stems), hint, also=len(pairs))
         assert every is not None
         poses: list[np.ndarray | None] | None = list(every)  # one pose per RGB-D pair
         if len(every) == len(stems) != len(pairs):  # one per image name: those of the pairs
@@ -578,7 +558,7 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
                          "image left out with their poses (first: "
                          f"{by_stem[unpaired[0]].relative_to(root)})")
     else:
-        read = _external_poses(traj, len(pairs), hint, shorter=True) \
+        read = trajectory_poses(traj, len(pairs), hint, shorter=True) \
             if traj is not None else None
         poses = None if read is None else list(read)
     dropped = 0

@@ -272,3 +272,23 @@ def is_open3d_log(path: Path) -> bool:
             if line and not line.startswith("#"):
                 return len(line.split()) == 3
     return False
+
+
+def trajectory_poses(trajectory: Path | None, count: int, hint: str = "",
+                     shorter: bool = False, also: int | None = None
+                     ) -> list[np.ndarray] | None:
+    """Poses from a --trajectory file for frames in order (Open3D .log, or a TUM file whose
+    lines are taken in order); ``hint`` says why the counts may differ; ``shorter``: a
+    trajectory that ends before the frames is taken (the first frames' poses); ``also``:
+    another count taken."""
+    if trajectory is None:
+        return None
+    if not trajectory.is_file():
+        raise SgtoolError(f"--trajectory {trajectory}: no such file")
+    if is_open3d_log(trajectory):
+        poses = read_open3d_log(trajectory)
+    else:
+        poses = [T for _, T in read_tum_trajectory(trajectory)]
+    if len(poses) not in (count, also) and not (shorter and 0 < len(poses) < count):
+        raise SgtoolError(f"{trajectory} has {len(poses)} poses for {count} frames{hint}")
+    return poses
