@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sgtool.log.frame import CameraIntrinsics
+from sgtool.log.poses import pose_difference
 from sgtool.recorders.importers.sanity import KNOWN_SCALES
 
 MIN_STEP_M = 0.02  # pose translation of a pair (m)
@@ -263,7 +264,7 @@ def pose_motion_problem(fit: ScaleFit | None, pose_source: str) -> tuple[str, bo
 
 
 FROZEN_M = 0.001  # poses this close (translation, m) and
-FROZEN_RAD = 0.002  # this close (rotation, rad) to the first stand still
+FROZEN_DEG = 0.1  # this close (rotation, degrees) to the first stand still
 MOVED_M = 0.05  # a pixel whose depth changes this much (or MOVED_REL of it) moved
 MOVED_REL = 0.05
 FROZEN_CLEAR = 0.5  # share of the pixels that moved between sampled frames: clear
@@ -282,10 +283,8 @@ def frozen_poses_problem(poses: Sequence[np.ndarray], depths_m: Sequence[np.ndar
         return None
     first = np.asarray(poses[0], float)
     for p in poses[1:]:
-        p = np.asarray(p, float)
-        cos = (np.trace(first[:3, :3].T @ p[:3, :3]) - 1.0) / 2.0
-        if np.linalg.norm(p[:3, 3] - first[:3, 3]) > FROZEN_M or \
-                np.arccos(np.clip(cos, -1.0, 1.0)) > FROZEN_RAD:
+        moved_m, turned_deg = pose_difference(first, np.asarray(p, float))
+        if moved_m > FROZEN_M or turned_deg > FROZEN_DEG:
             return None
     shares = []
     for a, b in zip(depths_m[:-1], depths_m[1:], strict=True):
