@@ -4,7 +4,8 @@ A panel swung open stands at right angles to its wall, hinged at one end of its 
 turned back by 90 degrees about that hinge it covers the doorway, the cells the room
 segmentation needs as door evidence. Which end is the hinge, and which side the doorway
 lies on, is read from the surroundings: the wall running away from the hinge, a clear
-opening across the doorway and the far jamb beyond it.
+opening across the doorway and the far jamb beyond it: the wall continuing in line, or at
+a room's corner the wall across the doorway's line, where the doorway then ends.
 
 The hinge need not touch the panel's seen end: near the hinge the panel stands in the
 corner between wall and door and is often seen only in part, so the wall line may lie
@@ -31,6 +32,9 @@ LINE_LEAST = 0.5  # the wall-line score a hinge needs (0 to 1: wall on both side
 LINE_MARGIN = 0.25  # and its lead over every other hinge and side
 MIN_REACH = 3  # cells past a panel's end the wall line is looked for, at least
 OFFSET_SLACK = 0.1  # a wall line this close to the best score of its hinge and side is as good
+CROSSING_NEAR, CROSSING_FAR = 0.8, 1.1  # door lengths out a wall across the doorway may stand
+CROSSING_REACH = 0.3  # door lengths of wall along the panel's direction a crossing wall has
+CROSSING_SHARE = 0.9  # occupied share of those cells
 
 _Candidate = tuple[float, float, float, int, np.ndarray]  # score, end, side, offset, out
 
@@ -39,9 +43,9 @@ def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
                        min_width: int = 8, memo: dict[bytes, Any] | None = None,
                        free: np.ndarray | None = None
                        ) -> tuple[np.ndarray, np.ndarray] | None:
-    """The doorway (rows, cols) of a door seen only as its swung-open panel (cells
-    ``rows``, ``cols`` of the bool grid ``occupied``): the panel's closed position, found
-    by turning it by 90 degrees about its hinge (module doc).
+    """The doorway (rows, cols) of a door seen only as its swung-open panel (cells ``rows``,
+    ``cols`` of the bool grid ``occupied``): the panel's closed position, found by turning
+    it by 90 degrees about its hinge (module doc).
 
     For each end of the panel (along its principal axis), each side across it and each
     offset of the wall line past that end, score how much the surroundings look like a
@@ -50,20 +54,21 @@ def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
     before the wall line was seen free together with its two neighbours across the line;
     when no hinge among those is found and ``free`` is given, up to the panel's length,
     where the panel's line before the wall line holds occupied cells (the panel's thin
-    columns) and then unseen ones (its unseen part): no free cell, no cell occupied with
-    its two neighbours across the line (a wall it would run through), no occupied cell
-    past an unseen one. The score: wall running away on one side (share of occupied
-    cells 0.1-0.45 door widths along it), a clear opening on the other (share of occupied
-    cells along the closed position, which must be low) and the far jamb just beyond it,
-    wall + jamb - 2 opening. The best hinge and side must score well and clearly
-    beat every alternative. When none does (a free end whose far-jamb ray hits furniture
-    can come close to a hinge whose opening ray, for a panel smeared longer than its
-    doorway, reaches the far wall), they are scored again by the wall line alone: the
+    columns) and then unseen ones (its unseen part): no free cell, no cell occupied with its
+    two neighbours across the line (a wall it would run through), no occupied cell past an
+    unseen one. The score: wall running away on one side (share of occupied cells 0.1-0.45
+    door widths along it), a clear opening on the other (share of occupied cells along the
+    closed position, which must be low) and the far jamb just beyond it (1.0 where a wall
+    crosses the doorway's line at its far end: :func:`_crossing_walls`; the doorway then
+    ends there), wall + jamb - 2 opening. The best hinge and side must score well and
+    clearly beat every alternative. When none does (a free end whose far-jamb ray hits
+    furniture can come close to a hinge whose opening ray, for a panel smeared longer than
+    its doorway, reaches the far wall), they are scored again by the wall line alone: the
     lesser of the wall and jamb shares minus the opening's (at least ``LINE_LEAST``,
     ``LINE_MARGIN`` ahead of every alternative). Otherwise None (the caller then uses the
     panel's own cells), as for cells that are not one panel at least ``min_width`` cells
-    long. ``free`` (bool, the shape of ``occupied``; None: no cell known free) is the
-    grid's cells seen free; ``memo`` caches answers by panel and surroundings."""
+    long. ``free`` (bool, the shape of ``occupied``; None: no cell known free) is the grid's
+    cells seen free; ``memo`` caches answers by panel and surroundings."""
     if len(rows) < 2:
         return None
     # work in a window around the panel: every ray starts at most a panel length past its
@@ -145,6 +150,10 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
                          (end, d, 1.05 * w, 1.3 * w, True)]
                 places.append((s, sign, off, out))
     shares = ray_shares(rays, occupied, grown, origin)
+    crossing = _crossing_walls(places, mean, a, t, width, occupied, origin)
+    for i, h in enumerate(crossing):
+        if h is not None:  # a wall across the doorway's line at its far end: its jamb
+            shares[3 * i + 2] = 1.0
     best = None
     for most in (MIN_REACH, reach):  # the nearest wall lines first
         best = _clear_best(shares, places, most, _sum_score, 1.0, 0.5)
@@ -156,6 +165,10 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
         return None
     _, s_end, sign, off, out = best
     end, d, w = mean + a * s_end + out * off, sign * t, width + off
+    h = next(h for (s, g, o, _), h in zip(places, crossing, strict=True)
+             if (s, g, o) == (s_end, sign, off))
+    if h is not None and h < w:
+        w = h  # the doorway ends at the wall across it
     f = np.linspace(0.0, w, int(np.ceil(2 * w)) + 1)[:, None]
     p = end[None, :] + d[None, :] * f
     c = np.round(p[:, 0]).astype(np.int64)
@@ -163,6 +176,36 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
     h, w_ = occupied.shape
     ok = (r >= origin[0]) & (r < origin[0] + h) & (c >= origin[1]) & (c < origin[1] + w_)
     return r[ok], c[ok]
+
+
+def _crossing_walls(places: list[tuple[float, float, int, np.ndarray]], mean: np.ndarray,
+                    a: np.ndarray, t: np.ndarray, width: float, occupied: np.ndarray,
+                    origin: tuple[int, int]) -> list[float | None]:
+    """Per place (end, side, offset, outward axis), the distance (cells) from its hinge to
+    a wall crossing the doorway's line at its far end (``CROSSING_NEAR`` to
+    ``CROSSING_FAR`` door lengths out), else None: the jamb of a door at a room's corner,
+    whose own wall does not continue past the opening. A wall crosses where an occupied
+    cell on the line has ``CROSSING_SHARE`` of the cells occupied along the panel's
+    direction on one side of it, ``CROSSING_REACH`` door lengths long (at least
+    ``MIN_REACH`` cells); a wall in line with the doorway is thinner than that."""
+    points, where = [], []  # every half cell of the far end's stretch of each place
+    for i, (s, sign, off, out) in enumerate(places):
+        end, d, w = mean + a * s + out * off, sign * t, width + off
+        for h in np.arange(CROSSING_NEAR * w, CROSSING_FAR * w + 0.25, 0.5):
+            points.append(end + d * h)
+            where.append((i, float(h), max(float(MIN_REACH), CROSSING_REACH * w)))
+    got: list[float | None] = [None] * len(places)
+    on_wall = grid_at(np.array(points).reshape(-1, 2), occupied, origin)
+    rays = [(p, e, 1.0, reach, False) for p, (_, _, reach), hit in
+            zip(points, where, on_wall.tolist(), strict=True) if hit for e in (a, -a)]
+    where = [w for w, hit in zip(where, on_wall.tolist(), strict=True) if hit]
+    if not rays:
+        return got
+    shares = ray_shares(rays, occupied, occupied, origin)
+    for k, (i, h, _) in enumerate(where):
+        if got[i] is None and max(shares[2 * k], shares[2 * k + 1]) >= CROSSING_SHARE:
+            got[i] = h
+    return got
 
 
 def _sum_score(wall: float, opening: float, jamb: float) -> float:

@@ -116,6 +116,28 @@ def test_smeared_panel_beside_a_cupboard_still_gives_its_doorway() -> None:
     assert np.all((r >= 14) & (r <= 20))  # along the wall ...
     assert c.min() <= 41 and c.max() >= 57  # ... across the whole doorway
 
+def test_panel_of_a_door_at_a_rooms_corner_gives_its_doorway() -> None:
+    """A door whose opening ends at a room's corner (the wall across it at row 20, the
+    door's own wall along column 40 from row 39 up), hinged at its other end and swung
+    into +column: no wall continues past the opening for the far-jamb ray (beyond the
+    wall across it lies unseen space), and a panel smeared 2 cells longer than its
+    doorway puts the jamb ray past that thin wall. The wall across the doorway's line
+    is its jamb; the doorway ends there."""
+    occupied = np.zeros((70, 100), dtype=bool)
+    occupied[19:21, :] = True  # the wall across the doorway (the room's corner)
+    occupied[39:, 39:42] = True  # the door's own wall, from the hinge up
+    rows = np.full(20, 39)  # the panel: 20 cells (doorway 18), hinged at (39, 40)
+    cols = np.arange(42, 62)
+    occupied[rows, cols] = True
+    free = ~occupied
+    free[:19] = False  # unseen past the wall across
+    got = opening_from_panel(rows, cols, occupied, min_width=8, free=free)
+    assert got is not None
+    r, c = got
+    assert np.all(np.abs(c - 41) <= 1)  # along the door's wall line ...
+    assert r.max() >= 38 and 20 <= r.min() <= 22  # ... from the hinge to the corner
+
+
 def _wall_with_doorway() -> tuple[np.ndarray, np.ndarray]:
     """A wall along x at row 20 with an 18-cell doorway (columns 40-57); floor seen free
     everywhere else."""
