@@ -61,6 +61,7 @@ from sgtool.recorders.importers.bag_sync import PlannedFrame, plan_frames, plann
 from sgtool.recorders.importers.bag_topics import check_flags, describe_bag, with_only_info
 from sgtool.recorders.importers.distortion import distortion_finding
 from sgtool.recorders.importers.floor import floor_confidence_problem, frame_floor_problem
+from sgtool.recorders.importers.focal_check import check_focal, turn_pairs
 from sgtool.recorders.importers.images import ResizeLog, depth_to_metres
 from sgtool.recorders.importers.odometry import (
     DriftReport,
@@ -165,17 +166,7 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
             findings.problem(clock_problem(offset, f"{path}: --depth {opts.depth}"),
                              given=opts.time_offset_ns != 0)
         if src is not None:
-            pairs = bag_scale_pairs(reader, idx, opts, src, k)
-            fit = fit_scale(pairs, k)
-            if fit is not None:
-                checks.append(("depth scale against the poses", fit.describe()))
-            for problem in convention_problems(pairs, k, fit, src.describe):
-                findings.problem(problem, given=estimate)
-            motion = pose_motion_problem(fit, src.describe)
-            if motion is not None:
-                findings.problem(motion[0], given=estimate or not motion[1])
-            findings.problem(bag_scale_problem(fit, idx, opts, src, _scale_origin(idx, opts)[1]),
-                             given=opts.depth_scale is not None)
+            _check_poses(reader, idx, opts, src, k, findings, checks, estimate)
         plan, notes = plan_frames(idx, src, opts, keep_unposed=estimate)
         if not plan:
             raise SgtoolError(
@@ -222,9 +213,7 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         if alignment.floor_detail:
             checks.append(("floor", alignment.floor_detail))
         sources = [("intrinsics", f"{k.fx:g},{k.fy:g},{k.cx:g},{k.cy:g}",
-                    "flag --intrinsics" if opts.intrinsics is not None else
-                    f"topic {opts.info}" + (f" ({opts.info_origin})" if opts.info_origin
-                                            else "")),
+                    _intrinsics_origin(opts)),
                    ("depth scale", *_scale_origin(idx, opts)), *alignment_sources(alignment)]
         meta["intrinsics"] = f"{k.fx:g},{k.fy:g},{k.cx:g},{k.cy:g}"
         meta.update(source_metadata(sources))
@@ -264,6 +253,39 @@ def _scale(raw: np.ndarray, scale: float, opts: BagOptions) -> float:
     """Units per metre of a decoded depth image: --depth-scale when given (16-bit or float
     depth alike), else the encoding's."""
     return opts.depth_scale if opts.depth_scale else scale
+
+
+def _check_poses(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
+                 k: CameraIntrinsics, findings: Findings, checks: list[tuple[str, str]],
+                 estimate: bool) -> None:
+    """The depth scale and the focal length against the poses of ``src`` (nearby and
+    turned depth pairs: :mod:`.scale_check`, :mod:`.focal_check`): the fits into
+    ``checks``, their problems into ``findings`` (the depth scale not blamed where the
+    focal length explains the depth's motion)."""
+    pairs = bag_scale_pairs(reader, idx, opts, src, k)
+    fit = fit_scale(pairs, k)
+    if fit is not None:
+        checks.append(("depth scale against the poses", fit.describe()))
+    focal, problem, explains = check_focal(
+        bag_scale_pairs(reader, idx, opts, src, k, turn_pairs), pairs, k, fit,
+        _intrinsics_origin(opts))
+    if focal is not None:
+        checks.append(("focal length against the poses", focal.describe()))
+    findings.problem(problem, given=opts.intrinsics is not None)
+    if explains:
+        return
+    for text in convention_problems(pairs, k, fit, src.describe):
+        findings.problem(text, given=estimate)
+    motion = pose_motion_problem(fit, src.describe)
+    if motion is not None:
+        findings.problem(motion[0], given=estimate or not motion[1])
+    findings.problem(bag_scale_problem(fit, idx, opts, src, _scale_origin(idx, opts)[1]),
+                     given=opts.depth_scale is not None)
+
+
+def _intrinsics_origin(opts: BagOptions) -> str:
+    return ("flag --intrinsics" if opts.intrinsics is not None else
+            f"topic {opts.info}" + (f" ({opts.info_origin})" if opts.info_origin else ""))
 
 
 def _scale_origin(idx: BagIndex, opts: BagOptions) -> tuple[str, str]:

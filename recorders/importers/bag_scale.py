@@ -6,6 +6,7 @@ depth's encoding; only 16-bit depth has a scale to name."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -24,11 +25,14 @@ from sgtool.recorders.importers.scale_check import (
 
 
 def bag_scale_pairs(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
-                    k: CameraIntrinsics) -> list[tuple[np.ndarray, np.ndarray, np.ndarray,
-                                                       np.ndarray]]:
-    """Pairs of nearby depth images in metres with their poses from ``src``, as
+                    k: CameraIntrinsics,
+                    select: Callable[[list[np.ndarray]], list[tuple[int, int]]] = pair_indices
+                    ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    """Pairs of depth images in metres with their poses from ``src``, as
     :func:`~.scale_check.fit_scale` and :func:`~.scale_check.convention_problems` take
-    them (one pass over the depth topic); empty without a usable pair."""
+    them (one pass over the depth topic): the pairs ``select`` picks from the images'
+    poses in time order (nearby frames; :func:`~.focal_check.turn_pairs`: turned ones);
+    empty without a usable pair."""
     if not idx.samples:
         return []
     explicit = opts.tf_frames is not None or opts.pose is not None
@@ -37,7 +41,7 @@ def bag_scale_pairs(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSourc
         T = src.at(idx.depth.stamps[kk], None if explicit else idx.depth.frames[kk])  # noqa: N806
         if T is not None:
             posed.append((kk, T))
-    pairs = pair_indices([T for _, T in posed])
+    pairs = select([T for _, T in posed])
     if not pairs:
         return []
     need = {posed[i][0] for p in pairs for i in p}

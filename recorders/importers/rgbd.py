@@ -40,6 +40,11 @@ from sgtool.recorders.importers.checks import (
     check_range,
 )
 from sgtool.recorders.importers.floor import floor_confidence_problem, frame_floor_problem
+from sgtool.recorders.importers.focal_check import (
+    FocalFit,
+    check_focal,
+    turn_pairs,
+)
 from sgtool.recorders.importers.images import (
     ResizeLog,
     colour_kind_problem,
@@ -254,23 +259,39 @@ def run_odometry(
 
 def check_scale_by_geometry(frames: list[FolderFrame], k: CameraIntrinsics, scale: float,
                             origin: str, pose_source: str, findings: Findings,
-                            given: bool, estimate: bool = False) -> ScaleFit | None:
-    r"""The depth scale against the metric poses (:mod:`.scale_check`), on a few pairs of
-    nearby frames, before any heavy work; the fit (None without a usable pair). Poses
-    the depth does not follow are an error when clear, else a warning (a warning only
-    when the poses are to be ``estimate``\ d anyway)."""
+                            given: bool, estimate: bool = False,
+                            intrinsics: tuple[str, bool] = ("given", True)
+                            ) -> tuple[ScaleFit | None, FocalFit | None]:
+    r"""The depth scale and the focal length against the metric poses
+    (:mod:`.scale_check`, :mod:`.focal_check`), on a few pairs of nearby and of turned
+    frames, before any heavy work; the fits (None without a usable pair). Poses the depth
+    does not follow are an error when clear, else a warning (a warning only when the
+    poses are to be ``estimate``\ d anyway); a focal length that does not fit is an error
+    unless the ``intrinsics`` (origin, whether given by the user) were given; when it
+    explains the depth not moving as the poses do, the depth scale is not blamed."""
     poses = [np.asarray(f.pose) for f in frames]
-    pairs = [(depth_to_metres(read_depth_file(frames[i].depth_path), scale),
-              depth_to_metres(read_depth_file(frames[j].depth_path), scale), poses[i], poses[j])
-             for i, j in pair_indices(poses)]
+
+    def depth_pairs(ij: list[tuple[int, int]]
+                    ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+        return [(depth_to_metres(read_depth_file(frames[i].depth_path), scale),
+                 depth_to_metres(read_depth_file(frames[j].depth_path), scale),
+                 poses[i], poses[j]) for i, j in ij]
+
+    pairs = depth_pairs(pair_indices(poses))
     fit = fit_scale(pairs, k)
+    turned = [p for p in depth_pairs(turn_pairs(poses))
+              if p[0].shape == p[1].shape == (k.height, k.width)]
+    focal, problem, explains = check_focal(turned, pairs, k, fit, intrinsics[0])
+    findings.problem(problem, given=intrinsics[1])
+    if explains:
+        return fit, focal
     for problem in convention_problems(pairs, k, fit, pose_source):
         findings.problem(problem, given=estimate)
     motion = pose_motion_problem(fit, pose_source)
     if motion is not None:
         findings.problem(motion[0], given=estimate or not motion[1])
     findings.problem(geometric_scale_problem(fit, scale, origin, pose_source), given=given)
-    return fit
+    return fit, focal
 
 
 def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = None) -> ImportReport:
@@ -309,13 +330,18 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     findings.problem(no_depth_problem(raws, str(root)), given=False)
     k = camera_for(seq, opts, raws[0].shape[1], raws[0].shape[0], findings)
     checks: list[tuple[str, str]] = []
+    intr_origin = "flag --intrinsics" if opts.intrinsics is not None else \
+        (seq.intrinsics.source if seq.intrinsics is not None else "given")
     if seq.pose_source != "none" and all(f.pose is not None for f in frames):
         # first: metric poses name the scale that fits better than a usual median does
-        fit = check_scale_by_geometry(frames, k, scale, scale_origin, seq.pose_source,
-                                      findings, given=opts.depth_scale is not None,
-                                      estimate=opts.estimate_poses)
+        fit, focal = check_scale_by_geometry(
+            frames, k, scale, scale_origin, seq.pose_source, findings,
+            given=opts.depth_scale is not None, estimate=opts.estimate_poses,
+            intrinsics=(intr_origin, opts.intrinsics is not None))
         checks.append(("depth scale against the poses",
                        fit.describe() if fit else "no verdict: no frame pair pins the motion down"))
+        if focal is not None:
+            checks.append(("focal length against the poses", focal.describe()))
         frozen = frozen_poses_problem([np.asarray(f.pose) for f in frames],
                                       [depth_to_metres(r, scale) for r in raws],
                                       seq.pose_source)
@@ -323,8 +349,6 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
             findings.problem(frozen[0], given=not frozen[1])
     findings.problem(depth_scale_problem(raws, scale, scale_origin),
                      given=opts.depth_scale is not None)
-    intr_origin = "flag --intrinsics" if opts.intrinsics is not None else \
-        (seq.intrinsics.source if seq.intrinsics is not None else "given")
     if opts.intrinsics is None and intr_origin.startswith("folder-name default"):
         findings.warning(f"intrinsics taken from the folder name ({intr_origin}); give "
                          "--intrinsics fx,fy,cx,cy if the images come from another camera")

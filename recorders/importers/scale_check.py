@@ -192,13 +192,19 @@ POSE_UNITS = ((0.01, "centimetres"), (0.001, "millimetres"))
 Pairs = Sequence[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
 
 
+def poses_fit_depth(fit: ScaleFit | None) -> bool:
+    """Whether the pairs agree that the depth moves as the poses do (within
+    :data:`TOLERANCE`): metric poses, metric depth."""
+    return fit is not None and fit.consistent() and abs(fit.ratio - 1.0) <= TOLERANCE
+
+
 def convention_problems(pairs: Pairs, k: CameraIntrinsics, fit: ScaleFit | None,
                         pose_source: str) -> list[str]:
     """When the poses do not fit the depth (``fit``, of ``pairs`` as :func:`fit_scale`
     takes them): the problems of the poses' inverses or their translations in another
     unit fitting it (:func:`inverted_poses_problem`, :func:`pose_units_problem`); empty
     when the poses fit, or neither does."""
-    if fit is not None and fit.consistent() and abs(fit.ratio - 1.0) <= TOLERANCE:
+    if poses_fit_depth(fit):
         return []
     inverted = fit_scale([(a, b, np.linalg.inv(p), np.linalg.inv(q)) for a, b, p, q in pairs],
                          k)

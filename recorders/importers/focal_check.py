@@ -1,0 +1,183 @@
+"""The focal length checked against metric poses: surfaces seen from two turned views meet.
+
+Back-projecting depth with a focal length ``c`` times too short stretches every point
+cloud sideways by ``c`` (depth unchanged). A camera that only moves forward hides that,
+but a turn does not: two views turned a few degrees apart, placed by their poses, show
+their shared surfaces apart, by centimetres for a focal length a quarter off. For a few
+pairs of frames turned :data:`TURN_DEG` apart (spread over the sequence), the median
+point-to-plane gap between the pair's surfaces is measured with the focal lengths scaled
+by each factor of :data:`FACTORS` (then finer around the best); the factor whose gap is
+smallest estimates ``c``.
+
+Only a clear, consistent disagreement counts (:func:`focal_problem`): ``c`` off 1 by more
+than :data:`OFF`, the gap at the given focal length :data:`CLEAR` times the best one or
+more, and nearly every pair's own best factor on the same side (three pairs at least).
+A wrong focal length also misleads the depth scale check of :mod:`.scale_check` (a
+stretched cloud moves too far between nearby frames): :func:`check_focal` tells whether
+the focal length that fits also makes the depth move as the poses do, and then the focal
+length, not the depth scale, is the problem to name.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from sgtool.log.frame import CameraIntrinsics
+from sgtool.log.poses import pose_difference
+from sgtool.recorders.importers.scale_check import Pairs, ScaleFit, fit_scale, poses_fit_depth
+
+TURN_DEG = (3.0, 25.0)  # the turn of a pair: enough to show a stretch, little enough to overlap
+MAX_STEP_M = 0.5  # and at most this much translation
+MAX_AHEAD = 30  # frames to look ahead for a turned neighbour
+PAIRS = 6
+FACTORS = tuple(float(x) for x in np.geomspace(0.5, 2.0, 9))  # 19 % apart, then 6 %
+OFF = 0.1  # |c - 1| that is no verdict
+CLEAR = 2.5  # gap at the focal length given / at the best factor, at least
+AGREE = 0.75  # share of the pairs whose own best factor is off the same way
+MIN_PAIRS = 3
+MATCH_REL = 0.1  # a point matches a surface within this share of the median depth
+MIN_MATCHED = 0.3  # share of a pair's points that must match
+
+
+@dataclass(frozen=True)
+class FocalFit:
+    """The focal length factor ``factor`` at which the surfaces of ``pairs`` turned frame
+    pairs meet best (median gap ``gap_mm``), the gap at the focal length given
+    (``given_mm``), and how many pairs' own best factor lies off 1 the same way
+    (``agree``)."""
+
+    factor: float
+    pairs: int
+    gap_mm: float
+    given_mm: float
+    agree: int
+
+    def describe(self) -> str:
+        return (f"surfaces of {self.pairs} turned frame pairs meet best at {self.factor:.2f}x "
+                f"the focal length (gap {self.gap_mm:.1f} mm; {self.given_mm:.1f} mm as given)")
+
+
+def turn_pairs(poses: Sequence[np.ndarray], n_pairs: int = PAIRS) -> list[tuple[int, int]]:
+    """Up to ``n_pairs`` (i, j) frame pairs spread over the sequence: j the first frame
+    after i (within :data:`MAX_AHEAD`) turned at least ``TURN_DEG[0]`` from it, kept when
+    turned at most ``TURN_DEG[1]`` and moved at most :data:`MAX_STEP_M` (i from
+    ``4 * n_pairs`` starts spread over the sequence)."""
+    n = len(poses)
+    out: list[tuple[int, int]] = []
+    if n < 2:
+        return out
+    for i in np.unique(np.linspace(0, n - 2, min(4 * n_pairs, n - 1)).round().astype(int)):
+        for j in range(int(i) + 1, min(n, int(i) + 1 + MAX_AHEAD)):
+            moved, turned = pose_difference(np.asarray(poses[i]), np.asarray(poses[j]))
+            if moved > MAX_STEP_M:
+                break
+            if turned >= TURN_DEG[0]:
+                if turned <= TURN_DEG[1]:
+                    out.append((int(i), j))
+                break
+    if len(out) > n_pairs:  # spread over the sequence
+        out = [out[i] for i in np.unique(np.linspace(0, len(out) - 1, n_pairs).round()
+                                         .astype(int))]
+    return out
+
+
+def surface_gap(d0: np.ndarray, d1: np.ndarray, k: CameraIntrinsics,
+                rel: np.ndarray) -> float | None:
+    """The median |point-to-plane| distance (m) of frame j's points (depth ``d1``, placed
+    in frame i's camera by ``rel``) to frame i's surfaces (depth ``d0``), both
+    back-projected with ``k``; None when fewer than :data:`MIN_MATCHED` of them (or 50)
+    lie within :data:`MATCH_REL` of the median depth of a surface point."""
+    from scipy.spatial import cKDTree
+
+    from sgtool.recorders.importers.upright import DepthSample, surface_points
+
+    eye = np.eye(4)
+    stride = max(1, d0.shape[1] // 80)
+    q, nq = surface_points(DepthSample(d0, k, eye), stride=stride)
+    p, _ = surface_points(DepthSample(d1, k, eye), stride=stride)
+    if len(q) < 50 or len(p) < 50:
+        return None
+    moved = p @ rel[:3, :3].T + rel[:3, 3]
+    dist, idx = cKDTree(q).query(moved, distance_upper_bound=MATCH_REL * float(
+        np.median(q[:, 2])))
+    ok = np.isfinite(dist)
+    if ok.sum() < 50 or ok.mean() < MIN_MATCHED:
+        return None
+    gaps = np.einsum("ij,ij->i", nq[idx[ok]], moved[ok] - q[idx[ok]])
+    return float(np.median(np.abs(gaps)))
+
+
+def fit_focal(pairs: Pairs, k: CameraIntrinsics) -> FocalFit | None:
+    """The fit over ``(depth_i, depth_j, pose_i, pose_j)`` (depth in metres, world_T_camera
+    poses; module doc); pairs without a gap at the given focal length are left out; None
+    without a usable pair."""
+    usable, given = [], []
+    for d0, d1, p0, p1 in pairs:
+        rel = np.linalg.inv(p0) @ p1  # camera j in camera i
+        gap = surface_gap(d0, d1, k, rel)
+        if gap is not None:
+            usable.append((d0, d1, rel))
+            given.append(gap)
+    if not usable:
+        return None
+
+    def gaps(c: float) -> list[float]:
+        kc = dataclasses.replace(k, fx=k.fx * c, fy=k.fy * c)
+        got = [surface_gap(d0, d1, kc, rel) for d0, d1, rel in usable]
+        return [math.inf if g is None else g for g in got]
+
+    table = {1.0: given}
+    for c in FACTORS:
+        table.setdefault(round(c, 6), gaps(c))
+    coarse = min(table, key=lambda c: float(np.median(table[c])))
+    for c in np.geomspace(coarse / 1.19, coarse * 1.19, 7).tolist():
+        table.setdefault(round(c, 6), gaps(c))
+    best = min(table, key=lambda c: float(np.median(table[c])))
+    side = math.copysign(1.0, math.log(best)) if best != 1.0 else 0.0
+    agree = 0
+    for i in range(len(usable)):
+        own = min(table, key=lambda c: table[c][i])
+        if side and abs(own - 1.0) > OFF and math.copysign(1.0, math.log(own)) == side:
+            agree += 1
+    return FocalFit(best, len(usable), 1000 * float(np.median(table[best])),
+                    1000 * float(np.median(given)), agree)
+
+
+def focal_problem(fit: FocalFit | None, k: CameraIntrinsics, origin: str) -> str | None:
+    """The problem of intrinsics whose focal length the turned pairs clearly disagree with
+    (module doc), naming the focal lengths that fit; None otherwise."""
+    if fit is None or fit.pairs < MIN_PAIRS or abs(fit.factor - 1.0) <= OFF:
+        return None
+    if not fit.given_mm >= CLEAR * fit.gap_mm or fit.agree < max(MIN_PAIRS,
+                                                                   AGREE * fit.pairs):
+        return None
+    how = "short" if fit.factor > 1.0 else "long"
+    return (f"intrinsics ({origin}): the focal length looks {fit.factor:.2f}x too {how}: "
+            f"between {fit.pairs} pairs of turned frames the surfaces seen from both meet "
+            f"within {fit.gap_mm:.1f} mm with fx, fy {k.fx * fit.factor:.0f}, "
+            f"{k.fy * fit.factor:.0f}, {fit.given_mm:.1f} mm apart with {k.fx:.4g}, {k.fy:.4g} "
+            "(a wrong focal length stretches the map): check the camera's intrinsics "
+            "(--intrinsics fx,fy,cx,cy)")
+
+
+def check_focal(turned: Pairs, nearby: Pairs, k: CameraIntrinsics, fit: ScaleFit | None,
+                origin: str) -> tuple[FocalFit | None, str | None, bool]:
+    """The focal fit of the ``turned`` pairs (:func:`turn_pairs`), its problem
+    (:func:`focal_problem`, intrinsics from ``origin``), and whether the problem explains
+    the depth scale fit ``fit`` of the ``nearby`` pairs not fitting the poses: with the
+    focal lengths the fit names, they fit. A problem whose focal lengths leave the depth
+    moving otherwise than the poses is dropped (the poses or the depth scale are wrong
+    then, and the turned pairs' gaps say nothing of the focal length)."""
+    focal = fit_focal(turned, k)
+    problem = focal_problem(focal, k, origin)
+    if problem is None or focal is None or poses_fit_depth(fit):
+        return focal, problem, False
+    c = focal.factor
+    if poses_fit_depth(fit_scale(nearby, dataclasses.replace(k, fx=k.fx * c, fy=k.fy * c))):
+        return focal, problem, True
+    return focal, None, False
