@@ -10,9 +10,11 @@ footprint). :func:`with_start_poses` gives a house without
 start poses (a house written by hand) one per reachable room, so that
 :func:`sgtool.datasets.episodes.list_episodes` can list its episodes.
 
-The origin is the first room of the spec unless named; its point is the free cell of that
-room nearest to the room's centroid. Yaws are drawn from ``numpy.random.default_rng(seed)``,
-one per room in spec order, so the result is a function of the house and the seed.
+The origin is the room named, else the first room of the spec from which the most rooms
+can be reached (a room walled off, listed first, does not make the rest of the house
+unreachable); its point is the free cell of that room nearest to the room's centroid.
+Yaws are drawn from ``numpy.random.default_rng(seed)``, one per room in spec order, so the
+result is a function of the house and the seed.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sgtool.datasets.footprint_reach import near_footprint
-from sgtool.house.spec import HouseSpec, StartPose
+from sgtool.house.spec import HouseSpec, Room, StartPose
 from sgtool.mapping.occupancy import geodesic_distances, house_occupancy
 from sgtool.mapping.raster import cell_centers, polygon_mask
 
@@ -53,13 +55,26 @@ def reachability(spec: HouseSpec, seed: int = 0, origin_room: str | None = None,
 
     Raises ``KeyError`` for an ``origin_room`` that is not a room id of the spec.
     """
-    origin = spec.room(origin_room) if origin_room is not None else spec.rooms[0]
+    origins = [spec.room(origin_room)] if origin_room is not None else list(spec.rooms)
     occ = house_occupancy(spec, closed_doors_free=True, robot_radius=robot_radius)
     X, Y = cell_centers(occ)
     free = ~occ.blocked
     masks = {r.id: polygon_mask(occ, r.polygon) & free for r in spec.rooms}
-    ox, oy = _nearest_cell(masks[origin.id], X, Y, origin.centroid) or origin.centroid
-    ok = np.isfinite(geodesic_distances(occ, (ox, oy), max_snap=1.0))
+    best: tuple[int, Room, np.ndarray] | None = None
+    seen: set[str] = set()  # rooms reached from an origin tried: the same part of the house
+    for room in origins:
+        if room.id in seen:
+            continue
+        ox, oy = _nearest_cell(masks[room.id], X, Y, room.centroid) or room.centroid
+        reached = np.isfinite(geodesic_distances(occ, (ox, oy), max_snap=1.0))
+        rooms = {r.id for r in spec.rooms if (masks[r.id] & reached).any()} | {room.id}
+        seen |= rooms
+        if best is None or len(rooms) > best[0]:
+            best = (len(rooms), room, reached)
+        if len(rooms) == len(spec.rooms):
+            break
+    assert best is not None  # a spec has a room
+    _, origin, ok = best
     rng = np.random.default_rng(seed)
     starts, lost_rooms = [], []
     for r in spec.rooms:
@@ -80,7 +95,7 @@ def reachability(spec: HouseSpec, seed: int = 0, origin_room: str | None = None,
 
 
 def start_poses(spec: HouseSpec, seed: int = 0) -> tuple[StartPose, ...]:
-    """One start pose per room reachable from the first room (module doc)."""
+    """One start pose per room reachable from the origin room (module doc)."""
     return reachability(spec, seed).starts
 
 

@@ -34,6 +34,21 @@ def test_walled_off_room_and_its_furniture_are_unreachable() -> None:
     assert not rep.complete and [s.room for s in rep.starts] == ["room_kitchen", "room_hall"]
 
 
+def test_a_walled_off_room_listed_first_does_not_cut_off_the_rest() -> None:
+    """The same walled-off bedroom listed first: the origin was the first room, so only the
+    bedroom was reachable (every episode started in its target's room, the recorder toured
+    the bedroom alone). The origin is the room that reaches the most."""
+    d = cottage()
+    d["doors"] = [x for x in d["doors"] if x["id"] != "door_bed"]
+    d["walls"].append({"id": "wall_shut", "a": [6, 1.5], "b": [6, 2.5]})
+    d["rooms"] = sorted(d["rooms"], key=lambda r: r["id"] != "room_bed")
+    rep = reachability(load_house(d))
+    assert rep.origin_room == "room_kitchen" and rep.unreachable_rooms == ("room_bed",)
+    assert [s.room for s in rep.starts] == ["room_kitchen", "room_hall"]
+    assert reachability(load_house(d), origin_room="room_bed").unreachable_rooms == (
+        "room_kitchen", "room_hall")
+
+
 def test_list_episodes_needs_the_start_poses_a_hand_made_house_lacks() -> None:
     spec = load_house(cottage())
     assert spec.starts == () and list_episodes(spec) == []
