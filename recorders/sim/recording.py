@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from sgtool.arg_checks import of_type, whole
-from sgtool.house.spec import HouseSpec
+from sgtool.house.spec import HouseSpec, spec_id_key
 from sgtool.log import codec
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics, Frame
@@ -256,9 +256,10 @@ class RecordOptions:
 class RecordReport:
     """What :func:`record_house` wrote: the log, its frames and actions, the metres
     driven, the rooms (or frontier goals) visited and those missed with why, the pieces
-    opened, whether the frame budget cut the tour short, the wall-clock seconds, and for
-    a frontier exploration the share of the house's floor seen over time. ``lines()``
-    is ``sgtool record``'s report."""
+    opened, whether the frame budget cut the tour short, the wall-clock seconds, for
+    a frontier exploration the share of the house's floor seen over time, and the open
+    doors and pieces whose panels had no room to swing (``taken_away``: out of the
+    simulation, an empty doorway in the log). ``lines()`` is ``sgtool record``'s report."""
 
     output: Path
     house_id: str
@@ -271,6 +272,7 @@ class RecordReport:
     truncated: bool
     seconds: float  # wall-clock time of the run (reported, never logged)
     coverage: tuple[tuple[float, float], ...] = ()  # frontier: (sim time s, floor share)
+    taken_away: tuple[str, ...] = ()  # open doors and pieces whose panels found no room
 
     def lines(self) -> list[str]:
         fps = self.frames / self.seconds if self.seconds > 0 else 0.0
@@ -287,6 +289,11 @@ class RecordReport:
             out.append(f"missed {r}: {why}")
         if self.truncated:
             out.append("stopped at the frame budget before the exploration finished")
+        if self.taken_away:
+            out.append(f"open without room to swing, so taken out of the simulation: "
+                       f"{', '.join(self.taken_away)} (the log shows an empty doorway there: "
+                       "no door leaf; a doorway without a lintel then leaves the replay no "
+                       "door to find)")
         if self.coverage:
             marks = [f"{m} min {100 * coverage_at(self.coverage, 60.0 * m):.1f} %"
                      for m in (1, 2, 5) if self.coverage[-1][0] >= 60.0 * m]
@@ -372,9 +379,12 @@ def record_house(house: HouseSpec | str | os.PathLike[str], output: str | os.Pat
         ), rec.last_time_ns)
         travelled = sim.travelled_m
         frames, actions = rec.frames, rec.actions
+        taken = tuple(sid for sid, bodies in sorted(sim.world.panels.items(),
+                                                    key=lambda kv: spec_id_key(kv[0]))
+                      if any(b.removed for b in bodies))
     return RecordReport(Path(output), hid, frames, actions, travelled, tuple(rep.visited),
                         dict(rep.missed), tuple(rep.opened), truncated,
-                        time.perf_counter() - t_wall, tuple(samples))
+                        time.perf_counter() - t_wall, tuple(samples), taken)
 
 
 def _explore_live(sim: Simulation, rec: LogRecorder, opts: RecordOptions,
