@@ -134,6 +134,9 @@ def test_docs_api_lists_every_public_name() -> None:
     spec.loader.exec_module(mod)
     assert mod.section() in mod.DOC.read_text(encoding="utf-8")
     assert sorted(n for _, names in mod.topics() for n in names) == sorted(sgtool.__all__)
+    # no first sentence cut inside a code span (a name wrapped after one of its dots)
+    cut = [line for line in mod.section().splitlines() if line.count("`") % 2]
+    assert cut == []
 
 
 def test_dir_and_unknown_names() -> None:

@@ -42,7 +42,9 @@ def topics() -> list[tuple[str, list[str]]]:
 def first_sentence(name: str) -> str:
     """The first sentence of the docstring of ``sgtool.NAME``, on one line."""
     text = " ".join((inspect.getdoc(getattr(sgtool, name)) or "").split())
-    cut = re.search(r"(?<!e\.g)(?<!i\.e)\.(\s|$)", text)
+    # a full stop outside a code span (a name wrapped after its dot is no sentence's end)
+    cut = next((m for m in re.finditer(r"(?<!e\.g)(?<!i\.e)\.(\s|$)", text)
+                if text[:m.start()].count("`") % 2 == 0), None)
     return (text[:cut.start() + 1] if cut else text).replace("|", "\\|")
 
 
