@@ -29,7 +29,13 @@ import numpy as np
 
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.poses import pose_difference
-from sgtool.recorders.importers.scale_check import Pairs, ScaleFit, fit_scale, poses_fit_depth
+from sgtool.recorders.importers.scale_check import (
+    Pairs,
+    ScaleFit,
+    fit_scale,
+    poses_fit_depth,
+    surface_gap,
+)
 
 TURN_DEG = (3.0, 25.0)  # the turn of a pair: enough to show a stretch, little enough to overlap
 MAX_STEP_M = 0.5  # and at most this much translation
@@ -40,8 +46,6 @@ OFF = 0.1  # |c - 1| that is no verdict
 CLEAR = 2.5  # gap at the focal length given / at the best factor, at least
 AGREE = 0.75  # share of the pairs whose own best factor is off the same way
 MIN_PAIRS = 3
-MATCH_REL = 0.1  # a point matches a surface within this share of the median depth
-MIN_MATCHED = 0.3  # share of a pair's points that must match
 
 
 @dataclass(frozen=True)
@@ -84,32 +88,6 @@ def turn_pairs(poses: Sequence[np.ndarray], n_pairs: int = PAIRS) -> list[tuple[
         out = [out[i] for i in np.unique(np.linspace(0, len(out) - 1, n_pairs).round()
                                          .astype(int))]
     return out
-
-
-def surface_gap(d0: np.ndarray, d1: np.ndarray, k: CameraIntrinsics,
-                rel: np.ndarray) -> float | None:
-    """The median |point-to-plane| distance (m) of frame j's points (depth ``d1``, placed
-    in frame i's camera by ``rel``) to frame i's surfaces (depth ``d0``), both
-    back-projected with ``k``; None when fewer than :data:`MIN_MATCHED` of them (or 50)
-    lie within :data:`MATCH_REL` of the median depth of a surface point."""
-    from scipy.spatial import cKDTree
-
-    from sgtool.recorders.importers.upright import DepthSample, surface_points
-
-    eye = np.eye(4)
-    stride = max(1, d0.shape[1] // 80)
-    q, nq = surface_points(DepthSample(d0, k, eye), stride=stride)
-    p, _ = surface_points(DepthSample(d1, k, eye), stride=stride)
-    if len(q) < 50 or len(p) < 50:
-        return None
-    moved = p @ rel[:3, :3].T + rel[:3, 3]
-    dist, idx = cKDTree(q).query(moved, distance_upper_bound=MATCH_REL * float(
-        np.median(q[:, 2])))
-    ok = np.isfinite(dist)
-    if ok.sum() < 50 or ok.mean() < MIN_MATCHED:
-        return None
-    gaps = np.einsum("ij,ij->i", nq[idx[ok]], moved[ok] - q[idx[ok]])
-    return float(np.median(np.abs(gaps)))
 
 
 def fit_focal(pairs: Pairs, k: CameraIntrinsics) -> FocalFit | None:

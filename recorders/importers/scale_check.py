@@ -9,9 +9,11 @@ translation is fitted, point-to-plane ICP style (a full 6-DoF ICP trades a small
 a translation on small steps and misjudges the length); that factor estimates ``s``. The
 scale that fits is ``scale * s`` (snapped to a usual scale within 10 %).
 
-Only a clear, consistent disagreement counts: ``s`` outside 1 +- :data:`TOLERANCE`, every
-pair's ratio within 35 % of it, at least two pairs, and ``s`` between 0.2 and 20 (geometry
-that barely moves, a scene that cannot pin the motion down, gives no verdict).
+Only a clear, consistent disagreement counts: ``s`` outside 1 +- :data:`TOLERANCE` (+-
+:data:`PRECISE_TOLERANCE` when four pairs or more agree within 10 %: a depth scale a
+fifth off, 4000 units/m read as 5000, is then named), every pair's ratio within 35 % of
+it, at least two pairs, and ``s`` between 0.2 and 20 (geometry that barely moves, a scene
+that cannot pin the motion down, gives no verdict).
 """
 
 from __future__ import annotations
@@ -28,6 +30,9 @@ from sgtool.recorders.importers.sanity import KNOWN_SCALES
 MIN_STEP_M = 0.02  # pose translation of a pair (m)
 MAX_GAP = 6  # frames to look ahead for a neighbour far enough away
 TOLERANCE = 0.2  # |s - 1| a scale may be off without a verdict
+PRECISE_TOLERANCE = 0.1  # or, when PRECISE_PAIRS pairs or more agree within PRECISE_SPREAD
+PRECISE_PAIRS = 4
+PRECISE_SPREAD = 0.1
 PAIRS = 6
 
 
@@ -48,6 +53,12 @@ class ScaleFit:
 
     def consistent(self) -> bool:
         return self.pairs >= 2 and self.spread <= 0.35 and 0.2 < self.ratio < 20.0
+
+    def within_tolerance(self) -> bool:
+        """Whether the ratio is as close to 1 as gives no verdict (module doc; a bound
+        itself is within)."""
+        precise = self.pairs >= PRECISE_PAIRS and self.spread <= PRECISE_SPREAD
+        return abs(self.ratio - 1.0) <= (PRECISE_TOLERANCE if precise else TOLERANCE) + 1e-9
 
 
 def pair_indices(poses: Sequence[np.ndarray], n_pairs: int = PAIRS) -> list[tuple[int, int]]:
@@ -108,7 +119,44 @@ def translation_scale(d0: np.ndarray, d1: np.ndarray, k: CameraIntrinsics,
 
 
 MIN_MATCHED = 0.3  # share of a pair's points matched
+MATCH_REL = 0.1  # a point matches a surface within this share of the median depth
+GAP_MATCHED = 0.3  # share of a pair's points that must match for a gap
+GAP_CLEAR = 2.5  # a convention whose surfaces meet this much closer is the poses'
 MIN_ALONG_M = 0.005  # RMS pose translation along the matched normals
+
+
+def surface_gap(d0: np.ndarray, d1: np.ndarray, k: CameraIntrinsics,
+                rel: np.ndarray) -> float | None:
+    """The median |point-to-plane| distance (m) of frame j's points (depth ``d1``, placed
+    in frame i's camera by ``rel``) to frame i's surfaces (depth ``d0``), both
+    back-projected with ``k``; None when fewer than :data:`GAP_MATCHED` of them (or 50)
+    lie within :data:`MATCH_REL` of the median depth of a surface point."""
+    from scipy.spatial import cKDTree
+
+    from sgtool.recorders.importers.upright import DepthSample, surface_points
+
+    eye = np.eye(4)
+    stride = max(1, d0.shape[1] // 80)
+    q, nq = surface_points(DepthSample(d0, k, eye), stride=stride)
+    p, _ = surface_points(DepthSample(d1, k, eye), stride=stride)
+    if len(q) < 50 or len(p) < 50:
+        return None
+    moved = p @ rel[:3, :3].T + rel[:3, 3]
+    dist, idx = cKDTree(q).query(moved, distance_upper_bound=MATCH_REL * float(
+        np.median(q[:, 2])))
+    ok = np.isfinite(dist)
+    if ok.sum() < 50 or ok.mean() < GAP_MATCHED:
+        return None
+    gaps = np.einsum("ij,ij->i", nq[idx[ok]], moved[ok] - q[idx[ok]])
+    return float(np.median(np.abs(gaps)))
+
+
+def median_gap(pairs: Pairs, k: CameraIntrinsics) -> float | None:
+    """The median over ``pairs`` (as :func:`fit_scale` takes them) of their
+    :func:`surface_gap` (m); None without a pair that has one."""
+    gaps = [surface_gap(d0, d1, k, np.linalg.inv(p0) @ p1) for d0, d1, p0, p1 in pairs]
+    got = [g for g in gaps if g is not None]
+    return float(np.median(got)) if got else None
 
 
 def fit_scale(pairs: Sequence[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]],
@@ -158,7 +206,7 @@ def geometric_scale_problem(fit: ScaleFit | None, scale: float, origin: str,
     """The problem of depth at ``scale`` units/m (from ``origin``) whose geometry moves
     ``fit.ratio`` times as far as the metric poses (``pose_source``) say, naming the scale
     that fits; None without a clear, consistent disagreement."""
-    if fit is None or not fit.consistent() or abs(fit.ratio - 1.0) <= TOLERANCE:
+    if fit is None or not fit.consistent() or fit.within_tolerance():
         return None
     fits = snap_scale(scale * fit.ratio)
     return (f"depth scale {scale:g} units/m ({origin}) disagrees with the {pose_source}: "
@@ -176,7 +224,7 @@ def inverted_poses_problem(given: ScaleFit | None, inverted: ScaleFit | None,
     consistent wrong ratio). The text; None otherwise."""
     if inverted is None or not inverted.consistent() or abs(inverted.ratio - 1.0) > TOLERANCE:
         return None
-    if given is not None and given.consistent() and abs(given.ratio - 1.0) <= TOLERANCE:
+    if poses_fit_depth(given):
         return None
     how = ("no consistent factor" if given is None else f"{given.ratio:.2f}x"
            if given.consistent() else f"{given.ratio:.2f}x on average, the pairs disagreeing,")
@@ -194,25 +242,75 @@ Pairs = Sequence[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
 
 def poses_fit_depth(fit: ScaleFit | None) -> bool:
     """Whether the pairs agree that the depth moves as the poses do (within
-    :data:`TOLERANCE`): metric poses, metric depth."""
-    return fit is not None and fit.consistent() and abs(fit.ratio - 1.0) <= TOLERANCE
+    :meth:`ScaleFit.within_tolerance`): metric poses, metric depth."""
+    return fit is not None and fit.consistent() and fit.within_tolerance()
 
 
 def convention_problems(pairs: Pairs, k: CameraIntrinsics, fit: ScaleFit | None,
                         pose_source: str) -> list[str]:
     """When the poses do not fit the depth (``fit``, of ``pairs`` as :func:`fit_scale`
-    takes them): the problems of the poses' inverses or their translations in another
-    unit fitting it (:func:`inverted_poses_problem`, :func:`pose_units_problem`); empty
-    when the poses fit, or neither does."""
+    takes them): the problems of the poses' inverses, their translations in another unit
+    or their quaternions in another order fitting it (:func:`inverted_poses_problem`,
+    :func:`pose_units_problem`, :func:`quaternion_order_problem`); empty when the poses
+    fit, or none does."""
+    reordered_pairs = [(a, b, _wxyz_read_as_xyzw(p), _wxyz_read_as_xyzw(q))
+                       for a, b, p, q in pairs]
     if poses_fit_depth(fit):
-        return []
+        # the translation's factor can fit with the rotations wrong, on small steps: the
+        # surfaces of a pair then do not meet
+        read, other = median_gap(pairs, k), median_gap(reordered_pairs, k)
+        if read is None or other is None or other * GAP_CLEAR > read:
+            return []
+        order = quaternion_order_problem(None, fit_scale(reordered_pairs, k), pose_source,
+                                         (read, other))
+        return [order] if order is not None else []
     inverted = fit_scale([(a, b, np.linalg.inv(p), np.linalg.inv(q)) for a, b, p, q in pairs],
                          k)
     units = [(unit, fit_scale([(a, b, _in_metres(p, f), _in_metres(q, f))
                                for a, b, p, q in pairs], k)) for f, unit in POSE_UNITS]
+    reordered = fit_scale(reordered_pairs, k)
     found = (inverted_poses_problem(fit, inverted, pose_source),
-             pose_units_problem(units, pose_source))
+             pose_units_problem(units, pose_source),
+             quaternion_order_problem(fit, reordered, pose_source))
     return [x for x in found if x is not None]
+
+
+def _wxyz_read_as_xyzw(pose: np.ndarray) -> np.ndarray:
+    """``pose`` as it would be had its rotation's quaternion been written w x y z and read
+    x y z w (the read (x, y, z, w) is the written (w, x, y, z))."""
+    from scipy.spatial.transform import Rotation
+
+    read = Rotation.from_matrix(np.asarray(pose, float)[:3, :3]).as_quat()  # x y z w
+    out = np.array(pose, dtype=float)
+    out[:3, :3] = Rotation.from_quat([read[1], read[2], read[3], read[0]]).as_matrix()
+    return out
+
+
+def quaternion_order_problem(given: ScaleFit | None, reordered: ScaleFit | None,
+                             pose_source: str, gaps: tuple[float, float] | None = None
+                             ) -> str | None:
+    """When the poses with their quaternions read w x y z (``reordered``) move as the
+    depth does and the poses as read (``given``) do not, or (``gaps``: the pairs'
+    :func:`median_gap` as read and reordered, in m, the first :data:`GAP_CLEAR` times the
+    second or more) the surfaces of the pairs meet only so: quaternions written scalar
+    first (as Eigen and many tools print them), read scalar last as TUM's format has them.
+    The text; None otherwise."""
+    if not poses_fit_depth(reordered) or (gaps is None and poses_fit_depth(given)):
+        return None
+    assert reordered is not None
+    if gaps is not None:
+        how = (f"the surfaces seen from both meet within {1000 * gaps[1]:.1f} mm with them "
+               f"read w x y z, {1000 * gaps[0]:.1f} mm apart read x y z w")
+    else:
+        moves = ("no consistent factor" if given is None else f"{given.ratio:.2f}x"
+                 if given.consistent() else
+                 f"{given.ratio:.2f}x on average, the pairs disagreeing,")
+        how = (f"the depth moves {moves} as far as the poses read x y z w, and "
+               f"{reordered.ratio:.2f}x as far with them read w x y z")
+    return (f"the poses' quaternions ({pose_source}) look written w x y z: between "
+            f"{reordered.pairs} pairs of nearby frames {how}; sgtool reads x y z w "
+            "(qx qy qz qw, as TUM files have them): reorder the "
+            "columns, or give --estimate-poses to estimate the poses from the depth")
 
 
 def _in_metres(pose: np.ndarray, unit_m: float) -> np.ndarray:

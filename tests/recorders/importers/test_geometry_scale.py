@@ -39,12 +39,46 @@ def test_the_right_scale_passes(tmp_path):
         "depth moves 1.00x as far as the poses over 6 frame pairs")
 
 
+def test_depth_a_fifth_off_is_named_when_the_pairs_agree(tmp_path):
+    """Depth in 1/4000 m (a RealSense L515) read at TUM's 5000: 0.8x, which passed as within
+    20 % although every pair agreed within a few percent; the scene was 0.8x its size."""
+    root = make_scene_folder(tmp_path / "f", room(), POSES, units_per_m=4000.0)
+    with pytest.raises(SgtoolError, match=r"moves 0\.80x as far as the poses .*"
+                       r"--depth-scale 4000 fits"):
+        import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
+
+
+def test_quaternions_written_scalar_first_are_named(tmp_path):
+    """The ground truth's quaternions written qw qx qy qz (read qx qy qz qw): the poses
+    turn the wrong way; the import said the poses "may" be in another convention (a
+    warning) and then blamed the floor, whose advised --floor imported a wrong map."""
+    root = make_scene_folder(tmp_path / "f", room(), POSES)
+    gt = root / "groundtruth.txt"
+    lines = gt.read_text().splitlines()
+    out = [lines[0]]
+    for line in lines[1:]:
+        t, x, y, z, qx, qy, qz, qw = line.split()
+        out.append(" ".join((t, x, y, z, qw, qx, qy, qz)))
+    gt.write_text("\n".join(out) + "\n")
+    # the translations fit (0.91x, spread 0.31): the surfaces decide
+    with pytest.raises(SgtoolError, match=r"the poses' quaternions \(ground truth\) look "
+                       r"written w x y z: between 6 pairs of nearby frames the surfaces seen "
+                       r"from both meet within 0\.\d mm with them read w x y z, \d+\.\d mm "
+                       r"apart read x y z w; .*reorder the columns"):
+        import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
+
+
 def test_no_verdict_without_a_clear_consistent_ratio():
     assert geometric_scale_problem(None, 1000.0, "x", "ground truth") is None
     # geometry that does not move (a static scene under moving poses): no verdict
     assert geometric_scale_problem(ScaleFit(0.02, 6, 0.1), 1000.0, "x", "gt") is None
     assert geometric_scale_problem(ScaleFit(2.0, 6, 0.9), 1000.0, "x", "gt") is None  # spread
     assert geometric_scale_problem(ScaleFit(1.1, 6, 0.1), 1000.0, "x", "gt") is None
+    # a fifth off, the pairs agreeing closely: named; as loosely agreed, or on 3 pairs: not
+    assert "--depth-scale 4000 fits" in str(
+        geometric_scale_problem(ScaleFit(0.8, 6, 0.05), 5000.0, "x", "gt"))
+    assert geometric_scale_problem(ScaleFit(0.8, 6, 0.2), 5000.0, "x", "gt") is None
+    assert geometric_scale_problem(ScaleFit(0.8, 3, 0.05), 5000.0, "x", "gt") is None
     p = geometric_scale_problem(ScaleFit(0.2, 6, 0.1), 1000.0, "x", "gt")
     assert p is None  # at the bound: no verdict
     assert "--depth-scale 5000 fits" in str(
