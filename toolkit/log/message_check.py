@@ -79,33 +79,36 @@ def checkable(schema: Schema | None, channel: Channel) -> bool:
         and schema.encoding == "protobuf")
 
 
-def message_problem(schema: Schema | None, channel: Channel, data: bytes | memoryview
-                    ) -> str | None:
+def message_problem(schema: Schema | None, channel: Channel, data: bytes | memoryview,
+                    sgtool_log: bool = True) -> str | None:
     """Why message bytes ``data`` of ``channel`` do not decode and check as the reader
     and replay would read them (module doc), in a few words; None when they do, or when
-    the encoding is not :func:`checkable`."""
+    the encoding is not :func:`checkable`. In a file that is not an sgtool log
+    (``sgtool_log`` False) only whether they parse with their schema (protobuf) or as
+    JSON: its topics follow other conventions (a ``/tf`` of ``foxglove.FrameTransforms``,
+    image encodings sgtool does not decode), none of them wrong."""
     if not checkable(schema, channel):
         return None
-    if (problem := channel_problem(schema, channel)) is not None:
+    if sgtool_log and (problem := channel_problem(schema, channel)) is not None:
         return problem
     try:
         if channel.message_encoding == "json":
             value = json.loads(bytes(data))
-            kind = _RECORD_TOPICS.get(channel.topic)
+            kind = _RECORD_TOPICS.get(channel.topic) if sgtool_log else None
             if kind is not None:
                 from sgtool.log.records import RECORD_TYPES
 
                 RECORD_TYPES[kind.key].from_json(value, where=kind.schema_name)
             return None
         assert schema is not None
-        return _protobuf_problem(schema, bytes(data))
+        return _protobuf_problem(schema, bytes(data), sgtool_log)
     except LogFormatError as e:
         return str(e)[:200]
     except (ValueError, RecursionError) as e:
         return f"not JSON ({str(e)[:80]})"
 
 
-def _protobuf_problem(schema: Schema, data: bytes) -> str | None:
+def _protobuf_problem(schema: Schema, data: bytes, check_values: bool = True) -> str | None:
     from sgtool.log.reader import proto_class
 
     cls = proto_class(schema.name)
@@ -121,7 +124,7 @@ def _protobuf_problem(schema: Schema, data: bytes) -> str | None:
         msg.ParseFromString(data)
     except Exception as e:  # noqa: BLE001 - protobuf's DecodeError and kin
         return f"not a valid {schema.name[:60]} ({type(e).__name__}: {str(e)[:80]})"
-    check = _PROTO_CHECKS.get(schema.name)
+    check = _PROTO_CHECKS.get(schema.name) if check_values else None
     if check is not None:
         check(msg)  # LogFormatError naming the field
     return None

@@ -23,7 +23,7 @@ import io
 import mmap
 import os
 from collections import Counter
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Literal
@@ -33,6 +33,7 @@ from mcap.writer import CompressionType, Writer
 
 from sgtool.errors import LogFormatError, SgtoolError
 from sgtool.files import atomic_open
+from sgtool.log import schemas as S
 from sgtool.log.file_check import SummaryState, check, expected_messages, summary_state
 from sgtool.log.file_walk import Item, Layout, data_crc_matches, walk
 from sgtool.log.log_file import appended_end, require_regular_file
@@ -90,7 +91,8 @@ def _diagnose(buf: mmap.mmap, diag: Diagnosis, writer: _Copier | None) -> None:
     lay = Layout(diag.size if end is None else end)
     if writer is not None:
         writer.layout = lay
-    unknown = _consume(walk(buf, lay), diag, writer)
+    unknown = _consume(walk(buf, lay), diag, writer,
+                       lambda: lay.header is None or lay.header.profile == S.PROFILE)
     read = {c.offset: Counter((cid, t) for cid, t, _ in c.messages if cid not in unknown)
             for c in lay.chunks}
     read[_OUTSIDE_CHUNKS] = Counter((cid, t) for cid, t, _ in lay.loose if cid not in unknown)
@@ -196,10 +198,14 @@ def _summary_channels(lay: Layout) -> list[Channel]:
     return [r.record for r in lay.summary_records() if isinstance(r.record, Channel)]
 
 
-def _consume(items: Iterator[Item], diag: Diagnosis, writer: _Copier | None) -> set[int]:
+def _consume(items: Iterator[Item], diag: Diagnosis, writer: _Copier | None,
+             sgtool_log: Callable[[], bool] = lambda: True) -> set[int]:
     """Count (and copy) the records of ``items``; messages whose channel is defined
     nowhere before them wait for the summary copies. Returns the ids of channels defined
-    nowhere (their messages are lost)."""
+    nowhere (their messages are lost). Messages are checked as an sgtool log's when
+    ``sgtool_log()`` says the file is one (its header's profile, asked at the first
+    message; a file whose header is lost counts as one), else only as parsing
+    (:func:`~sgtool.log.message_check.message_problem`)."""
     schemas: dict[int, Schema] = {}
     channels: dict[int, Channel] = {}
     spare_schemas: dict[int, Schema] = {}
@@ -212,10 +218,14 @@ def _consume(items: Iterator[Item], diag: Diagnosis, writer: _Copier | None) -> 
     malformed: Counter[str] = Counter()  # intact bytes that fail their check as written
     first_malformed: dict[str, str] = {}
 
+    own: list[bool] = []  # whether the file is an sgtool log, once asked
+
     def take(it: Item, ch: Channel) -> None:
         r = it.record
         schema = schemas.get(ch.schema_id) or spare_schemas.get(ch.schema_id)
-        problem = message_problem(schema, ch, r.data)
+        if not own:
+            own.append(sgtool_log())
+        problem = message_problem(schema, ch, r.data, own[0])
         if problem is not None:
             count, first = (malformed, first_malformed) if it.covered else (dropped, first_drop)
             count[ch.topic] += 1

@@ -109,3 +109,59 @@ def test_diff_refuses_a_foreign_recording_in_one_line(tmp_path):
     r = CliRunner().invoke(cli, ["diff", str(bag / "cam.mcap"), str(log)])
     assert r.exit_code == 2 and len(r.output.strip().splitlines()) == 1
     assert "is a ROS 2 recording" in r.output
+
+
+def _foreign_mcap(path, profile: str = "") -> None:  # type: ignore[no-untyped-def]
+    """A valid MCAP file another tool might write: /tf as JSON (a foxglove.FrameTransform
+    JSON schema) and a foxglove.RawImage in 'uyvy', which sgtool does not decode."""
+    import json
+
+    from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
+    from mcap.writer import Writer
+
+    from sgtool.log.reader import proto_class
+
+    assert proto_class("foxglove.RawImage") is not None
+    with open(path, "wb") as f:
+        w = Writer(f)
+        w.start(profile=profile, library="another tool")
+        tf = w.register_channel("/tf", "json", w.register_schema(
+            "foxglove.FrameTransform", "jsonschema", json.dumps({"type": "object"}).encode()))
+        from google.protobuf import descriptor_pb2
+
+        fds = descriptor_pb2.FileDescriptorSet()
+        RawImage.DESCRIPTOR.file.CopyToProto(fds.file.add())
+        from google.protobuf.timestamp_pb2 import Timestamp
+
+        Timestamp.DESCRIPTOR.file.CopyToProto(fds.file.add())
+        img = w.register_channel("/front/image", "protobuf", w.register_schema(
+            "foxglove.RawImage", "protobuf", fds.SerializeToString()))
+        for i in range(3):
+            t = 1_000_000_000 + i * 100_000_000
+            w.add_message(tf, t, json.dumps({"parent_frame_id": "map", "child_frame_id": "base",
+                                             "translation": {"x": i}}).encode(), t)
+            raw = RawImage(width=2, height=2, encoding="uyvy", step=4, data=bytes(8))
+            w.add_message(img, t, raw.SerializeToString(), t)
+        w.finish()
+
+
+def test_doctor_keeps_a_foreign_files_valid_messages(tmp_path):
+    """Another tool's /tf (JSON) and a 'uyvy' RawImage are valid MCAP: doctor called the
+    file corrupt ("written malformed", sgtool's own reading of /tf applied) and --recover
+    dropped them. Only an sgtool log is held to sgtool's reading of its topics."""
+    f = tmp_path / "other.mcap"
+    _foreign_mcap(f)
+    r = CliRunner().invoke(cli, ["doctor", str(f), "--recover", str(tmp_path / "r.mcap")])
+    assert r.exit_code == 0, r.output
+    assert "complete" in r.output.splitlines()[0]
+    assert "readable: 6 messages on 2 channels" in r.output
+    from mcap.reader import make_reader
+
+    with open(tmp_path / "r.mcap", "rb") as fh:
+        assert sum(1 for _ in make_reader(fh).iter_messages()) == 6
+    # the same file calling itself an sgtool log is held to sgtool's reading
+    own = tmp_path / "own.mcap"
+    _foreign_mcap(own, profile="sgtool")
+    r = CliRunner().invoke(cli, ["doctor", str(own)])
+    assert r.exit_code == 1 and "sgtool reads /tf as protobuf foxglove.FrameTransform" \
+        in r.output
