@@ -355,6 +355,9 @@ def _write(r: LogReader, w: BagWriter, chosen: list[str], base_ns: int,
                 w.transform_stamped(t0, p, c, T) for (p, c), T in sorted(static.items())]),
                 latched=True)
         calib: CameraIntrinsics | None = None
+        # images of one log time met before any calibration: their camera_info is written
+        # when a calibration of that log time follows (MCAP orders no messages of one time)
+        waiting: list[tuple[str, int, str]] = []  # (namespace, stamp, frame id)
         converters = _converters(w)
         # a mounting that moves at times (on the log's /tf_static, then on /tf): its
         # latest value and the stamp it was last written at
@@ -363,8 +366,13 @@ def _write(r: LogReader, w: BagWriter, chosen: list[str], base_ns: int,
             if progress is not None:
                 progress.update(1)
             t = d.log_time_ns + base_ns
+            if waiting and waiting[0][1] != t:
+                waiting.clear()  # no calibration at their time: as before, none for them
             if d.topic == S.CALIBRATION:
                 calib = codec.decode_calibration(d.message)
+                for ns, at, frame in waiting:
+                    w.write(f"{ns}/camera_info", INFO, at, w.camera_info(at, frame, calib))
+                waiting.clear()
             elif d.topic in (S.TF, TF_STATIC):
                 key = (d.message.parent_frame_id, d.message.child_frame_id)
                 if key in static or S.TF not in want:
@@ -384,9 +392,12 @@ def _write(r: LogReader, w: BagWriter, chosen: list[str], base_ns: int,
                         w.write(S.TF, TF_TYPE, t, w.tf(t, [w.transform_stamped(t, *key, T)]))
                 if f"{ns}/image_raw" in want:
                     w.write(f"{ns}/image_raw", IMAGE, t, _image(w, t, d.message))
-                if f"{ns}/camera_info" in want and calib is not None:
-                    w.write(f"{ns}/camera_info", INFO, t,
-                            w.camera_info(t, d.message.frame_id or S.CAMERA_FRAME, calib))
+                if f"{ns}/camera_info" in want:
+                    frame = d.message.frame_id or S.CAMERA_FRAME
+                    if calib is not None:
+                        w.write(f"{ns}/camera_info", INFO, t, w.camera_info(t, frame, calib))
+                    else:
+                        waiting.append((ns, t, frame))
             else:
                 for dst, make in converters[d.topic]:
                     if dst in want:

@@ -390,3 +390,39 @@ def test_trajectory_frames_leave_other_logs_alone():
     assert trajectory_frames({"content": "frames", "pose_frame": "x"}, REP105) == REP105
     got = trajectory_frames({"content": "trajectory", "pose_frame": "base_link"}, REP105)
     assert got == {S.WORLD_FRAME: "map", S.CAMERA_FRAME: "base_link"}  # no clash with base
+
+
+def test_a_calibration_logged_after_the_images_of_its_time_still_gives_camera_info(
+        tmp_path):
+    """MCAP orders no messages of one log time; a log rewritten with the calibration after
+    the images of the same time (as a ROS driver publishes camera_info after image) lost
+    the first frame's CameraInfo of every camera."""
+    from mcap.reader import make_reader
+    from mcap.writer import Writer
+
+    log = log_with_rooms(tmp_path / "d.mcap")
+    late = tmp_path / "late.mcap"
+    with open(log, "rb") as f:
+        r = make_reader(f)
+        summary, header = r.get_summary(), r.get_header()
+        assert summary is not None
+        msgs = sorted(r.iter_messages(log_time_order=True),
+                      key=lambda m: (m[2].log_time, m[1].topic == S.CALIBRATION))
+        metadata = [(m.name, dict(m.metadata)) for m in r.iter_metadata()]
+    with open(late, "wb") as f:
+        w = Writer(f)
+        w.start(profile=header.profile, library=header.library)
+        sid = {k: w.register_schema(s.name, s.encoding, s.data)
+               for k, s in summary.schemas.items()}
+        cid = {k: w.register_channel(c.topic, c.message_encoding, sid.get(c.schema_id, 0),
+                                     dict(c.metadata)) for k, c in summary.channels.items()}
+        for name, data in metadata:
+            w.add_metadata(name, data)
+        for _, c, m in msgs:
+            w.add_message(cid[c.id], m.log_time, m.data, m.publish_time, m.sequence)
+        w.finish()
+    got = read_bag(export_bag(late, tmp_path / "o.bag").output)
+    for ns in ("rgb", "depth", "instances"):
+        images = [t for t, _ in got[f"/camera/{ns}/image_raw"]]
+        infos = [t for t, _ in got[f"/camera/{ns}/camera_info"]]
+        assert infos == images and len(images) == 4
