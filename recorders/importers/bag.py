@@ -61,7 +61,7 @@ from sgtool.recorders.importers.bag_sync import PlannedFrame, plan_frames, plann
 from sgtool.recorders.importers.bag_topics import check_flags, describe_bag, with_only_info
 from sgtool.recorders.importers.distortion import distortion_finding
 from sgtool.recorders.importers.floor import floor_confidence_problem, frame_floor_problem
-from sgtool.recorders.importers.focal_check import check_focal, turn_pairs
+from sgtool.recorders.importers.focal_check import check_focal, ray_depth_problem, turn_pairs
 from sgtool.recorders.importers.images import ResizeLog, depth_to_metres
 from sgtool.recorders.importers.odometry import (
     DriftReport,
@@ -266,11 +266,14 @@ def _check_poses(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
     fit = fit_scale(pairs, k)
     if fit is not None:
         checks.append(("depth scale against the poses", fit.describe()))
-    focal, problem, explains = check_focal(
-        bag_scale_pairs(reader, idx, opts, src, k, turn_pairs), pairs, k, fit,
-        _intrinsics_origin(opts))
+    turned = bag_scale_pairs(reader, idx, opts, src, k, turn_pairs)
+    focal, problem, explains = check_focal(turned, pairs, k, fit, _intrinsics_origin(opts))
     if focal is not None:
         checks.append(("focal length against the poses", focal.describe()))
+    ray = ray_depth_problem(turned, k, focal, f"--depth {opts.depth}")
+    if ray is not None:
+        findings.warning(ray)
+        return
     findings.problem(problem, given=opts.intrinsics is not None)
     if explains:
         return

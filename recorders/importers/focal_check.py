@@ -33,6 +33,7 @@ from sgtool.recorders.importers.scale_check import (
     Pairs,
     ScaleFit,
     fit_scale,
+    median_gap,
     poses_fit_depth,
     surface_gap,
 )
@@ -159,3 +160,32 @@ def check_focal(turned: Pairs, nearby: Pairs, k: CameraIntrinsics, fit: ScaleFit
     if poses_fit_depth(fit_scale(nearby, dataclasses.replace(k, fx=k.fx * c, fy=k.fy * c))):
         return focal, problem, True
     return focal, None, False
+
+
+def along_axis(depth: np.ndarray, k: CameraIntrinsics) -> np.ndarray:
+    """``depth`` (metres) read as each pixel's distance along its ray, as the depth along
+    the optical axis: ``d / sqrt(1 + ((u - cx) / fx)^2 + ((v - cy) / fy)^2)``."""
+    v, u = np.mgrid[0:depth.shape[0], 0:depth.shape[1]]
+    return depth / np.sqrt(1.0 + ((u - k.cx) / k.fx) ** 2 + ((v - k.cy) / k.fy) ** 2)
+
+
+def ray_depth_problem(turned: Pairs, k: CameraIntrinsics, focal: FocalFit | None,
+                      origin: str) -> str | None:
+    """When the ``turned`` pairs' surfaces meet :data:`CLEAR` times closer with their
+    depth read as distances along each pixel's ray (:func:`along_axis`; as many renderers
+    and ICL-NUIM's raw files store it) than as given, and closer than with the focal
+    length ``focal`` found: the text (depth from ``origin``); None otherwise (fewer than
+    :data:`MIN_PAIRS` pairs, or no such gain)."""
+    if focal is None or focal.pairs < MIN_PAIRS:
+        return None
+    as_given = median_gap(turned, k)
+    as_ray = median_gap([(along_axis(a, k), along_axis(b, k), p, q) for a, b, p, q in turned],
+                        k)
+    if as_given is None or as_ray is None or as_ray * CLEAR > as_given or \
+            1000 * as_ray > focal.gap_mm:
+        return None
+    return (f"depth ({origin}) looks like each pixel's distance along its ray, not the depth "
+            f"along the optical axis that sgtool reads: between {focal.pairs} pairs of turned "
+            f"frames the surfaces seen from both meet within {1000 * as_ray:.1f} mm read so, "
+            f"{1000 * as_given:.1f} mm apart as given; convert each pixel first (z = d / "
+            "sqrt(1 + ((u - cx) / fx)^2 + ((v - cy) / fy)^2))")

@@ -43,6 +43,7 @@ from sgtool.recorders.importers.floor import floor_confidence_problem, frame_flo
 from sgtool.recorders.importers.focal_check import (
     FocalFit,
     check_focal,
+    ray_depth_problem,
     turn_pairs,
 )
 from sgtool.recorders.importers.images import (
@@ -282,6 +283,10 @@ def check_scale_by_geometry(frames: list[FolderFrame], k: CameraIntrinsics, scal
     turned = [p for p in depth_pairs(turn_pairs(poses))
               if p[0].shape == p[1].shape == (k.height, k.width)]
     focal, problem, explains = check_focal(turned, pairs, k, fit, intrinsics[0])
+    ray = ray_depth_problem(turned, k, focal, "the depth images")
+    if ray is not None:
+        findings.warning(ray)
+        return fit, focal
     findings.problem(problem, given=intrinsics[1])
     if explains:
         return fit, focal

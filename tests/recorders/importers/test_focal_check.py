@@ -104,3 +104,24 @@ def test_a_wrong_intrinsics_file_is_refused_before_any_work(rgbd_data: Path,
                        r"focal length looks 1\.3\dx too short: .* fx, fy 5[23]\d"):
         import_rgbd(folder, tmp_path / "i.mcap", RgbdOptions(progress=False, every=3))
     assert not (tmp_path / "i.mcap").exists()
+
+
+def test_depth_stored_along_each_ray_is_named(tmp_path: Path) -> None:
+    """Depth stored as each pixel's distance along its ray (as renderers and ICL-NUIM's raw
+    files do): every check passed (the scale 1.0x, the focal length's best gap not 2.5x
+    below) and the map bent. Read back along the optical axis the surfaces meet."""
+    import cv2
+
+    from sgtool.recorders.importers.focal_check import along_axis
+
+    root = make_scene_folder(tmp_path / "f", room(), POSES)
+    for png in sorted((root / "depth").glob("*.png")):
+        z = cv2.imread(str(png), cv2.IMREAD_UNCHANGED).astype(float)
+        ray = z / along_axis(np.ones_like(z), TRUE_K)  # z * sqrt(1 + x^2 + y^2)
+        cv2.imwrite(str(png), np.round(ray).astype(np.uint16))
+    right = PinholeParams(TRUE_K.fx, TRUE_K.fy, TRUE_K.cx, TRUE_K.cy)
+    rep = import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=right, progress=False))
+    (w,) = [w for w in rep.warnings if "distance along its ray" in w]
+    assert w.startswith("depth (the depth images) looks like each pixel's distance along its "
+                        "ray, not the depth along the optical axis")
+    assert "intrinsics" not in " ".join(rep.warnings)  # not blamed on the focal length
