@@ -15,6 +15,7 @@ Parsing errors are user errors naming the file and the line.
 
 from __future__ import annotations
 
+import io
 import json
 import math
 import re
@@ -43,7 +44,7 @@ MAX_TIME_NS = 2**63 - 1  # the largest time a log (int64 nanoseconds) holds: yea
 
 def _data_lines(path: Path) -> list[tuple[int, list[str]]]:
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark (Notepad) dropped
     except UnicodeDecodeError as e:
         raise SgtoolError(f"{path} is not a text file") from e
     out = []
@@ -225,17 +226,33 @@ def read_intrinsics_file(path: Path) -> PinholeParams:
             ) from e
         if any(v is not None and v <= 0 for v in size):
             raise SgtoolError(f"{path}: image size {w}x{h} is not positive")
+        if _transposed(m):
+            raise SgtoolError(
+                f"{path}: 'intrinsic_matrix' reads as [[fx 0 cx] [0 fy cy] [0 0 1]] only "
+                "transposed: Open3D lists it column by column (fx, 0, 0, 0, fy, 0, cx, cy, "
+                "1); this one is row by row: reorder it")
         return checked_pinhole(m[0, 0], m[1, 1], m[0, 2], m[1, 2], str(path), width=size[0],
                                height=size[1], source=str(path.name))
     try:
-        m = np.loadtxt(path, dtype=np.float64)
+        text = path.read_text(encoding="utf-8-sig", errors="replace")
+        m = np.loadtxt(io.StringIO(text), dtype=np.float64,
+                       delimiter="," if "," in text else None)
     except ValueError:
         raise SgtoolError(f"{path}: expected a 3x3 camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]] "
                           "(three rows of three numbers), or Open3D intrinsics JSON") from None
+    if m.shape == (3, 3) and _transposed(m):
+        raise SgtoolError(f"{path}: a 3x3 camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]] "
+                          "written transposed (cx, cy in its last row): transpose it")
     if m.shape != (3, 3) or abs(m[2, 2] - 1.0) > 1e-6 or m[0, 0] <= 0 or m[1, 1] <= 0:
         raise SgtoolError(f"{path}: expected a 3x3 camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]]")
     return checked_pinhole(m[0, 0], m[1, 1], m[0, 2], m[1, 2], str(path),
                            source=str(path.name))
+
+
+def _transposed(m: np.ndarray) -> bool:
+    """Whether the camera matrix ``m`` as read has its principal point in the last row
+    and nothing in the last column: the matrix written transposed."""
+    return bool((m[2, 0] != 0 or m[2, 1] != 0) and m[0, 2] == 0 and m[1, 2] == 0)
 
 
 def parse_intrinsics(text: str) -> PinholeParams:

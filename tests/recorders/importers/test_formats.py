@@ -103,6 +103,30 @@ def test_intrinsics_from_json_matrix_and_text(tmp_path: Path):
         textformats.parse_intrinsics("500,501")
 
 
+def test_transposed_matrices_are_named_and_commas_and_byte_order_marks_read(tmp_path: Path):
+    """A K written transposed, or an Open3D matrix listed row by row, read as cx = cy = 0
+    and was blamed on "intrinsics of 8x8 images"; a K with commas was refused as not three
+    rows of three numbers; a list file saved with a byte-order mark failed on its first
+    line."""
+    t = tmp_path / "K.txt"
+    t.write_text("525 0 0\n0 525 0\n319.5 239.5 1\n")
+    with pytest.raises(SgtoolError, match=r"K.txt: a 3x3 camera matrix .* written transposed"):
+        textformats.read_intrinsics_file(t)
+    j = tmp_path / "cam.json"
+    j.write_text('{"width": 640, "height": 480, "intrinsic_matrix": '
+                 '[525.0, 0, 319.5, 0, 525.0, 239.5, 0, 0, 1]}')
+    with pytest.raises(SgtoolError, match=r"only transposed: Open3D lists it column by "
+                       r"column .* this one is row by row"):
+        textformats.read_intrinsics_file(j)
+    t.write_text("585, 0, 320\n0, 586, 240\n0, 0, 1\n")
+    p = textformats.read_intrinsics_file(t)
+    assert (p.fx, p.fy, p.cx, p.cy) == (585, 586, 320, 240)
+    lst = tmp_path / "rgb.txt"
+    lst.write_text("\ufeff# rgb\n1305031102.175304 rgb/1305031102.175304.png\n",
+                   encoding="utf-8")
+    assert textformats.read_tum_list(lst) == [(1305031102175304000, "rgb/1305031102.175304.png")]
+
+
 # ----- poses ------------------------------------------------------------------------------------
 def test_interpolation_halfway_in_rotation_and_translation():
     a = np.eye(4)
