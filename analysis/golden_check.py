@@ -38,6 +38,7 @@ from sgtool.errors import SgtoolError
 from sgtool.files import (
     atomic_output,
     deferred_interrupts,
+    output_error,
     output_folder,
     quoted,
     read_manifest,
@@ -266,7 +267,13 @@ def pin_logs(logs: Sequence[str | Path] | str | Path, folder: str | Path,
             stored = f"{name}.mcap" if copy else stored_path(p, root)
             if copies.get(name) == "copy":
                 with atomic_output(out / stored) as tmp:
-                    shutil.copyfile(p, tmp)
+                    try:
+                        shutil.copyfile(p, tmp)
+                    except OSError as e:  # it names the file read; the copy is what failed
+                        if isinstance(e, (FileNotFoundError, PermissionError)) and \
+                                e.filename == str(p):
+                            raise
+                        raise output_error(e, root / stored) from None
             was = old.get(name)
             ours = copies.get(name) == "copy" or (copies.get(name) == "keep" and
                                                    was is not None and bool(was.copied))

@@ -196,7 +196,8 @@ def options_from(d: Mapping[str, Any], where: str) -> ReplayOptions:
     unknown = set(d) - known
     if unknown:
         raise PinError(f"{where}: replay option {sorted(unknown)[0]!r} is unknown to this "
-                       f"sgtool ({__version__}); upgrade sgtool, or pin again")
+                       f"sgtool ({__version__}); upgrade sgtool, or pin the logs again into "
+                       "a new folder")
     for k, v in sorted(d.items()):
         kinds = _OPTION_TYPES.get(k, (object,))
         if v is not None and (isinstance(v, bool) or not isinstance(v, kinds)):
@@ -288,7 +289,8 @@ def read_pins(folder: str | os.PathLike[str]) -> PinSet:
         raise _damaged(path, f"format {fmt!r} is no version number")
     if fmt > PIN_FORMAT:
         raise PinError(f"{path}: pin format {fmt} is newer than this sgtool reads (format "
-                       f"{PIN_FORMAT}, sgtool {__version__}); upgrade sgtool, or pin again")
+                       f"{PIN_FORMAT}, sgtool {__version__}); upgrade sgtool, or pin the "
+                       "logs again into a new folder (this one is left as it is)")
     common = doc.get("replay", {}) if fmt == 1 else {}
     logs: dict[str, Pinned] = {}
     for name, entry in sorted(doc["cases"].items()):

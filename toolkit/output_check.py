@@ -33,8 +33,9 @@ def check_output(path: str | os.PathLike[str], *, force: bool = False, option: s
     if p.exists() and not force:
         raise SgtoolError(f"{p} exists; not overwriting it (use {force_flag})")
     if p.exists() and not p.is_file():  # a device, FIFO or socket: a rename would replace it
-        raise SgtoolError(f"{option} {p} is not a regular file; not replacing it, even with "
-                          "--force")
+        raise SgtoolError(f"{option} {p} is not a regular file (a device, pipe or socket): "
+                          "outputs are written beside it and renamed into place, which would "
+                          "replace it; give a file's path")
     _probe_folder(p)
     return p
 

@@ -222,6 +222,8 @@ def test_a_newer_pin_format_is_refused_naming_both_versions(pinned, capsys):
     code, _, err = sgtool(capsys, "golden", "check", "--dir", pinned)
     assert code == 2 and err.count("\n") == 1
     assert f"pin format {PIN_FORMAT + 1} is newer" in err and f"(format {PIN_FORMAT}," in err
+    # its advice is no loop: pinning again into the same folder is refused the same way
+    assert "pin the logs again into a new folder" in err
 
 
 def test_check_on_two_workers_reports_as_one(pinned, capsys):
@@ -717,3 +719,19 @@ def test_a_file_an_older_index_pinned_is_not_replaced_by_a_copy(pinned, log, tmp
     shutil.copyfile(log, mine / "small.mcap")
     assert sgtool(capsys, "golden", "pin", mine / "small.mcap", "--dir", mine, *FRAMES)[0] == 0
     assert json.loads((mine / "expected.json").read_text())["cases"]["small"]["copied"] is False
+
+
+def test_a_copy_into_a_full_folder_names_the_copy(log, tmp_path, capsys, monkeypatch):
+    """A --copy that fails for want of space named the log read ("No space left on
+    device: LOG"), not the pin folder's file it could not write; nothing is pinned."""
+    import errno
+
+    def full(src, dst, *a, **k):  # type: ignore[no-untyped-def]
+        raise OSError(errno.ENOSPC, "No space left on device", str(src))
+
+    monkeypatch.setattr(shutil, "copyfile", full)
+    folder = tmp_path / "g"
+    code, _, err = sgtool(capsys, "golden", "pin", log, "--dir", folder, "--copy", *FRAMES)
+    assert code == 2 and err.count("\n") == 1
+    assert f"cannot write {folder / 'small.mcap'}: No space left on device" in err
+    assert not (folder / "expected.json").exists()

@@ -103,6 +103,9 @@ def test_a_fifo_is_never_replaced_even_with_force(tmp_path):
     err = _refusal(["doctor", str(GOLDEN_LOG), "--recover", str(fifo), "--force"])
     assert "not a regular file" in err
     assert fifo.exists() and not fifo.is_file()
+    # a command without --force is not told of one (golden check --junit /dev/stdout was)
+    err = _refusal(["golden", "check", "--dir", str(tmp_path), "--junit", str(fifo)])
+    assert "not a regular file (a device, pipe or socket)" in err and "--force" not in err
 
 
 def test_a_rerun_recording_must_be_named_rrd(tmp_path):
