@@ -57,6 +57,24 @@ def unended_problem(path: Path, size: int) -> str:
             f"written); {recover}")
 
 
+def magic_problem(path: Path) -> tuple[int, str | None]:
+    """The size of the MCAP file ``path`` and the one line when it does not start and end
+    with the MCAP magic (None when it does): not an MCAP file; one whose opening magic is
+    damaged but that ends as an MCAP file does; or :func:`unended_problem`'s."""
+    with open(path, "rb") as f:
+        opening = f.read(8)
+        size = f.seek(0, os.SEEK_END)
+        f.seek(max(size - 8, 0))
+        closing = f.read(8) if size >= 16 else b""
+    if opening != MAGIC:
+        return size, (f"{path}: not an MCAP file (it does not start with the MCAP magic bytes)"
+                      if closing != MAGIC else
+                      f"{path}: its opening MCAP magic bytes are damaged (it ends as an MCAP "
+                      f"file does); `sgtool doctor {quoted(path)} --recover OUT.mcap` "
+                      "recovers what is readable")
+    return size, None if closing == MAGIC else unended_problem(path, size)
+
+
 def require_regular_file(path: Path) -> None:
     """:class:`LogFormatError` unless ``path`` is a regular file (it must exist)."""
     mode = os.stat(path).st_mode

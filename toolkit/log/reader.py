@@ -45,7 +45,7 @@ from sgtool.log.chunk_copy import RawChunk, raw_chunk
 from sgtool.log.frame import CameraIntrinsics, Frame
 from sgtool.log.frame_assembly import FRAME_TOPICS, FrameAssembler, TransformBuffer, decoded
 from sgtool.log.image_wire import parse_raw_image
-from sgtool.log.log_file import require_regular_file, unended_problem
+from sgtool.log.log_file import magic_problem, require_regular_file
 from sgtool.log.records import LogRecord, record_type
 from sgtool.log.summary_check import BoundedReader, check_summary, read_attachment, read_footer
 from sgtool.vocabulary import RecordName
@@ -56,7 +56,6 @@ if TYPE_CHECKING:
 R = TypeVar("R", bound=LogRecord)
 
 _PROTO_CLASSES: dict[str, Any] = {}
-_MAGIC = bytes([137, 77, 67, 65, 80, 48, 13, 10])
 
 
 def proto_class(schema_name: str) -> Any:
@@ -112,16 +111,9 @@ class LogReader:
         if self.path.is_dir():
             raise LogFormatError(f"{self.path} is a folder; expected an MCAP file")
         require_regular_file(self.path)
-        with open(self.path, "rb") as f:
-            if f.read(8) != _MAGIC:
-                raise LogFormatError(
-                    f"{self.path}: not an MCAP file (it does not start with the MCAP magic bytes)"
-                )
-            f.seek(0, os.SEEK_END)
-            size = f.tell()
-            f.seek(max(size - 8, 0))
-            if size < 16 or f.read(8) != _MAGIC:
-                raise LogFormatError(unended_problem(self.path, size))
+        size, problem = magic_problem(self.path)
+        if problem is not None:
+            raise LogFormatError(problem)
         self.size = size
         # reads are clamped to the file: a damaged length cannot allocate gigabytes
         self._f = BoundedReader(io.FileIO(self.path, "rb"), size)

@@ -178,20 +178,31 @@ def scan(path: str | os.PathLike[str]) -> Diagnosis:
     if not p.exists():
         raise LogFormatError(f"{p}: no such file")
     require_regular_file(p)
-    _require_magic(p)
-    diag = Diagnosis(str(p), p.stat().st_size)
+    opening = _require_magic(p)
+    diag = Diagnosis(str(p), p.stat().st_size, problems=[opening] if opening else [])
     with open(p, "rb") as f, _mapped(f, diag.size) as buf:
         _diagnose(buf, diag, None)
     return diag
 
 
-def _require_magic(p: Path) -> None:
-    """A file that does not even start like an MCAP file is not a damaged log: say so."""
+def _require_magic(p: Path) -> str | None:
+    """A file that does not even start like an MCAP file is not a damaged log: say so. One
+    whose opening magic bytes are damaged but that is an MCAP file otherwise (its closing
+    magic, a header record after the opening one, or the opening bytes off by a few) is:
+    the problem to name (None when the opening magic is intact)."""
     with open(p, "rb") as f:
-        head = f.read(8)
-    if head != MAGIC:
-        raise LogFormatError(f"{p}: not an MCAP file (it does not start with the MCAP magic "
-                             "bytes): there is no log to check or recover")
+        head = f.read(9)
+        size = f.seek(0, os.SEEK_END)
+        f.seek(max(size - 8, 0))
+        tail = f.read(8)
+    if head[:8] == MAGIC:
+        return None
+    near = len(head) >= 8 and sum(a != b for a, b in zip(head[:8], MAGIC, strict=True)) <= 3
+    if size >= 17 and (near or tail == MAGIC or head[8:9] == b"\x01"):
+        return (f"the opening magic bytes are damaged ({head[:8].hex(' ')} instead of "
+                f"{MAGIC.hex(' ')})")
+    raise LogFormatError(f"{p}: not an MCAP file (it does not start with the MCAP magic "
+                         "bytes): there is no log to check or recover")
 
 
 def _summary_channels(lay: Layout) -> list[Channel]:
@@ -378,8 +389,8 @@ def recover(path: str | os.PathLike[str], out: str | os.PathLike[str],
     if dst.exists() and os.path.samefile(src, dst):
         raise SgtoolError(f"refusing to write the recovered log over its input {src}")
     check_log_output(dst, force=overwrite, option="--recover")
-    _require_magic(src)
-    diag = Diagnosis(str(src), src.stat().st_size)
+    opening = _require_magic(src)
+    diag = Diagnosis(str(src), src.stat().st_size, problems=[opening] if opening else [])
     with open(src, "rb") as f, _mapped(f, diag.size) as buf, atomic_open(dst, "wb") as o:
         copier = _Copier(o)
         _diagnose(buf, diag, copier)

@@ -50,6 +50,29 @@ def test_a_flip_in_the_first_chunk_loses_only_that_chunk(log40, tmp_path):
             list(r.frames())
 
 
+def test_a_damaged_opening_magic_is_a_corrupt_log_that_recovers(log40, tmp_path):
+    """One flipped bit in the opening magic: doctor said "not an MCAP file" (exit 2, the
+    usage error's) and recovered nothing, though every chunk was intact."""
+    from click.testing import CliRunner
+
+    from sgtool.cli import cli
+
+    bad = _flipped(log40, tmp_path, 3)
+    d = scan(bad)
+    assert d.status == "corrupt" and d.lost_messages == 0
+    assert d.problems[0].startswith("the opening magic bytes are damaged (89 4d 43 51")
+    full = scan(log40)
+    assert recover(bad, tmp_path / "rec.mcap").readable_messages == full.readable_messages
+    assert scan(tmp_path / "rec.mcap").status == "complete"
+    r = CliRunner().invoke(cli, ["info", str(bad)])
+    assert r.exit_code == 2 and "its opening MCAP magic bytes are damaged" in r.output
+    assert "--recover OUT.mcap` recovers" in r.output
+    text = tmp_path / "t.mcap"
+    text.write_bytes(b"not a log at all, just some text")
+    with pytest.raises(LogFormatError, match="not an MCAP file"):
+        scan(text)
+
+
 def test_doctor_reports_the_losses(log40, tmp_path):
     from click.testing import CliRunner
 
