@@ -313,13 +313,16 @@ def _read_tum(
     track = None
     if gt_path.is_file():
         # ground truth at ~100 Hz: interpolate over gaps up to 0.1 s, no extrapolation
-        # beyond 10 ms (the motion-capture system loses markers now and then)
+        # beyond 10 ms (the motion-capture system loses markers now and then); a slower
+        # trajectory (5-10 Hz from a SLAM system) over gaps of 2.5 of its steps, to 0.5 s
         samples = read_tum_trajectory(gt_path)
         if not samples and not keep_unposed:
             raise SgtoolError(f"{gt_path}: holds no poses (TUM lines: time tx ty tz qx qy qz "
                               "qw); give a trajectory, or --estimate-poses")
-        track = PoseTrack.from_samples(samples, max_gap_ns=100_000_000,
-                                       tolerance_ns=10_000_000) if samples else None
+        step = float(np.median(np.diff(sorted(t for t, _ in samples)))) if len(samples) > 1 else 0.0
+        track = PoseTrack.from_samples(
+            samples, max_gap_ns=int(min(max(100_000_000, 2.5 * step), 500_000_000)),
+            tolerance_ns=10_000_000) if samples else None
     frames = []
     no_rgb = no_pose = 0
     for t, name in depth:

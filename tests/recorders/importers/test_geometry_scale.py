@@ -208,3 +208,20 @@ def test_pose_motion_problem_needs_a_clear_disagreement():
     # a camera panning on a tripod (2.5 cm a pair, hidden by depth noise): likely only
     assert pose_motion_problem(ScaleFit(-0.04, 5, 37.0, step_m=0.025), "gt")[1] is False  # type: ignore[index]
     assert pose_motion_problem(ScaleFit(0.1, 6, 0.2), "gt") is None  # a scale: the pairs agree
+
+
+def test_a_five_hertz_ground_truth_is_interpolated(tmp_path):
+    """A ground truth at 5 Hz (a SLAM system's, not a motion-capture system's 100 Hz) was
+    refused as not covering the frames' time: the folder reader interpolated over gaps of
+    0.1 s only. Gaps of 2.5 of the trajectory's steps are bridged (to 0.5 s)."""
+    from sgtool.log import LogReader
+
+    root = make_scene_folder(tmp_path / "f", room(), POSES)  # 30 fps, ground truth per frame
+    gt = root / "groundtruth.txt"
+    lines = gt.read_text().splitlines()
+    gt.write_text("\n".join([lines[0], *lines[1::6]]) + "\n")  # every 6th pose: 5 Hz
+    rep = import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
+    assert rep.frames == 19  # frames 0 to 18 lie within the trajectory's span (0 to 18)
+    with LogReader(tmp_path / "a.mcap") as r:
+        first = next(iter(r.frames()))
+    assert first.pose is not None
