@@ -544,6 +544,10 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
                 f"{root}: several trajectories ({', '.join(p.name for p in logs)}); "
                 "choose one with --trajectory"
             )
+    if traj is None and (root / "groundtruth.txt").is_file():
+        notes.append("groundtruth.txt not read: a folder of depth/ and colour folders is read "
+                     "as the open3d layout (poses from a *.log trajectory, image times from "
+                     "their order); a TUM folder lists its images in rgb.txt and depth.txt")
     unpaired = sorted({c.stem for c in colors} - {d.stem for d in depths}, key=natural_key)
     hint = (f" ({len(unpaired)} colour images have no depth image; first: depth/{unpaired[0]}.*"
             f" for {by_stem[unpaired[0]].relative_to(root)}"

@@ -302,10 +302,12 @@ def trajectory_poses(trajectory: Path | None, count: int, hint: str = "",
         return None
     if not trajectory.is_file():
         raise SgtoolError(f"--trajectory {trajectory}: no such file")
-    if is_open3d_log(trajectory):
-        poses = read_open3d_log(trajectory)
-    else:
-        poses = [T for _, T in read_tum_trajectory(trajectory)]
+    timed = not is_open3d_log(trajectory)
+    poses = ([T for _, T in read_tum_trajectory(trajectory)] if timed
+             else read_open3d_log(trajectory))
     if len(poses) not in (count, also) and not (shorter and 0 < len(poses) < count):
-        raise SgtoolError(f"{trajectory} has {len(poses)} poses for {count} frames{hint}")
+        raise SgtoolError(f"{trajectory} has {len(poses)} poses for {count} frames{hint}"
+                          + ("; this layout takes a TUM trajectory's lines one per frame, in "
+                             "order, its times unused (a TUM folder, with rgb.txt and "
+                             "depth.txt, pairs them by time)" if timed else ""))
     return poses

@@ -78,6 +78,21 @@ def test_unpadded_names_sort_by_number_and_keep_their_poses(tmp_path):
         ["2.png", "10.png", "frame-1.png"]
 
 
+def test_a_tum_ground_truth_in_an_open3d_folder_is_said_to_be_unread(tmp_path):
+    """A TUM folder without rgb.txt and depth.txt reads as the open3d layout: its
+    groundtruth.txt was ignored without a word (the poses then estimated, the times lost)."""
+    root = open3d_folder(tmp_path / "f", ["0", "1", "2"])
+    (root / "traj.log").unlink()
+    (root / "groundtruth.txt").write_text("".join(f"{t}.0 0 0 0 0 0 0 1\n" for t in range(5)))
+    notes = read_sequence(root).notes
+    assert any(n.startswith("groundtruth.txt not read: a folder of depth/ and colour folders "
+                            "is read as the open3d layout") for n in notes), notes
+    # given as --trajectory, its lines are taken in order: a count that differs says so
+    with pytest.raises(SgtoolError, match=r"has 5 poses for 3 frames; this layout takes a "
+                       r"TUM trajectory's lines one per frame, in order, its times unused"):
+        read_sequence(root, trajectory=root / "groundtruth.txt")
+
+
 def test_names_whose_numbers_tie_are_refused(tmp_path):
     root = open3d_folder(tmp_path / "f", ["0", "1", "2"])
     _depth(root / "depth" / "01.png")
