@@ -171,5 +171,6 @@ def _camera_of(path: Path, idx: BagIndex, opts: BagOptions) -> CameraIntrinsics:
         )
     if not (fx > 0 and fy > 0):
         raise SgtoolError(f"{path}: --info {opts.info} has no usable focal length (K gives "
-                          f"fx {fx:g}, fy {fy:g}; each must be > 0)")
+                          f"fx {fx:g}, fy {fy:g}; each must be > 0): a camera not calibrated "
+                          "when recorded; give its intrinsics with --intrinsics fx,fy,cx,cy")
     return CameraIntrinsics(w, h, fx, fy, cx, cy)

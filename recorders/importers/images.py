@@ -57,7 +57,10 @@ def _read_image(path: Path) -> np.ndarray:
         raise SgtoolError(f"{path}: cannot read ({e.strerror or e})") from None
     a = _imdecode(data)
     if a is None:
-        raise SgtoolError(f"{path}: OpenCV cannot read this image")
+        exr = bytes(data[:4]) == b"\x76\x2f\x31\x01"  # OpenEXR's magic number
+        raise SgtoolError(f"{path}: OpenCV cannot read this image" + (
+            " (OpenEXR, which this OpenCV build does not decode): store depth as 16-bit PNG "
+            "in millimetres (or float TIFF)" if exr else ""))
     return a
 
 

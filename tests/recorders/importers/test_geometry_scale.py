@@ -225,3 +225,41 @@ def test_a_five_hertz_ground_truth_is_interpolated(tmp_path):
     with LogReader(tmp_path / "a.mcap") as r:
         first = next(iter(r.frames()))
     assert first.pose is not None
+
+
+def test_an_uncalibrated_camera_info_names_the_flag_that_helps(tmp_path):
+    """A CameraInfo whose K is all zeros (a driver that was never calibrated): refused
+    without a word of --intrinsics, which imports it."""
+    import dataclasses
+
+    from support.bag_export import BagWriter
+    from support.rgbd_scenes import K as SK
+    from support.rgbd_scenes import render
+
+    from sgtool.recorders.importers.bag import BagOptions, import_bag
+
+    bag = tmp_path / "b.bag"
+    t0, dt = 1_700_000_000_000_000_000, 33_000_000
+    zero = dataclasses.replace(SK, fx=0.0, fy=0.0, cx=0.0, cy=0.0)
+    with BagWriter(bag, "ros1") as w:
+        for i, pose in enumerate(POSES):
+            t = t0 + i * dt
+            w.write("/tf", "tf2_msgs/msg/TFMessage", t,
+                    w.tf(t, [w.transform_stamped(t, "map", "cam", pose)]))
+            w.write("/info", "sensor_msgs/msg/CameraInfo", t, w.camera_info(t, "cam", zero))
+            raw = (render(room(), pose) * 1000).round().astype("uint16")
+            w.write("/depth", "sensor_msgs/msg/Image", t, w.image(t, "cam", raw, "16UC1"))
+    with pytest.raises(SgtoolError, match=r"no usable focal length .*give its intrinsics "
+                       r"with --intrinsics fx,fy,cx,cy"):
+        import_bag(bag, tmp_path / "a.mcap", BagOptions(depth="/depth", info="/info",
+                                                        progress=False))
+
+
+def test_an_openexr_depth_image_is_named(tmp_path):
+    from sgtool.recorders.importers.images import read_depth_file
+
+    f = tmp_path / "d.exr"
+    f.write_bytes(b"\x76\x2f\x31\x01" + bytes(60))
+    with pytest.raises(SgtoolError, match=r"OpenEXR, which this OpenCV build does not "
+                       r"decode\): store depth as 16-bit PNG"):
+        read_depth_file(f)
