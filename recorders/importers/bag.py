@@ -201,10 +201,10 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         alignment = estimate_alignment(poses, samples, up=opts.up,
                                        floor=opts.floor, floor_auto=opts.floor_auto)
         findings.problem(given_up_problem(alignment), given=True)
-        findings.problem(floor_confidence_problem(
+        findings.problem(findings.floor_doubt(floor_confidence_problem(
             alignment.floor, alignment.floor_confidence, alignment.floor_method,
             alignment.floor_detail, float(np.median(camera_heights(poses, alignment.matrix))),
-            opts.camera_height), given=False)
+            opts.camera_height)), given=False)
         if alignment.floor_method != "none":
             findings.problem(
                 floor_problem(poses, alignment.matrix, alignment.floor,

@@ -69,6 +69,16 @@ class Findings:
             text = f"{head}; the value given is kept"
         self.warning(text)
 
+    def floor_doubt(self, text: str | None) -> str | None:
+        """``text`` (a floor problem, naming ``--floor``) with a word on the poses when a
+        warning before doubted them: wrong poses misplace the floor too, and a ``--floor``
+        given then writes a wrong map."""
+        if text is None or not any(w.startswith(("the poses (", "the poses' "))
+                                   for w in self.warnings):
+            return text
+        return (f"{text}; but the poses were doubted above: wrong poses misplace the floor "
+                "too, so fix them (or give --estimate-poses) before giving --floor")
+
     def warning(self, text: str) -> None:
         self.warnings.append(text)
         if self.warn is not None:

@@ -249,9 +249,10 @@ def poses_fit_depth(fit: ScaleFit | None) -> bool:
 def convention_problems(pairs: Pairs, k: CameraIntrinsics, fit: ScaleFit | None,
                         pose_source: str) -> list[str]:
     """When the poses do not fit the depth (``fit``, of ``pairs`` as :func:`fit_scale`
-    takes them): the problems of the poses' inverses, their translations in another unit
-    or their quaternions in another order fitting it (:func:`inverted_poses_problem`,
-    :func:`pose_units_problem`, :func:`quaternion_order_problem`); empty when the poses
+    takes them): the problems of the poses' inverses, their translations in another unit,
+    their quaternions in another order or the camera's body frame fitting it
+    (:func:`inverted_poses_problem`, :func:`pose_units_problem`,
+    :func:`quaternion_order_problem`, :func:`body_frame_problem`); empty when the poses
     fit, or none does."""
     reordered_pairs = [(a, b, _wxyz_read_as_xyzw(p), _wxyz_read_as_xyzw(q))
                        for a, b, p, q in pairs]
@@ -269,10 +270,38 @@ def convention_problems(pairs: Pairs, k: CameraIntrinsics, fit: ScaleFit | None,
     units = [(unit, fit_scale([(a, b, _in_metres(p, f), _in_metres(q, f))
                                for a, b, p, q in pairs], k)) for f, unit in POSE_UNITS]
     reordered = fit_scale(reordered_pairs, k)
+    body = fit_scale([(a, b, p @ BODY_T_OPTICAL, q @ BODY_T_OPTICAL) for a, b, p, q in pairs],
+                     k)
     found = (inverted_poses_problem(fit, inverted, pose_source),
              pose_units_problem(units, pose_source),
-             quaternion_order_problem(fit, reordered, pose_source))
+             quaternion_order_problem(fit, reordered, pose_source),
+             body_frame_problem(fit, body, pose_source))
     return [x for x in found if x is not None]
+
+
+# the optical frame (z forward, x right, y down) in a camera's body frame (ROS's
+# camera_link: x forward, y left, z up)
+BODY_T_OPTICAL = np.array([[0.0, 0.0, 1.0, 0.0], [-1.0, 0.0, 0.0, 0.0],
+                           [0.0, -1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
+
+
+def body_frame_problem(given: ScaleFit | None, body: ScaleFit | None,
+                       pose_source: str) -> str | None:
+    """When the poses taken as those of the camera's body frame (``body``: each turned
+    into the optical frame by :data:`BODY_T_OPTICAL`) move as the depth does and the poses
+    as read (``given``) do not: the poses of ROS's ``camera_link`` (x forward, z up), not
+    of the optical frame sgtool reads depth in. The text; None otherwise."""
+    if not poses_fit_depth(body) or poses_fit_depth(given):
+        return None
+    assert body is not None
+    moves = ("no consistent factor" if given is None else f"{given.ratio:.2f}x"
+             if given.consistent() else f"{given.ratio:.2f}x on average, the pairs disagreeing,")
+    return (f"the poses ({pose_source}) look like those of the camera's body frame (x "
+            f"forward, z up, as ROS's camera_link), not of its optical frame (z forward, x "
+            f"right, y down): between {body.pairs} pairs of nearby frames the depth moves "
+            f"{moves} as far as the poses, and {body.ratio:.2f}x as far as the optical frame "
+            "they imply; give the optical frame's poses (a bag: --tf-frames WORLD:"
+            "CAMERA_OPTICAL_FRAME), or --estimate-poses to estimate them from the depth")
 
 
 def _wxyz_read_as_xyzw(pose: np.ndarray) -> np.ndarray:

@@ -263,3 +263,39 @@ def test_an_openexr_depth_image_is_named(tmp_path):
     with pytest.raises(SgtoolError, match=r"OpenEXR, which this OpenCV build does not "
                        r"decode\): store depth as 16-bit PNG"):
         read_depth_file(f)
+
+
+def test_poses_of_the_cameras_body_frame_are_named(tmp_path):
+    """A ROS user whose tf has only camera_link (x forward, z up): its poses were blamed on
+    "another convention" in a warning, then the floor error's --floor wrote a wrong map."""
+    import numpy as np
+
+    from sgtool.recorders.importers.scale_check import BODY_T_OPTICAL
+
+    body = [p @ np.linalg.inv(BODY_T_OPTICAL) for p in POSES]
+    root = make_scene_folder(tmp_path / "f", room(), POSES)
+    gt = root / "groundtruth.txt"
+    from scipy.spatial.transform import Rotation
+
+    lines = gt.read_text().splitlines()
+    out = [lines[0]]
+    for line, pose in zip(lines[1:], body, strict=True):
+        q = Rotation.from_matrix(pose[:3, :3]).as_quat()
+        out.append(" ".join([line.split()[0], *(f"{x:.9f}" for x in pose[:3, 3]),
+                             *(f"{x:.9f}" for x in q)]))
+    gt.write_text("\n".join(out) + "\n")
+    with pytest.raises(SgtoolError, match=r"look like those of the camera's body frame .* "
+                       r"and 1\.0\dx as far as the optical frame they imply"):
+        import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
+
+
+def test_a_floor_error_after_doubted_poses_says_to_fix_the_poses_first():
+    from sgtool.recorders.importers.provenance import Findings
+
+    f = Findings()
+    text = "the floor is not clear ...; give the floor's height with --floor"
+    assert f.floor_doubt(text) == text and f.floor_doubt(None) is None
+    f.warning("the poses (ground truth) do not move as the depth does: ...")
+    assert f.floor_doubt(text).endswith(
+        "; but the poses were doubted above: wrong poses misplace the floor too, so fix "
+        "them (or give --estimate-poses) before giving --floor")
