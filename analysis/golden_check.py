@@ -44,6 +44,7 @@ from sgtool.files import (
     read_manifest,
     sha256_file,
 )
+from sgtool.log.inspect import foreign_log_problem
 from sgtool.replayers.derived_log import ReplayOptions
 from sgtool.replayers.golden import describe_mismatch, quality_lines
 from sgtool.replayers.golden_diff import paired_refreshes
@@ -232,6 +233,8 @@ def pin_logs(logs: Sequence[str | Path] | str | Path, folder: str | Path,
     for p in paths:
         if not p.is_file():
             raise SgtoolError(f"{p}: no such log")
+        if (foreign := foreign_log_problem(p)) is not None:  # a bag: say so, and its import
+            raise SgtoolError(foreign)
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise SgtoolError(f"two logs are named {dup[0]}.mcap; pin them into separate folders")

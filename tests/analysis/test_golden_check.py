@@ -416,6 +416,8 @@ def _without(src, dst, topic):
                for cid, c in summary.channels.items()}
         for a in r.iter_attachments():
             w.add_attachment(a.create_time, a.log_time, a.name, a.media_type, a.data)
+        for md in r.iter_metadata():  # still an sgtool log
+            w.add_metadata(md.name, dict(md.metadata))
         for _, c, m in r.iter_messages():
             if c.topic != topic:
                 w.add_message(ids[c.id], m.log_time, m.data, m.publish_time, m.sequence)

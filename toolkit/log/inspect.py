@@ -165,7 +165,8 @@ def foreign_log_problem(path: str | os.PathLike[str]) -> str | None:
     what = {"ros2": "a ROS 2 recording (MCAP, profile 'ros2')",
             "ros1": "a ROS 1 recording (MCAP, profile 'ros1')"}.get(
         profile, f"an MCAP file with profile {profile or ''!r}")
-    enc = (f"{len(channels)} topic(s) of messages encoded {', '.join(map(repr, encodings))}"
+    enc = (f"{len({t for t, _ in channels})} topic(s) of messages encoded "
+           f"{', '.join(map(repr, encodings))}"
            if encodings else "no message topics")
     if profile in ("ros1", "ros2") or encodings in (["cdr"], ["ros1"]):
         return f"{p} is {what} with {enc}, not an sgtool log; {_import_hint(p, channels)}"

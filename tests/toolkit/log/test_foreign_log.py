@@ -165,3 +165,24 @@ def test_doctor_keeps_a_foreign_files_valid_messages(tmp_path):
     r = CliRunner().invoke(cli, ["doctor", str(own)])
     assert r.exit_code == 1 and "sgtool reads /tf as protobuf foxglove.FrameTransform" \
         in r.output
+
+
+def test_pin_of_a_foreign_file_says_what_it_is_and_topics_count_once(tmp_path):
+    """golden pin on another tool's file said only that it had no /camera/depth channel;
+    two channels on one topic were counted as two topics."""
+    from mcap.writer import Writer
+
+    f = tmp_path / "other.mcap"
+    with open(f, "wb") as fh:
+        w = Writer(fh)
+        w.start(profile="", library="another tool")
+        a = w.register_channel("/a", "json", w.register_schema("A", "jsonschema", b"{}"))
+        b = w.register_channel("/a", "json", w.register_schema("B", "jsonschema", b"{}"))
+        w.add_message(a, 1, b"{}", 1)
+        w.add_message(b, 2, b"{}", 2)
+        w.finish()
+    assert "with 1 topic(s) of messages encoded 'json', not an sgtool log" in \
+        foreign_log_problem(f)
+    r = CliRunner().invoke(cli, ["golden", "pin", str(f), "--dir", str(tmp_path / "g")])
+    assert r.exit_code == 2 and "not an sgtool log" in r.output
+    assert not (tmp_path / "g").exists()
