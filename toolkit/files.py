@@ -384,7 +384,10 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
       as a new output are moved aside, the new entries moved in, and the moved-aside ones
       deleted; any other entry (a user's file) stays. A folder without a manifest that
       holds entries named as outputs is refused (:func:`_refuse_unlisted`: they may be a
-      user's). A failure or Ctrl-C while moving puts every entry back where it was.
+      user's). A failure or Ctrl-C while moving puts every entry back where it was;
+    - a ``target`` missing or empty at the start that another run filled meanwhile is
+      left alone: the outputs become ``NAME.1`` (the first free suffix) and a one-line
+      :class:`~sgtool.errors.SgtoolError` says so.
 
     The new :data:`MANIFEST` lists the top-level entries of the yielded folder, for the
     next ``--force``. On any exception (Ctrl-C included) the yielded folder is removed and
@@ -440,6 +443,11 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
     try:
         yield stage
         atomic_write(stage / MANIFEST, manifest_text(command, os.listdir(stage)))
+        if not busy and path.is_dir() and any(os.scandir(path)):
+            kept = _free_sibling(path)  # filled meanwhile (another run): not mixed, not lost
+            os.replace(stage, kept)
+            raise SgtoolError(f"{option} {target}: another run wrote into it while this one "
+                              f"ran; this run's outputs are in {kept} instead")
         try:
             _commit(stage, path, sgtool_entries(path, known) if path.is_dir() else set())
         except OSError as e:
@@ -455,6 +463,14 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
         _name_target(e, stage, path)
         raise
     shutil.rmtree(stage, ignore_errors=True)  # emptied by the moves, or moved in whole
+
+
+def _free_sibling(path: Path) -> Path:
+    """``path`` with the first suffix ``.1``, ``.2``, ... that names nothing yet."""
+    n = 1
+    while path.with_name(f"{path.name}.{n}").exists():
+        n += 1
+    return path.with_name(f"{path.name}.{n}")
 
 
 def _name_target(e: BaseException, stage: Path, target: Path) -> None:

@@ -62,6 +62,23 @@ def test_a_non_empty_folder_is_refused_in_one_line(tmp_path: Path) -> None:
     assert os.listdir(tmp_path) == ["res"]
 
 
+def test_a_folder_another_run_filled_meanwhile_is_left_alone(tmp_path: Path) -> None:
+    """Two runs started on one new -o: the first to finish moved in, the second replaced
+    its outputs with exit 0 (the folder was checked only at the start). The second's
+    outputs go beside it now, and it says so."""
+    target = tmp_path / "out"
+    with pytest.raises(SgtoolError, match=r"-o .*out: another run wrote into it while this "
+                       r"one ran; this run's outputs are in .*out\.1 instead"):
+        with output_folder(target, force=False, command="sgtool bench") as out:
+            (out / "summary.md").write_text("mine")
+            target.mkdir()
+            (target / "summary.md").write_text("theirs")
+    assert (target / "summary.md").read_text() == "theirs"
+    assert (tmp_path / "out.1" / "summary.md").read_text() == "mine"
+    assert read_manifest(tmp_path / "out.1")[0] == "sgtool bench"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "out.1"]
+
+
 def test_force_replaces_what_sgtool_wrote_and_keeps_the_users_files(tmp_path: Path) -> None:
     out = tmp_path / "res"
     with output_folder(out, force=False, command="c") as stage:
