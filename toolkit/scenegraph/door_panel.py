@@ -58,17 +58,18 @@ def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
     two neighbours across the line (a wall it would run through), no occupied cell past an
     unseen one. The score: wall running away on one side (share of occupied cells 0.1-0.45
     door widths along it), a clear opening on the other (share of occupied cells along the
-    closed position, which must be low) and the far jamb just beyond it (1.0 where a wall
-    crosses the doorway's line at its far end: :func:`_crossing_walls`; the doorway then
-    ends there), wall + jamb - 2 opening. The best hinge and side must score well and
-    clearly beat every alternative. When none does (a free end whose far-jamb ray hits
-    furniture can come close to a hinge whose opening ray, for a panel smeared longer than
-    its doorway, reaches the far wall), they are scored again by the wall line alone: the
-    lesser of the wall and jamb shares minus the opening's (at least ``LINE_LEAST``,
-    ``LINE_MARGIN`` ahead of every alternative). Otherwise None (the caller then uses the
-    panel's own cells), as for cells that are not one panel at least ``min_width`` cells
-    long. ``free`` (bool, the shape of ``occupied``; None: no cell known free) is the grid's
-    cells seen free; ``memo`` caches answers by panel and surroundings."""
+    closed position, which must be low) and the far jamb just beyond it, wall + jamb - 2
+    opening. The best hinge and side must score well and clearly beat every alternative.
+    When none does (a free end whose far-jamb ray hits furniture can come close to a hinge
+    whose opening ray, for a panel smeared longer than its doorway, reaches the far wall),
+    they are scored again by the wall line alone: the lesser of the wall and jamb shares
+    minus the opening's (at least ``LINE_LEAST``, ``LINE_MARGIN`` ahead of every
+    alternative). When neither finds one, both are asked again with the far jamb 1.0
+    wherever a wall crosses the doorway's line at its far end (:func:`_crossing_walls`: a
+    door at a room's corner; the doorway then ends there). Otherwise None (the caller then
+    uses the panel's own cells), as for cells that are not one panel at least ``min_width``
+    cells long. ``free`` (bool, the shape of ``occupied``; None: no cell known free) is the
+    grid's cells seen free; ``memo`` caches answers by panel and surroundings."""
     if len(rows) < 2:
         return None
     # work in a window around the panel: every ray starts at most a panel length past its
@@ -150,17 +151,15 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
                          (end, d, 1.05 * w, 1.3 * w, True)]
                 places.append((s, sign, off, out))
     shares = ray_shares(rays, occupied, grown, origin)
-    crossing = _crossing_walls(places, mean, a, t, width, occupied, origin)
-    for i, h in enumerate(crossing):
-        if h is not None:  # a wall across the doorway's line at its far end: its jamb
-            shares[3 * i + 2] = 1.0
-    best = None
-    for most in (MIN_REACH, reach):  # the nearest wall lines first
-        best = _clear_best(shares, places, most, _sum_score, 1.0, 0.5)
-        if best is None:  # ambiguous: ask for the wall line on both sides of the opening
-            best = _clear_best(shares, places, most, _line_score, LINE_LEAST, LINE_MARGIN)
-        if best is not None:
-            break
+    best = _best_place(shares, places, reach)
+    crossing: list[float | None] = [None] * len(places)
+    if best is None:  # only then a wall across the doorway's line may be its far jamb
+        crossing = _crossing_walls(places, mean, a, t, width, occupied, origin)
+        crossed = list(shares)
+        for i, h in enumerate(crossing):
+            if h is not None:
+                crossed[3 * i + 2] = 1.0
+        best = _best_place(crossed, places, reach)
     if best is None:
         return None
     _, s_end, sign, off, out = best
@@ -176,6 +175,19 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
     h, w_ = occupied.shape
     ok = (r >= origin[0]) & (r < origin[0] + h) & (c >= origin[1]) & (c < origin[1] + w_)
     return r[ok], c[ok]
+
+
+def _best_place(shares: list[float], places: list[tuple[float, float, int, np.ndarray]],
+                reach: int) -> _Candidate | None:
+    """The clear best hinge and side of :func:`opening_from_panel` (its doc), nearest wall
+    lines first: by the sum score, else by the wall line alone."""
+    for most in (MIN_REACH, reach):
+        best = _clear_best(shares, places, most, _sum_score, 1.0, 0.5)
+        if best is None:  # ambiguous: ask for the wall line on both sides of the opening
+            best = _clear_best(shares, places, most, _line_score, LINE_LEAST, LINE_MARGIN)
+        if best is not None:
+            return best
+    return None
 
 
 def _crossing_walls(places: list[tuple[float, float, int, np.ndarray]], mean: np.ndarray,

@@ -138,6 +138,26 @@ def test_panel_of_a_door_at_a_rooms_corner_gives_its_doorway() -> None:
     assert r.max() >= 38 and 20 <= r.min() <= 22  # ... from the hinge to the corner
 
 
+def test_a_wall_across_is_a_jamb_only_when_nothing_else_decides() -> None:
+    """A door mid-wall with a side wall 0.2 m past its far jamb and a cabinet just past the
+    leaf's free end: counting the side wall as the free end's far jamb made both ends of
+    the leaf score as hinges, and the doorway was lost (the rooms merged). The wall across
+    is asked only when the usual jambs decide nothing."""
+    occupied = np.zeros((80, 110), dtype=bool)
+    occupied[20:22, :] = True
+    occupied[20:22, 40:58] = False  # the doorway, columns 40-57
+    occupied[22:61, 62:64] = True  # a side wall past the far jamb
+    occupied[42:53, 33:52] = True  # a cabinet past the leaf's free end
+    rows = np.arange(22, 41)  # the leaf, hinged at (21, 40), swung into +row
+    cols = np.full(len(rows), 40)
+    occupied[rows, cols] = True
+    got = opening_from_panel(rows, cols, occupied, min_width=8, free=~occupied)
+    assert got is not None
+    r, c = got
+    assert np.all((r >= 19) & (r <= 22))
+    assert c.min() <= 41 and c.max() >= 56
+
+
 def _wall_with_doorway() -> tuple[np.ndarray, np.ndarray]:
     """A wall along x at row 20 with an 18-cell doorway (columns 40-57); floor seen free
     everywhere else."""
