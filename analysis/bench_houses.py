@@ -233,10 +233,12 @@ def house_notes(house: Any) -> tuple[str, ...]:
     walls or furniture than the robot's radius
     (:mod:`sgtool.house.clearance`)."""
     from sgtool.house.clearance import (
+        CORNER_WALL,
         FRONT_CLEAR,
         back_is_clear,
         blocked_fronts,
         cramped_starts,
+        doors_at_corners,
         hidden_pieces,
         pieces_in_walls,
         walls_in_rooms,
@@ -261,6 +263,12 @@ def house_notes(house: Any) -> tuple[str, ...]:
                                                  if near else "too narrow, or furniture "
                                                  "farther in cuts the door's side off") +
                      "); read as a wall")
+    for di, room, left in doors_at_corners(spec):
+        d = spec.doors[di]
+        notes.append(f"{d.id} ({' - '.join(d.rooms)}): its opening ends {left:.2f} m from a "
+                     f"corner of {room}: the replay may not find a door with no wall beside "
+                     "it (where furniture stands near its swung leaf; the two rooms then "
+                     f"merge): leave {CORNER_WALL:g} m of wall beside it")
     cut = house.isolated_rooms()
     if cut:
         notes.append(f"{', '.join(cut)}: no door or passage leads there from the rest of "

@@ -134,6 +134,29 @@ def test_a_closed_box_holding_things_is_noted(tmp_path: Path) -> None:
         in r.output
 
 
+def test_a_door_with_no_wall_beside_it_at_a_corner_gets_a_note() -> None:
+    """A door whose opening ends at a room's corner (its panel swung along the side wall):
+    the replay merged the two rooms, with no word at check time. A door 0.1 m from the
+    corner has no note."""
+    import dataclasses
+
+    from support.datasets_fixtures import two_rooms
+
+    from sgtool.analysis.bench_houses import house_notes, symbolic_house
+    from sgtool.house.io import load_house
+
+    spec = load_house(two_rooms())
+    d = spec.doors[0]
+    ys = [p[1] for r in d.rooms for p in spec.room(r).polygon]
+    at = dataclasses.replace(d, center=(d.center[0], min(ys) + d.width / 2))
+    for door, noted in ((at, True), (dataclasses.replace(
+            at, center=(d.center[0], min(ys) + d.width / 2 + 0.1)), False)):
+        house, bad = symbolic_house(dataclasses.replace(spec, doors=(door,)), "h.json")
+        assert bad is None
+        said = [n for n in house_notes(house) if "from a corner of" in n]
+        assert bool(said) == noted, said
+
+
 def test_a_front_blocked_by_a_piece_of_a_corner_says_to_move_that_piece() -> None:
     """A cabinet backed against the wall whose front an L-shaped corner piece blocks (the
     generator's own kitchens): turning it (yaw + pi) would face the wall; the note says to

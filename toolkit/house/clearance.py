@@ -28,6 +28,7 @@ from sgtool.house.geometry import (
     clip_convex,
     distance_to_border,
     distance_to_polygon,
+    opening_segment,
     overlap_area,
     point_in_polygon,
     segment_distance,
@@ -42,6 +43,8 @@ THROUGH_STRIP = 0.5  # m beyond a wall's far face looked at for a piece reaching
 INSIDE_CLEAR = 0.15  # m from a room's border where a wall is inside the room
 INSIDE_LEAST = 0.3  # m of a wall inside a room that is more than a corner's overlap
 CLEAR_SEARCH = 1.0  # m around a cramped start searched for a clear place (clear_start)
+CORNER_WALL = 0.1  # m of wall a door needs beside it at a room's corner (doors_at_corners)
+IN_LINE_BEYOND = 0.15  # m past a door's end where a wall in line with it is looked for
 
 
 def front_point(f: Furniture, clear: float = FRONT_CLEAR) -> tuple[float, float]:
@@ -246,3 +249,35 @@ def walls_in_rooms(spec: HouseSpec, step: float = 0.05
         if total >= INSIDE_LEAST:
             out.append((r.id, tuple(walls), total))
     return out
+
+
+def doors_at_corners(spec: HouseSpec) -> list[tuple[int, str, float]]:
+    """(door index, room, metres of wall left) of each door whose opening ends within
+    :data:`CORNER_WALL` of a corner of one of its rooms: the replay's door finding then has
+    no wall end beyond the opening there, and takes the wall across for one only when
+    nothing near the swung leaf decides otherwise; else the two rooms merge in the scene
+    graph."""
+    covers = Covers(spec)
+    out = []
+    for i, d in enumerate(spec.doors):
+        tips = opening_segment(d.center, d.width, d.yaw)
+        # a wall in line with the door beyond an end (another room's, a neighbour's
+        # border) gives the replay its wall end there, corner or not
+        bare = [tip for tip in tips if not _wall_in_line(covers, d.center, tip)]
+        for rid in d.rooms:
+            corners = spec.room(rid).polygon
+            left = min((math.dist(tip, c) for tip in bare for c in corners), default=math.inf)
+            if left < CORNER_WALL - 1e-6:  # (0.1 m of wall, read as 0.0999...)
+                out.append((i, rid, left))
+                break
+    return out
+
+
+def _wall_in_line(covers: Covers, center: tuple[float, float, float] | tuple[float, float],
+                  tip: tuple[float, float], beyond: float = IN_LINE_BEYOND) -> bool:
+    """Whether a wall body holds the point ``beyond`` metres past ``tip`` on the line
+    from the opening's ``center`` through it (past a side wall's half thickness)."""
+    dx, dy = tip[0] - center[0], tip[1] - center[1]
+    n = math.hypot(dx, dy) or 1.0
+    hit = covers.at(tip[0] + dx / n * beyond, tip[1] + dy / n * beyond)
+    return hit is not None and hit[0] == "walls"
