@@ -61,7 +61,12 @@ from sgtool.recorders.importers.bag_sync import PlannedFrame, plan_frames, plann
 from sgtool.recorders.importers.bag_topics import check_flags, describe_bag, with_only_info
 from sgtool.recorders.importers.distortion import distortion_finding
 from sgtool.recorders.importers.floor import floor_confidence_problem, frame_floor_problem
-from sgtool.recorders.importers.focal_check import check_focal, ray_depth_problem, turn_pairs
+from sgtool.recorders.importers.focal_check import (
+    along_axis_pairs,
+    check_focal,
+    ray_depth_problem,
+    turn_pairs,
+)
 from sgtool.recorders.importers.images import ResizeLog, depth_to_metres
 from sgtool.recorders.importers.odometry import (
     DriftReport,
@@ -271,9 +276,11 @@ def _check_poses(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
     if focal is not None:
         checks.append(("focal length against the poses", focal.describe()))
     ray = ray_depth_problem(turned, k, focal, f"--depth {opts.depth}")
-    if ray is not None:
+    if ray is not None:  # it explains the turned pairs' gaps: no focal length's problem
         findings.warning(ray)
-        return
+        problem, explains = None, False
+        pairs = along_axis_pairs(pairs, k)  # the rest judged on the depth so read
+        fit = fit_scale(pairs, k)
     findings.problem(problem, given=opts.intrinsics is not None)
     if explains:
         return

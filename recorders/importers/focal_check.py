@@ -47,6 +47,7 @@ OFF = 0.1  # |c - 1| that is no verdict
 CLEAR = 2.5  # gap at the focal length given / at the best factor, at least
 AGREE = 0.75  # share of the pairs whose own best factor is off the same way
 MIN_PAIRS = 3
+SCALE_AS_GOOD = 1.5  # a depth scale whose gap is within this of the focal length's leads
 
 
 @dataclass(frozen=True)
@@ -148,18 +149,26 @@ def check_focal(turned: Pairs, nearby: Pairs, k: CameraIntrinsics, fit: ScaleFit
                 origin: str) -> tuple[FocalFit | None, str | None, bool]:
     """The focal fit of the ``turned`` pairs (:func:`turn_pairs`), its problem
     (:func:`focal_problem`, intrinsics from ``origin``), and whether the problem explains
-    the depth scale fit ``fit`` of the ``nearby`` pairs not fitting the poses: with the
-    focal lengths the fit names, they fit. A problem whose focal lengths leave the depth
-    moving otherwise than the poses is dropped (the poses or the depth scale are wrong
-    then, and the turned pairs' gaps say nothing of the focal length)."""
+    the depth scale fit ``fit`` of the ``nearby`` pairs not fitting the poses (with the
+    focal lengths the fit names, they fit). A depth scale off stretches the surfaces too:
+    when the nearby pairs agree on a scale off 1 and the turned pairs' surfaces, their
+    depth read at that scale, meet as closely as with the focal lengths named, the depth
+    scale is the lead and the problem is dropped. The problem stands when the nearby pairs
+    give no fit or no consistent one (a camera that only turns; a wrong focal length
+    scatters the pairs' ratios: the better lead than a pose convention)."""
     focal = fit_focal(turned, k)
     problem = focal_problem(focal, k, origin)
     if problem is None or focal is None or poses_fit_depth(fit):
         return focal, problem, False
+    if fit is not None and fit.consistent():
+        rescaled = median_gap([(a / fit.ratio, b / fit.ratio, p, q) for a, b, p, q in turned],
+                              k)
+        if rescaled is not None and 1000 * rescaled <= focal.gap_mm * SCALE_AS_GOOD:
+            return focal, None, False
     c = focal.factor
-    if poses_fit_depth(fit_scale(nearby, dataclasses.replace(k, fx=k.fx * c, fy=k.fy * c))):
-        return focal, problem, True
-    return focal, None, False
+    mended = poses_fit_depth(fit_scale(nearby, dataclasses.replace(k, fx=k.fx * c,
+                                                                  fy=k.fy * c)))
+    return focal, problem, mended
 
 
 def along_axis(depth: np.ndarray, k: CameraIntrinsics) -> np.ndarray:
@@ -189,3 +198,10 @@ def ray_depth_problem(turned: Pairs, k: CameraIntrinsics, focal: FocalFit | None
             f"frames the surfaces seen from both meet within {1000 * as_ray:.1f} mm read so, "
             f"{1000 * as_given:.1f} mm apart as given; convert each pixel first (z = d / "
             "sqrt(1 + ((u - cx) / fx)^2 + ((v - cy) / fy)^2))")
+
+
+def along_axis_pairs(pairs: Pairs, k: CameraIntrinsics
+                     ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    """``pairs`` with their depth read as distances along each ray (:func:`along_axis`):
+    how the other checks judge depth that :func:`ray_depth_problem` found so stored."""
+    return [(along_axis(a, k), along_axis(b, k), p, q) for a, b, p, q in pairs]

@@ -42,6 +42,7 @@ from sgtool.recorders.importers.checks import (
 from sgtool.recorders.importers.floor import floor_confidence_problem, frame_floor_problem
 from sgtool.recorders.importers.focal_check import (
     FocalFit,
+    along_axis_pairs,
     check_focal,
     ray_depth_problem,
     turn_pairs,
@@ -284,9 +285,11 @@ def check_scale_by_geometry(frames: list[FolderFrame], k: CameraIntrinsics, scal
               if p[0].shape == p[1].shape == (k.height, k.width)]
     focal, problem, explains = check_focal(turned, pairs, k, fit, intrinsics[0])
     ray = ray_depth_problem(turned, k, focal, "the depth images")
-    if ray is not None:
+    if ray is not None:  # it explains the turned pairs' gaps: no focal length's problem
         findings.warning(ray)
-        return fit, focal
+        problem, explains = None, False
+        pairs = along_axis_pairs(pairs, k)  # the rest judged on the depth so read
+        fit = fit_scale(pairs, k)
     findings.problem(problem, given=intrinsics[1])
     if explains:
         return fit, focal

@@ -192,11 +192,14 @@ def _same_image(d0: np.ndarray, d1: np.ndarray) -> bool:
     return d0.shape == d1.shape and bool(np.array_equal(d0, d1))
 
 
+SNAP = 0.05  # a usual scale this close is the one named (well within PRECISE_TOLERANCE)
+
+
 def snap_scale(value: float) -> float:
-    """A usual depth scale within 10 % of ``value``, else ``value`` to 2 significant
-    digits."""
+    """A usual depth scale within :data:`SNAP` of ``value``, else ``value`` to 2
+    significant digits."""
     for s in KNOWN_SCALES:
-        if abs(value / s - 1.0) <= 0.10:
+        if abs(value / s - 1.0) <= SNAP:
             return s
     return float(f"{value:.2g}")
 
@@ -222,9 +225,7 @@ def inverted_poses_problem(given: ScaleFit | None, inverted: ScaleFit | None,
     the depth-scale and motion checks would otherwise take for a wrong scale (a few
     centimetres a pair, a small turn: the inverses' error is systematic, so it fits a
     consistent wrong ratio). The text; None otherwise."""
-    if inverted is None or not inverted.consistent() or abs(inverted.ratio - 1.0) > TOLERANCE:
-        return None
-    if poses_fit_depth(given):
+    if inverted is None or not clearly_fits(inverted) or poses_fit_depth(given):
         return None
     how = ("no consistent factor" if given is None else f"{given.ratio:.2f}x"
            if given.consistent() else f"{given.ratio:.2f}x on average, the pairs disagreeing,")
@@ -238,6 +239,14 @@ def inverted_poses_problem(given: ScaleFit | None, inverted: ScaleFit | None,
 POSE_UNITS = ((0.01, "centimetres"), (0.001, "millimetres"))
 
 Pairs = Sequence[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]
+
+
+def clearly_fits(fit: ScaleFit | None) -> bool:
+    """Whether the fit of poses in another convention (inverted, reordered, in another
+    unit or frame) is consistent and within :data:`PRECISE_TOLERANCE` of 1, whatever its
+    number of pairs: to blame the poses' convention, the other reading must fit better than
+    a depth scale a little off does."""
+    return fit is not None and fit.consistent() and abs(fit.ratio - 1.0) <= PRECISE_TOLERANCE
 
 
 def poses_fit_depth(fit: ScaleFit | None) -> bool:
@@ -256,6 +265,9 @@ def convention_problems(pairs: Pairs, k: CameraIntrinsics, fit: ScaleFit | None,
     fit, or none does."""
     reordered_pairs = [(a, b, _wxyz_read_as_xyzw(p), _wxyz_read_as_xyzw(q))
                        for a, b, p, q in pairs]
+    if fit is not None and fit.consistent() and not poses_fit_depth(fit) and \
+            abs(fit.ratio - 1.0) <= TOLERANCE:
+        return []  # 10-20 % off, the pairs agreeing closely: the depth scale's problem
     if poses_fit_depth(fit):
         # the translation's factor can fit with the rotations wrong, on small steps: the
         # surfaces of a pair then do not meet
@@ -291,7 +303,7 @@ def body_frame_problem(given: ScaleFit | None, body: ScaleFit | None,
     into the optical frame by :data:`BODY_T_OPTICAL`) move as the depth does and the poses
     as read (``given``) do not: the poses of ROS's ``camera_link`` (x forward, z up), not
     of the optical frame sgtool reads depth in. The text; None otherwise."""
-    if not poses_fit_depth(body) or poses_fit_depth(given):
+    if not clearly_fits(body) or poses_fit_depth(given):
         return None
     assert body is not None
     moves = ("no consistent factor" if given is None else f"{given.ratio:.2f}x"
@@ -324,7 +336,7 @@ def quaternion_order_problem(given: ScaleFit | None, reordered: ScaleFit | None,
     second or more) the surfaces of the pairs meet only so: quaternions written scalar
     first (as Eigen and many tools print them), read scalar last as TUM's format has them.
     The text; None otherwise."""
-    if not poses_fit_depth(reordered) or (gaps is None and poses_fit_depth(given)):
+    if not clearly_fits(reordered) or (gaps is None and poses_fit_depth(given)):
         return None
     assert reordered is not None
     if gaps is not None:
@@ -355,7 +367,7 @@ def pose_units_problem(fits: Sequence[tuple[str, ScaleFit | None]],
     (``fits``: the unit's name and the fit of the poses with their translations scaled
     to metres from it), move as the depth does: the text naming the unit; else None."""
     for unit, fit in fits:
-        if fit is not None and fit.consistent() and abs(fit.ratio - 1.0) <= TOLERANCE:
+        if fit is not None and clearly_fits(fit):
             return (f"the poses' translations ({pose_source}) look in {unit}: between "
                     f"{fit.pairs} pairs of nearby frames the depth moves {fit.ratio:.2f}x as "
                     f"far as the poses read in {unit}; sgtool reads metres: convert them, or "

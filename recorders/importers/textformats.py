@@ -214,7 +214,7 @@ def read_intrinsics_file(path: Path) -> PinholeParams:
     """Open3D intrinsic JSON or a 3x3 matrix text file."""
     if path.suffix.lower() == ".json":
         try:
-            d = json.loads(path.read_text())
+            d = json.loads(path.read_text(encoding="utf-8-sig"))
             m = np.asarray(d["intrinsic_matrix"], dtype=np.float64).reshape(3, 3).T
             w, h = d.get("width"), d.get("height")
             size = (int(w) if w else None, int(h) if h else None)
@@ -235,8 +235,9 @@ def read_intrinsics_file(path: Path) -> PinholeParams:
                                height=size[1], source=str(path.name))
     try:
         text = path.read_text(encoding="utf-8-sig", errors="replace")
-        m = np.loadtxt(io.StringIO(text), dtype=np.float64,
-                       delimiter="," if "," in text else None)
+        data = "\n".join(line.split("#", 1)[0] for line in text.splitlines())
+        m = np.loadtxt(io.StringIO(data), dtype=np.float64,
+                       delimiter="," if "," in data else None)
     except ValueError:
         raise SgtoolError(f"{path}: expected a 3x3 camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]] "
                           "(three rows of three numbers), or Open3D intrinsics JSON") from None

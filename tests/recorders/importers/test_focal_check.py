@@ -125,3 +125,28 @@ def test_depth_stored_along_each_ray_is_named(tmp_path: Path) -> None:
     assert w.startswith("depth (the depth images) looks like each pixel's distance along its "
                         "ray, not the depth along the optical axis")
     assert "intrinsics" not in " ".join(rep.warnings)  # not blamed on the focal length
+
+
+def test_review_cases_of_the_checks_order(tmp_path: Path) -> None:
+    """Found in review: depth along each ray and 0.7x its scale gave the ray warning alone
+    (exit 0; the scale error was skipped); a camera that only pans (no nearby pair for the
+    scale) dropped a clear focal problem."""
+    import cv2
+
+    from sgtool.recorders.importers.focal_check import along_axis
+
+    right = PinholeParams(TRUE_K.fx, TRUE_K.fy, TRUE_K.cx, TRUE_K.cy)
+    root = make_scene_folder(tmp_path / "ray", room(), POSES, units_per_m=3500.0)
+    for png in sorted((root / "depth").glob("*.png")):
+        z = cv2.imread(str(png), cv2.IMREAD_UNCHANGED).astype(float)
+        cv2.imwrite(str(png), np.round(z / along_axis(np.ones_like(z), TRUE_K))
+                    .astype(np.uint16))
+    with pytest.raises(SgtoolError, match=r"depth scale 5000 units/m .* disagrees"):
+        import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=right, progress=False))
+    pan = [look_at((0.0, 0.0, 1.4), (2.0 * np.cos(a), 2.0 * np.sin(a), 0.8))
+           for a in np.radians(np.arange(-40.0, 40.0, 2.0))]
+    root = make_scene_folder(tmp_path / "pan", room(), pan)
+    wrong = dataclasses.replace(right, fx=45.0, fy=45.0)
+    rep = import_rgbd(root, tmp_path / "b.mcap", RgbdOptions(intrinsics=wrong, progress=False,
+                                                             floor=0.0))
+    assert [w for w in rep.warnings if "the focal length looks 1.3" in w], rep.warnings

@@ -121,6 +121,12 @@ def test_transposed_matrices_are_named_and_commas_and_byte_order_marks_read(tmp_
     t.write_text("585, 0, 320\n0, 586, 240\n0, 0, 1\n")
     p = textformats.read_intrinsics_file(t)
     assert (p.fx, p.fy, p.cx, p.cy) == (585, 586, 320, 240)
+    t.write_text("# K (fx, fy, cx, cy in pixels)\n585 0 320\n0 586 240\n0 0 1\n")
+    p = textformats.read_intrinsics_file(t)  # a comma in a comment is no delimiter
+    assert (p.fx, p.fy, p.cx, p.cy) == (585, 586, 320, 240)
+    j.write_text('\ufeff{"width": 640, "height": 480, "intrinsic_matrix": '
+                 '[525.0, 0, 0, 0, 520.0, 0, 319.5, 239.5, 1]}', encoding="utf-8")
+    assert textformats.read_intrinsics_file(j).fy == 520.0
     lst = tmp_path / "rgb.txt"
     lst.write_text("\ufeff# rgb\n1305031102.175304 rgb/1305031102.175304.png\n",
                    encoding="utf-8")

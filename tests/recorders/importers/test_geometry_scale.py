@@ -84,6 +84,19 @@ def test_no_verdict_without_a_clear_consistent_ratio():
     assert "--depth-scale 5000 fits" in str(
         geometric_scale_problem(ScaleFit(4.9, 6, 0.1), 1000.0, "x", "gt"))
     assert snap_scale(9700.0) == 10000.0 and snap_scale(2345.0) == 2300.0
+    # a usual scale is named only within 5 %: 4350 named as 4000 left 9 % that then passed
+    assert snap_scale(4350.0) == 4400.0 and snap_scale(4150.0) == 4000.0
+
+
+def test_a_depth_scale_15_percent_off_is_not_blamed_on_the_poses(tmp_path):
+    """Depth stored at 5750 units/m read at 5000 (1.15x, the pairs agreeing closely) on a
+    camera that barely turns: the tight tolerance put the poses out, the loose one let
+    their inverses or reordered quaternions in, and the remedy named was to invert or
+    reorder correct poses."""
+    root = make_scene_folder(tmp_path / "f", room(), POSES, units_per_m=5750.0)
+    with pytest.raises(SgtoolError, match=r"depth scale 5000 units/m .* moves 1\.1\dx as far "
+                       r"as the poses .*--depth-scale 5[78]00 fits"):
+        import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
 
 
 def test_bag_depth_at_half_millimetres_names_the_scale_that_fits(tmp_path):
