@@ -46,9 +46,11 @@ What we do, and why it differs:
   at a wall's end join nothing): the floor is eroded k cells, which keeps passages of
   2k + 1 cells, k the fewest steps that make those at least ``JOIN_WIDTH`` (3 cells at
   5 cm). A merged room's centre is taken on its largest piece.
-  A component shorter than ``min_room_length`` is a room when it stands on floor of its
-  own (no longer component's nodes on it) of at least ``min_room_length`` squared: a room
-  glimpsed through a doorway has little graph but floor that belongs to no other room.
+  A component shorter than ``min_room_length`` is a room when it stands on open floor of
+  its own (no longer component's nodes on it) of at least ``OWN_FLOOR`` times
+  ``min_room_length`` squared (0.5 m^2): a room glimpsed through a doorway, or a closet or
+  WC of 1.5 m (0.9 m^2 of open floor outside its door's cut zone), has little graph but
+  floor that belongs to no other room.
 
 Room ids stay stable across refreshes (:class:`RoomTracker`): new rooms take the id of the
 previous room whose nodes they overlap most (greedy, largest overlap first), so a planner's
@@ -75,6 +77,7 @@ from sgtool.mapping.voronoi import VoronoiGraph, submatrix
 
 JOIN_WIDTH = 0.15  # m: passages of open floor narrower than this join no rooms (module doc)
 JOIN_SEAL = 0.3  # m around door evidence (and unsure floor) where floor joins nothing
+OWN_FLOOR = 0.5  # of min_room_length squared: the open floor of its own a short room needs
 
 
 @dataclass(frozen=True)
@@ -172,7 +175,8 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
     """``rooms`` (components long enough) joined where their nodes share a 4-connected part
     of the open floor (free, outside the cut zone and ``unsure``) that passages at least
     ``JOIN_WIDTH`` wide hold together, plus the ``short`` components whose parts of the
-    open floor no such room touches and hold at least ``min_room_length`` squared;
+    open floor no such room touches and hold at least ``OWN_FLOOR`` times
+    ``min_room_length`` squared;
     numbered by their lowest node."""
     open_floor = occ.free if density is None else occ.free & (density < cfg.door_threshold)
     if unsure is not None:  # and what lies within JOIN_SEAL of it
@@ -183,7 +187,7 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
         taken = {p for nodes in rooms for p in _parts(vg, part, nodes)}
         rooms = rooms + [nodes for nodes in short if (mine := _parts(vg, part, nodes))
                          and not taken.intersection(mine)
-                         and area[mine].sum() >= cfg.min_room_length ** 2]
+                         and area[mine].sum() >= OWN_FLOOR * cfg.min_room_length ** 2]
         rooms.sort(key=lambda nodes: int(nodes[0]))
     # a passage narrower than JOIN_WIDTH (a gap at a wall's end, beside a closed leaf)
     # joins nothing: k erosion steps keep passages of 2k + 1 cells and more

@@ -199,9 +199,9 @@ def test_a_passage_joins_from_join_width_at_any_cell_size(resolution: float,
 
 def test_a_short_piece_on_floor_of_its_own_is_a_room() -> None:
     """A room glimpsed through a door: its graph is a 0.6 m piece (under min_room_length),
-    dropped on its own. On floor of its own of at least min_room_length squared (1 m^2:
-    400 cells of 5 cm) it is a room; on less floor, or on floor a long piece stands on,
-    it is none (its nodes keep no room)."""
+    dropped on its own. On floor of its own of at least half min_room_length squared
+    (0.5 m^2: 200 cells of 5 cm; a closet's) it is a room; on less floor, or on floor a
+    long piece stands on, it is none (its nodes keep no room)."""
     a_pts, a_e = chain(0.0, 0.0, 6, 0.4)  # 2.4 m: a room
     b_pts, b_e = chain(0.0, 3.0, 3, 0.2)  # 0.6 m: short
     k = len(a_pts)
@@ -215,12 +215,12 @@ def test_a_short_piece_on_floor_of_its_own_is_a_room() -> None:
         free[:, k] = not wall  # ... behind a wall of one cell
         return floor(free)
 
-    assert 32 * 12 < 400 <= 32 * 13  # 40 - 7 - 1 = 32 columns
-    big = segment_rooms(vg, None, occ=grid(13))
+    assert 32 * 6 < 200 <= 32 * 7  # 40 - 7 - 1 = 32 columns
+    big = segment_rooms(vg, None, occ=grid(7))
     assert big.count == 2 and big.rooms[1].tolist() == list(range(k, k + 4))
     assert big.labels[k:].tolist() == [1] * 4
-    assert segment_rooms(vg, None, occ=grid(12)).count == 1  # under 1 m^2
-    seg = segment_rooms(vg, None, occ=grid(13, wall=False))  # one floor for both
+    assert segment_rooms(vg, None, occ=grid(6)).count == 1  # under 0.5 m^2
+    seg = segment_rooms(vg, None, occ=grid(7, wall=False))  # one floor for both
     assert seg.count == 1 and seg.rooms[0].tolist() == list(range(k))
 
 
