@@ -464,8 +464,8 @@ def write_outputs(res: BenchResult, out_dir: str | os.PathLike[str],
     """episodes.jsonl, summary.md, summary.json (no wall-clock figure), run.md, run.json
     (timing, command), per_house.md/.jsonl, per_query.md/.jsonl and the two efficiency
     PNGs (:data:`OUTPUT_NAMES`), each written atomically into ``out_dir`` (created when
-    missing) and listed in its manifest as ``sgtool bench``'s (:func:`sgtool.files.
-    note_written`); the commands write into the folder of
+    missing) and listed in its manifest as ``sgtool bench``'s
+    (:func:`sgtool.files.note_written`); the commands write into the folder of
     :func:`sgtool.files.output_folder`, so that the set appears complete."""
     from sgtool.analysis.curves import plot_efficiency
 

@@ -137,6 +137,10 @@ def test_docs_api_lists_every_public_name() -> None:
     # no first sentence cut inside a code span (a name wrapped after one of its dots)
     cut = [line for line in mod.section().splitlines() if line.count("`") % 2]
     assert cut == []
+    import re
+
+    spans = re.findall(r"`([^`\n]+)`", mod.section())
+    assert [x for x in spans if ". " in x] == []  # no name wrapped after one of its dots
 
 
 def test_dir_and_unknown_names() -> None:

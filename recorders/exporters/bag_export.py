@@ -355,8 +355,9 @@ def _write(r: LogReader, w: BagWriter, chosen: list[str], base_ns: int,
                 w.transform_stamped(t0, p, c, T) for (p, c), T in sorted(static.items())]),
                 latched=True)
         calib: CameraIntrinsics | None = None
-        # images of one log time met before any calibration: their camera_info is written
-        # when a calibration of that log time follows (MCAP orders no messages of one time)
+        # the images of one log time get their camera_info once the time has passed, with
+        # the calibration last logged by then (MCAP orders no messages of one log time: a
+        # calibration may follow the images it belongs to)
         waiting: list[tuple[str, int, str]] = []  # (namespace, stamp, frame id)
         converters = _converters(w)
         # a mounting that moves at times (on the log's /tf_static, then on /tf): its
@@ -367,12 +368,9 @@ def _write(r: LogReader, w: BagWriter, chosen: list[str], base_ns: int,
                 progress.update(1)
             t = d.log_time_ns + base_ns
             if waiting and waiting[0][1] != t:
-                waiting.clear()  # no calibration at their time: as before, none for them
+                _camera_infos(w, waiting, calib)
             if d.topic == S.CALIBRATION:
                 calib = codec.decode_calibration(d.message)
-                for ns, at, frame in waiting:
-                    w.write(f"{ns}/camera_info", INFO, at, w.camera_info(at, frame, calib))
-                waiting.clear()
             elif d.topic in (S.TF, TF_STATIC):
                 key = (d.message.parent_frame_id, d.message.child_frame_id)
                 if key in static or S.TF not in want:
@@ -393,17 +391,24 @@ def _write(r: LogReader, w: BagWriter, chosen: list[str], base_ns: int,
                 if f"{ns}/image_raw" in want:
                     w.write(f"{ns}/image_raw", IMAGE, t, _image(w, t, d.message))
                 if f"{ns}/camera_info" in want:
-                    frame = d.message.frame_id or S.CAMERA_FRAME
-                    if calib is not None:
-                        w.write(f"{ns}/camera_info", INFO, t, w.camera_info(t, frame, calib))
-                    else:
-                        waiting.append((ns, t, frame))
+                    waiting.append((ns, t, d.message.frame_id or S.CAMERA_FRAME))
             else:
                 for dst, make in converters[d.topic]:
                     if dst in want:
                         w.write(dst, OUTPUTS[dst][1], t, make(t, d.message),
                                 latched=OUTPUTS[dst][2])
+        _camera_infos(w, waiting, calib)
         return [(topic, OUTPUTS[topic][1], n) for topic, n in sorted(w.counts.items())]
+
+
+def _camera_infos(w: BagWriter, waiting: list[tuple[str, int, str]],
+                  calib: CameraIntrinsics | None) -> None:
+    """Write the camera_info of each waiting image (namespace, stamp, frame id) with
+    ``calib`` (none before any calibration) and empty ``waiting``."""
+    if calib is not None:
+        for ns, at, frame in waiting:
+            w.write(f"{ns}/camera_info", INFO, at, w.camera_info(at, frame, calib))
+    waiting.clear()
 
 
 OUTPUTS_ORDER = (S.CALIBRATION, S.TF, TF_STATIC, *IMAGE_TOPICS, S.OCCUPANCY, S.VORONOI,

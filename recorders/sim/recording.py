@@ -258,8 +258,9 @@ class RecordReport:
     driven, the rooms (or frontier goals) visited and those missed with why, the pieces
     opened, whether the frame budget cut the tour short, the wall-clock seconds, for
     a frontier exploration the share of the house's floor seen over time, and the open
-    doors and pieces whose panels had no room to swing (``taken_away``: out of the
-    simulation, an empty doorway in the log). ``lines()`` is ``sgtool record``'s report."""
+    doors and pieces whose panels had no room to swing (``taken_away``, the doors among
+    them ``doors_taken_away``: out of the simulation; an empty doorway in the log).
+    ``lines()`` is ``sgtool record``'s report."""
 
     output: Path
     house_id: str
@@ -273,6 +274,7 @@ class RecordReport:
     seconds: float  # wall-clock time of the run (reported, never logged)
     coverage: tuple[tuple[float, float], ...] = ()  # frontier: (sim time s, floor share)
     taken_away: tuple[str, ...] = ()  # open doors and pieces whose panels found no room
+    doors_taken_away: tuple[str, ...] = ()  # the doors among them
 
     def lines(self) -> list[str]:
         fps = self.frames / self.seconds if self.seconds > 0 else 0.0
@@ -289,11 +291,15 @@ class RecordReport:
             out.append(f"missed {r}: {why}")
         if self.truncated:
             out.append("stopped at the frame budget before the exploration finished")
-        if self.taken_away:
+        if self.doors_taken_away:
             out.append(f"open without room to swing, so taken out of the simulation: "
-                       f"{', '.join(self.taken_away)} (the log shows an empty doorway there: "
-                       "no door leaf; a doorway without a lintel then leaves the replay no "
-                       "door to find)")
+                       f"{', '.join(self.doors_taken_away)} (the log shows an empty doorway "
+                       "there: no door leaf; a doorway without a lintel then leaves the replay "
+                       "no door to find)")
+        pieces = [i for i in self.taken_away if i not in self.doors_taken_away]
+        if pieces:
+            out.append(f"opened without room for their doors to swing, so the doors were taken "
+                       f"out of the simulation: {', '.join(pieces)} (seen open, no door leaf)")
         if self.coverage:
             marks = [f"{m} min {100 * coverage_at(self.coverage, 60.0 * m):.1f} %"
                      for m in (1, 2, 5) if self.coverage[-1][0] >= 60.0 * m]
@@ -382,9 +388,11 @@ def record_house(house: HouseSpec | str | os.PathLike[str], output: str | os.Pat
         taken = tuple(sid for sid, bodies in sorted(sim.world.panels.items(),
                                                     key=lambda kv: spec_id_key(kv[0]))
                       if any(b.removed for b in bodies))
+        doors = {d.id for d in house.doors}
     return RecordReport(Path(output), hid, frames, actions, travelled, tuple(rep.visited),
                         dict(rep.missed), tuple(rep.opened), truncated,
-                        time.perf_counter() - t_wall, tuple(samples), taken)
+                        time.perf_counter() - t_wall, tuple(samples), taken,
+                        tuple(i for i in taken if i in doors))
 
 
 def _explore_live(sim: Simulation, rec: LogRecorder, opts: RecordOptions,

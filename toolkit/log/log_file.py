@@ -57,20 +57,30 @@ def unended_problem(path: Path, size: int) -> str:
             f"written); {recover}")
 
 
+def opening_damaged(head: bytes, size: int, closing: bytes) -> bool:
+    """Whether a file of ``size`` bytes whose first bytes ``head`` (9 or more) do not
+    start with the MCAP magic is an MCAP file with a damaged opening magic: it ends with the
+    closing magic, a header record follows the opening, or the opening is off by a few
+    bytes (not any other file)."""
+    near = len(head) >= 8 and sum(a != b for a, b in zip(head[:8], MAGIC, strict=True)) <= 3
+    return size >= 17 and (near or closing == MAGIC or head[8:9] == b"\x01")
+
+
 def magic_problem(path: Path) -> tuple[int, str | None]:
     """The size of the MCAP file ``path`` and the one line when it does not start and end
     with the MCAP magic (None when it does): not an MCAP file; one whose opening magic is
-    damaged but that ends as an MCAP file does; or :func:`unended_problem`'s."""
+    damaged (:func:`opening_damaged`); or :func:`unended_problem`'s."""
     with open(path, "rb") as f:
-        opening = f.read(8)
+        head = f.read(9)
         size = f.seek(0, os.SEEK_END)
         f.seek(max(size - 8, 0))
         closing = f.read(8) if size >= 16 else b""
+    opening = head[:8]
     if opening != MAGIC:
         return size, (f"{path}: not an MCAP file (it does not start with the MCAP magic bytes)"
-                      if closing != MAGIC else
-                      f"{path}: its opening MCAP magic bytes are damaged (it ends as an MCAP "
-                      f"file does); `sgtool doctor {quoted(path)} --recover OUT.mcap` "
+                      if not opening_damaged(head, size, closing) else
+                      f"{path}: its opening MCAP magic bytes are damaged (the rest reads as "
+                      f"MCAP); `sgtool doctor {quoted(path)} --recover OUT.mcap` "
                       "recovers what is readable")
     return size, None if closing == MAGIC else unended_problem(path, size)
 

@@ -22,6 +22,7 @@ from __future__ import annotations
 import io
 import mmap
 import os
+import struct
 from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -36,7 +37,7 @@ from sgtool.files import atomic_open
 from sgtool.log import schemas as S
 from sgtool.log.file_check import SummaryState, check, expected_messages, summary_state
 from sgtool.log.file_walk import Item, Layout, data_crc_matches, walk
-from sgtool.log.log_file import appended_end, require_regular_file
+from sgtool.log.log_file import appended_end, opening_damaged, require_regular_file
 from sgtool.log.mcap_records import MAGIC
 from sgtool.log.message_check import message_problem
 from sgtool.output_check import check_log_output
@@ -92,7 +93,8 @@ def _diagnose(buf: mmap.mmap, diag: Diagnosis, writer: _Copier | None) -> None:
     if writer is not None:
         writer.layout = lay
     unknown = _consume(walk(buf, lay), diag, writer,
-                       lambda: lay.header is None or lay.header.profile == S.PROFILE)
+                       lambda: lay.header is None or lay.header.profile == S.PROFILE
+                       or _names_sgtool_metadata(buf))
     read = {c.offset: Counter((cid, t) for cid, t, _ in c.messages if cid not in unknown)
             for c in lay.chunks}
     read[_OUTSIDE_CHUNKS] = Counter((cid, t) for cid, t, _ in lay.loose if cid not in unknown)
@@ -197,8 +199,7 @@ def _require_magic(p: Path) -> str | None:
         tail = f.read(8)
     if head[:8] == MAGIC:
         return None
-    near = len(head) >= 8 and sum(a != b for a, b in zip(head[:8], MAGIC, strict=True)) <= 3
-    if size >= 17 and (near or tail == MAGIC or head[8:9] == b"\x01"):
+    if opening_damaged(head, size, tail):
         return (f"the opening magic bytes are damaged ({head[:8].hex(' ')} instead of "
                 f"{MAGIC.hex(' ')})")
     raise LogFormatError(f"{p}: not an MCAP file (it does not start with the MCAP magic "
@@ -207,6 +208,19 @@ def _require_magic(p: Path) -> str | None:
 
 def _summary_channels(lay: Layout) -> list[Channel]:
     return [r.record for r in lay.summary_records() if isinstance(r.record, Channel)]
+
+
+def _names_sgtool_metadata(buf: mmap.mmap) -> bool:
+    """Whether ``buf`` holds a metadata record named as sgtool names its own (opcode 0x0C,
+    its length, then the name): an sgtool log whose header was damaged or rewritten
+    (a recovery that lost the header writes none)."""
+    name = struct.pack("<I", len(S.METADATA_NAME)) + S.METADATA_NAME.encode()
+    at = buf.find(name)
+    while at != -1:
+        if at >= 9 and buf[at - 9] == 0x0C:
+            return True
+        at = buf.find(name, at + 1)
+    return False
 
 
 def _consume(items: Iterator[Item], diag: Diagnosis, writer: _Copier | None,

@@ -396,11 +396,20 @@ def test_a_calibration_logged_after_the_images_of_its_time_still_gives_camera_in
         tmp_path):
     """MCAP orders no messages of one log time; a log rewritten with the calibration after
     the images of the same time (as a ROS driver publishes camera_info after image) lost
-    the first frame's CameraInfo of every camera."""
+    the first frame's CameraInfo of every camera, and gave the frame whose calibration
+    changed the old one."""
+    import dataclasses
+
     from mcap.reader import make_reader
     from mcap.writer import Writer
 
-    log = log_with_rooms(tmp_path / "d.mcap")
+    log = tmp_path / "d.mcap"
+    with LogWriter(log, seed=7) as w:  # the camera's calibration changes at frame 2
+        for i in range(4):
+            k, rgb, depth, ids, pose, base = synthetic_frame(i)
+            k = dataclasses.replace(k, fx=2 * k.fx) if i >= 2 else k
+            w.write_frame(i * DT, rgb=rgb, depth=depth, ids=ids, pose=pose, intrinsics=k,
+                          base_pose=base)
     late = tmp_path / "late.mcap"
     with open(log, "rb") as f:
         r = make_reader(f)
@@ -422,7 +431,12 @@ def test_a_calibration_logged_after_the_images_of_its_time_still_gives_camera_in
             w.add_message(cid[c.id], m.log_time, m.data, m.publish_time, m.sequence)
         w.finish()
     got = read_bag(export_bag(late, tmp_path / "o.bag").output)
+    fx0 = synthetic_frame(0)[0].fx
     for ns in ("rgb", "depth", "instances"):
         images = [t for t, _ in got[f"/camera/{ns}/image_raw"]]
         infos = [t for t, _ in got[f"/camera/{ns}/camera_info"]]
         assert infos == images and len(images) == 4
+        # each with the calibration of its own log time, logged after it
+        assert [getattr(m, "k", getattr(m, "K", None))[0]
+                for _, m in got[f"/camera/{ns}/camera_info"]] == pytest.approx(
+            [fx0, fx0, 2 * fx0, 2 * fx0])

@@ -46,7 +46,7 @@ def test_a_door_without_room_to_swing_is_named_in_the_report(tmp_path: Path) -> 
     rep = sgtool.record_house(sgtool.load_house(_two_corridors()), tmp_path / "c.mcap",
                               sgtool.RecordOptions(frames=3, camera=sgtool.CameraConfig(
                                   width=32, height=24)))
-    assert rep.taken_away == ("door_0",)
+    assert rep.taken_away == rep.doors_taken_away == ("door_0",)
     (line,) = [x for x in rep.lines() if x.startswith("open without room to swing")]
     assert "taken out of the simulation: door_0 (the log shows an empty doorway" in line
 
@@ -65,3 +65,33 @@ def test_a_door_with_room_to_swing_is_not(tmp_path: Path) -> None:
                                   width=32, height=24)))
     assert rep.taken_away == ()
     assert not [x for x in rep.lines() if "without room to swing" in x]
+
+
+def test_a_container_whose_door_cannot_swing_is_worded_as_a_piece(tmp_path: Path) -> None:
+    """A cabinet whose door would hit the table in front of it: its door is taken away when
+    the tour opens it; the report called that an empty doorway."""
+    import sgtool
+
+    house = _two_corridors()
+    house["rooms"][1]["polygon"] = [[1.2, 0], [4.2, 0], [4.2, 6], [1.2, 6]]
+    for w in house["walls"]:
+        for end in ("a", "b"):
+            if w[end][0] == 2.4:
+                w[end][0] = 4.2
+    house["furniture"] += [
+        {"id": "furn_1", "category": "cabinet", "synset": "cabinet.n.01", "room": "room_1",
+         "center": [3.0, 5.7, 0.45], "size": [0.8, 0.5, 0.9], "yaw": math.pi,
+         "affordances": ["openable", "container"], "state": "closed"},
+        {"id": "furn_2", "category": "table", "synset": "table.n.02", "room": "room_1",
+         "center": [3.0, 5.05, 0.375], "size": [1.6, 0.5, 0.75], "yaw": 0,
+         "affordances": ["supporter"], "state": None}]
+    house["objects"].append({"id": "obj_1", "category": "apple", "synset": "apple.n.01",
+                             "parent": "furn_1", "relation": "inside", "room": "room_1",
+                             "position": [3.0, 5.7, 0.3], "size": [0.08, 0.08, 0.08]})
+    rep = sgtool.record_house(sgtool.load_house(house), tmp_path / "c.mcap",
+                              sgtool.RecordOptions(camera=sgtool.CameraConfig(
+                                  width=32, height=24)))
+    assert rep.taken_away == ("furn_1",) and rep.doors_taken_away == ()
+    (line,) = [x for x in rep.lines() if "to swing" in x]
+    assert line.startswith("opened without room for their doors to swing") and \
+        "furn_1 (seen open, no door leaf)" in line and "doorway" not in line

@@ -111,7 +111,8 @@ def test_diff_refuses_a_foreign_recording_in_one_line(tmp_path):
     assert "is a ROS 2 recording" in r.output
 
 
-def _foreign_mcap(path, profile: str = "") -> None:  # type: ignore[no-untyped-def]
+def _foreign_mcap(path, profile: str = "",  # type: ignore[no-untyped-def]
+                  sgtool_metadata: bool = False) -> None:
     """A valid MCAP file another tool might write: /tf as JSON (a foxglove.FrameTransform
     JSON schema) and a foxglove.RawImage in 'uyvy', which sgtool does not decode."""
     import json
@@ -142,6 +143,8 @@ def _foreign_mcap(path, profile: str = "") -> None:  # type: ignore[no-untyped-d
                                              "translation": {"x": i}}).encode(), t)
             raw = RawImage(width=2, height=2, encoding="uyvy", step=4, data=bytes(8))
             w.add_message(img, t, raw.SerializeToString(), t)
+        if sgtool_metadata:
+            w.add_metadata("sgtool", {"sgtool_version": "0.1.0"})
         w.finish()
 
 
@@ -159,12 +162,14 @@ def test_doctor_keeps_a_foreign_files_valid_messages(tmp_path):
 
     with open(tmp_path / "r.mcap", "rb") as fh:
         assert sum(1 for _ in make_reader(fh).iter_messages()) == 6
-    # the same file calling itself an sgtool log is held to sgtool's reading
-    own = tmp_path / "own.mcap"
-    _foreign_mcap(own, profile="sgtool")
-    r = CliRunner().invoke(cli, ["doctor", str(own)])
-    assert r.exit_code == 1 and "sgtool reads /tf as protobuf foxglove.FrameTransform" \
-        in r.output
+    # the same file calling itself an sgtool log is held to sgtool's reading, by its
+    # header's profile or (a header lost and rewritten) by its sgtool metadata record
+    for profile, meta in (("sgtool", False), ("", True)):
+        own = tmp_path / f"own{profile}.mcap"
+        _foreign_mcap(own, profile=profile, sgtool_metadata=meta)
+        r = CliRunner().invoke(cli, ["doctor", str(own)])
+        assert r.exit_code == 1 and "sgtool reads /tf as protobuf foxglove.FrameTransform" \
+            in r.output
 
 
 def test_pin_of_a_foreign_file_says_what_it_is_and_topics_count_once(tmp_path):

@@ -67,6 +67,11 @@ def test_a_damaged_opening_magic_is_a_corrupt_log_that_recovers(log40, tmp_path)
     r = CliRunner().invoke(cli, ["info", str(bad)])
     assert r.exit_code == 2 and "its opening MCAP magic bytes are damaged" in r.output
     assert "--recover OUT.mcap` recovers" in r.output
+    cut = tmp_path / "cut.mcap"  # damaged opening and cut short: still doctor's to recover
+    cut.write_bytes(bad.read_bytes()[: bad.stat().st_size * 2 // 3])
+    r = CliRunner().invoke(cli, ["info", str(cut)])
+    assert r.exit_code == 2 and "its opening MCAP magic bytes are damaged" in r.output
+    assert scan(cut).readable_messages > 0
     text = tmp_path / "t.mcap"
     text.write_bytes(b"not a log at all, just some text")
     with pytest.raises(LogFormatError, match="not an MCAP file"):
