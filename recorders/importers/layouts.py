@@ -313,8 +313,8 @@ def _read_tum(
     track = None
     if gt_path.is_file():
         # ground truth at ~100 Hz: interpolate over gaps up to 0.1 s, no extrapolation
-        # beyond 10 ms (the motion-capture system loses markers now and then); a slower
-        # trajectory (5-10 Hz from a SLAM system) over gaps of 2.5 of its steps, to 0.5 s
+        # beyond 10 ms (the motion-capture system loses markers now and then); a sparser
+        # trajectory (a SLAM system's) over gaps of 2.5 of its steps, to 0.5 s
         samples = read_tum_trajectory(gt_path)
         if not samples and not keep_unposed:
             raise SgtoolError(f"{gt_path}: holds no poses (TUM lines: time tx ty tz qx qy qz "

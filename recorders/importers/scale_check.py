@@ -76,6 +76,20 @@ def pair_indices(poses: Sequence[np.ndarray], n_pairs: int = PAIRS) -> list[tupl
     return out
 
 
+def _pair_surfaces(d0: np.ndarray, d1: np.ndarray, k: CameraIntrinsics, columns: int
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Frame i's surface points and normals and frame j's points (each in its own camera
+    frame; depth ``d0``, ``d1`` sampled about ``columns`` pixels across); None with fewer
+    than 50 of either."""
+    from sgtool.recorders.importers.upright import DepthSample, surface_points
+
+    eye = np.eye(4)
+    stride = max(1, d0.shape[1] // columns)
+    q, nq = surface_points(DepthSample(d0, k, eye), stride=stride)
+    p, _ = surface_points(DepthSample(d1, k, eye), stride=stride)
+    return None if len(q) < 50 or len(p) < 50 else (q, nq, p)
+
+
 def translation_scale(d0: np.ndarray, d1: np.ndarray, k: CameraIntrinsics,
                       rel: np.ndarray) -> tuple[float, float, float] | None:
     """The factor ``s`` on the poses' translation that best aligns frame j's points with
@@ -87,14 +101,10 @@ def translation_scale(d0: np.ndarray, d1: np.ndarray, k: CameraIntrinsics,
     pair says about ``s``); None without enough points."""
     from scipy.spatial import cKDTree
 
-    from sgtool.recorders.importers.upright import DepthSample, surface_points
-
-    eye = np.eye(4)
-    stride = max(1, d0.shape[1] // 160)
-    q, nq = surface_points(DepthSample(d0, k, eye), stride=stride)
-    p, _ = surface_points(DepthSample(d1, k, eye), stride=stride)
-    if len(q) < 50 or len(p) < 50:
+    got = _pair_surfaces(d0, d1, k, 160)
+    if got is None:
         return None
+    q, nq, p = got
     med = float(np.median(q[:, 2]))
     R, t = rel[:3, :3], rel[:3, 3]  # noqa: N806
     pr = p @ R.T
@@ -133,14 +143,10 @@ def surface_gap(d0: np.ndarray, d1: np.ndarray, k: CameraIntrinsics,
     lie within :data:`MATCH_REL` of the median depth of a surface point."""
     from scipy.spatial import cKDTree
 
-    from sgtool.recorders.importers.upright import DepthSample, surface_points
-
-    eye = np.eye(4)
-    stride = max(1, d0.shape[1] // 80)
-    q, nq = surface_points(DepthSample(d0, k, eye), stride=stride)
-    p, _ = surface_points(DepthSample(d1, k, eye), stride=stride)
-    if len(q) < 50 or len(p) < 50:
+    got = _pair_surfaces(d0, d1, k, 80)
+    if got is None:
         return None
+    q, nq, p = got
     moved = p @ rel[:3, :3].T + rel[:3, 3]
     dist, idx = cKDTree(q).query(moved, distance_upper_bound=MATCH_REL * float(
         np.median(q[:, 2])))

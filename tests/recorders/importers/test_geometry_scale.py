@@ -99,25 +99,32 @@ def test_a_depth_scale_15_percent_off_is_not_blamed_on_the_poses(tmp_path):
         import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
 
 
-def test_bag_depth_at_half_millimetres_names_the_scale_that_fits(tmp_path):
-    """16UC1 depth in 0.5 mm units (ROS says millimetres): 2x too deep, still indoor by its
-    statistics; the /tf poses say otherwise."""
+def _scene_bag(bag, units_per_m, k=None):  # type: ignore[no-untyped-def]
+    """A ROS 1 bag of the room seen from POSES: /tf map -> cam, /info (``k``, else the
+    scene's camera), 16UC1 /depth at ``units_per_m``."""
     from support.bag_export import BagWriter
     from support.rgbd_scenes import K as SK
     from support.rgbd_scenes import render
 
-    from sgtool.recorders.importers.bag import BagOptions, import_bag
-
-    bag = tmp_path / "b.bag"
     t0, dt = 1_700_000_000_000_000_000, 33_000_000
     with BagWriter(bag, "ros1") as w:
         for i, pose in enumerate(POSES):
             t = t0 + i * dt
             w.write("/tf", "tf2_msgs/msg/TFMessage", t,
                     w.tf(t, [w.transform_stamped(t, "map", "cam", pose)]))
-            w.write("/info", "sensor_msgs/msg/CameraInfo", t, w.camera_info(t, "cam", SK))
-            raw = (render(room(), pose) * 2000).round().astype("uint16")
+            w.write("/info", "sensor_msgs/msg/CameraInfo", t,
+                    w.camera_info(t, "cam", SK if k is None else k))
+            raw = (render(room(), pose) * units_per_m).round().astype("uint16")
             w.write("/depth", "sensor_msgs/msg/Image", t, w.image(t, "cam", raw, "16UC1"))
+    return bag
+
+
+def test_bag_depth_at_half_millimetres_names_the_scale_that_fits(tmp_path):
+    """16UC1 depth in 0.5 mm units (ROS says millimetres): 2x too deep, still indoor by its
+    statistics; the /tf poses say otherwise."""
+    from sgtool.recorders.importers.bag import BagOptions, import_bag
+
+    bag = _scene_bag(tmp_path / "b.bag", 2000.0)
     opts = dict(depth="/depth", info="/info", progress=False)
     with pytest.raises(SgtoolError, match=r"depth scale 1000 units/m \(the image encoding.*\) "
                        r"disagrees with the tf map -> cam: .* moves 2.0\dx as far.*"
@@ -245,23 +252,12 @@ def test_an_uncalibrated_camera_info_names_the_flag_that_helps(tmp_path):
     without a word of --intrinsics, which imports it."""
     import dataclasses
 
-    from support.bag_export import BagWriter
     from support.rgbd_scenes import K as SK
-    from support.rgbd_scenes import render
 
     from sgtool.recorders.importers.bag import BagOptions, import_bag
 
-    bag = tmp_path / "b.bag"
-    t0, dt = 1_700_000_000_000_000_000, 33_000_000
     zero = dataclasses.replace(SK, fx=0.0, fy=0.0, cx=0.0, cy=0.0)
-    with BagWriter(bag, "ros1") as w:
-        for i, pose in enumerate(POSES):
-            t = t0 + i * dt
-            w.write("/tf", "tf2_msgs/msg/TFMessage", t,
-                    w.tf(t, [w.transform_stamped(t, "map", "cam", pose)]))
-            w.write("/info", "sensor_msgs/msg/CameraInfo", t, w.camera_info(t, "cam", zero))
-            raw = (render(room(), pose) * 1000).round().astype("uint16")
-            w.write("/depth", "sensor_msgs/msg/Image", t, w.image(t, "cam", raw, "16UC1"))
+    bag = _scene_bag(tmp_path / "b.bag", 1000.0, zero)
     with pytest.raises(SgtoolError, match=r"no usable focal length .*give its intrinsics "
                        r"with --intrinsics fx,fy,cx,cy"):
         import_bag(bag, tmp_path / "a.mcap", BagOptions(depth="/depth", info="/info",
