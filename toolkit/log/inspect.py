@@ -223,6 +223,9 @@ def format_summary(s: dict[str, Any]) -> str:
                     "travelled_m", "frames"]
             parts = [f"{k}={ep[k]}" for k in keys if ep.get(k) is not None]
             lines.append("episode: " + ", ".join(parts))
+        imported = s.get("metadata", {}).get(S.IMPORT_METADATA_NAME, {})
+        lines += [f"import warning: {w}" for w in str(imported.get("warnings") or "")
+                  .splitlines() if w.strip()]  # what `sgtool import` warned of, kept
     lines.append("")
     w_topic = max([len(c["topic"]) for c in s["channels"]] + [5])
     w_schema = max([len(c["schema"]) for c in s["channels"]] + [6])

@@ -131,3 +131,21 @@ def test_info_leaves_out_a_seed_the_log_has_none_of(tmp_path):
     r = CliRunner().invoke(cli, ["info", str(out)])
     assert r.exit_code == 0, r.output
     assert "None" not in r.output
+
+
+def test_info_shows_what_the_import_warned_of(tmp_path):
+    """An import's warnings are kept in the log's sgtool.import metadata; info showed them
+    only with --json."""
+    from support.logfixtures import synthetic_frame
+
+    from sgtool.log import LogWriter
+    from sgtool.log.inspect import format_summary, summarize
+    from sgtool.log.schemas import IMPORT_METADATA_NAME
+
+    log = tmp_path / "imported.mcap"
+    with LogWriter(log, seed=0) as w:
+        w.add_metadata(IMPORT_METADATA_NAME, {"source": "x", "warnings": "first\nsecond"})
+        k, rgb, depth, ids, pose, base = synthetic_frame(0)
+        w.write_frame(0, rgb=rgb, depth=depth, ids=ids, pose=pose, intrinsics=k)
+    text = format_summary(summarize(log))
+    assert "import warning: first\nimport warning: second" in text
