@@ -138,6 +138,14 @@ class ExportReport:
         if not self.derived:
             out.append("note: the log has no derived layers (occupancy, Voronoi graph, rooms, "
                        "scene graph): export the output of `sgtool replay LOG -o DERIVED.mcap`")
+        written = {t: n for t, _, n in self.counts}
+        bare = [t.removesuffix("/image_raw") for t, n in written.items()
+                if t.endswith("/image_raw") and n and f"{t.removesuffix('/image_raw')}"
+                f"/camera_info" in self.chosen and not written.get(
+                    t.removesuffix("/image_raw") + "/camera_info")]
+        if bare:
+            out.append(f"note: no CameraInfo for {', '.join(bare)}: the log holds no camera "
+                       "calibration (/camera/calibration) to give its images one")
         return out
 
 

@@ -440,3 +440,33 @@ def test_a_calibration_logged_after_the_images_of_its_time_still_gives_camera_in
         assert [getattr(m, "k", getattr(m, "K", None))[0]
                 for _, m in got[f"/camera/{ns}/camera_info"]] == pytest.approx(
             [fx0, fx0, 2 * fx0, 2 * fx0])
+
+
+def test_a_log_without_calibration_says_why_there_is_no_camera_info(tmp_path):
+    """Its images were exported without CameraInfo and nothing said so."""
+    from mcap.reader import make_reader
+    from mcap.writer import Writer
+
+    log = log_with_rooms(tmp_path / "d.mcap")
+    bare = tmp_path / "bare.mcap"
+    with open(log, "rb") as f, open(bare, "wb") as g:
+        r, w = make_reader(f), Writer(g)
+        head, summary = r.get_header(), r.get_summary()
+        assert summary is not None
+        w.start(head.profile, head.library)
+        for sc in summary.schemas.values():
+            w.register_schema(sc.name, sc.encoding, sc.data)
+        ids = {cid: w.register_channel(c.topic, c.message_encoding, c.schema_id, c.metadata)
+               for cid, c in summary.channels.items()}
+        for md in r.iter_metadata():
+            w.add_metadata(md.name, dict(md.metadata))
+        for _, c, m in r.iter_messages():
+            if c.topic != S.CALIBRATION:
+                w.add_message(ids[c.id], m.log_time, m.data, m.publish_time, m.sequence)
+        w.finish()
+    rep = export_bag(bare, tmp_path / "o.bag")
+    (note,) = [x for x in rep.lines() if "no CameraInfo" in x]
+    assert note == ("note: no CameraInfo for /camera/depth, /camera/instances, /camera/rgb: "
+                    "the log holds no camera calibration (/camera/calibration) to give its "
+                    "images one")
+    assert not [x for x in export_bag(log, tmp_path / "p.bag").lines() if "no CameraInfo" in x]
