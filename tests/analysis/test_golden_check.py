@@ -401,34 +401,12 @@ def test_a_symlinked_data_folder_stays_a_link_in_the_index(log, tmp_path, capsys
     assert summary_row(out, "small")
 
 
-def _without(src, dst, topic):
-    """``src`` with every message of ``topic`` left out (its channel kept)."""
-    from mcap.reader import make_reader
-    from mcap.writer import Writer
-
-    with open(src, "rb") as f, open(dst, "wb") as g:
-        r, w = make_reader(f), Writer(g)
-        head, summary = r.get_header(), r.get_summary()
-        w.start(head.profile, head.library)
-        for sc in summary.schemas.values():
-            w.register_schema(sc.name, sc.encoding, sc.data)
-        ids = {cid: w.register_channel(c.topic, c.message_encoding, c.schema_id, c.metadata)
-               for cid, c in summary.channels.items()}
-        for a in r.iter_attachments():
-            w.add_attachment(a.create_time, a.log_time, a.name, a.media_type, a.data)
-        for md in r.iter_metadata():  # still an sgtool log
-            w.add_metadata(md.name, dict(md.metadata))
-        for _, c, m in r.iter_messages():
-            if c.topic != topic:
-                w.add_message(ids[c.id], m.log_time, m.data, m.publish_time, m.sequence)
-        w.finish()
-    return dst
-
-
 def test_a_log_without_camera_frames_is_not_pinned(log, tmp_path, capsys):
     """Its replay maps nothing (a refresh at each action record, of an empty map): a pin
     of it would pass whatever the mapping code did."""
-    empty = _without(log, tmp_path / "no depth.mcap", "/camera/depth")
+    from support.mcap_variants import without
+
+    empty = without(log, tmp_path / "no depth.mcap", "/camera/depth")
     code, _, err = sgtool(capsys, "golden", "pin", empty, "--dir", tmp_path / "g")
     assert code == 2 and "mapped no camera frame" in err and err.count("\n") == 1
     assert not (tmp_path / "g").exists()

@@ -198,3 +198,18 @@ def rewrite(src: Path, dst: Path, v: Variant) -> Path:
     w.out += MAGIC
     dst.write_bytes(bytes(w.out))
     return dst
+
+
+def channel_ids(path: Path, topic: str) -> set[int]:
+    """The ids of the channels of ``topic`` in the MCAP file ``path`` (its summary's)."""
+    with open(path, "rb") as f:
+        summary = make_reader(f).get_summary()
+    assert summary is not None
+    return {cid for cid, c in summary.channels.items() if c.topic == topic}
+
+
+def without(src: Path, dst: Path, topic: str) -> Path:
+    """``src`` with every message of ``topic`` left out (its channel kept)."""
+    gone = channel_ids(src, topic)
+    return rewrite(src, dst, Variant(order=lambda ms: [m for m in ms
+                                                       if m.channel_id not in gone]))

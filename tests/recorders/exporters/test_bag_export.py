@@ -400,8 +400,7 @@ def test_a_calibration_logged_after_the_images_of_its_time_still_gives_camera_in
     changed the old one."""
     import dataclasses
 
-    from mcap.reader import make_reader
-    from mcap.writer import Writer
+    from support.mcap_variants import Variant, channel_ids, rewrite
 
     log = tmp_path / "d.mcap"
     with LogWriter(log, seed=7) as w:  # the camera's calibration changes at frame 2
@@ -410,26 +409,9 @@ def test_a_calibration_logged_after_the_images_of_its_time_still_gives_camera_in
             k = dataclasses.replace(k, fx=2 * k.fx) if i >= 2 else k
             w.write_frame(i * DT, rgb=rgb, depth=depth, ids=ids, pose=pose, intrinsics=k,
                           base_pose=base)
-    late = tmp_path / "late.mcap"
-    with open(log, "rb") as f:
-        r = make_reader(f)
-        summary, header = r.get_summary(), r.get_header()
-        assert summary is not None
-        msgs = sorted(r.iter_messages(log_time_order=True),
-                      key=lambda m: (m[2].log_time, m[1].topic == S.CALIBRATION))
-        metadata = [(m.name, dict(m.metadata)) for m in r.iter_metadata()]
-    with open(late, "wb") as f:
-        w = Writer(f)
-        w.start(profile=header.profile, library=header.library)
-        sid = {k: w.register_schema(s.name, s.encoding, s.data)
-               for k, s in summary.schemas.items()}
-        cid = {k: w.register_channel(c.topic, c.message_encoding, sid.get(c.schema_id, 0),
-                                     dict(c.metadata)) for k, c in summary.channels.items()}
-        for name, data in metadata:
-            w.add_metadata(name, data)
-        for _, c, m in msgs:
-            w.add_message(cid[c.id], m.log_time, m.data, m.publish_time, m.sequence)
-        w.finish()
+    calib = channel_ids(log, S.CALIBRATION)
+    late = rewrite(log, tmp_path / "late.mcap", Variant(order=lambda ms: sorted(
+        ms, key=lambda m: (m.log_time, m.channel_id in calib))))
     got = read_bag(export_bag(late, tmp_path / "o.bag").output)
     fx0 = synthetic_frame(0)[0].fx
     for ns in ("rgb", "depth", "instances"):
@@ -444,26 +426,10 @@ def test_a_calibration_logged_after_the_images_of_its_time_still_gives_camera_in
 
 def test_a_log_without_calibration_says_why_there_is_no_camera_info(tmp_path):
     """Its images were exported without CameraInfo and nothing said so."""
-    from mcap.reader import make_reader
-    from mcap.writer import Writer
+    from support.mcap_variants import without
 
     log = log_with_rooms(tmp_path / "d.mcap")
-    bare = tmp_path / "bare.mcap"
-    with open(log, "rb") as f, open(bare, "wb") as g:
-        r, w = make_reader(f), Writer(g)
-        head, summary = r.get_header(), r.get_summary()
-        assert summary is not None
-        w.start(head.profile, head.library)
-        for sc in summary.schemas.values():
-            w.register_schema(sc.name, sc.encoding, sc.data)
-        ids = {cid: w.register_channel(c.topic, c.message_encoding, c.schema_id, c.metadata)
-               for cid, c in summary.channels.items()}
-        for md in r.iter_metadata():
-            w.add_metadata(md.name, dict(md.metadata))
-        for _, c, m in r.iter_messages():
-            if c.topic != S.CALIBRATION:
-                w.add_message(ids[c.id], m.log_time, m.data, m.publish_time, m.sequence)
-        w.finish()
+    bare = without(log, tmp_path / "bare.mcap", S.CALIBRATION)
     rep = export_bag(bare, tmp_path / "o.bag")
     (note,) = [x for x in rep.lines() if "no CameraInfo" in x]
     assert note == ("note: no CameraInfo for /camera/depth, /camera/instances, /camera/rgb: "
