@@ -94,6 +94,7 @@ from sgtool.recorders.importers.sanity import (
 from sgtool.recorders.importers.scale_check import (
     convention_problems,
     fit_scale,
+    pair_indices,
     pose_motion_problem,
 )
 from sgtool.recorders.importers.sink import (
@@ -267,11 +268,10 @@ def _check_poses(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
     turned depth pairs: :mod:`.scale_check`, :mod:`.focal_check`): the fits into
     ``checks``, their problems into ``findings`` (the depth scale not blamed where the
     focal length explains the depth's motion)."""
-    pairs = bag_scale_pairs(reader, idx, opts, src, k)
+    pairs, turned = bag_scale_pairs(reader, idx, opts, src, k, (pair_indices, turn_pairs))
     fit = fit_scale(pairs, k)
     if fit is not None:
         checks.append(("depth scale against the poses", fit.describe()))
-    turned = bag_scale_pairs(reader, idx, opts, src, k, turn_pairs)
     focal, problem, explains = check_focal(turned, pairs, k, fit, _intrinsics_origin(opts))
     if focal is not None:
         checks.append(("focal length against the poses", focal.describe()))

@@ -6,7 +6,7 @@ depth's encoding; only 16-bit depth has a scale to name."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -23,28 +23,32 @@ from sgtool.recorders.importers.scale_check import (
     pair_indices,
 )
 
+_Pair = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
 
 def bag_scale_pairs(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
                     k: CameraIntrinsics,
-                    select: Callable[[list[np.ndarray]], list[tuple[int, int]]] = pair_indices
-                    ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
-    """Pairs of depth images in metres with their poses from ``src``, as
-    :func:`~.scale_check.fit_scale` and :func:`~.scale_check.convention_problems` take
-    them (one pass over the depth topic): the pairs ``select`` picks from the images'
-    poses in time order (nearby frames; :func:`~.focal_check.turn_pairs`: turned ones);
-    empty without a usable pair."""
+                    selects: Sequence[Callable[[list[np.ndarray]], list[tuple[int, int]]]]
+                    = (pair_indices,)) -> list[list[_Pair]]:
+    """Per selector of ``selects``, pairs of depth images in metres with their poses from
+    ``src``, as :func:`~.scale_check.fit_scale` and
+    :func:`~.scale_check.convention_problems` take them (one pass over the depth topic for
+    all): the pairs it picks from the images' poses in time order (:func:`pair_indices`:
+    nearby frames; :func:`~.focal_check.turn_pairs`: turned ones); empty without a usable
+    pair."""
+    empty: list[list[_Pair]] = [[] for _ in selects]
     if not idx.samples:
-        return []
+        return empty
     explicit = opts.tf_frames is not None or opts.pose is not None
     posed: list[tuple[int, np.ndarray]] = []
     for kk in sorted(range(len(idx.depth.stamps)), key=lambda i: idx.depth.stamps[i]):
         T = src.at(idx.depth.stamps[kk], None if explicit else idx.depth.frames[kk])  # noqa: N806
         if T is not None:
             posed.append((kk, T))
-    pairs = select([T for _, T in posed])
-    if not pairs:
-        return []
-    need = {posed[i][0] for p in pairs for i in p}
+    chosen = [select([T for _, T in posed]) for select in selects]
+    need = {posed[i][0] for pairs in chosen for p in pairs for i in p}
+    if not need:
+        return empty
     got: dict[int, np.ndarray] = {}
     count = 0
     for c, _, raw in reader.messages(connections=B.connections_for(reader, str(opts.depth))):
@@ -56,9 +60,10 @@ def bag_scale_pairs(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSourc
             if len(got) == len(need):
                 break
         count += 1
-    return [(got[posed[i][0]], got[posed[j][0]], posed[i][1], posed[j][1])
-            for i, j in pairs if posed[i][0] in got and posed[j][0] in got
-            and got[posed[i][0]].shape == (k.height, k.width)]
+    return [[(got[posed[i][0]], got[posed[j][0]], posed[i][1], posed[j][1])
+             for i, j in pairs if posed[i][0] in got and posed[j][0] in got
+             and got[posed[i][0]].shape == (k.height, k.width)]
+            for pairs in chosen]
 
 
 def bag_scale_problem(fit: ScaleFit | None, idx: BagIndex, opts: BagOptions,
