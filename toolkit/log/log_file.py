@@ -57,32 +57,49 @@ def unended_problem(path: Path, size: int) -> str:
             f"written); {recover}")
 
 
-def opening_damaged(head: bytes, size: int, closing: bytes) -> bool:
+def file_ends(path: Path) -> tuple[bytes, int, bytes]:
+    """(its first 9 bytes, its size, its last 37 bytes: a footer record and the closing
+    magic) of the file ``path`` (fewer bytes when it is shorter)."""
+    with open(path, "rb") as f:
+        head = f.read(9)
+        size = f.seek(0, os.SEEK_END)
+        f.seek(max(size - _FOOTED, 0))
+        tail = f.read(_FOOTED) if size >= 16 else b""
+    return head, size, tail
+
+
+_FOOTED = 1 + 8 + 20 + len(MAGIC)  # footer record (opcode, length, 20 bytes) and magic
+
+
+def _footed(tail: bytes) -> bool:
+    """Whether ``tail`` ends with a footer record and the closing magic."""
+    return (len(tail) >= _FOOTED and tail[-8:] == MAGIC and tail[-_FOOTED] == 0x02
+            and int.from_bytes(tail[-_FOOTED + 1:-_FOOTED + 9], "little") == 20)
+
+
+def opening_damaged(head: bytes, size: int, tail: bytes) -> bool:
     """Whether a file of ``size`` bytes whose first bytes ``head`` (9 or more) do not
-    start with the MCAP magic is an MCAP file with a damaged opening magic: it ends with the
-    closing magic, a header record follows the opening, or the opening is off by a few
-    bytes (not any other file)."""
+    start with the MCAP magic is an MCAP file with a damaged opening magic: it ends with a
+    footer record and the closing magic (``tail``: its last bytes, :func:`file_ends`), a
+    header record follows the opening, or the opening is off by a few bytes (not any other
+    file, such as a text file that happens to end with the magic bytes)."""
     near = len(head) >= 8 and sum(a != b for a, b in zip(head[:8], MAGIC, strict=True)) <= 3
-    return size >= 17 and (near or closing == MAGIC or head[8:9] == b"\x01")
+    return size >= 17 and (near or _footed(tail) or head[8:9] == b"\x01")
 
 
 def magic_problem(path: Path) -> tuple[int, str | None]:
     """The size of the MCAP file ``path`` and the one line when it does not start and end
     with the MCAP magic (None when it does): not an MCAP file; one whose opening magic is
     damaged (:func:`opening_damaged`); or :func:`unended_problem`'s."""
-    with open(path, "rb") as f:
-        head = f.read(9)
-        size = f.seek(0, os.SEEK_END)
-        f.seek(max(size - 8, 0))
-        closing = f.read(8) if size >= 16 else b""
+    head, size, tail = file_ends(path)
     opening = head[:8]
     if opening != MAGIC:
         return size, (f"{path}: not an MCAP file (it does not start with the MCAP magic bytes)"
-                      if not opening_damaged(head, size, closing) else
+                      if not opening_damaged(head, size, tail) else
                       f"{path}: its opening MCAP magic bytes are damaged (the rest reads as "
                       f"MCAP); `sgtool doctor {quoted(path)} --recover OUT.mcap` "
                       "recovers what is readable")
-    return size, None if closing == MAGIC else unended_problem(path, size)
+    return size, None if tail[-8:] == MAGIC else unended_problem(path, size)
 
 
 def require_regular_file(path: Path) -> None:

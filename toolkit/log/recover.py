@@ -37,7 +37,7 @@ from sgtool.files import atomic_open
 from sgtool.log import schemas as S
 from sgtool.log.file_check import SummaryState, check, expected_messages, summary_state
 from sgtool.log.file_walk import Item, Layout, data_crc_matches, walk
-from sgtool.log.log_file import appended_end, opening_damaged, require_regular_file
+from sgtool.log.log_file import appended_end, file_ends, opening_damaged, require_regular_file
 from sgtool.log.mcap_records import MAGIC
 from sgtool.log.message_check import message_problem
 from sgtool.output_check import check_log_output
@@ -192,11 +192,7 @@ def _require_magic(p: Path) -> str | None:
     whose opening magic bytes are damaged but that is an MCAP file otherwise (its closing
     magic, a header record after the opening one, or the opening bytes off by a few) is:
     the problem to name (None when the opening magic is intact)."""
-    with open(p, "rb") as f:
-        head = f.read(9)
-        size = f.seek(0, os.SEEK_END)
-        f.seek(max(size - 8, 0))
-        tail = f.read(8)
+    head, size, tail = file_ends(p)
     if head[:8] == MAGIC:
         return None
     if opening_damaged(head, size, tail):

@@ -76,6 +76,17 @@ def test_a_damaged_opening_magic_is_a_corrupt_log_that_recovers(log40, tmp_path)
     text.write_bytes(b"not a log at all, just some text")
     with pytest.raises(LogFormatError, match="not an MCAP file"):
         scan(text)
+    # a text file that happens to end with the magic bytes is no log either (it was called
+    # one with a damaged opening, "the rest reads as MCAP", and then truncated)
+    text.write_bytes(b"notes on the run\n" * 4 + bytes(bad.read_bytes()[-8:]))
+    for args in (["info", str(text)], ["doctor", str(text)]):
+        r = CliRunner().invoke(cli, args)
+        assert r.exit_code == 2 and "not an MCAP file" in r.output, args
+    wiped = tmp_path / "wiped.mcap"  # the opening and the header's opcode gone: its footer
+    data = bytearray(log40.read_bytes())  # still says it is a log
+    data[:9] = bytes(9)
+    wiped.write_bytes(bytes(data))
+    assert scan(wiped).status == "corrupt" and scan(wiped).lost_messages == 0
 
 
 def test_doctor_reports_the_losses(log40, tmp_path):
