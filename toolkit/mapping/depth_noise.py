@@ -83,9 +83,10 @@ class DepthNoise:
         far = f"{self.sigma[-1]:.2f} m (1 sigma) at {self.depths[-1] + BIN / 2:g} m"
         if self.max_depth is None:
             return f"depth noise: floor points scatter {far}; within the floor tolerance"
-        return (f"depth noise: floor points scatter {far}; depth mapped to "
-                f"{self.max_depth:g} m, where {SIGMAS:g} sigma reaches the floor tolerance "
-                "(--max-depth to choose)")
+        return (f"depth noise: floor points scatter {far} (noise, or depth and poses "
+                f"that disagree: a depth scale, calibration or clock error); depth mapped "
+                f"to {self.max_depth:g} m, where {SIGMAS:g} sigma reaches the floor "
+                "tolerance (--max-depth to choose)")
 
 
 @dataclass(frozen=True)
