@@ -9,7 +9,6 @@ work is :func:`sgtool.replayers.derived_log.replay`. ``show`` receives the repor
 
 from __future__ import annotations
 
-import json
 import sys
 from collections.abc import Callable
 from contextlib import AbstractContextManager
@@ -17,6 +16,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from sgtool.canonical import json_text
 from sgtool.errors import SgtoolError
 from sgtool.files import quoted
 
@@ -112,7 +112,7 @@ def _show_report(request: ReplayRequest, report: Any, rooms: Any, scores: Any,
         doc = replay_dict(report, scores, rrd)
         if rooms.exchanges:
             doc["llm_answers"] = rooms.stats().as_dict()
-        show(json.dumps(doc, sort_keys=True))
+        show(json_text(doc, sort_keys=True))
         return
     for line in report.lines() + rooms.lines():
         show(line)
@@ -138,7 +138,7 @@ def replay_many(request: BatchReplayRequest, show: Echo) -> None:
                          force=request.force, progress=request.progress,
                          verify=request.verify)
     if request.as_json:
-        show(json.dumps({"logs": [asdict(r) for r in report.logs],
+        show(json_text({"logs": [asdict(r) for r in report.logs],
                          "seconds": report.seconds}, sort_keys=True))
     else:
         for line in report.lines():

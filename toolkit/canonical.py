@@ -4,11 +4,12 @@ Scene graphs, house specs and benchmark results are written as canonical JSON an
 sha256 digests (golden logs, results digests). Their floats keep :data:`DECIMALS` decimals
 (0.1 mm for metres, 1e-4 for scores), with ``-0.0`` written as ``0.0`` so that a value that
 rounds to zero from below digests like one from above. :func:`strict_json` turns NaN into
-``None`` for strict JSON output.
+``None`` for strict JSON output; :func:`json_text` is the one way a command prints JSON.
 """
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Iterable
 from typing import Any
@@ -35,3 +36,17 @@ def strict_json(x: Any) -> Any:
     if isinstance(x, (list, tuple)):
         return [strict_json(v) for v in x]
     return x
+
+
+def json_text(doc: Any, *, indent: int | None = None, sort_keys: bool = True) -> str:
+    """``doc`` as strict JSON text (what ``--json`` prints): NaN and infinities become
+    ``null`` (``NaN`` is no JSON; a parser refuses it)."""
+    def finite(x: Any) -> Any:
+        if isinstance(x, float):
+            return x if math.isfinite(x) else None
+        if isinstance(x, dict):
+            return {k: finite(v) for k, v in x.items()}
+        if isinstance(x, (list, tuple)):
+            return [finite(v) for v in x]
+        return x
+    return json.dumps(finite(doc), indent=indent, sort_keys=sort_keys, allow_nan=False)

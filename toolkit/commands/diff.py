@@ -3,10 +3,9 @@ graphs (:mod:`sgtool.replayers.golden_diff`)."""
 
 from __future__ import annotations
 
-import json
-
 import click
 
+from sgtool.canonical import json_text
 from sgtool.commands.golden import make_options, replay_options
 from sgtool.commands.options import FiniteFloatRange, PathParam
 
@@ -42,7 +41,7 @@ def command(a: str, b: str, every: int | None, classifier: str | None,
         click.echo("sgtool: note: both logs hold their scene graphs, compared as they are: "
                    "the replay options given were not used", err=True)
     if as_json:
-        click.echo(json.dumps(d.to_dict(), sort_keys=True))
+        click.echo(json_text(d.to_dict(), sort_keys=True))
     else:
         for line in d.report():
             click.echo(line)

@@ -8,12 +8,12 @@ an interrupted run never leaves a mixed set); this module parses the options int
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import click
 
+from sgtool.canonical import json_text
 from sgtool.commands.options import SEED, FiniteFloatRange, PathParam, llm_endpoint_options
 from sgtool.errors import SgtoolError
 
@@ -141,7 +141,7 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
     _check_modes(out_dir, report_only, source, llm_slice, weights_dir)
     if report_only:
         rep = weights_report(weights_dir or _weights_dir())
-        click.echo(json.dumps(rep, indent=1, sort_keys=True) if as_json else format_report(rep))
+        click.echo(json_text(rep, indent=1, sort_keys=True) if as_json else format_report(rep))
         return
     llm = {k: given.pop(k) for k in list(given) if k.startswith("llm_")}
     target = out_dir or _weights_dir()
@@ -154,7 +154,7 @@ def command(out_dir: Path | None, report_only: bool, weights_dir: Path | None, a
                           "to replace them")
     meta = train_priors(request, note=lambda m: click.echo(m, err=True))
     if as_json:
-        click.echo(json.dumps(meta, indent=1, sort_keys=True))
+        click.echo(json_text(meta, indent=1, sort_keys=True))
         return
     for line in training_lines(meta):
         click.echo(line)

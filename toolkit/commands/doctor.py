@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import click
 
+from sgtool.canonical import json_text
 from sgtool.commands.options import PathParam
 from sgtool.errors import SgtoolError
 from sgtool.files import quoted
@@ -124,7 +124,8 @@ def command(log: str, out: str | None, force: bool, as_json: bool) -> None:
     _refuse_no_log(log)
     d = recover(log, out, overwrite=force) if out else scan(log)
     if as_json:
-        click.echo(json.dumps(d.as_dict() | ({"recovered_to": out} if out else {}), indent=2))
+        click.echo(json_text(d.as_dict() | ({"recovered_to": out} if out else {}), indent=2,
+                             sort_keys=False))
     else:
         click.echo(_report(d))
         if out:

@@ -6,7 +6,6 @@ prints the import report (or JSON with ``--json``).
 
 from __future__ import annotations
 
-import json
 import sys
 from collections.abc import Callable
 from dataclasses import asdict
@@ -15,6 +14,7 @@ from typing import Any
 
 import click
 
+from sgtool.canonical import json_text
 from sgtool.commands.options import PathParam, check_log_output, option_group
 from sgtool.errors import SgtoolError
 from sgtool.recorders.importers.checks import (
@@ -95,7 +95,7 @@ def _print_report(report, as_json: bool) -> None:  # type: ignore[no-untyped-def
             "resizes": [dict(r) for r in report.resize_counts],
             "checks": {name: verdict for name, verdict in report.checks},
         }
-        click.echo(json.dumps(d, indent=2, sort_keys=True))
+        click.echo(json_text(d, indent=2, sort_keys=True))
     else:  # on one terminal the warnings stand above already (:func:`_warn`)
         shown = sys.stdout.isatty() and sys.stderr.isatty()
         for line in report.lines(warnings_shown=shown):
@@ -238,7 +238,14 @@ def bag(path: str, list_only: bool, output: str | None, force: bool, as_json: bo
 
     if list_only:
         with open_bag(path) as reader:
-            click.echo(describe_bag(reader, Path(path)))
+            if as_json:
+                from sgtool.recorders.importers.bagfiles import list_topics
+
+                click.echo(json_text({"path": path, "topics": [
+                    {"topic": t.topic, "type": t.msgtype, "count": t.count}
+                    for t in list_topics(reader)]}, indent=2))
+            else:
+                click.echo(describe_bag(reader, Path(path)))
         return
     opts = _bag_options(**given)
     check_options(opts)

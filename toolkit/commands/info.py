@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import json
-
 import click
 
+from sgtool.canonical import json_text
 from sgtool.commands.options import PathParam
 from sgtool.errors import SgtoolError
 from sgtool.log.inspect import bag_problem, format_summary, summarize
@@ -23,6 +22,6 @@ def command(log: str, as_json: bool) -> None:
         raise SgtoolError(bag)
     s = summarize(log)
     if as_json:
-        click.echo(json.dumps(s, indent=2, sort_keys=True))
+        click.echo(json_text(s, indent=2, sort_keys=True))
     else:
         click.echo(format_summary(s))

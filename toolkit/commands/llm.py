@@ -10,13 +10,13 @@ duration of the check (:mod:`sgtool.analysis.llm_check_run`).
 
 from __future__ import annotations
 
-import json
 import signal
 import time
 from pathlib import Path
 
 import click
 
+from sgtool.canonical import json_text
 from sgtool.commands.options import F, PathParam, llm_endpoint_options
 from sgtool.errors import SgtoolError
 
@@ -124,7 +124,7 @@ def check(base_url: str | None, model_name: str | None, gguf: Path | None, threa
         api_key=llm_api_key, timeout_s=llm_timeout, gguf=gguf, threads=threads,
         max_tokens=max_tokens, constraint=constraint, reason_chars=reason_chars))
     if as_json:
-        click.echo(json.dumps(result.figures, sort_keys=True))
+        click.echo(json_text(result.figures, sort_keys=True))
     else:
         for line in result.lines:
             click.echo(line)

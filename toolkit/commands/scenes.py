@@ -3,13 +3,13 @@ search episodes."""
 
 from __future__ import annotations
 
-import json
 import math
 import sys
 from typing import Any
 
 import click
 
+from sgtool.canonical import json_text
 from sgtool.commands.options import SEED, FiniteFloatRange, PathParam
 from sgtool.errors import SgtoolError
 
@@ -159,7 +159,7 @@ def stats_cmd(houses: int, seed: int, rooms: tuple[int, int], split: str, preset
         **PAPER_TABLE_I,
     }
     if as_json:
-        click.echo(json.dumps({"rooms": list(rooms), "split": split, "preset": preset,
+        click.echo(json_text({"rooms": list(rooms), "split": split, "preset": preset,
                                "first_seed": seed, "rows": rows}, indent=2, sort_keys=True))
         return
     click.echo(format_table(rows))
@@ -220,7 +220,7 @@ def episodes_cmd(house: str, count: int | None, seed: int | None, reach: float, 
     spec = load_house(Path(house))  # a path, even one that starts with "{"
     eps = _episodes(spec, count, spec.seed if seed is None else seed, reach, preset)
     if as_json:
-        click.echo(json.dumps([e.to_dict() for e in eps], indent=1, sort_keys=True))
+        click.echo(json_text([e.to_dict() for e in eps], indent=1, sort_keys=True))
         return
     if not eps:
         from sgtool.analysis.bench_houses import symbolic_house_problem
@@ -258,7 +258,7 @@ def knowledge_cmd(as_json: bool) -> None:
         "eval": fig(evaluation_knowledge()), "negated_atoms_left_out": negated_relation_counts(),
         "unseen_queries": unseen_queries()}
     if as_json:
-        click.echo(json.dumps(out, indent=2, sort_keys=True))
+        click.echo(json_text(out, indent=2, sort_keys=True))
         return
     for part in ("all", "train", "eval"):
         f = out[part]
