@@ -122,7 +122,11 @@ def room_nodes(
     for i, rid in enumerate(room_ids):
         c = seg.centres[i]
         scores: list[tuple[str, float]] = []
-        if classifier is not None:
+        hub = (0 < config.corridor_hub <= len(nb[rid])
+               and corridor_like(vg, seg.rooms[i], config, semantic=bool(instances)))
+        if hub:
+            scores = [(str(config.corridor), 1.0)]
+        elif classifier is not None:
             evidence = tuple(sorted(voters.get(rid) or cats.get(rid) or ()))
             if evidence:
                 got = class_memo.get(evidence)
@@ -168,10 +172,12 @@ def checked_scores(classifier: RoomClassifier, got: Any) -> list[tuple[str, floa
 
 def corridor_like(vg: VoronoiGraph, nodes: np.ndarray, config: BuilderConfig,
                   semantic: bool = True) -> bool:
-    """An empty room that is long (its nodes span ``corridor_length``) and narrow (no node
-    farther than ``corridor_clearance`` from a wall): with no object to vote, the geometry
-    says corridor (transparent rule, off with ``corridor=None``). Without semantics
-    (``semantic=False``: no instance table) an empty room says nothing."""
+    """A room that is long (its nodes span ``corridor_length``) and narrow (no node
+    farther than ``corridor_clearance`` from a wall). Such a room with no object to vote,
+    or one joining ``corridor_hub`` rooms or more whatever it holds (a hall's shelves and
+    console tables vote for a utility room or a living room), is a corridor (transparent
+    rules, off with ``corridor=None``). Without semantics (``semantic=False``: no instance
+    table) a room's shape says nothing."""
     if config.corridor is None or len(nodes) < 2 or not semantic:
         return False
     p = vg.positions[nodes]

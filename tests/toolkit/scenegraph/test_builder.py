@@ -219,6 +219,43 @@ def test_empty_narrow_rooms_are_corridors() -> None:
     assert not corridor_like(corridor, np.arange(len(corridor)), CONFIG, semantic=False)
 
 
+@pytest.mark.parametrize("doors", [1, 4])
+def test_a_narrow_room_joining_four_rooms_is_a_corridor_whatever_it_holds(doors: int) -> None:
+    """A hall with a shelf and a console table (which vote for another type) is a
+    corridor once it joins four rooms (here behind four closed doors); with one door the
+    objects decide, as in any room."""
+    import numpy as np
+
+    from sgtool.datasets.room_evidence import frequency_room_classifier
+    from sgtool.mapping.grid import OccupancyGrid
+    from sgtool.mapping.voronoi import voronoi_graph
+    from sgtool.scenegraph.door_evidence import DoorObservation
+    from sgtool.scenegraph.instances import InstanceInfo
+    from sgtool.scenegraph.object_placement import PlacedObject
+    from sgtool.scenegraph.room_nodes import room_nodes
+    from sgtool.scenegraph.room_segmentation import RoomSegmentation
+
+    g = np.full((32, 124), 100, dtype=np.int8)
+    g[2:-2, 2:-2] = 0  # 6 m x 1.4 m
+    vg = voronoi_graph(OccupancyGrid(g, (-0.1, -0.1), 0.05))
+    n = len(vg.positions)
+    seg = RoomSegmentation(labels=np.zeros(n, dtype=np.int64),
+                           cut_edges=np.zeros(len(vg.edges), dtype=bool),
+                           cut_nodes=np.zeros(n, dtype=bool), rooms=(np.arange(n),),
+                           centres=(0,))
+    things = {1: InstanceInfo(1, "shelf", "furniture"),
+              2: InstanceInfo(2, "console_table", "furniture")}
+    placed = [PlacedObject(i, (1.0 + i, 0.6, 0.5), i, 0, None, room="room:0")
+              for i in things]
+    observed = [DoorObservation(10 + k, (1.0 + k, 1.4), "closed", ("room:0",),
+                                f"room:{k + 1}", 0) for k in range(doors)]
+    hall = room_nodes(vg, seg, ["room:0"], placed, observed,
+                      {f"room:{k + 1}": (1.0 + k, 2.4) for k in range(doors)}, things,
+                      frequency_room_classifier(), {}, CONFIG)[0]
+    assert len(hall.neighbours) == doors
+    assert (hall.category == "corridor") == (doors == 4), hall.category_scores
+
+
 def test_the_columns_the_camera_cannot_see_over_are_the_walls_not_the_floor() -> None:
     b, _ = build("closed")
     grid = b.layers.occupancy  # type: ignore[union-attr]
