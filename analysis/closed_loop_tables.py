@@ -95,8 +95,8 @@ def format_frame_curves(budgets: Sequence[float], rows: Sequence[FrameCurveRow],
     parts = [title] if title else []
     parts.append(pipe_table(header, body))
     parts.append("SR ≤ b: share of all episodes solved within b frames per room of the "
-                 f"house; AUC-E frames: area under that curve over [0, {top:.0f}] / "
-                 f"{top:.0f}.")
+                 f"house; AUC-E frames: MoMa-LLM's area on that cost (a point per "
+                 f"episode, joined by straight lines) over [0, {top:.0f}] / {top:.0f}.")
     return "\n".join(parts) + "\n"
 
 

@@ -10,14 +10,14 @@
   fewer when it gave up).
 - Decision time: mean wall time of one planner decision (total decision seconds over total
   decisions), SCOUT's "Inference Time".
-- AUC-E (MoMa-LLM, "Area Under the Efficiency Curve"): sort the episodes by cost; y(b) is
-  the share of ALL episodes solved with cost <= b; the curve starts at (0, 0), is clipped
-  at the budget maximum and its last value extended to it; the trapezoid area divided by
-  the maximum lies in [0, 1]. This is MoMa-LLM's computation (the trapezoid over the sorted
-  points, so the curve rises linearly from one solved episode to the next): its figures
-  compare with the paper's; the step function y(b) itself has a smaller area, by at most
-  c / (2 n B) for the last solved cost c of n episodes and budget B. Two cost models
-  (:data:`DISTANCE_COST`, :data:`STEP_COST`):
+- AUC-E (MoMa-LLM, "Area Under the Efficiency Curve"), as MoMa-LLM's released code
+  computes it (``run_agent.py``: ``_plot`` and ``calc_area_under_curve``): one point per
+  episode, failures included, at its cost x, with y = the share of ALL episodes solved at
+  a cost <= x (tied costs share the full count); the points above the budget maximum are
+  left out, the last y is extended to the maximum, (0, 0) is put first, and the trapezoid
+  area over the points divided by the maximum lies in [0, 1] (the curve rises linearly
+  between points, so its figures compare with the paper's, not with the area of the step
+  function y(b)). Two cost models (:data:`DISTANCE_COST`, :data:`STEP_COST`):
 
   * distance-plus-open cost, MoMa-LLM's low-level variant: low-level steps of 0.1 m
     (travelled / 0.1) plus 30 per open interaction, budget 5000;
@@ -26,8 +26,10 @@
 
 Aggregation over seeds (SCOUT: "averaged across 5 different seeds"): every metric is
 computed per seed on that seed's episodes, then reported as mean +- sample standard
-deviation (ddof = 1; none, "-", with one seed) over seeds. Efficiency curves pool all seeds
-(the same as the mean curve when every seed has the same episodes).
+deviation (ddof = 1; none, "-", with one seed) over seeds. Efficiency curves are drawn
+over all seeds' episodes pooled; their legends give the table's AUC-E, the mean of the
+seeds' areas (:func:`mean_auc_e`; the pooled curve's own area differs when the seeds'
+costs differ).
 """
 
 from __future__ import annotations
@@ -131,9 +133,10 @@ def efficiency_curve(costs: Sequence[float], successes: Sequence[bool], max_cost
                      ) -> tuple[np.ndarray, np.ndarray]:
     """MoMa-LLM's efficiency curve as polyline vertices (x = budget, y = SR within it).
 
-    Vertices: (0, 0); then for every solved episode in order of cost, (cost, solved so far
-    / all episodes), solved episodes above ``max_cost`` left out; finally (max_cost, last
-    y). Costs are clipped below at 0.
+    Vertices (module doc): (0, 0); then for every episode in order of cost, solved or
+    not, (cost, share of all episodes solved at a cost <= it), those above ``max_cost``
+    left out; finally (max_cost, last y) unless the last cost is ``max_cost``. Costs are
+    clipped below at 0.
     """
     if len(costs) != len(successes):
         raise ArgumentError("costs and successes differ in length")
@@ -144,13 +147,17 @@ def efficiency_curve(costs: Sequence[float], successes: Sequence[bool], max_cost
     n = len(costs)
     if n == 0:
         return np.array([0.0, float(max_cost)]), np.array([0.0, 0.0])
-    solved = np.sort(np.array([max(float(c), 0.0) for c, s in zip(costs, successes,
-                                                                   strict=True) if s]))
-    solved = solved[solved <= max_cost]
-    xs = np.concatenate([[0.0], solved, [float(max_cost)]])
-    ys = np.concatenate([[0.0], np.arange(1, solved.size + 1) / n,
-                         [solved.size / n]])
-    return xs, ys
+    cost = np.maximum(np.asarray(costs, dtype=np.float64), 0.0)
+    won = np.asarray(successes, dtype=bool)
+    xs = np.sort(cost)
+    # solved at a cost <= x, for every x (ties get the full count)
+    ys = np.searchsorted(np.sort(cost[won]), xs, side="right") / n
+    keep = xs <= max_cost
+    xs, ys = xs[keep], ys[keep]
+    if not xs.size or xs[-1] < max_cost:
+        xs = np.append(xs, float(max_cost))
+        ys = np.append(ys, ys[-1] if ys.size else 0.0)
+    return np.concatenate([[0.0], xs]), np.concatenate([[0.0], ys])
 
 
 def curve_area(xs: np.ndarray, ys: np.ndarray, max_cost: float) -> float:
@@ -170,6 +177,14 @@ def auc_e_of(results: Sequence[EpisodeResult], model: CostModel) -> float:
         return math.nan
     return auc_e([model.cost(r) for r in results], [r.success for r in results],
                  model.max_cost)
+
+
+def mean_auc_e(results: Sequence[EpisodeResult], model: CostModel) -> float:
+    """The mean over seeds of each seed's AUC-E (the tables' figure; NaN without results)."""
+    if not results:
+        return math.nan
+    by_seed = group_by(results, lambda r: r.seed)
+    return float(np.mean([auc_e_of(by_seed[s], model) for s in sorted(by_seed)]))
 
 
 def curve_of(results: Sequence[EpisodeResult], model: CostModel

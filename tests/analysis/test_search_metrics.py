@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from sgtool.analysis.search_metrics import (
@@ -58,11 +59,11 @@ def test_decision_time_is_per_decision():
 
 
 def test_efficiency_curve_vertices_and_area():
-    # N = 4; solved at 10 and 20; solved at 60 is over the budget 50 and left out
+    # N = 4: a point per episode (the failure at 30 too); 60 is over the budget 50
     xs, ys = efficiency_curve([10, 20, 30, 60], [True, True, False, True], 50)
-    assert xs.tolist() == [0, 10, 20, 50]
-    assert ys.tolist() == [0, 0.25, 0.5, 0.5]
-    # trapezoids: 10 * 0.125 + 10 * 0.375 + 30 * 0.5 = 20; 20 / 50 = 0.4
+    assert xs.tolist() == [0, 10, 20, 30, 50]
+    assert ys.tolist() == [0, 0.25, 0.5, 0.5, 0.5]
+    # trapezoids: 10 * 0.125 + 10 * 0.375 + 10 * 0.5 + 20 * 0.5 = 20; 20 / 50 = 0.4
     assert auc_e([10, 20, 30, 60], [True, True, False, True], 50) == pytest.approx(0.4)
 
 
@@ -70,9 +71,36 @@ def test_auc_e_bounds_and_ties():
     assert auc_e([0, 0, 0], [True, True, True], 50) == pytest.approx(1.0)
     assert auc_e([1, 2, 3], [False, False, False], 50) == 0.0
     assert auc_e([], [], 50) == 0.0
-    # ties: two solved at 25 of 2 episodes -> y jumps 0 -> 1 at x = 25 (after a ramp from
-    # (0,0)); area = 25 * 0.25 (ramp to the first vertex at y=0.5) + 0 + 25 * 1 = 31.25
-    assert auc_e([25, 25], [True, True], 50) == pytest.approx(31.25 / 50)
+    assert auc_e([60, 70], [True, True], 50) == 0.0  # every cost over the budget
+    # ties share the full count: two solved at 25 of 2 -> (25, 1) twice; area = 25 * 0.5
+    # (the ramp from (0, 0)) + 25 * 1 = 37.5 (it was 31.25, the first tie at y = 0.5)
+    assert auc_e([25, 25], [True, True], 50) == pytest.approx(37.5 / 50)
+
+
+def momallm_auc(costs, successes, max_x):
+    """MoMa-LLM's released code (run_agent.py, _plot then calc_area_under_curve), with
+    numpy for pandas and sklearn: the reference the metric must agree with."""
+    order = np.argsort(costs, kind="stable")
+    x = np.asarray(costs, dtype=float)[order]
+    won = np.asarray(successes, dtype=bool)
+    y = np.array([np.logical_and(won, np.asarray(costs) <= m).mean() for m in x])
+    if max(x) > max_x:
+        x, y = x[x <= max_x], y[x <= max_x]
+    if max(x) < max_x:
+        x, y = np.concatenate([x, [max_x]]), np.concatenate([y, [y[-1]]])
+    x, y = np.concatenate([[0], x]), np.concatenate([[0], y])
+    return float(np.trapezoid(y, x)) / max_x
+
+
+@pytest.mark.parametrize("costs, successes", [
+    ([10, 40, 50], [True, False, True]),  # a failure between two successes: 0.333, was 0.433
+    ([15, 49, 49] + [50] * 6, [True] * 3 + [False] * 6),  # ties: 0.174, was 0.137
+    ([3, 7, 7, 12, 30, 44, 49], [False, True, True, False, True, True, False]),
+    ([0, 5, 5, 5, 20], [True, False, True, True, False]),
+])
+def test_auc_e_is_momallms_computation(costs, successes):
+    assert auc_e(costs, successes, 50) == pytest.approx(momallm_auc(costs, successes, 50))
+    assert auc_e(costs, successes, 25) == pytest.approx(momallm_auc(costs, successes, 25))
 
 
 def test_distance_cost_is_momallm_low_level():
