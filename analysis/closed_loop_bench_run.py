@@ -113,6 +113,11 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
             print(f"sgtool: note: {len(left)} episode log(s) in {request.out_dir}/logs are left "
                   f"out of this report ({shown}{more}): give the --noise profiles, --planners, "
                   "houses and --episodes that ran them to report them", file=sys.stderr)
+        if request.report_only and not request.with_symbolic and request.symbolic_dir is None \
+                and _had_symbolic(root / "summary.json"):
+            print("sgtool: note: the earlier report compared the planners' order with the "
+                  "symbolic bench's; this one does not (give --with-symbolic or --symbolic "
+                  "DIR again to keep it)", file=sys.stderr)
         try:
             res = _with_symbolic(request, res)
             written = [p.name for p in write_tables(  # (a report keeps the run's run.md)
@@ -317,6 +322,18 @@ def run_record(rows: Sequence[RunRow], root: Path, runner: EpisodeRunner,
                          "node": runner.nodes.get(log, ""), "sent": log in runner.sent})
     return json.dumps({"executor": executor, "episodes": episodes}, indent=1,
                       sort_keys=True) + "\n"
+
+
+def _had_symbolic(summary: Path) -> bool:
+    """Whether the ``summary.json`` of an earlier report compared with the symbolic bench
+    (False when there is none or it does not read)."""
+    try:
+        doc = json.loads(summary.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    noise = doc.get("noise") if isinstance(doc, dict) else None
+    return isinstance(noise, dict) and any(
+        isinstance(v, dict) and "symbolic_agreement" in v for v in noise.values())
 
 
 def _with_symbolic(request: RunBenchRequest, res: Any) -> Any:

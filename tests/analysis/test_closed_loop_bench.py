@@ -168,6 +168,12 @@ def test_kendall_tau_against_a_symbolic_bench(house_file, tmp_path) -> None:
         "symbolic_agreement"]
     assert agreement["matched_episodes"] == 2
     assert [k["metric"] for k in agreement["kendall"]] == ["spl", "sr"]
+    # a report without the symbolic rows says it leaves the agreement out (it did so
+    # silently)
+    again = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                     "--report-only"])
+    assert again.exit_code == 0 and "this one does not (give --with-symbolic or " \
+        "--symbolic DIR again to keep it)" in again.output, again.output
     for args, msg in ((["--symbolic", str(tmp_path / "none")], "no episodes.jsonl"),
                       (["--symbolic", str(sym), "--with-symbolic"], "give one of them"),
                       (["--reference", "scout"], "--reference: 'scout' is not one of"),

@@ -112,7 +112,8 @@ if TYPE_CHECKING:
               help="Run nothing: the tables of the episodes whose logs are there already, "
               "run as OUT/run-options.json records (the options that decide the run need "
               "not be given again; the report settings --reference, --all-pairs, "
-              "--budgets, --symbolic and the budgets of AUC-E are this command's).")
+              "--budgets, --symbolic, --with-symbolic and the budgets of AUC-E are this "
+              "command's).")
 @click.option("--progress/--no-progress", default=None,
               help="Progress bar on stderr (default: when stderr is a terminal).")
 @click.option("--reference", default=None, metavar="PLANNER", callback=reference_planner,
