@@ -146,7 +146,10 @@ def command(**given: Any) -> None:
     houses (the houses and episodes of `sgtool bench`), under each noise profile: one
     episode log per run (what `sgtool run` writes), then the table of the symbolic bench
     (SR, SPL, steps, AUC-E) with failed skills per episode by reason, and the efficiency
-    curves; the wall-clock figures (decision time, frames per second) go to run.md.
+    curves; the wall-clock figures (decision time, frames per second) go to run.md. SPL's
+    shortest path ends within reach of the nearest target (as in MoMa-LLM's code) while an
+    episode succeeds once the target is seen: a robot that sees it from afar before driving
+    that far scores SPL 1, and such episodes tie whatever each planner drove.
 
     Resumable: an episode whose log exists is read back instead of run again (a log is
     only there once complete). Ctrl-C stops the run and leaves only complete logs (with
