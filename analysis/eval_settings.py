@@ -16,6 +16,8 @@ from sgtool.planning.registry import effective_options
 
 COMPARED = ("max_steps", "priors_dir",  # bench settings that change what an episode scores
             "distance_budget", "step_budget")  # and the AUC-E curves
+# what a generated house of a given id is made from (its seed is in the id)
+HOUSE_MAKING = ("rooms", "preset")
 
 
 def recorded_budgets(files: Sequence[str]) -> tuple[float | None, float | None]:
@@ -56,6 +58,14 @@ def settings_notes(files: Sequence[str]) -> list[str]:
             shown = ", ".join(f"{v} in {run}" for run, v in values.items())
             notes.append(f"the runs given ran with different {key} ({shown}): their rows and "
                          "paired comparisons mix them")
+    generated = {run: s for run, s in runs.items() if s.get("houses")}
+    for key in HOUSE_MAKING:
+        values = {run: s[key] for run, s in generated.items() if key in s}
+        if len({json.dumps(v) for v in values.values()}) > 1:
+            shown = ", ".join(f"{v} in {run}" for run, v in values.items())
+            notes.append(f"the runs given generated their houses with different {key} "
+                         f"({shown}): a house id names other houses in them, and their rows, "
+                         "intervals and paired comparisons mix them")
     options: dict[str, dict[str, str]] = {}
     for run, s in runs.items():
         given = s.get("planner_options") or {}

@@ -66,6 +66,21 @@ def test_runs_made_apart_under_other_settings_are_named(tmp_path: Path) -> None:
     assert r.exit_code == 0 and "other options" not in r.stderr, r.stderr
 
 
+def test_runs_of_other_generated_houses_under_one_id_are_named(tmp_path: Path) -> None:
+    """house-0 of 4-5 rooms and house-0 of 6 rooms are other houses: eval pooled them
+    (two houses for four in the intervals) without a word."""
+    a, b = tmp_path / "a", tmp_path / "b"
+    _bench(a, "scout")
+    r = CliRunner().invoke(cli, [*BENCH[:6], "6-6", *BENCH[7:], "--planners", "scout",
+                                 "-o", str(b)])
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(cli, ["eval", str(a), str(b)])
+    assert r.exit_code == 0, r.output
+    assert (f"sgtool: note: the runs given generated their houses with different rooms "
+            f"([4, 5] in {a}, [6, 6] in {b}): a house id names other houses in them") \
+        in r.stderr, r.stderr
+
+
 RUN = EpisodeResult("greedy", 0, "house-0", 0, "mug", True, steps=4, travelled_m=10.0,
                     shortest_m=9.48)
 
