@@ -52,9 +52,13 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
                            known=OUTPUT_NAMES) as stage, contextlib.ExitStack() as stack:
             logs: Path | None = None
             if log_dir is not None:  # the logs' own folder, or a part of OUT
-                logs = stage if Path(log_dir).resolve() == Path(out_dir).resolve() else \
-                    stack.enter_context(output_folder(log_dir, force=request.force,
-                                                      command="bench", option="--log-dir"))
+                inner = _within(log_dir, out_dir)
+                if inner is not None:  # moved in with the other outputs
+                    logs = stage / inner
+                    logs.mkdir(parents=True, exist_ok=True)
+                else:
+                    logs = stack.enter_context(output_folder(
+                        log_dir, force=request.force, command="bench", option="--log-dir"))
             cfg = replace(request.config, log_dir=None if logs is None else str(logs))
             stack.enter_context(transcript_run(
                 cfg.planner_options.get("moma-llm", {}).get("transcript")))
@@ -84,3 +88,12 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     for folder in (out_dir, *([log_dir] if log_dir is not None else [])):
         for line in leftover_notes(folder):
             show(line)
+
+
+def _within(folder: str, out_dir: str) -> Path | None:
+    """``folder``'s path relative to ``out_dir`` when it lies within it (``.`` for the same
+    folder), else None."""
+    try:
+        return Path(folder).resolve().relative_to(Path(out_dir).resolve())
+    except ValueError:
+        return None

@@ -419,6 +419,26 @@ def test_episode_logs_record_the_planner_options(tmp_path):
     assert "planner_options" not in extras["greedy"]  # built with its defaults
 
 
+def test_episode_logs_inside_the_output_folder(tmp_path):
+    """`-o rl --log-dir rl/logs` (examples/README.md's command) on a new folder: the logs
+    made rl non-empty while the run staged its outputs, so it took them for another run's
+    and wrote rl.1; the logs are outputs of the run now, moved in with the tables (and
+    replaced with them under --force)."""
+    args = ["bench", "--planners", "greedy", "--houses", "1", "--episodes", "2", "--seeds",
+            "1", "--max-steps", "2", "--no-progress", "-o", str(tmp_path / "rl"),
+            "--log-dir", str(tmp_path / "rl" / "logs")]
+    r = CliRunner().invoke(cli, args)
+    assert r.exit_code == 0, r.output
+    assert not (tmp_path / "rl.1").exists()
+    logs = sorted((tmp_path / "rl" / "logs").rglob("*.mcap"))
+    assert len(logs) == 2 and (tmp_path / "rl" / "summary.md").is_file()
+    assert CliRunner().invoke(cli, args).exit_code == 2  # not empty: --force to replace
+    r = CliRunner().invoke(cli, [*args, "--force"])
+    assert r.exit_code == 0, r.output
+    assert sorted((tmp_path / "rl" / "logs").rglob("*.mcap")) == logs
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rl"]
+
+
 def test_a_killed_runs_staging_folder_is_named(tmp_path):
     """A run killed outright leaves its hidden staging folder beside OUT; the next run
     that writes OUT names it (it never removes another run's folder)."""
