@@ -102,7 +102,7 @@ COMPRESSIONS: tuple[str, ...] = tuple(_COMPRESSION)  # the names a log may be wr
 def _check_frame(k: CameraIntrinsics, depth: np.ndarray, rgb: np.ndarray | None,
                  ids: np.ndarray | None) -> None:
     """``ValueError`` unless the frame's images would read back as written: depth of the
-    intrinsics' size, rgb (H, W, 3) and ids (H, W) of the depth's (the intrinsics
+    intrinsics' size and not negative, rgb (H, W, 3) and ids (H, W) of the depth's (the intrinsics
     themselves are checked where their calibration message is made, when they change)."""
     if not isinstance(k, CameraIntrinsics):
         raise ValueError(f"intrinsics: a CameraIntrinsics, got {type(k).__name__}")
@@ -110,12 +110,34 @@ def _check_frame(k: CameraIntrinsics, depth: np.ndarray, rgb: np.ndarray | None,
     if np.shape(depth) != size:
         raise ValueError(f"depth of shape {np.shape(depth)}: the intrinsics say {k.width}x"
                          f"{k.height}, so ({k.height}, {k.width})")
+    if np.issubdtype(np.asarray(depth).dtype, np.number):
+        neg = np.argwhere(np.asarray(depth) < 0)
+        if len(neg):
+            r, c = (int(v) for v in neg[0])
+            raise ValueError(f"depth {float(depth[r, c]):g} m at pixel (row {r}, col {c}): "
+                             "negative (no return is 0, NaN or inf)")
     if rgb is not None and np.shape(rgb) != (*size, 3):
         raise ValueError(f"rgb of shape {np.shape(rgb)}: give ({k.height}, {k.width}, 3), "
                          "the depth's size")
     if ids is not None and np.shape(ids) != size:
         raise ValueError(f"ids of shape {np.shape(ids)}: give ({k.height}, {k.width}), the "
                          "depth's size")
+
+
+def log_time(t_ns: Any) -> int:
+    """``t_ns`` as a log time: whole nanoseconds, at least 0; anything else (a float with a
+    fraction, such as seconds given by mistake, which would truncate to the same time as
+    its neighbours) is a ``ValueError`` naming it."""
+    if isinstance(t_ns, bool) or not isinstance(t_ns, int | float | np.integer | np.floating):
+        raise ValueError(f"log time {t_ns!r}: a time in whole nanoseconds (an int)")
+    if isinstance(t_ns, float | np.floating) and not (
+            math.isfinite(t_ns) and float(t_ns).is_integer()):
+        raise ValueError(f"log time {t_ns!r}: times are whole nanoseconds (seconds? "
+                         "int(round(t * 1e9)))")
+    t = int(t_ns)
+    if t < 0:
+        raise ValueError(f"log time {t}: must be >= 0")
+    return t
 
 
 class LogWriter:
@@ -221,9 +243,7 @@ class LogWriter:
              publish_ns: int | None = None) -> None:
         if self._closed:
             raise RuntimeError("log writer is closed")
-        t_ns = int(t_ns)
-        if t_ns < 0:
-            raise ValueError("log time must be >= 0")
+        t_ns = log_time(t_ns)
         if self._last_flush_ns is None:
             self._last_flush_ns = t_ns
         elif t_ns - self._last_flush_ns >= self._flush_interval_ns:
@@ -409,6 +429,7 @@ class LogWriter:
         is anything that would read back as something else: images of another size than
         the intrinsics' (depth (H, W), rgb (H, W, 3), ids (H, W)), intrinsics a reader
         refuses, colours as float or beyond 0..255, ids as float."""
+        t_ns = log_time(t_ns)
         if self._last_frame_t is not None and t_ns <= self._last_frame_t:
             raise ValueError(f"frame at t_ns={t_ns}: frame times must increase (the previous "
                              f"frame is at {self._last_frame_t})")

@@ -162,6 +162,15 @@ def test_input_that_would_read_back_wrong_is_refused(tmp_path):
         for t in (2 * DT, DT):  # the same time, an earlier one
             with pytest.raises(ValueError, match="frame times must increase"):
                 w.write_frame(t, depth=depth, pose=pose, intrinsics=k)
+        # seconds given for nanoseconds (2.5 truncated to 2, the next frames' times
+        # collided: the log did not read back), negative depth (read back as no return)
+        with pytest.raises(ValueError, match=r"log time 2.5: times are whole nanoseconds"):
+            w.write_frame(2.5, depth=depth, pose=pose, intrinsics=k)
+        with pytest.raises(ValueError, match="log time 2.5"):
+            w.write_record("instances", 2.5, {"instances": []})
+        with pytest.raises(ValueError, match=r"depth -1.5 m at pixel \(row 0, col 0\)"):
+            w.write_frame(3 * DT, depth=np.where(np.arange(depth.size).reshape(depth.shape)
+                                                 == 0, -1.5, depth), pose=pose, intrinsics=k)
         w.write_frame(3 * DT, depth=np.rint(depth * 1000).astype(np.uint16), pose=pose,
                       intrinsics=k)  # uint16 millimetres: as given
         # a refused frame leaves nothing of itself, and the same frame mended goes in
