@@ -4,6 +4,7 @@ to them, before any episode runs: one :class:`BenchError` line each.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -39,8 +40,9 @@ def config_names(value: Any, field: str, paths: bool = False) -> tuple[Any, ...]
 
 
 def config_planner_options(value: Any) -> dict[str, dict[str, Any]]:
-    """A config's ``planner_options`` copied (a caller's dict changed for the next run must
-    not change this one's): planner name -> {option: value}; anything else one line."""
+    """A config's ``planner_options`` copied, values deeply (a caller's dict changed for the
+    next run must not change this one's): planner name -> {option: value}; anything else
+    one line."""
     if not isinstance(value, Mapping):
         raise BenchError(f"planner_options: give {{planner: {{option: value}}}}, got a "
                          f"{type(value).__name__}")
@@ -49,8 +51,18 @@ def config_planner_options(value: Any) -> dict[str, dict[str, Any]]:
         if not isinstance(v, Mapping):
             raise BenchError(f"planner_options[{k!r}]: give {{option: value}}, got "
                              f"{v!r}")
-        out[str(k)] = dict(v)
+        out[str(k)] = {name: _own_copy(x) for name, x in v.items()}
     return out
+
+
+def _own_copy(value: Any) -> Any:
+    """A deep copy of an option's value (a dict or list of a Python-only option changed by
+    the caller afterwards must not change the run); the value itself when it cannot be
+    copied (a model or a client object)."""
+    try:
+        return copy.deepcopy(value)
+    except (TypeError, copy.Error, RecursionError):
+        return value
 
 
 def check_reference(reference: str | None, all_pairs: bool, planners: Sequence[str]) -> None:

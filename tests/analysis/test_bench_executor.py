@@ -157,6 +157,12 @@ def test_the_config_keeps_its_own_options():
     opts["scout"]["delta"] = 0.9
     opts["greedy"] = {}
     assert cfg.planner_options == {"scout": {"delta": 0.2}}
+    # a value that is itself a dict or list (a Python-only option) too: it was shared
+    nested = {"mine": {"weights": {"a": 1.0}, "order": [1, 2]}}
+    cfg = BenchConfig(planners=("scout",), planner_options=nested)
+    nested["mine"]["weights"]["a"] = 99.0
+    nested["mine"]["order"].append(3)
+    assert cfg.planner_options == {"mine": {"weights": {"a": 1.0}, "order": [1, 2]}}
     with pytest.raises(SgtoolError, match=r"^planner_options\['scout'\]: give \{option: "
                        r"value\}, got 0.2$"):
         BenchConfig(planners=("scout",), planner_options={"scout": 0.2})
