@@ -204,10 +204,13 @@ class BenchConfig:
         return cost_models(self.distance_budget, self.step_budget)
 
     def settings(self) -> dict[str, Any]:
+        from sgtool.planning.registry import typed_options
+
         d = asdict(self)
         d["planners"] = list(self.planners)
         d["rooms"] = list(self.rooms)
-        d["planner_options"] = options_as_text(self.planner_options)
+        d["planner_options"] = options_as_text(  # as taken: -O text and Python alike
+            {p: typed_options(p, o) for p, o in self.planner_options.items()})
         for key in ("workers", "executor", "ray_address",  # do not change the results
                     "reference", "all_pairs"):
             d.pop(key)

@@ -428,10 +428,13 @@ class ClosedLoopBenchResult:
     def summary(self) -> dict[str, Any]:
         """summary.json: per noise profile the statistics of :meth:`statistics`, and the
         settings ``sgtool eval`` re-scores and compares runs by (:mod:`.eval_settings`)."""
+        from sgtool.planning.registry import typed_options
+
         cfg = self.config
         settings = {"planners": list(cfg.planners), "max_steps": cfg.options.max_steps,
                     "distance_budget": cfg.distance_budget, "step_budget": cfg.step_budget,
-                    "planner_options": options_as_text(cfg.planner_options)}
+                    "planner_options": options_as_text(
+                        {p: typed_options(p, o) for p, o in cfg.planner_options.items()})}
         return {"planners": list(cfg.planners), "settings": settings,
                 "noise": {noise_folder(n): self.statistics(n)[1] for n in cfg.noise},
                 **({"missing_episodes": self.missing} if self.missing else {})}

@@ -149,6 +149,19 @@ def test_a_plug_in_redefined_between_runs_runs_anew(monkeypatch):
         [(r.success, r.steps) for r in greedy.results]
 
 
+def test_options_are_recorded_as_the_planner_takes_them():
+    """scout.delta=1 from Python was recorded as "1", from the command line as "1.0" (the
+    parsed float): summary.json differed, and eval of the two runs on a machine without
+    a plug-in called them other options."""
+    from sgtool.planning.registry import parse_option
+
+    cli = BenchConfig(planners=("scout",),
+                      planner_options={"scout": {"delta": parse_option("scout", "delta", "1")}})
+    py = BenchConfig(planners=("scout",), planner_options={"scout": {"delta": 1}})
+    assert py.settings()["planner_options"] == cli.settings()["planner_options"] == {
+        "scout": {"delta": "1.0"}}
+
+
 def test_the_config_keeps_its_own_options():
     """A sweep that changes its options dict for the next point leaves the finished
     run's configuration (and summary) as it ran."""

@@ -319,14 +319,24 @@ def effective_options(name: str, given: Mapping[str, Any]) -> dict[str, Any]:
                                   {i.name: i.default for i in option_infos(cls)})}
     if cls is None and name.strip().lower() not in REGISTRY:  # a plug-in's own defaults
         defaults |= _signature_defaults(_factory(name))
-    values = {}
+    values = typed_options(name, given)
+    return {k: v for k, v in sorted(values.items()) if k not in defaults or v != defaults[k]}
+
+
+def typed_options(name: str, given: Mapping[str, Any]) -> dict[str, Any]:
+    """``given`` options of planner ``name`` with each value as the planner takes it (parsed
+    as ``-O`` text is: ``2`` given from Python for a float option is ``2.0``, as from the
+    command line), so that a run records them alike however they were given; a value that
+    does not parse (a Python object, a key the planner does not take, a plug-in that does
+    not import here) as given."""
+    out = {}
     for k, v in given.items():
         try:
-            values[k] = parse_option(name, k, str(v)) if isinstance(
+            out[k] = parse_option(name, k, str(v)) if isinstance(
                 v, str | int | float | bool | os.PathLike) else v
-        except Exception:  # noqa: BLE001 - a key it does not take: compared as given
-            values[k] = v
-    return {k: v for k, v in sorted(values.items()) if k not in defaults or v != defaults[k]}
+        except Exception:  # noqa: BLE001 - as given (see above)
+            out[k] = v
+    return out
 
 
 def _signature_defaults(factory: Any) -> dict[str, Any]:
