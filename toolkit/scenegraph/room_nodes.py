@@ -17,6 +17,7 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
+from scipy.spatial.distance import pdist
 
 from sgtool.errors import SgtoolError
 from sgtool.mapping.voronoi import VoronoiGraph
@@ -172,7 +173,7 @@ def checked_scores(classifier: RoomClassifier, got: Any) -> list[tuple[str, floa
 
 def corridor_like(vg: VoronoiGraph, nodes: np.ndarray, config: BuilderConfig,
                   semantic: bool = True) -> bool:
-    """A room that is long (its nodes span ``corridor_length``) and narrow (no node
+    """A room that is long (two of its nodes ``corridor_length`` apart) and narrow (no node
     farther than ``corridor_clearance`` from a wall). Such a room with no object to vote,
     or one joining ``corridor_hub`` rooms or more whatever it holds (a hall's shelves and
     console tables vote for a utility room or a living room), is a corridor (transparent
@@ -180,7 +181,8 @@ def corridor_like(vg: VoronoiGraph, nodes: np.ndarray, config: BuilderConfig,
     table) a room's shape says nothing."""
     if config.corridor is None or len(nodes) < 2 or not semantic:
         return False
-    p = vg.positions[nodes]
-    span = float(np.hypot(*(p.max(axis=0) - p.min(axis=0))))
+    # the longest distance between two of its nodes (a bounding box's diagonal grew as
+    # the house turned: a 2.7 m room was 3.2 m long at 45 degrees)
+    span = float(pdist(vg.positions[nodes]).max())
     return (span >= config.corridor_length
             and float(vg.clearance[nodes].max()) <= config.corridor_clearance)

@@ -217,6 +217,16 @@ def test_empty_narrow_rooms_are_corridors() -> None:
     assert not corridor_like(room, np.arange(len(room)), CONFIG)
     assert not corridor_like(short, np.arange(len(short)), CONFIG)
     assert not corridor_like(corridor, np.arange(len(corridor)), CONFIG, semantic=False)
+    # a 2.7 m room is no longer long when the house turns (its nodes' bounding box grew to
+    # a diagonal over 3 m at 45 degrees: empty, it was called a corridor)
+    import dataclasses
+
+    store = voronoi_graph(walled(2.7, 1.4))
+    for deg in (0, 17, 45, 60):
+        a = np.radians(deg)
+        turned = dataclasses.replace(store, positions=store.positions @ np.array(
+            [[np.cos(a), np.sin(a)], [-np.sin(a), np.cos(a)]]))
+        assert not corridor_like(turned, np.arange(len(store)), CONFIG), deg
 
 
 @pytest.mark.parametrize("doors", [1, 4])
