@@ -92,6 +92,12 @@ class LoggedEpisode:
     decisions: tuple[Decision, ...]
     closed: bool = True  # False: the log has no closing record (a run cut short)
 
+    def __repr__(self) -> str:  # (the decisions hold every graph: a repr of megabytes)
+        e = self.episode
+        return (f"LoggedEpisode(source={self.source!r}, index={self.index}, "
+                f"planner={e.planner!r}, query={e.query!r}, "
+                f"decisions={len(self.decisions)}, closed={self.closed})")
+
     def result(self) -> EpisodeResult:
         r = result_from_log_records(self.episode, [d.action for d in self.decisions],
                                     source=self.source)

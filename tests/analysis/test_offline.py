@@ -50,6 +50,9 @@ def test_metrics_from_a_log_match_the_run(greedy_log):
     assert r.shortest_m == pytest.approx(res.shortest_m, abs=1e-3)
     assert [(s.skill, s.target, s.outcome) for s in r.trace] == \
         [(s.skill, s.target, s.outcome) for s in res.trace]
+    # its repr names it in a line (it printed every decision's graph: megabytes)
+    assert repr(ep) == (f"LoggedEpisode(source={str(path)!r}, index=0, planner='greedy', "
+                        f"query='sweater', decisions={res.steps}, closed=True)")
 
 
 def test_planner_against_its_own_log_agrees(greedy_log):

@@ -106,7 +106,8 @@ class Distances(dict[str, float]):
     """A read-only dict: a scene graph's ``distances``. A planner is handed the graph that
     is logged and handed to the next planner, so changing it in place would change both;
     every method that would change it raises :class:`TypeError` (copy it with
-    ``dict(graph.distances)``). Compares, pickles and serialises as a dict."""
+    ``dict(graph.distances)``). Compares, pickles and serialises as a dict, and hashes (so
+    a scene graph, frozen, can key a planner's cache)."""
 
     def _read_only(self, *args: Any, **kwargs: Any) -> Any:
         raise TypeError("SceneGraph.distances is read-only (the graph is logged and shared): "
@@ -117,6 +118,9 @@ class Distances(dict[str, float]):
 
     def __reduce__(self) -> tuple[type, tuple[dict[str, float]]]:
         return (type(self), (dict(self),))
+
+    def __hash__(self) -> int:  # type: ignore[override]  # (read-only: its graph hashes)
+        return hash(frozenset(self.items()))
 
     def copy(self) -> dict[str, float]:
         return dict(self)

@@ -31,3 +31,11 @@ def test_read_only_distances_pickle_copy_and_serialise_as_before() -> None:
     assert pickle.loads(pickle.dumps(g)) == g and copy.deepcopy(g) == g
     assert SceneGraph.from_json(g.to_json()) == g
     assert json.loads(json.dumps(g.distances)) == {"room:0": 1.5, "obj:2": 0.25}
+
+
+def test_a_frozen_graph_hashes() -> None:
+    """A planner may key a cache on the graph (it raised: the distances were a dict)."""
+    a = SceneGraph(RobotState((0.0, 0.0)), distances={"room:0": 1.5, "obj:2": 0.25})
+    b = SceneGraph(RobotState((0.0, 0.0)), distances={"obj:2": 0.25, "room:0": 1.5})
+    c = SceneGraph(RobotState((0.0, 0.0)), distances={"room:0": 2.5})
+    assert a == b and hash(a) == hash(b) and len({a, b, c}) == 2
