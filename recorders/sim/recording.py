@@ -294,8 +294,8 @@ class RecordReport:
         if self.doors_taken_away:
             out.append(f"open without room to swing, so taken out of the simulation: "
                        f"{', '.join(self.doors_taken_away)} (the log shows an empty doorway "
-                       "there: no door leaf; a doorway without a lintel then leaves the replay "
-                       "no door to find)")
+                       "there, no door leaf: the replay finds no door there, and without a "
+                       "lintel over the doorway may join its two rooms)")
         pieces = [i for i in self.taken_away if i not in self.doors_taken_away]
         if pieces:
             out.append(f"opened without room for their doors to swing, so the doors were taken "
