@@ -124,3 +124,14 @@ def test_a_truncated_log_among_the_inputs_is_left_out_not_fatal(tmp_path) -> Non
     assert r.exit_code == 2
     assert "| greedy" in r.output  # the metrics of the table
     assert "1 of 2 input(s) could not be read and are left out" in r.output
+
+
+def test_seen_unseen_figures_are_rounded_as_the_planners_are(tmp_path) -> None:
+    """eval --json printed 0.47400000000000003 in seen_unseen, 0.474 in planners."""
+    runs = [dataclasses.replace(RUN, episode=i, seen=True, success=i < 2,
+                                travelled_m=10.0 + i / 3) for i in range(3)]
+    write_jsonl(runs, tmp_path / "episodes.jsonl")
+    r = CliRunner().invoke(cli, ["eval", str(tmp_path / "episodes.jsonl"), "--json"])
+    assert r.exit_code == 0, r.output
+    (row,) = json.loads(r.stdout)["seen_unseen"]
+    assert row["seen_spl"] == round(row["seen_spl"], 6) and row["seen_sr"] == round(2 / 3, 6)
