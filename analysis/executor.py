@@ -51,6 +51,7 @@ from sgtool.errors import (
     Terminated,
     raise_terminated,
     set_stop_handlers,
+    traceback_text,
 )
 from sgtool.extras import missing_message
 
@@ -90,7 +91,11 @@ class Outcome:
 def error_line(e: BaseException) -> str:
     """``Type: first line of the message`` (a Ray task error is unwrapped to its cause);
     the message alone for an :class:`~sgtool.errors.SgtoolError`, which is written for
-    the user."""
+    the user; with ``SGTOOL_TRACEBACK=1`` the whole traceback
+    (:func:`~sgtool.errors.traceback_text`)."""
+    shown = traceback_text(e)  # SGTOOL_TRACEBACK=1: the whole traceback instead
+    if shown is not None:
+        return shown
     cause = getattr(e, "cause", None)
     if isinstance(cause, BaseException):
         e = cause

@@ -30,6 +30,7 @@ from sgtool.errors import (
     raise_terminated,
     set_stop_handlers,
     stop_exit_code,
+    traceback_text,
 )
 from sgtool.extras import missing_extra
 from sgtool.files import is_environment_error
@@ -142,6 +143,9 @@ class LazyGroup(click.Group):
         except click.UsageError as e:  # a subcommand's arguments, or an unknown command
             raise usage_line(e) from e
         except SgtoolError as e:
+            shown = traceback_text(e)
+            if shown is not None:  # SGTOOL_TRACEBACK=1: what raised, before the line
+                click.echo(shown, err=True)
             raise UserError(str(e)) from e
         except BrokenPipeError:  # `sgtool ... | head`: the reader has what it wanted
             _quiet_stdout()

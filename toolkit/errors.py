@@ -1,8 +1,12 @@
-"""Errors a user can cause and fix. The CLI prints them as one clear message, no traceback."""
+"""Errors a user can cause and fix. The CLI prints them as one clear message, no traceback
+(with the environment variable ``SGTOOL_TRACEBACK=1``, the traceback too: :func:`traceback_text`,
+for the author of a plug-in planner or classifier whose code raised)."""
 
 from __future__ import annotations
 
+import os
 import signal
+import traceback
 from typing import Any
 
 
@@ -85,3 +89,12 @@ def raised_text(e: BaseException) -> str:
     if isinstance(e, SystemExit):
         return f"exited (SystemExit: {text})"
     return f"{type(e).__name__}: {text}" if text else type(e).__name__
+
+
+def traceback_text(e: BaseException) -> str | None:
+    """The traceback of ``e`` with its causes (a plug-in's own frames: it is raised ``from``
+    what the plug-in raised; from a worker process, the worker's traceback), when the
+    environment variable ``SGTOOL_TRACEBACK`` is set (not empty, not ``0``); else None."""
+    if os.environ.get("SGTOOL_TRACEBACK", "") in ("", "0"):
+        return None
+    return "".join(traceback.format_exception(e)).rstrip()
