@@ -154,12 +154,13 @@ def condition_row(res: StudyResult, cond: Condition, first: str) -> list[str]:
             _median_range(vals("object_accuracy"), _pct),
             _median_range(kept(), _pct),
             _median_range(vals("ari"), _f3),
+            _median_range(vals("category_accuracy"), _pct),
             _signed(delta("purity")), _signed(delta("object_accuracy"))]
 
 
 FACTOR_HEADER = ["level", "rooms found/true per house", "room error vs true",
                  "purity", "objects right", "objects kept vs none", "ARI",
-                 "purity vs none (pts)", "objects vs none (pts)"]
+                 "categories right", "purity vs none (pts)", "objects vs none (pts)"]
 
 
 def summary_md(res: StudyResult) -> str:
@@ -180,7 +181,8 @@ def summary_md(res: StudyResult) -> str:
             "of the graph vs every true room of the house; 'vs none': median over houses of "
             "the difference to the house's noise-free cell, in points; 'objects kept vs "
             "none': the objects in the graph, as a share of those in the house's noise-free "
-            "graph (objects right counts only those kept).", ""]
+            "graph (objects right counts only those kept); 'categories right': the "
+            "explored rooms named with their true room's type.", ""]
     out += ["## Every house and condition", "",
             "Cell: rooms found/true, Voronoi purity, objects in the right room of the "
             "objects in the graph.", ""]

@@ -92,6 +92,10 @@ def test_tables_list_every_condition_once(study: dict[str, Path]) -> None:
     base = next(r for r in rows if r["factor"] == "none")
     kept = 100 * int(row["merged_objects"]) / int(base["merged_objects"])
     assert "| objects kept vs none |" in text and f"| {kept:.1f}% " in text
+    # the room-type stage has its column too
+    assert re.search(r"\| ARI +\| categories right +\|", text)
+    cats = 100 * float(base["merged_category_accuracy"])
+    assert re.search(rf"^\| 0 \(none\) .*\| {cats:.1f}% +\|", text, re.M), text
     assert "Houses: small (file " in text
     assert (out / "plots" / "label_dropout.png").read_bytes()[:4] == b"\x89PNG"
 
