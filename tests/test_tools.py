@@ -57,3 +57,16 @@ def test_every_mutation_of_tools_mutations_still_applies() -> None:
     finally:
         del sys.modules["tool_mutations"]
     assert not stale
+
+
+def test_room_types_compares_the_named_rooms_with_the_house(tmp_path: Path) -> None:
+    """The golden tour's three rooms: its corridor (joining two rooms) is named by what it
+    holds, the bathroom and the kitchen by theirs."""
+    env = {**os.environ, **OFFLINE}
+    proc = subprocess.run([sys.executable, str(REPO / "tools" / "room_types.py"),
+                           str(REPO / "tests" / "golden" / "house6-tour.mcap"), "--rooms"],
+                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600,
+                          check=False)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert "room:0: true corridor, named living_room, narrow True, joins 2" in proc.stdout
+    assert "rooms named right: 2 of 3" in proc.stdout
