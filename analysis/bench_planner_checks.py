@@ -4,7 +4,6 @@ to them, before any episode runs: one :class:`BenchError` line each.
 
 from __future__ import annotations
 
-import copy
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -40,9 +39,9 @@ def config_names(value: Any, field: str, paths: bool = False) -> tuple[Any, ...]
 
 
 def config_planner_options(value: Any) -> dict[str, dict[str, Any]]:
-    """A config's ``planner_options`` copied, values deeply (a caller's dict changed for the
-    next run must not change this one's): planner name -> {option: value}; anything else
-    one line."""
+    """A config's ``planner_options`` copied, with the containers in values (a caller's
+    dict changed for the next run must not change this one's): planner name -> {option:
+    value}; anything else one line."""
     if not isinstance(value, Mapping):
         raise BenchError(f"planner_options: give {{planner: {{option: value}}}}, got a "
                          f"{type(value).__name__}")
@@ -56,13 +55,18 @@ def config_planner_options(value: Any) -> dict[str, dict[str, Any]]:
 
 
 def _own_copy(value: Any) -> Any:
-    """A deep copy of an option's value (a dict or list of a Python-only option changed by
-    the caller afterwards must not change the run); the value itself when it cannot be
-    copied (a model or a client object)."""
-    try:
-        return copy.deepcopy(value)
-    except (TypeError, copy.Error, RecursionError):
-        return value
+    """An option's value with its containers copied (a dict or list of a Python-only option
+    changed by the caller afterwards must not change the run); anything else in it as
+    given: a client, an encoder or a callback is the caller's object, to be used as such."""
+    if isinstance(value, dict):
+        return {k: _own_copy(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_own_copy(v) for v in value]
+    if isinstance(value, tuple):
+        return tuple(_own_copy(v) for v in value)
+    if isinstance(value, set):
+        return {_own_copy(v) for v in value}
+    return value
 
 
 def check_reference(reference: str | None, all_pairs: bool, planners: Sequence[str]) -> None:

@@ -176,6 +176,14 @@ def test_the_config_keeps_its_own_options():
     nested["mine"]["weights"]["a"] = 99.0
     nested["mine"]["order"].append(3)
     assert cfg.planner_options == {"mine": {"weights": {"a": 1.0}, "order": [1, 2]}}
+    # the caller's objects stay theirs: a client or a callback is used, not a copy of it
+    client, seen = object(), []
+    cfg = BenchConfig(planners=("scout",), planner_options={
+        "mine": {"client": client, "on_exchange": seen.append, "clients": [client]}})
+    mine = cfg.planner_options["mine"]
+    assert mine["client"] is client and mine["clients"][0] is client
+    mine["on_exchange"](1)
+    assert seen == [1]
     with pytest.raises(SgtoolError, match=r"^planner_options\['scout'\]: give \{option: "
                        r"value\}, got 0.2$"):
         BenchConfig(planners=("scout",), planner_options={"scout": 0.2})
