@@ -47,18 +47,16 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     out_dir, log_dir = request.out_dir, request.config.log_dir
     request.config.check()  # before anything is emptied or written (the transcript)
     refuse_input_folder(out_dir, request.config.house_files, what="--house")
+    within = None if log_dir is None else _within(log_dir, out_dir)
     try:
-        with output_folder(out_dir, force=request.force, command="bench",
-                           known=OUTPUT_NAMES) as stage, contextlib.ExitStack() as stack:
+        with output_folder(out_dir, force=request.force, command="bench", known=OUTPUT_NAMES,
+                           inner=() if within is None else within.parts[:1]
+                           ) as stage, contextlib.ExitStack() as stack:
             logs: Path | None = None
-            if log_dir is not None:  # the logs' own folder, or a part of OUT
-                inner = _within(log_dir, out_dir)
-                if inner is not None:  # moved in with the other outputs
-                    logs = stage / inner
-                    logs.mkdir(parents=True, exist_ok=True)
-                else:
-                    logs = stack.enter_context(output_folder(
-                        log_dir, force=request.force, command="bench", option="--log-dir"))
+            if log_dir is not None:  # the logs' own folder, or OUT itself
+                logs = stage if within == Path() else \
+                    stack.enter_context(output_folder(log_dir, force=request.force,
+                                                      command="bench", option="--log-dir"))
             cfg = replace(request.config, log_dir=None if logs is None else str(logs))
             stack.enter_context(transcript_run(
                 cfg.planner_options.get("moma-llm", {}).get("transcript")))

@@ -367,7 +367,7 @@ def refuse_input_folder(target: str | os.PathLike[str],
 @contextlib.contextmanager
 def output_folder(target: str | os.PathLike[str], *, force: bool, command: str = "sgtool",
                   option: str = "-o", known: Sequence[str] = (),
-                  resume: bool = False) -> Iterator[Path]:
+                  resume: bool = False, inner: Sequence[str] = ()) -> Iterator[Path]:
     """Yield the folder to write a command's outputs into; ``target`` gets them complete.
 
     Build (the default): the yielded folder is new and empty, a uniquely named hidden
@@ -387,7 +387,9 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
       user's). A failure or Ctrl-C while moving puts every entry back where it was;
     - a ``target`` missing or empty at the start that another run filled meanwhile is
       left alone: the outputs become ``NAME.1`` (the first free suffix) and a one-line
-      :class:`~sgtool.errors.SgtoolError` says so.
+      :class:`~sgtool.errors.SgtoolError` says so; entries named in ``inner`` are this
+      run's own (a folder of its, such as ``--log-dir OUT/logs``, written by another
+      ``output_folder`` within ``target``): they are no other run's, and stay as they are.
 
     The new :data:`MANIFEST` lists the top-level entries of the yielded folder, for the
     next ``--force``. On any exception (Ctrl-C included) the yielded folder is removed and
@@ -443,7 +445,7 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
     try:
         yield stage
         atomic_write(stage / MANIFEST, manifest_text(command, os.listdir(stage)))
-        if not busy and path.is_dir() and any(os.scandir(path)):
+        if not busy and path.is_dir() and any(e.name not in inner for e in os.scandir(path)):
             kept = _free_sibling(path)  # filled meanwhile (another run): not mixed, not lost
             os.replace(stage, kept)
             raise SgtoolError(f"{option} {target}: another run wrote into it while this one "

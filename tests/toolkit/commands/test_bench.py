@@ -433,9 +433,12 @@ def test_episode_logs_inside_the_output_folder(tmp_path):
     logs = sorted((tmp_path / "rl" / "logs").rglob("*.mcap"))
     assert len(logs) == 2 and (tmp_path / "rl" / "summary.md").is_file()
     assert CliRunner().invoke(cli, args).exit_code == 2  # not empty: --force to replace
+    mine = tmp_path / "rl" / "logs" / "mine.txt"  # a user's file among the logs: kept
+    mine.write_text("keep")
     r = CliRunner().invoke(cli, [*args, "--force"])
     assert r.exit_code == 0, r.output
     assert sorted((tmp_path / "rl" / "logs").rglob("*.mcap")) == logs
+    assert mine.read_text() == "keep"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["rl"]
 
 
