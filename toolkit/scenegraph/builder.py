@@ -38,9 +38,8 @@ caller decides; :meth:`SceneGraphBuilder.due` says when K frames have passed):
    IV-A), placed ``unexplored_offset`` beyond the door;
 7. room categories (:mod:`sgtool.scenegraph.room_nodes`) from the contained furniture (all
    objects when a room has none) with the configured
-   :class:`~sgtool.scenegraph.categories.RoomClassifier`; a room with no object at all
-   whose nodes span >= 3 m and stay within 0.9 m of a wall is a corridor
-   (``BuilderConfig.corridor``), otherwise "unknown";
+   :class:`~sgtool.scenegraph.categories.RoomClassifier`, a long, narrow room's shape
+   (:func:`~sgtool.scenegraph.room_nodes.corridor_like`) speaking for a corridor;
 8. travel distances (:mod:`sgtool.scenegraph.travel`) from the robot to every node over
    the Voronoi graph (entry: the visible nodes within ``entry_radius``; object and
    frontier: their node plus the straight last leg);

@@ -34,8 +34,10 @@ class BuilderConfig:
     corridor: str | None = "corridor"  # the type of an empty narrow room (None: unknown)
     corridor_clearance: float = 0.9  # m: no node of a narrow room is farther from a wall
     corridor_length: float = 3.0  # m: the span of its nodes at least
-    # a narrow room joining this many rooms is a corridor whatever it holds (0: never)
+    # a narrow room joining this many rooms (0: never) has its corridor score weighed
+    # corridor_odds times: such rooms are mostly corridors, whatever a hall holds
     corridor_hub: int = 4
+    corridor_odds: float = 10.0
     # a container or supporter is examined once close frames saw into (onto) enough of it
     # (sgtool.scenegraph.examined.look_into); False: from any close view, the older rule
     look_inside: bool = True

@@ -2,10 +2,11 @@
 their neighbours and categories.
 
 Room categories come from the contained furniture (all objects when a room has none) with
-the configured :class:`~sgtool.scenegraph.categories.RoomClassifier`; a room with no object
-at all whose nodes span >= ``corridor_length`` and stay within ``corridor_clearance`` of a
-wall is a corridor (``BuilderConfig.corridor``), otherwise "unknown". Rooms seen only
-through a closed door are unexplored room nodes.
+the configured :class:`~sgtool.scenegraph.categories.RoomClassifier`; a long, narrow room
+(:func:`corridor_like`) with no object at all is a corridor (``BuilderConfig.corridor``),
+any other empty room "unknown", and a long, narrow one joining ``corridor_hub`` rooms has
+its corridor score weighed ``corridor_odds`` times. Rooms seen only through a closed door
+are unexplored room nodes.
 """
 
 from __future__ import annotations
@@ -123,17 +124,16 @@ def room_nodes(
     for i, rid in enumerate(room_ids):
         c = seg.centres[i]
         scores: list[tuple[str, float]] = []
-        hub = (0 < config.corridor_hub <= len(nb[rid])
-               and corridor_like(vg, seg.rooms[i], config, semantic=bool(instances)))
-        if hub:
-            scores = [(str(config.corridor), 1.0)]
-        elif classifier is not None:
+        if classifier is not None:
             evidence = tuple(sorted(voters.get(rid) or cats.get(rid) or ()))
             if evidence:
                 got = class_memo.get(evidence)
                 if got is None:
                     got = class_memo[evidence] = checked_scores(
                         classifier, classifier.classify(list(evidence)))
+                if 0 < config.corridor_hub <= len(nb[rid]) and corridor_like(
+                        vg, seg.rooms[i], config, semantic=bool(instances)):
+                    got = weigh_type(got, str(config.corridor), config.corridor_odds)
                 scores = got[: config.max_scores]
             elif corridor_like(vg, seg.rooms[i], config, semantic=bool(instances)):
                 scores = [(str(config.corridor), 1.0)]
@@ -171,14 +171,29 @@ def checked_scores(classifier: RoomClassifier, got: Any) -> list[tuple[str, floa
     return [(r, float(p)) for r, p in pairs]
 
 
+def weigh_type(scores: list[tuple[str, float]], room_type: str, odds: float
+               ) -> list[tuple[str, float]]:
+    """``scores`` (a classifier's answer) with ``room_type``'s score weighed ``odds`` times
+    (a prior the objects do not know of), renormalised and ranked again (best first, ties
+    by name); as they are when they do not name ``room_type``."""
+    if room_type not in dict(scores):
+        return scores
+    weighed = [(r, p * odds if r == room_type else p) for r, p in scores]
+    total = sum(p for _, p in weighed)
+    if not total > 0:
+        return scores
+    return sorted(((r, p / total) for r, p in weighed), key=lambda rp: (-rp[1], rp[0]))
+
+
 def corridor_like(vg: VoronoiGraph, nodes: np.ndarray, config: BuilderConfig,
                   semantic: bool = True) -> bool:
     """A room that is long (two of its nodes ``corridor_length`` apart) and narrow (no node
-    farther than ``corridor_clearance`` from a wall). Such a room with no object to vote,
-    or one joining ``corridor_hub`` rooms or more whatever it holds (a hall's shelves and
-    console tables vote for a utility room or a living room), is a corridor (transparent
-    rules, off with ``corridor=None``). Without semantics (``semantic=False``: no instance
-    table) a room's shape says nothing."""
+    farther than ``corridor_clearance`` from a wall). Such a room with no object to vote is
+    a corridor; one joining ``corridor_hub`` rooms or more has its corridor score weighed
+    ``corridor_odds`` times (a hall's shelves and console tables vote for a utility room
+    or a living room; a galley kitchen's stove and fridge still name a kitchen).
+    Transparent rules, off with ``corridor=None``; without semantics (``semantic=False``:
+    no instance table) a room's shape says nothing."""
     if config.corridor is None or len(nodes) < 2 or not semantic:
         return False
     # the longest distance between two of its nodes (a bounding box's diagonal grew as

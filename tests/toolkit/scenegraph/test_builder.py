@@ -230,10 +230,12 @@ def test_empty_narrow_rooms_are_corridors() -> None:
 
 
 @pytest.mark.parametrize("doors", [1, 4])
-def test_a_narrow_room_joining_four_rooms_is_a_corridor_whatever_it_holds(doors: int) -> None:
+def test_a_narrow_room_joining_four_rooms_leans_to_a_corridor(doors: int) -> None:
     """A hall with a shelf and a console table (which vote for another type) is a
     corridor once it joins four rooms (here behind four closed doors); with one door the
-    objects decide, as in any room."""
+    objects decide, as in any room. A galley kitchen of that shape and those doors stays
+    a kitchen (its stove and fridge name it clearly), and without a classifier no room is
+    named (the rule weighs the classifier's answer, it does not replace it)."""
     import numpy as np
 
     from sgtool.datasets.room_evidence import frequency_room_classifier
@@ -253,17 +255,24 @@ def test_a_narrow_room_joining_four_rooms_is_a_corridor_whatever_it_holds(doors:
                            cut_edges=np.zeros(len(vg.edges), dtype=bool),
                            cut_nodes=np.zeros(n, dtype=bool), rooms=(np.arange(n),),
                            centres=(0,))
-    things = {1: InstanceInfo(1, "shelf", "furniture"),
-              2: InstanceInfo(2, "console_table", "furniture")}
-    placed = [PlacedObject(i, (1.0 + i, 0.6, 0.5), i, 0, None, room="room:0")
-              for i in things]
     observed = [DoorObservation(10 + k, (1.0 + k, 1.4), "closed", ("room:0",),
                                 f"room:{k + 1}", 0) for k in range(doors)]
-    hall = room_nodes(vg, seg, ["room:0"], placed, observed,
-                      {f"room:{k + 1}": (1.0 + k, 2.4) for k in range(doors)}, things,
-                      frequency_room_classifier(), {}, CONFIG)[0]
-    assert len(hall.neighbours) == doors
-    assert (hall.category == "corridor") == (doors == 4), hall.category_scores
+    behind = {f"room:{k + 1}": (1.0 + k, 2.4) for k in range(doors)}
+
+    def named(categories: list[str], classifier: object) -> str:
+        things = {i + 1: InstanceInfo(i + 1, c, "furniture") for i, c in enumerate(categories)}
+        placed = [PlacedObject(i, (1.0 + i / 2, 0.6, 0.5), i, 0, None, room="room:0")
+                  for i in things]
+        room = room_nodes(vg, seg, ["room:0"], placed, observed, behind, things,
+                          classifier, {}, CONFIG)[0]  # type: ignore[arg-type]
+        assert len(room.neighbours) == doors
+        return room.category
+
+    frequency = frequency_room_classifier()
+    assert (named(["shelf", "console_table"], frequency) == "corridor") == (doors == 4)
+    assert named(["stove", "refrigerator", "dishwasher", "countertop"], frequency) == \
+        "kitchen"
+    assert named(["shelf", "console_table"], None) == "unknown"
 
 
 def test_the_columns_the_camera_cannot_see_over_are_the_walls_not_the_floor() -> None:
