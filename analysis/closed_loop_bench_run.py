@@ -113,7 +113,7 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
             print(f"sgtool: note: {len(left)} episode log(s) in {request.out_dir}/logs are left "
                   f"out of this report ({shown}{more}): give the --noise profiles, --planners, "
                   "houses and --episodes that ran them to report them", file=sys.stderr)
-        if request.report_only and not request.with_symbolic and request.symbolic_dir is None \
+        if not request.with_symbolic and request.symbolic_dir is None \
                 and _had_symbolic(root / "summary.json"):
             print("sgtool: note: the earlier report compared the planners' order with the "
                   "symbolic bench's; this one does not (give --with-symbolic or --symbolic "

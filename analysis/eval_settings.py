@@ -59,9 +59,11 @@ def settings_notes(files: Sequence[str]) -> list[str]:
             notes.append(f"the runs given ran with different {key} ({shown}): their rows and "
                          "paired comparisons mix them")
     generated = {run: s for run, s in runs.items() if s.get("houses")}
+    ids = {run: _house_ids(Path(run) / "episodes.jsonl") for run in generated}
     for key in HOUSE_MAKING:
         values = {run: s[key] for run, s in generated.items() if key in s}
-        if len({json.dumps(v) for v in values.values()}) > 1:
+        if len({json.dumps(v) for v in values.values()}) > 1 and _share_an_id(
+                [ids[run] for run in values]):
             shown = ", ".join(f"{v} in {run}" for run, v in values.items())
             notes.append(f"the runs given generated their houses with different {key} "
                          f"({shown}): a house id names other houses in them, and their rows, "
@@ -79,3 +81,30 @@ def settings_notes(files: Sequence[str]) -> list[str]:
             notes.append(f"{planner} ran with other options in the runs given ({shown}): its "
                          "rows pool them; run each under its own name to compare them")
     return notes
+
+
+def _house_ids(episodes: Path) -> set[str]:
+    """The house ids of a bench run's ``episodes.jsonl`` (empty when it does not read)."""
+    out: set[str] = set()
+    try:
+        with open(episodes, encoding="utf-8") as f:
+            for line in f:
+                try:
+                    house = json.loads(line).get("house")
+                except (ValueError, AttributeError):
+                    continue
+                if isinstance(house, str):
+                    out.add(house)
+    except OSError:
+        pass
+    return out
+
+
+def _share_an_id(sets: Sequence[set[str]]) -> bool:
+    """Whether two of ``sets`` have an id in common."""
+    seen: set[str] = set()
+    for ids in sets:
+        if seen & ids:
+            return True
+        seen |= ids
+    return False

@@ -174,6 +174,12 @@ def test_kendall_tau_against_a_symbolic_bench(house_file, tmp_path) -> None:
                                      "--report-only"])
     assert again.exit_code == 0 and "this one does not (give --with-symbolic or " \
         "--symbolic DIR again to keep it)" in again.output, again.output
+    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                   "--symbolic", str(sym)])  # (the agreement back)
+    assert res.exit_code == 0 and "this one does not" not in res.output, res.output
+    again = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
+    assert again.exit_code == 0 and "this one does not" in again.output, again.output  # (a
+    # resumed run with nothing left to run reports too)
     for args, msg in ((["--symbolic", str(tmp_path / "none")], "no episodes.jsonl"),
                       (["--symbolic", str(sym), "--with-symbolic"], "give one of them"),
                       (["--reference", "scout"], "--reference: 'scout' is not one of"),

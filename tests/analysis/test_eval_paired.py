@@ -79,6 +79,12 @@ def test_runs_of_other_generated_houses_under_one_id_are_named(tmp_path: Path) -
     assert (f"sgtool: note: the runs given generated their houses with different rooms "
             f"([4, 5] in {a}, [6, 6] in {b}): a house id names other houses in them") \
         in r.stderr, r.stderr
+    c = tmp_path / "c"  # other houses under other ids (house-100): nothing to say
+    r = CliRunner().invoke(cli, [*BENCH[:6], "6-6", *BENCH[7:], "--house-seed", "100",
+                                 "--planners", "scout", "-o", str(c)])
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(cli, ["eval", str(a), str(c)])
+    assert r.exit_code == 0 and "other houses" not in r.stderr, r.stderr
 
 
 RUN = EpisodeResult("greedy", 0, "house-0", 0, "mug", True, steps=4, travelled_m=10.0,

@@ -110,18 +110,26 @@ def _check_frame(k: CameraIntrinsics, depth: np.ndarray, rgb: np.ndarray | None,
     if np.shape(depth) != size:
         raise ValueError(f"depth of shape {np.shape(depth)}: the intrinsics say {k.width}x"
                          f"{k.height}, so ({k.height}, {k.width})")
-    if np.issubdtype(np.asarray(depth).dtype, np.number):
-        neg = np.argwhere(np.asarray(depth) < 0)
-        if len(neg):
-            r, c = (int(v) for v in neg[0])
-            raise ValueError(f"depth {float(depth[r, c]):g} m at pixel (row {r}, col {c}): "
-                             "negative (no return is 0, NaN or inf)")
+    check_depth_sign(depth)
     if rgb is not None and np.shape(rgb) != (*size, 3):
         raise ValueError(f"rgb of shape {np.shape(rgb)}: give ({k.height}, {k.width}, 3), "
                          "the depth's size")
     if ids is not None and np.shape(ids) != size:
         raise ValueError(f"ids of shape {np.shape(ids)}: give ({k.height}, {k.width}), the "
                          "depth's size")
+
+
+def check_depth_sign(depth: Any) -> None:
+    """``ValueError`` naming the first pixel of ``depth`` with a finite negative value (it
+    would read back as no return, which is 0, NaN or an infinity)."""
+    d = np.asarray(depth)
+    if d.ndim != 2 or not np.issubdtype(d.dtype, np.number):
+        return
+    neg = np.argwhere(np.isfinite(d) & (d < 0))
+    if len(neg):
+        r, c = (int(v) for v in neg[0])
+        raise ValueError(f"depth {float(d[r, c]):g} m at pixel (row {r}, col {c}): "
+                         "negative (no return is 0, NaN or inf)")
 
 
 def log_time(t_ns: Any) -> int:
@@ -393,7 +401,9 @@ class LogWriter:
 
     def write_depth(self, t_ns: int, depth_m: np.ndarray, frame_id: str = S.CAMERA_FRAME) -> None:
         """Metric depth (float metres) or already uint16 millimetres; what would read back
-        as no depth is a ``ValueError`` (:func:`~sgtool.log.codec.encode_depth`)."""
+        as no depth, or as other depth (a negative value), is a ``ValueError``
+        (:func:`~sgtool.log.codec.encode_depth`, :func:`check_depth_sign`)."""
+        check_depth_sign(depth_m)
         self.write_proto(S.DEPTH, t_ns, codec.encode_depth(t_ns, depth_m, frame_id))
 
     def write_ids(self, t_ns: int, ids: np.ndarray, frame_id: str = S.CAMERA_FRAME) -> None:

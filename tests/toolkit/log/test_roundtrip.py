@@ -168,9 +168,11 @@ def test_input_that_would_read_back_wrong_is_refused(tmp_path):
             w.write_frame(2.5, depth=depth, pose=pose, intrinsics=k)
         with pytest.raises(ValueError, match="log time 2.5"):
             w.write_record("instances", 2.5, {"instances": []})
+        negative = np.where(np.arange(depth.size).reshape(depth.shape) == 0, -1.5, depth)
         with pytest.raises(ValueError, match=r"depth -1.5 m at pixel \(row 0, col 0\)"):
-            w.write_frame(3 * DT, depth=np.where(np.arange(depth.size).reshape(depth.shape)
-                                                 == 0, -1.5, depth), pose=pose, intrinsics=k)
+            w.write_frame(3 * DT, depth=negative, pose=pose, intrinsics=k)
+        with pytest.raises(ValueError, match=r"depth -1.5 m at pixel"):
+            w.write_depth(3 * DT, negative)  # (its own writer too)
         w.write_frame(3 * DT, depth=np.rint(depth * 1000).astype(np.uint16), pose=pose,
                       intrinsics=k)  # uint16 millimetres: as given
         # a refused frame leaves nothing of itself, and the same frame mended goes in
