@@ -143,12 +143,15 @@ class ClosedLoopBenchConfig:
                            config_names(self.house_files, "house_files", paths=True))
         object.__setattr__(self, "rooms", config_rooms(self.rooms))
 
-    def check(self) -> None:
+    def check(self, *, planners: bool = True) -> None:
+        """One line for what is wrong; ``planners=False`` leaves the planners and their
+        options unasked (a report of logs run already: a plug-in need not import)."""
         from sgtool.analysis.bench_planner_checks import check_planner_list, check_reference
 
         for name in ("houses", "episodes", "frames_per_room"):  # "2" or 2.5: one line
             whole(name, getattr(self, name), optional=name == "frames_per_room")
-        check_planner_list(self.planners)
+        if planners:
+            check_planner_list(self.planners)
         if len(set(self.planners)) != len(self.planners) or \
                 len(set(self.noise)) != len(self.noise):
             raise SgtoolError("--planners/--noise: a name is given twice")
@@ -159,7 +162,8 @@ class ClosedLoopBenchConfig:
             raise SgtoolError(f"--budgets: a budget is given twice "
                               f"({', '.join(f'{b:g}' for b in self.budgets)})")
         check_reference(self.reference, self.all_pairs, self.planners)
-        check_planner_options(self.planners, self.planner_options, one_writer=True)
+        if planners:
+            check_planner_options(self.planners, self.planner_options, one_writer=True)
         if self.episodes < 1:
             raise SgtoolError(f"--episodes: must be >= 1, got {self.episodes}")
         if self.houses < 0 or (self.houses == 0 and not self.house_files):

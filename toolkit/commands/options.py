@@ -402,15 +402,16 @@ def split_planner_key(key: str, planners: Sequence[str] = ()) -> tuple[str, str]
     return name.strip(), opt.strip()
 
 
-def planner_options(items: tuple[str, ...], planners: Sequence[str] | None = None
-                    ) -> dict[str, dict[str, Any]]:
+def planner_options(items: tuple[str, ...], planners: Sequence[str] | None = None,
+                    *, typed: bool = True) -> dict[str, dict[str, Any]]:
     """``-O PLANNER.KEY=VALUE`` values (bench, run, run-bench, eval) as {planner: {key:
     value}}, each value checked and converted against the planner's options dataclass (a
     plug-in without one: int, float, true/false or text). With ``planners`` (the run's), an
     option for a name that is no planner is an error (a typo such as ``sout.delta`` would
     otherwise run everything with the defaults), and so is one for a planner not run whose
     name is close to one run (``lab:Labplanner`` for ``lab:LabPlanner``); one for another
-    planner not run is a note."""
+    planner not run is a note. ``typed=False`` (a report of a stored run, whose plug-ins
+    need not import here): every value as :func:`parse_value` reads it, no planner asked."""
     from sgtool.planning.registry import check_planner_name, parse_option
 
     out: dict[str, dict[str, Any]] = {}
@@ -436,7 +437,7 @@ def planner_options(items: tuple[str, ...], planners: Sequence[str] | None = Non
             click.echo(f"sgtool: note: --planner-option {key.strip()}: {name!r} is not "
                        "run; the option is unused", err=True)
         text = value.strip()
-        out.setdefault(name, {})[opt] = parse_option(name, opt, text) if run \
+        out.setdefault(name, {})[opt] = parse_option(name, opt, text) if run and typed \
             else parse_value(text)
     return out
 

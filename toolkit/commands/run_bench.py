@@ -227,7 +227,7 @@ def _request(args: RunBenchArgs) -> RunBenchRequest:
     cfg = _config(args)
     if args.symbolic_dir is not None and args.with_symbolic:
         raise SgtoolError("--symbolic and --with-symbolic: give one of them")
-    cfg.check()
+    cfg.check(planners=not args.report_only)  # (a report imports no plug-in)
     symbolic = load_symbolic(args.symbolic_dir) if args.symbolic_dir is not None else ()
     return RunBenchRequest(
         config=cfg, out_dir=args.out_dir, force=args.force, report_only=args.report_only,
@@ -279,7 +279,8 @@ def _config(args: RunBenchArgs) -> ClosedLoopBenchConfig:
                                                 peek=args.peek,
                                                 sight_lines=args.sight_lines,
                                                 explore_through=args.explore_through))
-    options = {k: v for k, v in planner_options(args.planner_option, names).items()
+    options = {k: v for k, v in planner_options(  # (a report imports no plug-in)
+        args.planner_option, names, typed=not args.report_only).items()
                if k in names}  # those of planners not run: a note said they are unused
     LlmEndpoint(args.llm_base_url, args.llm_model, args.llm_api_key,
                 args.llm_timeout).fill(options, names)

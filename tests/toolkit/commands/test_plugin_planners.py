@@ -273,6 +273,28 @@ def test_sgtool_traceback_shows_where_a_plugin_raised(plugin_dir: Path, tmp_path
     assert r.exit_code == 2 and r.output.count("\n") == 1, r.output
 
 
+def test_a_report_of_a_stored_run_needs_no_plugin(plugin_dir: Path, tmp_path: Path,
+                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    """run-bench --report-only re-tables logs run already: on a machine where the lab's
+    plug-in does not import it failed ("cannot import module"); it writes the same
+    summary.json now."""
+    import sys
+
+    monkeypatch.syspath_prepend(str(plugin_dir))
+    out = tmp_path / "rb"
+    r = CliRunner().invoke(cli, [
+        "run-bench", "--planners", "mymod_cli:MyPlanner,greedy", "-O",
+        "mymod_cli:MyPlanner.k=3", "--houses", "1", "--rooms", "4-4", "--episodes", "1",
+        "--frames", "40", "--max-steps", "2", "-w", "1", "--no-progress", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    before = (out / "summary.json").read_bytes()
+    monkeypatch.setattr(sys, "path", [p for p in sys.path if p != str(plugin_dir)])
+    monkeypatch.delitem(sys.modules, "mymod_cli")
+    r = CliRunner().invoke(cli, ["run-bench", "-o", str(out), "--report-only"])
+    assert r.exit_code == 0, r.output
+    assert (out / "summary.json").read_bytes() == before
+
+
 def test_a_plugin_that_raises_in_a_run_bench_leaves_no_folders(
         plugin_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """run-bench stops on a plug-in that raises with one line and leaves no folder of logs
