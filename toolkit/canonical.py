@@ -3,8 +3,9 @@
 Scene graphs, house specs and benchmark results are written as canonical JSON and pinned by
 sha256 digests (golden logs, results digests). Their floats keep :data:`DECIMALS` decimals
 (0.1 mm for metres, 1e-4 for scores), with ``-0.0`` written as ``0.0`` so that a value that
-rounds to zero from below digests like one from above. :func:`strict_json` turns NaN into
-``None`` for strict JSON output; :func:`json_text` is the one way a command prints JSON.
+rounds to zero from below digests like one from above. :func:`strict_json` turns NaN and
+infinities into ``None`` for strict JSON output; :func:`json_text` is the one way a command
+prints JSON.
 """
 
 from __future__ import annotations
@@ -28,9 +29,10 @@ def canonical_floats(xs: Iterable[float]) -> list[float]:
 
 
 def strict_json(x: Any) -> Any:
-    """NaN -> None, recursively through dicts, lists and tuples (for ``allow_nan=False``)."""
+    """NaN and infinities -> None, recursively through dicts, lists and tuples (for
+    ``allow_nan=False``)."""
     if isinstance(x, float):
-        return None if math.isnan(x) else x
+        return x if math.isfinite(x) else None
     if isinstance(x, dict):
         return {k: strict_json(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
@@ -41,12 +43,4 @@ def strict_json(x: Any) -> Any:
 def json_text(doc: Any, *, indent: int | None = None, sort_keys: bool = True) -> str:
     """``doc`` as strict JSON text (what ``--json`` prints): NaN and infinities become
     ``null`` (``NaN`` is no JSON; a parser refuses it)."""
-    def finite(x: Any) -> Any:
-        if isinstance(x, float):
-            return x if math.isfinite(x) else None
-        if isinstance(x, dict):
-            return {k: finite(v) for k, v in x.items()}
-        if isinstance(x, (list, tuple)):
-            return [finite(v) for v in x]
-        return x
-    return json.dumps(finite(doc), indent=indent, sort_keys=sort_keys, allow_nan=False)
+    return json.dumps(strict_json(doc), indent=indent, sort_keys=sort_keys, allow_nan=False)
