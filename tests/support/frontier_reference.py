@@ -8,7 +8,7 @@ import numpy as np
 from scipy import ndimage
 
 from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
-from sgtool.mapping.holes import between, near
+from sgtool.mapping.holes import near
 from sgtool.scenegraph.frontiers import (
     Frontier,
     FrontierConfig,
@@ -70,7 +70,7 @@ def plain_frontier_cells(occ: OccupancyGrid, start: tuple[float, float] | None,
     unknown = occ.grid == UNKNOWN
     max_cells = int(min_pocket / occ.resolution**2)
     if max_cells > 0 and unknown.any():
-        lab, _ = ndimage.label(unknown & ~between(occ.grid == OCCUPIED), structure=_FOUR)
+        lab, _ = ndimage.label(unknown, structure=_FOUR)
         small = np.bincount(lab.ravel()) < max_cells
         small[0] = False
         small[_border_labels(lab)] = False
@@ -82,10 +82,9 @@ def plain_frontier_cells(occ: OccupancyGrid, start: tuple[float, float] | None,
 
 
 def plain_outside(occ: OccupancyGrid) -> np.ndarray:
-    lab, n = ndimage.label((occ.grid == UNKNOWN) & ~between(occ.grid == OCCUPIED),
-                           structure=_FOUR)
+    lab, n = ndimage.label(occ.grid == UNKNOWN, structure=_FOUR)
     if n == 0:
-        return np.zeros(occ.grid.shape, dtype=bool)
+        return occ.grid == UNKNOWN
     out = np.zeros(n + 1, dtype=bool)
     out[_border_labels(lab)] = True
     out[0] = False

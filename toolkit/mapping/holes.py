@@ -57,33 +57,17 @@ def near_at(mask: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
     return out
 
 
-def between(mask: np.ndarray) -> np.ndarray:
-    """Cells with a ``mask`` cell on both sides: across a row, a column or a diagonal."""
-    p = np.pad(mask, 1)
-    h, w = mask.shape
-
-    def at(dr: int, dc: int) -> np.ndarray:
-        return p[1 + dr:1 + dr + h, 1 + dc:1 + dc + w]
-
-    return ((at(-1, 0) & at(1, 0)) | (at(0, -1) & at(0, 1)) | (at(-1, -1) & at(1, 1))
-            | (at(-1, 1) & at(1, -1)))
-
-
 def unknown_parts(grid: np.ndarray, near_occupied: np.ndarray | None = None) -> UnknownParts:
     """The 4-connected components of the unknown cells of ``grid`` (none filled);
     ``near_occupied``: ``near(grid == OCCUPIED)``, when the caller has it."""
-    occupied = grid == OCCUPIED
-    # an unknown cell between two occupied cells (across a row, a column or a diagonal) is
-    # the inside of a wall, which no ray reaches (a 0.1 m wall over three 5 cm cells): it
-    # joins no unknown parts, else every unseen pocket at a wall leads out along it
-    labels, n = ndimage.label((grid == UNKNOWN) & ~between(occupied), output=np.intp)
+    labels, n = ndimage.label(grid == UNKNOWN, output=np.intp)
     sizes = np.bincount(labels.ravel(), minlength=n + 1)
     border = np.zeros(n + 1, dtype=bool)
     if n:  # (an empty grid has no components, and no border rows to read)
         border[np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]])] = True
         border[0] = False
     if near_occupied is None:
-        near_occupied = near(occupied)
+        near_occupied = near(grid == OCCUPIED)
     return UnknownParts(labels, int(n), sizes, border, np.zeros(n + 1, dtype=bool),
                         near_occupied)
 

@@ -42,12 +42,10 @@ What we do, and why it differs:
   evidence (the cut zone reaches about 0.1 m past the end of a line of door cells, so a
   doorway whose cells cover part of it would leak) and from the floor near a door whose
   doorway was not found (a door standing partly open, whose cells need not span its
-  opening), and needs passages of free space ``JOIN_WIDTH`` wide (a slit beside a closed
-  leaf, a gap at a wall's end join nothing): the free space is eroded k cells, which
-  keeps passages of 2k + 1 cells, k the fewest steps that make those at least
-  ``JOIN_WIDTH`` (3 cells at 5 cm), before the door zones are taken out (floor between
-  the zones of two doors across a corridor joins it, however narrow the zones leave
-  it). A merged room's centre is taken on its largest piece.
+  opening), and needs passages ``JOIN_WIDTH`` wide (a slit beside a closed leaf, a gap
+  at a wall's end join nothing): the floor is eroded k cells, which keeps passages of
+  2k + 1 cells, k the fewest steps that make those at least ``JOIN_WIDTH`` (3 cells at
+  5 cm). A merged room's centre is taken on its largest piece.
   A component shorter than ``min_room_length`` is a room when it stands on open floor of
   its own (no longer component's nodes on it) of at least ``OWN_FLOOR`` times
   ``min_room_length`` squared (0.5 m^2): a room glimpsed through a doorway, or a closet or
@@ -191,15 +189,11 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
                          and not taken.intersection(mine)
                          and area[mine].sum() >= OWN_FLOOR * cfg.min_room_length ** 2]
         rooms.sort(key=lambda nodes: int(nodes[0]))
-    # a passage of free space narrower than JOIN_WIDTH (a gap at a wall's end, beside a
-    # closed leaf) joins nothing: k erosion steps keep passages of 2k + 1 cells and more.
-    # The free space is eroded, not the open floor: the floor left between the cut zones
-    # of two doors facing each other across a corridor is a passage of the corridor, however
-    # narrow the zones leave it
+    # a passage narrower than JOIN_WIDTH (a gap at a wall's end, beside a closed leaf)
+    # joins nothing: k erosion steps keep passages of 2k + 1 cells and more
     steps = max(0, math.ceil((JOIN_WIDTH / occ.resolution - 1) / 2 - 1e-9))
     if steps > 0:  # (the grid's edge is no wall)
-        open_floor = open_floor & ndimage.binary_erosion(occ.free, iterations=steps,
-                                                         border_value=1)
+        open_floor = ndimage.binary_erosion(open_floor, iterations=steps, border_value=1)
     part, count = ndimage.label(open_floor)
     # rooms and parts of floor as one graph: a room linked to each part it stands on
     links = [(i, len(rooms) + p) for i, nodes in enumerate(rooms) for p in _parts(vg, part, nodes)]

@@ -139,23 +139,6 @@ def test_a_corridor_cut_beside_a_door_is_joined_by_its_floor() -> None:
                              occ=occ).count == 2
 
 
-def test_floor_between_two_doors_across_a_corridor_joins_it() -> None:
-    """Door evidence 0.15 m deep on both walls of a 0.9 m corridor, the second 0.7 m along
-    the first: the graph is cut between them, but it is one corridor. Its floor between the
-    two cut zones is narrower than JOIN_WIDTH once the zones are taken out, and it was
-    eroded after that: the corridor stayed two rooms (a review's hall, depending on where
-    the grid fell). The free space is eroded now, then the zones taken out."""
-    g = walled(18, 120)
-    occ = OccupancyGrid(g, (0.0, 0.0), RES)
-    vg = voronoi_graph(occ)
-    door = np.zeros(g.shape, dtype=bool)
-    door[4:7, 44:58] = True  # 0.7 m along the north wall
-    door[19:22, 58:74] = True  # 0.8 m along the south wall, 0.7 m on
-    dens = door_density(door, RES, ROOMS.door_bandwidth)
-    assert segment_rooms(vg, dens, ROOMS).count == 2  # the graph alone: cut
-    assert segment_rooms(vg, dens, ROOMS, occ=occ).count == 1
-
-
 def floor(free: np.ndarray) -> OccupancyGrid:
     """A grid of ``free`` cells (else occupied), 5 cm cells, for a hand-made graph (whose
     node n sits in cell (0, n))."""
