@@ -48,6 +48,9 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     request.config.check()  # before anything is emptied or written (the transcript)
     refuse_input_folder(out_dir, request.config.house_files, what="--house")
     within = None if log_dir is None else _within(log_dir, out_dir)
+    if within is not None and within.parts and within.parts[0] in OUTPUT_NAMES:
+        raise SgtoolError(f"--log-dir {log_dir}: {within.parts[0]} is a file the bench "
+                          f"writes in {out_dir}; give the logs another folder")
     try:
         with output_folder(out_dir, force=request.force, command="bench", known=OUTPUT_NAMES,
                            inner=() if within is None else within.parts[:1]

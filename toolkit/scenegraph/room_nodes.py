@@ -131,8 +131,11 @@ def room_nodes(
                 if got is None:
                     got = class_memo[evidence] = checked_scores(
                         classifier, classifier.classify(list(evidence)))
-                if 0 < config.corridor_hub <= len(nb[rid]) and corridor_like(
-                        vg, seg.rooms[i], config, semantic=bool(instances)):
+                hub = 0 < config.corridor_hub <= len(nb[rid]) and corridor_like(
+                    vg, seg.rooms[i], config, semantic=bool(instances))
+                if hub and not got:  # the classifier says nothing: as an empty room
+                    got = [(str(config.corridor), 1.0)]
+                elif hub:
                     got = weigh_type(got, str(config.corridor), config.corridor_odds)
                 scores = got[: config.max_scores]
             elif corridor_like(vg, seg.rooms[i], config, semantic=bool(instances)):
@@ -174,15 +177,18 @@ def checked_scores(classifier: RoomClassifier, got: Any) -> list[tuple[str, floa
 def weigh_type(scores: list[tuple[str, float]], room_type: str, odds: float
                ) -> list[tuple[str, float]]:
     """``scores`` (a classifier's answer) with ``room_type``'s score weighed ``odds`` times
-    (a prior the objects do not know of), renormalised and ranked again (best first, ties
-    by name); as they are when they do not name ``room_type``."""
+    (a prior the objects do not know of), scaled back to the answer's own total (no other
+    type's score grows) and ranked again (best first, ties by name); as they are when they
+    do not name ``room_type`` (a classifier that answers one type, as the LLM's does, has
+    no distribution to weigh) or score nothing."""
     if room_type not in dict(scores):
         return scores
     weighed = [(r, p * odds if r == room_type else p) for r, p in scores]
-    total = sum(p for _, p in weighed)
-    if not total > 0:
+    before, after = sum(p for _, p in scores), sum(p for _, p in weighed)
+    if not (before > 0 and after > 0):
         return scores
-    return sorted(((r, p / total) for r, p in weighed), key=lambda rp: (-rp[1], rp[0]))
+    scale = before / after
+    return sorted(((r, p * scale) for r, p in weighed), key=lambda rp: (-rp[1], rp[0]))
 
 
 def corridor_like(vg: VoronoiGraph, nodes: np.ndarray, config: BuilderConfig,

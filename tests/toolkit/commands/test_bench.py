@@ -422,8 +422,8 @@ def test_episode_logs_record_the_planner_options(tmp_path):
 def test_episode_logs_inside_the_output_folder(tmp_path):
     """`-o rl --log-dir rl/logs` (examples/README.md's command) on a new folder: the logs
     made rl non-empty while the run staged its outputs, so it took them for another run's
-    and wrote rl.1; the logs are outputs of the run now, moved in with the tables (and
-    replaced with them under --force)."""
+    and wrote rl.1; the log folder is the run's own now (under --force a user's file in
+    it stays), and a log folder named as one of the outputs is refused."""
     args = ["bench", "--planners", "greedy", "--houses", "1", "--episodes", "2", "--seeds",
             "1", "--max-steps", "2", "--no-progress", "-o", str(tmp_path / "rl"),
             "--log-dir", str(tmp_path / "rl" / "logs")]
@@ -440,6 +440,11 @@ def test_episode_logs_inside_the_output_folder(tmp_path):
     assert sorted((tmp_path / "rl" / "logs").rglob("*.mcap")) == logs
     assert mine.read_text() == "keep"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["rl"]
+    fresh = tmp_path / "new"  # (its log folder would have been taken for an output)
+    r = CliRunner().invoke(cli, [*args[:-4], "-o", str(fresh), "--log-dir",
+                                 str(fresh / "run.md")])
+    assert r.exit_code == 2 and "run.md is a file the bench writes in" in r.output, r.output
+    assert not fresh.exists()
 
 
 def test_a_killed_runs_staging_folder_is_named(tmp_path):

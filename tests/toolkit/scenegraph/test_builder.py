@@ -274,6 +274,27 @@ def test_a_narrow_room_joining_four_rooms_leans_to_a_corridor(doors: int) -> Non
         "kitchen"
     assert named(["shelf", "console_table"], None) == "unknown"
 
+    class Silent:  # a classifier with nothing to say about these objects
+        def classify(self, categories: list[str]) -> list[tuple[str, float]]:
+            return []
+
+    # as an empty narrow room then (it was "unknown" while an empty one was a corridor)
+    assert named(["shelf"], Silent()) == ("corridor" if doors == 4 else "unknown")
+
+
+def test_weighing_a_type_moves_no_other_type_up() -> None:
+    """The corridor weight scales the answer back to its own total (a user classifier's
+    scores need not sum to 1: renormalising raised kitchen 0.2 -> 0.29); an answer that
+    does not name the type (one type at 1.0, as the LLM classifier answers) is left as it
+    is."""
+    from sgtool.scenegraph.room_nodes import weigh_type
+
+    got = dict(weigh_type([("kitchen", 0.2), ("corridor", 0.05)], "corridor", 10.0))
+    assert got["kitchen"] < 0.2 and sum(got.values()) == pytest.approx(0.25)
+    assert weigh_type([("utility_room", 1.0)], "corridor", 10.0) == [("utility_room", 1.0)]
+    assert weigh_type([("kitchen", 0.3), ("corridor", 0.0)], "corridor", 10.0) == [
+        ("kitchen", 0.3), ("corridor", 0.0)]
+
 
 def test_the_columns_the_camera_cannot_see_over_are_the_walls_not_the_floor() -> None:
     b, _ = build("closed")
