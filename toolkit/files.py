@@ -388,8 +388,7 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
     - a ``target`` missing or empty at the start that another run filled meanwhile is
       left alone: the outputs become ``NAME.1`` (the first free suffix) and a one-line
       :class:`~sgtool.errors.SgtoolError` says so; entries named in ``inner`` are this
-      run's own (a folder of its, such as ``--log-dir OUT/logs``, written by another
-      ``output_folder`` within ``target``): they are no other run's, and stay as they are.
+      run's (``--log-dir OUT/logs``, another ``output_folder``'s), left as they are.
 
     The new :data:`MANIFEST` lists the top-level entries of the yielded folder, for the
     next ``--force``. On any exception (Ctrl-C included) the yielded folder is removed and

@@ -410,8 +410,8 @@ def planner_options(items: tuple[str, ...], planners: Sequence[str] | None = Non
     option for a name that is no planner is an error (a typo such as ``sout.delta`` would
     otherwise run everything with the defaults), and so is one for a planner not run whose
     name is close to one run (``lab:Labplanner`` for ``lab:LabPlanner``); one for another
-    planner not run is a note. ``typed=False`` (a report of a stored run, whose plug-ins
-    need not import here): every value as :func:`parse_value` reads it, no planner asked."""
+    planner not run is a note. ``typed=False`` (a report: plug-ins need not import): every
+    value as :func:`parse_value` reads it, no planner asked."""
     from sgtool.planning.registry import check_planner_name, parse_option
 
     out: dict[str, dict[str, Any]] = {}
@@ -436,9 +436,8 @@ def planner_options(items: tuple[str, ...], planners: Sequence[str] | None = Non
                                   f"mean {close[0]!r}?")
             click.echo(f"sgtool: note: --planner-option {key.strip()}: {name!r} is not "
                        "run; the option is unused", err=True)
-        text = value.strip()
-        out.setdefault(name, {})[opt] = parse_option(name, opt, text) if run and typed \
-            else parse_value(text)
+        out.setdefault(name, {})[opt] = parse_option(name, opt, value.strip()) \
+            if run and typed else parse_value(value.strip())
     return out
 
 
