@@ -76,6 +76,7 @@ from sgtool.analysis.bench_planner_checks import (
     config_names,
     config_planner_options,
     config_rooms,
+    recorded_planner_options,
 )
 from sgtool.analysis.bench_priors import (
     planner_options_for,
@@ -107,7 +108,7 @@ from sgtool.arg_checks import of_type, whole
 from sgtool.canonical import strict_json
 from sgtool.files import atomic_write, note_written, output_dir, output_folder
 from sgtool.planning.episode import SUCCESS_RULES
-from sgtool.redact import options_as_text, redact_text, secret_values
+from sgtool.redact import redact_text, secret_values
 from sgtool.results import EpisodeResult, results_digest, write_jsonl
 from sgtool.version import __version__
 
@@ -204,13 +205,10 @@ class BenchConfig:
         return cost_models(self.distance_budget, self.step_budget)
 
     def settings(self) -> dict[str, Any]:
-        from sgtool.planning.registry import typed_options
-
         d = asdict(self)
         d["planners"] = list(self.planners)
         d["rooms"] = list(self.rooms)
-        d["planner_options"] = options_as_text(  # as taken: -O text and Python alike
-            {p: typed_options(p, o) for p, o in self.planner_options.items()})
+        d["planner_options"] = recorded_planner_options(self.planner_options)
         for key in ("workers", "executor", "ray_address",  # do not change the results
                     "reference", "all_pairs"):
             d.pop(key)

@@ -54,6 +54,17 @@ def config_planner_options(value: Any) -> dict[str, dict[str, Any]]:
     return out
 
 
+def recorded_planner_options(planner_options: Mapping[str, Mapping[str, Any]]
+                             ) -> dict[str, dict[str, str]]:
+    """A run's planner options as its settings record them: each value as the planner
+    takes it (:func:`sgtool.planning.registry.typed_options`: ``-O`` text and Python give
+    the same record), redacted and as text (:func:`sgtool.redact.options_as_text`)."""
+    from sgtool.planning.registry import typed_options
+    from sgtool.redact import options_as_text
+
+    return options_as_text({p: typed_options(p, o) for p, o in planner_options.items()})
+
+
 def _own_copy(value: Any) -> Any:
     """An option's value with its containers copied (a dict or list of a Python-only option
     changed by the caller afterwards must not change the run); anything else in it as

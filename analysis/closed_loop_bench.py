@@ -56,6 +56,7 @@ from sgtool.analysis.bench_planner_checks import (
     config_names,
     config_planner_options,
     config_rooms,
+    recorded_planner_options,
 )
 from sgtool.analysis.closed_loop_tables import (
     budget_comparisons,
@@ -95,7 +96,6 @@ from sgtool.recorders.sim.closed_loop import WENT_ON, ClosedLoopOptions, run_epi
 from sgtool.recorders.sim.fallback_explore import is_fallback
 from sgtool.recorders.sim.frame_budget import frame_budget
 from sgtool.recorders.sim.noise import NoiseProfile, names_file, parse_noise
-from sgtool.redact import options_as_text
 from sgtool.results import EpisodeResult, write_jsonl
 
 # what maps run_task over the tasks: map (in order, here) or an executor's runner
@@ -432,13 +432,10 @@ class ClosedLoopBenchResult:
     def summary(self) -> dict[str, Any]:
         """summary.json: per noise profile the statistics of :meth:`statistics`, and the
         settings ``sgtool eval`` re-scores and compares runs by (:mod:`.eval_settings`)."""
-        from sgtool.planning.registry import typed_options
-
         cfg = self.config
         settings = {"planners": list(cfg.planners), "max_steps": cfg.options.max_steps,
                     "distance_budget": cfg.distance_budget, "step_budget": cfg.step_budget,
-                    "planner_options": options_as_text(
-                        {p: typed_options(p, o) for p, o in cfg.planner_options.items()})}
+                    "planner_options": recorded_planner_options(cfg.planner_options)}
         return {"planners": list(cfg.planners), "settings": settings,
                 "noise": {noise_folder(n): self.statistics(n)[1] for n in cfg.noise},
                 **({"missing_episodes": self.missing} if self.missing else {})}
