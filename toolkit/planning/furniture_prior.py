@@ -10,10 +10,9 @@ mapping (e.g. the furniture categories of a house spec's vocabulary, each with Ï
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from functools import lru_cache
 from pathlib import Path
-from types import MappingProxyType
 
 from sgtool.errors import SgtoolError
 
@@ -23,6 +22,25 @@ LEVELS_VERSION = 1
 
 class FurniturePriorError(SgtoolError):
     """A furniture-level table that cannot be read."""
+
+
+class LevelTable(Mapping[str, float]):
+    """A read-only name -> Ï† table (it pickles, so a planner holding one does)."""
+
+    def __init__(self, levels: Mapping[str, float]) -> None:
+        self._levels = dict(levels)
+
+    def __getitem__(self, key: str) -> float:
+        return self._levels[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._levels)
+
+    def __len__(self) -> int:
+        return len(self._levels)
+
+    def __repr__(self) -> str:
+        return f"LevelTable({len(self._levels)} names)"
 
 
 def query_key(name: str) -> str:
@@ -42,7 +60,7 @@ def parse_levels(doc: object, source: str) -> Mapping[str, float]:
         if not isinstance(v, int | float) or isinstance(v, bool) or not 0.0 <= v <= 1.0:
             raise FurniturePriorError(f"{source}: levels[{k!r}]: {v!r} is not in [0, 1]")
         out[query_key(k)] = float(v)
-    return MappingProxyType(out)
+    return LevelTable(out)
 
 
 @lru_cache(maxsize=4)

@@ -17,7 +17,7 @@ import logging
 import os
 import threading
 from collections.abc import Iterator, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -90,6 +90,15 @@ class SentenceEncoder:
         self._lock = threading.Lock()
         self.dim = EMBEDDING_DIM
         self.model_loads = 0  # how often the model was loaded (0 when all was cached)
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The backend, the cache's path and the vectors in memory: a copy (in another
+        process) loads the model again when it meets a text it has not seen."""
+        return {"backend": self.backend, "cache": self.cache, "memory": self._memory}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__(state["cache"] or False, state["backend"])  # type: ignore[misc]
+        self._memory.update(state["memory"])
 
     @functools.cached_property
     def model_id(self) -> str:

@@ -112,3 +112,32 @@ def test_search_planners_with_real_priors(name: str, seed: int) -> None:
     first = play(make_planner(name, encoder=encoder()), World(seed), seed, 60)
     assert first[-1] is not None and len(first) < 60, f"{name}: no end or no target"
     assert first == play(make_planner(name, encoder=encoder()), World(seed), seed, 60)
+
+
+@pytest.mark.parametrize("name", [n for n in PLANNER_NAMES if "llm" not in n])
+def test_a_planner_pickled_mid_search_goes_on_the_same_way(name: str) -> None:
+    """Every built-in planner on the shipped priors pickles (for a Ray or pool worker, or a
+    deep copy), its search state with it: a copy taken after three decisions decides the
+    rest of the search as the original does."""
+    import copy
+    import pickle
+
+    world, twin = World(4), World(4)
+    planner = make_planner(name)
+    planner.reset(world.query, seed=4)
+    for _ in range(3):
+        a = planner.decide(world.graph())
+        assert a.skill != "done"
+        planner.feedback(world.execute(a))
+        twin.execute(a)
+    clone = pickle.loads(pickle.dumps(planner))
+    assert type(copy.deepcopy(planner)) is type(planner)
+    rest, rest_clone = [], []
+    for p, w, out in ((planner, world, rest), (clone, twin, rest_clone)):
+        for _ in range(40):
+            a = p.decide(w.graph())
+            out.append(a.target)
+            if a.skill == "done":
+                break
+            p.feedback(w.execute(a))
+    assert rest == rest_clone and len(rest) >= 2
