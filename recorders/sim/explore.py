@@ -9,8 +9,12 @@ Simulation`, so every step is a logged action:
    closed doors counted as passable), ties by room id; while closed doors are in the way
    (on that shortest path), ``navigate`` to the first one and ``open`` it; then
    ``navigate`` to the room;
-3. in each room reached: ``look_around``, then (optionally) go to every closed openable
-   container of the room, nearest first, and ``open`` it, so its contents are seen.
+3. in each room reached: ``look_around``; while a further place in the room would show at
+   least ``view_gain_m2`` of its floor that no look-around there has shown (an L- or
+   U-shaped room, one longer than the camera reaches: :mod:`.room_views`), up to
+   ``views`` times, ``navigate`` there and ``look_around`` again; then (optionally) go to
+   every closed openable container of the room, nearest first, and ``open`` it, so its
+   contents are seen.
 
 Rooms that cannot be reached (or whose doors fail to open) are reported, not retried
 forever. The order depends only on the house and the start pose, so the same inputs give
@@ -28,6 +32,7 @@ import numpy as np
 from sgtool.house.spec import spec_id_key
 from sgtool.mapping.occupancy import geodesic_distances, world_to_cell
 from sgtool.recorders.sim import navigation as nav
+from sgtool.recorders.sim import room_views
 from sgtool.recorders.sim.simulation import Simulation, SkillOutcome
 
 
@@ -36,6 +41,8 @@ class ScriptOptions:
     open_doors: bool = True
     open_containers: bool = True
     max_door_attempts: int = 6  # doors opened on the way to one room before giving up
+    views: int = 3  # further look-arounds per room at most (0: one, at its viewpoint)
+    view_gain_m2: float = 1.0  # floor a further look-around must newly show
 
 
 @dataclass
@@ -66,6 +73,7 @@ def explore_house(sim: Simulation, options: ScriptOptions | None = None,
     do(sim.look_around())
     if here is not None:
         rep.visited.append(here)
+        _look_further(sim, here, opts, do)
         if opts.open_containers:
             _open_containers(sim, here, rep, do)
     todo = [r.id for r in sim.spec.rooms if r.id not in rep.visited]
@@ -82,6 +90,7 @@ def explore_house(sim: Simulation, options: ScriptOptions | None = None,
             continue
         rep.visited.append(room)
         do(sim.look_around())
+        _look_further(sim, room, opts, do)
         if opts.open_containers:
             _open_containers(sim, room, rep, do)
     return rep
@@ -123,6 +132,41 @@ def _go_to_room(sim: Simulation, room: str, opts: ScriptOptions, rep: Exploratio
             return f"cannot open {door}: {out.reason}"
         rep.opened.append(door)
     return f"more than {opts.max_door_attempts} closed doors in the way"
+
+
+VIEW_STRIDE = 0.5  # m between the places a further look-around is weighed at
+VIEW_REACH = 0.75  # share of the camera's depth range a look-around counts as seen
+
+
+def _look_further(sim: Simulation, room: str, opts: ScriptOptions,
+                  do: Callable[[SkillOutcome], SkillOutcome]) -> None:
+    """Look around again from the places of ``room`` that show the most of its floor not
+    shown yet, while one shows ``opts.view_gain_m2`` (module doc, step 3)."""
+    if opts.views <= 0:
+        return
+    occ = sim.occupancy()
+    res, origin = occ.resolution, occ.origin
+    blocked = room_views.blockers(sim.spec, res, sim.camera.mount_height)
+    inroom = nav.room_mask(occ, sim.spec.room(room))
+    if blocked.shape != inroom.shape:
+        return
+    floor = inroom & ~occ.occupied
+    reach = VIEW_REACH * sim.camera.depth_max
+    seen = room_views.visible(blocked, origin, res, sim.base[:2], reach)
+    k = max(1, round(VIEW_STRIDE / res))
+    for _ in range(opts.views):
+        occ = sim.occupancy()
+        rows, cols = np.nonzero(inroom & np.isfinite(geodesic_distances(occ, sim.base[:2])))
+        on = (rows % k == k // 2) & (cols % k == k // 2)
+        places = [(origin[0] + (c + 0.5) * res, origin[1] + (r + 0.5) * res)
+                  for r, c in zip(rows[on], cols[on], strict=True)]
+        best = room_views.best_view(blocked, origin, res, floor, seen, places, reach)
+        if best is None or best[1] * res * res < opts.view_gain_m2:
+            return
+        if not do(sim.navigate(best[0])).success:
+            return
+        do(sim.look_around())
+        seen |= room_views.visible(blocked, origin, res, sim.base[:2], reach)
 
 
 def _open_containers(sim: Simulation, room: str, rep: ExplorationReport,

@@ -91,7 +91,9 @@ def command(**given: Any) -> None:
 
     Without a planner the robot runs a scripted exploration: it visits every room
     (nearest first), opening closed doors on the way and the closed containers of each
-    room, and looks around in each. With no --house and no --seed it records the demo
+    room, and looks around in each (again from further places of a room one look-around
+    does not show whole: an L- or U-shaped room, one longer than the camera reaches).
+    With no --house and no --seed it records the demo
     house shipped with sgtool. The same house, options and seeds give a byte-identical
     log. Example: `sgtool record -o demo.mcap && sgtool info demo.mcap`.
     """
