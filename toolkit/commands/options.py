@@ -410,9 +410,9 @@ def planner_options(items: tuple[str, ...], planners: Sequence[str] | None = Non
     option for a name that is no planner is an error (a typo such as ``sout.delta`` would
     otherwise run everything with the defaults), and so is one for a planner not run whose
     name is close to one run (``lab:Labplanner`` for ``lab:LabPlanner``); one for another
-    planner not run is a note. ``typed=False`` (a report: plug-ins need not import): every
-    value as :func:`parse_value` reads it, no planner asked."""
-    from sgtool.planning.registry import check_planner_name, parse_option
+    planner not run is a note. ``typed=False`` (a report: plug-ins need not import): a
+    plug-in's values as :func:`parse_value` reads them, the plug-in not asked."""
+    from sgtool.planning.registry import REGISTRY, check_planner_name, parse_option
 
     out: dict[str, dict[str, Any]] = {}
     if planners is not None:  # "-p Scout -O SCOUT.delta=..." is one planner
@@ -437,7 +437,7 @@ def planner_options(items: tuple[str, ...], planners: Sequence[str] | None = Non
             click.echo(f"sgtool: note: --planner-option {key.strip()}: {name!r} is not "
                        "run; the option is unused", err=True)
         out.setdefault(name, {})[opt] = parse_option(name, opt, value.strip()) \
-            if run and typed else parse_value(value.strip())
+            if run and (typed or name in REGISTRY) else parse_value(value.strip())
     return out
 
 

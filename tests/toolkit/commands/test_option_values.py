@@ -225,3 +225,18 @@ def test_distill_report_refuses_weights_it_cannot_score(tmp_path: Path) -> None:
     r = CliRunner().invoke(cli, ["distill", "--report", "--weights", str(wide)])
     assert r.exit_code == 2 and "containment.safetensors: containment: layer sizes" in r.output
     assert "Traceback" not in r.output
+
+
+def test_a_report_checks_a_built_in_planners_options() -> None:
+    """A report (``typed=False``: plug-ins need not import) still asks a built-in planner:
+    a misspelt key is the planner's own error (it was "run with other settings"), a value
+    is converted as the run converted it; a plug-in's value is read as text would be."""
+    from sgtool.commands.options import planner_options
+    from sgtool.errors import SgtoolError
+
+    with pytest.raises(SgtoolError, match="does not take option"):
+        planner_options(("scout.dleta=0.2",), ("scout",), typed=False)
+    assert planner_options(("scout.delta=1",), ("scout",), typed=False) == \
+        {"scout": {"delta": 1.0}}
+    got = planner_options(("nolab:Missing.k=2",), ("nolab:Missing",), typed=False)
+    assert got == {"nolab:Missing": {"k": 2}}
