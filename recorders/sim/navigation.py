@@ -27,7 +27,7 @@ from sgtool.errors import SgtoolError
 from sgtool.house.spec import HouseSpec, Room
 from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
 from sgtool.mapping.occupancy import OccupancyMap, house_occupancy, inflate
-from sgtool.mapping.raster import cell_centers, fill_box_grown, polygon_mask
+from sgtool.mapping.raster import cell_centers, fill_box_grown, fill_box_near, polygon_mask
 from sgtool.recorders.sim.articulation import Box2
 
 Pose2 = tuple[float, float, float]  # x, y, yaw
@@ -87,29 +87,40 @@ def occupancy_with(spec: HouseSpec, door_states: Mapping[str, str], extra: Seque
     if not extra:
         return base
     occ = base.occupied.copy()
+    near = np.zeros(base.shape, bool)  # cells blocked by the panels, as the house's boxes
     for x, y, sx, sy, yaw in extra:
         fill_box_grown(base, occ, (x, y), (sx, sy), yaw)
-    return with_occupied(base, occ)
+        if base.robot_radius > 0:
+            fill_box_near(base, near, (x, y), (sx, sy), yaw, base.robot_radius)
+    return with_occupied(base, occ, near)
 
 
-def with_occupied(base: OccupancyMap, occupied: np.ndarray) -> OccupancyMap:
+def with_occupied(base: OccupancyMap, occupied: np.ndarray,
+                  near: np.ndarray | None = None) -> OccupancyMap:
     """The map of ``occupied`` (``base.occupied`` plus cells), equal to
     ``OccupancyMap.of_occupied(occupied, ...)`` with ``base``'s origin, resolution, radius
-    and door rule; only the window around the added cells is grown by the radius (a cell
-    is blocked when it is in ``base`` or near an added cell, and every cell near an added
-    cell lies in that window)."""
+    and door rule when ``base`` is such a map; only the window around the added cells is
+    grown by the radius (a cell is blocked when it is blocked in ``base`` or near an added
+    cell, and every cell near an added cell lies in that window). ``near``: the cells the
+    added shapes block, measured to the shapes themselves (``fill_box_near``, as
+    :func:`~sgtool.mapping.occupancy.house_occupancy` blocks its boxes), used instead of
+    growing the added cells: those reach past a turned shape and would close a doorway
+    beside it that the house map leaves open."""
     res, radius = base.resolution, base.robot_radius
-    if not base.occupied.any():  # (the distance transform needs an occupied cell)
+    if near is None and not base.occupied.any():  # (the distance transform needs one)
         return OccupancyMap.of_occupied(occupied, base.origin, res, radius,
                                         base.closed_doors_free)
     added = occupied & ~base.occupied
-    blocked = base.blocked.copy()
-    if added.any():
+    blocked = base.blocked | added
+    if near is not None:
+        blocked |= near
+    elif added.any():
         rows, cols = np.nonzero(added)
         k = int(math.ceil((radius + res / 2.0) / res)) + 1
         win = (slice(max(int(rows.min()) - k, 0), int(rows.max()) + k + 1),
                slice(max(int(cols.min()) - k, 0), int(cols.max()) + k + 1))
-        blocked[win] |= inflate(occupied[win], radius, res)
+        # the added cells only: the base's own cells are blocked as ``base`` has them
+        blocked[win] |= inflate(added[win], radius, res)
     grid = OccupancyGrid(np.where(occupied, OCCUPIED, FREE).astype(np.int8), base.origin, res)
     return OccupancyMap(grid, blocked, radius, base.closed_doors_free)
 

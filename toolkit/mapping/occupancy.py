@@ -4,8 +4,12 @@ The grid is what the symbolic benchmark, the episode lister and the scripted rec
 on. ``occupied`` marks cells covered by an obstacle: walls, furniture whose box starts below
 ``max_obstacle_height``, closed doors (unless ``closed_doors_free``), and everything outside
 the house (cells whose centre lies in no room polygon), so paths never leave the house.
-``blocked`` is ``occupied`` grown by the robot's radius: a cell is blocked when a disc of
-``robot_radius`` centred on the cell centre would overlap an occupied cell. Paths run on the
+``blocked`` is where the robot's centre may not be: a cell is blocked when a disc of
+``robot_radius`` centred on the cell centre would touch a wall's or closed door's box (the
+exact distance from the centre to the box, so a doorway's free cells do not depend on how
+the house is turned against the grid: a door wider than the robot's diameter by a cell's
+diagonal is passable at any angle, one no wider than the diameter never), would overlap an
+occupied cell of furniture or of the outside (:func:`inflate`), or is occupied. Paths run on the
 free (not blocked) cells, 8-connected, unit steps of one cell and sqrt(2) cells on
 diagonals; a diagonal step needs both cells it cuts past to be free (no corner cutting).
 This is the "dilated occupancy map + A*" geodesic of SCOUT's SymSearch (Fig. 5 f).
@@ -33,6 +37,7 @@ from sgtool.house.spec import HouseSpec
 from sgtool.mapping.grid import FREE, OCCUPIED, OccupancyGrid
 from sgtool.mapping.raster import (
     cell_to_world,
+    fill_box_near,
     fill_box_overlap,
     fill_polygon,
     world_to_cell,
@@ -48,10 +53,11 @@ _STEPS = ((0, 1), (0, -1), (1, 0), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
 class OccupancyMap:
     """A house's occupancy grid (:class:`~sgtool.mapping.bev.OccupancyGrid`, FREE or
     OCCUPIED cells: the one grid type of the mapping code) with the robot's footprint:
-    ``blocked`` is ``occupied`` grown by ``robot_radius`` (see the module docstring)."""
+    ``blocked``, the cells the robot's centre may not be in (``occupied`` grown by
+    ``robot_radius``; a house's by the exact distance to its boxes: the module docstring)."""
 
     grid: OccupancyGrid
-    blocked: np.ndarray  # bool, occupied grown by robot_radius
+    blocked: np.ndarray  # bool, occupied grown by robot_radius (class doc)
     robot_radius: float = 0.2
     closed_doors_free: bool = False
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
@@ -121,18 +127,32 @@ def house_occupancy(spec: HouseSpec, resolution: float = 0.05, robot_radius: flo
     for room in spec.rooms:
         fill_polygon(grid, inside, room.polygon)
     occupied = ~inside
-    for w in spec.walls:
-        cx, cy = (w.a[0] + w.b[0]) / 2.0, (w.a[1] + w.b[1]) / 2.0
-        fill_box_overlap(grid, occupied, (cx, cy), (w.length, w.thickness), w.yaw)
+    # (centre, size, yaw) of the walls and closed doors, which make the doorways
+    frames = [(((w.a[0] + w.b[0]) / 2.0, (w.a[1] + w.b[1]) / 2.0), (w.length, w.thickness),
+               w.yaw) for w in spec.walls]
     if not closed_doors_free:
-        for d in spec.doors:
-            if d.state == "closed":
-                fill_box_overlap(grid, occupied, d.center, (d.width, d.thickness), d.yaw)
+        frames += [(d.center, (d.width, d.thickness), d.yaw) for d in spec.doors
+                   if d.state == "closed"]
+    for center, size, yaw in frames:
+        fill_box_overlap(grid, occupied, center, size, yaw)
+    pieces = np.zeros_like(occupied)
     for f in spec.furniture:
         if f.bottom < max_obstacle_height:
-            fill_box_overlap(grid, occupied, f.center[:2], f.size[:2], f.yaw)
-    return OccupancyMap.of_occupied(occupied, grid.origin, resolution, robot_radius,
-                                    closed_doors_free)
+            fill_box_overlap(grid, pieces, f.center[:2], f.size[:2], f.yaw)
+    if robot_radius <= 0:
+        blocked = occupied | pieces
+    else:
+        # walls and door frames by their exact distance, not grown from the cells they
+        # overlap (those reach up to a cell's diagonal past a turned wall, and growing
+        # them adds half a cell more: a 0.5 m door was closed at 15-75 degrees, a 0.55 m
+        # one at 25-35 and 55-65, both open at 0 and 90); furniture is grown as before
+        blocked = inflate(~inside | pieces, robot_radius, resolution) | occupied
+        for center, size, yaw in frames:
+            fill_box_near(grid, blocked, center, size, yaw, robot_radius)
+    occupied |= pieces
+    return OccupancyMap(OccupancyGrid(np.where(occupied, OCCUPIED, FREE).astype(np.int8),
+                                      grid.origin, resolution),
+                        blocked, robot_radius, closed_doors_free)
 
 
 def inflate(occupied: np.ndarray, radius: float, resolution: float) -> np.ndarray:

@@ -139,3 +139,19 @@ def fill_box_grown(grid: Grid, out: np.ndarray, center: Sequence[float],
         return
     win, lx, ly = frame
     out[win] |= (np.abs(lx) <= size[0] / 2 + h) & (np.abs(ly) <= size[1] / 2 + h)
+
+
+def fill_box_near(grid: Grid, out: np.ndarray, center: Sequence[float],
+                  size: Sequence[float], yaw: float, reach: float) -> None:
+    """Mark the cells whose centre lies within ``reach`` of the oriented box (its inside
+    and a centre at exactly ``reach`` included): the exact distance from the centre, so
+    the cells marked around a box do not depend on how it is turned against the grid. A
+    disc of radius ``reach`` on an unmarked centre keeps clear of the box, so a gap of
+    ``2 * reach`` or less between two boxes has no unmarked centre at any angle."""
+    frame = _box_frame(grid, center, size, yaw, max(reach, 0.0))
+    if frame is None:
+        return
+    win, lx, ly = frame
+    ex = np.maximum(np.abs(lx) - size[0] / 2.0, 0.0)
+    ey = np.maximum(np.abs(ly) - size[1] / 2.0, 0.0)
+    out[win] |= np.hypot(ex, ey) <= reach + _TOL
