@@ -59,11 +59,26 @@ def pose_of_message(msg: Any, msgtype: str, topic: str) -> tuple[int, str, np.nd
 
 
 def intrinsics_of_info(msg: Any) -> tuple[int, int, float, float, float, float]:
+    """(width, height, fx, fy, cx, cy) of the images a ``CameraInfo`` describes. ``K``,
+    ``width`` and ``height`` are the full sensor's; a driver that publishes a region of
+    interest (``roi``, all zeros: the whole image) or binned images (``binning_x``/``_y``
+    above 1) publishes images of the region's size divided by the binning, with the
+    principal point moved and the focal lengths divided alike (REP 104, as ROS's
+    ``image_geometry`` reads them)."""
     k = getattr(msg, "k", None)
     if k is None:
         k = msg.K  # ROS 1 spelling
     k = np.asarray(k, dtype=np.float64).ravel()
-    return int(msg.width), int(msg.height), float(k[0]), float(k[4]), float(k[2]), float(k[5])
+    width, height = int(msg.width), int(msg.height)
+    x0 = y0 = 0
+    roi = getattr(msg, "roi", None)
+    if roi is not None and int(roi.width) > 0 and int(roi.height) > 0:
+        x0, y0 = int(roi.x_offset), int(roi.y_offset)
+        width, height = int(roi.width), int(roi.height)
+    bx = max(int(getattr(msg, "binning_x", 0) or 0), 1)
+    by = max(int(getattr(msg, "binning_y", 0) or 0), 1)
+    return (width // bx, height // by, float(k[0]) / bx, float(k[4]) / by,
+            (float(k[2]) - x0) / bx, (float(k[5]) - y0) / by)
 
 
 def distortion_of_info(msg: Any) -> tuple[str, tuple[float, ...]]:

@@ -246,3 +246,39 @@ def test_time_stamps_in_milliseconds_are_named_so():
     assert timestamp_problem([int(i * 1e9 / 30) for i in range(10)], "depth.txt") is None
     slow = timestamp_problem([int(i * 300e9) for i in range(10)], "depth.txt")  # 1 per 5 min
     assert slow is not None and "milliseconds" not in slow
+
+
+@pytest.mark.parametrize(("binning", "offset"), [(2, (0, 0)), (1, (100, 60)), (2, (100, 60))])
+def test_a_binned_or_cropped_camera_gets_the_intrinsics_of_its_images(
+        tmp_path, binning: int, offset: tuple[int, int]) -> None:
+    """A driver publishing 2x2-binned images, a region of interest or both: its CameraInfo
+    holds the full sensor's K and size (REP 104). The import failed ("for 128x96 images
+    but the depth images are 64x48"); it gives the images' own intrinsics now."""
+    bag = tmp_path / "b"
+    with BagWriter(bag, "ros2-mcap") as w:
+        for i in range(5):
+            k, _, depth, _, pose, _ = synthetic_frame(i)
+            # the full sensor: the images' pixels are binning x binning of its pixels,
+            # starting at pixel offset of it
+            full = CameraIntrinsics(k.width * binning + 2 * offset[0],
+                                    k.height * binning + 2 * offset[1],
+                                    k.fx * binning, k.fy * binning,
+                                    k.cx * binning + offset[0], k.cy * binning + offset[1])
+            info = w.camera_info(0, "cam", full)
+            roi = replace(info.roi, x_offset=offset[0], y_offset=offset[1],
+                          width=k.width * binning, height=k.height * binning) \
+                if offset != (0, 0) else info.roi
+            info = replace(info, binning_x=binning, binning_y=binning, roi=roi)
+            t = 1_000_000_000 + i * 33_333_333
+            w.write("/tf", "tf2_msgs/msg/TFMessage", t,
+                    w.tf(t, [w.transform_stamped(t, "map", "cam", pose)]))
+            w.write("/d/info", "sensor_msgs/msg/CameraInfo", t, info)
+            w.write("/d/image", "sensor_msgs/msg/Image", t,
+                    w.image(t, "cam", np.round(depth * 1000).astype(np.uint16), "16UC1"))
+    opts = BagOptions(depth="/d/image", progress=False, up=np.array([0, 0, 1.0]), floor=0.0,
+                      tf_frames=("map", "cam"))
+    assert import_bag(bag, tmp_path / "a.mcap", opts).frames == 5
+    with LogReader(tmp_path / "a.mcap") as r:
+        got = next(r.frames()).intrinsics
+    assert (got.width, got.height) == (k.width, k.height)
+    assert (got.fx, got.fy, got.cx, got.cy) == pytest.approx((k.fx, k.fy, k.cx, k.cy))
