@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from sgtool.analysis.executor import Executor, LocalExecutor, Task
+from sgtool.analysis.pin_lock import pins_locked
 from sgtool.arg_checks import of_type
 from sgtool.errors import SgtoolError
 from sgtool.files import (
@@ -179,34 +180,6 @@ def pin_folder(root: Path, logs: Sequence[Path] = ()) -> Iterator[Path]:
         with output_folder(root, force=False, command=PIN_COMMAND, option="--dir",
                            known=PIN_FILES, resume=(root / INDEX).is_file()) as out:
             yield out
-
-
-@contextlib.contextmanager
-def pins_locked(root: Path, shared: bool = False) -> Iterator[None]:
-    """Hold the lock of the pin folder ``root`` (an advisory lock on a file of this user's
-    in a folder of them in the system's temporary folder, named after ``root``'s resolved
-    path; nothing is added to ``root``): one process at a time reads, changes and writes its index;
-    ``shared``: a reader's lock (checks read the index and the graphs it names together,
-    never half of a pin being written). Where there are no advisory locks (not POSIX),
-    nothing is held."""
-    import hashlib
-    import tempfile
-
-    try:
-        import fcntl
-    except ImportError:  # pragma: no cover - not POSIX
-        yield
-        return
-    key = hashlib.sha256(str(root.resolve()).encode()).hexdigest()[:20]
-    user = os.getuid() if hasattr(os, "getuid") else 0
-    locks = Path(tempfile.gettempdir()) / f"sgtool-pin-locks-{user}"  # one folder of them,
-    locks.mkdir(mode=0o700, exist_ok=True)  # not a file per pin folder in the temp folder
-    with open(locks / f"{key}.lock", "a+b") as fh:
-        fcntl.flock(fh, fcntl.LOCK_SH if shared else fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(fh, fcntl.LOCK_UN)
 
 
 def _same_place(out: Path, root: Path) -> bool:
@@ -585,7 +558,7 @@ def update_pins(report: CheckReport) -> list[str]:
             old = pins.logs[c.name]
             opts = overridden(old.options, report.options)
             pin = pinned_entry(c.name, old.log_path(pins.folder), old.log, opts, c.capture,
-                               old.why)
+                               old.why, copied=old.copied)  # a copy stays sgtool's
             write_capture(staged, pin, c.capture)
             pins.logs[c.name] = now[c.name] = pin
             what = c.first or "planner decisions or quality figures"

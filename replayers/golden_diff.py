@@ -127,17 +127,23 @@ def paired_refreshes(ta: Sequence[int], tb: Sequence[int]
                      ) -> tuple[list[int], list[int], str | None]:
     """The refreshes of two logs to compare, by index into each: all of them, in order,
     when both refresh at the same times; else those at a time both refresh at, and the
-    last of each (the final graphs), with a note saying so (two replays at other
-    ``--every`` compared refresh by refresh would set a graph at 3 s against one at 33 s)."""
+    last of each (the final graphs) unless one of them is among those already (a log that
+    ends earlier), with a note saying so (two replays at other ``--every`` compared
+    refresh by refresh would set a graph at 3 s against one at 33 s)."""
     if list(ta) == list(tb):
         return list(range(len(ta))), list(range(len(tb))), None
     where_b = {t: j for j, t in enumerate(tb)}
     pairs = [(i, where_b[t]) for i, t in enumerate(ta) if t in where_b]
-    if ta and tb and (not pairs or pairs[-1] != (len(ta) - 1, len(tb) - 1)):
+    # the final graphs, unless one of them is paired already (a log that ends earlier: its
+    # last graph is compared at its own time, not set against the other's later one)
+    finals = bool(ta and tb and (not pairs or (pairs[-1][0] != len(ta) - 1
+                                              and pairs[-1][1] != len(tb) - 1)))
+    if finals:
         pairs.append((len(ta) - 1, len(tb) - 1))
     common = sum(1 for i, j in pairs if ta[i] == tb[j])
     note = (f"the logs refresh at other times ({len(ta)} and {len(tb)} refreshes, {common} "
-            "at the same time): compared where both refresh, and the final graphs")
+            "at the same time): compared where both refresh"
+            + (", and the final graphs" if finals else ""))
     return [i for i, _ in pairs], [j for _, j in pairs], note
 
 

@@ -409,7 +409,7 @@ def stored_path(log: Path, folder: Path) -> str:
 
 
 def pinned_entry(name: str, log: Path, stored: str, options: ReplayOptions, cap: Capture,
-                 why: str | None = None, copied: bool = False) -> Pinned:
+                 why: str | None = None, copied: bool | None = False) -> Pinned:
     """The index entry of ``cap``, a capture of ``log`` (its bytes are digested; the index
     names it ``stored``: :func:`stored_path`) with ``options``; ``copied``: ``stored`` is
     a copy sgtool made."""

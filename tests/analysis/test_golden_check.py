@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import gzip
 import json
+import os
 import shlex
 import shutil
 import signal
@@ -132,6 +133,8 @@ def test_update_accepts_a_deliberate_change(pinned, capsys):
     assert code == 0
     assert "updated small: accepted the change from refresh 0 at 3.000 s" in out
     assert read_pins(pinned).logs["small"].options.voxel_size == 0.08
+    # the log sgtool copied in (--copy) stays its copy: a later pin --copy replaces it
+    assert read_pins(pinned).logs["small"].copied is True
     code, out, _ = sgtool(capsys, "golden", "check", "--dir", pinned)
     assert code == 0, out
 
@@ -665,7 +668,8 @@ def test_a_check_waits_for_a_pin_being_written(pinned, capsys):
     its graphs waits for it (it read a new graphs file against the old index: 'damaged')."""
     import threading
 
-    from sgtool.analysis.golden_check import check_pins, pins_locked
+    from sgtool.analysis.golden_check import check_pins
+    from sgtool.analysis.pin_lock import pins_locked
 
     done: list[str] = []
     with pins_locked(pinned):
@@ -715,3 +719,20 @@ def test_a_copy_into_a_full_folder_names_the_copy(log, tmp_path, capsys, monkeyp
     assert code == 2 and err.count("\n") == 1
     assert f"cannot write {folder / 'small.mcap'}: No space left on device" in err
     assert not (folder / "expected.json").exists()
+
+
+def test_a_lock_folder_that_is_not_the_user_s_is_one_line(log, tmp_path, capsys,
+                                                          monkeypatch):
+    """Something else named like this user's lock folder in the temporary folder (a file
+    here; another user's folder likewise): one line naming it and the way out, where pin
+    and check raised Python's FileExistsError or PermissionError."""
+    import tempfile
+
+    tmp = tmp_path / "tmp"
+    tmp.mkdir()
+    (tmp / f"sgtool-pin-locks-{os.getuid()}").write_text("")
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp))
+    code, _, err = sgtool(capsys, "golden", "pin", log, "--dir", tmp_path / "g", *FRAMES)
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err, err
+    assert f"its lock folder {tmp / f'sgtool-pin-locks-{os.getuid()}'} is unusable" in err
+    assert "set TMPDIR" in err and not (tmp_path / "g" / "expected.json").exists()

@@ -464,6 +464,12 @@ def test_diff_pairs_refreshes_by_time(tmp_path):
     assert (ia, ib) == ([1, 3, 4], [0, 1, 2]) and note is not None
     assert note.startswith("the logs refresh at other times (5 and 3 refreshes, 2 at the "
                            "same time)")
+    # a log that ends earlier: its last graph is compared at its own time only, not also
+    # set against the other's final graph (reported as a difference at a refresh that agreed)
+    ia, ib, note = paired_refreshes([10, 20, 30], [10, 20, 30, 40, 50])
+    assert (ia, ib) == ([0, 1, 2], [0, 1, 2]) and note is not None
+    assert note.endswith("compared where both refresh")
+    assert paired_refreshes([10, 20, 30, 40], [10, 20])[:2] == ([0, 1], [0, 1])
     a, b = tmp_path / "a.mcap", tmp_path / "b.mcap"
     replay(TOUR, a, ReplayOptions(max_frames=40, every=10))
     replay(TOUR, b, ReplayOptions(max_frames=40, every=20))
