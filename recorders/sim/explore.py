@@ -38,11 +38,26 @@ from sgtool.recorders.sim.simulation import Simulation, SkillOutcome
 
 @dataclass(frozen=True)
 class ScriptOptions:
+    """The scripted tour's choices (module doc): open the closed doors in the way and the
+    closed containers of each room; ``max_door_attempts`` doors opened on the way to one
+    room before it is given up; ``views`` further look-arounds per room at most (0: one,
+    at its viewpoint), each where it newly shows at least ``view_gain_m2`` of the room's
+    floor. A bad value is one :class:`~sgtool.errors.SgtoolError` line."""
+
     open_doors: bool = True
     open_containers: bool = True
-    max_door_attempts: int = 6  # doors opened on the way to one room before giving up
-    views: int = 3  # further look-arounds per room at most (0: one, at its viewpoint)
-    view_gain_m2: float = 1.0  # floor a further look-around must newly show
+    max_door_attempts: int = 6
+    views: int = 3
+    view_gain_m2: float = 1.0
+
+    def __post_init__(self) -> None:
+        from sgtool.arg_checks import number, typed_fields, whole
+
+        typed_fields(self)
+        whole("max_door_attempts", self.max_door_attempts, 0)
+        whole("views", self.views, 0)
+        object.__setattr__(self, "view_gain_m2", number("view_gain_m2", self.view_gain_m2,
+                                                        0.01))
 
 
 @dataclass

@@ -5,6 +5,7 @@ arms, out of sight of the room's viewpoint at the foot of the U."""
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -106,3 +107,16 @@ def _points_driven_to(log: Path) -> list[tuple[float, float]]:
                 out.append((x, y))
     assert all(math.isfinite(v) for p in out for v in p)
     return out
+
+
+@pytest.mark.parametrize(("given", "expect"), [
+    ({"views": -1}, "views=-1: a whole number >= 0"),
+    ({"view_gain_m2": float("nan")}, "view_gain_m2=nan: a finite number"),
+    ({"open_doors": "yes"}, "open_doors='yes': a bool"),
+])
+def test_a_bad_script_option_is_one_line(given: dict, expect: str) -> None:
+    from sgtool.errors import SgtoolError
+    from sgtool.recorders.sim import ScriptOptions
+
+    with pytest.raises(SgtoolError, match="^" + re.escape(expect)):
+        ScriptOptions(**given)
