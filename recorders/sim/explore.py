@@ -65,6 +65,7 @@ class ExplorationReport:
     visited: list[str] = field(default_factory=list)
     missed: dict[str, str] = field(default_factory=dict)  # room id -> reason
     opened: list[str] = field(default_factory=list)
+    looked_again: list[str] = field(default_factory=list)  # a room per further look-around
     outcomes: list[SkillOutcome] = field(default_factory=list)
 
     @property
@@ -88,7 +89,7 @@ def explore_house(sim: Simulation, options: ScriptOptions | None = None,
     do(sim.look_around())
     if here is not None:
         rep.visited.append(here)
-        _look_further(sim, here, opts, do)
+        _look_further(sim, here, opts, rep, do)
         if opts.open_containers:
             _open_containers(sim, here, rep, do)
     todo = [r.id for r in sim.spec.rooms if r.id not in rep.visited]
@@ -105,7 +106,7 @@ def explore_house(sim: Simulation, options: ScriptOptions | None = None,
             continue
         rep.visited.append(room)
         do(sim.look_around())
-        _look_further(sim, room, opts, do)
+        _look_further(sim, room, opts, rep, do)
         if opts.open_containers:
             _open_containers(sim, room, rep, do)
     return rep
@@ -153,7 +154,7 @@ VIEW_STRIDE = 0.5  # m between the places a further look-around is weighed at
 VIEW_REACH = 0.75  # share of the camera's depth range a look-around counts as seen
 
 
-def _look_further(sim: Simulation, room: str, opts: ScriptOptions,
+def _look_further(sim: Simulation, room: str, opts: ScriptOptions, rep: ExplorationReport,
                   do: Callable[[SkillOutcome], SkillOutcome]) -> None:
     """Look around again from the places of ``room`` that show the most of its floor not
     shown yet, while one shows ``opts.view_gain_m2`` (module doc, step 3)."""
@@ -181,6 +182,7 @@ def _look_further(sim: Simulation, room: str, opts: ScriptOptions,
         if not do(sim.navigate(best[0])).success:
             return
         do(sim.look_around())
+        rep.looked_again.append(room)
         seen |= room_views.visible(blocked, origin, res, sim.base[:2], reach)
 
 

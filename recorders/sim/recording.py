@@ -259,7 +259,8 @@ class RecordReport:
     opened, whether the frame budget cut the tour short, the wall-clock seconds, for
     a frontier exploration the share of the house's floor seen over time, and the open
     doors and pieces whose panels had no room to swing (``taken_away``, the doors among
-    them ``doors_taken_away``: out of the simulation; an empty doorway in the log).
+    them ``doors_taken_away``: out of the simulation; an empty doorway in the log), and
+    a room per further look-around of the scripted tour in it (``looked_again``).
     ``lines()`` is ``sgtool record``'s report."""
 
     output: Path
@@ -275,6 +276,7 @@ class RecordReport:
     coverage: tuple[tuple[float, float], ...] = ()  # frontier: (sim time s, floor share)
     taken_away: tuple[str, ...] = ()  # open doors and pieces whose panels found no room
     doors_taken_away: tuple[str, ...] = ()  # the doors among them
+    looked_again: tuple[str, ...] = ()  # a room per further look-around in it (script)
 
     def lines(self) -> list[str]:
         fps = self.frames / self.seconds if self.seconds > 0 else 0.0
@@ -285,6 +287,10 @@ class RecordReport:
             f"{'goals' if self.coverage else 'rooms'} visited: {len(self.rooms_visited)} "
             f"({', '.join(self.rooms_visited)})",
         ]
+        if self.looked_again:
+            rooms = dict.fromkeys(self.looked_again)
+            out.append("looked around again in rooms one place does not show whole: "
+                       + ", ".join(f"{r} ({self.looked_again.count(r)})" for r in rooms))
         if self.opened:
             out.append(f"opened: {', '.join(self.opened)}")
         for r, why in self.rooms_missed.items():
@@ -392,7 +398,7 @@ def record_house(house: HouseSpec | str | os.PathLike[str], output: str | os.Pat
     return RecordReport(Path(output), hid, frames, actions, travelled, tuple(rep.visited),
                         dict(rep.missed), tuple(rep.opened), truncated,
                         time.perf_counter() - t_wall, tuple(samples), taken,
-                        tuple(i for i in taken if i in doors))
+                        tuple(i for i in taken if i in doors), tuple(rep.looked_again))
 
 
 def _explore_live(sim: Simulation, rec: LogRecorder, opts: RecordOptions,

@@ -93,6 +93,9 @@ def test_a_u_shaped_room_is_seen_to_the_tips_of_its_arms(tmp_path: Path) -> None
     stands = sorted(_points_driven_to(tmp_path / "u.mcap"))
     assert len(stands) == 2 and stands[0][0] < 3.0 < 6.0 < stands[1][0]
     assert rep.rooms_visited == ("room_living", "room_closet")
+    assert rep.looked_again == ("room_living", "room_living")
+    assert "looked around again in rooms one place does not show whole: room_living (2)" \
+        in rep.lines()
 
 
 def _points_driven_to(log: Path) -> list[tuple[float, float]]:
