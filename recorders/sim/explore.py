@@ -151,7 +151,8 @@ def _go_to_room(sim: Simulation, room: str, opts: ScriptOptions, rep: Exploratio
 
 
 VIEW_STRIDE = 0.5  # m between the places a further look-around is weighed at
-VIEW_REACH = 0.75  # share of the camera's depth range a look-around counts as seen
+VIEW_REACH = 0.75  # share of the camera's depth range a look-around counts as seen,
+VIEW_REACH_MAX = 4.5  # m at most (a small object farther is a few pixels)
 
 
 def _look_further(sim: Simulation, room: str, opts: ScriptOptions, rep: ExplorationReport,
@@ -167,15 +168,12 @@ def _look_further(sim: Simulation, room: str, opts: ScriptOptions, rep: Explorat
     if blocked.shape != inroom.shape:
         return
     floor = inroom & ~occ.occupied
-    reach = VIEW_REACH * sim.camera.depth_max
+    reach = min(VIEW_REACH * sim.camera.depth_max, VIEW_REACH_MAX)
     seen = room_views.visible(blocked, origin, res, sim.base[:2], reach)
-    k = max(1, round(VIEW_STRIDE / res))
     for _ in range(opts.views):
         occ = sim.occupancy()
-        rows, cols = np.nonzero(inroom & np.isfinite(geodesic_distances(occ, sim.base[:2])))
-        on = (rows % k == k // 2) & (cols % k == k // 2)
-        places = [(origin[0] + (c + 0.5) * res, origin[1] + (r + 0.5) * res)
-                  for r, c in zip(rows[on], cols[on], strict=True)]
+        places = room_views.places(inroom & np.isfinite(geodesic_distances(occ, sim.base[:2])),
+                                   origin, res, VIEW_STRIDE)
         best = room_views.best_view(blocked, origin, res, floor, seen, places, reach)
         if best is None or best[1] * res * res < opts.view_gain_m2:
             return

@@ -18,6 +18,7 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
+from scipy.signal import fftconvolve
 
 from sgtool.house.spec import HouseSpec
 from sgtool.mapping.occupancy import house_occupancy
@@ -64,15 +65,60 @@ def visible(blocked: np.ndarray, origin: Sequence[float], resolution: float,
     return out
 
 
+def places(mask: np.ndarray, origin: Sequence[float], resolution: float,
+           stride: float) -> list[tuple[float, float]]:
+    """One place per block of ``stride`` x ``stride`` metres (of whole cells) that holds a
+    cell of ``mask``: that cell's centre nearest the block's centre cell (the first of
+    equals by row, then column), blocks in row, then column order. Anchored to the
+    blocks, a strip of ``mask`` narrower than ``stride`` gets places wherever the grid
+    falls on it."""
+    k = max(1, round(stride / resolution))
+    rows, cols = np.nonzero(mask)
+    if not rows.size:
+        return []
+    off = (rows % k - k // 2) ** 2 + (cols % k - k // 2) ** 2
+    order = np.lexsort((cols, rows, off, cols // k, rows // k))
+    block = (rows // k)[order] * (int(cols.max()) // k + 1) + (cols // k)[order]
+    first = order[np.r_[True, block[1:] != block[:-1]]]
+    return [(origin[0] + (c + 0.5) * resolution, origin[1] + (r + 0.5) * resolution)
+            for r, c in zip(rows[first], cols[first], strict=True)]
+
+
 def best_view(blocked: np.ndarray, origin: Sequence[float], resolution: float,
               floor: np.ndarray, seen: np.ndarray, candidates: Sequence[Sequence[float]],
               reach: float) -> tuple[tuple[float, float], int] | None:
     """The candidate point that would see the most cells of ``floor`` not in ``seen``, and
-    how many (the first of equals, in the order given); None without candidates."""
+    how many (the first of equals, in the order given); None without candidates.
+
+    Candidates are weighed in the order of how many such cells lie within reach of them
+    at all (an upper bound of what they could see), and the weighing stops where that
+    bound falls below the best found: the answer of weighing every one, in a fraction
+    of the time in a large room."""
     todo = floor & ~seen
-    best: tuple[tuple[float, float], int] | None = None
+    if not len(candidates):
+        return None
+    # cells of todo within reach of each cell, with 3 cells to spare (a ray's last sample
+    # lies up to half a cell past reach, and marks a cell whose centre is up to 0.71 cell
+    # from it; a candidate lies up to 0.71 cell from its cell's centre)
+    r = int(math.ceil(reach / resolution)) + 3
+    yy, xx = np.mgrid[-r:r + 1, -r:r + 1]
+    disc = (np.hypot(yy, xx) <= r).astype(np.float64)
+    near = fftconvolve(todo.astype(np.float64), disc, mode="same")
+    rows, cols = todo.shape
+    bounds = []
     for p in candidates:
+        rr = int(math.floor((p[1] - origin[1]) / resolution))
+        cc = int(math.floor((p[0] - origin[0]) / resolution))
+        inside = 0 <= rr < rows and 0 <= cc < cols
+        bounds.append(int(near[rr, cc] + 0.5) + 1 if inside else int(todo.sum()))
+    best: tuple[int, int] | None = None  # (gain, index)
+    for i in sorted(range(len(candidates)), key=lambda j: (-bounds[j], j)):
+        if best is not None and bounds[i] < best[0]:
+            break
+        p = candidates[i]
         gain = int(np.count_nonzero(visible(blocked, origin, resolution, p, reach) & todo))
-        if best is None or gain > best[1]:
-            best = ((float(p[0]), float(p[1])), gain)
-    return best
+        if best is None or gain > best[0] or (gain == best[0] and i < best[1]):
+            best = (gain, i)
+    assert best is not None
+    p = candidates[best[1]]
+    return (float(p[0]), float(p[1])), best[0]

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sgtool.recorders.sim.room_views import best_view, visible
+from sgtool.recorders.sim.room_views import best_view, places, visible
 
 W = {"thickness": 0.1, "height": 2.5}
 
@@ -77,6 +77,44 @@ def test_the_best_view_shows_the_most_floor_not_seen() -> None:
     (point, gain) = best_view(blocked, (0.0, 0.0), 0.05, floor, seen,
                               [(0.2, 0.2), (1.5, 1.0)], reach=5.0)
     assert point == (1.5, 1.0) and gain > 200
+
+
+@pytest.mark.parametrize("first_row", [0, 3, 7])
+def test_a_strip_narrower_than_the_stride_gets_places_wherever_the_grid_falls(
+        first_row: int) -> None:
+    """A corridor's reachable band 0.2 m wide (4 cells) and 3 m long, at three offsets
+    against the 0.5 m blocks: one place per block it crosses, on the band (a lattice of
+    block centres missed it at two of the three)."""
+    mask = np.zeros((20, 80), bool)
+    mask[first_row:first_row + 4, 10:70] = True
+    got = places(mask, (0.0, 0.0), 0.05, 0.5)
+    rows = {int(y / 0.05) for _, y in got}
+    assert len(got) == 6 * len({r // 10 for r in range(first_row, first_row + 4)})
+    assert rows <= set(range(first_row, first_row + 4))
+
+
+def test_the_bound_on_a_view_gives_the_answer_of_weighing_every_place() -> None:
+    """best_view stops weighing where what a place could see at most falls below the
+    best: the same place and gain as weighing all of them, on rooms with walls across."""
+    rng = np.random.default_rng(5)
+    for _ in range(4):
+        blocked = np.zeros((90, 120), bool)
+        blocked[[0, -1], :] = blocked[:, [0, -1]] = True
+        for _ in range(4):
+            r, c = rng.integers(5, 85), rng.integers(5, 115)
+            if rng.random() < 0.5:
+                blocked[r:r + 40, c:c + 2] = True
+            else:
+                blocked[r:r + 2, c:c + 50] = True
+        cands = places(~blocked, (0.0, 0.0), 0.05, 0.5)
+        reach = float(rng.uniform(1.0, 4.0))
+        seen = visible(blocked, (0.0, 0.0), 0.05, cands[0], reach)
+        todo = ~blocked & ~seen
+        gains = [int(np.count_nonzero(visible(blocked, (0.0, 0.0), 0.05, p, reach) & todo))
+                 for p in cands]
+        i = int(np.argmax(gains))
+        assert best_view(blocked, (0.0, 0.0), 0.05, ~blocked, seen, cands, reach) == \
+            (cands[i], gains[i])
 
 
 def test_a_u_shaped_room_is_seen_to_the_tips_of_its_arms(tmp_path: Path) -> None:
