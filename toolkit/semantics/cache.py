@@ -49,6 +49,7 @@ class EmbeddingCache:
 
     def __init__(self, path: str | Path | None = None) -> None:
         self.path = Path(path) if path is not None else default_cache_path()
+        self._default = path is None  # a copy elsewhere resolves its own default
         self._conn: sqlite3.Connection | None = None
         self._lock = threading.Lock()
         self._broken = False
@@ -56,7 +57,8 @@ class EmbeddingCache:
     def __getstate__(self) -> dict[str, Any]:
         """The path and whether it failed: a copy (in another process) opens its own
         connection when first used."""
-        return {"path": self.path, "broken": self._broken}
+        return {"path": None if self._default else self.path,
+                "broken": self._broken and not self._default}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__init__(state["path"])  # type: ignore[misc]

@@ -103,3 +103,21 @@ def test_loading_the_model_leaves_the_environment_as_it_was(monkeypatch) -> None
     e = SentenceEncoder(cache=False)
     assert e.encode(["mug"]).shape == (1, 384) and e.model_loads == 1
     assert "HF_HUB_OFFLINE" not in os.environ and "TRANSFORMERS_OFFLINE" not in os.environ
+
+
+def test_a_copy_of_an_encoder_finds_its_own_default_cache(monkeypatch, tmp_path) -> None:
+    """An encoder sent to another process (a planner pickled for a worker) keeps a cache
+    path it was given, but one it took by default is the receiver's default
+    ($SGTOOL_CACHE there), not the sender's folder."""
+    import pickle
+
+    monkeypatch.setenv("SGTOOL_CACHE", str(tmp_path / "sender"))
+    enc = SentenceEncoder()
+    given = SentenceEncoder(EmbeddingCache(tmp_path / "mine.sqlite"))
+    sent, sent_given = pickle.dumps(enc), pickle.dumps(given)
+    monkeypatch.setenv("SGTOOL_CACHE", str(tmp_path / "receiver"))
+    copy = pickle.loads(sent)
+    assert copy.cache is not None
+    assert copy.cache.path == tmp_path / "receiver" / "embeddings" / "embeddings.sqlite"
+    assert copy.model_loads == 0  # nothing loaded until a text needs the model
+    assert pickle.loads(sent_given).cache.path == tmp_path / "mine.sqlite"
