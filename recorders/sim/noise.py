@@ -19,9 +19,13 @@ the robot still drives where it drives and the instances table stays the truth.
 - label dropouts: per frame, each visible non-structure instance reads 0 with
   probability ``label_dropout`` (a missed detection);
 - pose drift: the logged base pose integrates the true per-frame motion (dx, dy, dyaw in
-  the base frame) with zero-mean errors of std ``drift_xy * |d|`` on each translation
-  component and ``drift_yaw * (|d| + |dyaw|)`` on the heading, like wheel odometry; the
-  logged camera pose rides on it.
+  the base frame) with zero-mean errors of std ``drift_xy * sqrt(|d|)`` on each
+  translation component and ``drift_yaw * sqrt(|d| + |dyaw|)`` on the heading (|d| in
+  metres, |dyaw| in radians), like wheel odometry: a random walk whose variance grows with
+  the distance driven and the angle turned, so ``drift_xy`` is the std (m) of the error
+  after 1 m and the same whatever the frame rate (errors of std ``drift * |d|`` a frame
+  added up to less the more frames a metre took: a third as much at 40 frames a metre
+  as at 4). The logged camera pose rides on it.
 
 Floor and walls (``structure``) are exempt from label faults, so rooms stay mappable; use
 them to study object-level robustness. Each fault draws from its own generator spawned
@@ -45,8 +49,8 @@ from sgtool.house.parse import JsonObject, json_object_pairs
 from sgtool.log.frame import Frame
 from sgtool.recorders.sim.camera import LINK_TOL, se2_matrix
 
-# the largest strengths taken: 1 m of depth std at 1 m, 1 m of drift per metre driven, 1 rad
-# of yaw drift per metre (the strong profile is 0.006, 0.02, 0.02)
+# the largest strengths taken: 1 m of depth std at 1 m, 1 m of drift std after 1 m driven,
+# 1 rad of yaw drift std after 1 m (the strong profile is 0.006, 0.007, 0.007)
 LIMITS = {"depth_sigma": 1.0, "drift_xy": 1.0, "drift_yaw": 1.0}
 EDGE_REL = 0.1  # a depth edge: neighbouring depths differ by this share of the nearer one
 EDGE_ABS = 0.1  # m; and by at least this much
@@ -63,8 +67,8 @@ class NoiseProfile:
     holes: float = 0.0  # probability a depth pixel reads 0
     label_swap: float = 0.0  # per visible instance and frame
     label_dropout: float = 0.0  # per visible instance and frame
-    drift_xy: float = 0.0  # std (m) per metre driven, per axis
-    drift_yaw: float = 0.0  # std (rad) per metre driven + per radian turned
+    drift_xy: float = 0.0  # std (m) per axis after 1 m driven (grows with its square root)
+    drift_yaw: float = 0.0  # std (rad) after 1 m driven or 1 rad turned (likewise)
     flying: float = 0.0  # probability a depth-edge pixel reads between the two surfaces
 
     def __post_init__(self) -> None:
@@ -100,11 +104,12 @@ class NoiseProfile:
 PROFILES: dict[str, NoiseProfile] = {
     "none": NoiseProfile("none"),
     # a good RGB-D camera and a fair segmenter
+    # (drift: what 0.005 and 0.02 per metre, a frame per 0.125 m, added up to after 1 m)
     "mild": NoiseProfile("mild", depth_sigma=0.0015, holes=0.01, label_swap=0.01,
-                         label_dropout=0.02, drift_xy=0.005, drift_yaw=0.005),
+                         label_dropout=0.02, drift_xy=0.002, drift_yaw=0.002),
     # a poor one: strong far-range noise, many holes, frequent label errors, fast drift
     "strong": NoiseProfile("strong", depth_sigma=0.006, holes=0.08, label_swap=0.05,
-                           label_dropout=0.1, drift_xy=0.02, drift_yaw=0.02),
+                           label_dropout=0.1, drift_xy=0.007, drift_yaw=0.007),
 }
 
 
@@ -297,9 +302,9 @@ class SensorFaults:
             da = math.atan2(math.sin(true[2] - a0), math.cos(true[2] - a0))
             dist = math.hypot(dx, dy)
             e = rng.standard_normal(3)
-            dx += e[0] * p.drift_xy * dist
-            dy += e[1] * p.drift_xy * dist
-            da += e[2] * p.drift_yaw * (dist + abs(da))
+            dx += e[0] * p.drift_xy * math.sqrt(dist)
+            dy += e[1] * p.drift_xy * math.sqrt(dist)
+            da += e[2] * p.drift_yaw * math.sqrt(dist + abs(da))
             ex, ey, ea = self._est
             ce, se = math.cos(ea), math.sin(ea)
             self._est = (ex + ce * dx - se * dy, ey + se * dx + ce * dy,

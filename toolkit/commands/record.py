@@ -48,9 +48,10 @@ def _pair(option: str, text: str) -> tuple[float, float]:
               help="Sensor faults: a profile (none, mild, strong), optionally with "
               "overrides ('mild,holes=0.05'), or a JSON file. Fields: depth_sigma (m of std "
               "at 1 m, grows with z^2), holes (share of depth pixels lost), label_swap, "
-              "label_dropout (per visible object and frame), drift_xy (m per m driven), "
-              "drift_yaw (rad per m driven and per rad turned), flying (share of depth-edge "
-              "pixels read between the two surfaces, as time-of-flight cameras do).")
+              "label_dropout (per visible object and frame), drift_xy (m of std after 1 m "
+              "driven), drift_yaw (rad of std after 1 m driven or 1 rad turned), flying "
+              "(share of depth-edge pixels read between the two surfaces, as "
+              "time-of-flight cameras do).")
 @click.option("--noise-seed", type=SEED, default=0, show_default=True,
               help="Seed of the sensor faults.")
 @click.option("--resolution", default="320x240", show_default=True,

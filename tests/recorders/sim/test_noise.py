@@ -83,12 +83,14 @@ def test_label_dropout_and_swaps_touch_objects_not_structure() -> None:
 
 def test_drift_follows_odometry_and_is_seeded() -> None:
     """Driving 10 m straight in 0.05 m steps: no drift -> the true pose; with drift_xy the
-    lateral error is a random walk of std drift_xy * sqrt(sum of d^2) per step..."""
-    def run(p: NoiseProfile, seed: int) -> np.ndarray:
+    lateral error is a random walk of std drift_xy * sqrt(10 m), and the same in 0.5 m
+    steps (errors of std drift_xy * |d| a frame made it sqrt(10) times smaller at 0.05
+    m than at 0.5 m)."""
+    def run(p: NoiseProfile, seed: int, step: float = 0.05) -> np.ndarray:
         faults = SensorFaults(p, seed, base_T_camera=CAM)
         out = []
-        for i in range(201):
-            f = faults.apply(_frame(i, base=(0.05 * i, 0.0, 0.0)))
+        for i in range(round(10 / step) + 1):
+            f = faults.apply(_frame(i, base=(step * i, 0.0, 0.0)))
             out.append(f.base_pose.copy())
             assert np.allclose(np.linalg.inv(f.base_pose) @ f.pose, CAM)
         return np.array(out)
@@ -98,9 +100,11 @@ def test_drift_follows_odometry_and_is_seeded() -> None:
     p = NoiseProfile("d", drift_xy=0.02)
     a, b, c = run(p, 1), run(p, 1), run(p, 2)
     assert np.array_equal(a, b) and not np.array_equal(a, c)
-    ends = np.array([run(p, s)[-1][1, 3] for s in range(40)])
-    # lateral: sum of 200 steps of std 0.02 * 0.05 -> std 0.02 * 0.05 * sqrt(200) = 0.0141
-    assert 0.008 < ends.std() < 0.02
+    # lateral: 200 steps of std 0.02 * sqrt(0.05) -> std 0.02 * sqrt(10) = 0.063; as many
+    # runs in 20 steps of 0.5 m: the same
+    for step in (0.05, 0.5):
+        ends = np.array([run(p, s, step)[-1][1, 3] for s in range(60)])
+        assert 0.045 < ends.std() < 0.085, (step, ends.std())
     assert np.allclose(a[0], clean[0])  # the first frame is the true pose
 
 
