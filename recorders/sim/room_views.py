@@ -100,11 +100,12 @@ def best_view(blocked: np.ndarray, origin: Sequence[float], resolution: float,
     # cells of todo within reach of each cell, with 3 cells to spare (a ray's last sample
     # lies up to half a cell past reach, and marks a cell whose centre is up to 0.71 cell
     # from it; a candidate lies up to 0.71 cell from its cell's centre)
-    r = int(math.ceil(reach / resolution)) + 3
+    rows, cols = todo.shape
+    # (no wider than the grid's diagonal: every cell is within that of every cell)
+    r = min(int(math.ceil(reach / resolution)) + 3, int(math.ceil(math.hypot(rows, cols))))
     yy, xx = np.mgrid[-r:r + 1, -r:r + 1]
     disc = (np.hypot(yy, xx) <= r).astype(np.float64)
     near = fftconvolve(todo.astype(np.float64), disc, mode="same")
-    rows, cols = todo.shape
     bounds = []
     for p in candidates:
         rr = int(math.floor((p[1] - origin[1]) / resolution))
