@@ -59,8 +59,8 @@ DEFAULT_LEVELS: Mapping[str, tuple[float, ...]] = {
     "holes": (0.01, 0.08),
     "label_swap": (0.01, 0.05),
     "label_dropout": (0.01, 0.05, 0.1),
-    "drift_xy": (0.002, 0.007),
-    "drift_yaw": (0.002, 0.007),
+    "drift_xy": (0.0018, 0.007),
+    "drift_yaw": (0.0027, 0.011),
     "flying": (0.1, 0.5),
 }
 DEFAULT_PROFILES: tuple[str, ...] = ("mild", "strong")
@@ -213,10 +213,13 @@ def house_key(house: BenchHouse, spec_text: str, rooms: tuple[int, int]) -> dict
 
 def cache_key(house: Mapping[str, Any], noise: str, settings: RecordingSettings) -> str:
     """The hex sha256 (first 20 digits) of everything a recording depends on."""
-    from sgtool.recorders.sim.noise import names_file, parse_noise
+    from sgtool.recorders.sim.noise import parse_noise
 
-    # a JSON profile's file by what it holds (an edited file records anew), a text as it is
-    key = parse_noise(noise).to_dict() if names_file(noise) else noise
+    # the faults as they are (a JSON profile's file by what it holds, so an edited file
+    # records anew; a profile's name by its values, so a preset changed by a new sgtool
+    # does too) and how drift accrues
+    profile = parse_noise(noise)
+    key = {**profile.to_dict(), "drift_model": profile.drift_model}
     doc = {"format": CACHE_FORMAT, "house": dict(house), "noise": key,
            "settings": asdict(settings)}
     text = json.dumps(doc, sort_keys=True, separators=(",", ":"))

@@ -66,6 +66,7 @@ def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None
             "turn_render_deg": float(opts.turn_render_deg),
             "navigation": opts.navigation, "noise": _faults(parse_noise(noise).to_dict()),
             "noise_seed": opts.noise_seed,
+            "drift_model": parse_noise(noise).drift_model,
             "seed": opts.planner_seed, "episode_seeds": True, "success": opts.success,
             "classifier": opts.classifier, "explore_on": opts.explore_on,
             "max_depth": dataclasses.replace(opts, noise=parse_noise(noise)).depth_mapped(),
@@ -122,6 +123,8 @@ def logged_settings(path: Path) -> tuple[dict[str, Any], str | None]:
              "navigation": nav.get("mode", "house"),
              # a fault added since (flying) was off in logs that do not name it
              "noise": with_new_faults(x.get("noise")), "noise_seed": x.get("noise_seed", 0),
+             # logs from before drift was a random walk in the distance: model 1
+             "drift_model": x.get("drift_model", 1) if _drifts(x.get("noise")) else None,
              "seed": x.get("seed"),
              # logs from before each episode drew its planner seed: all drew the run's
              "episode_seeds": "planner_seed" in x,
@@ -174,7 +177,10 @@ _LABELS = {"episode": "episode", "planner_options": "planner options (-O)",
            "max_steps": "max steps", "frame_budget": "frame budget",
            "size": "resolution", "render_step_m": "render step (m)",
            "turn_render_deg": "turn render angle (deg)", "navigation": "navigation",
-           "noise": "noise", "noise_seed": "noise seed", "seed": "seed",
+           "noise": "noise", "noise_seed": "noise seed",
+           "drift_model": "pose drift model (1: per frame, sgtool before 2026-12-06; 2: per "
+                          "distance)",
+           "seed": "seed",
            "episode_seeds": "planner seed per episode", "success": "success rule",
            "classifier": "room classifier", "explore_on": "explore on (frontiers)",
            "max_depth": "depth mapped (m)", "every": "graph refresh (--every frames)",
@@ -224,6 +230,11 @@ def with_new_faults(noise: Any) -> Any:
     if not isinstance(noise, dict):
         return noise
     return _faults({**NoiseProfile().to_dict(), **noise})
+
+
+def _drifts(noise: Any) -> bool:
+    """Whether a log's recorded noise profile drifts its poses."""
+    return isinstance(noise, dict) and bool(noise.get("drift_xy") or noise.get("drift_yaw"))
 
 
 def _faults(noise: dict[str, Any]) -> dict[str, Any]:

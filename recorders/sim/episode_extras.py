@@ -38,6 +38,7 @@ def started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOpt
         "robot": asdict(opts.robot),
         "navigation": {"mode": opts.navigation, **opts.live.to_dict()},
         "noise": opts.noise.to_dict(), "noise_seed": opts.noise_seed,
+        **({"drift_model": opts.noise.drift_model} if opts.noise.drift_model else {}),
         "turn_render_deg": opts.turn_render_deg, "render_step_m": opts.render_step_m,
         "explore_on": opts.explore_on,
         **success_rule(opts),

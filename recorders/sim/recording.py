@@ -444,6 +444,7 @@ def _episode_extra(opts: RecordOptions, sim: Simulation) -> dict[str, Any]:
                        "cx": k.cx, "cy": k.cy},
         "robot": asdict(opts.robot),
         "noise": opts.noise.to_dict(),
+        **({"drift_model": opts.noise.drift_model} if opts.noise.drift_model else {}),
         "script": asdict(opts.script),
         **({"explore": opts.explore} if opts.explore != "script" else {}),
         "frame_budget": opts.frames,

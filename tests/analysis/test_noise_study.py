@@ -160,6 +160,19 @@ def test_cache_key_changes_with_every_recording_input() -> None:
     assert base not in others and len(others) == 6
 
 
+def test_a_preset_is_cached_by_its_values(monkeypatch) -> None:
+    """A profile named by its preset is keyed by the preset's values: a newer sgtool whose
+    "mild" drifts otherwise does not reuse the older one's recordings of "mild"."""
+    from sgtool.recorders.sim import noise
+
+    house = {"generated": 3, "rooms": [8, 8]}
+    before = cache_key(house, "mild", RecordingSettings())
+    mild = noise.PROFILES["mild"]
+    newer = noise.NoiseProfile(**{**mild.to_dict(), "name": "newer", "drift_yaw": 0.5})
+    monkeypatch.setattr(noise, "parse_noise", lambda text: newer if text == "mild" else mild)
+    assert cache_key(house, "mild", RecordingSettings()) != before
+
+
 def test_a_json_profile_of_ones_own_is_studied_by_its_name(tmp_path: Path) -> None:
     """`--profile my.json` (record --noise and --closed-loop-noise take it) was refused as
     an unknown profile; it is a condition labelled by its name, recorded anew when the

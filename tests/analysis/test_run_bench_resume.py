@@ -273,3 +273,30 @@ def test_logs_from_before_mixed_pixels_were_left_out_say_so(
     assert again.exit_code == 2, again.output
     assert "mixed depth pixels left out: false in the log, true now" in again.output
     assert "noise:" not in again.output
+
+
+def test_a_log_drifted_by_the_per_frame_model_is_not_resumed(tmp_path: Path) -> None:
+    """Pose drift became a random walk in the distance (the same numbers mean another
+    sensor): a drifted log records the model, 2; one without it is model 1 and is not
+    resumed, where its noise numbers alone matched."""
+    from sgtool.analysis.run_bench_resume import logged_settings, task_settings
+    from sgtool.recorders.sim.camera import CameraConfig
+    from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
+
+    spec = generate_house(6, rooms=(4, 4))
+    house = tmp_path / "myhouse.json"
+    save_house(spec, house)
+    out = tmp_path / "rb"
+    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house), "--noise", "drift_yaw=0.02",
+                                   "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    (log,) = (out / "logs").rglob("ep-000.mcap")
+    logged, _ = logged_settings(log)
+    opts = ClosedLoopOptions(camera=CameraConfig(width=64, height=48), max_steps=2, frames=60)
+    now = task_settings(opts, "drift_yaw=0.02", logged["episode"])
+    assert logged["drift_model"] == now["drift_model"] == 2
+    assert settings_differences(logged, now) == []
+    assert settings_differences(dict(logged, drift_model=1), now) == [
+        "pose drift model (1: per frame, sgtool before 2026-12-06; 2: per distance): 1 in "
+        "the log, 2 now"]
+    assert task_settings(opts, "none", logged["episode"])["drift_model"] is None

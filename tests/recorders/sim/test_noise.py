@@ -108,6 +108,26 @@ def test_drift_follows_odometry_and_is_seeded() -> None:
     assert np.allclose(a[0], clean[0])  # the first frame is the true pose
 
 
+def test_heading_drift_on_the_spot_does_not_depend_on_the_frame_rate() -> None:
+    """Turning on the spot through 2 pi rad in steps of pi/8 or of pi/80: the heading's
+    error is a random walk of std drift_yaw * sqrt(2 pi) either way (errors of std
+    drift_yaw * |dyaw| a frame made it sqrt(10) times smaller in the smaller steps)."""
+    p = NoiseProfile("d", drift_yaw=0.02)
+
+    def end_yaw(seed: int, steps: int) -> float:
+        faults = SensorFaults(p, seed, base_T_camera=CAM)
+        for i in range(steps + 1):
+            yaw = 2 * np.pi * i / steps
+            b = faults.apply(_frame(i, base=(0.0, 0.0, yaw))).base_pose
+        err = np.arctan2(b[1, 0], b[0, 0])  # the true end heading is 2 pi = 0
+        return float(np.arctan2(np.sin(err), np.cos(err)))
+
+    want = 0.02 * np.sqrt(2 * np.pi)  # 0.050 rad
+    for steps in (16, 160):
+        ends = np.array([end_yaw(s, steps) for s in range(60)])
+        assert 0.7 * want < ends.std() < 1.3 * want, (steps, ends.std())
+
+
 def test_drift_keeps_a_tilted_head_link() -> None:
     """The mounting given to the faults is the untilted one; a frame whose camera is on a
     tilted head keeps that frame's base -> camera link under drift."""
