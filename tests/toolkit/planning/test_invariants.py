@@ -67,6 +67,11 @@ def play(planner, world: World, seed: int, limit: int) -> list[str | None]:
     """The targets of a search in ``world`` (at most ``limit`` actions; a final ``done``
     included)."""
     planner.reset(world.query, seed=seed)
+    return go_on(planner, world, limit)
+
+
+def go_on(planner, world: World, limit: int) -> list[str | None]:
+    """The targets of the rest of a search begun in ``world`` (as :func:`play`)."""
     out = []
     for _ in range(limit):
         a = planner.decide(world.graph())
@@ -132,12 +137,5 @@ def test_a_planner_pickled_mid_search_goes_on_the_same_way(name: str) -> None:
         twin.execute(a)
     clone = pickle.loads(pickle.dumps(planner))
     assert type(copy.deepcopy(planner)) is type(planner)
-    rest, rest_clone = [], []
-    for p, w, out in ((planner, world, rest), (clone, twin, rest_clone)):
-        for _ in range(40):
-            a = p.decide(w.graph())
-            out.append(a.target)
-            if a.skill == "done":
-                break
-            p.feedback(w.execute(a))
+    rest, rest_clone = go_on(planner, world, 40), go_on(clone, twin, 40)
     assert rest == rest_clone and len(rest) >= 2
