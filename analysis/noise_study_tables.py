@@ -163,7 +163,15 @@ FACTOR_HEADER = ["level", "rooms found/true per house", "room error vs true",
                  "categories right", "purity vs none (pts)", "objects vs none (pts)"]
 
 
+# under pose drift the map lies in the drifted frame: the position-based scores count that
+DRIFT_NOTE = ("Under pose drift the map lies in the drifted odometry frame: purity, ARI, "
+              "objects right and categories compare its positions with the house's outlines, "
+              "so they count how far the map has moved as well as how it is cut into rooms.")
+
+
 def summary_md(res: StudyResult) -> str:
+    from sgtool.recorders.sim.noise import parse_noise
+
     cfg = res.config
     s = cfg.settings
     houses = [h.id for h in cfg.houses]
@@ -200,12 +208,16 @@ def summary_md(res: StudyResult) -> str:
         rows = [condition_row(res, none, "0 (none)")]
         rows += [condition_row(res, c, c.level) for c in conds]
         out += [pipe_table(FACTOR_HEADER, rows), ""]
+        if f in ("drift_xy", "drift_yaw"):
+            out += [DRIFT_NOTE, ""]
     profiles = [c for c in cfg.conditions if c.factor == PROFILE]
     if profiles:
         out += ["## Profiles", ""]
         rows = [condition_row(res, none, "none")]
         rows += [condition_row(res, c, c.level) for c in profiles]
         out += [pipe_table(["profile", *FACTOR_HEADER[1:]], rows), ""]
+        if any(parse_noise(c.noise).drift_model for c in profiles):
+            out += [DRIFT_NOTE, ""]
     if res.closed_loop is not None:
         out += closed_loop_md(res.closed_loop)
     return "\n".join(out).rstrip("\n") + "\n"

@@ -257,3 +257,15 @@ def test_a_share_over_nothing_is_no_zero(study: dict[str, Path]) -> None:
     cells = json.loads((out / "results.json").read_text())["cells"]
     assert all(c["merged"]["objects"] == 0 for c in cells)
     assert all(c["merged"]["object_accuracy"] is None for c in cells)
+
+
+def test_a_drift_condition_says_what_its_scores_count(study: dict[str, Path]) -> None:
+    """Under pose drift the map is in the drifted frame: the drift table says that its
+    position-based scores count the map's shift too; the label-fault tables do not."""
+    out = study["root"] / "drift"
+    r = _study(study["house"], study["cache"], out, "--factor", "drift_yaw=0.01")
+    assert r.exit_code == 0, r.output
+    text = (out / "summary.md").read_text()
+    drift = text[text.index("## drift_yaw"):]
+    assert "Under pose drift the map lies in the drifted odometry frame" in drift
+    assert "drifted odometry frame" not in text[:text.index("## drift_yaw")]
