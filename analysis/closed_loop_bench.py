@@ -517,8 +517,10 @@ def run_closed_loop_bench(cfg: ClosedLoopBenchConfig, out_dir: str | Path,
                 progress.update(1)
     except BaseException as e:
         if report_only and isinstance(e, ResumeError):  # nothing to run again
-            raise ResumeError(f"{e.problem}; --report-only: give the options the run was "
-                              "made with") from None
+            how = ("it needs the sgtool it was run with (the per-frame drift model: "
+                   "before 992f26a)" if "pose drift model" in e.problem
+                   else "give the options the run was made with")
+            raise ResumeError(f"{e.problem}; --report-only: {how}") from None
         if not report_only:  # the folders of logs never written (a planner that raised)
             remove_empty_folders(logs)
         raise

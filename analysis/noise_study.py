@@ -211,16 +211,19 @@ def house_key(house: BenchHouse, spec_text: str, rooms: tuple[int, int]) -> dict
     return {"spec_sha256": hashlib.sha256(spec_text.encode()).hexdigest()}
 
 
-def cache_key(house: Mapping[str, Any], noise: str, settings: RecordingSettings) -> str:
-    """The hex sha256 (first 20 digits) of everything a recording depends on."""
+def noise_key(noise: str) -> dict[str, Any]:
+    """The noise part of a cache key: the faults as they are (a JSON profile's file by
+    what it holds, so an edited file records anew; a profile's name by its values, so a
+    preset changed by a new sgtool does too) and how drift accrues."""
     from sgtool.recorders.sim.noise import parse_noise
 
-    # the faults as they are (a JSON profile's file by what it holds, so an edited file
-    # records anew; a profile's name by its values, so a preset changed by a new sgtool
-    # does too) and how drift accrues
     profile = parse_noise(noise)
-    key = {**profile.to_dict(), "drift_model": profile.drift_model}
-    doc = {"format": CACHE_FORMAT, "house": dict(house), "noise": key,
+    return {**profile.to_dict(), "drift_model": profile.drift_model}
+
+
+def cache_key(house: Mapping[str, Any], noise: str, settings: RecordingSettings) -> str:
+    """The hex sha256 (first 20 digits) of everything a recording depends on."""
+    doc = {"format": CACHE_FORMAT, "house": dict(house), "noise": noise_key(noise),
            "settings": asdict(settings)}
     text = json.dumps(doc, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:20]
@@ -371,6 +374,7 @@ def plan_tasks(cfg: StudyConfig, cache: Path) -> tuple[list[StudyTask], dict[str
         for n in noises:
             key = cache_key(hk, n, cfg.settings)
             doc = {"format": CACHE_FORMAT, "house_id": h.id, "house": hk, "noise": n,
+                   "noise_key": noise_key(n),
                    "settings": asdict(cfg.settings)}
             tasks.append(StudyTask(h.id, n, text, cfg.settings,
                                    str(cache / h.id / f"{key}.mcap"),

@@ -178,8 +178,8 @@ _LABELS = {"episode": "episode", "planner_options": "planner options (-O)",
            "size": "resolution", "render_step_m": "render step (m)",
            "turn_render_deg": "turn render angle (deg)", "navigation": "navigation",
            "noise": "noise", "noise_seed": "noise seed",
-           "drift_model": "pose drift model (1: per frame, sgtool before 2026-12-06; 2: per "
-                          "distance)",
+           "drift_model": "pose drift model (1: per frame, sgtool before 992f26a, or a log "
+                          "of 992f26a that did not record it; 2: per distance)",
            "seed": "seed",
            "episode_seeds": "planner seed per episode", "success": "success rule",
            "classifier": "room classifier", "explore_on": "explore on (frontiers)",

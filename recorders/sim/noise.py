@@ -54,8 +54,8 @@ from sgtool.recorders.sim.camera import LINK_TOL, se2_matrix
 LIMITS = {"depth_sigma": 1.0, "drift_xy": 1.0, "drift_yaw": 1.0}
 EDGE_REL = 0.1  # a depth edge: neighbouring depths differ by this share of the nearer one
 EDGE_ABS = 0.1  # m; and by at least this much
-# how pose drift accrues, logged with a drifted episode: 1 (before 2026-12-06) an error of
-# std drift * |d| a frame, 2 a random walk in the distance (drift * sqrt(|d|) a frame)
+# how pose drift accrues, logged with a drifted episode: 1 (sgtool before 992f26a) an error
+# of std drift * |d| a frame, 2 a random walk in the distance (drift * sqrt(|d|) a frame)
 DRIFT_MODEL = 2
 
 
@@ -113,7 +113,8 @@ PROFILES: dict[str, NoiseProfile] = {
     "none": NoiseProfile("none"),
     # a good RGB-D camera and a fair segmenter
     # (drift: what the per-frame model's 0.005 and 0.02 added up to on the study's tours at
-    # 4 frames a second: position after 1 m driven, heading over a tour, mostly turns)
+    # 4 frames a second: position after 1 m driven, heading over a whole tour; per motion
+    # the heading differs, 0.87x on a look-around alone, 1.5x after 1 m of driving)
     "mild": NoiseProfile("mild", depth_sigma=0.0015, holes=0.01, label_swap=0.01,
                          label_dropout=0.02, drift_xy=0.0018, drift_yaw=0.0027),
     # a poor one: strong far-range noise, many holes, frequent label errors, fast drift

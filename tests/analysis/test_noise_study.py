@@ -269,3 +269,7 @@ def test_a_drift_condition_says_what_its_scores_count(study: dict[str, Path]) ->
     drift = text[text.index("## drift_yaw"):]
     assert "Under pose drift the map lies in the drifted odometry frame" in drift
     assert "drifted odometry frame" not in text[:text.index("## drift_yaw")]
+    # the cache's sidecar says what the key holds: the faults' values and the drift model
+    sides = [json.loads(p.read_text()) for p in (study["cache"] / "small").glob("*.json")]
+    side = next(d for d in sides if d["noise"] == "none,drift_yaw=0.01")
+    assert side["noise_key"]["drift_yaw"] == 0.01 and side["noise_key"]["drift_model"] == 2

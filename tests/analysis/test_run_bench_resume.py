@@ -297,6 +297,6 @@ def test_a_log_drifted_by_the_per_frame_model_is_not_resumed(tmp_path: Path) -> 
     assert logged["drift_model"] == now["drift_model"] == 2
     assert settings_differences(logged, now) == []
     assert settings_differences(dict(logged, drift_model=1), now) == [
-        "pose drift model (1: per frame, sgtool before 2026-12-06; 2: per distance): 1 in "
-        "the log, 2 now"]
+        "pose drift model (1: per frame, sgtool before 992f26a, or a log of 992f26a that "
+        "did not record it; 2: per distance): 1 in the log, 2 now"]
     assert task_settings(opts, "none", logged["episode"])["drift_model"] is None
