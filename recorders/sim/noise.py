@@ -113,8 +113,8 @@ PROFILES: dict[str, NoiseProfile] = {
     "none": NoiseProfile("none"),
     # a good RGB-D camera and a fair segmenter
     # (drift: what the per-frame model's 0.005 and 0.02 added up to on the study's tours at
-    # 4 frames a second: position after 1 m driven, heading over a whole tour; per motion
-    # the heading differs, 0.87x on a look-around alone, 1.5x after 1 m of driving)
+    # 4 frames a second: position after 1 m driven, heading over a whole tour, not per
+    # motion; docs/experiments/houses-nobody-designed.md)
     "mild": NoiseProfile("mild", depth_sigma=0.0015, holes=0.01, label_swap=0.01,
                          label_dropout=0.02, drift_xy=0.0018, drift_yaw=0.0027),
     # a poor one: strong far-range noise, many holes, frequent label errors, fast drift
