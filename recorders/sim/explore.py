@@ -151,8 +151,8 @@ def _go_to_room(sim: Simulation, room: str, opts: ScriptOptions, rep: Exploratio
 
 
 VIEW_STRIDE = 0.5  # m between the places a further look-around is weighed at
-VIEW_REACH = 0.75  # share of the camera's depth range a look-around counts as seen,
-VIEW_REACH_MAX = 4.5  # m at most (a small object farther is a few pixels)
+VIEW_REACH = 0.75  # share of the camera's depth range a look-around counts as seen
+VIEW_REACH_MAX = 4.5  # m, and at most this far (a small object farther is a few pixels)
 
 
 def _look_further(sim: Simulation, room: str, opts: ScriptOptions, rep: ExplorationReport,
@@ -164,9 +164,7 @@ def _look_further(sim: Simulation, room: str, opts: ScriptOptions, rep: Explorat
     occ = sim.occupancy()
     res, origin = occ.resolution, occ.origin
     blocked = room_views.blockers(sim.spec, res, sim.camera.mount_height)
-    inroom = nav.room_mask(occ, sim.spec.room(room))
-    if blocked.shape != inroom.shape:
-        return
+    inroom = nav.room_mask(occ, sim.spec.room(room))  # (the grids of one spec: one shape)
     floor = inroom & ~occ.occupied
     reach = min(VIEW_REACH * sim.camera.depth_max, VIEW_REACH_MAX)
     seen = room_views.visible(blocked, origin, res, sim.base[:2], reach)

@@ -144,8 +144,8 @@ def house_occupancy(spec: HouseSpec, resolution: float = 0.05, robot_radius: flo
     else:
         # walls and door frames by their exact distance, not grown from the cells they
         # overlap (those reach up to a cell's diagonal past a turned wall, and growing
-        # them adds half a cell more: a 0.5 m door was closed at 15-75 degrees, a 0.55 m
-        # one at 25-35 and 55-65, both open at 0 and 90); furniture is grown as before
+        # them adds half a cell more, so a narrow door's passability depended on the
+        # house's turn: docs/experiments/houses-nobody-designed.md); furniture is grown
         blocked = inflate(~inside | pieces, robot_radius, resolution) | occupied
         for center, size, yaw in frames:
             fill_box_near(grid, blocked, center, size, yaw, robot_radius)
