@@ -110,6 +110,9 @@ SMOKE: dict[str, Smoke] = {
     "benchmarks/side_by_side.py": Smoke(
         ("--base", "{repo}", "--rounds", "1", "--no-compile", "--", "info", "{log}"),
         marks=("slow",)),
+    "benchmarks/tour_views.py": Smoke(
+        ("--seeds", "107", "--rooms", "4-4", "--resolution", "32x24", "--rounds", "1",
+         "--random-rooms", "1", "--json", "{tmp}/o.json"), marks=("slow",)),
     "benchmarks/viewers.py": Smoke(("--frames", "3", "-r", "1", "--derived", "{log}")),
     "tools/api_reference.py": Smoke(()),
     "tools/closed_loop_failures.py": Smoke(("{tmp}", "{tmp}")),
