@@ -302,7 +302,7 @@ def score_log(log: str | Path) -> tuple[int, dict[str, dict[str, float | int]]]:
         # a share over nothing is no figure (NaN: "-" in the tables, null in the JSON),
         # not a 0 % that would enter the medians and plots
         if not v.objects:
-            d["object_accuracy"] = math.nan
+            d["object_accuracy"] = d["object_ari"] = math.nan
         if not v.rooms:
             d["category_accuracy"] = math.nan
         if not v.gt_rooms_with_nodes:

@@ -35,7 +35,8 @@ from sgtool.analysis.report import pipe_table
 SCORE_FIELDS: tuple[str, ...] = ("gt_rooms", "gt_rooms_seen", "rooms", "room_count_error",
                                  "room_error_vs_true", "purity", "ari", "objects",
                                  "object_accuracy", "categorised", "category_accuracy",
-                                 "gt_rooms_with_nodes", "house_objects", "objects_seen")
+                                 "gt_rooms_with_nodes", "house_objects", "objects_seen",
+                                 "object_ari")
 
 
 def _num(x: float | int) -> float | int | None:
@@ -153,20 +154,22 @@ def condition_row(res: StudyResult, cond: Condition, first: str) -> list[str]:
             _median_range(vals("purity"), _f3),
             _median_range(vals("object_accuracy"), _pct),
             _median_range(kept(), _pct),
+            _median_range(vals("object_ari"), _f3),
             _median_range(vals("ari"), _f3),
             _median_range(vals("category_accuracy"), _pct),
             _signed(delta("purity")), _signed(delta("object_accuracy"))]
 
 
 FACTOR_HEADER = ["level", "rooms found/true per house", "room error vs true",
-                 "purity", "objects right", "objects kept vs none", "ARI",
-                 "categories right", "purity vs none (pts)", "objects vs none (pts)"]
+                 "purity", "objects right", "objects kept vs none", "objects' rooms ARI",
+                 "ARI", "categories right", "purity vs none (pts)", "objects vs none (pts)"]
 
 
 # under pose drift the map lies in the drifted frame: the position-based scores count that
 DRIFT_NOTE = ("Under pose drift the map lies in the drifted odometry frame: purity, ARI, "
               "objects right and categories compare its positions with the house's outlines, "
-              "so they count how far the map has moved as well as how it is cut into rooms.")
+              "so they count how far the map has moved as well as how it is cut into rooms; "
+              "the objects' rooms ARI asks only which objects share a room, not where.")
 
 
 def summary_md(res: StudyResult) -> str:

@@ -113,7 +113,8 @@ def score_lines(scores: Mapping[str, Quality], graph_objects: int | None = None)
     the graph holds, 0 says so; None: not known)."""
     out = []
     for name, v in scores.items():
-        objects = (f"objects in the right room {v.object_accuracy:.1%} of {v.objects}"
+        objects = (f"objects in the right room {v.object_accuracy:.1%} of {v.objects} "
+                   f"(ARI of their rooms {v.object_ari:.3f})"
                    if v.objects else "no object in the graph to score" if graph_objects == 0
                    else "objects not scored (no object's instance names a spec element: "
                    "spec_id in the instance table)")
@@ -134,7 +135,7 @@ def score_dict(scores: Mapping[str, Quality]) -> dict[str, dict[str, float | int
     def figures(v: Quality) -> dict[str, float | int | None]:
         d: dict[str, float | int | None] = dict(asdict(v))
         if not v.objects:
-            d["object_accuracy"] = None
+            d["object_accuracy"] = d["object_ari"] = None
         if not v.rooms:
             d["category_accuracy"] = None
         return d

@@ -94,6 +94,9 @@ class Quality:
     # holds: a map that never saw half the house scores its objects over what it saw
     house_objects: int = 0
     objects_seen: int = 0
+    # adjusted Rand index of the scored objects' predicted rooms against their true rooms:
+    # which objects share a room, no position asked, so a map moved by pose drift keeps it
+    object_ari: float = 0.0
 
 
 def evaluate(node_xy: np.ndarray, node_rooms: Sequence[str | None],
@@ -129,8 +132,10 @@ def evaluate(node_xy: np.ndarray, node_rooms: Sequence[str | None],
     stood = gt_rooms_of(np.asarray(visited, dtype=float).reshape(-1, 2), polygons)
     seen = {g for _, g in pairs} | {r for r in map(m, stood) if r is not None}
     rooms = sorted(room_categories)
-    obj_ok = [majority.get(object_rooms[o]) == m(object_gt[o]) for o in sorted(object_rooms)
-              if o in object_gt]
+    scored = [o for o in sorted(object_rooms) if o in object_gt]
+    obj_ok = [majority.get(object_rooms[o]) == m(object_gt[o]) for o in scored]
+    obj_ari = adjusted_rand_index([object_rooms[o] for o in scored],
+                                  [m(object_gt[o]) for o in scored]) if scored else 0.0
     gt_cat: dict[str | None, set[str]] = {}
     for r, c in gt_categories.items():
         gt_cat.setdefault(m(r), set()).add(c)
@@ -142,5 +147,5 @@ def evaluate(node_xy: np.ndarray, node_rooms: Sequence[str | None],
         objects=len(obj_ok), object_accuracy=float(np.mean(obj_ok)) if obj_ok else 0.0,
         categorised=sum(room_categories[r] != "unknown" for r in rooms),
         category_accuracy=float(np.mean(cat_ok)) if cat_ok else 0.0,
-        gt_rooms_with_nodes=len({g for _, g in pairs}),
+        gt_rooms_with_nodes=len({g for _, g in pairs}), object_ari=float(obj_ari),
     )

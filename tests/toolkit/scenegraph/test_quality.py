@@ -68,3 +68,21 @@ def test_rooms_the_camera_stood_in_count_as_seen() -> None:
     assert q.gt_rooms_with_nodes == 1  # ...but they cover one of the three rooms seen
     empty = evaluate(np.zeros((0, 2)), [], {}, visited=walked[:2], **args)
     assert (empty.rooms, empty.gt_rooms_seen, empty.room_count_error) == (0, 2, -2)
+
+
+def test_a_map_moved_by_drift_keeps_its_objects_rooms_ari() -> None:
+    """The same three rooms and objects, the map moved 3 m along the row (pose drift: the
+    graph in the drifted frame): purity and objects right count the shift, the objects'
+    rooms ARI asks only which objects share a room and stays 1."""
+    xy = np.array([[1.0, 2.0], [2.0, 2.0], [5.0, 2.0], [6.0, 2.0], [9.0, 2.0], [10.0, 2.0]])
+    rooms = ["room:0", "room:0", "room:1", "room:1", "room:2", "room:2"]
+    objects = {"obj:1": "room:0", "obj:2": "room:0", "obj:3": "room:1", "obj:4": "room:2"}
+    gt = {"obj:1": "room_0", "obj:2": "room_0", "obj:3": "room_1", "obj:4": "room_2"}
+    cats = {"room:0": "kitchen", "room:1": "living_room", "room:2": "bedroom"}
+    right = evaluate(xy, rooms, cats, objects, gt, SQUARES, CATS)
+    moved = evaluate(xy + [3.0, 0.0], rooms, cats, objects, gt, SQUARES, CATS)
+    assert right.purity == 1.0 and right.object_accuracy == 1.0 and right.object_ari == 1.0
+    assert moved.object_accuracy < 1.0 and moved.object_ari == pytest.approx(1.0)
+    # objects put in other rooms do move it
+    wrong = evaluate(xy, rooms, cats, {**objects, "obj:2": "room:2"}, gt, SQUARES, CATS)
+    assert wrong.object_ari < 1.0
