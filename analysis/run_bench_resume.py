@@ -58,19 +58,21 @@ def episode_identity(ep: Episode) -> list[Any]:
 def task_settings(opts: ClosedLoopOptions, noise: str, episode: list[str] | None,
                   planner_options: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The settings a task's log must have been run with (as :func:`logged_settings`)."""
+    profile = parse_noise(noise)
+    ran = dataclasses.replace(opts, noise=profile)
     return {"episode": episode,
             "planner_options": recorded_options(planner_options or {}),
             "max_steps": opts.max_steps, "frame_budget": opts.frames,
             "size": [opts.camera.width, opts.camera.height],
             "render_step_m": float(opts.render_step_m),
             "turn_render_deg": float(opts.turn_render_deg),
-            "navigation": opts.navigation, "noise": _faults(parse_noise(noise).to_dict()),
+            "navigation": opts.navigation, "noise": _faults(profile.to_dict()),
             "noise_seed": opts.noise_seed,
-            "drift_model": parse_noise(noise).drift_model,
+            "drift_model": profile.drift_model,
             "seed": opts.planner_seed, "episode_seeds": True, "success": opts.success,
             "classifier": opts.classifier, "explore_on": opts.explore_on,
-            "max_depth": dataclasses.replace(opts, noise=parse_noise(noise)).depth_mapped(),
-            **_map_settings(dataclasses.replace(opts, noise=parse_noise(noise)).mapping()),
+            "max_depth": ran.depth_mapped(),
+            **_map_settings(ran.mapping()),
             "look_in": float(opts.live.look_in) if opts.navigation == "live" else None,
             "look_in_beyond": (_beyond(opts.live.look_in, opts.live.look_in_beyond)
                                if opts.navigation == "live" else None),
