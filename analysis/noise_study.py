@@ -68,8 +68,9 @@ NONE = "none"
 PROFILE = "profile"  # the factor name of a whole-profile condition
 # bump when what a cached log holds changes: 2 since the scripted tour's further
 # look-arounds (6aa451c) and walls blocking by exact distance (7983b7e); 3 since pose
-# drift is a random walk in the distance (not in the frames)
-CACHE_FORMAT = 3
+# drift is a random walk in the distance (not in the frames); 4 since a drifted log holds
+# the true base pose, by which its map is aligned before it is scored
+CACHE_FORMAT = 4
 
 
 def level_text(value: float) -> str:
@@ -278,10 +279,11 @@ def score_log(log: str | Path) -> tuple[int, dict[str, dict[str, float | int]]]:
     from sgtool.house.io import load_house_text
     from sgtool.log import LogReader
     from sgtool.replayers.derived_log import ReplayOptions, replay
-    from sgtool.replayers.score import score
+    from sgtool.replayers.score import score, truth_alignment
 
     with LogReader(Path(log)) as r:
         house = r.house_json()
+        align = truth_alignment(r)
     if house is None:
         raise SgtoolError(f"{log}: no house spec attachment; cannot score it")
     final: dict[str, Any] = {}
@@ -294,7 +296,8 @@ def score_log(log: str | Path) -> tuple[int, dict[str, dict[str, float | int]]]:
         raise SgtoolError(f"{log}: the replay produced no scene graph to score")
     spec = load_house_text(house)
     ref, stream = final["refresh"], final["stream"]
-    q = score(spec, stream.builder.instances, ref.layers, ref.graph, stream.builder.trajectory)
+    q = score(spec, stream.builder.instances, ref.layers, ref.graph, stream.builder.trajectory,
+              align)
     out: dict[str, dict[str, float | int]] = {}
     for name, v in q.items():
         d: dict[str, float | int] = dict(asdict(v))

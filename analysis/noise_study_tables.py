@@ -166,10 +166,12 @@ FACTOR_HEADER = ["level", "rooms found/true per house", "room error vs true",
 
 
 # under pose drift the map lies in the drifted frame: the position-based scores count that
-DRIFT_NOTE = ("Under pose drift the map lies in the drifted odometry frame: purity, ARI, "
-              "objects right and categories compare its positions with the house's outlines, "
-              "so they count how far the map has moved as well as how it is cut into rooms; "
-              "the objects' rooms ARI asks only which objects share a room, not where.")
+DRIFT_NOTE = ("Under pose drift the map lies in the drifted odometry frame; before it is "
+              "scored it is carried onto the house by the rotation and shift that best fit "
+              "the logged poses to the true ones, so purity, ARI, objects right and "
+              "categories still count the map's warp (what no rigid shift removes) as well "
+              "as how it is cut into rooms; the objects' rooms ARI asks only which objects "
+              "share a room, not where.")
 
 
 def summary_md(res: StudyResult) -> str:

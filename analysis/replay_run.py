@@ -94,7 +94,8 @@ def replay_one(request: ReplayRequest, show: Echo, note: Echo) -> None:
                         progress=bar, verify=request.verify, room_classifier=rooms.make)
     if live is not None:
         live.finish(note)
-    scores = _score(request.house, final) if request.house is not None else None
+    scores, align = _score(request.house, final, request.log) \
+        if request.house is not None else (None, None)
     if request.rrd is not None and request.output is not None:
         try:
             write_view(request.output, Path(request.rrd), request.progress)
@@ -102,14 +103,16 @@ def replay_one(request: ReplayRequest, show: Echo, note: Echo) -> None:
             e.note = (f"{request.output} was written; {request.rrd} was not (make it with: "  # type: ignore[attr-defined]
                       f"sgtool view {quoted(request.output)} -o {quoted(request.rrd)})")
             raise
-    _show_report(request, report, rooms, scores, show)
+    _show_report(request, report, rooms, scores, align, show)
 
 
-def _show_report(request: ReplayRequest, report: Any, rooms: Any, scores: Any,
+def _show_report(request: ReplayRequest, report: Any, rooms: Any, scores: Any, align: Any,
                  show: Echo) -> None:
     rrd = request.rrd
     if request.as_json:
         doc = replay_dict(report, scores, rrd)
+        if align is not None:
+            doc["score_alignment"] = {"frames": align.frames, "rms_m": align.rms_m}
         if rooms.exchanges:
             doc["llm_answers"] = rooms.stats().as_dict()
         show(json_text(doc, sort_keys=True))
@@ -120,6 +123,8 @@ def _show_report(request: ReplayRequest, report: Any, rooms: Any, scores: Any,
         from sgtool.replayers.score import score_lines
 
         last = report.last
+        if align is not None:
+            show(align.line())
         for line in score_lines(scores, None if last is None else len(last.graph.objects)):
             show(line)
     if rrd:
@@ -149,16 +154,21 @@ def replay_many(request: BatchReplayRequest, show: Echo) -> None:
                           f"(after a retry); the first: {failed[0].input}: {failed[0].error}")
 
 
-def _score(spec: Any, final: dict[str, Any]) -> Any:
-    from sgtool.replayers.score import score
+def _score(spec: Any, final: dict[str, Any], log: Any) -> tuple[Any, Any]:
+    """The scores of the final graph against ``spec`` and the alignment of a drifted map
+    to the true poses in ``log`` (None when it holds none)."""
+    from sgtool.log import LogReader
+    from sgtool.replayers.score import score, truth_alignment
 
     if "refresh" not in final:
         raise SgtoolError("the log produced no scene graph to score (no frames?)")
     ref, stream = final["refresh"], final["stream"]
     if ref.layers is None:
         raise SgtoolError("the last refresh has no map layers to score")
+    with LogReader(log) as reader:
+        align = truth_alignment(reader)
     return score(spec, stream.builder.instances, ref.layers, ref.graph,
-                 stream.builder.trajectory)
+                 stream.builder.trajectory, align), align
 
 
 def write_view(derived: Path, rrd: Path, show: bool) -> None:

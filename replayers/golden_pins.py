@@ -242,17 +242,19 @@ def capture(log: str | os.PathLike[str], options: ReplayOptions, *,
     report = replay(log, None, options, on_refresh=keep)
     figures = None
     if quality:
+        from sgtool.replayers.score import score, score_dict, truth_alignment
+
         with LogReader(log) as reader:
             house = reader.house_json()
+            align = truth_alignment(reader) if house is not None else None
         ref = last.get("refresh")
         if house is not None and ref is not None and ref.layers is not None:
             from sgtool.house.io import load_house
-            from sgtool.replayers.score import score, score_dict
 
             spec = load_house(json.loads(house))
             builder = last["stream"].builder
             figures = score_dict(score(spec, builder.instances, ref.layers, ref.graph,
-                                       builder.trajectory))
+                                       builder.trajectory, align))
             figures = {k: {f: canonical_float(v) if isinstance(v, float) else v
                            for f, v in q.items()} for k, q in figures.items()}
     return Capture(graphs, metas, asdict(report.options), figures)

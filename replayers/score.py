@@ -14,11 +14,16 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, replace
+from dataclasses import asdict, dataclass, replace
 from functools import partial
 from typing import Any
 
+import numpy as np
+
 from sgtool.house.spec import HouseSpec
+from sgtool.log import schemas as S
+from sgtool.log.codec import decode_transform
+from sgtool.log.poses import planar_fit
 from sgtool.scenegraph.builder import MapLayers
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.instances import InstanceInfo
@@ -44,12 +49,68 @@ def passage_groups(spec: HouseSpec) -> dict[str, str]:
     return {r: find(r) for r in sorted(parent)}
 
 
+@dataclass(frozen=True)
+class TruthAlignment:
+    """How a drifted map is carried onto the house before it is scored: ``transform`` (4x4,
+    the map's frame -> the house's) is the rotation and shift that best carries the logged
+    base poses onto the true ones (:func:`~sgtool.log.poses.planar_fit`) over ``frames``
+    frames; ``rms_m`` is what remains of the position error after it (the map's warp,
+    which no rigid shift removes)."""
+
+    transform: np.ndarray
+    frames: int
+    rms_m: float
+
+    def line(self) -> str:
+        return (f"map aligned to the true poses before scoring (pose drift): a rigid fit "
+                f"over {self.frames} frames, {self.rms_m:.3f} m RMS left")
+
+
+def truth_alignment(reader: Any) -> TruthAlignment | None:
+    """The :class:`TruthAlignment` of a log whose ``/tf`` holds the true base pose
+    (``world -> base_truth``, written by a simulated recording with pose drift) beside the
+    logged one (``world -> base``) at the same times; None for a log without it."""
+    base: dict[int, np.ndarray] = {}
+    truth: dict[int, np.ndarray] = {}
+    if not reader.has(S.TF):
+        return None
+    for m in reader.messages([S.TF]):
+        if m.message.parent_frame_id != S.WORLD_FRAME:
+            continue
+        child = m.message.child_frame_id
+        if child in (S.BASE_FRAME, S.TRUE_BASE_FRAME):
+            (base if child == S.BASE_FRAME else truth)[m.log_time_ns] = \
+                decode_transform(m.message)
+    times = sorted(set(base) & set(truth))
+    if not times:
+        return None
+    src = [base[t] for t in times]
+    dst = [truth[t] for t in times]
+    fit = planar_fit(src, dst)
+    moved = np.array([(fit @ p)[:2, 3] for p in src])
+    rms = float(np.sqrt(np.mean(np.sum((moved - np.array([p[:2, 3] for p in dst])) ** 2,
+                                       axis=1))))
+    return TruthAlignment(fit, len(times), rms)
+
+
+def _carried(xy: Any, transform: np.ndarray | None) -> Any:
+    """Points (x, y) in the map's frame carried into the house's by ``transform``."""
+    if transform is None:
+        return xy
+    p = np.asarray(xy, dtype=float).reshape(-1, 2)
+    return p @ transform[:2, :2].T + transform[:2, 3]
+
+
 def score(spec: HouseSpec, instances: Mapping[int, InstanceInfo], layers: MapLayers,
-          graph: SceneGraph, visited: Sequence[tuple[float, float]] = ()
-          ) -> dict[str, Quality]:
+          graph: SceneGraph, visited: Sequence[tuple[float, float]] = (),
+          align: TruthAlignment | None = None) -> dict[str, Quality]:
     """``{"strict": Quality, "merged": Quality}`` of ``graph`` (module doc); ``visited``:
     the camera's (x, y) positions (the builder's ``trajectory``), whose rooms count as
-    seen."""
+    seen. With ``align`` (:func:`truth_alignment`) the map's positions are carried onto
+    the house first: a drifted map is scored for its rooms, not for its shift."""
+    transform = None if align is None else align.transform
+    node_xy = _carried(layers.voronoi.positions, transform)
+    visited = _carried(visited, transform) if len(visited) else visited
     rooms_by_spec = ({f.id: f.room for f in spec.furniture}
                      | {o.id: o.room for o in spec.objects})
     object_gt: dict[str, str] = {}
@@ -59,13 +120,13 @@ def score(spec: HouseSpec, instances: Mapping[int, InstanceInfo], layers: MapLay
             object_gt[o.id] = rooms_by_spec[info.spec_id]
     of_graph = partial(
         evaluate,
-        node_xy=layers.voronoi.positions, node_rooms=layers.node_rooms,
+        node_xy=node_xy, node_rooms=layers.node_rooms,
         room_categories={r.id: r.category for r in graph.rooms if r.explored},
         object_rooms={o.id: o.room for o in graph.objects}, object_gt=object_gt,
         polygons={r.id: r.polygon for r in spec.rooms},
         gt_categories={r.id: r.category for r in spec.rooms}, visited=visited,
     )
-    merge = split_groups_kept_apart(passage_groups(spec), layers.voronoi.positions,
+    merge = split_groups_kept_apart(passage_groups(spec), node_xy,
                                     layers.node_rooms, {r.id: r.polygon for r in spec.rooms})
     seen = {info.spec_id for o in graph.objects
             if (info := instances.get(o.instance)) is not None and info.spec_id in rooms_by_spec}
@@ -81,8 +142,6 @@ def split_groups_kept_apart(merge: Mapping[str, str], node_xy: Any,
     group: rooms of a group whose Voronoi nodes lie mostly in one predicted room stay
     merged, rooms the graph gives predicted rooms of their own are scored apart; a room
     without nodes stays with its group's representative, as before."""
-    import numpy as np
-
     gt = gt_rooms_of(np.asarray(node_xy, dtype=float).reshape(-1, 2), polygons)
     of_gt: dict[str, Counter[str]] = {}  # ground-truth room -> its nodes' predicted rooms
     for p, g in zip(node_rooms, gt, strict=True):

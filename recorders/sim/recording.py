@@ -107,10 +107,16 @@ class LogRecorder(SimObserver):
         return self.max_frames is not None and self.frames >= self.max_frames
 
     def record_frame(self, f: Frame) -> None:
-        """Write a rendered frame (with the sensor faults applied) and count it."""
+        """Write a rendered frame (with the sensor faults applied) and count it; under pose
+        drift also the true base pose (world -> ``base_truth`` on ``/tf``)."""
+        truth = None
         if self.faults is not None:
+            if self.faults.profile.drift_model is not None:
+                truth = f.base_pose
             f = self.faults.apply(f)
         self.write_frame(f)
+        if truth is not None:
+            self.writer.write_transform(f.time_ns, S.WORLD_FRAME, S.TRUE_BASE_FRAME, truth)
         self.last_time_ns = f.time_ns
         self.last_frame = f
         self.frames += 1

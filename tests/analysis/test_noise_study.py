@@ -260,14 +260,16 @@ def test_a_share_over_nothing_is_no_zero(study: dict[str, Path]) -> None:
 
 
 def test_a_drift_condition_says_what_its_scores_count(study: dict[str, Path]) -> None:
-    """Under pose drift the map is in the drifted frame: the drift table says that its
-    position-based scores count the map's shift too; the label-fault tables do not."""
+    """Under pose drift the map is in the drifted frame: the drift table says how it was
+    aligned and what its position-based scores still count; the label-fault tables do
+    not."""
     out = study["root"] / "drift"
     r = _study(study["house"], study["cache"], out, "--factor", "drift_yaw=0.01")
     assert r.exit_code == 0, r.output
     text = (out / "summary.md").read_text()
     drift = text[text.index("## drift_yaw"):]
     assert "Under pose drift the map lies in the drifted odometry frame" in drift
+    assert "best fit the logged poses to the true ones" in drift
     assert "drifted odometry frame" not in text[:text.index("## drift_yaw")]
     # the cache's sidecar says what the key holds: the faults' values and the drift model
     sides = [json.loads(p.read_text()) for p in (study["cache"] / "small").glob("*.json")]

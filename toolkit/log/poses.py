@@ -11,6 +11,7 @@ stale transform would put the whole depth image in the wrong place.
 from __future__ import annotations
 
 import bisect
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -68,6 +69,29 @@ def pose_difference(A: np.ndarray, B: np.ndarray) -> tuple[float, float]:  # noq
     """(translation distance in metres, rotation angle in degrees) between two poses."""
     d = np.linalg.inv(A) @ B
     return float(np.linalg.norm(A[:3, 3] - B[:3, 3])), rotation_angle_deg(d)
+
+
+def planar_fit(source: Sequence[np.ndarray], target: Sequence[np.ndarray]) -> np.ndarray:
+    """The rotation about z and translation in x, y (a 4x4) that best carries the poses
+    ``source`` onto ``target`` (pairs, 4x4 each): least squares over each pose's position
+    and the point 1 m ahead of it along its x axis, so one pose fixes the heading too
+    (Kabsch in the plane). The identity when no pairs are given."""
+    if len(source) != len(target):
+        raise ValueError(f"{len(source)} source poses for {len(target)} target poses")
+    out = np.eye(4)
+    if not len(source):
+        return out
+    src, dst = (np.asarray(a, dtype=np.float64).reshape(-1, 4, 4) for a in (source, target))
+    p = np.concatenate([src[:, :2, 3], src[:, :2, 3] + src[:, :2, 0]])
+    q = np.concatenate([dst[:, :2, 3], dst[:, :2, 3] + dst[:, :2, 0]])
+    pm, qm = p.mean(axis=0), q.mean(axis=0)
+    h = (p - pm).T @ (q - qm)
+    angle = math.atan2(h[0, 1] - h[1, 0], h[0, 0] + h[1, 1])
+    c, s = math.cos(angle), math.sin(angle)
+    rot = np.array([[c, -s], [s, c]])
+    out[:2, :2] = rot
+    out[:2, 3] = qm - rot @ pm
+    return out
 
 
 @dataclass(frozen=True)

@@ -41,6 +41,9 @@ HOUSE_ATTACHMENT = "house.json"
 WORLD_FRAME = "world"
 BASE_FRAME = "base"
 CAMERA_FRAME = "camera"
+# the robot's true pose (world -> base_truth on /tf), written beside a base whose logged
+# pose drifts (a simulated recording with pose drift): what scoring aligns the map by
+TRUE_BASE_FRAME = "base_truth"
 
 # protobuf (Foxglove well-known) topics
 RGB = "/camera/rgb"
