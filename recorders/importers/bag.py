@@ -146,6 +146,8 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
                 ("depth", opts.depth), ("rgb", opts.rgb), ("ids", opts.ids),
                 ("info", opts.info), ("pose", opts.pose)) if t),
             "instance_ids": "present" if opts.ids else "absent",
+            **({"instance_table": f"{len(opts.instances.instances)} instances"}
+               if opts.instances is not None else {}),
         }
         if opts.depth is None:
             assert src is not None
@@ -229,7 +231,7 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
         n, has_rgb, has_ids = write_log(
             out, decode_frames(reader, plan, idx, opts, k, resizes), alignment=alignment,
             metadata=meta, total=len(plan), progress=opts.progress, notes=notes,
-            compression=opts.compression, resizes=resizes,
+            compression=opts.compression, resizes=resizes, instances=opts.instances,
         )
     return ImportReport(
         output=out, source=str(path), kind=kind, frames=n, poses=n, alignment=alignment,

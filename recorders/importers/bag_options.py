@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sgtool.errors import SgtoolError
+from sgtool.log.records import Instances
 from sgtool.recorders.importers.checks import (
     check_counts,
     check_depth_scale,
@@ -52,6 +53,7 @@ class BagOptions:
     info_origin: str = ""  # how --info was chosen, when not given ("the only CameraInfo topic")
     allow_drop: bool = False  # depth images without a pose may be more than 10 %
     time_offset_ns: int = 0  # added to the images' times (header stamps or record times)
+    instances: Instances | None = None  # what the ids stand for (:mod:`.instance_table`)
 
 
 def check_options(opts: BagOptions) -> None:
@@ -69,6 +71,9 @@ def check_options(opts: BagOptions) -> None:
     if abs(opts.time_offset_ns) > MAX_TIME_OFFSET_S * 1e9:
         raise SgtoolError(f"--time-offset {opts.time_offset_ns / 1e9:g}: must be within "
                           f"+-{MAX_TIME_OFFSET_S:g} seconds")
+    if opts.instances is not None and (opts.ids is None or opts.depth is None):
+        raise SgtoolError("--instances is the table of the instance ids: give the id image "
+                          "topic too (--ids TOPIC, with --depth)")
     if opts.pose is not None and opts.tf_frames is not None:
         raise SgtoolError(
             f"--tf-frames {':'.join(opts.tf_frames)} applies only to camera poses from the tf "

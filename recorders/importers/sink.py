@@ -28,7 +28,7 @@ import numpy as np
 
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
-from sgtool.log.records import Episode
+from sgtool.log.records import Episode, Instances
 from sgtool.log.schemas import IMPORT_METADATA_NAME
 from sgtool.log.writer import LogWriter
 from sgtool.recorders.importers.images import ResizeLog
@@ -145,8 +145,12 @@ def write_log(
     notes: Iterable[str] = (),
     compression: str = "zstd",
     resizes: ResizeLog | None = None,
+    instances: Instances | None = None,
 ) -> tuple[int, bool, bool]:
-    """Write the frames; returns (frame count, any colour, any ids). Raises
+    """Write the frames; returns (frame count, any colour, any ids). ``instances``, the
+    table of the ids (what each stands for), is written at the first frame's time; ids
+    the frames hold that it does not list are a note (a replay ignores them), added to
+    ``notes`` when it is a list (the caller's report). Raises
     :class:`SgtoolError` (leaving no output) when there is no frame at all. Chunks are zstd
     by default (``compression``; "lz4" trades a larger log for a faster import, see
     ``docs/experiments/moved-from-docstrings.md``). The resizes
@@ -158,6 +162,7 @@ def write_log(
     meta.update(alignment.metadata())
     n = 0
     has_rgb = has_ids = False
+    seen: set[int] = set()  # the ids the frames hold (with a table to check them against)
     first_t = last_t = 0
     A = alignment.matrix  # noqa: N806
     with LogWriter(out, compression=compression) as w:
@@ -171,6 +176,8 @@ def write_log(
                     w.write_record(Episode(kind="import", status="started",
                                            source=meta.get("source", ""), frames=0),
                                    fr.time_ns)
+                    if instances is not None:
+                        w.write_record(instances, fr.time_ns)
                 pose = A @ fr.pose
                 far = far_camera_problem(pose, f"frame {n} (t = {fr.time_ns} ns)")
                 if far is not None:
@@ -183,6 +190,8 @@ def write_log(
                                       "written") from None
                 has_rgb |= fr.rgb is not None
                 has_ids |= fr.ids is not None
+                if instances is not None and fr.ids is not None:
+                    seen.update(np.unique(fr.ids).tolist())
                 last_t = fr.time_ns
                 n += 1
                 bar.update(1)
@@ -190,6 +199,12 @@ def write_log(
             bar.close()
         if n == 0:
             raise SgtoolError("nothing to import: no frame has both a depth image and a pose")
+        if instances is not None:
+            unlisted = _unlisted(seen, instances)
+            if isinstance(notes, list):
+                notes.extend(unlisted)  # the caller's report says it too
+            else:
+                notes = [*notes, *unlisted]
         w.write_record(Episode(
             kind="import", status="ended", source=meta.get("source", ""), frames=n,
             extra={"notes": list(notes), "instance_ids": has_ids, "colour": has_rgb,
@@ -227,3 +242,14 @@ def odometry_report_fields(res: OdometryResult | None) -> OdometryReportFields:
         return {}
     return {"odometry_failures": res.failures, "odometry_summary": res.summary(),
             "odometry_reasons": tuple(res.reasons().items())}
+
+
+def _unlisted(seen: set[int], instances: Instances) -> list[str]:
+    """The note on ids the frames hold that the instance table does not list."""
+    listed = {i.id for i in instances.instances}
+    missing = sorted(seen - listed - {0})
+    if not missing:
+        return []
+    shown = ", ".join(str(i) for i in missing[:8]) + (" ..." if len(missing) > 8 else "")
+    return [f"{len(missing)} instance id(s) in the id images are not in the instance table "
+            f"({shown}): a replay ignores them"]

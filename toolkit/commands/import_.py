@@ -189,6 +189,11 @@ def command() -> None:
               "CompressedImage PNG/compressedDepth): one frame per depth image.")
 @click.option("--rgb", help="Colour image topic (Image or CompressedImage).")
 @click.option("--ids", help="Instance-id image topic (integer Image), if the bag has one.")
+@click.option("--instances", type=PathParam(dir_okay=False, exists=True),
+              help="What the --ids stand for: a JSON file {\"instances\": [{\"id\": 1, "
+              "\"category\": \"chair\", \"kind\": \"furniture\"}, ...]} (kind: object, "
+              "furniture, door or structure; the sgtool.Instances record, see docs/api.md). "
+              "Without it the ids are imported and a replay builds geometry only.")
 @click.option("--info", help="CameraInfo topic of the depth camera (the intrinsics).")
 @click.option("--tf-frames", help="WORLD:CAMERA frames of the tf tree for the camera pose "
               "(default: the depth image's frame in the root of its tree). Without --depth: "
@@ -272,7 +277,8 @@ def _tf_frames(text: str | None) -> tuple[str, str] | None:
     return parts[0], parts[1]
 
 
-def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None, info: str | None,
+def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None,
+                 instances: str | None, info: str | None,
                  tf_frames: str | None, pose: str | None, timestamps: str,
                  tf_tolerance: float, time_offset: float, estimate_poses: bool,
                  odometry: str, depth_max: float, up: str, floor: str, camera_height: str,
@@ -283,6 +289,7 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None, info: s
     :class:`sgtool.recorders.importers.bag.BagOptions`."""
     from sgtool.recorders.importers.bag import BagOptions
     from sgtool.recorders.importers.checks import parse_height_band
+    from sgtool.recorders.importers.instance_table import read_instance_table
     from sgtool.recorders.importers.textformats import parse_intrinsics
     from sgtool.recorders.importers.upright import parse_up
 
@@ -290,6 +297,7 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None, info: s
     fl, floor_auto = _floor(floor)
     return BagOptions(
         rgb=rgb, depth=depth, ids=ids, info=info, tf_frames=frames, pose=pose,
+        instances=None if instances is None else read_instance_table(instances),
         intrinsics=parse_intrinsics(intrinsics) if intrinsics else None,
         depth_scale=depth_scale, max_dt_ns=seconds_option_ns(max_dt, "--max-dt", MAX_DT_S),
         tf_tolerance_ns=seconds_option_ns(tf_tolerance, "--tf-tolerance", MAX_TF_TOLERANCE_S),
