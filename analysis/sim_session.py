@@ -74,9 +74,13 @@ def _progress(total: int | None, desc: str, quiet: bool) -> Iterator[Any]:
 def _live(rerun_to: str | None, source: str, note: Echo) -> Any:
     if rerun_to is None:
         return None
+    import uuid
+
     from sgtool.analysis.rerun_live import LiveReplay
 
-    return LiveReplay.start(rerun_to, source, note)
+    # the log's bytes do not exist yet: a recording id of its own per run, so that two
+    # runs to one output (other options, --force) never merge in a viewer left open
+    return LiveReplay.start(rerun_to, f"{source} {uuid.uuid4()}", note)
 
 
 def _finish(report: Any, live: Any, quiet: bool, show: Echo, note: Echo) -> None:

@@ -229,3 +229,30 @@ def test_a_live_replay_shares_the_timelines_of_view(tmp_path):
     view = _times(tmp_path / "view.rrd", "/world/map/occupancy")
     assert len(view) >= 3 and view[0][0] > 0
     assert _times(tmp_path / "live.rrd", "/world/map/occupancy") == view
+
+
+def test_two_live_recordings_to_one_output_never_share_an_id(tmp_path, monkeypatch):
+    """record --rerun twice to one output (other options, --force): a viewer left open
+    keeps them apart (the log's bytes do not exist while it is recorded, so the id cannot
+    come from them; it came from the command's words, the same both times)."""
+    import rerun as rr
+
+    from sgtool.analysis import rerun_live
+
+    ids = []
+
+    def stream(target, recording_id):  # noqa: ANN001, ANN202
+        ids.append(recording_id)
+        rec = rr.RecordingStream("test", recording_id=recording_id)
+        rec.save(str(tmp_path / f"live{len(ids)}.rrd"))
+        return rec, None
+
+    monkeypatch.setattr(rerun_live, "check_target", lambda target: None)
+    monkeypatch.setattr(rerun_live, "open_stream", stream)
+    url = f"rerun+http://127.0.0.1:{free_port()}/proxy"
+    for size in ("32x24", "40x30"):
+        r = CliRunner().invoke(cli, ["record", "--seed", "3", "--rooms", "4-4", "--frames", "3",
+                                     "--resolution", size, "--quiet", "--force", "-o",
+                                     str(tmp_path / "two.mcap"), "--rerun", f"connect:{url}"])
+        assert r.exit_code == 0, r.output
+    assert len(ids) == 2 and ids[0] != ids[1]

@@ -25,13 +25,14 @@ from sgtool.vocabulary import (
     SKILLS,
 )
 
-# sha256 of RecordKind.schema_bytes(), the schema record written into every log
+# sha256 of RecordKind.schema_bytes(), the schema record written into every log (the
+# form Foxglove parses since the session of 2026-12-06)
 SCHEMA_SHA256 = {
-    "episode": "09a772f2cd73b39c60a9ef1a2689d2220978bcfbc5d9aff52e924e59884cba49",
-    "instances": "3a7144fe8a9f4bcfbd2d10db092c8adef810eda86696e0b0cd0e39c992add11d",
-    "action": "9a37e0244a879ed2d3622b932947537a31fdb048995b5fe543ab9f4783ff6e06",
-    "scene_graph": "d75746a34e204e347ce74f3eba19ac3715d2c79915dbcfc496545997f41253ed",
-    "llm_exchange": "ebee81511fa0b81154bcbf905d2fa55e1dd344f1af15df72ee35b147bbfb7ac4",
+    "episode": "0191bcdfc39786a325f18fdb0cc268e2d51c0411d2fde9ee5ecb0fadb63adc13",
+    "instances": "8b1e4be18883ac4c982506a7e088cf11b1f6e37db37f371e2847087d514fbef2",
+    "action": "ad4aec0059323cd4663298a47eb0c46769c945c2ef9a194fd6b495df4eea4640",
+    "scene_graph": "871fff57ca45b5e9f0034ac6bb073b2aeeb90aef751c5ad64693e87a7845d0e2",
+    "llm_exchange": "24dfebd4d01c95bc7371c37b4cdf6a593b3d9f72a37692a831fd67edca4fd6c4",
 }
 
 

@@ -85,9 +85,35 @@ class RecordKind:
             "$id": f"sgtool/{self.schema_name}/{self.version}",
             "title": self.schema_name,
             "version": self.version,
-            **self.schema,
+            **_viewable(self.schema),
         }
         return json.dumps(doc, sort_keys=True, separators=(",", ":")).encode()
+
+
+def _viewable(node: Any) -> Any:
+    """``node`` in the JSON Schema subset Foxglove and Lichtblick parse (one ``type``
+    string per property, ``properties`` on every object, ``items`` on every array): a
+    nullable type is its non-null type, an ``enum`` gets the type of its values, an open
+    object gets no properties, an untyped array holds open objects. Records are checked
+    against :attr:`RecordKind.schema`, not against this."""
+    if not isinstance(node, dict):
+        return node
+    out = {k: _viewable(v) if k in ("items",) else v for k, v in node.items()}
+    if "properties" in node:
+        out["properties"] = {k: _viewable(v) for k, v in node["properties"].items()}
+    t = node.get("type")
+    if isinstance(t, list):
+        t = next((x for x in t if x != "null"), "null")
+    if t is None and "enum" in node:
+        kinds = {type(v) for v in node["enum"] if v is not None}
+        t = "string" if kinds <= {str} else "number"
+    if t is not None:
+        out["type"] = t
+    if t == "object":
+        out.setdefault("properties", {})
+    if t == "array":
+        out.setdefault("items", {"type": "object", "properties": {}})
+    return out
 
 
 def _obj(props: dict[str, Any], required: list[str]) -> dict[str, Any]:

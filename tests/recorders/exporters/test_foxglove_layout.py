@@ -51,3 +51,22 @@ def test_the_3d_panel_follows_a_frame_the_log_has(tmp_path):
     r = CliRunner().invoke(cli, ["export", "foxglove-layout", "-o", str(out), "--force",
                                  "--follow", "base_link"])
     assert r.exit_code == 2 and "'base_link' is not one of 'base', 'camera', 'world'" in r.output
+
+
+def test_the_id_and_depth_images_are_drawn_in_colour_over_their_range(tmp_path):
+    """Foxglove draws a 16UC1 image as grey over 0..10000 unless told otherwise: instance
+    ids (tens to hundreds) were black, depth in millimetres (up to the 6 m range) dim. The
+    layout maps each through a colour map over its own range."""
+    out = tmp_path / "layout.json"
+    assert CliRunner().invoke(cli, ["export", "foxglove-layout", "-o", str(out)]).exit_code == 0
+    modes = {cfg["imageMode"]["imageTopic"]: cfg["imageMode"]
+             for cfg in json.loads(out.read_text())["configById"].values()
+             if "imageTopic" in cfg.get("imageMode", {})}
+    ids, depth = modes["/camera/instances"], modes["/camera/depth"]
+    with LogReader(GOLDEN / "house10-start.mcap") as r:
+        frames = list(r.frames())
+    most_id = max(int(f.ids.max()) for f in frames)
+    most_mm = max(float(f.depth.max()) for f in frames) * 1000.0
+    for mode, most in ((ids, most_id), (depth, most_mm)):
+        assert mode["colorMode"] == "colormap" and mode["minValue"] == 0
+        assert most <= mode["maxValue"] <= 10 * most
