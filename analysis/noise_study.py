@@ -168,10 +168,13 @@ class RecordingSettings:
     noise_seed: int = 0
 
     def check(self) -> None:
-        if not (16 <= self.width <= 4096 and 16 <= self.height <= 4096):
-            raise SgtoolError(f"--resolution {self.width}x{self.height}: each side 16..4096 "
-                              "pixels")
+        from sgtool.recorders.sim.camera import SIDE_RANGE
         from sgtool.recorders.sim.simulation import FPS_RANGE
+
+        lo, hi = SIDE_RANGE  # the camera's own rule, as record's
+        if not (lo <= self.width <= hi and lo <= self.height <= hi):
+            raise SgtoolError(f"--resolution {self.width}x{self.height}: each side {lo}..{hi} "
+                              "pixels")
 
         if not (math.isfinite(self.fps) and FPS_RANGE[0] <= self.fps <= FPS_RANGE[1]):
             raise SgtoolError(f"--fps {self.fps}: must be {FPS_RANGE[0]:g}..{FPS_RANGE[1]:g}")

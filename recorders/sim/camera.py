@@ -33,6 +33,7 @@ from sgtool.log.frame import CameraIntrinsics
 # optical (x right, y down, z forward) -> OpenGL camera (x right, y up, z backward)
 _OPTICAL_T_GL = np.diag([1.0, -1.0, -1.0, 1.0])
 UID_MASK = 0xFFFFFF  # low 24 bits of a segmentation value: the body's unique id
+SIDE_RANGE = (8, 4096)  # pixels a camera image side may have (each of width, height)
 
 
 TILT_MIN, TILT_MAX = -60.0, 80.0  # degrees down from the horizontal, mast or head
@@ -62,9 +63,10 @@ class CameraConfig:
         for name in ("vfov_deg", "mount_height", "tilt_deg", "depth_min", "depth_max", "near"):
             # kept as a float: vfov_deg=75 logs as the CLI's 75.0 does
             object.__setattr__(self, name, number(name, getattr(self, name)))
-        if not (8 <= self.width <= 4096 and 8 <= self.height <= 4096):
+        if not (SIDE_RANGE[0] <= self.width <= SIDE_RANGE[1]
+                and SIDE_RANGE[0] <= self.height <= SIDE_RANGE[1]):
             raise SgtoolError(f"camera resolution {self.width}x{self.height}: each side must "
-                              "be 8..4096 pixels")
+                              f"be {SIDE_RANGE[0]}..{SIDE_RANGE[1]} pixels")
         if not 10.0 <= self.vfov_deg <= 150.0:
             raise SgtoolError(f"camera field of view {self.vfov_deg} deg: must be 10..150")
         if not 0.0 < self.near <= self.depth_min < self.depth_max:

@@ -275,3 +275,18 @@ def test_a_drift_condition_says_what_its_scores_count(study: dict[str, Path]) ->
     sides = [json.loads(p.read_text()) for p in (study["cache"] / "small").glob("*.json")]
     side = next(d for d in sides if d["noise"] == "none,drift_yaw=0.01")
     assert side["noise_key"]["drift_yaw"] == 0.01 and side["noise_key"]["drift_model"] == 2
+
+
+def test_the_study_takes_every_resolution_record_takes() -> None:
+    """One rule for a camera image's sides (record's, the camera's): the study refused
+    8..15 pixels that record and the closed loop take."""
+    from sgtool.analysis.noise_study import RecordingSettings
+    from sgtool.recorders.sim.camera import SIDE_RANGE, CameraConfig
+
+    lo, hi = SIDE_RANGE
+    for w, h in ((lo, lo), (hi, lo)):
+        RecordingSettings(w, h).check()
+        CameraConfig(width=w, height=h)
+    for w, h in ((lo - 1, 16), (16, hi + 1)):
+        with pytest.raises(SgtoolError, match=f"each side {lo}..{hi} pixels"):
+            RecordingSettings(w, h).check()

@@ -184,7 +184,9 @@ def test_a_run_that_leaves_its_recorded_transcript_is_an_error(tmp_path):
      "configured: set SGTOOL_LLM_BASE_URL (and SGTOOL_LLM_API_KEY if it needs one); study "
      "noise has no option for it"),
     (["--resolution", "4097x120"], "sgtool: error: --resolution 4097x120: each side "
-     "16..4096 pixels"),
+     "8..4096 pixels"),
+    (["--resolution", "7x120"], "sgtool: error: --resolution 7x120: each side "
+     "8..4096 pixels"),
     (["--cache", "{tmp}/f/x"], "sgtool: error: --cache {tmp}/f/x: lies under {tmp}/f, which "
      "is no folder"),
     (["--closed-loop-noise", "mild", "--closed-loop-houses", "2"], "sgtool: error: "
