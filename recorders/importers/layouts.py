@@ -15,12 +15,13 @@
   and ``depth/`` folders of images paired by name, a ``.log`` trajectory (camera-to-world)
   and an intrinsics JSON (``intrinsic_matrix``); depth in mm. Without a JSON, the PrimeSense
   default 525, 525, 319.5, 239.5 that Open3D itself assumes. Frames are ``1/fps`` apart, in
-  natural name order ("2.png" before "10.png", as Open3D's ``sorted_alphanum``).
+  natural name order ("2.png" before "10.png", as Open3D's ``sorted_alphanum``). Without
+  a ``.log``, a ``pose/`` folder of one 4x4 text file a frame and an
+  ``intrinsic/intrinsic_depth.txt`` (a ScanNet export: :mod:`.pose_files`) are read.
 """
 
 from __future__ import annotations
 
-import json
 import re
 from collections import Counter
 from dataclasses import dataclass, replace
@@ -31,9 +32,11 @@ import numpy as np
 
 from sgtool.errors import SgtoolError
 from sgtool.log.poses import PoseTrack
+from sgtool.recorders.importers.pose_files import folder_intrinsics, pose_folder, posed_pairs
 from sgtool.recorders.importers.sanity import time_range_problem, timestamp_problem
 from sgtool.recorders.importers.textformats import (
     PinholeParams,
+    is_intrinsics_json,
     is_open3d_log,
     read_intrinsics_file,
     read_pose_file,
@@ -462,25 +465,6 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
                           dropped=dropped)
 
 
-def _is_intrinsics_json(path: Path) -> bool:
-    """Whether a JSON file means to be intrinsics (names 'intrinsic_matrix', or is named
-    for a camera or its intrinsics and is no JSON at all: one cut short): other JSON
-    files of a folder are not read as intrinsics; a malformed intrinsics file is an
-    error."""
-    try:
-        text = path.read_text(errors="replace")
-    except OSError as e:
-        raise SgtoolError(f"{path}: cannot read ({e.strerror})") from e
-    if "intrinsic_matrix" in text:
-        return True
-    if any(w in path.name.lower() for w in ("intrinsic", "camera")):
-        try:
-            json.loads(text)
-        except ValueError:
-            return True
-    return False
-
-
 def _depth_images(folder: Path, notes: list[str]) -> list[Path]:
     """The depth images of ``folder``: those of its most common lossless image type (JPEG
     never holds depth: previews beside PNG depth are no frames, however many), the others
@@ -544,7 +528,8 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
                 f"{root}: several trajectories ({', '.join(p.name for p in logs)}); "
                 "choose one with --trajectory"
             )
-    if traj is None and (root / "groundtruth.txt").is_file():
+    per_frame = pose_folder(root) if traj is None else None
+    if traj is None and per_frame is None and (root / "groundtruth.txt").is_file():
         notes.append("groundtruth.txt not read: a folder of depth/ and colour folders is read "
                      "as the open3d layout (poses from a *.log trajectory, image times from "
                      "their order); a TUM folder lists its images in rgb.txt and depth.txt")
@@ -564,11 +549,13 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
             notes.append(f"--skip-missing: {len(unpaired)} colour image(s) without a depth "
                          "image left out with their poses (first: "
                          f"{by_stem[unpaired[0]].relative_to(root)})")
+    elif per_frame is not None:
+        pairs, poses, lost = posed_pairs(per_frame, pairs, keep_unposed, notes)
     else:
         read = trajectory_poses(traj, len(pairs), hint, shorter=True) \
             if traj is not None else None
         poses = None if read is None else list(read)
-    dropped = 0
+    dropped = 0 if per_frame is None else lost
     if poses is not None and len(poses) < len(pairs):  # a reconstruction that stopped early
         assert traj is not None
         late = len(pairs) - len(poses)
@@ -579,9 +566,9 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
             poses = [*poses, *([None] * late)]
         else:
             dropped, pairs = late, pairs[:len(poses)]
-    intr = None
-    for p in sorted(root.glob("*.json")):
-        if _is_intrinsics_json(p):
+    intr = folder_intrinsics(root)
+    for p in sorted(root.glob("*.json")) if intr is None else ():
+        if is_intrinsics_json(p):
             intr = replace(read_intrinsics_file(p), source=f"file {p.name}")
             break
     frames = tuple(

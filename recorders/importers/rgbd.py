@@ -323,6 +323,8 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
             seq.dropped, len(seq.frames) + seq.dropped,
             ("they have no pose.txt, or one of non-finite numbers (untracked)"
              if seq.layout == "7scenes" else
+             "they have no pose file, or one of non-finite numbers (untracked)"
+             if any(n.startswith("poses from pose") for n in seq.notes) else
              f"the {seq.pose_source} of {root.name} does not cover their time"),
             "give --estimate-poses to estimate the poses of all frames, or --allow-drop to "
             "import only the covered ones")

@@ -312,3 +312,22 @@ def trajectory_poses(trajectory: Path | None, count: int, hint: str = "",
                              "order, its times unused (a TUM folder, with rgb.txt and "
                              "depth.txt, pairs them by time)" if timed else ""))
     return poses
+
+
+def is_intrinsics_json(path: Path) -> bool:
+    """Whether a JSON file means to be intrinsics (names 'intrinsic_matrix', or is named
+    for a camera or its intrinsics and is no JSON at all: one cut short): other JSON
+    files of a folder are not read as intrinsics; a malformed intrinsics file is an
+    error."""
+    try:
+        text = path.read_text(errors="replace")
+    except OSError as e:
+        raise SgtoolError(f"{path}: cannot read ({e.strerror})") from e
+    if "intrinsic_matrix" in text:
+        return True
+    if any(w in path.name.lower() for w in ("intrinsic", "camera")):
+        try:
+            json.loads(text)
+        except ValueError:
+            return True
+    return False

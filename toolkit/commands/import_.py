@@ -316,7 +316,8 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None,
               default="auto", show_default=True,
               help="Folder layout: TUM RGB-D (rgb.txt, depth.txt, groundtruth.txt), 7-Scenes "
               "(frame-XXXXXX.color/depth/pose), Open3D/Redwood (color|image/, depth/, "
-              "*.log, intrinsics JSON).")
+              "*.log, intrinsics JSON; or, without a .log, a ScanNet export's pose/NAME.txt "
+              "and intrinsic/intrinsic_depth.txt).")
 @click.option("--fps", type=float, default=30.0, show_default=True,
               help="Frame rate (0.1-1000) for layouts without time stamps (7-Scenes frame n "
               "is at n/fps, Open3D frame i at i/fps) and for --timestamps index; give the "
