@@ -510,7 +510,13 @@ class RayExecutor(_Executor):
         with _sigterm_kept():
             if self.address:
                 check_reachable(self.address, given_as=self.given_as)
-                ray.init(address=self.address, **common)
+                try:
+                    ray.init(address=self.address, **common)
+                except ConnectionError as e:  # something listens there, but no Ray GCS
+                    raise ExecutorError(
+                        f"{self.given_as} {self.address}: no Ray cluster answers there "
+                        f"({str(e).splitlines()[0]}); give the head node's GCS address "
+                        "(`ray start --head` prints it, port 6379 by default)") from None
                 self.workers = max(self.workers, int(ray.cluster_resources().get("CPU", 1)))
             else:
                 ray.init(address="local", num_cpus=self.workers, **common)

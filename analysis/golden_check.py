@@ -518,6 +518,9 @@ def check_pins(folder: str | Path, options: ReplayOptions | None = None, *,
     code (module doc). ``options``: set fields override the pinned options; ``tolerance``
     (m, m², scores): differences up to it pass (0: byte-exact graphs); ``keep``: keep the
     new replay of changed logs for :func:`update_pins`."""
+    from sgtool.arg_checks import number
+
+    number("tolerance", tolerance, 0.0)
     pins = read_pins(folder)
     if not pins.logs:  # a check of nothing would pass a CI job whose pins were lost
         raise PinError(f"{pins.folder}: its index pins no log; pin some with `sgtool golden "

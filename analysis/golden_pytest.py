@@ -149,10 +149,19 @@ class GoldenFixture:
         its name (another path and other bytes) fails, one re-recorded in its place fails as
         ``golden check`` says; both are re-pinned under ``--sgtool-golden-update``. A
         mistake in the call (an unknown option, a damaged pin folder) fails in one line."""
+        import dataclasses
+
         from sgtool.errors import SgtoolError
+        from sgtool.planning.option_fields import nearest
         from sgtool.replayers.derived_log import ReplayOptions
 
-        try:  # a mistake in the call (an unknown option, a damaged pin folder): one line
+        known = [f.name for f in dataclasses.fields(ReplayOptions)]
+        for key in sorted(set(options) - set(known)):  # a misspelt option: the near one
+            near = nearest(key, known)
+            pytest.fail(f"sgtool_golden.check({log}): no replay option {key!r}"
+                        + (f"; did you mean {near!r}?" if near else
+                           f" (the options: {', '.join(known)})"), pytrace=False)
+        try:  # a mistake in the call (a bad value, a damaged pin folder): one line
             given = ReplayOptions(**options) if options else None
         except (SgtoolError, TypeError) as e:
             pytest.fail(f"sgtool_golden.check({log}): {e}", pytrace=False)

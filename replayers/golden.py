@@ -76,10 +76,11 @@ def sequence_digest(graphs: Sequence[str]) -> str:
 
 def replay_graphs(log: str | os.PathLike[str], options: ReplayOptions = REPLAY
                   ) -> list[tuple[Refresh, str]]:
-    """Every refresh of a replay of ``log`` with the canonical JSON of its graph. The
-    default ``options`` are the golden tests' (:data:`REPLAY`: the ``containment`` room
-    classifier the shipped golden logs were pinned with), not ``sgtool replay``'s
-    (``frequency``): pass ``ReplayOptions()`` for the graphs ``replay`` writes."""
+    """Every refresh of a replay of ``log`` with the canonical JSON of its graph, by
+    default with the golden tests' options, not ``replay``'s. Those (:data:`REPLAY`) use
+    the ``containment`` room classifier the shipped golden logs were pinned with, not
+    ``sgtool replay``'s ``frequency``: pass ``ReplayOptions()`` for the graphs ``replay``
+    writes."""
     out: list[tuple[Refresh, str]] = []
 
     def keep(r: Refresh, _s: SceneGraphStream) -> None:

@@ -322,3 +322,24 @@ def test_workers_of_a_driver_killed_outright_leave_and_clean_up(tmp_path):
         time.sleep(0.2)
     assert all(_gone(p) for p in pids)
     assert sorted(p.name for p in out.iterdir()) == ["pid-0", "pid-1"]
+
+
+def test_a_port_that_answers_but_is_no_ray_cluster_is_one_line(tmp_path, monkeypatch):
+    """Something listens (a dashboard port given for the cluster's): Ray's own connection
+    error was a traceback, and `golden check` then exited 1, "changed"."""
+    pytest.importorskip("ray")
+    import ray
+
+    def refuse(*_a, **_k):  # noqa: ANN202 - what Ray raises when no GCS answers
+        raise ConnectionError("Failed to connect to Ray cluster at 127.0.0.1:1\nmore")
+
+    monkeypatch.setattr(ray, "init", refuse)
+    with socket.socket() as s:  # accepts connections, speaks no Ray
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        port = s.getsockname()[1]
+        with pytest.raises(ExecutorError) as e:
+            make_executor("ray", 1, address=f"127.0.0.1:{port}").connect()
+    text = str(e.value)
+    assert "\n" not in text and f"127.0.0.1:{port}: no Ray cluster answers there" in text
+    assert "port 6379" in text

@@ -736,3 +736,13 @@ def test_a_lock_folder_that_is_not_the_user_s_is_one_line(log, tmp_path, capsys,
     assert code == 2 and err.count("\n") == 1 and "Traceback" not in err, err
     assert f"its lock folder {tmp / f'sgtool-pin-locks-{os.getuid()}'} is unusable" in err
     assert "set TMPDIR" in err and not (tmp_path / "g" / "expected.json").exists()
+
+
+@pytest.mark.parametrize("tolerance", [-1, float("nan"), "x"])
+def test_check_pins_refuses_a_tolerance_the_cli_refuses(pinned, tolerance):
+    """From Python a negative or NaN tolerance ran silently (and passed), text made every
+    log a check error; `--tolerance` and `diff_logs` refuse them in one line."""
+    from sgtool.errors import SgtoolError
+
+    with pytest.raises(SgtoolError, match="tolerance"):
+        check_pins(pinned, tolerance=tolerance)

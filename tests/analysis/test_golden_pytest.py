@@ -172,9 +172,10 @@ def test_updates_from_parallel_workers_keep_each_others_pins(tmp_path):
 
 
 def test_fixture_mistakes_and_a_bad_tolerance_are_one_line(tmp_path):
-    lab_test(tmp_path, "HERE / 'run.mcap', HERE / 'pins', voxel=0.08")
+    lab_test(tmp_path, "HERE / 'run.mcap', HERE / 'pins', voxelsize=0.08")
     code, out = pytest_run("test_lab.py", cwd=tmp_path)
-    assert code == 1 and "sgtool_golden.check(" in out and "voxel" in out, out
+    assert code == 1 and "sgtool_golden.check(" in out, out
+    assert "no replay option 'voxelsize'; did you mean 'voxel_size'?" in out, out
     assert "Traceback" not in out and "golden_pytest.py" not in out, out
     code, out = pytest_run("--sgtool-golden", tmp_path / "pins", "--sgtool-golden-tolerance",
                            "nan", cwd=tmp_path)

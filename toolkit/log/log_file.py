@@ -77,6 +77,15 @@ def _footed(tail: bytes) -> bool:
             and int.from_bytes(tail[-_FOOTED + 1:-_FOOTED + 9], "little") == 20)
 
 
+def rerun_problem(path: Path, head: bytes) -> str | None:
+    """The one line for a Rerun recording (its file magic ``RRF0``..``RRF2``: what
+    ``sgtool view -o`` writes) given where an sgtool log is read, else None."""
+    if not head.startswith(b"RRF"):
+        return None
+    return (f"{path} is a Rerun recording (.rrd), not an sgtool log: open it with "
+            f"`rerun {quoted(path)}`, and give sgtool the .mcap log it was made from")
+
+
 def opening_damaged(head: bytes, size: int, tail: bytes) -> bool:
     """Whether a file of ``size`` bytes whose first bytes ``head`` (9 or more) do not
     start with the MCAP magic is an MCAP file with a damaged opening magic: it ends with a
@@ -84,7 +93,8 @@ def opening_damaged(head: bytes, size: int, tail: bytes) -> bool:
     header record follows the opening, or the opening is off by a few bytes (not any other
     file, such as a text file that happens to end with the magic bytes)."""
     near = len(head) >= 8 and sum(a != b for a, b in zip(head[:8], MAGIC, strict=True)) <= 3
-    return size >= 17 and (near or _footed(tail) or head[8:9] == b"\x01")
+    return size >= 17 and not head.startswith(b"RRF") and (
+        near or _footed(tail) or head[8:9] == b"\x01")
 
 
 def magic_problem(path: Path) -> tuple[int, str | None]:
@@ -94,6 +104,9 @@ def magic_problem(path: Path) -> tuple[int, str | None]:
     head, size, tail = file_ends(path)
     opening = head[:8]
     if opening != MAGIC:
+        rerun = rerun_problem(path, head)
+        if rerun is not None:
+            return size, rerun
         return size, (f"{path}: not an MCAP file (it does not start with the MCAP magic bytes)"
                       if not opening_damaged(head, size, tail) else
                       f"{path}: its opening MCAP magic bytes are damaged (the rest reads as "

@@ -37,7 +37,13 @@ from sgtool.files import atomic_open
 from sgtool.log import schemas as S
 from sgtool.log.file_check import SummaryState, check, expected_messages, summary_state
 from sgtool.log.file_walk import Item, Layout, data_crc_matches, walk
-from sgtool.log.log_file import appended_end, file_ends, opening_damaged, require_regular_file
+from sgtool.log.log_file import (
+    appended_end,
+    file_ends,
+    opening_damaged,
+    require_regular_file,
+    rerun_problem,
+)
 from sgtool.log.mcap_records import MAGIC
 from sgtool.log.message_check import message_problem
 from sgtool.output_check import check_log_output
@@ -195,6 +201,9 @@ def _require_magic(p: Path) -> str | None:
     head, size, tail = file_ends(p)
     if head[:8] == MAGIC:
         return None
+    rerun = rerun_problem(p, head)
+    if rerun is not None:
+        raise LogFormatError(rerun)
     if opening_damaged(head, size, tail):
         return (f"the opening magic bytes are damaged ({head[:8].hex(' ')} instead of "
                 f"{MAGIC.hex(' ')})")
