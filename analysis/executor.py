@@ -465,12 +465,29 @@ def check_reachable(address: str, timeout_s: float = 3.0, given_as: str = "--ray
         raise ExecutorError(f"{given_as} {address!r}: give HOST:PORT (the head node's "
                             "GCS address, e.g. 10.0.0.5:6379) or ray://HOST:PORT")
     try:
-        with socket.create_connection((host, int(port)), timeout=timeout_s):
-            pass
+        with socket.create_connection((host, int(port)), timeout=timeout_s) as s:
+            web = _speaks_http1(s, timeout_s)
     except OSError as e:
         raise ExecutorError(f"Ray cluster at {address} is not reachable ({e.strerror or e}); "
                             "start one with `ray start --head` there, or leave out "
                             "--ray-address and RAY_ADDRESS to start a local Ray") from None
+    if web:
+        raise ExecutorError(f"{given_as} {address}: a web server answers there, not a Ray "
+                            "cluster (whose GCS speaks gRPC; Ray's dashboard is the web "
+                            "server, port 8265 by default); give the head node's GCS address "
+                            "(`ray start --head` prints it, port 6379 by default)")
+
+
+def _speaks_http1(s: socket.socket, timeout_s: float) -> bool:
+    """Whether the server on ``s`` answers a plain HTTP/1.0 request as a web server does
+    (a Ray GCS, gRPC over HTTP/2, answers with binary frames or not at all; Ray's
+    ``ray.init`` at a web server waited minutes and ignored SIGTERM)."""
+    try:
+        s.settimeout(min(timeout_s, 2.0))
+        s.sendall(b"GET / HTTP/1.0\r\n\r\n")
+        return s.recv(5) == b"HTTP/"
+    except OSError:
+        return False
 
 
 @contextlib.contextmanager

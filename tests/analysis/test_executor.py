@@ -343,3 +343,25 @@ def test_a_port_that_answers_but_is_no_ray_cluster_is_one_line(tmp_path, monkeyp
     text = str(e.value)
     assert "\n" not in text and f"127.0.0.1:{port}: no Ray cluster answers there" in text
     assert "port 6379" in text
+
+
+def test_a_web_server_given_as_the_ray_address_is_one_line_and_quick(tmp_path):
+    """Ray's dashboard port (a web server) given for the cluster's: `ray.init` waited for
+    minutes there and ignored SIGTERM; the reachability check now knows a web server."""
+    import http.server
+    import threading
+
+    server = http.server.HTTPServer(("127.0.0.1", 0), http.server.SimpleHTTPRequestHandler)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    try:
+        port = server.server_address[1]
+        with pytest.raises(ExecutorError) as e:
+            check_reachable(f"127.0.0.1:{port}")
+    finally:
+        server.shutdown()
+    text = str(e.value)
+    assert "\n" not in text and "a web server answers there, not a Ray cluster" in text
+    with socket.socket() as s:  # a server that says nothing (a GCS waiting for gRPC) passes
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        check_reachable(f"127.0.0.1:{s.getsockname()[1]}", timeout_s=0.5)
