@@ -66,7 +66,11 @@ def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
     minus the opening's (at least ``LINE_LEAST``, ``LINE_MARGIN`` ahead of every
     alternative). When neither finds one, both are asked again with the far jamb 1.0
     wherever a wall crosses the doorway's line at its far end (:func:`_crossing_walls`: a
-    door at a room's corner; the doorway then ends there). Otherwise None (the caller then
+    door at a room's corner; the doorway then ends there). When still none and ``free`` is
+    given, all of it again with the opening's cells not seen free counted as closed (a
+    doorway is floor seen free; a free end stopping short of a counter, which reads as a
+    wall line, "opens" over floor behind the panel that no frame saw). Otherwise None (the
+    caller then
     uses the panel's own cells), as for cells that are not one panel at least ``min_width``
     cells long. ``free`` (bool, the shape of ``occupied``; None: no cell known free) is the
     grid's cells seen free; ``memo`` caches answers by panel and surroundings."""
@@ -160,6 +164,11 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
             if h is not None:
                 crossed[3 * i + 2] = 1.0
         best = _best_place(crossed, places, reach)
+        if best is None and free is not None:  # unseen cells are no opening (doc)
+            unseen = ray_shares(rays, ~free, grown, origin)
+            for i in range(len(places)):
+                crossed[3 * i + 1] = unseen[3 * i + 1]
+            best = _best_place(crossed, places, reach)
     if best is None:
         return None
     _, s_end, sign, off, out = best
