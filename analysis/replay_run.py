@@ -165,8 +165,8 @@ def _score(spec: Any, final: dict[str, Any], log: Any) -> tuple[Any, Any]:
     ref, stream = final["refresh"], final["stream"]
     if ref.layers is None:
         raise SgtoolError("the last refresh has no map layers to score")
-    with LogReader(log) as reader:
-        align = truth_alignment(reader)
+    with LogReader(log) as reader:  # the poses of the frames replayed (--max-frames)
+        align = truth_alignment(reader, ref.time_ns)
     return score(spec, stream.builder.instances, ref.layers, ref.graph,
                  stream.builder.trajectory, align), align
 

@@ -246,8 +246,9 @@ def capture(log: str | os.PathLike[str], options: ReplayOptions, *,
 
         with LogReader(log) as reader:
             house = reader.house_json()
-            align = truth_alignment(reader) if house is not None else None
-        ref = last.get("refresh")
+            ref = last.get("refresh")
+            align = truth_alignment(reader, None if ref is None else ref.time_ns) \
+                if house is not None else None
         if house is not None and ref is not None and ref.layers is not None:
             from sgtool.house.io import load_house
 

@@ -66,10 +66,12 @@ class TruthAlignment:
                 f"over {self.frames} frames, {self.rms_m:.3f} m RMS left")
 
 
-def truth_alignment(reader: Any) -> TruthAlignment | None:
+def truth_alignment(reader: Any, until_ns: int | None = None) -> TruthAlignment | None:
     """The :class:`TruthAlignment` of a log whose ``/tf`` holds the true base pose
     (``world -> base_truth``, written by a simulated recording with pose drift) beside the
-    logged one (``world -> base``) at the same times; None for a log without it."""
+    logged one (``world -> base``) at the same times; None for a log without it.
+    ``until_ns``: only the poses up to this log time (the last frame a replay stopped at
+    with ``max_frames``: the map holds only those)."""
     base: dict[int, np.ndarray] = {}
     truth: dict[int, np.ndarray] = {}
     if not reader.has(S.TF):
@@ -81,7 +83,7 @@ def truth_alignment(reader: Any) -> TruthAlignment | None:
         if child in (S.BASE_FRAME, S.TRUE_BASE_FRAME):
             (base if child == S.BASE_FRAME else truth)[m.log_time_ns] = \
                 decode_transform(m.message)
-    times = sorted(set(base) & set(truth))
+    times = sorted(t for t in set(base) & set(truth) if until_ns is None or t <= until_ns)
     if not times:
         return None
     src = [base[t] for t in times]

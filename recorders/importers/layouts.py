@@ -549,7 +549,8 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
             notes.append(f"--skip-missing: {len(unpaired)} colour image(s) without a depth "
                          "image left out with their poses (first: "
                          f"{by_stem[unpaired[0]].relative_to(root)})")
-    elif per_frame is not None:
+    elif per_frame is not None:  # frame i stays at i/fps when frames before it are left out
+        slot = {d: i for i, (d, _) in enumerate(pairs)}
         pairs, poses, lost = posed_pairs(per_frame, pairs, keep_unposed, notes)
     else:
         read = trajectory_poses(traj, len(pairs), hint, shorter=True) \
@@ -572,7 +573,8 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
             intr = replace(read_intrinsics_file(p), source=f"file {p.name}")
             break
     frames = tuple(
-        FolderFrame(round(i * 1e9 / fps), d, c, poses[i] if poses is not None else None)
+        FolderFrame(round((i if per_frame is None else slot[d]) * 1e9 / fps), d, c,
+                    poses[i] if poses is not None else None)
         for i, (d, c) in enumerate(pairs)
     )
     return FolderSequence(

@@ -40,6 +40,8 @@ def _matrix(path: Path) -> np.ndarray:
     except OSError as e:
         raise SgtoolError(f"{path}: cannot read ({e.strerror})") from None
     data = "\n".join(line.split("#", 1)[0] for line in text.splitlines())
+    if not data.strip():  # an empty file (an export cut short): no numbers, no numpy warning
+        return np.empty((0, 0))
     try:
         m = np.loadtxt(io.StringIO(data), dtype=np.float64, ndmin=2,
                        delimiter="," if "," in data else None)
@@ -71,10 +73,17 @@ def read_pose(path: Path) -> np.ndarray | None:
 def read_pose_folder(folder: Path, names: list[str]) -> list[np.ndarray | None]:
     """The pose of each frame named in ``names`` (the depth images' stems): that of
     ``folder/NAME.txt``, None where it is missing or not finite."""
+    files = {p.stem: p for p in folder.iterdir() if p.suffix.lower() == ".txt"}
+    by_number = {int(k): p for k, p in files.items() if k.isdigit()}  # 000012.txt for 12.png
     out: list[np.ndarray | None] = []
     for name in names:
-        path = folder / f"{name}.txt"
-        out.append(read_pose(path) if path.is_file() else None)
+        path = files.get(name) or (by_number.get(int(name)) if name.isdigit() else None)
+        out.append(read_pose(path) if path is not None and path.is_file() else None)
+    if names and files and all(p is None for p in out) and not any(
+            n in files or (n.isdigit() and int(n) in by_number) for n in names):
+        raise SgtoolError(f"{folder}: none of its {len(files)} pose files is named for a depth "
+                          f"image (depth {names[0]}.* wants {folder.name}/{names[0]}.txt; "
+                          f"it has {sorted(files)[0]}.txt)")
     return out
 
 
@@ -110,5 +119,8 @@ def posed_pairs(folder: Path, pairs: list[tuple[Path, Path | None]], keep_unpose
                  f"(first: {lost[0].name})" + ("" if keep_unposed else ": left out"))
     if keep_unposed:
         return pairs, poses, 0
+    if len(lost) == len(pairs):
+        raise SgtoolError(f"{folder}: none of the {len(pairs)} frames has a finite pose "
+                          "(give --estimate-poses to estimate them from the depth)")
     kept = [(pair, p) for pair, p in zip(pairs, poses, strict=True) if p is not None]
     return [k for k, _ in kept], [p for _, p in kept], len(lost)

@@ -154,3 +154,20 @@ def test_a_drifted_recording_logs_its_true_poses(tmp_path):
                              for t in base]))
     assert raw > 0.0
     assert align.rms_m <= raw
+
+
+def test_a_replay_cut_short_is_aligned_by_the_poses_it_replayed(tmp_path):
+    """--max-frames: the map holds the first frames only, so the fit takes their poses
+    only (the later, more drifted ones carried the early map off the house)."""
+    from click.testing import CliRunner
+
+    from sgtool.cli import cli
+
+    log = tmp_path / "d.mcap"
+    r = CliRunner().invoke(cli, ["record", "--seed", "3", "--rooms", "4-4", "--resolution",
+                                 "32x24", "--fps", "2", "--frames", "60", "--noise",
+                                 "drift_xy=0.2,drift_yaw=0.2", "--quiet", "-o", str(log)])
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(cli, ["replay", str(log), "--score", "--max-frames", "20"])
+    assert r.exit_code == 0, r.output
+    assert "a rigid fit over 20 frames" in r.output

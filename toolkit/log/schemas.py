@@ -106,13 +106,16 @@ def _viewable(node: Any) -> Any:
         t = next((x for x in t if x != "null"), "null")
     if t is None and "enum" in node:
         kinds = {type(v) for v in node["enum"] if v is not None}
-        t = "string" if kinds <= {str} else "number"
+        t = "string" if kinds <= {str} else "boolean" if kinds <= {bool} else "number"
     if t is not None:
         out["type"] = t
     if t == "object":
         out.setdefault("properties", {})
     if t == "array":
         out.setdefault("items", {"type": "object", "properties": {}})
+        if out["items"].get("type") not in ("boolean", "string", "number", "integer",
+                                            "object"):  # Foxglove throws on arrays of arrays
+            out["items"] = {"type": "object", "properties": {}}
     return out
 
 

@@ -108,3 +108,25 @@ def test_a_log_trajectory_comes_first(tmp_path):
     (root / "trajectory.log").write_text("\n".join(lines) + "\n")
     seq = read_sequence(root)
     assert np.allclose(seq.frames[2].pose, moved[2])
+
+
+def test_a_frame_left_out_keeps_the_times_of_the_frames_after_it(tmp_path):
+    """Frame i of the folder is at i/fps whether or not frames before it have a pose (as
+    7-Scenes frame n is at n/fps): leaving out a lost frame does not pull the later ones
+    earlier."""
+    scannet_folder(tmp_path / "scene", n=12, lost=(3,))
+    seq = read_sequence(tmp_path / "scene", fps=10.0)
+    assert [round(f.time_ns / 1e8) for f in seq.frames] == [0, 1, 2, *range(4, 12)]
+
+
+def test_zero_padded_pose_names_pair_with_plain_depth_names(tmp_path):
+    root = tmp_path / "scene"
+    poses = scannet_folder(root, n=3)
+    for i in range(3):
+        (root / "pose" / f"{i}.txt").rename(root / "pose" / f"{i:06d}.txt")
+    seq = read_sequence(root)
+    assert len(seq.frames) == 3 and np.allclose(seq.frames[2].pose, poses[2])
+    for i in range(3):
+        (root / "pose" / f"{i:06d}.txt").rename(root / "pose" / f"frame-{i}.txt")
+    r = imported(root, tmp_path / "s.mcap")
+    assert r.exit_code == 2 and "none of its 3 pose files is named for a depth image" in r.output

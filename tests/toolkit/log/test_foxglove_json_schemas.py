@@ -54,3 +54,16 @@ def test_the_written_form_keeps_the_full_schema_for_checks() -> None:
     assert item["items"]["properties"]["kind"]["type"] == "string"
     assert item["items"]["properties"]["kind"]["enum"] == ["object", "furniture", "door",
                                                           "structure"]
+
+
+def test_arrays_of_arrays_and_boolean_enums_are_written_as_foxglove_takes_them() -> None:
+    """No record has them yet; a record that gets one must not take its channel down."""
+    kind = S.RecordKind("probe", "sgtool.Probe", "1.0", "/sgtool/probe", {
+        "type": "object",
+        "properties": {"polygon": {"type": "array",
+                                   "items": {"type": "array", "items": {"type": "number"}}},
+                       "flag": {"enum": [True, False, None]}},
+        "required": []})
+    written = json.loads(kind.schema_bytes())
+    assert sorted(foxglove_fields(written, "")) == [".flag", ".polygon"]
+    assert written["properties"]["flag"]["type"] == "boolean"
