@@ -86,12 +86,11 @@ import dataclasses
 import math
 import os
 import time
-from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 from sgtool.arg_checks import function, of_type
-from sgtool.canonical import canonical_float
 from sgtool.datasets.episodes import Episode
 from sgtool.datasets.episodes import list_episodes as list_episodes  # (imported from here)
 from sgtool.datasets.episodes import pick_episode as pick_episode  # (its home before)
@@ -120,7 +119,12 @@ from sgtool.recorders.sim.closed_loop_options import (  # noqa: F401 (re-exporte
     ClosedLoopOptions,
 )
 from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport, episode_notes
-from sgtool.recorders.sim.episode_extras import recorded_options, started_extra, success_rule
+from sgtool.recorders.sim.episode_extras import (
+    recorded_options,
+    shown_distances,
+    started_extra,
+    success_rule,
+)
 from sgtool.recorders.sim.execution import Executed, execute_live, execute_privileged
 from sgtool.recorders.sim.fallback_explore import (
     GAVE_UP,
@@ -132,7 +136,9 @@ from sgtool.recorders.sim.live_recorder import LiveRecorder
 from sgtool.recorders.sim.live_skills import IN_VIEW, LiveSkills, RobotBody, camera_sight
 from sgtool.recorders.sim.reachability import (
     FAILED_BEFORE,
+    UNREACHABLE,
     FailedGoals,
+    give_up_handed_over,
     not_seen_into,
     reachable_view,
     without_nodes,
@@ -155,14 +161,6 @@ from sgtool.scenegraph.stream import Refresh, SceneGraphStream
 # ----------------------------------------------------------------------------------------
 # one episode
 # ----------------------------------------------------------------------------------------
-def give_up_handed_over(offered: Iterable[str], failed: Collection[str]) -> bool:
-    """Whether a planner's give-up goes to the robot's own exploration (module doc): every
-    goal on offer when it gave up (``offered``) had failed before in the episode
-    (``failed``), so the give-up is the map's, not the planner's choice; otherwise done()
-    ends the episode."""
-    return all(n in failed for n in offered)
-
-
 class _Search:
     """The closed loop as a :class:`~sgtool.planning.episode.SearchEnvironment` and its
     :class:`~sgtool.planning.episode.SearchRecorder`: the graph in force is observed, an
@@ -263,7 +261,7 @@ class _Search:
             self.withheld[why] = self.withheld.get(why, 0) + 1
         self._graph_time_ns = int(cur.time_ns)
         graph = graph.canonical()  # as a replay of the log will show it
-        self._shown = _shown(graph, cur.graph)
+        self._shown = shown_distances(graph, cur.graph)
         self._seen = graph
         return graph
 
@@ -316,8 +314,9 @@ class _Search:
         plan = plan_skills(cur.graph, action)
         cut = False
         o: Outcome
-        if plan.done and action.target is None and self.fallback is not None and \
-                self._all_failed(self._seen) and self.fallback.can_explore():
+        if plan.done and action.target is None and self.fallback is not None and (
+                self._all_failed(self._seen) or self._forgot_withholding_marks()) and \
+                self.fallback.can_explore():
             return self._give_up_handed_over(action, self._seen or cur.graph)
         if plan.done:
             o, why, dist, ticks = "success", DONE_MESSAGE, 0.0, 0
@@ -384,7 +383,7 @@ class _Search:
             self.last_t = self.rec.act(
                 self.sim, SkillOutcome("explore", action.target, ex.outcome, why,
                                        ex.travelled_m, ex.ticks), dt,
-                {"graph_time_ns": int(cur.time_ns), **_shown(only, cur.graph)})
+                {"graph_time_ns": int(cur.time_ns), **shown_distances(only, cur.graph)})
             self.agent.feedback(Feedback(action, ex.outcome, ex.reason, ex.travelled_m))
             if ex.outcome == "failure":
                 self._failed_ever.add(str(action.target))
@@ -397,6 +396,16 @@ class _Search:
             assert now is not None
             graph = self._view(now)
         return graph
+
+    def _forgot_withholding_marks(self) -> bool:
+        """Whether bump marks stood while the last view withheld goals as unreachable (a
+        give-up then is the marks', not the planner's): they are dropped, as at
+        :meth:`observe`, and the give-up goes to the robot's own exploration."""
+        if self.skills is None or UNREACHABLE not in self._withheld_now.values() or \
+                not self.skills.forget_bumps():
+            return False
+        self.forgot_bumps += 1
+        return True
 
     def _all_failed(self, graph: SceneGraph | None) -> bool:
         """:func:`give_up_handed_over` of the planner's last view."""
@@ -575,15 +584,6 @@ def _log_exchanges(agent: Any, writer: LogWriter, t_ns: int) -> list[dict[str, A
     for ex in done:
         writer.write_record(LlmExchange.from_json(ex), t_ns)
     return done
-
-
-def _shown(view: SceneGraph, logged: SceneGraph) -> dict[str, Any]:
-    """``{"view_distances": ...}`` when the planner was shown ``view`` with other distances
-    than the ``logged`` graph's (the Action record's field: an offline replay shows a planner
-    the same graph); empty when they are the same."""
-    if view.distances == {k: canonical_float(v) for k, v in logged.distances.items()}:
-        return {}
-    return {"view_distances": dict(view.distances)}
 
 
 def _withheld(search: _Search) -> dict[str, Any]:

@@ -9,12 +9,14 @@ from __future__ import annotations
 from dataclasses import asdict
 from typing import Any
 
+from sgtool.canonical import canonical_float
 from sgtool.datasets.episodes import Episode
 from sgtool.planning.episode import planner_seed
 from sgtool.recorders.sim.closed_loop_options import ClosedLoopOptions
 from sgtool.recorders.sim.simulation import Simulation
 from sgtool.redact import recorded_options  # noqa: F401 (re-exported)
 from sgtool.scenegraph.build_options import ResolvedOptions, mapping_record
+from sgtool.scenegraph.graph import SceneGraph
 
 
 def started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOptions,
@@ -49,3 +51,12 @@ def success_rule(opts: ClosedLoopOptions) -> dict[str, str]:
     """``{"success": "done"}`` under MoMa-LLM's rule; nothing under the default (logs of
     the default rule stay as they were)."""
     return {} if opts.success == "observed" else {"success": opts.success}
+
+
+def shown_distances(view: SceneGraph, logged: SceneGraph) -> dict[str, Any]:
+    """``{"view_distances": ...}`` when the planner was shown ``view`` with other distances
+    than the ``logged`` graph's (the Action record's field: an offline replay shows a planner
+    the same graph); empty when they are the same."""
+    if view.distances == {k: canonical_float(v) for k, v in logged.distances.items()}:
+        return {}
+    return {"view_distances": dict(view.distances)}

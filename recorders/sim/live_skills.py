@@ -261,6 +261,9 @@ class LiveSkills:
         self.replans = 0  # plans made (for reports)
         self.contacts = 0
         self.bumps: list[tuple[float, float]] = []  # where the base touched something
+        # marks of a way that failed a skill on contacts (held: the unseal rule keeps them
+        # unless they wall the robot in)
+        self.held: list[tuple[float, float]] = []
         # where a look-around turned toward all the unknown it could (module doc), in order
         self.looked: list[tuple[float, float]] = []
         # asked at every refresh during a skill: True ends the skill (module doc)
@@ -282,7 +285,7 @@ class LiveSkills:
     def live_map(self, refresh: Refresh) -> OccupancyMap | None:
         if refresh.layers is None:
             return None
-        bumps = np.array(self.bumps, dtype=np.float64).reshape(-1, 2)
+        bumps = np.array(self.held + self.bumps, dtype=np.float64).reshape(-1, 2)
         return traversable(refresh.layers.occupancy, self.body.config.radius,
                            self.config.optimistic, bumps)
 
@@ -291,12 +294,13 @@ class LiveSkills:
         the robot stands (None: no map). Kept for the last (refresh, pose, bumps), so the
         reachability check of a decision and the skill's first plan share one Dijkstra
         run; the arrays are shared: read them, never change them."""
-        key = (refresh.index, id(refresh), self.body.base[:2], len(self.bumps))
+        key = (refresh.index, id(refresh), self.body.base[:2], len(self.bumps),
+               len(self.held))
         if self._planned is not None and self._planned[0] == key:
             return self._planned[1]
         occ = self.live_map(refresh)
         out = None if occ is None else (occ, geodesic_distances(occ, key[2]))
-        if out is not None and self.bumps and self.config.sealed_m2 > 0:
+        if out is not None and (self.bumps or self.held) and self.config.sealed_m2 > 0:
             out, key = self._unsealed(refresh, out, key)
         self._planned = (key, out)
         return out
@@ -320,23 +324,41 @@ class LiveSkills:
                 (floor - cells) * cell_m2 > self.config.sealed_m2
 
         if not sealed(planned[1]):
-            return planned, key
+            return self._unheld(refresh, planned, key)
         for k in range(1, len(kept) + 1):
             self.bumps = kept[k:]
             occ = self.live_map(refresh)
             assert occ is not None
             free = (occ, geodesic_distances(occ, key[2]))
             if not sealed(free[1]):
-                return free, (*key[:3], len(self.bumps))
+                return self._unheld(refresh, free, (*key[:3], len(self.bumps), len(self.held)))
         raise AssertionError("the map without bump marks walls nothing off")  # k = len
+
+    def _unheld(self, refresh: Refresh, planned: tuple[OccupancyMap, np.ndarray],
+                key: tuple) -> tuple[tuple[OccupancyMap, np.ndarray], tuple]:
+        """``planned`` unless the held marks wall the robot in (less than ``sealed_m2``
+        of floor while the map without any mark leaves more): then every mark is dropped."""
+        if not self.held:
+            return planned, key
+        held, bumps = self.held, self.bumps
+        self.held, self.bumps = [], []
+        bare = self.live_map(refresh)
+        assert bare is not None
+        cell_m2 = bare.resolution ** 2
+        floor = int(np.count_nonzero(np.isfinite(geodesic_distances(bare, key[2]))))
+        cells = int(np.count_nonzero(np.isfinite(planned[1])))
+        if cells * cell_m2 < self.config.sealed_m2 < floor * cell_m2:
+            return (bare, geodesic_distances(bare, key[2])), (*key[:3], 0, 0)
+        self.held, self.bumps = held, bumps
+        return planned, key
 
     def forget_bumps(self) -> int:
         """Drop every bump mark (the closed loop calls this when its view of the graph
         offers the planner nothing: marks at a door frame can wall off every goal while
         leaving the robot more than ``sealed_m2``); the number dropped."""
-        n = len(self.bumps)
+        n = len(self.bumps) + len(self.held)
         if n:
-            self.bumps = []
+            self.bumps, self.held = [], []
             self._planned = None
         return n
 
@@ -393,6 +415,7 @@ class LiveSkills:
                     self.contacts += 1
                     self.bumps.append(_bumped(body.base, p, body.config.radius))
                     if contacts > cfg.max_contacts:
+                        self.held.append(self.bumps.pop())  # the way is really blocked
                         return ("failure", f"{goal.label}: the way is blocked by an obstacle "
                                 "the robot's map does not show", driven)
                     arrived = False

@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Iterable
+from collections.abc import Collection, Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -254,3 +254,11 @@ def not_seen_into(refresh: Refresh | None, target: str | None) -> bool:
         return False
     node = next((n for n in refresh.graph.objects if n.id == target), None)
     return node is not None and EXAMINE in node.affordances and not node.explored
+
+
+def give_up_handed_over(offered: Iterable[str], failed: Collection[str]) -> bool:
+    """Whether a planner's give-up goes to the robot's own exploration (the closed loop's
+    module doc): every goal on offer when it gave up (``offered``) had failed before in
+    the episode (``failed``), so the give-up is the map's, not the planner's choice;
+    otherwise done() ends the episode."""
+    return all(n in failed for n in offered)

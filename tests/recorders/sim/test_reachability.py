@@ -311,3 +311,32 @@ def test_a_navigate_that_did_not_see_into_its_piece_counts_as_failed() -> None:
     assert not not_seen_into(refresh(False, ("container", "examine")), "obj:8")
     assert not not_seen_into(None, "obj:7") and not not_seen_into(
         refresh(False, ("examine",)), None)
+
+
+def test_marks_of_a_way_that_failed_on_contacts_are_held() -> None:
+    """A skill that ends on repeated contacts holds its last mark: the way is really
+    blocked. Before, the cut-off rule dropped it again at once (it walled off the floor
+    past a passage), the next plan was the same path, and a wedged robot spent up to 27
+    steps of an episode failing from the same place (a helper's bayes-search episode).
+    A held mark stays where a plain one goes; if held marks wall the robot in, they go."""
+    occ, _ = _map()  # the wall at x = 3 m has a 0.6 m gap at y = 1.8..2.4 m
+    ref = SimpleNamespace(index=4, layers=SimpleNamespace(occupancy=occ.grid))
+    gap = [(3.05, 1.95), (3.05, 2.25)]
+    for held in (False, True):
+        skills = LiveSkills(_Body((1.0, 2.0, 0.0), RobotConfig()), lambda: None,
+                            LiveNavConfig(sealed_m2=2.0))
+        (skills.held if held else skills.bumps).extend(gap)
+        planned = skills.plan_map(ref)
+        assert planned is not None
+        _, d = planned
+        assert np.isfinite(d[20, 40]) != held  # (4.05, 2.05): past the wall
+        assert (skills.held, skills.bumps) == ((gap, []) if held else ([], [gap[1]]))
+    ring = [(1.0 + 0.4 * math.cos(a), 2.0 + 0.4 * math.sin(a))
+            for a in np.linspace(0.0, 2.0 * math.pi, 12, endpoint=False)]
+    skills = LiveSkills(_Body((1.0, 2.0, 0.0), RobotConfig()), lambda: None)
+    skills.held.extend(ring)  # held marks ringing the robot in: all dropped
+    planned = skills.plan_map(ref)
+    assert planned is not None and np.isfinite(planned[1][20, 40])
+    assert skills.held == [] and skills.bumps == []
+    skills.held.append((2.0, 3.0))
+    assert skills.forget_bumps() == 1 and skills.held == []
