@@ -33,10 +33,13 @@ motion (:meth:`Simulation.drive`, which stops at a contact) and manipulation.
   ahead of the move, so scraping a corner of a narrow passage marks the passage itself,
   and everything past it would stay unreachable for the rest of the episode), the
   oldest are dropped until neither holds. A way that is really blocked costs a skill its
-  ``max_contacts`` again, and that goal is held back; ``sealed_m2`` = 0 turns the rule
-  off. When the marks wall off every goal of the graph while leaving more floor than
-  that (a room whose only open door frame the robot brushed), the closed loop drops them
-  all (:meth:`LiveSkills.forget_bumps`).
+  ``max_contacts`` again, and that goal is held back; the last mark of a skill that
+  ended so is *held*: the cut-off rule keeps it (the robot would otherwise plan the same
+  blocked way for every goal) until the robot is ``HOLD_M`` from where it was held, unless
+  it walls the robot in; ``sealed_m2`` = 0 turns the rule off. When the marks wall off
+  every goal of the graph while leaving more floor than that (a room whose only open door
+  frame the robot brushed), the closed loop drops them all
+  (:meth:`LiveSkills.forget_bumps`).
 - **Looking around** (:meth:`LiveSkills.look_around`) turns only toward unknown space
   near the robot on its own map (:func:`~sgtool.recorders.sim.motion.sweep`), the shorter
   way, and stops when a refresh during the turn shows no cell known that was not before.
@@ -115,6 +118,7 @@ if TYPE_CHECKING:
 
 
 IN_VIEW = "the target came into view"
+HOLD_M = 1.0  # m from where a way failed on contacts beyond which its held marks go
 
 
 class PrivilegedAccess(SgtoolError):
@@ -261,9 +265,8 @@ class LiveSkills:
         self.replans = 0  # plans made (for reports)
         self.contacts = 0
         self.bumps: list[tuple[float, float]] = []  # where the base touched something
-        # marks of a way that failed a skill on contacts (held: the unseal rule keeps them
-        # unless they wall the robot in)
-        self.held: list[tuple[float, float]] = []
+        self.held: list[tuple[float, float]] = []  # held marks (module doc)
+        self.held_from: tuple[float, float] | None = None
         # where a look-around turned toward all the unknown it could (module doc), in order
         self.looked: list[tuple[float, float]] = []
         # asked at every refresh during a skill: True ends the skill (module doc)
@@ -294,6 +297,8 @@ class LiveSkills:
         the robot stands (None: no map). Kept for the last (refresh, pose, bumps), so the
         reachability check of a decision and the skill's first plan share one Dijkstra
         run; the arrays are shared: read them, never change them."""
+        if self.held_from is not None and math.dist(self.body.base[:2], self.held_from) > HOLD_M:
+            self.held, self.held_from = [], None  # elsewhere: that way may be tried again
         key = (refresh.index, id(refresh), self.body.base[:2], len(self.bumps),
                len(self.held))
         if self._planned is not None and self._planned[0] == key:
@@ -416,6 +421,7 @@ class LiveSkills:
                     self.bumps.append(_bumped(body.base, p, body.config.radius))
                     if contacts > cfg.max_contacts:
                         self.held.append(self.bumps.pop())  # the way is really blocked
+                        self.held_from = (float(body.base[0]), float(body.base[1]))
                         return ("failure", f"{goal.label}: the way is blocked by an obstacle "
                                 "the robot's map does not show", driven)
                     arrived = False

@@ -30,7 +30,7 @@ from sgtool.planning.candidates import actionable
 from sgtool.recorders.sim import CameraConfig
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, run_episode
 from sgtool.recorders.sim.live_goals import Goal
-from sgtool.recorders.sim.live_skills import LiveNavConfig, LiveSkills
+from sgtool.recorders.sim.live_skills import HOLD_M, LiveNavConfig, LiveSkills
 from sgtool.recorders.sim.navigation import RobotConfig
 from sgtool.recorders.sim.reachability import (
     LOOKED,
@@ -340,3 +340,13 @@ def test_marks_of_a_way_that_failed_on_contacts_are_held() -> None:
     assert skills.held == [] and skills.bumps == []
     skills.held.append((2.0, 3.0))
     assert skills.forget_bumps() == 1 and skills.held == []
+    # held only near where the way failed: 1 m (HOLD_M) away it may be tried again
+    body = _Body((1.0, 2.0, 0.0), RobotConfig())
+    skills = LiveSkills(body, lambda: None, LiveNavConfig(sealed_m2=2.0))
+    skills.held.extend(gap)
+    skills.held_from = (1.0, 2.0)
+    skills.plan_map(ref)
+    assert skills.held == gap
+    body.base = (1.0 + HOLD_M + 0.1, 2.0, 0.0)
+    planned = skills.plan_map(ref)
+    assert skills.held == [] and planned is not None and np.isfinite(planned[1][20, 40])
