@@ -162,6 +162,7 @@ def test_ctrl_c_while_update_writes_leaves_the_pin_folder_whole(pinned, capsys,
     """Ctrl-C arriving after a graph file is rewritten and before the index (the moment
     that left them out of step): the update finishes its files first, then stops, so the
     folder checks against its index."""
+    import os
     import signal
 
     import sgtool.analysis.golden_check as gc
@@ -170,7 +171,7 @@ def test_ctrl_c_while_update_writes_leaves_the_pin_folder_whole(pinned, capsys,
 
     def interrupted(*args, **kwargs):
         real(*args, **kwargs)
-        signal.raise_signal(signal.SIGINT)  # to this thread: no race
+        os.kill(os.getpid(), signal.SIGINT)
 
     monkeypatch.setattr(gc, "write_capture", interrupted)
     monkeypatch.chdir(pinned.parent)  # --dir as the help shows it: relative

@@ -246,6 +246,7 @@ def test_the_current_folder_is_built_beside_it(tmp_path: Path,
 def test_deferred_interrupts_hold_ctrl_c_until_the_block_ends() -> None:
     """A Ctrl-C inside the block lets the block finish (every file of a commit written),
     then raises as usual; without one nothing is raised, and the handlers are restored."""
+    import os
     import signal
 
     from sgtool.files import deferred_interrupts
@@ -254,7 +255,7 @@ def test_deferred_interrupts_hold_ctrl_c_until_the_block_ends() -> None:
     done = []
     with pytest.raises(KeyboardInterrupt):
         with deferred_interrupts():
-            signal.raise_signal(signal.SIGINT)  # to this thread: no race
+            os.kill(os.getpid(), signal.SIGINT)
             done.append("after the signal")
     assert done == ["after the signal"]
     with deferred_interrupts():
