@@ -74,7 +74,9 @@ as an ``explore`` with reason :data:`WENT_ON` and its decision time, and counts 
 So an explore reveals what lies there, as the symbolic environment's reveals a region's
 furniture, and not one more metre of floor behind a chair. When the robot's bump
 marks wall off every goal (:meth:`LiveSkills.forget_bumps`), they are dropped before the
-hand-over (counted as ``extra.bumps_forgotten`` of the closing Episode record).
+hand-over, and so are marks that withheld goals the map without them reaches when the
+planner gives up (its goals then on offer again; counted as ``extra.bumps_forgotten`` of
+the closing Episode record).
 ``navigation="house"`` keeps the simulator's skills on the ground-truth occupancy (the
 behaviour before, for comparison). ``extra.navigation`` of the started
 Episode record says which, with the live settings.
@@ -82,6 +84,7 @@ Episode record says which, with the live settings.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import os
@@ -124,6 +127,7 @@ from sgtool.recorders.sim.episode_extras import (
     shown_distances,
     started_extra,
     success_rule,
+    withheld_extra,
 )
 from sgtool.recorders.sim.execution import Executed, execute_live, execute_privileged
 from sgtool.recorders.sim.fallback_explore import (
@@ -191,7 +195,7 @@ class _Search:
         # (:mod:`.reachability`); failed goals are not offered again from the same place
         self.failed = FailedGoals()
         self.withheld: dict[str, int] = {}  # reason -> nodes withheld, summed over decisions
-        self.forgot_bumps = 0  # times the bump marks were dropped (they walled off all)
+        self.forgot_bumps = 0  # times the bump marks were dropped (they withheld goals)
         self._seen: SceneGraph | None = None  # the graph the planner saw last
         self._failed_ever: set[str] = set()  # goals a skill failed on in this episode
         self._withheld_now: dict[str, str] = {}
@@ -315,8 +319,8 @@ class _Search:
         cut = False
         o: Outcome
         if plan.done and action.target is None and self.fallback is not None and (
-                self._all_failed(self._seen) or self._forgot_withholding_marks()) and \
-                self.fallback.can_explore():
+                self._all_failed(self._seen) and self.fallback.can_explore() or
+                self._forgot_withholding_marks()):  # (marks: the goals they withheld)
             return self._give_up_handed_over(action, self._seen or cur.graph)
         if plan.done:
             o, why, dist, ticks = "success", DONE_MESSAGE, 0.0, 0
@@ -398,13 +402,20 @@ class _Search:
         return graph
 
     def _forgot_withholding_marks(self) -> bool:
-        """Whether bump marks stood while the last view withheld goals as unreachable (a
-        give-up then is the marks', not the planner's): they are dropped, as at
-        :meth:`observe`, and the give-up goes to the robot's own exploration."""
-        if self.skills is None or UNREACHABLE not in self._withheld_now.values() or \
-                not self.skills.forget_bumps():
+        """Whether bump marks withheld goals of the last view as unreachable that the map
+        without them reaches (a give-up then is the marks'): they are dropped, as at
+        :meth:`observe`, and the freed goals are offered again; other marks stay."""
+        cur, skills = self.rec.stream.current, self.skills
+        if skills is None or cur is None or UNREACHABLE not in self._withheld_now.values():
             return False
-        self.forgot_bumps += 1
+        probe = copy.copy(skills)  # the same robot and map without its marks
+        if not probe.forget_bumps():
+            return False
+        now = reachable_view(cur, probe, self.failed).withheld
+        if all(why != UNREACHABLE or now.get(n) == UNREACHABLE
+               for n, why in self._withheld_now.items()):
+            return False
+        self.forgot_bumps += skills.forget_bumps() > 0
         return True
 
     def _all_failed(self, graph: SceneGraph | None) -> bool:
@@ -542,7 +553,8 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
                        "planner_seed": pseed,
                        "episode": int(episode_index), "episode_id": episode.id,
                        "end": end, "n_open": n_open, "mapping": mapping_record(mapping),
-                       **_withheld(search), **success_rule(opts), **recorded},
+                       **withheld_extra(search.withheld, search.forgot_bumps),
+                       **success_rule(opts), **recorded},
             ), t_end)
             rec.refreshed(stream.finish(t_end))  # as replay ends: only if anything is new
             travelled, frames, refreshes = sim.travelled_m, rec.frames, rec.refreshes
@@ -584,16 +596,3 @@ def _log_exchanges(agent: Any, writer: LogWriter, t_ns: int) -> list[dict[str, A
     for ex in done:
         writer.write_record(LlmExchange.from_json(ex), t_ns)
     return done
-
-
-def _withheld(search: _Search) -> dict[str, Any]:
-    """``{"withheld": {reason: count}}``: goals not offered to the planner, summed over
-    its decisions (live navigation; nothing when none was withheld), and
-    ``{"bumps_forgotten": n}`` when the robot's bump marks were dropped n times because
-    they walled off every goal."""
-    out: dict[str, Any] = {}
-    if search.withheld:
-        out["withheld"] = dict(sorted(search.withheld.items()))
-    if search.forgot_bumps:
-        out["bumps_forgotten"] = search.forgot_bumps
-    return out

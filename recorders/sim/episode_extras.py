@@ -6,6 +6,7 @@ was built with.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import asdict
 from typing import Any
 
@@ -60,3 +61,16 @@ def shown_distances(view: SceneGraph, logged: SceneGraph) -> dict[str, Any]:
     if view.distances == {k: canonical_float(v) for k, v in logged.distances.items()}:
         return {}
     return {"view_distances": dict(view.distances)}
+
+
+def withheld_extra(withheld: Mapping[str, int], forgot_bumps: int) -> dict[str, Any]:
+    """``{"withheld": {reason: count}}``: goals not offered to the planner, summed over
+    its decisions (live navigation; nothing when none was withheld), and
+    ``{"bumps_forgotten": n}`` when the robot's bump marks were dropped n times because
+    they walled off every goal or withheld goals the map without them reaches."""
+    out: dict[str, Any] = {}
+    if withheld:
+        out["withheld"] = dict(sorted(withheld.items()))
+    if forgot_bumps:
+        out["bumps_forgotten"] = forgot_bumps
+    return out

@@ -266,7 +266,7 @@ class LiveSkills:
         self.contacts = 0
         self.bumps: list[tuple[float, float]] = []  # where the base touched something
         self.held: list[tuple[float, float]] = []  # held marks (module doc)
-        self.held_from: tuple[float, float] | None = None
+        self.held_from: list[tuple[float, float]] = []  # where each was held (same order)
         # where a look-around turned toward all the unknown it could (module doc), in order
         self.looked: list[tuple[float, float]] = []
         # asked at every refresh during a skill: True ends the skill (module doc)
@@ -297,8 +297,10 @@ class LiveSkills:
         the robot stands (None: no map). Kept for the last (refresh, pose, bumps), so the
         reachability check of a decision and the skill's first plan share one Dijkstra
         run; the arrays are shared: read them, never change them."""
-        if self.held_from is not None and math.dist(self.body.base[:2], self.held_from) > HOLD_M:
-            self.held, self.held_from = [], None  # elsewhere: that way may be tried again
+        near = [math.dist(self.body.base[:2], p) <= HOLD_M for p in self.held_from]
+        if not all(near):  # away from where a way failed: it may be tried again
+            self.held = [m for m, k in zip(self.held, near, strict=True) if k]
+            self.held_from = [p for p, k in zip(self.held_from, near, strict=True) if k]
         key = (refresh.index, id(refresh), self.body.base[:2], len(self.bumps),
                len(self.held))
         if self._planned is not None and self._planned[0] == key:
@@ -345,15 +347,13 @@ class LiveSkills:
         of floor while the map without any mark leaves more): then every mark is dropped."""
         if not self.held:
             return planned, key
-        held, bumps = self.held, self.bumps
-        self.held, self.bumps = [], []
+        (held, self.held), (bumps, self.bumps) = (self.held, []), (self.bumps, [])
         bare = self.live_map(refresh)
         assert bare is not None
-        cell_m2 = bare.resolution ** 2
-        floor = int(np.count_nonzero(np.isfinite(geodesic_distances(bare, key[2]))))
-        cells = int(np.count_nonzero(np.isfinite(planned[1])))
-        if cells * cell_m2 < self.config.sealed_m2 < floor * cell_m2:
-            return (bare, geodesic_distances(bare, key[2])), (*key[:3], 0, 0)
+        a, d = bare.resolution ** 2, geodesic_distances(bare, key[2])
+        if np.isfinite(planned[1]).sum() * a < self.config.sealed_m2 < np.isfinite(d).sum() * a:
+            self.held_from = []
+            return (bare, d), (*key[:3], 0, 0)
         self.held, self.bumps = held, bumps
         return planned, key
 
@@ -363,7 +363,7 @@ class LiveSkills:
         leaving the robot more than ``sealed_m2``); the number dropped."""
         n = len(self.bumps) + len(self.held)
         if n:
-            self.bumps, self.held = [], []
+            self.bumps, self.held, self.held_from = [], [], []
             self._planned = None
         return n
 
@@ -421,7 +421,7 @@ class LiveSkills:
                     self.bumps.append(_bumped(body.base, p, body.config.radius))
                     if contacts > cfg.max_contacts:
                         self.held.append(self.bumps.pop())  # the way is really blocked
-                        self.held_from = (float(body.base[0]), float(body.base[1]))
+                        self.held_from.append((float(body.base[0]), float(body.base[1])))
                         return ("failure", f"{goal.label}: the way is blocked by an obstacle "
                                 "the robot's map does not show", driven)
                     arrived = False

@@ -400,3 +400,52 @@ def test_a_cluttered_room_is_explored_not_given_up(tmp_path) -> None:
     assert rep.end == "found" and rep.success
     edges = [a for a in _actions(out) if str(a["target"]).startswith("edge:")]
     assert all(is_fallback(a["reason"]) for a in edges)
+
+
+@pytest.mark.parametrize("marks_wall", [False, True])
+def test_a_give_up_is_the_marks_only_when_they_withheld_goals(house, tmp_path, monkeypatch,
+                                                              marks_wall):
+    """A give-up while bump marks stand and goals are withheld as unreachable is handed
+    over only when the marks withheld them (the map without them reaches them): a mark
+    far off, walling nothing, let any give-up with a goal out of reach (unknown space, a
+    closed door) go on (a review). Here the map is blocked beyond 1.5 m of the start,
+    always, or only while a mark stands."""
+    from sgtool.log.records import Episode as LoggedEpisode
+    from sgtool.mapping.occupancy import OccupancyMap
+    from sgtool.recorders.sim.live_skills import LiveSkills
+    from sgtool.recorders.sim.reachability import UNREACHABLE
+
+    idx, ep = _open_start(house)
+    real_map, real_init = LiveSkills.live_map, LiveSkills.__init__
+    start: list[tuple[float, float]] = []
+
+    def far_blocked(self, refresh):  # noqa: ANN001, ANN202
+        occ = real_map(self, refresh)
+        if occ is None or (marks_wall and not (self.bumps or self.held)):
+            return occ
+        h, w = occ.shape
+        x = occ.origin[0] + (np.arange(w) + 0.5) * occ.resolution
+        y = occ.origin[1] + (np.arange(h) + 0.5) * occ.resolution
+        xx, yy = np.meshgrid(x, y)
+        far = np.hypot(xx - start[0][0], yy - start[0][1]) > 1.5
+        return OccupancyMap(occ.grid, occ.blocked | far, occ.robot_radius)
+
+    def init(self, *a, **k):  # noqa: ANN001, ANN002, ANN003, ANN202
+        real_init(self, *a, **k)
+        start.append(tuple(self.body.base[:2]))
+        self.held.append((-50.0, -50.0))  # a contact far off: it walls nothing off
+        self.held_from.append(start[0])
+
+    monkeypatch.setattr(LiveSkills, "live_map", far_blocked)
+    monkeypatch.setattr(LiveSkills, "__init__", init)
+    out = tmp_path / "x.mcap"
+    rep = run_episode(house, ep, Scripted([Action("done")] * 6), out,
+                      dataclasses.replace(OPTS, max_steps=3, explore_on=0), episode_index=idx)
+    with LogReader(out) as r:
+        closing = [e for _, e in r.records(LoggedEpisode) if e.status != "started"][0]
+    assert closing.extras["withheld"].get(UNREACHABLE, 0) > 0
+    if marks_wall:  # the mark withheld the far goals: dropped, and the episode goes on
+        assert rep.steps > 1 and closing.extras["bumps_forgotten"] >= 1
+    else:  # it withheld nothing: the give-up is the planner's and ends the episode
+        assert rep.end == "gave_up" and rep.steps == 1
+        assert "bumps_forgotten" not in closing.extras

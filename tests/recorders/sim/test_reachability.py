@@ -344,9 +344,28 @@ def test_marks_of_a_way_that_failed_on_contacts_are_held() -> None:
     body = _Body((1.0, 2.0, 0.0), RobotConfig())
     skills = LiveSkills(body, lambda: None, LiveNavConfig(sealed_m2=2.0))
     skills.held.extend(gap)
-    skills.held_from = (1.0, 2.0)
+    skills.held_from = [(1.0, 2.0)] * len(gap)
     skills.plan_map(ref)
     assert skills.held == gap
     body.base = (1.0 + HOLD_M + 0.1, 2.0, 0.0)
     planned = skills.plan_map(ref)
     assert skills.held == [] and planned is not None and np.isfinite(planned[1][20, 40])
+
+
+def test_each_held_mark_lasts_near_where_it_was_held() -> None:
+    """Two ways failed at two places: each held mark stays while the robot is within
+    HOLD_M of where it was held (only the last place counted: a mark 0.45 m from its own
+    place went, one 1.6 m from its own stayed; a review)."""
+    occ, _ = _map()
+    ref = SimpleNamespace(index=4, layers=SimpleNamespace(occupancy=occ.grid))
+    body = _Body((1.0, 2.0, 0.0), RobotConfig())
+    skills = LiveSkills(body, lambda: None, LiveNavConfig(sealed_m2=2.0))
+    a, b = (1.0, 3.0), (2.3, 1.0)
+    skills.held, skills.held_from = [a, b], [(1.0, 2.0), (1.8, 2.0)]
+    body.base = (0.6, 1.8, 0.0)  # 0.45 m from a's place, 1.25 m from b's
+    skills.plan_map(ref)
+    assert skills.held == [a] and skills.held_from == [(1.0, 2.0)]
+    skills.held, skills.held_from = [a, b], [(1.0, 2.0), (1.9, 2.0)]
+    body.base = (2.6, 2.0, 0.0)  # 1.6 m from a's place, 0.7 m from b's
+    skills.plan_map(ref)
+    assert skills.held == [b] and skills.held_from == [(1.9, 2.0)]
