@@ -132,6 +132,7 @@ from sgtool.recorders.sim.episode_extras import (
 from sgtool.recorders.sim.execution import Executed, execute_live, execute_privileged
 from sgtool.recorders.sim.fallback_explore import (
     GAVE_UP,
+    MARKED,
     NO_ACTIONABLE,
     Fallback,
     new_candidates,
@@ -318,10 +319,11 @@ class _Search:
         plan = plan_skills(cur.graph, action)
         cut = False
         o: Outcome
-        if plan.done and action.target is None and self.fallback is not None and (
-                self._all_failed(self._seen) and self.fallback.can_explore() or
-                self._forgot_withholding_marks()):  # (marks: the goals they withheld)
-            return self._give_up_handed_over(action, self._seen or cur.graph)
+        if plan.done and action.target is None and self.fallback is not None:
+            if self._all_failed(self._seen) and self.fallback.can_explore():
+                return self._give_up_handed_over(action, self._seen or cur.graph, GAVE_UP)
+            if self._forgot_withholding_marks():  # the goals they withheld are on offer
+                return self._give_up_handed_over(action, self._seen or cur.graph, MARKED)
         if plan.done:
             o, why, dist, ticks = "success", DONE_MESSAGE, 0.0, 0
             self.end = "gave_up" if action.target is None else "wrong_done"
@@ -423,17 +425,17 @@ class _Search:
         offered = () if graph is None else [c.node_id for c in actionable(graph)]
         return give_up_handed_over(offered, self._failed_ever)
 
-    def _give_up_handed_over(self, action: Action, graph: SceneGraph) -> Feedback:
-        """The planner gave up but the robot's map has reachable frontiers: the give-up is
-        logged (its reason says so) and the robot explores until the graph offers a node
-        it did not offer before; the episode goes on."""
-        why = f"{GAVE_UP}: the robot explores them (fallback)"
+    def _give_up_handed_over(self, action: Action, graph: SceneGraph, reason: str) -> Feedback:
+        """The planner gave up while the map has reachable frontiers (``reason`` GAVE_UP) or
+        its marks withheld goals (MARKED): logged so, and the robot explores until the graph
+        offers a node it did not offer before; the episode goes on."""
+        why = f"{reason}: the robot explores {'them' if reason == GAVE_UP else 'on'} (fallback)"
         outcome = SkillOutcome("done", None, "success", why, 0.0, 0)
         self.last_t = self.rec.act(self.sim, outcome, self._decision_s,
                                    self._decided_fields(action, why))
         self._check(self.rec.stream.current, False)
         if not self.end:
-            self._hand_over(GAVE_UP, actionable(graph))
+            self._hand_over(reason, actionable(graph))
         return Feedback(action, "success", why, 0.0)
 
     def executed(self, step: SearchStep) -> None:

@@ -57,6 +57,7 @@ from sgtool.scenegraph.stream import Refresh
 
 NO_ACTIONABLE = "no actionable node"
 GAVE_UP = "the planner gave up while the robot's map has reachable frontiers"
+MARKED = "the planner gave up while bump marks withheld goals: the marks are dropped"
 PREFIX = "fallback: "
 
 

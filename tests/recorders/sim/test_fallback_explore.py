@@ -39,6 +39,8 @@ from sgtool.recorders.sim import CameraConfig
 from sgtool.recorders.sim import closed_loop as cl
 from sgtool.recorders.sim.closed_loop import ClosedLoopOptions, run_episode
 from sgtool.recorders.sim.fallback_explore import (
+    GAVE_UP,
+    MARKED,
     FallbackOptions,
     FallbackRun,
     is_fallback,
@@ -446,6 +448,11 @@ def test_a_give_up_is_the_marks_only_when_they_withheld_goals(house, tmp_path, m
     assert closing.extras["withheld"].get(UNREACHABLE, 0) > 0
     if marks_wall:  # the mark withheld the far goals: dropped, and the episode goes on
         assert rep.steps > 1 and closing.extras["bumps_forgotten"] >= 1
+        with LogReader(out) as r:
+            reasons = [a["message"] for _, a in r.records("action") if a["skill"] == "done"]
+        assert any(w.startswith(MARKED) for w in reasons), reasons
+        assert not any(
+            w.startswith(GAVE_UP) for w in reasons)
     else:  # it withheld nothing: the give-up is the planner's and ends the episode
         assert rep.end == "gave_up" and rep.steps == 1
         assert "bumps_forgotten" not in closing.extras
