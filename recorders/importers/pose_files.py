@@ -4,21 +4,26 @@
 
 - ``pose/NAME.txt`` (or ``poses/``): the 4x4 camera-to-world matrix of the depth image
   ``depth/NAME.*``, four rows of four numbers (a 3x4 without the last row is taken too);
-  a matrix that is not finite (ScanNet writes ``-inf`` where its reconstruction lost the
-  camera) or a missing file is a frame without a pose;
+  a matrix of no finite number (ScanNet writes ``-inf`` where its reconstruction lost the
+  camera) or a missing file is a frame without a pose, one partly finite is damaged;
 - ``intrinsic/intrinsic_depth.txt``: the depth camera's matrix, 3x3 or ScanNet's 4x4 (the
   3x3 in its top-left corner, the rest the identity's).
 """
 
 from __future__ import annotations
 
-import io
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from sgtool.errors import SgtoolError
-from sgtool.recorders.importers.textformats import PinholeParams, checked_pinhole
+from sgtool.log.codec import rigid_problem
+from sgtool.recorders.importers.textformats import (
+    PinholeParams,
+    read_intrinsics_file,
+    untracked_pose,
+)
 
 POSE_FOLDERS = ("pose", "poses")
 INTRINSICS_FILE = Path("intrinsic") / "intrinsic_depth.txt"
@@ -33,40 +38,31 @@ def pose_folder(root: Path) -> Path | None:
     return None
 
 
-def _matrix(path: Path) -> np.ndarray:
-    """The numbers of a text file (whitespace or commas; ``#`` comments) as rows."""
+def read_pose(path: Path) -> np.ndarray | None:
+    """The 4x4 camera-to-world matrix of one pose file (four rows of four numbers, or the
+    top three), None when no number is finite (:func:`untracked_pose`: a reconstruction
+    that lost the camera); a file of another shape, or a matrix that is not rigid
+    (:func:`~sgtool.log.codec.rigid_problem`), is a one-line error."""
+    if untracked_pose(path):
+        return None
     try:
         text = path.read_text(encoding="utf-8-sig", errors="replace")
     except OSError as e:
         raise SgtoolError(f"{path}: cannot read ({e.strerror})") from None
-    data = "\n".join(line.split("#", 1)[0] for line in text.splitlines())
-    if not data.strip():  # an empty file (an export cut short): no numbers, no numpy warning
-        return np.empty((0, 0))
+    rows = [r.replace(",", " ").split() for line in text.splitlines()
+            if (r := line.split("#", 1)[0].strip())]
     try:
-        m = np.loadtxt(io.StringIO(data), dtype=np.float64, ndmin=2,
-                       delimiter="," if "," in data else None)
-    except ValueError:
+        m = np.array(rows, dtype=np.float64)
+    except ValueError:  # not numbers, or rows of other lengths
         m = np.empty((0, 0))
-    return m
-
-
-def read_pose(path: Path) -> np.ndarray | None:
-    """The 4x4 camera-to-world matrix of one pose file, None when it is not finite (a
-    reconstruction that lost the camera); a file of another shape, or a matrix whose
-    rotation is not one, is a one-line error."""
-    m = _matrix(path)
     if m.shape == (3, 4):
         m = np.vstack([m, [0.0, 0.0, 0.0, 1.0]])
     if m.shape != (4, 4):
         raise SgtoolError(f"{path}: expected a 4x4 camera-to-world matrix (four rows of four "
                           f"numbers), got {m.shape[0]}x{m.shape[1] if m.ndim > 1 else 0}")
-    if not np.isfinite(m).all():
-        return None
-    r = m[:3, :3]
-    if not np.allclose(m[3], [0.0, 0.0, 0.0, 1.0], atol=1e-6) or \
-            not np.allclose(r @ r.T, np.eye(3), atol=1e-3) or np.linalg.det(r) <= 0:
-        raise SgtoolError(f"{path}: not a rigid camera-to-world matrix (its top-left 3x3 is "
-                          "no rotation, or its last row is not 0 0 0 1)")
+    problem = rigid_problem(m)
+    if problem is not None:
+        raise SgtoolError(f"{path}: not a rigid camera-to-world matrix ({problem[1]})")
     return m
 
 
@@ -88,19 +84,12 @@ def read_pose_folder(folder: Path, names: list[str]) -> list[np.ndarray | None]:
 
 
 def folder_intrinsics(root: Path) -> PinholeParams | None:
-    """The depth camera's intrinsics of ``intrinsic/intrinsic_depth.txt`` (module doc), or
-    None when the folder has no such file."""
+    """The depth camera's intrinsics of ``intrinsic/intrinsic_depth.txt`` (module doc, read
+    as ``--intrinsics FILE`` reads a file), or None when the folder has no such file."""
     path = root / INTRINSICS_FILE
     if not path.is_file():
         return None
-    m = _matrix(path)
-    if m.shape == (4, 4) and np.allclose(m[3], [0, 0, 0, 1]) and np.allclose(m[:3, 3], 0):
-        m = m[:3, :3]
-    if m.shape != (3, 3) or abs(m[2, 2] - 1.0) > 1e-6 or m[0, 0] <= 0 or m[1, 1] <= 0:
-        raise SgtoolError(f"{path}: expected a camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]] "
-                          "(3x3, or 4x4 with it in the top-left corner)")
-    return checked_pinhole(m[0, 0], m[1, 1], m[0, 2], m[1, 2], str(path),
-                           source=f"file {INTRINSICS_FILE}")
+    return replace(read_intrinsics_file(path), source=f"file {INTRINSICS_FILE}")
 
 
 def posed_pairs(folder: Path, pairs: list[tuple[Path, Path | None]], keep_unposed: bool,

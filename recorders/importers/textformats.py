@@ -211,7 +211,8 @@ def checked_pinhole(fx: float, fy: float, cx: float, cy: float, what: str, *,
 
 
 def read_intrinsics_file(path: Path) -> PinholeParams:
-    """Open3D intrinsic JSON or a 3x3 matrix text file."""
+    """Open3D intrinsic JSON or a 3x3 matrix text file (or a 4x4 with it in the top-left
+    corner and the identity's other entries, as ScanNet writes it)."""
     if path.suffix.lower() == ".json":
         try:
             d = json.loads(path.read_text(encoding="utf-8-sig"))
@@ -241,6 +242,8 @@ def read_intrinsics_file(path: Path) -> PinholeParams:
     except ValueError:
         raise SgtoolError(f"{path}: expected a 3x3 camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]] "
                           "(three rows of three numbers), or Open3D intrinsics JSON") from None
+    if m.shape == (4, 4) and np.allclose(m[3], [0, 0, 0, 1]) and np.allclose(m[:3, 3], 0):
+        m = m[:3, :3]  # ScanNet's intrinsic_*.txt: the camera matrix in a 4x4's corner
     if m.shape == (3, 3) and _transposed(m):
         raise SgtoolError(f"{path}: a 3x3 camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]] "
                           "written transposed (cx, cy in its last row): transpose it")
