@@ -200,13 +200,14 @@ def test_evaluate_logged_replays_the_logged_decisions(tmp_path: Path) -> None:
 def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                             capsys: pytest.CaptureFixture[str]) -> None:
     """docs/api.md's code blocks, in order, in one namespace, from a folder that looks like
-    the repository root (the closed-loop block is left out: a PyBullet episode takes a
-    minute; tests/recorders/sim covers run_episode)."""
+    the repository root (the two closed-loop blocks are left out: a PyBullet episode takes a
+    minute; tests/recorders/sim covers run_episode, tests/toolkit/commands/test_run_again
+    a logged episode run again)."""
     guide = (REPO / "docs" / "api.md").read_text()
     blocks = re.findall(r"```python\n(.*?)```", guide, re.DOTALL)
-    assert len(blocks) == 18
+    assert len(blocks) == 20
     runnable = [b for b in blocks if "run_closed_loop(" not in b]
-    assert len(runnable) == len(blocks) - 1
+    assert len(runnable) == len(blocks) - 2
     for name in ("tests", "examples"):
         (tmp_path / name).symlink_to(REPO / name)
     monkeypatch.chdir(tmp_path)
@@ -223,6 +224,9 @@ def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     assert (tmp_path / "derived.rrd").stat().st_size > 0
     assert (tmp_path / "run-bench" / "summary.md").is_file()
     assert "| scout " in (tmp_path / "run-bench" / "run.md").read_text()
+    logged = namespace["logged"]  # a run-bench episode read back to run again
+    assert isinstance(logged, sgtool.LoggedRun) and logged.planner == "scout"
+    assert logged.options.max_steps == 10 and logged.notes == ()
     again = namespace["again"]  # the tables at other budgets, read back (nothing run)
     assert again.results() == namespace["result"].results()  # type: ignore[attr-defined]
     with sgtool.LogReader(tmp_path / "my.mcap") as log:

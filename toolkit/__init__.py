@@ -42,7 +42,9 @@ closed loop            :func:`record_house` (a scripted tour into a log, with
                        closed-loop benchmark: :class:`ClosedLoopBenchConfig`,
                        :func:`run_closed_loop_bench` (runs or resumes into a folder),
                        :class:`ClosedLoopBenchResult`,
-                       :func:`write_closed_loop_bench_outputs`
+                       :func:`write_closed_loop_bench_outputs`; :func:`logged_run` (the
+                       episode a closed-loop log ran, to run it again: a
+                       :class:`LoggedRun`)
 noise study            :func:`noise_study_config` (a :class:`NoiseStudyConfig`),
                        :func:`run_noise_study` (records into a cache, scores each final
                        graph: a :class:`NoiseStudyResult`),

@@ -82,6 +82,8 @@ from sgtool.analysis.closed_loop_bench import ClosedLoopBenchConfig as ClosedLoo
 from sgtool.analysis.closed_loop_bench import ClosedLoopBenchResult as ClosedLoopBenchResult
 from sgtool.analysis.closed_loop_bench import run_closed_loop_bench as run_closed_loop_bench
 from sgtool.analysis.closed_loop_bench import write_outputs as write_closed_loop_bench_outputs
+from sgtool.analysis.logged_run import logged_run as logged_run
+from sgtool.analysis.logged_run import LoggedRun as LoggedRun
 # the noise study (recording: PyBullet, sgtool[sim])
 from sgtool.analysis.noise_study import StudyConfig as NoiseStudyConfig
 from sgtool.analysis.noise_study import StudyResult as NoiseStudyResult
@@ -163,6 +165,7 @@ __all__ = [
     "ClosedLoopReport",
     "pick_episode", "NoiseProfile", "parse_noise", "ClosedLoopBenchConfig",
     "ClosedLoopBenchResult", "run_closed_loop_bench", "write_closed_loop_bench_outputs",
+    "logged_run", "LoggedRun",
     "NoiseStudyConfig", "NoiseStudyResult", "noise_study_config", "run_noise_study",
     "write_noise_study_outputs",
     "write_rerun", "Interval", "PairedComparison",

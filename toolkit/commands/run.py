@@ -8,11 +8,13 @@ house, episode) and hands a :class:`~sgtool.analysis.sim_session.SearchRequest` 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import click
+from click.core import ParameterSource
 
 from sgtool.commands.options import (
     FINITE_FLOAT,
@@ -39,14 +41,27 @@ from sgtool.commands.options import (
 from sgtool.errors import SgtoolError
 
 if TYPE_CHECKING:
+    from sgtool.analysis.logged_run import LoggedRun
     from sgtool.analysis.sim_session import SearchRequest
+    from sgtool.recorders.sim.closed_loop import ClosedLoopOptions
 
 
 @click.command("run")
-@click.option("--planner", "-p", required=True, is_eager=True,
+@click.option("--planner", "-p", default=None, is_eager=True,
               help="The planner: a built-in (--list-planners shows them all with their "
-              "options: scout, voi, bayes-search, moma-llm, ...). " + PLUGIN_HELP_ONE)
+              "options: scout, voi, bayes-search, moma-llm, ...). " + PLUGIN_HELP_ONE +
+              " Required, unless --again names a log (then: the log's planner).")
 @list_planners_option("--planner")
+@click.option("--again", type=PathParam(exists=True, dir_okay=False), default=None,
+              metavar="LOG",
+              help="Run the episode of this closed-loop log again (a log of `sgtool run` or "
+              "of a `run-bench` folder, whose episodes `--episode K` does not pick): its "
+              "house, start, query, planner with its -O options and every setting it "
+              "recorded. Options given beside it change that setting only (--planner voi "
+              "to compare a planner on the episode, --rerun spawn to watch it, --noise "
+              "strong); --house, --seed, --rooms, --query and --episode pick another "
+              "episode and are refused. A log of older code: notes name what runs "
+              "otherwise today.")
 @house_options(
     seed_help="Search a generated evaluation house (`sgtool scenes generate`) of this seed "
     "instead of --house.",
@@ -152,8 +167,15 @@ def command(**given: Any) -> None:
     from sgtool.analysis.sim_session import run_search
 
     args = RunArgs(**given)
-    out = check_log_output(args.output, force=args.force, inputs=(args.house_path, args.noise))
-    request = _request(args, out)
+    if args.again is None and args.planner is None:
+        raise click.UsageError("Missing option '-p' / '--planner' (or --again LOG).")
+    out = check_log_output(args.output, force=args.force,
+                           inputs=(args.house_path, args.noise, args.again))
+    ctx = click.get_current_context()
+    given_here = frozenset(k for k in given if ctx.get_parameter_source(k) in (
+        ParameterSource.COMMANDLINE, ParameterSource.ENVIRONMENT))
+    request = _request(args, out) if args.again is None else \
+        again_request(args, given_here, out, note=lambda m: click.echo(m, err=True))
     run_search(request, show=click.echo, note=lambda m: click.echo(m, err=True))
 
 
@@ -161,7 +183,7 @@ def command(**given: Any) -> None:
 class RunArgs:
     """The options of `sgtool run` as given (the click parameters, by name)."""
 
-    planner: str
+    planner: str | None
     house_path: str | None
     seed: int | None
     rooms: str
@@ -200,6 +222,7 @@ class RunArgs:
     render_turn: float = 20.0
     max_depth: float | None = None
     noise_seed: int = 0
+    again: str | None = None
 
 
 def _planner(args: RunArgs) -> tuple[str, dict[str, Any]]:
@@ -207,7 +230,7 @@ def _planner(args: RunArgs) -> tuple[str, dict[str, Any]]:
     --llm-transcript)."""
     from sgtool.planning.registry import PLANNER_NAMES, check_planner_name, is_llm_planner
 
-    name = args.planner.strip()
+    name = (args.planner or "").strip()
     name = name.lower() if name.lower() in PLANNER_NAMES else name
     check_planner_name(name)
     options = run_planner_options(args.planner_option, name)
@@ -278,3 +301,68 @@ def _request(args: RunArgs, out: Path) -> SearchRequest:
     return SearchRequest(house=house, house_id=house_id, episode_index=index, episode=ep,
                          planner=name, output=out, options=opts, planner_options=options,
                          force=args.force, quiet=args.quiet, rerun_to=args.rerun_to)
+
+
+# options that pick another episode than the log's
+_OTHER_EPISODE = {"house_path": "--house", "seed": "--seed", "rooms": "--rooms",
+                  "query": "--query", "episode": "--episode"}
+# RunArgs fields given beside --again -> the ClosedLoopOptions field each sets
+_SAME_NAME = {"fps": "fps", "every": "every", "classifier": "classifier",
+              "min_points": "min_points", "max_steps": "max_steps",
+              "navigation": "navigation", "noise_seed": "noise_seed", "success": "success",
+              "planner_seed": "planner_seed", "explore_on": "explore_on",
+              "render_turn": "turn_render_deg", "max_depth": "max_depth"}
+_LIVE = ("optimistic", "look_in", "look_in_beyond", "peek", "sight_lines", "explore_through")
+
+
+def again_request(args: RunArgs, given: frozenset[str], out: Path,
+                  note: Callable[[str], None]) -> SearchRequest:
+    """The request of ``--again LOG``: the log's episode and settings
+    (:func:`sgtool.analysis.logged_run.logged_run`), each option in ``given`` (the names of
+    the options the user gave) changing its own setting."""
+    from sgtool.analysis.logged_run import logged_run
+    from sgtool.analysis.sim_session import SearchRequest
+    from sgtool.recorders.sim.frame_budget import frame_budget
+
+    other = [flag for name, flag in _OTHER_EPISODE.items() if name in given]
+    if other:
+        raise SgtoolError(f"{', '.join(other)}: --again runs the episode of its log; give "
+                          f"{'them' if len(other) > 1 else 'it'} without --again to pick "
+                          "another")
+    frame_budget(args.frames, args.frames_per_room, 1)  # both given: before the log is read
+    assert args.again is not None
+    run = logged_run(args.again)
+    for n in run.notes:
+        note(f"note: {args.again} was run by older sgtool with a setting it runs otherwise "
+             f"today: {n}")
+    name, options = _planner(replace(args, planner=args.planner or run.planner))
+    if name == run.planner:  # the log's options, -O given beside changing them
+        options = {**run.planner_options, **options}
+    return SearchRequest(house=run.house, house_id=run.house_id,
+                         episode_index=run.episode_index, episode=run.episode, planner=name,
+                         output=out, options=_changed(args, given, run),
+                         planner_options=options, force=args.force, quiet=args.quiet,
+                         rerun_to=args.rerun_to)
+
+
+def _changed(args: RunArgs, given: frozenset[str], run: LoggedRun) -> ClosedLoopOptions:
+    """The options ``run`` ran with, each option in ``given`` changing its own setting."""
+    from sgtool.commands.options import parse_resolution
+    from sgtool.recorders.sim import parse_noise
+    from sgtool.recorders.sim.frame_budget import frame_budget
+
+    o = run.options
+    changes: dict[str, Any] = {field: getattr(args, name)
+                               for name, field in _SAME_NAME.items() if name in given}
+    if "resolution" in given:
+        width, height = parse_resolution(args.resolution)
+        changes["camera"] = replace(o.camera, width=width, height=height)
+    if "noise" in given:
+        changes["noise"] = parse_noise(args.noise)
+    if {"frames", "frames_per_room"} & given:
+        changes["frames"] = frame_budget(args.frames, args.frames_per_room,
+                                         len(run.house.rooms))
+    live = {f: getattr(args, f) for f in _LIVE if f in given}
+    if live:
+        changes["live"] = replace(o.live, **live)
+    return replace(o, **changes)

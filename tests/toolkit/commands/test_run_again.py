@@ -1,0 +1,111 @@
+"""``sgtool run --again LOG`` (and ``sgtool.logged_run``): a run-bench episode, which
+``run --episode K`` does not pick (run-bench draws its own episodes), runs again into the
+same log; options given beside it change their own setting only."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+import sgtool
+from sgtool.cli import cli
+from sgtool.log.reader import LogReader
+from sgtool.log.records import Episode
+
+MEASURED = ("decision_time_s", "latency_s")  # wall-clock fields, the only ones that vary
+GOLDEN = Path(__file__).resolve().parents[2] / "golden" / "house6-tour.mcap"
+
+
+def masked(path: Path) -> list[tuple[str, int, object]]:
+    """Every message of a log, the measured fields of its JSON records blanked."""
+    out: list[tuple[str, int, object]] = []
+    with LogReader(path) as r:
+        for _, channel, m in r.raw_messages(None):
+            data: object = bytes(m.data)
+            if channel.topic.startswith("/sgtool/"):
+                rec = json.loads(m.data)
+                data = {k: 0 if k in MEASURED else v for k, v in rec.items()}
+            out.append((channel.topic, int(m.log_time), data))
+    return out
+
+
+def opening(path: Path) -> Episode:
+    with LogReader(path) as r:
+        return next(e for _, e in r.records(Episode) if e.status == "started")
+
+
+@pytest.fixture(scope="module")
+def bench(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A run-bench folder: 2 episodes of one 4-room house, 64x48, 3 steps, two planners
+    (random draws from a seed of its episode, so a rerun must get the episode's index)."""
+    out = tmp_path_factory.mktemp("again") / "rb"
+    r = CliRunner().invoke(cli, [
+        "run-bench", "--planners", "random,greedy", "--houses", "1", "--house-seed", "3",
+        "--rooms", "4-4", "--episodes", "2", "--max-steps", "3", "--resolution", "64x48",
+        "-O", "greedy.max_failures=1", "-w", "1", "--no-progress", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    return out / "logs" / "none"
+
+
+@pytest.mark.parametrize("planner", ["random", "greedy"])
+def test_a_run_bench_episode_runs_again_into_the_same_log(bench: Path, tmp_path: Path,
+                                                          planner: str) -> None:
+    log = bench / planner / "house-3" / "ep-001.mcap"
+    again = tmp_path / "again.mcap"
+    r = CliRunner().invoke(cli, ["run", "--again", str(log), "-o", str(again), "--quiet"])
+    assert r.exit_code == 0, r.output
+    assert "note:" not in r.output  # nothing of the log runs otherwise today
+    assert masked(again) == masked(log)
+
+
+def test_options_beside_again_change_their_setting_only(bench: Path, tmp_path: Path) -> None:
+    log = bench / "greedy" / "house-3" / "ep-001.mcap"
+    out = tmp_path / "scout.mcap"
+    r = CliRunner().invoke(cli, ["run", "--again", str(log), "--planner", "scout",
+                                 "--max-steps", "2", "--resolution", "160x120", "-o", str(out),
+                                 "--quiet"])
+    assert r.exit_code == 0, r.output
+    before, after = opening(log), opening(out)
+    assert (after.planner, before.planner) == ("scout", "greedy")
+    x, y = before.extras, after.extras
+    assert y["max_steps"] == 2 and y["camera"]["width"] == 160 and x["camera"]["width"] == 64
+    # the greedy's option stays with greedy; points per voxel follow the new image size
+    assert "planner_options" in x and "planner_options" not in y
+    assert y["mapping"]["min_points"] > x["mapping"]["min_points"]
+    for same in ("episode", "episode_id", "targets", "target_rooms", "start_pose",
+                 "start_room", "seed", "planner_seed", "fps", "noise", "navigation"):
+        assert x[same] == y[same], same
+    assert after.query == before.query and after.house_id == before.house_id
+
+
+def test_logged_run_from_python(bench: Path) -> None:
+    logged = sgtool.logged_run(bench / "greedy" / "house-3" / "ep-000.mcap")
+    assert (logged.planner, logged.episode_index, logged.house_id) == ("greedy", 0, "house-3")
+    assert logged.planner_options == {"max_failures": 1}
+    assert logged.options.max_steps == 3 and logged.options.camera.width == 64
+    assert logged.house.seed == 3 and logged.notes == ()
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--seed", "3"], "--seed: --again runs the episode of its log"),
+    (["--query", "bowl", "--episode", "1"], "--query, --episode: --again runs the episode"),
+])
+def test_options_that_pick_another_episode_are_refused(bench: Path, tmp_path: Path,
+                                                       args: list[str], message: str) -> None:
+    log = bench / "random" / "house-3" / "ep-000.mcap"
+    out = tmp_path / "x.mcap"
+    r = CliRunner().invoke(cli, ["run", "--again", str(log), *args, "-o", str(out)])
+    assert r.exit_code == 2 and message in r.output, r.output
+    assert not out.exists()
+
+
+def test_a_log_without_a_closed_loop_episode_is_refused(tmp_path: Path) -> None:
+    out = tmp_path / "x.mcap"
+    r = CliRunner().invoke(cli, ["run", "--again", str(GOLDEN), "-o", str(out)])
+    assert r.exit_code == 2, r.output
+    assert "no closed-loop episodes in it" in r.output and not out.exists()
+    r = CliRunner().invoke(cli, ["run", "-o", str(out)])
+    assert r.exit_code == 2 and "Missing option '-p' / '--planner' (or --again LOG)" in r.output
