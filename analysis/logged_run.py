@@ -91,9 +91,13 @@ def logged_run(path: str | os.PathLike[str]) -> LoggedRun:
     planner = start.planner if isinstance(start.planner, str) and start.planner else None
     if planner is None:
         raise SgtoolError(f"{p}: its opening Episode record names no planner")
+    from sgtool.planning.registry import typed_options
+
     run = LoggedRun(house=house, house_id=str(start.house_id or f"house-{house.seed}"),
                     episode_index=index, episode=episode, planner=planner,
-                    planner_options=dict(x.get("planner_options") or {}), options=options)
+                    # as the planner takes them (a list option: a tuple, as from -O)
+                    planner_options=typed_options(planner, x.get("planner_options") or {}),
+                    options=options)
     return dataclasses.replace(run, notes=tuple(changed_settings(p, run)))
 
 
@@ -106,12 +110,17 @@ def changed_settings(path: Path, run: LoggedRun) -> list[str]:
         settings_differences,
         task_settings,
     )
+    from sgtool.planning.registry import effective_options
 
     logged, _ = logged_settings(path)
     faults = {k: v for k, v in run.options.noise.to_dict().items() if k != "name" and v}
     noise = ",".join(f"{k}={v!r}" for k, v in faults.items()) or "none"
     want = task_settings(run.options, noise, episode_identity(run.episode),
                          run.planner_options)
+    # compared as the planner takes them, as run-bench's resume does
+    want["planner_options"] = effective_options(run.planner, want["planner_options"])
+    logged["planner_options"] = effective_options(run.planner,
+                                                  logged["planner_options"] or {})
     return settings_differences(logged, want)
 
 

@@ -2,8 +2,9 @@
 that turns given values (Python objects, or the text of ``-O P.KEY=VALUE``) into them.
 
 A field of an options dataclass carries :func:`option` metadata: its kind (``int``,
-``float``, ``bool``, ``str``, ``path``, ``choice``, or ``object``: a Python object such as
-an encoder, settable from Python only), a help line and its range. :func:`convert_options`
+``float``, ``bool``, ``str``, ``path``, ``choice``, ``list``: a list of ints, numbers or
+texts, comma-separated on the command line, or ``object``: a Python object such as an
+encoder, settable from Python only), a help line and its range. :func:`convert_options`
 checks a mapping of given values against the fields: an unknown key is one
 :class:`UnknownPlannerError` line naming the nearest known key (:mod:`difflib`), a value of
 the wrong type or out of range one :class:`PlannerOptionError` line naming the planner,
@@ -23,7 +24,9 @@ from typing import Any
 
 from sgtool.errors import SgtoolError
 
-KINDS = ("int", "float", "bool", "str", "path", "choice", "object")
+KINDS = ("int", "float", "bool", "str", "path", "choice", "list", "object")
+ITEM_KINDS = ("int", "float", "str")  # what a ``list`` holds
+_ITEM_WORDS = {"int": "integers", "float": "numbers", "str": "texts"}
 _TRUE = ("true", "yes", "on", "1")
 _FALSE = ("false", "no", "off", "0")
 _META = "sgtool_option"
@@ -43,7 +46,9 @@ class OptionMeta:
     (``lo_open``: strictly above ``lo``), ``choices`` of a ``choice``, ``optional``: None
     is a value (the default: "not set"), ``objects``: a ``path`` also takes Python objects
     (a mapping, a list of paths) as they are; ``path_object``: a ``path`` arrives as a
-    ``pathlib.Path`` (a plain field annotated ``Path``), else as text."""
+    ``pathlib.Path`` (a plain field annotated ``Path``), else as text. A ``list`` holds
+    ``item`` values (:data:`ITEM_KINDS`, each in the range), ``length`` of them when set,
+    and arrives as a tuple (``as_list``: a list)."""
 
     help: str
     kind: str
@@ -54,6 +59,9 @@ class OptionMeta:
     optional: bool = False
     objects: bool = False
     path_object: bool = False
+    item: str = ""
+    length: int | None = None
+    as_list: bool = False
 
     @property
     def cli(self) -> bool:
@@ -64,6 +72,11 @@ class OptionMeta:
         """The accepted values in words (empty when any value of the kind is)."""
         if self.kind == "choice":
             return "one of " + ", ".join(self.choices)
+        if self.kind == "list":
+            each = dataclasses.replace(self, kind=self.item).range_text()
+            count = "any number of" if self.length is None else str(self.length)
+            return f"{count} comma-separated {_ITEM_WORDS[self.item]}" + (
+                f", each {each}" if each else "")
         if self.lo is not None and self.hi is not None and not self.lo_open:
             return f"{_num(self.lo)}..{_num(self.hi)}"
         parts = []
@@ -76,12 +89,16 @@ class OptionMeta:
 
 def option(help: str, kind: str, *, lo: float | None = None, hi: float | None = None,
            lo_open: bool = False, choices: Iterable[str] = (), optional: bool = False,
-           objects: bool = False) -> dict[str, OptionMeta]:
+           objects: bool = False, item: str = "",
+           length: int | None = None) -> dict[str, OptionMeta]:
     """Metadata for ``dataclasses.field(metadata=...)`` of an options field."""
     if kind not in KINDS:
         raise ValueError(f"kind {kind!r}: one of {KINDS}")
+    if (kind == "list") != (item in ITEM_KINDS):
+        raise ValueError(f"item {item!r}: a list's items are one of {ITEM_KINDS}; only a "
+                         "list has items")
     return {_META: OptionMeta(help, kind, lo, hi, lo_open, tuple(choices), optional,
-                              objects)}
+                              objects, item=item, length=length)}
 
 
 @dataclass(frozen=True)
@@ -102,22 +119,26 @@ class OptionInfo:
         rng = self.meta.range_text()
         default = ", required" if self.required else \
             "" if self.default is None and "[default:" in self.meta.help else \
-            ", default " + ("unset" if self.default is None else _text(self.default))
-        return (f"{self.name} ({self.kind}{default}): {self.meta.help}"
+            ", default " + ("unset" if self.default is None else _text(self.default) or
+                            "none")
+        kind = f"{self.meta.item} list" if self.kind == "list" else self.kind
+        return (f"{self.name} ({kind}{default}): {self.meta.help}"
                 + (f" [{rng}]" if rng else ""))
 
 
 _PLAIN_KINDS = {bool: "bool", int: "int", float: "float", str: "str"}
 
 
-def _plain_meta(f: dataclasses.Field[Any], hint: Any) -> OptionMeta:
-    """The metadata of a field without :func:`option` (a plug-in's plain config dataclass),
-    from its type ``hint`` (the annotation as :func:`_type_hints` resolves it): ``int``,
-    ``float``, ``bool`` or ``str`` alone; a ``Literal`` of strings is a choice; a path
-    (``Path``, ``os.PathLike``, alone or with ``str``) a path; each of these with ``| None``
-    takes None too. Another annotation (``Any``, one that does not resolve) takes the kind
-    of a plain default (3: int); anything else (a list, a dict, a class) is a Python
-    object, settable from Python only."""
+def plain_meta(default: Any, hint: Any) -> OptionMeta:
+    """The metadata of a field without :func:`option` (a plug-in's plain config dataclass,
+    or a parameter of a plug-in's factory) with this ``default`` (None: none), from its
+    type ``hint`` (the annotation as :func:`_type_hints` resolves it): ``int``, ``float``,
+    ``bool`` or ``str`` alone; a ``Literal`` of strings is a choice; a path (``Path``,
+    ``os.PathLike``, alone or with ``str``) a path; ``tuple[float, ...]``,
+    ``tuple[int, int]`` or ``list[str]`` (of int, float or str) a list; each of these with
+    ``| None`` takes None too. Another annotation (``Any``, one that does not resolve)
+    takes the kind of a plain default (3: int); anything else (a dict, a class) is a
+    Python object, settable from Python only."""
     import types
     import typing
 
@@ -129,6 +150,11 @@ def _plain_meta(f: dataclasses.Field[Any], hint: Any) -> OptionMeta:
     bare = [typing.get_origin(a) or a for a in plain]
     paths = (pathlib.Path, os.PathLike)
     kind, choices, as_path = "object", (), False
+    listed = _list_of(plain[0]) if len(plain) == 1 else None
+    if listed is not None:
+        item, length, as_list = listed
+        return OptionMeta(f"a field of {_hint_text(hint)}", "list", optional=optional,
+                          item=item, length=length, as_list=as_list)
     if len(plain) == 1 and plain[0] in _PLAIN_KINDS:
         kind = _PLAIN_KINDS[plain[0]]
     elif len(plain) == 1 and typing.get_origin(plain[0]) is typing.Literal and all(
@@ -137,11 +163,34 @@ def _plain_meta(f: dataclasses.Field[Any], hint: Any) -> OptionMeta:
     elif bare and all(b in paths or b is str for b in bare) and any(b in paths for b in bare):
         kind, as_path = "path", str not in bare  # Path alone: a Path; str | Path: text
     elif not plain or plain[0] is Any or isinstance(plain[0], str):
-        default = f.default if f.default is not dataclasses.MISSING else None
         kind = _PLAIN_KINDS.get(type(default), "object")
-    note = hint.__name__ if isinstance(hint, type) else str(hint).replace("typing.", "")
-    return OptionMeta(f"a field of {note}", kind, choices=choices, optional=optional,
-                      path_object=as_path)
+    return OptionMeta(f"a field of {_hint_text(hint)}", kind, choices=choices,
+                      optional=optional, path_object=as_path)
+
+
+def _hint_text(hint: Any) -> str:
+    return hint.__name__ if isinstance(hint, type) else str(hint).replace("typing.", "")
+
+
+def _list_of(hint: Any) -> tuple[str, int | None, bool] | None:
+    """(item kind, length or None, a list) of ``tuple[X, ...]``, ``tuple[X, X]`` or
+    ``list[X]`` with X int, float or str; None for any other annotation."""
+    import typing
+
+    origin, args = typing.get_origin(hint), typing.get_args(hint)
+    if origin is list and len(args) == 1:
+        items, length = args, None
+    elif origin is tuple and len(args) == 2 and args[1] is Ellipsis:
+        items, length = args[:1], None
+    elif origin is tuple and args and Ellipsis not in args:
+        items, length = args, len(args)
+    else:
+        return None
+    kinds = {_PLAIN_KINDS.get(a, "") for a in items}
+    kind = kinds.pop()
+    if kinds or kind not in ITEM_KINDS:
+        return None
+    return kind, length, origin is list
 
 
 def _type_hints(cls: type) -> dict[str, Any]:
@@ -168,12 +217,12 @@ def _type_hints(cls: type) -> dict[str, Any]:
 def option_infos(cls: type) -> tuple[OptionInfo, ...]:
     """The options of an options dataclass, in field order; a field without
     :func:`option` metadata takes the kind of its type annotation
-    (:func:`_plain_meta`)."""
+    (:func:`plain_meta`)."""
     out = []
     hints = _type_hints(cls)
     for f in dataclasses.fields(cls):
-        meta = f.metadata.get(_META) or _plain_meta(f, hints.get(f.name, f.type))
         default = f.default if f.default is not dataclasses.MISSING else None
+        meta = f.metadata.get(_META) or plain_meta(default, hints.get(f.name, f.type))
         required = f.init and f.default is dataclasses.MISSING and \
             f.default_factory is dataclasses.MISSING
         out.append(OptionInfo(f.name, meta.kind, default, meta, required))
@@ -254,6 +303,8 @@ def convert_value(planner: str, key: str, meta: OptionMeta, value: Any,
     if from_cli and meta.optional and meta.kind in ("int", "float", "choice") and \
             isinstance(value, str) and not value.strip():
         return None  # `-O NAME.k=` sets an optional number or choice to None
+    if meta.kind == "list":
+        return _convert_list(planner, key, meta, value, from_cli)
     if meta.kind == "int":
         out: Any = _to_int(value)
         if out is None:
@@ -294,6 +345,26 @@ def convert_value(planner: str, key: str, meta: OptionMeta, value: Any,
             (meta.hi is not None and out > meta.hi):
         raise fail(f"must be {meta.range_text()}")
     return out
+
+
+def _convert_list(planner: str, key: str, meta: OptionMeta, value: Any,
+                  from_cli: bool) -> tuple[Any, ...] | list[Any]:
+    """A ``list`` option's value: text split at commas (empty: no items), or a list or
+    tuple, each item converted to ``meta.item`` and checked against the range."""
+    if isinstance(value, str):
+        items: list[Any] = [v.strip() for v in value.split(",")] if value.strip() else []
+    elif isinstance(value, list | tuple) and not from_cli:
+        items = list(value)
+    else:
+        raise PlannerOptionError(f"planner {planner!r}: option {key}={_shown(value)}: must "
+                                 f"be {meta.range_text()}")
+    if meta.length is not None and len(items) != meta.length:
+        raise PlannerOptionError(f"planner {planner!r}: option {key}={_shown(value)}: must "
+                                 f"be {meta.range_text()}, not {len(items)}")
+    each = dataclasses.replace(meta, kind=meta.item, optional=False)
+    out = [convert_value(planner, f"{key}[{i}]", each, v, from_cli)
+           for i, v in enumerate(items)]
+    return out if meta.as_list else tuple(out)
 
 
 def _to_int(value: Any) -> int | None:
@@ -345,6 +416,8 @@ def _num(x: float) -> str:
 def _text(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
+    if isinstance(value, list | tuple):
+        return ",".join(_text(v) for v in value)
     return str(value)
 
 
@@ -353,5 +426,7 @@ def _shown(value: Any) -> str:
     if isinstance(value, str):
         return value
     if isinstance(value, int | float | bool):
+        return _text(value)
+    if isinstance(value, list | tuple) and all(isinstance(v, str | int | float) for v in value):
         return _text(value)
     return f"<{type(value).__name__}>"

@@ -8,8 +8,11 @@ options as keyword arguments and must return a :class:`~sgtool.planning.base.Pla
 (``name``, ``reset``, ``decide``, ``feedback``). When the class or factory has an
 attribute ``Options`` that is a dataclass whose fields carry
 :func:`~sgtool.planning.option_fields.option` metadata, the options are checked and
-converted against it as a built-in planner's are; otherwise they are passed as given
-(``-O`` text parsed as int, float, true/false or text). A plug-in that fails to import,
+converted against it as a built-in planner's are; otherwise ``-O`` text is converted to the
+type its parameter of the factory is annotated with, as a plain ``Options`` field's is
+(``weights: tuple[float, float]`` takes ``-O my:P.weights=0.3,0.7``; :func:`signature_metas`),
+and parsed as int, float, true/false or text for a parameter with another annotation or none
+(options given from Python are passed as given). A plug-in that fails to import,
 raises, or returns something else is one :class:`PluginError` line naming it.
 """
 
@@ -24,7 +27,13 @@ from typing import Any
 
 from sgtool.errors import raised_text
 from sgtool.planning.base import Planner
-from sgtool.planning.option_fields import PlannerOptionError, check_required, convert_options
+from sgtool.planning.option_fields import (
+    OptionMeta,
+    PlannerOptionError,
+    check_required,
+    convert_options,
+    plain_meta,
+)
 
 GROUP = "sgtool.planners"
 _DOTTED = r"[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*"
@@ -126,6 +135,27 @@ def options_class(factory: Callable[..., Any]) -> type | None:
     """The factory's ``Options`` dataclass, or None."""
     cls = getattr(factory, "Options", None)
     return cls if isinstance(cls, type) and dataclasses.is_dataclass(cls) else None
+
+
+def signature_metas(factory: Callable[..., Any]) -> dict[str, OptionMeta]:
+    """The options a factory without ``Options`` types by its parameters' annotations (a
+    class: its ``__init__``'s): those whose annotation gives a kind the command line sets
+    (:func:`~sgtool.planning.option_fields.plain_meta`: not a Python object); none when
+    the annotations do not resolve."""
+    import inspect
+
+    try:
+        params = inspect.signature(factory, eval_str=True).parameters.values()
+    except Exception:  # noqa: BLE001 - a user's annotations that do not evaluate: untyped
+        return {}
+    out = {}
+    for p in params:
+        if p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD) or p.annotation is p.empty:
+            continue
+        meta = plain_meta(None if p.default is p.empty else p.default, p.annotation)
+        if meta.cli:
+            out[p.name] = meta
+    return out
 
 
 def plugin_options(name: str, factory: Callable[..., Any], given: Mapping[str, Any],

@@ -23,6 +23,7 @@ from sgtool.errors import SgtoolError
 from sgtool.planning import plugins
 from sgtool.planning.base import Planner
 from sgtool.planning.option_fields import (
+    OptionInfo,
     OptionMeta,
     PlannerOptionError,
     UnknownPlannerError,
@@ -332,11 +333,22 @@ def typed_options(name: str, given: Mapping[str, Any]) -> dict[str, Any]:
     out = {}
     for k, v in given.items():
         try:
-            out[k] = parse_option(name, k, str(v)) if isinstance(
-                v, str | int | float | bool | os.PathLike) else v
+            out[k] = _as_list_option(name, k, v) if isinstance(v, list | tuple) else \
+                parse_option(name, k, str(v)) if isinstance(
+                    v, str | int | float | bool | os.PathLike) else v
         except Exception:  # noqa: BLE001 - as given (see above)
             out[k] = v
     return out
+
+
+def _as_list_option(name: str, key: str, value: list[Any] | tuple[Any, ...]) -> Any:
+    """A list or tuple given for a ``list`` option as ``-O`` gives it (a log records a
+    list; Python may give a tuple); as given for any other option."""
+    if all(isinstance(x, str | int | float) and not isinstance(x, bool) for x in value):
+        typed = parse_option(name, key, ",".join(str(x) for x in value))
+        if isinstance(typed, list | tuple):
+            return typed
+    return value
 
 
 def _signature_defaults(factory: Any) -> dict[str, Any]:
@@ -360,8 +372,10 @@ def parse_option(name: str, key: str, text: str) -> Any:
     if entry is not None and key in entry.fixed:
         raise _fixed(name, key, entry.fixed[key])
     cls = options_of(name)
-    if cls is None:
-        return parse_text(text)
+    if cls is None:  # a plug-in without Options: typed by its factory's annotations
+        meta = plugins.signature_metas(_factory(name)).get(key)
+        return parse_text(text) if meta is None else \
+            convert_value(name, key, meta, text, from_cli=True)
     return convert_options(name, cls, {key: text}, from_cli=True)[key]
 
 
@@ -423,8 +437,13 @@ def _plugin_lines(name: str) -> list[str]:
     except SgtoolError as e:
         return [f"{name}: {e}"]
     if cls is None:
-        return [f"{name}: a plug-in without an Options dataclass (its -O values are passed "
-                "as int, float, true/false or text)"]
+        factory = _factory(name)
+        typed, defaults = plugins.signature_metas(factory), _signature_defaults(factory)
+        return [f"{name}: a plug-in without an Options dataclass (its -O values are "
+                "converted to its parameters' annotated types, else passed as int, float, "
+                "true/false or text)",
+                *(f"    {OptionInfo(k, m.kind, defaults.get(k), m, k not in defaults).line()}"
+                  for k, m in typed.items())]
     return [f"{name}: a plug-in", *(f"    {info.line()}" for info in option_infos(cls))]
 
 

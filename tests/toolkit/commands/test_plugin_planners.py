@@ -443,7 +443,8 @@ def test_list_planners_describes_a_plugin_named_with_it(
         plugin_dir: Path, monkeypatch: pytest.MonkeyPatch, command: list[str]) -> None:
     monkeypatch.syspath_prepend(str(plugin_dir))
     said = ("mymod_cli:MyPlanner: a plug-in without an Options dataclass (its -O values are "
-            "passed as int, float, true/false or text)")
+            "converted to its parameters' annotated types, else passed as int, float, "
+            "true/false or text)")
     r = CliRunner().invoke(cli, [*command, "mymod_cli:MyPlanner", "--list-planners"])
     assert r.exit_code == 0 and said in r.output, r.output
     # named after it, or as --opt=VALUE: the same

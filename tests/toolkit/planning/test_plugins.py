@@ -156,9 +156,9 @@ def test_a_plain_options_dataclass_checks_by_its_fields_types(plugin_dir: Path) 
 def test_plain_fields_are_typed_by_their_annotations(tmp_path: Path, monkeypatch) -> None:
     """Annotations as text (``from __future__ import annotations``) are resolved in the
     plug-in's module: ``X | None`` takes None, a ``Literal`` of strings is a choice, a
-    ``Path`` a path that arrives as a Path, ``str | Path`` one that arrives as text, a list
-    or a dict is a Python object (not set by -O); a name that does not resolve takes its
-    default's type."""
+    ``Path`` a path that arrives as a Path, ``str | Path`` one that arrives as text, a
+    ``list[str]`` a list (comma-separated), a dict a Python object (not set by -O); a name
+    that does not resolve takes its default's type."""
     (tmp_path / "future_plug.py").write_text(textwrap.dedent('''
         from __future__ import annotations
 
@@ -173,6 +173,7 @@ def test_plain_fields_are_typed_by_their_annotations(tmp_path: Path, monkeypatch
             @dataclass
             class Options:
                 tags: list[str] = field(default_factory=list)
+                table: dict[str, float] = field(default_factory=dict)
                 limit: Optional[int] = None
                 cap: int | None = None
                 mode: Unknowable = "a"
@@ -188,8 +189,9 @@ def test_plain_fields_are_typed_by_their_annotations(tmp_path: Path, monkeypatch
     monkeypatch.syspath_prepend(str(tmp_path))
     assert parse_option("future_plug:P", "limit", "5") == 5
     assert make_planner("future_plug:P", cap=None).inner.kw == {"cap": None}  # type: ignore[attr-defined]
+    assert parse_option("future_plug:P", "tags", "a, b") == ["a", "b"]
     with pytest.raises(PlannerOptionError, match="a Python object, set from Python only"):
-        parse_option("future_plug:P", "tags", "1.5")
+        parse_option("future_plug:P", "table", "1.5")
     assert parse_option("future_plug:P", "mode", "b") == "b"
     assert parse_option("future_plug:P", "speed", "slow") == "slow"
     with pytest.raises(PlannerOptionError, match="must be one of fast, slow"):
@@ -490,3 +492,68 @@ def test_a_plug_in_module_drawing_at_import_draws_the_same_in_any_process(
         assert after == random.random()  # the caller's stream as if nothing was imported
         tables.append(importlib.import_module("importrand_plug").TABLE)
     assert tables[0] == tables[1]
+
+
+def test_list_options_from_the_command_line(tmp_path: Path, monkeypatch) -> None:
+    """A ``tuple[float, float]``, ``tuple[str, ...]`` or ``list[int]`` option (an Options
+    field, or a parameter of a plug-in without Options) takes comma-separated -O text: each
+    item converted and checked, a fixed length counted; a log's list is the tuple -O gives.
+    (A tuple parameter of a plug-in without Options got the text "0.3,0.7" before.)"""
+    from sgtool.planning.registry import effective_options, typed_options
+
+    (tmp_path / "list_plug.py").write_text(textwrap.dedent('''
+        from __future__ import annotations
+
+        from dataclasses import dataclass, field
+
+        from sgtool.planning.option_fields import option
+        from sgtool.planning.planners import GreedyPlanner
+
+
+        class WithOptions(GreedyPlanner):
+            @dataclass(frozen=True)
+            class Options:
+                weights: tuple[float, float] = (0.5, 0.5)
+                shares: tuple[float, ...] = field(default=(), metadata=option(
+                    "shares", "list", item="float", lo=0.0, hi=1.0))
+
+            def __init__(self, **kw):
+                super().__init__()
+                self.kw = kw
+
+
+        class Signature(GreedyPlanner):
+            def __init__(self, weights: tuple[float, float] = (0.5, 0.5),
+                         rooms: tuple[str, ...] = (), counts: list[int] | None = None,
+                         k: int = 1, anything=None):
+                super().__init__()
+                self.kw = dict(weights=weights, rooms=rooms, counts=counts, k=k,
+                               anything=anything)
+    '''))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    for name in ("list_plug:WithOptions", "list_plug:Signature"):
+        assert parse_option(name, "weights", "0.3, 0.7") == (0.3, 0.7)
+        with pytest.raises(PlannerOptionError, match="must be 2 comma-separated numbers, "
+                                                     "not 3"):
+            parse_option(name, "weights", "1,2,3")
+        with pytest.raises(PlannerOptionError, match=r"option weights\[1\]=x: must be a "
+                                                     "number"):
+            parse_option(name, "weights", "1,x")
+        # a log records the list; compared as -O gives it
+        assert typed_options(name, {"weights": [0.3, 0.7]}) == {"weights": (0.3, 0.7)}
+        assert effective_options(name, {"weights": [0.5, 0.5]}) == {}
+    with pytest.raises(PlannerOptionError, match=r"shares\[0\]=2: must be 0..1"):
+        parse_option("list_plug:WithOptions", "shares", "2")
+    assert parse_option("list_plug:WithOptions", "shares", "") == ()
+    assert make_planner("list_plug:WithOptions", weights=[1, 2]).inner.kw == {  # type: ignore[attr-defined]
+        "weights": (1.0, 2.0)}
+    sig = "list_plug:Signature"
+    assert parse_option(sig, "rooms", "kitchen, bath room") == ("kitchen", "bath room")
+    assert parse_option(sig, "counts", "1,2") == [1, 2]
+    with pytest.raises(PlannerOptionError, match="option k=2.5: must be an integer"):
+        parse_option(sig, "k", "2.5")
+    assert parse_option(sig, "anything", "2.5") == 2.5  # not annotated: parsed as before
+    lines = describe_planners([sig])
+    assert "weights (float list, default 0.5,0.5): a field of tuple[float, float] " \
+        "[2 comma-separated numbers]" in lines
+    assert "rooms (str list, default none)" in lines
