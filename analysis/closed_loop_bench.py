@@ -568,9 +568,7 @@ def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path,
             paths.append(plot_efficiency(by_planner, model,
                                          out / f"efficiency_{noise_folder(noise)}_"
                                          f"{model.name}.png"))
-    models = {m.name for m in cost_models(cfg.distance_budget, cfg.step_budget)} | {"frames"}
-    for stale in sorted(p for p in set(out.glob("efficiency_*_*.png")) - set(paths)
-                        if p.stem.rpartition("_")[2] in models):  # another profile's
+    for stale in stale_curves(out, paths, cfg):
         stale.unlink()
     paths.append(atomic_write(out / "summary.md", res.table()))
     if timings:
@@ -578,6 +576,13 @@ def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path,
     paths.append(atomic_write(out / "summary.json", json.dumps(
         strict_json(res.summary()), indent=1, sort_keys=True, allow_nan=False) + "\n"))
     return paths
+
+
+def stale_curves(out: Path, written: Sequence[Path], cfg: ClosedLoopBenchConfig) -> list[Path]:
+    """The efficiency curves in ``out`` that are not ``written``: another profile's."""
+    models = {m.name for m in cost_models(cfg.distance_budget, cfg.step_budget)} | {"frames"}
+    return sorted(p for p in set(out.glob("efficiency_*_*.png")) - set(written)
+                  if p.stem.rpartition("_")[2] in models)
 
 
 def run_symbolic(cfg: ClosedLoopBenchConfig) -> tuple[EpisodeResult, ...]:

@@ -22,6 +22,7 @@ import json
 import sys
 import tempfile
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -31,6 +32,7 @@ from sgtool.analysis.closed_loop_bench import (
     RunRow,
     RunTask,
     log_source,
+    stale_curves,
 )
 from sgtool.analysis.executor import Executor, FolderMark
 from sgtool.errors import SgtoolError
@@ -98,7 +100,9 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
                                         report_only=request.report_only, runner=runner)
         except KeyboardInterrupt as e:  # the CLI prints the note; exit 130 (143: killed)
             kept = any((root / "logs").rglob("*.mcap")) if (root / "logs").is_dir() else False
-            e.note = (f"the complete episode logs are kept in {request.out_dir}/logs "  # type: ignore[attr-defined]
+            e.note = (f"{request.out_dir} is as it was (--report-only runs nothing)"  # type: ignore[attr-defined]
+                      if request.report_only else
+                      f"the complete episode logs are kept in {request.out_dir}/logs "
                       "(run the same command again to resume)" if kept else
                       "no episode had finished: no log was kept")
             raise  # (with --force, output_folder says OUT is as it was instead)
@@ -120,16 +124,20 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
                   "DIR again to keep it)", file=sys.stderr)
         try:
             res = _with_symbolic(request, res)
-            written = [p.name for p in write_tables(  # (a report keeps the run's run.md)
-                res, root, timings=not (request.report_only and (root / "run.md").is_file()))]
-            if not request.report_only:
-                written.append(atomic_write(root / RUN_FILE, run_record(
-                    res.rows, root, runner, request.executor)).name)
+            with _report_stage(root) as stage:  # the report's files go in together
+                written = [p.name for p in write_tables(  # (a report keeps the run's run.md)
+                    res, stage,
+                    timings=not (request.report_only and (root / "run.md").is_file()))]
+                if not request.report_only:
+                    written.append(atomic_write(stage / RUN_FILE, run_record(
+                        res.rows, root, runner, request.executor)).name)
         except KeyboardInterrupt as e:
-            e.note = (f"interrupted while writing the report: the report files in "  # type: ignore[attr-defined]
-                      f"{request.out_dir} may mix this run's and an earlier one's; the "
-                      "same command again rewrites them from the logs (nothing runs again)")
+            e.note = ("interrupted before the report was written: the report files in "  # type: ignore[attr-defined]
+                      f"{request.out_dir} are as they were; the same command again writes "
+                      "them from the logs (nothing runs again)")
             raise
+        for stale in stale_curves(root, [root / n for n in written], res.config):
+            stale.unlink()
     show(res.table())
     from sgtool.analysis.report import invalid_action_notes, llm_warnings
 
@@ -141,6 +149,29 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
     show(f"wrote {', '.join(str(Path(request.out_dir) / name) for name in written)}")
     for line in leftover_notes(request.out_dir):
         show(line)
+
+
+@contextmanager
+def _report_stage(root: Path) -> Iterator[Path]:
+    """A hidden folder in ``root`` to write a report into; on a clean exit its files move
+    into ``root`` with Ctrl-C deferred (an interrupt while they are written leaves the
+    earlier report whole, not a mix of two), and it is removed either way."""
+    import os
+    import shutil
+
+    from sgtool.files import deferred_interrupts, output_error
+
+    try:
+        stage = Path(tempfile.mkdtemp(prefix=".report.", suffix=".partial", dir=root))
+    except OSError as e:
+        raise output_error(e, root) from None
+    try:
+        yield stage
+        with deferred_interrupts():
+            for name in sorted(os.listdir(stage)):
+                os.replace(stage / name, root / name)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
 
 
 def unreported(logs: Path, reported: set[Path]) -> list[Path]:

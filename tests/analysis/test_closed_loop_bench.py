@@ -207,24 +207,33 @@ def test_ctrl_c_leaves_only_complete_logs(house_file, tmp_path, monkeypatch) -> 
     assert not first.exists() and partial_files(first) == []
 
 
-def test_ctrl_c_while_the_report_is_written_says_how_to_finish_it(house_file, tmp_path,
-                                                                  monkeypatch) -> None:
-    """Every episode logged, Ctrl-C in the tables: the note says the report may be mixed
-    and that the same command rewrites it from the logs (it said nothing was
-    half-written)."""
+def test_ctrl_c_while_the_report_is_written_leaves_the_earlier_one_whole(
+        house_file, tmp_path, monkeypatch) -> None:
+    """Every episode logged, Ctrl-C after the new report's first files were written: the
+    earlier report is there as it was, byte for byte (it was a mix of the two before), no
+    stage is left, and the note says the same command writes the report from the logs."""
     out = tmp_path / "rb"
+    first = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
+    assert first.exit_code == 0, first.output
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    write = clb.write_outputs
 
-    def interrupted(*a, **k):
+    def interrupted(res, out_dir, timings=True):
+        write(res, out_dir, timings)  # every file of the new report, then Ctrl-C
         raise KeyboardInterrupt
 
     monkeypatch.setattr(clb, "write_outputs", interrupted)
-    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
+    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                   "--report-only", "--budgets", "7"])
     assert res.exit_code == 130
-    assert "interrupted while writing the report" in res.output
-    assert "rewrites them from the logs (nothing runs again)" in res.output
+    assert "interrupted before the report was written" in res.output
+    assert "writes them from the logs (nothing runs again)" in res.output
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == before
+    assert not [p for p in out.iterdir() if p.name.startswith(".report.")]
     monkeypatch.undo()
-    again = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
-    assert again.exit_code == 0 and (out / "summary.md").is_file()
+    again = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                     "--report-only", "--budgets", "7"])
+    assert again.exit_code == 0 and (out / "summary.md").read_bytes() != before["summary.md"]
 
 
 def test_user_errors(tmp_path) -> None:
