@@ -159,7 +159,8 @@ def _report_stage(root: Path) -> Iterator[Path]:
     import os
     import shutil
 
-    from sgtool.files import deferred_interrupts, output_error
+    from sgtool.errors import deferred_interrupts
+    from sgtool.files import output_error
 
     try:
         stage = Path(tempfile.mkdtemp(prefix=".report.", suffix=".partial", dir=root))

@@ -6,7 +6,10 @@ from __future__ import annotations
 
 import os
 import signal
+import threading
 import traceback
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 
@@ -98,3 +101,30 @@ def traceback_text(e: BaseException) -> str | None:
     if os.environ.get("SGTOOL_TRACEBACK", "") in ("", "0"):
         return None
     return "".join(traceback.format_exception(e)).rstrip()
+
+
+@contextmanager
+def deferred_interrupts() -> Iterator[None]:
+    """Ctrl-C (and SIGTERM, SIGHUP) during the block take effect when it ends: for a commit of
+    files that must change together (a pin folder's graphs and its index), which an
+    interrupt between two of them would leave out of step. Outside the main thread (no
+    signal handlers there) the block runs as it is."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    got: list[int] = []
+    old = {int(s): signal.getsignal(s) for s in (signal.SIGINT, *STOP_SIGNALS)}
+    for s in old:
+        signal.signal(s, lambda signum, _frame: got.append(signum))
+    try:
+        yield
+    finally:
+        for s, handler in old.items():
+            signal.signal(s, handler)
+    if not got:
+        return
+    handler = old[got[0]]
+    if callable(handler):  # Python's Ctrl-C handler raises KeyboardInterrupt
+        handler(got[0], None)
+    elif handler == signal.SIG_DFL:  # the default action (SIGTERM: the process ends)
+        signal.raise_signal(got[0])

@@ -29,14 +29,12 @@ import json
 import os
 import shlex
 import shutil
-import signal
 import tempfile
-import threading
 from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import IO
 
-from sgtool.errors import STOP_SIGNALS, SgtoolError
+from sgtool.errors import SgtoolError, deferred_interrupts
 
 # OSError numbers that a user's environment causes (a destination that is read-only,
 # missing, full, not writable): reported as one line, never as a traceback
@@ -316,33 +314,6 @@ def leftover_stages(target: str | os.PathLike[str]) -> list[Path]:
                   and len(p.name) == len(head) + 8 + len(tail))
 
 
-@contextlib.contextmanager
-def deferred_interrupts() -> Iterator[None]:
-    """Ctrl-C (and SIGTERM, SIGHUP) during the block take effect when it ends: for a commit of
-    files that must change together (a pin folder's graphs and its index), which an
-    interrupt between two of them would leave out of step. Outside the main thread (no
-    signal handlers there) the block runs as it is."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    got: list[int] = []
-    old = {int(s): signal.getsignal(s) for s in (signal.SIGINT, *STOP_SIGNALS)}
-    for s in old:
-        signal.signal(s, lambda signum, _frame: got.append(signum))
-    try:
-        yield
-    finally:
-        for s, handler in old.items():
-            signal.signal(s, handler)
-    if not got:
-        return
-    handler = old[got[0]]
-    if callable(handler):  # Python's Ctrl-C handler raises KeyboardInterrupt
-        handler(got[0], None)
-    elif handler == signal.SIG_DFL:  # the default action (SIGTERM: the process ends)
-        signal.raise_signal(got[0])
-
-
 def leftover_notes(target: str | os.PathLike[str]) -> list[str]:
     """One note per :func:`leftover_stages` folder beside ``target``, for a command to
     show after its run."""
@@ -393,9 +364,10 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
     The new :data:`MANIFEST` lists the top-level entries of the yielded folder, for the
     next ``--force``. On any exception (Ctrl-C included) the yielded folder is removed and
     ``target`` is as it was; a :class:`KeyboardInterrupt` gets a ``note`` saying so (what
-    the CLI prints). The yielded folder's entries are moved, not copied: paths into it are
-    stale once the block ends (name outputs as ``target / name``). Only SIGKILL can leave
-    the hidden folder behind. A parent that cannot be written is one
+    the CLI prints). A Ctrl-C while the outputs go in takes effect once they are in (its
+    note says the target holds them). The yielded folder's entries are moved, not copied:
+    paths into it are stale once the block ends (name outputs as ``target / name``). Only
+    SIGKILL can leave the hidden folder behind. A parent that cannot be written is one
     :class:`OutputError` line.
 
     Resume (``resume=True``, for a command that keeps writing into a folder of its own,
@@ -441,6 +413,7 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
     except OSError as e:
         _remove_empty(made)
         raise output_error(e, target) from None
+    committed = False
     try:
         yield stage
         atomic_write(stage / MANIFEST, manifest_text(command, os.listdir(stage)))
@@ -450,16 +423,22 @@ def output_folder(target: str | os.PathLike[str], *, force: bool, command: str =
             raise SgtoolError(f"{option} {target}: another run wrote into it while this one "
                               f"ran; this run's outputs are in {kept} instead")
         try:
-            _commit(stage, path, sgtool_entries(path, known) if path.is_dir() else set())
+            with deferred_interrupts():  # a Ctrl-C in the moves: once they are done
+                _commit(stage, path, sgtool_entries(path, known) if path.is_dir() else set())
+                committed = True
         except OSError as e:
             if is_environment_error(e):
                 raise output_error(e, target, note=f"{target} is as it was") from None
             raise
     except BaseException as e:
         if isinstance(e, KeyboardInterrupt):  # what the CLI prints
-            e.note = (f"{target} is as it was: the outputs of the interrupted run "  # type: ignore[attr-defined]
+            e.note = (f"{target} holds this run's complete outputs (they went in as it was "  # type: ignore[attr-defined]
+                      "interrupted)" if committed else
+                      f"{target} is as it was: the outputs of the interrupted run "
                       "were discarded")
-        shutil.rmtree(stage, ignore_errors=True)
+        shutil.rmtree(stage, ignore_errors=True)  # (emptied by the moves when committed)
+        if committed:
+            raise
         _remove_empty(made)  # the folders made for the target, when still empty
         _name_target(e, stage, path)
         raise

@@ -263,6 +263,37 @@ def test_deferred_interrupts_hold_ctrl_c_until_the_block_ends() -> None:
     assert signal.getsignal(signal.SIGINT) is before
 
 
+def test_ctrl_c_as_the_outputs_go_in_says_they_did(tmp_path: Path,
+                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    """A Ctrl-C while --force moves the new outputs in (here: as the previous ones are
+    deleted) lets the moves finish, then interrupts saying the target holds this run's
+    complete outputs; it said the target was as it was, and left the previous outputs in
+    a hidden folder there."""
+    import shutil
+    import signal
+
+    import sgtool.files
+
+    out = tmp_path / "res"
+    with output_folder(out, force=False, command="bench") as stage:
+        _write(stage, **{"a.txt": "old", "b.txt": "old"})
+    rmtree = shutil.rmtree
+
+    def interrupted(path, *a, **k):  # type: ignore[no-untyped-def]
+        if Path(path).name.startswith(".sgtool-previous."):
+            signal.raise_signal(signal.SIGINT)
+        rmtree(path, *a, **k)
+
+    monkeypatch.setattr(sgtool.files.shutil, "rmtree", interrupted)
+    with pytest.raises(KeyboardInterrupt) as e:
+        with output_folder(out, force=True, command="bench") as stage:
+            _write(stage, **{"a.txt": "new"})
+    assert "holds this run's complete outputs" in e.value.note  # type: ignore[attr-defined]
+    assert sorted(os.listdir(out)) == [MANIFEST, "a.txt"]
+    assert (out / "a.txt").read_text() == "new"
+    assert os.listdir(tmp_path) == ["res"]
+
+
 def test_deferred_sigterm_with_the_default_handler_still_ends_the_process(tmp_path) -> None:
     """A library caller keeps Python's default SIGTERM action: a SIGTERM inside the block
     ends the process when the block ends (it was dropped)."""
