@@ -41,7 +41,6 @@ from __future__ import annotations
 import os
 import threading
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -195,19 +194,27 @@ class OpenAIChatClient:
     takes_constraint = True
 
     def __init__(self, settings: LlmSettings) -> None:
-        from openai import OpenAI
-
         self.settings = settings
         self.model = settings.model
-        self._new_client: Callable[[], Any] = lambda: OpenAI(
-            base_url=settings.base_url,
-            api_key=settings.api_key or "sk-no-key-needed",
-            timeout=settings.timeout_s,
-            max_retries=0,
-        )
         self._client = self._new_client()
         self.replies = 0  # HTTP replies received (any status): the endpoint exists
         self.answers = 0  # replies with a usable answer
+
+    def _new_client(self) -> Any:
+        from openai import OpenAI
+
+        return OpenAI(base_url=self.settings.base_url,
+                      api_key=self.settings.api_key or "sk-no-key-needed",
+                      timeout=self.settings.timeout_s, max_retries=0)
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickled without its HTTP client (a planner sent to another process), which
+        :meth:`__setstate__` makes anew."""
+        return {k: v for k, v in self.__dict__.items() if k != "_client"}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._client = self._new_client()
 
     @property
     def where(self) -> str:

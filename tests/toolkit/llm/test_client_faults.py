@@ -223,3 +223,20 @@ def test_a_mistyped_base_url_is_a_setup_error(url, says):
     with pytest.raises(LlmConfigError, match=re.escape(says)):
         LlmSettings.resolve(base_url=url, model="m")
     assert LlmSettings.resolve(base_url="http://[::1]:8080/v1").base_url
+
+
+def test_an_llm_planner_pickles_and_its_copy_asks_the_endpoint() -> None:
+    """An LLM planner goes to another process as the other planners do (it did not: the
+    client's factory was a lambda); the copy makes its own HTTP client and asks the same
+    endpoint with the same key."""
+    import pickle
+
+    from sgtool.planning.registry import make_planner
+
+    with ChatServer([{"text": "fine"}]) as srv:
+        planner = make_planner("moma-llm", base_url=srv.base_url, model="m", api_key=KEY)
+        copy = pickle.loads(pickle.dumps(planner))
+        llm = copy.inner.client  # type: ignore[attr-defined]
+        assert llm is not planner.inner.client  # type: ignore[attr-defined]
+        assert llm.complete([{"role": "user", "content": "x"}]).text == "fine"
+    assert srv.auth == [f"Bearer {KEY}"]
