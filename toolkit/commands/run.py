@@ -336,8 +336,10 @@ def again_request(args: RunArgs, given: frozenset[str], out: Path,
         note(f"note: {args.again} was run by older sgtool with a setting it runs otherwise "
              f"today: {n}")
     name, options = _planner(replace(args, planner=args.planner or run.planner))
-    if name == run.planner:  # the log's options, -O given beside changing them
-        options = {**run.planner_options, **options}
+    if name == run.planner:  # the log's options, -O given beside changing them; not its
+        # transcript, which a run empties when it starts (--llm-transcript names a new one)
+        logged = {k: v for k, v in run.planner_options.items() if k != "transcript"}
+        options = {**logged, **options}
     return SearchRequest(house=run.house, house_id=run.house_id,
                          episode_index=run.episode_index, episode=run.episode, planner=name,
                          output=out, options=_changed(args, given, run),
@@ -350,6 +352,7 @@ def _changed(args: RunArgs, given: frozenset[str], run: LoggedRun) -> ClosedLoop
     from sgtool.commands.options import parse_resolution
     from sgtool.recorders.sim import parse_noise
     from sgtool.recorders.sim.frame_budget import frame_budget
+    from sgtool.recorders.sim.live_skills import LiveNavConfig
 
     o = run.options
     changes: dict[str, Any] = {field: getattr(args, name)
@@ -363,6 +366,10 @@ def _changed(args: RunArgs, given: frozenset[str], run: LoggedRun) -> ClosedLoop
         changes["frames"] = frame_budget(args.frames, args.frames_per_room,
                                          len(run.house.rooms))
     live = {f: getattr(args, f) for f in _LIVE if f in given}
-    if live:
-        changes["live"] = replace(o.live, **live)
+    if changes.get("navigation", o.navigation) == "house" and o.navigation != "house":
+        base, changes["explore_on"] = LiveNavConfig(), changes.get("explore_on", 0)
+    else:  # (the robot's own navigation settings do not go to house navigation)
+        base = o.live
+    if live or base is not o.live:
+        changes["live"] = replace(base, **live)
     return replace(o, **changes)
