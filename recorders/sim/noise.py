@@ -46,6 +46,7 @@ import numpy as np
 from sgtool.arg_checks import of_type
 from sgtool.errors import SgtoolError
 from sgtool.house.parse import JsonObject, json_object_pairs
+from sgtool.log.codec import compose, relative
 from sgtool.log.frame import Frame
 from sgtool.recorders.sim.camera import LINK_TOL, se2_matrix
 
@@ -322,11 +323,11 @@ class SensorFaults:
             self._true_prev = true
         est_base = se2_matrix(*self._est)
         est_base[2, 3] = base[2, 3]
-        base_T_cam = np.linalg.inv(base) @ pose  # noqa: N806
+        base_T_cam = relative(base, pose)  # noqa: N806
         if self._base_T_cam is not None and np.allclose(base_T_cam, self._base_T_cam,
                                                         rtol=0.0, atol=LINK_TOL):
             base_T_cam = self._base_T_cam  # the mounting as given (not rounded again)
-        return est_base @ base_T_cam, est_base
+        return compose(est_base, base_T_cam), est_base
 
 
 def mixed_edges(depth: np.ndarray, share: float, rng: np.random.Generator) -> np.ndarray:

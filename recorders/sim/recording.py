@@ -142,7 +142,7 @@ class LogRecorder(SimObserver):
             w.write_transform(t, S.WORLD_FRAME, S.CAMERA_FRAME, f.pose)
         else:
             w.write_transform(t, S.WORLD_FRAME, S.BASE_FRAME, f.base_pose)
-            base_T_cam = np.linalg.inv(f.base_pose) @ f.pose  # noqa: N806
+            base_T_cam = codec.relative(f.base_pose, f.pose)  # noqa: N806
             if self._static is None:
                 self._static = base_T_cam
                 w.write_proto(S.TF_STATIC, t, codec.encode_transform(

@@ -33,6 +33,7 @@ import numpy as np
 from sgtool.errors import SgtoolError
 from sgtool.house.outline import outline_walls
 from sgtool.house.spec import HouseSpec, StartPose, room_at, spec_id_key
+from sgtool.log.codec import compose
 from sgtool.log.frame import Frame
 from sgtool.mapping.occupancy import OccupancyMap
 from sgtool.recorders.sim import articulation as art
@@ -178,7 +179,7 @@ class Simulation(Skills):
 
     def camera_matrix(self, pose: Pose2 | None = None) -> np.ndarray:
         """world_T_camera (optical frame) for the base at ``pose`` (default: now)."""
-        return self.base_matrix(pose) @ self._base_T_cam
+        return compose(self.base_matrix(pose), self._base_T_cam)
 
     def room_of_base(self) -> str | None:
         return room_at(self.spec, self.base[0], self.base[1])

@@ -205,11 +205,32 @@ def quat_from_matrix(R: np.ndarray) -> tuple[float, float, float, float]:  # noq
         s = np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2
         w, x = (m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s
         y, z = (m[1, 2] + m[2, 1]) / s, 0.25 * s
-    q = np.array([x, y, z, w])
-    q /= np.linalg.norm(q)
+    # the norm in plain floats: np.linalg.norm is a BLAS dot whose last bits depend on
+    # the CPU's kernel (OpenBLAS picks one per machine), so logs would differ by machine
+    x, y, z, w = float(x), float(y), float(z), float(w)
+    n = math.sqrt(x * x + y * y + z * z + w * w)
+    q = (x / n, y / n, z / n, w / n)
     if q[3] < 0:
-        q = -q
-    return float(q[0]), float(q[1]), float(q[2]), float(q[3])
+        q = (-q[0], -q[1], -q[2], -q[3])
+    return q
+
+
+def compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a @ b`` for 4x4 transforms in plain float arithmetic, each entry summed in one
+    fixed order: a BLAS product's last bits depend on the CPU kernel OpenBLAS picks, so
+    logs written with ``@`` differ from machine to machine."""
+    A, B = np.asarray(a, dtype=np.float64).tolist(), np.asarray(b, dtype=np.float64).tolist()
+    return np.array([[A[i][0] * B[0][j] + A[i][1] * B[1][j] + A[i][2] * B[2][j]
+                      + A[i][3] * B[3][j] for j in range(4)] for i in range(4)])
+
+
+def relative(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``inv(a) @ b`` for a rigid 4x4 transform ``a`` (rotation and translation), in plain
+    float arithmetic (:func:`compose`)."""
+    A = np.asarray(a, dtype=np.float64).tolist()
+    inv = [[A[0][i], A[1][i], A[2][i],
+            -(A[0][i] * A[0][3] + A[1][i] * A[1][3] + A[2][i] * A[2][3])] for i in range(3)]
+    return compose(np.array(inv + [[0.0, 0.0, 0.0, 1.0]]), b)
 
 
 def matrix_from_quat(x: float, y: float, z: float, w: float) -> np.ndarray:

@@ -42,7 +42,7 @@ def as_logged(frame: Frame) -> Frame:
         # the writer's chain world -> base -> camera, composed as the reader's TransformBuffer
         world_T_base = echo(S.WORLD_FRAME, S.BASE_FRAME, frame.base_pose)  # noqa: N806
         base_T_cam = echo(S.BASE_FRAME, S.CAMERA_FRAME,  # noqa: N806
-                          np.linalg.inv(frame.base_pose) @ frame.pose)
+                          codec.relative(frame.base_pose, frame.pose))
         pose = world_T_base @ (base_T_cam @ np.eye(4))
         base = world_T_base @ np.eye(4)
     else:

@@ -459,7 +459,7 @@ class LogWriter:
                 raise ValueError(f"intrinsics {intrinsics}: {e}") from None
             out.append((S.CALIBRATION, calibration))
         if base_pose is not None:
-            base_T_cam = np.linalg.inv(base_pose) @ pose  # noqa: N806
+            base_T_cam = codec.relative(base_pose, pose)  # noqa: N806
             out += [(S.TF, codec.encode_transform(t_ns, S.WORLD_FRAME, S.BASE_FRAME,
                                                   base_pose)),
                     (S.TF, codec.encode_transform(t_ns, S.BASE_FRAME, S.CAMERA_FRAME,
