@@ -550,9 +550,10 @@ OUTPUT_NAMES: tuple[str, ...] = ("logs", "episodes.jsonl", "summary.md", "summar
 
 def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path,
                   timings: bool = True) -> list[Path]:
-    """episodes.jsonl, summary.md, summary.json (no wall-clock figure: two runs give the
-    same bytes), run.md (decision times, frames/s; not with ``timings`` False: a report
-    of logs run earlier keeps the run's own), the efficiency curves per noise profile
+    """summary.md, summary.json (no wall-clock figure: two runs give the same bytes),
+    episodes.jsonl (the same but its measured ``wall`` fields), run.md (decision times,
+    frames/s; not with ``timings`` False: a report of logs run earlier keeps the run's
+    own), the efficiency curves per noise profile
     (distance, steps, frames per room; those of other profiles, an earlier run's, are
     removed), each written atomically into ``out_dir``."""
     from sgtool.analysis.curves import plot_efficiency

@@ -300,3 +300,17 @@ def test_a_log_drifted_by_the_per_frame_model_is_not_resumed(tmp_path: Path) -> 
         "pose drift model (1: per frame, sgtool before 992f26a, or a log of 992f26a that "
         "did not record it; 2: per distance): 1 in the log, 2 now"]
     assert task_settings(opts, "none", logged["episode"])["drift_model"] is None
+
+
+def test_where_an_llm_planner_gets_its_answers_is_no_setting() -> None:
+    """A run-bench of moma-llm resumed against the endpoint on another port, or replayed
+    from its transcript, decides alike: base_url, replay and transcript are not compared
+    (resume was refused, eval noted other options); the options that decide still are."""
+    from sgtool.planning.registry import effective_options
+
+    live = {"base_url": "http://127.0.0.1:18777/v1", "transcript": "t.jsonl",
+            "history_limit": 5}
+    assert effective_options("moma-llm", live) == {"history_limit": 5}
+    assert effective_options("moma-llm", {"replay": "t.jsonl", "history_limit": 5}) == \
+        {"history_limit": 5}
+    assert effective_options("moma-llm", {"history_limit": 30}) == {}  # the default

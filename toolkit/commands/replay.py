@@ -81,7 +81,9 @@ if TYPE_CHECKING:
               "than 0.05 s from their log times are warned about (the largest offset named), "
               "more than 1 s refused.")
 @click.option("--rrd", type=PathParam(dir_okay=False),
-              help="Also write a Rerun recording of the derived log (needs -o).")
+              help="Also write a Rerun recording of the derived log (needs -o); its bytes "
+              "differ from run to run (Rerun's own chunk and row ids), its content does "
+              "not.")
 @click.option("--rerun", "rerun_to", default=None,
               metavar="spawn|connect[:URL]|serve[:WEB_PORT[:GRPC_PORT]]",
               help="Stream every refresh (maps, scene graph, robot) to Rerun while replaying: "

@@ -321,7 +321,15 @@ def effective_options(name: str, given: Mapping[str, Any]) -> dict[str, Any]:
     if cls is None and name.strip().lower() not in REGISTRY:  # a plug-in's own defaults
         defaults |= _signature_defaults(_factory(name))
     values = typed_options(name, given)
-    return {k: v for k, v in sorted(values.items()) if k not in defaults or v != defaults[k]}
+    source = ANSWER_SOURCE if is_llm_planner(name) else frozenset()
+    return {k: v for k, v in sorted(values.items())
+            if k not in source and (k not in defaults or v != defaults[k])}
+
+
+# the options of the built-in LLM planners that say where their answers come from and where
+# they are written, not which answers: a live run, the same run on another port and its
+# offline replay from the transcript decide alike
+ANSWER_SOURCE = frozenset({"base_url", "replay", "transcript"})
 
 
 def typed_options(name: str, given: Mapping[str, Any]) -> dict[str, Any]:
