@@ -537,8 +537,9 @@ class SceneGraphBuilder:
                                     self.voxels.frame_counts, DOOR_MIN_FRAMES)
         reach = DOOR_REACH / self.voxels.resolution
         won = {iid: near_median(ijk, reach) for iid, ijk in won.items()}
-        cells, centres, unsure = doorways(occ, won, self._panel_memo)
-        cells |= lintel_doorways(occ, self.columns_between(occ, *LINTEL_BAND))  # no leaf seen
+        overhead = self.columns_between(occ, *LINTEL_BAND)
+        cells, centres, unsure = doorways(occ, won, self._panel_memo, overhead)
+        cells |= lintel_doorways(occ, overhead)  # no leaf seen
         cells.setflags(write=False)  # kept to recognise the same cells next time
         got = self._density
         if got is None or got[0] != occ.resolution or not np.array_equal(got[1], cells):

@@ -10,9 +10,15 @@ and each seen door's rooms.
   (those with at least ``CORE_SHARE`` of its fullest column's voxels), else from its line
   (the core continued by the thinner columns in line with it: :func:`panel_cells`), else
   its core columns. A door seen as a panel whose doorway was not found (a door standing
-  partly open, as a rule) also marks the floor within ``UNSURE_REACH`` (or its panel's
-  length, when longer) of its core as *unsure*: its doorway lies somewhere there, so the
-  room segmentation joins no floor through it.
+  partly open, as a rule; or a panel smeared by drift through its thickened wall) also
+  marks the floor within ``UNSURE_REACH`` (or its panel's length, when longer) of its
+  core as *unsure*: its doorway lies somewhere there, so the room segmentation joins no
+  floor through it. Its doorway is then also looked for under its lintel: the floor
+  seen free under something overhead (``LINTEL_BAND``, given as ``overhead``) within
+  that reach and ``LINTEL_TOUCH`` of its core, where a wall stands on both sides along
+  the wall's line (drift smears a lintel as deep as the wall, too deep for
+  :mod:`sgtool.scenegraph.lintels`); the wall's line through that floor's centre, jamb
+  to jamb, is door evidence too.
 - :func:`observe_doors`: the rooms on either side of a door from the visible Voronoi nodes
   within ``door_radius``; a closed door with only one explored side leads to an unexplored
   room node (SCOUT sec. IV-A), placed ``unexplored_offset`` beyond the door.
@@ -25,6 +31,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from sgtool.mapping.bev import line_of_sight
@@ -41,6 +48,7 @@ PASSABLE_SHARE = 0.25  # passable share of a door's columns that makes them its 
 CORE_SHARE = 0.5  # a panel's column holds at least this share of its fullest column's voxels
 LINE_SLACK = 0.9  # cells across a panel's line that are on it (a slanted line's cells: <0.71)
 LINE_GAP = 2  # cells a panel's line may miss between cells that continue it
+LINTEL_TOUCH = 0.25  # m: a lintel this close to a panel is its doorway's (doorways())
 UNSURE_REACH = 0.9  # m: a door leaf's width (interior doors 0.7-0.9 m), at least
 
 
@@ -60,7 +68,7 @@ def open_doors(instances: Mapping[int, InstanceInfo]) -> list[int]:
 
 
 def doorways(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
-             panel_memo: dict[bytes, object]
+             panel_memo: dict[bytes, object], overhead: np.ndarray | None = None
              ) -> tuple[np.ndarray, dict[int, tuple[float, float]], np.ndarray]:
     """Bool grid of the door evidence (module doc) from the voxels (ijk) of each open door,
     in any order (e.g. from :class:`sgtool.scenegraph.door_voxels.DoorVoxels`), the
@@ -117,20 +125,82 @@ def doorways(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
         cells[pr, pc] = True  # the panel's doorway, else its core cells
         centres[ids[i]] = _centre(occ, np.asarray(pr), np.asarray(pc))
         if got is None:
-            _near_panel(unsure, np.asarray(pr), np.asarray(pc), occ.resolution)
+            near = _near_panel(unsure, np.asarray(pr), np.asarray(pc), occ.resolution)
+            if overhead is not None and near is not None:  # its doorway, under its lintel
+                cells |= _lintel_by_panel(near, np.asarray(pr), np.asarray(pc),
+                                          overhead & free, occupied,
+                                          LINTEL_TOUCH / occ.resolution)
     return cells, centres, unsure
 
 
+def _lintel_by_panel(near: np.ndarray, rows: np.ndarray, cols: np.ndarray,
+                     overhead_floor: np.ndarray, occupied: np.ndarray,
+                     touch_cells: float) -> np.ndarray:
+    """Bool grid: the doorway, under its lintel, of a panel (cells ``rows``, ``cols``)
+    whose closed position was not found (a door is hinged at its doorway, under whose
+    lintel the floor is seen however drift smears the lintel and the wall). The
+    8-connected pieces of ``overhead_floor`` (floor seen free with something overhead)
+    within ``near`` (the panel's reach) that come within ``touch_cells`` of the panel;
+    of those, the cells with an ``occupied`` cell on both sides along the wall's line
+    (across the panel's principal axis) within the panel's span; the doorway is the
+    wall's line through their centre, to the first occupied cell each way (none when a
+    side has none within the span). All False when there is none."""
+    panel = np.zeros(near.shape, dtype=bool)
+    panel[rows, cols] = True
+    touch = within_cells(panel, touch_cells)
+    labels, _ = ndimage.label(overhead_floor & near, structure=np.ones((3, 3), dtype=bool))
+    mine = np.unique(labels[touch & (labels > 0)])
+    got = np.isin(labels, mine) & (labels > 0)
+    if not got.any() or len(rows) < 2:
+        return np.zeros_like(got)
+    # only the cells in the gap of the wall the door is hinged to: occupied cells on
+    # both sides along the wall's line (across the panel's line), within the panel's
+    # reach; drift smears a lintel out of its wall, as it smears the wall
+    pts = np.stack([cols, rows], axis=1).astype(np.float64)
+    cen = pts - pts.mean(axis=0)
+    evecs = np.linalg.eigh(cen.T @ cen)[1]
+    t = np.array([-evecs[1, -1], evecs[0, -1]])
+    reach = math.hypot(int(rows.max() - rows.min()), int(cols.max() - cols.min())) + 1
+    gr, gc = np.nonzero(got)
+    at = np.stack([gc, gr], axis=1).astype(np.float64)
+    steps = np.arange(1.0, reach + 1.0)
+    keep = np.ones(len(gr), dtype=bool)
+    for side in (1.0, -1.0):
+        p = at[:, None, :] + side * steps[None, :, None] * t[None, None, :]
+        hit = grid_at(p.reshape(-1, 2), occupied).reshape(len(gr), len(steps))
+        keep &= hit.any(axis=1)
+    out = np.zeros_like(got)
+    if not keep.any():
+        return out
+    # the doorway: the wall's line through the lintel's centre, jamb to jamb (one cell
+    # thick, as a panel's closed position: a smeared lintel's depth would cut a
+    # corridor that drift narrows in front of the doorway)
+    centre = at[keep].mean(axis=0)
+    for side in (1.0, -1.0):
+        p = centre[None, :] + side * np.arange(0.0, reach + 0.5, 0.5)[:, None] * t[None, :]
+        hit = grid_at(p, occupied)
+        if not hit.any():
+            return np.zeros_like(got)
+        p = p[:int(np.argmax(hit))]
+        r = np.round(p[:, 1]).astype(np.int64)
+        c = np.round(p[:, 0]).astype(np.int64)
+        out[r, c] = True
+    return out
+
+
 def _near_panel(unsure: np.ndarray, rows: np.ndarray, cols: np.ndarray,
-                resolution: float) -> None:
+                resolution: float) -> np.ndarray | None:
     """Mark in ``unsure`` the cells within the reach of a panel's cells: its span (the
-    diagonal of their bounding box, plus a cell), at least ``UNSURE_REACH``."""
+    diagonal of their bounding box, plus a cell), at least ``UNSURE_REACH``; those cells
+    (None: no panel cells)."""
     if len(rows) == 0:
-        return
+        return None
     span = math.hypot(int(rows.max() - rows.min()), int(cols.max() - cols.min())) + 1
     panel = np.zeros(unsure.shape, dtype=bool)
     panel[rows, cols] = True
-    unsure |= within_cells(panel, max(span, UNSURE_REACH / resolution))
+    near = within_cells(panel, max(span, UNSURE_REACH / resolution))
+    unsure |= near
+    return near
 
 
 _Cells = tuple[np.ndarray, np.ndarray]
