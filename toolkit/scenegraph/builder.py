@@ -549,7 +549,7 @@ class SceneGraphBuilder:
             got[2].setflags(write=False)
             self._density = got
         density = got[2]
-        seg = segment_rooms(vg, density, cfg, self._centre_memo, occ, unsure | cells)
+        seg = segment_rooms(vg, density, cfg, self._centre_memo, occ, unsure | cells, self._body)
         numbers = self._rooms.assign([vg.positions[r] for r in seg.rooms], cfg.match_radius)
         return _Rooms(cells, density, seg, [f"room:{n}" for n in numbers], centres)
 

@@ -45,7 +45,12 @@ What we do, and why it differs:
   opening), and needs passages ``JOIN_WIDTH`` wide (a slit beside a closed leaf, a gap
   at a wall's end join nothing): the floor is eroded k cells, which keeps passages of
   2k + 1 cells, k the fewest steps that make those at least ``JOIN_WIDTH`` (3 cells at
-  5 cm). A merged room's centre is taken on its largest piece.
+  5 cm). The robot's own path joins too: a stretch of it that stays outside the cut zone
+  and ``JOIN_SEAL`` joins the parts of open floor it crosses, whatever the grid shows
+  between them now (a phantom obstacle on its way, a swung door leaf and a cabinet door
+  opened after it passed, leaving a pocket of the room closed off; a path through a
+  doorway enters its cut zone, so it joins nothing there). A merged room's centre is
+  taken on its largest piece.
   A component shorter than ``min_room_length`` is a room when it stands on open floor of
   its own (no longer component's nodes on it) of at least ``OWN_FLOOR`` times
   ``min_room_length`` squared (0.5 m^2): a room glimpsed through a doorway, or a closet or
@@ -116,14 +121,18 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
                   config: RoomConfig | None = None,
                   centre_memo: dict[bytes, int] | None = None,
                   occ: OccupancyGrid | None = None,
-                  unsure: np.ndarray | None = None) -> RoomSegmentation:
+                  unsure: np.ndarray | None = None,
+                  trajectory: np.ndarray | Sequence[tuple[float, float]] | None = None
+                  ) -> RoomSegmentation:
     """Cut ``vg`` where the door density reaches the threshold; components are rooms.
     ``centre_memo`` keeps each room's centre across calls, keyed by its sub-graph (a room
     whose sub-graph is unchanged has the same centre: the same arrays, the same Dijkstra).
     ``occ``: the grid of ``vg``; with it, components sharing free space outside the cut
     zone are one room, and a short one on floor of its own is a room (module doc);
     ``unsure``: the door evidence and the cells near a door whose doorway is not known
-    (bool, ``vg.shape``): floor within ``JOIN_SEAL`` of them joins nothing."""
+    (bool, ``vg.shape``): floor within ``JOIN_SEAL`` of them joins nothing;
+    ``trajectory``: (k, 2) world x, y of the robot's path: a stretch of it that stays out
+    of the cut zone and that floor joins the parts it crosses (module doc)."""
     cfg = config or RoomConfig()
     n, m = len(vg.positions), len(vg.edges)
     cut_e = np.zeros(m, dtype=bool)
@@ -158,7 +167,7 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
         if len(nodes):
             (rooms if comp_len[c] >= cfg.min_room_length else short).append(nodes)
     if occ is not None:
-        rooms = _rooms_by_floor(vg, rooms, short, occ, density, cfg, unsure)
+        rooms = _rooms_by_floor(vg, rooms, short, occ, density, cfg, unsure, trajectory)
     for i, nodes in enumerate(rooms):
         labels[nodes] = i
     where = np.full(n, -1, dtype=np.int64)
@@ -171,16 +180,19 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
 
 def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.ndarray],
                     occ: OccupancyGrid, density: np.ndarray | None,
-                    cfg: RoomConfig, unsure: np.ndarray | None = None) -> list[np.ndarray]:
+                    cfg: RoomConfig, unsure: np.ndarray | None = None,
+                    trajectory: np.ndarray | Sequence[tuple[float, float]] | None = None
+                    ) -> list[np.ndarray]:
     """``rooms`` (components long enough) joined where their nodes share a 4-connected part
     of the open floor (free, outside the cut zone and ``unsure``) that passages at least
     ``JOIN_WIDTH`` wide hold together, plus the ``short`` components whose parts of the
     open floor no such room touches and hold at least ``OWN_FLOOR`` times
     ``min_room_length`` squared;
     numbered by their lowest node."""
-    open_floor = occ.free if density is None else occ.free & (density < cfg.door_threshold)
+    away = np.ones(occ.shape, dtype=bool) if density is None else density < cfg.door_threshold
     if unsure is not None:  # and what lies within JOIN_SEAL of it
-        open_floor = open_floor & ~within_cells(unsure, JOIN_SEAL / occ.resolution)
+        away &= ~within_cells(unsure, JOIN_SEAL / occ.resolution)
+    open_floor = occ.free & away
     if short:
         part, count = ndimage.label(open_floor)
         area = np.bincount(part.ravel(), minlength=count + 1) * occ.resolution ** 2
@@ -198,6 +210,9 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
     # rooms and parts of floor as one graph: a room linked to each part it stands on
     links = [(i, len(rooms) + p) for i, nodes in enumerate(rooms) for p in _parts(vg, part, nodes)]
     size = len(rooms) + count + 1
+    walked = _walked(occ, part, away, trajectory)  # and each stretch of the robot's path
+    links += [(size + run, len(rooms) + p) for run, p in walked]  # linked to its parts
+    size += max((run + 1 for run, _ in walked), default=0)
     a, b = np.array(links, dtype=np.int64).reshape(-1, 2).T
     _, joined = connected_components(csr_matrix((np.ones(len(a)), (a, b)), shape=(size, size)),
                                      directed=False)
@@ -205,6 +220,34 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
     for i, nodes in enumerate(rooms):  # rooms come by lowest node: so do the groups
         groups.setdefault(int(joined[i]), []).append(nodes)
     return [np.sort(np.concatenate(g)) if len(g) > 1 else g[0] for g in groups.values()]
+
+
+def _walked(occ: OccupancyGrid, part: np.ndarray, away: np.ndarray,
+            trajectory: np.ndarray | Sequence[tuple[float, float]] | None
+            ) -> list[tuple[int, int]]:
+    """(stretch, part) for the labelled parts of floor each stretch of the ``trajectory``
+    crosses, a stretch being a piece of the path (sampled every cell) that stays on
+    ``away`` cells of the grid: the robot passed from one part to the other without
+    passing a door, whatever the grid shows between them now (a phantom obstacle, a door
+    leaf or a container's door opened after it passed)."""
+    if trajectory is None or len(trajectory) < 2:
+        return []
+    pts = np.asarray(trajectory, dtype=np.float64).reshape(-1, 2)
+    step = np.diff(pts, axis=0)
+    n = np.maximum(1, np.ceil(np.hypot(step[:, 0], step[:, 1]) / occ.resolution)).astype(np.int64)
+    seg = np.repeat(np.arange(len(step)), n)
+    t = (np.arange(len(seg)) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
+    xy = np.vstack([pts[seg] + step[seg] * t[:, None], pts[-1:]])
+    r, c = occ.cell_of(xy[:, 0], xy[:, 1])
+    ok = occ.inside(r, c)
+    ok[ok] = away[r[ok], c[ok]]
+    run = np.cumsum(~ok)  # a new stretch after every sample off the away cells
+    p = np.zeros(len(ok), dtype=np.int64)
+    p[ok] = part[r[ok], c[ok]]
+    keep = ok & (p > 0)
+    pairs = np.unique(np.stack([run[keep], p[keep]], axis=1), axis=0)
+    _, stretch = np.unique(pairs[:, 0], return_inverse=True)  # numbered from 0
+    return list(zip(stretch.ravel().tolist(), pairs[:, 1].tolist(), strict=True))
 
 
 def _parts(vg: VoronoiGraph, part: np.ndarray, nodes: np.ndarray) -> list[int]:

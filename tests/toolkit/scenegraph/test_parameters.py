@@ -197,6 +197,33 @@ def test_a_passage_joins_from_join_width_at_any_cell_size(resolution: float,
         assert segment_rooms(vg, None, occ=occ).count == rooms, gap
 
 
+def test_the_robots_path_joins_the_floor_it_crossed_but_not_through_a_door() -> None:
+    """Two pieces of graph on floors either side of a one-cell wall (two rooms): the
+    robot's path from one floor to the other across that wall (a phantom obstacle, a
+    leaf or a container's door opened after it passed) makes them one room; the same
+    path through door evidence on the wall (its cut zone) does not, nor does a path that
+    stays on one side."""
+    a_pts, a_e = chain(0.0, 0.0, 6, 0.4)
+    b_pts, b_e = chain(0.0, 3.0, 4, 0.3)
+    k = len(a_pts)
+    vg = hand_graph(a_pts + b_pts, a_e + [(i + k, j + k) for i, j in b_e])
+    cells = np.stack([np.full(k + 5, 20), np.r_[np.arange(5, 5 + k), np.arange(45, 50)]],
+                     axis=1)
+    vg = dataclasses.replace(vg, cells=cells, shape=(40, 60))
+    free = np.ones((40, 60), dtype=bool)
+    free[:, 30] = False
+    occ = OccupancyGrid(np.where(free, FREE, OCCUPIED).astype(np.int8), (0.0, 0.0), RES)
+    across = np.array([[0.5, 1.0], [1.2, 1.0], [1.8, 1.05], [2.4, 1.0]])  # x 0.5 -> 2.4 m
+    assert segment_rooms(vg, None, occ=occ).count == 2
+    assert segment_rooms(vg, None, occ=occ, trajectory=across).count == 1
+    assert segment_rooms(vg, None, occ=occ, trajectory=across[:2]).count == 2
+    door = np.zeros((40, 60), dtype=bool)
+    door[12:28, 30] = True  # a doorway in the wall where the path crosses it
+    dens = door_density(door, RES, ROOMS.door_bandwidth)
+    assert segment_rooms(vg, dens, ROOMS, occ=occ, trajectory=across).count == 2
+    assert segment_rooms(vg, None, occ=occ, unsure=door, trajectory=across).count == 2
+
+
 def test_a_short_piece_on_floor_of_its_own_is_a_room() -> None:
     """A room glimpsed through a door: its graph is a 0.6 m piece (under min_room_length),
     dropped on its own. On floor of its own of at least half min_room_length squared
