@@ -132,7 +132,9 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
                     written.append(atomic_write(stage / RUN_FILE, run_record(
                         res.rows, root, runner, request.executor)).name)
         except KeyboardInterrupt as e:
-            e.note = ("interrupted before the report was written: the report files in "  # type: ignore[attr-defined]
+            e.note = (f"the report files in {request.out_dir} are this run's (they went in "  # type: ignore[attr-defined]
+                      "as it was interrupted)" if getattr(e, "report_in", False) else
+                      "interrupted before the report was written: the report files in "
                       f"{request.out_dir} are as they were; the same command again writes "
                       "them from the logs (nothing runs again)")
             raise
@@ -162,15 +164,21 @@ def _report_stage(root: Path) -> Iterator[Path]:
     from sgtool.errors import deferred_interrupts
     from sgtool.files import output_error
 
+    for stale in root.glob(".report.*.partial"):  # of a run killed outright (SIGKILL)
+        shutil.rmtree(stale, ignore_errors=True)
     try:
         stage = Path(tempfile.mkdtemp(prefix=".report.", suffix=".partial", dir=root))
     except OSError as e:
         raise output_error(e, root) from None
     try:
         yield stage
-        with deferred_interrupts():
-            for name in sorted(os.listdir(stage)):
-                os.replace(stage / name, root / name)
+        try:
+            with deferred_interrupts():
+                for name in sorted(os.listdir(stage)):
+                    os.replace(stage / name, root / name)
+        except KeyboardInterrupt as e:  # deferred: raised once every file went in
+            e.report_in = True  # type: ignore[attr-defined]
+            raise
     finally:
         shutil.rmtree(stage, ignore_errors=True)
 

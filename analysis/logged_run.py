@@ -98,7 +98,11 @@ def logged_run(path: str | os.PathLike[str]) -> LoggedRun:
                     # as the planner takes them (a list option: a tuple, as from -O)
                     planner_options=typed_options(planner, x.get("planner_options") or {}),
                     options=options)
-    return dataclasses.replace(run, notes=tuple(changed_settings(p, run)))
+    notes = tuple(changed_settings(p, run))
+    # not the log's LLM transcript: a planner made with it would write this run's
+    # exchanges into the transcript of the one logged (give a new one to keep them)
+    return dataclasses.replace(run, notes=notes, planner_options={
+        k: v for k, v in run.planner_options.items() if k != "transcript"})
 
 
 def changed_settings(path: Path, run: LoggedRun) -> list[str]:

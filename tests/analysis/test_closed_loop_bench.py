@@ -236,6 +236,35 @@ def test_ctrl_c_while_the_report_is_written_leaves_the_earlier_one_whole(
     assert again.exit_code == 0 and (out / "summary.md").read_bytes() != before["summary.md"]
 
 
+def test_ctrl_c_as_the_report_goes_in_says_it_is_this_runs(house_file, tmp_path,
+                                                          monkeypatch) -> None:
+    """A Ctrl-C while the staged report moves in waits for the moves: the note says the
+    report is this run's (it said the files were as they were); a stage a killed run left
+    is removed by the next report."""
+    import os
+    import signal
+
+    out = tmp_path / "rb"
+    first = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
+    assert first.exit_code == 0, first.output
+    before = (out / "summary.md").read_bytes()
+    (out / ".report.abcdefgh.partial").mkdir()  # what SIGKILL leaves
+    replace = os.replace
+
+    def interrupted(src, dst, *a, **k):  # type: ignore[no-untyped-def]
+        if Path(src).parent.name.startswith(".report.") and Path(dst).parent == out:
+            signal.raise_signal(signal.SIGINT)  # a move of the stage's files into OUT
+        return replace(src, dst, *a, **k)
+
+    monkeypatch.setattr(os, "replace", interrupted)
+    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                   "--report-only", "--budgets", "7"])
+    assert res.exit_code == 130
+    assert "are this run's (they went in as it was interrupted)" in res.output, res.output
+    assert (out / "summary.md").read_bytes() != before
+    assert not [p for p in out.iterdir() if p.name.startswith(".report.")]
+
+
 def test_user_errors(tmp_path) -> None:
     for args, msg in ((["--planners", "nope"], "unknown planner 'nope'"),
                       (["--houses", "0"], "--houses: must be >= 1"),

@@ -338,7 +338,9 @@ def again_request(args: RunArgs, given: frozenset[str], out: Path,
     name, options = _planner(replace(args, planner=args.planner or run.planner))
     if name == run.planner:  # the log's options, -O given beside changing them; not its
         # transcript, which a run empties when it starts (--llm-transcript names a new one)
-        logged = {k: v for k, v in run.planner_options.items() if k != "transcript"}
+        # (an endpoint given beside a replayed log asks it: the log's replay goes)
+        drop = {"transcript", *(("replay",) if "base_url" in options else ())}
+        logged = {k: v for k, v in run.planner_options.items() if k not in drop}
         options = {**logged, **options}
     return SearchRequest(house=run.house, house_id=run.house_id,
                          episode_index=run.episode_index, episode=run.episode, planner=name,

@@ -223,6 +223,8 @@ def option_infos(cls: type) -> tuple[OptionInfo, ...]:
     for f in dataclasses.fields(cls):
         default = f.default if f.default is not dataclasses.MISSING else None
         meta = f.metadata.get(_META) or plain_meta(default, hints.get(f.name, f.type))
+        if meta.kind == "list" and f.default_factory is not dataclasses.MISSING:
+            default = f.default_factory()  # (a list field's default needs a factory)
         required = f.init and f.default is dataclasses.MISSING and \
             f.default_factory is dataclasses.MISSING
         out.append(OptionInfo(f.name, meta.kind, default, meta, required))
@@ -300,7 +302,7 @@ def convert_value(planner: str, key: str, meta: OptionMeta, value: Any,
         return value
     if value is None and (meta.optional or meta.objects):
         return None
-    if from_cli and meta.optional and meta.kind in ("int", "float", "choice") and \
+    if from_cli and meta.optional and meta.kind in ("int", "float", "choice", "list") and \
             isinstance(value, str) and not value.strip():
         return None  # `-O NAME.k=` sets an optional number or choice to None
     if meta.kind == "list":

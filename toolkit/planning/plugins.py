@@ -145,14 +145,22 @@ def signature_metas(factory: Callable[..., Any]) -> dict[str, OptionMeta]:
     import inspect
 
     try:
-        params = inspect.signature(factory, eval_str=True).parameters.values()
-    except Exception:  # noqa: BLE001 - a user's annotations that do not evaluate: untyped
+        params = inspect.signature(factory).parameters.values()
+    except (TypeError, ValueError):
         return {}
+    code = getattr(factory, "__init__", None) if isinstance(factory, type) else factory
+    namespace = dict(getattr(inspect.unwrap(code), "__globals__", {})) if code else {}
     out = {}
     for p in params:
         if p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD) or p.annotation is p.empty:
             continue
-        meta = plain_meta(None if p.default is p.empty else p.default, p.annotation)
+        hint = p.annotation
+        if isinstance(hint, str):  # postponed: each evaluated on its own
+            try:
+                hint = eval(hint, namespace, {})  # noqa: S307 - the plug-in's own annotation
+            except Exception:  # noqa: BLE001 - one that does not evaluate: untyped
+                continue
+        meta = plain_meta(None if p.default is p.empty else p.default, hint)
         if meta.cli:
             out[p.name] = meta
     return out

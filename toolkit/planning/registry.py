@@ -352,11 +352,20 @@ def typed_options(name: str, given: Mapping[str, Any]) -> dict[str, Any]:
 def _as_list_option(name: str, key: str, value: list[Any] | tuple[Any, ...]) -> Any:
     """A list or tuple given for a ``list`` option as ``-O`` gives it (a log records a
     list; Python may give a tuple); as given for any other option."""
-    if all(isinstance(x, str | int | float) and not isinstance(x, bool) for x in value):
-        typed = parse_option(name, key, ",".join(str(x) for x in value))
-        if isinstance(typed, list | tuple):
-            return typed
-    return value
+    meta = _option_meta(name, key)
+    if meta is None or meta.kind != "list" or not all(
+            isinstance(x, str | int | float) and not isinstance(x, bool) for x in value):
+        return value
+    # item by item, not joined and split again: a text item may hold a comma or spaces
+    return convert_value(name, key, meta, list(value))
+
+
+def _option_meta(name: str, key: str) -> OptionMeta | None:
+    """The metadata of option ``key`` of planner ``name`` (None: not a typed option)."""
+    cls = options_of(name)
+    if cls is None:
+        return plugins.signature_metas(_factory(name)).get(key)
+    return next((i.meta for i in option_infos(cls) if i.name == key), None)
 
 
 def _signature_defaults(factory: Any) -> dict[str, Any]:

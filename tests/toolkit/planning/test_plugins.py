@@ -557,3 +557,47 @@ def test_list_options_from_the_command_line(tmp_path: Path, monkeypatch) -> None
     assert "weights (float list, default 0.5,0.5): a field of tuple[float, float] " \
         "[2 comma-separated numbers]" in lines
     assert "rooms (str list, default none)" in lines
+
+
+def test_list_options_keep_their_items_defaults_and_none(tmp_path: Path, monkeypatch) -> None:
+    """A review's cases: a logged text item holding a comma stays one item (it was joined
+    and split again), a list field's default_factory is its default (giving it was "other
+    settings"), `-O k=` sets an optional list to None, and one annotation that does not
+    evaluate leaves the others typed (it left every parameter untyped)."""
+    from sgtool.planning.registry import effective_options, typed_options
+
+    (tmp_path / "lists_plug.py").write_text(textwrap.dedent('''
+        from __future__ import annotations
+
+        from dataclasses import dataclass, field
+        from typing import TYPE_CHECKING
+
+        from sgtool.planning.planners import GreedyPlanner
+
+        if TYPE_CHECKING:
+            from nowhere import Missing
+
+
+        class WithOptions(GreedyPlanner):
+            @dataclass(frozen=True)
+            class Options:
+                tags: list[str] = field(default_factory=lambda: ["a", "b"])
+                pair: tuple[float, float] | None = None
+
+            def __init__(self, **kw):
+                super().__init__()
+
+
+        class Broken(GreedyPlanner):
+            def __init__(self, weights: tuple[float, float] = (0.5, 0.5),
+                         m: Missing | None = None):
+                super().__init__()
+    '''))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    name = "lists_plug:WithOptions"
+    assert typed_options(name, {"tags": ["kitchen, north", " bath"]}) == {
+        "tags": ["kitchen, north", " bath"]}
+    assert effective_options(name, {"tags": ["a", "b"]}) == {}
+    assert "tags (str list, default a,b)" in describe_planners([name])
+    assert parse_option(name, "pair", "") is None
+    assert parse_option("lists_plug:Broken", "weights", "0.3,0.7") == (0.3, 0.7)
