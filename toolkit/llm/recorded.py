@@ -147,6 +147,12 @@ class TranscriptWriter:
             raise output_error(e, self.path) from None
         self.count = 0
 
+    def __getstate__(self) -> None:
+        """Refused in one line: a writer in two processes would interleave one file."""
+        raise SgtoolError(f"an LLM planner writing the transcript {self.path} cannot be "
+                          "copied to another process (both would write that file); give "
+                          "each process its own transcript")
+
     def write(self, record: dict[str, Any]) -> None:
         try:
             self._fh.write(json.dumps(record, sort_keys=True, ensure_ascii=False) + "\n")

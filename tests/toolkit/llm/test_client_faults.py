@@ -240,3 +240,19 @@ def test_an_llm_planner_pickles_and_its_copy_asks_the_endpoint() -> None:
         assert llm is not planner.inner.client  # type: ignore[attr-defined]
         assert llm.complete([{"role": "user", "content": "x"}]).text == "fine"
     assert srv.auth == [f"Bearer {KEY}"]
+
+
+def test_a_planner_writing_a_transcript_is_refused_a_copy_in_one_line(tmp_path) -> None:
+    """Two processes writing one transcript would interleave it: pickling such a planner
+    is one SgtoolError line naming the file (it was a TypeError about a TextIOWrapper)."""
+    import pickle
+
+    from sgtool.errors import SgtoolError
+    from sgtool.planning.registry import make_planner
+
+    t = tmp_path / "llm.jsonl"
+    planner = make_planner("moma-llm", base_url="http://127.0.0.1:9/v1", model="m",
+                           api_key=KEY, transcript=str(t))
+    with pytest.raises(SgtoolError, match="cannot be copied to another process") as e:
+        pickle.dumps(planner)
+    assert str(t) in str(e.value) and "\n" not in str(e.value)
