@@ -169,6 +169,18 @@ def test_pieces_of_one_floor_are_one_room_centred_on_the_larger() -> None:
         assert segment_rooms(vg, None, occ=floor(gapped)).count == rooms, gap
 
 
+def two_pieces() -> VoronoiGraph:
+    """Two pieces of graph for a 40 x 60 grid with a wall at column 30: their nodes on
+    row 20, the first piece at columns 5-11, the second at 45-49."""
+    a_pts, a_e = chain(0.0, 0.0, 6, 0.4)
+    b_pts, b_e = chain(0.0, 3.0, 4, 0.3)
+    k = len(a_pts)
+    vg = hand_graph(a_pts + b_pts, a_e + [(i + k, j + k) for i, j in b_e])
+    cells = np.stack([np.full(k + 5, 20), np.r_[np.arange(5, 5 + k), np.arange(45, 50)]],
+                     axis=1)
+    return dataclasses.replace(vg, cells=cells, shape=(40, 60))
+
+
 @pytest.mark.parametrize(("resolution", "joins_from"), [(0.1, 3), (0.05, 3), (0.04, 5),
                                                        (0.025, 7), (0.02, 9)])
 def test_a_passage_joins_from_join_width_at_any_cell_size(resolution: float,
@@ -177,15 +189,7 @@ def test_a_passage_joins_from_join_width_at_any_cell_size(resolution: float,
     joins them from the fewest odd number of cells at least JOIN_WIDTH (0.15 m) wide
     (erosion keeps passages of 2k + 1 cells), a cell narrower it does not, even where
     that is 0.15 m or more (4 cells of 4 cm; at 0.1 m cells 3 cells, 0.3 m)."""
-    a_pts, a_e = chain(0.0, 0.0, 6, 0.4)
-    b_pts, b_e = chain(0.0, 3.0, 4, 0.3)
-    k = len(a_pts)
-    vg = hand_graph(a_pts + b_pts, a_e + [(i + k, j + k) for i, j in b_e])
-    # the nodes on row 20, away from the wall at column 30: the first piece at columns
-    # 5-11, the second at 45-49
-    cells = np.stack([np.full(k + 5, 20), np.r_[np.arange(5, 5 + k), np.arange(45, 50)]],
-                     axis=1)
-    vg = dataclasses.replace(vg, cells=cells, shape=(40, 60))
+    vg = two_pieces()
     assert joins_from % 2 == 1
     assert (joins_from - 2) * resolution < 0.15 <= joins_from * resolution + 1e-9
     for gap, rooms in ((joins_from - 1, 2), (joins_from, 1)):
@@ -203,13 +207,7 @@ def test_the_robots_path_joins_the_floor_it_crossed_but_not_through_a_door() -> 
     leaf or a container's door opened after it passed) makes them one room; the same
     path through door evidence on the wall (its cut zone) does not, nor does a path that
     stays on one side."""
-    a_pts, a_e = chain(0.0, 0.0, 6, 0.4)
-    b_pts, b_e = chain(0.0, 3.0, 4, 0.3)
-    k = len(a_pts)
-    vg = hand_graph(a_pts + b_pts, a_e + [(i + k, j + k) for i, j in b_e])
-    cells = np.stack([np.full(k + 5, 20), np.r_[np.arange(5, 5 + k), np.arange(45, 50)]],
-                     axis=1)
-    vg = dataclasses.replace(vg, cells=cells, shape=(40, 60))
+    vg = two_pieces()
     free = np.ones((40, 60), dtype=bool)
     free[:, 30] = False
     occ = OccupancyGrid(np.where(free, FREE, OCCUPIED).astype(np.int8), (0.0, 0.0), RES)
