@@ -46,7 +46,7 @@ What we do, and why it differs:
   at a wall's end join nothing): the floor is eroded k cells, which keeps passages of
   2k + 1 cells, k the fewest steps that make those at least ``JOIN_WIDTH`` (3 cells at
   5 cm). The robot's own path joins too: a stretch of it that stays outside the cut zone
-  and ``JOIN_SEAL`` joins the parts of open floor it crosses, whatever the grid shows
+  and ``WALK_SEAL`` joins the parts of open floor it crosses, whatever the grid shows
   between them now (a phantom obstacle on its way, a swung door leaf and a cabinet door
   opened after it passed, leaving a pocket of the room closed off; a path through a
   doorway enters its cut zone, so it joins nothing there). A merged room's centre is
@@ -82,6 +82,10 @@ from sgtool.mapping.voronoi import VoronoiGraph, submatrix
 
 JOIN_WIDTH = 0.15  # m: passages of open floor narrower than this join no rooms (module doc)
 JOIN_SEAL = 0.3  # m around door evidence (and unsure floor) where floor joins nothing
+# m around door evidence (and unsure floor) where the robot's path joins nothing: a door
+# leaf's width (door_evidence.UNSURE_REACH), within which a doorway lies of its evidence
+# (drift spreads passes through one doorway over its jambs)
+WALK_SEAL = 0.9
 OWN_FLOOR = 0.5  # of min_room_length squared: the open floor of its own a short room needs
 
 
@@ -210,7 +214,8 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
     # rooms and parts of floor as one graph: a room linked to each part it stands on
     links = [(i, len(rooms) + p) for i, nodes in enumerate(rooms) for p in _parts(vg, part, nodes)]
     size = len(rooms) + count + 1
-    walked = _walked(occ, part, away, trajectory)  # and each stretch of the robot's path
+    seal = None if unsure is None else within_cells(unsure, WALK_SEAL / occ.resolution)
+    walked = _walked(occ, part, away if seal is None else away & ~seal, trajectory)
     links += [(size + run, len(rooms) + p) for run, p in walked]  # linked to its parts
     size += max((run + 1 for run, _ in walked), default=0)
     a, b = np.array(links, dtype=np.int64).reshape(-1, 2).T
