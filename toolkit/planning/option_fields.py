@@ -200,18 +200,21 @@ def _type_hints(cls: type) -> dict[str, Any]:
     import sys
 
     namespace = dict(vars(sys.modules.get(cls.__module__, sys)))
-    out: dict[str, Any] = {}
-    for f in dataclasses.fields(cls):
-        hint = f.type
-        for _ in range(2):  # "'int'" under postponed annotations is text twice
-            if not isinstance(hint, str):
-                break
-            try:
-                hint = eval(hint, namespace, {})  # noqa: S307 - the plug-in's own annotation
-            except Exception:  # noqa: BLE001 - a name not importable there
-                break
-        out[f.name] = hint
-    return out
+    return {f.name: resolved(f.type, namespace) for f in dataclasses.fields(cls)}
+
+
+def resolved(hint: Any, namespace: dict[str, Any]) -> Any:
+    """An annotation as text (``from __future__ import annotations``) evaluated in
+    ``namespace`` (its module's); one naming what cannot be resolved there is kept as its
+    text."""
+    for _ in range(2):  # "'int'" under postponed annotations is text twice
+        if not isinstance(hint, str):
+            break
+        try:
+            hint = eval(hint, namespace, {})  # noqa: S307 - the plug-in's own annotation
+        except Exception:  # noqa: BLE001 - a name not importable there
+            break
+    return hint
 
 
 def option_infos(cls: type) -> tuple[OptionInfo, ...]:

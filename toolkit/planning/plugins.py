@@ -33,6 +33,7 @@ from sgtool.planning.option_fields import (
     check_required,
     convert_options,
     plain_meta,
+    resolved,
 )
 
 GROUP = "sgtool.planners"
@@ -154,12 +155,9 @@ def signature_metas(factory: Callable[..., Any]) -> dict[str, OptionMeta]:
     for p in params:
         if p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD) or p.annotation is p.empty:
             continue
-        hint = p.annotation
-        if isinstance(hint, str):  # postponed: each evaluated on its own
-            try:
-                hint = eval(hint, namespace, {})  # noqa: S307 - the plug-in's own annotation
-            except Exception:  # noqa: BLE001 - one that does not evaluate: untyped
-                continue
+        hint = resolved(p.annotation, namespace)  # each on its own
+        if isinstance(hint, str):  # one that does not evaluate: untyped
+            continue
         meta = plain_meta(None if p.default is p.empty else p.default, hint)
         if meta.cli:
             out[p.name] = meta
