@@ -214,8 +214,7 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
     # rooms and parts of floor as one graph: a room linked to each part it stands on
     links = [(i, len(rooms) + p) for i, nodes in enumerate(rooms) for p in _parts(vg, part, nodes)]
     size = len(rooms) + count + 1
-    seal = None if unsure is None else within_cells(unsure, WALK_SEAL / occ.resolution)
-    walked = _walked(occ, part, away if seal is None else away & ~seal, trajectory)
+    walked = _walked(occ, part, away, unsure, trajectory)
     links += [(size + run, len(rooms) + p) for run, p in walked]  # linked to its parts
     size += max((run + 1 for run, _ in walked), default=0)
     a, b = np.array(links, dtype=np.int64).reshape(-1, 2).T
@@ -228,15 +227,19 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
 
 
 def _walked(occ: OccupancyGrid, part: np.ndarray, away: np.ndarray,
+            unsure: np.ndarray | None,
             trajectory: np.ndarray | Sequence[tuple[float, float]] | None
             ) -> list[tuple[int, int]]:
     """(stretch, part) for the labelled parts of floor each stretch of the ``trajectory``
     crosses, a stretch being a piece of the path (sampled every cell) that stays on
-    ``away`` cells of the grid: the robot passed from one part to the other without
-    passing a door, whatever the grid shows between them now (a phantom obstacle, a door
-    leaf or a container's door opened after it passed)."""
+    ``away`` cells of the grid farther than ``WALK_SEAL`` from ``unsure`` (the door
+    evidence and unsure floor): the robot passed from one part to the other without
+    passing a door, whatever the grid shows between them now (a phantom obstacle on its
+    way). No path (a hand-held camera): nothing, and no distance transform."""
     if trajectory is None or len(trajectory) < 2:
         return []
+    if unsure is not None:
+        away = away & ~within_cells(unsure, WALK_SEAL / occ.resolution)
     pts = np.asarray(trajectory, dtype=np.float64).reshape(-1, 2)
     step = np.diff(pts, axis=0)
     n = np.maximum(1, np.ceil(np.hypot(step[:, 0], step[:, 1]) / occ.resolution)).astype(np.int64)
