@@ -162,7 +162,7 @@ def _report_stage(root: Path) -> Iterator[Path]:
     import shutil
 
     from sgtool.errors import deferred_interrupts
-    from sgtool.files import output_error
+    from sgtool.files import OutputError, output_error
 
     for stale in root.glob(".report.*.partial"):  # of a run killed outright (SIGKILL)
         shutil.rmtree(stale, ignore_errors=True)
@@ -179,6 +179,8 @@ def _report_stage(root: Path) -> Iterator[Path]:
         except KeyboardInterrupt as e:  # deferred: raised once every file went in
             e.report_in = True  # type: ignore[attr-defined]
             raise
+    except OutputError as e:  # a full disk: the report's file, not the stage's
+        raise OutputError(str(e).replace(str(stage), str(root))) from None
     finally:
         shutil.rmtree(stage, ignore_errors=True)
 

@@ -265,6 +265,35 @@ def test_ctrl_c_as_the_report_goes_in_says_it_is_this_runs(house_file, tmp_path,
     assert not [p for p in out.iterdir() if p.name.startswith(".report.")]
 
 
+def test_a_full_disk_while_the_report_is_written_names_the_report_s_file(
+        house_file, tmp_path, monkeypatch) -> None:
+    """The report is written into a hidden stage first; a write that fails there (a full
+    disk) names the file of the output folder it was for, not the stage's, and leaves the
+    earlier report as it was."""
+    import errno
+    import os
+
+    from sgtool.files import output_error
+
+    out = tmp_path / "rb"
+    first = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out)])
+    assert first.exit_code == 0, first.output
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+
+    def full(res, out_dir, timings=True):
+        raise output_error(OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)),
+                           Path(out_dir) / "summary.md")
+
+    monkeypatch.setattr(clb, "write_outputs", full)
+    res = CliRunner().invoke(cli, [*ARGS, "--house", str(house_file), "-o", str(out),
+                                   "--report-only", "--budgets", "7"])
+    assert res.exit_code == 2
+    assert res.output == (f"sgtool: error: cannot write {out / 'summary.md'}: No space left "
+                          "on device (nothing was written)\n")
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == before
+    assert not [p for p in out.iterdir() if p.name.startswith(".report.")]
+
+
 def test_user_errors(tmp_path) -> None:
     for args, msg in ((["--planners", "nope"], "unknown planner 'nope'"),
                       (["--houses", "0"], "--houses: must be >= 1"),
