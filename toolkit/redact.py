@@ -82,8 +82,17 @@ def options_as_text(planner_options: Mapping[str, Mapping[str, Any]]
                     ) -> dict[str, dict[str, str]]:
     """Planners' options as a run's settings record them: per planner (sorted) each value
     redacted (:func:`redact_options`) and as its text."""
-    return {planner: {k: str(v) for k, v in redact_options(opts).items()}
+    return {planner: {k: _as_text(v) for k, v in redact_options(opts).items()}
             for planner, opts in sorted(planner_options.items())}
+
+
+def _as_text(value: Any) -> str:
+    """An option value as ``-O`` text gives it: a list of plain values comma-separated
+    (``0.3,0.7``, which parses back to the same value), anything else ``str``."""
+    if isinstance(value, list | tuple) and all(
+            isinstance(x, str | int | float) for x in value):
+        return ",".join(str(x) for x in value)
+    return str(value)
 
 
 def recorded_options(options: Mapping[str, Any]) -> dict[str, Any]:

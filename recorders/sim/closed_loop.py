@@ -123,7 +123,7 @@ from sgtool.recorders.sim.closed_loop_options import (  # noqa: F401 (re-exporte
 )
 from sgtool.recorders.sim.closed_loop_report import ClosedLoopReport, episode_notes
 from sgtool.recorders.sim.episode_extras import (
-    recorded_options,
+    options_record,
     shown_distances,
     started_extra,
     success_rule,
@@ -478,7 +478,8 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
 
     ``planner`` is built by the caller (:func:`sgtool.planning.registry.make_planner`, with
     ``planner_options``: recorded in the episode records' ``extra.planner_options``, plain
-    values only and secrets left out, so that the log's planner can be built again) and
+    values only and secrets left out, so that the log's planner can be built again; when
+    None, the options ``make_planner`` built it with) and
     closed here (its ``close()``, when it has one) when the episode ends; its LLM
     exchanges, when it keeps them (``drain_exchanges()``, moma-llm), are logged after each
     decision. A planner object of the user's is held to the contract a plug-in is
@@ -494,10 +495,9 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
     if Path(output).suffix != ".mcap":
         raise SgtoolError(f"{output}: the output is an MCAP log; name it *.mcap")
     require("pybullet", api="sgtool.run_closed_loop")  # one line on a core install
+    recorded = options_record(planner, planner_options)
     planner = held_to_contract(planner)  # a user's planner object: one line for its faults
     opts = options or ClosedLoopOptions()
-    recorded = {"planner_options": recorded_options(planner_options)} if planner_options \
-        else {}
     if bad := refused_number(recorded.get("planner_options", {})):  # now, not at the end
         raise SgtoolError(f"planner option {bad[0]}={bad[1]}: a finite number (the "
                           "episode's log records it)")

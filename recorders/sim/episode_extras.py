@@ -20,6 +20,14 @@ from sgtool.scenegraph.build_options import ResolvedOptions, mapping_record
 from sgtool.scenegraph.graph import SceneGraph
 
 
+def options_record(planner: object, given: Mapping[str, Any] | None) -> dict[str, Any]:
+    """``{"planner_options": ...}`` for the episode records (empty: none): the options
+    ``given`` (None: those :func:`sgtool.planning.registry.make_planner` built ``planner``
+    with), as :func:`sgtool.redact.recorded_options` keeps them."""
+    options = getattr(planner, "given_options", None) if given is None else given
+    return {"planner_options": recorded_options(options)} if options else {}
+
+
 def started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOptions,
                   episode: Episode, index: int) -> dict[str, Any]:
     """The opening record's ``extra``: the episode, seeds, budgets, camera, robot,

@@ -62,3 +62,12 @@ def test_a_user_error_never_echoes_a_secret():
 
     r = CliRunner().invoke(cli, ["bench", "--planners", "random", "-O", "api_key=sk-LEAK99"])
     assert r.exit_code == 2 and "sk-LEAK99" not in r.output and REDACTED in r.output
+
+
+def test_list_options_are_recorded_as_the_o_text_that_gives_them():
+    """A run's settings keep option values as text; a list's is what -O takes (so the
+    text parses back to the same value: an explicit default compares equal to none)."""
+    from sgtool.redact import options_as_text
+
+    assert options_as_text({"p": {"w": (0.3, 0.7), "names": ["a", "b"], "on": True}}) == {
+        "p": {"names": "a,b", "on": "True", "w": "0.3,0.7"}}

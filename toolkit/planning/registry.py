@@ -265,8 +265,14 @@ def is_llm_planner(name: str) -> bool:
 
 
 def _unknown(name: str) -> UnknownPlannerError:
+    import difflib
+
+    installed = sorted(plugins.entry_points())
+    near = difflib.get_close_matches(name.strip().lower(), [*PLANNER_NAMES, *installed], n=1)
+    hint = f"did you mean {near[0]!r}? " if near else ""
     return UnknownPlannerError(
-        f"unknown planner {name!r}; choose one of: {', '.join(PLANNER_NAMES)}, a name "
+        f"unknown planner {name!r}; {hint}choose one of: "
+        f"{', '.join([*PLANNER_NAMES, *installed])}, a name "
         f"registered in the entry-point group {plugins.GROUP}, or module:Name (a plug-in)")
 
 
@@ -314,8 +320,8 @@ def effective_options(name: str, given: Mapping[str, Any]) -> dict[str, Any]:
     import in this process)."""
     try:
         cls = options_of(name)
-    except Exception:  # noqa: BLE001 - a plug-in that fails here: compare as given
-        return dict(sorted(given.items()))
+    except Exception:  # noqa: BLE001 - a plug-in that fails here: compare as -O text
+        return {k: _option_text(v) for k, v in sorted(given.items())}
     defaults = {"timed": True, **({} if cls is None else
                                   {i.name: i.default for i in option_infos(cls)})}
     if cls is None and name.strip().lower() not in REGISTRY:  # a plug-in's own defaults
@@ -330,6 +336,20 @@ def effective_options(name: str, given: Mapping[str, Any]) -> dict[str, Any]:
 # they are written, not which answers: a live run, the same run on another port and its
 # offline replay from the transcript decide alike
 ANSWER_SOURCE = frozenset({"base_url", "replay", "transcript"})
+
+
+def _option_text(value: Any) -> Any:
+    """A plain value as ``-O`` text (a list comma-separated, a bool ``true``/``false``), so
+    that a log's typed value and the text of a command compare alike; anything else as
+    given."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | float | str):
+        return str(value)
+    if isinstance(value, list | tuple) and all(
+            isinstance(x, int | float | str) and not isinstance(x, bool) for x in value):
+        return ",".join(str(x) for x in value)
+    return value
 
 
 def typed_options(name: str, given: Mapping[str, Any]) -> dict[str, Any]:
@@ -413,6 +433,7 @@ def make_planner(name: str, **options: Any) -> Planner:
     timed = convert_value(name, "timed", TIMED, options.pop("timed", True))
     key = name.strip().lower()
     entry = REGISTRY.get(key)
+    given = dict(options)  # as given: what a log of its episodes records (run_episode)
     if entry is None:
         planner = plugins.build_plugin(name, _factory(name), options)
     else:
@@ -423,6 +444,7 @@ def make_planner(name: str, **options: Any) -> Planner:
 
     # a plug-in is always wrapped: its contract is checked and its name is the one given
     wrapped = TimedPlanner(planner, plugin=entry is None, measure=timed)
+    wrapped.given_options = given
     if entry is None:
         wrapped.name = name
     return wrapped

@@ -108,6 +108,7 @@ class TimedPlanner:
         self.plugin = plugin  # a user's planner: what it raises is one line, not a traceback
         self.measure = measure
         self._globals: tuple[Any, Any] | None = None  # a plug-in's random, numpy states
+        self.given_options: dict[str, Any] = {}  # make_planner's options (recorded in logs)
 
     @contextlib.contextmanager
     def _own_randomness(self) -> Iterator[None]:

@@ -33,7 +33,7 @@ PLUGIN = textwrap.dedent('''
     class MyPlanner(GreedyPlanner):
         """Greedy under its own name, with a knob that must arrive."""
 
-        def __init__(self, k=1):
+        def __init__(self, k=1, weights: "tuple[float, float]" = (0.5, 0.5)):
             super().__init__()
             if k != 3:
                 raise ValueError(f"k={k}, expected 3")
@@ -276,15 +276,17 @@ def test_sgtool_traceback_shows_where_a_plugin_raised(plugin_dir: Path, tmp_path
 def test_a_report_of_a_stored_run_needs_no_plugin(plugin_dir: Path, tmp_path: Path,
                                                  monkeypatch: pytest.MonkeyPatch) -> None:
     """run-bench --report-only re-tables logs run already: on a machine where the lab's
-    plug-in does not import it failed ("cannot import module"); it writes the same
-    summary.json now."""
+    plug-in does not import it failed ("cannot import module"), and then refused its list
+    option (typed in the logs, text on the command line); it writes the same summary.json
+    now."""
     import sys
 
     monkeypatch.syspath_prepend(str(plugin_dir))
     out = tmp_path / "rb"
     r = CliRunner().invoke(cli, [
         "run-bench", "--planners", "mymod_cli:MyPlanner,greedy", "-O",
-        "mymod_cli:MyPlanner.k=3", "--houses", "1", "--rooms", "4-4", "--episodes", "1",
+        "mymod_cli:MyPlanner.k=3", "-O", "mymod_cli:MyPlanner.weights=0.2,0.8", "--houses",
+        "1", "--rooms", "4-4", "--episodes", "1",
         "--frames", "40", "--max-steps", "2", "-w", "1", "--no-progress", "-o", str(out)])
     assert r.exit_code == 0, r.output
     before = (out / "summary.json").read_bytes()

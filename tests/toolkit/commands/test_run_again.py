@@ -89,6 +89,18 @@ def test_logged_run_from_python(bench: Path) -> None:
     assert logged.house.seed == 3 and logged.notes == ()
 
 
+def test_options_given_to_make_planner_are_logged(tmp_path: Path) -> None:
+    """A planner built with options from Python runs with them: its log records them (it
+    recorded none, and --again ran the defaults)."""
+    house = sgtool.generate_house(3, rooms=(4, 4))
+    _, episode = sgtool.pick_episode(house)
+    opts = sgtool.ClosedLoopOptions(max_steps=1,
+                                    camera=sgtool.CameraConfig(width=64, height=48))
+    out = tmp_path / "scout.mcap"
+    sgtool.run_closed_loop(house, episode, sgtool.make_planner("scout", delta=0.3), out, opts)
+    assert sgtool.logged_run(out).planner_options == {"delta": 0.3}
+
+
 @pytest.mark.parametrize(("args", "message"), [
     (["--seed", "3"], "--seed: --again runs the episode of its log"),
     (["--query", "bowl", "--episode", "1"], "--query, --episode: --again runs the episode"),

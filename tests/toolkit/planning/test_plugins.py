@@ -267,6 +267,9 @@ def test_unknown_names_and_file_names() -> None:
     with pytest.raises(UnknownPlannerError, match="unknown planner 'astar'; choose one of: "
                                                   "random, .*or module:Name"):
         check_planner_name("astar")
+    with pytest.raises(UnknownPlannerError, match="unknown planner 'scuot'; did you mean "
+                                                  "'scout'\\? choose one of"):
+        check_planner_name("scuot")
     check_planner_name("pkg.sub:Cls.Inner")  # written right: not imported by the check
     assert file_name("pkg.sub:Cls") == "pkg.sub__Cls" and file_name("scout") == "scout"
 
@@ -296,6 +299,9 @@ def test_options_compared_as_the_planner_takes_them(plugin_dir: Path) -> None:
     assert effective_options("scout", {"delta": 0.2, "bogus": 1}) == {"delta": 0.2,
                                                                       "bogus": 1}
     assert effective_options("nomod_plug:X", {"k": "1"}) == {"k": "1"}  # cannot be asked
+    # ... and compared as -O text: a log's typed values and a command's text alike
+    assert effective_options("nomod_plug:X", {"w": [0.5, 0.5], "b": True, "x": 0.3}) == \
+        effective_options("nomod_plug:X", {"w": "0.5,0.5", "b": "true", "x": "0.3"})
     # a plug-in without an Options class: its __init__'s defaults are its defaults
     assert effective_options("mymod_plug:MyPlanner", {"k": "1", "label": "y"}) == {
         "label": "y"}
