@@ -23,21 +23,21 @@
 from __future__ import annotations
 
 import re
-from collections import Counter
 from dataclasses import dataclass, replace
-from decimal import Decimal
 from pathlib import Path
 
 import numpy as np
 
 from sgtool.errors import SgtoolError
 from sgtool.log.poses import PoseTrack
+from sgtool.recorders.importers.image_files import depth_images, images, natural_key, pair_name
 from sgtool.recorders.importers.pose_files import folder_intrinsics, pose_folder, posed_pairs
 from sgtool.recorders.importers.sanity import time_range_problem, timestamp_problem
 from sgtool.recorders.importers.textformats import (
     PinholeParams,
     is_intrinsics_json,
     is_open3d_log,
+    open3d_log_first_frame,
     read_intrinsics_file,
     read_pose_file,
     read_tum_list,
@@ -60,7 +60,6 @@ SEVEN_SCENES_INTRINSICS = PinholeParams(585.0, 585.0, 320.0, 240.0,
 PRIMESENSE_INTRINSICS = PinholeParams(525.0, 525.0, 319.5, 239.5,
                                       source="dataset default: PrimeSense, as Open3D assumes")
 
-_IMAGE_EXT = (".png", ".jpg", ".jpeg", ".ppm", ".bmp", ".tif", ".tiff")
 # (any case: "frame-000100.depth.PNG" as copied from a camera or another file system)
 _SEVEN = re.compile(r"^frame-(\d+)\.(color|depth|pose)\.(png|jpg|jpeg|txt)$", re.IGNORECASE)
 
@@ -141,7 +140,7 @@ def missing_for_layout(root: Path, layout: str) -> str | None:
             return "no depth/ folder"
         if _color_dir(root) is None:
             return "no color/, image/ or rgb/ folder"
-        if not _images(root / "depth"):
+        if not images(root / "depth"):
             return "no images in depth/"
         return None
     raise SgtoolError(f"unknown layout {layout!r} ({', '.join(LAYOUTS)})")
@@ -173,32 +172,6 @@ def _color_dir(root: Path) -> Path | None:
         if (root / n).is_dir():
             return root / n
     return None
-
-
-_NUMBER = re.compile(r"(\d+(?:\.\d+)?)")  # digits, with a fraction after one dot
-
-
-def natural_key(name: str) -> tuple[tuple[int, Decimal | str], ...]:
-    """Sort key of a file name by its numbers' values: "2.png" before "10.png", as Open3D's
-    ``sorted_alphanum``; a number with a fraction ("1305031103.05.png", a time stamp) is
-    one decimal number, so "X.05" comes before "X.1" as in time (``sorted_alphanum`` would
-    compare 5 with 1)."""
-    return tuple((0, Decimal(t)) if _NUMBER.fullmatch(t) else (1, t)
-                 for t in _NUMBER.split(name) if t)
-
-
-def _images(folder: Path) -> list[Path]:
-    """The image files of ``folder`` in natural order (names numbered without zero padding
-    sort by value); names whose numbers tie ("1.png" and "01.png", "2.5.png" and "2.50.png")
-    are an error."""
-    found = sorted((p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_EXT
-                    and not p.name.startswith(".")),  # hidden (macOS "._0001.png")
-                   key=lambda p: (natural_key(p.name), p.name))
-    for a, b in zip(found, found[1:], strict=False):
-        if natural_key(a.name) == natural_key(b.name):
-            raise SgtoolError(f"{folder}: {a.name} and {b.name} have the same number; the "
-                              "frame order is ambiguous (keep one naming)")
-    return found
 
 
 def read_sequence(
@@ -465,26 +438,6 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
                           dropped=dropped)
 
 
-def _depth_images(folder: Path, notes: list[str]) -> list[Path]:
-    """The depth images of ``folder``: those of its most common lossless image type (JPEG
-    never holds depth: previews beside PNG depth are no frames, however many), the others
-    left out with a note; .tif/.tiff and .jpg/.jpeg are one type."""
-    found = _images(folder)
-
-    def kind(p: Path) -> str:
-        s = p.suffix.lower()
-        return {".tiff": ".tif", ".jpeg": ".jpg"}.get(s, s)
-
-    kinds = Counter(kind(p) for p in found)
-    if len(kinds) < 2:
-        return found
-    main = max(sorted(kinds), key=lambda k: (k != ".jpg", kinds[k]))
-    stray = [p for p in found if kind(p) != main]
-    notes.append(f"{len(stray)} file(s) in {folder.name}/ are not {main} images as the "
-                 f"{kinds[main]} depth images are, and were left out (first: {stray[0].name})")
-    return [p for p in found if kind(p) == main]
-
-
 def _read_open3d(root: Path, fps: float, trajectory: Path | None,
                  skip_missing: bool = False, keep_unposed: bool = False) -> FolderSequence:
     """Depth images of ``depth/`` and colour images of the colour folder, paired by name
@@ -496,15 +449,15 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
     the frames without depth out with their poses."""
     notes: list[str] = []
     cdir = _color_dir(root)
-    depths = _depth_images(root / "depth", notes)
-    colors = _images(cdir) if cdir is not None else []
-    by_stem = {p.stem: p for p in colors}
+    depths = depth_images(root / "depth", notes)
+    colors = images(cdir) if cdir is not None else []
+    by_stem = {pair_name(p): p for p in colors}
     pairs: list[tuple[Path, Path | None]]
-    matched = sum(d.stem in by_stem for d in depths)
+    matched = sum(pair_name(d) in by_stem for d in depths)
     if matched or not colors:  # one naming scheme: by name, a depth image may lack colour
-        pairs = [(d, by_stem.get(d.stem)) for d in depths]
+        pairs = [(d, by_stem.get(pair_name(d))) for d in depths]
         if matched < len(depths):
-            first = next(d for d in depths if d.stem not in by_stem)
+            first = next(d for d in depths if pair_name(d) not in by_stem)
             notes.append(f"{len(depths) - matched} depth images have no colour image of "
                          f"their name (first: {first.relative_to(root)})")
     elif len(colors) == len(depths):
@@ -529,34 +482,51 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
                 "choose one with --trajectory"
             )
     per_frame = pose_folder(root) if traj is None else None
+    slot: dict[Path, int] = {}  # frame i stays at i/fps when frames before it are left out
+    dropped = 0
     if traj is None and per_frame is None and (root / "groundtruth.txt").is_file():
         notes.append("groundtruth.txt not read: a folder of depth/ and colour folders is read "
                      "as the open3d layout (poses from a *.log trajectory, image times from "
                      "their order); a TUM folder lists its images in rgb.txt and depth.txt")
-    unpaired = sorted({c.stem for c in colors} - {d.stem for d in depths}, key=natural_key)
-    hint = (f" ({len(unpaired)} colour images have no depth image; first: depth/{unpaired[0]}.*"
+    unpaired = sorted({pair_name(c) for c in colors} - {pair_name(d) for d in depths},
+                      key=natural_key)
+    hint = (f" ({len(unpaired)} colour images have no depth image; first: "
+            f"depth/{by_stem[unpaired[0]].stem}.*"
             f" for {by_stem[unpaired[0]].relative_to(root)}"
             + ("" if skip_missing else "; --skip-missing leaves them out with their poses")
             + ")" if unpaired and len(pairs) < len(colors) else "")
     if traj is not None and skip_missing and unpaired and matched:
-        stems = sorted({d.stem for d in depths} | set(by_stem), key=natural_key)
+        stems = sorted({pair_name(d) for d in depths} | set(by_stem), key=natural_key)
         every = trajectory_poses(traj, len(stems), hint, also=len(pairs))
         assert every is not None
         poses: list[np.ndarray | None] | None = list(every)  # one pose per RGB-D pair
         if len(every) == len(stems) != len(pairs):  # one per image name: those of the pairs
             pose_of = dict(zip(stems, every, strict=True))
-            poses = [pose_of[d.stem] for d, _ in pairs]
+            poses = [pose_of[pair_name(d)] for d, _ in pairs]
             notes.append(f"--skip-missing: {len(unpaired)} colour image(s) without a depth "
                          "image left out with their poses (first: "
                          f"{by_stem[unpaired[0]].relative_to(root)})")
-    elif per_frame is not None:  # frame i stays at i/fps when frames before it are left out
+    elif per_frame is not None:
         slot = {d: i for i, (d, _) in enumerate(pairs)}
-        pairs, poses, lost = posed_pairs(per_frame, pairs, keep_unposed, notes)
+        pairs, poses, dropped = posed_pairs(per_frame, pairs, keep_unposed, notes)
     else:
         read = trajectory_poses(traj, len(pairs), hint, shorter=True) \
             if traj is not None else None
         poses = None if read is None else list(read)
-    dropped = 0 if per_frame is None else lost
+        start = open3d_log_first_frame(traj) if traj is not None and poses is not None \
+            and len(poses) < len(pairs) and is_open3d_log(traj) else 0
+        if start and poses is not None and start + len(poses) <= len(pairs):
+            # a reconstruction that started late: its first pose block is frame ``start``
+            assert traj is not None
+            notes.append(f"{start} of {len(pairs)} frames come before the first pose of "
+                         f"{traj.name}, frame {start} (first: "
+                         f"{pairs[0][0].relative_to(root)})"
+                         + ("" if keep_unposed else ": left out"))
+            if keep_unposed:
+                poses = [*([None] * start), *poses]
+            else:
+                slot = {d: i for i, (d, _) in enumerate(pairs)}
+                dropped, pairs = start, pairs[start:]
     if poses is not None and len(poses) < len(pairs):  # a reconstruction that stopped early
         assert traj is not None
         late = len(pairs) - len(poses)
@@ -566,14 +536,14 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
         if keep_unposed:
             poses = [*poses, *([None] * late)]
         else:
-            dropped, pairs = late, pairs[:len(poses)]
+            dropped, pairs = dropped + late, pairs[:len(poses)]
     intr = folder_intrinsics(root)
     for p in sorted(root.glob("*.json")) if intr is None else ():
         if is_intrinsics_json(p):
             intr = replace(read_intrinsics_file(p), source=f"file {p.name}")
             break
     frames = tuple(
-        FolderFrame(round((i if per_frame is None else slot[d]) * 1e9 / fps), d, c,
+        FolderFrame(round((slot[d] if slot else i) * 1e9 / fps), d, c,
                     poses[i] if poses is not None else None)
         for i, (d, c) in enumerate(pairs)
     )

@@ -295,12 +295,21 @@ def is_open3d_log(path: Path) -> bool:
     return False
 
 
+def open3d_log_first_frame(path: Path) -> int:
+    """The smallest frame id ``i`` of an Open3D ``.log``'s block headers ``i j n`` (0 when
+    every block names the same one: ids that say nothing)."""
+    rows = _data_lines(path)
+    ids = {float(rows[b][1][0]) for b in range(0, len(rows) - len(rows) % 5, 5)
+           if len(rows[b][1]) == 3}
+    return int(min(ids)) if len(ids) > 1 else 0
+
+
 def trajectory_poses(trajectory: Path | None, count: int, hint: str = "",
                      shorter: bool = False, also: int | None = None
                      ) -> list[np.ndarray] | None:
     """Poses from a --trajectory file for frames in order (Open3D .log, or a TUM file whose
-    lines are taken in order); ``hint`` says why the counts may differ; ``shorter``: a
-    trajectory that ends before the frames is taken (the first frames' poses); ``also``:
+    lines are taken in order); ``hint`` says why the counts may differ; ``shorter``: an
+    Open3D .log that ends before the frames is taken (the first frames' poses); ``also``:
     another count taken."""
     if trajectory is None:
         return None
@@ -309,7 +318,10 @@ def trajectory_poses(trajectory: Path | None, count: int, hint: str = "",
     timed = not is_open3d_log(trajectory)
     poses = ([T for _, T in read_tum_trajectory(trajectory)] if timed
              else read_open3d_log(trajectory))
-    if len(poses) not in (count, also) and not (shorter and 0 < len(poses) < count):
+    # a TUM file's lines, their times unused, pose the frames in order only when there is
+    # one a frame: one short may lack any frame (tracking lost), not only the last ones
+    if len(poses) not in (count, also) and not (shorter and not timed
+                                                and 0 < len(poses) < count):
         raise SgtoolError(f"{trajectory} has {len(poses)} poses for {count} frames{hint}"
                           + ("; this layout takes a TUM trajectory's lines one per frame, in "
                              "order, its times unused (a TUM folder, with rgb.txt and "

@@ -16,8 +16,9 @@ from sgtool.cli import cli
 from sgtool.errors import SgtoolError
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.recorders.importers.checks import check_floor, seconds_option_ns
+from sgtool.recorders.importers.image_files import natural_key
 from sgtool.recorders.importers.images import read_color_file_kind, resize_to
-from sgtool.recorders.importers.layouts import FolderSequence, natural_key, read_sequence
+from sgtool.recorders.importers.layouts import FolderSequence, read_sequence
 from sgtool.recorders.importers.odometry import FailedStep, OdometryResult
 from sgtool.recorders.importers.provenance import FLOOR_ORIGINS, Findings
 from sgtool.recorders.importers.rgbd import RgbdOptions, camera_for, import_rgbd
@@ -143,6 +144,33 @@ def test_seven_scenes_pose_files_must_be_rigid(tmp_path):
     (root / "frame-000001.pose.txt").write_text("1 0 0 0\n0 1 0 0\n0 0 1 0\n0.1 0 0 1\n")
     with pytest.raises(SgtoolError, match="frame-000001.pose.txt:4: the last row"):
         read_sequence(root)
+
+
+def test_open3d_images_pair_by_number_whatever_their_zero_padding(tmp_path):
+    """Colour 00007.jpg pairs with depth 7.png (as pose/000007.txt poses it): one image
+    missing on each side never pairs the frames between by position (they took the next
+    frame's colour)."""
+    root = open3d_folder(tmp_path / "f", [str(i) for i in range(6)])
+    for i in range(6):
+        (root / "image" / f"{i}.jpg").rename(root / "image" / f"{i:05d}.jpg")
+    (root / "image" / "00001.jpg").unlink()
+    (root / "depth" / "4.png").unlink()
+    write_open3d_log(root / "traj.log", [_pose(float(i)) for i in range(5)])
+    frames = read_sequence(root).frames
+    assert [(f.depth_path.stem, f.color_path and f.color_path.stem) for f in frames] == [
+        ("0", "00000"), ("1", None), ("2", "00002"), ("3", "00003"), ("5", "00005")]
+
+
+def test_open3d_takes_no_tum_trajectory_short_of_the_frames(tmp_path):
+    """A TUM --trajectory (its lines taken in order, times unused) with fewer lines than the
+    frames may lack any frame (tracking lost mid-way): refused, never the first frames'
+    poses (frame 1 took frame 2's)."""
+    root = open3d_folder(tmp_path / "f", ["0", "1", "2"])
+    (root / "traj.log").unlink()
+    tum = tmp_path / "slam.txt"
+    tum.write_text("0.0 0 0 0 0 0 0 1\n0.0667 2 0 0 0 0 0 1\n")  # frame 1 lost
+    with pytest.raises(SgtoolError, match="slam.txt has 2 poses for 3 frames; this layout"):
+        read_sequence(root, trajectory=tum)
 
 
 def test_open3d_missing_depth_is_named(tmp_path):
@@ -344,7 +372,7 @@ def test_depth_scale_out_of_range(tmp_path, value):
 
 
 def test_file_names_with_superscripts_sort_as_text() -> None:
-    from sgtool.recorders.importers.layouts import natural_key as file_key
+    from sgtool.recorders.importers.image_files import natural_key as file_key
 
     names = ["²1.png", "10.png", "2.png"]  # "²" alone: isdigit() but not int()
     assert sorted(names, key=file_key) == ["2.png", "10.png", "²1.png"]
@@ -353,7 +381,7 @@ def test_file_names_with_superscripts_sort_as_text() -> None:
 def test_time_stamp_names_with_fractions_sort_in_time() -> None:
     """A number with a fraction is one decimal number: "X.05" before "X.1" (time order),
     and fixed-width TUM names keep their order; only equal values tie."""
-    from sgtool.recorders.importers.layouts import natural_key as file_key
+    from sgtool.recorders.importers.image_files import natural_key as file_key
 
     names = ["1305031103.1.png", "1305031103.05.png", "1305031102.175304.png", "10.png"]
     assert sorted(names, key=file_key) == ["10.png", "1305031102.175304.png",

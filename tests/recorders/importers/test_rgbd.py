@@ -607,6 +607,29 @@ def test_a_trajectory_that_stops_early_leaves_the_later_frames_out(rgbd_data, tm
     assert rep.frames == 20 and any("11 of 211 frames come after" in n for n in rep.notes)
 
 
+def test_a_trajectory_that_starts_late_poses_the_frames_it_names(rgbd_data, tmp_path):
+    """An Open3D .log whose pose blocks start at frame 8 (a reconstruction that started
+    late) poses frames 8.. with them, never frames 0.. (they were shifted by 8 frames, with
+    a note that the last 8 frames were left out); the frames before are left out with a
+    note and keep their times."""
+    src = rgbd_data / "icl-livingroom1-micro"
+    folder = tmp_path / "late"
+    shutil.copytree(src, folder)
+    lines = (src / "open3d_estimated_trajectory.log").read_text().split("\n")
+    (folder / "open3d_estimated_trajectory.log").write_text(
+        "\n".join(lines[5 * 8:5 * 211]) + "\n")
+    rep = import_rgbd(folder, tmp_path / "a.mcap", RgbdOptions(**QUIET, limit=40))
+    assert any("8 of 211 frames come before the first pose" in n for n in rep.notes)
+    want = [np.array([[float(x) for x in lines[5 * i + k].split()] for k in range(1, 5)])
+            for i in range(8, 48)]
+    with LogReader(tmp_path / "a.mcap") as r:
+        frames = list(r.frames())
+    got = [f.pose for f in frames]
+    assert frames[0].time_ns == round(8 * 1e9 / 30)
+    back = want[0] @ np.linalg.inv(got[0])
+    assert all(pose_difference(back @ g, w)[0] < 1e-5 for g, w in zip(got, want, strict=True))
+
+
 def test_a_still_camera_is_not_taken_for_frozen_poses() -> None:
     """Poses that stand still over depth that hardly changes (a camera on a tripod, a
     person walking through a corner of the view) pass; so do poses that move."""
