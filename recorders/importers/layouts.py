@@ -311,10 +311,12 @@ def _read_tum(
                 continue
         frames.append(FolderFrame(t, root / name, color, pose))
     if not frames:
+        span = "" if track is None else (  # two clocks (Unix time and from 0) show here
+            f" (depth {depth[0][0] / 1e9:.3f}-{depth[-1][0] / 1e9:.3f} s, poses "
+            f"{track.times[0] / 1e9:.3f}-{track.times[-1] / 1e9:.3f} s)")
         raise SgtoolError(
             f"{root}: none of the {len(depth)} depth images is within the time span of "
-            f"{gt_path.name}; give --estimate-poses to estimate their poses"
-        )
+            f"{gt_path.name}{span}; give --estimate-poses to estimate their poses")
     if no_rgb:
         notes.append(f"{no_rgb} depth images had no colour image within {max_dt_ns / 1e6:g} ms")
     if no_pose:

@@ -306,6 +306,16 @@ def test_tum_times_a_log_cannot_hold(tmp_path):
     assert time_range_problem([0, 10**9], "x") is None
 
 
+def test_ground_truth_on_another_clock_names_both_time_spans(tmp_path):
+    """Ground truth timed from 0 beside images in Unix time: the refusal shows both spans
+    (it said only that no image was within the ground truth's)."""
+    root = _tum(tmp_path / "rel", ["1305031102.175", "1305031102.211"])
+    (root / "groundtruth.txt").write_text("0.07 0 0 0 0 0 0 1\n1.97 0 0 0 0 0 0 1\n")
+    with pytest.raises(SgtoolError, match=r"time span of groundtruth.txt \(depth "
+                       r"1305031102.175-1305031102.211 s, poses 0.070-1.970 s\)"):
+        read_sequence(root)
+
+
 # ----- item 9: no valid depth ------------------------------------------------------------------
 def test_all_invalid_depth_is_refused(tmp_path):
     root = seven_folder(tmp_path / "s", depth_value=65535)
