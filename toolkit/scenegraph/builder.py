@@ -103,12 +103,7 @@ from sgtool.scenegraph.assembly import GraphParts, assemble_graph, robot_state
 from sgtool.scenegraph.assign import AssignCache
 from sgtool.scenegraph.builder_config import BuilderConfig
 from sgtool.scenegraph.categories import RoomClassifier
-from sgtool.scenegraph.door_evidence import (
-    DoorObservation,
-    doorways,
-    observe_doors,
-    open_doors,
-)
+from sgtool.scenegraph.door_evidence import DoorObservation, doorways, observe_doors, open_doors
 from sgtool.scenegraph.door_voxels import DoorVoxels, near_median
 from sgtool.scenegraph.examined import (
     FramePoints,
@@ -538,8 +533,8 @@ class SceneGraphBuilder:
         reach = DOOR_REACH / self.voxels.resolution
         won = {iid: near_median(ijk, reach) for iid, ijk in won.items()}
         overhead = self.columns_between(occ, *LINTEL_BAND)
-        cells, centres, unsure = doorways(occ, won, self._panel_memo, overhead)
-        cells |= lintel_doorways(occ, overhead)  # no leaf seen
+        found = doorways(occ, won, self._panel_memo, overhead)
+        cells, centres = found.cells | lintel_doorways(occ, overhead), found.centres
         cells.setflags(write=False)  # kept to recognise the same cells next time
         got = self._density
         if got is None or got[0] != occ.resolution or not np.array_equal(got[1], cells):
@@ -549,7 +544,8 @@ class SceneGraphBuilder:
             got[2].setflags(write=False)
             self._density = got
         density = got[2]
-        seg = segment_rooms(vg, density, cfg, self._centre_memo, occ, unsure | cells, self._body)
+        seg = segment_rooms(vg, density, cfg, self._centre_memo, occ, found.unsure | cells,
+                            self._body, found.leaves)
         numbers = self._rooms.assign([vg.positions[r] for r in seg.rooms], cfg.match_radius)
         return _Rooms(cells, density, seg, [f"room:{n}" for n in numbers], centres)
 

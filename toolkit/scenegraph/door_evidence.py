@@ -18,7 +18,9 @@ and each seen door's rooms.
   that reach and ``LINTEL_TOUCH`` of its core, where a wall stands on both sides along
   the wall's line (drift smears a lintel as deep as the wall, too deep for
   :mod:`sgtool.scenegraph.lintels`); the wall's line through that floor's centre, jamb
-  to jamb, is door evidence too.
+  to jamb, is door evidence too. A door whose doorway was found also gives its leaf:
+  its cells more than ``LEAF_OFF`` off the doorway's line, and their faces; the room
+  segmentation's floor join crosses it (a leaf swung into a room is no wall of it).
 - :func:`observe_doors`: the rooms on either side of a door from the visible Voronoi nodes
   within ``door_radius``; a closed door with only one explored side leads to an unexplored
   room node (SCOUT sec. IV-A), placed ``unexplored_offset`` beyond the door.
@@ -41,7 +43,7 @@ from sgtool.mapping.voronoi import VoronoiGraph
 from sgtool.scenegraph.door_panel import opening_from_panel
 from sgtool.scenegraph.instances import InstanceInfo
 from sgtool.scenegraph.object_placement import SeenInstance
-from sgtool.scenegraph.room_segmentation import RoomTracker
+from sgtool.scenegraph.room_segmentation import JOIN_SEAL, RoomTracker
 from sgtool.vocabulary import OpenState
 
 PASSABLE_SHARE = 0.25  # passable share of a door's columns that makes them its opening
@@ -50,6 +52,7 @@ LINE_SLACK = 0.9  # cells across a panel's line that are on it (a slanted line's
 LINE_GAP = 2  # cells a panel's line may miss between cells that continue it
 LINTEL_TOUCH = 0.25  # m: a lintel this close to a panel is its doorway's (doorways())
 UNSURE_REACH = 0.9  # m: a door leaf's width (interior doors 0.7-0.9 m), at least
+LEAF_OFF = JOIN_SEAL  # m off the doorway's line: a leaf's cells out of its wall
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,23 +70,38 @@ def open_doors(instances: Mapping[int, InstanceInfo]) -> list[int]:
     return [iid for iid, v in instances.items() if v.kind == "door" and v.state != "closed"]
 
 
+@dataclass(frozen=True, eq=False)
+class Doorways:
+    """What :func:`doorways` finds (bool grids the shape of the occupancy grid)."""
+
+    cells: np.ndarray  # the door evidence
+    centres: dict[int, tuple[float, float]]  # door id -> x, y (m) of its doorway
+    unsure: np.ndarray  # floor near a door whose doorway was not found
+    leaves: np.ndarray  # swung leaves standing in a room, off their doorway's wall
+
+
 def doorways(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
              panel_memo: dict[bytes, object], overhead: np.ndarray | None = None
-             ) -> tuple[np.ndarray, dict[int, tuple[float, float]], np.ndarray]:
-    """Bool grid of the door evidence (module doc) from the voxels (ijk) of each open door,
+             ) -> Doorways:
+    """The door evidence (module doc) from the voxels (ijk) of each open door,
     in any order (e.g. from :class:`sgtool.scenegraph.door_voxels.DoorVoxels`), the
     centre (x, y in m) of each door's cells in it: its doorway, where a swung panel's
-    centroid stands beside it; and the bool grid of unsure floor (module doc).
+    centroid stands beside it; the unsure floor; and the leaves: the cells of a door
+    whose doorway was found that are not its doorway and lie farther than ``LEAF_OFF``
+    from the doorway's line (out of its wall), and the occupied cells beside them (the
+    leaf's faces): a leaf swung into a room is no wall of it (a leaf that meets a
+    cabinet closes a pocket of floor off the room).
     ``panel_memo`` caches the openings found from swung panels across calls. The cells of
     every door are looked up at once; only a door with too few passable cells (a swung
     panel) is looked at on its own."""
     cells = np.zeros(occ.shape, dtype=bool)
     unsure = np.zeros(occ.shape, dtype=bool)
+    leaves = np.zeros(occ.shape, dtype=bool)
     centres: dict[int, tuple[float, float]] = {}
     ids = [iid for iid, ijk in sorted(door_voxels.items()) if len(ijk)]
     parts = [door_voxels[iid] for iid in ids]
     if not parts:
-        return cells, centres, unsure
+        return Doorways(cells, centres, unsure, leaves)
     ix0 = int(round(occ.origin[0] / occ.resolution))
     iy0 = int(round(occ.origin[1] / occ.resolution))
     door = np.repeat(np.arange(len(parts)), [len(p) for p in parts])
@@ -104,6 +122,8 @@ def doorways(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
     for i in np.flatnonzero(open_door).tolist():
         mine = use & (door == i)
         centres[ids[i]] = _centre(occ, r[mine], c[mine])
+        leaf = ~passable & (door == i)
+        _mark_leaf(leaves, r[leaf], c[leaf], r[mine], c[mine], occ)
     occupied: np.ndarray | None = None
     free: np.ndarray | None = None
     for i in np.flatnonzero(~open_door).tolist():  # doors seen as their panel (mostly)
@@ -120,6 +140,7 @@ def doorways(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
             got = opening_from_panel(*panel, occupied, int(0.4 / occ.resolution),
                                      memo=panel_memo, free=free)
             if got is not None:
+                _mark_leaf(leaves, *panel, np.asarray(got[0]), np.asarray(got[1]), occ)
                 break
         pr, pc = core if got is None else got
         cells[pr, pc] = True  # the panel's doorway, else its core cells
@@ -130,7 +151,41 @@ def doorways(occ: OccupancyGrid, door_voxels: Mapping[int, np.ndarray],
                 cells |= _lintel_by_panel(near, np.asarray(pr), np.asarray(pc),
                                           overhead & free, occupied,
                                           LINTEL_TOUCH / occ.resolution)
-    return cells, centres, unsure
+    return Doorways(cells, centres, unsure, leaves)
+
+
+def _mark_leaf(leaves: np.ndarray, rows: np.ndarray, cols: np.ndarray,
+               door_rows: np.ndarray, door_cols: np.ndarray, occ: OccupancyGrid) -> None:
+    """Mark in ``leaves`` the cells (``rows``, ``cols``) of a door's leaf farther than
+    ``LEAF_OFF`` from the line of its doorway's cells (``door_rows``, ``door_cols``):
+    the part of the leaf out of the wall the doorway is in; and the occupied cells one
+    step across the leaf from them (its faces, whose voxels often carry the label of
+    what stands behind them), not along it (its end may meet a wall)."""
+    if len(rows) == 0 or len(door_rows) < 2:
+        return
+    across = _normal(door_rows, door_cols)
+    off = np.abs((np.stack([cols, rows], axis=1) - np.stack([door_cols, door_rows], axis=1)
+                  .mean(axis=0)) @ across) * occ.resolution
+    rows, cols = rows[off > LEAF_OFF], cols[off > LEAF_OFF]
+    if len(rows) == 0:
+        return
+    leaves[rows, cols] = True
+    face = _normal(rows, cols) if len(rows) > 1 else np.zeros(2)
+    for side in (1.0, -1.0):
+        fr = np.round(rows + side * face[1]).astype(np.int64)
+        fc = np.round(cols + side * face[0]).astype(np.int64)
+        ok = occ.inside(fr, fc)
+        fr, fc = fr[ok], fc[ok]
+        hit = occ.grid[fr, fc] == OCCUPIED
+        leaves[fr[hit], fc[hit]] = True
+
+
+def _normal(rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """The unit vector (x = column, y = row) across the principal axis of the cells."""
+    pts = np.stack([cols, rows], axis=1).astype(np.float64)
+    cen = pts - pts.mean(axis=0)
+    evecs = np.linalg.eigh(cen.T @ cen)[1]
+    return np.array([-evecs[1, -1], evecs[0, -1]])
 
 
 def _lintel_by_panel(near: np.ndarray, rows: np.ndarray, cols: np.ndarray,
@@ -156,10 +211,7 @@ def _lintel_by_panel(near: np.ndarray, rows: np.ndarray, cols: np.ndarray,
     # only the cells in the gap of the wall the door is hinged to: occupied cells on
     # both sides along the wall's line (across the panel's line), within the panel's
     # reach; drift smears a lintel out of its wall, as it smears the wall
-    pts = np.stack([cols, rows], axis=1).astype(np.float64)
-    cen = pts - pts.mean(axis=0)
-    evecs = np.linalg.eigh(cen.T @ cen)[1]
-    t = np.array([-evecs[1, -1], evecs[0, -1]])
+    t = _normal(rows, cols)
     reach = math.hypot(int(rows.max() - rows.min()), int(cols.max() - cols.min())) + 1
     gr, gc = np.nonzero(got)
     at = np.stack([gc, gr], axis=1).astype(np.float64)

@@ -49,7 +49,10 @@ What we do, and why it differs:
   and ``WALK_SEAL`` joins the parts of open floor it crosses, whatever the grid shows
   between them now (a phantom obstacle on its way, a swung door leaf and a cabinet door
   opened after it passed, leaving a pocket of the room closed off; a path through a
-  doorway enters its cut zone, so it joins nothing there). A merged room's centre is
+  doorway enters its cut zone, so it joins nothing there). A door's leaf swung into a
+  room is open floor to this join where it stands out of its doorway's wall
+  (:func:`sgtool.scenegraph.door_evidence.doorways` gives its cells): a leaf whose end
+  meets a cabinet walls off no pocket of the room. A merged room's centre is
   taken on its largest piece.
   A component shorter than ``min_room_length`` is a room when it stands on open floor of
   its own (no longer component's nodes on it) of at least ``OWN_FLOOR`` times
@@ -126,8 +129,8 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
                   centre_memo: dict[bytes, int] | None = None,
                   occ: OccupancyGrid | None = None,
                   unsure: np.ndarray | None = None,
-                  trajectory: np.ndarray | Sequence[tuple[float, float]] | None = None
-                  ) -> RoomSegmentation:
+                  trajectory: np.ndarray | Sequence[tuple[float, float]] | None = None,
+                  leaves: np.ndarray | None = None) -> RoomSegmentation:
     """Cut ``vg`` where the door density reaches the threshold; components are rooms.
     ``centre_memo`` keeps each room's centre across calls, keyed by its sub-graph (a room
     whose sub-graph is unchanged has the same centre: the same arrays, the same Dijkstra).
@@ -136,7 +139,9 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
     ``unsure``: the door evidence and the cells near a door whose doorway is not known
     (bool, ``vg.shape``): floor within ``JOIN_SEAL`` of them joins nothing;
     ``trajectory``: (k, 2) world x, y of the robot's path: a stretch of it that stays out
-    of the cut zone and that floor joins the parts it crosses (module doc)."""
+    of the cut zone and that floor joins the parts it crosses (module doc);
+    ``leaves``: the cells of door leaves swung into rooms (bool, ``vg.shape``), floor to
+    join by (module doc)."""
     cfg = config or RoomConfig()
     n, m = len(vg.positions), len(vg.edges)
     cut_e = np.zeros(m, dtype=bool)
@@ -171,7 +176,8 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
         if len(nodes):
             (rooms if comp_len[c] >= cfg.min_room_length else short).append(nodes)
     if occ is not None:
-        rooms = _rooms_by_floor(vg, rooms, short, occ, density, cfg, unsure, trajectory)
+        rooms = _rooms_by_floor(vg, rooms, short, occ, density, cfg, unsure, trajectory,
+                                leaves)
     for i, nodes in enumerate(rooms):
         labels[nodes] = i
     where = np.full(n, -1, dtype=np.int64)
@@ -185,10 +191,11 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
 def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.ndarray],
                     occ: OccupancyGrid, density: np.ndarray | None,
                     cfg: RoomConfig, unsure: np.ndarray | None = None,
-                    trajectory: np.ndarray | Sequence[tuple[float, float]] | None = None
-                    ) -> list[np.ndarray]:
+                    trajectory: np.ndarray | Sequence[tuple[float, float]] | None = None,
+                    leaves: np.ndarray | None = None) -> list[np.ndarray]:
     """``rooms`` (components long enough) joined where their nodes share a 4-connected part
-    of the open floor (free, outside the cut zone and ``unsure``) that passages at least
+    of the open floor (free or a door's ``leaves``, outside the cut zone and ``unsure``)
+    that passages at least
     ``JOIN_WIDTH`` wide hold together, plus the ``short`` components whose parts of the
     open floor no such room touches and hold at least ``OWN_FLOOR`` times
     ``min_room_length`` squared;
@@ -196,7 +203,7 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
     away = np.ones(occ.shape, dtype=bool) if density is None else density < cfg.door_threshold
     if unsure is not None:  # and what lies within JOIN_SEAL of it
         away &= ~within_cells(unsure, JOIN_SEAL / occ.resolution)
-    open_floor = occ.free & away
+    open_floor = occ.free & away if leaves is None else (occ.free | leaves) & away
     if short:
         part, count = ndimage.label(open_floor)
         area = np.bincount(part.ravel(), minlength=count + 1) * occ.resolution ** 2

@@ -138,8 +138,8 @@ def joined(occ: OccupancyGrid, cut: np.ndarray, a: tuple[int, int],
 def test_a_smeared_panel_s_doorway_is_found_under_its_lintel() -> None:
     occ, overhead, panel = grid()
     corridor, bathroom = (14, 45), (50, 45)
-    before, _, unsure = doorways(occ, panel, {})
-    after, _, unsure_after = doorways(occ, panel, {}, overhead)
+    before, unsure = (got := doorways(occ, panel, {})).cells, got.unsure
+    after, unsure_after = (got := doorways(occ, panel, {}, overhead)).cells, got.unsure
     assert joined(occ, before, corridor, bathroom)  # what merged the rooms
     assert not joined(occ, after, corridor, bathroom)
     new = after & ~before
@@ -155,4 +155,4 @@ def test_without_floor_under_a_lintel_nothing_is_added() -> None:
     cells, as before."""
     occ, overhead, panel = grid()
     none = np.zeros_like(overhead)
-    assert np.array_equal(doorways(occ, panel, {}, none)[0], doorways(occ, panel, {})[0])
+    assert np.array_equal(doorways(occ, panel, {}, none).cells, doorways(occ, panel, {}).cells)

@@ -23,7 +23,7 @@ from sgtool.scenegraph.room_segmentation import room_overlaps
 
 def door_cells_of(occ, door_voxels, memo):
     """The door evidence grid of :func:`doorways` (its cells, not the doorway centres)."""
-    return doorways(occ, door_voxels, memo)[0]
+    return doorways(occ, door_voxels, memo).cells
 
 
 def _share(p0: np.ndarray, direction: np.ndarray, lo: float, hi: float,
@@ -286,9 +286,9 @@ def test_an_open_door_stands_at_its_doorway_not_at_its_swung_panel():
     0.4 m inside the room."""
     occ, panel = swung_door()
     lintel = np.stack([np.arange(10, 26), np.full(16, 20), np.full(16, 44)], axis=1)
-    cells, at, _ = doorways(occ, {7: np.concatenate([panel, lintel]).astype(np.int64)}, {})
+    at = doorways(occ, {7: np.concatenate([panel, lintel]).astype(np.int64)}, {}).centres
     assert at[7] == pytest.approx((0.9, 1.025))
-    cells, at, _ = doorways(occ, {7: panel.astype(np.int64), 8: np.zeros((0, 3), np.int64)}, {})
+    at = doorways(occ, {7: panel.astype(np.int64), 8: np.zeros((0, 3), np.int64)}, {}).centres
     assert set(at) == {7}  # a door without voxels has no doorway
     x, y = at[7]
     assert abs(y - 1.025) < 0.051 and 0.5 <= x <= 1.3  # in the gap (a cell), not in the room
@@ -305,7 +305,8 @@ def test_a_leaf_whose_doorway_is_not_found_marks_the_floor_around_it_unsure():
     g[rows, cols] = OCCUPIED
     panel = np.stack([cols, rows, np.zeros(15, np.int64)], axis=1).astype(np.int64)
     occ = OccupancyGrid(g, (0.0, 0.0), 0.05)
-    cells, _, unsure = doorways(occ, {7: panel}, {})
+    got = doorways(occ, {7: panel}, {})
+    cells, unsure = got.cells, got.unsure
     assert cells[rows, cols].all()  # the leaf's own cells
     dist = ndimage.distance_transform_edt(~cells)
     assert unsure[dist <= 18].all()
@@ -313,7 +314,7 @@ def test_a_leaf_whose_doorway_is_not_found_marks_the_floor_around_it_unsure():
     assert unsure[(dist > 19) & (dist <= reach - 0.5)].all()
     assert not unsure[dist > reach + 1].any()
     swung_occ, swung = swung_door()
-    _, _, none = doorways(swung_occ, {7: swung}, {})
+    none = doorways(swung_occ, {7: swung}, {}).unsure
     assert not none.any()
 
 
