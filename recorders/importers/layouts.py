@@ -517,7 +517,15 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
         poses = None if read is None else list(read)
         start = open3d_log_first_frame(traj) if traj is not None and poses is not None \
             and len(poses) < len(pairs) and is_open3d_log(traj) else 0
-        if start and poses is not None and start + len(poses) <= len(pairs):
+        head = pair_name(pairs[0][0]) if start else ""  # "2": numbered as recorded
+        if start and poses is not None and (start + len(poses) > len(pairs) or (
+                head.isascii() and head.isdigit() and head != "0")):
+            assert traj is not None
+            raise SgtoolError(f"{traj}: its pose blocks name frames {start}-"
+                              f"{start + len(poses) - 1}, and the {len(pairs)} frames of "
+                              f"{root.name} start at {pairs[0][0].name}: which frames they "
+                              "pose is unclear; give one block per frame from the first")
+        if start and poses is not None:
             # a reconstruction that started late: its first pose block is frame ``start``
             assert traj is not None
             notes.append(f"{start} of {len(pairs)} frames come before the first pose of "
@@ -532,7 +540,8 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
     if poses is not None and len(poses) < len(pairs):  # a reconstruction that stopped early
         assert traj is not None
         late = len(pairs) - len(poses)
-        notes.append(f"{late} of {len(pairs)} frames come after the last pose of {traj.name} "
+        notes.append(f"{late} of {len(pairs) + dropped} frames come after the last pose of "
+                     f"{traj.name} "
                      f"(first: {pairs[len(poses)][0].relative_to(root)})"
                      + ("" if keep_unposed else ": left out"))
         if keep_unposed:

@@ -25,7 +25,8 @@ def options_record(planner: object, given: Mapping[str, Any] | None) -> dict[str
     ``given`` (None: those :func:`sgtool.planning.registry.make_planner` built ``planner``
     with), as :func:`sgtool.redact.recorded_options` keeps them."""
     options = getattr(planner, "given_options", None) if given is None else given
-    return {"planner_options": recorded_options(options)} if options else {}
+    return {"planner_options": recorded_options(options)} \
+        if isinstance(options, Mapping) and options else {}
 
 
 def started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOptions,

@@ -12,6 +12,7 @@ Every planner comes wrapped in :class:`~sgtool.planning.timing.TimedPlanner` (op
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -339,17 +340,32 @@ ANSWER_SOURCE = frozenset({"base_url", "replay", "transcript"})
 
 
 def _option_text(value: Any) -> Any:
-    """A plain value as ``-O`` text (a list comma-separated, a bool ``true``/``false``), so
-    that a log's typed value and the text of a command compare alike; anything else as
-    given."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int | float | str):
-        return str(value)
+    """A plain value as ``-O`` text of one meaning (a list comma-separated, a bool
+    ``true``/``false`` however written, a number by its value: ``1``, ``1.0`` and
+    ``"1.0"`` alike), so that a log's typed value and the text of a command compare
+    alike; anything else as given."""
     if isinstance(value, list | tuple) and all(
             isinstance(x, int | float | str) and not isinstance(x, bool) for x in value):
-        return ",".join(str(x) for x in value)
-    return value
+        return ",".join(_plain_text(x) for x in value)
+    if isinstance(value, str):  # a list as -O text: item by item
+        return ",".join(_plain_text(x) for x in value.split(","))
+    return _plain_text(value) if isinstance(value, int | float) else value
+
+
+def _plain_text(value: int | float | str) -> str:
+    """One text per meaning of a bool, number or word (:func:`_option_text`)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    text = str(value).strip()
+    if text.lower() in ("true", "yes", "on", "false", "no", "off"):
+        return "true" if text.lower() in ("true", "yes", "on") else "false"
+    try:
+        number = float(text)
+    except ValueError:
+        return text
+    if not math.isfinite(number):
+        return text
+    return str(int(number)) if number.is_integer() else repr(number)
 
 
 def typed_options(name: str, given: Mapping[str, Any]) -> dict[str, Any]:
@@ -439,6 +455,8 @@ def make_planner(name: str, **options: Any) -> Planner:
     else:
         planner = _build(key, entry, options)
     if not timed and entry is not None:
+        # the options it was built with, which a closed-loop log records (run_episode)
+        planner.given_options = given  # type: ignore[attr-defined]
         return planner
     from sgtool.planning.timing import TimedPlanner
 

@@ -306,6 +306,38 @@ def test_tum_times_a_log_cannot_hold(tmp_path):
     assert time_range_problem([0, 10**9], "x") is None
 
 
+def _log_of_frames(path: Path, frames: list[int]) -> None:
+    """An Open3D .log with one block per frame id given, frame k's pose at x = k."""
+    lines = []
+    for k in frames:
+        lines.append(f"{k} {k} {k + 1}")
+        lines.extend(" ".join(f"{v:.8f}" for v in row) for row in _pose(float(k)))
+    path.write_text("\n".join(lines) + "\n")
+
+
+@pytest.mark.parametrize(("names", "blocks"), [
+    ([str(i) for i in range(2, 8)], [2, 3, 4]),  # a clip named as its recording's frames
+    ([str(i) for i in range(6)], [2, 3, 4, 5, 6]),  # ids past the last frame
+])
+def test_pose_blocks_that_do_not_name_the_frames_plainly_are_refused(tmp_path, names, blocks):
+    """A .log whose first block is not frame 0 poses the frames from that position (a
+    reconstruction that started late) only when the images are numbered from 0 and the
+    blocks end within them; otherwise which frames they pose is unclear (a clip numbered
+    2..7 had file 4 posed with frame 2's pose), and the import says so."""
+    root = open3d_folder(tmp_path / "o3d", names)
+    _log_of_frames(root / "traj.log", blocks)
+    with pytest.raises(SgtoolError, match="which frames they pose is unclear"):
+        read_sequence(root)
+    late = open3d_folder(tmp_path / "late", [str(i) for i in range(6)])
+    _log_of_frames(late / "traj.log", [2, 3, 4])
+    seq = read_sequence(late)
+    assert [(f.depth_path.stem, f.pose[0, 3]) for f in seq.frames] == [
+        ("2", 2.0), ("3", 3.0), ("4", 4.0)]
+    # both notes count the folder's 6 frames (the second counted the 4 left after the first)
+    assert [n.split(" frames")[0] for n in seq.notes if " frames come " in n] == [
+        "2 of 6", "1 of 6"], seq.notes
+
+
 def test_ground_truth_on_another_clock_names_both_time_spans(tmp_path):
     """Ground truth timed from 0 beside images in Unix time: the refusal shows both spans
     (it said only that no image was within the ground truth's)."""

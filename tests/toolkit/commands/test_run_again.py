@@ -96,9 +96,11 @@ def test_options_given_to_make_planner_are_logged(tmp_path: Path) -> None:
     _, episode = sgtool.pick_episode(house)
     opts = sgtool.ClosedLoopOptions(max_steps=1,
                                     camera=sgtool.CameraConfig(width=64, height=48))
-    out = tmp_path / "scout.mcap"
-    sgtool.run_closed_loop(house, episode, sgtool.make_planner("scout", delta=0.3), out, opts)
-    assert sgtool.logged_run(out).planner_options == {"delta": 0.3}
+    for timed in (True, False):
+        out = tmp_path / f"scout-{timed}.mcap"
+        planner = sgtool.make_planner("scout", delta=0.3, timed=timed)
+        sgtool.run_closed_loop(house, episode, planner, out, opts)
+        assert sgtool.logged_run(out).planner_options == {"delta": 0.3}, timed
 
 
 @pytest.mark.parametrize(("args", "message"), [
@@ -121,3 +123,15 @@ def test_a_log_without_a_closed_loop_episode_is_refused(tmp_path: Path) -> None:
     assert "no closed-loop episodes in it" in r.output and not out.exists()
     r = CliRunner().invoke(cli, ["run", "-o", str(out)])
     assert r.exit_code == 2 and "Missing option '-p' / '--planner' (or --again LOG)" in r.output
+
+
+def test_a_planner_s_own_given_options_attribute_is_not_taken_for_options() -> None:
+    """A user's planner with an attribute named like make_planner's record of its options
+    (not a mapping) runs with nothing recorded (it crashed the episode)."""
+    from sgtool.recorders.sim.episode_extras import options_record
+
+    class Mine:
+        given_options = ("alpha", "beta")
+
+    assert options_record(Mine(), None) == {}
+    assert options_record(Mine(), {"k": 1}) == {"planner_options": {"k": 1}}

@@ -302,6 +302,12 @@ def test_options_compared_as_the_planner_takes_them(plugin_dir: Path) -> None:
     # ... and compared as -O text: a log's typed values and a command's text alike
     assert effective_options("nomod_plug:X", {"w": [0.5, 0.5], "b": True, "x": 0.3}) == \
         effective_options("nomod_plug:X", {"w": "0.5,0.5", "b": "true", "x": "0.3"})
+    # a float logged 1.0 given as "1" or "1.0", a bool logged true given as yes or on
+    for text in ("1", "1.0", "1.00"):
+        assert effective_options("nomod_plug:X", {"a": 1.0, "f": True, "w": [1.0, 2]}) == \
+            effective_options("nomod_plug:X", {"a": text, "f": "yes", "w": f"{text},2.0"})
+    assert effective_options("nomod_plug:X", {"a": 1.5}) != \
+        effective_options("nomod_plug:X", {"a": "1"})
     # a plug-in without an Options class: its __init__'s defaults are its defaults
     assert effective_options("mymod_plug:MyPlanner", {"k": "1", "label": "y"}) == {
         "label": "y"}
