@@ -297,11 +297,11 @@ def is_open3d_log(path: Path) -> bool:
 
 def open3d_log_first_frame(path: Path) -> int:
     """The smallest frame id ``i`` of an Open3D ``.log``'s block headers ``i j n`` (0 when
-    every block names the same one: ids that say nothing)."""
+    every block names the same one, or one is negative: ids that say nothing)."""
     rows = _data_lines(path)
     ids = {float(rows[b][1][0]) for b in range(0, len(rows) - len(rows) % 5, 5)
            if len(rows[b][1]) == 3}
-    return int(min(ids)) if len(ids) > 1 else 0
+    return int(min(ids)) if len(ids) > 1 and min(ids) >= 0 else 0
 
 
 def trajectory_poses(trajectory: Path | None, count: int, hint: str = "",

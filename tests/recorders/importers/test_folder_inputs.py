@@ -333,6 +333,9 @@ def test_pose_blocks_that_do_not_name_the_frames_plainly_are_refused(tmp_path, n
     seq = read_sequence(late)
     assert [(f.depth_path.stem, f.pose[0, 3]) for f in seq.frames] == [
         ("2", 2.0), ("3", 3.0), ("4", 4.0)]
+    negative = open3d_folder(tmp_path / "negative", [str(i) for i in range(6)])
+    _log_of_frames(negative / "traj.log", [-2, -1, 0])  # ids that say nothing: in order
+    assert [f.pose[0, 3] for f in read_sequence(negative).frames] == [-2.0, -1.0, 0.0]
     # both notes count the folder's 6 frames (the second counted the 4 left after the first)
     assert [n.split(" frames")[0] for n in seq.notes if " frames come " in n] == [
         "2 of 6", "1 of 6"], seq.notes
