@@ -160,18 +160,35 @@ def _mark_leaf(leaves: np.ndarray, rows: np.ndarray, cols: np.ndarray,
     ``LEAF_OFF`` from the line of its doorway's cells (``door_rows``, ``door_cols``):
     the part of the leaf out of the wall the doorway is in; and the occupied cells one
     step across the leaf from them (its faces, whose voxels often carry the label of
-    what stands behind them), not along it (its end may meet a wall)."""
+    what stands behind them), not along it (its end may meet a wall). A face whose line
+    stays occupied for ``LEAF_OFF`` past the leaf's free end is a wall the leaf lies
+    against (a leaf's skin ends with the leaf): not marked."""
     if len(rows) == 0 or len(door_rows) < 2:
         return
     across = _normal(door_rows, door_cols)
-    off = np.abs((np.stack([cols, rows], axis=1) - np.stack([door_cols, door_rows], axis=1)
-                  .mean(axis=0)) @ across) * occ.resolution
-    rows, cols = rows[off > LEAF_OFF], cols[off > LEAF_OFF]
-    if len(rows) == 0:
+    signed = (np.stack([cols, rows], axis=1) - np.stack([door_cols, door_rows], axis=1)
+              .mean(axis=0)) @ across
+    off = np.abs(signed) * occ.resolution
+    body = off > LEAF_OFF
+    if not body.any():
         return
+    rows, cols, signed = rows[body], cols[body], signed[body]
     leaves[rows, cols] = True
-    face = _normal(rows, cols) if len(rows) > 1 else np.zeros(2)
+    if len(rows) < 2:
+        return
+    face = _normal(rows, cols)
+    out = np.array([face[1], -face[0]])  # along the leaf, away from its doorway
+    out = out if out @ across * np.sign(signed.mean()) >= 0 else -out
+    pts = np.stack([cols, rows], axis=1).astype(np.float64)
+    tip = pts[int(np.argmax(np.abs(signed)))]
+    across_leaf = pts @ face - tip @ face  # the leaf's cells across it, from the tip's
+    past = np.arange(1.0, LEAF_OFF / occ.resolution + 1.0)
     for side in (1.0, -1.0):
+        edge = across_leaf.max() + 1.0 if side > 0 else across_leaf.min() - 1.0
+        line = tip + edge * face + past[:, None] * out  # the face's line past the free end
+        lr, lc = np.round(line[:, 1]).astype(np.int64), np.round(line[:, 0]).astype(np.int64)
+        if occ.inside(lr, lc).all() and (occ.grid[lr, lc] == OCCUPIED).all():
+            continue  # a wall runs on along it
         fr = np.round(rows + side * face[1]).astype(np.int64)
         fc = np.round(cols + side * face[0]).astype(np.int64)
         ok = occ.inside(fr, fc)

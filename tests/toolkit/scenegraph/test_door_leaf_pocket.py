@@ -74,3 +74,40 @@ def test_without_the_face_the_leaf_s_labelled_cells_join_alone() -> None:
     occ, door = house(skin=False)
     assert rooms(occ, door, with_leaves=False) == 3
     assert rooms(occ, door, with_leaves=True) == 2
+
+
+def flush_against_a_wall(wall: tuple[int, int], labelled: tuple[int, ...]
+                         ) -> tuple[OccupancyGrid, dict[int, np.ndarray]]:
+    """The doorway of :func:`house`, its leaf (columns 58-59) swung flush against a wall
+    (columns ``wall``) between its room and another room to the right, the door's labels
+    on columns ``labelled`` (a label that reaches into the wall, when it holds 60)."""
+    g = np.full((80, 100), OCCUPIED, dtype=np.int8)
+    g[2:-2, 2:-2] = FREE
+    g[WALL[0]:WALL[1], :] = OCCUPIED
+    g[WALL[0]:WALL[1], DOORWAY[0]:DOORWAY[1]] = FREE
+    g[WALL[1]:, wall[0]:wall[1]] = OCCUPIED
+    g[LEAF[0]:LEAF[1], 58:60] = OCCUPIED
+    lintel = [(c, r, 42) for r in range(*WALL) for c in range(*DOORWAY)]
+    leaf = [(c, r, k) for r in range(*LEAF) for c in labelled for k in range(0, 40, 4)]
+    return OccupancyGrid(g, (0.0, 0.0), RES), {7: np.array(lintel + leaf)}
+
+
+def rooms_of(occ: OccupancyGrid, door: dict[int, np.ndarray]) -> tuple[int, int]:
+    """The rooms of the nodes nearest a point left and right of the side wall."""
+    found = doorways(occ, door, {})
+    vg = voronoi_graph(occ, trajectory=np.array([[2.45, 0.8], [1.5, 2.5], [4.0, 2.5]]))
+    cfg = RoomConfig()
+    seg = segment_rooms(vg, door_density(found.cells, RES, cfg.door_bandwidth), cfg, None,
+                        occ, found.unsure | found.cells, leaves=found.leaves)
+    near = [int(np.argmin(np.hypot(*(vg.positions - p).T))) for p in ((1.5, 2.5), (4.0, 2.5))]
+    return int(seg.labels[near[0]]), int(seg.labels[near[1]])
+
+
+def test_a_leaf_flush_against_a_thin_wall_does_not_open_it() -> None:
+    """The face beside a leaf is its skin only where it ends with the leaf: a wall that
+    runs on past the leaf's free end is a wall (a one-cell wall on the map, or a door
+    label reaching into a two-cell one, joined the rooms either side through the face)."""
+    for wall, labelled in (((60, 61), (58, 59)), ((60, 62), (58, 59, 60)),
+                           ((60, 62), (58, 59))):
+        left, right = rooms_of(*flush_against_a_wall(wall, labelled))
+        assert left != right, (wall, labelled)
