@@ -166,20 +166,18 @@ def _mark_leaf(leaves: np.ndarray, rows: np.ndarray, cols: np.ndarray,
     if len(rows) == 0 or len(door_rows) < 2:
         return
     across = _normal(door_rows, door_cols)
-    signed = (np.stack([cols, rows], axis=1) - np.stack([door_cols, door_rows], axis=1)
-              .mean(axis=0)) @ across
-    off = np.abs(signed) * occ.resolution
-    body = off > LEAF_OFF
+    pts = np.stack([cols, rows], axis=1).astype(np.float64)
+    signed = (pts - np.stack([door_cols, door_rows], axis=1).mean(axis=0)) @ across
+    body = np.abs(signed) * occ.resolution > LEAF_OFF
     if not body.any():
         return
-    rows, cols, signed = rows[body], cols[body], signed[body]
+    rows, cols, signed, pts = rows[body], cols[body], signed[body], pts[body]
     leaves[rows, cols] = True
     if len(rows) < 2:
         return
     face = _normal(rows, cols)
     out = np.array([face[1], -face[0]])  # along the leaf, away from its doorway
     out = out if out @ across * np.sign(signed.mean()) >= 0 else -out
-    pts = np.stack([cols, rows], axis=1).astype(np.float64)
     tip = pts[int(np.argmax(np.abs(signed)))]
     across_leaf = pts @ face - tip @ face  # the leaf's cells across it, from the tip's
     past = np.arange(1.0, LEAF_OFF / occ.resolution + 1.0)
