@@ -61,3 +61,19 @@ def pair_name(p: Path) -> str:
     """The name an image pairs by: its stem, a number without its zero padding ("00007.jpg"
     pairs with "7.png", as ``pose/000007.txt`` poses it)."""
     return str(int(p.stem)) if p.stem.isascii() and p.stem.isdigit() else p.stem
+
+
+def frame_slots(names: list[Path], every: list[Path]) -> dict[Path, float] | None:
+    """Each of ``names``' frame slot, its time in frame periods from the first image of
+    ``every`` (all images of the folder, colour or depth), when every name is a plain
+    number: ``(n - first) / step``, ``step`` the most common gap between consecutive
+    numbers (a folder of every fifth frame is 1/fps apart, as a dense one). A frame left out
+    of the numbering (no image of any kind) or without depth thus keeps the frames after it
+    at their times. None when some name is not a plain number (frames then sit at their
+    position in the list)."""
+    numbers = sorted({int(p.stem) for p in every if p.stem.isascii() and p.stem.isdigit()})
+    if not names or len(numbers) != len({pair_name(p) for p in every}):
+        return None
+    gaps = Counter(b - a for a, b in zip(numbers, numbers[1:], strict=False))
+    step = min(gaps, key=lambda g: (-gaps[g], g)) if gaps else 1
+    return {p: (int(p.stem) - numbers[0]) / step for p in names}

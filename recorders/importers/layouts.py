@@ -15,7 +15,9 @@
   and ``depth/`` folders of images paired by name, a ``.log`` trajectory (camera-to-world)
   and an intrinsics JSON (``intrinsic_matrix``); depth in mm. Without a JSON, the PrimeSense
   default 525, 525, 319.5, 239.5 that Open3D itself assumes. Frames are ``1/fps`` apart, in
-  natural name order ("2.png" before "10.png", as Open3D's ``sorted_alphanum``). Without
+  natural name order ("2.png" before "10.png", as Open3D's ``sorted_alphanum``); images
+  named by plain numbers are at their number's time (a frame missing from the numbering
+  leaves a gap). Without
   a ``.log``, a ``pose/`` folder of one 4x4 text file a frame and an
   ``intrinsic/intrinsic_depth.txt`` (a ScanNet export: :mod:`.pose_files`) are read.
 """
@@ -30,7 +32,13 @@ import numpy as np
 
 from sgtool.errors import SgtoolError
 from sgtool.log.poses import PoseTrack
-from sgtool.recorders.importers.image_files import depth_images, images, natural_key, pair_name
+from sgtool.recorders.importers.image_files import (
+    depth_images,
+    frame_slots,
+    images,
+    natural_key,
+    pair_name,
+)
 from sgtool.recorders.importers.pose_files import folder_intrinsics, pose_folder, posed_pairs
 from sgtool.recorders.importers.sanity import time_range_problem, timestamp_problem
 from sgtool.recorders.importers.textformats import (
@@ -484,7 +492,16 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
                 "choose one with --trajectory"
             )
     per_frame = pose_folder(root) if traj is None else None
-    slot: dict[Path, int] = {}  # frame i stays at i/fps when frames before it are left out
+    slot: dict[Path, float] = {}  # frame i stays at i/fps when frames before it are left out
+    numbered = frame_slots([d for d, _ in pairs], depths + colors)
+    if numbered is not None:  # times by number: a frame left out keeps later ones in place
+        slot = numbered
+        holes = [d for d, e in zip(depths, depths[1:], strict=False)
+                 if numbered[e] - numbered[d] > 1]
+        if holes:
+            notes.append(f"{len(holes)} gap(s) in the numbers of the depth images (first: "
+                         f"after {holes[0].relative_to(root)}); each frame is at its "
+                         "number's time")
     dropped = 0
     if traj is None and per_frame is None and (root / "groundtruth.txt").is_file():
         notes.append("groundtruth.txt not read: a folder of depth/ and colour folders is read "
@@ -509,7 +526,7 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
                          "image left out with their poses (first: "
                          f"{by_stem[unpaired[0]].relative_to(root)})")
     elif per_frame is not None:
-        slot = {d: i for i, (d, _) in enumerate(pairs)}
+        slot = slot or {d: i for i, (d, _) in enumerate(pairs)}
         pairs, poses, dropped = posed_pairs(per_frame, pairs, keep_unposed, notes)
     else:
         read = trajectory_poses(traj, len(pairs), hint, shorter=True) \
@@ -535,7 +552,7 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
             if keep_unposed:
                 poses = [*([None] * start), *poses]
             else:
-                slot = {d: i for i, (d, _) in enumerate(pairs)}
+                slot = slot or {d: i for i, (d, _) in enumerate(pairs)}
                 dropped, pairs = start, pairs[start:]
     if poses is not None and len(poses) < len(pairs):  # a reconstruction that stopped early
         assert traj is not None

@@ -161,6 +161,28 @@ def test_open3d_images_pair_by_number_whatever_their_zero_padding(tmp_path):
         ("0", "00000"), ("1", None), ("2", "00002"), ("3", "00003"), ("5", "00005")]
 
 
+def test_open3d_frames_keep_their_numbers_times_past_a_missing_frame(tmp_path):
+    """Frame 3 missing from the folder (no depth: colour only; or no image at all) leaves
+    frames 4 and 5 at 4/fps and 5/fps (they were at 3/fps and 4/fps, one frame early), with
+    a note; a folder of every fifth frame stays 1/fps apart; names that are not plain
+    numbers keep their list positions."""
+    def times(root: Path) -> list[float]:
+        return [f.time_ns / 1e8 for f in read_sequence(root, fps=10.0).frames]
+
+    root = open3d_folder(tmp_path / "a", [str(i) for i in range(6)])
+    (root / "traj.log").unlink()
+    (root / "depth" / "3.png").unlink()
+    assert times(root) == [0.0, 1.0, 2.0, 4.0, 5.0]
+    assert "1 gap(s) in the numbers of the depth images (first: after depth/2.png)" in \
+        read_sequence(root).notes[-1]
+    (root / "image" / "3.jpg").unlink()
+    assert times(root) == [0.0, 1.0, 2.0, 4.0, 5.0]
+    sparse = open3d_folder(tmp_path / "b", [f"{5 * i:06d}" for i in range(4)])
+    assert times(sparse) == [0.0, 1.0, 2.0, 3.0]
+    named = open3d_folder(tmp_path / "c", ["a0", "a1", "a3"])
+    assert times(named) == [0.0, 1.0, 2.0]
+
+
 def test_open3d_takes_no_tum_trajectory_short_of_the_frames(tmp_path):
     """A TUM --trajectory (its lines taken in order, times unused) with fewer lines than the
     frames may lack any frame (tracking lost mid-way): refused, never the first frames'
