@@ -91,11 +91,7 @@ class Outcome:
 def error_line(e: BaseException) -> str:
     """``Type: first line of the message`` (a Ray task error is unwrapped to its cause);
     the message alone for an :class:`~sgtool.errors.SgtoolError`, which is written for
-    the user; with ``SGTOOL_TRACEBACK=1`` the whole traceback
-    (:func:`~sgtool.errors.traceback_text`)."""
-    shown = traceback_text(e)  # SGTOOL_TRACEBACK=1: the whole traceback instead
-    if shown is not None:
-        return shown
+    the user."""
     cause = getattr(e, "cause", None)
     if isinstance(cause, BaseException):
         e = cause
@@ -148,6 +144,7 @@ class _Executor:
             queue = list(range(len(tasks)))[::-1]
             attempts = [0] * len(tasks)
             first_error: dict[int, str] = {}
+            traced = False  # a failed task's traceback shown (SGTOOL_TRACEBACK=1)
             flight: dict[Any, int] = {}
             try:
                 while queue or flight:
@@ -166,6 +163,10 @@ class _Executor:
                     node = ""
                     if isinstance(value, _Placed):
                         node, value = value.node, value.value
+                    shown = None if err is None or traced else traceback_text(err)
+                    if shown is not None:  # SGTOOL_TRACEBACK=1: where the first failed raised
+                        print(shown, file=sys.stderr)
+                        traced = True
                     out = Outcome(tasks[i].id, value, None if err is None else error_line(err),
                                   attempts[i], node, first_error.get(i))
                     done[i] = out

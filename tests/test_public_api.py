@@ -327,7 +327,7 @@ def test_api_mistakes_are_one_line_errors(tmp_path) -> None:
         sgtool.record_house(sgtool.generate_house(3, rooms=(4, 4)), tmp_path / "out.txt")
     assert not list(tmp_path.iterdir())
     house = sgtool.generate_house(3, rooms=(4, 5))
-    with pytest.raises(sgtool.SgtoolError, match=r"'nothing': decide\(\) returned a NoneType, not"):
+    with pytest.raises(sgtool.SgtoolError, match=r"'nothing': decide\(\) returned None, not"):
         sgtool.run_one(house, Nothing(), sgtool.list_episodes(house)[0].query)
 
 

@@ -94,6 +94,15 @@ def raised_text(e: BaseException) -> str:
     return f"{type(e).__name__}: {text}" if text else type(e).__name__
 
 
+def returned_text(value: object) -> str:
+    """What a user's code returned, for a message: "None", "an int", "a Half" (by its
+    type's name)."""
+    if value is None:
+        return "None"
+    name = type(value).__name__
+    return f"{'an' if name[:1].lower() in 'aeiou' else 'a'} {name}"
+
+
 def traceback_text(e: BaseException) -> str | None:
     """The traceback of ``e`` with its causes (a plug-in's own frames: it is raised ``from``
     what the plug-in raised; from a worker process, the worker's traceback), when the

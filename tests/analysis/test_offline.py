@@ -258,7 +258,7 @@ def _mistake(how: str):
 
 
 @pytest.mark.parametrize("how, why", [
-    ("none", r"decide\(\) returned a NoneType, not an sgtool.Action"),
+    ("none", r"decide\(\) returned None, not an sgtool.Action"),
     ("skill", r"decide\(\) returned an Action with skill 'fly'; the skills are"),
     ("raises", r"decide\(\) raised RuntimeError: bug in my planner"),
 ])

@@ -508,8 +508,8 @@ class _OwnClassifier:
 @pytest.mark.parametrize("answer, why", [
     ([("kitchen", float("nan"))], "scored 'kitchen' nan: a score is a number in"),
     ([("kitchen", 7.0)], "scored 'kitchen' 7.0"),
-    (None, "returned NoneType, not \\(category, score\\) pairs"),
-    ("kitchen", "returned str"),
+    (None, "returned None, not \\(category, score\\) pairs"),
+    ("kitchen", "returned a str"),
     ([("", 0.5)], "named a category ''"),
 ])
 def test_a_classifier_of_ones_own_is_checked_before_its_answer_enters_the_graph(

@@ -33,7 +33,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from sgtool.errors import SgtoolError
+from sgtool.errors import SgtoolError, returned_text
 from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.planning.timing import decision_time
 from sgtool.scenegraph.graph import SceneGraph
@@ -150,7 +150,7 @@ def _step(planner: Planner, graph: SceneGraph, index: int, recorder: SearchRecor
     dt = time.perf_counter() - t0
     if not isinstance(action, Action):
         raise SgtoolError(f"planner {getattr(planner, 'name', type(planner).__name__)!r}: "
-                          f"decide() returned {type(action).__name__}, not an Action")
+                          f"decide() returned {returned_text(action)}, not an Action")
     dt = decision_time(planner, action, dt)
     kept = getattr(planner, "exchanges", None)
     exchanges = tuple(kept[n0:]) if isinstance(kept, list) else ()

@@ -25,7 +25,7 @@ from collections.abc import Callable, Mapping
 from importlib import metadata
 from typing import Any
 
-from sgtool.errors import raised_text
+from sgtool.errors import raised_text, returned_text
 from sgtool.planning.base import Planner
 from sgtool.planning.option_fields import (
     OptionMeta,
@@ -188,7 +188,7 @@ def build_plugin(name: str, factory: Callable[..., Any], options: Mapping[str, A
                           else f"planner {name!r}: raised {raised_text(e)}") from None
     missing = missing_parts(planner)
     if missing:
-        raise PluginError(f"planner {name!r}: returned a {type(planner).__name__}, not a "
+        raise PluginError(f"planner {name!r}: returned {returned_text(planner)}, not a "
                           f"Planner (it lacks {', '.join(missing)})")
     return planner
 

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from sgtool.errors import SgtoolError, raised_text
+from sgtool.errors import SgtoolError, raised_text, returned_text
 from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.vocabulary import SKILLS
@@ -153,7 +153,7 @@ class TimedPlanner:
                           action.graph_time_ns, unknown=action.unknown, absent=action.absent)
         if not isinstance(action, Action):
             raise PlannerContractError(
-                f"planner {self.name!r}: decide() returned a {type(action).__name__}, not an "
+                f"planner {self.name!r}: decide() returned {returned_text(action)}, not an "
                 "sgtool.Action (e.g. Action('navigate', node_id))")
         return dataclasses.replace(action, decision_time_s=dt)
 

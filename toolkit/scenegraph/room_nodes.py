@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.distance import pdist
 
-from sgtool.errors import SgtoolError
+from sgtool.errors import SgtoolError, returned_text
 from sgtool.mapping.voronoi import VoronoiGraph
 from sgtool.scenegraph.builder_config import BuilderConfig
 from sgtool.scenegraph.categories import RoomClassifier
@@ -164,7 +164,7 @@ def checked_scores(classifier: RoomClassifier, got: Any) -> list[tuple[str, floa
     try:
         pairs = [(r, p) for r, p in got]
     except (TypeError, ValueError):
-        raise fail(f"returned {type(got).__name__}, not (category, score) pairs") from None
+        raise fail(f"returned {returned_text(got)}, not (category, score) pairs") from None
     for r, p in pairs:
         if not isinstance(r, str) or not r:
             raise fail(f"named a category {r!r}, not a room type's name")

@@ -223,7 +223,7 @@ def test_an_options_dataclass_checks_like_the_built_ins(plugin_dir: Path) -> Non
      "found and failed while importing: fix it, or install what it imports"),
     ("mymod_plug:Nope", "planner 'mymod_plug:Nope': 'mymod_plug' has no 'Nope'"),
     ("mymod_plug:raises", "planner 'mymod_plug:raises': raised ValueError: no GPU here"),
-    ("mymod_plug:not_a_planner", "planner 'mymod_plug:not_a_planner': returned a int, not a "
+    ("mymod_plug:not_a_planner", "planner 'mymod_plug:not_a_planner': returned an int, not a "
      "Planner (it lacks name, reset, decide, feedback)"),
     ("mymod_plug:Half", "returned a Half, not a Planner (it lacks decide, feedback)"),
     ("mymod_plug:", "planner 'mymod_plug:': a plug-in is named module:Name"),
