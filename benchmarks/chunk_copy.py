@@ -18,6 +18,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from harness import add_output_options, alternate, emit, log_given
+from side_by_side import temporary_folder
 
 from sgtool.blas import single_blas_thread
 from sgtool.log import LogReader
@@ -47,7 +48,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--rounds", type=int, default=3)
     a = add_output_options(ap).parse_args(argv)
     log_given(ap, a.log)
-    out = Path(tempfile.mkdtemp(prefix="sgtool-chunk-copy-"))
+    out = temporary_folder("sgtool-chunk-copy-")
     frames: dict[bool, int] = {}
 
     def case(copy: bool) -> Callable[[], None]:

@@ -36,7 +36,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any, TypeVar
 
-from side_by_side import _MAIN, run_once, shadow_package
+from side_by_side import _MAIN, run_once, shadow_package, temporary_folder
 
 REPO = Path(__file__).resolve().parents[1]
 T = TypeVar("T")
@@ -119,7 +119,7 @@ def best_of(fn: Callable[[], object], repeats: int) -> Sample:
 def shadow_tree(tree: Path, folder: Path | None = None) -> str:
     """A ``PYTHONPATH`` entry whose ``sgtool`` is the checkout ``tree`` (a fresh temporary
     folder of links unless ``folder`` is given)."""
-    folder = folder or Path(tempfile.mkdtemp(prefix="sgtool-tree-"))
+    folder = folder or temporary_folder("sgtool-tree-")
     return str(shadow_package(tree.resolve(), folder))
 
 

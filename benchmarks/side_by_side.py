@@ -28,6 +28,7 @@ each tree's default houses::
 from __future__ import annotations
 
 import argparse
+import atexit
 import compileall
 import os
 import shutil
@@ -39,6 +40,13 @@ import time
 from pathlib import Path
 
 SUBPACKAGES = ("recorders", "replayers", "datasets", "analysis")
+
+
+def temporary_folder(prefix: str) -> Path:
+    """A fresh temporary folder, removed when the benchmark exits."""
+    folder = Path(tempfile.mkdtemp(prefix=prefix))
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)
+    return folder
 
 
 def shadow_package(base: Path, folder: Path) -> Path:
@@ -116,7 +124,7 @@ def main(argv: list[str] | None = None) -> int:
     a = ap.parse_args(argv)
     cmd = [c for c in a.command if c != "--"]
     if a.base_pkg is None:
-        a.base_pkg = Path(tempfile.mkdtemp(prefix="sgtool-base-pkg-"))
+        a.base_pkg = temporary_folder("sgtool-base-pkg-")
     if not a.no_compile:
         here = Path(__file__).resolve().parents[1]
         for tree in (a.base, a.tree or here):
@@ -124,12 +132,12 @@ def main(argv: list[str] | None = None) -> int:
                 compileall.compile_dir(str(tree.resolve() / sub), quiet=1)
     load0 = os.getloadavg()[0]
     pkg = str(shadow_package(a.base.resolve(), a.base_pkg))
-    this = (str(shadow_package(a.tree.resolve(), a.base_pkg.with_name(a.base_pkg.name + "-tree")))
+    this = (str(shadow_package(a.tree.resolve(), temporary_folder("sgtool-tree-")))
             if a.tree is not None else None)
     trees = {"this tree": this, "baseline": pkg}
     got: dict[str, list[tuple[float, float, float]]] = {k: [] for k in trees}
     figures: dict[str, list[float]] = {k: [] for k in trees}
-    out_dir = Path(tempfile.mkdtemp(prefix="sgtool-side-"))
+    out_dir = temporary_folder("sgtool-side-")
     for r in range(a.rounds):
         order = list(trees) if r % 2 == 0 else list(trees)[::-1]
         for name in order:

@@ -53,7 +53,7 @@ SMOKE: dict[str, Smoke] = {
         ("--houses", "1", "--episodes", "1", "--seeds", "1", "--repeats", "2", "--planners",
          "env-only,random", "--rooms", "4-5", "--preset", "default", "--against", "{repo}",
          "--json", "{tmp}/o.json"), marks=("slow",)),
-    "benchmarks/chunk_copy.py": Smoke(("{log}", "--rounds", "1")),
+    "benchmarks/chunk_copy.py": Smoke(("{log}", "--rounds", "1"), subprocess=True),
     "benchmarks/closed_loop.py": Smoke(
         ("--planners", "random", "--episodes", "1", "--house-seeds", "0", "--rooms", "4-4",
          "--resolution", "32x24", "--max-steps", "1", "--out", "{tmp}/logs"), marks=("slow",)),
@@ -109,7 +109,7 @@ SMOKE: dict[str, Smoke] = {
         marks=("slow",)),
     "benchmarks/side_by_side.py": Smoke(
         ("--base", "{repo}", "--rounds", "1", "--no-compile", "--", "info", "{log}"),
-        marks=("slow",)),
+        subprocess=True, marks=("slow",)),
     "benchmarks/tour_views.py": Smoke(
         ("--seeds", "107", "--rooms", "4-4", "--resolution", "32x24", "--rounds", "1",
          "--random-rooms", "1", "--json", "{tmp}/o.json"), marks=("slow",)),
@@ -202,11 +202,16 @@ def _run(name: str, args: list[str], cwd: Path, monkeypatch: pytest.MonkeyPatch,
     :class:`Smoke` says so) in a subprocess; it must exit 0. Its standard output."""
     script = REPO / name
     env = {"HF_HUB_OFFLINE": "1", "TRANSFORMERS_OFFLINE": "1", "MPLBACKEND": "Agg"}
-    if SMOKE[name].subprocess:
+    if SMOKE[name].subprocess:  # with a temporary folder of its own, left as it was found
+        tmp = cwd / "tmpdir"
+        tmp.mkdir()
         proc = subprocess.run([sys.executable, str(script), *args], cwd=cwd,
-                              env={**os.environ, **env}, capture_output=True, text=True,
-                              timeout=1200)
+                              env={**os.environ, **env, "TMPDIR": str(tmp)},
+                              capture_output=True, text=True, timeout=1200)
         assert proc.returncode == 0, proc.stderr[-3000:]
+        left = sorted(p.name for p in tmp.iterdir() if p.name.startswith("sgtool-")
+                      and not p.name.startswith("sgtool-pin-locks-"))  # (kept: shared locks)
+        assert not left, f"{name} left temporary folders: {left}"
         return proc.stdout
     for k, v in env.items():
         monkeypatch.setenv(k, v)
