@@ -77,8 +77,9 @@ Status = Literal["unchanged", "changed", "error"]
 def planner_decisions(log: str | Path, graphs: Sequence[str], refreshes: Sequence[RefreshMeta]
                       ) -> tuple[str | None, tuple[Decision, ...] | None]:
     """(planner, its decisions) at the decision points of an episode log, on the replayed
-    graphs (module doc); (None, None) for a log that is no episode log or whose planner
-    needs an endpoint; an :class:`SgtoolError` when its planner cannot be built here (a
+    graphs (module doc); (None, None) for a log that is no episode log, whose planner
+    needs an endpoint or was a user's own object (``planner_object``: its name builds
+    another planner, or none); an :class:`SgtoolError` when its planner cannot be built here (a
     plug-in whose module is not on the path: silently leaving the decisions out would pin
     less than asked, and a check would call the log changed)."""
     from sgtool.analysis.offline import read_log_episodes, replay_decisions
@@ -91,7 +92,8 @@ def planner_decisions(log: str | Path, graphs: Sequence[str], refreshes: Sequenc
     if len(names) != 1 or not any(e.decisions for e in episodes):
         return None, None
     name = names.pop()
-    if is_llm_planner(name):
+    if is_llm_planner(name) or any(e.episode.extras.get("planner_object")
+                                   for e in episodes):  # a user's object: not by its name
         return None, None
     times = [m.time_ns for m in refreshes]
     parsed: dict[int, SceneGraph] = {}

@@ -54,6 +54,9 @@ class LoggedRun:
     planner_options: dict[str, Any]
     options: ClosedLoopOptions
     notes: tuple[str, ...] = ()
+    # "module:QualName" of a user's own planner object the episode ran (``planner`` is then
+    # its display name, no planner sgtool builds by it): pass that object again
+    planner_object: str | None = None
 
 
 def logged_run(path: str | os.PathLike[str]) -> LoggedRun:
@@ -93,12 +96,15 @@ def logged_run(path: str | os.PathLike[str]) -> LoggedRun:
         raise SgtoolError(f"{p}: its opening Episode record names no planner")
     from sgtool.planning.registry import typed_options
 
+    obj = x.get("planner_object")
+    obj = obj if isinstance(obj, str) and obj else None
+    logged = x.get("planner_options") or {}
     run = LoggedRun(house=house, house_id=str(start.house_id or f"house-{house.seed}"),
                     episode_index=index, episode=episode, planner=planner,
                     # as the planner takes them (a list option: a tuple, as from -O)
-                    planner_options=typed_options(planner, x.get("planner_options") or {}),
-                    options=options)
-    notes = tuple(changed_settings(p, run))
+                    planner_options=dict(logged) if obj else typed_options(planner, logged),
+                    options=options, planner_object=obj)
+    notes = () if obj else tuple(changed_settings(p, run))
     # not the log's LLM transcript: a planner made with it would write this run's
     # exchanges into the transcript of the one logged (give a new one to keep them)
     return dataclasses.replace(run, notes=notes, planner_options={

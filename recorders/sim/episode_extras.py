@@ -23,10 +23,19 @@ from sgtool.scenegraph.graph import SceneGraph
 def options_record(planner: object, given: Mapping[str, Any] | None) -> dict[str, Any]:
     """``{"planner_options": ...}`` for the episode records (empty: none): the options
     ``given`` (None: those :func:`sgtool.planning.registry.make_planner` built ``planner``
-    with), as :func:`sgtool.redact.recorded_options` keeps them."""
+    with), as :func:`sgtool.redact.recorded_options` keeps them; and ``"planner_object":
+    "module:QualName"`` for a user's own planner object (neither made by ``make_planner``
+    nor sgtool's): the log's planner name is then its display name, from which no planner
+    is rebuilt (``golden`` pins no decisions of it, ``run --again`` asks for ``-p``)."""
+    from sgtool.planning.timing import TimedPlanner
+
     options = getattr(planner, "given_options", None) if given is None else given
-    return {"planner_options": recorded_options(options)} \
+    out: dict[str, Any] = {"planner_options": recorded_options(options)} \
         if isinstance(options, Mapping) and options else {}
+    cls = type(planner)
+    if not isinstance(planner, TimedPlanner) and not cls.__module__.startswith("sgtool."):
+        out["planner_object"] = f"{cls.__module__}:{cls.__qualname__}"
+    return out
 
 
 def started_extra(opts: ClosedLoopOptions, sim: Simulation, mapping: ResolvedOptions,

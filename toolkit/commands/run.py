@@ -332,6 +332,11 @@ def again_request(args: RunArgs, given: frozenset[str], out: Path,
     frame_budget(args.frames, args.frames_per_room, 1)  # both given: before the log is read
     assert args.again is not None
     run = logged_run(args.again)
+    if run.planner_object and not args.planner:
+        raise SgtoolError(f"{args.again}: its planner {run.planner!r} was a Python object "
+                          f"({run.planner_object}) given to sgtool.run_closed_loop, which "
+                          "its name does not build; give -p (e.g. -p "
+                          f"{run.planner_object}, with its -O options)")
     for n in run.notes:
         note(f"note: {args.again} was run by older sgtool with a setting it runs otherwise "
              f"today: {n}")

@@ -133,5 +133,35 @@ def test_a_planner_s_own_given_options_attribute_is_not_taken_for_options() -> N
     class Mine:
         given_options = ("alpha", "beta")
 
-    assert options_record(Mine(), None) == {}
-    assert options_record(Mine(), {"k": 1}) == {"planner_options": {"k": 1}}
+    mine = {"planner_object": f"{__name__}:{Mine.__qualname__}"}
+    assert options_record(Mine(), None) == mine
+    assert options_record(Mine(), {"k": 1}) == {"planner_options": {"k": 1}, **mine}
+
+
+def test_a_planner_object_of_ones_own_is_not_rebuilt_by_its_name(tmp_path: Path) -> None:
+    """A user's own planner object named like a built-in: its log records its class, golden
+    pins no decisions of it (it pinned greedy's own, which the episode never made) and
+    `run --again` asks for -p (it ran greedy); make_planner's planners are rebuilt."""
+    greedy = type(sgtool.make_planner("greedy", timed=False))
+
+    class Mine(greedy):  # type: ignore[misc,valid-type]
+        pass
+
+    house = sgtool.generate_house(3, rooms=(4, 4))
+    _, episode = sgtool.pick_episode(house)
+    opts = sgtool.ClosedLoopOptions(max_steps=2,
+                                    camera=sgtool.CameraConfig(width=64, height=48))
+    sgtool.run_closed_loop(house, episode, Mine(), tmp_path / "mine.mcap", opts)
+    sgtool.run_closed_loop(house, episode, sgtool.make_planner("greedy"),
+                           tmp_path / "made.mcap", opts)
+    run = sgtool.logged_run(tmp_path / "mine.mcap")
+    assert (run.planner, run.planner_object) == ("greedy", f"{__name__}:{Mine.__qualname__}")
+    assert sgtool.logged_run(tmp_path / "made.mcap").planner_object is None
+    pins = sgtool.pin_logs([tmp_path / "mine.mcap", tmp_path / "made.mcap"], tmp_path / "p")
+    assert (pins.logs["mine"].planner, pins.logs["mine"].decisions) == (None, None)
+    assert pins.logs["made"].planner == "greedy" and pins.logs["made"].decisions
+    out = tmp_path / "again.mcap"
+    r = CliRunner().invoke(cli, ["run", "--again", str(tmp_path / "mine.mcap"), "-o", str(out)])
+    assert r.exit_code == 2 and r.output.count("\n") == 1, r.output
+    assert "its planner 'greedy' was a Python object (" in r.output and "give -p" in r.output
+    assert not out.exists()
