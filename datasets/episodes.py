@@ -296,6 +296,7 @@ def pick_episode(house: HouseSpec, query: str | None = None, index: int | None =
         raise SgtoolError("the house has no search episodes (it needs small objects and "
                           "start poses)")
     if query is not None:
+        of_type("query", query, str, "a category name (an episode number is index=)")
         if index is not None:
             raise SgtoolError("give either a query (--query, query=) or an episode index "
                               "(--episode, index=), not both")

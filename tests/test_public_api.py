@@ -329,6 +329,9 @@ def test_api_mistakes_are_one_line_errors(tmp_path) -> None:
     house = sgtool.generate_house(3, rooms=(4, 5))
     with pytest.raises(sgtool.SgtoolError, match=r"'nothing': decide\(\) returned None, not"):
         sgtool.run_one(house, Nothing(), sgtool.list_episodes(house)[0].query)
+    with pytest.raises(sgtool.SgtoolError, match=r"query: a category name \(an episode number "
+                                                 r"is index=\), got int"):
+        sgtool.pick_episode(house, 2)  # type: ignore[arg-type]
 
 
 def test_bench_config_shapes(tmp_path) -> None:

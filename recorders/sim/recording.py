@@ -290,8 +290,8 @@ class RecordReport:
             f"wrote {self.output} ({self.output.stat().st_size / 1e6:.1f} MB)",
             f"house {self.house_id}: {self.frames} frames, {self.actions} actions, "
             f"{self.travelled_m:.1f} m driven, {self.seconds:.1f} s ({fps:.1f} frames/s)",
-            f"{'goals' if self.coverage else 'rooms'} visited: {len(self.rooms_visited)} "
-            f"({', '.join(self.rooms_visited)})",
+            f"{'goals' if self.coverage else 'rooms'} visited: {len(self.rooms_visited)}"
+            + (f" ({', '.join(self.rooms_visited)})" if self.rooms_visited else ""),
         ]
         if self.looked_again:
             rooms = dict.fromkeys(self.looked_again)

@@ -12,7 +12,9 @@ converted against it as a built-in planner's are; otherwise ``-O`` text is conve
 type its parameter of the factory is annotated with, as a plain ``Options`` field's is
 (``weights: tuple[float, float]`` takes ``-O my:P.weights=0.3,0.7``; :func:`signature_metas`),
 and parsed as int, float, true/false or text for a parameter with another annotation or none
-(options given from Python are passed as given). A plug-in that fails to import,
+(from Python, text given for an annotated parameter is converted alike, other values are
+passed as given; a key the factory does not take is one line naming the nearest, unless it
+takes ``**kwargs``). A plug-in that fails to import,
 raises, or returns something else is one :class:`PluginError` line naming it.
 """
 
@@ -32,8 +34,10 @@ from sgtool.planning.option_fields import (
     PlannerOptionError,
     check_required,
     convert_options,
+    convert_value,
     plain_meta,
     resolved,
+    unknown_keys_error,
 )
 
 GROUP = "sgtool.planners"
@@ -166,11 +170,32 @@ def signature_metas(factory: Callable[..., Any]) -> dict[str, OptionMeta]:
 
 def plugin_options(name: str, factory: Callable[..., Any], given: Mapping[str, Any],
                    from_cli: bool = False) -> dict[str, Any]:
-    """``given`` checked against the factory's ``Options`` when it has one, else as given."""
+    """``given`` checked against the factory's ``Options`` when it has one, else against its
+    parameters (module doc)."""
     cls = options_class(factory)
     if cls is None:
-        return dict(given)
+        known = parameter_names(factory)
+        if known is not None and (unknown := set(given) - set(known)):
+            raise unknown_keys_error(name, unknown, known)
+        metas = signature_metas(factory) if any(isinstance(v, str) for v in given.values()) \
+            else {}
+        return {k: convert_value(name, k, metas[k], v, from_cli=True)  # text as -O gives it
+                if isinstance(v, str) and k in metas else v for k, v in given.items()}
     return convert_options(name, cls, given, from_cli=from_cli)
+
+
+def parameter_names(factory: Callable[..., Any]) -> list[str] | None:
+    """The keyword parameters of a factory without ``Options`` (a class: its
+    ``__init__``'s); None when it takes ``**kwargs`` or Python cannot tell."""
+    import inspect
+
+    try:
+        params = list(inspect.signature(factory).parameters.values())
+    except (TypeError, ValueError):
+        return None
+    if any(p.kind is p.VAR_KEYWORD for p in params):
+        return None
+    return [p.name for p in params if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
 
 
 def build_plugin(name: str, factory: Callable[..., Any], options: Mapping[str, Any]) -> Planner:

@@ -4,6 +4,8 @@ figure on a hand-built grid."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 from click.testing import CliRunner
 
@@ -24,6 +26,19 @@ def test_coverage_counts_known_floor_cells() -> None:
     assert coverage(grid, np.zeros((0, 2))) == 0.0
     samples = [(0.0, 0.1), (30.0, 0.4), (75.0, 0.7)]
     assert [coverage_at(samples, t) for t in (-1, 0, 60, 120)] == [0.0, 0.1, 0.4, 0.7]
+
+
+def test_a_report_without_goals_visited_says_none_without_an_empty_list(tmp_path) -> None:
+    from sgtool.recorders.sim.recording import RecordReport
+
+    out = tmp_path / "x.mcap"
+    out.write_bytes(b"")
+    report = RecordReport(out, "house-0", 10, 0, 0.0, (), {}, (), False, 1.0,
+                          coverage=((1.0, 0.2),))
+    assert "goals visited: 0" in report.lines() and not any("()" in line
+                                                            for line in report.lines())
+    assert "rooms visited: 2 (kitchen, bath)" in dataclasses.replace(
+        report, coverage=(), rooms_visited=("kitchen", "bath")).lines()
 
 
 def test_record_explore_frontier(tmp_path) -> None:
