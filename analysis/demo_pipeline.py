@@ -80,18 +80,32 @@ def run_demo(request: DemoRequest, show: Echo, progress: bool,
     """Run the demo into ``request.out``: ``demo.mcap``, ``derived.mcap``, ``view.rrd``
     (made by ``write_view(derived, rrd, progress)``; left out, with a note, when Rerun is
     not installed) and ``bench/``. A previous demo's outputs there go first, so that a run
-    cut short leaves its own outputs only (each written whole), not a mix of two runs."""
+    cut short leaves its own outputs only (each written whole), not a mix of two runs;
+    files of those names the folder's manifest does not list as the demo's (a user's) are
+    an error before any work (a folder of an older demo, with a bench's ``bench/`` and no
+    manifest of its own, is the demo's)."""
     import importlib.util
 
     from sgtool.analysis.bench import OUTPUT_NAMES, run_bench
-    from sgtool.files import sgtool_entries
+    from sgtool.errors import SgtoolError
+    from sgtool.files import MANIFEST, note_written, read_manifest, sgtool_entries
 
     out = request.out
     log, derived, rrd = out / "demo.mcap", out / "derived.mcap", out / "view.rrd"
+    owner, listed = read_manifest(out)
+    if owner is None and read_manifest(out / "bench")[0] == "bench":  # an older demo's
+        owner, listed = "demo", frozenset({log.name, derived.name, rrd.name})
+    theirs = [p.name for p in (log, derived, rrd)
+              if p.exists() and (owner != "demo" or p.name not in listed)]
+    if theirs:  # a user's files of these names: never deleted or replaced
+        raise SgtoolError(f"-o {out}: holds {', '.join(theirs)}, named as the demo's outputs "
+                          f"but not listed as its own ({MANIFEST}); not replacing them: move "
+                          "them away, or give another folder")
     for old in (log, derived, rrd, *(out / "bench" / n for n in sgtool_entries(
             out / "bench", OUTPUT_NAMES))):  # the bench's own files (a user's stay)
         if not old.is_dir():
             old.unlink(missing_ok=True)
+    note_written(out, "demo", [log.name, derived.name, rrd.name])
     frames = _record(request, log, show, progress)
     show(f"\n== sgtool replay {log} -o {derived} --rrd {rrd} --score")
     _replay(log, derived, frames, show, progress)

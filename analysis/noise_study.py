@@ -238,7 +238,7 @@ def record_task_log(task: StudyTask) -> bool:
     no longer opens, cut off or damaged in the cache, is recorded again); True when
     recorded now."""
     out = Path(task.log)
-    if out.is_file() and _opens(out):
+    if out.is_file() and complete_log(out):
         return False
     from sgtool.datasets.start_poses import with_start_poses
     from sgtool.house.io import load_house_text
@@ -265,13 +265,16 @@ def record_task_log(task: StudyTask) -> bool:
     return True
 
 
-def _opens(log: Path) -> bool:
-    """Whether ``log`` opens as an MCAP file (its start and end magic and summary)."""
+def complete_log(log: Path) -> bool:
+    """Whether ``log`` is a complete MCAP file: it opens (its start and end magic and
+    summary) and every CRC it carries is right (``sgtool doctor``'s "complete")."""
     from sgtool.log import LogReader
+    from sgtool.log.recover import scan
 
     try:
         with LogReader(log):
-            return True
+            pass
+        return scan(log).status == "complete"
     except (SgtoolError, OSError):
         return False
 

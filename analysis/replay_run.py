@@ -103,6 +103,11 @@ def replay_one(request: ReplayRequest, show: Echo, note: Echo) -> None:
             e.note = (f"{request.output} was written; {request.rrd} was not (make it with: "  # type: ignore[attr-defined]
                       f"sgtool view {quoted(request.output)} -o {quoted(request.rrd)})")
             raise
+        except SgtoolError as e:  # (a full disk) the derived log is complete: say so
+            said = str(e).removesuffix(" (nothing was written)")
+            raise SgtoolError(f"{said}; {request.output} was written, {request.rrd} was not "
+                              f"(make it with: sgtool view {quoted(request.output)} -o "
+                              f"{quoted(request.rrd)})") from e
     _show_report(request, report, rooms, scores, align, show)
 
 

@@ -35,6 +35,7 @@ from pathlib import Path
 from typing import IO
 
 from sgtool.errors import SgtoolError, deferred_interrupts
+from sgtool.publish import publish
 
 # OSError numbers that a user's environment causes (a destination that is read-only,
 # missing, full, not writable): reported as one line, never as a traceback
@@ -97,6 +98,14 @@ TEMP_RANDOM = 8  # the characters tempfile.mkstemp and mkdtemp put between prefi
 NAME_TAG = 8  # hex digits of the whole name's hash that a cut temporary name ends in
 
 
+def appeared_error(path: str | os.PathLike[str], kept: str | os.PathLike[str] | None = None
+                   ) -> OutputError:
+    """The one line for an output that another run wrote while this one ran."""
+    tail = f"; this run's output is kept in {kept}" if kept else " (nothing was written)"
+    return OutputError(f"{path} appeared while this run wrote it (another run?); not "
+                       f"overwriting it (use --force){tail}")
+
+
 def temp_prefix(name: str, suffix: str, hidden: bool = True) -> str:
     """The prefix of a temporary name beside ``name``: ``.NAME.`` (``NAME.`` when not
     ``hidden``). When the whole temporary name (the prefix, tempfile's 8 random
@@ -152,7 +161,12 @@ def atomic_output(path: str | os.PathLike[str], suffix: str = ".partial") -> Ite
         with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())
         os.chmod(tmp, 0o666 & ~_umask())  # a library may have made its own file anew
-        os.replace(tmp, path)
+        publish(tmp, path)
+    except FileExistsError as e:
+        tmp.unlink(missing_ok=True)
+        if str(e.filename) == str(path):
+            raise appeared_error(path) from None
+        raise
     except OSError as e:
         tmp.unlink(missing_ok=True)
         if concerns(e, tmp, path):

@@ -10,6 +10,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from sgtool.errors import SgtoolError
+from sgtool.publish import expect_new
 
 
 def check_output(path: str | os.PathLike[str], *, force: bool = False, option: str = "-o",
@@ -37,6 +38,7 @@ def check_output(path: str | os.PathLike[str], *, force: bool = False, option: s
                           "outputs are written beside it and renamed into place, which would "
                           "replace it; give a file's path")
     _probe_folder(p)
+    expect_new(p, new=not force)
     return p
 
 
@@ -48,12 +50,21 @@ def check_log_output(path: str | os.PathLike[str], *, force: bool = False,
     if not os.fspath(path):  # ("" would be the working folder)
         raise SgtoolError(f"{option} '': an empty path; give a file name")
     for given in inputs:
-        if given and Path(given).is_file() and Path(given).resolve() == Path(path).resolve():
+        if given and _is_file(given) and Path(given).resolve() == Path(path).resolve():
             raise SgtoolError(f"{option} {path}: the output must not be an input "
                               f"({given})")
     if Path(path).suffix != ".mcap" and not Path(path).is_dir():
         raise SgtoolError(f"{option} {path}: the output is an MCAP log; name it *.mcap")
     return check_output(path, force=force, option=option)
+
+
+def _is_file(given: str | os.PathLike[str]) -> bool:
+    """Whether ``given`` names a file; False when it cannot be looked at (an input that is
+    not a path, such as ``--noise none``, in a working folder this user cannot read)."""
+    try:
+        return Path(given).is_file()
+    except OSError:
+        return False
 
 
 def _probe_folder(path: Path) -> None:

@@ -74,10 +74,10 @@ def _check_mcap_profile(path: Path) -> None:
     if head != MAGIC:
         raise SgtoolError(f"{path}: not an MCAP file (it does not start with the MCAP magic "
                           "bytes)")
-    if size < 2 * len(MAGIC) or tail != MAGIC:
-        raise SgtoolError(f"{path}: the file ends without the MCAP footer (truncated, or "
-                          f"still being written); `sgtool doctor {quoted(path)} --recover "
-                          "OUT.mcap` copies what is readable into a valid file")
+    if size < 2 * len(MAGIC) or tail != MAGIC:  # cut short, or bytes appended after it
+        from sgtool.log.log_file import unended_problem
+
+        raise SgtoolError(unended_problem(path, size))
     try:
         with open(path, "rb") as f:
             reader = make_reader(f)
@@ -88,9 +88,11 @@ def _check_mcap_profile(path: Path) -> None:
     encodings = sorted({ch.message_encoding for ch in summary.channels.values()}) if summary \
         else []
     if header.profile != "ros2" or (encodings and encodings != ["cdr"]):
+        # (no summary: the channels, and so the encodings, are not known without a scan)
+        what = ", ".join(encodings) if encodings else "no" if summary else "unlisted"
         raise SgtoolError(
             f"{path} is an MCAP file with profile {header.profile!r} and "
-            f"{', '.join(encodings) or 'no'} messages, not a ROS 2 bag (profile 'ros2', cdr)"
+            f"{what} messages, not a ROS 2 bag (profile 'ros2', cdr)"
             + ("; it already is an sgtool log" if header.profile == "sgtool" else "")
         )
 

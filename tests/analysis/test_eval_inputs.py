@@ -124,6 +124,8 @@ def test_a_truncated_log_among_the_inputs_is_left_out_not_fatal(tmp_path) -> Non
     assert r.exit_code == 2
     assert "| greedy" in r.output  # the metrics of the table
     assert "1 of 2 input(s) could not be read and are left out" in r.output
+    assert r.output.count("not read (") == 1, r.output  # the note says why, the line not again
+    assert "half.mcap" not in r.output.strip().splitlines()[-1], r.output
 
 
 def test_seen_unseen_figures_are_rounded_as_the_planners_are(tmp_path) -> None:

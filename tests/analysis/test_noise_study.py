@@ -290,3 +290,25 @@ def test_the_study_takes_every_resolution_record_takes() -> None:
     for w, h in ((lo - 1, 16), (16, hi + 1)):
         with pytest.raises(SgtoolError, match=f"each side {lo}..{hi} pixels"):
             RecordingSettings(w, h).check()
+
+
+def test_a_cached_log_with_a_damaged_chunk_is_not_taken(tmp_path: Path) -> None:
+    """The cache takes a log only when it is complete: one flipped byte inside a chunk (a
+    CRC mismatch) opened as a log and failed the study at its replay, twice."""
+    from support.logfixtures import write_log
+
+    from sgtool.analysis.noise_study import complete_log
+    from sgtool.log import LogReader
+
+    log = tmp_path / "c.mcap"
+    write_log(log, n=4)
+    assert complete_log(log)
+    with LogReader(log) as r:
+        chunk = max(r.summary.chunk_indexes, key=lambda c: c.chunk_length)
+    data = bytearray(log.read_bytes())
+    data[chunk.chunk_start_offset + chunk.chunk_length // 2] ^= 0xFF
+    log.write_bytes(bytes(data))
+    with LogReader(log):  # it opens
+        pass
+    assert not complete_log(log)
+    assert not complete_log(tmp_path / "none.mcap")

@@ -102,10 +102,11 @@ def command(inputs: tuple[str, ...], out: str | None, force: bool = False,
     if out:
         atomic_write(out, outcome.text)
     click.echo(outcome.text, nl=False)
-    if outcome.unread:  # after the output, whose notes name each
+    if outcome.unread:  # after the output, whose notes name each (one: not again)
+        first = "" if len(outcome.unread) == 1 else f"; the first: {outcome.unread[0]}"
         raise SgtoolError(f"{len(outcome.unread)} of {len(request.inputs)} input(s) could not "
-                          f"be read and are left out of the metrics; the first: "
-                          f"{outcome.unread[0]}")
+                          f"be read and are left out of the metrics (the note above says "
+                          f"why){first}")
 
 
 @dataclass(frozen=True)

@@ -41,11 +41,19 @@ from mcap_protobuf.schema import build_file_descriptor_set
 
 from sgtool.arg_checks import whole
 from sgtool.errors import LogFormatError, SgtoolError, Terminated
-from sgtool.files import concerns, output_error, quoted, temp_beside, temp_prefix
+from sgtool.files import (
+    appeared_error,
+    concerns,
+    output_error,
+    quoted,
+    temp_beside,
+    temp_prefix,
+)
 from sgtool.log import chunk_copy, codec
 from sgtool.log import schemas as S
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.records import RECORD_TYPES, Instances, LogRecord
+from sgtool.publish import publish
 from sgtool.version import __version__
 from sgtool.vocabulary import RecordName
 
@@ -493,7 +501,13 @@ class LogWriter:
             os.fsync(self._stream.fileno())
             self._stream.close()
             self._closed = True
-            os.replace(self.partial_path, self.path)
+            publish(self.partial_path, self.path)
+        except FileExistsError as e:
+            if str(e.filename) != str(self.path):
+                self._closed = False
+                self.abort()
+                raise output_error(e, self.path) from None
+            raise appeared_error(self.path, kept=self.partial_path) from None
         except OSError as e:
             self._closed = False
             self.abort()

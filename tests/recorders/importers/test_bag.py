@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from mcap.writer import IndexType, Writer
 from support.bag_export import BagWriter, write_frames_bag, write_log_as_bag
 from support.logfixtures import synthetic_frame
 
@@ -314,6 +315,22 @@ def test_foreign_files_are_named(shared_data_dir, tmp_path):
     empty.write_bytes(b"")
     with pytest.raises(SgtoolError, match="empty.mcap: not an MCAP file"):
         import_bag(empty, tmp_path / "o.mcap", BagOptions(depth="/topic"))
+    assert not (tmp_path / "o.mcap").exists()
+    # bytes appended to a whole file are named so (it was called cut short), and a file
+    # without a summary has messages the summary does not list (it said "no messages")
+    appended = tmp_path / "appended.mcap"
+    appended.write_bytes(talker.read_bytes() + b"x" * 50)
+    with pytest.raises(SgtoolError, match=r"appended\.mcap: 50 bytes after the end of the MCAP"):
+        import_bag(appended, tmp_path / "o.mcap", BagOptions(depth="/topic"))
+    bare = tmp_path / "bare.mcap"
+    with open(bare, "wb") as f:
+        w = Writer(f, index_types=IndexType.NONE, repeat_channels=False, repeat_schemas=False,
+                   use_statistics=False, use_summary_offsets=False)
+        w.start(profile="sgtool", library="test")
+        w.add_message(w.register_channel("/t", "json", 0), 1, b"{}", 1)
+        w.finish()
+    with pytest.raises(SgtoolError, match="profile 'sgtool' and unlisted messages, not a ROS"):
+        import_bag(bare, tmp_path / "o.mcap", BagOptions(depth="/topic"))
     assert not (tmp_path / "o.mcap").exists()
 
 

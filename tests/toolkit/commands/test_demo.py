@@ -47,6 +47,8 @@ def test_a_demo_cut_short_leaves_no_outputs_of_the_run_before(tmp_path, monkeypa
         (out / name).write_text("old")
     (out / "bench" / ".sgtool-output").write_text(json.dumps(
         {"command": "bench", "files": ["summary.md"]}))
+    (out / ".sgtool-output").write_text(json.dumps(
+        {"command": "demo", "files": ["demo.mcap", "derived.mcap", "view.rrd"]}))
 
     def stopped(*args, **kwargs):
         raise KeyboardInterrupt
@@ -55,4 +57,30 @@ def test_a_demo_cut_short_leaves_no_outputs_of_the_run_before(tmp_path, monkeypa
     r = CliRunner().invoke(cli, ["demo", "-o", str(out), "--frames", "5"])
     assert r.exit_code != 0
     left = sorted(p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file())
-    assert left == ["bench/notes.txt", "mine.txt"]
+    assert left == [".sgtool-output", "bench/notes.txt", "mine.txt"]
+
+
+def test_a_demo_never_deletes_a_users_files_of_its_output_names(tmp_path, monkeypatch):
+    """A folder holding a derived.mcap sgtool demo did not write (no manifest lists it):
+    one error line before any work, the file untouched; in a folder an older demo wrote
+    (its bench's folder, no manifest of its own) they are the demo's, replaced."""
+    import json
+
+    import sgtool.recorders.sim as sim
+
+    out = tmp_path / "logs"
+    out.mkdir()
+    (out / "derived.mcap").write_text("mine")
+    r = CliRunner().invoke(cli, ["demo", "-o", str(out), "--frames", "5"])
+    assert r.exit_code == 2 and "derived.mcap" in r.output
+    assert (out / "derived.mcap").read_text() == "mine"
+    (out / "bench").mkdir()  # beside a bench's folder of its own: an older demo's folder
+    (out / "bench" / ".sgtool-output").write_text(json.dumps({"command": "bench",
+                                                             "files": []}))
+
+    def stopped(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sim, "record_house", stopped)
+    r = CliRunner().invoke(cli, ["demo", "-o", str(out), "--frames", "5"])
+    assert r.exit_code != 0 and not (out / "derived.mcap").exists(), r.output

@@ -128,3 +128,21 @@ def test_a_run_s_transcript_is_not_the_transcript_it_replays(tmp_path, given) ->
     assert r.exit_code == 2 and "it is the replay transcript" in r.output, r.output
     assert answers.read_text() == '{"messages": [], "model": "m"}\n'
     assert sorted(p.name for p in tmp_path.iterdir()) == ["answers.jsonl"]
+
+
+def test_an_input_that_cannot_be_looked_at_is_no_file(tmp_path: Path,
+                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    """An input that is no path (`--noise none`), looked at in a working folder this user
+    cannot read, is no file: the output check goes on (it said "Permission denied: none")."""
+    from sgtool.output_check import check_log_output
+
+    real = Path.is_file
+
+    def unreadable(self: Path) -> bool:
+        if not self.is_absolute():
+            raise PermissionError(13, "Permission denied", str(self))
+        return real(self)
+
+    monkeypatch.setattr(Path, "is_file", unreadable)
+    out = tmp_path / "x.mcap"
+    assert check_log_output(out, inputs=("none",)) == out

@@ -228,6 +228,26 @@ def test_ctrl_c_while_the_rrd_is_written_says_the_log_is_complete(tmp_path, monk
     assert out.exists() and not rrd.exists()
 
 
+def test_a_failed_rrd_says_the_log_is_complete(tmp_path, monkeypatch):
+    """replay -o D.mcap --rrd V.rrd on a disk that fills in the .rrd step: the one line
+    says the derived log was written (it said "nothing was written")."""
+    import sgtool.analysis.replay_run as replay_run
+    from sgtool.errors import SgtoolError
+
+    def full(derived, rrd, show):
+        raise SgtoolError(f"cannot write {rrd}: No space left on device (nothing was written)")
+
+    monkeypatch.setattr(replay_run, "write_view", full)
+    out, rrd = tmp_path / "d.mcap", tmp_path / "v.rrd"
+    r = CliRunner().invoke(cli, ["replay", str(GOLDEN_LOG), "-o", str(out), "--rrd", str(rrd),
+                                 "--no-progress"])
+    assert r.exit_code == 2, r.output
+    assert r.output.strip().splitlines()[-1] == (
+        f"sgtool: error: cannot write {rrd}: No space left on device; {out} was written, "
+        f"{rrd} was not (make it with: sgtool view {out} -o {rrd})")
+    assert out.exists() and not rrd.exists()
+
+
 @pytest.mark.parametrize("args, line", [
     (["bench", "--planners", ""], "sgtool: error: --planners: name at least one planner"),
     (["run-bench", "--planners", ""], "sgtool: error: --planners: name at least one planner"),

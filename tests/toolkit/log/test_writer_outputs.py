@@ -400,3 +400,31 @@ def test_two_long_names_that_begin_alike_keep_their_partial_files_apart(tmp_path
     wb.abort()
     assert partial_files(a) == [wa.partial_path] and partial_files(b) == []
     wa.abort()
+
+
+def test_an_output_another_run_wrote_meanwhile_is_not_replaced_without_force(tmp_path):
+    """The no---force check holds to the end: a file that appeared under the output's name
+    while the command ran (a second run with the same -o) is kept; this run says so in one
+    line, a log keeping its own finished file beside it."""
+    import pytest
+
+    from sgtool.files import OutputError, atomic_write
+    from sgtool.log.writer import LogWriter
+    from sgtool.output_check import check_output
+
+    out = tmp_path / "h.json"
+    check_output(out)
+    out.write_text("theirs")
+    with pytest.raises(OutputError, match="appeared while this run wrote it"):
+        atomic_write(out, "mine")
+    assert out.read_text() == "theirs" and sorted(tmp_path.iterdir()) == [out]
+    log = tmp_path / "r.mcap"
+    check_output(log)
+    w = LogWriter(log)
+    log.write_text("theirs")
+    with pytest.raises(OutputError, match="kept in"):
+        w.close()
+    assert log.read_text() == "theirs" and len(list(tmp_path.glob("r.mcap.*.partial"))) == 1
+    check_output(out, force=True)  # --force: replaced as before
+    atomic_write(out, "mine")
+    assert out.read_text() == "mine"

@@ -1,0 +1,45 @@
+"""Putting a finished output in place without replacing one another run wrote meanwhile.
+
+A command checks at its start that an output it was not told to overwrite (no ``--force``)
+does not exist (:func:`sgtool.output_check.check_output`, which calls :func:`expect_new`);
+a second run given the same path may write it before the first finishes. :func:`publish`
+moves such an output into place only while the path is still free (a hard link, which fails
+when it exists), so neither run's file is silently replaced; other outputs are renamed over
+whatever is there, as before.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+
+# the paths of this process's outputs that must still be new when published
+_NEW_ONLY: set[str] = set()
+
+
+def expect_new(path: str | os.PathLike[str], new: bool = True) -> None:
+    """``path`` must (``new``: no ``--force``) or need not still be new when the output
+    is moved into place."""
+    (_NEW_ONLY.add if new else _NEW_ONLY.discard)(os.path.abspath(path))
+
+
+def publish(tmp: str | os.PathLike[str], path: str | os.PathLike[str]) -> None:
+    """Move the finished ``tmp`` to ``path``: one rename, or, for a path that must be new
+    (:func:`expect_new`), a hard link that fails with :class:`FileExistsError` (naming
+    ``path``) when ``path`` appeared meanwhile; once in place, the path is this run's (a
+    second write of it replaces it)."""
+    key = os.path.abspath(path)
+    if key not in _NEW_ONLY:
+        os.replace(tmp, path)
+        return
+    try:
+        os.link(tmp, path)
+    except FileExistsError:  # (it names tmp: filename, path: filename2)
+        raise FileExistsError(errno.EEXIST, os.strerror(errno.EEXIST), str(path)) from None
+    except OSError:  # no hard links here (FAT, some network file systems)
+        if os.path.lexists(path):
+            raise FileExistsError(errno.EEXIST, os.strerror(errno.EEXIST), str(path)) from None
+        os.replace(tmp, path)
+    else:
+        os.unlink(tmp)
+    _NEW_ONLY.discard(key)
