@@ -154,3 +154,15 @@ def test_nohup_keeps_a_command_running_through_a_hang_up(tmp_path):
     finally:
         p.kill()
     assert out.is_file() and not list(tmp_path.glob("*.partial"))
+
+
+@pytest.mark.parametrize("command", [["record"], ["run"], ["bench"], ["run-bench"],
+                                     ["study", "noise"], ["scenes", "generate"]])
+def test_rooms_help_states_the_range_the_generator_takes(command: list[str]) -> None:
+    """--rooms 2-4 was refused with "need 4 <= MIN <= MAX <= 30", which no help said."""
+    from sgtool.datasets.generator import MAX_ROOMS
+
+    r = CliRunner().invoke(cli, [*command, "--help"], terminal_width=200)
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.split())
+    assert f"4..{MAX_ROOMS}" in text, text

@@ -35,7 +35,8 @@ def _pair(option: str, text: str) -> tuple[float, float]:
 @house_options(
     seed_help="Generate the house for this seed (`sgtool scenes generate`) instead of "
     "reading --house.",
-    rooms_help="Room count range for a house generated with --seed (N, MIN-MAX).")
+    rooms_help="Room count range for a house generated with --seed (N, MIN-MAX; "
+    "corridors included, 4..30).")
 @click.option("-o", "--output", required=True, type=PathParam(dir_okay=False),
               help="The log to write (OUT.mcap).")
 @click.option("--frames", type=int, default=None,

@@ -65,7 +65,8 @@ if TYPE_CHECKING:
 @house_options(
     seed_help="Search a generated evaluation house (`sgtool scenes generate`) of this seed "
     "instead of --house.",
-    rooms_help="Room count range of a house generated with --seed.")
+    rooms_help="Room count range of a house generated with --seed (corridors included, "
+    "4..30).")
 @click.option("--query", default=None, metavar="CATEGORY",
               help="The object category to find (a small object of the house, e.g. 'bowl'); "
               "the start pose is that of its episode in `sgtool scenes episodes`.")

@@ -57,7 +57,7 @@ if TYPE_CHECKING:
 @click.option("--house-seed", default=0, show_default=True, type=SEED,
               help="Seed of the first house.")
 @click.option("--rooms", default="12-16", show_default=True, metavar="MIN-MAX",
-              help="Room count range of the generated houses.")
+              help="Room count range of the generated houses (corridors included, 4..30).")
 @click.option("--preset", type=click.Choice(list(PRESET_NAMES)), default="symsearch",
               show_default=True, help="Generator preset of the generated houses.")
 @click.option("--episodes", default=6, show_default=True,

@@ -24,7 +24,8 @@ def _rooms_option(f):  # type: ignore[no-untyped-def]
     return click.option(
         "--rooms", default="4-12", show_default=True, metavar="MIN-MAX",
         callback=lambda ctx, p, v: _parse_rooms(v),
-        help="Range of the number of rooms, corridors included (or one number).")(f)
+        help="Range of the number of rooms, corridors included, 4..30 (or one "
+        "number).")(f)
 
 
 def _split_option(f):  # type: ignore[no-untyped-def]

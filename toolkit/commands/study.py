@@ -53,7 +53,7 @@ def command() -> None:
               help="A house spec JSON file or a folder of them (repeatable), studied after "
               "the generated houses.")
 @click.option("--rooms", default="8-8", show_default=True, metavar="MIN-MAX",
-              help="Room count range of the generated houses.")
+              help="Room count range of the generated houses (corridors included, 4..30).")
 @click.option("--factor", "factors", multiple=True, metavar="NAME=L1,L2,...",
               help="A noise factor and its levels (repeatable): depth_sigma, holes, "
               "label_swap, label_dropout, drift_xy, drift_yaw, flying (fields and units of `sgtool "
