@@ -75,6 +75,20 @@ def _replay(log: Path, derived: Path, frames: int, show: Echo, progress: bool) -
         show(line)
 
 
+def _demo_log(path: Path) -> bool:
+    """Whether ``path`` is an sgtool log of the demo house (an older demo's output)."""
+    from sgtool.errors import SgtoolError
+    from sgtool.log import LogReader
+
+    if not path.is_file():
+        return False
+    try:
+        with LogReader(path) as r:
+            return r.metadata.get("sgtool", {}).get("house_id") == "demo"
+    except (SgtoolError, OSError, ValueError):
+        return False
+
+
 def run_demo(request: DemoRequest, show: Echo, progress: bool,
              write_view: Callable[[Path, Path, bool], None]) -> None:
     """Run the demo into ``request.out``: ``demo.mcap``, ``derived.mcap``, ``view.rrd``
@@ -93,8 +107,11 @@ def run_demo(request: DemoRequest, show: Echo, progress: bool,
     out = request.out
     log, derived, rrd = out / "demo.mcap", out / "derived.mcap", out / "view.rrd"
     owner, listed = read_manifest(out)
-    if owner is None and read_manifest(out / "bench")[0] == "bench":  # an older demo's
-        owner, listed = "demo", frozenset({log.name, derived.name, rrd.name})
+    if owner is None and read_manifest(out / "bench")[0] == "bench":  # an older demo's?
+        # only logs of the demo house are (a user's own bench/ beside files of these names
+        # is no demo's folder); its view.rrd beside them
+        logs = {p.name for p in (log, derived) if _demo_log(p)}
+        owner, listed = "demo", frozenset(logs | ({rrd.name} if logs else set()))
     theirs = [p.name for p in (log, derived, rrd)
               if p.exists() and (owner != "demo" or p.name not in listed)]
     if theirs:  # a user's files of these names: never deleted or replaced

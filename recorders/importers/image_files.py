@@ -76,4 +76,6 @@ def frame_slots(names: list[Path], every: list[Path]) -> dict[Path, float] | Non
         return None
     gaps = Counter(b - a for a, b in zip(numbers, numbers[1:], strict=False))
     step = min(gaps, key=lambda g: (-gaps[g], g)) if gaps else 1
+    if any((n - numbers[0]) % step for n in numbers):  # time stamps, not frame numbers
+        return None
     return {p: (int(p.stem) - numbers[0]) / step for p in names}

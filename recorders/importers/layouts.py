@@ -493,7 +493,7 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
             )
     per_frame = pose_folder(root) if traj is None else None
     slot: dict[Path, float] = {}  # frame i stays at i/fps when frames before it are left out
-    numbered = frame_slots([d for d, _ in pairs], depths + colors)
+    numbered = frame_slots([d for d, _ in pairs], depths + (colors if matched else []))
     if numbered is not None:  # times by number: a frame left out keeps later ones in place
         slot = numbered
         holes = [d for d, e in zip(depths, depths[1:], strict=False)

@@ -32,8 +32,14 @@ def options_record(planner: object, given: Mapping[str, Any] | None) -> dict[str
     options = getattr(planner, "given_options", None) if given is None else given
     out: dict[str, Any] = {"planner_options": recorded_options(options)} \
         if isinstance(options, Mapping) and options else {}
-    cls = type(planner)
-    if not isinstance(planner, TimedPlanner) and not cls.__module__.startswith("sgtool."):
+    # the planner a TimedPlanner of one's own wraps; a built-in built without make_planner
+    # (no record of its options) is one's own object too
+    obj = planner.inner if isinstance(planner, TimedPlanner) and not planner.plugin \
+        else planner
+    cls = type(obj)
+    if not isinstance(obj, TimedPlanner) and (
+            not cls.__module__.startswith("sgtool.") or not isinstance(
+                getattr(planner, "given_options", None), Mapping)):
         out["planner_object"] = f"{cls.__module__}:{cls.__qualname__}"
     return out
 

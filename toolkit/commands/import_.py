@@ -320,8 +320,10 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None,
               "and intrinsic/intrinsic_depth.txt).")
 @click.option("--fps", type=float, default=30.0, show_default=True,
               help="Frame rate (0.1-1000) for layouts without time stamps (7-Scenes frame n "
-              "is at n/fps, Open3D frame i at i/fps) and for --timestamps index; give the "
-              "real spacing of the images when frames were skipped (odometry checks the "
+              "is at n/fps; an Open3D image numbered n at (n - first) / step / fps, step the "
+              "usual gap of the numbers, so a missing image leaves a gap; names that are "
+              "no frame numbers at their position / fps) and for --timestamps index; give "
+              "the real spacing of the images when frames were skipped (odometry checks the "
               "motion per step against it).")
 @click.option("--timestamps", type=click.Choice(["file", "index"]), default="file",
               show_default=True,

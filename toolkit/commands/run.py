@@ -334,10 +334,15 @@ def again_request(args: RunArgs, given: frozenset[str], out: Path,
     assert args.again is not None
     run = logged_run(args.again)
     if run.planner_object and not args.planner:
+        module, _, qual = run.planner_object.partition(":")
+        hint = (f"e.g. -p {run.planner_object}, with its -O options"
+                if module != "__main__" and "<locals>" not in qual else
+                f"its class was defined in {'a script' if module == '__main__' else 'a function'}"
+                f": put it in a module on PYTHONPATH and give -p MODULE:"
+                f"{qual.rsplit('.', 1)[-1]}, with its -O options")
         raise SgtoolError(f"{args.again}: its planner {run.planner!r} was a Python object "
                           f"({run.planner_object}) given to sgtool.run_closed_loop, which "
-                          "its name does not build; give -p (e.g. -p "
-                          f"{run.planner_object}, with its -O options)")
+                          f"its name does not build; give -p ({hint})")
     for n in run.notes:
         note(f"note: {args.again} was run by older sgtool with a setting it runs otherwise "
              f"today: {n}")

@@ -142,7 +142,8 @@ def options_class(factory: Callable[..., Any]) -> type | None:
     return cls if isinstance(cls, type) and dataclasses.is_dataclass(cls) else None
 
 
-def signature_metas(factory: Callable[..., Any]) -> dict[str, OptionMeta]:
+def signature_metas(factory: Callable[..., Any], declared: bool = False
+                    ) -> dict[str, OptionMeta]:
     """The options a factory without ``Options`` types by its parameters' annotations (a
     class: its ``__init__``'s): those whose annotation gives a kind the command line sets
     (:func:`~sgtool.planning.option_fields.plain_meta`: not a Python object); none when
@@ -160,7 +161,7 @@ def signature_metas(factory: Callable[..., Any]) -> dict[str, OptionMeta]:
         if p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD) or p.annotation is p.empty:
             continue
         hint = resolved(p.annotation, namespace)  # each on its own
-        if isinstance(hint, str):  # one that does not evaluate: untyped
+        if isinstance(hint, str) or (declared and hint is Any):  # untyped; Any: any value
             continue
         meta = plain_meta(None if p.default is p.empty else p.default, hint)
         if meta.cli:
@@ -177,8 +178,8 @@ def plugin_options(name: str, factory: Callable[..., Any], given: Mapping[str, A
         known = parameter_names(factory)
         if known is not None and (unknown := set(given) - set(known)):
             raise unknown_keys_error(name, unknown, known)
-        metas = signature_metas(factory) if any(isinstance(v, str) for v in given.values()) \
-            else {}
+        metas = signature_metas(factory, declared=True) \
+            if any(isinstance(v, str) for v in given.values()) else {}
         return {k: convert_value(name, k, metas[k], v, from_cli=True)  # text as -O gives it
                 if isinstance(v, str) and k in metas else v for k, v in given.items()}
     return convert_options(name, cls, given, from_cli=from_cli)

@@ -181,6 +181,14 @@ def test_open3d_frames_keep_their_numbers_times_past_a_missing_frame(tmp_path):
     assert times(sparse) == [0.0, 1.0, 2.0, 3.0]
     named = open3d_folder(tmp_path / "c", ["a0", "a1", "a3"])
     assert times(named) == [0.0, 1.0, 2.0]
+    # names that are time stamps (33 or 34 ms apart) are no frame numbers: list positions
+    stamps = open3d_folder(tmp_path / "d", [str(1_000_000 + 33 * i + i // 2) for i in range(4)])
+    assert times(stamps) == [0.0, 1.0, 2.0, 3.0]
+    # colour numbered otherwise (paired in order): the depth images' numbers alone
+    other = open3d_folder(tmp_path / "e", [str(1000 + i) for i in range(3)])
+    for i in range(3):
+        (other / "image" / f"{1000 + i}.jpg").rename(other / "image" / f"{i}.jpg")
+    assert times(other) == [0.0, 1.0, 2.0]
 
 
 def test_open3d_takes_no_tum_trajectory_short_of_the_frames(tmp_path):

@@ -74,7 +74,16 @@ def test_a_demo_never_deletes_a_users_files_of_its_output_names(tmp_path, monkey
     r = CliRunner().invoke(cli, ["demo", "-o", str(out), "--frames", "5"])
     assert r.exit_code == 2 and "derived.mcap" in r.output
     assert (out / "derived.mcap").read_text() == "mine"
-    (out / "bench").mkdir()  # beside a bench's folder of its own: an older demo's folder
+    (out / "bench").mkdir()  # beside a bench's folder of its own: a user's files stay
+    (out / "bench" / ".sgtool-output").write_text(json.dumps({"command": "bench",
+                                                             "files": []}))
+    r = CliRunner().invoke(cli, ["demo", "-o", str(out), "--frames", "5"])
+    assert r.exit_code == 2 and (out / "derived.mcap").read_text() == "mine", r.output
+    from sgtool.log.writer import LogWriter
+
+    (out / "derived.mcap").unlink()  # a log of the demo house there: an older demo's folder
+    with LogWriter(out / "derived.mcap", metadata={"house_id": "demo"}):
+        pass
     (out / "bench" / ".sgtool-output").write_text(json.dumps({"command": "bench",
                                                              "files": []}))
 

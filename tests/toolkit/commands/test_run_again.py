@@ -136,6 +136,16 @@ def test_a_planner_s_own_given_options_attribute_is_not_taken_for_options() -> N
     mine = {"planner_object": f"{__name__}:{Mine.__qualname__}"}
     assert options_record(Mine(), None) == mine
     assert options_record(Mine(), {"k": 1}) == {"planner_options": {"k": 1}, **mine}
+    # one's own object in a TimedPlanner, a built-in made without make_planner (its options
+    # unknown): marked too; make_planner's, timed or not: rebuilt by name
+    from sgtool.planning.timing import TimedPlanner
+
+    assert options_record(TimedPlanner(Mine()), None) == mine  # type: ignore[arg-type]
+    greedy = type(sgtool.make_planner("greedy", timed=False))
+    assert options_record(greedy(), None) == {
+        "planner_object": f"{greedy.__module__}:{greedy.__qualname__}"}
+    for timed in (True, False):
+        assert options_record(sgtool.make_planner("greedy", timed=timed), None) == {}
 
 
 def test_a_planner_object_of_ones_own_is_not_rebuilt_by_its_name(tmp_path: Path) -> None:
@@ -164,4 +174,6 @@ def test_a_planner_object_of_ones_own_is_not_rebuilt_by_its_name(tmp_path: Path)
     r = CliRunner().invoke(cli, ["run", "--again", str(tmp_path / "mine.mcap"), "-o", str(out)])
     assert r.exit_code == 2 and r.output.count("\n") == 1, r.output
     assert "its planner 'greedy' was a Python object (" in r.output and "give -p" in r.output
+    assert "its class was defined in a function: put it in a module on PYTHONPATH and give " \
+        "-p MODULE:Mine" in r.output, r.output
     assert not out.exists()

@@ -428,3 +428,8 @@ def test_an_output_another_run_wrote_meanwhile_is_not_replaced_without_force(tmp
     check_output(out, force=True)  # --force: replaced as before
     atomic_write(out, "mine")
     assert out.read_text() == "mine"
+    dangling = tmp_path / "d.json"  # a link to a missing file is no run's output: replaced
+    dangling.symlink_to(tmp_path / "gone.json")
+    check_output(dangling)
+    atomic_write(dangling, "mine")
+    assert dangling.read_text() == "mine" and not dangling.is_symlink()

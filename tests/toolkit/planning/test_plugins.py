@@ -23,6 +23,7 @@ from sgtool.planning.registry import (
 
 PLUGIN = textwrap.dedent('''
     from dataclasses import dataclass, field
+    from typing import Any
 
     from sgtool.planning.option_fields import option
     from sgtool.planning.planners import GreedyPlanner
@@ -39,9 +40,10 @@ PLUGIN = textwrap.dedent('''
 
     class Annotated(GreedyPlanner):
         def __init__(self, penalty: float = 1.0, weights: tuple[float, float] = (1.0, 0.0),
-                     verbose: bool = False, tag: str = "a"):
+                     verbose: bool = False, tag: str = "a", mode: Any = 3):
             super().__init__()
             self.penalty, self.weights, self.verbose, self.tag = penalty, weights, verbose, tag
+            self.mode = mode
 
 
     class Typed(GreedyPlanner):
@@ -261,6 +263,7 @@ def test_text_given_from_python_to_a_plain_plugin_is_converted_as_from_the_cli(
     assert (inner.penalty, inner.weights, inner.verbose, inner.tag) == (0.5, (1.0, 2.0),
                                                                          False, "7")
     assert make_planner("mymod_plug:Annotated", penalty=3).inner.penalty == 3  # type: ignore[attr-defined]
+    assert make_planner("mymod_plug:Annotated", mode="auto").inner.mode == "auto"  # type: ignore[attr-defined]
     with pytest.raises(SgtoolError, match="option penalty=abc: must be a number"):
         make_planner("mymod_plug:Annotated", penalty="abc")
     with pytest.raises(SgtoolError, match="does not take option\\(s\\): penalt; did you mean "
