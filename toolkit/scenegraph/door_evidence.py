@@ -53,6 +53,7 @@ LINE_GAP = 2  # cells a panel's line may miss between cells that continue it
 LINTEL_TOUCH = 0.25  # m: a lintel this close to a panel is its doorway's (doorways())
 UNSURE_REACH = 0.9  # m: a door leaf's width (interior doors 0.7-0.9 m), at least
 LEAF_OFF = JOIN_SEAL  # m off the doorway's line: a leaf's cells out of its wall
+LEAF_SKIN = 0.1  # m: occupied cells this deep beside a leaf's labelled cells are its face
 
 
 @dataclass(frozen=True, eq=False)
@@ -158,11 +159,12 @@ def _mark_leaf(leaves: np.ndarray, rows: np.ndarray, cols: np.ndarray,
                door_rows: np.ndarray, door_cols: np.ndarray, occ: OccupancyGrid) -> None:
     """Mark in ``leaves`` the cells (``rows``, ``cols``) of a door's leaf farther than
     ``LEAF_OFF`` from the line of its doorway's cells (``door_rows``, ``door_cols``):
-    the part of the leaf out of the wall the doorway is in; and the occupied cells one
-    step across the leaf from them (its faces, whose voxels often carry the label of
-    what stands behind them), not along it (its end may meet a wall). A face whose line
-    stays occupied for ``LEAF_OFF`` past the leaf's free end is a wall the leaf lies
-    against (a leaf's skin ends with the leaf): not marked."""
+    the part of the leaf out of the wall the doorway is in; and the occupied cells up to
+    ``LEAF_SKIN`` across the leaf from them, each step only beyond an occupied one (its
+    faces, whose voxels often carry the label of what stands behind them, two cells thick
+    under depth noise), not along it (its end may meet a wall). A face whose line stays
+    occupied for ``LEAF_OFF`` past the leaf's free end is a wall the leaf lies against (a
+    leaf's skin ends with the leaf): not marked, nor anything beyond it."""
     if len(rows) == 0 or len(door_rows) < 2:
         return
     across = _normal(door_rows, door_cols)
@@ -181,18 +183,25 @@ def _mark_leaf(leaves: np.ndarray, rows: np.ndarray, cols: np.ndarray,
     tip = pts[int(np.argmax(np.abs(signed)))]
     across_leaf = pts @ face - tip @ face  # the leaf's cells across it, from the tip's
     past = np.arange(1.0, LEAF_OFF / occ.resolution + 1.0)
+    skin = max(1, int(round(LEAF_SKIN / occ.resolution)))
     for side in (1.0, -1.0):
-        edge = across_leaf.max() + 1.0 if side > 0 else across_leaf.min() - 1.0
-        line = tip + edge * face + past[:, None] * out  # the face's line past the free end
-        lr, lc = np.round(line[:, 1]).astype(np.int64), np.round(line[:, 0]).astype(np.int64)
-        if occ.inside(lr, lc).all() and (occ.grid[lr, lc] == OCCUPIED).all():
-            continue  # a wall runs on along it
-        fr = np.round(rows + side * face[1]).astype(np.int64)
-        fc = np.round(cols + side * face[0]).astype(np.int64)
-        ok = occ.inside(fr, fc)
-        fr, fc = fr[ok], fc[ok]
-        hit = occ.grid[fr, fc] == OCCUPIED
-        leaves[fr[hit], fc[hit]] = True
+        alive = np.ones(len(rows), dtype=bool)  # the leaf's cells whose face goes on
+        for k in range(1, skin + 1):
+            edge = across_leaf.max() + k if side > 0 else across_leaf.min() - k
+            line = tip + edge * face + past[:, None] * out  # the face's line past the end
+            lr = np.round(line[:, 1]).astype(np.int64)
+            lc = np.round(line[:, 0]).astype(np.int64)
+            if occ.inside(lr, lc).all() and (occ.grid[lr, lc] == OCCUPIED).all():
+                break  # a wall runs on along it
+            fr = np.round(rows + side * k * face[1]).astype(np.int64)
+            fc = np.round(cols + side * k * face[0]).astype(np.int64)
+            ok = alive & occ.inside(fr, fc)
+            hit = np.zeros(len(rows), dtype=bool)
+            hit[ok] = occ.grid[fr[ok], fc[ok]] == OCCUPIED
+            leaves[fr[hit], fc[hit]] = True
+            alive = hit
+            if not alive.any():
+                break
 
 
 def _normal(rows: np.ndarray, cols: np.ndarray) -> np.ndarray:

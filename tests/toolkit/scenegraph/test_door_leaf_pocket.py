@@ -76,6 +76,22 @@ def test_without_the_face_the_leaf_s_labelled_cells_join_alone() -> None:
     assert rooms(occ, door, with_leaves=True) == 2
 
 
+def test_a_face_two_cells_thick_is_the_leaf_s_too() -> None:
+    """Under depth noise a leaf's unlabelled skin is two cells thick on the map (house 990,
+    mild: its door leaf cut the corridor in two); the cells up to LEAF_SKIN across the leaf
+    are its face, those beyond stay (a third cell is a wall beside it)."""
+    from sgtool.scenegraph.door_evidence import LEAF_SKIN
+
+    assert round(LEAF_SKIN / RES) == 2
+    for cells, expected in ((0, 2), (1, 2), (2, 2), (3, 3)):
+        occ, door = house(skin=False)
+        g = occ.grid.copy()
+        g[LEAF[0]:LEAF[1], 60:60 + cells] = OCCUPIED
+        thick = OccupancyGrid(g, (0.0, 0.0), RES)
+        assert rooms(thick, door, with_leaves=True) == expected, cells
+        assert rooms(thick, door, with_leaves=False) == 3
+
+
 def flush_against_a_wall(wall: tuple[int, int], labelled: tuple[int, ...]
                          ) -> tuple[OccupancyGrid, dict[int, np.ndarray]]:
     """The doorway of :func:`house`, its leaf (columns 58-59) swung flush against a wall
