@@ -334,15 +334,7 @@ def again_request(args: RunArgs, given: frozenset[str], out: Path,
     assert args.again is not None
     run = logged_run(args.again)
     if run.planner_object and not args.planner:
-        module, _, qual = run.planner_object.partition(":")
-        hint = (f"e.g. -p {run.planner_object}, with its -O options"
-                if module != "__main__" and "<locals>" not in qual else
-                f"its class was defined in {'a script' if module == '__main__' else 'a function'}"
-                f": put it in a module on PYTHONPATH and give -p MODULE:"
-                f"{qual.rsplit('.', 1)[-1]}, with its -O options")
-        raise SgtoolError(f"{args.again}: its planner {run.planner!r} was a Python object "
-                          f"({run.planner_object}) given to sgtool.run_closed_loop, which "
-                          f"its name does not build; give -p ({hint})")
+        raise _own_object(args.again, run.planner, run.planner_object)
     for n in run.notes:
         note(f"note: {args.again} was run by older sgtool with a setting it runs otherwise "
              f"today: {n}")
@@ -358,6 +350,20 @@ def again_request(args: RunArgs, given: frozenset[str], out: Path,
                          output=out, options=_changed(args, given, run),
                          planner_options=options, force=args.force, quiet=args.quiet,
                          rerun_to=args.rerun_to)
+
+
+def _own_object(log: str, planner: str, cls: str) -> SgtoolError:
+    """The one line for ``--again`` of a log whose planner was a user's object of class
+    ``cls`` (``module:QualName``), which no name builds."""
+    module, _, qual = cls.partition(":")
+    hint = (f"e.g. -p {cls}, with its -O options" if module != "__main__"
+            and "<locals>" not in qual else
+            f"its class was defined in {'a script' if module == '__main__' else 'a function'}"
+            f": put it in a module on PYTHONPATH and give -p MODULE:"
+            f"{qual.rsplit('.', 1)[-1]}, with its -O options")
+    return SgtoolError(f"{log}: its planner {planner!r} was a Python object ({cls}) given to "
+                       f"sgtool.run_closed_loop, which its name does not build; give -p "
+                       f"({hint})")
 
 
 def _changed(args: RunArgs, given: frozenset[str], run: LoggedRun) -> ClosedLoopOptions:
