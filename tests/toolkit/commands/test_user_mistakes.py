@@ -209,42 +209,31 @@ def test_study_names_its_own_closed_loop_options(tmp_path, monkeypatch, args, li
     assert not (tmp_path / "s").exists()
 
 
-def test_ctrl_c_while_the_rrd_is_written_says_the_log_is_complete(tmp_path, monkeypatch):
-    """replay -o D.mcap --rrd V.rrd: an interrupt in the .rrd step leaves the complete
-    derived log, and the one line says so, with the command that makes the .rrd."""
-    import sgtool.analysis.replay_run as replay_run
-
-    def interrupted(derived, rrd, show):
-        raise KeyboardInterrupt
-
-    monkeypatch.setattr(replay_run, "write_view", interrupted)
-    out, rrd = tmp_path / "d.mcap", tmp_path / "v.rrd"
-    r = CliRunner().invoke(cli, ["replay", str(GOLDEN_LOG), "-o", str(out), "--rrd", str(rrd),
-                                 "--no-progress"])
-    assert r.exit_code == 130, r.output
-    assert r.output.strip().splitlines()[-1] == (
-        f"sgtool: interrupted; {out} was written; {rrd} was not (make it with: sgtool view "
-        f"{out} -o {rrd})")
-    assert out.exists() and not rrd.exists()
-
-
-def test_a_failed_rrd_says_the_log_is_complete(tmp_path, monkeypatch):
-    """replay -o D.mcap --rrd V.rrd on a disk that fills in the .rrd step: the one line
-    says the derived log was written (it said "nothing was written")."""
+@pytest.mark.parametrize("fault, code, line", [
+    ("interrupt", 130, "sgtool: interrupted; {out} was written; {rrd} was not (make it with: "
+                       "sgtool view {out} -o {rrd})"),
+    ("full disk", 2, "sgtool: error: cannot write {rrd}: No space left on device; {out} was "
+                     "written, {rrd} was not (make it with: sgtool view {out} -o {rrd})"),
+])
+def test_a_failed_rrd_step_says_the_log_is_complete(tmp_path, monkeypatch, fault, code,
+                                                    line):
+    """replay -o D.mcap --rrd V.rrd: an interrupt or an error (a full disk: it said
+    "nothing was written") in the .rrd step leaves the complete derived log, and the one
+    line says so, with the command that makes the .rrd."""
     import sgtool.analysis.replay_run as replay_run
     from sgtool.errors import SgtoolError
 
-    def full(derived, rrd, show):
+    def failing(derived, rrd, show):
+        if fault == "interrupt":
+            raise KeyboardInterrupt
         raise SgtoolError(f"cannot write {rrd}: No space left on device (nothing was written)")
 
-    monkeypatch.setattr(replay_run, "write_view", full)
+    monkeypatch.setattr(replay_run, "write_view", failing)
     out, rrd = tmp_path / "d.mcap", tmp_path / "v.rrd"
     r = CliRunner().invoke(cli, ["replay", str(GOLDEN_LOG), "-o", str(out), "--rrd", str(rrd),
                                  "--no-progress"])
-    assert r.exit_code == 2, r.output
-    assert r.output.strip().splitlines()[-1] == (
-        f"sgtool: error: cannot write {rrd}: No space left on device; {out} was written, "
-        f"{rrd} was not (make it with: sgtool view {out} -o {rrd})")
+    assert r.exit_code == code, r.output
+    assert r.output.strip().splitlines()[-1] == line.format(out=out, rrd=rrd)
     assert out.exists() and not rrd.exists()
 
 
