@@ -162,13 +162,10 @@ def atomic_output(path: str | os.PathLike[str], suffix: str = ".partial") -> Ite
             os.fsync(fh.fileno())
         os.chmod(tmp, 0o666 & ~_umask())  # a library may have made its own file anew
         publish(tmp, path)
-    except FileExistsError as e:
-        tmp.unlink(missing_ok=True)
-        if str(e.filename) == str(path):
-            raise appeared_error(path) from None
-        raise
     except OSError as e:
         tmp.unlink(missing_ok=True)
+        if isinstance(e, FileExistsError) and str(e.filename) == str(path):
+            raise appeared_error(path) from None  # (publish: another run wrote it)
         if concerns(e, tmp, path):
             raise output_error(e, path) from None
         raise

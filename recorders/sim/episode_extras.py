@@ -32,14 +32,16 @@ def options_record(planner: object, given: Mapping[str, Any] | None) -> dict[str
     options = getattr(planner, "given_options", None) if given is None else given
     out: dict[str, Any] = {"planner_options": recorded_options(options)} \
         if isinstance(options, Mapping) and options else {}
-    # the planner a TimedPlanner of one's own wraps; a built-in built without make_planner
-    # (no record of its options) is one's own object too
+    # make_planner's planners are rebuilt by name: a plug-in's wrapper, a built-in with its
+    # options recorded; a TimedPlanner of one's own is its planner, and a built-in made
+    # without make_planner (options unknown) is one's own object too
     obj = planner.inner if isinstance(planner, TimedPlanner) and not planner.plugin \
         else planner
     cls = type(obj)
-    if not isinstance(obj, TimedPlanner) and (
-            not cls.__module__.startswith("sgtool.") or not isinstance(
-                getattr(planner, "given_options", None), Mapping)):
+    made = isinstance(obj, TimedPlanner) or (
+        cls.__module__.startswith("sgtool.")
+        and isinstance(getattr(planner, "given_options", None), Mapping))
+    if not made:
         out["planner_object"] = f"{cls.__module__}:{cls.__qualname__}"
     return out
 

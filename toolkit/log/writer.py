@@ -502,13 +502,10 @@ class LogWriter:
             self._stream.close()
             self._closed = True
             publish(self.partial_path, self.path)
-        except FileExistsError as e:
-            if str(e.filename) != str(self.path):
-                self._closed = False
-                self.abort()
-                raise output_error(e, self.path) from None
-            raise appeared_error(self.path, kept=self.partial_path) from None
         except OSError as e:
+            if isinstance(e, FileExistsError) and str(e.filename) == str(self.path):
+                # (publish: another run wrote it) this run's finished log stays as it is
+                raise appeared_error(self.path, kept=self.partial_path) from None
             self._closed = False
             self.abort()
             raise output_error(e, self.path) from None
