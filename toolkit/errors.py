@@ -94,13 +94,16 @@ def raised_text(e: BaseException) -> str:
     return f"{type(e).__name__}: {text}" if text else type(e).__name__
 
 
+def a_or_an(word: str) -> str:
+    """``word`` with its indefinite article by its first letter: "an int", "a TUM", "an
+    Open3D" (messages name types and formats, whose spelling decides)."""
+    return f"{'an' if word[:1].lower() in 'aeiou' else 'a'} {word}"
+
+
 def returned_text(value: object) -> str:
     """What a user's code returned, for a message: "None", "an int", "a Half" (by its
     type's name)."""
-    if value is None:
-        return "None"
-    name = type(value).__name__
-    return f"{'an' if name[:1].lower() in 'aeiou' else 'a'} {name}"
+    return "None" if value is None else a_or_an(type(value).__name__)
 
 
 def traceback_text(e: BaseException) -> str | None:

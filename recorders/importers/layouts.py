@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sgtool.errors import SgtoolError
+from sgtool.errors import SgtoolError, a_or_an
 from sgtool.log.poses import PoseTrack
 from sgtool.recorders.importers.image_files import (
     depth_images,
@@ -154,23 +154,19 @@ def missing_for_layout(root: Path, layout: str) -> str | None:
     raise SgtoolError(f"unknown layout {layout!r} ({', '.join(LAYOUTS)})")
 
 
-def _with_article(name: str) -> str:
-    return f"{'an' if name[0] in 'AEIOU' else 'a'} {name}"
-
-
 def layout_error(root: Path, layout: str, missing: str) -> SgtoolError:
     """A one-line error: the folder is not ``layout`` (what is missing), and which layout
     it looks like instead."""
     seen = looks_like(root) if root.is_dir() else None
     if seen is not None and seen != layout:
-        hint = (f"; it looks like {_with_article(LAYOUT_NAMES[seen])} folder "
+        hint = (f"; it looks like {a_or_an(LAYOUT_NAMES[seen])} folder "
                 f"({LAYOUT_FILES[seen]}): use --layout {seen}, or --layout auto")
     elif seen is None:
         hint = f"; it matches no known layout{_sequence_hint(root)}"
     else:
         hint = ""
     return SgtoolError(
-        f"{root}: not {_with_article(LAYOUT_NAMES[layout])} folder "
+        f"{root}: not {a_or_an(LAYOUT_NAMES[layout])} folder "
         f"({LAYOUT_FILES[layout]}): {missing}{hint}"
     )
 
