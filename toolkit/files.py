@@ -6,7 +6,8 @@ go to a temporary file with a unique name in the same folder, are flushed and fs
 the mode a plain ``open`` would give (umask applied), and are renamed over the final path.
 An error, Ctrl-C or a concurrent writer never leaves a half-written file at the final path;
 the temporary file is removed on any exception. Two processes writing the same path each
-use their own temporary file, and the last rename wins with a complete file.
+use their own temporary file; a path that must be new (no ``--force``) is taken by the
+first to finish (:mod:`sgtool.publish`), elsewhere the last rename wins.
 
 :func:`temp_beside` makes such a unique temporary file for writers that manage it
 themselves (the log writer); :class:`OutputError` is the one-line user error for a
@@ -35,7 +36,7 @@ from pathlib import Path
 from typing import IO
 
 from sgtool.errors import SgtoolError, deferred_interrupts
-from sgtool.publish import publish
+from sgtool.publish import keep_in_sight, publish
 
 # OSError numbers that a user's environment causes (a destination that is read-only,
 # missing, full, not writable): reported as one line, never as a traceback
@@ -147,7 +148,8 @@ def atomic_output(path: str | os.PathLike[str], suffix: str = ".partial") -> Ite
     """Yield a temporary path beside ``path``; on a clean exit it is renamed to ``path``.
 
     For writers that need a path (a library that opens the file itself); the temporary
-    file exists (empty) when the block starts. The parent folder is created.
+    file exists (empty) when the block starts. The parent folder is created. A file that
+    another run wrote at a ``path`` that must be new stays; this one is kept beside it.
     """
     path = Path(path)
     try:
@@ -163,9 +165,10 @@ def atomic_output(path: str | os.PathLike[str], suffix: str = ".partial") -> Ite
         os.chmod(tmp, 0o666 & ~_umask())  # a library may have made its own file anew
         publish(tmp, path)
     except OSError as e:
-        tmp.unlink(missing_ok=True)
         if isinstance(e, FileExistsError) and str(e.filename) == str(path):
-            raise appeared_error(path) from None  # (publish: another run wrote it)
+            # (publish: another run wrote it) this run's finished file is kept in sight
+            raise appeared_error(path, kept=keep_in_sight(tmp)) from None
+        tmp.unlink(missing_ok=True)
         if concerns(e, tmp, path):
             raise output_error(e, path) from None
         raise

@@ -5,13 +5,15 @@ does not exist (:func:`sgtool.output_check.check_output`, which calls :func:`exp
 a second run given the same path may write it before the first finishes. :func:`publish`
 moves such an output into place only while the path is still free (a hard link, which fails
 when it exists), so neither run's file is silently replaced; other outputs are renamed over
-whatever is there, as before.
+whatever is there, as before. A finished output that could not be published is kept in
+sight beside the path (:func:`keep_in_sight`).
 """
 
 from __future__ import annotations
 
 import errno
 import os
+from pathlib import Path
 
 # the paths of this process's outputs that must still be new when published
 _NEW_ONLY: set[str] = set()
@@ -43,3 +45,18 @@ def publish(tmp: str | os.PathLike[str], path: str | os.PathLike[str]) -> None:
     else:
         os.unlink(tmp)
     _NEW_ONLY.discard(key)
+
+
+def keep_in_sight(tmp: str | os.PathLike[str]) -> Path:
+    """Where a finished output that could not be published is kept: a hidden temporary
+    ``.NAME`` renamed to ``NAME`` beside it (never over a file; left hidden if that fails)."""
+    tmp = Path(tmp)
+    if not tmp.name.startswith("."):
+        return tmp
+    kept = tmp.with_name(tmp.name[1:])
+    try:
+        os.link(tmp, kept)
+    except OSError:
+        return tmp
+    os.unlink(tmp)
+    return kept

@@ -405,7 +405,7 @@ def test_two_long_names_that_begin_alike_keep_their_partial_files_apart(tmp_path
 def test_an_output_another_run_wrote_meanwhile_is_not_replaced_without_force(tmp_path):
     """The no---force check holds to the end: a file that appeared under the output's name
     while the command ran (a second run with the same -o) is kept; this run says so in one
-    line, a log keeping its own finished file beside it."""
+    line and keeps its own finished file beside it, in sight."""
     import pytest
 
     from sgtool.files import OutputError, atomic_write
@@ -415,9 +415,12 @@ def test_an_output_another_run_wrote_meanwhile_is_not_replaced_without_force(tmp
     out = tmp_path / "h.json"
     check_output(out)
     out.write_text("theirs")
-    with pytest.raises(OutputError, match="appeared while this run wrote it"):
+    with pytest.raises(OutputError, match="appeared while this run wrote it") as e:
         atomic_write(out, "mine")
-    assert out.read_text() == "theirs" and sorted(tmp_path.iterdir()) == [out]
+    kept = [p for p in tmp_path.iterdir() if p != out]
+    assert out.read_text() == "theirs" and [p.name[:7] for p in kept] == ["h.json."]
+    assert kept[0].read_text() == "mine" and str(e.value).endswith(f"kept in {kept[0]}")
+    kept[0].unlink()
     log = tmp_path / "r.mcap"
     check_output(log)
     w = LogWriter(log)
