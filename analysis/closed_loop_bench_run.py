@@ -327,16 +327,21 @@ class EpisodeRunner:
 def _record_options(root: Path, text: str | None, *, ran: bool) -> None:
     """Write :data:`RUN_OPTIONS_FILE` once a run that agreed with the logs there has logs
     to show (a run that wrote nothing, a full disk, leaves no file that makes its folder
-    look like a run), and either ``ran`` episodes now or finds no such file (a resume
-    naming fewer planners reads back and keeps the run's options); best effort while an
-    error is on its way."""
+    look like a run), and either ``ran`` episodes now or finds no readable such file (a
+    resume naming fewer planners reads back and keeps the run's options; a damaged file is
+    replaced); best effort while an error is on its way."""
     import contextlib
+    import json
 
     from sgtool.files import atomic_write
 
-    if text is None or not any((root / "logs").rglob("*.mcap")) or \
-            (not ran and (root / RUN_OPTIONS_FILE).is_file()):
+    if text is None or not any((root / "logs").rglob("*.mcap")):
         return
+    if not ran:
+        with contextlib.suppress(OSError, ValueError):
+            data = json.loads((root / RUN_OPTIONS_FILE).read_bytes())
+            if isinstance(data, dict) and isinstance(data.get("options"), dict):
+                return
     with contextlib.suppress(OSError):
         atomic_write(root / RUN_OPTIONS_FILE, text)
 

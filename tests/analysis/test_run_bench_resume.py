@@ -201,6 +201,22 @@ def test_a_refused_resume_runs_nothing_and_defaults_are_no_change(tmp_path: Path
             "(logs/none/random/myhouse/ep-000.mcap)") in r.stderr
 
 
+def test_a_resume_replaces_a_damaged_options_file(tmp_path: Path) -> None:
+    """A resume that runs nothing more replaces a damaged run-options.json (it was left,
+    and the next --report-only asked to delete it) and keeps a readable one."""
+    _, _, out, cmd = _first_run(tmp_path)
+    options = out / "run-options.json"
+    good = options.read_text()
+    for damaged in ("{", "[1, 2]", good[: len(good) // 2]):
+        options.write_text(damaged)
+        r = CliRunner().invoke(cli, cmd)
+        assert r.exit_code == 0, r.output
+        assert options.read_text() == good
+        r = CliRunner().invoke(cli, ["run-bench", "-o", str(out), "--report-only",
+                                     "--no-progress"])
+        assert r.exit_code == 0, r.output
+
+
 def test_report_only_tables_the_run_as_it_was_made(tmp_path: Path, monkeypatch) -> None:
     """--report-only needs none of the run's options again (run-options.json has them);
     one given is the user's (a setting the logs were not run with is refused); the report
