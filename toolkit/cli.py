@@ -146,6 +146,8 @@ class LazyGroup(click.Group):
             shown = traceback_text(e)
             if shown is not None:  # SGTOOL_TRACEBACK=1: what raised, before the line
                 click.echo(shown, err=True)
+            if e.details:  # what helps to mend the input, before the one line
+                click.echo(e.details, err=True)
             raise UserError(str(e)) from e
         except BrokenPipeError:  # `sgtool ... | head`: the reader has what it wanted
             _quiet_stdout()

@@ -14,9 +14,16 @@ from typing import Any
 
 
 class SgtoolError(Exception):
-    """Base for every error caused by input a user gave (a file, an option, a log)."""
+    """Base for every error caused by input a user gave (a file, an option, a log).
+
+    ``details``: text that helps to mend the input (a file's table of contents), which
+    the CLI prints before the one-line message; the message itself stands alone."""
 
     exit_code = 2
+
+    def __init__(self, *args: object, details: str = "") -> None:
+        super().__init__(*args)
+        self.details = details
 
 
 class ArgumentError(SgtoolError, ValueError):

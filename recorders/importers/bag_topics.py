@@ -231,18 +231,19 @@ def describe_bag(reader: Any, path: Path) -> str:
     return "\n".join(lines)
 
 
-def missing_message(
+def missing_error(
     path: Path, topics: list[B.TopicInfo], what: str, reader: Any = None
-) -> str:
+) -> SgtoolError:
+    """The one line for a missing or wrong topic flag, with the flags to try; the bag's
+    topic table rides as its ``details`` (printed before the line)."""
     tfs = None
     if reader is not None and any(t.msgtype in B.TF_TYPES for t in topics):
         tfs = tf_suggestions(peek_tf(reader, topics)) or None
     encodings = peek_encodings(reader, topics) if reader is not None else None
     sugg = suggest_flags(topics, tf_frames=tfs, encodings=encodings)
-    return (
-        f"{path}: {what}. The bag's topics:\n{B.format_topics(topics)}"
-        + (f"\nsuggested flags: {' '.join(sugg)}" if sugg else "")
-    )
+    return SgtoolError(
+        f"{path}: {what}" + (f"; suggested flags: {' '.join(sugg)}" if sugg else ""),
+        details=f"{path}: the bag's topics:\n{B.format_topics(topics)}")
 
 
 def _check_topic(
@@ -252,7 +253,7 @@ def _check_topic(
         return
     found = {t.topic: t for t in topics}
     if topic not in found:
-        raise SgtoolError(missing_message(path, topics, f"{flag} {topic}: no such topic"))
+        raise missing_error(path, topics, f"{flag} {topic}: no such topic")
     t = found[topic]
     if t.msgtype not in allowed:
         raise SgtoolError(
@@ -286,25 +287,23 @@ def check_flags(
 ) -> None:
     if opts.estimate_poses and opts.depth is None:
         has_images = any(t.msgtype in B.IMAGE_TYPES for t in topics)
-        raise SgtoolError(missing_message(
+        raise missing_error(
             path, topics,
             "--estimate-poses estimates camera poses from depth images, and "
             + ("it needs --depth (and --info, --rgb)" if has_images else
                "the bag has no image topic (sensor_msgs Image or CompressedImage): import "
                "its trajectory with --tf-frames or --pose, without --estimate-poses"),
             reader,
-        ))
+        )
     if opts.depth is None and opts.tf_frames is None and opts.pose is None:
-        raise SgtoolError(missing_message(
+        raise missing_error(
             path, topics,
             "say which topics to import: --depth (and --rgb, --info) for camera frames, or "
             "--tf-frames WORLD:FRAME / --pose TOPIC for a trajectory", reader,
-        ))
-    if opts.depth is None and (opts.rgb or opts.ids or opts.info):
-        raise SgtoolError(
-            missing_message(path, topics, "--rgb/--ids/--info need --depth (a frame is a "
-                             "depth image)")
         )
+    if opts.depth is None and (opts.rgb or opts.ids or opts.info):
+        raise missing_error(path, topics, "--rgb/--ids/--info need --depth (a frame is a "
+                            "depth image)")
     _check_topic(path, topics, opts.depth, "--depth", B.IMAGE_TYPES)
     _check_topic(path, topics, opts.rgb, "--rgb", B.IMAGE_TYPES)
     _check_topic(path, topics, opts.ids, "--ids", B.IMAGE_TYPES)

@@ -469,7 +469,10 @@ def test_trajectory_bag_suggests_pose_topics_and_tf(shared_data_dir, tmp_path):
     bag = shared_data_dir.joinpath(*NAV2)
     r = run(["import", "bag", str(bag), "-o", str(tmp_path / "o.mcap")])
     assert r.exit_code == 2 and "Traceback" not in r.output
-    sugg = next(line for line in r.output.splitlines() if line.startswith("suggested flags:"))
+    *table, line = r.output.splitlines()  # the topic table, then the one line
+    assert line.startswith(f"sgtool: error: {bag}: say which topics to import")
+    assert any(t.startswith("  /amcl_pose") for t in table)
+    sugg = line[line.index("suggested flags:"):]
     assert "--tf-frames map:oakd_rgb_camera_optical_frame" in sugg
     assert "| --pose /amcl_pose | --pose /odom" in sugg
     assert "WORLD:FRAME" not in sugg
