@@ -74,7 +74,7 @@ from sgtool.analysis.offline import (
     read_log_episodes,
     with_seen,
 )
-from sgtool.analysis.report import format_table, pipe_table
+from sgtool.analysis.report import format_table, llm_answer_lines, pipe_table
 from sgtool.analysis.run_bench_paths import log_path, log_source, noise_folder
 from sgtool.analysis.run_bench_resume import (
     ResumeError,
@@ -292,9 +292,10 @@ def _row(task: RunTask, seconds: float | None) -> RunRow:
                         spec, task.house.source if task.house.spec is not None
                         else task.house.id, task.planner)
     logged = read_log_episodes(task.output)
-    if len(logged) != 1:
-        raise SgtoolError(f"{task.output}: holds {len(logged)} episodes, not one; remove it "
-                          "to run the episode again")
+    if len(logged) != 1 or not logged[0].closed:  # (closed: not `doctor --recover`ed)
+        what = (f"holds {len(logged)} episodes, not one" if len(logged) != 1 else "its "
+                "episode has no closing record (a log recovered from a killed run?)")
+        raise SgtoolError(f"{task.output}: {what}; delete it to run the episode again")
     ep = logged[0]
     res = replace(with_seen(ep.result()), seed=task.options.planner_seed,
                   source=log_source(task.output),
@@ -412,6 +413,8 @@ class ClosedLoopBenchResult:
                                             f"{noise_folder(noise)!r}{rule}"))
             parts.append(_run_table(rows, cfg.planners))
             parts.append(self.statistics(noise)[0])
+            if answers := llm_answer_lines([r.result for r in rows], cfg.planners):
+                parts.append("\n".join(answers) + "\n")
         return "\n".join(parts)
 
     def timings(self) -> str:
@@ -553,9 +556,8 @@ def write_outputs(res: ClosedLoopBenchResult, out_dir: str | Path,
     """summary.md, summary.json (no wall-clock figure: two runs give the same bytes),
     episodes.jsonl (the same but its measured ``wall`` fields), run.md (decision times,
     frames/s; not with ``timings`` False: a report of logs run earlier keeps the run's
-    own), the efficiency curves per noise profile
-    (distance, steps, frames per room; those of other profiles, an earlier run's, are
-    removed), each written atomically into ``out_dir``."""
+    own), the efficiency curves per noise profile (distance, steps, frames per room; those
+    of other profiles, an earlier run's, are removed), each written atomically."""
     from sgtool.analysis.curves import plot_efficiency
 
     out = output_dir(out_dir)

@@ -208,6 +208,10 @@ def check_resumable(path: Path, want: dict[str, Any], spec: HouseSpec, house: st
     from sgtool.planning.registry import effective_options
 
     settings, logged_house = logged_settings(path)
+    if settings["episode"] is None:  # no episode started in it: a recovered fragment
+        raise _refused(f"{path} holds no closed-loop episode (no started episode record: "
+                       "a log recovered from a killed run, or not one run-bench wrote)",
+                       "delete the log to run the episode again")
     if planner:
         want = {**want, "planner_options": effective_options(planner,
                                                              want["planner_options"])}

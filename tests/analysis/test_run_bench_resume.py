@@ -330,3 +330,30 @@ def test_where_an_llm_planner_gets_its_answers_is_no_setting() -> None:
     assert effective_options("moma-llm", {"replay": "t.jsonl", "history_limit": 5}) == \
         {"history_limit": 5}
     assert effective_options("moma-llm", {"history_limit": 30}) == {}  # the default
+
+
+@pytest.mark.parametrize("keep", [0.0, 0.3, 0.9])
+def test_a_log_recovered_from_a_cut_run_is_not_resumed(tmp_path: Path, keep: float) -> None:
+    """A log that `sgtool doctor --recover` rebuilt from a killed run's partial file is not
+    a finished episode: a resume refuses it in one line (it was scored as an episode that
+    ended at its last step, or, holding no episode at all (``keep`` 0: a log with no
+    records), refused as "run with other settings" of 17 nulls)."""
+    from sgtool.log.writer import LogWriter
+
+    _, _, out, cmd = _first_run(tmp_path)
+    log = next((out / "logs").rglob("ep-000.mcap"))
+    cut = tmp_path / "cut.mcap"
+    data = log.read_bytes()
+    cut.write_bytes(data[: int(len(data) * keep)])
+    log.unlink()
+    if keep:
+        r = CliRunner().invoke(cli, ["doctor", str(cut), "--recover", str(log)])
+    else:
+        LogWriter(log).close()
+    assert log.is_file()
+    r = CliRunner().invoke(cli, cmd)
+    assert r.exit_code == 2, r.output
+    line = r.output.strip().splitlines()[-1]
+    assert line.startswith(f"sgtool: error: {log}") and (
+        "its episode has no closing record" in line or "holds no closed-loop episode" in line)
+    assert "delete" in line and "other settings" not in line
