@@ -61,7 +61,9 @@ def cached_planner(name: str, options: Mapping[str, Any], run: str = "") -> Any:
     its results do not depend on how tasks share workers, nor on a failed attempt."""
     from sgtool.planning.registry import REGISTRY, make_planner
 
-    if name.strip().lower() not in REGISTRY:
+    if name.strip().lower() not in REGISTRY or options.get("replay"):
+        # a replaying LLM planner's place in its transcript is state: a retried task
+        # must start from the transcript's beginning, as the first attempt did
         return make_planner(name, **dict(options))
     key = (name, json.dumps({k: [type(v).__name__, repr(v)] for k, v in
                              sorted(options.items())}))

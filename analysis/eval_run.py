@@ -288,6 +288,11 @@ def _as_tables(request: EvalRequest, results: Sequence[Any], notes: Sequence[str
         parts.append(format_offline(reports))
     if exchanges:
         parts.append(format_stats(answer_stats(exchanges), "the logs") + "\n")
+    else:  # episodes.jsonl of bench / run-bench: the rows' own answer counts
+        from sgtool.analysis.report import llm_answer_lines
+        lines = llm_answer_lines(results, list(dict.fromkeys(r.planner for r in results)))
+        if lines:
+            parts.append("\n".join(lines) + "\n")
     return "\n".join(parts)
 
 

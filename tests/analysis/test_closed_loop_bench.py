@@ -486,7 +486,13 @@ def test_run_bench_warns_of_an_llm_that_never_answered_usefully(tmp_path) -> Non
     assert r.exit_code == 0, r.output
     assert "sgtool: warning: moma-llm: none of its" in r.output
     (row,) = [json.loads(s) for s in (out / "episodes.jsonl").read_text().splitlines()]
-    assert row["llm_answers"]["requests"] > 0 and row["llm_answers"]["valid"] == 0
+    n = row["llm_answers"]["requests"]
+    assert n > 0 and row["llm_answers"]["valid"] == 0
+    # the counts in summary.md, as bench gives them, and in `sgtool eval` of the folder
+    line = f"LLM answers of moma-llm: {n} requests, 0 valid, {n} rejected"
+    assert line in (out / "summary.md").read_text()
+    r = CliRunner().invoke(cli, ["eval", str(out)])
+    assert r.exit_code == 0 and line in r.output, r.output
 
 
 def test_a_noise_profile_spelled_with_spaces_is_the_same_profile() -> None:

@@ -339,6 +339,19 @@ def test_moma_llm_transcript_then_replay(tmp_path):
     assert "holds no (more) responses for this prompt" in r.output
     assert "(house-5, episode 0, seed 0)" in r.output
     assert not (tmp_path / "other" / "episodes.jsonl").exists()
+    # a transcript of episode 0 only: the error names episode 1, where the replay ran out
+    # (the retry of the failed task replayed from where the first attempt had stopped,
+    # failed at episode 0 and named it)
+    import json
+
+    only0 = tmp_path / "only0.jsonl"
+    first = json.loads(lines[0])["query"]
+    only0.write_text("".join(x for x in lines if json.loads(x)["query"] == first))
+    assert 0 < len(only0.read_text().splitlines()) < len(lines)
+    r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
+                                 "--episodes", "2", "--seeds", "1", "--no-progress",
+                                 "--llm-replay", str(only0), "-o", str(tmp_path / "o4")])
+    assert r.exit_code == 2 and "(house-0, episode 1, seed 0)" in r.output, r.output
 
 
 @pytest.mark.parametrize("command", ["bench", "run-bench"])
