@@ -79,7 +79,7 @@ def run_check(request: LlmCheckRequest) -> LlmCheckResult:
                                     constraint=request.constraint,
                                     reason_chars=request.reason_chars)
     figures = {
-        "endpoint": client.where, "model": settings.model,
+        "endpoint": client.where, "model": speed.model or settings.model,
         "completion_tokens": speed.completion_tokens,
         "tokens_per_s": None if speed.tokens_per_s is None else round(speed.tokens_per_s, 2),
         "decision_parsed": dec.parsed, "decision": dec.action, "requests": dec.requests,
@@ -89,7 +89,8 @@ def run_check(request: LlmCheckRequest) -> LlmCheckResult:
     generation = (f"{speed.completion_tokens} tokens in {speed.latency_s:.2f} s = "
                   f"{speed.tokens_per_s:.1f} tokens/s" if speed.tokens_per_s is not None
                   else f"{speed.latency_s:.2f} s (the reply counted no tokens: no speed)")
-    lines = [f"endpoint {figures['endpoint']}, model {settings.model}",
+    asked = f" (asked for {settings.model})" if figures["model"] != settings.model else ""
+    lines = [f"endpoint {figures['endpoint']}, model {figures['model']}{asked}",
              f"generation: {generation}",
              f"scene decision (find {query}, constraint {dec.constraint}): "
              f"{'parsed' if dec.parsed else 'NOT parsed'}: {dec.action} "

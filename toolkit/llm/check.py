@@ -28,6 +28,7 @@ SPEED_PROMPT = "List the rooms of a house, one per line."
 class SpeedResult:
     completion_tokens: int | None
     latency_s: float
+    model: str = ""  # the model the endpoint says answered ("": it did not say)
 
     @property
     def tokens_per_s(self) -> float | None:
@@ -48,7 +49,7 @@ class DecisionCheck:
 def generation_speed(client: ChatClient, timeout_s: float = 120.0) -> SpeedResult:
     """One timed request (module doc); a transport fault is raised as is."""
     r = complete_within(client, [{"role": "user", "content": SPEED_PROMPT}], timeout_s)
-    return SpeedResult(r.completion_tokens, r.latency_s)
+    return SpeedResult(r.completion_tokens, r.latency_s, r.model or "")
 
 
 def decision_check(client: ChatClient, graph: SceneGraph, query: str,

@@ -56,6 +56,9 @@ def test_check_against_a_scripted_endpoint() -> None:
         assert d["decision_parsed"] is False and "no command found" in d["decision"]
         assert d["constraint"] == "none" and d["requests"] == 1
         assert srv.requests[0]["max_tokens"] == 48
+        # the model that answered, as the endpoint names it (not the default asked for)
+        assert srv.requests[0]["model"] == "m" and d["model"] == "scripted-model"
         r = CliRunner().invoke(cli, ["llm", "check", "--base-url", srv.base_url])
         assert r.exit_code == 0, r.output
         assert f"scene decision (find {query}, constraint none): parsed: " in r.output
+        assert ", model scripted-model (asked for " in r.output
