@@ -165,15 +165,15 @@ def house_options(seed_help: str, rooms_help: str) -> Callable[[F], F]:
 
 
 def llm_log_options(transcript_help: str, many: bool = False) -> Callable[[F], F]:
-    """``--llm-replay`` and ``--llm-transcript`` of the moma-llm planner; ``many``: the
-    replay option is repeatable and takes folders (of a bench's ``--log-dir`` logs)."""
+    """moma-llm's ``--llm-replay``/``--llm-transcript``; ``many``: replay from many, folders too."""
     replay = click.option(
         "--llm-replay", type=PathParam(), multiple=True,
         help="moma-llm: serve answers from these transcripts (JSONL, or MCAP logs' "
         "/sgtool/llm; repeatable; a folder: its *.mcap logs and *.jsonl transcripts, as "
         "`--log-dir` writes them) instead of an endpoint.") if many else click.option(
         "--llm-replay", type=PathParam(dir_okay=False), default=None,
-        help="moma-llm: serve answers from this JSONL transcript instead of an endpoint.")
+        help="moma-llm: serve answers from this transcript (JSONL, or an MCAP log's "
+        "/sgtool/llm) instead of an endpoint.")
     return option_group([
         replay,
         click.option("--llm-transcript", type=PathParam(dir_okay=False), default=None,
