@@ -44,7 +44,7 @@ import time
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from sgtool.errors import SgtoolError
+from sgtool.errors import SgtoolError, a_or_an
 from sgtool.llm.constraints import Constraint
 from sgtool.llm.exchange import Message
 from sgtool.redact import redact_text
@@ -338,6 +338,10 @@ def _close_quietly(client: Any) -> None:
 def reply_text(resp: object, where: str = "the endpoint") -> str:
     """``choices[0].message.content`` of a chat reply (an object or plain dicts), or a
     :class:`LlmTransportError` naming what is missing."""
+    if isinstance(resp, str | bytes):  # (the openai package hands back a body not JSON)
+        head = resp[:40] if isinstance(resp, str) else resp[:40].decode("utf-8", "replace")
+        raise LlmTransportError(f"{where}: unusable reply: not JSON (it begins "
+                                f"{' '.join(head.split())!r})")
     choices = _field(resp, "choices")
     if not isinstance(choices, list | tuple):
         raise LlmTransportError(
@@ -367,7 +371,7 @@ def _field(obj: Any, name: str) -> Any:
 
 
 def _kind(v: Any) -> str:
-    return "missing" if v is None else f"a {type(v).__name__}"
+    return "missing" if v is None else a_or_an(type(v).__name__)
 
 
 def _count(v: Any) -> int | None:

@@ -44,7 +44,7 @@ MESSAGE = {"message": {"role": "assistant", "content": "hi"}}
     (body(choices=[]), "'choices' is empty"),
     (body(), "'choices' is missing, not a list"),
     (body(choices=["text"]), "choices[0] has no message"),
-    (body(choices=[{"message": {"content": 7}}]), "the message content is a int, not text"),
+    (body(choices=[{"message": {"content": 7}}]), "the message content is an int, not text"),
     (body(choices=[{"message": {"content": None}}]), "the message content is missing"),
     ({"raw": b'{"choices": [ '}, "unusable reply: "),
     ({"raw": b"[1, 2]"}, "unusable reply: "),
@@ -55,6 +55,16 @@ def test_malformed_replies_are_retryable_one_line_faults(reply, reason):
             client(srv).complete([{"role": "user", "content": "x"}])
     msg = str(info.value)
     assert reason in msg and "\n" not in msg and KEY not in msg
+
+
+def test_a_body_that_is_not_json_is_named_so() -> None:
+    """The openai package hands back the text of a reply that is not JSON (a web page
+    served as text/html): named as such, not as a reply without 'choices'."""
+    for resp in ("<html>\n<body>a web page</body></html>", b"<html>a web page"):
+        with pytest.raises(LlmTransportError) as info:
+            reply_text(resp, "http://x/v1")
+        assert str(info.value).startswith("http://x/v1: unusable reply: not JSON (it begins "
+                                          "'<html>")
 
 
 @pytest.mark.parametrize(("first", "says"), [
