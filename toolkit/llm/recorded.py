@@ -52,7 +52,8 @@ def transcript_run(path: str | Path | None) -> Iterator[None]:
     run's exchanges). The transcript that was there is put back when the run is
     interrupted (Ctrl-C, SIGTERM: the run's other outputs are left as they were too) or
     fails before its first exchange (a setup mistake); a run that ends, or fails after
-    asking, keeps its own."""
+    asking, keeps its own. While the run lasts, the earlier transcript is kept beside it as
+    ``NAME.XXXXXXXX.previous``, where a killed run (SIGKILL) leaves it in sight."""
     if path is None:
         yield
         return
@@ -62,7 +63,7 @@ def transcript_run(path: str | Path | None) -> Iterator[None]:
     try:
         p.parent.mkdir(parents=True, exist_ok=True)
         if p.exists():
-            fd, previous = temp_beside(p)
+            fd, previous = temp_beside(p, ".previous", hidden=False)
             os.close(fd)
             os.replace(p, previous)
         with open(p, "w", encoding="utf-8"):

@@ -41,6 +41,23 @@ def test_an_interrupted_run_puts_the_previous_transcript_back(tmp_path):
     assert not fresh.exists()
 
 
+def test_a_killed_run_leaves_the_previous_transcript_in_sight(tmp_path):
+    """SIGKILL runs no clean-up: the earlier transcript stays beside the new one under a
+    visible name (it was a hidden .t.jsonl.*.partial that no later run mentioned)."""
+    import subprocess
+    import sys
+
+    t = tmp_path / "t.jsonl"
+    t.write_text(OLD)
+    code = ("import os, sys\nfrom sgtool.llm.recorded import transcript_run\n"
+            "with transcript_run(sys.argv[1]):\n    os.kill(os.getpid(), 9)\n")
+    r = subprocess.run([sys.executable, "-c", code, str(t)], check=False)
+    assert r.returncode == -9
+    (kept,) = [p for p in tmp_path.iterdir() if p != t]
+    assert kept.name.startswith("t.jsonl.") and kept.name.endswith(".previous")
+    assert kept.read_text() == OLD and t.read_text() == ""
+
+
 def test_a_failed_run_keeps_what_it_asked(tmp_path):
     """An error (not an interrupt) keeps the run's exchanges: they say what went wrong."""
     t = tmp_path / "t.jsonl"
