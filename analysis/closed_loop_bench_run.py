@@ -340,7 +340,8 @@ def _record_options(root: Path, text: str | None, *, ran: bool) -> None:
     if not ran:
         with contextlib.suppress(OSError, ValueError):
             data = json.loads((root / RUN_OPTIONS_FILE).read_bytes())
-            if isinstance(data, dict) and isinstance(data.get("options"), dict):
+            if isinstance(data, dict) and isinstance(data.get("options"), dict) and \
+                    data.get("format") == json.loads(text).get("format"):
                 return
     with contextlib.suppress(OSError):
         atomic_write(root / RUN_OPTIONS_FILE, text)

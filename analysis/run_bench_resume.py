@@ -209,9 +209,10 @@ def check_resumable(path: Path, want: dict[str, Any], spec: HouseSpec, house: st
 
     settings, logged_house = logged_settings(path)
     if settings["episode"] is None:  # no episode started in it: a recovered fragment
-        raise _refused(f"{path} holds no closed-loop episode (no started episode record: "
-                       "a log recovered from a killed run, or not one run-bench wrote)",
-                       "delete the log to run the episode again")
+        # (not a ResumeError: no option given again mends it, --report-only included)
+        raise SgtoolError(f"{path} holds no closed-loop episode (no started episode record: "
+                          "a log recovered from a killed run, or not one run-bench wrote); "
+                          "delete the log to run the episode again")
     if planner:
         want = {**want, "planner_options": effective_options(planner,
                                                              want["planner_options"])}

@@ -20,6 +20,7 @@ class SgtoolError(Exception):
     the CLI prints before the one-line message; the message itself stands alone."""
 
     exit_code = 2
+    details = ""  # (a subclass whose __init__ does not call this one's has none of its own)
 
     def __init__(self, *args: object, details: str = "") -> None:
         super().__init__(*args)

@@ -7,7 +7,8 @@ the mode a plain ``open`` would give (umask applied), and are renamed over the f
 An error, Ctrl-C or a concurrent writer never leaves a half-written file at the final path;
 the temporary file is removed on any exception. Two processes writing the same path each
 use their own temporary file; a path that must be new (no ``--force``) is taken by the
-first to finish (:mod:`sgtool.publish`), elsewhere the last rename wins.
+first to finish (:mod:`sgtool.publish`; the other's finished file is kept in sight beside
+it), elsewhere the last rename wins.
 
 :func:`temp_beside` makes such a unique temporary file for writers that manage it
 themselves (the log writer); :class:`OutputError` is the one-line user error for a

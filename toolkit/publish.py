@@ -56,7 +56,15 @@ def keep_in_sight(tmp: str | os.PathLike[str]) -> Path:
     kept = tmp.with_name(tmp.name[1:])
     try:
         os.link(tmp, kept)
-    except OSError:
+    except FileExistsError:
         return tmp
+    except OSError:  # no hard links here (FAT, some network file systems): a rename
+        if os.path.lexists(kept):
+            return tmp
+        try:
+            os.replace(tmp, kept)
+        except OSError:
+            return tmp
+        return kept
     os.unlink(tmp)
     return kept

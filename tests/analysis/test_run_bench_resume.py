@@ -207,7 +207,7 @@ def test_a_resume_replaces_a_damaged_options_file(tmp_path: Path) -> None:
     _, _, out, cmd = _first_run(tmp_path)
     options = out / "run-options.json"
     good = options.read_text()
-    for damaged in ("{", "[1, 2]", good[: len(good) // 2]):
+    for damaged in ("{", "[1, 2]", good[: len(good) // 2], '{"options": {}}'):
         options.write_text(damaged)
         r = CliRunner().invoke(cli, cmd)
         assert r.exit_code == 0, r.output
@@ -357,3 +357,7 @@ def test_a_log_recovered_from_a_cut_run_is_not_resumed(tmp_path: Path, keep: flo
     assert line.startswith(f"sgtool: error: {log}") and (
         "its episode has no closing record" in line or "holds no closed-loop episode" in line)
     assert "delete" in line and "other settings" not in line
+    r = CliRunner().invoke(cli, ["run-bench", "-o", str(out), "--report-only"])
+    line = r.output.strip().splitlines()[-1]  # no option given again mends such a log
+    assert r.exit_code == 2 and line.endswith(("delete the log to run the episode again",
+                                               "delete it to run the episode again")), line

@@ -12,7 +12,7 @@ import pytest
 from click.testing import CliRunner
 
 from sgtool.cli import Interrupted, Killed, LazyGroup, cli, main
-from sgtool.errors import Terminated
+from sgtool.errors import SgtoolError, Terminated
 
 CASES = [
     (["import", "rgbd", "{d}", "-o", "{d}/x.mcap", "--every", "abc"],
@@ -87,6 +87,29 @@ def test_an_interrupt_is_one_line_with_its_exit_code(capsys, exc, kind, code):
     assert Interrupted.exit_code == 130  # a kill does not change the Ctrl-C code
     e.value.show()
     assert capsys.readouterr().err == "sgtool: interrupted; no output was left half-written\n"
+
+
+class _OwnError(SgtoolError):
+    """A plug-in's error whose ``__init__`` does not call SgtoolError's."""
+
+    def __init__(self, what: str) -> None:
+        self.what = what
+
+    def __str__(self) -> str:
+        return f"{self.what} is not set"
+
+
+@pytest.mark.parametrize("exc, err", [
+    (_OwnError("map_file"), "sgtool: error: map_file is not set\n"),
+    (SgtoolError("no such topic", details="a table\nof topics"),
+     "a table\nof topics\nsgtool: error: no such topic\n")])
+def test_an_error_is_one_line_after_its_details(capsys, exc, err):
+    """An error's ``details`` come before its one line; a subclass that sets none (its own
+    ``__init__``) is one line, not an AttributeError."""
+    with pytest.raises(click.ClickException) as e:
+        _OneCommand(exc).main(["go"], standalone_mode=False)
+    e.value.show()
+    assert capsys.readouterr().err == err
 
 
 def test_a_reader_that_stops_early_is_no_error(tmp_path):

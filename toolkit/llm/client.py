@@ -339,9 +339,10 @@ def reply_text(resp: object, where: str = "the endpoint") -> str:
     """``choices[0].message.content`` of a chat reply (an object or plain dicts), or a
     :class:`LlmTransportError` naming what is missing."""
     if isinstance(resp, str | bytes):  # (the openai package hands back a body not JSON)
-        head = resp[:40] if isinstance(resp, str) else resp[:40].decode("utf-8", "replace")
-        raise LlmTransportError(f"{where}: unusable reply: not JSON (it begins "
-                                f"{' '.join(head.split())!r})")
+        text = resp[:4096] if isinstance(resp, str) else resp[:4096].decode("utf-8", "replace")
+        head = " ".join(text.split())[:40]  # (a page may start with blank lines)
+        raise LlmTransportError(f"{where}: unusable reply: not JSON (" + (
+            f"it begins {head!r})" if head else "an empty body)"))
     choices = _field(resp, "choices")
     if not isinstance(choices, list | tuple):
         raise LlmTransportError(

@@ -65,6 +65,11 @@ def test_a_body_that_is_not_json_is_named_so() -> None:
             reply_text(resp, "http://x/v1")
         assert str(info.value).startswith("http://x/v1: unusable reply: not JSON (it begins "
                                           "'<html>")
+    for resp, says in (("\n" * 45 + "<html>x</html>", "(it begins '<html>x</html>')"),
+                       ("", "(an empty body)"), (b" \r\n", "(an empty body)")):
+        with pytest.raises(LlmTransportError) as info:
+            reply_text(resp, "http://x/v1")
+        assert str(info.value).endswith(f"not JSON {says}")
 
 
 @pytest.mark.parametrize(("first", "says"), [

@@ -402,6 +402,31 @@ def test_two_long_names_that_begin_alike_keep_their_partial_files_apart(tmp_path
     wa.abort()
 
 
+def test_without_hard_links_a_beaten_output_is_kept_in_sight_too(tmp_path, monkeypatch):
+    """A file system without hard links (FAT, some network mounts): the output another run
+    wrote meanwhile stays, and this run's is renamed to its visible name."""
+    import errno
+    import os
+
+    import pytest
+
+    from sgtool.files import OutputError, atomic_write
+    from sgtool.output_check import check_output
+
+    def no_links(*args: object) -> None:
+        raise PermissionError(errno.EPERM, "Operation not permitted")
+
+    monkeypatch.setattr(os, "link", no_links)
+    out = tmp_path / "h.json"
+    check_output(out)
+    out.write_text("theirs")
+    with pytest.raises(OutputError, match="appeared while this run wrote it") as e:
+        atomic_write(out, "mine")
+    (kept,) = [p for p in tmp_path.iterdir() if p != out]
+    assert not kept.name.startswith(".") and kept.read_text() == "mine"
+    assert out.read_text() == "theirs" and str(e.value).endswith(f"kept in {kept}")
+
+
 def test_an_output_another_run_wrote_meanwhile_is_not_replaced_without_force(tmp_path):
     """The no---force check holds to the end: a file that appeared under the output's name
     while the command ran (a second run with the same -o) is kept; this run says so in one
