@@ -534,7 +534,7 @@ class SceneGraphBuilder:
         won = {iid: near_median(ijk, reach) for iid, ijk in won.items()}
         overhead = self.columns_between(occ, *LINTEL_BAND)
         found = doorways(occ, won, self._panel_memo, overhead)
-        cells, centres = found.cells | lintel_doorways(occ, overhead), found.centres
+        cells, centres = found.cells | lintel_doorways(occ, overhead, found.cells), found.centres
         cells.setflags(write=False)  # kept to recognise the same cells next time
         got = self._density
         if got is None or got[0] != occ.resolution or not np.array_equal(got[1], cells):

@@ -31,6 +31,10 @@ What we do, and why it differs:
   with edge length and node spacing).
 - **Tiny components**: fewer than ``min_room_length`` metres of edges (isolated nodes
   have none), unless on floor of their own (below). Dropped nodes keep no room label.
+- **Slits**: a component long enough none of whose nodes has ``ROBOT_RADIUS`` of
+  clearance is no room: nowhere in it would the robot fit (a strip of floor that a
+  cabinet door opened beside a doorway leaves between itself and the wall, whose only
+  mouth lies in the doorway's cut zone). Its nodes keep no room label.
 - **A door separates its two sides, nothing more**: given the grid, components
   whose nodes lie in one connected part of the free space outside the cut zone (cells
   below the threshold, 4-connected) are one room. The cut zone is a disc-like region
@@ -79,6 +83,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components, dijkstra
 from scipy.spatial import cKDTree
 
+from sgtool.mapping.bev import BevConfig
 from sgtool.mapping.grid import OccupancyGrid
 from sgtool.mapping.occupancy import within_cells
 from sgtool.mapping.voronoi import VoronoiGraph, submatrix
@@ -90,6 +95,7 @@ JOIN_SEAL = 0.3  # m around door evidence (and unsure floor) where floor joins n
 # (drift spreads passes through one doorway over its jambs)
 WALK_SEAL = 0.9
 OWN_FLOOR = 0.5  # of min_room_length squared: the open floor of its own a short room needs
+ROBOT_RADIUS = BevConfig.robot_radius  # m: the robot's footprint, as the map clears it
 
 
 @dataclass(frozen=True)
@@ -173,8 +179,12 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
             continue
         nodes = by_comp[bounds[c]:bounds[c + 1]]
         nodes = nodes[~cut_n[nodes]]
-        if len(nodes):
-            (rooms if comp_len[c] >= cfg.min_room_length else short).append(nodes)
+        if not len(nodes):
+            continue
+        if comp_len[c] < cfg.min_room_length:
+            short.append(nodes)
+        elif vg.clearance[nodes].max() >= ROBOT_RADIUS:  # somewhere the robot fits
+            rooms.append(nodes)
     if occ is not None:
         rooms = _rooms_by_floor(vg, rooms, short, occ, density, cfg, unsure, trajectory,
                                 leaves)

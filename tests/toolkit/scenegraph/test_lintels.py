@@ -79,3 +79,44 @@ def test_a_duct_across_a_corridor_is_no_doorway() -> None:
     d[:20, 56:60] = d[38:, 56:60] = OCCUPIED  # the wall smeared as deep
     d[:20, 62:66] = d[38:, 62:66] = OCCUPIED
     assert np.array_equal(lintel_doorways(grid(d), overhead), overhead)
+
+
+def test_a_lintel_with_a_thin_tail_along_its_wall_is_measured_by_its_body() -> None:
+    """Noise smears a wall into two copies with a line of floor between them, under the
+    wall's top: the lintel's piece runs on along the wall's line in a thin tail (here
+    1 m past a 0.9 m doorway: 1.9 m in all, longer than a doorway). The bar's body is the
+    doorway's lintel; the tail is no doorway."""
+    g, overhead = two_rooms()
+    g[:, 59:64] = OCCUPIED
+    g[20:38, 59:64] = FREE
+    overhead[20:38, 59:64] = True  # the smeared lintel, 5 cells deep
+    g[38:58, 61] = FREE
+    overhead[38:58, 61] = True  # the tail: between the wall's two copies
+    got = lintel_doorways(grid(g), overhead)
+    assert np.array_equal(got, overhead & (np.arange(60) < 38)[:, None])
+    # a bar as deep all along, as long, is no doorway's
+    g[38:58, 59:64] = FREE
+    overhead[38:58, 59:64] = True
+    assert not lintel_doorways(grid(g), overhead).any()
+
+
+def test_a_bar_cut_from_its_tails_beside_a_seen_doors_evidence_adds_nothing() -> None:
+    """A bar measured by its body (its thin tails cut) beside a seen door's evidence is
+    left out: that doorway has its evidence (house 990 under mild noise: such bars made
+    the evidence of three seen doors deeper, and objects beside them lost their room). A
+    whole bar beside a seen door is found as before, and a cut one apart from it."""
+    g, overhead = two_rooms()
+    doors = np.zeros(g.shape, dtype=bool)
+    doors[20:38, 62] = True  # the seen door's opening, beside the lintel's bar
+    assert np.array_equal(lintel_doorways(grid(g), overhead, doors), overhead)
+    g[:, 59:64] = OCCUPIED  # the tailed bar of the test above
+    g[20:38, 59:64] = FREE
+    overhead[20:38, 59:64] = True
+    g[38:58, 61] = FREE
+    overhead[38:58, 61] = True
+    doors[20:38, 62] = False
+    doors[20:38, 64] = True
+    assert not lintel_doorways(grid(g), overhead, doors).any()
+    doors[:] = False
+    doors[45:50, 90:92] = True  # a door elsewhere
+    assert lintel_doorways(grid(g), overhead, doors).any()
