@@ -339,12 +339,24 @@ def _record_options(root: Path, text: str | None, *, ran: bool) -> None:
         return
     if not ran:
         with contextlib.suppress(OSError, ValueError):
-            data = json.loads((root / RUN_OPTIONS_FILE).read_bytes())
+            data, ours = json.loads((root / RUN_OPTIONS_FILE).read_bytes()), json.loads(text)
             if isinstance(data, dict) and isinstance(data.get("options"), dict) and \
-                    data.get("format") == json.loads(text).get("format"):
+                    data.get("format") == ours["format"] and \
+                    _same_kinds(data["options"], ours["options"]):
                 return
     with contextlib.suppress(OSError):
         atomic_write(root / RUN_OPTIONS_FILE, text)
+
+
+def _same_kinds(saved: dict[str, Any], ours: dict[str, Any]) -> bool:
+    """Whether ``saved`` has every option of ``ours`` with a JSON value of its kind (a
+    number for a number, text for text...; None on either side agrees): a file edited
+    by hand to ``"episodes": "three"`` is no run's options."""
+    def kind(v: Any) -> str:
+        return "number" if isinstance(v, int | float) and not isinstance(v, bool) \
+            else type(v).__name__
+    return all(k in saved and (v is None or saved[k] is None or kind(saved[k]) == kind(v))
+               for k, v in ours.items())
 
 
 def _remove_partials(task: RunTask) -> None:

@@ -207,7 +207,9 @@ def test_a_resume_replaces_a_damaged_options_file(tmp_path: Path) -> None:
     _, _, out, cmd = _first_run(tmp_path)
     options = out / "run-options.json"
     good = options.read_text()
-    for damaged in ("{", "[1, 2]", good[: len(good) // 2], '{"options": {}}'):
+    wrong = good.replace('"max_steps": 2', '"max_steps": "two"')  # edited by hand
+    assert wrong != good
+    for damaged in ("{", "[1, 2]", good[: len(good) // 2], '{"options": {}}', wrong):
         options.write_text(damaged)
         r = CliRunner().invoke(cli, cmd)
         assert r.exit_code == 0, r.output
