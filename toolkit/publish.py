@@ -34,16 +34,7 @@ def publish(tmp: str | os.PathLike[str], path: str | os.PathLike[str]) -> None:
     if key not in _NEW_ONLY:
         os.replace(tmp, path)
         return
-    try:
-        os.link(tmp, path)
-    except FileExistsError:  # (it names tmp: filename, path: filename2)
-        raise FileExistsError(errno.EEXIST, os.strerror(errno.EEXIST), str(path)) from None
-    except OSError:  # no hard links here (FAT, some network file systems)
-        if os.path.lexists(path):
-            raise FileExistsError(errno.EEXIST, os.strerror(errno.EEXIST), str(path)) from None
-        os.replace(tmp, path)
-    else:
-        os.unlink(tmp)
+    _move_to_new(tmp, path)
     _NEW_ONLY.discard(key)
 
 
@@ -55,16 +46,23 @@ def keep_in_sight(tmp: str | os.PathLike[str]) -> Path:
         return tmp
     kept = tmp.with_name(tmp.name[1:])
     try:
-        os.link(tmp, kept)
-    except FileExistsError:
+        _move_to_new(tmp, kept)
+    except OSError:
         return tmp
-    except OSError:  # no hard links here (FAT, some network file systems): a rename
-        if os.path.lexists(kept):
-            return tmp
-        try:
-            os.replace(tmp, kept)
-        except OSError:
-            return tmp
-        return kept
-    os.unlink(tmp)
     return kept
+
+
+def _move_to_new(tmp: str | os.PathLike[str], path: str | os.PathLike[str]) -> None:
+    """Move ``tmp`` to ``path`` unless ``path`` exists (:class:`FileExistsError` naming
+    ``path``): a hard link, or, where there are none (FAT, some network file systems), a
+    rename after a check."""
+    try:
+        os.link(tmp, path)
+    except FileExistsError:  # (it names tmp: filename, path: filename2)
+        raise FileExistsError(errno.EEXIST, os.strerror(errno.EEXIST), str(path)) from None
+    except OSError:  # no hard links here
+        if os.path.lexists(path):
+            raise FileExistsError(errno.EEXIST, os.strerror(errno.EEXIST), str(path)) from None
+        os.replace(tmp, path)
+    else:
+        os.unlink(tmp)
