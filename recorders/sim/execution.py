@@ -76,7 +76,8 @@ def execute_live(sim: Simulation, skills: LiveSkills, calls: Sequence[SkillCall]
                 if outcome == "success" and at is not None:
                     outcome, reason, _ = skills.peek(at)
                     if reason != IN_VIEW:
-                        outcome, reason, _ = skills.look_in(at, str(c.node))
+                        outcome, reason, _ = skills.look_in(at, str(c.node),
+                                                            _room_of(c, decided))
             else:
                 goal = _goal(c, decided)
                 run = skills.explore if c.skill == "explore" else skills.navigate
@@ -106,6 +107,12 @@ def _container_at(call: SkillCall, decided: Refresh | None, open_only: bool = Fa
         return None
     x, y, z = node.position
     return float(x), float(y), float(z)
+
+
+def _room_of(call: SkillCall, decided: Refresh | None) -> str | None:
+    """The room of the object node of ``call`` in the graph decided on (None: none)."""
+    node = None if decided is None or call.node is None else decided.graph.node(call.node)
+    return node.room if isinstance(node, ObjectNode) else None
 
 
 def _goal(call: SkillCall, decided: Refresh | None) -> Goal:

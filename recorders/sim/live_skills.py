@@ -94,19 +94,15 @@ from sgtool.errors import SgtoolError
 from sgtool.mapping.grid import OccupancyGrid
 from sgtool.mapping.live_paths import (
     descend,
-    front_goal,
     nearest_reachable,
-    open_fan,
     point_goal,
-    stand_goal,
     traversable,
-    view_goal,
 )
 from sgtool.mapping.occupancy import OccupancyMap, geodesic_distances
 from sgtool.planning.base import Outcome
 from sgtool.recorders.sim import navigation as nav
 from sgtool.recorders.sim.events import SkillOutcome
-from sgtool.recorders.sim.live_goals import Goal
+from sgtool.recorders.sim.live_goals import Goal, room_fan, stand_cell
 from sgtool.recorders.sim.motion import drive_while_turning, head_tilts, peek_tilt, sweep
 
 if TYPE_CHECKING:
@@ -367,19 +363,17 @@ class LiveSkills:
             self._planned = None
         return n
 
-    def select(self, goal: Goal, occ: OccupancyMap, dist: np.ndarray
-               ) -> tuple[float, float] | None:
-        """The cell to drive to for ``goal`` on ``occ`` (None: the map cannot reach it)."""
+    def select(self, goal: Goal, occ: OccupancyMap, dist: np.ndarray,
+               layers: MapLayers | None = None) -> tuple[float, float] | None:
+        """The cell to drive to for ``goal`` on ``occ`` (None: the map cannot reach it).
+        A stand or view at an object of a known ``room`` is sought among the cells of that
+        room first (``layers``' Voronoi nodes: :func:`~.live_goals.stand_cell`)."""
         cfg = self.config
         if goal.kind == "cells":
             return nearest_reachable(occ, dist, goal.points, cfg.frontier_snap)
-        if goal.kind in ("stand", "front"):
-            reach = self.body.config.reach - 0.05
-            front = front_goal(occ, dist, goal.points[0], reach, cfg.slack) \
-                if goal.kind == "front" else None
-            return front or stand_goal(occ, dist, goal.points[0], reach, cfg.slack)
-        if goal.kind == "view":
-            return view_goal(occ, dist, goal.points[0], cfg.look_in)
+        if goal.kind in ("stand", "front", "view"):
+            return stand_cell(goal, occ, dist, layers, self.body.config.reach - 0.05,
+                              cfg.slack, cfg.look_in)
         return point_goal(occ, dist, goal.points[0], cfg.snap)
 
     # ----- skills -----------------------------------------------------------------------
@@ -435,28 +429,30 @@ class LiveSkills:
         return ("failure", f"{goal.label} not reached after {cfg.max_replans} re-plans",
                 driven)
 
-    def look_in(self, at: tuple[float, float, float], label: str = "container"
-                ) -> tuple[Outcome, str, float]:
+    def look_in(self, at: tuple[float, float, float], label: str = "container",
+                room: str | None = None) -> tuple[Outcome, str, float]:
         """Drive to where the opened container whose node is at ``at`` is seen whole
         (module doc: looking in), facing it, and peek into it there: (outcome, reason,
         metres); always a success (IN_VIEW when the target came into view), since the
         opening is done whether or not the robot gets there. With ``look_in_beyond`` > 0
         only when the robot stands more than that many degrees off the container's open
-        fan (:func:`~sgtool.mapping.live_paths.open_fan`)."""
+        fan (:func:`~sgtool.mapping.live_paths.open_fan`; in its ``room`` first, as
+        :meth:`select`)."""
         cfg = self.config
         if cfg.look_in <= 0.0:  # off: no map needed
             return "success", "", 0.0
         ref = self.current()
         planned = None if ref is None else self.plan_map(ref)
-        if planned is None:
+        if ref is None or planned is None:
             return "success", "", 0.0
         here = self.body.base[:2]
         if cfg.look_in_beyond > 0.0:
-            fan = open_fan(*planned, at[:2], cfg.look_in)
+            fan = room_fan(*planned, at[:2], cfg.look_in, ref.layers, room)
             if fan is None or off_bearing(at[:2], here, fan[0]) <= cfg.look_in_beyond:
                 return "success", "", 0.0
-        goal = Goal(f"a view into {label}", "view", np.array([at[:2]], dtype=np.float64))
-        there = self.select(goal, *planned)
+        goal = Goal(f"a view into {label}", "view", np.array([at[:2]], dtype=np.float64),
+                    room)
+        there = self.select(goal, *planned, ref.layers)
         if there is None or math.dist(there, here) <= planned[0].resolution:
             return "success", "", 0.0
         outcome, why, driven = self.navigate(goal)

@@ -14,6 +14,7 @@ import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
+from sgtool.house.geometry import segments_cross
 from sgtool.mapping.occupancy import astar, geodesic_distances, nearest_free_cell
 from sgtool.planning.base import Outcome
 from sgtool.recorders.sim import articulation as art
@@ -162,11 +163,24 @@ class Skills:
 
     # ----- open / close -----------------------------------------------------------------
     def _reach_problem(self, r: Resolved) -> str | None:
+        """Why the robot cannot work on ``r`` from where it stands: farther than its reach,
+        or (a piece or object) a wall or closed door between the base and the thing's
+        centre: an arm does not open a cabinet from the room behind its wall."""
         assert r.box is not None
         d = art.point_box_distance(self.base[0], self.base[1], r.box)
         if d > self.robot.reach + 1e-9:
             return (f"{r.label} is out of reach: {d:.2f} m from the robot (reach "
                     f"{self.robot.reach:.2f} m)")
+        if r.kind == "door":
+            return None
+        here, there = (self.base[0], self.base[1]), (r.box[0], r.box[1])
+        for w in self.spec.walls:
+            if segments_cross(here, there, w.a, w.b):
+                return f"{r.label} is out of reach: {w.id} stands between it and the robot"
+        for door in self.spec.doors:
+            if self.world.states[door.id] == "closed" and \
+                    segments_cross(here, there, *door.segment):
+                return f"{r.label} is out of reach: closed door {door.id} stands between"
         return None
 
     def open(self, target: Target) -> SkillOutcome:

@@ -234,6 +234,14 @@ def _segments_meet(a: Point, b: Point, c: Point, d: Point, eps: float) -> bool:
         or segment_distance(a[0], a[1], c, d) <= eps or segment_distance(b[0], b[1], c, d) <= eps
 
 
+def segments_cross(p: Point, q: Point, a: Point, b: Point) -> bool:
+    """Whether segment p-q passes from one side of segment a-b to the other: each strictly
+    separates the other's end points (touching or running along does not count)."""
+    d1, d2 = _cross(a, b, p), _cross(a, b, q)
+    d3, d4 = _cross(p, q, a), _cross(p, q, b)
+    return d1 * d2 < 0.0 and d3 * d4 < 0.0
+
+
 def length_in_strip(p: Point, q: Point, a: Point, b: Point, half_width: float) -> float:
     """Length of the part of segment p-q inside the rectangle around segment a-b of
     half-width ``half_width`` (a wall's body: no caps beyond a and b); Liang-Barsky."""

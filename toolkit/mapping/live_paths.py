@@ -33,21 +33,28 @@ the robot, ties by the lowest row, then column):
   container's own blocked cells out to that distance (a piece stands with its back to a
   wall and its sides often against others, so the open fan faces its front).
 
+These take ``within``, a bool grid of the cells a stand (and a fan's ray) may end in: the
+closed loop gives the cells of the container's own room (:func:`nearest_along_floor`
+labels each cell with the Voronoi node nearest along the floor), since a ray leaves a
+piece standing against a wall through the wall as easily as through its front.
+
 :func:`descend` reads a shortest cell path off a distance field (steepest descent from
 the goal to the robot), so one Dijkstra run serves both the goal choice and the path.
 """
 
 from __future__ import annotations
 
+import hashlib
 import itertools
 import math
 from collections.abc import Sequence
 
 import numpy as np
 from scipy import ndimage
+from scipy.sparse.csgraph import dijkstra
 
 from sgtool.mapping.grid import OccupancyGrid
-from sgtool.mapping.occupancy import OccupancyMap, inflate
+from sgtool.mapping.occupancy import OccupancyMap, free_cell_graph, inflate
 
 _SQRT2 = math.sqrt(2.0)
 _STEPS = ((0, 1), (0, -1), (1, 0), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
@@ -130,13 +137,16 @@ def point_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float],
 
 
 def stand_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], reach: float,
-               slack: float = 0.3) -> tuple[float, float] | None:
+               slack: float = 0.3, within: np.ndarray | None = None
+               ) -> tuple[float, float] | None:
     """Where to stand to work on a thing at ``xy``: of the reachable cells within ``reach``
-    m of it, those at most ``slack`` m farther than the nearest one, the one nearest along
-    the floor. None when no reachable cell is within ``reach``."""
+    m of it (and ``within``, a bool grid, when given), those at most ``slack`` m farther
+    than the nearest one, the one nearest along the floor. None when no such cell is
+    within ``reach``."""
     X, Y = _centres(occ)
     d = np.hypot(X - xy[0], Y - xy[1])
-    return _stand_among(occ, dist, d, np.isfinite(dist) & (d <= reach + 1e-9), slack)
+    ok = np.isfinite(dist) & (d <= reach + 1e-9)
+    return _stand_among(occ, dist, d, ok if within is None else ok & within, slack)
 
 
 def _stand_among(occ: OccupancyMap, dist: np.ndarray, d: np.ndarray, ok: np.ndarray,
@@ -153,7 +163,8 @@ VIEW_DIRECTIONS = 36  # directions tried round a container by view_goal (10 degr
 
 
 def view_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], distance: float,
-              exit_within: float = 0.8) -> tuple[float, float] | None:
+              exit_within: float = 0.8, within: np.ndarray | None = None
+              ) -> tuple[float, float] | None:
     """Where to look into a container at ``xy`` from (module doc): of
     :data:`VIEW_DIRECTIONS` rays from ``xy``, a ray is *open* when, after leaving the
     blocked cells round ``xy`` within ``exit_within`` m (the container and the robot-radius
@@ -161,16 +172,18 @@ def view_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], distance
     ``distance`` is reachable. The result is the end of the ray bisecting the widest
     circular run of open rays (when that ray is not open itself, the end of the run's
     middle ray; of equally wide runs, the one whose end is nearest along the floor; all
-    rays open: the nearest end of any). None when no ray is open."""
-    fan = open_fan(occ, dist, xy, distance, exit_within)
+    rays open: the nearest end of any). None when no ray is open. With ``within`` (a bool
+    grid) a ray whose end cell is outside it is not open either."""
+    fan = open_fan(occ, dist, xy, distance, exit_within, within)
     return None if fan is None else _centre(occ, *fan[1])
 
 
 def open_fan(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], distance: float,
-             exit_within: float = 0.8) -> tuple[float, tuple[int, int]] | None:
+             exit_within: float = 0.8, within: np.ndarray | None = None
+             ) -> tuple[float, tuple[int, int]] | None:
     """The bisector (radians) of the widest run of open rays round ``xy`` out to
-    ``distance`` and the cell :func:`view_goal` takes on it (its rules); None when no ray
-    is open."""
+    ``distance`` and the cell :func:`view_goal` takes on it (its rules, ``within``
+    included); None when no ray is open."""
     n = VIEW_DIRECTIONS
     radii = np.arange(0.0, distance + 1e-9, occ.resolution / 2.0)
     if radii.size == 0 or radii[-1] < distance - 1e-9:
@@ -184,7 +197,8 @@ def open_fan(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], distance:
         blocked = occ.blocked[rows, cols]
         free = np.flatnonzero(~blocked)
         if free.size == 0 or radii[free[0]] > exit_within + 1e-9 \
-                or blocked[free[0]:].any() or not math.isfinite(dist[rows[-1], cols[-1]]):
+                or blocked[free[0]:].any() or not math.isfinite(dist[rows[-1], cols[-1]]) \
+                or (within is not None and not within[rows[-1], cols[-1]]):
             return None
         return int(rows[-1]), int(cols[-1])
 
@@ -218,19 +232,20 @@ def open_fan(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], distance:
 
 
 def front_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], reach: float,
-               slack: float = 0.3, half_angle: float = math.radians(30.0)
-               ) -> tuple[float, float] | None:
+               slack: float = 0.3, half_angle: float = math.radians(30.0),
+               within: np.ndarray | None = None) -> tuple[float, float] | None:
     """Where to stand to open or look into a container at ``xy``, in front of its opening:
     :func:`stand_goal`'s rule (within ``reach``, at most ``slack`` farther than the
     nearest such cell, then nearest along the floor) over the reachable cells whose
     bearing from ``xy`` lies within ``half_angle`` of the bisector of its open fan
     (:func:`open_fan` out to ``reach``: a piece stands with its back to a wall and its
-    sides often against others, so the fan faces its front). None when there is no fan
-    or no such cell (then :func:`stand_goal` is the way to stand).
+    sides often against others, so the fan faces its front), and within ``within`` (a
+    bool grid) when given, for the fan's rays too. None when there is no fan or no such
+    cell (then :func:`stand_goal` is the way to stand).
 
     From 60 degrees off a cabinet's front its side board hides the inside; from in front
     the camera sees in."""
-    fan = open_fan(occ, dist, xy, reach)
+    fan = open_fan(occ, dist, xy, reach, within=within)
     if fan is None:
         return None
     X, Y = _centres(occ)
@@ -238,7 +253,43 @@ def front_goal(occ: OccupancyMap, dist: np.ndarray, xy: Sequence[float], reach: 
     d = np.hypot(dx, dy)
     off = np.abs(np.remainder(np.arctan2(dy, dx) - fan[0] + math.pi, 2.0 * math.pi) - math.pi)
     ok = np.isfinite(dist) & (d <= reach + 1e-9) & (off <= half_angle + 1e-9)
-    return _stand_among(occ, dist, d, ok, slack)
+    return _stand_among(occ, dist, d, ok if within is None else ok & within, slack)
+
+
+def nearest_along_floor(occ: OccupancyMap, points: np.ndarray) -> np.ndarray:
+    """For every cell, the index of the point of ``points`` (world x, y; e.g. the nodes of
+    a Voronoi graph) nearest to it along the floor (the free cells of ``occ``, 8-connected
+    as the geodesics); -1 for a blocked cell and one no point reaches. Points whose own
+    cell is blocked or off the grid take no part; of points sharing a cell, the first.
+    Kept on ``occ`` per set of points: read the grid, never change it."""
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    key = ("nearest_along_floor", hashlib.sha256(pts.tobytes()).hexdigest())
+    cached = occ._cache.get(key)
+    if cached is not None:
+        return cached
+    out = np.full(occ.shape, -1, dtype=np.int64)
+    occ._cache[key] = out  # filled in below; read it, never change it
+    g, index, flat = free_cell_graph(occ)
+    rows = np.floor((pts[:, 1] - occ.origin[1]) / occ.resolution).astype(np.int64)
+    cols = np.floor((pts[:, 0] - occ.origin[0]) / occ.resolution).astype(np.int64)
+    on = (rows >= 0) & (rows < occ.shape[0]) & (cols >= 0) & (cols < occ.shape[1])
+    source_of: dict[int, int] = {}
+    for i in np.flatnonzero(on):
+        node = int(index[rows[i], cols[i]])
+        if node >= 0:
+            source_of.setdefault(node, int(i))
+    if not source_of or flat.size == 0:
+        return out
+    sources = sorted(source_of)
+    _, _, reached = dijkstra(g, directed=True, indices=sources, min_only=True,
+                             return_predecessors=True)
+    lookup = np.full(flat.size, -1, dtype=np.int64)
+    lookup[sources] = [source_of[n] for n in sources]
+    ok = reached >= 0
+    labels = np.full(flat.size, -1, dtype=np.int64)
+    labels[ok] = lookup[reached[ok]]
+    out.ravel()[flat] = labels
+    return out
 
 
 def _centres(occ: OccupancyMap) -> tuple[np.ndarray, np.ndarray]:

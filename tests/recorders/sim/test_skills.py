@@ -8,10 +8,11 @@ import math
 import numpy as np
 import pytest
 from scipy import ndimage
-from support.small_house import small_house
+from support.small_house import small_house, small_house_dict
 
 from sgtool.datasets.generator import generate_house
 from sgtool.errors import SgtoolError
+from sgtool.house.io import load_house
 from sgtool.house.spec import room_at
 from sgtool.mapping.occupancy import world_to_cell
 from sgtool.recorders.sim import (
@@ -120,6 +121,25 @@ def test_open_and_close_need_reach_and_something_openable() -> None:
         assert sim.close("door_0").success and sim.states["door_0"] == "closed"
         assert [s for _, _, s in tr.states] == ["open", "closed"]
         assert sim.navigate("room_1").outcome == "failure"
+
+
+def test_a_piece_is_not_opened_through_the_wall_behind_it() -> None:
+    """A cabinet stands in the kitchen with its back to the wall x = 4; from the living
+    room, 0.4 m from its box, the arm would reach it through the wall: that fails; from
+    the kitchen in front of it, it opens."""
+    d = small_house_dict()
+    d["furniture"].append({"id": "furn_9", "category": "cabinet", "synset": "cabinet.n.01",
+                           "room": "room_1", "center": [4.3, 0.6, 0.45],
+                           "size": [0.8, 0.5, 0.9], "yaw": -math.pi / 2,  # front: +x
+                           "affordances": ["container", "openable"], "state": "closed"})
+    sim = Simulation(load_house(d), camera=SMALL, start=(3.65, 0.6, 0.0))
+    with sim:
+        behind = sim.open("furn_9")
+        assert behind.outcome == "failure"
+        assert behind.reason == "furn_9 is out of reach: wall_4 stands between it and the robot"
+        assert sim.states["furn_9"] == "closed"
+        sim.teleport((5.0, 0.6, math.pi))
+        assert sim.open("furn_9").success and sim.states["furn_9"] == "open"
 
 
 def test_opening_a_container_reveals_what_is_inside() -> None:

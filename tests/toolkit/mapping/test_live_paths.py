@@ -20,6 +20,7 @@ from sgtool.mapping.live_paths import (
     VIEW_DIRECTIONS,
     descend,
     front_goal,
+    nearest_along_floor,
     nearest_reachable,
     point_goal,
     stand_goal,
@@ -179,3 +180,42 @@ def test_a_container_is_opened_from_in_front_of_it() -> None:
     boxed = traversable(OccupancyGrid(g, (0.0, 0.0), RES), robot_radius=0.25)
     d2 = geodesic_distances(boxed, (0.6, 3.5))
     assert front_goal(boxed, d2, fridge, reach=0.95) is None
+
+
+def cabinet_against_a_wall() -> OccupancyGrid:
+    """6 x 5 m (10 cm cells): room B below the wall y = 3.0, room A above it, a doorway at
+    x 5.0..5.9. In room A a cabinet stands with its back to that wall (x 2.6..3.4, y
+    3.1..3.6, centre (3.0, 3.35)) between two counters along it (0.6 m deep, x 0.1..4.6),
+    and two chairs (x 2.0 and 4.0, y 4.1..4.3) narrow the floor in front of it."""
+    g = np.full((50, 60), FREE, np.int8)
+    g[0, :] = g[-1, :] = OCCUPIED
+    g[:, 0] = g[:, -1] = OCCUPIED
+    g[30, :50] = OCCUPIED  # the wall, its doorway at columns 50..58
+    g[31:36, 26:34] = OCCUPIED  # the cabinet
+    g[31:37, 1:26] = g[31:37, 34:46] = OCCUPIED  # the counters
+    g[41:43, 19:21] = g[41:43, 39:41] = OCCUPIED  # the chairs
+    return OccupancyGrid(g, (0.0, 0.0), RES)
+
+
+def test_a_stand_at_a_container_stays_in_its_room() -> None:
+    """Round the cabinet of cabinet_against_a_wall the widest open fan runs through the wall behind it
+    into room B (the wall and the robot's margin are left within exit_within), so the
+    front stand and the view fall in room B, where the cabinet cannot be opened or seen
+    into. Within room A's cells (labelled by the point nearest along the floor, through
+    the doorway for room B) both face its front."""
+    occ = traversable(cabinet_against_a_wall(), robot_radius=0.25)
+    cabinet = (3.0, 3.35)
+    dist = geodesic_distances(occ, (1.0, 4.5))  # in room A
+    labels = nearest_along_floor(occ, np.array([[3.0, 4.6], [3.0, 1.5]]))
+    r, c = occ.grid.cell_of(5.5, 2.0)
+    assert labels[r, c] == 1  # room B's floor below the doorway
+    r, c = occ.grid.cell_of(5.5, 4.5)
+    assert labels[r, c] == 0
+    assert labels[occ.blocked].max() == -1
+    room_a = labels != 1
+    for within, side in ((None, -1.0), (room_a, 1.0)):
+        stand = front_goal(occ, dist, cabinet, reach=0.95, slack=0.3, within=within)
+        view = view_goal(occ, dist, cabinet, 1.4, within=within)
+        assert stand is not None and view is not None
+        assert np.sign(stand[1] - 3.0) == side and np.sign(view[1] - 3.0) == side
+    assert stand_goal(occ, dist, cabinet, 0.95, 0.3, room_a)[1] > 3.0  # type: ignore[index]
