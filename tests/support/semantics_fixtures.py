@@ -119,7 +119,8 @@ class ChatServer:
     Each request consumes the next script item:
     ``{"text": str}`` a normal answer; ``{"status": int}`` an HTTP error;
     ``{"sleep": s, "text": str}`` an answer after ``s`` seconds (for timeouts);
-    ``{"raw": bytes}`` a 200 response with this body (malformed JSON).
+    ``{"raw": bytes}`` a 200 response with this body (malformed JSON);
+    ``{"drop": True}`` the connection closed without a response.
     When the script is exhausted, ``responder(request) -> item`` answers if given, else
     the server answers HTTP 500. Requests are kept in :attr:`requests` (decoded JSON).
     """
@@ -168,6 +169,9 @@ class ChatServer:
                         item = {"status": 599}
                 else:
                     item = {"status": 500}
+                if item.get("drop"):
+                    self.close_connection = True
+                    return
                 if "sleep" in item:
                     time.sleep(item["sleep"])
                 if "status" in item:

@@ -260,14 +260,19 @@ class OpenAIChatClient:
             raise LlmTransportError(
                 f"{self.where}: HTTP {e.status_code}: {self._short(e)}") from e
         except openai.APIConnectionError as e:
+            why, closed = self._short(_root_cause(e)), _closed_without_reply(e)
             if not self.replies:
-                # never reached at all: a wrong address, not a fault to retry around
+                # never answered at all: a wrong address, not a fault to retry around
+                what = (f"the LLM endpoint {self.where} closed the connection without "
+                        f"replying ({why}); is it an OpenAI-compatible server? check"
+                        if closed else
+                        f"cannot reach the LLM endpoint {self.where}: {why}; check")
                 raise LlmUnreachableError(
-                    f"cannot reach the LLM endpoint {self.where}: {self._short(e)}; check "
-                    "SGTOOL_LLM_BASE_URL / --llm-base-url / base_url (an LLM planner also "
-                    "replays a recorded transcript: --llm-replay FILE of bench, run and eval)"
-                ) from e
-            raise LlmTransportError(f"{self.where}: connection failed: {self._short(e)}") from e
+                    f"{what} SGTOOL_LLM_BASE_URL / --llm-base-url / base_url (an LLM planner "
+                    "also replays a recorded transcript: --llm-replay FILE of bench, run and "
+                    "eval)") from e
+            what = "closed the connection without replying" if closed else "connection failed"
+            raise LlmTransportError(f"{self.where}: {what}: {why}") from e
         except Exception as e:  # noqa: BLE001 - any malformed reply is a retryable fault
             raise LlmTransportError(
                 f"{self.where}: unusable reply: {type(e).__name__}: {self._short(e)}"
@@ -381,6 +386,24 @@ def _count(v: Any) -> int | None:
 
 def _text_or(v: Any, default: str) -> str:
     return v if isinstance(v, str) and v else default
+
+
+def _root_cause(e: BaseException) -> BaseException:
+    """The innermost exception behind ``e`` (its causes and contexts): the openai client's
+    "Connection error." says less than the socket's or the HTTP library's own."""
+    seen = {id(e)}
+    while True:
+        inner = e.__cause__ or e.__context__
+        if inner is None or id(inner) in seen or not str(inner).strip():
+            return e
+        seen.add(id(inner))
+        e = inner
+
+
+def _closed_without_reply(e: BaseException) -> bool:
+    """Whether the server took the request and closed the connection without an answer
+    (the HTTP library's RemoteProtocolError), rather than being out of reach."""
+    return type(_root_cause(e)).__name__ == "RemoteProtocolError"
 
 
 def _short(e: BaseException, limit: int = 200) -> str:

@@ -17,6 +17,7 @@ from sgtool.llm.client import (
     LlmConfigError,
     LlmSettings,
     LlmTransportError,
+    LlmUnreachableError,
     OpenAIChatClient,
     reply_text,
 )
@@ -92,6 +93,23 @@ def test_a_wrong_setup_stops_at_the_first_request(first, says):
             c.complete([{"role": "user", "content": "x"}])
     with ChatServer([{"status": 500}]) as srv, pytest.raises(LlmTransportError):
         client(srv).complete([{"role": "user", "content": "x"}])
+
+
+def test_a_server_closing_the_connection_is_named_so() -> None:
+    """A server that takes the request and hangs up is reached, not out of reach: a setup
+    error before any answer, a retryable fault after one; both name the hang-up."""
+    with ChatServer([{"drop": True}, {"text": "a"}, {"drop": True}]) as srv:
+        with pytest.raises(LlmUnreachableError) as first:
+            client(srv).complete([{"role": "user", "content": "x"}])
+        c = client(srv)
+        assert c.complete([{"role": "user", "content": "x"}]).text == "a"
+        with pytest.raises(LlmTransportError) as later:
+            c.complete([{"role": "user", "content": "y"}])
+    assert str(first.value).startswith(
+        f"the LLM endpoint {srv.base_url} closed the connection without replying (")
+    assert not isinstance(later.value, LlmUnreachableError)
+    assert str(later.value).startswith(
+        f"{srv.base_url}: closed the connection without replying: ")
 
 
 def test_bad_token_counts_are_dropped_not_fatal():

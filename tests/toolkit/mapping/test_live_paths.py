@@ -198,8 +198,9 @@ def cabinet_against_a_wall() -> OccupancyGrid:
 
 
 def test_a_stand_at_a_container_stays_in_its_room() -> None:
-    """Round the cabinet of cabinet_against_a_wall the widest open fan runs through the wall behind it
-    into room B (the wall and the robot's margin are left within exit_within), so the
+    """Round the cabinet of :func:`cabinet_against_a_wall` the widest open fan runs
+    through the wall behind it into room B (the wall and the robot's margin are left
+    within exit_within), so the
     front stand and the view fall in room B, where the cabinet cannot be opened or seen
     into. Within room A's cells (labelled by the point nearest along the floor, through
     the doorway for room B) both face its front."""
