@@ -566,8 +566,12 @@ def update_pins(report: CheckReport) -> list[str]:
                                old.why, copied=old.copied)  # a copy stays sgtool's
             write_capture(staged, pin, c.capture)
             pins.logs[c.name] = now[c.name] = pin
-            what = c.first or "planner decisions or quality figures"
-            accepted.append(f"updated {c.name}: accepted the change from {what} "
-                            f"({sum(c.layers.values())} differences in it)")
+            if c.first:
+                what = f"{c.first} ({sum(c.layers.values())} differences in it)"
+            elif c.decision:
+                what = f"the planner's decisions ({c.decision.removeprefix('decisions: ')})"
+            else:
+                what = "the quality figures"
+            accepted.append(f"updated {c.name}: accepted the change from {what}")
         write_index(staged)
     return accepted

@@ -34,8 +34,8 @@ def layer(module: str) -> str:
     parts = module.split(".")
     if len(parts) > 1 and parts[1] in ("recorders", "replayers", "datasets", "analysis"):
         return parts[1]
-    if len(parts) > 1 and parts[1] in ("commands", "cli"):
-        return "commands"
+    if len(parts) > 1 and parts[1] in ("commands", "cli", "__main__"):
+        return "commands"  # __main__: `python -m sgtool`, the command line
     return "core"
 
 
@@ -77,6 +77,7 @@ def test_layer_of_module_names() -> None:
     assert layer("sgtool.datasets.generator") == "datasets"
     assert layer("sgtool.commands.replay") == "commands"
     assert layer("sgtool.cli") == "commands"
+    assert layer("sgtool.__main__") == "commands"
     assert layer("sgtool") == "facade"
     assert layer("sgtool.version") == "core"
     assert module_name(REPO / "toolkit" / "__init__.py") == "sgtool"

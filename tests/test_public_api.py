@@ -208,6 +208,13 @@ def test_version_is_one_string() -> None:
     assert sgtool.__version__ == __version__ == importlib.metadata.version("sgtool")
 
 
+def test_python_dash_m_sgtool_is_the_command() -> None:
+    """`python -m sgtool`, for an environment whose scripts lack `sgtool`."""
+    out = subprocess.run([sys.executable, "-m", "sgtool", "--version"], capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode == 0 and sgtool.__version__ in out.stdout, out
+
+
 def test_planner_names_build_planners() -> None:
     names = sgtool.planner_names()
     assert {"random", "greedy", "scout"} <= set(names)

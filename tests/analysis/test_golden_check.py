@@ -322,6 +322,11 @@ def test_episode_logs_pin_the_planners_decisions(log, tmp_path, capsys):
             f"{d.text()}") in out
     row = summary_row(out, "episode")
     assert row[1] == "changed" and row[-1] == "changed"  # status, decisions
+    # --update names the decision it accepts, not "decisions or quality figures"
+    code, out, _ = sgtool(capsys, "golden", "check", "--dir", folder, "--update")
+    assert code == 0
+    assert (f"updated episode: accepted the change from the planner's decisions (greedy at "
+            f"episode 0, step {d.step}: navigate(room:99) -> {d.text()})") in out
 
 
 def test_the_first_decision_that_differs_is_named():
@@ -351,6 +356,23 @@ def test_pins_are_added_in_place_and_a_foreign_folder_is_refused(log, tmp_path, 
     code, _, err = sgtool(capsys, "golden", "pin", log, "--dir", mine, *FRAMES)
     assert code == 2 and "holds files but no pins" in err
     assert [p.name for p in mine.iterdir()] == ["notes.txt"]
+
+
+def test_a_pin_replacing_another_logs_pin_of_its_name_says_so(log, tmp_path, capsys):
+    """Logs of one name from two folders (a run-bench folder names every log ep-NNN) pin
+    under one name: the second replaces the first, and the output says which it replaced;
+    pinning the same log again says nothing of the kind."""
+    a, b = tmp_path / "a" / "ep-000.mcap", tmp_path / "b" / "ep-000.mcap"
+    for p in (a, b):
+        p.parent.mkdir()
+        shutil.copyfile(log, p)
+    folder = tmp_path / "g"
+    code, out, _ = sgtool(capsys, "golden", "pin", a, "--dir", folder, *FRAMES)
+    assert code == 0 and "replaces" not in out
+    code, out, _ = sgtool(capsys, "golden", "pin", a, "--dir", folder, *FRAMES)
+    assert code == 0 and "replaces" not in out
+    code, out, _ = sgtool(capsys, "golden", "pin", b, "--dir", folder, *FRAMES)
+    assert code == 0 and "; replaces the pin of ../a/ep-000.mcap (../b/ep-000.mcap)" in out
 
 
 def test_a_repository_of_logs_and_pins_checks_out_anywhere(log, tmp_path, capsys):

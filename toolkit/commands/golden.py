@@ -95,6 +95,7 @@ def pin(logs: tuple[str, ...], folder: str, copy: bool, why: str | None, every: 
 
     inputs = expand_inputs(logs, (".mcap",))
     runner = make_executor(executor, workers, ray_address)
+    before = _pinned_logs(Path(folder))
     pins = pin_logs(inputs, Path(folder),
                     make_options(every, classifier, min_points, voxel_size, max_frames),
                     copy=copy, executor=runner, progress=_show(progress), why=why)
@@ -104,9 +105,24 @@ def pin(logs: tuple[str, ...], folder: str, copy: bool, why: str | None, every: 
         e = pins.logs[pin_name(Path(p))]
         extra = ", quality figures" if e.quality else ""
         extra += f", {len(e.decisions)} {e.planner} decisions" if e.decisions else ""
+        replaced = before.get(e.name)
+        extra += f"; replaces the pin of {replaced}" if replaced not in (None, e.log) else ""
         click.echo(f"pinned {e.name}: {e.refreshes} refreshes{extra} ({e.log})")
     click.echo(f"wrote {Path(folder) / 'expected.json'}; check with: sgtool golden check "
                f"--dir {quoted(folder)}")
+
+
+def _pinned_logs(folder: Path) -> dict[str, str]:
+    """Pin name -> the log it pins, of the pin folder ``folder`` (none when it holds no
+    readable index): what a new pin of the same name replaces."""
+    from sgtool.replayers.golden_pins import INDEX, read_pins
+
+    if not (folder / INDEX).is_file():
+        return {}
+    try:
+        return {name: pin.log for name, pin in read_pins(folder).logs.items()}
+    except SgtoolError:
+        return {}  # pin_logs says what is wrong with it
 
 
 class _ReportingCommand(click.Command):

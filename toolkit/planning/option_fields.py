@@ -94,10 +94,14 @@ def option(help: str, kind: str, *, lo: float | None = None, hi: float | None = 
     """Metadata for ``dataclasses.field(metadata=...)`` of an options field."""
     if kind not in KINDS:
         raise ValueError(f"kind {kind!r}: one of {KINDS}")
+    choices = tuple(choices)
+    if (kind == "choice") != bool(choices):
+        raise ValueError(f"choices {choices!r}: a choice needs its choices; only a choice "
+                         "has them")
     if (kind == "list") != (item in ITEM_KINDS):
         raise ValueError(f"item {item!r}: a list's items are one of {ITEM_KINDS}; only a "
                          "list has items")
-    return {_META: OptionMeta(help, kind, lo, hi, lo_open, tuple(choices), optional,
+    return {_META: OptionMeta(help, kind, lo, hi, lo_open, choices, optional,
                               objects, item=item, length=length)}
 
 

@@ -404,6 +404,20 @@ def _option_meta(name: str, key: str) -> OptionMeta | None:
     return next((i.meta for i in option_infos(cls) if i.name == key), None)
 
 
+def _unannotated_parameters(factory: Any) -> list[str]:
+    """The parameters without an annotation of a plug-in without an ``Options`` class, in
+    order (its ``__init__``'s, for a class; not ``*args``/``**kwargs``): ``-O`` passes
+    them as int, float, true/false or text; none when Python cannot tell."""
+    import inspect
+
+    try:
+        params = inspect.signature(factory).parameters.values()
+    except (TypeError, ValueError):
+        return []
+    return [p.name for p in params if p.annotation is p.empty
+            and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+
+
 def _signature_defaults(factory: Any) -> dict[str, Any]:
     """The keyword defaults of a plug-in without an ``Options`` class: its factory's (its
     ``__init__``'s, for a class); none when Python cannot tell."""
@@ -496,11 +510,15 @@ def _plugin_lines(name: str) -> list[str]:
     if cls is None:
         factory = _factory(name)
         typed, defaults = plugins.signature_metas(factory), _signature_defaults(factory)
+        untyped = [k for k in _unannotated_parameters(factory) if k not in typed]
         return [f"{name}: a plug-in without an Options dataclass (its -O values are "
                 "converted to its parameters' annotated types, else passed as int, float, "
                 "true/false or text)",
                 *(f"    {OptionInfo(k, m.kind, defaults.get(k), m, k not in defaults).line()}"
-                  for k, m in typed.items())]
+                  for k, m in typed.items()),
+                *(f"    {k} (int, float, true/false or text, "
+                  + (f"default {defaults[k]!r})" if k in defaults else "required)")
+                  for k in untyped)]
     return [f"{name}: a plug-in", *(f"    {info.line()}" for info in option_infos(cls))]
 
 

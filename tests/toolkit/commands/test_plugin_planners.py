@@ -452,6 +452,8 @@ def test_list_planners_describes_a_plugin_named_with_it(
             "true/false or text)")
     r = CliRunner().invoke(cli, [*command, "mymod_cli:MyPlanner", "--list-planners"])
     assert r.exit_code == 0 and said in r.output, r.output
+    # its parameter without an annotation is listed too, as -O passes it
+    assert "    k (int, float, true/false or text, default 1)" in r.output, r.output
     # named after it, or as --opt=VALUE: the same
     flag = command[-1]
     for words in (["--list-planners", flag, "mymod_cli:MyPlanner"],

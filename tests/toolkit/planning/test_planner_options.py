@@ -13,6 +13,7 @@ from sgtool.planning.option_fields import (
     PlannerOptionError,
     UnknownPlannerError,
     convert_options,
+    option,
     option_infos,
 )
 from sgtool.planning.planner_options import (
@@ -201,3 +202,13 @@ def test_a_plug_ins_choices_keep_their_case_and_an_empty_optional_is_none() -> N
     assert convert_options("lab:P", Opts, {"n": ""}, from_cli=True) == {"n": None}
     with pytest.raises(PlannerOptionError, match="must be an integer"):
         convert_options("lab:P", Opts, {"n": "x"}, from_cli=True)
+
+
+def test_a_choice_needs_its_choices_and_only_a_choice_has_them() -> None:
+    """`option(help, "choice")` without choices could never be set ("must be one of ");
+    choices on another kind would be ignored: both are the plug-in author's error."""
+    with pytest.raises(ValueError, match="a choice needs its choices"):
+        option("mode", "choice")
+    with pytest.raises(ValueError, match="only a choice has them"):
+        option("n", "int", choices=("a", "b"))
+    assert option("mode", "choice", choices=("a", "b"))
