@@ -194,8 +194,13 @@ _LABELS = {"episode": "episode", "planner_options": "planner options (-O)",
 
 
 def settings_differences(logged: dict[str, Any], want: dict[str, Any]) -> list[str]:
-    """``NAME: X in the log, Y now`` for every setting that differs."""
-    return [f"{_LABELS.get(k, k)}: {json.dumps(logged.get(k))} in the log, {json.dumps(v)} now"
+    """``NAME: X in the log, Y now`` for every setting that differs (planner options
+    without any, ``{}``, are the planner's defaults: an option given at its default is not
+    kept, so it reads so)."""
+    def text(k: str, v: Any) -> str:
+        return "{} (the defaults)" if k == "planner_options" and v == {} else json.dumps(v)
+
+    return [f"{_LABELS.get(k, k)}: {text(k, logged.get(k))} in the log, {text(k, v)} now"
             for k, v in want.items() if logged.get(k) != v]
 
 

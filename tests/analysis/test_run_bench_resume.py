@@ -42,6 +42,9 @@ def test_the_house_is_compared_in_canonical_form() -> None:
 def test_settings_differences_name_the_setting() -> None:
     assert settings_differences({"max_steps": 2, "seed": 0}, {"max_steps": 3, "seed": 0}) \
         == ["max steps: 2 in the log, 3 now"]
+    # options given at their defaults are not kept: no options read as the defaults
+    assert settings_differences({"planner_options": {"k": 2.0}}, {"planner_options": {}}) \
+        == ['planner options (-O): {"k": 2.0} in the log, {} (the defaults) now']
 
 
 def _first_run(tmp_path: Path) -> tuple[object, Path, Path, list[str]]:
