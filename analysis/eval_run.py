@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 from sgtool.canonical import strict_json
 from sgtool.errors import SgtoolError
+from sgtool.log.records import given
 from sgtool.semantics.text import category_text
 
 if TYPE_CHECKING:
@@ -87,7 +88,8 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
                     else "") + "): each planner is scored per profile, as PLANNER [NOISE]"]
     if (other := _unlike_episodes(results)) is not None:
         notes = [*notes, other]
-    notes = [*notes, *settings_notes(request.inputs), *_logged_step_notes(logged)]
+    notes = [*notes, *settings_notes(request.inputs), *_logged_step_notes(logged),
+             *_default_option_notes(request, logged)]
     if unknown := sum(1 for r in results if r.shortest_m is None
                       or not math.isfinite(r.shortest_m)):
         notes = [*notes, f"{unknown} episode(s) have no shortest path (none was logged, or "
@@ -112,6 +114,23 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
     text = render(request, results, notes, models, summarize(results, models), reports,
                   exchanges)
     return EvalOutcome(text=text, unread=list(unread))
+
+
+def _default_option_notes(request: EvalRequest, logged: Sequence[Any]) -> list[str]:
+    """A note for each planner asked (``-p``) without ``-O`` whose own logged episodes ran
+    it with options: it is asked with its defaults, and disagrees where they matter."""
+    out = []
+    for name in request.planners:
+        if request.planner_options.get(name):
+            continue
+        ran = {json.dumps(opts, sort_keys=True) for e in logged
+               if given(e.episode.planner) == name
+               and isinstance(opts := e.episode.extras.get("planner_options"), dict) and opts}
+        if ran:
+            shown = "; ".join(sorted(ran))
+            out.append(f"-p {name} asks it with its default options; its logs ran it with "
+                       f"{shown} (give them with -O {name}.KEY=VALUE to ask it as it ran)")
+    return out
 
 
 def _logged_step_notes(logged: Sequence[Any]) -> list[str]:

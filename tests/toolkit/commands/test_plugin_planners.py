@@ -173,6 +173,11 @@ def test_eval_asks_a_plugin_and_reads_its_logs(plugin_dir: Path, tmp_path: Path,
     assert set(offline) == {"mymod_cli:MyPlanner", "greedy"}
     assert offline["mymod_cli:MyPlanner"]["same_action"] == 1.0  # it decides as logged
     assert offline["mymod_cli:MyPlanner"]["decisions"] == offline["greedy"]["decisions"] > 0
+    # asked without -O: with its defaults (here refused, k=1), and a note says how it ran
+    r = CliRunner().invoke(cli, ["eval", *files, "-p", "mymod_cli:MyPlanner"])
+    assert ('sgtool: note: -p mymod_cli:MyPlanner asks it with its default options; its logs '
+            'ran it with {"k": 3} (give them with -O mymod_cli:MyPlanner.KEY=VALUE to ask it '
+            "as it ran)") in r.output, r.output
     # the folders themselves: --log-dir by its logs in PLANNER/HOUSE/, -o by its table
     by_logs = CliRunner().invoke(cli, ["eval", str(logs), "--json"])
     by_out = CliRunner().invoke(cli, ["eval", str(tmp_path / "out"), "--json"])
