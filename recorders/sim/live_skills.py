@@ -390,7 +390,7 @@ class LiveSkills:
                 return "failure", "the robot has no map yet", driven
             here = body.base[:2]
             occ, dist = planned
-            target = self.select(goal, occ, dist)
+            target = self.select(goal, occ, dist, ref.layers)
             path = None if target is None else descend(occ, dist, target)
             self.replans += 1
             if target is None or path is None:

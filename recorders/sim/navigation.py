@@ -171,15 +171,19 @@ def box_distance_grid(grid: OccupancyMap, box: Box2) -> np.ndarray:
 # goals
 # ----------------------------------------------------------------------------------------
 def approach_goal(grid: OccupancyMap, dist: np.ndarray, box: Box2, robot: RobotConfig,
-                  front: Box2 | None = None) -> tuple[float, float] | None:
+                  front: Box2 | None = None, within: np.ndarray | None = None
+                  ) -> tuple[float, float] | None:
     """Where to stop to work on the object with footprint ``box``: a reachable free cell
     (finite ``dist``, the geodesic distance from the robot) whose distance to the box is in
     ``robot.approach``; when ``front`` (the box of the piece whose front matters) is given,
     cells in front of it (local +y beyond its face) come first, scored by path length plus
     the sideways offset from the front's centre line so the camera looks in square on.
-    Falls back to any reachable cell within reach. None when nothing qualifies."""
+    Falls back to any reachable cell within reach. Only cells of ``within`` (a bool grid:
+    the piece's room) when any of them is within reach. None when nothing qualifies."""
     d = box_distance_grid(grid, box)
     ok = np.isfinite(dist)
+    if within is not None and (ok & within & (d <= robot.reach - 1e-6)).any():
+        ok &= within
     lo, hi = robot.approach
     cand = ok & (d >= lo) & (d <= hi)
     if not cand.any():

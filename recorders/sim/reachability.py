@@ -43,6 +43,7 @@ import dataclasses
 import math
 from collections.abc import Collection, Iterable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy import ndimage
@@ -50,11 +51,14 @@ from scipy import ndimage
 from sgtool.canonical import canonical_float
 from sgtool.mapping.occupancy import OccupancyMap
 from sgtool.planning.candidates import actionable
-from sgtool.recorders.sim.live_goals import Goal, goal_of_node
+from sgtool.recorders.sim.live_goals import Goal, goal_of_node, room_cells
 from sgtool.recorders.sim.live_skills import LiveSkills
 from sgtool.scenegraph.examined import EXAMINE
 from sgtool.scenegraph.graph import SceneGraph
 from sgtool.scenegraph.stream import Refresh
+
+if TYPE_CHECKING:
+    from sgtool.scenegraph.builder import MapLayers
 
 UNREACHABLE = "unreachable on the robot's map"
 FAILED_BEFORE = "failed before from the same place"
@@ -148,11 +152,12 @@ def _pick(occ: OccupancyMap, win: tuple[slice, slice], score: np.ndarray
             occ.origin[1] + (win[0].start + r + 0.5) * res)
 
 
-def goal_cell(skills: LiveSkills, goal: Goal, occ: OccupancyMap, dist: np.ndarray
-              ) -> tuple[float, float] | None:
+def goal_cell(skills: LiveSkills, goal: Goal, occ: OccupancyMap, dist: np.ndarray,
+              layers: MapLayers | None = None) -> tuple[float, float] | None:
     """The cell :meth:`LiveSkills.select` drives to for ``goal`` (the same rule: stand
     within reach, point within ``snap``, nearest of a frontier's cells or within
-    ``frontier_snap`` of them), computed on a window around the goal; None: unreachable.
+    ``frontier_snap`` of them; a stand among the cells of the goal's ``room`` on
+    ``layers``' map first), computed on a window around the goal; None: unreachable.
     A ``front`` goal is taken as ``stand``: it is reachable exactly when that is (the
     skill falls back to it), and its cell in front of the opening is chosen on the way."""
     cfg = skills.config
@@ -184,6 +189,9 @@ def goal_cell(skills: LiveSkills, goal: Goal, occ: OccupancyMap, dist: np.ndarra
     off = np.hypot(X - pts[0, 0], Y - pts[0, 1])
     ok = np.isfinite(d) & (off <= radius + 1e-9)
     if goal.kind in ("stand", "front"):
+        inside = None if goal.room is None else room_cells(occ, layers, goal.room)
+        if inside is not None and (ok & inside[win]).any():  # in its room first, as select
+            ok = ok & inside[win]
         if not ok.any():
             return None
         best = float(off[ok].min())
@@ -209,7 +217,8 @@ def reachable_view(refresh: Refresh, skills: LiveSkills,
     for c in cands:
         node = graph.node(c.node_id)
         assert node is not None
-        cell = goal_cell(skills, goal_of_node(node, refresh.layers), occ, dist)
+        cell = goal_cell(skills, goal_of_node(node, refresh.layers), occ, dist,
+                         refresh.layers)
         if cell is None:
             withheld[c.node_id] = UNREACHABLE
             continue

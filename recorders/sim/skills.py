@@ -14,6 +14,8 @@ import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from sgtool.house.geometry import segments_cross
 from sgtool.mapping.occupancy import astar, geodesic_distances, nearest_free_cell
 from sgtool.planning.base import Outcome
@@ -106,7 +108,8 @@ class Skills:
         else:
             assert r.box is not None
             geo = geodesic_distances(occ, here)
-            goal = nav.approach_goal(occ, geo, r.box, self.robot, r.front)
+            goal = nav.approach_goal(occ, geo, r.box, self.robot, r.front,
+                                     self._room_of(r, occ))
             if goal is None:
                 return 0.0, self._unreachable_reason(r)
             final_yaw = math.atan2(r.point[1] - goal[1], r.point[0] - goal[0])
@@ -120,6 +123,19 @@ class Skills:
             pts = []
         poses = nav.follow_poses(self.base, pts, self._step(), self._turn_step(), final_yaw)
         return self._move(poses), None
+
+    def _room_of(self, r: Resolved, occ: OccupancyMap) -> np.ndarray | None:
+        """The cells of the room of the piece or object ``r`` (None: a door, or no room):
+        its stand is sought there first, where no wall stands between (:meth:`open`)."""
+        sid = None if r.instance is None else r.instance.spec_id
+        thing = self.spec.holder_by_id().get(sid) if sid is not None and \
+            r.kind in ("furniture", "object") else None
+        if thing is None:
+            return None
+        try:
+            return nav.room_mask(occ, self.spec.room(thing.room))
+        except KeyError:
+            return None
 
     def closed_doors_on_way(self, target: Target) -> list[str] | None:
         """The closed doors (spec ids, in the order met) on a shortest path to ``target``
@@ -180,7 +196,8 @@ class Skills:
         for door in self.spec.doors:
             if self.world.states[door.id] == "closed" and \
                     segments_cross(here, there, *door.segment):
-                return f"{r.label} is out of reach: closed door {door.id} stands between"
+                return (f"{r.label} is out of reach: closed door {door.id} stands between "
+                        "it and the robot")
         return None
 
     def open(self, target: Target) -> SkillOutcome:

@@ -373,6 +373,14 @@ def test_a_pin_replacing_another_logs_pin_of_its_name_says_so(log, tmp_path, cap
     assert code == 0 and "replaces" not in out
     code, out, _ = sgtool(capsys, "golden", "pin", b, "--dir", folder, *FRAMES)
     assert code == 0 and "; replaces the pin of ../a/ep-000.mcap (../b/ep-000.mcap)" in out
+    # copied in, both pins' log is ep-000.mcap of the folder: another log by its bytes
+    c = tmp_path / "c" / "ep-000.mcap"
+    c.parent.mkdir()
+    shutil.copyfile(GOLDEN / "house6-tour.mcap", c)
+    copies = tmp_path / "copies"
+    assert sgtool(capsys, "golden", "pin", a, "--dir", copies, "--copy", *FRAMES)[0] == 0
+    code, out, _ = sgtool(capsys, "golden", "pin", c, "--dir", copies, "--copy", *FRAMES)
+    assert code == 0 and "; replaces the pin of ep-000.mcap (another log, sha256 " in out
 
 
 def test_a_repository_of_logs_and_pins_checks_out_anywhere(log, tmp_path, capsys):

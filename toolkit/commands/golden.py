@@ -105,14 +105,16 @@ def pin(logs: tuple[str, ...], folder: str, copy: bool, why: str | None, every: 
         e = pins.logs[pin_name(Path(p))]
         extra = ", quality figures" if e.quality else ""
         extra += f", {len(e.decisions)} {e.planner} decisions" if e.decisions else ""
-        replaced = before.get(e.name)
-        extra += f"; replaces the pin of {replaced}" if replaced not in (None, e.log) else ""
+        was = before.get(e.name)
+        if was is not None and (was[0] != e.log or was[1] != e.log_sha256):
+            extra += f"; replaces the pin of {was[0]}" + (
+                f" (another log, sha256 {was[1][:12]})" if was[0] == e.log else "")
         click.echo(f"pinned {e.name}: {e.refreshes} refreshes{extra} ({e.log})")
     click.echo(f"wrote {Path(folder) / 'expected.json'}; check with: sgtool golden check "
                f"--dir {quoted(folder)}")
 
 
-def _pinned_logs(folder: Path) -> dict[str, str]:
+def _pinned_logs(folder: Path) -> dict[str, tuple[str, str]]:
     """Pin name -> the log it pins, of the pin folder ``folder`` (none when it holds no
     readable index): what a new pin of the same name replaces."""
     from sgtool.replayers.golden_pins import INDEX, read_pins
@@ -120,7 +122,8 @@ def _pinned_logs(folder: Path) -> dict[str, str]:
     if not (folder / INDEX).is_file():
         return {}
     try:
-        return {name: pin.log for name, pin in read_pins(folder).logs.items()}
+        return {name: (pin.log, pin.log_sha256)
+                for name, pin in read_pins(folder).logs.items()}
     except SgtoolError:
         return {}  # pin_logs says what is wrong with it
 

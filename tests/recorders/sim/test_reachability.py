@@ -78,6 +78,33 @@ def test_goal_cell_is_the_cell_the_skill_drives_to() -> None:
     assert all(0 < n < 150 for n in kinds.values()), kinds
 
 
+def test_a_stand_is_chosen_in_its_objects_room_by_both() -> None:
+    """_map's wall parts room L (a Voronoi node at (1.5, 2)) from room R (one at (4, 2)):
+    a thing on the wall's line (its stands on either side about as near) is stood at on
+    the left, the robot's side, when no room is known; as a thing of room R, on the right,
+    through the gap. The windowed goal cell and the skill's cell agree with the rooms as
+    without them."""
+    occ, dist = _map()
+    skills = LiveSkills(_Body((1.0, 2.0, 0.0), RobotConfig()), lambda: None)
+    layers = SimpleNamespace(node_rooms=("room:L", "room:R"),
+                             voronoi=SimpleNamespace(positions=np.array([[1.5, 2.0],
+                                                                         [4.0, 2.0]])))
+    thing = np.array([[3.05, 0.8]])
+    for room, side in ((None, -1.0), ("room:R", 1.0), ("room:L", -1.0)):
+        for kind in ("stand", "front"):
+            goal = Goal("obj:1", kind, thing, room)
+            cell = skills.select(goal, occ, dist, layers)  # type: ignore[arg-type]
+            assert cell is not None and math.copysign(1.0, cell[0] - 3.05) == side, (room, cell)
+            if kind == "stand":
+                assert goal_cell(skills, goal, occ, dist, layers) == cell  # type: ignore[arg-type]
+    rng = np.random.default_rng(5)
+    for xy in rng.uniform((-0.5, -0.5), (6.5, 4.5), size=(100, 2)):
+        for room in ("room:L", "room:R"):
+            goal = Goal("g", "stand", xy[None, :], room)
+            assert goal_cell(skills, goal, occ, dist, layers) == \
+                skills.select(goal, occ, dist, layers)  # type: ignore[arg-type]
+
+
 def test_a_failed_goal_waits_until_the_map_moves_it() -> None:
     f = FailedGoals(same=0.5)
     assert not f.blocks("obj:3", (1.0, 1.0))  # never failed
