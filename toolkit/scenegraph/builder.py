@@ -545,7 +545,7 @@ class SceneGraphBuilder:
             self._density = got
         density = got[2]
         seg = segment_rooms(vg, density, cfg, self._centre_memo, occ, found.unsure | cells,
-                            self._body, found.leaves)
+                            self._body, found.leaves, cells)
         numbers = self._rooms.assign([vg.positions[r] for r in seg.rooms], cfg.match_radius)
         return _Rooms(cells, density, seg, [f"room:{n}" for n in numbers], centres)
 

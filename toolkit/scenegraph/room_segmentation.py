@@ -62,7 +62,11 @@ What we do, and why it differs:
   its own (no longer component's nodes on it) of at least ``OWN_FLOOR`` times
   ``min_room_length`` squared (0.5 m^2): a room glimpsed through a doorway, or a closet or
   WC of 1.5 m (0.9 m^2 of open floor outside its door's cut zone), has little graph but
-  floor that belongs to no other room.
+  floor that belongs to no other room. Its floor must not join a longer component's
+  beside the door evidence either (a cell off the evidence, ``JOIN_SEAL`` off unsure floor
+  that is not evidence, passages ``JOIN_WIDTH`` wide): a pocket of floor at a corridor's
+  end, behind furniture, whose mouth runs past a doorway is cut off from the corridor by
+  that doorway's seal only, and is the corridor's, not a room.
 
 Room ids stay stable across refreshes (:class:`RoomTracker`): new rooms take the id of the
 previous room whose nodes they overlap most (greedy, largest overlap first), so a planner's
@@ -136,7 +140,8 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
                   occ: OccupancyGrid | None = None,
                   unsure: np.ndarray | None = None,
                   trajectory: np.ndarray | Sequence[tuple[float, float]] | None = None,
-                  leaves: np.ndarray | None = None) -> RoomSegmentation:
+                  leaves: np.ndarray | None = None,
+                  doors: np.ndarray | None = None) -> RoomSegmentation:
     """Cut ``vg`` where the door density reaches the threshold; components are rooms.
     ``centre_memo`` keeps each room's centre across calls, keyed by its sub-graph (a room
     whose sub-graph is unchanged has the same centre: the same arrays, the same Dijkstra).
@@ -147,7 +152,8 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
     ``trajectory``: (k, 2) world x, y of the robot's path: a stretch of it that stays out
     of the cut zone and that floor joins the parts it crosses (module doc);
     ``leaves``: the cells of door leaves swung into rooms (bool, ``vg.shape``), floor to
-    join by (module doc)."""
+    join by (module doc); ``doors``: the door evidence alone (bool, ``vg.shape``): a short
+    component whose floor joins a room's beside it is no room of its own."""
     cfg = config or RoomConfig()
     n, m = len(vg.positions), len(vg.edges)
     cut_e = np.zeros(m, dtype=bool)
@@ -187,7 +193,7 @@ def segment_rooms(vg: VoronoiGraph, density: np.ndarray | None,
             rooms.append(nodes)
     if occ is not None:
         rooms = _rooms_by_floor(vg, rooms, short, occ, density, cfg, unsure, trajectory,
-                                leaves)
+                                leaves, doors)
     for i, nodes in enumerate(rooms):
         labels[nodes] = i
     where = np.full(n, -1, dtype=np.int64)
@@ -202,13 +208,15 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
                     occ: OccupancyGrid, density: np.ndarray | None,
                     cfg: RoomConfig, unsure: np.ndarray | None = None,
                     trajectory: np.ndarray | Sequence[tuple[float, float]] | None = None,
-                    leaves: np.ndarray | None = None) -> list[np.ndarray]:
+                    leaves: np.ndarray | None = None,
+                    doors: np.ndarray | None = None) -> list[np.ndarray]:
     """``rooms`` (components long enough) joined where their nodes share a 4-connected part
     of the open floor (free or a door's ``leaves``, outside the cut zone and ``unsure``)
     that passages at least
     ``JOIN_WIDTH`` wide hold together, plus the ``short`` components whose parts of the
     open floor no such room touches and hold at least ``OWN_FLOOR`` times
-    ``min_room_length`` squared;
+    ``min_room_length`` squared, and (with ``doors``) whose floor beside the door evidence
+    (:func:`_beside_doors`) no such room stands on either;
     numbered by their lowest node."""
     away = np.ones(occ.shape, dtype=bool) if density is None else density < cfg.door_threshold
     if unsure is not None:  # and what lies within JOIN_SEAL of it
@@ -218,9 +226,14 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
         part, count = ndimage.label(open_floor)
         area = np.bincount(part.ravel(), minlength=count + 1) * occ.resolution ** 2
         taken = {p for nodes in rooms for p in _parts(vg, part, nodes)}
+        beside = _beside_doors(occ, doors, unsure, leaves)
+        by_side = set() if beside is None else \
+            {p for nodes in rooms for p in _parts(vg, beside, nodes)}
         rooms = rooms + [nodes for nodes in short if (mine := _parts(vg, part, nodes))
                          and not taken.intersection(mine)
-                         and area[mine].sum() >= OWN_FLOOR * cfg.min_room_length ** 2]
+                         and area[mine].sum() >= OWN_FLOOR * cfg.min_room_length ** 2
+                         and (beside is None
+                              or not by_side.intersection(_parts(vg, beside, nodes)))]
         rooms.sort(key=lambda nodes: int(nodes[0]))
     # a passage narrower than JOIN_WIDTH (a gap at a wall's end, beside a closed leaf)
     # joins nothing: k erosion steps keep passages of 2k + 1 cells and more
@@ -241,6 +254,25 @@ def _rooms_by_floor(vg: VoronoiGraph, rooms: list[np.ndarray], short: list[np.nd
     for i, nodes in enumerate(rooms):  # rooms come by lowest node: so do the groups
         groups.setdefault(int(joined[i]), []).append(nodes)
     return [np.sort(np.concatenate(g)) if len(g) > 1 else g[0] for g in groups.values()]
+
+
+def _beside_doors(occ: OccupancyGrid, doors: np.ndarray | None, unsure: np.ndarray | None,
+                  leaves: np.ndarray | None) -> np.ndarray | None:
+    """Labelled parts of the floor (free or ``leaves``) off the door evidence ``doors``
+    (a cell's margin) and ``JOIN_SEAL`` off the unsure floor that is not door evidence,
+    passages ``JOIN_WIDTH`` wide: floor a short component shares with a room there is the
+    room's, reached beside a doorway through its cut zone, not through it (a pocket of a
+    corridor's end behind furniture next to a doorway). None without ``doors``."""
+    if doors is None:
+        return None
+    floor = occ.free if leaves is None else occ.free | leaves
+    floor = floor & ~ndimage.binary_dilation(doors, structure=np.ones((3, 3), dtype=bool))
+    if unsure is not None:
+        floor &= ~within_cells(unsure & ~doors, JOIN_SEAL / occ.resolution)
+    steps = max(0, math.ceil((JOIN_WIDTH / occ.resolution - 1) / 2 - 1e-9))
+    if steps > 0:
+        floor = ndimage.binary_erosion(floor, iterations=steps, border_value=1)
+    return ndimage.label(floor)[0]
 
 
 def _walked(occ: OccupancyGrid, part: np.ndarray, away: np.ndarray,

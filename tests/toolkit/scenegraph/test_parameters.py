@@ -255,6 +255,32 @@ def test_a_short_piece_on_floor_of_its_own_is_a_room() -> None:
     assert seg.count == 1 and seg.rooms[0].tolist() == list(range(k))
 
 
+def test_a_pocket_beside_a_doorway_is_no_room_of_its_own() -> None:
+    """A 0.6 m piece of graph (short) on floor right of a wall at column 30, a 2.4 m one
+    left of it; the wall has a 0.8 m gap (rows 10-25) whose rows 10-19 hold door
+    evidence. Within JOIN_SEAL (6 cells) of the evidence the floor joins nothing, so the
+    right floor has no long piece on it and was a room of its own (a pocket at a
+    corridor's end whose mouth runs past a doorway, house 1105). Its floor joins the left
+    one beside the evidence (rows 21-25, off a cell's margin): no room. With the whole gap
+    door evidence (a closet's doorway), it is one."""
+    a_pts, a_e = chain(0.0, 0.0, 6, 0.4)
+    b_pts, b_e = chain(0.0, 3.0, 3, 0.2)
+    k = len(a_pts)
+    vg = hand_graph(a_pts + b_pts, a_e + [(i + k, j + k) for i, j in b_e])
+    cells = np.stack([np.full(k + 4, 20), np.r_[np.arange(5, 5 + k), np.arange(45, 49)]],
+                     axis=1)
+    vg = dataclasses.replace(vg, cells=cells, shape=(40, 60))
+    free = np.ones((40, 60), dtype=bool)
+    free[:, 30] = False
+    free[10:26, 30] = True
+    occ = floor(free)
+    for evidence, rooms in ((slice(10, 20), 1), (slice(10, 26), 2)):
+        door = np.zeros((40, 60), dtype=bool)
+        door[evidence, 30] = True
+        assert segment_rooms(vg, None, occ=occ, unsure=door).count == 2  # as before
+        assert segment_rooms(vg, None, occ=occ, unsure=door, doors=door).count == rooms
+
+
 # ----- hand-made Voronoi graphs ----------------------------------------------------------
 def hand_graph(positions: list[tuple[float, float]], edges: list[tuple[int, int]],
                lengths: list[float] | None = None) -> VoronoiGraph:
