@@ -169,15 +169,16 @@ def test_pieces_of_one_floor_are_one_room_centred_on_the_larger() -> None:
         assert segment_rooms(vg, None, occ=floor(gapped)).count == rooms, gap
 
 
-def two_pieces() -> VoronoiGraph:
+def two_pieces(steps: int = 4, step: float = 0.3) -> VoronoiGraph:
     """Two pieces of graph for a 40 x 60 grid with a wall at column 30: their nodes on
-    row 20, the first piece at columns 5-11, the second at 45-49."""
+    row 20, the first piece (2.4 m of edges) at columns 5-11, the second (``steps`` of
+    ``step`` m) from column 45 on."""
     a_pts, a_e = chain(0.0, 0.0, 6, 0.4)
-    b_pts, b_e = chain(0.0, 3.0, 4, 0.3)
+    b_pts, b_e = chain(0.0, 3.0, steps, step)
     k = len(a_pts)
     vg = hand_graph(a_pts + b_pts, a_e + [(i + k, j + k) for i, j in b_e])
-    cells = np.stack([np.full(k + 5, 20), np.r_[np.arange(5, 5 + k), np.arange(45, 50)]],
-                     axis=1)
+    cells = np.stack([np.full(k + steps + 1, 20),
+                      np.r_[np.arange(5, 5 + k), np.arange(45, 46 + steps)]], axis=1)
     return dataclasses.replace(vg, cells=cells, shape=(40, 60))
 
 
@@ -263,13 +264,7 @@ def test_a_pocket_beside_a_doorway_is_no_room_of_its_own() -> None:
     corridor's end whose mouth runs past a doorway, house 1105). Its floor joins the left
     one beside the evidence (rows 21-25, off a cell's margin): no room. With the whole gap
     door evidence (a closet's doorway), it is one."""
-    a_pts, a_e = chain(0.0, 0.0, 6, 0.4)
-    b_pts, b_e = chain(0.0, 3.0, 3, 0.2)
-    k = len(a_pts)
-    vg = hand_graph(a_pts + b_pts, a_e + [(i + k, j + k) for i, j in b_e])
-    cells = np.stack([np.full(k + 4, 20), np.r_[np.arange(5, 5 + k), np.arange(45, 49)]],
-                     axis=1)
-    vg = dataclasses.replace(vg, cells=cells, shape=(40, 60))
+    vg = two_pieces(3, 0.2)  # 0.6 m: short
     free = np.ones((40, 60), dtype=bool)
     free[:, 30] = False
     free[10:26, 30] = True
