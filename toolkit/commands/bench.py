@@ -26,6 +26,7 @@ from sgtool.commands.options import (
     planner_options,
     reference_planner,
     replay_files,
+    replay_sampling_note,
     shown_command,
     success_option,
 )
@@ -214,4 +215,7 @@ def _planners(args: BenchArgs) -> tuple[tuple[str, ...], dict[str, dict[str, Any
             moma["replay"] = replay_files(args.llm_replay)
         if args.llm_transcript:
             moma["transcript"] = args.llm_transcript
+    for name, given in options.items():
+        if note := replay_sampling_note(name, given):
+            click.echo(note, err=True)
     return names, options

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import difflib
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeVar
@@ -210,6 +210,19 @@ def replay_files(given: Sequence[str]) -> str | list[str]:
         else:
             raise SgtoolError(f"--llm-replay: no such transcript {g}")
     return out[0] if len(out) == 1 else out
+
+
+def replay_sampling_note(name: str, options: Mapping[str, Any]) -> str | None:
+    """A note for an LLM planner that replays a transcript (``replay``) and is given an
+    endpoint's sampling settings (``temperature``, ``max_tokens``): the transcript's
+    answers are served whatever they say, and the log records them as given."""
+    given = [f"-O {name}.{k}={options[k]}" for k in ("temperature", "max_tokens")
+             if options.get(k) is not None]
+    if not options.get("replay") or not given:
+        return None
+    return (f"sgtool: note: {', '.join(given)}: --llm-replay serves the transcript's "
+            "answers, which an endpoint's sampling settings do not change (the log records "
+            "them as given)")
 
 
 @dataclass(frozen=True)

@@ -34,6 +34,7 @@ from sgtool.commands.options import (
     look_in_option,
     peek_option,
     render_turn_option,
+    replay_sampling_note,
     run_planner_options,
     sight_lines_option,
     success_option,
@@ -249,6 +250,8 @@ def _planner(args: RunArgs) -> tuple[str, dict[str, Any]]:
         if not Path(args.llm_replay).is_file():
             raise SgtoolError(f"--llm-replay {args.llm_replay}: no such file")
         options["replay"] = args.llm_replay
+    if note := replay_sampling_note(name, options):
+        click.echo(note, err=True)
     if args.llm_transcript:
         if args.llm_replay and Path(args.llm_replay).resolve() == \
                 Path(args.llm_transcript).resolve():

@@ -299,6 +299,16 @@ def test_moma_llm_transcript_then_replay(tmp_path):
     assert r.exit_code == 0, r.output
     replayed = read_jsonl(tmp_path / "o" / "episodes.jsonl")
     assert results_digest(replayed) == live.digest
+    assert "sgtool: note:" not in r.output
+    # an endpoint's sampling setting changes no answer of a replay: a note says so
+    r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
+                                 "--episodes", "2", "--seeds", "1", "--no-progress",
+                                 "--llm-replay", str(transcript), "-O",
+                                 "moma-llm.temperature=0.7", "-o", str(tmp_path / "t")])
+    assert r.exit_code == 0, r.output
+    assert ("sgtool: note: -O moma-llm.temperature=0.7: --llm-replay serves the transcript's "
+            "answers") in r.output
+    assert results_digest(read_jsonl(tmp_path / "t" / "episodes.jsonl")) == live.digest
     # several transcripts (repeated, or a folder of them) serve as one
     lines = transcript.read_text().splitlines(keepends=True)
     parts = tmp_path / "parts"
