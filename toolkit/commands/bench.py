@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
+from sgtool.commands.llm_replay_options import replay_files, replay_sampling_note
 from sgtool.commands.options import (
     PLANNER_OPTION_HELP,
     PLANNERS_HELP,
@@ -25,8 +26,6 @@ from sgtool.commands.options import (
     planner_names,
     planner_options,
     reference_planner,
-    replay_files,
-    replay_sampling_note,
     shown_command,
     success_option,
 )

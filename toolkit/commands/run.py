@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import click
 from click.core import ParameterSource
 
+from sgtool.commands.llm_replay_options import replay_sampling_note
 from sgtool.commands.options import (
     FINITE_FLOAT,
     PLUGIN_HELP_ONE,
@@ -34,7 +35,6 @@ from sgtool.commands.options import (
     look_in_option,
     peek_option,
     render_turn_option,
-    replay_sampling_note,
     run_planner_options,
     sight_lines_option,
     success_option,

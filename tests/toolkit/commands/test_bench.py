@@ -409,7 +409,7 @@ def test_a_replay_folder_skips_logs_without_exchanges(tmp_path):
     one line."""
     from support.logfixtures import synthetic_frame
 
-    from sgtool.commands.options import replay_files
+    from sgtool.commands.llm_replay_options import replay_files
     from sgtool.errors import SgtoolError
     from sgtool.log import LogWriter
 
