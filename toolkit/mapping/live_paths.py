@@ -89,11 +89,18 @@ def traversable(grid: OccupancyGrid, robot_radius: float, optimistic: float = 0.
     return OccupancyMap(grid, blocked, robot_radius)
 
 
-def _cells_of(occ: OccupancyMap, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _grid_cells(occ: OccupancyMap, points: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(rows, cols, on the grid) of every point (world x, y)."""
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
     rows = np.floor((pts[:, 1] - occ.origin[1]) / occ.resolution).astype(np.int64)
     cols = np.floor((pts[:, 0] - occ.origin[0]) / occ.resolution).astype(np.int64)
     ok = (rows >= 0) & (rows < occ.shape[0]) & (cols >= 0) & (cols < occ.shape[1])
+    return rows, cols, ok
+
+
+def _cells_of(occ: OccupancyMap, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    rows, cols, ok = _grid_cells(occ, points)
     return rows[ok], cols[ok]
 
 
@@ -270,9 +277,7 @@ def nearest_along_floor(occ: OccupancyMap, points: np.ndarray) -> np.ndarray:
     out = np.full(occ.shape, -1, dtype=np.int64)
     occ._cache[key] = out  # filled in below; read it, never change it
     g, index, flat = free_cell_graph(occ)
-    rows = np.floor((pts[:, 1] - occ.origin[1]) / occ.resolution).astype(np.int64)
-    cols = np.floor((pts[:, 0] - occ.origin[0]) / occ.resolution).astype(np.int64)
-    on = (rows >= 0) & (rows < occ.shape[0]) & (cols >= 0) & (cols < occ.shape[1])
+    rows, cols, on = _grid_cells(occ, pts)
     source_of: dict[int, int] = {}
     for i in np.flatnonzero(on):
         node = int(index[rows[i], cols[i]])
