@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable, Collection, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -75,8 +75,9 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
                           if r.success and not j.success})
     symbolic = {lg.source for lg in logged if lg.episode.source == "symbolic"}
     results, profiles = per_noise(judged, symbolic)  # (fills the noise a row's folder names)
+    results, split = per_options(results, bool(profiles))
     results, twice = once_each(results)
-    notes = [*notes, *twice]
+    notes = [*notes, *split, *twice]
     if unconfirmed:  # runs made under "observed": their planners never had to call done
         notes = [*notes, f"--success {request.success}: successes of {', '.join(unconfirmed)} "
                  "that end without done() naming an object count as failures (a run made "
@@ -167,9 +168,50 @@ def per_noise(results: Sequence[EpisodeResult], symbolic_logs: Collection[str] =
         profiles
 
 
+def per_options(results: Sequence[EpisodeResult], noisy: bool = False
+                ) -> tuple[list[EpisodeResult], list[str]]:
+    """``results`` with each planner named ``PLANNER(KEY=VALUE,...)`` when one planner
+    ran with more than one set of options (:attr:`EpisodeResult.options` as the planner
+    takes them, an option at its default being none:
+    :func:`sgtool.planning.registry.effective_options`; ``PLANNER()``: its defaults), and a
+    note naming those sets (none: names kept): runs of other options are not pooled.
+    ``noisy``: the names end in the `` [NOISE]`` of :func:`per_noise`, kept last."""
+    tails = [f" [{r.noise or 'unknown'}]" if noisy else "" for r in results]
+    bases = [r.planner.removesuffix(t) for r, t in zip(results, tails, strict=True)]
+    labels = [_options_label(b, r.options) for b, r in zip(bases, results, strict=True)]
+    sets: dict[str, list[str]] = {}
+    for b, lab in zip(bases, labels, strict=True):
+        if lab not in sets.setdefault(b, []):
+            sets[b].append(lab)
+    split = {b for b, labs in sets.items() if len(labs) > 1}
+    if not split:
+        return list(results), []
+    out = [replace(r, planner=f"{b}({lab}){t}") if b in split else r
+           for r, b, lab, t in zip(results, bases, labels, tails, strict=True)]
+    shown = "; ".join(f"{b}: " + ", ".join(f"{b}({lab})" for lab in sets[b])
+                      for b in sorted(split))
+    return out, [f"planners ran with more than one set of options ({shown}): each set is "
+                 "scored as a planner of its own"]
+
+
+def _options_label(planner: str, options: Mapping[str, Any]) -> str:
+    """``KEY=VALUE,...`` of the options ``planner`` takes from ``options`` (sorted;
+    those at their defaults left out; as recorded when the planner cannot be asked)."""
+    from sgtool.planning.registry import effective_options
+    from sgtool.redact import options_as_text
+
+    try:
+        taken = effective_options(planner, options) if options else {}
+    except Exception:  # noqa: BLE001 - a plug-in not importable here, a value it refuses now
+        taken = dict(options)
+    text = options_as_text({planner: taken}).get(planner, {})
+    return ",".join(f"{k}={v}" for k, v in sorted(text.items()))
+
+
 def _episode_key(r: EpisodeResult) -> tuple[str, str, int, int, str, str]:
-    """What names one run of a planner: planner, house, episode, seed, query (generated
-    houses of other sizes share their names, house-0, but not their queries) and noise."""
+    """What names one run of a planner: planner (with its options when
+    :func:`per_options` told them apart), house, episode, seed, query (generated houses
+    of other sizes share their names, house-0, but not their queries) and noise."""
     return (r.planner, r.house, r.episode, r.seed, category_text(r.query), r.noise or "")
 
 

@@ -7,8 +7,8 @@ turned into one by :func:`result_from_log_records` from its typed ``sgtool.Episo
 
 Determinism: everything in a record is derived data except the ``wall`` mapping (decision
 and episode wall-clock seconds). Two runs of one command give the same JSONL bytes except
-inside ``wall``; :func:`results_digest` hashes the records with ``wall`` left out, so it is
-the figure to compare between runs.
+inside ``wall``; :func:`results_digest` hashes the records with ``wall`` (and the planners'
+``options``) left out, so it is the figure to compare between runs.
 """
 
 from __future__ import annotations
@@ -65,7 +65,11 @@ class EpisodeResult:
       record, for other planners, so their records are as before;
     - ``noise``: the sensor noise profile of a closed-loop episode (its name: ``none``,
       ``strong``, ``mild,holes=0.05``, ...; empty, and absent from the record, when not
-      known, as in the symbolic bench).
+      known, as in the symbolic bench);
+    - ``options``: the planner's options as the run recorded them
+      (:func:`sgtool.redact.recorded_options`: JSON values, secrets left out); empty, and
+      absent from the record, for a planner run with its defaults. Two runs of one planner
+      name with other options are two planners to ``sgtool eval``.
     """
 
     planner: str
@@ -87,6 +91,7 @@ class EpisodeResult:
     wall: Mapping[str, float] = field(default_factory=dict)
     llm_answers: Mapping[str, int] = field(default_factory=dict)
     noise: str = ""
+    options: Mapping[str, Any] = field(default_factory=dict)
 
     @property
     def decision_s(self) -> float:
@@ -124,6 +129,7 @@ class EpisodeResult:
             **({"llm_answers": {k: int(v) for k, v in sorted(self.llm_answers.items())}}
                if self.llm_answers else {}),
             **({"noise": self.noise} if self.noise else {}),
+            **({"options": dict(sorted(self.options.items()))} if self.options else {}),
         }
 
     def to_json(self) -> str:
@@ -164,10 +170,19 @@ class EpisodeResult:
             wall=dict(d.get("wall", {})),
             llm_answers={str(k): int(v) for k, v in (d.get("llm_answers") or {}).items()},
             noise=str(d.get("noise") or ""),
+            options=_options(d),
         )
 
 
 _ABSENT = object()
+
+
+def _options(d: Mapping[str, Any]) -> dict[str, Any]:
+    """A record's ``options``: a JSON object (absent or null: none)."""
+    value = d.get("options") or {}
+    if not isinstance(value, dict):
+        raise ResultsFormatError(f"options: expected an object, got {json.dumps(value)}")
+    return {str(k): v for k, v in value.items()}
 
 
 def _field(d: Mapping[str, Any], key: str, default: Any) -> Any:
@@ -269,11 +284,14 @@ def source_log(result: EpisodeResult, table: str | os.PathLike[str]) -> Path | N
 
 
 def results_digest(results: Sequence[EpisodeResult]) -> str:
-    """SHA-256 over the canonical records without their ``wall`` figures."""
+    """SHA-256 over the canonical records without their ``wall`` figures and ``options``
+    (what the planners did, not how they were set: a replay of an LLM planner's transcript
+    digests as its live run)."""
     h = hashlib.sha256()
     for r in results:
         d = r.to_dict()
         d.pop("wall")
+        d.pop("options", None)
         h.update(json.dumps(d, sort_keys=True, separators=(",", ":")).encode())
         h.update(b"\n")
     return h.hexdigest()
@@ -301,7 +319,8 @@ def result_from_log_records(episode: Episode, actions: Sequence[Action],
     ``steps``, ``travelled_m``, ``shortest_m``, ``query``, ``planner``, ``house_id``) and
     the episode's ``sgtool.Action`` records (``skill``, ``target``, ``outcome``,
     ``travelled_m``, ``decision_time_s``). From ``extra`` it reads, when present: ``seed``
-    (int), ``episode`` (int), ``seen`` (bool), ``end`` (str), ``n_open`` (int).
+    (int), ``episode`` (int), ``seen`` (bool), ``end`` (str), ``n_open`` (int),
+    ``planner_options`` (an object: the result's ``options``).
 
     Derived when absent: ``n_open`` = actions with skill "open" and outcome "success";
     ``n_invalid`` / ``n_failure`` = actions with that outcome; ``steps`` = the actions a
@@ -320,6 +339,7 @@ def result_from_log_records(episode: Episode, actions: Sequence[Action],
     decision_s = sum(float(given(a.decision_time_s, 0.0)) for a in actions)
     seen = extra.get("seen")
     shortest = given(episode.shortest_m)
+    options = extra.get("planner_options")
     return EpisodeResult(
         planner=str(given(episode.planner) or next(
             (a.planner for a in actions if given(a.planner)), "unknown")),
@@ -339,6 +359,7 @@ def result_from_log_records(episode: Episode, actions: Sequence[Action],
         source=source,
         trace=trace,
         wall={"decision_s": decision_s, "decisions": float(len(actions))},
+        options=dict(options) if isinstance(options, Mapping) else {},
     )
 
 

@@ -127,6 +127,7 @@ def run_episode(house: SymbolicHouse, planner: Planner, query: str, targets: Seq
         wall={"decision_s": sum(s.decision_s for s in steps), "decisions": float(len(steps)),
               "episode_s": time.perf_counter() - t_start},
         llm_answers=answer_counts(ex for s in steps for ex in s.exchanges),
+        options=recorded_options(planner_options) if planner_options else {},
     )
     if recorder is not None:
         recorder.close(len(steps), env, shortest, {
