@@ -30,9 +30,10 @@ from typing import Any
 
 from sgtool.errors import SgtoolError, SpecError
 from sgtool.files import quoted
+from sgtool.house.consistency import wall_gaps
 from sgtool.house.geometry import distance_to_polygon
 from sgtool.house.io import house_file_id
-from sgtool.house.spec import HouseSpec
+from sgtool.house.spec import HouseSpec, SpecLimits
 from sgtool.semantics.text import category_text
 
 
@@ -225,6 +226,18 @@ def symbolic_house(spec: HouseSpec, where: str | os.PathLike[str]) -> tuple[Any,
 DOOR_GAP = 0.02  # m between a door's two rooms: any gap is floor of neither (rounding)
 
 
+def _classifier_room_types() -> frozenset[str]:
+    """The room types (category text) the shipped priors' room classifier names; empty when
+    their metadata cannot be read."""
+    from sgtool.semantics.priors import METADATA_FILE, weights_folder
+
+    try:
+        meta = json.loads((weights_folder(None) / METADATA_FILE).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return frozenset()
+    return frozenset(category_text(t) for t in meta.get("room_types", ()))
+
+
 def house_notes(house: Any) -> tuple[str, ...]:
     """What a user should know of a house that loads: doors furniture blocks (read as
     walls), rooms walled off from the rest (their targets are searched from inside, the
@@ -319,6 +332,18 @@ def house_notes(house: Any) -> tuple[str, ...]:
                      f"less than the robot's radius ({house.robot_radius:g} m): the simulator "
                      "starts the robot at the nearest place clear of it")
     notes += unreachable_notes(spec)
+    for j, i, gap, (gx, gy) in wall_gaps(spec, SpecLimits().opening_offset):
+        notes.append(f"the walls between {spec.rooms[j].id} and {spec.rooms[i].id} have a "
+                     f"{gap:.2f} m gap at ({gx:.2f}, {gy:.2f}) beside their door(s) or "
+                     "passage(s): a hole in the wall the robot passes through, closed doors "
+                     "or not (add a wall, or widen the opening)")
+    named = _classifier_room_types()
+    odd = sorted({r.category for r in spec.rooms} - {
+        r.category for r in spec.rooms if category_text(r.category) in named})
+    if named and odd:
+        notes.append(f"room categories {', '.join(map(repr, odd))}: not a room type the "
+                     "replay's room classifier names, so `replay --score` counts every such "
+                     "room's category wrong; its types: " + ", ".join(sorted(named)))
     for ri in house.niches:
         notes.append(f"{spec.rooms[ri].id}: no free floor the robot (radius "
                      f"{house.robot_radius:g} m) fits on: the symbolic bench searches it from "

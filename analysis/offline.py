@@ -255,15 +255,16 @@ def _accepted(r: EpisodeResult, where: str, notes: list[str]) -> bool:
 
 
 def with_seen(r: EpisodeResult) -> EpisodeResult:
-    """A log that does not say whether its query is seen: decide it from the split (the
-    query is unseen when it is one of :func:`sgtool.datasets.split.unseen_queries`)."""
+    """A log that does not say whether its query is seen: decide it as `sgtool bench`
+    does (seen when it is one of the shipped priors' training queries,
+    :func:`sgtool.analysis.bench_priors.training_vocabulary`), so a house file's own
+    names ("yoga mat") are unseen in both."""
     if r.seen is not None or not r.query:
         return r
-    from sgtool.datasets.split import unseen_queries
+    from sgtool.analysis.bench_priors import training_vocabulary
     from sgtool.semantics.text import category_text
 
-    unseen = {category_text(q) for q in unseen_queries()}
-    return _replace(r, seen=category_text(r.query) not in unseen)
+    return _replace(r, seen=category_text(r.query) in training_vocabulary(None))
 
 
 # ----------------------------------------------------------------------------------------

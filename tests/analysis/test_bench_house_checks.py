@@ -168,3 +168,22 @@ def test_a_front_blocked_by_a_piece_of_a_corner_says_to_move_that_piece() -> Non
     fronts = [n for n in house_notes(house) if "cannot look into it" in n]
     assert bad is None and fronts
     assert all("(move furn_" in n and "yaw + pi" not in n for n in fronts)
+
+
+def test_a_hole_in_the_wall_beside_a_closed_door_is_noted(tmp_path: Path) -> None:
+    """The cottage's closed bedroom door with the wall north of it left out (a 1.55 m hole
+    from y 2.45 to 4, centre 3.225): the robot walks past the closed door; `scenes check`
+    says where. The cottage as written (walls up to both door jambs) has no such note, and room
+    categories the replay's classifier never names are noted too."""
+    doc = cottage()
+    doc["walls"] = [w for w in doc["walls"] if w["a"] != [6, 2.45]]
+    doc["rooms"][0]["category"] = "Lounge"
+    f = write_cottage(tmp_path, "holed.json", walls=doc["walls"], rooms=doc["rooms"])
+    r = CliRunner().invoke(cli, ["scenes", "check", str(f), str(write_cottage(tmp_path))])
+    assert r.exit_code == 0, r.output
+    holed, whole = r.output.split("ok ")[1:]
+    assert "the walls between room_bed and room_hall have a 1.55 m gap at (6.00, 3.22) " \
+        "beside their door(s)" in holed
+    assert "room categories 'Lounge': not a room type the replay's room classifier names" \
+        in holed and "living room" in holed
+    assert "gap" not in whole and "room categories" not in whole

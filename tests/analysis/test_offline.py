@@ -181,18 +181,21 @@ def test_bench_logs_round_trip_through_eval(tmp_path):
     assert rep.decisions == sum(r.steps for r in bench.results) and rep.rate("agree") == 1.0
 
 
-def test_seen_is_filled_from_the_split_when_a_log_lacks_it(tmp_path):
+def test_seen_is_filled_as_bench_does_when_a_log_lacks_it(tmp_path):
+    """Seen = a training query of the shipped priors, as `sgtool bench` counts it: an
+    unseen query of the split and a house file's own name ("yoga mat") are unseen."""
+    from sgtool.analysis.bench_priors import training_vocabulary
     from sgtool.datasets.split import unseen_queries
 
     unseen = unseen_queries()[0]
     path = tmp_path / "q.mcap"
     with LogWriter(path) as log:
-        for t, q in enumerate(("cup", unseen)):
+        for t, q in enumerate((sorted(training_vocabulary(None))[0], unseen, "yoga mat")):
             log.write_record("episode", 2 * t, {"kind": "search", "status": "started",
                                                 "query": q})
             log.write_record("episode", 2 * t + 1, {"kind": "search", "status": "failure"})
     results, _ = load_results([path])
-    assert [r.seen for r in results] == [True, False]
+    assert [r.seen for r in results] == [True, False, False]
 
 
 def test_a_ros2_mcap_with_sgtool_topic_names_is_called_foreign(tmp_path):

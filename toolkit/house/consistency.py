@@ -22,6 +22,7 @@ everything else is linear in the number of entries times the polygon sizes.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -181,6 +182,19 @@ def _openings_clear(spec: HouseSpec) -> None:
 
 def _gaps_have_openings(spec: HouseSpec) -> None:
     """A gap in the walls between two rooms is a door or a passage of the spec."""
+    for j, i, gap, (gx, gy) in wall_gaps(spec):
+        raise SpecError(f"rooms[{j}]: the walls between {spec.rooms[j].id} and "
+                        f"{spec.rooms[i].id} have a {gap:.2f} m gap at ({gx:.2f}, "
+                        f"{gy:.2f}) but no door or passage joins them")
+
+
+def wall_gaps(spec: HouseSpec, beside: float | None = None
+              ) -> Iterator[tuple[int, int, float, tuple[float, float]]]:
+    """The gaps of at least 0.3 m in the walls along the shared border of two rooms, as
+    (room index j, room index i < j, the longest gap's length in m, its centre): between
+    rooms no door or passage joins (``beside`` None), else between joined rooms beside
+    their openings (each of the pair's doors and passages covering the border within
+    ``beside`` m of its segment): a hole in the wall a closed door does not close."""
     if not spec.walls:
         return
     rooms, graph = spec.rooms, spec.room_graph()
@@ -188,23 +202,25 @@ def _gaps_have_openings(spec: HouseSpec) -> None:
     boxes = _boxes([(min(a[0], b[0]) - h, min(a[1], b[1]) - h, max(a[0], b[0]) + h,
                      max(a[1], b[1]) + h) for a, b, h in walls])
     near_by = [r.bounds for r in rooms]
+    openings = [o for _, ops in _openings(spec) for o in ops]
     t = _BORDER_TOL
     for j in range(len(rooms)):
         for i in range(j):
             a, b = near_by[i], near_by[j]
             if a[0] > b[2] + t or b[0] > a[2] + t or a[1] > b[3] + t or b[1] > a[3] + t \
-                    or rooms[i].id in graph[rooms[j].id]:
+                    or (rooms[i].id in graph[rooms[j].id]) != (beside is not None):
                 continue
+            pair = {rooms[i].id, rooms[j].id}
+            spans = [] if beside is None else [
+                (*o.segment, beside) for o in openings if set(o.rooms) == pair]
             for p, q in shared_borders(rooms[j].polygon, rooms[i].polygon, t):
                 x0, x1 = min(p[0], q[0]) - t, max(p[0], q[0]) + t
                 y0, y1 = min(p[1], q[1]) - t, max(p[1], q[1]) + t
                 near = np.flatnonzero((boxes[:, 0] <= x1) & (x0 <= boxes[:, 2])
                                       & (boxes[:, 1] <= y1) & (y0 <= boxes[:, 3]))
-                gap, (gx, gy) = longest_uncovered(p, q, [walls[k] for k in near], t)
+                gap, where = longest_uncovered(p, q, [walls[k] for k in near] + spans, t)
                 if gap >= _MIN_GAP:
-                    raise SpecError(f"rooms[{j}]: the walls between {rooms[j].id} and "
-                                    f"{rooms[i].id} have a {gap:.2f} m gap at ({gx:.2f}, "
-                                    f"{gy:.2f}) but no door or passage joins them")
+                    yield j, i, gap, where
 
 
 def _rooms_apart(spec: HouseSpec, tolerance: float) -> None:

@@ -269,7 +269,8 @@ class _Parser:
         if v <= 0:
             raise SpecError(f"{where}.{key}: must be > 0, got {v}")
         if v > limit:
-            raise SpecError(f"{where}.{key}: {v} is more than the limit of {limit:g}")
+            raise SpecError(f"{where}.{key}: {v} is more than the limit of {limit:g} m"
+                            f"{_METRES}")
         return v
 
     def size(self, where: str, v: Any, limit: float) -> Vec3:
@@ -277,7 +278,8 @@ class _Parser:
         if min(size) <= 0:
             raise SpecError(f"{where}: every side must be > 0, got {list(size)}")
         if max(size) > limit:
-            raise SpecError(f"{where}: {list(size)} has a side over the limit of {limit:g} m")
+            raise SpecError(f"{where}: {list(size)} has a side over the limit of {limit:g} m"
+                            f"{_METRES}")
         return size
 
     def room_ref(self, where: str, v: Any) -> str:
@@ -424,6 +426,9 @@ class _Parser:
                          room=self.room_ref(f"{where}.room", _required(where, x, "room")))
 
 
+_METRES = " (lengths are in metres: a file written in centimetres? divide by 100)"
+
+
 def _short(v: Any, n: int = 40) -> str:
     """``repr`` of a value cut to ``n`` characters (a 10^400 integer or a 100,000-character
     string is named, not printed)."""
@@ -454,7 +459,9 @@ def _unique_ids(key: str, items: Iterable[Any], prefix: str) -> set[str]:
         if problem:
             raise SpecError(f"{key}[{i}].id: {_short(it.id)} {problem}")
         if not it.id.startswith(prefix):
-            raise SpecError(f"{key}[{i}].id: {it.id!r} should start with {prefix!r}")
+            raise SpecError(f"{key}[{i}].id: {it.id!r} should start with {prefix!r} (every "
+                            "id starts with its section's prefix: room_, wall_, door_, pass_, "
+                            "furn_, obj_; e.g. 'room_kitchen')")
         if it.id in seen:
             raise SpecError(f"{key}[{i}].id: duplicate id {it.id!r}")
         seen.add(it.id)

@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sgtool.semantics.text import category_text
+
 Polygon = Sequence[tuple[float, float]]
 
 
@@ -137,10 +139,11 @@ def evaluate(node_xy: np.ndarray, node_rooms: Sequence[str | None],
     obj_ari = adjusted_rand_index([object_rooms[o] for o in scored],
                                   [m(object_gt[o]) for o in scored]) if scored else 0.0
     gt_cat: dict[str | None, set[str]] = {}
-    for r, c in gt_categories.items():
-        gt_cat.setdefault(m(r), set()).add(c)
+    for r, c in gt_categories.items():  # "Living Room" and "living_room" read the same
+        gt_cat.setdefault(m(r), set()).add(category_text(c))
     # a merged open-plan room may be called by any of its parts' categories
-    cat_ok = [room_categories[r] in gt_cat.get(majority.get(r), set()) for r in rooms]
+    cat_ok = [category_text(room_categories[r]) in gt_cat.get(majority.get(r), set())
+              for r in rooms]
     return Quality(
         gt_rooms=len(gt_all), gt_rooms_seen=len(seen), rooms=len(rooms),
         room_count_error=len(rooms) - len(seen), purity=float(purity), ari=float(ari),

@@ -99,13 +99,18 @@ def _obj(d: dict, oid: str) -> dict:
     (lambda d: d["furniture"][1].__setitem__("center", [3.6, 3.6, 0.45]),
      "furniture[1].size: a corner (4.20, 3.30) is 0.20 m outside its room room_kitchen"),
     (lambda d: d["furniture"][1].__setitem__("size", [1000, 0.6, 0.9]),
-     "furniture[1].size: [1000.0, 0.6, 0.9] has a side over the limit of 20 m"),
+     "furniture[1].size: [1000.0, 0.6, 0.9] has a side over the limit of 20 m (lengths are "
+     "in metres"),
     (lambda d: d["walls"][0].__setitem__("b", [1e9, 0]),
      "walls[0].b[0]: 1000000000.0 is out of range"),
     (lambda d: d["doors"][0].__setitem__("width", 1e6),
      "doors[0].width: 1000000.0 is out of range"),
     (lambda d: d["doors"][0].__setitem__("width", 900),
-     "doors[0].width: 900.0 is more than the limit of 5"),
+     "doors[0].width: 900.0 is more than the limit of 5 m (lengths are in metres: a file "
+     "written in centimetres? divide by 100)"),
+    (lambda d: d["rooms"][0].__setitem__("id", "kitchen"),
+     "rooms[0].id: 'kitchen' should start with 'room_' (every id starts with its section's "
+     "prefix: room_, wall_, door_, pass_, furn_, obj_; e.g. 'room_kitchen')"),
     (lambda d: d["rooms"][1].__setitem__("polygon", [[4, 0], [800, 0], [800, 4], [4, 4]]),
      "rooms: the house spans 800 m x 4 m, more than the limit of 100 m"),
     (lambda d: d["furniture"][0].__setitem__("center", [10 ** 400, 0.35, 0.5]),

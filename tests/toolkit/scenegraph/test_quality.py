@@ -86,3 +86,13 @@ def test_a_map_moved_by_drift_keeps_its_objects_rooms_ari() -> None:
     # objects put in other rooms do move it
     wrong = evaluate(xy, rooms, cats, {**objects, "obj:2": "room:2"}, gt, SQUARES, CATS)
     assert wrong.object_ari < 1.0
+
+
+def test_room_categories_that_read_the_same_are_one() -> None:
+    """A house file that spells its rooms "Living Room" and "Bedroom": the classifier's
+    living_room and bedroom are right (they scored 0.0 when compared as strings)."""
+    xy = np.array([[5.0, 2.0], [9.0, 2.0]])
+    q = evaluate(xy, ["room:0", "room:1"], {"room:0": "living_room", "room:1": "bedroom"},
+                 object_rooms={}, object_gt={}, polygons=SQUARES,
+                 gt_categories={**CATS, "room_1": "Living Room", "room_2": "Bedroom"})
+    assert q.category_accuracy == 1.0
