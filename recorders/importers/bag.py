@@ -137,6 +137,16 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
                 if not estimate:
                     raise
                 # estimating anyway: the bag's poses were only wanted as the reference
+        if (opts.depth is not None and src is not None and src.tree is not None
+                and src.track is None and not src.tree.sample_times(src.world, src.camera)):
+            # /tf_static links alone (a camera driver's mounts, a camera recorded alone)
+            # would pose every image the same
+            if not estimate:
+                raise SgtoolError(
+                    f"{path}: {src.describe} has static links only (/tf_static): every "
+                    "frame would get the same pose; give --tf-frames WORLD:CAMERA through a "
+                    "moving /tf link, --pose TOPIC, or --estimate-poses")
+            src = None  # no reference to measure the drift against
         kind = f"bag/{B.bag_kind(path)}"
         meta = {
             "source": path.resolve().name,

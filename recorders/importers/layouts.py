@@ -490,6 +490,7 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
     per_frame = pose_folder(root) if traj is None else None
     slot: dict[Path, float] = {}  # frame i stays at i/fps when frames before it are left out
     numbered = frame_slots([d for d, _ in pairs], depths + (colors if matched else []))
+    holes: list[Path] = []
     if numbered is not None:  # times by number: a frame left out keeps later ones in place
         slot = numbered
         holes = [d for d, e in zip(depths, depths[1:], strict=False)
@@ -528,6 +529,16 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
         read = trajectory_poses(traj, len(pairs), hint, shorter=True) \
             if traj is not None else None
         poses = None if read is None else list(read)
+        if read is not None and len(read) < len(pairs) and (holes or (unpaired and matched)):
+            # a short trajectory's blocks go to the frames in order: with frames missing
+            # from the numbering, which frames they pose is unclear (those of the image
+            # names, or of the images there are)
+            assert traj is not None
+            which = (f"no depth image for {by_stem[unpaired[0]].relative_to(root)}"
+                     if unpaired and matched else f"a gap after {holes[0].relative_to(root)}")
+            raise SgtoolError(f"{traj}: {len(read)} poses for {len(pairs)} frames with frames "
+                              f"missing from the numbering ({which}): which frames its poses "
+                              "belong to is unclear; give one pose per frame")
         start = open3d_log_first_frame(traj) if traj is not None and poses is not None \
             and len(poses) < len(pairs) and is_open3d_log(traj) else 0
         head = pair_name(pairs[0][0]) if start else ""  # "2": numbered as recorded

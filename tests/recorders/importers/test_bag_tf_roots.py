@@ -87,3 +87,20 @@ def test_a_camera_with_no_world_in_its_tree_is_told_to_estimate_poses(tmp_path):
     with pytest.raises(SgtoolError, match="no frame named like a world .* the bag holds no "
                        "camera trajectory; give --tf-frames WORLD:CAMERA, or --estimate-poses"):
         import_bag(tmp_path / "b", tmp_path / "o.mcap", options(frames))
+
+
+def test_a_tree_of_static_links_only_is_refused_not_posed_once(tmp_path):
+    """A camera driver's mounts alone (map -> camera_link -> cam on /tf_static, nothing on
+    /tf): every frame got the one static pose, exit 0. Now one line naming the ways out;
+    with --estimate-poses the bag's tree is no reference and the frames are estimated."""
+    frames = frames_of(4)
+    write_bag(tmp_path / "b", frames, lambda P: [("map", "camera_link", frames[0].pose),
+                                                 ("camera_link", "cam", np.eye(4))], "cam",
+              static=True)
+    out = tmp_path / "o.mcap"
+    with pytest.raises(SgtoolError, match=r"static links only \(/tf_static\): every frame "
+                       r"would get the same pose; give --tf-frames WORLD:CAMERA through a "
+                       r"moving /tf link, --pose TOPIC, or --estimate-poses$"):
+        import_bag(tmp_path / "b", out, options(frames))
+    assert not out.exists()
+    assert import_bag(tmp_path / "b", out, options(frames, estimate_poses=True)).frames == 4

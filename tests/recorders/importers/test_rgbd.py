@@ -605,6 +605,17 @@ def test_a_trajectory_that_stops_early_leaves_the_later_frames_out(rgbd_data, tm
     log.write_text("\n".join(lines[:5 * 200]) + "\n")  # 11 short: a note only
     rep = import_rgbd(folder, tmp_path / "c.mcap", RgbdOptions(**QUIET, every=10))
     assert rep.frames == 20 and any("11 of 211 frames come after" in n for n in rep.notes)
+    # a frame missing from the numbering (its depth image, or both images): the blocks,
+    # handed to the frames in order, posed every later frame with the block before its own
+    (folder / "depth" / "00008.png").unlink()
+    with pytest.raises(SgtoolError, match=r"200 poses for 210 frames with frames missing "
+                       r"from the numbering \(no depth image for image/00008.jpg\): which "
+                       r"frames its poses belong to is unclear; give one pose per frame$"):
+        import_rgbd(folder, tmp_path / "d.mcap", RgbdOptions(**QUIET))
+    (folder / "image" / "00008.jpg").unlink()
+    with pytest.raises(SgtoolError, match=r"\(a gap after depth/00007.png\)"):
+        import_rgbd(folder, tmp_path / "e.mcap", RgbdOptions(**QUIET))
+    assert not (tmp_path / "d.mcap").exists() and not (tmp_path / "e.mcap").exists()
 
 
 def test_a_trajectory_that_starts_late_poses_the_frames_it_names(rgbd_data, tmp_path):
