@@ -13,7 +13,8 @@
   (7-Scenes depth is not registered to colour; the mapping uses depth only.)
 - ``open3d`` (Open3D reconstruction system / Redwood): ``color/`` (or ``image/``, ``rgb/``)
   and ``depth/`` folders of images paired by name, a ``.log`` trajectory (camera-to-world)
-  and an intrinsics JSON (``intrinsic_matrix``); depth in mm. Without a JSON, the PrimeSense
+  and an intrinsics JSON (``intrinsic_matrix``) or text file named for them
+  (``intrinsics.txt``: a 3x3 camera matrix); depth in mm. Without one, the PrimeSense
   default 525, 525, 319.5, 239.5 that Open3D itself assumes. Frames are ``1/fps`` apart, in
   natural name order ("2.png" before "10.png", as Open3D's ``sorted_alphanum``); images
   named by plain numbers are at their number's time (a frame missing from the numbering
@@ -573,8 +574,8 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
         else:
             dropped, pairs = dropped + late, pairs[:len(poses)]
     intr = folder_intrinsics(root)
-    for p in sorted(root.glob("*.json")) if intr is None else ():
-        if is_intrinsics_json(p):
+    for p in sorted([*root.glob("*.json"), *root.glob("*.txt")]) if intr is None else ():
+        if is_intrinsics_json(p) if p.suffix == ".json" else "intrinsic" in p.name.lower():
             intr = replace(read_intrinsics_file(p), source=f"file {p.name}")
             break
     frames = tuple(

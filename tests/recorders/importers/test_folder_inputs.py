@@ -651,3 +651,17 @@ def test_a_tum_folder_missing_a_list_is_named_not_read_as_another_layout(tmp_pat
     (other / "depth.txt").unlink()  # rgb.txt alone (a validation sequence): TUM too
     with pytest.raises(SgtoolError, match="not a TUM RGB-D folder .*: no depth.txt"):
         read_sequence(other)
+
+
+@pytest.mark.parametrize("text", ["600 0 16\n0 600 12\n0 0 1\n", "600,0,16\n0,600,12\n0,0,1\n"])
+def test_an_intrinsics_text_file_in_an_open3d_folder_is_read(tmp_path: Path, text) -> None:
+    """An intrinsics.txt beside the images (a 3x3 camera matrix) was passed over for
+    the PrimeSense default; it is read as --intrinsics reads a file. A text file named for
+    something else is not."""
+    root = open3d_folder(tmp_path / "f", [str(i) for i in range(3)])
+    (root / "notes.txt").write_text("recorded on a Tuesday\n")
+    assert read_sequence(root).intrinsics.fx == 525.0  # the PrimeSense default
+    (root / "intrinsics.txt").write_text(text)
+    k = read_sequence(root).intrinsics
+    assert (k.fx, k.fy, k.cx, k.cy, k.source) == (600.0, 600.0, 16.0, 12.0,
+                                                 "file intrinsics.txt")
