@@ -44,7 +44,7 @@ from sgtool.house.spec import (
     hidden_objects,
     spec_id_key,
 )
-from sgtool.mapping.occupancy import OccupancyMap, geodesic_distances, house_occupancy
+from sgtool.mapping.occupancy import OccupancyMap, astar, geodesic_distances, house_occupancy
 from sgtool.mapping.raster import cell_centers, polygon_mask
 from sgtool.semantics.text import category_text
 
@@ -195,6 +195,29 @@ class EpisodeGeometry:
             if near is not None:
                 best = min(best, float(d[near[0]][near[1]].min()))
         return best
+
+
+    def shortest_route(self, start: StartPose, target_ids: list[str]
+                       ) -> list[tuple[float, float]] | None:
+        """A route of :meth:`shortest_path`'s length: the start, then the centres of the
+        8-connected path's cells to the nearest goal cell (world x, y); None when no target
+        is reached."""
+        d = self.distances(start)
+        best, goal = math.inf, (0, 0)
+        for oid in target_ids:
+            near = self.near(self._piece(oid))
+            if near is None:
+                continue
+            (rows, cols), mask = near
+            sub = np.where(mask, d[rows, cols], np.inf)
+            k = np.unravel_index(int(np.argmin(sub)), sub.shape)
+            if sub[k] < best:
+                best = float(sub[k])
+                goal = ((rows.start or 0) + int(k[0]), (cols.start or 0) + int(k[1]))
+        if math.isinf(best):
+            return None
+        path = astar(self.occ, (start.x, start.y), (self.X[goal], self.Y[goal]), max_snap=1.0)
+        return None if path is None else [(start.x, start.y), *path[1:]]
 
 
 def draw_start(spec: HouseSpec, geo: EpisodeGeometry, rooms: tuple[str, ...],

@@ -157,6 +157,7 @@ from sgtool.recorders.sim.skill_plan import (  # noqa: F401 (re-exported)
     SkillPlan,
     plan_skills,
 )
+from sgtool.recorders.sim.spl_shortest import driven_shortest
 from sgtool.scenegraph.build_options import MAX_DEPTH_M, builder_config, mapping_record
 from sgtool.scenegraph.categories import RoomClassifier
 from sgtool.scenegraph.graph import SceneGraph
@@ -508,9 +509,8 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
     mapping = opts.mapping()
     name = str(getattr(planner, "name", "planner"))
     classifier = _classifier(mapping.classifier)
-    hid = house_id or f"house-{house.seed}"
-    query = episode.query
-    shortest = episode.shortest_path if math.isfinite(episode.shortest_path) else None
+    hid, query = house_id or f"house-{house.seed}", episode.query
+    shortest = driven_shortest(house, episode) if math.isfinite(episode.shortest_path) else None
     t_wall = time.perf_counter()
     try:
         with Simulation(house, camera=opts.camera, robot=opts.robot, fps=opts.fps,
