@@ -59,18 +59,17 @@ def opening_from_panel(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
     unseen one. The score: wall running away on one side (share of occupied cells 0.1-0.45
     door widths along it), a clear opening on the other (share of occupied cells along the
     closed position, which must be low) and the far jamb just beyond it, wall + jamb - 2
-    opening. The best hinge and side must score well and clearly beat every alternative.
+    opening; with ``free`` given, the opening's cells not seen free count as closed (a
+    doorway is floor seen free: a free end beside a cabinet, with a wall beyond it, would
+    otherwise "open" over floor behind the panel that no frame saw). The best hinge and
+    side must score well and clearly beat every alternative.
     When none does (a free end whose far-jamb ray hits furniture can come close to a hinge
     whose opening ray, for a panel smeared longer than its doorway, reaches the far wall),
     they are scored again by the wall line alone: the lesser of the wall and jamb shares
     minus the opening's (at least ``LINE_LEAST``, ``LINE_MARGIN`` ahead of every
     alternative). When neither finds one, both are asked again with the far jamb 1.0
     wherever a wall crosses the doorway's line at its far end (:func:`_crossing_walls`: a
-    door at a room's corner; the doorway then ends there). When still none and ``free`` is
-    given, all of it again with the opening's cells not seen free counted as closed (a
-    doorway is floor seen free; a free end stopping short of a counter, which reads as a
-    wall line, "opens" over floor behind the panel that no frame saw). Otherwise None (the
-    caller then
+    door at a room's corner; the doorway then ends there). Otherwise None (the caller then
     uses the panel's own cells), as for cells that are not one panel at least ``min_width``
     cells long. ``free`` (bool, the shape of ``occupied``; None: no cell known free) is the
     grid's cells seen free; ``memo`` caches answers by panel and surroundings."""
@@ -155,6 +154,10 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
                          (end, d, 1.05 * w, 1.3 * w, True)]
                 places.append((s, sign, off, out))
     shares = ray_shares(rays, occupied, grown, origin)
+    if free is not None:  # a doorway is floor seen free: unseen cells are no opening
+        unseen = ray_shares(rays, ~free, grown, origin)
+        for i in range(len(places)):
+            shares[3 * i + 1] = unseen[3 * i + 1]
     best = _best_place(shares, places, reach)
     crossing: list[float | None] = [None] * len(places)
     if best is None:  # only then a wall across the doorway's line may be its far jamb
@@ -164,11 +167,6 @@ def _opening(rows: np.ndarray, cols: np.ndarray, occupied: np.ndarray,
             if h is not None:
                 crossed[3 * i + 2] = 1.0
         best = _best_place(crossed, places, reach)
-        if best is None and free is not None:  # unseen cells are no opening (doc)
-            unseen = ray_shares(rays, ~free, grown, origin)
-            for i in range(len(places)):
-                crossed[3 * i + 1] = unseen[3 * i + 1]
-            best = _best_place(crossed, places, reach)
     if best is None:
         return None
     _, s_end, sign, off, out = best

@@ -83,3 +83,27 @@ def test_without_knowing_what_was_seen_the_panel_stays_unplaced() -> None:
     panel, occupied, _ = grids()
     rows, cols = np.nonzero(panel)
     assert opening_from_panel(rows, cols, occupied, min_width=8) is None
+
+
+def test_a_free_end_that_opens_over_unseen_floor_is_no_hinge() -> None:
+    """House 1117 (generated, 12 rooms, strong noise, 160x120): a panel swung into a room
+    the robot never entered, its free end beside a cabinet (a wall line) with a wall 1.2
+    door widths beyond it (a far jamb), and between them floor no frame saw. Counting only
+    occupied cells as closed, that end scored as the hinge and the doorway was put there,
+    its centre 1.56 m (31 cells) from the real one, and the room merged with the corridor.
+    Unseen floor is no opening: the doorway is found at the hinge end, its centre within
+    0.6 m of the real doorway's (the panel, smeared by noise, reaches 0.5 m past the wall
+    line). ``data/door_panel_h1117.npz``: the replay's map window around that door at
+    0.05 m a cell (occupied and seen-free grids, bit-packed), the panel's cells and the
+    true doorway's ends in the map's cells (row, col)."""
+    from pathlib import Path
+
+    z = np.load(Path(__file__).parent / "data" / "door_panel_h1117.npz")
+    shape = tuple(int(v) for v in z["shape"])
+    n = shape[0] * shape[1]
+    occupied = np.unpackbits(z["occupied"])[:n].reshape(shape).astype(bool)
+    free = np.unpackbits(z["free"])[:n].reshape(shape).astype(bool)
+    got = opening_from_panel(z["rows"], z["cols"], occupied, min_width=8, free=free)
+    assert got is not None
+    centre = np.array([got[0].mean(), got[1].mean()])
+    assert np.hypot(*(centre - z["doorway"].mean(axis=0))) < 12.0
