@@ -8,25 +8,25 @@ draw, so a house's episodes are those of the symbolic bench). Every (noise, plan
 house, episode) is one :class:`RunTask`; :func:`run_task` runs it into its own log,
 ``LOGS/NOISE/PLANNER/HOUSE/ep-K.mcap``, and returns a :class:`RunRow` read back from that
 log (:func:`sgtool.analysis.offline.read_log_episodes`), so a fresh run and a resumed one
-give the same row. A log that exists is complete (the writer renames its partial file only
-at the end), so a task whose log exists is not run again: the benchmark resumes. Ctrl-C
-stops the run and removes the interrupted episode's partial file: only complete logs stay.
+give the same row (a resumed log's SPL shortest path measured as a new run measures it,
+:mod:`sgtool.recorders.sim.spl_shortest`). A log that exists is complete (the writer renames
+its partial file only at the end), so a task whose log exists is not run again: the
+benchmark resumes. Ctrl-C stops the run and removes the interrupted episode's partial file.
 
 :func:`run_task` takes everything it needs and returns a plain row, so executors can
 spread tasks over processes or machines (:func:`run_closed_loop_bench` takes a ``runner``,
 ``map`` by default, that maps ``run_task`` over the tasks in order).
 
 The outputs (:func:`write_outputs`): ``episodes.jsonl`` (the
-:class:`~sgtool.results.EpisodeResult` of every run, its ``source`` the log relative to
-the folder: :func:`log_source`), ``summary.md`` (per noise profile:
-SR / SPL / steps / AUC-E as the symbolic bench, then failed skills per episode by reason;
-then the statistics that separate planners, :mod:`sgtool.analysis.closed_loop_tables`: SR
-and SPL with bootstrap intervals over houses,
-paired comparisons over houses and per house, SR against the frame budget per room with
-AUC-E on frames, and, with symbolic bench results, Kendall's tau between the two planner
-orders), ``summary.json`` (the same statistics as numbers), ``run.md`` (the wall-clock
-figures: decision time, frames per second) and the efficiency curves per
-noise profile (distance, steps and frames per room).
+:class:`~sgtool.results.EpisodeResult` of every run, its ``source`` the log relative to the
+folder: :func:`log_source`), ``summary.md`` (per noise profile: SR / SPL / steps / AUC-E as
+the symbolic bench, then failed skills per episode by reason; then the statistics that
+separate planners, :mod:`sgtool.analysis.closed_loop_tables`: SR and SPL with bootstrap
+intervals over houses, paired comparisons over houses and per house, SR against the frame
+budget per room with AUC-E on frames, and, with symbolic bench results, Kendall's tau
+between the two planner orders), ``summary.json`` (the same statistics as numbers),
+``run.md`` (the wall-clock figures: decision time, frames per second) and the efficiency
+curves per noise profile (distance, steps and frames per room).
 """
 
 from __future__ import annotations
@@ -68,12 +68,7 @@ from sgtool.analysis.closed_loop_tables import (
     reason_class,
     symbolic_agreement,
 )
-from sgtool.analysis.offline import (
-    executor_message,
-    log_exchanges,
-    read_log_episodes,
-    with_seen,
-)
+from sgtool.analysis.offline import executor_message, log_exchanges, read_log_episodes, with_seen
 from sgtool.analysis.report import format_table, llm_answer_lines, pipe_table
 from sgtool.analysis.run_bench_paths import log_path, log_source, noise_folder
 from sgtool.analysis.run_bench_resume import (
@@ -96,6 +91,7 @@ from sgtool.recorders.sim.closed_loop import WENT_ON, ClosedLoopOptions, run_epi
 from sgtool.recorders.sim.fallback_explore import is_fallback
 from sgtool.recorders.sim.frame_budget import frame_budget
 from sgtool.recorders.sim.noise import NoiseProfile, names_file, parse_noise
+from sgtool.recorders.sim.spl_shortest import driven_shortest
 from sgtool.results import EpisodeResult, write_jsonl
 
 # what maps run_task over the tasks: map (in order, here) or an executor's runner
@@ -300,6 +296,8 @@ def _row(task: RunTask, seconds: float | None) -> RunRow:
     res = replace(with_seen(ep.result()), seed=task.options.planner_seed,
                   source=log_source(task.output),
                   llm_answers=answer_counts(rec for _, rec in log_exchanges([task.output])))
+    if seconds is None and task.episode < len(eps):  # SPL's shortest as it is measured now
+        res = replace(res, shortest_m=driven_shortest(spec, eps[task.episode]))
     fails = Counter(reason_class(executor_message(d.action)) for d in ep.decisions
                     if d.action.outcome == "failure")
     reasons = [d.action.reason or "" for d in ep.decisions]

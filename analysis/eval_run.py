@@ -89,6 +89,8 @@ def evaluate(request: EvalRequest, note: Echo) -> EvalOutcome:
                     else "") + "): each planner is scored per profile, as PLANNER [NOISE]"]
     if (other := _unlike_episodes(results)) is not None:
         notes = [*notes, other]
+    if (other := _unpaired_shortest(results)) is not None:
+        notes = [*notes, other]
     notes = [*notes, *settings_notes(request.inputs), *_logged_step_notes(logged),
              *_default_option_notes(request, logged)]
     if unknown := sum(1 for r in results if r.shortest_m is None
@@ -263,6 +265,23 @@ def _unlike_episodes(results: Sequence[EpisodeResult]) -> str | None:
     return (f"the planners ran on different episodes ({counts}; {len(common)} in common): "
             "their rows are not comparable as they stand; compare them on the same episodes "
             "(give the runs' logs of one episode list)")
+
+
+def _unpaired_shortest(results: Sequence[EpisodeResult]) -> str | None:
+    """A note when runs of one (house, episode, seed, query) disagree on its shortest path
+    (to 1 cm): the paired tables keep them apart."""
+    paths: dict[tuple[str, int, int, str], set[float]] = {}
+    for r in results:
+        if r.shortest_m is not None and math.isfinite(r.shortest_m):
+            paths.setdefault(_episode_key(r)[1:5], set()).add(round(r.shortest_m, 2))
+    odd = sorted(k for k, v in paths.items() if len(v) > 1)
+    if not odd:
+        return None
+    h, e, _, q = odd[0]
+    return (f"{len(odd)} episode(s) have other shortest paths in the inputs (first: {h} "
+            f"episode {e}, {q}: {', '.join(f'{v:g}' for v in sorted(paths[odd[0]]))} m) and "
+            "are not paired: other houses under one name, or closed-loop logs written "
+            "before SPL's shortest path was the robot's string-pulled route (run them again)")
 
 
 def _run_bench_noise(r: EpisodeResult) -> str:

@@ -12,8 +12,6 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from sgtool.planning.registry import effective_options
-
 COMPARED = ("max_steps", "priors_dir",  # bench settings that change what an episode scores
             "distance_budget", "step_budget")  # and the AUC-E curves
 # what a generated house of a given id is made from (its seed is in the id)
@@ -26,7 +24,7 @@ def recorded_budgets(files: Sequence[str]) -> tuple[float | None, float | None]:
     found: dict[str, set[float]] = {"distance_budget": set(), "step_budget": set()}
     for f in files:
         p = Path(f)
-        if p.name == "episodes.jsonl" and (s := _settings(p.parent / "summary.json")):
+        if p.name == "episodes.jsonl" and (s := run_settings(p.parent / "summary.json")):
             for key, seen in found.items():
                 if isinstance(s.get(key), int | float) and not isinstance(s[key], bool):
                     seen.add(float(s[key]))
@@ -34,7 +32,8 @@ def recorded_budgets(files: Sequence[str]) -> tuple[float | None, float | None]:
     return dist, steps
 
 
-def _settings(summary: Path) -> dict[str, Any] | None:
+def run_settings(summary: Path) -> dict[str, Any] | None:
+    """The ``settings`` a bench run's ``summary.json`` records; None when it has none."""
     try:
         doc = json.loads(summary.read_text())
     except (OSError, ValueError):
@@ -45,11 +44,12 @@ def _settings(summary: Path) -> dict[str, Any] | None:
 
 def settings_notes(files: Sequence[str]) -> list[str]:
     """One note per setting of :data:`COMPARED` whose value differs between the bench
-    runs among ``files``, and one per planner that ran with other options in two runs."""
+    runs among ``files`` (runs of one planner with other options are told apart by
+    :func:`sgtool.analysis.eval_run.per_options`)."""
     runs: dict[str, dict[str, Any]] = {}
     for f in files:
         p = Path(f)
-        if p.name == "episodes.jsonl" and (s := _settings(p.parent / "summary.json")):
+        if p.name == "episodes.jsonl" and (s := run_settings(p.parent / "summary.json")):
             runs[str(p.parent)] = s
     notes = []
     for key in COMPARED:
@@ -68,18 +68,6 @@ def settings_notes(files: Sequence[str]) -> list[str]:
             notes.append(f"the runs given generated their houses with different {key} "
                          f"({shown}): a house id names other houses in them, and their rows, "
                          "intervals and paired comparisons mix them")
-    options: dict[str, dict[str, str]] = {}
-    for run, s in runs.items():
-        given = s.get("planner_options") or {}
-        for planner in s.get("planners") or ():
-            options.setdefault(planner, {})[run] = json.dumps(
-                effective_options(planner, given.get(planner) or {}), sort_keys=True,
-                default=str)
-    for planner, per in options.items():
-        if len(set(per.values())) > 1:
-            shown = ", ".join(f"{opts} in {run}" for run, opts in per.items())
-            notes.append(f"{planner} ran with other options in the runs given ({shown}): its "
-                         "rows pool them; run each under its own name to compare them")
     return notes
 
 

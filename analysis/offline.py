@@ -229,11 +229,25 @@ def load_results(paths: Iterable[str | os.PathLike[str]], notes: list[str] | Non
                     logged.append(e)
                     results.append(r)
         elif p.suffix in (".jsonl", ".json") or head[:1] == b"{":
-            results.extend(r for i, r in enumerate(read_jsonl(p))
+            ran = _table_options(p)
+            results.extend(r if r.options or not ran.get(r.planner) else
+                           dataclasses.replace(r, options=ran[r.planner])
+                           for i, r in enumerate(read_jsonl(p))
                            if _accepted(r, f"{p}: record {i + 1}", notes))
         else:
             raise EvalInputError(f"{p}: neither an MCAP log nor an episode JSONL file")
     return results, logged
+
+
+def _table_options(table: Path) -> dict[str, dict[str, Any]]:
+    """The ``-O`` options per planner that the ``summary.json`` beside a bench table
+    records: those of its rows written before rows kept their options."""
+    from sgtool.analysis.eval_settings import run_settings
+
+    s = run_settings(table.parent / "summary.json") or {}
+    given = s.get("planner_options")
+    return {str(k): dict(v) for k, v in given.items() if isinstance(v, dict)} \
+        if isinstance(given, dict) else {}
 
 
 def _search_episodes(p: Path, episodes: list[LoggedEpisode], notes: list[str]

@@ -37,7 +37,7 @@ One episode (:func:`run_episode`), all of it into one MCAP log:
    target), after ``max_steps`` high-level steps ("max_steps", default 50) or at the frame
    budget ("frames": the skill under way is cut and logged as a failure). The closing
    Episode record has status success/failure, steps, travelled_m, shortest_m (the
-   episode's geodesic, :mod:`sgtool.datasets.episodes`), frames and ``extra`` (query,
+   episode's route pulled taut, :mod:`.spl_shortest`), frames and ``extra`` (query,
    planner, seed, end, n_open, mapping, episode). Under MoMa-LLM's success rule
    (``success="done"``, :func:`~sgtool.planning.episode.search_success`) the planner is
    asked once more on the graph that shows the target: that decision is logged as an

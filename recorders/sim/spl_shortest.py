@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 
+from sgtool.canonical import canonical_float
 from sgtool.datasets.episodes import Episode, EpisodeGeometry
 from sgtool.house.spec import HouseSpec
 from sgtool.recorders.sim.navigation import smooth_path
@@ -23,10 +24,12 @@ def driven_shortest(spec: HouseSpec, episode: Episode,
                     geometry: EpisodeGeometry | None = None) -> float | None:
     """The episode's shortest route (:meth:`EpisodeGeometry.shortest_route`, on
     ``geometry`` or the house's default one) string-pulled on that geometry's occupancy,
-    its length in m; None when no target is reached."""
+    its length in m as episode records keep it (:func:`sgtool.canonical.canonical_float`);
+    None when no target is reached."""
     geo = geometry or EpisodeGeometry(spec)
     route = geo.shortest_route(episode.start, list(episode.targets))
     if route is None:
         return None
     pulled = smooth_path(geo.occ, route)
-    return sum(math.dist(a, b) for a, b in zip(pulled, pulled[1:], strict=False))
+    return canonical_float(sum(math.dist(a, b) for a, b in zip(pulled, pulled[1:],
+                                                               strict=False)))

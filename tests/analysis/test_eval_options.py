@@ -74,3 +74,40 @@ def test_eval_of_two_bench_runs_with_other_options(tmp_path) -> None:
     assert r.exit_code == 0, r.output
     assert {p: v["episodes"] for p, v in json.loads(r.stdout)["planners"].items()} == \
         {"scout(delta=0.3)": 3, "scout()": 3}
+
+
+def test_a_table_from_before_options_were_kept_takes_its_runs_options(tmp_path) -> None:
+    """A bench table written before each record kept its options (rows without the field)
+    takes them from its summary.json: its -O run is not taken for a default run, and its
+    own logs given with it are the same runs (counted once)."""
+    runner = CliRunner()
+    for name, extra in (("a", []), ("b", ["-O", "scout.delta=0.3"])):
+        r = runner.invoke(cli, [*BENCH, *extra, "--log-dir", str(tmp_path / name / "logs"),
+                                "-o", str(tmp_path / name)])
+        assert r.exit_code == 0, r.output
+    table = tmp_path / "b" / "episodes.jsonl"
+    rows = [json.loads(line) for line in table.read_text().splitlines()]
+    table.write_text("".join(json.dumps({k: v for k, v in d.items() if k != "options"}) + "\n"
+                             for d in rows))
+    logs = [str(p) for p in sorted((tmp_path / "b" / "logs").rglob("*.mcap"))]
+    r = runner.invoke(cli, ["eval", str(tmp_path / "a"), str(tmp_path / "b"), *logs,
+                            "--json"])
+    assert r.exit_code == 0, r.output
+    assert {p: v["episodes"] for p, v in json.loads(r.stdout)["planners"].items()} == \
+        {"scout()": 3, "scout(delta=0.3)": 3}
+    assert "3 episode(s) were given twice" in r.stderr
+    assert "rows pool them" not in r.stderr  # (the note before runs were told apart)
+
+
+def test_runs_of_one_episode_with_other_shortest_paths_are_named(tmp_path) -> None:
+    """Two runs of one (house, episode, seed, query) whose shortest paths differ (a
+    closed-loop log from before SPL's shortest path was the pulled route) do not pair;
+    eval says so rather than print an empty paired table."""
+    from sgtool.results import write_jsonl
+
+    write_jsonl([RUN, dataclasses.replace(RUN, planner="greedy", shortest_m=9.1)],
+                tmp_path / "episodes.jsonl")
+    r = CliRunner().invoke(cli, ["eval", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    assert ("1 episode(s) have other shortest paths in the inputs (first: house-0 episode "
+            "0, mug: 9.1, 9.48 m) and are not paired") in r.stderr

@@ -27,8 +27,8 @@ def test_the_driven_shortest_path_is_the_grid_route_pulled_taut() -> None:
         assert abs(_length(route) - e.shortest_path) < 0.05 + 1e-9  # (snapped start cell)
         pulled = driven_shortest(spec, e, geo)
         assert pulled is not None
-        assert math.dist(route[0], route[-1]) - 1e-9 <= pulled <= e.shortest_path + 1e-9
+        assert math.dist(route[0], route[-1]) - 1e-4 <= pulled <= e.shortest_path + 1e-4
         ratios.append(pulled / e.shortest_path)
         if lines_are_free(geo.occ, route[0], [route[-1]])[0]:  # in sight: straight there
-            assert math.isclose(pulled, math.dist(route[0], route[-1]))
+            assert abs(pulled - math.dist(route[0], route[-1])) <= 1e-4  # (0.1 mm records)
     assert min(ratios) < 0.95 and max(ratios) <= 1.0
