@@ -138,7 +138,8 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
                     raise
                 # estimating anyway: the bag's poses were only wanted as the reference
         if (opts.depth is not None and src is not None and src.tree is not None
-                and src.track is None and not src.tree.sample_times(src.world, src.camera)):
+                and src.track is None and opts.tf_frames is None
+                and not src.tree.sample_times(src.world, src.camera)):
             # /tf_static links alone (a camera driver's mounts, a camera recorded alone)
             # would pose every image the same
             if not estimate:

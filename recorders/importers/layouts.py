@@ -445,6 +445,12 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
                           dropped=dropped)
 
 
+# text files an Open3D folder's intrinsics are read from (a 3x3 camera matrix; ScanNet's
+# 4x4): named for them, the depth camera's before the colour camera's
+INTRINSICS_TEXTS = frozenset({"intrinsic", "intrinsics", "camera_intrinsic",
+                              "camera_intrinsics", "intrinsic_depth", "intrinsic_color"})
+
+
 def _read_open3d(root: Path, fps: float, trajectory: Path | None,
                  skip_missing: bool = False, keep_unposed: bool = False) -> FolderSequence:
     """Depth images of ``depth/`` and colour images of the colour folder, paired by name
@@ -574,8 +580,10 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
         else:
             dropped, pairs = dropped + late, pairs[:len(poses)]
     intr = folder_intrinsics(root)
-    for p in sorted([*root.glob("*.json"), *root.glob("*.txt")]) if intr is None else ():
-        if is_intrinsics_json(p) if p.suffix == ".json" else "intrinsic" in p.name.lower():
+    texts = sorted((p for p in root.glob("*.txt") if p.stem.lower() in INTRINSICS_TEXTS),
+                   key=lambda p: ("depth" not in p.stem.lower(), p.name))  # depth's first
+    for p in [*sorted(root.glob("*.json")), *texts] if intr is None else ():
+        if p.suffix != ".json" or is_intrinsics_json(p):
             intr = replace(read_intrinsics_file(p), source=f"file {p.name}")
             break
     frames = tuple(

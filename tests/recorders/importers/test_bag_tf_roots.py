@@ -92,7 +92,8 @@ def test_a_camera_with_no_world_in_its_tree_is_told_to_estimate_poses(tmp_path):
 def test_a_tree_of_static_links_only_is_refused_not_posed_once(tmp_path):
     """A camera driver's mounts alone (map -> camera_link -> cam on /tf_static, nothing on
     /tf): every frame got the one static pose, exit 0. Now one line naming the ways out;
-    with --estimate-poses the bag's tree is no reference and the frames are estimated."""
+    with --estimate-poses the bag's tree is no reference and the frames are estimated; with
+    the pair named by --tf-frames the static pose is taken as asked."""
     frames = frames_of(4)
     write_bag(tmp_path / "b", frames, lambda P: [("map", "camera_link", frames[0].pose),
                                                  ("camera_link", "cam", np.eye(4))], "cam",
@@ -104,3 +105,7 @@ def test_a_tree_of_static_links_only_is_refused_not_posed_once(tmp_path):
         import_bag(tmp_path / "b", out, options(frames))
     assert not out.exists()
     assert import_bag(tmp_path / "b", out, options(frames, estimate_poses=True)).frames == 4
+    # the pair named (a camera on a tripod): its one pose is what was asked for
+    rep = import_bag(tmp_path / "b", tmp_path / "t.mcap",
+                     options(frames, tf_frames=("map", "cam")))
+    assert rep.frames == 4

@@ -665,3 +665,15 @@ def test_an_intrinsics_text_file_in_an_open3d_folder_is_read(tmp_path: Path, tex
     k = read_sequence(root).intrinsics
     assert (k.fx, k.fy, k.cx, k.cy, k.source) == (600.0, 600.0, 16.0, 12.0,
                                                  "file intrinsics.txt")
+
+
+def test_an_open3d_folder_reads_the_depth_cameras_intrinsics_file(tmp_path: Path) -> None:
+    """ScanNet-style intrinsic_color.txt and intrinsic_depth.txt beside each other: the
+    depth camera's is read (the colour one sorts first); a text file that only has
+    "intrinsic" in its name (a README) is not read as intrinsics."""
+    root = open3d_folder(tmp_path / "f", [str(i) for i in range(3)])
+    (root / "intrinsic_color.txt").write_text("1170 0 16\n0 1170 12\n0 0 1\n")
+    (root / "intrinsic_depth.txt").write_text("577 0 16\n0 577 12\n0 0 1\n")
+    (root / "intrinsics_README.txt").write_text("fx and fy in pixels\n")
+    k = read_sequence(root).intrinsics
+    assert (k.fx, k.source) == (577.0, "file intrinsic_depth.txt")
