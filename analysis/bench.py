@@ -229,10 +229,11 @@ class BenchResult:
     folder."""
 
     config: BenchConfig
-    results: tuple[EpisodeResult, ...]
+    # every episode with its trace: kilobytes each, left out of repr (a notebook prints it)
+    results: tuple[EpisodeResult, ...] = field(repr=False)
     throughput: dict[str, float]  # planner -> episodes per second of one core (wall-clock)
-    table: str
-    seen_table: str
+    table: str = field(repr=False)
+    seen_table: str = field(repr=False)
     digest: str
     wall_s: float
     houses: tuple[BenchHouse, ...] = ()

@@ -117,10 +117,10 @@ def resolve_options_measured(reader: LogReader, options: ReplayOptions
     depth noise reaches the floor tolerance
     (:func:`~sgtool.replayers.depth_range.first_frames`, returned with the options)."""
     if options.max_frames is not None and options.max_frames < 1:
-        raise SgtoolError(f"max frames {options.max_frames}: must be >= 1")
+        raise SgtoolError(f"max frames {options.max_frames} (--max-frames): must be >= 1")
     if options.tf_time not in ("log", "stamp"):
-        raise SgtoolError(f"tf time {options.tf_time!r}: \"log\" (pair /tf with frames by "
-                          "log time) or \"stamp\" (by header stamp)")
+        raise SgtoolError(f"tf time {options.tf_time!r} (--tf-time): \"log\" (pair /tf with "
+                          "frames by log time) or \"stamp\" (by header stamp)")
     recorded, found = _recorded_mapping(reader)
     size = _image_size(reader)
     every = options.every if options.every is not None else int(recorded.get("every", 10))
@@ -135,9 +135,9 @@ def resolve_options_measured(reader: LogReader, options: ReplayOptions
     if every < 1:
         raise SgtoolError(f"every {every} (--every): must be >= 1")
     if not 0.01 <= vs <= 0.5:
-        raise SgtoolError(f"voxel size {vs} m: must be 0.01..0.5")
+        raise SgtoolError(f"voxel size {vs} m (--voxel-size): must be 0.01..0.5")
     if int(mp) < 1:
-        raise SgtoolError(f"min points {mp}: must be >= 1")
+        raise SgtoolError(f"min points {mp} (--min-points): must be >= 1")
     md = options.max_depth if options.max_depth is not None else float(
         recorded.get("max_depth", MAX_DEPTH_M))
     first = None
@@ -146,7 +146,7 @@ def resolve_options_measured(reader: LogReader, options: ReplayOptions
         if first.noise is not None and first.noise.max_depth is not None:
             md = max(MAX_DEPTH_RANGE[0], first.noise.max_depth)
     if not MAX_DEPTH_RANGE[0] <= md <= MAX_DEPTH_RANGE[1]:
-        raise SgtoolError(f"max depth {md:g} m: must be {MAX_DEPTH_RANGE[0]:g}.."
+        raise SgtoolError(f"max depth {md:g} m (--max-depth): must be {MAX_DEPTH_RANGE[0]:g}.."
                           f"{MAX_DEPTH_RANGE[1]:g}")
     return ResolvedOptions(every=int(every), classifier=clf, min_points=int(mp),
                            voxel_size=float(vs), max_frames=options.max_frames,

@@ -412,7 +412,11 @@ def _explore_live(sim: Simulation, rec: LogRecorder, opts: RecordOptions,
     """Frontier exploration on the robot's own map (:mod:`.frontier_explore`), sampling
     the floor coverage at every refresh."""
     from sgtool.recorders.sim.coverage import coverage, floor_points
-    from sgtool.recorders.sim.frontier_explore import LiveMap, explore_frontiers
+    from sgtool.recorders.sim.frontier_explore import (
+        FrontierReport,
+        LiveMap,
+        explore_frontiers,
+    )
     from sgtool.recorders.sim.live_skills import LiveSkills, RobotBody, camera_sight
     from sgtool.scenegraph.build_options import ResolvedOptions, builder_config, default_min_points
     from sgtool.scenegraph.stream import Refresh, SceneGraphStream
@@ -434,10 +438,13 @@ def _explore_live(sim: Simulation, rec: LogRecorder, opts: RecordOptions,
     skills = LiveSkills(RobotBody(sim), lambda: stream.current,
                         sight=camera_sight(stream, sim.camera.mount_height))
     sim.tick()  # the view at the start pose
-    fr = explore_frontiers(skills, rec.on_skill_of(sim))
-    rep.visited.extend(fr.goals)
-    rep.missed.update({g: "not reached" for g in fr.failed})
-    rep.opened.extend(fr.opened)
+    fr = FrontierReport()  # filled as it goes: a frame budget stops it midway
+    try:
+        explore_frontiers(skills, rec.on_skill_of(sim), report=fr)
+    finally:
+        rep.visited.extend(fr.goals)
+        rep.missed.update({g: "not reached" for g in fr.failed})
+        rep.opened.extend(fr.opened)
 
 
 def _episode_extra(opts: RecordOptions, sim: Simulation) -> dict[str, Any]:

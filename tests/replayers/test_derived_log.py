@@ -201,6 +201,21 @@ def test_reports_print_short(tmp_path):
     assert len(repr(diff_logs(TOUR, TOUR))) < 2000
 
 
+@pytest.mark.parametrize(("options", "flag"), [
+    (ReplayOptions(voxel_size=0.001), "voxel size 0.001 m (--voxel-size): must be"),
+    (ReplayOptions(min_points=0), "min points 0 (--min-points): must be >= 1"),
+    (ReplayOptions(max_frames=0), "max frames 0 (--max-frames): must be >= 1"),
+    (ReplayOptions(max_depth=100.0), "max depth 100 m (--max-depth): must be"),
+    (ReplayOptions(tf_time="wall"), "tf time 'wall' (--tf-time):"),
+])
+def test_a_bad_replay_option_names_its_flag(options, flag):
+    """From Python too, as docs/api.md says: the message names the option by its flag."""
+    from sgtool.errors import SgtoolError
+
+    with pytest.raises(SgtoolError, match=flag.replace("(", r"\(").replace(")", r"\)")):
+        replay(TOUR, None, options)
+
+
 def test_the_voronoi_arrays_handed_out_are_read_only(tmp_path):
     """A refresh's Voronoi graph may be reused by the next refresh: a caller cannot edit
     its arrays (it would change later graphs)."""

@@ -195,6 +195,9 @@ class LogReader:
 
     @property
     def seed(self) -> int | None:
+        """The seed the log was recorded (or run) with (its metadata's ``seed``: the
+        recorder's or planner's, not the house's: :meth:`house_spec` ``.seed``); None when
+        not recorded."""
         s = self.metadata.get(S.METADATA_NAME, {}).get("seed", "")
         try:
             return int(s) if s else None

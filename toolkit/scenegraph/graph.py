@@ -19,10 +19,12 @@ from __future__ import annotations
 
 import functools
 import json
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any, Literal
 
 from sgtool.canonical import canonical_float, canonical_floats
+from sgtool.errors import ArgumentError
 from sgtool.vocabulary import OpenState, Relation
 
 SCENE_GRAPH_VERSION = "1.0"
@@ -230,9 +232,24 @@ class SceneGraph:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> SceneGraph:
+        """The graph of a :meth:`to_dict` object; anything else is one
+        :class:`~sgtool.errors.ArgumentError` line (a ``ValueError``) naming what is wrong."""
+        if not isinstance(d, Mapping):
+            raise ArgumentError(f"scene graph: a JSON object, got {type(d).__name__}")
+        try:
+            return cls._from_dict(d)
+        except KeyError as e:
+            raise ArgumentError(f"scene graph: field {e.args[0]!r} missing") from None
+        except (TypeError, AttributeError, ValueError) as e:
+            if isinstance(e, ArgumentError):
+                raise
+            raise ArgumentError(f"scene graph: {e}") from None
+
+    @classmethod
+    def _from_dict(cls, d: dict[str, Any]) -> SceneGraph:
         major = str(d.get("version", "0")).split(".")[0]
         if major != SCENE_GRAPH_VERSION.split(".")[0]:
-            raise ValueError(
+            raise ArgumentError(
                 f"scene graph version {d.get('version')} is not readable by this sgtool "
                 f"(reads {SCENE_GRAPH_VERSION.split('.')[0]}.x)"
             )
@@ -281,7 +298,11 @@ class SceneGraph:
 
     @classmethod
     def from_json(cls, text: str | bytes) -> SceneGraph:
-        return cls.from_dict(json.loads(text))
+        try:
+            d = json.loads(text)
+        except ValueError as e:  # JSONDecodeError, UnicodeDecodeError
+            raise ArgumentError(f"scene graph: not JSON ({e})") from None
+        return cls.from_dict(d)
 
 
 _FIELD_NAMES: dict[type, tuple[str, ...]] = {}

@@ -58,3 +58,7 @@ def test_record_explore_frontier(tmp_path) -> None:
     navs = [a for a in acts if a["skill"] == "navigate"]
     assert navs and all(a["target"].startswith(("frontier:", "door:")) for a in navs)
     assert any(a["travelled_m"] > 0.5 for a in navs)
+    # the budget stops the exploration midway: the goals it went to are still reported
+    # (they read "goals visited: 0" when the budget cut it short)
+    visited = int(res.output.split("goals visited: ")[1].split()[0])
+    assert visited == len(navs), (visited, len(navs))

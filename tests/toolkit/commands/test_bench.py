@@ -204,6 +204,10 @@ def test_run_bench_returns_the_tables():
     text = run_bench(planners=("random",), houses=1, episodes=2, seeds=1, progress=False)
     assert text.startswith("Symbolic benchmark")
     assert "| random" in text and "Seen vs unseen" in text
+    # the result object a notebook prints: its settings and figures, not every episode's
+    # trace and the tables (hundreds of kB at bench sizes)
+    result = run_benchmark(BenchConfig(planners=("random",), houses=1, episodes=4, seeds=2))
+    assert len(result.results) == 8 and len(repr(result)) < 2000
 
 
 @pytest.mark.parametrize("args, message", [
