@@ -145,7 +145,7 @@ class BenchConfig:
     workers: int = 1
     distance_budget: float = 5000.0  # MoMa-LLM low-level budget (0.1 m steps + 30 per open)
     step_budget: float = 50.0  # MoMa-LLM high-level budget
-    planner_options: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    planner_options: Mapping[str, Mapping[str, Any]] = field(default_factory=dict, repr=False)
     log_dir: str | None = None  # also record every episode as an MCAP log here
     house_files: tuple[str, ...] | str = ()  # house spec files or folders, after the generated
     priors_dir: str | None = None  # relational priors (vocabulary, scout weights)

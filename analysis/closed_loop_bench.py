@@ -118,7 +118,7 @@ class ClosedLoopBenchConfig:
     preset: str = "symsearch"
     noise: tuple[str, ...] | str = ("none",)  # noise profiles (`sgtool record --noise` syntax)
     options: ClosedLoopOptions = field(default_factory=ClosedLoopOptions)
-    planner_options: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    planner_options: Mapping[str, Mapping[str, Any]] = field(default_factory=dict, repr=False)
     frames_per_room: int | None = None  # frame budget per room (excludes options.frames)
     distance_budget: float = 5000.0
     step_budget: float = 50.0

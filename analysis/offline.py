@@ -243,11 +243,30 @@ def _table_options(table: Path) -> dict[str, dict[str, Any]]:
     """The ``-O`` options per planner that the ``summary.json`` beside a bench table
     records: those of its rows written before rows kept their options."""
     from sgtool.analysis.eval_settings import run_settings
+    from sgtool.redact import is_secret_name
 
     s = run_settings(table.parent / "summary.json") or {}
     given = s.get("planner_options")
-    return {str(k): dict(v) for k, v in given.items() if isinstance(v, dict)} \
-        if isinstance(given, dict) else {}
+    out = {}
+    for k, v in given.items() if isinstance(given, dict) else ():
+        # those a record keeps (sgtool.redact.recorded_options): no secret, no Python object
+        kept = {o: x for o, x in v.items() if not is_secret_name(str(o))
+                and str(o) not in _python_only(str(k))} if isinstance(v, dict) else {}
+        if kept:
+            out[str(k)] = kept
+    return out
+
+
+def _python_only(planner: str) -> frozenset[str]:
+    """The options of ``planner`` given from Python only (an encoder): none recorded."""
+    from sgtool.planning.option_fields import option_infos
+    from sgtool.planning.registry import options_of
+
+    try:
+        cls = options_of(planner)
+    except Exception:  # noqa: BLE001 - a plug-in not importable here
+        return frozenset()
+    return frozenset(i.name for i in option_infos(cls) if not i.meta.cli) if cls else frozenset()
 
 
 def _search_episodes(p: Path, episodes: list[LoggedEpisode], notes: list[str]

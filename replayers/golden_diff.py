@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from sgtool.errors import SgtoolError
+from sgtool.errors import ArgumentError, SgtoolError
 from sgtool.log import schemas as S
 from sgtool.log.reader import LogReader
 from sgtool.log.records import Action, SceneGraphRecord, given
@@ -63,7 +63,10 @@ def log_graphs(path: str | os.PathLike[str], options: ReplayOptions | None = Non
                     for d in r.messages([topic]):
                         by_time[d.log_time_ns] = d.message
             for t, rec in r.records(SceneGraphRecord):
-                graphs.append(rec.graph().to_json())
+                try:
+                    graphs.append(rec.graph().to_json())
+                except ArgumentError as e:  # a foreign graph: which log, which record
+                    raise ArgumentError(f"{p}: scene graph record at {t} ns: {e}") from None
                 layers = summary_of_messages(maps[S.VORONOI].get(t), maps[S.ROOMS].get(t))
                 metas.append(RefreshMeta(t, bisect.bisect_right(frames, t), "logged", layers))
             return LogGraphs(str(p), "logged", graphs, metas, None, actions)

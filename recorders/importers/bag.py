@@ -9,7 +9,8 @@ What is read (flags of the command):
 - ``--info`` ``CameraInfo`` (K/k, ROS 1 and ROS 2 spellings): the intrinsics;
 - the camera pose: the ``/tf`` + ``/tf_static`` tree from ``WORLD`` to ``CAMERA``
   (``--tf-frames WORLD:CAMERA``; by default the depth image's frame in the root of its
-  tree), every dynamic link interpolated at the image time (:mod:`.tftree`); or
+  tree; a tree of ``/tf_static`` links only is refused unless named, it would pose every
+  image alike), every dynamic link interpolated at the image time (:mod:`.tftree`); or
   ``--pose TOPIC`` (``PoseStamped``, ``PoseWithCovarianceStamped``, ``TransformStamped``,
   ``Odometry``) giving the camera's optical frame in the world directly.
 
@@ -138,16 +139,17 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
                     raise
                 # estimating anyway: the bag's poses were only wanted as the reference
         if (opts.depth is not None and src is not None and src.tree is not None
-                and src.track is None and opts.tf_frames is None
+                and src.track is None
                 and not src.tree.sample_times(src.world, src.camera)):
             # /tf_static links alone (a camera driver's mounts, a camera recorded alone)
-            # would pose every image the same
-            if not estimate:
+            # would pose every image the same (as asked when --tf-frames names the pair)
+            if not estimate and opts.tf_frames is None:
                 raise SgtoolError(
                     f"{path}: {src.describe} has static links only (/tf_static): every "
                     "frame would get the same pose; give --tf-frames WORLD:CAMERA through a "
                     "moving /tf link, --pose TOPIC, or --estimate-poses")
-            src = None  # no reference to measure the drift against
+            if estimate:
+                src = None  # no reference to measure the drift against
         kind = f"bag/{B.bag_kind(path)}"
         meta = {
             "source": path.resolve().name,

@@ -447,8 +447,8 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
 
 # text files an Open3D folder's intrinsics are read from (a 3x3 camera matrix; ScanNet's
 # 4x4): named for them, the depth camera's before the colour camera's
-INTRINSICS_TEXTS = frozenset({"intrinsic", "intrinsics", "camera_intrinsic",
-                              "camera_intrinsics", "intrinsic_depth", "intrinsic_color"})
+INTRINSICS_TEXTS = frozenset({"intrinsic", "intrinsics", "camera_intrinsic", "camera_intrinsics",
+                              "intrinsic_depth", "intrinsic_color", "depth_intrinsics"})
 
 
 def _read_open3d(root: Path, fps: float, trajectory: Path | None,
@@ -580,7 +580,8 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
         else:
             dropped, pairs = dropped + late, pairs[:len(poses)]
     intr = folder_intrinsics(root)
-    texts = sorted((p for p in root.glob("*.txt") if p.stem.lower() in INTRINSICS_TEXTS),
+    texts = sorted((p for p in root.glob("*.txt")
+                    if p.stem.lower().replace("-", "_") in INTRINSICS_TEXTS),
                    key=lambda p: ("depth" not in p.stem.lower(), p.name))  # depth's first
     for p in [*sorted(root.glob("*.json")), *texts] if intr is None else ():
         if p.suffix != ".json" or is_intrinsics_json(p):

@@ -111,3 +111,38 @@ def test_runs_of_one_episode_with_other_shortest_paths_are_named(tmp_path) -> No
     assert r.exit_code == 0, r.output
     assert ("1 episode(s) have other shortest paths in the inputs (first: house-0 episode "
             "0, mug: 9.1, 9.48 m) and are not paired") in r.stderr
+
+
+def test_a_tables_python_only_or_secret_options_are_no_options(tmp_path) -> None:
+    """A summary.json records options a record leaves out (an encoder object from Python,
+    an API key, as text): rows without options do not take those, so the run is not split
+    from a default run of the same episodes by an object's address; a -O option given as
+    text is taken."""
+    from sgtool.results import write_jsonl
+
+    for name in ("a", "b"):
+        (tmp_path / name).mkdir()
+        write_jsonl([RUN], tmp_path / name / "episodes.jsonl")
+    summary = tmp_path / "a" / "summary.json"
+    for options, names in (({"encoder": "<SentenceEncoder object at 0x7f>",
+                             "api_key": "<redacted>"}, ["scout"]),
+                           ({"delta": "0.3"}, ["scout(delta=0.3)", "scout()"])):
+        summary.write_text(json.dumps({"settings": {"planner_options": {"scout": options}}}))
+        r = CliRunner().invoke(cli, ["eval", str(tmp_path / "a"), str(tmp_path / "b"),
+                                     "--json"])
+        assert r.exit_code == 0, r.output
+        assert sorted(json.loads(r.stdout)["planners"]) == sorted(names)
+
+
+def test_the_symbolic_benchs_own_shortest_path_is_no_unpaired_run(tmp_path) -> None:
+    """The symbolic bench measures the grid geodesic, the closed loop the pulled route:
+    rows of one episode under the two profiles never pair, and no note says to run them
+    again."""
+    from sgtool.results import write_jsonl
+
+    write_jsonl([RUN, dataclasses.replace(RUN, shortest_m=9.1, noise="none",
+                                          source="logs/none/scout/house-0/ep-000.mcap")],
+                tmp_path / "episodes.jsonl")
+    r = CliRunner().invoke(cli, ["eval", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    assert "other shortest paths" not in r.stderr

@@ -109,3 +109,7 @@ def test_a_tree_of_static_links_only_is_refused_not_posed_once(tmp_path):
     rep = import_bag(tmp_path / "b", tmp_path / "t.mcap",
                      options(frames, tf_frames=("map", "cam")))
     assert rep.frames == 4
+    # estimated while naming it: a constant pose is no reference to measure drift against
+    rep = import_bag(tmp_path / "b", tmp_path / "e.mcap",
+                     options(frames, tf_frames=("map", "cam"), estimate_poses=True))
+    assert rep.drift is None

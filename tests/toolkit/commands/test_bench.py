@@ -208,6 +208,10 @@ def test_run_bench_returns_the_tables():
     # trace and the tables (hundreds of kB at bench sizes)
     result = run_benchmark(BenchConfig(planners=("random",), houses=1, episodes=4, seeds=2))
     assert len(result.results) == 8 and len(repr(result)) < 2000
+    # nor the planners' options, which may hold a secret (an API key given from Python)
+    cfg = BenchConfig(planners=("moma-llm",), planner_options={"moma-llm": {
+        "api_key": "sk-secret123"}})
+    assert "sk-secret123" not in repr(cfg)
 
 
 @pytest.mark.parametrize("args, message", [

@@ -36,5 +36,7 @@ def test_diff_of_a_log_with_a_foreign_scene_graph_is_one_line(tmp_path) -> None:
         w.write_record("scene_graph", 10**9, {"version": "1.0", "rooms": [{"id": "room:0"}],
                                               "objects": []})
     r = CliRunner().invoke(cli, ["diff", str(out), str(out)])
-    assert r.exit_code == 2 and "scene graph: field 'robot' missing" in r.output, r.output
+    assert r.exit_code == 2, r.output
+    assert f"{out}: scene graph record at 1000000000 ns: scene graph: field 'robot' missing" \
+        in r.output
     assert "Traceback" not in r.output
