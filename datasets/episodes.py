@@ -188,20 +188,23 @@ class EpisodeGeometry:
 
     def shortest_path(self, start: StartPose, target_ids: list[str]) -> float:
         """Geodesic to the nearest target (small object or furniture ids)."""
-        d = self.distances(start)
-        best = math.inf
-        for oid in target_ids:
-            near = self.near(self._piece(oid))
-            if near is not None:
-                best = min(best, float(d[near[0]][near[1]].min()))
-        return best
-
+        return self._nearest_goal(start, target_ids)[0]
 
     def shortest_route(self, start: StartPose, target_ids: list[str]
                        ) -> list[tuple[float, float]] | None:
         """A route of :meth:`shortest_path`'s length: the start, then the centres of the
         8-connected path's cells to the nearest goal cell (world x, y); None when no target
         is reached."""
+        best, goal = self._nearest_goal(start, target_ids)
+        if math.isinf(best):
+            return None
+        path = astar(self.occ, (start.x, start.y), (self.X[goal], self.Y[goal]), max_snap=1.0)
+        return None if path is None else [(start.x, start.y), *path[1:]]
+
+    def _nearest_goal(self, start: StartPose, target_ids: list[str]
+                      ) -> tuple[float, tuple[int, int]]:
+        """(geodesic, grid cell (row, col)) of the goal cell of the targets nearest to
+        ``start`` (the first target's on a tie); (inf, (0, 0)) when none is reached."""
         d = self.distances(start)
         best, goal = math.inf, (0, 0)
         for oid in target_ids:
@@ -214,10 +217,7 @@ class EpisodeGeometry:
             if sub[k] < best:
                 best = float(sub[k])
                 goal = ((rows.start or 0) + int(k[0]), (cols.start or 0) + int(k[1]))
-        if math.isinf(best):
-            return None
-        path = astar(self.occ, (start.x, start.y), (self.X[goal], self.Y[goal]), max_snap=1.0)
-        return None if path is None else [(start.x, start.y), *path[1:]]
+        return best, goal
 
 
 def draw_start(spec: HouseSpec, geo: EpisodeGeometry, rooms: tuple[str, ...],
