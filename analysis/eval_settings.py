@@ -1,8 +1,9 @@
 """What the inputs of ``sgtool eval`` say about the settings they ran under: runs made
 apart (a lab's planner, a stored run of the baselines) are paired on their episodes, so a
-step budget or a planner's options that differ between them would decide a comparison
-without a word. :func:`settings_notes` reads the ``summary.json`` beside each
-``episodes.jsonl`` input (``sgtool bench`` writes both) and names what differs.
+step budget that differs between them would decide a comparison without a word.
+:func:`settings_notes` reads the ``summary.json`` beside each ``episodes.jsonl`` input
+(``sgtool bench`` writes both) and names what differs (a planner's options that differ are
+told apart by :func:`sgtool.analysis.eval_run.per_options`).
 """
 
 from __future__ import annotations
