@@ -154,6 +154,7 @@ class SceneGraph:
 
     # ----- look-ups -------------------------------------------------------------------
     def node(self, node_id: str) -> RoomNode | RegionNode | ObjectNode | DoorNode | None:
+        """The room, region, object or door of id ``node_id``; None when there is none."""
         for group in (self.rooms, self.regions, self.objects, self.doors):
             for n in group:
                 if n.id == node_id:
@@ -161,25 +162,36 @@ class SceneGraph:
         return None
 
     def node_ids(self) -> set[str]:
+        """The ids of every room, region, object and door."""
         return {n.id for g in (self.rooms, self.regions, self.objects, self.doors) for n in g}
 
     def room(self, room_id: str) -> RoomNode | None:
+        """The room of id ``room_id`` (``room:0``); None when there is none."""
         return next((r for r in self.rooms if r.id == room_id), None)
 
     def objects_in(self, room_id: str) -> tuple[ObjectNode, ...]:
+        """The objects assigned to room ``room_id`` (their ``room``), furniture and small
+        objects alike, in graph order."""
         return tuple(o for o in self.objects if o.room == room_id)
 
     def children(self, node_id: str) -> tuple[ObjectNode, ...]:
+        """The objects whose ``parent`` is the object ``node_id`` (what lies on or in a
+        piece of furniture); a room's objects are :meth:`objects_in`."""
         return tuple(o for o in self.objects if o.parent == node_id)
 
     def frontiers(self) -> tuple[RegionNode, ...]:
+        """The regions of kind ``frontier``: where known free floor meets unexplored
+        space."""
         return tuple(r for r in self.regions if r.kind == "frontier")
 
     def categories(self) -> set[str]:
+        """The categories of the graph's objects."""
         return {o.category for o in self.objects}
 
     # ----- canonical form -------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
+        """The graph as a JSON object (floats rounded, lists sorted: :meth:`to_json`)."""
+
         def room(n: RoomNode) -> dict[str, Any]:
             d = _shallow(n)
             d["position"] = canonical_floats(n.position)
@@ -298,6 +310,8 @@ class SceneGraph:
 
     @classmethod
     def from_json(cls, text: str | bytes) -> SceneGraph:
+        """The graph of :meth:`to_json`'s text; anything else is one
+        :class:`~sgtool.errors.ArgumentError` line, as for :meth:`from_dict`."""
         try:
             d = json.loads(text)
         except ValueError as e:  # JSONDecodeError, UnicodeDecodeError
