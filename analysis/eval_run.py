@@ -270,14 +270,17 @@ def _unlike_episodes(results: Sequence[EpisodeResult]) -> str | None:
 def _unpaired_shortest(results: Sequence[EpisodeResult]) -> str | None:
     """A note when runs of one (house, episode, seed, query) disagree on its shortest path
     (to 1 cm): the paired tables keep them apart."""
-    paths: dict[tuple[str, int, int, str, str], set[float]] = {}
+    from sgtool.analysis.intervals import pair_key
+
+    paths: dict[tuple[object, ...], set[float]] = {}
     for r in results:  # per noise profile, as pairs are made (the symbolic bench's is its own)
-        if r.shortest_m is not None and math.isfinite(r.shortest_m):
-            paths.setdefault(_episode_key(r)[1:], set()).add(round(r.shortest_m, 2))
+        *episode, short = pair_key(r)  # (rounded as the pairing rounds it)
+        if short is not None:
+            paths.setdefault((*episode, r.noise or ""), set()).add(short)
     odd = sorted(k for k, v in paths.items() if len(v) > 1)
     if not odd:
         return None
-    h, e, _, q, _ = odd[0]
+    h, e, _, q, _ = odd[0]  # house, episode, seed, query, noise
     return (f"{len(odd)} episode(s) have other shortest paths in the inputs (first: {h} "
             f"episode {e}, {q}: {', '.join(f'{v:g}' for v in sorted(paths[odd[0]]))} m) and "
             "are not paired: other houses under one name, or closed-loop logs written "

@@ -268,7 +268,7 @@ class PairedComparison:
                 "losses": self.losses, "ties": self.ties}
 
 
-def _pair_key(r: EpisodeResult) -> tuple[str, int, int, str, float | None]:
+def pair_key(r: EpisodeResult) -> tuple[str, int, int, str, float | None]:
     """(house, episode, seed, query, shortest path to 1 cm): the shortest path keeps apart
     two houses under one name that drew the same query."""
     short = r.shortest_m
@@ -285,8 +285,8 @@ def paired_comparison(results: Sequence[EpisodeResult], planner: str, reference:
     :func:`planner_intervals`."""
     if check:
         _check_planners(results, planner, reference)
-    mine = {_pair_key(r): r for r in results if r.planner == planner}
-    ref = {_pair_key(r): r for r in results if r.planner == reference}
+    mine = {pair_key(r): r for r in results if r.planner == planner}
+    ref = {pair_key(r): r for r in results if r.planner == reference}
     common = sorted(mine.keys() & ref.keys())
     keys = _cluster_keys([mine[k] for k in common], cluster)
     pos = {k: i for i, k in enumerate(keys)}
