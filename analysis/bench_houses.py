@@ -229,13 +229,13 @@ DOOR_GAP = 0.02  # m between a door's two rooms: any gap is floor of neither (ro
 def _classifier_room_types() -> frozenset[str]:
     """The room types (category text) the shipped priors' room classifier names; empty when
     their metadata cannot be read."""
-    from sgtool.semantics.priors import METADATA_FILE, weights_folder
+    from sgtool.semantics.priors import PriorsVocabularyError, weights_metadata
 
     try:
-        meta = json.loads((weights_folder(None) / METADATA_FILE).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        types = weights_metadata(None).get("room_types", ())
+    except PriorsVocabularyError:
         return frozenset()
-    return frozenset(category_text(t) for t in meta.get("room_types", ()))
+    return frozenset(category_text(t) for t in types if isinstance(t, str))
 
 
 def house_notes(house: Any) -> tuple[str, ...]:

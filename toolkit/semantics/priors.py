@@ -36,7 +36,7 @@ import json
 import os
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -215,11 +215,10 @@ class PriorsVocabularyError(SgtoolError):
     """A weights folder whose metadata does not list the queries it was trained on."""
 
 
-def training_queries(weights_dir: str | Path | None = None) -> frozenset[str]:
-    """The query categories (canonical text) the distilled priors in ``weights_dir`` (the
-    shipped ones by default) were trained on, from the ``training_queries`` of their
-    ``metadata.json`` (written by ``sgtool distill`` since metadata version 4). A query is
-    *seen* by those priors when its :func:`category_text` is in this set."""
+def weights_metadata(weights_dir: str | Path | None = None) -> dict[str, Any]:
+    """The ``metadata.json`` of the distilled priors in ``weights_dir`` (the shipped ones by
+    default; not an object: empty); a missing or unreadable file is one
+    :class:`PriorsVocabularyError` line."""
     path = weights_folder(weights_dir) / METADATA_FILE
     try:
         meta = json.loads(path.read_text(encoding="utf-8"))
@@ -228,7 +227,16 @@ def training_queries(weights_dir: str | Path | None = None) -> frozenset[str]:
                                     "weights") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
         raise PriorsVocabularyError(f"{path}: cannot read weights metadata ({e})") from None
-    queries = meta.get("training_queries") if isinstance(meta, dict) else None
+    return meta if isinstance(meta, dict) else {}
+
+
+def training_queries(weights_dir: str | Path | None = None) -> frozenset[str]:
+    """The query categories (canonical text) the distilled priors in ``weights_dir`` (the
+    shipped ones by default) were trained on, from the ``training_queries`` of their
+    ``metadata.json`` (written by ``sgtool distill`` since metadata version 4). A query is
+    *seen* by those priors when its :func:`category_text` is in this set."""
+    path = weights_folder(weights_dir) / METADATA_FILE
+    queries = weights_metadata(weights_dir).get("training_queries")
     if not isinstance(queries, list) or not all(isinstance(q, str) for q in queries):
         raise PriorsVocabularyError(
             f"{path}: training_queries: missing or not a list of strings (weights distilled "
