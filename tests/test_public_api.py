@@ -304,6 +304,13 @@ def test_api_mistakes_are_one_line_errors(tmp_path) -> None:
     with pytest.raises(sgtool.SgtoolError,
                        match="noise: a NoiseProfile or a profile's text, got int"):
         sgtool.ClosedLoopOptions(noise=3)  # type: ignore[arg-type]
+    for bad, said in ((dict(max_steps=0), "--max-steps 0: must be >= 1"),
+                      (dict(frames=0), "--frames 0: must be >= 1"),
+                      (dict(voxel_size=5.0), "voxel size 5.0 m: must be 0.01..0.5"),
+                      (dict(navigation="map"), "navigation 'map': one of live, house")):
+        with pytest.raises(sgtool.SgtoolError) as e:  # when built, not when an episode runs
+            sgtool.ClosedLoopOptions(**bad)  # type: ignore[arg-type]
+        assert str(e.value) == said
     with pytest.raises(sgtool.SgtoolError, match="options: a ReplayOptions, got str"):
         sgtool.replay("any.mcap", options="every=5")  # type: ignore[arg-type]
     with pytest.raises(sgtool.SgtoolError, match=r"__main__.*workers=1"):

@@ -84,6 +84,11 @@ class ClosedLoopOptions:
         else:
             of_type("noise", self.noise, NoiseProfile, "a NoiseProfile or a profile's text")
         typed_fields(self)  # max_steps="3", camera=(96, 72): one line here
+        if self.max_steps < 1:
+            raise SgtoolError(f"--max-steps {self.max_steps}: must be >= 1")
+        if self.frames is not None and self.frames < 1:
+            raise SgtoolError(f"--frames {self.frames}: must be >= 1")
+        self.mapping()  # every other range, here rather than when an episode runs
 
     def keyframes(self) -> KeyframeRule:
         """Which ticks are frames (a one-line :class:`~sgtool.errors.SgtoolError` when
