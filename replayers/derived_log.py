@@ -307,9 +307,9 @@ def replay(
     of_type("log", log, (str, os.PathLike), "a log's path")
     if options is not None:
         of_type("options", options, ReplayOptions, "a ReplayOptions")
-    function("on_refresh", on_refresh)
+    function("on_refresh", on_refresh, ("refresh", "stream"))
     progress = check_progress("progress", progress)
-    function("room_classifier", room_classifier)
+    function("room_classifier", room_classifier, ("name",))
     if output is not None and not os.fspath(output):
         raise SgtoolError("output: an empty path; give the derived log's name (*.mcap)")
     src = Path(log)

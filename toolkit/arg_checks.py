@@ -5,6 +5,7 @@ number >= 1``), not an error deep inside a stage."""
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import math
 import sys
 import types
@@ -53,11 +54,23 @@ def of_type(name: str, value: Any, kind: type | tuple[type, ...], what: str) -> 
     return value
 
 
-def function(name: str, value: Any) -> Any:
+def function(name: str, value: Any, takes: tuple[str, ...] | None = None) -> Any:
     """``value`` when it is None or callable, else one line: ``{name}: a function, got
-    {type}``."""
-    if value is not None and not callable(value):
+    {type}``. With ``takes`` (the names of the arguments it is called with, positionally)
+    a function that cannot be called so is one line too, now rather than at its first
+    call (a function whose signature Python cannot read passes)."""
+    if value is None:
+        return value
+    if not callable(value):
         raise SgtoolError(f"{name}: a function, got {type(value).__name__}")
+    if takes is not None:
+        try:
+            inspect.signature(value).bind(*takes)
+        except (ValueError, TypeError) as e:
+            if isinstance(e, TypeError):
+                own = getattr(value, "__name__", type(value).__name__)
+                raise SgtoolError(f"{name}: called as {name}({', '.join(takes)}), which "
+                                  f"{own} cannot take ({e})") from None
     return value
 
 

@@ -216,6 +216,26 @@ def test_a_bad_replay_option_names_its_flag(options, flag):
         replay(TOUR, None, options)
 
 
+def test_a_callback_that_cannot_take_its_arguments_is_refused_before_any_frame(tmp_path):
+    """``on_refresh`` is called with (refresh, stream): a one-argument function is one line
+    before the replay starts (not a TypeError after frames were integrated); an output
+    file is not begun."""
+    from sgtool.errors import SgtoolError
+
+    def one(ref):
+        raise AssertionError("never called")
+
+    out = tmp_path / "out.mcap"
+    with pytest.raises(SgtoolError) as e:
+        replay(TOUR, out, ReplayOptions(), on_refresh=one)
+    assert str(e.value).startswith("on_refresh: called as on_refresh(refresh, stream), "
+                                   "which one cannot take (too many positional arguments")
+    assert not out.exists()
+    with pytest.raises(SgtoolError, match=r"room_classifier: called as room_classifier\(name"):
+        replay(TOUR, None, ReplayOptions(), room_classifier=lambda: None)
+    replay(TOUR, None, ReplayOptions(max_frames=2), on_refresh=lambda *a: None)  # *args: fine
+
+
 def test_the_voronoi_arrays_handed_out_are_read_only(tmp_path):
     """A refresh's Voronoi graph may be reused by the next refresh: a caller cannot edit
     its arrays (it would change later graphs)."""
