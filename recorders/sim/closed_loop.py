@@ -115,6 +115,7 @@ from sgtool.planning.episode import (
     search_success,
 )
 from sgtool.planning.plugins import held_to_contract
+from sgtool.planning.registry import make_planner
 from sgtool.progress import Progress
 from sgtool.recorders.sim.closed_loop_options import (  # noqa: F401 (re-exported)
     N_MAX,
@@ -468,7 +469,7 @@ class _Search:
         return execute_live(self.sim, self.skills, calls, self.rec.stream.current)
 
 
-def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
+def run_episode(house: HouseSpec, episode: Episode, planner: Planner | str,
                 output: str | os.PathLike[str], options: ClosedLoopOptions | None = None, *,
                 house_id: str = "", episode_index: int = 0,
                 overwrite: bool = False, progress: Progress | None = None,
@@ -477,10 +478,11 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
     """Run one closed-loop search episode into the log ``output`` (module doc) through
     :func:`sgtool.planning.episode.run_search`.
 
-    ``planner`` is built by the caller (:func:`sgtool.planning.registry.make_planner`, with
+    ``planner`` is a planner (:func:`sgtool.planning.registry.make_planner`'s, with
     ``planner_options``: recorded in the episode records' ``extra.planner_options``, plain
     values only and secrets left out, so that the log's planner can be built again; when
-    None, the options ``make_planner`` built it with) and
+    None, the options ``make_planner`` built it with), or a name ``make_planner`` builds
+    here from ``planner_options`` (recorded as converted), and it is
     closed here (its ``close()``, when it has one) when the episode ends; its LLM
     exchanges, when it keeps them (``drain_exchanges()``, moma-llm), are logged after each
     decision. A planner object of the user's is held to the contract a plug-in is
@@ -490,22 +492,20 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner,
     """
     of_type("house", house, HouseSpec, "a HouseSpec (sgtool.load_house(path))")
     of_type("episode", episode, Episode, "an Episode (sgtool.pick_episode(house))")
-    function("on_decision", on_decision)
+    function("on_decision", on_decision, ("graph", "action"))
     if options is not None:
         of_type("options", options, ClosedLoopOptions, "a ClosedLoopOptions")
     if Path(output).suffix != ".mcap":
         raise SgtoolError(f"{output}: the output is an MCAP log; name it *.mcap")
     require("pybullet", api="sgtool.run_closed_loop")  # one line on a core install
+    if isinstance(planner, str):  # recorded as make_planner converted them
+        planner, planner_options = make_planner(planner, **(planner_options or {})), None
     recorded = options_record(planner, planner_options)
     planner = held_to_contract(planner)  # a user's planner object: one line for its faults
     opts = options or ClosedLoopOptions()
     if bad := refused_number(recorded.get("planner_options", {})):  # now, not at the end
         raise SgtoolError(f"planner option {bad[0]}={bad[1]}: a finite number (the "
                           "episode's log records it)")
-    if opts.max_steps < 1:
-        raise SgtoolError(f"--max-steps {opts.max_steps}: must be >= 1")
-    if opts.frames is not None and opts.frames < 1:
-        raise SgtoolError(f"--frames {opts.frames}: must be >= 1")
     mapping = opts.mapping()
     name = str(getattr(planner, "name", "planner"))
     classifier = _classifier(mapping.classifier)

@@ -468,6 +468,8 @@ def make_planner(name: str, **options: Any) -> Planner:
         planner = plugins.build_plugin(name, _factory(name), options)
     else:
         planner = _build(key, entry, options)
+        # recorded as converted, so "2" from Python is recorded as -O's 2.0 is
+        given = convert_options(key, entry.options, given)
     if not timed and entry is not None:
         # the options it was built with, which a closed-loop log records (run_episode)
         planner.given_options = given  # type: ignore[attr-defined]

@@ -501,6 +501,14 @@ def test_the_log_keeps_the_planners_options(house, tmp_path) -> None:
     with LogReader(out) as r:
         records = [e for _, e in r.records("episode")]
     assert [e["extra"]["planner_options"] for e in records] == [{"max_failures": 3}] * 2
+    # a planner by name, its options given as text from Python: recorded as -O records them
+    run_episode(house, ep, "bayes-search", out, ClosedLoopOptions(
+        camera=OPTS.camera, frames=25, turn_render_deg=0.0),
+        planner_options={"step_cost": "2", "top_k": "4"}, overwrite=True)
+    with LogReader(out) as r:
+        records = [e for _, e in r.records("episode")]
+    assert records[0]["planner"] == "bayes-search"
+    assert records[0]["extra"]["planner_options"] == {"step_cost": 2.0, "top_k": 4}
     assert recorded_options({"api_key": "sk-1", "encoder": object(), "delta": 0.2,
                              "rooms": ["a", "b"]}) == {"delta": 0.2, "rooms": ["a", "b"]}
 
