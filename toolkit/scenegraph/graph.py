@@ -19,13 +19,15 @@ from __future__ import annotations
 
 import functools
 import json
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields
-from typing import Any, Literal
+from typing import Any, Literal, TypeVar
 
 from sgtool.canonical import canonical_float, canonical_floats
 from sgtool.errors import ArgumentError
 from sgtool.vocabulary import OpenState, Relation
+
+_N = TypeVar("_N")
 
 SCENE_GRAPH_VERSION = "1.0"
 
@@ -271,38 +273,23 @@ class SceneGraph:
                 position=tuple(rb["position"]), yaw=rb.get("yaw", 0.0),
                 room=rb.get("room"), region=rb.get("region"),
             ),
-            rooms=tuple(
-                RoomNode(
-                    id=r["id"], category=r["category"], position=tuple(r["position"]),
-                    explored=r["explored"],
-                    category_scores=tuple((c, p) for c, p in r.get("category_scores", [])),
-                    neighbours=tuple(r.get("neighbours", [])),
-                )
-                for r in d.get("rooms", [])
-            ),
-            regions=tuple(
-                RegionNode(
-                    id=r["id"], room=r["room"], position=tuple(r["position"]), kind=r["kind"],
-                    frontier_type=r.get("frontier_type"), size=r.get("size", 0.0),
-                )
-                for r in d.get("regions", [])
-            ),
-            objects=tuple(
-                ObjectNode(
-                    id=o["id"], category=o["category"], parent=o["parent"], room=o["room"],
-                    position=tuple(o["position"]), instance=o.get("instance", -1),
-                    relation=o.get("relation"), state=o.get("state"),
-                    affordances=tuple(o.get("affordances", [])), explored=o.get("explored", False),
-                )
-                for o in d.get("objects", [])
-            ),
-            doors=tuple(
-                DoorNode(
-                    id=x["id"], position=tuple(x["position"]), state=x["state"],
-                    rooms=tuple(x.get("rooms", [])), instance=x.get("instance", -1),
-                )
-                for x in d.get("doors", [])
-            ),
+            rooms=_nodes(d, "rooms", lambda r: RoomNode(
+                id=r["id"], category=r["category"], position=tuple(r["position"]),
+                explored=r["explored"],
+                category_scores=tuple((c, p) for c, p in r.get("category_scores", [])),
+                neighbours=tuple(r.get("neighbours", [])))),
+            regions=_nodes(d, "regions", lambda r: RegionNode(
+                id=r["id"], room=r["room"], position=tuple(r["position"]), kind=r["kind"],
+                frontier_type=r.get("frontier_type"), size=r.get("size", 0.0))),
+            objects=_nodes(d, "objects", lambda o: ObjectNode(
+                id=o["id"], category=o["category"], parent=o["parent"], room=o["room"],
+                position=tuple(o["position"]), instance=o.get("instance", -1),
+                relation=o.get("relation"), state=o.get("state"),
+                affordances=tuple(o.get("affordances", [])),
+                explored=o.get("explored", False))),
+            doors=_nodes(d, "doors", lambda x: DoorNode(
+                id=x["id"], position=tuple(x["position"]), state=x["state"],
+                rooms=tuple(x.get("rooms", [])), instance=x.get("instance", -1))),
             distances=dict(d.get("distances", {})),
             time_ns=int(d.get("time_ns", 0)),
             version=str(d.get("version", SCENE_GRAPH_VERSION)),
@@ -317,6 +304,21 @@ class SceneGraph:
         except ValueError as e:  # JSONDecodeError, UnicodeDecodeError
             raise ArgumentError(f"scene graph: not JSON ({e})") from None
         return cls.from_dict(d)
+
+
+def _nodes(d: Mapping[str, Any], key: str, build: Callable[[Any], _N]) -> tuple[_N, ...]:
+    """``build`` of each item of ``d[key]``; a fault names the item (``objects[3]
+    ('object:7'): field 'room' missing``), not only the field."""
+    out = []
+    for i, item in enumerate(d.get(key, [])):
+        try:
+            out.append(build(item))
+        except (KeyError, TypeError, AttributeError, ValueError) as e:
+            ident = item.get("id") if isinstance(item, Mapping) else None
+            where = f"{key}[{i}]" + (f" ({ident!r})" if isinstance(ident, str) else "")
+            why = f"field {e.args[0]!r} missing" if isinstance(e, KeyError) else str(e)
+            raise ArgumentError(f"scene graph: {where}: {why}") from None
+    return tuple(out)
 
 
 _FIELD_NAMES: dict[type, tuple[str, ...]] = {}

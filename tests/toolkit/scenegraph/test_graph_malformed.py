@@ -17,6 +17,14 @@ from sgtool.scenegraph.graph import SceneGraph
     ({"version": "1.0"}, "scene graph: field 'robot' missing"),
     ("{}", "scene graph: a JSON object, got str"),
     ({"version": "9.0"}, "scene graph version 9.0 is not readable"),
+    # a node's fault names the node: which list, which item, its id when it has one
+    ({"version": "1.0", "robot": {"position": [0, 0]}, "objects": [
+        {"id": "object:1", "category": "cup", "parent": "room:0", "room": "room:0",
+         "position": [0, 0, 0]},
+        {"id": "object:2", "category": "mug", "parent": "room:0", "position": [1, 0, 0]}]},
+     r"^scene graph: objects\[1\] \('object:2'\): field 'room' missing$"),
+    ({"version": "1.0", "robot": {"position": [0, 0]}, "doors": [7]},
+     r"^scene graph: doors\[0\]: 'int' object is not subscriptable$"),
 ])
 def test_from_dict_names_what_is_wrong(given, message) -> None:
     with pytest.raises(ArgumentError, match=message) as e:
