@@ -580,8 +580,8 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
         else:
             dropped, pairs = dropped + late, pairs[:len(poses)]
     intr = folder_intrinsics(root)
-    texts = sorted((p for p in root.glob("*.txt")
-                    if p.stem.lower().replace("-", "_") in INTRINSICS_TEXTS),
+    texts = sorted((p for p in root.iterdir() if p.suffix.lower() == ".txt"  # .TXT too
+                    and p.stem.lower().replace("-", "_") in INTRINSICS_TEXTS),
                    key=lambda p: ("depth" not in p.stem.lower(), p.name))  # depth's first
     for p in [*sorted(root.glob("*.json")), *texts] if intr is None else ():
         if p.suffix != ".json" or is_intrinsics_json(p):

@@ -679,10 +679,12 @@ def test_an_open3d_folder_reads_the_depth_cameras_intrinsics_file(tmp_path: Path
     assert (k.fx, k.source) == (577.0, "file intrinsic_depth.txt")
 
 
-@pytest.mark.parametrize("name", ["camera-intrinsics.txt", "depth_intrinsics.txt"])
+@pytest.mark.parametrize("name", ["camera-intrinsics.txt", "depth_intrinsics.txt",
+                                  "Intrinsics.TXT"])
 def test_other_names_of_an_intrinsics_file_are_read(tmp_path: Path, name: str) -> None:
-    """7-Scenes' and tsdf-fusion's camera-intrinsics.txt, a depth_intrinsics.txt: read as
-    the folder's intrinsics (not passed over for the PrimeSense default)."""
+    """7-Scenes' and tsdf-fusion's camera-intrinsics.txt, a depth_intrinsics.txt, a name in
+    capitals (a Windows tool's): read as the folder's intrinsics (not passed over for the
+    PrimeSense default)."""
     root = open3d_folder(tmp_path / "f", [str(i) for i in range(3)])
     (root / name).write_text("600 0 16\n0 600 12\n0 0 1\n")
     assert read_sequence(root).intrinsics.fx == 600.0
