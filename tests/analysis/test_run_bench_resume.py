@@ -366,3 +366,21 @@ def test_a_log_recovered_from_a_cut_run_is_not_resumed(tmp_path: Path, keep: flo
     line = r.output.strip().splitlines()[-1]  # no option given again mends such a log
     assert r.exit_code == 2 and line.endswith(("delete the log to run the episode again",
                                                "delete it to run the episode again")), line
+
+
+def test_a_resumed_log_s_shortest_path_is_measured_as_now(tmp_path: Path,
+                                                          monkeypatch) -> None:
+    """SPL's shortest path of a resumed log is measured again as a new run measures it
+    (a log of older code kept the grid geodesic), so a run resumed across the change pairs
+    its episodes; the log's own figure is not read."""
+    _, _, out, cmd = _first_run(tmp_path)
+
+    def shortest(name: str) -> float:
+        (row,) = [json.loads(line) for line in (out / name).read_text().splitlines()]
+        return float(row["shortest_m"])
+
+    logged = shortest("episodes.jsonl")
+    monkeypatch.setattr(clb, "run_episode", lambda *a, **k: pytest.fail("ran again"))
+    monkeypatch.setattr(clb, "driven_shortest", lambda spec, ep: logged + 1.25)
+    assert CliRunner().invoke(cli, cmd).exit_code == 0
+    assert shortest("episodes.jsonl") == pytest.approx(logged + 1.25)
