@@ -299,7 +299,7 @@ def _check_poses(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
     findings.problem(problem, given=opts.intrinsics is not None)
     if explains:
         return
-    for text in convention_problems(pairs, k, fit, src.describe):
+    for text in convention_problems(pairs, k, fit, src.describe, bag=True):
         findings.problem(text, given=estimate)
     motion = pose_motion_problem(fit, src.describe)
     if motion is not None:

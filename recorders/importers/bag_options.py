@@ -18,6 +18,7 @@ from sgtool.recorders.importers.checks import (
     check_non_negative,
     check_positive,
 )
+from sgtool.recorders.importers.pose_axes import check_camera_axes
 from sgtool.recorders.importers.sanity import DEFAULT_CAMERA_HEIGHT
 from sgtool.recorders.importers.textformats import PinholeParams
 
@@ -54,6 +55,7 @@ class BagOptions:
     allow_drop: bool = False  # depth images without a pose may be more than 10 %
     time_offset_ns: int = 0  # added to the images' times (header stamps or record times)
     instances: Instances | None = None  # what the ids stand for (:mod:`.instance_table`)
+    camera_axes: str = "optical"  # the axes of the posed camera frame (:mod:`.pose_axes`)
 
 
 def check_options(opts: BagOptions) -> None:
@@ -63,6 +65,7 @@ def check_options(opts: BagOptions) -> None:
     check_depth_scale(opts.depth_scale)
     check_height_band(opts.camera_height)
     check_intrinsics(opts.intrinsics)
+    check_camera_axes(opts.camera_axes)
     if opts.timestamps not in ("header", "bag"):
         raise SgtoolError(f"--timestamps {opts.timestamps!r}: give header or bag")
     check_positive(opts.depth_max, "--depth-max", "metres")

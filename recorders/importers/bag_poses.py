@@ -5,7 +5,7 @@ its frames and links."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +14,7 @@ from sgtool.errors import SgtoolError
 from sgtool.log.poses import PoseTrack
 from sgtool.recorders.importers.bag_index import BagIndex
 from sgtool.recorders.importers.bag_options import BagOptions
+from sgtool.recorders.importers.pose_axes import to_optical
 from sgtool.recorders.importers.tftree import TfTree, frame_name
 
 
@@ -29,10 +30,15 @@ class PoseSource:
     tree: TfTree | None = None
     track: PoseTrack | None = None
     mounted_on: str = ""  # the frame the track gives the pose of, when not the camera's
+    axes: str = "optical"  # the camera frame's axes (:mod:`.pose_axes`): turned to optical
 
     def at(self, t_ns: int, camera: str | None = None) -> np.ndarray | None:
-        """The pose at ``t_ns`` (of frame ``camera`` instead of the source's, in a tree);
-        None where it cannot be resolved."""
+        """The pose of the optical frame at ``t_ns`` (of frame ``camera`` instead of the
+        source's, in a tree); None where it cannot be resolved."""
+        pose = self._frame_at(t_ns, camera)
+        return pose if pose is None or self.axes == "optical" else to_optical(pose, self.axes)
+
+    def _frame_at(self, t_ns: int, camera: str | None) -> np.ndarray | None:
         if self.track is not None:
             pose = self.track.at(t_ns)
             if pose is None or not self.mounted_on:
@@ -52,6 +58,17 @@ def _links(tree: TfTree, most: int = 12) -> str:
 
 
 def pose_source_of(path: Path, idx: BagIndex, opts: BagOptions) -> PoseSource:
+    """Where the camera's poses come from (``--pose``, ``--tf-frames`` or the depth
+    images' frame in its tree), read with ``--camera-axes``; a one-line error naming the
+    flags when the bag does not give them."""
+    src = _source_of(path, idx, opts)
+    if opts.camera_axes == "optical":
+        return src
+    return replace(src, axes=opts.camera_axes,
+                   describe=f"{src.describe}, camera axes {opts.camera_axes}")
+
+
+def _source_of(path: Path, idx: BagIndex, opts: BagOptions) -> PoseSource:
     if opts.pose is not None:
         if not idx.pose_samples:
             raise SgtoolError(f"{path}: --pose {opts.pose} has no messages")

@@ -20,7 +20,7 @@ depth scale, up direction and floor came from.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -64,6 +64,7 @@ from sgtool.recorders.importers.odometry import (
     drift_where_known,
     estimate_with_progress,
 )
+from sgtool.recorders.importers.pose_axes import check_camera_axes, convention_text, to_optical
 from sgtool.recorders.importers.provenance import (
     ESTIMATED_FLOORS,
     FLOOR_ORIGINS,
@@ -112,8 +113,9 @@ class RgbdOptions:
     ``layout`` (None: detected), ``depth_scale`` and ``intrinsics`` (None: the layout's),
     ``fps``, a ``trajectory`` file or ``estimate_poses`` by ``odometry``, ``up`` and
     ``floor`` (None: estimated), ``every``/``limit`` on the frames, ``timestamps``
-    (``file``: the listed times; ``index``: n / fps). :func:`check_options` checks them
-    before anything is read."""
+    (``file``: the listed times; ``index``: n / fps), the poses' ``camera_axes`` and
+    ``world_to_camera`` (:mod:`.pose_axes`). :func:`check_options` checks them before
+    anything is read."""
 
     layout: str | None = None
     depth_scale: float | None = None  # raw units per metre; None = the layout's
@@ -136,6 +138,9 @@ class RgbdOptions:
     camera_height: tuple[float, float] = DEFAULT_CAMERA_HEIGHT  # plausible band, m
     warn: Callable[[str], None] | None = None  # shows a warning at once
     allow_drop: bool = False  # frames the poses do not cover may be more than 10 %
+    # the convention of the folder's (or ``trajectory``'s) poses (:mod:`.pose_axes`)
+    camera_axes: str = "optical"
+    world_to_camera: bool = False
 
 
 def check_options(opts: RgbdOptions) -> None:
@@ -150,6 +155,20 @@ def check_options(opts: RgbdOptions) -> None:
     check_range(opts.max_dt_ns / 1e9, "--max-dt", 0.0, MAX_DT_S, "seconds")
     check_floor(opts.floor)
     check_intrinsics(opts.intrinsics)
+    check_camera_axes(opts.camera_axes)
+
+
+def in_sgtool_convention(seq: FolderSequence, axes: str,
+                         world_to_camera: bool) -> FolderSequence:
+    """``seq`` with its poses, given with camera ``axes`` (and inverted), turned into
+    camera-to-world poses of the optical frame (:func:`~.pose_axes.to_optical`), and a
+    note saying so; ``seq`` itself in sgtool's own convention."""
+    said = convention_text(axes, world_to_camera)
+    if not said:
+        return seq
+    frames = tuple(replace(f, pose=None if f.pose is None else
+                           to_optical(f.pose, axes, world_to_camera)) for f in seq.frames)
+    return replace(seq, frames=frames, notes=(*seq.notes, f"poses read as given: {said}"))
 
 
 def drift_reference(seq: FolderSequence, trajectory: Path | None) -> str:
@@ -313,6 +332,7 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     seq = read_sequence(root, opts.layout, max_dt_ns=opts.max_dt_ns, fps=opts.fps,
                         trajectory=opts.trajectory, keep_unposed=opts.estimate_poses,
                         timestamps=opts.timestamps, skip_missing=opts.skip_missing)
+    seq = in_sgtool_convention(seq, opts.camera_axes, opts.world_to_camera)
     frames = list(seq.frames[:: opts.every])
     if opts.limit is not None:
         frames = frames[: opts.limit]

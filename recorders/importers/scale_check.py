@@ -25,6 +25,7 @@ import numpy as np
 
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.poses import pose_difference
+from sgtool.recorders.importers.pose_axes import CAMERA_AXES, to_optical
 from sgtool.recorders.importers.sanity import KNOWN_SCALES
 
 MIN_STEP_M = 0.02  # pose translation of a pair (m)
@@ -225,7 +226,7 @@ def geometric_scale_problem(fit: ScaleFit | None, scale: float, origin: str,
 
 
 def inverted_poses_problem(given: ScaleFit | None, inverted: ScaleFit | None,
-                           pose_source: str) -> str | None:
+                           pose_source: str, *, bag: bool = False) -> str | None:
     """When the poses' inverses move as the depth does (a consistent fit within
     :data:`TOLERANCE` of 1) and the poses themselves do not: world-to-camera poses, which
     the depth-scale and motion checks would otherwise take for a wrong scale (a few
@@ -238,8 +239,8 @@ def inverted_poses_problem(given: ScaleFit | None, inverted: ScaleFit | None,
     return (f"the poses ({pose_source}) look world-to-camera: between {inverted.pairs} pairs "
             f"of nearby frames the depth moves {how} as far as the poses, and "
             f"{inverted.ratio:.2f}x as far as their inverses; camera-to-world poses are "
-            "expected: invert them, or give --estimate-poses to estimate the poses from the "
-            "depth")
+            f"expected: {'invert them' if bag else 'give --world-to-camera to invert them'}, "
+            "or --estimate-poses to estimate the poses from the depth")
 
 
 POSE_UNITS = ((0.01, "centimetres"), (0.001, "millimetres"))
@@ -262,12 +263,13 @@ def poses_fit_depth(fit: ScaleFit | None) -> bool:
 
 
 def convention_problems(pairs: Pairs, k: CameraIntrinsics, fit: ScaleFit | None,
-                        pose_source: str) -> list[str]:
+                        pose_source: str, *, bag: bool = False) -> list[str]:
     """When the poses do not fit the depth (``fit``, of ``pairs`` as :func:`fit_scale`
     takes them): the problems of the poses' inverses, their translations in another unit,
-    their quaternions in another order or the camera's body frame fitting it
+    their quaternions in another order or the camera frame's other axes fitting it
     (:func:`inverted_poses_problem`, :func:`pose_units_problem`,
-    :func:`quaternion_order_problem`, :func:`body_frame_problem`); empty when the poses
+    :func:`quaternion_order_problem`, :func:`camera_axes_problem`), naming the flags of
+    ``sgtool import rgbd`` (``bag``: of ``sgtool import bag``); empty when the poses
     fit, or none does."""
     reordered_pairs = [(a, b, _wxyz_read_as_xyzw(p), _wxyz_read_as_xyzw(q))
                        for a, b, p, q in pairs]
@@ -288,38 +290,37 @@ def convention_problems(pairs: Pairs, k: CameraIntrinsics, fit: ScaleFit | None,
     units = [(unit, fit_scale([(a, b, _in_metres(p, f), _in_metres(q, f))
                                for a, b, p, q in pairs], k)) for f, unit in POSE_UNITS]
     reordered = fit_scale(reordered_pairs, k)
-    body = fit_scale([(a, b, p @ BODY_T_OPTICAL, q @ BODY_T_OPTICAL) for a, b, p, q in pairs],
-                     k)
-    found = (inverted_poses_problem(fit, inverted, pose_source),
+    axes = {name: fit_scale([(a, b, to_optical(p, name), to_optical(q, name))
+                             for a, b, p, q in pairs], k)
+            for name in CAMERA_AXES if name != "optical"}
+    found = (inverted_poses_problem(fit, inverted, pose_source, bag=bag),
              pose_units_problem(units, pose_source),
              quaternion_order_problem(fit, reordered, pose_source),
-             body_frame_problem(fit, body, pose_source))
+             camera_axes_problem(fit, axes, pose_source, bag=bag))
     return [x for x in found if x is not None]
 
 
-# the optical frame (z forward, x right, y down) in a camera's body frame (ROS's
-# camera_link: x forward, y left, z up)
-BODY_T_OPTICAL = np.array([[0.0, 0.0, 1.0, 0.0], [-1.0, 0.0, 0.0, 0.0],
-                           [0.0, -1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
-
-
-def body_frame_problem(given: ScaleFit | None, body: ScaleFit | None,
-                       pose_source: str) -> str | None:
-    """When the poses taken as those of the camera's body frame (``body``: each turned
-    into the optical frame by :data:`BODY_T_OPTICAL`) move as the depth does and the poses
-    as read (``given``) do not: the poses of ROS's ``camera_link`` (x forward, z up), not
-    of the optical frame sgtool reads depth in. The text; None otherwise."""
-    if not clearly_fits(body) or poses_fit_depth(given):
+def camera_axes_problem(given: ScaleFit | None, fits: dict[str, ScaleFit | None],
+                        pose_source: str, *, bag: bool = False) -> str | None:
+    """When the poses taken as those of a camera frame with other axes (``fits``, by name
+    of :data:`~.pose_axes.CAMERA_AXES`: each turned into the optical frame) move as the
+    depth does and the poses as read (``given``) do not: the poses of OpenGL's camera
+    frame or of ROS's ``camera_link``, not of the optical frame sgtool reads depth in. The
+    text, naming ``--camera-axes``; None otherwise."""
+    fitting = [(name, fit) for name, fit in fits.items() if fit is not None and clearly_fits(fit)]
+    if not fitting or poses_fit_depth(given):
         return None
-    assert body is not None
+    name, fit = min(fitting, key=lambda nf: abs(nf[1].ratio - 1.0))
     moves = ("no consistent factor" if given is None else f"{given.ratio:.2f}x"
              if given.consistent() else f"{given.ratio:.2f}x on average, the pairs disagreeing,")
-    return (f"the poses ({pose_source}) look like those of the camera's body frame (x "
-            f"forward, z up, as ROS's camera_link), not of its optical frame (z forward, x "
-            f"right, y down): between {body.pairs} pairs of nearby frames the depth moves "
-            f"{moves} as far as the poses, and {body.ratio:.2f}x as far as the optical frame "
-            "they imply; give the optical frame's poses (a bag: --tf-frames WORLD:"
-            "CAMERA_OPTICAL_FRAME), or --estimate-poses to estimate them from the depth")
+    other = (", or --tf-frames WORLD:CAMERA_OPTICAL_FRAME where the tree has the optical "
+             "frame" if bag and name == "body" else "")
+    return (f"the poses ({pose_source}) look like those of a camera frame with {name} axes "
+            f"({CAMERA_AXES[name][1]}), not of its optical frame (x right, y down, z "
+            f"forward): between {fit.pairs} pairs of nearby frames the depth moves {moves} as "
+            f"far as the poses, and {fit.ratio:.2f}x as far as the optical frame they imply; "
+            f"give --camera-axes {name} to read them so{other}, or --estimate-poses to "
+            "estimate the poses from the depth")
 
 
 def _wxyz_read_as_xyzw(pose: np.ndarray) -> np.ndarray:

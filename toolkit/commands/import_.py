@@ -160,6 +160,15 @@ _common_options = option_group([
 ])
 
 
+_camera_axes_option = click.option(
+    "--camera-axes", type=click.Choice(["optical", "opengl", "body"]), default="optical",
+    show_default=True,
+    help="Axes of the camera frame the poses are given in: optical (x right, y down, z "
+    "forward: OpenCV's, ROS's *_optical_frame), opengl (x right, y up, z backward: OpenGL's, "
+    "NeRF's, Blender's) or body (x forward, y left, z up: ROS's camera_link). The pose "
+    "check names the one that fits when the poses as read do not move as the depth does.")
+
+
 def _odometry_options(estimate_help: str, odometry_help: str,
                       depth_max_help: str) -> Callable[[Any], Any]:
     """``--estimate-poses``, ``--odometry`` and ``--depth-max``, with the command's help."""
@@ -220,6 +229,7 @@ def command() -> None:
     depth_max_help="Depth beyond this (m) is ignored by the odometry.")
 @click.option("--list", "list_only", is_flag=True,
               help="List the bag's topics, tf links and suggested flags, and stop.")
+@_camera_axes_option
 @_world_options
 @_common_options
 def bag(path: str, list_only: bool, output: str | None, force: bool, as_json: bool,
@@ -284,7 +294,7 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None,
                  odometry: str, depth_max: float, up: str, floor: str, camera_height: str,
                  intrinsics: str | None, depth_scale: float | None, max_dt: float,
                  every: int, limit: int | None, compression: str, allow_drop: bool,
-                 quiet: bool) -> Any:
+                 quiet: bool, camera_axes: str) -> Any:
     """The options of `sgtool import bag` (other than the output), each checked, as
     :class:`sgtool.recorders.importers.bag.BagOptions`."""
     from sgtool.recorders.importers.bag import BagOptions
@@ -306,7 +316,7 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None,
         compression=compression, estimate_poses=estimate_poses, odometry=odometry,
         depth_max=depth_max, camera_height=parse_height_band(camera_height), warn=_warn,
         timestamps=timestamps, allow_drop=allow_drop,
-        time_offset_ns=_offset_ns(time_offset),
+        time_offset_ns=_offset_ns(time_offset), camera_axes=camera_axes,
     )
 
 
@@ -344,6 +354,10 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None,
     odometry_help="Odometry: Open3D RGB-D odometry refined by point-to-plane ICP, RGB-D "
     "odometry alone, or ICP alone.",
     depth_max_help="Depth beyond this (m) is ignored by the odometry (not by the import).")
+@_camera_axes_option
+@click.option("--world-to-camera", is_flag=True,
+              help="The poses map the world into the camera (extrinsics, as COLMAP and some "
+              "SLAM systems write them), not the camera into the world: each is inverted.")
 @_world_options
 @_common_options
 def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bool,
@@ -352,7 +366,7 @@ def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bo
          output: str | None,
          intrinsics: str | None, depth_scale: float | None, max_dt: float, every: int,
          limit: int | None, compression: str, force: bool, allow_drop: bool, as_json: bool,
-         quiet: bool) -> None:
+         quiet: bool, camera_axes: str, world_to_camera: bool) -> None:
     """Import an RGB-D image folder (TUM RGB-D, 7-Scenes, Open3D/Redwood) at FOLDER.
 
     Log times are the dataset's time stamps (TUM) or frame number / --fps. Poses are the
@@ -379,6 +393,6 @@ def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bo
         max_dt_ns=seconds_option_ns(max_dt, "--max-dt", MAX_DT_S),
         progress=not quiet, compression=compression, timestamps=timestamps,
         skip_missing=skip_missing, camera_height=parse_height_band(camera_height), warn=_warn,
-        allow_drop=allow_drop,
+        allow_drop=allow_drop, camera_axes=camera_axes, world_to_camera=world_to_camera,
     )
     _print_report(import_rgbd(folder, out, opts), as_json)

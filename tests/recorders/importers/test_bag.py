@@ -682,3 +682,37 @@ def test_poses_of_float_depth_are_checked_against_it_too(shared_data_dir, tmp_pa
     rep = import_bag(good, tmp_path / "g.mcap", BagOptions(**flags))
     assert rep.frames == 20
     assert dict(rep.checks)["depth scale against the poses"].startswith("depth moves 1.0")
+
+
+def test_a_tree_that_ends_at_the_body_frame_imports_with_camera_axes(shared_data_dir,
+                                                                     tmp_path):
+    """A tf tree whose camera frame is ROS's camera_link (x forward, z up) with no static
+    link to an optical frame: the refusal names --camera-axes body, with which the frames
+    are posed as the optical frame's poses were."""
+    import dataclasses
+
+    from sgtool.recorders.importers.pose_axes import BODY_T_OPTICAL
+    from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
+
+    icl = tmp_path / "icl.mcap"
+    import_rgbd(shared_data_dir / "rgbd" / "icl-livingroom1-micro", icl,
+                RgbdOptions(every=3, limit=20, progress=False))
+    with LogReader(icl) as r:
+        frames = list(r.frames())
+    body = [dataclasses.replace(f, pose=f.pose @ np.linalg.inv(BODY_T_OPTICAL))
+            for f in frames]
+    bag = tmp_path / "body"
+    write_frames_bag(body, bag, "ros2-mcap")
+    flags = dict(depth=TOPICS["depth"], rgb=TOPICS["rgb"], info=TOPICS["info"], **KEEP_WORLD)
+    with pytest.raises(SgtoolError, match=r"camera frame with body axes .* give --camera-axes "
+                       r"body to read them so, or --tf-frames WORLD:CAMERA_OPTICAL_FRAME"):
+        import_bag(bag, tmp_path / "b.mcap", BagOptions(**flags))
+    rep = import_bag(bag, tmp_path / "b.mcap", BagOptions(**flags, camera_axes="body"))
+    assert rep.frames == 20
+    with LogReader(tmp_path / "b.mcap") as r:
+        for want, got in zip(frames, r.frames(), strict=True):
+            assert np.allclose(want.pose, got.pose, atol=1e-5)
+    res = CliRunner().invoke(cli, ["import", "bag", str(bag), "-o", str(tmp_path / "c.mcap"),
+                                   "--camera-axes", "sideways"])
+    assert res.exit_code == 2 and "'sideways' is not one of 'optical', 'opengl', 'body'" \
+        in res.output

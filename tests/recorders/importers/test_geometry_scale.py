@@ -4,6 +4,7 @@ truth between nearby frames; the error names --depth-scale 10000, which imports.
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 from support.rgbd_scenes import look_at, make_scene_folder, room
 
@@ -200,7 +201,7 @@ def test_poses_in_another_convention_are_caught(tmp_path):
     with pytest.raises(SgtoolError, match=r"the poses \(ground truth\) look world-to-camera: "
                        r"between 6 pairs .* moves -1\.\d\dx on average, the pairs "
                        r"disagreeing, as far as the poses, and 1\.0\dx as far as their "
-                       r"inverses; .*invert them, or give --estimate-poses"):
+                       r"inverses; .*give --world-to-camera to invert them, or --estimate-poses"):
         import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
     assert not (tmp_path / "a.mcap").exists()
     rep = import_rgbd(root, tmp_path / "est.mcap",
@@ -279,7 +280,7 @@ def test_poses_of_the_cameras_body_frame_are_named(tmp_path):
     "another convention" in a warning, then the floor error's --floor wrote a wrong map."""
     import numpy as np
 
-    from sgtool.recorders.importers.scale_check import BODY_T_OPTICAL
+    from sgtool.recorders.importers.pose_axes import BODY_T_OPTICAL
 
     body = [p @ np.linalg.inv(BODY_T_OPTICAL) for p in POSES]
     root = make_scene_folder(tmp_path / "f", room(), POSES)
@@ -293,9 +294,58 @@ def test_poses_of_the_cameras_body_frame_are_named(tmp_path):
         out.append(" ".join([line.split()[0], *(f"{x:.9f}" for x in pose[:3, 3]),
                              *(f"{x:.9f}" for x in q)]))
     gt.write_text("\n".join(out) + "\n")
-    with pytest.raises(SgtoolError, match=r"look like those of the camera's body frame .* "
-                       r"and 1\.0\dx as far as the optical frame they imply"):
+    with pytest.raises(SgtoolError, match=r"look like those of a camera frame with body axes "
+                       r"\(x forward, y left, z up: ROS's camera_link\).* and 1\.0\dx as far "
+                       r"as the optical frame they imply; give --camera-axes body"):
         import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
+    rep = import_rgbd(root, tmp_path / "b.mcap", RgbdOptions(intrinsics=K, progress=False,
+                                                            camera_axes="body"))
+    assert rep.frames == len(POSES)
+    assert dict(rep.checks)["depth scale against the poses"].startswith("depth moves 1.0")
+
+
+def _posed_as(root, convert) -> None:
+    """The folder's ground truth rewritten with each pose turned by ``convert``."""
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    def turned(v):
+        m = np.eye(4)
+        m[:3, :3] = Rotation.from_quat(v[3:]).as_matrix()
+        m[:3, 3] = v[:3]
+        c = convert(m)
+        return [f"{x:.9f}" for x in (*c[:3, 3], *Rotation.from_matrix(c[:3, :3]).as_quat())]
+
+    _rewrite_ground_truth(root, turned)
+
+
+GL = np.diag([1.0, -1.0, -1.0, 1.0])  # NeRF's and Blender's camera: y up, looking along -z
+
+
+@pytest.mark.parametrize(("convert", "flags", "named"), [
+    (lambda m: m @ GL, dict(camera_axes="opengl"), "give --camera-axes opengl to read them so"),
+    (np.linalg.inv, dict(world_to_camera=True), "give --world-to-camera to invert them"),
+    (lambda m: np.linalg.inv(m @ GL), dict(world_to_camera=True, camera_axes="opengl"), None),
+], ids=["opengl", "world-to-camera", "both"])
+def test_poses_of_another_convention_import_with_the_flag_named(tmp_path, convert, flags,
+                                                                named):
+    """Poses written in another camera frame's axes or world-to-camera: the refusal names
+    the flag that reads them (the check may name either of two conventions when both are
+    wrong at once), and with it the frames are posed as the ground truth is."""
+    from sgtool.log.reader import LogReader
+
+    plain = make_scene_folder(tmp_path / "plain", room(), POSES)
+    import_rgbd(plain, tmp_path / "plain.mcap", RgbdOptions(intrinsics=K, progress=False))
+    root = make_scene_folder(tmp_path / "f", room(), POSES)
+    _posed_as(root, convert)
+    with pytest.raises(SgtoolError, match=named or "give --"):
+        import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
+    rep = import_rgbd(root, tmp_path / "b.mcap", RgbdOptions(intrinsics=K, progress=False,
+                                                            **flags))
+    assert any(n.startswith("poses read as given: ") for n in rep.notes)
+    with LogReader(tmp_path / "plain.mcap") as a, LogReader(tmp_path / "b.mcap") as b:
+        for fa, fb in zip(a.frames(), b.frames(), strict=True):
+            assert np.allclose(fa.pose, fb.pose, atol=1e-6)
 
 
 def test_a_floor_error_after_doubted_poses_says_to_fix_the_poses_first():
