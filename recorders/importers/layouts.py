@@ -587,13 +587,20 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
         if p.suffix != ".json" or is_intrinsics_json(p):
             intr = replace(read_intrinsics_file(p), source=f"file {p.name}")
             break
+    default: PinholeParams | None = PRIMESENSE_INTRINSICS
+    if intr is None and (root / "intrinsic" / "intrinsic_color.txt").is_file():
+        # a ScanNet export without the depth camera's file: its colour camera's matrix is
+        # for the colour images' size, and the PrimeSense default is no ScanNet camera's
+        default = None
+        notes.append("intrinsic/intrinsic_color.txt not read: the colour camera's, not the "
+                     "depth images' (intrinsic/intrinsic_depth.txt)")
     frames = tuple(
         FolderFrame(round((slot[d] if slot else i) * 1e9 / fps), d, c,
                     poses[i] if poses is not None else None)
         for i, (d, c) in enumerate(pairs)
     )
     return FolderSequence(
-        "open3d", root, frames, intr or PRIMESENSE_INTRINSICS, 1000.0,
+        "open3d", root, frames, intr or default, 1000.0,
         "trajectory" if poses is not None else "none",
         ((f"poses from {traj.name}",) if traj is not None else ()) + tuple(notes),
         dropped=dropped,

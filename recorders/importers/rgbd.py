@@ -192,8 +192,10 @@ def camera_for(seq: FolderSequence, opts: RgbdOptions, width: int, height: int,
     p = opts.intrinsics or seq.intrinsics
     if p is None:
         raise SgtoolError(
-            f"{seq.root}: the {seq.layout} layout does not say the camera intrinsics; give "
-            "them with --intrinsics fx,fy,cx,cy (or an intrinsics file)"
+            f"{seq.root}: the {seq.layout} layout does not say the camera intrinsics"
+            + (" (intrinsic/ has only intrinsic_color.txt, the colour camera's)"
+               if any("intrinsic_color.txt not read" in n for n in seq.notes) else "")
+            + "; give them with --intrinsics fx,fy,cx,cy (or an intrinsics file)"
         )
     if (p.width and p.width != width) or (p.height and p.height != height):
         raise SgtoolError(

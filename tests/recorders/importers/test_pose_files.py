@@ -130,3 +130,20 @@ def test_zero_padded_pose_names_pair_with_plain_depth_names(tmp_path):
         (root / "pose" / f"{i:06d}.txt").rename(root / "pose" / f"frame-{i}.txt")
     r = imported(root, tmp_path / "s.mcap")
     assert r.exit_code == 2 and "none of its 3 pose files is named for a depth image" in r.output
+
+
+def test_only_the_colour_cameras_intrinsics_are_no_primesense_default(tmp_path):
+    """A ScanNet export with intrinsic_color.txt but no intrinsic_depth.txt: the colour
+    camera's matrix is not the depth images', and PrimeSense's default is no ScanNet
+    camera's: a refusal naming --intrinsics, not a map 10 % off with a warning blaming the
+    poses."""
+    root = tmp_path / "scene"
+    scannet_folder(root, n=3)
+    (root / "intrinsic" / "intrinsic_depth.txt").rename(root / "intrinsic" / "intrinsic_color.txt")
+    r = imported(root, tmp_path / "s.mcap")
+    assert r.exit_code == 2 and "only intrinsic_color.txt" in r.output
+    assert "--intrinsics" in r.output and not (tmp_path / "s.mcap").exists()
+    k = SMALL_K
+    r = imported(root, tmp_path / "s.mcap", "--intrinsics", f"{k.fx},{k.fy},{k.cx},{k.cy}")
+    assert r.exit_code == 0, r.output
+    assert "intrinsic/intrinsic_color.txt not read" in r.output
