@@ -32,8 +32,9 @@ MAX_FPS = 200.0
 MEDIAN_DEPTH_M = (0.4, 6.0)
 FAR_DEPTH_M = (0.9, 12.0)
 # the depth scales (raw units per metre) datasets use: mm (ROS, RealSense, 7-Scenes, Redwood),
-# 1/5000 m (TUM RGB-D), 0.1 mm (some Azure Kinect / ZED exports), 1/4000 m (ScanNet-style)
-KNOWN_SCALES = (1000.0, 5000.0, 10000.0, 4000.0)
+# 1/5000 m (TUM RGB-D), 0.1 mm (some Azure Kinect / ZED exports), 1/4000 m (ScanNet-style),
+# 1/6553.5 m (Replica as NICE-SLAM renders it: 10 m over 16 bits)
+KNOWN_SCALES = (1000.0, 5000.0, 10000.0, 4000.0, 6553.5)
 DEFAULT_CAMERA_HEIGHT = (0.45, 2.2)  # m above the floor
 
 
@@ -174,8 +175,11 @@ def depth_scale_problem(raw: Sequence[np.ndarray], scale: float, origin: str) ->
     fits = fitting_scales(raw, scale)
     if fits:
         k, fs = fits[0]
-        fix = (f"--depth-scale {k:g} fits (median {fs.median_m:.2f} m); give it, or "
-               f"--depth-scale {scale:g} to keep this one")
+        also = ", ".join(f"{a:g} (median {f.median_m:.2f} m)" for a, f in fits[1:])
+        fix = (f"--depth-scale {k:g} fits (median {fs.median_m:.2f} m)" + (
+            f", and so do {also}: the depth alone cannot tell them apart, so give the "
+            "sensor's units (its datasheet, the dataset's readme)" if also else "; give it")
+            + f", or --depth-scale {scale:g} to keep this one")
     else:
         fix = "no usual scale fits; give the sensor's units with --depth-scale"
     return (f"depth scale {scale:g} units/m ({origin}) looks wrong: median depth "

@@ -63,6 +63,21 @@ def test_depth_scale_problem_names_the_scale_that_fits():
     assert depth_scale_problem([mm.astype(np.float32) / 1000], 1.0, "x") is None  # metres
 
 
+def test_depth_scale_problem_names_every_scale_that_fits():
+    """Replica's depth as NICE-SLAM renders it (1/6553.5 m) read as millimetres: several
+    usual scales give indoor depth, which the depth alone cannot tell apart; the message
+    names them all (6553.5 among them), not only the likeliest, whose map was 31 % too
+    large with exit 0."""
+    replica = np.full((10, 10), round(1.6 * 6553.5), np.uint16)  # 1.6 m
+    replica[0] = round(3.0 * 6553.5)
+    p = depth_scale_problem([replica], 1000.0, "dataset default: open3d layout")
+    assert p is not None
+    assert "--depth-scale 5000 fits (median 2.10 m), and so do " in p
+    assert "6553.5 (median 1.60 m)" in p and "the depth alone cannot tell them apart" in p
+    assert p.endswith("or --depth-scale 1000 to keep this one")
+    assert depth_scale_problem([replica], 6553.5, "x") is None
+
+
 def test_floor_problem_band():
     cam = np.eye(4)
     cam[2, 3] = 1.0  # camera 1 m up in the source; floor estimate at 0.58 -> 0.42 m above
