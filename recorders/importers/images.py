@@ -60,7 +60,7 @@ def _read_image(path: Path) -> np.ndarray:
         exr = bytes(data[:4]) == b"\x76\x2f\x31\x01"  # OpenEXR's magic number
         raise SgtoolError(f"{path}: OpenCV cannot read this image" + (
             " (OpenEXR, which this OpenCV build does not decode): store depth as 16-bit PNG "
-            "in millimetres (or float TIFF)" if exr else ""))
+            "in millimetres" if exr else ""))
     return a
 
 
