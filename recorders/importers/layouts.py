@@ -44,7 +44,6 @@ from sgtool.recorders.importers.pose_files import folder_intrinsics, pose_folder
 from sgtool.recorders.importers.sanity import time_range_problem, timestamp_problem
 from sgtool.recorders.importers.textformats import (
     PinholeParams,
-    is_intrinsics_json,
     is_open3d_log,
     open3d_log_first_frame,
     read_intrinsics_file,
@@ -445,12 +444,6 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
                           dropped=dropped)
 
 
-# text files an Open3D folder's intrinsics are read from (a 3x3 camera matrix; ScanNet's
-# 4x4): named for them, the depth camera's before the colour camera's
-INTRINSICS_TEXTS = frozenset({"intrinsic", "intrinsics", "camera_intrinsic", "camera_intrinsics",
-                              "intrinsic_depth", "intrinsic_color", "depth_intrinsics"})
-
-
 def _read_open3d(root: Path, fps: float, trajectory: Path | None,
                  skip_missing: bool = False, keep_unposed: bool = False) -> FolderSequence:
     """Depth images of ``depth/`` and colour images of the colour folder, paired by name
@@ -579,28 +572,14 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
             poses = [*poses, *([None] * late)]
         else:
             dropped, pairs = dropped + late, pairs[:len(poses)]
-    intr = folder_intrinsics(root)
-    texts = sorted((p for p in root.iterdir() if p.suffix.lower() == ".txt"  # .TXT too
-                    and p.stem.lower().replace("-", "_") in INTRINSICS_TEXTS),
-                   key=lambda p: ("depth" not in p.stem.lower(), p.name))  # depth's first
-    for p in [*sorted(root.glob("*.json")), *texts] if intr is None else ():
-        if p.suffix != ".json" or is_intrinsics_json(p):
-            intr = replace(read_intrinsics_file(p), source=f"file {p.name}")
-            break
-    default: PinholeParams | None = PRIMESENSE_INTRINSICS
-    if intr is None and (root / "intrinsic" / "intrinsic_color.txt").is_file():
-        # a ScanNet export without the depth camera's file: its colour camera's matrix is
-        # for the colour images' size, and the PrimeSense default is no ScanNet camera's
-        default = None
-        notes.append("intrinsic/intrinsic_color.txt not read: the colour camera's, not the "
-                     "depth images' (intrinsic/intrinsic_depth.txt)")
+    intr = folder_intrinsics(root, PRIMESENSE_INTRINSICS, notes)
     frames = tuple(
         FolderFrame(round((slot[d] if slot else i) * 1e9 / fps), d, c,
                     poses[i] if poses is not None else None)
         for i, (d, c) in enumerate(pairs)
     )
     return FolderSequence(
-        "open3d", root, frames, intr or default, 1000.0,
+        "open3d", root, frames, intr, 1000.0,
         "trajectory" if poses is not None else "none",
         ((f"poses from {traj.name}",) if traj is not None else ()) + tuple(notes),
         dropped=dropped,

@@ -7,7 +7,8 @@
   a matrix of no finite number (ScanNet writes ``-inf`` where its reconstruction lost the
   camera) or a missing file is a frame without a pose, one partly finite is damaged;
 - ``intrinsic/intrinsic_depth.txt``: the depth camera's matrix, 3x3 or ScanNet's 4x4 (the
-  3x3 in its top-left corner, the rest the identity's).
+  3x3 in its top-left corner, the rest the identity's); an intrinsics file beside the
+  images (:func:`folder_intrinsics`) otherwise.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from sgtool.errors import SgtoolError
 from sgtool.log.codec import rigid_problem
 from sgtool.recorders.importers.textformats import (
     PinholeParams,
+    is_intrinsics_json,
     read_intrinsics_file,
     untracked_pose,
 )
@@ -83,13 +85,33 @@ def read_pose_folder(folder: Path, names: list[str]) -> list[np.ndarray | None]:
     return out
 
 
-def folder_intrinsics(root: Path) -> PinholeParams | None:
-    """The depth camera's intrinsics of ``intrinsic/intrinsic_depth.txt`` (module doc, read
-    as ``--intrinsics FILE`` reads a file), or None when the folder has no such file."""
+# text files beside the images an Open3D folder's intrinsics are read from (a 3x3 camera
+# matrix; ScanNet's 4x4): named for them, the depth camera's before the colour camera's
+INTRINSICS_TEXTS = frozenset({"intrinsic", "intrinsics", "camera_intrinsic", "camera_intrinsics",
+                              "intrinsic_depth", "intrinsic_color", "depth_intrinsics"})
+
+
+def folder_intrinsics(root: Path, default: PinholeParams,
+                      notes: list[str]) -> PinholeParams | None:
+    """The depth camera's intrinsics of a folder (each file read as ``--intrinsics FILE``
+    reads one): ``intrinsic/intrinsic_depth.txt`` (module doc), else an intrinsics JSON
+    or a text file of :data:`INTRINSICS_TEXTS` beside the images (any case), else
+    ``default``; None, with a note, for a ScanNet export with only the colour camera's
+    ``intrinsic/intrinsic_color.txt`` (no default is that camera's)."""
     path = root / INTRINSICS_FILE
-    if not path.is_file():
+    if path.is_file():
+        return replace(read_intrinsics_file(path), source=f"file {INTRINSICS_FILE}")
+    texts = sorted((p for p in root.iterdir() if p.suffix.lower() == ".txt"  # .TXT too
+                    and p.stem.lower().replace("-", "_") in INTRINSICS_TEXTS),
+                   key=lambda p: ("depth" not in p.stem.lower(), p.name))  # depth's first
+    for p in [*sorted(root.glob("*.json")), *texts]:
+        if p.suffix != ".json" or is_intrinsics_json(p):
+            return replace(read_intrinsics_file(p), source=f"file {p.name}")
+    if (root / "intrinsic" / "intrinsic_color.txt").is_file():
+        notes.append("intrinsic/intrinsic_color.txt not read: the colour camera's, not the "
+                     "depth images' (intrinsic/intrinsic_depth.txt)")
         return None
-    return replace(read_intrinsics_file(path), source=f"file {INTRINSICS_FILE}")
+    return default
 
 
 def posed_pairs(folder: Path, pairs: list[tuple[Path, Path | None]], keep_unposed: bool,
