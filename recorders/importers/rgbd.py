@@ -65,6 +65,7 @@ from sgtool.recorders.importers.odometry import (
     estimate_with_progress,
 )
 from sgtool.recorders.importers.pose_axes import check_camera_axes, convention_text, to_optical
+from sgtool.recorders.importers.pose_jumps import placeholder_poses_problem
 from sgtool.recorders.importers.provenance import (
     ESTIMATED_FLOORS,
     FLOOR_ORIGINS,
@@ -379,6 +380,10 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
                                       seq.pose_source)
         if frozen is not None and not opts.estimate_poses:
             findings.problem(frozen[0], given=not frozen[1])
+        if not opts.estimate_poses:
+            findings.problem(placeholder_poses_problem(
+                [np.asarray(f.pose) for f in frames], [f.depth_path.name for f in frames],
+                seq.pose_source), given=False)
     findings.problem(depth_scale_problem(raws, scale, scale_origin),
                      given=opts.depth_scale is not None)
     if opts.intrinsics is None and intr_origin.startswith("folder-name default"):
