@@ -18,8 +18,8 @@
   default 525, 525, 319.5, 239.5 that Open3D itself assumes. Frames are ``1/fps`` apart, in
   natural name order ("2.png" before "10.png", as Open3D's ``sorted_alphanum``); images
   named by plain numbers are at their number's time (a frame missing from the numbering
-  leaves a gap). Without
-  a ``.log``, a ``pose/`` folder of one 4x4 text file a frame and an
+  leaves a gap). Without a ``.log``, a ``traj.txt`` of a 4x4 matrix a line (NICE-SLAM's
+  Replica renders), or a ``pose/`` folder of one 4x4 text file a frame and an
   ``intrinsic/intrinsic_depth.txt`` (a ScanNet export: :mod:`.pose_files`) are read.
 """
 
@@ -44,6 +44,7 @@ from sgtool.recorders.importers.pose_files import folder_intrinsics, pose_folder
 from sgtool.recorders.importers.sanity import time_range_problem, timestamp_problem
 from sgtool.recorders.importers.textformats import (
     PinholeParams,
+    is_matrix_trajectory,
     is_open3d_log,
     open3d_log_first_frame,
     read_intrinsics_file,
@@ -288,7 +289,8 @@ def _read_tum(
         elif problem:
             raise SgtoolError(problem)
     gt_path = trajectory or (root / "groundtruth.txt")
-    if trajectory is not None and is_open3d_log(trajectory):
+    if trajectory is not None and (is_open3d_log(trajectory) or
+                                   is_matrix_trajectory(trajectory)):
         return _read_tum_log_poses(root, rgb, depth, max_dt_ns, trajectory, notes)
     track = None
     if gt_path.is_file():
@@ -350,7 +352,7 @@ def _read_tum_log_poses(root: Path, rgb: list[tuple[int, str]], depth: list[tupl
     no_rgb = sum(f.color_path is None for f in frames)
     if no_rgb:
         notes.append(f"{no_rgb} depth images had no colour image within {max_dt_ns / 1e6:g} ms")
-    notes.append(f"poses from {trajectory.name} in depth.txt's order (a .log has no times)")
+    notes.append(f"poses from {trajectory.name} in depth.txt's order (it has no times)")
     return FolderSequence("tum", root, tuple(frames), _tum_intrinsics(root), 5000.0,
                           "trajectory", tuple(notes))
 
@@ -487,6 +489,8 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
                 f"{root}: several trajectories ({', '.join(p.name for p in logs)}); "
                 "choose one with --trajectory"
             )
+        elif (root / "traj.txt").is_file() and is_matrix_trajectory(root / "traj.txt"):
+            traj = root / "traj.txt"  # a matrix a line: NICE-SLAM's Replica renders
     per_frame = pose_folder(root) if traj is None else None
     slot: dict[Path, float] = {}  # frame i stays at i/fps when frames before it are left out
     numbered = frame_slots([d for d, _ in pairs], depths + (colors if matched else []))

@@ -118,6 +118,32 @@ def pose_matrix(path: Path, rows: list[tuple[int, list[str]]]) -> np.ndarray:
     return m
 
 
+MATRIX_LINE = (12, 16)  # numbers a line of a trajectory of matrices: 3x4 or 4x4, row by row
+
+
+def is_matrix_trajectory(path: Path) -> bool:
+    """Whether ``path``'s first line of numbers is a pose matrix written on one line
+    (:func:`read_matrix_trajectory`), not a TUM line of 8 numbers."""
+    rows = _data_lines(path)
+    return bool(rows) and len(rows[0][1]) in MATRIX_LINE
+
+
+def read_matrix_trajectory(path: Path) -> list[np.ndarray]:
+    """Camera-to-world poses written a frame a line as a matrix, row by row: 16 numbers (a
+    4x4: the ``traj.txt`` of NICE-SLAM's Replica renders and of the SLAM systems that read
+    it) or 12 (a 3x4: KITTI's ``poses.txt``), in frame order; each checked rigid."""
+    out = []
+    for n, parts in _data_lines(path):
+        if len(parts) not in MATRIX_LINE:
+            raise SgtoolError(f"{path}:{n}: a line of this trajectory is a pose matrix of 12 "
+                              f"or 16 numbers (3x4 or 4x4, row by row); this one has "
+                              f"{len(parts)}")
+        rows = [(n, parts[i:i + 4]) for i in range(0, len(parts), 4)]
+        out.append(pose_matrix(path, rows if len(parts) == 16 else
+                               [*rows, (n, ["0", "0", "0", "1"])]))
+    return out
+
+
 def untracked_pose(path: Path) -> bool:
     """A 4x4 pose file (as :func:`read_pose_file` reads it) of which no number is finite:
     a frame its tracker lost (ScanNet writes ``-inf`` rows), no pose rather than a damaged
@@ -307,17 +333,18 @@ def open3d_log_first_frame(path: Path) -> int:
 def trajectory_poses(trajectory: Path | None, count: int, hint: str = "",
                      shorter: bool = False, also: int | None = None
                      ) -> list[np.ndarray] | None:
-    """Poses from a --trajectory file for frames in order (Open3D .log, or a TUM file whose
-    lines are taken in order); ``hint`` says why the counts may differ; ``shorter``: an
-    Open3D .log that ends before the frames is taken (the first frames' poses); ``also``:
-    another count taken."""
+    """Poses from a --trajectory file for frames in order (Open3D .log, a matrix a line
+    (:func:`read_matrix_trajectory`), or a TUM file whose lines are taken in order);
+    ``hint`` says why the counts may differ; ``shorter``: an Open3D .log that ends before
+    the frames is taken (the first frames' poses); ``also``: another count taken."""
     if trajectory is None:
         return None
     if not trajectory.is_file():
         raise SgtoolError(f"--trajectory {trajectory}: no such file")
-    timed = not is_open3d_log(trajectory)
+    timed = not is_open3d_log(trajectory) and not is_matrix_trajectory(trajectory)
     poses = ([T for _, T in read_tum_trajectory(trajectory)] if timed
-             else read_open3d_log(trajectory))
+             else read_open3d_log(trajectory) if is_open3d_log(trajectory)
+             else read_matrix_trajectory(trajectory))
     # a TUM file's lines, their times unused, pose the frames in order only when there is
     # one a frame: one short may lack any frame (tracking lost), not only the last ones
     if len(poses) not in (count, also) and not (shorter and not timed

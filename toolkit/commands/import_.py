@@ -346,7 +346,9 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None,
               "without its depth image (its pose left out with it); without it, missing "
               "files are an error before anything is read.")
 @click.option("--trajectory", type=PathParam(dir_okay=False, exists=True),
-              help="Poses to use instead of the dataset's: an Open3D .log or a TUM file.")
+              help="Poses to use instead of the dataset's: an Open3D .log, a TUM file, or a "
+              "camera-to-world matrix a line (16 numbers, as NICE-SLAM's traj.txt; 12, as "
+              "KITTI's poses.txt), one a frame in order.")
 @_odometry_options(
     estimate_help="Estimate the poses by RGB-D odometry even when the dataset has them (their "
     "drift against the dataset's poses is reported). Sources without poses are always "

@@ -227,6 +227,11 @@ def test_trajectory_log_for_a_tum_folder_goes_in_listed_order(tmp_path):
     seq = read_sequence(root, trajectory=tmp_path / "t.log")
     assert seq.pose_source == "trajectory"
     assert [f.pose[0, 3] for f in seq.frames] == [0.0, 1.0, 2.0]
+    # a matrix a line (NICE-SLAM's traj.txt) has no times either: the same order
+    (tmp_path / "traj.txt").write_text("".join(
+        " ".join(f"{x:g}" for x in _pose(float(i)).ravel()) + "\n" for i in range(3)))
+    seq = read_sequence(root, trajectory=tmp_path / "traj.txt")
+    assert [f.pose[0, 3] for f in seq.frames] == [0.0, 1.0, 2.0]
 
 
 # ----- item 6: intrinsics ----------------------------------------------------------------------
@@ -688,3 +693,27 @@ def test_other_names_of_an_intrinsics_file_are_read(tmp_path: Path, name: str) -
     root = open3d_folder(tmp_path / "f", [str(i) for i in range(3)])
     (root / name).write_text("600 0 16\n0 600 12\n0 0 1\n")
     assert read_sequence(root).intrinsics.fx == 600.0
+
+
+@pytest.mark.parametrize("numbers", [16, 12])
+def test_a_trajectory_of_a_matrix_a_line_poses_the_frames(tmp_path, numbers: int) -> None:
+    """NICE-SLAM's Replica renders keep their poses as traj.txt, a 4x4 matrix a line (KITTI
+    a 3x4): beside color/ and depth/ it was passed over without a note (the poses
+    estimated) and as --trajectory it was read as TUM ("8 numbers, this one has 16"). It
+    poses the frames in order, found by itself or given; a TUM folder takes it as it takes
+    a .log, in depth.txt's order."""
+    root = open3d_folder(tmp_path / "f", [str(i) for i in range(4)])
+    (root / "traj.log").unlink()
+    rows = [" ".join(f"{x:g}" for x in _pose(0.5 * i)[: numbers // 4].ravel())
+            for i in range(4)]
+    (root / "traj.txt").write_text("\n".join(rows) + "\n")
+    seq = read_sequence(root)
+    assert seq.pose_source == "trajectory" and "poses from traj.txt" in seq.notes
+    assert [f.pose[0, 3] for f in seq.frames] == [0.0, 0.5, 1.0, 1.5]
+    given = read_sequence(open3d_folder(tmp_path / "g", [str(i) for i in range(4)]),
+                          trajectory=root / "traj.txt")
+    assert [f.pose[0, 3] for f in given.frames] == [0.0, 0.5, 1.0, 1.5]
+    (root / "traj.txt").write_text(rows[0] + "\n" + rows[1] + " 7\n")
+    with pytest.raises(SgtoolError, match=r"traj\.txt:2: a line of this trajectory is a pose "
+                       r"matrix of 12 or 16 numbers .* this one has " + str(numbers + 1)):
+        read_sequence(root)
