@@ -180,7 +180,10 @@ def _options(x: dict[str, Any]) -> ClosedLoopOptions:
         voxel_size=float(mapping.get("voxel_size", 0.05)),
         max_steps=int(x["max_steps"]), frames=x.get("frame_budget"),
         planner_seed=int(x.get("seed", 0)), navigation=str(nav.get("mode", "house")),
-        live=LiveNavConfig(**_known(LiveNavConfig, {**_BEFORE, **nav})),
+        # house navigation uses none of them (ClosedLoopOptions refuses others than the
+        # defaults): an older log's missing ones are not the settings of before
+        live=LiveNavConfig(**_known(LiveNavConfig, {**_BEFORE, **nav}))
+        if str(nav.get("mode", "house")) != "house" else LiveNavConfig(),
         success=str(x.get("success", "observed")),
         turn_render_deg=float(x.get("turn_render_deg", 0.0)),
         render_step_m=float(x.get("render_step_m", 0.0)),

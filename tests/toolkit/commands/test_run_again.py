@@ -177,3 +177,46 @@ def test_a_planner_object_of_ones_own_is_not_rebuilt_by_its_name(tmp_path: Path)
     assert "its class was defined in a function: put it in a module on PYTHONPATH and give " \
         "-p MODULE:Mine" in r.output, r.output
     assert not out.exists()
+
+
+def _as_older_log(src: Path, dst: Path) -> None:
+    """``src`` with its Episode records' extras as a log of before live navigation has
+    them: no ``navigation`` (house navigation, the live settings absent)."""
+    from mcap.reader import make_reader
+    from mcap.writer import Writer
+
+    with open(src, "rb") as f, open(dst, "wb") as g:
+        r = make_reader(f)
+        summary = r.get_summary()
+        assert summary is not None
+        w = Writer(g)
+        w.start(profile=r.get_header().profile, library="test")
+        for sid, s in sorted(summary.schemas.items()):
+            w.register_schema(s.name, s.encoding, s.data)
+        for cid, c in sorted(summary.channels.items()):
+            w.register_channel(c.topic, c.message_encoding, c.schema_id, dict(c.metadata))
+        for _, channel, m in r.iter_messages(log_time_order=False):
+            data = m.data
+            if channel.topic == "/sgtool/episode":
+                rec = json.loads(data)
+                rec.get("extra", {}).pop("navigation", None)
+                data = json.dumps(rec).encode()
+            w.add_message(channel.id, m.log_time, data, m.publish_time, m.sequence)
+        for a in r.iter_attachments():
+            w.add_attachment(a.create_time, a.log_time, a.name, a.media_type, a.data)
+        for md in r.iter_metadata():
+            w.add_metadata(md.name, dict(md.metadata))
+        w.finish()
+
+
+def test_an_older_house_navigation_log_is_read(bench: Path, tmp_path: Path) -> None:
+    """A log of before live navigation (no navigation settings: the house's) is read by
+    logged_run as house navigation with the live settings at their defaults, which
+    ClosedLoopOptions accepts (it refused the missing ones read as the settings of before,
+    look_in 0 and no peek, for house navigation)."""
+    old = tmp_path / "old.mcap"
+    _as_older_log(bench / "greedy" / "house-3" / "ep-000.mcap", old)
+    assert "navigation" not in opening(old).extras
+    logged = sgtool.logged_run(old)
+    assert logged.options.navigation == "house"
+    assert logged.options.live == sgtool.ClosedLoopOptions().live
