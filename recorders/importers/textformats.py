@@ -341,18 +341,24 @@ def trajectory_poses(trajectory: Path | None, count: int, hint: str = "",
         return None
     if not trajectory.is_file():
         raise SgtoolError(f"--trajectory {trajectory}: no such file")
-    timed = not is_open3d_log(trajectory) and not is_matrix_trajectory(trajectory)
+    log = is_open3d_log(trajectory)
+    matrices = not log and is_matrix_trajectory(trajectory)
+    timed = not log and not matrices
     poses = ([T for _, T in read_tum_trajectory(trajectory)] if timed
-             else read_open3d_log(trajectory) if is_open3d_log(trajectory)
+             else read_open3d_log(trajectory) if log
              else read_matrix_trajectory(trajectory))
-    # a TUM file's lines, their times unused, pose the frames in order only when there is
-    # one a frame: one short may lack any frame (tracking lost), not only the last ones
-    if len(poses) not in (count, also) and not (shorter and not timed
+    # a TUM file's lines, their times unused, or a matrix a line (no frame ids either) pose
+    # the frames in order only when there is one a frame: one short may lack any frame
+    # (tracking lost, a placeholder line removed), not only the last ones; a .log's block
+    # headers name their frames
+    if len(poses) not in (count, also) and not (shorter and log
                                                 and 0 < len(poses) < count):
         raise SgtoolError(f"{trajectory} has {len(poses)} poses for {count} frames{hint}"
                           + ("; this layout takes a TUM trajectory's lines one per frame, in "
                              "order, its times unused (a TUM folder, with rgb.txt and "
-                             "depth.txt, pairs them by time)" if timed else ""))
+                             "depth.txt, pairs them by time)" if timed else
+                             "; a matrix a line names no frame: one line per frame, in order"
+                             if matrices else ""))
     return poses
 
 

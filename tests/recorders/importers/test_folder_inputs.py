@@ -713,6 +713,11 @@ def test_a_trajectory_of_a_matrix_a_line_poses_the_frames(tmp_path, numbers: int
     given = read_sequence(open3d_folder(tmp_path / "g", [str(i) for i in range(4)]),
                           trajectory=root / "traj.txt")
     assert [f.pose[0, 3] for f in given.frames] == [0.0, 0.5, 1.0, 1.5]
+    # a line short (a placeholder's line removed): no frame ids say which, refused
+    (root / "traj.txt").write_text("\n".join(rows[:2] + rows[3:]) + "\n")
+    with pytest.raises(SgtoolError, match=r"traj\.txt has 3 poses for 4 frames; a matrix a "
+                       r"line names no frame: one line per frame, in order"):
+        read_sequence(root)
     (root / "traj.txt").write_text(rows[0] + "\n" + rows[1] + " 7\n")
     with pytest.raises(SgtoolError, match=r"traj\.txt:2: a line of this trajectory is a pose "
                        r"matrix of 12 or 16 numbers .* this one has " + str(numbers + 1)):
