@@ -75,6 +75,7 @@ from sgtool.recorders.importers.odometry import (
     drift_where_known,
     estimate_with_progress,
 )
+from sgtool.recorders.importers.pose_axes import ReadAs
 from sgtool.recorders.importers.provenance import (
     ESTIMATED_FLOORS,
     FLOOR_ORIGINS,
@@ -299,7 +300,8 @@ def _check_poses(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSource,
     findings.problem(problem, given=opts.intrinsics is not None)
     if explains:
         return
-    for text in convention_problems(pairs, k, fit, src.describe, bag=True):
+    for text in convention_problems(pairs, k, fit, src.describe,
+                                    ReadAs(opts.camera_axes, bag=True)):
         findings.problem(text, given=estimate)
     motion = pose_motion_problem(fit, src.describe)
     if motion is not None:

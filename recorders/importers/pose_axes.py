@@ -11,6 +11,8 @@ whose convention fits the depth when the poses as read do not.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from sgtool.errors import SgtoolError
@@ -51,3 +53,39 @@ def convention_text(axes: str, world_to_camera: bool) -> str:
     parts = ([f"camera axes {axes} ({CAMERA_AXES[axes][1]})"] if axes != "optical" else []) \
         + (["inverted (world-to-camera)"] if world_to_camera else [])
     return ", ".join(parts)
+
+
+def composed_axes(first: str, then: str) -> str | None:
+    """The axes a pose read with ``first`` and then turned by ``then`` is read with (the
+    product of their matrices), or None when no name of :data:`CAMERA_AXES` is that."""
+    m = CAMERA_AXES[first][0] @ CAMERA_AXES[then][0]
+    return next((n for n, (a, _) in CAMERA_AXES.items() if np.allclose(a, m)), None)
+
+
+@dataclass(frozen=True)
+class ReadAs:
+    """How an import read its poses (``--camera-axes``, ``--world-to-camera``; ``bag``:
+    ``import bag``'s, which has no ``--world-to-camera``): the pose checks' advice is
+    the flags that read them otherwise."""
+
+    axes: str = "optical"
+    inverse: bool = False
+    bag: bool = False
+
+    def fix(self, axes: str, inverse: bool) -> str:
+        """The advice that reads the poses with ``axes``, inverted when ``inverse``."""
+        if inverse != self.inverse and self.bag:
+            return "invert them"
+        if (self.axes, self.inverse) == ("optical", False):
+            flags = " ".join([f"--camera-axes {axes}"] * (axes != "optical")
+                             + ["--world-to-camera"] * inverse)
+            return f"give {flags} to " + ("invert them" if axes == "optical" else
+                                          "read them so")
+        want = [f"--camera-axes {axes}"] * (axes != "optical") + ["--world-to-camera"] * inverse
+        had = [f"--camera-axes {self.axes}"] * (self.axes != "optical") + \
+            ["--world-to-camera"] * self.inverse
+        return (f"read them with {' '.join(want) or 'neither --camera-axes nor --world-to-camera'}"
+                f" instead of {' '.join(had)}")
+
+
+OPTICAL_C2W = ReadAs()  # sgtool's own convention, as a folder's import reads by default

@@ -64,7 +64,13 @@ from sgtool.recorders.importers.odometry import (
     drift_where_known,
     estimate_with_progress,
 )
-from sgtool.recorders.importers.pose_axes import check_camera_axes, convention_text, to_optical
+from sgtool.recorders.importers.pose_axes import (
+    OPTICAL_C2W,
+    ReadAs,
+    check_camera_axes,
+    convention_text,
+    to_optical,
+)
 from sgtool.recorders.importers.pose_jumps import placeholder_poses_problem
 from sgtool.recorders.importers.provenance import (
     ESTIMATED_FLOORS,
@@ -284,7 +290,8 @@ def run_odometry(
 def check_scale_by_geometry(frames: list[FolderFrame], k: CameraIntrinsics, scale: float,
                             origin: str, pose_source: str, findings: Findings,
                             given: bool, estimate: bool = False,
-                            intrinsics: tuple[str, bool] = ("given", True)
+                            intrinsics: tuple[str, bool] = ("given", True),
+                            read_as: ReadAs = OPTICAL_C2W
                             ) -> tuple[ScaleFit | None, FocalFit | None]:
     r"""The depth scale and the focal length against the metric poses
     (:mod:`.scale_check`, :mod:`.focal_check`), on a few pairs of nearby and of turned
@@ -315,7 +322,7 @@ def check_scale_by_geometry(frames: list[FolderFrame], k: CameraIntrinsics, scal
     findings.problem(problem, given=intrinsics[1])
     if explains:
         return fit, focal
-    for problem in convention_problems(pairs, k, fit, pose_source):
+    for problem in convention_problems(pairs, k, fit, pose_source, read_as):
         findings.problem(problem, given=estimate)
     motion = pose_motion_problem(fit, pose_source)
     if motion is not None:
@@ -370,7 +377,8 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         fit, focal = check_scale_by_geometry(
             frames, k, scale, scale_origin, seq.pose_source, findings,
             given=opts.depth_scale is not None, estimate=opts.estimate_poses,
-            intrinsics=(intr_origin, opts.intrinsics is not None))
+            intrinsics=(intr_origin, opts.intrinsics is not None),
+            read_as=ReadAs(opts.camera_axes, opts.world_to_camera))
         checks.append(("depth scale against the poses",
                        fit.describe() if fit else "no verdict: no frame pair pins the motion down"))
         if focal is not None:

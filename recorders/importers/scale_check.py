@@ -25,7 +25,13 @@ import numpy as np
 
 from sgtool.log.frame import CameraIntrinsics
 from sgtool.log.poses import pose_difference
-from sgtool.recorders.importers.pose_axes import CAMERA_AXES, to_optical
+from sgtool.recorders.importers.pose_axes import (
+    CAMERA_AXES,
+    OPTICAL_C2W,
+    ReadAs,
+    composed_axes,
+    to_optical,
+)
 from sgtool.recorders.importers.sanity import KNOWN_SCALES
 
 MIN_STEP_M = 0.02  # pose translation of a pair (m)
@@ -226,12 +232,14 @@ def geometric_scale_problem(fit: ScaleFit | None, scale: float, origin: str,
 
 
 def inverted_poses_problem(given: ScaleFit | None, inverted: ScaleFit | None,
-                           pose_source: str, *, bag: bool = False) -> str | None:
+                           pose_source: str, read_as: ReadAs = OPTICAL_C2W) -> str | None:
     """When the poses' inverses move as the depth does (a consistent fit within
     :data:`TOLERANCE` of 1) and the poses themselves do not: world-to-camera poses, which
     the depth-scale and motion checks would otherwise take for a wrong scale (a few
     centimetres a pair, a small turn: the inverses' error is systematic, so it fits a
-    consistent wrong ratio). The text; None otherwise."""
+    consistent wrong ratio). The text, naming the flags that read them so (``read_as``: as
+    they were read: a constant turn of the world before the inverse is no matter); None
+    otherwise."""
     if inverted is None or not clearly_fits(inverted) or poses_fit_depth(given):
         return None
     how = ("no consistent factor" if given is None else f"{given.ratio:.2f}x"
@@ -239,8 +247,8 @@ def inverted_poses_problem(given: ScaleFit | None, inverted: ScaleFit | None,
     return (f"the poses ({pose_source}) look world-to-camera: between {inverted.pairs} pairs "
             f"of nearby frames the depth moves {how} as far as the poses, and "
             f"{inverted.ratio:.2f}x as far as their inverses; camera-to-world poses are "
-            f"expected: {'invert them' if bag else 'give --world-to-camera to invert them'}, "
-            "or --estimate-poses to estimate the poses from the depth")
+            f"expected: {read_as.fix('optical', not read_as.inverse)}, or --estimate-poses to "
+            "estimate the poses from the depth")
 
 
 POSE_UNITS = ((0.01, "centimetres"), (0.001, "millimetres"))
@@ -263,14 +271,14 @@ def poses_fit_depth(fit: ScaleFit | None) -> bool:
 
 
 def convention_problems(pairs: Pairs, k: CameraIntrinsics, fit: ScaleFit | None,
-                        pose_source: str, *, bag: bool = False) -> list[str]:
+                        pose_source: str, read_as: ReadAs = OPTICAL_C2W) -> list[str]:
     """When the poses do not fit the depth (``fit``, of ``pairs`` as :func:`fit_scale`
     takes them): the problems of the poses' inverses, their translations in another unit,
     their quaternions in another order or the camera frame's other axes fitting it
     (:func:`inverted_poses_problem`, :func:`pose_units_problem`,
-    :func:`quaternion_order_problem`, :func:`camera_axes_problem`), naming the flags of
-    ``sgtool import rgbd`` (``bag``: of ``sgtool import bag``); empty when the poses
-    fit, or none does."""
+    :func:`quaternion_order_problem`, :func:`camera_axes_problem`), naming the flags that
+    read them so (the poses were read as ``read_as`` says); empty when the poses fit, or
+    none does."""
     reordered_pairs = [(a, b, _wxyz_read_as_xyzw(p), _wxyz_read_as_xyzw(q))
                        for a, b, p, q in pairs]
     if fit is not None and fit.consistent() and not poses_fit_depth(fit) and \
@@ -290,37 +298,44 @@ def convention_problems(pairs: Pairs, k: CameraIntrinsics, fit: ScaleFit | None,
     units = [(unit, fit_scale([(a, b, _in_metres(p, f), _in_metres(q, f))
                                for a, b, p, q in pairs], k)) for f, unit in POSE_UNITS]
     reordered = fit_scale(reordered_pairs, k)
-    axes = {name: fit_scale([(a, b, to_optical(p, name), to_optical(q, name))
-                             for a, b, p, q in pairs], k)
-            for name in CAMERA_AXES if name != "optical"}
-    found = (inverted_poses_problem(fit, inverted, pose_source, bag=bag),
+    axes = {(name, inv): fit_scale([(a, b, to_optical(p, name, inv), to_optical(q, name, inv))
+                                    for a, b, p, q in pairs], k)
+            for inv in (False, True) for name in CAMERA_AXES if name != "optical"}
+    found = (inverted_poses_problem(fit, inverted, pose_source, read_as),
              pose_units_problem(units, pose_source),
              quaternion_order_problem(fit, reordered, pose_source),
-             camera_axes_problem(fit, axes, pose_source, bag=bag))
+             camera_axes_problem(fit, axes, pose_source, read_as))
     return [x for x in found if x is not None]
 
 
-def camera_axes_problem(given: ScaleFit | None, fits: dict[str, ScaleFit | None],
-                        pose_source: str, *, bag: bool = False) -> str | None:
+def camera_axes_problem(given: ScaleFit | None,
+                        fits: dict[tuple[str, bool], ScaleFit | None],
+                        pose_source: str, read_as: ReadAs = OPTICAL_C2W) -> str | None:
     """When the poses taken as those of a camera frame with other axes (``fits``, by name
-    of :data:`~.pose_axes.CAMERA_AXES`: each turned into the optical frame) move as the
-    depth does and the poses as read (``given``) do not: the poses of OpenGL's camera
-    frame or of ROS's ``camera_link``, not of the optical frame sgtool reads depth in. The
-    text, naming ``--camera-axes``; None otherwise."""
-    fitting = [(name, fit) for name, fit in fits.items() if fit is not None and clearly_fits(fit)]
+    of :data:`~.pose_axes.CAMERA_AXES` and whether inverted first: each turned into the
+    optical frame's camera-to-world pose) move as the depth does and the poses as read
+    (``given``) do not: the poses of OpenGL's camera frame or of ROS's ``camera_link``
+    (world-to-camera, perhaps), not of the optical frame sgtool reads depth in. The text,
+    naming the flags that read them so (the poses were read as ``read_as`` says: a reading
+    inverted after them turns the world by a constant, which is no matter); None
+    otherwise."""
+    fitting = [(key, fit) for key, fit in fits.items() if fit is not None and clearly_fits(fit)]
     if not fitting or poses_fit_depth(given):
         return None
-    name, fit = min(fitting, key=lambda nf: abs(nf[1].ratio - 1.0))
+    (name, inv), fit = min(fitting, key=lambda kf: abs(kf[1].ratio - 1.0))
     moves = ("no consistent factor" if given is None else f"{given.ratio:.2f}x"
              if given.consistent() else f"{given.ratio:.2f}x on average, the pairs disagreeing,")
     other = (", or --tf-frames WORLD:CAMERA_OPTICAL_FRAME where the tree has the optical "
-             "frame" if bag and name == "body" else "")
+             "frame" if read_as.bag and name == "body" else "")
+    axes = name if inv else composed_axes(read_as.axes, name)  # as read, then turned so
+    fix = (read_as.fix(axes, read_as.inverse != inv) if axes is not None else
+           f"no --camera-axes reads them so ({read_as.axes} given)")
     return (f"the poses ({pose_source}) look like those of a camera frame with {name} axes "
-            f"({CAMERA_AXES[name][1]}), not of its optical frame (x right, y down, z "
+            f"({CAMERA_AXES[name][1]}){', inverted,' if inv else ','} not of its optical "
+            "frame (x right, y down, z "
             f"forward): between {fit.pairs} pairs of nearby frames the depth moves {moves} as "
             f"far as the poses, and {fit.ratio:.2f}x as far as the optical frame they imply; "
-            f"give --camera-axes {name} to read them so{other}, or --estimate-poses to "
-            "estimate the poses from the depth")
+            f"{fix}{other}, or --estimate-poses to estimate the poses from the depth")
 
 
 def _wxyz_read_as_xyzw(pose: np.ndarray) -> np.ndarray:

@@ -325,20 +325,21 @@ GL = np.diag([1.0, -1.0, -1.0, 1.0])  # NeRF's and Blender's camera: y up, looki
 @pytest.mark.parametrize(("convert", "flags", "named"), [
     (lambda m: m @ GL, dict(camera_axes="opengl"), "give --camera-axes opengl to read them so"),
     (np.linalg.inv, dict(world_to_camera=True), "give --world-to-camera to invert them"),
-    (lambda m: np.linalg.inv(m @ GL), dict(world_to_camera=True, camera_axes="opengl"), None),
+    (lambda m: np.linalg.inv(m @ GL), dict(world_to_camera=True, camera_axes="opengl"),
+     "give --camera-axes opengl --world-to-camera to read them so"),
 ], ids=["opengl", "world-to-camera", "both"])
 def test_poses_of_another_convention_import_with_the_flag_named(tmp_path, convert, flags,
                                                                 named):
-    """Poses written in another camera frame's axes or world-to-camera: the refusal names
-    the flag that reads them (the check may name either of two conventions when both are
-    wrong at once), and with it the frames are posed as the ground truth is."""
+    """Poses written in another camera frame's axes, world-to-camera, or both: the refusal
+    names the flags that read them, and with them the frames are posed as the ground
+    truth is."""
     from sgtool.log.reader import LogReader
 
     plain = make_scene_folder(tmp_path / "plain", room(), POSES)
     import_rgbd(plain, tmp_path / "plain.mcap", RgbdOptions(intrinsics=K, progress=False))
     root = make_scene_folder(tmp_path / "f", room(), POSES)
     _posed_as(root, convert)
-    with pytest.raises(SgtoolError, match=named or "give --"):
+    with pytest.raises(SgtoolError, match=named):
         import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False))
     rep = import_rgbd(root, tmp_path / "b.mcap", RgbdOptions(intrinsics=K, progress=False,
                                                             **flags))
@@ -358,3 +359,20 @@ def test_a_floor_error_after_doubted_poses_says_to_fix_the_poses_first():
     assert f.floor_doubt(text).endswith(
         "; but the poses were doubted above: wrong poses misplace the floor too, so fix "
         "them (or give --estimate-poses) before giving --floor")
+
+
+@pytest.mark.parametrize(("flags", "advice"), [
+    (dict(camera_axes="opengl"), "read them with neither --camera-axes nor --world-to-camera "
+                                 "instead of --camera-axes opengl"),
+    (dict(world_to_camera=True), "read them with neither --camera-axes nor --world-to-camera "
+                                 "instead of --world-to-camera"),
+])
+def test_a_convention_flag_given_wrongly_is_named_as_given(tmp_path, flags, advice) -> None:
+    """Poses in sgtool's convention read with a convention flag they do not need: the
+    refusal names the flags that read them, not the flag already given (following that
+    advice went round in a circle)."""
+    root = make_scene_folder(tmp_path / "f", room(), POSES)
+    with pytest.raises(SgtoolError) as e:
+        import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False,
+                                                          **flags))
+    assert advice in str(e.value), str(e.value)
