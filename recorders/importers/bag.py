@@ -151,6 +151,9 @@ def import_bag(path: str | Path, out: str | Path, opts: BagOptions) -> ImportRep
                     "moving /tf link, --pose TOPIC, or --estimate-poses")
             if estimate:
                 src = None  # no reference to measure the drift against
+        if src is None and opts.camera_axes != "optical":
+            raise SgtoolError(f"--camera-axes {opts.camera_axes}: {path}'s poses are not read "
+                              "(the camera's are estimated from the depth); leave it out")
         kind = f"bag/{B.bag_kind(path)}"
         meta = {
             "source": path.resolve().name,

@@ -66,6 +66,10 @@ def check_options(opts: BagOptions) -> None:
     check_height_band(opts.camera_height)
     check_intrinsics(opts.intrinsics)
     check_camera_axes(opts.camera_axes)
+    if opts.camera_axes != "optical" and opts.depth is None:
+        raise SgtoolError(f"--camera-axes {opts.camera_axes} reads the depth camera's poses "
+                          "(give --depth); a trajectory import keeps its frame's poses as "
+                          "they are")
     if opts.timestamps not in ("header", "bag"):
         raise SgtoolError(f"--timestamps {opts.timestamps!r}: give header or bag")
     check_positive(opts.depth_max, "--depth-max", "metres")

@@ -169,10 +169,17 @@ def in_sgtool_convention(seq: FolderSequence, axes: str,
                          world_to_camera: bool) -> FolderSequence:
     """``seq`` with its poses, given with camera ``axes`` (and inverted), turned into
     camera-to-world poses of the optical frame (:func:`~.pose_axes.to_optical`), and a
-    note saying so; ``seq`` itself in sgtool's own convention."""
+    note saying so; ``seq`` itself in sgtool's own convention; one line when the flags
+    were given for a folder without poses (estimated: they would be ignored)."""
     said = convention_text(axes, world_to_camera)
     if not said:
         return seq
+    if seq.pose_source == "none":
+        flags = [f for f, on in (("--camera-axes", axes != "optical"),
+                                 ("--world-to-camera", world_to_camera)) if on]
+        raise SgtoolError(f"{' and '.join(flags)}: {seq.root} has no poses to read (they "
+                          "are estimated from the depth); leave "
+                          f"{'them' if len(flags) > 1 else 'it'} out")
     frames = tuple(replace(f, pose=None if f.pose is None else
                            to_optical(f.pose, axes, world_to_camera)) for f in seq.frames)
     return replace(seq, frames=frames, notes=(*seq.notes, f"poses read as given: {said}"))

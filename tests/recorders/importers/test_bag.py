@@ -716,3 +716,16 @@ def test_a_tree_that_ends_at_the_body_frame_imports_with_camera_axes(shared_data
                                    "--camera-axes", "sideways"])
     assert res.exit_code == 2 and "'sideways' is not one of 'optical', 'opengl', 'body'" \
         in res.output
+
+
+def test_camera_axes_where_no_camera_pose_is_read_is_refused(shared_data_dir, tmp_path):
+    """--camera-axes turns the depth camera's poses: a trajectory import (no --depth) keeps
+    its frame's poses, so it is refused there (before, it turned them and kept the frame's
+    name, which an export published rotated)."""
+    bag = shared_data_dir / "logs" / "evo" / "tf_example.bag"
+    r = CliRunner().invoke(cli, ["import", "bag", str(bag), "--tf-frames", "odom:base_link",
+                                 "--camera-axes", "body", "-o", str(tmp_path / "t.mcap")])
+    assert r.exit_code == 2 and r.output.strip().endswith(
+        "--camera-axes body reads the depth camera's poses (give --depth); a trajectory "
+        "import keeps its frame's poses as they are"), r.output
+    assert not (tmp_path / "t.mcap").exists()

@@ -376,3 +376,14 @@ def test_a_convention_flag_given_wrongly_is_named_as_given(tmp_path, flags, advi
         import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(intrinsics=K, progress=False,
                                                           **flags))
     assert advice in str(e.value), str(e.value)
+
+
+def test_convention_flags_for_a_folder_without_poses_are_refused(tmp_path) -> None:
+    """A folder without poses has them estimated: --camera-axes/--world-to-camera would be
+    ignored (and the report said the poses were read so): one line."""
+    root = make_scene_folder(tmp_path / "f", room(), POSES)
+    (root / "groundtruth.txt").unlink()
+    with pytest.raises(SgtoolError, match=r"^--camera-axes and --world-to-camera: .* has no "
+                       r"poses to read \(they are estimated from the depth\); leave them out$"):
+        import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(
+            intrinsics=K, progress=False, camera_axes="opengl", world_to_camera=True))
