@@ -177,9 +177,9 @@ def depth_scale_problem(raw: Sequence[np.ndarray], scale: float, origin: str) ->
         k, fs = fits[0]
         also = ", ".join(f"{a:g} (median {f.median_m:.2f} m)" for a, f in fits[1:])
         fix = (f"--depth-scale {k:g} fits (median {fs.median_m:.2f} m)" + (
-            f", and so do {also}: the depth alone cannot tell them apart, so give the "
-            "sensor's units (its datasheet, the dataset's readme)" if also else "; give it")
-            + f", or --depth-scale {scale:g} to keep this one")
+            f", and so do {also}: the depth alone cannot tell them apart, and the sensor's "
+            "datasheet or the dataset's readme says which is its" if also else "")
+            + f"; give it, or --depth-scale {scale:g} to keep this one")
     else:
         fix = "no usual scale fits; give the sensor's units with --depth-scale"
     return (f"depth scale {scale:g} units/m ({origin}) looks wrong: median depth "

@@ -74,7 +74,13 @@ def test_depth_scale_problem_names_every_scale_that_fits():
     assert p is not None
     assert "--depth-scale 5000 fits (median 2.10 m), and so do " in p
     assert "6553.5 (median 1.60 m)" in p and "the depth alone cannot tell them apart" in p
-    assert p.endswith("or --depth-scale 1000 to keep this one")
+    assert p.endswith("says which is its; give it, or --depth-scale 1000 to keep this one")
+    # given by the user: a warning that keeps it (as for one scale that fits)
+    from sgtool.recorders.importers.provenance import Findings
+
+    kept = Findings()
+    kept.problem(p, given=True)
+    assert kept.warnings[0].endswith("says which is its; the value given is kept")
     assert depth_scale_problem([replica], 6553.5, "x") is None
 
 
