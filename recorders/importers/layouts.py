@@ -150,7 +150,10 @@ def missing_for_layout(root: Path, layout: str) -> str | None:
         if _color_dir(root) is None:
             return "no color/, image/ or rgb/ folder"
         if not images(root / "depth"):
-            return "no images in depth/"
+            held = sorted({p.suffix.lower() for p in (root / "depth").iterdir() if p.suffix})
+            return "no images in depth/" + (f" (it holds {', '.join(held[:4])} files; depth "
+                                            "is read from 16-bit PNG or TIFF images)"
+                                            if held else "")
         return None
     raise SgtoolError(f"unknown layout {layout!r} ({', '.join(LAYOUTS)})")
 

@@ -339,6 +339,12 @@ def test_empty_and_half_made_folders(tmp_path, layout):
               "open3d": "not an Open3D/Redwood folder", "auto": "no images in depth/"}
     assert expect[layout] in msg, msg
     assert not out.exists()
+    if layout == "auto":  # depth of another format: said, with what is read
+        np.save(half / "depth" / "000000.npy", np.zeros((4, 4), np.float32))
+        msg = one_line_error(["import", "rgbd", str(half), "-o", str(out)])
+        assert "no images in depth/ (it holds .npy files; depth is read from 16-bit PNG or " \
+            "TIFF images)" in msg, msg
+        (half / "depth" / "000000.npy").unlink()
     (half / "rgb.txt").write_text("0.0 rgb/a.png\n")
     with pytest.raises(SgtoolError, match=r"not a TUM RGB-D folder .*: no depth.txt"):
         read_sequence(half, "tum")
