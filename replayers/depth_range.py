@@ -30,6 +30,7 @@ from sgtool.mapping.depth_noise import DepthNoise, estimate, floor_height, frame
 FRAMES = 60  # the first frames of the log that are measured
 PIXELS = 20_000  # about this many pixels of each frame are measured (a fixed stride)
 UPRIGHT = -0.3  # median world z of the camera's image-down axis above this: not z-up
+UPSIDE_DOWN = 0.5  # above this: the world's z points down (not a y-up world's side-on)
 
 
 @dataclass(frozen=True)
@@ -60,8 +61,10 @@ def first_frames(reader: LogReader, ceiling: float, tf_time: str = "log",
     # a camera looking straight down has its image "down" level; a floor found at height
     # 0 shows the world is z-up all the same
     floor = floor_height(np.concatenate([fp.h for fp in samples])) if samples else None
-    if down_z and float(np.median(down_z)) > UPRIGHT and floor is None:
-        note = (f"the camera's image 'down' axis points {float(np.median(down_z)):+.2f} along "
-                "the world's z in the median of the first frames: sgtool maps heights along "
-                "z (z up), so a world written y-up maps side-on; check the poses' convention")
+    if down_z and (d := float(np.median(down_z))) > UPRIGHT and floor is None:
+        how = ("upside down: the world's z points down" if d > UPSIDE_DOWN else
+               "side-on (a world written y-up maps so)")
+        note = (f"the camera's image 'down' axis points {d:+.2f} along the world's z in the "
+                "median of the first frames: sgtool maps heights along z (z up), so this map "
+                f"is {how}; check the poses' convention (an import's --up)")
     return FirstFrames(estimate(samples, tol, ceiling=ceiling), note)

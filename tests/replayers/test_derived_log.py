@@ -258,7 +258,12 @@ def test_a_world_written_y_up_is_warned_of(tmp_path):
     y_up = np.array([[1.0, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]])
     rep = replay(synthetic_log(tmp_path / "yup.mcap", world=y_up), None, ReplayOptions())
     assert any(line.startswith("warning: the camera's image 'down' axis points") and
-               "y-up" in line for line in rep.lines())
+               "is side-on (a world written y-up maps so)" in line for line in rep.lines())
+    # turned half a turn about x: upside down, said so (not "side-on")
+    flipped = np.diag([1.0, -1.0, -1.0, 1.0])
+    rep = replay(synthetic_log(tmp_path / "flip.mcap", world=flipped), None, ReplayOptions())
+    assert any("this map is upside down: the world's z points down" in line
+               for line in rep.lines()), rep.lines()
     # a camera looking straight down has its image "down" level, but sees the floor at
     # height 0: upright, nothing said
     rep = replay(synthetic_log(tmp_path / "down.mcap", pitch=1.5), None, ReplayOptions())
