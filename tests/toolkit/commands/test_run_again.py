@@ -191,17 +191,18 @@ def _as_older_log(src: Path, dst: Path) -> None:
         assert summary is not None
         w = Writer(g)
         w.start(profile=r.get_header().profile, library="test")
-        for sid, s in sorted(summary.schemas.items()):
-            w.register_schema(s.name, s.encoding, s.data)
-        for cid, c in sorted(summary.channels.items()):
-            w.register_channel(c.topic, c.message_encoding, c.schema_id, dict(c.metadata))
+        schemas = {sid: w.register_schema(s.name, s.encoding, s.data)
+                   for sid, s in sorted(summary.schemas.items())}
+        channels = {cid: w.register_channel(c.topic, c.message_encoding,
+                                            schemas.get(c.schema_id, 0), dict(c.metadata))
+                    for cid, c in sorted(summary.channels.items())}
         for _, channel, m in r.iter_messages(log_time_order=False):
             data = m.data
             if channel.topic == "/sgtool/episode":
                 rec = json.loads(data)
                 rec.get("extra", {}).pop("navigation", None)
                 data = json.dumps(rec).encode()
-            w.add_message(channel.id, m.log_time, data, m.publish_time, m.sequence)
+            w.add_message(channels[channel.id], m.log_time, data, m.publish_time, m.sequence)
         for a in r.iter_attachments():
             w.add_attachment(a.create_time, a.log_time, a.name, a.media_type, a.data)
         for md in r.iter_metadata():
