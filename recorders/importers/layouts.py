@@ -21,6 +21,7 @@
   leaves a gap). Without a ``.log``, a ``traj.txt`` of a 4x4 matrix a line (NICE-SLAM's
   Replica renders), or a ``pose/`` folder of one 4x4 text file a frame and an
   ``intrinsic/intrinsic_depth.txt`` (a ScanNet export: :mod:`.pose_files`) are read.
+- ``replica``: Replica scenes as NICE-SLAM renders them (:mod:`.replica_layout`).
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ from sgtool.recorders.importers.image_files import (
     pair_name,
 )
 from sgtool.recorders.importers.pose_files import folder_intrinsics, pose_folder, posed_pairs
+from sgtool.recorders.importers.replica_layout import is_replica, read_replica, replica_missing
 from sgtool.recorders.importers.sanity import time_range_problem, timestamp_problem
 from sgtool.recorders.importers.textformats import (
     PinholeParams,
@@ -55,7 +57,7 @@ from sgtool.recorders.importers.textformats import (
     untracked_pose,
 )
 
-LAYOUTS = ("tum", "7scenes", "open3d")
+LAYOUTS = ("tum", "7scenes", "open3d", "replica")
 
 # TUM RGB-D calibrated colour intrinsics (vision.in.tum.de/data/datasets/rgbd-dataset/
 # file_formats, "Intrinsic Camera Calibration of the Kinect")
@@ -99,11 +101,13 @@ class FolderSequence:
     dropped: int = 0  # depth images left out because the poses do not cover their time
 
 
-LAYOUT_NAMES = {"tum": "TUM RGB-D", "7scenes": "7-Scenes", "open3d": "Open3D/Redwood"}
+LAYOUT_NAMES = {"tum": "TUM RGB-D", "7scenes": "7-Scenes", "open3d": "Open3D/Redwood",
+                "replica": "Replica (NICE-SLAM)"}
 LAYOUT_FILES = {
     "tum": "rgb.txt + depth.txt",
     "7scenes": "frame-XXXXXX.depth.png",
     "open3d": "color/ or image/ and depth/ folders",
+    "replica": "results/depthNNNNNN.png, traj.txt",
 }
 
 
@@ -116,7 +120,7 @@ def looks_like(root: Path) -> str | None:
         return "7scenes"
     if "depth" in names and (root / "depth").is_dir() and _color_dir(root) is not None:
         return "open3d"
-    return None
+    return "replica" if "results" in names and is_replica(root) else None
 
 
 def _sequence_hint(root: Path) -> str:
@@ -155,6 +159,8 @@ def missing_for_layout(root: Path, layout: str) -> str | None:
                                             "is read from 16-bit PNG or TIFF images)"
                                             if held else "")
         return None
+    if layout == "replica":
+        return replica_missing(root)
     raise SgtoolError(f"unknown layout {layout!r} ({', '.join(LAYOUTS)})")
 
 
@@ -215,6 +221,8 @@ def read_sequence(
         seq = _read_7scenes(root, fps, trajectory, skip_missing, keep_unposed)
     elif layout == "open3d":
         seq = _read_open3d(root, fps, trajectory, skip_missing, keep_unposed)
+    elif layout == "replica":
+        seq = read_replica(root, fps, trajectory)
     else:  # pragma: no cover - missing_for_layout refuses unknown layouts
         raise SgtoolError(f"unknown layout {layout!r} ({', '.join(LAYOUTS)})")
     if not seq.frames:
@@ -475,10 +483,8 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
         pairs = list(zip(depths, colors, strict=True))
         notes.append("depth and colour images paired in order (their names differ)")
     else:
-        raise SgtoolError(
-            f"{root}: {len(depths)} depth and {len(colors)} colour images with different "
-            "names; cannot pair them"
-        )
+        raise SgtoolError(f"{root}: {len(depths)} depth and {len(colors)} colour images with "
+                          "different names; cannot pair them")
     traj = trajectory
     if traj is None:
         logs = sorted(root.glob("*.log"))
@@ -488,10 +494,8 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
         elif len(logs) == 1:
             traj = logs[0]
         elif len(logs) > 1:
-            raise SgtoolError(
-                f"{root}: several trajectories ({', '.join(p.name for p in logs)}); "
-                "choose one with --trajectory"
-            )
+            raise SgtoolError(f"{root}: several trajectories ({', '.join(p.name for p in logs)})"
+                              "; choose one with --trajectory")
         elif (root / "traj.txt").is_file() and is_matrix_trajectory(root / "traj.txt"):
             traj = root / "traj.txt"  # a matrix a line: NICE-SLAM's Replica renders
     per_frame = pose_folder(root) if traj is None else None

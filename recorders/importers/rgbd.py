@@ -214,7 +214,8 @@ def camera_for(seq: FolderSequence, opts: RgbdOptions, width: int, height: int,
     if (p.width and p.width != width) or (p.height and p.height != height):
         raise SgtoolError(
             f"intrinsics {p.source or ''} are for {p.width}x{p.height} images, the depth "
-            f"images are {width}x{height}"
+            f"images are {width}x{height}; give theirs with --intrinsics fx,fy,cx,cy (or a "
+            "file)"
         )
     origin = "flag --intrinsics" if opts.intrinsics is not None else p.source
     if not (0 <= p.cx <= width and 0 <= p.cy <= height):

@@ -322,12 +322,13 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None,
 
 @command.command("rgbd")
 @click.argument("folder", type=PathParam(exists=True, file_okay=False))
-@click.option("--layout", type=click.Choice(["auto", "tum", "7scenes", "open3d"]),
+@click.option("--layout", type=click.Choice(["auto", "tum", "7scenes", "open3d", "replica"]),
               default="auto", show_default=True,
               help="Folder layout: TUM RGB-D (rgb.txt, depth.txt, groundtruth.txt), 7-Scenes "
               "(frame-XXXXXX.color/depth/pose), Open3D/Redwood (color|image/, depth/, "
-              "*.log, intrinsics JSON; or, without a .log, a ScanNet export's pose/NAME.txt "
-              "and intrinsic/intrinsic_depth.txt).")
+              "*.log or traj.txt, intrinsics JSON; or, without them, a ScanNet export's "
+              "pose/NAME.txt and intrinsic/intrinsic_depth.txt), Replica as NICE-SLAM renders "
+              "it (results/frameNNNNNN.jpg and depthNNNNNN.png, traj.txt, cam_params.json).")
 @click.option("--fps", type=float, default=30.0, show_default=True,
               help="Frame rate (0.1-1000) for layouts without time stamps (7-Scenes frame n "
               "is at n/fps; an Open3D image numbered n at (n - first) / step / fps, step the "
@@ -369,7 +370,8 @@ def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bo
          intrinsics: str | None, depth_scale: float | None, max_dt: float, every: int,
          limit: int | None, compression: str, force: bool, allow_drop: bool, as_json: bool,
          quiet: bool, camera_axes: str, world_to_camera: bool) -> None:
-    """Import an RGB-D image folder (TUM RGB-D, 7-Scenes, Open3D/Redwood) at FOLDER.
+    """Import an RGB-D image folder (TUM RGB-D, 7-Scenes, Open3D/Redwood, ScanNet export,
+    Replica as NICE-SLAM renders it) at FOLDER.
 
     Log times are the dataset's time stamps (TUM) or frame number / --fps. Poses are the
     dataset's (ground truth or trajectory) or estimated by odometry.
