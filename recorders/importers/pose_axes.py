@@ -55,13 +55,6 @@ def convention_text(axes: str, world_to_camera: bool) -> str:
     return ", ".join(parts)
 
 
-def composed_axes(first: str, then: str) -> str | None:
-    """The axes a pose read with ``first`` and then turned by ``then`` is read with (the
-    product of their matrices), or None when no name of :data:`CAMERA_AXES` is that."""
-    m = CAMERA_AXES[first][0] @ CAMERA_AXES[then][0]
-    return next((n for n, (a, _) in CAMERA_AXES.items() if np.allclose(a, m)), None)
-
-
 @dataclass(frozen=True)
 class ReadAs:
     """How an import read its poses (``--camera-axes``, ``--world-to-camera``; ``bag``:

@@ -29,7 +29,6 @@ from sgtool.recorders.importers.pose_axes import (
     CAMERA_AXES,
     OPTICAL_C2W,
     ReadAs,
-    composed_axes,
     to_optical,
 )
 from sgtool.recorders.importers.sanity import KNOWN_SCALES
@@ -298,9 +297,14 @@ def convention_problems(pairs: Pairs, k: CameraIntrinsics, fit: ScaleFit | None,
     units = [(unit, fit_scale([(a, b, _in_metres(p, f), _in_metres(q, f))
                                for a, b, p, q in pairs], k)) for f, unit in POSE_UNITS]
     reordered = fit_scale(reordered_pairs, k)
-    axes = {(name, inv): fit_scale([(a, b, to_optical(p, name, inv), to_optical(q, name, inv))
+    # each other convention the file may be in (the poses as written: the reading undone);
+    # the optical frame's other inversion is the inverted check's
+    axes = {(name, inv): fit_scale([(a, b, to_optical(_as_written(p, read_as), name, inv),
+                                     to_optical(_as_written(q, read_as), name, inv))
                                     for a, b, p, q in pairs], k)
-            for inv in (False, True) for name in CAMERA_AXES if name != "optical"}
+            for inv in (False, True) for name in CAMERA_AXES
+            if (name, inv) != (read_as.axes, read_as.inverse)
+            and (name, inv) != ("optical", not read_as.inverse)}
     found = (inverted_poses_problem(fit, inverted, pose_source, read_as),
              pose_units_problem(units, pose_source),
              quaternion_order_problem(fit, reordered, pose_source),
@@ -327,15 +331,23 @@ def camera_axes_problem(given: ScaleFit | None,
              if given.consistent() else f"{given.ratio:.2f}x on average, the pairs disagreeing,")
     other = (", or --tf-frames WORLD:CAMERA_OPTICAL_FRAME where the tree has the optical "
              "frame" if read_as.bag and name == "body" else "")
-    axes = name if inv else composed_axes(read_as.axes, name)  # as read, then turned so
-    fix = (read_as.fix(axes, read_as.inverse != inv) if axes is not None else
-           f"no --camera-axes reads them so ({read_as.axes} given)")
-    return (f"the poses ({pose_source}) look like those of a camera frame with {name} axes "
-            f"({CAMERA_AXES[name][1]}){', inverted,' if inv else ','} not of its optical "
-            "frame (x right, y down, z "
-            f"forward): between {fit.pairs} pairs of nearby frames the depth moves {moves} as "
-            f"far as the poses, and {fit.ratio:.2f}x as far as the optical frame they imply; "
+    fix = read_as.fix(name, inv)
+    frame = ("the camera's optical frame (x right, y down, z forward)" if name == "optical"
+             else f"a camera frame with {name} axes ({CAMERA_AXES[name][1]})")
+    as_read = ("of its optical frame (x right, y down, z forward)" if read_as.axes == "optical"
+               else f"of the {read_as.axes} axes --camera-axes {read_as.axes} reads")
+    return (f"the poses ({pose_source}) look like those of {frame}"
+            f"{', world-to-camera' if inv else ''}, not {as_read}: between {fit.pairs} pairs "
+            f"of nearby frames the depth moves {moves} as far as the poses, and "
+            f"{fit.ratio:.2f}x as far as the optical frame they imply; "
             f"{fix}{other}, or --estimate-poses to estimate the poses from the depth")
+
+
+def _as_written(pose: np.ndarray, read_as: ReadAs) -> np.ndarray:
+    """``pose`` as the file wrote it, before it was read as ``read_as`` says
+    (:func:`~.pose_axes.to_optical` undone)."""
+    p = np.asarray(pose, float) @ np.linalg.inv(CAMERA_AXES[read_as.axes][0])
+    return np.linalg.inv(p) if read_as.inverse else p
 
 
 def _wxyz_read_as_xyzw(pose: np.ndarray) -> np.ndarray:

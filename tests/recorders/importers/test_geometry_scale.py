@@ -387,3 +387,23 @@ def test_convention_flags_for_a_folder_without_poses_are_refused(tmp_path) -> No
                        r"poses to read \(they are estimated from the depth\); leave them out$"):
         import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(
             intrinsics=K, progress=False, camera_axes="opengl", world_to_camera=True))
+
+
+def test_a_wrong_axes_flag_over_other_axes_is_named(shared_data_dir, tmp_path) -> None:
+    """Real 7-Scenes poses rewritten as ROS camera_link's, read with --camera-axes opengl:
+    no single turn on top of that reading is one of the named axes, so the check said only
+    "do not move as the depth does"; the poses as written are tried now, and the advice
+    names the flag to give instead of the one given."""
+    import shutil
+
+    from sgtool.recorders.importers.pose_axes import BODY_T_OPTICAL
+
+    root = tmp_path / "kitchen"
+    shutil.copytree(shared_data_dir / "rgbd" / "7scenes-redkitchen-every10", root)
+    for f in sorted(root.glob("frame-*.pose.txt")):
+        np.savetxt(f, np.loadtxt(f) @ np.linalg.inv(BODY_T_OPTICAL))
+    with pytest.raises(SgtoolError, match=r"look like those of a camera frame with body axes "
+                       r".*, not of the opengl axes --camera-axes opengl reads: .* read them "
+                       r"with --camera-axes body instead of --camera-axes opengl"):
+        import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(progress=False, limit=50,
+                                                          camera_axes="opengl"))
