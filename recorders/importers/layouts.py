@@ -18,8 +18,8 @@
   default 525, 525, 319.5, 239.5 that Open3D itself assumes. Frames are ``1/fps`` apart, in
   natural name order ("2.png" before "10.png", as Open3D's ``sorted_alphanum``); images
   named by plain numbers are at their number's time (a frame missing from the numbering
-  leaves a gap). Without a ``.log``, a ``traj.txt`` of a 4x4 matrix a line (NICE-SLAM's
-  Replica renders), or a ``pose/`` folder of one 4x4 text file a frame and an
+  leaves a gap). Without a ``.log``, a ``traj.txt`` of a 4x4 matrix a line (as SLAM
+  systems write it), or a ``pose/`` folder of one 4x4 text file a frame and an
   ``intrinsic/intrinsic_depth.txt`` (a ScanNet export: :mod:`.pose_files`) are read.
 - ``replica``: Replica scenes as NICE-SLAM renders them (:mod:`.replica_layout`).
 """
@@ -99,6 +99,7 @@ class FolderSequence:
     pose_source: str  # "ground truth" | "trajectory" | "none"
     notes: tuple[str, ...] = ()
     dropped: int = 0  # depth images left out because the poses do not cover their time
+    scale_source: str = ""  # where depth_scale came from, when not the layout's default
 
 
 LAYOUT_NAMES = {"tum": "TUM RGB-D", "7scenes": "7-Scenes", "open3d": "Open3D/Redwood",
@@ -124,7 +125,8 @@ def looks_like(root: Path) -> str | None:
 
 
 def _sequence_hint(root: Path) -> str:
-    seqs = sorted(p.name for p in root.iterdir() if p.name.startswith("seq-") and p.is_dir())
+    seqs = sorted(p.name for p in root.iterdir() if p.is_dir() and (  # 7-Scenes; Replica
+        p.name.startswith("seq-") or (p / "results").is_dir()))
     return f"; it has sequence folders {', '.join(seqs[:5])}: import one of them" if seqs else ""
 
 
@@ -497,7 +499,7 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
             raise SgtoolError(f"{root}: several trajectories ({', '.join(p.name for p in logs)})"
                               "; choose one with --trajectory")
         elif (root / "traj.txt").is_file() and is_matrix_trajectory(root / "traj.txt"):
-            traj = root / "traj.txt"  # a matrix a line: NICE-SLAM's Replica renders
+            traj = root / "traj.txt"  # a 4x4 matrix a line, as SLAM systems write it
     per_frame = pose_folder(root) if traj is None else None
     slot: dict[Path, float] = {}  # frame i stays at i/fps when frames before it are left out
     numbered = frame_slots([d for d, _ in pairs], depths + (colors if matched else []))

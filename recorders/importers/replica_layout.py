@@ -110,4 +110,4 @@ def read_replica(root: Path, fps: float, trajectory: Path | None) -> FolderSeque
     return FolderSequence("replica", root, frames, k, scale,
                           "none" if poses is None else
                           ("trajectory" if trajectory is not None else "ground truth"),
-                          tuple(notes))
+                          tuple(notes), scale_source=origin)

@@ -372,7 +372,7 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     findings = Findings(opts.warn)
     scale = float(opts.depth_scale if opts.depth_scale is not None else seq.depth_scale)
     scale_origin = ("flag --depth-scale" if opts.depth_scale is not None
-                    else f"dataset default: {seq.layout} layout")
+                    else seq.scale_source or f"dataset default: {seq.layout} layout")
     picks = sample_indices(len(frames))
     raws = [read_depth_file(frames[i].depth_path) for i in picks]
     findings.problem(no_depth_problem(raws, str(root)), given=False)

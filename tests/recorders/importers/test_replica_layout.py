@@ -46,7 +46,8 @@ def test_a_replica_scene_imports_as_its_tum_twin(tmp_path) -> None:
     assert (seq.intrinsics.fx, seq.intrinsics.width) == (K.fx, K.width)
     assert "intrinsics and depth scale 6553.5 from file cam_params.json" in seq.notes
     rep = import_rgbd(root, tmp_path / "r.mcap", RgbdOptions(progress=False))
-    assert rep.frames == 20
+    assert rep.frames == 20 and any(line.startswith("depth scale: 6553.5 units/m [file "
+                                                    "cam_params.json]") for line in rep.lines())
     assert dict(rep.checks)["depth scale against the poses"].startswith("depth moves 1.0")
     twin = make_scene_folder(tmp_path / "tum", room(), POSES)
     intr = f"{K.fx},{K.fy},{K.cx},{K.cy}"
@@ -68,6 +69,16 @@ def test_a_replica_scene_without_cam_params_takes_the_renders_camera(tmp_path) -
                                                                                  680)
     with pytest.raises(SgtoolError, match="--intrinsics"):
         import_rgbd(root, tmp_path / "r.mcap", RgbdOptions(progress=False))
+
+
+def test_the_replica_folder_of_scenes_names_them(tmp_path) -> None:
+    """The download's top folder (scenes beside cam_params.json): the refusal names the
+    scene folders to import."""
+    replica_scene(tmp_path / "Replica" / "room0", poses=POSES[:3])
+    replica_scene(tmp_path / "Replica" / "office0", poses=POSES[:3])
+    with pytest.raises(SgtoolError, match=r"it has sequence folders office0, room0: import one "
+                       r"of them"):
+        read_sequence(tmp_path / "Replica")
 
 
 def test_a_replica_scene_s_faults_are_one_line(tmp_path) -> None:
