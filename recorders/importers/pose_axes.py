@@ -48,6 +48,21 @@ def to_optical(pose: np.ndarray, axes: str = "optical",
     return p if axes == "optical" else p @ CAMERA_AXES[axes][0]
 
 
+def from_optical(pose: np.ndarray, axes: str = "optical",
+                 world_to_camera: bool = False) -> np.ndarray:
+    """:func:`to_optical` undone: the pose as a file in that convention writes it."""
+    p = np.asarray(pose, float)
+    if axes != "optical":
+        p = p @ np.linalg.inv(CAMERA_AXES[axes][0])
+    return np.linalg.inv(p) if world_to_camera else p
+
+
+def convention_flags(axes: str, world_to_camera: bool) -> list[str]:
+    """The flags of ``import rgbd`` that read poses of that convention."""
+    return [f"--camera-axes {axes}"] * (axes != "optical") + \
+        ["--world-to-camera"] * world_to_camera
+
+
 def convention_text(axes: str, world_to_camera: bool) -> str:
     """How the poses were read, for notes: "" for sgtool's own convention."""
     parts = ([f"camera axes {axes} ({CAMERA_AXES[axes][1]})"] if axes != "optical" else []) \
@@ -69,16 +84,11 @@ class ReadAs:
         """The advice that reads the poses with ``axes``, inverted when ``inverse``."""
         if inverse != self.inverse and self.bag:
             return "invert them"
+        want = " ".join(convention_flags(axes, inverse))
         if (self.axes, self.inverse) == ("optical", False):
-            flags = " ".join([f"--camera-axes {axes}"] * (axes != "optical")
-                             + ["--world-to-camera"] * inverse)
-            return f"give {flags} to " + ("invert them" if axes == "optical" else
-                                          "read them so")
-        want = [f"--camera-axes {axes}"] * (axes != "optical") + ["--world-to-camera"] * inverse
-        had = [f"--camera-axes {self.axes}"] * (self.axes != "optical") + \
-            ["--world-to-camera"] * self.inverse
-        return (f"read them with {' '.join(want) or 'neither --camera-axes nor --world-to-camera'}"
-                f" instead of {' '.join(had)}")
+            return f"give {want} to " + ("invert them" if axes == "optical" else "read them so")
+        return (f"read them with {want or 'neither --camera-axes nor --world-to-camera'} "
+                f"instead of {' '.join(convention_flags(self.axes, self.inverse))}")
 
 
 OPTICAL_C2W = ReadAs()  # sgtool's own convention, as a folder's import reads by default

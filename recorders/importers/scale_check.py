@@ -29,6 +29,7 @@ from sgtool.recorders.importers.pose_axes import (
     CAMERA_AXES,
     OPTICAL_C2W,
     ReadAs,
+    from_optical,
     to_optical,
 )
 from sgtool.recorders.importers.sanity import KNOWN_SCALES
@@ -299,9 +300,10 @@ def convention_problems(pairs: Pairs, k: CameraIntrinsics, fit: ScaleFit | None,
     reordered = fit_scale(reordered_pairs, k)
     # each other convention the file may be in (the poses as written: the reading undone);
     # the optical frame's other inversion is the inverted check's
-    axes = {(name, inv): fit_scale([(a, b, to_optical(_as_written(p, read_as), name, inv),
-                                     to_optical(_as_written(q, read_as), name, inv))
-                                    for a, b, p, q in pairs], k)
+    written = [(a, b, from_optical(p, read_as.axes, read_as.inverse),
+                from_optical(q, read_as.axes, read_as.inverse)) for a, b, p, q in pairs]
+    axes = {(name, inv): fit_scale([(a, b, to_optical(p, name, inv), to_optical(q, name, inv))
+                                    for a, b, p, q in written], k)
             for inv in (False, True) for name in CAMERA_AXES
             if (name, inv) != (read_as.axes, read_as.inverse)
             and (name, inv) != ("optical", not read_as.inverse)}
@@ -341,13 +343,6 @@ def camera_axes_problem(given: ScaleFit | None,
             f"of nearby frames the depth moves {moves} as far as the poses, and "
             f"{fit.ratio:.2f}x as far as the optical frame they imply; "
             f"{fix}{other}, or --estimate-poses to estimate the poses from the depth")
-
-
-def _as_written(pose: np.ndarray, read_as: ReadAs) -> np.ndarray:
-    """``pose`` as the file wrote it, before it was read as ``read_as`` says
-    (:func:`~.pose_axes.to_optical` undone)."""
-    p = np.asarray(pose, float) @ np.linalg.inv(CAMERA_AXES[read_as.axes][0])
-    return np.linalg.inv(p) if read_as.inverse else p
 
 
 def _wxyz_read_as_xyzw(pose: np.ndarray) -> np.ndarray:
