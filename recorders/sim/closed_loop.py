@@ -482,11 +482,11 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner | str,
     ``planner_options``: recorded in the episode records' ``extra.planner_options``, plain
     values only and secrets left out, so that the log's planner can be built again; when
     None, the options ``make_planner`` built it with), or a name ``make_planner`` builds
-    here from ``planner_options`` (recorded as converted), and it is
-    closed here (its ``close()``, when it has one) when the episode ends; its LLM
-    exchanges, when it keeps them (``drain_exchanges()``, moma-llm), are logged after each
-    decision. A planner object of the user's is held to the contract a plug-in is
-    (:func:`sgtool.planning.plugins.held_to_contract`). ``progress`` is anything with
+    here from ``planner_options`` (recorded as converted); it is closed here (its
+    ``close()``, when it has one) when the episode ends or fails; its LLM exchanges, when
+    it keeps them (``drain_exchanges()``, moma-llm), are logged after each decision. A
+    user's planner object is held to a plug-in's contract
+    (:func:`sgtool.planning.plugins.held_to_contract`); ``progress`` is anything with
     ``update(n)`` (a tqdm bar), advanced per frame; ``on_decision`` sees every graph and
     the action chosen on it.
     """
@@ -500,19 +500,19 @@ def run_episode(house: HouseSpec, episode: Episode, planner: Planner | str,
     require("pybullet", api="sgtool.run_closed_loop")  # one line on a core install
     if isinstance(planner, str):  # recorded as make_planner converted them
         planner, planner_options = make_planner(planner, **(planner_options or {})), None
-    recorded = options_record(planner, planner_options)
-    planner = held_to_contract(planner)  # a user's planner object: one line for its faults
-    opts = options or ClosedLoopOptions()
-    if bad := refused_number(recorded.get("planner_options", {})):  # now, not at the end
-        raise SgtoolError(f"planner option {bad[0]}={bad[1]}: a finite number (the "
-                          "episode's log records it)")
-    mapping = opts.mapping()
-    name = str(getattr(planner, "name", "planner"))
-    classifier = _classifier(mapping.classifier)
-    hid, query = house_id or f"house-{house.seed}", episode.query
-    shortest = driven_shortest(house, episode) if math.isfinite(episode.shortest_path) else None
-    t_wall = time.perf_counter()
-    try:
+    try:  # the planner is closed however the episode ends, a refused option too
+        recorded = options_record(planner, planner_options)
+        planner = held_to_contract(planner)  # a user's planner object: one line for its faults
+        opts = options or ClosedLoopOptions()
+        if bad := refused_number(recorded.get("planner_options", {})):  # now, not at the end
+            raise SgtoolError(f"planner option {bad[0]}={bad[1]}: a finite number (the "
+                              "episode's log records it)")
+        mapping = opts.mapping()
+        name = str(getattr(planner, "name", "planner"))
+        classifier = _classifier(mapping.classifier)
+        hid, query, t_wall = house_id or f"house-{house.seed}", episode.query, time.perf_counter()
+        shortest = (driven_shortest(house, episode) if math.isfinite(episode.shortest_path)
+                    else None)
         with Simulation(house, camera=opts.camera, robot=opts.robot, fps=opts.fps,
                         start=episode.start) as sim, \
                 LogWriter(output, seed=opts.planner_seed, compression=opts.compression,

@@ -320,6 +320,34 @@ def test_a_closed_loop_run_refuses_what_it_could_not_log_before_it_runs(tmp_path
     assert not list(tmp_path.iterdir())
 
 
+def test_a_planner_built_from_a_name_is_closed_when_the_run_refuses(tmp_path,
+                                                                    monkeypatch) -> None:
+    """run_closed_loop builds a planner named to it; when an option it records is refused
+    (infinity), that planner is closed all the same (an LLM planner's server, a plug-in's
+    files), and nothing is written."""
+    pytest.importorskip("pybullet")
+    from support.symbolic_fixtures import three_rooms
+
+    (tmp_path / "closing_plugin.py").write_text(
+        "from sgtool.planning.planners import GreedyPlanner\n"
+        "CLOSED = []\n"
+        "class Closing(GreedyPlanner):\n"
+        "    def __init__(self, radius=1.0):\n"
+        "        super().__init__()\n"
+        "    def close(self):\n"
+        "        CLOSED.append(self)\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import closing_plugin  # type: ignore[import-not-found]
+
+    house = sgtool.load_house(three_rooms())
+    ep = sgtool.list_episodes(house, n=1)[0]
+    with pytest.raises(sgtool.SgtoolError, match="^planner option radius=inf: a finite"):
+        sgtool.run_closed_loop(house, ep, "closing_plugin:Closing", tmp_path / "e.mcap",
+                               planner_options={"radius": float("inf")})
+    assert len(closing_plugin.CLOSED) == 1
+    assert not (tmp_path / "e.mcap").exists()
+
+
 class _Shape(Protocol):
     def area(self) -> float: ...
 
