@@ -82,8 +82,9 @@ class ReadAs:
 
     def fix(self, axes: str, inverse: bool) -> str:
         """The advice that reads the poses with ``axes``, inverted when ``inverse``."""
-        if inverse != self.inverse and self.bag:
-            return "invert them"
+        if inverse != self.inverse and self.bag:  # no flag inverts a bag's transforms
+            return "invert them" + (f" and read them with --camera-axes {axes}"
+                                    if axes != self.axes else "")
         want = " ".join(convention_flags(axes, inverse))
         if (self.axes, self.inverse) == ("optical", False):
             return f"give {want} to " + ("invert them" if axes == "optical" else "read them so")

@@ -43,3 +43,7 @@ def test_the_advice_names_flags_relative_to_those_given() -> None:
         "read them with --camera-axes opengl --world-to-camera instead of --camera-axes "
         "body --world-to-camera")
     assert ReadAs(bag=True).fix("optical", True) == "invert them"
+    assert ReadAs(bag=True).fix("body", True) == \
+        "invert them and read them with --camera-axes body"
+    assert ReadAs("body", bag=True).fix("optical", True) == \
+        "invert them and read them with --camera-axes optical"
