@@ -28,14 +28,15 @@ rooms, the camera's RGB, depth and segmentation, the scene graph's graph view an
 action log.
 
 Two timelines: ``frame`` (frame index) and ``sim_time`` (log time since the start; Rerun's
-wall-clock ``log_time`` is turned off, :func:`new_stream`). What an
-export holds is a function of the log: the recording id is derived from the log's bytes
-(:func:`recording_id`), and every entity, time and value follows from the log. The file's
-bytes are not: Rerun stamps its rows and chunks with ids of its own (time-based, random), so
-two exports of one log differ under ``cmp``; compare what they hold, not their bytes. The
-robot's path is logged in pieces of :data:`PATH_CHUNK` points
-(``world/robot/path/K``), each re-logged only while it grows, so the recording grows
-linearly with the number of frames.
+wall-clock ``log_time`` is turned off, :func:`new_stream`). What an export holds is a
+function of the log: the recording id is derived from the log's bytes (:func:`recording_id`),
+every entity, time and value follows from the log, the blueprint's containers and views have
+fixed ids (:func:`blueprint`) and a file's rows are cut into chunks by size only, never by
+the clock (:func:`new_stream`). The file's bytes are not, and Rerun gives no way to make
+them so (:mod:`sgtool.analysis.rrd_contents` says why): two exports of one log differ under
+``cmp``; compare their :func:`sgtool.analysis.rrd_contents.content_digest`. The robot's
+path is logged in pieces of :data:`PATH_CHUNK` points (``world/robot/path/K``), each
+re-logged only while it grows, so the recording grows linearly with the number of frames.
 
 The ``.rrd`` is written atomically (:func:`sgtool.files.atomic_output`): an error or Ctrl-C
 leaves nothing at its path. Rerun's file sink does not report write errors (on a full disk
@@ -51,6 +52,7 @@ import contextlib
 import errno
 import hashlib
 import os
+import uuid
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -84,7 +86,7 @@ def blueprint() -> Any:
     import rerun.blueprint as rrb
 
     cam = "world/camera/image"
-    return rrb.Blueprint(rrb.Horizontal(
+    bp = rrb.Blueprint(rrb.Horizontal(
         rrb.Vertical(
             rrb.Spatial3DView(name="3D map", origin="world"),
             rrb.Spatial3DView(name="Bird's-eye map", origin="world", contents=[
@@ -104,6 +106,21 @@ def blueprint() -> Any:
         ),
         column_shares=[3, 2],
     ), collapse_panels=False)
+    _fixed_ids(bp.root_container, "root")
+    return bp
+
+
+BLUEPRINT_IDS = uuid.UUID("5b7c1f0e-3f44-4a52-9d7e-2a1c9b3e6d10")  # uuid5 namespace
+
+
+def _fixed_ids(part: Any, where: str) -> None:
+    """Give a container or view and everything in it an id that follows from its place
+    in the layout (Rerun draws a random uuid4 for each, which would change the blueprint's
+    entity paths from export to export)."""
+    part.id = uuid.uuid5(BLUEPRINT_IDS, where)
+    for k, sub in enumerate(getattr(part, "contents", None) or ()):
+        if hasattr(sub, "blueprint_path"):
+            _fixed_ids(sub, f"{where}/{k}")
 
 
 def recording_id(log_path: Path) -> str:
@@ -203,7 +220,7 @@ def export(
             if where is not None and warn is not None:
                 warn(f"web viewer at {where}")
         else:
-            rec = new_stream(rid)
+            rec = new_stream(rid, to_file=out is not None)
         if out is not None and tmp is not None:
             require_space(out)
             rec.save(tmp, default_blueprint=blueprint())
@@ -229,17 +246,23 @@ def export(
     return out
 
 
-def new_stream(rid: str) -> Any:
+def new_stream(rid: str, *, to_file: bool = False) -> Any:
     """A Rerun recording stream of id ``rid`` on sgtool's timelines only (Rerun's own
     ``log_time``, the wall clock of the export, is left out: it would differ from export to
-    export and squeeze the log's time into the export's)."""
+    export and squeeze the log's time into the export's). ``to_file``: rows are cut into
+    chunks by size only (Rerun's batcher otherwise also cuts them every 200 ms of wall
+    clock, so a slower export holds other chunks); a live viewer keeps that tick, which is
+    what makes it draw while the export runs."""
     import rerun as rr
 
-    rec = rr.RecordingStream(APP_ID, recording_id=rid, send_properties=False)
+    batching = (rr.ChunkBatcherConfig(flush_tick=FILE_FLUSH_TICK_S) if to_file else None)
+    rec = rr.RecordingStream(APP_ID, recording_id=rid, send_properties=False,
+                             batcher_config=batching)
     rec.set_log_time_enabled(False)
     return rec
 
 
+FILE_FLUSH_TICK_S = 1e9  # no flush by the clock when writing a file (new_stream)
 def class_ids(instance_ids: Iterable[int]) -> np.ndarray | None:
     """How instance ids become Rerun's 16-bit class ids: None when every id fits (an id is
     its class id), else the sorted ids, whose position + 1 is the class id (ids of a table

@@ -123,6 +123,13 @@ def test_info(small: Path) -> None:
                required=conditional - {"repeated_frame_times"})
 
 
+def test_info_of_a_rerun_recording(small: Path) -> None:
+    from sgtool.analysis.view_run import write_rerun
+
+    rrd = write_rerun(write_log(small / "rrd.mcap", n=3), small / "info.rrd", voxels=False)
+    check_keys("info FILE.rrd", run(["info", str(rrd), "--json"]))
+
+
 def test_doctor(small: Path) -> None:
     log = write_log(small / "doctor.mcap")
     check_keys("doctor", run(["doctor", str(log), "--json"]))

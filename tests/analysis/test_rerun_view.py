@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 import shutil
 import subprocess
@@ -277,3 +278,67 @@ def test_max_frames_leaves_out_what_was_logged_after_the_last_frame(tmp_path):
             assert last["/world/camera/image/depth"] == 9
             assert last["/world/map/occupancy"] <= 9 and last["/graph"] <= 9
     assert last["/graph"] > 9 and last["/world/camera/image/depth"] == 39
+
+
+def test_two_exports_of_one_log_hold_the_same(tmp_path, monkeypatch):
+    """Two exports of one log differ in bytes (Rerun's ids; module doc) but not in what they
+    hold: the same content digest, with the blueprint's entity paths fixed, however Rerun
+    cut the rows into chunks; another log's export has another digest."""
+    import time
+
+    import rerun.chunk as rc
+
+    import sgtool.analysis.rerun_view as rv
+    from sgtool.analysis.rrd_contents import content_digest
+
+    log = write_log(tmp_path / "run.mcap", n=6)
+    first, second = tmp_path / "a.rrd", tmp_path / "b.rrd"
+    rv.export(log, first)
+    rv.export(log, second)
+    assert content_digest(first) == content_digest(second)
+
+    def blueprint_paths(path: Path) -> set[str]:
+        reader = rc.RrdReader(str(path))
+        return {str(c.entity_path) for c in reader.stream(store=reader.blueprints()[0])}
+
+    assert blueprint_paths(first) == blueprint_paths(second)
+    assert any(p.startswith("/container/") for p in blueprint_paths(first))
+
+    # rows cut into chunks by the clock (what Rerun's default batcher does) hold the same
+    monkeypatch.setattr(rv, "FILE_FLUSH_TICK_S", 0.001)
+    chopped = tmp_path / "chopped.rrd"
+    rv.export(log, chopped, progress=lambda n: time.sleep(0.02))
+
+    def chunks(path: Path) -> int:
+        return len(rc.RrdReader(str(path)).stream().to_chunks())
+
+    assert chunks(chopped) > chunks(first)
+    assert content_digest(chopped) == content_digest(first)
+
+    shorter = tmp_path / "shorter.rrd"
+    rv.export(log, shorter, max_frames=5)
+    assert content_digest(shorter) != content_digest(first)
+
+
+def test_info_of_a_rerun_recording_names_its_stores_and_digest(tmp_path):
+    """`sgtool info FILE.rrd` prints the recording's stores and content digest (the same
+    for two exports of one log); a file that only looks like one is one error line."""
+    import sgtool.analysis.rerun_view as rv
+
+    log = write_log(tmp_path / "run.mcap", n=4)
+    a, b = tmp_path / "a.rrd", tmp_path / "b.rrd"
+    rv.export(log, a)
+    rv.export(log, b)
+    runner = CliRunner()
+    got = [json.loads(runner.invoke(cli, ["info", str(p), "--json"]).output) for p in (a, b)]
+    assert got[0]["content_digest"] == got[1]["content_digest"]
+    assert [s["kind"] for s in got[0]["stores"]] == ["recording", "blueprint"]
+    rec = got[0]["stores"][0]
+    assert rec["recording_id"] == rv.recording_id(log) and rec["rows"] > 4
+    text = runner.invoke(cli, ["info", str(a)]).output
+    assert "a Rerun recording" in text and got[0]["content_digest"] in text
+    fake = tmp_path / "fake.rrd"
+    fake.write_bytes(b"RRF2" + bytes(4))
+    r = runner.invoke(cli, ["info", str(fake)])
+    assert r.exit_code == 2 and "Rerun cannot read it" in r.output
+    assert len(r.output.strip().splitlines()) == 1
