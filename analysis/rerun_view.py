@@ -250,7 +250,7 @@ def new_stream(rid: str, *, to_file: bool = False) -> Any:
     """A Rerun recording stream of id ``rid`` on sgtool's timelines only (Rerun's own
     ``log_time``, the wall clock of the export, is left out: it would differ from export to
     export and squeeze the log's time into the export's). ``to_file``: rows are cut into
-    chunks by size only (Rerun's batcher otherwise also cuts them every 200 ms of wall
+    chunks by size only (Rerun's batcher otherwise also cuts them at a tick of the wall
     clock, so a slower export holds other chunks); a live viewer keeps that tick, which is
     what makes it draw while the export runs."""
     import rerun as rr

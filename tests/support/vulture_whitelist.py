@@ -78,6 +78,7 @@ _.containers  # toolkit/house/spec.py: HouseSpec method, public API
 _.children  # toolkit/scenegraph/graph.py: SceneGraph method, public API
 _.offered  # toolkit/planning/memory.py: EpisodeMemory method
 _.frame_at  # toolkit/log/reader.py: LogReader method, public API
+_.content_digest  # analysis/rrd_contents.py: public API (docs/viewers.md; info uses summarize_rrd)
 _.write_ids  # toolkit/log/writer.py: LogWriter method, public API (write_frame encodes its own)
 _.to_record  # toolkit/scenegraph/instances.py: Instance -> log record
 _.excludes  # analysis/intervals.py: Interval method
