@@ -81,7 +81,7 @@ def decode_frames(
         if targets is None:
             continue
         mt = B.normalise_type(c.msgtype)
-        msg = reader.deserialize(raw, c.msgtype)
+        msg = B.deserialize(reader, raw, c)
         if kind == "depth":
             raw_d, scale = decode_depth_message(msg, mt, c.topic)
             if raw_d.shape != (k.height, k.width):

@@ -48,6 +48,7 @@ class BagIndex:
         default_factory=list)
     samples: dict[int, tuple[np.ndarray, float]] = field(default_factory=dict)  # depth k ->
     zero_stamps: int = 0
+    tf_zero_stamps: int = 0  # dynamic /tf transforms with a zero stamp, put at bag time
     # record time minus header stamp of each dynamic /tf transform (ns)
     tf_latency_ns: list[int] = field(default_factory=list)
 
@@ -83,6 +84,19 @@ def _resolve_zero_stamps(ii: ImageIndex, idx: BagIndex) -> None:
         idx.zero_stamps += 1
 
 
+def _resolve_zero_tf_stamps(unset: list[tuple[Any, str, int]], idx: BagIndex,
+                            first_stamp: int | None) -> None:
+    """Add the /tf messages with a zero header stamp (message, topic, bag time) to the tree:
+    at their stamps when the first non-zero stamp of /tf lies within ``_SIM_CLOCK_NS`` (a
+    simulator's clock that starts at 0), else at the bag's record time, counted in
+    ``idx.tf_zero_stamps`` (a recorder that never set them)."""
+    sim = first_stamp is not None and first_stamp <= _SIM_CLOCK_NS
+    for msg, topic, bag_t in unset:
+        add_tf_message(idx.tf, msg, topic, unset_stamp_ns=None if sim else bag_t)
+        if not sim:
+            idx.tf_zero_stamps += sum(stamp_ns(tr.header) == 0 for tr in msg.transforms)
+
+
 def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIndex:
     """Pass 1 over the wanted topics (module doc); the tf tree comes back frozen."""
     from tqdm import tqdm
@@ -94,19 +108,27 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
     n_depth = sum(t.count for t in topics if t.topic == opts.depth)
     keep = set(sample_indices(n_depth))  # depth images kept for the world alignment
     info_received: list[int] = []  # the bag's record times of idx.info_samples
+    unset: list[tuple[Any, str, int]] = []  # /tf messages with a zero stamp, bag time
+    first_stamp: int | None = None  # the earliest non-zero stamp of /tf
     total = sum(int(c.msgcount) for c in conns)
     bar = tqdm(total=total, unit="msg", desc="index", file=sys.stderr,
                disable=None if opts.progress else True, leave=False)
     try:
         for c, bag_t, raw in reader.messages(connections=conns):
             bar.update(1)
-            msg = reader.deserialize(raw, c.msgtype)
+            msg = B.deserialize(reader, raw, c)
             mt = B.normalise_type(c.msgtype)
             if c.topic in tf_topics:
+                static = c.topic.rstrip("/").endswith("tf_static")
+                stamps = [stamp_ns(tr.header) for tr in msg.transforms]
+                if not static and 0 in stamps:  # unset, or a simulator's clock at 0
+                    unset.append((msg, c.topic, int(bag_t)))
+                    continue
+                if not static and stamps:
+                    first_stamp = min(stamps) if first_stamp is None else min(first_stamp, *stamps)
                 add_tf_message(idx.tf, msg, c.topic)
-                if not c.topic.rstrip("/").endswith("tf_static"):
-                    idx.tf_latency_ns.extend(int(bag_t) - stamp_ns(tr.header)
-                                             for tr in msg.transforms)
+                if not static:
+                    idx.tf_latency_ns.extend(int(bag_t) - t for t in stamps)
                 continue
             if c.topic == opts.pose:
                 t, parent, T = pose_of_message(msg, mt, c.topic)  # noqa: N806
@@ -138,6 +160,7 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
         bar.close()
     for ii in (idx.depth, idx.rgb, idx.ids):
         _resolve_zero_stamps(ii, idx)
+    _resolve_zero_tf_stamps(unset, idx, first_stamp)
     # the first CameraInfo is the camera's until a change; the changes in time order
     timed = [(t, k) for t, k in idx.info_samples[:1]] + sorted(
         (_info_time(idx.depth, t, r), k)

@@ -90,14 +90,16 @@ def distortion_of_info(msg: Any) -> tuple[str, tuple[float, ...]]:
     return str(getattr(msg, "distortion_model", "") or ""), coeffs
 
 
-def add_tf_message(tree: TfTree, msg: Any, topic: str, *, checked: bool = True) -> None:
+def add_tf_message(tree: TfTree, msg: Any, topic: str, *, checked: bool = True,
+                   unset_stamp_ns: int | None = None) -> None:
     """Every transform of a ``tf2_msgs/TFMessage`` into ``tree`` (static when the topic is
-    ``/tf_static``). ``checked``: a transform that is not finite or has a zero quaternion is
-    a user error naming the topic, the stamp, the link and the field (module doc); a peek
-    for frame names only does not check."""
+    ``/tf_static``), at its header stamp (``unset_stamp_ns`` for a zero stamp, when given).
+    ``checked``: a transform that is not finite or has a zero quaternion is a user error
+    naming the topic, the stamp, the link and the field (module doc); a peek for frame
+    names only does not check."""
     static = topic.rstrip("/").endswith("tf_static")
     for i, tr in enumerate(msg.transforms):
-        t_ns = stamp_ns(tr.header)
+        t_ns = stamp_ns(tr.header) or (unset_stamp_ns or 0)
         where = (f"{topic} message at {t_ns} ns (header stamp), transform "
                  f"{frame_name(tr.header.frame_id)} -> {frame_name(tr.child_frame_id)}"
                  if checked else None)

@@ -53,7 +53,7 @@ def bag_scale_pairs(reader: Any, idx: BagIndex, opts: BagOptions, src: PoseSourc
     count = 0
     for c, _, raw in reader.messages(connections=B.connections_for(reader, str(opts.depth))):
         if count in need:
-            a, scale = decode_depth_message(reader.deserialize(raw, c.msgtype),
+            a, scale = decode_depth_message(B.deserialize(reader, raw, c),
                                             B.normalise_type(c.msgtype), c.topic)
             s = opts.depth_scale if opts.depth_scale else scale
             got[count] = depth_to_metres(a, s)

@@ -56,7 +56,7 @@ def peek_encodings(reader: Any, topics: list[B.TopicInfo]) -> dict[str, str]:
         if t.msgtype not in B.IMAGE_TYPES or t.count == 0:
             continue
         for c, _, raw in reader.messages(B.connections_for(reader, t.topic)):
-            msg = reader.deserialize(raw, c.msgtype)
+            msg = B.deserialize(reader, raw, c)
             out[t.topic] = str(getattr(msg, "encoding", None) or getattr(msg, "format", ""))
             break
     return out
@@ -179,7 +179,7 @@ def peek_tf(reader: Any, topics: list[B.TopicInfo], max_messages: int = 500) -> 
         for n, (c, _, raw) in enumerate(reader.messages(B.connections_for(reader, t.topic))):
             if n >= max_messages:
                 break
-            add_tf_message(tree, reader.deserialize(raw, c.msgtype), t.topic, checked=False)
+            add_tf_message(tree, B.deserialize(reader, raw, c), t.topic, checked=False)
     return tree.freeze()
 
 

@@ -59,9 +59,12 @@ def bag_kind(path: Path) -> str:
     return "ros2"
 
 
-def _check_mcap_profile(path: Path) -> None:
+def _check_mcap_profile(path: Path) -> bool:
     """A non-ROS MCAP file (an sgtool log, a protobuf recording) gets a message that says
-    what it is, rather than the bag reader's "Profile is not ros2"."""
+    what it is, rather than the bag reader's "Profile is not ros2". Returns whether the
+    bag reader needs an indexed copy of the file to read all of its messages: a valid MCAP
+    file without a chunk index (read in file order, refused when not in log-time order)
+    or whose summary leaves out what the reader relies on (:func:`_summary_gap`)."""
     from mcap.reader import make_reader
 
     from sgtool.log.mcap_records import MAGIC
@@ -95,6 +98,59 @@ def _check_mcap_profile(path: Path) -> None:
             f"{what} messages, not a ROS 2 bag (profile 'ros2', cdr)"
             + ("; it already is an sgtool log" if header.profile == "sgtool" else "")
         )
+    return summary is None or not summary.chunk_indexes or _summary_gap(summary) is not None
+
+
+def _summary_gap(summary: Any) -> str | None:
+    """What a ROS 2 MCAP file's summary leaves out that ``rosbags`` relies on (the MCAP
+    specification makes each part optional), or None. ``rosbags`` scans the file for the
+    channels and schemas only when the summary lists neither: channels listed without
+    their schemas read as schemaless, schemas listed without the channels as no topic; and
+    a chunk index without message indexes hides that chunk's messages."""
+    stats, chunks = summary.statistics, summary.chunk_indexes
+    unlisted = (stats.channel_count > len(summary.channels) if stats is not None
+                else not summary.channels and bool(chunks))
+    if unlisted and (summary.schemas or (stats is None and chunks)):
+        return "does not list the channels"
+    if any(ch.schema_id and ch.schema_id not in summary.schemas
+           for ch in summary.channels.values()):
+        return "lists the channels but not their schemas"
+    if any(not ci.message_index_offsets and (ci.message_start_time or ci.message_end_time)
+           for ci in chunks):
+        return "indexes the chunks but not the messages in them"
+    return None
+
+
+def _renamed_bag(path: Path, stack: contextlib.ExitStack) -> Path:
+    """What the bag reader opens for a file not named as a bag: the bag folder of a storage
+    file compressed whole (rosbag2's compression mode 'file', said in the folder's
+    metadata.yaml), or a ROS 1 bag under a name the reader goes by (removed on leaving
+    ``stack``); anything else is one line."""
+    if _starts_with(path, _ZSTD_MAGIC):
+        if (path.parent / "metadata.yaml").is_file():
+            return path.parent
+        raise SgtoolError(
+            f"{path}: a zstd-compressed file (rosbag2's compression mode 'file'): import its "
+            f"bag folder, with its metadata.yaml, or decompress it first (`zstd -d "
+            f"{quoted(path)}`)")
+    if not _starts_with(path, ROS1_MAGIC):
+        raise SgtoolError(
+            f"{path}: not a ROS bag (expected a ROS 1 .bag file, a ROS 2 bag folder, "
+            "or a ROS 2 .mcap/.db3 file)")
+    target = Path(stack.enter_context(tempfile.TemporaryDirectory())) / "bag.bag"
+    target.symlink_to(path.resolve())
+    return target
+
+
+def _indexed_copy(path: Path, stack: contextlib.ExitStack) -> Path:
+    """``path``'s messages in a temporary, fully indexed MCAP file (``sgtool doctor
+    --recover``'s copy: the same schemas, channels and messages), removed on leaving
+    ``stack``."""
+    from sgtool.log.recover import recover
+
+    copy = Path(stack.enter_context(tempfile.TemporaryDirectory())) / path.name
+    recover(path, copy)
+    return copy
 
 
 def _starts_with(path: Path, magic: bytes) -> bool:
@@ -119,19 +175,13 @@ def open_bag(path: str | Path) -> Iterator[Any]:
         if path.is_file() and path.suffix in (".mcap", ".db3"):
             if (path.parent / "metadata.yaml").is_file():
                 target = path.parent
-            elif path.suffix == ".mcap":
-                _check_mcap_profile(path)
+            elif path.suffix == ".mcap" and _check_mcap_profile(path):
+                target = _indexed_copy(path, stack)
         elif path.is_dir() and not (path / "metadata.yaml").is_file():
             raise SgtoolError(f"{path}: a folder without metadata.yaml is not a ROS 2 bag")
 
         elif path.is_file() and path.suffix != ".bag":
-            if not _starts_with(path, ROS1_MAGIC):
-                raise SgtoolError(
-                    f"{path}: not a ROS bag (expected a ROS 1 .bag file, a ROS 2 bag folder, "
-                    "or a ROS 2 .mcap/.db3 file)")
-            # a ROS 1 bag by another name: the reader goes by the name, so give it one
-            target = Path(stack.enter_context(tempfile.TemporaryDirectory())) / "bag.bag"
-            target.symlink_to(path.resolve())
+            target = _renamed_bag(path, stack)
         if target.is_dir() and target.suffix == ".bag":
             # a ROS 2 bag folder named *.bag (`ros2 bag record -o run.bag`), given or found
             # above its storage file: the reader takes the name for a ROS 1 file
@@ -172,6 +222,29 @@ def damaged_bag(exc: BaseException) -> bool:
         return True
     return any(type(exc).__module__.startswith(m) or type(exc).__module__ == m.rstrip(".")
                for m in _DAMAGE_MODULES)
+
+
+_ZSTD_MAGIC = b"\x28\xb5\x2f\xfd"
+
+
+def deserialize(reader: Any, raw: bytes, connection: Any) -> Any:
+    """A message of ``connection`` decoded by ``reader``. A ROS 2 MCAP file may name its
+    schemas ``pkg/Type`` (as ROS 1 does; MCAP tools accept both), while the reader registers
+    them as ``pkg/msg/Type``: the type is looked up under either name. A message compressed
+    on its own (rosbag2's ``--compression-mode message``, said only in the bag folder's
+    ``metadata.yaml``) is a user error naming the folder as what to import."""
+    msgtype = connection.msgtype
+    if msgtype not in reader.typestore.fielddefs:
+        msgtype = normalise_type(msgtype)
+    try:
+        return reader.deserialize(raw, msgtype)
+    except Exception as e:
+        if bytes(raw[:4]) == _ZSTD_MAGIC and damaged_bag(e):
+            raise SgtoolError(
+                f"topic {connection.topic}: the messages are zstd-compressed one by one "
+                "(rosbag2's compression mode 'message'), which only the bag folder's "
+                "metadata.yaml says: import the bag folder, with its metadata.yaml") from None
+        raise
 
 
 def list_topics(reader: Any) -> list[TopicInfo]:

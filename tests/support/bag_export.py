@@ -47,13 +47,15 @@ def write_frames_bag(
     depth_units: float | None = None,
     record_offset_ns: int = 0,
     info_stamped: bool = True,
+    tf_stamped: bool = True,
 ) -> int:
     """Write sgtool frames as a bag (see the module docstring); returns the frame count.
     ``tf=False`` leaves the poses out (a camera recorded alone); ``depth_units`` writes the
     depth as 32FC1 floats in that many units per metre (1: metres; default: 16UC1 mm);
     ``record_offset_ns`` records each message that much after its header stamp (a bag
     recorded on the wall clock of a simulation whose clock starts at 0); ``info_stamped``
-    False leaves the CameraInfo header stamps at 0 (a driver that never sets them)."""
+    False leaves the CameraInfo header stamps at 0 (a driver that never sets them);
+    ``tf_stamped`` False those of the transforms (a tf broadcaster that never sets them)."""
     tp = topics or BagTopics()
     n = 0
     with BagWriter(out, fmt) as w:
@@ -62,7 +64,8 @@ def write_frames_bag(
             rt = t + record_offset_ns
             if tf:
                 w.write(tp.tf, "tf2_msgs/msg/TFMessage", rt,
-                        w.tf(t, [w.transform_stamped(t, tp.world, tp.camera, fr.pose)]))
+                        w.tf(t, [w.transform_stamped(t if tf_stamped else 0, tp.world,
+                                                     tp.camera, fr.pose)]))
             w.write(tp.info, "sensor_msgs/msg/CameraInfo", rt,
                     w.camera_info(t if info_stamped else 0, tp.camera, fr.intrinsics))
             if depth_units is None:

@@ -562,6 +562,27 @@ def test_a_simulator_clock_starting_at_zero_keeps_its_first_frame(tmp_path):
         assert [f.time_ns for f in r.frames()] == [f.time_ns for f in frames]
 
 
+def test_transforms_never_stamped_are_put_at_bag_time(tmp_path):
+    """A tf broadcaster that leaves its header stamps at 0 beside stamped images (wall
+    clock): the transforms are put at the bag's record times, said in a note, and every
+    frame gets its pose; a simulator's clock at 0 (the test above) keeps its stamps."""
+    frames = []
+    for i in range(5):
+        k, rgb, depth, ids, pose, _ = synthetic_frame(i)
+        frames.append(Frame(index=i, time_ns=1_733_000_000 * 10**9 + i * 33_000_000, rgb=rgb,
+                            depth=depth, ids=ids, pose=pose, intrinsics=k))
+    bag = tmp_path / "unstamped"
+    write_frames_bag(frames, bag, "ros2-mcap", tf_stamped=False)
+    out = tmp_path / "o.mcap"
+    rep = import_bag(bag, out, BagOptions(**TOPICS, **KEEP_WORLD))
+    assert rep.frames == 5
+    assert any(n.startswith("5 /tf transforms had a zero header stamp") for n in rep.notes)
+    with LogReader(out) as r:
+        for got, want in zip(r.frames(), frames, strict=True):
+            assert got.time_ns == want.time_ns
+            assert np.allclose(got.pose, want.pose, atol=1e-9)
+
+
 def test_a_camera_info_that_changes_part_way_is_followed(tmp_path):
     """A CameraInfo whose focal length changes at the fourth image (a zoom): each imported
     frame has the intrinsics in effect at its time, and the note counts one change."""
