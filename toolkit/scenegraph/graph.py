@@ -19,9 +19,11 @@ from __future__ import annotations
 
 import functools
 import json
+import math
+import numbers
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields
-from typing import Any, Literal, TypeVar
+from typing import Any, Literal, TypeVar, cast
 
 from sgtool.canonical import canonical_float, canonical_floats
 from sgtool.errors import ArgumentError
@@ -270,27 +272,28 @@ class SceneGraph:
         rb = d["robot"]
         return cls(
             robot=RobotState(
-                position=tuple(rb["position"]), yaw=rb.get("yaw", 0.0),
+                position=_xy(rb["position"], "robot.position"),
+                yaw=_number(rb.get("yaw", 0.0), "robot.yaw"),
                 room=rb.get("room"), region=rb.get("region"),
             ),
             rooms=_nodes(d, "rooms", lambda r: RoomNode(
-                id=r["id"], category=r["category"], position=tuple(r["position"]),
+                id=r["id"], category=r["category"], position=_xy(r["position"]),
                 explored=r["explored"],
                 category_scores=tuple((c, p) for c, p in r.get("category_scores", [])),
                 neighbours=tuple(r.get("neighbours", [])))),
             regions=_nodes(d, "regions", lambda r: RegionNode(
-                id=r["id"], room=r["room"], position=tuple(r["position"]), kind=r["kind"],
+                id=r["id"], room=r["room"], position=_xy(r["position"]), kind=r["kind"],
                 frontier_type=r.get("frontier_type"), size=r.get("size", 0.0))),
             objects=_nodes(d, "objects", lambda o: ObjectNode(
                 id=o["id"], category=o["category"], parent=o["parent"], room=o["room"],
-                position=tuple(o["position"]), instance=o.get("instance", -1),
+                position=_xyz(o["position"]), instance=o.get("instance", -1),
                 relation=o.get("relation"), state=o.get("state"),
                 affordances=tuple(o.get("affordances", [])),
                 explored=o.get("explored", False))),
             doors=_nodes(d, "doors", lambda x: DoorNode(
-                id=x["id"], position=tuple(x["position"]), state=x["state"],
+                id=x["id"], position=_xy(x["position"]), state=x["state"],
                 rooms=tuple(x.get("rooms", [])), instance=x.get("instance", -1))),
-            distances=dict(d.get("distances", {})),
+            distances=_distances(d.get("distances", {})),
             time_ns=int(d.get("time_ns", 0)),
             version=str(d.get("version", SCENE_GRAPH_VERSION)),
         )
@@ -304,6 +307,50 @@ class SceneGraph:
         except ValueError as e:  # JSONDecodeError, UnicodeDecodeError
             raise ArgumentError(f"scene graph: not JSON ({e})") from None
         return cls.from_dict(d)
+
+
+def _number(v: Any, what: str) -> float:
+    """``v`` as read (a finite real number, not a bool; ints stay ints, so the canonical
+    JSON of a graph read back is the same bytes); else the ValueError naming it that
+    :meth:`SceneGraph.from_dict` turns into its one line."""
+    if (type(v) is float or type(v) is int) and math.isfinite(v):  # the usual: fast
+        return v
+    if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
+        raise ValueError(f"{what}: {v!r} is not a finite number")
+    return cast(float, v)
+
+
+def _numbers(v: Any, n: int, what: str) -> tuple[float, ...]:
+    """``n`` finite numbers (a position), else a ValueError naming ``what``."""
+    if not isinstance(v, (list, tuple)) or len(v) != n:
+        raise ValueError(f"{what} {v!r}: give {n} numbers")
+    try:  # the usual: numbers whose sum is finite (a string raises; inf or nan is not)
+        if math.isfinite(sum(v)):
+            return tuple(v)
+    except TypeError:
+        pass
+    return tuple(_number(x, what) for x in v)
+
+
+def _distances(v: Any) -> dict[str, float]:
+    """The ``distances`` map, each a finite number (:func:`_number`)."""
+    out = dict(v)
+    try:  # the usual: numbers whose sum is finite
+        if math.isfinite(sum(out.values())):
+            return out
+    except TypeError:
+        pass
+    return {k: _number(x, f"distances[{k!r}]") for k, x in out.items()}
+
+
+def _xy(v: Any, what: str = "position") -> tuple[float, float]:
+    """An (x, y) position (:func:`_numbers`)."""
+    return cast("tuple[float, float]", _numbers(v, 2, what))
+
+
+def _xyz(v: Any) -> tuple[float, float, float]:
+    """An (x, y, z) position."""
+    return cast("tuple[float, float, float]", _numbers(v, 3, "position"))
 
 
 def _nodes(d: Mapping[str, Any], key: str, build: Callable[[Any], _N]) -> tuple[_N, ...]:

@@ -48,3 +48,22 @@ def test_diff_of_a_log_with_a_foreign_scene_graph_is_one_line(tmp_path) -> None:
     assert f"{out}: scene graph record at 1000000000 ns: scene graph: field 'robot' missing" \
         in r.output
     assert "Traceback" not in r.output
+
+
+@pytest.mark.parametrize(("edit", "message"), [
+    (lambda d: d["objects"][0].__setitem__("position", "abc"),
+     r"^scene graph: objects\[0\] \('obj:1'\): position 'abc': give 3 numbers$"),
+    (lambda d: d["robot"].__setitem__("position", [0, "x"]),
+     r"^scene graph: robot.position: 'x' is not a finite number$"),
+    (lambda d: d["distances"].__setitem__("obj:1", float("nan")),
+     r"^scene graph: distances\['obj:1'\]: nan is not a finite number$"),
+])
+def test_from_dict_refuses_positions_and_distances_that_are_no_numbers(edit, message) -> None:
+    """A hand-made graph with a position of text or a NaN distance was taken and failed
+    later, in to_json() or a planner, with a bare ValueError."""
+    d = {"version": "1.0", "robot": {"position": [0, 0]}, "distances": {"obj:1": 1.0},
+         "objects": [{"id": "obj:1", "category": "cup", "parent": "region:0.1",
+                      "room": "room:0", "position": [0, 0, 0]}]}
+    edit(d)
+    with pytest.raises(ArgumentError, match=message):
+        SceneGraph.from_dict(d)
