@@ -205,7 +205,7 @@ def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     a logged episode run again)."""
     guide = (REPO / "docs" / "api.md").read_text()
     blocks = re.findall(r"```python\n(.*?)```", guide, re.DOTALL)
-    assert len(blocks) == 21
+    assert len(blocks) == 22
     runnable = [b for b in blocks if "run_closed_loop(" not in b]
     assert len(runnable) == len(blocks) - 2
     for name in ("tests", "examples"):
@@ -231,6 +231,9 @@ def test_the_api_guide_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     assert again.results() == namespace["result"].results()  # type: ignore[attr-defined]
     with sgtool.LogReader(tmp_path / "my.mcap") as log:
         assert [r.skill for _, r in log.records(sgtool.ActionRecord)] == ["navigate"]
+    no_mugs = namespace["no_mugs"]  # a hand-made graph, read back from its dict form
+    assert isinstance(no_mugs, sgtool.SceneGraph)
+    assert not any(o.category == "mug" for o in no_mugs.objects)
     recorded = namespace["recorded"]  # the recording block
     assert isinstance(recorded, sgtool.RecordReport) and recorded.frames == 40
     with sgtool.LogReader(tmp_path / "house.mcap") as log:
