@@ -19,14 +19,14 @@ spread tasks over processes or machines (:func:`run_closed_loop_bench` takes a `
 
 The outputs (:func:`write_outputs`): ``episodes.jsonl`` (the
 :class:`~sgtool.results.EpisodeResult` of every run, its ``source`` the log relative to the
-folder: :func:`log_source`), ``summary.md`` (per noise profile: SR / SPL / steps / AUC-E as
-the symbolic bench, then failed skills per episode by reason; then the statistics that
+folder: :func:`log_source`), ``summary.md`` (per noise profile: SR / SPL / steps / AUC-E
+as the symbolic bench, then failed skills per episode by reason; then the statistics that
 separate planners, :mod:`sgtool.analysis.closed_loop_tables`: SR and SPL with bootstrap
 intervals over houses, paired comparisons over houses and per house, SR against the frame
 budget per room with AUC-E on frames, and, with symbolic bench results, Kendall's tau
 between the two planner orders), ``summary.json`` (the same statistics as numbers),
-``run.md`` (the wall-clock figures: decision time, frames per second) and the efficiency
-curves per noise profile (distance, steps and frames per room).
+``run.md`` (wall-clock figures: decision time, frames per second) and the efficiency curves
+per noise profile (distance, steps and frames per room).
 """
 
 from __future__ import annotations
@@ -168,8 +168,7 @@ class ClosedLoopBenchConfig:
         check_house_seeds(self.house_seed, self.houses)
         check_budgets(self.distance_budget, self.step_budget)
         of_type("options", self.options, ClosedLoopOptions, "a ClosedLoopOptions")
-        folders: dict[str, str] = {}
-        faults: dict[NoiseProfile, str] = {}
+        folders, faults = dict[str, str](), dict[NoiseProfile, str]()
         for n in self.noise:
             profile = replace(parse_noise(n), name="")
             folder = noise_folder(n)
@@ -256,13 +255,13 @@ def run_task(task: RunTask) -> RunRow:
     """Run one task into its log (unless the log is there already) and read its row back.
     Ctrl-C removes the partial log and re-raises."""
     from sgtool.planning.registry import make_planner
+    from sgtool.planning.timing import PlannerContractError
 
     seconds: float | None = None
     if not task.output.exists():
         spec, eps = house_episodes(task)
         if task.episode >= len(eps):
-            raise SgtoolError(f"{task.house.id}: has {len(eps)} episodes, not "
-                              f"{task.episode + 1}")
+            raise SgtoolError(f"{task.house.id}: has {len(eps)} episodes, not {task.episode + 1}")
         opts = replace(task_options(task), noise=parse_noise(task.noise))
         task.output.parent.mkdir(parents=True, exist_ok=True)
         try:
@@ -275,6 +274,9 @@ def run_task(task: RunTask) -> RunRow:
             for p in partial_files(task.output):
                 p.unlink(missing_ok=True)
             raise
+        except PlannerContractError as e:  # a plug-in's fault: where, and that it resumes
+            raise PlannerContractError(f"{e} ({task.house.id}, episode {task.episode}; the "
+                                       "logs written are kept: run again, it resumes)") from None
         seconds = rep.seconds
     return _row(task, seconds)
 

@@ -307,8 +307,9 @@ def test_a_report_of_a_stored_run_needs_no_plugin(plugin_dir: Path, tmp_path: Pa
 
 def test_a_plugin_that_raises_in_a_run_bench_leaves_no_folders(
         plugin_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """run-bench stops on a plug-in that raises with one line and leaves no folder of logs
-    never written: a fresh output folder is gone, a resumed one holds what it held."""
+    """run-bench stops on a plug-in that raises with one line naming the episode, and leaves
+    no folder of logs never written: a fresh output folder is gone, a resumed one holds what
+    it held."""
     monkeypatch.syspath_prepend(str(plugin_dir))
     out = tmp_path / "rb"
 
@@ -320,6 +321,7 @@ def test_a_plugin_that_raises_in_a_run_bench_leaves_no_folders(
         assert r.exit_code == (2 if "Stumbles" in planners else 0), r.output
         if "Stumbles" in planners:
             assert "decide() raised ZeroDivisionError" in r.output, r.output
+            assert "(house-0, episode 0; the logs written are kept" in r.output, r.output
         return sorted(p.relative_to(out).as_posix() for p in out.rglob("*.mcap"))
 
     assert run_bench("mymod_cli:Stumbles") == [] and not out.exists()
