@@ -322,7 +322,8 @@ def _replays(request: EvalRequest, logged: Sequence[Any], exchanges: Sequence[An
                 f"a folder is read as its table: give {tables[0] / 'logs'} for its logs"
                 if tables and not decisions else
                 "the inputs' logs hold no decision" if not decisions else
-                f"none of the inputs' {decisions} decisions has a graph before it"))
+                f"none of the inputs' {decisions} decisions has a SceneGraph record at or "
+                "before its graph_time_ns (or, without the field, before it)"))
     return [replay_decisions(make_planner(n, **options.get(n, {})), logged, name=n)
             for n in names]
 

@@ -137,3 +137,21 @@ def test_seen_unseen_figures_are_rounded_as_the_planners_are(tmp_path) -> None:
     assert r.exit_code == 0, r.output
     (row,) = json.loads(r.stdout)["seen_unseen"]
     assert row["seen_spl"] == round(row["seen_spl"], 6) and row["seen_sr"] == round(2 / 3, 6)
+
+
+def test_p_with_decisions_naming_no_graph_says_which_field(tmp_path) -> None:
+    """A hand-written log whose action names a graph_time_ns before its only scene graph:
+    the error names the field, not "no graph before it" (there is one)."""
+    import sgtool
+
+    graph = sgtool.SceneGraph.from_dict({"version": "1.0", "robot": {"position": [0, 0]}})
+    log = tmp_path / "hand.mcap"
+    with sgtool.LogWriter(log) as w:
+        w.write_record(sgtool.EpisodeRecord(kind="search", status="started", query="mug",
+                                            planner="greedy"), 0)
+        w.write_record(sgtool.SceneGraphRecord.of_graph(graph), 1)
+        w.write_record(sgtool.ActionRecord("explore", None, "look", outcome="success",
+                                            graph_time_ns=0), 2)
+    r = CliRunner().invoke(cli, ["eval", str(log), "-p", "greedy"])
+    assert r.exit_code == 2, r.output
+    assert "has a SceneGraph record at or before its graph_time_ns" in r.output, r.output
