@@ -437,5 +437,5 @@ def _shown(value: Any) -> str:
     if isinstance(value, int | float | bool):
         return _text(value)
     if isinstance(value, list | tuple) and all(isinstance(v, str | int | float) for v in value):
-        return _text(value)
+        return repr(value)  # (from Python: a list is no number, however short)
     return f"<{type(value).__name__}>"
