@@ -343,6 +343,7 @@ class LogCheck:
     error: str | None = None
     capture: Capture | None = None
     differing: int = 0  # refreshes whose graph is not byte-identical (or missing)
+    compared: int | None = None  # refreshes paired, when replayed at other times
 
     def report(self) -> list[str]:
         """The per-log report (text lines)."""
@@ -355,7 +356,10 @@ class LogCheck:
         if self.status == "unchanged":
             return out
         out += ["  " + x for x in self.lines]
-        if self.lines:
+        if self.lines and self.compared is not None:
+            out.append(f"  {self.differing} of the {self.compared} refreshes compared are not "
+                       "byte-identical")
+        elif self.lines:
             out.append(f"  {self.differing} of {max(self.refreshes)} refreshes are not "
                        "byte-identical")
         out += ["  " + x for x in quality_lines(*self.quality)]
@@ -479,13 +483,15 @@ def _check_task(t: _CheckTask) -> LogCheck:
     q_changed = bool(quality_lines(*quality, changed_only=True)) and (exact or bool(lines))
     changed = bool(lines) or decision is not None or q_changed
     first = lines[0].removesuffix(" differs:") if lines else None
-    differing = sum(e != g for e, (_, g) in zip(pinned, actual, strict=False)) + \
-        max(len(expected), len(cap.graphs)) - min(len(pinned), len(actual))
+    differing = sum(e != g for e, (_, g) in zip(pinned, actual, strict=False))
+    if note is None:  # every refresh paired: one missing differs too
+        differing += max(len(expected), len(cap.graphs)) - min(len(pinned), len(actual))
     return dataclasses.replace(
         base, status="changed" if changed else "unchanged",
         refreshes=(pin.refreshes, len(cap.graphs)), first=first, lines=tuple(lines),
         layers=_layer_counts(lines), quality=quality, decision=decision,
-        capture=cap if changed and t.keep else None, differing=differing)
+        capture=cap if changed and t.keep else None, differing=differing,
+        compared=None if note is None else min(len(pinned), len(actual)))
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,7 @@ import hashlib
 import io
 import math
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
@@ -124,6 +124,28 @@ def _added_removed(layer: str, expected: dict[str, Any], actual: dict[str, Any],
     return [f"{layer}: {'-' if k in expected else '+'} {k} "
             f"{describe(expected[k] if k in expected else actual[k])}"
             for k in sorted(expected.keys() ^ actual.keys())]
+
+
+def _renumbered(expected: Mapping[str, Any], actual: Mapping[str, Any],
+                tol: float = 1e-4) -> dict[str, str]:
+    """Frontiers of ``expected`` (id -> node) that ``actual`` holds under another id: equal
+    up to ``tol`` in position and length, in the same room and of the same kind. Frontier
+    ids number frontiers as they are found, so a replay that refreshes at other times finds
+    the same ones in another order. Ambiguous matches are left out (they read as removed
+    and added), as is a new id that another of ``expected``'s frontiers keeps."""
+    def same(x: Any, y: Any) -> bool:
+        return ((x.room, x.kind, x.frontier_type) == (y.room, y.kind, y.frontier_type)
+                and _moved(x, y, tol) is None and not _beyond(abs(x.size - y.size), tol))
+
+    kept = {k for k in expected.keys() & actual.keys() if same(expected[k], actual[k])}
+    xs = [expected[k] for k in sorted(expected.keys() - kept)]
+    ys = [actual[k] for k in sorted(actual.keys() - kept)]
+    out = {}
+    for x in xs:
+        match = [y for y in ys if same(x, y)]
+        if len(match) == 1 and match[0].id != x.id and sum(same(z, match[0]) for z in xs) == 1:
+            out[x.id] = match[0].id
+    return {k: v for k, v in out.items() if v not in expected.keys() - out.keys()}
 
 
 def _beyond(d: float, tol: float) -> bool:
@@ -229,12 +251,14 @@ _LAYERS: tuple[tuple[str, Callable[[SceneGraph], Sequence[Any]], Callable[[Any],
 )
 
 
-def _distance_changes(expected: SceneGraph, actual: SceneGraph, tol: float) -> list[str]:
+def _distance_changes(expected: SceneGraph, actual: SceneGraph, tol: float,
+                      renamed: Mapping[str, str]) -> list[str]:
     """One line: how many robot distances differ beyond ``tol``, how many nodes gained or
-    lost one, and the largest change."""
+    lost one, and the largest change (a renumbered frontier's under its new id)."""
     worst, n, gone = (0.0, ""), 0, 0
-    for k in sorted(expected.distances.keys() | actual.distances.keys()):
-        a, b = expected.distances.get(k), actual.distances.get(k)
+    before = {renamed.get(k, k): d for k, d in expected.distances.items()}
+    for k in sorted(before.keys() | actual.distances.keys()):
+        a, b = before.get(k), actual.distances.get(k)
         if a is None or b is None:
             gone += 1
         elif _beyond(abs(a - b), tol):
@@ -329,8 +353,13 @@ def diff_graphs(expected: SceneGraph, actual: SceneGraph, tol: float = 1e-4,
     for name, graph in (("expected", expected), ("actual", actual)):
         of_type(name, graph, SceneGraph, "a SceneGraph")
     out: list[str] = _room_set_changes(expected, actual, layers)
+    renamed: dict[str, str] = {}
     for layer, nodes, describe, changes in _LAYERS:
         e, a = _by_id(nodes(expected)), _by_id(nodes(actual))
+        if layer == "frontiers":
+            renamed = _renumbered(e, a, tol)
+            out += [f"frontiers: {k} is {v} (renumbered)" for k, v in renamed.items()]
+            e = {renamed.get(k, k): n for k, n in e.items()}
         if layer != "rooms":
             out += _added_removed(layer, e, a, describe)
         for k in sorted(e.keys() & a.keys()):
@@ -350,7 +379,7 @@ def diff_graphs(expected: SceneGraph, actual: SceneGraph, tol: float = 1e-4,
         out.append(f"graph: time {expected.time_ns} -> {actual.time_ns} ns")
     if expected.version != actual.version:
         out.append(f"graph: version {expected.version} -> {actual.version}")
-    out += _distance_changes(expected, actual, tol)
+    out += _distance_changes(expected, actual, tol, renamed)
     if not out and expected.to_json() != actual.to_json():
         out.append(ROUNDING)
     return out

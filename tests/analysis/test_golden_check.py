@@ -6,6 +6,7 @@ from __future__ import annotations
 import gzip
 import json
 import os
+import re
 import shlex
 import shutil
 import signal
@@ -521,6 +522,8 @@ def test_another_every_is_compared_at_the_times_both_refresh(pinned, capsys):
     assert code == 1
     assert "small: changed" in out and "compared where both refresh" in out
     assert "refresh 0 at 1.500 s" not in out  # no graph at 1.5 s was pinned
+    # the count is of the refreshes compared, not of those only one replay has
+    assert re.search(r"\b\d+ of the \d+ refreshes compared are not byte-identical", out), out
     heads = [x for x in out.splitlines() if " differs:" in x]
     for head in heads:  # a refresh of the new replay that the pin has a graph for too
         assert any(f"at {t:.3f} s" in head for t in (3.0, 6.0, 9.0)) or "refreshes where" \

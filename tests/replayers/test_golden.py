@@ -266,3 +266,23 @@ def test_format_1_pin_folders_are_still_read(tmp_path):
     assert old.format == 1
     assert old.logs["house10-start"].options == REPLAY
     assert old.logs["house10-start"].log_path(tmp_path) == tmp_path / "house10-start.mcap"
+
+
+def test_frontiers_found_in_another_order_read_as_renumbered() -> None:
+    """A replay that refreshes at other times numbers the same frontiers otherwise: the
+    diff says which id each now has (its distance followed), not one frontier removed and
+    another added; a frontier that did move is still a move."""
+    def graph(frontiers: list[tuple[str, float]]) -> SceneGraph:
+        return SceneGraph.from_dict({
+            "version": "1.0", "robot": {"position": [0, 0]},
+            "regions": [{"id": i, "room": "room:0", "position": [x, 1.0], "kind": "frontier",
+                         "frontier_type": "leading_out", "size": 1.4} for i, x in frontiers],
+            "distances": {i: 2.0 + x for i, x in frontiers}})
+
+    before = graph([("frontier:1", 0.0), ("frontier:3", 5.0), ("frontier:4", 9.0)])
+    after = graph([("frontier:1", 5.0), ("frontier:2", 0.0), ("frontier:4", 9.5)])
+    assert diff_graphs(before, after) == [
+        "frontiers: frontier:1 is frontier:2 (renumbered)",
+        "frontiers: frontier:3 is frontier:1 (renumbered)",
+        "frontiers: frontier:4 moved 0.500 m",
+        "distances: 1 differ, largest 0.500 m (frontier:4)"]
