@@ -268,7 +268,7 @@ def is_llm_planner(name: str) -> bool:
 def _unknown(name: str) -> UnknownPlannerError:
     import difflib
 
-    installed = sorted(plugins.entry_points())
+    installed = sorted(set(plugins.entry_points()) - set(PLANNER_NAMES))  # (shadowed)
     near = difflib.get_close_matches(name.strip().lower(), [*PLANNER_NAMES, *installed], n=1)
     hint = f"did you mean {near[0]!r}? " if near else ""
     return UnknownPlannerError(

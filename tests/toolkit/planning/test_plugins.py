@@ -291,6 +291,9 @@ def test_entry_points_register_names(plugin_dir: Path) -> None:
     text = describe_planners()
     assert "    fake-greedy = mymod_plug:MyPlanner\n" in text
     assert "    scout = mymod_plug:MyPlanner (shadowed by the built-in planner)" in text
+    with pytest.raises(UnknownPlannerError) as e:  # a shadowed name is listed once
+        check_planner_name("astar")
+    assert str(e.value).count(" scout,") == 1 and "fake-greedy" in str(e.value)
 
 
 def test_unknown_names_and_file_names() -> None:
