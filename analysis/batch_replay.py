@@ -81,7 +81,13 @@ class LogResult:
             return f"wrote {self.output}: {self.frames} frames, {self.refreshes} refreshes"
         if self.status == "skipped":
             return f"kept {self.output}: complete already (--force replays it again)"
-        return f"failed {self.input}: {self.error}"
+        return f"failed {self.input}: {self.reason}"
+
+    @property
+    def reason(self) -> str:
+        """The error without the input's path it may start with (named beside it)."""
+        err = self.error or ""
+        return err.removeprefix(f"{self.input}: ")
 
 
 @dataclass(frozen=True)

@@ -156,7 +156,7 @@ def replay_many(request: BatchReplayRequest, show: Echo) -> None:
     failed = [r for r in report.logs if r.status == "failed"]
     if failed:
         raise SgtoolError(f"{len(failed)} of {len(report.logs)} log(s) failed to replay "
-                          f"(after a retry); the first: {failed[0].input}: {failed[0].error}")
+                          f"(after a retry); the first: {failed[0].input}: {failed[0].reason}")
 
 
 def _score(spec: Any, final: dict[str, Any], log: Any) -> tuple[Any, Any]:

@@ -66,10 +66,12 @@ def test_a_log_that_fails_is_reported_and_the_others_are_written(logs, tmp_path)
     lines = r.stdout.splitlines()
     assert lines[0] == f"wrote {out / 'run6.mcap'}: 6 frames, 2 refreshes"
     assert lines[1].startswith(f"failed {bad}: ") and "ends without the MCAP" in lines[1]
+    assert f"{bad}: {bad}" not in lines[1]  # named once, before its error
     assert lines[2] == f"wrote {out / 'run8.mcap'}: 8 frames, 2 refreshes"
     assert lines[3].startswith("2 replayed, 0 skipped, 1 failed in ")
     assert r.stderr.startswith(f"sgtool: error: 1 of 3 log(s) failed to replay (after a "
                                f"retry); the first: {bad}: ")
+    assert f"{bad}: {bad}" not in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1
     assert sorted(f.name for f in out.iterdir()) == [".sgtool-output", "run6.mcap",
                                                      "run8.mcap"]
