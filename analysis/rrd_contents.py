@@ -23,7 +23,10 @@ NOT_CONTENT_TIMELINES = frozenset({"log_time", "log_tick"})  # when it was writt
 
 
 def is_rrd(path: str | os.PathLike[str]) -> bool:
-    """Whether ``path`` is a file that starts as a Rerun recording does."""
+    """Whether ``path`` is a file that starts as a Rerun recording does (a pipe or a
+    device is not opened: the open would block)."""
+    if not Path(path).is_file():
+        return False
     try:
         with open(path, "rb") as f:
             return f.read(3) == RRD_MAGIC
