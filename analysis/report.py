@@ -271,11 +271,20 @@ def llm_answer_totals(results: Sequence[EpisodeResult], planners: Sequence[str]
 
 def llm_warnings(results: Sequence[EpisodeResult], planners: Sequence[str]) -> list[str]:
     """A warning line per planner that asked an LLM and got no valid answer at all (a
-    wrong endpoint or model, one answering garbage)."""
-    return [f"sgtool: warning: {p}: none of its {t['requests']} LLM requests got a valid "
-            f"answer ({t['invalid']} rejected, {t['faults']} faults); check the endpoint "
-            "and model with `sgtool llm check`"
-            for p, t in llm_answer_totals(results, planners).items() if not t["valid"]]
+    wrong endpoint or model, one answering garbage), or met faults (timeouts, server
+    errors, unusable replies: a decision none of whose attempts got an answer ended its
+    episode given up)."""
+    out = []
+    for p, t in llm_answer_totals(results, planners).items():
+        if not t["valid"]:
+            out.append(f"sgtool: warning: {p}: none of its {t['requests']} LLM requests got "
+                       f"a valid answer ({t['invalid']} rejected, {t['faults']} faults); "
+                       "check the endpoint and model with `sgtool llm check`")
+        elif t["faults"]:
+            out.append(f"sgtool: warning: {p}: {t['faults']} of its {t['requests']} LLM "
+                       "requests failed (timeouts, server errors, unusable replies); a "
+                       "decision left without an answer ended its episode given up")
+    return out
 
 
 def invalid_action_notes(results: Sequence[EpisodeResult], planners: Sequence[str]

@@ -88,3 +88,25 @@ def test_side_by_side_quotes_table_vii() -> None:
     # the paper's agents we have no planner for still appear, with our cells empty
     assert any(line.startswith("| -") and "GODHS" in line for line in lines)
     assert "quoted from SCOUT Table VII" in text
+
+
+def test_llm_faults_are_warned_of_even_when_some_answers_were_valid() -> None:
+    """No valid answer at all is a setup warning; faults beside valid answers are warned of
+    too (a decision none of whose attempts got an answer ended its episode given up)."""
+    from sgtool.analysis.report import llm_warnings
+    from sgtool.results import EpisodeResult
+
+    def run(planner: str, **counts: int) -> EpisodeResult:
+        return EpisodeResult(planner, 0, "house-0", 0, "mug", False, steps=3,
+                             travelled_m=1.0, shortest_m=1.0,
+                             llm_answers={"requests": 0, "valid": 0, "invalid": 0,
+                                          "faults": 0, **counts})
+
+    got = llm_warnings([run("a", requests=5, invalid=2, faults=3),
+                        run("b", requests=13, valid=8, faults=5),
+                        run("c", requests=4, valid=4), run("greedy")], ["a", "b", "c", "greedy"])
+    assert got == [
+        "sgtool: warning: a: none of its 5 LLM requests got a valid answer (2 rejected, 3 "
+        "faults); check the endpoint and model with `sgtool llm check`",
+        "sgtool: warning: b: 5 of its 13 LLM requests failed (timeouts, server errors, "
+        "unusable replies); a decision left without an answer ended its episode given up"]

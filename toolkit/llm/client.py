@@ -3,8 +3,9 @@
 :class:`OpenAIChatClient` wraps the ``openai`` package. It makes exactly one HTTP attempt
 per call (the package's own retries are off) so the caller decides about retries and every
 attempt is logged. Transport faults (timeout, connection refused, HTTP 5xx/4xx, a reply
-without text) raise :class:`LlmTransportError` with a message naming the endpoint; they are
-expected at run time and handled by the planner, unlike configuration mistakes, which raise
+without text) raise :class:`LlmTransportError` with a message naming the endpoint (an
+endpoint gone after it answered, :class:`LlmEndpointDown`); they are expected at run time
+and handled by the planner, unlike configuration mistakes, which raise
 :class:`LlmConfigError` (a user error).
 
 Settings come from options, then the environment:
@@ -65,6 +66,13 @@ class LlmUnreachableError(LlmConfigError):
 
 class LlmTransportError(Exception):
     """One request failed (timeout, HTTP error, unusable reply); retrying may help."""
+
+
+class LlmEndpointDown(LlmTransportError):
+    """One request found an endpoint that had answered before gone: the connection failed
+    or the server failed (HTTP 5xx). A planner whose every attempt at a decision ends so
+    stops the run (:class:`LlmUnreachableError`) rather than scoring the outage as its
+    own failure."""
 
 
 @dataclass(frozen=True)
@@ -257,7 +265,7 @@ class OpenAIChatClient:
                     f"the LLM endpoint {self.where} refused the first request: HTTP "
                     f"{e.status_code}: {self._short(e)}; check the API key, the base URL "
                     f"and the model ({self.model}) with `sgtool llm check`") from e
-            raise LlmTransportError(
+            raise (LlmEndpointDown if e.status_code >= 500 else LlmTransportError)(
                 f"{self.where}: HTTP {e.status_code}: {self._short(e)}") from e
         except openai.APIConnectionError as e:
             why, closed = self._short(_root_cause(e)), _closed_without_reply(e)
@@ -272,7 +280,8 @@ class OpenAIChatClient:
                     "also replays a recorded transcript: --llm-replay FILE of bench, run and "
                     "eval)") from e
             what = "closed the connection without replying" if closed else "connection failed"
-            raise LlmTransportError(f"{self.where}: {what}: {why}") from e
+            raise (LlmTransportError if closed else LlmEndpointDown)(
+                f"{self.where}: {what}: {why}") from e
         except Exception as e:  # noqa: BLE001 - any malformed reply is a retryable fault
             raise LlmTransportError(
                 f"{self.where}: unusable reply: {type(e).__name__}: {self._short(e)}"

@@ -42,7 +42,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from sgtool.llm.client import ChatClient, LlmTransportError, complete_within
+from sgtool.llm.client import (
+    ChatClient,
+    LlmEndpointDown,
+    LlmTransportError,
+    LlmUnreachableError,
+    complete_within,
+)
 from sgtool.llm.constraints import REASON_CHARS, Constraint, check_kind, detect_kind
 from sgtool.llm.exchange import Message, exchange_record
 from sgtool.llm.recorded import ReplayMiss, TranscriptWriter
@@ -173,7 +179,7 @@ class MomaLlmPlanner:
         ]
         problems: list[str] = []
         deadline = time.monotonic() + self.decision_timeout_s
-        attempts = 0
+        attempts = down = 0
         for attempt in range(self.max_attempts):
             left = deadline - time.monotonic()
             if left <= 0:
@@ -192,6 +198,7 @@ class MomaLlmPlanner:
                 self._log(messages, None, time.perf_counter() - t_ask, None, None, str(e),
                           attempt)
                 problems.append(str(e))
+                down += isinstance(e, LlmEndpointDown)
                 continue
             cmd = None
             try:
@@ -220,6 +227,11 @@ class MomaLlmPlanner:
                       getattr(result, "truncated_from", None), "ok")
             return self._accept(cmd.name, action, graph, scene.name_by_room)
         last = problems[-1] if problems else "no answer"
+        if attempts and down == attempts:  # the endpoint's outage, not the planner's answer
+            raise LlmUnreachableError(
+                f"the LLM endpoint stopped answering during the run ({last}, at all "
+                f"{attempts} attempts of a decision): not scored as the planner giving up; "
+                "start it again and run again (run-bench keeps the episodes logged)")
         return Action(
             "done", None,
             reason=f"llm failure: no valid command after {attempts} attempt"
