@@ -63,13 +63,14 @@ def check_consistency(spec: HouseSpec, limits: SpecLimits) -> None:
     by_room = {r.id: r for r in spec.rooms}
     for key, openings in _openings(spec):
         for i, d in enumerate(openings):
-            for rid in d.rooms:
+            for rid in d.rooms:  # both rooms first: the yaw is judged only on a shared border
                 off = distance_to_polygon(d.center[0], d.center[1], by_room[rid].polygon)
                 if off > limits.opening_offset:
                     raise SpecError(f"{key}[{i}].center: ({d.center[0]}, {d.center[1]}) is "
                                     f"{off:.2f} m from its room {rid} (more than "
                                     f"{limits.opening_offset:g} m)"
                                     f"{id_note(key, i, d.id)}")
+            for rid in d.rooms:
                 # the opening runs along the border (yaw: the wall's direction), so both
                 # its ends lie at each of its rooms, not one end inside the other room
                 poly = by_room[rid].polygon

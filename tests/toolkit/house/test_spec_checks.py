@@ -358,6 +358,17 @@ def test_a_door_skewed_off_its_wall_is_refused(yaw, degrees, note) -> None:
                 rf"radians{re.escape(note)}")
 
 
+def test_a_door_far_from_one_of_its_rooms_names_its_center_not_its_yaw() -> None:
+    """A door set inside the first of its rooms, 2 m from the second: its yaw was judged
+    against a border of the first room it does not sit on ("lies 90 degrees off the border
+    of room_0 it sits on"); the distance to the second room is the fault to name."""
+    d = two_rooms()
+    d["doors"][0]["center"] = [1.0, 2.0]  # inside room_0, 3 m from room_1
+    d["doors"][0]["yaw"] = 0.0
+    _refused(d, r"^doors\[0\]\.center: \(1\.0, 2\.0\) is 3\.00 m from its room room_1 "
+                r"\(more than 0\.3 m\)")
+
+
 def test_a_door_past_the_end_of_its_border_names_its_center_not_its_yaw() -> None:
     """A door at a room's corner runs past the border whatever its yaw: the message said to
     change the yaw, which could not help; it names the center to move."""
