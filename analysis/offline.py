@@ -9,7 +9,9 @@ record with status "success", "failure" or "ended" closes it (it carries the fin
 see :func:`sgtool.results.result_from_log_records` for the fields read); the
 actions in between belong to it. A log without a "started" record has one episode from its
 start; an episode still open at the end of the log (a killed run) is closed as "ended"
-(not a success) with the figures derived from its actions.
+(not a success) with the figures derived from its actions. An episode's result is numbered
+by its closing record's ``extra`` (``episode``, ``seed``), else by its place in the log and
+the log's metadata seed.
 
 **Decision points.** Every Action record is a decision point, except one decided on no
 graph. An action with ``graph_time_ns`` (``sgtool.Action`` 1.1) was decided on the last
@@ -91,6 +93,7 @@ class LoggedEpisode:
     episode: Episode  # the closing Episode record (synthesised when missing)
     decisions: tuple[Decision, ...]
     closed: bool = True  # False: the log has no closing record (a run cut short)
+    log_seed: int | None = None  # the log's metadata seed: the result's when extras lack one
 
     def __repr__(self) -> str:  # (the decisions hold every graph: a repr of megabytes)
         e = self.episode
@@ -108,6 +111,8 @@ class LoggedEpisode:
                 "decisions": float(len(decided))})
         if "episode" not in self.episode.extras:
             r = _replace(r, episode=self.index)
+        if "seed" not in self.episode.extras and self.log_seed is not None:
+            r = _replace(r, seed=self.log_seed)
         noise = self.episode.extras.get("noise")
         if isinstance(noise, dict) and isinstance(noise.get("name"), str):
             r = _replace(r, noise=noise["name"])
@@ -124,6 +129,7 @@ def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
 
     p = Path(path)
     with LogReader(p) as log:
+        seed = log.seed
         stream: list[tuple[int, int, LogRecord]] = []
         kinds: tuple[type[LogRecord], ...] = (SceneGraphRecord, Episode, Action)
         for order, kind in enumerate(kinds):
@@ -146,7 +152,7 @@ def read_log_episodes(path: str | os.PathLike[str]) -> list[LoggedEpisode]:
     def close(record: Episode, closed: bool = True) -> None:
         nonlocal decisions, opened
         episodes.append(LoggedEpisode(str(p), len(episodes), record, tuple(decisions),
-                                      closed))
+                                      closed, seed))
         decisions = []
         opened = None
 

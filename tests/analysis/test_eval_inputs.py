@@ -155,3 +155,23 @@ def test_p_with_decisions_naming_no_graph_says_which_field(tmp_path) -> None:
     r = CliRunner().invoke(cli, ["eval", str(log), "-p", "greedy"])
     assert r.exit_code == 2, r.output
     assert "has a SceneGraph record at or before its graph_time_ns" in r.output, r.output
+
+
+def test_a_hand_written_log_takes_its_own_seed(tmp_path) -> None:
+    """Two logs written with LogWriter(seed=1) and (seed=2), their records without extra:
+    two seeds of one episode, not one run given twice with other endings."""
+    import sgtool
+
+    for seed, ok in ((1, True), (2, False)):
+        with sgtool.LogWriter(tmp_path / f"s{seed}.mcap", seed=seed) as w:
+            start = dict(kind="search", query="mug", planner="mine", house_id="h")
+            w.write_record(sgtool.EpisodeRecord(status="started", **start), 0)
+            w.write_record(sgtool.EpisodeRecord(
+                status="success" if ok else "failure", steps=2, travelled_m=3.0,
+                shortest_m=3.0, **start), 1)
+    r = CliRunner().invoke(cli, ["eval", str(tmp_path / "s1.mcap"), str(tmp_path / "s2.mcap"),
+                                 "--json"])
+    assert r.exit_code == 0, r.output
+    assert "pooled" not in r.stderr, r.stderr
+    doc = json.loads(r.stdout)
+    assert doc["planners"]["mine"]["episodes"] == 2
