@@ -69,10 +69,10 @@ class LlmTransportError(Exception):
 
 
 class LlmEndpointDown(LlmTransportError):
-    """One request found an endpoint that had answered before gone: the connection failed
-    or the server failed (HTTP 5xx). A planner whose every attempt at a decision ends so
-    stops the run (:class:`LlmUnreachableError`) rather than scoring the outage as its
-    own failure."""
+    """One request found the endpoint down: the server failed (HTTP 5xx), or the connection
+    failed after the endpoint had answered (before, :class:`LlmUnreachableError`). A planner
+    whose every attempt at a decision ends so stops the run (:class:`LlmUnreachableError`)
+    rather than scoring the outage as its own failure."""
 
 
 @dataclass(frozen=True)

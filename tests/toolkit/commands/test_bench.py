@@ -383,7 +383,9 @@ def test_help_names_the_default_planners(command):
 
 def test_an_endpoint_that_never_answers_is_warned_about(tmp_path):
     """Every request fails (HTTP 500 from the start: a busy or broken server, no setup
-    mistake the first request could name): the run completes and says that no answer came."""
+    mistake the first request could name): an outage, the run stops in one line and writes
+    no table (scored, every episode would be the planner giving up); an endpoint that
+    answers, never with a command, is the planner's: the run completes and warns."""
     from support.semantics_fixtures import ChatServer
 
     def bench_against(srv: ChatServer, out: str) -> Any:
@@ -394,14 +396,17 @@ def test_an_endpoint_that_never_answers_is_warned_about(tmp_path):
 
     with ChatServer() as srv:  # HTTP 500 to every request
         r = bench_against(srv, "o")
-    assert r.exit_code == 0, r.output
-    assert "sgtool: warning: moma-llm: none of its" in r.output
-    assert "check the endpoint and model with `sgtool llm check`" in r.output
+    assert r.exit_code == 2, r.output
+    assert "the LLM endpoint failed at all 5 attempts of a decision" in r.output
+    assert len(r.output.strip().splitlines()) == 1
+    assert not (tmp_path / "o" / "episodes.jsonl").exists()
     # an endpoint that answers every request, never with a command: warned about too
     with ChatServer(responder=lambda req: {"text": "<html>a web page</html>"}) as srv:
         r = bench_against(srv, "o3")
     assert r.exit_code == 0, r.output
-    assert "rejected, 0 faults); check the endpoint and model" in r.output
+    assert "sgtool: warning: moma-llm: none of its" in r.output
+    assert "rejected, 0 faults); check the endpoint and model with `sgtool llm check`" \
+        in r.output
     with ChatServer(responder=lambda req: {"status": 401}) as srv:  # a wrong key: stop
         r = CliRunner().invoke(cli, ["bench", "--planners", "moma-llm", "--houses", "1",
                                      "--episodes", "1", "--seeds", "1", "--no-progress",

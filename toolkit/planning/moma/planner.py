@@ -229,9 +229,9 @@ class MomaLlmPlanner:
         last = problems[-1] if problems else "no answer"
         if attempts and down == attempts:  # the endpoint's outage, not the planner's answer
             raise LlmUnreachableError(
-                f"the LLM endpoint stopped answering during the run ({last}, at all "
-                f"{attempts} attempts of a decision): not scored as the planner giving up; "
-                "start it again and run again (run-bench keeps the episodes logged)")
+                f"the LLM endpoint failed at all {attempts} attempts of a decision ({last}): "
+                "an outage, not scored as the planner giving up; restart or fix it and run "
+                "again (run-bench keeps the episodes logged)")
         return Action(
             "done", None,
             reason=f"llm failure: no valid command after {attempts} attempt"

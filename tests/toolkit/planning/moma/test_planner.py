@@ -146,8 +146,8 @@ def test_an_endpoint_gone_at_every_attempt_stops_the_run() -> None:
         p = planner(srv, max_attempts=3)
         p.reset("milk")
         assert p.decide(house()).skill == "explore"
-        with pytest.raises(LlmUnreachableError, match=r"^the LLM endpoint stopped answering "
-                                                      r"during the run \(.*HTTP 502"):
+        with pytest.raises(LlmUnreachableError, match=r"^the LLM endpoint failed at all 3 "
+                                                      r"attempts of a decision \(.*HTTP 502"):
             p.decide(house())
     assert len(p.exchanges) == 4 and all(e["error"] for e in p.exchanges[1:])
     srv = ChatServer([answer("explore(kitchen)")])
