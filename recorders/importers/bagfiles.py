@@ -6,7 +6,10 @@
   storage file inside such a folder;
 - a bare ROS 2 ``.mcap`` or ``.db3`` file without ``metadata.yaml`` (a copy of the storage
   file alone, or a recording made by ``mcap``/Foxglove tools): ``rosbags`` reads these
-  from the file's own schemas and tables.
+  from the file's own schemas and tables; one without a chunk index, or whose summary
+  leaves out channels, schemas or message indexes (all valid MCAP, misread by
+  ``rosbags``), through a temporary indexed copy (:func:`sgtool.log.recover.recover`'s);
+- a storage file compressed whole (``*.mcap.zstd``) inside its bag folder.
 
 Failures become :class:`SgtoolError` messages that name the file and what it is instead
 (an sgtool log or another non-ROS MCAP file is named as such).
@@ -145,11 +148,17 @@ def _renamed_bag(path: Path, stack: contextlib.ExitStack) -> Path:
 def _indexed_copy(path: Path, stack: contextlib.ExitStack) -> Path:
     """``path``'s messages in a temporary, fully indexed MCAP file (``sgtool doctor
     --recover``'s copy: the same schemas, channels and messages), removed on leaving
-    ``stack``."""
+    ``stack``. A damaged file is refused in one line, as the bag reader refuses one it
+    reads directly: the copy would leave out what is lost without a word."""
     from sgtool.log.recover import recover
 
     copy = Path(stack.enter_context(tempfile.TemporaryDirectory())) / path.name
-    recover(path, copy)
+    diag = recover(path, copy)
+    if diag.status in ("corrupt", "truncated"):
+        first = (diag.problems or [diag.status])[0][:200]
+        raise SgtoolError(f"{path}: damaged or truncated bag ({first}); `sgtool doctor "
+                          f"{quoted(path)}` says what is lost, `--recover OUT.mcap` copies "
+                          "what is readable")
     return copy
 
 

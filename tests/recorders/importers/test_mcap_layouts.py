@@ -186,3 +186,31 @@ def test_a_file_compressed_whole_names_its_folder_or_zstd(tmp_path):
     import_bag(part.parent, ref, BagOptions(**OPTS))
     import_bag(storage, got, BagOptions(**OPTS))
     _same_frames(ref, got)
+
+
+def test_a_damaged_file_read_through_an_index_is_refused(tmp_path):
+    """A damaged chunk in a file without a chunk index (read through an indexed copy) is
+    refused in one line, as the bag reader refuses it in an indexed file: never imported
+    with that chunk's messages left out without a word."""
+    import struct
+
+    bare = _rewrite(_ros2_mcap(tmp_path), tmp_path / "bare.mcap", index_types=IndexType.NONE,
+                    chunk_size=2000)
+    data = bytearray(bare.read_bytes())
+    off, chunks = 8, []
+    while data[off] != 0x0F:  # up to the data end record
+        length = struct.unpack_from("<Q", data, off + 1)[0]
+        if data[off] == 0x06:
+            chunks.append((off, length))
+        off += 9 + length
+    at, length = chunks[len(chunks) // 2]
+    for i in range(at + 9 + length - 30, at + 9 + length - 20):  # inside its compressed data
+        data[i] ^= 0x5A
+    bare.write_bytes(bytes(data))
+    out = tmp_path / "out.mcap"
+    r = CliRunner().invoke(cli, ["import", "bag", str(bare), "-o", str(out), "--quiet",
+                                 "--depth", TOPICS["depth"], "--info", TOPICS["info"],
+                                 "--up", "z", "--floor", "none"])
+    assert r.exit_code == 2 and r.output.count("\n") == 1, r.output
+    assert "damaged or truncated bag" in r.output and "--recover" in r.output
+    assert not out.exists()
