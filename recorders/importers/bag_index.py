@@ -48,7 +48,7 @@ class BagIndex:
         default_factory=list)
     samples: dict[int, tuple[np.ndarray, float]] = field(default_factory=dict)  # depth k ->
     zero_stamps: int = 0
-    tf_zero_stamps: int = 0  # dynamic /tf transforms with a zero stamp, put at bag time
+    tf_zero_stamps: int = 0  # dynamic /tf transforms with a zero stamp (_resolve_zero_tf_stamps)
     # record time minus header stamp of each dynamic /tf transform (ns)
     tf_latency_ns: list[int] = field(default_factory=list)
 
@@ -86,13 +86,17 @@ def _resolve_zero_stamps(ii: ImageIndex, idx: BagIndex) -> None:
 
 def _resolve_zero_tf_stamps(unset: list[tuple[Any, str, int]], idx: BagIndex,
                             first_stamp: int | None) -> None:
-    """Add the /tf messages with a zero header stamp (message, topic, bag time) to the tree:
-    at their stamps when the first non-zero stamp of /tf lies within ``_SIM_CLOCK_NS`` (a
-    simulator's clock that starts at 0), else at the bag's record time, counted in
-    ``idx.tf_zero_stamps`` (a recorder that never set them)."""
+    """Add the /tf messages with a zero header stamp (message, topic, bag time) to the tree,
+    at the bag's record time less the median delay of the stamped /tf transforms
+    (``idx.tf_latency_ns``: about none on one clock, the offset of a simulator's clock from
+    the recorder's), so on the clock of the other stamps. Counted in
+    ``idx.tf_zero_stamps`` (a recorder that never set them) unless the first non-zero
+    stamp of /tf lies within ``_SIM_CLOCK_NS``: a simulator's clock that starts at 0, whose
+    zero is a time."""
     sim = first_stamp is not None and first_stamp <= _SIM_CLOCK_NS
+    delay = int(np.median(idx.tf_latency_ns)) if idx.tf_latency_ns else 0
     for msg, topic, bag_t in unset:
-        add_tf_message(idx.tf, msg, topic, unset_stamp_ns=None if sim else bag_t)
+        add_tf_message(idx.tf, msg, topic, unset_stamp_ns=max(bag_t - delay, 0) or None)
         if not sim:
             idx.tf_zero_stamps += sum(stamp_ns(tr.header) == 0 for tr in msg.transforms)
 
@@ -121,14 +125,15 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
             if c.topic in tf_topics:
                 static = c.topic.rstrip("/").endswith("tf_static")
                 stamps = [stamp_ns(tr.header) for tr in msg.transforms]
-                if not static and 0 in stamps:  # unset, or a simulator's clock at 0
-                    unset.append((msg, c.topic, int(bag_t)))
-                    continue
-                if not static and stamps:
-                    first_stamp = min(stamps) if first_stamp is None else min(first_stamp, *stamps)
+                if not static:  # the stamped ones of a message with a zero stamp count too
+                    set_ = [t for t in stamps if t]
+                    if set_:
+                        first_stamp = min(set_ if first_stamp is None else [first_stamp, *set_])
+                    idx.tf_latency_ns.extend(int(bag_t) - t for t in set_)
+                    if len(set_) < len(stamps):  # unset, or a simulator's clock at 0
+                        unset.append((msg, c.topic, int(bag_t)))
+                        continue
                 add_tf_message(idx.tf, msg, c.topic)
-                if not static:
-                    idx.tf_latency_ns.extend(int(bag_t) - t for t in stamps)
                 continue
             if c.topic == opts.pose:
                 t, parent, T = pose_of_message(msg, mt, c.topic)  # noqa: N806

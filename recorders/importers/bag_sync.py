@@ -115,7 +115,7 @@ def plan_frames(
         notes.append(f"{idx.zero_stamps} images had a zero header stamp (bag time used)")
     if idx.tf_zero_stamps:
         notes.append(f"{idx.tf_zero_stamps} /tf transforms had a zero header stamp (bag time "
-                     "used)")
+                     "used, less the other /tf stamps' delay)")
     if idx.info_changes:
         notes.append(f"the camera info changed {idx.info_changes} time(s); each image has the "
                      "one in effect at its time (the world alignment and checks use the first)")

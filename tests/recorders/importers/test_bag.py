@@ -750,3 +750,37 @@ def test_camera_axes_where_no_camera_pose_is_read_is_refused(shared_data_dir, tm
         "--camera-axes body reads the depth camera's poses (give --depth); a trajectory "
         "import keeps its frame's poses as they are"), r.output
     assert not (tmp_path / "t.mcap").exists()
+
+
+@pytest.mark.parametrize("t0_s", [0, 100])
+@pytest.mark.parametrize("together", [True, False])
+def test_a_link_never_stamped_beside_a_simulator_clock_is_on_that_clock(tmp_path, t0_s,
+                                                                          together):
+    """A broadcaster that leaves one link's stamps at 0 beside /tf stamped on a simulator's
+    clock (started 0 s or 100 s before the recording, on the wall clock): the link is put
+    on the simulator's clock (its record time less the other transforms' delay), in the
+    same TFMessage as a stamped transform or in its own, and every frame gets its pose."""
+    from sgtool.log.codec import depth_to_mm
+
+    wall = 1_733_000_000 * 10**9
+    bag, poses = tmp_path / "sim", []
+    with BagWriter(bag, "ros2-mcap") as w:
+        for i in range(5):
+            k, rgb, depth, _, pose, _ = synthetic_frame(i)
+            poses.append(pose)
+            t = t0_s * 10**9 + i * 33_000_000
+            moved = w.transform_stamped(t, "world", "base", pose)
+            fixed = w.transform_stamped(0, "base", "camera_optical_frame", np.eye(4))
+            for part in ([moved, fixed],) if together else ([moved], [fixed]):
+                w.write("/tf", "tf2_msgs/msg/TFMessage", t + wall, w.tf(t, part))
+            w.write(TOPICS["info"], "sensor_msgs/msg/CameraInfo", t + wall,
+                    w.camera_info(t, "camera_optical_frame", k))
+            w.write(TOPICS["depth"], "sensor_msgs/msg/Image", t + wall,
+                    w.image(t, "camera_optical_frame", depth_to_mm(depth), "16UC1"))
+    out = tmp_path / "o.mcap"
+    rep = import_bag(bag, out, BagOptions(depth=TOPICS["depth"], info=TOPICS["info"],
+                                          **KEEP_WORLD))
+    assert rep.frames == 5
+    with LogReader(out) as r:
+        for got, want in zip(r.frames(), poses, strict=True):
+            assert np.allclose(got.pose, want, atol=1e-9)
