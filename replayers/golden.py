@@ -132,7 +132,8 @@ def _renumbered(expected: Mapping[str, Any], actual: Mapping[str, Any],
     up to ``tol`` in position and length, in the same room and of the same kind. Frontier
     ids number frontiers as they are found, so a replay that refreshes at other times finds
     the same ones in another order. Ambiguous matches are left out (they read as removed
-    and added), as is a new id that another of ``expected``'s frontiers keeps."""
+    and added), as is a new id that another of ``expected``'s frontiers keeps (until none
+    is: leaving one out makes its frontier keep its id)."""
     def same(x: Any, y: Any) -> bool:
         return ((x.room, x.kind, x.frontier_type) == (y.room, y.kind, y.frontier_type)
                 and _moved(x, y, tol) is None and not _beyond(abs(x.size - y.size), tol))
@@ -145,7 +146,10 @@ def _renumbered(expected: Mapping[str, Any], actual: Mapping[str, Any],
         match = [y for y in ys if same(x, y)]
         if len(match) == 1 and match[0].id != x.id and sum(same(z, match[0]) for z in xs) == 1:
             out[x.id] = match[0].id
-    return {k: v for k, v in out.items() if v not in expected.keys() - out.keys()}
+    while clash := [k for k, v in out.items() if v in expected.keys() - out.keys()]:
+        for k in clash:
+            del out[k]
+    return out
 
 
 def _beyond(d: float, tol: float) -> bool:
