@@ -322,6 +322,8 @@ def _number(v: Any, what: str) -> float:
 
 def _numbers(v: Any, n: int, what: str) -> tuple[float, ...]:
     """``n`` finite numbers (a position), else a ValueError naming ``what``."""
+    if hasattr(v, "tolist") and not isinstance(v, (list, tuple)):  # a numpy array
+        v = v.tolist()
     if not isinstance(v, (list, tuple)) or len(v) != n:
         raise ValueError(f"{what} {v!r}: give {n} numbers")
     try:  # the usual: numbers whose sum is finite (a string raises; inf or nan is not)

@@ -67,3 +67,16 @@ def test_from_dict_refuses_positions_and_distances_that_are_no_numbers(edit, mes
     edit(d)
     with pytest.raises(ArgumentError, match=message):
         SceneGraph.from_dict(d)
+
+
+def test_from_dict_takes_numpy_positions() -> None:
+    """Another lab's graph turned into sgtool's form in Python: positions as numpy arrays
+    are numbers too."""
+    import numpy as np
+
+    g = SceneGraph.from_dict({"version": "1.0", "robot": {"position": np.zeros(2)},
+                              "objects": [{"id": "obj:1", "category": "cup",
+                                           "parent": "region:0.1", "room": "room:0",
+                                           "position": np.array([1.0, 2.0, 0.5])}]})
+    assert g.objects[0].position == (1.0, 2.0, 0.5)
+    assert SceneGraph.from_json(g.to_json()) == g
