@@ -246,6 +246,9 @@ def export(
     return out
 
 
+FILE_FLUSH_TICK_S = 1e9  # no flush by the clock when writing a file (new_stream)
+
+
 def new_stream(rid: str, *, to_file: bool = False) -> Any:
     """A Rerun recording stream of id ``rid`` on sgtool's timelines only (Rerun's own
     ``log_time``, the wall clock of the export, is left out: it would differ from export to
@@ -262,7 +265,6 @@ def new_stream(rid: str, *, to_file: bool = False) -> Any:
     return rec
 
 
-FILE_FLUSH_TICK_S = 1e9  # no flush by the clock when writing a file (new_stream)
 def class_ids(instance_ids: Iterable[int]) -> np.ndarray | None:
     """How instance ids become Rerun's 16-bit class ids: None when every id fits (an id is
     its class id), else the sorted ids, whose position + 1 is the class id (ids of a table

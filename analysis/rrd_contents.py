@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -62,13 +63,15 @@ def summarize_rrd(rrd_path: str | os.PathLike[str]) -> dict[str, Any]:
     require("rerun", api="sgtool.analysis.rrd_contents")
     from rerun.chunk import RrdReader
 
+    h = hashlib.sha256()
     try:
-        reader = RrdReader(p)
-        stores = ([("recording", s) for s in sorted(reader.recordings(),
-                                                    key=lambda s: s.recording_id)]
-                  + [("blueprint", s) for s in reader.blueprints()])
-        h = hashlib.sha256()
-        described = [_store(h, reader, kind, store) for kind, store in stores]
+        with warnings.catch_warnings():  # a damaged file: Rerun warns, then raises
+            warnings.simplefilter("ignore")
+            reader = RrdReader(p)
+            stores = ([("recording", s) for s in sorted(reader.recordings(),
+                                                        key=lambda s: s.recording_id)]
+                      + [("blueprint", s) for s in reader.blueprints()])
+            described = [_store(h, reader, kind, store) for kind, store in stores]
     except SgtoolError:
         raise
     except Exception as e:  # noqa: BLE001 - Rerun's reader raises its own kinds

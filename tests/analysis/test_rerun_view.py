@@ -7,6 +7,7 @@ import re
 import shutil
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -342,3 +343,10 @@ def test_info_of_a_rerun_recording_names_its_stores_and_digest(tmp_path):
     r = runner.invoke(cli, ["info", str(fake)])
     assert r.exit_code == 2 and "Rerun cannot read it" in r.output
     assert len(r.output.strip().splitlines()) == 1
+    cut = tmp_path / "cut.rrd"  # a recording cut short: one line, no warning of Rerun's
+    cut.write_bytes(a.read_bytes()[: a.stat().st_size // 2])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = runner.invoke(cli, ["info", str(cut)])
+    assert r.exit_code == 2 and r.output.count("\n") == 1, r.output
+    assert not caught, [str(w.message) for w in caught]

@@ -117,7 +117,8 @@ class ChatServer:
     """A chat-completions endpoint on 127.0.0.1 that plays back a script.
 
     Each request consumes the next script item:
-    ``{"text": str}`` a normal answer; ``{"status": int}`` an HTTP error;
+    ``{"text": str}`` a normal answer; ``{"status": int}`` an HTTP error (its body's
+    ``type`` and ``message`` given by the item's, when it has them);
     ``{"sleep": s, "text": str}`` an answer after ``s`` seconds (for timeouts);
     ``{"raw": bytes}`` a 200 response with this body (malformed JSON);
     ``{"drop": True}`` the connection closed without a response.
@@ -175,7 +176,8 @@ class ChatServer:
                 if "sleep" in item:
                     time.sleep(item["sleep"])
                 if "status" in item:
-                    err = {"error": {"message": "scripted failure", "type": "server_error"}}
+                    err = {"error": {"message": item.get("message", "scripted failure"),
+                                     "type": item.get("type", "server_error")}}
                     self._send(int(item["status"]), json.dumps(err).encode())
                     return
                 if "raw" in item:

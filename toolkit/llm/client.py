@@ -69,8 +69,9 @@ class LlmTransportError(Exception):
 
 
 class LlmEndpointDown(LlmTransportError):
-    """One request found the endpoint down: the server failed (HTTP 5xx), or the connection
-    failed after the endpoint had answered (before, :class:`LlmUnreachableError`). A planner
+    """One request found the endpoint down: the server failed (HTTP 5xx, but for a
+    ``model_error``: the model's own failure on that prompt), or the connection failed
+    after the endpoint had answered (before, :class:`LlmUnreachableError`). A planner
     whose every attempt at a decision ends so stops the run (:class:`LlmUnreachableError`)
     rather than scoring the outage as its own failure."""
 
@@ -265,7 +266,12 @@ class OpenAIChatClient:
                     f"the LLM endpoint {self.where} refused the first request: HTTP "
                     f"{e.status_code}: {self._short(e)}; check the API key, the base URL "
                     f"and the model ({self.model}) with `sgtool llm check`") from e
-            raise (LlmEndpointDown if e.status_code >= 500 else LlmTransportError)(
+            # a 5xx the model caused (OpenAI's "model_error": "The model produced invalid
+            # content", the same for the same prompt) is the model's failure, not an
+            # outage, and so is a gateway's timeout (504: the model too slow, as a timeout)
+            down = e.status_code >= 500 and e.status_code != 504 and \
+                getattr(e, "type", None) != "model_error"
+            raise (LlmEndpointDown if down else LlmTransportError)(
                 f"{self.where}: HTTP {e.status_code}: {self._short(e)}") from e
         except openai.APIConnectionError as e:
             why, closed = self._short(_root_cause(e)), _closed_without_reply(e)

@@ -159,6 +159,23 @@ def test_an_endpoint_gone_at_every_attempt_stops_the_run() -> None:
         p.decide(house())
 
 
+@pytest.mark.parametrize("bad", [
+    {"status": 500, "type": "model_error", "message": "The model produced invalid content."},
+    {"status": 504, "message": "upstream request timeout"},
+])
+def test_a_model_error_at_every_attempt_is_the_planner_giving_up(bad: dict) -> None:
+    """HTTP 500 of type model_error (OpenAI: "The model produced invalid content", the same
+    for the same prompt), or a gateway's timeout (504: a model too slow, as a timeout of the
+    client), is the model's failure: the episode ends given up, the run goes on (an outage
+    would stop it and stop every resumed run)."""
+    with ChatServer([answer("explore(kitchen)"), bad, bad, bad]) as srv:
+        p = planner(srv, max_attempts=3)
+        p.reset("milk")
+        assert p.decide(house()).skill == "explore"
+        a = p.decide(house())
+    assert a.skill == "done" and bad["message"].rstrip(".") in a.reason
+
+
 def test_an_endpoint_that_never_answers_is_a_configuration_error() -> None:
     """Connection refused before any reply: a wrong address, reported at once (the CLI
     prints it as one line) instead of every episode quietly giving up."""
