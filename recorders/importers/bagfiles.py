@@ -145,14 +145,16 @@ def _renamed_bag(path: Path, stack: contextlib.ExitStack) -> Path:
     return target
 
 
-def _indexed_copy(path: Path, stack: contextlib.ExitStack) -> Path:
+def _indexed_copy(path: Path, stack: contextlib.ExitStack, into: Path | None = None) -> Path:
     """``path``'s messages in a temporary, fully indexed MCAP file (``sgtool doctor
     --recover``'s copy: the same schemas, channels and messages), removed on leaving
-    ``stack``. A damaged file is refused in one line, as the bag reader refuses one it
-    reads directly: the copy would leave out what is lost without a word."""
+    ``stack`` (or in the folder ``into``). A damaged file is refused in one line, as the
+    bag reader refuses one it reads directly: the copy would leave out what is lost without
+    a word."""
     from sgtool.log.recover import recover
 
-    copy = Path(stack.enter_context(tempfile.TemporaryDirectory())) / path.name
+    folder = into or Path(stack.enter_context(tempfile.TemporaryDirectory()))
+    copy = folder / path.name
     diag = recover(path, copy)
     if diag.status in ("corrupt", "truncated"):
         first = (diag.problems or [diag.status])[0][:200]
@@ -160,6 +162,30 @@ def _indexed_copy(path: Path, stack: contextlib.ExitStack) -> Path:
                           f"{quoted(path)}` says what is lost, `--recover OUT.mcap` copies "
                           "what is readable")
     return copy
+
+
+def _indexed_folder(folder: Path, stack: contextlib.ExitStack) -> Path:
+    """A ROS 2 bag folder whose MCAP storage files rosbags would misread (rosbag2's storage
+    options write them without chunks or message indexes): a temporary folder of the same
+    files, those through an indexed copy (:func:`_indexed_copy`), the others linked;
+    ``folder`` itself when none needs it."""
+    def needs_index(f: Path) -> bool:
+        try:
+            return _check_mcap_profile(f)
+        except SgtoolError:  # (not a ROS 2 MCAP file: the bag reader says what it is)
+            return False
+
+    needs = [f for f in sorted(folder.glob("*.mcap")) if needs_index(f)]
+    if not needs:
+        return folder
+    tmp = Path(stack.enter_context(tempfile.TemporaryDirectory())) / folder.name
+    tmp.mkdir()
+    for f in sorted(folder.iterdir()):
+        if f in needs:
+            _indexed_copy(f, stack, into=tmp)
+        else:
+            (tmp / f.name).symlink_to(f.resolve())
+    return tmp
 
 
 def _starts_with(path: Path, magic: bytes) -> bool:
@@ -191,6 +217,8 @@ def open_bag(path: str | Path) -> Iterator[Any]:
 
         elif path.is_file() and path.suffix != ".bag":
             target = _renamed_bag(path, stack)
+        if target.is_dir() and (target / "metadata.yaml").is_file():
+            target = _indexed_folder(target, stack)
         if target.is_dir() and target.suffix == ".bag":
             # a ROS 2 bag folder named *.bag (`ros2 bag record -o run.bag`), given or found
             # above its storage file: the reader takes the name for a ROS 1 file

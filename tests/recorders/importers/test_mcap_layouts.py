@@ -214,3 +214,25 @@ def test_a_damaged_file_read_through_an_index_is_refused(tmp_path):
     assert r.exit_code == 2 and r.output.count("\n") == 1, r.output
     assert "damaged or truncated bag" in r.output and "--recover" in r.output
     assert not out.exists()
+
+
+@pytest.mark.parametrize("layout", [
+    dict(index_types=IndexType.CHUNK),
+    dict(use_chunking=False, shuffle=True),
+    dict(repeat_channels=False),
+], ids=["no-message-index", "unchunked-out-of-order", "channels-not-repeated"])
+def test_a_bag_folder_of_such_storage_files_imports_the_same(tmp_path, layout):
+    """rosbag2's storage options write such files inside a bag folder (no chunking, no
+    message index): the folder, and its storage file given alone, import the frames a
+    plain folder gives."""
+    import shutil
+
+    part = _ros2_mcap(tmp_path)
+    ref = tmp_path / "ref.mcap"
+    import_bag(part.parent, ref, BagOptions(**OPTS))
+    folder = tmp_path / "rewritten"
+    shutil.copytree(part.parent, folder)
+    _rewrite(part, folder / part.name, **layout)
+    for given, out in ((folder, tmp_path / "a.mcap"), (folder / part.name, tmp_path / "b.mcap")):
+        import_bag(given, out, BagOptions(**OPTS))
+        _same_frames(ref, out)
