@@ -83,7 +83,7 @@ def generate_cmd(seed: int, rooms: tuple[int, int], split: str, preset: str, out
 @click.argument("houses", nargs=-1, required=True, type=PathParam())
 def check_cmd(houses: tuple[str, ...]) -> None:
     """Check house files (or folders of them) as `sgtool bench --house` does before it runs:
-    the house spec (toolkit/house/spec.py), small objects to search for, free floor for the
+    the house spec (docs/house-format.md), small objects to search for, free floor for the
     robot, ids that can name log folders. One line per file: "ok FILE: id, counts" with
     notes (rooms no door leads into), or "error" and the problem; exit code 2 when any
     file fails."""
