@@ -102,15 +102,18 @@ def parse_value(text: str) -> Any:
 DEFAULT_ROOMS_TEXT = "4-12"  # --rooms of a house generated with --seed
 
 
-def house_from_options(path: str | None, seed: int | None, rooms: str) -> tuple[Any, str]:
-    """(HouseSpec, house id) of ``--house``, ``--seed`` (with ``--rooms``) or the demo
-    house shipped with sgtool; both given is an error."""
+def house_from_options(path: str | None, seed: int | None, rooms: str,
+                       preset: str = "default") -> tuple[Any, str]:
+    """(HouseSpec, house id) of ``--house``, ``--seed`` (with ``--rooms`` and ``--preset``)
+    or the demo house shipped with sgtool; both given is an error."""
     if path is not None and seed is not None:
         raise SgtoolError("give either --house or --seed, not both")
     parsed = parse_rooms(rooms)  # a bad range is an error, with or without --seed
-    if seed is None and rooms != DEFAULT_ROOMS_TEXT:
-        raise SgtoolError(f"--rooms {rooms}: the room count of a house generated with --seed; "
-                          "give --seed N as well")
+    for flag, value, default in (("--rooms", rooms, DEFAULT_ROOMS_TEXT),
+                                 ("--preset", preset, "default")):
+        if seed is None and value != default:
+            raise SgtoolError(f"{flag} {value}: for a house generated with --seed; give "
+                              "--seed N as well")
     if path is not None:
         from sgtool.house.io import house_file_id, load_house
 
@@ -119,7 +122,7 @@ def house_from_options(path: str | None, seed: int | None, rooms: str) -> tuple[
     if seed is not None:
         from sgtool.datasets.generator import generate_house
 
-        return generate_house(seed, rooms=parsed), f"house-{seed}"
+        return generate_house(seed, rooms=parsed, preset=preset), f"house-{seed}"
     from sgtool.datasets import demo_house
 
     return demo_house(), "demo"
@@ -150,8 +153,10 @@ def option_group(options: Sequence[Callable[[F], F]]) -> Callable[[F], F]:
 
 
 def house_options(seed_help: str, rooms_help: str) -> Callable[[F], F]:
-    """``--house``, ``--seed`` and ``--rooms`` (for :func:`house_from_options`); the help of
-    ``--seed`` and ``--rooms`` says what the command does with the house."""
+    """``--house``, ``--seed``, ``--rooms`` and ``--preset`` (for :func:`house_from_options`);
+    the help of ``--seed`` and ``--rooms`` says what the command does with the house."""
+    from sgtool.datasets.presets import PRESET_NAMES
+
     return option_group([
         click.option("--house", "house_path", type=PathParam(dir_okay=False),
                      help="House spec (JSON, see `sgtool scenes`). Default: the demo house "
@@ -161,6 +166,10 @@ def house_options(seed_help: str, rooms_help: str) -> Callable[[F], F]:
         click.option("--rooms", default=DEFAULT_ROOMS_TEXT, show_default=True,
                      metavar="MIN-MAX",
                      help=rooms_help),
+        click.option("--preset", type=click.Choice(list(PRESET_NAMES)),
+                     default="default", show_default=True,
+                     help="Generator preset of a house generated with --seed: 'symsearch' "
+                     "for houses as dense as SymSearch's scenes (`sgtool scenes generate`)."),
     ])
 
 

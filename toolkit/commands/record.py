@@ -114,6 +114,7 @@ class RecordArgs:
     house_path: str | None
     seed: int | None
     rooms: str
+    preset: str
     output: str
     frames: int | None
     fps: float
@@ -158,7 +159,7 @@ def _request(args: RecordArgs, out: Path) -> RecordRequest:
                           mount_height=args.camera_height, tilt_deg=args.tilt,
                           depth_min=dmin, depth_max=dmax, near=min(0.05, dmin))
     profile = parse_noise(args.noise)
-    house, house_id = house_from_options(args.house_path, args.seed, args.rooms)
+    house, house_id = house_from_options(args.house_path, args.seed, args.rooms, args.preset)
     house = with_starts(house, args.house_path or house_id)  # a hand-made house: as bench
     opts = RecordOptions(fps=args.fps, frames=args.frames, camera=camera,
                          robot=replace(RobotConfig(), speed=args.speed), noise=profile,

@@ -189,6 +189,7 @@ class RunArgs:
     house_path: str | None
     seed: int | None
     rooms: str
+    preset: str
     query: str | None
     episode: int | None
     max_steps: int
@@ -287,7 +288,7 @@ def _request(args: RunArgs, out: Path) -> SearchRequest:
         raise SgtoolError(f"--fps {args.fps}: must be {FPS_RANGE[0]:g}..{FPS_RANGE[1]:g}")
     name, options = _planner(args)
     width, height = parse_resolution(args.resolution)
-    house, house_id = house_from_options(args.house_path, args.seed, args.rooms)
+    house, house_id = house_from_options(args.house_path, args.seed, args.rooms, args.preset)
     house = with_starts(house, args.house_path or house_id)  # a hand-made house: as bench
     index, ep = pick_episode(house, query=args.query, index=args.episode)
     opts = ClosedLoopOptions(
@@ -309,7 +310,7 @@ def _request(args: RunArgs, out: Path) -> SearchRequest:
 
 # options that pick another episode than the log's
 _OTHER_EPISODE = {"house_path": "--house", "seed": "--seed", "rooms": "--rooms",
-                  "query": "--query", "episode": "--episode"}
+                  "preset": "--preset", "query": "--query", "episode": "--episode"}
 # RunArgs fields given beside --again -> the ClosedLoopOptions field each sets
 _SAME_NAME = {"fps": "fps", "every": "every", "classifier": "classifier",
               "min_points": "min_points", "max_steps": "max_steps",

@@ -240,3 +240,27 @@ def test_a_report_checks_a_built_in_planners_options() -> None:
         {"scout": {"delta": 1.0}}
     got = planner_options(("nolab:Missing.k=2",), ("nolab:Missing",), typed=False)
     assert got == {"nolab:Missing": {"k": 2}}
+
+
+def test_record_and_run_generate_a_house_of_either_preset(tmp_path: Path) -> None:
+    """`record --seed N --preset symsearch` records the house `scenes generate` writes with
+    those options (it needed a house file); --preset without --seed is one line."""
+    pytest.importorskip("pybullet")
+    from sgtool.datasets.generator import generate_house
+    from sgtool.log import LogReader
+
+    out = tmp_path / "r.mcap"
+    r = CliRunner().invoke(cli, ["record", "--seed", "9150", "--rooms", "4-4", "--preset",
+                                 "symsearch", "--frames", "3", "--resolution", "96x72",
+                                 "--quiet", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    with LogReader(out) as log:
+        house = log.house_spec()
+    assert house == generate_house(9150, rooms=(4, 4), preset="symsearch")
+    assert house != generate_house(9150, rooms=(4, 4))
+    for command in (["record"], ["run", "--planner", "greedy"]):
+        r = CliRunner().invoke(cli, [*command, "--preset", "symsearch", "-o",
+                                     str(tmp_path / "x.mcap")])
+        assert r.exit_code == 2 and "--preset symsearch: for a house generated with --seed" \
+            in r.output, r.output
+    assert not (tmp_path / "x.mcap").exists()
