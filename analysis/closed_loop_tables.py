@@ -118,6 +118,8 @@ def budget_comparisons(results: Sequence[EpisodeResult], planners: Sequence[str]
     present = [p for p in planners if any(r.planner == p for r in results)]
     pairs = comparison_pairs(present, reference if reference in present else None,
                              all_pairs)
+    if not pairs:
+        return "", []
     scored = [within_budget(results, model, b) for b in budgets]
     body: list[list[str]] = []
     data: list[dict[str, object]] = []
@@ -193,12 +195,13 @@ def interval_tables(results: Sequence[EpisodeResult], planners: Sequence[str],
     per_house = [(h, paired_comparison([r for r in results if r.house == h], a, b,
                                        by_episode, boot, check=False))
                  for h in houses for a, b in pairs]
-    text = "\n".join([
-        format_intervals(ivs, boot, title="SR and SPL with bootstrap intervals over houses"),
-        format_paired(overall, boot, title="Paired comparisons over houses"),
-        format_paired([c for _, c in per_house], boot, cluster="episode",
-                      title="Paired comparisons per house (intervals over its episodes)",
-                      labels=[h for h, _ in per_house])])
+    ivs_text = format_intervals(ivs, boot, title="SR and SPL with bootstrap intervals over "
+                                                 "houses")
+    text = ivs_text + "\nPaired comparisons: no two planners to pair.\n" if not pairs else \
+        "\n".join([ivs_text, format_paired(overall, boot, title="Paired comparisons over houses"),
+                   format_paired([c for _, c in per_house], boot, cluster="episode",
+                                 title="Paired comparisons per house (intervals over its "
+                                 "episodes)", labels=[h for h, _ in per_house])])
     data: dict[str, object] = {
         "bootstrap": boot.to_dict(),
         "planners": {r.planner: r.to_dict() for r in ivs},

@@ -119,6 +119,17 @@ def test_within_a_budget_the_slow_planner_fails() -> None:
     assert "| SR diff ≤ 50 f/room" in text and "+1.000 [+1.000, +1.000]" in text
 
 
+def test_one_planner_says_there_is_nothing_to_pair() -> None:
+    """A run of one planner: its intervals and one line saying there is no pair, as the
+    symbolic bench's summary has it, not empty tables of comparisons."""
+    rows = [ep("scout", f"h{h}", 0, True) for h in range(3)]
+    text, data = interval_tables(rows, ["scout"], boot=Bootstrap(resamples=200))
+    assert "Paired comparisons: no two planners to pair." in text
+    assert "Paired comparisons over houses" not in text and data["paired"] == []
+    model = frames_model({r.key(): 10.0 for r in rows}, budget=100.0)
+    assert budget_comparisons(rows, ["scout"], model, (50.0,)) == ("", [])
+
+
 def test_symbolic_rows_must_come_from_a_symbolic_bench(tmp_path):
     """--symbolic given a run-bench folder compared the closed loop with itself (tau 1): its
     episodes are refused in one line naming their source; a bench's are read."""
