@@ -108,7 +108,8 @@ class LoggedEpisode:
             decided = [d.action for d in self.decisions if d.decided]
             r = _replace(r, wall={
                 "decision_s": sum(float(given(a.decision_time_s, 0.0)) for a in decided),
-                "decisions": float(len(decided))})
+                "decisions": float(sum(given(a.decision_time_s) is not None
+                                       for a in decided))})
         if "episode" not in self.episode.extras:
             r = _replace(r, episode=self.index)
         if "seed" not in self.episode.extras and self.log_seed is not None:

@@ -358,7 +358,8 @@ def result_from_log_records(episode: Episode, actions: Sequence[Action],
         end=str(extra.get("end", status or "")),
         source=source,
         trace=trace,
-        wall={"decision_s": decision_s, "decisions": float(len(actions))},
+        wall={"decision_s": decision_s,  # over the actions that say how long they took
+              "decisions": float(sum(given(a.decision_time_s) is not None for a in actions))},
         options=dict(options) if isinstance(options, Mapping) else {},
     )
 

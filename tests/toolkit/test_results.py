@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 
 import pytest
 
@@ -106,6 +107,13 @@ def test_result_from_log_records_derives_counts():
     r2 = result_from_log_records(Episode(kind="search", status="failure"), actions)
     assert not r2.success and r2.steps == 3 and r2.travelled_m == pytest.approx(6.5)
     assert r2.shortest_m is None and r2.planner == "unknown"
+    # actions that do not say how long they took (a hand-written log): no decision time,
+    # not a mean of 0 s
+    from sgtool.analysis.search_metrics import mean_decision_time
+
+    untimed = [dataclasses.replace(a, decision_time_s=None) for a in actions]
+    r3 = result_from_log_records(Episode(kind="search", status="failure"), untimed)
+    assert r3.decisions == 0 and math.isnan(mean_decision_time([r3]))
 
 
 def test_a_closed_loop_log_cut_short_counts_planner_steps_only():
