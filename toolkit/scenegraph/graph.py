@@ -21,7 +21,7 @@ import functools
 import json
 import math
 import numbers
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any, Literal, TypeVar, cast
 
@@ -326,23 +326,26 @@ def _numbers(v: Any, n: int, what: str) -> tuple[float, ...]:
         v = v.tolist()
     if not isinstance(v, (list, tuple)) or len(v) != n:
         raise ValueError(f"{what} {v!r}: give {n} numbers")
-    try:  # the usual: numbers whose sum is finite (a string raises; inf or nan is not)
-        if math.isfinite(sum(v)):
-            return tuple(v)
-    except TypeError:
-        pass
+    if _finite_sum(v):  # the usual, checked at once
+        return tuple(v)
     return tuple(_number(x, what) for x in v)
 
 
 def _distances(v: Any) -> dict[str, float]:
     """The ``distances`` map, each a finite number (:func:`_number`)."""
     out = dict(v)
-    try:  # the usual: numbers whose sum is finite
-        if math.isfinite(sum(out.values())):
-            return out
-    except TypeError:
-        pass
+    if _finite_sum(out.values()):  # the usual, checked at once
+        return out
     return {k: _number(x, f"distances[{k!r}]") for k, x in out.items()}
+
+
+def _finite_sum(values: Iterable[Any]) -> bool:
+    """Whether ``values`` are numbers whose sum is finite (text raises, inf or nan is not):
+    every one of them a finite number, but for an overflow (then each is checked)."""
+    try:
+        return math.isfinite(sum(values))
+    except TypeError:
+        return False
 
 
 def _xy(v: Any, what: str = "position") -> tuple[float, float]:
