@@ -59,7 +59,7 @@ from sgtool.log.inspect import foreign_log_problem
 from sgtool.log.records import ABSENT, Absent, Episode, LogRecord, SceneGraphRecord, given
 from sgtool.planning.base import Action, Feedback, Planner
 from sgtool.planning.episode import NOT_CONFIRMED, check_success_rule
-from sgtool.results import EpisodeResult, read_jsonl, result_from_log_records
+from sgtool.results import EpisodeResult, decision_wall, read_jsonl, result_from_log_records
 from sgtool.scenegraph.graph import DoorNode, SceneGraph
 
 _TERMINAL = ("success", "failure", "ended")
@@ -106,10 +106,7 @@ class LoggedEpisode:
                                     source=self.source)
         if not all(d.decided for d in self.decisions):  # decision time over decisions only
             decided = [d.action for d in self.decisions if d.decided]
-            r = _replace(r, wall={
-                "decision_s": sum(float(given(a.decision_time_s, 0.0)) for a in decided),
-                "decisions": float(sum(given(a.decision_time_s) is not None
-                                       for a in decided))})
+            r = _replace(r, wall=decision_wall(decided))
         if "episode" not in self.episode.extras:
             r = _replace(r, episode=self.index)
         if "seed" not in self.episode.extras and self.log_seed is not None:

@@ -311,6 +311,14 @@ def planner_steps(actions: Sequence[Action]) -> int:
     return sum(1 for a in decided if not str(a.reason or "").startswith(WENT_ON))
 
 
+def decision_wall(actions: Sequence[Action]) -> dict[str, float]:
+    """An episode's ``wall`` decision figures: the seconds the ``actions`` took to decide
+    and how many said how long they took (an action without ``decision_time_s`` counts
+    as no decision, not as an instant one)."""
+    timed = [float(t) for a in actions if (t := given(a.decision_time_s)) is not None]
+    return {"decision_s": sum(timed), "decisions": float(len(timed))}
+
+
 def result_from_log_records(episode: Episode, actions: Sequence[Action],
                             source: str = "log") -> EpisodeResult:
     """An :class:`EpisodeResult` from the records of one episode of a log.
@@ -336,7 +344,6 @@ def result_from_log_records(episode: Episode, actions: Sequence[Action],
     n_open = extra.get("n_open")
     if n_open is None:
         n_open = sum(1 for s in trace if s.skill == "open" and s.outcome == "success")
-    decision_s = sum(float(given(a.decision_time_s, 0.0)) for a in actions)
     seen = extra.get("seen")
     shortest = given(episode.shortest_m)
     options = extra.get("planner_options")
@@ -358,8 +365,7 @@ def result_from_log_records(episode: Episode, actions: Sequence[Action],
         end=str(extra.get("end", status or "")),
         source=source,
         trace=trace,
-        wall={"decision_s": decision_s,  # over the actions that say how long they took
-              "decisions": float(sum(given(a.decision_time_s) is not None for a in actions))},
+        wall=decision_wall(actions),
         options=dict(options) if isinstance(options, Mapping) else {},
     )
 

@@ -126,11 +126,12 @@ def index_bag(reader: Any, opts: BagOptions, topics: list[B.TopicInfo]) -> BagIn
                 static = c.topic.rstrip("/").endswith("tf_static")
                 stamps = [stamp_ns(tr.header) for tr in msg.transforms]
                 if not static:  # the stamped ones of a message with a zero stamp count too
-                    set_ = [t for t in stamps if t]
-                    if set_:
-                        first_stamp = min(set_ if first_stamp is None else [first_stamp, *set_])
-                    idx.tf_latency_ns.extend(int(bag_t) - t for t in set_)
-                    if len(set_) < len(stamps):  # unset, or a simulator's clock at 0
+                    stamped = [t for t in stamps if t]
+                    if stamped:
+                        first_stamp = min(stamped if first_stamp is None
+                                          else [first_stamp, *stamped])
+                    idx.tf_latency_ns.extend(int(bag_t) - t for t in stamped)
+                    if len(stamped) < len(stamps):  # unset, or a simulator's clock at 0
                         unset.append((msg, c.topic, int(bag_t)))
                         continue
                 add_tf_message(idx.tf, msg, c.topic)
