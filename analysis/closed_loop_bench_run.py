@@ -361,10 +361,12 @@ def _same_kinds(saved: dict[str, Any], ours: dict[str, Any]) -> bool:
 
 def _remove_partials(task: RunTask) -> None:
     """The partial files of ``task``'s log that a killed run left (its writer, killed,
-    could not remove them)."""
+    could not remove them): the log writer's, and the driver's temporary file of a log
+    sent back (a driver killed while it wrote one)."""
+    from sgtool.files import leftover_temps
     from sgtool.log.writer import partial_files
 
-    for p in partial_files(task.output):
+    for p in [*partial_files(task.output), *leftover_temps(task.output)]:
         p.unlink(missing_ok=True)
 
 

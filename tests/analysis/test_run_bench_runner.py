@@ -84,11 +84,14 @@ def test_a_worker_that_does_not_see_the_folder_sends_its_log_back(
     stale = away / "logs/none/greedy/small/ep-000.mcap.k1lled00.partial"
     stale.parent.mkdir(parents=True)
     stale.write_bytes(b"half a log")
+    # and the driver's copy of a log sent back, the driver killed while it wrote it
+    unsent = away / "logs/none/greedy/small/.ep-000.mcap.k1lled01.partial"
+    unsent.write_bytes(b"half a log sent back")
     # every worker is "on another machine": it runs into a folder of its own
     monkeypatch.setattr(FolderMark, "here", lambda self: False)
     runner = EpisodeRunner(LocalExecutor(1), away)
     shipped = run_closed_loop_bench(cfg, away, runner=runner)
-    assert not stale.exists()
+    assert not stale.exists() and not unsent.exists()
     logs = sorted(p.relative_to(away) for p in away.rglob("*.mcap"))
     assert logs == sorted(p.relative_to(here) for p in here.rglob("*.mcap"))
     assert len(logs) == 2 and not list(away.rglob("*.partial"))
