@@ -12,6 +12,11 @@ table, :data:`RULES`, applied in order; the first rule an episode breaks is its 
 - no steps, no travel: ``steps`` 0 needs ``travelled_m`` 0 (not in the closed loop,
   :func:`closed_loop`, whose robot explores on its own between steps);
 - every successful open is a step: ``n_open`` <= ``steps``;
+- the figures agree with the actions (when the episode lists them: a log's Action records,
+  a result's ``trace``): every step is an action (``steps`` <= the actions), and
+  ``travelled_m`` is at least what the actions travelled (less :data:`ROUNDING_M` per
+  action: each is rounded on write). A closed-loop robot may drive more than its actions
+  (a look-around is not a step);
 - a success came within sight of the target (symbolic episodes; the closed loop's camera
   sees over furniture the path goes round): its ``travelled_m`` is at least its
   ``shortest_m`` less the tolerance :func:`shortfall_tolerance_m`. The shortest path ends
@@ -41,6 +46,7 @@ SIGHT_M = 6.0  # metres: the farthest a target is seen from (the simulator camer
 SHORTFALL_M = 0.5  # metres a success may travel less than the shortest path, plus ...
 SHORTFALL_SHARE = 0.1  # ... this share of the shortest path (and the sight beyond reach)
 NO_TRAVEL_M = 1e-6  # metres that count as no travel (rounding of a sum of zero moves)
+ROUNDING_M = 1e-4  # metres of rounding per action a sum of actions' travel may be off by
 
 
 @dataclass(frozen=True)
@@ -103,6 +109,21 @@ def _opens_beyond_steps(r: EpisodeResult) -> str | None:
     return None
 
 
+def _steps_beyond_actions(r: EpisodeResult) -> str | None:
+    if r.trace and r.steps > len(r.trace):
+        return (f"steps {r.steps} but {len(r.trace)} action(s) listed: every step is an "
+                "action")
+    return None
+
+
+def _travel_below_actions(r: EpisodeResult) -> str | None:
+    moved = math.fsum(s.travelled_m for s in r.trace)
+    if r.trace and r.travelled_m < moved - ROUNDING_M * len(r.trace):
+        return (f"travelled_m {r.travelled_m:g} m is less than the {moved:.4g} m its "
+                f"{len(r.trace)} action(s) travelled")
+    return None
+
+
 def _success_short_of_target(r: EpisodeResult) -> str | None:
     if not r.success or r.shortest_m is None or closed_loop(r):
         return None
@@ -120,6 +141,8 @@ RULES: tuple[Rule, ...] = (
     *(_distance(n) for n in DISTANCES),
     Rule("steps 0 needs travelled_m 0", _travel_without_steps),
     Rule("n_open <= steps", _opens_beyond_steps),
+    Rule("steps <= the actions listed", _steps_beyond_actions),
+    Rule("travelled_m >= what the actions travelled", _travel_below_actions),
     Rule(f"a success travelled at least shortest_m less {SIGHT_M - REACH + SHORTFALL_M:g} m "
          f"+ {SHORTFALL_SHARE:.0%} of it", _success_short_of_target),
 )

@@ -23,8 +23,8 @@ from sgtool.analysis.validity import (
 from sgtool.cli import cli
 from sgtool.datasets.episodes import REACH
 from sgtool.log import LogWriter
-from sgtool.log.records import Episode
-from sgtool.results import EpisodeResult, write_jsonl
+from sgtool.log.records import Action, Episode
+from sgtool.results import EpisodeResult, Step, write_jsonl
 
 GOOD = EpisodeResult("greedy", 0, "h", 0, "mug", True, steps=4, travelled_m=10.0,
                      shortest_m=9.48)
@@ -48,6 +48,14 @@ GOOD = EpisodeResult("greedy", 0, "h", 0, "mug", True, steps=4, travelled_m=10.0
     ({"noise": "symbolic", "steps": 0, "travelled_m": 1.0},  # eval's label, no sensor
      "steps 0 but travelled_m 1 m: no step, no travel"),
     ({"noise": "none", "n_open": 5}, "n_open 5 is more than steps 4: every open is a step"),
+    # the closing figures against the actions listed: four steps, three actions
+    ({"trace": (Step("navigate", "room_1", "success", 4.0),) * 3},
+     "steps 4 but 3 action(s) listed: every step is an action"),
+    # four actions that drove 4 m each, a closing record of 10 m
+    ({"trace": (Step("navigate", "room_1", "success", 4.0),) * 4},
+     "travelled_m 10 m is less than the 16 m its 4 action(s) travelled"),
+    ({"noise": "none", "trace": (Step("navigate", "room_1", "success", 4.0),) * 4},
+     "travelled_m 10 m is less than the 16 m its 4 action(s) travelled"),
 ])
 def test_contradicting_figures_are_refused_naming_them(change, problem):
     assert episode_problem(dataclasses.replace(GOOD, **change)) == problem
@@ -68,6 +76,12 @@ def test_contradicting_figures_are_refused_naming_them(change, problem):
     {"noise": "none", "steps": 0, "travelled_m": 0.81},
     {"noise": "mild", "steps": 0, "travelled_m": 0.0, "shortest_m": 6.31},
     {"noise": "none", "steps": 3, "travelled_m": 1.0},
+    # actions that agree: each 2.5 m rounded on write, the total not (0.1 mm per action)
+    {"trace": (Step("navigate", "room_1", "success", 2.50004),) * 4},
+    # the closed loop's look-arounds and fallback explores are actions but no steps, and
+    # drive between them; a robot may drive more than its actions
+    {"noise": "none", "trace": (Step("explore", "frontier_1", "success", 0.5),) * 6},
+    {"noise": "none", "trace": (Step("open", "furn_1", "success", 0.0),) * 4},
 ])
 def test_consistent_figures_pass(change):
     assert episode_problem(dataclasses.replace(GOOD, **change)) is None
@@ -92,6 +106,9 @@ def test_every_rule_of_the_table_catches_its_own_case():
         "shortest_m a finite number >= 0 (or unknown)": {"shortest_m": -1.0},
         "steps 0 needs travelled_m 0": {"steps": 0, "success": False},
         "n_open <= steps": {"n_open": 9},
+        "steps <= the actions listed": {"trace": (Step("open", "furn_1", "success", 0.0),)},
+        "travelled_m >= what the actions travelled":
+            {"trace": (Step("navigate", "room_1", "success", 3.0),) * 4},
         "a success travelled at least shortest_m less 5.5 m + 10% of it":
             {"travelled_m": 2.0},
     }
@@ -142,3 +159,24 @@ def test_eval_refuses_the_zero_travel_success_of_a_log(tmp_path):
     assert lines[0].startswith(f"sgtool: note: {log}: episode 0: refused: a success with "
                                "travelled_m 0 m, less than shortest_m 9.48 m")
     assert lines[1].startswith("sgtool: error: no search episodes to score")
+
+
+def test_eval_refuses_a_closing_record_that_contradicts_the_logs_actions(tmp_path):
+    """A hand-written log whose closing record counts more steps and less travel than its
+    Action records was scored as the closing record said (an outside lab's log)."""
+    log = tmp_path / "run.mcap"
+    with LogWriter(log) as w:
+        w.write_record(Episode(kind="search", status="started", planner="greedy",
+                               house_id="h", query="mug"), 0)
+        for i in range(2):
+            w.write_record(Action(step=i, skill="navigate", target=f"room_{i}",
+                                  outcome="success", travelled_m=6.0, planner="greedy"),
+                           1 + i)
+        w.write_record(Episode(kind="search", status="success", planner="greedy",
+                               house_id="h", query="mug", steps=9, travelled_m=12.0,
+                               shortest_m=9.48), 10)
+    r = CliRunner().invoke(cli, ["eval", str(log)])
+    assert r.exit_code == 2
+    assert r.stderr.strip().splitlines()[0] == (
+        f"sgtool: note: {log}: episode 0: refused: steps 9 but 2 action(s) listed: every "
+        "step is an action")

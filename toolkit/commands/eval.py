@@ -86,7 +86,8 @@ def command(inputs: tuple[str, ...], out: str | None, force: bool = False,
     An episode whose figures cannot be true, or contradict each other, is refused: it is
     left out of every metric and a one-line note on stderr names the file, the episode and
     the contradiction (the JSON output lists the notes too). Refused: negative steps or
-    counts; a negative or non-finite travelled_m or shortest_m; more opens than steps; and
+    counts; a negative or non-finite travelled_m or shortest_m; more opens than steps; more
+    steps than the actions it lists, or less travel than they travelled; and
     in symbolic episodes travel without a step (steps 0, travelled_m > 0) and a success
     that travelled less than its shortest path by more than 5.5 m + 10% of it (the path
     ends 1 m from the target, a camera sees it from up to 6 m: a success with 0 m
