@@ -10,19 +10,15 @@ is unchanged, changed (the first refresh that differs, layer by layer, the quali
 before and after, the first decision that differs) or could not be checked (an error, one
 line). :func:`update_pins` writes the changed logs' new pins.
 
-**Planner decisions** (episode logs: a log whose ``sgtool.Episode`` records name a planner
-and a query): the planner, built with its defaults, is asked at every logged decision
-point on the *replayed* graph in force at that point (the last refresh at or before the
-action's ``graph_time_ns``, else its log time) and told the logged outcome (teacher
-forcing, as :func:`sgtool.analysis.offline.replay_decisions`); its choices are pinned. So a
-change of the mapping that changes a graph a planner decides on, or a change of the
-planner, shows as the first decision that differs. LLM planners are not re-asked (they need
-an endpoint); their logs pin graphs and figures only.
+**Planner decisions** (episode logs, :mod:`sgtool.analysis.golden_decisions`): the
+planner is asked again at every logged decision point on the replayed graph and its
+choices are pinned. So a change of the mapping that changes a graph a planner decides on,
+or a change of the planner, shows as the first decision that differs. LLM planners and
+planner objects of one's own are not asked again; their logs pin graphs and figures only.
 """
 
 from __future__ import annotations
 
-import bisect
 import contextlib
 import dataclasses
 import os
@@ -33,6 +29,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from sgtool.analysis.executor import Executor, LocalExecutor, Task
+from sgtool.analysis.golden_decisions import planner_decisions
 from sgtool.analysis.pin_lock import pins_locked
 from sgtool.arg_checks import of_type
 from sgtool.errors import SgtoolError
@@ -71,62 +68,6 @@ from sgtool.replayers.golden_pins import (
 from sgtool.version import __version__
 
 Status = Literal["unchanged", "changed", "error"]
-
-
-# ----- planner decisions ------------------------------------------------------------------
-def planner_decisions(log: str | Path, graphs: Sequence[str], refreshes: Sequence[RefreshMeta]
-                      ) -> tuple[str | None, tuple[Decision, ...] | None]:
-    """(planner, its decisions) at the decision points of an episode log, on the replayed
-    graphs (module doc); (None, None) for a log that is no episode log, whose planner
-    needs an endpoint or was a user's own object (``planner_object``: its name builds
-    another planner, or none); an :class:`SgtoolError` when its planner cannot be built here (a
-    plug-in whose module is not on the path: silently leaving the decisions out would pin
-    less than asked, and a check would call the log changed)."""
-    from sgtool.analysis.offline import read_log_episodes, replay_decisions
-    from sgtool.log.records import given
-    from sgtool.planning.registry import is_llm_planner, make_planner
-    from sgtool.scenegraph.graph import SceneGraph
-
-    episodes = [e for e in read_log_episodes(log) if given(e.episode.query)]
-    names = {str(given(e.episode.planner)) for e in episodes if given(e.episode.planner)}
-    if len(names) != 1 or not any(e.decisions for e in episodes):
-        return None, None
-    name = names.pop()
-    if is_llm_planner(name) or any(e.episode.extras.get("planner_object")
-                                   for e in episodes):  # a user's object: not by its name
-        return None, None
-    times = [m.time_ns for m in refreshes]
-    parsed: dict[int, SceneGraph] = {}
-
-    def graph_at(t: int) -> SceneGraph | None:
-        i = bisect.bisect_right(times, t) - 1
-        if i < 0:
-            return None
-        if i not in parsed:
-            parsed[i] = SceneGraph.from_json(graphs[i])
-        return parsed[i]
-
-    replayed = []
-    for ep in episodes:
-        ds = []
-        for d in ep.decisions:
-            gt = d.action.graph_time_ns
-            t = gt if isinstance(gt, int) else d.t_ns
-            ds.append(dataclasses.replace(d, graph=graph_at(t) if d.decided else None))
-        replayed.append(dataclasses.replace(ep, decisions=tuple(ds)))
-    extra = given(episodes[0].episode.extra) or {}
-    logged = extra.get("planner_options")
-    options = dict(logged) if isinstance(logged, dict) else {}  # as the run built it
-    options["timed"] = False  # asked again, not timed (whatever the run chose)
-    try:
-        planner = make_planner(name, **options)
-    except SgtoolError as e:  # a plug-in not importable here: its decisions cannot be asked
-        raise SgtoolError(f"{log}: its planner cannot be built here ({e}); the decisions of "
-                          "an episode log are pinned and checked by asking its planner again "
-                          "(a plug-in's module on PYTHONPATH)") from None
-    report = replay_decisions(planner, replayed, name)
-    return name, tuple(Decision(c.episode, c.step, c.chosen[0], c.chosen[1])
-                       for c in report.comparisons)
 
 
 def capture_log(log: str | Path, options: ReplayOptions) -> Capture:

@@ -14,7 +14,8 @@ import signal
 import pytest
 from support.paths import GOLDEN
 
-from sgtool.analysis.golden_check import check_pins, first_decision_change, planner_decisions
+from sgtool.analysis.golden_check import check_pins, first_decision_change
+from sgtool.analysis.golden_decisions import planner_decisions
 from sgtool.cli import main
 from sgtool.log import LogReader, LogWriter
 from sgtool.log.records import Episode

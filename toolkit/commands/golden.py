@@ -99,12 +99,15 @@ def pin(logs: tuple[str, ...], folder: str, copy: bool, why: str | None, every: 
     pins = pin_logs(inputs, Path(folder),
                     make_options(every, classifier, min_points, voxel_size, max_frames),
                     copy=copy, executor=runner, progress=_show(progress), why=why)
-    for p in inputs:
-        from sgtool.analysis.golden_check import pin_name
+    from sgtool.analysis.golden_check import pin_name
+    from sgtool.analysis.golden_decisions import decisions_left_out
 
+    for p in inputs:
         e = pins.logs[pin_name(Path(p))]
         extra = ", quality figures" if e.quality else ""
         extra += f", {len(e.decisions)} {e.planner} decisions" if e.decisions else ""
+        left = None if e.decisions is not None else decisions_left_out(p)
+        extra += f"; its decisions are not pinned ({left})" if left else ""
         was = before.get(e.name)
         if was is not None and (was[0] != e.log or was[1] != e.log_sha256):
             extra += f"; replaces the pin of {was[0]}" + (

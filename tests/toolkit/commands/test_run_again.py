@@ -170,6 +170,17 @@ def test_a_planner_object_of_ones_own_is_not_rebuilt_by_its_name(tmp_path: Path)
     pins = sgtool.pin_logs([tmp_path / "mine.mcap", tmp_path / "made.mcap"], tmp_path / "p")
     assert (pins.logs["mine"].planner, pins.logs["mine"].decisions) == (None, None)
     assert pins.logs["made"].planner == "greedy" and pins.logs["made"].decisions
+    # and `golden pin` says so: a lab expecting its planner's decisions pinned is told
+    r = CliRunner().invoke(cli, ["golden", "pin", str(tmp_path / "mine.mcap"),
+                                 str(tmp_path / "made.mcap"), "--dir", str(tmp_path / "q")])
+    assert r.exit_code == 0, r.output
+    mine_line, made_line = r.stdout.splitlines()[:2]
+    assert mine_line.startswith("pinned mine: ") and mine_line.endswith(
+        f"; its decisions are not pinned (greedy: a planner object of one's own "
+        f"({__name__}:{Mine.__qualname__}) cannot be built again from the log (its options "
+        f"are unknown); record with sgtool.make_planner('module:Name', **options) to pin "
+        f"its decisions) (../mine.mcap)"), mine_line  # the log as the pin stores it
+    assert " greedy decisions (" in made_line and "not pinned" not in made_line
     out = tmp_path / "again.mcap"
     r = CliRunner().invoke(cli, ["run", "--again", str(tmp_path / "mine.mcap"), "-o", str(out)])
     assert r.exit_code == 2 and r.output.count("\n") == 1, r.output
