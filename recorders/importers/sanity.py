@@ -11,7 +11,9 @@ flag (they know their data better than these bands do):
 - depth scale (:func:`depth_scale_problem`): the median depth of the valid pixels and the far
   end of the depth range (95th percentile) must be what indoor RGB-D gives; millimetres read
   with TUM's 5000 units per metre make the world 5x too small. The scales that would fit are
-  named;
+  named, or the byte order when the depth read with its bytes swapped is indoor depth and
+  far smoother (:func:`swapped_fit`: a scale may "fit" swapped 16-bit depth, whose values
+  spread over the whole range);
 - floor (:func:`floor_problem`): the camera's median height above the estimated floor must be
   within a band (``--camera-height``, 0.5-2.2 m by default: hand-held, head- and robot-mounted
   cameras); a desk top taken for the floor puts a hand-held camera 0.4 m above it.
@@ -36,6 +38,7 @@ FAR_DEPTH_M = (0.9, 12.0)
 # 1/6553.5 m (Replica as NICE-SLAM renders it: 10 m over 16 bits)
 KNOWN_SCALES = (1000.0, 5000.0, 10000.0, 4000.0, 6553.5)
 DEFAULT_CAMERA_HEIGHT = (0.45, 2.2)  # m above the floor
+SWAP_SMOOTHER = 4.0  # how much smoother depth read with its bytes swapped must be to say so
 
 
 @dataclass(frozen=True)
@@ -161,6 +164,42 @@ def fitting_scales(raw: Sequence[np.ndarray], scale: float) -> list[tuple[float,
     return sorted(out, key=lambda ks: abs(np.log(ks[1].median_m / 2.0)))
 
 
+def roughness(raw: Sequence[np.ndarray]) -> float:
+    """How much valid depth changes from a pixel to its right-hand neighbour, relative to
+    its size: the median of ``|a - b| / (a + b)`` over the pairs of valid pixels (0 for a
+    flat image; depth of real surfaces changes little from pixel to pixel, bytes read in
+    the wrong order make it jump)."""
+    parts = []
+    for a in raw:
+        a = np.asarray(a, dtype=np.float64)
+        if a.ndim != 2 or a.shape[1] < 2:
+            continue
+        left, right = a[:, :-1], a[:, 1:]
+        ok = (left > 0) & (right > 0) & np.isfinite(left) & np.isfinite(right) \
+            & (left != 65535) & (right != 65535)
+        parts.append((np.abs(left - right)[ok] / (left + right)[ok]).ravel())
+    v = np.concatenate(parts) if parts else np.zeros(0)
+    return float(np.median(v)) if len(v) else 0.0
+
+
+def swapped_fit(raw: Sequence[np.ndarray], scale: float) -> tuple[float, DepthStats] | None:
+    """(scale, stats) at which ``raw`` read with each value's bytes swapped is indoor depth
+    (``scale`` first, then :data:`KNOWN_SCALES`), when swapped it is also far smoother
+    (:data:`SWAP_SMOOTHER` times, :func:`roughness`): depth written in the other byte order
+    than the image says (a ROS Image's ``is_bigendian``); None otherwise."""
+    raw = [a for a in raw if a.dtype.itemsize > 1]
+    if not raw:
+        return None
+    swapped = [a.byteswap() for a in raw]
+    if roughness(swapped) * SWAP_SMOOTHER >= roughness(raw):
+        return None
+    for k in (scale, *(k for k in KNOWN_SCALES if k != scale)):
+        s = depth_stats(swapped, k)
+        if s.valid and depth_plausible(s):
+            return k, s
+    return None
+
+
 def depth_scale_problem(raw: Sequence[np.ndarray], scale: float, origin: str) -> str | None:
     """The problem of reading ``raw`` depth (16-bit integers, or floats: 32FC1 is metres
     unless a scale was given) at ``scale`` units per metre (which came from ``origin``: a
@@ -172,8 +211,15 @@ def depth_scale_problem(raw: Sequence[np.ndarray], scale: float, origin: str) ->
     s = depth_stats(raw, scale)
     if s.valid == 0 or depth_plausible(s):
         return None
+    swap = swapped_fit(raw, scale)
     fits = fitting_scales(raw, scale)
-    if fits:
+    if swap is not None:
+        k, fs = swap
+        at = "" if k == scale else f" at --depth-scale {k:g}"
+        fix = (f"with each value's bytes swapped it is smooth indoor depth (median "
+               f"{fs.median_m:.2f} m{at}): the images are in the other byte order than they "
+               "say (a ROS Image's is_bigendian flag); write them with the right flag")
+    elif fits:
         k, fs = fits[0]
         also = ", ".join(f"{a:g} (median {f.median_m:.2f} m)" for a, f in fits[1:])
         fix = (f"--depth-scale {k:g} fits (median {fs.median_m:.2f} m)" + (

@@ -22,8 +22,10 @@ from sgtool.log.frame import CameraIntrinsics
 from sgtool.recorders.importers.bag import BagOptions, import_bag
 from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
 from sgtool.recorders.importers.sanity import (
+    SWAP_SMOOTHER,
     depth_scale_problem,
     floor_problem,
+    roughness,
     timestamp_problem,
 )
 from sgtool.recorders.importers.sink import IMPORT_METADATA
@@ -303,3 +305,33 @@ def test_a_binned_or_cropped_camera_gets_the_intrinsics_of_its_images(
         got = next(r.frames()).intrinsics
     assert (got.width, got.height) == (k.width, k.height)
     assert (got.fx, got.fy, got.cx, got.cy) == pytest.approx((k.fx, k.fy, k.cx, k.cy))
+
+
+def _floor_and_wall(h: int = 60, w: int = 80) -> np.ndarray:
+    """Smooth depth in millimetres: a wall 3 m away above a floor that comes nearer row by
+    row (1-3 m), with a little sensor noise."""
+    rows = np.linspace(3000.0, 1000.0, h)[:, None] * np.ones((1, w))
+    rows[: h // 3] = 3000.0
+    noise = np.random.default_rng(0).normal(0.0, 3.0, (h, w))
+    return np.round(rows + noise).astype(np.uint16)
+
+
+def test_depth_in_the_other_byte_order_is_named_as_such_not_as_a_scale():
+    """16-bit depth whose is_bigendian flag is wrong read as millimetres: its values spread
+    over the whole 16-bit range, which one of the usual scales "fits"; the message said
+    to give that scale (an outside lab's bag). Swapped back it is smooth indoor depth."""
+    mm = _floor_and_wall()
+    wrong = mm.byteswap()  # the bytes as a wrong flag reads them
+    assert roughness([wrong]) > SWAP_SMOOTHER * roughness([mm])
+    p = depth_scale_problem([wrong], 1000.0, "the encoding 16UC1")
+    assert p is not None and "--depth-scale 10000 fits" not in p, p
+    assert "with each value's bytes swapped it is smooth indoor depth (median 2.00 m)" in p, p
+    assert "(a ROS Image's is_bigendian flag)" in p
+    # depth in the right order is no problem, and a wrong scale is still named as one
+    assert depth_scale_problem([mm], 1000.0, "x") is None
+    p = depth_scale_problem([mm], 5000.0, "x")
+    assert p is not None and "--depth-scale 1000 fits" in p and "swapped" not in p
+    # a float image in the other byte order too (32FC1 metres)
+    metres = (mm.astype(np.float32) / 1000).byteswap()
+    p = depth_scale_problem([metres], 1.0, "x")
+    assert p is not None and "bytes swapped" in p, p
