@@ -68,5 +68,6 @@ def placeholder_poses_problem(poses: Sequence[np.ndarray], names: Sequence[str],
             "frame after them is near again): placeholder poses where tracking was lost (an "
             "identity matrix, where ScanNet writes -inf) are the usual cause, and each "
             "would be mapped at the wrong place; give those frames no pose where the "
-            "layout has a way to (a pose/NAME.txt of -inf, as ScanNet writes, or none), or "
-            "--estimate-poses to estimate the poses from the depth")
+            "layout has a way to (a pose/NAME.txt of -inf, as ScanNet writes, or none), "
+            "--allow-drop to import the other frames only, or --estimate-poses to estimate "
+            "the poses from the depth")

@@ -71,7 +71,7 @@ from sgtool.recorders.importers.pose_axes import (
     convention_text,
     to_optical,
 )
-from sgtool.recorders.importers.pose_jumps import placeholder_poses_problem
+from sgtool.recorders.importers.pose_jumps import placeholder_poses_problem, placeholder_runs
 from sgtool.recorders.importers.provenance import (
     ESTIMATED_FLOORS,
     FLOOR_ORIGINS,
@@ -339,6 +339,19 @@ def check_scale_by_geometry(frames: list[FolderFrame], k: CameraIntrinsics, scal
     return fit, focal
 
 
+def _without_placeholders(frames: list[FolderFrame], opts: RgbdOptions
+                          ) -> tuple[list[FolderFrame], int]:
+    """``frames`` without the runs of placeholder poses
+    (:func:`~sgtool.recorders.importers.pose_jumps.placeholder_runs`) when ``--allow-drop``
+    asks for the posed frames only (the poses are not estimated), and how many were left
+    out; else ``frames`` as they are (a run stops the import later, naming its frames)."""
+    if not opts.allow_drop or opts.estimate_poses or any(f.pose is None for f in frames):
+        return frames, 0
+    runs = placeholder_runs(np.array([np.asarray(f.pose, float)[:3, 3] for f in frames]))
+    out = {i for a, b in runs for i in range(a, b + 1)}
+    return [f for i, f in enumerate(frames) if i not in out], len(out)
+
+
 def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = None) -> ImportReport:
     """Import the RGB-D folder ``root`` into the log ``out`` (module doc) and return what
     was written; options and the folder's files are checked before any work, each problem
@@ -368,6 +381,7 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
             "import only the covered ones")
         if problem:
             raise SgtoolError(f"{root}: {problem}")
+    frames, jumped = _without_placeholders(frames, opts)
     colour = ColourStream.of(frames)
     findings = Findings(opts.warn)
     scale = float(opts.depth_scale if opts.depth_scale is not None else seq.depth_scale)
@@ -406,7 +420,8 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         findings.warning(f"intrinsics taken from the folder name ({intr_origin}); give "
                          "--intrinsics fx,fy,cx,cy if the images come from another camera")
 
-    notes = list(seq.notes)
+    notes = list(seq.notes) + ([f"{jumped} frame(s) whose poses jump away and come back "
+                                 "(placeholders) left out (--allow-drop)"] if jumped else [])
     drift: DriftReport | None = None
     odo: OdometryResult | None = None
     reference = drift_reference(seq, opts.trajectory)

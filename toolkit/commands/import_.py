@@ -154,7 +154,9 @@ _common_options = option_group([
     click.option("--force", is_flag=True, help="Overwrite the output log."),
     click.option("--allow-drop", is_flag=True,
                  help="Import the frames that have a pose even when more than 10 % of the "
-                 "depth images have none (without it, an error)."),
+                 "depth images have none (without it, an error); for a folder, also leave "
+                 "out the frames whose poses jump away and come back (placeholders where "
+                 "tracking was lost)."),
     click.option("--json", "as_json", is_flag=True, help="Print the report as JSON."),
     click.option("--quiet", is_flag=True, help="No progress bars."),
 ])

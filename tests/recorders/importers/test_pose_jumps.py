@@ -9,6 +9,7 @@ import pytest
 from support.rgbd_scenes import look_at, make_scene_folder, room
 
 from sgtool.errors import SgtoolError
+from sgtool.log import LogReader
 from sgtool.recorders.importers.pose_jumps import placeholder_runs
 from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
 from sgtool.recorders.importers.textformats import PinholeParams
@@ -58,3 +59,12 @@ def test_an_identity_pose_among_a_walks_is_refused(tmp_path) -> None:
     rep = import_rgbd(root, tmp_path / "b.mcap", RgbdOptions(intrinsics=K, progress=False,
                                                             estimate_poses=True))
     assert rep.frames == 20
+    # the poses as they are, the two placeholder frames left out (no flag did that before:
+    # --allow-drop named frames without a pose only)
+    rep = import_rgbd(root, tmp_path / "c.mcap", RgbdOptions(intrinsics=K, progress=False,
+                                                            allow_drop=True))
+    assert rep.frames == 18 and rep.pose_source == "ground truth of the dataset"
+    assert "2 frame(s) whose poses jump away and come back (placeholders) left out " \
+        "(--allow-drop)" in rep.notes
+    times = [f.time_ns for f in LogReader(tmp_path / "c.mcap").frames()]
+    assert len(times) == 18
