@@ -15,7 +15,7 @@ import hashlib
 import json
 from typing import Any
 
-from sgtool.log.records import LlmExchange
+from sgtool.log.records import ABSENT, LlmExchange
 
 Message = dict[str, str]
 
@@ -48,9 +48,11 @@ def exchange_record(
     ``attempt`` counts retries within one decision (0 = first try); ``step`` is the decision
     number within the episode; ``source`` is ``endpoint`` or ``replay``;
     ``truncated_from`` the length of a reply that was cut to ``response``; ``extra``
-    adds fields beyond the schema (the planner's ``constraint`` and ``verdict``).
+    adds fields beyond the schema (the planner's ``constraint``), but its ``verdict`` (the
+    planner's judgement of the answer: ``ok`` or ``invalid: reason``) is the record's own.
     """
     unknown = dict(extra or {})
+    verdict = unknown.pop("verdict", ABSENT)
     if truncated_from is not None:
         unknown["response_truncated_from"] = int(truncated_from)
     return LlmExchange(
@@ -66,5 +68,6 @@ def exchange_record(
         step=step,
         query=query,
         source=source,
+        verdict=verdict if verdict is ABSENT or verdict is None else str(verdict),
         unknown=unknown,
     ).to_json()

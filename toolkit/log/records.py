@@ -537,6 +537,7 @@ _LLM_TRANSCRIPT_FIELDS = {
     "step": {"type": ["integer", "null"]},
     "query": {"type": ["string", "null"]},
     "source": {"type": "string"},
+    "verdict": {"type": ["string", "null"]},
 }
 
 
@@ -558,6 +559,7 @@ class LlmExchange(LogRecord):
     step: int | None | Absent = ABSENT
     query: str | None | Absent = ABSENT
     source: str | Absent = ABSENT
+    verdict: str | None | Absent = ABSENT  # the planner's: "ok" or "invalid: reason"
 
     @classmethod
     def json_schema(cls) -> Mapping[str, Any]:

@@ -95,3 +95,20 @@ def test_transcript_errors_and_interrupted_last_line(tmp_path) -> None:
     tour = TESTS / "golden" / "house6-tour.mcap"  # an MCAP log without /sgtool/llm
     with pytest.raises(TranscriptError, match=r"holds no LLM exchanges \(/sgtool/llm\)"):
         ReplayChatClient(tour)
+
+
+def test_the_planners_verdict_is_a_field_of_the_record(tmp_path) -> None:
+    """A planner's verdict on an answer was read back from a log only in ``unknown`` (an
+    outside lab looked for ``record.verdict``); its constraint stays an extra field."""
+    from sgtool.log import LogReader, LogWriter
+    from sgtool.log.records import LlmExchange
+
+    d = exchange_record(model="m", messages=MSGS, response="Command: fly()", latency_s=0.1,
+                        extra={"verdict": "invalid: unknown skill 'fly'", "constraint": "x"})
+    assert d["verdict"] == "invalid: unknown skill 'fly'" and d["constraint"] == "x"
+    with LogWriter(tmp_path / "x.mcap") as w:
+        w.write_record(LlmExchange.from_json(d), 1)
+    [(_, rec)] = list(LogReader(tmp_path / "x.mcap").records(LlmExchange))
+    assert rec.verdict == "invalid: unknown skill 'fly'"
+    assert dict(rec.unknown) == {"constraint": "x"}
+    assert LlmExchange.json_schema()["properties"]["verdict"] == {"type": ["string", "null"]}
