@@ -19,6 +19,7 @@ depth scale, up direction and floor came from.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -148,6 +149,51 @@ class RgbdOptions:
     # the convention of the folder's (or ``trajectory``'s) poses (:mod:`.pose_axes`)
     camera_axes: str = "optical"
     world_to_camera: bool = False
+
+
+def python_options(opts: object) -> RgbdOptions:
+    """``opts`` as a Python caller may give them, in the types :func:`import_rgbd` works
+    with: None is the defaults; ``trajectory`` a path as text too (one that is no file is
+    one line, as the flag's is); ``up`` an axis or ``auto`` as ``--up`` takes it, or three
+    numbers; ``floor`` ``"auto"`` or ``"none"`` as ``--floor`` takes them. A value of
+    another type is one :class:`SgtoolError` line naming the field (not an error deep
+    inside the import)."""
+    from sgtool.arg_checks import of_type, whole
+    from sgtool.recorders.importers.upright import parse_up
+
+    if opts is None:
+        return RgbdOptions()
+    of_type("opts", opts, RgbdOptions, "an sgtool.RgbdOptions (RgbdOptions(every=2, ...))")
+    assert isinstance(opts, RgbdOptions)
+    whole("every", opts.every)  # the range: check_options, naming the flag
+    whole("limit", opts.limit, optional=True)
+    if isinstance(opts.max_dt_ns, bool) or not isinstance(opts.max_dt_ns, int | np.integer):
+        raise SgtoolError(f"max_dt_ns={opts.max_dt_ns!r}: whole nanoseconds (--max-dt 0.02 "
+                          "is max_dt_ns=20_000_000)")
+    changes: dict[str, object] = {}
+    traj = opts.trajectory
+    if traj is not None and not isinstance(traj, Path):
+        if not isinstance(traj, str | os.PathLike):
+            raise SgtoolError(f"trajectory: a file's path, got {type(traj).__name__}")
+        changes["trajectory"] = traj = Path(traj)
+    if traj is not None and not Path(traj).is_file():
+        raise SgtoolError(f"--trajectory {traj}: no such file")
+    up = opts.up
+    if isinstance(up, str):
+        changes["up"] = parse_up(up)
+    elif up is not None:
+        try:
+            v = np.asarray(up, dtype=np.float64)
+        except (TypeError, ValueError):
+            v = np.zeros(0)
+        if v.shape != (3,) or not np.all(np.isfinite(v)) or np.linalg.norm(v) < 1e-9:
+            raise SgtoolError(f"up={up!r}: three finite numbers, not all 0 (or an axis as "
+                              "--up takes it: 'z', '-y', 'auto')")
+        changes["up"] = v / np.linalg.norm(v)
+    if isinstance(opts.floor, str) and opts.floor.strip().lower() in ("auto", "none"):
+        changes["floor"] = None
+        changes["floor_auto"] = opts.floor.strip().lower() == "auto"
+    return replace(opts, **changes) if changes else opts  # type: ignore[arg-type]
 
 
 def check_options(opts: RgbdOptions) -> None:
@@ -357,7 +403,7 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     was written; options and the folder's files are checked before any work, each problem
     a one-line :class:`~sgtool.errors.SgtoolError`."""
     require("cv2", api="sgtool.import_rgbd")  # before any work
-    opts = opts or RgbdOptions()
+    opts = python_options(opts)
     root, out = Path(root), Path(out)
     check_options(opts)
     seq = read_sequence(root, opts.layout, max_dt_ns=opts.max_dt_ns, fps=opts.fps,

@@ -19,6 +19,7 @@ from sgtool.cli import cli
 from sgtool.errors import SgtoolError
 from sgtool.log import LogReader
 from sgtool.log.frame import CameraIntrinsics
+from sgtool.log.records import Instances
 from sgtool.recorders.importers.bag import BagOptions, import_bag
 from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
 from sgtool.recorders.importers.sanity import (
@@ -335,3 +336,47 @@ def test_depth_in_the_other_byte_order_is_named_as_such_not_as_a_scale():
     metres = (mm.astype(np.float32) / 1000).byteswap()
     p = depth_scale_problem([metres], 1.0, "x")
     assert p is not None and "bytes swapped" in p, p
+
+
+def test_python_options_of_another_type_are_one_line_or_taken_as_the_flags_take_them(tmp_path):
+    """import_rgbd from Python: a dict, a number as text, seconds for nanoseconds are one
+    SgtoolError line naming the field (not a TypeError/AttributeError from inside); a
+    trajectory as text, up as an axis or a list, floor 'auto' work as the flags do."""
+    root = make_tum_folder(tmp_path / "f", GOOD_TIMES[:6])
+    for bad, match in ((lambda: import_rgbd(root, tmp_path / "a.mcap", {"every": 2}),
+                        r"^opts: an sgtool.RgbdOptions .*got dict$"),
+                       (lambda: import_rgbd(root, tmp_path / "a.mcap", opts(every="2")),
+                        r"^every='2': a whole number$"),
+                       (lambda: import_rgbd(root, tmp_path / "a.mcap", opts(max_dt_ns=0.02)),
+                        r"^max_dt_ns=0.02: whole nanoseconds"),
+                       (lambda: import_rgbd(root, tmp_path / "a.mcap", opts(up=[0, 0, 0])),
+                        r"^up=\[0, 0, 0\]: three finite numbers"),
+                       (lambda: import_rgbd(root, tmp_path / "a.mcap", opts(trajectory=3)),
+                        r"^trajectory: a file's path, got int$"),
+                       (lambda: import_rgbd(root, tmp_path / "a.mcap",
+                                            opts(trajectory="nope.txt")),
+                        r"^--trajectory nope.txt: no such file$")):
+        with pytest.raises(SgtoolError, match=match):
+            bad()
+    assert not list(tmp_path.glob("a.mcap*"))
+    with pytest.raises(SgtoolError, match=r"^--every 0: must be >= 1$"):  # the flag's range
+        import_rgbd(root, tmp_path / "a.mcap", opts(every=0))
+    given = import_rgbd(root, tmp_path / "b.mcap", opts(
+        trajectory=str(root / "groundtruth.txt"), floor="auto"))
+    assert given.frames == 6
+    as_axis = import_rgbd(root, tmp_path / "c.mcap", opts(up="z"))
+    as_list = import_rgbd(root, tmp_path / "d.mcap", opts(up=[0, 0, 2]))
+    assert as_axis.frames == as_list.frames == 6
+    assert (tmp_path / "c.mcap").read_bytes() == (tmp_path / "d.mcap").read_bytes()
+
+
+def test_bag_instances_given_as_a_path_or_without_depth_say_what_to_give(tmp_path):
+    table = Instances.from_json({"instances": [{"id": 1, "category": "chair",
+                                                "kind": "furniture"}]})
+    with pytest.raises(SgtoolError, match=r"^instances: an sgtool.Instances "
+                       r"\(read_instance_table\(path\).*got str$"):
+        import_bag(tmp_path, tmp_path / "a.mcap", BagOptions(
+            depth="/d", ids="/i", instances="table.json", progress=False))  # type: ignore[arg-type]
+    with pytest.raises(SgtoolError, match=r"^--ids /i --instances: give the depth topic too"):
+        import_bag(tmp_path, tmp_path / "a.mcap", BagOptions(ids="/i", instances=table,
+                                                             progress=False))
