@@ -46,7 +46,9 @@ def _imdecode(data: Any) -> np.ndarray | None:
     return a
 
 
-def _read_image(path: Path) -> np.ndarray:
+def read_image_file(path: Path) -> np.ndarray:
+    """An image file as OpenCV decodes it (depth and channels unchanged: BGR order for
+    colour); one :class:`SgtoolError` line for a missing or undecodable file."""
     if not Path(path).is_file():
         raise SgtoolError(f"{path}: no such image file")
     # decoded from the bytes: cv2.imread takes the name as UTF-8 text and crashes on a
@@ -83,7 +85,7 @@ def read_color_file_kind(path: Path) -> tuple[np.ndarray, str]:
     if Path(path).is_file() and _jpeg_truncated(Path(path)):
         raise SgtoolError(f"{path}: truncated JPEG (no end-of-image marker): the file is cut "
                           "off or damaged")
-    a = _read_image(path)
+    a = read_image_file(path)
     return _to_rgb(a, str(path)), pixel_kind(a)
 
 
@@ -130,7 +132,7 @@ def colour_kind_problem(kind: str, path: Path | str, first: str, first_path: Pat
 def read_depth_file(path: Path) -> np.ndarray:
     """A 16-bit depth image file (PNG/TIFF) -> its raw uint16 values (units per the
     dataset's depth scale)."""
-    a = _read_image(path)
+    a = read_image_file(path)
     if a.ndim == 2 and a.dtype.kind == "f":
         raise SgtoolError(
             f"{path}: a depth image file must be single-channel 16-bit, this one is "

@@ -29,6 +29,7 @@ import numpy as np
 from sgtool.errors import SgtoolError
 from sgtool.extras import require
 from sgtool.log.frame import CameraIntrinsics
+from sgtool.log.records import Instances
 from sgtool.recorders.importers.checks import (
     FPS_RANGE,
     MAX_DT_S,
@@ -48,6 +49,7 @@ from sgtool.recorders.importers.focal_check import (
     ray_depth_problem,
     turn_pairs,
 )
+from sgtool.recorders.importers.folder_ids import id_files, read_ids, unread_ids_note
 from sgtool.recorders.importers.images import (
     ResizeLog,
     colour_kind_problem,
@@ -122,8 +124,9 @@ class RgbdOptions:
     ``fps``, a ``trajectory`` file or ``estimate_poses`` by ``odometry``, ``up`` and
     ``floor`` (None: estimated), ``every``/``limit`` on the frames, ``timestamps``
     (``file``: the listed times; ``index``: n / fps), the poses' ``camera_axes`` and
-    ``world_to_camera`` (:mod:`.pose_axes`). :func:`check_options` checks them before
-    anything is read."""
+    ``world_to_camera`` (:mod:`.pose_axes`), a folder of instance-id images ``ids`` and
+    their table ``instances`` (:mod:`.folder_ids`). :func:`check_options` checks them
+    before anything is read."""
 
     layout: str | None = None
     depth_scale: float | None = None  # raw units per metre; None = the layout's
@@ -149,6 +152,8 @@ class RgbdOptions:
     # the convention of the folder's (or ``trajectory``'s) poses (:mod:`.pose_axes`)
     camera_axes: str = "optical"
     world_to_camera: bool = False
+    ids: Path | None = None  # a folder of instance-id images (:mod:`.folder_ids`)
+    instances: Instances | None = None  # what the ids stand for (:mod:`.instance_table`)
 
 
 def python_options(opts: object) -> RgbdOptions:
@@ -190,6 +195,17 @@ def python_options(opts: object) -> RgbdOptions:
             raise SgtoolError(f"up={up!r}: three finite numbers, not all 0 (or an axis as "
                               "--up takes it: 'z', '-y', 'auto')")
         changes["up"] = v / np.linalg.norm(v)
+    if opts.ids is not None and not isinstance(opts.ids, Path):
+        if not isinstance(opts.ids, str | os.PathLike):
+            raise SgtoolError(f"ids: a folder's path, got {type(opts.ids).__name__}")
+        changes["ids"] = Path(opts.ids)
+    if opts.instances is not None and not isinstance(opts.instances, Instances):
+        raise SgtoolError("instances: an sgtool.Instances (read_instance_table(path) of "
+                          "sgtool.recorders.importers.instance_table reads the JSON file), "
+                          f"got {type(opts.instances).__name__}")
+    if opts.instances is not None and opts.ids is None:
+        raise SgtoolError("--instances is the table of the instance ids: give the folder of "
+                          "the id images too (--ids DIR)")
     if isinstance(opts.floor, str) and opts.floor.strip().lower() in ("auto", "none"):
         changes["floor"] = None
         changes["floor_auto"] = opts.floor.strip().lower() == "auto"
@@ -428,6 +444,8 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         if problem:
             raise SgtoolError(f"{root}: {problem}")
     frames, jumped = _without_placeholders(frames, opts)
+    id_paths = None if opts.ids is None else id_files(opts.ids, [f.depth_path
+                                                                 for f in frames])
     colour = ColourStream.of(frames)
     findings = Findings(opts.warn)
     scale = float(opts.depth_scale if opts.depth_scale is not None else seq.depth_scale)
@@ -468,6 +486,8 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
 
     notes = list(seq.notes) + ([f"{jumped} frame(s) whose poses jump away and come back "
                                  "(placeholders) left out (--allow-drop)"] if jumped else [])
+    unread = unread_ids_note(root) if opts.ids is None else None
+    notes += [unread] if unread else []
     drift: DriftReport | None = None
     odo: OdometryResult | None = None
     reference = drift_reference(seq, opts.trajectory)
@@ -522,7 +542,7 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
         "depth_scale": f"{scale:g}",
         "intrinsics": f"{k.fx:g},{k.fy:g},{k.cx:g},{k.cy:g}",
         **source_metadata(sources),
-        "instance_ids": "absent",
+        "instance_ids": "absent" if opts.ids is None else "present",
         "frames_in_source": str(len(seq.frames)),
         "every": str(opts.every),
         "timestamps": opts.timestamps,
@@ -535,13 +555,15 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
 
     def gen() -> Iterator[ImportFrame]:
         size = (k.width, k.height)
-        for fr, pose in zip(frames, poses, strict=True):
+        for i, (fr, pose) in enumerate(zip(frames, poses, strict=True)):
             raw, rgb = _load(fr, scale, size, colour, resizes)
-            yield ImportFrame(fr.time_ns, depth_for_log(raw, scale), pose, k, rgb=rgb)
+            ids = None if id_paths is None else read_ids(id_paths[i], raw.shape)
+            yield ImportFrame(fr.time_ns, depth_for_log(raw, scale), pose, k, rgb=rgb, ids=ids)
 
     n, has_rgb, has_ids = write_log(out, gen(), alignment=alignment, metadata=meta,
                                     total=len(frames), progress=opts.progress, notes=notes,
-                                    compression=opts.compression, resizes=resizes)
+                                    compression=opts.compression, resizes=resizes,
+                                    instances=opts.instances)
     return ImportReport(
         output=out, source=str(root), kind=f"rgbd/{seq.layout}", frames=n, poses=len(poses),
         alignment=alignment, has_rgb=has_rgb, has_ids=has_ids, pose_source=pose_source,

@@ -363,6 +363,12 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None,
 @click.option("--world-to-camera", is_flag=True,
               help="The poses map the world into the camera (extrinsics, as COLMAP and some "
               "SLAM systems write them), not the camera into the world: each is inverted.")
+@click.option("--ids", type=PathParam(file_okay=False, exists=True), default=None,
+              help="A folder of instance-id images (single-channel integer PNG/TIFF or .npy, "
+              "0: no instance), each named as its depth image and of its size.")
+@click.option("--instances", type=PathParam(dir_okay=False, exists=True), default=None,
+              help="What the --ids stand for: a JSON file, as `import bag --instances` "
+              "takes. Without it the ids are imported and a replay builds geometry only.")
 @_world_options
 @_common_options
 def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bool,
@@ -371,12 +377,16 @@ def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bo
          output: str | None,
          intrinsics: str | None, depth_scale: float | None, max_dt: float, every: int,
          limit: int | None, compression: str, force: bool, allow_drop: bool, as_json: bool,
-         quiet: bool, camera_axes: str, world_to_camera: bool) -> None:
+         quiet: bool, camera_axes: str, world_to_camera: bool, ids: str | None,
+         instances: str | None) -> None:
     """Import an RGB-D image folder (TUM RGB-D, 7-Scenes, Open3D/Redwood, ScanNet export,
     Replica as NICE-SLAM renders it) at FOLDER.
 
     Log times are the dataset's time stamps (TUM) or frame number / --fps. Poses are the
     dataset's (ground truth or trajectory) or estimated by odometry.
+
+    Instance ids of one's own come from a folder of id images (--ids) with the table of
+    what they stand for (--instances).
 
     \b
     Example:
@@ -384,6 +394,7 @@ def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bo
       sgtool import rgbd 7scenes/redkitchen/seq-01 -o kitchen.mcap --estimate-poses
     """
     from sgtool.recorders.importers.checks import parse_height_band
+    from sgtool.recorders.importers.instance_table import read_instance_table
     from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
     from sgtool.recorders.importers.textformats import parse_intrinsics
     from sgtool.recorders.importers.upright import parse_up
@@ -400,5 +411,7 @@ def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bo
         progress=not quiet, compression=compression, timestamps=timestamps,
         skip_missing=skip_missing, camera_height=parse_height_band(camera_height), warn=_warn,
         allow_drop=allow_drop, camera_axes=camera_axes, world_to_camera=world_to_camera,
+        ids=Path(ids) if ids else None,
+        instances=None if instances is None else read_instance_table(instances),
     )
     _print_report(import_rgbd(folder, out, opts), as_json)
