@@ -13,6 +13,7 @@ from sgtool.recorders.importers.bag_index import BagIndex
 from sgtool.recorders.importers.bag_options import BagOptions
 from sgtool.recorders.importers.bag_poses import PoseSource
 from sgtool.recorders.importers.sanity import dropped_problem
+from sgtool.recorders.importers.stamps import nearest_within
 from sgtool.recorders.importers.tftree import frame_name
 
 
@@ -33,24 +34,6 @@ def planned_poses(plan: list[PlannedFrame]) -> list[np.ndarray]:
         assert p.pose is not None, f"depth image {p.k_depth} was planned without a pose"
         poses.append(p.pose)
     return poses
-
-
-def nearest_within(stamps: list[int], order: list[int], t: int, max_dt: int) -> int | None:
-    """Index (into ``stamps``) of the stamp nearest ``t`` within ``max_dt``; ``order`` is
-    the argsort of ``stamps``."""
-    import bisect
-
-    if not stamps:
-        return None
-    sorted_t = [stamps[i] for i in order]
-    j = bisect.bisect_left(sorted_t, t)
-    best = None
-    for jj in (j - 1, j):
-        if 0 <= jj < len(sorted_t):
-            d = abs(sorted_t[jj] - t)
-            if d <= max_dt and (best is None or d < best[0]):
-                best = (d, order[jj])
-    return None if best is None else best[1]
 
 
 def plan_frames(

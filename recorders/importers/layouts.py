@@ -41,15 +41,20 @@ from sgtool.recorders.importers.image_files import (
     natural_key,
     pair_name,
 )
-from sgtool.recorders.importers.pose_files import folder_intrinsics, pose_folder, posed_pairs
+from sgtool.recorders.importers.pose_files import (
+    folder_intrinsics,
+    pose_folder,
+    posed_pairs,
+    seven_scenes_intrinsics,
+)
 from sgtool.recorders.importers.replica_layout import is_replica, read_replica, replica_missing
 from sgtool.recorders.importers.sanity import time_range_problem, timestamp_problem
+from sgtool.recorders.importers.stamps import nearest_within
 from sgtool.recorders.importers.textformats import (
     PinholeParams,
     is_matrix_trajectory,
     is_open3d_log,
     open3d_log_first_frame,
-    read_intrinsics_file,
     read_pose_file,
     read_tum_list,
     read_tum_trajectory,
@@ -200,13 +205,15 @@ def read_sequence(
     keep_unposed: bool = False,
     timestamps: str = "file",
     skip_missing: bool = False,
+    intrinsics_given: bool = False,
 ) -> FolderSequence:
     """List a folder's frames (see the module docstring). ``trajectory`` overrides the
     dataset's pose file (TUM text or Open3D .log); ``keep_unposed`` keeps frames the
     ground truth does not cover (for pose estimation). ``timestamps`` "file" takes the
     listed times (checked: :func:`~.sanity.timestamp_problem`), "index" frame n at n / fps
     in the listed order; ``skip_missing`` leaves out listed files that do not exist
-    (otherwise an error before anything is read)."""
+    (otherwise an error before anything is read); ``intrinsics_given``: the folder's
+    intrinsics files are not read (``--intrinsics`` overrides them, broken or not)."""
     root = Path(root)
     if not root.is_dir():
         raise SgtoolError(f"{root}: no such folder" if not root.exists()
@@ -220,9 +227,9 @@ def read_sequence(
         seq = _read_tum(root, max_dt_ns, trajectory, keep_unposed, timestamps, fps,
                         skip_missing)
     elif layout == "7scenes":
-        seq = _read_7scenes(root, fps, trajectory, skip_missing, keep_unposed)
+        seq = _read_7scenes(root, fps, trajectory, skip_missing, keep_unposed, intrinsics_given)
     elif layout == "open3d":
-        seq = _read_open3d(root, fps, trajectory, skip_missing, keep_unposed)
+        seq = _read_open3d(root, fps, trajectory, skip_missing, keep_unposed, intrinsics_given)
     elif layout == "replica":
         seq = read_replica(root, fps, trajectory)
     else:  # pragma: no cover - missing_for_layout refuses unknown layouts
@@ -242,16 +249,6 @@ def read_sequence(
                                   f"folder also looks like {LAYOUT_NAMES[seen]} "
                                   f"({LAYOUT_FILES[seen]})"))
     return seq
-
-
-def _nearest(times: list[int], t: int) -> int | None:
-    import bisect
-
-    if not times:
-        return None
-    i = bisect.bisect_left(times, t)
-    cands = [j for j in (i - 1, i) if 0 <= j < len(times)]
-    return min(cands, key=lambda j: abs(times[j] - t))
 
 
 def _missing_files(root: Path, lists: dict[str, list[tuple[int, str]]],
@@ -349,9 +346,10 @@ def _read_tum(
 
 
 def _colour_near(root: Path, rgb: list[tuple[int, str]], t: int, max_dt_ns: int) -> Path | None:
-    """The colour image of ``rgb`` nearest to time ``t``, within ``max_dt_ns``."""
-    j = _nearest([r for r, _ in rgb], t)
-    return root / rgb[j][1] if j is not None and abs(rgb[j][0] - t) <= max_dt_ns else None
+    """The colour image of ``rgb`` (in time order) nearest to time ``t``, within
+    ``max_dt_ns``."""
+    j = nearest_within([r for r, _ in rgb], list(range(len(rgb))), t, max_dt_ns)
+    return None if j is None else root / rgb[j][1]
 
 
 def _read_tum_log_poses(root: Path, rgb: list[tuple[int, str]], depth: list[tuple[int, str]],
@@ -419,8 +417,8 @@ def _seven_missing(root: Path, by_id: dict[int, dict[str, Path]],
     return keep, [f"skipped {len(lacking)} frames without depth or colour (first: {first})"]
 
 
-def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
-                  skip_missing: bool = False, keep_unposed: bool = False) -> FolderSequence:
+def _read_7scenes(root: Path, fps: float, trajectory: Path | None, skip_missing: bool = False,
+                  keep_unposed: bool = False, intrinsics_given: bool = False) -> FolderSequence:
     """Frames ``frame-XXXXXX.*`` in id order; frames without a pose.txt (when others have
     one) are kept to be estimated (``keep_unposed``) or left out and counted as dropped,
     as a TUM ground truth that does not cover them."""
@@ -440,10 +438,7 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
         elif "pose" in files and not untracked_pose(files["pose"]):
             pose = read_pose_file(files["pose"])
         frames.append(FolderFrame(round(i * 1e9 / fps), files["depth"], files.get("color"), pose))
-    intr = SEVEN_SCENES_INTRINSICS
-    if (root / "camera-intrinsics.txt").is_file():
-        intr = replace(read_intrinsics_file(root / "camera-intrinsics.txt"),
-                       source="file camera-intrinsics.txt")
+    intr = seven_scenes_intrinsics(root, SEVEN_SCENES_INTRINSICS, given=intrinsics_given)
     posed = sum(f.pose is not None for f in frames)
     dropped = 0
     if 0 < posed < len(frames):
@@ -459,8 +454,8 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None,
                           dropped=dropped)
 
 
-def _read_open3d(root: Path, fps: float, trajectory: Path | None,
-                 skip_missing: bool = False, keep_unposed: bool = False) -> FolderSequence:
+def _read_open3d(root: Path, fps: float, trajectory: Path | None, skip_missing: bool = False,
+                 keep_unposed: bool = False, intrinsics_given: bool = False) -> FolderSequence:
     """Depth images of ``depth/`` and colour images of the colour folder, paired by name
     (else in order when every name differs); a depth image without a colour image of its
     name (a lab that dropped bad colour frames) is a frame without colour, with a note:
@@ -585,7 +580,7 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None,
             poses = [*poses, *([None] * late)]
         else:
             dropped, pairs = dropped + late, pairs[:len(poses)]
-    intr = folder_intrinsics(root, PRIMESENSE_INTRINSICS, notes)
+    intr = folder_intrinsics(root, PRIMESENSE_INTRINSICS, notes, given=intrinsics_given)
     frames = tuple(
         FolderFrame(round((slot[d] if slot else i) * 1e9 / fps), d, c,
                     poses[i] if poses is not None else None)

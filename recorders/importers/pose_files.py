@@ -91,13 +91,26 @@ INTRINSICS_TEXTS = frozenset({"intrinsic", "intrinsics", "camera_intrinsic", "ca
                               "intrinsic_depth", "intrinsic_color", "depth_intrinsics"})
 
 
-def folder_intrinsics(root: Path, default: PinholeParams,
-                      notes: list[str]) -> PinholeParams | None:
+def seven_scenes_intrinsics(root: Path, default: PinholeParams, *,
+                            given: bool = False) -> PinholeParams:
+    """A 7-Scenes folder's ``camera-intrinsics.txt`` (a 3x3 camera matrix), else
+    ``default``; not read when the intrinsics are ``given`` (``--intrinsics``)."""
+    path = root / "camera-intrinsics.txt"
+    if given or not path.is_file():
+        return default
+    return replace(read_intrinsics_file(path), source="file camera-intrinsics.txt")
+
+
+def folder_intrinsics(root: Path, default: PinholeParams, notes: list[str], *,
+                      given: bool = False) -> PinholeParams | None:
     """The depth camera's intrinsics of a folder (each file read as ``--intrinsics FILE``
     reads one): ``intrinsic/intrinsic_depth.txt`` (module doc), else an intrinsics JSON
     or a text file of :data:`INTRINSICS_TEXTS` beside the images (any case), else
     ``default``; None, with a note, for a ScanNet export with only the colour camera's
-    ``intrinsic/intrinsic_color.txt`` (no default is that camera's)."""
+    ``intrinsic/intrinsic_color.txt`` (no default is that camera's). None of them is read
+    when the intrinsics are ``given`` (``--intrinsics``): ``default``."""
+    if given:
+        return default
     path = root / INTRINSICS_FILE
     if path.is_file():
         return replace(read_intrinsics_file(path), source=f"file {INTRINSICS_FILE}")

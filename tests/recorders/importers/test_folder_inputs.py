@@ -695,6 +695,17 @@ def test_other_names_of_an_intrinsics_file_are_read(tmp_path: Path, name: str) -
     assert read_sequence(root).intrinsics.fx == 600.0
 
 
+def test_a_broken_intrinsics_file_is_not_read_when_the_intrinsics_are_given(
+        tmp_path: Path) -> None:
+    """--intrinsics overrides what the folder says: a folder whose intrinsics file does not
+    read was refused all the same (an outside lab's 7-Scenes copy)."""
+    root = open3d_folder(tmp_path / "f", [str(i) for i in range(3)])
+    (root / "camera-intrinsics.txt").write_text("600 0 16\n0 600\n")  # a row cut short
+    with pytest.raises(SgtoolError, match=r"camera-intrinsics\.txt"):
+        read_sequence(root)
+    assert read_sequence(root, intrinsics_given=True).frames
+
+
 @pytest.mark.parametrize("numbers", [16, 12])
 def test_a_trajectory_of_a_matrix_a_line_poses_the_frames(tmp_path, numbers: int) -> None:
     """NICE-SLAM's Replica renders keep their poses as traj.txt, a 4x4 matrix a line (KITTI

@@ -25,6 +25,7 @@ from sgtool.recorders.importers.odometry import drift_against
 from sgtool.recorders.importers.rgbd import RgbdOptions, import_rgbd
 from sgtool.recorders.importers.sink import IMPORT_METADATA
 from sgtool.recorders.importers.textformats import (
+    PinholeParams,
     parse_intrinsics,
     read_open3d_log,
     read_tum_trajectory,
@@ -449,6 +450,19 @@ def test_7scenes_names_in_upper_case_are_read(rgbd_data, tmp_path):
     assert detect_layout(folder) == "7scenes"
     rep = import_rgbd(folder, tmp_path / "u.mcap", RgbdOptions(**QUIET))
     assert rep.frames == 10
+
+
+def test_7scenes_broken_intrinsics_file_gives_way_to_the_flag(rgbd_data, tmp_path):
+    """A 7-Scenes copy whose camera-intrinsics.txt does not read: refused (naming it) unless
+    --intrinsics is given, which overrides what the folder says."""
+    folder = tmp_path / "k"
+    shutil.copytree(rgbd_data / "7scenes-redkitchen-every10", folder)
+    (folder / "camera-intrinsics.txt").write_text("585 0 320\n")
+    with pytest.raises(SgtoolError, match=r"camera-intrinsics\.txt"):
+        import_rgbd(folder, tmp_path / "a.mcap", RgbdOptions(limit=3, **QUIET))
+    rep = import_rgbd(folder, tmp_path / "b.mcap", RgbdOptions(
+        limit=3, intrinsics=PinholeParams(585.0, 585.0, 320.0, 240.0), **QUIET))
+    assert rep.frames == 3
 
 
 def icl_with_poses(rgbd_data: Path, folder: Path, change) -> Path:
