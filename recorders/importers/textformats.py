@@ -237,8 +237,10 @@ def checked_pinhole(fx: float, fy: float, cx: float, cy: float, what: str, *,
 
 
 def read_intrinsics_file(path: Path) -> PinholeParams:
-    """Open3D intrinsic JSON or a 3x3 matrix text file (or a 4x4 with it in the top-left
-    corner and the identity's other entries, as ScanNet writes it)."""
+    """Open3D intrinsic JSON, a 3x3 matrix text file (or a 4x4 with it in the top-left
+    corner and the identity's other entries, as ScanNet writes it), or a text file of the
+    four numbers ``fx fy cx cy`` as ``--intrinsics`` takes them (one line, spaces or
+    commas)."""
     if path.suffix.lower() == ".json":
         try:
             d = json.loads(path.read_text(encoding="utf-8-sig"))
@@ -267,14 +269,19 @@ def read_intrinsics_file(path: Path) -> PinholeParams:
                        delimiter="," if "," in data else None)
     except ValueError:
         raise SgtoolError(f"{path}: expected a 3x3 camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]] "
-                          "(three rows of three numbers), or Open3D intrinsics JSON") from None
+                          "(three rows of three numbers), the four numbers fx fy cx cy, or "
+                          "Open3D intrinsics JSON") from None
+    if m.size == 4 and m.ndim == 1:  # fx fy cx cy, as --intrinsics takes them
+        fx, fy, cx, cy = (float(v) for v in m)
+        return checked_pinhole(fx, fy, cx, cy, str(path), source=str(path.name))
     if m.shape == (4, 4) and np.allclose(m[3], [0, 0, 0, 1]) and np.allclose(m[:3, 3], 0):
         m = m[:3, :3]  # ScanNet's intrinsic_*.txt: the camera matrix in a 4x4's corner
     if m.shape == (3, 3) and _transposed(m):
         raise SgtoolError(f"{path}: a 3x3 camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]] "
                           "written transposed (cx, cy in its last row): transpose it")
     if m.shape != (3, 3) or abs(m[2, 2] - 1.0) > 1e-6 or m[0, 0] <= 0 or m[1, 1] <= 0:
-        raise SgtoolError(f"{path}: expected a 3x3 camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]]")
+        raise SgtoolError(f"{path}: expected a 3x3 camera matrix [[fx 0 cx] [0 fy cy] [0 0 1]], "
+                          "the four numbers fx fy cx cy, or Open3D intrinsics JSON")
     return checked_pinhole(m[0, 0], m[1, 1], m[0, 2], m[1, 2], str(path),
                            source=str(path.name))
 

@@ -254,8 +254,8 @@ def test_an_intrinsics_file_of_another_shape_says_what_it_should_hold(tmp_path):
     with pytest.raises(SgtoolError) as err:
         read_intrinsics_file(bad)
     assert str(err.value) == (f"{bad}: expected a 3x3 camera matrix [[fx 0 cx] [0 fy cy] "
-                              "[0 0 1]] (three rows of three numbers), or Open3D intrinsics "
-                              "JSON")
+                              "[0 0 1]] (three rows of three numbers), the four numbers fx fy "
+                              "cx cy, or Open3D intrinsics JSON")
 
 
 def test_time_stamps_in_milliseconds_are_named_so():

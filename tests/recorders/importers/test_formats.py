@@ -99,6 +99,16 @@ def test_intrinsics_from_json_matrix_and_text(tmp_path: Path):
     assert (p.fx, p.fy, p.cx, p.cy) == (585, 586, 320, 240)
     p = textformats.parse_intrinsics("500, 501, 320.5, 240")
     assert (p.fx, p.fy, p.cx, p.cy) == (500, 501, 320.5, 240)
+    # the same four numbers in a file (an outside lab's intrinsics.txt), as the flag takes
+    for text in ("500 501 320.5 240\n", "500,501,320.5,240\n", "# fx fy cx cy\n500 501 320.5 240"):
+        four = tmp_path / "four.txt"
+        four.write_text(text)
+        p = textformats.read_intrinsics_file(four)
+        assert (p.fx, p.fy, p.cx, p.cy, p.source) == (500, 501, 320.5, 240, "four.txt")
+    four.write_text("500 501 320.5\n")
+    with pytest.raises(SgtoolError, match=r"four\.txt: expected a 3x3 camera matrix .*, the four "
+                       r"numbers fx fy cx cy, or Open3D intrinsics JSON"):
+        textformats.read_intrinsics_file(four)
     with pytest.raises(SgtoolError, match="fx,fy,cx,cy"):
         textformats.parse_intrinsics("500,501")
 
