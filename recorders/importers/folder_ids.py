@@ -33,8 +33,9 @@ def id_files(folder: Path, depth_files: Sequence[Path]) -> list[Path]:
                                                   else "not a folder (give the folder of "
                                                   "the id images)"))
     by_stem: dict[str, Path] = {}
-    for p in sorted(folder.iterdir()):
-        if p.suffix.lower() in SUFFIXES and p.is_file():
+    ours = [p for p in folder.iterdir() if p.suffix.lower() in SUFFIXES]
+    for p in sorted(ours, key=lambda p: (SUFFIXES.index(p.suffix.lower()), p.name)):
+        if p.is_file():
             by_stem.setdefault(p.stem, p)
     missing = [d for d in depth_files if d.stem not in by_stem]
     if missing:
@@ -57,6 +58,10 @@ def read_ids(path: Path, shape: tuple[int, int]) -> np.ndarray:
             raise SgtoolError(f"{path}: cannot read it as a NumPy array ({e})") from None
     else:
         a = read_image_file(path)
+    if a.ndim != 2 and _palette_png(path):
+        raise SgtoolError(f"{path}: a palette (indexed-colour) PNG, whose colours OpenCV "
+                          "reads, not its indices: save the ids as a greyscale 8- or 16-bit "
+                          "PNG (or .npy)")
     if a.ndim != 2 or a.dtype.kind not in "ui":
         raise SgtoolError(f"{path}: an id image must be single-channel integers (8, 16 or "
                           f"32 bit), this one is {a.dtype} with shape {a.shape}")
@@ -67,6 +72,16 @@ def read_ids(path: Path, shape: tuple[int, int]) -> np.ndarray:
             a.size and int(a.max()) > np.iinfo(np.int32).max:
         raise SgtoolError(f"{path}: ids must be 0 (no instance) or positive 32-bit numbers")
     return a.astype(np.int32)
+
+
+def _palette_png(path: Path) -> bool:
+    """Whether ``path`` is a PNG of indexed colour (IHDR colour type 3)."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(26)
+    except OSError:
+        return False
+    return head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR" and head[25] == 3
 
 
 def unread_ids_note(root: Path) -> str | None:

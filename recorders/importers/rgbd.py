@@ -172,10 +172,13 @@ def python_options(opts: object) -> RgbdOptions:
     assert isinstance(opts, RgbdOptions)
     whole("every", opts.every)  # the range: check_options, naming the flag
     whole("limit", opts.limit, optional=True)
-    if isinstance(opts.max_dt_ns, bool) or not isinstance(opts.max_dt_ns, int | np.integer):
+    changes: dict[str, object] = {}
+    dt: object = opts.max_dt_ns
+    if isinstance(dt, float) and dt.is_integer():
+        changes["max_dt_ns"] = int(dt)  # 2e7 nanoseconds, as before
+    elif isinstance(opts.max_dt_ns, bool) or not isinstance(opts.max_dt_ns, int | np.integer):
         raise SgtoolError(f"max_dt_ns={opts.max_dt_ns!r}: whole nanoseconds (--max-dt 0.02 "
                           "is max_dt_ns=20_000_000)")
-    changes: dict[str, object] = {}
     traj = opts.trajectory
     if traj is not None and not isinstance(traj, Path):
         if not isinstance(traj, str | os.PathLike):

@@ -166,9 +166,11 @@ def fitting_scales(raw: Sequence[np.ndarray], scale: float) -> list[tuple[float,
 
 def roughness(raw: Sequence[np.ndarray]) -> float:
     """How much valid depth changes from a pixel to its right-hand neighbour, relative to
-    its size: the median of ``|a - b| / (a + b)`` over the pairs of valid pixels (0 for a
-    flat image; depth of real surfaces changes little from pixel to pixel, bytes read in
-    the wrong order make it jump)."""
+    its size: the median of ``|a - b| / (a + b)`` over the pairs of valid pixels that
+    differ (0 for a flat image; depth of real surfaces changes little from pixel to pixel,
+    bytes read in the wrong order make it jump). Equal pairs are left out: they are equal
+    in either byte order, and a Kinect's quantised depth has more of them than not (its
+    median would be 0 both ways)."""
     parts = []
     for a in raw:
         a = np.asarray(a, dtype=np.float64)
@@ -176,7 +178,7 @@ def roughness(raw: Sequence[np.ndarray]) -> float:
             continue
         left, right = a[:, :-1], a[:, 1:]
         ok = (left > 0) & (right > 0) & np.isfinite(left) & np.isfinite(right) \
-            & (left != 65535) & (right != 65535)
+            & (left != 65535) & (right != 65535) & (left != right)
         parts.append((np.abs(left - right)[ok] / (left + right)[ok]).ravel())
     v = np.concatenate(parts) if parts else np.zeros(0)
     return float(np.median(v)) if len(v) else 0.0
@@ -218,7 +220,8 @@ def depth_scale_problem(raw: Sequence[np.ndarray], scale: float, origin: str) ->
         at = "" if k == scale else f" at --depth-scale {k:g}"
         fix = (f"with each value's bytes swapped it is smooth indoor depth (median "
                f"{fs.median_m:.2f} m{at}): the images are in the other byte order than they "
-               "say (a ROS Image's is_bigendian flag); write them with the right flag")
+               "say (a ROS Image's is_bigendian flag, or files written with their bytes "
+               "swapped); write them in the right order")
     elif fits:
         k, fs = fits[0]
         also = ", ".join(f"{a:g} (median {f.median_m:.2f} m)" for a, f in fits[1:])

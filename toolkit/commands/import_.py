@@ -134,8 +134,9 @@ _common_options = option_group([
     click.option("-o", "--output", type=PathParam(dir_okay=False),
                  help="The sgtool log to write (OUT.mcap)."),
     click.option("--intrinsics", default=None,
-                 help="Camera intrinsics 'fx,fy,cx,cy' in pixels, or a file (Open3D JSON "
-                 "or a 3x3 matrix as text); overrides what the source says."),
+                 help="Camera intrinsics 'fx,fy,cx,cy' in pixels, or a file (Open3D JSON, "
+                 "a 3x3 matrix as text, or the four numbers fx fy cx cy); overrides what the "
+                 "source says."),
     click.option("--depth-scale", type=float, default=None,
                  help="Raw depth units per metre (default: 16-bit depth 1000 for bags "
                  "and 7-Scenes/Open3D, 5000 for TUM; a bag's 32FC1 float depth 1, metres; "

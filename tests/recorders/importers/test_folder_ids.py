@@ -98,3 +98,28 @@ def test_id_images_that_do_not_fit_are_one_line(tmp_path) -> None:
                        r"give the folder of the id images too \(--ids DIR\)$"):
         import_rgbd(root, tmp_path / "a.mcap",
                     RgbdOptions(intrinsics=K, progress=False, instances=table))
+
+
+def test_a_palette_png_of_ids_says_to_save_them_grey(tmp_path) -> None:
+    """Label tools save masks as palette (indexed-colour) PNGs, one channel of indices;
+    OpenCV expands them to colour, and the message called the file a colour image."""
+    import zlib
+    from pathlib import Path
+
+    from sgtool.recorders.importers.folder_ids import read_ids
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return (len(data).to_bytes(4, "big") + kind + data
+                + zlib.crc32(kind + data).to_bytes(4, "big"))
+
+    h, w = 3, 4
+    rows = b"".join(b"\x00" + bytes([0, 1, 2, 1]) for _ in range(h))
+    png = (b"\x89PNG\r\n\x1a\n"
+           + chunk(b"IHDR", w.to_bytes(4, "big") + h.to_bytes(4, "big") + bytes([8, 3, 0, 0, 0]))
+           + chunk(b"PLTE", bytes([0, 0, 0, 255, 0, 0, 0, 255, 0]))
+           + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+    path = Path(tmp_path / "0000.png")
+    path.write_bytes(png)
+    with pytest.raises(SgtoolError, match=r"0000.png: a palette \(indexed-colour\) PNG, whose "
+                       r"colours OpenCV reads, not its indices: save the ids as a greyscale"):
+        read_ids(path, (h, w))
