@@ -384,10 +384,13 @@ def _run(reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
 def unposed_note(feed: _Feed) -> str | None:
     """One line for the frames left out without a camera pose (before the first /tf, a
     chain broken); an error when no frame had one."""
-    if not feed.unposed:
-        return None
     why = (f"{S.TF} has no chain from '{S.WORLD_FRAME}' to the depth image's frame (sgtool's "
            f"logs name them '{S.WORLD_FRAME}' and '{S.CAMERA_FRAME}') at their time")
+    if not feed.report.frames and not feed.report.truncated and feed.stale_out:
+        raise LogFormatError(f"{feed.reader.path}: no frame has a camera pose: "
+                             f"{feed.asm.stale.note()}")
+    if not feed.unposed:
+        return None
     if not feed.report.frames and not feed.report.truncated:
         raise LogFormatError(f"{feed.reader.path}: no frame has a camera pose: {why}")
     return f"{feed.unposed} frame(s) without a camera pose left out: {why}"
@@ -429,7 +432,7 @@ class _Feed:
         self.frame_topics = set(FRAME_TOPICS)
         self.needed = self.frame_topics | {_INSTANCES, _ACTION}
         self.copied: dict[int, int] = {}  # input channel id -> output channel id
-        self.asm = FrameAssembler(where=str(reader.path), tf_time=tf_time)
+        self.asm = FrameAssembler(where=str(reader.path), tf_time=tf_time, drop_stale=True)
         self.last_t = 0
         # instance tables and actions of one log time, held until that time's messages
         # are all in (:meth:`settle`): MCAP orders no messages of one time
@@ -437,6 +440,7 @@ class _Feed:
         # records of earlier times waiting for their frames (held for a later /tf)
         self.queue: collections.deque[tuple[int, Instances | None]] = collections.deque()
         self.unposed = 0  # frames without a camera pose, left out
+        self.stale_out = 0  # frames left out whose pose would come from a stale /tf
 
     def refreshed(self, r: Refresh | None) -> None:
         if r is None:
@@ -459,7 +463,10 @@ class _Feed:
                 return False
             self._records(before=fr.time_ns)
             if not np.isfinite(fr.pose).all():
-                self.unposed += 1
+                if fr.index in self.asm.stale_left_out:
+                    self.stale_out += 1
+                else:
+                    self.unposed += 1
                 continue
             report.frames += 1
             if self.progress is not None:

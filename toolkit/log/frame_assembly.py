@@ -211,19 +211,29 @@ class StalePoses:
     count: int = 0
     worst_ns: int = 0
     worst_at_ns: int = 0
+    left_out: bool = False  # the frames were left out (unposed), not posed stale
 
-    def add(self, age_ns: int, t_ns: int) -> None:
+    def add(self, age_ns: int, t_ns: int) -> bool:
+        """Count a frame whose pose is ``age_ns`` old; True when it is stale."""
         if age_ns <= STALE_NS:
-            return
+            return False
         self.count += 1
         if age_ns > self.worst_ns:
             self.worst_ns, self.worst_at_ns = age_ns, t_ns
+        return True
 
     def note(self, where: str = "") -> str | None:
-        """One line when any frame was posed from a stale ``/tf``, else None."""
+        """One line when any frame was posed from a stale ``/tf`` (or left out for it),
+        else None."""
         if not self.count:
             return None
         prefix = f"{where}: " if where else ""
+        if self.left_out:
+            return (f"{prefix}{self.count} frame(s) left out: their camera pose would come "
+                    f"from a {S.TF} sample older than the image (up to "
+                    f"{self.worst_ns / 1e9:.3f} s, at log time {self.worst_at_ns} ns; "
+                    f"{S.TF} samples more than {MAX_GAP_NS / 1e9:g} s apart are a dropout, "
+                    "not interpolated), which misplaces their points where the camera moved")
         return (f"{prefix}{self.count} frame(s) took a camera pose from a {S.TF} sample "
                 f"older than the image (up to {self.worst_ns / 1e9:.3f} s, at log time "
                 f"{self.worst_at_ns} ns; no later {S.TF} came within "
@@ -273,11 +283,15 @@ class FrameAssembler:
     time) a ``/tf`` header stamp more than :data:`TF_STAMP_REFUSE_S` from its log time.
 
     ``tf_time`` (one of :data:`TF_TIMES`) is the time that pairs ``/tf`` with frames
-    (module doc); :attr:`tf_offsets` sums up how far the stamps lie from the log times."""
+    (module doc); :attr:`tf_offsets` sums up how far the stamps lie from the log times.
+    ``drop_stale``: a frame whose pose would come from a stale ``/tf`` sample (older than
+    :data:`STALE_NS`: a ``/tf`` dropout longer than :data:`MAX_GAP_NS`, or a ``/tf`` that
+    stopped) gets no pose (NaN, as a frame /tf does not pose), so a mapper leaves it out
+    rather than putting its whole depth image where the camera was seconds before."""
 
     def __init__(self, index: int = 0, transforms: TransformBuffer | None = None,
                  calibration: CameraIntrinsics | None = None, where: str = "",
-                 tf_time: str = "log") -> None:
+                 tf_time: str = "log", drop_stale: bool = False) -> None:
         if tf_time not in TF_TIMES:
             raise ValueError(f"tf_time must be one of {', '.join(TF_TIMES)}, not {tf_time!r}")
         self.index = index
@@ -292,7 +306,8 @@ class FrameAssembler:
         # frames waiting for /tf: the frame, its pose's time, the camera's frame id and the
         # links of its camera and base chains as read when it was assembled
         self._held: list[tuple[Frame, int, str, tuple[_Snapshot, _Snapshot]]] = []
-        self.stale = StalePoses()
+        self.stale = StalePoses(left_out=drop_stale)
+        self.stale_left_out: set[int] = set()  # indices of the frames drop_stale left out
 
     def tf_stamp_note(self) -> str | None:
         """One line when ``/tf`` stamps disagreed with their log times beyond
@@ -372,7 +387,10 @@ class FrameAssembler:
             if found is None:
                 out.append(fr)  # (its pose is NaN: no chain at its time)
                 continue
-            self.stale.add(found[1], fr.time_ns)
+            if self.stale.add(found[1], fr.time_ns) and self.stale.left_out:
+                self.stale_left_out.add(fr.index)
+                out.append(fr)  # (its pose is NaN: left out, not posed from a stale /tf)
+                continue
             base = self.transforms.resolve(at, S.BASE_FRAME, snapshot=snaps[1])
             out.append(dataclasses.replace(fr, pose=found[0],
                                            base_pose=None if base is None else base[0]))

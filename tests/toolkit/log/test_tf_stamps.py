@@ -122,11 +122,14 @@ def test_replay_warns_refuses_and_takes_the_choice(tmp_path):
     assert CliRunner().invoke(cli, ["replay", str(early)]).exit_code == 2
     out = tmp_path / "derived.mcap"
     r = CliRunner().invoke(cli, ["replay", str(early), "--tf-time", "stamp", "-o", str(out)])
-    assert r.exit_code == 0, r.output
     assert "header stamps" not in r.output  # the user's choice: no offset warning, but
-    # each frame's pose comes from a transform stamped 2 s before its image, and is told
-    assert "6 frame(s) took a camera pose from a /tf sample older than the image (up to " \
-        "2.000 s" in r.output
+    # each frame's pose would come from a transform stamped 2 s before its image: left out
+    assert r.exit_code == 2, r.output
+    assert "no frame has a camera pose: 6 frame(s) left out: their camera pose would come " \
+        "from a /tf sample older than the image (up to 2.000 s" in r.output
+    half = tf_log(tmp_path / "half.mcap", -0.25)  # by stamps, poses a quarter second old
+    r = CliRunner().invoke(cli, ["replay", str(half), "--tf-time", "stamp", "-o", str(out)])
+    assert r.exit_code == 0, r.output
     with LogReader(out) as d:
         assert d.metadata["sgtool.replay"]["tf_time"] == "stamp"
 

@@ -86,17 +86,51 @@ def test_a_log_without_any_transform_is_refused(tmp_path):
         replay(log, None)
 
 
-def test_a_transform_that_stops_gives_stale_poses_and_says_so(tmp_path):
-    """/tf stops after 10 s while the camera goes on: the frames after take the last
-    transforms (the only ones there are) and a warning names how old they were."""
+def test_a_transform_that_stops_leaves_its_frames_out_and_says_so(tmp_path):
+    """/tf stops after 10 s while the camera goes on: the frames after would take the last
+    transforms (the only ones there are), seconds old; they are left out and a warning
+    names how old those transforms were. The reader still poses them (stale)."""
     topics = _topics()
     log = rewrite(START, tmp_path / "stops.mcap", Variant(
         order=lambda ms: [m for m in ms if not (topics[m.channel_id] == S.TF
                                                 and m.log_time > 10 * 10**9)]))
     report = replay(log, None)
-    assert report.frames == 110
     (note,) = [w for w in report.warnings if "older than the image" in w]
-    assert note.split(" frame(s)")[0].isdigit()
+    n = int(note.split(" frame(s)")[0].split(": ")[-1])
+    assert "left out" in note and n > 0 and report.frames == 110 - n
+    assert np.isfinite(poses(log)).all()
+
+
+def tf_gaps(every: int, gap: int):
+    """Every ``every``-th frame starts a /tf dropout of ``gap`` frames (images kept)."""
+    topics = _topics()
+
+    def order(messages):
+        times = sorted({m.log_time for m in messages if topics[m.channel_id] == S.DEPTH})
+        lost = {t for k, t in enumerate(times) if k % every >= every - gap}
+        return [m for m in messages if not (topics[m.channel_id] == S.TF and m.log_time in lost)]
+    return order
+
+
+def test_frames_in_a_tf_dropout_are_left_out_not_posed_where_the_robot_was(tmp_path):
+    """/tf lost for 4 frames (over 1 s at 3 Hz) in every 10 while the camera goes on: the
+    frames in a dropout are left out, as frames without images would be, instead of
+    taking the pose of the last transform before it (the robot turned and drove on
+    meanwhile). Their rooms are those of the same log without those frames' images."""
+    topics = _topics()
+    lost_tf = rewrite(START, tmp_path / "gaps.mcap", Variant(order=tf_gaps(10, 4)))
+
+    def without_images(messages):
+        with_tf = {m.log_time for m in tf_gaps(10, 4)(messages) if topics[m.channel_id] == S.TF}
+        return [m for m in messages if topics[m.channel_id] not in IMAGES
+                or m.log_time in with_tf]
+    lost_images = rewrite(START, tmp_path / "frames.mcap", Variant(order=without_images))
+    a, b = replay(lost_tf, None), replay(lost_images, None)
+    assert a.frames == b.frames < 110
+    assert a.last is not None and b.last is not None
+    assert len(a.last.graph.rooms) == len(b.last.graph.rooms)
+    (note,) = [w for w in a.warnings if "older than the image" in w]
+    assert note.startswith(f"{110 - a.frames} frame(s) left out")
 
 
 TOUR = GOLDEN / "house6-tour.mcap"
@@ -162,15 +196,18 @@ def test_a_link_sent_once_on_tf_waits_for_no_later_sample(tmp_path):
 
 
 def test_the_frame_budget_counts_frames_held_for_their_transform(tmp_path):
-    """--max-frames 40 on a log whose /tf stops at 10 s (frames held, then posed from the
-    last transforms): 40 frames integrated and 40 depth images in the derived log."""
+    """--max-frames 40 on a log whose /tf stops at 10 s (frames held, then left out, their
+    pose stale): 40 frames read, those after the stop left out, and 40 depth images in the
+    derived log."""
     topics = _topics()
     log = rewrite(START, tmp_path / "stops.mcap", Variant(
         order=lambda ms: [m for m in ms if not (topics[m.channel_id] == S.TF
                                                 and m.log_time > 10 * 10**9)]))
     out = tmp_path / "derived.mcap"
     report = replay(log, out, ReplayOptions(max_frames=40))
-    assert report.frames == 40 and report.truncated
+    (note,) = [w for w in report.warnings if "older than the image" in w]
+    left_out = int(note.split(" frame(s)")[0])
+    assert report.frames + left_out == 40 and 0 < left_out < 40 and report.truncated
     with LogReader(out) as r:
         assert r.message_count(S.DEPTH) == 40
 
