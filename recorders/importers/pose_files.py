@@ -109,18 +109,16 @@ def folder_intrinsics(root: Path, default: PinholeParams, notes: list[str], *,
     ``default``; None, with a note, for a ScanNet export with only the colour camera's
     ``intrinsic/intrinsic_color.txt`` (no default is that camera's). None of them is read
     when the intrinsics are ``given`` (``--intrinsics``): ``default``."""
-    if given:
-        return default
     path = root / INTRINSICS_FILE
-    if path.is_file():
+    if path.is_file() and not given:
         return replace(read_intrinsics_file(path), source=f"file {INTRINSICS_FILE}")
     texts = sorted((p for p in root.iterdir() if p.suffix.lower() == ".txt"  # .TXT too
                     and p.stem.lower().replace("-", "_") in INTRINSICS_TEXTS),
                    key=lambda p: ("depth" not in p.stem.lower(), p.name))  # depth's first
-    for p in [*sorted(root.glob("*.json")), *texts]:
+    for p in [] if given else [*sorted(root.glob("*.json")), *texts]:
         if p.suffix != ".json" or is_intrinsics_json(p):
             return replace(read_intrinsics_file(p), source=f"file {p.name}")
-    if (root / "intrinsic" / "intrinsic_color.txt").is_file():
+    if not path.is_file() and (root / "intrinsic" / "intrinsic_color.txt").is_file():
         notes.append("intrinsic/intrinsic_color.txt not read: the colour camera's, not the "
                      "depth images' (intrinsic/intrinsic_depth.txt)")
         return None

@@ -373,21 +373,18 @@ def _bag_options(*, depth: str | None, rgb: str | None, ids: str | None,
 @_world_options
 @_common_options
 def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bool,
-         trajectory: str | None, estimate_poses: bool,
-         odometry: str, depth_max: float, up: str, floor: str, camera_height: str,
-         output: str | None,
-         intrinsics: str | None, depth_scale: float | None, max_dt: float, every: int,
-         limit: int | None, compression: str, force: bool, allow_drop: bool, as_json: bool,
-         quiet: bool, camera_axes: str, world_to_camera: bool, ids: str | None,
-         instances: str | None) -> None:
+         trajectory: str | None, estimate_poses: bool, odometry: str, depth_max: float,
+         up: str, floor: str, camera_height: str, output: str | None, intrinsics: str | None,
+         depth_scale: float | None, max_dt: float, every: int, limit: int | None,
+         compression: str, force: bool, allow_drop: bool, as_json: bool, quiet: bool,
+         camera_axes: str, world_to_camera: bool, ids: str | None, instances: str | None
+         ) -> None:
     """Import an RGB-D image folder (TUM RGB-D, 7-Scenes, Open3D/Redwood, ScanNet export,
     Replica as NICE-SLAM renders it) at FOLDER.
 
     Log times are the dataset's time stamps (TUM) or frame number / --fps. Poses are the
-    dataset's (ground truth or trajectory) or estimated by odometry.
-
-    Instance ids of one's own come from a folder of id images (--ids) with the table of
-    what they stand for (--instances).
+    dataset's (ground truth or trajectory) or estimated by odometry; instance ids come
+    from a folder of id images (--ids) with the table of what they stand for.
 
     \b
     Example:
@@ -400,8 +397,7 @@ def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bo
     from sgtool.recorders.importers.textformats import parse_intrinsics
     from sgtool.recorders.importers.upright import parse_up
 
-    out = _output(output, force)
-    fl, floor_auto = _floor(floor)
+    out, (fl, floor_auto) = _output(output, force), _floor(floor)
     opts = RgbdOptions(
         layout=None if layout == "auto" else layout, depth_scale=depth_scale,
         intrinsics=parse_intrinsics(intrinsics) if intrinsics else None, fps=fps,
@@ -412,7 +408,7 @@ def rgbd(folder: str, layout: str, fps: float, timestamps: str, skip_missing: bo
         progress=not quiet, compression=compression, timestamps=timestamps,
         skip_missing=skip_missing, camera_height=parse_height_band(camera_height), warn=_warn,
         allow_drop=allow_drop, camera_axes=camera_axes, world_to_camera=world_to_camera,
-        ids=Path(ids) if ids else None,
-        instances=None if instances is None else read_instance_table(instances),
+        ids=Path(ids) if ids else None, instances=read_instance_table(instances)
+        if instances is not None else None,
     )
     _print_report(import_rgbd(folder, out, opts), as_json)
