@@ -307,6 +307,8 @@ class FrameAssembler:
         # links of its camera and base chains as read when it was assembled
         self._held: list[tuple[Frame, int, str, tuple[_Snapshot, _Snapshot]]] = []
         self.stale = StalePoses(left_out=drop_stale)
+        # colour and id images at a log time without a depth image: never part of a frame
+        self.unpaired: dict[str, int] = {"rgb": 0, "ids": 0}
         self.stale_left_out: set[int] = set()  # indices of the frames drop_stale left out
 
     def tf_stamp_note(self) -> str | None:
@@ -331,7 +333,7 @@ class FrameAssembler:
         out: list[Frame] = []
         if self._t is not None and t_ns != self._t:
             out = self.flush()
-            self._pending = {}
+            self._drop_unpaired()
         self._t = t_ns
         self._now = t_ns if self._now is None else max(self._now, t_ns)
         if topic in (S.TF, S.TF_STATIC):  # /tf_static: links written once
@@ -351,6 +353,20 @@ class FrameAssembler:
             self._pending[key] = message
         return out
 
+    def unpaired_note(self) -> str | None:
+        """One line when colour or instance-id images came at a log time without a depth
+        image (a writer that logs them apart, even by a millisecond): they are in no frame,
+        and the map has no colour or no objects from them; else None."""
+        parts = [f"{n} {what} image(s)" for key, what in (("ids", "instance-id"),
+                                                          ("rgb", "colour"))
+                 if (n := self.unpaired.get(key, 0))]
+        if not parts:
+            return None
+        prefix = f"{self.where}: " if self.where else ""
+        return (f"{prefix}{' and '.join(parts)} at a log time without a depth image were "
+                "not used: a frame is the depth, colour and id images of one log time (log "
+                "them at the depth image's time)")
+
     def tick(self, t_ns: int) -> list[Frame]:
         """Log time ``t_ns`` has come (a message the caller does not push): the held frames
         that waited long enough."""
@@ -359,7 +375,15 @@ class FrameAssembler:
 
     def finish(self) -> list[Frame]:
         """After the last message: the frame being assembled and every frame held."""
-        return self.flush() + self._release(final=True)
+        out = self.flush()
+        self._drop_unpaired()
+        return out + self._release(final=True)
+
+    def _drop_unpaired(self) -> None:
+        """Its log time over: the images still pending had no depth image (counted)."""
+        for key in self._pending:
+            self.unpaired[key] = self.unpaired.get(key, 0) + 1
+        self._pending = {}
 
     @property
     def holding(self) -> bool:

@@ -241,3 +241,26 @@ def test_a_record_past_the_budget_is_not_taken_whatever_its_order(tmp_path):
 def _topics_of(path):
     with LogReader(path) as r:
         return {cid: ch.topic for cid, ch in r.summary.channels.items()}
+
+
+def test_id_images_a_millisecond_off_their_depth_are_named(tmp_path):
+    """Instance-id images logged 1 ms after their depth images (a writer that stamps each
+    stream as it comes): a frame is the images of one log time, so no frame had ids; the
+    graph lost every object with only a warning blaming the segmenter (an outside lab)."""
+    topics = _topics()
+
+    def late_ids(messages):
+        moved = [dataclasses.replace(m, log_time=m.log_time + 1_000_000)
+                 if topics[m.channel_id] == S.IDS else m for m in messages]
+        return sorted(moved, key=lambda m: m.log_time)
+
+    log = rewrite(START, tmp_path / "late.mcap", Variant(order=late_ids))
+    n_ids = sum(1 for t in _topics().values() if t == S.IDS)
+    assert n_ids == 1
+    report = replay(log, None)
+    (note,) = [w for w in report.warnings if "at a log time without a depth image" in w]
+    with LogReader(START) as r:
+        frames = sum(1 for _ in r.frames())
+    assert note.startswith(f"{log}: {frames} instance-id image(s) at a log time without a "
+                           "depth image were not used"), note
+    assert not any("without a depth image" in w for w in replay(START, None).warnings)
