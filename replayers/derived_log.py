@@ -376,8 +376,8 @@ def _run(reader: LogReader, stream: SceneGraphStream, writer: LogWriter | None,
             if not feed.message(schema, channel, message, write=writer is not None):
                 break
     feed.end()
-    for note in (feed.asm.tf_stamp_note(), feed.asm.stale.note(), unposed_note(feed),
-                 feed.asm.unpaired_note()):
+    for note in (feed.asm.tf_stamp_note(), feed.asm.depth_stamp_note(), feed.asm.stale.note(),
+                 unposed_note(feed), feed.asm.unpaired_note()):
         if note is not None:
             report.warnings.append(note)
 

@@ -300,6 +300,7 @@ class FrameAssembler:
         self.where = where
         self.tf_time = tf_time
         self.tf_offsets = TfStampOffsets()
+        self.depth_offsets = TfStampOffsets()  # the depth images' stamps, the same way
         self._pending: dict[str, Any] = {}
         self._t: int | None = None
         self._now: int | None = None  # the latest log time pushed or ticked
@@ -323,6 +324,19 @@ class FrameAssembler:
                 f"more than {TF_STAMP_WARN_S:g} s from their log times (at most "
                 f"{o.worst_ns / 1e9:+.3f} s, at log time {o.worst_at_ns} ns); frames were "
                 f"paired with {S.TF} by log time ({TF_TIME_OPTION} pairs them by stamps)")
+
+    def depth_stamp_note(self) -> str | None:
+        """One line when depth images' header stamps lie more than :data:`TF_STAMP_WARN_S`
+        from their log times while frames are paired with ``/tf`` by log time (images
+        logged late, say: their poses are those of the log time), else None."""
+        o = self.depth_offsets
+        if self.tf_time != "log" or not o.beyond:
+            return None
+        prefix = f"{self.where}: " if self.where else ""
+        return (f"{prefix}{o.beyond} of {o.checked} {S.DEPTH} image(s) have header stamps "
+                f"more than {TF_STAMP_WARN_S:g} s from their log times (at most "
+                f"{o.worst_ns / 1e9:+.3f} s, at log time {o.worst_at_ns} ns); each was "
+                f"posed by {S.TF} at its log time ({TF_TIME_OPTION} poses it at its stamp)")
 
     @property
     def time(self) -> int | None:
@@ -450,6 +464,8 @@ class FrameAssembler:
             return self._release()
         self._pending = {}
         depth_msg = pending["depth"]
+        if self.tf_time == "log" and (stamp := stamp_ns(depth_msg)) is not None:
+            self.depth_offsets.add(t, stamp - t)
         k = self.calibration
         if k is None:
             self._fail(S.DEPTH, t, f"no camera calibration ({S.CALIBRATION}) before it")
