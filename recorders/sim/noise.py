@@ -161,16 +161,20 @@ def parse_noise(text: str | None) -> NoiseProfile:
             raise SgtoolError(f"--noise {t}: unknown profile {parts[0]!r} (one of "
                               f"{', '.join(PROFILES)}, or NAME=VALUE overrides, or a .json file)")
         base = PROFILES[parts.pop(0)]
-    items = []
+    items: list[tuple[str, Any]] = []
     for s in parts:
         k, eq, v = s.partition("=")
         if not eq:
             raise SgtoolError(f"--noise {t}: {s!r} is not NAME=VALUE")
+        if k.strip() == "name":  # the profile's name, as a file's "name" gives it
+            items.append(("name", v.strip()))
+            continue
         try:
             items.append((k.strip(), float(v)))
         except ValueError:
             raise SgtoolError(f"--noise {t}: {k.strip()}={v!r} is not a number") from None
-    return _override(base, items, t, default_name=_spelled(base.name, items))
+    return _override(base, items, t,
+                     default_name=_spelled(base.name, [(k, v) for k, v in items if k != "name"]))
 
 
 def _spelled(base: str, items: Iterable[tuple[str, float]]) -> str:
@@ -213,6 +217,9 @@ def _override(base: NoiseProfile, items: Iterable[tuple[str, Any]], where: str,
         return base
     how = "its \"name\"" if "name" in kw else "the file's name"
     name = str(kw.pop("name", default_name))
+    if not name.strip() or name.strip() in (".", "..") or any(c in name for c in "/\\\0"):
+        raise SgtoolError(f"--noise {where}: name {name!r}: a profile's name names its log "
+                          "folder (run-bench's logs/NAME/): give a name without / or \\")
     out = replace(base, **kw, name="")
     same = PROFILES.get(name.strip())
     if same is not None and replace(out, name="") != replace(same, name=""):  # pooled as it

@@ -267,3 +267,21 @@ def test_a_profile_made_in_python_cannot_take_a_built_in_name() -> None:
     assert NoiseProfile("mild", **{k: v for k, v in PROFILES["mild"].to_dict().items()
                                    if k != "name"}) == PROFILES["mild"]
     assert NoiseProfile("mine", holes=0.3).holes == 0.3
+
+
+def test_a_profiles_name_must_name_a_folder_and_the_text_form_takes_it(tmp_path: Path) -> None:
+    """A profile's name is its run-bench log folder (logs/NAME/): an empty one or one with
+    a / was taken (an outside lab's JSON), and `--noise mild,name=x` said "name='x' is not
+    a number" while the JSON form takes a name."""
+    for name in ("", "  ", "a/b", "..", "x\\y"):
+        f = tmp_path / "p.json"
+        f.write_text(json.dumps({"name": name, "holes": 0.1}))
+        with pytest.raises(SgtoolError, match=r"name .*: a profile's name names its log "
+                           r"folder \(run-bench's logs/NAME/\)"):
+            parse_noise(str(f))
+    with pytest.raises(SgtoolError, match=r"name 'a/b': a profile's name names its log"):
+        parse_noise("mild,holes=0.1,name=a/b")
+    p = parse_noise("mild,holes=0.1,name=mine")
+    assert p.name == "mine" and p.holes == 0.1
+    assert parse_noise("holes=0.1,name=mine") == replace(PROFILES["none"], holes=0.1,
+                                                         name="mine")
