@@ -45,6 +45,7 @@ from sgtool.recorders.importers.pose_files import (
     folder_intrinsics,
     pose_folder,
     posed_pairs,
+    poses_by_block_id,
     seven_scenes_intrinsics,
 )
 from sgtool.recorders.importers.replica_layout import is_replica, read_replica, replica_missing
@@ -534,8 +535,10 @@ def _read_open3d(root: Path, fps: float, trajectory: Path | None, skip_missing: 
         slot = slot or {d: i for i, (d, _) in enumerate(pairs)}
         pairs, poses, dropped = posed_pairs(per_frame, pairs, keep_unposed, notes)
     else:
-        read = trajectory_poses(traj, len(pairs), hint, shorter=True) \
-            if traj is not None else None
+        by_id = poses_by_block_id(traj, [float(d.stem) for d, _ in pairs], notes) \
+            if traj is not None and numbered is not None else None
+        read = by_id if by_id is not None else trajectory_poses(
+            traj, len(pairs), hint, shorter=True) if traj is not None else None
         poses = None if read is None else list(read)
         if read is not None and len(read) < len(pairs) and (holes or (unpaired and matched)):
             # a short trajectory's blocks go to the frames in order: with frames missing

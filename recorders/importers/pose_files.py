@@ -23,6 +23,8 @@ from sgtool.log.codec import rigid_problem
 from sgtool.recorders.importers.textformats import (
     PinholeParams,
     is_intrinsics_json,
+    is_open3d_log,
+    open3d_log_blocks,
     read_intrinsics_file,
     untracked_pose,
 )
@@ -146,3 +148,24 @@ def posed_pairs(folder: Path, pairs: list[tuple[Path, Path | None]], keep_unpose
                           "(give --estimate-poses to estimate them from the depth)")
     kept = [(pair, p) for pair, p in zip(pairs, poses, strict=True) if p is not None]
     return [k for k, _ in kept], [p for _, p in kept], len(lost)
+
+
+def poses_by_block_id(trajectory: Path, numbers: list[float], notes: list[str]
+                      ) -> list[np.ndarray] | None:
+    """The poses of frames numbered ``numbers`` (their image names) from an Open3D
+    ``.log`` whose block ids skip some numbers (a lab removed bad frames with their pose
+    blocks), each frame's the block of its number, with a note; None when ``trajectory``
+    is no such log, its ids run without a gap, or a frame's number has no block (those
+    are read, or refused, frame by frame in order)."""
+    if not is_open3d_log(trajectory):
+        return None
+    blocks = open3d_log_blocks(trajectory)
+    ids = [k for k, _ in blocks]
+    if len(set(ids)) < len(ids) or ids == [ids[0] + i for i in range(len(ids))]:
+        return None
+    by_id = dict(blocks)
+    if not numbers or any(n not in by_id for n in numbers):
+        return None
+    notes.append(f"poses from {trajectory.name} paired with the images by its block ids "
+                 f"(they skip numbers, as the images do)")
+    return [by_id[n] for n in numbers]

@@ -172,6 +172,12 @@ def read_open3d_log(path: Path) -> list[np.ndarray]:
     ``i i i+1`` for frame i): blocks out of order are put in order; a frame id given twice,
     or ids with a gap (a pose for a frame the folder may not have), are refused (unless
     every block has the same one: ids that say nothing, file order)."""
+    return [m for _, m in open3d_log_blocks(path, gaps=False)]
+
+
+def open3d_log_blocks(path: Path, gaps: bool = True) -> list[tuple[float, np.ndarray]]:
+    """(frame id, pose) of each block of an Open3D ``.log`` (:func:`read_open3d_log`), in
+    id order; ids with a gap are refused only when not ``gaps``."""
     rows = _data_lines(path)
     if len(rows) % 5:
         raise SgtoolError(
@@ -198,12 +204,12 @@ def read_open3d_log(path: Path) -> list[np.ndarray]:
     if len(seen) == len(poses):
         poses.sort(key=lambda p: p[0])
         ids = [k for k, _ in poses]
-        if ids != [ids[0] + i for i in range(len(ids))]:
+        if not gaps and ids != [ids[0] + i for i in range(len(ids))]:
             gap = next(i for i in range(1, len(ids)) if ids[i] != ids[i - 1] + 1)
             raise SgtoolError(f"{path}: the frame ids of its pose blocks jump from "
                               f"{ids[gap - 1]:g} to {ids[gap]:g}; each block's header 'i j n' "
                               "names its frame, one pose per frame in order")
-    return [m for _, m in poses]
+    return poses
 
 
 @dataclass(frozen=True)

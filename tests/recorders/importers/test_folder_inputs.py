@@ -733,3 +733,25 @@ def test_a_trajectory_of_a_matrix_a_line_poses_the_frames(tmp_path, numbers: int
     with pytest.raises(SgtoolError, match=r"traj\.txt:2: a line of this trajectory is a pose "
                        r"matrix of 12 or 16 numbers .* this one has " + str(numbers + 1)):
         read_sequence(root)
+
+
+def test_pose_blocks_removed_with_their_frames_pair_by_their_ids(tmp_path: Path) -> None:
+    """A lab removed bad frames 10-14 with their pose blocks: images 0-9 and 15-19, a .log
+    whose block ids are the same numbers. Refused ("the frame ids jump from 9 to 15") with
+    nothing to do about it; each image takes the block of its number. A block missing for
+    an image there is still refused."""
+    names = [f"{i:05d}" for i in (*range(10), *range(15, 20))]
+    root = open3d_folder(tmp_path / "f", names)
+    blocks = []
+    for i in (*range(10), *range(15, 20)):
+        blocks.append(f"{i} {i} {i + 1}")
+        blocks.extend(" ".join(f"{v:.8f}" for v in row) for row in _pose(float(i)))
+    (root / "traj.log").write_text("\n".join(blocks) + "\n")
+    seq = read_sequence(root)
+    assert [f.pose[0, 3] for f in seq.frames] == [float(i) for i in (*range(10),
+                                                                     *range(15, 20))]
+    assert any("paired with the images by its block ids" in n for n in seq.notes)
+    (root / "depth" / "00016.png").rename(root / "depth" / "00012.png")  # no block 12
+    (root / "image" / "00016.jpg").rename(root / "image" / "00012.jpg")
+    with pytest.raises(SgtoolError, match=r"the frame ids of its pose blocks jump from 9 to 15"):
+        read_sequence(root)
