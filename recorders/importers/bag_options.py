@@ -18,6 +18,7 @@ from sgtool.recorders.importers.checks import (
     check_non_negative,
     check_positive,
 )
+from sgtool.recorders.importers.instance_table import check_instances
 from sgtool.recorders.importers.pose_axes import check_camera_axes
 from sgtool.recorders.importers.sanity import DEFAULT_CAMERA_HEIGHT
 from sgtool.recorders.importers.textformats import PinholeParams
@@ -78,13 +79,8 @@ def check_options(opts: BagOptions) -> None:
     if abs(opts.time_offset_ns) > MAX_TIME_OFFSET_S * 1e9:
         raise SgtoolError(f"--time-offset {opts.time_offset_ns / 1e9:g}: must be within "
                           f"+-{MAX_TIME_OFFSET_S:g} seconds")
-    if opts.instances is not None and not isinstance(opts.instances, Instances):
-        raise SgtoolError("instances: an sgtool.Instances (read_instance_table(path) of "
-                          "sgtool.recorders.importers.instance_table reads the JSON file), "
-                          f"got {type(opts.instances).__name__}")
-    if opts.instances is not None and opts.ids is None:
-        raise SgtoolError("--instances is the table of the instance ids: give the id image "
-                          "topic too (--ids TOPIC, with --depth)")
+    check_instances(opts.instances, opts.ids, "the id image topic too (--ids TOPIC, with "
+                    "--depth)")
     if opts.instances is not None and opts.depth is None:
         raise SgtoolError(f"--ids {opts.ids} --instances: give the depth topic too "
                           "(--depth TOPIC)")

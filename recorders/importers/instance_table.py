@@ -48,3 +48,16 @@ def read_instance_table(path: str | Path, option: str = "--instances") -> Instan
     if not table.instances:
         raise SgtoolError(f"{where}: the table lists no instance")
     return table
+
+
+def check_instances(table: object, ids: object, give_ids: str) -> None:
+    """An import's options from Python: ``table`` (its ``instances``) is None or an
+    :class:`Instances` (not a file's path: :func:`read_instance_table` reads one), given
+    only with ``ids``; one :class:`SgtoolError` line naming what to give otherwise
+    (``give_ids``: the ids option as the importer takes it)."""
+    if table is not None and not isinstance(table, Instances):
+        raise SgtoolError("instances: an sgtool.Instances (read_instance_table(path) of "
+                          "sgtool.recorders.importers.instance_table reads the JSON file), "
+                          f"got {type(table).__name__}")
+    if table is not None and ids is None:
+        raise SgtoolError(f"--instances is the table of the instance ids: give {give_ids}")

@@ -60,6 +60,7 @@ from sgtool.recorders.importers.images import (
     read_depth_file,
     resize_to,
 )
+from sgtool.recorders.importers.instance_table import check_instances
 from sgtool.recorders.importers.layouts import FolderFrame, FolderSequence, read_sequence
 from sgtool.recorders.importers.odometry import (
     DriftReport,
@@ -202,13 +203,7 @@ def python_options(opts: object) -> RgbdOptions:
         if not isinstance(opts.ids, str | os.PathLike):
             raise SgtoolError(f"ids: a folder's path, got {type(opts.ids).__name__}")
         changes["ids"] = Path(opts.ids)
-    if opts.instances is not None and not isinstance(opts.instances, Instances):
-        raise SgtoolError("instances: an sgtool.Instances (read_instance_table(path) of "
-                          "sgtool.recorders.importers.instance_table reads the JSON file), "
-                          f"got {type(opts.instances).__name__}")
-    if opts.instances is not None and opts.ids is None:
-        raise SgtoolError("--instances is the table of the instance ids: give the folder of "
-                          "the id images too (--ids DIR)")
+    check_instances(opts.instances, opts.ids, "the folder of the id images too (--ids DIR)")
     if isinstance(opts.floor, str) and opts.floor.strip().lower() in ("auto", "none"):
         changes["floor"] = None
         changes["floor_auto"] = opts.floor.strip().lower() == "auto"

@@ -316,27 +316,26 @@ class FrameAssembler:
         """One line when ``/tf`` stamps disagreed with their log times beyond
         :data:`TF_STAMP_WARN_S` while pairing by log time (naming the largest offset and
         the option that pairs by stamps), else None."""
-        o = self.tf_offsets
-        if self.tf_time != "log" or not o.beyond:
-            return None
-        prefix = f"{self.where}: " if self.where else ""
-        return (f"{prefix}{o.beyond} of {o.checked} {S.TF} message(s) have header stamps "
-                f"more than {TF_STAMP_WARN_S:g} s from their log times (at most "
-                f"{o.worst_ns / 1e9:+.3f} s, at log time {o.worst_at_ns} ns); frames were "
-                f"paired with {S.TF} by log time ({TF_TIME_OPTION} pairs them by stamps)")
+        return self._offsets_note(self.tf_offsets, f"{S.TF} message(s)", (
+            f"frames were paired with {S.TF} by log time ({TF_TIME_OPTION} pairs them by "
+            "stamps)"))
 
     def depth_stamp_note(self) -> str | None:
         """One line when depth images' header stamps lie more than :data:`TF_STAMP_WARN_S`
         from their log times while frames are paired with ``/tf`` by log time (images
         logged late, say: their poses are those of the log time), else None."""
-        o = self.depth_offsets
+        return self._offsets_note(self.depth_offsets, f"{S.DEPTH} image(s)", (
+            f"each was posed by {S.TF} at its log time ({TF_TIME_OPTION} poses it at its "
+            "stamp)"))
+
+    def _offsets_note(self, o: TfStampOffsets, what: str, then: str) -> str | None:
+        """The line of :meth:`tf_stamp_note` and :meth:`depth_stamp_note`."""
         if self.tf_time != "log" or not o.beyond:
             return None
         prefix = f"{self.where}: " if self.where else ""
-        return (f"{prefix}{o.beyond} of {o.checked} {S.DEPTH} image(s) have header stamps "
-                f"more than {TF_STAMP_WARN_S:g} s from their log times (at most "
-                f"{o.worst_ns / 1e9:+.3f} s, at log time {o.worst_at_ns} ns); each was "
-                f"posed by {S.TF} at its log time ({TF_TIME_OPTION} poses it at its stamp)")
+        return (f"{prefix}{o.beyond} of {o.checked} {what} have header stamps more than "
+                f"{TF_STAMP_WARN_S:g} s from their log times (at most {o.worst_ns / 1e9:+.3f} "
+                f"s, at log time {o.worst_at_ns} ns); {then}")
 
     @property
     def time(self) -> int | None:
