@@ -41,7 +41,8 @@ def bench_into(request: BenchRunRequest, show: Echo) -> None:
     error line and nothing is written; Ctrl-C leaves both folders as they were."""
     from sgtool.analysis.bench import OUTPUT_NAMES, run_benchmark, write_outputs
     from sgtool.analysis.report import invalid_action_notes, llm_warnings
-    from sgtool.files import leftover_notes, output_folder, refuse_input_folder
+    from sgtool.files import output_folder, refuse_input_folder
+    from sgtool.leftovers import leftover_notes
     from sgtool.llm.recorded import transcript_run
 
     out_dir, log_dir = request.out_dir, request.config.log_dir

@@ -77,12 +77,8 @@ def run_bench_into(request: RunBenchRequest, show: Echo) -> None:
 
     from sgtool.analysis.closed_loop_bench import OUTPUT_NAMES, run_closed_loop_bench
     from sgtool.analysis.closed_loop_bench import write_outputs as write_tables
-    from sgtool.files import (
-        atomic_write,
-        leftover_notes,
-        output_folder,
-        refuse_input_folder,
-    )
+    from sgtool.files import atomic_write, output_folder, refuse_input_folder
+    from sgtool.leftovers import leftover_notes
 
     refuse_input_folder(request.out_dir, request.config.house_files, what="--house")
     executor, bars = _executor(request)
@@ -363,7 +359,7 @@ def _remove_partials(task: RunTask) -> None:
     """The partial files of ``task``'s log that a killed run left (its writer, killed,
     could not remove them): the log writer's, and the driver's temporary file of a log
     sent back (a driver killed while it wrote one)."""
-    from sgtool.files import leftover_temps
+    from sgtool.leftovers import leftover_temps
     from sgtool.log.writer import partial_files
 
     for p in [*partial_files(task.output), *leftover_temps(task.output)]:

@@ -316,40 +316,6 @@ def _folder_target(target: str | os.PathLike[str], option: str) -> Path:
     return path
 
 
-def _leftovers(target: str | os.PathLike[str], *, folders: bool) -> list[Path]:
-    """The hidden temporary entries beside ``target`` (``.NAME.XXXXXXXX.partial``,
-    :func:`temp_beside`'s names), folders or files, sorted by name."""
-    path = Path(target)
-    head, tail = temp_prefix(path.name, ".partial"), ".partial"
-    if not path.parent.is_dir():
-        return []
-    return sorted(p for p in path.parent.iterdir()
-                  if p.name.startswith(head) and p.name.endswith(tail)
-                  and len(p.name) == len(head) + TEMP_RANDOM + len(tail)
-                  and (p.is_dir() if folders else p.is_file()))
-
-
-def leftover_stages(target: str | os.PathLike[str]) -> list[Path]:
-    """The hidden staging folders of :func:`output_folder` beside ``target``
-    (``.NAME.XXXXXXXX.partial``) that no run removed: a run killed outright (SIGKILL, a
-    power cut) leaves one; sorted by name."""
-    return _leftovers(target, folders=True)
-
-
-def leftover_temps(target: str | os.PathLike[str]) -> list[Path]:
-    """The hidden temporary files of :func:`atomic_write` (and :func:`atomic_output`)
-    beside ``target`` (``.NAME.XXXXXXXX.partial``) that no writer removed: a process
-    killed outright while it wrote ``target`` leaves one; sorted by name."""
-    return _leftovers(target, folders=False)
-
-
-def leftover_notes(target: str | os.PathLike[str]) -> list[str]:
-    """One note per :func:`leftover_stages` folder beside ``target``, for a command to
-    show after its run."""
-    return [f"sgtool: note: {stale} is the unfinished output of a run that was killed (or "
-            "one still running); remove it when none is" for stale in leftover_stages(target)]
-
-
 def refuse_input_folder(target: str | os.PathLike[str],
                         inputs: Iterable[str | os.PathLike[str]], *, option: str = "-o",
                         what: str = "input") -> None:

@@ -286,7 +286,8 @@ def test_a_folder_name_near_the_limit_is_staged_beside_it(tmp_path: Path) -> Non
     """An output folder named with 250 bytes: its hidden staging folder
     (``.NAME.XXXXXXXX.partial``, 18 bytes longer) is cut to fit, and a stage a killed run
     left beside it is found."""
-    from sgtool.files import leftover_stages, output_folder
+    from sgtool.files import output_folder
+    from sgtool.leftovers import leftover_stages
 
     target = tmp_path / ("d" * 250)
     with output_folder(target, force=False, command="bench") as root:
