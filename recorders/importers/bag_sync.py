@@ -13,7 +13,7 @@ from sgtool.recorders.importers.bag_index import BagIndex
 from sgtool.recorders.importers.bag_options import BagOptions
 from sgtool.recorders.importers.bag_poses import PoseSource
 from sgtool.recorders.importers.sanity import dropped_problem
-from sgtool.recorders.importers.stamps import nearest_within
+from sgtool.recorders.importers.stamps import NearestStamp
 from sgtool.recorders.importers.tftree import frame_name
 
 
@@ -46,8 +46,7 @@ def plan_frames(
     flags, unless ``opts.allow_drop``."""
     notes = []
     seen: set[int] = set()
-    rgb_order = sorted(range(len(idx.rgb.stamps)), key=lambda i: idx.rgb.stamps[i])
-    ids_order = sorted(range(len(idx.ids.stamps)), key=lambda i: idx.ids.stamps[i])
+    rgb_near, ids_near = NearestStamp(idx.rgb.stamps), NearestStamp(idx.ids.stamps)
     plan = []
     no_pose = dup = no_rgb = no_ids = 0
     explicit_cam = opts.tf_frames is not None or opts.pose is not None
@@ -62,8 +61,8 @@ def plan_frames(
             no_pose += 1
             if not keep_unposed:
                 continue
-        k_rgb = nearest_within(idx.rgb.stamps, rgb_order, t, opts.max_dt_ns) if opts.rgb else None
-        k_ids = nearest_within(idx.ids.stamps, ids_order, t, opts.max_dt_ns) if opts.ids else None
+        k_rgb = rgb_near(t, opts.max_dt_ns) if opts.rgb else None
+        k_ids = ids_near(t, opts.max_dt_ns) if opts.ids else None
         no_rgb += opts.rgb is not None and k_rgb is None
         no_ids += opts.ids is not None and k_ids is None
         plan.append(PlannedFrame(k, t, pose, k_rgb, k_ids))

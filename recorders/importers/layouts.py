@@ -50,7 +50,7 @@ from sgtool.recorders.importers.pose_files import (
 )
 from sgtool.recorders.importers.replica_layout import is_replica, read_replica, replica_missing
 from sgtool.recorders.importers.sanity import time_range_problem, timestamp_problem
-from sgtool.recorders.importers.stamps import nearest_within
+from sgtool.recorders.importers.stamps import NearestStamp
 from sgtool.recorders.importers.textformats import (
     PinholeParams,
     is_matrix_trajectory,
@@ -318,8 +318,9 @@ def _read_tum(
             tolerance_ns=10_000_000) if samples else None
     frames = []
     no_rgb = no_pose = 0
+    near = NearestStamp([r for r, _ in rgb])
     for t, name in depth:
-        color = _colour_near(root, rgb, t, max_dt_ns)
+        color = _colour_near(root, rgb, near(t, max_dt_ns))
         no_rgb += color is None
         pose = track.at(t) if track is not None else None
         if track is not None and pose is None:
@@ -346,10 +347,8 @@ def _read_tum(
     )
 
 
-def _colour_near(root: Path, rgb: list[tuple[int, str]], t: int, max_dt_ns: int) -> Path | None:
-    """The colour image of ``rgb`` (in time order) nearest to time ``t``, within
-    ``max_dt_ns``."""
-    j = nearest_within([r for r, _ in rgb], list(range(len(rgb))), t, max_dt_ns)
+def _colour_near(root: Path, rgb: list[tuple[int, str]], j: int | None) -> Path | None:
+    """The colour image ``j`` of ``rgb`` (a :class:`NearestStamp` answer), None for None."""
     return None if j is None else root / rgb[j][1]
 
 
@@ -359,7 +358,8 @@ def _read_tum_log_poses(root: Path, rgb: list[tuple[int, str]], depth: list[tupl
     to the depth images in the listed order."""
     poses = trajectory_poses(trajectory, len(depth))
     assert poses is not None
-    frames = [FolderFrame(t, root / name, _colour_near(root, rgb, t, max_dt_ns), poses[i])
+    near = NearestStamp([r for r, _ in rgb])
+    frames = [FolderFrame(t, root / name, _colour_near(root, rgb, near(t, max_dt_ns)), poses[i])
               for i, (t, name) in enumerate(depth)]
     no_rgb = sum(f.color_path is None for f in frames)
     if no_rgb:

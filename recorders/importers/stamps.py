@@ -5,21 +5,23 @@ images)."""
 from __future__ import annotations
 
 import bisect
+from collections.abc import Sequence
 
 
-def nearest_within(stamps: list[int], order: list[int], t: int, max_dt: int) -> int | None:
-    """Index (into ``stamps``) of the stamp nearest ``t`` within ``max_dt``; ``order`` is
-    the argsort of ``stamps``."""
-    if not stamps:
-        return None
-    sorted_t = [stamps[i] for i in order]
-    j = bisect.bisect_left(sorted_t, t)
-    best = None
-    for jj in (j - 1, j):
-        if 0 <= jj < len(sorted_t):
-            d = abs(sorted_t[jj] - t)
-            if d <= max_dt and (best is None or d < best[0]):
-                best = (d, order[jj])
-    return None if best is None else best[1]
+class NearestStamp:
+    """``near(t, max_dt)``: the index (into ``stamps``) of the stamp nearest ``t`` within
+    ``max_dt``, else None; the stamps are sorted once, for one query per frame."""
 
+    def __init__(self, stamps: Sequence[int]) -> None:
+        self.order = sorted(range(len(stamps)), key=lambda i: stamps[i])
+        self.sorted = [stamps[i] for i in self.order]
 
+    def __call__(self, t: int, max_dt: int) -> int | None:
+        j = bisect.bisect_left(self.sorted, t)
+        best = None
+        for jj in (j - 1, j):
+            if 0 <= jj < len(self.sorted):
+                d = abs(self.sorted[jj] - t)
+                if d <= max_dt and (best is None or d < best[0]):
+                    best = (d, self.order[jj])
+        return None if best is None else best[1]
