@@ -29,9 +29,8 @@ DEMO_HOUSE = "demo_house.json"
 def demo_house() -> HouseSpec:
     """The small house shipped with the package (``data/demo_house.json``).
 
-    Its layout and furniture are ``generate_house`` output for a fixed seed; its small
-    objects and start yaws are an older draw of the generator, kept on purpose. See
-    :mod:`sgtool.datasets.demo` (``python -m sgtool.datasets.demo --check`` checks both).
+    It is ``generate_house`` output for a fixed seed. See :mod:`sgtool.datasets.demo`
+    (``python -m sgtool.datasets.demo --check`` checks that it still is).
     """
     from sgtool.house.io import load_house_text
 

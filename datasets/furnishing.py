@@ -1,7 +1,9 @@
 """Furniture of a generated house (step 3 of :mod:`sgtool.datasets.generator`): per room,
 the categories of that room type's real inventories drawn with their frequencies, placed
 against walls, in the open (tables) or around tables (chairs), stacked pieces on a base,
-each kept only if the room stays crossable and its containers reachable."""
+each kept only if the room stays crossable and its containers reachable, and no floor piece
+stands in front of a container's front (:func:`front_zone`: the robot opens and looks in
+there; :func:`sgtool.house.clearance.blocked_fronts` checks the same in a spec)."""
 
 from __future__ import annotations
 
@@ -23,9 +25,11 @@ from sgtool.datasets.sizes import (
     furniture_size,
 )
 from sgtool.datasets.synsets import ancestors
+from sgtool.house.clearance import FRONT_CLEAR
 
 EXTRA_ATTEMPTS = 8  # positions tried for an extra holder (first_level module)
 TOP_MAX_HEIGHT = 1.2  # m, highest top face an extra holder is stood on
+FRONT_TOUCH = 0.01  # m: a piece this near a container's front zone stands in it
 
 
 def _furniture_list(rng: np.random.Generator, room_type: str, inv: Inventory,
@@ -63,6 +67,44 @@ def _footprint(cx: float, cy: float, w: float, d: float, yaw: float) -> Rect:
         w, d = d, w
     return Rect(round(cx - w / 2, 4), round(cy - d / 2, 4), round(cx + w / 2, 4),
                  round(cy + d / 2, 4))
+
+
+def front_zone(box: Rect, yaw: float, clear: float = FRONT_CLEAR) -> Rect:
+    """The floor strip ``clear`` metres deep in front of the front (local +y) face of a
+    piece with footprint ``box`` turned by ``yaw`` (a multiple of 90 degrees), as wide as
+    that face."""
+    dx, dy = round(-math.sin(yaw)), round(math.cos(yaw))
+    if dy > 0:
+        return Rect(box.x0, box.y1, box.x1, box.y1 + clear)
+    if dy < 0:
+        return Rect(box.x0, box.y0 - clear, box.x1, box.y0)
+    if dx > 0:
+        return Rect(box.x1, box.y0, box.x1 + clear, box.y1)
+    return Rect(box.x0 - clear, box.y0, box.x0, box.y1)
+
+
+def _blocks_a_front(box: Rect, yaw: float, container: bool, mine: list[Piece]) -> bool:
+    """Whether a floor piece at ``box`` would stand in front of a container of ``mine``
+    (on the floor or on another piece), or, being a ``container``, have one of ``mine``
+    in front of its own front."""
+    if container and any(front_zone(box, yaw).overlaps(p.box, FRONT_TOUCH) for p in mine):
+        return True
+    return any(box.overlaps(front_zone(p.box, p.yaw), FRONT_TOUCH) for p in mine
+               if "container" in p.affordances)
+
+
+def _centred(base: Piece, size: tuple[float, float, float]) -> Rect:
+    """The footprint of a piece of ``size`` stood in the middle of ``base``'s top."""
+    cx, cy = (base.box.x0 + base.box.x1) / 2, (base.box.y0 + base.box.y1) / 2
+    return _footprint(cx, cy, size[0], size[1], base.yaw)
+
+
+def _front_covered(box: Rect, base: Piece, container: bool, mine: list[Piece]) -> bool:
+    """Whether a ``container`` stood at ``box`` on ``base`` (facing as it does) would have
+    a floor piece of ``mine`` other than its base in front of its front."""
+    zone = front_zone(box, base.yaw)
+    return container and any(zone.overlaps(p.box, FRONT_TOUCH) for p in mine
+                             if p.on is None and p is not base)
 
 
 def _wall_candidate(rng: np.random.Generator, inner: Rect, w: float,
@@ -112,14 +154,14 @@ def furnish_room(rng: np.random.Generator, room: PlanRoom, plan: Plan, inv: Inve
         bases = [p for p in mine if p.on is None and not p.top_used
                  and any(a in ancestors(p.synset) for a in STACKED_ON[s])]
         size = _jittered_size(rng, furniture_size(s))
-        bases = [p for p in bases if p.size[0] >= size[0] and p.size[1] >= size[1]]
+        aff = inv.knowledge.affordances.get(s, ())
+        bases = [p for p in bases if p.size[0] >= size[0] and p.size[1] >= size[1]
+                 and not _front_covered(_centred(p, size), p, "container" in aff, mine)]
         if not bases:
             continue
         base = bases[int(rng.integers(len(bases)))]
         base.top_used = True
-        cx, cy = (base.box.x0 + base.box.x1) / 2, (base.box.y0 + base.box.y1) / 2
-        aff = inv.knowledge.affordances.get(s, ())
-        mine.append(Piece(s, room.idx, _footprint(cx, cy, size[0], size[1], base.yaw),
+        mine.append(Piece(s, room.idx, _centred(base, size),
                            base.z0 + base.size[2], size, base.yaw,
                            len(pieces) + mine.index(base), True, aff,
                            _initial_state(rng, aff)))
@@ -167,6 +209,8 @@ def _place_floor(rng: np.random.Generator, s: str, base_size: tuple[float, float
         if any(box.overlaps(k) for k in space.keepouts):
             continue
         aff = inv.knowledge.affordances.get(s, ())
+        if _blocks_a_front(box, yaw, "container" in aff, mine):
+            continue
         reach = [p.box for p in mine if p.affordances]
         if aff:
             reach.append(box)
@@ -190,26 +234,31 @@ def _place_on_top(rng: np.random.Generator, s: str, room: PlanRoom, space: RoomS
     small objects. Returns whether the holder was placed."""
     size = _jittered_size(rng, holder_size(s))
     w, d, _ = size
+    aff = inv.knowledge.affordances.get(s, ())
+
+    def at_front(i: int) -> Rect:  # along the base's width, at its front edge (local +y)
+        base = mine[i]
+        lx = -base.size[0] / 2 + used.get(i, 0.0) + w / 2
+        ly = base.size[1] / 2 - d / 2
+        c, sn = math.cos(base.yaw), math.sin(base.yaw)
+        cx = (base.box.x0 + base.box.x1) / 2 + c * lx - sn * ly
+        cy = (base.box.y0 + base.box.y1) / 2 + sn * lx + c * ly
+        return _footprint(cx, cy, w, d, base.yaw)
+
     bases = [i for i, p in enumerate(mine)
              if p.on is None and "supporter" in p.affordances and p.size[2] <= TOP_MAX_HEIGHT
              and (p.top_used == (i in used)) and p.size[1] >= d
-             and used.get(i, 0.0) + w <= p.size[0]]
+             and used.get(i, 0.0) + w <= p.size[0]
+             and not _front_covered(at_front(i), p, "container" in aff, mine)]
     if s not in FLOOR_HOLDERS or not bases:
         return False
     i = bases[int(rng.integers(len(bases)))]
     base = mine[i]
-    # along the base's width, at its front edge (local +y faces into the room)
-    lx = -base.size[0] / 2 + used.get(i, 0.0) + w / 2
-    ly = base.size[1] / 2 - d / 2
-    c, sn = math.cos(base.yaw), math.sin(base.yaw)
-    cx = (base.box.x0 + base.box.x1) / 2 + c * lx - sn * ly
-    cy = (base.box.y0 + base.box.y1) / 2 + sn * lx + c * ly
-    box = _footprint(cx, cy, w, d, base.yaw)
+    box = at_front(i)
     if not space.free_ok([box], None):
         return False
     used[i] = used.get(i, 0.0) + w + 0.02
     base.top_used = True
-    aff = inv.knowledge.affordances.get(s, ())
     mine.append(Piece(s, room.idx, box, base.z0 + base.size[2], size, base.yaw, offset + i,
                       True, aff, _initial_state(rng, aff)))
     return True

@@ -20,9 +20,10 @@
    (:attr:`Knowledge.room_furniture` over the split's household scenes) is included with
    its frequency, in a count drawn around its mean count; pieces stand against walls
    (tables in the open, chairs at tables, microwaves and televisions on a counter or
-   cabinet), never in front of a door, and a piece is only kept if the robot (radius
-   0.2 m) can still cross the room between all its doors and stand within 1 m of every
-   container and supporter.
+   cabinet), never in front of a door nor within 0.3 m of a container's front (where the
+   robot opens it and looks in), and a piece is only kept if the robot (radius 0.2 m) can
+   still cross the room between all its doors and stand within 1 m of every container
+   and supporter.
 4. **Small objects.** Containers are filled and supporters dressed with objects drawn
    by the room type of the piece. A category is a candidate for a piece when (a) some
    activity of the split relates it ``inside``/``ontop`` the piece's synset or one of its

@@ -4,6 +4,7 @@ approachable containers, determinism, and no knowledge from the other split."""
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from collections import deque
@@ -12,7 +13,7 @@ import numpy as np
 import pytest
 
 import sgtool.datasets as ds
-from sgtool.datasets.demo import build_demo, layout_differences
+from sgtool.datasets.demo import build_demo, spec_differences
 from sgtool.datasets.demo import main as demo_main
 from sgtool.datasets.episodes import EpisodeGeometry
 from sgtool.datasets.generator import generate_house
@@ -193,15 +194,15 @@ def test_bad_arguments():
         generate_house(-1)
 
 
-# sha256 (first 16 hex) of the house JSON as the tree before 30-room support generated them:
-# houses of 4..16 rooms (the benchmarks' and golden logs' houses) must stay byte-identical
-OLD_HOUSES = {(3, 4): "dced227ec0b5eb80", (3, 8): "dc3c038dca0685f3",
-              (3, 12): "774b8cc430850985", (3, 16): "175777039fbb04c1",
-              (7, 16): "4a3ed8f571e85692"}
+# sha256 (first 16 hex) of the house JSON since container fronts are kept clear: houses of
+# 4..16 rooms (the benchmarks' houses) change only on purpose
+OLD_HOUSES = {(3, 4): "6bc14d3aa3fc75c9", (3, 8): "dc3c038dca0685f3",
+              (3, 12): "2c51fd8146701f02", (3, 16): "162e67d7245f60b2",
+              (7, 16): "ef3076d984adfe18"}
 
 
 @pytest.mark.parametrize("seed, n", sorted(OLD_HOUSES))
-def test_houses_up_to_16_rooms_are_unchanged(seed, n):
+def test_houses_up_to_16_rooms_change_only_on_purpose(seed, n):
     import hashlib
 
     text = generate_house(seed, rooms=(n, n)).to_json()
@@ -219,25 +220,23 @@ def test_corridor_rooms_grow_with_the_house(n, corridors):
         assert a.bounds[2] - a.bounds[0] >= 2.5 - 1e-6
 
 
-def test_demo_house_is_shipped_and_matches_the_generator_layout():
+def test_demo_house_is_shipped_and_is_the_generator_output():
     spec = ds.demo_house()
     assert len(spec.rooms) == 5
     assert any(d.state == "closed" for d in spec.doors)
     furn = spec.furniture_by_id()
     assert any(o.relation == "inside" and furn[o.parent].state == "closed"
                for o in spec.objects)
-    # the file's layout and furniture are what the documented command writes today; its
-    # small objects (and the start yaws drawn after them) are the placement before small
-    # objects followed their room type (see sgtool.datasets.demo): kept on purpose, so the
-    # demo's recorded figures and the tests built on its first frames stay comparable
-    assert layout_differences(spec, build_demo()) == []
-    assert spec.objects != build_demo().objects  # the older draw: say so if this changes
+    # the file is what the documented command writes today (sgtool.datasets.demo)
+    assert spec_differences(spec, build_demo()) == []
+    stale = dataclasses.replace(spec, objects=spec.objects[1:])
+    assert spec_differences(stale, build_demo()) == ["objects"]
 
 
 def test_demo_check_passes_and_says_what_holds(capsys):
     assert demo_main(["--check"]) == 0
     out = capsys.readouterr().out
-    assert "up to date" in out and "older draw" in out
+    assert "up to date" in out and "generate_house(1, rooms=(5, 5)) output" in out
 
 
 TABLEWARE = frozenset({"bowl", "plate", "mug", "wineglass", "beer glass", "water glass",
@@ -266,9 +265,10 @@ def test_every_small_object_has_evidence_in_its_room_type(split, seeds):
 
 
 def test_bathrooms_hold_no_tableware():
-    """Evaluation houses (seeds 0-5): bathrooms hold soap, towels, brushes (measured top:
-    bar soap 19, scrub brush 14, liquid soap bottle 11, hand towel 10), no glasses, bowls,
-    plates or shakers (13 wineglasses, 9 beer glasses, 8 bowls, 8 mugs before)."""
+    """Evaluation houses (seeds 0-5): bathrooms hold soap, towels, brushes, no glasses,
+    bowls, plates or shakers (13 wineglasses, 9 beer glasses, 8 bowls, 8 mugs before
+    small objects followed their room type); bar soap and scrub brush lead, and bathroom
+    things make up at least three quarters of what bathrooms hold."""
     from collections import Counter
 
     bath: Counter[str] = Counter()
@@ -277,9 +277,10 @@ def test_bathrooms_hold_no_tableware():
         types = {r.id: r.category for r in h.rooms}
         bath.update(o.category for o in h.objects if types[o.room] == "bathroom")
     assert not set(bath) & TABLEWARE, bath
-    top = {c for c, _ in bath.most_common(4)}
-    assert top <= {"bar soap", "scrub brush", "liquid soap bottle", "hand towel", "rag",
-                   "toothbrush", "toilet tissue"}, bath
+    assert {c for c, _ in bath.most_common(2)} == {"bar soap", "scrub brush"}, bath
+    things = {"bar soap", "scrub brush", "liquid soap bottle", "hand towel", "bath towel",
+              "rag", "toothbrush", "toilet tissue"}
+    assert sum(bath[c] for c in things) >= 0.75 * sum(bath.values()), bath
 
 
 def test_candidates_weigh_room_type_evidence_only():

@@ -5,11 +5,11 @@ A container opens, and is looked into, through its front: the box's local +y fac
 (:mod:`sgtool.house.spec`). :func:`blocked_fronts` finds the pieces whose front a wall,
 another piece or the room's border covers: the point :data:`FRONT_CLEAR` in front of the
 middle of the front face is outside the piece's room, within a wall's body or inside
-another piece's footprint (a cabinet set with its back to the room). :func:`cramped_starts`
-finds the start poses nearer to a wall or a piece than the robot's radius, and
-:func:`clear_start` the nearest place clear of them, where the simulator puts the robot.
-:func:`hidden_pieces` finds the pieces no camera can see: a box whose top lies under the
-floor, or one inside another piece's box.
+another piece's footprint (a cabinet set with its back to the room), not counting a piece
+under it (the table a box stands on). :func:`cramped_starts` finds the start poses nearer
+to a wall or a piece than the robot's radius, and :func:`clear_start` the nearest place
+clear of them, where the simulator puts the robot. :func:`hidden_pieces` finds the pieces
+no camera can see: a box whose top lies under the floor, or one inside another piece's box.
 :func:`pieces_in_walls` finds the pieces whose footprint reaches through a wall, past its
 far face (a piece through a wall stands in two rooms; set against a wall, or into its
 body up to the middle line that is a room's border, it does not). :func:`walls_in_rooms`
@@ -74,16 +74,19 @@ class Covers:
         return np.flatnonzero((box[:, 0] - pad <= x) & (x <= box[:, 2] + pad)
                               & (box[:, 1] - pad <= y) & (y <= box[:, 3] + pad))
 
-    def at(self, x: float, y: float, skip: int = -1) -> tuple[str, int] | None:
+    def at(self, x: float, y: float, skip: int = -1,
+           above: float | None = None) -> tuple[str, int] | None:
         """What covers the floor point (x, y): ("walls", index) of a wall whose body holds
-        it, else ("furniture", index) of a piece whose footprint does (not ``skip``), else
-        None."""
+        it, else ("furniture", index) of a piece whose footprint does (not ``skip``, nor,
+        given ``above``, a piece whose top is at or under that height), else None."""
         for j in self._near(self.wbox, x, y):
             w = self.spec.walls[j]
             if segment_distance(x, y, w.a, w.b) <= w.thickness / 2.0:
                 return "walls", int(j)
         for k in self._near(self.fbox, x, y):
-            if k != skip and point_in_polygon(x, y, self.feet[k]):
+            if k == skip or (above is not None and self.spec.furniture[k].top <= above):
+                continue
+            if point_in_polygon(x, y, self.feet[k]):
                 return "furniture", int(k)
         return None
 
@@ -118,7 +121,7 @@ def blocked_fronts(spec: HouseSpec) -> list[tuple[int, str]]:
         x, y = front_point(f)
         if not point_in_polygon(x, y, spec.room(f.room).polygon):
             out.append((k, "the room's border"))
-        elif (what := covers.at(x, y, skip=k)) is not None:
+        elif (what := covers.at(x, y, skip=k, above=f.bottom + 1e-6)) is not None:
             kind, i = what
             out.append((k, spec.walls[i].id if kind == "walls" else spec.furniture[i].id))
     return out
