@@ -18,6 +18,7 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from support.pinned_houses import pinned_house_path
 from support.scripted_planner import Scripted
 from support.semantics_fixtures import ChatServer
 
@@ -42,6 +43,7 @@ from sgtool.recorders.sim.closed_loop import (
 )
 from sgtool.recorders.sim.closed_loop_report import episode_notes
 from sgtool.recorders.sim.noise import PROFILES
+from sgtool.recorders.sim.spl_shortest import driven_shortest
 from sgtool.replayers.derived_log import ReplayOptions, replay
 from sgtool.scenegraph.derived_layers import DERIVED_TOPICS
 from sgtool.scenegraph.examined import EXAMINE, close_views
@@ -159,7 +161,9 @@ def test_scout_episode_log(scout_log, house) -> None:
                                                "min_points": 12, "voxel_size": 0.05,
                                                "mixed_pixels": True}
         assert ended["status"] == "success" and ended["planner"] == "scout"
-        assert ended["shortest_m"] == pytest.approx(ep.shortest_path, abs=1e-3)
+        # SPL's shortest: the episode's grid route pulled taut (no longer than the route)
+        assert ended["shortest_m"] == pytest.approx(driven_shortest(house, ep), abs=1e-4)
+        assert ended["shortest_m"] <= ep.shortest_path + 1e-4
         assert ended["extra"]["end"] == "found" and ended["extra"]["query"] == ep.query
         assert ended["frames"] == r.frame_count() > 20
         actions = list(r.records("action"))
@@ -576,12 +580,10 @@ def test_live_only_options_refused_with_house_navigation(tmp_path: Path) -> None
 
 
 def _scout_in_house_3(tmp_path: Path, query: str, *args: str) -> Path:
-    """`sgtool run --planner scout` in generated house 3 (4-5 rooms) searching ``query``
-    with ``args``; the log's path."""
-    from sgtool.house.io import save_house
-
-    house = tmp_path / "h.json"
-    save_house(generate_house(3, rooms=(4, 5)), house)
+    """`sgtool run --planner scout` in the pinned generated house 3 (5 rooms; its targets
+    and the drives past them, support.pinned_houses) searching ``query`` with ``args``;
+    the log's path."""
+    house = pinned_house_path("generated-3-rooms-4-5")
     out = tmp_path / "run.mcap"
     r = CliRunner().invoke(cli, ["run", "--planner", "scout", "--house", str(house), "--query",
                                  query, *args, "-o", str(out)])

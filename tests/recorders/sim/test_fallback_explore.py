@@ -22,12 +22,12 @@ import math
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from support.pinned_houses import pinned_house
 from support.scripted_planner import Scripted
 from support.seed0_episodes import seed0_episode
 
 from sgtool.cli import cli
 from sgtool.datasets.episodes import list_episodes
-from sgtool.datasets.generator import generate_house
 from sgtool.log import LogReader
 from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.live_paths import traversable
@@ -57,7 +57,7 @@ GRAPH = "/sgtool/scene_graph"
 
 @pytest.fixture(scope="module")
 def house():
-    return generate_house(6, rooms=(4, 4))
+    return pinned_house("generated-6-rooms-4")  # its closed door (support.pinned_houses)
 
 
 def _open_start(house) -> tuple[int, object]:
@@ -385,14 +385,15 @@ def test_with_no_grid_frontier_the_hand_over_goes_to_open_edges(house, tmp_path,
 
 
 def test_a_cluttered_room_is_explored_not_given_up(tmp_path) -> None:
-    """House 5 of the closed-loop bench (8-16 rooms, symsearch), episode 4 at 160x120:
-    the random planner opens the door out of the start room into a bedroom whose floor is
-    fringed with glimpses of a bed; the episode once ended ``gave_up`` after 4 steps (the
-    graph offered nothing and no frontier was reachable). It finds the magazine; any open
-    edge it goes to is the fallback's."""
-    from sgtool.analysis.bench_houses import bench_episodes, generated_houses
+    """House 5 of the closed-loop bench (8-16 rooms, symsearch; pinned as generated
+    before the generator kept container fronts clear), episode 4 at 160x120: the random
+    planner opens the door out of the start room into a bedroom whose floor is fringed
+    with glimpses of a bed; the episode once ended ``gave_up`` after 4 steps (the graph
+    offered nothing and no frontier was reachable). It finds the magazine; any open edge
+    it goes to is the fallback's."""
+    from sgtool.analysis.bench_houses import bench_episodes
 
-    spec = generated_houses(6, 0)[5].load((8, 16), "symsearch")
+    spec = pinned_house("generated-5-rooms-8-16-symsearch")
     ep = bench_episodes(spec, 6, "symsearch")[4]
     assert ep.query == "magazine"
     out = tmp_path / "magazine.mcap"

@@ -17,10 +17,10 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from support.pinned_houses import pinned_house
 from support.scripted_planner import Scripted
 from support.seed0_episodes import seed0_episode
 
-from sgtool.datasets.generator import generate_house
 from sgtool.log import LogReader
 from sgtool.mapping.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from sgtool.mapping.live_paths import traversable
@@ -130,7 +130,7 @@ def test_a_failed_goal_is_released_once_when_nothing_else_is_left() -> None:
 
 @pytest.fixture(scope="module")
 def house():
-    return generate_house(6, rooms=(4, 4))
+    return pinned_house("generated-6-rooms-4")  # its closed door (support.pinned_houses)
 
 
 def test_the_planner_is_not_offered_a_room_its_map_cannot_reach(house, tmp_path) -> None:
