@@ -325,8 +325,8 @@ def replay(
         report = ReplayReport(src, dst, opts, semantic=reader.has(S.IDS))
         if first is not None and first.noise is not None and first.noise.max_depth is not None:
             report.notes.append(first.noise.describe())
-        if first is not None and first.up_note is not None:
-            report.warnings.append(first.up_note)
+        if first is not None:
+            report.warnings.extend(n for n in (first.up_note, first.tilt_note) if n)
         stream = SceneGraphStream(None, (room_classifier or make_classifier)(opts.classifier),
                                   builder_config(opts))
         with frozen_heap(), small_pages():  # no full-collection or huge-page stalls

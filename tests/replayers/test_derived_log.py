@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from collections import defaultdict
 from pathlib import Path
 
@@ -50,14 +51,16 @@ def messages(path: Path) -> dict[str, list[tuple[int, bytes]]]:
 def synthetic_log(path: Path, with_ids: bool = True, opening: str = "open",
                   noise: float = 0.0, world: np.ndarray | None = None,
                   table_without: str | None = None, pitch: float = 0.3,
-                  calibration: bool = False) -> Path:
+                  calibration: bool = False, pose_pitch: float = 0.0) -> Path:
     """The two-room house seen by a robot looking around in the kitchen, walking to the
     bedroom and looking around there; an action record after each part. ``noise``: depth
     noise of std ``noise`` z^2 (seeded); ``world``: a 4x4 transform applied to every pose
     (another world convention); ``table_without``: an instance kind left out of the
     instance table (its ids stay in the images); ``pitch``: the camera's, down (rad);
     ``calibration``: an attachment created long before its log time, as a user's tool
-    attaches a calibration file."""
+    attaches a calibration file; ``pose_pitch``: the logged camera poses turned that much
+    more about the camera's x axis than the camera that took the depth (rad: a
+    base-to-camera transform measured wrong)."""
     hw = world_of_house(two_room_house(opening))
     rng = np.random.default_rng(5)
     parts = [look_around(2.0, 1.5, 0.0, 12), walk([(2.0, 1.5), (6.0, 1.5)], 0.25),
@@ -75,7 +78,10 @@ def synthetic_log(path: Path, with_ids: bool = True, opening: str = "open",
                 f = make_frame(hw.world, x, y, yaw, K, index=i, pitch=pitch, with_ids=with_ids)
                 d = f.depth + (noise * f.depth ** 2 * rng.standard_normal(f.depth.shape)
                                ).astype(np.float32) if noise else f.depth
-                pose = f.pose if world is None else world @ f.pose
+                c, sn = math.cos(pose_pitch), math.sin(pose_pitch)
+                pose = f.pose @ np.array([[1, 0, 0, 0], [0, c, -sn, 0], [0, sn, c, 0],
+                                          [0, 0, 0, 1.0]])
+                pose = pose if world is None else world @ pose
                 w.write_frame(i * 100_000_000, depth=d, pose=pose, intrinsics=K,
                               ids=f.ids, base_pose=f.base_pose)
                 i += 1
@@ -268,6 +274,21 @@ def test_a_world_written_y_up_is_warned_of(tmp_path):
     # height 0: upright, nothing said
     rep = replay(synthetic_log(tmp_path / "down.mcap", pitch=1.5), None, ReplayOptions())
     assert not any("'down' axis" in line for line in rep.lines())
+
+
+@pytest.mark.parametrize("degrees", [-2.0, 2.0])
+def test_a_camera_pitch_off_by_two_degrees_is_warned_of(tmp_path, degrees):
+    """The logged poses pitched 2 degrees off the camera that took the depth (the far
+    floor then lands 0.14 m off at 4 m): the report says the floor rises or falls about
+    2 degrees ahead of the camera and names the pitch; the true poses say nothing."""
+    log = synthetic_log(tmp_path / "pitched.mcap", pose_pitch=math.radians(degrees))
+    rep = replay(log, None, ReplayOptions(max_frames=30))
+    (line,) = [w for w in rep.warnings if "degrees ahead of the camera" in w]
+    ahead = float(line.split(" degrees ahead")[0].split()[-1])
+    assert ahead == pytest.approx(2.0, abs=0.3), line
+    assert "the camera's pitch in the poses is likely off" in line
+    rep = replay(synthetic_log(tmp_path / "true.mcap"), None, ReplayOptions(max_frames=30))
+    assert not [w for w in rep.warnings if "degrees ahead of the camera" in w], rep.warnings
 
 
 def test_the_report_warns_of_doors_joining_one_room_and_of_no_room(tmp_path):
