@@ -206,7 +206,7 @@ def read_sequence(
     keep_unposed: bool = False,
     timestamps: str = "file",
     skip_missing: bool = False,
-    intrinsics_given: bool = False,
+    intrinsics_given: bool = False, depth_scale_given: bool = False,
 ) -> FolderSequence:
     """List a folder's frames (see the module docstring). ``trajectory`` overrides the
     dataset's pose file (TUM text or Open3D .log); ``keep_unposed`` keeps frames the
@@ -214,7 +214,8 @@ def read_sequence(
     listed times (checked: :func:`~.sanity.timestamp_problem`), "index" frame n at n / fps
     in the listed order; ``skip_missing`` leaves out listed files that do not exist
     (otherwise an error before anything is read); ``intrinsics_given``: the folder's
-    intrinsics files are not read (``--intrinsics`` overrides them, broken or not)."""
+    intrinsics files are not read (``--intrinsics`` overrides them, broken or not; a
+    Replica cam_params.json, which holds the depth scale too, not if ``depth_scale_given``)."""
     root = Path(root)
     if not root.is_dir():
         raise SgtoolError(f"{root}: no such folder" if not root.exists()
@@ -232,7 +233,7 @@ def read_sequence(
     elif layout == "open3d":
         seq = _read_open3d(root, fps, trajectory, skip_missing, keep_unposed, intrinsics_given)
     elif layout == "replica":
-        seq = read_replica(root, fps, trajectory)
+        seq = read_replica(root, fps, trajectory, (intrinsics_given, depth_scale_given))
     else:  # pragma: no cover - missing_for_layout refuses unknown layouts
         raise SgtoolError(f"unknown layout {layout!r} ({', '.join(LAYOUTS)})")
     if not seq.frames:

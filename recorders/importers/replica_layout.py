@@ -50,13 +50,20 @@ def replica_missing(root: Path) -> str | None:
     return None
 
 
-def _camera(root: Path) -> tuple[PinholeParams, float, str]:
+def _camera(root: Path, intrinsics_given: bool = False, scale_given: bool = False
+            ) -> tuple[PinholeParams, float, str]:
     """The intrinsics, the depth scale and where they came from: cam_params.json in the
-    scene folder or beside it, else the renders' defaults."""
+    scene folder or beside it, else the renders' defaults. The file is not read when
+    both are given (``--intrinsics``, ``--depth-scale``: they override it, broken or not);
+    when one is, a file that does not read is refused naming the other flag (it holds
+    both)."""
     path = next((p for p in (root / "cam_params.json", root.parent / "cam_params.json")
                  if p.is_file()), None)
     if path is None:
         return REPLICA_INTRINSICS, REPLICA_DEPTH_SCALE, "dataset default: replica layout"
+    if intrinsics_given and scale_given:
+        return REPLICA_INTRINSICS, REPLICA_DEPTH_SCALE, \
+            f"the flags ({path.name} not read)"
     try:
         cam = json.loads(path.read_text(encoding="utf-8-sig"))["camera"]
         k = checked_pinhole(float(cam["fx"]), float(cam["fy"]), float(cam["cx"]),
@@ -64,16 +71,22 @@ def _camera(root: Path) -> tuple[PinholeParams, float, str]:
                             height=int(cam["h"]), source=f"file {path.name}")
         scale = float(cam.get("scale", REPLICA_DEPTH_SCALE))
     except (json.JSONDecodeError, KeyError, TypeError, ValueError) as e:
+        flag = ("--depth-scale as well" if intrinsics_given else "--intrinsics as well"
+                if scale_given else "--intrinsics and --depth-scale")
         raise SgtoolError(f"{path}: expected {{\"camera\": {{\"w\", \"h\", \"fx\", \"fy\", "
-                          f"\"cx\", \"cy\", \"scale\"}}}} ({type(e).__name__}: {e})") from e
+                          f"\"cx\", \"cy\", \"scale\"}}}} ({type(e).__name__}: {e}); it holds "
+                          f"the intrinsics and the depth scale: mend it, or give {flag} "
+                          "to override it") from e
     if not scale > 0:
         raise SgtoolError(f"{path}: depth scale {scale:g}: must be positive")
     return k, scale, f"file {path.name}"
 
 
-def read_replica(root: Path, fps: float, trajectory: Path | None) -> FolderSequence:
+def read_replica(root: Path, fps: float, trajectory: Path | None,
+                 given: tuple[bool, bool] = (False, False)) -> FolderSequence:
     """The frames of a ``replica`` folder (module doc); ``trajectory`` overrides
-    ``traj.txt`` (read as ``--trajectory`` files are)."""
+    ``traj.txt`` (read as ``--trajectory`` files are); ``given``: whether the intrinsics
+    and the depth scale are given (:func:`_camera`)."""
     from sgtool.recorders.importers.layouts import FolderFrame, FolderSequence
 
     results = root / "results"
@@ -102,8 +115,9 @@ def read_replica(root: Path, fps: float, trajectory: Path | None) -> FolderSeque
                               "images; a matrix a line names no frame: one line per frame, "
                               "in order")
         notes.append(f"poses from {traj.name}")
-    k, scale, origin = _camera(root)
-    notes.append(f"intrinsics and depth scale {scale:g} from {origin}")
+    k, scale, origin = _camera(root, *given)
+    notes.append(f"intrinsics and depth scale {scale:g} from {origin}" if not all(given)
+                 else f"intrinsics and depth scale from {origin}")
     frames = tuple(FolderFrame(round((n - numbers[0]) * 1e9 / fps), depths[n],
                                colours.get(n), None if poses is None else poses[i])
                    for i, n in enumerate(numbers))

@@ -423,7 +423,8 @@ def import_rgbd(root: str | Path, out: str | Path, opts: RgbdOptions | None = No
     seq = read_sequence(root, opts.layout, max_dt_ns=opts.max_dt_ns, fps=opts.fps,
                         trajectory=opts.trajectory, keep_unposed=opts.estimate_poses,
                         timestamps=opts.timestamps, skip_missing=opts.skip_missing,
-                        intrinsics_given=opts.intrinsics is not None)
+                        intrinsics_given=opts.intrinsics is not None,
+                        depth_scale_given=opts.depth_scale is not None)
     seq = in_sgtool_convention(seq, opts.camera_axes, opts.world_to_camera)
     frames = list(seq.frames[:: opts.every])
     if opts.limit is not None:

@@ -97,3 +97,26 @@ def test_a_replica_scene_s_faults_are_one_line(tmp_path) -> None:
     (root / "results" / "frame000004.jpg").unlink()
     assert any(n.startswith("1 depth images without frameNNNNNN.jpg (first: depth000004")
                for n in read_sequence(root).notes)
+
+
+def test_a_broken_cam_params_gives_way_to_both_flags(tmp_path) -> None:
+    """A cam_params.json that does not read (no "scale"-bearing camera block) blocked the
+    import even with --intrinsics (an outside lab's report): it holds the depth scale too,
+    so --intrinsics alone is refused naming --depth-scale, and the two flags together
+    import without reading it."""
+    from sgtool.recorders.importers.textformats import parse_intrinsics
+
+    root = replica_scene(tmp_path / "Replica" / "room0")
+    (root.parent / "cam_params.json").write_text('{"camera": {"w": 80,')  # cut short
+    with pytest.raises(SgtoolError, match=r"mend it, or give --intrinsics and --depth-scale "
+                       r"to override it"):
+        import_rgbd(root, tmp_path / "a.mcap", RgbdOptions(progress=False))
+    intr = parse_intrinsics(f"{K.fx},{K.fy},{K.cx},{K.cy}")
+    with pytest.raises(SgtoolError, match=r"give --depth-scale as well to override it"):
+        import_rgbd(root, tmp_path / "b.mcap", RgbdOptions(progress=False, intrinsics=intr))
+    assert not (tmp_path / "b.mcap").exists()
+    rep = import_rgbd(root, tmp_path / "c.mcap", RgbdOptions(
+        progress=False, intrinsics=intr, depth_scale=6553.5))
+    assert rep.frames == 20
+    assert "intrinsics and depth scale from the flags (cam_params.json not read)" in \
+        read_sequence(root, intrinsics_given=True, depth_scale_given=True).notes
