@@ -49,7 +49,7 @@ from sgtool.recorders.importers.pose_files import (
     seven_scenes_intrinsics,
 )
 from sgtool.recorders.importers.replica_layout import is_replica, read_replica, replica_missing
-from sgtool.recorders.importers.sanity import time_range_problem, timestamp_problem
+from sgtool.recorders.importers.sanity import id_step_notes, time_range_problem, timestamp_problem
 from sgtool.recorders.importers.stamps import NearestStamp
 from sgtool.recorders.importers.textformats import (
     PinholeParams,
@@ -430,6 +430,7 @@ def _read_7scenes(root: Path, fps: float, trajectory: Path | None, skip_missing:
         if m:
             by_id.setdefault(int(m.group(1)), {})[m.group(2).lower()] = p
     ids, notes = _seven_missing(root, by_id, skip_missing)
+    notes += id_step_notes(ids, fps)
     ext_poses = trajectory_poses(trajectory, len(ids))
     frames = []
     for n, i in enumerate(ids):

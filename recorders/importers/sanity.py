@@ -327,3 +327,18 @@ def clock_problem(offset_s: float | None, what: str) -> str | None:
             "take the poses of that much later; give --time-offset "
             f"{offset_s:.3f} to shift the image times, or --timestamps bag to use the record "
             "times")
+
+
+def id_step_notes(ids: Sequence[int], fps: float) -> list[str]:
+    """A note when the frame numbers that place frames (frame n at n / ``fps``) advance
+    by a common step above 1 (every k-th frame of a recording kept): ``fps`` is then the
+    rate of the numbering, and the note says what the frames span; else none."""
+    steps = np.diff(np.asarray(sorted(ids), dtype=np.int64))
+    step = int(np.gcd.reduce(steps)) if steps.size else 1
+    if step <= 1:
+        return []
+    span = (max(ids) - min(ids)) / fps
+    return [f"the frame numbers advance by {step} (every {step}th frame of a recording): "
+            f"frame n is at n/{fps:g} s, so --fps is the rate of the numbering, not of these "
+            f"{len(ids)} frames; they span {span:.3g} s ({len(ids) / span:.3g} frames a "
+            "second)"]

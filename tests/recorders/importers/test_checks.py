@@ -26,6 +26,7 @@ from sgtool.recorders.importers.sanity import (
     SWAP_SMOOTHER,
     depth_scale_problem,
     floor_problem,
+    id_step_notes,
     roughness,
     timestamp_problem,
 )
@@ -401,3 +402,16 @@ def test_real_depth_in_the_other_byte_order_is_named_so(shared_data_dir, folder)
     assert p is not None and "with each value's bytes swapped" in p, p
     for k in (scale, 1000.0, 5000.0, 10000.0, 100.0):
         assert swapped_fit(raws, k) is None
+
+
+def test_frame_numbers_that_step_say_what_fps_means() -> None:
+    """A folder of every 10th frame of a 30 Hz recording (frame-000000, -000010, ...):
+    frame n is at n / fps, so `--fps 3` (the rate of the kept frames) spread the 100
+    frames over 330 s without a word; the note says the step and the span. Consecutive
+    numbers say nothing; a common step of 5 among steps of 10 and 5 is named."""
+    (note,) = id_step_notes(range(0, 1000, 10), 3.0)
+    assert note.startswith("the frame numbers advance by 10 (every 10th frame of a "
+                           "recording): frame n is at n/3 s, so --fps is the rate of the "
+                           "numbering, not of these 100 frames; they span 330 s"), note
+    assert id_step_notes([0, 1, 2, 3], 30.0) == [] and id_step_notes([7], 30.0) == []
+    assert "advance by 5" in id_step_notes([0, 10, 15, 25], 30.0)[0]

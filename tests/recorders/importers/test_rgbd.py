@@ -140,8 +140,10 @@ def test_7scenes_ground_truth_and_z_up_world(rgbd_data, tmp_path):
         A = alignment_of(r)  # noqa: N806
         assert np.allclose(A[:3, :3] @ np.array(a.up), [0, 0, 1])
         times = r.frame_times()
-        # frame-000990 is the 100th file: Kinect frame n at n / 30 s
+        # frame-000990 is the 100th file: Kinect frame n at n / 30 s, and the report says so
         assert times[0] == 0 and times[-1] == round(990 * 1e9 / 30)
+        assert any(n.startswith("the frame numbers advance by 10") and "33 s" in n
+                   for n in rep.notes), rep.notes
         heights = []
         for i in (0, 33, 99):
             f = r.frame_at(times[i])
