@@ -43,8 +43,8 @@ _Snapshot = dict[str, tuple[np.ndarray, int]] | None
 class TransformBuffer:
     """Transforms by (parent, child) over time. A link's value at time t is its sample at
     t, else interpolated between the samples around t (linear in translation, slerp in
-    rotation, as ``tf2`` does) when they are at most :data:`MAX_GAP_NS` apart, else the
-    latest before t; before a link's first sample, that sample when it is at most
+    rotation, as ``tf2`` does) when they are no further apart than :func:`gap_limit`
+    allows, else the latest before t; before a link's first sample, that sample when it is at most
     :data:`NEAR_NS` away. A ``static`` link (``/tf_static``) holds at every time, a link
     sent once on ``/tf`` (:meth:`_fixed`) from its time on."""
 
@@ -109,7 +109,7 @@ class TransformBuffer:
             return vals[i], 0
         if i < 0:
             return (vals[0], times[0] - t_ns) if times[0] - t_ns <= NEAR_NS else None
-        if i + 1 < len(times) and times[i + 1] - times[i] <= MAX_GAP_NS:
+        if i + 1 < len(times) and times[i + 1] - times[i] <= gap_limit(times, i):
             a = (t_ns - times[i]) / (times[i + 1] - times[i])
             return interpolate(vals[i], vals[i + 1], a), 0
         return vals[i], t_ns - times[i]
@@ -156,11 +156,30 @@ class TransformBuffer:
         return None if found is None else found[0]
 
 
-MAX_GAP_NS = 1_000_000_000  # /tf samples further apart: a dropout, not interpolated
+MAX_GAP_NS = 1_000_000_000  # /tf samples further apart: a dropout, before a rate is known
+MIN_GAP_NS = 250_000_000  # /tf samples this near are interpolated whatever the rate
+GAP_FACTOR = 2.5  # /tf samples more than this many usual intervals apart: a dropout
+RATE_SAMPLES = 16  # the samples before a gap whose intervals give the usual one
 NEAR_NS = 50_000_000  # a link's first sample counts this far before it
 HOLD_NS = 1_000_000_000  # a frame waits this long (log time) for a later /tf
 MAX_HELD = 64  # frames held at most (a /tf that stopped)
 STALE_NS = 50_000_000  # a pose from /tf older than this is noted
+
+
+
+
+def gap_limit(times: list[int], i: int) -> int:
+    """The widest gap (ns) after sample ``i`` of a link's sample ``times`` that is still
+    interpolated: :data:`GAP_FACTOR` times the median interval of the
+    :data:`RATE_SAMPLES` samples up to ``i``, at least :data:`MIN_GAP_NS`, so a /tf that
+    stops for a few of its samples is a dropout whatever its rate (a 0.75 s gap in a 4 Hz
+    /tf was interpolated across a turn and split a room), and a slow /tf is not one;
+    :data:`MAX_GAP_NS` with fewer than three samples."""
+    if i < 2:
+        return MAX_GAP_NS
+    lo = max(0, i - RATE_SAMPLES)
+    steps = sorted(b - a for a, b in zip(times[lo:i], times[lo + 1:i + 1], strict=True))
+    return max(MIN_GAP_NS, int(GAP_FACTOR * steps[len(steps) // 2]))
 
 
 FRAME_TOPICS = (S.RGB, S.DEPTH, S.IDS, S.CALIBRATION, S.TF, S.TF_STATIC)
@@ -232,8 +251,9 @@ class StalePoses:
             return (f"{prefix}{self.count} frame(s) left out: their camera pose would come "
                     f"from a {S.TF} sample older than the image (up to "
                     f"{self.worst_ns / 1e9:.3f} s, at log time {self.worst_at_ns} ns; "
-                    f"{S.TF} samples more than {MAX_GAP_NS / 1e9:g} s apart are a dropout, "
-                    "not interpolated), which misplaces their points where the camera moved")
+                    f"{S.TF} samples more than {GAP_FACTOR:g} times their usual interval "
+                    f"apart, and at least {MIN_GAP_NS / 1e9:g} s, are a dropout, not "
+                    "interpolated), which misplaces their points where the camera moved")
         return (f"{prefix}{self.count} frame(s) took a camera pose from a {S.TF} sample "
                 f"older than the image (up to {self.worst_ns / 1e9:.3f} s, at log time "
                 f"{self.worst_at_ns} ns; no later {S.TF} came within "
@@ -285,7 +305,7 @@ class FrameAssembler:
     ``tf_time`` (one of :data:`TF_TIMES`) is the time that pairs ``/tf`` with frames
     (module doc); :attr:`tf_offsets` sums up how far the stamps lie from the log times.
     ``drop_stale``: a frame whose pose would come from a stale ``/tf`` sample (older than
-    :data:`STALE_NS`: a ``/tf`` dropout longer than :data:`MAX_GAP_NS`, or a ``/tf`` that
+    :data:`STALE_NS`: a ``/tf`` dropout (:func:`gap_limit`), or a ``/tf`` that
     stopped) gets no pose (NaN, as a frame /tf does not pose), so a mapper leaves it out
     rather than putting its whole depth image where the camera was seconds before."""
 

@@ -133,6 +133,33 @@ def test_frames_in_a_tf_dropout_are_left_out_not_posed_where_the_robot_was(tmp_p
     assert note.startswith(f"{110 - a.frames} frame(s) left out")
 
 
+def test_a_dropout_is_measured_in_the_tf_rate_not_in_seconds(tmp_path):
+    """/tf lost for 2 frames in every 10 at 3 Hz: gaps of 1.0 s, three of its intervals,
+    were interpolated across (only gaps over 1 s were dropouts; an outside lab's 0.75 s
+    gaps in a 4 Hz /tf split a room that way). Now more than 2.5 intervals is a dropout:
+    its frames are left out, as without their images; one lost /tf (a gap of two
+    intervals) is still interpolated: only the log's last frame, whose /tf never comes,
+    is left out (as before)."""
+    topics = _topics()
+    lost_tf = rewrite(START, tmp_path / "gaps.mcap", Variant(order=tf_gaps(10, 2)))
+
+    def without_images(messages):
+        with_tf = {m.log_time for m in tf_gaps(10, 2)(messages) if topics[m.channel_id] == S.TF}
+        return [m for m in messages if topics[m.channel_id] not in IMAGES
+                or m.log_time in with_tf]
+    lost_images = rewrite(START, tmp_path / "frames.mcap", Variant(order=without_images))
+    a, b = replay(lost_tf, None), replay(lost_images, None)
+    assert a.frames == b.frames == 110 - 22
+    assert a.last is not None and b.last is not None
+    assert len(a.last.graph.rooms) == len(b.last.graph.rooms)
+    (note,) = [w for w in a.warnings if "older than the image" in w]
+    assert note.startswith("22 frame(s) left out") and "2.5 times their usual interval" in note
+    one = replay(rewrite(START, tmp_path / "one.mcap", Variant(order=tf_gaps(10, 1))), None)
+    assert one.frames == 109
+    (note,) = [w for w in one.warnings if "older than the image" in w]
+    assert note.startswith("1 frame(s) left out")
+
+
 TOUR = GOLDEN / "house6-tour.mcap"
 
 
