@@ -57,10 +57,10 @@ def floor_slopes(depth: np.ndarray, pose: np.ndarray, fx: float, fy: float, cx: 
     cam = np.stack([(u - cx) / fx * d, (v - cy) / fy * d, d], axis=-1)
     world = cam @ T[:3, :3].T + T[:3, 3]
     # a surface facing up: the normal of each pixel's right and lower neighbours
-    n = np.cross(world[:-1, 1:] - world[:-1, :-1], world[1:, :-1] - world[:-1, :-1])
+    normal = np.cross(world[:-1, 1:] - world[:-1, :-1], world[1:, :-1] - world[:-1, :-1])
     world = world[:-1, :-1]
     with np.errstate(invalid="ignore"):
-        up = np.abs(n[..., 2]) >= UPRIGHT * np.linalg.norm(n, axis=-1)
+        up = np.abs(normal[..., 2]) >= UPRIGHT * np.linalg.norm(normal, axis=-1)
     rel = world[..., :2] - T[:2, 3]
     a_u, a_w, h = rel @ fwd, rel @ left, world[..., 2]
     with np.errstate(invalid="ignore"):
