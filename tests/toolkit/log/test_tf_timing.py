@@ -112,16 +112,16 @@ def tf_gaps(every: int, gap: int):
     return order
 
 
-def test_frames_in_a_tf_dropout_are_left_out_not_posed_where_the_robot_was(tmp_path):
-    """/tf lost for 4 frames (over 1 s at 3 Hz) in every 10 while the camera goes on: the
-    frames in a dropout are left out, as frames without images would be, instead of
-    taking the pose of the last transform before it (the robot turned and drove on
-    meanwhile). Their rooms are those of the same log without those frames' images."""
+def _tf_lost_and_images_lost(tmp_path, gap: int):
+    """Replays of START with /tf lost for ``gap`` frames in every 10 (:func:`tf_gaps`),
+    and with those frames' images lost instead, both checked to build as many rooms from
+    the same frames; the first replay's stale-pose note."""
     topics = _topics()
-    lost_tf = rewrite(START, tmp_path / "gaps.mcap", Variant(order=tf_gaps(10, 4)))
+    lost_tf = rewrite(START, tmp_path / "gaps.mcap", Variant(order=tf_gaps(10, gap)))
 
     def without_images(messages):
-        with_tf = {m.log_time for m in tf_gaps(10, 4)(messages) if topics[m.channel_id] == S.TF}
+        with_tf = {m.log_time for m in tf_gaps(10, gap)(messages)
+                   if topics[m.channel_id] == S.TF}
         return [m for m in messages if topics[m.channel_id] not in IMAGES
                 or m.log_time in with_tf]
     lost_images = rewrite(START, tmp_path / "frames.mcap", Variant(order=without_images))
@@ -131,6 +131,15 @@ def test_frames_in_a_tf_dropout_are_left_out_not_posed_where_the_robot_was(tmp_p
     assert len(a.last.graph.rooms) == len(b.last.graph.rooms)
     (note,) = [w for w in a.warnings if "older than the image" in w]
     assert note.startswith(f"{110 - a.frames} frame(s) left out")
+    return a, note
+
+
+def test_frames_in_a_tf_dropout_are_left_out_not_posed_where_the_robot_was(tmp_path):
+    """/tf lost for 4 frames (over 1 s at 3 Hz) in every 10 while the camera goes on: the
+    frames in a dropout are left out, as frames without images would be, instead of
+    taking the pose of the last transform before it (the robot turned and drove on
+    meanwhile). Their rooms are those of the same log without those frames' images."""
+    _tf_lost_and_images_lost(tmp_path, 4)
 
 
 def test_a_dropout_is_measured_in_the_tf_rate_not_in_seconds(tmp_path):
@@ -140,20 +149,8 @@ def test_a_dropout_is_measured_in_the_tf_rate_not_in_seconds(tmp_path):
     its frames are left out, as without their images; one lost /tf (a gap of two
     intervals) is still interpolated: only the log's last frame, whose /tf never comes,
     is left out (as before)."""
-    topics = _topics()
-    lost_tf = rewrite(START, tmp_path / "gaps.mcap", Variant(order=tf_gaps(10, 2)))
-
-    def without_images(messages):
-        with_tf = {m.log_time for m in tf_gaps(10, 2)(messages) if topics[m.channel_id] == S.TF}
-        return [m for m in messages if topics[m.channel_id] not in IMAGES
-                or m.log_time in with_tf]
-    lost_images = rewrite(START, tmp_path / "frames.mcap", Variant(order=without_images))
-    a, b = replay(lost_tf, None), replay(lost_images, None)
-    assert a.frames == b.frames == 110 - 22
-    assert a.last is not None and b.last is not None
-    assert len(a.last.graph.rooms) == len(b.last.graph.rooms)
-    (note,) = [w for w in a.warnings if "older than the image" in w]
-    assert note.startswith("22 frame(s) left out") and "2.5 times their usual interval" in note
+    a, note = _tf_lost_and_images_lost(tmp_path, 2)
+    assert a.frames == 110 - 22 and "2.5 times their usual interval" in note
     one = replay(rewrite(START, tmp_path / "one.mcap", Variant(order=tf_gaps(10, 1))), None)
     assert one.frames == 109
     (note,) = [w for w in one.warnings if "older than the image" in w]
